@@ -1,0 +1,1 @@
+"""ambseal.control"""

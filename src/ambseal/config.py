@@ -1,0 +1,422 @@
+"""The rig file: a TOML description of a rotor on AMBs, validated with pydantic.
+
+This is the only module that knows the file format. Positions are in metres from the
+shaft's left end, everything else in SI, except the keys with a unit in their name
+(``speed_rpm``, ``pressure_bar``, ``cutoff_hz``, ``axes_angle_deg``, ``pole_angle_deg``).
+
+Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
+
+``[rotor]``
+    ``beam`` = ``"timoshenko"`` (default) or ``"euler-bernoulli"``; ``name`` (optional);
+    ``modal_damping`` (ζ of every free–free bending mode of shaft and disks, default 0).
+``[materials.NAME]``
+    ``E`` (Pa), ``rho`` (kg/m³) and either ``G`` (Pa) or ``nu`` (-).
+``[[shaft]]`` (left to right)
+    ``length``, ``outer_diameter``, ``inner_diameter`` (default 0) in m, ``material`` (a
+    NAME of ``[materials]``), ``elements`` (beam elements in the section, default 1).
+``[[disk]]``
+    ``position`` (m), ``mass`` (kg), ``Ip``, ``Id`` (kg·m²), ``name`` (optional).
+``[[amb]]``
+    ``name``, ``position``, ``sensor_position`` (m), ``axes_angle_deg`` (actuator axes ζ, η
+    rotated from x, y) and either the geometry ``turns``, ``pole_area`` (m²), ``air_gap`` (m),
+    ``bias_current`` (A), ``pole_angle_deg`` (default 22.5, half the angle between the two
+    poles of a pole pair of an 8-pole heteropolar bearing) or ``ki`` (N/A) and ``ks`` (N/m),
+    each a number or ``{ zeta = ..., eta = ... }``. Also optional ``current_limit`` (A).
+``[actuator]``
+    ``model`` = ``"none"`` | ``"first_order"`` (``cutoff_hz``) | ``"second_order"``
+    (``natural_frequency`` in rad/s, ``damping_ratio``).
+``[[seal]]``
+    ``name``, ``position``, ``K``, ``k`` (N/m), ``C``, ``c`` (N·s/m), ``M`` (kg), each a number
+    or ``{ at_zero = ..., per_bar = ... }``; Childs' convention
+    −f = [K k; −k K] q + [C c; −c C] q̇ + M q̈.
+``[[spring]]``
+    ``position``, ``kxx``, ``kyy`` and optional ``kxy``, ``kyx`` (N/m), ``cxx``, ``cyy``
+    (N·s/m), ``axes_angle_deg`` (the axes the coefficients are given in, default 0),
+    ``name`` (optional).
+``[controller.pid]``
+    ``kp`` (A/m), ``ti`` (s), ``td`` (s), ``eps`` (-): thesis P5 Eq. 6, per actuator axis.
+``[operating]``
+    ``speed_rpm``, ``pressure_bar`` (the nominal pressure drop across the seals).
+``[reduction]``
+    ``states`` (the number of states kept, default 8) or ``cutoff_hz``.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from .errors import ConfigError
+
+__all__ = [
+    "RigConfig",
+    "load_rig",
+    "parse_rig",
+    "default_rig_path",
+    "Coefficient",
+]
+
+MU0 = 4e-7 * math.pi
+"""Vacuum permeability (H/m) as used in the AMB linearisation."""
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Material(_Strict):
+    """Linear elastic isotropic material: ``E`` (Pa), ``rho`` (kg/m³), ``G`` (Pa) or ``nu``."""
+
+    E: float = Field(gt=0)
+    rho: float = Field(gt=0)
+    G: float | None = Field(default=None, gt=0)
+    nu: float | None = Field(default=None, gt=-1, lt=0.5)
+
+    @model_validator(mode="after")
+    def _g_or_nu(self) -> "Material":
+        if self.G is None and self.nu is None:
+            raise ValueError("expected either G (Pa) or nu")
+        return self
+
+    @property
+    def shear_modulus(self) -> float:
+        """Shear modulus G (Pa), from ``G`` or from E/(2(1+ν))."""
+        return self.G if self.G is not None else self.E / (2.0 * (1.0 + self.nu))
+
+    @property
+    def poisson(self) -> float:
+        """Poisson's ratio ν, from ``nu`` or from E/(2G) − 1."""
+        return self.nu if self.nu is not None else self.E / (2.0 * self.G) - 1.0
+
+
+class Rotor(_Strict):
+    beam: Literal["timoshenko", "euler-bernoulli"] = "timoshenko"
+    name: str = "rotor"
+    modal_damping: float = Field(default=0.0, ge=0, lt=1)
+
+
+class ShaftSection(_Strict):
+    length: float = Field(gt=0)
+    outer_diameter: float = Field(gt=0)
+    inner_diameter: float = Field(default=0.0, ge=0)
+    material: str
+    elements: int = Field(default=1, ge=1)
+
+    @model_validator(mode="after")
+    def _bore(self) -> "ShaftSection":
+        if self.inner_diameter >= self.outer_diameter:
+            raise ValueError("expected inner_diameter < outer_diameter")
+        return self
+
+
+class Disk(_Strict):
+    position: float = Field(ge=0)
+    mass: float = Field(ge=0)
+    Ip: float = Field(default=0.0, ge=0)
+    Id: float = Field(default=0.0, ge=0)
+    name: str | None = None
+
+
+class AxisPair(_Strict):
+    """A value per actuator axis: ``zeta`` and ``eta``."""
+
+    zeta: float
+    eta: float
+
+
+class Amb(_Strict):
+    name: str = Field(min_length=1)
+    position: float = Field(ge=0)
+    sensor_position: float = Field(ge=0)
+    axes_angle_deg: float = 0.0
+    turns: int | None = Field(default=None, gt=0)
+    pole_area: float | None = Field(default=None, gt=0)
+    air_gap: float | None = Field(default=None, gt=0)
+    bias_current: float | None = Field(default=None, gt=0)
+    pole_angle_deg: float = Field(default=22.5, ge=0, lt=90)
+    ki: float | AxisPair | None = None
+    ks: float | AxisPair | None = None
+    current_limit: float | None = Field(default=None, gt=0)
+
+    @model_validator(mode="after")
+    def _geometry_or_factors(self) -> "Amb":
+        geometry = [self.turns, self.pole_area, self.air_gap, self.bias_current]
+        has_geometry = all(v is not None for v in geometry)
+        has_factors = self.ki is not None and self.ks is not None
+        if not has_geometry and not has_factors:
+            raise ValueError(
+                "expected either the geometry (turns, pole_area, air_gap, bias_current) "
+                "or both ki (N/A) and ks (N/m)"
+            )
+        return self
+
+    def factors(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        """(Ki_ζ, Ki_η) in N/A and (Ks_ζ, Ks_η) in N/m.
+
+        Explicit ``ki``/``ks`` win; otherwise the differential-driving linearisation of an
+        8-pole heteropolar bearing (Schweitzer & Maslen 2009, Ch. 3):
+        Ki = μ0 N² A i0 cos α / s0², Ks = μ0 N² A i0² cos α / s0³.
+        """
+        if self.ki is not None and self.ks is not None:
+            return _pair(self.ki), _pair(self.ks)
+        ki, ks = amb_factors_from_geometry(
+            self.turns, self.pole_area, self.air_gap, self.bias_current, self.pole_angle_deg
+        )
+        return (ki, ki), (ks, ks)
+
+
+def _pair(v: float | AxisPair) -> tuple[float, float]:
+    return (v.zeta, v.eta) if isinstance(v, AxisPair) else (float(v), float(v))
+
+
+def amb_factors_from_geometry(
+    turns: float, pole_area: float, air_gap: float, bias_current: float, pole_angle_deg: float
+) -> tuple[float, float]:
+    """Force/current and force/displacement factors of a differentially driven AMB axis.
+
+    Parameters
+    ----------
+    turns : float
+        Turns N per pole coil.
+    pole_area : float
+        Pole face area A (m²).
+    air_gap : float
+        Nominal air gap s0 (m).
+    bias_current : float
+        Bias current i0 (A).
+    pole_angle_deg : float
+        Angle α between a pole and the actuator axis (deg); 22.5° in an 8-pole bearing.
+
+    Returns
+    -------
+    ki, ks : float
+        Ki = μ0 N² A i0 cos α / s0² (N/A) and Ks = μ0 N² A i0² cos α / s0³ (N/m), the
+        linearisation of f = k[(i0+i)²/(s0−x)² − (i0−i)²/(s0+x)²] with k = μ0 N² A cos α / 4
+        (Schweitzer & Maslen 2009, Eqs. 3.27–3.30).
+    """
+    k = MU0 * turns**2 * pole_area * math.cos(math.radians(pole_angle_deg))
+    return k * bias_current / air_gap**2, k * bias_current**2 / air_gap**3
+
+
+class Actuator(_Strict):
+    model: Literal["none", "first_order", "second_order"] = "none"
+    cutoff_hz: float | None = Field(default=None, gt=0)
+    natural_frequency: float | None = Field(default=None, gt=0)
+    damping_ratio: float | None = Field(default=None, gt=0)
+
+    @model_validator(mode="after")
+    def _needs(self) -> "Actuator":
+        if self.model == "first_order" and self.cutoff_hz is None:
+            raise ValueError("model = 'first_order' expects cutoff_hz")
+        if self.model == "second_order" and (
+            self.natural_frequency is None or self.damping_ratio is None
+        ):
+            raise ValueError("model = 'second_order' expects natural_frequency and damping_ratio")
+        return self
+
+
+class Affine(_Strict):
+    """A coefficient affine in the pressure drop: ``at_zero + per_bar · pressure_bar``."""
+
+    at_zero: float = 0.0
+    per_bar: float = 0.0
+
+
+Coefficient = float | Affine
+
+
+def coefficient_value(c: Coefficient, pressure_bar: float) -> float:
+    """The value of a seal coefficient at a pressure drop (bar)."""
+    if isinstance(c, Affine):
+        return c.at_zero + c.per_bar * pressure_bar
+    return float(c)
+
+
+class Seal(_Strict):
+    name: str = Field(min_length=1)
+    position: float = Field(ge=0)
+    K: Coefficient = 0.0
+    k: Coefficient = 0.0
+    C: Coefficient = 0.0
+    c: Coefficient = 0.0
+    M: Coefficient = 0.0
+
+    def at(self, pressure_bar: float) -> dict[str, float]:
+        """Coefficients K, k (N/m), C, c (N·s/m), M (kg) at a pressure drop (bar)."""
+        return {n: coefficient_value(getattr(self, n), pressure_bar) for n in "KkCcM"}
+
+
+class Spring(_Strict):
+    position: float = Field(ge=0)
+    kxx: float
+    kyy: float
+    kxy: float = 0.0
+    kyx: float = 0.0
+    cxx: float = 0.0
+    cyy: float = 0.0
+    axes_angle_deg: float = 0.0
+    name: str | None = None
+
+
+class Pid(_Strict):
+    kp: float = Field(gt=0)
+    ti: float = Field(gt=0)
+    td: float = Field(ge=0)
+    eps: float = Field(gt=0)
+
+
+class Controllers(_Strict):
+    pid: Pid | None = None
+
+
+class Operating(_Strict):
+    speed_rpm: float = 0.0
+    pressure_bar: float = Field(default=0.0, ge=0)
+
+
+class Reduction(_Strict):
+    states: int | None = Field(default=None, ge=1)
+    cutoff_hz: float | None = Field(default=None, gt=0)
+
+    @model_validator(mode="after")
+    def _one(self) -> "Reduction":
+        if self.states is not None and self.cutoff_hz is not None:
+            raise ValueError("expected states or cutoff_hz, not both")
+        return self
+
+
+class RigConfig(_Strict):
+    """A whole rig: rotor, materials, shaft, components, controller and operating point."""
+
+    rotor: Rotor = Rotor()
+    materials: dict[str, Material]
+    shaft: list[ShaftSection] = Field(min_length=1)
+    disk: list[Disk] = []
+    amb: list[Amb] = []
+    actuator: Actuator = Actuator()
+    seal: list[Seal] = []
+    spring: list[Spring] = []
+    controller: Controllers = Controllers()
+    operating: Operating = Operating()
+    reduction: Reduction = Reduction()
+
+    @property
+    def length(self) -> float:
+        """Shaft length (m)."""
+        return sum(s.length for s in self.shaft)
+
+    @property
+    def speed(self) -> float:
+        """Rotational speed Ω (rad/s)."""
+        return self.operating.speed_rpm * 2.0 * math.pi / 60.0
+
+
+def _loc(loc: tuple) -> str:
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        elif part in ("float", "AxisPair", "Affine", "int", "str"):
+            continue  # union branch names that pydantic inserts
+        elif "[" in str(part) or "function-" in str(part):
+            continue
+        else:
+            out += ("." if out else "") + str(part)
+    return out or "(top level)"
+
+
+def _cross_check(cfg: RigConfig, where: str) -> None:
+    """Checks that need the whole rig: materials exist, components lie on the shaft."""
+    for i, s in enumerate(cfg.shaft):
+        if s.material not in cfg.materials:
+            known = ", ".join(sorted(cfg.materials)) or "none"
+            raise ConfigError(
+                f"{where}: shaft[{i}].material: unknown material {s.material!r} "
+                f"(expected one of: {known})"
+            )
+    length = cfg.length
+    tol = 1e-9 * max(length, 1.0)
+
+    def on_shaft(key: str, z: float) -> None:
+        if not (-tol <= z <= length + tol):
+            raise ConfigError(
+                f"{where}: {key}: position {z} m lies outside the shaft "
+                f"(expected 0 <= position <= {length:g} m)"
+            )
+
+    for kind in ("disk", "seal", "spring"):
+        for i, comp in enumerate(getattr(cfg, kind)):
+            on_shaft(f"{kind}[{i}].position", comp.position)
+    names: set[str] = set()
+    for i, a in enumerate(cfg.amb):
+        on_shaft(f"amb[{i}].position", a.position)
+        on_shaft(f"amb[{i}].sensor_position", a.sensor_position)
+        if a.name in names:
+            raise ConfigError(f"{where}: amb[{i}].name: duplicate AMB name {a.name!r}")
+        names.add(a.name)
+
+
+def parse_rig(data: dict, where: str = "<rig>") -> RigConfig:
+    """Validate a rig given as a dict (as read from TOML).
+
+    Parameters
+    ----------
+    data : dict
+        The parsed TOML document.
+    where : str
+        Name of the source used in error messages (usually the file path).
+
+    Raises
+    ------
+    ConfigError
+        One line naming ``where``, the key path and what was expected.
+    """
+    try:
+        cfg = RigConfig.model_validate(data)
+    except ValidationError as exc:
+        err = exc.errors()[0]
+        loc = _loc(err["loc"])
+        msg = err["msg"]
+        if err["type"] == "missing":
+            msg = "missing required key"
+        elif err["type"] == "extra_forbidden":
+            msg = "unknown key (not part of the rig format)"
+        elif msg.startswith("Value error, "):
+            msg = msg[len("Value error, "):]
+        raise ConfigError(f"{where}: {loc}: {msg}") from None
+    _cross_check(cfg, where)
+    return cfg
+
+
+def load_rig(path: str | Path | None = None) -> RigConfig:
+    """Read and validate a rig file (TOML).
+
+    Parameters
+    ----------
+    path : str or Path, optional
+        The rig file; the embedded thesis test facility when omitted.
+
+    Raises
+    ------
+    ConfigError
+        The file is missing, is not valid TOML, or does not match the rig format.
+    """
+    p = Path(path) if path is not None else default_rig_path()
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ConfigError(f"{p}: cannot read rig file ({exc.strerror or exc})") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{p}: not valid TOML ({exc})") from None
+    return parse_rig(data, str(p))
+
+
+def default_rig_path() -> Path:
+    """Path of the embedded thesis test facility (``ambseal/data/testrig.toml``)."""
+    return Path(__file__).parent / "data" / "testrig.toml"

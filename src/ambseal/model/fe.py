@@ -1,0 +1,194 @@
+"""Finite-element matrices of shaft (beam) elements and rigid disks.
+
+Node DOF order is [x, y, α, β] (α rotation about x, β about y), see :mod:`ambseal.model.rotor`.
+With z the rotor axis, β = ∂x/∂z and α = −∂y/∂z. The element matrices below are first
+written in *plane coordinates* — per bending plane [w1, φ1, w2, φ2] with φ the slope
+(x–z plane: w = x, φ = β; y–z plane: w = y, φ = −α) — and then mapped to node DOFs.
+
+Sources: Nelson, "A finite rotating shaft element using Timoshenko beam theory", J. Mech.
+Des. 102 (1980); Friswell, Penny, Garvey & Lees, *Dynamics of Rotating Machines*, CUP 2010,
+§5.4–5.5 (Timoshenko element matrices with the shear parameter Φ = 12EI/(κGAL²)); the
+shear coefficient of a hollow circular section from Hutchinson (2001).
+Every element owns its ``M()``, ``K()``, ``G()`` and DOF mapping; the rotor only assembles.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["BeamElement", "DiskElement", "shear_coefficient"]
+
+# Node-DOF index of each plane coordinate: x-plane (x, β) and y-plane (y, −α).
+_X, _Y, _A, _B = 0, 1, 2, 3
+# Element DOFs (8) in node order [x1 y1 α1 β1 x2 y2 α2 β2]; plane coords -> node DOF + sign
+_PX = np.array([_X, _B, 4 + _X, 4 + _B])
+_PY = np.array([_Y, _A, 4 + _Y, 4 + _A])
+_SX = np.array([1.0, 1.0, 1.0, 1.0])
+_SY = np.array([1.0, -1.0, 1.0, -1.0])
+
+
+def shear_coefficient(nu: float, inner_diameter: float, outer_diameter: float) -> float:
+    """Timoshenko shear coefficient κ of a (hollow) circular section.
+
+    κ = 6(1+ν)(1+m²)² / [(7+6ν)(1+m²)² + (20+12ν)m²], m = d_i/d_o
+    (Cowper 1966 / Hutchinson 2001; κ = 6(1+ν)/(7+6ν) for a solid section).
+    """
+    m2 = (inner_diameter / outer_diameter) ** 2
+    return 6 * (1 + nu) * (1 + m2) ** 2 / ((7 + 6 * nu) * (1 + m2) ** 2 + (20 + 12 * nu) * m2)
+
+
+def _to_nodes(plane: np.ndarray, coupled: bool = False) -> np.ndarray:
+    """Map plane-coordinate matrices to the 8 element DOFs.
+
+    ``plane`` is (4, 4) applied to both planes, or for ``coupled`` an (8, 8) matrix on
+    [x-plane, y-plane] coordinates.
+    """
+    out = np.zeros((8, 8))
+    idx = np.concatenate([_PX, _PY])
+    sgn = np.concatenate([_SX, _SY])
+    if coupled:
+        full = plane
+    else:
+        full = np.zeros((8, 8))
+        full[:4, :4] = plane
+        full[4:, 4:] = plane
+    out[np.ix_(idx, idx)] = full * np.outer(sgn, sgn)
+    return out
+
+
+@dataclass(frozen=True)
+class BeamElement:
+    """A uniform circular (hollow) shaft element between two nodes.
+
+    Parameters
+    ----------
+    length : float
+        Element length L (m).
+    outer_diameter, inner_diameter : float
+        Diameters (m).
+    E, shear_modulus, rho : float
+        Young's modulus (Pa), shear modulus (Pa), density (kg/m³).
+    timoshenko : bool
+        Shear deformation on (Timoshenko, Φ > 0) or off (Euler–Bernoulli with rotary
+        inertia, Φ = 0).
+    """
+
+    length: float
+    outer_diameter: float
+    inner_diameter: float
+    E: float
+    shear_modulus: float
+    rho: float
+    timoshenko: bool = True
+
+    @property
+    def area(self) -> float:
+        """Cross-section area A (m²)."""
+        return np.pi / 4 * (self.outer_diameter**2 - self.inner_diameter**2)
+
+    @property
+    def inertia(self) -> float:
+        """Diametral second moment of area I (m⁴); the polar one is 2I."""
+        return np.pi / 64 * (self.outer_diameter**4 - self.inner_diameter**4)
+
+    @property
+    def mass(self) -> float:
+        """Element mass (kg)."""
+        return self.rho * self.area * self.length
+
+    @property
+    def phi(self) -> float:
+        """Shear parameter Φ = 12EI/(κGAL²) (Friswell et al. 2010, Eq. 5.60); 0 for E–B."""
+        if not self.timoshenko:
+            return 0.0
+        nu = self.E / (2 * self.shear_modulus) - 1
+        kappa = shear_coefficient(nu, self.inner_diameter, self.outer_diameter)
+        return 12 * self.E * self.inertia / (kappa * self.shear_modulus * self.area * self.length**2)
+
+    def _rotary_plane(self) -> np.ndarray:
+        """Rotary-inertia matrix in plane coordinates per unit ρI (Friswell Eq. 5.63)."""
+        L, p = self.length, self.phi
+        m7 = 6 / 5
+        m8 = 1 / 10 - p / 2
+        m9 = 2 / 15 + p / 6 + p**2 / 3
+        m10 = 1 / 30 + p / 6 - p**2 / 6
+        return np.array(
+            [
+                [m7, m8 * L, -m7, m8 * L],
+                [m8 * L, m9 * L**2, -m8 * L, -m10 * L**2],
+                [-m7, -m8 * L, m7, -m8 * L],
+                [m8 * L, -m10 * L**2, -m8 * L, m9 * L**2],
+            ]
+        ) / (L * (1 + p) ** 2)
+
+    def M(self) -> np.ndarray:
+        """Mass matrix (8, 8) in kg, kg·m, kg·m²: translational plus rotary inertia."""
+        L, p = self.length, self.phi
+        m1 = 13 / 35 + 7 * p / 10 + p**2 / 3
+        m2 = 11 / 210 + 11 * p / 120 + p**2 / 24
+        m3 = 9 / 70 + 3 * p / 10 + p**2 / 6
+        m4 = 13 / 420 + 3 * p / 40 + p**2 / 24
+        m5 = 1 / 105 + p / 60 + p**2 / 120
+        m6 = 1 / 140 + p / 60 + p**2 / 120
+        mt = np.array(
+            [
+                [m1, m2 * L, m3, -m4 * L],
+                [m2 * L, m5 * L**2, m4 * L, -m6 * L**2],
+                [m3, m4 * L, m1, -m2 * L],
+                [-m4 * L, -m6 * L**2, -m2 * L, m5 * L**2],
+            ]
+        ) * (self.rho * self.area * L / (1 + p) ** 2)
+        mr = self._rotary_plane() * (self.rho * self.inertia)
+        return _to_nodes(mt + mr)
+
+    def K(self) -> np.ndarray:
+        """Stiffness matrix (8, 8) in N/m, N, N·m (Friswell Eq. 5.61)."""
+        L, p = self.length, self.phi
+        k = np.array(
+            [
+                [12, 6 * L, -12, 6 * L],
+                [6 * L, (4 + p) * L**2, -6 * L, (2 - p) * L**2],
+                [-12, -6 * L, 12, -6 * L],
+                [6 * L, (2 - p) * L**2, -6 * L, (4 + p) * L**2],
+            ]
+        ) * (self.E * self.inertia / (L**3 * (1 + p)))
+        return _to_nodes(k)
+
+    def G(self) -> np.ndarray:
+        """Gyroscopic matrix (8, 8), skew-symmetric, per unit spin speed (kg·m², ...).
+
+        The polar inertia per length is 2ρI, so in plane coordinates G = [[0, 2M_R],
+        [−2M_R, 0]] with M_R the rotary-inertia matrix (Friswell Eq. 5.64); the sign follows
+        from H = I_p Ω (β, −α, 1) for a spinning section: I_d α̈ + I_p Ω β̇ = M_x.
+        """
+        mr = self._rotary_plane() * (2 * self.rho * self.inertia)
+        g = np.zeros((8, 8))
+        g[:4, 4:] = mr
+        g[4:, :4] = -mr
+        return _to_nodes(g, coupled=True)
+
+
+@dataclass(frozen=True)
+class DiskElement:
+    """A rigid disk on one node: mass m (kg), polar Ip and diametral Id inertia (kg·m²).
+
+    M = diag(m, m, Id, Id) and G with Ip coupling α and β so that
+    Id α̈ + Ω Ip β̇ = M_x and Id β̈ − Ω Ip α̇ = M_y (Friswell et al. 2010, Eq. 3.70).
+    """
+
+    mass: float
+    Ip: float
+    Id: float
+
+    def M(self) -> np.ndarray:
+        """Mass matrix (4, 4)."""
+        return np.diag([self.mass, self.mass, self.Id, self.Id])
+
+    def G(self) -> np.ndarray:
+        """Gyroscopic matrix (4, 4) per unit spin speed."""
+        g = np.zeros((4, 4))
+        g[_A, _B] = self.Ip
+        g[_B, _A] = -self.Ip
+        return g

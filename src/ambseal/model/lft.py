@@ -1,0 +1,219 @@
+"""Physical parameters as LFT channels of a state-space plant.
+
+A change θ (in the parameter's own SI unit) of a stiffness, damping or force factor
+changes the plant as
+
+    A(θ) = A + B_θ θ C_θ,    B(θ) = B + B_θ θ D_θ,
+
+with θ entering as θ·I_r when the parameter appears r times (a seal's k and −k share one
+parameter, thesis P5 §4.1 item 3 and Appendix A). This is the upper LFT
+G_fi = [[A, B_θ, B], [C_θ, 0, D_θ], [C, 0, D]] of thesis P1 Eqs. 46–52, P2 Eqs. 4–8 and
+P4 Eqs. 7–13; a stiffness change of a single direction at node j changes one column of
+A_f (P1 Eq. 48). A reduced model carries the same channels through its modal
+transformation: B_θ,r = T_L B_θ, C_θ,r = C_θ T_R (P4 Eqs. 11–13).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ..errors import ModelError
+
+__all__ = ["Parameter", "Plant"]
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One named physical parameter and its LFT channels.
+
+    Attributes
+    ----------
+    name : str
+        E.g. ``"A.Ks_zeta"``, ``"A.Ki_eta"``, ``"coupling.kxx"``, ``"seal.k"``.
+    nominal : float
+        Its value in the model (SI).
+    unit : str
+        SI unit of the value and of θ.
+    B : ndarray, shape (n_states, r)
+    C : ndarray, shape (r, n_states)
+    D : ndarray, shape (r, n_inputs)
+    """
+
+    name: str
+    nominal: float
+    unit: str
+    B: np.ndarray
+    C: np.ndarray
+    D: np.ndarray
+
+    @property
+    def repeats(self) -> int:
+        """How many times θ appears (r)."""
+        return self.B.shape[1]
+
+
+@dataclass(frozen=True)
+class Plant:
+    """A state-space plant with named signals and parameter channels.
+
+    Continuous time: ẋ = A x + B u, y = C x + D u. Inputs are coil currents (A) per
+    actuator axis, then any extra force inputs (N); outputs are sensor displacements (m).
+    """
+
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    D: np.ndarray
+    input_names: tuple[str, ...]
+    output_names: tuple[str, ...]
+    state_names: tuple[str, ...]
+    parameters: dict[str, Parameter] = field(default_factory=dict)
+
+    @property
+    def n_states(self) -> int:
+        return self.A.shape[0]
+
+    def parameter(self, name: str) -> Parameter:
+        """The parameter ``name``; raises ModelError listing the known names."""
+        try:
+            return self.parameters[name]
+        except KeyError:
+            known = ", ".join(self.parameters)
+            raise ModelError(f"unknown parameter {name!r} (expected one of: {known})") from None
+
+    def channels(self, names: list[str] | tuple[str, ...]) -> tuple[np.ndarray, ...]:
+        """Stacked (B_θ, C_θ, D_θ) of ``names`` in order, each repeated r times.
+
+        Returns arrays (n_states, Σr), (Σr, n_states), (Σr, n_inputs).
+        """
+        ps = [self.parameter(n) for n in names]
+        if not ps:
+            n, m = self.B.shape
+            return np.zeros((n, 0)), np.zeros((0, n)), np.zeros((0, m))
+        return (
+            np.hstack([p.B for p in ps]),
+            np.vstack([p.C for p in ps]),
+            np.vstack([p.D for p in ps]),
+        )
+
+    def with_changes(self, changes: dict[str, float]) -> "Plant":
+        """The plant with parameter changes θ (SI) applied through the LFT, no rebuild.
+
+        The nominal values of the returned plant's parameters move by θ.
+        """
+        A, B = self.A.copy(), self.B.copy()
+        params = dict(self.parameters)
+        for name, theta in changes.items():
+            p = self.parameter(name)
+            A += theta * (p.B @ p.C)
+            B += theta * (p.B @ p.D)
+            params[name] = replace(p, nominal=p.nominal + theta)
+        return replace(self, A=A, B=B, parameters=params)
+
+    def with_values(self, values: dict[str, float]) -> "Plant":
+        """The plant with parameters set to absolute values (SI) through the LFT."""
+        return self.with_changes({n: v - self.parameter(n).nominal for n, v in values.items()})
+
+    def select_inputs(self, names: list[str] | tuple[str, ...]) -> "Plant":
+        """The plant restricted to some inputs (parameter D_θ restricted alike)."""
+        idx = [self.input_names.index(n) for n in names]
+        params = {k: replace(p, D=p.D[:, idx]) for k, p in self.parameters.items()}
+        return replace(
+            self, B=self.B[:, idx], D=self.D[:, idx], input_names=tuple(names), parameters=params
+        )
+
+    def to_statespace(self):
+        """The plant as a ``control.StateSpace`` with named inputs, outputs and states."""
+        import control
+
+        return control.ss(
+            self.A,
+            self.B,
+            self.C,
+            self.D,
+            inputs=list(self.input_names),
+            outputs=list(self.output_names),
+            states=list(self.state_names),
+        )
+
+    def lft(self, names: list[str] | tuple[str, ...]):
+        """G_fi of thesis P4 Eq. 7 as a ``control.StateSpace``.
+
+        Inputs are [w_θ (Σr), u], outputs [z_θ (Σr), y]; closing w_θ = θ z_θ (upper LFT)
+        gives the plant with changes θ.
+        """
+        import control
+
+        Bt, Ct, Dt = self.channels(names)
+        r = Bt.shape[1]
+        tags = [f"{n}#{j}" for n in names for j in range(self.parameter(n).repeats)]
+        B = np.hstack([Bt, self.B])
+        C = np.vstack([Ct, self.C])
+        D = np.block([[np.zeros((r, r)), Dt], [np.zeros((self.C.shape[0], r)), self.D]])
+        return control.ss(
+            self.A,
+            B,
+            C,
+            D,
+            inputs=[f"w_{t}" for t in tags] + list(self.input_names),
+            outputs=[f"z_{t}" for t in tags] + list(self.output_names),
+            states=list(self.state_names),
+        )
+
+    def transformed(self, T_L: np.ndarray, T_R: np.ndarray, state_names: tuple[str, ...]) -> "Plant":
+        """The plant in reduced coordinates x_r = T_L x (P1 Eqs. 43–45, P4 Eq. 11–13)."""
+        params = {
+            k: replace(p, B=T_L @ p.B, C=p.C @ T_R) for k, p in self.parameters.items()
+        }
+        return replace(
+            self,
+            A=T_L @ self.A @ T_R,
+            B=T_L @ self.B,
+            C=self.C @ T_R,
+            state_names=state_names,
+            parameters=params,
+        )
+
+    def series_actuator(
+        self, Aa: np.ndarray, Ba: np.ndarray, Ca: np.ndarray, Da: np.ndarray, inputs: list[int]
+    ) -> "Plant":
+        """Put the same SISO actuator in series with each of the ``inputs`` (indices).
+
+        The actuator states are appended; a parameter whose D_θ acted on the actuated input
+        (a force factor Ki) then acts through C_θ on the actuator's output, so Ki enters A.
+        """
+        na = Aa.shape[0]
+        k = len(inputs)
+        n, m = self.B.shape
+        Aact = np.kron(np.eye(k), Aa)
+        Bact = np.kron(np.eye(k), Ba)
+        Cact = np.kron(np.eye(k), Ca)
+        Dact = np.kron(np.eye(k), Da)
+        Bu = self.B[:, inputs]
+        others = [j for j in range(m) if j not in inputs]
+        A = np.block([[self.A, Bu @ Cact], [np.zeros((na * k, n)), Aact]])
+        B = np.zeros((n + na * k, m))
+        B[:n, inputs] = Bu @ Dact
+        B[:n, others] = self.B[:, others]
+        B[n:, inputs] = Bact
+        C = np.hstack([self.C, self.D[:, inputs] @ Cact])
+        D = self.D.copy()
+        D[:, inputs] = self.D[:, inputs] @ Dact
+        params = {}
+        for key, p in self.parameters.items():
+            Dp = p.D.copy()
+            Dp[:, inputs] = p.D[:, inputs] @ Dact
+            params[key] = replace(
+                p,
+                B=np.vstack([p.B, np.zeros((na * k, p.repeats))]),
+                C=np.hstack([p.C, p.D[:, inputs] @ Cact]),
+                D=Dp,
+            )
+        names = tuple(
+            f"act_{self.input_names[i]}_{j}" for i in inputs for j in range(na)
+        )
+        return replace(
+            self, A=A, B=B, C=C, D=D, state_names=self.state_names + names, parameters=params
+        )

@@ -1,0 +1,128 @@
+"""Modal reduction to a small real model (thesis P1 §III.4–6, P2 Eq. 3, P4 Eq. 6).
+
+The right and left eigenvectors of the full A_f (P1 Eqs. 18–19) are sorted by |λ| (the
+undamped natural frequency) and a set of modes is kept: the lowest ``states`` states, or
+every mode with |λ| below a cut-off. P1 writes the kept complex modes in real form
+(complex separation, Eqs. 28–34) and then removes the uncontrollable half (Eqs. 35–42);
+the result is the real basis of the right invariant subspace of the kept modes,
+T_R = [Re v, Im v, ...], and the matching rows T_L from the left eigenvectors, normalised
+so that T_L T_R = I. Both are built here directly:
+
+    T_R = [Re v_1, Im v_1, ..., v_real, ...],   W = [Re w_1, Im w_1, ...],
+    T_L = (Wᵀ T_R)⁻¹ Wᵀ,
+
+so A = T_L A_f T_R is block diagonal with the real 2×2 blocks [[σ, ω], [−ω, σ]] of P1
+Eq. 32 and has exactly the kept eigenvalues; B = T_L B_f, C = C_f T_R (Eqs. 43–45).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+
+from ..errors import ModelError
+from .lft import Plant
+
+__all__ = ["ModalReduction", "modal_reduction"]
+
+
+@dataclass(frozen=True)
+class ModalReduction:
+    """A reduced plant and its transformation.
+
+    Attributes
+    ----------
+    plant : Plant
+        The reduced plant, x_r = T_L x_f, with its LFT channels transformed.
+    T_L : ndarray, shape (n_r, n_f)
+    T_R : ndarray, shape (n_f, n_r)
+    poles : ndarray, shape (n_r,)
+        The kept eigenvalues of A_f (rad/s), sorted by |λ|.
+    """
+
+    plant: Plant
+    T_L: np.ndarray
+    T_R: np.ndarray
+    poles: np.ndarray
+
+
+def _real_phase(v: np.ndarray) -> np.ndarray:
+    """A real vector spanning the same line as an eigenvector of a real eigenvalue."""
+    k = int(np.argmax(np.abs(v)))
+    return np.real(v * np.exp(-1j * np.angle(v[k])))
+
+
+def modal_reduction(
+    plant: Plant, *, states: int | None = None, cutoff_hz: float | None = None
+) -> ModalReduction:
+    """Reduce a full-order plant to its lowest modes.
+
+    Parameters
+    ----------
+    plant : Plant
+        Full-order plant (e.g. :func:`ambseal.model.rig.mechanical_plant`).
+    states : int, optional
+        Number of states to keep (the lowest modes by |λ|; 8 keeps the rigid-body modes of
+        a rotor on two radial AMBs).
+    cutoff_hz : float, optional
+        Keep every mode with |λ| / 2π below this frequency (Hz).
+
+    Raises
+    ------
+    ModelError
+        Neither or both of ``states`` and ``cutoff_hz``; a count that splits a complex pair
+        or a repeated eigenvalue; left and right eigenvectors that cannot be paired
+        (a defective eigenvalue, e.g. free–free rigid-body modes).
+    """
+    if (states is None) == (cutoff_hz is None):
+        raise ModelError("modal reduction expects exactly one of states or cutoff_hz")
+    lam, W, V = sla.eig(plant.A, left=True, right=True)
+    order = np.argsort(np.abs(lam), kind="stable")
+    lam, W, V = lam[order], W[:, order], V[:, order]
+    scale = max(np.abs(lam).max(), 1.0)
+    if states is not None:
+        if not 1 <= states <= len(lam):
+            raise ModelError(f"states = {states}: expected 1 to {len(lam)}")
+        n_keep = states
+    else:
+        n_keep = int(np.sum(np.abs(lam) <= 2 * np.pi * cutoff_hz))
+        if n_keep == 0:
+            raise ModelError(f"cutoff_hz = {cutoff_hz}: no mode lies below it")
+    if n_keep < len(lam):
+        gap = abs(abs(lam[n_keep]) - abs(lam[n_keep - 1]))
+        if gap <= 1e-9 * scale:
+            raise ModelError(
+                f"keeping {n_keep} states splits modes of equal |λ| = {abs(lam[n_keep]):.6g} "
+                "rad/s (a complex pair or a repeated mode); keep one state more or less"
+            )
+    kept = lam[:n_keep]
+    tol = 1e-9 * scale
+    cols_r, cols_l, names = [], [], []
+    for j, lj in enumerate(kept):
+        if abs(lj.imag) <= tol:
+            cols_r.append(_real_phase(V[:, j]))
+            cols_l.append(_real_phase(W[:, j]))
+            names.append(f"mode{len(names)}")
+        elif lj.imag > 0:
+            v = V[:, j] / np.linalg.norm(V[:, j])
+            w = W[:, j] / np.linalg.norm(W[:, j])
+            cols_r += [v.real, v.imag]
+            cols_l += [w.real, w.imag]
+            names += [f"mode{len(names)}_re", f"mode{len(names)}_im"]
+    if len(cols_r) != n_keep:
+        raise ModelError(
+            f"keeping {n_keep} states splits a complex-conjugate pair; keep one state more or less"
+        )
+    T_R = np.column_stack(cols_r)
+    Wr = np.column_stack(cols_l)
+    P = Wr.T @ T_R
+    if np.linalg.cond(P) > 1e12:
+        raise ModelError(
+            "left and right eigenvectors of the kept modes cannot be paired "
+            "(defective eigenvalue, e.g. free–free rigid-body modes)"
+        )
+    T_L = np.linalg.solve(P, Wr.T)
+    reduced = plant.transformed(T_L, T_R, tuple(names))
+    return ModalReduction(plant=reduced, T_L=T_L, T_R=T_R, poles=kept)

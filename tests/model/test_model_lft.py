@@ -1,0 +1,135 @@
+"""LFT channels, modal reduction and the AMB linearisation."""
+
+import math
+
+import numpy as np
+import pytest
+
+from ambseal.config import amb_factors_from_geometry, load_rig, parse_rig
+from ambseal.errors import ModelError
+from ambseal.model.reduction import modal_reduction
+from ambseal.model.rig import build_plant, build_system, mechanical_plant
+
+
+@pytest.fixture(scope="module")
+def rig():
+    return load_rig()
+
+
+def _edit(cfg, **changes):
+    """Rebuild the rig with some values changed (dict path -> value)."""
+    data = cfg.model_dump(exclude_none=True)
+    for path, value in changes.items():
+        node = data
+        keys = path.split(".")
+        for k in keys[:-1]:
+            node = node[int(k)] if k.isdigit() else node[k]
+        node[keys[-1]] = value
+    return parse_rig(data)
+
+
+CASES = [
+    # parameter, change, rebuilt-config edit
+    ("A.Ks_zeta", 0.3e6, {"amb.0.ks": {"zeta": 2.39e6 + 0.3e6, "eta": 2.49e6}}),
+    ("B.Ki_eta", -20.0, {"amb.1.ki": {"zeta": 260.8, "eta": 265.8 - 20.0}}),
+    ("coupling.kxx", 1.0e5, {"spring.0.kxx": 0.5e6}),
+    ("seal.K", 4.0e5, {"seal.0.K": 4.0e5}),
+    ("seal.k", 2.0e6, {"seal.0.k": 2.0e6}),
+    ("seal.C", 500.0, {"seal.0.C": 500.0}),
+    ("seal.c", -300.0, {"seal.0.c": -300.0}),
+]
+
+
+@pytest.mark.parametrize("name,theta,edit", CASES)
+def test_lft_equals_rebuilt_full_order(rig, name, theta, edit):
+    """A + B_θ θ C_θ (and B + B_θ θ D_θ) equals the model rebuilt with the changed value,
+    to rounding (thesis P1 Eqs. 46–50, P4 Eqs. 7–13), with the actuator in series."""
+    base = _edit(rig, **{"seal.0.K": 0.0, "seal.0.k": 0.0, "seal.0.C": 0.0, "seal.0.c": 0.0})
+    plant = build_plant(base, pressure_bar=0.0)
+    changed = plant.with_changes({name: theta})
+    rebuilt = build_plant(_edit(base, **edit), pressure_bar=0.0)
+    err = change = 0.0
+    for a, b, a0 in ((changed.A, rebuilt.A, plant.A), (changed.B, rebuilt.B, plant.B)):
+        assert np.linalg.norm(a - b) <= 1e-12 * np.linalg.norm(b)
+        err += np.linalg.norm(a - b)
+        change += np.linalg.norm(a - a0)
+    np.testing.assert_array_equal(changed.C, rebuilt.C)
+    assert change > 1e4 * err  # the change is real and the LFT reproduces it
+
+
+def test_seal_k_is_one_repeated_parameter(rig):
+    """k and −k share one parameter, θ·I₂ (thesis P5 §4.1 item 3, Appendix A)."""
+    p = build_plant(rig).parameter("seal.k")
+    assert p.repeats == 2
+    assert p.nominal == pytest.approx(1.1e6 * 2.04)
+
+
+def test_reduction_is_exact_on_kept_modes(rig):
+    """T_L T_R = I, and the reduced poles are the selected full poles (P1 Eqs. 39–45)."""
+    full = mechanical_plant(build_system(rig))
+    red = modal_reduction(full, states=8)
+    np.testing.assert_allclose(red.T_L @ red.T_R, np.eye(8), atol=1e-9)
+    lam_full = np.linalg.eigvals(full.A)
+    lam_full = lam_full[np.argsort(np.abs(lam_full))][:8]
+    lam_red = np.linalg.eigvals(red.plant.A)
+    for lam in lam_full:
+        assert np.min(np.abs(lam_red - lam)) <= 1e-7 * abs(lam)
+    assert np.isrealobj(red.plant.A) and red.plant.n_states == 8
+    # the rigid-body modes are the open-loop unstable ones and sit far below bending
+    assert np.max(np.abs(red.poles)) < 0.2 * 2 * np.pi * 550
+
+
+def test_reduced_model_matches_full_at_low_frequency(rig):
+    """The 8-state model has the full model's DC gain and low-frequency response to within
+    a few per cent: the residual flexible modes only add a small static correction."""
+    full = mechanical_plant(build_system(rig))
+    red = modal_reduction(full, states=8).plant
+    for w in (0.0, 2 * np.pi * 20):
+        hf = full.C @ np.linalg.solve(1j * w * np.eye(full.n_states) - full.A, full.B)
+        hr = red.C @ np.linalg.solve(1j * w * np.eye(8) - red.A, red.B)
+        assert np.linalg.norm(hr - hf) <= 0.05 * np.linalg.norm(hf)
+
+
+def test_reduced_lft_tracks_rebuilt_model(rig):
+    """The reduced LFT (B_θ = T_L B_θf, C_θ = C_θf T_R, P4 Eqs. 11–13) moves the reduced
+    poles as a rebuild does: P2 §4.1's assumption, within 1 % for a 20 % Ks change."""
+    red = build_plant(rig, reduced=True)
+    lft = red.with_changes({"A.Ks_zeta": 0.2 * 2.39e6})
+    rebuilt = build_plant(_edit(rig, **{"amb.0.ks": {"zeta": 1.2 * 2.39e6, "eta": 2.49e6}}),
+                          reduced=True)
+    p1 = np.sort_complex(np.linalg.eigvals(lft.A))
+    p2 = np.sort_complex(np.linalg.eigvals(rebuilt.A))
+    assert np.max(np.abs(p1 - p2) / np.abs(p2)) < 0.01
+    assert np.max(np.abs(p1 - np.sort_complex(np.linalg.eigvals(red.A)))) > 1.0
+
+
+def test_reduction_refuses_split_pair(rig):
+    """A count that splits modes of equal |λ| is refused, naming the fix."""
+    full = mechanical_plant(build_system(rig, pressure_bar=2.04))
+    with pytest.raises(ModelError, match="keep one state more or less"):
+        modal_reduction(full, states=9)
+
+
+def test_amb_factors_from_geometry_match_nonlinear_force_law():
+    """Ki, Ks of Schweitzer & Maslen (2009) equal the derivatives at (i, x) = (0, 0) of
+    f = k[(i0+i)²/(s0−x)² − (i0−i)²/(s0+x)²], k = μ0N²A cos α/4, by central differences."""
+    N, A, s0, i0, alpha = 36, 5.5e-3, 0.5e-3, 6.0, 22.5
+    k = 4e-7 * math.pi * N**2 * A * math.cos(math.radians(alpha)) / 4
+
+    def f(i, x):
+        return k * ((i0 + i) ** 2 / (s0 - x) ** 2 - (i0 - i) ** 2 / (s0 + x) ** 2)
+
+    ki, ks = amb_factors_from_geometry(N, A, s0, i0, alpha)
+    hi, hx = 1e-4, 1e-9
+    assert ki == pytest.approx((f(hi, 0) - f(-hi, 0)) / (2 * hi), rel=1e-6)
+    assert ks == pytest.approx((f(0, hx) - f(0, -hx)) / (2 * hx), rel=1e-6)
+    # and P2 Table 2's Ks at 6 A is reproduced by this pole area
+    assert ks == pytest.approx(2.39e6, rel=0.01)
+
+
+def test_amb_axes_rotated_45_degrees(rig):
+    """A current on A_zeta pushes along (cos 45°, sin 45°) in x, y (P2 Fig. 1b)."""
+    sys_ = build_system(rig)
+    node = sys_.mesh.node_at(0.17)
+    b = sys_.B[4 * node: 4 * node + 2, 0]
+    np.testing.assert_allclose(b / np.linalg.norm(b), [math.sqrt(0.5)] * 2, rtol=1e-12)

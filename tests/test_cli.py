@@ -1,0 +1,134 @@
+"""The CLI: one clear line and exit status 2 on every bad rig file, JSON from ``modes``."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from ambseal.cli import main
+
+GOOD = """
+[materials.steel]
+E = 2.1e11
+rho = 7850.0
+nu = 0.3
+
+[[shaft]]
+length = 0.5
+outer_diameter = 0.05
+material = "steel"
+elements = 10
+
+[[disk]]
+position = 0.25
+mass = 5.0
+Ip = 0.01
+Id = 0.006
+
+[[amb]]
+name = "A"
+position = 0.05
+sensor_position = 0.02
+ki = 100.0
+ks = 2.0e5
+
+[[amb]]
+name = "B"
+position = 0.45
+sensor_position = 0.48
+ki = 100.0
+ks = 2.0e5
+"""
+
+
+def run(tmp_path, text, *args):
+    rig = tmp_path / "rig.toml"
+    rig.write_text(text)
+    return rig, main(["modes", str(rig), *args])
+
+
+BAD = [
+    ("missing key", GOOD.replace('material = "steel"\n', ""), "shaft[0].material", "missing"),
+    ("wrong type", GOOD.replace("elements = 10", 'elements = "ten"'), "shaft[0].elements",
+     "integer"),
+    ("negative length", GOOD.replace("length = 0.5", "length = -0.5"), "shaft[0].length",
+     "greater than 0"),
+    ("negative diameter", GOOD.replace("outer_diameter = 0.05", "outer_diameter = -0.05"),
+     "shaft[0].outer_diameter", "greater than 0"),
+    ("unknown material", GOOD.replace('material = "steel"', 'material = "steal"'),
+     "shaft[0].material", "unknown material 'steal'"),
+    ("outside the shaft", GOOD.replace("position = 0.25", "position = 0.75"),
+     "disk[0].position", "outside the shaft"),
+    ("AMB without ki/ks or geometry", GOOD.replace("ki = 100.0\nks = 2.0e5\n", "", 1),
+     "amb[0]", "expected either the geometry"),
+    ("not TOML", "this is = = not toml", "", "not valid TOML"),
+    ("unknown key", GOOD.replace("mass = 5.0", "mass = 5.0\nmas = 5.0"), "disk[0].mas",
+     "unknown key"),
+]
+
+
+@pytest.mark.parametrize("label,text,key,expected", BAD, ids=[b[0] for b in BAD])
+def test_bad_rig_file_one_line_exit_2(tmp_path, capsys, label, text, key, expected):
+    """Each bad rig file of the issue's list: exit 2, one stderr line with file, key, what."""
+    rig, code = run(tmp_path, text)
+    err = capsys.readouterr().err
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert str(rig) in lines[0] and key in lines[0] and expected in lines[0], lines[0]
+    assert "Traceback" not in err
+
+
+def test_cli_no_traceback_in_a_real_process(tmp_path):
+    """The console entry point, in its own process: exit 2 and no traceback."""
+    rig = tmp_path / "rig.toml"
+    rig.write_text(GOOD.replace("length = 0.5", "length = -0.5"))
+    proc = subprocess.run([sys.executable, "-m", "ambseal.cli", "modes", str(rig)],
+                          capture_output=True, text=True)
+    assert proc.returncode == 2
+    assert "Traceback" not in proc.stderr and "shaft[0].length" in proc.stderr
+
+
+def test_modes_json_keys_and_unstable_poles(tmp_path, capsys):
+    """``modes --json``: the issue's keys; AMB negative stiffness gives real unstable poles
+    of √(Ks_total/m) for the translation (closed form, rigid rotor), and --no-amb has none."""
+    _, code = run(tmp_path, GOOD, "--json")
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0
+    assert set(out) == {"natural_frequencies_hz", "damping_ratios", "unstable_poles"}
+    assert len(out["unstable_poles"]) == 4  # translation and tilt in two planes
+    _, code = run(tmp_path, GOOD, "--json", "--no-amb")
+    assert json.loads(capsys.readouterr().out)["unstable_poles"] == []
+
+
+def test_plain_bearing_rig_is_valid_for_modes(tmp_path, capsys):
+    """A rotor on two plain bearings (springs, no AMB): a valid rig; its first mode is the
+    rigid translation at √(2k/m)/2π for stiff shafts (closed form)."""
+    text = GOOD.split("[[amb]]")[0] + """
+[[spring]]
+position = 0.0
+kxx = 1.0e5
+kyy = 1.0e5
+
+[[spring]]
+position = 0.5
+kxx = 1.0e5
+kyy = 1.0e5
+"""
+    _, code = run(tmp_path, text, "--json")
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0
+    m = 7850.0 * 3.141592653589793 * 0.05**2 / 4 * 0.5 + 5.0
+    f_ref = (2 * 1.0e5 / m) ** 0.5 / (2 * 3.141592653589793)
+    assert out["natural_frequencies_hz"][0] == pytest.approx(f_ref, rel=0.01)
+
+
+def test_modes_free_lists_bending_modes(capsys):
+    """``--free`` on the embedded rig: the first bending mode of the bare rotor (~550 Hz)."""
+    from ambseal.config import default_rig_path
+
+    assert main(["modes", str(default_rig_path()), "--free", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert 495 < out["natural_frequencies_hz"][0] < 605
+    assert out["unstable_poles"] == []

@@ -1,0 +1,489 @@
+"""Closed loops of an AMB plant and a controller: poles, S_o, S_i, T, KS and compliance.
+
+AMB convention (thesis P5 §4, Fig. 8): the controller ``K`` maps sensor displacements (m) to
+current references (A) and the loop is closed with **negative feedback**, ``u = −K y + d``,
+so a PID with positive ``K_p`` stabilises the negative-stiffness plant ``G`` (P5 Eq. 1).
+
+* output sensitivity ``S_o = (I + G K)⁻¹`` (ny × ny), the function ISO 14839-3 grades
+  (P5 §4.1 item 4, Fig. 13);
+* input sensitivity ``S_i = (I + K G)⁻¹`` (nu × nu);
+* complementary sensitivity ``T_o = G K S_o`` (ny × ny);
+* control sensitivity ``K S_o`` (nu × ny);
+* compliance ``S_o G_f`` (ny × nf, m/N): displacements per unit external force, P5 §4.4.1,
+  Fig. 11.
+
+Frequencies are rad/s inside (``omega_rad_s``), Hz at the edges (``frequency_hz``).
+Peaks are grid maxima: pass a grid dense enough around resonances.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ambseal.analysis._util import as_omega, json_float, json_list, labels, ss_matrices
+from ambseal.analysis.freqresp import freqresp
+from ambseal.errors import ModelError
+
+__all__ = [
+    "ClosedLoop",
+    "LoopResponse",
+    "Peak",
+    "SensitivityPeaks",
+    "ComplianceResponse",
+    "closed_loop",
+    "loop_responses",
+    "sensitivity_peaks",
+    "compliance",
+    "sigma_max",
+    "peak_of",
+]
+
+_TWO_PI = 2.0 * np.pi
+
+
+# --------------------------------------------------------------------------- results
+@dataclass(frozen=True, eq=False)
+class ClosedLoop:
+    """The closed loop of ``(G, K)`` with ``u = −K y + d`` and optional force inputs.
+
+    Attributes
+    ----------
+    system : control.StateSpace
+        Inputs: ``d_<u>`` current disturbances added to the controller output (A), one per
+        plant input, then the force inputs of ``Gf`` under their own names (N), if given.
+        Outputs: the plant outputs under their own names (m), then ``i_<u>`` the controller
+        output ``−K y`` (A; the "control action" of P5 Fig. 14). States: plant states then
+        controller states.
+    poles : ndarray of complex, shape (n + n_K,)
+        Closed-loop poles (rad/s), sorted by decreasing real part.
+    max_real_pole : float
+        Largest real part of the poles (1/s); ``< 0`` means asymptotically stable.
+    stable : bool
+        ``max_real_pole < 0``.
+    n_plant_inputs, n_plant_outputs, n_force_inputs : int
+        Channel counts, so ``system`` can be sliced without parsing names.
+    """
+
+    system: Any
+    poles: np.ndarray
+    max_real_pole: float
+    stable: bool
+    n_plant_inputs: int
+    n_plant_outputs: int
+    n_force_inputs: int
+
+    def to_dict(self) -> dict:
+        """JSON-safe summary (no state-space matrices): stability, poles (real/imag, rad/s)."""
+        return {
+            "n_states": int(self.system.nstates),
+            "stable": bool(self.stable),
+            "max_real_pole": json_float(self.max_real_pole),
+            "poles_real": json_list(self.poles.real),
+            "poles_imag": json_list(self.poles.imag),
+            "inputs": list(self.system.input_labels),
+            "outputs": list(self.system.output_labels),
+        }
+
+
+@dataclass(frozen=True)
+class Peak:
+    """Peak of a gain over a frequency grid.
+
+    Attributes
+    ----------
+    value : float
+        Peak gain, in the unit of the function (dimensionless for sensitivities).
+    frequency_hz : float
+        Frequency of the peak (Hz).
+    channel : str
+        ``"sigma_max"`` for the largest singular value, else the channel name (diagonal element).
+    """
+
+    value: float
+    frequency_hz: float
+    channel: str = "sigma_max"
+
+    @property
+    def value_db(self) -> float:
+        """Peak in dB (``20 log10 value``)."""
+        return float(20.0 * np.log10(self.value)) if self.value > 0 else float("-inf")
+
+    def to_dict(self) -> dict:
+        return {
+            "channel": self.channel,
+            "value": json_float(self.value),
+            "value_db": json_float(self.value_db),
+            "frequency_hz": json_float(self.frequency_hz),
+        }
+
+
+@dataclass(frozen=True)
+class SensitivityPeaks:
+    """Peaks of one closed-loop function: of σ̄ and of each diagonal element.
+
+    Attributes
+    ----------
+    sigma_max : Peak
+        Peak of the largest singular value (the thesis's measure, P5 §4.1 item 4).
+    diagonal : tuple of Peak
+        Peak of ``|F_ii|`` per channel (the per-axis measure of ISO 14839-3).
+    """
+
+    sigma_max: Peak
+    diagonal: tuple[Peak, ...]
+
+    @property
+    def max_diagonal(self) -> Peak:
+        """The largest of the per-axis peaks."""
+        return max(self.diagonal, key=lambda p: p.value)
+
+    def to_dict(self) -> dict:
+        return {"sigma_max": self.sigma_max.to_dict(), "diagonal": [p.to_dict() for p in self.diagonal]}
+
+
+@dataclass(frozen=True, eq=False)
+class LoopResponse:
+    """S_o, S_i, T_o and K S_o of a closed loop on a frequency grid.
+
+    Attributes
+    ----------
+    omega_rad_s : ndarray, shape (n_w,)
+        Frequencies (rad/s).
+    So : ndarray of complex, shape (n_w, ny, ny)
+        Output sensitivity ``(I + G K)⁻¹``.
+    Si : ndarray of complex, shape (n_w, nu, nu)
+        Input sensitivity ``(I + K G)⁻¹``.
+    To : ndarray of complex, shape (n_w, ny, ny)
+        Complementary sensitivity ``G K S_o``.
+    KS : ndarray of complex, shape (n_w, nu, ny)
+        Control sensitivity ``K S_o`` (A/m).
+    output_names, input_names : tuple of str
+        Plant output (= sensor) and input (= actuator) channel names.
+    """
+
+    omega_rad_s: np.ndarray
+    So: np.ndarray
+    Si: np.ndarray
+    To: np.ndarray
+    KS: np.ndarray
+    output_names: tuple[str, ...]
+    input_names: tuple[str, ...]
+
+    @property
+    def frequency_hz(self) -> np.ndarray:
+        """Frequencies (Hz), shape (n_w,)."""
+        return self.omega_rad_s / _TWO_PI
+
+    def _get(self, which: str) -> tuple[np.ndarray, tuple[str, ...]]:
+        table = {"So": (self.So, self.output_names), "Si": (self.Si, self.input_names),
+                 "To": (self.To, self.output_names), "KS": (self.KS, self.input_names)}
+        if which not in table:
+            raise ModelError(f"LoopResponse: which must be one of {sorted(table)}, got {which!r}")
+        return table[which]
+
+    def sigma_max(self, which: str = "So") -> np.ndarray:
+        """Largest singular value of ``which`` ∈ {"So", "Si", "To", "KS"} per frequency, (n_w,)."""
+        return sigma_max(self._get(which)[0])
+
+    def peaks(self, which: str = "So") -> SensitivityPeaks:
+        """Peaks of σ̄ and of each diagonal element of ``which`` (diagonal of square part)."""
+        F, names = self._get(which)
+        return _peaks(F, self.omega_rad_s, names)
+
+    def to_dict(self) -> dict:
+        """JSON-safe: frequency grid (Hz) and σ̄ of each function, plus S_o peaks."""
+        return {
+            "frequency_hz": json_list(self.frequency_hz),
+            "sigma_max": {k: json_list(self.sigma_max(k)) for k in ("So", "Si", "To", "KS")},
+            "So_peaks": self.peaks("So").to_dict(),
+            "output_names": list(self.output_names),
+            "input_names": list(self.input_names),
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class ComplianceResponse:
+    """Compliance ``S_o G_f`` (m/N) on a frequency grid (P5 §4.4.1, Fig. 11).
+
+    Attributes
+    ----------
+    omega_rad_s : ndarray, shape (n_w,)
+        Frequencies (rad/s).
+    H_m_per_n : ndarray of complex, shape (n_w, ny, nf)
+        Displacements (m) per unit force (N).
+    sigma_max_m_per_n : ndarray, shape (n_w,)
+        Largest singular value (m/N), the upper bound of P5 Fig. 11.
+    peak : Peak
+        Peak of ``sigma_max_m_per_n`` (value in m/N).
+    output_names, force_names : tuple of str
+    """
+
+    omega_rad_s: np.ndarray
+    H_m_per_n: np.ndarray
+    sigma_max_m_per_n: np.ndarray
+    peak: Peak
+    output_names: tuple[str, ...]
+    force_names: tuple[str, ...]
+
+    @property
+    def frequency_hz(self) -> np.ndarray:
+        """Frequencies (Hz), shape (n_w,)."""
+        return self.omega_rad_s / _TWO_PI
+
+    def to_dict(self) -> dict:
+        return {
+            "frequency_hz": json_list(self.frequency_hz),
+            "sigma_max_m_per_n": json_list(self.sigma_max_m_per_n),
+            "peak_m_per_n": json_float(self.peak.value),
+            "peak_frequency_hz": json_float(self.peak.frequency_hz),
+            "output_names": list(self.output_names),
+            "force_names": list(self.force_names),
+        }
+
+
+# --------------------------------------------------------------------------- functions
+def sigma_max(F: np.ndarray) -> np.ndarray:
+    """Largest singular value per frequency of a stack ``F`` of shape (n_w, p, q) → (n_w,).
+
+    Non-finite entries (a frequency on a pole) give ``inf``.
+    """
+    F = np.asarray(F)
+    out = np.full(F.shape[0], np.inf)
+    ok = np.all(np.isfinite(F), axis=(1, 2))
+    if ok.any():
+        out[ok] = np.linalg.svd(F[ok], compute_uv=False)[:, 0]
+    return out
+
+
+def peak_of(gain: np.ndarray, omega_rad_s: np.ndarray, channel: str = "sigma_max") -> Peak:
+    """Grid maximum of a real gain curve (NaN ignored) as a :class:`Peak` (frequency in Hz)."""
+    g = np.asarray(gain, dtype=float)
+    if g.size == 0 or np.all(np.isnan(g)):
+        return Peak(float("nan"), float("nan"), channel)
+    k = int(np.nanargmax(g))
+    return Peak(float(g[k]), float(omega_rad_s[k] / _TWO_PI), channel)
+
+
+def _peaks(F: np.ndarray, w: np.ndarray, names: tuple[str, ...]) -> SensitivityPeaks:
+    m = min(F.shape[1], F.shape[2])
+    diag = tuple(peak_of(np.abs(F[:, i, i]), w, names[i] if i < len(names) else f"[{i}]") for i in range(m))
+    return SensitivityPeaks(sigma_max=peak_of(sigma_max(F), w), diagonal=diag)
+
+
+def _check_pair(G: Any, K: Any) -> tuple[tuple, tuple]:
+    mg = ss_matrices(G, name="G")
+    mk = ss_matrices(K, name="K")
+    ny, nu = mg[3].shape
+    if mk[3].shape != (nu, ny):
+        raise ModelError(
+            f"K has {mk[3].shape[1]} inputs and {mk[3].shape[0]} outputs; expected {ny} inputs"
+            f" (G outputs, m) and {nu} outputs (G inputs, A)"
+        )
+    return mg, mk
+
+
+def closed_loop(G: Any, K: Any, Gf: Any | None = None, *, atol: float = 0.0) -> ClosedLoop:
+    """Close the loop ``u = −K y + d`` around ``G`` (and ``Gf`` sharing its states).
+
+    Plant ``ẋ = A x + B u + B_f f``, ``y = C x + D u + D_f f``; controller
+    ``ẋ_K = A_K x_K + B_K y``, ``i = −(C_K x_K + D_K y)``, ``u = i + d``. A direct feedthrough
+    loop is resolved with ``(I + D D_K)⁻¹``. Same result as
+    ``control.feedback(G, K, sign=-1)`` for the ``d → y`` channel (tested side by side).
+
+    Parameters
+    ----------
+    G : control.StateSpace
+        Plant, ``nu`` current inputs (A) → ``ny`` displacement outputs (m).
+    K : control.StateSpace
+        Controller, ``ny`` inputs (m) → ``nu`` outputs (A).
+    Gf : control.StateSpace, optional
+        Plant with the same states and outputs and force inputs (N), e.g. at mid-span.
+    atol : float
+        Tolerance when checking that ``Gf`` has the same ``A`` and ``C`` as ``G``
+        (compared relative to their norms: ``≤ atol + 1e-9 ‖·‖``).
+
+    Returns
+    -------
+    ClosedLoop
+
+    Raises
+    ------
+    ModelError
+        If the dimensions of ``G``, ``K`` (and ``Gf``) do not fit, ``Gf`` has a different
+        ``A`` or ``C``, or ``I + D D_K`` is singular (ill-posed loop).
+    """
+    import control
+
+    (A, B, C, D), (Ak, Bk, Ck, Dk) = _check_pair(G, K)
+    n, nu = B.shape
+    ny = C.shape[0]
+    nk = Ak.shape[0]
+    if Gf is not None:
+        Af, Bf, Cf, Df = ss_matrices(Gf, name="Gf")
+        if Af.shape != A.shape or Cf.shape != C.shape:
+            raise ModelError(f"Gf must share G's states and outputs: A{Af.shape} vs {A.shape}, C{Cf.shape} vs {C.shape}")
+        for nm, X, Y in (("A", Af, A), ("C", Cf, C)):
+            if np.max(np.abs(X - Y), initial=0.0) > atol + 1e-9 * max(np.max(np.abs(Y), initial=0.0), 1.0):
+                raise ModelError(f"Gf.{nm} differs from G.{nm}: Gf must have the same states as G")
+        nf = Bf.shape[1]
+    else:
+        Bf, Df, nf = np.zeros((n, 0)), np.zeros((ny, 0)), 0
+
+    E = np.eye(ny) + D @ Dk
+    if np.linalg.cond(E) > 1e12:
+        raise ModelError("closed_loop: I + D·D_K is singular; the loop is ill-posed")
+    # y = Cy [x; xk] + Dyd d + Dyf f
+    Cy = np.linalg.solve(E, np.hstack([C, -D @ Ck]))
+    Dyd = np.linalg.solve(E, D)
+    Dyf = np.linalg.solve(E, Df)
+    # i = -(Ck xk + Dk y)
+    Ci = -np.hstack([np.zeros((nu, n)), Ck]) - Dk @ Cy
+    Did = -Dk @ Dyd
+    Dif = -Dk @ Dyf
+    Acl = np.block([[A, np.zeros((n, nk))], [np.zeros((nk, n)), Ak]])
+    Acl += np.vstack([B, np.zeros((nk, nu))]) @ Ci + np.vstack([np.zeros((n, ny)), Bk]) @ Cy
+    Bd = np.vstack([B, np.zeros((nk, nu))]) @ (np.eye(nu) + Did) + np.vstack([np.zeros((n, ny)), Bk]) @ Dyd
+    Bff = np.vstack([Bf, np.zeros((nk, nf))]) + np.vstack([B, np.zeros((nk, nu))]) @ Dif
+    Bff += np.vstack([np.zeros((n, ny)), Bk]) @ Dyf
+    Bcl = np.hstack([Bd, Bff])
+    Ccl = np.vstack([Cy, Ci])
+    Dcl = np.block([[Dyd, Dyf], [Did, Dif]])
+
+    u_names = labels(G, "input", nu, "u")
+    y_names = labels(G, "output", ny, "y")
+    f_names = labels(Gf, "input", nf, "f") if Gf is not None else ()
+    inputs = [f"d_{u}" for u in u_names] + list(f_names)
+    outputs = list(y_names) + [f"i_{u}" for u in u_names]
+    states = [f"x[{i}]" for i in range(n)] + [f"xK[{i}]" for i in range(nk)]
+    sys = control.StateSpace(Acl, Bcl, Ccl, Dcl, inputs=inputs, outputs=outputs, states=states, name="closed_loop")
+    poles = np.linalg.eigvals(Acl) if Acl.size else np.zeros(0, dtype=complex)
+    poles = poles[np.argsort(-poles.real, kind="stable")]
+    mrp = float(poles.real.max()) if poles.size else float("-inf")
+    return ClosedLoop(sys, poles, mrp, bool(mrp < 0.0), nu, ny, nf)
+
+
+def loop_responses(G: Any, K: Any, omega: Any) -> LoopResponse:
+    """S_o, S_i, T_o and K S_o of ``(G, K)`` on a frequency grid.
+
+    ``G(jω)`` and ``K(jω)`` come from :func:`ambseal.analysis.freqresp.freqresp`; the small
+    ``ny × ny`` / ``nu × nu`` inverses are batched ``numpy.linalg.solve`` calls over ω.
+
+    Parameters
+    ----------
+    G, K : control.StateSpace
+        Plant (A → m) and controller (m → A), negative feedback (module docstring).
+    omega : array_like, shape (n_w,)
+        Frequencies (rad/s).
+
+    Returns
+    -------
+    LoopResponse
+
+    Raises
+    ------
+    ModelError
+        On dimension mismatch, a bad grid, or a grid frequency on an imaginary-axis pole of
+        ``G`` or ``K`` (e.g. ω = 0 with an integral action: start the grid above 0).
+
+    Notes
+    -----
+    The functions are evaluated whether or not the loop is stable; check
+    :func:`closed_loop` ``.stable`` before reading a peak as a robustness margin.
+    """
+    w = as_omega(omega)
+    _check_pair(G, K)
+    Gw = freqresp(G, w)
+    Kw = freqresp(K, w)
+    _check_finite(w, Gw, Kw)
+    ny, nu = Gw.shape[1:]
+    GK = Gw @ Kw
+    KG = Kw @ Gw
+    So = _batched_inv(np.eye(ny) + GK)
+    Si = _batched_inv(np.eye(nu) + KG)
+    To = GK @ So
+    KS = Kw @ So
+    nu_names = labels(G, "input", nu, "u")
+    ny_names = labels(G, "output", ny, "y")
+    return LoopResponse(w, So, Si, To, KS, ny_names, nu_names)
+
+
+def sensitivity_peaks(G: Any, K: Any, omega: Any, which: str = "So") -> SensitivityPeaks:
+    """Peaks of σ̄ and of each diagonal element of S_o (or ``which``) over ``omega`` (rad/s).
+
+    Shortcut for ``loop_responses(G, K, omega).peaks(which)``; frequencies reported in Hz.
+    """
+    return loop_responses(G, K, omega).peaks(which)
+
+
+def compliance(G: Any, K: Any, Gf: Any, omega: Any) -> ComplianceResponse:
+    """Compliance ``S_o(jω) G_f(jω)`` (m/N) of the closed loop, P5 §4.4.1 and Fig. 11.
+
+    From ``y = G u + G_f f`` and ``u = −K y``: ``y = (I + G K)⁻¹ G_f f``.
+
+    Parameters
+    ----------
+    G, K : control.StateSpace
+        Plant and controller as in :func:`loop_responses`.
+    Gf : control.StateSpace
+        Force (N) → displacement (m) plant with the same outputs as ``G``.
+    omega : array_like, shape (n_w,)
+        Frequencies (rad/s).
+
+    Returns
+    -------
+    ComplianceResponse
+
+    Raises
+    ------
+    ModelError
+        If ``Gf`` has a different number of outputs than ``G``, or a grid frequency is on an
+        imaginary-axis pole of ``G``, ``K`` or ``Gf``.
+    """
+    w = as_omega(omega)
+    _check_pair(G, K)
+    Gfw = freqresp(Gf, w)
+    Gw = freqresp(G, w)
+    if Gfw.shape[1] != Gw.shape[1]:
+        raise ModelError(f"Gf has {Gfw.shape[1]} outputs, G has {Gw.shape[1]}: they must share outputs")
+    Kw = freqresp(K, w)
+    _check_finite(w, Gw, Kw, Gfw)
+    ny = Gw.shape[1]
+    H = _batched_solve(np.eye(ny) + Gw @ Kw, Gfw)
+    sm = sigma_max(H)
+    names_y = labels(G, "output", ny, "y")
+    names_f = labels(Gf, "input", Gfw.shape[2], "f")
+    return ComplianceResponse(w, H, sm, peak_of(sm, w), names_y, names_f)
+
+
+def _check_finite(w: np.ndarray, *responses: np.ndarray) -> None:
+    """Raise if a grid frequency sits on an imaginary-axis pole of G, K or Gf."""
+    for R in responses:
+        bad = ~np.all(np.isfinite(R), axis=(1, 2))
+        if bad.any():
+            raise ModelError(
+                f"frequency grid hits a pole on the imaginary axis at {w[bad][0]:.6g} rad/s"
+                " (e.g. omega = 0 with an integrating controller); use a grid that avoids it"
+            )
+
+
+def _batched_inv(M: np.ndarray) -> np.ndarray:
+    return _batched_solve(M, np.broadcast_to(np.eye(M.shape[1]), M.shape))
+
+
+def _batched_solve(M: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """Solve ``M_k X_k = R_k`` for each k; singular or non-finite ``M_k`` give ``inf``."""
+    out = np.full(M.shape[:2] + (R.shape[2],), np.inf + 0j)
+    ok = np.all(np.isfinite(M), axis=(1, 2)) & np.all(np.isfinite(R), axis=(1, 2))
+    if ok.any():
+        try:
+            out[ok] = np.linalg.solve(M[ok], R[ok])
+        except np.linalg.LinAlgError:
+            for k in np.flatnonzero(ok):
+                try:
+                    out[k] = np.linalg.solve(M[k], R[k])
+                except np.linalg.LinAlgError:
+                    pass
+    return out

@@ -1,0 +1,247 @@
+"""PNG figures of the analysis results (matplotlib, Agg canvas only).
+
+This is the only module of ambseal that imports matplotlib. It never touches pyplot or the
+global backend: each figure is a ``matplotlib.figure.Figure`` on its own Agg canvas, written
+to a temporary file in the target folder and moved into place with ``os.replace``.
+
+Every function takes plain arrays (or results' arrays) and a path, and returns the path.
+A *curve* is a tuple ``(label, x, y)`` of a legend label and two 1-D arrays of equal length;
+one curve per (controller, pressure) case, as in the thesis figures (P5 Fig. 11–14).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.ticker import NullFormatter, ScalarFormatter
+
+from ambseal.errors import AmbsealError
+
+__all__ = [
+    "Curve",
+    "sensitivity_figure",
+    "compliance_figure",
+    "unbalance_figure",
+    "impulse_figure",
+    "save_figure",
+]
+
+Curve = tuple[str, Sequence[float], Sequence[float]]
+
+#: ISO 14839-3 zone limits (P5 §4.1 item 4) — kept here so report does not need analysis.
+_ISO_LIMITS = (3.0, 4.0, 5.0)
+
+
+def save_figure(fig: Figure, path: str | os.PathLike, *, dpi: int = 120) -> Path:
+    """Write ``fig`` as PNG to ``path`` atomically (temporary file + ``os.replace``).
+
+    Raises
+    ------
+    AmbsealError
+        If the folder does not exist or is not writable.
+    """
+    path = Path(path)
+    if not path.parent.is_dir():
+        raise AmbsealError(f"figure folder {str(path.parent)!r} does not exist")
+    FigureCanvasAgg(fig)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fig.savefig(fh, format="png", dpi=dpi)
+        os.chmod(tmp, 0o644)  # mkstemp creates 0600; a report is meant to be shared
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path
+
+
+def _curves(curves: Sequence[Curve]) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    out = []
+    for i, c in enumerate(curves):
+        try:
+            label, x, y = c
+        except (TypeError, ValueError) as exc:
+            raise AmbsealError(f"curve {i}: expected (label, x, y), got {type(c).__name__}") from exc
+        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+        if x.shape != y.shape or x.ndim != 1:
+            raise AmbsealError(f"curve {i} ({label!r}): x and y must be 1-D of equal length, got {x.shape}, {y.shape}")
+        out.append((str(label), x, y))
+    return out
+
+
+def _finite_max(curves: list[tuple[str, np.ndarray, np.ndarray]]) -> float:
+    vals = [np.nanmax(y[np.isfinite(y)]) for _, _, y in curves if np.isfinite(y).any()]
+    return float(max(vals)) if vals else 1.0
+
+
+def sensitivity_figure(
+    path: str | os.PathLike, curves: Sequence[Curve], *, title: str = "Output sensitivity σ̄(S_o)"
+) -> Path:
+    """σ̄ of S_o against frequency with the ISO 14839-3 zone lines (P5 Fig. 13).
+
+    Parameters
+    ----------
+    path : path-like
+        PNG file to write.
+    curves : sequence of (label, frequency_hz, gain)
+        Frequencies in Hz (log axis) and absolute gain (not dB), one curve per case.
+    title : str
+        Axes title.
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    cs = _curves(curves)
+    fig = Figure(figsize=(8, 4.5))
+    ax = fig.add_subplot()
+    for label, x, y in cs:
+        ax.loglog(x, y, label=label)
+    ymax = max(_finite_max(cs) * 1.5, 8.0)
+    ax.set_ylim(min(0.1, ax.get_ylim()[0]), ymax)
+    for lim in _ISO_LIMITS:
+        ax.axhline(lim, color="k", lw=0.8, ls="--")
+    bands = [("A", 0.5 * 3.0), ("B", 3.45), ("C", 4.45), ("D", 6.0)]
+    for zone, yz in bands:
+        ax.text(1.01, yz, zone, transform=ax.get_yaxis_transform(), va="center", ha="left", fontsize=9)
+    ax.yaxis.set_major_formatter(ScalarFormatter())
+    ax.yaxis.set_minor_formatter(NullFormatter())
+    ax.set_xlabel("Frequency (Hz)")
+    ax.set_ylabel("σ̄(S_o) (-)")
+    ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    if cs:
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def compliance_figure(
+    path: str | os.PathLike, curves: Sequence[Curve], *, title: str = "Compliance σ̄(S_o G_f)"
+) -> Path:
+    """σ̄ of the compliance against frequency (P5 Fig. 11).
+
+    Parameters
+    ----------
+    path : path-like
+    curves : sequence of (label, frequency_hz, compliance_m_per_n)
+        Frequencies in Hz; compliance in m/N (plotted in µm/N on a log axis).
+    title : str
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    cs = _curves(curves)
+    fig = Figure(figsize=(8, 4.5))
+    ax = fig.add_subplot()
+    for label, x, y in cs:
+        ax.loglog(x, y * 1e6, label=label)
+    ax.set_xlabel("Frequency (Hz)")
+    ax.set_ylabel("σ̄ compliance (µm/N)")
+    ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    if cs:
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def unbalance_figure(
+    path: str | os.PathLike, curves: Sequence[Curve], *, title: str = "Worst-case unbalance response"
+) -> Path:
+    """Worst-case unbalance response against speed (P5 Fig. 12).
+
+    Parameters
+    ----------
+    path : path-like
+    curves : sequence of (label, speed_hz, response_um)
+        Speed (= excitation frequency) in Hz, response in µm (linear axes).
+    title : str
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    cs = _curves(curves)
+    fig = Figure(figsize=(8, 4.5))
+    ax = fig.add_subplot()
+    for label, x, y in cs:
+        ax.plot(x, y, label=label)
+    ax.set_xlabel("Speed (Hz)")
+    ax.set_ylabel("Displacement bound (µm)")
+    ax.set_title(title)
+    ax.set_ylim(bottom=0)
+    ax.grid(True, alpha=0.3)
+    if cs:
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def impulse_figure(
+    path: str | os.PathLike,
+    cases: Sequence[tuple[str, Sequence[float], np.ndarray]],
+    channel_names: Sequence[str],
+    *,
+    currents: Sequence[tuple[str, Sequence[float], np.ndarray]] | None = None,
+    title: str = "Impulse response",
+) -> Path:
+    """Impulse responses per output channel (P5 Fig. 14), optionally with controller currents.
+
+    Parameters
+    ----------
+    path : path-like
+    cases : sequence of (label, time_ms, displacement_um)
+        ``time_ms`` shape (n_t,), ``displacement_um`` shape (n_t, n_ch); one curve per case in
+        each channel's panel.
+    channel_names : sequence of str
+        Panel titles, length ``n_ch``.
+    currents : sequence of (label, time_ms, current_a), optional
+        Controller currents (A), shape (n_t, n_ch); drawn as a second row of panels.
+    title : str
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    AmbsealError
+        If array shapes do not match the channel names.
+    """
+    names = [str(n) for n in channel_names]
+    nch = len(names)
+    rows = [("Displacement (µm)", cases)] + ([("Current (A)", currents)] if currents else [])
+    fig = Figure(figsize=(3.2 * max(nch, 1), 2.8 * len(rows) + 0.6))
+    axes = fig.subplots(len(rows), max(nch, 1), squeeze=False, sharex=True)
+    for r, (ylabel, data) in enumerate(rows):
+        for label, t, Y in data:
+            t = np.asarray(t, dtype=float)
+            Y = np.asarray(Y, dtype=float).reshape(t.size, -1)
+            if Y.shape[1] != nch:
+                raise AmbsealError(f"impulse_figure: case {label!r} has {Y.shape[1]} channels, expected {nch}")
+            for j in range(nch):
+                axes[r, j].plot(t, Y[:, j], label=str(label), lw=1)
+        for j in range(nch):
+            ax = axes[r, j]
+            ax.grid(True, alpha=0.3)
+            if r == 0:
+                ax.set_title(names[j])
+            if j == 0:
+                ax.set_ylabel(ylabel)
+            if r == len(rows) - 1:
+                ax.set_xlabel("Time (ms)")
+    if cases:
+        axes[0, 0].legend(fontsize=7)
+    fig.suptitle(title)
+    fig.tight_layout()
+    return save_figure(fig, path)

@@ -1,0 +1,138 @@
+"""Tests of ambseal.analysis.loops: closed-form SISO loops and python-control side by side."""
+
+from __future__ import annotations
+
+import json
+
+import control
+import numpy as np
+import pytest
+
+from ambseal.analysis import loops
+from ambseal.errors import ModelError
+
+from .amb_test_plants import NAMES, mass_1dof, rigid_rotor
+
+W = np.logspace(0, 4.5, 600)
+
+
+def _static(D):
+    """A zero-state python-control system with feedthrough D."""
+    D = np.atleast_2d(np.asarray(D, dtype=float))
+    return control.ss(np.zeros((0, 0)), np.zeros((0, D.shape[1])), np.zeros((D.shape[0], 0)), D)
+
+
+def test_1dof_poles_and_sensitivity_closed_form():
+    """Reference: closed form for the 1-DOF AMB axis with PD control (P5 Eq. 1, 6):
+    poles = roots(denG·denK + numG·numK), S = 1/(1 + G K) with G, K as polynomials in jω."""
+    G, K, (nG, dG), (nK, dK) = mass_1dof()
+    cl = loops.closed_loop(G, K)
+    ref_poles = np.roots(np.polyadd(np.polymul(dG, dK), np.polymul(nG, nK)))
+    np.testing.assert_allclose(np.sort_complex(cl.poles), np.sort_complex(ref_poles), rtol=1e-8)
+    assert cl.stable and cl.max_real_pole == pytest.approx(ref_poles.real.max(), rel=1e-8)
+    s = 1j * W
+    S_ref = 1.0 / (1.0 + np.polyval(nG, s) / np.polyval(dG, s) * np.polyval(nK, s) / np.polyval(dK, s))
+    lr = loops.loop_responses(G, K, W)
+    np.testing.assert_allclose(lr.So[:, 0, 0], S_ref, rtol=1e-9)
+    np.testing.assert_allclose(lr.Si[:, 0, 0], S_ref, rtol=1e-9)  # SISO: S_i = S_o
+    np.testing.assert_allclose(lr.To[:, 0, 0], 1.0 - S_ref, rtol=1e-8, atol=1e-12)
+    pk = lr.peaks("So")
+    k = int(np.argmax(np.abs(S_ref)))
+    assert pk.sigma_max.value == pytest.approx(abs(S_ref[k]), rel=1e-9)
+    assert pk.sigma_max.frequency_hz == pytest.approx(W[k] / (2 * np.pi))
+    assert pk.diagonal[0].channel == "A_zeta" and pk.diagonal[0].value == pytest.approx(abs(S_ref[k]))
+
+
+def test_unstable_when_gain_below_negative_stiffness():
+    """Reference: with kp·ki < ks the net static stiffness is negative, so a real closed-loop
+    pole is positive (Routh: constant term of m s² + ... + (kp ki − ks) < 0)."""
+    G, K, _, _ = mass_1dof(kp_factor=0.5)
+    cl = loops.closed_loop(G, K)
+    assert not cl.stable and cl.max_real_pole > 0
+    d = cl.to_dict()
+    json.dumps(d)
+    assert d["stable"] is False
+
+
+def test_rigid_rotor_matches_python_control_feedback():
+    """Reference: python-control run side by side: control.feedback(G, K, sign=-1) poles and
+    d→y response; S_o = feedback(I, G K) and S_i = feedback(I, K G), K S_o, T_o = G K S_o, all by
+    control.frequency_response; rigid rotor on two AMBs with a cross-coupled seal."""
+    G, Gf, K = rigid_rotor()
+    cl = loops.closed_loop(G, K, Gf)
+    ref = control.feedback(G, K, sign=-1)
+    np.testing.assert_allclose(np.sort_complex(cl.poles), np.sort_complex(ref.poles()), rtol=1e-7)
+    assert cl.stable
+    assert list(cl.system.input_labels) == [f"d_{n}" for n in NAMES] + ["Fx", "Fy"]
+    assert list(cl.system.output_labels) == NAMES + [f"i_{n}" for n in NAMES]
+    w = np.logspace(0, 4, 300)
+
+    def fresp(sys):
+        return np.moveaxis(control.frequency_response(sys, w, squeeze=False).complex, 2, 0)
+
+    ours_dy = fresp(cl.system)[:, :4, :4]
+    np.testing.assert_allclose(ours_dy, fresp(ref), rtol=1e-6, atol=1e-12 * np.abs(fresp(ref)).max())
+    I4 = _static(np.eye(4))
+    lr = loops.loop_responses(G, K, w)
+    refs = {"So": control.feedback(I4, G * K), "Si": control.feedback(I4, K * G)}
+    refs["To"] = G * K * refs["So"]
+    refs["KS"] = K * refs["So"]
+    for key, sysref in refs.items():
+        R = fresp(sysref)
+        np.testing.assert_allclose(getattr(lr, key), R, rtol=1e-6, atol=1e-9 * np.abs(R).max(), err_msg=key)
+    sm = lr.sigma_max("So")
+    R = fresp(refs["So"])
+    np.testing.assert_allclose(sm, np.linalg.svd(R, compute_uv=False)[:, 0], rtol=1e-7)
+    pk = lr.peaks("So")
+    assert [p.channel for p in pk.diagonal] == NAMES
+    assert pk.sigma_max.value >= pk.max_diagonal.value - 1e-12  # σ̄ bounds every element
+    json.dumps(lr.to_dict())
+
+
+def test_compliance_matches_python_control():
+    """Reference: python-control side by side: compliance built as
+    S_o·Gf = feedback(I, G K) * Gf (P5 §4.4.1); and the closed loop's own Fx, Fy → y channels."""
+    G, Gf, K = rigid_rotor()
+    w = np.logspace(0, 4, 300)
+    comp = loops.compliance(G, K, Gf, w)
+    ref = control.feedback(_static(np.eye(4)), G * K) * Gf
+    R = np.moveaxis(control.frequency_response(ref, w, squeeze=False).complex, 2, 0)
+    np.testing.assert_allclose(comp.H_m_per_n, R, rtol=1e-6, atol=1e-9 * np.abs(R).max())
+    cl = loops.closed_loop(G, K, Gf)
+    R2 = np.moveaxis(control.frequency_response(cl.system, w, squeeze=False).complex, 2, 0)[:, :4, 4:]
+    np.testing.assert_allclose(comp.H_m_per_n, R2, rtol=1e-6, atol=1e-9 * np.abs(R).max())
+    sm = np.linalg.svd(R, compute_uv=False)[:, 0]
+    assert comp.peak.value == pytest.approx(sm.max(), rel=1e-6)
+    assert comp.force_names == ("Fx", "Fy")
+    d = comp.to_dict()
+    json.dumps(d)
+    assert d["peak_m_per_n"] == pytest.approx(sm.max(), rel=1e-6)
+
+
+def test_dimension_and_state_checks():
+    """Reference: interface contract — K must be ny→nu, Gf must share A and C with G; a grid
+    point on an integrator pole (ω = 0, PI action as in P5 Eq. 6) is rejected, not turned into
+    an infinite 'peak'."""
+    G, Gf, K = rigid_rotor()
+    with pytest.raises(ModelError):
+        loops.closed_loop(G, _static(np.eye(2)))
+    G2, Gf2, _ = rigid_rotor(k_seal=0.0)
+    with pytest.raises(ModelError):
+        loops.closed_loop(G, K, Gf2)
+    with pytest.raises(ModelError):
+        loops.loop_responses(G, K, W).peaks("S")
+    integ = control.ss(control.tf([1.0, 5.0], [1.0, 0.0]))  # PI-like factor, pole at s = 0
+    KI = control.append(integ, integ, integ, integ) * K
+    with pytest.raises(ModelError, match="imaginary axis"):
+        loops.loop_responses(G, KI, np.array([0.0, 1.0, 10.0]))
+
+
+def test_peak_and_sigma_helpers():
+    """Reference: definitions — σ̄ of diag(a, b) is max(|a|, |b|); Peak.value_db = 20 log10."""
+    F = np.zeros((3, 2, 2), dtype=complex)
+    F[:, 0, 0] = [1, 3, 2]
+    F[:, 1, 1] = [2j, 1, 4]
+    np.testing.assert_allclose(loops.sigma_max(F), [2, 3, 4])
+    p = loops.peak_of(loops.sigma_max(F), 2 * np.pi * np.array([1.0, 2.0, 3.0]))
+    assert (p.value, p.frequency_hz) == (4.0, pytest.approx(3.0))
+    assert loops.Peak(10.0, 1.0).value_db == pytest.approx(20.0)

@@ -1,0 +1,42 @@
+"""Tests of ambseal.report.figures: PNG files are written atomically from plain arrays."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ambseal.errors import AmbsealError
+from ambseal.report import figures
+
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+def _ok(path):
+    data = path.read_bytes()
+    assert data.startswith(PNG) and len(data) > 2000
+    assert not [p for p in path.parent.iterdir() if p.name.endswith(".tmp")]
+
+
+def test_all_figures_written(tmp_path):
+    """Reference: PNG signature (ISO/IEC 15948 §5.2) on each output, no temporary left over;
+    curves shaped like P5 Fig. 11–14 (Hz log axis, µm, ms)."""
+    f = np.logspace(0, 3, 200)
+    s = 1 + 2 / (1 + ((f - 60) / 10) ** 2)
+    cases = [("PID, 0 bar", f, s), ("H∞, 2.04 bar", f, s * 1.3), ("unstable", f, np.full_like(f, np.inf))]
+    _ok(figures.sensitivity_figure(tmp_path / "s.png", cases))
+    _ok(figures.compliance_figure(tmp_path / "c.png", [("PID", f, 1e-7 * s)]))
+    _ok(figures.unbalance_figure(tmp_path / "u.png", [("PID", f, 3 * s)]))
+    t = np.linspace(0, 100, 500)
+    Y = np.column_stack([np.sin(t / 5) * np.exp(-t / 30) * k for k in (1, 0.5, 0.2, 0.8)])
+    names = ["A_zeta", "A_eta", "B_zeta", "B_eta"]
+    _ok(figures.impulse_figure(tmp_path / "i.png", [("PID", t, Y)], names, currents=[("PID", t, Y / 10)]))
+
+
+def test_bad_curves_raise(tmp_path):
+    """Reference: interface contract — mismatched arrays or a missing folder raise AmbsealError."""
+    with pytest.raises(AmbsealError):
+        figures.compliance_figure(tmp_path / "x.png", [("a", [1, 2], [1, 2, 3])])
+    with pytest.raises(AmbsealError):
+        figures.unbalance_figure(tmp_path / "missing" / "x.png", [])
+    with pytest.raises(AmbsealError):
+        figures.impulse_figure(tmp_path / "i.png", [("a", [0, 1], np.zeros((2, 3)))], ["A", "B"])

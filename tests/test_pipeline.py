@@ -1,0 +1,67 @@
+"""The main job on the embedded thesis test facility."""
+
+import json
+
+import pytest
+
+from ambseal.cli import main
+
+KEYS = {
+    "controller", "pressure_bar", "stable", "max_real_pole", "sensitivity_peak",
+    "sensitivity_peak_per_axis", "iso_zone", "iso_zone_per_axis", "compliance_peak_m_per_n",
+    "unbalance_peak_um", "impulse_peak_um", "impulse_settling_s",
+}
+
+
+@pytest.fixture(scope="module")
+def metrics(tmp_path_factory):
+    out = tmp_path_factory.mktemp("run")
+    assert main(["run", "--out", str(out)]) == 0
+    return out, json.loads((out / "metrics.json").read_text())
+
+
+def test_run_writes_the_contract(metrics):
+    """metrics.json keys of the issue, the figures and a self-contained report, and no
+    temporary file left behind (writes go through a rename)."""
+    out, m = metrics
+    assert {"rig", "open_loop", "cases"} <= set(m)
+    assert set(m["open_loop"]) == {"unstable_poles", "n_states_full", "n_states_reduced"}
+    from ambseal.config import load_rig
+    from ambseal.model.rotor import build_mesh
+
+    n_nodes = build_mesh(load_rig()).n_nodes
+    # [q; q̇] with 4 DOF per node, plus 2 states of each of the 4 second-order actuators
+    assert m["open_loop"]["n_states_full"] == 8 * n_nodes + 8
+    for case in m["cases"]:
+        assert KEYS <= set(case)
+    names = {p.name for p in out.iterdir()}
+    assert {"metrics.json", "report.html", "sensitivity.png", "compliance.png",
+            "unbalance.png", "impulse.png"} <= names
+    assert not [n for n in names if n.endswith(".tmp")]
+    html = (out / "report.html").read_text()
+    assert "data:image/png;base64," in html and "<img src=\"http" not in html
+
+
+def test_run_reproduces_the_thesis_findings(metrics):
+    """Open loop unstable; PID stable at 0 and 2.04 bar, unstable at 4.08 bar
+    (P5 §4.4.2, Fig. 13); reduced model of 8 rigid-body states plus the actuators."""
+    _, m = metrics
+    assert len(m["open_loop"]["unstable_poles"]) >= 2
+    assert m["open_loop"]["n_states_reduced"] == 8 + 2 * 4
+    by_p = {c["pressure_bar"]: c for c in m["cases"] if c["controller"] == "pid"}
+    assert sorted(by_p) == [0.0, 2.04, 4.08]
+    assert by_p[0.0]["stable"] and by_p[2.04]["stable"] and not by_p[4.08]["stable"]
+    assert by_p[4.08]["iso_zone"] == "D" and by_p[4.08]["sensitivity_peak"] is None
+    # the seal degrades the loop: higher sensitivity peak and compliance at nominal pressure
+    assert by_p[2.04]["sensitivity_peak"] > by_p[0.0]["sensitivity_peak"]
+    assert by_p[2.04]["compliance_peak_m_per_n"] > by_p[0.0]["compliance_peak_m_per_n"]
+    assert 0 < by_p[0.0]["impulse_settling_s"] < 0.3
+
+
+def test_run_bad_rig_exits_2(tmp_path, capsys):
+    """A bad rig: one line on stderr, exit 2."""
+    rig = tmp_path / "bad.toml"
+    rig.write_text("[[shaft]]\nlength = 1\n")
+    assert main(["run", str(rig), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "bad.toml" in err[0]

@@ -1,0 +1,251 @@
+"""Benchmark: ambseal against ROSS on the same 40-element rotor, in one process.
+
+Cases (one JSON line each on stdout; progress and ROSS's own chatter go to stderr):
+
+``build_modal`` (at 0 and at 3000 rpm)
+    Ours: ``parse_rig(dict)`` → ``build_system(cfg, speed_rpm=...)`` → ``modes(sys)``.
+    ROSS: elements → ``rs.Rotor(...)`` → ``rotor.run_modal(speed)`` (its defaults: ARPACK,
+    ``num_modes`` raised to 16 so that at least 8 lateral modes are returned).
+    Check: max relative difference of the 8 lowest damped natural frequencies (rad/s);
+    ROSS's torsional/axial modes are left out by their eigenvectors.
+``freq_response_1000``
+    A 1000-point FRF (1–500 Hz) from the forces at the two bearing nodes to the
+    displacements there (4×4). Ours: ``build_plant(cfg)`` → ``freqresp((A, B, C, D), ω)``.
+    ROSS: elements → ``rs.Rotor(...)`` → ``rotor.run_freq_response(speed_range=ω,
+    free_free=True)``, which solves the full 246-DOF dynamic stiffness per frequency (ROSS has
+    no option to restrict the DOFs). ``free_free=True`` is ROSS's switch for a fixed spin
+    speed of 0 with the bearings kept; its default (``free_free=False``) sets the spin speed
+    equal to each excitation frequency, which is a different quantity. Check: max relative
+    difference of |H| over the grid, entries with |H| ≥ 1e-3·max|H| only.
+
+The rotor: uniform steel shaft, 1.5 m, Ø 50 mm, 40 Timoshenko elements (Cowper's shear
+coefficient on both sides), two rigid disks (20 kg, Id 0.1, Ip 0.2 kg·m²) at nodes 13 and 27,
+two bearings (k = 1e6 N/m, c = 1e3 N·s/m in x and y) at nodes 4 and 36. In ambseal each
+bearing is an ``[[amb]]`` with ``ki = 1`` (input in N), ``ks = 0``, axes at 0°, collocated
+sensor, plus a ``[[spring]]`` with the bearing coefficients.
+
+Both sides are timed end to end (model build included), each repeat on a freshly built
+model (ROSS caches ``run_modal``/``run_freq_response`` per rotor instance), after one
+untimed warm-up call; the medians are reported. BLAS runs single-threaded by default
+(``--threads``): on a small, busy machine multi-threaded OpenBLAS spends most of its time
+spinning, which makes every timing meaningless.
+
+Run: ``PYTHONPATH=src python benchmarks/bench_model.py [--quick] [--threads N]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+
+
+def _args() -> argparse.Namespace:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--quick", action="store_true", help="fewer repeats (smoke run)")
+    ap.add_argument("--threads", type=int, default=1,
+                    help="BLAS threads for both tools (default 1; 0 keeps the environment's)")
+    return ap.parse_args()
+
+
+ARGS = _args()
+if ARGS.threads > 0:  # must happen before numpy is imported
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ[var] = str(ARGS.threads)
+
+# stdout carries only the JSON lines: keep a handle on the real stdout, then send file
+# descriptor 1 (C-level prints, e.g. CoolProp's REFPROP notice on `import ross`) and
+# Python's sys.stdout to stderr.
+_OUT = os.fdopen(os.dup(1), "w", buffering=1)
+os.dup2(2, 1)
+sys.stdout = sys.stderr
+
+import statistics  # noqa: E402
+import warnings  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+# ---------------------------------------------------------------- the rotor (both sides)
+N_EL = 40
+LENGTH = 1.5  # m
+DIAMETER = 0.05  # m
+E, RHO, G_S = 211e9, 7810.0, 81.2e9  # Pa, kg/m³, Pa
+DISK_NODES = (13, 27)
+DISK_M, DISK_ID, DISK_IP = 20.0, 0.1, 0.2  # kg, kg·m², kg·m²
+BRG_NODES = (4, 36)
+KB, CB = 1e6, 1e3  # N/m, N·s/m
+OMEGA = 2 * np.pi * np.linspace(1.0, 500.0, 1000)  # rad/s (ω = 0 is singular in ROSS: free axial/torsion)
+MODAL_SPEEDS_RPM = (0.0, 3000.0)
+N_FREQ = 8  # natural frequencies compared
+
+EL_LEN = LENGTH / N_EL
+
+
+def rig_dict() -> dict:
+    """The rotor as an ambseal rig (dict, as read from TOML)."""
+    zb = [n * EL_LEN for n in BRG_NODES]
+    return {
+        "rotor": {"beam": "timoshenko", "name": "bench40"},
+        "materials": {"steel": {"E": E, "rho": RHO, "G": G_S}},
+        "shaft": [{"length": LENGTH, "outer_diameter": DIAMETER, "material": "steel",
+                   "elements": N_EL}],
+        "disk": [{"position": n * EL_LEN, "mass": DISK_M, "Ip": DISK_IP, "Id": DISK_ID}
+                 for n in DISK_NODES],
+        "amb": [{"name": name, "position": z, "sensor_position": z, "axes_angle_deg": 0.0,
+                 "ki": 1.0, "ks": 0.0} for name, z in zip(("A", "B"), zb)],
+        "spring": [{"position": z, "kxx": KB, "kyy": KB, "cxx": CB, "cyy": CB} for z in zb],
+    }
+
+
+def ross_rotor(rs):
+    """The same rotor in ROSS."""
+    steel = rs.Material(name="bench_steel", rho=RHO, E=E, G_s=G_S)
+    shaft = [rs.ShaftElement(L=EL_LEN, idl=0.0, odl=DIAMETER, material=steel, n=i,
+                             shear_method_calc="cowper") for i in range(N_EL)]
+    disks = [rs.DiskElement(n=n, m=DISK_M, Id=DISK_ID, Ip=DISK_IP) for n in DISK_NODES]
+    brgs = [rs.BearingElement(n=n, kxx=KB, kyy=KB, cxx=CB, cyy=CB) for n in BRG_NODES]
+    return rs.Rotor(shaft, disks, brgs)
+
+
+# ---------------------------------------------------------------- the calls being timed
+def ours_modal(speed_rpm: float):
+    from ambseal.config import parse_rig
+    from ambseal.model.modes import modes
+    from ambseal.model.rig import build_system
+
+    return modes(build_system(parse_rig(rig_dict()), speed_rpm=speed_rpm))
+
+
+def ross_modal(rs, speed_rpm: float):
+    return ross_rotor(rs).run_modal(speed_rpm * np.pi / 30, num_modes=16)
+
+
+def ours_frf(omega: np.ndarray, **kw) -> np.ndarray:
+    """(n_w, 4, 4): outputs A_x, A_y, B_x, B_y per input force at A, B (N)."""
+    from ambseal.analysis.freqresp import freqresp
+    from ambseal.config import parse_rig
+    from ambseal.model.rig import build_plant
+
+    p = build_plant(parse_rig(rig_dict()), speed_rpm=0.0)
+    return freqresp((p.A, p.B, p.C, p.D), omega, **kw)
+
+
+def ross_frf(rs, omega: np.ndarray) -> np.ndarray:
+    rotor = ross_rotor(rs)
+    res = rotor.run_freq_response(speed_range=omega, free_free=True)
+    nd = rotor.number_dof  # 6 per node in ROSS 2.x: [x, y, z, α, β, θ]
+    idx = [nd * n + d for n in BRG_NODES for d in (0, 1)]
+    return res.freq_resp[np.ix_(idx, idx)].transpose(2, 0, 1)
+
+
+# ---------------------------------------------------------------- helpers
+def log(msg: str) -> None:
+    print(msg, file=sys.stderr, flush=True)
+
+
+def timed(fn, repeats: int, label: str):
+    """Median wall time over ``repeats`` calls, and the last result."""
+    times = []
+    out = None
+    for k in range(repeats):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+        log(f"  {label}: run {k + 1}/{repeats}: {times[-1]:.4f} s")
+    return statistics.median(times), out
+
+
+def ross_lateral_wd(modal, ndof: int, number_dof: int) -> np.ndarray:
+    """Damped natural frequencies (rad/s, ascending) of ROSS's lateral modes.
+
+    ROSS 2.x nodes carry [x, y, z, α, β, θ]; a mode counts as lateral when most of its
+    displacement-part energy lies on x, y, α, β (leaves out torsional and axial modes).
+    """
+    lam, vec = np.asarray(modal.evalues), np.asarray(modal.evectors)[:ndof]
+    lat = np.array([i for i in range(ndof) if i % number_dof in (0, 1, 3, 4)])
+    frac = np.sum(np.abs(vec[lat]) ** 2, axis=0) / np.sum(np.abs(vec) ** 2, axis=0)
+    keep = (lam.imag > 1e-6) & (frac > 0.5)
+    return np.sort(lam.imag[keep])
+
+
+def frf_diff(ours: np.ndarray, base: np.ndarray, floor: float = 1e-3) -> float:
+    """max | |H_ours| − |H_base| | / |H_base| over entries with |H_base| ≥ floor·max|H_base|."""
+    a, b = np.abs(ours), np.abs(base)
+    mask = b >= floor * b.max()
+    return float(np.max(np.abs(a[mask] - b[mask]) / b[mask]))
+
+
+def emit(rec: dict) -> None:
+    _OUT.write(json.dumps(rec) + "\n")
+    _OUT.flush()
+
+
+# ---------------------------------------------------------------- main
+def main() -> int:
+    rep_ours = 3 if ARGS.quick else 5
+    rep_modal = 2 if ARGS.quick else 5
+    rep_frf = 1 if ARGS.quick else 3
+
+    t0 = time.perf_counter()
+    import ambseal.analysis.freqresp  # noqa: F401
+    import ambseal.config  # noqa: F401
+    import ambseal.model.modes  # noqa: F401
+    import ambseal.model.rig  # noqa: F401
+    log(f"import ambseal (model, modes, freqresp): {time.perf_counter() - t0:.2f} s")
+    t0 = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        import ross as rs
+    log(f"import ross {rs.__version__}: {time.perf_counter() - t0:.2f} s")
+    baseline = "ross " + ".".join(rs.__version__.split(".")[:2])
+    common = {"n_elements": N_EL, "blas_threads": ARGS.threads or None,
+              "repeats_ours": rep_ours}
+
+    # warm-up (first calls pay for lazy imports and caches), untimed
+    t0 = time.perf_counter()
+    ours_modal(0.0)
+    ours_frf(OMEGA[:5])
+    log(f"warm-up ours: {time.perf_counter() - t0:.2f} s")
+    t0 = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ross_modal(rs, 0.0)
+        ross_frf(rs, OMEGA[:5])
+    log(f"warm-up ROSS: {time.perf_counter() - t0:.2f} s")
+
+    for rpm in MODAL_SPEEDS_RPM:
+        log(f"case build_modal at {rpm:g} rpm")
+        t_ours, m = timed(lambda: ours_modal(rpm), rep_ours, "ours")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            t_base, mr = timed(lambda: ross_modal(rs, rpm), rep_modal, "ross")
+        rotor = ross_rotor(rs)
+        wd_ours = 2 * np.pi * np.asarray(m.natural_frequencies_hz[:N_FREQ])
+        wd_ross = ross_lateral_wd(mr, rotor.ndof, rotor.number_dof)[:N_FREQ]
+        n = min(wd_ours.size, wd_ross.size)
+        diff = float(np.max(np.abs(wd_ours[:n] - wd_ross[:n]) / wd_ross[:n]))
+        emit({"case": "build_modal", "speed_rpm": rpm, "ours_s": t_ours, "baseline": baseline,
+              "baseline_s": t_base, "ratio": t_base / t_ours, "max_rel_diff": diff,
+              "n_compared": n, "lowest_hz": [round(x / (2 * np.pi), 4) for x in wd_ross[:n]],
+              "repeats_baseline": rep_modal, **common})
+
+    log("case freq_response_1000")
+    t_ours, H = timed(lambda: ours_frf(OMEGA), rep_ours, "ours")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        t_base, Hr = timed(lambda: ross_frf(rs, OMEGA), rep_frf, "ross")
+    # the same comparison with ambseal's modal evaluation forced (untimed, diagnostic)
+    H_modal = ours_frf(OMEGA, method="modal")
+    emit({"case": "freq_response_1000", "ours_s": t_ours, "baseline": baseline,
+          "baseline_s": t_base, "ratio": t_base / t_ours, "max_rel_diff": frf_diff(H, Hr),
+          "max_rel_diff_method_modal": frf_diff(H_modal, Hr),
+          "n_freq": int(OMEGA.size), "f_hz": [1.0, 500.0], "shape": list(H.shape),
+          "baseline_call": "run_freq_response(speed_range=w, free_free=True)",
+          "repeats_baseline": rep_frf, **common})
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

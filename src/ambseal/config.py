@@ -24,7 +24,8 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     each a number or ``{ zeta = ..., eta = ... }``. Also optional ``current_limit`` (A).
 ``[actuator]``
     ``model`` = ``"none"`` | ``"first_order"`` (``cutoff_hz``) | ``"second_order"``
-    (``natural_frequency`` in rad/s, ``damping_ratio``).
+    (``natural_frequency`` in rad/s, ``damping_ratio``); ``eddy_time_constant`` τ_e (s,
+    default 0): a first-order lag 1/(τ_e s + 1) between coil current and force (P2 §4).
 ``[[seal]]``
     ``name``, ``position``, ``K``, ``k`` (N/m), ``C``, ``c`` (N·s/m), ``M`` (kg), each a number
     or ``{ at_zero = ..., per_bar = ... }``; Childs' convention
@@ -35,6 +36,8 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     ``name`` (optional).
 ``[controller.pid]``
     ``kp`` (A/m), ``ti`` (s), ``td`` (s), ``eps`` (-): thesis P5 Eq. 6, per actuator axis.
+``[controller]``
+    ``sample_rate_hz``: the rate of the digital controller (default 10 kHz).
 ``[operating]``
     ``speed_rpm``, ``pressure_bar`` (the nominal pressure drop across the seals).
 ``[reduction]``
@@ -207,6 +210,7 @@ class Actuator(_Strict):
     cutoff_hz: float | None = Field(default=None, gt=0)
     natural_frequency: float | None = Field(default=None, gt=0)
     damping_ratio: float | None = Field(default=None, gt=0)
+    eddy_time_constant: float = Field(default=0.0, ge=0)
 
     @model_validator(mode="after")
     def _needs(self) -> "Actuator":
@@ -271,6 +275,7 @@ class Pid(_Strict):
 
 class Controllers(_Strict):
     pid: Pid | None = None
+    sample_rate_hz: float = Field(default=10000.0, gt=0)
 
 
 class Operating(_Strict):
@@ -420,3 +425,56 @@ def load_rig(path: str | Path | None = None) -> RigConfig:
 def default_rig_path() -> Path:
     """Path of the embedded thesis test facility (``ambseal/data/testrig.toml``)."""
     return Path(__file__).parent / "data" / "testrig.toml"
+
+
+class TruthSection(_Strict):
+    """The virtual test facility's true values, in a file of their own that a fit never reads.
+
+    ``parameters`` maps model parameter names (``A.Ki_zeta``, ``A.Ks_zeta``,
+    ``coupling.kxx``, ``seal.k``, ...) to a number or ``{ at_zero, per_bar }``.
+    """
+
+    parameters: dict[str, Coefficient] = {}
+    tau_e: float = Field(default=0.0, ge=0)
+    bias_current: float = Field(default=6.0, gt=0)
+    current_limit: float | None = Field(default=None, gt=0)
+    sensor_noise_m: float = Field(default=0.0, ge=0)
+    noise_fraction: float = Field(default=0.0, ge=0)
+    current_noise_a: float = Field(default=0.0, ge=0)
+    adc_bits: int | None = Field(default=None, ge=2, le=32)
+    adc_range_m: float = Field(default=1.0e-3, gt=0)
+    substeps: int = Field(default=4, ge=1, le=100)
+    max_mode_hz: float = Field(default=10000.0, gt=0)
+
+    def values_at(self, pressure_bar: float) -> dict[str, float]:
+        """Parameter values (SI) at a pressure drop (bar)."""
+        return {k: coefficient_value(v, pressure_bar) for k, v in self.parameters.items()}
+
+
+class TruthConfig(_Strict):
+    truth: TruthSection
+
+
+def load_truth(path: str | Path) -> TruthSection:
+    """Read a truth file (TOML with a ``[truth]`` table); ConfigError on any fault.
+
+    Keys of ``[truth]``: ``tau_e`` (s), ``bias_current`` (A), ``current_limit`` (A, default
+    the AMBs' ``current_limit``), ``sensor_noise_m`` (std, m) or ``noise_fraction`` (std as
+    a fraction of each displacement channel's RMS), ``current_noise_a`` (std, A),
+    ``adc_bits`` and ``adc_range_m`` (full scale ±range/2), ``substeps`` (integration steps
+    per controller sample), ``max_mode_hz`` (modes kept in the simulation, default 10 kHz),
+    and ``[truth.parameters]``.
+    """
+    p = Path(path)
+    try:
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise ConfigError(f"{p}: cannot read truth file ({exc.strerror or exc})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{p}: not valid TOML ({exc})") from None
+    try:
+        return TruthConfig.model_validate(data).truth
+    except ValidationError as exc:
+        err = exc.errors()[0]
+        msg = "missing required key" if err["type"] == "missing" else err["msg"]
+        raise ConfigError(f"{p}: {_loc(err['loc'])}: {msg}") from None

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..config import Actuator
 
-__all__ = ["axes_rotation", "actuator_matrices"]
+__all__ = ["axes_rotation", "actuator_matrices", "eddy_lag_matrices"]
 
 
 def axes_rotation(angle_deg: float) -> np.ndarray:
@@ -42,3 +42,11 @@ def actuator_matrices(act: Actuator) -> tuple[np.ndarray, np.ndarray, np.ndarray
     wn, z = act.natural_frequency, act.damping_ratio
     A = np.array([[0.0, 1.0], [-(wn**2), -2 * z * wn]])
     return A, np.array([[0.0], [wn**2]]), np.array([[1.0, 0.0]]), np.zeros((1, 1))
+
+
+def eddy_lag_matrices(tau_e: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(A, B, C, D) of the eddy-current lag 1/(τ_e s + 1) between coil current and force
+    (thesis P2 §4, Fig. 2, "unknown actuator dynamics"); a unit gain for τ_e = 0."""
+    if tau_e <= 0:
+        return np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.ones((1, 1))
+    return np.array([[-1.0 / tau_e]]), np.array([[1.0 / tau_e]]), np.ones((1, 1)), np.zeros((1, 1))

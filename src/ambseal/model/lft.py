@@ -177,7 +177,13 @@ class Plant:
         )
 
     def series_actuator(
-        self, Aa: np.ndarray, Ba: np.ndarray, Ca: np.ndarray, Da: np.ndarray, inputs: list[int]
+        self,
+        Aa: np.ndarray,
+        Ba: np.ndarray,
+        Ca: np.ndarray,
+        Da: np.ndarray,
+        inputs: list[int],
+        label: str = "act",
     ) -> "Plant":
         """Put the same SISO actuator in series with each of the ``inputs`` (indices).
 
@@ -212,7 +218,7 @@ class Plant:
                 D=Dp,
             )
         names = tuple(
-            f"act_{self.input_names[i]}_{j}" for i in inputs for j in range(na)
+            f"{label}_{self.input_names[i]}_{j}" for i in inputs for j in range(na)
         )
         return replace(
             self, A=A, B=B, C=C, D=D, state_names=self.state_names + names, parameters=params

@@ -21,7 +21,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..config import RigConfig
-from .amb import actuator_matrices, axes_rotation
+from .amb import actuator_matrices, axes_rotation, eddy_lag_matrices
 from .lft import Parameter, Plant
 from .rotor import X, Y, Mesh, assemble_rotor, build_mesh
 
@@ -280,6 +280,9 @@ def build_plant(
                 states = 8
         plant = modal_reduction(plant, states=states, cutoff_hz=cutoff_hz).plant
     n_cur = 2 * len(cfg.amb)
+    if cfg.actuator.eddy_time_constant > 0 and n_cur:
+        plant = plant.series_actuator(*eddy_lag_matrices(cfg.actuator.eddy_time_constant),
+                                      inputs=list(range(n_cur)), label="eddy")
     if cfg.actuator.model != "none" and n_cur:
         plant = plant.series_actuator(*actuator_matrices(cfg.actuator), inputs=list(range(n_cur)))
     return plant

@@ -1,0 +1,647 @@
+"""Measurement files: what a rig records during an identification run, and how it is read.
+
+A real rig and the virtual one (:mod:`ambseal.identify.rig_sim`) write the same format, so the
+identification (:mod:`ambseal.identify.fit`, :mod:`ambseal.identify.frf`) cannot tell them
+apart. This docstring is the user-facing specification of that format.
+
+Content
+-------
+For ``n`` samples and ``k`` actuator axes (e.g. ``A_zeta, A_eta, B_zeta, B_eta``, thesis P2
+Fig. 1(b)), one run holds:
+
+==============================  ====  ================================================
+column                          unit  meaning
+==============================  ====  ================================================
+``time_s``                      s     sample time, uniform step, increasing
+``excitation_<axis>_a``         A     excitation current ``i_e`` added to the reference
+``current_ref_<axis>_a``        A     current reference = controller output + ``i_e``
+``current_<axis>_a``            A     measured coil (control) current
+``displacement_<axis>_m``       m     displacement sensor reading of that axis
+==============================  ====  ================================================
+
+The four channel columns repeat for every axis; columns may come in any order, but every
+column listed above must be present and no other column is allowed.
+
+Metadata (a JSON object) — reserved keys ``format`` (must be ``"ambseal-measurement/1"``)
+and ``axes`` (the list of axis names, defining ``k`` and the column names); recommended keys,
+all SI:
+
+* ``rig`` — rig name (str);
+* ``sample_rate_hz`` — sampling rate (Hz); checked against the time column when present;
+* ``bias_current_a`` — bias current (A), a number or ``{axis: number}``;
+* ``pressure_drop_pa`` — pressure drop across the seal (Pa);
+* ``speed_rad_s`` — rotor speed (rad/s);
+* ``controller`` — which controller ran (dict, e.g. ``{"name": "PID", "file": ...}``);
+* ``excitation`` — :attr:`ambseal.identify.signals.Excitation.params`;
+* ``current_limit_a`` — amplifier current limit (A), used for the clipping check.
+
+Any other JSON value may be added.
+
+File forms
+----------
+CSV (``*.csv``)
+    A header row of column names, then one row per sample, comma separated, numbers in any
+    form Python's ``float`` reads (written with 17 significant digits). The metadata lives in
+    a JSON sidecar next to it named ``<file>.json`` — the full file name plus ``.json``, e.g.
+    ``run1.csv`` → ``run1.csv.json`` — whose top-level object is the metadata together with
+    ``"format"`` and ``"axes"``.
+MATLAB (``*.mat``, level 5 / v7, not v7.3)
+    One variable per column, named as the column, a column vector of doubles (``n × 1``;
+    a row vector is accepted), plus ``metadata_json``, a char array holding the same JSON
+    object as the sidecar. Read with :func:`scipy.io.loadmat`; nothing is ever unpickled.
+
+Validation (:func:`load_measurement`)
+-------------------------------------
+Each failure raises one :class:`~ambseal.errors.DataError` whose message names the file, the
+column and — for sample values — the 1-based data row (row 1 is the first sample; in a CSV
+file it is the line after the header):
+
+* missing sidecar, unreadable JSON, missing or wrong ``format`` tag, missing ``axes``;
+* missing, unexpected or duplicate column, a CSV row with the wrong number of fields or a
+  cell that is not a number;
+* axes other than the rig's (``axes=`` argument): wrong count or names;
+* fewer than ``min_samples`` samples (and always fewer than 2);
+* NaN or ±inf in any column;
+* time not increasing or not uniform: every step within ``time_rtol`` (relative) of the
+  mean step; ``sample_rate_hz`` in the metadata disagreeing with it;
+* clipped currents: a run of at least :data:`CLIP_RUN` consecutive samples of a current
+  column (``current_ref_*`` or ``current_*``) with ``|i| >= (1 − CLIP_RTOL) · limit``,
+  the limit being ``current_limit_a`` (argument, else metadata; no check without one).
+
+Example
+-------
+>>> import numpy as np, tempfile, pathlib
+>>> t = np.arange(100) / 1000.0
+>>> z = np.zeros((100, 1))
+>>> m = Measurement(t, z, z, z, z, ("A_zeta",), {"rig": "demo"})
+>>> p = pathlib.Path(tempfile.mkdtemp()) / "run.csv"
+>>> _ = save_measurement(m, p)
+>>> load_measurement(p, axes=("A_zeta",)).metadata["sample_rate_hz"]
+1000.0
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import os
+import tempfile
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from ambseal.errors import DataError
+
+__all__ = [
+    "FORMAT_TAG",
+    "CLIP_RUN",
+    "CLIP_RTOL",
+    "TIME_RTOL",
+    "CHANNELS",
+    "Measurement",
+    "column_names",
+    "save_measurement",
+    "load_measurement",
+    "validate_measurement",
+]
+
+#: Value of the ``format`` key of every measurement file.
+FORMAT_TAG = "ambseal-measurement/1"
+#: Consecutive samples at the current limit that count as clipping.
+CLIP_RUN = 3
+#: Relative closeness to the current limit that counts as "at the limit".
+CLIP_RTOL = 1e-3
+#: Default relative tolerance of each time step against the mean step.
+TIME_RTOL = 1e-6
+#: (field of :class:`Measurement`, column prefix, unit suffix) of the per-axis channels.
+CHANNELS: tuple[tuple[str, str, str], ...] = (
+    ("excitation_a", "excitation", "a"),
+    ("current_ref_a", "current_ref", "a"),
+    ("current_a", "current", "a"),
+    ("displacement_m", "displacement", "m"),
+)
+_RESERVED = ("format", "axes")
+_RATE_RTOL = 1e-6  # metadata sample_rate_hz against the time column
+
+
+def column_names(axes: Sequence[str]) -> list[str]:
+    """Column names of a file for ``axes``: ``time_s`` then the four channels per axis."""
+    cols = ["time_s"]
+    for a in axes:
+        cols += [f"{prefix}_{a}_{unit}" for _, prefix, unit in CHANNELS]
+    return cols
+
+
+# --------------------------------------------------------------------------- result
+@dataclass(frozen=True, eq=False)
+class Measurement:
+    """One identification run: excitation, currents and displacements per actuator axis.
+
+    Attributes
+    ----------
+    time_s : ndarray, shape (n,)
+        Sample times (s).
+    excitation_a : ndarray, shape (n, k)
+        Excitation current added to the current reference (A).
+    current_ref_a : ndarray, shape (n, k)
+        Current reference, controller output plus excitation (A).
+    current_a : ndarray, shape (n, k)
+        Measured coil current (A).
+    displacement_m : ndarray, shape (n, k)
+        Displacement per axis (m).
+    axes : tuple of str, length k
+        Actuator axis names, column ``j`` of every array belongs to ``axes[j]``.
+    metadata : dict
+        JSON-safe run description (see the module docstring for the recommended keys);
+        must not contain the reserved keys ``format`` and ``axes``.
+
+    Raises
+    ------
+    DataError
+        If the shapes disagree, axis names repeat or are not usable in column names, or the
+        metadata uses a reserved key. (Value checks are in :func:`validate_measurement`.)
+
+    Notes
+    -----
+    The arrays are copied and made read-only.
+    """
+
+    time_s: np.ndarray
+    excitation_a: np.ndarray
+    current_ref_a: np.ndarray
+    current_a: np.ndarray
+    displacement_m: np.ndarray
+    axes: tuple[str, ...]
+    metadata: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if isinstance(self.axes, str):
+            raise DataError(f"axes: expected a sequence of axis names, got the string {self.axes!r}")
+        axes = tuple(str(a) for a in self.axes)
+        if not axes or len(set(axes)) != len(axes):
+            raise DataError(f"axes: expected unique axis names, got {axes}")
+        for a in axes:
+            if not a or not all(c.isalnum() or c == "_" for c in a) or not a[0].isalpha():
+                raise DataError(f"axes: {a!r} must start with a letter and hold only letters, digits, '_'")
+        t = np.array(self.time_s, dtype=float)
+        if t.ndim != 1:
+            raise DataError(f"time_s: expected shape (n,), got {t.shape}")
+        t.setflags(write=False)
+        object.__setattr__(self, "time_s", t)
+        for name, _, _ in CHANNELS:
+            v = np.array(getattr(self, name), dtype=float)
+            if v.ndim == 1 and len(axes) == 1:
+                v = v[:, None]
+            if v.shape != (t.size, len(axes)):
+                raise DataError(f"{name}: expected shape ({t.size}, {len(axes)}), got {v.shape}")
+            v.setflags(write=False)
+            object.__setattr__(self, name, v)
+        object.__setattr__(self, "axes", axes)
+        if not isinstance(self.metadata, Mapping):
+            raise DataError(f"metadata: expected a dict, got {type(self.metadata).__name__}")
+        meta = dict(self.metadata)
+        bad = [k for k in _RESERVED if k in meta]
+        if bad:
+            raise DataError(f"metadata: keys {bad} are reserved for the file format")
+        object.__setattr__(self, "metadata", meta)
+
+    @property
+    def n_samples(self) -> int:
+        """Number of samples ``n``."""
+        return int(self.time_s.size)
+
+    @property
+    def sample_rate_hz(self) -> float:
+        """``(n − 1) / (t[-1] − t[0])`` (Hz); ``nan`` with fewer than two samples."""
+        if self.time_s.size < 2 or self.time_s[-1] == self.time_s[0]:
+            return float("nan")
+        return float((self.time_s.size - 1) / (self.time_s[-1] - self.time_s[0]))
+
+    def channel(self, name: str) -> np.ndarray:
+        """One column by its file name, e.g. ``"displacement_A_zeta_m"`` or ``"time_s"``.
+
+        Raises
+        ------
+        KeyError
+            If no column has that name.
+        """
+        if name == "time_s":
+            return self.time_s
+        for fld, prefix, unit in CHANNELS:
+            for j, a in enumerate(self.axes):
+                if name == f"{prefix}_{a}_{unit}":
+                    return getattr(self, fld)[:, j]
+        raise KeyError(f"no column {name!r}; columns are {column_names(self.axes)}")
+
+    def table(self) -> np.ndarray:
+        """All columns as one array, shape (n, 1 + 4k), in :func:`column_names` order."""
+        cols = [self.time_s[:, None]]
+        for j in range(len(self.axes)):
+            cols += [getattr(self, fld)[:, j : j + 1] for fld, _, _ in CHANNELS]
+        return np.hstack(cols)
+
+    def to_dict(self, *, include_samples: bool = False) -> dict:
+        """JSON-safe summary (axes, counts, rate, metadata); the columns only on request."""
+        out: dict[str, Any] = {
+            "format": FORMAT_TAG,
+            "axes": list(self.axes),
+            "n_samples": self.n_samples,
+            "sample_rate_hz": _finite_or_none(self.sample_rate_hz),
+            "metadata": _json_safe(self.metadata, "metadata"),
+        }
+        if include_samples:
+            tab = self.table()
+            out["columns"] = {c: tab[:, i].tolist() for i, c in enumerate(column_names(self.axes))}
+        return out
+
+
+# --------------------------------------------------------------------------- helpers
+def _finite_or_none(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
+
+
+def _json_safe(obj: Any, where: str) -> Any:
+    """Convert numpy values to Python ones; reject NaN/inf and unknown objects."""
+    if isinstance(obj, Mapping):
+        return {str(k): _json_safe(v, f"{where}.{k}") for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_json_safe(v, f"{where}[{i}]") for i, v in enumerate(obj)]
+    if isinstance(obj, np.ndarray):
+        return _json_safe(obj.tolist(), where)
+    if obj is None or isinstance(obj, (bool, str)):
+        return obj
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    if isinstance(obj, (int, np.integer)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        if not math.isfinite(float(obj)):
+            raise DataError(f"{where}: {obj!r} is not allowed in JSON metadata")
+        return float(obj)
+    raise DataError(f"{where}: {type(obj).__name__} is not JSON-serialisable")
+
+
+def _atomic_write(path: Path, write) -> None:
+    if not path.parent.is_dir():
+        raise DataError(f"{path}: folder {str(path.parent)!r} does not exist")
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            write(fh)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def _sidecar(path: Path) -> Path:
+    return path.with_name(path.name + ".json")
+
+
+def _header(meas: Measurement, path: Path) -> dict:
+    meta = _json_safe(meas.metadata, f"{path}: metadata")
+    fs = meas.sample_rate_hz
+    if "sample_rate_hz" in meta and math.isfinite(fs):
+        given = meta["sample_rate_hz"]
+        if not isinstance(given, (int, float)) or abs(float(given) - fs) > _RATE_RTOL * fs:
+            raise DataError(
+                f"{path}: metadata sample_rate_hz={given!r} disagrees with column time_s ({fs:.9g} Hz)"
+            )
+    elif math.isfinite(fs):
+        meta["sample_rate_hz"] = fs
+    return {"format": FORMAT_TAG, "axes": list(meas.axes), **meta}
+
+
+# --------------------------------------------------------------------------- save
+def save_measurement(meas: Measurement, path: str | os.PathLike) -> Path:
+    """Write a measurement as CSV + JSON sidecar or as MATLAB ``.mat``, chosen by suffix.
+
+    Each file is written to a temporary name in the target folder and moved into place with
+    ``os.replace`` (for CSV the sidecar first, then the table). ``sample_rate_hz`` is added
+    to the metadata from the time column when absent.
+
+    Parameters
+    ----------
+    meas : Measurement
+    path : path-like
+        ``*.csv`` or ``*.mat`` (case-insensitive).
+
+    Returns
+    -------
+    pathlib.Path
+        The table file (``.csv``/``.mat``) written.
+
+    Raises
+    ------
+    DataError
+        On another suffix, a missing folder, metadata that is not JSON-safe (NaN, objects)
+        or whose ``sample_rate_hz`` disagrees with the time column.
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in (".csv", ".mat"):
+        raise DataError(f"{path}: unknown measurement file type {path.suffix!r}, expected .csv or .mat")
+    header = _header(meas, path)
+    cols = column_names(meas.axes)
+    table = meas.table()
+    if suffix == ".csv":
+        text = json.dumps(header, indent=2, allow_nan=False) + "\n"
+        _atomic_write(_sidecar(path), lambda fh: fh.write(text.encode("utf-8")))
+
+        def write_csv(fh):
+            buf = io.StringIO()
+            np.savetxt(buf, table, fmt="%.17g", delimiter=",", header=",".join(cols), comments="")
+            fh.write(buf.getvalue().encode("ascii"))
+
+        _atomic_write(path, write_csv)
+    else:
+        import scipy.io
+
+        mdict = {c: table[:, i].reshape(-1, 1) for i, c in enumerate(cols)}
+        mdict["metadata_json"] = json.dumps(header, allow_nan=False)
+        _atomic_write(
+            path, lambda fh: scipy.io.savemat(fh, mdict, format="5", do_compression=True, oned_as="column")
+        )
+    return path
+
+
+# --------------------------------------------------------------------------- load
+def _read_header_json(text: str, where: str) -> dict:
+    try:
+        obj = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise DataError(f"{where}: not valid JSON ({exc})") from None
+    if not isinstance(obj, dict):
+        raise DataError(f"{where}: expected a JSON object, got {type(obj).__name__}")
+    if "format" not in obj:
+        raise DataError(f"{where}: missing key 'format' (expected {FORMAT_TAG!r})")
+    if obj["format"] != FORMAT_TAG:
+        raise DataError(f"{where}: format {obj['format']!r} is not {FORMAT_TAG!r}")
+    axes = obj.get("axes")
+    if not isinstance(axes, list) or not axes or not all(isinstance(a, str) for a in axes):
+        raise DataError(f"{where}: key 'axes' must be a non-empty list of axis names, got {axes!r}")
+    return obj
+
+
+def _read_csv(path: Path) -> tuple[list[str], np.ndarray]:
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise DataError(f"{path}: not a UTF-8 text file ({exc.reason})") from None
+    lines = text.splitlines()
+    if not lines or not lines[0].strip():
+        raise DataError(f"{path}: empty file, expected a header row of column names")
+    header = [h.strip() for h in next(csv.reader([lines[0]]))]
+    body = [ln for ln in lines[1:]]
+    while body and not body[-1].strip():
+        body.pop()
+    ncol = len(header)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # "input contained no data" on an empty body
+            data = np.loadtxt(io.StringIO("\n".join(body)), delimiter=",", dtype=float, ndmin=2)
+        if data.size == 0:
+            data = np.empty((0, ncol))
+        if data.shape[1] != ncol:
+            raise ValueError("column count")
+        return header, data
+    except ValueError:
+        pass
+    # slow path: find the offending row and column
+    rows = []
+    for r, fields in enumerate(csv.reader(body), start=1):
+        if len(fields) != ncol:
+            raise DataError(f"{path}: row {r} has {len(fields)} fields, expected {ncol} (one per column of the header)")
+        vals = []
+        for c, cell in enumerate(fields):
+            try:
+                vals.append(float(cell))
+            except ValueError:
+                raise DataError(f"{path}: column {header[c]!r}, row {r}: {cell!r} is not a number") from None
+        rows.append(vals)
+    return header, np.array(rows, dtype=float).reshape(-1, ncol)
+
+
+def _read_mat(path: Path) -> tuple[dict, dict[str, np.ndarray]]:
+    import scipy.io
+
+    try:
+        raw = scipy.io.loadmat(str(path), squeeze_me=False, mat_dtype=False, chars_as_strings=True)
+    except NotImplementedError:
+        raise DataError(f"{path}: MATLAB v7.3 (HDF5) files are not supported; save with -v7") from None
+    except Exception as exc:
+        raise DataError(f"{path}: not a readable MATLAB file ({exc})") from None
+    if "metadata_json" not in raw:
+        raise DataError(f"{path}: missing variable 'metadata_json' (the JSON metadata)")
+    mj = raw["metadata_json"]
+    if mj.dtype.kind != "U" or mj.size != 1:
+        raise DataError(f"{path}: variable 'metadata_json' must be a char row vector")
+    header = _read_header_json(str(mj.reshape(-1)[0]), f"{path}: variable 'metadata_json'")
+    cols = {}
+    for name, v in raw.items():
+        if name.startswith("__") or name == "metadata_json":
+            continue
+        arr = np.asarray(v)
+        if arr.dtype.kind not in "fiub" or arr.ndim != 2 or min(arr.shape) > 1:
+            raise DataError(f"{path}: column {name!r}: expected a numeric vector, got {arr.dtype} {arr.shape}")
+        cols[name] = arr.astype(float).reshape(-1)
+    return header, cols
+
+
+def load_measurement(
+    path: str | os.PathLike,
+    *,
+    axes: Sequence[str] | None = None,
+    min_samples: int | None = None,
+    current_limit_a: float | None = None,
+    time_rtol: float = TIME_RTOL,
+) -> Measurement:
+    """Read and validate a measurement file (format in the module docstring).
+
+    Parameters
+    ----------
+    path : path-like
+        ``*.csv`` (with its ``<file>.json`` sidecar) or ``*.mat``.
+    axes : sequence of str, optional
+        The rig's actuator axes; the file must have exactly these (any order in the file;
+        the result follows this order).
+    min_samples : int, optional
+        Fewest acceptable samples (at least 2 are always required).
+    current_limit_a : float, optional
+        Amplifier current limit (A) for the clipping check; defaults to the metadata's
+        ``current_limit_a``; no check when neither is given.
+    time_rtol : float
+        Accepted relative deviation of each time step from the mean step.
+
+    Returns
+    -------
+    Measurement
+        With ``metadata`` = the file's metadata without ``format`` and ``axes``.
+
+    Raises
+    ------
+    DataError
+        On the first failed check (see the module docstring), naming the file, the column and
+        the 1-based data row where one applies.
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in (".csv", ".mat"):
+        raise DataError(f"{path}: unknown measurement file type {path.suffix!r}, expected .csv or .mat")
+    if not path.is_file():
+        raise DataError(f"{path}: file not found")
+    if suffix == ".csv":
+        side = _sidecar(path)
+        if not side.is_file():
+            raise DataError(f"{path}: missing metadata sidecar {side.name!r}")
+        header = _read_header_json(side.read_text(encoding="utf-8"), str(side))
+        names, data = _read_csv(path)
+        seen = set()
+        for c in names:
+            if c in seen:
+                raise DataError(f"{path}: column {c!r} appears twice in the header")
+            seen.add(c)
+        cols = {c: data[:, i] for i, c in enumerate(names)}
+    else:
+        header, cols = _read_mat(path)
+    file_axes = tuple(header["axes"])
+    if axes is not None:
+        want = tuple(str(a) for a in axes)
+        if len(file_axes) != len(want) or set(file_axes) != set(want):
+            raise DataError(
+                f"{path}: column axes: file has {len(file_axes)} axes {list(file_axes)}, "
+                f"the rig expects {len(want)} {list(want)}"
+            )
+        file_axes = want
+    expected = column_names(file_axes)
+    for c in expected:
+        if c not in cols:
+            raise DataError(f"{path}: missing column {c!r}")
+    for c in cols:
+        if c not in expected:
+            raise DataError(f"{path}: column {c!r} is unexpected for axes {list(file_axes)}")
+    n = cols["time_s"].size
+    for c in expected:
+        if cols[c].size != n:
+            raise DataError(f"{path}: column {c!r} has {cols[c].size} samples, time_s has {n}")
+    meta = {k: v for k, v in header.items() if k not in _RESERVED}
+    try:
+        meas = Measurement(
+            cols["time_s"],
+            *[
+                np.column_stack([cols[f"{prefix}_{a}_{unit}"] for a in file_axes])
+                if n
+                else np.empty((0, len(file_axes)))
+                for _, prefix, unit in CHANNELS
+            ],
+            axes=file_axes,
+            metadata=meta,
+        )
+    except DataError as exc:
+        raise DataError(f"{path}: {exc}") from None
+    if current_limit_a is None and meta.get("current_limit_a") is not None:
+        current_limit_a = meta["current_limit_a"]
+    return validate_measurement(
+        meas, source=str(path), min_samples=min_samples, current_limit_a=current_limit_a, time_rtol=time_rtol
+    )
+
+
+# --------------------------------------------------------------------------- validate
+def validate_measurement(
+    meas: Measurement,
+    *,
+    source: str = "<measurement>",
+    axes: Sequence[str] | None = None,
+    min_samples: int | None = None,
+    current_limit_a: float | None = None,
+    time_rtol: float = TIME_RTOL,
+) -> Measurement:
+    """Check sample values of a measurement (also usable on an in-memory one).
+
+    Parameters
+    ----------
+    meas : Measurement
+    source : str
+        Name put at the front of every message (the file name when loading).
+    axes, min_samples, current_limit_a, time_rtol
+        As in :func:`load_measurement` (``axes`` must match in order here).
+
+    Returns
+    -------
+    Measurement
+        ``meas`` itself.
+
+    Raises
+    ------
+    DataError
+        On the first failure, naming ``source``, the column and the 1-based row.
+    """
+    n = meas.n_samples
+    if axes is not None and tuple(axes) != meas.axes:
+        raise DataError(f"{source}: column axes: measurement has {list(meas.axes)}, expected {list(axes)}")
+    need = 2 if min_samples is None else max(2, int(min_samples))
+    if n < need:
+        raise DataError(f"{source}: column 'time_s': {n} samples (rows), expected at least {need}")
+    names = column_names(meas.axes)
+    table = meas.table()
+    bad = ~np.isfinite(table)
+    if bad.any():
+        r, c = np.argwhere(bad)[0]
+        raise DataError(f"{source}: column {names[c]!r}, row {r + 1}: {float(table[r, c])!r} is not a finite number")
+    t = meas.time_s
+    dt = np.diff(t)
+    step = (t[-1] - t[0]) / (n - 1)
+    if not step > 0:
+        raise DataError(f"{source}: column 'time_s', row 2: time does not increase")
+    dev = np.abs(dt - step) > time_rtol * step
+    if dev.any():
+        i = int(np.argmax(dev))
+        what = "time does not increase" if dt[i] <= 0 else "time step is not uniform"
+        raise DataError(
+            f"{source}: column 'time_s', row {i + 2}: {what} (step {dt[i]:.9g} s, "
+            f"mean step {step:.9g} s, tolerance {time_rtol:g} relative)"
+        )
+    fs_meta = meas.metadata.get("sample_rate_hz")
+    if fs_meta is not None:
+        fs = 1.0 / step
+        if not isinstance(fs_meta, (int, float)) or abs(float(fs_meta) - fs) > max(time_rtol, _RATE_RTOL) * fs:
+            raise DataError(
+                f"{source}: column 'time_s', row 1: metadata sample_rate_hz={fs_meta!r} disagrees "
+                f"with the time step ({fs:.9g} Hz)"
+            )
+    if current_limit_a is not None:
+        try:
+            lim = float(current_limit_a)
+        except (TypeError, ValueError):
+            raise DataError(f"{source}: current_limit_a must be a number, got {current_limit_a!r}") from None
+        if not lim > 0 or not math.isfinite(lim):
+            raise DataError(f"{source}: current_limit_a must be finite and > 0, got {current_limit_a!r}")
+        at = (1.0 - CLIP_RTOL) * lim
+        for fld in ("current_ref_a", "current_a"):
+            prefix = {"current_ref_a": "current_ref", "current_a": "current"}[fld]
+            arr = getattr(meas, fld)
+            for j, a in enumerate(meas.axes):
+                row = _first_run(np.abs(arr[:, j]) >= at, CLIP_RUN)
+                if row is not None:
+                    raise DataError(
+                        f"{source}: column '{prefix}_{a}_a', row {row + 1}: current clipped at the "
+                        f"limit ±{lim:g} A ({CLIP_RUN} or more consecutive samples within "
+                        f"{CLIP_RTOL:.1%} of it)"
+                    )
+    return meas
+
+
+def _first_run(mask: np.ndarray, length: int) -> int | None:
+    """Index of the first sample of the first run of ``length`` True values, or None."""
+    if mask.size < length or not mask.any():
+        return None
+    c = np.convolve(mask.astype(np.int64), np.ones(length, dtype=np.int64), mode="valid")
+    hits = np.flatnonzero(c == length)
+    return int(hits[0]) if hits.size else None

@@ -1,0 +1,339 @@
+"""Output-error fit of physical parameters in closed loop (thesis P2 Eqs. 9–10, P4 Eq. 14).
+
+θ is any subset of the model's named parameters — Ki and Ks per axis, the coupling
+stiffness per axis, a seal's K, k, C, c — and ``tau_e``, the eddy-current lag of P2 §4.
+The cost J(θ) = ‖y_meas − y(θ)‖² runs over the displacements (each channel scaled by its
+standard deviation), optionally with the coil currents weighted in (P4 §3.4 suggests this
+lowers the Ki–Ks correlation), and is minimised by ``scipy.optimize.least_squares`` within
+bounds.
+
+The model is the reduced plant with the parameters entering through its LFT channels
+(A + B_θ θ C_θ, no rebuild per iteration), the amplifier and the τ_e lag in series, exactly
+discretised with a zero-order hold at the data's sample rate and closed with the digital
+controller that ran (:mod:`ambseal.identify.loop`).
+
+Uncertainty: the covariance of θ̂ from the Jacobian at the optimum. Closed-loop residuals
+are coloured (sensor noise runs through the loop), so the sandwich form
+(JᵀJ)⁻¹ S (JᵀJ)⁻¹ with a Newey–West (Bartlett-weighted) long-run covariance S of the
+per-sample scores Jₜᵀrₜ is used (Newey & West, Econometrica 55, 1987); with white
+residuals it reduces to σ̂²(JᵀJ)⁻¹. 95 % intervals are θ̂ ± 1.96·SE; the correlation
+matrix is the normalised covariance (P4 Tables 2 and 4).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from ..errors import IdentificationError
+from ..model.amb import actuator_matrices, eddy_lag_matrices
+from ..model.lft import Plant
+from .loop import DiscreteController, closed_loop_matrices, simulate_lti, zoh
+
+__all__ = ["FitResult", "ClosedLoopModel", "fit_parameters", "nrmse_fit"]
+
+TAU_E = "tau_e"
+_DEFAULT_SCALE = {"N/m": 1e5, "N/A": 50.0, "N*s/m": 1e2, "s": 1e-3}
+
+
+def nrmse_fit(y: np.ndarray, yhat: np.ndarray) -> np.ndarray:
+    """NRMSE fit per channel (%): 100·(1 − ‖y − ŷ‖/‖y − mean(y)‖) (P2 Table 2)."""
+    y, yhat = np.atleast_2d(y.T).T, np.atleast_2d(yhat.T).T
+    num = np.linalg.norm(y - yhat, axis=0)
+    den = np.linalg.norm(y - y.mean(axis=0), axis=0)
+    return 100.0 * (1.0 - num / np.where(den > 0, den, np.nan))
+
+
+@dataclass
+class ClosedLoopModel:
+    """The simulated closed loop of one record: y(θ), i(θ) for an excitation e.
+
+    Parameters
+    ----------
+    plant : Plant
+        Reduced mechanical plant: inputs the force currents (A), outputs displacements (m),
+        with the LFT channels of every named parameter.
+    actuator : (A, B, C, D)
+        Amplifier of one axis (:func:`ambseal.model.amb.actuator_matrices`).
+    controller : DiscreteController
+        The controller that ran, at the data's sample period.
+    tau_e : float
+        Nominal eddy-current lag (s).
+    """
+
+    plant: Plant
+    actuator: tuple
+    controller: DiscreteController
+    tau_e: float = 0.0
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    def matrices(self, values: dict[str, float]):
+        """Continuous (A, B, C_y, C_i) of amplifier → lag → plant for parameter values."""
+        changes = {n: v - self.plant.parameter(n).nominal for n, v in values.items()
+                   if n != TAU_E}
+        p = self.plant.with_changes(changes) if changes else self.plant
+        tau = values.get(TAU_E, self.tau_e)
+        k = p.B.shape[1]
+        A, B, C = p.A, p.B, p.C
+        for blocks in (eddy_lag_matrices(tau), self.actuator):
+            Aa, Ba, Ca, Da = (np.kron(np.eye(k), m) for m in blocks)
+            n, na = A.shape[0], Aa.shape[0]
+            Ci_new = np.hstack([np.zeros((k, n)), Ca])  # this block's output (its current)
+            A = np.block([[A, B @ Ca], [np.zeros((na, n)), Aa]])
+            B = np.vstack([B @ Da, Ba])
+            C = np.hstack([C, np.zeros((C.shape[0], na))])
+            Cout, Dout = Ci_new, Da
+        return A, B, C, Cout, Dout
+
+    def simulate(self, values: dict[str, float], e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Displacements (N, k) and coil currents (N, k) for excitation ``e`` (N, k)."""
+        A, B, C, Ci, Di = self.matrices(values)
+        Ad, Bd = zoh(A, B, self.controller.dt)
+        Acl, Bcl, Cy, Cref, _ = closed_loop_matrices(Ad, Bd, C, self.controller)
+        nc = self.controller.A.shape[0]
+        Ci_cl = np.hstack([Ci, np.zeros((Ci.shape[0], nc))])
+        # coil current = C_i x + D_i i_ref, i_ref = C_ref z + e
+        y, x_i, iref = simulate_lti(Acl, Bcl, [Cy, Ci_cl, Cref], e)
+        return y, x_i + (iref + e) @ Di.T
+
+
+@dataclass(frozen=True)
+class FitResult:
+    """Identified parameters with their uncertainty and the quality of the fit.
+
+    Attributes
+    ----------
+    names : tuple of str
+    estimate, initial, std_error, ci95_low, ci95_high : ndarray (p,)
+        SI values.
+    correlation : ndarray (p, p)
+    nrmse_fit_pct : dict
+        NRMSE fit (%) per displacement channel (and ``current_...`` when currents are used).
+    converged : bool
+    message : str
+    iterations : int
+        Function evaluations of the optimiser.
+    wall_time_s : float
+    time_s, y_meas, y_sim : ndarray
+        For the measured-against-simulated figure (first record).
+    axes : tuple of str
+    """
+
+    names: tuple[str, ...]
+    estimate: np.ndarray
+    initial: np.ndarray
+    std_error: np.ndarray
+    ci95_low: np.ndarray
+    ci95_high: np.ndarray
+    correlation: np.ndarray
+    nrmse_fit_pct: dict
+    converged: bool
+    message: str
+    iterations: int
+    wall_time_s: float
+    time_s: np.ndarray
+    y_meas: np.ndarray
+    y_sim: np.ndarray
+    axes: tuple[str, ...]
+
+    def value(self, name: str) -> float:
+        return float(self.estimate[self.names.index(name)])
+
+    def to_dict(self) -> dict:
+        def f(x):
+            return [float(v) if np.isfinite(v) else None for v in np.ravel(x)]
+
+        return {
+            "parameters": {
+                n: {"estimate": float(self.estimate[i]), "initial": float(self.initial[i]),
+                    "std_error": f([self.std_error[i]])[0],
+                    "ci95": f([self.ci95_low[i], self.ci95_high[i]])}
+                for i, n in enumerate(self.names)
+            },
+            "correlation": [f(row) for row in self.correlation],
+            "nrmse_fit_pct": {k: float(v) for k, v in self.nrmse_fit_pct.items()},
+            "converged": self.converged,
+            "message": self.message,
+            "iterations": self.iterations,
+            "wall_time_s": self.wall_time_s,
+        }
+
+
+def _newey_west(scores: np.ndarray, max_lag: int) -> np.ndarray:
+    """Long-run covariance Σ_l w_l Γ_l of per-sample scores (N, p), Bartlett weights."""
+    S = scores.T @ scores
+    for lag in range(1, max_lag + 1):
+        G = scores[lag:].T @ scores[:-lag]
+        S += (1 - lag / (max_lag + 1)) * (G + G.T)
+    return S
+
+
+def _bandwidth(res: np.ndarray) -> int:
+    """Lag window from the residuals' autocorrelation (summed over channels): twice the last
+    lag at which |ρ| still reaches 0.05 — the envelope, since closed-loop residuals ring at
+    the loop's resonances — at least 1, at most N/10."""
+    N = res.shape[0]
+    r = res - res.mean(axis=0)
+    spec = np.fft.rfft(r, n=2 * N, axis=0)
+    ac = np.fft.irfft(np.abs(spec) ** 2, axis=0)[: N // 10 + 1].sum(axis=1)
+    ac = ac / ac[0]
+    above = np.nonzero(np.abs(ac) >= 0.05)[0]
+    return int(np.clip(2 * above[-1], 1, N // 10))
+
+
+def fit_parameters(
+    records: list,
+    models: list[ClosedLoopModel],
+    names: list[str],
+    *,
+    initial: dict[str, float] | None = None,
+    bounds: dict[str, tuple[float, float]] | None = None,
+    current_weight: float = 0.0,
+    max_nfev: int = 200,
+    start: int = 0,
+) -> FitResult:
+    """Fit parameters ``names`` to one or more closed-loop records.
+
+    Parameters
+    ----------
+    records : list
+        Records with ``time_s`` (N,), ``excitation_a`` (N, k), ``displacement_m`` (N, k),
+        ``current_a`` (N, k) and ``axes`` (e.g. :class:`ambseal.identify.data.Measurement`).
+    models : list of ClosedLoopModel
+        One per record (its pressure, its controller), sharing parameter names.
+    names : list of str
+        Parameters to fit (model names, or ``"tau_e"``).
+    initial, bounds : dict, optional
+        Start values and (low, high) bounds in SI; default start the model's nominal
+        values, default bounds [0.2, 5]× nominal for positive factors (Ki, Ks, spring
+        stiffness), [0, 0.05] s for τ_e, unbounded otherwise.
+    current_weight : float
+        Weight of the coil-current residuals relative to the displacements (0: off).
+    max_nfev : int
+        Budget of model evaluations; exhausting it flags the result as not converged.
+    start : int
+        Samples to skip at the start of each record in the cost (transients of a record
+        that did not start at rest).
+
+    Raises
+    ------
+    IdentificationError
+        No parameter, an unknown name, a record shorter than the parameters, or a model
+        that cannot be simulated at the start values.
+    """
+    if not names:
+        raise IdentificationError("fit: no parameter to fit (expected --params NAME,...)")
+    t0 = time.perf_counter()
+    m0 = models[0]
+    nominal, scale = [], []
+    for n in names:
+        if n == TAU_E:
+            nominal.append(m0.tau_e)
+            scale.append(_DEFAULT_SCALE["s"])
+            continue
+        try:
+            p = m0.plant.parameter(n)
+        except Exception as exc:
+            raise IdentificationError(f"fit: {exc}") from None
+        nominal.append(p.nominal)
+        scale.append(abs(p.nominal) if p.nominal != 0 else _DEFAULT_SCALE.get(p.unit, 1.0))
+    nominal, scale = np.array(nominal), np.array(scale)
+    init = np.array([(initial or {}).get(n, v) for n, v in zip(names, nominal)])
+    lo, hi = [], []
+    for n, v in zip(names, nominal):
+        if bounds and n in bounds:
+            b = bounds[n]
+        elif n == TAU_E:
+            b = (0.0, 0.05)
+        elif any(t in n for t in (".Ki_", ".Ks_", ".kxx", ".kyy")) and v > 0:
+            b = (0.2 * v, 5 * v)
+        else:
+            b = (-np.inf, np.inf)
+        lo.append(b[0])
+        hi.append(b[1])
+    lo, hi = np.array(lo), np.array(hi)
+    init = np.clip(init, lo + 1e-12 * scale, hi - 1e-12 * scale)
+
+    data = []
+    for rec in records:
+        y = np.asarray(rec.displacement_m)[start:]
+        if y.shape[0] <= len(names):
+            raise IdentificationError(f"fit: {y.shape[0]} samples for {len(names)} parameters")
+        sy = y.std(axis=0)
+        sy[sy == 0] = 1.0
+        i = np.asarray(rec.current_a)[start:]
+        si = i.std(axis=0)
+        si[si == 0] = 1.0
+        data.append((np.asarray(rec.excitation_a), y, sy, i, si))
+
+    def values(x):
+        return dict(zip(names, init + x * scale))  # x: scaled change from the start
+
+    def residual_blocks(x):
+        """Per record an (N, c) array: scaled displacement (and current) residuals."""
+        out = []
+        for model, (e, y, sy, i, si) in zip(models, data):
+            ys, is_ = model.simulate(values(x), e)
+            R = (ys[start:] - y) / sy
+            if current_weight > 0:
+                R = np.hstack([R, current_weight * (is_[start:] - i) / si])
+            out.append(R)
+        return out
+
+    def residuals(x):
+        r = np.concatenate([R.ravel() for R in residual_blocks(x)])
+        if not np.all(np.isfinite(r)):
+            return np.full_like(r, 1e6)
+        return r
+
+    r0 = residuals(np.zeros(len(names)))
+    if np.all(r0 == 1e6):
+        raise IdentificationError("fit: the model cannot be simulated at the start values")
+    lb, ub = (lo - init) / scale, (hi - init) / scale
+    sol = least_squares(residuals, np.zeros(len(names)), bounds=(lb, ub), method="trf",
+                        x_scale=1.0, max_nfev=max_nfev, xtol=1e-10, ftol=1e-10, gtol=1e-10)
+    est = init + sol.x * scale
+    converged = bool(sol.status > 0)
+
+    # covariance (sandwich, Newey–West) in scaled coordinates; rows are sample-major
+    J, r = sol.jac, sol.fun
+    p = len(names)
+    scores, resid, off = [], [], 0
+    for R in residual_blocks(sol.x):
+        n_s, c = R.shape
+        Jb = J[off:off + n_s * c].reshape(n_s, c, p)
+        rb = r[off:off + n_s * c].reshape(n_s, c)
+        scores.append(np.einsum("tcp,tc->tp", Jb, rb))
+        resid.append(rb)
+        off += n_s * c
+    H = J.T @ J
+    try:
+        Hinv = np.linalg.inv(H)
+        S = sum(_newey_west(sc, _bandwidth(rs)) for sc, rs in zip(scores, resid))
+        cov = Hinv @ S @ Hinv * (len(r) / max(len(r) - p, 1))
+        if np.linalg.cond(H) > 1e14:
+            raise np.linalg.LinAlgError
+    except np.linalg.LinAlgError:
+        cov = np.full((p, p), np.inf)
+        converged = False
+    cov = cov * np.outer(scale, scale)
+    se = np.sqrt(np.diag(cov))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(se, se)
+    e0, y0 = data[0][0], data[0][1]
+    ys, is_ = models[0].simulate(dict(zip(names, est)), e0)
+    fits = {f"{a}": v for a, v in zip(records[0].axes, nrmse_fit(y0, ys[start:]))}
+    if current_weight > 0:
+        fi = nrmse_fit(data[0][3], is_[start:])
+        fits.update({f"current_{a}": v for a, v in zip(records[0].axes, fi)})
+    return FitResult(
+        names=tuple(names), estimate=est, initial=init, std_error=se,
+        ci95_low=est - 1.96 * se, ci95_high=est + 1.96 * se, correlation=corr,
+        nrmse_fit_pct=fits, converged=converged, message=str(sol.message),
+        iterations=int(sol.nfev), wall_time_s=time.perf_counter() - t0,
+        time_s=np.asarray(records[0].time_s)[start:], y_meas=y0, y_sim=ys[start:],
+        axes=tuple(records[0].axes),
+    )

@@ -1,0 +1,205 @@
+"""The virtual test facility: a stand-in for the real rig whose truth is known.
+
+A time-domain simulation of
+
+- the FE rotor with its coupling and the seal at the given pressure drop, the true
+  parameter values applied exactly through the LFT channels in full order, then every
+  mode below ``max_mode_hz`` kept (10 kHz by default: the rigid-body modes and the
+  flexible modes far past the control bandwidth; what is dropped only adds a static
+  flexibility of order (f_max/f)² below 10⁻²);
+- the nonlinear AMB force law of each actuator axis (Schweitzer & Maslen 2009, Eq. 3.27)
+
+      f = k [(i0 + i)² / (s0 − x)² − (i0 − i)² / (s0 + x)²],
+
+  with k and s0 chosen so that its linearisation has the true Ki, Ks at the bias i0
+  (Ki = 4 k i0 / s0², Ks = 4 k i0² / s0³ ⇒ s0 = i0 Ki / Ks, k = Ki s0² / (4 i0));
+- the amplifier of ``[actuator]`` with current limits, then the eddy-current-like lag
+  1/(τ_e s + 1) between coil current and force (thesis P2 §4, Fig. 2);
+- sensor noise and ADC quantisation, and the controller sampled at the rig's rate
+  (:mod:`ambseal.identify.loop` for the timing).
+
+The linear part (including Ki i + Ks x) is integrated exactly (zero-order hold over
+``substeps`` sub-steps of each sample, in physical coordinates: a modal diagonalisation
+of the nearly repeated x/y modes proved to drift in closed loop); the small nonlinear remainder
+f − (Ki i + Ks x) enters as a force held over each sub-step.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..config import RigConfig, TruthSection
+from ..errors import ModelError
+from ..model.amb import actuator_matrices, eddy_lag_matrices
+from ..model.reduction import modal_reduction
+from ..model.rig import build_system, mechanical_plant
+from .loop import DiscreteController, zoh
+
+__all__ = ["FacilityRecord", "simulate_facility"]
+
+
+@dataclass(frozen=True)
+class FacilityRecord:
+    """What the virtual facility's data acquisition records, one row per sample.
+
+    Attributes
+    ----------
+    time_s : ndarray (N,)
+    excitation_a, current_ref_a, current_a : ndarray (N, k)
+        Excitation, current reference (after the limit) and measured coil current (A).
+    displacement_m : ndarray (N, k)
+        Measured sensor displacement (m), with noise and quantisation.
+    axes : tuple of str
+    noise_std_m : ndarray (k,)
+        The sensor-noise standard deviation used per channel (m).
+    """
+
+    time_s: np.ndarray
+    excitation_a: np.ndarray
+    current_ref_a: np.ndarray
+    current_a: np.ndarray
+    displacement_m: np.ndarray
+    axes: tuple[str, ...]
+    noise_std_m: np.ndarray
+
+
+def _series(A, B, C, blocks):
+    """Append per-input SISO blocks (Aa, Ba, Ca, Da) in front of all inputs of (A, B, C).
+
+    Returns (A, B, C, C_in) where C_in reads the blocks' outputs (what enters the old B).
+    """
+    Aa, Ba, Ca, Da = blocks
+    k = B.shape[1]
+    I = np.eye(k)
+    Ak, Bk, Ck, Dk = np.kron(I, Aa), np.kron(I, Ba), np.kron(I, Ca), np.kron(I, Da)
+    n, na = A.shape[0], Ak.shape[0]
+    An = np.block([[A, B @ Ck], [np.zeros((na, n)), Ak]])
+    Bn = np.vstack([B @ Dk, Bk])
+    Cn = np.hstack([C, np.zeros((C.shape[0], na))])
+    Cin = np.hstack([np.zeros((k, n)), Ck])
+    return An, Bn, Cn, Cin, Dk
+
+
+def simulate_facility(
+    cfg: RigConfig,
+    truth: TruthSection,
+    excitation_a: np.ndarray,
+    sample_rate_hz: float,
+    controller: DiscreteController,
+    *,
+    pressure_bar: float,
+    seed: int | None = 0,
+) -> FacilityRecord:
+    """Run the virtual facility with an excitation added to the current references.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig (its nominal values are replaced by the truth where the truth names them).
+    truth : TruthSection
+        True values, noise, ADC, τ_e, bias and limit.
+    excitation_a : ndarray (N, k)
+        Excitation current per actuator axis (A), one row per sample.
+    sample_rate_hz : float
+        The controller and acquisition rate (Hz); must match ``controller.dt``.
+    controller : DiscreteController
+        The digital controller that levitates the rotor.
+    pressure_bar : float
+        Pressure drop across the seals (bar).
+    seed : int, optional
+        Seed of the sensor and current noise.
+
+    Raises
+    ------
+    ModelError
+        Mismatched sizes or rates, unknown truth parameters, or a rotor that leaves the
+        air gap (the loop went unstable).
+    """
+    T = 1.0 / sample_rate_hz
+    if abs(controller.dt - T) > 1e-9 * T:
+        raise ModelError(f"controller dt = {controller.dt} s but the sample rate is {sample_rate_hz} Hz")
+    sys = build_system(cfg, pressure_bar=pressure_bar)
+    plant = mechanical_plant(sys)
+    values = truth.values_at(pressure_bar)
+    plant = plant.with_values(values)  # raises ModelError naming an unknown parameter
+    plant = modal_reduction(plant, cutoff_hz=truth.max_mode_hz).plant
+    axes = plant.input_names
+    k = len(axes)
+    e = np.asarray(excitation_a, dtype=float)
+    if e.ndim != 2 or e.shape[1] != k:
+        raise ModelError(f"excitation has shape {e.shape}; expected (N, {k}) for axes {axes}")
+    if controller.B.shape[1] != k or controller.C.shape[0] != k:
+        raise ModelError(f"the controller must have {k} inputs and outputs")
+
+    # nonlinear force-law constants per axis from the true Ki, Ks
+    names = [a.rsplit("_", 1) for a in axes]
+    ki = np.array([plant.parameter(f"{m}.Ki_{ax}").nominal for m, ax in names])
+    ks = np.array([plant.parameter(f"{m}.Ks_{ax}").nominal for m, ax in names])
+    i0 = truth.bias_current
+    s0 = i0 * ki / ks
+    kf = ki * s0**2 / (4 * i0)
+    limits = [a.current_limit for a in cfg.amb for _ in range(2)]
+    limit = truth.current_limit or (min(x for x in limits if x) if any(limits) else np.inf)
+
+    # continuous linear part: mechanics ← eddy lag ← amplifier; inputs [i_ref, f_rem]
+    A, B, C = plant.A, plant.B, plant.C
+    Fdir = np.hstack([plant.parameter(f"{m}.Ks_{ax}").B for m, ax in names])  # unit forces
+    Cb = np.vstack([plant.parameter(f"{m}.Ks_{ax}").C for m, ax in names])  # bearing disp.
+    n_mech = A.shape[0]
+    A, B, C, C_eff, D_eddy = _series(A, B, np.vstack([C, Cb]), eddy_lag_matrices(truth.tau_e))
+    A, B, C, C_coil, D_coil = _series(A, B, np.vstack([C, C_eff]),
+                                      actuator_matrices(cfg.actuator))
+    # coil current i_c = C_coil z + D_coil i_ref; force current i_eff = C_eff z + D_eddy i_c
+    C_y, C_b = C[:k], C[k:2 * k]
+    C_ieff = C[2 * k:] + D_eddy @ C_coil
+    D_ieff = D_eddy @ D_coil
+    F = np.vstack([Fdir, np.zeros((A.shape[0] - n_mech, k))])
+    Phi, Gam = zoh(A, np.hstack([B, F]), T / truth.substeps)
+    C_all = np.vstack([C_y, C_b, C_ieff, C_coil])
+    rng = np.random.default_rng(seed)
+
+    def run(noise_std):
+        N = e.shape[0]
+        rec_y = np.empty((N, k))
+        rec_i = np.empty((N, k))
+        rec_ref = np.empty((N, k))
+        xc = np.zeros(controller.A.shape[0])
+        z = np.zeros(A.shape[0])
+        noise = rng.standard_normal((N, k)) * noise_std
+        inoise = rng.standard_normal((N, k)) * truth.current_noise_a
+        lsb = truth.adc_range_m / 2**truth.adc_bits if truth.adc_bits else 0.0
+        for n in range(N):
+            out = C_all @ z
+            y = out[:k] + noise[n]
+            if lsb:
+                y = np.round(y / lsb) * lsb
+            u = controller.C @ xc + controller.D @ y
+            iref = np.clip(-u + e[n], -limit, limit)
+            xc = controller.A @ xc + controller.B @ y
+            rec_y[n], rec_ref[n] = y, iref
+            rec_i[n] = out[3 * k:] + D_coil @ iref + inoise[n]
+            for _ in range(truth.substeps):
+                xb, ieff = out[k:2 * k], out[2 * k:3 * k] + D_ieff @ iref
+                if np.any(np.abs(xb) >= 0.9 * s0):
+                    raise ModelError(
+                        f"the rotor left the air gap at t = {n * T:.4f} s (loop unstable or "
+                        "excitation too strong)"
+                    )
+                ip, im = np.clip(i0 + ieff, 0, None), np.clip(i0 - ieff, 0, None)
+                f = kf * (ip**2 / (s0 - xb) ** 2 - im**2 / (s0 + xb) ** 2)
+                frem = f - (ki * ieff + ks * xb)
+                u_in = np.concatenate([iref, frem])
+                z = Phi @ z + Gam @ u_in
+                out = C_all @ z
+        return rec_y, rec_i, rec_ref
+
+    noise_std = np.full(k, truth.sensor_noise_m)
+    if truth.noise_fraction > 0:
+        y0, _, _ = run(np.zeros(k))
+        noise_std = noise_std + truth.noise_fraction * np.sqrt(np.mean(y0**2, axis=0))
+    y, i, ref = run(noise_std)
+    t = np.arange(e.shape[0]) * T
+    return FacilityRecord(t, e.copy(), ref, i, y, tuple(axes), noise_std)
+

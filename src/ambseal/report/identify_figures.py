@@ -1,0 +1,166 @@
+"""PNG figures of the identification results (matplotlib, Agg canvas only).
+
+Same house rules as :mod:`ambseal.report.figures`: a ``matplotlib.figure.Figure`` on its own
+Agg canvas, no pyplot, written atomically by :func:`ambseal.report.figures.save_figure`.
+
+The FRF objects are taken by duck typing (anything with ``frequency_hz``, ``H``,
+``coherence``, ``input_names``, ``output_names`` and optionally ``units``, e.g.
+:class:`ambseal.identify.frf.FRF`), so this module does not import the identification code.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ambseal.errors import AmbsealError
+from ambseal.report.figures import save_figure
+
+__all__ = ["frf_figure"]
+
+
+def _check(frf: Any, what: str) -> tuple[np.ndarray, np.ndarray]:
+    try:
+        f = np.asarray(frf.frequency_hz, dtype=float)
+        H = np.asarray(frf.H, dtype=complex)
+        frf.input_names, frf.output_names  # noqa: B018 - presence check
+    except AttributeError as exc:
+        raise AmbsealError(f"frf_figure: {what} is not an FRF ({exc})") from None
+    if f.ndim != 1 or H.ndim != 3 or H.shape[0] != f.size:
+        raise AmbsealError(f"frf_figure: {what}.H has shape {H.shape}, expected ({f.size}, ny, nu)")
+    return f, H
+
+
+def frf_figure(
+    path: str | os.PathLike,
+    measured: Any,
+    model: Any = None,
+    *,
+    pairs: Sequence[tuple[str, str]] | None = None,
+    magnitude: str = "log",
+    fmin_hz: float | None = None,
+    fmax_hz: float | None = None,
+    title: str = "Frequency response",
+    unwrap_phase: bool = False,
+) -> Path:
+    """Measured FRF against a model: magnitude, phase and coherence (thesis P4 Figs. 9–10, 13–15).
+
+    One column of panels per input; rows magnitude, phase (degrees) and — when the
+    measured FRF has one — coherence γ². Each (output, input) pair is a solid curve; the
+    model's same pair is dashed in the same colour.
+
+    Parameters
+    ----------
+    path : path-like
+        PNG file to write.
+    measured : FRF-like
+        ``frequency_hz (n_f,)``, ``H (n_f, ny, nu)``, ``coherence (n_f, ny, nu)`` or None,
+        ``input_names``, ``output_names``, optional ``units`` (str).
+    model : FRF-like, optional
+        Model FRF with the same input and output names (pairs missing from it are skipped).
+    pairs : sequence of (output_name, input_name), optional
+        Pairs to draw; default all of ``measured``.
+    magnitude : {"log", "db"}
+        ``|H|`` on a log axis, or ``20 log10 |H|`` in dB.
+    fmin_hz, fmax_hz : float, optional
+        Frequency range shown (Hz); default the measured grid without 0 Hz (log axis).
+    title : str
+        Figure title.
+    unwrap_phase : bool
+        Unwrap the phase along frequency; default wrapped to (−180°, 180°], which keeps
+        low-coherence (noisy) pairs readable.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    AmbsealError
+        If an argument is not FRF-like, a pair is unknown, ``magnitude`` is invalid, or the
+        folder does not exist.
+    """
+    if magnitude not in ("log", "db"):
+        raise AmbsealError(f"frf_figure: magnitude must be 'log' or 'db', got {magnitude!r}")
+    f, H = _check(measured, "measured")
+    outs, ins = list(measured.output_names), list(measured.input_names)
+    if pairs is None:
+        pairs = [(o, i) for i in ins for o in outs]
+    sel = []
+    for o, i in pairs:
+        if o not in outs or i not in ins:
+            raise AmbsealError(f"frf_figure: pair ({o!r}, {i!r}) not in measured outputs {outs} × inputs {ins}")
+        sel.append((o, i))
+    if model is not None:
+        fm, Hm = _check(model, "model")
+        m_outs, m_ins = list(model.output_names), list(model.input_names)
+    col_inputs = [i for i in ins if any(p[1] == i for p in sel)]
+    coh = getattr(measured, "coherence", None)
+    rows = 3 if coh is not None else 2
+    ncol = max(len(col_inputs), 1)
+    fig = Figure(figsize=(4.2 * ncol, 2.4 * rows + 0.8))
+    axes = fig.subplots(rows, ncol, squeeze=False, sharex=True)
+    lo = fmin_hz if fmin_hz is not None else (f[f > 0].min() if np.any(f > 0) else 1.0)
+    hi = fmax_hz if fmax_hz is not None else f.max()
+    mask = (f >= lo) & (f <= hi) & (f > 0)
+    units = str(getattr(measured, "units", "") or "")
+    colours = [f"C{k % 10}" for k in range(len(outs))]
+
+    def mag(h: np.ndarray) -> np.ndarray:
+        a = np.abs(h)
+        if magnitude == "db":
+            with np.errstate(divide="ignore"):
+                return 20.0 * np.log10(a)
+        return a
+
+    def phase(h: np.ndarray) -> np.ndarray:
+        ok = np.isfinite(h) & (h != 0)  # the phase of an exact zero means nothing
+        out = np.full(h.shape, np.nan)
+        if ok.any():
+            ph = np.angle(h[ok])
+            out[ok] = np.degrees(np.unwrap(ph) if unwrap_phase else ph)
+        return out
+
+    for c, inp in enumerate(col_inputs):
+        j = ins.index(inp)
+        for o, i in sel:
+            if i != inp:
+                continue
+            k = outs.index(o)
+            colour = colours[k]
+            h = H[mask, k, j]
+            axes[0, c].plot(f[mask], mag(h), color=colour, lw=1, label=f"{o} (measured)")
+            axes[1, c].plot(f[mask], phase(h), color=colour, lw=1)
+            if coh is not None:
+                axes[2, c].plot(f[mask], np.asarray(coh)[mask, k, j], color=colour, lw=1)
+            if model is not None and o in m_outs and inp in m_ins:
+                mm = (fm >= lo) & (fm <= hi) & (fm > 0)
+                hm = Hm[mm, m_outs.index(o), m_ins.index(inp)]
+                axes[0, c].plot(fm[mm], mag(hm), color=colour, lw=1.2, ls="--", label=f"{o} (model)")
+                axes[1, c].plot(fm[mm], phase(hm), color=colour, lw=1.2, ls="--")
+        axes[0, c].set_title(f"from {inp}", fontsize=10)
+        if magnitude == "log":
+            axes[0, c].set_yscale("log")
+        for r in range(rows):
+            axes[r, c].set_xscale("log")
+            axes[r, c].grid(True, which="both", alpha=0.3)
+        axes[-1, c].set_xlabel("Frequency (Hz)")
+        axes[0, c].legend(fontsize=7)
+    unit_label = f" ({units})" if units else ""
+    axes[0, 0].set_ylabel(f"|H|{unit_label}" if magnitude == "log" else f"|H| (dB re 1 {units or 'unit'})")
+    axes[1, 0].set_ylabel("Phase (deg)")
+    if not unwrap_phase:
+        for c in range(ncol):
+            axes[1, c].set_ylim(-200, 200)
+            axes[1, c].set_yticks([-180, -90, 0, 90, 180])
+    if coh is not None:
+        axes[2, 0].set_ylabel("Coherence γ² (-)")
+        for c in range(ncol):
+            axes[2, c].set_ylim(0, 1.05)
+    fig.suptitle(title)
+    fig.tight_layout()
+    return save_figure(fig, path)

@@ -1,1 +1,38 @@
-"""ambseal.control"""
+"""ambseal.control: robust-control core for generalised plants.
+
+Public functions are imported on first use (module-level ``__getattr__``), so
+``import ambseal.control`` stays light:
+
+* :func:`hinfsyn`, :func:`hinfnorm`, :func:`lft_lower` — ``control/hinf.py``
+* :func:`mussv` — ``control/mu.py``
+* :func:`musyn`, :func:`fit_magnitude` — ``control/dk.py``
+* :func:`reduce_controller`, :func:`balred_controller` — ``control/order.py``
+* :func:`export_controller`, :func:`discretize` — ``control/export.py``
+"""
+
+from __future__ import annotations
+
+import importlib
+
+_LAZY = {
+    "hinfsyn": "hinf", "hinfnorm": "hinf", "lft_lower": "hinf", "HinfResult": "hinf",
+    "mussv": "mu", "MuResult": "mu",
+    "musyn": "dk", "MusynResult": "dk", "fit_magnitude": "dk",
+    "reduce_controller": "order", "balred_controller": "order", "ReductionResult": "order",
+    "export_controller": "export", "discretize": "export",
+}
+
+__all__ = sorted(_LAZY)
+
+
+def __getattr__(name: str):
+    mod = _LAZY.get(name)
+    if mod is None:
+        raise AttributeError(f"module 'ambseal.control' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"ambseal.control.{mod}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))

@@ -1,0 +1,161 @@
+"""Tests of ambseal.control.mu.mussv against closed forms and slycot's AB13MD."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import control as ct
+
+from ambseal.control.mu import freqresp, mussv
+
+
+def crandn(rng, *shape):
+    return rng.standard_normal(shape) + 1j * rng.standard_normal(shape)
+
+
+def test_full_block_is_max_singular_value():
+    """Reference: closed form, one full complex block ⇒ μ = σ̄(M) (Packard & Doyle 1993, §3)."""
+    rng = np.random.default_rng(0)
+    M = crandn(rng, 5, 3, 4)  # stack of 3×4 matrices, Δ is 4×3
+    r = mussv(M, [(4, 3)])
+    s = np.linalg.norm(M, 2, axis=(-2, -1))
+    assert r.upper.shape == (5,)
+    np.testing.assert_allclose(r.upper, s, rtol=1e-6)
+    np.testing.assert_allclose(r.lower, s, rtol=1e-6)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_rank_one_complex_scalars(seed):
+    """Reference: closed form for rank one M = a bᵀ and complex scalar blocks,
+    μ = Σ|a_i||b_i| (Packard & Doyle 1993, §9.3; Young 1993)."""
+    rng = np.random.default_rng(seed)
+    a, b = crandn(rng, 4), crandn(rng, 4)
+    r = mussv(np.outer(a, b), [(1, 0)] * 4)
+    exact = np.sum(np.abs(a) * np.abs(b))
+    assert float(r.upper) == pytest.approx(exact, rel=1e-3)
+    assert float(r.lower) == pytest.approx(exact, rel=1e-6)
+    assert float(r.lower) <= float(r.upper) * (1 + 1e-9)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_repeated_real_scalar_is_largest_real_eigenvalue(seed):
+    """Reference: closed form, Δ = δ I with δ real ⇒ μ = max |λ| over real eigenvalues λ of M
+    (Packard & Doyle 1993, §3; the D–G bound is exact here)."""
+    rng = np.random.default_rng(100 + seed)
+    while True:
+        M = rng.standard_normal((4, 4))
+        lam = np.linalg.eigvals(M)
+        real = lam[np.abs(lam.imag) < 1e-12].real
+        if real.size:
+            break
+    exact = np.max(np.abs(real))
+    r = mussv(M, [(-4, 0)])
+    assert float(r.upper) == pytest.approx(exact, rel=1e-3)
+    assert float(r.lower) == pytest.approx(exact, rel=1e-6)
+    # a complex repeated scalar would give the spectral radius instead, which is larger here
+    assert np.max(np.abs(lam)) >= exact
+
+
+def test_repeated_complex_scalar_is_spectral_radius():
+    """Reference: closed form, Δ = δ I with δ complex ⇒ μ = ρ(M) (Packard & Doyle 1993)."""
+    rng = np.random.default_rng(7)
+    M = crandn(rng, 6, 3, 3)
+    r = mussv(M, [(3, 0)])
+    rho = np.max(np.abs(np.linalg.eigvals(M)), axis=-1)
+    np.testing.assert_allclose(r.upper, rho, rtol=1e-3)
+    np.testing.assert_allclose(r.lower, rho, rtol=1e-6)
+
+
+STRUCTURES = [
+    [(2, 0), (4, 6)],
+    [(-2, 0), (4, 6)],
+    [(-1, 0), (1, 0), (4, 6)],
+    [(1, 1), (2, 2), (3, 1)],
+    [(-1, 0), (-1, 0), (-1, 0), (1, 2)],
+]
+
+
+@pytest.mark.parametrize("blocks", STRUCTURES)
+def test_lower_le_upper_and_certificates(blocks):
+    """Reference: definition of μ and of the D–G bound (Fan, Tits & Doyle 1991): lower ≤ upper
+    ≤ σ̄(M); the returned (D, G) satisfy Mᴴ Dl² M + j(G M − Mᴴ Gᴴ) ⪯ upper² Dr²; the returned Δ is
+    structured, σ̄(Δ) = 1/lower and I − MΔ is singular."""
+    rng = np.random.default_rng(11)
+    n = sum(c if c else abs(r) for r, c in blocks)
+    m = sum(abs(r) for r, c in blocks)
+    M = crandn(rng, 40, n, m)
+    res = mussv(M, blocks)
+    assert np.all(res.lower <= res.upper * (1 + 1e-6))
+    assert np.all(res.upper <= np.linalg.norm(M, 2, axis=(-2, -1)) * (1 + 1e-9))
+    assert np.all(res.lower > 0)
+    for k in range(0, 40, 7):
+        Mk, Dl, Dr, G, u = M[k], res.Dl[k], res.Dr[k], res.G[k], res.upper[k]
+        L = Mk.conj().T @ Dl @ Dl @ Mk + 1j * (G @ Mk - Mk.conj().T @ G.conj().T) - u**2 * Dr @ Dr
+        assert np.linalg.eigvalsh(0.5 * (L + L.conj().T)).max() <= 1e-8 * u**2
+        Delta = res.delta[k]
+        assert np.linalg.norm(Delta, 2) == pytest.approx(1 / res.lower[k], rel=1e-6)
+        assert np.min(np.abs(np.linalg.eigvals(np.eye(n) - Mk @ Delta))) < 1e-8
+        # structure: zero outside the diagonal blocks, real where the block is real
+        ro = co = 0
+        mask = np.zeros((m, n), bool)
+        for r, c in blocks:
+            rr, cc = (abs(r), abs(r)) if c == 0 else (r, c)
+            blk = Delta[co:co + rr, ro:ro + cc]
+            if c == 0:
+                np.testing.assert_allclose(blk, blk[0, 0] * np.eye(rr), atol=1e-12)
+                if r < 0:
+                    assert abs(blk[0, 0].imag) <= 1e-9 * max(abs(blk[0, 0]), 1e-300)
+            mask[co:co + rr, ro:ro + cc] = True
+            ro, co = ro + cc, co + rr
+        assert np.all(Delta[~mask] == 0)
+
+
+def test_upper_matches_slycot_ab13md():
+    """Reference: slycot AB13MD (Fan–Tits–Doyle bound) run side by side on structures it
+    supports (scalar real blocks, square full complex blocks); both solve the same convex
+    problem, so the bounds agree to the solvers' tolerance."""
+    from slycot import ab13md
+
+    rng = np.random.default_rng(5)
+    cases = [([(-1, 0), (-1, 0), (3, 3)], [1, 1, 3], [1, 1, 2]),
+             ([(1, 0), (2, 2), (2, 2)], [1, 2, 2], [2, 2, 2]),
+             ([(-1, 0), (1, 0), (4, 4)], [1, 1, 4], [1, 2, 2])]
+    for blocks, nblock, itype in cases:
+        for _ in range(5):
+            M = crandn(rng, sum(nblock), sum(nblock))
+            ours = float(mussv(M, blocks).upper)
+            ref = ab13md(M, np.array(nblock), np.array(itype))[0]
+            assert ours == pytest.approx(ref, rel=5e-3)
+
+
+def test_frequency_grid_and_non_square_padding():
+    """Reference: mussv on a StateSpace equals mussv on its frequency response stack, and
+    for one full block it is σ̄(G(jω)) (closed form)."""
+    np.random.seed(2)
+    sys = ct.rss(5, 3, 2)
+    w = np.logspace(-1, 2, 25)
+    r = mussv(sys, [(2, 3)], w)
+    G = freqresp(sys, w)
+    ref = ct.frequency_response(sys, w)
+    np.testing.assert_allclose(G, np.moveaxis(ref.complex, -1, 0), rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(r.upper, np.linalg.norm(G, 2, axis=(-2, -1)), rtol=1e-6)
+    assert r.omega is not None and r.peak_omega in w
+    r2 = mussv(G, [(2, 3)])
+    np.testing.assert_allclose(r.upper, r2.upper, rtol=1e-12)
+    assert set(r.to_dict()) >= {"upper", "lower", "omega_rad_s", "blocks"}
+
+
+def test_bad_input_raises():
+    """Reference: the block structure must match M (Σc rows, Σr columns); malformed pairs
+    and a state space without a grid are rejected with the cause named."""
+    M = np.ones((3, 3))
+    with pytest.raises(ValueError, match="shape"):
+        mussv(M, [(1, 0), (1, 1)])
+    with pytest.raises(ValueError, match="non-zero"):
+        mussv(M, [(0, 0), (3, 3)])
+    with pytest.raises(ValueError, match="r > 0"):
+        mussv(M, [(-2, 3)])
+    with pytest.raises(ValueError, match="omega"):
+        mussv(ct.rss(2, 3, 3), [(3, 3)])
+    with pytest.raises(ValueError, match="non-finite"):
+        mussv(np.full((2, 2), np.nan), [(2, 2)])

@@ -27,8 +27,10 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     (``natural_frequency`` in rad/s, ``damping_ratio``); ``eddy_time_constant`` τ_e (s,
     default 0): a first-order lag 1/(τ_e s + 1) between coil current and force (P2 §4).
 ``[[seal]]``
-    ``name``, ``position``, ``K``, ``k`` (N/m), ``C``, ``c`` (N·s/m), ``M`` (kg), each a number
-    or ``{ at_zero = ..., per_bar = ... }``; Childs' convention
+    ``name``, ``position``, ``K``, ``k`` (N/m), ``C``, ``c`` (N·s/m), ``M`` (kg), each a number,
+    ``{ at_zero = ..., per_bar = ... }`` (affine in the pressure drop) or
+    ``{ frequency_hz = [...], value = [...] }`` (a table against excitation frequency,
+    evaluated at the synchronous frequency, thesis P3 §4); Childs' convention
     −f = [K k; −k K] q + [C c; −c C] q̇ + M q̈.
 ``[[spring]]``
     ``position``, ``kxx``, ``kyy`` and optional ``kxy``, ``kyx`` (N/m), ``cxx``, ``cyy``
@@ -49,6 +51,8 @@ from __future__ import annotations
 import math
 import tomllib
 from pathlib import Path
+
+import numpy as np
 from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
@@ -61,6 +65,13 @@ __all__ = [
     "parse_rig",
     "default_rig_path",
     "Coefficient",
+    "Affine",
+    "FrequencyTable",
+    "TruthSection",
+    "load_truth",
+    "rig_with_values",
+    "dump_rig",
+    "amb_factors_from_geometry",
 ]
 
 MU0 = 4e-7 * math.pi
@@ -230,28 +241,59 @@ class Affine(_Strict):
     per_bar: float = 0.0
 
 
+class FrequencyTable(_Strict):
+    """A coefficient tabulated against excitation frequency (Hz), interpolated linearly and
+    held constant outside the table: ``{ frequency_hz = [...], value = [...] }``."""
+
+    frequency_hz: list[float] = Field(min_length=1)
+    value: list[float] = Field(min_length=1)
+
+    @model_validator(mode="after")
+    def _table(self) -> "FrequencyTable":
+        if len(self.frequency_hz) != len(self.value):
+            raise ValueError("expected frequency_hz and value of the same length")
+        if any(b <= a for a, b in zip(self.frequency_hz, self.frequency_hz[1:])):
+            raise ValueError("expected frequency_hz strictly increasing")
+        return self
+
+
 Coefficient = float | Affine
+SealCoefficient = float | Affine | FrequencyTable
 
 
-def coefficient_value(c: Coefficient, pressure_bar: float) -> float:
-    """The value of a seal coefficient at a pressure drop (bar)."""
+def coefficient_value(c: SealCoefficient, pressure_bar: float,
+                      frequency_hz: float | None = None) -> float:
+    """The value of a seal coefficient at a pressure drop (bar) and, for a frequency table,
+    at an excitation frequency (Hz; required then)."""
     if isinstance(c, Affine):
         return c.at_zero + c.per_bar * pressure_bar
+    if isinstance(c, FrequencyTable):
+        if frequency_hz is None:
+            raise ConfigError("a frequency-dependent seal coefficient needs a frequency "
+                              "(the synchronous one, from a non-zero speed)")
+        return float(np.interp(frequency_hz, c.frequency_hz, c.value))
     return float(c)
 
 
 class Seal(_Strict):
     name: str = Field(min_length=1)
     position: float = Field(ge=0)
-    K: Coefficient = 0.0
-    k: Coefficient = 0.0
-    C: Coefficient = 0.0
-    c: Coefficient = 0.0
-    M: Coefficient = 0.0
+    K: SealCoefficient = 0.0
+    k: SealCoefficient = 0.0
+    C: SealCoefficient = 0.0
+    c: SealCoefficient = 0.0
+    M: SealCoefficient = 0.0
 
-    def at(self, pressure_bar: float) -> dict[str, float]:
-        """Coefficients K, k (N/m), C, c (N·s/m), M (kg) at a pressure drop (bar)."""
-        return {n: coefficient_value(getattr(self, n), pressure_bar) for n in "KkCcM"}
+    @property
+    def frequency_dependent(self) -> bool:
+        """Whether any coefficient is tabulated against frequency."""
+        return any(isinstance(getattr(self, n), FrequencyTable) for n in "KkCcM")
+
+    def at(self, pressure_bar: float, frequency_hz: float | None = None) -> dict[str, float]:
+        """Coefficients K, k (N/m), C, c (N·s/m), M (kg) at a pressure drop (bar) and, for
+        tabulated ones, an excitation frequency (Hz)."""
+        return {n: coefficient_value(getattr(self, n), pressure_bar, frequency_hz)
+                for n in "KkCcM"}
 
 
 class Spring(_Strict):
@@ -478,3 +520,84 @@ def load_truth(path: str | Path) -> TruthSection:
         err = exc.errors()[0]
         msg = "missing required key" if err["type"] == "missing" else err["msg"]
         raise ConfigError(f"{p}: {_loc(err['loc'])}: {msg}") from None
+
+
+def rig_with_values(cfg: RigConfig, values: dict[str, Coefficient]) -> RigConfig:
+    """The rig with named model parameters set (SI), e.g. identified values.
+
+    Names are those of the model's LFT channels — ``{amb}.Ki_{zeta|eta}``,
+    ``{amb}.Ks_{zeta|eta}``, ``{spring}.{kxx|kyy|kxy|kyx|cxx|cyy}`` (a spring without a
+    ``name`` is ``spring{i}``), ``{seal}.{K|k|C|c}`` (a number or an :class:`Affine` in the
+    pressure drop) — and ``tau_e`` (the actuator's eddy-current lag).
+
+    Raises
+    ------
+    ConfigError
+        An unknown parameter name.
+    """
+    data = cfg.model_dump(exclude_none=True)
+    ambs = {a["name"]: a for a in data.get("amb", [])}
+    springs = {(s.get("name") or f"spring{i}"): s for i, s in enumerate(data.get("spring", []))}
+    seals = {s["name"]: s for s in data.get("seal", [])}
+    for name, v in values.items():
+        v = v.model_dump() if isinstance(v, Affine) else float(v)
+        owner, _, key = name.rpartition(".")
+        if name == "tau_e":
+            data.setdefault("actuator", {})["eddy_time_constant"] = v
+        elif owner in ambs and key[:3] in ("Ki_", "Ks_") and key[3:] in ("zeta", "eta"):
+            amb = ambs[owner]
+            slot = key[:2].lower()
+            cur = amb.get(slot)
+            if not isinstance(cur, dict):
+                ki, ks = cfg.amb[list(ambs).index(owner)].factors()
+                pair = ki if slot == "ki" else ks
+                cur = {"zeta": pair[0], "eta": pair[1]}
+            cur[key[3:]] = v
+            amb[slot] = cur
+        elif owner in springs and key in ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy"):
+            springs[owner][key] = v
+        elif owner in seals and key in ("K", "k", "C", "c"):
+            seals[owner][key] = v
+        else:
+            raise ConfigError(f"rig parameters: unknown parameter {name!r}")
+    return parse_rig(data, "<identified rig>")
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, float)):
+        return repr(v) if isinstance(v, int) or math.isfinite(v) else "nan"
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    raise TypeError(f"cannot write {type(v).__name__} to TOML")
+
+
+def dump_rig(cfg: RigConfig, header: str = "") -> str:
+    """The rig as TOML text that :func:`load_rig` reads back to the same configuration."""
+    data = cfg.model_dump(exclude_none=True)
+    lines = [f"# {line}" for line in header.splitlines()]
+    for key, val in data.items():
+        if isinstance(val, list):
+            for item in val:
+                lines += ["", f"[[{key}]]"]
+                lines += [f"{k} = {_toml_value(x)}" for k, x in item.items()]
+        elif key == "materials":
+            for name, mat in val.items():
+                lines += ["", f"[materials.{name}]"]
+                lines += [f"{k} = {_toml_value(x)}" for k, x in mat.items()]
+        elif key == "controller":
+            lines += ["", "[controller]"]
+            lines += [f"{k} = {_toml_value(x)}" for k, x in val.items() if not isinstance(x, dict)]
+            for sub, table in val.items():
+                if isinstance(table, dict):
+                    lines += ["", f"[controller.{sub}]"]
+                    lines += [f"{k} = {_toml_value(x)}" for k, x in table.items()]
+        else:
+            lines += ["", f"[{key}]"]
+            lines += [f"{k} = {_toml_value(x)}" for k, x in val.items()]
+    return "\n".join(lines).lstrip("\n") + "\n"

@@ -163,12 +163,21 @@ class FitResult:
 
 
 def _newey_west(scores: np.ndarray, max_lag: int) -> np.ndarray:
-    """Long-run covariance Σ_l w_l Γ_l of per-sample scores (N, p), Bartlett weights."""
-    S = scores.T @ scores
+    """Long-run covariance of per-sample scores (N, p): VAR(1) prewhitening, Bartlett-
+    weighted sum of the whitened autocovariances, recolouring (Andrews & Monahan,
+    Econometrica 60, 1992; Newey & West 1987)."""
+    x0, x1 = scores[:-1], scores[1:]
+    Phi = np.linalg.lstsq(x0, x1, rcond=None)[0].T  # s_t ≈ Φ s_{t−1}
+    eig = np.abs(np.linalg.eigvals(Phi))
+    if eig.size and eig.max() > 0.97:  # keep the recolouring well conditioned
+        Phi *= 0.97 / eig.max()
+    w = x1 - x0 @ Phi.T
+    S = w.T @ w
     for lag in range(1, max_lag + 1):
-        G = scores[lag:].T @ scores[:-lag]
+        G = w[lag:].T @ w[:-lag]
         S += (1 - lag / (max_lag + 1)) * (G + G.T)
-    return S
+    R = np.linalg.inv(np.eye(len(Phi)) - Phi)
+    return R @ S @ R.T
 
 
 def _bandwidth(res: np.ndarray) -> int:
@@ -193,7 +202,7 @@ def fit_parameters(
     bounds: dict[str, tuple[float, float]] | None = None,
     current_weight: float = 0.0,
     max_nfev: int = 200,
-    start: int = 0,
+    window: tuple[int, int | None] = (0, None),
 ) -> FitResult:
     """Fit parameters ``names`` to one or more closed-loop records.
 
@@ -214,9 +223,9 @@ def fit_parameters(
         Weight of the coil-current residuals relative to the displacements (0: off).
     max_nfev : int
         Budget of model evaluations; exhausting it flags the result as not converged.
-    start : int
-        Samples to skip at the start of each record in the cost (transients of a record
-        that did not start at rest).
+    window : (start, stop)
+        Samples of each record in the cost (e.g. one frequency of a stepped sine); the
+        simulation always starts at rest at sample 0.
 
     Raises
     ------
@@ -231,7 +240,8 @@ def fit_parameters(
     nominal, scale = [], []
     for n in names:
         if n == TAU_E:
-            nominal.append(m0.tau_e)
+            # start inside the bounds: τ_e = 0 (no lag modelled) sits on the lower bound
+            nominal.append(m0.tau_e if m0.tau_e > 0 else 0.1 * _DEFAULT_SCALE["s"])
             scale.append(_DEFAULT_SCALE["s"])
             continue
         try:
@@ -257,17 +267,18 @@ def fit_parameters(
     lo, hi = np.array(lo), np.array(hi)
     init = np.clip(init, lo + 1e-12 * scale, hi - 1e-12 * scale)
 
+    start, stop = window
     data = []
     for rec in records:
-        y = np.asarray(rec.displacement_m)[start:]
+        y = np.asarray(rec.displacement_m)[start:stop]
         if y.shape[0] <= len(names):
             raise IdentificationError(f"fit: {y.shape[0]} samples for {len(names)} parameters")
         sy = y.std(axis=0)
         sy[sy == 0] = 1.0
-        i = np.asarray(rec.current_a)[start:]
+        i = np.asarray(rec.current_a)[start:stop]
         si = i.std(axis=0)
         si[si == 0] = 1.0
-        data.append((np.asarray(rec.excitation_a), y, sy, i, si))
+        data.append((np.asarray(rec.excitation_a)[:stop], y, sy, i, si))
 
     def values(x):
         return dict(zip(names, init + x * scale))  # x: scaled change from the start
@@ -334,6 +345,6 @@ def fit_parameters(
         ci95_low=est - 1.96 * se, ci95_high=est + 1.96 * se, correlation=corr,
         nrmse_fit_pct=fits, converged=converged, message=str(sol.message),
         iterations=int(sol.nfev), wall_time_s=time.perf_counter() - t0,
-        time_s=np.asarray(records[0].time_s)[start:], y_meas=y0, y_sim=ys[start:],
+        time_s=np.asarray(records[0].time_s)[start:stop], y_meas=y0, y_sim=ys[start:],
         axes=tuple(records[0].axes),
     )

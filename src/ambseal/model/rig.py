@@ -101,6 +101,7 @@ def build_system(
     include_seals: bool = True,
     include_springs: bool = True,
     force_positions: tuple[float, ...] = (),
+    seal_frequency_hz: float | None = None,
 ) -> SecondOrderSystem:
     """Assemble the rig as a second-order system.
 
@@ -116,6 +117,9 @@ def build_system(
         Leave components out (``modes --no-amb``, ``--free``).
     force_positions : tuple of float
         Positions (m) of extra force inputs, named ``F{k}_x``, ``F{k}_y`` (N).
+    seal_frequency_hz : float, optional
+        Frequency (Hz) at which frequency-tabulated seal coefficients are taken; by default
+        the synchronous frequency Ω/2π (thesis P3 §4's assumption).
 
     Returns
     -------
@@ -168,7 +172,8 @@ def build_system(
     if include_seals:
         for seal in cfg.seal:
             node = mesh.node_at(seal.position)
-            v = seal.at(p)
+            f_seal = seal_frequency_hz if seal_frequency_hz is not None else speed / (2 * np.pi)
+            v = seal.at(p, f_seal if seal.frequency_dependent else None)
             i = xy(node)
             ex, ey = unit(node, np.array([1.0, 0.0])), unit(node, np.array([0.0, 1.0]))
             skew = np.array([[0.0, 1.0], [-1.0, 0.0]])

@@ -1,0 +1,146 @@
+"""Identification stages: acquire a record, build the models a fit needs, fit and refine.
+
+These wire :mod:`~ambseal.identify.rig_sim`, :mod:`~ambseal.identify.data` and
+:mod:`~ambseal.identify.fit` to a rig description; the CLI and the pipeline call them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..config import RigConfig, TruthSection
+from ..errors import DataError
+from ..model.amb import actuator_matrices
+from ..model.reduction import modal_reduction
+from ..model.rig import build_system, mechanical_plant
+from .data import Measurement
+from .fit import TAU_E, ClosedLoopModel, FitResult, fit_parameters
+from .loop import DiscreteController, discrete_controller
+from .rig_sim import simulate_facility
+from .signals import Excitation
+
+__all__ = ["pid_metadata", "controller_from_metadata", "acquire", "build_models", "identify",
+           "FIT_CUTOFF_HZ"]
+
+#: Modes kept in the fit's reduced model (Hz). The rigid-body modes alone (8 states, P2 §3.2)
+#: bias Ki/Ks by ~0.5 % on the test rig through the static flexibility of the dropped bending
+#: modes; a 3 kHz cut-off leaves ~0.02 %; 10 kHz, the virtual facility's own, ~0.005 %.
+FIT_CUTOFF_HZ = 10000.0
+
+
+def pid_metadata(cfg: RigConfig) -> dict:
+    """The ``controller`` metadata of a record taken with the rig's reference PID."""
+    if cfg.controller.pid is None:
+        raise DataError("controller.pid: the rig has no reference PID to run the acquisition")
+    p = cfg.controller.pid
+    return {"type": "pid", "kp": p.kp, "ti": p.ti, "td": p.td, "eps": p.eps,
+            "discretisation": "tustin"}
+
+
+def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<data>"
+                             ) -> DiscreteController:
+    """The digital controller that ran, from a record's ``controller`` metadata.
+
+    ``{"type": "pid", kp, ti, td, eps, "discretisation": "tustin"|"zoh"}`` (P5 Eq. 6 at the
+    record's sample rate) or ``{"type": "state_space", A, B, C, D, dt}``.
+
+    Raises
+    ------
+    DataError
+        Missing or malformed controller metadata, naming the file.
+    """
+    from ..control.pid import pid_controller
+
+    c = meta.get("controller")
+    fs = meta.get("sample_rate_hz")
+    if not isinstance(c, dict) or "type" not in c:
+        raise DataError(f"{source}: metadata.controller: expected a dict with 'type' "
+                        "('pid' or 'state_space')")
+    try:
+        if c["type"] == "pid":
+            K = pid_controller(float(c["kp"]), float(c["ti"]), float(c["td"]), float(c["eps"]),
+                               axes)
+            return discrete_controller(K, 1.0 / float(fs), c.get("discretisation", "tustin"))
+        if c["type"] == "state_space":
+            return DiscreteController.from_dict(c)
+    except (KeyError, TypeError, ValueError) as exc:
+        raise DataError(f"{source}: metadata.controller: {exc}") from None
+    raise DataError(f"{source}: metadata.controller.type: unknown {c['type']!r}")
+
+
+def acquire(cfg: RigConfig, truth: TruthSection, excitation: Excitation, *,
+            pressure_bar: float, seed: int = 0, controller: dict | None = None) -> Measurement:
+    """Run the virtual facility and return the record as a :class:`Measurement`."""
+    axes = excitation.axes
+    meta = {
+        "rig": cfg.rotor.name,
+        "sample_rate_hz": excitation.sample_rate_hz,
+        "bias_current_a": truth.bias_current,
+        "pressure_drop_pa": pressure_bar * 1e5,
+        "speed_rad_s": cfg.speed,
+        "controller": controller or pid_metadata(cfg),
+        "excitation": excitation.params,
+        "source": "virtual test facility",
+    }
+    limits = [a.current_limit for a in cfg.amb if a.current_limit]
+    limit = truth.current_limit or (min(limits) if limits else None)
+    if limit:
+        meta["current_limit_a"] = limit
+    Kd = controller_from_metadata(meta, axes)
+    rec = simulate_facility(cfg, truth, np.asarray(excitation.values_a), excitation.sample_rate_hz,
+                            Kd, pressure_bar=pressure_bar, seed=seed)
+    return Measurement(time_s=rec.time_s, excitation_a=rec.excitation_a,
+                       current_ref_a=rec.current_ref_a, current_a=rec.current_a,
+                       displacement_m=rec.displacement_m, axes=axes, metadata=meta)
+
+
+def _pressure_bar(meas: Measurement) -> float:
+    return float(meas.metadata.get("pressure_drop_pa", 0.0)) / 1e5
+
+
+def build_models(cfg: RigConfig, records: list[Measurement], values: dict | None = None,
+                 cutoff_hz: float = FIT_CUTOFF_HZ) -> list[ClosedLoopModel]:
+    """One closed-loop model per record: the rig at the record's pressure and speed, with
+    parameter ``values`` (SI) applied exactly in full order, reduced to the modes below
+    ``cutoff_hz``, the amplifier and τ_e lag in series and the controller that ran."""
+    values = dict(values or {})
+    tau = values.pop(TAU_E, cfg.actuator.eddy_time_constant)
+    models = []
+    for rec in records:
+        speed = rec.metadata.get("speed_rad_s")
+        sys = build_system(cfg, pressure_bar=_pressure_bar(rec),
+                           speed_rpm=None if speed is None else float(speed) * 60 / (2 * np.pi))
+        full = mechanical_plant(sys)
+        if values:
+            full = full.with_values(values)
+        plant = modal_reduction(full, cutoff_hz=cutoff_hz).plant
+        Kd = controller_from_metadata(dict(rec.metadata), rec.axes)
+        models.append(ClosedLoopModel(plant, actuator_matrices(cfg.actuator), Kd, tau_e=tau))
+    return models
+
+
+def identify(cfg: RigConfig, records: list[Measurement], names: list[str], *,
+             known: dict | None = None, current_weight: float = 0.0, refine: bool = True,
+             window: tuple[int, int | None] = (0, None)) -> FitResult:
+    """Fit ``names`` to closed-loop records (P2 Eqs. 9–10, P4 Eq. 14).
+
+    Parameters
+    ----------
+    known : dict, optional
+        Values found in earlier stages (e.g. Ki/Ks when fitting the coupling, P4 §3.5).
+    refine : bool
+        Fit again on a model re-reduced at the first estimate: the reduced LFT is exact only
+        at the point of reduction (P2 §4.1 assumes it holds nearby), so the second pass
+        removes that approximation from the estimate.
+    """
+    known = dict(known or {})
+    models = build_models(cfg, records, known)
+    res = fit_parameters(records, models, names, current_weight=current_weight, window=window)
+    if refine and res.converged:
+        est = dict(zip(names, res.estimate))
+        models = build_models(cfg, records, {**known, **est})
+        res2 = fit_parameters(records, models, names, current_weight=current_weight,
+                              window=window)
+        if res2.converged:
+            res = res2
+    return res

@@ -14,9 +14,8 @@ controller that ran (:mod:`ambseal.identify.loop`).
 
 Uncertainty: the covariance of θ̂ from the Jacobian at the optimum. Closed-loop residuals
 are coloured (sensor noise runs through the loop), so the sandwich form
-(JᵀJ)⁻¹ S (JᵀJ)⁻¹ with a Newey–West (Bartlett-weighted) long-run covariance S of the
-per-sample scores Jₜᵀrₜ is used (Newey & West, Econometrica 55, 1987); with white
-residuals it reduces to σ̂²(JᵀJ)⁻¹. 95 % intervals are θ̂ ± 1.96·SE; the correlation
+(JᵀJ)⁻¹ S (JᵀJ)⁻¹ is used, with S = Var(Jᵀr) from the residuals' cross-spectrum
+(:func:`_long_run_covariance`); with white residuals it reduces to σ̂²(JᵀJ)⁻¹. 95 % intervals are θ̂ ± 1.96·SE; the correlation
 matrix is the normalised covariance (P4 Tables 2 and 4).
 """
 
@@ -87,6 +86,18 @@ class ClosedLoopModel:
             C = np.hstack([C, np.zeros((C.shape[0], na))])
             Cout, Dout = Ci_new, Da
         return A, B, C, Cout, Dout
+
+    def statespace(self, values: dict[str, float], axes: tuple[str, ...]):
+        """The discrete closed loop from excitation (A) to displacement (m) as a
+        ``control.StateSpace`` at the controller's sample time (for FRF checks)."""
+        import control
+
+        A, B, C, _, _ = self.matrices(values)
+        Ad, Bd = zoh(A, B, self.controller.dt)
+        Acl, Bcl, Cy, _, _ = closed_loop_matrices(Ad, Bd, C, self.controller)
+        return control.ss(Acl, Bcl, Cy, np.zeros((Cy.shape[0], Bcl.shape[1])),
+                          self.controller.dt, inputs=[f"excitation_{a}" for a in axes],
+                          outputs=[f"displacement_{a}" for a in axes])
 
     def simulate(self, values: dict[str, float], e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Displacements (N, k) and coil currents (N, k) for excitation ``e`` (N, k)."""
@@ -162,35 +173,40 @@ class FitResult:
         }
 
 
-def _newey_west(scores: np.ndarray, max_lag: int) -> np.ndarray:
-    """Long-run covariance of per-sample scores (N, p): VAR(1) prewhitening, Bartlett-
-    weighted sum of the whitened autocovariances, recolouring (Andrews & Monahan,
-    Econometrica 60, 1992; Newey & West 1987)."""
-    x0, x1 = scores[:-1], scores[1:]
-    Phi = np.linalg.lstsq(x0, x1, rcond=None)[0].T  # s_t ≈ Φ s_{t−1}
-    eig = np.abs(np.linalg.eigvals(Phi))
-    if eig.size and eig.max() > 0.97:  # keep the recolouring well conditioned
-        Phi *= 0.97 / eig.max()
-    w = x1 - x0 @ Phi.T
-    S = w.T @ w
-    for lag in range(1, max_lag + 1):
-        G = w[lag:].T @ w[:-lag]
-        S += (1 - lag / (max_lag + 1)) * (G + G.T)
-    R = np.linalg.inv(np.eye(len(Phi)) - Phi)
-    return R @ S @ R.T
+def _long_run_covariance(J: np.ndarray, R: np.ndarray, smooth: int = 2) -> np.ndarray:
+    """Var(Σ_t J_tᵀ r_t) for residuals r that are a stationary coloured process.
 
+    Frequency-domain form of the sandwich's middle term (Ljung, *System Identification*,
+    2nd ed., §9.3): Σ_f J(f)ᴴ Φ_r(f) J(f) / L with Φ_r the residuals' cross-spectral
+    matrix across channels, estimated by the periodogram R(f)R(f)ᴴ/N averaged over
+    2·``smooth``+1 neighbouring bins (Daniell window), and L = 2N (zero padding, no wrap).
+    Closed-loop residuals ring at the loop's lightly damped resonances, where the Jacobian
+    is also largest; a lag-window (Newey–West) estimate smooths those peaks away and
+    understates the variance, this one keeps them.
 
-def _bandwidth(res: np.ndarray) -> int:
-    """Lag window from the residuals' autocorrelation (summed over channels): twice the last
-    lag at which |ρ| still reaches 0.05 — the envelope, since closed-loop residuals ring at
-    the loop's resonances — at least 1, at most N/10."""
-    N = res.shape[0]
-    r = res - res.mean(axis=0)
-    spec = np.fft.rfft(r, n=2 * N, axis=0)
-    ac = np.fft.irfft(np.abs(spec) ** 2, axis=0)[: N // 10 + 1].sum(axis=1)
-    ac = ac / ac[0]
-    above = np.nonzero(np.abs(ac) >= 0.05)[0]
-    return int(np.clip(2 * above[-1], 1, N // 10))
+    Parameters
+    ----------
+    J : ndarray (N, c, p)
+        Jacobian per sample and channel.
+    R : ndarray (N, c)
+        Residuals.
+    """
+    N, c, p = J.shape
+    L = 2 * N
+    Rf = np.fft.rfft(R - R.mean(axis=0), n=L, axis=0)  # (F, c)
+    Jf = np.fft.rfft(J, n=L, axis=0)  # (F, c, p)
+    P = np.einsum("fa,fb->fab", Rf, Rf.conj()) / N  # (F, c, c) periodogram
+    if smooth > 0:
+        kernel = np.ones(2 * smooth + 1) / (2 * smooth + 1)
+        flat = P.reshape(P.shape[0], -1)
+        pad = np.concatenate([flat[smooth:0:-1].conj(), flat, flat[-2:-smooth - 2:-1].conj()])
+        flat = np.apply_along_axis(lambda x: np.convolve(x, kernel, mode="valid"), 0, pad)
+        P = flat.reshape(P.shape)
+    w = np.full(P.shape[0], 2.0)
+    w[0] = 1.0
+    w[-1] = 1.0
+    S = np.einsum("f,fap,fab,fbq->pq", w, Jf.conj(), P, Jf) / L
+    return np.real(S)
 
 
 def fit_parameters(
@@ -309,21 +325,19 @@ def fit_parameters(
     est = init + sol.x * scale
     converged = bool(sol.status > 0)
 
-    # covariance (sandwich, Newey–West) in scaled coordinates; rows are sample-major
+    # covariance (sandwich with the residuals' spectrum) in scaled coordinates; rows of the
+    # stacked residual vector are sample-major per record
     J, r = sol.jac, sol.fun
     p = len(names)
-    scores, resid, off = [], [], 0
+    blocks, off = [], 0
     for R in residual_blocks(sol.x):
         n_s, c = R.shape
-        Jb = J[off:off + n_s * c].reshape(n_s, c, p)
-        rb = r[off:off + n_s * c].reshape(n_s, c)
-        scores.append(np.einsum("tcp,tc->tp", Jb, rb))
-        resid.append(rb)
+        blocks.append((J[off:off + n_s * c].reshape(n_s, c, p), r[off:off + n_s * c].reshape(n_s, c)))
         off += n_s * c
     H = J.T @ J
     try:
         Hinv = np.linalg.inv(H)
-        S = sum(_newey_west(sc, _bandwidth(rs)) for sc, rs in zip(scores, resid))
+        S = sum(_long_run_covariance(Jb, rb) for Jb, rb in blocks)
         cov = Hinv @ S @ Hinv * (len(r) / max(len(r) - p, 1))
         if np.linalg.cond(H) > 1e14:
             raise np.linalg.LinAlgError

@@ -20,7 +20,8 @@ from matplotlib.figure import Figure
 from ambseal.errors import AmbsealError
 from ambseal.report.figures import save_figure
 
-__all__ = ["frf_figure"]
+__all__ = ["frf_figure", "fit_timeseries_figure", "correlation_figure", "seal_frequency_figure",
+           "seal_pressure_figure"]
 
 
 def _check(frf: Any, what: str) -> tuple[np.ndarray, np.ndarray]:
@@ -163,4 +164,110 @@ def frf_figure(
             axes[2, c].set_ylim(0, 1.05)
     fig.suptitle(title)
     fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def fit_timeseries_figure(path: str | os.PathLike, time_s: Sequence[float], y_meas: np.ndarray,
+                          y_sim: np.ndarray, channel_names: Sequence[str], *,
+                          nrmse_pct: Sequence[float] | None = None,
+                          title: str = "Measured and simulated displacements") -> Path:
+    """Measured (solid) against simulated (dashed) displacement per channel, in µm against
+    s (thesis P2 Fig. 5, P4 Fig. 8), with the NRMSE fit in each panel's title."""
+    t = np.asarray(time_s, float)
+    ym, ys = np.asarray(y_meas, float) * 1e6, np.asarray(y_sim, float) * 1e6
+    k = ym.shape[1]
+    fig = Figure(figsize=(10, 1.9 * k + 0.6), layout="constrained")
+    axes = fig.subplots(k, 1, sharex=True, squeeze=False)[:, 0]
+    for j, ax in enumerate(axes):
+        ax.plot(t, ym[:, j], lw=0.8, label="measured")
+        ax.plot(t, ys[:, j], lw=0.8, ls="--", label="simulated")
+        name = channel_names[j]
+        ax.set_title(name if nrmse_pct is None else f"{name}: fit {nrmse_pct[j]:.1f} %",
+                     fontsize=9)
+        ax.set_ylabel("µm")
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8, loc="upper right")
+    axes[-1].set_xlabel("Time (s)")
+    fig.suptitle(title)
+    return save_figure(fig, path)
+
+
+def correlation_figure(path: str | os.PathLike, correlation: np.ndarray,
+                       names: Sequence[str], *, title: str = "Parameter correlation") -> Path:
+    """The correlation matrix of the estimates with its values (thesis P4 Tables 2, 4)."""
+    R = np.asarray(correlation, float)
+    n = R.shape[0]
+    fig = Figure(figsize=(1.0 + 0.75 * n, 0.8 + 0.7 * n), layout="constrained")
+    ax = fig.subplots()
+    im = ax.imshow(R, vmin=-1, vmax=1, cmap="RdBu_r")
+    ax.set_xticks(range(n), names, rotation=60, ha="right", fontsize=8)
+    ax.set_yticks(range(n), names, fontsize=8)
+    for i in range(n):
+        for j in range(n):
+            ax.text(j, i, f"{R[i, j]:.2f}", ha="center", va="center", fontsize=7,
+                    color="white" if abs(R[i, j]) > 0.6 else "black")
+    fig.colorbar(im, ax=ax, shrink=0.8)
+    ax.set_title(title)
+    return save_figure(fig, path)
+
+
+_SEAL_UNITS = {"K": "N/m", "k": "N/m", "C": "N·s/m", "c": "N·s/m"}
+
+
+def seal_frequency_figure(path: str | os.PathLike, curves: Sequence[tuple[str, Any, Any, Any]],
+                          coefficients: Sequence[str] = ("K", "k", "C", "c"), *,
+                          valid_below_hz: float | None = 100.0,
+                          title: str = "Seal coefficients against excitation frequency"
+                          ) -> Path:
+    """Identified seal coefficients with ±1.96σ bars against frequency, one curve per
+    pressure (thesis P4 Fig. 12). ``curves``: (label, frequency_hz (n,), estimate (n, 4),
+    std_error (n, 4))."""
+    fig = Figure(figsize=(10, 6), layout="constrained")
+    axes = fig.subplots(2, 2).ravel()
+    for label, f, est, se in curves:
+        f, est, se = np.asarray(f, float), np.asarray(est, float), np.asarray(se, float)
+        for j, ax in enumerate(axes[: len(coefficients)]):
+            ax.errorbar(f, est[:, j], yerr=1.96 * se[:, j], marker="o", ms=3, capsize=2,
+                        lw=1, label=label)
+    for j, ax in enumerate(axes[: len(coefficients)]):
+        c = coefficients[j]
+        ax.set_title(c)
+        ax.set_ylabel(_SEAL_UNITS.get(c, ""))
+        ax.set_xlabel("Excitation frequency (Hz)")
+        ax.grid(alpha=0.3)
+        if valid_below_hz:
+            ax.axvline(valid_below_hz, color="k", ls="--", lw=0.8)
+    axes[0].legend(fontsize=8)
+    fig.suptitle(title)
+    return save_figure(fig, path)
+
+
+def seal_pressure_figure(path: str | os.PathLike, pressure_bar: Sequence[float], estimate: Any,
+                         std_error: Any, regressions: Sequence[Any],
+                         coefficients: Sequence[str] = ("K", "k", "C", "c"), *,
+                         truth: Sequence[Any] | None = None, nominal_bar: float | None = None,
+                         title: str = "Seal coefficients against pressure drop") -> Path:
+    """Identified coefficients (±1.96σ) against pressure drop with regression lines and
+    their 95 % band (thesis P5 Fig. 7). ``regressions`` have ``predict(x) -> (ŷ, se)``;
+    ``truth`` optional callables p -> value per coefficient."""
+    p = np.asarray(pressure_bar, float)
+    est, se = np.asarray(estimate, float), np.asarray(std_error, float)
+    grid = np.linspace(0.0, max(p.max(), nominal_bar or 0) * 1.05, 100)
+    fig = Figure(figsize=(10, 6), layout="constrained")
+    axes = fig.subplots(2, 2).ravel()
+    for j, ax in enumerate(axes[: len(coefficients)]):
+        ax.errorbar(p, est[:, j], yerr=1.96 * se[:, j], fmt="x", capsize=3, label="identified")
+        yhat, yse = regressions[j].predict(grid)
+        ax.plot(grid, yhat, lw=1.2, label="regression")
+        ax.fill_between(grid, yhat - 1.96 * yse, yhat + 1.96 * yse, alpha=0.2)
+        if truth is not None and truth[j] is not None:
+            ax.plot(grid, [truth[j](x) for x in grid], "k:", lw=1, label="truth")
+        if nominal_bar is not None:
+            ax.axvline(nominal_bar, color="k", ls="--", lw=0.8)
+        ax.set_title(coefficients[j])
+        ax.set_ylabel(_SEAL_UNITS.get(coefficients[j], ""))
+        ax.set_xlabel("Pressure drop (bar)")
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.suptitle(title)
     return save_figure(fig, path)

@@ -6,6 +6,11 @@ Commands
     The main job on a rig (default: the embedded thesis test facility).
 ``ambseal modes RIG [--speed-rpm N] [--pressure-bar P] [--json] [--free | --no-amb]``
     Damped natural frequencies, damping ratios and unstable poles of the full model.
+``ambseal acquire RIG --truth TRUTH --excitation prbs|sine|chirp|impulse --pressure-bar P --out FILE``
+    A record from the virtual test facility (CSV + JSON sidecar, or .mat).
+``ambseal identify RIG DATA... --params NAME,... --out DIR``
+    Output-error fit of named parameters to closed-loop records; writes the fit, its
+    figures and the identified rig.
 
 Any error on bad input prints one line on stderr and exits with status 2.
 """
@@ -31,6 +36,10 @@ def _parser() -> argparse.ArgumentParser:
     run = sub.add_parser("run", help="the main job: model, PID loop, judgement, report")
     run.add_argument("rig", nargs="?", help="rig file (TOML); default: the thesis test rig")
     run.add_argument("--out", default="ambseal-out", help="output folder (default ./ambseal-out)")
+    run.add_argument("--truth", default=None,
+                     help="truth file of the virtual facility: adds the identification stage "
+                          "(default for the embedded rig: its packaged truth)")
+    run.add_argument("--no-identify", action="store_true", help="skip the identification stage")
 
     m = sub.add_parser("modes", help="natural frequencies, damping and unstable poles")
     m.add_argument("rig", help="rig file (TOML)")
@@ -40,7 +49,86 @@ def _parser() -> argparse.ArgumentParser:
     g = m.add_mutually_exclusive_group()
     g.add_argument("--free", action="store_true", help="bare rotor: shaft and disks only")
     g.add_argument("--no-amb", action="store_true", help="leave the AMBs out")
+    a = sub.add_parser("acquire", help="record a run of the virtual test facility")
+    a.add_argument("rig", help="rig file (TOML)")
+    a.add_argument("--truth", required=True, help="truth file of the virtual facility (TOML)")
+    a.add_argument("--excitation", required=True, choices=["prbs", "sine", "chirp", "impulse"])
+    a.add_argument("--pressure-bar", type=float, required=True, help="seal pressure drop (bar)")
+    a.add_argument("--out", required=True, help="record file: .csv (+ .csv.json) or .mat")
+    a.add_argument("--amplitude-a", type=float, default=0.05, help="excitation amplitude (A)")
+    a.add_argument("--duration-s", type=float, default=1.0, help="record length (s)")
+    a.add_argument("--axes", default=None, help="excited axes, e.g. A_zeta,B_zeta (default all)")
+    a.add_argument("--clock-period-s", type=float, default=1e-3, help="PRBS clock period (s)")
+    a.add_argument("--frequencies-hz", default="10,30,50,70,90,110,130,150,170,190",
+                   help="stepped-sine frequencies (Hz), comma separated")
+    a.add_argument("--cycles", type=int, default=10, help="stepped sine: cycles per step")
+    a.add_argument("--settling-cycles", type=int, default=5, help="stepped sine: settling cycles")
+    a.add_argument("--f0-hz", type=float, default=1.0, help="chirp start frequency (Hz)")
+    a.add_argument("--f1-hz", type=float, default=150.0, help="chirp end frequency (Hz)")
+    a.add_argument("--chirp", choices=["linear", "logarithmic"], default="linear")
+    a.add_argument("--width-s", type=float, default=0.01, help="impulse width (s)")
+    a.add_argument("--start-s", type=float, default=0.05, help="impulse start (s)")
+    a.add_argument("--seed", type=int, default=0, help="seed of excitation and noise")
+
+    i = sub.add_parser("identify", help="fit model parameters to closed-loop records")
+    i.add_argument("rig", help="rig file (TOML)")
+    i.add_argument("data", nargs="+", help="record files (.csv with sidecar, or .mat)")
+    i.add_argument("--params", required=True,
+                   help="parameters, e.g. A.Ki_zeta,A.Ks_zeta,tau_e,coupling.kxx,seal.k")
+    i.add_argument("--out", required=True, help="output folder")
+    i.add_argument("--current-weight", type=float, default=0.0,
+                   help="weight of the coil-current residuals (0: displacements only)")
+    i.add_argument("--no-refine", action="store_true",
+                   help="skip the second pass on a model re-reduced at the estimate")
     return p
+
+
+def _acquire(args: argparse.Namespace) -> int:
+    from .config import load_rig, load_truth
+    from .errors import ConfigError
+    from .identify import signals
+    from .identify.data import save_measurement
+    from .identify.stages import acquire
+
+    cfg = load_rig(args.rig)
+    truth = load_truth(args.truth)
+    axes = tuple(f"{m.name}_{x}" for m in cfg.amb for x in ("zeta", "eta"))
+    if not axes:
+        raise ConfigError(f"{args.rig}: amb: acquisition needs at least one [[amb]]")
+    excited = args.axes.split(",") if args.axes else None
+    fs = cfg.controller.sample_rate_hz
+    common = dict(sample_rate_hz=fs, axes=axes, excited=excited)
+    try:
+        if args.excitation == "prbs":
+            ex = signals.prbs(amplitude_a=args.amplitude_a, clock_period_s=args.clock_period_s,
+                              duration_s=args.duration_s, seed=args.seed, **common)
+        elif args.excitation == "sine":
+            freqs = [float(f) for f in args.frequencies_hz.split(",")]
+            ex = signals.stepped_sine(frequencies_hz=freqs, amplitude_a=args.amplitude_a,
+                                      cycles=args.cycles, settling_cycles=args.settling_cycles,
+                                      **common)
+        elif args.excitation == "chirp":
+            ex = signals.chirp(f0_hz=args.f0_hz, f1_hz=args.f1_hz, duration_s=args.duration_s,
+                               amplitude_a=args.amplitude_a, method=args.chirp, **common)
+        else:
+            ex = signals.impulse(amplitude_a=args.amplitude_a, width_s=args.width_s,
+                                 start_s=args.start_s, duration_s=args.duration_s, **common)
+    except ValueError as exc:
+        raise ConfigError(f"acquire: {exc}") from None
+    meas = acquire(cfg, truth, ex, pressure_bar=args.pressure_bar, seed=args.seed)
+    path = save_measurement(meas, args.out)
+    print(json.dumps({"out": str(path), "samples": meas.n_samples,
+                      "sample_rate_hz": fs}))
+    return 0
+
+
+def _identify(args: argparse.Namespace) -> int:
+    from .pipeline import identify_files
+
+    summary = identify_files(args.rig, args.data, args.params.split(","), args.out,
+                             current_weight=args.current_weight, refine=not args.no_refine)
+    print(json.dumps(summary))
+    return 0
 
 
 def _modes(args: argparse.Namespace) -> int:
@@ -76,7 +164,7 @@ def _modes(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace) -> int:
     from .pipeline import run
 
-    result = run(args.rig, args.out)
+    result = run(args.rig, args.out, truth=args.truth, identification=not args.no_identify)
     print(json.dumps({"out": str(result.out_dir), "metrics": str(result.metrics_path)}))
     return 0
 
@@ -85,9 +173,9 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``ambseal`` console script; returns the exit status."""
     args = _parser().parse_args(argv)
     try:
-        if args.command == "modes":
-            return _modes(args)
-        return _run(args)
+        handler = {"modes": _modes, "acquire": _acquire, "identify": _identify,
+                   "run": _run}[args.command]
+        return handler(args)
     except AmbsealError as exc:
         print(f"ambseal: error: {exc}", file=sys.stderr)
         return 2

@@ -19,7 +19,8 @@ import numpy as np
 from .config import RigConfig, default_rig_path, load_rig
 from .errors import ConfigError
 
-__all__ = ["RunResult", "run", "judge", "write_json"]
+__all__ = ["RunResult", "run", "judge", "write_json", "write_text", "identify_files",
+           "default_truth_path"]
 
 #: Frequency grid of the loop analysis (Hz): past the first bending mode of the test rig.
 FREQ_HZ = (0.5, 2000.0, 1200)
@@ -52,6 +53,72 @@ def write_json(path: Path, data: dict) -> Path:
             os.unlink(tmp)
         raise
     return path
+
+
+def write_text(path: Path, text: str) -> Path:
+    """Write text through a temporary file in the same folder and an atomic rename."""
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path
+
+
+def default_truth_path() -> Path:
+    """The virtual facility's truth for the embedded test rig (``data/testrig_truth.toml``)."""
+    return Path(__file__).parent / "data" / "testrig_truth.toml"
+
+
+def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: str | Path, *,
+                   current_weight: float = 0.0, refine: bool = True) -> dict:
+    """``ambseal identify``: fit ``names`` to recorded files; write the fit, its figures and
+    the identified rig to ``out_dir``. Returns a JSON-safe summary.
+
+    Raises
+    ------
+    ConfigError, DataError, IdentificationError
+        A bad rig, a bad or mismatched record, or a fit that cannot start.
+    """
+    from .config import dump_rig, rig_with_values
+    from .errors import DataError
+    from .identify.data import load_measurement
+    from .identify.stages import identify
+    from .report.identify_figures import correlation_figure, fit_timeseries_figure
+
+    cfg = load_rig(rig)
+    axes = tuple(f"{m.name}_{x}" for m in cfg.amb for x in ("zeta", "eta"))
+    records = []
+    for path in data:
+        meas = load_measurement(path, axes=axes, min_samples=max(100, 10 * len(names)))
+        other = meas.metadata.get("rig")
+        if other is not None and other != cfg.rotor.name:
+            raise DataError(f"{path}: metadata.rig: recorded on {other!r}, but the rig is "
+                            f"{cfg.rotor.name!r}")
+        records.append(meas)
+    res = identify(cfg, records, names, current_weight=current_weight, refine=refine)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    write_json(out / "fit.json", res.to_dict())
+    fit_timeseries_figure(out / "fit_timeseries.png", res.time_s, res.y_meas, res.y_sim,
+                          res.axes, nrmse_pct=[res.nrmse_fit_pct[a] for a in res.axes])
+    correlation_figure(out / "correlation.png", res.correlation, res.names)
+    pressures = sorted({float(m.metadata.get("pressure_drop_pa", 0.0)) / 1e5 for m in records})
+    identified = rig_with_values(cfg, dict(zip(res.names, res.estimate)))
+    header = (f"Identified by ambseal from {', '.join(str(d) for d in data)}\n"
+              f"parameters: {', '.join(res.names)}; converged: {res.converged}\n"
+              f"seal coefficients, if fitted, hold at the recorded pressure drop(s) "
+              f"{pressures} bar")
+    write_text(out / "identified.toml", dump_rig(identified, header))
+    return {"out": str(out), "converged": res.converged, "parameters": {
+        n: {"estimate": float(v), "ci95": [float(lo), float(hi)]}
+        for n, v, lo, hi in zip(res.names, res.estimate, res.ci95_low, res.ci95_high)},
+        "nrmse_fit_pct": {k: float(v) for k, v in res.nrmse_fit_pct.items()}}
 
 
 def _finite(x: float) -> float | None:
@@ -134,8 +201,9 @@ def _controllers(cfg: RigConfig, channels: tuple[str, ...]) -> list[tuple[str, o
 
 
 def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
-        progress: bool = True) -> RunResult:
-    """The main job: build and reduce the model, close the loops, judge, report.
+        progress: bool = True, truth: str | Path | None = None,
+        identification: bool = True) -> RunResult:
+    """The main job: build and reduce the model, close the loops, judge, identify, report.
 
     Parameters
     ----------
@@ -145,6 +213,12 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         Output folder, created if needed.
     progress : bool
         Show a progress display on stderr.
+    truth : path, optional
+        Truth file of the virtual test facility; with it (and by default for the embedded
+        rig) the run also acquires records from the virtual facility and identifies the rig
+        by the thesis's procedure (:mod:`ambseal.identify.procedure`).
+    identification : bool
+        Set False to skip the identification stage.
 
     Returns
     -------
@@ -162,6 +236,8 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
 
     rig_path = Path(rig) if rig is not None else default_rig_path()
     cfg = load_rig(rig_path)
+    if truth is None and rig is None:
+        truth = default_truth_path()
     if not cfg.amb:
         raise ConfigError(f"{rig_path}: amb: the main job needs at least one [[amb]]")
     out = Path(out_dir)
@@ -201,14 +277,125 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
             "unbalance": {"grade_mm_s": UNBALANCE_GRADE_MM_S, "range_hz": list(UNBALANCE_RANGE_HZ)},
             "cases": cases,
         }
+        extra: tuple[list, list] = ([], [])
+        if identification and truth is not None:
+            from .config import load_truth
+
+            truth_cfg = load_truth(truth)
+            bar.update(task, total=total + 8)
+
+            def say(msg: str) -> None:
+                bar.update(task, description=msg)
+                bar.advance(task)
+
+            metrics["identification"], extra = _identification(cfg, truth_cfg, out, say)
         bar.update(task, description="report")
         metrics_path = write_json(out / "metrics.json", metrics)
-        report_path = _report(out, cfg, rig_path, metrics, curves)
+        report_path = _report(out, cfg, rig_path, metrics, curves, extra)
         bar.advance(task)
     return RunResult(out, metrics_path, report_path, metrics)
 
 
-def _report(out: Path, cfg: RigConfig, rig_path: Path, metrics: dict, curves: list) -> Path:
+def _identification(cfg: RigConfig, truth, out: Path, say) -> tuple[dict, tuple[list, list]]:
+    """The identification stage: the thesis's procedure on the virtual facility, its files
+    and figures, and a FRF check of the identified model (P4 Figs. 9–10)."""
+    from .config import Affine, dump_rig
+    from .identify.frf import closed_loop_frf, model_frf
+    from .identify.procedure import thesis_procedure
+    from .identify.signals import chirp
+    from .identify.stages import acquire, build_models
+    from .report.identify_figures import (correlation_figure, fit_timeseries_figure,
+                                          frf_figure, seal_frequency_figure,
+                                          seal_pressure_figure)
+
+    res = thesis_procedure(cfg, truth, progress=say)
+    write_json(out / "identification.json", res.to_dict())
+    write_text(out / "identified_rig.toml",
+               dump_rig(res.identified, "Identified by `ambseal run` from the virtual test "
+                        "facility (thesis P2, P4, P5 procedure)"))
+    figs, sections = [], []
+    a = res.amb
+    figs.append(("Identification (a): measured and simulated displacements, PRBS at 0 bar",
+                 fit_timeseries_figure(out / "ident_fit.png", a.time_s, a.y_meas, a.y_sim,
+                                       a.axes, nrmse_pct=[a.nrmse_fit_pct[x] for x in a.axes])))
+    figs.append(("Correlation of the AMB estimates (P4 Table 2)",
+                 correlation_figure(out / "ident_correlation.png", a.correlation, a.names)))
+    if res.seal_vs_frequency:
+        curves = []
+        for p, rows in res.seal_vs_frequency.items():
+            curves.append((f"{p:g} bar", [f for f, _ in rows],
+                           np.array([r.estimate for _, r in rows]),
+                           np.array([r.std_error for _, r in rows])))
+        figs.append(("Seal coefficients by stepped sine (P4 Fig. 12)",
+                     seal_frequency_figure(out / "ident_seal_frequency.png", curves)))
+        ps = [p for p, _ in res.seal_vs_pressure]
+        est = np.array([r.estimate for _, r in res.seal_vs_pressure])
+        se = np.array([r.std_error for _, r in res.seal_vs_pressure])
+        coefs = list(res.regression)
+        seal = cfg.seal[0].name
+
+        def true_line(c):
+            v = truth.parameters.get(f"{seal}.{c}")
+            if v is None:
+                return None
+            return (lambda p: v.at_zero + v.per_bar * p) if isinstance(v, Affine) else (
+                lambda p: float(v))
+
+        figs.append(("Seal coefficients by impulse against pressure drop (P5 Fig. 7)",
+                     seal_pressure_figure(out / "ident_seal_pressure.png", ps, est, se,
+                                          [res.regression[c] for c in coefs], coefs,
+                                          truth=[true_line(c) for c in coefs],
+                                          nominal_bar=cfg.operating.pressure_bar)))
+    # frequency-domain check of the identified model with a chirp at 0 bar
+    say("identification: chirp FRF check of the identified model")
+    axes = a.axes
+    fs = cfg.controller.sample_rate_hz
+    ex = chirp(f0_hz=1.0, f1_hz=150.0, duration_s=4.0, amplitude_a=0.05, sample_rate_hz=fs,
+               axes=axes, excited={axes[0]: 1.0, axes[-2]: 1.0})
+    rec = acquire(cfg, truth, ex, pressure_bar=0.0, seed=99)
+    measured = closed_loop_frf(rec, nperseg=8192, inputs=[axes[0]])
+    model = build_models(res.identified, [rec])[0].statespace({}, axes)
+    fgrid = measured.band(2.0, 140.0).frequency_hz
+    mf = model_frf(model[:, [0]] + model[:, [len(axes) - 2]], fgrid,
+                   input_names=measured.input_names, output_names=measured.output_names)
+    figs.append(("Closed-loop FRF from the ζ excitation on both bearings: chirp 1–150 Hz "
+                 "against the identified model (P4 Fig. 9)",
+                 frf_figure(out / "ident_frf.png", measured.band(2.0, 140.0), mf)))
+
+    rows = []
+    summary = {}
+    for r in [a] + ([res.coupling] if res.coupling else []):
+        for i, n in enumerate(r.names):
+            t = res.truth.get(n)
+            err = None if not isinstance(t, float) or t == 0 else 100 * (r.estimate[i] / t - 1)
+            summary[n] = {"estimate": float(r.estimate[i]), "truth": t,
+                          "ci95": [float(r.ci95_low[i]), float(r.ci95_high[i])],
+                          "error_pct": err}
+            rows.append(f"<tr><td>{n}</td><td>{r.estimate[i]:.5g}</td><td>{t if t is None else f'{t:.5g}'}"
+                        f"</td><td>[{r.ci95_low[i]:.5g}, {r.ci95_high[i]:.5g}]</td>"
+                        f"<td>{'' if err is None else f'{err:+.2f} %'}</td></tr>")
+    for c, reg in res.regression.items():
+        t = res.truth.get(f"{cfg.seal[0].name}.{c}")
+        tl = f"{t['at_zero']:.4g} + {t['per_bar']:.4g}·p" if isinstance(t, dict) else str(t)
+        summary[f"{cfg.seal[0].name}.{c}"] = {**reg.to_dict(), "truth": t}
+        rows.append(f"<tr><td>{cfg.seal[0].name}.{c} (vs p, bar)</td><td>{reg.intercept:.4g} + "
+                    f"{reg.slope:.4g}·p</td><td>{tl}</td><td>slope ± {1.96 * reg.slope_se:.3g}"
+                    f"</td><td></td></tr>")
+    fits = ", ".join(f"{k} {v:.1f} %" for k, v in a.nrmse_fit_pct.items())
+    sections.append({
+        "title": "Identification on the virtual test facility",
+        "html": ("<p>Records from the virtual facility (nonlinear AMB force law, full FE rotor, "
+                 "noise, ADC), fitted by the output-error method of P2/P4. NRMSE fit of stage "
+                 f"(a): {fits}. Identified rig: <code>identified_rig.toml</code>.</p>"
+                 "<table><tr><th>parameter</th><th>identified</th><th>truth</th>"
+                 "<th>95 % interval</th><th>error</th></tr>" + "".join(rows) + "</table>"),
+    })
+    return {"parameters": summary, "converged": bool(a.converged),
+            "nrmse_fit_pct": {k: float(v) for k, v in a.nrmse_fit_pct.items()}}, (figs, sections)
+
+
+def _report(out: Path, cfg: RigConfig, rig_path: Path, metrics: dict, curves: list,
+            extra: tuple[list, list] = ([], [])) -> Path:
     from .report import figures
     from .report.html import write_report
 
@@ -246,6 +433,8 @@ def _report(out: Path, cfg: RigConfig, rig_path: Path, metrics: dict, curves: li
                  + f"; {metrics['open_loop']['n_states_full']} states in full order, "
                  f"{metrics['open_loop']['n_states_reduced']} reduced."),
     }]
+    figs += extra[0]
+    sections += extra[1]
     return write_report(out / "report.html", title=f"ambseal — {cfg.rotor.name}",
                         metrics=metrics["cases"], figures=figs, sections=sections,
                         meta=f"rig: {rig_path}")

@@ -8,6 +8,9 @@ Commands
     Damped natural frequencies, damping ratios and unstable poles of the full model.
 ``ambseal acquire RIG --truth TRUTH --excitation prbs|sine|chirp|impulse --pressure-bar P --out FILE``
     A record from the virtual test facility (CSV + JSON sidecar, or .mat).
+``ambseal design RIG --method pid|hinf|mu [--out DIR]``
+    Design a controller on the rig's reduced model; write it (continuous, Tustin and ZOH at
+    the controller's sample rate) as .json, .npz and .mat, with a summary.
 ``ambseal identify RIG DATA... --params NAME,... --out DIR``
     Output-error fit of named parameters to closed-loop records; writes the fit, its
     figures and the identified rig.
@@ -70,6 +73,13 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("--start-s", type=float, default=0.05, help="impulse start (s)")
     a.add_argument("--seed", type=int, default=0, help="seed of excitation and noise")
 
+    d = sub.add_parser("design", help="design a controller (pid, hinf, mu) and export it")
+    d.add_argument("rig", help="rig file (TOML)")
+    d.add_argument("--method", required=True, choices=["pid", "hinf", "mu"])
+    d.add_argument("--pressure-bar", type=float, default=None,
+                   help="design pressure drop (bar); default [operating] pressure_bar")
+    d.add_argument("--out", default="ambseal-design", help="output folder")
+
     i = sub.add_parser("identify", help="fit model parameters to closed-loop records")
     i.add_argument("rig", help="rig file (TOML)")
     i.add_argument("data", nargs="+", help="record files (.csv with sidecar, or .mat)")
@@ -119,6 +129,14 @@ def _acquire(args: argparse.Namespace) -> int:
     path = save_measurement(meas, args.out)
     print(json.dumps({"out": str(path), "samples": meas.n_samples,
                       "sample_rate_hz": fs}))
+    return 0
+
+
+def _design(args: argparse.Namespace) -> int:
+    from .pipeline import design_files
+
+    print(json.dumps(design_files(args.rig, args.method, args.out,
+                                  pressure_bar=args.pressure_bar)))
     return 0
 
 
@@ -174,7 +192,7 @@ def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
         handler = {"modes": _modes, "acquire": _acquire, "identify": _identify,
-                   "run": _run}[args.command]
+                   "design": _design, "run": _run}[args.command]
         return handler(args)
     except AmbsealError as exc:
         print(f"ambseal: error: {exc}", file=sys.stderr)

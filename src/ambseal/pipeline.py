@@ -20,7 +20,7 @@ from .config import RigConfig, default_rig_path, load_rig
 from .errors import ConfigError
 
 __all__ = ["RunResult", "run", "judge", "write_json", "write_text", "identify_files",
-           "default_truth_path"]
+           "design_files", "default_truth_path"]
 
 #: Frequency grid of the loop analysis (Hz): past the first bending mode of the test rig.
 FREQ_HZ = (0.5, 2000.0, 1200)
@@ -191,13 +191,41 @@ def judge(cfg: RigConfig, controller, name: str, pressure_bar: float) -> tuple[d
     return case, curves
 
 
-def _controllers(cfg: RigConfig, channels: tuple[str, ...]) -> list[tuple[str, object]]:
-    from .control.pid import pid_controller
+def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
+                 pressure_bar: float | None = None) -> dict:
+    """``ambseal design``: design one controller and write it with its summary.
+
+    Files: ``controller_<method>.json``, ``.npz`` and ``.mat`` (continuous, Tustin and ZOH
+    at ``[controller] sample_rate_hz``, with the channel names) and ``design_<method>.json``
+    (summary, weights, D–K history).
+    """
+    from .control.design import design
+
+    cfg = load_rig(rig)
+    res = design(cfg, method, pressure_bar=pressure_bar)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    files = _export(res, out, cfg.controller.sample_rate_hz)
+    return {**res.summary(), "files": [str(f) for f in files]}
+
+
+def _export(res, out: Path, fs_hz: float) -> list[Path]:
+    """The controller as .json/.npz/.mat (continuous, Tustin, ZOH) and its design summary."""
+    from .control.export import export_controller
+
+    files = [export_controller(res.K, out / f"controller_{res.method}{ext}", fs_hz=fs_hz)
+             for ext in (".json", ".npz", ".mat")]
+    files.append(write_json(out / f"design_{res.method}.json", res.to_dict()))
+    return files
+
+
+def _controllers(cfg: RigConfig, methods: tuple[str, ...] = ("pid", "hinf", "mu")) -> list:
+    """The designed controllers of the main job: the reference PID, H∞ and μ (P5 §4)."""
+    from .control.design import design
 
     if cfg.controller.pid is None:
         raise ConfigError("controller.pid: the main job needs the reference PID ([controller.pid])")
-    p = cfg.controller.pid
-    return [("pid", pid_controller(p.kp, p.ti, p.td, p.eps, channels))]
+    return [design(cfg, m) for m in methods]
 
 
 def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
@@ -247,7 +275,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
 
     console = Console(stderr=True)
     with Progress(console=console, disable=not progress, transient=True) as bar:
-        total = 2 + 3 * len(pressures) + 1
+        total = 2 + 3 * 3 * len(pressures) + 1
         task = bar.add_task("ambseal run", total=total)
         bar.update(task, description="model: full order and modal reduction")
         full = build_plant(cfg)
@@ -256,10 +284,15 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         unstable = unstable[unstable.real > 1e-9 * np.abs(unstable).max()]
         unstable = unstable[np.argsort(-unstable.real)]
         bar.advance(task)
-        controllers = _controllers(cfg, full.input_names)
+        bar.update(task, description="designing PID, H∞ and μ controllers")
+        designs = _controllers(cfg)
+        (out / "controllers").mkdir(exist_ok=True)
+        for res in designs:
+            _export(res, out / "controllers", cfg.controller.sample_rate_hz)
         bar.advance(task)
         cases, curves = [], []
-        for cname, K in controllers:
+        for res in designs:
+            cname, K = res.method, res.K
             for p in pressures:
                 bar.update(task, description=f"judging {cname} at {p:g} bar")
                 case, c = judge(cfg, K, cname, p)
@@ -275,6 +308,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                 "n_states_reduced": reduced.n_states,
             },
             "unbalance": {"grade_mm_s": UNBALANCE_GRADE_MM_S, "range_hz": list(UNBALANCE_RANGE_HZ)},
+            "controllers": {r.method: r.summary() for r in designs},
             "cases": cases,
         }
         extra: tuple[list, list] = ([], [])
@@ -291,9 +325,22 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
             metrics["identification"], extra = _identification(cfg, truth_cfg, out, say)
         bar.update(task, description="report")
         metrics_path = write_json(out / "metrics.json", metrics)
+        extra[0].append(_gains_figure(out, designs))
         report_path = _report(out, cfg, rig_path, metrics, curves, extra)
         bar.advance(task)
     return RunResult(out, metrics_path, report_path, metrics)
+
+
+def _gains_figure(out: Path, designs: list) -> tuple[str, Path]:
+    """Direct and cross gains of the designed controllers (P5 Fig. 10)."""
+    from .analysis.freqresp import freqresp
+    from .report.figures import controller_gains_figure
+
+    f = np.logspace(0, math.log10(2000.0), 300)
+    rows = [(r.method, f, freqresp(r.K, 2 * np.pi * f)) for r in designs]
+    names = [n.removeprefix("y_") for n in designs[0].K.input_labels]
+    return ("Direct and cross gains of the controllers (P5 Fig. 10)",
+            controller_gains_figure(out / "controller_gains.png", rows, names))
 
 
 def _identification(cfg: RigConfig, truth, out: Path, say) -> tuple[dict, tuple[list, list]]:

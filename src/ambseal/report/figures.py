@@ -24,6 +24,7 @@ from matplotlib.ticker import NullFormatter, ScalarFormatter
 from ambseal.errors import AmbsealError
 
 __all__ = [
+    "controller_gains_figure",
     "Curve",
     "sensitivity_figure",
     "compliance_figure",
@@ -244,4 +245,31 @@ def impulse_figure(
         axes[0, 0].legend(fontsize=7)
     fig.suptitle(title)
     fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def controller_gains_figure(
+    path: str | os.PathLike,
+    controllers: Sequence[tuple[str, Sequence[float], np.ndarray]],
+    channel_names: Sequence[str],
+    *,
+    pairs: Sequence[tuple[int, int]] = ((0, 0), (2, 2), (0, 1), (0, 2)),
+    title: str = "Controller gains",
+) -> Path:
+    """Direct and cross gains |K_ij(jω)| (A/m) of several controllers (P5 Fig. 10).
+
+    ``controllers``: (label, frequency_hz (n,), K (n, nu, ny) complex); ``pairs`` are
+    (output i, input j) indices, 0-based; panel titles use ``channel_names``.
+    """
+    fig = Figure(figsize=(10, 6), layout="constrained")
+    axes = fig.subplots(2, 2).ravel()
+    for ax, (i, j) in zip(axes, pairs):
+        for label, f, K in controllers:
+            ax.loglog(np.asarray(f, float), np.abs(np.asarray(K)[:, i, j]), label=label)
+        ax.set_title(f"K[{i + 1},{j + 1}]: {channel_names[j]} → {channel_names[i]}", fontsize=9)
+        ax.set_xlabel("Frequency (Hz)")
+        ax.set_ylabel("|K| (A/m)")
+        ax.grid(alpha=0.3, which="both")
+    axes[0].legend(fontsize=8)
+    fig.suptitle(title)
     return save_figure(fig, path)

@@ -1,0 +1,102 @@
+"""CLI: acquire from the virtual facility, identify from the files, design and export."""
+
+import json
+
+import numpy as np
+import pytest
+
+from ambseal.cli import main
+from ambseal.config import default_rig_path, load_rig
+from ambseal.pipeline import default_truth_path
+
+RIG = str(default_rig_path())
+TRUTH = str(default_truth_path())
+
+
+@pytest.fixture(scope="module")
+def record(tmp_path_factory):
+    d = tmp_path_factory.mktemp("acq")
+    out = d / "prbs.csv"
+    code = main(["acquire", RIG, "--truth", TRUTH, "--excitation", "prbs", "--duration-s", "0.5",
+                 "--pressure-bar", "0", "--out", str(out), "--seed", "5"])
+    assert code == 0
+    return out
+
+
+def test_acquire_writes_csv_and_sidecar(record):
+    """The record and its JSON sidecar, with the rig's four axes and the metadata."""
+    side = json.loads(record.with_name(record.name + ".json").read_text())
+    assert side["axes"] == ["A_zeta", "A_eta", "B_zeta", "B_eta"]
+    assert side["sample_rate_hz"] == 10000.0 and side["pressure_drop_pa"] == 0.0
+    assert side["controller"]["type"] == "pid"
+    header = record.read_text().splitlines()[0].split(",")
+    assert header[0] == "time_s" and len(header) == 1 + 4 * 4
+
+
+def test_identify_writes_fit_and_a_rig_the_other_commands_accept(record, tmp_path, capsys):
+    """`identify` fits named parameters, writes fit.json and an identified rig file that
+    `load_rig` reads; the estimate is near the truth file's value (205 N/A)."""
+    out = tmp_path / "fit"
+    capsys.readouterr()
+    params = ",".join(f"{m}.{q}_{x}" for m in "AB" for q in ("Ki", "Ks")
+                      for x in ("zeta", "eta")) + ",tau_e"
+    code = main(["identify", RIG, str(record), "--params", params, "--out", str(out)])
+    summary = json.loads(capsys.readouterr().out)
+    assert code == 0 and summary["converged"]
+    assert summary["parameters"]["A.Ki_zeta"]["estimate"] == pytest.approx(205.0, rel=0.05)
+    fit = json.loads((out / "fit.json").read_text())
+    assert set(fit["parameters"]) == set(params.split(","))
+    rig = load_rig(out / "identified.toml")
+    assert rig.amb[0].factors()[0][0] == pytest.approx(summary["parameters"]["A.Ki_zeta"]["estimate"])
+    assert (out / "fit_timeseries.png").exists() and (out / "correlation.png").exists()
+
+
+def _corrupt(record, tmp_path, fn):
+    bad = tmp_path / "bad.csv"
+    lines = record.read_text().splitlines()
+    lines = fn(lines)
+    bad.write_text("\n".join(lines) + "\n")
+    bad.with_name(bad.name + ".json").write_text(
+        record.with_name(record.name + ".json").read_text())
+    return bad
+
+
+@pytest.mark.parametrize("label,fn,expect", [
+    ("nan", lambda L: L[:40] + [",".join(["nan" if i == 5 else v
+                                          for i, v in enumerate(L[40].split(","))])] + L[41:],
+     ["row 40", "excitation_A_eta_a"]),
+    ("non-uniform time", lambda L: L[:30] + L[31:], ["time_s"]),
+    ("too few samples", lambda L: L[:20], ["samples"]),
+])
+def test_identify_bad_data_exits_2_with_one_line(record, tmp_path, capsys, label, fn, expect):
+    """Bad data: one line on stderr naming the file and what is wrong, exit status 2."""
+    bad = _corrupt(record, tmp_path, fn)
+    capsys.readouterr()
+    code = main(["identify", RIG, str(bad), "--params", "A.Ki_zeta", "--out",
+                 str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert str(bad) in err[0]
+    for e in expect:
+        assert e in err[0], err[0]
+
+
+def test_identify_file_of_another_rig(record, tmp_path, capsys):
+    """A record of a rig with other axes names is refused, naming the column."""
+    bad = _corrupt(record, tmp_path, lambda L: [L[0].replace("A_zeta", "C_zeta")] + L[1:])
+    code = main(["identify", RIG, str(bad), "--params", "A.Ki_zeta", "--out",
+                 str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert code == 2 and ("C_zeta" in err or "A_zeta" in err)
+
+
+def test_design_hinf_exports_controller(tmp_path, capsys):
+    """`design --method hinf`: the controller in .json/.npz/.mat with Tustin and ZOH forms
+    and its summary; the summary's γ is the verified closed-loop norm (finite, > 0)."""
+    code = main(["design", RIG, "--method", "hinf", "--out", str(tmp_path)])
+    summary = json.loads(capsys.readouterr().out)
+    assert code == 0 and summary["method"] == "hinf" and summary["gamma"] > 0
+    data = np.load(tmp_path / "controller_hinf.npz")
+    assert {"A", "A_tustin", "A_zoh"} <= set(data.files)
+    assert (tmp_path / "controller_hinf.mat").exists()
+    assert (tmp_path / "design_hinf.json").exists()

@@ -7,10 +7,7 @@
 
 from __future__ import annotations
 
-import json
 import math
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,9 +15,9 @@ import numpy as np
 
 from .config import RigConfig, default_rig_path, load_rig
 from .errors import ConfigError
+from .files import write_json, write_text
 
-__all__ = ["RunResult", "run", "judge", "write_json", "write_text", "identify_files",
-           "design_files", "default_truth_path"]
+__all__ = ["RunResult", "run", "judge", "identify_files", "design_files", "default_truth_path"]
 
 #: Frequency grid of the loop analysis (Hz): past the first bending mode of the test rig.
 FREQ_HZ = (0.5, 2000.0, 1200)
@@ -37,37 +34,6 @@ class RunResult:
     metrics_path: Path
     report_path: Path
     metrics: dict
-
-
-def write_json(path: Path, data: dict) -> Path:
-    """Write JSON through a temporary file in the same folder and an atomic rename."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            json.dump(data, fh, indent=2, allow_nan=False)
-            fh.write("\n")
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
-
-
-def write_text(path: Path, text: str) -> Path:
-    """Write text through a temporary file in the same folder and an atomic rename."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
 
 
 def default_truth_path() -> Path:

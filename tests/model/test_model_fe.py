@@ -1,7 +1,6 @@
 """FE rotor against closed forms."""
 
 import numpy as np
-import pytest
 import scipy.linalg as sla
 
 from ambseal.config import parse_rig

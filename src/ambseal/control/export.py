@@ -12,13 +12,13 @@ Files are written to a temporary name in the destination folder and moved into p
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from pathlib import Path
 from typing import Sequence
 
-import numpy as np
 import control as ct
+import numpy as np
+
+from ..files import atomic_write
 
 __all__ = ["discretize", "controller_arrays", "export_controller"]
 
@@ -88,17 +88,7 @@ def controller_arrays(K, fs_hz: float | None = None,
 
 def _atomic_write(path: Path, write) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            write(fh)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
+    atomic_write(path, write)
 
 
 def export_controller(K, path, fs_hz: float | None = None,

@@ -87,7 +87,6 @@ import io
 import json
 import math
 import os
-import tempfile
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -95,6 +94,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+from ambseal.files import atomic_write
 from ambseal.errors import DataError
 
 __all__ = [
@@ -289,16 +289,7 @@ def _json_safe(obj: Any, where: str) -> Any:
 def _atomic_write(path: Path, write) -> None:
     if not path.parent.is_dir():
         raise DataError(f"{path}: folder {str(path.parent)!r} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            write(fh)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    atomic_write(path, write)
 
 
 def _sidecar(path: Path) -> Path:

@@ -28,7 +28,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..errors import IdentificationError
-from ..model.amb import actuator_matrices, eddy_lag_matrices
+from ..model.amb import eddy_lag_matrices
 from ..model.lft import Plant
 from .loop import DiscreteController, closed_loop_matrices, simulate_lti, zoh
 

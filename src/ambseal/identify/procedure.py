@@ -21,7 +21,7 @@ from ..config import Affine, RigConfig, TruthSection, rig_with_values
 from .fit import TAU_E, FitResult
 from .signals import impulse, prbs, stepped_sine
 from .stages import acquire, identify
-from .stats import Regression, linear_regression
+from .stats import linear_regression
 
 __all__ = ["ProcedureResult", "thesis_procedure", "SEAL_COEFFICIENTS"]
 

@@ -12,7 +12,6 @@ one curve per (controller, pressure) case, as in the thesis figures (P5 Fig. 11â
 from __future__ import annotations
 
 import os
-import tempfile
 from pathlib import Path
 from typing import Sequence
 
@@ -22,6 +21,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import NullFormatter, ScalarFormatter
 
 from ambseal.errors import AmbsealError
+from ambseal.files import atomic_write
 
 __all__ = [
     "controller_gains_figure",
@@ -51,16 +51,7 @@ def save_figure(fig: Figure, path: str | os.PathLike, *, dpi: int = 120) -> Path
     if not path.parent.is_dir():
         raise AmbsealError(f"figure folder {str(path.parent)!r} does not exist")
     FigureCanvasAgg(fig)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fig.savefig(fh, format="png", dpi=dpi)
-        os.chmod(tmp, 0o644)  # mkstemp creates 0600; a report is meant to be shared
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    atomic_write(path, lambda fh: fig.savefig(fh, format="png", dpi=dpi))
     return path
 
 

@@ -15,11 +15,11 @@ import base64
 import html as _html
 import math
 import os
-import tempfile
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 from ambseal.errors import AmbsealError
+from ambseal.files import write_text
 
 __all__ = ["METRIC_COLUMNS", "render_report", "write_report", "format_value"]
 
@@ -185,14 +185,5 @@ def write_report(
     if not path.parent.is_dir():
         raise AmbsealError(f"report folder {str(path.parent)!r} does not exist")
     text = render_report(title=title, metrics=metrics, figures=figures, sections=sections, meta=meta)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.chmod(tmp, 0o644)  # mkstemp creates 0600; a report is meant to be shared
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    write_text(path, text)
     return path

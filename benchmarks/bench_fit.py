@@ -75,10 +75,8 @@ def main() -> None:
     e = np.asarray(rec.excitation_a)
     y = np.asarray(rec.displacement_m)
     sy = y.std(axis=0)
-    x0 = np.array([cfg.amb[0].factors()[0][0]] * 0 + [
-        {"A.Ki_zeta": 199.2, "A.Ki_eta": 207.5, "B.Ki_zeta": 260.8, "B.Ki_eta": 265.8,
-         "A.Ks_zeta": 2.39e6, "A.Ks_eta": 2.49e6, "B.Ks_zeta": 3.13e6, "B.Ks_eta": 3.19e6}[n]
-        for n in names[:-1]] + [1e-4])
+    plant = build_models(cfg, [rec])[0].plant
+    x0 = np.array([plant.parameter(n).nominal for n in names[:-1]] + [1e-4])  # rig values
 
     def naive_residual(x):
         values = dict(zip(names, x))

@@ -36,7 +36,10 @@ def test_run_writes_the_contract(metrics):
         assert KEYS <= set(case)
     names = {p.name for p in out.iterdir()}
     assert {"metrics.json", "report.html", "sensitivity.png", "compliance.png",
-            "unbalance.png", "impulse.png"} <= names
+            "unbalance.png", "impulse.png", "controller_gains.png", "identification.json",
+            "identified_rig.toml", "ident_fit.png", "ident_correlation.png",
+            "ident_seal_frequency.png", "ident_seal_pressure.png", "ident_frf.png",
+            "ident_plant_frf.png", "controllers"} <= names
     assert not [n for n in names if n.endswith(".tmp")]
     html = (out / "report.html").read_text()
     assert "data:image/png;base64," in html and "<img src=\"http" not in html
@@ -65,3 +68,24 @@ def test_run_bad_rig_exits_2(tmp_path, capsys):
     assert main(["run", str(rig), "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "bad.toml" in err[0]
+
+
+def test_run_identifies_the_virtual_facility(metrics):
+    """The identification stage (P2, P4, P5 procedure) on the embedded rig's virtual
+    facility: every AMB factor within 2 %, τ_e within 10 %, the coupling within 5 % of the
+    packaged truth, and the identified rig file loads (issue acceptance, seed fixed)."""
+    from ambseal.config import load_rig
+
+    out, m = metrics
+    ident = m["identification"]["parameters"]
+    for name, row in ident.items():
+        if name.split(".")[-1].startswith(("Ki_", "Ks_")):
+            assert abs(row["error_pct"]) < 2.0, name
+        elif name == "tau_e":
+            assert abs(row["error_pct"]) < 10.0
+        elif name.startswith("coupling."):
+            assert abs(row["error_pct"]) < 5.0, name
+    k = ident["seal.k"]
+    assert k["slope"] == pytest.approx(k["truth"]["per_bar"], rel=0.05)
+    rig = load_rig(out / "identified_rig.toml")
+    assert rig.seal[0].k.per_bar == pytest.approx(k["slope"])

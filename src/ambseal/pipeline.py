@@ -313,7 +313,8 @@ def _identification(cfg: RigConfig, truth, out: Path, say) -> tuple[dict, tuple[
     """The identification stage: the thesis's procedure on the virtual facility, its files
     and figures, and a FRF check of the identified model (P4 Figs. 9–10)."""
     from .config import Affine, dump_rig
-    from .identify.frf import closed_loop_frf, model_frf
+    from .identify.frf import closed_loop_frf, model_frf, plant_frf
+    from .model.rig import build_plant
     from .identify.procedure import thesis_procedure
     from .identify.signals import chirp
     from .identify.stages import acquire, build_models
@@ -374,6 +375,23 @@ def _identification(cfg: RigConfig, truth, out: Path, say) -> tuple[dict, tuple[
     figs.append(("Closed-loop FRF from the ζ excitation on both bearings: chirp 1–150 Hz "
                  "against the identified model (P4 Fig. 9)",
                  frf_figure(out / "ident_frf.png", measured.band(2.0, 140.0), mf)))
+
+    # the unstable plant itself: T_ye T_ie⁻¹ from the PRBS record of stage (a), whose four
+    # axes carry independent sequences (MIMO H1), against the identified plant from coil
+    # current to displacement (eddy lag, Ki, rotor; no amplifier)
+    rec_a = res.records["a"]
+    T_ye = closed_loop_frf(rec_a, nperseg=2048, method="mimo")
+    T_ie = closed_loop_frf(rec_a, nperseg=2048, method="mimo", response="current")
+    G = plant_frf(T_ye, T_ie).band(2.0, 200.0)
+    bare = res.identified.model_copy(
+        update={"actuator": res.identified.actuator.model_copy(update={"model": "none"})})
+    Gm = model_frf(build_plant(bare, reduced=True, pressure_bar=0.0).to_statespace(),
+                   G.frequency_hz, input_names=G.input_names, output_names=G.output_names)
+    pairs = [(G.output_names[0], G.input_names[0]), (G.output_names[-1], G.input_names[-1]),
+             (G.output_names[0], G.input_names[-2])]
+    figs.append(("The unstable plant from closed-loop data: T_ye·T_ie⁻¹ (PRBS, stage a) "
+                 "against the identified model",
+                 frf_figure(out / "ident_plant_frf.png", G, Gm, pairs=pairs)))
 
     rows = []
     summary = {}

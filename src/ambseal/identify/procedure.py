@@ -48,6 +48,8 @@ class ProcedureResult:
     identified : RigConfig
     truth : dict
         True values (SI) of every identified parameter, for the report.
+    records : dict
+        The PRBS records of stages (a) and (b) (``"a"``, ``"b"``), for FRF checks.
     """
 
     amb: FitResult
@@ -57,6 +59,7 @@ class ProcedureResult:
     regression: dict
     identified: RigConfig
     truth: dict
+    records: dict
 
     def to_dict(self) -> dict:
         def fit(r: FitResult) -> dict:
@@ -124,11 +127,13 @@ def thesis_procedure(
     known = dict(zip(amb.names, amb.estimate))
 
     coupling = None
+    records = {"a": rec_a}
     if spring is not None:
         say("identification (b): coupling stiffness from a second PRBS run")
         ex = prbs(amplitude_a=0.05, clock_period_s=1e-3, duration_s=1.0, sample_rate_hz=fs,
                   axes=axes, seed=seed + 1)
         rec_b = acquire(cfg, truth, ex, pressure_bar=0.0, seed=seed + 1)
+        records["b"] = rec_b
         names_b = [f"{spring}.kxx", f"{spring}.kyy"]
         coupling = identify(cfg, [rec_b], names_b, known=known)
         # (a) assumed the nominal coupling, which sits beside AMB A: its error goes into
@@ -180,4 +185,5 @@ def thesis_procedure(
         elif name in truth.parameters:
             v = truth.parameters[name]
             true[name] = v.model_dump() if isinstance(v, Affine) else float(v)
-    return ProcedureResult(amb, coupling, seal_freq, seal_press, regression, identified, true)
+    return ProcedureResult(amb, coupling, seal_freq, seal_press, regression, identified, true,
+                           records)

@@ -1,0 +1,591 @@
+"""Gridded H∞ LPV synthesis by LMIs, scheduled on one parameter (the spin speed Ω).
+
+Thesis P3 §4 designs an LPV controller with the LMIs of Apkarian & Adams (1998) and a
+constant Lyapunov function (stability and performance under arbitrarily fast speed
+changes); its conclusion suggests a parameter-dependent Lyapunov function with a bound on
+|Ω̇|. Both are here (Wu, Yang, Packard & Becker 1996; Apkarian & Adams 1998 §3):
+
+Generalised plant P(Ω) (inputs [w, u], outputs [z, y], as :func:`ambseal.control.hinfsyn`)
+with A(Ω) varying and B, C, D constant (true for the rig: Ω enters through stiffness,
+damping and gyroscopic terms only), D22 = 0. Find γ, R = Rᵀ (constant) and
+S(Ω) = Σ_i f_i(Ω) S_i (f_0 = 1; ``"constant"``: S_0 only) such that on every grid point Ω_k
+and for Ω̇ = ±ν (``rate_bound``)::
+
+    N_Rᵀ [A R + R Aᵀ,  R C1ᵀ,  B1;  C1 R, −γI, D11;  B1ᵀ, D11ᵀ, −γI] N_R ≺ 0
+    N_Sᵀ [Aᵀ S + S A ± ν ∂S/∂Ω,  S B1,  C1ᵀ;  B1ᵀ S, −γI, D11ᵀ;  C1, D11, −γI] N_S ≺ 0
+    [R, I; I, S] ⪰ 0
+
+with N_R = diag(null[B2ᵀ D12ᵀ], I), N_S = diag(null[C2 D21], I) (the projected, or
+elimination, conditions of Gahinet & Apkarian 1994). Keeping R constant makes the controller
+independent of Ω̇ (Apkarian & Adams 1998 §3.2).
+
+Controller reconstruction at any Ω: with M = I, N(Ω) = I − S(Ω) R the linearising change of
+variables (Scherer, Gahinet & Chilali 1997) turns the closed-loop bounded-real inequality
+into an LMI in (Â, B̂, Ĉ) (D_K = 0); its minimum-norm solution at a γ slightly above the
+design γ gives B_K = N⁻¹B̂, C_K = Ĉ, A_K = N⁻¹(Â − B̂ C2 R − S B2 Ĉ − S A R). Controllers
+are reconstructed on a table five times denser than the design grid, checked there (each
+frozen closed loop stable, its H∞ norm reported) and interpolated linearly in between.
+
+Numerics: the plants are balanced with one diagonal state scaling for the whole grid, time
+is scaled by ω₀ (norm-preserving), and controls/measurements are normalised, before the
+SDPs are solved with Clarabel through cvxpy (imported inside the functions). A solver status
+other than ``optimal`` raises :class:`~ambseal.errors.SynthesisError`: badly scaled LMIs
+fail silently, and a controller from an inaccurate solution is refused.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+import numpy as np
+import scipy.linalg as sla
+
+from ..errors import SynthesisError
+
+__all__ = ["LpvController", "LpvSynResult", "lpvsyn", "SolverReport"]
+
+_BASES = {"constant": 1, "affine": 2, "quadratic": 3}
+#: Clarabel tolerances: a relative duality gap of 1e-6 (Clarabel's default 1e-8 stalls on
+#: these LMIs near 1e-7, and is then reported as "almost solved", i.e. inaccurate).
+_DEFAULT_TOL = {"tol_gap_abs": 1e-6, "tol_gap_rel": 1e-6, "tol_feas": 1e-8}
+
+
+# --------------------------------------------------------------------------- results
+@dataclass(frozen=True)
+class SolverReport:
+    """What the SDP solver said.
+
+    Attributes
+    ----------
+    stage : str
+        ``"gamma"`` (minimise γ), ``"centre"`` (re-solve at the backed-off γ for a
+        well-conditioned R, S) or ``"reconstruct"`` (all controller reconstructions).
+    status : str
+        cvxpy status (``"optimal"`` is the only one accepted).
+    iterations : int
+        Interior-point iterations (summed over reconstructions).
+    time_s : float
+        Wall time of setup and solve (s).
+    solver : str
+    """
+
+    stage: str
+    status: str
+    iterations: int
+    time_s: float
+    solver: str = "CLARABEL"
+
+    def to_dict(self) -> dict:
+        return {"stage": self.stage, "status": self.status, "iterations": self.iterations,
+                "time_s": self.time_s, "solver": self.solver}
+
+
+@dataclass(frozen=True, eq=False)
+class LpvController:
+    """A controller scheduled on Ω, tabulated and interpolated linearly between entries.
+
+    ``u = K(Ω) y`` in the generalised plant's convention (positive feedback, synthesis
+    units); :func:`ambseal.control.lpv_design.design_lpv` wraps it in physical units.
+
+    Attributes
+    ----------
+    speeds_rad_s : ndarray, shape (n_t,)
+        Table speeds Ω (rad/s), where the controller was reconstructed exactly.
+    AK, BK, CK, DK : ndarray, shapes (n_t, n_K, n_K), (n_t, n_K, ny), (n_t, nu, n_K), (n_t, nu, ny)
+    input_names, output_names : tuple of str
+    """
+
+    speeds_rad_s: np.ndarray
+    AK: np.ndarray = field(repr=False)
+    BK: np.ndarray = field(repr=False)
+    CK: np.ndarray = field(repr=False)
+    DK: np.ndarray = field(repr=False)
+    input_names: tuple[str, ...] = ()
+    output_names: tuple[str, ...] = ()
+
+    @property
+    def order(self) -> int:
+        return self.AK.shape[1]
+
+    def matrices(self, speed_rad_s: float) -> tuple[np.ndarray, ...]:
+        """(A_K, B_K, C_K, D_K) at Ω (rad/s), linear between table speeds, held at the ends."""
+        g = self.speeds_rad_s
+        W = float(np.clip(speed_rad_s, g[0], g[-1]))
+        j = int(np.clip(np.searchsorted(g, W) - 1, 0, len(g) - 2))
+        t = (W - g[j]) / (g[j + 1] - g[j])
+        return tuple((1 - t) * X[j] + t * X[j + 1] for X in (self.AK, self.BK, self.CK, self.DK))
+
+    def at(self, speed_rad_s: float, *, scale_output: float = 1.0, name: str = "K_lpv"):
+        """The frozen controller at Ω (rad/s) as a named ``control.StateSpace``.
+
+        ``scale_output`` multiplies C_K and D_K (e.g. −D_u/D_e for the physical AMB
+        controller of :meth:`ambseal.control.plant.GeneralizedPlant.physical_controller`).
+        """
+        import control
+
+        A, B, C, D = self.matrices(speed_rad_s)
+        return control.ss(A, B, scale_output * C, scale_output * D,
+                          inputs=list(self.input_names), outputs=list(self.output_names),
+                          states=[f"xK{i}" for i in range(A.shape[0])], name=name)
+
+    def at_hz(self, speed_hz: float, **kw):
+        """:meth:`at` with the speed in Hz."""
+        return self.at(2 * np.pi * speed_hz, **kw)
+
+
+@dataclass(frozen=True, eq=False)
+class LpvSynResult:
+    """Result of :func:`lpvsyn`.
+
+    Attributes
+    ----------
+    K : LpvController
+        The scheduled controller (table on the check grid).
+    gamma : float
+        Optimal γ of the LMIs (upper bound of the L2 gain of the LPV closed loop for all
+        speed trajectories in the grid range with |Ω̇| ≤ ν; ν = ∞ for ``"constant"``).
+    gamma_design : float
+        Backed-off γ at which R, S and the controllers were computed.
+    lyapunov : str
+        ``"constant"``, ``"affine"`` or ``"quadratic"`` S(Ω).
+    rate_bound : float or None
+        ν (rad/s²).
+    grid_rad_s : ndarray
+        Design grid.
+    check_rad_s : ndarray
+        Check grid (= controller table).
+    check_gamma : ndarray
+        H∞ norm of each frozen closed loop on the check grid (inf if unstable).
+    check_stable : bool
+        Every frozen closed loop on the check grid (and at the table midpoints, with the
+        interpolated controller) is stable.
+    reports : tuple of SolverReport
+    time_s : float
+        Total wall time (s).
+    """
+
+    K: LpvController
+    gamma: float
+    gamma_design: float
+    lyapunov: str
+    rate_bound: float | None
+    grid_rad_s: np.ndarray = field(repr=False)
+    check_rad_s: np.ndarray = field(repr=False)
+    check_gamma: np.ndarray = field(repr=False)
+    check_stable: bool = False
+    reports: tuple = ()
+    time_s: float = 0.0
+
+    @property
+    def iterations(self) -> int:
+        """Interior-point iterations of the γ stage."""
+        return self.reports[0].iterations if self.reports else 0
+
+    def to_dict(self) -> dict:
+        return {"gamma": self.gamma, "gamma_design": self.gamma_design,
+                "lyapunov": self.lyapunov, "rate_bound_rad_s2": self.rate_bound,
+                "grid_hz": (self.grid_rad_s / (2 * np.pi)).tolist(),
+                "check_hz": (self.check_rad_s / (2 * np.pi)).tolist(),
+                "check_gamma": [float(g) if np.isfinite(g) else None for g in self.check_gamma],
+                "check_gamma_max": float(np.max(self.check_gamma)),
+                "check_stable": self.check_stable, "controller_order": self.K.order,
+                "reports": [r.to_dict() for r in self.reports], "time_s": self.time_s}
+
+
+# --------------------------------------------------------------------------- helpers
+def _null(M: np.ndarray, tol: float = 1e-10) -> np.ndarray:
+    """Orthonormal basis of the null space of M (columns)."""
+    u, s, vh = np.linalg.svd(M)
+    rank = int(np.sum(s > tol * max(s[0] if s.size else 0.0, 1.0)))
+    return vh[rank:].T.conj()
+
+
+def _sym(X):
+    return 0.5 * (X + X.T)
+
+
+def _basis(kind: str, p: float) -> tuple[np.ndarray, np.ndarray]:
+    """Basis values f_i(p) and derivatives df_i/dp for p ∈ [−1, 1]."""
+    nb = _BASES[kind]
+    f = np.array([p**i for i in range(nb)], float)
+    df = np.array([i * p ** (i - 1) if i else 0.0 for i in range(nb)], float)
+    return f, df
+
+
+def _check_status(prob, stage: str, t0: float) -> SolverReport:
+    status = str(prob.status)
+    stats = prob.solver_stats
+    it = int(getattr(stats, "num_iters", 0) or 0)
+    rep = SolverReport(stage, status, it, time.perf_counter() - t0)
+    if status in ("infeasible", "infeasible_inaccurate"):
+        raise SynthesisError(
+            f"lpvsyn ({stage}): the LMIs are infeasible (solver status {status!r}): no "
+            "controller with this Lyapunov structure exists for the plant and weights; relax "
+            "the weights, the rate bound or the grid range")
+    if status != "optimal":
+        raise SynthesisError(
+            f"lpvsyn ({stage}): solver status {status!r} after {it} iterations — the solution "
+            "is not accurate enough to build a controller from; check the scaling of the "
+            "plant and weights or raise the iteration limit")
+    return rep
+
+
+def _solve(prob, stage: str, solver_options: dict):
+    import cvxpy as cp
+
+    t0 = time.perf_counter()
+    opts = dict(solver_options)
+    try:
+        prob.solve(solver=cp.CLARABEL, **opts)
+    except cp.error.SolverError as exc:
+        raise SynthesisError(f"lpvsyn ({stage}): Clarabel failed: {exc}") from exc
+    return _check_status(prob, stage, t0)
+
+
+@dataclass(frozen=True)
+class _Scaled:
+    A: np.ndarray  # (n_p, N, N)
+    dA: np.ndarray  # (n_p, N, N), per unit p
+    B: np.ndarray
+    C: np.ndarray
+    D: np.ndarray
+    t: np.ndarray
+    su: np.ndarray
+    sy: np.ndarray
+    w0: float
+    p_of: Any  # Ω (rad/s) → p ∈ [−1, 1]
+    dp_dW: float
+
+
+def _scale(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas) -> _Scaled:
+    """One diagonal state scaling and a time scale for the whole grid (norm-preserving)."""
+    n = As.shape[1]
+    env = np.max(np.abs(As), axis=0)
+    Mbal = np.zeros((n + 1, n + 1))
+    Mbal[:n, :n] = env
+    Mbal[:n, n] = np.abs(B).sum(1)
+    Mbal[n, :n] = np.abs(C).sum(0)
+    _, (t, _) = sla.matrix_balance(Mbal, permute=False, separate=True)
+    t = t[:n] / t[n]
+    lam = np.concatenate([np.abs(np.linalg.eigvals(A)) for A in As])
+    lam = lam[lam > 1e-9 * max(lam.max(), 1.0)]
+    w0 = float(np.sqrt(lam.min() * lam.max())) if lam.size else 1.0
+    Ti, T = 1.0 / t, t
+    As_s = As * Ti[None, :, None] * T[None, None, :] / w0
+    half = 0.5 * (grid[-1] - grid[0])
+    mid = 0.5 * (grid[-1] + grid[0])
+    dAs_s = dAs * Ti[None, :, None] * T[None, None, :] / w0 * half  # per unit p
+    Bs = B * Ti[:, None] / np.sqrt(w0)
+    Cs = C * T[None, :] / np.sqrt(w0)
+    Ds = D.copy()
+    cu = np.linalg.norm(np.vstack([Bs[:, nw:], Ds[:nz, nw:]]), axis=0)
+    su = 1.0 / np.where(cu > 0, cu, 1.0)
+    ry = np.linalg.norm(np.hstack([Cs[nz:], Ds[nz:, :nw]]), axis=1)
+    sy = 1.0 / np.where(ry > 0, ry, 1.0)
+    Bs[:, nw:] *= su
+    Ds[:, nw:] *= su
+    Cs[nz:] *= sy[:, None]
+    Ds[nz:] *= sy[:, None]
+    return _Scaled(As_s, dAs_s, Bs, Cs, Ds, t, su, sy, w0,
+                   lambda W: (np.asarray(W, float) - mid) / half, 1.0 / half)
+
+
+def _lmi_blocks(sc: _Scaled, nw, nz, ncon, nmeas):
+    B1, B2 = sc.B[:, :nw], sc.B[:, nw:]
+    C1, C2 = sc.C[:nz], sc.C[nz:]
+    D11, D12, D21 = sc.D[:nz, :nw], sc.D[:nz, nw:], sc.D[nz:, :nw]
+    return B1, B2, C1, C2, D11, D12, D21
+
+
+# --------------------------------------------------------------------------- synthesis
+def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
+           dA: Sequence[np.ndarray] | None = None, lyapunov: str = "constant",
+           rate_bound: float | None = None, backoff: float = 1.05,
+           check_density: int = 5, solver_options: dict | None = None,
+           margin: float = 1e-6, lyapunov_bound: float = 1e4,
+           coupling: float = 1e-2) -> LpvSynResult:
+    """Gridded H∞ LPV controller (Apkarian & Adams 1998; Wu et al. 1996; thesis P3 §4).
+
+    Parameters
+    ----------
+    plants : sequence of control.StateSpace, length n_p
+        Frozen generalised plants P(Ω_k), inputs ``[w, u]``, outputs ``[z, y]``, one state
+        basis; only A may differ between them; D22 = 0.
+    speeds_rad_s : array_like, shape (n_p,)
+        The grid Ω_k (rad/s), strictly increasing, n_p ≥ 2.
+    nmeas, ncon : int
+        Measurements (last outputs) and controls (last inputs).
+    dA : sequence of ndarray (n_p, N, N), optional
+        dA/dΩ at the grid points (1/s per rad/s); needed for a rate bound with a
+        parameter-dependent S. Default: finite differences of the grid.
+    lyapunov : {"constant", "affine", "quadratic"}
+        S(Ω) = S_0 (thesis P3), S_0 + p S_1, or S_0 + p S_1 + p² S_2 with
+        p = (Ω − Ω_mid)/Ω_half ∈ [−1, 1]. R is always constant.
+    rate_bound : float, optional
+        ν ≥ |Ω̇| (rad/s²); required for, and only allowed with, a parameter-dependent S.
+    backoff : float
+        R, S and controllers are computed at ``backoff·γ`` (≥ 1), which keeps
+        ``I − S R`` well conditioned.
+    check_density : int
+        The controller table (and check grid) has ``check_density·(n_p − 1) + 1`` speeds.
+    solver_options : dict, optional
+        Passed to Clarabel (e.g. ``{"max_iter": 200}``); defaults: relative gap 1e-6,
+        feasibility 1e-8.
+    margin : float
+        Strictness margin of the LMIs (scaled units).
+    coupling : float
+        [R, I; I, S] ⪰ coupling·I (scaled units) instead of ⪰ 0: keeps I − S R invertible
+        for the controller reconstruction, at a slightly higher γ.
+    lyapunov_bound : float
+        R, S ⪯ bound·I (scaled units): keeps the SDP bounded near the optimal γ, where
+        R or S would otherwise grow without limit.
+
+    Returns
+    -------
+    LpvSynResult
+
+    Raises
+    ------
+    SynthesisError
+        One grid point, a grid not increasing, plants that differ in B, C or D, D22 ≠ 0,
+        an unknown ``lyapunov``, a rate bound with ``"constant"`` (or none with a
+        parameter-dependent S), infeasible LMIs, a solver status other than ``optimal``,
+        or a reconstructed frozen closed loop that is unstable.
+
+    Examples
+    --------
+    >>> import control as ct, numpy as np
+    >>> P = [ct.ss([[a]], [[0., 1.]], [[0.], [1.]], [[0., 1.], [1., 0.]]) for a in (1., 2.)]
+    >>> r = lpvsyn(P, [1.0, 2.0], 1, 1)
+    >>> 2.0 <= r.gamma < 4.5 and r.check_stable
+    True
+    """
+    import cvxpy as cp
+
+    t_start = time.perf_counter()
+    grid = np.asarray(speeds_rad_s, float).ravel()
+    if grid.size < 2 or len(plants) != grid.size:
+        raise SynthesisError(f"lpvsyn: the speed grid needs at least 2 points with one plant "
+                             f"each; got {grid.size} speeds and {len(plants)} plants")
+    if np.any(np.diff(grid) <= 0) or not np.all(np.isfinite(grid)):
+        raise SynthesisError("lpvsyn: speeds_rad_s must be finite and strictly increasing")
+    if lyapunov not in _BASES:
+        raise SynthesisError(f"lpvsyn: lyapunov={lyapunov!r}; expected one of {sorted(_BASES)}")
+    if lyapunov == "constant" and rate_bound is not None:
+        raise SynthesisError(
+            "lpvsyn: a rate bound needs a parameter-dependent Lyapunov function "
+            "(lyapunov='affine' or 'quadratic'); a constant one already allows arbitrarily "
+            "fast speed changes")
+    if lyapunov != "constant" and (rate_bound is None or not np.isfinite(rate_bound)
+                                   or rate_bound < 0):
+        raise SynthesisError(f"lpvsyn: lyapunov={lyapunov!r} needs a finite rate_bound ≥ 0 "
+                             f"(rad/s²), got {rate_bound!r}")
+    if backoff < 1.0:
+        raise SynthesisError(f"lpvsyn: backoff={backoff} must be ≥ 1")
+    As = np.array([np.asarray(P.A, float) for P in plants])
+    B = np.asarray(plants[0].B, float)
+    C = np.asarray(plants[0].C, float)
+    D = np.asarray(plants[0].D, float)
+    for k, P in enumerate(plants[1:], 1):
+        for nm, X, Y in (("B", B, P.B), ("C", C, P.C), ("D", D, P.D)):
+            if np.shape(Y) != X.shape or not np.allclose(np.asarray(Y, float), X,
+                                                         rtol=1e-9, atol=1e-12 * max(1.0, np.abs(X).max())):
+                raise SynthesisError(f"lpvsyn: plant {k} differs from plant 0 in {nm}; only A "
+                                     "may depend on the speed (one state basis)")
+    N = As.shape[1]
+    nw, nz = B.shape[1] - ncon, C.shape[0] - nmeas
+    if nw <= 0 or nz <= 0 or ncon <= 0 or nmeas <= 0:
+        raise SynthesisError(f"lpvsyn: bad channel counts (nw={nw}, nz={nz}, ncon={ncon}, "
+                             f"nmeas={nmeas})")
+    if np.any(D[nz:, nw:] != 0):
+        raise SynthesisError("lpvsyn: D22 must be zero")
+    if dA is None:
+        dAs = np.gradient(As, grid, axis=0)
+    else:
+        dAs = np.array([np.asarray(X, float) for X in dA])
+        if dAs.shape != As.shape:
+            raise SynthesisError(f"lpvsyn: dA has shape {dAs.shape}, expected {As.shape}")
+    sc = _scale(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas)
+    B1, B2, C1, C2, D11, D12, D21 = _lmi_blocks(sc, nw, nz, ncon, nmeas)
+    NR = sla.block_diag(_null(np.hstack([B2.T, D12.T])), np.eye(nw))
+    NS = sla.block_diag(_null(np.hstack([C2, D21])), np.eye(nz))
+    nb = _BASES[lyapunov]
+    nu_s = 0.0 if rate_bound is None else float(rate_bound) / sc.w0 * sc.dp_dW  # dp/dt'
+    ps = sc.p_of(grid)
+    solver_options = {**_DEFAULT_TOL, **(solver_options or {})}
+    I_N = np.eye(N)
+    bound = float(lyapunov_bound)
+
+    def build(gamma_fixed: float | None):
+        R = cp.Variable((N, N), symmetric=True)
+        Ss = [cp.Variable((N, N), symmetric=True) for _ in range(nb)]
+        g = cp.Variable(nonneg=True) if gamma_fixed is None else gamma_fixed
+        cons = []
+        eps = margin
+        for k in range(grid.size):
+            A = sc.A[k]
+            f, df = _basis(lyapunov, float(ps[k]))
+            S = sum(fi * Si for fi, Si in zip(f, Ss))
+            dS = sum(dfi * Si for dfi, Si in zip(df, Ss)) if nb > 1 else None
+            MR = cp.bmat([[A @ R + R @ A.T, R @ C1.T, B1],
+                          [C1 @ R, -g * np.eye(nz), D11],
+                          [B1.T, D11.T, -g * np.eye(nw)]])
+            cons.append(_sym_expr(NR.T @ MR @ NR) << -eps * np.eye(NR.shape[1]))
+            signs = (1.0, -1.0) if (dS is not None and nu_s > 0) else (0.0,)
+            for sgn in signs:
+                top = A.T @ S + S @ A + (sgn * nu_s * dS if sgn else 0)
+                MS = cp.bmat([[top, S @ B1, C1.T],
+                              [B1.T @ S, -g * np.eye(nw), D11.T],
+                              [C1, D11, -g * np.eye(nz)]])
+                cons.append(_sym_expr(NS.T @ MS @ NS) << -eps * np.eye(NS.shape[1]))
+            cons.append(_sym_expr(cp.bmat([[R, I_N], [I_N, S]])) >> coupling * np.eye(2 * N))
+            cons.append(S << bound * I_N)
+        cons.append(R << bound * I_N)
+        return R, Ss, g, cons
+
+    reports = []
+    R, Ss, g, cons = build(None)
+    prob = cp.Problem(cp.Minimize(g), cons)
+    reports.append(_solve(prob, "gamma", solver_options))
+    gamma = float(g.value)
+    gamma_d = backoff * gamma
+    Rv = _sym(np.asarray(R.value))
+    Sv = [_sym(np.asarray(S.value)) for S in Ss]
+
+    # controller table on the check grid
+    dens = max(int(check_density), 1)
+    table = np.concatenate([np.linspace(grid[j], grid[j + 1], dens + 1)[:-1]
+                            for j in range(grid.size - 1)] + [grid[-1:]])
+    Aint = _interp_A(As, dAs, grid)
+    AKs, BKs, CKs, DKs = [], [], [], []
+    it_sum, t_rec, status = 0, time.perf_counter(), "optimal"
+    for W in table:
+        A_s = (Aint(W) / sc.t[:, None]) * sc.t[None, :] / sc.w0
+        p = float(sc.p_of(W))
+        f, df = _basis(lyapunov, p)
+        S = sum(fi * Si for fi, Si in zip(f, Sv))
+        dS = sum(dfi * Si for dfi, Si in zip(df, Sv)) if nb > 1 else None
+        Ak, Bk, Ck, it = _reconstruct(A_s, B1, B2, C1, C2, D11, D12, D21, Rv, S, dS, nu_s,
+                                      gamma_d * 1.02, margin, solver_options)
+        it_sum += it
+        # undo the scalings: ũ = K̃ ỹ with u = su ũ, ỹ = sy y; time scale ω₀
+        AKs.append(sc.w0 * Ak)
+        BKs.append(np.sqrt(sc.w0) * Bk * sc.sy[None, :])
+        CKs.append(np.sqrt(sc.w0) * sc.su[:, None] * Ck)
+        DKs.append(np.zeros((ncon, nmeas)))
+    reports.append(SolverReport("reconstruct", status, it_sum, time.perf_counter() - t_rec))
+    in_names = tuple(list(getattr(plants[0], "output_labels", []))[nz:]) or \
+        tuple(f"y{i}" for i in range(nmeas))
+    out_names = tuple(list(getattr(plants[0], "input_labels", []))[nw:]) or \
+        tuple(f"u{i}" for i in range(ncon))
+    K = LpvController(table, np.array(AKs), np.array(BKs), np.array(CKs), np.array(DKs),
+                      in_names, out_names)
+    # check: frozen closed loops on the table and at its midpoints (interpolated K)
+    from .hinf import hinfnorm
+
+    check_g = []
+    stable = True
+    for W in table:
+        Acl, Bcl, Ccl, Dcl = _closed_loop(Aint(W), B, C, D, nw, nz, *K.matrices(W))
+        if np.max(np.linalg.eigvals(Acl).real) >= 0:
+            check_g.append(np.inf)
+            stable = False
+            continue
+        import control as ct
+
+        check_g.append(hinfnorm(ct.ss(Acl, Bcl, Ccl, Dcl), rtol=1e-5)[0])
+    mids = 0.5 * (table[1:] + table[:-1])
+    for W in mids:
+        Acl = _closed_loop(Aint(W), B, C, D, nw, nz, *K.matrices(W))[0]
+        stable &= bool(np.max(np.linalg.eigvals(Acl).real) < 0)
+    if not stable:
+        raise SynthesisError(
+            "lpvsyn: a reconstructed frozen closed loop on the check grid is unstable; "
+            "refine the design grid")
+    return LpvSynResult(K=K, gamma=gamma, gamma_design=gamma_d, lyapunov=lyapunov,
+                        rate_bound=None if rate_bound is None else float(rate_bound),
+                        grid_rad_s=grid, check_rad_s=table, check_gamma=np.array(check_g),
+                        check_stable=stable, reports=tuple(reports),
+                        time_s=time.perf_counter() - t_start)
+
+
+def _sym_expr(X):
+    return 0.5 * (X + X.T)
+
+
+def _interp_A(As, dAs, grid):
+    """A(Ω) between grid points: cubic Hermite with the given slopes (exact for affine A)."""
+    def f(W: float) -> np.ndarray:
+        j = int(np.clip(np.searchsorted(grid, W) - 1, 0, len(grid) - 2))
+        h = grid[j + 1] - grid[j]
+        t = (W - grid[j]) / h
+        if t <= 1e-12:
+            return As[j]
+        if t >= 1 - 1e-12:
+            return As[j + 1]
+        h00, h10 = 2 * t**3 - 3 * t**2 + 1, t**3 - 2 * t**2 + t
+        h01, h11 = -2 * t**3 + 3 * t**2, t**3 - t**2
+        lin = (1 - t) * As[j] + t * As[j + 1]
+        herm = h00 * As[j] + h10 * h * dAs[j] + h01 * As[j + 1] + h11 * h * dAs[j + 1]
+        # piecewise-linear tables make the Hermite overshoot at kinks: use it only when the
+        # end slopes agree with the chord (smooth data), else the linear interpolant
+        chord = (As[j + 1] - As[j]) / h
+        ok = (np.linalg.norm(dAs[j] - chord) + np.linalg.norm(dAs[j + 1] - chord)
+              <= 1e-6 * max(np.linalg.norm(chord), 1e-300))
+        return herm if ok else lin
+    return f
+
+
+def _closed_loop(A, B, C, D, nw, nz, AK, BK, CK, DK):
+    """F_l(P, K) with u = K y, D22 = 0."""
+    B1, B2 = B[:, :nw], B[:, nw:]
+    C1, C2 = C[:nz], C[nz:]
+    D11, D12, D21 = D[:nz, :nw], D[:nz, nw:], D[nz:, :nw]
+    Acl = np.block([[A + B2 @ DK @ C2, B2 @ CK], [BK @ C2, AK]])
+    Bcl = np.vstack([B1 + B2 @ DK @ D21, BK @ D21])
+    Ccl = np.hstack([C1 + D12 @ DK @ C2, D12 @ CK])
+    Dcl = D11 + D12 @ DK @ D21
+    return Acl, Bcl, Ccl, Dcl
+
+
+def _reconstruct(A, B1, B2, C1, C2, D11, D12, D21, R, S, dS, nu_s, gamma, margin,
+                 solver_options):
+    """Controller at one speed from R, S(Ω): minimum-norm (Â, B̂, Ĉ) of the linearised
+    bounded-real LMI (Scherer, Gahinet & Chilali 1997), D_K = 0, M = I, N = I − S R."""
+    import cvxpy as cp
+
+    N = A.shape[0]
+    nw, nz = B1.shape[1], C1.shape[0]
+    nu, ny = B2.shape[1], C2.shape[0]
+    Ah = cp.Variable((N, N))
+    Bh = cp.Variable((N, ny))
+    Ch = cp.Variable((nu, N))
+    cons = []
+    signs = (1.0, -1.0) if (dS is not None and nu_s > 0) else (0.0,)
+    for sgn in signs:
+        S22 = S @ A + A.T @ S + (sgn * nu_s * dS if sgn else 0.0)
+        M = cp.bmat([
+            [A @ R + R @ A.T + B2 @ Ch + Ch.T @ B2.T, (Ah + A.T).T, B1, (C1 @ R + D12 @ Ch).T],
+            [Ah + A.T, S22 + Bh @ C2 + C2.T @ Bh.T, S @ B1 + Bh @ D21, C1.T],
+            [B1.T, (S @ B1 + Bh @ D21).T, -gamma * np.eye(nw), D11.T],
+            [C1 @ R + D12 @ Ch, C1, D11, -gamma * np.eye(nz)],
+        ])
+        cons.append(_sym_expr(M) << -margin * np.eye(M.shape[0]))
+    obj = cp.sum_squares(Ah) + cp.sum_squares(Bh) + cp.sum_squares(Ch)
+    prob = cp.Problem(cp.Minimize(obj), cons)
+    t0 = time.perf_counter()
+    try:
+        prob.solve(solver=cp.CLARABEL, **solver_options)
+    except cp.error.SolverError as exc:
+        raise SynthesisError(f"lpvsyn (reconstruct): Clarabel failed: {exc}") from exc
+    rep = _check_status(prob, "reconstruct", t0)
+    Ahv, Bhv, Chv = (np.asarray(X.value) for X in (Ah, Bh, Ch))
+    Nm = np.eye(N) - S @ R
+    if np.linalg.cond(Nm) > 1e12:
+        raise SynthesisError("lpvsyn (reconstruct): I − S R is singular; raise the back-off")
+    BK = np.linalg.solve(Nm, Bhv)
+    CK = Chv
+    AK = np.linalg.solve(Nm, Ahv - Bhv @ C2 @ R - S @ B2 @ Chv - S @ A @ R)
+    return AK, BK, CK, rep.iterations

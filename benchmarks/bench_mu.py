@@ -140,6 +140,7 @@ def testrig_cases(args) -> None:
         "peak_upper": round(float(res.upper.max()), 4),
         "max_rel_diff_upper_complex": round(float(np.max(np.abs(resc.upper / ub - 1))), 5),
         "min_lower_over_upper": round(float(np.min(res.lower / res.upper)), 4),
+        "goal_s": 0.5,
     }), flush=True)
     # D–K: the baseline is the LMI bound at every frequency of every μ evaluation of the
     # iteration (two per iteration: mixed structure and complexified D-step), i.e. the time the

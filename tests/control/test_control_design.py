@@ -1,8 +1,14 @@
 """Acceptance of the PID / H∞ / μ designs on the FULL-order test-facility plant.
 
 References: thesis P5 §4.1 (objectives), §4.4 and Figs. 11–13 (σ̄(S_o) of PID/H∞/μ over
-0 … 4.08 bar; the PID loses stability at high pressure), ISO 14839-3 (σ̄(S_o) < 3, zone A).
+0 … 4.08 bar; the PID loses stability at high pressure), §4.4.1 and Fig. 12 (worst-case
+unbalance orbit, G2.5 on the 69 kg rotor, F_u = m·G·Ω), ISO 14839-3 (σ̄(S_o) < 3, zone A).
 Designs are made on the reduced model; every check uses ``build_plant(cfg, pressure_bar=p)``.
+
+σ̄(S_o) peaks are taken on the log grid PLUS a fine grid around every lightly damped
+closed-loop pole: the first bending mode (≈ 557 Hz) has closed-loop damping ratios down to
+≈ 0.002, a resonance the 800-point log grid steps over (the previous μ design read 2.8 on
+the log grid but 5.8 at 556.8 Hz, 4.08 bar).
 """
 
 import numpy as np
@@ -39,7 +45,12 @@ def designs(cfg):
 
 
 def _so_peak(G, K):
-    return loop_responses(G, K, OMEGA).peaks("So").sigma_max.value
+    """Peak σ̄(S_o) with every lightly damped closed-loop resonance resolved (module doc)."""
+    p = closed_loop(G, K).poles
+    p = p[(p.imag > 0) & (p.imag < OMEGA[-1]) & (np.abs(p.real) < 0.1 * np.abs(p))]
+    w = np.sort(np.concatenate([OMEGA] + [q.imag + abs(q.real) * np.linspace(-4, 4, 81)
+                                         for q in p]))
+    return loop_responses(G, K, w[w > 0]).peaks("So").sigma_max.value
 
 
 def test_results_are_physical_controllers(designs):
@@ -74,7 +85,10 @@ def test_pid_unstable_at_high_pressure(designs, plants):
 
 
 def test_mu_robust_stability_and_sensitivity_over_pressure(designs, plants):
-    """P5 §4.1 item 2, §4.4.2: μ keeps the loop stable and σ̄(S_o) ≤ 3.3 for 0 … 4.08 bar."""
+    """P5 §4.1 item 2, §4.4.2: μ keeps the loop stable and σ̄(S_o) ≤ 3.3 for 0 … 4.08 bar.
+
+    The seal's k goes from 0 to 2× its nominal value over this range (P5 §4.1 items 2–3).
+    """
     K = designs["mu"].K
     for p in PRESSURES:
         G, _ = plants[p]
@@ -83,23 +97,40 @@ def test_mu_robust_stability_and_sensitivity_over_pressure(designs, plants):
 
 
 def test_mu_unbalance_orbit(designs, plants):
-    """P5 §4.4.1, Fig. 12: worst-case orbit σ̄(S_o G_f)·F_u, G2.5 on 69 kg, force at 0.43 m.
+    """P5 §4.4.1, Fig. 12: worst-case orbit σ̄(S_o G_f(jΩ))·F_u(Ω) < 8 µm for Ω ≤ 200 Hz.
 
-    With F_u = m·G·Ω (balanced to G2.5 at every speed) the μ design reaches ≈ 10 µm (the
-    thesis's 8 µm is not met on this model, see the design report); with the rotor balanced
-    to G2.5 at 500 Hz (F_u = m·G·Ω²/Ω_max, 541 N at 500 Hz) the orbit stays below 8 µm.
+    F_u = m·G·Ω (ISO 21940-11: G2.5 on the 69 kg rotor, balanced to G2.5 at every speed;
+    541.9 N at 500 Hz), acting at the seal (0.43 m), orbit at the sensors, on the full-order
+    plant at every pressure of the grid 0 … 4.08 bar. The μ design reaches ≈ 6.6 µm (worst
+    at 0 bar, ≈ 50 Hz); the PID and H∞ do not (≥ 16 µm), which is what the force channel of
+    the μ design is for.
     """
-    K = designs["mu"].K
     w = 2 * np.pi * np.linspace(1.0, 200.0, 400)
-    worst, worst500 = 0.0, 0.0
-    for p in PRESSURES:
-        G, Gf = plants[p]
-        c = compliance(G, K, Gf, w)
-        worst = max(worst, unbalance_from_compliance(c, mass_kg=69.0, grade_mm_s=2.5).peak_um)
-        worst500 = max(worst500, unbalance_from_compliance(
-            c, mass_kg=69.0, grade_mm_s=2.5, max_speed_rad_s=2 * np.pi * 500).peak_um)
-    assert worst500 < 8.0
-    assert worst < 11.0  # regression bound; 8 µm with F_u = m·G·Ω is NOT met (see docstring)
+
+    def worst(K):
+        out = 0.0
+        for p in PRESSURES:
+            G, Gf = plants[p]
+            c = compliance(G, K, Gf, w)
+            out = max(out, unbalance_from_compliance(c, mass_kg=69.0, grade_mm_s=2.5).peak_um)
+        return out
+
+    assert worst(designs["mu"].K) < 8.0
+    assert worst(designs["hinf"].K) > 8.0  # the demand is not met by accident
+
+
+def test_mu_force_weight_reads_as_orbit_bound():
+    """W_p·W_f/D_e = m·G·s·B_4(s)/orbit (closed form): the force channel bounds the orbit."""
+    wts = DesignWeights(M=3.0, omega_b=30.0, orbit_um=6.0, wf_rolloff_hz=260.0)
+    Wp, Wf = wts.Wp(), wts.Wf(20e-6)
+    for hz in (10.0, 100.0, 200.0, 557.0):
+        s = 2j * np.pi * hz
+        b4 = 1 / np.sqrt(1 + (hz / 260.0) ** 8)  # |Butterworth, 4th order|
+        want = 69.0 * 2.5e-3 * abs(s) * b4 / 6e-6
+        assert abs(complex(Wp(s)) * complex(Wf(s))) / 20e-6 == pytest.approx(want, rel=1e-6)
+    assert DesignWeights().Wf() is None
+    with pytest.raises(ValueError, match="orbit_um"):
+        DesignWeights(orbit_um=-1.0).Wf()
 
 
 def test_design_is_deterministic_and_validates(cfg, designs):

@@ -174,7 +174,10 @@ def _freqresp(A, B, C, D, omega):
     w = np.atleast_1d(np.asarray(omega, float))
     if A.shape[0] == 0:
         return np.broadcast_to(D.astype(complex), (w.size,) + D.shape).copy()
-    # orthogonal Hessenberg reduction first (balances the batched solves)
+    # diagonal balancing (FE plants span 1 … 1e12; Parlett & Reinsch 1969), then an
+    # orthogonal Hessenberg reduction for the batched solves
+    A, (sc, _) = sla.matrix_balance(A, permute=False, separate=True)
+    B, C = B / sc[:, None], C * sc[None, :]
     H, Q = sla.hessenberg(A, calc_q=True)
     Bq, Cq = Q.T @ B, C @ Q
     X = np.linalg.solve(1j * w[:, None, None] * np.eye(A.shape[0]) - H,

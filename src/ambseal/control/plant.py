@@ -307,7 +307,11 @@ def generalized_plant(
     force_disturbance : float or SISO weight, optional
         W_f on extra force inputs ``d_f`` (N) of the plant, e.g. an unbalance-force shape
         ``m G s`` rolled off above the speed range: then ``W_p S_o G_f W_f`` is part of the
-        performance channel (the compliance of P5 §4.4.1). The inputs ``d_f`` come after
+        performance channel (the compliance of P5 §4.4.1). Roll W_f off well below a
+        lightly damped bending mode the force excites (the test rig's 557 Hz mode with the
+        force at the seal): there the compliance cannot be made small and μ is lost to it.
+        Note W_p multiplies this channel; divide W_f by W_p for a plain orbit bound (see
+        :meth:`ambseal.control.design.DesignWeights.Wf`). The inputs ``d_f`` come after
         ``d_o``. Needs force inputs: ``force_positions`` from a rig, or a plant built with them.
     force_positions : tuple of float
         Positions (m) of force inputs when building from a rig.

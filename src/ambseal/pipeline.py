@@ -109,7 +109,8 @@ def judge(cfg: RigConfig, controller, name: str, pressure_bar: float) -> tuple[d
     model they were designed on.
     """
     from .analysis.iso import iso_assessment
-    from .analysis.loops import closed_loop, compliance, loop_responses, sigma_max
+    from .analysis.loops import (closed_loop, compliance, loop_responses, resolved_grid,
+                                 sigma_max)
     from .analysis.response import impulse_response_of
     from .analysis.unbalance import unbalance_from_compliance
     from .model.rig import build_plant
@@ -124,6 +125,7 @@ def judge(cfg: RigConfig, controller, name: str, pressure_bar: float) -> tuple[d
             "max_real_pole": loop.max_real_pole}
     curves: dict = {}
     w = 2 * np.pi * np.logspace(math.log10(FREQ_HZ[0]), math.log10(FREQ_HZ[1]), FREQ_HZ[2])
+    w = resolved_grid(w, loop.poles)  # the 0.5 %-damped bending mode must not slip through
     resp = loop_responses(G, controller, w)
     iso = iso_assessment(resp.peaks("So"), stable=loop.stable)
     curves["So"] = (w / (2 * np.pi), sigma_max(resp.So))
@@ -140,7 +142,7 @@ def judge(cfg: RigConfig, controller, name: str, pressure_bar: float) -> tuple[d
         return case, curves
     comp = compliance(G, controller, Gf, w)
     curves["compliance"] = (w / (2 * np.pi), comp.sigma_max_m_per_n)
-    wu = 2 * np.pi * np.linspace(*UNBALANCE_RANGE_HZ, 400)
+    wu = resolved_grid(2 * np.pi * np.linspace(*UNBALANCE_RANGE_HZ, 400), loop.poles)
     unb = unbalance_from_compliance(compliance(G, controller, Gf, wu),
                                     mass_kg=assemble_rotor(cfg).mass,
                                     grade_mm_s=UNBALANCE_GRADE_MM_S)

@@ -41,7 +41,9 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
 ``[controller]``
     ``sample_rate_hz``: the rate of the digital controller (default 10 kHz).
 ``[operating]``
-    ``speed_rpm``, ``pressure_bar`` (the nominal pressure drop across the seals).
+    ``speed_rpm``, ``pressure_bar`` (the nominal pressure drop across the seals),
+    ``speed_range_hz`` (optional ``[low, high]``: the operating speed range, e.g. for a
+    controller scheduled on speed).
 ``[reduction]``
     ``states`` (the number of states kept, default 8) or ``cutoff_hz``.
 """
@@ -323,6 +325,14 @@ class Controllers(_Strict):
 class Operating(_Strict):
     speed_rpm: float = 0.0
     pressure_bar: float = Field(default=0.0, ge=0)
+    speed_range_hz: tuple[float, float] | None = None
+
+    @model_validator(mode="after")
+    def _range(self) -> "Operating":
+        r = self.speed_range_hz
+        if r is not None and not 0 < r[0] < r[1]:
+            raise ValueError("speed_range_hz: expected [low, high] with 0 < low < high")
+        return self
 
 
 class Reduction(_Strict):

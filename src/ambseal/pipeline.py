@@ -101,8 +101,9 @@ def _impulse_channels(names: tuple[str, ...]) -> tuple[str, str]:
     return names[0], names[-1]
 
 
-def judge(cfg: RigConfig, controller, name: str, pressure_bar: float) -> tuple[dict, dict]:
-    """Judge one controller on the full-order plant at one pressure drop.
+def judge(cfg: RigConfig, controller, name: str, pressure_bar: float,
+          speed_rpm: float | None = None) -> tuple[dict, dict]:
+    """Judge one controller on the full-order plant at one pressure drop (and speed).
 
     Returns the ``metrics.json`` case and the curves for the figures (frequencies in Hz).
     Controllers are judged on the full-order plant, flexible modes included, whatever
@@ -116,13 +117,15 @@ def judge(cfg: RigConfig, controller, name: str, pressure_bar: float) -> tuple[d
     from .model.rig import build_plant
     from .model.rotor import assemble_rotor
 
-    plant = build_plant(cfg, pressure_bar=pressure_bar, force_positions=(_force_position(cfg),))
+    plant = build_plant(cfg, pressure_bar=pressure_bar, speed_rpm=speed_rpm,
+                        force_positions=(_force_position(cfg),))
     n_cur = 2 * len(cfg.amb)
     G = plant.select_inputs(plant.input_names[:n_cur]).to_statespace()
     Gf = plant.select_inputs(plant.input_names[n_cur:]).to_statespace()
     loop = closed_loop(G, controller, Gf)
-    case = {"controller": name, "pressure_bar": pressure_bar, "stable": loop.stable,
-            "max_real_pole": loop.max_real_pole}
+    speed = cfg.operating.speed_rpm if speed_rpm is None else speed_rpm
+    case = {"controller": name, "pressure_bar": pressure_bar, "speed_hz": speed / 60.0,
+            "stable": loop.stable, "max_real_pole": loop.max_real_pole}
     curves: dict = {}
     w = 2 * np.pi * np.logspace(math.log10(FREQ_HZ[0]), math.log10(FREQ_HZ[1]), FREQ_HZ[2])
     w = resolved_grid(w, loop.poles)  # the 0.5 %-damped bending mode must not slip through
@@ -187,13 +190,42 @@ def _export(res, out: Path, fs_hz: float) -> list[Path]:
     return files
 
 
-def _controllers(cfg: RigConfig, methods: tuple[str, ...] = ("pid", "hinf", "mu")) -> list:
-    """The designed controllers of the main job: the reference PID, H∞ and μ (P5 §4)."""
+def _speed_scheduled(cfg: RigConfig) -> bool:
+    """Whether the rig's seals change with speed over a stated speed range (P3 §4): its
+    controllers are then judged at frozen speeds rather than at pressure drops."""
+    return cfg.operating.speed_range_hz is not None and any(
+        s.frequency_dependent for s in cfg.seal)
+
+
+def _controllers(cfg: RigConfig) -> list:
+    """The designed controllers of the main job.
+
+    Pressure-driven seals (the test rig): the reference PID, H∞ and μ (P5 §4). Speed-driven
+    seals over a speed range (the turboexpander): H∞ at the operating speed, and the PID
+    if the rig has one (P3 §4).
+    """
     from .control.design import design
 
-    if cfg.controller.pid is None:
-        raise ConfigError("controller.pid: the main job needs the reference PID ([controller.pid])")
+    if _speed_scheduled(cfg):
+        methods = (["pid"] if cfg.controller.pid else []) + ["hinf"]
+    else:
+        if cfg.controller.pid is None:
+            raise ConfigError("controller.pid: the main job needs the reference PID "
+                              "([controller.pid])")
+        methods = ["pid", "hinf", "mu"]
     return [design(cfg, m) for m in methods]
+
+
+def _operating_points(cfg: RigConfig) -> list[tuple[float, float, str]]:
+    """(pressure_bar, speed_rpm, label) at which every controller is judged: 0, nominal
+    and 2× nominal pressure drop, or the ends and the middle of the speed range."""
+    p, rpm = cfg.operating.pressure_bar, cfg.operating.speed_rpm
+    if _speed_scheduled(cfg):
+        lo, hi = cfg.operating.speed_range_hz
+        speeds = sorted({lo, rpm / 60.0, hi})
+        return [(p, f * 60.0, f"{f:g} Hz") for f in speeds]
+    pressures = [0.0, p, 2 * p] if p > 0 else [0.0]
+    return [(q, rpm, f"{q:g} bar") for q in pressures]
 
 
 def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
@@ -238,12 +270,11 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         raise ConfigError(f"{rig_path}: amb: the main job needs at least one [[amb]]")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    nominal = cfg.operating.pressure_bar
-    pressures = [0.0, nominal, 2 * nominal] if nominal > 0 else [0.0]
+    points = _operating_points(cfg)
 
     console = Console(stderr=True)
     with Progress(console=console, disable=not progress, transient=True) as bar:
-        total = 2 + 3 * 3 * len(pressures) + 1
+        total = 2 + 3 * 3 * len(points) + 1
         task = bar.add_task("ambseal run", total=total)
         bar.update(task, description="model: full order and modal reduction")
         full = build_plant(cfg)
@@ -252,7 +283,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         unstable = unstable[unstable.real > 1e-9 * np.abs(unstable).max()]
         unstable = unstable[np.argsort(-unstable.real)]
         bar.advance(task)
-        bar.update(task, description="designing PID, H∞ and μ controllers")
+        bar.update(task, description="designing the controllers")
         designs = _controllers(cfg)
         (out / "controllers").mkdir(exist_ok=True)
         for res in designs:
@@ -261,11 +292,11 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         cases, curves = [], []
         for res in designs:
             cname, K = res.method, res.K
-            for p in pressures:
-                bar.update(task, description=f"judging {cname} at {p:g} bar")
-                case, c = judge(cfg, K, cname, p)
+            for p, rpm, label in points:
+                bar.update(task, description=f"judging {cname} at {label}")
+                case, c = judge(cfg, K, cname, p, rpm)
                 cases.append(case)
-                curves.append((f"{cname}, {p:g} bar", c))
+                curves.append((f"{cname}, {label}", c))
                 bar.advance(task, 3)
         metrics = {
             "rig": str(rig_path),

@@ -129,3 +129,53 @@ def test_lpv_plant_affine_without_tables():
         lpv_plant(cfg, [10.0])
     with pytest.raises(ModelError, match="outside the grid"):
         L.A_at(2 * np.pi * 200.0)
+
+
+# --------------------------------------------------------------------------- turboexpander
+@pytest.fixture(scope="module")
+def turbo_designs():
+    """Constant- and rate-bounded-Lyapunov LPV designs on a 10-point 20–300 Hz grid (P3 §4)."""
+    from ambseal.control.lpv_design import design_lpv
+
+    cfg = load_rig(TURBO)
+    const = design_lpv(cfg)
+    # |Ω̇|/2π ≤ 280 Hz/s: the 20 → 300 Hz ramp in 1 s of P3 Fig. 11
+    rate = design_lpv(cfg, rate_bound_hz_per_s=280.0, frozen_gamma=False)
+    return cfg, const, rate
+
+
+def test_turbo_lpv_solves_accurately(turbo_designs):
+    """Every SDP stage of the turboexpander design ends 'optimal' (Clarabel), the
+    controller table is the 5× denser grid, and every frozen closed loop on it is stable
+    (Wu et al. 1996; issue 5 §3)."""
+    _, const, rate = turbo_designs
+    for d in (const, rate):
+        assert all(r.status == "optimal" for r in d.reports)
+        assert d.check_speeds_hz.size == 5 * (d.speeds_hz.size - 1) + 1
+        assert np.all(np.isfinite(d.check_gamma))
+        assert d.check_gamma.max() <= 1.02 * d.gamma_design * (1 + 1e-3)
+    assert const.to_dict()["lyapunov"] == "constant" and rate.lyapunov == "affine"
+
+
+def test_turbo_gamma_ordering(turbo_designs):
+    """Apkarian & Adams 1998: max frozen H∞ γ ≤ rate-bounded γ ≤ constant-Lyapunov γ."""
+    _, const, rate = turbo_designs
+    frozen = float(np.max(const.frozen_gamma))
+    assert frozen <= rate.gamma * (1 + 1e-3)
+    assert rate.gamma <= const.gamma * (1 + 1e-4)
+    assert const.gamma < 1.0  # the weights are met: ‖W_p S_o‖ < 1 on the design model
+
+
+def test_turbo_full_order_frozen_loops_stable(turbo_designs):
+    """The LPV controller, designed on the rigid-body model (P3 §2.2), stabilises the
+    full-order plant (bending modes included) at every frozen speed of 20–300 Hz."""
+    from ambseal.analysis.spinup import frozen_sensitivity
+
+    cfg, const, _ = turbo_designs
+    fs = frozen_sensitivity(cfg, const, np.linspace(20.0, 300.0, 8), name="lpv",
+                            omega=2 * np.pi * np.logspace(0, np.log10(3000.0), 200))
+    assert fs.stable.all()
+    # σ̄(S_o) ≤ 3 (P3 §3.1) is NOT met on the full-order plant: the peaks sit at the
+    # 2 kHz bending modes (spill-over; the static W_u does not roll the controller off).
+    # Recorded here so that a fix shows: below 3 up to 100 Hz (3.1 at 140 Hz), not everywhere.
+    assert np.all(fs.peak[fs.speeds_hz <= 100.0] < 3.0)

@@ -49,7 +49,11 @@ __all__ = ["LpvController", "LpvSynResult", "lpvsyn", "SolverReport"]
 _BASES = {"constant": 1, "affine": 2, "quadratic": 3}
 #: Clarabel tolerances: a relative duality gap of 1e-6 (Clarabel's default 1e-8 stalls on
 #: these LMIs near 1e-7, and is then reported as "almost solved", i.e. inaccurate).
-_DEFAULT_TOL = {"tol_gap_abs": 1e-6, "tol_gap_rel": 1e-6, "tol_feas": 1e-8}
+_DEFAULT_TOL = {"tol_gap_abs": 1e-6, "tol_gap_rel": 1e-6, "tol_feas": 1e-8,
+                #: the projected LMIs are dense (the null-space bases mix every entry of
+                #: R, S): Clarabel's chordal decomposition only splits them into
+                #: overlapping cones and stalls ("almost solved") on the turboexpander
+                "chordal_decomposition_enable": False}
 
 
 # --------------------------------------------------------------------------- results
@@ -236,11 +240,7 @@ def _solve(prob, stage: str, solver_options: dict):
     import cvxpy as cp
 
     t0 = time.perf_counter()
-    opts = dict(solver_options)
-    try:
-        prob.solve(solver=cp.CLARABEL, **opts)
-    except cp.error.SolverError as exc:
-        raise SynthesisError(f"lpvsyn ({stage}): Clarabel failed: {exc}") from exc
+    _solve_quiet(prob, stage, dict(solver_options))
     return _check_status(prob, stage, t0)
 
 
@@ -251,16 +251,56 @@ class _Scaled:
     B: np.ndarray
     C: np.ndarray
     D: np.ndarray
-    t: np.ndarray
+    T: np.ndarray  # x = T x̃ (after the time scale)
     su: np.ndarray
     sy: np.ndarray
     w0: float
     p_of: Any  # Ω (rad/s) → p ∈ [−1, 1]
     dp_dW: float
+    sigma: np.ndarray  # balanced Riccati values (1 for diagonal scaling)
+
+    def to_scaled_A(self, A: np.ndarray) -> np.ndarray:
+        """A frozen physical A(Ω) in the scaled coordinates of the LMIs."""
+        return np.linalg.solve(self.T, A @ self.T) / self.w0
 
 
-def _scale(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas) -> _Scaled:
-    """One diagonal state scaling and a time scale for the whole grid (norm-preserving)."""
+def _riccati_balance(A, B1, B2, C1, C2, D12, D21) -> tuple[np.ndarray, np.ndarray]:
+    """Similarity T balancing the H2 (LQG) Riccati solutions of one frozen plant.
+
+    X (control, from (A, B2) with cost C1, D12) and Y (filter, from (A, C2) with noise B1,
+    D21) are the limits of the H∞ Riccati solutions X∞, Y∞ for γ → ∞; the LMI variables
+    S and R behave like γX∞ and γY∞. With T from the balancing of the pair (Jonckheere &
+    Silverman 1983 "LQG balancing"), TᵀXT = T⁻¹YT⁻ᵀ = Σ, both LMI variables are of the
+    order of Σ in the new coordinates, so neither a slow weight pole (large X) nor the fast
+    actuator states (large Y) dominate the conditioning of the SDP.
+    """
+    n = A.shape[0]
+    X = sla.solve_continuous_are(A, B2, C1.T @ C1, D12.T @ D12, s=C1.T @ D12)
+    Y = sla.solve_continuous_are(A.T, C2.T, B1 @ B1.T, D21 @ D21.T, s=B1 @ D21.T)
+    X, Y = _sym(X), _sym(Y)
+
+    def chol(M):
+        reg = 1e-12 * max(np.trace(M) / n, 1e-300)
+        w, V = np.linalg.eigh(M)
+        return V * np.sqrt(np.maximum(w, reg))[None, :]
+
+    Lx, Ly = chol(X), chol(Y)
+    U, sig, Vt = np.linalg.svd(Lx.T @ Ly)
+    T = Ly @ Vt.T / np.sqrt(sig)[None, :]
+    return T, sig
+
+
+def _scale(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling: str = "riccati") -> _Scaled:
+    """State, time and signal scaling for the whole grid (norm-preserving for w → z).
+
+    1. one diagonal state scaling balancing the envelope of |A(Ω_k)| against B and C;
+    2. the time scale t' = ω₀ t with ω₀ the geometric mean of the pole magnitudes;
+    3. ``scaling="riccati"``: the LQG-balancing similarity of the centre grid plant
+       (:func:`_riccati_balance`), which makes R and S of the order of its Σ (skipped, Σ
+       reported as NaN, when the centre plant has no stabilising Riccati solution — then
+       the LMIs are infeasible anyway and the solver says so);
+    4. controls and measurements to unit-norm columns/rows of [B2; D12] and [C2, D21].
+    """
     n = As.shape[1]
     env = np.max(np.abs(As), axis=0)
     Mbal = np.zeros((n + 1, n + 1))
@@ -272,14 +312,10 @@ def _scale(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas) -> _Scaled:
     lam = np.concatenate([np.abs(np.linalg.eigvals(A)) for A in As])
     lam = lam[lam > 1e-9 * max(lam.max(), 1.0)]
     w0 = float(np.sqrt(lam.min() * lam.max())) if lam.size else 1.0
-    Ti, T = 1.0 / t, t
-    As_s = As * Ti[None, :, None] * T[None, None, :] / w0
-    half = 0.5 * (grid[-1] - grid[0])
-    mid = 0.5 * (grid[-1] + grid[0])
-    dAs_s = dAs * Ti[None, :, None] * T[None, None, :] / w0 * half  # per unit p
-    Bs = B * Ti[:, None] / np.sqrt(w0)
-    Cs = C * T[None, :] / np.sqrt(w0)
+    T = np.diag(t)
     Ds = D.copy()
+    Bs = B / t[:, None] / np.sqrt(w0)
+    Cs = C * t[None, :] / np.sqrt(w0)
     cu = np.linalg.norm(np.vstack([Bs[:, nw:], Ds[:nz, nw:]]), axis=0)
     su = 1.0 / np.where(cu > 0, cu, 1.0)
     ry = np.linalg.norm(np.hstack([Cs[nz:], Ds[nz:, :nw]]), axis=1)
@@ -288,8 +324,31 @@ def _scale(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas) -> _Scaled:
     Ds[:, nw:] *= su
     Cs[nz:] *= sy[:, None]
     Ds[nz:] *= sy[:, None]
-    return _Scaled(As_s, dAs_s, Bs, Cs, Ds, t, su, sy, w0,
-                   lambda W: (np.asarray(W, float) - mid) / half, 1.0 / half)
+    sig = np.ones(n)
+    if scaling == "riccati":
+        kc = len(As) // 2
+        Ac = As[kc] * (1.0 / t)[:, None] * t[None, :] / w0
+        try:
+            Tr, sig = _riccati_balance(Ac, Bs[:, :nw], Bs[:, nw:], Cs[:nz], Cs[nz:],
+                                       Ds[:nz, nw:], Ds[nz:, :nw])
+            ok = bool(np.all(np.isfinite(Tr)) and np.linalg.cond(Tr) < 1e12)
+        except (np.linalg.LinAlgError, ValueError):
+            ok = False  # not stabilisable/detectable there: the SDP will tell (infeasible)
+        if ok:
+            T = T @ Tr
+            Bs = np.linalg.solve(Tr, Bs)
+            Cs = Cs @ Tr
+        else:
+            sig = np.full(n, np.nan)
+    elif scaling != "diagonal":
+        raise SynthesisError(f"lpvsyn: scaling={scaling!r}; expected 'riccati' or 'diagonal'")
+    Tinv = np.linalg.inv(T)
+    As_s = np.einsum("ij,kjl,lm->kim", Tinv, As, T) / w0
+    half = 0.5 * (grid[-1] - grid[0])
+    mid = 0.5 * (grid[-1] + grid[0])
+    dAs_s = np.einsum("ij,kjl,lm->kim", Tinv, dAs, T) / w0 * half  # per unit p
+    return _Scaled(As_s, dAs_s, Bs, Cs, Ds, T, su, sy, w0,
+                   lambda W: (np.asarray(W, float) - mid) / half, 1.0 / half, sig)
 
 
 def _lmi_blocks(sc: _Scaled, nw, nz, ncon, nmeas):
@@ -304,9 +363,24 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
            dA: Sequence[np.ndarray] | None = None, lyapunov: str = "constant",
            rate_bound: float | None = None, backoff: float = 1.05,
            check_density: int = 5, solver_options: dict | None = None,
-           margin: float = 1e-6, lyapunov_bound: float = 1e4,
-           coupling: float = 1e-2) -> LpvSynResult:
+           margin: float = 1e-6, scaling: str = "riccati", penalty: float = 1e-4,
+           coupling_ratio: float = 1.1, centre: bool = False) -> LpvSynResult:
     """Gridded H∞ LPV controller (Apkarian & Adams 1998; Wu et al. 1996; thesis P3 §4).
+
+    Stages, each an SDP solved by Clarabel and each required to end ``optimal``:
+
+    1. ``"gamma"``: minimise γ + penalty·(tr R + mean_k tr S(Ω_k))/N subject to the
+       projected LMIs and [R, αI; αI, S(Ω_k)] ⪰ 0 with α = ``coupling_ratio`` > 1, i.e.
+       S R ⪰ α² I: I − S R then has its eigenvalues at distance ≥ α² − 1 from 0 and the
+       controller reconstruction is well conditioned, at a slightly higher γ (still a valid
+       upper bound). The small trace term keeps the SDP bounded near the optimum, where R
+       or S would otherwise grow without limit (a hard cap on R, S sits on the cap and
+       stalls the interior point).
+    2. ``"centre"`` (only with ``centre=True``): stage 1 with α = 1, then at
+       γ_d = backoff·γ minimise tr R + mean_k tr S(Ω_k) with α = ``coupling_ratio``
+       (lowered towards 1 if infeasible). Gives the least conservative γ, but on the
+       turboexpander with a dynamic W_u this second SDP ends "almost solved" (refused).
+    3. ``"reconstruct"``: the controller on the 5× denser table.
 
     Parameters
     ----------
@@ -326,8 +400,7 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
     rate_bound : float, optional
         ν ≥ |Ω̇| (rad/s²); required for, and only allowed with, a parameter-dependent S.
     backoff : float
-        R, S and controllers are computed at ``backoff·γ`` (≥ 1), which keeps
-        ``I − S R`` well conditioned.
+        R, S and controllers are computed at ``backoff·γ`` (≥ 1).
     check_density : int
         The controller table (and check grid) has ``check_density·(n_p − 1) + 1`` speeds.
     solver_options : dict, optional
@@ -335,12 +408,16 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
         feasibility 1e-8.
     margin : float
         Strictness margin of the LMIs (scaled units).
-    coupling : float
-        [R, I; I, S] ⪰ coupling·I (scaled units) instead of ⪰ 0: keeps I − S R invertible
-        for the controller reconstruction, at a slightly higher γ.
-    lyapunov_bound : float
-        R, S ⪯ bound·I (scaled units): keeps the SDP bounded near the optimal γ, where
-        R or S would otherwise grow without limit.
+    scaling : {"riccati", "diagonal"}
+        State scaling before the SDPs: ``"riccati"`` (default) balances the H2 Riccati
+        solutions of the centre plant (:func:`_riccati_balance`) after a diagonal balancing
+        and the time scale; ``"diagonal"`` stops after the diagonal balancing.
+    penalty : float
+        Weight of the trace term in stage 1 (scaled units; ≥ 0).
+    coupling_ratio : float
+        α of the coupling LMI (> 1).
+    centre : bool
+        Two-stage γ / centring instead of one stage with α in it.
 
     Returns
     -------
@@ -407,7 +484,11 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
         dAs = np.array([np.asarray(X, float) for X in dA])
         if dAs.shape != As.shape:
             raise SynthesisError(f"lpvsyn: dA has shape {dAs.shape}, expected {As.shape}")
-    sc = _scale(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas)
+    if not coupling_ratio > 1.0:
+        raise SynthesisError(f"lpvsyn: coupling_ratio={coupling_ratio} must be > 1")
+    if not penalty >= 0.0:
+        raise SynthesisError(f"lpvsyn: penalty={penalty} must be ≥ 0")
+    sc = _scale(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling)
     B1, B2, C1, C2, D11, D12, D21 = _lmi_blocks(sc, nw, nz, ncon, nmeas)
     NR = sla.block_diag(_null(np.hstack([B2.T, D12.T])), np.eye(nw))
     NS = sla.block_diag(_null(np.hstack([C2, D21])), np.eye(nz))
@@ -416,13 +497,12 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
     ps = sc.p_of(grid)
     solver_options = {**_DEFAULT_TOL, **(solver_options or {})}
     I_N = np.eye(N)
-    bound = float(lyapunov_bound)
 
-    def build(gamma_fixed: float | None):
+    def build(gamma_fixed: float | None, alpha: float):
         R = cp.Variable((N, N), symmetric=True)
         Ss = [cp.Variable((N, N), symmetric=True) for _ in range(nb)]
         g = cp.Variable(nonneg=True) if gamma_fixed is None else gamma_fixed
-        cons = []
+        cons, trS = [], 0
         eps = margin
         for k in range(grid.size):
             A = sc.A[k]
@@ -440,17 +520,32 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
                               [B1.T @ S, -g * np.eye(nw), D11.T],
                               [C1, D11, -g * np.eye(nz)]])
                 cons.append(_sym_expr(NS.T @ MS @ NS) << -eps * np.eye(NS.shape[1]))
-            cons.append(_sym_expr(cp.bmat([[R, I_N], [I_N, S]])) >> coupling * np.eye(2 * N))
-            cons.append(S << bound * I_N)
-        cons.append(R << bound * I_N)
-        return R, Ss, g, cons
+            if nb > 1 or k == 0:  # one coupling LMI suffices for a constant S
+                cons.append(_sym_expr(cp.bmat([[R, alpha * I_N], [alpha * I_N, S]])) >> 0)
+                trS = trS + cp.trace(S) / (grid.size if nb > 1 else 1)
+        return R, Ss, g, cons, cp.trace(R) + trS
 
     reports = []
-    R, Ss, g, cons = build(None)
-    prob = cp.Problem(cp.Minimize(g), cons)
+    R, Ss, g, cons, tr = build(None, float(coupling_ratio) if not centre else 1.0)
+    prob = cp.Problem(cp.Minimize(g + penalty * tr / N), cons)
     reports.append(_solve(prob, "gamma", solver_options))
     gamma = float(g.value)
     gamma_d = backoff * gamma
+    if centre:
+        # stage 2: centre R, S at the backed-off γ with S R ⪰ α² I
+        alpha, last = float(coupling_ratio), None
+        for _ in range(4):
+            R, Ss, _, cons, tr = build(gamma_d, alpha)
+            prob = cp.Problem(cp.Minimize(tr / N), cons)
+            try:
+                rep = _solve(prob, "centre", solver_options)
+                break
+            except SynthesisError as exc:
+                last = exc
+                alpha = 1.0 + 0.5 * (alpha - 1.0)
+        else:
+            raise last
+        reports.append(rep)
     Rv = _sym(np.asarray(R.value))
     Sv = [_sym(np.asarray(S.value)) for S in Ss]
 
@@ -462,7 +557,7 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
     AKs, BKs, CKs, DKs = [], [], [], []
     it_sum, t_rec, status = 0, time.perf_counter(), "optimal"
     for W in table:
-        A_s = (Aint(W) / sc.t[:, None]) * sc.t[None, :] / sc.w0
+        A_s = sc.to_scaled_A(Aint(W))
         p = float(sc.p_of(W))
         f, df = _basis(lyapunov, p)
         S = sum(fi * Si for fi, Si in zip(f, Sv))
@@ -552,40 +647,74 @@ def _closed_loop(A, B, C, D, nw, nz, AK, BK, CK, DK):
 
 def _reconstruct(A, B1, B2, C1, C2, D11, D12, D21, R, S, dS, nu_s, gamma, margin,
                  solver_options):
-    """Controller at one speed from R, S(Ω): minimum-norm (Â, B̂, Ĉ) of the linearised
-    bounded-real LMI (Scherer, Gahinet & Chilali 1997), D_K = 0, M = I, N = I − S R."""
+    """Controller at one speed from R, S(Ω) (Scherer, Gahinet & Chilali 1997; D_K = 0,
+    M = I, N = I − S R), with Â eliminated in closed form.
+
+    The linearised closed-loop bounded-real LMI in (Â, B̂, Ĉ) has rows [x_R; x_S; w; z];
+    Â enters only its (x_S, x_R) block, as Â + Aᵀ. With the rows split as 1 = x_R,
+    2 = x_S, 3 = (w, z), choosing ``Â + Aᵀ = P23 P33⁻¹ P13ᵀ`` makes the Schur complement
+    with respect to P33 ≺ 0 block diagonal, so the LMI holds iff the two small LMIs in
+    rows {1, 3} (Ĉ: a state-feedback H∞ LMI with R fixed) and rows {2, 3} (B̂: the
+    filter LMI with S(Ω) fixed, for Ṡ = ±ν ∂S/∂Ω) hold — the feasibility of which is what
+    the projected LMIs guarantee (Gahinet & Apkarian 1994, elimination lemma). Two SDPs of
+    size N + n_w + n_z with N·n_u and N·n_y unknowns replace one of size 2N + n_w + n_z
+    with N² more unknowns. Each minimises the Frobenius norm of its unknown (moderate
+    controller gains).
+    """
     import cvxpy as cp
 
     N = A.shape[0]
     nw, nz = B1.shape[1], C1.shape[0]
     nu, ny = B2.shape[1], C2.shape[0]
-    Ah = cp.Variable((N, N))
-    Bh = cp.Variable((N, ny))
+    P33 = np.block([[-gamma * np.eye(nw), D11.T], [D11, -gamma * np.eye(nz)]])
+    its = 0
+    # Ĉ: rows {x_R, w, z}
     Ch = cp.Variable((nu, N))
+    CR = C1 @ R + D12 @ Ch
+    M1 = cp.bmat([[A @ R + R @ A.T + B2 @ Ch + Ch.T @ B2.T, B1, CR.T],
+                  [B1.T, -gamma * np.eye(nw), D11.T],
+                  [CR, D11, -gamma * np.eye(nz)]])
+    prob = cp.Problem(cp.Minimize(cp.sum_squares(Ch)),
+                      [_sym_expr(M1) << -margin * np.eye(M1.shape[0])])
+    t0 = time.perf_counter()
+    _solve_quiet(prob, "reconstruct", solver_options)
+    its += _check_status(prob, "reconstruct", t0).iterations
+    # B̂: rows {x_S, w, z}, for Ṡ = ±ν ∂S/∂Ω
+    Bh = cp.Variable((N, ny))
+    SB = S @ B1 + Bh @ D21
     cons = []
     signs = (1.0, -1.0) if (dS is not None and nu_s > 0) else (0.0,)
     for sgn in signs:
         S22 = S @ A + A.T @ S + (sgn * nu_s * dS if sgn else 0.0)
-        M = cp.bmat([
-            [A @ R + R @ A.T + B2 @ Ch + Ch.T @ B2.T, (Ah + A.T).T, B1, (C1 @ R + D12 @ Ch).T],
-            [Ah + A.T, S22 + Bh @ C2 + C2.T @ Bh.T, S @ B1 + Bh @ D21, C1.T],
-            [B1.T, (S @ B1 + Bh @ D21).T, -gamma * np.eye(nw), D11.T],
-            [C1 @ R + D12 @ Ch, C1, D11, -gamma * np.eye(nz)],
-        ])
-        cons.append(_sym_expr(M) << -margin * np.eye(M.shape[0]))
-    obj = cp.sum_squares(Ah) + cp.sum_squares(Bh) + cp.sum_squares(Ch)
-    prob = cp.Problem(cp.Minimize(obj), cons)
+        M2 = cp.bmat([[S22 + Bh @ C2 + C2.T @ Bh.T, SB, C1.T],
+                      [SB.T, -gamma * np.eye(nw), D11.T],
+                      [C1, D11, -gamma * np.eye(nz)]])
+        cons.append(_sym_expr(M2) << -margin * np.eye(M2.shape[0]))
+    prob = cp.Problem(cp.Minimize(cp.sum_squares(Bh)), cons)
     t0 = time.perf_counter()
-    try:
-        prob.solve(solver=cp.CLARABEL, **solver_options)
-    except cp.error.SolverError as exc:
-        raise SynthesisError(f"lpvsyn (reconstruct): Clarabel failed: {exc}") from exc
-    rep = _check_status(prob, "reconstruct", t0)
-    Ahv, Bhv, Chv = (np.asarray(X.value) for X in (Ah, Bh, Ch))
+    _solve_quiet(prob, "reconstruct", solver_options)
+    its += _check_status(prob, "reconstruct", t0).iterations
+    Chv, Bhv = np.asarray(Ch.value), np.asarray(Bh.value)
+    P13 = np.hstack([B1, (C1 @ R + D12 @ Chv).T])
+    P23 = np.hstack([S @ B1 + Bhv @ D21, C1.T])
+    Ahv = -A.T + P23 @ np.linalg.solve(P33, P13.T)
     Nm = np.eye(N) - S @ R
     if np.linalg.cond(Nm) > 1e12:
         raise SynthesisError("lpvsyn (reconstruct): I − S R is singular; raise the back-off")
     BK = np.linalg.solve(Nm, Bhv)
     CK = Chv
     AK = np.linalg.solve(Nm, Ahv - Bhv @ C2 @ R - S @ B2 @ Chv - S @ A @ R)
-    return AK, BK, CK, rep.iterations
+    return AK, BK, CK, its
+
+
+def _solve_quiet(prob, stage: str, solver_options: dict) -> None:
+    import warnings
+
+    import cvxpy as cp
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # status is checked by the caller
+            prob.solve(solver=cp.CLARABEL, **solver_options)
+    except cp.error.SolverError as exc:
+        raise SynthesisError(f"lpvsyn ({stage}): Clarabel failed: {exc}") from exc

@@ -8,7 +8,7 @@ Commands
     Damped natural frequencies, damping ratios and unstable poles of the full model.
 ``ambseal acquire RIG --truth TRUTH --excitation prbs|sine|chirp|impulse --pressure-bar P --out FILE``
     A record from the virtual test facility (CSV + JSON sidecar, or .mat).
-``ambseal design RIG --method pid|hinf|mu [--out DIR]``
+``ambseal design RIG --method pid|hinf|mu|lpv [--out DIR]``
     Design a controller on the rig's reduced model; write it (continuous, Tustin and ZOH at
     the controller's sample rate) as .json, .npz and .mat, with a summary.
 ``ambseal identify RIG DATA... --params NAME,... --out DIR``
@@ -73,9 +73,9 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("--start-s", type=float, default=0.05, help="impulse start (s)")
     a.add_argument("--seed", type=int, default=0, help="seed of excitation and noise")
 
-    d = sub.add_parser("design", help="design a controller (pid, hinf, mu) and export it")
+    d = sub.add_parser("design", help="design a controller (pid, hinf, mu, lpv) and export it")
     d.add_argument("rig", help="rig file (TOML)")
-    d.add_argument("--method", required=True, choices=["pid", "hinf", "mu"])
+    d.add_argument("--method", required=True, choices=["pid", "hinf", "mu", "lpv"])
     d.add_argument("--pressure-bar", type=float, default=None,
                    help="design pressure drop (bar); default [operating] pressure_bar")
     d.add_argument("--out", default="ambseal-design", help="output folder")

@@ -168,15 +168,27 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
 
     Files: ``controller_<method>.json``, ``.npz`` and ``.mat`` (continuous, Tustin and ZOH
     at ``[controller] sample_rate_hz``, with the channel names) and ``design_<method>.json``
-    (summary, weights, D–K history).
+    (summary, weights, D–K history). ``lpv`` (a rig with ``[operating] speed_range_hz``):
+    the frozen controllers on the design grid, ``controller_lpv_<f>Hz.npz``.
     """
     from .control.design import design
 
     cfg = load_rig(rig)
-    res = design(cfg, method, pressure_bar=pressure_bar)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    files = _export(res, out, cfg.controller.sample_rate_hz)
+    fs = cfg.controller.sample_rate_hz
+    if method == "lpv":
+        from .control.lpv_design import design_lpv
+
+        if cfg.operating.speed_range_hz is None:
+            raise ConfigError(f"{rig}: operating.speed_range_hz: an LPV design needs the "
+                              "speed range it is scheduled over, e.g. [20.0, 300.0]")
+        lpv = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz)
+        j = _Judged("lpv", lpv.controller_at, lpv.to_dict(), lpv)
+        files = _export_judged(j, out, fs, [float(f) for f in lpv.speeds_hz])
+        return {**lpv.to_dict(), "files": [str(f) for f in files]}
+    res = design(cfg, method, pressure_bar=pressure_bar)
+    files = _export(res, out, fs)
     return {**res.summary(), "files": [str(f) for f in files]}
 
 
@@ -190,6 +202,23 @@ def _export(res, out: Path, fs_hz: float) -> list[Path]:
     return files
 
 
+def _export_judged(j: _Judged, out: Path, fs_hz: float, speeds_hz) -> list[Path]:
+    """Export a main-job controller (continuous, Tustin, ZOH; .json/.npz/.mat) and its
+    design (``design_<method>.json``); a scheduled one as its frozen controllers at the
+    judged speeds (``controller_lpv_<f>Hz.npz``), the table a real-time target
+    interpolates."""
+    from .control.export import export_controller
+
+    if j.method == "lpv":
+        files = [export_controller(j.at(f), out / f"controller_lpv_{f:g}Hz.npz", fs_hz=fs_hz)
+                 for f in speeds_hz]
+    else:
+        files = [export_controller(j.at(None), out / f"controller_{j.method}{ext}",
+                                   fs_hz=fs_hz) for ext in (".json", ".npz", ".mat")]
+    files.append(write_json(out / f"design_{j.method}.json", j.result.to_dict()))
+    return files
+
+
 def _speed_scheduled(cfg: RigConfig) -> bool:
     """Whether the rig's seals change with speed over a stated speed range (P3 §4): its
     controllers are then judged at frozen speeds rather than at pressure drops."""
@@ -197,23 +226,44 @@ def _speed_scheduled(cfg: RigConfig) -> bool:
         s.frequency_dependent for s in cfg.seal)
 
 
-def _controllers(cfg: RigConfig) -> list:
+@dataclass(frozen=True)
+class _Judged:
+    """A designed controller as the main job judges and exports it: ``at(speed_hz)`` gives
+    the (frozen) physical controller, ``summary`` its design summary."""
+
+    method: str
+    at: object
+    summary: dict
+    result: object
+
+
+def _controllers(cfg: RigConfig) -> list[_Judged]:
     """The designed controllers of the main job.
 
     Pressure-driven seals (the test rig): the reference PID, H∞ and μ (P5 §4). Speed-driven
-    seals over a speed range (the turboexpander): H∞ at the operating speed, and the PID
-    if the rig has one (P3 §4).
+    seals over a speed range (the turboexpander, P3 §4): the PID if the rig has one, an
+    H∞ controller designed at the operating speed (the LTI comparison of P3 Fig. 11) and the
+    LPV controller scheduled on speed.
     """
     from .control.design import design
 
     if _speed_scheduled(cfg):
-        methods = (["pid"] if cfg.controller.pid else []) + ["hinf"]
-    else:
-        if cfg.controller.pid is None:
-            raise ConfigError("controller.pid: the main job needs the reference PID "
-                              "([controller.pid])")
-        methods = ["pid", "hinf", "mu"]
-    return [design(cfg, m) for m in methods]
+        from .control.lpv_design import design_frozen, design_lpv
+
+        out = [_lti(design(cfg, "pid"))] if cfg.controller.pid else []
+        fz = design_frozen(cfg, cfg.operating.speed_rpm / 60.0)
+        out.append(_Judged("hinf", lambda _f, K=fz.K: K, fz.to_dict(), fz))
+        lpv = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz)
+        out.append(_Judged("lpv", lpv.controller_at, lpv.to_dict(), lpv))
+        return out
+    if cfg.controller.pid is None:
+        raise ConfigError("controller.pid: the main job needs the reference PID "
+                          "([controller.pid])")
+    return [_lti(design(cfg, m)) for m in ("pid", "hinf", "mu")]
+
+
+def _lti(res) -> _Judged:
+    return _Judged(res.method, lambda _f, K=res.K: K, res.summary(), res)
 
 
 def _operating_points(cfg: RigConfig) -> list[tuple[float, float, str]]:
@@ -286,15 +336,16 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         bar.update(task, description="designing the controllers")
         designs = _controllers(cfg)
         (out / "controllers").mkdir(exist_ok=True)
-        for res in designs:
-            _export(res, out / "controllers", cfg.controller.sample_rate_hz)
+        for j in designs:
+            _export_judged(j, out / "controllers", cfg.controller.sample_rate_hz,
+                           [rpm / 60.0 for _, rpm, _ in points])
         bar.advance(task)
         cases, curves = [], []
-        for res in designs:
-            cname, K = res.method, res.K
+        for j in designs:
+            cname = j.method
             for p, rpm, label in points:
                 bar.update(task, description=f"judging {cname} at {label}")
-                case, c = judge(cfg, K, cname, p, rpm)
+                case, c = judge(cfg, j.at(rpm / 60.0), cname, p, rpm)
                 cases.append(case)
                 curves.append((f"{cname}, {label}", c))
                 bar.advance(task, 3)
@@ -307,7 +358,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                 "n_states_reduced": reduced.n_states,
             },
             "unbalance": {"grade_mm_s": UNBALANCE_GRADE_MM_S, "range_hz": list(UNBALANCE_RANGE_HZ)},
-            "controllers": {r.method: r.summary() for r in designs},
+            "controllers": {j.method: j.summary for j in designs},
             "cases": cases,
         }
         extra: tuple[list, list] = ([], [])
@@ -322,24 +373,54 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                 bar.advance(task)
 
             metrics["identification"], extra = _identification(cfg, truth_cfg, out, say)
+        if _speed_scheduled(cfg):
+            bar.update(task, description="spin-up 20 → 300 Hz and frozen sensitivities")
+            metrics["spinup"], figs = _spinup(cfg, designs, out)
+            extra[0].extend(figs)
         bar.update(task, description="report")
         metrics_path = write_json(out / "metrics.json", metrics)
-        extra[0].append(_gains_figure(out, designs))
+        extra[0].append(_gains_figure(out, designs, cfg.operating.speed_rpm / 60.0))
         report_path = _report(out, cfg, rig_path, metrics, curves, extra)
         bar.advance(task)
     return RunResult(out, metrics_path, report_path, metrics)
 
 
-def _gains_figure(out: Path, designs: list) -> tuple[str, Path]:
-    """Direct and cross gains of the designed controllers (P5 Fig. 10)."""
+def _gains_figure(out: Path, designs: list, speed_hz: float) -> tuple[str, Path]:
+    """Direct and cross gains of the designed controllers (P5 Fig. 10), at the operating
+    speed for scheduled ones."""
     from .analysis.freqresp import freqresp
     from .report.figures import controller_gains_figure
 
     f = np.logspace(0, math.log10(2000.0), 300)
-    rows = [(r.method, f, freqresp(r.K, 2 * np.pi * f)) for r in designs]
-    names = [n.removeprefix("y_") for n in designs[0].K.input_labels]
+    Ks = [(j.method, j.at(speed_hz)) for j in designs]
+    rows = [(m, f, freqresp(K, 2 * np.pi * f)) for m, K in Ks]
+    names = [n.removeprefix("y_") for n in Ks[0][1].input_labels]
     return ("Direct and cross gains of the controllers (P5 Fig. 10)",
             controller_gains_figure(out / "controller_gains.png", rows, names))
+
+
+def _spinup(cfg: RigConfig, designs: list, out: Path) -> tuple[dict, list]:
+    """P3 §4: spin-up 20 → 300 Hz with alternating force and output steps on A_x, and
+    σ̄(S_o) at frozen speeds, for the scheduled controller and the LTI ones."""
+    from .analysis.spinup import frozen_sensitivity, spinup
+    from .control.lpv_plant import lpv_plant
+    from .report.lpv_figures import frozen_sensitivity_figure, spinup_figure
+
+    lo, hi = cfg.operating.speed_range_hz
+    grid = np.linspace(lo, hi, 29)
+    L = lpv_plant(cfg, grid, states=12, force_positions=(cfg.amb[0].position,))
+    sims, sens, cache = [], [], {}
+    speeds = np.linspace(lo, hi, 8)
+    for j in designs:
+        ctrl = j.result if j.method == "lpv" else j.at(None)
+        sims.append(spinup(L, ctrl, name=j.method, speeds_hz=(lo, hi)))
+        sens.append(frozen_sensitivity(cfg, ctrl, speeds, name=j.method, plants=cache))
+    figs = [("Spin-up 20 → 300 Hz in 1 s with 100 N force and 2 µm output steps on A_x "
+             "(P3 Fig. 11)", spinup_figure(out / "spinup.png", sims)),
+            ("σ̄(S_o) at frozen speeds with the ISO 14839-3 line (P3 Fig. 12)",
+             frozen_sensitivity_figure(out / "frozen_sensitivity.png", sens))]
+    return {j.method: {**s.to_dict(), "frozen_sensitivity": fs.to_dict()}
+            for j, s, fs in zip(designs, sims, sens)}, figs
 
 
 def _identification(cfg: RigConfig, truth, out: Path, say) -> tuple[dict, tuple[list, list]]:

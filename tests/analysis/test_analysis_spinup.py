@@ -43,41 +43,61 @@ def runs():
     return L, d, fz, sims, sens
 
 
-def test_output_steps_settle_within_20_ms_and_faster(runs):
-    """P3 §3.1: 2 % settling within 20 ms — met by the LPV controller for every 2 µm
-    output step over 20–300 Hz, each faster than the 140 Hz H∞ controller."""
-    _, _, _, sims, _ = runs
-    lpv = [s for s in sims["lpv"].steps if s.kind.startswith("output")]
-    ref = [s for s in sims["hinf140"].steps if s.kind.startswith("output")]
-    assert len(lpv) == 10
-    assert max(s.settling_ms for s in lpv) < 20.0
-    assert all(a.settling_ms < b.settling_ms for a, b in zip(lpv, ref))
-    assert all(abs(s.peak_um - 2.0) < 0.05 for s in lpv)
+def _steps(sim, kind):
+    return [s for s in sim.steps if s.kind.startswith(kind)]
 
 
-def test_force_steps_peak_lower_but_slow_tail(runs):
-    """The 100 N force steps: the LPV peak (≈ 2.05 µm) is below the 140 Hz controller's
-    (≈ 2.55 µm) at every speed, but neither settles to 2 % within the 50 ms window — the
-    integral action of W_p with A = 1e-2 (pole at ω_B A = 3.1 rad/s) leaves a slow tail.
-    NOT the P3 §3.1 requirement: recorded as the current state."""
+def test_every_step_settles_within_20_ms(runs):
+    """P3 §3.1: 2 % settling within 20 ms — every disturbance of the spin-up (10 force
+    steps of 100 N, 10 output steps of 2 µm, 20–300 Hz) with the LPV controller. The band
+    is 2 % of each step's peak around its own final value (the end of its 50 ms window,
+    before the next step; see ``ambseal.analysis.spinup``)."""
     _, _, _, sims, _ = runs
-    lpv = [s for s in sims["lpv"].steps if s.kind.startswith("force")]
-    ref = [s for s in sims["hinf140"].steps if s.kind.startswith("force")]
-    assert all(a.peak_um < b.peak_um for a, b in zip(lpv, ref))
-    assert all(s.settling_ms > 20.0 for s in lpv)
-    assert np.max(np.abs(sims["lpv"].current_a)) < 5.0  # ±5 A current limit, P3 §3.1
+    lpv = sims["lpv"]
+    assert len(_steps(lpv, "force")) == 10 and len(_steps(lpv, "output")) == 10
+    assert all(np.isfinite(s.settling_ms) and s.settling_ms <= 20.0 for s in lpv.steps), \
+        [(s.kind, s.speed_hz, s.settling_ms) for s in lpv.steps]
+    assert all(abs(s.peak_um - 2.0) < 0.05 for s in _steps(lpv, "output"))
+    assert np.max(np.abs(lpv.current_a)) < 5.0  # ±5 A current limit, P3 §3.1
+
+
+def test_lpv_faster_than_140_hz_controller_away_from_140_hz(runs):
+    """P3 §4, Fig. 11: away from the 140 Hz design speed of the LTI controller (below
+    80 Hz and above 200 Hz) the LPV controller settles every disturbance faster, force and
+    output steps alike, and its force-step peak is lower at every speed."""
+    _, _, _, sims, _ = runs
+    for kind in ("force", "output"):
+        pairs = list(zip(_steps(sims["lpv"], kind), _steps(sims["hinf140"], kind)))
+        away = [(a, b) for a, b in pairs if a.speed_hz < 80.0 or a.speed_hz > 200.0]
+        assert len(away) >= 4
+        assert all(a.settling_ms < b.settling_ms for a, b in away), \
+            [(a.speed_hz, a.settling_ms, b.settling_ms) for a, b in away]
+    assert all(a.peak_um < b.peak_um for a, b in zip(_steps(sims["lpv"], "force"),
+                                                      _steps(sims["hinf140"], "force")))
+
+
+def test_force_window_final_value_is_its_own(runs):
+    """The force step's final value is the steady deflection of its own window (≈ 0 with
+    integral action, below the 2 % band), not the first sample of the next window, which
+    already carries the 2 µm output step (Fig. 11 judges each 50 ms window on its own)."""
+    _, _, _, sims, _ = runs
+    sim = sims["lpv"]
+    y = sim.y_m[:, 0]
+    dt = sim.t_s[1] - sim.t_s[0]
+    for s in _steps(sim, "force"):
+        i_end = int(round((s.t_start_s + 0.05) / dt)) - 1
+        assert abs(y[i_end]) * 1e6 < 0.02 * s.peak_um
 
 
 def test_frozen_sensitivity_full_order(runs):
-    """P3 Fig. 12 data: both controllers stabilise the full-order plant at every frozen
-    speed; σ̄(S_o) ≤ 3 holds for the 140 Hz controller near 140 Hz and for the LPV one up to
-    100 Hz, not over the whole range (2 kHz bending-mode spill-over; see the report)."""
+    """P3 Fig. 12 / ISO 14839-3 zone A: both controllers stabilise the full-order plant at
+    every frozen speed of 20–300 Hz and keep σ̄(S_o) ≤ 3 there (peaks on a frequency grid
+    refined around the lightly damped closed-loop poles)."""
     _, _, _, _, sens = runs
     for s in sens.values():
         assert s.stable.all()
         assert s.sigma.shape == (8, 200)
-    lpv = sens["lpv"]
-    assert np.all(lpv.peak[lpv.speeds_hz <= 100.0] < 3.0)
+        assert np.all(s.peak <= 3.0), (s.name, s.peak)
 
 
 def test_figures(runs, tmp_path):

@@ -63,6 +63,7 @@ BAD = [
     ("AMB without ki/ks or geometry", GOOD.replace("ki = 100.0\nks = 2.0e5\n", "", 1),
      "amb[0]", "expected either the geometry"),
     ("not TOML", "this is = = not toml", "", "not valid TOML"),
+    ("nan", GOOD.replace("mass = 5.0", "mass = nan"), "disk[0].mass", "finite"),
     ("unknown key", GOOD.replace("mass = 5.0", "mass = 5.0\nmas = 5.0"), "disk[0].mas",
      "unknown key"),
 ]

@@ -43,7 +43,8 @@ def test_identify_writes_fit_and_a_rig_the_other_commands_accept(record, tmp_pat
     code = main(["identify", RIG, str(record), "--params", params, "--out", str(out)])
     summary = json.loads(capsys.readouterr().out)
     assert code == 0 and summary["converged"]
-    assert summary["parameters"]["A.Ki_zeta"]["estimate"] == pytest.approx(205.0, rel=0.05)
+    # the truth file's 205 N/A, 2.9 % above the rig file's 199.2 start: the fit must move
+    assert summary["parameters"]["A.Ki_zeta"]["estimate"] == pytest.approx(205.0, rel=0.01)
     fit = json.loads((out / "fit.json").read_text())
     assert set(fit["parameters"]) == set(params.split(","))
     rig = load_rig(out / "identified.toml")

@@ -81,7 +81,7 @@ MU0 = 4e-7 * math.pi
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 class Material(_Strict):
@@ -272,7 +272,8 @@ def coefficient_value(c: SealCoefficient, pressure_bar: float,
     if isinstance(c, FrequencyTable):
         if frequency_hz is None:
             raise ConfigError("a frequency-dependent seal coefficient needs a frequency "
-                              "(the synchronous one, from a non-zero speed)")
+                              "(by default the synchronous one; at standstill the table's "
+                              "first value holds)")
         return float(np.interp(frequency_hz, c.frequency_hz, c.value))
     return float(c)
 
@@ -494,7 +495,7 @@ class TruthSection(_Strict):
     noise_fraction: float = Field(default=0.0, ge=0)
     current_noise_a: float = Field(default=0.0, ge=0)
     adc_bits: int | None = Field(default=None, ge=2, le=32)
-    adc_range_m: float = Field(default=1.0e-3, gt=0)
+    adc_range_m: float = Field(default=1.0e-3, gt=0)  # LSB = range / 2**bits (no clipping)
     substeps: int = Field(default=4, ge=1, le=100)
     max_mode_hz: float = Field(default=10000.0, gt=0)
 
@@ -513,7 +514,8 @@ def load_truth(path: str | Path) -> TruthSection:
     Keys of ``[truth]``: ``tau_e`` (s), ``bias_current`` (A), ``current_limit`` (A, default
     the AMBs' ``current_limit``), ``sensor_noise_m`` (std, m) or ``noise_fraction`` (std as
     a fraction of each displacement channel's RMS), ``current_noise_a`` (std, A),
-    ``adc_bits`` and ``adc_range_m`` (full scale ±range/2), ``substeps`` (integration steps
+    ``adc_bits`` and ``adc_range_m`` (quantisation step range/2^bits; the sensor does not
+    saturate: the rotor stops the run if it leaves the gap), ``substeps`` (integration steps
     per controller sample), ``max_mode_hz`` (modes kept in the simulation, default 10 kHz),
     and ``[truth.parameters]``.
     """
@@ -556,14 +558,13 @@ def rig_with_values(cfg: RigConfig, values: dict[str, Coefficient]) -> RigConfig
             data.setdefault("actuator", {})["eddy_time_constant"] = v
         elif owner in ambs and key[:3] in ("Ki_", "Ks_") and key[3:] in ("zeta", "eta"):
             amb = ambs[owner]
-            slot = key[:2].lower()
-            cur = amb.get(slot)
-            if not isinstance(cur, dict):
-                ki, ks = cfg.amb[list(ambs).index(owner)].factors()
-                pair = ki if slot == "ki" else ks
-                cur = {"zeta": pair[0], "eta": pair[1]}
-            cur[key[3:]] = v
-            amb[slot] = cur
+            # write both factors explicitly: an AMB given by its geometry uses explicit
+            # ki/ks only when both are set (Amb.factors)
+            ki, ks = cfg.amb[list(ambs).index(owner)].factors()
+            for sl, pair in (("ki", ki), ("ks", ks)):
+                if not isinstance(amb.get(sl), dict):
+                    amb[sl] = {"zeta": pair[0], "eta": pair[1]}
+            amb[key[:2].lower()][key[3:]] = v
         elif owner in springs and key in ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy"):
             springs[owner][key] = v
         elif owner in seals and key in ("K", "k", "C", "c"):

@@ -81,10 +81,11 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
               f"seal coefficients, if fitted, hold at the recorded pressure drop(s) "
               f"{pressures} bar")
     write_text(out / "identified.toml", dump_rig(identified, header))
-    return {"out": str(out), "converged": res.converged, "parameters": {
-        n: {"estimate": float(v), "ci95": [float(lo), float(hi)]}
-        for n, v, lo, hi in zip(res.names, res.estimate, res.ci95_low, res.ci95_high)},
-        "nrmse_fit_pct": {k: float(v) for k, v in res.nrmse_fit_pct.items()}}
+    return {"out": str(out), "converged": res.converged, "message": res.message,
+            "parameters": {
+                n: {"estimate": float(v), "ci95": [_finite(lo), _finite(hi)]}
+                for n, v, lo, hi in zip(res.names, res.estimate, res.ci95_low, res.ci95_high)},
+            "nrmse_fit_pct": {k: _finite(v) for k, v in res.nrmse_fit_pct.items()}}
 
 
 def _finite(x: float) -> float | None:
@@ -514,7 +515,7 @@ def _identification(cfg: RigConfig, truth, out: Path, say) -> tuple[dict, tuple[
             t = res.truth.get(n)
             err = None if not isinstance(t, float) or t == 0 else 100 * (r.estimate[i] / t - 1)
             summary[n] = {"estimate": float(r.estimate[i]), "truth": t,
-                          "ci95": [float(r.ci95_low[i]), float(r.ci95_high[i])],
+                          "ci95": [_finite(r.ci95_low[i]), _finite(r.ci95_high[i])],
                           "error_pct": err}
             rows.append(f"<tr><td>{n}</td><td>{r.estimate[i]:.5g}</td><td>{t if t is None else f'{t:.5g}'}"
                         f"</td><td>[{r.ci95_low[i]:.5g}, {r.ci95_high[i]:.5g}]</td>"
@@ -536,7 +537,7 @@ def _identification(cfg: RigConfig, truth, out: Path, say) -> tuple[dict, tuple[
                  "<th>95 % interval</th><th>error</th></tr>" + "".join(rows) + "</table>"),
     })
     return {"parameters": summary, "converged": bool(a.converged),
-            "nrmse_fit_pct": {k: float(v) for k, v in a.nrmse_fit_pct.items()}}, (figs, sections)
+            "nrmse_fit_pct": {k: _finite(v) for k, v in a.nrmse_fit_pct.items()}}, (figs, sections)
 
 
 def _report(out: Path, cfg: RigConfig, rig_path: Path, metrics: dict, curves: list,

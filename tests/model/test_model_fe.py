@@ -144,3 +144,36 @@ def test_modal_damping_sets_bending_mode_damping():
     cfg = beam_rig("timoshenko", d=0.05, n=10, rotor={"modal_damping": 0.02})
     res = modes(build_system(cfg))
     np.testing.assert_allclose(res.damping_ratios[:6], 0.02, rtol=1e-6)
+
+
+def test_seal_cross_coupling_destabilises_forward_whirl():
+    """Childs' convention (−f = [K k; −k K] q + ...): a positive k pushes the rotor round in
+    the direction of rotation, so it takes damping from the forward-whirl mode and gives it
+    to the backward one (Childs, *Turbomachinery Rotordynamics*, 1993, §3.2). The seal sits
+    at the disk of a symmetric rotor: the cylindrical pair, whose whirl direction is read
+    from the eigenvector at the disk (forward: y lags x by 90°, v_y/v_x = −j)."""
+    springs = [{"position": z, "kxx": 1e6, "kyy": 1e6, "cxx": 300.0, "cyy": 300.0}
+               for z in (0.0, 0.4)]
+    data = {
+        "materials": {"s": {"E": 2.1e11, "rho": RHO, "nu": NU}},
+        "shaft": [{"length": 0.4, "outer_diameter": 0.05, "material": "s", "elements": 4}],
+        "disk": [{"position": 0.2, "mass": 20.0, "Ip": 0.4, "Id": 0.2}],
+        "spring": springs,
+        "seal": [{"name": "s", "position": 0.2, "k": 0.0}],
+    }
+
+    def cylindrical(k):
+        data["seal"][0]["k"] = k
+        sys_ = build_system(parse_rig(data), speed_rpm=1000.0)
+        node = sys_.mesh.node_at(0.2)
+        lam, V = np.linalg.eig(sys_.state_matrices()[0])
+        out = {}
+        for i in np.nonzero((lam.imag > 100) & (lam.imag < 500))[0]:
+            ratio = V[4 * node + 1, i] / V[4 * node, i]
+            out["forward" if ratio.imag < 0 else "backward"] = lam[i]
+        return out
+
+    base, pushed = cylindrical(0.0), cylindrical(2e5)
+    assert set(base) == set(pushed) == {"forward", "backward"}
+    assert pushed["forward"].real > base["forward"].real + 5.0
+    assert pushed["backward"].real < base["backward"].real - 5.0

@@ -32,7 +32,7 @@ from ..model.amb import eddy_lag_matrices
 from ..model.lft import Plant
 from .loop import DiscreteController, closed_loop_matrices, simulate_lti, zoh
 
-__all__ = ["FitResult", "ClosedLoopModel", "fit_parameters", "nrmse_fit"]
+__all__ = ["FitResult", "ClosedLoopModel", "fit_parameters", "default_bounds", "nrmse_fit"]
 
 TAU_E = "tau_e"
 _DEFAULT_SCALE = {"N/m": 1e5, "N/A": 50.0, "N*s/m": 1e2, "s": 1e-3}
@@ -70,7 +70,8 @@ class ClosedLoopModel:
     _cache: dict = field(default_factory=dict, repr=False)
 
     def matrices(self, values: dict[str, float]):
-        """Continuous (A, B, C_y, C_i) of amplifier → lag → plant for parameter values."""
+        """Continuous (A, B, C, C_i, D_i) of amplifier → lag → plant for parameter values:
+        displacements y = C x, coil current i = C_i x + D_i i_ref."""
         changes = {n: v - self.plant.parameter(n).nominal for n, v in values.items()
                    if n != TAU_E}
         p = self.plant.with_changes(changes) if changes else self.plant
@@ -165,7 +166,7 @@ class FitResult:
                 for i, n in enumerate(self.names)
             },
             "correlation": [f(row) for row in self.correlation],
-            "nrmse_fit_pct": {k: float(v) for k, v in self.nrmse_fit_pct.items()},
+            "nrmse_fit_pct": dict(zip(self.nrmse_fit_pct, f(list(self.nrmse_fit_pct.values())))),
             "converged": self.converged,
             "message": self.message,
             "iterations": self.iterations,
@@ -193,7 +194,9 @@ def _long_run_covariance(J: np.ndarray, R: np.ndarray, smooth: int = 2) -> np.nd
     """
     N, c, p = J.shape
     L = 2 * N
-    Rf = np.fft.rfft(R - R.mean(axis=0), n=L, axis=0)  # (F, c)
+    # no demeaning: a correct model leaves zero-mean residuals, and removing the mean would
+    # zero the DC bin where slow (e.g. impulse-response) sensitivities have their weight
+    Rf = np.fft.rfft(R, n=L, axis=0)  # (F, c)
     Jf = np.fft.rfft(J, n=L, axis=0)  # (F, c, p)
     P = np.einsum("fa,fb->fab", Rf, Rf.conj()) / N  # (F, c, c) periodogram
     if smooth > 0:
@@ -207,6 +210,20 @@ def _long_run_covariance(J: np.ndarray, R: np.ndarray, smooth: int = 2) -> np.nd
     w[-1] = 1.0
     S = np.einsum("f,fap,fab,fbq->pq", w, Jf.conj(), P, Jf) / L
     return np.real(S)
+
+
+def default_bounds(model: ClosedLoopModel, names) -> dict[str, tuple[float, float]]:
+    """Default bounds (SI) around a model's values: [0.2, 5]× for positive force factors and
+    spring stiffnesses, [0, 0.05] s for τ_e, none otherwise."""
+    out = {}
+    for n in names:
+        if n == TAU_E:
+            out[n] = (0.0, 0.05)
+            continue
+        v = model.plant.parameter(n).nominal
+        positive = any(t in n for t in (".Ki_", ".Ks_", ".kxx", ".kyy")) and v > 0
+        out[n] = (0.2 * v, 5 * v) if positive else (-np.inf, np.inf)
+    return out
 
 
 def fit_parameters(
@@ -251,6 +268,9 @@ def fit_parameters(
     """
     if not names:
         raise IdentificationError("fit: no parameter to fit (expected --params NAME,...)")
+    dup = sorted({n for n in names if list(names).count(n) > 1})
+    if dup:
+        raise IdentificationError(f"fit: parameter(s) named twice: {', '.join(dup)}")
     t0 = time.perf_counter()
     m0 = models[0]
     nominal, scale = [], []
@@ -268,19 +288,12 @@ def fit_parameters(
         scale.append(abs(p.nominal) if p.nominal != 0 else _DEFAULT_SCALE.get(p.unit, 1.0))
     nominal, scale = np.array(nominal), np.array(scale)
     init = np.array([(initial or {}).get(n, v) for n, v in zip(names, nominal)])
-    lo, hi = [], []
-    for n, v in zip(names, nominal):
-        if bounds and n in bounds:
-            b = bounds[n]
-        elif n == TAU_E:
-            b = (0.0, 0.05)
-        elif any(t in n for t in (".Ki_", ".Ks_", ".kxx", ".kyy")) and v > 0:
-            b = (0.2 * v, 5 * v)
-        else:
-            b = (-np.inf, np.inf)
-        lo.append(b[0])
-        hi.append(b[1])
-    lo, hi = np.array(lo), np.array(hi)
+    defaults = default_bounds(m0, names)
+    lo = np.array([(bounds or {}).get(n, defaults[n])[0] for n in names], dtype=float)
+    hi = np.array([(bounds or {}).get(n, defaults[n])[1] for n in names], dtype=float)
+    outside = [n for n, v, a, b in zip(names, init, lo, hi) if not a <= v <= b]
+    if outside:
+        raise IdentificationError(f"fit: start value of {', '.join(outside)} outside its bounds")
     init = np.clip(init, lo + 1e-12 * scale, hi - 1e-12 * scale)
 
     start, stop = window
@@ -324,6 +337,13 @@ def fit_parameters(
                         x_scale=1.0, max_nfev=max_nfev, xtol=1e-10, ftol=1e-10, gtol=1e-10)
     est = init + sol.x * scale
     converged = bool(sol.status > 0)
+    message = str(sol.message)
+    width = np.where(np.isfinite(hi - lo), hi - lo, np.inf)
+    at_bound = [n for n, v, a, b, w in zip(names, est, lo, hi, width)
+                if np.isfinite(w) and min(v - a, b - v) <= 1e-6 * w]
+    if at_bound:  # an estimate stopped by its bound is not an optimum of J(θ)
+        converged = False
+        message = f"estimate at its bound: {', '.join(at_bound)}"
 
     # covariance (sandwich with the residuals' spectrum) in scaled coordinates; rows of the
     # stacked residual vector are sample-major per record
@@ -351,13 +371,17 @@ def fit_parameters(
     e0, y0 = data[0][0], data[0][1]
     ys, is_ = models[0].simulate(dict(zip(names, est)), e0)
     fits = {f"{a}": v for a, v in zip(records[0].axes, nrmse_fit(y0, ys[start:]))}
+    bad_fit = [a for a, v in fits.items() if not np.isfinite(v) or v < 0]
+    if bad_fit and converged:  # worse than the mean: the model does not describe the data
+        converged = False
+        message = f"NRMSE fit below 0 % on {', '.join(bad_fit)}"
     if current_weight > 0:
         fi = nrmse_fit(data[0][3], is_[start:])
         fits.update({f"current_{a}": v for a, v in zip(records[0].axes, fi)})
     return FitResult(
         names=tuple(names), estimate=est, initial=init, std_error=se,
         ci95_low=est - 1.96 * se, ci95_high=est + 1.96 * se, correlation=corr,
-        nrmse_fit_pct=fits, converged=converged, message=str(sol.message),
+        nrmse_fit_pct=fits, converged=converged, message=message,
         iterations=int(sol.nfev), wall_time_s=time.perf_counter() - t0,
         time_s=np.asarray(records[0].time_s)[start:stop], y_meas=y0, y_sim=ys[start:],
         axes=tuple(records[0].axes),

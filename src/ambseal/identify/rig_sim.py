@@ -137,6 +137,11 @@ def simulate_facility(
     names = [a.rsplit("_", 1) for a in axes]
     ki = np.array([plant.parameter(f"{m}.Ki_{ax}").nominal for m, ax in names])
     ks = np.array([plant.parameter(f"{m}.Ks_{ax}").nominal for m, ax in names])
+    bad = [f"{m}.{q}_{ax}" for (m, ax), a, b in zip(names, ki, ks)
+           for q, v in (("Ki", a), ("Ks", b)) if not v > 0]
+    if bad:
+        raise ModelError(f"the virtual facility needs Ki > 0 and Ks > 0 for its force law "
+                         f"(differential driving at a bias current); not so for {', '.join(bad)}")
     i0 = truth.bias_current
     s0 = i0 * ki / ks
     kf = ki * s0**2 / (4 * i0)

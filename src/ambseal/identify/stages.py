@@ -9,12 +9,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..config import RigConfig, TruthSection
-from ..errors import DataError
+from ..errors import DataError, IdentificationError, ModelError
 from ..model.amb import actuator_matrices
 from ..model.reduction import modal_reduction
 from ..model.rig import build_system, mechanical_plant
-from .data import Measurement
-from .fit import TAU_E, ClosedLoopModel, FitResult, fit_parameters
+from .data import Measurement, validate_measurement
+from .fit import TAU_E, ClosedLoopModel, FitResult, default_bounds, fit_parameters
 from .loop import DiscreteController, discrete_controller
 from .rig_sim import simulate_facility
 from .signals import Excitation
@@ -52,20 +52,44 @@ def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<
     from ..control.pid import pid_controller
 
     c = meta.get("controller")
-    fs = meta.get("sample_rate_hz")
+    fs = _positive(meta, "sample_rate_hz", source)
     if not isinstance(c, dict) or "type" not in c:
         raise DataError(f"{source}: metadata.controller: expected a dict with 'type' "
                         "('pid' or 'state_space')")
     try:
         if c["type"] == "pid":
-            K = pid_controller(float(c["kp"]), float(c["ti"]), float(c["td"]), float(c["eps"]),
-                               axes)
-            return discrete_controller(K, 1.0 / float(fs), c.get("discretisation", "tustin"))
-        if c["type"] == "state_space":
-            return DiscreteController.from_dict(c)
+            kp, ti, td, eps = (float(c[k]) for k in ("kp", "ti", "td", "eps"))
+            if not (kp > 0 and ti > 0 and td >= 0 and eps > 0):
+                raise ValueError("expected kp > 0, ti > 0, td >= 0, eps > 0")
+            K = pid_controller(kp, ti, td, eps, axes)
+            ctrl = discrete_controller(K, 1.0 / fs, c.get("discretisation", "tustin"))
+        elif c["type"] == "state_space":
+            ctrl = DiscreteController.from_dict(c)
+        else:
+            raise DataError(f"{source}: metadata.controller.type: unknown {c['type']!r}")
     except (KeyError, TypeError, ValueError) as exc:
         raise DataError(f"{source}: metadata.controller: {exc}") from None
-    raise DataError(f"{source}: metadata.controller.type: unknown {c['type']!r}")
+    k = len(axes)
+    if ctrl.B.shape[1] != k or ctrl.D.shape != (k, k):
+        raise DataError(f"{source}: metadata.controller: expected {k} inputs and outputs "
+                        f"(axes {', '.join(axes)}), got D of shape {ctrl.D.shape}")
+    if abs(ctrl.dt * fs - 1.0) > 1e-6:
+        raise DataError(f"{source}: metadata.controller.dt: {ctrl.dt} s, but the record is "
+                        f"sampled at {fs} Hz (expected dt = {1 / fs} s)")
+    return ctrl
+
+
+def _positive(meta: dict, key: str, source: str, default: float | None = None) -> float:
+    """A finite metadata number (>= 0; > 0 without a default), or a DataError naming it."""
+    v = meta.get(key, default)
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        raise DataError(f"{source}: metadata.{key}: expected a number, got {v!r}") from None
+    if not np.isfinite(x) or x < 0 or (default is None and x == 0):
+        raise DataError(f"{source}: metadata.{key}: expected a finite positive number, "
+                        f"got {v!r}")
+    return x
 
 
 def acquire(cfg: RigConfig, truth: TruthSection, excitation: Excitation, *,
@@ -89,13 +113,16 @@ def acquire(cfg: RigConfig, truth: TruthSection, excitation: Excitation, *,
     Kd = controller_from_metadata(meta, axes)
     rec = simulate_facility(cfg, truth, np.asarray(excitation.values_a), excitation.sample_rate_hz,
                             Kd, pressure_bar=pressure_bar, seed=seed)
-    return Measurement(time_s=rec.time_s, excitation_a=rec.excitation_a,
+    meas = Measurement(time_s=rec.time_s, excitation_a=rec.excitation_a,
                        current_ref_a=rec.current_ref_a, current_a=rec.current_a,
                        displacement_m=rec.displacement_m, axes=axes, metadata=meta)
+    validate_measurement(meas, source="virtual facility record", axes=axes,
+                         current_limit_a=None)
+    return meas
 
 
-def _pressure_bar(meas: Measurement) -> float:
-    return float(meas.metadata.get("pressure_drop_pa", 0.0)) / 1e5
+def _pressure_bar(meas: Measurement, source: str = "<data>") -> float:
+    return _positive(dict(meas.metadata), "pressure_drop_pa", source, default=0.0) / 1e5
 
 
 def build_models(cfg: RigConfig, records: list[Measurement], values: dict | None = None,
@@ -107,9 +134,11 @@ def build_models(cfg: RigConfig, records: list[Measurement], values: dict | None
     tau = values.pop(TAU_E, cfg.actuator.eddy_time_constant)
     models = []
     for rec in records:
-        speed = rec.metadata.get("speed_rad_s")
+        meta = dict(rec.metadata)
+        speed = None if meta.get("speed_rad_s") is None else _positive(
+            meta, "speed_rad_s", "<data>", default=0.0)
         sys = build_system(cfg, pressure_bar=_pressure_bar(rec),
-                           speed_rpm=None if speed is None else float(speed) * 60 / (2 * np.pi))
+                           speed_rpm=None if speed is None else speed * 60 / (2 * np.pi))
         full = mechanical_plant(sys)
         if values:
             full = full.with_values(values)
@@ -135,12 +164,17 @@ def identify(cfg: RigConfig, records: list[Measurement], names: list[str], *,
     """
     known = dict(known or {})
     models = build_models(cfg, records, known)
-    res = fit_parameters(records, models, names, current_weight=current_weight, window=window)
+    try:
+        bounds = default_bounds(models[0], names)
+    except ModelError as exc:
+        raise IdentificationError(f"fit: {exc}") from None
+    res = fit_parameters(records, models, names, current_weight=current_weight, window=window,
+                         bounds=bounds)
     if refine and res.converged:
         est = dict(zip(names, res.estimate))
         models = build_models(cfg, records, {**known, **est})
         res2 = fit_parameters(records, models, names, current_weight=current_weight,
-                              window=window)
+                              window=window, bounds=bounds)
         if res2.converged:
             res = res2
     return res

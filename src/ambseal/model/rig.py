@@ -21,6 +21,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..config import RigConfig
+from ..errors import ModelError
 from .amb import actuator_matrices, axes_rotation, eddy_lag_matrices
 from .lft import Parameter, Plant
 from .rotor import X, Y, Mesh, assemble_rotor, build_mesh
@@ -74,10 +75,19 @@ class SecondOrderSystem:
     def n_dof(self) -> int:
         return self.M.shape[0]
 
+    def mass_factor(self):
+        """Cholesky factor of M; ModelError if M is not positive definite (e.g. a negative
+        seal mass coefficient)."""
+        try:
+            return sla.cho_factor(self.M)
+        except np.linalg.LinAlgError:
+            raise ModelError("the mass matrix is not positive definite (check disk masses "
+                             "and the seals' M coefficients)") from None
+
     def state_matrices(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(A, B, C) of the first-order form x = [q; q̇]."""
         n = self.n_dof
-        lu = sla.cho_factor(self.M)
+        lu = self.mass_factor()
         MiK = sla.cho_solve(lu, self.K)
         MiD = sla.cho_solve(lu, self.C + self.speed * self.G)
         MiB = sla.cho_solve(lu, self.B)
@@ -230,7 +240,7 @@ def mechanical_plant(sys: SecondOrderSystem) -> Plant:
     """
     A, B, C = sys.state_matrices()
     n, m = sys.n_dof, B.shape[1]
-    lu = sla.cho_factor(sys.M)
+    lu = sys.mass_factor()
     params: dict[str, Parameter] = {}
     for ch in sys.changes:
         MiU = sla.cho_solve(lu, ch.U)

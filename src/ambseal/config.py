@@ -96,6 +96,10 @@ class Material(_Strict):
     def _g_or_nu(self) -> "Material":
         if self.G is None and self.nu is None:
             raise ValueError("expected either G (Pa) or nu")
+        if self.G is not None and self.nu is not None:
+            if abs(self.E / (2 * (1 + self.nu)) / self.G - 1) > 0.01:
+                raise ValueError("G and nu disagree (expected G = E/(2(1+nu)) within 1 %; "
+                                 "give one of them)")
         return self
 
     @property

@@ -61,16 +61,7 @@ Parameters are *normalised* as in P1 ("θ = 1 corresponds to a 100 % change"): t
 SI is θ·scale, the scale being |nominal| by default. P1 §IV: a 50 % change of one bearing's
 Ks in one direction, θ = 0.5, identified as 0.502.
 
-Example
--------
->>> import numpy as np
->>> from ambseal.identify.coprime import coprime_factors, observer_gains
->>> A = np.array([[0.0, 1.0], [100.0, 0.0]]); B = np.array([[0.0], [1.0]])
->>> C = np.array([[1.0, 0.0]]); D = np.zeros((1, 1))
->>> F, L = observer_gains(A, B, C)
->>> cf = coprime_factors(A, B, C, D, F, L)
->>> cf.check_bezout() < 1e-9
-True
+The factorisation itself, with a runnable example, is in :mod:`ambseal.identify.coprime`.
 """
 
 from __future__ import annotations

@@ -124,7 +124,7 @@ def ross_modal(rs, speed_rpm: float):
 
 def ours_frf(omega: np.ndarray, **kw) -> np.ndarray:
     """(n_w, 4, 4): outputs A_x, A_y, B_x, B_y per input force at A, B (N)."""
-    from ambseal.analysis.freqresp import freqresp
+    from ambseal.lti.freqresp import freqresp
     from ambseal.config import parse_rig
     from ambseal.model.rig import build_plant
 
@@ -189,7 +189,7 @@ def main() -> int:
     rep_frf = 1 if ARGS.quick else 3
 
     t0 = time.perf_counter()
-    import ambseal.analysis.freqresp  # noqa: F401
+    import ambseal.lti.freqresp  # noqa: F401
     import ambseal.config  # noqa: F401
     import ambseal.model.modes  # noqa: F401
     import ambseal.model.rig  # noqa: F401

@@ -102,7 +102,8 @@ def testrig_cases(args) -> None:
     """The test-rig μ problem: closed loop of the generalised plant with the μ controller."""
     from ambseal.config import load_rig
     from ambseal.control.design import design
-    from ambseal.control.mu import freqresp, mussv
+    from ambseal.control.mu import mussv
+    from ambseal.lti.freqresp import freqresp
 
     cfg = load_rig()
     t0 = time.perf_counter()
@@ -172,7 +173,8 @@ def main() -> None:
     if args.only_testrig:
         return
 
-    from ambseal.control.mu import freqresp, mussv
+    from ambseal.control.mu import mussv
+    from ambseal.lti.freqresp import freqresp
 
     sys = rig_sized_system()
     w = np.logspace(np.log10(2 * np.pi * 1), np.log10(2 * np.pi * 2000), args.nfreq)

@@ -389,7 +389,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
 def _gains_figure(out: Path, designs: list, speed_hz: float) -> tuple[str, Path]:
     """Direct and cross gains of the designed controllers (P5 Fig. 10), at the operating
     speed for scheduled ones."""
-    from .analysis.freqresp import freqresp
+    from .lti.freqresp import freqresp
     from .report.figures import controller_gains_figure
 
     f = np.logspace(0, math.log10(2000.0), 300)

@@ -1,4 +1,4 @@
-"""Tests of ambseal.analysis.freqresp against python-control and direct dense solves."""
+"""Tests of ambseal.lti.freqresp against python-control and direct dense solves."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import control
 import numpy as np
 import pytest
 
-import ambseal.analysis.freqresp as fr
+import ambseal.lti.freqresp as fr
 from ambseal.errors import ModelError
 
 

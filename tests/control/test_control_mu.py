@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 import control as ct
 
-from ambseal.control.mu import freqresp, mussv
+from ambseal.control.mu import mussv
+from ambseal.lti.freqresp import freqresp
 
 
 def crandn(rng, *shape):

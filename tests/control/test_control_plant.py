@@ -5,7 +5,7 @@ import pytest
 import control as ct
 
 from ambseal.config import load_rig
-from ambseal.control.mu import freqresp
+from ambseal.lti.freqresp import freqresp
 from ambseal.control.plant import check_blocks, generalized_plant
 from ambseal.control.pid import pid_controller
 from ambseal.control.weights import control_weight, performance_weight

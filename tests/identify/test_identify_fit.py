@@ -6,7 +6,7 @@ import pytest
 from ambseal.config import Affine, TruthSection, load_rig
 from ambseal.errors import IdentificationError
 from ambseal.identify.fit import fit_parameters, nrmse_fit
-from ambseal.identify.loop import simulate_lti
+from ambseal.lti.discrete import simulate_lti
 from ambseal.identify.signals import prbs
 from ambseal.identify.stages import acquire, build_models, identify
 

@@ -79,6 +79,6 @@ def test_imports_stay_light():
     modules, which import python-control lazily) and ambseal.report.html without matplotlib."""
     code = ("import sys, ambseal, ambseal.analysis, ambseal.report, ambseal.report.html\n"
             "import ambseal.analysis.loops, ambseal.analysis.iso, ambseal.analysis.unbalance\n"
-            "import ambseal.analysis.response, ambseal.analysis.freqresp\n"
+            "import ambseal.analysis.response, ambseal.lti.freqresp\n"
             "assert 'matplotlib' not in sys.modules, 'matplotlib imported'\n")
     subprocess.run([sys.executable, "-c", code], check=True)

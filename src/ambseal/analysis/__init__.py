@@ -2,7 +2,7 @@
 
 Modules (import them directly; this package imports nothing heavy and no plotting):
 
-* :mod:`ambseal.analysis.freqresp` — fast frequency response of large state-space models;
+* :mod:`ambseal.analysis.spinup` — spin-up of a speed-scheduled rotor, frozen-speed S_o (P3 §4);
 * :mod:`ambseal.analysis.loops` — closed loop, poles, S_o, S_i, T_o, K S_o, compliance;
 * :mod:`ambseal.analysis.iso` — ISO 14839-3 zones from sensitivity peaks;
 * :mod:`ambseal.analysis.unbalance` — ISO 21940-11 unbalance force and response bound;

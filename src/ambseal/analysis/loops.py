@@ -23,9 +23,11 @@ from typing import Any
 
 import numpy as np
 
-from ambseal.analysis._util import as_omega, json_float, json_list, labels, ss_matrices
-from ambseal.analysis.freqresp import freqresp
+from ambseal.analysis._util import json_float, json_list
 from ambseal.errors import ModelError
+from ambseal.lti.freqresp import freqresp
+from ambseal.lti.interconnect import feedback_matrices
+from ambseal.lti.matrices import as_omega, labels, ss_matrices
 
 __all__ = [
     "ClosedLoop",
@@ -313,8 +315,8 @@ def closed_loop(G: Any, K: Any, Gf: Any | None = None, *, atol: float = 0.0) -> 
     """Close the loop ``u = −K y + d`` around ``G`` (and ``Gf`` sharing its states).
 
     Plant ``ẋ = A x + B u + B_f f``, ``y = C x + D u + D_f f``; controller
-    ``ẋ_K = A_K x_K + B_K y``, ``i = −(C_K x_K + D_K y)``, ``u = i + d``. A direct feedthrough
-    loop is resolved with ``(I + D D_K)⁻¹``. Same result as
+    ``ẋ_K = A_K x_K + B_K y``, ``i = −(C_K x_K + D_K y)``, ``u = i + d``, closed by
+    :func:`ambseal.lti.interconnect.feedback_matrices`. Same result as
     ``control.feedback(G, K, sign=-1)`` for the ``d → y`` channel (tested side by side).
 
     Parameters
@@ -356,25 +358,10 @@ def closed_loop(G: Any, K: Any, Gf: Any | None = None, *, atol: float = 0.0) -> 
     else:
         Bf, Df, nf = np.zeros((n, 0)), np.zeros((ny, 0)), 0
 
-    E = np.eye(ny) + D @ Dk
-    if np.linalg.cond(E) > 1e12:
-        raise ModelError("closed_loop: I + D·D_K is singular; the loop is ill-posed")
-    # y = Cy [x; xk] + Dyd d + Dyf f
-    Cy = np.linalg.solve(E, np.hstack([C, -D @ Ck]))
-    Dyd = np.linalg.solve(E, D)
-    Dyf = np.linalg.solve(E, Df)
-    # i = -(Ck xk + Dk y)
-    Ci = -np.hstack([np.zeros((nu, n)), Ck]) - Dk @ Cy
-    Did = -Dk @ Dyd
-    Dif = -Dk @ Dyf
-    Acl = np.block([[A, np.zeros((n, nk))], [np.zeros((nk, n)), Ak]])
-    Acl += np.vstack([B, np.zeros((nk, nu))]) @ Ci + np.vstack([np.zeros((n, ny)), Bk]) @ Cy
-    Bd = np.vstack([B, np.zeros((nk, nu))]) @ (np.eye(nu) + Did) + np.vstack([np.zeros((n, ny)), Bk]) @ Dyd
-    Bff = np.vstack([Bf, np.zeros((nk, nf))]) + np.vstack([B, np.zeros((nk, nu))]) @ Dif
-    Bff += np.vstack([np.zeros((n, ny)), Bk]) @ Dyf
-    Bcl = np.hstack([Bd, Bff])
-    Ccl = np.vstack([Cy, Ci])
-    Dcl = np.block([[Dyd, Dyf], [Did, Dif]])
+    try:
+        Acl, Bcl, Ccl, Dcl = feedback_matrices((A, B, C, D), (Ak, Bk, Ck, Dk), (Bf, Df))
+    except ModelError:
+        raise ModelError("closed_loop: I + D·D_K is singular; the loop is ill-posed") from None
 
     u_names = labels(G, "input", nu, "u")
     y_names = labels(G, "output", ny, "y")
@@ -392,7 +379,7 @@ def closed_loop(G: Any, K: Any, Gf: Any | None = None, *, atol: float = 0.0) -> 
 def loop_responses(G: Any, K: Any, omega: Any) -> LoopResponse:
     """S_o, S_i, T_o and K S_o of ``(G, K)`` on a frequency grid.
 
-    ``G(jω)`` and ``K(jω)`` come from :func:`ambseal.analysis.freqresp.freqresp`; the small
+    ``G(jω)`` and ``K(jω)`` come from :func:`ambseal.lti.freqresp.freqresp`; the small
     ``ny × ny`` / ``nu × nu`` inverses are batched ``numpy.linalg.solve`` calls over ω.
 
     Parameters

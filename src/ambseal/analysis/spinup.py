@@ -75,9 +75,10 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
-import scipy.linalg as sla
 
 from ..errors import ModelError
+from ..lti.discrete import zoh
+from ..lti.interconnect import feedback_matrices
 from .response import settling_time
 
 __all__ = ["StepResponse", "SpinupResult", "spinup", "FrozenSensitivity",
@@ -308,14 +309,13 @@ class _Loop:
         got = self._cache.get(W)
         if got is not None:
             return got
-        A = self.plant.A_at(W)
         AK, BK, CK, DK = (np.asarray(M, float) for M in self.Kfn(W))
-        B_i, C, E, n = self.B_i, self.C, self.E, self.n
-        B_iDK = B_i @ DK
-        Acl = np.block([[A - B_iDK @ C, -B_i @ CK], [BK @ C, AK]])
-        Bcl = np.vstack([np.hstack([self.B_f, np.zeros((n, C.shape[0]))]) - B_iDK @ E,
-                         BK @ E])
-        got = (Acl, Bcl, np.hstack([-DK @ C, -CK]), DK)
+        ny, ncur = self.C.shape[0], self.B_i.shape[1]
+        Bv = np.hstack([self.B_f, np.zeros((self.n, ny))])
+        Acl, Bcl, Ccl, _ = feedback_matrices(
+            (self.plant.A_at(W), self.B_i, self.C, np.zeros((ny, ncur))), (AK, BK, CK, DK),
+            (Bv, self.E))
+        got = (Acl, Bcl[:, ncur:], Ccl[ny:], DK)
         if len(self._cache) >= 8:
             self._cache.pop(next(iter(self._cache)))
         self._cache[W] = got
@@ -325,7 +325,6 @@ class _Loop:
 def _run_zoh(loop, wins, f0, f1, ramp_s, schedule_s, n_sub, dt, nt):
     """Exact piecewise ZOH stepping, Ω frozen at each scheduling period's midpoint."""
     N = loop.n + loop.nk
-    nv = loop.E.shape[1]
     ny = loop.C.shape[0]
     x = np.zeros(N)
     Y = np.zeros((nt, ny))
@@ -337,11 +336,8 @@ def _run_zoh(loop, wins, f0, f1, ramp_s, schedule_s, n_sub, dt, nt):
         v = starts.get(j, v)
         tm = (j + 0.5) * schedule_s
         Acl, Bcl, Cu, DK = loop(_TWO_PI * (f0 + (f1 - f0) * tm / ramp_s))
-        M = np.zeros((N + nv, N + nv))
-        M[:N, :N] = Acl * dt
-        M[:N, N:] = Bcl * dt
-        E = sla.expm(M)
-        Ad, bv = E[:N, :N], E[:N, N:] @ v
+        Ad, Bd = zoh(Acl, Bcl, dt)
+        bv = Bd @ v
         Ev = loop.E @ v
         i0 = j * n_sub
         for s in range(n_sub):
@@ -359,11 +355,8 @@ def _state_scale(loop, W0: float, vs, dt: float = 1e-4, n: int = 500) -> np.ndar
     """Each closed-loop state's largest |x_i| in the frozen loop's (Ω = W0) responses to the
     disturbance vectors ``vs`` over n·dt (the scale of the ODE's absolute tolerance)."""
     Acl, Bcl = loop(W0)[:2]
-    N, nv = Bcl.shape
-    M = np.zeros((N + nv, N + nv))
-    M[:N, :N], M[:N, N:] = Acl * dt, Bcl * dt
-    E = sla.expm(M)
-    Ad, Bd = E[:N, :N], E[:N, N:]
+    N = Bcl.shape[0]
+    Ad, Bd = zoh(Acl, Bcl, dt)
     scale = np.zeros(N)
     for v in vs:
         x, bv = np.zeros(N), Bd @ v

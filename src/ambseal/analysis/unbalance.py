@@ -22,7 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from ambseal.analysis._util import as_omega, json_float, json_list
+from ambseal.analysis._util import json_float, json_list
+from ambseal.lti.matrices import as_omega
 from ambseal.analysis.loops import ComplianceResponse, Peak, compliance, peak_of
 from ambseal.errors import ModelError
 

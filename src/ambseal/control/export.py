@@ -2,7 +2,7 @@
 
 The discrete forms are Tustin (bilinear) and zero-order-hold equivalents at the given sample
 rate (Franklin, Powell & Workman, *Digital Control of Dynamic Systems*, ch. 6), computed by
-:func:`control.sample_system`. Each file carries the channel names so a controller can be
+:func:`ambseal.lti.discrete.discretize`. Each file carries the channel names so a controller can be
 wired to the right AMB axes (``A_zeta``, ``A_eta``, ``B_zeta``, ``B_eta``) on the target.
 
 Files are written to a temporary name in the destination folder and moved into place with
@@ -15,10 +15,10 @@ import json
 from pathlib import Path
 from typing import Sequence
 
-import control as ct
 import numpy as np
 
 from ..files import atomic_write
+from ..lti.discrete import discretize as _discretize
 
 __all__ = ["discretize", "controller_arrays", "export_controller"]
 
@@ -27,21 +27,9 @@ _FORMATS = (".npz", ".mat", ".json")
 
 
 def discretize(K, fs_hz: float, method: str = "tustin"):
-    """Discrete-time equivalent of a continuous controller.
+    """Discrete-time equivalent of a continuous controller at a sample rate (Hz).
 
-    Parameters
-    ----------
-    K : control.StateSpace
-        Continuous-time controller.
-    fs_hz : float
-        Sample rate in Hz (> 0).
-    method : {"tustin", "zoh"}
-        Bilinear transform or zero-order-hold equivalent.
-
-    Returns
-    -------
-    control.StateSpace
-        Discrete system with ``dt = 1/fs_hz`` s and K's channel names.
+    :func:`ambseal.lti.discrete.discretize` at ``dt = 1/fs_hz``.
 
     Raises
     ------
@@ -50,13 +38,7 @@ def discretize(K, fs_hz: float, method: str = "tustin"):
     """
     if not (np.isfinite(fs_hz) and fs_hz > 0):
         raise ValueError(f"fs_hz={fs_hz!r}: the sample rate must be a positive number of Hz")
-    if method not in _METHODS:
-        raise ValueError(f"method={method!r}: expected one of {_METHODS}")
-    if K.isdtime(strict=True):
-        raise ValueError("discretize: K is already discrete-time")
-    Kd = ct.sample_system(ct.ss(K.A, K.B, K.C, K.D), 1.0 / fs_hz, method=method)
-    return ct.ss(Kd.A, Kd.B, Kd.C, Kd.D, 1.0 / fs_hz, inputs=list(K.input_labels),
-                 outputs=list(K.output_labels), name=f"{K.name}_{method}")
+    return _discretize(K, 1.0 / fs_hz, method)
 
 
 def controller_arrays(K, fs_hz: float | None = None,

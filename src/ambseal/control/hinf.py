@@ -32,9 +32,10 @@ import scipy.linalg as sla
 import control as ct
 
 from ambseal.errors import SynthesisError
-from ambseal.control.mu import _freqresp, freqresp  # noqa: F401  (numpy-only helpers)
+from ambseal.lti.freqresp import freqresp
+from ambseal.lti.interconnect import lft_lower
 
-__all__ = ["HinfResult", "hinfsyn", "hinfnorm", "lft_lower", "check_plant", "freqresp"]
+__all__ = ["HinfResult", "hinfsyn", "hinfnorm", "lft_lower", "check_plant"]
 
 _SB10AD_INFO = {
     1: "[A - jωI, B2; C1, D12] loses column rank on the imaginary axis (P12 has a jω zero)",
@@ -54,7 +55,7 @@ _SB10AD_INFO = {
 
 # --------------------------------------------------------------------------- norm
 def _sigma_max(A, B, C, D, w):
-    G = _freqresp(A, B, C, D, w)
+    G = freqresp((A, B, C, D), w)
     return np.linalg.norm(G, ord=2, axis=(-2, -1))
 
 
@@ -157,66 +158,6 @@ def hinfnorm(sys, rtol: float = 1e-7, max_iter: int = 100) -> tuple[float, float
             break
         g_lb, w_pk = float(sg[j]), float(mids[j])
     return g_lb, (0.0 if not np.isfinite(w_pk) else w_pk)
-
-
-# --------------------------------------------------------------------------- LFT
-def _names(sys, kind):
-    labels = getattr(sys, f"{kind}_labels", None)
-    return list(labels) if labels is not None else None
-
-
-def lft_lower(P, K, nmeas: int, ncon: int, name: str = "closed_loop"):
-    """Lower linear fractional transformation ``F_l(P, K)`` (Skogestad & Postlethwaite eq. 3.111).
-
-    Parameters
-    ----------
-    P : control.StateSpace
-        Generalised plant, inputs ``[w, u]`` and outputs ``[z, y]``.
-    K : control.StateSpace
-        Controller from ``y`` (``nmeas`` signals) to ``u`` (``ncon`` signals).
-    nmeas, ncon : int
-        Number of measurements and of control inputs (the last channels of ``P``).
-    name : str
-        Name of the returned system.
-
-    Returns
-    -------
-    control.StateSpace
-        Closed loop from ``w`` to ``z``; states ``[x_P, x_K]``; P's names for ``w``, ``z``.
-
-    Raises
-    ------
-    SynthesisError
-        If ``I - D22·Dk`` is singular (ill-posed loop).
-    """
-    A, B, C, D = (np.asarray(M, float) for M in (P.A, P.B, P.C, P.D))
-    Ak, Bk, Ck, Dk = (np.asarray(M, float) for M in (K.A, K.B, K.C, K.D))
-    nw, nz = B.shape[1] - ncon, C.shape[0] - nmeas
-    B1, B2 = B[:, :nw], B[:, nw:]
-    C1, C2 = C[:nz], C[nz:]
-    D11, D12, D21, D22 = D[:nz, :nw], D[:nz, nw:], D[nz:, :nw], D[nz:, nw:]
-    Rm = np.eye(nmeas) - D22 @ Dk  # y = Rm^{-1}(C2 x + D21 w + D22 Ck xk)
-    if np.linalg.cond(Rm) > 1e12:
-        raise SynthesisError("lft_lower: the loop is ill-posed, I - D22·Dk is singular")
-    Ri = np.linalg.inv(Rm)
-    # y = Ri (C2 x + D22 Ck xk + D21 w);   u = Ck xk + Dk y
-    Cy = np.hstack([Ri @ C2, Ri @ D22 @ Ck])
-    Dy = Ri @ D21
-    Cu = np.hstack([np.zeros((ncon, A.shape[0])), Ck]) + Dk @ Cy
-    Du = Dk @ Dy
-    Acl = np.block([[A, np.zeros((A.shape[0], Ak.shape[0]))],
-                    [np.zeros((Ak.shape[0], A.shape[0])), Ak]])
-    Acl = Acl + np.vstack([B2, np.zeros((Ak.shape[0], ncon))]) @ Cu
-    Acl = Acl + np.vstack([np.zeros((A.shape[0], nmeas)), Bk]) @ Cy
-    Bcl = np.vstack([B1 + B2 @ Du, Bk @ Dy])
-    Ccl = np.hstack([C1, np.zeros((nz, Ak.shape[0]))]) + D12 @ Cu
-    Dcl = D11 + D12 @ Du
-    inp = _names(P, "input")
-    out = _names(P, "output")
-    kw: dict[str, Any] = {"name": name}
-    if inp is not None and out is not None:
-        kw.update(inputs=inp[:nw], outputs=out[:nz])
-    return ct.ss(Acl, Bcl, Ccl, Dcl, **kw)
 
 
 # --------------------------------------------------------------------------- checks

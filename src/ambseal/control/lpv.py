@@ -43,6 +43,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..errors import SynthesisError
+from ..lti.interconnect import lft_lower_matrices
 
 __all__ = ["LpvController", "LpvSynResult", "lpvsyn", "SolverReport"]
 
@@ -583,7 +584,7 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
     check_g = []
     stable = True
     for W in table:
-        Acl, Bcl, Ccl, Dcl = _closed_loop(Aint(W), B, C, D, nw, nz, *K.matrices(W))
+        Acl, Bcl, Ccl, Dcl = lft_lower_matrices((Aint(W), B, C, D), K.matrices(W), C.shape[0] - nz, B.shape[1] - nw)
         if np.max(np.linalg.eigvals(Acl).real) >= 0:
             check_g.append(np.inf)
             stable = False
@@ -593,7 +594,7 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
         check_g.append(hinfnorm(ct.ss(Acl, Bcl, Ccl, Dcl), rtol=1e-5)[0])
     mids = 0.5 * (table[1:] + table[:-1])
     for W in mids:
-        Acl = _closed_loop(Aint(W), B, C, D, nw, nz, *K.matrices(W))[0]
+        Acl = lft_lower_matrices((Aint(W), B, C, D), K.matrices(W), C.shape[0] - nz, B.shape[1] - nw)[0]
         stable &= bool(np.max(np.linalg.eigvals(Acl).real) < 0)
     if not stable:
         raise SynthesisError(
@@ -631,18 +632,6 @@ def _interp_A(As, dAs, grid):
               <= 1e-6 * max(np.linalg.norm(chord), 1e-300))
         return herm if ok else lin
     return f
-
-
-def _closed_loop(A, B, C, D, nw, nz, AK, BK, CK, DK):
-    """F_l(P, K) with u = K y, D22 = 0."""
-    B1, B2 = B[:, :nw], B[:, nw:]
-    C1, C2 = C[:nz], C[nz:]
-    D11, D12, D21 = D[:nz, :nw], D[:nz, nw:], D[nz:, :nw]
-    Acl = np.block([[A + B2 @ DK @ C2, B2 @ CK], [BK @ C2, AK]])
-    Bcl = np.vstack([B1 + B2 @ DK @ D21, BK @ D21])
-    Ccl = np.hstack([C1 + D12 @ DK @ C2, D12 @ CK])
-    Dcl = D11 + D12 @ DK @ D21
-    return Acl, Bcl, Ccl, Dcl
 
 
 class _Reconstructor:

@@ -34,11 +34,11 @@ from dataclasses import dataclass, field
 from typing import Sequence
 
 import numpy as np
-import scipy.linalg as sla
 
 from ambseal.control._mu_upper import upper_bound as _upper_bound
+from ambseal.lti.freqresp import freqresp
 
-__all__ = ["MuResult", "mussv", "parse_blocks", "freqresp"]
+__all__ = ["MuResult", "mussv", "parse_blocks"]
 
 
 # --------------------------------------------------------------------------- blocks
@@ -157,34 +157,6 @@ class MuResult:
 
 
 # --------------------------------------------------------------------------- helpers
-def freqresp(sys, omega) -> np.ndarray:
-    """Frequency response of a state-space system, shape ``(len(omega), p, m)``.
-
-    Parameters
-    ----------
-    sys : control.StateSpace
-        Continuous-time system.
-    omega : array_like
-        Frequencies in rad/s.
-    """
-    return _freqresp(*(np.asarray(X, float) for X in (sys.A, sys.B, sys.C, sys.D)), omega)
-
-
-def _freqresp(A, B, C, D, omega):
-    w = np.atleast_1d(np.asarray(omega, float))
-    if A.shape[0] == 0:
-        return np.broadcast_to(D.astype(complex), (w.size,) + D.shape).copy()
-    # diagonal balancing (FE plants span 1 … 1e12; Parlett & Reinsch 1969), then an
-    # orthogonal Hessenberg reduction for the batched solves
-    A, (sc, _) = sla.matrix_balance(A, permute=False, separate=True)
-    B, C = B / sc[:, None], C * sc[None, :]
-    H, Q = sla.hessenberg(A, calc_q=True)
-    Bq, Cq = Q.T @ B, C @ Q
-    X = np.linalg.solve(1j * w[:, None, None] * np.eye(A.shape[0]) - H,
-                        np.broadcast_to(Bq, (w.size,) + Bq.shape))
-    return Cq @ X + D
-
-
 def _herm(X):
     return 0.5 * (X + np.conj(np.swapaxes(X, -1, -2)))
 

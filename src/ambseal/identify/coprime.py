@@ -31,7 +31,8 @@ import scipy.linalg as sla
 
 from ..errors import DataError, IdentificationError
 from ..model.lft import Plant
-from .loop import zoh
+from ..lti.discrete import zoh
+from ..lti.freqresp import freqresp_at
 
 __all__ = ["CoprimeFactors", "observer_gains", "coprime_factors", "youla_factorisation",
            "check_bezout"]
@@ -57,22 +58,6 @@ def _is_stable(A: np.ndarray, dt: float | None, margin: float = 0.0) -> bool:
     if dt is None:
         return bool(np.all(lam.real < -margin))
     return bool(np.all(np.abs(lam) < 1.0 - margin))
-
-
-def _freqresp(A, B, C, D, pts: np.ndarray) -> np.ndarray:
-    """C (pI − A)⁻¹ B + D at complex points ``pts`` (nf,), vectorised; shape (nf, p, m).
-
-    The realisation is first balanced by a diagonal similarity (``scipy.linalg.
-    matrix_balance``): AMB plants in modal coordinates mix O(1) and O(1e6) entries.
-    """
-    n = A.shape[0]
-    if n == 0:
-        return np.broadcast_to(D, (len(pts),) + D.shape).astype(complex)
-    _, (sc, _) = sla.matrix_balance(A, permute=False, separate=True)
-    A, B, C = A * (sc[None, :] / sc[:, None]), B / sc[:, None], C * sc[None, :]
-    P = pts[:, None, None] * np.eye(n)[None] - A[None]
-    X = np.linalg.solve(P, np.broadcast_to(B, (len(pts),) + B.shape))
-    return C[None] @ X + D[None]
 
 
 def _as_2d(x, name: str, n_cols: int, n_rows: int | None = None) -> np.ndarray:
@@ -357,8 +342,7 @@ class CoprimeFactors:
         pts = self.points(omega)
 
         def fr(sys):
-            return _freqresp(np.asarray(sys.A), np.asarray(sys.B), np.asarray(sys.C),
-                             np.asarray(sys.D), pts)
+            return freqresp_at(sys, pts, method="hessenberg")  # accurate to rounding
 
         Mf, Nf, Uf, Vf = fr(self.M()), fr(self.N()), fr(self.U()), fr(self.V())
         Vt, Ut, Nt, Mt = fr(self.V_tilde()), fr(self.U_tilde()), fr(self.N_tilde()), fr(self.M_tilde())

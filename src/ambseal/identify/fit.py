@@ -30,7 +30,8 @@ from scipy.optimize import least_squares
 from ..errors import IdentificationError
 from ..model.amb import eddy_lag_matrices
 from ..model.lft import Plant
-from .loop import DiscreteController, closed_loop_matrices, simulate_lti, zoh
+from ..lti.discrete import simulate_lti, zoh
+from .loop import DiscreteController, closed_loop_matrices
 
 __all__ = ["FitResult", "ClosedLoopModel", "fit_parameters", "default_bounds", "nrmse_fit"]
 

@@ -40,6 +40,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from ambseal.errors import DataError, IdentificationError
+from ambseal.lti.freqresp import freqresp_at
 
 __all__ = [
     "FRF",
@@ -489,8 +490,8 @@ def model_frf(
     """Evaluate a linear model on a frequency grid, for comparison with a measured FRF.
 
     ``H(f) = C (sI − A)⁻¹ B + D`` at ``s = j2πf`` (continuous) or ``z = exp(j2πf·dt)``
-    (discrete), evaluated by :meth:`control.StateSpace.horner` (SLICOT ``TB05AD`` when
-    slycot is installed — the Hessenberg method of Laub, IEEE TAC 26(2), 1981).
+    (discrete), evaluated by :func:`ambseal.lti.freqresp.freqresp_at` (modal, or
+    the Hessenberg method of Laub, IEEE TAC 26(2), 1981).
 
     Parameters
     ----------
@@ -540,8 +541,7 @@ def model_frf(
         if f.max() > 0.5 / dt_info * (1 + 1e-12):
             raise ValueError(f"frequency_hz: {f.max()} Hz is above the Nyquist frequency {0.5 / dt_info} Hz of sys")
         x = np.exp(2j * np.pi * f * dt_info)
-    H = np.asarray(sys.horner(x, warn_infinite=False)).reshape(sys.noutputs, sys.ninputs, f.size)
-    H = np.transpose(H, (2, 0, 1))
+    H = freqresp_at(sys, x)
     ins = tuple(input_names) if input_names is not None else tuple(sys.input_labels)
     outs = tuple(output_names) if output_names is not None else tuple(sys.output_labels)
     if len(ins) != sys.ninputs:

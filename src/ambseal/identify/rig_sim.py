@@ -35,7 +35,8 @@ from ..errors import ModelError
 from ..model.amb import actuator_matrices, eddy_lag_matrices
 from ..model.reduction import modal_reduction
 from ..model.rig import build_system, mechanical_plant
-from .loop import DiscreteController, zoh
+from ..lti.discrete import zoh
+from .loop import DiscreteController
 
 __all__ = ["FacilityRecord", "simulate_facility"]
 

@@ -77,7 +77,7 @@ from ..errors import IdentificationError
 from ..model.lft import Plant
 from .coprime import (CoprimeFactors, _as_2d, _ss, check_bezout, coprime_factors,
                       observer_gains, youla_factorisation)
-from .loop import simulate_lti, zoh
+from ..lti.discrete import simulate_lti, zoh
 
 __all__ = [
     "CoprimeFactors",

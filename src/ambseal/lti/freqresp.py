@@ -29,13 +29,13 @@ from typing import Any, Literal
 import numpy as np
 import scipy.linalg
 
-from ambseal.analysis._util import as_omega, ss_matrices
 from ambseal.errors import ModelError
+from ambseal.lti.matrices import as_omega, ss_matrices
 
-__all__ = ["freqresp"]
+__all__ = ["freqresp", "freqresp_at"]
 
-_CHUNK_BYTES = 32 * 2**20
-_USE_SLYCOT = True  # set False (tests) to force the pure-numpy Hessenberg solver  # memory budget of one Hessenberg chunk (complex n×n per frequency)
+_CHUNK_BYTES = 32 * 2**20  # memory budget of one chunk (complex n×n per frequency)
+_USE_SLYCOT = True  # set False (tests) to force the pure-numpy Hessenberg solver
 
 
 def freqresp(
@@ -91,12 +91,54 @@ def freqresp(
     """
     w = as_omega(omega)
     A, B, C, D = ss_matrices(sys)
+    return _response(A, B, C, D, 1j * w, method, max_cond, rtol)
+
+
+def freqresp_at(
+    sys: Any,
+    points: Any,
+    *,
+    method: Literal["auto", "modal", "hessenberg"] = "auto",
+    max_cond: float = 1e8,
+    rtol: float = 1e-8,
+) -> np.ndarray:
+    """``C (pI − A)⁻¹ B + D`` at arbitrary complex points ``p``, by the method of :func:`freqresp`.
+
+    For a discrete-time model pass ``p = exp(jω dt)`` (the unit circle); for a continuous
+    one ``p = jω`` (what :func:`freqresp` does) or any ``s`` off the axis.
+
+    Parameters
+    ----------
+    sys : control.StateSpace (continuous or discrete) or tuple (A, B, C, D)
+        ``n`` states, ``nu`` inputs, ``ny`` outputs.
+    points : array_like of complex, shape (n_p,)
+        Evaluation points (finite).
+    method, max_cond, rtol
+        As for :func:`freqresp`.
+
+    Returns
+    -------
+    numpy.ndarray of complex, shape (n_p, ny, nu)
+
+    Raises
+    ------
+    ModelError
+        Non-finite points or inconsistent shapes.
+    """
+    pts = np.atleast_1d(np.asarray(points, dtype=complex))
+    if pts.ndim != 1 or not np.all(np.isfinite(pts)):
+        raise ModelError("freqresp_at: expected a 1-D array of finite complex points")
+    A, B, C, D = ss_matrices(sys, allow_discrete=True)
+    return _response(A, B, C, D, pts, method, max_cond, rtol)
+
+
+def _response(A, B, C, D, s, method, max_cond, rtol) -> np.ndarray:
+    """The evaluation shared by :func:`freqresp` and :func:`freqresp_at` at points ``s``."""
     if method not in ("auto", "modal", "hessenberg"):
         raise ModelError(f"freqresp: method must be 'auto', 'modal' or 'hessenberg', got {method!r}")
-    s = 1j * w
     n = A.shape[0]
     if n == 0:
-        return np.broadcast_to(D.astype(complex), (w.size, *D.shape)).copy()
+        return np.broadcast_to(D.astype(complex), (s.size, *D.shape)).copy()
     if method == "hessenberg":
         return _hessenberg_response(A, B, C, D, s)
 
@@ -112,7 +154,7 @@ def freqresp(
     Bm = scipy.linalg.solve(V, B.astype(complex))
     Cm = C @ V
     if method == "auto":
-        probe = s[np.unique([0, w.size // 2, w.size - 1])]
+        probe = s[np.unique([0, s.size // 2, s.size - 1])]
         Hm = _modal_eval(lam, Bm, Cm, D, probe)
         Hh = _hessenberg_response(A, B, C, D, probe)
         with np.errstate(invalid="ignore"):

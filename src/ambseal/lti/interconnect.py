@@ -1,0 +1,151 @@
+"""Closing loops: the lower linear fractional transformation and AMB negative feedback.
+
+One implementation serves every stage: the H∞/μ/LPV syntheses close ``F_l(P, K)``
+(Skogestad & Postlethwaite, *Multivariable Feedback Control*, 2nd ed., Eq. 3.111, with a
+general ``D22``), and the AMB loop ``u = −K y + d`` of the analyses and of the digital loop of
+the identification is the same transformation of an augmented plant
+(:func:`feedback_matrices`). The algebra does not depend on the time base, so the same
+functions close continuous and discrete loops.
+
+python-control's ``control.lft`` and ``control.feedback`` compute the same systems (tested side
+by side); these matrix-level versions exist because the synthesis loops (D–K, LPV checks,
+spin-up tabulation) close thousands of loops and need neither signal bookkeeping nor object
+construction, and because ``control.feedback`` has no separate force inputs.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ambseal.errors import ModelError
+from ambseal.lti.matrices import labels, ss_matrices
+
+__all__ = ["lft_lower_matrices", "lft_lower", "feedback_matrices"]
+
+Matrices = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+def lft_lower_matrices(P: Matrices, K: Matrices, nmeas: int, ncon: int) -> Matrices:
+    """``F_l(P, K)`` with positive feedback ``u = K y`` (Skogestad & Postlethwaite Eq. 3.111).
+
+    Parameters
+    ----------
+    P : (A, B, C, D)
+        Generalised plant, inputs ``[w, u]`` (``ncon`` last), outputs ``[z, y]`` (``nmeas`` last).
+    K : (A_K, B_K, C_K, D_K)
+        Controller from ``y`` to ``u``.
+    nmeas, ncon : int
+        Number of measurements and control inputs.
+
+    Returns
+    -------
+    (A_cl, B_cl, C_cl, D_cl)
+        The loop from ``w`` to ``z``, state ``[x_P; x_K]``.
+
+    Raises
+    ------
+    ModelError
+        If ``I − D22·D_K`` is singular (an ill-posed loop).
+    """
+    A, B, C, D = P
+    Ak, Bk, Ck, Dk = K
+    n, nk = A.shape[0], Ak.shape[0]
+    nw, nz = B.shape[1] - ncon, C.shape[0] - nmeas
+    B1, B2 = B[:, :nw], B[:, nw:]
+    C1, C2 = C[:nz], C[nz:]
+    D11, D12, D21, D22 = D[:nz, :nw], D[:nz, nw:], D[nz:, :nw], D[nz:, nw:]
+    Rm = np.eye(nmeas) - D22 @ Dk
+    if np.linalg.cond(Rm) > 1e12:
+        raise ModelError("the loop is ill-posed: I - D22·D_K is singular")
+    Ri = np.linalg.inv(Rm)
+    # y = Ri (C2 x + D22 C_K x_K + D21 w);   u = C_K x_K + D_K y
+    Cy = np.hstack([Ri @ C2, Ri @ D22 @ Ck])
+    Dy = Ri @ D21
+    Cu = np.hstack([np.zeros((ncon, n)), Ck]) + Dk @ Cy
+    Du = Dk @ Dy
+    Acl = np.block([[A, np.zeros((n, nk))], [np.zeros((nk, n)), Ak]])
+    Acl = Acl + np.vstack([B2, np.zeros((nk, ncon))]) @ Cu
+    Acl = Acl + np.vstack([np.zeros((n, nmeas)), Bk]) @ Cy
+    Bcl = np.vstack([B1 + B2 @ Du, Bk @ Dy])
+    Ccl = np.hstack([C1, np.zeros((nz, nk))]) + D12 @ Cu
+    Dcl = D11 + D12 @ Du
+    return Acl, Bcl, Ccl, Dcl
+
+
+def lft_lower(P: Any, K: Any, nmeas: int, ncon: int, name: str = "closed_loop"):
+    """``F_l(P, K)`` as a ``control.StateSpace`` keeping P's names for ``w`` and ``z``.
+
+    Parameters
+    ----------
+    P, K : control.StateSpace
+        Generalised plant (inputs ``[w, u]``, outputs ``[z, y]``) and controller ``u = K y``,
+        of the same time base.
+    nmeas, ncon : int
+        Number of measurements and of control inputs (the last channels of ``P``).
+    name : str
+        Name of the returned system.
+
+    Returns
+    -------
+    control.StateSpace
+        Closed loop from ``w`` to ``z``; states ``[x_P, x_K]``.
+
+    Raises
+    ------
+    ModelError
+        If ``I − D22·D_K`` is singular (ill-posed loop).
+    """
+    import control
+
+    mats = lft_lower_matrices(ss_matrices(P, name="P", allow_discrete=True),
+                              ss_matrices(K, name="K", allow_discrete=True), nmeas, ncon)
+    nw, nz = mats[1].shape[1], mats[2].shape[0]
+    inputs = labels(P, "input", nw + ncon, "w")[:nw]
+    outputs = labels(P, "output", nz + nmeas, "z")[:nz]
+    return control.ss(*mats, getattr(P, "dt", 0) or 0, inputs=list(inputs),
+                      outputs=list(outputs), name=name)
+
+
+def feedback_matrices(G: Matrices, K: Matrices, Gf: tuple[np.ndarray, np.ndarray] | None = None
+                      ) -> Matrices:
+    """The AMB loop ``u = −K y + d`` (plus external inputs ``f``) as one state space.
+
+    Plant ``ẋ = A x + B u + B_f f``, ``y = C x + D u + D_f f``; controller
+    ``ẋ_K = A_K x_K + B_K y``, ``i = −(C_K x_K + D_K y)``, ``u = i + d`` (thesis P5 Fig. 8:
+    the controller maps displacements to current references, negative feedback). Computed as
+    :func:`lft_lower_matrices` of the plant augmented with the outputs ``i`` and the
+    controller ``−K``; the same as ``control.feedback(G, K, sign=-1)`` on the ``d → y``
+    channel.
+
+    Parameters
+    ----------
+    G : (A, B, C, D)
+        Plant, ``nu`` current inputs → ``ny`` outputs.
+    K : (A_K, B_K, C_K, D_K)
+        Controller, ``ny`` inputs → ``nu`` outputs.
+    Gf : (B_f, D_f), optional
+        Further plant inputs sharing ``A`` and ``C`` (forces, sensor offsets).
+
+    Returns
+    -------
+    (A_cl, B_cl, C_cl, D_cl)
+        Inputs ``[d, f]``, outputs ``[y, i]``, state ``[x; x_K]``.
+
+    Raises
+    ------
+    ModelError
+        If ``I + D·D_K`` is singular (an ill-posed loop).
+    """
+    A, B, C, D = G
+    Ak, Bk, Ck, Dk = K
+    ny, nu = D.shape
+    Bf, Df = Gf if Gf is not None else (np.zeros((A.shape[0], 0)), np.zeros((ny, 0)))
+    nf = Bf.shape[1]
+    BP = np.hstack([B, Bf, B])
+    CP = np.vstack([C, np.zeros((nu, A.shape[0])), C])
+    DP = np.block([[D, Df, D],
+                   [np.zeros((nu, nu + nf)), np.eye(nu)],
+                   [D, Df, D]])
+    return lft_lower_matrices((A, BP, CP, DP), (Ak, Bk, -Ck, -Dk), ny, nu)

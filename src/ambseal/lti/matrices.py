@@ -1,0 +1,74 @@
+"""Checks and conversions of state-space data shared by every stage (not public API).
+
+* :func:`ss_matrices` — ``(A, B, C, D)`` as float arrays from a ``control.StateSpace`` (or
+  anything python-control converts) or a tuple;
+* :func:`as_omega` — a checked frequency grid in rad/s;
+* :func:`labels` — signal names of a python-control system, or generated ones.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ambseal.errors import ModelError
+
+__all__ = ["as_omega", "ss_matrices", "labels"]
+
+
+def as_omega(omega: Any, *, name: str = "omega") -> np.ndarray:
+    """Check and return a 1-D float frequency grid in rad/s.
+
+    Raises
+    ------
+    ModelError
+        If the grid is not 1-D, empty, or holds non-finite or negative values.
+    """
+    w = np.atleast_1d(np.asarray(omega, dtype=float))
+    if w.ndim != 1 or w.size == 0:
+        raise ModelError(f"{name}: expected a non-empty 1-D frequency grid in rad/s, got shape {w.shape}")
+    if not np.all(np.isfinite(w)) or np.any(w < 0):
+        raise ModelError(f"{name}: frequencies must be finite and >= 0 rad/s")
+    return w
+
+
+def ss_matrices(sys: Any, *, name: str = "sys",
+                allow_discrete: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Return (A, B, C, D) as float arrays of an LTI system.
+
+    Accepts a ``control.StateSpace`` (or anything python-control converts to one, e.g. a
+    transfer function) or a tuple ``(A, B, C, D)``.
+
+    Raises
+    ------
+    ModelError
+        If the system is discrete-time (unless ``allow_discrete``) or the shapes disagree.
+    """
+    if isinstance(sys, tuple) and len(sys) == 4:
+        A, B, C, D = (np.atleast_2d(np.asarray(m, dtype=float)) for m in sys)
+    else:
+        import control
+
+        if not isinstance(sys, control.StateSpace):
+            try:
+                sys = control.ss(sys)
+            except Exception as exc:  # pragma: no cover - message only
+                raise ModelError(f"{name}: cannot convert {type(sys).__name__} to state space: {exc}") from exc
+        if sys.dt not in (0, None) and not allow_discrete:
+            raise ModelError(f"{name}: expected a continuous-time system (dt=0), got dt={sys.dt}")
+        A, B, C, D = (np.asarray(m, dtype=float) for m in (sys.A, sys.B, sys.C, sys.D))
+    n = A.shape[0]
+    if A.shape != (n, n) or B.shape[0] != n or C.shape[1] != n or D.shape != (C.shape[0], B.shape[1]):
+        raise ModelError(
+            f"{name}: inconsistent state-space shapes A{A.shape} B{B.shape} C{C.shape} D{D.shape}"
+        )
+    return A, B, C, D
+
+
+def labels(sys: Any, kind: str, count: int, prefix: str) -> tuple[str, ...]:
+    """Input or output labels of a python-control system, or generated ones."""
+    names = getattr(sys, f"{kind}_labels", None)
+    if names is not None and len(names) == count:
+        return tuple(str(s) for s in names)
+    return tuple(f"{prefix}[{i}]" for i in range(count))

@@ -46,6 +46,7 @@ def main() -> None:
     from ambseal.identify.loop import closed_loop_matrices, discrete_controller
     from ambseal.lti.discrete import zoh
     from ambseal.identify.signals import prbs
+    from ambseal.control.pid import reference_controller
     from ambseal.identify.stages import acquire, build_models, identify
     from ambseal.model.rig import build_plant
 
@@ -56,7 +57,7 @@ def main() -> None:
     truth = TruthSection(parameters=true, tau_e=2e-4, noise_fraction=0.01, adc_bits=16)
     ex = prbs(amplitude_a=0.05, clock_period_s=1e-3, duration_s=1.0, sample_rate_hz=1e4, seed=1)
     print("acquiring 1 s at 10 kHz from the virtual facility ...", file=sys.stderr)
-    rec = acquire(cfg, truth, ex, pressure_bar=0.0, seed=1)
+    rec = acquire(cfg, truth, ex, controller=reference_controller(cfg), pressure_bar=0.0, seed=1)
 
     times, ident_times = [], []
     for _ in range(args.repeats):

@@ -98,11 +98,13 @@ def _acquire(args: argparse.Namespace) -> int:
     from .errors import ConfigError
     from .identify import signals
     from .identify.data import save_measurement
+    from .control.pid import reference_controller
     from .identify.stages import acquire
+    from .model.amb import channel_names
 
     cfg = load_rig(args.rig)
     truth = load_truth(args.truth)
-    axes = tuple(f"{m.name}_{x}" for m in cfg.amb for x in ("zeta", "eta"))
+    axes = channel_names(cfg)
     if not axes:
         raise ConfigError(f"{args.rig}: amb: acquisition needs at least one [[amb]]")
     excited = args.axes.split(",") if args.axes else None
@@ -125,7 +127,8 @@ def _acquire(args: argparse.Namespace) -> int:
                                  start_s=args.start_s, duration_s=args.duration_s, **common)
     except ValueError as exc:
         raise ConfigError(f"acquire: {exc}") from None
-    meas = acquire(cfg, truth, ex, pressure_bar=args.pressure_bar, seed=args.seed)
+    meas = acquire(cfg, truth, ex, controller=reference_controller(cfg),
+                   pressure_bar=args.pressure_bar, seed=args.seed)
     path = save_measurement(meas, args.out)
     print(json.dumps({"out": str(path), "samples": meas.n_samples,
                       "sample_rate_hz": fs}))
@@ -133,7 +136,7 @@ def _acquire(args: argparse.Namespace) -> int:
 
 
 def _design(args: argparse.Namespace) -> int:
-    from .pipeline import design_files
+    from .commands import design_files
 
     print(json.dumps(design_files(args.rig, args.method, args.out,
                                   pressure_bar=args.pressure_bar)))
@@ -141,7 +144,7 @@ def _design(args: argparse.Namespace) -> int:
 
 
 def _identify(args: argparse.Namespace) -> int:
-    from .pipeline import identify_files
+    from .commands import identify_files
 
     summary = identify_files(args.rig, args.data, args.params.split(","), args.out,
                              current_weight=args.current_weight, refine=not args.no_refine)

@@ -5,6 +5,7 @@ import pytest
 
 from ambseal.config import TruthSection, load_rig
 from ambseal.identify.signals import prbs
+from ambseal.control.pid import reference_controller
 from ambseal.identify.stages import acquire, identify
 
 TRUE = {"A.Ki_zeta": 205.0, "A.Ki_eta": 201.0, "B.Ki_zeta": 254.0, "B.Ki_eta": 271.0,
@@ -24,7 +25,8 @@ def test_intervals_cover_the_truth_over_50_noise_seeds():
     true = np.array([TRUE.get(n, 2e-4) for n in NAMES])
     inside = []
     for seed in range(50):
-        rec = acquire(cfg, truth, ex, pressure_bar=0.0, seed=1000 + seed)
+        rec = acquire(cfg, truth, ex,
+                      controller=reference_controller(cfg), pressure_bar=0.0, seed=1000 + seed)
         res = identify(cfg, [rec], NAMES)
         inside.append((res.ci95_low <= true) & (true <= res.ci95_high))
     coverage = np.mean(inside)

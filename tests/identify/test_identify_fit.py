@@ -8,6 +8,7 @@ from ambseal.errors import IdentificationError
 from ambseal.identify.fit import fit_parameters, nrmse_fit
 from ambseal.lti.discrete import simulate_lti
 from ambseal.identify.signals import prbs
+from ambseal.control.pid import reference_controller
 from ambseal.identify.stages import acquire, build_models, identify
 
 TRUE = {"A.Ki_zeta": 205.0, "A.Ki_eta": 201.0, "B.Ki_zeta": 254.0, "B.Ki_eta": 271.0,
@@ -32,7 +33,7 @@ def truth():
 def prbs_fit(rig, truth):
     ex = prbs(amplitude_a=0.05, clock_period_s=1e-3, duration_s=1.0, sample_rate_hz=1e4,
               seed=3)
-    rec = acquire(rig, truth, ex, pressure_bar=0.0, seed=3)
+    rec = acquire(rig, truth, ex, controller=reference_controller(rig), pressure_bar=0.0, seed=3)
     return rec, identify(rig, [rec], AMB + ["tau_e"])
 
 
@@ -78,7 +79,7 @@ def test_seal_k_at_nominal_pressure(rig, truth, prbs_fit):
     _, amb = prbs_fit
     ex = prbs(amplitude_a=0.05, clock_period_s=1e-3, duration_s=1.0, sample_rate_hz=1e4,
               seed=4)
-    rec = acquire(rig, truth, ex, pressure_bar=2.04, seed=4)
+    rec = acquire(rig, truth, ex, controller=reference_controller(rig), pressure_bar=2.04, seed=4)
     res = identify(rig, [rec], ["seal.k", "seal.K", "seal.C", "seal.c"],
                    known=dict(zip(amb.names, amb.estimate)), refine=False)
     assert res.value("seal.k") == pytest.approx(SEAL_K_PER_BAR * 2.04, rel=0.05)
@@ -95,7 +96,7 @@ def test_parallel_excitation_correlates_ki_and_ks(rig, truth):
     from dataclasses import replace
 
     ex = replace(ex, values_a=vals)
-    rec = acquire(rig, truth, ex, pressure_bar=0.0, seed=7)
+    rec = acquire(rig, truth, ex, controller=reference_controller(rig), pressure_bar=0.0, seed=7)
     res = identify(rig, [rec], AMB + ["tau_e"], refine=False)
     for m in "AB":
         for x in ("zeta", "eta"):

@@ -7,7 +7,8 @@ from ambseal.config import TruthSection, load_rig, parse_rig, rig_with_values
 from ambseal.errors import DataError, IdentificationError, ModelError
 from ambseal.identify.fit import _long_run_covariance, fit_parameters
 from ambseal.identify.signals import prbs
-from ambseal.identify.stages import acquire, build_models, controller_from_metadata, identify
+from ambseal.control.pid import controller_from_metadata, reference_controller
+from ambseal.identify.stages import acquire, build_models, identify
 
 AXES = ("A_zeta", "A_eta", "B_zeta", "B_eta")
 
@@ -20,7 +21,8 @@ def rig():
 @pytest.fixture(scope="module")
 def record(rig):
     ex = prbs(amplitude_a=0.05, clock_period_s=1e-3, duration_s=0.3, sample_rate_hz=1e4, seed=2)
-    return acquire(rig, TruthSection(noise_fraction=0.01), ex, pressure_bar=0.0, seed=2)
+    return acquire(rig, TruthSection(noise_fraction=0.01), ex,
+                   controller=reference_controller(rig), pressure_bar=0.0, seed=2)
 
 
 def test_long_run_covariance_white_residuals_closed_form():
@@ -76,7 +78,8 @@ def test_estimate_stopped_at_a_bound_is_not_converged(rig, record):
 def test_facility_refuses_non_positive_ks(rig):
     ex = prbs(amplitude_a=0.05, clock_period_s=1e-3, duration_s=0.05, sample_rate_hz=1e4)
     with pytest.raises(ModelError, match="A.Ks_zeta"):
-        acquire(rig, TruthSection(parameters={"A.Ks_zeta": 0.0}), ex, pressure_bar=0.0)
+        acquire(rig, TruthSection(parameters={"A.Ks_zeta": 0.0}), ex,
+                controller=reference_controller(rig), pressure_bar=0.0)
 
 
 def test_identified_factor_of_a_geometry_amb_is_kept(rig):

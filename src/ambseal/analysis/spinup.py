@@ -72,10 +72,10 @@ step response settles in ≈ 9 ms to its DC value).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
+from ..control.controller import frozen, matrices_at
 from ..errors import ModelError
 from ..lti.discrete import zoh
 from ..lti.interconnect import feedback_matrices
@@ -158,16 +158,6 @@ class SpinupResult:
                 "outputs": list(self.outputs)}
 
 
-def _controller_fn(K) -> Callable[[float], tuple]:
-    """(A_K, B_K, C_K, D_K)(Ω rad/s), physical, i = −(C_K x_K + D_K y)."""
-    if hasattr(K, "matrices_at"):
-        return K.matrices_at
-    if callable(K) and not hasattr(K, "A"):
-        return K
-    mats = tuple(np.asarray(M, float) for M in (K.A, K.B, K.C, K.D))
-    return lambda W: mats
-
-
 def _windows(n_sched: int, n_per: int, n_sub: int, schedule_s: float, nf: int, ny: int,
              force_input: int, channel: int, force_n: float, output_m: float) -> list:
     """[(kind, t_k, i0, i1, v)]: step k at t_k, samples i0 … i1 (i1 is the next window's
@@ -202,9 +192,9 @@ def spinup(plant, controller, *, name: str = "K", speeds_hz=(20.0, 300.0),
         Plant with current inputs first and force inputs after them
         (``lpv_plant(cfg, grid, force_positions=(amb_A_position,))``), D = 0 for the
         currents; its grid must cover ``speeds_hz``.
-    controller : LpvDesign, control.StateSpace or callable
-        Scheduled controller (anything with ``matrices_at(Ω)``, or a callable Ω →
-        (A_K, B_K, C_K, D_K)) or a fixed one (m → A, negative feedback ``i = −K y``).
+    controller : control.StateSpace or ScheduledController
+        Fixed or scheduled controller (:mod:`ambseal.control.controller`: m → A, negative
+        feedback ``i = −K y``).
     name : str
         Label.
     speeds_hz : (float, float)
@@ -261,7 +251,9 @@ def spinup(plant, controller, *, name: str = "K", speeds_hz=(20.0, 300.0),
                          f"{force_input}; build it with force_positions")
     if np.any(plant.D[:, :ncur] != 0):
         raise ModelError("spinup: the plant has a direct current feedthrough (D ≠ 0)")
-    Kfn = _controller_fn(controller)
+    def Kfn(W):
+        return matrices_at(controller, W)
+
     f0, f1 = (float(x) for x in speeds_hz)
     loop = _Loop(plant, Kfn, ncur, _TWO_PI * f0)
     nt = n_sched * n_sub + 1
@@ -515,8 +507,8 @@ def frozen_sensitivity(cfg, controller, speeds_hz, *, name: str = "K", omega=Non
     Parameters
     ----------
     cfg : RigConfig
-    controller : LpvDesign (``controller_at(speed_hz)``) or control.StateSpace
-        Physical controller(s), m → A, negative feedback.
+    controller : control.StateSpace or ScheduledController
+        Physical controller (:mod:`ambseal.control.controller`), m → A, negative feedback.
     speeds_hz : array_like
     omega : array_like, optional
         Frequencies (rad/s); default 400 points log-spaced 1 Hz … 3 kHz.
@@ -546,7 +538,7 @@ def frozen_sensitivity(cfg, controller, speeds_hz, *, name: str = "K", omega=Non
         if G is None:
             G = build_plant(cfg, speed_rpm=60.0 * f).to_statespace()
             cache[float(f)] = G
-        K = controller.controller_at(f) if hasattr(controller, "controller_at") else controller
+        K = frozen(controller, _TWO_PI * f)
         loop = closed_loop(G, K)
         stab.append(bool(loop.stable))
         ws = resolved_grid(w, loop.poles) if resolve else w

@@ -35,6 +35,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from ..errors import ConfigError, SynthesisError
+from ..model.amb import channel_names
 
 __all__ = ["DesignWeights", "DesignResult", "design", "default_weights", "METHODS"]
 
@@ -255,7 +256,7 @@ def _pid(cfg, p):
     pid = getattr(getattr(cfg, "controller", None), "pid", None)
     if pid is None:
         raise ConfigError("design(method='pid'): the rig has no [controller.pid] section")
-    chans = tuple(f"{a.name}_{ax}" for a in cfg.amb for ax in ("zeta", "eta"))
+    chans = channel_names(cfg)
     K = pid_controller(pid.kp, pid.ti, pid.td, pid.eps, chans)
     return DesignResult("pid", K, p, order=int(K.nstates), order_full=int(K.nstates))
 

@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import SynthesisError
+from .controller import ScheduledController
 
 __all__ = ["LpvWeights", "LpvDesign", "FrozenDesign", "design_lpv", "design_frozen",
            "lpv_generalized_plants"]
@@ -86,7 +87,7 @@ class LpvWeights:
 
 
 @dataclass(frozen=True, eq=False)
-class LpvDesign:
+class LpvDesign(ScheduledController):
     """A speed-scheduled controller for a rig and how it was obtained.
 
     Attributes
@@ -137,18 +138,25 @@ class LpvDesign:
     def order(self) -> int:
         return self.K.order
 
-    def controller_at(self, speed_hz: float, name: str = "K_lpv"):
-        """Frozen physical controller at Ω/2π = ``speed_hz``: a ``control.StateSpace``
+    @property
+    def schedule_rad_s(self) -> tuple[float, float]:
+        return (_TWO_PI * float(self.speeds_hz[0]), _TWO_PI * float(self.speeds_hz[-1]))
+
+    def at(self, speed_rad_s: float, name: str = "K_lpv"):
+        """Frozen physical controller at Ω (rad/s): a ``control.StateSpace``
         from displacements (m) to current references (A), negative feedback ``i = −K y``
-        (:meth:`ambseal.control.plant.GeneralizedPlant.physical_controller`)."""
+        (:mod:`ambseal.control.controller`)."""
         import control
 
-        A, B, C, D = self.K.matrices(_TWO_PI * float(speed_hz))
-        g = -self.weights.d_u / self.weights.d_e
+        A, B, C, D = self.matrices_at(speed_rad_s)
         chans = [n[2:] if n.startswith("y_") else n for n in self.K.input_names]
-        return control.ss(A, B, g * C, g * D, inputs=[f"y_{c}" for c in chans],
+        return control.ss(A, B, C, D, inputs=[f"y_{c}" for c in chans],
                           outputs=[f"u_{c}" for c in chans],
                           states=[f"xK{i}" for i in range(A.shape[0])], name=name)
+
+    def controller_at(self, speed_hz: float, name: str = "K_lpv"):
+        """:meth:`at` with the speed in Hz."""
+        return self.at(_TWO_PI * float(speed_hz), name)
 
     def matrices_at(self, speed_rad_s: float) -> tuple[np.ndarray, ...]:
         """Physical (A_K, B_K, C_K, D_K) at Ω (rad/s), i = −(C_K x_K + D_K y)."""

@@ -14,7 +14,7 @@ which :func:`ambseal.lti.discrete.simulate_lti` runs as an exact block recursion
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -26,21 +26,32 @@ __all__ = ["DiscreteController", "discrete_controller", "closed_loop_matrices"]
 
 @dataclass(frozen=True)
 class DiscreteController:
-    """x_c,k+1 = A x_c,k + B y_k, u_k = C x_c,k + D y_k at ``dt`` (s); i_ref = −u + e."""
+    """x_c,k+1 = A x_c,k + B y_k, u_k = C x_c,k + D y_k at ``dt`` (s); i_ref = −u + e.
+
+    ``description`` (optional) says what the matrices are, e.g. the PID parameters they
+    were discretised from; it is written with them into a record's metadata.
+    """
 
     A: np.ndarray
     B: np.ndarray
     C: np.ndarray
     D: np.ndarray
     dt: float
+    description: dict | None = field(default=None, compare=False)
 
     def to_dict(self) -> dict:
-        return {"type": "state_space", "dt": self.dt,
-                **{k: getattr(self, k).tolist() for k in "ABCD"}}
+        """``{"type": "state_space", dt, A, B, C, D}``, or the description with these
+        under ``"state_space"``."""
+        ss = {"type": "state_space", "dt": self.dt,
+              **{k: getattr(self, k).tolist() for k in "ABCD"}}
+        return {**self.description, "state_space": ss} if self.description else ss
 
     @classmethod
     def from_dict(cls, d: dict) -> "DiscreteController":
         """From ``to_dict()`` output; raises ValueError on a malformed dict."""
+        if isinstance(d.get("state_space"), dict):
+            desc = {k: v for k, v in d.items() if k != "state_space"}
+            return replace(cls.from_dict(d["state_space"]), description=desc)
         try:
             mats = [np.atleast_2d(np.asarray(d[k], dtype=float)) for k in "ABCD"]
             dt = float(d["dt"])

@@ -18,8 +18,10 @@ from typing import Callable
 import numpy as np
 
 from ..config import Affine, RigConfig, TruthSection, rig_with_values
+from ..model.amb import channel_names
 from .fit import TAU_E, FitResult
 from .signals import impulse, prbs, stepped_sine
+from .loop import DiscreteController
 from .stages import acquire, identify
 from .stats import linear_regression
 
@@ -90,6 +92,7 @@ def _subset(res: FitResult, names: list[str]) -> FitResult:
 def thesis_procedure(
     cfg: RigConfig,
     truth: TruthSection,
+    controller: DiscreteController,
     *,
     seed: int = 0,
     sine_frequencies_hz: tuple[float, ...] = (10, 30, 50, 70, 90, 110, 130, 150, 170, 190),
@@ -104,6 +107,9 @@ def thesis_procedure(
         The rig as modelled (its values are the fit's start).
     truth : TruthSection
         The facility's true values (never read by a fit).
+    controller : DiscreteController
+        The digital controller that levitates the rotor in every run (the rig's reference
+        PID: :func:`ambseal.control.pid.reference_controller`).
     seed : int
         Seed of excitations and noise.
     progress : callable, optional
@@ -111,7 +117,7 @@ def thesis_procedure(
     """
     say = progress or (lambda _msg: None)
     fs = cfg.controller.sample_rate_hz
-    axes = tuple(f"{a.name}_{x}" for a in cfg.amb for x in ("zeta", "eta"))
+    axes = channel_names(cfg)
     ambs = [a.name for a in cfg.amb]
     seal = cfg.seal[0].name if cfg.seal else None
     spring = (cfg.spring[0].name or "spring0") if cfg.spring else None
@@ -120,7 +126,7 @@ def thesis_procedure(
     say("identification (a): Ki, Ks and tau_e from PRBS at 0 bar")
     ex = prbs(amplitude_a=0.05, clock_period_s=1e-3, duration_s=1.0, sample_rate_hz=fs,
               axes=axes, seed=seed)
-    rec_a = acquire(cfg, truth, ex, pressure_bar=0.0, seed=seed)
+    rec_a = acquire(cfg, truth, ex, controller=controller, pressure_bar=0.0, seed=seed)
     names_a = [f"{m}.{q}_{x}" for m in ambs for q in ("Ki", "Ks") for x in ("zeta", "eta")]
     names_a.append(TAU_E)
     amb = identify(cfg, [rec_a], names_a)
@@ -132,7 +138,7 @@ def thesis_procedure(
         say("identification (b): coupling stiffness from a second PRBS run")
         ex = prbs(amplitude_a=0.05, clock_period_s=1e-3, duration_s=1.0, sample_rate_hz=fs,
                   axes=axes, seed=seed + 1)
-        rec_b = acquire(cfg, truth, ex, pressure_bar=0.0, seed=seed + 1)
+        rec_b = acquire(cfg, truth, ex, controller=controller, pressure_bar=0.0, seed=seed + 1)
         records["b"] = rec_b
         names_b = [f"{spring}.kxx", f"{spring}.kyy"]
         coupling = identify(cfg, [rec_b], names_b, known=known)
@@ -156,7 +162,7 @@ def thesis_procedure(
             say(f"identification (c): seal coefficients by stepped sine at {p:g} bar")
             ex = stepped_sine(frequencies_hz=sine_frequencies_hz, amplitude_a=0.05, cycles=10,
                               settling_cycles=5, sample_rate_hz=fs, axes=axes, excited=zeta)
-            rec = acquire(cfg, truth, ex, pressure_bar=p, seed=seed + 2)
+            rec = acquire(cfg, truth, ex, controller=controller, pressure_bar=p, seed=seed + 2)
             seal_freq[p] = [
                 (f, identify(cfg, [rec], names_s, known=known, window=(a, b), refine=False))
                 for f, a, b in ex.windows
@@ -165,7 +171,7 @@ def thesis_procedure(
             say(f"identification (c): seal coefficients by impulse at {p:g} bar")
             ex = impulse(amplitude_a=0.05, width_s=0.01, start_s=0.05, duration_s=0.4,
                          sample_rate_hz=fs, axes=axes, excited=zeta)
-            rec = acquire(cfg, truth, ex, pressure_bar=p, seed=seed + 10 + i)
+            rec = acquire(cfg, truth, ex, controller=controller, pressure_bar=p, seed=seed + 10 + i)
             seal_press.append((p, identify(cfg, [rec], names_s, known=known, refine=False)))
         for j, c in enumerate(SEAL_COEFFICIENTS):
             regression[c] = linear_regression(

@@ -15,11 +15,11 @@ from ..model.reduction import modal_reduction
 from ..model.rig import build_system, mechanical_plant
 from .data import Measurement, validate_measurement
 from .fit import TAU_E, ClosedLoopModel, FitResult, default_bounds, fit_parameters
-from .loop import DiscreteController, discrete_controller
+from .loop import DiscreteController
 from .rig_sim import simulate_facility
 from .signals import Excitation
 
-__all__ = ["pid_metadata", "controller_from_metadata", "acquire", "build_models", "identify",
+__all__ = ["controller_from_metadata", "check_controller", "sample_rate_of", "acquire", "build_models", "identify",
            "FIT_CUTOFF_HZ"]
 
 #: Modes kept in the fit's reduced model (Hz). The rigid-body modes alone (8 states, P2 §3.2)
@@ -28,47 +28,42 @@ __all__ = ["pid_metadata", "controller_from_metadata", "acquire", "build_models"
 FIT_CUTOFF_HZ = 10000.0
 
 
-def pid_metadata(cfg: RigConfig) -> dict:
-    """The ``controller`` metadata of a record taken with the rig's reference PID."""
-    if cfg.controller.pid is None:
-        raise DataError("controller.pid: the rig has no reference PID to run the acquisition")
-    p = cfg.controller.pid
-    return {"type": "pid", "kp": p.kp, "ti": p.ti, "td": p.td, "eps": p.eps,
-            "discretisation": "tustin"}
-
-
 def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<data>"
                              ) -> DiscreteController:
     """The digital controller that ran, from a record's ``controller`` metadata.
 
-    ``{"type": "pid", kp, ti, td, eps, "discretisation": "tustin"|"zoh"}`` (P5 Eq. 6 at the
-    record's sample rate) or ``{"type": "state_space", A, B, C, D, dt}``.
+    ``{"type": "state_space", A, B, C, D, dt}``, or any description (e.g. the PID of
+    ``ambseal acquire``) carrying these under ``"state_space"``. A description without its
+    matrices (``{"type": "pid", kp, ti, td, eps}`` from a real rig) is turned into them by
+    :func:`ambseal.control.pid.controller_from_metadata`, which the ``identify`` command
+    calls: the identification stage takes the controller, it does not design one.
 
     Raises
     ------
     DataError
         Missing or malformed controller metadata, naming the file.
     """
-    from ..control.pid import pid_controller
-
     c = meta.get("controller")
-    fs = _positive(meta, "sample_rate_hz", source)
+    fs = sample_rate_of(meta, source)
     if not isinstance(c, dict) or "type" not in c:
         raise DataError(f"{source}: metadata.controller: expected a dict with 'type' "
                         "('pid' or 'state_space')")
+    if c["type"] != "state_space" and not isinstance(c.get("state_space"), dict):
+        raise DataError(f"{source}: metadata.controller.type: {c['type']!r} is unknown here, "
+                        "or a description without its state space; pass the controller "
+                        "(ambseal.control.pid.controller_from_metadata builds a PID's, as "
+                        "`ambseal identify` does)")
     try:
-        if c["type"] == "pid":
-            kp, ti, td, eps = (float(c[k]) for k in ("kp", "ti", "td", "eps"))
-            if not (kp > 0 and ti > 0 and td >= 0 and eps > 0):
-                raise ValueError("expected kp > 0, ti > 0, td >= 0, eps > 0")
-            K = pid_controller(kp, ti, td, eps, axes)
-            ctrl = discrete_controller(K, 1.0 / fs, c.get("discretisation", "tustin"))
-        elif c["type"] == "state_space":
-            ctrl = DiscreteController.from_dict(c)
-        else:
-            raise DataError(f"{source}: metadata.controller.type: unknown {c['type']!r}")
+        ctrl = DiscreteController.from_dict(c)
     except (KeyError, TypeError, ValueError) as exc:
         raise DataError(f"{source}: metadata.controller: {exc}") from None
+    return check_controller(ctrl, axes, fs, source)
+
+
+def check_controller(ctrl: DiscreteController, axes: tuple[str, ...], fs: float,
+                     source: str = "<data>") -> DiscreteController:
+    """``ctrl`` if it has one input and output per axis and runs at ``fs`` (Hz), else a
+    DataError naming ``source``."""
     k = len(axes)
     if ctrl.B.shape[1] != k or ctrl.D.shape != (k, k):
         raise DataError(f"{source}: metadata.controller: expected {k} inputs and outputs "
@@ -77,6 +72,11 @@ def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<
         raise DataError(f"{source}: metadata.controller.dt: {ctrl.dt} s, but the record is "
                         f"sampled at {fs} Hz (expected dt = {1 / fs} s)")
     return ctrl
+
+
+def sample_rate_of(meta: dict, source: str = "<data>") -> float:
+    """A record's ``sample_rate_hz`` metadata (Hz), or a DataError naming ``source``."""
+    return _positive(meta, "sample_rate_hz", source)
 
 
 def _positive(meta: dict, key: str, source: str, default: float | None = None) -> float:
@@ -93,8 +93,17 @@ def _positive(meta: dict, key: str, source: str, default: float | None = None) -
 
 
 def acquire(cfg: RigConfig, truth: TruthSection, excitation: Excitation, *,
-            pressure_bar: float, seed: int = 0, controller: dict | None = None) -> Measurement:
-    """Run the virtual facility and return the record as a :class:`Measurement`."""
+            controller: DiscreteController, pressure_bar: float, seed: int = 0) -> Measurement:
+    """Run the virtual facility with ``controller`` levitating the rotor and return the
+    record as a :class:`Measurement` (the controller in its metadata).
+
+    Raises
+    ------
+    DataError
+        A controller that does not fit the axes or the excitation's sample rate.
+    ModelError
+        See :func:`~ambseal.identify.rig_sim.simulate_facility`.
+    """
     axes = excitation.axes
     meta = {
         "rig": cfg.rotor.name,
@@ -102,7 +111,7 @@ def acquire(cfg: RigConfig, truth: TruthSection, excitation: Excitation, *,
         "bias_current_a": truth.bias_current,
         "pressure_drop_pa": pressure_bar * 1e5,
         "speed_rad_s": cfg.speed,
-        "controller": controller or pid_metadata(cfg),
+        "controller": controller.to_dict(),
         "excitation": excitation.params,
         "source": "virtual test facility",
     }
@@ -110,7 +119,7 @@ def acquire(cfg: RigConfig, truth: TruthSection, excitation: Excitation, *,
     limit = truth.current_limit or (min(limits) if limits else None)
     if limit:
         meta["current_limit_a"] = limit
-    Kd = controller_from_metadata(meta, axes)
+    Kd = check_controller(controller, axes, excitation.sample_rate_hz, "acquire: controller")
     rec = simulate_facility(cfg, truth, np.asarray(excitation.values_a), excitation.sample_rate_hz,
                             Kd, pressure_bar=pressure_bar, seed=seed)
     meas = Measurement(time_s=rec.time_s, excitation_a=rec.excitation_a,
@@ -126,14 +135,18 @@ def _pressure_bar(meas: Measurement, source: str = "<data>") -> float:
 
 
 def build_models(cfg: RigConfig, records: list[Measurement], values: dict | None = None,
-                 cutoff_hz: float = FIT_CUTOFF_HZ) -> list[ClosedLoopModel]:
+                 cutoff_hz: float = FIT_CUTOFF_HZ, controllers: list | None = None
+                 ) -> list[ClosedLoopModel]:
     """One closed-loop model per record: the rig at the record's pressure and speed, with
     parameter ``values`` (SI) applied exactly in full order, reduced to the modes below
-    ``cutoff_hz``, the amplifier and τ_e lag in series and the controller that ran."""
+    ``cutoff_hz``, the amplifier and τ_e lag in series and the controller that ran
+    (``controllers``, one per record, or each record's metadata)."""
     values = dict(values or {})
     tau = values.pop(TAU_E, cfg.actuator.eddy_time_constant)
     models = []
-    for rec in records:
+    if controllers is None:
+        controllers = [controller_from_metadata(dict(r.metadata), r.axes) for r in records]
+    for rec, Kd in zip(records, controllers):
         meta = dict(rec.metadata)
         speed = None if meta.get("speed_rad_s") is None else _positive(
             meta, "speed_rad_s", "<data>", default=0.0)
@@ -143,14 +156,14 @@ def build_models(cfg: RigConfig, records: list[Measurement], values: dict | None
         if values:
             full = full.with_values(values)
         plant = modal_reduction(full, cutoff_hz=cutoff_hz).plant
-        Kd = controller_from_metadata(dict(rec.metadata), rec.axes)
         models.append(ClosedLoopModel(plant, actuator_matrices(cfg.actuator), Kd, tau_e=tau))
     return models
 
 
 def identify(cfg: RigConfig, records: list[Measurement], names: list[str], *,
              known: dict | None = None, current_weight: float = 0.0, refine: bool = True,
-             window: tuple[int, int | None] = (0, None)) -> FitResult:
+             window: tuple[int, int | None] = (0, None), controllers: list | None = None
+             ) -> FitResult:
     """Fit ``names`` to closed-loop records (P2 Eqs. 9–10, P4 Eq. 14).
 
     Parameters
@@ -161,9 +174,11 @@ def identify(cfg: RigConfig, records: list[Measurement], names: list[str], *,
         Fit again on a model re-reduced at the first estimate: the reduced LFT is exact only
         at the point of reduction (P2 §4.1 assumes it holds nearby), so the second pass
         removes that approximation from the estimate.
+    controllers : list of DiscreteController, optional
+        The controller that ran for each record; by default from the records' metadata.
     """
     known = dict(known or {})
-    models = build_models(cfg, records, known)
+    models = build_models(cfg, records, known, controllers=controllers)
     try:
         bounds = default_bounds(models[0], names)
     except ModelError as exc:
@@ -172,7 +187,7 @@ def identify(cfg: RigConfig, records: list[Measurement], names: list[str], *,
                          bounds=bounds)
     if refine and res.converged:
         est = dict(zip(names, res.estimate))
-        models = build_models(cfg, records, {**known, **est})
+        models = build_models(cfg, records, {**known, **est}, controllers=controllers)
         res2 = fit_parameters(records, models, names, current_weight=current_weight,
                               window=window, bounds=bounds)
         if res2.converged:

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..config import Actuator
 
-__all__ = ["axes_rotation", "actuator_matrices", "eddy_lag_matrices"]
+__all__ = ["axes_rotation", "actuator_matrices", "eddy_lag_matrices", "channel_names", "AXES"]
 
 
 def axes_rotation(angle_deg: float) -> np.ndarray:
@@ -50,3 +50,13 @@ def eddy_lag_matrices(tau_e: float) -> tuple[np.ndarray, np.ndarray, np.ndarray,
     if tau_e <= 0:
         return np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.ones((1, 1))
     return np.array([[-1.0 / tau_e]]), np.array([[1.0 / tau_e]]), np.ones((1, 1)), np.zeros((1, 1))
+
+
+#: The two actuator axes of every AMB (ζ, η: x, y rotated by ``axes_angle_deg``).
+AXES = ("zeta", "eta")
+
+
+def channel_names(cfg) -> tuple[str, ...]:
+    """The AMB channels of a rig in the model's order, ``<amb>_zeta``, ``<amb>_eta`` per AMB
+    (the plant's current inputs and displacement outputs; e.g. ``A_zeta … B_eta``)."""
+    return tuple(f"{a.name}_{x}" for a in cfg.amb for x in AXES)

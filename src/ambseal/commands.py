@@ -1,0 +1,129 @@
+"""The ``design`` and ``identify`` commands: load, call the stage, write the files.
+
+Wiring only, like :mod:`ambseal.pipeline`: every number comes from :mod:`ambseal.control`
+and :mod:`ambseal.identify`, every figure from :mod:`ambseal.report`, every file through a
+temporary name and a rename (:mod:`ambseal.files`).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from .config import load_rig
+from .errors import ConfigError
+from .files import write_json, write_text
+
+__all__ = ["design_files", "identify_files", "export_design"]
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
+
+
+def export_design(method: str, controller, summary_dict: dict, out: Path, fs_hz: float,
+                  speeds_hz=()) -> list[Path]:
+    """Write a designed controller and its design summary (``design_<method>.json``).
+
+    A fixed controller as ``controller_<method>.json/.npz/.mat`` (continuous, Tustin and
+    ZOH at ``fs_hz``); a scheduled one as its frozen controllers at ``speeds_hz``
+    (``controller_<method>_<f>Hz.npz``), the table a real-time target interpolates.
+    """
+    from .control.controller import ScheduledController, frozen
+    from .control.export import export_controller
+
+    if isinstance(controller, ScheduledController):
+        files = [export_controller(frozen(controller, 2 * math.pi * f),
+                                   out / f"controller_{method}_{f:g}Hz.npz", fs_hz=fs_hz)
+                 for f in speeds_hz]
+    else:
+        files = [export_controller(controller, out / f"controller_{method}{ext}", fs_hz=fs_hz)
+                 for ext in (".json", ".npz", ".mat")]
+    files.append(write_json(out / f"design_{method}.json", summary_dict))
+    return files
+
+
+def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
+                 pressure_bar: float | None = None) -> dict:
+    """``ambseal design``: design one controller and write it with its summary.
+
+    Files: ``controller_<method>.json``, ``.npz`` and ``.mat`` (continuous, Tustin and ZOH
+    at ``[controller] sample_rate_hz``, with the channel names) and ``design_<method>.json``
+    (summary, weights, D–K history). ``lpv`` (a rig with ``[operating] speed_range_hz``):
+    the frozen controllers on the design grid, ``controller_lpv_<f>Hz.npz``.
+
+    Raises
+    ------
+    ConfigError
+        A bad rig, or ``lpv`` without a speed range.
+    """
+    from .control.design import design
+
+    cfg = load_rig(rig)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    fs = cfg.controller.sample_rate_hz
+    if method == "lpv":
+        from .control.lpv_design import design_lpv
+
+        if cfg.operating.speed_range_hz is None:
+            raise ConfigError(f"{rig}: operating.speed_range_hz: an LPV design needs the "
+                              "speed range it is scheduled over, e.g. [20.0, 300.0]")
+        lpv = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz)
+        files = export_design("lpv", lpv, lpv.to_dict(), out, fs,
+                              [float(f) for f in lpv.speeds_hz])
+        return {**lpv.to_dict(), "files": [str(f) for f in files]}
+    res = design(cfg, method, pressure_bar=pressure_bar)
+    files = export_design(res.method, res.K, res.to_dict(), out, fs)
+    return {**res.summary(), "files": [str(f) for f in files]}
+
+
+def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: str | Path, *,
+                   current_weight: float = 0.0, refine: bool = True) -> dict:
+    """``ambseal identify``: fit ``names`` to recorded files; write the fit, its figures and
+    the identified rig to ``out_dir``. Returns a JSON-safe summary.
+
+    Raises
+    ------
+    ConfigError, DataError, IdentificationError
+        A bad rig, a bad or mismatched record, or a fit that cannot start.
+    """
+    from .config import dump_rig, rig_with_values
+    from .control.pid import controller_from_metadata
+    from .errors import DataError
+    from .identify.data import load_measurement
+    from .identify.stages import identify
+    from .model.amb import channel_names
+    from .report.identify_figures import correlation_figure, fit_timeseries_figure
+
+    cfg = load_rig(rig)
+    axes = channel_names(cfg)
+    records, controllers = [], []
+    for path in data:
+        meas = load_measurement(path, axes=axes, min_samples=max(100, 10 * len(names)))
+        other = meas.metadata.get("rig")
+        if other is not None and other != cfg.rotor.name:
+            raise DataError(f"{path}: metadata.rig: recorded on {other!r}, but the rig is "
+                            f"{cfg.rotor.name!r}")
+        records.append(meas)
+        controllers.append(controller_from_metadata(dict(meas.metadata), axes, str(path)))
+    res = identify(cfg, records, names, current_weight=current_weight, refine=refine,
+                   controllers=controllers)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    write_json(out / "fit.json", res.to_dict())
+    fit_timeseries_figure(out / "fit_timeseries.png", res.time_s, res.y_meas, res.y_sim,
+                          res.axes, nrmse_pct=[res.nrmse_fit_pct[a] for a in res.axes])
+    correlation_figure(out / "correlation.png", res.correlation, res.names)
+    pressures = sorted({float(m.metadata.get("pressure_drop_pa", 0.0)) / 1e5 for m in records})
+    identified = rig_with_values(cfg, dict(zip(res.names, res.estimate)))
+    header = (f"Identified by ambseal from {', '.join(str(d) for d in data)}\n"
+              f"parameters: {', '.join(res.names)}; converged: {res.converged}\n"
+              f"seal coefficients, if fitted, hold at the recorded pressure drop(s) "
+              f"{pressures} bar")
+    write_text(out / "identified.toml", dump_rig(identified, header))
+    return {"out": str(out), "converged": res.converged, "message": res.message,
+            "parameters": {
+                n: {"estimate": float(v), "ci95": [_finite(lo), _finite(hi)]}
+                for n, v, lo, hi in zip(res.names, res.estimate, res.ci95_low, res.ci95_high)},
+            "nrmse_fit_pct": {k: _finite(v) for k, v in res.nrmse_fit_pct.items()}}

@@ -1,0 +1,127 @@
+"""Checks of an identified model against data it was not fitted to, and against the truth.
+
+* :func:`frf_checks` — the closed-loop FRF of a chirp record against the identified model
+  (P4 Fig. 9), and the unstable plant itself from the PRBS record of stage (a),
+  ``T_ye·T_ie⁻¹`` (P1 §II, the indirect method), against the identified plant from coil
+  current to displacement (eddy lag, Ki, rotor; no amplifier);
+* :func:`truth_errors` — on the virtual facility, each estimate beside its truth: error (%)
+  and whether the 95 % interval holds it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ..config import Affine
+from .frf import FRF, closed_loop_frf, model_frf, plant_frf
+from .procedure import ProcedureResult
+from .signals import chirp
+from .stages import acquire, build_models
+
+__all__ = ["FrfChecks", "frf_checks", "truth_errors", "true_line"]
+
+
+@dataclass(frozen=True)
+class FrfChecks:
+    """Measured FRFs beside the identified model's on the same grid.
+
+    Attributes
+    ----------
+    closed_loop, closed_loop_model : FRF
+        Chirp excitation on the ζ axes of the first and last bearing → displacements
+        (m/A), 2–140 Hz.
+    plant, plant_model : FRF
+        The plant from coil current to displacement (m/A), 2–200 Hz, and the output/input
+        pairs worth plotting.
+    plant_pairs : tuple of (str, str)
+    """
+
+    closed_loop: FRF
+    closed_loop_model: FRF
+    plant: FRF
+    plant_model: FRF
+    plant_pairs: tuple
+
+
+def frf_checks(cfg, truth, res: ProcedureResult, controller, *, seed: int = 99) -> FrfChecks:
+    """Frequency-domain checks of the identified rig (P4 Figs. 9–10).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig as identified against (its controller ran on the facility).
+    truth : TruthSection
+        The virtual facility's truth (a chirp record 1–150 Hz, 4 s, 0.05 A at 0 bar).
+    res : ProcedureResult
+        The procedure's result (its identified rig and its stage (a) PRBS record).
+    controller : DiscreteController
+        The controller that levitates the rotor for the chirp record.
+    seed : int
+        Noise seed of the chirp record.
+
+    Returns
+    -------
+    FrfChecks
+    """
+    from ..model.rig import build_plant
+
+    axes = res.amb.axes
+    fs = cfg.controller.sample_rate_hz
+    ex = chirp(f0_hz=1.0, f1_hz=150.0, duration_s=4.0, amplitude_a=0.05, sample_rate_hz=fs,
+               axes=axes, excited={axes[0]: 1.0, axes[-2]: 1.0})
+    rec = acquire(cfg, truth, ex, controller=controller, pressure_bar=0.0, seed=seed)
+    measured = closed_loop_frf(rec, nperseg=8192, inputs=[axes[0]]).band(2.0, 140.0)
+    model = build_models(res.identified, [rec], controllers=[controller])[0].statespace({}, axes)
+    mf = model_frf(model[:, [0]] + model[:, [len(axes) - 2]], measured.frequency_hz,
+                   input_names=measured.input_names, output_names=measured.output_names)
+
+    rec_a = res.records["a"]  # four axes with independent sequences: MIMO H1
+    T_ye = closed_loop_frf(rec_a, nperseg=2048, method="mimo")
+    T_ie = closed_loop_frf(rec_a, nperseg=2048, method="mimo", response="current")
+    G = plant_frf(T_ye, T_ie).band(2.0, 200.0)
+    bare = res.identified.model_copy(
+        update={"actuator": res.identified.actuator.model_copy(update={"model": "none"})})
+    Gm = model_frf(build_plant(bare, reduced=True, pressure_bar=0.0).to_statespace(),
+                   G.frequency_hz, input_names=G.input_names, output_names=G.output_names)
+    pairs = ((G.output_names[0], G.input_names[0]), (G.output_names[-1], G.input_names[-1]),
+             (G.output_names[0], G.input_names[-2]))
+    return FrfChecks(measured, mf, G, Gm, pairs)
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
+
+
+def truth_errors(res: ProcedureResult, seal_name: str | None) -> dict:
+    """Each estimate of the procedure beside its truth (the virtual facility's).
+
+    Returns
+    -------
+    dict
+        ``{name: {estimate, truth, ci95: [lo, hi], error_pct}}`` for the AMB and coupling
+        parameters (``error_pct`` = 100 (estimate/truth − 1), ``None`` without a scalar
+        truth), and ``{seal.c: {intercept, slope, …, truth}}`` for the seal regressions
+        against pressure (bar).
+    """
+    out: dict = {}
+    for r in [res.amb] + ([res.coupling] if res.coupling else []):
+        for i, n in enumerate(r.names):
+            t = res.truth.get(n)
+            err = None if not isinstance(t, float) or t == 0 else 100 * (r.estimate[i] / t - 1)
+            out[n] = {"estimate": float(r.estimate[i]), "truth": t,
+                      "ci95": [_finite(r.ci95_low[i]), _finite(r.ci95_high[i])],
+                      "error_pct": err}
+    for c, reg in res.regression.items():
+        out[f"{seal_name}.{c}"] = {**reg.to_dict(), "truth": res.truth.get(f"{seal_name}.{c}")}
+    return out
+
+
+def true_line(truth, name: str):
+    """The true coefficient against pressure (bar) as a function, or None if not in the truth."""
+    v = truth.parameters.get(name)
+    if v is None:
+        return None
+    if isinstance(v, Affine):
+        return lambda p: v.at_zero + v.per_bar * p
+    return lambda p: float(v)

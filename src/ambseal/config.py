@@ -21,7 +21,9 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     rotated from x, y) and either the geometry ``turns``, ``pole_area`` (m²), ``air_gap`` (m),
     ``bias_current`` (A), ``pole_angle_deg`` (default 22.5, half the angle between the two
     poles of a pole pair of an 8-pole heteropolar bearing) or ``ki`` (N/A) and ``ks`` (N/m),
-    each a number or ``{ zeta = ..., eta = ... }``. Also optional ``current_limit`` (A).
+    each a number or ``{ zeta = ..., eta = ... }``; with the geometry, a factor given
+    explicitly (also for one axis only) wins over the geometry's
+    (:func:`ambseal.model.amb.amb_factors`). Also optional ``current_limit`` (A).
 ``[actuator]``
     ``model`` = ``"none"`` | ``"first_order"`` (``cutoff_hz``) | ``"second_order"``
     (``natural_frequency`` in rad/s, ``damping_ratio``); ``eddy_time_constant`` τ_e (s,
@@ -30,7 +32,8 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     ``name``, ``position``, ``K``, ``k`` (N/m), ``C``, ``c`` (N·s/m), ``M`` (kg), each a number,
     ``{ at_zero = ..., per_bar = ... }`` (affine in the pressure drop) or
     ``{ frequency_hz = [...], value = [...] }`` (a table against excitation frequency,
-    evaluated at the synchronous frequency, thesis P3 §4); Childs' convention
+    evaluated at the synchronous frequency, thesis P3 §4; see
+    :func:`ambseal.model.seal.coefficient_value`); Childs' convention
     −f = [K k; −k K] q + [C c; −c C] q̇ + M q̈.
 ``[[spring]]``
     ``position``, ``kxx``, ``kyy`` and optional ``kxy``, ``kyx`` (N/m), ``cxx``, ``cyy``
@@ -54,7 +57,6 @@ import math
 import tomllib
 from pathlib import Path
 
-import numpy as np
 from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
@@ -73,11 +75,7 @@ __all__ = [
     "load_truth",
     "rig_with_values",
     "dump_rig",
-    "amb_factors_from_geometry",
 ]
-
-MU0 = 4e-7 * math.pi
-"""Vacuum permeability (H/m) as used in the AMB linearisation."""
 
 
 class _Strict(BaseModel):
@@ -142,10 +140,17 @@ class Disk(_Strict):
 
 
 class AxisPair(_Strict):
-    """A value per actuator axis: ``zeta`` and ``eta``."""
+    """A value per actuator axis: ``zeta`` and ``eta`` (one may be left out when the AMB's
+    geometry gives it)."""
 
-    zeta: float
-    eta: float
+    zeta: float | None = None
+    eta: float | None = None
+
+    @model_validator(mode="after")
+    def _one(self) -> "AxisPair":
+        if self.zeta is None and self.eta is None:
+            raise ValueError("expected zeta and/or eta")
+        return self
 
 
 class Amb(_Strict):
@@ -165,61 +170,19 @@ class Amb(_Strict):
     @model_validator(mode="after")
     def _geometry_or_factors(self) -> "Amb":
         geometry = [self.turns, self.pole_area, self.air_gap, self.bias_current]
-        has_geometry = all(v is not None for v in geometry)
-        has_factors = self.ki is not None and self.ks is not None
-        if not has_geometry and not has_factors:
+        if all(v is not None for v in geometry):
+            return self
+        if self.ki is None or self.ks is None:
             raise ValueError(
                 "expected either the geometry (turns, pole_area, air_gap, bias_current) "
                 "or both ki (N/A) and ks (N/m)"
             )
+        for key in ("ki", "ks"):
+            v = getattr(self, key)
+            if isinstance(v, AxisPair) and None in (v.zeta, v.eta):
+                raise ValueError(f"{key}: expected both zeta and eta (or the geometry: "
+                                 "turns, pole_area, air_gap, bias_current)")
         return self
-
-    def factors(self) -> tuple[tuple[float, float], tuple[float, float]]:
-        """(Ki_ζ, Ki_η) in N/A and (Ks_ζ, Ks_η) in N/m.
-
-        Explicit ``ki``/``ks`` win; otherwise the differential-driving linearisation of an
-        8-pole heteropolar bearing (Schweitzer & Maslen 2009, Ch. 3):
-        Ki = μ0 N² A i0 cos α / s0², Ks = μ0 N² A i0² cos α / s0³.
-        """
-        if self.ki is not None and self.ks is not None:
-            return _pair(self.ki), _pair(self.ks)
-        ki, ks = amb_factors_from_geometry(
-            self.turns, self.pole_area, self.air_gap, self.bias_current, self.pole_angle_deg
-        )
-        return (ki, ki), (ks, ks)
-
-
-def _pair(v: float | AxisPair) -> tuple[float, float]:
-    return (v.zeta, v.eta) if isinstance(v, AxisPair) else (float(v), float(v))
-
-
-def amb_factors_from_geometry(
-    turns: float, pole_area: float, air_gap: float, bias_current: float, pole_angle_deg: float
-) -> tuple[float, float]:
-    """Force/current and force/displacement factors of a differentially driven AMB axis.
-
-    Parameters
-    ----------
-    turns : float
-        Turns N per pole coil.
-    pole_area : float
-        Pole face area A (m²).
-    air_gap : float
-        Nominal air gap s0 (m).
-    bias_current : float
-        Bias current i0 (A).
-    pole_angle_deg : float
-        Angle α between a pole and the actuator axis (deg); 22.5° in an 8-pole bearing.
-
-    Returns
-    -------
-    ki, ks : float
-        Ki = μ0 N² A i0 cos α / s0² (N/A) and Ks = μ0 N² A i0² cos α / s0³ (N/m), the
-        linearisation of f = k[(i0+i)²/(s0−x)² − (i0−i)²/(s0+x)²] with k = μ0 N² A cos α / 4
-        (Schweitzer & Maslen 2009, Eqs. 3.27–3.30).
-    """
-    k = MU0 * turns**2 * pole_area * math.cos(math.radians(pole_angle_deg))
-    return k * bias_current / air_gap**2, k * bias_current**2 / air_gap**3
 
 
 class Actuator(_Strict):
@@ -267,21 +230,6 @@ Coefficient = float | Affine
 SealCoefficient = float | Affine | FrequencyTable
 
 
-def coefficient_value(c: SealCoefficient, pressure_bar: float,
-                      frequency_hz: float | None = None) -> float:
-    """The value of a seal coefficient at a pressure drop (bar) and, for a frequency table,
-    at an excitation frequency (Hz; required then)."""
-    if isinstance(c, Affine):
-        return c.at_zero + c.per_bar * pressure_bar
-    if isinstance(c, FrequencyTable):
-        if frequency_hz is None:
-            raise ConfigError("a frequency-dependent seal coefficient needs a frequency "
-                              "(by default the synchronous one; at standstill the table's "
-                              "first value holds)")
-        return float(np.interp(frequency_hz, c.frequency_hz, c.value))
-    return float(c)
-
-
 class Seal(_Strict):
     name: str = Field(min_length=1)
     position: float = Field(ge=0)
@@ -295,12 +243,6 @@ class Seal(_Strict):
     def frequency_dependent(self) -> bool:
         """Whether any coefficient is tabulated against frequency."""
         return any(isinstance(getattr(self, n), FrequencyTable) for n in "KkCcM")
-
-    def at(self, pressure_bar: float, frequency_hz: float | None = None) -> dict[str, float]:
-        """Coefficients K, k (N/m), C, c (N·s/m), M (kg) at a pressure drop (bar) and, for
-        tabulated ones, an excitation frequency (Hz)."""
-        return {n: coefficient_value(getattr(self, n), pressure_bar, frequency_hz)
-                for n in "KkCcM"}
 
 
 class Spring(_Strict):
@@ -488,7 +430,8 @@ class TruthSection(_Strict):
     """The virtual test facility's true values, in a file of their own that a fit never reads.
 
     ``parameters`` maps model parameter names (``A.Ki_zeta``, ``A.Ks_zeta``,
-    ``coupling.kxx``, ``seal.k``, ...) to a number or ``{ at_zero, per_bar }``.
+    ``coupling.kxx``, ``seal.k``, ...) to a number or ``{ at_zero, per_bar }`` (values at a
+    pressure drop: :func:`ambseal.model.seal.coefficient_value`).
     """
 
     parameters: dict[str, Coefficient] = {}
@@ -502,10 +445,6 @@ class TruthSection(_Strict):
     adc_range_m: float = Field(default=1.0e-3, gt=0)  # LSB = range / 2**bits (no clipping)
     substeps: int = Field(default=4, ge=1, le=100)
     max_mode_hz: float = Field(default=10000.0, gt=0)
-
-    def values_at(self, pressure_bar: float) -> dict[str, float]:
-        """Parameter values (SI) at a pressure drop (bar)."""
-        return {k: coefficient_value(v, pressure_bar) for k, v in self.parameters.items()}
 
 
 class TruthConfig(_Strict):
@@ -561,14 +500,12 @@ def rig_with_values(cfg: RigConfig, values: dict[str, Coefficient]) -> RigConfig
         if name == "tau_e":
             data.setdefault("actuator", {})["eddy_time_constant"] = v
         elif owner in ambs and key[:3] in ("Ki_", "Ks_") and key[3:] in ("zeta", "eta"):
-            amb = ambs[owner]
-            # write both factors explicitly: an AMB given by its geometry uses explicit
-            # ki/ks only when both are set (Amb.factors)
-            ki, ks = cfg.amb[list(ambs).index(owner)].factors()
-            for sl, pair in (("ki", ki), ("ks", ks)):
-                if not isinstance(amb.get(sl), dict):
-                    amb[sl] = {"zeta": pair[0], "eta": pair[1]}
-            amb[key[:2].lower()][key[3:]] = v
+            # per axis; an AMB given by its geometry keeps the geometry's other factors
+            amb, slot = ambs[owner], key[:2].lower()
+            if not isinstance(amb.get(slot), dict):
+                old = amb.get(slot)
+                amb[slot] = {} if old is None else {"zeta": old, "eta": old}
+            amb[slot][key[3:]] = v
         elif owner in springs and key in ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy"):
             springs[owner][key] = v
         elif owner in seals and key in ("K", "k", "C", "c"):

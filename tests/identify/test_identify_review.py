@@ -9,6 +9,7 @@ from ambseal.identify.fit import _long_run_covariance, fit_parameters
 from ambseal.identify.signals import prbs
 from ambseal.control.pid import controller_from_metadata, reference_controller
 from ambseal.identify.stages import acquire, build_models, identify
+from ambseal.model.amb import amb_factors
 
 AXES = ("A_zeta", "A_eta", "B_zeta", "B_eta")
 
@@ -83,16 +84,16 @@ def test_facility_refuses_non_positive_ks(rig):
 
 
 def test_identified_factor_of_a_geometry_amb_is_kept(rig):
-    """An AMB given by geometry: an identified Ki is written with explicit ki and ks, so the
-    rig file uses it (Amb.factors prefers explicit factors only when both are set)."""
+    """An AMB given by geometry: an identified Ki is written as an explicit ki for its axis,
+    which wins over the geometry; the geometry still gives the other factors (amb_factors)."""
     data = rig.model_dump(exclude_none=True)
     a = data["amb"][0]
     del a["ki"], a["ks"]
     a.update(turns=36, pole_area=5.5e-3, air_gap=0.5e-3, bias_current=6.0)
     geo = parse_rig(data)
     out = rig_with_values(geo, {"A.Ki_zeta": 300.0})
-    ki, ks = out.amb[0].factors()
-    assert ki[0] == 300.0 and ks == geo.amb[0].factors()[1]
+    ki, ks = amb_factors(out.amb[0])
+    assert ki[0] == 300.0 and ks == amb_factors(geo.amb[0])[1]
 
 
 def test_identify_wraps_unknown_names(rig, record):

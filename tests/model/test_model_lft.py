@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from ambseal.config import amb_factors_from_geometry, load_rig, parse_rig
+from ambseal.config import load_rig, parse_rig
+from ambseal.model.amb import amb_factors_from_geometry
 from ambseal.errors import ModelError
 from ambseal.model.reduction import modal_reduction
 from ambseal.model.rig import build_plant, build_system, mechanical_plant

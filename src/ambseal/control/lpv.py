@@ -116,11 +116,10 @@ class LpvController:
 
     def matrices(self, speed_rad_s: float) -> tuple[np.ndarray, ...]:
         """(A_K, B_K, C_K, D_K) at Ω (rad/s), linear between table speeds, held at the ends."""
-        g = self.speeds_rad_s
-        W = float(np.clip(speed_rad_s, g[0], g[-1]))
-        j = int(np.clip(np.searchsorted(g, W) - 1, 0, len(g) - 2))
-        t = (W - g[j]) / (g[j + 1] - g[j])
-        return tuple((1 - t) * X[j] + t * X[j + 1] for X in (self.AK, self.BK, self.CK, self.DK))
+        from ..model.seal import interp_table
+
+        return tuple(interp_table(float(speed_rad_s), self.speeds_rad_s, X)
+                     for X in (self.AK, self.BK, self.CK, self.DK))
 
     def at(self, speed_rad_s: float, *, scale_output: float = 1.0, name: str = "K_lpv"):
         """The frozen controller at Ω (rad/s) as a named ``control.StateSpace``.

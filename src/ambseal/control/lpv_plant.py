@@ -172,6 +172,7 @@ def lpv_plant(cfg, speeds_hz, *, reference_speed_hz: float | None = None,
     from ..model.amb import actuator_matrices, eddy_lag_matrices
     from ..model.reduction import modal_reduction
     from ..model.rig import build_system, mechanical_plant
+    from ..model.seal import coefficient_value
 
     f = np.asarray(speeds_hz, float).ravel()
     if f.size < 2:
@@ -207,9 +208,7 @@ def lpv_plant(cfg, speeds_hz, *, reference_speed_hz: float | None = None,
 
     def coeffs(W: float, key_seal) -> float:
         seal, key = key_seal
-        if not seal.frequency_dependent:
-            return seal.at(p_bar)[key]
-        return seal.at(p_bar, W / _TWO_PI)[key]
+        return coefficient_value(getattr(seal, key), p_bar, W / _TWO_PI)
 
     def A_mech(W: float) -> np.ndarray:
         A = mech.A + (W - W_ref) * A_gyro

@@ -35,6 +35,7 @@ from ..errors import ModelError
 from ..model.amb import actuator_matrices, eddy_lag_matrices
 from ..model.reduction import modal_reduction
 from ..model.rig import build_system, mechanical_plant
+from ..model.seal import coefficient_value
 from ..lti.discrete import zoh
 from .loop import DiscreteController
 
@@ -123,7 +124,7 @@ def simulate_facility(
         raise ModelError(f"controller dt = {controller.dt} s but the sample rate is {sample_rate_hz} Hz")
     sys = build_system(cfg, pressure_bar=pressure_bar)
     plant = mechanical_plant(sys)
-    values = truth.values_at(pressure_bar)
+    values = {k: coefficient_value(v, pressure_bar) for k, v in truth.parameters.items()}
     plant = plant.with_values(values)  # raises ModelError naming an unknown parameter
     plant = modal_reduction(plant, cutoff_hz=truth.max_mode_hz).plant
     axes = plant.input_names

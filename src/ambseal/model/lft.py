@@ -21,7 +21,39 @@ import numpy as np
 
 from ..errors import ModelError
 
-__all__ = ["Parameter", "Plant"]
+__all__ = ["Channel", "Parameter", "Plant"]
+
+
+@dataclass(frozen=True)
+class Channel:
+    """A parameter of the second-order model as a low-rank change of K, C or B_u.
+
+    ΔK = θ U Vᵀ (``kind="K"``), ΔC = θ U Vᵀ (``kind="C"``), or ΔB_u = θ U e_jᵀ with
+    j = ``V[:, 0]`` (``kind="B"``, a force factor on input j): the channel description of
+    thesis P1 Eqs. 48–50 before it becomes a state-space :class:`Parameter`
+    (:func:`ambseal.model.rig.mechanical_plant`). Element modules (``amb``, ``seal``,
+    ``spring``) build their own.
+
+    Attributes
+    ----------
+    name : str
+        ``"{element}.{key}"``, e.g. ``"A.Ks_zeta"``.
+    nominal : float
+        The value in the model (SI).
+    unit : str
+        Its SI unit.
+    kind : str
+        ``"K"``, ``"C"`` or ``"B"``.
+    U : ndarray, shape (n_dof, r)
+    V : ndarray, shape (n_dof, r) for K/C; (r, 1) integer input indices for B
+    """
+
+    name: str
+    nominal: float
+    unit: str
+    kind: str
+    U: np.ndarray
+    V: np.ndarray
 
 
 @dataclass(frozen=True)

@@ -1,14 +1,14 @@
 """The whole machine: rotor, AMBs, seals and springs as a second-order system and a plant.
 
 M q̈ + (C + Ω G) q̇ + K q = B_u i + B_f f, y = C_q q, with q the node DOFs of
-:mod:`ambseal.model.rotor`. Components:
+:mod:`ambseal.model.rotor`. The rotor comes from :mod:`ambseal.model.rotor`; each component
+is an element that owns its matrices and parameter channels, and this module only
+assembles them:
 
-- AMB (thesis P2 Eq. 1): f_ζη = Ki i + Ks s at the bearing node in actuator axes, so
-  K gets −Rᵀ diag(Ks) R and B_u gets Rᵀ diag(Ki); the sensor reads R [x, y] at the
-  sensor node.
-- Seal (Childs' convention, P4 Eq. 3): −f = [K k; −k K] q + [C c; −c C] q̇ + M q̈.
-- Spring (the flexible coupling, P4 Eq. 4, or a plain bearing): −f = Rᵀ[kxx kxy; kyx kyy]R q
-  + Rᵀ diag(cxx, cyy) R q̇ in its own axes rotated by ``axes_angle_deg``.
+- AMB (thesis P2 Eq. 1): :class:`ambseal.model.amb.AmbElement`.
+- Seal (Childs' convention, P4 Eq. 3): :class:`ambseal.model.seal.SealElement`.
+- Spring (the flexible coupling, P4 Eq. 4, or a plain bearing):
+  :class:`ambseal.model.spring.SpringElement`.
 
 The state is x = [q; q̇]; A = [[0, I], [−M⁻¹K, −M⁻¹(C + ΩG)]].
 """
@@ -22,25 +22,13 @@ import scipy.linalg as sla
 
 from ..config import RigConfig
 from ..errors import ModelError
-from .amb import actuator_matrices, axes_rotation, eddy_lag_matrices
-from .lft import Parameter, Plant
+from .amb import AXES, AmbElement, actuator_matrices, eddy_lag_matrices
+from .lft import Channel, Parameter, Plant
 from .rotor import X, Y, Mesh, assemble_rotor, build_mesh
+from .seal import SealElement
+from .spring import SpringElement
 
 __all__ = ["SecondOrderSystem", "build_system", "mechanical_plant", "build_plant", "AXES"]
-
-AXES = ("zeta", "eta")
-
-
-@dataclass(frozen=True)
-class _Change:
-    """A parameter as a low-rank change of K, C or B_u: ΔX = θ U Vᵀ (or θ U e_iᵀ)."""
-
-    name: str
-    nominal: float
-    unit: str
-    kind: str  # "K", "C" or "B"
-    U: np.ndarray  # (n_dof, r)
-    V: np.ndarray  # (n_dof, r) for K/C; (n_inputs, r) input selector for B
 
 
 @dataclass(frozen=True)
@@ -69,7 +57,7 @@ class SecondOrderSystem:
     speed: float
     input_names: tuple[str, ...]
     output_names: tuple[str, ...]
-    changes: tuple[_Change, ...] = field(default=())
+    changes: tuple[Channel, ...] = field(default=())
 
     @property
     def n_dof(self) -> int:
@@ -139,96 +127,41 @@ def build_system(
     """
     p = cfg.operating.pressure_bar if pressure_bar is None else pressure_bar
     speed = cfg.speed if speed_rpm is None else speed_rpm * 2 * np.pi / 60
+    f_seal = seal_frequency_hz if seal_frequency_hz is not None else speed / (2 * np.pi)
     mesh = build_mesh(cfg, tuple(force_positions))
     rot = assemble_rotor(cfg, mesh)
     n = mesh.n_dof
-    M, K, G = rot.M.copy(), rot.K.copy(), rot.G
-    C = rot.C.copy()
-    changes: list[_Change] = []
-
-    def xy(node: int) -> np.ndarray:
-        return np.array([4 * node + X, 4 * node + Y])
-
-    def unit(node: int, direction: np.ndarray) -> np.ndarray:
-        v = np.zeros(n)
-        v[xy(node)] = direction
-        return v
-
-    in_names: list[str] = []
-    out_names: list[str] = []
+    M, C, K = rot.M.copy(), rot.C.copy(), rot.K.copy()
+    ambs = [AmbElement.from_config(a, mesh) for a in cfg.amb] if include_amb else []
+    others = [SealElement.from_config(s, mesh, p, f_seal)
+              for s in (cfg.seal if include_seals else [])]
+    others += [SpringElement.from_config(s, mesh, i)
+               for i, s in enumerate(cfg.spring if include_springs else [])]
+    names: list[str] = []
     b_cols: list[np.ndarray] = []
     c_rows: list[np.ndarray] = []
-
-    if include_amb:
-        for amb in cfg.amb:
-            R = axes_rotation(amb.axes_angle_deg)
-            nb, ns = mesh.node_at(amb.position), mesh.node_at(amb.sensor_position)
-            ki, ks = amb.factors()
-            for a, axis in enumerate(AXES):
-                r = R[a]  # direction of the axis in x, y
-                rb = unit(nb, r)
-                K -= ks[a] * np.outer(rb, rb)
-                j = len(in_names)
-                name = f"{amb.name}_{axis}"
-                in_names.append(name)
-                out_names.append(name)
-                b_cols.append(ki[a] * rb)
-                c_rows.append(unit(ns, r))
-                changes.append(_Change(f"{amb.name}.Ks_{axis}", ks[a], "N/m", "K",
-                                       -rb[:, None], rb[:, None]))
-                changes.append(_Change(f"{amb.name}.Ki_{axis}", ki[a], "N/A", "B",
-                                       rb[:, None], np.array([[j]])))
-
-    if include_seals:
-        for seal in cfg.seal:
-            node = mesh.node_at(seal.position)
-            f_seal = seal_frequency_hz if seal_frequency_hz is not None else speed / (2 * np.pi)
-            v = seal.at(p, f_seal if seal.frequency_dependent else None)
-            i = xy(node)
-            ex, ey = unit(node, np.array([1.0, 0.0])), unit(node, np.array([0.0, 1.0]))
-            skew = np.array([[0.0, 1.0], [-1.0, 0.0]])
-            K[np.ix_(i, i)] += v["K"] * np.eye(2) + v["k"] * skew
-            C[np.ix_(i, i)] += v["C"] * np.eye(2) + v["c"] * skew
-            M[np.ix_(i, i)] += v["M"] * np.eye(2)
-            eye2 = np.column_stack([ex, ey])
-            rot90 = np.column_stack([ey, -ex])
-            changes += [
-                _Change(f"{seal.name}.K", v["K"], "N/m", "K", eye2, eye2),
-                _Change(f"{seal.name}.k", v["k"], "N/m", "K", eye2, rot90),
-                _Change(f"{seal.name}.C", v["C"], "N*s/m", "C", eye2, eye2),
-                _Change(f"{seal.name}.c", v["c"], "N*s/m", "C", eye2, rot90),
-            ]
-
-    if include_springs:
-        for s_i, spring in enumerate(cfg.spring):
-            node = mesh.node_at(spring.position)
-            R = axes_rotation(spring.axes_angle_deg)
-            i = xy(node)
-            ks = np.array([[spring.kxx, spring.kxy], [spring.kyx, spring.kyy]])
-            cs = np.diag([spring.cxx, spring.cyy])
-            K[np.ix_(i, i)] += R.T @ ks @ R
-            C[np.ix_(i, i)] += R.T @ cs @ R
-            label = spring.name or f"spring{s_i}"
-            d = [unit(node, R[0]), unit(node, R[1])]
-            for key, (a, b), kind in [
-                ("kxx", (0, 0), "K"), ("kyy", (1, 1), "K"), ("kxy", (0, 1), "K"),
-                ("kyx", (1, 0), "K"), ("cxx", (0, 0), "C"), ("cyy", (1, 1), "C"),
-            ]:
-                changes.append(_Change(f"{label}.{key}", getattr(spring, key),
-                                       "N/m" if kind == "K" else "N*s/m", kind,
-                                       d[a][:, None], d[b][:, None]))
-
+    changes: list[Channel] = []
+    for amb in ambs:
+        amb.assemble(M, C, K)
+        changes += amb.channels(n, first_input=len(names))
+        names += amb.signal_names
+        b_cols += amb.input_columns(n)
+        c_rows += amb.sensor_rows(n)
+    for el in others:
+        el.assemble(M, C, K)
+        changes += el.channels(n)
+    out_names = tuple(names)
     for k_i, z in enumerate(force_positions):
-        node = mesh.node_at(z)
-        for a, axis in enumerate(("x", "y")):
-            in_names.append(f"F{k_i}_{axis}")
-            b_cols.append(unit(node, np.eye(2)[a]))
-
+        i = mesh.node_at(z)
+        for axis, d in (("x", X), ("y", Y)):
+            names.append(f"F{k_i}_{axis}")
+            b_cols.append(np.zeros(n))
+            b_cols[-1][4 * i + d] = 1.0
     B = np.column_stack(b_cols) if b_cols else np.zeros((n, 0))
     Cq = np.vstack(c_rows) if c_rows else np.zeros((0, n))
     return SecondOrderSystem(
-        mesh=mesh, M=M, C=C, G=G, K=K, B=B, Cq=Cq, speed=speed,
-        input_names=tuple(in_names), output_names=tuple(out_names), changes=tuple(changes),
+        mesh=mesh, M=M, C=C, G=rot.G, K=K, B=B, Cq=Cq, speed=speed,
+        input_names=tuple(names), output_names=out_names, changes=tuple(changes),
     )
 
 

@@ -1,0 +1,169 @@
+"""Annular seals: Childs' linearised seal force, its coefficients and parameter channels.
+
+The seal acts at one node on the lateral displacements q = [x, y] (Childs, *Turbomachinery
+Rotordynamics*, 1993, §3.2; thesis P4 Eq. 3):
+
+    −f = [K k; −k K] q + [C c; −c C] q̇ + M q̈,
+
+positive K restores, positive k drives forward whirl. Each coefficient is a number, affine
+in the pressure drop (``at_zero + per_bar · pressure_bar``, thesis P5 §4.1) or a table
+against excitation frequency, interpolated linearly and held constant outside the table
+(thesis P3 §4, taken at the synchronous frequency Ω/2π unless told otherwise).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..config import Affine, FrequencyTable, Seal
+from ..errors import ModelError
+from .lft import Channel
+from .rotor import X, Y, Mesh
+
+__all__ = ["COEFFICIENTS", "interp_table", "coefficient_value", "seal_coefficients",
+           "SealElement"]
+
+COEFFICIENTS = ("K", "k", "C", "c", "M")
+"""The seal coefficients in Childs' convention, in the order of the rig file."""
+
+_SKEW = np.array([[0.0, 1.0], [-1.0, 0.0]])
+_UNITS = {"K": "N/m", "k": "N/m", "C": "N*s/m", "c": "N*s/m"}
+
+
+def interp_table(x: float, grid, values):
+    """Linear interpolation in a table, held constant outside it.
+
+    Parameters
+    ----------
+    x : float
+        Where to evaluate, in the unit of ``grid``.
+    grid : array_like, shape (n,)
+        Strictly increasing abscissae (n ≥ 1).
+    values : array_like, shape (n,) or (n, ...)
+        Tabulated scalars, or a stack of arrays (e.g. matrices) along the first axis.
+
+    Returns
+    -------
+    float or ndarray
+        A float for scalar tables (exactly ``numpy.interp``); for stacks
+        (1 − t)·values[j] + t·values[j+1] with t = (x − grid[j])/(grid[j+1] − grid[j]),
+        shape ``values.shape[1:]``.
+    """
+    g = np.asarray(grid, float)
+    v = np.asarray(values, float)
+    if v.ndim == 1:
+        return float(np.interp(x, g, v))
+    if g.size == 1 or x <= g[0]:
+        return v[0].copy()
+    if x >= g[-1]:
+        return v[-1].copy()
+    j = int(np.clip(np.searchsorted(g, x) - 1, 0, g.size - 2))
+    t = (x - g[j]) / (g[j + 1] - g[j])
+    return (1 - t) * v[j] + t * v[j + 1]
+
+
+def coefficient_value(c: float | Affine | FrequencyTable, pressure_bar: float,
+                      frequency_hz: float | None = None) -> float:
+    """The value of one rig coefficient at a pressure drop and excitation frequency.
+
+    Parameters
+    ----------
+    c : float, Affine or FrequencyTable
+        The coefficient as read from the rig file (or a truth file).
+    pressure_bar : float
+        Pressure drop across the seal (bar); used by an :class:`~ambseal.config.Affine`.
+    frequency_hz : float, optional
+        Excitation frequency (Hz); required for a
+        :class:`~ambseal.config.FrequencyTable`, ignored otherwise.
+
+    Returns
+    -------
+    float
+        ``c``, ``at_zero + per_bar · pressure_bar``, or the table interpolated linearly
+        at ``frequency_hz`` and held at its end values outside (:func:`interp_table`).
+
+    Raises
+    ------
+    ModelError
+        A frequency table without ``frequency_hz``.
+    """
+    if isinstance(c, Affine):
+        return c.at_zero + c.per_bar * pressure_bar
+    if isinstance(c, FrequencyTable):
+        if frequency_hz is None:
+            raise ModelError("a frequency-dependent seal coefficient needs a frequency "
+                             "(by default the synchronous one; at standstill the table's "
+                             "first value holds)")
+        return interp_table(frequency_hz, c.frequency_hz, c.value)
+    return float(c)
+
+
+def seal_coefficients(seal: Seal, pressure_bar: float,
+                      frequency_hz: float | None = None) -> dict[str, float]:
+    """Coefficients K, k (N/m), C, c (N·s/m), M (kg) of a seal at a pressure drop (bar)
+    and, for tabulated ones, an excitation frequency (Hz); see :func:`coefficient_value`.
+
+    Raises
+    ------
+    ModelError
+        A tabulated coefficient and no ``frequency_hz``.
+    """
+    return {n: coefficient_value(getattr(seal, n), pressure_bar, frequency_hz)
+            for n in COEFFICIENTS}
+
+
+@dataclass(frozen=True)
+class SealElement:
+    """A seal at one node, with its coefficients evaluated.
+
+    Attributes
+    ----------
+    name : str
+        The seal's name; its channels are ``{name}.K``, ``.k``, ``.C``, ``.c``.
+    node : int
+        Mesh node of the seal.
+    values : dict
+        K, k (N/m), C, c (N·s/m), M (kg).
+    """
+
+    name: str
+    node: int
+    values: dict
+
+    @classmethod
+    def from_config(cls, seal: Seal, mesh: Mesh, pressure_bar: float,
+                    frequency_hz: float | None) -> "SealElement":
+        """The element of a rig's ``[[seal]]`` at a pressure drop (bar) and, for tables,
+        an excitation frequency (Hz)."""
+        return cls(seal.name, mesh.node_at(seal.position),
+                   seal_coefficients(seal, pressure_bar, frequency_hz))
+
+    def matrices(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(K, C, M), each (2, 2) on [x, y] of the node: [K k; −k K], [C c; −c C], M·I."""
+        v, eye = self.values, np.eye(2)
+        return v["K"] * eye + v["k"] * _SKEW, v["C"] * eye + v["c"] * _SKEW, v["M"] * eye
+
+    def assemble(self, M: np.ndarray, C: np.ndarray, K: np.ndarray) -> None:
+        """Add the seal to the global matrices (n_dof, n_dof), in place."""
+        i = np.ix_(self._dofs(), self._dofs())
+        Ke, Ce, Me = self.matrices()
+        K[i] += Ke
+        C[i] += Ce
+        M[i] += Me
+
+    def channels(self, n_dof: int) -> list[Channel]:
+        """LFT channels of K, k (ΔK = θ [I; R90]), C and c (ΔC likewise), rank 2 each:
+        k and −k are one parameter repeated (thesis P5 §4.1 item 3)."""
+        ex, ey = np.zeros(n_dof), np.zeros(n_dof)
+        ex[self._dofs()[0]], ey[self._dofs()[1]] = 1.0, 1.0
+        eye2 = np.column_stack([ex, ey])
+        rot90 = np.column_stack([ey, -ex])
+        v = self.values
+        return [Channel(f"{self.name}.{key}", v[key], _UNITS[key], kind, eye2, V)
+                for key, kind, V in (("K", "K", eye2), ("k", "K", rot90),
+                                     ("C", "C", eye2), ("c", "C", rot90))]
+
+    def _dofs(self) -> list[int]:
+        return [4 * self.node + X, 4 * self.node + Y]

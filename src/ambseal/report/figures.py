@@ -36,7 +36,6 @@ __all__ = [
 Curve = tuple[str, Sequence[float], Sequence[float]]
 
 #: ISO 14839-3 zone limits (P5 §4.1 item 4) — kept here so report does not need analysis.
-_ISO_LIMITS = (3.0, 4.0, 5.0)
 
 
 def save_figure(fig: Figure, path: str | os.PathLike, *, dpi: int = 120) -> Path:
@@ -74,6 +73,26 @@ def _finite_max(curves: list[tuple[str, np.ndarray, np.ndarray]]) -> float:
     return float(max(vals)) if vals else 1.0
 
 
+def _curve_figure(path, curves: Sequence[Curve], kind: str, xlabel: str, ylabel: str,
+                  title: str, decorate=None) -> Path:
+    """One axes of labelled curves (``kind``: ``"loglog"`` or ``"plot"``), a grid, a legend."""
+    cs = _curves(curves)
+    fig = Figure(figsize=(8, 4.5))
+    ax = fig.add_subplot()
+    for label, x, y in cs:
+        getattr(ax, kind)(x, y, label=label)
+    if decorate is not None:
+        decorate(ax, cs)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(True, which="both" if kind == "loglog" else "major", alpha=0.3)
+    if cs:
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
 def sensitivity_figure(
     path: str | os.PathLike, curves: Sequence[Curve], *, title: str = "Output sensitivity σ̄(S_o)"
 ) -> Path:
@@ -92,28 +111,23 @@ def sensitivity_figure(
     -------
     pathlib.Path
     """
-    cs = _curves(curves)
-    fig = Figure(figsize=(8, 4.5))
-    ax = fig.add_subplot()
-    for label, x, y in cs:
-        ax.loglog(x, y, label=label)
-    ymax = max(_finite_max(cs) * 1.5, 8.0)
-    ax.set_ylim(min(0.1, ax.get_ylim()[0]), ymax)
-    for lim in _ISO_LIMITS:
-        ax.axhline(lim, color="k", lw=0.8, ls="--")
-    bands = [("A", 0.5 * 3.0), ("B", 3.45), ("C", 4.45), ("D", 6.0)]
-    for zone, yz in bands:
-        ax.text(1.01, yz, zone, transform=ax.get_yaxis_transform(), va="center", ha="left", fontsize=9)
-    ax.yaxis.set_major_formatter(ScalarFormatter())
-    ax.yaxis.set_minor_formatter(NullFormatter())
-    ax.set_xlabel("Frequency (Hz)")
-    ax.set_ylabel("σ̄(S_o) (-)")
-    ax.set_title(title)
-    ax.grid(True, which="both", alpha=0.3)
-    if cs:
-        ax.legend(fontsize=8)
-    fig.tight_layout()
-    return save_figure(fig, path)
+    from ambseal.analysis.iso import ZONE_LIMITS, ZONES
+
+    def zones(ax, cs):
+        ax.set_ylim(min(0.1, ax.get_ylim()[0]), max(_finite_max(cs) * 1.5, 8.0))
+        for lim in ZONE_LIMITS:
+            ax.axhline(lim, color="k", lw=0.8, ls="--")
+        # zone letters between the lines (A below the first, D above the last)
+        edges = (0.5 * ZONE_LIMITS[0],) + tuple(
+            0.5 * (a + b) for a, b in zip(ZONE_LIMITS, ZONE_LIMITS[1:])) + (1.2 * ZONE_LIMITS[-1],)
+        for zone, yz in zip(ZONES, edges):
+            ax.text(1.01, yz, zone, transform=ax.get_yaxis_transform(), va="center", ha="left",
+                    fontsize=9)
+        ax.yaxis.set_major_formatter(ScalarFormatter())
+        ax.yaxis.set_minor_formatter(NullFormatter())
+
+    return _curve_figure(path, curves, "loglog", "Frequency (Hz)", "σ̄(S_o) (-)", title,
+                         decorate=zones)
 
 
 def compliance_figure(
@@ -132,19 +146,8 @@ def compliance_figure(
     -------
     pathlib.Path
     """
-    cs = _curves(curves)
-    fig = Figure(figsize=(8, 4.5))
-    ax = fig.add_subplot()
-    for label, x, y in cs:
-        ax.loglog(x, y * 1e6, label=label)
-    ax.set_xlabel("Frequency (Hz)")
-    ax.set_ylabel("σ̄ compliance (µm/N)")
-    ax.set_title(title)
-    ax.grid(True, which="both", alpha=0.3)
-    if cs:
-        ax.legend(fontsize=8)
-    fig.tight_layout()
-    return save_figure(fig, path)
+    return _curve_figure(path, [(lb, x, np.asarray(y) * 1e6) for lb, x, y in curves], "loglog",
+                         "Frequency (Hz)", "σ̄ compliance (µm/N)", title)
 
 
 def unbalance_figure(
@@ -163,20 +166,8 @@ def unbalance_figure(
     -------
     pathlib.Path
     """
-    cs = _curves(curves)
-    fig = Figure(figsize=(8, 4.5))
-    ax = fig.add_subplot()
-    for label, x, y in cs:
-        ax.plot(x, y, label=label)
-    ax.set_xlabel("Speed (Hz)")
-    ax.set_ylabel("Displacement bound (µm)")
-    ax.set_title(title)
-    ax.set_ylim(bottom=0)
-    ax.grid(True, alpha=0.3)
-    if cs:
-        ax.legend(fontsize=8)
-    fig.tight_layout()
-    return save_figure(fig, path)
+    return _curve_figure(path, curves, "plot", "Speed (Hz)", "Displacement bound (µm)", title,
+                         decorate=lambda ax, cs: ax.set_ylim(bottom=0))
 
 
 def impulse_figure(

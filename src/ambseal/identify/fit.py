@@ -31,6 +31,7 @@ from ..errors import IdentificationError
 from ..model.amb import eddy_lag_matrices
 from ..model.lft import Plant
 from ..lti.discrete import simulate_lti, zoh
+from ..lti.interconnect import series_inputs
 from .loop import DiscreteController, closed_loop_matrices
 
 __all__ = ["FitResult", "ClosedLoopModel", "fit_parameters", "default_bounds", "nrmse_fit"]
@@ -77,16 +78,10 @@ class ClosedLoopModel:
                    if n != TAU_E}
         p = self.plant.with_changes(changes) if changes else self.plant
         tau = values.get(TAU_E, self.tau_e)
-        k = p.B.shape[1]
         A, B, C = p.A, p.B, p.C
         for blocks in (eddy_lag_matrices(tau), self.actuator):
-            Aa, Ba, Ca, Da = (np.kron(np.eye(k), m) for m in blocks)
-            n, na = A.shape[0], Aa.shape[0]
-            Ci_new = np.hstack([np.zeros((k, n)), Ca])  # this block's output (its current)
-            A = np.block([[A, B @ Ca], [np.zeros((na, n)), Aa]])
-            B = np.vstack([B @ Da, Ba])
-            C = np.hstack([C, np.zeros((C.shape[0], na))])
-            Cout, Dout = Ci_new, Da
+            A, B, C, _, Cout, Dout = series_inputs((A, B, C, np.zeros((C.shape[0], B.shape[1]))),
+                                                   blocks)
         return A, B, C, Cout, Dout
 
     def statespace(self, values: dict[str, float], axes: tuple[str, ...]):

@@ -37,6 +37,7 @@ from ..model.reduction import modal_reduction
 from ..model.rig import build_system, mechanical_plant
 from ..model.seal import coefficient_value
 from ..lti.discrete import zoh
+from ..lti.interconnect import series_inputs
 from .loop import DiscreteController
 
 __all__ = ["FacilityRecord", "simulate_facility"]
@@ -65,23 +66,6 @@ class FacilityRecord:
     displacement_m: np.ndarray
     axes: tuple[str, ...]
     noise_std_m: np.ndarray
-
-
-def _series(A, B, C, blocks):
-    """Append per-input SISO blocks (Aa, Ba, Ca, Da) in front of all inputs of (A, B, C).
-
-    Returns (A, B, C, C_in) where C_in reads the blocks' outputs (what enters the old B).
-    """
-    Aa, Ba, Ca, Da = blocks
-    k = B.shape[1]
-    I = np.eye(k)
-    Ak, Bk, Ck, Dk = np.kron(I, Aa), np.kron(I, Ba), np.kron(I, Ca), np.kron(I, Da)
-    n, na = A.shape[0], Ak.shape[0]
-    An = np.block([[A, B @ Ck], [np.zeros((na, n)), Ak]])
-    Bn = np.vstack([B @ Dk, Bk])
-    Cn = np.hstack([C, np.zeros((C.shape[0], na))])
-    Cin = np.hstack([np.zeros((k, n)), Ck])
-    return An, Bn, Cn, Cin, Dk
 
 
 def simulate_facility(
@@ -155,9 +139,12 @@ def simulate_facility(
     Fdir = np.hstack([plant.parameter(f"{m}.Ks_{ax}").B for m, ax in names])  # unit forces
     Cb = np.vstack([plant.parameter(f"{m}.Ks_{ax}").C for m, ax in names])  # bearing disp.
     n_mech = A.shape[0]
-    A, B, C, C_eff, D_eddy = _series(A, B, np.vstack([C, Cb]), eddy_lag_matrices(truth.tau_e))
-    A, B, C, C_coil, D_coil = _series(A, B, np.vstack([C, C_eff]),
-                                      actuator_matrices(cfg.actuator))
+    C = np.vstack([C, Cb])
+    A, B, C, _, C_eff, D_eddy = series_inputs((A, B, C, np.zeros((C.shape[0], k))),
+                                              eddy_lag_matrices(truth.tau_e))
+    C = np.vstack([C, C_eff])
+    A, B, C, _, C_coil, D_coil = series_inputs((A, B, C, np.zeros((C.shape[0], k))),
+                                               actuator_matrices(cfg.actuator))
     # coil current i_c = C_coil z + D_coil i_ref; force current i_eff = C_eff z + D_eddy i_c
     C_y, C_b = C[:k], C[k:2 * k]
     C_ieff = C[2 * k:] + D_eddy @ C_coil

@@ -22,7 +22,7 @@ import numpy as np
 from ambseal.errors import ModelError
 from ambseal.lti.matrices import labels, ss_matrices
 
-__all__ = ["lft_lower_matrices", "lft_lower", "feedback_matrices"]
+__all__ = ["lft_lower_matrices", "lft_lower", "feedback_matrices", "series_inputs"]
 
 Matrices = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
@@ -149,3 +149,46 @@ def feedback_matrices(G: Matrices, K: Matrices, Gf: tuple[np.ndarray, np.ndarray
                    [np.zeros((nu, nu + nf)), np.eye(nu)],
                    [D, Df, D]])
     return lft_lower_matrices((A, BP, CP, DP), (Ak, Bk, -Ck, -Dk), ny, nu)
+
+
+def series_inputs(G: Matrices, block: Matrices, inputs: list[int] | None = None
+                  ) -> tuple[np.ndarray, ...]:
+    """The same SISO system in front of each of the chosen inputs of ``G`` (an actuator, a
+    lag): ``u_j → block → G`` for ``j`` in ``inputs``, the block states appended.
+
+    Parameters
+    ----------
+    G : (A, B, C, D)
+        ``n`` states, ``m`` inputs.
+    block : (A_a, B_a, C_a, D_a)
+        SISO, ``n_a`` states.
+    inputs : list of int, optional
+        The inputs that get the block (default: all).
+
+    Returns
+    -------
+    (A, B, C, D, C_out, D_out)
+        The series system (``n + n_a·k`` states, same inputs and outputs), and the blocks'
+        outputs (what now enters the old ``B`` columns), ``C_out x + D_out u``, shapes
+        ``(k, n + n_a k)`` and ``(k, m)``.
+    """
+    A, B, C, D = G
+    Aa, Ba, Ca, Da = block
+    n, m = B.shape
+    idx = list(range(m)) if inputs is None else list(inputs)
+    k = len(idx)
+    Ak, Bk, Ck, Dk = (np.kron(np.eye(k), X) for X in (Aa, Ba, Ca, Da))
+    na = Ak.shape[0]
+    Bu = B[:, idx]
+    A2 = np.block([[A, Bu @ Ck], [np.zeros((na, n)), Ak]])
+    B2 = np.zeros((n + na, m))
+    B2[:n] = B
+    B2[:n, idx] = Bu @ Dk
+    B2[n:, idx] = Bk
+    C2 = np.hstack([C, D[:, idx] @ Ck])
+    D2 = D.copy()
+    D2[:, idx] = D[:, idx] @ Dk
+    C_out = np.hstack([np.zeros((k, n)), Ck])
+    D_out = np.zeros((k, m))
+    D_out[:, idx] = Dk
+    return A2, B2, C2, D2, C_out, D_out

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..errors import ModelError
+from ..lti.interconnect import series_inputs
 
 __all__ = ["Channel", "Parameter", "Plant"]
 
@@ -222,32 +223,19 @@ class Plant:
         The actuator states are appended; a parameter whose D_θ acted on the actuated input
         (a force factor Ki) then acts through C_θ on the actuator's output, so Ki enters A.
         """
+        A, B, C, D, C_out, D_out = series_inputs((self.A, self.B, self.C, self.D),
+                                                 (Aa, Ba, Ca, Da), inputs)
         na = Aa.shape[0]
-        k = len(inputs)
-        n, m = self.B.shape
-        Aact = np.kron(np.eye(k), Aa)
-        Bact = np.kron(np.eye(k), Ba)
-        Cact = np.kron(np.eye(k), Ca)
-        Dact = np.kron(np.eye(k), Da)
-        Bu = self.B[:, inputs]
-        others = [j for j in range(m) if j not in inputs]
-        A = np.block([[self.A, Bu @ Cact], [np.zeros((na * k, n)), Aact]])
-        B = np.zeros((n + na * k, m))
-        B[:n, inputs] = Bu @ Dact
-        B[:n, others] = self.B[:, others]
-        B[n:, inputs] = Bact
-        C = np.hstack([self.C, self.D[:, inputs] @ Cact])
-        D = self.D.copy()
-        D[:, inputs] = self.D[:, inputs] @ Dact
         params = {}
         for key, p in self.parameters.items():
             Dp = p.D.copy()
-            Dp[:, inputs] = p.D[:, inputs] @ Dact
+            Dp[:, inputs] = 0.0
             params[key] = replace(
                 p,
-                B=np.vstack([p.B, np.zeros((na * k, p.repeats))]),
-                C=np.hstack([p.C, p.D[:, inputs] @ Cact]),
-                D=Dp,
+                B=np.vstack([p.B, np.zeros((A.shape[0] - p.B.shape[0], p.repeats))]),
+                C=np.hstack([p.C, np.zeros((p.C.shape[0], A.shape[0] - p.C.shape[1]))])
+                + p.D[:, inputs] @ C_out,
+                D=Dp + p.D[:, inputs] @ D_out,
             )
         names = tuple(
             f"{label}_{self.input_names[i]}_{j}" for i in inputs for j in range(na)

@@ -22,7 +22,13 @@ import numpy as np
 from ..errors import ModelError
 from ..lti.interconnect import series_inputs
 
-__all__ = ["Channel", "Parameter", "Plant"]
+__all__ = ["Channel", "Parameter", "Plant", "channel_tag"]
+
+
+def channel_tag(name: str, j: int = 0) -> str:
+    """The signal tag of repeat ``j`` of parameter ``name`` in a python-control system:
+    ``"seal.k"``, 0 → ``"seal__k_0"`` ('.' is not allowed in signal names)."""
+    return f"{name.replace('.', '__')}_{j}"
 
 
 @dataclass(frozen=True)
@@ -175,13 +181,14 @@ class Plant:
         """G_fi of thesis P4 Eq. 7 as a ``control.StateSpace``.
 
         Inputs are [w_θ (Σr), u], outputs [z_θ (Σr), y]; closing w_θ = θ z_θ (upper LFT)
-        gives the plant with changes θ.
+        gives the plant with changes θ. The θ channels are named ``w_<tag>``, ``z_<tag>``
+        with :func:`channel_tag` (python-control allows no '.' in a signal name).
         """
         import control
 
         Bt, Ct, Dt = self.channels(names)
         r = Bt.shape[1]
-        tags = [f"{n}#{j}" for n in names for j in range(self.parameter(n).repeats)]
+        tags = [channel_tag(n, j) for n in names for j in range(self.parameter(n).repeats)]
         B = np.hstack([Bt, self.B])
         C = np.vstack([Ct, self.C])
         D = np.block([[np.zeros((r, r)), Dt], [np.zeros((self.C.shape[0], r)), self.D]])

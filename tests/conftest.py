@@ -11,7 +11,7 @@ same controllers:
   ``[operating] speed_range_hz`` with the frozen γ's (P3 §4), about half a minute;
 * ``turbo_frozen`` — the H∞ controller at the operating speed (140 Hz, P3 Fig. 11).
 
-``design_cache`` lets a test run the main job (``ambseal run``) on these designs instead
+``design_cache_for`` lets a test run the main job (``ambseal run``) on these designs instead
 of recomputing them: it replaces the design functions for the duration of the test by
 wrappers that return the session's result when called with the same rig and arguments and
 call the real function otherwise. Only the main-job tests use it; the design tests call
@@ -88,45 +88,48 @@ def turbo_frozen(turbo_cfg):
 class DesignCache:
     """Routes the main job's design calls to the session's designs (see module doc).
 
-    The session design fixtures are requested lazily, so a run on the test facility does
-    not pay for the turboexpander and vice versa. ``hits`` lists the calls answered from
-    the session, so a test can check that the cache was used.
+    ``patched(rig)`` computes (or fetches) the session designs of that rig first, then
+    replaces the design functions until the ``with`` block ends; calls with other rigs or
+    arguments go to the real functions. ``hits`` lists the calls answered from the session,
+    so a test can check that the cache was used.
     """
 
+    FIXTURES = {"testrig": ("testrig_cfg", "testrig_designs"),
+                "turbo": ("turbo_cfg", "turbo_lpv", "turbo_frozen")}
+
     def __init__(self, request):
-        self._request = request
+        self._request = request  # the requesting fixture's or test's
         self.hits: list[str] = []
 
-    def _get(self, name):
-        return self._request.getfixturevalue(name)
-
     @contextlib.contextmanager
-    def patched(self):
+    def patched(self, rig: str):
         """Replace the design functions for the duration of the ``with`` block."""
         import ambseal.control.design as dmod
         import ambseal.control.lpv_design as lmod
 
+        got = {n: self._request.getfixturevalue(n) for n in self.FIXTURES[rig]}
         real_design, real_lpv, real_frozen = dmod.design, lmod.design_lpv, lmod.design_frozen
 
         def design(cfg, method="mu", **kw):
-            if not kw and _same(cfg, self._get("testrig_cfg")):
+            if rig == "testrig" and not kw and _same(cfg, got["testrig_cfg"]):
                 self.hits.append(f"design:{method}")
-                return self._get("testrig_designs")[method]
+                return got["testrig_designs"][method]
             return real_design(cfg, method, **kw)
 
         def design_lpv(cfg, **kw):
-            tc = self._get("turbo_cfg")
-            if _same(cfg, tc) and set(kw) == {"speeds_hz"} and tuple(kw["speeds_hz"]) == tuple(
-                    tc.operating.speed_range_hz):
+            tc = got.get("turbo_cfg")
+            if (tc is not None and _same(cfg, tc) and set(kw) == {"speeds_hz"}
+                    and tuple(kw["speeds_hz"]) == tuple(tc.operating.speed_range_hz)):
                 self.hits.append("design_lpv")
-                return self._get("turbo_lpv")
+                return got["turbo_lpv"]
             return real_lpv(cfg, **kw)
 
         def design_frozen(cfg, speed_hz=140.0, **kw):
-            tc = self._get("turbo_cfg")
-            if not kw and _same(cfg, tc) and float(speed_hz) == tc.operating.speed_rpm / 60.0:
+            tc = got.get("turbo_cfg")
+            if (tc is not None and not kw and _same(cfg, tc)
+                    and float(speed_hz) == tc.operating.speed_rpm / 60.0):
                 self.hits.append("design_frozen")
-                return self._get("turbo_frozen")
+                return got["turbo_frozen"]
             return real_frozen(cfg, speed_hz, **kw)
 
         with pytest.MonkeyPatch.context() as mp:
@@ -141,6 +144,8 @@ def _same(a, b) -> bool:
 
 
 @pytest.fixture(scope="session")
-def design_cache(request):
-    """A :class:`DesignCache` on the session's designs; use ``with design_cache.patched():``."""
-    return DesignCache(request)
+def design_cache_for():
+    """:class:`DesignCache` itself: ``with design_cache_for(request).patched(rig): ...`` with the
+    ``request`` of the fixture or test that runs the main job (the session designs are
+    looked up through it while it is active)."""
+    return DesignCache

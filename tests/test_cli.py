@@ -126,10 +126,12 @@ kyy = 1.0e5
 
 
 def test_modes_free_lists_bending_modes(capsys):
-    """``--free`` on the embedded rig: the first bending mode of the bare rotor (~550 Hz)."""
+    """``--free`` on the embedded rig: the first bending mode of the bare rotor within ±10 %
+    of the 550 Hz of the thesis's rig data (P2 rig data, P4 Table 1: "1st rotor bending
+    mode @ 550 Hz"; the tolerance is for the FE model, not for our own value)."""
     from ambseal.config import default_rig_path
 
     assert main(["modes", str(default_rig_path()), "--free", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert 495 < out["natural_frequencies_hz"][0] < 605
+    assert out["natural_frequencies_hz"][0] == pytest.approx(550.0, rel=0.10)
     assert out["unstable_poles"] == []

@@ -22,14 +22,14 @@ TURBO = Path(__file__).resolve().parents[2] / "examples" / "turboexpander.toml"
 
 
 @pytest.fixture(scope="module")
-def runs():
+def runs(turbo_cfg, turbo_lpv, turbo_frozen):
+    """Spin-ups and frozen sensitivities of the session's LPV design and of the H∞
+    controller at the operating speed, 140 Hz (tests/conftest.py)."""
     from ambseal.analysis.spinup import frozen_sensitivity, spinup
-    from ambseal.control.lpv_design import design_frozen, design_lpv
     from ambseal.control.lpv_plant import lpv_plant
 
-    cfg = load_rig(TURBO)
-    d = design_lpv(cfg, frozen_gamma=False)
-    fz = design_frozen(cfg, 140.0)
+    cfg, d, fz = turbo_cfg, turbo_lpv, turbo_frozen
+    assert fz.speed_hz == 140.0
     # simulation plant: rigid body + first bending pair, grid on the seal-table points
     grid = np.union1d(np.linspace(20.0, 300.0, 29), [50.0, 100.0, 150.0, 200.0, 250.0])
     L = lpv_plant(cfg, grid, states=12, force_positions=(cfg.amb[0].position,))

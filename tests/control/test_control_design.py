@@ -16,32 +16,34 @@ import pytest
 
 from ambseal.analysis.loops import closed_loop, compliance, loop_responses
 from ambseal.analysis.unbalance import unbalance_from_compliance
-from ambseal.config import load_rig
-from ambseal.control.design import DesignResult, DesignWeights, design
-from ambseal.model.rig import build_plant
+from ambseal.control.design import DesignWeights, design
 
-PRESSURES = (0.0, 0.51, 1.02, 1.53, 2.04, 2.55, 3.06, 3.57, 4.08)
 OMEGA = 2 * np.pi * np.logspace(-1, np.log10(3000.0), 800)
+#: ISO 14839-3:2006 zone A/B boundary of the sensitivity peak (3, i.e. 9.5 dB; P5 §4.1).
+ISO_ZONE_A_LIMIT = 3.0
+#: Thesis demand on the worst-case G2.5 unbalance orbit up to 200 Hz (P5 §4.4.1): 8 µm.
+ORBIT_DEMAND_UM = 8.0
+#: Regression pin, not a published value: order reduction of the μ controller (46 → 28
+#: states) raised the peak μ by 2.1 % (1.116 → 1.139) when this pin was set (issue 8);
+#: P5 §4.3 reduces its controllers without quoting the cost. 5 % flags a change.
+MU_REDUCTION_COST_PIN = 0.05
 
 
 @pytest.fixture(scope="module")
-def cfg():
-    return load_rig()
+def cfg(testrig_cfg):
+    return testrig_cfg
 
 
 @pytest.fixture(scope="module")
-def plants(cfg):
-    out = {}
-    for p in PRESSURES:
-        pl = build_plant(cfg, pressure_bar=p, force_positions=(0.43,))
-        out[p] = (pl.select_inputs(pl.input_names[:4]).to_statespace(),
-                  pl.select_inputs(pl.input_names[4:]).to_statespace())
-    return out
+def plants(testrig_plants):
+    """0 … 4.08 bar in 9 steps (P5 Fig. 13), full order (tests/conftest.py)."""
+    assert sorted(testrig_plants)[0] == 0.0 and sorted(testrig_plants)[-1] == 4.08
+    return testrig_plants
 
 
 @pytest.fixture(scope="module")
-def designs(cfg):
-    return {m: design(cfg, m) for m in ("pid", "hinf", "mu")}
+def designs(testrig_designs):
+    return testrig_designs
 
 
 def _so_peak(G, K):
@@ -53,21 +55,46 @@ def _so_peak(G, K):
     return loop_responses(G, K, w[w > 0]).peaks("So").sigma_max.value
 
 
-def test_results_are_physical_controllers(designs):
-    """Controllers map 4 displacements (m) to 4 currents (A), negative feedback, named."""
-    for m, r in designs.items():
-        assert isinstance(r, DesignResult)
-        assert r.K.ninputs == 4 and r.K.noutputs == 4
-        assert r.K.input_labels == ["y_A_zeta", "y_A_eta", "y_B_zeta", "y_B_eta"]
-        assert r.K.output_labels == ["u_A_zeta", "u_A_eta", "u_B_zeta", "u_B_eta"]
-        assert r.K.isctime()
-        d = r.summary()
-        assert d["method"] == m and d["order"] == r.K.nstates
+def test_pid_is_p5_eq6_on_every_axis(cfg, designs):
+    """Reference: P5 Eq. 6 closed form, K(jω) = Kp (1 + 1/(Ti jω) + Td jω/(ε Td jω + 1)) with
+    the rig's [controller.pid] values, the same on the 4 axes and nothing across axes; from
+    displacement (m) to current (A), named per axis."""
+    K = designs["pid"].K
+    pid = cfg.controller.pid
+    for f in (0.5, 10.0, 100.0, 1000.0):
+        s = 2j * np.pi * f
+        want = pid.kp * (1 + 1 / (pid.ti * s) + pid.td * s / (pid.eps * pid.td * s + 1))
+        np.testing.assert_allclose(np.asarray(K(s)), want * np.eye(4), rtol=1e-10,
+                                   atol=1e-12 * abs(want))
+    assert K.input_labels == ["y_A_zeta", "y_A_eta", "y_B_zeta", "y_B_eta"]
+    assert K.output_labels == ["u_A_zeta", "u_A_eta", "u_B_zeta", "u_B_eta"]
+
+
+def test_hinf_gamma_is_the_verified_closed_loop_norm(designs):
+    """Reference: python-control side by side — γ of the H∞ design equals
+    control.norm(P.lft(K_P), 'inf') (slycot AB13DD) of the nominal generalised plant closed
+    by the synthesis-form controller K_P = −(D_e/D_u) K (DESIGN.md scaling), and that loop is
+    stable (its poles by python-control)."""
+    r = designs["hinf"]
+    gp = r.plant
+    g = -gp.d_e / gp.d_u
+    import control as ct
+
+    K_P = ct.ss(r.K.A, r.K.B, g * np.asarray(r.K.C), g * np.asarray(r.K.D))
+    cl = gp.P_nominal.lft(K_P, gp.nmeas, gp.ncon)
+    assert cl.poles().real.max() < 0
+    assert r.gamma == pytest.approx(ct.norm(cl, "inf"), rel=1e-5)
+    assert r.K.ninputs == r.K.noutputs == 4 and r.order == r.K.nstates
+
+
+def test_mu_reduction_cost_regression_pin(designs):
+    """Regression pin MU_REDUCTION_COST_PIN (module constant, own measurement): the reduced μ
+    controller's peak μ is within 5 % of the full-order one, and reduction did reduce."""
     mu = designs["mu"]
-    assert mu.mu is not None and np.isfinite(mu.mu) and len(mu.history) >= 2
-    assert mu.order <= 28 and mu.reduction is not None
-    assert mu.reduction["mu"] <= 1.05 * mu.reduction["mu_full"]  # reduction costs < 5 % in μ
-    assert designs["hinf"].gamma is not None
+    red = mu.reduction
+    assert red is not None and red["order"] < red["order_full"] == mu.order_full
+    assert mu.order == mu.K.nstates == red["order"]
+    assert red["mu"] <= (1 + MU_REDUCTION_COST_PIN) * red["mu_full"]
 
 
 def test_hinf_beats_pid_at_nominal_pressure(designs, plants):
@@ -79,21 +106,25 @@ def test_hinf_beats_pid_at_nominal_pressure(designs, plants):
 
 
 def test_pid_unstable_at_high_pressure(designs, plants):
-    """P5 Fig. 13: the decentralised PID does not stabilise the rig at 4.08 bar."""
+    """P5 Fig. 13: the decentralised PID stabilises the rig at 0 and at the nominal 2.04 bar
+    but not at 4.08 bar (2× nominal)."""
     assert closed_loop(plants[0.0][0], designs["pid"].K).stable
+    assert closed_loop(plants[2.04][0], designs["pid"].K).stable
     assert not closed_loop(plants[4.08][0], designs["pid"].K).stable
 
 
 def test_mu_robust_stability_and_sensitivity_over_pressure(designs, plants):
-    """P5 §4.1 item 2, §4.4.2: μ keeps the loop stable and σ̄(S_o) ≤ 3.3 for 0 … 4.08 bar.
+    """P5 §4.1 items 2 and 4, §4.4.2: μ keeps the loop stable and σ̄(S_o) in ISO 14839-3
+    zone A (< 3) for 0 … 4.08 bar (measured ≈ 2.5 when written).
 
     The seal's k goes from 0 to 2× its nominal value over this range (P5 §4.1 items 2–3).
     """
     K = designs["mu"].K
-    for p in PRESSURES:
+    for p in sorted(plants):
         G, _ = plants[p]
         assert closed_loop(G, K).stable, f"unstable at {p} bar"
-        assert _so_peak(G, K) <= 3.3, f"σ̄(S_o) peak above 3.3 at {p} bar"
+        peak = _so_peak(G, K)
+        assert peak < ISO_ZONE_A_LIMIT, f"σ̄(S_o) = {peak:.2f} at {p} bar, not ISO zone A"
 
 
 def test_mu_unbalance_orbit(designs, plants):
@@ -101,22 +132,22 @@ def test_mu_unbalance_orbit(designs, plants):
 
     F_u = m·G·Ω (ISO 21940-11: G2.5 on the 69 kg rotor, balanced to G2.5 at every speed;
     541.9 N at 500 Hz), acting at the seal (0.43 m), orbit at the sensors, on the full-order
-    plant at every pressure of the grid 0 … 4.08 bar. The μ design reaches ≈ 6.6 µm (worst
-    at 0 bar, ≈ 50 Hz); the PID and H∞ do not (≥ 16 µm), which is what the force channel of
-    the μ design is for.
+    plant at every pressure of the grid 0 … 4.08 bar. The μ design reaches ≈ 6.4 µm (worst
+    at 0 bar); the H∞ does not (≥ 16 µm), which is what the force channel of the μ design
+    is for.
     """
     w = 2 * np.pi * np.linspace(1.0, 200.0, 400)
 
     def worst(K):
         out = 0.0
-        for p in PRESSURES:
+        for p in sorted(plants):
             G, Gf = plants[p]
             c = compliance(G, K, Gf, w)
             out = max(out, unbalance_from_compliance(c, mass_kg=69.0, grade_mm_s=2.5).peak_um)
         return out
 
-    assert worst(designs["mu"].K) < 8.0
-    assert worst(designs["hinf"].K) > 8.0  # the demand is not met by accident
+    assert worst(designs["mu"].K) < ORBIT_DEMAND_UM
+    assert worst(designs["hinf"].K) > ORBIT_DEMAND_UM  # the demand is not met by accident
 
 
 def test_mu_force_weight_reads_as_orbit_bound():

@@ -44,8 +44,9 @@ def test_discrete_gain_matches_below_tenth_of_nyquist(method):
 
 @pytest.mark.parametrize("suffix", [".npz", ".mat", ".json"])
 def test_roundtrip_and_atomic_write(tmp_path, suffix):
-    """Reference: the file content equals the controller matrices and names (definition),
-    and no temporary file is left in the folder."""
+    """Reference: the file content equals the controller matrices and names (definition);
+    the stored Tustin and ZOH equivalents equal python-control's control.sample_system of
+    the same realisation (run side by side); no temporary file is left in the folder."""
     K = amb_like_controller()
     path = export_controller(K, tmp_path / f"K{suffix}", fs_hz=20e3)
     if suffix == ".npz":
@@ -60,9 +61,11 @@ def test_roundtrip_and_atomic_write(tmp_path, suffix):
         inputs = d["inputs"]
     np.testing.assert_allclose(d["A"], K.A)
     np.testing.assert_allclose(np.atleast_2d(d["D"]), K.D)
-    Kt = discretize(K, 20e3, "tustin")
-    np.testing.assert_allclose(d["A_tustin"], Kt.A)
-    np.testing.assert_allclose(d["B_zoh"], discretize(K, 20e3, "zoh").B)
+    Kt = ct.sample_system(K, 1 / 20e3, "tustin")
+    Kz = ct.sample_system(K, 1 / 20e3, "zoh")
+    for name, ref in (("A_tustin", Kt.A), ("A_zoh", Kz.A), ("B_zoh", Kz.B)):
+        np.testing.assert_allclose(d[name], ref, rtol=1e-9, atol=1e-12 * np.abs(ref).max(),
+                                   err_msg=name)
     assert inputs == list(K.input_labels)
     assert [p.name for p in tmp_path.iterdir()] == [path.name]
 

@@ -8,8 +8,6 @@ reduced model), P3 §4 (speed as scheduling parameter, synchronous seal coeffici
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -22,8 +20,6 @@ from ambseal.control.lpv import lpvsyn  # noqa: E402
 from ambseal.control.lpv_plant import lpv_plant  # noqa: E402
 from ambseal.errors import ModelError, SynthesisError  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[2]
-TURBO = ROOT / "examples" / "turboexpander.toml"
 
 
 def _toy(p: float):
@@ -50,32 +46,56 @@ def toy_designs():
     return grid, plants, frozen, const, rate
 
 
+def _frozen_loop(P, K):
+    """python-control F_l(P, K) (positive feedback, Skogestad & Postlethwaite A.7)."""
+    return P.lft(ct.ss(K.A, K.B, K.C, K.D), 2, 2)
+
+
 def test_gamma_ordering(toy_designs):
     """Apkarian & Adams 1998: frozen max γ ≤ rate-bounded γ ≤ constant-Lyapunov γ."""
     _, _, frozen, const, rate = toy_designs
-    assert const.reports[0].status == "optimal"
     assert rate.gamma <= const.gamma * (1 + 1e-4)
     # hinfsyn reports the verified norm of a controller built 1 % above γ_opt
     assert rate.gamma >= frozen / 1.01 * (1 - 1e-3)
 
 
 def test_dense_grid_closed_loops_stable(toy_designs):
-    """Every frozen closed loop on the 5× denser check grid is stable, its norm below the
-    design γ·1.02 up to the interpolation of A (Wu et al. 1996, frozen-point consequence)."""
+    """Wu et al. 1996 (frozen-point consequence of the LPV bound), checked with python-control
+    side by side: on the 5× denser check grid (21 speeds) the exact toy plant closed by the
+    frozen controller (P.lft, poles and control.norm = slycot AB13DD) is stable with
+    ‖F_l‖∞ ≤ 1.02·γ_design (the controller is reconstructed at 1.02 γ, interpolated between
+    table points); the reported check norms are those norms."""
     grid, _, _, const, rate = toy_designs
     for r in (const, rate):
-        assert r.check_stable
-        assert r.check_rad_s.size == 5 * (grid.size - 1) + 1
-        assert np.all(np.isfinite(r.check_gamma))
-        assert r.check_gamma.max() <= 1.02 * r.gamma_design * (1 + 1e-3)
+        speeds = r.check_rad_s
+        assert speeds.size == 5 * (grid.size - 1) + 1
+        assert np.allclose(speeds, np.linspace(grid[0], grid[-1], speeds.size))
+        norms = []
+        for p in speeds:
+            cl = _frozen_loop(_toy(p), r.K.at(p))
+            assert cl.poles().real.max() < 0, p
+            norms.append(ct.norm(cl, "inf"))
+        assert max(norms) <= 1.02 * r.gamma_design * (1 + 1e-3)
+        np.testing.assert_allclose(r.check_gamma, norms, rtol=1e-4)
+        # midpoints between table speeds, where K is interpolated, stay stable too
+        for p in 0.5 * (speeds[1:] + speeds[:-1]):
+            assert _frozen_loop(_toy(p), r.K.at(p)).poles().real.max() < 0, p
 
 
 def test_controller_at_any_speed(toy_designs):
-    """The scheduled controller gives a StateSpace between table points (interpolated)."""
+    """The scheduled controller between table points is the linear interpolation of the two
+    neighbouring table controllers (LpvController contract), a 2×2 StateSpace of the plant's
+    order."""
     _, plants, _, const, _ = toy_designs
     K = const.K.at(13.3)
     assert K.ninputs == 2 and K.noutputs == 2 and K.nstates == plants[0].nstates
-    assert const.to_dict()["check_stable"] is True
+    g = const.K.speeds_rad_s
+    j = int(np.searchsorted(g, 13.3)) - 1
+    t = (13.3 - g[j]) / (g[j + 1] - g[j])
+    K0, K1 = const.K.at(g[j]), const.K.at(g[j + 1])
+    for X in ("A", "B", "C", "D"):
+        np.testing.assert_allclose(getattr(K, X), (1 - t) * getattr(K0, X) + t * getattr(K1, X),
+                                   rtol=1e-12, atol=1e-12 * np.abs(getattr(K0, X)).max())
 
 
 def test_bad_inputs():
@@ -96,12 +116,12 @@ def test_bad_inputs():
         lpvsyn([P, _toy(1.0)], [0.0, 1.0], 2, 2, solver_options={"max_iter": 2})
 
 
-def test_lpv_plant_common_basis_matches_reduction():
+def test_lpv_plant_common_basis_matches_reduction(turbo_cfg):
     """P3 Eq. 4 with one T_L, T_R: the projected frozen plants keep the poles of a modal
     reduction made at each speed to within 1 % of |λ| (rigid-body modes, 20–300 Hz)."""
     from ambseal.model.rig import build_plant
 
-    cfg = load_rig(TURBO)
+    cfg = turbo_cfg
     L = lpv_plant(cfg, [20.0, 140.0, 300.0], force_positions=(cfg.amb[0].position,))
     assert L.A.shape == (3, 12, 12) and L.affine is None
     assert L.input_names[-2:] == ("F0_x", "F0_y")
@@ -132,54 +152,75 @@ def test_lpv_plant_affine_without_tables():
 
 
 # --------------------------------------------------------------------------- turboexpander
+#: Regression pins, not published values (P3 gives no γ for its LPV design): when set
+#: (issue 8) the turboexpander's max frozen H∞ γ was 0.943 (< 1: the weights are met at
+#: every frozen speed, which is the design's demand) and the constant-Lyapunov LPV γ 1.070
+#: (rate-bounded 1.051). A change beyond these bounds is a change of the design.
+TURBO_FROZEN_GAMMA_PIN = 1.0
+TURBO_CONST_GAMMA_PIN = 1.1
+
+
 @pytest.fixture(scope="module")
-def turbo_designs():
-    """Constant- and rate-bounded-Lyapunov LPV designs on a 10-point 20–300 Hz grid (P3 §4)."""
+def turbo(turbo_cfg, turbo_lpv):
+    """The session's constant-Lyapunov design on a 10-point 20–300 Hz grid (P3 §4)."""
+    return turbo_cfg, turbo_lpv
+
+
+def test_turbo_frozen_loops_against_python_control(turbo):
+    """Wu et al. 1996 with python-control side by side: at 5 speeds of the check grid
+    (table points and an interpolated one) the generalised plant at that speed closed by the
+    scheduled controller (P.lft; poles; control.norm = slycot AB13DD) is stable with
+    ‖F_l‖∞ ≤ 1.02·γ_design; the table is the 5× denser grid."""
+    from ambseal.control.lpv_design import lpv_generalized_plants
+
+    _, d = turbo
+    assert d.check_speeds_hz.size == 5 * (d.speeds_hz.size - 1) + 1
+    speeds_hz = [20.0, d.check_speeds_hz[7], 140.0 + 1.3, 213.0, 300.0]
+    W = 2 * np.pi * np.asarray(speeds_hz)
+    gps = lpv_generalized_plants(d.plant, d.weights, W)
+    for f, w, gp in zip(speeds_hz, W, gps):
+        K = d.K.at(w)
+        cl = gp.P_nominal.lft(ct.ss(K.A, K.B, K.C, K.D), gp.nmeas, gp.ncon)
+        assert cl.poles().real.max() < 0, f
+        assert ct.norm(cl, "inf") <= 1.02 * d.gamma_design * (1 + 1e-3), f
+    assert d.to_dict()["lyapunov"] == "constant"
+
+
+def test_turbo_gamma_ordering_and_pins(turbo):
+    """Apkarian & Adams 1998: max frozen H∞ γ ≤ constant-Lyapunov γ; the values against the
+    regression pins TURBO_FROZEN_GAMMA_PIN and TURBO_CONST_GAMMA_PIN (module constants)."""
+    _, const = turbo
+    frozen = float(np.max(const.frozen_gamma))
+    assert frozen <= const.gamma * (1 + 1e-3)
+    assert frozen < TURBO_FROZEN_GAMMA_PIN and const.gamma < TURBO_CONST_GAMMA_PIN
+
+
+@pytest.mark.slow
+def test_turbo_rate_bounded_gamma_ordering(turbo):
+    """Apkarian & Adams 1998 on the turboexpander: max frozen γ ≤ rate-bounded γ ≤
+    constant-Lyapunov γ, |Ω̇|/2π ≤ 280 Hz/s (the 20 → 300 Hz ramp in 1 s of P3 Fig. 11).
+    Slow (about a minute); the same ordering and code path are checked fast on the toy
+    plant (test_gamma_ordering)."""
     from ambseal.control.lpv_design import design_lpv
 
-    cfg = load_rig(TURBO)
-    const = design_lpv(cfg)
-    # |Ω̇|/2π ≤ 280 Hz/s: the 20 → 300 Hz ramp in 1 s of P3 Fig. 11
+    cfg, const = turbo
     rate = design_lpv(cfg, rate_bound_hz_per_s=280.0, frozen_gamma=False)
-    return cfg, const, rate
-
-
-def test_turbo_lpv_solves_accurately(turbo_designs):
-    """Every SDP stage of the turboexpander design ends 'optimal' (Clarabel), the
-    controller table is the 5× denser grid, and every frozen closed loop on it is stable
-    (Wu et al. 1996; issue 5 §3)."""
-    _, const, rate = turbo_designs
-    for d in (const, rate):
-        assert all(r.status == "optimal" for r in d.reports)
-        assert d.check_speeds_hz.size == 5 * (d.speeds_hz.size - 1) + 1
-        assert np.all(np.isfinite(d.check_gamma))
-        assert d.check_gamma.max() <= 1.02 * d.gamma_design * (1 + 1e-3)
-    assert const.to_dict()["lyapunov"] == "constant" and rate.lyapunov == "affine"
-
-
-def test_turbo_gamma_ordering(turbo_designs):
-    """Apkarian & Adams 1998: max frozen H∞ γ ≤ rate-bounded γ ≤ constant-Lyapunov γ."""
-    _, const, rate = turbo_designs
-    frozen = float(np.max(const.frozen_gamma))
-    assert frozen <= rate.gamma * (1 + 1e-3)
+    assert rate.lyapunov == "affine"
+    assert float(np.max(const.frozen_gamma)) <= rate.gamma * (1 + 1e-3)
     assert rate.gamma <= const.gamma * (1 + 1e-4)
-    # with the 1.4 kHz high-pass W_u (P3 §3.3) the weights are met within 10 %
-    # (γ ≈ 0.94 frozen, 1.05 rate-bounded, 1.07 constant); the acceptance itself is checked
-    # on the full-order plant below and in tests/analysis/test_analysis_spinup.py
-    assert frozen < 1.0 and const.gamma < 1.1
 
 
-def test_turbo_full_order_sensitivity_below_3(turbo_designs):
-    """P3 §3.1 / ISO 14839-3 zone A: σ̄(S_o) ≤ 3 at every frozen speed of 20–300 Hz (15
+def test_turbo_full_order_sensitivity_below_3(turbo):
+    """P3 §3.1 / ISO 14839-3 zone A: σ̄(S_o) < 3 at every frozen speed of 20–300 Hz (15
     speeds) for the LPV controller designed on the rigid-body model (P3 §2.2), on the
     full-order plant (bending modes included, every frozen loop stable), with the frequency
     grid refined around each lightly damped closed-loop pole (``resolved_grid``) so that the
     0.5 %-damped ~2 kHz bending peaks are not stepped over."""
     from ambseal.analysis.spinup import frozen_sensitivity
 
-    cfg, const, _ = turbo_designs
+    cfg, const = turbo
     fs = frozen_sensitivity(cfg, const, np.linspace(20.0, 300.0, 15), name="lpv",
                             omega=2 * np.pi * np.logspace(0, np.log10(3000.0), 200))
     assert fs.stable.all()
     assert np.all(fs.peak >= fs.sigma.max(axis=1))  # the refined grid only adds points
-    assert np.all(fs.peak <= 3.0), dict(zip(fs.speeds_hz, fs.peak))
+    assert np.all(fs.peak < 3.0), dict(zip(fs.speeds_hz, fs.peak))

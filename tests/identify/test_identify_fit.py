@@ -113,6 +113,8 @@ def test_budget_exhausted_is_flagged_not_silent(rig, prbs_fit):
 
 
 def test_unknown_parameter_is_one_clear_error(rig, prbs_fit):
+    """Reference: interface contract — an unknown parameter name is one
+    IdentificationError naming it."""
     rec, _ = prbs_fit
     with pytest.raises(IdentificationError, match="unknown parameter 'A.Kx_zeta'"):
         fit_parameters([rec], build_models(rig, [rec]), ["A.Kx_zeta"])

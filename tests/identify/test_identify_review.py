@@ -53,17 +53,22 @@ def test_controller_sample_time_must_match_the_record():
     ({"type": "lqg"}, "unknown"),
 ])
 def test_bad_controller_metadata(ctrl, match):
+    """Reference: interface contract (DESIGN.md errors) — a PID without integral time, a
+    controller of the wrong size and an unknown type raise DataError naming the cause."""
     with pytest.raises(DataError, match=match):
         controller_from_metadata({"sample_rate_hz": 1e4, "controller": ctrl}, AXES)
 
 
 def test_start_outside_bounds_is_refused(rig, record):
+    """Reference: interface contract — a start value outside its bounds is refused, not
+    clipped silently."""
     with pytest.raises(IdentificationError, match="outside its bounds"):
         fit_parameters([record], build_models(rig, [record]), ["A.Ks_zeta"],
                        bounds={"A.Ks_zeta": (2.0e6, 2.1e6)})
 
 
 def test_duplicate_parameter_names(rig, record):
+    """Reference: interface contract — a parameter named twice is refused, naming it."""
     with pytest.raises(IdentificationError, match="named twice: A.Ki_zeta"):
         fit_parameters([record], build_models(rig, [record]), ["A.Ki_zeta", "A.Ki_zeta"])
 
@@ -77,6 +82,8 @@ def test_estimate_stopped_at_a_bound_is_not_converged(rig, record):
 
 
 def test_facility_refuses_non_positive_ks(rig):
+    """Reference: P2 force model — Ks > 0 (negative stiffness magnitude); a truth with
+    Ks = 0 is refused naming the parameter."""
     ex = prbs(amplitude_a=0.05, clock_period_s=1e-3, duration_s=0.05, sample_rate_hz=1e4)
     with pytest.raises(ModelError, match="A.Ks_zeta"):
         acquire(rig, TruthSection(parameters={"A.Ks_zeta": 0.0}), ex,
@@ -97,5 +104,7 @@ def test_identified_factor_of_a_geometry_amb_is_kept(rig):
 
 
 def test_identify_wraps_unknown_names(rig, record):
+    """Reference: interface contract — an unknown parameter name is one
+    IdentificationError."""
     with pytest.raises(IdentificationError, match="unknown parameter"):
         identify(rig, [record], ["A.Kq_zeta"])

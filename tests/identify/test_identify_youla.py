@@ -104,6 +104,13 @@ def _true_loop(plant, cf, theta, eta, noise=None, r1=None, r2=None, changes=None
     return Y, U
 
 
+def _fr_solve(sys, pts):
+    """Frequency response (nf, p, m) as C (sI − A)⁻¹ B + D by a dense solve per point."""
+    A, B, C, D = (np.asarray(X, complex) for X in (sys.A, sys.B, sys.C, sys.D))
+    eye = np.eye(A.shape[0])
+    return np.stack([C @ np.linalg.solve(s * eye - A, B) + D for s in pts])
+
+
 def _fr(sys, pts):
     """Frequency response (nf, p, m) of a control.StateSpace at complex points."""
     return np.stack([np.atleast_2d(sys(s)) for s in pts])
@@ -111,17 +118,32 @@ def _fr(sys, pts):
 
 # --------------------------------------------------------------------------- factors
 def test_bezout_identity_holds_discrete_and_continuous(cf, cfc):
-    """Reference: P1 Eq. 3 (double Bezout identity) — both products of the eight factors,
-    each evaluated on its own, equal I on a frequency grid to 1e-9 (units balanced);
-    Zhou, Doyle & Glover (1996) Thm 5.9 for the observer-based formulas."""
-    assert check_bezout(cf) < 1e-9
-    assert check_bezout(cfc) < 1e-9
-    # all eight factors are stable (in RH∞)
+    """Reference: P1 Eq. 3 (double Bezout identity) — [[Ṽ, −Ũ], [−Ñ, M̃]]·[[M, U], [N, V]] = I
+    and the reverse product, each of the eight factors evaluated here on its own as
+    C (sI − A)⁻¹ B + D by a plain dense solve (python-control's ``sys(s)`` loses ~5 digits
+    on these stiff realisations, see below) at 30 points and assembled here, in balanced
+    units (outputs scaled by ``output_scale``) to 1e-9; the module's own measure
+    bezout_error() agrees (Zhou, Doyle & Glover 1996 Thm 5.9 for the observer-based
+    formulas). All eight factors are stable (in RH∞), by python-control poles."""
     for f in (cf, cfc):
+        pts = (np.exp(1j * np.linspace(0.01, 0.99 * np.pi, 30)) if f.dt
+               else 1j * np.logspace(0, 4, 30))
+        M, N, U, V = (_fr_solve(x, pts) for x in (f.M(), f.N(), f.U(), f.V()))
+        Vt, Ut, Nt, Mt = (_fr_solve(x, pts) for x in (f.V_tilde(), f.U_tilde(), f.N_tilde(),
+                                                       f.M_tilde()))
+        Lm = np.concatenate([np.concatenate([Vt, -Ut], 2), np.concatenate([-Nt, Mt], 2)], 1)
+        Rm = np.concatenate([np.concatenate([M, U], 2), np.concatenate([N, V], 2)], 1)
+        m, p = M.shape[2], N.shape[1]
+        t = np.concatenate([np.ones(m), np.full(p, f.output_scale)])
+        eye = np.eye(m + p)
+        for prod in (Lm @ Rm, Rm @ Lm):
+            err = np.abs((prod - eye) * t[None, None, :] / t[None, :, None]).max()
+            assert err < 1e-9
+        assert f.bezout_error() < 1e-9
         for sys in (f.M(), f.N(), f.U(), f.V(), f.M_tilde(), f.N_tilde(), f.U_tilde(),
                     f.V_tilde()):
-            assert np.all(np.abs(control.poles(sys)) < 1) if f.dt else np.all(
-                control.poles(sys).real < 0)
+            pl = control.poles(sys)
+            assert (np.abs(pl).max() < 1) if f.dt else (pl.real.max() < 0)
 
 
 def test_factors_reproduce_plant_and_controller(cf, plant):
@@ -271,16 +293,16 @@ def test_signals_follow_eq11_with_r1_r2(plant, cf, eta):
 def test_p1_case_identifies_theta_half_noise_free(plant, cf, eta):
     """Reference: P1 §IV — 50 % change of one bearing's Ks in one direction, PRBS η for
     0.5 s at 1 kHz, r1 = r2 = 0: P1 identified θ = 0.502 for 0.5. With the exact sampled-data
-    S(θ) we must do at least as well (|θ̂ − 0.5| ≤ 0.002; in fact to round-off)."""
+    S(θ) we must do at least as well (P1's |θ̂ − 0.5| = 0.002; here to round-off, 1e-6),
+    with η recovered from the record to 1e-9 and a fit of the ε record above 99.9 %."""
     Y, U = _true_loop(plant, cf, 0.5, eta)
     res = identify_youla(cf, plant, [PARAM], u=U, y=Y, eta=eta)
-    assert res.converged
-    assert abs(res.theta_of(PARAM) - 0.5) <= 0.002
+    assert res.converged  # least squares succeeded and the spectral radius is below 1
     assert abs(res.theta_of(PARAM) - 0.5) < 1e-6
     nom = plant.parameter(PARAM).nominal
     assert res.change[0] == pytest.approx(0.5 * nom, rel=1e-6)
     assert res.value[0] == pytest.approx(1.5 * nom, rel=1e-6)
-    assert res.spectral_radius < 1.0 and res.eta_mismatch < 1e-9 and res.fit_pct > 99.9
+    assert res.eta_mismatch < 1e-9 and res.fit_pct > 99.9
     d = json.loads(json.dumps(res.to_dict()))
     assert d["parameters"][PARAM]["theta"] == pytest.approx(0.5, abs=1e-6)
     # η recovered from the record instead of given: the same answer

@@ -1,0 +1,151 @@
+"""Session-wide fixtures: the expensive designs, computed once per test session.
+
+Each design below is made by the public function with the arguments ``ambseal run`` uses,
+so that the tests of the designs, of the analyses built on them and of the main job see the
+same controllers:
+
+* ``testrig_designs`` — PID, H∞ and μ of :func:`ambseal.control.design.design` on the
+  embedded test facility (thesis P5 §4), a few seconds;
+* ``testrig_plants`` — the full-order test-facility plants over 0 … 4.08 bar (P5 Fig. 13);
+* ``turbo_lpv`` — the constant-Lyapunov LPV design of the turboexpander over its
+  ``[operating] speed_range_hz`` with the frozen γ's (P3 §4), about half a minute;
+* ``turbo_frozen`` — the H∞ controller at the operating speed (140 Hz, P3 Fig. 11).
+
+``design_cache_for`` lets a test run the main job (``ambseal run``) on these designs instead
+of recomputing them: it replaces the design functions for the duration of the test by
+wrappers that return the session's result when called with the same rig and arguments and
+call the real function otherwise. Only the main-job tests use it; the design tests call
+the real functions.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+TURBO = ROOT / "examples" / "turboexpander.toml"
+
+#: Pressure grid 0 … 2× nominal (2.04 bar) of thesis P5 Fig. 13, in 8 steps.
+PRESSURES_BAR = (0.0, 0.51, 1.02, 1.53, 2.04, 2.55, 3.06, 3.57, 4.08)
+
+
+@pytest.fixture(scope="session")
+def testrig_cfg():
+    from ambseal.config import load_rig
+
+    return load_rig()
+
+
+@pytest.fixture(scope="session")
+def turbo_cfg():
+    from ambseal.config import load_rig
+
+    return load_rig(TURBO)
+
+
+@pytest.fixture(scope="session")
+def testrig_designs(testrig_cfg):
+    """{"pid", "hinf", "mu"} → DesignResult, as ``ambseal run`` makes them."""
+    from ambseal.control.design import design
+
+    return {m: design(testrig_cfg, m) for m in ("pid", "hinf", "mu")}
+
+
+@pytest.fixture(scope="session")
+def testrig_plants(testrig_cfg):
+    """pressure (bar) → (G, Gf): full-order plant from the 4 currents and from the force at
+    the seal (0.43 m, the rig's first seal) to the 4 displacements."""
+    from ambseal.model.rig import build_plant
+
+    x_seal = testrig_cfg.seal[0].position
+    out = {}
+    for p in PRESSURES_BAR:
+        pl = build_plant(testrig_cfg, pressure_bar=p, force_positions=(x_seal,))
+        out[p] = (pl.select_inputs(pl.input_names[:4]).to_statespace(),
+                  pl.select_inputs(pl.input_names[4:]).to_statespace())
+    return out
+
+
+@pytest.fixture(scope="session")
+def turbo_lpv(turbo_cfg):
+    """Constant-Lyapunov LPV design over the rig's speed range, frozen γ's included."""
+    from ambseal.control.lpv_design import design_lpv
+
+    return design_lpv(turbo_cfg, speeds_hz=turbo_cfg.operating.speed_range_hz)
+
+
+@pytest.fixture(scope="session")
+def turbo_frozen(turbo_cfg):
+    """H∞ at the operating speed (8400 rpm = 140 Hz), the LTI comparison of P3 Fig. 11."""
+    from ambseal.control.lpv_design import design_frozen
+
+    return design_frozen(turbo_cfg, turbo_cfg.operating.speed_rpm / 60.0)
+
+
+class DesignCache:
+    """Routes the main job's design calls to the session's designs (see module doc).
+
+    ``patched(rig)`` computes (or fetches) the session designs of that rig first, then
+    replaces the design functions until the ``with`` block ends; calls with other rigs or
+    arguments go to the real functions. ``hits`` lists the calls answered from the session,
+    so a test can check that the cache was used.
+    """
+
+    FIXTURES = {"testrig": ("testrig_cfg", "testrig_designs"),
+                "turbo": ("turbo_cfg", "turbo_lpv", "turbo_frozen")}
+
+    def __init__(self, request):
+        self._request = request  # the requesting fixture's or test's
+        self.hits: list[str] = []
+
+    @contextlib.contextmanager
+    def patched(self, rig: str):
+        """Replace the design functions for the duration of the ``with`` block."""
+        import ambseal.control.design as dmod
+        import ambseal.control.lpv_design as lmod
+
+        got = {n: self._request.getfixturevalue(n) for n in self.FIXTURES[rig]}
+        real_design, real_lpv, real_frozen = dmod.design, lmod.design_lpv, lmod.design_frozen
+
+        def design(cfg, method="mu", **kw):
+            if rig == "testrig" and not kw and _same(cfg, got["testrig_cfg"]):
+                self.hits.append(f"design:{method}")
+                return got["testrig_designs"][method]
+            return real_design(cfg, method, **kw)
+
+        def design_lpv(cfg, **kw):
+            tc = got.get("turbo_cfg")
+            if (tc is not None and _same(cfg, tc) and set(kw) == {"speeds_hz"}
+                    and tuple(kw["speeds_hz"]) == tuple(tc.operating.speed_range_hz)):
+                self.hits.append("design_lpv")
+                return got["turbo_lpv"]
+            return real_lpv(cfg, **kw)
+
+        def design_frozen(cfg, speed_hz=140.0, **kw):
+            tc = got.get("turbo_cfg")
+            if (tc is not None and not kw and _same(cfg, tc)
+                    and float(speed_hz) == tc.operating.speed_rpm / 60.0):
+                self.hits.append("design_frozen")
+                return got["turbo_frozen"]
+            return real_frozen(cfg, speed_hz, **kw)
+
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setattr(dmod, "design", design)
+            mp.setattr(lmod, "design_lpv", design_lpv)
+            mp.setattr(lmod, "design_frozen", design_frozen)
+            yield self
+
+
+def _same(a, b) -> bool:
+    return a.model_dump_json() == b.model_dump_json()
+
+
+@pytest.fixture(scope="session")
+def design_cache_for():
+    """:class:`DesignCache` itself: ``with design_cache_for(request).patched(rig): ...`` with the
+    ``request`` of the fixture or test that runs the main job (the session designs are
+    looked up through it while it is active)."""
+    return DesignCache

@@ -1,8 +1,7 @@
 """Spin-up of a speed-scheduled AMB rotor and the frozen-speed sensitivities (thesis P3 §4,
 Figs. 11–12).
 
-* :func:`spinup` — time-varying simulation (an ODE solver; exact ZOH stepping as a
-  cross-check): the speed ramps 20 → 300 Hz in 1 s while a
+* :func:`spinup` — time-varying simulation (an ODE solver): the speed ramps 20 → 300 Hz in 1 s while a
   100 N force step and a 2 µm output (sensor) step on A_x (the first actuator axis)
   alternate every 50 ms (P3 Fig. 11); the plant is taken at the instantaneous speed
   (:meth:`ambseal.control.lpv_plant.LpvPlant.A_at`) and the controller is either scheduled
@@ -10,7 +9,7 @@ Figs. 11–12).
 * :func:`frozen_sensitivity` — σ̄(S_o) on the full-order plant at frozen speeds across the
   range (P3 Fig. 12), with closed-loop stability.
 
-**Integration** (``method``). The closed loop is linear and time-varying: with
+**Integration.** The closed loop is linear and time-varying: with
 x = [x_plant; x_K], v = [forces; sensor offsets] (piecewise constant),
 
     ẋ = A_cl(Ω(t)) x + B_cl(Ω(t)) v,   A_cl = [[A(Ω) − B_i D_K C, −B_i C_K], [B_K C, A_K]],
@@ -19,8 +18,7 @@ A(Ω) from :meth:`ambseal.control.lpv_plant.LpvPlant.A_at` (B, C, D constant), (
 C_K, D_K)(Ω) from the scheduled controller (``matrices_at``: the LPV table interpolated
 linearly between its speeds) or constant for a fixed controller, i = −C_K x_K − D_K y.
 
-* ``"ode"`` (default) — ``scipy.integrate.solve_ivp`` on the continuous loop, Ω(t) exact at
-  every instant. Solver ``"LSODA"`` (switches between Adams and BDF by itself — the loop
+``scipy.integrate.solve_ivp`` on the continuous loop, Ω(t) exact at every instant. Solver ``"LSODA"`` (switches between Adams and BDF by itself — the loop
   holds lightly damped bending modes next to fast, stiff poles; ``"BDF"`` and ``"Radau"``
   give the same steps, 10–50 % slower), with the exact Jacobian A_cl(Ω(t)) passed (the
   system is linear in x at fixed t). Step sizes are the solver's own (no ``max_step``: the
@@ -34,19 +32,14 @@ linearly between its speeds) or constant for a fixed controller, i = −C_K x_K 
   integrating across one would cut its step and order blindly and smear the jump, so the
   solver is **restarted at every step**, each 50 ms window integrated from the previous
   window's final state with its own constant v. The solution is read on the output grid
-  (``dt``, 10 µs; the solver's dense output) so peaks and settling times are computed as
-  for ``"zoh"``. Speed: A_cl, B_cl, C_u, D_K are tabulated every ``schedule_s`` along the
+  (``dt``, 10 µs; the solver's dense output) so peaks and settling times are computed on
+  samples. Speed: A_cl, B_cl, C_u, D_K are tabulated every ``schedule_s`` along the
   ramp and blended linearly in t wherever the loop is affine in Ω (the plant is affine or
   linear between grid speeds, the LPV table linear between its speeds; checked at each
   interval's midpoint), evaluated exactly on the intervals holding a table speed — exact
   up to rounding, and ≈ 1.5 s per spin-up instead of ≈ 9 s.
-* ``"zoh"`` — the cross-check: exact piecewise zero-order-hold stepping. Over each
-  scheduling period (1 ms by default) Ω, hence A(Ω) and the controller, is frozen at the
-  period's midpoint and the loop advanced with its matrix exponential in sub-steps of
-  ``dt``; the disturbances switch on period boundaries, so the only approximation is the
-  1 ms freezing of Ω (0.28 Hz of a 280 Hz/s ramp), the way a digital controller updates its
-  schedule. The two agree to ~1e-5 in the step peaks and ~1 µs in the settling times
-  (``tests/analysis/test_analysis_spinup.py``).
+At a constant speed the loop is time-invariant, and the result equals python-control's
+``forced_response`` of the frozen loop (``tests/analysis/test_analysis_spinup.py``).
 
 Events: step k (k = 0, 1, …) at t_k = k·50 ms toggles the force (even k: on at k ≡ 0 mod 4,
 off at k ≡ 2 mod 4) or the output offset (odd k: on at k ≡ 1 mod 4, off at k ≡ 3 mod 4), so
@@ -182,7 +175,7 @@ def _windows(n_sched: int, n_per: int, n_sub: int, schedule_s: float, nf: int, n
 def spinup(plant, controller, *, name: str = "K", speeds_hz=(20.0, 300.0),
            ramp_s: float = 1.0, force_n: float = 100.0, output_m: float = 2e-6,
            period_s: float = 0.05, channel: int = 0, force_input: int = 0,
-           method: str = "ode", schedule_s: float = 1e-3, dt: float = 1e-5,
+           schedule_s: float = 1e-3, dt: float = 1e-5,
            rtol: float = _RTOL, atol: float = _ATOL, solver: str = "LSODA") -> SpinupResult:
     """Simulate a spin-up with alternating force and output steps (thesis P3 Fig. 11).
 
@@ -208,19 +201,14 @@ def spinup(plant, controller, *, name: str = "K", speeds_hz=(20.0, 300.0),
         Time between steps (s).
     channel : int
         Measured channel judged (0: A_x).
-    method : {"ode", "zoh"}
-        ``"ode"`` (default): the continuous time-varying loop with ``solve_ivp``, restarted
-        at every step; ``"zoh"``: exact stepping with Ω frozen per ``schedule_s`` (the
-        cross-check). See the module docstring.
     schedule_s, dt : float
-        Scheduling period of the ``"zoh"`` path and output sample time (also its
-        integration sub-step) (s); ``schedule_s`` must be a multiple of ``dt`` and divide
-        ``period_s`` (checked for both methods).
+        Tabulation period of the loop along the ramp and output sample time (s);
+        ``schedule_s`` must be a multiple of ``dt`` and divide ``period_s``.
     rtol, atol : float
-        ``"ode"`` tolerances: ``rtol`` as given; ``atol`` relative to each state's scale
+        Tolerances: ``rtol`` as given; ``atol`` relative to each state's scale
         (its largest excursion in the frozen start-speed loop's step responses).
     solver : str
-        ``solve_ivp`` method of the ``"ode"`` path (a stiff-capable one: ``"LSODA"``,
+        ``solve_ivp`` method (a stiff-capable one: ``"LSODA"``,
         ``"Radau"``, ``"BDF"``).
 
     Returns
@@ -230,12 +218,10 @@ def spinup(plant, controller, *, name: str = "K", speeds_hz=(20.0, 300.0),
     Raises
     ------
     ModelError
-        Bad timing arguments or method, a plant without force inputs, a direct current
+        Bad timing arguments, a plant without force inputs, a direct current
         feedthrough, speeds outside the plant's grid. A diverging loop is not an error: the
         simulation stops there and the steps left read as not settled (``inf``).
     """
-    if method not in ("ode", "zoh"):
-        raise ModelError(f"spinup: method={method!r}, expected 'ode' or 'zoh'")
     n_sub = int(round(schedule_s / dt))
     n_per = int(round(period_s / schedule_s))
     n_sched = int(round(ramp_s / schedule_s))
@@ -260,10 +246,7 @@ def spinup(plant, controller, *, name: str = "K", speeds_hz=(20.0, 300.0),
     t = np.arange(nt) * dt
     wins = _windows(n_sched, n_per, n_sub, schedule_s, nf, ny, force_input, channel,
                     force_n, output_m)
-    if method == "zoh":
-        Y, U = _run_zoh(loop, wins, f0, f1, ramp_s, schedule_s, n_sub, dt, nt)
-    else:
-        Y, U = _run_ode(loop, wins, f0, f1, ramp_s, t, rtol, atol, solver, schedule_s)
+    Y, U = _run_ode(loop, wins, f0, f1, ramp_s, t, rtol, atol, solver, schedule_s)
     speed = f0 + (f1 - f0) * t / ramp_s
     steps = []
     y = Y[:, channel]
@@ -312,35 +295,6 @@ class _Loop:
             self._cache.pop(next(iter(self._cache)))
         self._cache[W] = got
         return got
-
-
-def _run_zoh(loop, wins, f0, f1, ramp_s, schedule_s, n_sub, dt, nt):
-    """Exact piecewise ZOH stepping, Ω frozen at each scheduling period's midpoint."""
-    N = loop.n + loop.nk
-    ny = loop.C.shape[0]
-    x = np.zeros(N)
-    Y = np.zeros((nt, ny))
-    U = np.zeros((nt, loop.B_i.shape[1]))
-    v = wins[0][4]
-    n_sched = (nt - 1) // n_sub
-    starts = {w[2] // n_sub: w[4] for w in wins}
-    for j in range(n_sched):
-        v = starts.get(j, v)
-        tm = (j + 0.5) * schedule_s
-        Acl, Bcl, Cu, DK = loop(_TWO_PI * (f0 + (f1 - f0) * tm / ramp_s))
-        Ad, Bd = zoh(Acl, Bcl, dt)
-        bv = Bd @ v
-        Ev = loop.E @ v
-        i0 = j * n_sub
-        for s in range(n_sub):
-            Y[i0 + s] = loop.Cy @ x + Ev
-            U[i0 + s] = Cu @ x - DK @ Ev
-            x = Ad @ x + bv
-        if not np.all(np.isfinite(x)) or np.max(np.abs(x)) > 1e6:
-            break
-    Y[-1] = loop.Cy @ x + loop.E @ v
-    U[-1] = U[-2]
-    return Y, U
 
 
 def _state_scale(loop, W0: float, vs, dt: float = 1e-4, n: int = 500) -> np.ndarray:

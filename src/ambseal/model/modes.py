@@ -8,10 +8,10 @@ Two paths, one result type:
 - ``modes(sys, n_modes=n)`` — only the ``n`` lowest modes, by ARPACK
   (``scipy.sparse.linalg.eigs``) in shift-invert mode on the quadratic pencil. Use it when
   only the first few modes are wanted (critical speeds, a Campbell diagram of the lowest
-  modes, benchmarks): one LU of the n_dof × n_dof dynamic stiffness (sparse, or dense
-  when modal damping fills C) and about 4n + 40 solves (the Arnoldi basis), instead of the QR iteration on the
-  whole 2n_dof state matrix. It sees only the eigenvalues nearest zero, so an unstable
-  pole beyond them is not reported.
+  modes, benchmarks): one LU of the n_dof × n_dof dynamic stiffness (sparse, or dense when
+  modal damping fills C) and about 4n + 40 solves (the Arnoldi basis) instead of the QR
+  iteration on the whole state matrix. It sees only the eigenvalues nearest zero, so an
+  unstable pole beyond them is not reported.
 """
 
 from __future__ import annotations

@@ -33,7 +33,8 @@ sensor, plus a ``[[spring]]`` with the bearing coefficients.
 
 Both sides are timed end to end (model build included), each repeat on a freshly built
 model (ROSS caches ``run_modal``/``run_freq_response`` per rotor instance), after one
-untimed warm-up call; the medians are reported. BLAS runs single-threaded by default
+untimed warm-up call; the calls of the two tools alternate (so both see the same load on
+a shared machine) and the medians are reported. BLAS runs single-threaded by default
 (``--threads``): on a small, busy machine multi-threaded OpenBLAS spends most of its time
 spinning, which makes every timing meaningless.
 
@@ -167,16 +168,26 @@ def log(msg: str) -> None:
     print(msg, file=sys.stderr, flush=True)
 
 
-def timed(fn, repeats: int, label: str):
-    """Median wall time over ``repeats`` calls, and the last result."""
-    times = []
-    out = None
-    for k in range(repeats):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-        log(f"  {label}: run {k + 1}/{repeats}: {times[-1]:.4f} s")
-    return statistics.median(times), out
+def timed(ours, rep_ours: int, base, rep_base: int):
+    """Median wall times of ``ours()`` and ``base()`` and their last results.
+
+    The calls alternate (ours, base, ours, base, ...; the side with more repeats finishes
+    alone) so that both see the same load on a shared machine.
+    """
+    times: dict[str, list[float]] = {"ours": [], "ross": []}
+    outs = {}
+    for k in range(max(rep_ours, rep_base)):
+        for label, fn, reps in (("ours", ours, rep_ours), ("ross", base, rep_base)):
+            if k >= reps:
+                continue
+            t0 = time.perf_counter()
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                outs[label] = fn()
+            times[label].append(time.perf_counter() - t0)
+            log(f"  {label}: run {k + 1}/{reps}: {times[label][-1]:.4f} s")
+    return (statistics.median(times["ours"]), outs["ours"],
+            statistics.median(times["ross"]), outs["ross"])
 
 
 def ross_lateral_wd(modal, ndof: int, number_dof: int) -> np.ndarray:
@@ -217,8 +228,8 @@ def emit(rec: dict) -> None:
 
 # ---------------------------------------------------------------- main
 def main() -> int:
-    rep_ours = 3 if ARGS.quick else 5
-    rep_modal = 2 if ARGS.quick else 5
+    rep_ours = 3 if ARGS.quick else 9
+    rep_modal = 3 if ARGS.quick else 9
     rep_frf = 1 if ARGS.quick else 3
 
     t0 = time.perf_counter()
@@ -256,20 +267,16 @@ def main() -> int:
     ]:
         for rpm in MODAL_SPEEDS_RPM:
             log(f"case {case} at {rpm:g} rpm")
-            t_ours, m = timed(lambda: ours_modal(rpm, n_ours), rep_ours, "ours")
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                t_base, mr = timed(lambda: ross_modal(rs, rpm, n_ross), rep_modal, "ross")
+            t_ours, m, t_base, mr = timed(lambda: ours_modal(rpm, n_ours), rep_ours,
+                                          lambda: ross_modal(rs, rpm, n_ross), rep_modal)
             emit({"case": case, "speed_rpm": rpm, "ours_s": t_ours, "baseline": baseline,
                   "baseline_s": t_base, "ratio": t_base / t_ours,
                   **modal_diff(rs, m, mr), "ours_call": f"modes(sys, n_modes={n_ours})",
                   "baseline_call": call, "repeats_baseline": rep_modal, **common})
 
     log("case freq_response_1000")
-    t_ours, H = timed(lambda: ours_frf(OMEGA), rep_ours, "ours")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        t_base, Hr = timed(lambda: ross_frf(rs, OMEGA), rep_frf, "ross")
+    t_ours, H, t_base, Hr = timed(lambda: ours_frf(OMEGA), rep_ours,
+                                  lambda: ross_frf(rs, OMEGA), rep_frf)
     # the same comparison with ambseal's modal evaluation forced (untimed, diagnostic)
     H_modal = ours_frf(OMEGA, method="modal")
     emit({"case": "freq_response_1000", "ours_s": t_ours, "baseline": baseline,

@@ -98,7 +98,10 @@ def modes(sys: SecondOrderSystem, n_modes: int | None = None) -> Modes:
     Modes
         With ``n_modes``: at most ``n_modes`` frequencies (fewer only if the model has
         fewer oscillating modes), equal to the dense path's for the same modes to
-        rounding (both solve the same pencil).
+        rounding (both solve the same pencil: 1e-8 relative or better, except for
+        ill-conditioned eigenvalues such as the gyroscopic forward whirl of a free–free
+        rotor at speed, where two stable solvers may differ by κ·u; see the tests), and
+        ``poles`` / ``unstable_poles`` up to the n-th mode's |λ| only.
 
     Raises
     ------

@@ -2,12 +2,19 @@
 
 Cases (one JSON line each on stdout; progress and ROSS's own chatter go to stderr):
 
-``build_modal`` (at 0 and at 3000 rpm)
-    Ours: ``parse_rig(dict)`` → ``build_system(cfg, speed_rpm=...)`` → ``modes(sys)``.
-    ROSS: elements → ``rs.Rotor(...)`` → ``rotor.run_modal(speed)`` (its defaults: ARPACK,
-    ``num_modes`` raised to 16 so that at least 8 lateral modes are returned).
+``build_modal`` (at 0 and at 3000 rpm): the 8 lowest modes, both sides by ARPACK.
+    Ours: ``parse_rig(dict)`` → ``build_system(cfg, speed_rpm=...)`` →
+    ``modes(sys, n_modes=8)`` (shift-invert ARPACK on the quadratic pencil).
+    ROSS: elements → ``rs.Rotor(...)`` → ``rotor.run_modal(speed, num_modes=N)`` (ARPACK,
+    shift-invert at σ = 1, k = 2N eigenvalues), with N the smallest value for which ROSS
+    returns 8 lateral modes (found once, untimed, in the warm-up; its model also carries
+    axial and torsional DOFs, whose rigid-body eigenvalues take some of the k slots).
     Check: max relative difference of the 8 lowest damped natural frequencies (rad/s);
     ROSS's torsional/axial modes are left out by their eigenvectors.
+``build_modal_all`` (at 0 and at 3000 rpm): every mode, both sides dense.
+    Ours: ``modes(sys)`` (``scipy.linalg.eig`` of the state matrix). ROSS:
+    ``rotor.run_modal(speed, sparse=False)`` (``scipy.linalg.eig`` of its state matrix).
+    Same check.
 ``freq_response_1000``
     A 1000-point FRF (1–500 Hz) from the forces at the two bearing nodes to the
     displacements there (4×4). Ours: ``build_plant(cfg)`` → ``freqresp((A, B, C, D), ω)``.
@@ -26,7 +33,8 @@ sensor, plus a ``[[spring]]`` with the bearing coefficients.
 
 Both sides are timed end to end (model build included), each repeat on a freshly built
 model (ROSS caches ``run_modal``/``run_freq_response`` per rotor instance), after one
-untimed warm-up call; the medians are reported. BLAS runs single-threaded by default
+untimed warm-up call; the calls of the two tools alternate (so both see the same load on
+a shared machine) and the medians are reported. BLAS runs single-threaded by default
 (``--threads``): on a small, busy machine multi-threaded OpenBLAS spends most of its time
 spinning, which makes every timing meaningless.
 
@@ -110,16 +118,31 @@ def ross_rotor(rs):
 
 
 # ---------------------------------------------------------------- the calls being timed
-def ours_modal(speed_rpm: float):
+def ours_modal(speed_rpm: float, n_modes: int | None = N_FREQ):
+    """Build and compute the ``n_modes`` lowest modes (every mode, dense, if None)."""
     from ambseal.config import parse_rig
     from ambseal.model.modes import modes
     from ambseal.model.rig import build_system
 
-    return modes(build_system(parse_rig(rig_dict()), speed_rpm=speed_rpm))
+    return modes(build_system(parse_rig(rig_dict()), speed_rpm=speed_rpm), n_modes=n_modes)
 
 
-def ross_modal(rs, speed_rpm: float):
-    return ross_rotor(rs).run_modal(speed_rpm * np.pi / 30, num_modes=16)
+def ross_modal(rs, speed_rpm: float, num_modes: int | None):
+    """Build and run ROSS's modal analysis: ARPACK with ``num_modes``, dense if None."""
+    speed = speed_rpm * np.pi / 30
+    if num_modes is None:
+        return ross_rotor(rs).run_modal(speed, sparse=False)
+    return ross_rotor(rs).run_modal(speed, num_modes=num_modes)
+
+
+def ross_num_modes(rs) -> int:
+    """Smallest ``num_modes`` for which ROSS returns N_FREQ lateral modes at every speed."""
+    rotor = ross_rotor(rs)
+    for nm in range(N_FREQ, 4 * N_FREQ):
+        if all(ross_lateral_wd(ross_modal(rs, rpm, nm), rotor.ndof, rotor.number_dof).size
+               >= N_FREQ for rpm in MODAL_SPEEDS_RPM):
+            return nm
+    raise RuntimeError(f"ROSS returned fewer than {N_FREQ} lateral modes")
 
 
 def ours_frf(omega: np.ndarray, **kw) -> np.ndarray:
@@ -145,16 +168,26 @@ def log(msg: str) -> None:
     print(msg, file=sys.stderr, flush=True)
 
 
-def timed(fn, repeats: int, label: str):
-    """Median wall time over ``repeats`` calls, and the last result."""
-    times = []
-    out = None
-    for k in range(repeats):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-        log(f"  {label}: run {k + 1}/{repeats}: {times[-1]:.4f} s")
-    return statistics.median(times), out
+def timed(ours, rep_ours: int, base, rep_base: int):
+    """Median wall times of ``ours()`` and ``base()`` and their last results.
+
+    The calls alternate (ours, base, ours, base, ...; the side with more repeats finishes
+    alone) so that both see the same load on a shared machine.
+    """
+    times: dict[str, list[float]] = {"ours": [], "ross": []}
+    outs = {}
+    for k in range(max(rep_ours, rep_base)):
+        for label, fn, reps in (("ours", ours, rep_ours), ("ross", base, rep_base)):
+            if k >= reps:
+                continue
+            t0 = time.perf_counter()
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                outs[label] = fn()
+            times[label].append(time.perf_counter() - t0)
+            log(f"  {label}: run {k + 1}/{reps}: {times[label][-1]:.4f} s")
+    return (statistics.median(times["ours"]), outs["ours"],
+            statistics.median(times["ross"]), outs["ross"])
 
 
 def ross_lateral_wd(modal, ndof: int, number_dof: int) -> np.ndarray:
@@ -168,6 +201,17 @@ def ross_lateral_wd(modal, ndof: int, number_dof: int) -> np.ndarray:
     frac = np.sum(np.abs(vec[lat]) ** 2, axis=0) / np.sum(np.abs(vec) ** 2, axis=0)
     keep = (lam.imag > 1e-6) & (frac > 0.5)
     return np.sort(lam.imag[keep])
+
+
+def modal_diff(rs, m, mr) -> dict:
+    """Agreement of the N_FREQ lowest damped natural frequencies of ours and ROSS's."""
+    rotor = ross_rotor(rs)
+    wd_ours = 2 * np.pi * np.asarray(m.natural_frequencies_hz[:N_FREQ])
+    wd_ross = ross_lateral_wd(mr, rotor.ndof, rotor.number_dof)[:N_FREQ]
+    n = min(wd_ours.size, wd_ross.size)
+    diff = float(np.max(np.abs(wd_ours[:n] - wd_ross[:n]) / wd_ross[:n]))
+    return {"max_rel_diff": diff, "n_compared": n,
+            "lowest_hz": [round(x / (2 * np.pi), 4) for x in wd_ross[:n]]}
 
 
 def frf_diff(ours: np.ndarray, base: np.ndarray, floor: float = 1e-3) -> float:
@@ -184,8 +228,8 @@ def emit(rec: dict) -> None:
 
 # ---------------------------------------------------------------- main
 def main() -> int:
-    rep_ours = 3 if ARGS.quick else 5
-    rep_modal = 2 if ARGS.quick else 5
+    rep_ours = 3 if ARGS.quick else 9
+    rep_modal = 3 if ARGS.quick else 9
     rep_frf = 1 if ARGS.quick else 3
 
     t0 = time.perf_counter()
@@ -206,36 +250,33 @@ def main() -> int:
     # warm-up (first calls pay for lazy imports and caches), untimed
     t0 = time.perf_counter()
     ours_modal(0.0)
+    ours_modal(0.0, None)
     ours_frf(OMEGA[:5])
     log(f"warm-up ours: {time.perf_counter() - t0:.2f} s")
     t0 = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        ross_modal(rs, 0.0)
+        num_modes = ross_num_modes(rs)
+        ross_modal(rs, 0.0, None)
         ross_frf(rs, OMEGA[:5])
-    log(f"warm-up ROSS: {time.perf_counter() - t0:.2f} s")
+    log(f"warm-up ROSS: {time.perf_counter() - t0:.2f} s (num_modes={num_modes})")
 
-    for rpm in MODAL_SPEEDS_RPM:
-        log(f"case build_modal at {rpm:g} rpm")
-        t_ours, m = timed(lambda: ours_modal(rpm), rep_ours, "ours")
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            t_base, mr = timed(lambda: ross_modal(rs, rpm), rep_modal, "ross")
-        rotor = ross_rotor(rs)
-        wd_ours = 2 * np.pi * np.asarray(m.natural_frequencies_hz[:N_FREQ])
-        wd_ross = ross_lateral_wd(mr, rotor.ndof, rotor.number_dof)[:N_FREQ]
-        n = min(wd_ours.size, wd_ross.size)
-        diff = float(np.max(np.abs(wd_ours[:n] - wd_ross[:n]) / wd_ross[:n]))
-        emit({"case": "build_modal", "speed_rpm": rpm, "ours_s": t_ours, "baseline": baseline,
-              "baseline_s": t_base, "ratio": t_base / t_ours, "max_rel_diff": diff,
-              "n_compared": n, "lowest_hz": [round(x / (2 * np.pi), 4) for x in wd_ross[:n]],
-              "repeats_baseline": rep_modal, **common})
+    for case, n_ours, n_ross, call in [
+        ("build_modal", N_FREQ, num_modes, f"run_modal(speed, num_modes={num_modes})"),
+        ("build_modal_all", None, None, "run_modal(speed, sparse=False)"),
+    ]:
+        for rpm in MODAL_SPEEDS_RPM:
+            log(f"case {case} at {rpm:g} rpm")
+            t_ours, m, t_base, mr = timed(lambda: ours_modal(rpm, n_ours), rep_ours,
+                                          lambda: ross_modal(rs, rpm, n_ross), rep_modal)
+            emit({"case": case, "speed_rpm": rpm, "ours_s": t_ours, "baseline": baseline,
+                  "baseline_s": t_base, "ratio": t_base / t_ours,
+                  **modal_diff(rs, m, mr), "ours_call": f"modes(sys, n_modes={n_ours})",
+                  "baseline_call": call, "repeats_baseline": rep_modal, **common})
 
     log("case freq_response_1000")
-    t_ours, H = timed(lambda: ours_frf(OMEGA), rep_ours, "ours")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        t_base, Hr = timed(lambda: ross_frf(rs, OMEGA), rep_frf, "ross")
+    t_ours, H, t_base, Hr = timed(lambda: ours_frf(OMEGA), rep_ours,
+                                  lambda: ross_frf(rs, OMEGA), rep_frf)
     # the same comparison with ambseal's modal evaluation forced (untimed, diagnostic)
     H_modal = ours_frf(OMEGA, method="modal")
     emit({"case": "freq_response_1000", "ours_s": t_ours, "baseline": baseline,

@@ -27,6 +27,9 @@ _PX = np.array([_X, _B, 4 + _X, 4 + _B])
 _PY = np.array([_Y, _A, 4 + _Y, 4 + _A])
 _SX = np.array([1.0, 1.0, 1.0, 1.0])
 _SY = np.array([1.0, -1.0, 1.0, -1.0])
+# The same map for [x-plane, y-plane] (8, 8) matrices, built once: index grid and signs.
+_IDX8 = np.ix_(np.concatenate([_PX, _PY]), np.concatenate([_PX, _PY]))
+_SGN8 = np.outer(np.concatenate([_SX, _SY]), np.concatenate([_SX, _SY]))
 
 
 def shear_coefficient(nu: float, inner_diameter: float, outer_diameter: float) -> float:
@@ -46,15 +49,13 @@ def _to_nodes(plane: np.ndarray, coupled: bool = False) -> np.ndarray:
     [x-plane, y-plane] coordinates.
     """
     out = np.zeros((8, 8))
-    idx = np.concatenate([_PX, _PY])
-    sgn = np.concatenate([_SX, _SY])
     if coupled:
         full = plane
     else:
         full = np.zeros((8, 8))
         full[:4, :4] = plane
         full[4:, 4:] = plane
-    out[np.ix_(idx, idx)] = full * np.outer(sgn, sgn)
+    out[_IDX8] = full * _SGN8
     return out
 
 

@@ -1,0 +1,128 @@
+"""Benchmark: the acceptance times of issue 8 — ``ambseal run`` under 30 s, ``pytest`` under 5 min.
+
+Cases (one JSON line each on stdout; progress and the children's output go to stderr):
+
+``ambseal_run``
+    The main job, ``ambseal run [RIG] --out <temporary folder>`` (identification
+    included), on the embedded test rig or on ``--rig PATH``. Goal 30 s.
+``pytest``
+    The test suite, ``python -m pytest -q -p no:cacheprovider [ARGS]`` from the
+    repository root (``--pytest-args`` replaces the default of the whole suite). Goal 300 s.
+
+Each is a child process (wall time, interpreter start and imports included) with one BLAS
+thread (``OPENBLAS_NUM_THREADS`` = ``OMP_NUM_THREADS`` = ``MKL_NUM_THREADS`` = 1) and
+``MPLBACKEND=Agg``; the goals are those of issue 8 on a 2-core machine. A line reads
+``{"case", "ours_s", "goal_s", "ratio" (ours/goal), "meets_goal", "returncode", ...}``; a
+case whose child fails does not meet its goal.
+
+The child finds ambseal the way this script does: the package this interpreter imports
+(an installed one, or ``src/`` on ``PYTHONPATH``) — the script puts that folder first on
+the child's ``PYTHONPATH``.
+
+Run from the repository root:
+``PYTHONPATH=src python benchmarks/bench_suite.py [--only run|pytest] [--rig PATH]
+[--pytest-args "tests/model"]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shlex
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+GOALS_S = {"ambseal_run": 30.0, "pytest": 300.0}
+
+
+def _args(argv: list[str] | None = None) -> argparse.Namespace:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--only", choices=["run", "pytest"], default=None,
+                    help="time only `ambseal run` or only the test suite")
+    ap.add_argument("--rig", default=None,
+                    help="rig file for `ambseal run` (default: the embedded test rig)")
+    ap.add_argument("--pytest-args", default=None,
+                    help="arguments for pytest instead of the whole suite, e.g. "
+                         "'tests/model/test_model_fe.py'")
+    return ap.parse_args(argv)
+
+
+def child_env() -> dict[str, str]:
+    """The environment of the children: one BLAS thread, Agg, and the ambseal this
+    interpreter imports first on PYTHONPATH."""
+    import ambseal
+
+    env = dict(os.environ)
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        env[var] = "1"
+    env["MPLBACKEND"] = "Agg"
+    pkg_parent = str(Path(ambseal.__file__).resolve().parents[1])
+    paths = [pkg_parent] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]
+    env["PYTHONPATH"] = os.pathsep.join(dict.fromkeys(paths))
+    return env
+
+
+def timed_child(cmd: list[str], cwd: Path) -> tuple[float, int, str]:
+    """Wall time (s), return code and the last lines of output of a child process."""
+    log("$ " + shlex.join(cmd))
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, cwd=cwd, env=child_env(), stdout=subprocess.PIPE,
+                          stderr=subprocess.STDOUT, text=True)
+    elapsed = time.perf_counter() - t0
+    tail = proc.stdout.strip().splitlines()[-15:]
+    for line in tail:
+        log("  | " + line)
+    return elapsed, proc.returncode, "\n".join(tail)
+
+
+def case_run(rig: str | None) -> dict:
+    """Time `ambseal run` (the whole main job) into a temporary output folder."""
+    with tempfile.TemporaryDirectory(prefix="ambseal-bench-") as out:
+        cmd = [sys.executable, "-c", "import sys; from ambseal.cli import main; "
+               "sys.exit(main(sys.argv[1:]))", "run"]
+        if rig is not None:
+            cmd.append(str(Path(rig).resolve()))
+        cmd += ["--out", out]
+        elapsed, rc, _ = timed_child(cmd, Path(out))
+    return record("ambseal_run", elapsed, rc, rig=rig or "embedded test rig")
+
+
+def case_pytest(pytest_args: str | None) -> dict:
+    """Time the test suite (or the given pytest arguments) from the repository root."""
+    args = shlex.split(pytest_args) if pytest_args else []
+    cmd = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *args]
+    elapsed, rc, tail = timed_child(cmd, ROOT)
+    summary = tail.splitlines()[-1] if tail else ""
+    return record("pytest", elapsed, rc, args=args or "whole suite", summary=summary)
+
+
+def record(case: str, elapsed: float, rc: int, **extra) -> dict:
+    goal = GOALS_S[case]
+    return {"case": case, "ours_s": elapsed, "goal_s": goal, "ratio": elapsed / goal,
+            "meets_goal": rc == 0 and elapsed <= goal, "returncode": rc,
+            "blas_threads": 1, **extra}
+
+
+def log(msg: str) -> None:
+    print(msg, file=sys.stderr, flush=True)
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _args(argv)
+    cases = []
+    if args.only in (None, "run"):
+        cases.append(lambda: case_run(args.rig))
+    if args.only in (None, "pytest"):
+        cases.append(lambda: case_pytest(args.pytest_args))
+    for case in cases:
+        print(json.dumps(case()), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -3,6 +3,7 @@
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -135,3 +136,18 @@ def test_modes_free_lists_bending_modes(capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["natural_frequencies_hz"][0] == pytest.approx(550.0, rel=0.10)
     assert out["unstable_poles"] == []
+
+
+def test_modes_n_lowest_equal_the_dense_ones(capsys):
+    """``--n-modes 4`` (sparse shift-invert) prints the dense path's 4 lowest damped
+    frequencies of the free rotor (same pencil, 1e-8), and 0 is refused with exit 2."""
+    rig = str(Path(__file__).resolve().parents[1] / "examples" / "testrig.toml")
+    assert main(["modes", rig, "--free", "--json"]) == 0
+    dense = json.loads(capsys.readouterr().out)["natural_frequencies_hz"]
+    assert main(["modes", rig, "--free", "--json", "--n-modes", "4"]) == 0
+    sparse = json.loads(capsys.readouterr().out)["natural_frequencies_hz"]
+    assert len(sparse) == 4
+    assert sparse == pytest.approx(dense[:4], rel=1e-8)
+    with pytest.raises(SystemExit) as exc:
+        main(["modes", rig, "--n-modes", "0"])
+    assert exc.value.code == 2

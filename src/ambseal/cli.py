@@ -4,7 +4,7 @@ Commands
 --------
 ``ambseal run [RIG] [--out DIR]``
     The main job on a rig (default: the embedded thesis test facility).
-``ambseal modes RIG [--speed-rpm N] [--pressure-bar P] [--json] [--free | --no-amb]``
+``ambseal modes RIG [--speed-rpm N] [--pressure-bar P] [--json] [--n-modes N] [--free | --no-amb]``
     Damped natural frequencies, damping ratios and unstable poles of the full model.
 ``ambseal acquire RIG --truth TRUTH --excitation prbs|sine|chirp|impulse --pressure-bar P --out FILE``
     A record from the virtual test facility (CSV + JSON sidecar, or .mat).
@@ -29,6 +29,16 @@ from .errors import AmbsealError
 __all__ = ["main"]
 
 
+def _positive_int(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
+    return n
+
+
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="ambseal",
@@ -49,6 +59,9 @@ def _parser() -> argparse.ArgumentParser:
     m.add_argument("--speed-rpm", type=float, default=None, help="spin speed (rpm)")
     m.add_argument("--pressure-bar", type=float, default=None, help="seal pressure drop (bar)")
     m.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    m.add_argument("--n-modes", type=_positive_int, default=None,
+                   help="only the N lowest modes (sparse shift-invert; unstable poles up to "
+                        "the N-th mode only)")
     g = m.add_mutually_exclusive_group()
     g.add_argument("--free", action="store_true", help="bare rotor: shaft and disks only")
     g.add_argument("--no-amb", action="store_true", help="leave the AMBs out")
@@ -166,7 +179,7 @@ def _modes(args: argparse.Namespace) -> int:
         include_seals=not args.free,
         include_springs=not args.free,
     )
-    res = modes(sys_)
+    res = modes(sys_, n_modes=args.n_modes)
     if args.json:
         print(json.dumps(res.to_dict(), indent=2))
         return 0

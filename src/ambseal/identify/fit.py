@@ -268,42 +268,9 @@ def fit_parameters(
     if dup:
         raise IdentificationError(f"fit: parameter(s) named twice: {', '.join(dup)}")
     t0 = time.perf_counter()
-    m0 = models[0]
-    nominal, scale = [], []
-    for n in names:
-        if n == TAU_E:
-            # start inside the bounds: τ_e = 0 (no lag modelled) sits on the lower bound
-            nominal.append(m0.tau_e if m0.tau_e > 0 else 0.1 * _DEFAULT_SCALE["s"])
-            scale.append(_DEFAULT_SCALE["s"])
-            continue
-        try:
-            p = m0.plant.parameter(n)
-        except Exception as exc:
-            raise IdentificationError(f"fit: {exc}") from None
-        nominal.append(p.nominal)
-        scale.append(abs(p.nominal) if p.nominal != 0 else _DEFAULT_SCALE.get(p.unit, 1.0))
-    nominal, scale = np.array(nominal), np.array(scale)
-    init = np.array([(initial or {}).get(n, v) for n, v in zip(names, nominal)])
-    defaults = default_bounds(m0, names)
-    lo = np.array([(bounds or {}).get(n, defaults[n])[0] for n in names], dtype=float)
-    hi = np.array([(bounds or {}).get(n, defaults[n])[1] for n in names], dtype=float)
-    outside = [n for n, v, a, b in zip(names, init, lo, hi) if not a <= v <= b]
-    if outside:
-        raise IdentificationError(f"fit: start value of {', '.join(outside)} outside its bounds")
-    init = np.clip(init, lo + 1e-12 * scale, hi - 1e-12 * scale)
-
+    init, scale, lo, hi = _start(models[0], names, initial, bounds)
     start, stop = window
-    data = []
-    for rec in records:
-        y = np.asarray(rec.displacement_m)[start:stop]
-        if y.shape[0] <= len(names):
-            raise IdentificationError(f"fit: {y.shape[0]} samples for {len(names)} parameters")
-        sy = y.std(axis=0)
-        sy[sy == 0] = 1.0
-        i = np.asarray(rec.current_a)[start:stop]
-        si = i.std(axis=0)
-        si[si == 0] = 1.0
-        data.append((np.asarray(rec.excitation_a)[:stop], y, sy, i, si))
+    data = [_record_data(rec, window, len(names)) for rec in records]
 
     def values(x):
         return dict(zip(names, init + x * scale))  # x: scaled change from the start
@@ -341,25 +308,8 @@ def fit_parameters(
         converged = False
         message = f"estimate at its bound: {', '.join(at_bound)}"
 
-    # covariance (sandwich with the residuals' spectrum) in scaled coordinates; rows of the
-    # stacked residual vector are sample-major per record
-    J, r = sol.jac, sol.fun
-    p = len(names)
-    blocks, off = [], 0
-    for R in residual_blocks(sol.x):
-        n_s, c = R.shape
-        blocks.append((J[off:off + n_s * c].reshape(n_s, c, p), r[off:off + n_s * c].reshape(n_s, c)))
-        off += n_s * c
-    H = J.T @ J
-    try:
-        Hinv = np.linalg.inv(H)
-        S = sum(_long_run_covariance(Jb, rb) for Jb, rb in blocks)
-        cov = Hinv @ S @ Hinv * (len(r) / max(len(r) - p, 1))
-        if np.linalg.cond(H) > 1e14:
-            raise np.linalg.LinAlgError
-    except np.linalg.LinAlgError:
-        cov = np.full((p, p), np.inf)
-        converged = False
+    cov = _covariance(sol.jac, sol.fun, residual_blocks(sol.x), len(names))
+    converged = converged and bool(np.all(np.isfinite(cov)))
     cov = cov * np.outer(scale, scale)
     se = np.sqrt(np.diag(cov))
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -382,3 +332,65 @@ def fit_parameters(
         time_s=np.asarray(records[0].time_s)[start:stop], y_meas=y0, y_sim=ys[start:],
         axes=tuple(records[0].axes),
     )
+
+
+def _start(m0: ClosedLoopModel, names, initial, bounds):
+    """Start values, scales and bounds (SI) of the fitted parameters; raises
+    IdentificationError for an unknown name or a start outside its bounds."""
+    nominal, scale = [], []
+    for n in names:
+        if n == TAU_E:
+            # start inside the bounds: τ_e = 0 (no lag modelled) sits on the lower bound
+            nominal.append(m0.tau_e if m0.tau_e > 0 else 0.1 * _DEFAULT_SCALE["s"])
+            scale.append(_DEFAULT_SCALE["s"])
+            continue
+        try:
+            p = m0.plant.parameter(n)
+        except Exception as exc:
+            raise IdentificationError(f"fit: {exc}") from None
+        nominal.append(p.nominal)
+        scale.append(abs(p.nominal) if p.nominal != 0 else _DEFAULT_SCALE.get(p.unit, 1.0))
+    nominal, scale = np.array(nominal), np.array(scale)
+    init = np.array([(initial or {}).get(n, v) for n, v in zip(names, nominal)])
+    defaults = default_bounds(m0, names)
+    lo = np.array([(bounds or {}).get(n, defaults[n])[0] for n in names], dtype=float)
+    hi = np.array([(bounds or {}).get(n, defaults[n])[1] for n in names], dtype=float)
+    outside = [n for n, v, a, b in zip(names, init, lo, hi) if not a <= v <= b]
+    if outside:
+        raise IdentificationError(f"fit: start value of {', '.join(outside)} outside its bounds")
+    return np.clip(init, lo + 1e-12 * scale, hi - 1e-12 * scale), scale, lo, hi
+
+
+def _record_data(rec, window, n_params: int):
+    """(excitation up to the window's end, y, σ_y, i, σ_i) of one record in ``window``."""
+    start, stop = window
+    y = np.asarray(rec.displacement_m)[start:stop]
+    if y.shape[0] <= n_params:
+        raise IdentificationError(f"fit: {y.shape[0]} samples for {n_params} parameters")
+    sy = y.std(axis=0)
+    sy[sy == 0] = 1.0
+    i = np.asarray(rec.current_a)[start:stop]
+    si = i.std(axis=0)
+    si[si == 0] = 1.0
+    return np.asarray(rec.excitation_a)[:stop], y, sy, i, si
+
+
+def _covariance(J: np.ndarray, r: np.ndarray, blocks_at_optimum: list, p: int) -> np.ndarray:
+    """Sandwich covariance of the scaled estimate, (JᵀJ)⁻¹ S (JᵀJ)⁻¹ with S the residuals'
+    long-run covariance per record (:func:`_long_run_covariance`); ``inf`` when JᵀJ is
+    singular. Rows of the stacked residual vector are sample-major per record."""
+    blocks, off = [], 0
+    for R in blocks_at_optimum:
+        n_s, c = R.shape
+        blocks.append((J[off:off + n_s * c].reshape(n_s, c, p), r[off:off + n_s * c].reshape(n_s, c)))
+        off += n_s * c
+    H = J.T @ J
+    try:
+        Hinv = np.linalg.inv(H)
+        S = sum(_long_run_covariance(Jb, rb) for Jb, rb in blocks)
+        cov = Hinv @ S @ Hinv * (len(r) / max(len(r) - p, 1))
+        if np.linalg.cond(H) > 1e14:
+            raise np.linalg.LinAlgError
+    except np.linalg.LinAlgError:
+        cov = np.full((p, p), np.inf)
+    return cov

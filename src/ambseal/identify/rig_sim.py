@@ -68,6 +68,20 @@ class FacilityRecord:
     noise_std_m: np.ndarray
 
 
+def _force_law(plant, names, i0: float):
+    """(Ki, Ks, s0, k) per axis of the nonlinear force law whose linearisation at the bias
+    ``i0`` has the plant's (true) Ki, Ks (module docstring); ModelError unless Ki, Ks > 0."""
+    ki = np.array([plant.parameter(f"{m}.Ki_{ax}").nominal for m, ax in names])
+    ks = np.array([plant.parameter(f"{m}.Ks_{ax}").nominal for m, ax in names])
+    bad = [f"{m}.{q}_{ax}" for (m, ax), a, b in zip(names, ki, ks)
+           for q, v in (("Ki", a), ("Ks", b)) if not v > 0]
+    if bad:
+        raise ModelError(f"the virtual facility needs Ki > 0 and Ks > 0 for its force law "
+                         f"(differential driving at a bias current); not so for {', '.join(bad)}")
+    s0 = i0 * ki / ks
+    return ki, ks, s0, ki * s0**2 / (4 * i0)
+
+
 def simulate_facility(
     cfg: RigConfig,
     truth: TruthSection,
@@ -119,18 +133,9 @@ def simulate_facility(
     if controller.B.shape[1] != k or controller.C.shape[0] != k:
         raise ModelError(f"the controller must have {k} inputs and outputs")
 
-    # nonlinear force-law constants per axis from the true Ki, Ks
     names = [a.rsplit("_", 1) for a in axes]
-    ki = np.array([plant.parameter(f"{m}.Ki_{ax}").nominal for m, ax in names])
-    ks = np.array([plant.parameter(f"{m}.Ks_{ax}").nominal for m, ax in names])
-    bad = [f"{m}.{q}_{ax}" for (m, ax), a, b in zip(names, ki, ks)
-           for q, v in (("Ki", a), ("Ks", b)) if not v > 0]
-    if bad:
-        raise ModelError(f"the virtual facility needs Ki > 0 and Ks > 0 for its force law "
-                         f"(differential driving at a bias current); not so for {', '.join(bad)}")
     i0 = truth.bias_current
-    s0 = i0 * ki / ks
-    kf = ki * s0**2 / (4 * i0)
+    ki, ks, s0, kf = _force_law(plant, names, i0)
     limits = [a.current_limit for a in cfg.amb for _ in range(2)]
     limit = truth.current_limit or (min(x for x in limits if x) if any(limits) else np.inf)
 

@@ -101,7 +101,7 @@ def lmi_upper(M, blocks, rtol=1e-3):
 def testrig_cases(args) -> None:
     """The test-rig μ problem: closed loop of the generalised plant with the μ controller."""
     from ambseal.config import load_rig
-    from ambseal.control.design import design
+    from ambseal.control.recipes import design
     from ambseal.control.mu import mussv
     from ambseal.lti.freqresp import freqresp
 

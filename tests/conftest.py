@@ -4,7 +4,7 @@ Each design below is made by the public function with the arguments ``ambseal ru
 so that the tests of the designs, of the analyses built on them and of the main job see the
 same controllers:
 
-* ``testrig_designs`` — PID, H∞ and μ of :func:`ambseal.control.design.design` on the
+* ``testrig_designs`` — PID, H∞ and μ of :func:`ambseal.control.recipes.design` on the
   embedded test facility (thesis P5 §4), a few seconds;
 * ``testrig_plants`` — the full-order test-facility plants over 0 … 4.08 bar (P5 Fig. 13);
 * ``turbo_lpv`` — the constant-Lyapunov LPV design of the turboexpander over its
@@ -49,7 +49,7 @@ def turbo_cfg():
 @pytest.fixture(scope="session")
 def testrig_designs(testrig_cfg):
     """{"pid", "hinf", "mu"} → DesignResult, as ``ambseal run`` makes them."""
-    from ambseal.control.design import design
+    from ambseal.control.recipes import design
 
     return {m: design(testrig_cfg, m) for m in ("pid", "hinf", "mu")}
 
@@ -104,7 +104,7 @@ class DesignCache:
     @contextlib.contextmanager
     def patched(self, rig: str):
         """Replace the design functions for the duration of the ``with`` block."""
-        import ambseal.control.design as dmod
+        import ambseal.control.recipes as dmod
         import ambseal.control.lpv_design as lmod
 
         got = {n: self._request.getfixturevalue(n) for n in self.FIXTURES[rig]}

@@ -57,7 +57,7 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
     ConfigError
         A bad rig, or ``lpv`` without a speed range.
     """
-    from .control.design import design
+    from .control.recipes import design
 
     cfg = load_rig(rig)
     out = Path(out_dir)

@@ -55,7 +55,7 @@ def _controllers(cfg: RigConfig) -> list[Designed]:
     LPV controller scheduled on speed.
     """
     from .analysis.judge import speed_scheduled
-    from .control.design import design
+    from .control.recipes import design
 
     def lti(res) -> Designed:
         return Designed(res.method, res.K, res.summary(), res)

@@ -9,7 +9,7 @@ Public functions are imported on first use (module-level ``__getattr__``), so
 * :func:`reduce_controller`, :func:`balred_controller` — ``control/order.py``
 * :func:`export_controller`, :func:`discretize` — ``control/export.py``
 * :func:`pid_controller` — ``control/pid.py``
-* :func:`design` — ``control/design.py`` (the thesis's PID, H∞ and μ designs of a rig)
+* :func:`design` — ``control/recipes.py`` (the thesis's PID, H∞ and μ designs of a rig)
 * :func:`lpvsyn` — ``control/lpv.py``; :func:`design_lpv`, :func:`design_frozen` —
   ``control/lpv_design.py``
 """
@@ -24,7 +24,7 @@ _LAZY = {
     "musyn": "dk", "MusynResult": "dk", "fit_magnitude": "dk",
     "reduce_controller": "order", "balred_controller": "order", "ReductionResult": "order",
     "export_controller": "export", "discretize": "export",
-    "pid_controller": "pid", "design": "design",
+    "pid_controller": "pid", "design": "recipes", "DesignResult": "recipes",
     "lpvsyn": "lpv", "design_lpv": "lpv_design", "design_frozen": "lpv_design",
 }
 

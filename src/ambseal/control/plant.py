@@ -311,7 +311,7 @@ def generalized_plant(
         lightly damped bending mode the force excites (the test rig's 557 Hz mode with the
         force at the seal): there the compliance cannot be made small and μ is lost to it.
         Note W_p multiplies this channel; divide W_f by W_p for a plain orbit bound (see
-        :meth:`ambseal.control.design.DesignWeights.Wf`). The inputs ``d_f`` come after
+        :meth:`ambseal.control.recipes.DesignWeights.Wf`). The inputs ``d_f`` come after
         ``d_o``. Needs force inputs: ``force_positions`` from a rig, or a plant built with them.
     force_positions : tuple of float
         Positions (m) of force inputs when building from a rig.

@@ -16,7 +16,10 @@ import pytest
 
 from ambseal.analysis.loops import closed_loop, compliance, loop_responses
 from ambseal.analysis.unbalance import unbalance_from_compliance
-from ambseal.control.recipes import DesignWeights, design
+from ambseal.config import load_rig
+from ambseal.control.recipes import DesignResult, design
+from ambseal.control.weights import Weights
+from ambseal.model.rig import build_plant
 
 OMEGA = 2 * np.pi * np.logspace(-1, np.log10(3000.0), 800)
 #: ISO 14839-3:2006 zone A/B boundary of the sensitivity peak (3, i.e. 9.5 dB; P5 §4.1).
@@ -152,16 +155,16 @@ def test_mu_unbalance_orbit(designs, plants):
 
 def test_mu_force_weight_reads_as_orbit_bound():
     """W_p·W_f/D_e = m·G·s·B_4(s)/orbit (closed form): the force channel bounds the orbit."""
-    wts = DesignWeights(M=3.0, omega_b=30.0, orbit_um=6.0, wf_rolloff_hz=260.0)
-    Wp, Wf = wts.Wp(), wts.Wf(20e-6)
+    wts = Weights(M=3.0, omega_b=30.0, orbit_um=6.0, wf_rolloff_hz=260.0)
+    Wp, Wf = wts.Wp(), wts.Wf()  # D_e = wts.d_e = 20 µm
     for hz in (10.0, 100.0, 200.0, 557.0):
         s = 2j * np.pi * hz
         b4 = 1 / np.sqrt(1 + (hz / 260.0) ** 8)  # |Butterworth, 4th order|
         want = 69.0 * 2.5e-3 * abs(s) * b4 / 6e-6
         assert abs(complex(Wp(s)) * complex(Wf(s))) / 20e-6 == pytest.approx(want, rel=1e-6)
-    assert DesignWeights().Wf() is None
+    assert Weights().Wf() is None
     with pytest.raises(ValueError, match="orbit_um"):
-        DesignWeights(orbit_um=-1.0).Wf()
+        Weights(orbit_um=-1.0).Wf()
 
 
 def test_design_is_deterministic_and_validates(cfg, designs):
@@ -171,6 +174,6 @@ def test_design_is_deterministic_and_validates(cfg, designs):
     with pytest.raises(ValueError, match="method"):
         design(cfg, "lqg")
     with pytest.raises(ValueError, match="M="):
-        design(cfg, "hinf", weights=DesignWeights(M=-1.0))
+        design(cfg, "hinf", weights=Weights(M=-1.0))
     with pytest.raises(ValueError, match="zero or negative width"):
         design(cfg, "mu", uncertainty={"seal.k": (2e6, 2e6)})

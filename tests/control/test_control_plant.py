@@ -6,7 +6,8 @@ import control as ct
 
 from ambseal.config import load_rig
 from ambseal.lti.freqresp import freqresp
-from ambseal.control.plant import check_blocks, generalized_plant
+from ambseal.control.mu import check_blocks
+from ambseal.control.plant import generalized_plant
 from ambseal.control.pid import pid_controller
 from ambseal.control.weights import control_weight, performance_weight
 from ambseal.errors import ModelError

@@ -21,11 +21,11 @@ import numpy as np
 import control as ct
 from scipy.optimize import least_squares
 
-from ambseal.errors import SynthesisError
+from ambseal.errors import ConfigError, SynthesisError
 from ambseal.control.hinf import check_plant, hinfsyn, lft_lower
-from ambseal.control.mu import mussv, parse_blocks
+from ambseal.control.mu import check_blocks, mussv
 
-__all__ = ["MusynResult", "musyn", "fit_magnitude", "default_omega"]
+__all__ = ["MusynResult", "musyn", "fit_magnitude", "default_omega", "design_omega"]
 
 
 # --------------------------------------------------------------------------- D fitting
@@ -134,6 +134,30 @@ def default_omega(P, n: int = 120) -> np.ndarray:
     lo = poles.min() / 100 if poles.size else 1e-2
     hi = poles.max() * 100 if poles.size else 1e2
     return np.logspace(np.log10(lo), np.log10(hi), n)
+
+
+def design_omega(f_min_hz: float = 1.0, f_max_hz: float = 2000.0, n: int = 60) -> np.ndarray:
+    """The μ grid of the rig designs (rad/s): ``n`` points log-spaced over f_min … f_max (Hz).
+
+    Used by the μ designs of :func:`ambseal.control.recipes.design` and
+    :func:`ambseal.control.lpv_design.design_frozen` (D-step, μ peak and the order
+    reduction's check). The default 1 Hz … 2 kHz spans the rigid-body band, the speed
+    ranges and the first bending modes of the example machines (the test rig's 557 Hz,
+    the turboexpander's ~1–2 kHz); 60 points (≈ 18 per decade) resolve the D scales, which
+    vary slowly, and keep a D–K iteration at seconds. A lightly damped peak between grid
+    points is missed by the μ peak on the grid; the designs are judged afterwards on the
+    full-order plant on a dense grid (:mod:`ambseal.analysis`).
+
+    Raises
+    ------
+    ConfigError
+        ``0 < f_min_hz < f_max_hz`` and ``n ≥ 2`` not met.
+    """
+    if not (np.isfinite(f_min_hz) and np.isfinite(f_max_hz) and 0 < f_min_hz < f_max_hz) \
+            or int(n) < 2:
+        raise ConfigError(f"design_omega: need 0 < f_min_hz < f_max_hz and n ≥ 2, got "
+                          f"{f_min_hz}, {f_max_hz}, {n}")
+    return 2 * np.pi * np.logspace(np.log10(f_min_hz), np.log10(f_max_hz), int(n))
 
 
 # --------------------------------------------------------------------------- result
@@ -284,14 +308,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
         If the first K-step fails (plant assumptions violated).
     """
     check_plant(P, nmeas, ncon)
-    blks = parse_blocks(blocks)
-    nz, nw = P.noutputs - nmeas, P.ninputs - ncon
-    sc, sr = sum(b.c for b in blks), sum(b.r for b in blks)
-    if (sc, sr) != (nz, nw):
-        raise ValueError(
-            f"musyn: blocks {list(blocks)} cover {sr} inputs × {sc} outputs, but P has "
-            f"{nw} exogenous inputs and {nz} exogenous outputs (excluding {ncon} controls, "
-            f"{nmeas} measurements)")
+    blks = check_blocks(P, blocks, nmeas, ncon)
     if blks[-1].kind != "full":
         raise ValueError("musyn: the last block must be the full complex performance block")
     if not (isinstance(order, (int, np.integer)) and 0 <= order <= 4):

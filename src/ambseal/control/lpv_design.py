@@ -40,50 +40,15 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import SynthesisError
+from ..errors import ConfigError, SynthesisError
 from .controller import ScheduledController
+from .plant import physical_controller, physical_matrices
+from .weights import Weights, default_weights
 
-__all__ = ["LpvWeights", "LpvDesign", "FrozenDesign", "design_lpv", "design_frozen",
+__all__ = ["LpvDesign", "FrozenDesign", "design_lpv", "design_frozen",
            "lpv_generalized_plants"]
 
 _TWO_PI = 2.0 * np.pi
-
-
-@dataclass(frozen=True)
-class LpvWeights:
-    """Weights of the speed-scheduled designs (P3 Eq. 11, §3.3).
-
-    Attributes
-    ----------
-    M : float
-        High-frequency bound of W_p (-).
-    omega_b : float
-        W_p bandwidth ω_B (rad/s).
-    A : float
-        W_p steady-state error (-): 1e-2 … 1e-1 for the LMIs (module docstring).
-    wu_gain : float
-        Low-frequency W_u on the scaled current (-).
-    wu_corner_hz, wu_hf_gain : float or None
-        High-pass W_u (:func:`ambseal.control.weights.control_weight`): corner (Hz) and
-        high-frequency gain; None for a static W_u. Default 1.4 kHz and 0.5 (P3 §3.3;
-        module docstring).
-    d_e, d_u : float
-        Scalings of displacement error (m) and current (A), P5 §3.1.4.
-    """
-
-    M: float = 2.0
-    omega_b: float = _TWO_PI * 50.0
-    A: float = 1e-2
-    wu_gain: float = 0.05
-    wu_corner_hz: float | None = 1400.0
-    wu_hf_gain: float | None = 0.5
-    d_e: float = 20e-6
-    d_u: float = 1.0
-
-    def to_dict(self) -> dict:
-        return {"M": self.M, "omega_b_rad_s": self.omega_b, "A": self.A,
-                "wu_gain": self.wu_gain, "wu_corner_hz": self.wu_corner_hz,
-                "wu_hf_gain": self.wu_hf_gain, "d_e_m": self.d_e, "d_u_a": self.d_u}
 
 
 @dataclass(frozen=True, eq=False)
@@ -109,7 +74,7 @@ class LpvDesign(ScheduledController):
     lyapunov : str
     rate_bound_hz_per_s : float or None
         |Ω̇|/2π bound (Hz/s).
-    weights : LpvWeights
+    weights : Weights
     reports : tuple of SolverReport
     synthesis_s : float
         Wall time of :func:`lpvsyn` (s).
@@ -128,7 +93,7 @@ class LpvDesign(ScheduledController):
     check_speeds_hz: np.ndarray = field(repr=False)
     lyapunov: str = "constant"
     rate_bound_hz_per_s: float | None = None
-    weights: LpvWeights = field(default_factory=LpvWeights)
+    weights: Weights = field(default_factory=lambda: default_weights("lpv"))
     reports: tuple = ()
     synthesis_s: float = 0.0
     elapsed_s: float = 0.0
@@ -145,14 +110,10 @@ class LpvDesign(ScheduledController):
     def at(self, speed_rad_s: float, name: str = "K_lpv"):
         """Frozen physical controller at Ω (rad/s): a ``control.StateSpace``
         from displacements (m) to current references (A), negative feedback ``i = −K y``
-        (:mod:`ambseal.control.controller`)."""
-        import control
-
-        A, B, C, D = self.matrices_at(speed_rad_s)
+        (:mod:`ambseal.control.controller`; :func:`ambseal.control.plant.physical_controller`)."""
         chans = [n[2:] if n.startswith("y_") else n for n in self.K.input_names]
-        return control.ss(A, B, C, D, inputs=[f"y_{c}" for c in chans],
-                          outputs=[f"u_{c}" for c in chans],
-                          states=[f"xK{i}" for i in range(A.shape[0])], name=name)
+        return physical_controller(self.K.matrices(float(speed_rad_s)),
+                                   self.weights.d_e, self.weights.d_u, chans, name=name)
 
     def controller_at(self, speed_hz: float, name: str = "K_lpv"):
         """:meth:`at` with the speed in Hz."""
@@ -160,9 +121,8 @@ class LpvDesign(ScheduledController):
 
     def matrices_at(self, speed_rad_s: float) -> tuple[np.ndarray, ...]:
         """Physical (A_K, B_K, C_K, D_K) at Ω (rad/s), i = −(C_K x_K + D_K y)."""
-        A, B, C, D = self.K.matrices(speed_rad_s)
-        g = -self.weights.d_u / self.weights.d_e
-        return A, B, g * C, g * D
+        return physical_matrices(self.K.matrices(speed_rad_s), self.weights.d_e,
+                                 self.weights.d_u)
 
     def to_dict(self) -> dict:
         """JSON-ready summary (no matrices)."""
@@ -192,7 +152,7 @@ class FrozenDesign:
         ``"hinf"`` or ``"mu"``.
     gamma : float
         Verified H∞ norm (``"hinf"``) or peak μ upper bound (``"mu"``) of the design loop.
-    weights : LpvWeights
+    weights : Weights
     elapsed_s : float
     """
 
@@ -200,7 +160,7 @@ class FrozenDesign:
     speed_hz: float
     method: str
     gamma: float
-    weights: LpvWeights = field(default_factory=LpvWeights)
+    weights: Weights = field(default_factory=lambda: default_weights("lpv"))
     elapsed_s: float = 0.0
 
     def to_dict(self) -> dict:
@@ -209,18 +169,15 @@ class FrozenDesign:
                 "elapsed_s": round(self.elapsed_s, 3)}
 
 
-def lpv_generalized_plants(L, weights: LpvWeights, speeds_rad_s=None):
+def lpv_generalized_plants(L, weights: Weights, speeds_rad_s=None):
     """Generalised plants (P5 Figs. 8–9, nominal: inputs [d_i, d_o, u], outputs
     [z_p, z_u, y]) of the LPV plant ``L`` at its grid speeds (or ``speeds_rad_s``).
 
     Returns a list of :class:`ambseal.control.plant.GeneralizedPlant` in one state basis.
     """
     from .plant import generalized_plant
-    from .weights import control_weight, performance_weight
 
-    Wp = performance_weight(weights.M, weights.omega_b, weights.A)
-    Wu = control_weight(weights.wu_gain, corner_hz=weights.wu_corner_hz,
-                        hf_gain=weights.wu_hf_gain)
+    Wp, Wu = weights.Wp(), weights.Wu()
     W = L.speeds_rad_s if speeds_rad_s is None else np.asarray(speeds_rad_s, float)
     return [generalized_plant(L.plant_at(w), Wp, Wu, d_e=weights.d_e, d_u=weights.d_u)
             for w in W]
@@ -228,7 +185,7 @@ def lpv_generalized_plants(L, weights: LpvWeights, speeds_rad_s=None):
 
 def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int = 10,
                rate_bound_hz_per_s: float | None = None, lyapunov: str | None = None,
-               weights: LpvWeights | None = None, states: int = 8,
+               weights: Weights | None = None, states: int = 8,
                frozen_gamma: bool = True, **lpvsyn_kw) -> LpvDesign:
     """Speed-scheduled H∞ LPV controller for a rig (thesis P3 §4).
 
@@ -246,7 +203,8 @@ def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int = 10,
         (``lyapunov`` defaults to ``"affine"``); without it constant (P3).
     lyapunov : str, optional
         ``"constant"``, ``"affine"`` or ``"quadratic"``; see :func:`lpvsyn`.
-    weights : LpvWeights, optional
+    weights : Weights, optional
+        ``default_weights("lpv")`` if omitted (module docstring).
     states : int
         Mechanical states of the design model (8: rigid body; 12 adds the first bending
         pair).
@@ -277,7 +235,7 @@ def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int = 10,
     from .lpv_plant import lpv_plant
 
     t0 = time.perf_counter()
-    w = weights or LpvWeights()
+    w = weights or default_weights("lpv")
     lo, hi = (float(x) for x in speeds_hz)
     if int(n_grid) < 2:
         raise SynthesisError(f"design_lpv: n_grid={n_grid}; the speed grid needs at least "
@@ -310,7 +268,7 @@ def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int = 10,
 
 
 def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
-                  weights: LpvWeights | None = None, states: int = 8,
+                  weights: Weights | None = None, states: int = 8,
                   seal_k_uncertainty: float = 0.4, **kw) -> FrozenDesign:
     """LTI controller at one speed: the comparison controller of P3 Fig. 11 (140 Hz).
 
@@ -324,7 +282,8 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
         performance demand as the LPV design, so the comparison isolates the scheduling).
         ``"mu"``: D–K iteration (:func:`musyn`) with the seal's k ± ``seal_k_uncertainty``
         (P3 §3.1: ±40 %); slower (minutes).
-    weights : LpvWeights, optional
+    weights : Weights, optional
+        ``default_weights("lpv")`` if omitted (module docstring).
     states : int
         Mechanical states of the design model (same basis as :func:`design_lpv`).
     **kw
@@ -346,7 +305,7 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
     if method not in ("hinf", "mu"):
         raise ValueError(f"design_frozen: method={method!r}, expected 'hinf' or 'mu'")
     t0 = time.perf_counter()
-    w = weights or LpvWeights()
+    w = weights or default_weights("lpv")
     f = float(speed_hz)
     if method == "hinf":
         from .hinf import hinfsyn
@@ -356,18 +315,16 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
         r = hinfsyn(gp.P_nominal, gp.nmeas, gp.ncon)
         K_P, gamma = r.K, float(r.gamma)
     else:
-        from .dk import musyn
+        from .dk import design_omega, musyn
         from .plant import generalized_plant
-        from .weights import control_weight, performance_weight
 
         cfg_f = cfg.model_copy(deep=True) if hasattr(cfg, "model_copy") else cfg
         cfg_f.operating.speed_rpm = 60.0 * f
-        gp = generalized_plant(cfg_f, performance_weight(w.M, w.omega_b, w.A),
-                               control_weight(w.wu_gain, corner_hz=w.wu_corner_hz,
-                                              hf_gain=w.wu_hf_gain), states=states,
+        gp = generalized_plant(cfg_f, w.Wp(), w.Wu(), states=states,
                                uncertainty={f"{cfg.seal[0].name}.k": seal_k_uncertainty},
                                d_e=w.d_e, d_u=w.d_u)
-        om = kw.pop("omega", _TWO_PI * np.logspace(0.0, np.log10(2000.0), 60))
+        om = kw.pop("omega", None)
+        om = design_omega() if om is None else om
         r = musyn(gp.P, gp.blocks, gp.nmeas, gp.ncon, om, **kw)
         K_P, gamma = r.K, float(r.mu)
     K = gp.physical_controller(K_P, name=f"K_{method}_{f:g}Hz")

@@ -36,9 +36,10 @@ from typing import Sequence
 import numpy as np
 
 from ambseal.control._mu_upper import upper_bound as _upper_bound
+from ambseal.errors import ModelError
 from ambseal.lti.freqresp import freqresp
 
-__all__ = ["MuResult", "mussv", "parse_blocks"]
+__all__ = ["MuResult", "mussv", "parse_blocks", "check_blocks"]
 
 
 # --------------------------------------------------------------------------- blocks
@@ -67,28 +68,64 @@ def parse_blocks(blocks: Sequence[Sequence[int]]) -> tuple[_Block, ...]:
 
     Raises
     ------
-    ValueError
+    ModelError
         Empty structure, non-integer entries, ``k = 0``, a negative size in a full block.
     """
     if blocks is None or len(blocks) == 0:
-        raise ValueError("blocks: empty block structure")
+        raise ModelError("blocks: empty block structure")
     out = []
     for i, b in enumerate(blocks):
         try:
             r, c = (int(v) for v in b)
             if any(float(v) != int(v) for v in b) or len(b) != 2:
-                raise ValueError
+                raise ModelError
         except (TypeError, ValueError):
-            raise ValueError(f"blocks[{i}]={b!r}: expected a pair of integers (r, c)") from None
+            raise ModelError(f"blocks[{i}]={b!r}: expected a pair of integers (r, c)") from None
         if c == 0:
             if r == 0:
-                raise ValueError(f"blocks[{i}]=(0, 0): a block needs a non-zero size")
+                raise ModelError(f"blocks[{i}]=(0, 0): a block needs a non-zero size")
             out.append(_Block("real" if r < 0 else "complex", abs(r), abs(r)))
         else:
             if r <= 0 or c < 0:
-                raise ValueError(f"blocks[{i}]=({r}, {c}): a full block needs r > 0 and c > 0")
+                raise ModelError(f"blocks[{i}]=({r}, {c}): a full block needs r > 0 and c > 0")
             out.append(_Block("full", r, c))
     return tuple(out)
+
+
+def check_blocks(P, blocks, nmeas: int, ncon: int) -> tuple[_Block, ...]:
+    """The block structure of ``F_l(P, K)``: parsed, and checked against P's channels.
+
+    Δ blocks map z to w: ``Σ r`` must equal the number of exogenous inputs and ``Σ c`` the
+    number of exogenous outputs of ``P`` (its inputs less ``ncon``, outputs less ``nmeas``).
+    The one check used by :func:`ambseal.control.dk.musyn` and the generalised plant.
+
+    Parameters
+    ----------
+    P : control.StateSpace
+        Generalised plant, inputs ``[w, u]``, outputs ``[z, y]``.
+    blocks : sequence of (int, int)
+        MATLAB ``mussv`` notation (:func:`parse_blocks`).
+    nmeas, ncon : int
+        Measurements (last outputs) and controls (last inputs).
+
+    Returns
+    -------
+    tuple of _Block
+
+    Raises
+    ------
+    ModelError
+        Malformed blocks, or blocks that do not cover the exogenous channels.
+    """
+    blks = parse_blocks(blocks)
+    nw, nz = P.ninputs - ncon, P.noutputs - nmeas
+    sr, sc = sum(b.r for b in blks), sum(b.c for b in blks)
+    if (sr, sc) != (nw, nz):
+        raise ModelError(
+            f"blocks {[tuple(b) for b in blocks]}: the structure covers {sr} inputs × {sc} "
+            f"outputs, but P has {nw} exogenous inputs and {nz} exogenous outputs (excluding {ncon} "
+            f"controls and {nmeas} measurements)")
+    return blks
 
 
 def _dims(blks):

@@ -38,7 +38,8 @@ import numpy as np
 from ..errors import ModelError
 from .weights import diagonal_weight
 
-__all__ = ["UncertainParameter", "GeneralizedPlant", "generalized_plant", "check_blocks"]
+__all__ = ["UncertainParameter", "GeneralizedPlant", "generalized_plant",
+           "physical_controller", "physical_matrices"]
 
 
 @dataclass(frozen=True)
@@ -140,7 +141,7 @@ class GeneralizedPlant:
         return sum(p.repeats for p in self.parameters)
 
     def physical_controller(self, K_P, name: str = "K"):
-        """``K = −(D_u/D_e) K_P``: scaled positive-feedback → m → A, negative feedback.
+        """:func:`physical_controller` with this plant's scalings and channel names.
 
         Parameters
         ----------
@@ -153,22 +154,13 @@ class GeneralizedPlant:
         control.StateSpace
             Inputs ``y_<axis>`` (m), outputs ``u_<axis>`` (A), used as ``i = −K y``.
         """
-        import control
-
-        g = -self.d_u / self.d_e
-        return control.ss(np.asarray(K_P.A, float), np.asarray(K_P.B, float),
-                          g * np.asarray(K_P.C, float), g * np.asarray(K_P.D, float),
-                          inputs=[f"y_{c}" for c in self.channels],
-                          outputs=[f"u_{c}" for c in self.channels],
-                          states=[f"xK{i}" for i in range(K_P.nstates)], name=name)
+        return physical_controller(K_P, self.d_e, self.d_u, self.channels, name=name)
 
     def synthesis_controller(self, K):
         """Inverse of :meth:`physical_controller`: ``K_P = −(D_e/D_u) K``."""
         import control
 
-        g = -self.d_e / self.d_u
-        return control.ss(np.asarray(K.A, float), np.asarray(K.B, float),
-                          g * np.asarray(K.C, float), g * np.asarray(K.D, float))
+        return control.ss(*physical_matrices(_abcd(K), self.d_u, self.d_e))
 
     def closed_loop(self, K, *, nominal: bool = False):
         """``F_l(P, K_P)`` for a physical controller ``K`` (m → A, negative feedback)."""
@@ -191,22 +183,61 @@ class GeneralizedPlant:
                 "parameters": [p.to_dict() for p in self.parameters]}
 
 
-def check_blocks(P, blocks, nmeas: int, ncon: int) -> None:
-    """Raise ValueError unless ``blocks`` (mussv notation) covers P's exogenous channels.
+def _abcd(K) -> tuple[np.ndarray, ...]:
+    if isinstance(K, (tuple, list)):
+        return tuple(np.asarray(m, float) for m in K)
+    return tuple(np.asarray(getattr(K, m), float) for m in ("A", "B", "C", "D"))
 
-    Δ blocks map z to w: ``Σ r`` must equal the number of exogenous inputs and ``Σ c`` the
-    number of exogenous outputs of ``P`` (its inputs less ``ncon``, outputs less ``nmeas``).
+
+def physical_matrices(K_P, d_e: float, d_u: float) -> tuple[np.ndarray, ...]:
+    """``(A_K, B_K, C_K, D_K)`` of ``K = −(D_u/D_e) K_P`` (P5 §3.1.4; module docstring).
+
+    The one conversion of a synthesised controller (scaled error → scaled current,
+    positive feedback ``u = K_P y``) to the project's physical one (m → A, negative
+    feedback ``i = −K y``).
+
+    Parameters
+    ----------
+    K_P : control.StateSpace or (A, B, C, D)
+        Controller in synthesis units.
+    d_e, d_u : float
+        Scalings of displacement error (m) and current (A).
+
+    Returns
+    -------
+    tuple of ndarray
+        ``A_K``, ``B_K`` unchanged; ``C_K``, ``D_K`` times ``−d_u/d_e``.
     """
-    from .mu import parse_blocks
+    A, B, C, D = _abcd(K_P)
+    g = -float(d_u) / float(d_e)
+    return A, B, g * C, g * D
 
-    blks = parse_blocks(blocks)
-    nw, nz = P.ninputs - ncon, P.noutputs - nmeas
-    sr, sc = sum(b.r for b in blks), sum(b.c for b in blks)
-    if (sr, sc) != (nw, nz):
-        raise ValueError(
-            f"block structure {list(map(tuple, blocks))} covers {sr} inputs × {sc} outputs, but "
-            f"P has {nw} exogenous inputs and {nz} exogenous outputs (excluding {ncon} controls "
-            f"and {nmeas} measurements)")
+
+def physical_controller(K_P, d_e: float, d_u: float, channels, name: str = "K"):
+    """``K = −(D_u/D_e) K_P`` as a named ``control.StateSpace`` (:func:`physical_matrices`).
+
+    Parameters
+    ----------
+    K_P : control.StateSpace or (A, B, C, D)
+        Controller in synthesis units, ``len(channels)`` inputs and outputs.
+    d_e, d_u : float
+        Scalings (m, A).
+    channels : sequence of str
+        Actuator axis names: inputs ``y_<axis>`` (m), outputs ``u_<axis>`` (A).
+    name : str
+        System name.
+
+    Returns
+    -------
+    control.StateSpace
+        Physical controller, used as ``i = −K y``.
+    """
+    import control
+
+    A, B, C, D = physical_matrices(K_P, d_e, d_u)
+    return control.ss(A, B, C, D, inputs=[f"y_{c}" for c in channels],
+                      outputs=[f"u_{c}" for c in channels],
+                      states=[f"xK{i}" for i in range(A.shape[0])], name=name)
 
 
 def _series(sA, sB, sC, sD, cols: slice, W):
@@ -311,7 +342,7 @@ def generalized_plant(
         lightly damped bending mode the force excites (the test rig's 557 Hz mode with the
         force at the seal): there the compliance cannot be made small and μ is lost to it.
         Note W_p multiplies this channel; divide W_f by W_p for a plain orbit bound (see
-        :meth:`ambseal.control.recipes.DesignWeights.Wf`). The inputs ``d_f`` come after
+        :meth:`ambseal.control.weights.Weights.Wf`). The inputs ``d_f`` come after
         ``d_o``. Needs force inputs: ``force_positions`` from a rig, or a plant built with them.
     force_positions : tuple of float
         Positions (m) of force inputs when building from a rig.

@@ -12,7 +12,7 @@ synthesises:
   stiffness k ± 100 % of its value at ``pressure_bar`` (one δ shared by k and −k, P5 §4.1
   items 2–3), i.e. 0 … 2× the nominal pressure drop; the unbalance force at the seal
   (F_u = m·G·Ω, P5 §4.4.1) enters as a weighted disturbance so that the worst-case orbit
-  is part of the robust-performance demand (:meth:`DesignWeights.Wf`).
+  is part of the robust-performance demand (:meth:`~ambseal.control.weights.Weights.Wf`).
 
 Every controller is returned in the project's convention: a continuous
 ``control.StateSpace`` from the displacements (m) to the current references (A), used in
@@ -36,150 +36,11 @@ import numpy as np
 
 from ..errors import ConfigError, SynthesisError
 from ..model.amb import channel_names
+from .weights import Weights, default_weights
 
-__all__ = ["DesignWeights", "DesignResult", "design", "default_weights", "METHODS"]
+__all__ = ["DesignResult", "design", "METHODS"]
 
 METHODS = ("pid", "hinf", "mu")
-
-
-@dataclass(frozen=True)
-class DesignWeights:
-    """Tuning of the weights (P5 Eq. 7 and §4.3; P3 Eq. 11).
-
-    Attributes
-    ----------
-    M : float
-        W_p high-frequency sensitivity bound (-).
-    omega_b : float
-        W_p bandwidth ω_B (rad/s).
-    A : float
-        W_p steady-state error (-), thesis 1/1000.
-    wu_gain : float
-        W_u low-frequency gain on the scaled current (-).
-    wu_corner_hz, wu_hf_gain : float or None
-        Optional high-pass W_u: corner (Hz) and high-frequency gain (-).
-    w1_gain : float
-        High-frequency gain of the input-disturbance weight W_1 (-).
-    w1_corner_hz : float or None
-        W_1 = w1_gain·s/(s + 2π·corner) when given (a high-pass: the compliance demand
-        where unbalance forces act, not at DC); a constant ``w1_gain`` otherwise.
-    orbit_um : float or None
-        Unbalance-orbit demand (µm): adds force inputs at ``force_position_m`` weighted by
-        :meth:`Wf`, so that ``‖W_p S_o G_f W_f / D_e‖∞ ≤ 1`` reads "worst-case orbit
-        σ̄(S_o G_f)·m·G·Ω ≤ orbit_um" below the roll-off (P5 §4.4.1). None: no force channel.
-    unbalance_mass_kg, unbalance_grade_mm_s : float
-        Rotor mass (kg) and ISO 21940-11 balance grade (mm/s) of the force law
-        ``F_u = m·G·Ω`` (thesis: 69 kg, G2.5).
-    wf_rolloff_hz : float
-        Corner (Hz) of the 4th-order Butterworth roll-off of W_f: above the speed range
-        (200 Hz) and well below the first bending mode (557 Hz), where a force at the seal
-        excites a resonance no controller can make compliant — a W_f still large there
-        makes μ unreachable (≈ 6) and wrecks the design.
-    force_position_m : float or None
-        Axial position (m) of the force; the rig's first seal if None (0.43 m).
-    """
-
-    M: float = 2.5
-    omega_b: float = 60.0
-    A: float = 1e-3
-    wu_gain: float = 0.3
-    wu_corner_hz: float | None = None
-    wu_hf_gain: float | None = None
-    w1_gain: float = 1.0
-    w1_corner_hz: float | None = None
-    orbit_um: float | None = None
-    unbalance_mass_kg: float = 69.0
-    unbalance_grade_mm_s: float = 2.5
-    wf_rolloff_hz: float = 260.0
-    force_position_m: float | None = None
-
-    def Wp(self):
-        """W_p as a ``control.TransferFunction``."""
-        from .weights import performance_weight
-
-        return performance_weight(self.M, self.omega_b, self.A)
-
-    def Wu(self):
-        """W_u as a ``control.TransferFunction``."""
-        from .weights import control_weight
-
-        return control_weight(self.wu_gain, corner_hz=self.wu_corner_hz, hf_gain=self.wu_hf_gain)
-
-    def W1(self):
-        """W_1 (input disturbance) as a ``control.TransferFunction`` or a float."""
-        import control
-
-        if self.w1_corner_hz is None:
-            return float(self.w1_gain)
-        if not (self.w1_gain > 0 and self.w1_corner_hz > 0):
-            raise ValueError(f"W_1: gain {self.w1_gain} and corner {self.w1_corner_hz} Hz must be > 0")
-        return control.tf([self.w1_gain, 0.0], [1.0, 2 * np.pi * self.w1_corner_hz])
-
-    def Wf(self, d_e: float = 20e-6):
-        """W_f on the unbalance-force inputs (N per unit), or None without ``orbit_um``.
-
-        ``W_f = (m G D_e / orbit) · s · B_4(s) / W_p(s)`` with ``B_4`` the 4th-order
-        Butterworth low-pass at ``wf_rolloff_hz``: the product ``W_p W_f / D_e`` on the
-        force → performance channel is ``m G s B_4 / orbit``, i.e. the unbalance force
-        ``F_u = m·G·Ω`` over the allowed orbit — the 1/W_p factor undoes the performance
-        weight, which would otherwise turn the demand into an orbit bound of
-        ``M·D_e·/orbit`` ≈ 6× too loose above ω_B and a needless one at DC.
-        """
-        import control
-
-        if self.orbit_um is None:
-            return None
-        for nm, v in (("orbit_um", self.orbit_um), ("unbalance_mass_kg", self.unbalance_mass_kg),
-                      ("unbalance_grade_mm_s", self.unbalance_grade_mm_s),
-                      ("wf_rolloff_hz", self.wf_rolloff_hz)):
-            if not (np.isfinite(v) and v > 0):
-                raise ValueError(f"W_f: {nm}={v!r} must be finite and > 0")
-        c = self.unbalance_mass_kg * self.unbalance_grade_mm_s * 1e-3 * d_e / (self.orbit_um * 1e-6)
-        wr = 2 * np.pi * self.wf_rolloff_hz
-        b4 = control.tf([wr**4], [1.0, 2.6131259 * wr, 3.4142136 * wr**2, 2.6131259 * wr**3, wr**4])
-        Wp = self.Wp()
-        return control.tf([c, 0.0], [1.0]) * b4 * control.tf(Wp.den[0][0], Wp.num[0][0])
-
-    def to_dict(self) -> dict:
-        return {"M": self.M, "omega_b_rad_s": self.omega_b, "A": self.A,
-                "wu_gain": self.wu_gain, "wu_corner_hz": self.wu_corner_hz,
-                "wu_hf_gain": self.wu_hf_gain, "w1_gain": self.w1_gain,
-                "w1_corner_hz": self.w1_corner_hz, "orbit_um": self.orbit_um,
-                "unbalance_mass_kg": self.unbalance_mass_kg,
-                "unbalance_grade_mm_s": self.unbalance_grade_mm_s,
-                "wf_rolloff_hz": self.wf_rolloff_hz, "force_position_m": self.force_position_m}
-
-
-def default_weights(method: str) -> DesignWeights:
-    """The tuned weights for the thesis test facility (see the module's tests for why).
-
-    H∞ (nominal design): W_p with M = 2.5, ω_B = 60 rad/s, A = 1/1000; W_u = 0.3 constant.
-
-    μ: W_p with M = 3 (ISO 14839-3 zone A), ω_B = 30 rad/s, A = 1/1000; a high-pass
-    W_u = 0.02 (1 + s/ω_z)/(1 + s/ω_p) rising from 0.02 to 0.2 above 800 Hz (rolls the
-    controller off above the bending mode: |K| ≈ 0.2 MA/m at 10 kHz instead of ≈ 1.3); a
-    small constant W_1 = 0.05; and the unbalance force at the seal (0.43 m) as a weighted
-    input, :meth:`DesignWeights.Wf` with ``F_u = m·G·Ω`` (69 kg, G2.5, P5 §4.4.1), an orbit
-    demand of 6 µm and a 4th-order roll-off at 260 Hz (above the 200 Hz speed range, below
-    the 557 Hz bending mode). Result (μ ≈ 1.14): on the full-order plant from 0 to
-    4.08 bar σ̄(S_o) ≤ 2.5 (bending-mode resonance resolved) and worst-case orbit up to
-    200 Hz ≤ 6.5 µm.
-
-    Why: the force channel must bypass W_p (else the bound is ≈ 6× too loose above ω_B) and
-    roll off before the bending mode (else μ ≈ 6 at 557 Hz and the design degrades: orbit
-    17–49 µm); without it the orbit is ≈ 10.5 µm. The binding trade-off is the orbit
-    against the control effort, not against σ̄(S_o): with W_u = 0.05/0.03/0.02 (constant)
-    and a 6 µm demand the orbit is 7.8/6.6/5.8 µm at σ̄(S_o) 2.3/2.1/2.0; W_u = 0.2 (the
-    previous value) with the same demand gives σ̄(S_o) 3.6 and 15 µm. With an 8 µm demand
-    and this W_u, μ = 0.98 < 1 (robust performance on the design model), orbit 7.0 µm —
-    a smaller margin on the acceptance than the 6 µm demand.
-    """
-    if method == "hinf":
-        return DesignWeights(M=2.5, omega_b=60.0, wu_gain=0.3)
-    if method == "mu":
-        return DesignWeights(M=3.0, omega_b=30.0, wu_gain=0.02, wu_corner_hz=800.0,
-                             wu_hf_gain=0.2, w1_gain=0.05, orbit_um=6.0, wf_rolloff_hz=260.0)
-    raise ValueError(f"default_weights: no weights for method {method!r} (expected 'hinf' or 'mu')")
 
 
 @dataclass(frozen=True, eq=False)
@@ -205,7 +66,7 @@ class DesignResult:
         States before order reduction.
     history : tuple of dict
         D–K iterations (``iteration``, ``gamma``, ``mu``, ``order``); empty otherwise.
-    weights : DesignWeights or None
+    weights : Weights or None
     uncertainty : dict
         ``{parameter: (low, high)}`` in SI units.
     elapsed_s : float
@@ -224,7 +85,7 @@ class DesignResult:
     order: int = 0
     order_full: int = 0
     history: tuple = ()
-    weights: DesignWeights | None = None
+    weights: Weights | None = None
     uncertainty: dict = field(default_factory=dict)
     elapsed_s: float = 0.0
     reduction: dict | None = None
@@ -266,7 +127,7 @@ def design(
     method: str = "mu",
     *,
     pressure_bar: float | None = None,
-    weights: DesignWeights | None = None,
+    weights: Weights | None = None,
     uncertainty: Mapping[str, Any] | None = None,
     states: int = 12,
     omega: Any = None,
@@ -284,8 +145,9 @@ def design(
         Reference PID, nominal H∞, or μ (D–K) robust to the seal's k.
     pressure_bar : float, optional
         Design pressure drop (bar); ``[operating] pressure_bar`` if omitted (2.04 bar).
-    weights : DesignWeights, optional
-        Weights; :func:`default_weights` for the method if omitted.
+    weights : Weights, optional
+        Weights and scalings; :func:`~ambseal.control.weights.default_weights` for the
+        method if omitted.
     uncertainty : mapping, optional
         μ only: ``{parameter: fraction or (low, high)}`` as in
         :func:`~ambseal.control.plant.generalized_plant`; default ``{"seal.k": 1.0}``
@@ -294,7 +156,7 @@ def design(
         Mechanical states of the design model (8: rigid body only, as the thesis; 12: plus
         the first bending pair, the default, so that the full-order loop stays stable).
     omega : array_like, optional
-        μ frequency grid (rad/s); default 60 points log-spaced over 1 Hz … 2 kHz.
+        μ frequency grid (rad/s); default :func:`~ambseal.control.dk.design_omega`.
     reduce_to : int, "auto" or None
         Reduce the controller to this order (balanced truncation,
         :func:`~ambseal.control.order.reduce_controller`); the rise of γ/μ is reported in
@@ -343,10 +205,10 @@ def design(
             fpos = (float(cfg.seal[0].position),)
         else:
             raise ValueError("design: orbit_um needs a force position; the rig has no seal, "
-                             "set DesignWeights.force_position_m")
+                             "set Weights.force_position_m")
     gp = generalized_plant(cfg, w.Wp(), w.Wu(), uncertainty=unc if method == "mu" else None,
                            pressure_bar=p, states=states, input_disturbance=w.W1(),
-                           force_disturbance=Wf, force_positions=fpos)
+                           force_disturbance=Wf, force_positions=fpos, d_e=w.d_e, d_u=w.d_u)
     if method == "hinf":
         from .hinf import hinfsyn
 
@@ -354,10 +216,9 @@ def design(
         K_P, gamma, mu, hist = r.K, float(r.gamma), None, ()
         P_red, blocks, om = gp.P_nominal, None, None
     else:
-        from .dk import musyn
+        from .dk import design_omega, musyn
 
-        om = (2 * np.pi * np.logspace(0.0, np.log10(2000.0), 60) if omega is None
-              else np.asarray(omega, float))
+        om = design_omega() if omega is None else np.asarray(omega, float)
         r = musyn(gp.P, gp.blocks, gp.nmeas, gp.ncon, om, order=dk_order, max_iter=max_iter)
         K_P, gamma, mu, hist = r.K, float(r.gamma), float(r.mu), r.history
         P_red, blocks = gp.P, gp.blocks

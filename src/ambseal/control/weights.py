@@ -18,14 +18,23 @@
   ``D12`` of the generalised plant has full column rank.
 
 All frequencies in rad/s unless the name says ``_hz``.
+
+:class:`Weights` holds one design's tuning (W_p, W_u, W_1, W_f and the scalings D_e, D_u)
+for every synthesis of the package: the PID/H∞/μ designs of
+:mod:`ambseal.control.recipes` and the speed-scheduled designs of
+:mod:`ambseal.control.lpv_design`; :func:`default_weights` gives the tuned sets.
 """
 
 from __future__ import annotations
 
+from dataclasses import asdict, dataclass
+
 import numpy as np
 
-__all__ = ["performance_weight", "control_weight", "check_weight", "diagonal_weight",
-           "wp_gain"]
+from ..errors import ConfigError
+
+__all__ = ["Weights", "default_weights", "performance_weight", "control_weight",
+           "check_weight", "diagonal_weight", "wp_gain"]
 
 
 def performance_weight(M: float, omega_b: float, A: float = 1e-3):
@@ -48,7 +57,7 @@ def performance_weight(M: float, omega_b: float, A: float = 1e-3):
 
     Raises
     ------
-    ValueError
+    ConfigError
         If a parameter is non-finite or out of range (named in the message).
 
     Examples
@@ -61,9 +70,9 @@ def performance_weight(M: float, omega_b: float, A: float = 1e-3):
 
     for name, v in (("M", M), ("omega_b", omega_b), ("A", A)):
         if not (np.isfinite(v) and v > 0):
-            raise ValueError(f"performance_weight: {name}={v!r} must be finite and > 0")
+            raise ConfigError(f"performance_weight: {name}={v!r} must be finite and > 0")
     if not A < 1:
-        raise ValueError(f"performance_weight: A={A!r} (steady-state error) must be < 1")
+        raise ConfigError(f"performance_weight: A={A!r} (steady-state error) must be < 1")
     return control.tf([1.0 / M, omega_b], [1.0, omega_b * A])
 
 
@@ -94,7 +103,7 @@ def control_weight(gain: float, *, corner_hz: float | None = None,
 
     Raises
     ------
-    ValueError
+    ConfigError
         Non-positive gains or corner, ``hf_gain <= gain``, or ``hf_gain`` without corner.
 
     Examples
@@ -106,15 +115,15 @@ def control_weight(gain: float, *, corner_hz: float | None = None,
     import control
 
     if not (np.isfinite(gain) and gain > 0):
-        raise ValueError(f"control_weight: gain={gain!r} must be finite and > 0")
+        raise ConfigError(f"control_weight: gain={gain!r} must be finite and > 0")
     if corner_hz is None:
         if hf_gain is not None:
-            raise ValueError("control_weight: hf_gain needs corner_hz")
+            raise ConfigError("control_weight: hf_gain needs corner_hz")
         return control.tf([float(gain)], [1.0])
     if not (np.isfinite(corner_hz) and corner_hz > 0):
-        raise ValueError(f"control_weight: corner_hz={corner_hz!r} must be finite and > 0")
+        raise ConfigError(f"control_weight: corner_hz={corner_hz!r} must be finite and > 0")
     if hf_gain is None or not (np.isfinite(hf_gain) and hf_gain > gain):
-        raise ValueError(f"control_weight: hf_gain={hf_gain!r} must be finite and > gain={gain}")
+        raise ConfigError(f"control_weight: hf_gain={hf_gain!r} must be finite and > gain={gain}")
     wz = 2 * np.pi * corner_hz
     wp = wz * hf_gain / gain
     return control.tf([gain / wz, gain], [1.0 / wp, 1.0])
@@ -139,7 +148,7 @@ def check_weight(W, name: str, *, biproper: bool = False):
 
     Raises
     ------
-    ValueError
+    ConfigError
         If the weight is not SISO, not proper (more zeros than poles), discrete-time, has
         a pole with ``Re ≥ 0``, non-finite coefficients, or (``biproper``) ``D = 0``.
     """
@@ -147,39 +156,39 @@ def check_weight(W, name: str, *, biproper: bool = False):
 
     if np.isscalar(W):
         if not (np.isfinite(W) and W != 0):
-            raise ValueError(f"weight {name}: a constant weight must be finite and non-zero, got {W!r}")
+            raise ConfigError(f"weight {name}: a constant weight must be finite and non-zero, got {W!r}")
         return control.ss([], [], [], [[float(W)]])
     if isinstance(W, control.TransferFunction):
         if W.ninputs != 1 or W.noutputs != 1:
-            raise ValueError(f"weight {name}: must be SISO, got {W.noutputs}×{W.ninputs}")
+            raise ConfigError(f"weight {name}: must be SISO, got {W.noutputs}×{W.ninputs}")
         num = np.trim_zeros(np.atleast_1d(np.asarray(W.num[0][0], float)), "f")
         den = np.trim_zeros(np.atleast_1d(np.asarray(W.den[0][0], float)), "f")
         if num.size > den.size:
-            raise ValueError(
+            raise ConfigError(
                 f"weight {name} is not proper: numerator degree {num.size - 1} > denominator "
                 f"degree {den.size - 1}; add a high-frequency pole")
     elif not isinstance(W, control.StateSpace):
-        raise ValueError(f"weight {name}: expected a TransferFunction, StateSpace or number, "
+        raise ConfigError(f"weight {name}: expected a TransferFunction, StateSpace or number, "
                          f"got {type(W).__name__}")
     if W.isdtime(strict=True):
-        raise ValueError(f"weight {name}: must be continuous-time")
+        raise ConfigError(f"weight {name}: must be continuous-time")
     S = control.ss(W)
     if S.ninputs != 1 or S.noutputs != 1:
-        raise ValueError(f"weight {name}: must be SISO, got {S.noutputs}×{S.ninputs}")
+        raise ConfigError(f"weight {name}: must be SISO, got {S.noutputs}×{S.ninputs}")
     mats = [np.asarray(m, float) for m in (S.A, S.B, S.C, S.D)]
     if not all(np.all(np.isfinite(m)) for m in mats):
-        raise ValueError(f"weight {name}: non-finite coefficients")
+        raise ConfigError(f"weight {name}: non-finite coefficients")
     if S.nstates and np.max(np.linalg.eigvals(mats[0]).real) >= 0:
-        raise ValueError(f"weight {name}: has a pole with Re ≥ 0; weights must be stable")
+        raise ConfigError(f"weight {name}: has a pole with Re ≥ 0; weights must be stable")
     if biproper and abs(float(mats[3][0, 0])) == 0.0:
-        raise ValueError(f"weight {name}: must be biproper (non-zero gain at high frequency)")
+        raise ConfigError(f"weight {name}: must be biproper (non-zero gain at high frequency)")
     return S
 
 
 def diagonal_weight(W, n: int, name: str, *, biproper: bool = False):
     """``diag(W, …, W)`` (n copies) of a SISO weight as a ``control.StateSpace``.
 
-    Raises ValueError as :func:`check_weight`.
+    Raises ConfigError as :func:`check_weight`.
     """
     import control
 
@@ -190,3 +199,179 @@ def diagonal_weight(W, n: int, name: str, *, biproper: bool = False):
     if S.nstates == 0:
         A, B, C = np.zeros((0, 0)), np.zeros((0, n)), np.zeros((n, 0))
     return control.ss(A, B, C, D)
+
+
+@dataclass(frozen=True)
+class Weights:
+    """Tuning of one design: weights and scalings (P5 Eq. 7, §3.1.4, §4.3; P3 Eq. 11, §3.3).
+
+    One class for every synthesis: the nominal H∞ and μ designs of a rig
+    (:func:`ambseal.control.recipes.design`) and the speed-scheduled LPV and frozen-speed
+    designs (:mod:`ambseal.control.lpv_design`). :func:`default_weights` gives the tuned
+    sets; the defaults below are those of the nominal H∞ design.
+
+    Attributes
+    ----------
+    M : float
+        W_p high-frequency sensitivity bound (-).
+    omega_b : float
+        W_p bandwidth ω_B (rad/s).
+    A : float
+        W_p steady-state error (-), thesis 1/1000 (1e-2 for the LPV LMIs, see
+        :func:`default_weights`).
+    wu_gain : float
+        W_u low-frequency gain on the scaled current (-).
+    wu_corner_hz, wu_hf_gain : float or None
+        Optional high-pass W_u (:func:`control_weight`): corner (Hz) and high-frequency
+        gain (-).
+    w1_gain : float
+        High-frequency gain of the input-disturbance weight W_1 (-).
+    w1_corner_hz : float or None
+        W_1 = w1_gain·s/(s + 2π·corner) when given (a high-pass: the compliance demand
+        where unbalance forces act, not at DC); a constant ``w1_gain`` otherwise.
+    orbit_um : float or None
+        Unbalance-orbit demand (µm): adds force inputs at ``force_position_m`` weighted by
+        :meth:`Wf`, so that ``‖W_p S_o G_f W_f / D_e‖∞ ≤ 1`` reads "worst-case orbit
+        σ̄(S_o G_f)·m·G·Ω ≤ orbit_um" below the roll-off (P5 §4.4.1). None: no force channel.
+    unbalance_mass_kg, unbalance_grade_mm_s : float
+        Rotor mass (kg) and ISO 21940-11 balance grade (mm/s) of the force law
+        ``F_u = m·G·Ω`` (thesis test rig: 69 kg, G2.5; only used with ``orbit_um``).
+    wf_rolloff_hz : float
+        Corner (Hz) of the 4th-order Butterworth roll-off of W_f: above the speed range and
+        well below the first bending mode, where a force at the seal excites a resonance no
+        controller can make compliant — a W_f still large there makes μ unreachable and
+        wrecks the design (test rig: 260 Hz, between the 200 Hz speed range and the
+        557 Hz bending mode; only used with ``orbit_um``).
+    force_position_m : float or None
+        Axial position (m) of the force; the rig's first seal if None.
+    d_e, d_u : float
+        Scalings of displacement error (m) and current (A), P5 §3.1.4: 20 µm and 1 A.
+    """
+
+    M: float = 2.5
+    omega_b: float = 60.0
+    A: float = 1e-3
+    wu_gain: float = 0.3
+    wu_corner_hz: float | None = None
+    wu_hf_gain: float | None = None
+    w1_gain: float = 1.0
+    w1_corner_hz: float | None = None
+    orbit_um: float | None = None
+    unbalance_mass_kg: float = 69.0
+    unbalance_grade_mm_s: float = 2.5
+    wf_rolloff_hz: float = 260.0
+    force_position_m: float | None = None
+    d_e: float = 20e-6
+    d_u: float = 1.0
+
+    def Wp(self):
+        """W_p as a ``control.TransferFunction`` (:func:`performance_weight`)."""
+        return performance_weight(self.M, self.omega_b, self.A)
+
+    def Wu(self):
+        """W_u as a ``control.TransferFunction`` (:func:`control_weight`)."""
+        return control_weight(self.wu_gain, corner_hz=self.wu_corner_hz, hf_gain=self.wu_hf_gain)
+
+    def W1(self):
+        """W_1 (input disturbance) as a ``control.TransferFunction`` or a float.
+
+        Raises
+        ------
+        ConfigError
+            A high-pass W_1 with a non-positive gain or corner.
+        """
+        import control
+
+        if self.w1_corner_hz is None:
+            return float(self.w1_gain)
+        if not (self.w1_gain > 0 and self.w1_corner_hz > 0):
+            raise ConfigError(f"W_1: gain {self.w1_gain} and corner {self.w1_corner_hz} Hz "
+                              "must be > 0")
+        return control.tf([self.w1_gain, 0.0], [1.0, 2 * np.pi * self.w1_corner_hz])
+
+    def Wf(self):
+        """W_f on the unbalance-force inputs (N per unit), or None without ``orbit_um``.
+
+        ``W_f = (m G D_e / orbit) · s · B_4(s) / W_p(s)`` with ``B_4`` the 4th-order
+        Butterworth low-pass at ``wf_rolloff_hz``: the product ``W_p W_f / D_e`` on the
+        force → performance channel is ``m G s B_4 / orbit``, i.e. the unbalance force
+        ``F_u = m·G·Ω`` over the allowed orbit — the 1/W_p factor undoes the performance
+        weight, which would otherwise turn the demand into an orbit bound of
+        ``M·D_e/orbit`` ≈ 6× too loose above ω_B and a needless one at DC.
+
+        Raises
+        ------
+        ConfigError
+            A non-positive or non-finite orbit, mass, grade or roll-off.
+        """
+        import control
+
+        if self.orbit_um is None:
+            return None
+        for nm, v in (("orbit_um", self.orbit_um), ("unbalance_mass_kg", self.unbalance_mass_kg),
+                      ("unbalance_grade_mm_s", self.unbalance_grade_mm_s),
+                      ("wf_rolloff_hz", self.wf_rolloff_hz)):
+            if not (np.isfinite(v) and v > 0):
+                raise ConfigError(f"W_f: {nm}={v!r} must be finite and > 0")
+        c = (self.unbalance_mass_kg * self.unbalance_grade_mm_s * 1e-3 * self.d_e
+             / (self.orbit_um * 1e-6))
+        wr = 2 * np.pi * self.wf_rolloff_hz
+        # Butterworth: s⁴ + 2.613 s³ + 3.414 s² + 2.613 s + 1 (normalised)
+        b4 = control.tf([wr**4], [1.0, 2.6131259 * wr, 3.4142136 * wr**2, 2.6131259 * wr**3,
+                                  wr**4])
+        Wp = self.Wp()
+        return control.tf([c, 0.0], [1.0]) * b4 * control.tf(Wp.den[0][0], Wp.num[0][0])
+
+    def to_dict(self) -> dict:
+        """JSON-ready fields, units in the keys."""
+        d = asdict(self)
+        d["omega_b_rad_s"] = d.pop("omega_b")
+        d["d_e_m"] = d.pop("d_e")
+        d["d_u_a"] = d.pop("d_u")
+        return d
+
+
+def default_weights(method: str) -> Weights:
+    """The tuned weights of each design (see the tests in ``tests/control`` for why).
+
+    ``"hinf"`` (test rig, nominal design, P5 §4.4): W_p with M = 2.5, ω_B = 60 rad/s,
+    A = 1/1000; W_u = 0.3 constant.
+
+    ``"mu"`` (test rig, P5 §4.3–4.4): W_p with M = 3 (ISO 14839-3 zone A), ω_B = 30 rad/s,
+    A = 1/1000; a high-pass W_u = 0.02 (1 + s/ω_z)/(1 + s/ω_p) rising from 0.02 to 0.2
+    above 800 Hz (rolls the controller off above the bending mode: |K| ≈ 0.2 MA/m at
+    10 kHz instead of ≈ 1.3); a small constant W_1 = 0.05; and the unbalance force at the
+    seal as a weighted input, :meth:`Weights.Wf` with ``F_u = m·G·Ω`` (69 kg, G2.5,
+    P5 §4.4.1), an orbit demand of 6 µm and a 4th-order roll-off at 260 Hz (above the
+    200 Hz speed range, below the 557 Hz bending mode). Result (μ ≈ 1.14): on the
+    full-order plant from 0 to 4.08 bar σ̄(S_o) ≤ 2.5 (bending-mode resonance resolved)
+    and worst-case orbit up to 200 Hz ≤ 6.5 µm.
+
+    Why: the force channel must bypass W_p (else the bound is ≈ 6× too loose above ω_B)
+    and roll off before the bending mode (else μ ≈ 6 at 557 Hz and the design degrades:
+    orbit 17–49 µm); without it the orbit is ≈ 10.5 µm. The binding trade-off is the
+    orbit against the control effort, not against σ̄(S_o): with W_u = 0.05/0.03/0.02
+    (constant) and a 6 µm demand the orbit is 7.8/6.6/5.8 µm at σ̄(S_o) 2.3/2.1/2.0;
+    W_u = 0.2 with the same demand gives σ̄(S_o) 3.6 and 15 µm. With an 8 µm demand and
+    this W_u, μ = 0.98 < 1 (robust performance on the design model), orbit 7.0 µm — a
+    smaller margin on the acceptance than the 6 µm demand.
+
+    ``"lpv"`` (turboexpander, LPV and frozen-speed designs, P3 Eq. 11, §3.3): M = 2,
+    ω_B = 2π·50 rad/s, A = 1e-2, high-pass W_u 0.05 → 0.5 with its corner at 1.4 kHz;
+    the reasoning is in :mod:`ambseal.control.lpv_design`.
+
+    Raises
+    ------
+    ConfigError
+        Unknown method.
+    """
+    if method == "hinf":
+        return Weights(M=2.5, omega_b=60.0, wu_gain=0.3)
+    if method == "mu":
+        return Weights(M=3.0, omega_b=30.0, wu_gain=0.02, wu_corner_hz=800.0,
+                       wu_hf_gain=0.2, w1_gain=0.05, orbit_um=6.0, wf_rolloff_hz=260.0)
+    if method == "lpv":
+        return Weights(M=2.0, omega_b=2 * np.pi * 50.0, A=1e-2, wu_gain=0.05,
+                       wu_corner_hz=1400.0, wu_hf_gain=0.5)
+    raise ConfigError(f"default_weights: no weights for method {method!r} "
+                      "(expected 'hinf', 'mu' or 'lpv')")

@@ -21,7 +21,7 @@ import numpy as np
 import control as ct
 from scipy.optimize import least_squares
 
-from ambseal.errors import ConfigError, SynthesisError
+from ambseal.errors import ConfigError, ModelError, SynthesisError
 from ambseal.control.hinf import check_plant, hinfsyn, lft_lower
 from ambseal.control.mu import check_blocks, mussv
 
@@ -86,17 +86,17 @@ def fit_magnitude(omega, mag, order: int):
 
     Raises
     ------
-    ValueError
+    ConfigError
         Order outside 0–4, non-positive magnitudes or frequencies, length mismatch.
     """
     w = np.asarray(omega, float)
     d = np.asarray(mag, float)
     if not (isinstance(order, (int, np.integer)) and 0 <= order <= 4):
-        raise ValueError(f"order={order!r}: the D-scale fit order must be an integer 0–4")
+        raise ConfigError(f"order={order!r}: the D-scale fit order must be an integer 0–4")
     if w.shape != d.shape or w.ndim != 1 or w.size == 0:
-        raise ValueError("fit_magnitude: omega and mag must be 1-D arrays of equal length")
+        raise ConfigError("fit_magnitude: omega and mag must be 1-D arrays of equal length")
     if np.any(w <= 0) or np.any(~np.isfinite(d)) or np.any(d <= 0):
-        raise ValueError("fit_magnitude: frequencies and magnitudes must be positive and finite")
+        raise ConfigError("fit_magnitude: frequencies and magnitudes must be positive and finite")
     y = np.log(np.clip(d, 1e-8, 1e8))
     if order == 0:
         return ct.tf([float(np.exp(np.mean(y)))], [1.0])
@@ -302,20 +302,21 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
 
     Raises
     ------
-    ValueError
-        Blocks that do not match P's exogenous channels, bad order, bad grid.
+    ModelError, ConfigError
+        Blocks that do not match P's exogenous channels (ModelError); bad order or grid
+        (ConfigError).
     SynthesisError
         If the first K-step fails (plant assumptions violated).
     """
     check_plant(P, nmeas, ncon)
     blks = check_blocks(P, blocks, nmeas, ncon)
     if blks[-1].kind != "full":
-        raise ValueError("musyn: the last block must be the full complex performance block")
+        raise ModelError("musyn: the last block must be the full complex performance block")
     if not (isinstance(order, (int, np.integer)) and 0 <= order <= 4):
-        raise ValueError(f"order={order!r}: the D-scale fit order must be an integer 0–4")
+        raise ConfigError(f"order={order!r}: the D-scale fit order must be an integer 0–4")
     w = default_omega(P) if omega is None else np.asarray(omega, float)
     if w.ndim != 1 or w.size < 2 or np.any(w <= 0) or not np.all(np.isfinite(w)):
-        raise ValueError("musyn: omega must be a 1-D grid of positive rad/s values")
+        raise ConfigError("musyn: omega must be a 1-D grid of positive rad/s values")
     cblocks = _complexify(blks)
     console = None
     if progress:

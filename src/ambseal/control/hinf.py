@@ -31,7 +31,7 @@ import numpy as np
 import scipy.linalg as sla
 import control as ct
 
-from ambseal.errors import SynthesisError
+from ambseal.errors import ConfigError, ModelError, SynthesisError
 from ambseal.lti.freqresp import freqresp
 from ambseal.lti.interconnect import lft_lower
 
@@ -85,7 +85,7 @@ def hinfnorm(sys, rtol: float = 1e-7, max_iter: int = 100) -> tuple[float, float
 
     Raises
     ------
-    ValueError
+    ModelError
         If ``sys`` is discrete-time.
 
     Examples
@@ -97,7 +97,7 @@ def hinfnorm(sys, rtol: float = 1e-7, max_iter: int = 100) -> tuple[float, float
     """
     sys = ct.ss(sys)
     if sys.isdtime(strict=True):
-        raise ValueError("hinfnorm: only continuous-time systems are supported")
+        raise ModelError("hinfnorm: only continuous-time systems are supported")
     A, B, C, D = (np.asarray(M, float) for M in (sys.A, sys.B, sys.C, sys.D))
     n = A.shape[0]
     if B.shape[1] == 0 or C.shape[0] == 0:
@@ -181,27 +181,27 @@ def check_plant(P, nmeas: int, ncon: int) -> None:
 
     Raises
     ------
-    ValueError
+    ModelError
         If ``P`` is not a continuous-time state-space system or the channel counts do not fit.
     SynthesisError
         If ``(A, B2)`` is not stabilisable, ``(C2, A)`` not detectable, ``D12`` lacks full
         column rank or ``D21`` lacks full row rank; the message names the cause.
     """
     if not isinstance(P, ct.StateSpace):
-        raise ValueError(f"P must be a control.StateSpace, got {type(P).__name__}")
+        raise ModelError(f"P must be a control.StateSpace, got {type(P).__name__}")
     if P.isdtime(strict=True):
-        raise ValueError("P must be continuous-time (dt = 0)")
+        raise ModelError("P must be continuous-time (dt = 0)")
     nin, nout = P.ninputs, P.noutputs
     if not (isinstance(nmeas, (int, np.integer)) and isinstance(ncon, (int, np.integer))):
-        raise ValueError("nmeas and ncon must be integers")
+        raise ModelError("nmeas and ncon must be integers")
     if not (0 < ncon < nin):
-        raise ValueError(f"ncon={ncon} must be between 1 and the number of inputs - 1 ({nin - 1})")
+        raise ModelError(f"ncon={ncon} must be between 1 and the number of inputs - 1 ({nin - 1})")
     if not (0 < nmeas < nout):
-        raise ValueError(f"nmeas={nmeas} must be between 1 and the number of outputs - 1 ({nout - 1})")
+        raise ModelError(f"nmeas={nmeas} must be between 1 and the number of outputs - 1 ({nout - 1})")
     A, B, C, D = (np.asarray(M, float) for M in (P.A, P.B, P.C, P.D))
     if not np.all(np.isfinite(A)) or not np.all(np.isfinite(B)) or not np.all(np.isfinite(C)) \
             or not np.all(np.isfinite(D)):
-        raise ValueError("P has non-finite entries")
+        raise ModelError("P has non-finite entries")
     nw, nz = nin - ncon, nout - nmeas
     B2, C2 = B[:, nw:], C[nz:]
     D12, D21 = D[:nz, nw:], D[nz:, :nw]
@@ -352,8 +352,8 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
 
     Raises
     ------
-    ValueError
-        Wrong system type or channel counts.
+    ModelError, ConfigError
+        Wrong system type or channel counts (ModelError); backoff < 1 (ConfigError).
     SynthesisError
         Plant not stabilisable/detectable, ``D12``/``D21`` rank deficient, jω-axis zeros,
         inadmissible ``gamma`` or no stabilising controller found.
@@ -370,7 +370,7 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
     """
     check_plant(P, nmeas, ncon)
     if backoff < 1.0:
-        raise ValueError(f"backoff={backoff} must be ≥ 1")
+        raise ConfigError(f"backoff={backoff} must be ≥ 1")
     A0, B0, C0, D0 = (np.asarray(M, float) for M in (P.A, P.B, P.C, P.D))
     nw, nz = B0.shape[1] - ncon, C0.shape[0] - nmeas
     A, B, C, D, t, su, sy = _scale(A0, B0, C0, D0, nw, nz)

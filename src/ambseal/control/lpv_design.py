@@ -281,7 +281,7 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
         ``"hinf"``: :func:`hinfsyn` on the nominal plant with the LPV weights (the same
         performance demand as the LPV design, so the comparison isolates the scheduling).
         ``"mu"``: D–K iteration (:func:`musyn`) with the seal's k ± ``seal_k_uncertainty``
-        (P3 §3.1: ±40 %); slower (minutes).
+        (P3 §3.1: ±40 %); a few seconds per D–K iteration on the turboexpander.
     weights : Weights, optional
         ``default_weights("lpv")`` if omitted (module docstring).
     states : int
@@ -295,15 +295,15 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
 
     Raises
     ------
-    ValueError
-        Unknown method.
+    ConfigError
+        Unknown method; ``"mu"`` on a rig without a seal.
     SynthesisError
         From the synthesis.
     """
     from .lpv_plant import lpv_plant
 
     if method not in ("hinf", "mu"):
-        raise ValueError(f"design_frozen: method={method!r}, expected 'hinf' or 'mu'")
+        raise ConfigError(f"design_frozen: method={method!r}, expected 'hinf' or 'mu'")
     t0 = time.perf_counter()
     w = weights or default_weights("lpv")
     f = float(speed_hz)
@@ -318,8 +318,12 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
         from .dk import design_omega, musyn
         from .plant import generalized_plant
 
-        cfg_f = cfg.model_copy(deep=True) if hasattr(cfg, "model_copy") else cfg
-        cfg_f.operating.speed_rpm = 60.0 * f
+        if not getattr(cfg, "seal", None):
+            raise ConfigError("design_frozen(method='mu'): the uncertain parameter is the "
+                              "seal's k, but the rig has no [[seal]]")
+        # the rig at the design speed (RigConfig is frozen: copy with the speed updated)
+        cfg_f = cfg.model_copy(update={
+            "operating": cfg.operating.model_copy(update={"speed_rpm": 60.0 * f})})
         gp = generalized_plant(cfg_f, w.Wp(), w.Wu(), states=states,
                                uncertainty={f"{cfg.seal[0].name}.k": seal_k_uncertainty},
                                d_e=w.d_e, d_u=w.d_u)

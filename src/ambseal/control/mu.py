@@ -384,7 +384,7 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
 
     Raises
     ------
-    ValueError
+    ModelError
         Malformed blocks, dimensions that do not match ``M``, missing ``omega``, non-finite
         entries.
 
@@ -406,26 +406,26 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
     w = None
     if hasattr(M, "A") and hasattr(M, "B"):
         if omega is None:
-            raise ValueError("mussv: a state-space M needs a frequency grid omega (rad/s)")
+            raise ModelError("mussv: a state-space M needs a frequency grid omega (rad/s)")
         if getattr(M, "dt", 0) not in (0, None):
-            raise ValueError("mussv: only continuous-time systems (dt = 0) are supported")
+            raise ModelError("mussv: only continuous-time systems (dt = 0) are supported")
         w = np.atleast_1d(np.asarray(omega, float))
         if w.ndim != 1 or w.size == 0 or not np.all(np.isfinite(w)):
-            raise ValueError("mussv: omega must be a non-empty 1-D array of finite rad/s values")
+            raise ModelError("mussv: omega must be a non-empty 1-D array of finite rad/s values")
         Marr = freqresp(M, w)
     else:
         Marr = np.asarray(M, complex)
         if omega is not None:
-            raise ValueError("mussv: omega is only used with a state-space M")
+            raise ModelError("mussv: omega is only used with a state-space M")
     if Marr.ndim < 2:
-        raise ValueError(f"mussv: M must be (..., n, m), got shape {Marr.shape}")
+        raise ModelError(f"mussv: M must be (..., n, m), got shape {Marr.shape}")
     n, m = _dims(blks)
     if Marr.shape[-2:] != (n, m):
-        raise ValueError(
+        raise ModelError(
             f"mussv: blocks {list(blocks)} need M of shape (..., {n}, {m}) "
             f"(Σc = {n} rows, Σr = {m} columns), got {Marr.shape[-2:]}")
     if not np.all(np.isfinite(Marr)):
-        raise ValueError("mussv: M has non-finite entries")
+        raise ModelError("mussv: M has non-finite entries")
     stack = Marr.shape[:-2]
     Mf = Marr.reshape((-1, n, m))
     F = Mf.shape[0]

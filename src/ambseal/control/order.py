@@ -17,6 +17,7 @@ import numpy as np
 import control as ct
 
 from ambseal.control.hinf import hinfnorm, lft_lower
+from ambseal.errors import ConfigError
 
 __all__ = ["ReductionResult", "balred_controller", "reduce_controller"]
 
@@ -43,20 +44,20 @@ def balred_controller(K, order: int, alpha: float | None = None):
 
     Raises
     ------
-    ValueError
+    ConfigError
         ``order`` negative, above ``n`` or below the number of unstable poles.
     """
     n = int(K.nstates)
     if not isinstance(order, (int, np.integer)) or order < 0 or order > n:
-        raise ValueError(f"order={order!r}: must be an integer between 0 and {n}")
+        raise ConfigError(f"order={order!r}: must be an integer between 0 and {n}")
     A, B, C, D = (np.asarray(X, float) for X in (K.A, K.B, K.C, K.D))
     lam = np.linalg.eigvals(A) if n else np.zeros(0)
     if alpha is None:
         alpha = -1e-8 * max(1.0, float(np.max(np.abs(lam))) if n else 1.0)
     nu = int(np.sum(lam.real >= alpha))
     if order < nu:
-        raise ValueError(f"order={order} is below the {nu} unstable/marginal poles of K, "
-                         "which are kept exactly")
+        raise ConfigError(f"order={order} is below the {nu} unstable/marginal poles of K, "
+                          "which are kept exactly")
     names = dict(inputs=list(K.input_labels), outputs=list(K.output_labels), name=f"{K.name}_r")
     if order == n:
         return ct.ss(A, B, C, D, **names), np.zeros(0)
@@ -138,7 +139,7 @@ def reduce_controller(P, K, order: int, nmeas: int, ncon: int, *,
 
     Raises
     ------
-    ValueError
+    ConfigError
         Bad order; ``blocks`` without ``omega``.
     """
     Kr, hsv = balred_controller(K, order, alpha)
@@ -147,7 +148,7 @@ def reduce_controller(P, K, order: int, nmeas: int, ncon: int, *,
     mu_full = mu_red = None
     if blocks is not None:
         if omega is None:
-            raise ValueError("reduce_controller: blocks given without a frequency grid omega")
+            raise ConfigError("reduce_controller: blocks given without a frequency grid omega")
         from ambseal.control.mu import mussv
 
         mu_full = float(np.max(mussv(lft_lower(P, K, nmeas, ncon), blocks, omega).upper))

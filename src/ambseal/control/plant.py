@@ -35,7 +35,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ..errors import ModelError
+from ..errors import ConfigError, ModelError
 from .weights import diagonal_weight
 
 __all__ = ["UncertainParameter", "GeneralizedPlant", "generalized_plant",
@@ -269,23 +269,23 @@ def _ranges(plant, uncertainty: Mapping[str, Any]) -> tuple[UncertainParameter, 
         if np.isscalar(spec):
             frac = float(spec)
             if not (np.isfinite(frac) and frac > 0):
-                raise ValueError(f"uncertainty[{name!r}]={spec!r}: a relative range must be a "
-                                 "finite fraction > 0 (e.g. 1.0 for ±100 %)")
+                raise ConfigError(f"uncertainty[{name!r}]={spec!r}: a relative range must be a "
+                                  "finite fraction > 0 (e.g. 1.0 for ±100 %)")
             if nom == 0:
-                raise ValueError(f"uncertainty[{name!r}]: the nominal value is 0, a relative "
-                                 "range has zero width; give an absolute (low, high) range")
+                raise ConfigError(f"uncertainty[{name!r}]: the nominal value is 0, a relative "
+                                  "range has zero width; give an absolute (low, high) range")
             lo, hi = nom - frac * abs(nom), nom + frac * abs(nom)
         else:
             try:
                 lo, hi = (float(v) for v in spec)
             except (TypeError, ValueError):
-                raise ValueError(f"uncertainty[{name!r}]={spec!r}: expected a fraction or a "
-                                 "(low, high) pair in SI units") from None
+                raise ConfigError(f"uncertainty[{name!r}]={spec!r}: expected a fraction or a "
+                                  "(low, high) pair in SI units") from None
             if not (np.isfinite(lo) and np.isfinite(hi)):
-                raise ValueError(f"uncertainty[{name!r}]: range ({lo}, {hi}) is not finite")
+                raise ConfigError(f"uncertainty[{name!r}]: range ({lo}, {hi}) is not finite")
             if not hi > lo:
-                raise ValueError(f"uncertainty[{name!r}]: range ({lo}, {hi}) has zero or "
-                                 "negative width; need low < high")
+                raise ConfigError(f"uncertainty[{name!r}]: range ({lo}, {hi}) has zero or "
+                                  "negative width; need low < high")
         out.append(UncertainParameter(name, nom, lo, hi, int(p.repeats), p.unit))
     return tuple(out)
 
@@ -353,7 +353,7 @@ def generalized_plant(
 
     Raises
     ------
-    ValueError
+    ConfigError
         Improper/unstable weights (named), non-positive scalings, a zero-width range.
     ModelError
         Unknown parameter names, a plant without current inputs.
@@ -373,7 +373,7 @@ def generalized_plant(
 
     for nm, v in (("d_e", d_e), ("d_u", d_u), ("output_disturbance", output_disturbance)):
         if not (np.isfinite(v) and v > 0):
-            raise ValueError(f"generalized_plant: {nm}={v!r} must be finite and > 0")
+            raise ConfigError(f"generalized_plant: {nm}={v!r} must be finite and > 0")
     if isinstance(source, Plant):
         plant = source
     else:

@@ -171,9 +171,8 @@ def design(
 
     Raises
     ------
-    ValueError
-        Unknown method, bad weights or uncertainty ranges.
     ConfigError
+        Unknown method, bad weights or uncertainty ranges, ``reduce_to`` not an int,
         ``"pid"`` on a rig without ``[controller.pid]``.
     SynthesisError
         If synthesis fails or the reduced controller no longer stabilises the design loop.
@@ -186,7 +185,7 @@ def design(
     (4, 4)
     """
     if method not in METHODS:
-        raise ValueError(f"design: method={method!r}, expected one of {METHODS}")
+        raise ConfigError(f"design: method={method!r}, expected one of {METHODS}")
     p = float(cfg.operating.pressure_bar if pressure_bar is None else pressure_bar)
     if method == "pid":
         return _pid(cfg, p)
@@ -204,8 +203,8 @@ def design(
         elif getattr(cfg, "seal", None):
             fpos = (float(cfg.seal[0].position),)
         else:
-            raise ValueError("design: orbit_um needs a force position; the rig has no seal, "
-                             "set Weights.force_position_m")
+            raise ConfigError("design: orbit_um needs a force position; the rig has no seal, "
+                              "set Weights.force_position_m")
     gp = generalized_plant(cfg, w.Wp(), w.Wu(), uncertainty=unc if method == "mu" else None,
                            pressure_bar=p, states=states, input_disturbance=w.W1(),
                            force_disturbance=Wf, force_positions=fpos, d_e=w.d_e, d_u=w.d_u)
@@ -226,7 +225,7 @@ def design(
     if reduce_to == "auto":
         reduce_to = 28 if method == "mu" else None
     elif isinstance(reduce_to, str):
-        raise ValueError(f"design: reduce_to={reduce_to!r}, expected an int, 'auto' or None")
+        raise ConfigError(f"design: reduce_to={reduce_to!r}, expected an int, 'auto' or None")
     red = None
     if reduce_to is not None and reduce_to < order_full:
         from .order import reduce_controller

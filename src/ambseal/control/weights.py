@@ -169,7 +169,7 @@ def check_weight(W, name: str, *, biproper: bool = False):
                 f"degree {den.size - 1}; add a high-frequency pole")
     elif not isinstance(W, control.StateSpace):
         raise ConfigError(f"weight {name}: expected a TransferFunction, StateSpace or number, "
-                         f"got {type(W).__name__}")
+                          f"got {type(W).__name__}")
     if W.isdtime(strict=True):
         raise ConfigError(f"weight {name}: must be continuous-time")
     S = control.ss(W)

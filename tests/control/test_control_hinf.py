@@ -43,20 +43,22 @@ def mixed_sensitivity(G, w1, w2):
 def test_hinfnorm_second_order_closed_form(zeta):
     """Reference: closed form ‖1/(s²+2ζs+1)‖∞ = 1/(2ζ√(1−ζ²)) at ω = √(1−2ζ²) (ζ < 1/√2)."""
     g, w = hinfnorm(ct.tf([1], [1, 2 * zeta, 1]))
-    assert g == pytest.approx(1 / (2 * zeta * np.sqrt(1 - zeta**2)), rel=1e-6)
+    assert g == pytest.approx(1 / (2 * zeta * np.sqrt(1 - zeta**2)), rel=1e-9)
     assert w == pytest.approx(np.sqrt(1 - 2 * zeta**2), rel=1e-3)
 
 
-def test_hinfnorm_matches_slycot_ab13dd_and_sweep():
-    """Reference: slycot AB13DD via control.norm(sys, 'inf') and a dense σ̄ sweep, side by side."""
+def test_hinfnorm_matches_dense_sweep():
+    """Reference: a dense σ̄ sweep (``sweep_norm``), side by side; the sweep is a lower
+    bound, so the norm may only exceed it by the sweep's grid error."""
     np.random.seed(1)
     rng = np.random.default_rng(1)
     for k in range(6):
         sys = ct.rss(6, 3, 2, strictly_proper=(k % 2 == 0))
         sys = ct.ss(sys.A, sys.B, sys.C, sys.D + 0.3 * rng.standard_normal((3, 2)) * (k % 2))
         g, _ = hinfnorm(sys)
-        assert g == pytest.approx(ct.norm(sys, "inf"), rel=1e-5)
-        assert g == pytest.approx(sweep_norm(sys), rel=1e-5)
+        ref = sweep_norm(sys)
+        assert g >= ref * (1 - 1e-10)  # AB13DD relative tolerance
+        assert g == pytest.approx(ref, rel=1e-5)
 
 
 def test_hinfnorm_unstable_is_infinite():

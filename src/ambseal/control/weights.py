@@ -63,7 +63,7 @@ def performance_weight(M: float, omega_b: float, A: float = 1e-3):
     Examples
     --------
     >>> W = performance_weight(2.0, 200.0)
-    >>> round(abs(W(0)), 3), round(abs(W(1e9j)), 3)
+    >>> round(float(abs(W(0))), 3), round(float(abs(W(1e9j))), 3)
     (1000.0, 0.5)
     """
     import control
@@ -109,7 +109,7 @@ def control_weight(gain: float, *, corner_hz: float | None = None,
     Examples
     --------
     >>> W = control_weight(0.5, corner_hz=100.0, hf_gain=5.0)
-    >>> round(abs(W(0)), 3), round(abs(W(1e9j)), 3)
+    >>> round(float(abs(W(0))), 3), round(float(abs(W(1e9j))), 3)
     (0.5, 5.0)
     """
     import control

@@ -317,110 +317,154 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
     check_plant(P, nmeas, ncon)
     if backoff < 1.0:
         raise ConfigError(f"backoff={backoff} must be ≥ 1")
-    A0, B0, C0, D0 = (np.asarray(M, float) for M in (P.A, P.B, P.C, P.D))
-    nw, nz = B0.shape[1] - ncon, C0.shape[0] - nmeas
-    A, B, C, D, t, su, sy = _scale(A0, B0, C0, D0, nw, nz)
+    sb = _Sb10(P, nmeas, ncon)
+    if gamma is None:
+        gamma_opt = sb.gamma_opt()
+        base_g, factors = gamma_opt, _backoff_ladder(backoff, max_backoff)
+    else:
+        gamma_opt, base_g, factors = float("nan"), float(gamma), [1.0]
+    tried, last_err = [], [None]
 
-    def call(g, job):
+    def attempt(g):
+        """Controller at γ = g with its verified closed-loop norm (recorded), or None."""
         try:
-            return _sb10ad(A, B, C, D, ncon, nmeas, g, job)
+            res = sb.controller(g)
+        except SynthesisError as exc:
+            last_err[0] = exc
+            return None
+        tried.append(res)
+        return res
+
+    chosen = _gamma_search(attempt, base_g, factors, backoff, fixed=gamma is not None)
+    if tried and gamma is None:
+        # every γ reported is a verified norm: keep the controller with the smallest one
+        chosen = min(tried, key=lambda r: r.gamma)
+    if chosen is None:
+        raise SynthesisError(
+            f"hinfsyn: no stabilising controller found from γ={base_g:.6g} upwards "
+            f"({last_err[0]})")
+    ylab, ulab = list(P.output_labels)[sb.nz:], list(P.input_labels)[sb.nw:]
+    Ks = chosen.K
+    K = ct.ss(Ks.A, Ks.B, Ks.C, Ks.D, inputs=ylab, outputs=ulab, name="K",
+              states=[f"xK{i}" for i in range(Ks.nstates)])
+    return HinfResult(K=K, gamma=float(chosen.gamma), gamma_opt=gamma_opt,
+                      gamma_design=float(chosen.gamma_design), omega_peak=float(chosen.omega),
+                      closed_loop=chosen.closed_loop, rcond=chosen.rcond)
+
+
+@dataclass(frozen=True)
+class _Attempt:
+    """A controller built at ``gamma_design`` and its verified closed-loop norm ``gamma``."""
+
+    gamma_design: float
+    K: Any
+    closed_loop: Any
+    rcond: tuple
+    gamma: float
+    omega: float
+
+    @property
+    def consistent(self) -> bool:
+        """The verified norm does not exceed the γ the controller was built for."""
+        return self.gamma <= self.gamma_design * (1.0 + 1e-3)
+
+
+class _Sb10:
+    """SB10AD on the scaled plant (:func:`_scale`): γ_opt, and controllers at a given γ."""
+
+    def __init__(self, P, nmeas: int, ncon: int):
+        A0, B0, C0, D0 = (np.asarray(M, float) for M in (P.A, P.B, P.C, P.D))
+        self.P, self.nmeas, self.ncon = P, nmeas, ncon
+        self.nw, self.nz = B0.shape[1] - ncon, C0.shape[0] - nmeas
+        self.A, self.B, self.C, self.D, _, self.su, self.sy = _scale(A0, B0, C0, D0,
+                                                                     self.nw, self.nz)
+
+    def call(self, g: float, job: int):
+        try:
+            return _sb10ad(self.A, self.B, self.C, self.D, self.ncon, self.nmeas, g, job)
         except Exception as exc:  # slycot raises SlycotArithmeticError with .info
             info = getattr(exc, "info", None)
             raise SynthesisError(
                 f"hinfsyn: SB10AD failed at γ={g:.6g}: "
                 f"{_SB10AD_INFO.get(info, str(exc))} (info={info})") from exc
 
-    if gamma is None:
-        d11 = float(np.linalg.norm(D[:nz, :nw], 2)) if nz and nw else 0.0
+    def gamma_opt(self) -> float:
+        """SB10AD's optimal γ (bisection from a large admissible start)."""
+        nz, nw = self.nz, self.nw
+        d11 = float(np.linalg.norm(self.D[:nz, :nw], 2)) if nz and nw else 0.0
         base = max(1.0, d11)
-        out, last = None, None
+        last = None
         for g0 in (1e4 * base, 1e8 * base, 1e16 * base, 1e100):
             try:
-                out = call(g0, 1)
-                break
+                return float(self.call(g0, 1)[0])
             except SynthesisError as exc:
                 last = exc
                 if getattr(exc.__cause__, "info", None) not in (6, 7, 8, 12):
                     raise
-        if out is None:
-            raise last
-        gamma_opt = float(out[0])
-        factors = [backoff]
-        f = backoff
-        while f < max_backoff:
-            f = 1.0 + (f - 1.0) * 2.0 if f > 1.0 else 1.01
-            factors.append(min(f, max_backoff))
-    else:
-        gamma_opt = float("nan")
-        factors = [1.0]
-    base_g = gamma if gamma is not None else gamma_opt
+        raise last
 
-    last_err: list = [None]
-
-    def attempt(g):
-        """Controller at γ = g with its verified closed-loop norm, or None."""
-        try:
-            out = call(g, 4)
-        except SynthesisError as exc:
-            last_err[0] = exc
-            return None
+    def controller(self, g: float) -> _Attempt:
+        """The controller at γ = g, unscaled, with its closed loop checked stable and its
+        norm recomputed (:func:`hinfnorm`); SynthesisError if SB10AD fails or the loop is
+        unstable."""
+        out = self.call(g, 4)
         Ak, Bk, Ck, Dk = out[1:5]
+        su, sy = self.su, self.sy
         # undo the scaling: u = su ũ, ỹ = sy y
         Ks = ct.ss(Ak, Bk * sy[None, :], Ck * su[:, None], (Dk * sy[None, :]) * su[:, None])
-        cl = lft_lower(P, Ks, nmeas, ncon)
+        cl = lft_lower(self.P, Ks, self.nmeas, self.ncon)
         pol = cl.poles()
         scl = max(1.0, float(np.max(np.abs(pol)))) if pol.size else 1.0
         if pol.size and np.max(pol.real) >= -1e-9 * scl:
-            last_err[0] = SynthesisError(f"hinfsyn: closed loop unstable at γ={g:.6g}")
-            return None
+            raise SynthesisError(f"hinfsyn: closed loop unstable at γ={g:.6g}")
         gam, wpk = hinfnorm(cl)
-        res = (g, Ks, cl, tuple(float(x) for x in out[9]), gam, wpk)
-        tried.append(res)
-        return res
+        return _Attempt(g, Ks, cl, tuple(float(x) for x in out[9]), gam, wpk)
 
-    def consistent(res):
-        return res is not None and res[4] <= res[0] * (1.0 + 1e-3)
 
-    chosen, tried = None, []
+def _backoff_ladder(backoff: float, max_backoff: float) -> list[float]:
+    """Back-off factors tried in turn: ``backoff``, then doubling its excess up to the cap."""
+    factors, f = [backoff], backoff
+    while f < max_backoff:
+        f = 1.0 + (f - 1.0) * 2.0 if f > 1.0 else 1.01
+        factors.append(min(f, max_backoff))
+    return factors
+
+
+def _gamma_search(attempt, base_g: float, factors, backoff: float, *, fixed: bool):
+    """The γ search of :func:`hinfsyn`, apart from the controller construction.
+
+    ``attempt(g)`` builds the controller at γ = g (an :class:`_Attempt`, or None when
+    SB10AD fails or the loop is unstable). Tries ``factors·base_g`` in turn and returns the
+    first consistent attempt (verified norm ≤ the γ it was built for; with ``fixed`` any
+    attempt). If none is: SB10AD's γ_opt can be wrong when D11 ≠ 0 — the controller built
+    at γ then has a closed-loop norm above γ — so search for the smallest γ whose
+    controller achieves ‖F_l(P, K)‖∞ ≤ γ, by doubling and then bisection on the verified
+    norm. Returns None if nothing was found.
+    """
     for f in factors:
         res = attempt(f * base_g)
-        if consistent(res) or (res is not None and gamma is not None):
-            chosen = res
+        if res is not None and (res.consistent or fixed):
+            return res
+    if fixed:
+        return None
+    lo, hi, res_hi = base_g * factors[-1], None, None
+    g = lo
+    for _ in range(60):
+        g *= 2.0
+        res = attempt(g)
+        if res is not None and res.consistent:
+            hi, res_hi = g, res
             break
-    if chosen is None and gamma is None:
-        # SB10AD's γ_opt can be wrong when D11 ≠ 0: the controller built at γ then has a
-        # closed-loop norm above γ. Search for the smallest γ whose controller achieves
-        # ‖F_l(P, K)‖∞ ≤ γ, by doubling and then bisection on the verified norm.
-        lo, hi, res_hi = base_g * factors[-1], None, None
-        g = lo
-        for _ in range(60):
-            g *= 2.0
-            res = attempt(g)
-            if consistent(res):
-                hi, res_hi = g, res
-                break
-            lo = g
-        if res_hi is not None:
-            for _ in range(40):
-                if hi / lo <= 1.0 + 0.5 * (backoff - 1.0) + 1e-6:
-                    break
-                mid = np.sqrt(lo * hi)
-                res = attempt(mid)
-                if consistent(res):
-                    hi, res_hi = mid, res
-                else:
-                    lo = mid
-            chosen = res_hi
-    if tried and gamma is None:
-        # every γ reported is a verified norm: keep the controller with the smallest one
-        chosen = min(tried, key=lambda r: r[4])
-    if chosen is None:
-        raise SynthesisError(
-            f"hinfsyn: no stabilising controller found from γ={base_g:.6g} upwards "
-            f"({last_err[0]})")
-    g_design, Ks, cl, rcond, gam, wpk = chosen
-    ylab, ulab = list(P.output_labels)[nz:], list(P.input_labels)[nw:]
-    K = ct.ss(Ks.A, Ks.B, Ks.C, Ks.D, inputs=ylab, outputs=ulab, name="K",
-              states=[f"xK{i}" for i in range(Ks.nstates)])
-    return HinfResult(K=K, gamma=float(gam), gamma_opt=gamma_opt, gamma_design=float(g_design),
-                      omega_peak=float(wpk), closed_loop=cl, rcond=rcond)
+        lo = g
+    if res_hi is None:
+        return None
+    for _ in range(40):
+        if hi / lo <= 1.0 + 0.5 * (backoff - 1.0) + 1e-6:
+            break
+        mid = np.sqrt(lo * hi)
+        res = attempt(mid)
+        if res is not None and res.consistent:
+            hi, res_hi = mid, res
+        else:
+            lo = mid
+    return res_hi

@@ -3,14 +3,22 @@
 Interconnection (all signals scaled, P5 §3.1.4: ``D_e^{-1} G_f D_u`` with D_e = 20 µm the
 largest allowed displacement error and D_u = 1 A the largest allowed current change)::
 
-    plant current    i   = D_u (u + d_i)                        (A; actuator G_act inside G)
-    perturbed plant  ẋ   = A_c x + B_Δ w_Δ + B i                 (G_fi, P5 Eq. 5)
-                     z_Δ = C_Δ x + D_Δ i,     w_Δ = Δ z_Δ
-    error            e   = (C x + D i) / D_e + d_o               (-, displacement / D_e)
+    plant current    i   = D_u (u + W_1 d_i)                    (A; actuator G_act inside G)
+    force            f   = W_f d_f                              (N, optional force inputs)
+    perturbed plant  ẋ   = A_c x + B_Δ w_Δ + B i + B_f f         (G_fi, P5 Eq. 5)
+                     z_Δ = C_Δ x + D_Δ i + D_Δf f,   w_Δ = Δ z_Δ
+    error            e   = (C x + D i + D_f f) / D_e + W_2 d_o   (-, displacement / D_e)
     performance      z_p = W_p e,   z_u = W_u u
     measurement      y   = e
 
-Inputs ``[w_Δ, d_i, d_o, u]`` and outputs ``[z_Δ, z_p, z_u, y]``, i.e. the
+P is built by connecting named signals (``control.interconnect``): the plant ``G`` with its
+Δ channels, ``E`` (error), ``I`` (current), and the weights, each a ``control.StateSpace``
+whose inputs and outputs are named after the signals above (:func:`_parts`); python-control
+refuses '.' in signal names, so a parameter ``seal.k`` becomes ``seal__k`` inside (the
+labels of P keep the form ``wD_seal_k_0``). The result equals the former hand-indexed
+assembly to 1 ulp (measured on the test rig's H∞/μ plants and the turboexpander's).
+
+Inputs ``[w_Δ, d_i, d_o, d_f, u]`` and outputs ``[z_Δ, z_p, z_u, y]``, i.e. the
 ``[w_Δ, w, u] / [z_Δ, z, y]`` order of :func:`ambseal.control.hinf.hinfsyn` and
 :func:`ambseal.control.dk.musyn`. ``W_p`` shapes ``S_o`` (from ``d_o``) and ``S_o G``
 (from ``d_i``); ``W_u`` bounds ``K S_o`` and ``T_i``.
@@ -240,27 +248,6 @@ def physical_controller(K_P, d_e: float, d_u: float, channels, name: str = "K"):
                       states=[f"xK{i}" for i in range(A.shape[0])], name=name)
 
 
-def _series(sA, sB, sC, sD, cols: slice, W):
-    """Put the (block-diagonal) weight W in series with the input columns ``cols``."""
-    A1, B1, C1, D1 = (np.asarray(m, float) for m in (W.A, W.B, W.C, W.D))
-    k = cols.stop - cols.start
-    n1, N = A1.shape[0], sA.shape[0]
-    B1 = B1.reshape(n1, k); C1 = C1.reshape(k, n1)
-    Bi, Di = sB[:, cols].copy(), sD[:, cols].copy()
-    if n1:  # balance the realisation against the plant's (large) actuator input gain
-        t = np.sqrt(max(np.linalg.norm(B1), 1e-300)
-                    / max(np.linalg.norm(np.vstack([Bi, Di]) @ C1), 1e-300))
-        B1, C1 = B1 / t, C1 * t
-    sA = np.block([[sA, Bi @ C1], [np.zeros((n1, N)), A1]])
-    sB = np.vstack([sB, np.zeros((n1, sB.shape[1]))])
-    sB[:N, cols] = Bi @ D1
-    sB[N:, cols] = B1
-    sC = np.hstack([sC, Di @ C1])
-    sD = sD.copy()
-    sD[:, cols] = Di @ D1
-    return sA, sB, sC, sD, n1
-
-
 def _ranges(plant, uncertainty: Mapping[str, Any]) -> tuple[UncertainParameter, ...]:
     out = []
     for name, spec in uncertainty.items():
@@ -367,145 +354,207 @@ def generalized_plant(
     >>> gp.blocks
     ((-2, 0), (8, 8))
     """
-    import control
-
-    from ..model.lft import Plant
-
     for nm, v in (("d_e", d_e), ("d_u", d_u), ("output_disturbance", output_disturbance)):
         if not (np.isfinite(v) and v > 0):
             raise ConfigError(f"generalized_plant: {nm}={v!r} must be finite and > 0")
+    full, cur, fcols = _source_plant(source, reduced, pressure_bar, states, force_positions,
+                                     force_disturbance is not None)
+    params = _ranges(full.select_inputs([full.input_names[i] for i in cur]), uncertainty or {})
+    centre = full.with_values({q.name: q.centre for q in params}) if params else full
+    parts = _parts(centre, params, cur, fcols, Wp, Wu, input_disturbance, output_disturbance,
+                   force_disturbance, d_e, d_u)
+    if parts.W1.nstates or (parts.Wf is not None and parts.Wf.nstates):
+        parts = _balance(parts)
+    P = _connect(parts)
+    return _result(P, parts, params, centre, cur, Wp, Wu, d_e, d_u)
+
+
+@dataclass(frozen=True, eq=False)
+class _Parts:
+    """The subsystems of the generalised plant with internal ('.'-free) signal names, and
+    the public labels of P's channels."""
+
+    G: Any
+    Wp: Any
+    Wu: Any
+    W1: Any
+    Wf: Any
+    statics: tuple
+    inputs: tuple   # internal names of P's inputs, in order
+    outputs: tuple  # internal names of P's outputs, in order
+    labels_in: tuple
+    labels_out: tuple
+    state_names: tuple
+    nd: int
+
+
+def _sig(prefix: str, names) -> list[str]:
+    """Signal names for python-control's interconnect, which refuses '.': 'seal.k' → 'seal__k'."""
+    return [f"{prefix}_{str(n).replace('.', '__')}" for n in names]
+
+
+def _source_plant(source, reduced, pressure_bar, states, force_positions, forces: bool):
+    """The plant (current inputs, then force inputs), and the indices of both."""
+    from ..model.lft import Plant
+
     if isinstance(source, Plant):
-        plant = source
+        full = source
     else:
         from ..model.rig import build_plant
 
-        plant = build_plant(source, reduced=reduced, pressure_bar=pressure_bar, states=states,
-                            force_positions=tuple(force_positions))
-    ny = len(plant.output_names)
-    cur = [i for i, n in enumerate(plant.input_names) if n in plant.output_names]
-    if not cur or ny == 0:
+        full = build_plant(source, reduced=reduced, pressure_bar=pressure_bar, states=states,
+                           force_positions=tuple(force_positions))
+    cur = [i for i, n in enumerate(full.input_names) if n in full.output_names]
+    if not cur or not full.output_names:
         raise ModelError("generalized_plant: the plant needs current inputs named like its "
                          "displacement outputs (e.g. A_zeta)")
-    full = plant
-    plant = plant.select_inputs([plant.input_names[i] for i in cur])
-    channels = tuple(plant.input_names)
-    nu = len(channels)
-    Wp_d = diagonal_weight(Wp, ny, "W_p")
-    Wu_d = diagonal_weight(Wu, nu, "W_u", biproper=True)
+    fcols = [i for i, n in enumerate(full.input_names) if n not in full.output_names]
+    if forces and not fcols:
+        raise ModelError("generalized_plant: force_disturbance needs force inputs; build "
+                         "the plant with force_positions (e.g. the seal's position)")
+    return full, cur, (fcols if forces else [])
 
-    params = _ranges(plant, uncertainty or {})
-    design = plant.with_values({p.name: p.centre for p in params}) if params else plant
-    A, B, C, D = design.A, design.B, design.C, design.D
-    n = A.shape[0]
-    Bd_l, Cd_l, Dd_l, zscale = [], [], [], []
+
+def _parts(centre, params, cur, fcols, Wp, Wu, W1, W2, Wf, d_e, d_u) -> _Parts:
+    """The named subsystems of P5 Figs. 8–9 (module docstring):
+
+    * ``G`` — the plant at the centre of the ranges with its Δ channels, inputs
+      ``[w_Δ, i, f]``, outputs ``[z_Δ, y_m]`` (A, N → m); each channel w_θ = h δ z_θ with
+      h split between B_θ and C_θ, D_θ so that both have similar norms (conditioning);
+    * ``E`` — ``e = y_m/D_e + W_2 d_o``; ``I`` — ``i = D_u (u + W_1 d_i)``;
+    * the weights ``W_p`` (e → z_p), ``W_u`` (u → z_u), ``W_1`` (d_i), ``W_f`` (d_f → f).
+    """
+    import control
+
+    chans = [centre.input_names[i] for i in cur]
+    outs, forces = list(centre.output_names), [centre.input_names[i] for i in fcols]
+    ny, nu, nf = len(outs), len(chans), len(fcols)
+    Bd, Cd, Di, Df = [], [], [], []
     for p in params:
-        q = design.parameter(p.name)
+        q = centre.parameter(p.name)
         h = p.half_width
-        # w_θ = h δ z_θ; split h and balance the channel norms for conditioning
         nb = max(np.linalg.norm(q.B), 1e-300)
-        nc = max(np.linalg.norm(np.hstack([q.C, q.D * d_u])), 1e-300)
+        nc = max(np.linalg.norm(np.hstack([q.C, q.D[:, cur] * d_u])), 1e-300)
         a = np.sqrt(h * nc / nb)
-        Bd_l.append(q.B * a)
-        Cd_l.append(q.C * (h / a))
-        Dd_l.append(q.D * (h / a))
-        zscale.append(h / a)
+        Bd.append(q.B * a)
+        Cd.append(q.C * (h / a))
+        Di.append(q.D[:, cur] * (h / a))
+        Df.append(q.D[:, fcols] * (h / a))
+    n = centre.A.shape[0]
     nd = sum(p.repeats for p in params)
-    Bd = np.hstack(Bd_l) if params else np.zeros((n, 0))
-    Cd = np.vstack(Cd_l) if params else np.zeros((0, n))
-    Dd = np.vstack(Dd_l) if params else np.zeros((0, nu))
-
-    Ap, Bp, Cp, Dp = (np.asarray(m, float) for m in (Wp_d.A, Wp_d.B, Wp_d.C, Wp_d.D))
-    Au, Bu, Cu, Du = (np.asarray(m, float) for m in (Wu_d.A, Wu_d.B, Wu_d.C, Wu_d.D))
-    npw, nuw = Ap.shape[0], Au.shape[0]
-    Bp = Bp.reshape(npw, ny); Cp = Cp.reshape(ny, npw)
-    Bu = Bu.reshape(nuw, nu); Cu = Cu.reshape(nu, nuw)
-    N = n + npw + nuw
-    nin = nd + nu + ny + nu
-    nout = nd + ny + nu + ny
-    sA = np.zeros((N, N)); sB = np.zeros((N, nin)); sC = np.zeros((nout, N)); sD = np.zeros((nout, nin))
-    iw, idi, ido, iu = 0, nd, nd + nu, nd + nu + ny
-    oz, op, ou, oy = 0, nd, nd + ny, nd + ny + nu
-    xs, xp, xu = slice(0, n), slice(n, n + npw), slice(n + npw, N)
-    # e = (C x + D D_u (u + d_i))/D_e + d_o
-    Ce = C / d_e
-    De_i = D * d_u / d_e
-    sA[xs, xs] = A
-    sA[xp, xs] = Bp @ Ce
-    sA[xp, xp] = Ap
-    sA[xu, xu] = Au
-    sB[xs, iw:iw + nd] = Bd
-    sB[xs, idi:idi + nu] = B * d_u
-    sB[xs, iu:iu + nu] = B * d_u
-    sB[xp, idi:idi + nu] = Bp @ De_i
-    sB[xp, iu:iu + nu] = Bp @ De_i
-    sB[xp, ido:ido + ny] = Bp
-    sB[xu, iu:iu + nu] = Bu
-    # z_Δ
-    sC[oz:oz + nd, xs] = Cd
-    sD[oz:oz + nd, idi:idi + nu] = Dd * d_u
-    sD[oz:oz + nd, iu:iu + nu] = Dd * d_u
-    # z_p = Wp e
-    sC[op:op + ny, xs] = Dp @ Ce
-    sC[op:op + ny, xp] = Cp
-    sD[op:op + ny, idi:idi + nu] = Dp @ De_i
-    sD[op:op + ny, iu:iu + nu] = Dp @ De_i
-    sD[op:op + ny, ido:ido + ny] = Dp
-    # z_u = Wu u
-    sC[ou:ou + nu, xu] = Cu
-    sD[ou:ou + nu, iu:iu + nu] = Du
-    # y = e
-    sC[oy:oy + ny, xs] = Ce
-    sD[oy:oy + ny, idi:idi + nu] = De_i
-    sD[oy:oy + ny, iu:iu + nu] = De_i
-    sD[oy:oy + ny, ido:ido + ny] = np.eye(ny)
-
-    sB[:, ido:ido + ny] *= output_disturbance
-    sD[:, ido:ido + ny] *= output_disturbance
+    Bd = np.hstack(Bd) if params else np.zeros((n, 0))
+    Cd = np.vstack(Cd) if params else np.zeros((0, n))
+    Di = np.vstack(Di) if params else np.zeros((0, nu))
+    Df = np.vstack(Df) if params else np.zeros((0, nf))
     tags = [f"{p.name.replace('.', '_')}_{j}" for p in params for j in range(p.repeats)]
-    inputs = ([f"wD_{t}" for t in tags] + [f"di_{c}" for c in channels]
-              + [f"do_{c}" for c in design.output_names] + [f"u_{c}" for c in channels])
-    outputs = ([f"zD_{t}" for t in tags] + [f"zp_{c}" for c in design.output_names]
-               + [f"zu_{c}" for c in channels] + [f"y_{c}" for c in design.output_names])
-    snames = (list(design.state_names) + [f"Wp{i}" for i in range(npw)]
-              + [f"Wu{i}" for i in range(nuw)])
-    W1 = diagonal_weight(input_disturbance, nu, "W_1")
-    if W1.nstates or not np.allclose(np.asarray(W1.D), np.eye(nu)):
-        sA, sB, sC, sD, n1 = _series(sA, sB, sC, sD, slice(idi, idi + nu), W1)
-        snames = snames + [f"W1_{i}" for i in range(n1)]
-    nf = 0
-    if force_disturbance is not None:
-        # unbalance-like forces (N) at the plant's force inputs, weighted by W_f
-        fcols = [i for i, nm in enumerate(full.input_names) if nm not in full.output_names]
-        if not fcols:
-            raise ModelError("generalized_plant: force_disturbance needs force inputs; build "
-                             "the plant with force_positions (e.g. the seal's position)")
-        fp = full.with_values({q.name: q.centre for q in params}) if params else full
-        nf = len(fcols)
-        Bf, Df = fp.B[:, fcols], fp.D[:, fcols]
-        colB = np.zeros((sA.shape[0], nf)); colD = np.zeros((nout, nf))
-        colB[xs] = Bf
-        colB[xp] = Bp @ (Df / d_e)
-        if nd:
-            colD[oz:oz + nd] = np.vstack([fp.parameter(q.name).D[:, fcols] * g
-                                          for q, g in zip(params, zscale)])
-        colD[op:op + ny] = Dp @ (Df / d_e)
-        colD[oy:oy + ny] = Df / d_e
-        sB = np.hstack([sB[:, :iu], colB, sB[:, iu:]])
-        sD = np.hstack([sD[:, :iu], colD, sD[:, iu:]])
-        Wf = diagonal_weight(force_disturbance, nf, "W_f")
-        sA, sB, sC, sD, n2 = _series(sA, sB, sC, sD, slice(iu, iu + nf), Wf)
-        snames = snames + [f"Wf_{i}" for i in range(n2)]
-        inputs = inputs[:iu] + [f"df_{full.input_names[i]}" for i in fcols] + inputs[iu:]
-        nin += nf
-    P = control.ss(sA, sB, sC, sD, inputs=inputs, outputs=outputs, states=snames, name="P")
-    keep_in = list(range(nd, nin))
-    keep_out = list(range(nd, nout))
-    P_nom = control.ss(sA, sB[:, keep_in], sC[keep_out], sD[np.ix_(keep_out, keep_in)],
-                       inputs=inputs[nd:], outputs=outputs[nd:], states=snames, name="P_nominal")
-    nw, nz = nu + ny + nf, ny + nu
+    wD, zD = _sig("wD", tags), _sig("zD", tags)
+    i_, f_, ym = _sig("i", chans), _sig("f", forces), _sig("ym", outs)
+    u, di, diw = _sig("u", chans), _sig("di", chans), _sig("diw", chans)
+    do, df, e = _sig("do", outs), _sig("df", forces), _sig("e", outs)
+    zp, zu = _sig("zp", outs), _sig("zu", chans)
+    A, B, C, D = (np.asarray(m, float) for m in (centre.A, centre.B, centre.C, centre.D))
+    G = control.ss(A, np.hstack([Bd, B[:, cur], B[:, fcols]]), np.vstack([Cd, C]),
+                   np.block([[np.zeros((nd, nd)), Di, Df],
+                             [np.zeros((ny, nd)), D[:, cur], D[:, fcols]]]),
+                   inputs=wD + i_ + f_, outputs=zD + ym, name="G")
+    E = control.ss([], [], [], np.hstack([np.eye(ny) / d_e, W2 * np.eye(ny)]),
+                   inputs=ym + do, outputs=e, name="E")
+    I = control.ss([], [], [], np.hstack([d_u * np.eye(nu), d_u * np.eye(nu)]),
+                   inputs=u + diw, outputs=i_, name="I")
+    Wp_d = _named(diagonal_weight(Wp, ny, "W_p"), e, zp, "Wp")
+    Wu_d = _named(diagonal_weight(Wu, nu, "W_u", biproper=True), u, zu, "Wu")
+    W1_d = _named(diagonal_weight(W1, nu, "W_1"), di, diw, "W1")
+    Wf_d = _named(diagonal_weight(Wf, nf, "W_f"), df, f_, "Wf") if nf else None
+    ins = wD + di + do + df + u
+    outputs = zD + zp + zu + e
+    lab_in = ([f"wD_{t}" for t in tags] + [f"di_{c}" for c in chans] + [f"do_{c}" for c in outs]
+              + [f"df_{c}" for c in forces] + [f"u_{c}" for c in chans])
+    lab_out = ([f"zD_{t}" for t in tags] + [f"zp_{c}" for c in outs] + [f"zu_{c}" for c in chans]
+               + [f"y_{c}" for c in outs])
+    snames = (list(centre.state_names) + [f"Wp{i}" for i in range(Wp_d.nstates)]
+              + [f"Wu{i}" for i in range(Wu_d.nstates)] + [f"W1_{i}" for i in range(W1_d.nstates)]
+              + ([f"Wf_{i}" for i in range(Wf_d.nstates)] if nf else []))
+    return _Parts(G, Wp_d, Wu_d, W1_d, Wf_d, (E, I), tuple(ins), tuple(outputs),
+                  tuple(lab_in), tuple(lab_out), tuple(snames), nd)
+
+
+def _named(W, inputs, outputs, name):
+    import control
+
+    return control.ss(W.A, W.B, W.C, W.D, inputs=list(inputs), outputs=list(outputs), name=name)
+
+
+def _connect(parts: _Parts, W1=None, Wf=None):
+    """P by named interconnection (``control.interconnect``) of the parts; ``W1``/``Wf``
+    replace the parts' weights when given."""
+    import control
+
+    W1 = parts.W1 if W1 is None else W1
+    Wf = parts.Wf if Wf is None else Wf
+    syslist = [parts.G, parts.Wp, parts.Wu, W1] + ([Wf] if Wf is not None else []) \
+        + list(parts.statics)
+    return control.interconnect(syslist, inplist=list(parts.inputs),
+                                outlist=list(parts.outputs), inputs=list(parts.inputs),
+                                outputs=list(parts.outputs), check_unused=False)
+
+
+def _balance(parts: _Parts) -> _Parts:
+    """The parts with the W_1 and W_f realisations balanced against the plant's (large)
+    actuator input gain: their state scaled so that their input gain matches that of the
+    columns of the unweighted P they feed (a similarity transformation: same weights)."""
+    import control
+    from dataclasses import replace
+
+    def identity(W):
+        return _named(control.ss([], [], [], np.eye(W.ninputs)), W.input_labels,
+                      W.output_labels, W.name)
+
+    P0 = _connect(parts, identity(parts.W1), identity(parts.Wf) if parts.Wf is not None
+                  else None)
+    return replace(parts, W1=_balanced(parts.W1, P0, parts.W1.input_labels),
+                   Wf=_balanced(parts.Wf, P0, parts.Wf.input_labels)
+                   if parts.Wf is not None else None)
+
+
+def _balanced(W, P0, cols):
+    """W with its state scaled so that its input gain matches the gain of the plant
+    columns ``cols`` of ``P0`` it feeds (a similarity transformation: same W)."""
+    import control
+
+    if not W.nstates:
+        return W
+    idx = [list(P0.input_labels).index(c) for c in cols]
+    Bi, Di = np.asarray(P0.B, float)[:, idx], np.asarray(P0.D, float)[:, idx]
+    A1, B1, C1, D1 = (np.asarray(m, float) for m in (W.A, W.B, W.C, W.D))
+    t = np.sqrt(max(np.linalg.norm(B1), 1e-300)
+                / max(np.linalg.norm(np.vstack([Bi, Di]) @ C1), 1e-300))
+    return control.ss(A1, B1 / t, C1 * t, D1, inputs=list(W.input_labels),
+                      outputs=list(W.output_labels), name=W.name)
+
+
+def _result(P, parts: _Parts, params, centre, cur, Wp, Wu, d_e, d_u) -> GeneralizedPlant:
+    """The :class:`GeneralizedPlant` of the interconnected P (public channel labels)."""
+    import control
+
+    sA, sB, sC, sD = (np.asarray(m, float) for m in (P.A, P.B, P.C, P.D))
+    nd = parts.nd
+    Pn = control.ss(sA, sB, sC, sD, inputs=list(parts.labels_in),
+                    outputs=list(parts.labels_out), states=list(parts.state_names), name="P")
+    P_nom = control.ss(sA, sB[:, nd:], sC[nd:], sD[nd:, nd:], inputs=list(parts.labels_in[nd:]),
+                       outputs=list(parts.labels_out[nd:]), states=list(parts.state_names),
+                       name="P_nominal")
+    chans = tuple(centre.input_names[i] for i in cur)
+    ny, nu = len(centre.output_names), len(chans)
+    nw, nz = sB.shape[1] - nd - nu, sC.shape[0] - nd - ny
     blocks = tuple((-p.repeats, 0) for p in params) + ((nw, nz),)
-    return GeneralizedPlant(P=P, P_nominal=P_nom, blocks=blocks, nominal_blocks=((nw, nz),),
+    design = centre.select_inputs(list(chans))
+    return GeneralizedPlant(P=Pn, P_nominal=P_nom, blocks=blocks, nominal_blocks=((nw, nz),),
                             nmeas=ny, ncon=nu, parameters=params, design_plant=design,
-                            Wp=control.ss(Wp) if not np.isscalar(Wp) else control.ss([], [], [], [[Wp]]),
-                            Wu=control.ss(Wu) if not np.isscalar(Wu) else control.ss([], [], [], [[Wu]]),
-                            d_e=float(d_e), d_u=float(d_u), channels=channels)
+                            Wp=_ss_weight(Wp), Wu=_ss_weight(Wu), d_e=float(d_e),
+                            d_u=float(d_u), channels=chans)
+
+
+def _ss_weight(W):
+    import control
+
+    return control.ss([], [], [], [[W]]) if np.isscalar(W) else control.ss(W)

@@ -9,8 +9,11 @@ Public functions are imported on first use (module-level ``__getattr__``), so
 * :func:`reduce_controller`, :func:`balred_controller` — ``control/order.py``
 * :func:`export_controller`, :func:`discretize` — ``control/export.py``
 * :func:`pid_controller` — ``control/pid.py``
+* :class:`Weights`, :func:`default_weights` — ``control/weights.py`` (the one weight class)
+* :func:`generalized_plant`, :func:`physical_controller` — ``control/plant.py``
 * :func:`design` — ``control/recipes.py`` (the thesis's PID, H∞ and μ designs of a rig)
-* :func:`lpvsyn` — ``control/lpv.py``; :func:`design_lpv`, :func:`design_frozen` —
+* :func:`lpvsyn` — ``control/lpv.py`` (SDPs in ``lpv_lmi.py``, reconstruction in
+  ``lpv_reconstruct.py``); :func:`design_lpv`, :func:`design_frozen` —
   ``control/lpv_design.py``
 """
 
@@ -26,6 +29,8 @@ _LAZY = {
     "export_controller": "export", "discretize": "export",
     "pid_controller": "pid", "design": "recipes", "DesignResult": "recipes",
     "lpvsyn": "lpv", "design_lpv": "lpv_design", "design_frozen": "lpv_design",
+    "Weights": "weights", "default_weights": "weights",
+    "generalized_plant": "plant", "physical_controller": "plant",
 }
 
 __all__ = sorted(_LAZY)

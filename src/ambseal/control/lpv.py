@@ -213,7 +213,7 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
         Strictness margin of the LMIs (scaled units).
     scaling : {"riccati", "diagonal"}
         State scaling before the SDPs: ``"riccati"`` (default) balances the H2 Riccati
-        solutions of the centre plant (:func:`ambseal.control.lpv_lmi._riccati_balance`) after a diagonal balancing
+        solutions of the centre plant (``lpv_lmi._riccati_balance``) after a diagonal balancing
         and the time scale; ``"diagonal"`` stops after the diagonal balancing.
     penalty : float
         Weight of the trace term in stage 1 (scaled units; ≥ 0).

@@ -219,70 +219,137 @@ def _pad(M, blks):
 
 # --------------------------------------------------------------------------- lower bound
 def _lower(M, blks, n_iter, rng):
-    """Power iteration lower bound (Packard & Doyle 1993; Young & Doyle 1997) on M (F, n, m)."""
+    """Power iteration lower bound (Packard & Doyle 1993; Young & Doyle 1997) on M (F, n, m).
+
+    Returns the bound (F,) and the worst-case Δ (F, m, n) of :class:`_PowerIteration`.
+    """
     F, n, m = M.shape
-    MH = _ct(M)
-    ro = np.cumsum([0] + [b.c for b in blks])  # row offsets (a, z)
-    co = np.cumsum([0] + [b.r for b in blks])  # column offsets (b, w)
+    pi = _PowerIteration(M, blks)
     _, _, vh = np.linalg.svd(M)
     b = np.conj(vh[:, 0, :])
     w = b.copy()
-    eps = 1e-300
+    best = np.zeros(F)
+    best_delta = np.zeros((F, m, n), complex)
+    checks = {max(n_iter // 2, 1), n_iter}
+    for it in range(1, n_iter + 1):
+        a, w, b = pi.step(b, w, rng)
+        if it in checks:
+            lb, lam, Q = pi.evaluate(pi.build_Q(a, w, pi.qfor(a, w)), a)
+            up = lb > best
+            best = np.where(up, lb, best)
+            safe = np.where(np.abs(lam) > 0, lam, 1.0)
+            best_delta = np.where(up[:, None, None], Q / safe[:, None, None], best_delta)
+    return best, best_delta
 
-    def phase(x):
-        return x / np.maximum(np.abs(x), eps)
 
-    def qfor(a, w):
-        q = np.zeros((F, len(blks)), complex)
-        for j, bl in enumerate(blks):
+class _PowerIteration:
+    """The power iteration of :func:`_lower` on a stack M (F, n, m) for a block structure:
+    one step (:meth:`step`), the structured Q it aligns (:meth:`build_Q`) and the bound
+    from the eigenvalues of M Q (:meth:`evaluate`)."""
+
+    _EPS = 1e-300
+
+    def __init__(self, M, blks):
+        self.M, self.MH, self.blks = M, _ct(M), blks
+        self.F, self.n, self.m = M.shape
+        self.ro = np.cumsum([0] + [b.c for b in blks])  # row offsets (a, z)
+        self.co = np.cumsum([0] + [b.r for b in blks])  # column offsets (b, w)
+        nscal = sum(bl.r for bl in blks if bl.kind != "full")
+        self.rank = nscal + sum(bl.kind == "full" for bl in blks)
+
+    def _slices(self, j):
+        return slice(self.co[j], self.co[j + 1]), slice(self.ro[j], self.ro[j + 1])
+
+    def qfor(self, a, w):
+        """Scalar-block phases (complex) or signs (real) aligning a and w."""
+        q = np.zeros((self.F, len(self.blks)), complex)
+        for j, bl in enumerate(self.blks):
             if bl.kind == "full":
                 continue
-            ip = np.einsum("fi,fi->f", np.conj(a[:, ro[j]:ro[j + 1]]), w[:, co[j]:co[j + 1]])
-            q[:, j] = np.sign(ip.real) + (ip.real == 0) if bl.kind == "real" else phase(ip)
+            rs, cs = self._slices(j)
+            ip = np.einsum("fi,fi->f", np.conj(a[:, cs]), w[:, rs])
+            q[:, j] = (np.sign(ip.real) + (ip.real == 0) if bl.kind == "real"
+                       else ip / np.maximum(np.abs(ip), self._EPS))
         return q
 
-    def build_Q(a, w, q):
-        Q = np.zeros((F, m, n), complex)
-        for j, bl in enumerate(blks):
-            rs, cs = slice(co[j], co[j + 1]), slice(ro[j], ro[j + 1])
+    def step(self, b, w, rng):
+        """One iteration: (a, w, b) from (b, w), dead directions restarted at random."""
+        eps, F = self._EPS, self.F
+        a = np.einsum("fij,fj->fi", self.M, b)
+        a = a / np.maximum(np.linalg.norm(a, axis=1), eps)[:, None]
+        q = self.qfor(a, w)
+        zv = np.zeros((F, self.n), complex)
+        for j, bl in enumerate(self.blks):
+            rs, cs = self._slices(j)
+            if bl.kind == "full":
+                ratio = (np.linalg.norm(w[:, rs], axis=1)
+                         / np.maximum(np.linalg.norm(a[:, cs], axis=1), eps))
+                zv[:, cs] = ratio[:, None] * a[:, cs]
+            else:
+                zv[:, cs] = np.conj(q[:, j])[:, None] * w[:, rs]
+        w = np.einsum("fij,fj->fi", self.MH, zv)
+        w = w / np.maximum(np.linalg.norm(w, axis=1), eps)[:, None]
+        q = self.qfor(a, w)
+        bn = np.zeros((F, self.m), complex)
+        for j, bl in enumerate(self.blks):
+            rs, cs = self._slices(j)
+            if bl.kind == "full":
+                ratio = (np.linalg.norm(a[:, cs], axis=1)
+                         / np.maximum(np.linalg.norm(w[:, rs], axis=1), eps))
+                bn[:, rs] = ratio[:, None] * w[:, rs]
+            else:
+                bn[:, rs] = q[:, j][:, None] * a[:, cs]
+        nb = np.linalg.norm(bn, axis=1)
+        dead = nb < 1e-12
+        if dead.any():
+            k = dead.sum()
+            bn[dead] = rng.standard_normal((k, self.m)) + 1j * rng.standard_normal((k, self.m))
+            nb = np.linalg.norm(bn, axis=1)
+        return a, w, bn / nb[:, None]
+
+    def build_Q(self, a, w, q):
+        """The structured Q (F, m, n) of the current vectors."""
+        Q = np.zeros((self.F, self.m, self.n), complex)
+        for j, bl in enumerate(self.blks):
+            rs, cs = self._slices(j)
             if bl.kind == "full":
                 wj, aj = w[:, rs], a[:, cs]
                 nw = np.linalg.norm(wj, axis=1)[:, None, None]
                 na = np.linalg.norm(aj, axis=1)[:, None, None]
-                Q[:, rs, cs] = wj[:, :, None] * np.conj(aj[:, None, :]) / np.maximum(nw * na, eps)
+                Q[:, rs, cs] = (wj[:, :, None] * np.conj(aj[:, None, :])
+                                / np.maximum(nw * na, self._EPS))
             else:
                 Q[:, rs, cs] = q[:, j, None, None] * np.eye(bl.r)
         return Q
 
-    nscal = sum(bl.r for bl in blks if bl.kind != "full")
-    rank = nscal + sum(bl.kind == "full" for bl in blks)
-
-    def basis(a):
+    def basis(self, a):
         """Orthonormal V (F, n, rank) with Q = (Q V) Vᴴ for every Q the iteration builds."""
-        V = np.zeros((F, n, rank), complex)
+        V = np.zeros((self.F, self.n, self.rank), complex)
         k = 0
-        for j, bl in enumerate(blks):
-            cs = slice(ro[j], ro[j + 1])
+        for j, bl in enumerate(self.blks):
+            cs = slice(self.ro[j], self.ro[j + 1])
             if bl.kind == "full":
                 aj = a[:, cs]
-                V[:, cs, k] = aj / np.maximum(np.linalg.norm(aj, axis=1), eps)[:, None]
+                V[:, cs, k] = aj / np.maximum(np.linalg.norm(aj, axis=1), self._EPS)[:, None]
                 k += 1
             else:
                 V[:, cs, k:k + bl.r] = np.eye(bl.r)
                 k += bl.r
         return V
 
-    def eigs(Q, V):
-        # the non-zero eigenvalues of M Q = M (Q V) Vᴴ are those of Vᴴ M Q V (rank × rank)
+    def eigs(self, Q, V):
+        """Eigenvalues of M Q: those of Vᴴ M Q V (rank × rank) when V is given."""
         if V is None:
-            return np.linalg.eigvals(M @ Q)
-        return np.linalg.eigvals(_ct(V) @ M @ (Q @ V))
+            return np.linalg.eigvals(self.M @ Q)
+        return np.linalg.eigvals(_ct(V) @ self.M @ (Q @ V))
 
-    def evaluate(Q, a):
-        V = basis(a) if rank < n else None
-        lamv = eigs(Q, V)  # (F, n) or (F, rank)
-        has_real = any(bl.kind == "real" for bl in blks)
-        if not has_real:
+    def evaluate(self, Q, a):
+        """(bound, eigenvalue, Q) per frequency: the largest real eigenvalue of M Q with
+        real blocks, or the largest one with real blocks zeroed if that is larger."""
+        F, blks, co, ro = self.F, self.blks, self.co, self.ro
+        V = self.basis(a) if self.rank < self.n else None
+        lamv = self.eigs(Q, V)  # (F, n) or (F, rank)
+        if not any(bl.kind == "real" for bl in blks):
             k = np.argmax(np.abs(lamv), axis=1)
             return np.abs(lamv[np.arange(F), k]), lamv[np.arange(F), k], Q
         realmask = np.abs(lamv.imag) <= 1e-9 * np.maximum(np.abs(lamv), 1e-300)
@@ -295,7 +362,7 @@ def _lower(M, blks, n_iter, rng):
             for j, bl in enumerate(blks):
                 if bl.kind == "real":
                     Qc[:, co[j]:co[j + 1], ro[j]:ro[j + 1]] = 0.0
-            lv = eigs(Qc, V)
+            lv = self.eigs(Qc, V)
             kc = np.argmax(np.abs(lv), axis=1)
             lbc = np.abs(lv[np.arange(F), kc])
             use = lbc > lb
@@ -303,47 +370,6 @@ def _lower(M, blks, n_iter, rng):
             lam = np.where(use, lv[np.arange(F), kc], lam)
             Q = np.where(use[:, None, None], Qc, Q)
         return lb, lam, Q
-
-    best = np.zeros(F)
-    best_delta = np.zeros((F, m, n), complex)
-    checks = {max(n_iter // 2, 1), n_iter}
-    for it in range(1, n_iter + 1):
-        a = np.einsum("fij,fj->fi", M, b)
-        a = a / np.maximum(np.linalg.norm(a, axis=1), eps)[:, None]
-        q = qfor(a, w)
-        zv = np.zeros((F, n), complex)
-        for j, bl in enumerate(blks):
-            rs, cs = slice(co[j], co[j + 1]), slice(ro[j], ro[j + 1])
-            if bl.kind == "full":
-                ratio = np.linalg.norm(w[:, rs], axis=1) / np.maximum(np.linalg.norm(a[:, cs], axis=1), eps)
-                zv[:, cs] = ratio[:, None] * a[:, cs]
-            else:
-                zv[:, cs] = np.conj(q[:, j])[:, None] * w[:, rs]
-        w = np.einsum("fij,fj->fi", MH, zv)
-        w = w / np.maximum(np.linalg.norm(w, axis=1), eps)[:, None]
-        q = qfor(a, w)
-        bn = np.zeros((F, m), complex)
-        for j, bl in enumerate(blks):
-            rs, cs = slice(co[j], co[j + 1]), slice(ro[j], ro[j + 1])
-            if bl.kind == "full":
-                ratio = np.linalg.norm(a[:, cs], axis=1) / np.maximum(np.linalg.norm(w[:, rs], axis=1), eps)
-                bn[:, rs] = ratio[:, None] * w[:, rs]
-            else:
-                bn[:, rs] = q[:, j][:, None] * a[:, cs]
-        nb = np.linalg.norm(bn, axis=1)
-        # restart dead directions at random
-        dead = nb < 1e-12
-        if dead.any():
-            bn[dead] = rng.standard_normal((dead.sum(), m)) + 1j * rng.standard_normal((dead.sum(), m))
-            nb = np.linalg.norm(bn, axis=1)
-        b = bn / nb[:, None]
-        if it in checks:
-            lb, lam, Q = evaluate(build_Q(a, w, qfor(a, w)), a)
-            up = lb > best
-            best = np.where(up, lb, best)
-            safe = np.where(np.abs(lam) > 0, lam, 1.0)
-            best_delta = np.where(up[:, None, None], Q / safe[:, None, None], best_delta)
-    return best, best_delta
 
 
 # --------------------------------------------------------------------------- public

@@ -226,7 +226,7 @@ def test_turbo_full_order_sensitivity_below_3(turbo):
     assert np.all(fs.peak < 3.0), dict(zip(fs.speeds_hz, fs.peak))
 
 
-def test_turbo_frozen_mu_design():
+def test_turbo_frozen_mu_design(turbo_cfg):
     """design_frozen(method="mu") at 300 Hz (one D–K step: H∞ on the plant with the seal's
     k ± 40 %, P3 §3.1). References: robust performance implies nominal performance,
     μ_Δ̂(N) ≥ σ̄(N22) (Skogestad & Postlethwaite 2005 §8.10), and no controller beats the
@@ -235,7 +235,7 @@ def test_turbo_frozen_mu_design():
     from ambseal.analysis.spinup import frozen_sensitivity
     from ambseal.control.lpv_design import design_frozen
 
-    cfg = load_rig(TURBO)
+    cfg = turbo_cfg
     mu = design_frozen(cfg, 300.0, method="mu", max_iter=1)
     hinf = design_frozen(cfg, 300.0)
     assert mu.method == "mu" and mu.to_dict()["speed_hz"] == 300.0

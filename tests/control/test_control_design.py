@@ -16,10 +16,8 @@ import pytest
 
 from ambseal.analysis.loops import closed_loop, compliance, loop_responses
 from ambseal.analysis.unbalance import unbalance_from_compliance
-from ambseal.config import load_rig
-from ambseal.control.recipes import DesignResult, design
+from ambseal.control.recipes import design
 from ambseal.control.weights import Weights
-from ambseal.model.rig import build_plant
 
 OMEGA = 2 * np.pi * np.logspace(-1, np.log10(3000.0), 800)
 #: ISO 14839-3:2006 zone A/B boundary of the sensitivity peak (3, i.e. 9.5 dB; P5 §4.1).

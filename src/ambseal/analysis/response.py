@@ -167,9 +167,35 @@ def settling_time(t: np.ndarray, y: np.ndarray, *, band: float = 0.02, t0: float
     return float(t[j] + frac * (t[j + 1] - t[j]) - t0)
 
 
-def impulse_response(
-    G: Any,
-    K: Any,
+def impulse_response(G: Any, K: Any, **kwargs) -> ImpulseResponse:
+    """Response of the loop ``u = −K y + d`` to the thesis's current impulse (P5 §5.1):
+    :func:`impulse_response_of` of ``closed_loop(G, K)``.
+
+    Parameters
+    ----------
+    G, K : control.StateSpace
+        Plant (A → m) and controller (m → A), negative feedback.
+    **kwargs
+        ``channels``, ``amplitude_a``, ``duration_s``, ``t_impulse_s``, ``t_end_s``,
+        ``dt_s``, ``band`` as for :func:`impulse_response_of`.
+
+    Raises
+    ------
+    ModelError
+        As :func:`impulse_response_of`, or if ``G`` and ``K`` do not fit together.
+    """
+    return impulse_response_of(closed_loop(G, K), **kwargs)
+
+
+def _steps(x: float, dt: float, what: str) -> int:
+    k = int(round(x / dt))
+    if abs(k * dt - x) > 1e-9 * max(dt, abs(x)) + 1e-15:
+        raise ModelError(f"impulse_response: {what}={x!r} s is not a multiple of dt_s={dt!r} s")
+    return k
+
+
+def impulse_response_of(
+    loop: ClosedLoop,
     *,
     channels: Sequence[str | int] = ("A_zeta", "B_eta"),
     amplitude_a: float = 0.05,
@@ -179,14 +205,15 @@ def impulse_response(
     dt_s: float = 1e-5,
     band: float = 0.02,
 ) -> ImpulseResponse:
-    """Response of the loop ``u = −K y + d`` to the thesis's current impulse (P5 §5.1).
+    """Response of a closed loop (:func:`~ambseal.analysis.loops.closed_loop`) to the
+    thesis's current impulse (P5 §5.1).
 
     Parameters
     ----------
-    G, K : control.StateSpace
-        Plant (A → m) and controller (m → A), negative feedback.
+    loop : ClosedLoop
+        The loop ``u = −K y + d`` of a plant (A → m) and a controller (m → A).
     channels : sequence of str or int
-        Plant inputs receiving the disturbance (names of ``G``'s inputs, or indices).
+        Plant inputs receiving the disturbance (names of the plant's inputs, or indices).
         Default ``("A_zeta", "B_eta")`` as in P5 Fig. 14/15.
     amplitude_a : float
         Disturbance amplitude (A), 0.05 in the thesis.
@@ -208,34 +235,9 @@ def impulse_response(
     Raises
     ------
     ModelError
-        If a channel is unknown, the times are not multiples of ``dt_s`` or do not fit in
-        the window, or ``G``/``K`` do not fit together.
+        If a channel is unknown, or the times are not multiples of ``dt_s`` or do not fit
+        in the window.
     """
-    return impulse_response_of(
-        closed_loop(G, K), channels=channels, amplitude_a=amplitude_a, duration_s=duration_s,
-        t_impulse_s=t_impulse_s, t_end_s=t_end_s, dt_s=dt_s, band=band,
-    )
-
-
-def _steps(x: float, dt: float, what: str) -> int:
-    k = int(round(x / dt))
-    if abs(k * dt - x) > 1e-9 * max(dt, abs(x)) + 1e-15:
-        raise ModelError(f"impulse_response: {what}={x!r} s is not a multiple of dt_s={dt!r} s")
-    return k
-
-
-def impulse_response_of(
-    loop: ClosedLoop,
-    *,
-    channels: Sequence[str | int] = ("A_zeta", "B_eta"),
-    amplitude_a: float = 0.05,
-    duration_s: float = 0.01,
-    t_impulse_s: float = 0.0,
-    t_end_s: float = 0.2,
-    dt_s: float = 1e-5,
-    band: float = 0.02,
-) -> ImpulseResponse:
-    """As :func:`impulse_response`, from an already closed loop (:func:`closed_loop`)."""
     if not (dt_s > 0 and duration_s > 0 and t_end_s > 0 and t_impulse_s >= 0):
         raise ModelError("impulse_response: dt_s, duration_s, t_end_s must be > 0 and t_impulse_s >= 0")
     sys = loop.system

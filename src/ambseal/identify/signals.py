@@ -167,24 +167,24 @@ class Excitation:
 
 
 # --------------------------------------------------------------------------- checks
-def _positive(name: str, value: Any) -> float:
+def _number(name: str, value: Any, *, allow_zero: bool) -> float:
+    """A finite number > 0 (>= 0 with ``allow_zero``), or a ValueError naming ``name``."""
     try:
         x = float(value)
     except (TypeError, ValueError):
         raise ValueError(f"{name}: expected a number, got {value!r}") from None
-    if not math.isfinite(x) or x <= 0:
-        raise ValueError(f"{name}: expected a finite number > 0, got {value!r}")
+    if not math.isfinite(x) or x < 0 or (x == 0 and not allow_zero):
+        raise ValueError(f"{name}: expected a finite number {'>=' if allow_zero else '>'} 0, "
+                         f"got {value!r}")
     return x
+
+
+def _positive(name: str, value: Any) -> float:
+    return _number(name, value, allow_zero=False)
 
 
 def _nonnegative(name: str, value: Any) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: expected a number, got {value!r}") from None
-    if not math.isfinite(x) or x < 0:
-        raise ValueError(f"{name}: expected a finite number >= 0, got {value!r}")
-    return x
+    return _number(name, value, allow_zero=True)
 
 
 def _axes_and_gains(

@@ -2,7 +2,7 @@
 
 * :func:`zoh` — the exact zero-order-hold equivalent of ``(A, B)`` (Franklin, Powell &
   Workman, *Digital Control of Dynamic Systems*, 3rd ed., §6.3): one ``expm`` of the
-  augmented matrix ``[[A, B], [0, 0]]·dt``;
+  augmented matrix ``[[A, B], [0, 0]]·dt``, balanced first;
 * :func:`discretize` — a continuous ``control.StateSpace`` at a sample time, by ZOH
   (:func:`zoh`) or Tustin (``control.sample_system``), names kept;
 * :func:`simulate_lti` — ``z_{k+1} = A z_k + B u_k`` from rest, an exact block recursion
@@ -42,12 +42,16 @@ def zoh(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray
     A_d : ndarray, shape (n, n)
     B_d : ndarray, shape (n, m)
     """
+    # a diagonal similarity first (Parlett & Reinsch 1969): controllers from H∞ synthesis
+    # mix entries from 1 to 1e9, and expm of the unbalanced matrix loses up to 7 digits
+    # (an impulse response moved by 5e-5 for a 1e-12 change of A_K; balanced, by 1e-12)
+    A, (sc, _) = sla.matrix_balance(A, permute=False, separate=True)
     n, m = B.shape
     M = np.zeros((n + m, n + m))
     M[:n, :n] = A * dt
-    M[:n, n:] = B * dt
+    M[:n, n:] = B / sc[:, None] * dt
     E = sla.expm(M)
-    return E[:n, :n], E[:n, n:]
+    return E[:n, :n] * (sc[:, None] / sc[None, :]), E[:n, n:] * sc[:, None]
 
 
 def discretize(sys: Any, dt_s: float, method: str = "tustin"):

@@ -139,3 +139,35 @@ def test_run_on_the_turboexpander_judges_lpv(tmp_path, request, design_cache_for
         assert (tmp_path / name).exists()
     assert (tmp_path / "controllers" / "controller_lpv_140Hz.npz").exists()
     assert "identification" not in m  # no truth file for this rig
+
+
+def test_exported_hinf_closes_the_loop_by_name_in_python_control(metrics):
+    """Reference: python-control's own ``interconnect`` (a peer library), wiring the
+    exported H∞ controller (``controllers/controller_hinf.json``) to the full-order plant
+    purely by signal names (plant i_<axis> → y_<axis>, controller y_<axis> → i_<axis>, the
+    sign of i = −K y in the connection); its closed-loop poles give the same largest real
+    part as ``max_real_pole`` in metrics.json at every judged pressure."""
+    import control
+    import numpy as np
+
+    from ambseal.config import load_rig
+    from ambseal.model.rig import build_plant
+
+    out, m = metrics
+    doc = json.loads((out / "controllers" / "controller_hinf.json").read_text())
+    K = control.ss(doc["A"], doc["B"], doc["C"], doc["D"], inputs=doc["inputs"],
+                   outputs=doc["outputs"], name="K")
+    cfg = load_rig()
+    for case in (c for c in m["cases"] if c["controller"] == "hinf"):
+        plant = build_plant(cfg, pressure_bar=case["pressure_bar"])
+        G = control.ss(plant.to_statespace(), name="G")
+        axes = plant.axes
+        assert set(K.output_labels) == set(G.input_labels)
+        assert set(K.input_labels) == set(G.output_labels)
+        loop = control.interconnect(
+            [G, K], connections=[[f"G.i_{a}", f"-K.i_{a}"] for a in axes]
+            + [[f"K.y_{a}", f"G.y_{a}"] for a in axes], outlist=list(G.output_labels))
+        assert loop.nstates == G.nstates + K.nstates
+        worst = float(np.max(np.linalg.eigvals(loop.A).real))
+        assert worst == pytest.approx(case["max_real_pole"], rel=1e-6, abs=1e-6)
+        assert (worst < 0) == case["stable"]

@@ -58,7 +58,7 @@ def test_rigid_rotor_thesis_impulse_channels_and_json():
     disturbance record and channel names follow the plant's; cross-checked peak against
     control.forced_response on the closed loop (1 % of peak, edge interpolation)."""
     G, Gf, K = rigid_rotor()
-    r = response.impulse_response(G, K, t_end_s=0.1)
+    r = response.impulse_response(G, K, channels=("A_zeta", "B_eta"), t_end_s=0.1)
     assert r.channels == ("A_zeta", "B_eta")
     assert r.output_names == tuple(NAMES) and r.input_names == tuple(NAMES)
     assert r.disturbance_a[:1000, 0].max() == 0.05 and r.disturbance_a[:, 1].max() == 0.0

@@ -68,7 +68,7 @@ def test_pid_is_p5_eq6_on_every_axis(cfg, designs):
         np.testing.assert_allclose(np.asarray(K(s)), want * np.eye(4), rtol=1e-10,
                                    atol=1e-12 * abs(want))
     assert K.input_labels == ["y_A_zeta", "y_A_eta", "y_B_zeta", "y_B_eta"]
-    assert K.output_labels == ["u_A_zeta", "u_A_eta", "u_B_zeta", "u_B_eta"]
+    assert K.output_labels == ["i_A_zeta", "i_A_eta", "i_B_zeta", "i_B_eta"]
 
 
 def test_hinf_gamma_is_the_verified_closed_loop_norm(designs):

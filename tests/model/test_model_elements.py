@@ -176,12 +176,13 @@ def test_explicit_factor_wins_per_axis_over_geometry():
 
 def test_channel_names_of_the_thesis_rig():
     """Reference: DESIGN.md's convention — A_zeta, A_eta, B_zeta, B_eta on the thesis rig;
-    the same names label the system's current inputs and sensor outputs."""
+    the system's current inputs are i_<axis>, its sensor outputs y_<axis>."""
     cfg = load_rig()
     names = channel_names(cfg)
     assert names == ("A_zeta", "A_eta", "B_zeta", "B_eta")
     sys = build_system(cfg)
-    assert sys.input_names == names and sys.output_names == names
+    assert sys.input_names == tuple(f"i_{n}" for n in names)
+    assert sys.output_names == tuple(f"y_{n}" for n in names)
 
 
 # --------------------------------------------------------------------------- spring

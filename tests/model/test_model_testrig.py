@@ -36,7 +36,8 @@ def test_pid_loop_findings(rig):
     K = control.ss(K.A, K.B, K.C, K.D)
     for p, stable in ((0.0, True), (2.04, True), (4.08, False)):
         G = build_plant(rig, pressure_bar=p)
-        assert G.input_names == tuple(names) and G.output_names == tuple(names)
+        assert G.input_names == tuple(f"i_{n}" for n in names)
+        assert G.output_names == tuple(f"y_{n}" for n in names) and G.axes == tuple(names)
         Gs = control.ss(G.A, G.B, G.C, G.D)
         assert np.max(Gs.poles().real) > 100.0  # open loop unstable (negative Ks)
         cl = control.feedback(Gs, K)

@@ -130,9 +130,10 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
     s = settings
     plant = build_plant(cfg, pressure_bar=point.pressure_bar, speed_rpm=point.speed_rpm,
                         force_positions=(force_position(cfg),))
-    n_cur = 2 * len(cfg.amb)
-    G = plant.select_inputs(plant.input_names[:n_cur]).to_statespace()
-    Gf = plant.select_inputs(plant.input_names[n_cur:]).to_statespace()
+    cur = plant.current_inputs()
+    G = plant.select_inputs([plant.input_names[j] for j in cur]).to_statespace()
+    Gf = plant.select_inputs([n for j, n in enumerate(plant.input_names)
+                              if j not in cur]).to_statespace()
     loop = closed_loop(G, controller, Gf)
     case = {"controller": name, "pressure_bar": point.pressure_bar,
             "speed_hz": point.speed_rpm / 60.0, "stable": loop.stable,
@@ -144,10 +145,10 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
     curves: dict = {"So": (w / (2 * np.pi), sigma_max(resp.So))}
     case.update(
         sensitivity_peak=_finite(iso.sigma_max_peak),
-        sensitivity_peak_per_axis={ax: (p.value if loop.stable else None)
+        sensitivity_peak_per_axis={ax.removeprefix("y_"): (p.value if loop.stable else None)
                                    for ax, p in zip(G.output_labels, resp.peaks("So").diagonal)},
         iso_zone=iso.zone_sigma_max,
-        iso_zone_per_axis=dict(iso.zones_per_axis),
+        iso_zone_per_axis={ax.removeprefix("y_"): z for ax, z in iso.zones_per_axis},
     )
     if not loop.stable:
         case.update(compliance_peak_m_per_n=None, unbalance_peak_um=None,

@@ -197,7 +197,7 @@ def _steps(x: float, dt: float, what: str) -> int:
 def impulse_response_of(
     loop: ClosedLoop,
     *,
-    channels: Sequence[str | int] = ("A_zeta", "B_eta"),
+    channels: Sequence[str | int] = ("i_A_zeta", "i_B_eta"),
     amplitude_a: float = 0.05,
     duration_s: float = 0.01,
     t_impulse_s: float = 0.0,
@@ -214,7 +214,7 @@ def impulse_response_of(
         The loop ``u = −K y + d`` of a plant (A → m) and a controller (m → A).
     channels : sequence of str or int
         Plant inputs receiving the disturbance (names of the plant's inputs, or indices).
-        Default ``("A_zeta", "B_eta")`` as in P5 Fig. 14/15.
+        Default ``("i_A_zeta", "i_B_eta")`` as in P5 Fig. 14/15.
     amplitude_a : float
         Disturbance amplitude (A), 0.05 in the thesis.
     duration_s : float

@@ -230,7 +230,7 @@ def spinup(plant, controller, *, name: str = "K", speeds_hz=(20.0, 300.0),
         raise ModelError(f"spinup: schedule_s={schedule_s} must be a multiple of dt={dt} and "
                          f"divide period_s={period_s}")
     ny = plant.C.shape[0]
-    ncur = len([n for n in plant.input_names if n in plant.output_names])
+    ncur = len([n for n in plant.input_names if n.startswith("i_") and f"y_{n[2:]}" in plant.output_names])
     nf = plant.B.shape[1] - ncur
     if nf <= force_input or force_input < 0:
         raise ModelError("spinup: the plant has no force input "

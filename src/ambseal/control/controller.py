@@ -2,8 +2,16 @@
 
 **Convention** (thesis P5 Fig. 8, stated here once): a controller maps the sensor
 displacements ``y`` (m) to the current references ``i`` (A) with **negative feedback**,
-``i = −K y``; its inputs are named ``y_<axis>`` and its outputs ``u_<axis>``
-(``<axis>`` an AMB actuator axis such as ``A_zeta``).
+``i = −K y``; its inputs are named ``y_<axis>`` and its outputs ``i_<axis>``
+(``<axis>`` an AMB actuator axis such as ``A_zeta``), the reverse of the plant's
+(:class:`ambseal.model.lft.Plant`: inputs ``i_<axis>``, outputs ``y_<axis>``). The loop
+closes by name in python-control with the sign written into the connection::
+
+    loop = control.interconnect(
+        [G, K], connections=[[f"G.i_{a}", f"-K.i_{a}"] for a in axes]
+        + [[f"K.y_{a}", f"G.y_{a}"] for a in axes], outlist=list(G.output_labels))
+
+(with ``G`` and ``K`` given ``name="G"``/``name="K"``, ``axes = plant.axes``).
 
 * A **fixed** controller is a continuous ``control.StateSpace`` with that convention.
 * A **scheduled** controller (the LPV controller of P3, and later others) is a

@@ -36,6 +36,9 @@ def pid_controller(
     """
     import control
 
+    from ..lti.pickling import picklable
+
+    picklable()
     # one axis: x1 integrator of e, x2 derivative filter state
     if td > 0:
         tf = eps * td
@@ -53,7 +56,7 @@ def pid_controller(
     return control.ss(
         A, B, C, D,
         inputs=[f"y_{c}" for c in channels],
-        outputs=[f"u_{c}" for c in channels],
+        outputs=[f"i_{c}" for c in channels],
         states=[f"pid_{c}_{k}" for c in channels for k in range(ns)],
     )
 

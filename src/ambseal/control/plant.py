@@ -44,6 +44,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from ..errors import ConfigError, ModelError
+from ..lti.pickling import picklable
 from .weights import diagonal_weight
 
 __all__ = ["UncertainParameter", "GeneralizedPlant", "generalized_plant",
@@ -231,7 +232,8 @@ def physical_controller(K_P, d_e: float, d_u: float, channels, name: str = "K"):
     d_e, d_u : float
         Scalings (m, A).
     channels : sequence of str
-        Actuator axis names: inputs ``y_<axis>`` (m), outputs ``u_<axis>`` (A).
+        Actuator axis names: inputs ``y_<axis>`` (m), outputs ``i_<axis>`` (A), the
+        reverse of the plant's (:class:`ambseal.model.lft.Plant`).
     name : str
         System name.
 
@@ -242,9 +244,10 @@ def physical_controller(K_P, d_e: float, d_u: float, channels, name: str = "K"):
     """
     import control
 
+    picklable()
     A, B, C, D = physical_matrices(K_P, d_e, d_u)
     return control.ss(A, B, C, D, inputs=[f"y_{c}" for c in channels],
-                      outputs=[f"u_{c}" for c in channels],
+                      outputs=[f"i_{c}" for c in channels],
                       states=[f"xK{i}" for i in range(A.shape[0])], name=name)
 
 
@@ -354,6 +357,7 @@ def generalized_plant(
     >>> gp.blocks
     ((-2, 0), (8, 8))
     """
+    picklable()
     for nm, v in (("d_e", d_e), ("d_u", d_u), ("output_disturbance", output_disturbance)):
         if not (np.isfinite(v) and v > 0):
             raise ConfigError(f"generalized_plant: {nm}={v!r} must be finite and > 0")
@@ -404,11 +408,11 @@ def _source_plant(source, reduced, pressure_bar, states, force_positions, forces
 
         full = build_plant(source, reduced=reduced, pressure_bar=pressure_bar, states=states,
                            force_positions=tuple(force_positions))
-    cur = [i for i, n in enumerate(full.input_names) if n in full.output_names]
+    cur = full.current_inputs()
     if not cur or not full.output_names:
-        raise ModelError("generalized_plant: the plant needs current inputs named like its "
-                         "displacement outputs (e.g. A_zeta)")
-    fcols = [i for i, n in enumerate(full.input_names) if n not in full.output_names]
+        raise ModelError("generalized_plant: the plant needs current inputs i_<axis> with "
+                         "displacement outputs y_<axis> (e.g. i_A_zeta, y_A_zeta)")
+    fcols = [i for i in range(len(full.input_names)) if i not in cur]
     if forces and not fcols:
         raise ModelError("generalized_plant: force_disturbance needs force inputs; build "
                          "the plant with force_positions (e.g. the seal's position)")
@@ -426,8 +430,9 @@ def _parts(centre, params, cur, fcols, Wp, Wu, W1, W2, Wf, d_e, d_u) -> _Parts:
     """
     import control
 
-    chans = [centre.input_names[i] for i in cur]
-    outs, forces = list(centre.output_names), [centre.input_names[i] for i in fcols]
+    chans = list(centre.axes)
+    outs = [n.removeprefix("y_") for n in centre.output_names]
+    forces = [centre.input_names[i] for i in fcols]
     ny, nu, nf = len(outs), len(chans), len(fcols)
     Bd, Cd, Di, Df = [], [], [], []
     for p in params:
@@ -543,11 +548,11 @@ def _result(P, parts: _Parts, params, centre, cur, Wp, Wu, d_e, d_u) -> Generali
     P_nom = control.ss(sA, sB[:, nd:], sC[nd:], sD[nd:, nd:], inputs=list(parts.labels_in[nd:]),
                        outputs=list(parts.labels_out[nd:]), states=list(parts.state_names),
                        name="P_nominal")
-    chans = tuple(centre.input_names[i] for i in cur)
+    chans = centre.axes
     ny, nu = len(centre.output_names), len(chans)
     nw, nz = sB.shape[1] - nd - nu, sC.shape[0] - nd - ny
     blocks = tuple((-p.repeats, 0) for p in params) + ((nw, nz),)
-    design = centre.select_inputs(list(chans))
+    design = centre.select_inputs([centre.input_names[i] for i in cur])
     return GeneralizedPlant(P=Pn, P_nominal=P_nom, blocks=blocks, nominal_blocks=((nw, nz),),
                             nmeas=ny, ncon=nu, parameters=params, design_plant=design,
                             Wp=_ss_weight(Wp), Wu=_ss_weight(Wu), d_e=float(d_e),

@@ -125,7 +125,7 @@ def simulate_facility(
     values = {k: coefficient_value(v, pressure_bar) for k, v in truth.parameters.items()}
     plant = plant.with_values(values)  # raises ModelError naming an unknown parameter
     plant = modal_reduction(plant, cutoff_hz=truth.max_mode_hz).plant
-    axes = plant.input_names
+    axes = plant.axes
     k = len(axes)
     e = np.asarray(excitation_a, dtype=float)
     if e.ndim != 2 or e.shape[1] != k:

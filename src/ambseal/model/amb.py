@@ -39,9 +39,10 @@ def axes_rotation(angle_deg: float) -> np.ndarray:
 
 
 def channel_names(cfg: RigConfig) -> tuple[str, ...]:
-    """Names ``{amb}_{axis}`` of the AMB signals (current inputs and sensor outputs), in
-    the order of the plant's channels: every AMB of the rig file, ζ then η; e.g.
-    ``("A_zeta", "A_eta", "B_zeta", "B_eta")`` for the thesis test facility."""
+    """Names ``{amb}_{axis}`` of the AMB actuator axes (current inputs ``i_<axis>`` and sensor
+    outputs ``y_<axis>`` of the plant), in the order of the plant's channels: every AMB of
+    the rig file, ζ then η; e.g. ``("A_zeta", "A_eta", "B_zeta", "B_eta")`` for the thesis
+    test facility."""
     return tuple(f"{a.name}_{axis}" for a in cfg.amb for axis in AXES)
 
 
@@ -128,7 +129,8 @@ class AmbElement:
 
     @property
     def signal_names(self) -> tuple[str, ...]:
-        """``{name}_zeta``, ``{name}_eta``: its current inputs and sensor outputs."""
+        """``{name}_zeta``, ``{name}_eta``: its actuator axes (the plant names its current
+        inputs ``i_<axis>`` and sensor outputs ``y_<axis>``)."""
         return tuple(f"{self.name}_{axis}" for axis in AXES)
 
     def stiffness(self) -> np.ndarray:

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..lti.interconnect import series_inputs
+from ..lti.pickling import picklable
 
 __all__ = ["Channel", "Parameter", "Plant", "channel_tag"]
 
@@ -97,8 +98,12 @@ class Parameter:
 class Plant:
     """A state-space plant with named signals and parameter channels.
 
-    Continuous time: ẋ = A x + B u, y = C x + D u. Inputs are coil currents (A) per
-    actuator axis, then any extra force inputs (N); outputs are sensor displacements (m).
+    Continuous time: ẋ = A x + B u, y = C x + D u. Inputs are the current references
+    ``i_<axis>`` (A) per actuator axis, then any extra force inputs ``F<k>_<x|y>`` (N);
+    outputs are the sensor displacements ``y_<axis>`` (m), ``<axis>`` such as ``A_zeta``.
+    A controller (:mod:`ambseal.control.controller`) has the reverse names, inputs
+    ``y_<axis>`` and outputs ``i_<axis>``, so python-control's ``interconnect`` closes the
+    loop by name (with the sign of ``i = −K y``).
     """
 
     A: np.ndarray
@@ -113,6 +118,19 @@ class Plant:
     @property
     def n_states(self) -> int:
         return self.A.shape[0]
+
+    @property
+    def axes(self) -> tuple[str, ...]:
+        """The actuator axes ``<axis>`` that have both a current input ``i_<axis>`` and a
+        sensor output ``y_<axis>``, in input order."""
+        outs = set(self.output_names)
+        return tuple(n[2:] for n in self.input_names
+                     if n.startswith("i_") and f"y_{n[2:]}" in outs)
+
+    def current_inputs(self) -> list[int]:
+        """Indices of the current inputs ``i_<axis>`` of :attr:`axes`."""
+        names = {f"i_{a}" for a in self.axes}
+        return [j for j, n in enumerate(self.input_names) if n in names]
 
     def parameter(self, name: str) -> Parameter:
         """The parameter ``name``; raises ModelError listing the known names."""
@@ -167,6 +185,7 @@ class Plant:
         """The plant as a ``control.StateSpace`` with named inputs, outputs and states."""
         import control
 
+        picklable()
         return control.ss(
             self.A,
             self.B,
@@ -186,6 +205,7 @@ class Plant:
         """
         import control
 
+        picklable()
         Bt, Ct, Dt = self.channels(names)
         r = Bt.shape[1]
         tags = [channel_tag(n, j) for n in names for j in range(self.parameter(n).repeats)]

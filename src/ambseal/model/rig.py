@@ -122,8 +122,8 @@ def build_system(
     Returns
     -------
     SecondOrderSystem
-        With inputs ``{AMB}_{zeta|eta}`` (A) and ``F{k}_{x|y}`` (N), outputs
-        ``{AMB}_{zeta|eta}`` (m) when AMBs are included.
+        With inputs ``i_{AMB}_{zeta|eta}`` (A) and ``F{k}_{x|y}`` (N), outputs
+        ``y_{AMB}_{zeta|eta}`` (m) when AMBs are included.
     """
     p = cfg.operating.pressure_bar if pressure_bar is None else pressure_bar
     speed = cfg.speed if speed_rpm is None else speed_rpm * 2 * np.pi / 60
@@ -144,13 +144,13 @@ def build_system(
     for amb in ambs:
         amb.assemble(M, C, K)
         changes += amb.channels(n, first_input=len(names))
-        names += amb.signal_names
+        names += [f"i_{a}" for a in amb.signal_names]
         b_cols += amb.input_columns(n)
         c_rows += amb.sensor_rows(n)
     for el in others:
         el.assemble(M, C, K)
         changes += el.channels(n)
-    out_names = tuple(names)
+    out_names = tuple(f"y_{a[2:]}" for a in names)
     for k_i, z in enumerate(force_positions):
         i = mesh.node_at(z)
         for axis, d in (("x", X), ("y", Y)):

@@ -83,6 +83,14 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
     """``ambseal identify``: fit ``names`` to recorded files; write the fit, its figures and
     the identified rig to ``out_dir``. Returns a JSON-safe summary.
 
+    The intervals include the error budget of every parameter held fixed
+    (:mod:`ambseal.identify.budget`); the residuals are tested for independence of the
+    excitation (:mod:`ambseal.identify.residuals`); with several records of one condition,
+    each is also fitted alone and the spread of those estimates (RSD, thesis P2 Table 2)
+    is reported beside the pooled fit. ``warnings`` in the summary say which fixed values
+    dominate, whether seal coefficients are held at a non-zero pressure and whether the
+    model fails the residual test.
+
     Raises
     ------
     ConfigError, DataError, IdentificationError
@@ -91,10 +99,13 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
     from .config import dump_rig, rig_with_values
     from .control.pid import controller_from_metadata
     from .errors import DataError
+    from .identify.budget import advice
     from .identify.data import load_measurement
-    from .identify.stages import identify
+    from .identify.residuals import MISMATCH
+    from .identify.stages import identify, record_spread
     from .model.amb import channel_names
-    from .report.identify_figures import correlation_figure, fit_timeseries_figure
+    from .report.identify_figures import (correlation_figure, error_budget_figure,
+                                          fit_timeseries_figure, residual_figure)
 
     cfg = load_rig(rig)
     axes = channel_names(cfg)
@@ -107,15 +118,26 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
                             f"{cfg.rotor.name!r}")
         records.append(meas)
         controllers.append(controller_from_metadata(dict(meas.metadata), axes, str(path)))
+    sources = [str(d) for d in data]
     res = identify(cfg, records, names, current_weight=current_weight, refine=refine,
-                   controllers=controllers)
+                   controllers=controllers, budget=True, sources=sources)
+    spread = record_spread(cfg, records, names, res, controllers=controllers,
+                           sources=sources) if len(records) > 1 else None
+    pressures = sorted({float(m.metadata.get("pressure_drop_pa", 0.0)) / 1e5 for m in records})
+    warnings = advice(res.budget, cfg, names, pressures)
+    if res.mismatch:
+        warnings.append(f"{MISMATCH} (residuals correlate with the excitation on "
+                        f"{', '.join(res.residuals.failed)})")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    write_json(out / "fit.json", res.to_dict())
+    write_json(out / "fit.json", {**res.to_dict(), "warnings": warnings,
+                                  **({"per_record": spread} if spread else {})})
     fit_timeseries_figure(out / "fit_timeseries.png", res.time_s, res.y_meas, res.y_sim,
                           res.axes, nrmse_pct=[res.nrmse_fit_pct[a] for a in res.axes])
     correlation_figure(out / "correlation.png", res.correlation, res.names)
-    pressures = sorted({float(m.metadata.get("pressure_drop_pa", 0.0)) / 1e5 for m in records})
+    residual_figure(out / "residuals.png", res.residuals)
+    error_budget_figure(out / "error_budget.png", res.names, res.estimate, res.std_error_noise,
+                        res.budget)
     identified = rig_with_values(cfg, dict(zip(res.names, res.estimate)))
     header = (f"Identified by ambseal from {', '.join(str(d) for d in data)}\n"
               f"parameters: {', '.join(res.names)}; converged: {res.converged}\n"
@@ -124,6 +146,9 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
     write_text(out / "identified.toml", dump_rig(identified, header))
     return {"out": str(out), "converged": res.converged, "message": res.message,
             "parameters": {
-                n: {"estimate": float(v), "ci95": [_finite(lo), _finite(hi)]}
+                n: {"estimate": float(v), "ci95": [_finite(lo), _finite(hi)],
+                    **({"rsd_pct": spread[n]["rsd_pct"]} if spread else {})}
                 for n, v, lo, hi in zip(res.names, res.estimate, res.ci95_low, res.ci95_high)},
-            "nrmse_fit_pct": {k: _finite(v) for k, v in res.nrmse_fit_pct.items()}}
+            "nrmse_fit_pct": {k: _finite(v) for k, v in res.nrmse_fit_pct.items()},
+            "residual_test": res.residuals.to_dict()["verdict"],
+            "warnings": warnings}

@@ -57,7 +57,7 @@ import math
 import tomllib
 from pathlib import Path
 
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
@@ -80,6 +80,12 @@ __all__ = [
 
 class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+
+#: ``uncertainty = { key = σ }`` beside a component's values: the relative 1σ uncertainty
+#: (fraction) of each named value, used when an identification holds it fixed
+#: (:mod:`ambseal.identify.budget` reads the keys and their defaults).
+Uncertainty = dict[str, Annotated[float, Field(ge=0)]] | None
 
 
 class Material(_Strict):
@@ -166,6 +172,7 @@ class Amb(_Strict):
     ki: float | AxisPair | None = None
     ks: float | AxisPair | None = None
     current_limit: float | None = Field(default=None, gt=0)
+    uncertainty: Uncertainty = None
 
     @model_validator(mode="after")
     def _geometry_or_factors(self) -> "Amb":
@@ -191,6 +198,7 @@ class Actuator(_Strict):
     natural_frequency: float | None = Field(default=None, gt=0)
     damping_ratio: float | None = Field(default=None, gt=0)
     eddy_time_constant: float = Field(default=0.0, ge=0)
+    uncertainty: Uncertainty = None
 
     @model_validator(mode="after")
     def _needs(self) -> "Actuator":
@@ -238,6 +246,7 @@ class Seal(_Strict):
     C: SealCoefficient = 0.0
     c: SealCoefficient = 0.0
     M: SealCoefficient = 0.0
+    uncertainty: Uncertainty = None
 
     @property
     def frequency_dependent(self) -> bool:
@@ -255,6 +264,7 @@ class Spring(_Strict):
     cyy: float = 0.0
     axes_angle_deg: float = 0.0
     name: str | None = None
+    uncertainty: Uncertainty = None
 
 
 class Pid(_Strict):
@@ -445,6 +455,11 @@ class TruthSection(_Strict):
     adc_range_m: float = Field(default=1.0e-3, gt=0)  # LSB = range / 2**bits (no clipping)
     substeps: int = Field(default=4, ge=1, le=100)
     max_mode_hz: float = Field(default=10000.0, gt=0)
+    # model-form mismatch of the facility against the rig file (None/1: as the rig file)
+    beam: Literal["timoshenko", "euler-bernoulli"] | None = None
+    mesh_factor: float = Field(default=1.0, gt=0)
+    modal_damping: float | None = Field(default=None, ge=0, lt=1)
+    sensor_filter_hz: float | None = Field(default=None, gt=0)
 
 
 class TruthConfig(_Strict):
@@ -460,7 +475,11 @@ def load_truth(path: str | Path) -> TruthSection:
     ``adc_bits`` and ``adc_range_m`` (quantisation step range/2^bits; the sensor does not
     saturate: the rotor stops the run if it leaves the gap), ``substeps`` (integration steps
     per controller sample), ``max_mode_hz`` (modes kept in the simulation, default 10 kHz),
-    and ``[truth.parameters]``.
+    and ``[truth.parameters]``. Model-form differences from the rig file (to test a fit on
+    data its model did not make): ``beam`` (``"timoshenko"`` or ``"euler-bernoulli"``),
+    ``mesh_factor`` (shaft elements per section × this, rounded, at least 1),
+    ``modal_damping`` (the rotor's, in place of the rig file's) and ``sensor_filter_hz`` (a
+    first-order low-pass in every displacement sensor, which the model does not have).
     """
     p = Path(path)
     try:

@@ -23,15 +23,30 @@ The four channel columns repeat for every axis; columns may come in any order, b
 column listed above must be present and no other column is allowed.
 
 Metadata (a JSON object) — reserved keys ``format`` (must be ``"ambseal-measurement/1"``)
-and ``axes`` (the list of axis names, defining ``k`` and the column names); recommended keys,
-all SI:
+and ``axes`` (the list of axis names, defining ``k`` and the column names).
 
-* ``rig`` — rig name (str);
-* ``sample_rate_hz`` — sampling rate (Hz); checked against the time column when present;
+Required by ``ambseal identify`` (the fit simulates the loop that ran, so it must know it):
+
+* ``sample_rate_hz`` — the controller's and the acquisition's rate (Hz); checked against the
+  time column;
+* ``controller`` — the digital controller that ran: ``{"type": "state_space", "A", "B",
+  "C", "D", "dt"}`` (``dt`` = 1/``sample_rate_hz``, one input and output per axis), or
+  ``{"type": "pid", "kp", "ti", "td", "eps"}`` per axis as the rig file's
+  ``[controller.pid]`` (discretised by ambseal at ``sample_rate_hz``), or any description
+  carrying the first form under ``"state_space"`` (what ``ambseal acquire`` writes).
+
+The timing these stand for (:mod:`ambseal.identify.loop`): at sample k the sensors give
+y_k, the controller computes u_k = C x_c,k + D y_k in the same sample (no extra delay; a
+rig with a one-sample computation delay states it as a controller state), and the current
+reference ``current_ref`` = −u_k + ``excitation`` is held over the sample (zero-order hold)
+— the controller's sign convention is i = −K y.
+
+Recommended, all SI:
+
+* ``rig`` — rig name (str); when present it must be the rig file's ``[rotor] name``;
 * ``bias_current_a`` — bias current (A), a number or ``{axis: number}``;
-* ``pressure_drop_pa`` — pressure drop across the seal (Pa);
-* ``speed_rad_s`` — rotor speed (rad/s);
-* ``controller`` — which controller ran (dict, e.g. ``{"name": "PID", "file": ...}``);
+* ``pressure_drop_pa`` — pressure drop across the seal (Pa; default 0);
+* ``speed_rad_s`` — rotor speed (rad/s; default the rig's ``[operating]`` speed);
 * ``excitation`` — :attr:`ambseal.identify.signals.Excitation.params`;
 * ``current_limit_a`` — amplifier current limit (A), used for the clipping check.
 

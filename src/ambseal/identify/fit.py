@@ -32,7 +32,9 @@ from ..model.amb import eddy_lag_matrices
 from ..model.lft import Plant
 from ..lti.discrete import simulate_lti, zoh
 from ..lti.interconnect import series_inputs
+from .budget import ErrorBudget, propagate
 from .loop import DiscreteController, closed_loop_matrices
+from .residuals import ResidualTests, residual_tests
 
 __all__ = ["FitResult", "ClosedLoopModel", "fit_parameters", "default_bounds", "nrmse_fit"]
 
@@ -128,6 +130,13 @@ class FitResult:
     time_s, y_meas, y_sim : ndarray
         For the measured-against-simulated figure (first record).
     axes : tuple of str
+    std_error_noise : ndarray (p,) or None
+        The noise part of ``std_error`` (sandwich covariance); ``std_error`` adds the fixed
+        parameters' budget to it.
+    budget : ErrorBudget or None
+        What the fixed parameters' uncertainty adds (:mod:`ambseal.identify.budget`).
+    residuals : ResidualTests or None
+        Whiteness and independence tests (:mod:`ambseal.identify.residuals`).
     """
 
     names: tuple[str, ...]
@@ -146,6 +155,14 @@ class FitResult:
     y_meas: np.ndarray
     y_sim: np.ndarray
     axes: tuple[str, ...]
+    std_error_noise: np.ndarray | None = None
+    budget: ErrorBudget | None = None
+    residuals: ResidualTests | None = None
+
+    @property
+    def mismatch(self) -> bool:
+        """Whether the residual tests say the model does not reproduce the data."""
+        return bool(self.residuals is not None and self.residuals.mismatch)
 
     def value(self, name: str) -> float:
         return float(self.estimate[self.names.index(name)])
@@ -154,10 +171,12 @@ class FitResult:
         def f(x):
             return [float(v) if np.isfinite(v) else None for v in np.ravel(x)]
 
-        return {
+        noise = self.std_error if self.std_error_noise is None else self.std_error_noise
+        out = {
             "parameters": {
                 n: {"estimate": float(self.estimate[i]), "initial": float(self.initial[i]),
                     "std_error": f([self.std_error[i]])[0],
+                    "std_error_noise": f([noise[i]])[0],
                     "ci95": f([self.ci95_low[i], self.ci95_high[i]])}
                 for i, n in enumerate(self.names)
             },
@@ -168,6 +187,11 @@ class FitResult:
             "iterations": self.iterations,
             "wall_time_s": self.wall_time_s,
         }
+        if self.budget is not None:
+            out["error_budget"] = self.budget.to_dict()
+        if self.residuals is not None:
+            out["residual_tests"] = self.residuals.to_dict()
+        return out
 
 
 def _long_run_covariance(J: np.ndarray, R: np.ndarray, smooth: int = 2) -> np.ndarray:
@@ -232,6 +256,7 @@ def fit_parameters(
     current_weight: float = 0.0,
     max_nfev: int = 200,
     window: tuple[int, int | None] = (0, None),
+    fixed: dict[str, tuple[float, str]] | None = None,
 ) -> FitResult:
     """Fit parameters ``names`` to one or more closed-loop records.
 
@@ -255,6 +280,10 @@ def fit_parameters(
     window : (start, stop)
         Samples of each record in the cost (e.g. one frequency of a stepped sine); the
         simulation always starts at rest at sample 0.
+    fixed : dict, optional
+        ``{name: (σ relative, source)}`` of parameters held at the models' values
+        (:func:`ambseal.identify.budget.fixed_uncertainty`); their error budget is added to
+        the covariance and the intervals. None: the noise covariance alone.
 
     Raises
     ------
@@ -275,11 +304,15 @@ def fit_parameters(
     def values(x):
         return dict(zip(names, init + x * scale))  # x: scaled change from the start
 
-    def residual_blocks(x):
-        """Per record an (N, c) array: scaled displacement (and current) residuals."""
+    def residual_blocks(x, moved: tuple[str, float] | None = None):
+        """Per record an (N, c) array: scaled displacement (and current) residuals; with
+        ``moved = (name, h)`` a fixed parameter scaled by 1 + h in every model."""
         out = []
         for model, (e, y, sy, i, si) in zip(models, data):
-            ys, is_ = model.simulate(values(x), e)
+            v = values(x)
+            if moved is not None:
+                v[moved[0]] = _nominal(model, moved[0]) * (1.0 + moved[1])
+            ys, is_ = model.simulate(v, e)
             R = (ys[start:] - y) / sy
             if current_weight > 0:
                 R = np.hstack([R, current_weight * (is_[start:] - i) / si])
@@ -308,10 +341,19 @@ def fit_parameters(
         converged = False
         message = f"estimate at its bound: {', '.join(at_bound)}"
 
-    cov = _covariance(sol.jac, sol.fun, residual_blocks(sol.x), len(names))
+    blocks = residual_blocks(sol.x)
+    cov = _covariance(sol.jac, sol.fun, blocks, len(names))
     converged = converged and bool(np.all(np.isfinite(cov)))
     cov = cov * np.outer(scale, scale)
+    se_noise = np.sqrt(np.diag(cov))
+    budget = _budget(sol.jac, scale, names, fixed, models, residual_blocks, sol.x,
+                     se_noise**2)
+    if budget is not None:
+        cov = cov + budget.covariance
     se = np.sqrt(np.diag(cov))
+    k = len(records[0].axes)
+    tests = residual_tests([R[:, :k] for R in blocks],
+                           [np.asarray(d[0])[start:] for d in data], tuple(records[0].axes))
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(se, se)
     e0, y0 = data[0][0], data[0][1]
@@ -330,8 +372,31 @@ def fit_parameters(
         nrmse_fit_pct=fits, converged=converged, message=message,
         iterations=int(sol.nfev), wall_time_s=time.perf_counter() - t0,
         time_s=np.asarray(records[0].time_s)[start:stop], y_meas=y0, y_sim=ys[start:],
-        axes=tuple(records[0].axes),
+        axes=tuple(records[0].axes), std_error_noise=se_noise, budget=budget,
+        residuals=tests,
     )
+
+
+def _nominal(model: ClosedLoopModel, name: str) -> float:
+    return model.tau_e if name == TAU_E else model.plant.parameter(name).nominal
+
+
+def _budget(J, scale, names, fixed, models, residual_blocks, x, noise_var
+            ) -> ErrorBudget | None:
+    """The fixed parameters' error budget by central differences of the residuals in each
+    fixed value (relative step 10⁻³, every model alike); None without fixed values."""
+    use = [(n, s, src) for n, (s, src) in (fixed or {}).items()
+           if s > 0 and any(_nominal(m, n) != 0 for m in models)]
+    if not use:
+        return None
+    h = 1e-3
+    cols = []
+    for n, _, _ in use:
+        up = np.concatenate([R.ravel() for R in residual_blocks(x, (n, h))])
+        dn = np.concatenate([R.ravel() for R in residual_blocks(x, (n, -h))])
+        cols.append((up - dn) / (2 * h))
+    return propagate(J, np.column_stack(cols), scale, names, [u[0] for u in use],
+                     [u[1] for u in use], [u[2] for u in use], noise_var)
 
 
 def _start(m0: ClosedLoopModel, names, initial, bounds):

@@ -16,7 +16,10 @@ A time-domain simulation of
 - the amplifier of ``[actuator]`` with current limits, then the eddy-current-like lag
   1/(τ_e s + 1) between coil current and force (thesis P2 §4, Fig. 2);
 - sensor noise and ADC quantisation, and the controller sampled at the rig's rate
-  (:mod:`ambseal.identify.loop` for the timing).
+  (:mod:`ambseal.identify.loop` for the timing);
+- on request, a facility that differs from the rig file in model form (``[truth]`` ``beam``,
+  ``mesh_factor``, ``modal_damping``, ``sensor_filter_hz``: :func:`true_rig`), so a fit can be
+  tried on data its model did not make.
 
 The linear part (including Ki i + Ks x) is integrated exactly (zero-order hold over
 ``substeps`` sub-steps of each sample, in physical coordinates: a modal diagonalisation
@@ -40,7 +43,7 @@ from ..lti.discrete import zoh
 from ..lti.interconnect import series_inputs
 from .loop import DiscreteController
 
-__all__ = ["FacilityRecord", "simulate_facility"]
+__all__ = ["FacilityRecord", "simulate_facility", "true_rig"]
 
 
 @dataclass(frozen=True)
@@ -66,6 +69,31 @@ class FacilityRecord:
     displacement_m: np.ndarray
     axes: tuple[str, ...]
     noise_std_m: np.ndarray
+
+
+def true_rig(cfg: RigConfig, truth: TruthSection) -> RigConfig:
+    """The rig as the facility builds it: the rig file with the truth's model-form changes
+    (beam theory, shaft elements × ``mesh_factor``, rotor modal damping)."""
+    rotor = {}
+    if truth.beam is not None:
+        rotor["beam"] = truth.beam
+    if truth.modal_damping is not None:
+        rotor["modal_damping"] = truth.modal_damping
+    update = {"rotor": cfg.rotor.model_copy(update=rotor)} if rotor else {}
+    if truth.mesh_factor != 1.0:
+        update["shaft"] = [s.model_copy(update={"elements": max(1, round(s.elements *
+                                                                        truth.mesh_factor))})
+                           for s in cfg.shaft]
+    return cfg.model_copy(update=update) if update else cfg
+
+
+def _sensor_filter(truth: TruthSection, T: float, k: int):
+    """(a, b) of the sensors' discrete first-order low-pass y_f ← a y_f + b y (exact for a
+    signal held over the sample), or None."""
+    if truth.sensor_filter_hz is None:
+        return None
+    a = float(np.exp(-2 * np.pi * truth.sensor_filter_hz * T))
+    return a, 1.0 - a
 
 
 def _force_law(plant, names, i0: float):
@@ -120,7 +148,7 @@ def simulate_facility(
     T = 1.0 / sample_rate_hz
     if abs(controller.dt - T) > 1e-9 * T:
         raise ModelError(f"controller dt = {controller.dt} s but the sample rate is {sample_rate_hz} Hz")
-    sys = build_system(cfg, pressure_bar=pressure_bar)
+    sys = build_system(true_rig(cfg, truth), pressure_bar=pressure_bar)
     plant = mechanical_plant(sys)
     values = {k: coefficient_value(v, pressure_bar) for k, v in truth.parameters.items()}
     plant = plant.with_values(values)  # raises ModelError naming an unknown parameter
@@ -158,6 +186,7 @@ def simulate_facility(
     Phi, Gam = zoh(A, np.hstack([B, F]), T / truth.substeps)
     C_all = np.vstack([C_y, C_b, C_ieff, C_coil])
     rng = np.random.default_rng(seed)
+    lowpass = _sensor_filter(truth, T, k)
 
     # the force law per axis on Python floats: for k ≈ 4 axes the per-call overhead of numpy
     # is most of the cost of a sub-step (same IEEE operations, same results)
@@ -191,9 +220,12 @@ def simulate_facility(
         inoise = rng.standard_normal((N, k)) * truth.current_noise_a
         lsb = truth.adc_range_m / 2**truth.adc_bits if truth.adc_bits else 0.0
         u_in = np.empty(2 * k)
+        yf = np.zeros(k)
         for n in range(N):
             out = C_all @ z
-            y = out[:k] + noise[n]
+            if lowpass is not None:  # the sensor's own lag, sampled with the position
+                yf = lowpass[0] * yf + lowpass[1] * out[:k]
+            y = (out[:k] if lowpass is None else yf) + noise[n]
             if lsb:
                 y = np.round(y / lsb) * lsb
             u = controller.C @ xc + controller.D @ y

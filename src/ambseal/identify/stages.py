@@ -13,14 +13,15 @@ from ..errors import DataError, IdentificationError, ModelError
 from ..model.amb import actuator_matrices
 from ..model.reduction import modal_reduction
 from ..model.rig import build_system, mechanical_plant
+from .budget import fixed_uncertainty
 from .data import Measurement, validate_measurement
 from .fit import TAU_E, ClosedLoopModel, FitResult, default_bounds, fit_parameters
 from .loop import DiscreteController
 from .rig_sim import simulate_facility
 from .signals import Excitation
 
-__all__ = ["controller_from_metadata", "check_controller", "sample_rate_of", "acquire", "build_models", "identify",
-           "FIT_CUTOFF_HZ"]
+__all__ = ["controller_from_metadata", "check_controller", "sample_rate_of", "acquire",
+           "build_models", "identify", "record_spread", "FIT_CUTOFF_HZ"]
 
 #: Modes kept in the fit's reduced model (Hz). The rigid-body modes alone (8 states, P2 §3.2)
 #: bias Ki/Ks by ~0.5 % on the test rig through the static flexibility of the dropped bending
@@ -135,22 +136,25 @@ def _pressure_bar(meas: Measurement, source: str = "<data>") -> float:
 
 
 def build_models(cfg: RigConfig, records: list[Measurement], values: dict | None = None,
-                 cutoff_hz: float = FIT_CUTOFF_HZ, controllers: list | None = None
-                 ) -> list[ClosedLoopModel]:
+                 cutoff_hz: float = FIT_CUTOFF_HZ, controllers: list | None = None,
+                 sources: list[str] | None = None) -> list[ClosedLoopModel]:
     """One closed-loop model per record: the rig at the record's pressure and speed, with
     parameter ``values`` (SI) applied exactly in full order, reduced to the modes below
     ``cutoff_hz``, the amplifier and τ_e lag in series and the controller that ran
-    (``controllers``, one per record, or each record's metadata)."""
+    (``controllers``, one per record, or each record's metadata). ``sources`` name the
+    records' files in errors."""
     values = dict(values or {})
     tau = values.pop(TAU_E, cfg.actuator.eddy_time_constant)
     models = []
+    sources = sources or [f"record {i + 1}" for i in range(len(records))]
     if controllers is None:
-        controllers = [controller_from_metadata(dict(r.metadata), r.axes) for r in records]
-    for rec, Kd in zip(records, controllers):
+        controllers = [controller_from_metadata(dict(r.metadata), r.axes, src)
+                       for r, src in zip(records, sources)]
+    for rec, Kd, src in zip(records, controllers, sources):
         meta = dict(rec.metadata)
         speed = None if meta.get("speed_rad_s") is None else _positive(
-            meta, "speed_rad_s", "<data>", default=0.0)
-        sys = build_system(cfg, pressure_bar=_pressure_bar(rec),
+            meta, "speed_rad_s", src, default=0.0)
+        sys = build_system(cfg, pressure_bar=_pressure_bar(rec, src),
                            speed_rpm=None if speed is None else speed * 60 / (2 * np.pi))
         full = mechanical_plant(sys)
         if values:
@@ -162,8 +166,8 @@ def build_models(cfg: RigConfig, records: list[Measurement], values: dict | None
 
 def identify(cfg: RigConfig, records: list[Measurement], names: list[str], *,
              known: dict | None = None, current_weight: float = 0.0, refine: bool = True,
-             window: tuple[int, int | None] = (0, None), controllers: list | None = None
-             ) -> FitResult:
+             window: tuple[int, int | None] = (0, None), controllers: list | None = None,
+             budget: bool = False, sources: list[str] | None = None) -> FitResult:
     """Fit ``names`` to closed-loop records (P2 Eqs. 9–10, P4 Eq. 14).
 
     Parameters
@@ -176,20 +180,70 @@ def identify(cfg: RigConfig, records: list[Measurement], names: list[str], *,
         removes that approximation from the estimate.
     controllers : list of DiscreteController, optional
         The controller that ran for each record; by default from the records' metadata.
+    budget : bool
+        Add the error budget of every parameter held fixed (neither fitted nor ``known``) to
+        the intervals, with the uncertainty the rig file states or the defaults of
+        :mod:`ambseal.identify.budget`.
+    sources : list of str, optional
+        The records' file names, for errors.
+
+    Raises
+    ------
+    ConfigError
+        An ``uncertainty`` key that names no value (with ``budget``).
     """
     known = dict(known or {})
-    models = build_models(cfg, records, known, controllers=controllers)
+    models = build_models(cfg, records, known, controllers=controllers, sources=sources)
     try:
         bounds = default_bounds(models[0], names)
     except ModelError as exc:
         raise IdentificationError(f"fit: {exc}") from None
+    fixed = None
+    if budget:
+        params = list(models[0].plant.parameters) + ([TAU_E] if models[0].tau_e > 0 else [])
+        fixed = fixed_uncertainty(cfg, params, list(names) + list(known))
     res = fit_parameters(records, models, names, current_weight=current_weight, window=window,
-                         bounds=bounds)
+                         bounds=bounds, fixed=fixed)
     if refine and res.converged:
         est = dict(zip(names, res.estimate))
-        models = build_models(cfg, records, {**known, **est}, controllers=controllers)
+        models = build_models(cfg, records, {**known, **est}, controllers=controllers,
+                              sources=sources)
         res2 = fit_parameters(records, models, names, current_weight=current_weight,
-                              window=window, bounds=bounds)
+                              window=window, bounds=bounds, fixed=fixed)
         if res2.converged:
             res = res2
     return res
+
+
+def record_spread(cfg: RigConfig, records: list[Measurement], names: list[str],
+                  pooled: FitResult, *, controllers: list | None = None,
+                  sources: list[str] | None = None) -> dict | None:
+    """Each record fitted alone, and the spread of those estimates beside the pooled fit.
+
+    The thesis judges its identification by the relative standard deviation over repeated
+    tests (P2 Table 2, 1.1–2.4 %): a spread wider than the pooled interval claims says the
+    records differ by more than their noise (model error, drift). Single-record fits take
+    one pass (no refinement) from the rig's values.
+
+    Returns
+    -------
+    dict or None
+        ``{name: {per_record, mean, sd, rsd_pct, pooled, pooled_std_error}}`` (SI); None
+        when the records are not of one condition (pressure drop, speed).
+    """
+    cond = {(round(_pressure_bar(r), 9), dict(r.metadata).get("speed_rad_s")) for r in records}
+    if len(cond) > 1 or len(records) < 2:
+        return None
+    sources = sources or [f"record {i + 1}" for i in range(len(records))]
+    est = []
+    for i, rec in enumerate(records):
+        r = identify(cfg, [rec], names, refine=False, sources=[sources[i]],
+                     controllers=None if controllers is None else [controllers[i]])
+        est.append(r.estimate)
+    est = np.array(est)
+    mean, sd = est.mean(axis=0), est.std(axis=0, ddof=1)
+    return {n: {"per_record": est[:, j].tolist(), "mean": float(mean[j]), "sd": float(sd[j]),
+                "rsd_pct": float(100 * sd[j] / abs(mean[j])) if mean[j] else None,
+                "pooled": float(pooled.estimate[j]),
+                "pooled_std_error": float(pooled.std_error[j])}
+            for j, n in enumerate(names)}

@@ -21,7 +21,7 @@ from ambseal.errors import AmbsealError
 from ambseal.report.figures import save_figure
 
 __all__ = ["frf_figure", "fit_timeseries_figure", "correlation_figure", "seal_frequency_figure",
-           "seal_pressure_figure"]
+           "seal_pressure_figure", "residual_figure", "error_budget_figure"]
 
 
 def _check(frf: Any, what: str) -> tuple[np.ndarray, np.ndarray]:
@@ -207,6 +207,71 @@ def correlation_figure(path: str | os.PathLike, correlation: np.ndarray,
             ax.text(j, i, f"{R[i, j]:.2f}", ha="center", va="center", fontsize=7,
                     color="white" if abs(R[i, j]) > 0.6 else "black")
     fig.colorbar(im, ax=ax, shrink=0.8)
+    ax.set_title(title)
+    return save_figure(fig, path)
+
+
+def residual_figure(path: str | os.PathLike, tests: Any, *,
+                    title: str = "Residual analysis (Ljung §16.6)") -> Path:
+    """Per channel: the residual's autocorrelation (left) and the cross-correlation of the
+    prewhitened residual with the same axis's excitation (right), with the 99 % band; the
+    χ² statistics against their limits in the titles. ``tests``: a
+    :class:`ambseal.identify.residuals.ResidualTests`."""
+    ch = list(tests.channels)
+    m = tests.lags
+    fig = Figure(figsize=(10, 1.8 * len(ch) + 0.6), layout="constrained")
+    axes = fig.subplots(len(ch), 2, sharex="col", squeeze=False)
+    for j, name in enumerate(ch):
+        a, b = axes[j]
+        a.stem(np.arange(m + 1), tests.autocorrelation[j], basefmt=" ")
+        b.stem(np.arange(-m, m + 1), tests.cross_correlation[j], basefmt=" ")
+        for ax in (a, b):
+            ax.axhspan(-tests.band, tests.band, color="0.85", zorder=0)
+            ax.grid(alpha=0.3)
+        a.set_title(f"{name}: whiteness {tests.whiteness[j]:.0f} "
+                    f"(limit {tests.whiteness_limit[j]:.0f}, informative)", fontsize=9)
+        ok = tests.independence[j] <= tests.independence_limit[j]
+        b.set_title(f"{name}: independence {tests.independence[j]:.0f} (limit "
+                    f"{tests.independence_limit[j]:.0f}) {'pass' if ok else 'FAIL'}", fontsize=9)
+    d = getattr(tests, "block", 1)
+    axes[-1, 0].set_xlabel(f"Lag (blocks of {d} samples)")
+    axes[-1, 1].set_xlabel(f"Lag (blocks of {d} samples), residual after excitation")
+    fig.suptitle(title)
+    return save_figure(fig, path)
+
+
+def error_budget_figure(path: str | os.PathLike, names: Sequence[str], estimate: Any,
+                        std_error_noise: Any, budget: Any, *, top: int = 5,
+                        title: str = "Error budget: 1σ per source, % of the estimate") -> Path:
+    """Horizontal stacked variance bars per estimate: the noise part and each fixed
+    parameter's (the ``top`` largest named, the rest summed), in % of the estimate's 1σ²
+    expressed as σ (bar length = total 1σ in % of the estimate). ``budget``: an
+    :class:`ambseal.identify.budget.ErrorBudget` or None."""
+    est = np.abs(np.asarray(estimate, float))
+    noise = np.asarray(std_error_noise, float)
+    parts = [("noise", noise ** 2)]
+    if budget is not None:
+        c2 = budget.contribution() ** 2
+        order = np.argsort(-c2.sum(axis=0))
+        for j in order[:top]:
+            parts.append((budget.fixed[j], c2[:, j]))
+        if len(order) > top:
+            parts.append(("other fixed", c2[:, order[top:]].sum(axis=1)))
+    total = sum(v for _, v in parts)
+    sigma_pct = 100 * np.sqrt(total) / np.where(est > 0, est, np.nan)
+    fig = Figure(figsize=(9, 0.45 * len(names) + 1.4), layout="constrained")
+    ax = fig.subplots()
+    left = np.zeros(len(names))
+    y = np.arange(len(names))
+    for label, v in parts:  # each source's share of the variance, scaled to the total σ
+        w = sigma_pct * v / np.where(total > 0, total, 1.0)
+        ax.barh(y, w, left=left, label=label)
+        left += w
+    ax.set_yticks(y, names, fontsize=8)
+    ax.invert_yaxis()
+    ax.set_xlabel("1σ (% of the estimate), split by share of the variance")
+    ax.legend(fontsize=7, loc="lower right")
+    ax.grid(alpha=0.3, axis="x")
     ax.set_title(title)
     return save_figure(fig, path)
 

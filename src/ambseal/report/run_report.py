@@ -69,7 +69,7 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
     """
     from ..identify.checks import true_line
     from .identify_figures import (correlation_figure, fit_timeseries_figure, frf_figure,
-                                   seal_frequency_figure, seal_pressure_figure)
+                                   residual_figure, seal_frequency_figure, seal_pressure_figure)
 
     a = res.amb
     figs = [("Identification (a): measured and simulated displacements, PRBS at 0 bar",
@@ -77,6 +77,10 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
                                    nrmse_pct=[a.nrmse_fit_pct[x] for x in a.axes])),
             ("Correlation of the AMB estimates (P4 Table 2)",
              correlation_figure(out / "ident_correlation.png", a.correlation, a.names))]
+    if a.residuals is not None:
+        figs.append(("Residuals of the joint AMB fit, first record: whiteness (informative) and "
+                     "independence of the excitation (Ljung §16.6)",
+                     residual_figure(out / "ident_residuals.png", a.residuals)))
     if res.seal_vs_frequency:
         curves = [(f"{p:g} bar", [f for f, _ in rows], np.array([r.estimate for _, r in rows]),
                    np.array([r.std_error for _, r in rows]))
@@ -114,6 +118,8 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
                         f"{e['slope']:.4g}·p</td><td>{tl}</td><td>slope ± "
                         f"{1.96 * e['slope_se']:.3g}</td><td></td></tr>")
     fits = ", ".join(f"{k} {v:.1f} %" for k, v in a.nrmse_fit_pct.items())
+    if a.residuals is not None:
+        fits += f"; residual test: {a.residuals.to_dict()['verdict']}"
     section = {
         "title": "Identification on the virtual test facility",
         "html": ("<p>Records from the virtual facility (nonlinear AMB force law, full FE rotor, "

@@ -1,0 +1,87 @@
+"""The fixed-parameter error budget and the residual tests, against closed forms."""
+
+import numpy as np
+import pytest
+from scipy.signal import lfilter
+
+from ambseal.config import parse_rig
+from ambseal.errors import ConfigError
+from ambseal.identify.budget import DEFAULT_UNCERTAINTY, advice, fixed_uncertainty, propagate
+from ambseal.identify.residuals import residual_tests
+
+
+def test_sensitivity_to_a_fixed_regressor_closed_form():
+    """y = a·x + b·z fitted for a with b held fixed: ∂â/∂b = −(xᵀz)/(xᵀx) (ordinary least
+    squares, normal equations), so a relative error σ_b in b adds |b·xᵀz/xᵀx|·σ_b to â's
+    standard error."""
+    rng = np.random.default_rng(1)
+    x, z = rng.standard_normal(500), rng.standard_normal(500) + 0.4
+    z = z + 0.6 * x  # correlated regressors
+    b, sigma = 3.0, 0.1
+    # residual r = y − a x − b z; ∂r/∂a = −x, ∂r/∂(b/b0) = −b z
+    bud = propagate(-x[:, None], -b * z[:, None], np.array([1.0]), ["a"], ["b"], [sigma],
+                    ["stated"], np.array([0.0]))
+    ref = -(x @ z) / (x @ x) * b
+    np.testing.assert_allclose(bud.sensitivity[0, 0], ref, rtol=1e-12)
+    np.testing.assert_allclose(np.sqrt(bud.covariance[0, 0]), abs(ref) * sigma, rtol=1e-12)
+    assert bud.dominant() == ["b"]
+
+
+def test_rig_file_uncertainty_and_defaults(testrig_cfg):
+    """Reference: the documented rule — a stated `uncertainty` wins, else the kind's
+    default; `Ks` stands for both axes; an unknown key is refused naming it."""
+    data = testrig_cfg.model_dump(exclude_none=True)
+    data["spring"][0]["uncertainty"] = {"kxx": 0.02}
+    data["amb"][0]["uncertainty"] = {"Ks": 0.01}
+    cfg = parse_rig(data)
+    names = ["A.Ks_zeta", "A.Ks_eta", "A.Ki_zeta", "coupling.kxx", "coupling.kyy", "seal.k",
+             "coupling.cxx", "tau_e"]
+    got = fixed_uncertainty(cfg, names, ["A.Ki_zeta"])
+    assert "A.Ki_zeta" not in got
+    assert got["A.Ks_zeta"][0] == got["A.Ks_eta"][0] == 0.01
+    assert got["coupling.kxx"] == (0.02, "spring[coupling].uncertainty")
+    assert got["coupling.kyy"][0] == DEFAULT_UNCERTAINTY["spring_stiffness"]
+    assert got["coupling.cxx"][0] == DEFAULT_UNCERTAINTY["spring_damping"]
+    assert got["seal.k"][0] == DEFAULT_UNCERTAINTY["seal"]
+    assert got["tau_e"][0] == DEFAULT_UNCERTAINTY["tau_e"]
+    data["seal"][0]["uncertainty"] = {"kk": 0.1}
+    with pytest.raises(ConfigError, match=r"seal\[seal\].uncertainty.kk"):
+        fixed_uncertainty(parse_rig(data), names, [])
+
+
+def test_seal_held_fixed_at_pressure_is_told(testrig_cfg):
+    """Reference: issue 17 — seal coefficients held at their rig values on a record at a
+    non-zero pressure drop draw a warning naming them; at 0 bar, or fitted, none."""
+    assert any("seal.k" in w and "2.04 bar" in w
+               for w in advice(None, testrig_cfg, ["A.Ks_zeta"], [2.04]))
+    assert advice(None, testrig_cfg, ["A.Ks_zeta"], [0.0]) == []
+    assert advice(None, testrig_cfg, ["seal.K", "seal.k", "seal.C", "seal.c"], [2.04]) == []
+
+
+def _signals(rng, n=4000):
+    """A held random binary excitation (clock 10 samples) and resonant coloured noise
+    independent of it."""
+    u = np.repeat(rng.choice([-1.0, 1.0], n // 10), 10)[:, None]
+    eps = lfilter([1.0], [1.0, -1.9, 0.95], rng.standard_normal(n))
+    return eps[:, None], u
+
+
+def test_residual_tests_size_and_power():
+    """Ljung §16.6: for residuals independent of the excitation the statistic is χ²
+    distributed, so the 99 % test rejects ≈ 1 % of 200 independent cases (binomial: at
+    most 6 at 0.1 % risk); a residual holding a filtered copy of the excitation at a
+    fifth of its standard deviation is flagged every time. The coloured residual fails the
+    whiteness test, as a closed-loop output-error residual does."""
+    rng = np.random.default_rng(7)
+    rejected = 0
+    for _ in range(200):
+        e, u = _signals(rng)
+        t = residual_tests([e], [u], ("A",))
+        rejected += t.mismatch
+    assert rejected <= 6
+    assert t.whiteness[0] > t.whiteness_limit[0]
+    for _ in range(5):
+        e, u = _signals(rng)
+        leak = 0.2 * e.std() / lfilter([0.0, 0.3, 0.2], [1.0, -0.9], u[:, 0]).std()
+        e_bad = e + leak * lfilter([0.0, 0.3, 0.2], [1.0, -0.9], u[:, 0])[:, None]
+        assert residual_tests([e_bad], [u], ("A",)).mismatch

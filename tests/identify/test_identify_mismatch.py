@@ -1,0 +1,84 @@
+"""Intervals on data the model did not make: fixed parameters off their rig values and a
+different rotor discretisation on the virtual facility (issue 17)."""
+
+import json
+
+import numpy as np
+import pytest
+
+from ambseal.config import TruthSection
+from ambseal.control.pid import reference_controller
+from ambseal.identify.signals import prbs
+from ambseal.identify.stages import acquire, identify
+
+# Ki/Ks of the facility, a few per cent from the rig file's (the fit's start)
+TRUE = {"A.Ki_zeta": 205.0, "A.Ki_eta": 201.0, "B.Ki_zeta": 254.0, "B.Ki_eta": 271.0,
+        "A.Ks_zeta": 2.45e6, "A.Ks_eta": 2.42e6, "B.Ks_zeta": 3.06e6, "B.Ks_eta": 3.25e6}
+NAMES = list(TRUE) + ["tau_e"]
+TAU = 2e-4
+#: coupling 4 % stiffer than the rig file's 0.40/0.42 MN/m, seal damping 5 % off
+OFF = {"coupling.kxx": 0.416e6, "coupling.kyy": 0.4368e6, "seal.C": 105.0, "seal.c": 285.0}
+CASES = {
+    "matched": {},
+    "fixed values off": {"parameters": {**TRUE, **OFF}},
+    "euler-bernoulli, mesh x2": {"beam": "euler-bernoulli", "mesh_factor": 2.0},
+}
+
+
+def _run(cfg, case: str, seeds, duration_s: float):
+    kw = dict(parameters=TRUE, tau_e=TAU, noise_fraction=0.01, adc_bits=16)
+    kw.update(CASES[case])
+    truth = TruthSection(**kw)
+    true = np.array([TRUE.get(n, TAU) for n in NAMES])
+    inside, inside_noise, width, flagged, dominant = [], [], [], [], []
+    for seed in seeds:
+        ex = prbs(amplitude_a=0.05, clock_period_s=1e-3, duration_s=duration_s,
+                  sample_rate_hz=1e4, seed=100 + seed)
+        rec = acquire(cfg, truth, ex, controller=reference_controller(cfg), pressure_bar=0.0,
+                      seed=1000 + seed)
+        res = identify(cfg, [rec], NAMES, budget=True)
+        inside.append((res.ci95_low <= true) & (true <= res.ci95_high))
+        inside_noise.append(np.abs(res.estimate - true) <= 1.96 * res.std_error_noise)
+        width.append(res.ci95_high - res.ci95_low)
+        flagged.append(res.mismatch)
+        dominant.append(res.budget.dominant())
+    return (np.array(inside), np.array(inside_noise), np.array(width), np.array(flagged),
+            dominant)
+
+
+def test_budget_covers_a_coupling_held_wrong_and_names_it(testrig_cfg):
+    """Two seeds, coupling held 4 % off: the noise-only intervals miss A's Ks (the bias of
+    several standard errors the issue reports), the intervals with the fixed-parameter
+    budget contain every truth, and the budget names the coupling as dominant. Reference:
+    the facility's truth (the rig file's coupling is known to be 4 % off)."""
+    inside, inside_noise, _, _, dominant = _run(testrig_cfg, "fixed values off", range(2), 0.3)
+    assert inside.all(), inside
+    assert not inside_noise[:, NAMES.index("A.Ks_zeta")].any()
+    assert all({"coupling.kxx", "coupling.kyy"} <= set(d) for d in dominant)
+
+
+@pytest.mark.slow
+def test_coverage_over_20_seeds_matched_and_mismatched(testrig_cfg):
+    """Issue 17 acceptance over 20 seeds (PRBS and noise both drawn anew): matched records
+    cover every parameter in ≥ 90 % of seeds; with fixed values off by a few per cent and
+    with an Euler–Bernoulli rotor on a twice finer mesh, ≥ 90 % of all intervals cover,
+    no more than 5× the matched width. Reference: the facility's truth; 90 % is the
+    issue's bar (a binomial 95 % tolerance of nominal 95 % over 20 seeds is ±9.6 %, over
+    180 intervals ±3.2 %)."""
+    seeds = range(20)
+    out = {}
+    runs = {case: _run(testrig_cfg, case, seeds, 0.5) for case in CASES}
+    w0 = np.median(runs["matched"][2], axis=0)
+    for case, (inside, inside_noise, width, flagged, dominant) in runs.items():
+        out[case] = {"coverage": inside.mean(), "per_parameter": inside.mean(axis=0).round(2).tolist(),
+                     "coverage_noise_only": inside_noise.mean(),
+                     "width_vs_matched": (np.median(width, axis=0) / w0).round(2).tolist(),
+                     "flagged": flagged.mean(),
+                     "coupling_named": np.mean([{"coupling.kxx", "coupling.kyy"} <= set(d)
+                                                for d in dominant])}
+    print(json.dumps(out, default=float))
+    assert (runs["matched"][0].mean(axis=0) >= 0.90).all()
+    for case in ("fixed values off", "euler-bernoulli, mesh x2"):
+        assert out[case]["coverage"] >= 0.90
+        assert max(out[case]["width_vs_matched"]) <= 5.0
+    assert out["fixed values off"]["coupling_named"] == 1.0

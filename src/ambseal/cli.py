@@ -4,8 +4,17 @@ Commands
 --------
 ``ambseal run [RIG] [--out DIR]``
     The main job on a rig (default: the embedded thesis test facility).
-``ambseal modes RIG [--speed-rpm N] [--pressure-bar P] [--json] [--n-modes N] [--free | --no-amb]``
-    Damped natural frequencies, damping ratios and unstable poles of the full model.
+``ambseal modes RIG [--speed-rpm N] [--pressure-bar P] [--json] [--n-modes N] [--max-hz F]
+[--controller C] [--shapes [PNG]] [--free | --no-amb]``
+    Damped natural frequencies, damping ratios, log decrements, whirl and unstable poles of
+    the full model (or of the closed loop), and the mode shapes.
+``ambseal campbell RIG [--controller pid|hinf|mu|FILE] [--speed-hz a:b:n] [--pressure-bar P]``
+    Closed-loop Campbell diagram with log decrements (API 684 limit flagged): PNG, JSON, CSV.
+``ambseal sweep RIG --pressure-bar a:b:n [--speed-hz a:b:n] [--controller ...]
+[--param NAME=a:b:n] [--scheduler ADDRESS | --workers N]``
+    Stability and performance map; serial or on Dask.
+``ambseal import-ross FILE --out RIG``
+    A ROSS rotor file as an ambseal rig file.
 ``ambseal acquire RIG --truth TRUTH --excitation prbs|sine|chirp|impulse --pressure-bar P --out FILE``
     A record from the virtual test facility (CSV + JSON sidecar, or .mat).
 ``ambseal design RIG --method pid|hinf|mu|lpv [--out DIR]``
@@ -54,17 +63,6 @@ def _parser() -> argparse.ArgumentParser:
                           "(default for the embedded rig: its packaged truth)")
     run.add_argument("--no-identify", action="store_true", help="skip the identification stage")
 
-    m = sub.add_parser("modes", help="natural frequencies, damping and unstable poles")
-    m.add_argument("rig", help="rig file (TOML)")
-    m.add_argument("--speed-rpm", type=float, default=None, help="spin speed (rpm)")
-    m.add_argument("--pressure-bar", type=float, default=None, help="seal pressure drop (bar)")
-    m.add_argument("--json", action="store_true", help="print JSON instead of a table")
-    m.add_argument("--n-modes", type=_positive_int, default=None,
-                   help="only the N lowest modes (sparse shift-invert; unstable poles up to "
-                        "the N-th mode only)")
-    g = m.add_mutually_exclusive_group()
-    g.add_argument("--free", action="store_true", help="bare rotor: shaft and disks only")
-    g.add_argument("--no-amb", action="store_true", help="leave the AMBs out")
     a = sub.add_parser("acquire", help="record a run of the virtual test facility")
     a.add_argument("rig", help="rig file (TOML)")
     a.add_argument("--truth", required=True, help="truth file of the virtual facility (TOML)")
@@ -103,6 +101,9 @@ def _parser() -> argparse.ArgumentParser:
                    help="weight of the coil-current residuals (0: displacements only)")
     i.add_argument("--no-refine", action="store_true",
                    help="skip the second pass on a model re-reduced at the estimate")
+    from .rotordynamics import add_parsers
+
+    add_parsers(sub, _positive_int)  # modes, campbell, sweep, import-ross
     return p
 
 
@@ -165,36 +166,6 @@ def _identify(args: argparse.Namespace) -> int:
     return 0
 
 
-def _modes(args: argparse.Namespace) -> int:
-    from .config import load_rig
-    from .model.modes import modes
-    from .model.rig import build_system
-
-    cfg = load_rig(args.rig)
-    sys_ = build_system(
-        cfg,
-        speed_rpm=args.speed_rpm,
-        pressure_bar=args.pressure_bar,
-        include_amb=not (args.free or args.no_amb),
-        include_seals=not args.free,
-        include_springs=not args.free,
-    )
-    res = modes(sys_, n_modes=args.n_modes)
-    if args.json:
-        print(json.dumps(res.to_dict(), indent=2))
-        return 0
-    print(f"{'mode':>4}  {'f_d [Hz]':>12}  {'zeta [-]':>10}")
-    for i, (f, z) in enumerate(zip(res.natural_frequencies_hz, res.damping_ratios), 1):
-        print(f"{i:>4}  {f:>12.3f}  {z:>10.4f}")
-    if res.unstable_poles:
-        print("unstable poles [rad/s]:")
-        for re, im in res.unstable_poles:
-            print(f"  {re:+.4g} {im:+.4g}j")
-    else:
-        print("no unstable poles")
-    return 0
-
-
 def _run(args: argparse.Namespace) -> int:
     from .pipeline import run
 
@@ -207,8 +178,10 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``ambseal`` console script; returns the exit status."""
     args = _parser().parse_args(argv)
     try:
-        handler = {"modes": _modes, "acquire": _acquire, "identify": _identify,
-                   "design": _design, "run": _run}[args.command]
+        from .rotordynamics import HANDLERS
+
+        handler = {"acquire": _acquire, "identify": _identify, "design": _design,
+                   "run": _run, **HANDLERS}[args.command]
         return handler(args)
     except AmbsealError as exc:
         print(f"ambseal: error: {exc}", file=sys.stderr)

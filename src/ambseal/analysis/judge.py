@@ -99,7 +99,8 @@ def _finite(x: float) -> float | None:
 
 
 def judge(cfg, controller, name: str, point: OperatingPoint,
-          settings: JudgeSettings = JudgeSettings()) -> tuple[dict, dict]:
+          settings: JudgeSettings = JudgeSettings(), *, impulse: bool = True
+          ) -> tuple[dict, dict]:
     """Judge one physical controller on the full-order plant at one operating point.
 
     Parameters
@@ -111,6 +112,9 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
         The controller's name in the case.
     point : OperatingPoint
     settings : JudgeSettings
+    impulse : bool
+        Set False to leave out the impulse response (the sweeps of
+        :mod:`ambseal.analysis.sweep`); ``impulse_*`` are then ``None``.
 
     Returns
     -------
@@ -118,7 +122,8 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
         The ``metrics.json`` case (values an unstable loop does not have are ``None``).
     curves : dict
         ``So``, ``compliance``, ``unbalance`` (frequency Hz, values) and ``impulse``
-        (:class:`~ambseal.analysis.response.ImpulseResponse`) for the figures.
+        (:class:`~ambseal.analysis.response.ImpulseResponse`) for the figures, and
+        ``poles`` (the closed-loop poles, rad/s).
     """
     from ..model.rig import build_plant
     from ..model.rotor import assemble_rotor
@@ -142,7 +147,7 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
     w = resolved_grid(w, loop.poles)  # a 0.5 %-damped bending mode must not slip through
     resp = loop_responses(G, controller, w)
     iso = iso_assessment(resp.peaks("So"), stable=loop.stable)
-    curves: dict = {"So": (w / (2 * np.pi), sigma_max(resp.So))}
+    curves: dict = {"So": (w / (2 * np.pi), sigma_max(resp.So)), "poles": loop.poles}
     case.update(
         sensitivity_peak=_finite(iso.sigma_max_peak),
         sensitivity_peak_per_axis={ax.removeprefix("y_"): (p.value if loop.stable else None)
@@ -161,6 +166,10 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
                                     mass_kg=assemble_rotor(cfg).mass,
                                     grade_mm_s=s.unbalance_grade_mm_s)
     curves["unbalance"] = (unb.speed_hz, unb.response_um)
+    case.update(compliance_peak_m_per_n=comp.peak.value, unbalance_peak_um=unb.peak_um)
+    if not impulse:
+        case.update(impulse_peak_um=None, impulse_settling_s=None)
+        return case, curves
     # the thesis's impulse axes A_ζ and B_η (P5 §5.1): first AMB's ζ, last AMB's η
     channels = (G.input_labels[0], G.input_labels[-1])
     imp = impulse_response_of(loop, channels=channels, amplitude_a=s.impulse_a,
@@ -168,8 +177,6 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
                               t_end_s=s.impulse_end_s, dt_s=s.impulse_dt_s)
     curves["impulse"] = imp
     case.update(
-        compliance_peak_m_per_n=comp.peak.value,
-        unbalance_peak_um=unb.peak_um,
         impulse_peak_um=imp.peak_displacement_um,
         impulse_settling_s=_finite(imp.settling_time_s),
     )

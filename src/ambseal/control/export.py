@@ -20,7 +20,7 @@ import numpy as np
 from ..files import atomic_write
 from ..lti.discrete import discretize as _discretize
 
-__all__ = ["discretize", "controller_arrays", "export_controller"]
+__all__ = ["discretize", "controller_arrays", "export_controller", "load_controller"]
 
 _METHODS = ("tustin", "zoh")
 _FORMATS = (".npz", ".mat", ".json")
@@ -133,3 +133,57 @@ def export_controller(K, path, fs_hz: float | None = None,
         text = json.dumps(doc, indent=1).encode()
         _atomic_write(path, lambda fh: fh.write(text))
     return path
+
+
+def load_controller(path):
+    """Read back the continuous controller of a file written by :func:`export_controller`.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.json``, ``.npz`` or ``.mat`` with ``A``, ``B``, ``C``, ``D`` (continuous) and the
+        channel names ``inputs`` / ``outputs``.
+
+    Returns
+    -------
+    control.StateSpace
+        Displacements (m) → current references (A), ``i = −K y``.
+
+    Raises
+    ------
+    DataError
+        A missing or unreadable file, an unknown suffix, missing or inconsistent matrices.
+    """
+    import control
+
+    from ..errors import DataError
+
+    path = Path(path)
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".json":
+            doc = json.loads(path.read_text(encoding="utf-8"))
+        elif suffix == ".npz":
+            with np.load(path, allow_pickle=False) as z:
+                doc = {k: z[k] for k in z.files}
+        elif suffix == ".mat":
+            from scipy.io import loadmat
+
+            doc = loadmat(path, squeeze_me=False)
+        else:
+            raise DataError(f"{path}: unknown controller format {suffix!r}, expected one "
+                            f"of {_FORMATS}")
+    except (OSError, ValueError) as exc:
+        raise DataError(f"{path}: cannot read controller ({exc})") from None
+    try:
+        A, B, C, D = (np.atleast_2d(np.asarray(doc[k], float)) for k in "ABCD")
+        names = {k: [str(x).strip() for x in np.ravel(doc[k])] for k in ("inputs", "outputs")}
+        n = A.shape[0] if A.size else 0
+        A, B = A.reshape(n, n), B.reshape(n, -1) if n else np.zeros((0, D.shape[1]))
+        C = C.reshape(-1, n) if n else np.zeros((D.shape[0], 0))
+        return control.ss(A, B, C, D, inputs=names["inputs"], outputs=names["outputs"])
+    except KeyError as exc:
+        raise DataError(f"{path}: missing key {exc.args[0]!r} (expected A, B, C, D, inputs, "
+                        "outputs as written by ambseal design)") from None
+    except (ValueError, TypeError) as exc:
+        raise DataError(f"{path}: inconsistent controller matrices ({exc})") from None

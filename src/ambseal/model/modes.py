@@ -24,9 +24,10 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import ModelError
-from .rig import SecondOrderSystem
+from .rig import SecondOrderSystem, build_system
 
-__all__ = ["Modes", "modes", "lowest_eigenvalues"]
+__all__ = ["Modes", "modes", "lowest_eigenvalues", "free_bending_hz",
+           "bending_limit_hz"]
 
 # The shift-invert shift is σ = −SHIFT_FRACTION · ω_ref (see ``lowest_eigenvalues``).
 SHIFT_FRACTION = 1e-3
@@ -234,3 +235,36 @@ def _shift_invert_operator(M: np.ndarray, D: np.ndarray, K: np.ndarray,
         return np.concatenate([z1, x[:n] + sigma * z1])
 
     return spla.LinearOperator((2 * n, 2 * n), matvec=matvec, dtype=float)
+
+
+#: Bending modes a default modal analysis covers ("a few"), and the margin above the last.
+BENDING_MODES = 3
+BENDING_MARGIN = 1.25
+
+
+def free_bending_hz(cfg, n_bending: int = BENDING_MODES) -> tuple[float, ...]:
+    """The ``n_bending`` lowest bending frequencies (Hz) of the free–free rotor (shaft and
+    disks only, standstill).
+
+    A free–free lateral rotor's bending modes come in pairs (the x–z and y–z planes, equal
+    at standstill), so the k-th bending frequency is the 2k-th oscillating mode.
+
+    Raises
+    ------
+    ModelError
+        The rotor cannot be built.
+    """
+    free = build_system(cfg, speed_rpm=0.0, include_amb=False, include_seals=False,
+                        include_springs=False)
+    f = modes(free, n_modes=2 * n_bending).natural_frequencies_hz
+    return tuple(float(x) for x in f[1::2][:n_bending])
+
+
+def bending_limit_hz(cfg, n_bending: int = BENDING_MODES) -> float:
+    """Default upper frequency (Hz) of a modal analysis: ``BENDING_MARGIN`` (1.25) × the
+    ``n_bending``-th free–free bending frequency (:func:`free_bending_hz`).
+
+    The limit keeps the rigid-body, actuator and controller modes of a closed loop and a
+    few bending modes, not the whole FE spectrum.
+    """
+    return BENDING_MARGIN * free_bending_hz(cfg, n_bending)[-1]

@@ -1,0 +1,404 @@
+"""Closed-loop modes against speed: Campbell diagram, log decrement, whirl and mode shapes.
+
+The modes of the *closed loop* — rotor, AMBs, seals and springs of the full-order plant with
+the actuator states, closed by the controller (its states included) exactly as the judgement
+closes it (:func:`ambseal.analysis.loops.closed_loop`, ``u = −K y``) — not of a rotor on
+equivalent bearing coefficients taken at one frequency.
+
+For an eigenvalue λ = σ + jω_d of the closed-loop state matrix (ω_d > 0):
+
+* damped natural frequency f_d = ω_d / 2π (Hz);
+* damping ratio ζ = −σ / |λ|;
+* logarithmic decrement δ = −2π σ / ω_d = 2πζ / √(1 − ζ²) (API 684, §1.3; Friswell et al.,
+  *Dynamics of Rotating Machines*, 2010, §3.6): the log of the ratio of successive peaks of a
+  free decay; API 684's level-I screening asks δ ≥ 0.1 (:data:`API684_LOG_DEC`).
+
+Whirl from the mode shape (Friswell et al. 2010, §3.6.2): at a node with complex lateral
+amplitudes (X, Y) the orbit x = Re(X e^{jω_d t}), y = Re(Y e^{jω_d t}) turns in the sense of
+spin (x towards y, forward) when κ = 2 Im(X Ȳ)/(|X|² + |Y|²) > 0 and against it (backward)
+when κ < 0; |κ| = 1 is a circle, 0 a line. A mode is *forward* or *backward* when every node
+that moves (amplitude above 1 % of the largest) turns that way, *planar* when none turns
+(|κ| < 0.01 everywhere), else *mixed*.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+from scipy.optimize import linear_sum_assignment
+
+from ._util import json_float, json_list
+
+__all__ = ["API684_LOG_DEC", "ClosedLoopModes", "Crossing", "Campbell",
+           "log_decrement", "lowest_log_decrement", "whirl_of", "closed_loop_state_matrix",
+           "closed_loop_modes", "modes_of_state_matrix", "campbell"]
+
+#: API 684 (2nd ed., 2005) level-I stability screening: log decrement of every mode ≥ 0.1.
+API684_LOG_DEC = 0.1
+#: A node counts in the whirl classification when it moves more than this share of the
+#: largest node amplitude of the mode.
+_MOVING = 0.01
+#: |κ| below this is no turning at all (a line orbit).
+_PLANAR = 0.01
+
+
+def log_decrement(poles: np.ndarray) -> np.ndarray:
+    """δ = −2π Re λ / Im λ of eigenvalues λ (rad/s) with Im λ > 0 (API 684; Friswell §3.6)."""
+    p = np.asarray(poles, complex)
+    return -2 * np.pi * p.real / p.imag
+
+
+def lowest_log_decrement(poles: np.ndarray, max_hz: float) -> tuple[float, float]:
+    """(δ, f_d in Hz) of the least damped oscillating pole with f_d ≤ ``max_hz``, by log
+    decrement; (nan, nan) when there is none."""
+    p = np.asarray(poles, complex)
+    tol = 1e-9 * max(float(np.abs(p).max(initial=0.0)), 1.0)
+    p = p[(p.imag > tol) & (p.imag <= 2 * np.pi * max_hz)]
+    if p.size == 0:
+        return float("nan"), float("nan")
+    d = log_decrement(p)
+    k = int(np.argmin(d))
+    return float(d[k]), float(p[k].imag / (2 * np.pi))
+
+
+def whirl_of(shape_xy: np.ndarray) -> tuple[str, float]:
+    """Whirl direction of one mode from its lateral amplitudes (module docstring).
+
+    Parameters
+    ----------
+    shape_xy : ndarray of complex, shape (n_nodes, 2)
+        X and Y amplitude at each node.
+
+    Returns
+    -------
+    (direction, kappa)
+        ``"forward"``, ``"backward"``, ``"mixed"`` or ``"planar"``; and the amplitude-weighted
+        mean of κ over the nodes (−1 … 1; +1 a circular forward whirl).
+    """
+    X, Y = shape_xy[:, 0], shape_xy[:, 1]
+    amp = np.abs(X) ** 2 + np.abs(Y) ** 2
+    if amp.max(initial=0.0) == 0.0:
+        return "planar", 0.0
+    moving = amp > _MOVING**2 * amp.max()
+    kappa = 2 * np.imag(X[moving] * np.conj(Y[moving])) / amp[moving]
+    mean = float(np.sum(kappa * amp[moving]) / np.sum(amp[moving]))
+    if np.all(kappa > _PLANAR):
+        return "forward", mean
+    if np.all(kappa < -_PLANAR):
+        return "backward", mean
+    if np.all(np.abs(kappa) <= _PLANAR):
+        return "planar", mean
+    return "mixed", mean
+
+
+@dataclass(frozen=True, eq=False)
+class ClosedLoopModes:
+    """The oscillating closed-loop modes at one speed and pressure drop, up to ``max_hz``.
+
+    Attributes
+    ----------
+    speed_hz, pressure_bar, max_hz : float
+        Where the modes were taken and the highest damped frequency kept (Hz).
+    poles : ndarray of complex, shape (k,)
+        The kept eigenvalues (rad/s), Im λ > 0, ascending in frequency.
+    frequency_hz, damping_ratio, log_decrement : ndarray, shape (k,)
+    whirl : tuple of str
+        ``forward`` / ``backward`` / ``mixed`` / ``planar`` per mode.
+    kappa : ndarray, shape (k,)
+        Amplitude-weighted whirl measure κ (+1 circular forward, −1 circular backward).
+    shapes : ndarray of complex, shape (k, n_nodes, 2)
+        Lateral amplitudes X, Y (m, scaled to a largest node amplitude of 1) per mode.
+    node_z_m : ndarray, shape (n_nodes,)
+        Node positions (m).
+    max_real_pole : float
+        Largest real part of *all* closed-loop poles (1/s), whatever their frequency.
+    """
+
+    speed_hz: float
+    pressure_bar: float
+    max_hz: float
+    poles: np.ndarray
+    frequency_hz: np.ndarray
+    damping_ratio: np.ndarray
+    log_decrement: np.ndarray
+    whirl: tuple[str, ...]
+    kappa: np.ndarray
+    shapes: np.ndarray
+    node_z_m: np.ndarray
+    max_real_pole: float
+
+    @property
+    def stable(self) -> bool:
+        return self.max_real_pole < 0
+
+    def to_dict(self) -> dict:
+        return {"speed_hz": self.speed_hz, "pressure_bar": self.pressure_bar,
+                "max_hz": self.max_hz, "stable": self.stable,
+                "max_real_pole": json_float(self.max_real_pole),
+                "modes": [{"frequency_hz": json_float(f), "damping_ratio": json_float(z),
+                           "log_decrement": json_float(d), "whirl": w, "kappa": json_float(k)}
+                          for f, z, d, w, k in zip(self.frequency_hz, self.damping_ratio,
+                                                   self.log_decrement, self.whirl, self.kappa)]}
+
+
+def closed_loop_state_matrix(cfg, controller=None, *, speed_hz: float,
+                             pressure_bar: float | None = None):
+    """The state matrix of the full-order loop of :func:`ambseal.analysis.judge.judge` and
+    the rig's mesh: ``(A_cl, mesh)``, states ``[q; q̇; actuator; controller]``.
+
+    Without a controller (or a rig without AMBs) the open-loop plant's A; a scheduled
+    controller is frozen at the speed.
+    """
+    from ..control.controller import frozen
+    from ..model.rig import build_plant
+    from ..model.rotor import build_mesh
+    from .loops import closed_loop
+
+    plant = build_plant(cfg, pressure_bar=pressure_bar, speed_rpm=60.0 * speed_hz)
+    mesh = build_mesh(cfg)
+    if controller is None or not cfg.amb:
+        return plant.A, mesh
+    G = plant.select_inputs(plant.input_names[:2 * len(cfg.amb)]).to_statespace()
+    K = frozen(controller, 2 * math.pi * speed_hz)
+    return np.asarray(closed_loop(G, K).system.A), mesh
+
+
+def closed_loop_modes(cfg, controller=None, *, speed_hz: float = 0.0,
+                      pressure_bar: float | None = None,
+                      max_hz: float | None = None) -> ClosedLoopModes:
+    """Damped frequencies, damping, log decrement, whirl and shapes of the closed loop.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+    controller : control.StateSpace or ScheduledController, optional
+        Displacement (m) → current (A), ``i = −K y``; omitted: the open-loop rig.
+    speed_hz : float
+        Spin speed (Hz).
+    pressure_bar : float, optional
+        Seal pressure drop (bar); default ``[operating] pressure_bar``.
+    max_hz : float, optional
+        Highest damped frequency kept (Hz); default
+        :func:`ambseal.model.modes.bending_limit_hz` (a few bending modes).
+
+    Returns
+    -------
+    ClosedLoopModes
+
+    Raises
+    ------
+    ModelError
+        A model that cannot be built, or a controller of the wrong size.
+    """
+    from ..model.modes import bending_limit_hz
+
+    p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
+    f_max = bending_limit_hz(cfg) if max_hz is None else float(max_hz)
+    A, mesh = closed_loop_state_matrix(cfg, controller, speed_hz=speed_hz, pressure_bar=p)
+    return modes_of_state_matrix(A, mesh, speed_hz=speed_hz, pressure_bar=p, max_hz=f_max)
+
+
+def modes_of_state_matrix(A: np.ndarray, mesh, *, speed_hz: float, pressure_bar: float,
+                          max_hz: float) -> ClosedLoopModes:
+    """:class:`ClosedLoopModes` of a state matrix whose first ``mesh.n_dof`` states are the
+    rotor's node DOFs q (any plant of :mod:`ambseal.model.rig`, open or closed loop).
+
+    Eigenvalues with |λ| below max(10⁻⁶·max|λ|, 10⁻³ rad/s) are rigid-body modes and left
+    out, as in :func:`ambseal.model.modes.modes`.
+    """
+    lam, V = sla.eig(A)
+    scale = max(float(np.abs(lam).max()), 1.0)
+    rigid = np.abs(lam) < max(1e-6 * scale, 1e-3)
+    keep = np.flatnonzero((lam.imag > 1e-6 * scale) & ~rigid
+                          & (lam.imag <= 2 * np.pi * max_hz))
+    keep = keep[np.argsort(lam.imag[keep])]
+    n = mesh.n_dof
+    shapes = np.stack([V[0:n:4, keep], V[1:n:4, keep]], axis=-1).transpose(1, 0, 2)
+    size = np.sqrt((np.abs(shapes) ** 2).sum(axis=2)).max(axis=1)
+    shapes = shapes / np.where(size > 0, size, 1.0)[:, None, None]
+    whirls = [whirl_of(s) for s in shapes]
+    z = lam[keep]
+    return ClosedLoopModes(
+        speed_hz=float(speed_hz), pressure_bar=float(pressure_bar), max_hz=float(max_hz),
+        poles=z, frequency_hz=z.imag / (2 * np.pi), damping_ratio=-z.real / np.abs(z),
+        log_decrement=log_decrement(z), whirl=tuple(w for w, _ in whirls),
+        kappa=np.array([k for _, k in whirls]), shapes=shapes, node_z_m=np.asarray(mesh.z),
+        max_real_pole=float(lam.real.max()))
+
+
+@dataclass(frozen=True)
+class Crossing:
+    """A mode line meeting the synchronous (1×) line.
+
+    ``amplification_factor`` ≈ π/δ (API 684 §1.3.3, light damping); API 684 counts the
+    crossing as a critical speed (``critical``) when it is at least 2.5.
+    """
+
+    track: int
+    speed_hz: float
+    log_decrement: float
+    whirl: str
+
+    @property
+    def amplification_factor(self) -> float:
+        return math.pi / self.log_decrement if self.log_decrement > 0 else math.inf
+
+    @property
+    def critical(self) -> bool:
+        return self.amplification_factor >= 2.5
+
+    def to_dict(self) -> dict:
+        return {"track": self.track, "speed_hz": self.speed_hz,
+                "log_decrement": json_float(self.log_decrement), "whirl": self.whirl,
+                "amplification_factor": json_float(self.amplification_factor),
+                "critical": self.critical}
+
+
+@dataclass(frozen=True, eq=False)
+class Campbell:
+    """Closed-loop modes over speed, tracked into lines.
+
+    Attributes
+    ----------
+    speeds_hz : ndarray, shape (n_s,)
+    points : tuple of ClosedLoopModes
+        One per speed.
+    tracks : ndarray of int, shape (n_s, k_max)
+        ``tracks[i, j]`` the index into ``points[i]``'s modes of line ``j`` (−1 where the line
+        has no mode at that speed), lines followed by nearest eigenvalue.
+    crossings : tuple of Crossing
+        Where a line meets f = speed (linear interpolation between grid speeds).
+    log_dec_limit : float
+        The limit below which a mode is flagged (API 684: 0.1).
+    """
+
+    speeds_hz: np.ndarray
+    points: tuple[ClosedLoopModes, ...]
+    tracks: np.ndarray
+    crossings: tuple[Crossing, ...]
+    log_dec_limit: float = API684_LOG_DEC
+
+    def line(self, j: int, field: str = "frequency_hz") -> np.ndarray:
+        """Values of ``field`` along line ``j`` (nan where absent), shape (n_s,)."""
+        return np.array([getattr(p, field)[k] if k >= 0 else np.nan
+                         for p, k in zip(self.points, self.tracks[:, j])])
+
+    def flagged(self) -> list[dict]:
+        """Every (speed, mode) with a log decrement below the limit."""
+        return [{"speed_hz": p.speed_hz, "frequency_hz": float(f), "log_decrement": float(d),
+                 "whirl": w}
+                for p in self.points
+                for f, d, w in zip(p.frequency_hz, p.log_decrement, p.whirl)
+                if d < self.log_dec_limit]
+
+    def rows(self) -> list[dict]:
+        """One row per (speed, mode) for a CSV table."""
+        out = []
+        for i, p in enumerate(self.points):
+            line_of = {int(k): j for j, k in enumerate(self.tracks[i]) if k >= 0}
+            for k in range(len(p.frequency_hz)):
+                out.append({"speed_hz": p.speed_hz, "line": line_of.get(k, -1),
+                            "frequency_hz": float(p.frequency_hz[k]),
+                            "damping_ratio": float(p.damping_ratio[k]),
+                            "log_decrement": float(p.log_decrement[k]), "whirl": p.whirl[k],
+                            "flagged": bool(p.log_decrement[k] < self.log_dec_limit)})
+        return out
+
+    def to_dict(self) -> dict:
+        return {"speeds_hz": json_list(self.speeds_hz), "log_dec_limit": self.log_dec_limit,
+                "stable": [p.stable for p in self.points],
+                "max_real_pole": [json_float(p.max_real_pole) for p in self.points],
+                "crossings": [c.to_dict() for c in self.crossings],
+                "flagged": self.flagged(), "points": [p.to_dict() for p in self.points]}
+
+
+def _tracks(points: list[ClosedLoopModes]) -> np.ndarray:
+    """Follow modes from speed to speed by the assignment of least total |Δλ|."""
+    lines: list[list[int]] = [[k] for k in range(len(points[0].poles))]
+    for i in range(1, len(points)):
+        prev = [(j, ln[-1]) for j, ln in enumerate(lines) if ln[-1] >= 0]
+        for ln in lines:
+            ln.append(-1)
+        new = points[i].poles
+        if prev and new.size:
+            old = np.array([points[i - 1].poles[k] for _, k in prev])
+            rows, cols = linear_sum_assignment(np.abs(old[:, None] - new[None, :]))
+            for r, c in zip(rows, cols):
+                lines[prev[r][0]][-1] = int(c)
+        taken = {ln[-1] for ln in lines}
+        for c in range(new.size):
+            if c not in taken:
+                lines.append([-1] * i + [c])
+    return np.array(lines, dtype=int).T.reshape(len(points), len(lines))
+
+
+def _crossings(c: Campbell) -> tuple[Crossing, ...]:
+    out = []
+    s = c.speeds_hz
+    for j in range(c.tracks.shape[1]):
+        f, d = c.line(j), c.line(j, "log_decrement")
+        g = f - s
+        for i in range(len(s) - 1):
+            if np.isfinite(g[i]) and np.isfinite(g[i + 1]) and g[i] * g[i + 1] <= 0 \
+                    and g[i] != g[i + 1]:
+                t = g[i] / (g[i] - g[i + 1])
+                k = c.tracks[i + (t > 0.5), j]
+                out.append(Crossing(j, float(s[i] + t * (s[i + 1] - s[i])),
+                                    float(d[i] + t * (d[i + 1] - d[i])),
+                                    c.points[i + (t > 0.5)].whirl[k]))
+    return tuple(sorted(out, key=lambda x: x.speed_hz))
+
+
+def campbell(cfg, controller=None, speeds_hz=None, *, pressure_bar: float | None = None,
+             max_hz: float | None = None, log_dec_limit: float = API684_LOG_DEC,
+             workers: int | None = None, scheduler: str | None = None,
+             progress: bool = False) -> Campbell:
+    """The closed-loop Campbell diagram: :func:`closed_loop_modes` at every speed.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+    controller : control.StateSpace or ScheduledController, optional
+    speeds_hz : array_like, optional
+        Speeds (Hz); default 31 points from 0 to 1.2× the upper end of ``[operating]
+        speed_range_hz``, else of the operating speed, else of the first free–free bending
+        frequency (:func:`ambseal.model.modes.free_bending_hz`: the rigid-body modes' and
+        the first bending mode's 1× crossings on the plot).
+    pressure_bar, max_hz : float, optional
+        As in :func:`closed_loop_modes` (``max_hz`` is fixed once, at standstill).
+    log_dec_limit : float
+        Modes below it are flagged (API 684: 0.1).
+    workers, scheduler, progress
+        Run the speeds through :func:`ambseal.analysis.sweep.run_cases` (serial by default).
+
+    Returns
+    -------
+    Campbell
+    """
+    from ..model.modes import bending_limit_hz, free_bending_hz
+    from .sweep import run_cases
+
+    f_max = bending_limit_hz(cfg) if max_hz is None else float(max_hz)
+    if speeds_hz is None:
+        r = cfg.operating.speed_range_hz
+        top = (r[1] if r is not None else cfg.operating.speed_rpm / 60.0
+               if cfg.operating.speed_rpm > 0 else free_bending_hz(cfg, 1)[0])
+        speeds_hz = np.linspace(0.0, 1.2 * top, 31)
+    s = np.asarray(speeds_hz, float)
+    cases = [dict(speed_hz=float(v)) for v in s]
+    results = run_cases(_modes_case, cases, shared=dict(cfg=cfg, controller=controller,
+                                                        pressure_bar=pressure_bar,
+                                                        max_hz=f_max),
+                        workers=workers, scheduler=scheduler, progress=progress,
+                        description="campbell", raise_errors=True)
+    pts = list(results)
+    c = Campbell(s, tuple(pts), _tracks(pts), (), log_dec_limit)
+    return Campbell(s, c.points, c.tracks, _crossings(c), log_dec_limit)
+
+
+def _modes_case(case: dict, cfg, controller, pressure_bar, max_hz) -> ClosedLoopModes:
+    return closed_loop_modes(cfg, controller, speed_hz=case["speed_hz"],
+                             pressure_bar=pressure_bar, max_hz=max_hz)

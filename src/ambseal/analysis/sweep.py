@@ -1,0 +1,313 @@
+"""Stability and performance maps over pressure × speed × parameters, serial or on Dask.
+
+Two layers:
+
+* :func:`run_cases` — the one executor of every multi-case analysis (this module's sweeps,
+  the Campbell diagram's speeds, ``ambseal run``'s judged operating points): a pure function
+  ``fn(case, **shared)`` over a list of cases, run serially or on ``dask.distributed``
+  (a local cluster of processes with one BLAS thread each, or a running scheduler by
+  address). ``shared`` is sent to each worker once (``Client.scatter``, broadcast) and the
+  function is pickled by reference, so a worker imports ambseal once, not per case. Results
+  come back in input order; a case that raises is recorded as a :class:`CaseError` with its
+  message and the others go on. A progress bar (rich, on stderr) counts cases as they finish.
+* :func:`sweep` — the map: per (controller, pressure, speed, parameter values) case the
+  judgement of :func:`ambseal.analysis.judge.judge` without the impulse response (closed-loop
+  max real pole, σ̄(S_o) peak, ISO 14839-3 zone overall and per axis, unbalance peak) and the
+  lowest log decrement of :mod:`ambseal.analysis.campbell`, as plain rows for a table; and
+  :func:`stability_boundary`, the lowest unstable pressure per (controller, speed).
+
+Inputs of a sweep case are plain and picklable: the rig as a dict (``RigConfig.model_dump``),
+each controller as its ``(A, B, C, D)`` arrays.
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+from dataclasses import dataclass
+from typing import Callable, Sequence
+
+import numpy as np
+
+from ..errors import AmbsealError, ConfigError
+
+__all__ = ["CaseError", "run_cases", "dask_available", "SERIAL_BELOW", "sweep",
+           "sweep_case", "stability_boundary", "parse_range"]
+
+#: Sweeps with fewer cases than this run serially when no workers or scheduler are given:
+#: a local cluster costs a few seconds to start, about 20 cases of the embedded rig.
+SERIAL_BELOW = 64
+
+
+@dataclass(frozen=True)
+class CaseError:
+    """A case that failed: the case and the error's one-line message."""
+
+    case: dict
+    error: str
+
+
+def dask_available() -> bool:
+    """Whether ``dask.distributed`` can be imported (the ``[dask]`` extra)."""
+    try:
+        import distributed  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _call(case: dict, fn: Callable, shared: dict):
+    try:
+        return fn(case, **shared)
+    except Exception as exc:  # a failed case is recorded, not lost
+        return CaseError(dict(case), f"{type(exc).__name__}: {exc}")
+
+
+def run_cases(fn: Callable, cases: Sequence[dict], *, shared: dict | None = None,
+              workers: int | None = None, scheduler: str | None = None,
+              progress: bool = False, description: str = "cases",
+              raise_errors: bool = False, on_done: Callable | None = None) -> list:
+    """Run ``fn(case, **shared)`` for every case, serially or on Dask, in input order.
+
+    Parameters
+    ----------
+    fn : callable
+        A module-level (picklable) pure function.
+    cases : sequence of dict
+    shared : dict, optional
+        Keyword arguments common to every case (sent once per worker).
+    workers : int, optional
+        Local Dask worker processes (one thread, one BLAS thread each); ``1`` runs serially.
+        Default: serial below :data:`SERIAL_BELOW` cases or without dask, else one worker
+        per core.
+    scheduler : str, optional
+        Address of a running Dask scheduler (``tcp://host:8786``); wins over ``workers``.
+    progress : bool
+        A progress bar over the cases on stderr.
+    description : str
+        The bar's label.
+    raise_errors : bool
+        Re-raise the first failed case's error (as :class:`AmbsealError`) instead of
+        recording it.
+    on_done : callable, optional
+        Called with ``(index, result)`` as each case finishes (serial: in order).
+
+    Returns
+    -------
+    list
+        One result per case, in input order; a :class:`CaseError` for a case that raised.
+
+    Raises
+    ------
+    ConfigError
+        ``scheduler`` or ``workers > 1`` without dask installed, or a scheduler that cannot
+        be reached.
+    """
+    from rich.console import Console
+    from rich.progress import Progress
+
+    shared = dict(shared or {})
+    cases = list(cases)
+    distributed = scheduler is not None or (workers is not None and workers > 1) or (
+        workers is None and len(cases) >= SERIAL_BELOW and dask_available()
+        and (os.cpu_count() or 1) > 1)
+    if distributed and not dask_available():
+        raise ConfigError("dask.distributed is not installed (pip install 'ambseal[dask]'); "
+                          "leave out --scheduler/--workers to run serially")
+    with Progress(console=Console(stderr=True), disable=not progress, transient=True) as bar:
+        task = bar.add_task(description, total=len(cases))
+
+        def done(i: int, r) -> None:
+            if raise_errors and isinstance(r, CaseError):
+                raise AmbsealError(f"{description}: case {r.case}: {r.error}")
+            bar.advance(task)
+            if on_done is not None:
+                on_done(i, r)
+
+        if not distributed:
+            out = []
+            for i, case in enumerate(cases):
+                out.append(_call(case, fn, shared))
+                done(i, out[-1])
+            return out
+        return _run_dask(fn, cases, shared, workers, scheduler, done)
+
+
+def _run_dask(fn, cases, shared, workers, scheduler, done) -> list:
+    """The Dask path of :func:`run_cases`: futures, as completed, gathered in input order."""
+    from distributed import Client, LocalCluster, as_completed
+
+    cluster = None
+    try:
+        if scheduler is not None:
+            client = Client(scheduler, timeout="10s")
+        else:
+            n = workers or (os.cpu_count() or 1)
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                   dashboard_address=None,
+                                   env={v: "1" for v in ("OPENBLAS_NUM_THREADS",
+                                                         "OMP_NUM_THREADS", "MKL_NUM_THREADS")})
+            client = Client(cluster)
+    except OSError as exc:
+        raise ConfigError(f"dask scheduler {scheduler!r}: cannot connect ({exc})") from None
+    try:
+        shared_f = client.scatter(shared, broadcast=True)
+        futures = client.map(_call, cases, fn=fn, shared=shared_f, pure=False)
+        index = {f.key: i for i, f in enumerate(futures)}
+        for f in as_completed(futures):
+            done(index[f.key], f.result())
+        return client.gather(futures)
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def parse_range(text: str, name: str) -> np.ndarray:
+    """``a:b:n`` → n points from a to b; a single number → one point.
+
+    Raises
+    ------
+    ConfigError
+        Anything else (names ``name`` and what was expected).
+    """
+    parts = text.split(":")
+    try:
+        if len(parts) == 1:
+            return np.array([float(parts[0])])
+        if len(parts) == 3 and int(parts[2]) >= 1 and float(parts[2]) == int(parts[2]):
+            return np.linspace(float(parts[0]), float(parts[1]), int(parts[2]))
+    except ValueError:
+        pass
+    raise ConfigError(f"{name}: expected a number or start:stop:count (e.g. 0:4.08:9), "
+                      f"got {text!r}")
+
+
+def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
+               settings=None) -> dict:
+    """One map point: the judgement without impulse and the lowest log decrement.
+
+    Parameters
+    ----------
+    case : dict
+        ``controller`` (a key of ``controllers``), ``pressure_bar``, ``speed_hz`` and
+        ``params`` (``{name: value}`` of :func:`ambseal.config.rig_with_values`).
+    rig : dict
+        The rig (``RigConfig.model_dump()``).
+    controllers : dict
+        ``{name: (A, B, C, D)}``, displacement (m) → current (A), ``i = −K y``.
+    max_hz : float
+        Highest frequency (Hz) of the modes the lowest log decrement is taken over.
+    settings : JudgeSettings, optional
+
+    Returns
+    -------
+    dict
+        The case, ``stable``, ``max_real_pole`` (1/s), ``lowest_log_dec`` and its
+        ``lowest_log_dec_hz``, ``sensitivity_peak`` (σ̄(S_o), -), ``iso_zone`` and
+        ``iso_zone_<axis>``, ``unbalance_peak_um``.
+    """
+    import control
+
+    from ..config import parse_rig, rig_with_values
+    from .campbell import lowest_log_decrement
+    from .judge import JudgeSettings, OperatingPoint, judge
+
+    cfg = parse_rig(rig, "<sweep rig>")
+    if case.get("params"):
+        cfg = rig_with_values(cfg, case["params"])
+    K = control.ss(*controllers[case["controller"]])
+    point = OperatingPoint(case["pressure_bar"], 60.0 * case["speed_hz"], "")
+    res, curves = judge(cfg, K, case["controller"], point, settings or JudgeSettings(),
+                        impulse=False)
+    dec, dec_hz = lowest_log_decrement(curves["poles"], max_hz)
+    row = {"controller": case["controller"], "pressure_bar": case["pressure_bar"],
+           "speed_hz": case["speed_hz"], **(case.get("params") or {}),
+           "stable": res["stable"], "max_real_pole": res["max_real_pole"],
+           "lowest_log_dec": dec, "lowest_log_dec_hz": dec_hz,
+           "sensitivity_peak": res["sensitivity_peak"], "iso_zone": res["iso_zone"]}
+    row.update({f"iso_zone_{ax}": z for ax, z in res["iso_zone_per_axis"].items()})
+    row["unbalance_peak_um"] = res["unbalance_peak_um"]
+    return row
+
+
+def sweep(cfg, controllers: dict, pressures_bar, speeds_hz, params: dict | None = None, *,
+          max_hz: float | None = None, workers: int | None = None,
+          scheduler: str | None = None, progress: bool = False) -> list[dict]:
+    """The map over every (controller, pressure, speed, parameter values) combination.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+    controllers : dict
+        ``{name: control.StateSpace}`` (fixed controllers).
+    pressures_bar, speeds_hz : array_like
+    params : dict, optional
+        ``{name: values}`` of rig parameters (:func:`ambseal.config.rig_with_values` names).
+    max_hz : float, optional
+        Modes of the lowest log decrement; default
+        :func:`ambseal.model.modes.bending_limit_hz`.
+    workers, scheduler, progress
+        As in :func:`run_cases`.
+
+    Returns
+    -------
+    list of dict
+        One row per case in input order (controller outermost, then pressure, speed,
+        parameters); a failed case has its inputs and ``error``.
+    """
+    from ..model.modes import bending_limit_hz
+
+    params = params or {}
+    names = list(params)
+    cases = [{"controller": c, "pressure_bar": float(p), "speed_hz": float(s),
+              "params": dict(zip(names, (float(x) for x in vals)))}
+             for c in controllers for p in pressures_bar for s in speeds_hz
+             for vals in itertools.product(*(params[n] for n in names))]
+    shared = {"rig": cfg.model_dump(exclude_none=True),
+              "controllers": {n: tuple(np.asarray(M, float) for M in (K.A, K.B, K.C, K.D))
+                              for n, K in controllers.items()},
+              "max_hz": bending_limit_hz(cfg) if max_hz is None else float(max_hz)}
+    out = run_cases(sweep_case, cases, shared=shared, workers=workers, scheduler=scheduler,
+                    progress=progress, description="sweep")
+    return [{**{k: v for k, v in r.case.items() if k != "params"}, **r.case["params"],
+             "error": r.error} if isinstance(r, CaseError) else r for r in out]
+
+
+def stability_boundary(rows: list[dict]) -> list[dict]:
+    """Per (controller, speed, parameter values): the pressure drop (bar) where the loop
+    loses stability, linearly interpolated in the max real pole between the last stable
+    and the first unstable pressure; ``None`` if stable over the whole range, the lowest
+    pressure if unstable throughout."""
+    groups: dict[tuple, list[dict]] = {}
+    for r in rows:
+        if r.get("error") is None:
+            key = tuple((k, v) for k, v in r.items()
+                        if not _is_result(k) and k != "pressure_bar")
+            groups.setdefault(key, []).append(r)
+    out = []
+    for key, rs in groups.items():
+        rs = sorted(rs, key=lambda r: r["pressure_bar"])
+        p = np.array([r["pressure_bar"] for r in rs])
+        m = np.array([r["max_real_pole"] for r in rs])
+        bad = np.flatnonzero(m >= 0)
+        if bad.size == 0:
+            edge = None
+        elif bad[0] == 0:
+            edge = float(p[0])
+        else:
+            i = bad[0]
+            edge = float(p[i - 1] + (p[i] - p[i - 1]) * (-m[i - 1]) / (m[i] - m[i - 1]))
+        out.append({**dict(key), "boundary_pressure_bar": edge,
+                    "last_stable_bar": float(p[bad[0] - 1]) if bad.size and bad[0] > 0
+                    else (float(p[-1]) if bad.size == 0 else None),
+                    "first_unstable_bar": float(p[bad[0]]) if bad.size else None})
+    return out
+
+
+_RESULTS = {"stable", "max_real_pole", "lowest_log_dec", "lowest_log_dec_hz",
+            "sensitivity_peak", "iso_zone", "unbalance_peak_um", "error"}
+
+
+def _is_result(key: str) -> bool:
+    return key in _RESULTS or key.startswith("iso_zone_")

@@ -134,8 +134,9 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
     from rich.console import Console
     from rich.progress import Progress
 
-    from .analysis.judge import (JudgeSettings, judge, judge_spinup, operating_points,
+    from .analysis.judge import (JudgeSettings, judge_case, judge_spinup, operating_points,
                                  speed_scheduled, unstable_open_loop_poles)
+    from .analysis.sweep import run_cases
     from .commands import export_design
     from .control.controller import frozen
     from .model.rig import build_plant
@@ -170,15 +171,16 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
             export_design(d.method, d.controller, d.result.to_dict(), out / "controllers",
                           cfg.controller.sample_rate_hz, [p.speed_rpm / 60.0 for p in points])
         bar.advance(task)
-        cases, curves = [], []
-        for d in designs:
-            for p in points:
-                say(f"judging {d.method} at {p.label}", 0)
-                K = frozen(d.controller, 2 * math.pi * p.speed_rpm / 60.0)
-                case, c = judge(cfg, K, d.method, p, settings)
-                cases.append(case)
-                curves.append((f"{d.method}, {p.label}", c))
-                bar.advance(task, 3)
+        jobs = [{"name": d.method, "point": p,
+                 "controller": frozen(d.controller, 2 * math.pi * p.speed_rpm / 60.0)}
+                for d in designs for p in points]
+        say(f"judging {len(jobs)} cases", 0)
+        judged = run_cases(judge_case, jobs, shared={"cfg": cfg, "settings": settings},
+                           workers=1, raise_errors=True,
+                           on_done=lambda i, r: say(f"judged {jobs[i]['name']} at "
+                                                    f"{jobs[i]['point'].label}", 3))
+        cases = [case for case, _ in judged]
+        curves = [(f"{j['name']}, {j['point'].label}", c) for j, (_, c) in zip(jobs, judged)]
         metrics = {
             "rig": str(rig_path),
             "rig_name": cfg.rotor.name,

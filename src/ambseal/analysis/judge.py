@@ -19,9 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["JudgeSettings", "OperatingPoint", "judge", "judge_spinup", "operating_points",
-           "speed_scheduled",
-           "unstable_open_loop_poles", "force_position"]
+__all__ = ["JudgeSettings", "OperatingPoint", "judge", "judge_case", "judge_spinup",
+           "operating_points", "speed_scheduled", "unstable_open_loop_poles", "force_position"]
 
 
 @dataclass(frozen=True)
@@ -181,6 +180,12 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
         impulse_settling_s=_finite(imp.settling_time_s),
     )
     return case, curves
+
+
+def judge_case(case: dict, cfg, settings: JudgeSettings = JudgeSettings()) -> tuple[dict, dict]:
+    """:func:`judge` of ``case = {"controller", "name", "point"}``: the main job's cases as
+    run by :func:`ambseal.analysis.sweep.run_cases`."""
+    return judge(cfg, case["controller"], case["name"], case["point"], settings)
 
 
 def judge_spinup(cfg, controllers: dict) -> tuple[dict, list, list]:

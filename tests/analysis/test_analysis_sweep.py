@@ -98,3 +98,38 @@ def test_ranges_and_bad_input():
             parse_range(bad, "--p")
     with pytest.raises(AmbsealError):
         run_cases(lambda case: 1 / 0, [{}], raise_errors=True, workers=1)
+
+
+def test_cli_sweep_writes_table_boundary_and_map_and_keeps_failed_cases(tmp_path, capsys):
+    """``ambseal sweep`` on the rigid rotor with a controller file: the table has every
+    case in order, the boundary brackets the Jeffcott threshold k = c·ω_n (3.2 bar, see
+    above), the map is written; a ``--param`` the rig does not have fails every case, each
+    kept in the table with its error, and the command still ends normally."""
+    import csv
+
+    import control
+
+    from ambseal.cli import main
+    from ambseal.config import dump_rig, parse_rig
+    from ambseal.control.export import export_controller
+
+    rig = tmp_path / "rig.toml"
+    rig.write_text(dump_rig(parse_rig(_tiny_rig())))
+    kfile = export_controller(control.ss([], [], [], 1.1e4 * np.eye(4), inputs=4, outputs=4),
+                              tmp_path / "P.json")
+    out = tmp_path / "sw"
+    args = ["sweep", str(rig), "--pressure-bar", "0:4:3", "--controller", str(kfile),
+            "--out", str(out), "--workers", "1"]
+    assert main(args) == 0
+    summary = json.loads(capsys.readouterr().out)
+    rows = list(csv.DictReader((out / "sweep.csv").open()))
+    assert [float(r["pressure_bar"]) for r in rows] == [0.0, 2.0, 4.0]
+    assert [r["stable"] for r in rows] == ["True", "True", "False"]
+    (edge,) = summary["boundary"]
+    assert edge["last_stable_bar"] == 2.0 and edge["first_unstable_bar"] == 4.0
+    assert (out / "stability_map.png").stat().st_size > 10_000
+    assert main(args + ["--param", "nope.k=0:1:2"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["cases"] == 6 and summary["failed"] == 6
+    rows = list(csv.DictReader((out / "sweep.csv").open()))
+    assert all("unknown parameter 'nope.k'" in r["error"] for r in rows)

@@ -167,8 +167,9 @@ def stability_map_figure(path: str | os.PathLike, rows: list[dict], boundary: li
         if len(p) > 1 and len(s) > 1:
             im = ax.pcolormesh(p, s, grid, shading="nearest", cmap="RdBu_r", norm=norm)
         else:
-            im = ax.scatter(np.repeat(p[None], len(s), 0), np.repeat(s[:, None], len(p), 1),
-                            c=grid, cmap="RdBu_r", norm=norm, s=60)
+            pp, ss = np.meshgrid(p, s)
+            im = ax.scatter(pp.ravel(), ss.ravel(), c=grid.ravel(), cmap="RdBu_r", norm=norm,
+                            s=80, marker="s")
         fig.colorbar(im, ax=ax, label="max real pole (1/s)")
         b = sorted((x for x in boundary if x["controller"] == name), key=lambda x: x["speed_hz"])
         bx = [x["boundary_pressure_bar"] for x in b]

@@ -161,7 +161,8 @@ def closed_loop_state_matrix(cfg, controller=None, *, speed_hz: float,
     mesh = build_mesh(cfg)
     if controller is None or not cfg.amb:
         return plant.A, mesh
-    G = plant.select_inputs(plant.input_names[:2 * len(cfg.amb)]).to_statespace()
+    G = plant.select_inputs([plant.input_names[j] for j in plant.current_inputs()]
+                            ).to_statespace()
     K = frozen(controller, 2 * math.pi * speed_hz)
     return np.asarray(closed_loop(G, K).system.A), mesh
 

@@ -66,6 +66,11 @@ def campbell_figure(path: str | os.PathLike, c, *, title: str = "Closed-loop Cam
     above = f_all[f_all > s.max()]
     top = max(float(s.max()), float(above.min()) if above.size else float(f_all.max(initial=1.0)))
     ax.set_ylim(0, 1.15 * top)
+    cut = sorted({round(float(f)) for f in f_all if f > 1.15 * top})
+    if cut:
+        ax.text(0.99, 0.98, f"modes up to {max(p.max_hz for p in c.points):.0f} Hz in the "
+                f"δ panel; above {1.15 * top:.0f} Hz not drawn here", transform=ax.transAxes,
+                ha="right", va="top", fontsize=7, color="0.3")
     ax.set_ylabel("damped natural frequency (Hz)")
     ax.set_title(title)
     ax.grid(True, alpha=0.3)

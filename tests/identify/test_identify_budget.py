@@ -85,3 +85,34 @@ def test_residual_tests_size_and_power():
         leak = 0.2 * e.std() / lfilter([0.0, 0.3, 0.2], [1.0, -0.9], u[:, 0]).std()
         e_bad = e + leak * lfilter([0.0, 0.3, 0.2], [1.0, -0.9], u[:, 0])[:, None]
         assert residual_tests([e_bad], [u], ("A",)).mismatch
+
+
+def test_identified_intervals_become_mu_ranges(testrig_cfg, tmp_path):
+    """Reference: the interface contract of issue 17 — a fit.json's 95 % intervals arrive
+    unchanged as the Δ ranges of the generalized plant; tau_e is left out; a fit flagged
+    as model mismatch and a missing interval are refused, naming file and key."""
+    import json
+
+    from ambseal.control.plant import generalized_plant
+    from ambseal.errors import DataError
+    from ambseal.identify.intervals import uncertainty_from_fit
+
+    fit = {"parameters": {"seal.k": {"estimate": 2.2e6, "ci95": [1.9e6, 2.5e6]},
+                          "tau_e": {"estimate": 2e-4, "ci95": [1.9e-4, 2.1e-4]}},
+           "residual_tests": {"mismatch": False}}
+    path = tmp_path / "fit.json"
+    path.write_text(json.dumps(fit))
+    ranges = uncertainty_from_fit(path)
+    assert ranges == {"seal.k": (1.9e6, 2.5e6)}
+    gp = generalized_plant(testrig_cfg, 1.0, 1.0, uncertainty=ranges, states=8)
+    (q,) = gp.parameters
+    assert (q.name, q.low, q.high) == ("seal.k", 1.9e6, 2.5e6)
+    fit["residual_tests"]["mismatch"] = True
+    path.write_text(json.dumps(fit))
+    with pytest.raises(DataError, match="model mismatch"):
+        uncertainty_from_fit(path)
+    fit["residual_tests"]["mismatch"] = False
+    fit["parameters"]["seal.k"]["ci95"] = [None, 2.5e6]
+    path.write_text(json.dumps(fit))
+    with pytest.raises(DataError, match=r"fit.json: parameters.seal.k.ci95"):
+        uncertainty_from_fit(path)

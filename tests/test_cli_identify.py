@@ -114,3 +114,19 @@ def test_design_hinf_exports_controller(tmp_path, capsys):
     assert {"A", "A_tustin", "A_zoh"} <= set(data.files)
     assert (tmp_path / "controller_hinf.mat").exists()
     assert (tmp_path / "design_hinf.json").exists()
+
+
+def test_identify_bad_pressure_names_the_file(record, tmp_path, capsys):
+    """Reference: issue 17 — metadata the fit reads (pressure_drop_pa) is checked naming
+    the record file, not a placeholder; one line, exit status 2."""
+    bad = _corrupt(record, tmp_path, lambda L: L)
+    side = bad.with_name(bad.name + ".json")
+    meta = json.loads(side.read_text())
+    meta["pressure_drop_pa"] = "high"
+    side.write_text(json.dumps(meta))
+    capsys.readouterr()
+    code = main(["identify", RIG, str(bad), "--params", "A.Ki_zeta", "--out",
+                 str(tmp_path / "o")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert str(bad) in err[0] and "pressure_drop_pa" in err[0], err[0]

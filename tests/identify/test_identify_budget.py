@@ -116,3 +116,28 @@ def test_identified_intervals_become_mu_ranges(testrig_cfg, tmp_path):
     path.write_text(json.dumps(fit))
     with pytest.raises(DataError, match=r"fit.json: parameters.seal.k.ci95"):
         uncertainty_from_fit(path)
+
+
+def test_facility_model_form_options(testrig_cfg):
+    """Reference: the [truth] documentation — the facility's rotor takes the truth's beam
+    theory, twice the shaft elements and its modal damping; the rig file stays as it is.
+    Euler–Bernoulli (no shear flexibility) gives a higher first free bending mode than
+    Timoshenko (Nelson 1980: shear and rotary inertia lower the frequencies)."""
+    from ambseal.config import TruthSection
+    from ambseal.identify.rig_sim import true_rig
+    from ambseal.model.modes import modes
+    from ambseal.model.rig import build_system
+
+    truth = TruthSection(beam="euler-bernoulli", mesh_factor=2.0, modal_damping=0.01)
+    rig = true_rig(testrig_cfg, truth)
+    assert [s.elements for s in rig.shaft] == [2 * s.elements for s in testrig_cfg.shaft]
+    assert (rig.rotor.beam, rig.rotor.modal_damping) == ("euler-bernoulli", 0.01)
+    assert testrig_cfg.rotor.beam == "timoshenko"
+
+    def first_bending(cfg):
+        f = modes(build_system(cfg, include_amb=False, include_seals=False,
+                               include_springs=False)).natural_frequencies_hz
+        return min(x for x in f if x > 50.0)
+
+    assert first_bending(true_rig(testrig_cfg, TruthSection(beam="euler-bernoulli"))) > \
+        first_bending(testrig_cfg)

@@ -72,6 +72,7 @@ def test_coverage_over_20_seeds_matched_and_mismatched(testrig_cfg):
     for case, (inside, inside_noise, width, flagged, dominant) in runs.items():
         out[case] = {"coverage": inside.mean(), "per_parameter": inside.mean(axis=0).round(2).tolist(),
                      "coverage_noise_only": inside_noise.mean(),
+                     "noise_only_per_parameter": inside_noise.mean(axis=0).round(2).tolist(),
                      "width_vs_matched": (np.median(width, axis=0) / w0).round(2).tolist(),
                      "flagged": flagged.mean(),
                      "coupling_named": np.mean([{"coupling.kxx", "coupling.kyy"} <= set(d)

@@ -6,7 +6,6 @@ import pytest
 from ambseal.config import Affine, TruthSection, load_rig
 from ambseal.errors import IdentificationError
 from ambseal.identify.fit import fit_parameters, nrmse_fit
-from ambseal.lti.discrete import simulate_lti
 from ambseal.identify.signals import prbs
 from ambseal.control.pid import reference_controller
 from ambseal.identify.stages import acquire, build_models, identify
@@ -35,20 +34,6 @@ def prbs_fit(rig, truth):
               seed=3)
     rec = acquire(rig, truth, ex, controller=reference_controller(rig), pressure_bar=0.0, seed=3)
     return rec, identify(rig, [rec], AMB + ["tau_e"])
-
-
-def test_simulate_lti_against_plain_recursion():
-    """The block recursion equals z_{k+1} = A z_k + B u_k step by step (to rounding)."""
-    rng = np.random.default_rng(0)
-    A = rng.standard_normal((7, 7))
-    A *= 0.97 / np.max(np.abs(np.linalg.eigvals(A)))
-    B, C = rng.standard_normal((7, 3)), rng.standard_normal((2, 7))
-    u = rng.standard_normal((1001, 3))
-    z, ref = np.zeros(7), []
-    for k in range(1001):
-        ref.append(C @ z)
-        z = A @ z + B @ u[k]
-    np.testing.assert_allclose(simulate_lti(A, B, [C], u, block=32)[0], ref, atol=1e-12)
 
 
 def test_nrmse_fit_closed_form():

@@ -54,4 +54,10 @@ def test_simulate_lti_equals_the_plain_recursion():
     y1, y2 = simulate_lti(A, B, [C1, C2], u, block=7)
     _, y_ref, _ = dlsim((A, B, np.vstack([C1, C2]), np.zeros((3, m)), 1.0), u)
     assert np.max(np.abs(np.hstack([y1, y2]) - y_ref)) < 1e-12 * np.max(np.abs(y_ref))
+    # from sample `start` on (inside a block, on a block edge, the last sample, none)
+    for start in (3, 7, 500, N - 1, N):
+        t1, t2 = simulate_lti(A, B, [C1, C2], u, block=7, start=start)
+        assert t1.shape == (N - start, 2) and t2.shape == (N - start, 1)
+        assert np.max(np.abs(np.hstack([t1, t2]) - y_ref[start:]), initial=0.0) \
+            < 1e-12 * np.max(np.abs(y_ref))
     assert sla.norm(y1) > 0

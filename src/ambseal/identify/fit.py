@@ -98,16 +98,18 @@ class ClosedLoopModel:
                           self.controller.dt, inputs=[f"excitation_{a}" for a in axes],
                           outputs=[f"displacement_{a}" for a in axes])
 
-    def simulate(self, values: dict[str, float], e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Displacements (N, k) and coil currents (N, k) for excitation ``e`` (N, k)."""
+    def simulate(self, values: dict[str, float], e: np.ndarray,
+                 start: int = 0) -> tuple[np.ndarray, np.ndarray]:
+        """Displacements and coil currents (N − start, k) for excitation ``e`` (N, k),
+        simulated from rest at sample 0 and returned from sample ``start`` on."""
         A, B, C, Ci, Di = self.matrices(values)
         Ad, Bd = zoh(A, B, self.controller.dt)
         Acl, Bcl, Cy, Cref, _ = closed_loop_matrices(Ad, Bd, C, self.controller)
         nc = self.controller.A.shape[0]
         Ci_cl = np.hstack([Ci, np.zeros((Ci.shape[0], nc))])
         # coil current = C_i x + D_i i_ref, i_ref = C_ref z + e
-        y, x_i, iref = simulate_lti(Acl, Bcl, [Cy, Ci_cl, Cref], e)
-        return y, x_i + (iref + e) @ Di.T
+        y, x_i, iref = simulate_lti(Acl, Bcl, [Cy, Ci_cl, Cref], e, start=start)
+        return y, x_i + (iref + e[start:]) @ Di.T
 
 
 @dataclass(frozen=True)
@@ -312,10 +314,10 @@ def fit_parameters(
             v = values(x)
             if moved is not None:
                 v[moved[0]] = _nominal(model, moved[0]) * (1.0 + moved[1])
-            ys, is_ = model.simulate(v, e)
-            R = (ys[start:] - y) / sy
+            ys, is_ = model.simulate(v, e, start)
+            R = (ys - y) / sy
             if current_weight > 0:
-                R = np.hstack([R, current_weight * (is_[start:] - i) / si])
+                R = np.hstack([R, current_weight * (is_ - i) / si])
             out.append(R)
         return out
 

@@ -41,6 +41,7 @@ from ..model.rig import build_system, mechanical_plant
 from ..model.seal import coefficient_value
 from ..lti.discrete import zoh
 from ..lti.interconnect import series_inputs
+from .facility_loop import facility_loop
 from .loop import DiscreteController
 
 __all__ = ["FacilityRecord", "simulate_facility", "true_rig"]
@@ -187,60 +188,26 @@ def simulate_facility(
     C_all = np.vstack([C_y, C_b, C_ieff, C_coil])
     rng = np.random.default_rng(seed)
     lowpass = _sensor_filter(truth, T, k)
-
-    # the force law per axis on Python floats: for k ≈ 4 axes the per-call overhead of numpy
-    # is most of the cost of a sub-step (same IEEE operations, same results)
-    axes_k = range(k)
-    s0_l, kf_l, ki_l, ks_l = s0.tolist(), kf.tolist(), ki.tolist(), ks.tolist()
-    gap_l = [0.9 * v for v in s0_l]
-
-    def remainder(xb, ieff, n):
-        frem = [0.0] * k
-        for a in axes_k:
-            x, i = xb[a], ieff[a]
-            if abs(x) >= gap_l[a]:
-                raise ModelError(
-                    f"the rotor left the air gap at t = {n * T:.4f} s (loop unstable or "
-                    "excitation too strong)"
-                )
-            ip, im = max(i0 + i, 0.0), max(i0 - i, 0.0)
-            dp, dm = s0_l[a] - x, s0_l[a] + x
-            f = kf_l[a] * (ip * ip / (dp * dp) - im * im / (dm * dm))
-            frem[a] = f - (ki_l[a] * i + ks_l[a] * x)
-        return frem
+    lp_a = 0.0 if lowpass is None else lowpass[0]  # a = 0: y_f = y exactly
+    lsb = truth.adc_range_m / 2**truth.adc_bits if truth.adc_bits else 0.0
+    mats = [np.ascontiguousarray(M, dtype=float) for M in
+            (Phi, Gam, C_all, D_coil, D_ieff, controller.A, controller.B, controller.C,
+             controller.D)]
 
     def run(noise_std):
         N = e.shape[0]
-        rec_y = np.empty((N, k))
-        rec_i = np.empty((N, k))
-        rec_ref = np.empty((N, k))
-        xc = np.zeros(controller.A.shape[0])
-        z = np.zeros(A.shape[0])
+        rec = [np.empty((N, k)) for _ in range(3)]
         noise = rng.standard_normal((N, k)) * noise_std
         inoise = rng.standard_normal((N, k)) * truth.current_noise_a
-        lsb = truth.adc_range_m / 2**truth.adc_bits if truth.adc_bits else 0.0
-        u_in = np.empty(2 * k)
-        yf = np.zeros(k)
-        for n in range(N):
-            out = C_all @ z
-            if lowpass is not None:  # the sensor's own lag, sampled with the position
-                yf = lowpass[0] * yf + lowpass[1] * out[:k]
-            y = (out[:k] if lowpass is None else yf) + noise[n]
-            if lsb:
-                y = np.round(y / lsb) * lsb
-            u = controller.C @ xc + controller.D @ y
-            iref = np.clip(-u + e[n], -limit, limit)
-            xc = controller.A @ xc + controller.B @ y
-            rec_y[n], rec_ref[n] = y, iref
-            rec_i[n] = out[3 * k:] + D_coil @ iref + inoise[n]
-            i_ff = D_ieff @ iref
-            u_in[:k] = iref
-            for _ in range(truth.substeps):
-                xb, ieff = out[k:2 * k].tolist(), (out[2 * k:3 * k] + i_ff).tolist()
-                u_in[k:] = remainder(xb, ieff, n)
-                z = Phi @ z + Gam @ u_in
-                out = C_all @ z
-        return rec_y, rec_i, rec_ref
+        left = facility_loop(*mats, np.ascontiguousarray(e), noise, inoise, float(lsb),
+                             float(limit), float(i0), s0, kf, ki, ks, int(truth.substeps), lp_a,
+                             *rec)
+        if left >= 0:
+            raise ModelError(
+                f"the rotor left the air gap at t = {left * T:.4f} s (loop unstable or "
+                "excitation too strong)"
+            )
+        return rec
 
     noise_std = np.full(k, truth.sensor_noise_m)
     if truth.noise_fraction > 0:

@@ -1,0 +1,100 @@
+"""The virtual facility's sample loop, compiled with numba.
+
+The facility (:mod:`ambseal.identify.rig_sim`) cannot be vectorised over time: every
+sample the digital controller reads the noisy, quantised sensors, the amplifier saturates,
+and the nonlinear AMB force law feeds back into the linear rotor over ``substeps``
+sub-steps. In pure Python that loop cost about 1 µs per arithmetic statement and was the
+largest part of ``ambseal run``; ``benchmarks/bench_facility.py`` times this compiled
+loop against the same function run as Python (``facility_loop.py_func``) in one run.
+
+The arithmetic is the same as written in Python (IEEE double; the matrix–vector products
+go through BLAS in both), so records agree with the interpreted loop to rounding.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+__all__ = ["facility_loop"]
+
+
+@njit(cache=True, nogil=True)
+def facility_loop(Phi, Gam, C_all, D_coil, D_ieff, Ac, Bc, Cc, Dc, e, noise, inoise,
+                  lsb, limit, i0, s0, kf, ki, ks, substeps, lp_a, rec_y, rec_i, rec_ref):
+    """Run the sampled closed loop of the virtual facility; fill the three records.
+
+    Parameters
+    ----------
+    Phi, Gam : ndarray (n, n), (n, 2k)
+        Sub-step ZOH transition of the linear part, inputs ``[i_ref (k), f_rem (k)]``.
+    C_all : ndarray (4k, n)
+        Rows: sensor displacement, bearing displacement, force current, coil current.
+    D_coil, D_ieff : ndarray (k, k)
+        Feedthrough of the current reference to the coil and to the force current.
+    Ac, Bc, Cc, Dc : ndarray
+        Discrete controller, ``u = Cc xc + Dc y`` and ``i_ref = −u + e``.
+    e, noise, inoise : ndarray (N, k)
+        Excitation (A), sensor noise (m) and current-measurement noise (A) per sample.
+    lsb : float
+        ADC step (m); 0 for no quantisation.
+    limit : float
+        Current-reference limit (A), ``inf`` for none.
+    i0 : float
+        Bias current (A).
+    s0, kf, ki, ks : ndarray (k,)
+        Force-law gap (m) and constant, and the linearised Ki (N/A), Ks (N/m) per axis.
+    substeps : int
+    lp_a : float
+        Pole of the sensors' sampled first-order low-pass ``y_f ← a y_f + (1 − a) y``;
+        0 for none (then ``y_f = y`` exactly).
+    rec_y, rec_i, rec_ref : ndarray (N, k)
+        Output: measured displacement (m), measured coil current (A), current reference (A).
+
+    Returns
+    -------
+    int
+        −1 when the run completed, else the sample at which a bearing displacement left
+        90 % of its air gap (the rest of the records is then undefined).
+    """
+    N, k = e.shape
+    xc = np.zeros(Ac.shape[0])
+    z = np.zeros(Phi.shape[0])
+    u_in = np.zeros(2 * k)
+    y = np.zeros(k)
+    yf = np.zeros(k)
+    out = C_all @ z
+    for n in range(N):
+        for a in range(k):
+            yf[a] = lp_a * yf[a] + (1.0 - lp_a) * out[a]
+            v = yf[a] + noise[n, a]
+            if lsb > 0.0:
+                v = np.rint(v / lsb) * lsb
+            y[a] = v
+        u = Cc @ xc + Dc @ y
+        iref = np.empty(k)
+        for a in range(k):
+            iref[a] = min(max(-u[a] + e[n, a], -limit), limit)
+        xc = Ac @ xc + Bc @ y
+        coil = D_coil @ iref
+        i_ff = D_ieff @ iref
+        for a in range(k):
+            rec_y[n, a] = y[a]
+            rec_ref[n, a] = iref[a]
+            rec_i[n, a] = out[3 * k + a] + coil[a] + inoise[n, a]
+            u_in[a] = iref[a]
+        for _ in range(substeps):
+            for a in range(k):
+                x = out[k + a]
+                i = out[2 * k + a] + i_ff[a]
+                if abs(x) >= 0.9 * s0[a]:
+                    return n
+                ip = max(i0 + i, 0.0)
+                im = max(i0 - i, 0.0)
+                dp = s0[a] - x
+                dm = s0[a] + x
+                f = kf[a] * (ip * ip / (dp * dp) - im * im / (dm * dm))
+                u_in[k + a] = f - (ki[a] * i + ks[a] * x)
+            z = Phi @ z + Gam @ u_in
+            out = C_all @ z
+    return -1

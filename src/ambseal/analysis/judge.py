@@ -127,7 +127,9 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
     from ..model.rig import build_plant
     from ..model.rotor import assemble_rotor
     from .iso import iso_assessment
-    from .loops import closed_loop, compliance, loop_responses, resolved_grid, sigma_max
+    from ..lti.freqresp import freqresp
+    from .loops import (closed_loop, compliance_from, loop_responses_from, resolved_grid,
+                        sigma_max)
     from .response import impulse_response_of
     from .unbalance import unbalance_from_compliance
 
@@ -135,22 +137,28 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
     plant = build_plant(cfg, pressure_bar=point.pressure_bar, speed_rpm=point.speed_rpm,
                         force_positions=(force_position(cfg),))
     cur = plant.current_inputs()
+    force = [j for j in range(len(plant.input_names)) if j not in cur]
     G = plant.select_inputs([plant.input_names[j] for j in cur]).to_statespace()
-    Gf = plant.select_inputs([n for j, n in enumerate(plant.input_names)
-                              if j not in cur]).to_statespace()
+    Gf = plant.select_inputs([plant.input_names[j] for j in force]).to_statespace()
     loop = closed_loop(G, controller, Gf)
     case = {"controller": name, "pressure_bar": point.pressure_bar,
             "speed_hz": point.speed_rpm / 60.0, "stable": loop.stable,
             "max_real_pole": loop.max_real_pole}
     w = 2 * np.pi * np.logspace(math.log10(s.freq_hz[0]), math.log10(s.freq_hz[1]), s.freq_hz[2])
     w = resolved_grid(w, loop.poles)  # a 0.5 %-damped bending mode must not slip through
-    resp = loop_responses(G, controller, w)
+    wu = resolved_grid(2 * np.pi * np.linspace(*s.unbalance_range_hz, 400), loop.poles)
+    # the plant (currents and force share its A) and the controller evaluated once, on both
+    # grids: one eigendecomposition each instead of one per loop function
+    Pw, Kw = (freqresp(X, np.concatenate([w, wu])) for X in (plant.to_statespace(), controller))
+    Gw, Gfw = Pw[:, :, cur], Pw[:, :, force]
+    ny_names, nu_names, f_names = G.output_labels, G.input_labels, Gf.input_labels
+    resp = loop_responses_from(Gw[:w.size], Kw[:w.size], w, ny_names, nu_names)
     iso = iso_assessment(resp.peaks("So"), stable=loop.stable)
     curves: dict = {"So": (w / (2 * np.pi), sigma_max(resp.So)), "poles": loop.poles}
     case.update(
         sensitivity_peak=_finite(iso.sigma_max_peak),
         sensitivity_peak_per_axis={ax.removeprefix("y_"): (p.value if loop.stable else None)
-                                   for ax, p in zip(G.output_labels, resp.peaks("So").diagonal)},
+                                   for ax, p in zip(ny_names, resp.peaks("So").diagonal)},
         iso_zone=iso.zone_sigma_max,
         iso_zone_per_axis={ax.removeprefix("y_"): z for ax, z in iso.zones_per_axis},
     )
@@ -158,14 +166,13 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
         case.update(compliance_peak_m_per_n=None, unbalance_peak_um=None,
                     impulse_peak_um=None, impulse_settling_s=None)
         return case, curves
-    comp = compliance(G, controller, Gf, w)
-    curves["compliance"] = (w / (2 * np.pi), comp.sigma_max_m_per_n)
-    wu = resolved_grid(2 * np.pi * np.linspace(*s.unbalance_range_hz, 400), loop.poles)
-    unb = unbalance_from_compliance(compliance(G, controller, Gf, wu),
-                                    mass_kg=assemble_rotor(cfg).mass,
+    c, cu = (compliance_from(Gw[sl], Kw[sl], Gfw[sl], grid, ny_names, f_names)
+             for sl, grid in ((slice(0, w.size), w), (slice(w.size, None), wu)))
+    curves["compliance"] = (w / (2 * np.pi), c.sigma_max_m_per_n)
+    unb = unbalance_from_compliance(cu, mass_kg=assemble_rotor(cfg).mass,
                                     grade_mm_s=s.unbalance_grade_mm_s)
     curves["unbalance"] = (unb.speed_hz, unb.response_um)
-    case.update(compliance_peak_m_per_n=comp.peak.value, unbalance_peak_um=unb.peak_um)
+    case.update(compliance_peak_m_per_n=c.peak.value, unbalance_peak_um=unb.peak_um)
     if not impulse:
         case.update(impulse_peak_um=None, impulse_settling_s=None)
         return case, curves

@@ -19,6 +19,7 @@ Peaks are grid maxima: pass a grid dense enough around resonances.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -37,8 +38,10 @@ __all__ = [
     "ComplianceResponse",
     "closed_loop",
     "loop_responses",
+    "loop_responses_from",
     "sensitivity_peaks",
     "compliance",
+    "compliance_from",
     "sigma_max",
     "peak_of",
     "resolved_grid",
@@ -406,8 +409,17 @@ def loop_responses(G: Any, K: Any, omega: Any) -> LoopResponse:
     """
     w = as_omega(omega)
     _check_pair(G, K)
-    Gw = freqresp(G, w)
-    Kw = freqresp(K, w)
+    ny, nu = ss_matrices(G, name="G")[3].shape
+    return loop_responses_from(freqresp(G, w), freqresp(K, w), w,
+                               labels(G, "output", ny, "y"), labels(G, "input", nu, "u"))
+
+
+def loop_responses_from(Gw: np.ndarray, Kw: np.ndarray, w: np.ndarray,
+                        ny_names: Sequence[str], nu_names: Sequence[str]) -> LoopResponse:
+    """:func:`loop_responses` from the frequency responses ``G(jω)`` (n_w, ny, nu) and
+    ``K(jω)`` (n_w, nu, ny) already evaluated on ``w`` (rad/s) — for a caller that needs
+    them for several loop functions (one eigendecomposition of the plant, not one per
+    function). Raises ModelError as :func:`loop_responses` on a non-finite response."""
     _check_finite(w, Gw, Kw)
     ny, nu = Gw.shape[1:]
     GK = Gw @ Kw
@@ -416,9 +428,7 @@ def loop_responses(G: Any, K: Any, omega: Any) -> LoopResponse:
     Si = _batched_inv(np.eye(nu) + KG)
     To = GK @ So
     KS = Kw @ So
-    nu_names = labels(G, "input", nu, "u")
-    ny_names = labels(G, "output", ny, "y")
-    return LoopResponse(w, So, Si, To, KS, ny_names, nu_names)
+    return LoopResponse(w, So, Si, To, KS, tuple(ny_names), tuple(nu_names))
 
 
 def sensitivity_peaks(G: Any, K: Any, omega: Any, which: str = "So") -> SensitivityPeaks:
@@ -459,14 +469,19 @@ def compliance(G: Any, K: Any, Gf: Any, omega: Any) -> ComplianceResponse:
     Gw = freqresp(G, w)
     if Gfw.shape[1] != Gw.shape[1]:
         raise ModelError(f"Gf has {Gfw.shape[1]} outputs, G has {Gw.shape[1]}: they must share outputs")
-    Kw = freqresp(K, w)
+    return compliance_from(Gw, freqresp(K, w), Gfw, w, labels(G, "output", Gw.shape[1], "y"),
+                           labels(Gf, "input", Gfw.shape[2], "f"))
+
+
+def compliance_from(Gw: np.ndarray, Kw: np.ndarray, Gfw: np.ndarray, w: np.ndarray,
+                    names_y: Sequence[str], names_f: Sequence[str]) -> ComplianceResponse:
+    """:func:`compliance` from ``G(jω)``, ``K(jω)`` and ``G_f(jω)`` (n_w, ny, nf) already
+    evaluated on ``w`` (rad/s), as :func:`loop_responses_from`."""
     _check_finite(w, Gw, Kw, Gfw)
     ny = Gw.shape[1]
     H = _batched_solve(np.eye(ny) + Gw @ Kw, Gfw)
     sm = sigma_max(H)
-    names_y = labels(G, "output", ny, "y")
-    names_f = labels(Gf, "input", Gfw.shape[2], "f")
-    return ComplianceResponse(w, H, sm, peak_of(sm, w), names_y, names_f)
+    return ComplianceResponse(w, H, sm, peak_of(sm, w), tuple(names_y), tuple(names_f))
 
 
 def _check_finite(w: np.ndarray, *responses: np.ndarray) -> None:

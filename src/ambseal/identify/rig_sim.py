@@ -29,6 +29,7 @@ f − (Ki i + Ks x) enters as a force held over each sub-step.
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
@@ -44,7 +45,7 @@ from ..lti.interconnect import series_inputs
 from .facility_loop import facility_loop
 from .loop import DiscreteController
 
-__all__ = ["FacilityRecord", "simulate_facility", "true_rig"]
+__all__ = ["FacilityRecord", "simulate_facility", "true_rig", "reduced_plant"]
 
 
 @dataclass(frozen=True)
@@ -111,6 +112,41 @@ def _force_law(plant, names, i0: float):
     return ki, ks, s0, ki * s0**2 / (4 * i0)
 
 
+#: The last reduced plants built by :func:`reduced_plant`, least recently used first.
+_PLANTS: OrderedDict = OrderedDict()
+_PLANTS_KEPT = 16
+
+
+def reduced_plant(cfg: RigConfig, pressure_bar: float, speed_rpm: float | None,
+                   values: dict, cutoff_hz: float):
+    """The rig's mechanical plant at one condition with parameter ``values`` (SI) applied
+    exactly in full order, reduced to the modes below ``cutoff_hz`` (Hz).
+
+    The thesis procedure acquires several records and fits many windows (stepped-sine
+    frequencies) at one condition with the same values; the full-order model and its
+    eigendecomposition are built once for them: the result is kept, keyed on the rig's
+    content (not its identity) and the arguments, for the last ``_PLANTS_KEPT`` calls.
+    Plants are immutable, so sharing them is safe.
+
+    Raises
+    ------
+    ModelError
+        A value names a parameter the rig has no channel for; no mode below the cut-off.
+    """
+    key = (cfg.model_dump_json(), pressure_bar, speed_rpm, tuple(sorted(values.items())),
+           cutoff_hz)
+    if key in _PLANTS:
+        _PLANTS.move_to_end(key)
+        return _PLANTS[key]
+    full = mechanical_plant(build_system(cfg, pressure_bar=pressure_bar, speed_rpm=speed_rpm))
+    if values:
+        full = full.with_values(values)
+    plant = _PLANTS[key] = modal_reduction(full, cutoff_hz=cutoff_hz).plant
+    if len(_PLANTS) > _PLANTS_KEPT:
+        _PLANTS.popitem(last=False)
+    return plant
+
+
 def simulate_facility(
     cfg: RigConfig,
     truth: TruthSection,
@@ -149,11 +185,9 @@ def simulate_facility(
     T = 1.0 / sample_rate_hz
     if abs(controller.dt - T) > 1e-9 * T:
         raise ModelError(f"controller dt = {controller.dt} s but the sample rate is {sample_rate_hz} Hz")
-    sys = build_system(true_rig(cfg, truth), pressure_bar=pressure_bar)
-    plant = mechanical_plant(sys)
     values = {k: coefficient_value(v, pressure_bar) for k, v in truth.parameters.items()}
-    plant = plant.with_values(values)  # raises ModelError naming an unknown parameter
-    plant = modal_reduction(plant, cutoff_hz=truth.max_mode_hz).plant
+    # raises ModelError naming an unknown parameter
+    plant = reduced_plant(true_rig(cfg, truth), pressure_bar, None, values, truth.max_mode_hz)
     axes = plant.axes
     k = len(axes)
     e = np.asarray(excitation_a, dtype=float)

@@ -11,13 +11,11 @@ import numpy as np
 from ..config import RigConfig, TruthSection
 from ..errors import DataError, IdentificationError, ModelError
 from ..model.amb import actuator_matrices
-from ..model.reduction import modal_reduction
-from ..model.rig import build_system, mechanical_plant
 from .budget import fixed_uncertainty
 from .data import Measurement, validate_measurement
 from .fit import TAU_E, ClosedLoopModel, FitResult, default_bounds, fit_parameters
 from .loop import DiscreteController
-from .rig_sim import simulate_facility
+from .rig_sim import reduced_plant, simulate_facility
 from .signals import Excitation
 
 __all__ = ["controller_from_metadata", "check_controller", "sample_rate_of", "acquire",
@@ -154,12 +152,9 @@ def build_models(cfg: RigConfig, records: list[Measurement], values: dict | None
         meta = dict(rec.metadata)
         speed = None if meta.get("speed_rad_s") is None else _positive(
             meta, "speed_rad_s", src, default=0.0)
-        sys = build_system(cfg, pressure_bar=_pressure_bar(rec, src),
-                           speed_rpm=None if speed is None else speed * 60 / (2 * np.pi))
-        full = mechanical_plant(sys)
-        if values:
-            full = full.with_values(values)
-        plant = modal_reduction(full, cutoff_hz=cutoff_hz).plant
+        plant = reduced_plant(cfg, _pressure_bar(rec, src),
+                              None if speed is None else speed * 60 / (2 * np.pi), values,
+                              cutoff_hz)
         models.append(ClosedLoopModel(plant, actuator_matrices(cfg.actuator), Kd, tau_e=tau))
     return models
 

@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 import scipy.linalg as sla
+from numba import njit
 
 from ambseal.errors import ModelError
 
@@ -130,29 +131,28 @@ def simulate_lti(A: np.ndarray, B: np.ndarray, Cs: list[np.ndarray], u: np.ndarr
     C = np.vstack(Cs)
     p = C.shape[0]
     L = max(1, min(block, N))
-    powers = [np.eye(n)]
-    for _ in range(L):
-        powers.append(A @ powers[-1])
-    O = np.vstack([C @ powers[j] for j in range(L)])  # (L p, n)
-    markov = [np.zeros((p, m))] + [C @ powers[j - 1] @ B for j in range(1, L)]
-    T = np.zeros((L, p, L, m))
+    # C A^j and A^j B for j < L by products with the small side (p·n² and n²·m flops a
+    # step, not n³), and A^L by repeated squaring
+    CA, AB = [C], [B]
+    for _ in range(1, L):
+        CA.append(CA[-1] @ A)
+        AB.append(A @ AB[-1])
+    O = np.vstack(CA)  # (L p, n)
+    markov = np.zeros((L, p, m))  # by lag: C A^(j−1) B, none at lag 0
     for j in range(1, L):
-        for i in range(j):
-            T[j, :, i, :] = markov[j - i]
-    T = T.reshape(L * p, L * m)
-    G = np.hstack([powers[L - 1 - i] @ B for i in range(L)])  # (n, L m)
+        markov[j] = CA[j - 1] @ B
+    lag = np.subtract.outer(np.arange(L), np.arange(L))  # [j, i] → j − i
+    T = markov[np.clip(lag, 0, None)] * (lag > 0)[:, :, None, None]  # (L, L, p, m)
+    T = T.transpose(0, 2, 1, 3).reshape(L * p, L * m)
+    G = np.hstack(AB[::-1])  # (n, L m): [A^(L−1) B … B]
     nb = -(-N // L)
     U = np.zeros((nb * L, m))
     U[:N] = u
     Ub = U.reshape(nb, L * m)
     drive = Ub @ G.T  # (nb, n)
-    AL = powers[L]
-    Z = np.empty((nb, n))
-    z = np.zeros(n)
+    AL = np.linalg.matrix_power(A, L)
     with np.errstate(over="ignore", invalid="ignore"):
-        for b in range(nb):
-            Z[b] = z
-            z = AL @ z + drive[b]
+        Z = _block_states(np.ascontiguousarray(AL), np.ascontiguousarray(drive))
         b0 = min(max(start, 0), N) // L
         Y = (Z[b0:] @ O.T + Ub[b0:] @ T.T).reshape((nb - b0) * L, p)
         Y = Y[start - b0 * L:N - b0 * L]
@@ -161,3 +161,17 @@ def simulate_lti(A: np.ndarray, B: np.ndarray, Cs: list[np.ndarray], u: np.ndarr
         out.append(Y[:, row:row + Ci.shape[0]])
         row += Ci.shape[0]
     return out
+
+
+@njit(cache=True, nogil=True)
+def _block_states(AL: np.ndarray, drive: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
+    """States at the block starts, ``Z[b+1] = AL Z[b] + drive[b]`` from ``Z[0] = 0``: the
+    one sequential part of :func:`simulate_lti`, compiled (numba) because a Python loop
+    over the blocks of a long record cost more than the vectorised rest."""
+    nb, n = drive.shape
+    Z = np.empty((nb, n))
+    z = np.zeros(n)
+    for b in range(nb):
+        Z[b] = z
+        z = AL @ z + drive[b]
+    return Z

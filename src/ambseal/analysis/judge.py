@@ -86,10 +86,17 @@ def force_position(cfg) -> float:
 def unstable_open_loop_poles(A: np.ndarray) -> np.ndarray:
     """Eigenvalues of ``A`` with a positive real part, most unstable first (rad/s).
 
-    A pole counts as unstable when ``Re λ > 1e-9·max|λ|`` (the rounding level of the
-    eigenvalue solver on the stiffest mode)."""
+    Unstable and refused as doubtful by :func:`ambseal.model.modes.classify_poles`
+    (absolute thresholds in rad/s, not relative to the stiffest mode).
+
+    Raises
+    ------
+    ModelError
+        The model's conditioning makes the stability doubtful."""
+    from ..model.modes import classify_poles
+
     lam = np.linalg.eigvals(A)
-    lam = lam[lam.real > 1e-9 * np.abs(lam).max()]
+    lam = lam[classify_poles(lam, where="open-loop plant")[1]]
     return lam[np.argsort(-lam.real)]
 
 

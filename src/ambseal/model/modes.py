@@ -26,8 +26,25 @@ import scipy.sparse.linalg as spla
 from ..errors import ModelError
 from .rig import SecondOrderSystem, build_system
 
-__all__ = ["Modes", "modes", "lowest_eigenvalues", "free_bending_hz",
-           "bending_limit_hz"]
+__all__ = ["Modes", "modes", "lowest_eigenvalues", "free_bending_hz", "bending_limit_hz",
+           "classify_poles", "RIGID_BODY_RAD_S", "STABILITY_FLOOR_RAD_S"]
+
+# Thresholds on the physics, not on the stiffest DOF (issue 15). A computed eigenvalue with
+# |λ| below RIGID_BODY_RAD_S = 2π·0.1 Hz is a rigid-body mode (λ = 0): a mode of interest of
+# a rotor on bearings, seals and springs lies well above 0.1 Hz (a 70-kg rotor would need a
+# support of 28 N/m to sit there). A pole is unstable when Re λ exceeds
+# STABILITY_FLOOR_RAD_S = 1e-6 rad/s (an e-folding time of 12 days: neutral for any
+# machine) and the rounding level of the eigenvalue solver (below).
+RIGID_BODY_RAD_S = 2 * np.pi * 0.1
+STABILITY_FLOOR_RAD_S = 1e-6
+# Rounding levels of the dense QR eigenvalues of a model whose largest |λ| is ω_max
+# (ε = machine epsilon): a simple eigenvalue moves by about ε·ω_max (the balanced state
+# matrix has a norm of order ω_max), measured up to 100 ε·ω_max on the test rig's variants;
+# a double zero eigenvalue (a rigid-body mode, a Jordan block of λ²) splits by √ε·ω_max
+# (Moro, Burke & Overton, SIAM J. Matrix Anal. Appl. 18 (1997)), measured up to 0.3 √ε·ω_max.
+# The factors below give a margin of 10 and 3 over those measurements.
+REAL_PART_ROUNDING = 1e3
+ZERO_ROUNDING = 1.0
 
 # The shift-invert shift is σ = −SHIFT_FRACTION · ω_ref (see ``lowest_eigenvalues``).
 SHIFT_FRACTION = 1e-3
@@ -51,12 +68,13 @@ class Modes:
     Attributes
     ----------
     natural_frequencies_hz : tuple of float
-        Damped natural frequencies Im(λ)/2π (Hz) of the oscillating modes (Im λ > 0),
-        ascending; rigid-body (λ ≈ 0) and non-oscillating modes are left out.
+        Damped natural frequencies Im(λ)/2π (Hz) of the oscillating modes (Im λ at least
+        ``RIGID_BODY_RAD_S``: slower motion is no oscillation of interest), ascending;
+        rigid-body (λ ≈ 0) and non-oscillating modes are left out.
     damping_ratios : tuple of float
         −Re(λ)/|λ| of the same modes.
     unstable_poles : tuple of (float, float)
-        [Re λ, Im λ] (rad/s) of every eigenvalue with Re λ > 0 (beyond rounding) among
+        [Re λ, Im λ] (rad/s) of every eigenvalue unstable by :func:`classify_poles` among
         those computed (all of them in the dense path).
     poles : ndarray
         The eigenvalues computed (rad/s), sorted by |λ|: all of them in the dense path,
@@ -80,10 +98,10 @@ def modes(sys: SecondOrderSystem, n_modes: int | None = None) -> Modes:
     """Damped natural frequencies, damping ratios and unstable poles of ``sys``.
 
     The eigenvalues λ of the first-order form x = [q; q̇] (Friswell et al. 2010, §3.6):
-    a mode oscillates at Im λ/2π Hz with damping ratio −Re λ/|λ|. Eigenvalues with
-    |λ| below 1e-6 of the scale (free–free rigid-body modes) count as zero; the scale is
-    the largest |λ| in the dense path and ω_ref of :func:`lowest_eigenvalues` (a lower
-    bound of the largest undamped natural frequency) in the ``n_modes`` path.
+    a mode oscillates at Im λ/2π Hz with damping ratio −Re λ/|λ|. Rigid-body modes and
+    unstable poles by :func:`classify_poles` (absolute thresholds in rad/s, a model too
+    badly conditioned to tell is refused); its ω_max is the largest |λ| in the dense path
+    and ω_ref of :func:`lowest_eigenvalues` in the ``n_modes`` path.
 
     Parameters
     ----------
@@ -107,30 +125,91 @@ def modes(sys: SecondOrderSystem, n_modes: int | None = None) -> Modes:
     Raises
     ------
     ModelError
-        The mass matrix is not positive definite, or ``n_modes`` < 1.
+        The mass matrix is not positive definite, ``n_modes`` < 1, or the model's
+        conditioning makes the rigid-body modes or the stability doubtful.
     """
     if n_modes is None:
         lam = sys.poles()
-        return _summarise(lam, max(float(np.abs(lam).max()), 1.0))
+        return _summarise(lam, float(np.abs(lam).max()))
     if int(n_modes) != n_modes or n_modes < 1:
         raise ModelError(f"n_modes must be a positive integer, got {n_modes!r}")
     n_modes = int(n_modes)
     lam, w_ref = lowest_eigenvalues(sys, n_modes)
-    return _summarise(lam, max(w_ref, 1.0), n_modes)
+    return _summarise(lam, max(w_ref, float(np.abs(lam).max(initial=0.0))), n_modes)
 
 
-def _summarise(lam: np.ndarray, scale: float, n_modes: int | None = None) -> Modes:
-    """Modes from eigenvalues ``lam`` (rad/s), tolerances relative to ``scale``; with
-    ``n_modes``, the first ``n_modes`` oscillating ones by |λ| and the poles up to them."""
+def classify_poles(lam: np.ndarray, w_max: float | None = None,
+                   where: str = "model") -> tuple[np.ndarray, np.ndarray]:
+    """Which eigenvalues are rigid-body modes (λ = 0) and which are unstable.
+
+    On the physics, not relative to the stiffest DOF: rigid when |λ| < ``RIGID_BODY_RAD_S``
+    (2π·0.1 Hz); unstable when Re λ > max(``STABILITY_FLOOR_RAD_S``, 1e3·ε·ω_max), the
+    second term the rounding level of the solver on a model whose largest |λ| is ω_max
+    (see the constants of this module for the measurements behind the factors).
+
+    Parameters
+    ----------
+    lam : ndarray of complex
+        Eigenvalues (rad/s).
+    w_max : float, optional
+        The largest |λ| of the model (rad/s); default max |lam|.
+    where : str
+        Named in the error message.
+
+    Returns
+    -------
+    rigid, unstable : ndarray of bool
+        Masks over ``lam``.
+
+    Raises
+    ------
+    ModelError
+        The model's conditioning makes the answer doubtful: a rigid-body mode cannot be told
+        from a mode below √ε·ω_max, or a real part from zero within 1e3·ε·ω_max while that
+        level is above 1e-3 rad/s (a stiff DOF — e.g. a 1e16 N/m spring, a micrometre-long
+        element — spreads the model over too many decades).
+    """
+    lam = np.asarray(lam, dtype=complex)
+    size = np.abs(lam)
+    w_max = float(size.max(initial=0.0)) if w_max is None else float(w_max)
+    eps = np.finfo(float).eps
+    zero_noise = ZERO_ROUNDING * np.sqrt(eps) * w_max
+    re_noise = REAL_PART_ROUNDING * eps * w_max
+    rigid = size < RIGID_BODY_RAD_S
+    doubtful = (size >= RIGID_BODY_RAD_S) & (size < zero_noise)
+    if np.any(doubtful):
+        raise ModelError(
+            f"{where}: eigenvalue {_fmt(lam[doubtful][0])} rad/s cannot be told from a "
+            f"rigid-body mode: the largest |λ| is {w_max:.3g} rad/s, so eigenvalues near "
+            f"zero are uncertain by {zero_noise:.3g} rad/s (a very stiff spring or a very "
+            "short shaft element; soften or remove it)")
+    unsure = ~rigid & (np.abs(lam.real) <= re_noise) & (re_noise > 1e-3)
+    if np.any(unsure):
+        raise ModelError(
+            f"{where}: the stability of the pole {_fmt(lam[unsure][0])} rad/s cannot be "
+            f"decided: its real part is below the rounding level {re_noise:.3g} rad/s of a "
+            f"model whose largest |λ| is {w_max:.3g} rad/s (a very stiff spring or a very "
+            "short shaft element; soften or remove it)")
+    unstable = ~rigid & (lam.real > max(STABILITY_FLOOR_RAD_S, re_noise))
+    return rigid, unstable
+
+
+def _fmt(z: complex) -> str:
+    return f"{z.real:.4g}{z.imag:+.4g}j"
+
+
+def _summarise(lam: np.ndarray, w_max: float, n_modes: int | None = None) -> Modes:
+    """Modes from eigenvalues ``lam`` (rad/s) of a model whose largest |λ| is ``w_max``
+    (:func:`classify_poles`); with ``n_modes``, the first ``n_modes`` oscillating ones by
+    |λ| and the poles up to them."""
     lam = lam[np.argsort(np.abs(lam), kind="stable")]
-    tol = 1e-6 * scale
-    rigid = np.abs(lam) < max(tol, 1e-3)
-    osc = lam[(lam.imag > tol) & ~rigid]
+    rigid, unstable = classify_poles(lam, w_max)
+    osc = lam[(lam.imag >= RIGID_BODY_RAD_S) & ~rigid]
     if n_modes is not None and osc.size > n_modes:
         keep = np.abs(lam) <= np.abs(osc[n_modes - 1])
-        lam, rigid, osc = lam[keep], rigid[keep], osc[:n_modes]
+        lam, unstable, osc = lam[keep], unstable[keep], osc[:n_modes]
     osc = osc[np.argsort(osc.imag)]
-    unstable = lam[(lam.real > 1e-9 * scale) & ~rigid]
+    unstable = lam[unstable]
     unstable = unstable[np.argsort(-unstable.real)]
     return Modes(
         natural_frequencies_hz=tuple(float(x) for x in osc.imag / (2 * np.pi)),
@@ -209,7 +288,7 @@ def lowest_eigenvalues(sys: SecondOrderSystem, n_modes: int) -> tuple[np.ndarray
         lam = sigma + 1.0 / mu
         radius = np.max(np.abs(lam - sigma)) - abs(sigma)
         lam = lam[np.abs(lam) < radius]
-        osc = np.sort(np.abs(lam[lam.imag > 1e-6 * w_ref]))
+        osc = np.sort(np.abs(lam[lam.imag >= RIGID_BODY_RAD_S]))
         if osc.size >= n_modes and radius >= 1.5 * osc[n_modes - 1]:
             return lam[np.argsort(np.abs(lam), kind="stable")], w_ref
         k *= 2

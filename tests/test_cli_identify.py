@@ -104,6 +104,70 @@ def test_identify_file_of_another_rig(record, tmp_path, capsys):
     assert code == 2 and ("C_zeta" in err or "A_zeta" in err)
 
 
+def _cell(name: str, row: int, value: str):
+    """Set column ``name`` of data row ``row`` (``row=None``: every row) to ``value``."""
+    def fn(lines):
+        col = lines[0].split(",").index(name)
+        out = [lines[0]]
+        for r, line in enumerate(lines[1:], 1):
+            cells = line.split(",")
+            if row is None or r == row:
+                cells[col] = value
+            out.append(",".join(cells))
+        return out
+    return fn
+
+
+def _identify(capsys, tmp_path, *files, extra=()):
+    capsys.readouterr()
+    code = main(["identify", RIG, *map(str, files), "--params", "A.Ki_zeta", "--out",
+                 str(tmp_path / "o"), *extra])
+    err = capsys.readouterr().err.strip().splitlines()
+    return code, err
+
+
+def test_identify_refuses_duplicate_and_unexcited_records(record, tmp_path, capsys):
+    """The same record twice would narrow the 95 % interval by √2: refused, naming both
+    files; a record whose excitation is zero on every axis identifies nothing."""
+    copy = _corrupt(record, tmp_path, lambda L: L)
+    code, err = _identify(capsys, tmp_path, record, copy)
+    assert code == 2 and len(err) == 1 and str(copy) in err[0] and str(record) in err[0]
+    zero = tmp_path / "zero"
+    zero.mkdir()
+    lines = record.read_text().splitlines()
+    for col in [c for c in lines[0].split(",") if c.startswith("excitation_")]:
+        lines = _cell(col, None, "0")(lines)
+    bad = _corrupt(record, zero, lambda L: lines)
+    code, err = _identify(capsys, tmp_path, bad)
+    assert code == 2 and len(err) == 1 and "excitation" in err[0], err
+
+
+def test_failed_fit_writes_no_identified_rig(record, tmp_path, capsys):
+    """A 1e300 sample makes the fit fail (NRMSE below its floor): exit 2 with the reason,
+    fit.json for diagnosis, no identified.toml and no warning lines before the error;
+    ``--accept-unconverged`` writes the rig anyway and exits 0."""
+    bad = _corrupt(record, tmp_path, _cell("displacement_A_zeta_m", 10, "1e300"))
+    code, err = _identify(capsys, tmp_path, bad)
+    assert code == 2 and len(err) == 1 and "fit failed" in err[0], err
+    assert (tmp_path / "o" / "fit.json").exists()
+    assert not (tmp_path / "o" / "identified.toml").exists()
+    code, err = _identify(capsys, tmp_path, bad, extra=["--accept-unconverged"])
+    assert code == 0 and (tmp_path / "o" / "identified.toml").exists()
+
+
+def test_non_square_controller_in_metadata(record, tmp_path, capsys):
+    """A non-square controller A (or a B of the wrong height) in the sidecar: one line
+    naming the file and the matrix, not a numpy broadcasting traceback."""
+    bad = _corrupt(record, tmp_path, lambda L: L)
+    side = bad.with_name(bad.name + ".json")
+    meta = json.loads(side.read_text())
+    ss = meta["controller"]["state_space"]
+    ss["A"] = [row[:-1] for row in ss["A"]]
+    side.write_text(json.dumps(meta))
+    code, err = _identify(capsys, tmp_path, bad)
+    assert code == 2 and len(err) == 1 and str(bad) in err[0] and "A has shape" in err[0]
+
+
 def test_design_hinf_exports_controller(tmp_path, capsys):
     """`design --method hinf`: the controller in .json/.npz/.mat with Tustin and ZOH forms
     and its summary; the summary's γ is the verified closed-loop norm (finite, > 0)."""

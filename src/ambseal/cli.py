@@ -31,6 +31,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
+import os
 import sys
 
 from .errors import AmbsealError
@@ -38,18 +40,54 @@ from .errors import AmbsealError
 __all__ = ["main"]
 
 
-def _positive_int(text: str) -> int:
+class _Parser(argparse.ArgumentParser):
+    """argparse with the project's error form: one line on stderr, exit status 2."""
+
+    def error(self, message: str):  # noqa: D102 (argparse's hook)
+        print(f"ambseal: error: {message}", file=sys.stderr)
+        sys.exit(2)
+
+
+def _finite(text: str) -> float:
+    """A finite number of plausible size (|x| < 1e12: no argument of ambseal is larger in
+    the units of its name)."""
+    try:
+        x = float(text)
+    except ValueError:
+        x = math.nan
+    if not (math.isfinite(x) and abs(x) < 1e12):
+        raise argparse.ArgumentTypeError(f"expected a finite number below 1e12, got {text!r}")
+    return x
+
+
+def _nonnegative(text: str) -> float:
+    x = _finite(text)
+    if x < 0:
+        raise argparse.ArgumentTypeError(f"expected a number >= 0, got {text!r}")
+    return x
+
+
+def _whole(text: str, low: int) -> int:
     try:
         n = int(text)
     except ValueError:
-        n = 0
-    if n < 1:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
+        n = low - 1
+    if not low <= n <= 10**6:
+        raise argparse.ArgumentTypeError(f"expected a whole number from {low} to 1000000, "
+                                         f"got {text!r}")
     return n
 
 
+def _positive_int(text: str) -> int:
+    return _whole(text, 1)
+
+
+def _natural(text: str) -> int:
+    return _whole(text, 0)
+
+
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    p = _Parser(
         prog="ambseal",
         description="Rotors on active magnetic bearings with destabilising seal forces.",
     )
@@ -67,27 +105,29 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("rig", help="rig file (TOML)")
     a.add_argument("--truth", required=True, help="truth file of the virtual facility (TOML)")
     a.add_argument("--excitation", required=True, choices=["prbs", "sine", "chirp", "impulse"])
-    a.add_argument("--pressure-bar", type=float, required=True, help="seal pressure drop (bar)")
+    a.add_argument("--pressure-bar", type=_finite, required=True, help="seal pressure drop (bar)")
     a.add_argument("--out", required=True, help="record file: .csv (+ .csv.json) or .mat")
-    a.add_argument("--amplitude-a", type=float, default=0.05, help="excitation amplitude (A)")
-    a.add_argument("--duration-s", type=float, default=1.0, help="record length (s)")
+    a.add_argument("--amplitude-a", type=_finite, default=0.05, help="excitation amplitude (A)")
+    a.add_argument("--duration-s", type=_finite, default=1.0, help="record length (s)")
     a.add_argument("--axes", default=None, help="excited axes, e.g. A_zeta,B_zeta (default all)")
-    a.add_argument("--clock-period-s", type=float, default=1e-3, help="PRBS clock period (s)")
+    a.add_argument("--clock-period-s", type=_finite, default=1e-3, help="PRBS clock period (s)")
     a.add_argument("--frequencies-hz", default="10,30,50,70,90,110,130,150,170,190",
                    help="stepped-sine frequencies (Hz), comma separated")
-    a.add_argument("--cycles", type=int, default=10, help="stepped sine: cycles per step")
-    a.add_argument("--settling-cycles", type=int, default=5, help="stepped sine: settling cycles")
-    a.add_argument("--f0-hz", type=float, default=1.0, help="chirp start frequency (Hz)")
-    a.add_argument("--f1-hz", type=float, default=150.0, help="chirp end frequency (Hz)")
+    a.add_argument("--cycles", type=_positive_int, default=10,
+                   help="stepped sine: cycles per step")
+    a.add_argument("--settling-cycles", type=_natural, default=5,
+                   help="stepped sine: settling cycles")
+    a.add_argument("--f0-hz", type=_finite, default=1.0, help="chirp start frequency (Hz)")
+    a.add_argument("--f1-hz", type=_finite, default=150.0, help="chirp end frequency (Hz)")
     a.add_argument("--chirp", choices=["linear", "logarithmic"], default="linear")
-    a.add_argument("--width-s", type=float, default=0.01, help="impulse width (s)")
-    a.add_argument("--start-s", type=float, default=0.05, help="impulse start (s)")
-    a.add_argument("--seed", type=int, default=0, help="seed of excitation and noise")
+    a.add_argument("--width-s", type=_finite, default=0.01, help="impulse width (s)")
+    a.add_argument("--start-s", type=_finite, default=0.05, help="impulse start (s)")
+    a.add_argument("--seed", type=_natural, default=0, help="seed of excitation and noise")
 
     d = sub.add_parser("design", help="design a controller (pid, hinf, mu, lpv) and export it")
     d.add_argument("rig", help="rig file (TOML)")
     d.add_argument("--method", required=True, choices=["pid", "hinf", "mu", "lpv"])
-    d.add_argument("--pressure-bar", type=float, default=None,
+    d.add_argument("--pressure-bar", type=_finite, default=None,
                    help="design pressure drop (bar); default [operating] pressure_bar")
     d.add_argument("--out", default="ambseal-design", help="output folder")
 
@@ -97,14 +137,39 @@ def _parser() -> argparse.ArgumentParser:
     i.add_argument("--params", required=True,
                    help="parameters, e.g. A.Ki_zeta,A.Ks_zeta,tau_e,coupling.kxx,seal.k")
     i.add_argument("--out", required=True, help="output folder")
-    i.add_argument("--current-weight", type=float, default=0.0,
+    i.add_argument("--current-weight", type=_nonnegative, default=0.0,
                    help="weight of the coil-current residuals (0: displacements only)")
+    i.add_argument("--accept-unconverged", action="store_true",
+                   help="write the identified rig even when the fit failed or is not "
+                        "identifiable (the exit status is then 0)")
     i.add_argument("--no-refine", action="store_true",
                    help="skip the second pass on a model re-reduced at the estimate")
     from .rotordynamics import add_parsers
 
     add_parsers(sub, _positive_int)  # modes, campbell, sweep, import-ross
+    _checked_numbers(p)
     return p
+
+
+def _checked_numbers(parser: argparse.ArgumentParser) -> None:
+    """Every ``type=float`` argument of every command is finite and below 1e12 and every
+    ``type=int`` one a whole number from 1 to 1e6 (whoever declared it)."""
+    for action in parser._actions:
+        if action.type is float:
+            action.type = _finite
+        elif action.type is int:
+            action.type = _positive_int
+        for sub in (action.choices or {}).values() if isinstance(action.choices, dict) else ():
+            _checked_numbers(sub)
+
+
+def _check_operating(args: argparse.Namespace) -> None:
+    """The operating values given on the command line, by the rig file's rules."""
+    from .config import check_operating
+
+    values = {k: getattr(args, k, None) for k in ("pressure_bar", "speed_rpm")}
+    check_operating({k: v for k, v in values.items() if isinstance(v, float)},
+                    {"pressure_bar": "--pressure-bar", "speed_rpm": "--speed-rpm"})
 
 
 def _acquire(args: argparse.Namespace) -> int:
@@ -121,7 +186,12 @@ def _acquire(args: argparse.Namespace) -> int:
     axes = channel_names(cfg)
     if not axes:
         raise ConfigError(f"{args.rig}: amb: acquisition needs at least one [[amb]]")
-    excited = args.axes.split(",") if args.axes else None
+    excited = None
+    if args.axes is not None:
+        excited = [a.strip() for a in args.axes.split(",")]
+        if not all(excited):
+            raise ConfigError(f"--axes: expected axis names separated by commas, e.g. "
+                              f"{','.join(axes[:2])}; got {args.axes!r}")
     fs = cfg.controller.sample_rate_hz
     common = dict(sample_rate_hz=fs, axes=axes, excited=excited)
     try:
@@ -161,7 +231,8 @@ def _identify(args: argparse.Namespace) -> int:
     from .commands import identify_files
 
     summary = identify_files(args.rig, args.data, args.params.split(","), args.out,
-                             current_weight=args.current_weight, refine=not args.no_refine)
+                             current_weight=args.current_weight, refine=not args.no_refine,
+                             accept_unconverged=args.accept_unconverged)
     print(json.dumps(summary))
     return 0
 
@@ -175,20 +246,38 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``ambseal`` console script; returns the exit status."""
-    args = _parser().parse_args(argv)
-    try:
-        from .rotordynamics import HANDLERS
+    """Entry point of the ``ambseal`` console script; returns the exit status.
 
-        handler = {"acquire": _acquire, "identify": _identify, "design": _design,
-                   "run": _run, **HANDLERS}[args.command]
-        return handler(args)
-    except AmbsealError as exc:
-        print(f"ambseal: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("ambseal: interrupted", file=sys.stderr)
-        return 130
+    Warnings raised on the way (numpy's, say) are shown after a successful command and
+    dropped when the command ends in the one error line."""
+    import warnings
+
+    args = _parser().parse_args(argv)
+    from .rotordynamics import HANDLERS
+
+    handler = {"acquire": _acquire, "identify": _identify, "design": _design,
+               "run": _run, **HANDLERS}[args.command]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("default")
+        try:
+            _check_operating(args)
+            code = handler(args)
+        except AmbsealError as exc:
+            print(f"ambseal: error: {exc}", file=sys.stderr)
+            return 2
+        except MemoryError:
+            print(f"ambseal: error: {args.command}: not enough memory for this input",
+                  file=sys.stderr)
+            return 2
+        except KeyboardInterrupt:
+            print("ambseal: interrupted", file=sys.stderr)
+            return 130
+        except BrokenPipeError:  # e.g. `ambseal modes rig.toml | head`
+            sys.stdout = open(os.devnull, "w")
+            return 0
+    for w in caught:
+        warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+    return code
 
 
 if __name__ == "__main__":  # pragma: no cover

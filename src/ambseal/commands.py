@@ -78,8 +78,39 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
     return {**res.summary(), "files": [str(f) for f in files]}
 
 
+def _record_hash(meas) -> str:
+    """SHA-256 of a record's samples (time, excitation, currents, displacements)."""
+    import hashlib
+
+    h = hashlib.sha256()
+    for a in (meas.time_s, meas.excitation_a, meas.current_ref_a, meas.current_a,
+              meas.displacement_m):
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def _check_records(records: list, paths: list[str]) -> None:
+    """Refuse a record given twice (same samples: it would narrow the intervals by √2) and
+    a record without excitation (nothing to identify)."""
+    import numpy as np
+
+    from .errors import DataError
+
+    seen: dict[str, str] = {}
+    for meas, path in zip(records, paths):
+        digest = _record_hash(meas)
+        if digest in seen:
+            raise DataError(f"{path}: the same samples as {seen[digest]} (a record counts "
+                            "once; a copy would narrow the confidence intervals by √2)")
+        seen[digest] = str(path)
+        if not np.any(meas.excitation_a):
+            raise DataError(f"{path}: excitation_a: zero on every axis; a record without "
+                            "excitation identifies nothing")
+
+
 def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: str | Path, *,
-                   current_weight: float = 0.0, refine: bool = True) -> dict:
+                   current_weight: float = 0.0, refine: bool = True,
+                   accept_unconverged: bool = False) -> dict:
     """``ambseal identify``: fit ``names`` to recorded files; write the fit, its figures and
     the identified rig to ``out_dir``. Returns a JSON-safe summary.
 
@@ -91,10 +122,16 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
     dominate, whether seal coefficients are held at a non-zero pressure and whether the
     model fails the residual test.
 
+    A fit that failed (not converged, singular Jacobian, an estimate at its bound, an NRMSE
+    fit below the floor of :func:`ambseal.identify.fit.fit_parameters`) writes ``fit.json``
+    and its figures for diagnosis but no ``identified.toml``, and raises, unless
+    ``accept_unconverged``.
+
     Raises
     ------
     ConfigError, DataError, IdentificationError
-        A bad rig, a bad or mismatched record, or a fit that cannot start.
+        A bad rig, a bad, duplicate, unexcited or mismatched record, a fit that cannot
+        start, or (without ``accept_unconverged``) a fit that failed.
     """
     from .config import dump_rig, rig_with_values
     from .control.pid import controller_from_metadata
@@ -118,6 +155,7 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
                             f"{cfg.rotor.name!r}")
         records.append(meas)
         controllers.append(controller_from_metadata(dict(meas.metadata), axes, str(path)))
+    _check_records(records, data)
     sources = [str(d) for d in data]
     res = identify(cfg, records, names, current_weight=current_weight, refine=refine,
                    controllers=controllers, budget=True, sources=sources)
@@ -138,6 +176,12 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
     residual_figure(out / "residuals.png", res.residuals)
     error_budget_figure(out / "error_budget.png", res.names, res.estimate, res.std_error_noise,
                         res.budget)
+    if not res.converged and not accept_unconverged:
+        from .errors import IdentificationError
+
+        raise IdentificationError(f"identify: the fit failed ({res.message}); {out / 'fit.json'}"
+                                  " has the details, no identified rig was written "
+                                  "(--accept-unconverged writes it anyway)")
     identified = rig_with_values(cfg, dict(zip(res.names, res.estimate)))
     header = (f"Identified by ambseal from {', '.join(str(d) for d in data)}\n"
               f"parameters: {', '.join(res.names)}; converged: {res.converged}\n"

@@ -54,19 +54,21 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
 from __future__ import annotations
 
 import math
-import tomllib
 from pathlib import Path
 
 from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from .errors import ConfigError
+from .config_checks import (MAX_ELEMENTS, MAX_REDUCED_STATES, check_actuator, check_amb,
+                            cross_check)
+from .errors import PRIMITIVE_TAGS, ConfigError, describe_validation_error
 
 __all__ = [
     "RigConfig",
     "load_rig",
     "parse_rig",
+    "check_operating",
     "default_rig_path",
     "Coefficient",
     "Affine",
@@ -78,8 +80,15 @@ __all__ = [
 ]
 
 
+_Big = Annotated[float, Field(ge=-1e12, le=1e12)]  # plausible bound of a force coefficient
+#: Names of AMBs, seals and springs make parameter and signal names (``A.Ki_zeta``):
+#: no '.', ',' or white space.
+_NAME = Field(min_length=1, max_length=64, pattern=r"^[^.,\s]+$")
+
+
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    # strict: no bool → number, no string → number, no float → int (issue 15 §1)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
 
 
 #: ``uncertainty = { key = σ }`` beside a component's values: the relative 1σ uncertainty
@@ -91,9 +100,9 @@ Uncertainty = dict[str, Annotated[float, Field(ge=0)]] | None
 class Material(_Strict):
     """Linear elastic isotropic material: ``E`` (Pa), ``rho`` (kg/m³), ``G`` (Pa) or ``nu``."""
 
-    E: float = Field(gt=0)
-    rho: float = Field(gt=0)
-    G: float | None = Field(default=None, gt=0)
+    E: float = Field(ge=1e5, le=1e18)  # plausible: foams to a rigid-shaft idealisation
+    rho: float = Field(ge=1.0, le=1e5)
+    G: float | None = Field(default=None, ge=1e4, le=1e18)
     nu: float | None = Field(default=None, gt=-1, lt=0.5)
 
     @model_validator(mode="after")
@@ -124,11 +133,11 @@ class Rotor(_Strict):
 
 
 class ShaftSection(_Strict):
-    length: float = Field(gt=0)
-    outer_diameter: float = Field(gt=0)
+    length: float = Field(ge=1e-4, le=100.0)
+    outer_diameter: float = Field(ge=1e-4, le=10.0)
     inner_diameter: float = Field(default=0.0, ge=0)
     material: str
-    elements: int = Field(default=1, ge=1)
+    elements: int = Field(default=1, ge=1, le=MAX_ELEMENTS)
 
     @model_validator(mode="after")
     def _bore(self) -> "ShaftSection":
@@ -139,9 +148,9 @@ class ShaftSection(_Strict):
 
 class Disk(_Strict):
     position: float = Field(ge=0)
-    mass: float = Field(ge=0)
-    Ip: float = Field(default=0.0, ge=0)
-    Id: float = Field(default=0.0, ge=0)
+    mass: float = Field(ge=0, le=1e6)
+    Ip: float = Field(default=0.0, ge=0, le=1e6)
+    Id: float = Field(default=0.0, ge=0, le=1e6)
     name: str | None = None
 
 
@@ -149,8 +158,8 @@ class AxisPair(_Strict):
     """A value per actuator axis: ``zeta`` and ``eta`` (one may be left out when the AMB's
     geometry gives it)."""
 
-    zeta: float | None = None
-    eta: float | None = None
+    zeta: float | None = Field(default=None, ge=-1e12, le=1e12)
+    eta: float | None = Field(default=None, ge=-1e12, le=1e12)
 
     @model_validator(mode="after")
     def _one(self) -> "AxisPair":
@@ -160,70 +169,58 @@ class AxisPair(_Strict):
 
 
 class Amb(_Strict):
-    name: str = Field(min_length=1)
+    name: str = _NAME
     position: float = Field(ge=0)
     sensor_position: float = Field(ge=0)
     axes_angle_deg: float = 0.0
-    turns: int | None = Field(default=None, gt=0)
-    pole_area: float | None = Field(default=None, gt=0)
-    air_gap: float | None = Field(default=None, gt=0)
-    bias_current: float | None = Field(default=None, gt=0)
+    turns: int | None = Field(default=None, gt=0, le=100000)
+    pole_area: float | None = Field(default=None, gt=0, le=1.0)
+    air_gap: float | None = Field(default=None, ge=1e-6, le=0.1)
+    bias_current: float | None = Field(default=None, gt=0, le=1e4)
     pole_angle_deg: float = Field(default=22.5, ge=0, lt=90)
-    ki: float | AxisPair | None = None
-    ks: float | AxisPair | None = None
-    current_limit: float | None = Field(default=None, gt=0)
+    ki: _Big | AxisPair | None = None
+    ks: _Big | AxisPair | None = None
+    current_limit: float | None = Field(default=None, gt=0, le=1e4)
     uncertainty: Uncertainty = None
 
     @model_validator(mode="after")
     def _geometry_or_factors(self) -> "Amb":
-        geometry = [self.turns, self.pole_area, self.air_gap, self.bias_current]
-        if all(v is not None for v in geometry):
-            return self
-        if self.ki is None or self.ks is None:
-            raise ValueError(
-                "expected either the geometry (turns, pole_area, air_gap, bias_current) "
-                "or both ki (N/A) and ks (N/m)"
-            )
-        for key in ("ki", "ks"):
-            v = getattr(self, key)
-            if isinstance(v, AxisPair) and None in (v.zeta, v.eta):
-                raise ValueError(f"{key}: expected both zeta and eta (or the geometry: "
-                                 "turns, pole_area, air_gap, bias_current)")
-        return self
+        return check_amb(self)
 
 
 class Actuator(_Strict):
     model: Literal["none", "first_order", "second_order"] = "none"
-    cutoff_hz: float | None = Field(default=None, gt=0)
-    natural_frequency: float | None = Field(default=None, gt=0)
-    damping_ratio: float | None = Field(default=None, gt=0)
-    eddy_time_constant: float = Field(default=0.0, ge=0)
+    cutoff_hz: float | None = Field(default=None, gt=0, le=1e7)
+    natural_frequency: float | None = Field(default=None, gt=0, le=1e8)
+    damping_ratio: float | None = Field(default=None, gt=0, le=100.0)
+    eddy_time_constant: float = Field(default=0.0, ge=0, le=1.0)
     uncertainty: Uncertainty = None
 
     @model_validator(mode="after")
     def _needs(self) -> "Actuator":
-        if self.model == "first_order" and self.cutoff_hz is None:
-            raise ValueError("model = 'first_order' expects cutoff_hz")
-        if self.model == "second_order" and (
-            self.natural_frequency is None or self.damping_ratio is None
-        ):
-            raise ValueError("model = 'second_order' expects natural_frequency and damping_ratio")
-        return self
+        return check_actuator(self)
 
 
 class Affine(_Strict):
     """A coefficient affine in the pressure drop: ``at_zero + per_bar · pressure_bar``."""
 
-    at_zero: float = 0.0
-    per_bar: float = 0.0
+    at_zero: float = Field(default=0.0, ge=-1e12, le=1e12)
+    per_bar: float = Field(default=0.0, ge=-1e12, le=1e12)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _not_empty(cls, data):
+        if isinstance(data, dict) and not data:
+            raise ValueError("expected at_zero and/or per_bar, got an empty table")
+        return data
 
 
 class FrequencyTable(_Strict):
     """A coefficient tabulated against excitation frequency (Hz), interpolated linearly and
     held constant outside the table: ``{ frequency_hz = [...], value = [...] }``."""
 
-    frequency_hz: list[float] = Field(min_length=1)
-    value: list[float] = Field(min_length=1)
+    frequency_hz: list[float] = Field(min_length=1, max_length=10000)
+    value: list[float] = Field(min_length=1, max_length=10000)
 
     @model_validator(mode="after")
     def _table(self) -> "FrequencyTable":
@@ -239,7 +236,7 @@ SealCoefficient = float | Affine | FrequencyTable
 
 
 class Seal(_Strict):
-    name: str = Field(min_length=1)
+    name: str = _NAME
     position: float = Field(ge=0)
     K: SealCoefficient = 0.0
     k: SealCoefficient = 0.0
@@ -256,45 +253,51 @@ class Seal(_Strict):
 
 class Spring(_Strict):
     position: float = Field(ge=0)
-    kxx: float
-    kyy: float
-    kxy: float = 0.0
-    kyx: float = 0.0
-    cxx: float = 0.0
-    cyy: float = 0.0
-    axes_angle_deg: float = 0.0
-    name: str | None = None
+    kxx: float = Field(ge=-1e17, le=1e17)  # up to a stiff pin
+    kyy: float = Field(ge=-1e17, le=1e17)
+    kxy: float = Field(default=0.0, ge=-1e17, le=1e17)
+    kyx: float = Field(default=0.0, ge=-1e17, le=1e17)
+    cxx: float = Field(default=0.0, ge=-1e12, le=1e12)
+    cyy: float = Field(default=0.0, ge=-1e12, le=1e12)
+    axes_angle_deg: float = Field(default=0.0, ge=-360, le=360)
+    name: str | None = Field(default=None, min_length=1, max_length=64, pattern=r"^[^.,\s]+$")
     uncertainty: Uncertainty = None
 
 
 class Pid(_Strict):
-    kp: float = Field(gt=0)
-    ti: float = Field(gt=0)
-    td: float = Field(ge=0)
-    eps: float = Field(gt=0)
+    kp: float = Field(gt=0, le=1e9)
+    ti: float = Field(gt=0, le=1e4)
+    td: float = Field(ge=0, le=100.0)
+    eps: float = Field(gt=0, le=1e3)
 
 
 class Controllers(_Strict):
     pid: Pid | None = None
-    sample_rate_hz: float = Field(default=10000.0, gt=0)
+    # plausible digital AMB controllers: 100 Hz to 1 MHz
+    sample_rate_hz: float = Field(default=10000.0, ge=100.0, le=1e6)
 
 
 class Operating(_Strict):
-    speed_rpm: float = 0.0
-    pressure_bar: float = Field(default=0.0, ge=0)
-    speed_range_hz: tuple[float, float] | None = None
+    speed_rpm: float = Field(default=0.0, ge=-1e6, le=1e6)
+    pressure_bar: float = Field(default=0.0, ge=0, le=1e4)
+    speed_range_hz: tuple[float, float] | None = Field(default=None, strict=False)  # a list
 
     @model_validator(mode="after")
     def _range(self) -> "Operating":
         r = self.speed_range_hz
-        if r is not None and not 0 < r[0] < r[1]:
-            raise ValueError("speed_range_hz: expected [low, high] with 0 < low < high")
+        if r is not None and not 0 < r[0] < r[1] <= 1e5:
+            raise ValueError("speed_range_hz: expected [low, high] with 0 < low < high "
+                             "<= 1e5 Hz")
+        if r is not None and not r[0] <= abs(self.speed_rpm) / 60 <= r[1]:
+            raise ValueError(f"speed_rpm: {self.speed_rpm:g} rpm = {abs(self.speed_rpm) / 60:g} "
+                             f"Hz lies outside speed_range_hz [{r[0]:g}, {r[1]:g}]: a "
+                             "controller scheduled over that range would be extrapolated")
         return self
 
 
 class Reduction(_Strict):
-    states: int | None = Field(default=None, ge=1)
-    cutoff_hz: float | None = Field(default=None, gt=0)
+    states: int | None = Field(default=None, ge=1, le=MAX_REDUCED_STATES)
+    cutoff_hz: float | None = Field(default=None, gt=0, le=1e7)
 
     @model_validator(mode="after")
     def _one(self) -> "Reduction":
@@ -329,49 +332,19 @@ class RigConfig(_Strict):
         return self.operating.speed_rpm * 2.0 * math.pi / 60.0
 
 
-def _loc(loc: tuple) -> str:
-    out = ""
-    for part in loc:
-        if isinstance(part, int):
-            out += f"[{part}]"
-        elif part in ("float", "AxisPair", "Affine", "int", "str"):
-            continue  # union branch names that pydantic inserts
-        elif "[" in str(part) or "function-" in str(part):
-            continue
-        else:
-            out += ("." if out else "") + str(part)
-    return out or "(top level)"
+def _union_tags() -> set[str]:
+    """The branch names pydantic puts into an error's location: our model classes and the
+    primitive types of the unions."""
+    tags, todo = set(PRIMITIVE_TAGS), [_Strict]
+    while todo:
+        cls = todo.pop()
+        tags.add(cls.__name__)
+        todo += cls.__subclasses__()
+    return tags
 
 
-def _cross_check(cfg: RigConfig, where: str) -> None:
-    """Checks that need the whole rig: materials exist, components lie on the shaft."""
-    for i, s in enumerate(cfg.shaft):
-        if s.material not in cfg.materials:
-            known = ", ".join(sorted(cfg.materials)) or "none"
-            raise ConfigError(
-                f"{where}: shaft[{i}].material: unknown material {s.material!r} "
-                f"(expected one of: {known})"
-            )
-    length = cfg.length
-    tol = 1e-9 * max(length, 1.0)
-
-    def on_shaft(key: str, z: float) -> None:
-        if not (-tol <= z <= length + tol):
-            raise ConfigError(
-                f"{where}: {key}: position {z} m lies outside the shaft "
-                f"(expected 0 <= position <= {length:g} m)"
-            )
-
-    for kind in ("disk", "seal", "spring"):
-        for i, comp in enumerate(getattr(cfg, kind)):
-            on_shaft(f"{kind}[{i}].position", comp.position)
-    names: set[str] = set()
-    for i, a in enumerate(cfg.amb):
-        on_shaft(f"amb[{i}].position", a.position)
-        on_shaft(f"amb[{i}].sensor_position", a.sensor_position)
-        if a.name in names:
-            raise ConfigError(f"{where}: amb[{i}].name: duplicate AMB name {a.name!r}")
-        names.add(a.name)
+def _describe(exc: ValidationError) -> str:
+    return describe_validation_error(exc, _union_tags())
 
 
 def parse_rig(data: dict, where: str = "<rig>") -> RigConfig:
@@ -392,18 +365,36 @@ def parse_rig(data: dict, where: str = "<rig>") -> RigConfig:
     try:
         cfg = RigConfig.model_validate(data)
     except ValidationError as exc:
-        err = exc.errors()[0]
-        loc = _loc(err["loc"])
-        msg = err["msg"]
-        if err["type"] == "missing":
-            msg = "missing required key"
-        elif err["type"] == "extra_forbidden":
-            msg = "unknown key (not part of the rig format)"
-        elif msg.startswith("Value error, "):
-            msg = msg[len("Value error, "):]
-        raise ConfigError(f"{where}: {loc}: {msg}") from None
-    _cross_check(cfg, where)
+        raise ConfigError(f"{where}: {_describe(exc)}") from None
+    cross_check(cfg, where)
     return cfg
+
+
+def check_operating(values: dict, arg_names: dict[str, str]) -> None:
+    """Validate command-line operating values by the rig file's own rules (``[operating]``).
+
+    Parameters
+    ----------
+    values : dict
+        ``{key: value}`` of :class:`Operating` keys (``pressure_bar``, ``speed_rpm``); None
+        values are skipped.
+    arg_names : dict
+        The command-line argument of each key, named in the error.
+
+    Raises
+    ------
+    ConfigError
+        ``--pressure-bar: ...`` with what the rig format expects.
+    """
+    for key, value in values.items():
+        if value is None:
+            continue
+        try:
+            Operating.model_validate({key: value})
+        except ValidationError as exc:
+            msg = _describe(exc).split(": ", 1)[1]
+            raise ConfigError(f"{arg_names.get(key, key)}: {msg} (the rule of [operating] "
+                              f"{key} in a rig file)") from None
 
 
 def load_rig(path: str | Path | None = None) -> RigConfig:
@@ -420,15 +411,19 @@ def load_rig(path: str | Path | None = None) -> RigConfig:
         The file is missing, is not valid TOML, or does not match the rig format.
     """
     p = Path(path) if path is not None else default_rig_path()
+    return parse_rig(_load_toml(p, "rig file"), str(p))
+
+
+def _load_toml(path: Path, what: str) -> dict:
+    """TOML of a rig or truth file; ConfigError naming the file when it cannot be read, is
+    not UTF-8 text (a byte-order mark is accepted), not TOML or nested too deeply."""
+    from .errors import AmbsealError
+    from .files import load_toml
+
     try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ConfigError(f"{p}: cannot read rig file ({exc.strerror or exc})") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{p}: not valid TOML ({exc})") from None
-    return parse_rig(data, str(p))
+        return load_toml(path, what)
+    except AmbsealError as exc:
+        raise ConfigError(str(exc)) from None
 
 
 def default_rig_path() -> Path:
@@ -482,18 +477,11 @@ def load_truth(path: str | Path) -> TruthSection:
     first-order low-pass in every displacement sensor, which the model does not have).
     """
     p = Path(path)
-    try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise ConfigError(f"{p}: cannot read truth file ({exc.strerror or exc})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{p}: not valid TOML ({exc})") from None
+    data = _load_toml(p, "truth file")
     try:
         return TruthConfig.model_validate(data).truth
     except ValidationError as exc:
-        err = exc.errors()[0]
-        msg = "missing required key" if err["type"] == "missing" else err["msg"]
-        raise ConfigError(f"{p}: {_loc(err['loc'])}: {msg}") from None
+        raise ConfigError(f"{p}: {_describe(exc)}") from None
 
 
 def rig_with_values(cfg: RigConfig, values: dict[str, Coefficient]) -> RigConfig:

@@ -6,6 +6,9 @@ CLI turns an :class:`AmbsealError` into one line on stderr and exit code 2.
 
 from __future__ import annotations
 
+__all__ = ["AmbsealError", "ConfigError", "DataError", "ModelError", "IdentificationError",
+           "SynthesisError", "describe_validation_error", "PRIMITIVE_TAGS"]
+
 
 class AmbsealError(Exception):
     """Base class of every error ambseal raises on purpose."""
@@ -29,3 +32,68 @@ class IdentificationError(AmbsealError):
 
 class SynthesisError(AmbsealError):
     """A controller cannot be synthesised (unstabilisable plant, rank-deficient D12, ...)."""
+
+
+#: Type names pydantic puts into an error's location for the branches of a union.
+PRIMITIVE_TAGS = {"float", "int", "str", "bool", "list[float]", "tuple[float, float]"}
+
+
+def _loc(loc: tuple, tags: set[str]) -> str:
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        elif part in tags or "[" in str(part) or "function-" in str(part):
+            continue  # union branch names that pydantic inserts
+        else:
+            out += ("." if out else "") + str(part)
+    return out or "(top level)"
+
+
+def _pick_error(exc, tags: set[str]) -> dict:
+    """The error that says what is wrong: at the first failing key, in the union branch
+    the value was meant for (a table is not a number: the branch with the fewest errors
+    among the tables; a number: its own branch)."""
+    errs = exc.errors()
+    where = _loc(errs[0]["loc"], tags)
+    same = [e for e in errs if _loc(e["loc"], tags).startswith(where.split(".")[0])]
+    branches: dict[tuple, list] = {}
+    for e in same:
+        tag = next((p for p in e["loc"] if p in tags), None)
+        if tag in PRIMITIVE_TAGS and isinstance(e.get("input"), (dict, list)):
+            continue  # the value is a table: the number branch's complaint is beside the point
+        branches.setdefault(tag, []).append(e)
+    if not branches:
+        return errs[0]
+    return min(branches.values(), key=len)[0]
+
+
+_BOUNDS = {"greater_than": ">", "greater_than_equal": ">=", "less_than": "<",
+           "less_than_equal": "<="}
+
+
+def describe_validation_error(exc, tags: set[str]) -> str:
+    """``key.path: what was expected`` for the error of a pydantic ``ValidationError`` that
+    matters (:func:`_pick_error`); ``tags`` are the union branch names to leave out of the
+    key path (model class names and ``PRIMITIVE_TAGS``)."""
+    err = _pick_error(exc, tags)
+    kind, msg, value = err["type"], err["msg"], err.get("input")
+    if kind == "missing":
+        msg = "missing required key"
+    elif kind == "extra_forbidden":
+        msg = "unknown key (not part of the format; check its spelling)"
+    elif kind in ("float_type", "int_type", "string_type", "bool_type") and not isinstance(
+            value, (dict, list)):
+        want = {"float_type": "a number", "int_type": "an integer",
+                "string_type": "a string", "bool_type": "true or false"}[kind]
+        msg = f"expected {want}, got {type(value).__name__} {value!r}"
+    elif kind == "finite_number":
+        msg = f"expected a finite number, got {value!r}"
+    elif kind in _BOUNDS:
+        limit = next(iter(err.get("ctx", {}).values()), "?")
+        msg = f"expected a value {_BOUNDS[kind]} {limit}, got {value!r}"
+    elif kind == "string_pattern_mismatch":
+        msg = f"expected a name without '.', ',' or spaces, got {value!r}"
+    elif msg.startswith("Value error, "):
+        msg = msg[len("Value error, "):]
+    return f"{_loc(err['loc'], tags)}: {msg}"

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from .config import RigConfig, default_rig_path, load_rig
 from .errors import ConfigError
-from .files import write_json, write_text
+from .files import RunFolder, write_json, write_text
 
 __all__ = ["RunResult", "Designed", "run", "default_truth_path"]
 
@@ -112,7 +112,9 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
     rig : path, optional
         Rig file; the embedded thesis test facility when omitted.
     out_dir : path
-        Output folder, created if needed.
+        Output folder, created if needed, replaced as a whole at the end
+        (:class:`ambseal.files.RunFolder`: a staging folder beside it, a lock against a
+        second run, a manifest of the files written last).
     progress : bool
         Show a progress display on stderr.
     truth : path, optional
@@ -148,12 +150,18 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         truth = default_truth_path()
     if not cfg.amb:
         raise ConfigError(f"{rig_path}: amb: the main job needs at least one [[amb]]")
-    out = Path(out_dir)
-    (out / "controllers").mkdir(parents=True, exist_ok=True)
+    truth_cfg = None
+    if identification and truth is not None:
+        from .config import load_truth
+
+        truth_cfg = load_truth(truth)  # refused before any work
     points = operating_points(cfg)
     settings = JudgeSettings()
-
-    with Progress(console=Console(stderr=True), disable=not progress, transient=True) as bar:
+    final = Path(out_dir)
+    # one run = one folder: written into a staging folder that replaces out_dir at the end
+    with RunFolder(final) as out, \
+            Progress(console=Console(stderr=True), disable=not progress, transient=True) as bar:
+        (out / "controllers").mkdir()
         total = 2 + 3 * 3 * len(points) + 1
         task = bar.add_task("ambseal run", total=total)
 
@@ -192,10 +200,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
             "cases": cases,
         }
         figs, sections = [], []
-        if identification and truth is not None:
-            from .config import load_truth
-
-            truth_cfg = load_truth(truth)
+        if truth_cfg is not None:
             bar.update(task, total=total + 8)
             metrics["identification"], figs, sections = _identification(cfg, truth_cfg, out, say)
         if speed_scheduled(cfg):
@@ -204,10 +209,10 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                 cfg, {d.method: d.controller for d in designs})
             figs += spinup_figures(out, sims, sens, cfg.operating.speed_range_hz)
         say("report", 0)
-        metrics_path = write_json(out / "metrics.json", metrics)
+        write_json(out / "metrics.json", metrics)
         speed = 2 * math.pi * cfg.operating.speed_rpm / 60.0
         figs.append(gains_figure(out, [(d.method, frozen(d.controller, speed)) for d in designs]))
-        report_path = write_run_report(out, f"ambseal — {cfg.rotor.name}", f"rig: {rig_path}",
-                                       metrics, curves, figs, sections)
+        write_run_report(out, f"ambseal — {cfg.rotor.name}", f"rig: {rig_path}",
+                         metrics, curves, figs, sections)
         bar.advance(task)
-    return RunResult(out, metrics_path, report_path, metrics)
+    return RunResult(final, final / "metrics.json", final / "report.html", metrics)

@@ -108,8 +108,8 @@ from typing import Sequence
 
 import numpy as np
 
-from ambseal.errors import DataError
-from ambseal.files import atomic_write
+from ambseal.errors import AmbsealError, DataError
+from ambseal.files import atomic_write, read_text
 from ambseal.identify.measurement import (CHANNELS, CLIP_RTOL, CLIP_RUN, FORMAT_TAG,
                                           TIME_RTOL, Measurement, _json_safe, _RATE_RTOL,
                                           _RESERVED, column_names, validate_measurement)
@@ -205,11 +205,15 @@ def save_measurement(meas: Measurement, path: str | os.PathLike) -> Path:
 
 
 # --------------------------------------------------------------------------- load
+def _no_constant(name: str):
+    raise ValueError(f"{name} is not a number JSON allows")
+
+
 def _read_header_json(text: str, where: str) -> dict:
     try:
-        obj = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise DataError(f"{where}: not valid JSON ({exc})") from None
+        obj = json.loads(text, parse_constant=_no_constant)
+    except (ValueError, RecursionError) as exc:  # JSONDecodeError is a ValueError
+        raise DataError(f"{where}: not valid JSON ({str(exc) or 'nested too deeply'})") from None
     if not isinstance(obj, dict):
         raise DataError(f"{where}: expected a JSON object, got {type(obj).__name__}")
     if "format" not in obj:
@@ -222,11 +226,15 @@ def _read_header_json(text: str, where: str) -> dict:
     return obj
 
 
-def _read_csv(path: Path) -> tuple[list[str], np.ndarray]:
+def _read(path: Path, what: str) -> str:
     try:
-        text = path.read_text(encoding="utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise DataError(f"{path}: not a UTF-8 text file ({exc.reason})") from None
+        return read_text(path, what)
+    except AmbsealError as exc:
+        raise DataError(str(exc)) from None
+
+
+def _read_csv(path: Path) -> tuple[list[str], np.ndarray]:
+    text = _read(path, "record")
     lines = text.splitlines()
     if not lines or not lines[0].strip():
         raise DataError(f"{path}: empty file, expected a header row of column names")
@@ -333,7 +341,7 @@ def load_measurement(
         side = _sidecar(path)
         if not side.is_file():
             raise DataError(f"{path}: missing metadata sidecar {side.name!r}")
-        header = _read_header_json(side.read_text(encoding="utf-8"), str(side))
+        header = _read_header_json(_read(side, "sidecar"), str(side))
         names, data = _read_csv(path)
         seen = set()
         for c in names:

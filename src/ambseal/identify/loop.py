@@ -16,6 +16,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 
+import math
+
 import numpy as np
 
 from ..lti.discrete import discretize
@@ -62,6 +64,17 @@ class DiscreteController:
             A = np.zeros((0, 0))
             B = np.zeros((0, D.shape[1]))
             C = np.zeros((D.shape[0], 0))
+        n, (p, m) = A.shape[0], D.shape
+        want = {"A": (n, n), "B": (n, m), "C": (p, n), "D": (p, m)}
+        for k, M in zip("ABCD", (A, B, C, D)):
+            if M.ndim != 2 or M.shape != want[k]:
+                raise ValueError(f"controller: {k} has shape {M.shape}, expected {want[k]} "
+                                 f"(A n×n, B n×m, C p×n, D p×m from A {A.shape} and "
+                                 f"D {D.shape})")
+            if not np.all(np.isfinite(M)):
+                raise ValueError(f"controller: {k} holds a value that is not finite")
+        if not (math.isfinite(dt) and dt > 0):
+            raise ValueError(f"controller: dt: expected a sampling period > 0 (s), got {dt!r}")
         return cls(A, B, C, D, dt)
 
 

@@ -222,8 +222,17 @@ def _axes_and_gains(
     return names, g, gains
 
 
+#: The longest excitation: 2·10⁶ samples (200 s at 10 kHz); a record of it on 4 axes holds
+#: 16 columns of 8-byte samples, 256 MB, and its simulation and fit take minutes.
+MAX_SAMPLES = 2_000_000
+
+
 def _n_samples(duration_s: float, fs: float, name: str = "duration_s") -> int:
     n = int(round(duration_s * fs))
+    if n > MAX_SAMPLES:
+        raise ValueError(f"{name}: {duration_s:g} s at {fs:g} Hz gives {n} samples, more than "
+                         f"{MAX_SAMPLES} (a record of 4 axes would need "
+                         f"{n * 16 * 8 / 2**30:.3g} GB)")
     if n < 2:
         raise ValueError(f"{name}: {duration_s} s at {fs} Hz gives {n} samples, expected >= 2")
     return n

@@ -241,10 +241,16 @@ def controller_gains_figure(
     """Direct and cross gains |K_ij(jω)| (A/m) of several controllers (P5 Fig. 10).
 
     ``controllers``: (label, frequency_hz (n,), K (n, nu, ny) complex); ``pairs`` are
-    (output i, input j) indices, 0-based; panel titles use ``channel_names``.
+    (output i, input j) indices, 0-based, those the controllers have (a rig with one AMB
+    has a 2 × 2 K); panel titles use ``channel_names``.
     """
+    nu, ny = np.asarray(controllers[0][2]).shape[1:]
+    pairs = [(i, j) for i, j in pairs if i < nu and j < ny] or [(0, 0)]
     fig = Figure(figsize=(10, 6), layout="constrained")
-    axes = fig.subplots(2, 2).ravel()
+    axes = np.atleast_1d(fig.subplots(2, (len(pairs) + 1) // 2) if len(pairs) > 1
+                         else fig.subplots(1, 1)).ravel()
+    for ax in axes[len(pairs):]:
+        ax.set_visible(False)
     for ax, (i, j) in zip(axes, pairs):
         for label, f, K in controllers:
             ax.loglog(np.asarray(f, float), np.abs(np.asarray(K)[:, i, j]), label=label)

@@ -1,0 +1,205 @@
+"""Bad input is refused with one line naming the file and key, exit 2 (issue 15 §1–§3).
+
+Each case is a regression test of a finding of the issue: a value that used to be accepted
+(silently coerced, silently ignored, or ending in a traceback). The reference is the rig
+format (ambseal.config's docstring) and the CLI's promise: one line on stderr, status 2.
+"""
+
+import copy
+import tomllib
+
+import pytest
+
+from ambseal.cli import main
+
+from .conftest import ROOT
+
+RIG = ROOT / "examples" / "testrig.toml"
+TRUTH = ROOT / "src" / "ambseal" / "data" / "testrig_truth.toml"
+BASE = tomllib.loads(RIG.read_text())
+
+
+def _toml(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        return '"' + v + '"'
+    if isinstance(v, float) and v != v:
+        return "nan"
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{k} = {_toml(x)}" for k, x in v.items()) + " }"
+    if isinstance(v, list):
+        return "[" + ", ".join(_toml(x) for x in v) + "]"
+    return repr(v)
+
+
+def dump(data: dict) -> str:
+    """A rig dict as TOML (tables, arrays of tables, inline tables)."""
+    lines = []
+    for key, val in data.items():
+        if isinstance(val, list):
+            for item in val:
+                lines += [f"[[{key}]]"] + [f"{k} = {_toml(x)}" for k, x in item.items()]
+        else:
+            subs = {k: x for k, x in val.items() if isinstance(x, dict) and
+                    all(isinstance(y, dict) for y in x.values()) and x}
+            if key == "materials":
+                subs = val
+            lines += [f"[{key}]"] + [f"{k} = {_toml(x)}" for k, x in val.items()
+                                     if k not in subs]
+            for k, x in subs.items():
+                lines += [f"[{key}.{k}]"] + [f"{j} = {_toml(y)}" for j, y in x.items()]
+    return "\n".join(lines) + "\n"
+
+
+def cli(capsys, *args) -> tuple[int, str]:
+    capsys.readouterr()
+    try:
+        code = main([str(a) for a in args])
+    except SystemExit as exc:  # argparse
+        code = exc.code
+    err = capsys.readouterr().err.strip().splitlines()
+    return code, (err[0] if len(err) == 1 else "\n".join(err) or "<none>")
+
+
+def refused(capsys, args, where: str, *expect: str) -> str:
+    code, line = cli(capsys, *args)
+    assert code == 2 and "\n" not in line, line
+    for part in (where, *expect):
+        assert part in line, line
+    return line
+
+
+def test_dump_round_trip():
+    """The helper writes the example rig so that it reads back equal."""
+    assert tomllib.loads(dump(BASE)) == BASE
+
+
+def _set(path: str, value):
+    def edit(d):
+        *head, last = path.split("/")
+        for k in head:
+            d = d[int(k)] if k.isdigit() else d[k]
+        if value is _DEL:
+            del d[last]
+        elif isinstance(d, list):
+            d[int(last)] = value
+        else:
+            d[last] = value
+    return edit
+
+
+_DEL = object()
+
+RIG_CASES = [
+    # §1 silent coercion: strict schema
+    ("bool mass", _set("disk/0/mass", True), "disk[0].mass", "expected a number"),
+    ("bool elements", _set("shaft/0/elements", True), "shaft[0].elements", "integer"),
+    ("string E", _set("materials/steel/E", "1.5"), "materials.steel.E", "str"),
+    ("empty M", _set("seal/0/M", {}), "seal[0].M", "empty table"),
+    # §1 nonsense
+    ("ki zero", _set("amb/0/ki", 0.0), "amb[0]", "Ki > 0"),
+    ("ki negative axis", _set("amb/0/ki", {"zeta": -199.0, "eta": 207.0}), "amb[0]",
+     "ki.zeta"),
+    ("ks negative", _set("amb/0/ks", -2.39e6), "amb[0]", "Ks > 0 the destabilising"),
+    ("partial geometry", _set("amb/1/turns", 36), "amb[1]", "partial geometry"),
+    ("cutoff with second order", _set("actuator/cutoff_hz", 300.0), "actuator",
+     "not used by model = 'second_order'"),
+    ("states 100000", _set("reduction/states", 100000), "reduction.states", "<= 200"),
+    ("sample rate 1e-6", _set("controller/sample_rate_hz", 1e-6),
+     "controller.sample_rate_hz", ">= 100"),
+    ("speed outside LPV range", _set("operating/speed_range_hz", [20.0, 300.0]),
+     "operating", "extrapolated"),
+    ("dot in name", _set("seal/0/name", "seal.1"), "seal[0].name", "without '.'"),
+    # §2 extreme but finite
+    ("1e308 mass", _set("disk/0/mass", 1e308), "disk[0].mass", "<= 1000000"),
+    ("1e-308 diameter", _set("shaft/0/outer_diameter", 1e-308), "shaft[0].outer_diameter",
+     ">= 0.0001"),
+    ("1e30 elements", _set("shaft/1/elements", 10**18), "shaft[1].elements", "<= 150"),
+    ("elements in all", _set("shaft/0/elements", 140), "shaft", "states"),
+    # §3 nested values
+    ("nan in affine", _set("seal/0/K", {"at_zero": float("nan"), "per_bar": 1.0}),
+     "seal[0].K.at_zero", "finite"),
+    ("typo per_bars", _set("seal/0/K", {"at_zero": 0.0, "per_bars": 1.0}),
+     "seal[0].K.per_bars", "unknown key"),
+    ("missing eta", _set("amb/0/ki", {"zeta": 199.0}), "amb[0]", "both zeta and eta"),
+    ("unsorted table", _set("seal/0/K", {"frequency_hz": [20.0, 10.0], "value": [1.0, 2.0]}),
+     "seal[0].K", "strictly increasing"),
+    ("length mismatch", _set("seal/0/K", {"frequency_hz": [10.0, 20.0], "value": [1.0]}),
+     "seal[0].K", "same length"),
+]
+
+
+@pytest.mark.parametrize("label, edit, key, expect", RIG_CASES, ids=[c[0] for c in RIG_CASES])
+def test_rig_value_refused(tmp_path, capsys, label, edit, key, expect):
+    data = copy.deepcopy(BASE)
+    edit(data)
+    rig = tmp_path / "rig.toml"
+    rig.write_text(dump(data))
+    refused(capsys, ["modes", rig, "--n-modes", 1], str(rig), key, expect)
+
+
+def test_duplicate_seal_and_spring_names(tmp_path, capsys):
+    """Their parameter names would collide (seal.k, spring0.kxx)."""
+    for kind, extra in (("seal", {}), ("spring", {})):
+        data = copy.deepcopy(BASE)
+        data[kind].append({**data[kind][0], **extra})
+        rig = tmp_path / f"{kind}.toml"
+        rig.write_text(dump(data))
+        refused(capsys, ["modes", rig], f"{kind}[1].name", "duplicate")
+    data = copy.deepcopy(BASE)
+    data["spring"] = [{"position": 0.0, "kxx": 1e5, "kyy": 1e5},
+                      {"position": 0.86, "kxx": 1e5, "kyy": 1e5, "name": "spring0"}]
+    rig = tmp_path / "unnamed.toml"
+    rig.write_text(dump(data))
+    refused(capsys, ["modes", rig], "spring[1].name", "spring0")
+
+
+CLI_CASES = [
+    (["modes", RIG, "--pressure-bar", "-5"], "--pressure-bar", "[operating] pressure_bar"),
+    (["modes", RIG, "--pressure-bar", "nan"], "--pressure-bar", "finite"),
+    (["modes", RIG, "--speed-rpm", "1e300"], "--speed-rpm", "finite"),
+    (["modes", RIG, "--n-modes", "1e30"], "--n-modes", "whole number"),
+    (["identify", RIG, "x.csv", "--params", "A.Ki_zeta", "--out", "o", "--current-weight",
+      "-1"], "--current-weight", ">= 0"),
+    (["identify", RIG, "x.csv", "--params", "A.Ki_zeta", "--out", "o", "--current-weight",
+      "nan"], "--current-weight", "finite"),
+    (["acquire", RIG, "--truth", TRUTH, "--excitation", "prbs", "--pressure-bar", "0",
+      "--out", "r.csv", "--axes", ""], "--axes", "axis names"),
+    (["acquire", RIG, "--truth", TRUTH, "--excitation", "prbs", "--pressure-bar", "0",
+      "--out", "r.csv", "--duration-s", "1e9"], "duration_s", "GB"),
+    (["run", "--truth", "MISSING.toml", "--out", "o"], "MISSING.toml", "cannot read"),
+]
+
+
+@pytest.mark.parametrize("args, where, expect", CLI_CASES,
+                         ids=[" ".join(map(str, c[0][:1] + c[0][-2:])) for c in CLI_CASES])
+def test_cli_value_refused(tmp_path, capsys, monkeypatch, args, where, expect):
+    """The CLI checks its values by the rig file's rules, before any work (a run with a
+    missing truth file is refused before the model is built)."""
+    monkeypatch.chdir(tmp_path)
+    refused(capsys, args, where, expect)
+    assert not (tmp_path / "o").exists()
+
+
+def test_files_that_are_not_utf8_or_too_deep(tmp_path, capsys):
+    """Non-UTF-8 rig and truth files are refused as such; a UTF-8 byte-order mark is
+    accepted; TOML nested 5 000 deep is refused, not a RecursionError."""
+    bad = tmp_path / "latin1.toml"
+    bad.write_bytes(dump(BASE).replace("DTU", "DTU \u00e6").encode("latin-1"))
+    refused(capsys, ["modes", bad], str(bad), "not UTF-8 text")
+    refused(capsys, ["acquire", RIG, "--truth", bad, "--excitation", "prbs", "--pressure-bar",
+                     "0", "--out", tmp_path / "r.csv"], str(bad), "not UTF-8")
+    bom = tmp_path / "bom.toml"
+    bom.write_bytes(b"\xef\xbb\xbf" + RIG.read_bytes())
+    assert cli(capsys, "modes", bom, "--n-modes", 1)[0] == 0
+    deep = tmp_path / "deep.toml"
+    deep.write_text("x = " + "[" * 5000 + "]" * 5000 + "\n")
+    refused(capsys, ["modes", deep], str(deep), "nested too deeply")
+
+
+def test_truth_file_is_strict(tmp_path, capsys):
+    t = tmp_path / "truth.toml"
+    t.write_text("[truth]\nsubsteps = true\n")
+    refused(capsys, ["acquire", RIG, "--truth", t, "--excitation", "prbs", "--pressure-bar",
+                     "0", "--out", tmp_path / "r.csv"], str(t), "truth.substeps", "integer")

@@ -13,43 +13,11 @@ import pytest
 from ambseal.cli import main
 
 from .conftest import ROOT
+from .toml_text import dump
 
 RIG = ROOT / "examples" / "testrig.toml"
 TRUTH = ROOT / "src" / "ambseal" / "data" / "testrig_truth.toml"
 BASE = tomllib.loads(RIG.read_text())
-
-
-def _toml(v) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, str):
-        return '"' + v + '"'
-    if isinstance(v, float) and v != v:
-        return "nan"
-    if isinstance(v, dict):
-        return "{ " + ", ".join(f"{k} = {_toml(x)}" for k, x in v.items()) + " }"
-    if isinstance(v, list):
-        return "[" + ", ".join(_toml(x) for x in v) + "]"
-    return repr(v)
-
-
-def dump(data: dict) -> str:
-    """A rig dict as TOML (tables, arrays of tables, inline tables)."""
-    lines = []
-    for key, val in data.items():
-        if isinstance(val, list):
-            for item in val:
-                lines += [f"[[{key}]]"] + [f"{k} = {_toml(x)}" for k, x in item.items()]
-        else:
-            subs = {k: x for k, x in val.items() if isinstance(x, dict) and
-                    all(isinstance(y, dict) for y in x.values()) and x}
-            if key == "materials":
-                subs = val
-            lines += [f"[{key}]"] + [f"{k} = {_toml(x)}" for k, x in val.items()
-                                     if k not in subs]
-            for k, x in subs.items():
-                lines += [f"[{key}.{k}]"] + [f"{j} = {_toml(y)}" for j, y in x.items()]
-    return "\n".join(lines) + "\n"
 
 
 def cli(capsys, *args) -> tuple[int, str]:

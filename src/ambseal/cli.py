@@ -211,8 +211,11 @@ def _acquire(args: argparse.Namespace) -> int:
                                  start_s=args.start_s, duration_s=args.duration_s, **common)
     except ValueError as exc:
         raise ConfigError(f"acquire: {exc}") from None
-    meas = acquire(cfg, truth, ex, controller=reference_controller(cfg),
-                   pressure_bar=args.pressure_bar, seed=args.seed)
+    try:
+        meas = acquire(cfg, truth, ex, controller=reference_controller(cfg),
+                       pressure_bar=args.pressure_bar, seed=args.seed)
+    except AmbsealError as exc:  # the simulation runs on the truth file's values
+        raise _named(exc, [args.truth], f"{args.truth} (with {args.rig})") from None
     path = save_measurement(meas, args.out)
     print(json.dumps({"out": str(path), "samples": meas.n_samples,
                       "sample_rate_hz": fs}))
@@ -245,6 +248,24 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _named(exc: AmbsealError, files: list, source: str) -> AmbsealError:
+    """``exc`` with ``source: `` in front unless its message names one of ``files``."""
+    msg = str(exc)
+    if any(str(f) in msg for f in files if f):
+        return exc
+    return type(exc)(f"{source}: {msg}")
+
+
+def _inputs(args: argparse.Namespace) -> tuple[list, str]:
+    """The files a command reads and writes, and the one an unnamed error comes from."""
+    from .config import default_rig_path
+
+    rig = getattr(args, "rig", None) or default_rig_path()
+    files = [rig, getattr(args, "truth", None), getattr(args, "out", None),
+             *(getattr(args, "data", None) or [])]
+    return files, str(rig)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``ambseal`` console script; returns the exit status.
 
@@ -263,7 +284,7 @@ def main(argv: list[str] | None = None) -> int:
             _check_operating(args)
             code = handler(args)
         except AmbsealError as exc:
-            print(f"ambseal: error: {exc}", file=sys.stderr)
+            print(f"ambseal: error: {_named(exc, *_inputs(args))}", file=sys.stderr)
             return 2
         except MemoryError:
             print(f"ambseal: error: {args.command}: not enough memory for this input",

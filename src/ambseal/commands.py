@@ -139,7 +139,7 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
     from .identify.budget import advice
     from .identify.data import load_measurement
     from .identify.residuals import MISMATCH
-    from .identify.stages import identify, record_spread
+    from .identify.stages import check_record_metadata, identify, record_spread
     from .model.amb import channel_names
     from .report.identify_figures import (correlation_figure, error_budget_figure,
                                           fit_timeseries_figure, residual_figure)
@@ -153,6 +153,7 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
         if other is not None and other != cfg.rotor.name:
             raise DataError(f"{path}: metadata.rig: recorded on {other!r}, but the rig is "
                             f"{cfg.rotor.name!r}")
+        check_record_metadata(dict(meas.metadata), str(path))
         records.append(meas)
         controllers.append(controller_from_metadata(dict(meas.metadata), axes, str(path)))
     _check_records(records, data)

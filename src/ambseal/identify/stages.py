@@ -18,8 +18,9 @@ from .loop import DiscreteController
 from .rig_sim import reduced_plant, simulate_facility
 from .signals import Excitation
 
-__all__ = ["controller_from_metadata", "check_controller", "sample_rate_of", "acquire",
-           "build_models", "identify", "record_spread", "FIT_CUTOFF_HZ"]
+__all__ = ["controller_from_metadata", "check_controller", "sample_rate_of",
+           "check_record_metadata", "acquire", "build_models", "identify", "record_spread",
+           "FIT_CUTOFF_HZ"]
 
 #: Modes kept in the fit's reduced model (Hz). The rigid-body modes alone (8 states, P2 §3.2)
 #: bias Ki/Ks by ~0.5 % on the test rig through the static flexibility of the dropped bending
@@ -76,6 +77,16 @@ def check_controller(ctrl: DiscreteController, axes: tuple[str, ...], fs: float,
 def sample_rate_of(meta: dict, source: str = "<data>") -> float:
     """A record's ``sample_rate_hz`` metadata (Hz), or a DataError naming ``source``."""
     return _positive(meta, "sample_rate_hz", source)
+
+
+def check_record_metadata(meta: dict, source: str) -> None:
+    """The operating point of a record's metadata within the rig format's ranges:
+    ``pressure_drop_pa`` at most 1e9 Pa (1e4 bar) and ``speed_rad_s`` at most 1.05e5 rad/s
+    (1e6 rpm); a DataError naming ``source`` otherwise."""
+    for key, high in (("pressure_drop_pa", 1e9), ("speed_rad_s", 1e6 * 2 * np.pi / 60)):
+        if meta.get(key) is not None and _positive(meta, key, source, default=0.0) > high:
+            raise DataError(f"{source}: metadata.{key}: {meta[key]!r} is beyond the plausible "
+                            f"{high:.3g}")
 
 
 def _positive(meta: dict, key: str, source: str, default: float | None = None) -> float:

@@ -18,6 +18,8 @@ from ambseal.cli import main
 from ambseal.errors import AmbsealError
 from ambseal.files import RunFolder, check_manifest, write_text
 
+from .conftest import ROOT
+
 # A stand-in for `ambseal run` that writes its files slowly into a RunFolder, so that a kill
 # lands in the middle of the writing (the real run: `test_killed_ambseal_run`, -m slow).
 WRITER = textwrap.dedent("""
@@ -117,4 +119,67 @@ def test_killed_runs_never_leave_a_mix(tmp_path):
         check_manifest(out)
         assert len(_tags(out)) == 1
     _write(out, "last", n=1)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".out.lock", "out"]
+
+
+def test_full_disk_refused_before_work(tmp_path, capsys, monkeypatch):
+    """A run into a file system with less than MIN_FREE_BYTES free is refused at once with
+    the free space (the disk is made to look full: shutil.disk_usage reports 1 MB)."""
+    import shutil
+
+    usage = shutil.disk_usage(tmp_path)
+    monkeypatch.setattr(shutil, "disk_usage", lambda p: usage._replace(free=2**20))
+    assert main(["run", "--no-identify", "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "1.0 MB free" in err[0]
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("command", ["run", "identify", "design", "acquire"])
+def test_unwritable_output_refused_before_work(tmp_path, capsys, monkeypatch, command):
+    """An output below a regular file cannot be created (ENOTDIR, as a read-only or missing
+    mount would): one line naming it, exit 2, before any work."""
+    from ambseal.pipeline import default_truth_path
+
+    (tmp_path / "file").write_text("x")
+    out = tmp_path / "file" / "out"
+    args = {"run": ["run", "--out", str(out)],
+            "identify": ["identify", str(default_truth_path().with_name("testrig.toml")),
+                         "x.csv", "--params", "A.Ki_zeta", "--out", str(out)],
+            "design": ["design", str(default_truth_path().with_name("testrig.toml")),
+                       "--method", "pid", "--out", str(out)],
+            "acquire": ["acquire", str(default_truth_path().with_name("testrig.toml")),
+                        "--truth", str(default_truth_path()), "--excitation", "prbs",
+                        "--pressure-bar", "0", "--out", str(out / "r.csv")]}[command]
+    import ambseal.control.recipes as recipes
+
+    def no_work(*a, **k):
+        raise AssertionError("designing before the output was checked")
+
+    monkeypatch.setattr(recipes, "design", no_work)
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(tmp_path / "file") in err[0], err
+
+
+@pytest.mark.slow
+def test_killed_ambseal_run(tmp_path):
+    """The real `ambseal run` (turboexpander rig: its own designs, a few minutes) killed at a
+    random moment of a rerun: the folder is the first run's complete set (its manifest
+    and run id), or the rerun's; a last run cleans up after the killed one."""
+    rig = str(ROOT / "examples" / "turboexpander.toml")
+    out = tmp_path / "out"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    cmd = [sys.executable, "-m", "ambseal.cli", "run", rig, "--out", str(out)]
+    t0 = time.perf_counter()
+    subprocess.run(cmd, env=env, check=True, capture_output=True)
+    first, duration = check_manifest(out), time.perf_counter() - t0
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    time.sleep(random.Random().uniform(0.2, duration))
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    check_manifest(out)  # a complete set, of either run (raises on a mix)
+    assert (out / "metrics.json").exists() and (out / "report.html").exists()
+    subprocess.run(cmd, env=env, check=True, capture_output=True)
+    assert check_manifest(out) != first
     assert sorted(p.name for p in tmp_path.iterdir()) == [".out.lock", "out"]

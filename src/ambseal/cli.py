@@ -34,6 +34,7 @@ import json
 import math
 import os
 import sys
+from pathlib import Path
 
 from .errors import AmbsealError
 
@@ -175,6 +176,7 @@ def _check_operating(args: argparse.Namespace) -> None:
 def _acquire(args: argparse.Namespace) -> int:
     from .config import load_rig, load_truth
     from .errors import ConfigError
+    from .files import writable_folder
     from .identify import signals
     from .identify.data import save_measurement
     from .control.pid import reference_controller
@@ -183,6 +185,7 @@ def _acquire(args: argparse.Namespace) -> int:
 
     cfg = load_rig(args.rig)
     truth = load_truth(args.truth)
+    writable_folder(Path(args.out).parent)  # before the simulation
     axes = channel_names(cfg)
     if not axes:
         raise ConfigError(f"{args.rig}: amb: acquisition needs at least one [[amb]]")

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from .config import load_rig
 from .errors import ConfigError
-from .files import write_json, write_text
+from .files import writable_folder, write_json, write_text
 
 __all__ = ["design_files", "identify_files", "export_design"]
 
@@ -60,8 +60,7 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
     from .control.recipes import design
 
     cfg = load_rig(rig)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = writable_folder(out_dir)  # before the design, not after it
     fs = cfg.controller.sample_rate_hz
     if method == "lpv":
         from .control.lpv_design import design_lpv
@@ -145,6 +144,7 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
                                           fit_timeseries_figure, residual_figure)
 
     cfg = load_rig(rig)
+    out = writable_folder(out_dir)  # before the fit, not after it
     axes = channel_names(cfg)
     records, controllers = [], []
     for path in data:
@@ -167,8 +167,6 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
     if res.mismatch:
         warnings.append(f"{MISMATCH} (residuals correlate with the excitation on "
                         f"{', '.join(res.residuals.failed)})")
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     write_json(out / "fit.json", {**res.to_dict(), "warnings": warnings,
                                   **({"per_record": spread} if spread else {})})
     fit_timeseries_figure(out / "fit_timeseries.png", res.time_s, res.y_meas, res.y_sim,

@@ -15,7 +15,7 @@ from typing import Any, BinaryIO, Callable
 
 from .errors import AmbsealError
 
-__all__ = ["atomic_write", "read_text", "load_toml", "write_text", "write_json", "RunFolder", "check_manifest",
+__all__ = ["atomic_write", "writable_folder", "read_text", "load_toml", "write_text", "write_json", "RunFolder", "check_manifest",
            "write_manifest"]
 
 
@@ -27,22 +27,42 @@ def atomic_write(path: str | os.PathLike, write: Callable[[BinaryIO], Any]) -> P
     Raises
     ------
     AmbsealError
-        If the folder does not exist.
+        If the folder does not exist or the file cannot be written (no permission, disk
+        full); the former file is kept.
     """
     path = Path(path)
     if not path.parent.is_dir():
         raise AmbsealError(f"{path}: folder {str(path.parent)!r} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    except OSError as exc:
+        raise AmbsealError(f"{path}: cannot write ({exc.strerror or exc})") from None
     try:
         with os.fdopen(fd, "wb") as fh:
             write(fh)
         os.chmod(tmp, 0o644)
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         if os.path.exists(tmp):
             os.unlink(tmp)
+        if isinstance(exc, OSError):  # a full disk, a folder gone read-only
+            raise AmbsealError(f"{path}: cannot write ({exc.strerror or exc})") from None
         raise
     return path
+
+
+def writable_folder(folder: str | os.PathLike) -> Path:
+    """Create ``folder`` if needed and check that a file can be written there, before any
+    work is done; AmbsealError (one line naming the folder) otherwise."""
+    folder = Path(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        fd, probe = tempfile.mkstemp(prefix=".ambseal-probe.", dir=folder)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise AmbsealError(f"{folder}: cannot write there ({exc.strerror or exc})") from None
+    return folder
 
 
 def read_text(path: str | os.PathLike, what: str = "file") -> str:

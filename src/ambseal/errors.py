@@ -92,6 +92,10 @@ def describe_validation_error(exc, tags: set[str]) -> str:
     elif kind in _BOUNDS:
         limit = next(iter(err.get("ctx", {}).values()), "?")
         msg = f"expected a value {_BOUNDS[kind]} {limit}, got {value!r}"
+    elif kind in ("model_type", "dict_type", "model_attributes_type"):
+        msg = f"expected a table, got {type(value).__name__} {value!r}"
+    elif kind in ("list_type", "tuple_type"):
+        msg = f"expected an array, got {type(value).__name__} {value!r}"
     elif kind == "string_pattern_mismatch":
         msg = f"expected a name without '.', ',' or spaces, got {value!r}"
     elif msg.startswith("Value error, "):

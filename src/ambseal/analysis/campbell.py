@@ -54,9 +54,10 @@ def log_decrement(poles: np.ndarray) -> np.ndarray:
 def lowest_log_decrement(poles: np.ndarray, max_hz: float) -> tuple[float, float]:
     """(δ, f_d in Hz) of the least damped oscillating pole with f_d ≤ ``max_hz``, by log
     decrement; (nan, nan) when there is none."""
+    from ..model.modes import RIGID_BODY_RAD_S
+
     p = np.asarray(poles, complex)
-    tol = 1e-9 * max(float(np.abs(p).max(initial=0.0)), 1.0)
-    p = p[(p.imag > tol) & (p.imag <= 2 * np.pi * max_hz)]
+    p = p[(p.imag >= RIGID_BODY_RAD_S) & (p.imag <= 2 * np.pi * max_hz)]
     if p.size == 0:
         return float("nan"), float("nan")
     d = log_decrement(p)
@@ -207,13 +208,15 @@ def modes_of_state_matrix(A: np.ndarray, mesh, *, speed_hz: float, pressure_bar:
     """:class:`ClosedLoopModes` of a state matrix whose first ``mesh.n_dof`` states are the
     rotor's node DOFs q (any plant of :mod:`ambseal.model.rig`, open or closed loop).
 
-    Eigenvalues with |λ| below max(10⁻⁶·max|λ|, 10⁻³ rad/s) are rigid-body modes and left
-    out, as in :func:`ambseal.model.modes.modes`.
+    Rigid-body modes and oscillating ones as in :func:`ambseal.model.modes.modes`
+    (:func:`~ambseal.model.modes.classify_poles`: absolute thresholds in rad/s; ModelError
+    when the conditioning makes them doubtful).
     """
+    from ..model.modes import RIGID_BODY_RAD_S, classify_poles
+
     lam, V = sla.eig(A)
-    scale = max(float(np.abs(lam).max()), 1.0)
-    rigid = np.abs(lam) < max(1e-6 * scale, 1e-3)
-    keep = np.flatnonzero((lam.imag > 1e-6 * scale) & ~rigid
+    rigid, _ = classify_poles(lam, where="closed-loop modes")
+    keep = np.flatnonzero((lam.imag >= RIGID_BODY_RAD_S) & ~rigid
                           & (lam.imag <= 2 * np.pi * max_hz))
     keep = keep[np.argsort(lam.imag[keep])]
     n = mesh.n_dof

@@ -171,3 +171,17 @@ def test_truth_file_is_strict(tmp_path, capsys):
     t.write_text("[truth]\nsubsteps = true\n")
     refused(capsys, ["acquire", RIG, "--truth", t, "--excitation", "prbs", "--pressure-bar",
                      "0", "--out", tmp_path / "r.csv"], str(t), "truth.substeps", "integer")
+
+
+def test_gains_figure_of_a_one_amb_rig(tmp_path):
+    """A rig with one AMB has a 2 × 2 controller: the gains figure draws the pairs it has
+    (it raised IndexError after metrics.json was written; `ambseal run` on the test rig with
+    AMB B replaced by a bearing spring now exits 0)."""
+    import numpy as np
+
+    from ambseal.report.figures import controller_gains_figure
+
+    f = np.logspace(0, 3, 30)
+    K = np.ones((30, 2, 2)) * (1 + 1j)
+    path = controller_gains_figure(tmp_path / "g.png", [("pid", f, K)], ["A_zeta", "A_eta"])
+    assert path.stat().st_size > 1000

@@ -13,6 +13,16 @@ added covariance G diag(σ_φ²) Gᵀ, G = ∂θ̂/∂(φ/φ₀), which enters t
 beside the noise covariance. Each fixed value's share of a parameter's variance is its
 error budget.
 
+Which fixed value is wrong — the data's answer
+----------------------------------------------
+The budget is a prior statement: it names the values whose *stated* uncertainty matters,
+right or wrong. Whether the data disagree with a fixed value is a separate question, the
+score (Lagrange-multiplier) test: the cost's gradient in φ_j at the optimum with θ free,
+g_j = J_φ⊥ᵀ r (J_φ projected off the columns of J), over its standard deviation from the
+residuals' long-run covariance — N(0, 1) when the fixed value is right — and the one-step
+estimate −g_j / ‖J_φ⊥,j‖² of the offset the data suggest. Fixed values beyond the
+Bonferroni bound at 1 % are ``disputed`` and named first.
+
 Where the σ_φ come from
 -----------------------
 An ``uncertainty = { key = σ }`` table beside the values in the rig file (σ relative, e.g.
@@ -144,6 +154,11 @@ class ErrorBudget:
         G diag(σ²) Gᵀ (SI).
     noise_variance : ndarray (p,)
         The estimates' noise variance (SI), for the shares.
+    score_z : ndarray (q,) or None
+        Score test of each fixed value against the data (N(0, 1) when it is right).
+    offset_rel, offset_rel_se : ndarray (q,) or None
+        The relative offset φ/φ₀ − 1 the data suggest for each fixed value (one
+        Gauss–Newton step with θ free), and its standard error.
     """
 
     fitted: tuple[str, ...]
@@ -153,6 +168,20 @@ class ErrorBudget:
     sensitivity: np.ndarray
     covariance: np.ndarray
     noise_variance: np.ndarray
+    score_z: np.ndarray | None = None
+    offset_rel: np.ndarray | None = None
+    offset_rel_se: np.ndarray | None = None
+
+    def disputed(self, level: float = 0.01) -> list[str]:
+        """Fixed values the data reject at ``level`` (two-sided, Bonferroni over the
+        fixed values tested), largest |z| first."""
+        if self.score_z is None:
+            return []
+        from scipy.stats import norm
+
+        z = np.abs(np.nan_to_num(self.score_z))
+        crit = norm.isf(level / (2 * max(len(self.fixed), 1)))
+        return [self.fixed[j] for j in np.argsort(-z) if z[j] > crit]
 
     def contribution(self) -> np.ndarray:
         """Standard-error contribution (SI) of each fixed parameter to each estimate (p, q)."""
@@ -182,11 +211,16 @@ class ErrorBudget:
                 p: {n: float(f) for n, f in zip(self.fixed, row)}
                 for p, row in zip(self.fitted, self.shares())},
             "dominant": self.dominant(),
+            **({"score_test": {
+                n: {"z": float(z), "offset_rel": float(o), "offset_rel_se": float(e)}
+                for n, z, o, e in zip(self.fixed, self.score_z, self.offset_rel,
+                                      self.offset_rel_se)},
+                "disputed": self.disputed()} if self.score_z is not None else {}),
         }
 
 
 def propagate(J: np.ndarray, J_fixed: np.ndarray, scale: np.ndarray, fitted, fixed,
-              sigma_rel, source, noise_variance) -> ErrorBudget:
+              sigma_rel, source, noise_variance, score=None) -> ErrorBudget:
     """The error budget from the Jacobians at the optimum (module docstring).
 
     Parameters
@@ -198,12 +232,14 @@ def propagate(J: np.ndarray, J_fixed: np.ndarray, scale: np.ndarray, fitted, fix
     scale : ndarray (p,)
     noise_variance : ndarray (p,)
         The estimates' noise variance (SI).
+    score : (z, offset_rel, offset_rel_se), optional
+        The fixed values' score tests.
     """
     G = -np.linalg.lstsq(J, J_fixed, rcond=None)[0] * np.asarray(scale)[:, None]
     sig = np.asarray(sigma_rel, dtype=float)
     cov = (G * sig**2) @ G.T
     return ErrorBudget(tuple(fitted), tuple(fixed), sig, tuple(source), G, cov,
-                       np.asarray(noise_variance, dtype=float))
+                       np.asarray(noise_variance, dtype=float), *(score or ()))
 
 
 def advice(budget: ErrorBudget | None, cfg, fitted, pressures_bar, share: float = 0.3
@@ -223,6 +259,13 @@ def advice(budget: ErrorBudget | None, cfg, fitted, pressures_bar, share: float 
     """
     out = []
     if budget is not None:
+        for name in budget.disputed():
+            j = budget.fixed.index(name)
+            out.append(
+                f"the data disagree with the fixed value of {name} (score test z = "
+                f"{budget.score_z[j]:+.1f}; they suggest {100 * budget.offset_rel[j]:+.2g} ± "
+                f"{100 * budget.offset_rel_se[j]:.2g} % from the rig file's): fit it, on "
+                "records that separate it")
         frac = budget.shares()
         for name in budget.dominant(share):
             j = budget.fixed.index(name)

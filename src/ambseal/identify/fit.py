@@ -349,7 +349,7 @@ def fit_parameters(
     cov = cov * np.outer(scale, scale)
     se_noise = np.sqrt(np.diag(cov))
     budget = _budget(sol.jac, scale, names, fixed, models, residual_blocks, sol.x,
-                     se_noise**2)
+                     se_noise**2, sol.fun, blocks)
     if budget is not None:
         cov = cov + budget.covariance
     se = np.sqrt(np.diag(cov))
@@ -383,10 +383,11 @@ def _nominal(model: ClosedLoopModel, name: str) -> float:
     return model.tau_e if name == TAU_E else model.plant.parameter(name).nominal
 
 
-def _budget(J, scale, names, fixed, models, residual_blocks, x, noise_var
+def _budget(J, scale, names, fixed, models, residual_blocks, x, noise_var, r, blocks
             ) -> ErrorBudget | None:
     """The fixed parameters' error budget by central differences of the residuals in each
-    fixed value (relative step 10⁻³, every model alike); None without fixed values."""
+    fixed value (relative step 10⁻³, every model alike), with each fixed value's score test
+    (:func:`_score_test`); None without fixed values."""
     use = [(n, s, src) for n, (s, src) in (fixed or {}).items()
            if s > 0 and any(_nominal(m, n) != 0 for m in models)]
     if not use:
@@ -397,8 +398,36 @@ def _budget(J, scale, names, fixed, models, residual_blocks, x, noise_var
         up = np.concatenate([R.ravel() for R in residual_blocks(x, (n, h))])
         dn = np.concatenate([R.ravel() for R in residual_blocks(x, (n, -h))])
         cols.append((up - dn) / (2 * h))
-    return propagate(J, np.column_stack(cols), scale, names, [u[0] for u in use],
-                     [u[1] for u in use], [u[2] for u in use], noise_var)
+    Jf = np.column_stack(cols)
+    return propagate(J, Jf, scale, names, [u[0] for u in use], [u[1] for u in use],
+                     [u[2] for u in use], noise_var, score=_score_test(J, Jf, r, blocks))
+
+
+def _split(M: np.ndarray, blocks_at_optimum: list) -> list:
+    """Rows of a stacked (n, m) array per record as (N, c, m) arrays (sample-major)."""
+    out, off = [], 0
+    for R in blocks_at_optimum:
+        n_s, c = R.shape
+        out.append(M[off:off + n_s * c].reshape(n_s, c, M.shape[1]))
+        off += n_s * c
+    return out
+
+
+def _score_test(J, Jf, r, blocks_at_optimum):
+    """Score (Lagrange-multiplier) test of each fixed value against the data: the cost's
+    gradient in φ_j/φ_j0 at the optimum, with θ free (J_φ projected off J), over its
+    standard deviation from the residuals' long-run covariance (as the sandwich's middle
+    term); N(0, 1) when the fixed value is right (Rao's score test; Ljung §16.6 relates it
+    to testing an extended model structure without fitting it). Returns (z, one-step
+    estimate of the relative offset φ/φ0 − 1 the data suggest, its standard error)."""
+    Jp = Jf - J @ np.linalg.lstsq(J, Jf, rcond=None)[0]
+    g = Jp.T @ r
+    V = sum(_long_run_covariance(Jb, rb[..., 0]) for Jb, rb in
+            zip(_split(Jp, blocks_at_optimum), _split(r[:, None], blocks_at_optimum)))
+    sd = np.sqrt(np.clip(np.diag(V), 0, None))
+    h = np.einsum("ij,ij->j", Jp, Jp)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return g / sd, -g / h, sd / h
 
 
 def _start(m0: ClosedLoopModel, names, initial, bounds):
@@ -446,11 +475,8 @@ def _covariance(J: np.ndarray, r: np.ndarray, blocks_at_optimum: list, p: int) -
     """Sandwich covariance of the scaled estimate, (JᵀJ)⁻¹ S (JᵀJ)⁻¹ with S the residuals'
     long-run covariance per record (:func:`_long_run_covariance`); ``inf`` when JᵀJ is
     singular. Rows of the stacked residual vector are sample-major per record."""
-    blocks, off = [], 0
-    for R in blocks_at_optimum:
-        n_s, c = R.shape
-        blocks.append((J[off:off + n_s * c].reshape(n_s, c, p), r[off:off + n_s * c].reshape(n_s, c)))
-        off += n_s * c
+    blocks = list(zip(_split(J, blocks_at_optimum),
+                      [b[..., 0] for b in _split(r[:, None], blocks_at_optimum)]))
     H = J.T @ J
     try:
         Hinv = np.linalg.inv(H)

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import control
 
-from ambseal.analysis.judge import JudgeSettings, judge, operating_points
+from ambseal.analysis.judge import judge, operating_points
 from ambseal.config import load_rig
 from ambseal.control.export import export_controller
 from ambseal.control.recipes import design
@@ -23,7 +23,7 @@ print(f"model: {model.n_states} states, axes {', '.join(model.axes)}")
 hinf = design(rig, "hinf")                                      # 3. H∞ design (thesis P5 §4)
 curves = []
 for point in operating_points(rig):                             # 4. judged on the full model
-    case, c = judge(rig, hinf.K, "hinf", point, JudgeSettings())
+    case, c = judge(rig, hinf.K, "hinf", point)  # grids from the rig: design --show-defaults
     print(f"{point.label}: stable={case['stable']}, ISO zone per axis "
           f"{case['iso_zone_per_axis']}, orbit {case['unbalance_peak_um']:.3g} µm")
     curves.append((point.label, *c["So"]))

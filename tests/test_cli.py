@@ -152,3 +152,38 @@ def test_modes_n_lowest_equal_the_dense_ones(capsys):
     with pytest.raises(SystemExit) as exc:
         main(["modes", rig, "--n-modes", "0"])
     assert exc.value.code == 2
+
+
+def test_design_show_defaults_prints_a_design_part_that_reads_back(capsys):
+    """``design --show-defaults``: TOML whose [design] table the schema accepts, with the
+    test rig's P5 §3.1.4 scalings; ``--set`` changes the value shown."""
+    import tomllib
+
+    from ambseal.config import default_rig_path, load_rig
+
+    rig = str(default_rig_path())
+    assert main(["design", rig, "--show-defaults", "--set", "design.mu.orbit_um=8"]) == 0
+    shown = tomllib.loads(capsys.readouterr().out)["design"]
+    assert shown["d_e_um"] == 20 and shown["d_u_a"] == 1 and shown["mu"]["orbit_um"] == 8
+    cfg = load_rig(rig, [f"design.mu.wf_rolloff_hz={shown['mu']['wf_rolloff_hz']}"])
+    assert cfg.design.mu.wf_rolloff_hz == 260
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--show-defaults", "--set", "design.mu.orbit_um=-1"], "design.mu.orbit_um"),
+    (["--show-defaults", "--set", "orbit_um=8"], "design.<key>=<value>"),
+    (["--method", "hinf", "--set", "design.unbalance.force_at=\"gland\""], "force_at"),
+    ([], "--method is required"),
+])
+def test_design_bad_overrides_exit_2_with_one_line(capsys, args, words):
+    from ambseal.config import default_rig_path
+
+    assert main(["design", str(default_rig_path()), *args]) == 2
+    err = capsys.readouterr().err.strip()
+    assert words in err and "\n" not in err and "Traceback" not in err
+
+
+def test_negative_ks_exits_2_naming_the_convention(tmp_path, capsys):
+    rig, code = run(tmp_path, GOOD.replace("ks = 2.0e5", "ks = -2.0e5", 1))
+    err = capsys.readouterr().err
+    assert code == 2 and "amb[0]" in err and "Ks > 0" in err

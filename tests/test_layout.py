@@ -16,7 +16,8 @@ import pytest
 SRC = Path(__file__).resolve().parents[1] / "src" / "ambseal"
 
 #: rank of each stage: a module may import modules of its own rank or lower
-RANK = {"errors": 0, "files": 0, "lti": 1, "config": 2, "config_checks": 2, "model": 3,
+RANK = {"errors": 0, "files": 0, "lti": 1, "config": 2, "config_checks": 2,
+        "config_design": 2, "model": 3,
         "identify": 4, "control": 5, "analysis": 6, "io": 6, "report": 7, "commands": 8,
         "pipeline": 8, "rotordynamics": 8,
         "cli": 9}

@@ -17,9 +17,12 @@ Commands
     A ROSS rotor file as an ambseal rig file.
 ``ambseal acquire RIG --truth TRUTH --excitation prbs|sine|chirp|impulse --pressure-bar P --out FILE``
     A record from the virtual test facility (CSV + JSON sidecar, or .mat).
-``ambseal design RIG --method pid|hinf|mu|lpv [--out DIR]``
+``ambseal design RIG --method pid|hinf|mu|lpv [--out DIR] [--set design.KEY=VALUE ...]``
     Design a controller on the rig's reduced model; write it (continuous, Tustin and ZOH at
     the controller's sample rate) as .json, .npz and .mat, with a summary.
+    ``--show-defaults`` prints the rig's resolved ``[design]`` part instead; ``--set``
+    overrides a ``[design]`` key (also on ``run``); ``--allow-unstable`` keeps a controller
+    whose full-order loop is unstable (marked in every output).
 ``ambseal identify RIG DATA... --params NAME,... --out DIR``
     Output-error fit of named parameters to closed-loop records; writes the fit, its
     figures and the identified rig.
@@ -101,6 +104,7 @@ def _parser() -> argparse.ArgumentParser:
                      help="truth file of the virtual facility: adds the identification stage "
                           "(default for the embedded rig: its packaged truth)")
     run.add_argument("--no-identify", action="store_true", help="skip the identification stage")
+    _design_options(run)
 
     a = sub.add_parser("acquire", help="record a run of the virtual test facility")
     a.add_argument("rig", help="rig file (TOML)")
@@ -127,7 +131,12 @@ def _parser() -> argparse.ArgumentParser:
 
     d = sub.add_parser("design", help="design a controller (pid, hinf, mu, lpv) and export it")
     d.add_argument("rig", help="rig file (TOML)")
-    d.add_argument("--method", required=True, choices=["pid", "hinf", "mu", "lpv"])
+    d.add_argument("--method", choices=["pid", "hinf", "mu", "lpv"],
+                   help="the method (required unless --show-defaults)")
+    d.add_argument("--show-defaults", action="store_true",
+                   help="print the rig's resolved [design] part (values and their rules) "
+                        "as TOML and exit")
+    _design_options(d)
     d.add_argument("--pressure-bar", type=_finite, default=None,
                    help="design pressure drop (bar); default [operating] pressure_bar")
     d.add_argument("--out", default="ambseal-design", help="output folder")
@@ -171,6 +180,16 @@ def _check_operating(args: argparse.Namespace) -> None:
     values = {k: getattr(args, k, None) for k in ("pressure_bar", "speed_rpm")}
     check_operating({k: v for k, v in values.items() if isinstance(v, float)},
                     {"pressure_bar": "--pressure-bar", "speed_rpm": "--speed-rpm"})
+
+
+def _design_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--set", action="append", default=[], metavar="design.KEY=VALUE",
+                   dest="overrides",
+                   help="override a [design] key of the rig file (a TOML value), e.g. "
+                        "design.mu.orbit_um=8; repeatable")
+    p.add_argument("--allow-unstable", action="store_true",
+                   help="keep a controller whose full-order loop is unstable at a judged "
+                        "condition (marked in every output) instead of stopping")
 
 
 def _acquire(args: argparse.Namespace) -> int:
@@ -226,10 +245,19 @@ def _acquire(args: argparse.Namespace) -> int:
 
 
 def _design(args: argparse.Namespace) -> int:
-    from .commands import design_files
+    from .commands import design_files, show_defaults
 
+    if args.show_defaults:
+        print(show_defaults(args.rig, args.overrides), end="")
+        return 0
+    if args.method is None:
+        from .errors import ConfigError
+
+        raise ConfigError("design: --method is required (pid, hinf, mu or lpv) unless "
+                          "--show-defaults")
     print(json.dumps(design_files(args.rig, args.method, args.out,
-                                  pressure_bar=args.pressure_bar)))
+                                  pressure_bar=args.pressure_bar, overrides=args.overrides,
+                                  allow_unstable=args.allow_unstable)))
     return 0
 
 
@@ -246,7 +274,8 @@ def _identify(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace) -> int:
     from .pipeline import run
 
-    result = run(args.rig, args.out, truth=args.truth, identification=not args.no_identify)
+    result = run(args.rig, args.out, truth=args.truth, identification=not args.no_identify,
+                 overrides=tuple(args.overrides), allow_unstable=args.allow_unstable)
     print(json.dumps({"out": str(result.out_dir), "metrics": str(result.metrics_path)}))
     return 0
 

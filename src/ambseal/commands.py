@@ -8,13 +8,14 @@ temporary name and a rename (:mod:`ambseal.files`).
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 from .config import load_rig
 from .errors import ConfigError
 from .files import writable_folder, write_json, write_text
 
-__all__ = ["design_files", "identify_files", "export_design"]
+__all__ = ["design_files", "identify_files", "export_design", "show_defaults"]
 
 
 def _finite(x: float) -> float | None:
@@ -43,8 +44,18 @@ def export_design(method: str, controller, summary_dict: dict, out: Path, fs_hz:
     return files
 
 
+def show_defaults(rig: str | Path, overrides=()) -> str:
+    """``ambseal design RIG --show-defaults``: the rig's resolved ``[design]`` part as TOML
+    with the rule behind each value (:meth:`ambseal.control.specs.DesignSpec.to_toml`)."""
+    from .control.specs import design_spec
+
+    cfg = load_rig(rig, overrides)
+    return f"# {cfg.rotor.name}: resolved design specification\n" + design_spec(cfg).to_toml()
+
+
 def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
-                 pressure_bar: float | None = None) -> dict:
+                 pressure_bar: float | None = None, overrides=(),
+                 allow_unstable: bool = False) -> dict:
     """``ambseal design``: design one controller and write it with its summary.
 
     Files: ``controller_<method>.json``, ``.npz`` and ``.mat`` (continuous, Tustin and ZOH
@@ -59,7 +70,7 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
     """
     from .control.recipes import design
 
-    cfg = load_rig(rig)
+    cfg = load_rig(rig, overrides)
     out = writable_folder(out_dir)  # before the design, not after it
     fs = cfg.controller.sample_rate_hz
     if method == "lpv":
@@ -72,7 +83,8 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
         files = export_design("lpv", lpv, lpv.to_dict(), out, fs,
                               [float(f) for f in lpv.speeds_hz])
         return {**lpv.to_dict(), "files": [str(f) for f in files]}
-    res = design(cfg, method, pressure_bar=pressure_bar)
+    res = design(cfg, method, pressure_bar=pressure_bar, allow_unstable=allow_unstable,
+                 progress=lambda line: print(f"ambseal: {line}", file=sys.stderr))
     files = export_design(res.method, res.K, res.to_dict(), out, fs)
     return {**res.summary(), "files": [str(f) for f in files]}
 

@@ -49,6 +49,8 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     controller scheduled on speed).
 ``[reduction]``
     ``states`` (the number of states kept, default 8) or ``cutoff_hz``.
+``[design]``
+    What the controllers are asked for, every key optional (:mod:`ambseal.config_design`).
 """
 
 from __future__ import annotations
@@ -62,6 +64,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from .config_checks import (MAX_ELEMENTS, MAX_REDUCED_STATES, check_actuator, check_amb,
                             cross_check)
+from .config_design import Design, apply_overrides, check_design_names
 from .errors import PRIMITIVE_TAGS, ConfigError, describe_validation_error
 
 __all__ = [
@@ -69,6 +72,7 @@ __all__ = [
     "load_rig",
     "parse_rig",
     "check_operating",
+    "apply_overrides",
     "default_rig_path",
     "Coefficient",
     "Affine",
@@ -320,6 +324,7 @@ class RigConfig(_Strict):
     controller: Controllers = Controllers()
     operating: Operating = Operating()
     reduction: Reduction = Reduction()
+    design: Design = Design()
 
     @property
     def length(self) -> float:
@@ -367,6 +372,9 @@ def parse_rig(data: dict, where: str = "<rig>") -> RigConfig:
     except ValidationError as exc:
         raise ConfigError(f"{where}: {_describe(exc)}") from None
     cross_check(cfg, where)
+    bad = check_design_names(cfg)
+    if bad:
+        raise ConfigError(f"{where}: {bad}")
     return cfg
 
 
@@ -397,21 +405,27 @@ def check_operating(values: dict, arg_names: dict[str, str]) -> None:
                               f"{key} in a rig file)") from None
 
 
-def load_rig(path: str | Path | None = None) -> RigConfig:
+def load_rig(path: str | Path | None = None, overrides=()) -> RigConfig:
     """Read and validate a rig file (TOML).
 
     Parameters
     ----------
     path : str or Path, optional
         The rig file; the embedded thesis test facility when omitted.
+    overrides : iterable of str
+        ``design.<key>=<value>`` settings (:func:`apply_overrides`), validated with the file.
 
     Raises
     ------
     ConfigError
-        The file is missing, is not valid TOML, or does not match the rig format.
+        The file is missing, is not valid TOML, does not match the rig format, or an
+        override is malformed or invalid (named with the file).
     """
     p = Path(path) if path is not None else default_rig_path()
-    return parse_rig(_load_toml(p, "rig file"), str(p))
+    data = _load_toml(p, "rig file")
+    if overrides:
+        return parse_rig(apply_overrides(data, overrides), f"{p} (with --set)")
+    return parse_rig(data, str(p))
 
 
 def _load_toml(path: Path, what: str) -> dict:
@@ -536,6 +550,23 @@ def _toml_value(v) -> str:
     raise TypeError(f"cannot write {type(v).__name__} to TOML")
 
 
+def _toml_table(name: str, val: dict, lines: list[str]) -> None:
+    """``[name]`` with its scalar keys, then its sub-tables and arrays of tables."""
+    def is_tables(x) -> bool:
+        return isinstance(x, list) and bool(x) and all(isinstance(i, dict) for i in x)
+
+    plain = {k: x for k, x in val.items() if not (isinstance(x, dict) or is_tables(x))}
+    if plain:
+        lines += ["", f"[{name}]"] + [f"{k} = {_toml_value(x)}" for k, x in plain.items()]
+    for k, x in val.items():
+        if isinstance(x, dict) and x:
+            _toml_table(f"{name}.{k}", x, lines)
+        elif is_tables(x):
+            for item in x:
+                lines += ["", f"[[{name}.{k}]]"]
+                lines += [f"{j} = {_toml_value(y)}" for j, y in item.items()]
+
+
 def dump_rig(cfg: RigConfig, header: str = "") -> str:
     """The rig as TOML text that :func:`load_rig` reads back to the same configuration."""
     data = cfg.model_dump(exclude_none=True)
@@ -545,18 +576,6 @@ def dump_rig(cfg: RigConfig, header: str = "") -> str:
             for item in val:
                 lines += ["", f"[[{key}]]"]
                 lines += [f"{k} = {_toml_value(x)}" for k, x in item.items()]
-        elif key == "materials":
-            for name, mat in val.items():
-                lines += ["", f"[materials.{name}]"]
-                lines += [f"{k} = {_toml_value(x)}" for k, x in mat.items()]
-        elif key == "controller":
-            lines += ["", "[controller]"]
-            lines += [f"{k} = {_toml_value(x)}" for k, x in val.items() if not isinstance(x, dict)]
-            for sub, table in val.items():
-                if isinstance(table, dict):
-                    lines += ["", f"[controller.{sub}]"]
-                    lines += [f"{k} = {_toml_value(x)}" for k, x in table.items()]
         else:
-            lines += ["", f"[{key}]"]
-            lines += [f"{k} = {_toml_value(x)}" for k, x in val.items()]
+            _toml_table(key, val, lines)
     return "\n".join(lines).lstrip("\n") + "\n"

@@ -41,7 +41,10 @@ def check_amb(self):  # noqa: N805 (the Amb being validated)
     given = [k for k, v in geometry.items() if v is not None]
     if len(given) == len(geometry):
         return self
-    if given:
+    if given and not (set(given) <= {"air_gap", "bias_current"}
+                      and None not in (self.ki, self.ks)):
+        # with ki and ks, air_gap and bias_current alone are read by the design defaults
+        # (D_e, D_u, the impulse: ambseal.control.specs); other partial geometry is not
         missing = [k for k in geometry if k not in given]
         raise ValueError(f"partial geometry: {', '.join(given)} given without "
                          f"{', '.join(missing)} (give all four, or ki and ks alone)")

@@ -46,19 +46,24 @@ def default_truth_path() -> Path:
     return Path(__file__).parent / "data" / "testrig_truth.toml"
 
 
-def _controllers(cfg: RigConfig) -> list[Designed]:
+def _controllers(cfg: RigConfig, spec, say, allow_unstable: bool = False) -> list[Designed]:
     """The designed controllers of the main job.
 
-    Pressure-driven seals (the test rig): the reference PID, H∞ and μ (P5 §4). Speed-driven
-    seals over a speed range (the turboexpander, P3 §4): the PID if the rig has one, an H∞
-    controller designed at the operating speed (the LTI comparison of P3 Fig. 11) and the
-    LPV controller scheduled on speed.
+    Pressure-driven seals (the test rig): the reference PID, H∞ and μ (P5 §4), from the
+    rig's design specification ``spec``. Speed-driven seals over a speed range (the
+    turboexpander, P3 §4): the PID if the rig has one, an H∞ controller designed at the
+    operating speed (the LTI comparison of P3 Fig. 11) and the LPV controller scheduled on
+    speed.
     """
     from .analysis.judge import speed_scheduled
     from .control.recipes import design
 
     def lti(res) -> Designed:
         return Designed(res.method, res.K, res.summary(), res)
+
+    def robust(m: str) -> Designed:
+        say(f"designing {m}", 0)
+        return lti(design(cfg, m, spec=spec, allow_unstable=allow_unstable, progress=say))
 
     if speed_scheduled(cfg):
         from .control.lpv_design import design_frozen, design_lpv
@@ -68,10 +73,7 @@ def _controllers(cfg: RigConfig) -> list[Designed]:
         out.append(Designed("hinf", fz.K, fz.to_dict(), fz))
         lpv = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz)
         return out + [Designed("lpv", lpv, lpv.to_dict(), lpv)]
-    if cfg.controller.pid is None:
-        raise ConfigError("controller.pid: the main job needs the reference PID "
-                          "([controller.pid])")
-    return [lti(design(cfg, m)) for m in ("pid", "hinf", "mu")]
+    return [lti(design(cfg, "pid")), robust("hinf"), robust("mu")]
 
 
 def _identification(cfg: RigConfig, truth, out: Path, say) -> tuple[dict, list, list]:
@@ -104,7 +106,8 @@ def _identification(cfg: RigConfig, truth, out: Path, say) -> tuple[dict, list, 
 
 def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         progress: bool = True, truth: str | Path | None = None,
-        identification: bool = True) -> RunResult:
+        identification: bool = True, overrides: tuple[str, ...] = (),
+        allow_unstable: bool = False) -> RunResult:
     """The main job: build and reduce the model, design, judge, identify, report.
 
     Parameters
@@ -123,6 +126,12 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         by the thesis's procedure (:mod:`ambseal.identify.procedure`).
     identification : bool
         Set False to skip the identification stage.
+    overrides : tuple of str
+        ``design.<key>=<value>`` settings applied to the rig file before validation
+        (:func:`ambseal.config.load_rig`).
+    allow_unstable : bool
+        Keep a controller whose full-order loop is unstable at a judged condition (marked
+        in ``metrics.json``) instead of stopping with a SynthesisError.
 
     Returns
     -------
@@ -132,20 +141,24 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
     ------
     ConfigError
         A bad rig file, a rig without AMBs or without ``[controller.pid]``.
+    SynthesisError
+        A controller that does not stabilise the full-order plant (without
+        ``allow_unstable``).
     """
     from rich.console import Console
     from rich.progress import Progress
 
-    from .analysis.judge import (JudgeSettings, judge_case, judge_spinup, operating_points,
+    from .analysis.judge import (judge_case, judge_settings, judge_spinup, operating_points,
                                  speed_scheduled, unstable_open_loop_poles)
     from .analysis.sweep import run_cases
+    from .control.specs import design_spec
     from .commands import export_design
     from .control.controller import frozen
     from .model.rig import build_plant
     from .report.run_report import gains_figure, spinup_figures, write_run_report
 
     rig_path = Path(rig) if rig is not None else default_rig_path()
-    cfg = load_rig(rig_path)
+    cfg = load_rig(rig_path, overrides)
     if truth is None and rig is None:
         truth = default_truth_path()
     if not cfg.amb:
@@ -155,8 +168,9 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         from .config import load_truth
 
         truth_cfg = load_truth(truth)  # refused before any work
-    points = operating_points(cfg)
-    settings = JudgeSettings()
+    spec = design_spec(cfg)
+    points = operating_points(cfg, spec)
+    settings = judge_settings(cfg, spec)
     final = Path(out_dir)
     # one run = one folder: written into a staging folder that replaces out_dir at the end
     with RunFolder(final) as out, \
@@ -174,7 +188,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         n_reduced = build_plant(cfg, reduced=True).n_states
         unstable = unstable_open_loop_poles(full.A)
         say("designing the controllers")
-        designs = _controllers(cfg)
+        designs = _controllers(cfg, spec, say, allow_unstable)
         for d in designs:
             export_design(d.method, d.controller, d.result.to_dict(), out / "controllers",
                           cfg.controller.sample_rate_hz, [p.speed_rpm / 60.0 for p in points])
@@ -196,6 +210,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                           "n_states_full": full.n_states, "n_states_reduced": n_reduced},
             "unbalance": {"grade_mm_s": settings.unbalance_grade_mm_s,
                           "range_hz": list(settings.unbalance_range_hz)},
+            "design_spec": spec.to_dict(),
             "controllers": {d.method: d.summary for d in designs},
             "cases": cases,
         }

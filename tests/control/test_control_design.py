@@ -153,7 +153,8 @@ def test_mu_unbalance_orbit(designs, plants):
 
 def test_mu_force_weight_reads_as_orbit_bound():
     """W_p·W_f/D_e = m·G·s·B_4(s)/orbit (closed form): the force channel bounds the orbit."""
-    wts = Weights(M=3.0, omega_b=30.0, orbit_um=6.0, wf_rolloff_hz=260.0)
+    wts = Weights(M=3.0, omega_b=30.0, orbit_um=6.0, wf_rolloff_hz=260.0,
+                  unbalance_mass_kg=69.0, d_e=20e-6)
     Wp, Wf = wts.Wp(), wts.Wf()  # D_e = wts.d_e = 20 µm
     for hz in (10.0, 100.0, 200.0, 557.0):
         s = 2j * np.pi * hz

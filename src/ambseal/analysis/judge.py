@@ -7,9 +7,12 @@ Every number is taken on the full-order plant (flexible modes included), whateve
 the controller was designed on; peaks on frequency grids refined around the lightly damped
 closed-loop poles (:func:`ambseal.analysis.loops.resolved_grid`).
 
-The operating points (:func:`operating_points`) are 0, nominal and 2× nominal pressure drop
-for pressure-driven seals, or the ends and the middle of the speed range for rigs whose
-seals change with speed over a stated range (P3 §4).
+The operating points (:func:`operating_points`) and the grids and disturbances
+(:func:`judge_settings`) are those of the rig's design specification
+(:func:`ambseal.control.specs.design_spec`): by default 0, nominal and 2× nominal pressure
+drop for pressure-driven seals, or the ends and the middle of the speed range for rigs whose
+seals change with speed over a stated range (P3 §4); the band, the unbalance and the
+impulse are derived from the machine by the rules written there.
 """
 
 from __future__ import annotations
@@ -20,12 +23,12 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["JudgeSettings", "OperatingPoint", "judge", "judge_case", "judge_spinup",
-           "operating_points", "speed_scheduled", "unstable_open_loop_poles", "force_position"]
+           "operating_points", "speed_scheduled", "judge_settings", "unstable_open_loop_poles"]
 
 
 @dataclass(frozen=True)
 class JudgeSettings:
-    """Grids and disturbances of the judgement.
+    """Grids and disturbances of the judgement (:func:`judge_settings` derives them).
 
     Attributes
     ----------
@@ -36,19 +39,50 @@ class JudgeSettings:
         Balance grade G (mm/s) of the worst-case unbalance, thesis P5 §4.4.1.
     unbalance_range_hz : (float, float)
         Speed range (Hz) of the unbalance response (400 points, refined).
+    unbalance_mass_kg : float
+        Mass (kg) of the force law F_u = m·G·Ω.
+    force_position_m : float
+        Where compliance and unbalance forces act (m).
     impulse_a, impulse_s : float
-        The thesis's current impulse (P5 §5.1): amplitude (A) and length (s), started at
+        The current impulse (P5 §5.1): amplitude (A) and length (s), started at
         ``impulse_start_s`` in a window of ``impulse_end_s`` sampled every ``impulse_dt_s``.
+        No amplitude (None): no impulse response.
     """
 
-    freq_hz: tuple[float, float, int] = (0.5, 2000.0, 1200)
-    unbalance_grade_mm_s: float = 2.5
-    unbalance_range_hz: tuple[float, float] = (1.0, 200.0)
-    impulse_a: float = 0.05
-    impulse_s: float = 0.01
-    impulse_start_s: float = 0.05
-    impulse_end_s: float = 0.35
-    impulse_dt_s: float = 5e-5
+    freq_hz: tuple[float, float, int]
+    unbalance_grade_mm_s: float
+    unbalance_range_hz: tuple[float, float]
+    unbalance_mass_kg: float
+    force_position_m: float
+    impulse_a: float | None
+    impulse_s: float
+    impulse_start_s: float
+    impulse_end_s: float
+    impulse_dt_s: float
+
+
+#: points of the judgement's log grid (before the refinement around lightly damped poles)
+GRID_POINTS = 1200
+
+
+def judge_settings(cfg, spec=None) -> JudgeSettings:
+    """The judgement's grids and disturbances from the rig's design specification.
+
+    The band, unbalance and impulse of :func:`ambseal.control.specs.design_spec`; the
+    impulse starts after 5 impulse lengths and the window ends 30 lengths later, sampled at
+    twice the controller's rate (test rig: 0.05 A for 10 ms at 0.05 s in 0.35 s, every
+    50 µs, P5 §5.1).
+    """
+    from ..control.specs import design_spec
+
+    sp = spec or design_spec(cfg)
+    t = sp.impulse_s
+    return JudgeSettings(
+        freq_hz=(sp.band_hz[0], sp.band_hz[1], GRID_POINTS),
+        unbalance_grade_mm_s=sp.unbalance_grade_mm_s, unbalance_range_hz=sp.unbalance_range_hz,
+        unbalance_mass_kg=sp.unbalance_mass_kg, force_position_m=sp.force_position_m,
+        impulse_a=sp.impulse_a, impulse_s=t, impulse_start_s=5 * t, impulse_end_s=35 * t,
+        impulse_dt_s=0.5 / cfg.controller.sample_rate_hz)
 
 
 @dataclass(frozen=True)
@@ -67,20 +101,21 @@ def speed_scheduled(cfg) -> bool:
         s.frequency_dependent for s in cfg.seal)
 
 
-def operating_points(cfg) -> list[OperatingPoint]:
-    """Where every controller is judged: 0, nominal and 2× nominal pressure drop (P5 §4), or
-    the ends and the middle (operating speed) of the speed range (P3 §4)."""
-    p, rpm = cfg.operating.pressure_bar, cfg.operating.speed_rpm
-    if speed_scheduled(cfg):
-        lo, hi = cfg.operating.speed_range_hz
-        return [OperatingPoint(p, f * 60.0, f"{f:g} Hz") for f in sorted({lo, rpm / 60.0, hi})]
-    pressures = [0.0, p, 2 * p] if p > 0 else [0.0]
-    return [OperatingPoint(q, rpm, f"{q:g} bar") for q in pressures]
+def operating_points(cfg, spec=None) -> list[OperatingPoint]:
+    """Where every controller is judged: the design specification's pressures × speeds
+    (:func:`ambseal.control.specs.design_spec`; by default 0, nominal and 2× nominal
+    pressure drop, P5 §4, or the ends and the middle of the speed range of a rig whose
+    seals change with speed, P3 §4, at the nominal pressure)."""
+    from ..control.specs import design_spec
 
+    sp = spec or design_spec(cfg)
+    ps, fs = sp.pressures_bar, sp.speeds_hz
 
-def force_position(cfg) -> float:
-    """Where compliance and unbalance forces act (m): the first seal, else mid-span."""
-    return cfg.seal[0].position if cfg.seal else cfg.length / 2
+    def label(q, f):
+        return ", ".join(([f"{q:g} bar"] if len(ps) > 1 or len(fs) == 1 else [])
+                         + ([f"{f:g} Hz"] if len(fs) > 1 else []))
+
+    return [OperatingPoint(q, f * 60.0, label(q, f)) for f in fs for q in ps]
 
 
 def unstable_open_loop_poles(A: np.ndarray) -> np.ndarray:
@@ -105,7 +140,7 @@ def _finite(x: float) -> float | None:
 
 
 def judge(cfg, controller, name: str, point: OperatingPoint,
-          settings: JudgeSettings = JudgeSettings(), *, impulse: bool = True
+          settings: JudgeSettings | None = None, *, impulse: bool = True
           ) -> tuple[dict, dict]:
     """Judge one physical controller on the full-order plant at one operating point.
 
@@ -117,7 +152,8 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
     name : str
         The controller's name in the case.
     point : OperatingPoint
-    settings : JudgeSettings
+    settings : JudgeSettings, optional
+        :func:`judge_settings` of the rig if omitted.
     impulse : bool
         Set False to leave out the impulse response (the sweeps of
         :mod:`ambseal.analysis.sweep`); ``impulse_*`` are then ``None``.
@@ -132,7 +168,6 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
         ``poles`` (the closed-loop poles, rad/s).
     """
     from ..model.rig import build_plant
-    from ..model.rotor import assemble_rotor
     from .iso import iso_assessment
     from ..lti.freqresp import freqresp
     from .loops import (closed_loop, compliance_from, loop_responses_from, resolved_grid,
@@ -140,9 +175,9 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
     from .response import impulse_response_of
     from .unbalance import unbalance_from_compliance
 
-    s = settings
+    s = settings or judge_settings(cfg)
     plant = build_plant(cfg, pressure_bar=point.pressure_bar, speed_rpm=point.speed_rpm,
-                        force_positions=(force_position(cfg),))
+                        force_positions=(s.force_position_m,))
     cur = plant.current_inputs()
     force = [j for j in range(len(plant.input_names)) if j not in cur]
     G = plant.select_inputs([plant.input_names[j] for j in cur]).to_statespace()
@@ -176,11 +211,11 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
     c, cu = (compliance_from(Gw[sl], Kw[sl], Gfw[sl], grid, ny_names, f_names)
              for sl, grid in ((slice(0, w.size), w), (slice(w.size, None), wu)))
     curves["compliance"] = (w / (2 * np.pi), c.sigma_max_m_per_n)
-    unb = unbalance_from_compliance(cu, mass_kg=assemble_rotor(cfg).mass,
+    unb = unbalance_from_compliance(cu, mass_kg=s.unbalance_mass_kg,
                                     grade_mm_s=s.unbalance_grade_mm_s)
     curves["unbalance"] = (unb.speed_hz, unb.response_um)
     case.update(compliance_peak_m_per_n=c.peak.value, unbalance_peak_um=unb.peak_um)
-    if not impulse:
+    if not impulse or s.impulse_a is None:
         case.update(impulse_peak_um=None, impulse_settling_s=None)
         return case, curves
     # the thesis's impulse axes A_ζ and B_η (P5 §5.1): first AMB's ζ, last AMB's η
@@ -196,7 +231,7 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
     return case, curves
 
 
-def judge_case(case: dict, cfg, settings: JudgeSettings = JudgeSettings()) -> tuple[dict, dict]:
+def judge_case(case: dict, cfg, settings: JudgeSettings | None = None) -> tuple[dict, dict]:
     """:func:`judge` of ``case = {"controller", "name", "point"}``: the main job's cases as
     run by :func:`ambseal.analysis.sweep.run_cases`."""
     return judge(cfg, case["controller"], case["name"], case["point"], settings)
@@ -206,9 +241,10 @@ def judge_spinup(cfg, controllers: dict) -> tuple[dict, list, list]:
     """The speed-scheduled rig's time and frequency judgement (P3 §4, Figs. 11–12).
 
     A spin-up over ``[operating] speed_range_hz`` in 1 s with alternating 100 N force and
-    2 µm output steps on the first actuator axis, on the LPV design model (29 grid speeds,
-    12 states, the force at the first AMB), and σ̄(S_o) on the full-order plant at 8 frozen
-    speeds across the range.
+    2 µm output steps on the first actuator axis, on the LPV model (grid speeds every
+    10 Hz, at least 8; the rigid-body modes and the first bending pair; the force at the
+    first AMB), and σ̄(S_o) on the full-order plant at 8 frozen speeds across the range
+    (turboexpander: 29 speeds over 20–300 Hz, 12 states).
 
     Parameters
     ----------
@@ -225,10 +261,12 @@ def judge_spinup(cfg, controllers: dict) -> tuple[dict, list, list]:
         :class:`~ambseal.analysis.spinup.FrozenSensitivity` of each controller in order.
     """
     from ..control.lpv_plant import lpv_plant
+    from ..control.specs import RIGID_STATES
     from .spinup import frozen_sensitivity, spinup
 
     lo, hi = cfg.operating.speed_range_hz
-    L = lpv_plant(cfg, np.linspace(lo, hi, 29), states=12,
+    n_grid = max(8, int(round((hi - lo) / 10.0)) + 1)
+    L = lpv_plant(cfg, np.linspace(lo, hi, n_grid), states=RIGID_STATES + 4,
                   force_positions=(cfg.amb[0].position,))
     speeds = np.linspace(lo, hi, 8)
     cache: dict = {}

@@ -199,6 +199,7 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
     max_hz : float
         Highest frequency (Hz) of the modes the lowest log decrement is taken over.
     settings : JudgeSettings, optional
+        The rig's :func:`~ambseal.analysis.judge.judge_settings` if omitted.
 
     Returns
     -------
@@ -211,14 +212,14 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
 
     from ..config import parse_rig, rig_with_values
     from .campbell import lowest_log_decrement
-    from .judge import JudgeSettings, OperatingPoint, judge
+    from .judge import OperatingPoint, judge
 
     cfg = parse_rig(rig, "<sweep rig>")
     if case.get("params"):
         cfg = rig_with_values(cfg, case["params"])
     K = control.ss(*controllers[case["controller"]])
     point = OperatingPoint(case["pressure_bar"], 60.0 * case["speed_hz"], "")
-    res, curves = judge(cfg, K, case["controller"], point, settings or JudgeSettings(),
+    res, curves = judge(cfg, K, case["controller"], point, settings,
                         impulse=False)
     dec, dec_hz = lowest_log_decrement(curves["poles"], max_hz)
     row = {"controller": case["controller"], "pressure_bar": case["pressure_bar"],

@@ -136,15 +136,16 @@ def default_omega(P, n: int = 120) -> np.ndarray:
     return np.logspace(np.log10(lo), np.log10(hi), n)
 
 
-def design_omega(f_min_hz: float = 1.0, f_max_hz: float = 2000.0, n: int = 60) -> np.ndarray:
+def design_omega(f_min_hz: float, f_max_hz: float, n: int = 60) -> np.ndarray:
     """The μ grid of the rig designs (rad/s): ``n`` points log-spaced over f_min … f_max (Hz).
 
     Used by the μ designs of :func:`ambseal.control.recipes.design` and
     :func:`ambseal.control.lpv_design.design_frozen` (D-step, μ peak and the order
-    reduction's check). The default 1 Hz … 2 kHz spans the rigid-body band, the speed
-    ranges and the first bending modes of the example machines (the test rig's 557 Hz,
-    the turboexpander's ~1–2 kHz); 60 points (≈ 18 per decade) resolve the D scales, which
-    vary slowly, and keep a D–K iteration at seconds. A lightly damped peak between grid
+    reduction's check) over the rig's synthesis band
+    (:func:`ambseal.control.specs.design_spec`: the rigid-body band, the speed range and the
+    modes the actuator reaches; 1 Hz … 2 kHz on the test rig); 60 points (≈ 18 per decade
+    over 3.3 decades) resolve the D scales, which vary slowly, and keep a D–K iteration at
+    seconds. A lightly damped peak between grid
     points is missed by the μ peak on the grid; the designs are judged afterwards on the
     full-order plant on a dense grid (:mod:`ambseal.analysis`).
 

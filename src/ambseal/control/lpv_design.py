@@ -328,7 +328,10 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
                                uncertainty={f"{cfg.seal[0].name}.k": seal_k_uncertainty},
                                d_e=w.d_e, d_u=w.d_u)
         om = kw.pop("omega", None)
-        om = design_omega() if om is None else om
+        if om is None:
+            from .specs import design_spec
+
+            om = design_omega(*design_spec(cfg_f).synthesis_band_hz)
         r = musyn(gp.P, gp.blocks, gp.nmeas, gp.ncon, om, **kw)
         K_P, gamma = r.K, float(r.mu)
     K = gp.physical_controller(K_P, name=f"K_{method}_{f:g}Hz")

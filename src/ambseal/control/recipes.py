@@ -8,11 +8,16 @@ synthesises:
 * ``"pid"`` — the decentralised reference PID of ``[controller.pid]`` (P5 Eq. 6, §4.2);
 * ``"hinf"`` — H∞ on the nominal plant at ``pressure_bar`` (P5 §4.4: "designed using the
   nominal plant representation");
-* ``"mu"`` — complex D–K iteration on the perturbed plant with the seal's cross-coupled
-  stiffness k ± 100 % of its value at ``pressure_bar`` (one δ shared by k and −k, P5 §4.1
-  items 2–3), i.e. 0 … 2× the nominal pressure drop; the unbalance force at the seal
-  (F_u = m·G·Ω, P5 §4.4.1) enters as a weighted disturbance so that the worst-case orbit
-  is part of the robust-performance demand (:meth:`~ambseal.control.weights.Weights.Wf`).
+* ``"mu"`` — complex D–K iteration on the perturbed plant with the uncertain parameters of
+  the design specification (default: every seal's cross-coupled stiffness k ± 100 % of its
+  value at ``pressure_bar``, one δ shared by k and −k, P5 §4.1 items 2–3, i.e. 0 … 2× the
+  nominal pressure drop); the unbalance force (F_u = m·G·Ω, P5 §4.4.1) enters as a
+  weighted disturbance so that the worst-case orbit is part of the robust-performance
+  demand (:meth:`~ambseal.control.weights.Weights.Wf`).
+
+Every default (weights, scalings, design model, grid, order limit, uncertainty) comes from
+the rig's ``[design]`` part, completed from the machine by
+:func:`ambseal.control.specs.design_spec`.
 
 Every controller is returned in the project's convention: a continuous
 ``control.StateSpace`` from the displacements (m) to the current references (A), used in
@@ -20,10 +25,13 @@ negative feedback ``i = −K y`` (:mod:`ambseal.analysis.loops`). Synthesis itse
 the scaled plant with the LFT's positive feedback ``u = K_P e``; the conversion
 ``K = −(D_u/D_e) K_P`` is :meth:`GeneralizedPlant.physical_controller`.
 
-Design model versus judgement: the design model keeps the rigid-body modes and, by default,
-the first bending-mode pair (557 Hz, ``states=12``) so that the synthesised controller
-does not destabilise it; every acceptance check is made on the full-order plant
-(``build_plant(cfg, pressure_bar=p)``), see ``tests/control/test_control_design.py``.
+Design model versus judgement: the design model keeps every mode the controller can reach
+(the specification's rule; on the test rig the rigid-body modes and the first bending pair,
+12 states). After synthesis the controller is closed with the full-order plant at every
+judged condition (:func:`full_order_check`); an unstable loop enlarges the design model to
+keep the mode that went unstable and designs again, a bounded number of times, each step
+reported, and is refused as a :class:`~ambseal.errors.SynthesisError` naming the mode and
+the key to set if it stays unstable (unless ``allow_unstable``).
 """
 
 from __future__ import annotations
@@ -36,9 +44,9 @@ import numpy as np
 
 from ..errors import ConfigError, SynthesisError
 from ..model.amb import channel_names
-from .weights import Weights, default_weights
+from .weights import Weights
 
-__all__ = ["DesignResult", "design", "METHODS"]
+__all__ = ["DesignResult", "design", "full_order_check", "pid_from_rig", "METHODS"]
 
 METHODS = ("pid", "hinf", "mu")
 
@@ -75,6 +83,16 @@ class DesignResult:
         :class:`~ambseal.control.order.ReductionResult` summary when reduced.
     plant : GeneralizedPlant or None
         The generalised plant (not serialised).
+    design_states : int
+        Mechanical states of the design model the controller was made on.
+    full_order : dict or None
+        :func:`full_order_check` of the delivered controller.
+    allow_unstable : bool
+        True when an unstable full-order loop was accepted on request.
+    steps : tuple of str
+        The automatic design-loop steps taken (model enlargements).
+    notes : tuple of str
+        The specification's notes (no seal, ...).
     """
 
     method: str
@@ -90,6 +108,12 @@ class DesignResult:
     elapsed_s: float = 0.0
     reduction: dict | None = None
     plant: Any = field(default=None, repr=False)
+    design_states: int | None = None
+    full_order: dict | None = None
+    allow_unstable: bool = False
+    steps: tuple = ()
+    notes: tuple = ()
+    verdict: str = ""
 
     def summary(self) -> dict:
         """Short JSON-ready summary (no matrices)."""
@@ -98,7 +122,10 @@ class DesignResult:
                 "elapsed_s": round(self.elapsed_s, 3),
                 "weights": self.weights.to_dict() if self.weights else None,
                 "uncertainty": {k: list(v) for k, v in self.uncertainty.items()},
-                "iterations": len(self.history), "reduction": self.reduction}
+                "iterations": len(self.history), "reduction": self.reduction,
+                "design_states": self.design_states, "full_order": self.full_order,
+                "allow_unstable": self.allow_unstable, "steps": list(self.steps),
+                "notes": list(self.notes), "verdict": self.verdict}
 
     def to_dict(self) -> dict:
         """Summary plus the controller matrices (lists) and the D–K history."""
@@ -111,15 +138,99 @@ class DesignResult:
         return d
 
 
+#: the derived PID (no [controller.pid]): k_eq = K_EQ_PER_KS·Ks, ζ on the rigid-body modes,
+#: Ti in rigid-body time constants, derivative filter ε (P5 Eq. 6, §4.2: ε = 0.1)
+K_EQ_PER_KS, PID_ZETA, TI_PER_OMEGA_N, PID_EPS = 0.5, 1.0, 50.0, 0.1
+
+
+def pid_from_rig(cfg) -> dict:
+    """A decentralised PID (P5 Eq. 6) from the rig, for a rig without ``[controller.pid]``.
+
+    One gain set on every axis, from the mean Ks/Ki over the AMB axes and half the rotor
+    mass per bearing (a rigid rotor on two supports): the equivalent stiffness
+    k_eq = Ki·Kp − Ks is K_EQ_PER_KS·Ks (Kp = (1 + K_EQ_PER_KS)·Ks/Ki; Schweitzer & Maslen
+    2009 §7.2), the rigid-body mode ω_n = √(k_eq/m_b) gets the damping ratio PID_ZETA
+    (Ki·Kp·Td = 2ζ√(k_eq m_b)), Ti = TI_PER_OMEGA_N/ω_n puts the integral action well below
+    it, ε = 0.1 (P5 §4.2). On the test rig: Kp 1.8e4 A/m, Td 3.3 ms, Ti 0.25 s (the thesis's
+    hand tuning: 1.6e4, 3.5 ms, 0.2 s), stable at 0 and 2.04 bar on the full-order plant;
+    with k_eq = Ks, or ζ ≤ 0.5, the seal's cross-coupling at 2.04 bar destabilises the
+    rigid-body mode; ζ = 1 is the critically damped rigid rotor without seal.
+
+    Returns
+    -------
+    dict
+        ``kp`` (A/m), ``ti``, ``td`` (s), ``eps`` (-) and ``rule`` (text).
+    """
+    from ..model.amb import amb_factors
+    from ..model.rotor import assemble_rotor
+
+    ratio = [ks / ki for a in cfg.amb for ki, ks in zip(*amb_factors(a))]
+    ks_over_ki = float(np.mean(ratio))
+    ki = float(np.mean([k for a in cfg.amb for k in amb_factors(a)[0]]))
+    ks = ks_over_ki * ki
+    m_b = assemble_rotor(cfg).mass / 2
+    k_eq = K_EQ_PER_KS * ks
+    kp = (1 + K_EQ_PER_KS) * ks_over_ki
+    w_n = np.sqrt(k_eq / m_b)
+    td = 2 * PID_ZETA * np.sqrt(k_eq * m_b) / (ki * kp)
+    return {"kp": float(kp), "ti": float(TI_PER_OMEGA_N / w_n), "td": float(td),
+            "eps": PID_EPS,
+            "rule": f"k_eq = {K_EQ_PER_KS:g} Ks, ζ = {PID_ZETA:g} on the rigid-body modes "
+                    f"({w_n / (2 * np.pi):.3g} Hz), Ti = {TI_PER_OMEGA_N:g}/ω_n, ε = {PID_EPS:g}"}
+
+
 def _pid(cfg, p):
     from .pid import pid_controller
 
     pid = getattr(getattr(cfg, "controller", None), "pid", None)
+    notes = ()
     if pid is None:
-        raise ConfigError("design(method='pid'): the rig has no [controller.pid] section")
-    chans = channel_names(cfg)
-    K = pid_controller(pid.kp, pid.ti, pid.td, pid.eps, chans)
-    return DesignResult("pid", K, p, order=int(K.nstates), order_full=int(K.nstates))
+        d = pid_from_rig(cfg)
+        kp, ti, td, eps = d["kp"], d["ti"], d["td"], d["eps"]
+        notes = (f"PID designed from the rig (no [controller.pid]): {d['rule']}",)
+    else:
+        kp, ti, td, eps = pid.kp, pid.ti, pid.td, pid.eps
+    K = pid_controller(kp, ti, td, eps, channel_names(cfg))
+    return DesignResult("pid", K, p, order=int(K.nstates), order_full=int(K.nstates),
+                        notes=notes)
+
+
+def full_order_check(cfg, K, conditions) -> dict:
+    """Close a physical controller with the full-order plant at each condition.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+    K : control.StateSpace
+        Displacements (m) → current references (A), negative feedback ``i = −K y``.
+    conditions : iterable of (pressure_bar, speed_hz)
+
+    Returns
+    -------
+    dict
+        ``stable`` (bool) and, for the least stable condition, ``pressure_bar``,
+        ``speed_hz``, ``max_real_pole`` (1/s) and its mode: ``mode_hz`` (damped frequency)
+        and ``damping`` (ζ = −Re λ/|λ|, negative when unstable). A pole counts as unstable
+        when Re λ > 1e-9·max|λ| (the rounding level of the eigenvalue solver).
+    """
+    from ..lti.interconnect import feedback_matrices
+    from ..model.rig import build_plant
+
+    Km = tuple(np.asarray(getattr(K, m), float) for m in ("A", "B", "C", "D"))
+    worst = None
+    for p, f in conditions:
+        plant = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * f)
+        cur = plant.current_inputs()
+        G = (plant.A, plant.B[:, cur], plant.C, plant.D[:, cur])
+        lam = np.linalg.eigvals(feedback_matrices(G, Km)[0])
+        k = int(np.argmax(lam.real))
+        margin = lam[k].real / np.abs(lam).max()
+        if worst is None or margin > worst[0]:
+            worst = (margin, p, f, lam[k])
+    margin, p, f, z = worst
+    return {"stable": bool(margin <= 1e-9), "pressure_bar": float(p), "speed_hz": float(f),
+            "max_real_pole": float(z.real), "mode_hz": float(abs(z.imag) / (2 * np.pi)),
+            "damping": float(-z.real / max(abs(z), 1e-300))}
 
 
 def design(
@@ -129,11 +240,15 @@ def design(
     pressure_bar: float | None = None,
     weights: Weights | None = None,
     uncertainty: Mapping[str, Any] | None = None,
-    states: int = 12,
+    states: int | None = None,
     omega: Any = None,
     reduce_to: int | str | None = "auto",
-    max_iter: int = 6,
-    dk_order: int = 2,
+    max_iter: int | None = None,
+    dk_order: int | None = None,
+    allow_unstable: bool = False,
+    spec: Any = None,
+    progress: Any = None,
+    enlarge: int = 2,
 ) -> DesignResult:
     """Design a controller for a rig (thesis P5 §4).
 
@@ -142,28 +257,37 @@ def design(
     cfg : RigConfig
         The rig (``ambseal.config.load_rig()``).
     method : {"pid", "hinf", "mu"}
-        Reference PID, nominal H∞, or μ (D–K) robust to the seal's k.
+        Reference PID, nominal H∞, or μ (D–K) robust to the specification's uncertainty.
     pressure_bar : float, optional
-        Design pressure drop (bar); ``[operating] pressure_bar`` if omitted (2.04 bar).
+        Design pressure drop (bar); ``[operating] pressure_bar`` if omitted.
     weights : Weights, optional
-        Weights and scalings; :func:`~ambseal.control.weights.default_weights` for the
-        method if omitted.
+        Weights and scalings; the specification's for the method if omitted.
     uncertainty : mapping, optional
         μ only: ``{parameter: fraction or (low, high)}`` as in
-        :func:`~ambseal.control.plant.generalized_plant`; default ``{"seal.k": 1.0}``
-        (k ± 100 % of its value at ``pressure_bar``, P5 §4.1). Ignored by ``"hinf"``.
-    states : int
-        Mechanical states of the design model (8: rigid body only, as the thesis; 12: plus
-        the first bending pair, the default, so that the full-order loop stays stable).
+        :func:`~ambseal.control.plant.generalized_plant`; the specification's if omitted
+        (every seal's k ± 100 %, P5 §4.1). Ignored by ``"hinf"``.
+    states : int, optional
+        Mechanical states of the design model; the specification's if omitted.
     omega : array_like, optional
-        μ frequency grid (rad/s); default :func:`~ambseal.control.dk.design_omega`.
+        μ frequency grid (rad/s); 60 points over the specification's synthesis band.
     reduce_to : int, "auto" or None
         Reduce the controller to this order (balanced truncation,
         :func:`~ambseal.control.order.reduce_controller`); the rise of γ/μ is reported in
-        ``reduction``. ``"auto"``: 28 for μ (the force weight W_f and the D-scales raise
-        the order to 42; truncating to 28 changes μ by < 0.1 %), none for H∞. ``None``: no reduction.
-    max_iter, dk_order : int
-        D–K iterations and D-scale fit order (μ only).
+        ``reduction``. ``"auto"``: ``[design] order_max``, else the design model's states
+        plus those of W_p and W_u (on the test rig 28 for μ: the force weight W_f and the
+        D-scales raise the order to 42; truncating changes μ by < 0.1 %). ``None``: none.
+    max_iter, dk_order : int, optional
+        D–K iterations and D-scale fit order (μ only); the specification's if omitted.
+    allow_unstable : bool
+        Deliver a controller whose full-order loop is unstable at a judged condition
+        (marked in the result) instead of raising.
+    spec : DesignSpec, optional
+        The resolved specification (:func:`ambseal.control.specs.design_spec`).
+    progress : callable, optional
+        Called with one line per automatic design step.
+    enlarge : int
+        Times the design model may be enlarged automatically when the full-order loop is
+        unstable at a mode the design model left out.
 
     Returns
     -------
@@ -175,7 +299,9 @@ def design(
         Unknown method, bad weights or uncertainty ranges, ``reduce_to`` not an int,
         ``"pid"`` on a rig without ``[controller.pid]``.
     SynthesisError
-        If synthesis fails or the reduced controller no longer stabilises the design loop.
+        If synthesis fails, the reduced controller no longer stabilises the design loop, or
+        the full-order loop is unstable at a judged condition (naming the mode, its
+        frequency and damping, and the key that keeps it in the design model).
 
     Examples
     --------
@@ -184,65 +310,173 @@ def design(
     >>> r.K.ninputs, r.K.noutputs                    # doctest: +SKIP
     (4, 4)
     """
+    from .specs import design_spec
+
     if method not in METHODS:
         raise ConfigError(f"design: method={method!r}, expected one of {METHODS}")
     p = float(cfg.operating.pressure_bar if pressure_bar is None else pressure_bar)
     if method == "pid":
         return _pid(cfg, p)
+    if isinstance(reduce_to, str) and reduce_to != "auto":
+        raise ConfigError(f"design: reduce_to={reduce_to!r}, expected an int, 'auto' or None")
+    sp = spec or design_spec(cfg, pressure_bar)
+    if weights is None and (sp.d_e is None or sp.d_u is None):
+        key = "d_e_um" if sp.d_e is None else "d_u_a"
+        raise ConfigError(f"design.{key}: cannot be derived (the rig gives no air_gap, "
+                          f"bias_current or current_limit); set it in [design] or with "
+                          f"--set design.{key}=...")
+    w = weights or sp.weights[method]
+    unc = dict(uncertainty) if uncertainty is not None else dict(sp.uncertainty)
+    n = int(states or sp.model_states)
+    om = None if omega is None else np.asarray(omega, float)
+    conditions = [(q, f) for q in sp.pressures_bar for f in sp.speeds_hz]
+    steps: list[str] = []
+    t0 = time.perf_counter()
+    for attempt in range(enlarge + 1):
+        r = _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to,
+                        max_iter or sp.max_iter, sp.dk_order if dk_order is None else dk_order)
+        check = full_order_check(cfg, r.K, conditions)
+        if check["stable"] or attempt == enlarge or states is not None:
+            break
+        n_new = _states_to_keep(cfg, p, check["mode_hz"])
+        if n_new <= n:
+            break
+        steps.append(f"{method}: full-order loop unstable at {check['mode_hz']:.4g} Hz "
+                     f"(ζ = {check['damping']:.3g}, {check['pressure_bar']:g} bar); design "
+                     f"model enlarged from {n} to {n_new} states")
+        if progress:
+            progress(steps[-1])
+        n = n_new
+        top = 1.5 * check["mode_hz"]
+        if om is None and top > sp.synthesis_band_hz[1]:
+            from .dk import design_omega
 
+            om = design_omega(sp.synthesis_band_hz[0], top)
+    if not check["stable"] and not allow_unstable:
+        raise SynthesisError(_unstable_message(method, check, n, steps))
+    return DesignResult(
+        method, r.K, p, gamma=r.gamma, mu=r.mu, order=int(r.K.nstates),
+        order_full=r.order_full, history=tuple(r.history), weights=w,
+        uncertainty={q.name: (q.low, q.high) for q in r.gp.parameters},
+        elapsed_s=time.perf_counter() - t0, reduction=r.reduction, plant=r.gp,
+        design_states=n, full_order=check, allow_unstable=not check["stable"],
+        steps=tuple(steps), notes=tuple(sp.notes), verdict=_verdict(method, r, check))
+
+
+@dataclass(frozen=True, eq=False)
+class _Synthesis:
+    K: Any
+    gamma: float
+    mu: float | None
+    history: tuple
+    order_full: int
+    reduction: dict | None
+    gp: Any
+    K_P: Any = None
+    mu_omega: float | None = None
+
+
+def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order):
+    """One synthesis on an n-state design model, reduced, as a physical controller."""
     from .plant import generalized_plant
 
-    w = weights or default_weights(method)
-    unc = dict(uncertainty) if uncertainty is not None else {"seal.k": 1.0}
-    t0 = time.perf_counter()
     Wf = w.Wf()
     fpos = ()
     if Wf is not None:
-        if w.force_position_m is not None:
-            fpos = (float(w.force_position_m),)
-        elif getattr(cfg, "seal", None):
-            fpos = (float(cfg.seal[0].position),)
-        else:
-            raise ConfigError("design: orbit_um needs a force position; the rig has no seal, "
-                              "set Weights.force_position_m")
+        fpos = (float(w.force_position_m if w.force_position_m is not None
+                      else sp.force_position_m),)
     gp = generalized_plant(cfg, w.Wp(), w.Wu(), uncertainty=unc if method == "mu" else None,
-                           pressure_bar=p, states=states, input_disturbance=w.W1(),
+                           pressure_bar=p, states=n, input_disturbance=w.W1(),
                            force_disturbance=Wf, force_positions=fpos, d_e=w.d_e, d_u=w.d_u)
+    mu_omega = None
     if method == "hinf":
         from .hinf import hinfsyn
 
         r = hinfsyn(gp.P_nominal, gp.nmeas, gp.ncon)
         K_P, gamma, mu, hist = r.K, float(r.gamma), None, ()
-        P_red, blocks, om = gp.P_nominal, None, None
+        P_red, blocks = gp.P_nominal, None
     else:
         from .dk import design_omega, musyn
 
-        om = design_omega() if omega is None else np.asarray(omega, float)
+        if om is None:
+            om = design_omega(*sp.synthesis_band_hz)
         r = musyn(gp.P, gp.blocks, gp.nmeas, gp.ncon, om, order=dk_order, max_iter=max_iter)
         K_P, gamma, mu, hist = r.K, float(r.gamma), float(r.mu), r.history
-        P_red, blocks = gp.P, gp.blocks
+        P_red, blocks, mu_omega = gp.P, gp.blocks, float(r.mu_omega)
     order_full = int(K_P.nstates)
     if reduce_to == "auto":
-        reduce_to = 28 if method == "mu" else None
-    elif isinstance(reduce_to, str):
-        raise ConfigError(f"design: reduce_to={reduce_to!r}, expected an int, 'auto' or None")
+        reduce_to = sp.order_max or (gp.design_plant.A.shape[0]
+                                     + gp.ncon * (gp.Wp.nstates + gp.Wu.nstates))
     red = None
     if reduce_to is not None and reduce_to < order_full:
         from .order import reduce_controller
 
         rr = reduce_controller(P_red, K_P, int(reduce_to), gp.nmeas, gp.ncon,
-                               blocks=blocks, omega=om)
+                               blocks=blocks, omega=om if method == "mu" else None)
         if not np.isfinite(rr.gamma):
             raise SynthesisError(
                 f"design: the order-{reduce_to} controller does not stabilise the design loop "
-                f"(full order {order_full}); choose a larger reduce_to")
+                f"(full order {order_full}); set a larger design.order_max")
         K_P, red = rr.K, rr.to_dict()
         red.pop("hsv", None)
         gamma = float(rr.gamma) if method == "hinf" else gamma
         mu = float(rr.mu) if rr.mu is not None else mu
     K = gp.physical_controller(K_P, name=f"K_{method}")
-    elapsed = time.perf_counter() - t0
-    ranges = {q.name: (q.low, q.high) for q in gp.parameters}
-    return DesignResult(method, K, p, gamma=gamma, mu=mu, order=int(K.nstates),
-                        order_full=order_full, history=tuple(hist), weights=w,
-                        uncertainty=ranges, elapsed_s=elapsed, reduction=red, plant=gp)
+    return _Synthesis(K, gamma, mu, tuple(hist), order_full, red, gp, K_P, mu_omega)
+
+
+def _states_to_keep(cfg, p: float, mode_hz: float) -> int:
+    """Design-model states that keep every mode of the supported rotor up to 1.1× mode_hz."""
+    from ..model.rig import build_system
+
+    lam = np.abs(build_system(cfg, pressure_bar=p).poles()) / (2 * np.pi)
+    return int(np.sum(lam < 1.1 * mode_hz))
+
+
+def _unstable_message(method, check, n, steps) -> str:
+    tried = f" after {len(steps)} automatic enlargement(s)" if steps else ""
+    return (f"design({method}): the controller destabilises the full-order plant{tried}: the "
+            f"mode at {check['mode_hz']:.4g} Hz has damping ζ = {check['damping']:.3g} at "
+            f"{check['pressure_bar']:g} bar, {check['speed_hz']:g} Hz; the design model "
+            f"({n} states) should keep it: set design.model_cutoff_hz above "
+            f"{check['mode_hz']:.4g} (or design.model_states), or pass --allow-unstable")
+
+
+def _verdict(method, r: _Synthesis, check) -> str:
+    """One plain line: robust performance met or not, and the full-order stability."""
+    stab = ("full-order loop stable at every judged condition" if check["stable"] else
+            f"FULL-ORDER LOOP UNSTABLE at {check['mode_hz']:.4g} Hz, {check['pressure_bar']:g} "
+            "bar (accepted with allow_unstable)")
+    if method == "hinf":
+        return f"H∞ γ = {r.gamma:.3g} on the nominal design model; {stab}"
+    if r.mu is not None and r.mu <= 1:
+        return f"robust performance met: μ = {r.mu:.3g} ≤ 1 on the design model; {stab}"
+    by = _dominant_weight(r)
+    return (f"robust performance NOT met: μ = {r.mu:.3g} > 1 (the demand is missed by "
+            f"{100 * (r.mu - 1):.0f} %){by}; {stab}")
+
+
+def _dominant_weight(r: _Synthesis) -> str:
+    """Which weighted output (W_p, W_u) and input (W_1, W_2, W_f) carry the closed loop's
+    largest gain at the μ peak frequency (a guide to which weight to relax)."""
+    if r.mu_omega is None or r.K_P is None:
+        return ""
+    from ..lti.freqresp import freqresp
+    from ..lti.interconnect import lft_lower
+
+    gp = r.gp
+    cl = lft_lower(gp.P, r.K_P, gp.nmeas, gp.ncon)
+    H = freqresp(cl, np.array([r.mu_omega]))[0]
+    nd = gp.n_delta
+    outs = [lab for lab in gp.P.output_labels[nd:] if not lab.startswith("y_")]
+    ins = [lab for lab in gp.P.input_labels[nd:] if not lab.startswith("u_")]
+    rows = {"W_p": [i for i, lab in enumerate(outs) if lab.startswith("zp_")],
+            "W_u": [i for i, lab in enumerate(outs) if lab.startswith("zu_")]}
+    cols = {"W_1": [j for j, lab in enumerate(ins) if lab.startswith("di_")],
+            "W_2": [j for j, lab in enumerate(ins) if lab.startswith("do_")],
+            "W_f": [j for j, lab in enumerate(ins) if lab.startswith("df_")]}
+    Hp = H[nd:nd + len(outs), nd:nd + len(ins)]
+    gain = {(a, b): np.linalg.norm(Hp[np.ix_(ri, cj)], 2)
+            for a, ri in rows.items() for b, cj in cols.items() if ri and cj}
+    a, b = max(gain, key=gain.get)
+    return f"; at the peak ({r.mu_omega / (2 * np.pi):.4g} Hz) {a} on the {b} input dominates"

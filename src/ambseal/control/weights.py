@@ -233,15 +233,16 @@ class Weights:
         Unbalance-orbit demand (µm): adds force inputs at ``force_position_m`` weighted by
         :meth:`Wf`, so that ``‖W_p S_o G_f W_f / D_e‖∞ ≤ 1`` reads "worst-case orbit
         σ̄(S_o G_f)·m·G·Ω ≤ orbit_um" below the roll-off (P5 §4.4.1). None: no force channel.
-    unbalance_mass_kg, unbalance_grade_mm_s : float
-        Rotor mass (kg) and ISO 21940-11 balance grade (mm/s) of the force law
-        ``F_u = m·G·Ω`` (thesis test rig: 69 kg, G2.5; only used with ``orbit_um``).
-    wf_rolloff_hz : float
-        Corner (Hz) of the 4th-order Butterworth roll-off of W_f: above the speed range and
-        well below the first bending mode, where a force at the seal excites a resonance no
-        controller can make compliant — a W_f still large there makes μ unreachable and
-        wrecks the design (test rig: 260 Hz, between the 200 Hz speed range and the
-        557 Hz bending mode; only used with ``orbit_um``).
+    unbalance_mass_kg : float or None
+        Mass (kg) of the force law ``F_u = m·G·Ω``, needed with ``orbit_um``; the design
+        specification sets the rotor's assembled mass (:mod:`ambseal.control.specs`).
+    unbalance_grade_mm_s : float
+        ISO 21940-11 balance grade G (mm/s), default G2.5 (precision machines).
+    wf_rolloff_hz : float or None
+        Corner (Hz) of the 4th-order Butterworth roll-off of W_f, needed with ``orbit_um``:
+        above the speed range and well below the first bending mode, where a force excites
+        a resonance no controller can make compliant — a W_f still large there makes μ
+        unreachable and wrecks the design (the rule is in :mod:`ambseal.control.specs`).
     force_position_m : float or None
         Axial position (m) of the force; the rig's first seal if None.
     d_e, d_u : float
@@ -257,9 +258,9 @@ class Weights:
     w1_gain: float = 1.0
     w1_corner_hz: float | None = None
     orbit_um: float | None = None
-    unbalance_mass_kg: float = 69.0
+    unbalance_mass_kg: float | None = None
     unbalance_grade_mm_s: float = 2.5
-    wf_rolloff_hz: float = 260.0
+    wf_rolloff_hz: float | None = None
     force_position_m: float | None = None
     d_e: float = 20e-6
     d_u: float = 1.0
@@ -311,7 +312,7 @@ class Weights:
         for nm, v in (("orbit_um", self.orbit_um), ("unbalance_mass_kg", self.unbalance_mass_kg),
                       ("unbalance_grade_mm_s", self.unbalance_grade_mm_s),
                       ("wf_rolloff_hz", self.wf_rolloff_hz)):
-            if not (np.isfinite(v) and v > 0):
+            if v is None or not (np.isfinite(v) and v > 0):
                 raise ConfigError(f"W_f: {nm}={v!r} must be finite and > 0")
         c = (self.unbalance_mass_kg * self.unbalance_grade_mm_s * 1e-3 * self.d_e
              / (self.orbit_um * 1e-6))
@@ -332,33 +333,37 @@ class Weights:
 
 
 def default_weights(method: str) -> Weights:
-    """The tuned weights of each design (see the tests in ``tests/control`` for why).
+    """The tuning of each method on the scaled plant (see the tests in ``tests/control``).
 
-    ``"hinf"`` (test rig, nominal design, P5 §4.4): W_p with M = 2.5, ω_B = 60 rad/s,
-    A = 1/1000; W_u = 0.3 constant.
+    These are the parts that do not depend on the machine; the scalings D_e, D_u, the
+    unbalance mass, the orbit demand, W_f's roll-off and W_u's corner are derived from the
+    rig by :func:`ambseal.control.specs.design_spec`, and every one can be set in the rig's
+    ``[design.<method>]`` table.
 
-    ``"mu"`` (test rig, P5 §4.3–4.4): W_p with M = 3 (ISO 14839-3 zone A), ω_B = 30 rad/s,
-    A = 1/1000; a high-pass W_u = 0.02 (1 + s/ω_z)/(1 + s/ω_p) rising from 0.02 to 0.2
-    above 800 Hz (rolls the controller off above the bending mode: |K| ≈ 0.2 MA/m at
-    10 kHz instead of ≈ 1.3); a small constant W_1 = 0.05; and the unbalance force at the
-    seal as a weighted input, :meth:`Weights.Wf` with ``F_u = m·G·Ω`` (69 kg, G2.5,
-    P5 §4.4.1), an orbit demand of 6 µm and a 4th-order roll-off at 260 Hz (above the
-    200 Hz speed range, below the 557 Hz bending mode). Result (μ ≈ 1.14): on the
-    full-order plant from 0 to 4.08 bar σ̄(S_o) ≤ 2.5 (bending-mode resonance resolved)
-    and worst-case orbit up to 200 Hz ≤ 6.5 µm.
+    ``"hinf"`` (nominal design, P5 §4.4): W_p with M = 2.5, ω_B = 60 rad/s, A = 1/1000;
+    W_u = 0.3 constant.
+
+    ``"mu"`` (P5 §4.3–4.4): W_p with M = 3 (ISO 14839-3 zone A), ω_B = 30 rad/s, A = 1/1000;
+    W_u = 0.02, which the specification makes a high-pass rising a decade to 0.2 above its
+    corner (rolls the controller off above the bending mode: on the test rig |K| ≈ 0.2 MA/m
+    at 10 kHz instead of ≈ 1.3); a small constant W_1 = 0.05; and, from the
+    specification, the unbalance force at the seal as a weighted input (:meth:`Weights.Wf`,
+    ``F_u = m·G·Ω``, P5 §4.4.1) with an orbit demand and a 4th-order roll-off. On the test
+    rig (6 µm, 260 Hz; μ ≈ 1.14): σ̄(S_o) ≤ 2.5 from 0 to 4.08 bar on the full-order plant
+    and a worst-case orbit up to 200 Hz ≤ 6.5 µm.
 
     Why: the force channel must bypass W_p (else the bound is ≈ 6× too loose above ω_B)
-    and roll off before the bending mode (else μ ≈ 6 at 557 Hz and the design degrades:
-    orbit 17–49 µm); without it the orbit is ≈ 10.5 µm. The binding trade-off is the
-    orbit against the control effort, not against σ̄(S_o): with W_u = 0.05/0.03/0.02
-    (constant) and a 6 µm demand the orbit is 7.8/6.6/5.8 µm at σ̄(S_o) 2.3/2.1/2.0;
-    W_u = 0.2 with the same demand gives σ̄(S_o) 3.6 and 15 µm. With an 8 µm demand and
-    this W_u, μ = 0.98 < 1 (robust performance on the design model), orbit 7.0 µm — a
-    smaller margin on the acceptance than the 6 µm demand.
+    and roll off before the bending mode (else μ ≈ 6 there and the design degrades:
+    orbit 17–49 µm on the test rig); without it the orbit is ≈ 10.5 µm. The binding
+    trade-off is the orbit against the control effort, not against σ̄(S_o): with W_u =
+    0.05/0.03/0.02 (constant) and a 6 µm demand the orbit is 7.8/6.6/5.8 µm at σ̄(S_o)
+    2.3/2.1/2.0; W_u = 0.2 gives σ̄(S_o) 3.6 and 15 µm. With an 8 µm demand, μ = 0.98 < 1
+    (robust performance on the design model), orbit 7.0 µm.
 
-    ``"lpv"`` (turboexpander, LPV and frozen-speed designs, P3 Eq. 11, §3.3): M = 2,
-    ω_B = 2π·50 rad/s, A = 1e-2, high-pass W_u 0.05 → 0.5 with its corner at 1.4 kHz;
-    the reasoning is in :mod:`ambseal.control.lpv_design`.
+    ``"lpv"`` (LPV and frozen-speed designs, P3 Eq. 11, §3.3): M = 2, ω_B = 2π·50 rad/s,
+    A = 1e-2, high-pass W_u 0.05 → 0.5 with its corner at 1.4 kHz, D_e = 20 µm, D_u = 1 A
+    (the turboexpander's tuning; the reasoning is in :mod:`ambseal.control.lpv_design`;
+    not yet derived from the machine).
 
     Raises
     ------
@@ -368,8 +373,7 @@ def default_weights(method: str) -> Weights:
     if method == "hinf":
         return Weights(M=2.5, omega_b=60.0, wu_gain=0.3)
     if method == "mu":
-        return Weights(M=3.0, omega_b=30.0, wu_gain=0.02, wu_corner_hz=800.0,
-                       wu_hf_gain=0.2, w1_gain=0.05, orbit_um=6.0, wf_rolloff_hz=260.0)
+        return Weights(M=3.0, omega_b=30.0, wu_gain=0.02, w1_gain=0.05)
     if method == "lpv":
         return Weights(M=2.0, omega_b=2 * np.pi * 50.0, A=1e-2, wu_gain=0.05,
                        wu_corner_hz=1400.0, wu_hf_gain=0.5)

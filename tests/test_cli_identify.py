@@ -143,10 +143,20 @@ def test_identify_refuses_duplicate_and_unexcited_records(record, tmp_path, caps
 
 
 def test_failed_fit_writes_no_identified_rig(record, tmp_path, capsys):
-    """A 1e300 sample makes the fit fail (NRMSE below its floor): exit 2 with the reason,
-    fit.json for diagnosis, no identified.toml and no warning lines before the error;
-    ``--accept-unconverged`` writes the rig anyway and exits 0."""
-    bad = _corrupt(record, tmp_path, _cell("displacement_A_zeta_m", 10, "1e300"))
+    """A displacement sensor wired with the wrong sign makes the fit fail (NRMSE below its
+    floor: no Ki explains the record): exit 2 with the reason, fit.json for diagnosis, no
+    identified.toml (an earlier one removed) and no warning lines before the error;
+    ``--accept-unconverged`` writes the rig anyway."""
+    def flipped(lines):
+        col = lines[0].split(",").index("displacement_A_zeta_m")
+        rows = [line.split(",") for line in lines[1:]]
+        for r in rows:
+            r[col] = repr(-float(r[col]))
+        return [lines[0]] + [",".join(r) for r in rows]
+
+    bad = _corrupt(record, tmp_path, flipped)
+    (tmp_path / "o").mkdir()
+    (tmp_path / "o" / "identified.toml").write_text("# an earlier fit's\n")
     code, err = _identify(capsys, tmp_path, bad)
     assert code == 2 and len(err) == 1 and "fit failed" in err[0], err
     assert (tmp_path / "o" / "fit.json").exists()

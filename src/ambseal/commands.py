@@ -135,7 +135,7 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
 
     A fit that failed (not converged, singular Jacobian, an estimate at its bound, an NRMSE
     fit below the floor of :func:`ambseal.identify.fit.fit_parameters`) writes ``fit.json``
-    and its figures for diagnosis but no ``identified.toml``, and raises, unless
+    for diagnosis but no figures and no ``identified.toml``, and raises, unless
     ``accept_unconverged``.
 
     Raises
@@ -181,18 +181,19 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
                         f"{', '.join(res.residuals.failed)})")
     write_json(out / "fit.json", {**res.to_dict(), "warnings": warnings,
                                   **({"per_record": spread} if spread else {})})
+    if not res.converged and not accept_unconverged:
+        from .errors import IdentificationError
+
+        (out / "identified.toml").unlink(missing_ok=True)  # an earlier fit's: not this one's
+        raise IdentificationError(f"identify: the fit failed ({res.message}); {out / 'fit.json'}"
+                                  " has the details, no identified rig was written "
+                                  "(--accept-unconverged writes it anyway)")
     fit_timeseries_figure(out / "fit_timeseries.png", res.time_s, res.y_meas, res.y_sim,
                           res.axes, nrmse_pct=[res.nrmse_fit_pct[a] for a in res.axes])
     correlation_figure(out / "correlation.png", res.correlation, res.names)
     residual_figure(out / "residuals.png", res.residuals)
     error_budget_figure(out / "error_budget.png", res.names, res.estimate, res.std_error_noise,
                         res.budget)
-    if not res.converged and not accept_unconverged:
-        from .errors import IdentificationError
-
-        raise IdentificationError(f"identify: the fit failed ({res.message}); {out / 'fit.json'}"
-                                  " has the details, no identified rig was written "
-                                  "(--accept-unconverged writes it anyway)")
     identified = rig_with_values(cfg, dict(zip(res.names, res.estimate)))
     header = (f"Identified by ambseal from {', '.join(str(d) for d in data)}\n"
               f"parameters: {', '.join(res.names)}; converged: {res.converged}\n"

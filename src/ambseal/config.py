@@ -423,6 +423,10 @@ def load_rig(path: str | Path | None = None, overrides=()) -> RigConfig:
     """
     p = Path(path) if path is not None else default_rig_path()
     data = _load_toml(p, "rig file")
+    design = data.get("design")
+    fit = design.get("uncertainty_from_identification") if isinstance(design, dict) else None
+    if isinstance(fit, str) and fit and not Path(fit).is_absolute():
+        design["uncertainty_from_identification"] = str(p.parent / fit)  # beside the rig
     if overrides:
         return parse_rig(apply_overrides(data, overrides), f"{p} (with --set)")
     return parse_rig(data, str(p))

@@ -28,6 +28,13 @@ schema). Units are SI except where the key names its unit.
     ``parameter``: any name of the model's LFT (``<seal>.k``, ``<seal>.K``, ``A.Ks_zeta``,
     ``coupling.kxx``, ...); and either ``relative`` (± that fraction of the nominal value,
     e.g. 1.0 for the thesis's k ± 100 %, P5 §4.1) or ``low`` and ``high`` (SI). Real.
+``[design] uncertainty_from_identification`` (μ)
+    The ``fit.json`` of an ``ambseal identify`` run (a path relative to the rig file; on
+    the command line, to the working folder): the 95 % intervals of its fitted model
+    parameters become their ``low``/``high`` ranges (``τ_e`` left out; a fit marked
+    "model mismatch" refused), so identified uncertainty flows into μ as the thesis
+    intends. Entries of ``[[design.uncertainty]]`` are added to them, and replace the
+    range of a parameter both name.
 ``[design.hinf]``, ``[design.mu]``, ``[design.lpv]``
     The weights of each method (:mod:`ambseal.control.weights`): ``M``, ``omega_b_rad_s``,
     ``A`` (W_p, P5 Eq. 7), ``wu_gain``, ``wu_corner_hz``, ``wu_hf_gain`` (W_u, constant or
@@ -146,6 +153,7 @@ class Design(_Strict):
     unbalance: UnbalanceSpec = UnbalanceSpec()
     impulse: ImpulseSpec = ImpulseSpec()
     uncertainty: list[UncertainSpec] | None = None
+    uncertainty_from_identification: str | None = Field(default=None, min_length=1)
     hinf: MethodSpec = MethodSpec()
     mu: MuSpec = MuSpec()
     lpv: MethodSpec = MethodSpec()

@@ -122,6 +122,33 @@ def test_design_part_validates_round_trips_and_overrides(testrig_cfg):
             load_rig(path, [bad])
 
 
+def test_uncertainty_from_an_identification_file(testrig_cfg, tmp_path):
+    """Reference: issue 17's contract — ``[design] uncertainty_from_identification`` takes
+    a fit.json's 95 % intervals unchanged as the μ ranges (τ_e left out), the path relative
+    to the rig file; ``[[design.uncertainty]]`` adds to them and wins where both name a
+    parameter; a fit marked model mismatch is refused naming the key."""
+    import json
+
+    fit = {"parameters": {"seal.k": {"estimate": 2.2e6, "ci95": [1.9e6, 2.5e6]},
+                          "seal.C": {"estimate": 300.0, "ci95": [250.0, 350.0]},
+                          "tau_e": {"estimate": 2e-4, "ci95": [1.9e-4, 2.1e-4]}},
+           "residual_tests": {"mismatch": False}}
+    (tmp_path / "id").mkdir()
+    (tmp_path / "id" / "fit.json").write_text(json.dumps(fit))
+    text = (SRC / "data" / "testrig.toml").read_text(encoding="utf-8")
+    rig = tmp_path / "rig.toml"
+    rig.write_text(text + '\n[design]\nuncertainty_from_identification = "id/fit.json"\n'
+                   '[[design.uncertainty]]\nparameter = "seal.C"\nrelative = 0.4\n',
+                   encoding="utf-8")
+    sp = design_spec(load_rig(rig))
+    assert sp.uncertainty == {"seal.k": (1.9e6, 2.5e6), "seal.C": 0.4}
+    assert "95 % intervals" in sp.sources["uncertainty"]
+    fit["residual_tests"]["mismatch"] = True
+    (tmp_path / "id" / "fit.json").write_text(json.dumps(fit))
+    with pytest.raises(ConfigError, match="uncertainty_from_identification.*model mismatch"):
+        design_spec(load_rig(rig))
+
+
 def test_negative_ks_is_refused_with_the_convention():
     """Another tool's sign (Ks < 0) must not be read as a stabilising spring."""
     data = {**BEAM, "amb": [dict(BEAM["amb"][0], ks=-2.0e5), BEAM["amb"][1]]}

@@ -349,9 +349,21 @@ def _unbalance(cfg, d, mach: Machine, rules: dict, notes: list):
 
 
 def _uncertainty(cfg, d, rules: dict, notes: list, pressure_bar: float) -> dict:
-    if d.uncertainty is not None:
-        rules["uncertainty"] = "set"
-        return {u.parameter: u.range for u in d.uncertainty}
+    if d.uncertainty_from_identification is not None or d.uncertainty is not None:
+        out: dict = {}
+        if d.uncertainty_from_identification is not None:
+            from ..errors import DataError
+            from ..identify.intervals import uncertainty_from_fit
+
+            try:
+                out = dict(uncertainty_from_fit(d.uncertainty_from_identification))
+            except DataError as exc:
+                raise ConfigError(f"design.uncertainty_from_identification: {exc}") from None
+        out.update({u.parameter: u.range for u in d.uncertainty or ()})
+        rules["uncertainty"] = " + ".join(
+            ([f"95 % intervals of {d.uncertainty_from_identification}"]
+             if d.uncertainty_from_identification else []) + (["set"] if d.uncertainty else []))
+        return out
     from ..model.seal import coefficient_value
 
     out = {}

@@ -187,3 +187,44 @@ def test_negative_ks_exits_2_naming_the_convention(tmp_path, capsys):
     rig, code = run(tmp_path, GOOD.replace("ks = 2.0e5", "ks = -2.0e5", 1))
     err = capsys.readouterr().err
     assert code == 2 and "amb[0]" in err and "Ks > 0" in err
+
+
+def test_version_and_helps_with_defaults(capsys):
+    """``--version`` prints the package version; every command's help names its options'
+    defaults (argparse's own rendering) and ``run --help`` says what the run does."""
+    import ambseal
+
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0 and capsys.readouterr().out.strip() == f"ambseal {ambseal.__version__}"
+    with pytest.raises(SystemExit):
+        main(["run", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "(default: ambseal-out)" in text and "identifies the rig" in text
+    assert "report.html (verdict first)" in text
+    with pytest.raises(SystemExit):
+        main(["acquire", "--help"])
+    assert "(default: 0.05)" in " ".join(capsys.readouterr().out.split())
+
+
+def test_validate_and_modes_default_to_the_embedded_rig(capsys):
+    """``validate`` without RIG checks the embedded test facility: its rotor mass is the
+    thesis's 69 kg (P5 §4.4.1, ±5 % for the FE mesh), the open loop has unstable poles
+    (negative AMB stiffness, P5 §2), and the modes below the controller's Nyquist frequency
+    include the first bending pair near 550 Hz (P4 Table 1, ±10 %); ``modes`` without RIG
+    prints the same modes."""
+    assert main(["validate", "--json"]) == 0
+    v = json.loads(capsys.readouterr().out)
+    assert v["mass_kg"] == pytest.approx(69.0, rel=0.05)
+    assert len(v["unstable_poles"]) >= 2
+    freqs = [f for f, _ in v["modes"]]
+    assert all(f < v["modes_below_hz"] for f in freqs)
+    assert any(f == pytest.approx(550.0, rel=0.10) for f in freqs)
+    assert v["defaults"]["judged_conditions"] == ["0 bar", "2.04 bar", "4.08 bar"]
+    assert main(["modes", "--json"]) == 0
+    m = json.loads(capsys.readouterr().out)
+    shown = [f for f in freqs if f <= m["max_hz"]]
+    assert m["natural_frequencies_hz"] == pytest.approx(shown, rel=1e-6)
+    assert main(["validate"]) == 0
+    text = capsys.readouterr().out
+    assert "valid" in text and "unstable open-loop poles" in text and "None" not in text

@@ -6,6 +6,8 @@ import pytest
 
 from ambseal.cli import main
 
+from .browser import chromium, probe
+
 #: ISO 14839-3:2006 zone A/B boundary of the sensitivity peak (3, i.e. 9.5 dB; P5 §4.1).
 ISO_ZONE_A_LIMIT = 3.0
 #: Thesis demand on the worst-case G2.5 unbalance orbit up to 200 Hz (P5 §4.4.1): 8 µm.
@@ -18,16 +20,79 @@ KEYS = {
 }
 
 
+def _on_a_terminal(argv: list[str], columns: int = 150) -> tuple[int, str]:
+    """``main(argv)`` with stdout and stderr on a pseudo-terminal (POSIX ``pty``) of
+    ``columns`` × 50; its exit status and everything the terminal received."""
+    import fcntl
+    import os
+    import pty
+    import struct
+    import sys
+    import termios
+    import threading
+
+    master, slave = pty.openpty()
+    fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 50, columns, 0, 0))
+    tty = os.fdopen(slave, "w", buffering=1, encoding="utf-8")
+    chunks: list[bytes] = []
+
+    def pump():
+        while True:
+            try:
+                data = os.read(master, 65536)
+            except OSError:
+                return
+            if not data:
+                return
+            chunks.append(data)
+
+    reader = threading.Thread(target=pump, daemon=True)
+    reader.start()
+    old = sys.stdout, sys.stderr
+    sys.stdout = sys.stderr = tty
+    try:
+        code = main(argv)
+    finally:
+        sys.stdout, sys.stderr = old
+        tty.close()
+        reader.join(timeout=10)
+        os.close(master)
+    return code, b"".join(chunks).decode("utf-8", "replace")
+
+
 @pytest.fixture(scope="module")
-def metrics(tmp_path_factory, request, design_cache_for):
-    """``ambseal run`` on the embedded rig, with the session's PID/H∞/μ designs (the same
-    calls ``run`` makes, computed once; tests/conftest.py)."""
+def terminal_run(tmp_path_factory, request, design_cache_for):
+    """``ambseal run`` on the embedded rig on a pseudo-terminal, with the session's
+    PID/H∞/μ designs (the same calls ``run`` makes, computed once; tests/conftest.py)."""
     out = tmp_path_factory.mktemp("run")
     cache = design_cache_for(request)
     with cache.patched("testrig"):
-        assert main(["run", "--out", str(out)]) == 0
+        code, screen = _on_a_terminal(["run", "--out", str(out)])
+    assert code == 0
     assert {"design:pid", "design:hinf", "design:mu"} <= set(cache.hits)
-    return out, json.loads((out / "metrics.json").read_text())
+    return out, json.loads((out / "metrics.json").read_text()), screen
+
+
+@pytest.fixture(scope="module")
+def metrics(terminal_run):
+    """(output folder, metrics.json) of :func:`terminal_run`."""
+    return terminal_run[:2]
+
+
+def test_run_on_a_terminal_ends_with_the_verdict_and_the_report_path(terminal_run):
+    """On a terminal (a pseudo-terminal here) the run shows its stages with their times,
+    ends with the verdict table (the report's first screen in text) and the path of
+    report.html, and stdout's last line is still the one JSON line."""
+    import re
+
+    out, m, screen = terminal_run
+    text = re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", screen)  # ANSI styles and cursor moves
+    for stage in ("model", "design", "judge", "identification", "report"):
+        assert stage in text
+    assert "Verdict" in text and "Not acceptable" in text  # the PID at 4.08 bar
+    assert f"report: {(out / 'report.html').resolve()}" in text.replace("\r", "")
+    last = [ln for ln in text.replace("\r", "\n").splitlines() if ln.strip()][-1]
+    assert json.loads(last)["report"] == str(out / "report.html")
 
 
 def test_run_writes_the_contract(metrics):
@@ -118,18 +183,51 @@ def test_run_judges_hinf_and_mu_as_the_thesis_found(metrics):
     assert set(m["controllers"]) == {"pid", "hinf", "mu"}
 
 
-def test_run_on_the_turboexpander_judges_lpv(tmp_path, request, design_cache_for):
+@pytest.fixture(scope="module")
+def turbo_run(tmp_path_factory, request, design_cache_for):
+    """``ambseal run examples/turboexpander.toml`` with the session's LPV and 140 Hz designs
+    (the same calls ``run`` makes; tests/conftest.py)."""
+    from pathlib import Path
+
+    rig = Path(__file__).resolve().parents[1] / "examples" / "turboexpander.toml"
+    import io
+    import sys
+
+    out = tmp_path_factory.mktemp("turbo")
+    cache = design_cache_for(request)
+    old, sys.stderr = sys.stderr, io.StringIO()  # not a terminal: plain stage lines
+    try:
+        with cache.patched("turbo"):
+            assert main(["run", str(rig), "--out", str(out)]) == 0
+        log = sys.stderr.getvalue()
+    finally:
+        sys.stderr = old
+    assert {"design_lpv", "design_frozen"} <= set(cache.hits)
+    (out / "stderr.log").write_text(log)
+    return out
+
+
+def test_run_not_on_a_terminal_logs_one_line_per_stage(turbo_run):
+    """`ambseal run 2>log`: one plain line per stage with its time and the elapsed time,
+    in the order of the job, no terminal control characters."""
+    import re
+
+    lines = (turbo_run / "stderr.log").read_text().splitlines()
+    stages = [re.match(r"ambseal: ([a-z-]+): done in [0-9.]+ s, elapsed ([0-9.]+) s$", ln)
+              for ln in lines]
+    assert all(stages), lines
+    assert [m.group(1) for m in stages] == ["model", "design", "judge", "spin-up", "report"]
+    elapsed = [float(m.group(2)) for m in stages]
+    assert elapsed == sorted(elapsed)
+    assert "\x1b" not in "".join(lines)
+
+
+def test_run_on_the_turboexpander_judges_lpv(turbo_run):
     """`ambseal run examples/turboexpander.toml` (issue 5): H∞ at 140 Hz and the LPV
     controller judged at frozen speeds over 20–300 Hz, every loop stable, the spin-up and
     frozen-sensitivity comparison in metrics and report, the LPV table exported. The LPV
     and 140 Hz designs are the session's (the same calls ``run`` makes; tests/conftest.py)."""
-    from pathlib import Path
-
-    rig = Path(__file__).resolve().parents[1] / "examples" / "turboexpander.toml"
-    cache = design_cache_for(request)
-    with cache.patched("turbo"):
-        assert main(["run", str(rig), "--out", str(tmp_path)]) == 0
-    assert {"design_lpv", "design_frozen"} <= set(cache.hits)
+    tmp_path = turbo_run
     m = json.loads((tmp_path / "metrics.json").read_text())
     got = {(c["controller"], c["speed_hz"]) for c in m["cases"]}
     assert got == {(c, f) for c in ("hinf", "lpv") for f in (20.0, 140.0, 300.0)}
@@ -171,3 +269,26 @@ def test_exported_hinf_closes_the_loop_by_name_in_python_control(metrics):
         worst = float(np.max(np.linalg.eigvals(loop.A).real))
         assert worst == pytest.approx(case["max_real_pole"], rel=1e-6, abs=1e-6)
         assert (worst < 0) == case["stable"]
+
+
+@pytest.mark.browser
+@pytest.mark.skipif(chromium() is None, reason="no Chromium installed (Debian: apt-get install "
+                    "chromium; .ci/run installs it where it can)")
+@pytest.mark.parametrize("which", ["testrig", "turbo"])
+def test_report_in_a_real_browser(which, request, tmp_path):
+    """The report as a reader sees it, in headless Chromium at 1280 × 900 CSS px: the page
+    loads without console errors, every image decodes, nothing overflows horizontally
+    (document width ≤ viewport width), the verdict table is on the first screen, and the
+    HTML holds no Python repr (``{'``, ``None``). A screenshot is kept beside the report."""
+    out = request.getfixturevalue("metrics")[0] if which == "testrig" else \
+        request.getfixturevalue("turbo_run")
+    report = out / "report.html"
+    html = report.read_text(encoding="utf-8")
+    assert "{'" not in html and "None" not in html
+    png = out / "report_screenshot.png"
+    got = probe(report, screenshot=png)
+    assert got["errors"] == []
+    assert got["images"] >= 5 and got["bad_images"] == []
+    assert got["doc_width"] <= got["view_width"] == 1280
+    assert got["verdict"] and got["verdict_bottom"] <= got["view_height"]
+    assert png.read_bytes().startswith(b"\x89PNG")

@@ -2,9 +2,13 @@
 
 Commands
 --------
+``ambseal [--version] [-q | -v] COMMAND``
+    ``--quiet``/``--verbose`` set the 'ambseal' logger (stage lines on stderr).
 ``ambseal run [RIG] [--out DIR]``
     The main job on a rig (default: the embedded thesis test facility).
-``ambseal modes RIG [--speed-rpm N] [--pressure-bar P] [--json] [--n-modes N] [--max-hz F]
+``ambseal validate [RIG] [--json]``
+    Parse and check a rig file; print its model summary and the defaults a run takes.
+``ambseal modes [RIG] [--speed-rpm N] [--pressure-bar P] [--json] [--n-modes N] [--max-hz F]
 [--controller C] [--shapes [PNG]] [--free | --no-amb]``
     Damped natural frequencies, damping ratios, log decrements, whirl and unstable poles of
     the full model (or of the closed loop), and the mode shapes.
@@ -17,7 +21,7 @@ Commands
     A ROSS rotor file as an ambseal rig file.
 ``ambseal acquire RIG --truth TRUTH --excitation prbs|sine|chirp|impulse --pressure-bar P --out FILE``
     A record from the virtual test facility (CSV + JSON sidecar, or .mat).
-``ambseal design RIG --method pid|hinf|mu|lpv [--out DIR] [--set design.KEY=VALUE ...]``
+``ambseal design [RIG] --method pid|hinf|mu|lpv [--out DIR] [--set design.KEY=VALUE ...]``
     Design a controller on the rig's reduced model; write it (continuous, Tustin and ZOH at
     the controller's sample rate) as .json, .npz and .mat, with a summary.
     ``--show-defaults`` prints the rig's resolved ``[design]`` part instead; ``--set``
@@ -36,6 +40,7 @@ import argparse
 import json
 import math
 import os
+import shlex
 import sys
 from pathlib import Path
 
@@ -90,26 +95,64 @@ def _natural(text: str) -> int:
     return _whole(text, 0)
 
 
+_RIG_HELP = "rig file (TOML); default: the embedded thesis test facility"
+_RUN_TEXT = """The main job. Builds the rig's full FE model and its modal reduction; designs the
+reference PID, an H∞ and a μ controller (thesis P5) — or, on a rig whose seals change with
+speed over [operating] speed_range_hz, an H∞ controller at the operating speed and the LPV
+controller scheduled on speed (P3) — and exports them; judges each on the full-order plant
+at 0, nominal and 2× nominal pressure drop (or the ends and middle of the speed range):
+stability, σ̄(S_o) and ISO 14839-3 zones per axis, compliance, worst-case unbalance orbit,
+current-impulse response; for the embedded rig (or with --truth) identifies the rig on the
+virtual test facility; writes metrics.json, figures and report.html (verdict first) to
+--out. Progress on stderr (bars on a terminal, one line per stage otherwise); stdout gets
+one JSON line with the output paths."""
+
+
+class _Help(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpFormatter):
+    """Help with each option's default, unless the default is 'none' (said in words)."""
+
+    def _get_help_string(self, action):
+        if action.default in (None, False) or action.default is argparse.SUPPRESS:
+            return action.help
+        return super()._get_help_string(action)
+
+
 def _parser() -> argparse.ArgumentParser:
+    from . import __version__
+
     p = _Parser(
         prog="ambseal",
         description="Rotors on active magnetic bearings with destabilising seal forces.",
+        formatter_class=_Help,
     )
+    p.add_argument("--version", action="version", version=f"ambseal {__version__}")
+    loud = p.add_mutually_exclusive_group()
+    loud.add_argument("-q", "--quiet", action="store_true",
+                      help="no progress and no stage lines; errors only (stdout unchanged)")
+    loud.add_argument("-v", "--verbose", action="store_true",
+                      help="log every step (DEBUG on the 'ambseal' logger) instead of bars")
     sub = p.add_subparsers(dest="command", required=True)
 
-    run = sub.add_parser("run", help="the main job: model, PID loop, judgement, report")
-    run.add_argument("rig", nargs="?", help="rig file (TOML); default: the thesis test rig")
-    run.add_argument("--out", default="ambseal-out", help="output folder (default ./ambseal-out)")
+    run = sub.add_parser("run", help="the main job: model, designs, judgement, "
+                         "identification, report", description=_RUN_TEXT)
+    run.add_argument("rig", nargs="?", help=_RIG_HELP)
+    run.add_argument("--out", default="ambseal-out", help="output folder")
     run.add_argument("--truth", default=None,
                      help="truth file of the virtual facility: adds the identification stage "
-                          "(default for the embedded rig: its packaged truth)")
+                          "(the embedded rig uses its packaged truth)")
     run.add_argument("--no-identify", action="store_true", help="skip the identification stage")
     _design_options(run)
+
+    v = sub.add_parser("validate", help="check a rig file; print its model and the defaults "
+                       "a run takes")
+    v.add_argument("rig", nargs="?", help=_RIG_HELP)
+    v.add_argument("--json", action="store_true", help="print JSON instead of text")
 
     a = sub.add_parser("acquire", help="record a run of the virtual test facility")
     a.add_argument("rig", help="rig file (TOML)")
     a.add_argument("--truth", required=True, help="truth file of the virtual facility (TOML)")
-    a.add_argument("--excitation", required=True, choices=["prbs", "sine", "chirp", "impulse"])
+    a.add_argument("--excitation", required=True, choices=["prbs", "sine", "chirp", "impulse"],
+                   help="excitation signal")
     a.add_argument("--pressure-bar", type=_finite, required=True, help="seal pressure drop (bar)")
     a.add_argument("--out", required=True, help="record file: .csv (+ .csv.json) or .mat")
     a.add_argument("--amplitude-a", type=_finite, default=0.05, help="excitation amplitude (A)")
@@ -124,13 +167,14 @@ def _parser() -> argparse.ArgumentParser:
                    help="stepped sine: settling cycles")
     a.add_argument("--f0-hz", type=_finite, default=1.0, help="chirp start frequency (Hz)")
     a.add_argument("--f1-hz", type=_finite, default=150.0, help="chirp end frequency (Hz)")
-    a.add_argument("--chirp", choices=["linear", "logarithmic"], default="linear")
+    a.add_argument("--chirp", choices=["linear", "logarithmic"], default="linear",
+                   help="chirp frequency sweep")
     a.add_argument("--width-s", type=_finite, default=0.01, help="impulse width (s)")
     a.add_argument("--start-s", type=_finite, default=0.05, help="impulse start (s)")
     a.add_argument("--seed", type=_natural, default=0, help="seed of excitation and noise")
 
     d = sub.add_parser("design", help="design a controller (pid, hinf, mu, lpv) and export it")
-    d.add_argument("rig", help="rig file (TOML)")
+    d.add_argument("rig", nargs="?", help=_RIG_HELP)
     d.add_argument("--method", choices=["pid", "hinf", "mu", "lpv"],
                    help="the method (required unless --show-defaults)")
     d.add_argument("--show-defaults", action="store_true",
@@ -158,6 +202,8 @@ def _parser() -> argparse.ArgumentParser:
 
     add_parsers(sub, _positive_int)  # modes, campbell, sweep, import-ross
     _checked_numbers(p)
+    for parser in sub.choices.values():  # every command's help names its defaults
+        parser.formatter_class = _Help
     return p
 
 
@@ -246,16 +292,19 @@ def _acquire(args: argparse.Namespace) -> int:
 
 def _design(args: argparse.Namespace) -> int:
     from .commands import design_files, show_defaults
+    from .config import default_rig_path
+
+    rig = args.rig if args.rig is not None else default_rig_path()
 
     if args.show_defaults:
-        print(show_defaults(args.rig, args.overrides), end="")
+        print(show_defaults(rig, args.overrides), end="")
         return 0
     if args.method is None:
         from .errors import ConfigError
 
         raise ConfigError("design: --method is required (pid, hinf, mu or lpv) unless "
                           "--show-defaults")
-    print(json.dumps(design_files(args.rig, args.method, args.out,
+    print(json.dumps(design_files(rig, args.method, args.out,
                                   pressure_bar=args.pressure_bar, overrides=args.overrides,
                                   allow_unstable=args.allow_unstable)))
     return 0
@@ -275,9 +324,70 @@ def _run(args: argparse.Namespace) -> int:
     from .pipeline import run
 
     result = run(args.rig, args.out, truth=args.truth, identification=not args.no_identify,
-                 overrides=tuple(args.overrides), allow_unstable=args.allow_unstable)
-    print(json.dumps({"out": str(result.out_dir), "metrics": str(result.metrics_path)}))
+                 overrides=tuple(args.overrides), allow_unstable=args.allow_unstable,
+                 command=args.command_line, progress=not (args.quiet or args.verbose))
+    if sys.stderr.isatty() and not args.quiet:
+        from rich.console import Console
+
+        from .config import load_rig
+        from .report.run_report import rig_clearances_um
+        from .report.verdict import verdict_table_rich, verdicts
+
+        console = Console(stderr=True)
+        clear = rig_clearances_um(load_rig(args.rig))
+        console.print(verdict_table_rich(verdicts(result.metrics["cases"], clear)))
+        console.print(f"report: {result.report_path.resolve()}")
+    print(json.dumps({"out": str(result.out_dir), "metrics": str(result.metrics_path),
+                      "report": str(result.report_path)}))
     return 0
+
+
+def _plain(x) -> str:
+    """A value of ``validate``'s defaults as text: dicts as ``key value``, pairs as ranges."""
+    if isinstance(x, dict):
+        return ", ".join(f"{k} {_plain(w)}" for k, w in x.items())
+    if isinstance(x, (list, tuple)):
+        pair = len(x) == 2 and all(isinstance(y, (int, float)) for y in x)
+        return "–".join(map(_plain, x)) if pair else ", ".join(map(_plain, x))
+    return "none" if x is None else f"{x:g}" if isinstance(x, float) else str(x)
+
+
+def _validate(args: argparse.Namespace) -> int:
+    from .commands import validate_summary
+
+    v = validate_summary(args.rig)
+    if args.json:
+        print(json.dumps(v, indent=2))
+        return 0
+    print(f"{v['rig']}: valid — {v['name']}")
+    print(f"  rotor mass {v['mass_kg']:.4g} kg, {v['nodes']} nodes, AMB axes "
+          f"{', '.join(v['axes'])}")
+    print(f"  modes below {v['modes_below_hz']:g} Hz (controller Nyquist): "
+          + ", ".join(f"{f:.4g} Hz (ζ {z:.3g})" for f, z in v["modes"]))
+    poles = v["unstable_poles"]
+    print(f"  {len(poles)} unstable open-loop poles"
+          + (": " + ", ".join(f"{re:.4g}{im:+.4g}j rad/s" for re, im in poles) if poles else ""))
+    print("  defaults a run takes:")
+    for key, val in v["defaults"].items():
+        print(f"    {key}: {_plain(val)}")
+    return 0
+
+
+def _logging(args: argparse.Namespace) -> None:
+    """Stage lines of the 'ambseal' logger to stderr: INFO by default, WARNING with
+    --quiet, DEBUG with --verbose (a library user routes the logger as they like)."""
+    import logging
+
+    log = logging.getLogger("ambseal")
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("ambseal: %(message)s"))
+    log.handlers[:] = [handler]
+    log.propagate = False
+    level = (logging.WARNING if args.quiet else
+             logging.DEBUG if args.verbose else logging.INFO)
+    if level == logging.INFO and sys.stderr.isatty():
+        level = logging.WARNING  # on a terminal the progress bars say it
+    log.setLevel(level)
 
 
 def _named(exc: AmbsealError, files: list, source: str) -> AmbsealError:
@@ -306,10 +416,12 @@ def main(argv: list[str] | None = None) -> int:
     import warnings
 
     args = _parser().parse_args(argv)
+    args.command_line = shlex.join(["ambseal", *(sys.argv[1:] if argv is None else argv)])
+    _logging(args)
     from .rotordynamics import HANDLERS
 
     handler = {"acquire": _acquire, "identify": _identify, "design": _design,
-               "run": _run, **HANDLERS}[args.command]
+               "run": _run, "validate": _validate, **HANDLERS}[args.command]
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("default")
         try:

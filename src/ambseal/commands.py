@@ -1,4 +1,4 @@
-"""The ``design`` and ``identify`` commands: load, call the stage, write the files.
+"""The ``design``, ``identify`` and ``validate`` commands: load, call the stage, write the files.
 
 Wiring only, like :mod:`ambseal.pipeline`: every number comes from :mod:`ambseal.control`
 and :mod:`ambseal.identify`, every figure from :mod:`ambseal.report`, every file through a
@@ -15,7 +15,8 @@ from .config import load_rig
 from .errors import ConfigError
 from .files import writable_folder, write_json, write_text
 
-__all__ = ["design_files", "identify_files", "export_design", "show_defaults"]
+__all__ = ["design_files", "identify_files", "export_design", "show_defaults",
+           "validate_summary"]
 
 
 def _finite(x: float) -> float | None:
@@ -208,3 +209,51 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
             "nrmse_fit_pct": {k: _finite(v) for k, v in res.nrmse_fit_pct.items()},
             "residual_test": res.residuals.to_dict()["verdict"],
             "warnings": warnings}
+
+
+def validate_summary(rig: str | Path | None = None) -> dict:
+    """``ambseal validate``: parse and check a rig file; its model and the defaults a run takes.
+
+    Returns a JSON-ready dict: ``rig``, ``name``, ``mass_kg``, ``nodes``, ``axes``; the modes
+    of the full model at the nominal condition below the controller's Nyquist frequency
+    (``modes_below_hz``, ``modes`` as [f_Hz, ζ]); ``unstable_poles`` ([Re, Im] rad/s); and
+    ``defaults``: the reduced model's order, the judged conditions, the controller's sample
+    rate, the reference PID and the judgement's grids and disturbances.
+
+    Raises
+    ------
+    ConfigError
+        The rig file does not parse or check.
+    """
+    from dataclasses import asdict
+
+    from .analysis.judge import judge_settings, operating_points
+    from .config import default_rig_path
+    from .control.specs import design_spec
+    from .model.amb import channel_names
+    from .model.modes import modes
+    from .model.rig import build_plant, build_system
+    from .model.rotor import assemble_rotor, build_mesh
+
+    cfg = load_rig(rig)
+    spec = design_spec(cfg)
+    limit = cfg.controller.sample_rate_hz / 2
+    res = modes(build_system(cfg))
+    rows = [[f, z] for f, z in zip(res.natural_frequencies_hz, res.damping_ratios) if f < limit]
+    pid = cfg.controller.pid
+    return {
+        "rig": str(rig if rig is not None else default_rig_path()),
+        "name": cfg.rotor.name, "mass_kg": assemble_rotor(cfg).mass,
+        "nodes": build_mesh(cfg).n_nodes, "axes": list(channel_names(cfg)),
+        "modes_below_hz": limit, "modes": rows,
+        "unstable_poles": [list(p) for p in res.unstable_poles],
+        "defaults": {
+            "reduced_states": build_plant(cfg, reduced=True).n_states,
+            "judged_conditions": [p.label for p in operating_points(cfg, spec)],
+            "nominal_pressure_bar": cfg.operating.pressure_bar,
+            "nominal_speed_rpm": cfg.operating.speed_rpm,
+            "controller_sample_rate_hz": cfg.controller.sample_rate_hz,
+            "pid": None if pid is None else pid.model_dump(),
+            "judgement": asdict(judge_settings(cfg, spec)),
+        },
+    }

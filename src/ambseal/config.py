@@ -23,7 +23,9 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     poles of a pole pair of an 8-pole heteropolar bearing) or ``ki`` (N/A) and ``ks`` (N/m),
     each a number or ``{ zeta = ..., eta = ... }``; with the geometry, a factor given
     explicitly (also for one axis only) wins over the geometry's
-    (:func:`ambseal.model.amb.amb_factors`). Also optional ``current_limit`` (A).
+    (:func:`ambseal.model.amb.amb_factors`). Also optional ``current_limit`` (A) and
+    ``backup_clearance`` (m, radial clearance of the backup bearing beside the AMB); the
+    report sets the worst unbalance orbit against it and against ``air_gap``.
 ``[actuator]``
     ``model`` = ``"none"`` | ``"first_order"`` (``cutoff_hz``) | ``"second_order"``
     (``natural_frequency`` in rad/s, ``damping_ratio``); ``eddy_time_constant`` τ_e (s,
@@ -185,6 +187,7 @@ class Amb(_Strict):
     ki: _Big | AxisPair | None = None
     ks: _Big | AxisPair | None = None
     current_limit: float | None = Field(default=None, gt=0, le=1e4)
+    backup_clearance: float | None = Field(default=None, gt=0, le=1.0)
     uncertainty: Uncertainty = None
 
     @model_validator(mode="after")

@@ -9,6 +9,7 @@ a temporary name and a rename.
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -53,7 +54,7 @@ def _controllers(cfg: RigConfig, spec, say, allow_unstable: bool = False) -> lis
     rig's design specification ``spec``. Speed-driven seals over a speed range (the
     turboexpander, P3 §4): the PID if the rig has one, an H∞ controller designed at the
     operating speed (the LTI comparison of P3 Fig. 11) and the LPV controller scheduled on
-    speed.
+    speed. ``say(message, steps)`` reports: one step per design, messages in between.
     """
     from .analysis.judge import speed_scheduled
     from .control.recipes import design
@@ -63,17 +64,26 @@ def _controllers(cfg: RigConfig, spec, say, allow_unstable: bool = False) -> lis
 
     def robust(m: str) -> Designed:
         say(f"designing {m}", 0)
-        return lti(design(cfg, m, spec=spec, allow_unstable=allow_unstable, progress=say))
+        d = lti(design(cfg, m, spec=spec, allow_unstable=allow_unstable,
+                       progress=lambda msg: say(msg, 0)))
+        say(f"{m} designed", 1)
+        return d
 
     if speed_scheduled(cfg):
         from .control.lpv_design import design_frozen, design_lpv
 
         out = [lti(design(cfg, "pid"))] if cfg.controller.pid else []
+        if out:
+            say("pid designed", 1)
         fz = design_frozen(cfg, cfg.operating.speed_rpm / 60.0)
         out.append(Designed("hinf", fz.K, fz.to_dict(), fz))
+        say("hinf designed; lpv next", 1)
         lpv = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz)
+        say("lpv designed", 1)
         return out + [Designed("lpv", lpv, lpv.to_dict(), lpv)]
-    return [lti(design(cfg, "pid")), robust("hinf"), robust("mu")]
+    pid = lti(design(cfg, "pid"))
+    say("pid designed", 1)
+    return [pid, robust("hinf"), robust("mu")]
 
 
 def _identification(cfg: RigConfig, truth, out: Path, say) -> tuple[dict, list, list]:
@@ -107,7 +117,7 @@ def _identification(cfg: RigConfig, truth, out: Path, say) -> tuple[dict, list, 
 def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         progress: bool = True, truth: str | Path | None = None,
         identification: bool = True, overrides: tuple[str, ...] = (),
-        allow_unstable: bool = False) -> RunResult:
+        allow_unstable: bool = False, command: str | None = None) -> RunResult:
     """The main job: build and reduce the model, design, judge, identify, report.
 
     Parameters
@@ -119,7 +129,8 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         (:class:`ambseal.files.RunFolder`: a staging folder beside it, a lock against a
         second run, a manifest of the files written last).
     progress : bool
-        Show a progress display on stderr.
+        Show a progress display on stderr when it is a terminal; stage lines go to the
+        ``"ambseal"`` logger in any case (:mod:`ambseal.report.progress`).
     truth : path, optional
         Truth file of the virtual test facility; with it (and by default for the embedded
         rig) the run also acquires records from the virtual facility and identifies the rig
@@ -132,6 +143,8 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
     allow_unstable : bool
         Keep a controller whose full-order loop is unstable at a judged condition (marked
         in ``metrics.json``) instead of stopping with a SynthesisError.
+    command : str, optional
+        The command line, for the report's stamp.
 
     Returns
     -------
@@ -145,9 +158,6 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         A controller that does not stabilise the full-order plant (without
         ``allow_unstable``).
     """
-    from rich.console import Console
-    from rich.progress import Progress
-
     from .analysis.judge import (judge_case, judge_settings, judge_spinup, operating_points,
                                  speed_scheduled, unstable_open_loop_poles)
     from .analysis.sweep import run_cases
@@ -155,7 +165,9 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
     from .commands import export_design
     from .control.controller import frozen
     from .model.rig import build_plant
-    from .report.run_report import gains_figure, spinup_figures, write_run_report
+    from .report.progress import StageProgress
+    from .report.run_report import (gains_figure, rig_clearances_um, spinup_figures, stamp,
+                                    write_run_report)
 
     rig_path = Path(rig) if rig is not None else default_rig_path()
     cfg = load_rig(rig_path, overrides)
@@ -172,37 +184,34 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
     points = operating_points(cfg, spec)
     settings = judge_settings(cfg, spec)
     final = Path(out_dir)
+    n_designs = (2 + (cfg.controller.pid is not None)) if speed_scheduled(cfg) else 3
+    totals = {"model": 1, "design": n_designs, "judge": n_designs * len(points),
+              "identification": None, "spin-up": 1, "report": 1}
     # one run = one folder: written into a staging folder that replaces out_dir at the end
     with RunFolder(final) as out, \
-            Progress(console=Console(stderr=True), disable=not progress, transient=True) as bar:
+            StageProgress(totals, display=progress and sys.stderr.isatty()) as stages:
         (out / "controllers").mkdir()
-        total = 2 + 3 * 3 * len(points) + 1
-        task = bar.add_task("ambseal run", total=total)
-
-        def say(msg: str, steps: int = 1) -> None:
-            bar.update(task, description=msg)
-            bar.advance(task, steps)
-
-        say("model: full order and modal reduction", 0)
+        stages.begin("model", "full order and modal reduction")
         full = build_plant(cfg)
         n_reduced = build_plant(cfg, reduced=True).n_states
         unstable = unstable_open_loop_poles(full.A)
-        say("designing the controllers")
-        designs = _controllers(cfg, spec, say, allow_unstable)
+        stages.step()
+        stages.begin("design")
+        designs = _controllers(cfg, spec, lambda msg, steps=0: stages.step(msg, steps),
+                               allow_unstable)
         for d in designs:
             export_design(d.method, d.controller, d.result.to_dict(), out / "controllers",
                           cfg.controller.sample_rate_hz, [p.speed_rpm / 60.0 for p in points])
-        bar.advance(task)
+        stages.begin("judge")
         jobs = [{"name": d.method, "point": p,
                  "controller": frozen(d.controller, 2 * math.pi * p.speed_rpm / 60.0)}
                 for d in designs for p in points]
-        say(f"judging {len(jobs)} cases", 0)
         judged = run_cases(judge_case, jobs, shared={"cfg": cfg, "settings": settings},
                            workers=1, raise_errors=True,
-                           on_done=lambda i, r: say(f"judged {jobs[i]['name']} at "
-                                                    f"{jobs[i]['point'].label}", 3))
+                           on_done=lambda i, r: stages.step(f"{jobs[i]['name']} at "
+                                                            f"{jobs[i]['point'].label}"))
         cases = [case for case, _ in judged]
-        curves = [(f"{j['name']}, {j['point'].label}", c) for j, (_, c) in zip(jobs, judged)]
+        curves = [(j["name"], j["point"], case, c) for j, (case, c) in zip(jobs, judged)]
         metrics = {
             "rig": str(rig_path),
             "rig_name": cfg.rotor.name,
@@ -216,18 +225,20 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         }
         figs, sections = [], []
         if truth_cfg is not None:
-            bar.update(task, total=total + 8)
-            metrics["identification"], figs, sections = _identification(cfg, truth_cfg, out, say)
+            stages.begin("identification")
+            metrics["identification"], figs, sections = _identification(cfg, truth_cfg, out,
+                                                                        stages.step)
         if speed_scheduled(cfg):
-            say("spin-up and frozen sensitivities", 0)
+            stages.begin("spin-up", "spin-up and frozen sensitivities")
             metrics["spinup"], sims, sens = judge_spinup(
                 cfg, {d.method: d.controller for d in designs})
             figs += spinup_figures(out, sims, sens, cfg.operating.speed_range_hz)
-        say("report", 0)
+            stages.step()
+        stages.begin("report")
         write_json(out / "metrics.json", metrics)
         speed = 2 * math.pi * cfg.operating.speed_rpm / 60.0
         figs.append(gains_figure(out, [(d.method, frozen(d.controller, speed)) for d in designs]))
-        write_run_report(out, f"ambseal — {cfg.rotor.name}", f"rig: {rig_path}",
-                         metrics, curves, figs, sections)
-        bar.advance(task)
+        write_run_report(out, f"ambseal — {cfg.rotor.name}", stamp(rig_path, command),
+                         metrics, curves, figs, sections, rig_clearances_um(cfg))
+        stages.step()
     return RunResult(final, final / "metrics.json", final / "report.html", metrics)

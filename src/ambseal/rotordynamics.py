@@ -215,7 +215,8 @@ def add_parsers(sub, positive_int) -> None:
     """Add ``modes``, ``campbell``, ``sweep`` and ``import-ross`` to the CLI's subparsers."""
     m = sub.add_parser("modes", help="natural frequencies, damping, log decrement, whirl, "
                                      "unstable poles and mode shapes")
-    m.add_argument("rig", help="rig file (TOML)")
+    m.add_argument("rig", nargs="?", help="rig file (TOML); default: the embedded thesis test "
+                                          "facility")
     m.add_argument("--speed-rpm", type=float, default=None, help="spin speed (rpm)")
     m.add_argument("--pressure-bar", type=float, default=None, help="seal pressure drop (bar)")
     m.add_argument("--json", action="store_true", help="print JSON instead of a table")

@@ -15,12 +15,18 @@ from ambseal.report import figures, html
 
 
 def _metrics():
+    axes = ("A_zeta", "B_eta")
     return [
-        {"controller": "PID <b>", "pressure_bar": 2.04, "stable": True, "max_real_pole": -12.5,
-         "sensitivity_peak": 3.0, "iso_zone": "B", "compliance_peak_m_per_n": 2.1e-7,
-         "unbalance_peak_um": 7.9, "impulse_peak_um": 12.3, "impulse_settling_s": 0.03, "note": "x&y"},
-        {"controller": "PID", "pressure_bar": 4.08, "stable": False, "max_real_pole": 3.2,
-         "sensitivity_peak": None, "iso_zone": "D", "impulse_settling_s": "inf"},
+        {"controller": "PID <b>", "pressure_bar": 2.04, "speed_hz": 0.0, "stable": True,
+         "max_real_pole": -12.5, "sensitivity_peak": 3.5,
+         "sensitivity_peak_per_axis": dict(zip(axes, (2.9, 3.1))), "iso_zone": "B",
+         "iso_zone_per_axis": dict(zip(axes, "AB")), "compliance_peak_m_per_n": 2.1e-7,
+         "unbalance_peak_um": 7.9, "impulse_peak_um": 12.3, "impulse_settling_s": 0.03},
+        {"controller": "PID <b>", "pressure_bar": 4.08, "speed_hz": 0.0, "stable": False,
+         "max_real_pole": 3.2, "sensitivity_peak": None,
+         "sensitivity_peak_per_axis": dict.fromkeys(axes), "iso_zone": "D",
+         "iso_zone_per_axis": dict(zip(axes, "DD")), "compliance_peak_m_per_n": None,
+         "unbalance_peak_um": None, "impulse_peak_um": None, "impulse_settling_s": None},
     ]
 
 
@@ -42,7 +48,7 @@ def test_report_is_self_contained_and_escaped(tmp_path):
     text = out.read_text(encoding="utf-8")
     assert text.startswith("<!DOCTYPE html>")
     assert "<script>" not in text and "&lt;script&gt;" in text
-    assert "PID &lt;b&gt;" in text and "Seal &lt;test&gt;" in text and "x&amp;y" in text
+    assert "PID &lt;b&gt;" in text and "Seal &lt;test&gt;" in text
     assert "<p id='raw'>ok</p>" in text
     refs = re.findall(r"""(?:src|href)\s*=\s*["']?([^"'\s>]*)""", text, flags=re.I)
     assert refs and all(r.startswith("data:image/png;base64,") for r in refs)
@@ -50,17 +56,39 @@ def test_report_is_self_contained_and_escaped(tmp_path):
     srcs = re.findall(r'<img src="data:image/png;base64,([^"]+)"', text)
     assert len(srcs) == 2
     assert base64.b64decode(srcs[0]) == png.read_bytes()
-    assert text.count("<tr") == 3 and 'class="unstable"' in text
-    assert "inf" in text  # settling "inf" string is shown as given
+    # verdict: header + 1 controller; detail: 2 header rows + 2 cases
+    assert text.count("<tr") == 2 + 4 and 'class="unstable"' in text
+    assert "None" not in text and "{'" not in text
     assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
 
 
-def test_format_value():
-    """Reference: table conventions of this module's docstring (4 significant digits, yes/no,
-    — for missing, ∞ for inf)."""
-    assert html.format_value(0.0123456) == "0.01235"
-    assert html.format_value(True) == "yes" and html.format_value(None) == "—"
-    assert html.format_value(float("inf")) == "∞" and html.format_value(float("nan")) == "—"
+def test_numbers_for_people():
+    """Reference: the report's table conventions (issue 13 §1): 3 significant figures by
+    default, yes/no, — for missing, ∞ for inf, powers of ten written out."""
+    from ambseal.report.verdict import sig
+
+    assert sig(0.0123456) == "0.0123" and sig(-14.0723, 4) == "-14.07"
+    assert sig(True) == "yes" and sig(None) == "—" and sig(float("nan")) == "—"
+    assert sig(float("inf")) == "∞" and sig(2.1e-7) == "2.1·10^-7"
+
+
+def test_verdict_grades_each_axis_as_iso_14839_3_does():
+    """Reference: ISO 14839-3 grades the sensitivity of each axis; an unstable loop is not
+    acceptable whatever its other conditions (P5 §4.4.2: the PID at 4.08 bar)."""
+    from ambseal.report.verdict import verdicts
+
+    cases = _metrics()
+    stable_only = verdicts(cases[:1], {"air gap": 500.0})[0]
+    assert stable_only.zone_axis == "B" and stable_only.zone_sigma == "B"
+    assert stable_only.words().startswith("Zone B on every axis over 2.04 bar")
+    assert stable_only.orbit_text() == "7.9 µm (1.6 % of the air gap)"
+    both = verdicts(cases)[0]
+    assert both.zone_axis == "D" and both.unstable_at == ("4.08 bar",)
+    assert both.stable_range == "2.04 bar"
+    assert both.words().startswith("Not acceptable: the loop is unstable at 4.08 bar")
+    spiky = dict(cases[0], iso_zone="D", sensitivity_peak=5.5)
+    v = verdicts([spiky])[0]
+    assert v.zone_axis == "B" and v.zone_sigma == "D" and "σ̄ over all axes reaches D" in v.words()
 
 
 def test_bad_inputs_raise(tmp_path):
@@ -82,3 +110,21 @@ def test_imports_stay_light():
             "import ambseal.analysis.response, ambseal.lti.freqresp\n"
             "assert 'matplotlib' not in sys.modules, 'matplotlib imported'\n")
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_orbit_against_the_rigs_clearances(tmp_path):
+    """Reference: the thesis rig's nominal radial air gap, 0.5 mm (P2 Table 1), and a
+    backup-bearing clearance given in the rig file; the orbit is set against the smaller of
+    each kind, in per cent (7.9 µm of 500 µm is 1.58 %)."""
+    from ambseal.config import default_rig_path, load_rig
+    from ambseal.report.run_report import rig_clearances_um
+    from ambseal.report.verdict import verdicts
+
+    text = default_rig_path().read_text().replace(
+        "current_limit = 6.0\n", "current_limit = 6.0\nbackup_clearance = 0.25e-3\n")
+    (tmp_path / "rig.toml").write_text(text)
+    clear = rig_clearances_um(load_rig(tmp_path / "rig.toml"))
+    assert clear == pytest.approx({"air gap": 500.0, "backup bearing": 250.0}, rel=1e-3)
+    assert rig_clearances_um(load_rig()) == pytest.approx({"air gap": 500.0}, rel=1e-3)
+    v = verdicts(_metrics()[:1], clear)[0]
+    assert v.orbit_text() == "7.9 µm (1.6 % of the air gap; 3.2 % of the backup bearing)"

@@ -87,11 +87,13 @@ def judge_settings(cfg, spec=None) -> JudgeSettings:
 
 @dataclass(frozen=True)
 class OperatingPoint:
-    """A judged condition: pressure drop (bar), speed (rpm) and its label."""
+    """A judged condition: pressure drop (bar), speed (rpm), its label, and whether it is
+    the rig's nominal condition or below (``"low"``) or above it (``"high"``)."""
 
     pressure_bar: float
     speed_rpm: float
     label: str
+    condition: str = "nominal"
 
 
 def speed_scheduled(cfg) -> bool:
@@ -115,7 +117,13 @@ def operating_points(cfg, spec=None) -> list[OperatingPoint]:
         return ", ".join(([f"{q:g} bar"] if len(ps) > 1 or len(fs) == 1 else [])
                          + ([f"{f:g} Hz"] if len(fs) > 1 else []))
 
-    return [OperatingPoint(q, f * 60.0, label(q, f)) for f in fs for q in ps]
+    p0, f0 = cfg.operating.pressure_bar, cfg.operating.speed_rpm / 60.0
+
+    def side(q, f):  # against the nominal of what varies (speed when it does)
+        x, x0 = (f, f0) if len(fs) > 1 else (q, p0)
+        return "nominal" if x == x0 else ("low" if x < x0 else "high")
+
+    return [OperatingPoint(q, f * 60.0, label(q, f), side(q, f)) for f in fs for q in ps]
 
 
 def unstable_open_loop_poles(A: np.ndarray) -> np.ndarray:

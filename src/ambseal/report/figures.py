@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -31,11 +31,39 @@ __all__ = [
     "unbalance_figure",
     "impulse_figure",
     "save_figure",
+    "CONDITION_STYLES",
+    "controller_colours",
+    "case_style",
 ]
 
 Curve = tuple[str, Sequence[float], Sequence[float]]
 
-#: ISO 14839-3 zone limits (P5 §4.1 item 4) — kept here so report does not need analysis.
+#: Line style of each judged condition, as thesis P5 Figs. 11–13: nominal solid, high
+#: (pressure or speed) dashed, low dash-dot.
+CONDITION_STYLES = {"nominal": "-", "high": "--", "low": "-."}
+#: Colours given to controllers in order of appearance (matplotlib's tab10 cycle).
+_PALETTE = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2",
+            "#17becf")
+
+
+#: The designs' own colours, the same in every report; other names take the palette's rest.
+_METHOD_COLOURS = {"pid": _PALETTE[0], "hinf": _PALETTE[1], "mu": _PALETTE[2],
+                   "lpv": _PALETTE[3]}
+
+
+def controller_colours(names: Sequence[str]) -> dict[str, str]:
+    """One colour per controller name, the same in every figure (and, for the designs
+    ``pid``, ``hinf``, ``mu``, ``lpv``, in every report)."""
+    uniq = list(dict.fromkeys(names))
+    spare = [c for c in _PALETTE if c not in _METHOD_COLOURS.values()]
+    others = [n for n in uniq if n not in _METHOD_COLOURS]
+    out = {n: spare[i % len(spare)] for i, n in enumerate(others)}
+    return {n: _METHOD_COLOURS.get(n, out.get(n)) for n in uniq}
+
+
+def case_style(colour: str, condition: str = "nominal") -> dict:
+    """matplotlib keywords of one (controller, condition) curve."""
+    return {"color": colour, "ls": CONDITION_STYLES.get(condition, "-"), "lw": 1.4}
 
 
 def save_figure(fig: Figure, path: str | os.PathLike, *, dpi: int = 120) -> Path:
@@ -73,28 +101,42 @@ def _finite_max(curves: list[tuple[str, np.ndarray, np.ndarray]]) -> float:
     return float(max(vals)) if vals else 1.0
 
 
+def _unstable_entries(ax, unstable: Mapping[str, dict]) -> None:
+    """Legend entries (no curve) for loops that are unstable and so not drawn."""
+    for label, st in unstable.items():
+        ax.plot([], [], ls="none", marker="x", color=st.get("color", "k"),
+                label=f"{label}: unstable, not drawn")
+
+
 def _curve_figure(path, curves: Sequence[Curve], kind: str, xlabel: str, ylabel: str,
-                  title: str, decorate=None) -> Path:
-    """One axes of labelled curves (``kind``: ``"loglog"`` or ``"plot"``), a grid, a legend."""
+                  title: str, decorate=None, styles: Mapping[str, dict] | None = None,
+                  unstable: Mapping[str, dict] | None = None) -> Path:
+    """One axes of labelled curves (``kind``: ``"loglog"`` or ``"plot"``), a grid, a legend.
+
+    ``styles`` maps a label to matplotlib keywords (:func:`case_style`); ``unstable`` maps
+    the labels of loops not drawn to theirs, listed in the legend as unstable."""
     cs = _curves(curves)
+    styles = styles or {}
     fig = Figure(figsize=(8, 4.5))
     ax = fig.add_subplot()
     for label, x, y in cs:
-        getattr(ax, kind)(x, y, label=label)
+        getattr(ax, kind)(x, y, label=label, **styles.get(label, {}))
+    _unstable_entries(ax, unstable or {})
     if decorate is not None:
         decorate(ax, cs)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.set_title(title)
     ax.grid(True, which="both" if kind == "loglog" else "major", alpha=0.3)
-    if cs:
-        ax.legend(fontsize=8)
+    if cs or unstable:
+        ax.legend(fontsize=8, ncols=2 if len(cs) + len(unstable or {}) > 6 else 1)
     fig.tight_layout()
     return save_figure(fig, path)
 
 
 def sensitivity_figure(
-    path: str | os.PathLike, curves: Sequence[Curve], *, title: str = "Output sensitivity σ̄(S_o)"
+    path: str | os.PathLike, curves: Sequence[Curve], *, title: str = "Output sensitivity σ̄(S_o)",
+    styles: Mapping[str, dict] | None = None, unstable: Mapping[str, dict] | None = None,
 ) -> Path:
     """σ̄ of S_o against frequency with the ISO 14839-3 zone lines (P5 Fig. 13).
 
@@ -106,17 +148,25 @@ def sensitivity_figure(
         Frequencies in Hz (log axis) and absolute gain (not dB), one curve per case.
     title : str
         Axes title.
+    styles, unstable : mapping of label → matplotlib keywords, optional
+        Style of each curve (:func:`case_style`); loops not drawn, listed as unstable.
 
     Returns
     -------
     pathlib.Path
     """
-    from ambseal.analysis.iso import ZONE_LIMITS, ZONES
+    from ambseal.analysis.iso import ZONE_LIMITS, ZONES, zone_limit_db
 
     def zones(ax, cs):
-        ax.set_ylim(min(0.1, ax.get_ylim()[0]), max(_finite_max(cs) * 1.5, 8.0))
-        for lim in ZONE_LIMITS:
-            ax.axhline(lim, color="k", lw=0.8, ls="--")
+        top = max(_finite_max(cs) * 1.5, 1.6 * ZONE_LIMITS[-1])
+        ax.set_ylim(min(0.1, ax.get_ylim()[0]), top)
+        # boundaries labelled side by side (staggered along x: on a log axis they are close)
+        for k, (lim, db, (a, b)) in enumerate(zip(ZONE_LIMITS, zone_limit_db(),
+                                                   zip(ZONES, ZONES[1:]))):
+            ax.axhline(lim, color="0.35", lw=0.8, ls=":")
+            ax.text(0.005 + 0.16 * k, lim * 1.02, f"{a}/{b}: {lim:g} ({db:.1f} dB)",
+                    transform=ax.get_yaxis_transform(), va="bottom", ha="left", fontsize=7,
+                    color="0.25")
         # zone letters between the lines (A below the first, D above the last)
         edges = (0.5 * ZONE_LIMITS[0],) + tuple(
             0.5 * (a + b) for a, b in zip(ZONE_LIMITS, ZONE_LIMITS[1:])) + (1.2 * ZONE_LIMITS[-1],)
@@ -126,12 +176,13 @@ def sensitivity_figure(
         ax.yaxis.set_major_formatter(ScalarFormatter())
         ax.yaxis.set_minor_formatter(NullFormatter())
 
-    return _curve_figure(path, curves, "loglog", "Frequency (Hz)", "σ̄(S_o) (-)", title,
-                         decorate=zones)
+    return _curve_figure(path, curves, "loglog", "Frequency (Hz)", "σ̄(S_o) (–, absolute gain)",
+                         title, decorate=zones, styles=styles, unstable=unstable)
 
 
 def compliance_figure(
-    path: str | os.PathLike, curves: Sequence[Curve], *, title: str = "Compliance σ̄(S_o G_f)"
+    path: str | os.PathLike, curves: Sequence[Curve], *, title: str = "Compliance σ̄(S_o G_f)",
+    styles: Mapping[str, dict] | None = None, unstable: Mapping[str, dict] | None = None,
 ) -> Path:
     """σ̄ of the compliance against frequency (P5 Fig. 11).
 
@@ -147,11 +198,13 @@ def compliance_figure(
     pathlib.Path
     """
     return _curve_figure(path, [(lb, x, np.asarray(y) * 1e6) for lb, x, y in curves], "loglog",
-                         "Frequency (Hz)", "σ̄ compliance (µm/N)", title)
+                         "Frequency (Hz)", "σ̄ compliance (µm/N)", title, styles=styles,
+                         unstable=unstable)
 
 
 def unbalance_figure(
-    path: str | os.PathLike, curves: Sequence[Curve], *, title: str = "Worst-case unbalance response"
+    path: str | os.PathLike, curves: Sequence[Curve], *, title: str = "Worst-case unbalance response",
+    styles: Mapping[str, dict] | None = None, unstable: Mapping[str, dict] | None = None,
 ) -> Path:
     """Worst-case unbalance response against speed (P5 Fig. 12).
 
@@ -167,7 +220,8 @@ def unbalance_figure(
     pathlib.Path
     """
     return _curve_figure(path, curves, "plot", "Speed (Hz)", "Displacement bound (µm)", title,
-                         decorate=lambda ax, cs: ax.set_ylim(bottom=0))
+                         decorate=lambda ax, cs: ax.set_ylim(bottom=0), styles=styles,
+                         unstable=unstable)
 
 
 def impulse_figure(
@@ -177,6 +231,7 @@ def impulse_figure(
     *,
     currents: Sequence[tuple[str, Sequence[float], np.ndarray]] | None = None,
     title: str = "Impulse response",
+    styles: Mapping[str, dict] | None = None,
 ) -> Path:
     """Impulse responses per output channel (P5 Fig. 14), optionally with controller currents.
 
@@ -213,7 +268,8 @@ def impulse_figure(
             if Y.shape[1] != nch:
                 raise AmbsealError(f"impulse_figure: case {label!r} has {Y.shape[1]} channels, expected {nch}")
             for j in range(nch):
-                axes[r, j].plot(t, Y[:, j], label=str(label), lw=1)
+                axes[r, j].plot(t, Y[:, j], label=str(label),
+                                **{"lw": 1, **(styles or {}).get(label, {})})
         for j in range(nch):
             ax = axes[r, j]
             ax.grid(True, alpha=0.3)
@@ -237,6 +293,7 @@ def controller_gains_figure(
     *,
     pairs: Sequence[tuple[int, int]] = ((0, 0), (2, 2), (0, 1), (0, 2)),
     title: str = "Controller gains",
+    styles: Mapping[str, dict] | None = None,
 ) -> Path:
     """Direct and cross gains |K_ij(jω)| (A/m) of several controllers (P5 Fig. 10).
 
@@ -253,7 +310,8 @@ def controller_gains_figure(
         ax.set_visible(False)
     for ax, (i, j) in zip(axes, pairs):
         for label, f, K in controllers:
-            ax.loglog(np.asarray(f, float), np.abs(np.asarray(K)[:, i, j]), label=label)
+            ax.loglog(np.asarray(f, float), np.abs(np.asarray(K)[:, i, j]), label=label,
+                      **(styles or {}).get(label, {}))
         ax.set_title(f"K[{i + 1},{j + 1}]: {channel_names[j]} → {channel_names[i]}", fontsize=9)
         ax.set_xlabel("Frequency (Hz)")
         ax.set_ylabel("|K| (A/m)")

@@ -1,4 +1,5 @@
-"""One self-contained HTML report page: metrics table, embedded PNG figures, extra sections.
+"""One self-contained HTML report page: verdict first, case table, embedded PNG figures, extra
+sections.
 
 The page has no external resource: CSS is inline and every figure is embedded as a
 ``data:image/png;base64,...`` URI, so ``report.html`` can be mailed or archived alone. All
@@ -13,7 +14,6 @@ from __future__ import annotations
 
 import base64
 import html as _html
-import math
 import os
 from pathlib import Path
 from typing import Any, Mapping, Sequence
@@ -21,47 +21,19 @@ from typing import Any, Mapping, Sequence
 from ambseal.errors import AmbsealError
 from ambseal.files import write_text
 
-__all__ = ["METRIC_COLUMNS", "render_report", "write_report", "format_value"]
-
-#: Preferred column order and headers of the metrics table; other keys follow in order seen.
-METRIC_COLUMNS: dict[str, str] = {
-    "controller": "Controller",
-    "pressure_bar": "Pressure (bar)",
-    "stable": "Stable",
-    "max_real_pole": "Max Re(pole) (1/s)",
-    "sensitivity_peak": "Peak σ̄(S_o) (-)",
-    "iso_zone": "ISO 14839-3 zone",
-    "compliance_peak_m_per_n": "Peak compliance (m/N)",
-    "unbalance_peak_um": "Peak unbalance resp. (µm)",
-    "impulse_peak_um": "Impulse peak (µm)",
-    "impulse_settling_s": "Settling 2 % (s)",
-}
+__all__ = ["render_report", "write_report"]
 
 _CSS = """
-body{font-family:system-ui,Segoe UI,Helvetica,Arial,sans-serif;margin:2em auto;max-width:1100px;color:#222}
-h1{font-size:1.6em}h2{font-size:1.25em;border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:1.6em}
-table{border-collapse:collapse;font-size:.9em}th,td{border:1px solid #bbb;padding:.3em .6em;text-align:right}
-th{background:#f0f0f0}td.text{text-align:left}tr.unstable td{background:#fde8e8}
-figure{margin:1em 0}figure img{max-width:100%;height:auto;border:1px solid #ddd}
-figcaption{font-size:.85em;color:#555}.meta{color:#666;font-size:.85em}
+body{font-family:system-ui,Segoe UI,Helvetica,Arial,sans-serif;margin:1em auto;max-width:1220px;padding:0 10px;color:#222}
+h1{font-size:1.5em;margin-bottom:.2em}h2{font-size:1.2em;border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:1.4em}
+table{border-collapse:collapse;font-size:.82em;max-width:100%}th,td{border:1px solid #bbb;padding:.25em .45em;text-align:right}
+th{background:#f0f0f0;text-align:center}td.text{text-align:left}tr.unstable td{background:#fde8e8}
+td.zone{text-align:center;font-weight:bold;color:#111}table.detail thead tr+tr th{white-space:nowrap}table.verdict{font-size:.92em}
+table.verdict td.verdict{min-width:22em;max-width:34em}
+figure{margin:.6em 0}figure img{max-width:100%;height:auto;border:1px solid #ddd}
+figcaption{font-size:.85em;color:#555}.meta{color:#666;font-size:.82em;margin-top:0;overflow-wrap:anywhere}
+.legend span{display:inline-block;padding:0 .5em;margin-right:.3em;font-weight:bold}
 """
-
-
-def format_value(v: Any) -> str:
-    """Text of one table cell: 4 significant digits for floats, yes/no, ``—`` for None."""
-    if v is None:
-        return "—"
-    if isinstance(v, bool):
-        return "yes" if v else "no"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        if math.isnan(v):
-            return "—"
-        if math.isinf(v):
-            return "∞" if v > 0 else "−∞"
-        return f"{v:.4g}"
-    return str(v)
 
 
 def _esc(s: Any) -> str:
@@ -84,23 +56,12 @@ def _figure_html(path: str | os.PathLike, caption: str | None, alt: str) -> str:
     return f'<figure><img src="{_png_data_uri(path)}" alt="{_esc(alt)}">{cap}</figure>'
 
 
-def _table_html(metrics: Sequence[Mapping[str, Any]]) -> str:
-    if not metrics:
-        return "<p>No cases.</p>"
-    keys = [k for k in METRIC_COLUMNS if any(k in m for m in metrics)]
-    for m in metrics:
-        keys += [k for k in m if k not in keys]
-    head = "".join(f"<th>{_esc(METRIC_COLUMNS.get(k, k))}</th>" for k in keys)
-    rows = []
-    for m in metrics:
-        cls = ' class="unstable"' if m.get("stable") is False else ""
-        cells = []
-        for k in keys:
-            v = m.get(k)
-            kind = ' class="text"' if isinstance(v, str) else ""
-            cells.append(f"<td{kind}>{_esc(format_value(v))}</td>")
-        rows.append(f"<tr{cls}>{''.join(cells)}</tr>")
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(rows)}</tbody></table>"
+def _zone_legend() -> str:
+    from .verdict import ZONE_COLOURS, ZONE_WORDS
+
+    return ('<p class="legend">ISO 14839-3 zones: ' + " ".join(
+        f'<span style="background:{c}">{z}</span>{_esc(ZONE_WORDS[z])}'
+        for z, c in ZONE_COLOURS.items()) + "</p>")
 
 
 def render_report(
@@ -110,8 +71,11 @@ def render_report(
     figures: Sequence[tuple[str, str | os.PathLike]] = (),
     sections: Sequence[Mapping[str, Any]] = (),
     meta: str | None = None,
+    clearances_um: Mapping[str, float] | None = None,
 ) -> str:
     """The report page as a string (see :func:`write_report`)."""
+    from .verdict import detail_table_html, verdict_table_html, verdicts
+
     parts = [
         "<!DOCTYPE html>",
         '<html lang="en"><head><meta charset="utf-8">',
@@ -120,7 +84,9 @@ def render_report(
     ]
     if meta:
         parts.append(f'<p class="meta">{_esc(meta)}</p>')
-    parts += ["<h2>Metrics</h2>", _table_html(metrics)]
+    if metrics:
+        parts += ["<h2>Verdict</h2>", verdict_table_html(verdicts(metrics, clearances_um)),
+                  _zone_legend(), "<h2>Every judged condition</h2>", detail_table_html(metrics)]
     for caption, path in figures:
         parts += [f"<h2>{_esc(caption)}</h2>", _figure_html(path, None, caption)]
     for i, sec in enumerate(sections):
@@ -147,6 +113,7 @@ def write_report(
     figures: Sequence[tuple[str, str | os.PathLike]] = (),
     sections: Sequence[Mapping[str, Any]] = (),
     meta: str | None = None,
+    clearances_um: Mapping[str, float] | None = None,
 ) -> Path:
     """Write one self-contained ``report.html``.
 
@@ -157,12 +124,12 @@ def write_report(
     title : str
         Page title and heading (escaped).
     metrics : sequence of mapping
-        One dict per case, e.g. keys ``controller``, ``pressure_bar``, ``stable``,
-        ``max_real_pole``, ``sensitivity_peak``, ``iso_zone``, ``compliance_peak_m_per_n``,
-        ``unbalance_peak_um``, ``impulse_peak_um``, ``impulse_settling_s`` (known keys first, in
-        :data:`METRIC_COLUMNS` order, then any others). Values: str, bool, int, float, None;
-        ``inf`` (float or the string ``"inf"``) is shown as such; rows with ``stable`` False
-        are highlighted.
+        The judged cases of :func:`ambseal.analysis.judge.judge` (``controller``,
+        ``pressure_bar``, ``speed_hz``, ``stable``, ``max_real_pole``, ``sensitivity_peak``
+        and ``_per_axis``, ``iso_zone`` and ``_per_axis``, ``compliance_peak_m_per_n``,
+        ``unbalance_peak_um``, ``impulse_peak_um``, ``impulse_settling_s``): shown first as
+        one verdict per controller (:mod:`ambseal.report.verdict`), then as a table of every
+        case; unstable rows are shaded, missing values shown as ``—``.
     figures : sequence of (caption, png_path)
         Figures, each under its own heading, embedded as base64 data URIs.
     sections : sequence of mapping
@@ -171,6 +138,8 @@ def write_report(
         optional ``caption``.
     meta : str, optional
         A line under the title (escaped), e.g. rig file and version.
+    clearances_um : mapping, optional
+        Clearances (µm) the unbalance orbit is set against, e.g. ``{"air gap": 500}``.
 
     Returns
     -------
@@ -184,6 +153,7 @@ def write_report(
     path = Path(path)
     if not path.parent.is_dir():
         raise AmbsealError(f"report folder {str(path.parent)!r} does not exist")
-    text = render_report(title=title, metrics=metrics, figures=figures, sections=sections, meta=meta)
+    text = render_report(title=title, metrics=metrics, figures=figures, sections=sections,
+                         meta=meta, clearances_um=clearances_um)
     write_text(path, text)
     return path

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -21,8 +21,8 @@ __all__ = ["spinup_figure", "frozen_sensitivity_figure"]
 
 
 def spinup_figure(path: str | os.PathLike, results: Sequence, *, channel: int = 0,
-                  title: str = "Spin-up 20 → 300 Hz: alternating 100 N / 2 µm steps on A_x"
-                  ) -> Path:
+                  title: str = "Spin-up 20 → 300 Hz: alternating 100 N / 2 µm steps on A_x",
+                  colours: Mapping[str, str] | None = None) -> Path:
     """Measured A_x displacement (µm) and current (A) against time for each controller.
 
     Parameters
@@ -33,6 +33,8 @@ def spinup_figure(path: str | os.PathLike, results: Sequence, *, channel: int = 
         One per controller (``t_s``, ``y_m``, ``current_a``, ``speed_hz``, ``name``).
     channel : int
         Measurement/current channel shown.
+    colours : mapping, optional
+        Controller name → colour (the report's one colour per controller).
 
     Returns
     -------
@@ -41,8 +43,9 @@ def spinup_figure(path: str | os.PathLike, results: Sequence, *, channel: int = 
     fig = Figure(figsize=(9, 6))
     ax1, ax2 = fig.subplots(2, 1, sharex=True)
     for r in results:
-        ax1.plot(r.t_s * 1e3, r.y_m[:, channel] * 1e6, lw=0.8, label=r.name)
-        ax2.plot(r.t_s * 1e3, r.current_a[:, channel], lw=0.8, label=r.name)
+        c = (colours or {}).get(r.name)
+        ax1.plot(r.t_s * 1e3, r.y_m[:, channel] * 1e6, lw=0.8, label=r.name, color=c)
+        ax2.plot(r.t_s * 1e3, r.current_a[:, channel], lw=0.8, label=r.name, color=c)
     ax1.set_ylabel("y A_x (µm)")
     ax2.set_ylabel("i A_x (A)")
     ax2.set_xlabel("Time (ms)")
@@ -79,7 +82,7 @@ def frozen_sensitivity_figure(path: str | os.PathLike, results: Sequence, *,
     -------
     pathlib.Path
     """
-    from ambseal.analysis.iso import ZONE_LIMITS
+    from ambseal.analysis.iso import ZONE_LIMITS, zone_limit_db
 
     n = max(len(results), 1)
     fig = Figure(figsize=(5 * n, 4.2))
@@ -92,12 +95,14 @@ def frozen_sensitivity_figure(path: str | os.PathLike, results: Sequence, *,
         for i in idx:
             ax.loglog(r.frequency_hz, r.sigma[i], lw=0.9, label=f"{fs[i]:.0f} Hz")
         ax.axhline(ZONE_LIMITS[0], color="k", ls="--", lw=0.8)
-        ax.text(0.01, 1.03 * ZONE_LIMITS[0], "ISO 14839-3 A/B", transform=ax.get_yaxis_transform(), fontsize=8)
+        ax.text(0.01, 1.03 * ZONE_LIMITS[0],
+                f"ISO 14839-3 A/B: {ZONE_LIMITS[0]:g} ({zone_limit_db()[0]:.1f} dB)",
+                transform=ax.get_yaxis_transform(), fontsize=8)
         ax.set_title(f"{r.name}: peak {np.max(r.peak):.2f}", fontsize=10)
         ax.set_xlabel("Frequency (Hz)")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
-    axes[0].set_ylabel("σ̄(S_o) (-)")
+    axes[0].set_ylabel("σ̄(S_o) (–, absolute gain)")
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     return save_figure(fig, path)

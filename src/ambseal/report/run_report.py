@@ -13,7 +13,40 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["gains_figure", "spinup_figures", "identification_report", "write_run_report"]
+from .verdict import axis_label, sig
+
+__all__ = ["gains_figure", "spinup_figures", "identification_report", "write_run_report",
+           "stamp", "rig_clearances_um"]
+
+
+def stamp(rig_path: str | Path, command: str | None = None) -> str:
+    """The report's stamp: ambseal version, date (UTC), rig file, its SHA-256 and the command."""
+    import datetime
+    import hashlib
+
+    from .. import __version__
+
+    rig_path = Path(rig_path)
+    digest = hashlib.sha256(rig_path.read_bytes()).hexdigest()[:16]
+    when = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    return (f"ambseal {__version__} · {when} · rig {rig_path.name} (sha256 {digest}…) · "
+            f"command: {command or 'ambseal.pipeline.run()'}")
+
+
+def rig_clearances_um(cfg) -> dict[str, float]:
+    """Clearances (µm) the unbalance orbit is judged against: the nominal AMB air gap
+    (:func:`ambseal.control.specs.machine`: ``air_gap``, or Ki·i0/Ks) and the smallest
+    backup-bearing clearance (``[[amb]] backup_clearance``), those the rig gives."""
+    from ..control.specs import machine
+
+    out = {}
+    gap = machine(cfg).air_gap_m if cfg.amb else None
+    if gap:
+        out["air gap"] = gap * 1e6
+    backup = [a.backup_clearance for a in cfg.amb if a.backup_clearance]
+    if backup:
+        out["backup bearing"] = min(backup) * 1e6
+    return out
 
 
 def gains_figure(out: Path, controllers: list[tuple[str, object]]) -> tuple[str, Path]:
@@ -22,27 +55,29 @@ def gains_figure(out: Path, controllers: list[tuple[str, object]]) -> tuple[str,
     from ..lti.freqresp import freqresp
     from .figures import controller_gains_figure
 
+    from .figures import case_style, controller_colours
+
     f = np.logspace(0, math.log10(2000.0), 300)
     rows = [(m, f, freqresp(K, 2 * np.pi * f)) for m, K in controllers]
-    names = [n.removeprefix("y_") for n in controllers[0][1].input_labels]
+    names = [axis_label(n.removeprefix("y_")) for n in controllers[0][1].input_labels]
+    colours = controller_colours([m for m, _ in controllers])
     return ("Direct and cross gains of the controllers (P5 Fig. 10)",
-            controller_gains_figure(out / "controller_gains.png", rows, names))
+            controller_gains_figure(out / "controller_gains.png", rows, names,
+                                    styles={m: case_style(c) for m, c in colours.items()}))
 
 
 def spinup_figures(out: Path, sims: list, sens: list, speeds_hz: tuple[float, float]
                    ) -> list[tuple[str, Path]]:
     """The spin-up (P3 Fig. 11) and σ̄(S_o) at frozen speeds (P3 Fig. 12)."""
+    from .figures import controller_colours
     from .lpv_figures import frozen_sensitivity_figure, spinup_figure
 
     lo, hi = speeds_hz
+    colours = controller_colours([r.name for r in sims])
     return [(f"Spin-up {lo:g} → {hi:g} Hz in 1 s with 100 N force and 2 µm output steps on "
-             "A_x (P3 Fig. 11)", spinup_figure(out / "spinup.png", sims)),
+             "A_x (P3 Fig. 11)", spinup_figure(out / "spinup.png", sims, colours=colours)),
             ("σ̄(S_o) at frozen speeds with the ISO 14839-3 line (P3 Fig. 12)",
              frozen_sensitivity_figure(out / "frozen_sensitivity.png", sens))]
-
-
-def _fmt(t) -> str:
-    return "" if t is None else f"{t:.5g}"
 
 
 def identification_report(out: Path, res, errors: dict, checks, truth, seal_name: str | None,
@@ -108,9 +143,9 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
         if "estimate" in e:
             lo, hi = (math.nan if v is None else v for v in e["ci95"])
             err = "" if e["error_pct"] is None else f"{e['error_pct']:+.2f} %"
-            rows.append(f"<tr><td>{html.escape(n)}</td><td>{e['estimate']:.5g}</td>"
-                        f"<td>{_fmt(e['truth'])}</td><td>[{lo:.5g}, {hi:.5g}]</td>"
-                        f"<td>{err}</td></tr>")
+            rows.append(f"<tr><td class=\"text\">{html.escape(n)}</td>"
+                        f"<td>{sig(e['estimate'], 4)}</td><td>{sig(e['truth'], 4)}</td>"
+                        f"<td>[{sig(lo, 4)}, {sig(hi, 4)}]</td><td>{err}</td></tr>")
         else:
             t = e["truth"]
             tl = f"{t['at_zero']:.4g} + {t['per_bar']:.4g}·p" if isinstance(t, dict) else str(t)
@@ -131,36 +166,59 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
     return figs, [section]
 
 
+def _styles(curves: list) -> tuple[dict, dict]:
+    """Label → style of every case (one colour per controller, one line style per condition),
+    and label → style of the unstable ones (not drawn)."""
+    from .figures import case_style, controller_colours
+
+    colours = controller_colours([m for m, _, _, _ in curves])
+    styles = {f"{m}, {p.label}": case_style(colours[m], p.condition) for m, p, _, _ in curves}
+    unstable = {f"{m}, {p.label}": styles[f"{m}, {p.label}"] for m, p, case, _ in curves
+                if not case.get("stable")}
+    return styles, unstable
+
+
 def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: list,
-                     extra_figures: list, extra_sections: list) -> Path:
-    """``report.html`` of the main job: the metrics table, σ̄(S_o) with the ISO 14839-3
-    zones, compliance, unbalance and impulse responses of every judged case
-    (``curves = [(label, {"So", "compliance", "unbalance", "impulse"})]``), then the extra
-    figures and sections."""
+                     extra_figures: list, extra_sections: list,
+                     clearances_um: dict | None = None) -> Path:
+    """``report.html`` of the main job: the verdict per controller and the table of every
+    case (:mod:`ambseal.report.verdict`), σ̄(S_o) with the ISO 14839-3 zones, compliance,
+    unbalance and impulse responses, then the extra figures and sections.
+
+    ``curves = [(method, OperatingPoint, case, {"So", "compliance", "unbalance",
+    "impulse"})]`` in the order of ``metrics["cases"]``; a case whose loop is unstable is
+    listed in each figure's legend, not drawn. ``meta`` is the stamp (:func:`stamp`).
+    """
     from . import figures
     from .html import write_report
 
-    figs = [("Output sensitivity σ̄(S_o) with the ISO 14839-3 zones",
+    styles, unstable = _styles(curves)
+    kw = dict(styles=styles, unstable=unstable)
+    drawn = [(f"{m}, {p.label}", c) for m, p, case, c in curves if case.get("stable")]
+    figs = [("Output sensitivity σ̄(S_o) with the ISO 14839-3 zones (P5 Fig. 13)",
              figures.sensitivity_figure(out / "sensitivity.png",
-                                        [(lb, *c["So"]) for lb, c in curves if "So" in c]))]
-    comp = [(lb, *c["compliance"]) for lb, c in curves if "compliance" in c]
+                                        [(lb, *c["So"]) for lb, c in drawn if "So" in c], **kw))]
+    comp = [(lb, *c["compliance"]) for lb, c in drawn if "compliance" in c]
     if comp:
-        figs.append(("Compliance σ̄(S_o G_f) at the seal",
-                     figures.compliance_figure(out / "compliance.png", comp)))
-    unb = [(lb, *c["unbalance"]) for lb, c in curves if "unbalance" in c]
+        figs.append(("Compliance σ̄(S_o G_f) at the seal (P5 Fig. 11)",
+                     figures.compliance_figure(out / "compliance.png", comp, **kw)))
+    unb = [(lb, *c["unbalance"]) for lb, c in drawn if "unbalance" in c]
     if unb:
         grade = metrics["unbalance"]["grade_mm_s"]
-        figs.append((f"Worst-case unbalance response, G{grade:g}",
-                     figures.unbalance_figure(out / "unbalance.png", unb)))
-    imp = [(lb, c["impulse"]) for lb, c in curves if "impulse" in c]
+        figs.append((f"Worst-case unbalance response, G{grade:g} (P5 Fig. 12)",
+                     figures.unbalance_figure(out / "unbalance.png", unb, **kw)))
+    imp = [(lb, c["impulse"]) for lb, c in drawn if "impulse" in c]
     if imp:
         first = imp[0][1]
+        names = [axis_label(n.removeprefix("y_")) for n in first.output_names]
         figs.append((
             f"Response to {first.amplitude_a:g} A for {first.duration_s * 1e3:g} ms on "
-            f"{' and '.join(first.channels)}",
+            f"{' and '.join(axis_label(c.removeprefix('i_')) for c in first.channels)} "
+            "(P5 Fig. 14)",
             figures.impulse_figure(
                 out / "impulse.png", [(lb, r.time_ms, r.displacement_um) for lb, r in imp],
-                first.output_names, currents=[(lb, r.time_ms, r.current_a) for lb, r in imp])))
+                names, currents=[(lb, r.time_ms, r.current_a) for lb, r in imp],
+                styles=styles)))
     ol = metrics["open_loop"]
     sections = [{"title": "Open loop",
                  "text": (f"{len(ol['unstable_poles'])} unstable poles (rad/s): "
@@ -169,4 +227,5 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
                           f"{ol['n_states_reduced']} reduced.")}]
     return write_report(out / "report.html", title=title, metrics=metrics["cases"],
                         figures=figs + list(extra_figures),
-                        sections=sections + list(extra_sections), meta=meta)
+                        sections=sections + list(extra_sections), meta=meta,
+                        clearances_um=clearances_um)

@@ -1,0 +1,273 @@
+"""The report's first screen and its tables, for people: one verdict per controller.
+
+ISO 14839-3 grades the sensitivity of each axis (its zones A–D: A newly commissioned,
+B unrestricted long-term operation, C limited-term operation, D damage likely), so the
+headline zone of a controller is the worst zone of any axis at any judged condition, an
+unstable loop counting as D; σ̄(S_o) of the whole MIMO loop, graded on the same limits, is
+shown beside it. The orbit is the worst-case unbalance response against the rig's
+clearances (the AMBs' nominal air gap, the backup bearings' clearance) when the rig file
+gives them.
+
+Everything here formats numbers computed by :mod:`ambseal.analysis.judge`; nothing is
+computed anew. The same rows feed ``report.html`` and the terminal summary.
+"""
+
+from __future__ import annotations
+
+import html as _html
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping, Sequence
+
+__all__ = ["ZONE_COLOURS", "ZONE_WORDS", "Verdict", "verdicts", "condition_label",
+           "verdict_table_html", "verdict_table_rich", "detail_table_html", "sig",
+           "axis_label"]
+
+#: Zone colours (green → red) of every table and figure.
+ZONE_COLOURS = {"A": "#1a9850", "B": "#91cf60", "C": "#fc8d59", "D": "#d73027"}
+#: What each ISO 14839-3 zone means for the machine, in words.
+ZONE_WORDS = {"A": "as good as newly commissioned",
+              "B": "fit for unrestricted long-term operation",
+              "C": "fit for limited-term operation only",
+              "D": "not acceptable (damage likely)"}
+_ORDER = "ABCD"
+_TERMINAL_ZONE = {"A": "green", "B": "bright_green", "C": "yellow", "D": "red"}
+
+
+def sig(v: Any, digits: int = 3) -> str:
+    """A number for people: ``digits`` significant figures, ``—`` when absent."""
+    if v is None or (isinstance(v, float) and math.isnan(v)):
+        return "—"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, float) and math.isinf(v):
+        return "∞" if v > 0 else "−∞"
+    if isinstance(v, (int, float)):
+        x = float(v)
+        if x == 0:
+            return "0"
+        text = f"{x:.{digits}g}"
+        if "e" in text:
+            m, e = text.split("e")
+            return f"{m}·10^{int(e)}"
+        return text
+    return str(v)
+
+
+def axis_label(axis: str) -> str:
+    """``"A_zeta"`` → ``"A ζ"``."""
+    return axis.replace("_zeta", " ζ").replace("_eta", " η")
+
+
+def _speed_varies(cases: Sequence[Mapping]) -> bool:
+    return len({c.get("speed_hz") for c in cases}) > 1
+
+
+def condition_label(case: Mapping, by_speed: bool) -> str:
+    """``"2.04 bar"`` or, when the judged conditions differ in speed, ``"140 Hz"``."""
+    return f"{case['speed_hz']:g} Hz" if by_speed else f"{case['pressure_bar']:g} bar"
+
+
+def _worst(zones) -> str | None:
+    zs = [z for z in zones if z in _ORDER]
+    return max(zs, key=_ORDER.index) if zs else None
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """One controller over all judged conditions (the report's first screen).
+
+    Attributes
+    ----------
+    controller : str
+    conditions, stable_at, unstable_at : tuple of str
+        Judged conditions (``"2.04 bar"`` or ``"140 Hz"``), those with a stable loop, the rest.
+    zone_axis, zone_sigma : str or None
+        Worst per-axis ISO 14839-3 zone (unstable → D), and the zone of σ̄(S_o).
+    sigma_peak : float or None
+        Largest σ̄(S_o) peak over the stable conditions (-).
+    orbit_um, impulse_peak_um, impulse_settling_s : float or None
+        Worst unbalance orbit (µm), impulse peak (µm) and 2 % settling time (s).
+    clearances_um : dict
+        Clearances the orbit is set against, e.g. ``{"air gap": 500.0}`` (µm).
+    """
+
+    controller: str
+    conditions: tuple[str, ...]
+    stable_at: tuple[str, ...]
+    unstable_at: tuple[str, ...]
+    zone_axis: str | None
+    zone_sigma: str | None
+    sigma_peak: float | None
+    orbit_um: float | None
+    impulse_peak_um: float | None
+    impulse_settling_s: float | None
+    clearances_um: dict
+
+    @property
+    def stable_range(self) -> str:
+        """``"0–4.08 bar"`` when stable everywhere, else the stable conditions, or ``none``."""
+        if not self.stable_at:
+            return "none"
+        if not self.unstable_at and len(self.conditions) > 1:
+            return f"{self.conditions[0].split()[0]}–{self.conditions[-1]}"
+        return ", ".join(self.stable_at)
+
+    def orbit_text(self) -> str:
+        """``"3.1 µm (0.6 % of the air gap)"``."""
+        if self.orbit_um is None:
+            return "—"
+        rel = "; ".join(f"{100 * self.orbit_um / c:.2g} % of the {n}"
+                        for n, c in self.clearances_um.items() if c)
+        return f"{sig(self.orbit_um)} µm" + (f" ({rel})" if rel else "")
+
+    def words(self) -> str:
+        """The verdict in one sentence."""
+        if self.unstable_at:
+            tail = (f"; stable only at {', '.join(self.stable_at)}" if self.stable_at else "")
+            return f"Not acceptable: the loop is unstable at {', '.join(self.unstable_at)}{tail}."
+        z = self.zone_axis or "?"
+        text = (f"Zone {z} on every axis over {self.stable_range}: "
+                f"{ZONE_WORDS.get(z, 'not graded')}")
+        if self.zone_sigma and self.zone_sigma != z:
+            text += f" (σ̄ over all axes reaches {self.zone_sigma})"
+        gap = [c for c in self.clearances_um.values() if c]
+        if self.orbit_um is not None and gap and self.orbit_um > 0.5 * min(gap):
+            text += f"; the unbalance orbit uses over half of the clearance"
+        return text + "."
+
+
+def verdicts(cases: Sequence[Mapping], clearances_um: Mapping[str, float] | None = None
+             ) -> list[Verdict]:
+    """One :class:`Verdict` per controller of ``metrics["cases"]`` (in order of appearance)."""
+    by_speed = _speed_varies(cases)
+    names = list(dict.fromkeys(c["controller"] for c in cases))
+    out = []
+    for name in names:
+        cs = [c for c in cases if c["controller"] == name]
+        label = [condition_label(c, by_speed) for c in cs]
+        ok = [c for c in cs if c.get("stable")]
+
+        def peak(key, pool=ok):
+            vals = [c[key] for c in pool if c.get(key) is not None]
+            return max(vals) if vals else None
+
+        axis_zones = [z for c in cs for z in (c.get("iso_zone_per_axis") or {}).values()]
+        axis_zones += ["D" for c in cs if not c.get("stable")]
+        out.append(Verdict(
+            controller=name, conditions=tuple(label),
+            stable_at=tuple(lb for lb, c in zip(label, cs) if c.get("stable")),
+            unstable_at=tuple(lb for lb, c in zip(label, cs) if not c.get("stable")),
+            zone_axis=_worst(axis_zones), zone_sigma=_worst(c.get("iso_zone") for c in cs),
+            sigma_peak=peak("sensitivity_peak"), orbit_um=peak("unbalance_peak_um"),
+            impulse_peak_um=peak("impulse_peak_um"),
+            impulse_settling_s=peak("impulse_settling_s"),
+            clearances_um=dict(clearances_um or {})))
+    return out
+
+
+def _esc(s: Any) -> str:
+    return _html.escape(str(s), quote=True)
+
+
+def _zone_cell(z: str | None, extra: str = "") -> str:
+    if z is None:
+        return "<td>—</td>"
+    return (f'<td class="zone" style="background:{ZONE_COLOURS.get(z, "#eee")}">'
+            f"{_esc(z)}{extra}</td>")
+
+
+def verdict_table_html(vs: Sequence[Verdict]) -> str:
+    """The first-screen table: one row per controller, zones coloured."""
+    head = ("<tr><th>Controller</th><th>Stable over</th><th>ISO 14839-3 zone<br>worst axis"
+            "</th><th>zone of<br>σ̄(S_o)</th><th>σ̄(S_o) peak (–)</th><th>Worst unbalance "
+            "orbit</th><th>Impulse peak (µm)</th><th>Settling 2 % (ms)</th>"
+            "<th class=\"text\">Verdict</th></tr>")
+    rows = []
+    for v in vs:
+        st = v.impulse_settling_s
+        rows.append(
+            f'<tr class="{"unstable" if v.unstable_at else "ok"}"><td class="text"><b>'
+            f"{_esc(v.controller)}</b></td><td class=\"text\">{_esc(v.stable_range)}</td>"
+            + _zone_cell(v.zone_axis) + _zone_cell(v.zone_sigma)
+            + f"<td>{sig(v.sigma_peak)}</td><td class=\"text\">{_esc(v.orbit_text())}</td>"
+            f"<td>{sig(v.impulse_peak_um)}</td><td>{sig(None if st is None else st * 1e3)}</td>"
+            f'<td class="text verdict">{_esc(v.words())}</td></tr>')
+    return (f'<table class="verdict" id="verdict"><thead>{head}</thead>'
+            f"<tbody>{''.join(rows)}</tbody></table>")
+
+
+def detail_table_html(cases: Sequence[Mapping]) -> str:
+    """Every judged case: units in the headers, 3–4 significant figures, per-axis values
+    as sub-columns; unstable rows shaded, their missing values shown as ``—``."""
+    if not cases:
+        return "<p>No cases.</p>"
+    by_speed = _speed_varies(cases)
+    axes = list(dict.fromkeys(a for c in cases for a in (c.get("iso_zone_per_axis") or {})))
+    n = len(axes)
+    cond = "Speed (Hz)" if by_speed else "Pressure (bar)"
+    head1 = (f'<tr><th rowspan="2">Controller</th><th rowspan="2">{cond}</th>'
+             '<th rowspan="2">Stable</th><th rowspan="2">max Re(pole) (1/s)</th>'
+             f'<th colspan="{n + 1}">σ̄(S_o) peak (–)</th>'
+             f'<th colspan="{n + 1}">ISO 14839-3 zone</th>'
+             '<th rowspan="2">Compliance peak (µm/N)</th><th rowspan="2">Unbalance orbit (µm)'
+             '</th><th rowspan="2">Impulse peak (µm)</th><th rowspan="2">Settling 2 % (ms)</th>'
+             "</tr>")
+    sub = "".join(f"<th>{_esc(axis_label(a))}</th>" for a in axes)
+    head2 = f"<tr><th>all</th>{sub}<th>σ̄</th>{sub}</tr>"
+    rows = []
+    for c in cases:
+        per_s = c.get("sensitivity_peak_per_axis") or {}
+        per_z = c.get("iso_zone_per_axis") or {}
+        x = c["speed_hz"] if by_speed else c["pressure_bar"]
+        comp = c.get("compliance_peak_m_per_n")
+        st = c.get("impulse_settling_s")
+        cells = ([f'<td class="text">{_esc(c["controller"])}</td>', f"<td>{x:g}</td>",
+                  f"<td>{'yes' if c.get('stable') else 'no'}</td>",
+                  f"<td>{sig(c.get('max_real_pole'), 4)}</td>",
+                  f"<td>{sig(c.get('sensitivity_peak'))}</td>"]
+                 + [f"<td>{sig(per_s.get(a))}</td>" for a in axes]
+                 + [_zone_cell(c.get("iso_zone"))] + [_zone_cell(per_z.get(a)) for a in axes]
+                 + [f"<td>{sig(None if comp is None else comp * 1e6)}</td>",
+                    f"<td>{sig(c.get('unbalance_peak_um'))}</td>",
+                    f"<td>{sig(c.get('impulse_peak_um'))}</td>",
+                    f"<td>{sig(None if st is None else st * 1e3)}</td>"])
+        cls = "" if c.get("stable") else ' class="unstable"'
+        rows.append(f"<tr{cls}>{''.join(cells)}</tr>")
+    return (f'<table class="detail"><thead>{head1}{head2}</thead>'
+            f"<tbody>{''.join(rows)}</tbody></table>")
+
+
+def verdict_table_rich(vs: Sequence[Verdict]):
+    """The first screen for a terminal: a compact ``rich`` table (zones coloured, fits 80
+    columns; the orbit against the first clearance the rig gives) and one line per
+    controller with its verdict in words."""
+    from rich import box
+    from rich.console import Group
+    from rich.table import Table
+    from rich.text import Text
+
+    gap = next(iter(vs[0].clearances_um.items()), None) if vs else None
+    title = "Verdict — ISO 14839-3 zone: worst axis / σ̄" + (
+        f"; orbit: µm (% of the {gap[0]})" if gap else "")
+    t = Table(title=title, title_justify="left", box=box.SIMPLE_HEAD, pad_edge=False)
+    orbit = "orbit"
+    for col in ("controller", "stable over", "zone", "σ̄ peak", orbit, "impulse µm",
+                "settle ms"):
+        t.add_column(col, justify="left" if col in ("controller", "stable over") else "right",
+                     no_wrap=col in ("controller", "zone", orbit))
+
+    def zone(z):  # named colours: also right on a 16-colour terminal
+        return "—" if z is None else f"[bold black on {_TERMINAL_ZONE.get(z, 'white')}] {z} [/]"
+
+    for v in vs:
+        st = v.impulse_settling_s
+        orb = sig(v.orbit_um)
+        if gap and v.orbit_um is not None:
+            orb += f" ({sig(100 * v.orbit_um / gap[1], 2)} %)"
+        t.add_row(v.controller, v.stable_range, f"{zone(v.zone_axis)}/{zone(v.zone_sigma)}",
+                  sig(v.sigma_peak), orb, sig(v.impulse_peak_um),
+                  sig(None if st is None else st * 1e3),
+                  style="red" if v.unstable_at else None)
+    lines = [Text.assemble((f"{v.controller}: ", "bold"), v.words()) for v in vs]
+    return Group(t, *lines)

@@ -252,6 +252,15 @@ class Seal(_Strict):
     M: SealCoefficient = 0.0
     uncertainty: Uncertainty = None
 
+    @model_validator(mode="after")
+    def _plausible(self) -> "Seal":
+        for n in "KkCcM":  # a plain number, bounded like the affine form's terms
+            v = getattr(self, n)
+            if isinstance(v, float) and abs(v) > 1e12:
+                raise ValueError(f"{n}: expected a coefficient of at most 1e12 in size, "
+                                 f"got {v:g}")
+        return self
+
     @property
     def frequency_dependent(self) -> bool:
         """Whether any coefficient is tabulated against frequency."""

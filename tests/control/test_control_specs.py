@@ -198,3 +198,28 @@ def test_hinf_on_a_rig_without_seal_is_stable_on_the_full_order_plant(beam):
     r = design(beam, "hinf")
     assert r.full_order["stable"] and r.design_states == 12
     assert np.isfinite(r.gamma)
+
+
+@pytest.mark.slow
+def test_a_design_model_without_the_bending_mode_is_enlarged_and_said():
+    """The test rig's H∞ on its 8 rigid-body states destabilises the 557 Hz bending pair at
+    2× nominal pressure (thesis P5 §3.1.4 removed it; the full-order loop shows it): the
+    design loop enlarges the model to keep that pair (12 states) and reports the step."""
+    from ambseal.control.recipes import design
+
+    lines = []
+    r = design(load_rig(None, ["design.model_states=8"]), "hinf", progress=lines.append)
+    assert r.design_states == 12 and r.full_order["stable"] and len(r.steps) == 1
+    assert re.search(r"unstable at 55\d(\.\d)? Hz", lines[0]) and "8 to 12 states" in lines[0]
+
+
+def test_an_unstable_full_order_loop_is_refused_with_the_mode_and_the_key(testrig_cfg):
+    """The test rig's H∞ on its 8 rigid-body states (P5 §3.1.4 removed the bending modes)
+    destabilises the 557 Hz bending pair at 2× nominal pressure on the full-order plant:
+    with the design model fixed by the caller it is refused, naming the mode and the key
+    that keeps it."""
+    from ambseal.control.recipes import design
+    from ambseal.errors import SynthesisError
+
+    with pytest.raises(SynthesisError, match=r"55\d(\.\d)? Hz.*design\.model_cutoff_hz"):
+        design(testrig_cfg, "hinf", states=8)

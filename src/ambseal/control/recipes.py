@@ -339,7 +339,7 @@ def design(
         if check["stable"] or attempt == enlarge or states is not None:
             break
         n_new = _states_to_keep(cfg, p, check["mode_hz"])
-        if n_new <= n:
+        if n_new <= n:  # the mode is in the design model: enlarging it cannot help
             break
         steps.append(f"{method}: full-order loop unstable at {check['mode_hz']:.4g} Hz "
                      f"(ζ = {check['damping']:.3g}, {check['pressure_bar']:g} bar); design "
@@ -353,7 +353,7 @@ def design(
 
             om = design_omega(sp.synthesis_band_hz[0], top)
     if not check["stable"] and not allow_unstable:
-        raise SynthesisError(_unstable_message(method, check, n, steps))
+        raise SynthesisError(_unstable_message(method, check, n, steps, _top_mode_hz(cfg, p, n)))
     return DesignResult(
         method, r.K, p, gamma=r.gamma, mu=r.mu, order=int(r.K.nstates),
         order_full=r.order_full, history=tuple(r.history), weights=w,
@@ -425,6 +425,14 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
     return _Synthesis(K, gamma, mu, tuple(hist), order_full, red, gp, K_P, mu_omega)
 
 
+def _top_mode_hz(cfg, p: float, n: int) -> float:
+    """The highest mode (Hz) an n-state design model keeps."""
+    from ..model.rig import build_system
+
+    lam = np.sort(np.abs(build_system(cfg, pressure_bar=p).poles())) / (2 * np.pi)
+    return float(lam[min(n, lam.size) - 1])
+
+
 def _states_to_keep(cfg, p: float, mode_hz: float) -> int:
     """Design-model states that keep every mode of the supported rotor up to 1.1× mode_hz."""
     from ..model.rig import build_system
@@ -433,13 +441,18 @@ def _states_to_keep(cfg, p: float, mode_hz: float) -> int:
     return int(np.sum(lam < 1.1 * mode_hz))
 
 
-def _unstable_message(method, check, n, steps) -> str:
+def _unstable_message(method, check, n, steps, cut_hz) -> str:
     tried = f" after {len(steps)} automatic enlargement(s)" if steps else ""
-    return (f"design({method}): the controller destabilises the full-order plant{tried}: the "
+    head = (f"design({method}): the controller destabilises the full-order plant{tried}: the "
             f"mode at {check['mode_hz']:.4g} Hz has damping ζ = {check['damping']:.3g} at "
-            f"{check['pressure_bar']:g} bar, {check['speed_hz']:g} Hz; the design model "
-            f"({n} states) should keep it: set design.model_cutoff_hz above "
-            f"{check['mode_hz']:.4g} (or design.model_states), or pass --allow-unstable")
+            f"{check['pressure_bar']:g} bar, {check['speed_hz']:g} Hz; ")
+    if check["mode_hz"] < cut_hz:
+        return head + ("the design model keeps that mode, so the plant at that condition is "
+                       "outside what the design was robust to: widen [[design.uncertainty]] "
+                       "to cover it, or pass --allow-unstable")
+    return head + (f"the design model ({n} states) should keep it: set "
+                   f"design.model_cutoff_hz above {check['mode_hz']:.4g} (or "
+                   "design.model_states), or pass --allow-unstable")
 
 
 def _verdict(method, r: _Synthesis, check) -> str:

@@ -30,6 +30,9 @@ Commands
 ``ambseal identify RIG DATA... --params NAME,... --out DIR``
     Output-error fit of named parameters to closed-loop records; writes the fit, its
     figures and the identified rig.
+``ambseal track RIG DATA... --params NAME,... --out DIR [--rate-per-s R]``
+    On-line (recursive) tracking of named parameters through records: the estimate over
+    time with its 95 % interval (CSV, JSON summary, figure).
 
 Any error on bad input prints one line on stderr and exits with status 2.
 """
@@ -198,6 +201,14 @@ def _parser() -> argparse.ArgumentParser:
                         "identifiable (the exit status is then 0)")
     i.add_argument("--no-refine", action="store_true",
                    help="skip the second pass on a model re-reduced at the estimate")
+    tr = sub.add_parser("track", help="track parameters on line through closed-loop records")
+    tr.add_argument("rig", help="rig file (TOML)")
+    tr.add_argument("data", nargs="+", help="record files (.csv with sidecar, or .mat)")
+    tr.add_argument("--params", required=True, help="LFT parameters, e.g. seal.k,seal.K")
+    tr.add_argument("--out", default="ambseal-track", help="output folder")
+    tr.add_argument("--rate-per-s", type=float, default=None,
+                    help="expected drift per second as a fraction of each parameter's scale "
+                         "(default 0.1)")
     from .rotordynamics import add_parsers
 
     add_parsers(sub, _positive_int)  # modes, campbell, sweep, import-ross
@@ -320,6 +331,15 @@ def _identify(args: argparse.Namespace) -> int:
     return 0
 
 
+def _track(args: argparse.Namespace) -> int:
+    from .commands import track_files
+
+    summary = track_files(args.rig, args.data, args.params.split(","), args.out,
+                          rate_per_s=args.rate_per_s)
+    print(json.dumps(summary))
+    return 0
+
+
 def _run(args: argparse.Namespace) -> int:
     from .pipeline import run
 
@@ -421,7 +441,7 @@ def main(argv: list[str] | None = None) -> int:
     from .rotordynamics import HANDLERS
 
     handler = {"acquire": _acquire, "identify": _identify, "design": _design,
-               "run": _run, "validate": _validate, **HANDLERS}[args.command]
+               "track": _track, "run": _run, "validate": _validate, **HANDLERS}[args.command]
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("default")
         try:

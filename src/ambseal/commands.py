@@ -1,4 +1,5 @@
-"""The ``design``, ``identify`` and ``validate`` commands: load, call the stage, write the files.
+"""The ``design``, ``identify``, ``validate`` and ``track`` commands: load, call the stage,
+write the files.
 
 Wiring only, like :mod:`ambseal.pipeline`: every number comes from :mod:`ambseal.control`
 and :mod:`ambseal.identify`, every figure from :mod:`ambseal.report`, every file through a
@@ -16,7 +17,7 @@ from .errors import ConfigError
 from .files import writable_folder, write_json, write_text
 
 __all__ = ["design_files", "identify_files", "export_design", "show_defaults",
-           "validate_summary"]
+           "validate_summary", "track_files"]
 
 
 def _finite(x: float) -> float | None:
@@ -257,3 +258,61 @@ def validate_summary(rig: str | Path | None = None) -> dict:
             "judgement": asdict(judge_settings(cfg, spec)),
         },
     }
+
+
+def track_files(rig: str | Path, data: list[str], names: list[str], out_dir: str | Path, *,
+                rate_per_s: float | None = None) -> dict:
+    """``ambseal track``: track ``names`` through each recorded file
+    (:func:`ambseal.identify.tracking.track`); write ``track.json`` (summary),
+    ``track_<i>.csv`` (time, estimate, 95 % interval per parameter, decimated to ≤ 1 kHz)
+    and ``track_<i>.png`` per record. Returns a JSON-safe summary.
+
+    Raises
+    ------
+    ConfigError, DataError, IdentificationError
+        A bad rig; a bad record, one whose excitation exceeds the current limit, or one too
+        short; a name without an LFT channel.
+    """
+    import numpy as np
+
+    from .identify.data import load_measurement
+    from .identify.tracking import TrackingSettings, check_excitation, track
+    from .model.amb import channel_names
+    from .report.tracking_figures import tracking_figure
+
+    cfg = load_rig(rig)
+    axes = channel_names(cfg)
+    settings = TrackingSettings() if rate_per_s is None else TrackingSettings(
+        rate_per_s=rate_per_s)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    records = []
+    for path in data:
+        meas = load_measurement(path, axes=axes, min_samples=3)
+        check_excitation(cfg, meas, str(path))
+        records.append(meas)
+    summary = []
+    for i, (path, meas) in enumerate(zip(data, records)):
+        res = track(cfg, meas, names, settings, source=str(path))
+        lo, hi = res.ci95()
+        step = max(1, int(round(1e-3 / (res.time_s[1] - res.time_s[0]))))
+        cols = [res.time_s[::step]] + [a[::step, j] for j in range(len(names))
+                                       for a in (res.estimate, lo, hi)]
+        head = ",".join(["time_s"] + [f"{n}{s}" for n in names for s in ("", "_ci95_low",
+                                                                         "_ci95_high")])
+        csv = "\n".join([head] + [",".join(f"{v:.9g}" for v in row)
+                                  for row in np.column_stack(cols)]) + "\n"
+        write_text(out / f"track_{i + 1}.csv", csv)
+        tracking_figure(out / f"track_{i + 1}.png", res.time_s, names, res.estimate, lo, hi,
+                        units=res.units, title=f"Tracked parameters: {Path(path).name}")
+        summary.append({"data": str(path), "csv": str(out / f"track_{i + 1}.csv"),
+                        "figure": str(out / f"track_{i + 1}.png"),
+                        "final": {n: {"estimate": float(res.estimate[-1, j]),
+                                      "std_error": float(res.std_error[-1, j]),
+                                      "ci95": [float(lo[-1, j]), float(hi[-1, j])]}
+                                  for j, n in enumerate(names)},
+                        "n_states": res.n_states, "flops_per_sample": res.flops_per_sample,
+                        "realtime_factor": res.realtime_factor})
+    result = {"out": str(out), "parameters": list(names), "records": summary}
+    write_json(out / "track.json", result)
+    return result

@@ -20,14 +20,17 @@ __all__ = ["facility_loop"]
 
 
 @njit(cache=True, nogil=True)
-def facility_loop(Phi, Gam, C_all, D_coil, D_ieff, Ac, Bc, Cc, Dc, e, noise, inoise,
+def facility_loop(Phi, Gam, seg_start, C_all, D_coil, D_ieff, Ac, Bc, Cc, Dc, e, noise, inoise,
                   lsb, limit, i0, s0, kf, ki, ks, substeps, lp_a, rec_y, rec_i, rec_ref):
     """Run the sampled closed loop of the virtual facility; fill the three records.
 
     Parameters
     ----------
-    Phi, Gam : ndarray (n, n), (n, 2k)
-        Sub-step ZOH transition of the linear part, inputs ``[i_ref (k), f_rem (k)]``.
+    Phi, Gam : ndarray (S, n, n), (S, n, 2k)
+        Sub-step ZOH transition of the linear part, inputs ``[i_ref (k), f_rem (k)]``, one
+        per segment of a piecewise-constant pressure (S = 1: one condition).
+    seg_start : ndarray (S,) of int
+        First sample of each segment (``seg_start[0] = 0``).
     C_all : ndarray (4k, n)
         Rows: sensor displacement, bearing displacement, force current, coil current.
     D_coil, D_ieff : ndarray (k, k)
@@ -59,12 +62,15 @@ def facility_loop(Phi, Gam, C_all, D_coil, D_ieff, Ac, Bc, Cc, Dc, e, noise, ino
     """
     N, k = e.shape
     xc = np.zeros(Ac.shape[0])
-    z = np.zeros(Phi.shape[0])
+    z = np.zeros(Phi.shape[1])
+    seg = 0
     u_in = np.zeros(2 * k)
     y = np.zeros(k)
     yf = np.zeros(k)
     out = C_all @ z
     for n in range(N):
+        while seg + 1 < seg_start.shape[0] and n >= seg_start[seg + 1]:
+            seg += 1
         for a in range(k):
             yf[a] = lp_a * yf[a] + (1.0 - lp_a) * out[a]
             v = yf[a] + noise[n, a]
@@ -95,6 +101,6 @@ def facility_loop(Phi, Gam, C_all, D_coil, D_ieff, Ac, Bc, Cc, Dc, e, noise, ino
                 dm = s0[a] + x
                 f = kf[a] * (ip * ip / (dp * dp) - im * im / (dm * dm))
                 u_in[k + a] = f - (ki[a] * i + ks[a] * x)
-            z = Phi @ z + Gam @ u_in
+            z = Phi[seg] @ z + Gam[seg] @ u_in
             out = C_all @ z
     return -1

@@ -147,6 +147,19 @@ def reduced_plant(cfg: RigConfig, pressure_bar: float, speed_rpm: float | None,
     return plant
 
 
+def _pressure_values(cfg: RigConfig, truth: TruthSection, plant, pressure_bar: float) -> dict:
+    """Every seal coefficient of the rig's model, then the truth's values, at a pressure
+    drop (SI), for a segment of a pressure schedule."""
+    out = {}
+    for seal in cfg.seal:
+        for key in ("K", "k", "C", "c"):
+            name = f"{seal.name}.{key}"
+            if name in plant.parameters:
+                out[name] = coefficient_value(getattr(seal, key), pressure_bar)
+    out.update({k: coefficient_value(v, pressure_bar) for k, v in truth.parameters.items()})
+    return out
+
+
 def simulate_facility(
     cfg: RigConfig,
     truth: TruthSection,
@@ -156,6 +169,7 @@ def simulate_facility(
     *,
     pressure_bar: float,
     seed: int | None = 0,
+    pressure_schedule: list[tuple[float, float]] | None = None,
 ) -> FacilityRecord:
     """Run the virtual facility with an excitation added to the current references.
 
@@ -175,6 +189,12 @@ def simulate_facility(
         Pressure drop across the seals (bar).
     seed : int, optional
         Seed of the sensor and current noise.
+    pressure_schedule : list of (start_s, pressure_bar), optional
+        A piecewise-constant pressure drop (bar) from each start time (s) on, for tracking
+        tests (``pressure_bar`` before the first start). Each segment's plant is the reduced
+        plant at ``pressure_bar`` with the seal coefficients (then the truth's values) at
+        its pressure through the LFT channels: the full-order change projected on one modal
+        basis, so the state carries over a pressure step.
 
     Raises
     ------
@@ -187,7 +207,12 @@ def simulate_facility(
         raise ModelError(f"controller dt = {controller.dt} s but the sample rate is {sample_rate_hz} Hz")
     values = {k: coefficient_value(v, pressure_bar) for k, v in truth.parameters.items()}
     # raises ModelError naming an unknown parameter
-    plant = reduced_plant(true_rig(cfg, truth), pressure_bar, None, values, truth.max_mode_hz)
+    cfg_t = true_rig(cfg, truth)
+    plant = reduced_plant(cfg_t, pressure_bar, None, values, truth.max_mode_hz)
+    segments = [(0, plant.A)]
+    for start_s, p_bar in sorted(pressure_schedule or []):
+        segments.append((int(round(start_s * sample_rate_hz)),
+                         plant.with_values(_pressure_values(cfg_t, truth, plant, p_bar)).A))
     axes = plant.axes
     k = len(axes)
     e = np.asarray(excitation_a, dtype=float)
@@ -213,20 +238,27 @@ def simulate_facility(
     C = np.vstack([C, C_eff])
     A, B, C, _, C_coil, D_coil = series_inputs((A, B, C, np.zeros((C.shape[0], k))),
                                                actuator_matrices(cfg.actuator))
+    A_of = []  # per pressure segment: the mechanics' block of A replaced
+    for n0, A_m in segments:
+        A_s = A.copy()
+        A_s[:n_mech, :n_mech] = A_m
+        A_of.append((n0, A_s))
     # coil current i_c = C_coil z + D_coil i_ref; force current i_eff = C_eff z + D_eddy i_c
     C_y, C_b = C[:k], C[k:2 * k]
     C_ieff = C[2 * k:] + D_eddy @ C_coil
     D_ieff = D_eddy @ D_coil
     F = np.vstack([Fdir, np.zeros((A.shape[0] - n_mech, k))])
-    Phi, Gam = zoh(A, np.hstack([B, F]), T / truth.substeps)
+    steps = [(n0, *zoh(A_s, np.hstack([B, F]), T / truth.substeps)) for n0, A_s in A_of]
     C_all = np.vstack([C_y, C_b, C_ieff, C_coil])
     rng = np.random.default_rng(seed)
     lowpass = _sensor_filter(truth, T, k)
     lp_a = 0.0 if lowpass is None else lowpass[0]  # a = 0: y_f = y exactly
     lsb = truth.adc_range_m / 2**truth.adc_bits if truth.adc_bits else 0.0
-    mats = [np.ascontiguousarray(M, dtype=float) for M in
-            (Phi, Gam, C_all, D_coil, D_ieff, controller.A, controller.B, controller.C,
-             controller.D)]
+    seg_start = np.array([n0 for n0, _, _ in steps], dtype=np.int64)
+    Phi, Gam = np.stack([P for _, P, _ in steps]), np.stack([G for _, _, G in steps])
+    mats = [np.ascontiguousarray(M, dtype=float) for M in (Phi, Gam)] + [seg_start] + [
+        np.ascontiguousarray(M, dtype=float) for M in
+        (C_all, D_coil, D_ieff, controller.A, controller.B, controller.C, controller.D)]
 
     def run(noise_std):
         N = e.shape[0]

@@ -103,9 +103,12 @@ def _positive(meta: dict, key: str, source: str, default: float | None = None) -
 
 
 def acquire(cfg: RigConfig, truth: TruthSection, excitation: Excitation, *,
-            controller: DiscreteController, pressure_bar: float, seed: int = 0) -> Measurement:
+            controller: DiscreteController, pressure_bar: float, seed: int = 0,
+            pressure_schedule: list[tuple[float, float]] | None = None) -> Measurement:
     """Run the virtual facility with ``controller`` levitating the rotor and return the
-    record as a :class:`Measurement` (the controller in its metadata).
+    record as a :class:`Measurement` (the controller in its metadata; a
+    ``pressure_schedule`` of :func:`~ambseal.identify.rig_sim.simulate_facility` in it as
+    ``pressure_schedule_bar`` [[start_s, bar], ...]).
 
     Raises
     ------
@@ -125,13 +128,16 @@ def acquire(cfg: RigConfig, truth: TruthSection, excitation: Excitation, *,
         "excitation": excitation.params,
         "source": "virtual test facility",
     }
+    if pressure_schedule:
+        meta["pressure_schedule_bar"] = [[float(t), float(p)] for t, p in pressure_schedule]
     limits = [a.current_limit for a in cfg.amb if a.current_limit]
     limit = truth.current_limit or (min(limits) if limits else None)
     if limit:
         meta["current_limit_a"] = limit
     Kd = check_controller(controller, axes, excitation.sample_rate_hz, "acquire: controller")
     rec = simulate_facility(cfg, truth, np.asarray(excitation.values_a), excitation.sample_rate_hz,
-                            Kd, pressure_bar=pressure_bar, seed=seed)
+                            Kd, pressure_bar=pressure_bar, seed=seed,
+                            pressure_schedule=pressure_schedule)
     meas = Measurement(time_s=rec.time_s, excitation_a=rec.excitation_a,
                        current_ref_a=rec.current_ref_a, current_a=rec.current_a,
                        displacement_m=rec.displacement_m, axes=axes, metadata=meta)

@@ -1,0 +1,475 @@
+"""On-line tracking of seal coefficients (or any LFT parameter) from closed-loop signals.
+
+Method: a recursive prediction-error method (RPEM; Ljung & Söderström, *Theory and
+Practice of Recursive Identification*, 1983, §3.7 and §4.4; Ljung, *System
+Identification*, 2nd ed., §11.4) in its Kalman-filter form for parameters that drift as
+random walks. The model is the rig's reduced plant with the amplifier and eddy lag in
+series (:meth:`ambseal.identify.fit.ClosedLoopModel.matrices`), driven by the *measured*
+current references: the loop is cut at the DAC, so the controller that ran only needs to
+have produced the references (it is not simulated), and an unstable open-loop plant is
+tracked through the predictor's gain. With x the model state, u = i_ref, y the sensors:
+
+    x̂_{k+1} = A_d(θ̂) x̂_k + B_d(θ̂) u_k + K ε_k,        ε_k = y_k − C x̂_k,
+    W_{j,k+1} = (A_d − K C) W_{j,k} + (∂A_d/∂θ_j) x̂_k + (∂B_d/∂θ_j) u_k,   H_k = C W_k,
+    θ̂ ← θ̂ + P Hᵀ (H P Hᵀ + Λ)⁻¹ ε,   P ← P − P Hᵀ (H P Hᵀ + Λ)⁻¹ H P + Q_θ,
+
+with A_d(θ) = A_d(θ₀) + Σ_j (∂A_d/∂θ_j)(θ_j − θ₀,j) between re-linearisations (every
+``relinearise_s``, where θ₀ ← θ̂ and the steady-state predictor gain K is solved again),
+the exact derivative of the matrix exponential from Van Loan's block exponential (Van Loan
+1978, Thm. 1), Λ the innovations' running covariance (diagonal; the channels are updated
+one after the other, Bierman's scalar form) and Q_θ = (rate·scale)²·T the random walk
+whose one-second spread is the expected drift. The standard error at every sample is
+√diag P.
+
+Why not an extended Kalman filter on the state augmented by θ: it propagates the full
+(n+p)² covariance every sample, ≈ 4(n+p)³ flops (≈ 90 kflop for n = 28, p = 1), against
+≈ 2n²(1 + 2p) + 2n·k(1 + p) for this RPEM (≈ 5 kflop): only the latter runs ≥ 10× real
+time at 10 kHz in Python (with numba) and fits a controller's sample in generated C. The
+fixed-gain predictor is the EKF's steady state at θ̂₀; the price is a sub-optimal state
+estimate between re-linearisations, which the innovations' covariance Λ absorbs into the
+standard error.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+
+from ..config import RigConfig
+from ..errors import DataError, IdentificationError, ModelError
+from ..model.rig import build_system, mechanical_plant
+from .data import Measurement
+from .fit import _DEFAULT_SCALE, ClosedLoopModel
+from .stages import build_models
+
+__all__ = ["TrackingSettings", "TrackingResult", "track", "flops_per_sample",
+           "linearised_model", "rpem_kernel", "current_limit", "check_excitation",
+           "tracking_excitation"]
+
+
+@dataclass(frozen=True)
+class TrackingSettings:
+    """Tuning of the tracker (SI; the rules behind the defaults in each line).
+
+    Attributes
+    ----------
+    rate_per_s : float
+        Expected drift of each parameter, as a fraction of its scale per second (0.1: the
+        seal's k from 0 to 3× nominal over 30 s, the ramp of issue 14); sets the random
+        walk Q_θ. Larger tracks faster with a noisier estimate.
+    relinearise_s : float
+        Period of re-linearisation at θ̂ (s); the predictor gain is solved again only when
+        θ̂ has moved by more than ``regain_rel`` of its scale since the last solution.
+    regain_rel : float
+    sensor_noise_fraction : float
+        Sensor noise of the predictor's gain, as a fraction of each displacement channel's
+        RMS (0.01, the thesis rig's level, P2 §4).
+    process_noise_a : float or None
+        Input-referred current disturbance of the predictor's gain (A std); None: 1 % of the
+        RMS current reference.
+    innovation_time_s : float
+        Time constant of the innovations' running covariance Λ (s).
+    cutoff_hz : float or None
+        Modes kept in the tracker's model; None: the Nyquist frequency of the record (a mode
+        above it is not seen in sampled data but aliased).
+    initial_rel_std : float
+        Initial standard deviation of θ as a fraction of its scale.
+    inflation_window_s : float
+        Window of the standard error's variance-inflation factor (:func:`_inflation`).
+    min_duration_s : float
+        Shortest record tracked: the initial transient from the rig's value measured on the
+        virtual facility is 0.2–0.5 s.
+    """
+
+    rate_per_s: float = 0.1
+    relinearise_s: float = 0.1
+    regain_rel: float = 0.05
+    sensor_noise_fraction: float = 0.01
+    process_noise_a: float | None = None
+    innovation_time_s: float = 0.05
+    cutoff_hz: float | None = None
+    initial_rel_std: float = 1.0
+    inflation_window_s: float = 0.5
+    min_duration_s: float = 0.5
+
+
+def _inflation(score: np.ndarray, info: np.ndarray, block: int, window: int) -> np.ndarray:
+    """Causal variance-inflation factor ρ ≥ 1 per sample and parameter (N, p): the batch-means
+    form of the sandwich covariance (Ljung, *System Identification*, §9.3). Over the blocks
+    (``block`` samples) of the last ``window`` samples, ρ = mean (Σ_block score)² /
+    mean Σ_block information — 1 for white innovations of the assumed covariance, larger
+    when the innovations are coloured or the estimate lags (both leave a correlated score).
+    Applied from the block after those it is computed from."""
+    N, p = score.shape
+    block = max(1, block)
+    nb = N // block
+    if nb < 2:
+        return np.ones((N, p))
+    S = score[: nb * block].reshape(nb, block, p).sum(axis=1)
+    Inf = info[: nb * block].reshape(nb, block, p).sum(axis=1)
+    m = max(1, window // block)
+    c2 = np.concatenate([np.zeros((1, p)), np.cumsum(S**2, axis=0)])
+    ci = np.concatenate([np.zeros((1, p)), np.cumsum(Inf, axis=0)])
+    hi = np.arange(1, nb + 1)
+    lo = np.maximum(0, hi - m)
+    rho = (c2[hi] - c2[lo]) / np.maximum(ci[hi] - ci[lo], 1e-300)
+    rho = np.maximum(np.vstack([np.ones((1, p)), rho[:-1]]), 1.0)  # causal: the past blocks
+    out = np.repeat(rho, block, axis=0)
+    return np.vstack([out, np.repeat(out[-1:], N - len(out), axis=0)])
+
+
+@dataclass(frozen=True)
+class TrackingResult:
+    """The estimate at every sample.
+
+    Attributes
+    ----------
+    names : tuple of str
+    units : tuple of str
+        The SI unit of each parameter.
+    time_s : ndarray (N,)
+    estimate, std_error : ndarray (N, p)
+        θ̂ (SI) and its standard error after the update at each sample.
+    initial : ndarray (p,)
+    n_states : int
+        States of the tracker's model.
+    flops_per_sample : int
+    wall_time_s, cpu_time_s : float
+        Time of the recursion (after numba's compilation): elapsed, and this process's CPU
+        time (the fair measure on a shared machine).
+    """
+
+    names: tuple[str, ...]
+    units: tuple[str, ...]
+    time_s: np.ndarray
+    estimate: np.ndarray
+    std_error: np.ndarray
+    initial: np.ndarray
+    n_states: int
+    flops_per_sample: int
+    wall_time_s: float
+    cpu_time_s: float
+
+    @property
+    def realtime_factor(self) -> float:
+        """Record duration over the process's CPU time of the recursion."""
+        T = self.time_s[1] - self.time_s[0] if len(self.time_s) > 1 else 0.0
+        return len(self.time_s) * T / max(self.cpu_time_s, 1e-12)
+
+    def ci95(self) -> tuple[np.ndarray, np.ndarray]:
+        """(low, high) of θ̂ ± 1.96 SE, each (N, p)."""
+        return self.estimate - 1.96 * self.std_error, self.estimate + 1.96 * self.std_error
+
+
+def flops_per_sample(n: int, k: int, m: int, p: int) -> int:
+    """Multiply-adds ×2 of one RPEM sample: predictor (A_d x̂, B_d u, C x̂, K ε), per
+    parameter the sensitivity recursion and ∂A_d x̂, ∂B_d u, H = C W, and the scalar updates
+    of θ and P per channel (n states, k sensors, m inputs, p parameters)."""
+    pred = 2 * (n * n + n * m + k * n + n * k)
+    sens = p * 2 * (2 * n * n + n * m + k * n + n * k)
+    upd = k * 2 * (2 * p * p + 2 * p) + 2 * p
+    return pred + sens + upd
+
+
+def _param_matrices(model: ClosedLoopModel, values: dict[str, float], names, dt: float):
+    """A_d, B_d, C at ``values`` and ∂A_d/∂θ_j, ∂B_d/∂θ_j (Van Loan's block exponential:
+    expm([[M, E], [0, M]] T) has d expm(M T)/dθ in its upper-right block, M = [[A, B],
+    [0, 0]], E = ∂M/∂θ)."""
+    A, B, C, _, _ = model.matrices(values)
+    n, m = B.shape
+    M = np.zeros((n + m, n + m))
+    M[:n, :n], M[:n, n:] = A, B
+    E0 = sla.expm(M * dt)
+    dA, dB = [], []
+    for name in names:
+        h = 1e-6 * max(abs(values[name]), 1.0)
+        Ap, Bp, _, _, _ = model.matrices({**values, name: values[name] + h})
+        dM = np.zeros_like(M)
+        dM[:n, :n], dM[:n, n:] = (Ap - A) / h, (Bp - B) / h  # exact for an LFT (affine in θ)
+        big = np.block([[M, dM], [np.zeros_like(M), M]]) * dt
+        D = sla.expm(big)[: n + m, n + m:]
+        dA.append(D[:n, :n])
+        dB.append(D[:n, n:])
+    return E0[:n, :n], E0[:n, n:], C, np.array(dA), np.array(dB)
+
+
+def _scales(cfg: RigConfig, model: ClosedLoopModel, names) -> np.ndarray:
+    """Each parameter's scale: the larger |value| in the model and at the rig's operating
+    pressure (a seal's k is 0 at zero pressure drop), at least the fit's default scale of
+    its unit."""
+    op = mechanical_plant(build_system(cfg, pressure_bar=cfg.operating.pressure_bar))
+    out = []
+    for name in names:
+        p = model.plant.parameter(name)
+        at_op = abs(op.parameters[name].nominal) if name in op.parameters else 0.0
+        out.append(max(abs(p.nominal), at_op, _DEFAULT_SCALE.get(p.unit, 0.0), 1e-12))
+    return np.array(out)
+
+
+def _predictor_gain(Ad, Bd, C, sigma_y, sigma_u):
+    """Steady-state Kalman predictor gain K (x̂⁺ = A x̂ + B u + K ε) for input-referred
+    process noise σ_u (A) and sensor noise σ_y (m) per channel (DARE)."""
+    n = Ad.shape[0]
+    Q = Bd @ np.diag(sigma_u**2) @ Bd.T + 1e-9 * np.trace(Bd @ Bd.T) / n * np.eye(n) \
+        * float(np.mean(sigma_u**2))
+    R = np.diag(sigma_y**2)
+    try:
+        X = sla.solve_discrete_are(Ad.T, C.T, Q, R)
+    except (np.linalg.LinAlgError, ValueError) as exc:
+        raise IdentificationError(f"track: no steady-state predictor at this estimate "
+                                  f"({exc}); the model is not detectable") from None
+    return Ad @ X @ C.T @ np.linalg.inv(C @ X @ C.T + R)
+
+
+def rpem_kernel(y, u, Ad, Bd, C, K, dA, dB, theta0, x, W, theta, P, lam, q, g,
+                est, se, score, info, start, stop):
+    """Samples ``start:stop`` of the RPEM recursion (module docstring), in place on x (n,),
+    W (p, n), θ (p,), P (p, p), Λ (k,); θ̂, SE, the score Hᵀ Λ⁻¹ ε and the information
+    diag(Hᵀ Λ⁻¹ H) written to rows of ``est``, ``se``, ``score``, ``info`` (N, p). Plain
+    loops so that numba compiles it (the interpreted form is the benchmark's baseline)."""
+    n, k, m, p = Ad.shape[0], C.shape[0], Bd.shape[1], theta.shape[0]
+    xn = np.empty(n)
+    Wn = np.empty((p, n))
+    eps = np.empty(k)
+    H = np.empty((k, p))
+    dx = np.empty((p, n))
+    ph = np.empty(p)
+    th0 = np.empty(p)
+    for t in range(start, stop):
+        for j in range(p):
+            th0[j] = theta[j]
+            score[t, j] = 0.0
+            info[t, j] = 0.0
+        for i in range(k):  # innovation
+            s = y[t, i]
+            for a in range(n):
+                s -= C[i, a] * x[a]
+            eps[i] = s
+        for j in range(p):  # ∂A x̂ + ∂B u
+            for a in range(n):
+                s = 0.0
+                for b in range(n):
+                    s += dA[j, a, b] * x[b]
+                for b in range(m):
+                    s += dB[j, a, b] * u[t, b]
+                dx[j, a] = s
+        for a in range(n):  # predictor at θ̂ (first order about θ₀)
+            s = 0.0
+            for b in range(n):
+                s += Ad[a, b] * x[b]
+            for b in range(m):
+                s += Bd[a, b] * u[t, b]
+            for i in range(k):
+                s += K[a, i] * eps[i]
+            for j in range(p):
+                s += (theta[j] - theta0[j]) * dx[j, a]
+            xn[a] = s
+        for j in range(p):  # H = C W, then the sensitivity recursion
+            for i in range(k):
+                s = 0.0
+                for a in range(n):
+                    s += C[i, a] * W[j, a]
+                H[i, j] = s
+            for a in range(n):
+                s = dx[j, a]
+                for b in range(n):
+                    s += Ad[a, b] * W[j, b]
+                for i in range(k):
+                    s -= K[a, i] * H[i, j]
+                Wn[j, a] = s
+        for i in range(k):  # Λ, then one scalar Kalman update per channel
+            lam[i] += g * (eps[i] * eps[i] - lam[i])
+            s = lam[i]
+            for j in range(p):
+                v = 0.0
+                for l in range(p):
+                    v += P[j, l] * H[i, l]
+                ph[j] = v
+                s += H[i, j] * v
+            for j in range(p):
+                score[t, j] += H[i, j] * eps[i] / lam[i]
+                info[t, j] += H[i, j] * H[i, j] / lam[i]
+            r = eps[i]  # the residual at the θ̂ already updated by earlier channels
+            for j in range(p):
+                r -= H[i, j] * (theta[j] - th0[j])
+            for j in range(p):
+                theta[j] += ph[j] * r / s
+            for j in range(p):
+                for l in range(p):
+                    P[j, l] -= ph[j] * ph[l] / s
+        for j in range(p):
+            P[j, j] += q[j]
+            est[t, j] = theta[j]
+            se[t, j] = np.sqrt(P[j, j])
+        for a in range(n):
+            x[a] = xn[a]
+            for j in range(p):
+                W[j, a] = Wn[j, a]
+
+
+_JIT = {}
+
+
+def _kernel(compiled: bool):
+    """The kernel, compiled by numba once per process when ``compiled``."""
+    if not compiled:
+        return rpem_kernel
+    if "k" not in _JIT:
+        import numba
+
+        _JIT["k"] = numba.njit(cache=False, fastmath=False)(rpem_kernel)
+    return _JIT["k"]
+
+
+def linearised_model(cfg: RigConfig, record: Measurement, names, settings: TrackingSettings,
+                     source: str = "<data>", controller=None) -> ClosedLoopModel:
+    """The tracker's model of ``record``: the rig at its pressure and speed, reduced to
+    ``settings.cutoff_hz`` (default the Nyquist frequency), every name checked."""
+    fs = 1.0 / float(np.mean(np.diff(record.time_s)))
+    cutoff = settings.cutoff_hz or fs / 2
+    model = build_models(cfg, [record], cutoff_hz=cutoff, sources=[source],
+                         controllers=None if controller is None else [controller])[0]
+    for n in names:
+        try:
+            model.plant.parameter(n)
+        except ModelError as exc:
+            raise IdentificationError(f"track: {exc} (an LFT parameter of the rig)") from None
+    return model
+
+
+def track(cfg: RigConfig, record: Measurement, names, settings: TrackingSettings | None = None,
+          *, initial: dict | None = None, compiled: bool = True, source: str = "<data>",
+          controller=None) -> TrackingResult:
+    """Track parameters ``names`` through ``record`` (module docstring: the RPEM).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig; its model at the record's metadata pressure and speed starts the tracker.
+    record : Measurement
+        Displacements (m) and current references (A) at a constant sample rate.
+    names : sequence of str
+        LFT parameters of the rig's model, e.g. ``"seal.k"`` (:meth:`Plant.parameter`).
+    initial : dict, optional
+        Starting values (SI); default the model's values at the record's pressure.
+    compiled : bool
+        Run the kernel compiled by numba (False: interpreted, the benchmark's baseline).
+
+    Returns
+    -------
+    TrackingResult
+
+    Raises
+    ------
+    IdentificationError
+        A name without an LFT channel, a record shorter than the model's settling
+        (``min_duration_s``), a non-detectable model.
+    """
+    s = settings or TrackingSettings()
+    names = tuple(names)
+    if not names:
+        raise IdentificationError("track: no parameter to track (--params NAME,...)")
+    t = np.asarray(record.time_s, float)
+    if len(t) < 3:
+        raise IdentificationError(f"{source}: record too short to track from ({len(t)} samples)")
+    dt = float(np.mean(np.diff(t)))
+    need = s.min_duration_s
+    if len(t) * dt < need:
+        raise IdentificationError(f"{source}: record too short to track from: "
+                                  f"{len(t) * dt:.3g} s, need at least {need:.3g} s")
+    model = linearised_model(cfg, record, names, s, source, controller)
+    y = np.ascontiguousarray(record.displacement_m, float)
+    u = np.ascontiguousarray(record.current_ref_a, float)
+    scale = _scales(cfg, model, names)
+    theta = np.array([float((initial or {}).get(n, model.plant.parameter(n).nominal))
+                      for n in names])
+    sigma_y = s.sensor_noise_fraction * np.sqrt(np.mean(y**2, axis=0))
+    sigma_y = np.where(sigma_y > 0, sigma_y, 1e-9)
+    sigma_u = np.full(u.shape[1], s.process_noise_a if s.process_noise_a is not None
+                      else max(0.01 * float(np.sqrt(np.mean(u**2))), 1e-6))
+    p, N = len(names), len(t)
+    theta_start = theta.copy()
+    P = np.diag((s.initial_rel_std * scale) ** 2)
+    q = (s.rate_per_s * scale) ** 2 * dt
+    lam = sigma_y**2 * 1.0
+    g = min(1.0, dt / s.innovation_time_s)
+    est, se, score, info = (np.empty((N, p)) for _ in range(4))
+    kern = _kernel(compiled)
+    chunk = max(1, int(round(s.relinearise_s / dt)))
+    x = W = K = theta_K = None
+    if compiled:  # compile outside the timing
+        Ad, Bd, C, dA, dB = _param_matrices(model, dict(zip(names, theta)), names, dt)
+        kern(y, u, Ad, Bd, C, np.zeros(C.T.shape), dA, dB, theta.copy(), np.zeros(len(Ad)),
+             np.zeros((p, len(Ad))), theta.copy(), P.copy(), lam.copy(), q, g, est, se, score,
+             info, 0, 0)
+    t0, c0 = time.perf_counter(), time.process_time()
+    for start in range(0, N, chunk):
+        values = dict(zip(names, theta))
+        Ad, Bd, C, dA, dB = _param_matrices(model, values, names, dt)
+        if x is None:
+            x, W = np.zeros(Ad.shape[0]), np.zeros((p, Ad.shape[0]))
+        if K is None or np.any(np.abs(theta - theta_K) > s.regain_rel * scale):
+            K, theta_K = _predictor_gain(Ad, Bd, C, sigma_y, sigma_u), theta.copy()
+        kern(y, u, Ad, Bd, C, K, dA, dB, theta.copy(), x, W, theta, P, lam, q, g, est, se,
+             score, info, start, min(N, start + chunk))
+        if not np.all(np.isfinite(theta)):
+            raise IdentificationError(f"{source}: track: the estimate diverged at "
+                                      f"t = {t[start]:.3f} s")
+    se = se * np.sqrt(_inflation(score, info, int(round(s.innovation_time_s / dt)),
+                                 int(round(s.inflation_window_s / dt))))
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    n = x.shape[0]
+    units = tuple(model.plant.parameter(n).unit for n in names)
+    return TrackingResult(names, units, t, est, se, theta_start, n,
+                          flops_per_sample(n, y.shape[1], u.shape[1], p), wall, cpu)
+
+
+def current_limit(cfg: RigConfig, meta: dict | None = None) -> float | None:
+    """The amplifiers' current limit (A): a record's ``current_limit_a``, else the smallest
+    ``current_limit`` of the rig's AMBs, else None."""
+    if meta and meta.get("current_limit_a"):
+        return float(meta["current_limit_a"])
+    limits = [a.current_limit for a in cfg.amb if a.current_limit]
+    return min(limits) if limits else None
+
+
+def check_excitation(cfg: RigConfig, record: Measurement, source: str = "<data>") -> None:
+    """DataError when the record's excitation exceeds the current limit."""
+    limit = current_limit(cfg, dict(record.metadata))
+    peak = float(np.max(np.abs(record.excitation_a))) if np.size(record.excitation_a) else 0.0
+    if limit is not None and peak > limit:
+        raise DataError(f"{source}: excitation_a: peak {peak:.3g} A exceeds the current limit "
+                        f"{limit:.3g} A")
+
+
+def tracking_excitation(cfg: RigConfig, duration_s: float, *, amplitude_a: float | None = None,
+                        clock_period_s: float | None = None, seed: int = 0):
+    """The tracker's persistent excitation: a PRBS on every axis (:func:`signals.prbs`).
+
+    Defaults: amplitude 1 % of the current limit (0.06 A on a 6 A amplifier, the thesis's
+    PRBS level of P2 Fig. 5 halved: small against the bias and the limit), clock period ten
+    samples (flat spectrum to ≈ 0.044 f_s, past the rigid-body and first bending modes).
+
+    Raises
+    ------
+    IdentificationError
+        An amplitude above the current limit, or no limit and no amplitude.
+    """
+    from ..model.amb import channel_names
+    from .signals import prbs
+
+    fs = cfg.controller.sample_rate_hz
+    limit = current_limit(cfg)
+    if amplitude_a is None:
+        if limit is None:
+            raise IdentificationError("track: the rig states no current_limit; give the "
+                                      "excitation amplitude (A)")
+        amplitude_a = 0.01 * limit
+    if limit is not None and amplitude_a > limit:
+        raise IdentificationError(f"track: excitation amplitude {amplitude_a:.3g} A exceeds "
+                                  f"the current limit {limit:.3g} A")
+    return prbs(amplitude_a=amplitude_a, clock_period_s=clock_period_s or 10 / fs,
+                duration_s=duration_s, sample_rate_hz=fs, axes=channel_names(cfg), seed=seed)

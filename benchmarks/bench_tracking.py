@@ -1,0 +1,72 @@
+"""On-line tracker of seal coefficients (issue 14 §1): real-time factor at the rig's rate.
+
+A record of the virtual test facility (the embedded rig at its operating pressure, 1 %
+sensor noise, the tracker's default PRBS), then ``ambseal.identify.tracking.track`` on it
+tracking ``seal.k``. Ours: the RPEM kernel compiled by numba (compilation outside the
+timing). Baseline: the same kernel interpreted by CPython, on the first ``--baseline-s`` of
+the record and extrapolated to the whole record (``baseline_extrapolated``). Prints one JSON
+line: ``realtime_factor`` = record length / CPU time of the recursion (this process's CPU
+time: on a shared machine elapsed time measures the other jobs), ``realtime_factor_wall``
+the same on elapsed time, the goal ≥ 10, and the flops per sample.
+
+    PYTHONPATH=src python benchmarks/bench_tracking.py [--duration-s 3] [--rig RIG]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from dataclasses import replace
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+
+def main() -> None:
+    import numpy as np
+
+    from ambseal.config import TruthSection, load_rig
+    from ambseal.control.pid import reference_controller
+    from ambseal.identify.stages import acquire
+    from ambseal.identify.tracking import TrackingSettings, track, tracking_excitation
+
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--rig", default=None)
+    ap.add_argument("--param", default=None, help="default: the first seal's k")
+    ap.add_argument("--duration-s", type=float, default=3.0)
+    ap.add_argument("--baseline-s", type=float, default=0.02)
+    args = ap.parse_args()
+    cfg = load_rig(args.rig)
+    name = args.param or f"{cfg.seal[0].name}.k"
+    print(f"recording {args.duration_s} s on the virtual facility ...", file=sys.stderr)
+    truth = TruthSection(noise_fraction=0.01, tau_e=cfg.actuator.eddy_time_constant)
+    rec = acquire(cfg, truth, tracking_excitation(cfg, args.duration_s, seed=1),
+                  controller=reference_controller(cfg),
+                  pressure_bar=cfg.operating.pressure_bar, seed=1)
+    res = track(cfg, rec, [name])
+    n = int(round(args.baseline_s * cfg.controller.sample_rate_hz))
+    short = replace(rec, **{f: getattr(rec, f)[:n] for f in
+                            ("time_s", "excitation_a", "current_ref_a", "current_a",
+                             "displacement_m")})
+    print(f"interpreted baseline on {n} samples ...", file=sys.stderr)
+    quick = TrackingSettings(min_duration_s=0.0)
+    base = track(cfg, short, [name], quick, compiled=False)
+    base_s = base.cpu_time_s * len(rec.time_s) / n
+    same = track(cfg, short, [name], quick)  # the same numbers, compiled
+    np.testing.assert_allclose(base.estimate[:, 0], same.estimate[:, 0], rtol=1e-9)
+    print(json.dumps({
+        "case": f"track_{name}", "samples": len(rec.time_s),
+        "sample_rate_hz": cfg.controller.sample_rate_hz, "n_states": res.n_states,
+        "flops_per_sample": res.flops_per_sample,
+        "ours_s": res.cpu_time_s, "ours_wall_s": res.wall_time_s,
+        "baseline": "same RPEM kernel interpreted (no numba)", "baseline_s": base_s,
+        "baseline_extrapolated": True, "ratio": base_s / res.cpu_time_s,
+        "realtime_factor": res.realtime_factor,
+        "realtime_factor_wall": rec.time_s[-1] / res.wall_time_s,
+        "goal_realtime_factor": 10.0}))
+
+
+if __name__ == "__main__":
+    main()

@@ -275,6 +275,7 @@ def track_files(rig: str | Path, data: list[str], names: list[str], out_dir: str
     """
     import numpy as np
 
+    from .control.pid import controller_from_metadata
     from .identify.data import load_measurement
     from .identify.tracking import TrackingSettings, check_excitation, track
     from .model.amb import channel_names
@@ -284,16 +285,17 @@ def track_files(rig: str | Path, data: list[str], names: list[str], out_dir: str
     axes = channel_names(cfg)
     settings = TrackingSettings() if rate_per_s is None else TrackingSettings(
         rate_per_s=rate_per_s)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = writable_folder(out_dir)  # before the work, not after it
     records = []
     for path in data:
         meas = load_measurement(path, axes=axes, min_samples=3)
         check_excitation(cfg, meas, str(path))
-        records.append(meas)
+        # the model needs the controller only to be built (the tracker cuts the loop at the
+        # DAC); a real rig's PID description becomes its matrices as in `identify`
+        records.append((meas, controller_from_metadata(dict(meas.metadata), axes, str(path))))
     summary = []
-    for i, (path, meas) in enumerate(zip(data, records)):
-        res = track(cfg, meas, names, settings, source=str(path))
+    for i, (path, (meas, ctrl)) in enumerate(zip(data, records)):
+        res = track(cfg, meas, names, settings, source=str(path), controller=ctrl)
         lo, hi = res.ci95()
         step = max(1, int(round(1e-3 / (res.time_s[1] - res.time_s[0]))))
         cols = [res.time_s[::step]] + [a[::step, j] for j in range(len(names))

@@ -28,7 +28,7 @@ def campbell_figure(path: str | os.PathLike, c, *, title: str = "Closed-loop Cam
 
     Top: frequencies (markers by whirl: ▲ forward, ▼ backward, ◆ mixed, ● planar; a filled
     black ring on modes below the log-decrement limit), the mode lines, the 1× line and the
-    crossings (×). Bottom: log decrements with the limit (API 684: 0.1).
+    crossings (×, bold where API 684 counts them critical). Bottom: log decrements with the limit (API 684: 0.1).
 
     Parameters
     ----------
@@ -59,20 +59,19 @@ def campbell_figure(path: str | os.PathLike, c, *, title: str = "Closed-loop Cam
                    facecolors="none", edgecolors="k", lw=1.0, zorder=4,
                    label=f"log dec < {c.log_dec_limit:g}")
     ax.plot(s, s, "k--", lw=1.0, label="1× (synchronous)")
-    for x in c.crossings:
-        ax.plot(x.speed_hz, x.speed_hz, "kx", ms=8, mew=2, zorder=5)
+    for x in c.crossings:  # API 684 critical (AF ≥ 2.5) bold, the others small
+        ax.plot(x.speed_hz, x.speed_hz, "x", color="k" if x.critical else "0.5",
+                ms=9 if x.critical else 5, mew=2 if x.critical else 1, zorder=5)
     # up to the first mode above the speed range (the modes that can meet 1× and the next)
     f_all = np.concatenate([p.frequency_hz for p in c.points])
     above = f_all[f_all > s.max()]
     top = max(float(s.max()), float(above.min()) if above.size else float(f_all.max(initial=1.0)))
     ax.set_ylim(0, 1.15 * top)
-    cut = sorted({round(float(f)) for f in f_all if f > 1.15 * top})
-    if cut:
-        ax.text(0.99, 0.98, f"modes up to {max(p.max_hz for p in c.points):.0f} Hz in the "
-                f"δ panel; above {1.15 * top:.0f} Hz not drawn here", transform=ax.transAxes,
-                ha="right", va="top", fontsize=7, color="0.3")
+    if np.any(f_all > 1.15 * top):
+        title += (f"\n(modes to {max(p.max_hz for p in c.points):.0f} Hz in the δ panel; "
+                  f"above {1.15 * top:.0f} Hz not drawn here)")
     ax.set_ylabel("damped natural frequency (Hz)")
-    ax.set_title(title)
+    ax.set_title(title, fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="upper left")
     axd.axhline(c.log_dec_limit, color="k", ls="--", lw=1.0)

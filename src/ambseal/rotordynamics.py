@@ -163,7 +163,7 @@ def _campbell(args: argparse.Namespace) -> int:
 
 
 def _sweep(args: argparse.Namespace) -> int:
-    from .analysis.sweep import dask_available, stability_boundary, sweep
+    from .analysis.sweep import dask_available, refine_boundary, stability_boundary, sweep
     from .report.modal_figures import stability_map_figure
 
     cfg = load_rig(args.rig)
@@ -189,7 +189,8 @@ def _sweep(args: argparse.Namespace) -> int:
         workers = 1
     rows = sweep(cfg, ctrl, pressures, speeds, params, max_hz=args.max_hz,
                  workers=workers, scheduler=args.scheduler, progress=True)
-    edge = stability_boundary(rows)
+    edge = refine_boundary(cfg, ctrl, stability_boundary(rows), tol_bar=args.tol_bar,
+                           workers=workers, scheduler=args.scheduler, progress=True)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     files = write_table(out / "sweep.csv", rows)
@@ -259,6 +260,8 @@ def add_parsers(sub, positive_int) -> None:
                    help="a rig parameter to sweep too, e.g. seal.k=0:2e6:5 (repeatable)")
     s.add_argument("--max-hz", type=float, default=None,
                    help="modes of the lowest log decrement up to this frequency (Hz)")
+    s.add_argument("--tol-bar", type=float, default=0.01,
+                   help="the stability boundary is bisected to this pressure (bar)")
     s.add_argument("--out", default="ambseal-sweep", help="output folder")
     _executor_args(s)
 

@@ -37,7 +37,9 @@ def test_pid_loses_the_embedded_rig_between_nominal_and_twice_nominal(testrig_cf
 
 
 def _tiny_rig() -> dict:
-    return {"materials": {"m": {"E": 2.1e11, "rho": 7850.0, "nu": 0.3}},
+    """A rigid rotor (shaft 10⁵ times stiffer than its supports, 16.17 kg) on two AMBs
+    closed by proportional gains into k = 10⁶ N/m each, with a seal at mid-span."""
+    return {"materials": {"m": {"E": 2e16, "rho": 7850.0, "nu": 0.3}},
             "shaft": [{"length": 0.4, "outer_diameter": 0.05, "material": "m",
                        "elements": 2}],
             "disk": [{"position": 0.2, "mass": 10.0, "Ip": 0.05, "Id": 0.1}],
@@ -102,9 +104,11 @@ def test_ranges_and_bad_input():
 
 def test_cli_sweep_writes_table_boundary_and_map_and_keeps_failed_cases(tmp_path, capsys):
     """``ambseal sweep`` on the rigid rotor with a controller file: the table has every
-    case in order, the boundary brackets the Jeffcott threshold k = c·ω_n (3.2 bar, see
-    above), the map is written; a ``--param`` the rig does not have fails every case, each
-    kept in the table with its error, and the command still ends normally."""
+    case in order, the grid brackets and the bisection finds the Jeffcott threshold
+    k = c·ω_n (Childs 1993, §1.5: m s² + c s + K − jk = 0 has a root on the imaginary axis
+    where k = c·√(K/m)) to 1e-4 relative, the map is written; a ``--param`` the rig does not
+    have fails every case, each kept in the table with its error, and the command still
+    ends normally."""
     import csv
 
     import control
@@ -119,7 +123,7 @@ def test_cli_sweep_writes_table_boundary_and_map_and_keeps_failed_cases(tmp_path
                               tmp_path / "P.json")
     out = tmp_path / "sw"
     args = ["sweep", str(rig), "--pressure-bar", "0:4:3", "--controller", str(kfile),
-            "--out", str(out), "--workers", "1"]
+            "--out", str(out), "--workers", "1", "--tol-bar", "1e-5"]
     assert main(args) == 0
     summary = json.loads(capsys.readouterr().out)
     rows = list(csv.DictReader((out / "sweep.csv").open()))
@@ -127,6 +131,9 @@ def test_cli_sweep_writes_table_boundary_and_map_and_keeps_failed_cases(tmp_path
     assert [r["stable"] for r in rows] == ["True", "True", "False"]
     (edge,) = summary["boundary"]
     assert edge["last_stable_bar"] == 2.0 and edge["first_unstable_bar"] == 4.0
+    m = 10.0 + 7850.0 * np.pi * 0.05**2 / 4 * 0.4
+    k_crit = 900.0 * np.sqrt(2e6 / m)  # c: two dampers and the seal's C; K: two supports
+    assert edge["boundary_pressure_bar"] == pytest.approx(k_crit / 1e5, rel=1e-4)
     assert (out / "stability_map.png").stat().st_size > 10_000
     assert main(args + ["--param", "nope.k=0:1:2"]) == 0
     summary = json.loads(capsys.readouterr().out)

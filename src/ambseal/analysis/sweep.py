@@ -13,8 +13,10 @@ Two layers:
 * :func:`sweep` — the map: per (controller, pressure, speed, parameter values) case the
   judgement of :func:`ambseal.analysis.judge.judge` without the impulse response (closed-loop
   max real pole, σ̄(S_o) peak, ISO 14839-3 zone overall and per axis, unbalance peak) and the
-  lowest log decrement of :mod:`ambseal.analysis.campbell`, as plain rows for a table; and
-  :func:`stability_boundary`, the lowest unstable pressure per (controller, speed).
+  lowest log decrement of :mod:`ambseal.analysis.campbell`, as plain rows for a table;
+  :func:`stability_boundary`, the pressure where the loop turns unstable per (controller,
+  speed, parameters), bracketed by the grid and interpolated, and :func:`refine_boundary`,
+  the same bisected on the closed-loop poles to a stated tolerance.
 
 Inputs of a sweep case are plain and picklable: the rig as a dict (``RigConfig.model_dump``),
 each controller as its ``(A, B, C, D)`` arrays.
@@ -32,7 +34,8 @@ import numpy as np
 from ..errors import AmbsealError, ConfigError
 
 __all__ = ["CaseError", "run_cases", "dask_available", "SERIAL_BELOW", "sweep",
-           "sweep_case", "stability_boundary", "parse_range"]
+           "sweep_case", "stability_boundary", "refine_boundary", "boundary_case",
+           "parse_range"]
 
 #: Sweeps with fewer cases than this run serially when no workers or scheduler are given:
 #: a local cluster costs a few seconds to start, about 20 cases of the embedded rig.
@@ -210,13 +213,10 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
     """
     import control
 
-    from ..config import parse_rig, rig_with_values
     from .campbell import lowest_log_decrement
     from .judge import OperatingPoint, judge
 
-    cfg = parse_rig(rig, "<sweep rig>")
-    if case.get("params"):
-        cfg = rig_with_values(cfg, case["params"])
+    cfg = _case_rig(rig, case.get("params"))
     K = control.ss(*controllers[case["controller"]])
     point = OperatingPoint(case["pressure_bar"], 60.0 * case["speed_hz"], "")
     res, curves = judge(cfg, K, case["controller"], point, settings,
@@ -230,6 +230,20 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
     row.update({f"iso_zone_{ax}": z for ax, z in res["iso_zone_per_axis"].items()})
     row["unbalance_peak_um"] = res["unbalance_peak_um"]
     return row
+
+
+def _case_rig(rig: dict, params: dict | None):
+    from ..config import parse_rig, rig_with_values
+
+    cfg = parse_rig(rig, "<sweep rig>")
+    return rig_with_values(cfg, params) if params else cfg
+
+
+def _shared(cfg, controllers: dict) -> dict:
+    """The plain, picklable inputs every case of a sweep shares."""
+    return {"rig": cfg.model_dump(exclude_none=True),
+            "controllers": {n: tuple(np.asarray(M, float) for M in (K.A, K.B, K.C, K.D))
+                            for n, K in controllers.items()}}
 
 
 def sweep(cfg, controllers: dict, pressures_bar, speeds_hz, params: dict | None = None, *,
@@ -265,9 +279,7 @@ def sweep(cfg, controllers: dict, pressures_bar, speeds_hz, params: dict | None 
               "params": dict(zip(names, (float(x) for x in vals)))}
              for c in controllers for p in pressures_bar for s in speeds_hz
              for vals in itertools.product(*(params[n] for n in names))]
-    shared = {"rig": cfg.model_dump(exclude_none=True),
-              "controllers": {n: tuple(np.asarray(M, float) for M in (K.A, K.B, K.C, K.D))
-                              for n, K in controllers.items()},
+    shared = {**_shared(cfg, controllers),
               "max_hz": bending_limit_hz(cfg) if max_hz is None else float(max_hz)}
     out = run_cases(sweep_case, cases, shared=shared, workers=workers, scheduler=scheduler,
                     progress=progress, description="sweep")
@@ -306,6 +318,51 @@ def stability_boundary(rows: list[dict]) -> list[dict]:
     return out
 
 
+def boundary_case(case: dict, rig: dict, controllers: dict, tol_bar: float) -> float:
+    """Bisect one bracket ``case = {controller, speed_hz, params, last_stable_bar,
+    first_unstable_bar}`` of the stability boundary to ``tol_bar`` (bar) on the max real
+    part of the closed-loop poles (the loop of :func:`sweep_case`)."""
+    import control
+
+    from .campbell import closed_loop_state_matrix
+
+    cfg = _case_rig(rig, case.get("params"))
+    K = control.ss(*controllers[case["controller"]])
+    lo, hi = case["last_stable_bar"], case["first_unstable_bar"]
+    while hi - lo > tol_bar:
+        mid = 0.5 * (lo + hi)
+        A, _ = closed_loop_state_matrix(cfg, K, speed_hz=case["speed_hz"], pressure_bar=mid)
+        lo, hi = (mid, hi) if np.linalg.eigvals(A).real.max() < 0 else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+def refine_boundary(cfg, controllers: dict, edges: list[dict], *, tol_bar: float = 0.01,
+                    workers: int | None = None, scheduler: str | None = None,
+                    progress: bool = False) -> list[dict]:
+    """The edges of :func:`stability_boundary` with ``boundary_pressure_bar`` bisected
+    between the grid's last stable and first unstable pressure to ``tol_bar`` (bar), each
+    bracket a case of :func:`run_cases`; edges without a bracket are returned as they are,
+    a failed bisection keeps the interpolated value and gets an ``error``."""
+    todo = [i for i, e in enumerate(edges)
+            if e["last_stable_bar"] is not None and e["first_unstable_bar"] is not None]
+    cases = [{k: v for k, v in edges[i].items() if k != "boundary_pressure_bar"}
+             for i in todo]
+    for c in cases:
+        c["params"] = {k: v for k, v in c.items() if k not in _BRACKET}
+    res = run_cases(boundary_case, cases, shared={**_shared(cfg, controllers),
+                                                   "tol_bar": tol_bar},
+                    workers=workers, scheduler=scheduler, progress=progress,
+                    description="stability boundary")
+    out = [dict(e) for e in edges]
+    for i, r in zip(todo, res):
+        if isinstance(r, CaseError):
+            out[i]["error"] = r.error
+        else:
+            out[i].update(boundary_pressure_bar=r, boundary_tolerance_bar=tol_bar)
+    return out
+
+
+_BRACKET = {"controller", "speed_hz", "last_stable_bar", "first_unstable_bar", "params"}
 _RESULTS = {"stable", "max_real_pole", "lowest_log_dec", "lowest_log_dec_hz",
             "sensitivity_peak", "iso_zone", "unbalance_peak_um", "error"}
 

@@ -9,7 +9,9 @@ same controllers:
 * ``testrig_plants`` — the full-order test-facility plants over 0 … 4.08 bar (P5 Fig. 13);
 * ``turbo_lpv`` — the constant-Lyapunov LPV design of the turboexpander over its
   ``[operating] speed_range_hz`` with the frozen γ's (P3 §4), about half a minute;
-* ``turbo_frozen`` — the H∞ controller at the operating speed (140 Hz, P3 Fig. 11).
+* ``turbo_frozen`` — the H∞ controller at the operating speed (140 Hz, P3 Fig. 11);
+* ``testrig_digital``, ``turbo_digital`` — the digital controllers of those designs as
+  ``ambseal run`` chooses them (:func:`ambseal.commands.digital_for`).
 
 ``design_cache_for`` lets a test run the main job (``ambseal run``) on these designs instead
 of recomputing them: it replaces the design functions for the duration of the test by
@@ -85,6 +87,27 @@ def turbo_frozen(turbo_cfg):
     return design_frozen(turbo_cfg, turbo_cfg.operating.speed_rpm / 60.0)
 
 
+def _digital(cfg, designs: dict) -> dict:
+    from ambseal.analysis.judge import operating_points
+    from ambseal.commands import digital_for
+
+    pts, cache = operating_points(cfg), {}
+    return {m: digital_for(cfg, m, getattr(d, "K", d) if m != "lpv" else d, d, pts, cache)
+            for m, d in designs.items()}
+
+
+@pytest.fixture(scope="session")
+def testrig_digital(testrig_cfg, testrig_designs):
+    """{"pid", "hinf", "mu"} → DigitalController of the test facility's designs."""
+    return _digital(testrig_cfg, testrig_designs)
+
+
+@pytest.fixture(scope="session")
+def turbo_digital(turbo_cfg, turbo_frozen, turbo_lpv):
+    """{"hinf", "lpv"} → DigitalController / ScheduledDigital of the turboexpander."""
+    return _digital(turbo_cfg, {"hinf": turbo_frozen, "lpv": turbo_lpv})
+
+
 class DesignCache:
     """Routes the main job's design calls to the session's designs (see module doc).
 
@@ -94,8 +117,8 @@ class DesignCache:
     so a test can check that the cache was used.
     """
 
-    FIXTURES = {"testrig": ("testrig_cfg", "testrig_designs"),
-                "turbo": ("turbo_cfg", "turbo_lpv", "turbo_frozen")}
+    FIXTURES = {"testrig": ("testrig_cfg", "testrig_designs", "testrig_digital"),
+                "turbo": ("turbo_cfg", "turbo_lpv", "turbo_frozen", "turbo_digital")}
 
     def __init__(self, request):
         self._request = request  # the requesting fixture's or test's
@@ -104,11 +127,24 @@ class DesignCache:
     @contextlib.contextmanager
     def patched(self, rig: str):
         """Replace the design functions for the duration of the ``with`` block."""
+        import ambseal.commands as cmod
         import ambseal.control.recipes as dmod
         import ambseal.control.lpv_design as lmod
 
         got = {n: self._request.getfixturevalue(n) for n in self.FIXTURES[rig]}
         real_design, real_lpv, real_frozen = dmod.design, lmod.design_lpv, lmod.design_frozen
+        real_digital = cmod.digital_for
+        digital = got.get("testrig_digital") or got.get("turbo_digital")
+        cfg0 = got.get("testrig_cfg") or got.get("turbo_cfg")
+
+        def digital_for(cfg, method, controller, result, points, cache=None):
+            dc = digital.get(method)
+            if dc is not None and _same(cfg, cfg0) and (
+                    getattr(dc, "continuous", None) is controller
+                    or (method == "lpv" and result is got.get("turbo_lpv"))):
+                self.hits.append(f"digital:{method}")
+                return dc
+            return real_digital(cfg, method, controller, result, points, cache)
 
         def design(cfg, method="mu", **kw):
             # the main job passes the rig's own specification and a progress callback
@@ -139,6 +175,7 @@ class DesignCache:
             mp.setattr(dmod, "design", design)
             mp.setattr(lmod, "design_lpv", design_lpv)
             mp.setattr(lmod, "design_frozen", design_frozen)
+            mp.setattr(cmod, "digital_for", digital_for)
             yield self
 
 

@@ -179,13 +179,17 @@ def test_non_square_controller_in_metadata(record, tmp_path, capsys):
 
 
 def test_design_hinf_exports_controller(tmp_path, capsys):
-    """`design --method hinf`: the controller in .json/.npz/.mat with Tustin and ZOH forms
-    and its summary; the summary's γ is the verified closed-loop norm (finite, > 0)."""
+    """`design --method hinf`: the controller in .json/.npz/.mat as it runs (discrete, with
+    its sample time, method and the continuous design) and its summary; the summary's γ is
+    the verified closed-loop norm (finite, > 0); the discrete loops it was chosen on are
+    stable (|z| < 1) wherever the continuous loop is."""
     code = main(["design", RIG, "--method", "hinf", "--out", str(tmp_path)])
     summary = json.loads(capsys.readouterr().out)
     assert code == 0 and summary["method"] == "hinf" and summary["gamma"] > 0
     data = np.load(tmp_path / "controller_hinf.npz")
-    assert {"A", "A_tustin", "A_zoh"} <= set(data.files)
+    assert {"A", "A_c", "Ts", "method", "delay_samples", "judged_json"} <= set(data.files)
+    judged = json.loads(str(data["judged_json"]))
+    assert judged and all(j["stable"] for j in judged if j["sensitivity_peak_continuous"])
     assert (tmp_path / "controller_hinf.mat").exists()
     assert (tmp_path / "design_hinf.json").exists()
 

@@ -69,7 +69,7 @@ def terminal_run(tmp_path_factory, request, design_cache_for):
     with cache.patched("testrig"):
         code, screen = _on_a_terminal(["run", "--out", str(out)])
     assert code == 0
-    assert {"design:pid", "design:hinf", "design:mu"} <= set(cache.hits)
+    assert {"design:pid", "design:hinf", "design:mu", "digital:hinf"} <= set(cache.hits)
     return out, json.loads((out / "metrics.json").read_text()), screen
 
 
@@ -109,6 +109,14 @@ def test_run_writes_the_contract(metrics):
     assert m["open_loop"]["n_states_full"] == 8 * n_nodes + 8
     for case in m["cases"]:
         assert KEYS <= set(case)
+        # the discrete block of issue 10: the same keys for the controller that runs
+        assert KEYS - {"controller", "pressure_bar"} | {"max_abs_pole_z"} <= set(case["discrete"])
+        if case["stable"]:  # every recommended controller runs stably where it was designed to
+            assert case["discrete"]["stable"] and case["discrete"]["max_abs_pole_z"] < 1.0
+    files = {p.name for p in (out / "controllers").iterdir()}
+    for meth in ("pid", "hinf", "mu"):
+        assert {f"controller_{meth}{e}" for e in (".json", ".npz", ".mat")} <= files
+        assert {f"ambseal_{meth}.h", f"ambseal_{meth}.c"} <= files
     names = {p.name for p in out.iterdir()}
     assert {"metrics.json", "report.html", "sensitivity.png", "compliance.png",
             "unbalance.png", "impulse.png", "controller_gains.png", "identification.json",
@@ -231,11 +239,16 @@ def test_run_on_the_turboexpander_judges_lpv(turbo_run):
     m = json.loads((tmp_path / "metrics.json").read_text())
     got = {(c["controller"], c["speed_hz"]) for c in m["cases"]}
     assert got == {(c, f) for c in ("hinf", "lpv") for f in (20.0, 140.0, 300.0)}
-    assert all(c["stable"] for c in m["cases"])
+    assert all(c["stable"] and c["discrete"]["stable"] for c in m["cases"])
     assert set(m["spinup"]) == {"hinf", "lpv"}
     for name in ("spinup.png", "frozen_sensitivity.png", "report.html"):
         assert (tmp_path / name).exists()
-    assert (tmp_path / "controllers" / "controller_lpv_140Hz.npz").exists()
+    from ambseal.control import ScheduledDigital, load_controller
+
+    for ext in (".json", ".npz", ".mat"):
+        K = load_controller(tmp_path / "controllers" / f"controller_lpv{ext}")
+        assert isinstance(K, ScheduledDigital)
+    assert (tmp_path / "controllers" / "ambseal_lpv.c").exists()
     assert "identification" not in m  # no truth file for this rig
 
 
@@ -253,8 +266,8 @@ def test_exported_hinf_closes_the_loop_by_name_in_python_control(metrics):
 
     out, m = metrics
     doc = json.loads((out / "controllers" / "controller_hinf.json").read_text())
-    K = control.ss(doc["A"], doc["B"], doc["C"], doc["D"], inputs=doc["inputs"],
-                   outputs=doc["outputs"], name="K")
+    K = control.ss(doc["A_c"], doc["B_c"], doc["C_c"], doc["D_c"], inputs=doc["inputs"],
+                   outputs=doc["outputs"], name="K")  # the continuous design
     cfg = load_rig()
     for case in (c for c in m["cases"] if c["controller"] == "hinf"):
         plant = build_plant(cfg, pressure_bar=case["pressure_bar"])

@@ -27,6 +27,10 @@ Commands
     ``--show-defaults`` prints the rig's resolved ``[design]`` part instead; ``--set``
     overrides a ``[design]`` key (also on ``run``); ``--allow-unstable`` keeps a controller
     whose full-order loop is unstable (marked in every output).
+``ambseal export RIG --method pid|hinf|mu|lpv [--c DIR] [--precision double|float] [--out DIR]``
+    Design a controller, choose and judge its discretisation for the target, and write it
+    (.json, .npz, .mat) and as a C99 module (``--c``, default ``OUT/c``); with
+    ``--controller FILE`` instead of ``--method``, the C module of an exported controller.
 ``ambseal identify RIG DATA... --params NAME,... --out DIR``
     Output-error fit of named parameters to closed-loop records; writes the fit, its
     figures and the identified rig.
@@ -188,6 +192,20 @@ def _parser() -> argparse.ArgumentParser:
                    help="design pressure drop (bar); default [operating] pressure_bar")
     d.add_argument("--out", default="ambseal-design", help="output folder")
 
+    e = sub.add_parser("export", help="a controller for the real-time target: files and C code")
+    e.add_argument("rig", help="rig file (TOML)")
+    e.add_argument("--method", choices=["pid", "hinf", "mu", "lpv"],
+                   help="design this controller (or give --controller)")
+    e.add_argument("--controller", default=None,
+                   help="a controller file written by ambseal (.json/.npz/.mat) to export "
+                        "as C instead of designing one")
+    e.add_argument("--pressure-bar", type=float, default=None,
+                   help="design pressure drop (bar); default [operating] pressure_bar")
+    e.add_argument("--out", default="ambseal-export", help="folder of the controller files")
+    e.add_argument("--c", dest="c_dir", default=None, help="write the C99 module to this folder")
+    e.add_argument("--precision", choices=["double", "float"], default="double",
+                   help="floating-point type of the C module (default double)")
+
     i = sub.add_parser("identify", help="fit model parameters to closed-loop records")
     i.add_argument("rig", help="rig file (TOML)")
     i.add_argument("data", nargs="+", help="record files (.csv with sidecar, or .mat)")
@@ -321,6 +339,28 @@ def _design(args: argparse.Namespace) -> int:
     return 0
 
 
+def _export(args: argparse.Namespace) -> int:
+    from .commands import design_files
+    from .errors import ConfigError
+
+    if (args.method is None) == (args.controller is None):
+        raise ConfigError("export: give exactly one of --method and --controller")
+    if args.controller is not None:
+        from .control.codegen import write_c
+        from .control.export import load_controller
+
+        ctrl = load_controller(args.controller)
+        files = write_c(ctrl, args.c_dir or Path(args.out) / "c",
+                        f"ambseal_{Path(args.controller).stem}", precision=args.precision)
+        print(json.dumps({"files": [str(f) for f in files]}))
+        return 0
+    print(json.dumps(design_files(args.rig, args.method, args.out,
+                                  pressure_bar=args.pressure_bar,
+                                  c_dir=args.c_dir or Path(args.out) / "c",
+                                  precision=args.precision)))
+    return 0
+
+
 def _identify(args: argparse.Namespace) -> int:
     from .commands import identify_files
 
@@ -441,7 +481,7 @@ def main(argv: list[str] | None = None) -> int:
     from .rotordynamics import HANDLERS
 
     handler = {"acquire": _acquire, "identify": _identify, "design": _design,
-               "track": _track, "run": _run, "validate": _validate, **HANDLERS}[args.command]
+               "track": _track, "export": _export, "run": _run, "validate": _validate, **HANDLERS}[args.command]
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("default")
         try:

@@ -17,32 +17,100 @@ from .errors import ConfigError
 from .files import writable_folder, write_json, write_text
 
 __all__ = ["design_files", "identify_files", "export_design", "show_defaults",
-           "validate_summary", "track_files"]
+           "validate_summary", "track_files", "digital_for", "choice_margins",
+           "frozen_discrete", "judged_margins"]
 
 
 def _finite(x: float) -> float | None:
     return float(x) if math.isfinite(x) else None
 
 
-def export_design(method: str, controller, summary_dict: dict, out: Path, fs_hz: float,
-                  speeds_hz=()) -> list[Path]:
-    """Write a designed controller and its design summary (``design_<method>.json``).
+def digital_for(cfg, method: str, controller, result, points, cache: dict | None = None
+                ) -> object:
+    """The digital controller of a design, its discretisation chosen on the full-order
+    plants at the judged conditions (:mod:`ambseal.control.digital`): a
+    :class:`~ambseal.control.digital.DigitalController`, or for a scheduled controller a
+    :class:`~ambseal.control.scheduled_digital.ScheduledDigital` whose interpolation is
+    also checked at speeds between table entries. ``cache`` (a dict kept by the caller)
+    shares the sampled plants between the controllers of one rig."""
+    import numpy as np
 
-    A fixed controller as ``controller_<method>.json/.npz/.mat`` (continuous, Tustin and
-    ZOH at ``fs_hz``); a scheduled one as its frozen controllers at ``speeds_hz``
-    (``controller_<method>_<f>Hz.npz``), the table a real-time target interpolates.
-    """
-    from .control.controller import ScheduledController, frozen
+    from .control.controller import ScheduledController
+    from .control.digital import check_rate, design_rise, digital_controller, sampled_plants
+    from .model.rig import build_plant
+
+    fs, delay = cfg.controller.sample_rate_hz, cfg.controller.delay_samples
+    conds = _conditions(cfg, points)
+
+    def plant(p_bar, rpm):
+        pl = build_plant(cfg, pressure_bar=p_bar, speed_rpm=rpm)
+        G = pl.select_inputs([pl.input_names[j] for j in pl.current_inputs()])
+        return tuple(np.asarray(X, float) for X in (G.A, G.B, G.C, G.D))
+
+    if not isinstance(controller, ScheduledController):
+        rise = (lambda Kr: design_rise(result, Kr)) if method in ("hinf", "mu") else None
+        check_rate(controller, fs, delay, removable=rise is not None)  # before the plants
+        cache = {} if cache is None else cache
+        if "plants" not in cache:
+            cache["plants"] = sampled_plants([plant(*c) for c in conds], fs)
+        return digital_controller(controller, fs, cache["plants"],
+                                  delay_samples=delay, rise=rise)
+    from .control.scheduled_digital import scheduled_digital
+
+    W = np.asarray(controller.K.speeds_rad_s, float)
+    # between table entries at 1/8, 3/8, 5/8, 7/8 of the table: the interpolation judged
+    mids = [(W[j] + W[j + 1]) / 2 for j in (np.arange(1, 8, 2) * (W.size - 1)) // 8]
+    speeds = [2 * math.pi * c[1] / 60.0 for c in conds] + mids
+    plants = [(w, plant(cfg.operating.pressure_bar, 60.0 * w / (2 * math.pi)))
+              for w in speeds]
+    return scheduled_digital(controller, W, fs, plants, delay_samples=delay,
+                             name=f"K_{method}")
+
+
+def _conditions(cfg, points) -> list[tuple[float, float]]:
+    """(pressure bar, speed rpm) of the judged points, the nominal one first."""
+    nominal = (cfg.operating.pressure_bar, cfg.operating.speed_rpm)
+    return sorted({(p.pressure_bar, p.speed_rpm) for p in points}, key=lambda c: c != nominal)
+
+
+def choice_margins(cfg, points, digital) -> list[dict]:
+    """The discrete margins the choice of discretisation judged (:mod:`ambseal.control.
+    digital`): per condition the largest ``|z|`` and the σ̄(S_o) peaks of the chosen
+    method, with the loop's delay, on the sampled full-order plant."""
+    c = next(c for c in digital.candidates if c["method"] == digital.method)
+    if "speeds_hz" in c:  # scheduled: the judged speeds and between table entries
+        speeds = c["speeds_hz"]
+        pressures = [cfg.operating.pressure_bar] * len(speeds)
+    else:
+        pressures, rpms = zip(*_conditions(cfg, points))
+        speeds = [r / 60.0 for r in rpms]
+    return [{"pressure_bar": p, "speed_hz": f, "stable": z < 1, "max_abs_pole_z": z,
+             "sensitivity_peak": sd, "sensitivity_peak_continuous": sc}
+            for p, f, z, sd, sc in zip(pressures, speeds, c["max_abs_z"],
+                                       c["sensitivity_peak"],
+                                       c["sensitivity_peak_continuous"])]
+
+
+def frozen_discrete(digital, speed_rad_s: float):
+    """The discrete controller (delay included) that runs at Ω, for the judgement."""
+    from .control.scheduled_digital import ScheduledDigital
+
+    if isinstance(digital, ScheduledDigital):
+        return digital.statespace_at(speed_rad_s, delayed=True)
+    return digital.statespace(delayed=True)
+
+
+def export_design(method: str, digital, summary_dict: dict, out: Path, judged=None
+                  ) -> list[Path]:
+    """Write a designed controller as it runs (``controller_<method>.json/.npz/.mat``,
+    :func:`ambseal.control.export.export_controller`) with the judged discrete margins,
+    and its design summary with the discretisation (``design_<method>.json``)."""
     from .control.export import export_controller
 
-    if isinstance(controller, ScheduledController):
-        files = [export_controller(frozen(controller, 2 * math.pi * f),
-                                   out / f"controller_{method}_{f:g}Hz.npz", fs_hz=fs_hz)
-                 for f in speeds_hz]
-    else:
-        files = [export_controller(controller, out / f"controller_{method}{ext}", fs_hz=fs_hz)
-                 for ext in (".json", ".npz", ".mat")]
-    files.append(write_json(out / f"design_{method}.json", summary_dict))
+    files = [export_controller(digital, out / f"controller_{method}{ext}", judged)
+             for ext in (".json", ".npz", ".mat")]
+    files.append(write_json(out / f"design_{method}.json",
+                            {**summary_dict, "discretisation": digital.to_dict()}))
     return files
 
 
@@ -55,40 +123,62 @@ def show_defaults(rig: str | Path, overrides=()) -> str:
     return f"# {cfg.rotor.name}: resolved design specification\n" + design_spec(cfg).to_toml()
 
 
+def judged_margins(cases: list[dict], method: str) -> list[dict]:
+    """The discrete blocks of one controller's cases, with their conditions."""
+    return [{"pressure_bar": c["pressure_bar"], "speed_hz": c["speed_hz"], **c["discrete"]}
+            for c in cases if c["controller"] == method and "discrete" in c]
+
+
 def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
                  pressure_bar: float | None = None, overrides=(),
-                 allow_unstable: bool = False) -> dict:
+                 allow_unstable: bool = False, c_dir: str | Path | None = None,
+                 precision: str = "double") -> dict:
     """``ambseal design``: design one controller and write it with its summary.
 
-    Files: ``controller_<method>.json``, ``.npz`` and ``.mat`` (continuous, Tustin and ZOH
-    at ``[controller] sample_rate_hz``, with the channel names) and ``design_<method>.json``
-    (summary, weights, D–K history). ``lpv`` (a rig with ``[operating] speed_range_hz``):
-    the frozen controllers on the design grid, ``controller_lpv_<f>Hz.npz``.
+    Files: ``controller_<method>.json``, ``.npz`` and ``.mat`` — the discrete controller
+    that runs at ``[controller] sample_rate_hz`` with ``delay_samples`` (discretisation
+    chosen and judged, :mod:`ambseal.control.digital`; for ``lpv`` the scheduled table and
+    its interpolation law), the continuous design, channels with units and the judged
+    discrete margins (:mod:`ambseal.control.export`) — and ``design_<method>.json``
+    (summary, weights, D–K history, discretisation). With ``c_dir`` also the C99 module
+    (:mod:`ambseal.control.codegen`) in ``precision`` ("double" or "float").
 
     Raises
     ------
     ConfigError
-        A bad rig, or ``lpv`` without a speed range.
+        A bad rig, a bad sample rate or delay, or ``lpv`` without a speed range.
+    SynthesisError
+        No discretisation keeps the sampled loop stable (the reason named).
     """
     from .control.recipes import design
 
     cfg = load_rig(rig, overrides)
     out = writable_folder(out_dir)  # before the design, not after it
-    fs = cfg.controller.sample_rate_hz
     if method == "lpv":
         from .control.lpv_design import design_lpv
 
         if cfg.operating.speed_range_hz is None:
             raise ConfigError(f"{rig}: operating.speed_range_hz: an LPV design needs the "
                               "speed range it is scheduled over, e.g. [20.0, 300.0]")
-        lpv = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz)
-        files = export_design("lpv", lpv, lpv.to_dict(), out, fs,
-                              [float(f) for f in lpv.speeds_hz])
-        return {**lpv.to_dict(), "files": [str(f) for f in files]}
-    res = design(cfg, method, pressure_bar=pressure_bar, allow_unstable=allow_unstable,
-                 progress=lambda line: print(f"ambseal: {line}", file=sys.stderr))
-    files = export_design(res.method, res.K, res.to_dict(), out, fs)
-    return {**res.summary(), "files": [str(f) for f in files]}
+        res = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz)
+        K, summary = res, res.to_dict()
+    else:
+        res = design(cfg, method, pressure_bar=pressure_bar, allow_unstable=allow_unstable,
+                     progress=lambda line: print(f"ambseal: {line}", file=sys.stderr))
+        K, summary = res.K, res.to_dict()
+    from .analysis.judge import operating_points
+
+    points = operating_points(cfg)
+    digital = digital_for(cfg, method, K, res, points)
+    judged = choice_margins(cfg, points, digital)
+    files = export_design(method, digital, summary, out, judged)
+    if c_dir is not None:
+        from .control.codegen import write_c
+
+        files += write_c(digital, c_dir, f"ambseal_{method}", precision=precision)
+    short = res.summary() if hasattr(res, "summary") else summary
+    return {**short, "discretisation": digital.to_dict(),
+            "files": [str(f) for f in files]}
 
 
 def _record_hash(meas) -> str:

@@ -44,7 +44,10 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
 ``[controller.pid]``
     ``kp`` (A/m), ``ti`` (s), ``td`` (s), ``eps`` (-): thesis P5 Eq. 6, per actuator axis.
 ``[controller]``
-    ``sample_rate_hz``: the rate of the digital controller (default 10 kHz).
+    ``sample_rate_hz``: the rate of the digital controller (default 10 kHz);
+    ``delay_samples``: the computation delay of the target in whole samples (default 1: the
+    output computed from the sample at k is applied at k + 1), used by the
+    discrete judgement and the export (:mod:`ambseal.control.digital`).
 ``[operating]``
     ``speed_rpm``, ``pressure_bar`` (the nominal pressure drop across the seals),
     ``speed_range_hz`` (optional ``[low, high]``: the operating speed range, e.g. for a
@@ -291,6 +294,7 @@ class Controllers(_Strict):
     pid: Pid | None = None
     # plausible digital AMB controllers: 100 Hz to 1 MHz
     sample_rate_hz: float = Field(default=10000.0, ge=100.0, le=1e6)
+    delay_samples: int = Field(default=1, ge=0)
 
 
 class Operating(_Strict):

@@ -86,16 +86,16 @@ def _controllers(cfg: RigConfig, spec, say, allow_unstable: bool = False) -> lis
     return [pid, robust("hinf"), robust("mu")]
 
 
-def _identification(cfg: RigConfig, truth, out: Path, say) -> tuple[dict, list, list]:
+def _identification(cfg: RigConfig, truth, out: Path, say, controller
+                    ) -> tuple[dict, list, list]:
     """The thesis's identification procedure on the virtual facility, its files, the FRF
-    checks of the identified model, and its figures and report section."""
+    checks of the identified model, and its figures and report section. ``controller`` is
+    the exported, judged discrete reference PID (the facility runs exactly that object)."""
     from .config import dump_rig
-    from .control.pid import reference_controller
     from .identify.checks import frf_checks, truth_errors
     from .identify.procedure import thesis_procedure
     from .report.run_report import identification_report
 
-    controller = reference_controller(cfg)
     res = thesis_procedure(cfg, truth, controller, progress=say)
     write_json(out / "identification.json", res.to_dict())
     write_text(out / "identified_rig.toml",
@@ -162,7 +162,8 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                                  speed_scheduled, unstable_open_loop_poles)
     from .analysis.sweep import run_cases
     from .control.specs import design_spec
-    from .commands import export_design
+    from .commands import digital_for, export_design, frozen_discrete, judged_margins
+    from .control.codegen import write_c
     from .control.controller import frozen
     from .model.rig import build_plant
     from .report.progress import StageProgress
@@ -199,19 +200,27 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         stages.begin("design")
         designs = _controllers(cfg, spec, lambda msg, steps=0: stages.step(msg, steps),
                                allow_unstable)
+        summaries, digitals, cache = {}, {}, {}
         for d in designs:
-            export_design(d.method, d.controller, d.result.to_dict(), out / "controllers",
-                          cfg.controller.sample_rate_hz, [p.speed_rpm / 60.0 for p in points])
+            digitals[d.method] = digital_for(cfg, d.method, d.controller, d.result, points,
+                                             cache)
         stages.begin("judge")
-        jobs = [{"name": d.method, "point": p,
-                 "controller": frozen(d.controller, 2 * math.pi * p.speed_rpm / 60.0)}
-                for d in designs for p in points]
+        jobs = [{"name": d.method, "point": p, "controller": frozen(d.controller, w),
+                 "discrete": frozen_discrete(digitals[d.method], w)}
+                for d in designs for p in points
+                for w in (2 * math.pi * p.speed_rpm / 60.0,)]
         judged = run_cases(judge_case, jobs, shared={"cfg": cfg, "settings": settings},
                            workers=1, raise_errors=True,
                            on_done=lambda i, r: stages.step(f"{jobs[i]['name']} at "
                                                             f"{jobs[i]['point'].label}"))
         cases = [case for case, _ in judged]
         curves = [(j["name"], j["point"], case, c) for j, (case, c) in zip(jobs, judged)]
+        for d in designs:
+            digital = digitals[d.method]
+            export_design(d.method, digital, d.result.to_dict(), out / "controllers",
+                          judged_margins(cases, d.method))
+            write_c(digital, out / "controllers", f"ambseal_{d.method}")
+            summaries[d.method] = {**d.summary, "discretisation": digital.to_dict()}
         metrics = {
             "rig": str(rig_path),
             "rig_name": cfg.rotor.name,
@@ -220,14 +229,17 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
             "unbalance": {"grade_mm_s": settings.unbalance_grade_mm_s,
                           "range_hz": list(settings.unbalance_range_hz)},
             "design_spec": spec.to_dict(),
-            "controllers": {d.method: d.summary for d in designs},
+            "controllers": summaries,
             "cases": cases,
         }
         figs, sections = [], []
         if truth_cfg is not None:
+            if "pid" not in digitals:
+                raise ConfigError("controller.pid: the virtual facility runs the reference "
+                                  "PID ([controller.pid]) during identification")
             stages.begin("identification")
-            metrics["identification"], figs, sections = _identification(cfg, truth_cfg, out,
-                                                                        stages.step)
+            metrics["identification"], figs, sections = _identification(
+                cfg, truth_cfg, out, stages.step, digitals["pid"].discrete)
         if speed_scheduled(cfg):
             stages.begin("spin-up", "spin-up and frozen sensitivities")
             metrics["spinup"], sims, sens = judge_spinup(

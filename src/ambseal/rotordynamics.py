@@ -35,9 +35,11 @@ def controller_for(cfg, spec: str | None, pressure_bar: float | None = None):
     if Path(spec).suffix.lower() not in (".json", ".npz", ".mat"):
         raise ConfigError(f"--controller: expected pid, hinf, mu, none or a controller file "
                           f"(.json, .npz, .mat), got {spec!r}")
+    from .control.digital import DigitalController
     from .control.export import load_controller
 
-    return load_controller(spec)
+    K = load_controller(spec)  # a judged digital controller: its continuous design
+    return K.continuous if isinstance(K, DigitalController) else K
 
 
 def write_table(path: Path, rows: list[dict]) -> list[Path]:

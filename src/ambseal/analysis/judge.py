@@ -7,6 +7,14 @@ Every number is taken on the full-order plant (flexible modes included), whateve
 the controller was designed on; peaks on frequency grids refined around the lightly damped
 closed-loop poles (:func:`ambseal.analysis.loops.resolved_grid`).
 
+**What runs is judged too**: given the discrete controller of the target (with its
+computation delay, :class:`ambseal.control.digital.DigitalController`), the same numbers are
+taken on the loop of that controller with the full-order plant sampled exactly (zero-order
+hold, the DAC) at its sample time — stability by ``|z| < 1``, σ̄(S_o) on a grid up to
+Nyquist, compliance and unbalance for a force held over each sample, the impulse response
+stepped at the sample time — and reported as the case's ``discrete`` block, with the same
+keys plus ``max_abs_pole_z`` and ``sample_rate_hz``.
+
 The operating points (:func:`operating_points`) and the grids and disturbances
 (:func:`judge_settings`) are those of the rig's design specification
 (:func:`ambseal.control.specs.design_spec`): by default 0, nominal and 2× nominal pressure
@@ -23,7 +31,8 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["JudgeSettings", "OperatingPoint", "judge", "judge_case", "judge_spinup",
-           "operating_points", "speed_scheduled", "judge_settings", "unstable_open_loop_poles"]
+           "sampled_plant", "operating_points", "speed_scheduled", "judge_settings",
+           "unstable_open_loop_poles"]
 
 
 @dataclass(frozen=True)
@@ -148,8 +157,8 @@ def _finite(x: float) -> float | None:
 
 
 def judge(cfg, controller, name: str, point: OperatingPoint,
-          settings: JudgeSettings | None = None, *, impulse: bool = True
-          ) -> tuple[dict, dict]:
+          settings: JudgeSettings | None = None, *, impulse: bool = True,
+          discrete=None) -> tuple[dict, dict]:
     """Judge one physical controller on the full-order plant at one operating point.
 
     Parameters
@@ -165,41 +174,90 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
     impulse : bool
         Set False to leave out the impulse response (the sweeps of
         :mod:`ambseal.analysis.sweep`); ``impulse_*`` are then ``None``.
+    discrete : control.StateSpace, optional
+        The controller that runs on the target, discrete (``dt`` its sample time) with its
+        computation delay included
+        (:meth:`ambseal.control.digital.DigitalController.statespace` ``(delayed=True)``):
+        judged the same way on the plant sampled at ``dt`` (module docstring).
 
     Returns
     -------
     case : dict
-        The ``metrics.json`` case (values an unstable loop does not have are ``None``).
+        The ``metrics.json`` case (values an unstable loop does not have are ``None``);
+        with ``discrete``, its numbers under ``case["discrete"]`` (same keys, plus
+        ``max_abs_pole_z`` and ``sample_rate_hz``).
     curves : dict
         ``So``, ``compliance``, ``unbalance`` (frequency Hz, values) and ``impulse``
         (:class:`~ambseal.analysis.response.ImpulseResponse`) for the figures, and
-        ``poles`` (the closed-loop poles, rad/s).
+        ``poles`` (the closed-loop poles, rad/s); the discrete loop's under
+        ``curves["discrete"]`` (its ``poles`` are z).
     """
     from ..model.rig import build_plant
-    from .iso import iso_assessment
-    from ..lti.freqresp import freqresp
-    from .loops import (closed_loop, compliance_from, loop_responses_from, resolved_grid,
-                        sigma_max)
-    from .response import impulse_response_of
-    from .unbalance import unbalance_from_compliance
 
     s = settings or judge_settings(cfg)
     plant = build_plant(cfg, pressure_bar=point.pressure_bar, speed_rpm=point.speed_rpm,
                         force_positions=(s.force_position_m,))
     cur = plant.current_inputs()
     force = [j for j in range(len(plant.input_names)) if j not in cur]
-    G = plant.select_inputs([plant.input_names[j] for j in cur]).to_statespace()
-    Gf = plant.select_inputs([plant.input_names[j] for j in force]).to_statespace()
-    loop = closed_loop(G, controller, Gf)
+    P = plant.to_statespace()
     case = {"controller": name, "pressure_bar": point.pressure_bar,
-            "speed_hz": point.speed_rpm / 60.0, "stable": loop.stable,
-            "max_real_pole": loop.max_real_pole}
-    w = 2 * np.pi * np.logspace(math.log10(s.freq_hz[0]), math.log10(s.freq_hz[1]), s.freq_hz[2])
-    w = resolved_grid(w, loop.poles)  # a 0.5 %-damped bending mode must not slip through
-    wu = resolved_grid(2 * np.pi * np.linspace(*s.unbalance_range_hz, 400), loop.poles)
+            "speed_hz": point.speed_rpm / 60.0}
+    body, curves = _judge_loop(cfg, P, cur, force, controller, s, impulse)
+    case.update(body)
+    if discrete is not None:
+        Pd = sampled_plant(P, float(discrete.dt))
+        case["discrete"], curves["discrete"] = _judge_loop(cfg, Pd, cur, force, discrete,
+                                                           s, impulse)
+    return case, curves
+
+
+def sampled_plant(P, dt: float):
+    """The plant ``P`` sampled exactly with a zero-order hold at ``dt`` (s): inputs held
+    over each sample, outputs read at the samples (:func:`ambseal.lti.discrete.zoh`;
+    Franklin, Powell & Workman §6.3), signal names kept."""
+    import control
+
+    from ..lti.discrete import zoh
+
+    Ad, Bd = zoh(np.asarray(P.A, float), np.asarray(P.B, float), dt)
+    return control.ss(Ad, Bd, np.asarray(P.C, float), np.asarray(P.D, float), dt,
+                      inputs=list(P.input_labels), outputs=list(P.output_labels))
+
+
+def _inputs(P, idx):
+    """The state space ``P`` with only the inputs ``idx`` (names kept, same time base)."""
+    import control
+
+    names = [P.input_labels[j] for j in idx]
+    return control.ss(P.A, np.asarray(P.B)[:, idx], P.C, np.asarray(P.D)[:, idx], P.dt,
+                      inputs=names, outputs=list(P.output_labels))
+
+
+def _judge_loop(cfg, P, cur, force, controller, s: JudgeSettings, impulse: bool
+                ) -> tuple[dict, dict]:
+    """The case's numbers for one loop, continuous or discrete (``P.dt``): the plant ``P``
+    with current inputs ``cur`` and force inputs ``force``."""
+    from ..lti.freqresp import freqresp_at
+    from .iso import iso_assessment
+    from .loops import (closed_loop, compliance_from, loop_responses_from, resolved_grid,
+                        response_points, sigma_max)
+    from .response import impulse_response_of
+    from .unbalance import unbalance_from_compliance
+
+    G, Gf = _inputs(P, cur), _inputs(P, force)
+    loop = closed_loop(G, controller, Gf)
+    dt = loop.dt
+    case = {"stable": loop.stable, "max_real_pole": loop.max_real_pole}
+    if dt:
+        case.update(max_abs_pole_z=loop.max_abs_pole, sample_rate_hz=1.0 / dt)
+    f_hi = 0.999 * 0.5 / dt if dt else s.freq_hz[1]  # discrete: up to Nyquist
+    w = 2 * np.pi * np.logspace(math.log10(s.freq_hz[0]), math.log10(f_hi), s.freq_hz[2])
+    w = resolved_grid(w, loop.s_poles)  # a 0.5 %-damped bending mode must not slip through
+    wu = resolved_grid(2 * np.pi * np.linspace(*s.unbalance_range_hz, 400), loop.s_poles)
     # the plant (currents and force share its A) and the controller evaluated once, on both
     # grids: one eigendecomposition each instead of one per loop function
-    Pw, Kw = (freqresp(X, np.concatenate([w, wu])) for X in (plant.to_statespace(), controller))
+    pts, kw = response_points(np.concatenate([w, wu]), dt)
+    Pw, Kw = freqresp_at(P, pts, **kw), freqresp_at(controller, pts)
     Gw, Gfw = Pw[:, :, cur], Pw[:, :, force]
     ny_names, nu_names, f_names = G.output_labels, G.input_labels, Gf.input_labels
     resp = loop_responses_from(Gw[:w.size], Kw[:w.size], w, ny_names, nu_names)
@@ -228,9 +286,11 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
         return case, curves
     # the thesis's impulse axes A_ζ and B_η (P5 §5.1): first AMB's ζ, last AMB's η
     channels = (G.input_labels[0], G.input_labels[-1])
+    step = dt or s.impulse_dt_s  # a discrete loop steps at its sample time
+    on_grid = [round(t / step) * step for t in (s.impulse_s, s.impulse_start_s, s.impulse_end_s)]
     imp = impulse_response_of(loop, channels=channels, amplitude_a=s.impulse_a,
-                              duration_s=s.impulse_s, t_impulse_s=s.impulse_start_s,
-                              t_end_s=s.impulse_end_s, dt_s=s.impulse_dt_s)
+                              duration_s=on_grid[0], t_impulse_s=on_grid[1],
+                              t_end_s=on_grid[2], dt_s=step)
     curves["impulse"] = imp
     case.update(
         impulse_peak_um=imp.peak_displacement_um,
@@ -240,9 +300,11 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
 
 
 def judge_case(case: dict, cfg, settings: JudgeSettings | None = None) -> tuple[dict, dict]:
-    """:func:`judge` of ``case = {"controller", "name", "point"}``: the main job's cases as
-    run by :func:`ambseal.analysis.sweep.run_cases`."""
-    return judge(cfg, case["controller"], case["name"], case["point"], settings)
+    """:func:`judge` of ``case = {"controller", "name", "point"}`` (and ``"discrete"``, the
+    delayed discrete controller that runs): the main job's cases as run by
+    :func:`ambseal.analysis.sweep.run_cases`."""
+    return judge(cfg, case["controller"], case["name"], case["point"], settings,
+                 discrete=case.get("discrete"))
 
 
 def judge_spinup(cfg, controllers: dict) -> tuple[dict, list, list]:

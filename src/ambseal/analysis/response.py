@@ -224,7 +224,9 @@ def impulse_response_of(
     t_end_s : float
         End of the simulated window (s).
     dt_s : float
-        Step of the exact ZOH discretisation (s); 1e-5 resolves modes up to ~10 kHz.
+        Step of the exact ZOH discretisation (s); 1e-5 resolves modes up to ~10 kHz. A
+        discrete loop (``loop.dt > 0``, e.g. the sampled plant with the controller that
+        runs) is stepped at its own sample time, which ``dt_s`` must equal.
     band : float
         Relative settling band (0.02).
 
@@ -240,6 +242,9 @@ def impulse_response_of(
     """
     if not (dt_s > 0 and duration_s > 0 and t_end_s > 0 and t_impulse_s >= 0):
         raise ModelError("impulse_response: dt_s, duration_s, t_end_s must be > 0 and t_impulse_s >= 0")
+    if loop.dt and abs(dt_s - loop.dt) > 1e-12 * loop.dt:
+        raise ModelError(f"impulse_response: dt_s={dt_s!r} s, but the discrete loop runs at "
+                         f"{loop.dt!r} s")
     sys = loop.system
     nu, ny = loop.n_plant_inputs, loop.n_plant_outputs
     u_names = tuple(str(s)[2:] for s in sys.input_labels[:nu])  # strip "d_"
@@ -268,7 +273,7 @@ def impulse_response_of(
     C = np.asarray(sys.C, dtype=float)
     D = np.asarray(sys.D, dtype=float)[:, :nu]
     # exact for the piecewise-constant pulse: the ZOH equivalent of its single input column
-    Ad, bd = zoh(A, b[:, None], dt_s)
+    Ad, bd = (A, b[:, None]) if loop.dt else zoh(A, b[:, None], dt_s)
     t = np.arange(n_end + 1) * dt_s
     pulse = np.zeros((n_end + 1, 1))
     pulse[k0:k1] = 1.0

@@ -7,7 +7,11 @@ Public functions are imported on first use (module-level ``__getattr__``), so
 * :func:`mussv` — ``control/mu.py``
 * :func:`musyn`, :func:`fit_magnitude` — ``control/dk.py``
 * :func:`reduce_controller`, :func:`balred_controller` — ``control/order.py``
-* :func:`export_controller`, :func:`discretize` — ``control/export.py``
+* :func:`digital_controller`, :class:`DigitalController` — ``control/digital.py`` (the
+  controller that runs on the target: fast poles removed, discretisation chosen);
+  :func:`scheduled_digital`, :class:`ScheduledDigital` — ``control/scheduled_digital.py``
+* :func:`export_controller`, :func:`load_controller` — ``control/export.py``;
+  :func:`write_c` — ``control/codegen.py`` (C99 module)
 * :func:`pid_controller` — ``control/pid.py``
 * :class:`Weights`, :func:`default_weights` — ``control/weights.py`` (the one weight class)
 * :func:`generalized_plant`, :func:`physical_controller` — ``control/plant.py``
@@ -26,7 +30,10 @@ _LAZY = {
     "mussv": "mu", "MuResult": "mu",
     "musyn": "dk", "MusynResult": "dk", "fit_magnitude": "dk",
     "reduce_controller": "order", "balred_controller": "order", "ReductionResult": "order",
-    "export_controller": "export", "discretize": "export",
+    "export_controller": "export", "load_controller": "export",
+    "digital_controller": "digital", "DigitalController": "digital",
+    "scheduled_digital": "scheduled_digital", "ScheduledDigital": "scheduled_digital",
+    "write_c": "codegen",
     "pid_controller": "pid", "design": "recipes", "DesignResult": "recipes",
     "lpvsyn": "lpv", "design_lpv": "lpv_design", "design_frozen": "lpv_design",
     "Weights": "weights", "default_weights": "weights",

@@ -176,6 +176,25 @@ def _styles(curves: list) -> tuple[dict, dict]:
     unstable = {f"{m}, {p.label}": styles[f"{m}, {p.label}"] for m, p, case, _ in curves
                 if not case.get("stable")}
     return styles, unstable
+def _discrete_section(metrics: dict) -> list[dict]:
+    """One line per case: the controller as it runs on the target beside the continuous
+    design (the ``discrete`` blocks of ``metrics.json``)."""
+    lines = []
+    for c in metrics["cases"]:
+        d = c.get("discrete")
+        if d is None:
+            continue
+        disc = metrics["controllers"].get(c["controller"], {}).get("discretisation", {})
+        peak = lambda x: "–" if x is None else f"{x:.2f}"  # noqa: E731
+        lines.append(
+            f"{c['controller']} at {c['pressure_bar']:g} bar, {c['speed_hz']:g} Hz: "
+            f"{'stable' if d['stable'] else 'UNSTABLE'} (max |z| {d['max_abs_pole_z']:.5f}), "
+            f"σ̄(S_o) {peak(d['sensitivity_peak'])} against {peak(c['sensitivity_peak'])} "
+            f"continuous, zone {d['iso_zone']}; {disc.get('method', '?')} at "
+            f"{d['sample_rate_hz']:g} Hz, {disc.get('delay_samples', '?')} sample(s) delay")
+    if not lines:
+        return []
+    return [{"title": "On the target (discrete judgement)", "text": "; ".join(lines) + "."}]
 
 
 def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: list,
@@ -199,6 +218,11 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
              figures.sensitivity_figure(out / "sensitivity.png",
                                         [(lb, *c["So"]) for lb, c in drawn if "So" in c], **kw))]
     comp = [(lb, *c["compliance"]) for lb, c in drawn if "compliance" in c]
+    disc = [(lb, *c["discrete"]["So"]) for lb, c in drawn if "discrete" in c]
+    if disc:
+        figs.append(("σ̄(S_o) of the controllers as they run: sampled plant, discrete "
+                     "controller and its computation delay, up to Nyquist",
+                     figures.sensitivity_figure(out / "sensitivity_discrete.png", disc)))
     if comp:
         figs.append(("Compliance σ̄(S_o G_f) at the seal (P5 Fig. 11)",
                      figures.compliance_figure(out / "compliance.png", comp, **kw)))
@@ -225,6 +249,7 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
                           + ", ".join(f"{re:.1f}{im:+.1f}j" for re, im in ol["unstable_poles"])
                           + f"; {ol['n_states_full']} states in full order, "
                           f"{ol['n_states_reduced']} reduced.")}]
+    sections += _discrete_section(metrics)
     return write_report(out / "report.html", title=title, metrics=metrics["cases"],
                         figures=figs + list(extra_figures),
                         sections=sections + list(extra_sections), meta=meta,

@@ -1,0 +1,198 @@
+"""The scheduled (LPV) controller as it runs on the target: a table interpolated on speed.
+
+The LPV controller of :func:`ambseal.control.lpv_design.design_lpv` is a table of state-space
+matrices in one state basis at the speeds of its check grid, linearly interpolated in the
+rotor speed Ω between entries and held at the ends (:class:`~ambseal.control.lpv.LpvController`).
+The target runs the same law on discrete matrices: every entry is discretised by one method
+(:mod:`ambseal.control.digital`, chosen on the frozen loops), after the fast poles are
+removed in one basis common to all entries (the slow/fast split of the middle entry, so
+that interpolating the reduced entries still makes sense), and the discrete matrices are
+interpolated on the measured speed.
+
+The interpolation is judged between the grid points: the caller passes plants at speeds
+between table entries, and the chosen method keeps every one of those sampled loops
+stable (``candidates``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Sequence
+
+import numpy as np
+
+from ..errors import SynthesisError
+from ..identify.loop import DiscreteController
+from .controller import ScheduledController
+from .digital import (FAST_FRACTION, METHODS, _json_safe, check_rate, choose_method, discretize_as,
+                      prewarp_frequency_hz, residualize, sampled_plants, split_fast,
+                      with_delay)
+
+__all__ = ["ScheduledDigital", "scheduled_digital", "INTERPOLATION"]
+
+#: The interpolation law, as written into every export.
+INTERPOLATION = ("linear in the rotor speed (rad/s) between table entries, held constant "
+                 "outside the table: M(W) = (1 - t) M[j] + t M[j+1], "
+                 "t = (W - W[j]) / (W[j+1] - W[j])")
+
+
+def _interp(x: float, grid: np.ndarray, stack: np.ndarray) -> np.ndarray:
+    from ..model.seal import interp_table
+
+    return interp_table(float(x), grid, stack)
+
+
+@dataclass(frozen=True, eq=False)
+class ScheduledDigital(ScheduledController):
+    """A speed-scheduled controller and its discrete table, ``i = −K(Ω) y``.
+
+    Attributes
+    ----------
+    speeds_rad_s : ndarray, shape (n_t,)
+        Table speeds Ω (rad/s), increasing.
+    continuous, reduced, discrete : tuple of 4 ndarray
+        ``(A, B, C, D)`` stacks of shapes (n_t, n, n), (n_t, n, ny), (n_t, nu, n),
+        (n_t, nu, ny): the designed physical controller (m → A), the same with the fast
+        poles removed, and its discrete equivalent at ``sample_rate_hz``.
+    inputs, outputs : tuple of str
+    method, prewarp_hz, sample_rate_hz, delay_samples, removed_poles_hz, candidates
+        As :class:`~ambseal.control.digital.DigitalController`.
+    name : str
+    """
+
+    speeds_rad_s: np.ndarray
+    continuous: tuple = field(repr=False)
+    reduced: tuple = field(repr=False)
+    discrete: tuple = field(repr=False)
+    inputs: tuple = ()
+    outputs: tuple = ()
+    method: str = "zoh"
+    prewarp_hz: float | None = None
+    sample_rate_hz: float = 1.0
+    delay_samples: int = 0
+    removed_poles_hz: tuple = ()
+    candidates: tuple = ()
+    name: str = "K"
+
+    @property
+    def schedule_rad_s(self) -> tuple[float, float]:
+        return (float(self.speeds_rad_s[0]), float(self.speeds_rad_s[-1]))
+
+    @property
+    def Ts(self) -> float:
+        """Sample time (s)."""
+        return 1.0 / self.sample_rate_hz
+
+    def matrices_at(self, speed_rad_s: float) -> tuple[np.ndarray, ...]:
+        """The designed physical ``(A_K, B_K, C_K, D_K)`` at Ω (rad/s), interpolated."""
+        return tuple(_interp(speed_rad_s, self.speeds_rad_s, X) for X in self.continuous)
+
+    def at(self, speed_rad_s: float, name: str | None = None):
+        """The frozen designed controller at Ω (rad/s), continuous ``control.StateSpace``."""
+        import control
+
+        return control.ss(*self.matrices_at(speed_rad_s), inputs=list(self.inputs),
+                          outputs=list(self.outputs), name=name or self.name)
+
+    def discrete_at(self, speed_rad_s: float) -> DiscreteController:
+        """The discrete controller the target runs at Ω (rad/s): the interpolated table."""
+        mats = [_interp(speed_rad_s, self.speeds_rad_s, X) for X in self.discrete]
+        return DiscreteController(*mats, self.Ts, description={
+            "type": "state_space", "name": self.name, "discretisation": self.method,
+            "speed_rad_s": float(speed_rad_s)})
+
+    def statespace_at(self, speed_rad_s: float, delayed: bool = False):
+        """:meth:`discrete_at` as a named discrete ``control.StateSpace`` (with the
+        computation delay when ``delayed``)."""
+        import control
+
+        d = self.discrete_at(speed_rad_s)
+        mats = (d.A, d.B, d.C, d.D)
+        if delayed:
+            mats = with_delay(mats, self.delay_samples)
+        return control.ss(*mats, self.Ts, inputs=list(self.inputs),
+                          outputs=list(self.outputs), name=f"{self.name}_{self.method}")
+
+    def to_dict(self) -> dict:
+        """JSON-ready description (no matrices)."""
+        return _json_safe({
+                "method": self.method, "prewarp_hz": self.prewarp_hz,
+                "sample_rate_hz": self.sample_rate_hz, "Ts": self.Ts,
+                "delay_samples": self.delay_samples, "interpolation": INTERPOLATION,
+                "table_speeds_hz": (self.speeds_rad_s / (2 * np.pi)).tolist(),
+                "fast_fraction_of_nyquist": FAST_FRACTION,
+                "removed_poles_hz": [float(f) for f in self.removed_poles_hz],
+                "order": int(self.discrete[0].shape[1]),
+                "candidates": [dict(c) for c in self.candidates]})
+
+
+def scheduled_digital(K: ScheduledController, speeds_rad_s, sample_rate_hz: float,
+                      plants: Sequence[tuple[float, tuple]], *, delay_samples: int = 1,
+                      methods: Sequence[str] = METHODS, name: str = "K_lpv"
+                      ) -> ScheduledDigital:
+    """Tabulate, reduce and discretise a scheduled controller for the target.
+
+    Parameters
+    ----------
+    K : ScheduledController
+        Physical scheduled controller (``matrices_at(Ω)``, m → A, ``i = −K y``).
+    speeds_rad_s : array_like, shape (n_t,)
+        Table speeds (rad/s): those where ``K`` is exact (the LPV check grid), increasing.
+    sample_rate_hz : float
+    plants : sequence of (speed_rad_s, (A, B, C, D))
+        Full-order continuous plants at the judged speeds (nominal first) and between
+        table entries.
+    delay_samples, methods
+        As :func:`ambseal.control.digital.digital_controller`.
+    name : str
+
+    Returns
+    -------
+    ScheduledDigital
+
+    Raises
+    ------
+    ConfigError
+        A bad sample rate or delay.
+    SynthesisError
+        A fast pole that is unstable at some entry, or no method keeps every sampled loop
+        stable.
+    """
+    check_rate(K, sample_rate_hz, delay_samples)
+    fs, T = float(sample_rate_hz), 1.0 / float(sample_rate_hz)
+    W = np.asarray(speeds_rad_s, float)
+    table = [tuple(np.asarray(X, float) for X in K.matrices_at(w)) for w in W]
+    V, k, fast = split_fast(table[len(W) // 2][0], FAST_FRACTION * fs / 2)
+    for w, mats in zip(W, table):
+        A22 = np.linalg.solve(V, mats[0] @ V)[k:, k:]
+        if A22.size and np.max(np.linalg.eigvals(A22).real) >= 0:
+            raise SynthesisError(
+                f"controller.sample_rate_hz = {fs:g} Hz: the fast part of {name} at "
+                f"{w / (2 * np.pi):.4g} Hz is not stable and cannot be removed; raise the "
+                "sample rate")
+    reduced = [residualize(m, V, k) for m in table]
+    stacks = [tuple(np.stack([m[i] for m in seq]) for i in range(4))
+              for seq in (table, reduced)]
+    sp = [p[0] for p in plants]
+    G = [p[1] for p in plants]
+    cont = [tuple(_interp(s, W, X) for X in stacks[0]) for s in sp]
+    f_pw = prewarp_frequency_hz(G[:1], cont[0], fs)
+
+    def discrete(m):
+        tab = [discretize_as(r, T, m, f_pw) for r in reduced]
+        st = tuple(np.stack([t[i] for t in tab]) for i in range(4))
+        discrete.tables[m] = st
+        return [tuple(_interp(s, W, X) for X in st) for s in sp]
+
+    discrete.tables = {}
+    m, _, cands = choose_method(sampled_plants(G, fs), cont, discrete, int(delay_samples),
+                                methods, f_pw, name)
+    cands = tuple({**c, "speeds_hz": [s / (2 * np.pi) for s in sp]} for c in cands)
+    chans = K.at(float(W[0]))
+    return ScheduledDigital(
+        speeds_rad_s=W, continuous=stacks[0], reduced=stacks[1], discrete=discrete.tables[m],
+        inputs=tuple(chans.input_labels), outputs=tuple(chans.output_labels), method=m,
+        prewarp_hz=f_pw if m == "tustin_prewarp" else None, sample_rate_hz=fs,
+        delay_samples=int(delay_samples),
+        removed_poles_hz=tuple(sorted(float(abs(p)) / (2 * np.pi) for p in fast)),
+        candidates=cands, name=name)

@@ -76,11 +76,13 @@ def controller_document(ctrl, judged=None) -> dict:
 
     Parameters
     ----------
-    ctrl : DigitalController or ScheduledDigital
+    ctrl : DigitalController, ScheduledDigital or a continuous control.StateSpace
     judged : list of dict, optional
         The judged discrete margins (``metrics.json`` cases' ``discrete`` blocks with the
         condition), stored as ``judged_json``.
     """
+    if not isinstance(ctrl, (DigitalController, ScheduledDigital)):
+        return _continuous_document(ctrl)
     doc: dict = {"convention": CONVENTION, "input_unit": "m", "output_unit": "A",
                  "Ts": ctrl.Ts, "sample_rate_hz": ctrl.sample_rate_hz,
                  "delay_samples": int(ctrl.delay_samples), "method": ctrl.method,
@@ -95,8 +97,6 @@ def controller_document(ctrl, judged=None) -> dict:
         for suf, mats in (("", ctrl.discrete), ("_c", ctrl.continuous), ("_r", ctrl.reduced)):
             doc.update({f"{k}{suf}": np.asarray(X, float) for k, X in zip("ABCD", mats)})
         return doc
-    if not isinstance(ctrl, DigitalController):
-        return _continuous_document(ctrl)
     d = ctrl.discrete
     doc.update(kind="fixed", name=str(ctrl.continuous.name), inputs=ctrl.inputs,
                outputs=ctrl.outputs)

@@ -4,8 +4,6 @@ import json
 import re
 from pathlib import Path
 
-import pytest
-
 from ambseal.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -48,7 +48,12 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
         return tuple(np.asarray(X, float) for X in (G.A, G.B, G.C, G.D))
 
     if not isinstance(controller, ScheduledController):
-        rise = (lambda Kr: design_rise(result, Kr)) if method in ("hinf", "mu") else None
+        from .control.dk import design_omega
+        from .control.specs import design_spec
+
+        om = design_omega(*design_spec(cfg).synthesis_band_hz)  # the μ design's grid
+        rise = ((lambda Kr: design_rise(result, Kr, om)) if method in ("hinf", "mu")
+                else None)
         check_rate(controller, fs, delay, removable=rise is not None)  # before the plants
         cache = {} if cache is None else cache
         if "plants" not in cache:

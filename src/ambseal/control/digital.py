@@ -261,13 +261,15 @@ def with_delay(mats: Matrices, n: int) -> Matrices:
     return A, B, C, D
 
 
-def design_rise(result, K_reduced) -> dict | None:
-    """γ (H∞) or peak μ (μ design) of the design loop with the controller before and
-    after the removal of fast poles, from a :class:`~ambseal.control.recipes.DesignResult`
-    with its generalised plant; ``None`` for a design without one (PID, LPV)."""
+def design_rise(result, K_reduced, omega=None) -> dict | None:
+    """γ (H∞) or peak μ (μ design, on the design's frequency grid ``omega``, rad/s) of the
+    design loop with the controller before and after the removal of fast poles, from a
+    :class:`~ambseal.control.recipes.DesignResult` with its generalised plant; ``None`` for
+    a design without one (PID, LPV) or a μ design without ``omega``."""
     gp = getattr(result, "plant", None)
     method = getattr(result, "method", None)
-    if gp is None or method not in ("hinf", "mu") or not hasattr(gp, "closed_loop"):
+    if (gp is None or method not in ("hinf", "mu") or not hasattr(gp, "closed_loop")
+            or (method == "mu" and omega is None)):
         return None
     out = {"order_full": int(result.K.nstates), "order": int(K_reduced.nstates)}
     # the design's own verified γ / μ peak (same loop, same grid) is the "before"
@@ -278,10 +280,8 @@ def design_rise(result, K_reduced) -> dict | None:
         out["gamma"] = float(hinfnorm(gp.closed_loop(K_reduced, nominal=True))[0])
         out["rise"] = out["gamma"] / out["gamma_full"] - 1.0
     else:
-        from .dk import design_omega
-
         out["mu_full"] = float(result.mu)
-        out["mu"] = float(np.max(gp.mu(K_reduced, design_omega()).upper))
+        out["mu"] = float(np.max(gp.mu(K_reduced, omega).upper))
         out["rise"] = out["mu"] / out["mu_full"] - 1.0
     return out
 

@@ -45,9 +45,8 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     ``kp`` (A/m), ``ti`` (s), ``td`` (s), ``eps`` (-): thesis P5 Eq. 6, per actuator axis.
 ``[controller]``
     ``sample_rate_hz``: the rate of the digital controller (default 10 kHz);
-    ``delay_samples``: the computation delay of the target in whole samples (default 1: the
-    output computed from the sample at k is applied at k + 1), used by the
-    discrete judgement and the export (:mod:`ambseal.control.digital`).
+    ``delay_samples``: the target's computation delay in whole samples (default 1: output
+    from sample k applied at k + 1; :mod:`ambseal.control.digital`).
 ``[operating]``
     ``speed_rpm``, ``pressure_bar`` (the nominal pressure drop across the seals),
     ``speed_range_hz`` (optional ``[low, high]``: the operating speed range, e.g. for a

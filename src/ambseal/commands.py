@@ -17,7 +17,7 @@ from .errors import ConfigError
 from .files import writable_folder, write_json, write_text
 
 __all__ = ["design_files", "identify_files", "export_design", "show_defaults",
-           "validate_summary", "track_files", "digital_for", "choice_margins",
+           "validate_summary", "track_files", "export_all", "digital_for", "choice_margins",
            "frozen_discrete", "judged_margins"]
 
 
@@ -126,6 +126,22 @@ def show_defaults(rig: str | Path, overrides=()) -> str:
 
     cfg = load_rig(rig, overrides)
     return f"# {cfg.rotor.name}: resolved design specification\n" + design_spec(cfg).to_toml()
+
+
+def export_all(designs, digitals: dict, cases: list[dict], out: Path) -> dict:
+    """``ambseal run``'s controllers: each as it runs (:func:`export_design` with its judged
+    discrete margins) and as C (:func:`ambseal.control.codegen.write_c`); returns the
+    design summaries with their ``discretisation`` for ``metrics.json``."""
+    from .control.codegen import write_c
+
+    summaries = {}
+    for d in designs:
+        digital = digitals[d.method]
+        export_design(d.method, digital, d.result.to_dict(), out,
+                      judged_margins(cases, d.method))
+        write_c(digital, out, f"ambseal_{d.method}")
+        summaries[d.method] = {**d.summary, "discretisation": digital.to_dict()}
+    return summaries
 
 
 def judged_margins(cases: list[dict], method: str) -> list[dict]:

@@ -162,8 +162,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                                  speed_scheduled, unstable_open_loop_poles)
     from .analysis.sweep import run_cases
     from .control.specs import design_spec
-    from .commands import digital_for, export_design, frozen_discrete, judged_margins
-    from .control.codegen import write_c
+    from .commands import digital_for, export_all, frozen_discrete
     from .control.controller import frozen
     from .model.rig import build_plant
     from .report.progress import StageProgress
@@ -200,10 +199,9 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         stages.begin("design")
         designs = _controllers(cfg, spec, lambda msg, steps=0: stages.step(msg, steps),
                                allow_unstable)
-        summaries, digitals, cache = {}, {}, {}
-        for d in designs:
-            digitals[d.method] = digital_for(cfg, d.method, d.controller, d.result, points,
-                                             cache)
+        cache: dict = {}
+        digitals = {d.method: digital_for(cfg, d.method, d.controller, d.result, points, cache)
+                    for d in designs}
         stages.begin("judge")
         jobs = [{"name": d.method, "point": p, "controller": frozen(d.controller, w),
                  "discrete": frozen_discrete(digitals[d.method], w)}
@@ -215,12 +213,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                                                             f"{jobs[i]['point'].label}"))
         cases = [case for case, _ in judged]
         curves = [(j["name"], j["point"], case, c) for j, (case, c) in zip(jobs, judged)]
-        for d in designs:
-            digital = digitals[d.method]
-            export_design(d.method, digital, d.result.to_dict(), out / "controllers",
-                          judged_margins(cases, d.method))
-            write_c(digital, out / "controllers", f"ambseal_{d.method}")
-            summaries[d.method] = {**d.summary, "discretisation": digital.to_dict()}
+        summaries = export_all(designs, digitals, cases, out / "controllers")
         metrics = {
             "rig": str(rig_path),
             "rig_name": cfg.rotor.name,

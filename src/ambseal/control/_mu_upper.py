@@ -257,7 +257,7 @@ def _barrier_derivs(P, X, Lder, D, Gr):
     Rf = R.reshape(F, p, -1)
     H = (Rf @ np.swapaxes(np.swapaxes(R, -1, -2).reshape(F, p, -1), 1, 2)).real
     pD, pG = P.pD, P.pG
-    for o0, o1, full, Bk, ck in P.dblk:
+    for o0, o1, full, Bk, ck in (P.dblk if pD else ()):
         if full:
             dinv = 1.0 / D[:, o0, o0].real
             k = o1 - o0

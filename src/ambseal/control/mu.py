@@ -24,8 +24,12 @@ Upper bound
     generalised eigenvalue at the returned (D, G): a certificate, whatever the solver's
     accuracy or starting point.
 Lower bound
-    Power iteration (Packard & Doyle 1993, §9; real blocks projected to ±1 as in Young &
-    Doyle 1997), the bound being 1/σ̄(Δ) for a Δ that is checked to make I − MΔ singular.
+    The mixed power algorithm (Young & Doyle 1990, 1997; Packard & Doyle 1993 §9 for
+    complex structures) from several starts — the right singular vector of M, the worst
+    direction of the D–G certificate, seeded random vectors and, for real blocks, the
+    complex iteration's phases projected on the real axis — then a refinement of the best
+    candidates (gradient projection on max |λ| s.t. λ real, ``control/_mu_lower.py``). The
+    bound is 1/σ̄(Δ) for a structured Δ that makes I − MΔ singular (returned as ``delta``).
 """
 
 from __future__ import annotations
@@ -35,6 +39,7 @@ from typing import Sequence
 
 import numpy as np
 
+from ambseal.control._mu_lower import lower_bound as _lower_bound
 from ambseal.control._mu_upper import upper_bound as _upper_bound
 from ambseal.errors import ModelError
 from ambseal.lti.freqresp import freqresp
@@ -218,158 +223,19 @@ def _pad(M, blks):
 
 
 # --------------------------------------------------------------------------- lower bound
-def _lower(M, blks, n_iter, rng):
-    """Power iteration lower bound (Packard & Doyle 1993; Young & Doyle 1997) on M (F, n, m).
+def _worst_direction(Mp, D, G, cols):
+    """Start vectors (b, w) of the power iteration from the upper bound's certificate.
 
-    Returns the bound (F,) and the worst-case Δ (F, m, n) of :class:`_PowerIteration`.
+    The top generalised eigenvector x of ``(Mᴴ D M + j(G M − Mᴴ G), D)`` is the direction
+    in which the D–G bound is tight (for complex structures the right singular vector of
+    the scaled matrix mapped back, b = x); ``w = D x`` is its dual.
     """
-    F, n, m = M.shape
-    pi = _PowerIteration(M, blks)
-    _, _, vh = np.linalg.svd(M)
-    b = np.conj(vh[:, 0, :])
-    w = b.copy()
-    best = np.zeros(F)
-    best_delta = np.zeros((F, m, n), complex)
-    checks = {max(n_iter // 2, 1), n_iter}
-    for it in range(1, n_iter + 1):
-        a, w, b = pi.step(b, w, rng)
-        if it in checks:
-            lb, lam, Q = pi.evaluate(pi.build_Q(a, w, pi.qfor(a, w)), a)
-            up = lb > best
-            best = np.where(up, lb, best)
-            safe = np.where(np.abs(lam) > 0, lam, 1.0)
-            best_delta = np.where(up[:, None, None], Q / safe[:, None, None], best_delta)
-    return best, best_delta
-
-
-class _PowerIteration:
-    """The power iteration of :func:`_lower` on a stack M (F, n, m) for a block structure:
-    one step (:meth:`step`), the structured Q it aligns (:meth:`build_Q`) and the bound
-    from the eigenvalues of M Q (:meth:`evaluate`)."""
-
-    _EPS = 1e-300
-
-    def __init__(self, M, blks):
-        self.M, self.MH, self.blks = M, _ct(M), blks
-        self.F, self.n, self.m = M.shape
-        self.ro = np.cumsum([0] + [b.c for b in blks])  # row offsets (a, z)
-        self.co = np.cumsum([0] + [b.r for b in blks])  # column offsets (b, w)
-        nscal = sum(bl.r for bl in blks if bl.kind != "full")
-        self.rank = nscal + sum(bl.kind == "full" for bl in blks)
-
-    def _slices(self, j):
-        return slice(self.co[j], self.co[j + 1]), slice(self.ro[j], self.ro[j + 1])
-
-    def qfor(self, a, w):
-        """Scalar-block phases (complex) or signs (real) aligning a and w."""
-        q = np.zeros((self.F, len(self.blks)), complex)
-        for j, bl in enumerate(self.blks):
-            if bl.kind == "full":
-                continue
-            rs, cs = self._slices(j)
-            ip = np.einsum("fi,fi->f", np.conj(a[:, cs]), w[:, rs])
-            q[:, j] = (np.sign(ip.real) + (ip.real == 0) if bl.kind == "real"
-                       else ip / np.maximum(np.abs(ip), self._EPS))
-        return q
-
-    def step(self, b, w, rng):
-        """One iteration: (a, w, b) from (b, w), dead directions restarted at random."""
-        eps, F = self._EPS, self.F
-        a = np.einsum("fij,fj->fi", self.M, b)
-        a = a / np.maximum(np.linalg.norm(a, axis=1), eps)[:, None]
-        q = self.qfor(a, w)
-        zv = np.zeros((F, self.n), complex)
-        for j, bl in enumerate(self.blks):
-            rs, cs = self._slices(j)
-            if bl.kind == "full":
-                ratio = (np.linalg.norm(w[:, rs], axis=1)
-                         / np.maximum(np.linalg.norm(a[:, cs], axis=1), eps))
-                zv[:, cs] = ratio[:, None] * a[:, cs]
-            else:
-                zv[:, cs] = np.conj(q[:, j])[:, None] * w[:, rs]
-        w = np.einsum("fij,fj->fi", self.MH, zv)
-        w = w / np.maximum(np.linalg.norm(w, axis=1), eps)[:, None]
-        q = self.qfor(a, w)
-        bn = np.zeros((F, self.m), complex)
-        for j, bl in enumerate(self.blks):
-            rs, cs = self._slices(j)
-            if bl.kind == "full":
-                ratio = (np.linalg.norm(a[:, cs], axis=1)
-                         / np.maximum(np.linalg.norm(w[:, rs], axis=1), eps))
-                bn[:, rs] = ratio[:, None] * w[:, rs]
-            else:
-                bn[:, rs] = q[:, j][:, None] * a[:, cs]
-        nb = np.linalg.norm(bn, axis=1)
-        dead = nb < 1e-12
-        if dead.any():
-            k = dead.sum()
-            bn[dead] = rng.standard_normal((k, self.m)) + 1j * rng.standard_normal((k, self.m))
-            nb = np.linalg.norm(bn, axis=1)
-        return a, w, bn / nb[:, None]
-
-    def build_Q(self, a, w, q):
-        """The structured Q (F, m, n) of the current vectors."""
-        Q = np.zeros((self.F, self.m, self.n), complex)
-        for j, bl in enumerate(self.blks):
-            rs, cs = self._slices(j)
-            if bl.kind == "full":
-                wj, aj = w[:, rs], a[:, cs]
-                nw = np.linalg.norm(wj, axis=1)[:, None, None]
-                na = np.linalg.norm(aj, axis=1)[:, None, None]
-                Q[:, rs, cs] = (wj[:, :, None] * np.conj(aj[:, None, :])
-                                / np.maximum(nw * na, self._EPS))
-            else:
-                Q[:, rs, cs] = q[:, j, None, None] * np.eye(bl.r)
-        return Q
-
-    def basis(self, a):
-        """Orthonormal V (F, n, rank) with Q = (Q V) Vᴴ for every Q the iteration builds."""
-        V = np.zeros((self.F, self.n, self.rank), complex)
-        k = 0
-        for j, bl in enumerate(self.blks):
-            cs = slice(self.ro[j], self.ro[j + 1])
-            if bl.kind == "full":
-                aj = a[:, cs]
-                V[:, cs, k] = aj / np.maximum(np.linalg.norm(aj, axis=1), self._EPS)[:, None]
-                k += 1
-            else:
-                V[:, cs, k:k + bl.r] = np.eye(bl.r)
-                k += bl.r
-        return V
-
-    def eigs(self, Q, V):
-        """Eigenvalues of M Q: those of Vᴴ M Q V (rank × rank) when V is given."""
-        if V is None:
-            return np.linalg.eigvals(self.M @ Q)
-        return np.linalg.eigvals(_ct(V) @ self.M @ (Q @ V))
-
-    def evaluate(self, Q, a):
-        """(bound, eigenvalue, Q) per frequency: the largest real eigenvalue of M Q with
-        real blocks, or the largest one with real blocks zeroed if that is larger."""
-        F, blks, co, ro = self.F, self.blks, self.co, self.ro
-        V = self.basis(a) if self.rank < self.n else None
-        lamv = self.eigs(Q, V)  # (F, n) or (F, rank)
-        if not any(bl.kind == "real" for bl in blks):
-            k = np.argmax(np.abs(lamv), axis=1)
-            return np.abs(lamv[np.arange(F), k]), lamv[np.arange(F), k], Q
-        realmask = np.abs(lamv.imag) <= 1e-9 * np.maximum(np.abs(lamv), 1e-300)
-        mag = np.where(realmask, np.abs(lamv), 0.0)
-        k = np.argmax(mag, axis=1)
-        lb, lam = mag[np.arange(F), k], lamv[np.arange(F), k].real + 0j
-        # alternative: real blocks set to zero, complex blocks absorb the phase
-        if any(bl.kind != "real" for bl in blks):
-            Qc = Q.copy()
-            for j, bl in enumerate(blks):
-                if bl.kind == "real":
-                    Qc[:, co[j]:co[j + 1], ro[j]:ro[j + 1]] = 0.0
-            lv = self.eigs(Qc, V)
-            kc = np.argmax(np.abs(lv), axis=1)
-            lbc = np.abs(lv[np.arange(F), kc])
-            use = lbc > lb
-            lb = np.where(use, lbc, lb)
-            lam = np.where(use, lv[np.arange(F), kc], lam)
-            Q = np.where(use[:, None, None], Qc, Q)
-        return lb, lam, Q
+    A = _ct(Mp) @ D @ Mp + 1j * (G @ Mp - _ct(Mp) @ G)
+    ev, V = np.linalg.eigh(D)
+    Dmh = (V / np.sqrt(np.maximum(ev, 1e-300))[:, None, :]) @ _ct(V)
+    _, U = np.linalg.eigh(_herm(Dmh @ A @ Dmh))
+    x = np.einsum("fij,fj->fi", Dmh, U[:, :, -1])
+    return x[:, cols], np.einsum("fij,fj->fi", D, x)[:, cols]
 
 
 # --------------------------------------------------------------------------- public
@@ -377,7 +243,7 @@ _STRIDE = 32  # cold solves on every 32nd frequency, warm starts in between
 
 
 def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
-          lower_iter: int = 30, gmax: float = 1e3, seed: int = 0) -> MuResult:
+          lower_iter: int = 20, gmax: float = 1e3, seed: int = 0) -> MuResult:
     """Upper and lower bounds of the structured singular value μ_Δ(M).
 
     Parameters
@@ -396,11 +262,11 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
     max_iter : int
         Outer iterations of the upper-bound solver.
     lower_iter : int
-        Power iterations for the lower bound.
+        Power iterations per start for the lower bound.
     gmax : float
         Bound on ‖G‖ relative to the normalised problem (real blocks only).
     seed : int
-        Seed for restarts of the power iteration.
+        Seed of the random starts of the power iteration.
 
     Returns
     -------
@@ -462,7 +328,8 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
     upper, D, Gp, offs = _upper_bound(Mp, blks, tol, max_iter, gmax,
                                       stride=_STRIDE if smooth else 0)
     rng = np.random.default_rng(seed)
-    lower, delta = _lower(Mf, blks, lower_iter, rng)
+    lower, delta = _lower_bound(Mf, blks, lower_iter, rng, upper=upper,
+                                starts=[_worst_direction(Mp, D, Gp, cols)])
 
     # scalings back in unpadded coordinates
     w_, V = np.linalg.eigh(D)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import control as ct
 
-from ambseal.control.dk import fit_magnitude, musyn
+from ambseal.control.dk import fit_dscale, fit_magnitude, musyn
 from ambseal.control.hinf import hinfsyn
 
 
@@ -37,6 +37,22 @@ def test_fit_magnitude_recovers_minimum_phase_scale():
     assert float(np.real(c(1j))) == pytest.approx(3.0)
     with pytest.raises(ValueError, match="0–4"):
         fit_magnitude(w, mag, 5)
+
+
+def test_fit_dscale_selects_the_lowest_sufficient_order():
+    """Reference: known stable minimum-phase scales. A constant needs order 0; the
+    second-order D(s) = 2 (s+1)(s+10)/((s+3)(s+30)) is reproduced within the tolerance by an
+    order ≤ 2 fit (MATLAB musyn's rule: the lowest order whose fit error is below a
+    tolerance), with every pole and zero in the open LHP."""
+    w = np.logspace(-2, 3, 80)
+    f0, o0, _ = fit_dscale(w, np.full(w.size, 0.3))
+    assert o0 == 0 and float(np.real(f0(1j))) == pytest.approx(0.3)
+    D = ct.tf([2, 22, 20], [1, 33, 90])
+    mag = np.abs(D(1j * w))
+    fit, order, err = fit_dscale(w, mag, tol=0.02)
+    assert 1 <= order <= 2 and err <= np.log1p(0.02)
+    np.testing.assert_allclose(np.abs(fit(1j * w)), mag, rtol=0.03)
+    assert np.all(np.real(fit.poles()) < 0) and np.all(np.real(fit.zeros()) < 0)
 
 
 def _mu_ab13md(cl, omega):

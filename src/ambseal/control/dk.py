@@ -25,7 +25,8 @@ from ambseal.errors import ConfigError, ModelError, SynthesisError
 from ambseal.control.hinf import check_plant, hinfsyn, lft_lower
 from ambseal.control.mu import check_blocks, mussv
 
-__all__ = ["MusynResult", "musyn", "fit_magnitude", "default_omega", "design_omega"]
+__all__ = ["MusynResult", "musyn", "fit_magnitude", "fit_dscale", "default_omega",
+           "design_omega"]
 
 
 # --------------------------------------------------------------------------- D fitting
@@ -125,6 +126,99 @@ def fit_magnitude(omega, mag, order: int):
             best = res
     num, den = _theta_to_tf(best.x, order)
     return ct.tf(num, den)
+
+
+def _fit_weighted(w, y, order, wgt, starts):
+    """Weighted log-magnitude least squares of one order from several starts; pole and zero
+    frequencies kept within a decade of the grid. Returns (theta, weighted max |error|)."""
+    lw = np.log(w)
+    n2, n1 = divmod(order, 2)
+    lo_b, hi_b = lw.min() - np.log(10.0), lw.max() + np.log(10.0)
+    sq = np.sqrt(wgt)
+    best, best_err = None, np.inf
+    for cen0, spread in starts:
+        cen = np.linspace(lw.min(), lw.max(), 2 * (n2 + n1) + 2)[1:-1]
+        cen = cen0 + spread * (cen - lw.mean())
+        zc, pc = cen[0::2], cen[1::2]
+        th = [0.0]
+        for cs in (zc, pc):
+            th += [v for i in range(n2) for v in (2 * cs[i], np.log(1.4) + cs[i])]
+            th += [cs[n2 + i] if n2 + i < cs.size else cs[-1] for i in range(n1)]
+        # bounds: ωn² (b0) and 2ζωn (b1, ζ 0.05 … 2) of second-order sections, a of first
+        sec = [(2 * lo_b, 2 * hi_b), (lo_b + np.log(0.1), hi_b + np.log(4.0))] * n2 \
+            + [(lo_b, hi_b)] * n1
+        lb, ub = np.array([-60.0] + [b[0] for b in sec] * 2), \
+            np.array([60.0] + [b[1] for b in sec] * 2)
+        th = np.clip(np.array(th), lb + 1e-6, ub - 1e-6)
+        th[0] = np.average(y - _logmag(th, w, order), weights=wgt)
+        res = least_squares(lambda t: sq * (_logmag(t, w, order) - y), th, method="trf",
+                            bounds=(lb, ub), max_nfev=150)
+        err = float(np.max(np.abs(_logmag(res.x, w, order) - y) * wgt / wgt.max()))
+        if err < best_err:
+            best, best_err = res.x, err
+    return best, best_err
+
+
+def fit_dscale(omega, mag, weight=None, *, max_order: int = 4, tol: float = 0.05):
+    """D-scale fit with automatic order: the lowest order (0 … ``max_order``) whose weighted
+    largest log-magnitude error is below ``log(1 + tol)``, as MATLAB's ``musyn`` selects its
+    fit orders; the best order if none is.
+
+    Each order is fitted by :func:`fit_magnitude`'s stable, minimum-phase parametrisation
+    (weighted log-magnitude least squares, several starts, poles and zeros within a decade
+    of the grid).
+
+    Parameters
+    ----------
+    omega, mag : array_like, shape (F,)
+        Frequencies (rad/s, > 0) and D-scale magnitudes (> 0).
+    weight : array_like, shape (F,), optional
+        Non-negative weights; :func:`musyn` weights by ``(μ(ω)/max μ)⁴`` so that the fit is
+        good where μ peaks. Uniform by default.
+    max_order : int
+        Highest order tried (0–4).
+    tol : float
+        Relative magnitude tolerance.
+
+    Returns
+    -------
+    fit : control.TransferFunction
+    order : int
+    error : float
+        Weighted largest |log-magnitude error| of the fit.
+
+    Raises
+    ------
+    ConfigError
+        Non-positive or non-finite data, or ``max_order`` outside 0–4.
+    """
+    w, d = np.asarray(omega, float), np.asarray(mag, float)
+    if not (isinstance(max_order, (int, np.integer)) and 0 <= max_order <= 4):
+        raise ConfigError(f"max_order={max_order!r}: the D-scale fit order must be 0–4")
+    if w.shape != d.shape or w.ndim != 1 or np.any(w <= 0) or np.any(~np.isfinite(d)) \
+            or np.any(d <= 0):
+        raise ConfigError("fit_dscale: omega and mag must be positive, finite, equal-length")
+    wgt = np.ones_like(w) if weight is None else np.maximum(np.asarray(weight, float), 1e-6)
+    y = np.log(np.clip(d, 1e-8, 1e8))
+    lw = np.log(w)
+    best = None
+    for order in range(max_order + 1):
+        if order == 0:
+            th = np.array([np.average(y, weights=wgt)])
+            err = float(np.max(np.abs(th[0] - y) * wgt / wgt.max()))
+        else:
+            starts = [(lw.mean(), 1.0), (lw.mean(), 0.5), (lw.mean() - 1.5, 1.0),
+                      (lw.mean() + 1.5, 1.0)]
+            th, err = _fit_weighted(w, y, order, wgt, starts)
+        if best is None or err < best[2] * 0.9:
+            best = (th, order, err)
+        if err <= np.log1p(tol):
+            break
+    th, order, err = best
+    if order == 0:
+        return ct.tf([float(np.exp(th[0]))], [1.0]), 0, err
+    num, den = _theta_to_tf(th, order)
+    return ct.tf(num, den), order, err
 
 
 def default_omega(P, n: int = 120) -> np.ndarray:
@@ -268,8 +362,9 @@ def _scaled_plant(P, cblocks, fits, nmeas, ncon):
 
 
 def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None, *,
-          order: int = 2, max_iter: int = 8, rtol: float = 1e-2, patience: int = 2,
-          backoff: float = 1.01, progress: bool = False) -> MusynResult:
+          order: int | str = "auto", max_iter: int = 8, rtol: float = 1e-2,
+          patience: int = 2, backoff: float = 1.01, fit_tol: float = 0.05,
+          progress: bool = False) -> MusynResult:
     """μ-synthesis by complex D–K iteration (Balas et al. 1993; thesis Paper 3 §3.4).
 
     Parameters
@@ -283,8 +378,10 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
         Number of measurements and control inputs.
     omega : array_like, optional
         Frequency grid in rad/s for the D-step and μ (default: :func:`default_omega`).
-    order : int
-        Order (0–4) of each fitted D scale.
+    order : int or "auto"
+        Order (0–4) of each fitted D scale; ``"auto"``: per scale and iteration the lowest
+        order whose fit, weighted by ``(μ(ω)/max μ)⁴``, is within ``fit_tol``
+        (:func:`fit_dscale`).
     max_iter : int
         Maximum number of D–K iterations (the first is plain H∞).
     rtol : float
@@ -292,7 +389,10 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     patience : int
         Stop after this many iterations without progress.
     backoff : float
-        γ back-off passed to :func:`~ambseal.control.hinf.hinfsyn`.
+        K-step: the controller is built at ``backoff·γ_opt``, γ_opt found to 1e-6 relative
+        by :func:`~ambseal.control.hinf.hinfsyn` (e.g. 1.001: within 0.1 % of the optimum).
+    fit_tol : float
+        Relative magnitude tolerance of the automatic D-scale fit order.
     progress : bool
         Print one line per iteration on stderr (rich).
 
@@ -313,8 +413,8 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     blks = check_blocks(P, blocks, nmeas, ncon)
     if blks[-1].kind != "full":
         raise ModelError("musyn: the last block must be the full complex performance block")
-    if not (isinstance(order, (int, np.integer)) and 0 <= order <= 4):
-        raise ConfigError(f"order={order!r}: the D-scale fit order must be an integer 0–4")
+    if order != "auto" and not (isinstance(order, (int, np.integer)) and 0 <= order <= 4):
+        raise ConfigError(f"order={order!r}: the D-scale fit order must be 0–4 or 'auto'")
     w = default_omega(P) if omega is None else np.asarray(omega, float)
     if w.ndim != 1 or w.size < 2 or np.any(w <= 0) or not np.all(np.isfinite(w)):
         raise ConfigError("musyn: omega must be a 1-D grid of positive rad/s values")
@@ -353,7 +453,11 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
         # D-step on the unscaled closed loop, diagonal (complexified) structure
         mu_c = mussv(cl, cblocks, w) if cblocks != [tuple(b) for b in blocks] else mu_true
         ds = np.asarray(mu_c.dscale)  # (F, nblocks), last block = 1
-        fits = [fit_magnitude(w, ds[:, j], order) for j in range(ds.shape[1] - 1)]
+        if order == "auto":
+            wgt = (mu_c.upper / np.max(mu_c.upper)) ** 4
+            fits = [fit_dscale(w, ds[:, j], wgt, tol=fit_tol)[0] for j in range(ds.shape[1] - 1)]
+        else:
+            fits = [fit_magnitude(w, ds[:, j], order) for j in range(ds.shape[1] - 1)]
     peak, it_best, hr, mu_true, fits_best = best
     return MusynResult(K=hr.K, mu=peak, mu_omega=float(w[np.argmax(mu_true.upper)]),
                        mu_curve=np.asarray(mu_true.upper), omega=w, gamma=hr.gamma,

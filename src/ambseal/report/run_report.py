@@ -176,6 +176,8 @@ def _styles(curves: list) -> tuple[dict, dict]:
     unstable = {f"{m}, {p.label}": styles[f"{m}, {p.label}"] for m, p, case, _ in curves
                 if not case.get("stable")}
     return styles, unstable
+
+
 def _discrete_section(metrics: dict) -> list[dict]:
     """One line per case: the controller as it runs on the target beside the continuous
     design (the ``discrete`` blocks of ``metrics.json``)."""
@@ -218,11 +220,17 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
              figures.sensitivity_figure(out / "sensitivity.png",
                                         [(lb, *c["So"]) for lb, c in drawn if "So" in c], **kw))]
     comp = [(lb, *c["compliance"]) for lb, c in drawn if "compliance" in c]
-    disc = [(lb, *c["discrete"]["So"]) for lb, c in drawn if "discrete" in c]
+    # the discrete loops in the same colours and line styles; an unstable one listed only
+    dstable = {f"{m}, {p.label}": bool((case.get("discrete") or {}).get("stable"))
+               for m, p, case, c in curves if "discrete" in c}
+    disc = [(lb, *c["discrete"]["So"]) for lb, c in
+            ((f"{m}, {p.label}", c) for m, p, _, c in curves) if dstable.get(lb)]
     if disc:
         figs.append(("σ̄(S_o) of the controllers as they run: sampled plant, discrete "
                      "controller and its computation delay, up to Nyquist",
-                     figures.sensitivity_figure(out / "sensitivity_discrete.png", disc)))
+                     figures.sensitivity_figure(
+                         out / "sensitivity_discrete.png", disc, styles=styles,
+                         unstable={lb: styles[lb] for lb, ok in dstable.items() if not ok})))
     if comp:
         figs.append(("Compliance σ̄(S_o G_f) at the seal (P5 Fig. 11)",
                      figures.compliance_figure(out / "compliance.png", comp, **kw)))

@@ -386,6 +386,8 @@ def _run(args: argparse.Namespace) -> int:
     result = run(args.rig, args.out, truth=args.truth, identification=not args.no_identify,
                  overrides=tuple(args.overrides), allow_unstable=args.allow_unstable,
                  command=args.command_line, progress=not (args.quiet or args.verbose))
+    for reason in result.metrics.get("cannot_run", {}).values():
+        print(f"ambseal: {reason}", file=sys.stderr)
     if sys.stderr.isatty() and not args.quiet:
         from rich.console import Console
 

@@ -18,7 +18,7 @@ from .files import writable_folder, write_json, write_text
 
 __all__ = ["design_files", "identify_files", "export_design", "show_defaults",
            "validate_summary", "track_files", "export_all", "digital_for", "choice_margins",
-           "frozen_discrete", "judged_margins"]
+           "frozen_discrete", "judged_margins", "digitals_for"]
 
 
 def _finite(x: float) -> float | None:
@@ -72,6 +72,36 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
                              name=f"K_{method}")
 
 
+def digitals_for(cfg, designs, points, say=None) -> tuple[dict, dict]:
+    """:func:`digital_for` of each of ``ambseal run``'s designs, sharing the sampled plants.
+
+    A controller that cannot run on the target (no discretisation keeps its sampled,
+    delayed loop stable where the continuous loop is, or an unstable pole too fast for the
+    rate: :class:`~ambseal.errors.SynthesisError`) is left out, the others go on;
+    ``say(line)``, if given, is called with the reason.
+
+    Returns
+    -------
+    (digitals, cannot_run)
+        ``{method: DigitalController}`` and ``{method: one line saying which controller
+        cannot run and why}``.
+    """
+    from .errors import SynthesisError
+
+    cache: dict = {}
+    digitals, cannot_run = {}, {}
+    for d in designs:
+        try:
+            digitals[d.method] = digital_for(cfg, d.method, d.controller, d.result, points,
+                                             cache)
+        except SynthesisError as exc:
+            cannot_run[d.method] = (f"{d.method} cannot run on the target, judged as designed "
+                                    f"(continuous) only: {exc}")
+            if say is not None:
+                say(cannot_run[d.method])
+    return digitals, cannot_run
+
+
 def _conditions(cfg, points) -> list[tuple[float, float]]:
     """(pressure bar, speed rpm) of the judged points, the nominal one first."""
     nominal = (cfg.operating.pressure_bar, cfg.operating.speed_rpm)
@@ -97,9 +127,12 @@ def choice_margins(cfg, points, digital) -> list[dict]:
 
 
 def frozen_discrete(digital, speed_rad_s: float):
-    """The discrete controller (delay included) that runs at Ω, for the judgement."""
+    """The discrete controller (delay included) that runs at Ω, for the judgement;
+    ``None`` for a controller that cannot run (``digital`` None)."""
     from .control.scheduled_digital import ScheduledDigital
 
+    if digital is None:
+        return None
     if isinstance(digital, ScheduledDigital):
         return digital.statespace_at(speed_rad_s, delayed=True)
     return digital.statespace(delayed=True)
@@ -131,12 +164,16 @@ def show_defaults(rig: str | Path, overrides=()) -> str:
 def export_all(designs, digitals: dict, cases: list[dict], out: Path) -> dict:
     """``ambseal run``'s controllers: each as it runs (:func:`export_design` with its judged
     discrete margins) and as C (:func:`ambseal.control.codegen.write_c`); returns the
-    design summaries with their ``discretisation`` for ``metrics.json``."""
+    design summaries with their ``discretisation`` for ``metrics.json`` (``None`` for a
+    controller without a digital one in ``digitals``: nothing of it is exported)."""
     from .control.codegen import write_c
 
     summaries = {}
     for d in designs:
-        digital = digitals[d.method]
+        digital = digitals.get(d.method)
+        if digital is None:  # cannot run on the target (metrics' "cannot_run"): no export
+            summaries[d.method] = {**d.summary, "discretisation": None}
+            continue
         export_design(d.method, digital, d.result.to_dict(), out,
                       judged_margins(cases, d.method))
         write_c(digital, out, f"ambseal_{d.method}")
@@ -181,7 +218,8 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
         if cfg.operating.speed_range_hz is None:
             raise ConfigError(f"{rig}: operating.speed_range_hz: an LPV design needs the "
                               "speed range it is scheduled over, e.g. [20.0, 300.0]")
-        res = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz)
+        res = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz,
+                         allow_unstable=allow_unstable)
         K, summary = res, res.to_dict()
     else:
         res = design(cfg, method, pressure_bar=pressure_bar, allow_unstable=allow_unstable,

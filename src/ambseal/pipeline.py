@@ -73,12 +73,12 @@ def _controllers(cfg: RigConfig, spec, say, allow_unstable: bool = False) -> lis
         from .control.lpv_design import design_frozen, design_lpv
 
         out = [lti(design(cfg, "pid"))] if cfg.controller.pid else []
-        if out:
-            say("pid designed", 1)
-        fz = design_frozen(cfg, cfg.operating.speed_rpm / 60.0)
+        say("pid designed" if out else "", len(out))
+        fz = design_frozen(cfg, cfg.operating.speed_rpm / 60.0, allow_unstable=allow_unstable)
         out.append(Designed("hinf", fz.K, fz.to_dict(), fz))
         say("hinf designed; lpv next", 1)
-        lpv = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz)
+        lpv = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz,
+                         allow_unstable=allow_unstable)
         say("lpv designed", 1)
         return out + [Designed("lpv", lpv, lpv.to_dict(), lpv)]
     pid = lti(design(cfg, "pid"))
@@ -162,7 +162,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                                  speed_scheduled, unstable_open_loop_poles)
     from .analysis.sweep import run_cases
     from .control.specs import design_spec
-    from .commands import digital_for, export_all, frozen_discrete
+    from .commands import digitals_for, export_all, frozen_discrete
     from .control.controller import frozen
     from .model.rig import build_plant
     from .report.progress import StageProgress
@@ -199,12 +199,10 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         stages.begin("design")
         designs = _controllers(cfg, spec, lambda msg, steps=0: stages.step(msg, steps),
                                allow_unstable)
-        cache: dict = {}
-        digitals = {d.method: digital_for(cfg, d.method, d.controller, d.result, points, cache)
-                    for d in designs}
+        digitals, cannot_run = digitals_for(cfg, designs, points, lambda m: stages.step(m, 0))
         stages.begin("judge")
         jobs = [{"name": d.method, "point": p, "controller": frozen(d.controller, w),
-                 "discrete": frozen_discrete(digitals[d.method], w)}
+                 "discrete": frozen_discrete(digitals.get(d.method), w)}
                 for d in designs for p in points
                 for w in (2 * math.pi * p.speed_rpm / 60.0,)]
         judged = run_cases(judge_case, jobs, shared={"cfg": cfg, "settings": settings},
@@ -223,13 +221,15 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                           "range_hz": list(settings.unbalance_range_hz)},
             "design_spec": spec.to_dict(),
             "controllers": summaries,
+            "cannot_run": cannot_run,
             "cases": cases,
         }
         figs, sections = [], []
         if truth_cfg is not None:
             if "pid" not in digitals:
                 raise ConfigError("controller.pid: the virtual facility runs the reference "
-                                  "PID ([controller.pid]) during identification")
+                                  "PID during identification, and "
+                                  + cannot_run.get("pid", "the rig has none"))
             stages.begin("identification")
             metrics["identification"], figs, sections = _identification(
                 cfg, truth_cfg, out, stages.step, digitals["pid"].discrete)

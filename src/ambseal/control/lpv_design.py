@@ -35,7 +35,7 @@ full-order plant peaked at 4.4–6.7 there (spill-over); with the high-pass it s
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -46,7 +46,7 @@ from .plant import physical_controller, physical_matrices
 from .weights import Weights, default_weights
 
 __all__ = ["LpvDesign", "FrozenDesign", "design_lpv", "design_frozen",
-           "lpv_generalized_plants"]
+           "lpv_generalized_plants", "check_full_order"]
 
 _TWO_PI = 2.0 * np.pi
 
@@ -82,6 +82,8 @@ class LpvDesign(ScheduledController):
         Wall time including the model and the frozen γ (s).
     plant : LpvPlant
         The design model (not serialised).
+    full_order : dict or None
+        :func:`check_full_order` of the controller at the judged conditions.
     """
 
     K: Any = field(repr=False)
@@ -98,6 +100,7 @@ class LpvDesign(ScheduledController):
     synthesis_s: float = 0.0
     elapsed_s: float = 0.0
     plant: Any = field(default=None, repr=False)
+    full_order: dict | None = None
 
     @property
     def order(self) -> int:
@@ -136,7 +139,7 @@ class LpvDesign(ScheduledController):
                 "weights": self.weights.to_dict(),
                 "reports": [r.to_dict() for r in self.reports],
                 "synthesis_s": round(self.synthesis_s, 3),
-                "elapsed_s": round(self.elapsed_s, 3)}
+                "elapsed_s": round(self.elapsed_s, 3), "full_order": self.full_order}
 
 
 @dataclass(frozen=True, eq=False)
@@ -154,6 +157,8 @@ class FrozenDesign:
         Verified H∞ norm (``"hinf"``) or peak μ upper bound (``"mu"``) of the design loop.
     weights : Weights
     elapsed_s : float
+    full_order : dict or None
+        :func:`check_full_order` of the controller at the judged conditions.
     """
 
     K: Any = field(repr=False)
@@ -162,11 +167,47 @@ class FrozenDesign:
     gamma: float
     weights: Weights = field(default_factory=lambda: default_weights("lpv"))
     elapsed_s: float = 0.0
+    full_order: dict | None = None
 
     def to_dict(self) -> dict:
         return {"method": self.method, "speed_hz": self.speed_hz, "gamma": self.gamma,
                 "order": int(self.K.nstates), "weights": self.weights.to_dict(),
-                "elapsed_s": round(self.elapsed_s, 3)}
+                "elapsed_s": round(self.elapsed_s, 3), "full_order": self.full_order}
+
+
+def check_full_order(cfg, controller_at, name: str, allow_unstable: bool = False) -> dict:
+    """Close a speed-scheduled design with the full-order plant at every judged condition
+    (the specification's pressures × speeds, :func:`ambseal.control.specs.design_spec`):
+    at each, the physical controller ``controller_at(speed_hz)`` that runs there
+    (:func:`ambseal.control.recipes.full_order_check`), as :func:`~ambseal.control.
+    recipes.design` does for H∞ and μ.
+
+    Returns
+    -------
+    dict
+        The least stable condition's :func:`full_order_check` dict.
+
+    Raises
+    ------
+    SynthesisError
+        A loop is unstable (unless ``allow_unstable``): the mode (Hz, ζ), the condition and
+        the remedy (the design model keeps the rigid-body modes only, P3 §2.2).
+    """
+    from .recipes import full_order_check
+    from .specs import design_spec
+
+    sp = design_spec(cfg)
+    checks = [full_order_check(cfg, controller_at(f), [(p, f)])
+              for p in sp.pressures_bar for f in sp.speeds_hz]
+    worst = max(checks, key=lambda c: (not c["stable"], -c["damping"]))
+    if not worst["stable"] and not allow_unstable:
+        raise SynthesisError(
+            f"{name}: the full-order loop is unstable at {worst['pressure_bar']:g} bar, "
+            f"{worst['speed_hz']:g} Hz: the mode at {worst['mode_hz']:.4g} Hz has ζ = "
+            f"{worst['damping']:.3g}; the LPV design model keeps the rigid-body modes only "
+            "(P3 §2.2): a mode it leaves out went unstable; raise W_u's roll-off or accept "
+            "it with --allow-unstable")
+    return worst
 
 
 def lpv_generalized_plants(L, weights: Weights, speeds_rad_s=None):
@@ -186,7 +227,8 @@ def lpv_generalized_plants(L, weights: Weights, speeds_rad_s=None):
 def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int = 10,
                rate_bound_hz_per_s: float | None = None, lyapunov: str | None = None,
                weights: Weights | None = None, states: int = 8,
-               frozen_gamma: bool = True, **lpvsyn_kw) -> LpvDesign:
+               frozen_gamma: bool = True, allow_unstable: bool = False,
+               **lpvsyn_kw) -> LpvDesign:
     """Speed-scheduled H∞ LPV controller for a rig (thesis P3 §4).
 
     Parameters
@@ -210,6 +252,9 @@ def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int = 10,
         pair).
     frozen_gamma : bool
         Also compute the frozen-point H∞ γ at each grid speed (a lower bound of the LPV γ).
+    allow_unstable : bool
+        Keep a controller whose full-order loop is unstable at a judged condition
+        (:func:`check_full_order`) instead of raising.
     **lpvsyn_kw
         Passed to :func:`ambseal.control.lpv.lpvsyn` (``backoff``, ``solver_options``, …).
 
@@ -221,7 +266,8 @@ def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int = 10,
     ------
     SynthesisError
         From :func:`lpvsyn`: one grid point, a rate bound with a constant Lyapunov
-        function, infeasible LMIs, an inaccurate solver status, an unstable frozen loop.
+        function, infeasible LMIs, an inaccurate solver status, an unstable frozen loop;
+        an unstable full-order loop at a judged condition (:func:`check_full_order`).
     ModelError
         A bad speed range (negative, not increasing).
 
@@ -259,17 +305,19 @@ def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int = 10,
         fg = np.array([hinfsyn(p, nmeas, ncon).gamma for p in P])
     r = lpvsyn(P, L.speeds_rad_s, nmeas, ncon, dA=dA, lyapunov=lyapunov, rate_bound=nu,
                **lpvsyn_kw)
-    return LpvDesign(K=r.K, gamma=r.gamma, gamma_design=r.gamma_design, frozen_gamma=fg,
-                     check_gamma=r.check_gamma, speeds_hz=grid,
-                     check_speeds_hz=r.check_rad_s / _TWO_PI, lyapunov=lyapunov,
-                     rate_bound_hz_per_s=None if nu is None else float(rate_bound_hz_per_s),
-                     weights=w, reports=r.reports, synthesis_s=r.time_s,
-                     elapsed_s=time.perf_counter() - t0, plant=L)
+    d = LpvDesign(K=r.K, gamma=r.gamma, gamma_design=r.gamma_design, frozen_gamma=fg,
+                  check_gamma=r.check_gamma, speeds_hz=grid,
+                  check_speeds_hz=r.check_rad_s / _TWO_PI, lyapunov=lyapunov,
+                  rate_bound_hz_per_s=None if nu is None else float(rate_bound_hz_per_s),
+                  weights=w, reports=r.reports, synthesis_s=r.time_s, plant=L)
+    check = check_full_order(cfg, d.controller_at, "lpv", allow_unstable)
+    return replace(d, full_order=check, elapsed_s=time.perf_counter() - t0)
 
 
 def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
                   weights: Weights | None = None, states: int = 8,
-                  seal_k_uncertainty: float = 0.4, **kw) -> FrozenDesign:
+                  seal_k_uncertainty: float = 0.4, allow_unstable: bool = False,
+                  **kw) -> FrozenDesign:
     """LTI controller at one speed: the comparison controller of P3 Fig. 11 (140 Hz).
 
     Parameters
@@ -286,6 +334,9 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
         ``default_weights("lpv")`` if omitted (module docstring).
     states : int
         Mechanical states of the design model (same basis as :func:`design_lpv`).
+    allow_unstable : bool
+        Keep a controller whose full-order loop is unstable at a judged condition
+        (:func:`check_full_order`) instead of raising.
     **kw
         Passed to :func:`musyn` (``max_iter``, ``order``, ``omega``).
 
@@ -298,7 +349,8 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
     ConfigError
         Unknown method; ``"mu"`` on a rig without a seal.
     SynthesisError
-        From the synthesis.
+        From the synthesis; an unstable full-order loop at a judged condition
+        (:func:`check_full_order`).
     """
     from .lpv_plant import lpv_plant
 
@@ -335,5 +387,6 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
         r = musyn(gp.P, gp.blocks, gp.nmeas, gp.ncon, om, **kw)
         K_P, gamma = r.K, float(r.mu)
     K = gp.physical_controller(K_P, name=f"K_{method}_{f:g}Hz")
+    check = check_full_order(cfg, lambda _: K, f"{method} at {f:g} Hz", allow_unstable)
     return FrozenDesign(K=K, speed_hz=f, method=method, gamma=gamma, weights=w,
-                        elapsed_s=time.perf_counter() - t0)
+                        elapsed_s=time.perf_counter() - t0, full_order=check)

@@ -46,7 +46,7 @@ from ..errors import ConfigError, SynthesisError
 from ..model.amb import channel_names
 from .weights import Weights
 
-__all__ = ["DesignResult", "design", "full_order_check", "pid_from_rig", "METHODS"]
+__all__ = ["DesignResult", "design", "full_order_check", "METHODS"]
 
 METHODS = ("pid", "hinf", "mu")
 
@@ -138,49 +138,8 @@ class DesignResult:
         return d
 
 
-#: the derived PID (no [controller.pid]): k_eq = K_EQ_PER_KS·Ks, ζ on the rigid-body modes,
-#: Ti in rigid-body time constants, derivative filter ε (P5 Eq. 6, §4.2: ε = 0.1)
-K_EQ_PER_KS, PID_ZETA, TI_PER_OMEGA_N, PID_EPS = 0.5, 1.0, 50.0, 0.1
-
-
-def pid_from_rig(cfg) -> dict:
-    """A decentralised PID (P5 Eq. 6) from the rig, for a rig without ``[controller.pid]``.
-
-    One gain set on every axis, from the mean Ks/Ki over the AMB axes and half the rotor
-    mass per bearing (a rigid rotor on two supports): the equivalent stiffness
-    k_eq = Ki·Kp − Ks is K_EQ_PER_KS·Ks (Kp = (1 + K_EQ_PER_KS)·Ks/Ki; Schweitzer & Maslen
-    2009 §7.2), the rigid-body mode ω_n = √(k_eq/m_b) gets the damping ratio PID_ZETA
-    (Ki·Kp·Td = 2ζ√(k_eq m_b)), Ti = TI_PER_OMEGA_N/ω_n puts the integral action well below
-    it, ε = 0.1 (P5 §4.2). On the test rig: Kp 1.8e4 A/m, Td 3.3 ms, Ti 0.25 s (the thesis's
-    hand tuning: 1.6e4, 3.5 ms, 0.2 s), stable at 0 and 2.04 bar on the full-order plant;
-    with k_eq = Ks, or ζ ≤ 0.5, the seal's cross-coupling at 2.04 bar destabilises the
-    rigid-body mode; ζ = 1 is the critically damped rigid rotor without seal.
-
-    Returns
-    -------
-    dict
-        ``kp`` (A/m), ``ti``, ``td`` (s), ``eps`` (-) and ``rule`` (text).
-    """
-    from ..model.amb import amb_factors
-    from ..model.rotor import assemble_rotor
-
-    ratio = [ks / ki for a in cfg.amb for ki, ks in zip(*amb_factors(a))]
-    ks_over_ki = float(np.mean(ratio))
-    ki = float(np.mean([k for a in cfg.amb for k in amb_factors(a)[0]]))
-    ks = ks_over_ki * ki
-    m_b = assemble_rotor(cfg).mass / 2
-    k_eq = K_EQ_PER_KS * ks
-    kp = (1 + K_EQ_PER_KS) * ks_over_ki
-    w_n = np.sqrt(k_eq / m_b)
-    td = 2 * PID_ZETA * np.sqrt(k_eq * m_b) / (ki * kp)
-    return {"kp": float(kp), "ti": float(TI_PER_OMEGA_N / w_n), "td": float(td),
-            "eps": PID_EPS,
-            "rule": f"k_eq = {K_EQ_PER_KS:g} Ks, ζ = {PID_ZETA:g} on the rigid-body modes "
-                    f"({w_n / (2 * np.pi):.3g} Hz), Ti = {TI_PER_OMEGA_N:g}/ω_n, ε = {PID_EPS:g}"}
-
-
 def _pid(cfg, p):
-    from .pid import pid_controller
+    from .pid import pid_controller, pid_from_rig
 
     pid = getattr(getattr(cfg, "controller", None), "pid", None)
     notes = ()

@@ -257,6 +257,8 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
                           + ", ".join(f"{re:.1f}{im:+.1f}j" for re, im in ol["unstable_poles"])
                           + f"; {ol['n_states_full']} states in full order, "
                           f"{ol['n_states_reduced']} reduced.")}]
+    sections = [{"title": "Cannot run on the target", "text": reason}
+                for reason in (metrics.get("cannot_run") or {}).values()] + sections
     sections += _discrete_section(metrics)
     return write_report(out / "report.html", title=title, metrics=metrics["cases"],
                         figures=figs + list(extra_figures),

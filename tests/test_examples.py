@@ -1,0 +1,99 @@
+"""Every example rig end to end, and the unusual rigs of issue 9 §4 (a rig without a seal,
+a rig with one AMB and one plain bearing): ``ambseal run --no-identify`` exits 0 and every
+controller is stable on the full-order plant at every judged condition, as designed and as
+it runs on the target — or the run states plainly which one cannot run and why.
+
+The full runs are ``slow`` (15–50 s of CPU each). The default suite keeps the cheap
+parts: the test rig and the turboexpander run end to end in tests/test_pipeline.py (with
+the session's designs), and the part that broke the blower and the pump (their PID
+derived from the rig could not run on the target; a controller that cannot run stopped
+the run) is tests/control/test_control_pid_rule.py.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+from ambseal.cli import main
+
+EXAMPLES = sorted((Path(__file__).resolve().parents[1] / "examples").glob("*.toml"))
+TESTRIG = Path(__file__).resolve().parents[1] / "examples" / "testrig.toml"
+
+
+def _run(rig: Path, out: Path, capsys) -> tuple[dict, str]:
+    code = main(["run", str(rig), "--no-identify", "--quiet", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 0, err
+    assert "Traceback" not in err
+    return json.loads((out / "metrics.json").read_text()), err
+
+
+def _check_stable_or_stated(metrics: dict, err: str) -> None:
+    """H∞/μ/LPV: stable at every judged condition, continuous and as it runs; the PID at
+    every condition up to the nominal pressure (above it the thesis's own finding is that
+    the PID goes unstable, P5 Fig. 13, and the verdict says so). A controller that cannot
+    run on the target is named in metrics' ``cannot_run`` and on stderr, judged
+    continuous only."""
+    cannot = metrics["cannot_run"]
+    for reason in cannot.values():
+        assert reason in err
+    nominal = metrics["controllers"].get("pid", {}).get("pressure_bar", 0.0)
+    for c in metrics["cases"]:
+        name = c["controller"]
+        if name == "pid" and c["pressure_bar"] > nominal + 1e-9:
+            continue
+        assert c["stable"], (name, c["pressure_bar"], c["speed_hz"])
+        if name in cannot:
+            assert "discrete" not in c
+        else:
+            assert c["discrete"]["stable"], (name, c["pressure_bar"], c["speed_hz"])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("rig", EXAMPLES, ids=lambda p: p.stem)
+def test_every_example_runs_end_to_end(rig, tmp_path, capsys):
+    """Issue 9 §4 acceptance: `ambseal run RIG --no-identify` on each example exits 0,
+    and every loop is stable on the full-order plant (or the run says why not)."""
+    metrics, err = _run(rig, tmp_path / "out", capsys)
+    _check_stable_or_stated(metrics, err)
+    assert {c["controller"] for c in metrics["cases"]} >= {"hinf"}
+
+
+def _testrig_without(kind: str) -> str:
+    """The test rig's text without its seal, or with AMB B replaced by a plain bearing."""
+    text = TESTRIG.read_text()
+    if kind == "seal":
+        return re.sub(r"\n\[\[seal\]\]\n(?:[^\n\[#][^\n]*\n)*", "\n", text)
+    block = re.search(r"\n\[\[amb\]\]\nname = \"B\"\n(?:[^\n\[#][^\n]*\n)*", text)
+    pos = re.search(r"\nposition = ([0-9.]+)", block.group(0)).group(1)
+    return text.replace(block.group(0), f"\n[[spring]]\nname = \"bearing_B\"\nposition = "
+                                         f"{pos}\nkxx = 5.0e7\nkyy = 5.0e7\n")
+
+
+@pytest.mark.slow
+def test_a_rig_without_seal_runs_end_to_end_with_a_note(tmp_path, capsys):
+    """Issue 9 §2/§4: no seal — H∞ and μ designed without seal uncertainty, the summary
+    says so; every loop stable (the seal-less rig has nothing to destabilise at 2×)."""
+    rig = tmp_path / "noseal.toml"
+    rig.write_text(_testrig_without("seal"))
+    metrics, err = _run(rig, tmp_path / "out", capsys)
+    _check_stable_or_stated(metrics, err)
+    notes = " ".join(metrics["controllers"]["mu"]["notes"])
+    assert "seal" in notes
+    assert metrics["controllers"]["mu"]["uncertainty"] == {}
+
+
+@pytest.mark.slow
+def test_a_rig_with_one_amb_and_a_plain_bearing_runs_end_to_end(tmp_path, capsys):
+    """Issue 9 §4: one AMB (2 axes) and a plain bearing (a spring): 2 × 2 controllers, the
+    run exits 0 with every loop stable or stated."""
+    rig = tmp_path / "oneamb.toml"
+    rig.write_text(_testrig_without("amb"))
+    metrics, err = _run(rig, tmp_path / "out", capsys)
+    _check_stable_or_stated(metrics, err)
+    assert all(len(c["discrete"]["iso_zone_per_axis"]) == 2 for c in metrics["cases"]
+               if "discrete" in c)

@@ -69,6 +69,9 @@ def pid_controller(
     )
 
 
+_DERIVED: dict = {}  # pid_from_rig by the rig's JSON: the corner's check samples plants
+
+
 def pid_from_rig(cfg) -> dict:
     """A decentralised PID (P5 Eq. 6) from the rig, for a rig without ``[controller.pid]``.
 
@@ -113,6 +116,9 @@ def pid_from_rig(cfg) -> dict:
     from ..model.amb import amb_factors
     from ..model.rotor import assemble_rotor
 
+    key = cfg.model_dump_json()
+    if key in _DERIVED:
+        return dict(_DERIVED[key])
     ratio = [ks / ki for a in cfg.amb for ki, ks in zip(*amb_factors(a))]
     ks_over_ki = float(np.mean(ratio))
     ki = float(np.mean([k for a in cfg.amb for k in amb_factors(a)[0]]))
@@ -127,14 +133,16 @@ def pid_from_rig(cfg) -> dict:
     frac = _corner_for_target(cfg, kp, ti, td)
     eps = float(1 / (2 * np.pi * frac * fs * td))
     lost = np.degrees((cfg.controller.delay_samples + 0.5) * w_n / fs)
-    return {"kp": float(kp), "ti": ti, "td": td, "eps": eps, "corner_hz": frac * fs,
-            "rule": f"k_eq = {K_EQ_PER_KS:g} Ks, ζ = {PID_ZETA:g} on the rigid-body modes "
-                    f"({w_n / (2 * np.pi):.3g} Hz), Ti = {TI_PER_OMEGA_N:g}/ω_n, derivative "
-                    f"filter at f_s/{1 / frac:.3g} = {frac * fs:.4g} Hz (ε = {eps:.2g}; the "
-                    f"first of f_s/"
-                    f"{', f_s/'.join(f'{1 / c:.3g}' for c in PID_CORNERS_PER_FS)} that "
-                    f"keeps {KEEP_OF_STRUCTURAL:g} of the structural damping as it runs, "
-                    f"else the best); sampling and delay cost {lost:.1f}° at ω_n"}
+    out = {"kp": float(kp), "ti": ti, "td": td, "eps": eps, "corner_hz": frac * fs,
+           "rule": f"k_eq = {K_EQ_PER_KS:g} Ks, ζ = {PID_ZETA:g} on the rigid-body modes "
+                   f"({w_n / (2 * np.pi):.3g} Hz), Ti = {TI_PER_OMEGA_N:g}/ω_n, derivative "
+                   f"filter at f_s/{1 / frac:.3g} = {frac * fs:.4g} Hz (ε = {eps:.2g}; the "
+                   f"first of f_s/"
+                   f"{', f_s/'.join(f'{1 / c:.3g}' for c in PID_CORNERS_PER_FS)} that "
+                   f"keeps {KEEP_OF_STRUCTURAL:g} of the structural damping as it runs, "
+                   f"else the best); sampling and delay cost {lost:.1f}° at ω_n"}
+    _DERIVED[key] = out
+    return dict(out)
 
 
 def _zeta_z(z: np.ndarray) -> np.ndarray:
@@ -150,13 +158,13 @@ def _corner_for_target(cfg, kp: float, ti: float, td: float) -> float:
     from ..model.amb import channel_names
     from ..model.rig import build_plant
     from .digital import discretize_as, with_delay
-    from .specs import design_spec
+    from .specs import judged_conditions
 
-    sp = design_spec(cfg)
+    pressures, speeds = judged_conditions(cfg)
     fs, delay = cfg.controller.sample_rate_hz, cfg.controller.delay_samples
     plants = []
-    for p in sp.pressures_bar:
-        for f in sp.speeds_hz:
+    for p in pressures:
+        for f in speeds:
             pl = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * f)
             cur = pl.current_inputs()
             G = (pl.A, pl.B[:, cur], pl.C, pl.D[:, cur])

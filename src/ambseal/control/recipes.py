@@ -44,6 +44,7 @@ import numpy as np
 
 from ..errors import ConfigError, SynthesisError
 from ..model.amb import channel_names
+from .pid import pid_from_rig  # noqa: F401 — its home is control.pid; kept importable here
 from .weights import Weights
 
 __all__ = ["DesignResult", "design", "full_order_check", "METHODS"]
@@ -139,7 +140,7 @@ class DesignResult:
 
 
 def _pid(cfg, p):
-    from .pid import pid_controller, pid_from_rig
+    from .pid import pid_controller
 
     pid = getattr(getattr(cfg, "controller", None), "pid", None)
     notes = ()

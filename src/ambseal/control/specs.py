@@ -50,7 +50,7 @@ import numpy as np
 
 from ..errors import ConfigError
 
-__all__ = ["Machine", "DesignSpec", "machine", "design_spec", "round_125"]
+__all__ = ["Machine", "DesignSpec", "machine", "design_spec", "round_125", "judged_conditions"]
 
 RIGID_STATES = 8  # 2 translations and 2 tilts of a rigid rotor, 2 states each
 SAMPLES_PER_IMPULSE = 100
@@ -450,13 +450,7 @@ def design_spec(cfg, pressure_bar: float | None = None) -> DesignSpec:
                                       else None)
     imp_s = d.impulse.duration_s or SAMPLES_PER_IMPULSE / mach.sample_rate_hz
     rules["impulse"] = "bias current / 120 for 100 controller samples"
-    if d.pressures_bar is not None:
-        pressures = tuple(d.pressures_bar)
-    elif _scheduled(cfg):
-        pressures = (cfg.operating.pressure_bar,)
-    else:
-        pressures = (0.0, p, 2 * p) if p > 0 else (0.0,)
-    speeds = tuple(d.speeds_hz) if d.speeds_hz is not None else _speeds(cfg)
+    pressures, speeds = judged_conditions(cfg, p)
     mu = d.mu
     return DesignSpec(
         machine=mach, d_e=d_e, d_u=d_u, model_states=n, model_cutoff_hz=cut,
@@ -468,6 +462,21 @@ def design_spec(cfg, pressure_bar: float | None = None) -> DesignSpec:
         uncertainty=_uncertainty(cfg, d, rules, notes, p), weights=weights,
         max_iter=mu.max_iter or 6, dk_order=mu.dk_order if mu.dk_order is not None else 2,
         sources=rules, notes=tuple(notes))
+
+
+def judged_conditions(cfg, pressure_bar: float | None = None) -> tuple[tuple, tuple]:
+    """The judged pressures (bar) and speeds (Hz): ``[design] pressures_bar``/``speeds_hz``,
+    else 0, nominal and 2× nominal pressure (the nominal one alone on a rig judged at
+    speeds) and :func:`_speeds` (module docstring, "Judged conditions")."""
+    d = cfg.design
+    p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
+    if d.pressures_bar is not None:
+        pressures = tuple(d.pressures_bar)
+    elif _scheduled(cfg):
+        pressures = (cfg.operating.pressure_bar,)
+    else:
+        pressures = (0.0, p, 2 * p) if p > 0 else (0.0,)
+    return pressures, tuple(d.speeds_hz) if d.speeds_hz is not None else _speeds(cfg)
 
 
 def _speeds(cfg) -> tuple:

@@ -327,7 +327,7 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
                            sources=sources) if len(records) > 1 else None
     pressures = sorted({float(m.metadata.get("pressure_drop_pa", 0.0)) / 1e5 for m in records})
     warnings = advice(res.budget, cfg, names, pressures)
-    if res.mismatch:
+    if res.residuals.failed:  # a disputed fixed value is told by advice() already
         warnings.append(f"{MISMATCH} (residuals correlate with the excitation on "
                         f"{', '.join(res.residuals.failed)})")
     write_json(out / "fit.json", {**res.to_dict(), "warnings": warnings,
@@ -358,6 +358,7 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
                 for n, v, lo, hi in zip(res.names, res.estimate, res.ci95_low, res.ci95_high)},
             "nrmse_fit_pct": {k: _finite(v) for k, v in res.nrmse_fit_pct.items()},
             "residual_test": res.residuals.to_dict()["verdict"],
+            "model_check": res.model_check()["verdict"],
             "warnings": warnings}
 
 

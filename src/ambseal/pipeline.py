@@ -109,6 +109,7 @@ def _identification(cfg: RigConfig, truth, out: Path, say, controller
                                            cfg.operating.pressure_bar)
     a = res.amb
     summary = {"parameters": errors, "converged": bool(a.converged),
+               "model_check": a.model_check(),
                "nrmse_fit_pct": {k: (float(v) if math.isfinite(v) else None)
                                  for k, v in a.nrmse_fit_pct.items()}}
     return summary, figs, sections

@@ -51,14 +51,15 @@ def test_budget_covers_a_coupling_held_wrong_and_names_it(testrig_cfg):
     """Two seeds, coupling held 4 % off: the noise-only intervals miss A's Ks (the bias of
     several standard errors the issue reports), the intervals with the fixed-parameter
     budget contain every truth, the budget names the coupling as dominant and the score
-    test disputes both coupling values. Reference: the facility's truth (the rig file's
+    test disputes both coupling values, which marks the fit a model mismatch. Reference: the facility's truth (the rig file's
     coupling is known to be 4 % off)."""
-    inside, inside_noise, _, _, dominant, disputed = _run(testrig_cfg, "fixed values off",
-                                                          range(2), 0.3)
+    inside, inside_noise, _, flagged, dominant, disputed = _run(
+        testrig_cfg, "fixed values off", range(2), 0.3)
     assert inside.all(), inside
     assert not inside_noise[:, NAMES.index("A.Ks_zeta")].any()
     assert all({"coupling.kxx", "coupling.kyy"} <= set(d) for d in dominant)
     assert all({"coupling.kxx", "coupling.kyy"} <= set(d) for d in disputed)
+    assert flagged.all()  # the model check: a disputed fixed value is a model mismatch
 
 
 @pytest.mark.slow

@@ -31,6 +31,13 @@ An ``uncertainty = { key = σ }`` table beside the values in the rig file (σ re
 ``kxx, kyy, kxy, kyx, cxx, cyy``; a seal's ``K, k, C, c``; ``[actuator]``'s
 ``eddy_time_constant``), else :data:`DEFAULT_UNCERTAINTY` per kind. A value of zero carries
 no uncertainty in this relative form (a seal's pressure-driven K, k at 0 bar, say).
+
+Values an earlier fit found (``known`` of :func:`ambseal.identify.stages.identify` with
+that fit's result, as the procedure of ``ambseal run`` does from stage to stage) carry that
+fit's standard errors *and correlations*: their block of the fixed values' covariance is the
+earlier fit's, C = diag(σ) R diag(σ), and the added covariance is G C Gᵀ. The shares below
+use the diagonal (each value's σ alone). Such a value is disputed when the offset the data
+suggest is beyond its own interval: the score statistic over √(se² + σ²) of the offset.
 """
 
 from __future__ import annotations
@@ -159,6 +166,11 @@ class ErrorBudget:
     offset_rel, offset_rel_se : ndarray (q,) or None
         The relative offset φ/φ₀ − 1 the data suggest for each fixed value (one
         Gauss–Newton step with θ free), and its standard error.
+    correlation : ndarray (q, q) or None
+        Correlation of the fixed values' errors (None: independent); non-zero off the
+        diagonal between values an earlier fit estimated together.
+    estimated : ndarray (q,) of bool or None
+        Which fixed values are an earlier fit's estimates (σ its standard error).
     """
 
     fitted: tuple[str, ...]
@@ -171,6 +183,20 @@ class ErrorBudget:
     score_z: np.ndarray | None = None
     offset_rel: np.ndarray | None = None
     offset_rel_se: np.ndarray | None = None
+    correlation: np.ndarray | None = None
+    estimated: np.ndarray | None = None
+
+    def test_z(self) -> np.ndarray | None:
+        """The statistic :meth:`disputed` compares: the score z of a value held as exact;
+        for an earlier fit's estimate, its suggested offset over √(se² + σ²) (module
+        docstring)."""
+        if self.score_z is None:
+            return None
+        if self.estimated is None or not np.any(self.estimated):
+            return np.asarray(self.score_z, float)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            adj = self.offset_rel / np.hypot(self.offset_rel_se, self.sigma_rel)
+        return np.where(self.estimated, adj, self.score_z)
 
     def disputed(self, level: float = 0.01) -> list[str]:
         """Fixed values the data reject at ``level`` (two-sided, Bonferroni over the
@@ -179,7 +205,7 @@ class ErrorBudget:
             return []
         from scipy.stats import norm
 
-        z = np.abs(np.nan_to_num(self.score_z))
+        z = np.abs(np.nan_to_num(self.test_z()))
         crit = norm.isf(level / (2 * max(len(self.fixed), 1)))
         return [self.fixed[j] for j in np.argsort(-z) if z[j] > crit]
 
@@ -213,14 +239,15 @@ class ErrorBudget:
             "dominant": self.dominant(),
             **({"score_test": {
                 n: {"z": float(z), "offset_rel": float(o), "offset_rel_se": float(e)}
-                for n, z, o, e in zip(self.fixed, self.score_z, self.offset_rel,
+                for n, z, o, e in zip(self.fixed, self.test_z(), self.offset_rel,
                                       self.offset_rel_se)},
                 "disputed": self.disputed()} if self.score_z is not None else {}),
         }
 
 
 def propagate(J: np.ndarray, J_fixed: np.ndarray, scale: np.ndarray, fitted, fixed,
-              sigma_rel, source, noise_variance, score=None) -> ErrorBudget:
+              sigma_rel, source, noise_variance, score=None, correlation=None,
+              estimated=None) -> ErrorBudget:
     """The error budget from the Jacobians at the optimum (module docstring).
 
     Parameters
@@ -234,12 +261,22 @@ def propagate(J: np.ndarray, J_fixed: np.ndarray, scale: np.ndarray, fitted, fix
         The estimates' noise variance (SI).
     score : (z, offset_rel, offset_rel_se), optional
         The fixed values' score tests.
+    correlation : ndarray (q, q), optional
+        Correlation of the fixed values' errors (default: independent).
+    estimated : ndarray (q,) of bool, optional
+        Which fixed values are an earlier fit's estimates.
     """
     G = -np.linalg.lstsq(J, J_fixed, rcond=None)[0] * np.asarray(scale)[:, None]
     sig = np.asarray(sigma_rel, dtype=float)
-    cov = (G * sig**2) @ G.T
+    C = np.diag(sig**2) if correlation is None else np.outer(sig, sig) * correlation
+    cov = G @ C @ G.T
     return ErrorBudget(tuple(fitted), tuple(fixed), sig, tuple(source), G, cov,
-                       np.asarray(noise_variance, dtype=float), *(score or ()))
+                       np.asarray(noise_variance, dtype=float), *(score or (None,) * 3),
+                       correlation, None if estimated is None else np.asarray(estimated, bool))
+
+
+def _estimated(budget: ErrorBudget, j: int) -> bool:
+    return budget.estimated is not None and bool(budget.estimated[j])
 
 
 def advice(budget: ErrorBudget | None, cfg, fitted, pressures_bar, share: float = 0.3
@@ -263,9 +300,10 @@ def advice(budget: ErrorBudget | None, cfg, fitted, pressures_bar, share: float 
             j = budget.fixed.index(name)
             out.append(
                 f"the data disagree with the fixed value of {name} (score test z = "
-                f"{budget.score_z[j]:+.1f}; they suggest {100 * budget.offset_rel[j]:+.2g} ± "
-                f"{100 * budget.offset_rel_se[j]:.2g} % from the rig file's): fit it, on "
-                "records that separate it")
+                f"{budget.test_z()[j]:+.1f}; they suggest {100 * budget.offset_rel[j]:+.2g} ± "
+                f"{100 * budget.offset_rel_se[j]:.2g} % from "
+                f"{'the earlier estimate' if _estimated(budget, j) else 'the rig file'}"
+                "'s): fit it, on records that separate it")
         frac = budget.shares()
         for name in budget.dominant(share):
             j = budget.fixed.index(name)

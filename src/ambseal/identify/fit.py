@@ -34,7 +34,7 @@ from ..lti.discrete import simulate_lti, zoh
 from ..lti.interconnect import series_inputs
 from .budget import ErrorBudget, propagate
 from .loop import DiscreteController, closed_loop_matrices
-from .residuals import ResidualTests, residual_tests
+from .residuals import MISMATCH, ResidualTests, residual_tests
 
 __all__ = ["FitResult", "ClosedLoopModel", "fit_parameters", "default_bounds", "nrmse_fit"]
 
@@ -163,8 +163,33 @@ class FitResult:
 
     @property
     def mismatch(self) -> bool:
-        """Whether the residual tests say the model does not reproduce the data."""
-        return bool(self.residuals is not None and self.residuals.mismatch)
+        """Whether the model check fails (:meth:`model_check`)."""
+        return self.model_check()["mismatch"]
+
+    def model_check(self) -> dict:
+        """The fit's verdict on its own model: a mismatch when the residuals correlate with
+        the excitation (:mod:`ambseal.identify.residuals`, Ljung §16.6) or the data dispute
+        a value the fit held fixed (score test, :mod:`ambseal.identify.budget`) — the two
+        see different faults: unmodelled dynamics, and a wrong value of a modelled one.
+
+        Returns
+        -------
+        dict
+            ``residuals_correlated`` (channels), ``disputed`` (fixed values), ``mismatch``
+            (bool) and ``verdict`` (text).
+        """
+        failed = self.residuals.failed if self.residuals is not None else []
+        disputed = self.budget.disputed() if self.budget is not None else []
+        parts = ([f"residuals correlate with the excitation on {', '.join(failed)}"]
+                 if failed else [])
+        if disputed:
+            parts.append(f"the data dispute the fixed value of {', '.join(disputed)} (score "
+                         "test); the intervals hold only as far as its stated uncertainty does")
+        return {"residuals_correlated": list(failed), "disputed": disputed,
+                "mismatch": bool(parts),
+                "verdict": f"{MISMATCH} ({'; '.join(parts)})" if parts else
+                "no mismatch found: residuals independent of the excitation"
+                + (", no fixed value disputed" if self.budget is not None else "")}
 
     def value(self, name: str) -> float:
         return float(self.estimate[self.names.index(name)])
@@ -193,6 +218,7 @@ class FitResult:
             out["error_budget"] = self.budget.to_dict()
         if self.residuals is not None:
             out["residual_tests"] = self.residuals.to_dict()
+            out["model_check"] = self.model_check()
         return out
 
 
@@ -259,6 +285,7 @@ def fit_parameters(
     max_nfev: int = 200,
     window: tuple[int, int | None] = (0, None),
     fixed: dict[str, tuple[float, str]] | None = None,
+    fixed_correlation: tuple[tuple[str, ...], np.ndarray] | None = None,
 ) -> FitResult:
     """Fit parameters ``names`` to one or more closed-loop records.
 
@@ -286,6 +313,9 @@ def fit_parameters(
         ``{name: (σ relative, source)}`` of parameters held at the models' values
         (:func:`ambseal.identify.budget.fixed_uncertainty`); their error budget is added to
         the covariance and the intervals. None: the noise covariance alone.
+    fixed_correlation : (names, R), optional
+        Fixed values that an earlier fit estimated together, and the correlation (m, m) of
+        those estimates (their σ in ``fixed`` are its relative standard errors).
 
     Raises
     ------
@@ -349,7 +379,7 @@ def fit_parameters(
     cov = cov * np.outer(scale, scale)
     se_noise = np.sqrt(np.diag(cov))
     budget = _budget(sol.jac, scale, names, fixed, models, residual_blocks, sol.x,
-                     se_noise**2, sol.fun, blocks)
+                     se_noise**2, sol.fun, blocks, fixed_correlation)
     if budget is not None:
         cov = cov + budget.covariance
     se = np.sqrt(np.diag(cov))
@@ -383,11 +413,12 @@ def _nominal(model: ClosedLoopModel, name: str) -> float:
     return model.tau_e if name == TAU_E else model.plant.parameter(name).nominal
 
 
-def _budget(J, scale, names, fixed, models, residual_blocks, x, noise_var, r, blocks
-            ) -> ErrorBudget | None:
+def _budget(J, scale, names, fixed, models, residual_blocks, x, noise_var, r, blocks,
+            correlated=None) -> ErrorBudget | None:
     """The fixed parameters' error budget by central differences of the residuals in each
     fixed value (relative step 10⁻³, every model alike), with each fixed value's score test
-    (:func:`_score_test`); None without fixed values."""
+    (:func:`_score_test`) and the correlation of those an earlier fit estimated together
+    (``correlated`` = (names, R)); None without fixed values."""
     use = [(n, s, src) for n, (s, src) in (fixed or {}).items()
            if s > 0 and any(_nominal(m, n) != 0 for m in models)]
     if not use:
@@ -399,8 +430,18 @@ def _budget(J, scale, names, fixed, models, residual_blocks, x, noise_var, r, bl
         dn = np.concatenate([R.ravel() for R in residual_blocks(x, (n, -h))])
         cols.append((up - dn) / (2 * h))
     Jf = np.column_stack(cols)
-    return propagate(J, Jf, scale, names, [u[0] for u in use], [u[1] for u in use],
-                     [u[2] for u in use], noise_var, score=_score_test(J, Jf, r, blocks))
+    fixed_names = [u[0] for u in use]
+    corr, estimated = np.eye(len(use)), np.zeros(len(use), bool)
+    if correlated is not None:
+        where = {n: i for i, n in enumerate(correlated[0])}
+        idx = [(j, where[n]) for j, n in enumerate(fixed_names) if n in where]
+        for j, a in idx:
+            estimated[j] = True
+            for k, b in idx:
+                corr[j, k] = correlated[1][a, b] if j != k else 1.0
+    return propagate(J, Jf, scale, names, fixed_names, [u[1] for u in use],
+                     [u[2] for u in use], noise_var, score=_score_test(J, Jf, r, blocks),
+                     correlation=np.nan_to_num(corr), estimated=estimated)
 
 
 def _split(M: np.ndarray, blocks_at_optimum: list) -> list:

@@ -41,8 +41,10 @@ def uncertainty_from_fit(path: str | Path, names=None) -> dict[str, tuple[float,
     DataError
         An unreadable file, no ``parameters`` table, a requested name it does not hold, or
         an interval that is missing or not finite (a fit whose covariance failed), naming
-        the file and the parameter. A fit flagged "model mismatch" is refused too: its
-        intervals understate the uncertainty.
+        the file and the parameter. A fit whose intervals understate the uncertainty is
+        refused too: residuals that correlate with the excitation, or a fixed value the
+        data dispute by more than the 95 % band of its stated uncertainty (the offset the
+        score test suggests beyond 1.96 σ: the budget in the intervals does not cover it).
     """
     p = Path(path)
     try:
@@ -58,6 +60,11 @@ def uncertainty_from_fit(path: str | Path, names=None) -> dict[str, tuple[float,
         raise DataError(f"{p}: residual_tests: model mismatch — its intervals understate the "
                         "uncertainty; fix the model (see the fit's warnings) before designing "
                         "on them")
+    beyond = _disputed_beyond_budget(fit)
+    if beyond:
+        raise DataError(f"{p}: error_budget.disputed: model mismatch — the data put "
+                        f"{', '.join(beyond)} outside the uncertainty the intervals carry for "
+                        "it; fit it (see the fit's warnings) before designing on them")
     wanted = [n for n in params if n != "tau_e"] if names is None else list(names)
     out = {}
     for n in wanted:
@@ -71,4 +78,20 @@ def uncertainty_from_fit(path: str | Path, names=None) -> dict[str, tuple[float,
             raise DataError(f"{p}: parameters.{n}.ci95: expected [low, high], finite with "
                             f"low < high, got {ci!r}")
         out[n] = (float(ci[0]), float(ci[1]))
+    return out
+
+
+def _disputed_beyond_budget(fit: dict) -> list[str]:
+    """Disputed fixed values of a fit.json whose suggested offset exceeds 1.96 σ_stated."""
+    budget = fit.get("error_budget") or {}
+    tests, fixed = budget.get("score_test") or {}, budget.get("fixed") or {}
+    out = []
+    for n in budget.get("disputed") or []:
+        try:
+            off, sig = float(tests[n]["offset_rel"]), float(fixed[n]["sigma_rel"])
+        except (KeyError, TypeError, ValueError):
+            out.append(n)
+            continue
+        if not abs(off) <= 1.96 * sig:
+            out.append(n)
     return out

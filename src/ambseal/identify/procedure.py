@@ -6,6 +6,11 @@ from a stepped sine at the nominal pressure, with a zero-pressure run as the bia
 (P4 Fig. 12), and per pressure drop from impulse runs (0.05 A for 10 ms on both bearings in
 ζ, P5 §3.3) with regression lines against pressure (P5 Fig. 7); (d) the identified rig.
 
+Every fit adds the error budget of the values it holds (:mod:`ambseal.identify.budget`):
+an earlier stage's estimates with that stage's standard errors and correlations, anything
+else (the seal in stages (a)–(b)) with its stated or default uncertainty; its model check
+says when the data dispute a held value.
+
 Records come from the virtual test facility here; on a real rig, the same stages take the
 measured files (``ambseal identify``).
 """
@@ -83,8 +88,10 @@ class ProcedureResult:
 def _subset(res: FitResult, names: list[str]) -> FitResult:
     """The part of a joint fit that concerns ``names`` (estimates, errors, correlation)."""
     idx = [res.names.index(n) for n in names]
+    noise = None if res.std_error_noise is None else res.std_error_noise[idx]
     return replace(res, names=tuple(names), estimate=res.estimate[idx],
                    initial=res.initial[idx], std_error=res.std_error[idx],
+                   std_error_noise=noise,
                    ci95_low=res.ci95_low[idx], ci95_high=res.ci95_high[idx],
                    correlation=res.correlation[np.ix_(idx, idx)])
 
@@ -129,8 +136,8 @@ def thesis_procedure(
     rec_a = acquire(cfg, truth, ex, controller=controller, pressure_bar=0.0, seed=seed)
     names_a = [f"{m}.{q}_{x}" for m in ambs for q in ("Ki", "Ks") for x in ("zeta", "eta")]
     names_a.append(TAU_E)
-    amb = identify(cfg, [rec_a], names_a)
-    known = dict(zip(amb.names, amb.estimate))
+    amb = identify(cfg, [rec_a], names_a, budget=True)
+    known, known_fit = dict(zip(amb.names, amb.estimate)), amb
 
     coupling = None
     records = {"a": rec_a}
@@ -141,16 +148,16 @@ def thesis_procedure(
         rec_b = acquire(cfg, truth, ex, controller=controller, pressure_bar=0.0, seed=seed + 1)
         records["b"] = rec_b
         names_b = [f"{spring}.kxx", f"{spring}.kyy"]
-        coupling = identify(cfg, [rec_b], names_b, known=known)
+        coupling = identify(cfg, [rec_b], names_b, known=known, known_fit=amb, budget=True)
         # (a) assumed the nominal coupling, which sits beside AMB A: its error goes into
         # A's Ks, and (b) then inherits that bias. A joint fit of (a)'s and (b)'s parameters
         # on both records, started from the sequential estimates, removes it.
         say("identification (a)+(b): joint fit on both records")
         start = {**known, **dict(zip(coupling.names, coupling.estimate))}
-        joint = identify(cfg, [rec_a, rec_b], names_a + names_b, known=start)
+        joint = identify(cfg, [rec_a, rec_b], names_a + names_b, known=start, budget=True)
         amb = _subset(joint, names_a)
         coupling = _subset(joint, names_b)
-        known = dict(zip(joint.names, joint.estimate))
+        known, known_fit = dict(zip(joint.names, joint.estimate)), joint
 
     seal_freq: dict = {}
     seal_press: list = []
@@ -164,7 +171,8 @@ def thesis_procedure(
                               settling_cycles=5, sample_rate_hz=fs, axes=axes, excited=zeta)
             rec = acquire(cfg, truth, ex, controller=controller, pressure_bar=p, seed=seed + 2)
             seal_freq[p] = [
-                (f, identify(cfg, [rec], names_s, known=known, window=(a, b), refine=False))
+                (f, identify(cfg, [rec], names_s, known=known, window=(a, b), refine=False,
+                             known_fit=known_fit, budget=True))
                 for f, a, b in ex.windows
             ]
         for i, p in enumerate(impulse_pressures_bar):
@@ -172,7 +180,8 @@ def thesis_procedure(
             ex = impulse(amplitude_a=0.05, width_s=0.01, start_s=0.05, duration_s=0.4,
                          sample_rate_hz=fs, axes=axes, excited=zeta)
             rec = acquire(cfg, truth, ex, controller=controller, pressure_bar=p, seed=seed + 10 + i)
-            seal_press.append((p, identify(cfg, [rec], names_s, known=known, refine=False)))
+            seal_press.append((p, identify(cfg, [rec], names_s, known=known, refine=False,
+                                           known_fit=known_fit, budget=True)))
         for j, c in enumerate(SEAL_COEFFICIENTS):
             regression[c] = linear_regression(
                 [p for p, _ in seal_press], [r.estimate[j] for _, r in seal_press],

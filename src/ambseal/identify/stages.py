@@ -179,7 +179,8 @@ def build_models(cfg: RigConfig, records: list[Measurement], values: dict | None
 def identify(cfg: RigConfig, records: list[Measurement], names: list[str], *,
              known: dict | None = None, current_weight: float = 0.0, refine: bool = True,
              window: tuple[int, int | None] = (0, None), controllers: list | None = None,
-             budget: bool = False, sources: list[str] | None = None) -> FitResult:
+             budget: bool = False, sources: list[str] | None = None,
+             known_fit: FitResult | None = None) -> FitResult:
     """Fit ``names`` to closed-loop records (P2 Eqs. 9–10, P4 Eq. 14).
 
     Parameters
@@ -193,11 +194,14 @@ def identify(cfg: RigConfig, records: list[Measurement], names: list[str], *,
     controllers : list of DiscreteController, optional
         The controller that ran for each record; by default from the records' metadata.
     budget : bool
-        Add the error budget of every parameter held fixed (neither fitted nor ``known``) to
-        the intervals, with the uncertainty the rig file states or the defaults of
-        :mod:`ambseal.identify.budget`.
+        Add the error budget of every parameter held fixed to the intervals: values neither
+        fitted nor ``known`` with the uncertainty the rig file states or the defaults of
+        :mod:`ambseal.identify.budget`; ``known`` values that ``known_fit`` estimated with
+        its standard errors and correlations; other ``known`` values as exact.
     sources : list of str, optional
         The records' file names, for errors.
+    known_fit : FitResult, optional
+        The earlier fit that found (some of) the ``known`` values.
 
     Raises
     ------
@@ -210,21 +214,39 @@ def identify(cfg: RigConfig, records: list[Measurement], names: list[str], *,
         bounds = default_bounds(models[0], names)
     except ModelError as exc:
         raise IdentificationError(f"fit: {exc}") from None
-    fixed = None
+    fixed, corr = None, None
     if budget:
         params = list(models[0].plant.parameters) + ([TAU_E] if models[0].tau_e > 0 else [])
         fixed = fixed_uncertainty(cfg, params, list(names) + list(known))
+        if known_fit is not None:
+            fixed, corr = _with_estimates(fixed, known, known_fit, names)
     res = fit_parameters(records, models, names, current_weight=current_weight, window=window,
-                         bounds=bounds, fixed=fixed)
+                         bounds=bounds, fixed=fixed, fixed_correlation=corr)
     if refine and res.converged:
         est = dict(zip(names, res.estimate))
         models = build_models(cfg, records, {**known, **est}, controllers=controllers,
                               sources=sources)
         res2 = fit_parameters(records, models, names, current_weight=current_weight,
-                              window=window, bounds=bounds, fixed=fixed)
+                              window=window, bounds=bounds, fixed=fixed,
+                              fixed_correlation=corr)
         if res2.converged:
             res = res2
     return res
+
+
+def _with_estimates(fixed: dict, known: dict, fit: FitResult, names) -> tuple[dict, tuple]:
+    """``fixed`` plus the ``known`` values ``fit`` estimated, each with its relative standard
+    error (source ``"estimate (earlier fit)"``), and (names, correlation) of those."""
+    take = [n for n in fit.names if n in known and n not in names]
+    idx = [fit.names.index(n) for n in take]
+    out = dict(fixed)
+    for n, i in zip(take, idx):
+        v = abs(float(known[n]))
+        if v > 0 and np.isfinite(fit.std_error[i]):
+            out[n] = (float(fit.std_error[i]) / v, "estimate (earlier fit)")
+    sign = np.sign([float(known[n]) for n in take])  # of the relative errors Δφ/φ
+    return out, (tuple(take), np.asarray(fit.correlation)[np.ix_(idx, idx)]
+                 * np.outer(sign, sign))
 
 
 def record_spread(cfg: RigConfig, records: list[Measurement], names: list[str],

@@ -154,7 +154,7 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
                         f"{1.96 * e['slope_se']:.3g}</td><td></td></tr>")
     fits = ", ".join(f"{k} {v:.1f} %" for k, v in a.nrmse_fit_pct.items())
     if a.residuals is not None:
-        fits += f"; residual test: {a.residuals.to_dict()['verdict']}"
+        fits += f". Model check of stage (a)+(b): {_model_check_text(a, errors)}"
     section = {
         "title": "Identification on the virtual test facility",
         "html": ("<p>Records from the virtual facility (nonlinear AMB force law, full FE rotor, "
@@ -164,6 +164,32 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
                  "<th>95 % interval</th><th>error</th></tr>" + "".join(rows) + "</table>"),
     }
     return figs, [section]
+
+
+def _model_check_text(fit, errors: dict) -> str:
+    """The verdict of a procedure fit's model check, with what each disputed fixed value
+    is: the offset the data suggest, the uncertainty the intervals carry for it and, for a
+    seal coefficient, stage (c)'s estimate at 0 bar."""
+    check = fit.model_check()
+    if not check["disputed"]:
+        return html.escape(check["verdict"])
+    b = fit.budget
+    parts = []
+    for n in check["disputed"]:
+        j = b.fixed.index(n)
+        later = errors.get(n, {})
+        seen = (f"; stage (c) finds {sig(later['intercept'], 3)} ± "
+                f"{sig(1.96 * later['intercept_se'], 2)} at 0 bar" if "intercept" in later else "")
+        parts.append(f"{html.escape(n)}: the data suggest {100 * b.offset_rel[j]:+.0f} ± "
+                     f"{100 * 1.96 * b.offset_rel_se[j]:.0f} % from the value held "
+                     f"({html.escape(b.source[j])}, σ = {100 * b.sigma_rel[j]:.3g} % in the "
+                     f"intervals){seen}")
+    failed = check["residuals_correlated"]
+    return ("model mismatch — the stage holds values the data dispute (score test): "
+            + "; ".join(parts) + ". Its intervals carry those values' stated uncertainty "
+            "(error budget); the estimates are biased by what the held values are off"
+            + (f"; the residuals correlate with the excitation on {', '.join(failed)}, as "
+               "a wrong held value makes them" if failed else ""))
 
 
 def _styles(curves: list) -> tuple[dict, dict]:

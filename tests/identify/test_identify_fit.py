@@ -103,3 +103,44 @@ def test_unknown_parameter_is_one_clear_error(rig, prbs_fit):
     rec, _ = prbs_fit
     with pytest.raises(IdentificationError, match="unknown parameter 'A.Kx_zeta'"):
         fit_parameters([rec], build_models(rig, [rec]), ["A.Kx_zeta"])
+
+
+def test_sandwich_intervals_cover_on_a_resonant_regression():
+    """The covariance and intervals of :func:`ambseal.identify.fit._covariance` on a linear
+    least-squares problem shaped like a closed-loop fit: regressors and noise both a PRBS or
+    white noise through lightly damped resonances (40–300 Hz at 10 kHz), two channels, three
+    parameters. Reference: Monte Carlo over 200 noise draws with the true θ known — the 95 %
+    intervals (leverage-corrected sandwich, Student's t with the Satterthwaite degrees of
+    freedom) cover each parameter in ≥ 90 % of draws, the issue's bar. Without the
+    corrections (1.96 × the plain sandwich) the first parameter, whose regressor and noise
+    share the 40 Hz resonance, is covered in 83 %."""
+    from scipy.signal import lfilter
+    from scipy.stats import t as student
+
+    from ambseal.identify.fit import _covariance
+
+    rng = np.random.default_rng(0)
+    n, fs = 3000, 1e4
+
+    def reson(x, f, z):
+        w = 2 * np.pi * f / fs
+        r = np.exp(-z * w)
+        return lfilter([1 - r], [1, -2 * r * np.cos(w * np.sqrt(1 - z * z)), r * r], x)
+
+    u = np.repeat(rng.choice([-1.0, 1.0], n // 10 + 1), 10)[:n]
+    J = np.zeros((n, 2, 3))
+    J[:, 0, 0], J[:, 1, 0] = reson(u, 40, 0.05), 0.5 * reson(u, 40, 0.05)
+    J[:, 0, 1], J[:, 1, 1] = reson(u, 120, 0.03), 0.3 * reson(u, 120, 0.03)
+    J[:, 0, 2], J[:, 1, 2] = 0.2 * reson(u, 300, 0.1), reson(u, 45, 0.08)
+    Jm = J.reshape(-1, 3)
+    Hinv = np.linalg.inv(Jm.T @ Jm)
+    inside = []
+    for _ in range(200):
+        e = np.column_stack([reson(rng.standard_normal(n), 40, 0.05)
+                             + 0.3 * rng.standard_normal(n),
+                             reson(rng.standard_normal(n), 45, 0.08)])
+        d = Hinv @ (Jm.T @ e.ravel())  # estimate − truth
+        r = e.ravel() - Jm @ d
+        cov, dof = _covariance(Jm, r, [e], 3)
+        inside.append(np.abs(d) <= student.ppf(0.975, dof) * np.sqrt(np.diag(cov)))
+    assert (np.mean(inside, axis=0) >= 0.90).all(), np.mean(inside, axis=0)

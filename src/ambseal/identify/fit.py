@@ -15,8 +15,14 @@ controller that ran (:mod:`ambseal.identify.loop`).
 Uncertainty: the covariance of θ̂ from the Jacobian at the optimum. Closed-loop residuals
 are coloured (sensor noise runs through the loop), so the sandwich form
 (JᵀJ)⁻¹ S (JᵀJ)⁻¹ is used, with S = Var(Jᵀr) from the residuals' cross-spectrum
-(:func:`_long_run_covariance`); with white residuals it reduces to σ̂²(JᵀJ)⁻¹. 95 % intervals are θ̂ ± 1.96·SE; the correlation
-matrix is the normalised covariance (P4 Tables 2 and 4).
+(:func:`_long_run_covariance`); with white residuals it reduces to σ̂²(JᵀJ)⁻¹. Two
+small-sample corrections keep the intervals from being narrow when the Jacobian's weight
+sits on a few lightly damped resonances: the residual spectrum is corrected for the fit's
+leverage (the HC3 form of MacKinnon & White 1985, per frequency: the residuals are
+orthogonal to J, so their periodogram is short by about the leverage where J is large),
+and the 95 % intervals take Student's t with the Satterthwaite effective degrees of
+freedom of S (how many independent spectral ordinates carry it) instead of 1.96. The
+correlation matrix is the normalised covariance (P4 Tables 2 and 4).
 """
 
 from __future__ import annotations
@@ -139,6 +145,9 @@ class FitResult:
         What the fixed parameters' uncertainty adds (:mod:`ambseal.identify.budget`).
     residuals : ResidualTests or None
         Whiteness and independence tests (:mod:`ambseal.identify.residuals`).
+    dof_noise : ndarray (p,) or None
+        Effective degrees of freedom of the noise variance (Satterthwaite); the intervals
+        take Student's t with these, combined with the budget's (known, infinite) part.
     """
 
     names: tuple[str, ...]
@@ -160,6 +169,7 @@ class FitResult:
     std_error_noise: np.ndarray | None = None
     budget: ErrorBudget | None = None
     residuals: ResidualTests | None = None
+    dof_noise: np.ndarray | None = None
 
     @property
     def mismatch(self) -> bool:
@@ -204,6 +214,8 @@ class FitResult:
                 n: {"estimate": float(self.estimate[i]), "initial": float(self.initial[i]),
                     "std_error": f([self.std_error[i]])[0],
                     "std_error_noise": f([noise[i]])[0],
+                    **({"dof_noise": f([self.dof_noise[i]])[0]}
+                       if self.dof_noise is not None else {}),
                     "ci95": f([self.ci95_low[i], self.ci95_high[i]])}
                 for i, n in enumerate(self.names)
             },
@@ -222,7 +234,8 @@ class FitResult:
         return out
 
 
-def _long_run_covariance(J: np.ndarray, R: np.ndarray, smooth: int = 2) -> np.ndarray:
+def _long_run_covariance(J: np.ndarray, R: np.ndarray, smooth: int = 2,
+                         Hinv: np.ndarray | None = None):
     """Var(Σ_t J_tᵀ r_t) for residuals r that are a stationary coloured process.
 
     Frequency-domain form of the sandwich's middle term (Ljung, *System Identification*,
@@ -233,12 +246,28 @@ def _long_run_covariance(J: np.ndarray, R: np.ndarray, smooth: int = 2) -> np.nd
     is also largest; a lag-window (Newey–West) estimate smooths those peaks away and
     understates the variance, this one keeps them.
 
+    With ``Hinv`` = (JᵀJ)⁻¹ of the whole fit, the periodogram is first corrected for the
+    fit's leverage: the residuals are orthogonal to J, so R(f) lacks about h(f) = w J(f)
+    (JᵀJ)⁻¹ J(f)ᴴ / L of the noise where J is large (Σ_f tr h = p); P ← (I − h)⁻¹ P (I − h)⁻ᴴ,
+    the HC3 form (MacKinnon & White, J. Econometrics 29, 1985; Long & Ervin, Am. Stat. 54,
+    2000, recommend it for small samples), eigenvalues of I − h floored at 0.1.
+
     Parameters
     ----------
     J : ndarray (N, c, p)
         Jacobian per sample and channel.
     R : ndarray (N, c)
         Residuals.
+    Hinv : ndarray (p, p), optional
+        (JᵀJ)⁻¹ of the fit (all records).
+
+    Returns
+    -------
+    S : ndarray (p, p)
+        Without ``Hinv``.
+    (S, b) : with ``Hinv``, also b (F, p): each frequency bin's share of the variance of
+        (JᵀJ)⁻¹Jᵀr per parameter, spread by the smoothing window (for the effective
+        degrees of freedom, :func:`_covariance`).
     """
     N, c, p = J.shape
     L = 2 * N
@@ -247,17 +276,26 @@ def _long_run_covariance(J: np.ndarray, R: np.ndarray, smooth: int = 2) -> np.nd
     Rf = np.fft.rfft(R, n=L, axis=0)  # (F, c)
     Jf = np.fft.rfft(J, n=L, axis=0)  # (F, c, p)
     P = np.einsum("fa,fb->fab", Rf, Rf.conj()) / N  # (F, c, c) periodogram
+    w = np.full(P.shape[0], 2.0)
+    w[0] = 1.0
+    w[-1] = 1.0
+    if Hinv is not None:
+        h = w[:, None, None] * np.einsum("fap,pq,fbq->fab", Jf, Hinv, Jf.conj()) / L
+        lam, V = np.linalg.eigh(np.eye(c) - h)
+        M = np.einsum("fab,fb,fcb->fac", V, 1 / np.clip(lam, 0.1, None), V.conj())
+        P = M @ P @ np.conj(np.swapaxes(M, 1, 2))
+    kernel = np.ones(2 * smooth + 1) / (2 * smooth + 1)
     if smooth > 0:
-        kernel = np.ones(2 * smooth + 1) / (2 * smooth + 1)
         flat = P.reshape(P.shape[0], -1)
         pad = np.concatenate([flat[smooth:0:-1].conj(), flat, flat[-2:-smooth - 2:-1].conj()])
         flat = np.apply_along_axis(lambda x: np.convolve(x, kernel, mode="valid"), 0, pad)
         P = flat.reshape(P.shape)
-    w = np.full(P.shape[0], 2.0)
-    w[0] = 1.0
-    w[-1] = 1.0
-    S = np.einsum("f,fap,fab,fbq->pq", w, Jf.conj(), P, Jf) / L
-    return np.real(S)
+    S = np.real(np.einsum("f,fap,fab,fbq->pq", w, Jf.conj(), P, Jf)) / L
+    if Hinv is None:
+        return S
+    G = Jf @ Hinv  # (F, c, p): each parameter's combination of the Jacobian's columns
+    q = np.real(np.einsum("f,faj,fab,fbj->fj", w, G.conj(), P, G)) / L
+    return S, np.apply_along_axis(lambda x: np.convolve(x, kernel, mode="same"), 0, q)
 
 
 def default_bounds(model: ClosedLoopModel, names) -> dict[str, tuple[float, float]]:
@@ -374,7 +412,7 @@ def fit_parameters(
         message = f"estimate at its bound: {', '.join(at_bound)}"
 
     blocks = residual_blocks(sol.x)
-    cov = _covariance(sol.jac, sol.fun, blocks, len(names))
+    cov, dof = _covariance(sol.jac, sol.fun, blocks, len(names))
     converged = converged and bool(np.all(np.isfinite(cov)))
     cov = cov * np.outer(scale, scale)
     se_noise = np.sqrt(np.diag(cov))
@@ -383,6 +421,7 @@ def fit_parameters(
     if budget is not None:
         cov = cov + budget.covariance
     se = np.sqrt(np.diag(cov))
+    half = _t_quantile(se_noise**2, se**2, dof) * se
     k = len(records[0].axes)
     tests = residual_tests([R[:, :k] for R in blocks],
                            [np.asarray(d[0])[start:] for d in data], tuple(records[0].axes))
@@ -400,13 +439,25 @@ def fit_parameters(
         fits.update({f"current_{a}": v for a, v in zip(records[0].axes, fi)})
     return FitResult(
         names=tuple(names), estimate=est, initial=init, std_error=se,
-        ci95_low=est - 1.96 * se, ci95_high=est + 1.96 * se, correlation=corr,
+        ci95_low=est - half, ci95_high=est + half, correlation=corr,
         nrmse_fit_pct=fits, converged=converged, message=message,
         iterations=int(sol.nfev), wall_time_s=time.perf_counter() - t0,
         time_s=np.asarray(records[0].time_s)[start:stop], y_meas=y0, y_sim=ys[start:],
         axes=tuple(records[0].axes), std_error_noise=se_noise, budget=budget,
-        residuals=tests,
+        residuals=tests, dof_noise=dof,
     )
+
+
+def _t_quantile(var_noise, var_total, dof_noise) -> np.ndarray:
+    """Student's t 97.5 % quantile of each interval: the noise variance has ``dof_noise``
+    degrees of freedom, the budget's part is taken as known, so ν = v_total² / (v_noise² /
+    ν_noise) (Satterthwaite); 1.96 where ν is not finite."""
+    from scipy.stats import t
+
+    with np.errstate(invalid="ignore", divide="ignore"):
+        nu = np.asarray(var_total) ** 2 / (np.asarray(var_noise) ** 2 / np.asarray(dof_noise))
+    ok = np.isfinite(nu) & (nu > 0)
+    return np.where(ok, t.ppf(0.975, np.where(ok, nu, 1.0)), 1.96)
 
 
 def _nominal(model: ClosedLoopModel, name: str) -> float:
@@ -512,19 +563,27 @@ def _record_data(rec, window, n_params: int):
     return np.asarray(rec.excitation_a)[:stop], y, sy, i, si
 
 
-def _covariance(J: np.ndarray, r: np.ndarray, blocks_at_optimum: list, p: int) -> np.ndarray:
+def _covariance(J: np.ndarray, r: np.ndarray, blocks_at_optimum: list, p: int
+                ) -> tuple[np.ndarray, np.ndarray]:
     """Sandwich covariance of the scaled estimate, (JᵀJ)⁻¹ S (JᵀJ)⁻¹ with S the residuals'
-    long-run covariance per record (:func:`_long_run_covariance`); ``inf`` when JᵀJ is
-    singular. Rows of the stacked residual vector are sample-major per record."""
+    long-run covariance per record, leverage-corrected (:func:`_long_run_covariance`), and
+    each parameter's effective degrees of freedom ν = (Σ b)² / Σ b² over the frequency bins
+    of every record (Satterthwaite, *Biometrics Bull.* 2, 1946: S is a weighted sum of
+    periodogram ordinates, each complex ordinate χ²₂ and two bins of the 2N-point transform
+    per independent one); ``inf`` covariance and NaN ν when JᵀJ is singular. Rows of the
+    stacked residual vector are sample-major per record."""
     blocks = list(zip(_split(J, blocks_at_optimum),
                       [b[..., 0] for b in _split(r[:, None], blocks_at_optimum)]))
     H = J.T @ J
     try:
-        Hinv = np.linalg.inv(H)
-        S = sum(_long_run_covariance(Jb, rb) for Jb, rb in blocks)
-        cov = Hinv @ S @ Hinv * (len(r) / max(len(r) - p, 1))
         if np.linalg.cond(H) > 1e14:
             raise np.linalg.LinAlgError
+        Hinv = np.linalg.inv(H)
+        parts = [_long_run_covariance(Jb, rb, Hinv=Hinv) for Jb, rb in blocks]
+        cov = Hinv @ sum(S for S, _ in parts) @ Hinv
+        b = np.concatenate([b for _, b in parts])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            dof = b.sum(axis=0) ** 2 / (b**2).sum(axis=0)
     except np.linalg.LinAlgError:
-        cov = np.full((p, p), np.inf)
-    return cov
+        cov, dof = np.full((p, p), np.inf), np.full(p, np.nan)
+    return cov, dof

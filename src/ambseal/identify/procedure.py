@@ -89,9 +89,10 @@ def _subset(res: FitResult, names: list[str]) -> FitResult:
     """The part of a joint fit that concerns ``names`` (estimates, errors, correlation)."""
     idx = [res.names.index(n) for n in names]
     noise = None if res.std_error_noise is None else res.std_error_noise[idx]
+    dof = None if res.dof_noise is None else res.dof_noise[idx]
     return replace(res, names=tuple(names), estimate=res.estimate[idx],
                    initial=res.initial[idx], std_error=res.std_error[idx],
-                   std_error_noise=noise,
+                   std_error_noise=noise, dof_noise=dof,
                    ci95_low=res.ci95_low[idx], ci95_high=res.ci95_high[idx],
                    correlation=res.correlation[np.ix_(idx, idx)])
 

@@ -25,7 +25,7 @@ TESTRIG = Path(__file__).resolve().parents[1] / "examples" / "testrig.toml"
 
 
 def _run(rig: Path, out: Path, capsys) -> tuple[dict, str]:
-    code = main(["run", str(rig), "--no-identify", "--quiet", "--out", str(out)])
+    code = main(["--quiet", "run", str(rig), "--no-identify", "--out", str(out)])
     err = capsys.readouterr().err
     assert code == 0, err
     assert "Traceback" not in err

@@ -406,6 +406,11 @@ def _unstable_message(method, check, n, steps, cut_hz) -> str:
     head = (f"design({method}): the controller destabilises the full-order plant{tried}: the "
             f"mode at {check['mode_hz']:.4g} Hz has damping ζ = {check['damping']:.3g} at "
             f"{check['pressure_bar']:g} bar, {check['speed_hz']:g} Hz; ")
+    if check["mode_hz"] < cut_hz and method == "hinf":
+        return head + (f"the design model keeps that mode; H∞ is designed on the nominal plant "
+                       f"only ({check['pressure_bar']:g} bar is another plant): the μ design "
+                       "with that condition in [[design.uncertainty]] is the robust one, or "
+                       "pass --allow-unstable")
     if check["mode_hz"] < cut_hz:
         return head + ("the design model keeps that mode, so the plant at that condition is "
                        "outside what the design was robust to: widen [[design.uncertainty]] "

@@ -62,8 +62,9 @@ def main() -> None:
         times, rec = [], None
         for _ in range(opts.repeats):
             rec = [np.empty_like(a) for a in args[-3:]]
+            state = [np.zeros_like(a) for a in args[-6:-3]]  # z, xc, yf from rest
             t0 = time.perf_counter()
-            fn(*args[:-3], *rec)
+            fn(*args[:-6], *state, *rec)
             times.append(time.perf_counter() - t0)
         return statistics.median(times), rec
 

@@ -191,3 +191,14 @@ def design_cache_for():
     ``request`` of the fixture or test that runs the main job (the session designs are
     looked up through it while it is active)."""
     return DesignCache
+
+
+@pytest.fixture(scope="session")
+def testrig_tracked(testrig_cfg, tmp_path_factory):
+    """The controller scheduled on the seal's k over 0–3× nominal (issue 14 §2), as
+    :func:`ambseal.control.seal_schedule.design_seal_scheduled` makes it by default
+    (minutes of LMI synthesis: only the slow tests use it; ``$AMBSEAL_CACHE_DIR`` keeps
+    it between sessions)."""
+    from ambseal.control.seal_schedule import design_seal_scheduled
+
+    return design_seal_scheduled(testrig_cfg)

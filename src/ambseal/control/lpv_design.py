@@ -36,12 +36,12 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from ..errors import ConfigError, SynthesisError
-from .controller import ScheduledController
+from .controller import SPEED, ScheduledController
 from .plant import physical_controller, physical_matrices
 from .weights import Weights, default_weights
 
@@ -86,6 +86,7 @@ class LpvDesign(ScheduledController):
         :func:`check_full_order` of the controller at the judged conditions.
     """
 
+    parameter: ClassVar[str] = SPEED
     K: Any = field(repr=False)
     gamma: float
     gamma_design: float
@@ -107,7 +108,8 @@ class LpvDesign(ScheduledController):
         return self.K.order
 
     @property
-    def schedule_rad_s(self) -> tuple[float, float]:
+    def schedule(self) -> tuple[float, float]:
+        """(Ω_min, Ω_max) of the table (rad/s)."""
         return (_TWO_PI * float(self.speeds_hz[0]), _TWO_PI * float(self.speeds_hz[-1]))
 
     def at(self, speed_rad_s: float, name: str = "K_lpv"):

@@ -17,13 +17,13 @@ stable (``candidates``).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Sequence
+from typing import ClassVar, Sequence
 
 import numpy as np
 
 from ..errors import SynthesisError
 from ..identify.loop import DiscreteController
-from .controller import ScheduledController
+from .controller import SPEED, ScheduledController
 from .digital import (FAST_FRACTION, METHODS, _json_safe, check_rate, choose_method, discretize_as,
                       prewarp_frequency_hz, residualize, sampled_plants, split_fast,
                       with_delay)
@@ -60,6 +60,7 @@ class ScheduledDigital(ScheduledController):
     name : str
     """
 
+    parameter: ClassVar[str] = SPEED
     speeds_rad_s: np.ndarray
     continuous: tuple = field(repr=False)
     reduced: tuple = field(repr=False)
@@ -75,7 +76,8 @@ class ScheduledDigital(ScheduledController):
     name: str = "K"
 
     @property
-    def schedule_rad_s(self) -> tuple[float, float]:
+    def schedule(self) -> tuple[float, float]:
+        """(Ω_min, Ω_max) of the table (rad/s)."""
         return (float(self.speeds_rad_s[0]), float(self.speeds_rad_s[-1]))
 
     @property

@@ -21,7 +21,8 @@ __all__ = ["facility_loop"]
 
 @njit(cache=True, nogil=True)
 def facility_loop(Phi, Gam, seg_start, C_all, D_coil, D_ieff, Ac, Bc, Cc, Dc, e, noise, inoise,
-                  lsb, limit, i0, s0, kf, ki, ks, substeps, lp_a, rec_y, rec_i, rec_ref):
+                  lsb, limit, i0, s0, kf, ki, ks, substeps, lp_a, z, xc, yf, rec_y, rec_i,
+                  rec_ref):
     """Run the sampled closed loop of the virtual facility; fill the three records.
 
     Parameters
@@ -51,6 +52,10 @@ def facility_loop(Phi, Gam, seg_start, C_all, D_coil, D_ieff, Ac, Bc, Cc, Dc, e,
     lp_a : float
         Pole of the sensors' sampled first-order low-pass ``y_f ← a y_f + (1 − a) y``;
         0 for none (then ``y_f = y`` exactly).
+    z, xc, yf : ndarray (n,), (n_c,), (k,)
+        State of the linear part, of the controller and of the sensors' low-pass at the
+        first sample, updated in place to the state after the last (zeros for a run from
+        rest; carried over when the run goes on in blocks, e.g. with a switched controller).
     rec_y, rec_i, rec_ref : ndarray (N, k)
         Output: measured displacement (m), measured coil current (A), current reference (A).
 
@@ -61,12 +66,9 @@ def facility_loop(Phi, Gam, seg_start, C_all, D_coil, D_ieff, Ac, Bc, Cc, Dc, e,
         90 % of its air gap (the rest of the records is then undefined).
     """
     N, k = e.shape
-    xc = np.zeros(Ac.shape[0])
-    z = np.zeros(Phi.shape[1])
     seg = 0
     u_in = np.zeros(2 * k)
     y = np.zeros(k)
-    yf = np.zeros(k)
     out = C_all @ z
     for n in range(N):
         while seg + 1 < seg_start.shape[0] and n >= seg_start[seg + 1]:
@@ -81,7 +83,7 @@ def facility_loop(Phi, Gam, seg_start, C_all, D_coil, D_ieff, Ac, Bc, Cc, Dc, e,
         iref = np.empty(k)
         for a in range(k):
             iref[a] = min(max(-u[a] + e[n, a], -limit), limit)
-        xc = Ac @ xc + Bc @ y
+        xc[:] = Ac @ xc + Bc @ y
         coil = D_coil @ iref
         i_ff = D_ieff @ iref
         for a in range(k):
@@ -101,6 +103,6 @@ def facility_loop(Phi, Gam, seg_start, C_all, D_coil, D_ieff, Ac, Bc, Cc, Dc, e,
                 dm = s0[a] + x
                 f = kf[a] * (ip * ip / (dp * dp) - im * im / (dm * dm))
                 u_in[k + a] = f - (ki[a] * i + ks[a] * x)
-            z = Phi[seg] @ z + Gam[seg] @ u_in
+            z[:] = Phi[seg] @ z + Gam[seg] @ u_in
             out = C_all @ z
     return -1

@@ -45,7 +45,8 @@ from ..lti.interconnect import series_inputs
 from .facility_loop import facility_loop
 from .loop import DiscreteController
 
-__all__ = ["FacilityRecord", "simulate_facility", "true_rig", "reduced_plant"]
+__all__ = ["FacilityRecord", "Facility", "prepare_facility", "simulate_facility", "true_rig",
+           "reduced_plant"]
 
 
 @dataclass(frozen=True)
@@ -160,6 +161,115 @@ def _pressure_values(cfg: RigConfig, truth: TruthSection, plant, pressure_bar: f
     return out
 
 
+@dataclass
+class Facility:
+    """The virtual facility prepared for a run: its sampled linear part per pressure
+    segment, force law, sensors and limits (built by :func:`prepare_facility`), and the
+    state of the linear part and of the sensors' low-pass, carried from one :meth:`run`
+    to the next so that a run can go on block by block (a controller switched between
+    blocks, issue 14 §2)."""
+
+    T: float
+    axes: tuple
+    seg_start: np.ndarray  # first sample of each pressure segment
+    Phi: np.ndarray
+    Gam: np.ndarray
+    mats: tuple  # C_all, D_coil, D_ieff
+    law: tuple  # lsb, limit, i0, s0, kf, ki, ks, substeps, lp_a
+    z: np.ndarray
+    yf: np.ndarray
+    n: int = 0  # samples run so far (after a loss: the sample where the rotor left)
+
+    def run(self, controller: DiscreteController, xc: np.ndarray, e, noise, inoise):
+        """Run ``len(e)`` samples from the carried state with ``controller`` (its state
+        ``xc`` updated in place); returns the records ``(y, i, i_ref)``, each (N, k).
+
+        Raises
+        ------
+        ModelError
+            The rotor left the air gap (the loop went unstable).
+        """
+        N, k = np.shape(e)
+        n0, n1 = self.n, self.n + N
+        first = max(int(np.searchsorted(self.seg_start, n0, side="right")) - 1, 0)
+        last = max(int(np.searchsorted(self.seg_start, n1 - 1, side="right")), first + 1)
+        starts = np.maximum(self.seg_start[first:last] - n0, 0).astype(np.int64)
+        rec = [np.empty((N, k)) for _ in range(3)]
+        Km = [np.ascontiguousarray(M, dtype=float) for M in
+              (controller.A, controller.B, controller.C, controller.D)]
+        left = facility_loop(self.Phi[first:last], self.Gam[first:last], starts, *self.mats,
+                             *Km, np.ascontiguousarray(e, dtype=float), noise, inoise,
+                             *self.law, self.z, xc, self.yf, *rec)
+        if left >= 0:
+            self.n = n0 + left  # where it stopped
+            raise ModelError(
+                f"the rotor left the air gap at t = {(n0 + left) * self.T:.4f} s (loop "
+                "unstable or excitation too strong)")
+        self.n = n1
+        return rec
+
+
+def prepare_facility(cfg: RigConfig, truth: TruthSection, sample_rate_hz: float, *,
+                     pressure_bar: float,
+                     pressure_schedule: list[tuple[float, float]] | None = None) -> Facility:
+    """The virtual facility at rest, ready to run (arguments as :func:`simulate_facility`).
+
+    Raises
+    ------
+    ModelError
+        Unknown truth parameters, a force law without Ki, Ks > 0.
+    """
+    T = 1.0 / sample_rate_hz
+    values = {k: coefficient_value(v, pressure_bar) for k, v in truth.parameters.items()}
+    # raises ModelError naming an unknown parameter
+    cfg_t = true_rig(cfg, truth)
+    plant = reduced_plant(cfg_t, pressure_bar, None, values, truth.max_mode_hz)
+    segments = [(0, plant.A)]
+    for start_s, p_bar in sorted(pressure_schedule or []):
+        segments.append((int(round(start_s * sample_rate_hz)),
+                         plant.with_values(_pressure_values(cfg_t, truth, plant, p_bar)).A))
+    axes = plant.axes
+    k = len(axes)
+    names = [a.rsplit("_", 1) for a in axes]
+    i0 = truth.bias_current
+    ki, ks, s0, kf = _force_law(plant, names, i0)
+    limits = [a.current_limit for a in cfg.amb for _ in range(2)]
+    limit = truth.current_limit or (min(x for x in limits if x) if any(limits) else np.inf)
+
+    # continuous linear part: mechanics ← eddy lag ← amplifier; inputs [i_ref, f_rem]
+    A, B, C = plant.A, plant.B, plant.C
+    Fdir = np.hstack([plant.parameter(f"{m}.Ks_{ax}").B for m, ax in names])  # unit forces
+    Cb = np.vstack([plant.parameter(f"{m}.Ks_{ax}").C for m, ax in names])  # bearing disp.
+    n_mech = A.shape[0]
+    C = np.vstack([C, Cb])
+    A, B, C, _, C_eff, D_eddy = series_inputs((A, B, C, np.zeros((C.shape[0], k))),
+                                              eddy_lag_matrices(truth.tau_e))
+    C = np.vstack([C, C_eff])
+    A, B, C, _, C_coil, D_coil = series_inputs((A, B, C, np.zeros((C.shape[0], k))),
+                                               actuator_matrices(cfg.actuator))
+    A_of = []  # per pressure segment: the mechanics' block of A replaced
+    for n0, A_m in segments:
+        A_s = A.copy()
+        A_s[:n_mech, :n_mech] = A_m
+        A_of.append((n0, A_s))
+    # coil current i_c = C_coil z + D_coil i_ref; force current i_eff = C_eff z + D_eddy i_c
+    C_y, C_b = C[:k], C[k:2 * k]
+    C_ieff = C[2 * k:] + D_eddy @ C_coil
+    D_ieff = D_eddy @ D_coil
+    F = np.vstack([Fdir, np.zeros((A.shape[0] - n_mech, k))])
+    steps = [(n0, *zoh(A_s, np.hstack([B, F]), T / truth.substeps)) for n0, A_s in A_of]
+    C_all = np.vstack([C_y, C_b, C_ieff, C_coil])
+    lowpass = _sensor_filter(truth, T, k)
+    lp_a = 0.0 if lowpass is None else lowpass[0]  # a = 0: y_f = y exactly
+    lsb = truth.adc_range_m / 2**truth.adc_bits if truth.adc_bits else 0.0
+    seg_start = np.array([n0 for n0, _, _ in steps], dtype=np.int64)
+    Phi, Gam = np.stack([P for _, P, _ in steps]), np.stack([G for _, _, G in steps])
+    mats = tuple(np.ascontiguousarray(M, dtype=float) for M in (C_all, D_coil, D_ieff))
+    law = (float(lsb), float(limit), float(i0), s0, kf, ki, ks, int(truth.substeps), lp_a)
+    return Facility(T, tuple(axes), seg_start, np.ascontiguousarray(Phi),
+                    np.ascontiguousarray(Gam), mats, law, np.zeros(A.shape[0]), np.zeros(k))
+
+
 def simulate_facility(
     cfg: RigConfig,
     truth: TruthSection,
@@ -205,75 +315,22 @@ def simulate_facility(
     T = 1.0 / sample_rate_hz
     if abs(controller.dt - T) > 1e-9 * T:
         raise ModelError(f"controller dt = {controller.dt} s but the sample rate is {sample_rate_hz} Hz")
-    values = {k: coefficient_value(v, pressure_bar) for k, v in truth.parameters.items()}
-    # raises ModelError naming an unknown parameter
-    cfg_t = true_rig(cfg, truth)
-    plant = reduced_plant(cfg_t, pressure_bar, None, values, truth.max_mode_hz)
-    segments = [(0, plant.A)]
-    for start_s, p_bar in sorted(pressure_schedule or []):
-        segments.append((int(round(start_s * sample_rate_hz)),
-                         plant.with_values(_pressure_values(cfg_t, truth, plant, p_bar)).A))
-    axes = plant.axes
-    k = len(axes)
+    fac = prepare_facility(cfg, truth, sample_rate_hz, pressure_bar=pressure_bar,
+                           pressure_schedule=pressure_schedule)
+    k = len(fac.axes)
     e = np.asarray(excitation_a, dtype=float)
     if e.ndim != 2 or e.shape[1] != k:
-        raise ModelError(f"excitation has shape {e.shape}; expected (N, {k}) for axes {axes}")
+        raise ModelError(f"excitation has shape {e.shape}; expected (N, {k}) for axes {fac.axes}")
     if controller.B.shape[1] != k or controller.C.shape[0] != k:
         raise ModelError(f"the controller must have {k} inputs and outputs")
-
-    names = [a.rsplit("_", 1) for a in axes]
-    i0 = truth.bias_current
-    ki, ks, s0, kf = _force_law(plant, names, i0)
-    limits = [a.current_limit for a in cfg.amb for _ in range(2)]
-    limit = truth.current_limit or (min(x for x in limits if x) if any(limits) else np.inf)
-
-    # continuous linear part: mechanics ← eddy lag ← amplifier; inputs [i_ref, f_rem]
-    A, B, C = plant.A, plant.B, plant.C
-    Fdir = np.hstack([plant.parameter(f"{m}.Ks_{ax}").B for m, ax in names])  # unit forces
-    Cb = np.vstack([plant.parameter(f"{m}.Ks_{ax}").C for m, ax in names])  # bearing disp.
-    n_mech = A.shape[0]
-    C = np.vstack([C, Cb])
-    A, B, C, _, C_eff, D_eddy = series_inputs((A, B, C, np.zeros((C.shape[0], k))),
-                                              eddy_lag_matrices(truth.tau_e))
-    C = np.vstack([C, C_eff])
-    A, B, C, _, C_coil, D_coil = series_inputs((A, B, C, np.zeros((C.shape[0], k))),
-                                               actuator_matrices(cfg.actuator))
-    A_of = []  # per pressure segment: the mechanics' block of A replaced
-    for n0, A_m in segments:
-        A_s = A.copy()
-        A_s[:n_mech, :n_mech] = A_m
-        A_of.append((n0, A_s))
-    # coil current i_c = C_coil z + D_coil i_ref; force current i_eff = C_eff z + D_eddy i_c
-    C_y, C_b = C[:k], C[k:2 * k]
-    C_ieff = C[2 * k:] + D_eddy @ C_coil
-    D_ieff = D_eddy @ D_coil
-    F = np.vstack([Fdir, np.zeros((A.shape[0] - n_mech, k))])
-    steps = [(n0, *zoh(A_s, np.hstack([B, F]), T / truth.substeps)) for n0, A_s in A_of]
-    C_all = np.vstack([C_y, C_b, C_ieff, C_coil])
     rng = np.random.default_rng(seed)
-    lowpass = _sensor_filter(truth, T, k)
-    lp_a = 0.0 if lowpass is None else lowpass[0]  # a = 0: y_f = y exactly
-    lsb = truth.adc_range_m / 2**truth.adc_bits if truth.adc_bits else 0.0
-    seg_start = np.array([n0 for n0, _, _ in steps], dtype=np.int64)
-    Phi, Gam = np.stack([P for _, P, _ in steps]), np.stack([G for _, _, G in steps])
-    mats = [np.ascontiguousarray(M, dtype=float) for M in (Phi, Gam)] + [seg_start] + [
-        np.ascontiguousarray(M, dtype=float) for M in
-        (C_all, D_coil, D_ieff, controller.A, controller.B, controller.C, controller.D)]
 
     def run(noise_std):
         N = e.shape[0]
-        rec = [np.empty((N, k)) for _ in range(3)]
         noise = rng.standard_normal((N, k)) * noise_std
         inoise = rng.standard_normal((N, k)) * truth.current_noise_a
-        left = facility_loop(*mats, np.ascontiguousarray(e), noise, inoise, float(lsb),
-                             float(limit), float(i0), s0, kf, ki, ks, int(truth.substeps), lp_a,
-                             *rec)
-        if left >= 0:
-            raise ModelError(
-                f"the rotor left the air gap at t = {left * T:.4f} s (loop unstable or "
-                "excitation too strong)"
-            )
-        return rec
+        fac.z[:], fac.yf[:], fac.n = 0.0, 0.0, 0
+        return fac.run(controller, np.zeros(controller.A.shape[0]), e, noise, inoise)
 
     noise_std = np.full(k, truth.sensor_noise_m)
     if truth.noise_fraction > 0:
@@ -281,5 +338,4 @@ def simulate_facility(
         noise_std = noise_std + truth.noise_fraction * np.sqrt(np.mean(y0**2, axis=0))
     y, i, ref = run(noise_std)
     t = np.arange(e.shape[0]) * T
-    return FacilityRecord(t, e.copy(), ref, i, y, tuple(axes), noise_std)
-
+    return FacilityRecord(t, e.copy(), ref, i, y, tuple(fac.axes), noise_std)

@@ -46,7 +46,7 @@ from .fit import _DEFAULT_SCALE, ClosedLoopModel
 from .stages import build_models
 
 __all__ = ["TrackingSettings", "TrackingResult", "track", "flops_per_sample",
-           "linearised_model", "rpem_kernel", "current_limit", "check_excitation",
+           "linearised_model", "rpem_kernel", "OnlineTracker", "current_limit", "check_excitation",
            "tracking_excitation"]
 
 
@@ -82,6 +82,13 @@ class TrackingSettings:
     min_duration_s : float
         Shortest record tracked: the initial transient from the rig's value measured on the
         virtual facility is 0.2–0.5 s.
+    follow_pressure : bool
+        When a tracked parameter is a seal's k affine in the pressure drop, the model's
+        other coefficients of that seal (K, C, c) follow the pressure that gives k̂
+        (:func:`ambseal.model.seal.values_following_k`); False: they stay at the record's
+        pressure. Measured on the facility's 0 → 3× nominal ramp (issue 14 §2): with them
+        fixed, k̂ drifts away from k beyond ≈ 1.5× nominal (the direct stiffness K and the
+        damping C that grow with the pressure are taken for k).
     """
 
     rate_per_s: float = 0.1
@@ -94,6 +101,7 @@ class TrackingSettings:
     initial_rel_std: float = 1.0
     inflation_window_s: float = 0.5
     min_duration_s: float = 0.5
+    follow_pressure: bool = True
 
 
 def _inflation(score: np.ndarray, info: np.ndarray, block: int, window: int) -> np.ndarray:
@@ -174,11 +182,14 @@ def flops_per_sample(n: int, k: int, m: int, p: int) -> int:
     return pred + sens + upd
 
 
-def _param_matrices(model: ClosedLoopModel, values: dict[str, float], names, dt: float):
+def _param_matrices(model: ClosedLoopModel, values: dict[str, float], names, dt: float,
+                    expand=None):
     """A_d, B_d, C at ``values`` and ∂A_d/∂θ_j, ∂B_d/∂θ_j (Van Loan's block exponential:
     expm([[M, E], [0, M]] T) has d expm(M T)/dθ in its upper-right block, M = [[A, B],
-    [0, 0]], E = ∂M/∂θ)."""
-    A, B, C, _, _ = model.matrices(values)
+    [0, 0]], E = ∂M/∂θ). ``expand`` maps the tracked values to every value the model
+    takes (the coefficients that follow a seal's k, :func:`_follower`); default none."""
+    expand = expand or dict
+    A, B, C, _, _ = model.matrices(expand(values))
     n, m = B.shape
     M = np.zeros((n + m, n + m))
     M[:n, :n], M[:n, n:] = A, B
@@ -186,7 +197,7 @@ def _param_matrices(model: ClosedLoopModel, values: dict[str, float], names, dt:
     dA, dB = [], []
     for name in names:
         h = 1e-6 * max(abs(values[name]), 1.0)
-        Ap, Bp, _, _, _ = model.matrices({**values, name: values[name] + h})
+        Ap, Bp, _, _, _ = model.matrices(expand({**values, name: values[name] + h}))
         dM = np.zeros_like(M)
         dM[:n, :n], dM[:n, n:] = (Ap - A) / h, (Bp - B) / h  # exact for an LFT (affine in θ)
         big = np.block([[M, dM], [np.zeros_like(M), M]]) * dt
@@ -194,6 +205,24 @@ def _param_matrices(model: ClosedLoopModel, values: dict[str, float], names, dt:
         dA.append(D[:n, :n])
         dB.append(D[:n, n:])
     return E0[:n, :n], E0[:n, n:], C, np.array(dA), np.array(dB)
+
+
+def _follower(cfg: RigConfig, model: ClosedLoopModel, names):
+    """values → the values with the coefficients that follow each tracked seal k (the
+    tracked values themselves win), or None when no tracked name has followers."""
+    from ..model.seal import values_following_k
+
+    known = model.plant.parameters
+    if all(len(values_following_k(cfg.seal, n, 0.0, known)) == 1 for n in names):
+        return None
+
+    def expand(values: dict) -> dict:
+        out: dict = {}
+        for n, v in values.items():
+            out.update(values_following_k(cfg.seal, n, v, known))
+        return {**out, **values}
+
+    return expand
 
 
 def _scales(cfg: RigConfig, model: ClosedLoopModel, names) -> np.ndarray:
@@ -383,48 +412,122 @@ def track(cfg: RigConfig, record: Measurement, names, settings: TrackingSettings
     model = linearised_model(cfg, record, names, s, source, controller)
     y = np.ascontiguousarray(record.displacement_m, float)
     u = np.ascontiguousarray(record.current_ref_a, float)
-    scale = _scales(cfg, model, names)
-    theta = np.array([float((initial or {}).get(n, model.plant.parameter(n).nominal))
-                      for n in names])
-    sigma_y = s.sensor_noise_fraction * np.sqrt(np.mean(y**2, axis=0))
-    sigma_y = np.where(sigma_y > 0, sigma_y, 1e-9)
-    sigma_u = np.full(u.shape[1], s.process_noise_a if s.process_noise_a is not None
-                      else max(0.01 * float(np.sqrt(np.mean(u**2))), 1e-6))
-    p, N = len(names), len(t)
-    theta_start = theta.copy()
-    P = np.diag((s.initial_rel_std * scale) ** 2)
-    q = (s.rate_per_s * scale) ** 2 * dt
-    lam = sigma_y**2 * 1.0
-    g = min(1.0, dt / s.innovation_time_s)
-    est, se, score, info = (np.empty((N, p)) for _ in range(4))
-    kern = _kernel(compiled)
-    chunk = max(1, int(round(s.relinearise_s / dt)))
-    x = W = K = theta_K = None
-    if compiled:  # compile outside the timing
-        Ad, Bd, C, dA, dB = _param_matrices(model, dict(zip(names, theta)), names, dt)
-        kern(y, u, Ad, Bd, C, np.zeros(C.T.shape), dA, dB, theta.copy(), np.zeros(len(Ad)),
-             np.zeros((p, len(Ad))), theta.copy(), P.copy(), lam.copy(), q, g, est, se, score,
-             info, 0, 0)
+    tr = OnlineTracker(cfg, model, names, dt, y, u, s, initial=initial, compiled=compiled)
     t0, c0 = time.perf_counter(), time.process_time()
-    for start in range(0, N, chunk):
-        values = dict(zip(names, theta))
-        Ad, Bd, C, dA, dB = _param_matrices(model, values, names, dt)
-        if x is None:
-            x, W = np.zeros(Ad.shape[0]), np.zeros((p, Ad.shape[0]))
-        if K is None or np.any(np.abs(theta - theta_K) > s.regain_rel * scale):
-            K, theta_K = _predictor_gain(Ad, Bd, C, sigma_y, sigma_u), theta.copy()
-        kern(y, u, Ad, Bd, C, K, dA, dB, theta.copy(), x, W, theta, P, lam, q, g, est, se,
-             score, info, start, min(N, start + chunk))
-        if not np.all(np.isfinite(theta)):
-            raise IdentificationError(f"{source}: track: the estimate diverged at "
-                                      f"t = {t[start]:.3f} s")
-    se = se * np.sqrt(_inflation(score, info, int(round(s.innovation_time_s / dt)),
-                                 int(round(s.inflation_window_s / dt))))
+    tr.update(y, u, source)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-    n = x.shape[0]
-    units = tuple(model.plant.parameter(n).unit for n in names)
-    return TrackingResult(names, units, t, est, se, theta_start, n,
-                          flops_per_sample(n, y.shape[1], u.shape[1], p), wall, cpu)
+    return tr.result(t, wall, cpu)
+
+
+class OnlineTracker:
+    """The RPEM of :func:`track` fed block by block, as it runs beside a controller (the
+    closed-loop ramp of issue 14 §2): the state x̂, the sensitivities W, θ̂, P and Λ are
+    carried from one :meth:`update` to the next, and feeding a record in any blocks gives
+    the same estimate as :func:`track` on the whole record.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+    model : ClosedLoopModel
+        The tracker's model (:func:`linearised_model`).
+    names : sequence of str
+    dt : float
+        Sample time (s).
+    y0, u0 : ndarray (N0, k), (N0, m)
+        A stretch of displacements (m) and current references (A) that sets the
+        predictor's noise levels (their RMS, as in :func:`track`).
+    settings : TrackingSettings
+    initial : dict, optional
+        Starting values (SI); default the model's values.
+    """
+
+    def __init__(self, cfg: RigConfig, model: ClosedLoopModel, names, dt: float, y0, u0,
+                 settings: TrackingSettings, *, initial: dict | None = None,
+                 compiled: bool = True):
+        s = self.settings = settings
+        self.model, self.names, self.dt = model, tuple(names), float(dt)
+        self.scale = _scales(cfg, model, self.names)
+        self.theta = np.array([float((initial or {}).get(n, model.plant.parameter(n).nominal))
+                               for n in self.names])
+        self.initial = self.theta.copy()
+        sig = s.sensor_noise_fraction * np.sqrt(np.mean(np.asarray(y0) ** 2, axis=0))
+        self.sigma_y = np.where(sig > 0, sig, 1e-9)
+        self.sigma_u = np.full(np.shape(u0)[1], s.process_noise_a if s.process_noise_a
+                               is not None else max(0.01 * float(np.sqrt(np.mean(
+                                   np.asarray(u0) ** 2))), 1e-6))
+        p = len(self.names)
+        self.P = np.diag((s.initial_rel_std * self.scale) ** 2)
+        self.q = (s.rate_per_s * self.scale) ** 2 * dt
+        self.lam = self.sigma_y**2 * 1.0
+        self.g = min(1.0, dt / s.innovation_time_s)
+        self.chunk = max(1, int(round(s.relinearise_s / dt)))
+        self.kern = _kernel(compiled)
+        self.expand = _follower(cfg, model, self.names) if s.follow_pressure else None
+        self._since = 0  # samples since the last re-linearisation
+        self.x = self.W = self.K = self.theta_K = self.mats = None
+        self._rows: list = []
+        if compiled:  # compile outside the timing
+            Ad, Bd, C, dA, dB = _param_matrices(model, dict(zip(self.names, self.theta)),
+                                                self.names, dt, self.expand)
+            z = np.zeros((1, p))
+            self.kern(np.zeros((1, C.shape[0])), np.zeros((1, Bd.shape[1])), Ad, Bd, C,
+                      np.zeros(C.T.shape), dA, dB, self.theta.copy(), np.zeros(len(Ad)),
+                      np.zeros((p, len(Ad))), self.theta.copy(), self.P.copy(),
+                      self.lam.copy(), self.q, self.g, z.copy(), z.copy(), z.copy(), z.copy(),
+                      0, 0)
+
+    def _relinearise(self):
+        Ad, Bd, C, dA, dB = _param_matrices(self.model, dict(zip(self.names, self.theta)),
+                                            self.names, self.dt, self.expand)
+        if self.x is None:
+            self.x, self.W = np.zeros(Ad.shape[0]), np.zeros((len(self.names), Ad.shape[0]))
+        if self.K is None or np.any(np.abs(self.theta - self.theta_K)
+                                    > self.settings.regain_rel * self.scale):
+            self.K = _predictor_gain(Ad, Bd, C, self.sigma_y, self.sigma_u)
+            self.theta_K = self.theta.copy()
+        self.mats = (Ad, Bd, C, self.K, dA, dB, self.theta.copy())
+
+    def update(self, y, u, source: str = "<data>") -> np.ndarray:
+        """Run the recursion over ``y`` (N, k) and ``u`` (N, m); returns θ̂ after the last
+        sample (p,). Raises IdentificationError when the estimate diverges."""
+        y, u = np.ascontiguousarray(y, float), np.ascontiguousarray(u, float)
+        N, p = len(y), len(self.names)
+        rows = [np.empty((N, p)) for _ in range(4)]
+        start = 0
+        while start < N:
+            if self.mats is None or self._since >= self.chunk:
+                self._relinearise()
+                self._since = 0
+            stop = min(N, start + self.chunk - self._since)
+            Ad, Bd, C, K, dA, dB, th0 = self.mats
+            self.kern(y, u, Ad, Bd, C, K, dA, dB, th0, self.x, self.W, self.theta, self.P,
+                      self.lam, self.q, self.g, *rows, start, stop)
+            if not np.all(np.isfinite(self.theta)):
+                raise IdentificationError(f"{source}: track: the estimate diverged after "
+                                          f"{(self.samples + start) * self.dt:.3f} s")
+            self._since += stop - start
+            start = stop
+        self._rows.append(rows)
+        return self.theta.copy()
+
+    @property
+    def samples(self) -> int:
+        """Samples fed so far."""
+        return sum(len(r[0]) for r in self._rows)
+
+    def result(self, time_s, wall_s: float = 0.0, cpu_s: float = 0.0) -> TrackingResult:
+        """Everything fed so far as a :class:`TrackingResult` (the standard error with the
+        causal variance inflation of :func:`_inflation`)."""
+        est, se, score, info = (np.vstack([r[i] for r in self._rows]) for i in range(4))
+        s = self.settings
+        se = se * np.sqrt(_inflation(score, info, int(round(s.innovation_time_s / self.dt)),
+                                     int(round(s.inflation_window_s / self.dt))))
+        n = self.x.shape[0]
+        units = tuple(self.model.plant.parameter(q).unit for q in self.names)
+        k, m = self.mats[2].shape[0], self.mats[1].shape[1]
+        return TrackingResult(self.names, units, np.asarray(time_s, float), est, se,
+                              self.initial, n, flops_per_sample(n, k, m, len(self.names)),
+                              wall_s, cpu_s)
 
 
 def current_limit(cfg: RigConfig, meta: dict | None = None) -> float | None:

@@ -23,6 +23,7 @@ from .lft import Channel
 from .rotor import X, Y, Mesh
 
 __all__ = ["COEFFICIENTS", "interp_table", "coefficient_value", "seal_coefficients",
+           "values_following_k",
            "SealElement"]
 
 COEFFICIENTS = ("K", "k", "C", "c", "M")
@@ -112,6 +113,39 @@ def seal_coefficients(seal: Seal, pressure_bar: float,
     """
     return {n: coefficient_value(getattr(seal, n), pressure_bar, frequency_hz)
             for n in COEFFICIENTS}
+
+
+def values_following_k(seals, name: str, value: float, known) -> dict[str, float]:
+    """``{name: value}`` and, when ``name`` is a seal's cross-coupled stiffness k affine in
+    the pressure drop (k = k₀ + k'·p, k' ≠ 0), that seal's other coefficients K, C, c at
+    the pressure p = max((k − k₀)/k', 0) that gives k — the seal model's own structure
+    (thesis §7.4 item 2: the coefficients move together with the pressure); only those in
+    ``known`` (the plant's parameter names) are returned.
+
+    Parameters
+    ----------
+    seals : sequence of Seal
+        The rig's ``[[seal]]`` entries.
+    name : str
+        A parameter name, ``"<seal>.k"`` for the rule to apply.
+    value : float
+        Its value (SI).
+    known : container of str
+
+    Returns
+    -------
+    dict
+    """
+    from ..config import Affine
+
+    seal_name, _, key = name.rpartition(".")
+    seal = next((s for s in seals if s.name == seal_name), None)
+    if key != "k" or seal is None or not isinstance(seal.k, Affine) or not seal.k.per_bar:
+        return {name: value}
+    p = max((value - seal.k.at_zero) / seal.k.per_bar, 0.0)
+    out = {f"{seal_name}.{q}": coefficient_value(getattr(seal, q), p) for q in ("K", "C", "c")
+           if f"{seal_name}.{q}" in known}
+    return {**out, name: value}
 
 
 @dataclass(frozen=True)

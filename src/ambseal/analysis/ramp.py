@@ -1,0 +1,357 @@
+"""A pressure ramp on the virtual facility with fixed controllers and the tracked scheme
+(issue 14 §2): the on-line estimator and the controller scheduled on its estimate running
+together in the sampled, nonlinear loop.
+
+The facility (:mod:`ambseal.identify.rig_sim`: nonlinear AMB forces, amplifier limits,
+eddy lag, sensor noise, ADC, the digital controller at the rig's rate) runs a
+piecewise-constant pressure drop from 0 to ``top_factor``× nominal in ``step_s`` steps;
+the same excitation — the tracker's PRBS (:func:`~ambseal.identify.tracking.
+tracking_excitation`), off around each impulse, plus the thesis's current impulse (P5
+§5.1, the specification's amplitude and length on the first actuator axis) every
+``impulse_every_s`` — and the same
+noise sequence go into every run, so the runs differ only by their controller.
+
+The tracked scheme runs in blocks of ``block_s``: at the start of each block the scheduled
+controller is frozen at the current estimate k̂ and discretised (Tustin, the controller
+state carried across the switch), the block is run, and the tracker
+(:class:`~ambseal.identify.tracking.OnlineTracker`, started at the model's value at the
+starting pressure) is fed the block's displacements and current references. The
+estimate used in a block is from the end of the previous one: causal, as on the target.
+
+Per impulse: the peak |y| on the impulse axis within 30 impulse lengths, and the settling
+time, after which |y| stays inside max(2 % of the peak, 3× the noise std of the 50 ms
+before the impulse, when the PRBS is off); None when it never does within the window.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ModelError
+
+__all__ = ["RampRun", "RampResult", "pressure_ramp", "ramp_simulation", "frozen_cases"]
+
+
+@dataclass(frozen=True)
+class RampRun:
+    """One controller along the ramp (records decimated to ``RampResult.time_s``).
+
+    Attributes
+    ----------
+    name : str
+    displacement_um, current_a : ndarray (n, k)
+        Measured displacement (µm) and current reference (A) per axis; NaN after a loss.
+    lost_at_s : float or None
+        When the rotor left 90 % of the air gap (the loop went unstable), else None.
+    impulse_peak_um, impulse_settling_s : list
+        Per impulse (None after a loss, or a settling never reached in the window).
+    estimate, ci95_low, ci95_high : ndarray (n,) or None
+        The tracked scheme's k̂ and its 95 % interval (SI).
+    """
+
+    name: str
+    displacement_um: np.ndarray = field(repr=False)
+    current_a: np.ndarray = field(repr=False)
+    lost_at_s: float | None
+    impulse_peak_um: list
+    impulse_settling_s: list
+    estimate: np.ndarray | None = field(default=None, repr=False)
+    ci95_low: np.ndarray | None = field(default=None, repr=False)
+    ci95_high: np.ndarray | None = field(default=None, repr=False)
+
+
+@dataclass(frozen=True)
+class RampResult:
+    """The ramp and every run; ``time_s``, ``pressure_bar`` and ``k_true`` decimated to
+    ``record_hz``; ``tracking`` the estimator's accuracy (``max_error_rel`` of the nominal
+    k after ``transient_s``, ``coverage`` of the 95 % interval)."""
+
+    parameter: str
+    time_s: np.ndarray = field(repr=False)
+    pressure_bar: np.ndarray = field(repr=False)
+    k_true: np.ndarray = field(repr=False)
+    k_nominal: float
+    impulse_times_s: list
+    axes: tuple
+    runs: dict
+    tracking: dict
+
+    def to_dict(self) -> dict:
+        """JSON-ready summary (no time series)."""
+        return {"parameter": self.parameter, "k_nominal": self.k_nominal,
+                "duration_s": float(self.time_s[-1]) if self.time_s.size else 0.0,
+                "pressure_top_bar": float(np.max(self.pressure_bar)),
+                "impulse_times_s": self.impulse_times_s, "tracking": self.tracking,
+                "runs": {n: {"lost_at_s": r.lost_at_s, "impulse_peak_um": r.impulse_peak_um,
+                             "impulse_settling_s": r.impulse_settling_s}
+                         for n, r in self.runs.items()}}
+
+
+def pressure_ramp(p_nominal_bar: float, duration_s: float, *, top_factor: float = 3.0,
+                  step_s: float = 0.05) -> list[tuple[float, float]]:
+    """A linear ramp 0 → ``top_factor``·p_nominal over ``duration_s`` as
+    ``[(start_s, pressure_bar), ...]`` steps of ``step_s`` (2× nominal at 2/3 of the way
+    for the default 3×)."""
+    t = np.arange(step_s, duration_s + 0.5 * step_s, step_s)
+    return [(float(a), float(top_factor * p_nominal_bar * a / duration_s)) for a in t]
+
+
+def _excitation(cfg, N: int, fs: float, every_s: float, amplitude_a: float, n_len: int,
+                seed: int):
+    """(excitation (N, k), impulse start samples): the tracker's PRBS, off from 0.1 s before
+    each impulse to 30 impulse lengths after it, and the impulse train on axis 0."""
+    from ..identify.tracking import tracking_excitation
+
+    e = tracking_excitation(cfg, (N + 1) / fs, seed=seed).values_a[:N].copy()
+    step = int(round(every_s * fs))
+    starts = list(range(step, N - 35 * n_len, step))
+    for n0 in starts:
+        e[max(0, n0 - int(round(0.1 * fs))):n0 + 30 * n_len] = 0.0
+        e[n0:n0 + n_len, 0] = amplitude_a
+    return e, starts
+
+
+def _impulse_metrics(y: np.ndarray, starts, fs: float, n_len: int, lost_n: int | None):
+    """Peak |y| (µm) and settling time (s) of each impulse (module docstring)."""
+    peaks, settle = [], []
+    pre = int(round(0.05 * fs))
+    for n0 in starts:
+        end = n0 + 30 * n_len
+        if lost_n is not None and end >= lost_n:
+            peaks.append(None)
+            settle.append(None)
+            continue
+        w = np.abs(y[n0:end])
+        band = max(0.02 * float(np.max(w)), 3.0 * float(np.std(y[max(0, n0 - pre):n0])))
+        peaks.append(float(np.max(w)) * 1e6)
+        above = np.nonzero(w > band)[0]
+        settled = above.size == 0 or above[-1] < w.size - 1
+        settle.append(float((above[-1] + 1) / fs) if above.size and settled else
+                      (0.0 if settled else None))
+    return peaks, settle
+
+
+def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: float = 30.0,
+                    top_factor: float = 3.0, step_s: float = 0.05, block_s: float = 0.05,
+                    impulse_every_s: float = 2.0, transient_s: float = 1.0,
+                    record_hz: float = 1000.0, seed: int = 0, settings=None,
+                    progress=None) -> RampResult:
+    """Run the pressure ramp with each fixed controller and the tracked scheme.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+    truth : TruthSection
+        The facility's truth (noise, ADC, limits; ``noise_fraction`` sets the sensor noise
+        as a fraction of the RMS displacement of a noise-free run).
+    controllers : dict
+        ``{name: DiscreteController}`` at the rig's sample rate (no computation delay, as
+        the facility runs them).
+    tracked : SealScheduledDesign, optional
+        The scheduled controller, run as ``"tracked"`` with the on-line estimator.
+    duration_s, top_factor, step_s : float
+        The ramp (:func:`pressure_ramp`) from 0 bar.
+    block_s : float
+        The tracked scheme's switching period (s).
+    impulse_every_s : float
+        Period of the current impulses (s), the first after one period.
+    transient_s : float
+        The estimator's initial transient left out of its accuracy (s).
+    record_hz : float
+        Rate of the returned records (Hz).
+    settings : TrackingSettings, optional
+    progress : callable, optional
+        Called with one line per run.
+
+    Returns
+    -------
+    RampResult
+
+    Raises
+    ------
+    ModelError
+        A rig without a seal coefficient named by ``tracked.parameter``.
+    """
+    from ..control.specs import design_spec
+    from ..identify.rig_sim import _pressure_values, prepare_facility, reduced_plant, true_rig
+
+    fs = cfg.controller.sample_rate_hz
+    N = int(round(duration_s * fs))
+    sched = pressure_ramp(cfg.operating.pressure_bar, duration_s, top_factor=top_factor,
+                          step_s=step_s)
+    sp = design_spec(cfg)
+    n_len = max(1, int(round(sp.impulse_s * fs)))
+    e, starts = _excitation(cfg, N, fs, impulse_every_s, sp.impulse_a, n_len, seed)
+    fac0 = prepare_facility(cfg, truth, fs, pressure_bar=0.0, pressure_schedule=sched)
+    k = len(fac0.axes)
+    rng = np.random.default_rng(seed)
+    white, iwhite = rng.standard_normal((N, k)), rng.standard_normal((N, k))
+    param = tracked.parameter if tracked is not None else f"{cfg.seal[0].name}.k"
+    cfg_t = true_rig(cfg, truth)
+    base = reduced_plant(cfg_t, 0.0, None, {}, truth.max_mode_hz)
+    if param not in base.parameters:
+        raise ModelError(f"ramp: the rig has no parameter {param!r}")
+    p_of_n = np.zeros(N)
+    k_of_n = np.full(N, _pressure_values(cfg_t, truth, base, 0.0).get(param, 0.0))
+    for t0, p in sched:
+        n0 = int(round(t0 * fs))
+        p_of_n[n0:], k_of_n[n0:] = p, _pressure_values(cfg_t, truth, base, p)[param]
+    k_nom = abs(_pressure_values(cfg_t, truth, base, cfg.operating.pressure_bar)[param])
+    noise_std = _noise_std(cfg, truth, controllers, tracked, e, fs)
+    noise, inoise = white * noise_std, iwhite * truth.current_noise_a
+    dec = max(1, int(round(fs / record_hz)))
+    runs = {}
+    for name, Kd in controllers.items():
+        fac = prepare_facility(cfg, truth, fs, pressure_bar=0.0, pressure_schedule=sched)
+        runs[name] = _run_fixed(name, fac, Kd, e, noise, inoise, fs, starts, n_len, dec,
+                                block_s)
+        if progress:
+            lost = runs[name].lost_at_s
+            progress(f"ramp: {name} " + ("kept the rotor" if lost is None
+                                         else f"lost the rotor at {lost:.2f} s"))
+    tracking = {}
+    if tracked is not None:
+        fac = prepare_facility(cfg, truth, fs, pressure_bar=0.0, pressure_schedule=sched)
+        runs["tracked"], tracking = _run_tracked(cfg, fac, tracked, e, noise, inoise, fs,
+                                                 starts, n_len, dec, block_s, k_of_n,
+                                                 float(k_nom), transient_s, settings)
+        if progress:
+            progress(f"ramp: tracked {tracking}")
+    t = np.arange(N)[::dec] / fs
+    return RampResult(param, t, p_of_n[::dec], k_of_n[::dec], float(k_nom),
+                      [n0 / fs for n0 in starts], tuple(fac0.axes), runs, tracking)
+
+
+def _noise_std(cfg, truth, controllers, tracked, e, fs):
+    """Sensor noise std per axis: the truth's floor plus ``noise_fraction`` × the RMS of a
+    noise-free first second at 0 bar with the tracked controller (else the first one)."""
+    from ..identify.rig_sim import prepare_facility
+
+    k = e.shape[1]
+    std = np.full(k, truth.sensor_noise_m)
+    if truth.noise_fraction <= 0:
+        return std
+    Kd = (_discrete(tracked, tracked.schedule[0], 1.0 / fs) if tracked is not None
+          else next(iter(controllers.values())))
+    n = min(len(e), int(round(fs)))
+    fac = prepare_facility(cfg, truth, fs, pressure_bar=0.0)
+    y, _, _ = fac.run(Kd, np.zeros(Kd.A.shape[0]), e[:n], np.zeros((n, k)), np.zeros((n, k)))
+    return std + truth.noise_fraction * np.sqrt(np.mean(y**2, axis=0))
+
+
+def _discrete(tracked, value: float, T: float):
+    """The tracked controller frozen at θ = ``value`` and discretised (Tustin)."""
+    from ..control.digital import discretize_as
+    from ..identify.loop import DiscreteController
+
+    return DiscreteController(*discretize_as(tracked.matrices_at(value), T, "tustin"), T)
+
+
+def _records(N: int, k: int):
+    return np.full((N, k), np.nan), np.full((N, k), np.nan)
+
+
+def _run_fixed(name, fac, Kd, e, noise, inoise, fs, starts, n_len, dec, block_s) -> RampRun:
+    """One fixed controller over the ramp, in blocks (the records up to a loss kept)."""
+    N, k = e.shape
+    y, ref = _records(N, k)
+    xc, lost, nb = np.zeros(Kd.A.shape[0]), None, max(1, int(round(block_s * fs)))
+    for a in range(0, N, nb):
+        b = min(N, a + nb)
+        try:
+            y[a:b], _, ref[a:b] = fac.run(Kd, xc, e[a:b], noise[a:b], inoise[a:b])
+        except ModelError:
+            lost = (a, fac.n)
+            break
+    return _run(name, y, ref, lost, fs, starts, dec, n_len)
+
+
+def _run(name, y, ref, lost, fs, starts, dec, n_len, **extra) -> RampRun:
+    """The run's record; ``lost`` = (first sample not recorded, sample of the loss)."""
+    peaks, settle = _impulse_metrics(y[:, 0], starts, fs, n_len,
+                                     None if lost is None else lost[0])
+    return RampRun(name, y[::dec] * 1e6, ref[::dec], None if lost is None else lost[1] / fs,
+                   peaks, settle, **extra)
+
+
+def _run_tracked(cfg, fac, tracked, e, noise, inoise, fs, starts, n_len, dec, block_s,
+                 k_true, k_nom, transient_s, settings):
+    """The tracked scheme over the ramp (module docstring); its run and the estimator's
+    accuracy."""
+    from ..identify.fit import ClosedLoopModel
+    from ..identify.rig_sim import reduced_plant
+    from ..identify.tracking import OnlineTracker, TrackingSettings
+    from ..model.amb import actuator_matrices
+
+    N, k = e.shape
+    T = 1.0 / fs
+    s = settings or TrackingSettings()
+    plant = reduced_plant(cfg, 0.0, None, {}, s.cutoff_hz or fs / 2)
+    theta = float(plant.parameter(tracked.parameter).nominal)
+    Kd = _discrete(tracked, theta, T)
+    model = ClosedLoopModel(plant, actuator_matrices(cfg.actuator), Kd,
+                            tau_e=cfg.actuator.eddy_time_constant)
+    y, ref = _records(N, k)
+    xc, lost, tr, nb = np.zeros(Kd.A.shape[0]), None, None, max(1, int(round(block_s * fs)))
+    for a in range(0, N, nb):
+        b = min(N, a + nb)
+        Kd = _discrete(tracked, theta, T)
+        try:
+            y[a:b], _, ref[a:b] = fac.run(Kd, xc, e[a:b], noise[a:b], inoise[a:b])
+        except ModelError:
+            lost = (a, fac.n)
+            break
+        if tr is None:
+            tr = OnlineTracker(cfg, model, [tracked.parameter], T, y[a:b], ref[a:b], s)
+        theta = float(tr.update(y[a:b], ref[a:b])[0])
+    res = tr.result(np.arange(tr.samples) * T)
+    est = res.estimate[:, 0]
+    lo, hi = (c[:, 0] for c in res.ci95())
+    n = len(est)
+    after = slice(int(round(transient_s * fs)), n)
+    kt = k_true[:n]
+    acc = {"max_error_rel": None, "coverage": None, "transient_s": transient_s}
+    if n > after.start:
+        acc["max_error_rel"] = float(np.max(np.abs(est[after] - kt[after])) / k_nom)
+        acc["coverage"] = float(np.mean((lo[after] <= kt[after]) & (kt[after] <= hi[after])))
+    pad = np.full(N - n, np.nan)
+    run = _run("tracked", y, ref, lost, fs, starts, dec, n_len,
+               estimate=np.r_[est, pad][::dec], ci95_low=np.r_[lo, pad][::dec],
+               ci95_high=np.r_[hi, pad][::dec])
+    return run, acc
+
+
+def frozen_cases(cfg, design, *, settings=None, impulse: bool = False) -> list[dict]:
+    """The scheduled controller judged on the full-order plant at frozen pressures: the
+    design's range (``range_factor`` × the operating pressure) on a grid 5× denser than
+    its design grid, the controller frozen at the rig model's value of its parameter at
+    each pressure (:func:`ambseal.analysis.judge.judge`; each case also has ``"value"``,
+    θ in SI).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+    design : SealScheduledDesign
+    settings : JudgeSettings, optional
+    impulse : bool
+        Include the impulse response (off: the frequency-domain numbers only).
+
+    Returns
+    -------
+    list of dict
+    """
+    from ..model.rig import build_plant
+    from .judge import OperatingPoint, judge, judge_settings
+
+    s = settings or judge_settings(cfg)
+    p0, rpm = cfg.operating.pressure_bar, cfg.operating.speed_rpm
+    lo, hi = design.range_factor
+    cases = []
+    for p in np.linspace(lo * p0, hi * p0, 5 * (len(design.grid) - 1) + 1):
+        theta = float(build_plant(cfg, pressure_bar=p).parameter(design.parameter).nominal)
+        case, _ = judge(cfg, design.at(theta), "tracked",
+                        OperatingPoint(float(p), rpm, f"{p:.3g} bar"), s, impulse=impulse)
+        cases.append({**case, "value": theta})
+    return cases

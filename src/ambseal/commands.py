@@ -60,8 +60,12 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
             cache["plants"] = sampled_plants([plant(*c) for c in conds], fs)
         return digital_controller(controller, fs, cache["plants"],
                                   delay_samples=delay, rise=rise)
+    from .control.controller import SPEED
     from .control.scheduled_digital import scheduled_digital
 
+    if controller.parameter != SPEED:
+        raise ConfigError(f"{method}: a controller scheduled on {controller.parameter!r} "
+                          "has no digital table yet (only speed-scheduled ones)")
     W = np.asarray(controller.K.speeds_rad_s, float)
     # between table entries at 1/8, 3/8, 5/8, 7/8 of the table: the interpolation judged
     mids = [(W[j] + W[j + 1]) / 2 for j in (np.arange(1, 8, 2) * (W.size - 1)) // 8]

@@ -1,0 +1,50 @@
+"""The closed-loop pressure ramp on the virtual facility (issue 14 §2)."""
+
+import numpy as np
+import pytest
+
+from ambseal.analysis.ramp import pressure_ramp
+
+
+def test_pressure_ramp_reaches_two_and_three_times_nominal():
+    """Reference: the linear ramp written out — 0 → 3 p over 30 s in 0.05 s steps is 600
+    steps, 2 p at 20 s and 3 p at the end."""
+    r = pressure_ramp(2.0, 30.0)
+    assert len(r) == 600
+    t, p = np.array(r).T
+    assert p[np.argmin(np.abs(t - 20.0))] == pytest.approx(4.0)
+    assert r[-1] == (pytest.approx(30.0), pytest.approx(6.0))
+    assert np.all(np.diff(p) > 0)
+
+
+@pytest.mark.slow
+def test_ramp_losses_agree_with_the_frozen_full_order_loops(testrig_cfg, testrig_designs,
+                                                            testrig_digital, testrig_tracked):
+    """Reference: the frozen full-order loops (:func:`ambseal.analysis.judge.judge`,
+    eigenvalues of the continuous loop at fixed pressure). The reference PID is stable at
+    1.25× and unstable at 1.5× nominal pressure: on the 0 → 3× ramp it loses the rotor
+    between 1.1× and 1.5× (the facility's truth has a 5 % larger k per bar than the rig
+    file); the μ controller is stable with σ̄(S_o) < 2 up to 3×: it keeps the rotor and
+    its impulse peaks stay within a factor 2 along the ramp. The tracked scheme's run and
+    the estimator's accuracy are reported (issue 14's note), not asserted: along this ramp
+    the estimate leaves the truth from ≈ 1.7× nominal."""
+    from ambseal.analysis.judge import OperatingPoint, judge
+    from ambseal.analysis.ramp import ramp_simulation
+    from ambseal.config import load_truth
+    from ambseal.pipeline import default_truth_path
+
+    cfg = testrig_cfg
+    p0, rpm = cfg.operating.pressure_bar, cfg.operating.speed_rpm
+    frozen = {(m, f): judge(cfg, testrig_designs[m].K, m, OperatingPoint(f * p0, rpm, ""),
+                            impulse=False)[0]["stable"]
+              for m, f in (("pid", 1.25), ("pid", 1.5), ("mu", 3.0))}
+    assert frozen == {("pid", 1.25): True, ("pid", 1.5): False, ("mu", 3.0): True}
+    truth = load_truth(default_truth_path())
+    ctrls = {m: testrig_digital[m].discrete for m in ("pid", "mu")}
+    r = ramp_simulation(cfg, truth, ctrls, testrig_tracked, duration_s=30.0)
+    top = 3.0 * p0
+    lost_p = r.runs["pid"].lost_at_s / 30.0 * top
+    assert 1.1 * p0 < lost_p < 1.5 * p0
+    assert r.runs["mu"].lost_at_s is None
+    peaks = [x for x in r.runs["mu"].impulse_peak_um if x is not None]
+    assert len(peaks) == len(r.impulse_times_s) and max(peaks) < 2 * min(peaks)

@@ -6,21 +6,22 @@ The facility (:mod:`ambseal.identify.rig_sim`: nonlinear AMB forces, amplifier l
 eddy lag, sensor noise, ADC, the digital controller at the rig's rate) runs a
 piecewise-constant pressure drop from 0 to ``top_factor``× nominal in ``step_s`` steps;
 the same excitation — the tracker's PRBS (:func:`~ambseal.identify.tracking.
-tracking_excitation`), off around each impulse, plus the thesis's current impulse (P5
-§5.1, the specification's amplitude and length on the first actuator axis) every
-``impulse_every_s`` — and the same
+tracking_excitation`) plus the thesis's current impulse (P5 §5.1, the specification's
+amplitude and length on the first actuator axis) every ``impulse_every_s`` — and the same
 noise sequence go into every run, so the runs differ only by their controller.
 
 The tracked scheme runs in blocks of ``block_s``: at the start of each block the scheduled
-controller is frozen at the current estimate k̂ and discretised (Tustin, the controller
+controller is frozen at the scheduling value and discretised (Tustin, the controller
 state carried across the switch), the block is run, and the tracker
 (:class:`~ambseal.identify.tracking.OnlineTracker`, started at the model's value at the
 starting pressure) is fed the block's displacements and current references. The
-estimate used in a block is from the end of the previous one: causal, as on the target.
+scheduling value follows the estimate at the end of the previous block (causal, as on the
+target) within the design's rate bound ν and its schedule: the LPV guarantee holds only
+for |θ̇| ≤ ν, and an estimate jumps (at an impulse) faster than that.
 
 Per impulse: the peak |y| on the impulse axis within 30 impulse lengths, and the settling
-time, after which |y| stays inside max(2 % of the peak, 3× the noise std of the 50 ms
-before the impulse, when the PRBS is off); None when it never does within the window.
+time, after which |y| stays inside max(2 % of the peak, 3× the std of the 50 ms before
+the impulse: noise and the PRBS's response); None when it never does within the window.
 """
 
 from __future__ import annotations
@@ -100,16 +101,15 @@ def pressure_ramp(p_nominal_bar: float, duration_s: float, *, top_factor: float 
 
 def _excitation(cfg, N: int, fs: float, every_s: float, amplitude_a: float, n_len: int,
                 seed: int):
-    """(excitation (N, k), impulse start samples): the tracker's PRBS, off from 0.1 s before
-    each impulse to 30 impulse lengths after it, and the impulse train on axis 0."""
+    """(excitation (N, k), impulse start samples): the tracker's PRBS and the impulse train
+    on axis 0 added to it."""
     from ..identify.tracking import tracking_excitation
 
     e = tracking_excitation(cfg, (N + 1) / fs, seed=seed).values_a[:N].copy()
     step = int(round(every_s * fs))
     starts = list(range(step, N - 35 * n_len, step))
     for n0 in starts:
-        e[max(0, n0 - int(round(0.1 * fs))):n0 + 30 * n_len] = 0.0
-        e[n0:n0 + n_len, 0] = amplitude_a
+        e[n0:n0 + n_len, 0] += amplitude_a
     return e, starts
 
 
@@ -305,7 +305,8 @@ def _run_tracked(cfg, fac, tracked, e, noise, inoise, fs, starts, n_len, dec, bl
             break
         if tr is None:
             tr = OnlineTracker(cfg, model, [tracked.parameter], T, y[a:b], ref[a:b], s)
-        theta = float(tr.update(y[a:b], ref[a:b])[0])
+        est, step = float(tr.update(y[a:b], ref[a:b])[0]), tracked.rate_bound * (b - a) * T
+        theta = float(np.clip(theta + np.clip(est - theta, -step, step), *tracked.schedule))
     res = tr.result(np.arange(tr.samples) * T)
     est = res.estimate[:, 0]
     lo, hi = (c[:, 0] for c in res.ci95())

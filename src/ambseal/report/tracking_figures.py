@@ -103,7 +103,8 @@ def ramp_figure(path: str | os.PathLike, ramp, *, axis: int = 0) -> Path:
     ax_p.set_ylabel("impulse peak (µm)")
     ax_p.set_xlabel("Time (s)")
     for ax in (ax_y, ax_i, ax_p):
-        ax.legend(fontsize=8, loc="upper left", ncol=len(names))
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=8, loc="upper left", ncol=len(names))
         ax.grid(alpha=0.3)
     ax_k.grid(alpha=0.3)
     fig.suptitle(f"Pressure ramp 0 → {float(np.max(ramp.pressure_bar)):.3g} bar: "

@@ -172,7 +172,7 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
     Raises
     ------
     ModelError
-        A rig without a seal coefficient named by ``tracked.parameter``.
+        A rig without a seal, or without the parameter named by ``tracked.parameter``.
     """
     from ..control.specs import design_spec
     from ..identify.rig_sim import _pressure_values, prepare_facility, reduced_plant, true_rig
@@ -188,6 +188,8 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
     k = len(fac0.axes)
     rng = np.random.default_rng(seed)
     white, iwhite = rng.standard_normal((N, k)), rng.standard_normal((N, k))
+    if tracked is None and not cfg.seal:
+        raise ModelError("ramp: the rig has no [[seal]] whose pressure could ramp")
     param = tracked.parameter if tracked is not None else f"{cfg.seal[0].name}.k"
     cfg_t = true_rig(cfg, truth)
     base = reduced_plant(cfg_t, 0.0, None, {}, truth.max_mode_hz)
@@ -307,6 +309,8 @@ def _run_tracked(cfg, fac, tracked, e, noise, inoise, fs, starts, n_len, dec, bl
             tr = OnlineTracker(cfg, model, [tracked.parameter], T, y[a:b], ref[a:b], s)
         est, step = float(tr.update(y[a:b], ref[a:b])[0]), tracked.rate_bound * (b - a) * T
         theta = float(np.clip(theta + np.clip(est - theta, -step, step), *tracked.schedule))
+    if tr is None:  # lost in the first block: nothing tracked
+        return _run("tracked", y, ref, lost, fs, starts, dec, n_len), {}
     res = tr.result(np.arange(tr.samples) * T)
     est = res.estimate[:, 0]
     lo, hi = (c[:, 0] for c in res.ci95())

@@ -85,11 +85,11 @@ class TrackingSettings:
     follow_pressure : bool
         When a tracked parameter is a seal's k affine in the pressure drop, the model's
         other coefficients of that seal (K, C, c) follow the pressure that gives k̂
-        (:func:`ambseal.model.seal.values_following_k`); False: they stay at the record's
-        pressure. Measured on the facility's 0 → 3× nominal ramp with the k-scheduled
-        controller (issue 14 §2): the largest error after 1 s is 1.90 k_nom with them
-        following, 2.13 k_nom with them fixed — in both cases k̂ leaves k from ≈ 1.7×
-        nominal (not understood yet; the error below that is ≈ 10 %).
+        (:func:`ambseal.model.seal.values_following_k`); False (default): they stay at the
+        record's pressure. Measured on the facility's 0 → 3× nominal ramp (issue 14 §2),
+        the largest error over 2.5–3× with the μ controller running: 0.25 k_nom following,
+        0.22 fixed; with the k-scheduled controller 1.90 following, 2.13 fixed — no clear
+        gain, so the default keeps the model of §1.
     """
 
     rate_per_s: float = 0.1
@@ -102,7 +102,7 @@ class TrackingSettings:
     initial_rel_std: float = 1.0
     inflation_window_s: float = 0.5
     min_duration_s: float = 0.5
-    follow_pressure: bool = True
+    follow_pressure: bool = False
 
 
 def _inflation(score: np.ndarray, info: np.ndarray, block: int, window: int) -> np.ndarray:

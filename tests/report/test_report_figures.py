@@ -40,3 +40,27 @@ def test_bad_curves_raise(tmp_path):
         figures.unbalance_figure(tmp_path / "missing" / "x.png", [])
     with pytest.raises(AmbsealError):
         figures.impulse_figure(tmp_path / "i.png", [("a", [0, 1], np.zeros((2, 3)))], ["A", "B"])
+
+
+def test_log_minor_grid_drawn_as_one_collection(tmp_path):
+    """Reference: the decade grid of log paper — minor lines at m·10ᵏ, m = 2…9, strictly
+    inside the axis limits; an axis spanning under a decade keeps matplotlib's minor ticks
+    (they carry its only labels)."""
+    from matplotlib.collections import LineCollection
+    from matplotlib.figure import Figure
+    from matplotlib.ticker import LogLocator, NullLocator
+
+    fig = Figure()
+    ax, short = fig.subplots(1, 2)
+    ax.loglog([3.0, 4000.0], [1.0, 2.0])
+    ax.set_xlim(3.0, 4000.0)
+    ax.grid(True, which="both", alpha=0.3)
+    short.semilogx([2.0, 7.0], [1.0, 2.0])
+    figures.save_figure(fig, tmp_path / "g.png", tight=True)
+    _ok(tmp_path / "g.png")
+    lines = [c for c in ax.collections if isinstance(c, LineCollection)]
+    xs = sorted(seg[0][0] for c in lines for seg in c.get_segments() if seg[0][1] == 0)
+    expected = [m * 10.0**k for k in range(0, 4) for m in range(2, 10) if 3 < m * 10.0**k < 4000]
+    np.testing.assert_allclose(xs, expected)
+    assert isinstance(ax.xaxis.get_minor_locator(), NullLocator)
+    assert isinstance(short.xaxis.get_minor_locator(), LogLocator)

@@ -163,8 +163,7 @@ def frf_figure(
         for c in range(ncol):
             axes[2, c].set_ylim(0, 1.05)
     fig.suptitle(title)
-    fig.tight_layout()
-    return save_figure(fig, path)
+    return save_figure(fig, path, tight=True)
 
 
 def fit_timeseries_figure(path: str | os.PathLike, time_s: Sequence[float], y_meas: np.ndarray,

@@ -59,8 +59,7 @@ def spinup_figure(path: str | os.PathLike, results: Sequence, *, channel: int = 
     for ax in (ax1, ax2):
         ax.grid(True, alpha=0.3)
     ax1.set_title(title, fontsize=10)
-    fig.tight_layout()
-    return save_figure(fig, path)
+    return save_figure(fig, path, tight=True)
 
 
 def frozen_sensitivity_figure(path: str | os.PathLike, results: Sequence, *,
@@ -104,5 +103,4 @@ def frozen_sensitivity_figure(path: str | os.PathLike, results: Sequence, *,
         ax.legend(fontsize=7)
     axes[0].set_ylabel("σ̄(S_o) (–, absolute gain)")
     fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
-    return save_figure(fig, path)
+    return save_figure(fig, path, tight=True)

@@ -79,8 +79,7 @@ def campbell_figure(path: str | os.PathLike, c, *, title: str = "Closed-loop Cam
     axd.set_xlabel("speed (Hz)")
     axd.set_ylabel("log decrement δ (-)")
     axd.grid(True, alpha=0.3)
-    fig.tight_layout()
-    return save_figure(fig, path)
+    return save_figure(fig, path, tight=True)
 
 
 def mode_shapes_figure(path: str | os.PathLike, m, positions: dict[str, list[float]], *,
@@ -133,8 +132,7 @@ def mode_shapes_figure(path: str | os.PathLike, m, positions: dict[str, list[flo
     for ax in axes[-cols:]:
         ax.set_xlabel("axial position z (m)")
     fig.suptitle(f"{title} — {m.speed_hz:g} Hz, {m.pressure_bar:g} bar", fontsize=11)
-    fig.tight_layout()
-    return save_figure(fig, path)
+    return save_figure(fig, path, tight=True)
 
 
 def stability_map_figure(path: str | os.PathLike, rows: list[dict], boundary: list[dict], *,
@@ -187,5 +185,4 @@ def stability_map_figure(path: str | os.PathLike, rows: list[dict], boundary: li
         ax.set_xlabel("pressure drop (bar)")
         ax.set_ylabel("speed (Hz)")
         ax.set_title(f"{title}: {name}")
-    fig.tight_layout()
-    return save_figure(fig, path)
+    return save_figure(fig, path, tight=True)

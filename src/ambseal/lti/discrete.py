@@ -22,10 +22,12 @@ import scipy.linalg as sla
 from numba import njit
 
 from ambseal.errors import ModelError
+from ambseal.lti.matrices import ArrayMemo
 
 __all__ = ["zoh", "discretize", "simulate_lti"]
 
 _METHODS = ("tustin", "zoh")
+_ZOH = ArrayMemo()  # the last large (A, B, dt) sampled
 
 
 def zoh(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
@@ -42,7 +44,17 @@ def zoh(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray
     -------
     A_d : ndarray, shape (n, n)
     B_d : ndarray, shape (n, m)
+
+    The result for the last few large ``(A, B, dt)`` is kept
+    (:class:`~ambseal.lti.matrices.ArrayMemo`): the full-order plant of one operating point
+    is sampled once for every controller judged on it.
     """
+    Ad, Bd = _ZOH.get((np.asarray(A, float), np.asarray(B, float)), float(dt),
+                      lambda: _zoh(A, B, dt))
+    return Ad.copy(), Bd.copy()
+
+
+def _zoh(A, B, dt):
     # a diagonal similarity first (Parlett & Reinsch 1969): controllers from H∞ synthesis
     # mix entries from 1 to 1e9, and expm of the unbalanced matrix loses up to 7 digits
     # (an impulse response moved by 5e-5 for a 1e-12 change of A_K; balanced, by 1e-12)

@@ -30,12 +30,14 @@ import numpy as np
 import scipy.linalg
 
 from ambseal.errors import ModelError
-from ambseal.lti.matrices import as_omega, ss_matrices
+from ambseal.lti.matrices import ArrayMemo, as_omega, ss_matrices
 
 __all__ = ["freqresp", "freqresp_at"]
 
 _CHUNK_BYTES = 32 * 2**20  # memory budget of one chunk (complex n×n per frequency)
 _USE_SLYCOT = True  # set False (tests) to force the pure-numpy Hessenberg solver
+_MODAL = ArrayMemo()  # (λ, V, cond V, V⁻¹B, CV) of the last large (A, B, C)
+_HESSENBERG = ArrayMemo()  # balanced upper-Hessenberg form of the last large (A, B, C)
 
 
 def freqresp(
@@ -142,8 +144,7 @@ def _response(A, B, C, D, s, method, max_cond, rtol) -> np.ndarray:
     if method == "hessenberg":
         return _hessenberg_response(A, B, C, D, s)
 
-    lam, V = scipy.linalg.eig(A)
-    cond = np.linalg.cond(V)
+    lam, cond, Bm, Cm = _MODAL.get((A, B, C), max_cond, lambda: _modal_form(A, B, C, max_cond))
     if not np.isfinite(cond) or cond > max_cond:
         if method == "modal":
             raise ModelError(
@@ -151,8 +152,6 @@ def _response(A, B, C, D, s, method, max_cond, rtol) -> np.ndarray:
                 " use method='hessenberg'"
             )
         return _hessenberg_response(A, B, C, D, s)
-    Bm = scipy.linalg.solve(V, B.astype(complex))
-    Cm = C @ V
     if method == "auto":
         probe = s[np.unique([0, s.size // 2, s.size - 1])]
         Hm = _modal_eval(lam, Bm, Cm, D, probe)
@@ -164,6 +163,16 @@ def _response(A, B, C, D, s, method, max_cond, rtol) -> np.ndarray:
             if ok.any() and np.any(err[ok] > rtol * np.maximum(scale[ok], np.finfo(float).tiny)):
                 return _hessenberg_response(A, B, C, D, s)
     return _modal_eval(lam, Bm, Cm, D, s)
+
+
+def _modal_form(A, B, C, max_cond):
+    """(λ, cond V, V⁻¹B, CV) of ``A = V diag(λ) V⁻¹``; ``V⁻¹B``, ``CV`` None when
+    ``cond V > max_cond`` (not used then)."""
+    lam, V = scipy.linalg.eig(A)
+    cond = np.linalg.cond(V)
+    if not np.isfinite(cond) or cond > max_cond:
+        return lam, cond, None, None
+    return lam, cond, scipy.linalg.solve(V, B.astype(complex)), C @ V
 
 
 def _modal_eval(lam: np.ndarray, Bm: np.ndarray, Cm: np.ndarray, D: np.ndarray, s: np.ndarray) -> np.ndarray:
@@ -183,22 +192,20 @@ def _hessenberg_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndar
 
     ``A`` is balanced first (diagonal similarity, ``scipy.linalg.matrix_balance``; Parlett &
     Reinsch 1969): FE models in [q; q̇] form have entries from 1 to 1e12 and lose several
-    digits without it. Uses SLICOT ``TB05AD`` through slycot when it is installed (Fortran
-    loop, the routine python-control also uses), else the vectorised :func:`hessenberg_solve`.
+    digits without it. The orthogonal reduction to upper Hessenberg form (LAPACK
+    ``dgehrd``, as SLICOT ``TB05AD`` does it) is kept for the last large systems
+    (:class:`~ambseal.lti.matrices.ArrayMemo`). The solves use ``TB05AD`` (job ``'NH'``)
+    through slycot when it is installed (Fortran loop, the routine python-control also
+    uses), else the vectorised :func:`hessenberg_solve`.
     """
-    A, (sc, _) = scipy.linalg.matrix_balance(A, permute=False, separate=True)
-    B = B / sc[:, None]
-    C = C * sc[None, :]
+    Hs, Bh, Ch = _HESSENBERG.get((A, B, C), None, lambda: _hessenberg_form(A, B, C))
     if _USE_SLYCOT:
         try:
-            return _slycot_response(A, B, C, D, s)
+            return _slycot_response(Hs, Bh, Ch, D, s)
         except ImportError:
             pass
-    Hs, Q = scipy.linalg.hessenberg(A, calc_q=True)
-    Bh = Q.T @ B
-    Ch = C @ Q
-    n = A.shape[0]
-    out = np.empty((s.size, C.shape[0], B.shape[1]), dtype=complex)
+    n = Hs.shape[0]
+    out = np.empty((s.size, Ch.shape[0], Bh.shape[1]), dtype=complex)
     step = max(1, _CHUNK_BYTES // (16 * n * n))
     with np.errstate(divide="ignore", invalid="ignore"):
         for i in range(0, s.size, step):
@@ -207,24 +214,24 @@ def _hessenberg_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndar
     return out
 
 
-def _slycot_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """TB05AD: Hessenberg form once (job 'NG'), then O(n²) per frequency (job 'NH')."""
+def _hessenberg_form(A, B, C):
+    """``(H, QᵀB̃, C̃Q)`` with ``H = QᵀÃQ`` upper Hessenberg, ``Ã, B̃, C̃`` balanced."""
+    A, (sc, _) = scipy.linalg.matrix_balance(A, permute=False, separate=True)
+    Hs, Q = scipy.linalg.hessenberg(A, calc_q=True)
+    return Hs, Q.T @ (B / sc[:, None]), (C * sc[None, :]) @ Q
+
+
+def _slycot_response(Hs: np.ndarray, Bh: np.ndarray, Ch: np.ndarray, D: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """TB05AD with job 'NH' (A given in upper Hessenberg form): O(n²) per frequency."""
     from slycot import tb05ad
 
-    n, m = B.shape
-    p = C.shape[0]
+    n, m = Bh.shape
+    p = Ch.shape[0]
     out = np.empty((s.size, p, m), dtype=complex)
-    At, Bt, Ct = (np.array(x, dtype=float, order="F") for x in (A, B, C))
-    first = True
+    At, Bt, Ct = (np.array(x, dtype=float, order="F") for x in (Hs, Bh, Ch))
     for k, sk in enumerate(s):
         try:
-            if first:
-                res = tb05ad(n, m, p, sk, A.copy(order="F"), B.copy(order="F"), C.copy(order="F"), job="NG")
-                At, Bt, Ct = res[0], res[1], res[2]
-                g = res[3]
-                first = False
-            else:
-                g = tb05ad(n, m, p, sk, At, Bt, Ct, job="NH")[0]
+            g = tb05ad(n, m, p, sk, At, Bt, Ct, job="NH")[0]
         except Exception:  # slycot raises when s_k is (numerically) a pole: singular sI - A
             g = np.full((p, m), np.nan + 1j * np.nan)
         out[k] = g + D

@@ -3,18 +3,23 @@
 * :func:`ss_matrices` — ``(A, B, C, D)`` as float arrays from a ``control.StateSpace`` (or
   anything python-control converts) or a tuple;
 * :func:`as_omega` — a checked frequency grid in rad/s;
-* :func:`labels` — signal names of a python-control system, or generated ones.
+* :func:`labels` — signal names of a python-control system, or generated ones;
+* :class:`ArrayMemo` — results of an expensive function of large arrays, kept for the last
+  few distinct inputs (the full-order plant of one condition is decomposed once, not once
+  per controller judged on it).
 """
 
 from __future__ import annotations
 
-from typing import Any
+import hashlib
+from collections import OrderedDict
+from typing import Any, Callable
 
 import numpy as np
 
 from ambseal.errors import ModelError
 
-__all__ = ["as_omega", "ss_matrices", "labels"]
+__all__ = ["as_omega", "ss_matrices", "labels", "ArrayMemo"]
 
 
 def as_omega(omega: Any, *, name: str = "omega") -> np.ndarray:
@@ -72,3 +77,37 @@ def labels(sys: Any, kind: str, count: int, prefix: str) -> tuple[str, ...]:
     if names is not None and len(names) == count:
         return tuple(str(s) for s in names)
     return tuple(f"{prefix}[{i}]" for i in range(count))
+
+
+class ArrayMemo:
+    """Results of ``compute()`` kept for the last ``keep`` distinct inputs, keyed by a digest
+    (BLAKE2b) of the input arrays' shapes, dtypes and bytes plus ``extra``.
+
+    Used where one large matrix is decomposed again and again with the same content (the
+    full-order plant of one operating point, judged with every controller): hashing a
+    320 × 320 matrix costs about 1 ms, its eigendecomposition about 60 ms. Only inputs
+    with at least ``min_states`` rows are kept (small systems are cheaper to recompute
+    than to hash). Cached results are shared: callers must not modify them in place.
+    """
+
+    def __init__(self, keep: int = 8, min_states: int = 64):
+        self.keep, self.min_states = keep, min_states
+        self._kept: OrderedDict = OrderedDict()
+
+    def get(self, arrays: tuple, extra: Any, compute: Callable[[], Any]) -> Any:
+        """``compute()``, or its kept result for the same ``arrays`` and ``extra``."""
+        if arrays[0].shape[0] < self.min_states:
+            return compute()
+        h = hashlib.blake2b(repr(extra).encode(), digest_size=20)
+        for a in arrays:
+            a = np.ascontiguousarray(a)
+            h.update(f"{a.shape}{a.dtype.str}".encode())
+            h.update(a.data)
+        key = h.digest()
+        if key in self._kept:
+            self._kept.move_to_end(key)
+            return self._kept[key]
+        value = self._kept[key] = compute()
+        if len(self._kept) > self.keep:
+            self._kept.popitem(last=False)
+        return value

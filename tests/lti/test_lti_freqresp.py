@@ -110,3 +110,26 @@ def test_fe_rotor_plant_against_direct_solves():
     for method in ("auto", "modal", "hessenberg"):
         H = fr.freqresp((P.A, P.B, P.C, P.D), w, method=method)
         assert np.max(np.abs(H - ref)) <= 1e-6 * np.max(np.abs(ref)), method
+
+
+def test_kept_decompositions_follow_the_matrix_content():
+    """Reference: C (sI − A)⁻¹ B + D by a dense solve at each point. A large system
+    (above ArrayMemo's 64 states) evaluated, changed in place, evaluated again: the kept
+    eigendecomposition, Hessenberg form and ZOH belong to the content, not the object."""
+    import scipy.linalg
+
+    from ambseal.lti.discrete import zoh
+
+    rng = np.random.default_rng(3)
+    n = 80
+    A = rng.standard_normal((n, n)) - 12 * np.eye(n)
+    B, C, D = rng.standard_normal((n, 2)), rng.standard_normal((3, n)), np.zeros((3, 2))
+    s = 1j * np.array([0.5, 3.0, 40.0])
+    for method in ("modal", "hessenberg", "modal"):
+        for _ in range(2):
+            H = fr.freqresp_at((A, B, C, D), s, method=method)
+            ref = np.stack([C @ np.linalg.solve(sk * np.eye(n) - A, B) for sk in s])
+            np.testing.assert_allclose(H, ref, rtol=1e-9, atol=1e-12)
+            Ad, _ = zoh(A, B, 0.01)
+            np.testing.assert_allclose(Ad, scipy.linalg.expm(A * 0.01), rtol=1e-9, atol=1e-12)
+            A[0, 1] += 0.5  # same array object, new content

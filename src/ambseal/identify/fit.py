@@ -399,8 +399,11 @@ def fit_parameters(
     if np.all(r0 == 1e6):
         raise IdentificationError("fit: the model cannot be simulated at the start values")
     lb, ub = (lo - init) / scale, (hi - init) / scale
+    # scipy's default tolerances (1e-8): on the thesis procedure of the test rig, 1e-10
+    # took 35 % more model evaluations and moved no estimate by more than 1e-3 of its
+    # standard error
     sol = least_squares(residuals, np.zeros(len(names)), bounds=(lb, ub), method="trf",
-                        x_scale=1.0, max_nfev=max_nfev, xtol=1e-10, ftol=1e-10, gtol=1e-10)
+                        x_scale=1.0, max_nfev=max_nfev, xtol=1e-8, ftol=1e-8, gtol=1e-8)
     est = init + sol.x * scale
     converged = bool(sol.status > 0)
     message = str(sol.message)

@@ -58,14 +58,15 @@ def testrig_designs(testrig_cfg):
 
 @pytest.fixture(scope="session")
 def testrig_plants(testrig_cfg):
-    """pressure (bar) → (G, Gf): full-order plant from the 4 currents and from the force at
-    the seal (0.43 m, the rig's first seal) to the 4 displacements."""
+    """pressure (bar) → (G, Gf): full-order plant from the 4 currents and from the forces at
+    the bearings A and B (0.17 and 0.69 m, where P5 §4.4.1 takes the compliance) to the 4
+    displacements."""
     from ambseal.model.rig import build_plant
 
-    x_seal = testrig_cfg.seal[0].position
+    x_amb = tuple(a.position for a in testrig_cfg.amb)
     out = {}
     for p in PRESSURES_BAR:
-        pl = build_plant(testrig_cfg, pressure_bar=p, force_positions=(x_seal,))
+        pl = build_plant(testrig_cfg, pressure_bar=p, force_positions=x_amb)
         out[p] = (pl.select_inputs(pl.input_names[:4]).to_statespace(),
                   pl.select_inputs(pl.input_names[4:]).to_statespace())
     return out

@@ -17,9 +17,12 @@ schema). Units are SI except where the key names its unit.
     truncation above it). ``pressures_bar`` and ``speeds_hz``: the conditions every
     controller is judged at.
 ``[design.unbalance]``
-    ``grade_mm_s`` (ISO 21940-11 balance grade G, mm/s), ``mass_kg`` (the mass of the
-    force law F_u = m·G·Ω), ``force_at`` (the name of the seal, disk, AMB or spring where
-    the unbalance force and the compliance are taken), ``range_hz`` = ``[low, high]`` (the
+    ``grade_mm_s`` (ISO 21940-11 balance grade G, mm/s), ``mass_kg`` (the mass m of the
+    force law), ``law`` (``"iso21940"``, the default: F_u = m·G·Ω²/Ω_max, or
+    ``"constant_velocity"``: F_u = m·G·Ω; :mod:`ambseal.analysis.unbalance`),
+    ``max_speed_hz`` (the maximum service speed Ω_max/2π at which the grade holds, Hz),
+    ``force_at`` (the name of the seal, disk, AMB or spring where the unbalance force and
+    the compliance are taken; by default the bearings), ``range_hz`` = ``[low, high]`` (the
     speeds of the unbalance response, Hz).
 ``[design.impulse]``
     ``amplitude_a`` (A) and ``duration_s`` (s) of the current impulse of the time-domain
@@ -46,6 +49,7 @@ schema). Units are SI except where the key names its unit.
 from __future__ import annotations
 
 import tomllib
+from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
@@ -125,6 +129,8 @@ class UncertainSpec(_Strict):
 class UnbalanceSpec(_Strict):
     grade_mm_s: float | None = Field(default=None, gt=0)
     mass_kg: float | None = Field(default=None, gt=0)
+    law: Literal["iso21940", "constant_velocity"] | None = None
+    max_speed_hz: float | None = Field(default=None, gt=0)
     force_at: str | None = Field(default=None, min_length=1)
     range_hz: tuple[float, float] | None = None
 

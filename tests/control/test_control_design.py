@@ -2,7 +2,8 @@
 
 References: thesis P5 §4.1 (objectives), §4.4 and Figs. 11–13 (σ̄(S_o) of PID/H∞/μ over
 0 … 4.08 bar; the PID loses stability at high pressure), §4.4.1 and Fig. 12 (worst-case
-unbalance orbit, G2.5 on the 69 kg rotor, F_u = m·G·Ω), ISO 14839-3 (σ̄(S_o) < 3, zone A).
+unbalance orbit, G2.5 at 500 Hz on the 69 kg rotor, ISO 21940-11: F_u = m·G·Ω²/Ω_max), ISO
+14839-3 (σ̄(S_o) < 3, zone A).
 Designs are made on the reduced model; every check uses ``build_plant(cfg, pressure_bar=p)``.
 
 σ̄(S_o) peaks are taken on the log grid PLUS a fine grid around every lightly damped
@@ -128,14 +129,15 @@ def test_mu_robust_stability_and_sensitivity_over_pressure(designs, plants):
         assert peak < ISO_ZONE_A_LIMIT, f"σ̄(S_o) = {peak:.2f} at {p} bar, not ISO zone A"
 
 
-def test_mu_unbalance_orbit(designs, plants):
-    """P5 §4.4.1, Fig. 12: worst-case orbit σ̄(S_o G_f(jΩ))·F_u(Ω) < 8 µm for Ω ≤ 200 Hz.
+def test_unbalance_orbit_hinf_and_mu_below_8um(designs, plants):
+    """P5 §4.4.1, Fig. 12: "Both the H∞ and μ controllers ensure an orbit below 8 µm over the
+    200 Hz frequency range": worst-case orbit σ̄(S_o G_f(jΩ))·F_u(Ω) for Ω ≤ 200 Hz.
 
-    F_u = m·G·Ω (ISO 21940-11: G2.5 on the 69 kg rotor, balanced to G2.5 at every speed;
-    541.9 N at 500 Hz), acting at the seal (0.43 m), orbit at the sensors, on the full-order
-    plant at every pressure of the grid 0 … 4.08 bar. The μ design reaches ≈ 6.4 µm (worst
-    at 0 bar); the H∞ does not (≥ 16 µm), which is what the force channel of the μ design
-    is for.
+    F_u = m·G·Ω²/Ω_max (ISO 21940-11; G2.5 at Ω_max = 2π·500 rad/s on the 69 kg rotor, 541.9 N
+    at 500 Hz), the forces at the bearings A and B where P5 §4.4.1 takes the compliance,
+    orbit at the sensors, on the full-order plant at every pressure of the grid 0 … 4.08 bar.
+    The PID's orbit, where it is stable, is above 8 µm (the thesis names only H∞ and μ):
+    the demand is not met by accident.
     """
     w = 2 * np.pi * np.linspace(1.0, 200.0, 400)
 
@@ -143,27 +145,60 @@ def test_mu_unbalance_orbit(designs, plants):
         out = 0.0
         for p in sorted(plants):
             G, Gf = plants[p]
+            if not closed_loop(G, K).stable:
+                continue
             c = compliance(G, K, Gf, w)
-            out = max(out, unbalance_from_compliance(c, mass_kg=69.0, grade_mm_s=2.5).peak_um)
+            out = max(out, unbalance_from_compliance(c, mass_kg=69.0, grade_mm_s=2.5,
+                                                     max_speed_rad_s=2 * np.pi * 500.0).peak_um)
         return out
 
     assert worst(designs["mu"].K) < ORBIT_DEMAND_UM
-    assert worst(designs["hinf"].K) > ORBIT_DEMAND_UM  # the demand is not met by accident
+    assert worst(designs["hinf"].K) < ORBIT_DEMAND_UM
+    assert worst(designs["pid"].K) > ORBIT_DEMAND_UM
 
 
-def test_mu_force_weight_reads_as_orbit_bound():
-    """W_p·W_f/D_e = m·G·s·B_4(s)/orbit (closed form): the force channel bounds the orbit."""
+@pytest.mark.parametrize("law", ["iso21940", "constant_velocity"])
+def test_mu_force_weight_reads_as_orbit_bound(law):
+    """W_p·W_f/D_e = |F_u(jΩ)|·|B_4|/orbit (closed form): the force channel bounds the orbit;
+    F_u = m·G·Ω²/Ω_max (ISO 21940-11) or m·G·Ω, hand formulas."""
+    wmax = 2 * np.pi * 500.0
     wts = Weights(M=3.0, omega_b=30.0, orbit_um=6.0, wf_rolloff_hz=260.0,
-                  unbalance_mass_kg=69.0, d_e=20e-6)
+                  unbalance_mass_kg=69.0, d_e=20e-6, unbalance_law=law, max_speed_rad_s=wmax)
     Wp, Wf = wts.Wp(), wts.Wf()  # D_e = wts.d_e = 20 µm
     for hz in (10.0, 100.0, 200.0, 557.0):
         s = 2j * np.pi * hz
         b4 = 1 / np.sqrt(1 + (hz / 260.0) ** 8)  # |Butterworth, 4th order|
-        want = 69.0 * 2.5e-3 * abs(s) * b4 / 6e-6
+        force = 69.0 * 2.5e-3 * abs(s) * (abs(s) / wmax if law == "iso21940" else 1.0)
+        want = force * b4 / 6e-6
         assert abs(complex(Wp(s)) * complex(Wf(s))) / 20e-6 == pytest.approx(want, rel=1e-6)
     assert Weights().Wf() is None
     with pytest.raises(ValueError, match="orbit_um"):
         Weights(orbit_um=-1.0).Wf()
+    with pytest.raises(ValueError, match="max_speed_rad_s"):
+        Weights(orbit_um=6.0, wf_rolloff_hz=260.0, unbalance_mass_kg=69.0).Wf()
+
+
+def test_mu_robust_performance_and_moderate_gains(designs, cfg):
+    """P5 §4.1 objective 1 and Fig. 10, Ch. 7 item 2: the μ controller "guarantees robust
+    performance (μ ≤ 1) and simultaneously keeps the controller gains moderate": every
+    direct gain |K_ii| within a factor 2 of the reference PID's (P5 Eq. 6, closed form) from
+    1 to 200 Hz, and no gain |K_ij| above 3× the PID's peak Kp (1 + 1/ε) below Nyquist;
+    order 24, the thesis's μ controller order (P5 §4.4)."""
+    from ambseal.lti.freqresp import freqresp
+
+    mu = designs["mu"]
+    assert mu.mu <= 1.0
+    pid = cfg.controller.pid
+    f = np.logspace(0, np.log10(0.5 * cfg.controller.sample_rate_hz), 400)
+    s = 2j * np.pi * f
+    k_pid = np.abs(pid.kp * (1 + 1 / (pid.ti * s) + pid.td * s / (pid.eps * pid.td * s + 1)))
+    H = np.abs(freqresp(mu.K, 2 * np.pi * f))
+    low = f <= 200.0
+    for i in range(4):
+        ratio = H[low, i, i] / k_pid[low]
+        assert 0.5 <= ratio.min() and ratio.max() <= 2.0, (i, ratio.min(), ratio.max())
+    assert H.max() <= 3 * pid.kp * (1 + 1 / pid.eps)
+    assert mu.order == 24
 
 
 def test_design_is_deterministic_and_validates(cfg, designs):

@@ -15,7 +15,7 @@ import scipy.io
 from ambseal.control.digital import (discretize_as, residualize, split_fast, with_delay)
 from ambseal.control.export import export_controller, load_controller
 from ambseal.errors import DataError
-from ambseal.lti.discrete import discretize, zoh
+from ambseal.lti.discrete import zoh
 from ambseal.lti.interconnect import feedback_matrices
 
 
@@ -29,18 +29,15 @@ def _max_abs_z(G, K_discrete, T, delay):
     return float(np.abs(np.linalg.eigvals(Acl)).max())
 
 
-def test_old_tustin_export_is_unstable_and_the_recommended_one_is_not(
+def test_exported_controllers_keep_every_stable_loop_stable_with_a_sample_of_delay(
         testrig_cfg, testrig_plants, testrig_digital, tmp_path):
-    """Reference: issue 10's report — the plain Tustin H∞ and μ controllers of the embedded
-    rig (no pre-warp, no pole removal) closed with the full-order plant sampled by ZOH at
-    10 kHz are unstable (largest |z| 1.0004 for H∞ at 2.04 bar, 1.0001 for μ at 0 bar),
-    while the controller ambseal exports, reloaded from its file, keeps every loop whose
-    continuous loop is stable inside the unit circle with one sample of delay. On the old
-    export (A_tustin) the second half of this test fails."""
+    """Reference: issue 10's report — the controller ambseal exports, reloaded from its
+    file, keeps every loop whose continuous loop is stable inside the unit circle with one
+    sample of delay (full-order plant sampled by ZOH at 10 kHz, eigenvalues by numpy). On
+    issue 10's controllers the plain Tustin export (no pre-warp, no pole removal) was
+    unstable (|z| 1.0004 for H∞ at 2.04 bar); the moderate H∞ and μ of issue 16 no longer
+    show it (|z| 0.99967), so that half of the check went."""
     T = 1.0 / testrig_cfg.controller.sample_rate_hz
-    old = {m: _mats(discretize(testrig_digital[m].continuous, T, "tustin")) for m in ("hinf", "mu")}
-    assert _max_abs_z(_mats(testrig_plants[2.04][0]), old["hinf"], T, 0) > 1.0
-    assert _max_abs_z(_mats(testrig_plants[0.0][0]), old["mu"], T, 0) > 1.0
     for m, dc in testrig_digital.items():
         path = export_controller(dc, tmp_path / f"K_{m}.mat")
         K = load_controller(path).discrete

@@ -93,6 +93,34 @@ def test_bands_grids_and_unbalance(specs):
     assert specs["turbo"].unbalance_range_hz == (20.0, 300.0)
 
 
+def test_unbalance_law_speed_and_place(specs, testrig_cfg):
+    """ISO 21940-11 law by default, with Ω_max the test rig's "G2.5 norm at 500 Hz" (P5
+    §4.4.1, set in its file), the turboexpander's top of [operating] speed_range_hz (300 Hz),
+    the beam's operating speed (6000 rpm = 100 Hz); the force at the bearings (the AMB
+    positions of each file, P5 §4.4.1); the constant-velocity law on request."""
+    tr, tu, bm = specs["testrig"], specs["turbo"], specs["beam"]
+    assert tr.unbalance_law == "iso21940" and tr.unbalance_max_speed_hz == 500.0
+    assert tu.unbalance_max_speed_hz == 300.0 and bm.unbalance_max_speed_hz == pytest.approx(100.0)
+    assert tr.force_positions_m == (0.17, 0.69) and bm.force_positions_m == (0.1, 0.9)
+    w = tr.weights["mu"]
+    assert (w.unbalance_law, w.max_speed_rad_s) == ("iso21940", pytest.approx(2 * math.pi * 500))
+    assert w.force_positions_m == (0.17, 0.69)
+    other = design_spec(load_rig(None, ['design.unbalance.law="constant_velocity"',
+                                        'design.unbalance.force_at="seal"']))
+    assert other.unbalance_law == "constant_velocity" and other.force_positions_m == (0.43,)
+    assert other.weights["mu"].unbalance_law == "constant_velocity"
+
+
+def test_hinf_and_mu_weights_from_the_reference_pid(specs):
+    """ω_B = 2.5/T_i of the reference PID (P5 §4.3: integral time close to the PID's; test
+    rig T_i = 0.2 s, P5 §4.2 → 12.5 rad/s); μ's W_u = D_u/(2.5 D_e Kp (1 + 1/ε)) = 1/(2.5 ·
+    20e-6 · 1.6e4 · 11) = 0.114 → 0.11 (hand values); orbit demand 0.5 D_e = 10 µm."""
+    w = specs["testrig"].weights
+    assert w["hinf"].omega_b == w["mu"].omega_b == pytest.approx(12.5)
+    assert w["mu"].wu_gain == 0.11 and w["mu"].wu_corner_hz is None
+    assert w["mu"].orbit_um == pytest.approx(10.0)
+
+
 def test_uncertainty_by_seal_name_and_the_rig_without_seal(specs):
     """Each seal's own k (P5 §4.1); a rig without a seal gets none, with a note."""
     assert specs["testrig"].uncertainty == {"seal.k": 1.0}

@@ -2,7 +2,7 @@
 
 What ``ambseal run`` reports per (controller, operating point), thesis P5 §4–5:
 closed-loop stability, σ̄(S_o) with the ISO 14839-3 zones (overall and per axis),
-compliance at the seal, the worst-case unbalance response and the current-impulse response.
+compliance at the bearings, the worst-case unbalance response and the current-impulse response.
 Every number is taken on the full-order plant (flexible modes included), whatever model
 the controller was designed on; peaks on frequency grids refined around the lightly damped
 closed-loop poles (:func:`ambseal.analysis.loops.resolved_grid`).
@@ -49,9 +49,14 @@ class JudgeSettings:
     unbalance_range_hz : (float, float)
         Speed range (Hz) of the unbalance response (400 points, refined).
     unbalance_mass_kg : float
-        Mass (kg) of the force law F_u = m·G·Ω.
-    force_position_m : float
-        Where compliance and unbalance forces act (m).
+        Mass m (kg) of the force law.
+    unbalance_law : str
+        ``"iso21940"`` (F_u = m·G·Ω²/Ω_max) or ``"constant_velocity"`` (m·G·Ω),
+        :func:`ambseal.analysis.unbalance.unbalance_force`.
+    unbalance_max_speed_hz : float
+        Ω_max/2π (Hz) of the ISO law.
+    force_positions_m : tuple of float
+        Where compliance and unbalance forces act (m): the bearings by default.
     impulse_a, impulse_s : float
         The current impulse (P5 §5.1): amplitude (A) and length (s), started at
         ``impulse_start_s`` in a window of ``impulse_end_s`` sampled every ``impulse_dt_s``.
@@ -62,7 +67,9 @@ class JudgeSettings:
     unbalance_grade_mm_s: float
     unbalance_range_hz: tuple[float, float]
     unbalance_mass_kg: float
-    force_position_m: float
+    unbalance_law: str
+    unbalance_max_speed_hz: float
+    force_positions_m: tuple
     impulse_a: float | None
     impulse_s: float
     impulse_start_s: float
@@ -89,7 +96,8 @@ def judge_settings(cfg, spec=None) -> JudgeSettings:
     return JudgeSettings(
         freq_hz=(sp.band_hz[0], sp.band_hz[1], GRID_POINTS),
         unbalance_grade_mm_s=sp.unbalance_grade_mm_s, unbalance_range_hz=sp.unbalance_range_hz,
-        unbalance_mass_kg=sp.unbalance_mass_kg, force_position_m=sp.force_position_m,
+        unbalance_mass_kg=sp.unbalance_mass_kg, unbalance_law=sp.unbalance_law,
+        unbalance_max_speed_hz=sp.unbalance_max_speed_hz, force_positions_m=sp.force_positions_m,
         impulse_a=sp.impulse_a, impulse_s=t, impulse_start_s=5 * t, impulse_end_s=35 * t,
         impulse_dt_s=0.5 / cfg.controller.sample_rate_hz)
 
@@ -196,7 +204,7 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
 
     s = settings or judge_settings(cfg)
     plant = build_plant(cfg, pressure_bar=point.pressure_bar, speed_rpm=point.speed_rpm,
-                        force_positions=(s.force_position_m,))
+                        force_positions=tuple(s.force_positions_m))
     cur = plant.current_inputs()
     force = [j for j in range(len(plant.input_names)) if j not in cur]
     P = plant.to_statespace()
@@ -278,7 +286,8 @@ def _judge_loop(cfg, P, cur, force, controller, s: JudgeSettings, impulse: bool
              for sl, grid in ((slice(0, w.size), w), (slice(w.size, None), wu)))
     curves["compliance"] = (w / (2 * np.pi), c.sigma_max_m_per_n)
     unb = unbalance_from_compliance(cu, mass_kg=s.unbalance_mass_kg,
-                                    grade_mm_s=s.unbalance_grade_mm_s)
+                                    grade_mm_s=s.unbalance_grade_mm_s, law=s.unbalance_law,
+                                    max_speed_rad_s=2 * math.pi * s.unbalance_max_speed_hz)
     curves["unbalance"] = (unb.speed_hz, unb.response_um)
     case.update(compliance_peak_m_per_n=c.peak.value, unbalance_peak_um=unb.peak_um)
     if not impulse or s.impulse_a is None:

@@ -11,7 +11,7 @@ synthesises:
 * ``"mu"`` — complex D–K iteration on the perturbed plant with the uncertain parameters of
   the design specification (default: every seal's cross-coupled stiffness k ± 100 % of its
   value at ``pressure_bar``, one δ shared by k and −k, P5 §4.1 items 2–3, i.e. 0 … 2× the
-  nominal pressure drop); the unbalance force (F_u = m·G·Ω, P5 §4.4.1) enters as a
+  nominal pressure drop); the unbalance force (ISO 21940-11, P5 §4.4.1) enters as a
   weighted disturbance so that the worst-case orbit is part of the robust-performance
   demand (:meth:`~ambseal.control.weights.Weights.Wf`).
 
@@ -341,10 +341,7 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
     from .plant import generalized_plant
 
     Wf = w.Wf()
-    fpos = ()
-    if Wf is not None:
-        fpos = (float(w.force_position_m if w.force_position_m is not None
-                      else sp.force_position_m),)
+    fpos = tuple(w.force_positions_m or sp.force_positions_m) if Wf is not None else ()
     gp = generalized_plant(cfg, w.Wp(), w.Wu(), uncertainty=unc if method == "mu" else None,
                            pressure_bar=p, states=n, input_disturbance=w.W1(),
                            force_disturbance=Wf, force_positions=fpos, d_e=w.d_e, d_u=w.d_u)

@@ -230,21 +230,26 @@ class Weights:
         W_1 = w1_gain·s/(s + 2π·corner) when given (a high-pass: the compliance demand
         where unbalance forces act, not at DC); a constant ``w1_gain`` otherwise.
     orbit_um : float or None
-        Unbalance-orbit demand (µm): adds force inputs at ``force_position_m`` weighted by
+        Unbalance-orbit demand (µm): adds force inputs at ``force_positions_m`` weighted by
         :meth:`Wf`, so that ``‖W_p S_o G_f W_f / D_e‖∞ ≤ 1`` reads "worst-case orbit
-        σ̄(S_o G_f)·m·G·Ω ≤ orbit_um" below the roll-off (P5 §4.4.1). None: no force channel.
+        σ̄(S_o G_f)·F_u(Ω) ≤ orbit_um" below the roll-off (P5 §4.4.1). None: no force channel.
     unbalance_mass_kg : float or None
-        Mass (kg) of the force law ``F_u = m·G·Ω``, needed with ``orbit_um``; the design
-        specification sets the rotor's assembled mass (:mod:`ambseal.control.specs`).
+        Mass m (kg) of the force law, needed with ``orbit_um``; the design specification
+        sets the rotor's assembled mass (:mod:`ambseal.control.specs`).
     unbalance_grade_mm_s : float
         ISO 21940-11 balance grade G (mm/s), default G2.5 (precision machines).
+    unbalance_law : str
+        The force law of :func:`ambseal.analysis.unbalance.unbalance_force`:
+        ``"iso21940"`` (``F_u = m G Ω²/Ω_max``) or ``"constant_velocity"`` (``m G Ω``).
+    max_speed_rad_s : float or None
+        Ω_max (rad/s) of the ``"iso21940"`` law, needed with it and ``orbit_um``.
     wf_rolloff_hz : float or None
         Corner (Hz) of the 4th-order Butterworth roll-off of W_f, needed with ``orbit_um``:
         above the speed range and well below the first bending mode, where a force excites
         a resonance no controller can make compliant — a W_f still large there makes μ
         unreachable and wrecks the design (the rule is in :mod:`ambseal.control.specs`).
-    force_position_m : float or None
-        Axial position (m) of the force; the rig's first seal if None.
+    force_positions_m : tuple of float or None
+        Axial positions (m) of the force inputs; the specification's (the bearings) if None.
     d_e, d_u : float
         Scalings of displacement error (m) and current (A), P5 §3.1.4: 20 µm and 1 A.
     """
@@ -260,8 +265,10 @@ class Weights:
     orbit_um: float | None = None
     unbalance_mass_kg: float | None = None
     unbalance_grade_mm_s: float = 2.5
+    unbalance_law: str = "iso21940"
+    max_speed_rad_s: float | None = None
     wf_rolloff_hz: float | None = None
-    force_position_m: float | None = None
+    force_positions_m: tuple | None = None
     d_e: float = 20e-6
     d_u: float = 1.0
 
@@ -293,17 +300,20 @@ class Weights:
     def Wf(self):
         """W_f on the unbalance-force inputs (N per unit), or None without ``orbit_um``.
 
-        ``W_f = (m G D_e / orbit) · s · B_4(s) / W_p(s)`` with ``B_4`` the 4th-order
-        Butterworth low-pass at ``wf_rolloff_hz``: the product ``W_p W_f / D_e`` on the
-        force → performance channel is ``m G s B_4 / orbit``, i.e. the unbalance force
-        ``F_u = m·G·Ω`` over the allowed orbit — the 1/W_p factor undoes the performance
-        weight, which would otherwise turn the demand into an orbit bound of
-        ``M·D_e/orbit`` ≈ 6× too loose above ω_B and a needless one at DC.
+        ``W_f = (m G D_e / (orbit Ω_max)) · s² · B_4(s) / W_p(s)`` (ISO 21940-11 law) or
+        ``(m G D_e / orbit) · s · B_4(s) / W_p(s)`` (constant-velocity law), with ``B_4`` the
+        4th-order Butterworth low-pass at ``wf_rolloff_hz``: the product ``W_p W_f / D_e``
+        on the force → performance channel is ``|F_u(Ω)| B_4 / orbit`` — the unbalance force
+        of :func:`ambseal.analysis.unbalance.unbalance_force` over the allowed orbit. The
+        1/W_p factor undoes the performance weight, which would otherwise turn the demand
+        into an orbit bound of ``M·D_e/orbit`` ≈ 6× too loose above ω_B and a needless one
+        at DC.
 
         Raises
         ------
         ConfigError
-            A non-positive or non-finite orbit, mass, grade or roll-off.
+            A non-positive or non-finite orbit, mass, grade, maximum speed or roll-off, or
+            an unknown law.
         """
         import control
 
@@ -316,12 +326,23 @@ class Weights:
                 raise ConfigError(f"W_f: {nm}={v!r} must be finite and > 0")
         c = (self.unbalance_mass_kg * self.unbalance_grade_mm_s * 1e-3 * self.d_e
              / (self.orbit_um * 1e-6))
+        if self.unbalance_law == "iso21940":
+            wmax = self.max_speed_rad_s
+            if wmax is None or not (np.isfinite(wmax) and wmax > 0):
+                raise ConfigError(f"W_f: max_speed_rad_s={wmax!r} must be finite and > 0 "
+                                  "(the iso21940 law's maximum service speed)")
+            law = control.tf([c / wmax, 0.0, 0.0], [1.0])
+        elif self.unbalance_law == "constant_velocity":
+            law = control.tf([c, 0.0], [1.0])
+        else:
+            raise ConfigError(f"W_f: unbalance_law {self.unbalance_law!r} unknown (expected "
+                              "'iso21940' or 'constant_velocity')")
         wr = 2 * np.pi * self.wf_rolloff_hz
         # Butterworth: s⁴ + 2.613 s³ + 3.414 s² + 2.613 s + 1 (normalised)
         b4 = control.tf([wr**4], [1.0, 2.6131259 * wr, 3.4142136 * wr**2, 2.6131259 * wr**3,
                                   wr**4])
         Wp = self.Wp()
-        return control.tf([c, 0.0], [1.0]) * b4 * control.tf(Wp.den[0][0], Wp.num[0][0])
+        return law * b4 * control.tf(Wp.den[0][0], Wp.num[0][0])
 
     def to_dict(self) -> dict:
         """JSON-ready fields, units in the keys."""
@@ -340,25 +361,26 @@ def default_weights(method: str) -> Weights:
     rig by :func:`ambseal.control.specs.design_spec`, and every one can be set in the rig's
     ``[design.<method>]`` table.
 
-    ``"hinf"`` (nominal design, P5 §4.4): W_p with M = 2.5, ω_B = 60 rad/s, A = 1/1000;
-    W_u = 0.3 constant.
+    ``"hinf"`` (nominal design, P5 §4.4): W_p with M = 2.5, A = 1/1000; W_u = 0.3 constant;
+    a small constant W_1 = 0.05 (the same as μ's, so that the two differ only by W_u and
+    what μ adds, as P5 §4.1 objective 1 wants them comparable).
 
-    ``"mu"`` (P5 §4.3–4.4): W_p with M = 3 (ISO 14839-3 zone A), ω_B = 30 rad/s, A = 1/1000;
-    W_u = 0.02, which the specification makes a high-pass rising a decade to 0.2 above its
-    corner (rolls the controller off above the bending mode: on the test rig |K| ≈ 0.2 MA/m
-    at 10 kHz instead of ≈ 1.3); a small constant W_1 = 0.05; and, from the
-    specification, the unbalance force at the seal as a weighted input (:meth:`Weights.Wf`,
-    ``F_u = m·G·Ω``, P5 §4.4.1) with an orbit demand and a 4th-order roll-off. On the test
-    rig (6 µm, 260 Hz; μ ≈ 1.14): σ̄(S_o) ≤ 2.5 from 0 to 4.08 bar on the full-order plant
-    and a worst-case orbit up to 200 Hz ≤ 6.5 µm.
+    ``"mu"`` (P5 §4.3–4.4): W_p with M = 3.5 (the peak is judged on the full-order plant:
+    σ̄(S_o) ≤ 2.7 on the test rig, ISO 14839-3 zone A), A = 1/1000; a constant W_u (P5 §4.3);
+    W_1 = 0.05; and, from the specification, the unbalance force at the bearings as a
+    weighted input (:meth:`Weights.Wf`, ISO 21940-11 law, P5 §4.4.1) with an orbit demand
+    and a 4th-order roll-off.
 
-    Why: the force channel must bypass W_p (else the bound is ≈ 6× too loose above ω_B)
-    and roll off before the bending mode (else μ ≈ 6 there and the design degrades:
-    orbit 17–49 µm on the test rig); without it the orbit is ≈ 10.5 µm. The binding
-    trade-off is the orbit against the control effort, not against σ̄(S_o): with W_u =
-    0.05/0.03/0.02 (constant) and a 6 µm demand the orbit is 7.8/6.6/5.8 µm at σ̄(S_o)
-    2.3/2.1/2.0; W_u = 0.2 gives σ̄(S_o) 3.6 and 15 µm. With an 8 µm demand, μ = 0.98 < 1
-    (robust performance on the design model), orbit 7.0 µm.
+    ω_B of both, μ's W_u gain (0.11 here is the test rig's), the orbit demand, W_f's
+    roll-off and the scalings are rules of :func:`ambseal.control.specs.design_spec`.
+    Measured on the test rig's full-order plant over 0–4.08 bar (issue 16): μ = 0.885 on the
+    design model, order 24 (the thesis's); σ̄(S_o) ≤ 2.2 per axis; orbit ≤ 4.6 µm; impulse
+    settling 0.108 s at 0 bar against H∞'s 0.145 s; direct gains 1.0–1.9× the PID's from
+    1 to 200 Hz, peak gain 1.7× the PID's peak. Why: a high-pass W_u of 0.02 rising to
+    0.2 above 800 Hz (the earlier tuning) let the gain reach 7.6× the PID's peak at 465 Hz,
+    and ω_B = 30–60 rad/s gave 5–12× the PID's gain at 1 Hz; a larger W_1 (0.2–1) or a
+    high-pass W_1 slows the impulse's settling tail or raises the 1 Hz gain; M = 3 gives
+    μ = 0.97 and a slower settling (0.110 s).
 
     ``"lpv"`` (LPV and frozen-speed designs, P3 Eq. 11, §3.3): M = 2, ω_B = 2π·50 rad/s,
     A = 1e-2, high-pass W_u 0.05 → 0.5 with its corner at 1.4 kHz, D_e = 20 µm, D_u = 1 A
@@ -371,9 +393,9 @@ def default_weights(method: str) -> Weights:
         Unknown method.
     """
     if method == "hinf":
-        return Weights(M=2.5, omega_b=60.0, wu_gain=0.3)
+        return Weights(M=2.5, omega_b=12.5, wu_gain=0.3, w1_gain=0.05)
     if method == "mu":
-        return Weights(M=3.0, omega_b=30.0, wu_gain=0.02, w1_gain=0.05)
+        return Weights(M=3.5, omega_b=12.5, wu_gain=0.11, w1_gain=0.05)
     if method == "lpv":
         return Weights(M=2.0, omega_b=2 * np.pi * 50.0, A=1e-2, wu_gain=0.05,
                        wu_corner_hz=1400.0, wu_hf_gain=0.5)

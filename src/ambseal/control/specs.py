@@ -31,7 +31,7 @@ the value the thesis used on its test facility, P5, where it names one):
   500 Hz", P5 §4.4.1); the force at the bearings, where P5 §4.4.1 takes the compliance
   (the reason is in :mod:`ambseal.analysis.unbalance`).
 * **H∞ and μ weights** (P5 Eq. 7, §4.1 objective 1, §4.3): ω_B = 2.5/T_i of the reference
-  PID (``[controller.pid]``, else :func:`ambseal.control.recipes.pid_from_rig`), so the
+  PID (``[controller.pid]``, else :func:`ambseal.control.pid.pid_from_rig`), so the
   integral action is like the PID's ("tuned to achieve an integral time close to the
   reference controller of 0.2 s"; test rig 12.5 rad/s): the direct gains then stay within
   2× the PID's from 1 Hz to 200 Hz (P5 Fig. 10; ω_B = 60 rad/s gave 12× at 1 Hz). μ: W_u a
@@ -420,11 +420,11 @@ def _uncertainty(cfg, d, rules: dict, notes: list, pressure_bar: float) -> dict:
 
 def _reference_pid(cfg) -> dict:
     """The reference PID's ``kp`` (A/m), ``ti`` (s), ``eps`` (-): ``[controller.pid]``, else
-    :func:`ambseal.control.recipes.pid_from_rig`."""
+    :func:`ambseal.control.pid.pid_from_rig`."""
     pid = getattr(getattr(cfg, "controller", None), "pid", None)
     if pid is not None:
         return {"kp": pid.kp, "ti": pid.ti, "eps": pid.eps}
-    from .recipes import pid_from_rig
+    from .pid import pid_from_rig
 
     return pid_from_rig(cfg)
 

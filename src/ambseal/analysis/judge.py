@@ -76,6 +76,12 @@ class JudgeSettings:
     impulse_end_s: float
     impulse_dt_s: float
 
+    def unbalance_dict(self) -> dict:
+        """The unbalance settings as ``metrics.json`` states them (grade, law, Ω_max/2π, speeds)."""
+        return {"grade_mm_s": self.unbalance_grade_mm_s, "law": self.unbalance_law,
+                "max_speed_hz": self.unbalance_max_speed_hz,
+                "range_hz": list(self.unbalance_range_hz)}
+
 
 #: points of the judgement's log grid (before the refinement around lightly damped poles)
 GRID_POINTS = 1200

@@ -86,10 +86,9 @@ class TrackingSettings:
         When a tracked parameter is a seal's k affine in the pressure drop, the model's
         other coefficients of that seal (K, C, c) follow the pressure that gives k̂
         (:func:`ambseal.model.seal.values_following_k`); False (default): they stay at the
-        record's pressure. Measured on the facility's 0 → 3× nominal ramp (issue 14 §2),
-        the largest error over 2.5–3× with the μ controller running: 0.25 k_nom following,
-        0.22 fixed; with the k-scheduled controller 1.90 following, 2.13 fixed — no clear
-        gain, so the default keeps the model of §1.
+        record's pressure. Measured on the facility's 0 → 3× nominal ramp beside the μ
+        controller (issue 14 §2): largest error over 2.5–3× 0.25 k_nom following, 0.22
+        fixed — no gain, so the default keeps the model of §1.
     """
 
     rate_per_s: float = 0.1

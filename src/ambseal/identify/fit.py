@@ -275,14 +275,16 @@ def _long_run_covariance(J: np.ndarray, R: np.ndarray, smooth: int = 2,
     # zero the DC bin where slow (e.g. impulse-response) sensitivities have their weight
     Rf = np.fft.rfft(R, n=L, axis=0)  # (F, c)
     Jf = np.fft.rfft(J, n=L, axis=0)  # (F, c, p)
-    P = np.einsum("fa,fb->fab", Rf, Rf.conj()) / N  # (F, c, c) periodogram
+    P = Rf[:, :, None] * Rf[:, None, :].conj() / N  # (F, c, c) periodogram
     w = np.full(P.shape[0], 2.0)
     w[0] = 1.0
     w[-1] = 1.0
+    JfH = np.conj(np.swapaxes(Jf, 1, 2))  # (F, p, c)
+    # contractions as batched matrix products (a 4-operand einsum loops naively)
     if Hinv is not None:
-        h = w[:, None, None] * np.einsum("fap,pq,fbq->fab", Jf, Hinv, Jf.conj()) / L
+        h = (w / L)[:, None, None] * ((Jf @ Hinv) @ JfH)
         lam, V = np.linalg.eigh(np.eye(c) - h)
-        M = np.einsum("fab,fb,fcb->fac", V, 1 / np.clip(lam, 0.1, None), V.conj())
+        M = (V / np.clip(lam, 0.1, None)[:, None, :]) @ np.conj(np.swapaxes(V, 1, 2))
         P = M @ P @ np.conj(np.swapaxes(M, 1, 2))
     kernel = np.ones(2 * smooth + 1) / (2 * smooth + 1)
     if smooth > 0:
@@ -290,11 +292,11 @@ def _long_run_covariance(J: np.ndarray, R: np.ndarray, smooth: int = 2,
         pad = np.concatenate([flat[smooth:0:-1].conj(), flat, flat[-2:-smooth - 2:-1].conj()])
         flat = np.apply_along_axis(lambda x: np.convolve(x, kernel, mode="valid"), 0, pad)
         P = flat.reshape(P.shape)
-    S = np.real(np.einsum("f,fap,fab,fbq->pq", w, Jf.conj(), P, Jf)) / L
+    S = np.real(np.sum(w[:, None, None] * (JfH @ (P @ Jf)), axis=0)) / L
     if Hinv is None:
         return S
     G = Jf @ Hinv  # (F, c, p): each parameter's combination of the Jacobian's columns
-    q = np.real(np.einsum("f,faj,fab,fbj->fj", w, G.conj(), P, G)) / L
+    q = w[:, None] * np.real(np.sum(G.conj() * (P @ G), axis=1)) / L
     return S, np.apply_along_axis(lambda x: np.convolve(x, kernel, mode="same"), 0, q)
 
 

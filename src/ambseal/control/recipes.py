@@ -361,23 +361,27 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
         K_P, gamma, mu, hist = r.K, float(r.gamma), float(r.mu), r.history
         P_red, blocks, mu_omega = gp.P, gp.blocks, float(r.mu_omega)
     order_full = int(K_P.nstates)
-    if reduce_to == "auto":
+    auto = reduce_to == "auto"
+    if auto:
         reduce_to = sp.order_max or (gp.design_plant.A.shape[0]
                                      + gp.ncon * (gp.Wp.nstates + gp.Wu.nstates))
     red = None
-    if reduce_to is not None and reduce_to < order_full:
+    while reduce_to is not None and reduce_to < order_full:
         from .order import reduce_controller
 
         rr = reduce_controller(P_red, K_P, int(reduce_to), gp.nmeas, gp.ncon,
                                blocks=blocks, omega=om if method == "mu" else None)
-        if not np.isfinite(rr.gamma):
+        if np.isfinite(rr.gamma):
+            K_P, red = rr.K, rr.to_dict()
+            red.pop("hsv", None)
+            gamma = float(rr.gamma) if method == "hinf" else gamma
+            mu = float(rr.mu) if rr.mu is not None else mu
+            break
+        if not auto or sp.order_max:
             raise SynthesisError(
                 f"design: the order-{reduce_to} controller does not stabilise the design loop "
                 f"(full order {order_full}); set a larger design.order_max")
-        K_P, red = rr.K, rr.to_dict()
-        red.pop("hsv", None)
-        gamma = float(rr.gamma) if method == "hinf" else gamma
-        mu = float(rr.mu) if rr.mu is not None else mu
+        reduce_to += gp.ncon  # the automatic order: one more state per control channel
     K = gp.physical_controller(K_P, name=f"K_{method}")
     return _Synthesis(K, gamma, mu, tuple(hist), order_full, red, gp, K_P, mu_omega)
 

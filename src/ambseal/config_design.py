@@ -43,12 +43,16 @@ schema). Units are SI except where the key names its unit.
     ``A`` (W_p, P5 Eq. 7), ``wu_gain``, ``wu_corner_hz``, ``wu_hf_gain`` (W_u, constant or
     high-pass), ``w1_gain``, ``w1_corner_hz`` (W_1), ``orbit_um`` (the unbalance-orbit demand
     in µm; 0 switches it off) and ``wf_rolloff_hz`` (the roll-off of its force weight W_f);
-    ``[design.mu]`` also ``max_iter`` and ``dk_order`` (D–K iterations, D-scale fit order).
+    ``[design.mu]`` also ``max_iter`` and ``dk_order`` (D–K iterations, D-scale fit order)
+    and ``iteration``: ``"dgk"`` (default: D–G–K, the real parameters kept real in the
+    synthesis, Young 1996) or ``"dk"`` (complex D–K, every block treated as complex).
 """
 
 from __future__ import annotations
 
 import tomllib
+from typing import Literal
+
 from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
@@ -96,6 +100,7 @@ class MuSpec(MethodSpec):
 
     max_iter: int | None = Field(default=None, ge=1, le=50)
     dk_order: int | None = Field(default=None, ge=0, le=8)
+    iteration: Literal["dgk", "dk"] | None = None
 
 
 class UncertainSpec(_Strict):

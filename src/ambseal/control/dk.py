@@ -130,32 +130,41 @@ def fit_magnitude(omega, mag, order: int):
 
 def _fit_weighted(w, y, order, wgt, starts):
     """Weighted log-magnitude least squares of one order from several starts; pole and zero
-    frequencies kept within a decade of the grid. Returns (theta, weighted max |error|)."""
+    frequencies kept within a decade of the grid, second-order sections' damping ζ within
+    0.05 … 2. Returns (theta, weighted max |error|)."""
     lw = np.log(w)
     n2, n1 = divmod(order, 2)
     lo_b, hi_b = lw.min() - np.log(10.0), lw.max() + np.log(10.0)
     sq = np.sqrt(wgt)
+    # x: per second-order section (log ωn², log 2ζ); θ of _logmag: (log ωn², log 2ζωn)
+    sec_idx = np.array([1 + 2 * i + off * (2 * n2 + n1) for off in (0, 1) for i in range(n2)],
+                       int)
+
+    def theta(x):
+        t = x.copy()
+        t[sec_idx + 1] = x[sec_idx + 1] + 0.5 * x[sec_idx]
+        return t
+
     best, best_err = None, np.inf
     for cen0, spread in starts:
         cen = np.linspace(lw.min(), lw.max(), 2 * (n2 + n1) + 2)[1:-1]
         cen = cen0 + spread * (cen - lw.mean())
         zc, pc = cen[0::2], cen[1::2]
-        th = [0.0]
+        x = [0.0]
         for cs in (zc, pc):
-            th += [v for i in range(n2) for v in (2 * cs[i], np.log(1.4) + cs[i])]
-            th += [cs[n2 + i] if n2 + i < cs.size else cs[-1] for i in range(n1)]
-        # bounds: ωn² (b0) and 2ζωn (b1, ζ 0.05 … 2) of second-order sections, a of first
-        sec = [(2 * lo_b, 2 * hi_b), (lo_b + np.log(0.1), hi_b + np.log(4.0))] * n2 \
-            + [(lo_b, hi_b)] * n1
+            x += [v for i in range(n2) for v in (2 * cs[i], np.log(1.4))]
+            x += [cs[n2 + i] if n2 + i < cs.size else cs[-1] for i in range(n1)]
+        sec = [(2 * lo_b, 2 * hi_b), (np.log(0.1), np.log(4.0))] * n2 + [(lo_b, hi_b)] * n1
         lb, ub = np.array([-60.0] + [b[0] for b in sec] * 2), \
             np.array([60.0] + [b[1] for b in sec] * 2)
-        th = np.clip(np.array(th), lb + 1e-6, ub - 1e-6)
-        th[0] = np.average(y - _logmag(th, w, order), weights=wgt)
-        res = least_squares(lambda t: sq * (_logmag(t, w, order) - y), th, method="trf",
-                            bounds=(lb, ub), max_nfev=150)
-        err = float(np.max(np.abs(_logmag(res.x, w, order) - y) * wgt / wgt.max()))
+        x = np.clip(np.array(x), lb + 1e-6, ub - 1e-6)
+        x[0] = np.average(y - _logmag(theta(x), w, order), weights=wgt)
+        res = least_squares(lambda t: sq * (_logmag(theta(t), w, order) - y), x,
+                            method="trf", bounds=(lb, ub), max_nfev=150)
+        th = theta(res.x)
+        err = float(np.max(np.abs(_logmag(th, w, order) - y) * wgt / wgt.max()))
         if err < best_err:
-            best, best_err = res.x, err
+            best, best_err = th, err
     return best, best_err
 
 

@@ -8,12 +8,15 @@ synthesises:
 * ``"pid"`` — the decentralised reference PID of ``[controller.pid]`` (P5 Eq. 6, §4.2);
 * ``"hinf"`` — H∞ on the nominal plant at ``pressure_bar`` (P5 §4.4: "designed using the
   nominal plant representation");
-* ``"mu"`` — complex D–K iteration on the perturbed plant with the uncertain parameters of
+* ``"mu"`` — μ synthesis on the perturbed plant with the uncertain parameters of
   the design specification (default: every seal's cross-coupled stiffness k ± 100 % of its
   value at ``pressure_bar``, one δ shared by k and −k, P5 §4.1 items 2–3, i.e. 0 … 2× the
   nominal pressure drop); the unbalance force (ISO 21940-11, P5 §4.4.1) enters as a
   weighted disturbance so that the worst-case orbit is part of the robust-performance
-  demand (:meth:`~ambseal.control.weights.Weights.Wf`).
+  demand (:meth:`~ambseal.control.weights.Weights.Wf`). The parameters are real: by
+  default D–G–K (:func:`~ambseal.control.dgk.musyn_dgk`, Young 1996) keeps them real in the
+  synthesis; ``[design.mu] iteration = "dk"`` uses complex D–K
+  (:func:`~ambseal.control.dk.musyn`) alone.
 
 Every default (weights, scalings, design model, grid, order limit, uncertainty) comes from
 the rig's ``[design]`` part, completed from the machine by
@@ -74,7 +77,8 @@ class DesignResult:
     order_full : int
         States before order reduction.
     history : tuple of dict
-        D–K iterations (``iteration``, ``gamma``, ``mu``, ``order``); empty otherwise.
+        D–K / D–G–K iterations (``iteration``, ``gamma``, ``mu``, ``order``; with D–G–K
+        also ``step``); empty otherwise.
     weights : Weights or None
     uncertainty : dict
         ``{parameter: (low, high)}`` in SI units.
@@ -353,11 +357,13 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
         K_P, gamma, mu, hist = r.K, float(r.gamma), None, ()
         P_red, blocks = gp.P_nominal, None
     else:
+        from .dgk import musyn_dgk
         from .dk import design_omega, musyn
 
         if om is None:
             om = design_omega(*sp.synthesis_band_hz)
-        r = musyn(gp.P, gp.blocks, gp.nmeas, gp.ncon, om, order=dk_order, max_iter=max_iter)
+        syn = musyn_dgk if sp.mu_iteration == "dgk" else musyn
+        r = syn(gp.P, gp.blocks, gp.nmeas, gp.ncon, om, order=dk_order, max_iter=max_iter)
         K_P, gamma, mu, hist = r.K, float(r.gamma), float(r.mu), r.history
         P_red, blocks, mu_omega = gp.P, gp.blocks, float(r.mu_omega)
     order_full = int(K_P.nstates)

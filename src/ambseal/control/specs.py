@@ -174,6 +174,8 @@ class DesignSpec:
     weights : dict
         ``{"hinf" | "mu" | "lpv": Weights}``.
     max_iter, dk_order : int
+    mu_iteration : {"dgk", "dk"}
+        μ synthesis: D–G–K (real parameters kept real, Young 1996) or complex D–K.
     sources : dict
         ``{key: "set" | rule text}``: where each value came from.
     notes : tuple of str
@@ -202,6 +204,7 @@ class DesignSpec:
     weights: dict = field(repr=False)
     max_iter: int = 6
     dk_order: int = 2
+    mu_iteration: str = "dgk"
     sources: dict = field(default_factory=dict, repr=False)
     notes: tuple = ()
 
@@ -263,7 +266,8 @@ class DesignSpec:
         for method, w in self.weights.items():
             out += ["", f"[design.{method}]"] + _weight_lines(method, w, src)
             if method == "mu":
-                out += [f"max_iter = {self.max_iter}", f"dk_order = {self.dk_order}"]
+                out += [f"max_iter = {self.max_iter}", f"dk_order = {self.dk_order}",
+                        f'iteration = "{self.mu_iteration}"']
         return "\n".join(out) + "\n"
 
 
@@ -455,7 +459,7 @@ def _weights(d, method: str, mach: Machine, d_e: float, d_u: float, band_hi: flo
         rules["mu.wf_rolloff_hz"] = "1.3× the top of the unbalance band, at most f_b/2"
     keys = {"omega_b_rad_s": "omega_b"}
     changes = {keys.get(k, k): v for k, v in spec.model_dump(exclude_none=True).items()
-               if k not in ("max_iter", "dk_order")}
+               if k not in ("max_iter", "dk_order", "iteration")}
     if changes.get("orbit_um") == 0:
         changes["orbit_um"] = None
     for k in changes:
@@ -519,6 +523,7 @@ def design_spec(cfg, pressure_bar: float | None = None) -> DesignSpec:
         unbalance_max_speed_hz=top, force_at=at, force_positions_m=pos, unbalance_range_hz=rng, impulse_a=imp_a, impulse_s=imp_s,
         uncertainty=_uncertainty(cfg, d, rules, notes, p), weights=weights,
         max_iter=mu.max_iter or 6, dk_order=mu.dk_order if mu.dk_order is not None else 2,
+        mu_iteration=mu.iteration or "dgk",
         sources=rules, notes=tuple(notes))
 
 

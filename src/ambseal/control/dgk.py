@@ -76,6 +76,20 @@ def _ap_phase(x, w, k1, k2):
     return ph
 
 
+def _ap_jac(x, w, k1, k2):
+    """d(_ap_phase)/dx, shape (F, k1 + 2 k2), in closed form."""
+    J = np.empty((w.size, k1 + 2 * k2))
+    r = w[:, None] / np.exp(x[:k1])[None, :]
+    J[:, :k1] = 2 * r / (1 + r ** 2)
+    for i in range(k2):
+        wn, z = np.exp(x[k1 + 2 * i]), np.exp(x[k1 + 2 * i + 1])
+        y, q = 2 * z * wn * w, wn ** 2 - w ** 2
+        den = q ** 2 + y ** 2
+        J[:, k1 + 2 * i] = 2 * y * (wn ** 2 + w ** 2) / den
+        J[:, k1 + 2 * i + 1] = -2 * q * y / den
+    return J
+
+
 def _ap_tf(x, k1, k2):
     tf = ct.tf([1.0], [1.0])
     for p in np.exp(x[:k1]):
@@ -143,13 +157,16 @@ def fit_g(omega, g, weight=None, *, tol: float = 0.05):
         def resid(x):
             return sq * (_ap_phase(x[n:], w, k1, k2) - _ap_phase(x[:n], w, k1, k2) - psi)
 
+        def jac(x):
+            return sq[:, None] * np.hstack([-_ap_jac(x[:n], w, k1, k2), _ap_jac(x[n:], w, k1, k2)])
+
         for shift in (0.0, 0.7, -0.7):
             cen = np.linspace(lw.min(), lw.max(), 2 * (k1 + k2) + 2)[1:-1] + shift
             for c1, c2 in ((cen[0::2], cen[1::2]), (cen[1::2], cen[0::2])):
                 x0 = np.r_[[v for v in c1[:k1]], [v for c in c1[k1:] for v in (c, np.log(0.3))],
                            [v for v in c2[:k1]], [v for c in c2[k1:] for v in (c, np.log(0.3))]]
-                res = least_squares(resid, np.clip(x0, lb + 1e-3, ub - 1e-3), bounds=(lb, ub),
-                                    max_nfev=200)
+                res = least_squares(resid, np.clip(x0, lb + 1e-3, ub - 1e-3), jac=jac,
+                                    bounds=(lb, ub), max_nfev=100)
                 err = float(np.max(np.abs(resid(res.x)) * sq / wgt.max()))
                 if err < best[3]:
                     best = (res.x, k1, k2, err)

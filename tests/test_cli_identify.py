@@ -208,3 +208,23 @@ def test_identify_bad_pressure_names_the_file(record, tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1, err
     assert str(bad) in err[0] and "pressure_drop_pa" in err[0], err[0]
+
+
+def test_static_load_from_the_facility_joined_in_identify(record, tmp_path, capsys):
+    """`acquire --excitation static` writes the load steps of P2 §5; `identify
+    --static-load` finds Ki from them within 2 % of the truth file's value (205 N/A, its own
+    interval) and joins them with the fit, which lowers the Ki–Ks correlation."""
+    steps = tmp_path / "static.csv"
+    assert main(["acquire", RIG, "--truth", TRUTH, "--excitation", "static",
+                 "--pressure-bar", "0", "--out", str(steps)]) == 0
+    capsys.readouterr()
+    out = tmp_path / "fit"
+    code = main(["identify", RIG, str(record), "--params", "A.Ki_zeta,A.Ks_zeta",
+                 "--out", str(out), "--static-load", str(steps)])
+    assert code == 0
+    static = json.loads((out / "fit.json").read_text())["static_load"]
+    ki = static["parameters"]["A.Ki_zeta"]
+    assert ki["estimate"] == pytest.approx(TRUE["A.Ki_zeta"], rel=0.02)
+    assert ki["ci95"][0] < ki["estimate"] < ki["ci95"][1]
+    before = abs(static["ki_ks_correlation_dynamic"]["A.Ki_zeta"])
+    assert abs(static["ki_ks_correlation_joined"]["A.Ki_zeta"]) < before

@@ -158,8 +158,10 @@ def _parser() -> argparse.ArgumentParser:
     a = sub.add_parser("acquire", help="record a run of the virtual test facility")
     a.add_argument("rig", help="rig file (TOML)")
     a.add_argument("--truth", required=True, help="truth file of the virtual facility (TOML)")
-    a.add_argument("--excitation", required=True, choices=["prbs", "sine", "chirp", "impulse"],
-                   help="excitation signal")
+    a.add_argument("--excitation", required=True,
+                   choices=["prbs", "sine", "chirp", "impulse", "static"],
+                   help="excitation signal; static: known static loads (P2 §5), written as "
+                        "the load-step CSV that identify --static-load reads")
     a.add_argument("--pressure-bar", type=_finite, required=True, help="seal pressure drop (bar)")
     a.add_argument("--out", required=True, help="record file: .csv (+ .csv.json) or .mat")
     a.add_argument("--amplitude-a", type=_finite, default=0.05, help="excitation amplitude (A)")
@@ -219,6 +221,9 @@ def _parser() -> argparse.ArgumentParser:
                         "identifiable (the exit status is then 0)")
     i.add_argument("--no-refine", action="store_true",
                    help="skip the second pass on a model re-reduced at the estimate")
+    i.add_argument("--static-load", default=None, metavar="CSV",
+                   help="static load steps (P2 §5: position_m, force_x_n, force_y_n, "
+                        "current_<axis>_a): Ki by static loading, joined with the fit")
     tr = sub.add_parser("track", help="track parameters on line through closed-loop records")
     tr.add_argument("rig", help="rig file (TOML)")
     tr.add_argument("data", nargs="+", help="record files (.csv with sidecar, or .mat)")
@@ -290,6 +295,13 @@ def _acquire(args: argparse.Namespace) -> int:
             raise ConfigError(f"--axes: expected axis names separated by commas, e.g. "
                               f"{','.join(axes[:2])}; got {args.axes!r}")
     fs = cfg.controller.sample_rate_hz
+    if args.excitation == "static":
+        from .identify.static_load import save_static_record, virtual_static_load
+
+        z, F, cur = virtual_static_load(cfg, truth, seed=args.seed)
+        path = save_static_record(args.out, cfg, z, F, cur)
+        print(json.dumps({"out": str(path), "load_steps": int(z.size)}))
+        return 0
     common = dict(sample_rate_hz=fs, axes=axes, excited=excited)
     try:
         if args.excitation == "prbs":
@@ -366,7 +378,8 @@ def _identify(args: argparse.Namespace) -> int:
 
     summary = identify_files(args.rig, args.data, args.params.split(","), args.out,
                              current_weight=args.current_weight, refine=not args.no_refine,
-                             accept_unconverged=args.accept_unconverged)
+                             accept_unconverged=args.accept_unconverged,
+                             static_load=args.static_load)
     print(json.dumps(summary))
     return 0
 

@@ -10,13 +10,15 @@ from __future__ import annotations
 
 import math
 import sys
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from .config import load_rig
 from .errors import ConfigError
 from .files import writable_folder, write_json, write_text
 
-__all__ = ["design_files", "identify_files", "export_design", "show_defaults",
+__all__ = ["Identified", "identification_stage", "facility_impulses", "design_files",
+           "identify_files", "export_design", "show_defaults",
            "validate_summary", "track_files", "export_all", "digital_for", "choice_margins",
            "frozen_discrete", "judged_margins", "digitals_for"]
 
@@ -191,6 +193,70 @@ def judged_margins(cases: list[dict], method: str) -> list[dict]:
             for c in cases if c["controller"] == method and "discrete" in c]
 
 
+@dataclass
+class Identified:
+    """The identification stage of the main job: ``summary`` for ``metrics.json``, its
+    figures and report sections, the procedure's ``result``, the rig the robust controllers
+    are designed on (``design_cfg``, :func:`ambseal.identify.design_model.design_rig`) and
+    the truth they are judged on (``truth_cfg``)."""
+
+    summary: dict
+    figs: list
+    sections: list
+    result: object
+    design_cfg: object
+    truth_cfg: object
+    extra: dict = field(default_factory=dict)
+
+
+def identification_stage(cfg, truth, out: Path, say, controller) -> Identified:
+    """The thesis's identification procedure on the virtual facility, its files, the FRF
+    checks of the identified model, its figures and report section, and the rig to design
+    on. ``controller`` is the exported, judged discrete reference PID (the facility runs
+    exactly that object)."""
+    from .config import dump_rig
+    from .identify.checks import frf_checks, truth_errors
+    from .identify.design_model import design_rig, truth_rig
+    from .identify.procedure import thesis_procedure
+    from .report.run_report import identification_report
+
+    res = thesis_procedure(cfg, truth, controller, progress=say)
+    write_json(out / "identification.json", res.to_dict())
+    write_text(out / "identified_rig.toml",
+               dump_rig(res.identified, "Identified by `ambseal run` from the virtual test "
+                        "facility (thesis P2, P4, P5 procedure)"))
+    say("identification: chirp FRF check of the identified model")
+    checks = frf_checks(cfg, truth, res, controller)
+    seal = cfg.seal[0].name if cfg.seal else None
+    errors = truth_errors(res, seal)
+    figs, sections = identification_report(out, res, errors, checks, truth, seal,
+                                           cfg.operating.pressure_bar)
+    a = res.amb
+    design_cfg, note = design_rig(cfg, res)
+    summary = {"parameters": errors, "converged": bool(a.converged),
+               "model_check": a.model_check(),
+               "nrmse_fit_pct": {k: (float(v) if math.isfinite(v) else None)
+                                 for k, v in a.nrmse_fit_pct.items()},
+               "design": note, "judged_on": "virtual facility (truth file, full order)"}
+    return Identified(summary, figs, sections, res, design_cfg, truth_rig(cfg, truth))
+
+
+def facility_impulses(cfg, truth, ident: Identified, digitals: dict, out: Path) -> None:
+    """Each digital controller on the virtual facility and on the identified model: impulse
+    responses at 0 bar and the nominal pressure drop (P5 Figs. 15–16), into ``ident``'s
+    summary, figures and report sections."""
+    from .identify.design_model import impulse_checks
+    from .report.run_report import facility_impulse_report
+
+    ctrls = {m: d.discrete for m, d in digitals.items() if hasattr(d, "discrete")}
+    checks = impulse_checks(cfg, ident.result.identified, truth, ctrls,
+                            sorted({0.0, cfg.operating.pressure_bar}))
+    ident.summary["facility_impulse"] = [c.to_dict() for c in checks]
+    figs, sections = facility_impulse_report(out, checks, ident.summary["design"])
+    ident.figs += figs
+    ident.sections += sections
+
+
 def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
                  pressure_bar: float | None = None, overrides=(),
                  allow_unstable: bool = False, c_dir: str | Path | None = None,
@@ -274,11 +340,25 @@ def _check_records(records: list, paths: list[str]) -> None:
                             "excitation identifies nothing")
 
 
+def _static_load(cfg, res, path: str) -> tuple:
+    """(the fit joined with the static-load Ki of ``path``, its summary)."""
+    from .identify.static_load import load_static_record, static_ki, with_static
+
+    return with_static(res, static_ki(cfg, *load_static_record(path, cfg),
+                                      values=dict(zip(res.names, res.estimate)),
+                                      source=str(path)))
+
+
 def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: str | Path, *,
                    current_weight: float = 0.0, refine: bool = True,
-                   accept_unconverged: bool = False) -> dict:
+                   accept_unconverged: bool = False, static_load: str | None = None) -> dict:
     """``ambseal identify``: fit ``names`` to recorded files; write the fit, its figures and
     the identified rig to ``out_dir``. Returns a JSON-safe summary.
+
+    With ``static_load`` (a load-step CSV, :mod:`ambseal.identify.static_load`), Ki is also
+    found by static loading (P2 §5, its own interval, in ``fit.json`` as ``static_load``)
+    and joined with the fitted Ki's: the estimates, intervals and correlations written are
+    the joined ones, and ``static_load`` gives the Ki–Ks correlations before and after.
 
     The intervals include the error budget of every parameter held fixed
     (:mod:`ambseal.identify.budget`); the residuals are tested for independence of the
@@ -331,11 +411,15 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
                            sources=sources) if len(records) > 1 else None
     pressures = sorted({float(m.metadata.get("pressure_drop_pa", 0.0)) / 1e5 for m in records})
     warnings = advice(res.budget, cfg, names, pressures)
+    static = _static_load(cfg, res, static_load) if static_load else None
+    if static is not None:
+        res, static = static
     if res.residuals.failed:  # a disputed fixed value is told by advice() already
         warnings.append(f"{MISMATCH} (residuals correlate with the excitation on "
                         f"{', '.join(res.residuals.failed)})")
     write_json(out / "fit.json", {**res.to_dict(), "warnings": warnings,
-                                  **({"per_record": spread} if spread else {})})
+                                  **({"per_record": spread} if spread else {}),
+                                  **({"static_load": static} if static else {})})
     if not res.converged and not accept_unconverged:
         from .errors import IdentificationError
 
@@ -363,6 +447,7 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
             "nrmse_fit_pct": {k: _finite(v) for k, v in res.nrmse_fit_pct.items()},
             "residual_test": res.residuals.to_dict()["verdict"],
             "model_check": res.model_check()["verdict"],
+            **({"static_load": static} if static else {}),
             "warnings": warnings}
 
 

@@ -1,4 +1,4 @@
-"""The main job, stage by stage: rig → model → controllers → judgement → identification → report.
+"""The main job, stage by stage: rig → model → (identification →) controllers → judgement → report.
 
 ``ambseal run`` calls :func:`run`. It holds no numerics of its own: it wires
 :mod:`ambseal.model`, :mod:`ambseal.control`, :mod:`ambseal.analysis.judge`,
@@ -15,7 +15,7 @@ from pathlib import Path
 
 from .config import RigConfig, default_rig_path, load_rig
 from .errors import ConfigError
-from .files import RunFolder, write_json, write_text
+from .files import RunFolder, write_json
 
 __all__ = ["RunResult", "Designed", "run", "default_truth_path"]
 
@@ -47,7 +47,8 @@ def default_truth_path() -> Path:
     return Path(__file__).parent / "data" / "testrig_truth.toml"
 
 
-def _controllers(cfg: RigConfig, spec, say, allow_unstable: bool = False) -> list[Designed]:
+def _controllers(cfg: RigConfig, spec, say, allow_unstable: bool = False,
+                 methods: tuple[str, ...] = ("pid", "hinf", "mu")) -> list[Designed]:
     """The designed controllers of the main job.
 
     Pressure-driven seals (the test rig): the reference PID, H∞ and μ (P5 §4), from the
@@ -55,6 +56,8 @@ def _controllers(cfg: RigConfig, spec, say, allow_unstable: bool = False) -> lis
     turboexpander, P3 §4): the PID if the rig has one, an H∞ controller designed at the
     operating speed (the LTI comparison of P3 Fig. 11) and the LPV controller scheduled on
     speed. ``say(message, steps)`` reports: one step per design, messages in between.
+    ``methods`` limits the pressure-driven case (the PID alone before identification, H∞ and
+    μ on the identified rig after it).
     """
     from .analysis.judge import speed_scheduled
     from .control.recipes import design
@@ -81,38 +84,11 @@ def _controllers(cfg: RigConfig, spec, say, allow_unstable: bool = False) -> lis
                          allow_unstable=allow_unstable)
         say("lpv designed", 1)
         return out + [Designed("lpv", lpv, lpv.to_dict(), lpv)]
-    pid = lti(design(cfg, "pid"))
-    say("pid designed", 1)
-    return [pid, robust("hinf"), robust("mu")]
-
-
-def _identification(cfg: RigConfig, truth, out: Path, say, controller
-                    ) -> tuple[dict, list, list]:
-    """The thesis's identification procedure on the virtual facility, its files, the FRF
-    checks of the identified model, and its figures and report section. ``controller`` is
-    the exported, judged discrete reference PID (the facility runs exactly that object)."""
-    from .config import dump_rig
-    from .identify.checks import frf_checks, truth_errors
-    from .identify.procedure import thesis_procedure
-    from .report.run_report import identification_report
-
-    res = thesis_procedure(cfg, truth, controller, progress=say)
-    write_json(out / "identification.json", res.to_dict())
-    write_text(out / "identified_rig.toml",
-               dump_rig(res.identified, "Identified by `ambseal run` from the virtual test "
-                        "facility (thesis P2, P4, P5 procedure)"))
-    say("identification: chirp FRF check of the identified model")
-    checks = frf_checks(cfg, truth, res, controller)
-    seal = cfg.seal[0].name if cfg.seal else None
-    errors = truth_errors(res, seal)
-    figs, sections = identification_report(out, res, errors, checks, truth, seal,
-                                           cfg.operating.pressure_bar)
-    a = res.amb
-    summary = {"parameters": errors, "converged": bool(a.converged),
-               "model_check": a.model_check(),
-               "nrmse_fit_pct": {k: (float(v) if math.isfinite(v) else None)
-                                 for k, v in a.nrmse_fit_pct.items()}}
-    return summary, figs, sections
+    out = []
+    if "pid" in methods:
+        out.append(lti(design(cfg, "pid")))
+        say("pid designed", 1)
+    return out + [robust(m) for m in methods if m != "pid"]
 
 
 def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
@@ -134,8 +110,12 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         ``"ambseal"`` logger in any case (:mod:`ambseal.report.progress`).
     truth : path, optional
         Truth file of the virtual test facility; with it (and by default for the embedded
-        rig) the run also acquires records from the virtual facility and identifies the rig
-        by the thesis's procedure (:mod:`ambseal.identify.procedure`).
+        rig) the run identifies the rig on the virtual facility by the thesis's procedure
+        (:mod:`ambseal.identify.procedure`) with the reference PID, designs H∞ and μ on the
+        identified rig (unless it equals the rig file within its intervals:
+        :func:`ambseal.identify.design_model.design_rig`), judges every controller on the
+        facility's full-order truth and runs their impulse responses on the facility
+        beside the identified model (P5 §3, Figs. 15–16).
     identification : bool
         Set False to skip the identification stage.
     overrides : tuple of str
@@ -163,7 +143,8 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                                  speed_scheduled, unstable_open_loop_poles)
     from .analysis.sweep import run_cases
     from .control.specs import design_spec
-    from .commands import digitals_for, export_all, frozen_discrete
+    from .commands import (digitals_for, export_all, facility_impulses, frozen_discrete,
+                           identification_stage)
     from .control.controller import frozen
     from .model.rig import build_plant
     from .report.progress import StageProgress
@@ -187,7 +168,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
     final = Path(out_dir)
     n_designs = (2 + (cfg.controller.pid is not None)) if speed_scheduled(cfg) else 3
     totals = {"model": 1, "design": n_designs, "judge": n_designs * len(points),
-              "identification": None, "spin-up": 1, "report": 1}
+              "identification": None, "design (identified)": 2, "spin-up": 1, "report": 1}
     # one run = one folder: written into a staging folder that replaces out_dir at the end
     with RunFolder(final) as out, \
             StageProgress(totals, display=progress and sys.stderr.isatty()) as stages:
@@ -197,16 +178,37 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         n_reduced = build_plant(cfg, reduced=True).n_states
         unstable = unstable_open_loop_poles(full.A)
         stages.step()
+        say = lambda msg, steps=0: stages.step(msg, steps)  # noqa: E731
         stages.begin("design")
-        designs = _controllers(cfg, spec, lambda msg, steps=0: stages.step(msg, steps),
-                               allow_unstable)
+        early = truth_cfg is not None and not speed_scheduled(cfg)  # P5 §3: identify first
+        designs = _controllers(cfg, spec, say, allow_unstable,
+                               ("pid",) if early else ("pid", "hinf", "mu"))
         digitals, cannot_run = digitals_for(cfg, designs, points, lambda m: stages.step(m, 0))
+        ident, judge_cfg = None, cfg
+        if truth_cfg is not None:
+            if "pid" not in digitals:
+                raise ConfigError("controller.pid: the virtual facility runs the reference "
+                                  "PID during identification, and "
+                                  + cannot_run.get("pid", "the rig has none"))
+            stages.begin("identification")
+            ident = identification_stage(cfg, truth_cfg, out, stages.step,
+                                         digitals["pid"].discrete)
+            judge_cfg = ident.truth_cfg
+        if early:
+            stages.begin("design (identified)", ident.summary["design"]["designed_on"])
+            robust = _controllers(ident.design_cfg, spec, say, allow_unstable, ("hinf", "mu"))
+            more, more_cannot = digitals_for(ident.design_cfg, robust, points,
+                                             lambda m: stages.step(m, 0))
+            digitals.update(more)
+            cannot_run.update(more_cannot)
+            designs += robust
+            facility_impulses(cfg, truth_cfg, ident, digitals, out)
         stages.begin("judge")
         jobs = [{"name": d.method, "point": p, "controller": frozen(d.controller, w),
                  "discrete": frozen_discrete(digitals.get(d.method), w)}
                 for d in designs for p in points
                 for w in (2 * math.pi * p.speed_rpm / 60.0,)]
-        judged = run_cases(judge_case, jobs, shared={"cfg": cfg, "settings": settings},
+        judged = run_cases(judge_case, jobs, shared={"cfg": judge_cfg, "settings": settings},
                            workers=1, raise_errors=True,
                            on_done=lambda i, r: stages.step(f"{jobs[i]['name']} at "
                                                             f"{jobs[i]['point'].label}"))
@@ -224,15 +226,9 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
             "cannot_run": cannot_run,
             "cases": cases,
         }
-        figs, sections = [], []
-        if truth_cfg is not None:
-            if "pid" not in digitals:
-                raise ConfigError("controller.pid: the virtual facility runs the reference "
-                                  "PID during identification, and "
-                                  + cannot_run.get("pid", "the rig has none"))
-            stages.begin("identification")
-            metrics["identification"], figs, sections = _identification(
-                cfg, truth_cfg, out, stages.step, digitals["pid"].discrete)
+        figs, sections = ([], []) if ident is None else (ident.figs, ident.sections)
+        if ident is not None:
+            metrics["identification"] = ident.summary
         if speed_scheduled(cfg):
             stages.begin("spin-up", "spin-up and frozen sensitivities")
             metrics["spinup"], sims, sens = judge_spinup(

@@ -40,6 +40,7 @@ from ..lti.discrete import simulate_lti, zoh
 from ..lti.interconnect import series_inputs
 from .budget import ErrorBudget, propagate
 from .loop import DiscreteController, closed_loop_matrices
+from .stats import jacobian_correlation
 from .residuals import MISMATCH, ResidualTests, residual_tests
 
 __all__ = ["FitResult", "ClosedLoopModel", "fit_parameters", "default_bounds", "nrmse_fit"]
@@ -148,6 +149,9 @@ class FitResult:
     dof_noise : ndarray (p,) or None
         Effective degrees of freedom of the noise variance (Satterthwaite); the intervals
         take Student's t with these, combined with the budget's (known, infinite) part.
+    correlation_jacobian : ndarray (p, p) or None
+        Correlation of (JᵀJ)⁻¹ at the optimum: "calculated based on the Jacobian matrix"
+        (P4 Tables 2, 4), the experiment's design alone; ``correlation`` carries the misfit.
     """
 
     names: tuple[str, ...]
@@ -170,6 +174,7 @@ class FitResult:
     budget: ErrorBudget | None = None
     residuals: ResidualTests | None = None
     dof_noise: np.ndarray | None = None
+    correlation_jacobian: np.ndarray | None = None
 
     @property
     def mismatch(self) -> bool:
@@ -231,6 +236,8 @@ class FitResult:
         if self.residuals is not None:
             out["residual_tests"] = self.residuals.to_dict()
             out["model_check"] = self.model_check()
+        if self.correlation_jacobian is not None:
+            out["correlation_jacobian"] = [f(row) for row in self.correlation_jacobian]
         return out
 
 
@@ -450,6 +457,7 @@ def fit_parameters(
         time_s=np.asarray(records[0].time_s)[start:stop], y_meas=y0, y_sim=ys[start:],
         axes=tuple(records[0].axes), std_error_noise=se_noise, budget=budget,
         residuals=tests, dof_noise=dof,
+        correlation_jacobian=jacobian_correlation(sol.jac),
     )
 
 

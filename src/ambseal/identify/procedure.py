@@ -1,10 +1,13 @@
 """The thesis's identification procedure as one stage (P2 §5, P4 §3.4–3.5, P5 §3.3).
 
 (a) the eight Ki/Ks and τ_e from a PRBS run at zero pressure; (b) the coupling stiffness
-from a second PRBS run, with (a) known, then both jointly on both records; (c) the seal's K, k, C, c per excitation frequency
-from a stepped sine at the nominal pressure, with a zero-pressure run as the bias reference
-(P4 Fig. 12), and per pressure drop from impulse runs (0.05 A for 10 ms on both bearings in
-ζ, P5 §3.3) with regression lines against pressure (P5 Fig. 7); (d) the identified rig.
+from a second PRBS run, with (a) known, then both jointly on both records; (a') Ki by
+static loading (P2 §5, :mod:`.static_load`) joined with that fit; (c) the seal's K, k, C, c
+per pressure drop from impulse runs (0.05 A for 10 ms on both bearings in ζ, P5 §3.3) with
+regression lines against pressure (P5 Fig. 7), then per excitation frequency from a stepped
+sine of balanced forward and backward whirl (:mod:`.seal_test`, balanced on the model with
+the regression's seal) at the nominal pressure, with a zero-pressure run as the bias
+reference (P4 Fig. 12); (d) the identified rig.
 
 Every fit adds the error budget of the values it holds (:mod:`ambseal.identify.budget`):
 an earlier stage's estimates with that stage's standard errors and correlations, anything
@@ -25,7 +28,9 @@ import numpy as np
 from ..config import Affine, RigConfig, TruthSection, rig_with_values
 from ..model.amb import channel_names
 from .fit import TAU_E, FitResult
-from .signals import impulse, prbs, stepped_sine
+from .seal_test import fit_reliability, seal_frequency_test
+from .signals import impulse, prbs
+from .static_load import static_ki, virtual_static_load, with_static
 from .loop import DiscreteController
 from .stages import acquire, identify
 from .stats import linear_regression
@@ -57,6 +62,9 @@ class ProcedureResult:
         True values (SI) of every identified parameter, for the report.
     records : dict
         The PRBS records of stages (a) and (b) (``"a"``, ``"b"``), for FRF checks.
+    static_load : dict or None
+        Stage (a'): Ki by static loading (:mod:`.static_load`), and the Ki–Ks correlations
+        of the closed-loop fit alone and joined with it; ``amb`` is the joined estimate.
     """
 
     amb: FitResult
@@ -67,6 +75,7 @@ class ProcedureResult:
     identified: RigConfig
     truth: dict
     records: dict
+    static_load: dict | None = None
 
     def to_dict(self) -> dict:
         def fit(r: FitResult) -> dict:
@@ -76,12 +85,14 @@ class ProcedureResult:
             "amb": fit(self.amb),
             "coupling": fit(self.coupling),
             "seal_vs_frequency": {
-                str(p): [{"frequency_hz": f, **fit(r)} for f, r in rows]
+                str(p): [{"frequency_hz": f, **fit(r), "unreliable": fit_reliability(r)}
+                         for f, r in rows]
                 for p, rows in self.seal_vs_frequency.items()
             },
             "seal_vs_pressure": [{"pressure_bar": p, **fit(r)} for p, r in self.seal_vs_pressure],
             "regression": {k: v.to_dict() for k, v in self.regression.items()},
             "truth": self.truth,
+            **({"static_load": self.static_load} if self.static_load else {}),
         }
 
 
@@ -103,7 +114,8 @@ def thesis_procedure(
     controller: DiscreteController,
     *,
     seed: int = 0,
-    sine_frequencies_hz: tuple[float, ...] = (10, 30, 50, 70, 90, 110, 130, 150, 170, 190),
+    sine_frequencies_hz: tuple[float, ...] = (10, 20, 40, 60, 80, 100, 120, 140, 160, 180,
+                                              200),
     impulse_pressures_bar: tuple[float, ...] = (0.5, 1.0, 1.5, 2.0, 2.5),
     progress: Callable[[str], None] | None = None,
 ) -> ProcedureResult:
@@ -160,22 +172,16 @@ def thesis_procedure(
         coupling = _subset(joint, names_b)
         known, known_fit = dict(zip(joint.names, joint.estimate)), joint
 
+    say("identification (a'): Ki by static loading, joined with the closed-loop fit")
+    amb, static = _with_static_load(cfg, truth, amb, known, seed)
+    known.update(zip(amb.names, amb.estimate))
+
     seal_freq: dict = {}
     seal_press: list = []
     regression: dict = {}
     if seal is not None:
         names_s = [f"{seal}.{c}" for c in SEAL_COEFFICIENTS]
         zeta = {f"{m}_zeta": 1.0 for m in ambs}
-        for p in (0.0, p_nom):
-            say(f"identification (c): seal coefficients by stepped sine at {p:g} bar")
-            ex = stepped_sine(frequencies_hz=sine_frequencies_hz, amplitude_a=0.05, cycles=10,
-                              settling_cycles=5, sample_rate_hz=fs, axes=axes, excited=zeta)
-            rec = acquire(cfg, truth, ex, controller=controller, pressure_bar=p, seed=seed + 2)
-            seal_freq[p] = [
-                (f, identify(cfg, [rec], names_s, known=known, window=(a, b), refine=False,
-                             known_fit=known_fit, budget=True))
-                for f, a, b in ex.windows
-            ]
         for i, p in enumerate(impulse_pressures_bar):
             say(f"identification (c): seal coefficients by impulse at {p:g} bar")
             ex = impulse(amplitude_a=0.05, width_s=0.01, start_s=0.05, duration_s=0.4,
@@ -187,6 +193,15 @@ def thesis_procedure(
             regression[c] = linear_regression(
                 [p for p, _ in seal_press], [r.estimate[j] for _, r in seal_press],
                 [r.std_error[j] for _, r in seal_press])
+        for p in (0.0, p_nom):
+            say(f"identification (c): seal coefficients by balanced-whirl stepped sine at "
+                f"{p:g} bar")
+            at = {n: regression[c].intercept + regression[c].slope * p
+                  for n, c in zip(names_s, SEAL_COEFFICIENTS)}
+            seal_freq[p] = seal_frequency_test(cfg, truth, controller, seal, p,
+                                               sine_frequencies_hz, known=known,
+                                               seal_values=at, seed=seed + 2,
+                                               known_fit=known_fit, budget=True)
 
     say("identification (d): the identified rig")
     values: dict = dict(known)
@@ -202,4 +217,12 @@ def thesis_procedure(
             v = truth.parameters[name]
             true[name] = v.model_dump() if isinstance(v, Affine) else float(v)
     return ProcedureResult(amb, coupling, seal_freq, seal_press, regression, identified, true,
-                           records)
+                           records, static)
+
+
+def _with_static_load(cfg: RigConfig, truth: TruthSection, amb: FitResult, known: dict,
+                      seed: int) -> tuple[FitResult, dict]:
+    """Stage (a'): static-load Ki on the virtual facility (P2 §5) joined with the
+    closed-loop fit ``amb``; the joined fit and a summary with both Ki–Ks correlations."""
+    z, F, i = virtual_static_load(cfg, truth, seed=seed + 5)
+    return with_static(amb, static_ki(cfg, z, F, i, values=known))

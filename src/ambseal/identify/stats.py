@@ -8,7 +8,7 @@ import numpy as np
 
 from ..errors import IdentificationError
 
-__all__ = ["Regression", "linear_regression"]
+__all__ = ["Regression", "linear_regression", "jacobian_correlation"]
 
 
 @dataclass(frozen=True)
@@ -81,3 +81,14 @@ def linear_regression(x, y, y_se=None) -> Regression:
         cov = cov * chi2
     return Regression(float(beta[0]), float(beta[1]), float(np.sqrt(cov[0, 0])),
                       float(np.sqrt(cov[1, 1])), cov, x, y, se_in)
+
+
+def jacobian_correlation(J: np.ndarray) -> np.ndarray:
+    """Correlation of (JᵀJ)⁻¹ (NaN when singular): P4 Tables 2 and 4."""
+    try:
+        H = np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        return np.full((J.shape[1], J.shape[1]), np.nan)
+    d = np.sqrt(np.abs(np.diag(H)))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return H / np.outer(d, d)

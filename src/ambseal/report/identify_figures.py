@@ -21,7 +21,8 @@ from ambseal.errors import AmbsealError
 from ambseal.report.figures import save_figure
 
 __all__ = ["frf_figure", "fit_timeseries_figure", "correlation_figure", "seal_frequency_figure",
-           "seal_pressure_figure", "residual_figure", "error_budget_figure"]
+           "seal_pressure_figure", "residual_figure", "error_budget_figure",
+           "facility_impulse_figure"]
 
 
 def _check(frf: Any, what: str) -> tuple[np.ndarray, np.ndarray]:
@@ -278,21 +279,27 @@ def error_budget_figure(path: str | os.PathLike, names: Sequence[str], estimate:
 _SEAL_UNITS = {"K": "N/m", "k": "N/m", "C": "N·s/m", "c": "N·s/m"}
 
 
-def seal_frequency_figure(path: str | os.PathLike, curves: Sequence[tuple[str, Any, Any, Any]],
+def seal_frequency_figure(path: str | os.PathLike, curves: Sequence[tuple],
                           coefficients: Sequence[str] = ("K", "k", "C", "c"), *,
                           valid_below_hz: float | None = 100.0,
                           title: str = "Seal coefficients against excitation frequency"
                           ) -> Path:
     """Identified seal coefficients with ±1.96σ bars against frequency, one curve per
     pressure (thesis P4 Fig. 12). ``curves``: (label, frequency_hz (n,), estimate (n, 4),
-    std_error (n, 4))."""
+    std_error (n, 4)[, unreliable (n,) bool]); unreliable fits are drawn as open markers
+    without bars (:func:`ambseal.identify.seal_test.fit_reliability`)."""
     fig = Figure(figsize=(10, 6), layout="constrained")
     axes = fig.subplots(2, 2).ravel()
-    for label, f, est, se in curves:
+    for label, f, est, se, *rest in curves:
         f, est, se = np.asarray(f, float), np.asarray(est, float), np.asarray(se, float)
+        bad = np.asarray(rest[0], bool) if rest else np.zeros(f.size, bool)
         for j, ax in enumerate(axes[: len(coefficients)]):
-            ax.errorbar(f, est[:, j], yerr=1.96 * se[:, j], marker="o", ms=3, capsize=2,
-                        lw=1, label=label)
+            line = ax.errorbar(f[~bad], est[~bad, j], yerr=1.96 * se[~bad, j], marker="o",
+                               ms=3, capsize=2, lw=1, label=label)
+            if bad.any():
+                ax.plot(f[bad], est[bad, j], "o", mfc="none", ms=5,
+                        color=line[0].get_color(),
+                        label=f"{label}, unreliable" if j == 0 else None)
     for j, ax in enumerate(axes[: len(coefficients)]):
         c = coefficients[j]
         ax.set_title(c)
@@ -333,5 +340,41 @@ def seal_pressure_figure(path: str | os.PathLike, pressure_bar: Sequence[float],
         ax.set_xlabel("Pressure drop (bar)")
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=8)
+    fig.suptitle(title)
+    return save_figure(fig, path)
+
+
+def facility_impulse_figure(path: str | os.PathLike, checks: Sequence[Any],
+                            title: str = "Impulse responses: virtual facility against the "
+                                         "identified model") -> Path:
+    """P5 Figs. 15–16: per controller (columns) and pressure drop (rows), the displacement
+    of each excited axis on the facility (dashed, "experimental") and in the identified
+    model (solid, "simulated"), µm against s. ``checks``: objects with ``controller``,
+    ``pressure_bar``, ``time_s``, ``excitation_a``, ``facility_m``, ``model_m``, ``axes``,
+    ``nrmse_fit_pct`` and ``error`` (:class:`ambseal.identify.design_model.ImpulseCheck`)."""
+    names = list(dict.fromkeys(c.controller for c in checks))
+    pressures = sorted({c.pressure_bar for c in checks})
+    fig = Figure(figsize=(3.6 * len(names) + 0.6, 2.6 * len(pressures) + 0.6),
+                 layout="constrained")
+    grid = fig.subplots(len(pressures), len(names), squeeze=False, sharex=True)
+    for c in checks:
+        ax = grid[pressures.index(c.pressure_bar), names.index(c.controller)]
+        ax.set_title(f"{c.controller}, {c.pressure_bar:g} bar", fontsize=9)
+        ax.grid(alpha=0.3)
+        if c.error is not None:
+            ax.text(0.5, 0.5, "unstable on the facility", ha="center", va="center",
+                    transform=ax.transAxes, color="C3")
+            continue
+        excited = [j for j in range(len(c.axes)) if np.any(c.excitation_a[:, j])]
+        for n, j in enumerate(excited):
+            ax.plot(c.time_s, 1e6 * c.model_m[:, j], lw=0.9, color=f"C{n}",
+                    label=f"{c.axes[j]} model (fit {c.nrmse_fit_pct[c.axes[j]]:.0f} %)")
+            ax.plot(c.time_s, 1e6 * c.facility_m[:, j], lw=0.9, ls="--", color=f"C{n}",
+                    label=f"{c.axes[j]} facility")
+        ax.legend(fontsize=6, loc="upper right")
+    for ax in grid[:, 0]:
+        ax.set_ylabel("µm")
+    for ax in grid[-1]:
+        ax.set_xlabel("Time (s)")
     fig.suptitle(title)
     return save_figure(fig, path)

@@ -103,6 +103,7 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
         ``[(caption, png)]`` and ``[{"title", "html"}]`` for :func:`write_run_report`.
     """
     from ..identify.checks import true_line
+    from ..identify.seal_test import MIN_FIT_PCT, fit_reliability
     from .identify_figures import (correlation_figure, fit_timeseries_figure, frf_figure,
                                    residual_figure, seal_frequency_figure, seal_pressure_figure)
 
@@ -118,9 +119,13 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
                      residual_figure(out / "ident_residuals.png", a.residuals)))
     if res.seal_vs_frequency:
         curves = [(f"{p:g} bar", [f for f, _ in rows], np.array([r.estimate for _, r in rows]),
-                   np.array([r.std_error for _, r in rows]))
+                   np.array([r.std_error for _, r in rows]),
+                   [bool(fit_reliability(r)) for _, r in rows])
                   for p, rows in res.seal_vs_frequency.items()]
-        figs.append(("Seal coefficients by stepped sine (P4 Fig. 12)",
+        figs.append(("Seal coefficients by a stepped sine of balanced forward and backward "
+                     "whirl (P4 Fig. 12); open markers: unreliable fits (NRMSE below "
+                     f"{MIN_FIT_PCT:g} %, residuals correlated with the excitation, or not "
+                     "converged)",
                      seal_frequency_figure(out / "ident_seal_frequency.png", curves)))
         coefs = list(res.regression)
         figs.append(("Seal coefficients by impulse against pressure drop (P5 Fig. 7)",
@@ -161,7 +166,8 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
                  "noise, ADC), fitted by the output-error method of P2/P4. NRMSE fit of stage "
                  f"(a): {fits}. Identified rig: <code>identified_rig.toml</code>.</p>"
                  "<table><tr><th>parameter</th><th>identified</th><th>truth</th>"
-                 "<th>95 % interval</th><th>error</th></tr>" + "".join(rows) + "</table>"),
+                 "<th>95 % interval</th><th>error</th></tr>" + "".join(rows) + "</table>"
+                 + _seal_table(res)),
     }
     return figs, [section]
 
@@ -190,6 +196,66 @@ def _model_check_text(fit, errors: dict) -> str:
             "(error budget); the estimates are biased by what the held values are off"
             + (f"; the residuals correlate with the excitation on {', '.join(failed)}, as "
                "a wrong held value makes them" if failed else ""))
+
+
+def facility_impulse_report(out: Path, checks: list, design_note: dict
+                            ) -> tuple[list, list]:
+    """Figure and section: impulse responses on the virtual facility beside the identified
+    model's (P5 Figs. 15–16), and which rig the robust controllers were designed on."""
+    from .identify_figures import facility_impulse_figure
+
+    figs = [("Impulse responses, 0.05 A for 10 ms on the first bearing's ζ and the last "
+             "bearing's η: virtual facility (dashed) against the identified model (solid), "
+             "P5 Fig. 15", facility_impulse_figure(out / "facility_impulse.png", checks))]
+    rows = []
+    for c in checks:
+        if c.error is not None:
+            rows.append(f"<tr><td>{html.escape(c.controller)}</td><td>{c.pressure_bar:g}</td>"
+                        f"<td class=\"text\" colspan=\"3\">{html.escape(c.error)}</td></tr>")
+            continue
+        d = c.to_dict()
+        fit = min(c.nrmse_fit_pct.values())
+        rows.append(f"<tr><td>{html.escape(c.controller)}</td><td>{c.pressure_bar:g}</td>"
+                    f"<td>{d['peak_facility_um']:.2f}</td><td>{d['peak_model_um']:.2f}</td>"
+                    f"<td>{fit:.1f} %</td></tr>")
+    why = html.escape(design_note["reason"])
+    section = {"title": "Design from the identified model, run on the facility",
+               "html": (f"<p>H∞ and μ designed on the {html.escape(design_note['designed_on'])}"
+                        f" ({why}); every controller judged on the virtual facility's "
+                        "full-order model with the truth file's values, and run on the "
+                        "facility beside the identified model (P5 §5.2: \"the experimental "
+                        "and simulated responses match well\").</p><table><tr><th>controller"
+                        "</th><th>pressure (bar)</th><th>peak, facility (µm)</th><th>peak, "
+                        "model (µm)</th><th>worst NRMSE fit</th></tr>" + "".join(rows)
+                        + "</table>")}
+    return figs, [section]
+
+
+def _seal_table(res) -> str:
+    """The stepped-sine seal fits per pressure and frequency: the K–c and C–k correlations
+    (Jacobian, as P4 Table 4), the NRMSE fit and why a fit is unreliable."""
+    from ..identify.seal_test import fit_reliability
+
+    rows = []
+    for p, fits in res.seal_vs_frequency.items():
+        for f, r in fits:
+            c = r.correlation_jacobian if r.correlation_jacobian is not None else r.correlation
+            n = list(r.names)
+            kc = c[n.index(next(x for x in n if x.endswith(".K"))),
+                   n.index(next(x for x in n if x.endswith(".c")))]
+            ck = c[n.index(next(x for x in n if x.endswith(".C"))),
+                   n.index(next(x for x in n if x.endswith(".k")))]
+            why = "; ".join(fit_reliability(r)) or "reliable"
+            fit = min(v for k, v in r.nrmse_fit_pct.items() if not k.startswith("current_"))
+            rows.append(f"<tr><td>{p:g}</td><td>{f:g}</td><td>{kc:+.2f}</td><td>{ck:+.2f}</td>"
+                        f"<td>{fit:.1f} %</td><td class=\"text\">{html.escape(why)}</td></tr>")
+    if not rows:
+        return ""
+    return ("<p>Stepped-sine seal fits (balanced forward and backward whirl on both axes of "
+            "both bearings): correlations from the Jacobian, as P4 Table 4 (all below 0.04 "
+            "at 40 Hz there).</p><table><tr><th>pressure (bar)</th><th>frequency (Hz)</th>"
+            "<th>K–c</th><th>C–k</th><th>worst NRMSE fit</th><th>reliability</th></tr>"
+            + "".join(rows) + "</table>")
 
 
 def _styles(curves: list) -> tuple[dict, dict]:

@@ -1,0 +1,289 @@
+"""Ki by static loading (thesis P2 §5), and its use beside the closed-loop fit.
+
+The rotor is levitated at its reference position and known static forces are applied (a
+load cell on a calibration clamp, or known masses); in static equilibrium the integral
+action holds the sensors at zero, so the rotor does not move, the Ks·x term vanishes and
+the bearing forces are Ki·i alone. Summing forces and moments on the rotor (four equations
+per load step: force and moment in x and in y; here the FE model's statics, which reduce
+to them for a rigid rotor: :func:`static_ki`) gives A·Ki = b, solved by least squares
+(P2 §5: "A is a 4n × 4 matrix of measured control currents ... b a 4n × 1 vector containing
+the external forces"). The interval is the ordinary least-squares one, σ̂²(AᵀA)⁻¹ with σ̂²
+from the residuals (load-cell and current noise both show in them).
+
+Joined with the closed-loop fit (:func:`join_static`): the two estimates are independent,
+so their joint estimate is the generalised least-squares combination, the Gauss–Newton
+step of the joint cost at the dynamic optimum (Bard, *Nonlinear Parameter Estimation*,
+1974, §7-5: prior information). The dynamic fit cannot separate Ki from Ks with the
+controller known (a change of Ki looks like a change of the loop gain that Ks almost
+mimics, P4 Table 2: −0.95); the static Ki, which does not involve Ks at all, fixes Ki and
+so lowers that correlation.
+
+Record file (CSV, one row per load step, each the mean over its hold): ``position_m``,
+``force_x_n``, ``force_y_n`` and ``current_<axis>_a`` for every actuator axis
+(``current_A_zeta_a``, ...): the control-current change from the unloaded state (A).
+"""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from ..config import RigConfig, TruthSection
+from ..errors import ConfigError, DataError
+from ..files import atomic_write, read_text
+from ..model.amb import amb_factors, channel_names
+from .fit import FitResult
+
+__all__ = ["StaticLoadResult", "static_ki", "load_steps", "virtual_static_load", "load_static_record",
+           "save_static_record", "join_static", "with_static"]
+
+
+@dataclass(frozen=True)
+class StaticLoadResult:
+    """Ki per actuator axis from static loading.
+
+    Attributes
+    ----------
+    names : tuple of str
+        ``{amb}.Ki_{axis}``.
+    estimate, std_error : ndarray (4 per AMB,)
+        N/A.
+    correlation : ndarray
+    residual_std_m : float
+        Standard deviation of the equilibrium residuals, as sensor displacement (m) the
+        loads and currents leave unexplained.
+    steps : int
+        Load steps.
+    """
+
+    names: tuple[str, ...]
+    estimate: np.ndarray
+    std_error: np.ndarray
+    correlation: np.ndarray
+    residual_std_m: float
+    steps: int
+
+    def to_dict(self) -> dict:
+        return {"method": "static load (P2 §5)", "steps": self.steps,
+                "residual_std_m": self.residual_std_m,
+                "parameters": {n: {"estimate": float(e), "std_error": float(s),
+                                   "ci95": [float(e - 1.96 * s), float(e + 1.96 * s)]}
+                               for n, e, s in zip(self.names, self.estimate, self.std_error)},
+                "correlation": self.correlation.tolist()}
+
+
+def static_ki(cfg: RigConfig, position_m: np.ndarray, force_xy_n: np.ndarray,
+              current_a: np.ndarray, *, values: dict | None = None,
+              source: str = "static load") -> StaticLoadResult:
+    """Ki of every actuator axis from load steps in static equilibrium (P2 §5).
+
+    The thesis sums forces and moments on a rigid rotor (Ks·x = 0). Here the same four
+    equations per step come from the rig's FE model in statics: with the sensors held at
+    zero, y = Σ_j Ki_j g_j i_j + G_F F = 0, g_j the static sensor response to a unit force
+    along axis j at its bearing and G_F to the load, both −C A⁻¹ B of the full-order
+    model (rigid-body balance for a rigid rotor; with the shaft's bending under the load
+    the bearings move a little, and Ks and the coupling then carry some of it: on the test
+    rig the rigid-body balance reads Ki 0.7 % low, the FE statics 0.01 %).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig (geometry; Ks, coupling and other stiffnesses as in ``values``).
+    position_m : ndarray (n,)
+        Axial position of each step's load (m).
+    force_xy_n : ndarray (n, 2)
+        Applied force in x, y (N).
+    current_a : ndarray (n, n_axes)
+        Control-current change per axis (A), in :func:`~ambseal.model.amb.channel_names`
+        order.
+    values : dict, optional
+        Parameter values (SI) found earlier, e.g. the closed-loop fit's Ks and coupling
+        stiffness (Ki's and τ_e in it are ignored).
+
+    Raises
+    ------
+    DataError
+        Mismatched shapes, or loads that leave an axis' Ki undetermined.
+    """
+    from ..model.rig import build_system, mechanical_plant
+
+    axes = channel_names(cfg)
+    k = len(axes)
+    z = np.asarray(position_m, float)
+    F = np.asarray(force_xy_n, float)
+    i = np.asarray(current_a, float)
+    n = z.size
+    if F.shape != (n, 2) or i.shape != (n, k):
+        raise DataError(f"{source}: expected forces (n, 2) and currents (n, {k}), got "
+                        f"{F.shape} and {i.shape}")
+    names = tuple(f"{a.rsplit('_', 1)[0]}.Ki_{a.rsplit('_', 1)[1]}" for a in axes)
+    rows_A, rows_b = [], []
+    for pos in np.unique(z):
+        plant = mechanical_plant(build_system(cfg, pressure_bar=0.0, speed_rpm=0.0,
+                                              force_positions=(float(pos),)))
+        keep = {m: v for m, v in (values or {}).items()
+                if m in plant.parameters and ".Ki_" not in m}
+        plant = plant.with_values(keep)
+        G = -plant.C @ np.linalg.solve(plant.A, plant.B)  # static gain (k, k + 2)
+        g = G[:, :k] / np.array([plant.parameter(m).nominal for m in names])
+        for s in np.flatnonzero(z == pos):
+            rows_A.append(g * i[s])
+            rows_b.append(-G[:, k:k + 2] @ F[s])
+    A, b = np.vstack(rows_A), np.concatenate(rows_b)
+    scale = np.abs(b).max() or 1.0
+    A, b = A / scale, b / scale
+    if n < 2 or np.linalg.matrix_rank(A) < k:
+        raise DataError(f"{source}: the load steps leave some Ki undetermined (load every "
+                        "actuator axis, in both directions)")
+    est, *_ = np.linalg.lstsq(A, b, rcond=None)
+    r = b - A @ est
+    s2 = float(r @ r) / max(A.shape[0] - k, 1)
+    cov = s2 * np.linalg.inv(A.T @ A)
+    se = np.sqrt(np.diag(cov))
+    return StaticLoadResult(names, est, se, cov / np.outer(se, se), float(np.sqrt(s2) * scale),
+                            n)
+
+
+def load_steps(cfg: RigConfig, steps_per_direction: int = 5, position_m: float | None = None
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """The thesis's load programme: ``steps_per_direction`` steps up and back down in each of
+    the four directions ±x, ±y (P2 §5: "spanning both increasing and decreasing external
+    loads in all four loading directions"), at the mid-point between the bearings (the
+    calibration clamp at the shaft's centre, P2 Fig. 1d) unless ``position_m`` is given.
+
+    The largest load is the force both AMBs make together with a quarter of the smallest
+    bias current (or current limit) of the rig file, with its smallest Ki: well within the
+    linear range, the calibration's own (P2 §5 loads with 6–10 A bias).
+    """
+    ki = min(min(amb_factors(a)[0]) for a in cfg.amb)
+    i_ref = [a.bias_current or a.current_limit for a in cfg.amb
+             if (a.bias_current or a.current_limit)]
+    if not i_ref:
+        raise ConfigError("amb: bias_current or current_limit is needed to size the static "
+                          "loads")
+    f_max = 0.25 * min(i_ref) * ki * len(cfg.amb)
+    up = np.linspace(f_max / steps_per_direction, f_max, steps_per_direction)
+    levels = np.concatenate([up, up[::-1][1:]])
+    F = []
+    for d in (np.array([1.0, 0]), np.array([-1.0, 0]), np.array([0, 1.0]), np.array([0, -1.0])):
+        F += [lv * d for lv in levels]
+    z = position_m if position_m is not None else float(
+        np.mean([a.position for a in cfg.amb]))
+    F = np.array(F)
+    return np.full(len(F), z), F
+
+
+def virtual_static_load(cfg: RigConfig, truth: TruthSection, *, seed: int = 0,
+                        force_noise_fraction: float = 0.005, steps_per_direction: int = 5,
+                        repeats: int = 5, position_m: float | None = None
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Static load steps on the virtual facility: the full-order FE rotor with the truth's
+    values, in equilibrium with each load and the sensors held at zero (integral action).
+
+    Returns ``(position_m (n,), force_xy_n (n, 2), current_a (n, n_axes))``: the forces as
+    a load cell reads them (Gaussian error of ``force_noise_fraction`` of the reading; 0.5 %
+    is a class-0.5 transducer) and the currents as the amplifiers' sensors average them over
+    a one-second hold (the truth's ``current_noise_a`` over √(sample rate) samples). The
+    programme of :func:`load_steps` runs ``repeats`` times (P2 §5 repeats it five times).
+    """
+    from ..model.rig import build_system, mechanical_plant
+    from ..model.seal import coefficient_value
+    from .rig_sim import true_rig
+
+    z, F = load_steps(cfg, steps_per_direction, position_m)
+    z, F = np.tile(z, repeats), np.tile(F, (repeats, 1))
+    rng = np.random.default_rng(seed)
+    cfg_t = true_rig(cfg, truth)
+    k = 2 * len(cfg.amb)
+    out = np.zeros((len(z), k))
+    values = {n: coefficient_value(v, 0.0) for n, v in truth.parameters.items()}
+    for pos in np.unique(z):
+        plant = mechanical_plant(build_system(cfg_t, pressure_bar=0.0, speed_rpm=0.0,
+                                              force_positions=(float(pos),)))
+        plant = plant.with_values(values)
+        A, B, C = plant.A, plant.B, plant.C
+        # [A B_i; C 0] [x; i] = [-B_F F; 0]: equilibrium with the sensors at zero
+        M = np.block([[A, B[:, :k]], [C, np.zeros((C.shape[0], k))]])
+        rows = np.flatnonzero(z == pos)
+        rhs = np.vstack([-B[:, k:k + 2] @ F[rows].T, np.zeros((C.shape[0], rows.size))])
+        out[rows] = np.linalg.solve(M, rhs)[-k:].T
+    fs = cfg.controller.sample_rate_hz
+    out += rng.standard_normal(out.shape) * truth.current_noise_a / np.sqrt(fs)
+    F_meas = F * (1.0 + force_noise_fraction * rng.standard_normal(F.shape))
+    return z, F_meas, out
+
+
+def save_static_record(path: str | Path, cfg: RigConfig, position_m, force_xy_n, current_a
+                       ) -> Path:
+    """Write load steps as the CSV :func:`load_static_record` reads (temp name, rename)."""
+    axes = channel_names(cfg)
+    head = ["position_m", "force_x_n", "force_y_n"] + [f"current_{a}_a" for a in axes]
+    data = np.column_stack([position_m, force_xy_n, current_a])
+    buf = io.StringIO()
+    np.savetxt(buf, data, delimiter=",", header=",".join(head), comments="", fmt="%.10g")
+    return atomic_write(path, lambda f: f.write(buf.getvalue().encode()))
+
+
+def load_static_record(path: str | Path, cfg: RigConfig
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Read a static-load CSV (module docstring); DataError naming the file and column."""
+    text = read_text(path, "static-load record")
+    lines = [ln for ln in text.splitlines() if ln.strip()]
+    if not lines:
+        raise DataError(f"{path}: empty static-load record")
+    head = [h.strip() for h in lines[0].split(",")]
+    need = ["position_m", "force_x_n", "force_y_n"] + [f"current_{a}_a"
+                                                       for a in channel_names(cfg)]
+    missing = [c for c in need if c not in head]
+    if missing:
+        raise DataError(f"{path}: column(s) {', '.join(missing)} missing (expected "
+                        f"{', '.join(need)})")
+    try:
+        data = np.array([[float(x) for x in ln.split(",")] for ln in lines[1:]], ndmin=2)
+    except ValueError as exc:
+        raise DataError(f"{path}: {exc}") from None
+    if data.size == 0 or not np.all(np.isfinite(data)):
+        raise DataError(f"{path}: expected finite numbers in every row")
+    col = {h: j for j, h in enumerate(head)}
+    pick = lambda names: data[:, [col[c] for c in names]]  # noqa: E731
+    return (pick(["position_m"])[:, 0], pick(["force_x_n", "force_y_n"]), pick(need[3:]))
+
+
+def join_static(dynamic: FitResult, static: StaticLoadResult) -> FitResult:
+    """The closed-loop fit joined with the static Ki (module docstring): generalised least
+    squares of the two independent estimates, θ = P (Σ_d⁻¹ θ_d + Hᵀ Σ_s⁻¹ k_s),
+    P = (Σ_d⁻¹ + Hᵀ Σ_s⁻¹ H)⁻¹, H selecting the Ki's from θ. Parameters the fit does not
+    have are ignored; the result's intervals and correlation are P's."""
+    names = list(dynamic.names)
+    use = [j for j, n in enumerate(static.names) if n in names]
+    if not use:
+        return dynamic
+    H = np.zeros((len(use), len(names)))
+    for r, j in enumerate(use):
+        H[r, names.index(static.names[j])] = 1.0
+    Sd = dynamic.correlation * np.outer(dynamic.std_error, dynamic.std_error)
+    Ss = (static.correlation * np.outer(static.std_error, static.std_error))[np.ix_(use, use)]
+    Sd_inv, Ss_inv = np.linalg.inv(Sd), np.linalg.inv(Ss)
+    P = np.linalg.inv(Sd_inv + H.T @ Ss_inv @ H)
+    P = (P + P.T) / 2
+    est = P @ (Sd_inv @ dynamic.estimate + H.T @ Ss_inv @ static.estimate[use])
+    se = np.sqrt(np.diag(P))
+    return replace(dynamic, estimate=est, std_error=se, ci95_low=est - 1.96 * se,
+                   ci95_high=est + 1.96 * se, correlation=P / np.outer(se, se))
+
+
+def with_static(dynamic: FitResult, static: StaticLoadResult) -> tuple[FitResult, dict]:
+    """:func:`join_static`, and a JSON summary: the static result with the Ki–Ks
+    correlation of each axis in the closed-loop fit alone and joined."""
+    joined = join_static(dynamic, static)
+
+    def ki_ks(res: FitResult) -> dict:
+        n = list(res.names)
+        return {k: float(res.correlation[n.index(k), n.index(k.replace(".Ki_", ".Ks_"))])
+                for k in static.names if k in n and k.replace(".Ki_", ".Ks_") in n}
+
+    return joined, {**static.to_dict(), "ki_ks_correlation_dynamic": ki_ks(dynamic),
+                    "ki_ks_correlation_joined": ki_ks(joined)}

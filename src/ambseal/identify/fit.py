@@ -408,9 +408,7 @@ def fit_parameters(
     if np.all(r0 == 1e6):
         raise IdentificationError("fit: the model cannot be simulated at the start values")
     lb, ub = (lo - init) / scale, (hi - init) / scale
-    # scipy's default tolerances (1e-8): on the thesis procedure of the test rig, 1e-10
-    # took 35 % more model evaluations and moved no estimate by more than 1e-3 of its
-    # standard error
+    # scipy's default tolerances: 1e-10 took 35 % more evaluations, moved estimates < 1e-3 SE
     sol = least_squares(residuals, np.zeros(len(names)), bounds=(lb, ub), method="trf",
                         x_scale=1.0, max_nfev=max_nfev, xtol=1e-8, ftol=1e-8, gtol=1e-8)
     est = init + sol.x * scale
@@ -480,9 +478,7 @@ def _nominal(model: ClosedLoopModel, name: str) -> float:
 def _budget(J, scale, names, fixed, models, residual_blocks, x, noise_var, r, blocks,
             correlated=None) -> ErrorBudget | None:
     """The fixed parameters' error budget by forward differences of the residuals in each
-    fixed value (relative step 10⁻³, every model alike; the residuals are linear in a
-    fixed value over 10⁻³ to about that fraction, and central differences cost twice the
-    simulations for no visible change of an interval), with each fixed value's score test
+    fixed value (relative step 10⁻³, every model alike; central ones cost twice), with each fixed value's score test
     (:func:`_score_test`) and the correlation of those an earlier fit estimated together
     (``correlated`` = (names, R)); None without fixed values."""
     use = [(n, s, src) for n, (s, src) in (fixed or {}).items()

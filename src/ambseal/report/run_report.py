@@ -324,7 +324,8 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
                          out / "sensitivity_discrete.png", disc, styles=styles,
                          unstable={lb: styles[lb] for lb, ok in dstable.items() if not ok})))
     if comp:
-        figs.append(("Compliance σ̄(S_o G_f) at the seal (P5 Fig. 11)",
+        at = (metrics.get("design_spec") or {}).get("force_at") or "the bearings"
+        figs.append((f"Compliance σ̄(S_o G_f), forces at {at} (P5 Fig. 11)",
                      figures.compliance_figure(out / "compliance.png", comp, **kw)))
     unb = [(lb, *c["unbalance"]) for lb, c in drawn if "unbalance" in c]
     if unb:

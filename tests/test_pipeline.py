@@ -233,7 +233,8 @@ def test_run_separates_the_seal_coefficients_and_static_ki(metrics):
     """Issue 16 §4: at the nominal 2.04 bar and 40 Hz the stepped-sine seal fit's K–c and C–k
     correlations (Jacobian, P4 Table 4) are below 0.5; every seal fit carries its
     reliability; the static-load Ki (P2 §5) of every axis is within 2 % of the truth file's
-    and joining it with the closed-loop fit brings every Ki–Ks correlation below 0.9."""
+    and joining it with the closed-loop fit brings every Ki–Ks correlation below 0.9 (the
+    programme repeated at least P2's five times, until the static Ki is twice as precise)."""
     out, _ = metrics
     ident = json.loads((out / "identification.json").read_text())
     rows = {r["frequency_hz"]: r for r in ident["seal_vs_frequency"]["2.04"]}
@@ -247,6 +248,7 @@ def test_run_separates_the_seal_coefficients_and_static_ki(metrics):
         t = ident["truth"][n]
         assert abs(row["estimate"] - t) < 0.02 * t, n
     assert all(abs(v) < 0.9 for v in static["ki_ks_correlation_joined"].values())
+    assert static["repeats"] >= 5
     assert max(abs(v) for v in static["ki_ks_correlation_dynamic"].values()) > max(
         abs(v) for v in static["ki_ks_correlation_joined"].values())
 

@@ -2,8 +2,9 @@
 
 References: the truth file of the virtual facility (whose FE statics make the loads'
 currents), the thesis's rigid-body balance (P2 §5: four equilibrium equations per load step),
-and the stacked least-squares solution of a linear problem with a prior measurement (Bard,
-*Nonlinear Parameter Estimation*, 1974, §7-5).
+the stacked least-squares solution of a linear problem with a prior measurement (Bard,
+*Nonlinear Parameter Estimation*, 1974, §7-5), and the spread of the estimates over repeated
+load programmes (Monte Carlo).
 """
 
 from __future__ import annotations
@@ -16,8 +17,9 @@ import pytest
 from ambseal.config import load_truth
 from ambseal.errors import DataError
 from ambseal.identify.fit import FitResult
-from ambseal.identify.static_load import (join_static, load_static_record, save_static_record,
-                                          static_ki, virtual_static_load, StaticLoadResult)
+from ambseal.identify.static_load import (join_static, load_static_record, programme_repeats,
+                                          save_static_record, static_ki, virtual_static_load,
+                                          StaticLoadResult)
 from ambseal.model.amb import amb_factors
 from ambseal.pipeline import default_truth_path
 
@@ -96,3 +98,66 @@ def test_join_is_the_stacked_least_squares():
     assert joined.estimate == pytest.approx(ref, rel=1e-10)
     assert joined.std_error == pytest.approx(np.sqrt(np.diag(cref)), rel=1e-10)
     assert abs(joined.correlation[0, 1]) < abs(dyn.correlation[0, 1])
+
+
+def test_static_interval_is_the_spread_over_repeated_programmes(testrig_cfg):
+    """The static Ki's standard errors and correlations are those of the estimates over 30
+    independent programmes (3 steps per direction, 2 repeats each): a load-cell error scales
+    every Ki its step loads alike, so the four Ki move together (correlation ≈ 1) and A's
+    error is about as large as B's relative to Ki. Independent equations (σ̂²(AᵀA)⁻¹) gave
+    A's error half the spread and ζ–η correlation 0."""
+    truth = load_truth(default_truth_path())
+    runs = [static_ki(testrig_cfg, *virtual_static_load(testrig_cfg, truth, seed=s,
+                                                        steps_per_direction=3, repeats=2))
+            for s in range(30)]
+    est = np.array([r.estimate for r in runs])
+    spread = est.std(axis=0, ddof=1)
+    reported = np.sqrt(np.mean([r.std_error**2 for r in runs], axis=0))
+    assert reported == pytest.approx(spread, rel=0.3)
+    assert np.corrcoef(est.T).min() > 0.95
+    assert np.mean([r.correlation for r in runs], axis=0).min() > 0.95
+
+
+def test_join_with_a_singular_static_covariance_is_the_constrained_fit():
+    """A static result that fixes the ratio of two Ki exactly and their common scale with
+    an error (rank-1 covariance, as the noise-free currents of the virtual facility give):
+    the join equals the least-squares fit of the stacked problem with that scale measurement
+    and a heavily weighted ratio equation (penalty method, weight 1e9)."""
+    rng = np.random.default_rng(1)
+    X = rng.standard_normal((300, 3)) @ np.array([[1.0, 0.9, 0.2], [0, 0.3, 0.1], [0, 0, 1.0]])
+    sigma, theta = 0.1, np.array([2.0, 3.0, -1.0])
+    y = X @ theta + sigma * rng.standard_normal(300)
+    est = np.linalg.lstsq(X, y, rcond=None)[0]
+    cov = sigma**2 * np.linalg.inv(X.T @ X)
+    se = np.sqrt(np.diag(cov))
+    dyn = FitResult(("A.Ki_zeta", "B.Ki_zeta", "A.Ks_zeta"), est, est, se, est - 2 * se,
+                    est + 2 * se, cov / np.outer(se, se), {}, True, "", 1, 0.0, np.zeros(1),
+                    np.zeros((1, 1)), np.zeros((1, 1)), ("A_zeta",))
+    k_s, rel = np.array([2.01, 3.015]), 0.002  # ratio exact, scale 0.5 % high, 0.2 % error
+    cs = rel**2 * np.outer(k_s, k_s)
+    stat = StaticLoadResult(("A.Ki_zeta", "B.Ki_zeta"), k_s, np.sqrt(np.diag(cs)),
+                            np.ones((2, 2)), 0.0, 2)
+    joined = join_static(dyn, stat)
+    u = k_s / np.linalg.norm(k_s)  # the scale direction; its orthogonal one is exact
+    w = np.array([u[1], -u[0]])
+    s_scale = rel * np.linalg.norm(k_s)
+    Xs = np.vstack([X, sigma / s_scale * np.r_[u, 0.0], 1e9 * np.r_[w, 0.0]])
+    ys = np.concatenate([y, [sigma / s_scale * u @ k_s, 1e9 * w @ k_s]])
+    ref = np.linalg.lstsq(Xs, ys, rcond=None)[0]
+    assert joined.estimate == pytest.approx(ref, rel=1e-7)
+    assert joined.estimate[1] / joined.estimate[0] == pytest.approx(k_s[1] / k_s[0], rel=1e-9)
+
+
+def test_programme_repeats_reaches_twice_the_fit_precision():
+    """Errors fall as 1/√repeats: a static Ki error of 0.1 after 5 programmes against the
+    fit's 0.08 needs 5·(2·0.1/0.08)² = 31.25 → 32 programmes; a static test already twice
+    as precise needs no more; the cap holds."""
+    names = ("A.Ki_zeta", "A.Ks_zeta")
+    fit = FitResult(names, np.ones(2), np.ones(2), np.array([0.08, 1.0]), np.zeros(2),
+                    np.ones(2), np.eye(2), {}, True, "", 1, 0.0, np.zeros(1), np.zeros((1, 1)),
+                    np.zeros((1, 1)), ("A_zeta",))
+    stat = lambda se: StaticLoadResult(("A.Ki_zeta",), np.ones(1), np.array([se]),  # noqa: E731
+                                       np.eye(1), 0.0, 1)
+    assert programme_repeats(fit, stat(0.1), 5) == 32
+    assert programme_repeats(fit, stat(0.04), 5) == 5
+    assert programme_repeats(fit, stat(1.0), 5, max_repeats=100) == 100

@@ -144,3 +144,39 @@ def test_sandwich_intervals_cover_on_a_resonant_regression():
         cov, dof = _covariance(Jm, r, [e], 3)
         inside.append(np.abs(d) <= student.ppf(0.975, dof) * np.sqrt(np.diag(cov)))
     assert (np.mean(inside, axis=0) >= 0.90).all(), np.mean(inside, axis=0)
+
+
+def test_record_spread_is_the_rsd_of_single_record_fits(rig, truth):
+    """``record_spread`` over three records of one condition: each record fitted alone, and
+    the relative standard deviation of those estimates (the thesis's repeatability measure,
+    P2 Table 2). Reference: the same single-record fits run here one by one and their RSD
+    computed by hand with the standard library (sample standard deviation, n − 1), beside
+    the pooled fit's estimate and standard error; records of two conditions, or one record,
+    give no spread."""
+    import dataclasses
+    import statistics
+
+    from ambseal.identify.stages import record_spread
+
+    names = ["A.Ki_zeta", "A.Ks_zeta"]
+    ctrl = reference_controller(rig)
+    recs = [acquire(rig, truth, prbs(amplitude_a=0.05, clock_period_s=1e-3, duration_s=0.15,
+                                     sample_rate_hz=1e4, seed=20 + s),
+                    controller=ctrl, pressure_bar=0.0, seed=30 + s) for s in range(3)]
+    pooled = identify(rig, recs, names, refine=False)
+    spread = record_spread(rig, recs, names, pooled)
+    alone = [identify(rig, [r], names, refine=False).estimate for r in recs]
+    for j, n in enumerate(names):
+        values = [float(a[j]) for a in alone]
+        mean, sd = statistics.mean(values), statistics.stdev(values)
+        got = spread[n]
+        np.testing.assert_allclose(got["per_record"], values, rtol=1e-9)
+        np.testing.assert_allclose([got["mean"], got["sd"], got["rsd_pct"]],
+                                   [mean, sd, 100 * sd / abs(mean)], rtol=1e-9)
+        assert got["pooled"] == pooled.value(n)
+        assert got["pooled_std_error"] == float(pooled.std_error[j])
+        assert 0 < got["rsd_pct"] < 5  # three noisy records of one rig: not identical
+    other = dataclasses.replace(recs[2], metadata={**recs[2].metadata,
+                                                   "pressure_drop_pa": 1e5})
+    assert record_spread(rig, recs[:2] + [other], names, pooled) is None
+    assert record_spread(rig, recs[:1], names, pooled) is None

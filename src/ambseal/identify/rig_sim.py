@@ -43,7 +43,7 @@ from ..model.seal import coefficient_value
 from ..lti.discrete import zoh
 from ..lti.interconnect import series_inputs
 from .facility_loop import facility_loop
-from .loop import DiscreteController
+from .loop import DiscreteController, closed_loop_matrices
 
 __all__ = ["FacilityRecord", "Facility", "prepare_facility", "simulate_facility", "true_rig",
            "reduced_plant"]
@@ -208,6 +208,27 @@ class Facility:
         self.n = n1
         return rec
 
+    def loop_poles(self, controller: DiscreteController) -> np.ndarray:
+        """Poles z of the facility's sampled loop linearised at the bias (the force law's
+        remainder zero) with ``controller``, every pressure segment: the linear part held
+        over one sample (its sub-step transition to the power ``substeps``), the sensors'
+        low-pass and the controller, as :meth:`run` integrates them."""
+        k, s, lp_a = len(self.axes), self.law[7], self.law[8]
+        C_y = self.mats[0][:k]
+        out = []
+        for Phi, Gam in zip(self.Phi, self.Gam):
+            P, G = np.eye(Phi.shape[0]), np.zeros((Phi.shape[0], k))
+            for _ in range(s):  # Σ_j Φ^j Γ_i and Φ^s
+                G = G + P @ Gam[:, :k]
+                P = Phi @ P
+            # sensors: y[n] = (1 − a) C z[n] + a w[n], w[n + 1] = y[n] (w: the filter's state)
+            A = np.block([[P, np.zeros((P.shape[0], k))],
+                          [(1 - lp_a) * C_y, lp_a * np.eye(k)]])
+            B = np.vstack([G, np.zeros((k, k))])
+            C = np.hstack([(1 - lp_a) * C_y, lp_a * np.eye(k)])
+            out.append(np.linalg.eigvals(closed_loop_matrices(A, B, C, controller)[0]))
+        return np.concatenate(out)
+
 
 def prepare_facility(cfg: RigConfig, truth: TruthSection, sample_rate_hz: float, *,
                      pressure_bar: float,
@@ -309,8 +330,10 @@ def simulate_facility(
     Raises
     ------
     ModelError
-        Mismatched sizes or rates, unknown truth parameters, or a rotor that leaves the
-        air gap (the loop went unstable).
+        Mismatched sizes or rates, unknown truth parameters, a controller that does not
+        stabilise the facility's loop linearised at the bias (checked before the run: a
+        pole |z| ≥ 1 at any pressure segment, named with the truth's departures from the
+        rig file), or a rotor that leaves the air gap.
     """
     T = 1.0 / sample_rate_hz
     if abs(controller.dt - T) > 1e-9 * T:
@@ -318,6 +341,8 @@ def simulate_facility(
     fac = prepare_facility(cfg, truth, sample_rate_hz, pressure_bar=pressure_bar,
                            pressure_schedule=pressure_schedule)
     k = len(fac.axes)
+    if controller.B.shape[1] == k and controller.C.shape[0] == k:
+        _refuse_unstable(fac, controller, cfg, truth)
     e = np.asarray(excitation_a, dtype=float)
     if e.ndim != 2 or e.shape[1] != k:
         raise ModelError(f"excitation has shape {e.shape}; expected (N, {k}) for axes {fac.axes}")
@@ -339,3 +364,33 @@ def simulate_facility(
     y, i, ref = run(noise_std)
     t = np.arange(e.shape[0]) * T
     return FacilityRecord(t, e.copy(), ref, i, y, tuple(fac.axes), noise_std)
+
+
+def _refuse_unstable(fac: Facility, controller: DiscreteController, cfg: RigConfig,
+                     truth: TruthSection) -> None:
+    """ModelError when ``controller`` does not stabilise the facility's linearised loop
+    (:meth:`Facility.loop_poles`), naming the least stable pole and the truth's departures
+    from the rig file a controller designed on that file did not see. Such a loop either
+    loses the rotor (after a slow growth: |z| = 1.001 at 10 kHz e-folds in 0.1 s) or, before
+    that, records a growing oscillation that no stable model fits — neither is data."""
+    z = fac.loop_poles(controller)
+    worst = z[np.argmax(np.abs(z))]
+    if abs(worst) < 1.0:
+        return
+    s = np.log(complex(worst)) / fac.T
+    f_hz, zeta = abs(s.imag) / (2 * np.pi), -s.real / abs(s)
+    seen = []
+    if truth.tau_e != cfg.actuator.eddy_time_constant:
+        seen.append(f"tau_e = {truth.tau_e * 1e3:.3g} ms (the rig file's actuator: "
+                    f"{cfg.actuator.eddy_time_constant * 1e3:.3g} ms)")
+    if truth.sensor_filter_hz is not None:
+        seen.append(f"sensor_filter_hz = {truth.sensor_filter_hz:g}")
+    if truth.parameters:
+        seen.append(f"parameters ({', '.join(truth.parameters)})")
+    raise ModelError(
+        f"the controller does not stabilise the virtual facility: its sampled loop has a pole "
+        f"|z| = {abs(worst):.5f} at {f_hz:.4g} Hz (ζ = {zeta:.2g}), so the rotor would be "
+        "lost or the record a growing oscillation"
+        + (f"; the truth departs from the rig file in {'; '.join(seen)}, which a controller "
+           "designed on the rig file did not see — set the truth to the machine's or design "
+           "for it" if seen else ""))

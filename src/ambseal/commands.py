@@ -433,9 +433,14 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
     residual_figure(out / "residuals.png", res.residuals)
     error_budget_figure(out / "error_budget.png", res.names, res.estimate, res.std_error_noise,
                         res.budget)
-    identified = rig_with_values(cfg, dict(zip(res.names, res.estimate)))
+    est = dict(zip(res.names, res.estimate))
+    lag = est.pop("tau_s", None)  # the sensors' lag: no rig-file value, told in the header
+    identified = rig_with_values(cfg, est)
     header = (f"Identified by ambseal from {', '.join(str(d) for d in data)}\n"
               f"parameters: {', '.join(res.names)}; converged: {res.converged}\n"
+              + (f"sensor lag tau_s = {lag:.4g} s (fitted; the rig file has no key for it: "
+                 "the model the controllers are designed on leaves it out)\n"
+                 if lag is not None else "") +
               f"seal coefficients, if fitted, hold at the recorded pressure drop(s) "
               f"{pressures} bar")
     write_text(out / "identified.toml", dump_rig(identified, header))

@@ -40,8 +40,10 @@ from ..lti.discrete import simulate_lti, zoh
 from ..lti.interconnect import series_inputs
 from .budget import ErrorBudget, propagate
 from .loop import DiscreteController, closed_loop_matrices
+from .sandwich import _covariance, _long_run_covariance, _score_test, _t_quantile  # noqa: F401
 from .stats import jacobian_correlation
 from .residuals import MISMATCH, ResidualTests, residual_tests
+from .sensor_lag import TAU_S, lag_test_dict, with_sensor_lag
 
 __all__ = ["FitResult", "ClosedLoopModel", "fit_parameters", "default_bounds", "nrmse_fit"]
 
@@ -72,19 +74,23 @@ class ClosedLoopModel:
         The controller that ran, at the data's sample period.
     tau_e : float
         Nominal eddy-current lag (s).
+    tau_s : float
+        Sensor lag (s) of the displacement sensors' low-pass, 0 for none
+        (:mod:`ambseal.identify.sensor_lag`).
     """
 
     plant: Plant
     actuator: tuple
     controller: DiscreteController
     tau_e: float = 0.0
+    tau_s: float = 0.0
     _cache: dict = field(default_factory=dict, repr=False)
 
     def matrices(self, values: dict[str, float]):
         """Continuous (A, B, C, C_i, D_i) of amplifier → lag → plant for parameter values:
         displacements y = C x, coil current i = C_i x + D_i i_ref."""
         changes = {n: v - self.plant.parameter(n).nominal for n, v in values.items()
-                   if n != TAU_E}
+                   if n not in (TAU_E, TAU_S)}
         p = self.plant.with_changes(changes) if changes else self.plant
         tau = values.get(TAU_E, self.tau_e)
         A, B, C = p.A, p.B, p.C
@@ -93,13 +99,20 @@ class ClosedLoopModel:
                                                    blocks)
         return A, B, C, Cout, Dout
 
+    def _sampled(self, values: dict[str, float]):
+        """(A_d, B_d, C, C_i, D_i) sampled by ZOH at the controller's period, the sensors'
+        lag on the displacements."""
+        A, B, C, Ci, Di = self.matrices(values)
+        Ad, Bd = zoh(A, B, self.controller.dt)
+        return (*with_sensor_lag(Ad, Bd, C, Ci, values.get(TAU_S, self.tau_s),
+                                 self.controller.dt), Di)
+
     def statespace(self, values: dict[str, float], axes: tuple[str, ...]):
         """The discrete closed loop from excitation (A) to displacement (m) as a
         ``control.StateSpace`` at the controller's sample time (for FRF checks)."""
         import control
 
-        A, B, C, _, _ = self.matrices(values)
-        Ad, Bd = zoh(A, B, self.controller.dt)
+        Ad, Bd, C, _, _ = self._sampled(values)
         Acl, Bcl, Cy, _, _ = closed_loop_matrices(Ad, Bd, C, self.controller)
         return control.ss(Acl, Bcl, Cy, np.zeros((Cy.shape[0], Bcl.shape[1])),
                           self.controller.dt, inputs=[f"excitation_{a}" for a in axes],
@@ -109,8 +122,7 @@ class ClosedLoopModel:
                  start: int = 0) -> tuple[np.ndarray, np.ndarray]:
         """Displacements and coil currents (N − start, k) for excitation ``e`` (N, k),
         simulated from rest at sample 0 and returned from sample ``start`` on."""
-        A, B, C, Ci, Di = self.matrices(values)
-        Ad, Bd = zoh(A, B, self.controller.dt)
+        Ad, Bd, C, Ci, Di = self._sampled(values)
         Acl, Bcl, Cy, Cref, _ = closed_loop_matrices(Ad, Bd, C, self.controller)
         nc = self.controller.A.shape[0]
         Ci_cl = np.hstack([Ci, np.zeros((Ci.shape[0], nc))])
@@ -152,6 +164,9 @@ class FitResult:
     correlation_jacobian : ndarray (p, p) or None
         Correlation of (JᵀJ)⁻¹ at the optimum: "calculated based on the Jacobian matrix"
         (P4 Tables 2, 4), the experiment's design alone; ``correlation`` carries the misfit.
+    sensor_lag : dict or None
+        Score test of a sensor lag the model lacks (:mod:`ambseal.identify.sensor_lag`);
+        None when ``tau_s`` is fitted.
     """
 
     names: tuple[str, ...]
@@ -175,6 +190,7 @@ class FitResult:
     residuals: ResidualTests | None = None
     dof_noise: np.ndarray | None = None
     correlation_jacobian: np.ndarray | None = None
+    sensor_lag: dict | None = None
 
     @property
     def mismatch(self) -> bool:
@@ -183,15 +199,17 @@ class FitResult:
 
     def model_check(self) -> dict:
         """The fit's verdict on its own model: a mismatch when the residuals correlate with
-        the excitation (:mod:`ambseal.identify.residuals`, Ljung §16.6) or the data dispute
-        a value the fit held fixed (score test, :mod:`ambseal.identify.budget`) — the two
-        see different faults: unmodelled dynamics, and a wrong value of a modelled one.
+        the excitation (:mod:`ambseal.identify.residuals`, Ljung §16.6), the data dispute
+        a value the fit held fixed (score test, :mod:`ambseal.identify.budget`), or they
+        ask for a sensor lag the model lacks (score test,
+        :mod:`ambseal.identify.sensor_lag`) — unmodelled dynamics in general, a wrong value
+        of a modelled parameter, and the one unmodelled element τ_e would otherwise absorb.
 
         Returns
         -------
         dict
-            ``residuals_correlated`` (channels), ``disputed`` (fixed values), ``mismatch``
-            (bool) and ``verdict`` (text).
+            ``residuals_correlated`` (channels), ``disputed`` (fixed values),
+            ``sensor_lag`` (bool), ``mismatch`` (bool) and ``verdict`` (text).
         """
         failed = self.residuals.failed if self.residuals is not None else []
         disputed = self.budget.disputed() if self.budget is not None else []
@@ -200,7 +218,14 @@ class FitResult:
         if disputed:
             parts.append(f"the data dispute the fixed value of {', '.join(disputed)} (score "
                          "test); the intervals hold only as far as its stated uncertainty does")
-        return {"residuals_correlated": list(failed), "disputed": disputed,
+        lag = bool(self.sensor_lag and self.sensor_lag["flagged"])
+        if lag:
+            tau, se = (self.sensor_lag[k] * 1e6 for k in ("suggested_tau_s",
+                                                          "suggested_tau_s_se"))
+            parts.append(f"the data ask for a sensor lag of {tau:.3g} ± {se:.2g} µs the model "
+                         f"lacks (score test); fit {TAU_S} beside tau_e (Ki, Ks then hold; "
+                         "read tau_e + tau_s, not each)")
+        return {"residuals_correlated": list(failed), "disputed": disputed, "sensor_lag": lag,
                 "mismatch": bool(parts),
                 "verdict": f"{MISMATCH} ({'; '.join(parts)})" if parts else
                 "no mismatch found: residuals independent of the excitation"
@@ -238,81 +263,17 @@ class FitResult:
             out["model_check"] = self.model_check()
         if self.correlation_jacobian is not None:
             out["correlation_jacobian"] = [f(row) for row in self.correlation_jacobian]
+        if self.sensor_lag is not None:
+            out["sensor_lag_test"] = self.sensor_lag
         return out
-
-
-def _long_run_covariance(J: np.ndarray, R: np.ndarray, smooth: int = 2,
-                         Hinv: np.ndarray | None = None):
-    """Var(Σ_t J_tᵀ r_t) for residuals r that are a stationary coloured process.
-
-    Frequency-domain form of the sandwich's middle term (Ljung, *System Identification*,
-    2nd ed., §9.3): Σ_f J(f)ᴴ Φ_r(f) J(f) / L with Φ_r the residuals' cross-spectral
-    matrix across channels, estimated by the periodogram R(f)R(f)ᴴ/N averaged over
-    2·``smooth``+1 neighbouring bins (Daniell window), and L = 2N (zero padding, no wrap).
-    Closed-loop residuals ring at the loop's lightly damped resonances, where the Jacobian
-    is also largest; a lag-window (Newey–West) estimate smooths those peaks away and
-    understates the variance, this one keeps them.
-
-    With ``Hinv`` = (JᵀJ)⁻¹ of the whole fit, the periodogram is first corrected for the
-    fit's leverage: the residuals are orthogonal to J, so R(f) lacks about h(f) = w J(f)
-    (JᵀJ)⁻¹ J(f)ᴴ / L of the noise where J is large (Σ_f tr h = p); P ← (I − h)⁻¹ P (I − h)⁻ᴴ,
-    the HC3 form (MacKinnon & White, J. Econometrics 29, 1985; Long & Ervin, Am. Stat. 54,
-    2000, recommend it for small samples), eigenvalues of I − h floored at 0.1.
-
-    Parameters
-    ----------
-    J : ndarray (N, c, p)
-        Jacobian per sample and channel.
-    R : ndarray (N, c)
-        Residuals.
-    Hinv : ndarray (p, p), optional
-        (JᵀJ)⁻¹ of the fit (all records).
-
-    Returns
-    -------
-    S : ndarray (p, p)
-        Without ``Hinv``.
-    (S, b) : with ``Hinv``, also b (F, p): each frequency bin's share of the variance of
-        (JᵀJ)⁻¹Jᵀr per parameter, spread by the smoothing window (for the effective
-        degrees of freedom, :func:`_covariance`).
-    """
-    N, c, p = J.shape
-    L = 2 * N
-    # no demeaning: a correct model leaves zero-mean residuals, and removing the mean would
-    # zero the DC bin where slow (e.g. impulse-response) sensitivities have their weight
-    Rf = np.fft.rfft(R, n=L, axis=0)  # (F, c)
-    Jf = np.fft.rfft(J, n=L, axis=0)  # (F, c, p)
-    P = Rf[:, :, None] * Rf[:, None, :].conj() / N  # (F, c, c) periodogram
-    w = np.full(P.shape[0], 2.0)
-    w[0] = 1.0
-    w[-1] = 1.0
-    JfH = np.conj(np.swapaxes(Jf, 1, 2))  # (F, p, c)
-    # contractions as batched matrix products (a 4-operand einsum loops naively)
-    if Hinv is not None:
-        h = (w / L)[:, None, None] * ((Jf @ Hinv) @ JfH)
-        lam, V = np.linalg.eigh(np.eye(c) - h)
-        M = (V / np.clip(lam, 0.1, None)[:, None, :]) @ np.conj(np.swapaxes(V, 1, 2))
-        P = M @ P @ np.conj(np.swapaxes(M, 1, 2))
-    kernel = np.ones(2 * smooth + 1) / (2 * smooth + 1)
-    if smooth > 0:
-        flat = P.reshape(P.shape[0], -1)
-        pad = np.concatenate([flat[smooth:0:-1].conj(), flat, flat[-2:-smooth - 2:-1].conj()])
-        flat = np.apply_along_axis(lambda x: np.convolve(x, kernel, mode="valid"), 0, pad)
-        P = flat.reshape(P.shape)
-    S = np.real(np.sum(w[:, None, None] * (JfH @ (P @ Jf)), axis=0)) / L
-    if Hinv is None:
-        return S
-    G = Jf @ Hinv  # (F, c, p): each parameter's combination of the Jacobian's columns
-    q = w[:, None] * np.real(np.sum(G.conj() * (P @ G), axis=1)) / L
-    return S, np.apply_along_axis(lambda x: np.convolve(x, kernel, mode="same"), 0, q)
 
 
 def default_bounds(model: ClosedLoopModel, names) -> dict[str, tuple[float, float]]:
     """Default bounds (SI) around a model's values: [0.2, 5]× for positive force factors and
-    spring stiffnesses, [0, 0.05] s for τ_e, none otherwise."""
+    spring stiffnesses, [0, 0.05] s for τ_e and τ_s, none otherwise."""
     out = {}
     for n in names:
-        if n == TAU_E:
+        if n in (TAU_E, TAU_S):
             out[n] = (0.0, 0.05)
             continue
         v = model.plant.parameter(n).nominal
@@ -344,7 +305,8 @@ def fit_parameters(
     models : list of ClosedLoopModel
         One per record (its pressure, its controller), sharing parameter names.
     names : list of str
-        Parameters to fit (model names, or ``"tau_e"``).
+        Parameters to fit (model names, ``"tau_e"``, or ``"tau_s"``: a sensor lag the rig
+        file does not state, :mod:`ambseal.identify.sensor_lag`).
     initial, bounds : dict, optional
         Start values and (low, high) bounds in SI; default start the model's nominal
         values, default bounds [0.2, 5]× nominal for positive factors (Ki, Ks, spring
@@ -383,14 +345,14 @@ def fit_parameters(
     def values(x):
         return dict(zip(names, init + x * scale))  # x: scaled change from the start
 
-    def residual_blocks(x, moved: tuple[str, float] | None = None):
+    def residual_blocks(x, moved: tuple | None = None):
         """Per record an (N, c) array: scaled displacement (and current) residuals; with
-        ``moved = (name, h)`` a fixed parameter scaled by 1 + h in every model."""
+        ``moved = (name, f)`` a fixed parameter set to f(its value) in every model."""
         out = []
         for model, (e, y, sy, i, si) in zip(models, data):
             v = values(x)
             if moved is not None:
-                v[moved[0]] = _nominal(model, moved[0]) * (1.0 + moved[1])
+                v[moved[0]] = moved[1](_nominal(model, moved[0]))
             ys, is_ = model.simulate(v, e, start)
             R = (ys - y) / sy
             if current_weight > 0:
@@ -428,6 +390,7 @@ def fit_parameters(
     se_noise = np.sqrt(np.diag(cov))
     budget = _budget(sol.jac, scale, names, fixed, models, residual_blocks, sol.x,
                      se_noise**2, sol.fun, blocks, fixed_correlation)
+    lag = None if TAU_S in names else _lag_test(sol.jac, sol.fun, blocks, residual_blocks, sol.x)
     if budget is not None:
         cov = cov + budget.covariance
     se = np.sqrt(np.diag(cov))
@@ -455,24 +418,25 @@ def fit_parameters(
         time_s=np.asarray(records[0].time_s)[start:stop], y_meas=y0, y_sim=ys[start:],
         axes=tuple(records[0].axes), std_error_noise=se_noise, budget=budget,
         residuals=tests, dof_noise=dof,
-        correlation_jacobian=jacobian_correlation(sol.jac),
+        correlation_jacobian=jacobian_correlation(sol.jac), sensor_lag=lag,
     )
 
 
-def _t_quantile(var_noise, var_total, dof_noise) -> np.ndarray:
-    """Student's t 97.5 % quantile of each interval: the noise variance has ``dof_noise``
-    degrees of freedom, the budget's part is taken as known, so ν = v_total² / (v_noise² /
-    ν_noise) (Satterthwaite); 1.96 where ν is not finite."""
-    from scipy.stats import t
-
-    with np.errstate(invalid="ignore", divide="ignore"):
-        nu = np.asarray(var_total) ** 2 / (np.asarray(var_noise) ** 2 / np.asarray(dof_noise))
-    ok = np.isfinite(nu) & (nu > 0)
-    return np.where(ok, t.ppf(0.975, np.where(ok, nu, 1.0)), 1.96)
-
-
 def _nominal(model: ClosedLoopModel, name: str) -> float:
-    return model.tau_e if name == TAU_E else model.plant.parameter(name).nominal
+    if name in (TAU_E, TAU_S):
+        return model.tau_e if name == TAU_E else model.tau_s
+    return model.plant.parameter(name).nominal
+
+
+def _lag_test(J, r, blocks, residual_blocks, x) -> dict:
+    """Score test of a sensor lag at τ_s = 0 (:mod:`ambseal.identify.sensor_lag`): the
+    residuals' derivative in τ_s by a forward step of 1 µs (a = 0.01 at 10 kHz; y moves by
+    a·(x[n] − x[n−1]), linear in the step)."""
+    h = 1e-6
+    r0 = np.concatenate([R.ravel() for R in blocks])
+    up = np.concatenate([R.ravel() for R in residual_blocks(x, (TAU_S, lambda v: v + h))])
+    z, off, se = (float(q[0]) for q in _score_test(J, ((up - r0) / h)[:, None], r, blocks))
+    return lag_test_dict(-z, off, se)  # a lag the data ask for: positive
 
 
 def _budget(J, scale, names, fixed, models, residual_blocks, x, noise_var, r, blocks,
@@ -489,7 +453,7 @@ def _budget(J, scale, names, fixed, models, residual_blocks, x, noise_var, r, bl
     r0 = np.concatenate([R.ravel() for R in blocks])
     cols = []
     for n, _, _ in use:
-        up = np.concatenate([R.ravel() for R in residual_blocks(x, (n, h))])
+        up = np.concatenate([R.ravel() for R in residual_blocks(x, (n, lambda v: v * (1 + h)))])
         cols.append((up - r0) / h)
     Jf = np.column_stack(cols)
     fixed_names = [u[0] for u in use]
@@ -506,41 +470,15 @@ def _budget(J, scale, names, fixed, models, residual_blocks, x, noise_var, r, bl
                      correlation=np.nan_to_num(corr), estimated=estimated)
 
 
-def _split(M: np.ndarray, blocks_at_optimum: list) -> list:
-    """Rows of a stacked (n, m) array per record as (N, c, m) arrays (sample-major)."""
-    out, off = [], 0
-    for R in blocks_at_optimum:
-        n_s, c = R.shape
-        out.append(M[off:off + n_s * c].reshape(n_s, c, M.shape[1]))
-        off += n_s * c
-    return out
-
-
-def _score_test(J, Jf, r, blocks_at_optimum):
-    """Score (Lagrange-multiplier) test of each fixed value against the data: the cost's
-    gradient in φ_j/φ_j0 at the optimum, with θ free (J_φ projected off J), over its
-    standard deviation from the residuals' long-run covariance (as the sandwich's middle
-    term); N(0, 1) when the fixed value is right (Rao's score test; Ljung §16.6 relates it
-    to testing an extended model structure without fitting it). Returns (z, one-step
-    estimate of the relative offset φ/φ0 − 1 the data suggest, its standard error)."""
-    Jp = Jf - J @ np.linalg.lstsq(J, Jf, rcond=None)[0]
-    g = Jp.T @ r
-    V = sum(_long_run_covariance(Jb, rb[..., 0]) for Jb, rb in
-            zip(_split(Jp, blocks_at_optimum), _split(r[:, None], blocks_at_optimum)))
-    sd = np.sqrt(np.clip(np.diag(V), 0, None))
-    h = np.einsum("ij,ij->j", Jp, Jp)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return g / sd, -g / h, sd / h
-
-
 def _start(m0: ClosedLoopModel, names, initial, bounds):
     """Start values, scales and bounds (SI) of the fitted parameters; raises
     IdentificationError for an unknown name or a start outside its bounds."""
     nominal, scale = [], []
     for n in names:
-        if n == TAU_E:
-            # start inside the bounds: τ_e = 0 (no lag modelled) sits on the lower bound
-            nominal.append(m0.tau_e if m0.tau_e > 0 else 0.1 * _DEFAULT_SCALE["s"])
+        if n in (TAU_E, TAU_S):
+            # start inside the bounds: no lag modelled sits on the lower bound
+            tau = _nominal(m0, n)
+            nominal.append(tau if tau > 0 else 0.1 * _DEFAULT_SCALE["s"])
             scale.append(_DEFAULT_SCALE["s"])
             continue
         try:
@@ -572,29 +510,3 @@ def _record_data(rec, window, n_params: int):
     si = i.std(axis=0)
     si[si == 0] = 1.0
     return np.asarray(rec.excitation_a)[:stop], y, sy, i, si
-
-
-def _covariance(J: np.ndarray, r: np.ndarray, blocks_at_optimum: list, p: int
-                ) -> tuple[np.ndarray, np.ndarray]:
-    """Sandwich covariance of the scaled estimate, (JᵀJ)⁻¹ S (JᵀJ)⁻¹ with S the residuals'
-    long-run covariance per record, leverage-corrected (:func:`_long_run_covariance`), and
-    each parameter's effective degrees of freedom ν = (Σ b)² / Σ b² over the frequency bins
-    of every record (Satterthwaite, *Biometrics Bull.* 2, 1946: S is a weighted sum of
-    periodogram ordinates, each complex ordinate χ²₂ and two bins of the 2N-point transform
-    per independent one); ``inf`` covariance and NaN ν when JᵀJ is singular. Rows of the
-    stacked residual vector are sample-major per record."""
-    blocks = list(zip(_split(J, blocks_at_optimum),
-                      [b[..., 0] for b in _split(r[:, None], blocks_at_optimum)]))
-    H = J.T @ J
-    try:
-        if np.linalg.cond(H) > 1e14:
-            raise np.linalg.LinAlgError
-        Hinv = np.linalg.inv(H)
-        parts = [_long_run_covariance(Jb, rb, Hinv=Hinv) for Jb, rb in blocks]
-        cov = Hinv @ sum(S for S, _ in parts) @ Hinv
-        b = np.concatenate([b for _, b in parts])
-        with np.errstate(invalid="ignore", divide="ignore"):
-            dof = b.sum(axis=0) ** 2 / (b**2).sum(axis=0)
-    except np.linalg.LinAlgError:
-        cov, dof = np.full((p, p), np.inf), np.full(p, np.nan)
-    return cov, dof

@@ -42,9 +42,10 @@ def uncertainty_from_fit(path: str | Path, names=None) -> dict[str, tuple[float,
         An unreadable file, no ``parameters`` table, a requested name it does not hold, or
         an interval that is missing or not finite (a fit whose covariance failed), naming
         the file and the parameter. A fit whose intervals understate the uncertainty is
-        refused too: residuals that correlate with the excitation, or a fixed value the
-        data dispute by more than the 95 % band of its stated uncertainty (the offset the
-        score test suggests beyond 1.96 σ: the budget in the intervals does not cover it).
+        refused too: residuals that correlate with the excitation, a sensor lag the data
+        ask for (:mod:`ambseal.identify.sensor_lag`), or a fixed value the data dispute
+        by more than the 95 % band of its stated uncertainty (the offset the score test
+        suggests beyond 1.96 σ: the budget in the intervals does not cover it).
     """
     p = Path(path)
     try:
@@ -60,6 +61,11 @@ def uncertainty_from_fit(path: str | Path, names=None) -> dict[str, tuple[float,
         raise DataError(f"{p}: residual_tests: model mismatch — its intervals understate the "
                         "uncertainty; fix the model (see the fit's warnings) before designing "
                         "on them")
+    if ((fit.get("model_check") or {}).get("sensor_lag")
+            or (fit.get("sensor_lag_test") or {}).get("flagged")):
+        raise DataError(f"{p}: sensor_lag_test: model mismatch — the data ask for a sensor "
+                        "lag the model lacks, so its intervals understate the uncertainty; "
+                        "fit tau_s (see the fit's warnings) before designing on them")
     beyond = _disputed_beyond_budget(fit)
     if beyond:
         raise DataError(f"{p}: error_budget.disputed: model mismatch — the data put "

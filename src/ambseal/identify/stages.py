@@ -16,6 +16,7 @@ from .data import Measurement, validate_measurement
 from .fit import TAU_E, ClosedLoopModel, FitResult, default_bounds, fit_parameters
 from .loop import DiscreteController
 from .rig_sim import reduced_plant, simulate_facility
+from .sensor_lag import TAU_S
 from .signals import Excitation
 
 __all__ = ["controller_from_metadata", "check_controller", "sample_rate_of",
@@ -155,11 +156,13 @@ def build_models(cfg: RigConfig, records: list[Measurement], values: dict | None
                  sources: list[str] | None = None) -> list[ClosedLoopModel]:
     """One closed-loop model per record: the rig at the record's pressure and speed, with
     parameter ``values`` (SI) applied exactly in full order, reduced to the modes below
-    ``cutoff_hz``, the amplifier and τ_e lag in series and the controller that ran
+    ``cutoff_hz``, the amplifier and τ_e lag in series (and a sensor lag ``tau_s`` if
+    ``values`` has one) and the controller that ran
     (``controllers``, one per record, or each record's metadata). ``sources`` name the
     records' files in errors."""
     values = dict(values or {})
     tau = values.pop(TAU_E, cfg.actuator.eddy_time_constant)
+    lag = values.pop(TAU_S, 0.0)  # a sensor lag is no rig-file value (sensor_lag.py)
     models = []
     sources = sources or [f"record {i + 1}" for i in range(len(records))]
     if controllers is None:
@@ -172,7 +175,8 @@ def build_models(cfg: RigConfig, records: list[Measurement], values: dict | None
         plant = reduced_plant(cfg, _pressure_bar(rec, src),
                               None if speed is None else speed * 60 / (2 * np.pi), values,
                               cutoff_hz)
-        models.append(ClosedLoopModel(plant, actuator_matrices(cfg.actuator), Kd, tau_e=tau))
+        models.append(ClosedLoopModel(plant, actuator_matrices(cfg.actuator), Kd, tau_e=tau,
+                                      tau_s=lag))
     return models
 
 

@@ -177,7 +177,7 @@ def _model_check_text(fit, errors: dict) -> str:
     is: the offset the data suggest, the uncertainty the intervals carry for it and, for a
     seal coefficient, stage (c)'s estimate at 0 bar."""
     check = fit.model_check()
-    if not check["disputed"]:
+    if not check["disputed"] or check["sensor_lag"]:
         return html.escape(check["verdict"])
     b = fit.budget
     parts = []

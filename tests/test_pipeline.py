@@ -161,7 +161,10 @@ def test_run_identifies_the_virtual_facility(metrics):
     facility: every AMB factor within 2 %, τ_e within 10 %, the coupling within 5 % of the
     packaged truth, and the identified rig file loads (issue acceptance, seed fixed); the
     seal damping the joint AMB fit holds at the rig file's values (the truth's differ) is
-    disputed by its model check (issue 17)."""
+    disputed by its model check (issue 17). The seal's impulse run at 2.5 bar is skipped: the
+    reference PID does not hold the facility's rotor there ("the rotor-bearing-seal system
+    with PID controller turns unstable for high pressures", P5 §5.1; the facility's loop
+    poles are checked against the fit model's in tests/identify/test_identify_facility.py)."""
     from ambseal.config import load_rig
 
     out, m = metrics
@@ -182,6 +185,9 @@ def test_run_identifies_the_virtual_facility(metrics):
     assert "seal.C: the data suggest +" in (out / "report.html").read_text(encoding="utf-8")
     rig = load_rig(out / "identified_rig.toml")
     assert rig.seal[0].k.per_bar == pytest.approx(k["slope"])
+    runs = json.loads((out / "identification.json").read_text(encoding="utf-8"))
+    assert [r["pressure_bar"] for r in runs["seal_vs_pressure"]] == [0.5, 1.0, 1.5, 2.0]
+    assert [r["pressure_bar"] for r in runs["seal_pressures_skipped"]] == [2.5]
 
 
 def test_run_judges_hinf_and_mu_as_the_thesis_found(metrics):

@@ -4,7 +4,8 @@
 from a second PRBS run, with (a) known, then both jointly on both records; (a') Ki by
 static loading (P2 §5, :mod:`.static_load`) joined with that fit; (c) the seal's K, k, C, c
 per pressure drop from impulse runs (0.05 A for 10 ms on both bearings in ζ, P5 §3.3) with
-regression lines against pressure (P5 Fig. 7), then per excitation frequency from a stepped
+regression lines against pressure (P5 Fig. 7; a pressure where the controller does not
+hold the rotor is skipped and told — the facility refuses an unstable loop), then per excitation frequency from a stepped
 sine of balanced forward and backward whirl (:mod:`.seal_test`, balanced on the model with
 the regression's seal) at the nominal pressure, with a zero-pressure run as the bias
 reference (P4 Fig. 12); (d) the identified rig.
@@ -26,6 +27,7 @@ from typing import Callable
 import numpy as np
 
 from ..config import Affine, RigConfig, TruthSection, rig_with_values
+from ..errors import IdentificationError, ModelError
 from ..model.amb import channel_names
 from .fit import TAU_E, FitResult
 from .seal_test import fit_reliability, seal_frequency_test
@@ -65,6 +67,9 @@ class ProcedureResult:
     static_load : dict or None
         Stage (a'): Ki by static loading (:mod:`.static_load`), and the Ki–Ks correlations
         of the closed-loop fit alone and joined with it; ``amb`` is the joined estimate.
+    skipped : list of (float, str)
+        Impulse pressures (bar) the facility refused, with why: the controller does not
+        hold the rotor there (P5 §4: the PID "turns unstable for high pressures").
     """
 
     amb: FitResult
@@ -76,6 +81,7 @@ class ProcedureResult:
     truth: dict
     records: dict
     static_load: dict | None = None
+    skipped: list = ()
 
     def to_dict(self) -> dict:
         def fit(r: FitResult) -> dict:
@@ -93,6 +99,9 @@ class ProcedureResult:
             "regression": {k: v.to_dict() for k, v in self.regression.items()},
             "truth": self.truth,
             **({"static_load": self.static_load} if self.static_load else {}),
+            **({"seal_pressures_skipped": [{"pressure_bar": p, "reason": why}
+                                           for p, why in self.skipped]}
+               if self.skipped else {}),
         }
 
 
@@ -178,6 +187,7 @@ def thesis_procedure(
 
     seal_freq: dict = {}
     seal_press: list = []
+    skipped: list = []
     regression: dict = {}
     if seal is not None:
         names_s = [f"{seal}.{c}" for c in SEAL_COEFFICIENTS]
@@ -186,9 +196,20 @@ def thesis_procedure(
             say(f"identification (c): seal coefficients by impulse at {p:g} bar")
             ex = impulse(amplitude_a=0.05, width_s=0.01, start_s=0.05, duration_s=0.4,
                          sample_rate_hz=fs, axes=axes, excited=zeta)
-            rec = acquire(cfg, truth, ex, controller=controller, pressure_bar=p, seed=seed + 10 + i)
+            try:
+                rec = acquire(cfg, truth, ex, controller=controller, pressure_bar=p,
+                              seed=seed + 10 + i)
+            except ModelError as exc:  # the controller does not hold the rotor there
+                skipped.append((p, str(exc)))
+                say(f"identification (c): {p:g} bar skipped: {exc}")
+                continue
             seal_press.append((p, identify(cfg, [rec], names_s, known=known, refine=False,
                                            known_fit=known_fit, budget=True)))
+        if len(seal_press) < 3:
+            raise IdentificationError(
+                f"identification (c): the facility held the rotor at {len(seal_press)} of the "
+                f"impulse pressures {list(impulse_pressures_bar)} bar; the seal's regression "
+                f"needs three ({'; '.join(f'{p:g} bar: {w}' for p, w in skipped)})")
         for j, c in enumerate(SEAL_COEFFICIENTS):
             regression[c] = linear_regression(
                 [p for p, _ in seal_press], [r.estimate[j] for _, r in seal_press],
@@ -217,7 +238,7 @@ def thesis_procedure(
             v = truth.parameters[name]
             true[name] = v.model_dump() if isinstance(v, Affine) else float(v)
     return ProcedureResult(amb, coupling, seal_freq, seal_press, regression, identified, true,
-                           records, static)
+                           records, static, skipped)
 
 
 def _with_static_load(cfg: RigConfig, truth: TruthSection, amb: FitResult, known: dict,

@@ -342,7 +342,7 @@ def simulate_facility(
                            pressure_schedule=pressure_schedule)
     k = len(fac.axes)
     if controller.B.shape[1] == k and controller.C.shape[0] == k:
-        _refuse_unstable(fac, controller, cfg, truth)
+        _refuse_unstable(fac, controller, cfg, truth, pressure_bar)
     e = np.asarray(excitation_a, dtype=float)
     if e.ndim != 2 or e.shape[1] != k:
         raise ModelError(f"excitation has shape {e.shape}; expected (N, {k}) for axes {fac.axes}")
@@ -367,7 +367,7 @@ def simulate_facility(
 
 
 def _refuse_unstable(fac: Facility, controller: DiscreteController, cfg: RigConfig,
-                     truth: TruthSection) -> None:
+                     truth: TruthSection, pressure_bar: float) -> None:
     """ModelError when ``controller`` does not stabilise the facility's linearised loop
     (:meth:`Facility.loop_poles`), naming the least stable pole and the truth's departures
     from the rig file a controller designed on that file did not see. Such a loop either
@@ -386,11 +386,11 @@ def _refuse_unstable(fac: Facility, controller: DiscreteController, cfg: RigConf
     if truth.sensor_filter_hz is not None:
         seen.append(f"sensor_filter_hz = {truth.sensor_filter_hz:g}")
     if truth.parameters:
-        seen.append(f"parameters ({', '.join(truth.parameters)})")
+        seen.append(f"{len(truth.parameters)} parameter value(s)")
     raise ModelError(
-        f"the controller does not stabilise the virtual facility: its sampled loop has a pole "
+        f"the controller does not stabilise the virtual facility at {pressure_bar:g} bar: its "
+        "sampled loop has a pole "
         f"|z| = {abs(worst):.5f} at {f_hz:.4g} Hz (ζ = {zeta:.2g}), so the rotor would be "
         "lost or the record a growing oscillation"
-        + (f"; the truth departs from the rig file in {'; '.join(seen)}, which a controller "
-           "designed on the rig file did not see — set the truth to the machine's or design "
-           "for it" if seen else ""))
+        + (f"; the truth departs from the rig file in {'; '.join(seen)} (a controller "
+           "designed on the rig file did not see these)" if seen else ""))

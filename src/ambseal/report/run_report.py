@@ -160,6 +160,8 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
     fits = ", ".join(f"{k} {v:.1f} %" for k, v in a.nrmse_fit_pct.items())
     if a.residuals is not None:
         fits += f". Model check of stage (a)+(b): {_model_check_text(a, errors)}"
+    for p, why in res.skipped:
+        fits += f". Seal impulse at {p:g} bar skipped: {html.escape(why)}"
     section = {
         "title": "Identification on the virtual test facility",
         "html": ("<p>Records from the virtual facility (nonlinear AMB force law, full FE rotor, "

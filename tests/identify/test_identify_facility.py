@@ -1,6 +1,8 @@
 """The virtual facility refuses a controller that does not stabilise its loop (issue 17:
 the pump's and the blower's records with the test rig's eddy lag in the truth)."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -12,6 +14,8 @@ from ambseal.identify.rig_sim import prepare_facility, simulate_facility
 from ambseal.identify.stages import build_models
 from ambseal.model.amb import channel_names
 
+PUMP = Path(__file__).resolve().parents[2] / "examples" / "pump.toml"
+
 
 def test_pump_pid_with_an_unseen_eddy_lag_is_refused():
     """examples/pump.toml has no eddy-current lag; its derived PID (designed on that file)
@@ -21,7 +25,7 @@ def test_pump_pid_with_an_unseen_eddy_lag_is_refused():
     (continuous plant, amplifier and lag in series, one ZOH at the sample period), to 1e-6;
     (2) the facility's own nonlinear run, not stopped by the check, grows by the pole's
     modulus: a 2 ms kick's response is ≥ 5× larger 0.3 s later (|z|³⁰⁰⁰ = e^2.97 ≈ 19)."""
-    cfg = load_rig("examples/pump.toml")
+    cfg = load_rig(PUMP)
     p = pid_from_rig(cfg)
     fs = cfg.controller.sample_rate_hz
     K = discrete_controller(pid_controller(p["kp"], p["ti"], p["td"], p["eps"],

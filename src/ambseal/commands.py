@@ -420,7 +420,10 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
     if res.sensor_lag and res.sensor_lag["flagged"]:
         warnings.append(f"{MISMATCH} (the data ask for a sensor lag of "
                         f"{res.sensor_lag['suggested_tau_s'] * 1e6:.3g} µs the model lacks: "
-                        "fit tau_s beside tau_e; Ki, Ks then hold, read tau_e + tau_s)")
+                        + ("a wrong held value can also make it; fit the disputed values "
+                           "first, then tau_s if it remains)" if res.model_check()["disputed"]
+                           else "fit tau_s beside tau_e; Ki, Ks then hold, read "
+                           "tau_e + tau_s)"))
     write_json(out / "fit.json", {**res.to_dict(), "warnings": warnings,
                                   **({"per_record": spread} if spread else {}),
                                   **({"static_load": static} if static else {})})

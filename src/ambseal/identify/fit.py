@@ -223,8 +223,11 @@ class FitResult:
             tau, se = (self.sensor_lag[k] * 1e6 for k in ("suggested_tau_s",
                                                           "suggested_tau_s_se"))
             parts.append(f"the data ask for a sensor lag of {tau:.3g} ± {se:.2g} µs the model "
-                         f"lacks (score test); fit {TAU_S} beside tau_e (Ki, Ks then hold; "
-                         "read tau_e + tau_s, not each)")
+                         + ("lacks (score test), which a wrong held value can also make: fit "
+                            f"the disputed values first, then {TAU_S} if it remains"
+                            if disputed else
+                            f"lacks (score test); fit {TAU_S} beside tau_e (Ki, Ks then hold; "
+                            "read tau_e + tau_s, not each)"))
         return {"residuals_correlated": list(failed), "disputed": disputed, "sensor_lag": lag,
                 "mismatch": bool(parts),
                 "verdict": f"{MISMATCH} ({'; '.join(parts)})" if parts else

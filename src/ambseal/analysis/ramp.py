@@ -19,7 +19,12 @@ test rig's design unstable, |z| = 1.0008–1.0017 without delay, and lost the ro
 starting pressure) is fed the block's displacements and current references. The
 scheduling value follows the estimate at the end of the previous block (causal, as on the
 target) within the design's rate bound ν and its schedule: the LPV guarantee holds only
-for |θ̇| ≤ ν, and an estimate jumps (at an impulse) faster than that.
+for |θ̇| ≤ ν, and an estimate jumps (at an impulse) faster than that. The tracker's model
+is built from ``model_cfg``, the identified rig: on the test rig's ramp (seeds 0, 1, 2)
+the estimate is then within 0.028–0.030 k_nom of the truth after 1 s and its 95 %
+interval covers the truth 99.9 % of the time; built from the rig file (τ_e = 0, Ki, Ks a
+few per cent off) 0.60 k_nom and 88 % (:mod:`ambseal.identify.tracking`, "The model must
+be the identified one").
 
 Per impulse: the peak |y| on the impulse axis within 30 impulse lengths, and the settling
 time, after which |y| stays inside max(2 % of the peak, 3× the std of the 50 ms before
@@ -139,7 +144,7 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
                     top_factor: float = 3.0, step_s: float = 0.05, block_s: float = 0.05,
                     impulse_every_s: float = 2.0, transient_s: float = 1.0,
                     record_hz: float = 1000.0, seed: int = 0, settings=None,
-                    progress=None) -> RampResult:
+                    model_cfg=None, progress=None) -> RampResult:
     """Run the pressure ramp with each fixed controller and the tracked scheme.
 
     Parameters
@@ -164,6 +169,10 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
     record_hz : float
         Rate of the returned records (Hz).
     settings : TrackingSettings, optional
+    model_cfg : RigConfig, optional
+        The rig the tracker's model is built from: the identified rig (Ki, Ks, τ_e, the
+        seal's coefficient curves; thesis stages (a)–(c)); default ``cfg`` (module
+        docstring).
     progress : callable, optional
         Called with one line per run.
 
@@ -218,9 +227,9 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
     tracking = {}
     if tracked is not None:
         fac = prepare_facility(cfg, truth, fs, pressure_bar=0.0, pressure_schedule=sched)
-        runs["tracked"], tracking = _run_tracked(cfg, fac, tracked, e, noise, inoise, fs,
-                                                 starts, n_len, dec, block_s, k_of_n,
-                                                 float(k_nom), transient_s, settings)
+        runs["tracked"], tracking = _run_tracked(model_cfg or cfg, fac, tracked, e, noise,
+                                                 inoise, fs, starts, n_len, dec, block_s,
+                                                 k_of_n, float(k_nom), transient_s, settings)
         if progress:
             progress(f"ramp: tracked {tracking}")
     t = np.arange(N)[::dec] / fs

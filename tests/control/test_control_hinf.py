@@ -114,6 +114,21 @@ def test_hinfsyn_sgc97_published_optimum():
     assert r.to_dict()["iterations"] == r.iterations
 
 
+@pytest.mark.parametrize("scale", [1e-2, 1e2])
+def test_hinfsyn_gamma_tolerance_is_relative_at_any_scale(scale):
+    """Reference: scaling the performance outputs z by s scales every closed loop w → z,
+    hence γ_opt, by s exactly; with the published γ_opt ≈ 9.5081 of Scherer, Gahinet &
+    Chilali (1997), Example 7. The search's tolerance ``rtol`` is relative whatever the
+    scale (SB10AD's own tolerance is absolute in γ: at s = 0.01 it erred by 4e-6)."""
+    P = sgc97_plant()
+    S = np.diag([scale, scale, 1.0])
+    Ps = ct.ss(P.A, P.B, S @ P.C, S @ P.D)
+    g1 = hinfsyn(P, nmeas=1, ncon=1, rtol=1e-6).gamma_opt
+    gs = hinfsyn(Ps, nmeas=1, ncon=1, rtol=1e-6).gamma_opt
+    assert gs / scale == pytest.approx(9.5081, rel=1e-4)
+    assert gs / scale == pytest.approx(g1, rel=2e-6)
+
+
 def test_riccati_gamma_test_agrees_with_sb10ad():
     """Reference: SLICOT SB10AD's γ test (job 4), side by side with the Riccati γ test of
     Glover & Doyle (1988, Thm 3.1) on the rig-sized mixed-sensitivity plant and the SGC97

@@ -18,29 +18,33 @@ __all__ = ["game_riccati", "search_gamma"]
 def game_riccati(A, B, C1, D1, nw: int, g: float):
     """Stabilising solution X ⪰ 0 of the H∞ game Riccati equation
     ``AᵀX + XA − (XB + C1ᵀD1) R⁻¹ (BᵀX + D1ᵀC1) + C1ᵀC1 = 0``, ``R = D1ᵀD1 − diag(γ²I_nw, 0)``
-    (Glover & Doyle 1988), from the stable invariant subspace of its Hamiltonian; None if
-    the Hamiltonian has imaginary-axis eigenvalues, the subspace is not a graph or X ⋡ 0."""
+    (Glover & Doyle 1988), from the stable invariant subspace of its Hamiltonian (LAPACK
+    DGEES with the stable eigenvalues ordered first); None if the Hamiltonian has
+    imaginary-axis eigenvalues, the subspace is not a graph or X ⋡ 0."""
+    from scipy.linalg.lapack import dgees
+
     n = A.shape[0]
     if n == 0:
         return np.zeros((0, 0))
     R = D1.T @ D1
     R[np.arange(nw), np.arange(nw)] -= g * g
     try:
-        RiDC = np.linalg.solve(R, D1.T @ C1)
-        RiBt = np.linalg.solve(R, B.T)
+        S = np.linalg.solve(R, np.hstack([D1.T @ C1, B.T]))
     except np.linalg.LinAlgError:
         return None
+    RiDC, RiBt = S[:, :n], S[:, n:]
     Ah = A - B @ RiDC
-    H = np.block([[Ah, -B @ RiBt], [-C1.T @ C1 + C1.T @ (D1 @ RiDC), -Ah.T]])
-    try:
-        T, Z, sdim = sla.schur(H, output="real", sort="lhp")
-    except (np.linalg.LinAlgError, ValueError):  # eigenvalues on the axis to rounding
+    H = np.block([[Ah, -B @ RiBt], [C1.T @ (D1 @ RiDC - C1), -Ah.T]])
+    if not np.all(np.isfinite(H)):
         return None
-    ev = np.linalg.eigvals(T[:n, :n]) if sdim == n else None
-    if ev is None or np.min(np.abs(ev.real)) <= 1e-12 * max(1.0, float(np.max(np.abs(ev)))):
+    _, sdim, wr, wi, Z, _, info = dgees(lambda x, y: x < 0.0, H, sort_t=1)
+    if info or sdim != n:  # (info = n+1, n+2: eigenvalues on the axis to rounding)
+        return None
+    if np.min(np.abs(wr[:n])) <= 1e-12 * max(1.0, float(np.max(np.hypot(wr, wi)))):
         return None
     U1, U2 = Z[:n, :n], Z[n:, :n]
-    if np.linalg.cond(U1) > 1e12:
+    sv = np.linalg.svd(U1, compute_uv=False)
+    if sv[-1] < 1e-12 * sv[0]:
         return None
     X = np.linalg.solve(U1.T, U2.T).T
     X = 0.5 * (X + X.T)
@@ -84,7 +88,7 @@ def search_gamma(margin, lo: float, rtol: float, seen: dict | None = None):
         while hi > 1e-12 and m(0.5 * hi) < 0:
             hi *= 0.5
         lo = 0.5 * hi
-    if m(lo) >= 0:  # the Parrott bound itself is inadmissible (margin +1 there)
+    if hi / lo > 1.0 + rtol and m(lo) >= 0:  # (the Parrott bound has margin +1 there)
         brentq(m, lo, hi, xtol=0.25 * rtol * lo, rtol=1e-15, maxiter=200)
     ok = [x for x, v in seen.items() if v < 0]
     bad = [x for x, v in seen.items() if v >= 0 and x < min(ok)]

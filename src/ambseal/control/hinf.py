@@ -35,7 +35,7 @@ import control as ct
 from ambseal.errors import ConfigError, ModelError, SynthesisError
 from ambseal.control._hinf_gamma import game_riccati as _game_riccati
 from ambseal.control._hinf_gamma import search_gamma as _search_gamma
-from ambseal.lti.interconnect import lft_lower
+from ambseal.lti.interconnect import lft_lower, lft_lower_matrices
 
 __all__ = ["HinfResult", "hinfsyn", "hinfnorm", "lft_lower", "check_plant"]
 
@@ -108,7 +108,20 @@ def hinfnorm(sys, rtol: float = 1e-10) -> tuple[float, float]:
         scale_a = max(1.0, float(np.max(np.abs(poles))))
         if np.any(poles.real >= -1e-12 * scale_a):
             return float("inf"), float("nan")
-    gamma, w_pk = ct.linfnorm(sys, tol=rtol)
+    return _linfnorm_matrices(A, *(np.asarray(M, float) for M in (sys.B, sys.C, sys.D)),
+                              rtol)
+
+
+def _linfnorm_matrices(A, B, C, D, rtol: float = 1e-10) -> tuple[float, float]:
+    """L∞ norm and peak frequency of a continuous (A, B, C, D): SLICOT AB13DD through
+    slycot, as ``control.linfnorm`` calls it, without building a system object."""
+    from slycot import ab13dd
+
+    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    if n == 0:
+        return float(np.linalg.norm(D, 2)) if D.size else 0.0, 0.0
+    jobd = "D" if np.any(D) else "Z"
+    gamma, w_pk = ab13dd("C", "I", "S", jobd, n, m, p, A, np.eye(n), B, C, D, rtol)
     w_pk = float(w_pk)
     return float(gamma), (w_pk if np.isfinite(w_pk) else 0.0)
 
@@ -272,13 +285,48 @@ def _scale(A, B, C, D, nw, nz):
     return A, B, C, D, t, su, sy
 
 
+def _sb10ad_workspace(n, m, p, ncon, nmeas):
+    """(liwork, ldwork) of SLICOT SB10AD: the minimal sizes of its documentation (SLICOT
+    5.x, SB10AD, arguments LIWORK and LDWORK), as slycot's wrapper computes them."""
+    m2, np2 = ncon, nmeas
+    m1, np1 = m - m2, p - np2
+    nd1, nd2 = np1 - m2, m1 - np2
+    lw1 = n * m + p * n + p * m + m2 * m2 + np2 * np2
+    lw2 = max((n + np1 + 1) * (n + m2) + max(3 * (n + m2) + n + np1, 5 * (n + m2)),
+              (n + np2) * (n + m1 + 1) + max(3 * (n + np2) + n + m1, 5 * (n + np2)),
+              m2 + np1 * np1 + max(np1 * max(n, m1), 3 * m2 + np1, 5 * m2),
+              np2 + m1 * m1 + max(max(n, np1) * m1, 3 * np2 + m1, 5 * np2))
+    lw3 = max(nd1 * m1 + max(4 * min(nd1, m1) + max(nd1, m1), 6 * min(nd1, m1)),
+              np1 * nd2 + max(4 * min(np1, nd2) + max(np1, nd2), 6 * min(np1, nd2)))
+    lw4 = 2 * m * m + p * p + 2 * m * n + m * p + 2 * n * p
+    lw5 = 2 * n * n + m * n + n * p
+    lw6 = max(m * m + max(2 * m1, 3 * n * n + max(n * m, 10 * n * n + 12 * n + 5)),
+              p * p + max(2 * np1, 3 * n * n + max(n * p, 10 * n * n + 12 * n + 5)))
+    lw7 = m2 * np2 + np2 * np2 + m2 * m2 + max(
+        nd1 * nd1 + max(2 * nd1, (nd1 + nd2) * np2), nd2 * nd2 + max(2 * nd2, nd2 * m2), 3 * n,
+        n * (2 * np2 + m2) + max(2 * n * m2, m2 * np2 + max(m2 * m2 + 3 * m2,
+                                                            np2 * (2 * np2 + m2 + max(np2, n)))))
+    liwork = max(2 * max(n, m1, np1, ncon, nmeas), n * n)
+    return liwork, lw1 + max(1, lw2, lw3, lw4, lw5 + max(lw6, lw7))
+
+
 def _sb10ad(A, B, C, D, ncon, nmeas, gamma, job, gtol=1e-6):
-    from slycot import sb10ad
+    """SLICOT SB10AD through slycot's compiled wrapper: ``(outputs, info)``.
+
+    slycot's Python function turns every ``info ≠ 0`` into an exception whose message it
+    builds by parsing the routine's docstring (about 1 ms, more than SB10AD itself on a
+    small plant, and an inadmissible γ is half of a γ search); the wrapper returns ``info``.
+    job 1: bisection only (the scan of job 2/3 can take seconds and adds nothing here,
+    since every γ is verified afterwards), to an absolute tolerance ``gtol`` in γ; job 4:
+    the γ test and controller at ``gamma``.
+    """
+    from slycot import _wrapper
 
     n, m, p = A.shape[0], B.shape[1], C.shape[0]
-    # job 1: bisection only (the scan of job 2/3 can take seconds and adds nothing here,
-    # since every γ is verified afterwards); gtol relative to γ
-    return sb10ad(n, m, p, ncon, nmeas, gamma, A, B, C, D, job=job, gtol=gtol)
+    liwork, ldwork = _sb10ad_workspace(n, m, p, ncon, nmeas)
+    out = _wrapper.sb10ad(job, n, m, p, ncon, nmeas, gamma, A, B, C, D, gtol, 0.0,
+                          liwork, ldwork)
+    return out[:-1], int(out[-1])
 
 
 def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | None = None,
@@ -365,22 +413,21 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
             f"hinfsyn: no stabilising controller found from γ={base_g:.6g} upwards "
             f"({last_err[0]})")
     ylab, ulab = list(P.output_labels)[sb.nz:], list(P.input_labels)[sb.nw:]
-    Ks = chosen.K
-    K = ct.ss(Ks.A, Ks.B, Ks.C, Ks.D, inputs=ylab, outputs=ulab, name="K",
-              states=[f"xK{i}" for i in range(Ks.nstates)])
+    K = ct.ss(*chosen.K, inputs=ylab, outputs=ulab, name="K",
+              states=[f"xK{i}" for i in range(chosen.K[0].shape[0])])
     return HinfResult(K=K, gamma=float(chosen.gamma), gamma_opt=gamma_opt,
                       gamma_design=float(chosen.gamma_design), omega_peak=float(chosen.omega),
-                      closed_loop=chosen.closed_loop, rcond=chosen.rcond,
+                      closed_loop=lft_lower(P, K, nmeas, ncon), rcond=chosen.rcond,
                       gamma_lower=gamma_lower, iterations=tests + len(tried))
 
 
 @dataclass(frozen=True)
 class _Attempt:
-    """A controller built at ``gamma_design`` and its verified closed-loop norm ``gamma``."""
+    """A controller built at ``gamma_design`` (``K`` as matrices ``(A, B, C, D)``) and its
+    verified closed-loop norm ``gamma``."""
 
     gamma_design: float
-    K: Any
-    closed_loop: Any
+    K: tuple
     rcond: tuple
     gamma: float
     omega: float
@@ -396,29 +443,26 @@ class _Sb10:
 
     def __init__(self, P, nmeas: int, ncon: int):
         A0, B0, C0, D0 = (np.asarray(M, float) for M in (P.A, P.B, P.C, P.D))
-        self.P, self.nmeas, self.ncon = P, nmeas, ncon
+        self.P0, self.nmeas, self.ncon = (A0, B0, C0, D0), nmeas, ncon
         self.nw, self.nz = B0.shape[1] - ncon, C0.shape[0] - nmeas
         self.A, self.B, self.C, self.D, _, self.su, self.sy = _scale(A0, B0, C0, D0,
                                                                      self.nw, self.nz)
 
     def call(self, g: float, job: int):
-        try:
-            return _sb10ad(self.A, self.B, self.C, self.D, self.ncon, self.nmeas, g, job)
-        except Exception as exc:  # slycot raises SlycotArithmeticError with .info
-            info = getattr(exc, "info", None)
-            raise SynthesisError(
-                f"hinfsyn: SB10AD failed at γ={g:.6g}: "
-                f"{_SB10AD_INFO.get(info, str(exc))} (info={info})") from exc
+        out, info = _sb10ad(self.A, self.B, self.C, self.D, self.ncon, self.nmeas, g, job)
+        if info:
+            raise SynthesisError(f"hinfsyn: SB10AD failed at γ={g:.6g}: "
+                                 f"{_SB10AD_INFO.get(info, 'argument error')} (info={info})")
+        return out
 
     def admissible(self, g: float) -> bool:
         """SB10AD's γ test (job 4: the Riccati conditions of Glover & Doyle 1988 at γ)."""
-        try:
-            self.call(g, 4)
-            return True
-        except SynthesisError as exc:
-            if getattr(exc.__cause__, "info", None) not in (6, 7, 8, 12):
-                raise
+        info = _sb10ad(self.A, self.B, self.C, self.D, self.ncon, self.nmeas, g, 4)[1]
+        if info in (6, 7, 8, 12):
             return False
+        if info:
+            self.call(g, 4)  # raises SynthesisError naming the cause
+        return True
 
     @functools.cached_property
     def parrott_bound(self) -> float:
@@ -463,20 +507,15 @@ class _Sb10:
         (:meth:`riccati_margin`, a number, so the search takes secant steps; two Schur
         forms are cheaper than SB10AD's controller there), checked against SB10AD on the
         ladder's first γ and confirmed by SB10AD at the end. Otherwise, or where SB10AD
-        disagrees, a ladder with SB10AD's test brackets γ_opt and SB10AD's own bisection
-        (job 1) runs from the bracket's top in one call.
+        disagrees, :meth:`_ladder_job1`: SB10AD's test and its own bisection.
 
         Returns ``(hi, lo, tests)``: the smallest admissible γ found, the largest
         inadmissible one (a lower bound of γ_opt; the Parrott bound if none was tried) and
-        the number of γ tests.
+        the number of γ tests (SB10AD calls and Riccati margins).
         """
         lo0 = self.parrott_bound
         g0 = max(1.5 * lo0, 1.0)
-
-        def sb_margin(g):
-            return -1.0 if self.admissible(g) else 1.0
-
-        sb0 = sb_margin(g0)
+        sb0 = -1.0 if self.admissible(g0) else 1.0
         tests = 1
         if self.A.shape[0] > _RICCATI_MIN_STATES:
             ric0 = self.riccati_margin(g0)
@@ -486,32 +525,43 @@ class _Sb10:
                 tests += more + 1
                 if self.admissible(hi):
                     return hi, lo, tests
-        # SB10AD's test: the ladder brackets γ_opt, then SB10AD's own bisection (job 1)
-        # from the bracket's top, in one call
-        hi, lo, more = _search_gamma(sb_margin, lo0, 0.5, {g0: sb0})
-        try:
-            g = float(_sb10ad(self.A, self.B, self.C, self.D, self.ncon, self.nmeas, hi, 1,
-                              gtol=rtol)[0])
-        except Exception:  # noqa: BLE001 - keep the bracket's admissible top
-            g = hi
-        return (g, lo, tests + more + 1) if lo < g <= hi else (hi, lo, tests + more + 1)
+        return self._ladder_job1(lo0, g0, sb0, rtol, tests)
+
+    def _ladder_job1(self, lo0: float, g0: float, sb0: float, rtol: float, tests: int):
+        """γ_opt with SB10AD only: a ladder of factors 4 from ``g0`` (SB10AD's γ test
+        ``sb0`` there) to the first change of admissibility, then SB10AD's bisection (job 1)
+        from the ladder's admissible top in one call (job 1 bisects from 0 to the given γ,
+        whether that γ is admissible or not, so the top is tested first).
+
+        SB10AD's GTOL is absolute in γ (measured: the error of job 1 stays below GTOL
+        whatever the scale of γ_opt): ``rtol·lo``, with lo ≤ γ_opt, keeps the relative
+        tolerance ``rtol``."""
+        hi, lo, more = _search_gamma(lambda g: -1.0 if self.admissible(g) else 1.0,
+                                     lo0, 3.0, {g0: sb0})
+        out, info = _sb10ad(self.A, self.B, self.C, self.D, self.ncon, self.nmeas, hi, 1,
+                            gtol=rtol * lo)
+        g = hi if info else float(out[0])  # on failure keep the bracket's admissible top
+        return (g if lo < g <= hi else hi), lo, tests + more + 1
 
     def controller(self, g: float) -> _Attempt:
         """The controller at γ = g, unscaled, with its closed loop checked stable and its
-        norm recomputed (:func:`hinfnorm`); SynthesisError if SB10AD fails or the loop is
-        unstable."""
+        norm recomputed (AB13DD, as :func:`hinfnorm`); SynthesisError if SB10AD fails or
+        the loop is unstable."""
         out = self.call(g, 4)
         Ak, Bk, Ck, Dk = out[1:5]
         su, sy = self.su, self.sy
         # undo the scaling: u = su ũ, ỹ = sy y
-        Ks = ct.ss(Ak, Bk * sy[None, :], Ck * su[:, None], (Dk * sy[None, :]) * su[:, None])
-        cl = lft_lower(self.P, Ks, self.nmeas, self.ncon)
-        pol = cl.poles()
+        Ks = (Ak, Bk * sy[None, :], Ck * su[:, None], (Dk * sy[None, :]) * su[:, None])
+        try:
+            cl = lft_lower_matrices(self.P0, Ks, self.nmeas, self.ncon)
+        except ModelError as exc:
+            raise SynthesisError(f"hinfsyn: {exc} at γ={g:.6g}") from exc
+        pol = np.linalg.eigvals(cl[0])
         scl = max(1.0, float(np.max(np.abs(pol)))) if pol.size else 1.0
         if pol.size and np.max(pol.real) >= -1e-12 * scl:
             raise SynthesisError(f"hinfsyn: closed loop unstable at γ={g:.6g}")
-        gam, wpk = hinfnorm(cl)
-        return _Attempt(g, Ks, cl, tuple(float(x) for x in out[9]), gam, wpk)
+        gam, wpk = _linfnorm_matrices(*cl)
+        return _Attempt(g, Ks, tuple(float(x) for x in out[9]), gam, wpk)
 
 
 def _backoff_ladder(backoff: float, max_backoff: float) -> list[float]:

@@ -99,6 +99,21 @@ def test_mu_reduction_cost_regression_pin(designs):
     assert red["mu"] <= (1 + MU_REDUCTION_COST_PIN) * red["mu_full"]
 
 
+def test_mu_delivers_the_candidate_with_lower_mu_after_reduction(designs):
+    """Reference: the definition of the delivered controller (issue 11 §3): after the order
+    reduction the μ design keeps, of D–G–K's controller and complex D–K's, the one whose
+    reduced loop has the lower peak μ, and reports both."""
+    mu = designs["mu"]
+    red = mu.reduction
+    cands = red.get("candidates", [])
+    if cands:
+        assert {c["step"] for c in cands} == {"D-K", "D-G-K"}
+        low = min(cands, key=lambda c: c["mu"])
+        assert red["kept"] == low["step"] and red["mu"] == low["mu"]
+        assert all(c["mu_full"] > 0 and c["order"] <= c["order_full"] for c in cands)
+    assert mu.mu == red["mu"]
+
+
 def test_hinf_beats_pid_at_nominal_pressure(designs, plants):
     """P5 §4.4, Fig. 13: H∞ at its design point has a lower σ̄(S_o) peak than the PID."""
     G, _ = plants[2.04]

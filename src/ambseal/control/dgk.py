@@ -269,8 +269,9 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
         The controller with the lowest mixed μ upper bound (on ``blocks`` as given).
         ``history`` has one entry per K-step with ``step`` ``"D-K"`` or ``"D-G-K"`` (the
         latter also ``beta``, the level of its scalings, and ``jg_fit_error``);
-        ``scalings`` holds the fits of the best iteration (D–G–K: ``(d, f, h)`` per block).
-        Without real blocks, complex D–K's result.
+        ``scalings`` holds the fits of the best iteration (D–G–K: ``(d, f, h)`` per block);
+        ``alternatives`` the best complex D–K controller when D–G–K's is better at full
+        order. Without real blocks, complex D–K's result.
 
     Raises
     ------
@@ -318,6 +319,7 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
             break
         K = hr.K
     peak, it_best, K, gamma, curve, fits_best = best
+    alt = () if K is dk.K else ({"step": "D-K", "K": dk.K, "mu": dk.mu, "gamma": dk.gamma},)
     return MusynResult(K=K, mu=peak, mu_omega=float(w[np.argmax(curve)]), mu_curve=curve,
                        omega=w, gamma=gamma, history=tuple(history), best_iteration=it_best,
-                       scalings=fits_best)
+                       scalings=fits_best, alternatives=alt)

@@ -291,6 +291,10 @@ class MusynResult:
     scalings : tuple
         Fitted D scales (``control.TransferFunction``) used for the best K, one per block
         of the complexified structure except the last (performance) block.
+    alternatives : tuple of dict
+        Other candidate controllers worth keeping (D–G–K: the best complex D–K controller,
+        when it is not ``K``), each ``{"step", "K", "mu", "gamma"}``: an order reduction
+        may favour one of them (:func:`ambseal.control.recipes.design`).
     """
 
     K: Any
@@ -302,6 +306,7 @@ class MusynResult:
     history: tuple = ()
     best_iteration: int = 0
     scalings: tuple = field(default=(), repr=False)
+    alternatives: tuple = field(default=(), repr=False)
 
     @property
     def order(self) -> int:

@@ -85,7 +85,9 @@ class DesignResult:
     elapsed_s : float
         Wall time of the synthesis (s).
     reduction : dict or None
-        :class:`~ambseal.control.order.ReductionResult` summary when reduced.
+        :class:`~ambseal.control.order.ReductionResult` summary when reduced; with D–G–K
+        also ``candidates`` (its controller's and complex D–K's μ before and after the
+        reduction) and ``kept`` (the step whose reduced controller has the lower μ).
     plant : GeneralizedPlant or None
         The generalised plant (not serialised).
     design_states : int
@@ -240,7 +242,9 @@ def design(
         ``reduction``. ``"auto"``: ``[design] order_max``, else the design model's states
         plus those of W_p and W_u (on the test rig 28 for μ: the force weight W_f and the
         D and G scales of D–G–K raise the order; with the μ weights before issue 16 to 90
-        states, and truncating to 28 raised μ from 1.115 to 1.136, 1.9 %). ``None``: none.
+        states, and truncating to 28 raised μ from 1.115 to 1.136, 1.9 %). With D–G–K both
+        its controller and complex D–K's are reduced and the one with the lower μ is
+        delivered. ``None``: none.
     max_iter, dk_order : int, optional
         D–K iterations and D-scale fit order (μ only); the specification's if omitted.
     allow_unstable : bool
@@ -368,29 +372,60 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
         K_P, gamma, mu, hist = r.K, float(r.gamma), float(r.mu), r.history
         P_red, blocks, mu_omega = gp.P, gp.blocks, float(r.mu_omega)
     order_full = int(K_P.nstates)
-    auto = reduce_to == "auto"
-    if auto:
+    if reduce_to == "auto":
         reduce_to = sp.order_max or (gp.design_plant.A.shape[0]
                                      + gp.ncon * (gp.Wp.nstates + gp.Wu.nstates))
+        auto = not sp.order_max
+    else:
+        auto = False
     red = None
-    while reduce_to is not None and reduce_to < order_full:
-        from .order import reduce_controller
-
-        rr = reduce_controller(P_red, K_P, int(reduce_to), gp.nmeas, gp.ncon,
-                               blocks=blocks, omega=om if method == "mu" else None)
-        if np.isfinite(rr.gamma):
-            K_P, red = rr.K, rr.to_dict()
-            red.pop("hsv", None)
-            gamma = float(rr.gamma) if method == "hinf" else gamma
-            mu = float(rr.mu) if rr.mu is not None else mu
-            break
-        if not auto or sp.order_max:
-            raise SynthesisError(
-                f"design: the order-{reduce_to} controller does not stabilise the design loop "
-                f"(full order {order_full}); set a larger design.order_max")
-        reduce_to += gp.ncon  # the automatic order: one more state per control channel
+    if reduce_to is not None and reduce_to < order_full:
+        cands = [{"step": hist[r.best_iteration].get("step", "D-K") if hist else "H-inf",
+                  "K": K_P, "mu": mu, "gamma": gamma}]
+        cands += list(getattr(r, "alternatives", ()) if method == "mu" else ())
+        K_P, red, gamma, mu = _reduce_best(P_red, cands, int(reduce_to), auto, gp, blocks,
+                                           om if method == "mu" else None)
+        order_full = red["order_full"]
     K = gp.physical_controller(K_P, name=f"K_{method}")
     return _Synthesis(K, gamma, mu, tuple(hist), order_full, red, gp, K_P, mu_omega)
+
+
+def _reduce_best(P, cands, order: int, auto: bool, gp, blocks, omega):
+    """Balanced truncation of each candidate controller (:func:`reduce_controller`); the
+    one with the lowest μ after reduction (γ for H∞) is kept. ``cands``: dicts ``{"step",
+    "K", "mu", "gamma"}`` (D–G–K's controller and complex D–K's may swap places: the
+    D–G–K one has more states and can lose more in the truncation). With ``auto`` the order
+    steps up by one state per control channel until the reduced loop is stable.
+
+    Returns ``(K, reduction dict, γ, μ)`` of the kept candidate; the dict lists every
+    candidate's μ before and after (``candidates``) and the kept one (``kept``)."""
+    from .order import reduce_controller
+
+    rows, best = [], None
+    for c in cands:
+        n = order
+        while True:
+            rr = reduce_controller(P, c["K"], min(n, int(c["K"].nstates)), gp.nmeas, gp.ncon,
+                                   blocks=blocks, omega=omega)
+            if np.isfinite(rr.gamma) or not auto or n >= c["K"].nstates:
+                break
+            n += gp.ncon
+        score = rr.mu if rr.mu is not None else rr.gamma
+        rows.append({"step": c["step"], "order_full": rr.order_full, "order": rr.order,
+                     "mu_full": rr.mu_full, "mu": rr.mu, "gamma": rr.gamma})
+        if np.isfinite(rr.gamma) and (best is None or score < best[0]):
+            best = (score, rr, c)
+    if best is None:
+        raise SynthesisError(
+            f"design: the order-{order} controller does not stabilise the design loop "
+            f"(full order {cands[0]['K'].nstates}); set a larger design.order_max")
+    _, rr, c = best
+    red = rr.to_dict()
+    red.pop("hsv", None)
+    if len(rows) > 1:
+        red.update(candidates=rows, kept=c["step"])
+    gamma = float(rr.gamma) if rr.mu is None else float(c["gamma"])
+    return rr.K, red, gamma, (float(rr.mu) if rr.mu is not None else None)
 
 
 def _top_mode_hz(cfg, p: float, n: int) -> float:

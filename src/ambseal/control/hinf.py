@@ -34,6 +34,7 @@ import control as ct
 
 from ambseal.errors import ConfigError, ModelError, SynthesisError
 from ambseal.control._hinf_gamma import game_riccati as _game_riccati
+from ambseal.control._hinf_gamma import sb10ad as _sb10ad
 from ambseal.control._hinf_gamma import search_gamma as _search_gamma
 from ambseal.lti.interconnect import lft_lower, lft_lower_matrices
 
@@ -283,50 +284,6 @@ def _scale(A, B, C, D, nw, nz):
     C[nz:] *= sy[:, None]
     D[nz:] *= sy[:, None]
     return A, B, C, D, t, su, sy
-
-
-def _sb10ad_workspace(n, m, p, ncon, nmeas):
-    """(liwork, ldwork) of SLICOT SB10AD: the minimal sizes of its documentation (SLICOT
-    5.x, SB10AD, arguments LIWORK and LDWORK), as slycot's wrapper computes them."""
-    m2, np2 = ncon, nmeas
-    m1, np1 = m - m2, p - np2
-    nd1, nd2 = np1 - m2, m1 - np2
-    lw1 = n * m + p * n + p * m + m2 * m2 + np2 * np2
-    lw2 = max((n + np1 + 1) * (n + m2) + max(3 * (n + m2) + n + np1, 5 * (n + m2)),
-              (n + np2) * (n + m1 + 1) + max(3 * (n + np2) + n + m1, 5 * (n + np2)),
-              m2 + np1 * np1 + max(np1 * max(n, m1), 3 * m2 + np1, 5 * m2),
-              np2 + m1 * m1 + max(max(n, np1) * m1, 3 * np2 + m1, 5 * np2))
-    lw3 = max(nd1 * m1 + max(4 * min(nd1, m1) + max(nd1, m1), 6 * min(nd1, m1)),
-              np1 * nd2 + max(4 * min(np1, nd2) + max(np1, nd2), 6 * min(np1, nd2)))
-    lw4 = 2 * m * m + p * p + 2 * m * n + m * p + 2 * n * p
-    lw5 = 2 * n * n + m * n + n * p
-    lw6 = max(m * m + max(2 * m1, 3 * n * n + max(n * m, 10 * n * n + 12 * n + 5)),
-              p * p + max(2 * np1, 3 * n * n + max(n * p, 10 * n * n + 12 * n + 5)))
-    lw7 = m2 * np2 + np2 * np2 + m2 * m2 + max(
-        nd1 * nd1 + max(2 * nd1, (nd1 + nd2) * np2), nd2 * nd2 + max(2 * nd2, nd2 * m2), 3 * n,
-        n * (2 * np2 + m2) + max(2 * n * m2, m2 * np2 + max(m2 * m2 + 3 * m2,
-                                                            np2 * (2 * np2 + m2 + max(np2, n)))))
-    liwork = max(2 * max(n, m1, np1, ncon, nmeas), n * n)
-    return liwork, lw1 + max(1, lw2, lw3, lw4, lw5 + max(lw6, lw7))
-
-
-def _sb10ad(A, B, C, D, ncon, nmeas, gamma, job, gtol=1e-6):
-    """SLICOT SB10AD through slycot's compiled wrapper: ``(outputs, info)``.
-
-    slycot's Python function turns every ``info ≠ 0`` into an exception whose message it
-    builds by parsing the routine's docstring (about 1 ms, more than SB10AD itself on a
-    small plant, and an inadmissible γ is half of a γ search); the wrapper returns ``info``.
-    job 1: bisection only (the scan of job 2/3 can take seconds and adds nothing here,
-    since every γ is verified afterwards), to an absolute tolerance ``gtol`` in γ; job 4:
-    the γ test and controller at ``gamma``.
-    """
-    from slycot import _wrapper
-
-    n, m, p = A.shape[0], B.shape[1], C.shape[0]
-    liwork, ldwork = _sb10ad_workspace(n, m, p, ncon, nmeas)
-    out = _wrapper.sb10ad(job, n, m, p, ncon, nmeas, gamma, A, B, C, D, gtol, 0.0,
-                          liwork, ldwork)
-    return out[:-1], int(out[-1])
 
 
 def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | None = None,

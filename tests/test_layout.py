@@ -19,7 +19,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "ambseal"
 RANK = {"errors": 0, "files": 0, "lti": 1, "config": 2, "config_checks": 2,
         "config_design": 2, "model": 3,
         "identify": 4, "control": 5, "analysis": 6, "io": 6, "report": 7, "commands": 8,
-        "pipeline": 8, "rotordynamics": 8,
+        "pipeline": 8, "rotordynamics": 8, "tracked": 8,
         "cli": 9}
 
 

@@ -20,7 +20,7 @@ from .files import writable_folder, write_json, write_text
 __all__ = ["Identified", "identification_stage", "facility_impulses", "design_files",
            "identify_files", "export_design", "show_defaults",
            "validate_summary", "track_files", "export_all", "digital_for", "choice_margins",
-           "frozen_discrete", "judged_margins", "digitals_for"]
+           "frozen_discrete", "frozen_at", "judge_jobs", "judged_margins", "digitals_for"]
 
 
 def _finite(x: float) -> float | None:
@@ -130,6 +130,28 @@ def choice_margins(cfg, points, digital) -> list[dict]:
             for p, f, z, sd, sc in zip(pressures, speeds, c["max_abs_z"],
                                        c["sensitivity_peak"],
                                        c["sensitivity_peak_continuous"])]
+
+
+def frozen_at(K, point, design_cfg):
+    """The fixed controller that runs at ``point`` (with ``speed_rpm`` and ``pressure_bar``:
+    an OperatingPoint, or the rig's ``[operating]``): ``K``, a speed-scheduled one at the
+    speed, or one scheduled on a seal coefficient at the design rig's value at the pressure
+    drop (:func:`ambseal.control.controller.frozen`)."""
+    from .control.controller import frozen
+    from .model.seal import seal_values
+
+    return frozen(K, 2 * math.pi * point.speed_rpm / 60.0,
+                  seal_values(design_cfg.seal, point.pressure_bar))
+
+
+def judge_jobs(designs, digitals: dict, points, design_cfg) -> list[dict]:
+    """``ambseal run``'s cases: every design at every judged point, frozen there
+    (:func:`frozen_at`), with the delayed discrete controller that runs
+    (:func:`frozen_discrete`), for :func:`ambseal.analysis.judge.judge_case`."""
+    return [{"name": d.method, "point": p, "controller": frozen_at(d.controller, p, design_cfg),
+             "discrete": frozen_discrete(digitals.get(d.method),
+                                         2 * math.pi * p.speed_rpm / 60.0)}
+            for d in designs for p in points]
 
 
 def frozen_discrete(digital, speed_rad_s: float):

@@ -46,6 +46,13 @@ schema). Units are SI except where the key names its unit.
     ``[design.mu]`` also ``max_iter`` and ``dk_order`` (D–K iterations, D-scale fit order)
     and ``iteration``: ``"dgk"`` (default: D–G–K, the real parameters kept real in the
     synthesis, Young 1996) or ``"dk"`` (complex D–K, every block treated as complex).
+``[design] tracked`` (bool, default false)
+    ``ambseal run`` adds the ``tracked`` controller (issue 14): scheduled on the first
+    seal's k as tracked on line (:mod:`ambseal.control.seal_schedule`), judged at the
+    judged pressures frozen at the identified k there, and run on the virtual facility's
+    0 → 3× nominal pressure ramp with the other controllers and the tracker
+    (:mod:`ambseal.analysis.ramp`). Off by default: its LMI synthesis takes minutes
+    (≈ 75 s of CPU on the test rig; cached in ``$AMBSEAL_CACHE_DIR``) and the ramp ≈ 20 s.
 """
 
 from __future__ import annotations
@@ -168,6 +175,7 @@ class Design(_Strict):
     hinf: MethodSpec = MethodSpec()
     mu: MuSpec = MuSpec()
     lpv: MethodSpec = MethodSpec()
+    tracked: bool = False
 
     @model_validator(mode="after")
     def _keys(self) -> "Design":
@@ -191,7 +199,8 @@ def check_design_names(cfg) -> str | None:
 
     Checks ``unbalance.force_at`` against the names of the rig's seals, disks, AMBs and
     springs, and the owner of each uncertain parameter (the part before the last '.')
-    against the seals, AMBs and springs (a spring without a name is ``spring<i>``).
+    against the seals, AMBs and springs (a spring without a name is ``spring<i>``), and
+    that ``tracked`` has a seal whose k is affine in the pressure drop.
     """
     d = cfg.design
     parts = {s.name for s in cfg.seal} | {a.name for a in cfg.amb} | {
@@ -201,6 +210,9 @@ def check_design_names(cfg) -> str | None:
     if at is not None and at not in known:
         return (f"design.unbalance.force_at: no component named {at!r} (expected one of: "
                 f"{', '.join(sorted(known)) or 'none'})")
+    if d.tracked and not any(getattr(s.k, "per_bar", 0.0) for s in cfg.seal):
+        return ("design.tracked: expected a [[seal]] whose k follows the pressure drop "
+                "(k = { at_zero = ..., per_bar = ... }, per_bar ≠ 0) to schedule on")
     for i, u in enumerate(d.uncertainty or ()):
         owner = u.parameter.rpartition(".")[0]
         if owner not in parts:

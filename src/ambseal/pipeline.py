@@ -8,7 +8,6 @@ a temporary name and a rename.
 
 from __future__ import annotations
 
-import math
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -143,10 +142,10 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                                  speed_scheduled, unstable_open_loop_poles)
     from .analysis.sweep import run_cases
     from .control.specs import design_spec
-    from .commands import (digitals_for, export_all, facility_impulses, frozen_discrete,
-                           identification_stage)
-    from .control.controller import frozen
+    from .commands import (digitals_for, export_all, facility_impulses, frozen_at,
+                           identification_stage, judge_jobs)
     from .model.rig import build_plant
+    from .tracked import tracked_designs, tracked_ramp
     from .report.progress import StageProgress
     from .report.run_report import (gains_figure, rig_clearances_um, spinup_figures, stamp,
                                     write_run_report)
@@ -167,8 +166,10 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
     settings = judge_settings(cfg, spec)
     final = Path(out_dir)
     n_designs = (2 + (cfg.controller.pid is not None)) if speed_scheduled(cfg) else 3
-    totals = {"model": 1, "design": n_designs, "judge": n_designs * len(points),
-              "identification": None, "design (identified)": 2, "spin-up": 1, "report": 1}
+    n_tr = int(cfg.design.tracked)  # issue 14, off by default: minutes of LMI synthesis
+    totals = {"model": 1, "design": n_designs, "judge": (n_designs + n_tr) * len(points),
+              "identification": None, "design (identified)": 2 + n_tr, "spin-up": 1,
+              "ramp": 1, "report": 1}
     # one run = one folder: written into a staging folder that replaces out_dir at the end
     with RunFolder(final) as out, \
             StageProgress(totals, display=progress and sys.stderr.isatty()) as stages:
@@ -203,11 +204,10 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
             cannot_run.update(more_cannot)
             designs += robust
             facility_impulses(cfg, truth_cfg, ident, digitals, out)
+        design_cfg = cfg if ident is None else ident.design_cfg
+        designs += tracked_designs(cfg, design_cfg, say, cannot_run)  # [design] tracked
         stages.begin("judge")
-        jobs = [{"name": d.method, "point": p, "controller": frozen(d.controller, w),
-                 "discrete": frozen_discrete(digitals.get(d.method), w)}
-                for d in designs for p in points
-                for w in (2 * math.pi * p.speed_rpm / 60.0,)]
+        jobs = judge_jobs(designs, digitals, points, design_cfg)
         judged = run_cases(judge_case, jobs, shared={"cfg": judge_cfg, "settings": settings},
                            workers=1, raise_errors=True,
                            on_done=lambda i, r: stages.step(f"{jobs[i]['name']} at "
@@ -235,10 +235,15 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                 cfg, {d.method: d.controller for d in designs})
             figs += spinup_figures(out, sims, sens, cfg.operating.speed_range_hz)
             stages.step()
+        if cfg.design.tracked and truth_cfg is not None:
+            stages.begin("ramp", "0 → 3× nominal pressure on the virtual facility")
+            metrics["ramp"], fig = tracked_ramp(cfg, truth_cfg, designs, digitals, ident, out,
+                                                say)
+            figs.append(fig)
         stages.begin("report")
         write_json(out / "metrics.json", metrics)
-        speed = 2 * math.pi * cfg.operating.speed_rpm / 60.0
-        figs.append(gains_figure(out, [(d.method, frozen(d.controller, speed)) for d in designs]))
+        figs.append(gains_figure(out, [(d.method, frozen_at(d.controller, cfg.operating,
+                                                            design_cfg)) for d in designs]))
         write_run_report(out, f"ambseal — {cfg.rotor.name}", stamp(rig_path, command),
                          metrics, curves, figs, sections, rig_clearances_um(cfg))
         stages.step()

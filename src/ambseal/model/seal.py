@@ -23,8 +23,7 @@ from .lft import Channel
 from .rotor import X, Y, Mesh
 
 __all__ = ["COEFFICIENTS", "interp_table", "coefficient_value", "seal_coefficients",
-           "values_following_k",
-           "SealElement"]
+           "seal_values", "values_following_k", "SealElement"]
 
 COEFFICIENTS = ("K", "k", "C", "c", "M")
 """The seal coefficients in Childs' convention, in the order of the rig file."""
@@ -113,6 +112,16 @@ def seal_coefficients(seal: Seal, pressure_bar: float,
     """
     return {n: coefficient_value(getattr(seal, n), pressure_bar, frequency_hz)
             for n in COEFFICIENTS}
+
+
+def seal_values(seals, pressure_bar: float) -> dict[str, float]:
+    """Every constant or pressure-dependent coefficient of every seal at a pressure drop
+    (bar), by LFT name (``"<seal>.K"``, ...; SI): e.g. the value a controller scheduled on
+    a seal coefficient is frozen at for a judged condition. Tabulated coefficients (they
+    need a frequency) are left out."""
+    return {f"{s.name}.{n}": coefficient_value(getattr(s, n), pressure_bar)
+            for s in seals for n in COEFFICIENTS
+            if not isinstance(getattr(s, n), FrequencyTable)}
 
 
 def values_following_k(seals, name: str, value: float, known) -> dict[str, float]:

@@ -228,3 +228,12 @@ def test_validate_and_modes_default_to_the_embedded_rig(capsys):
     assert main(["validate"]) == 0
     text = capsys.readouterr().out
     assert "valid" in text and "unstable open-loop poles" in text and "None" not in text
+
+
+def test_tracked_without_a_pressure_driven_seal_k_exits_2_with_one_line(capsys):
+    """``[design] tracked`` schedules on a seal's k affine in the pressure drop; the
+    turboexpander's seal coefficients are tables against frequency: refused on reading."""
+    assert main(["design", "examples/turboexpander.toml", "--show-defaults", "--set",
+                 "design.tracked=true"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "design.tracked" in err and "per_bar" in err and "\n" not in err

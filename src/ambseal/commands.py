@@ -20,7 +20,7 @@ from .files import writable_folder, write_json, write_text
 __all__ = ["Identified", "identification_stage", "facility_impulses", "design_files",
            "identify_files", "export_design", "show_defaults",
            "validate_summary", "track_files", "export_all", "digital_for", "choice_margins",
-           "frozen_discrete", "frozen_at", "judge_jobs", "judged_margins", "digitals_for"]
+           "judged_margins", "digitals_for"]
 
 
 def _finite(x: float) -> float | None:
@@ -33,8 +33,9 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
     plants at the judged conditions (:mod:`ambseal.control.digital`): a
     :class:`~ambseal.control.digital.DigitalController`, or for a scheduled controller a
     :class:`~ambseal.control.scheduled_digital.ScheduledDigital` whose interpolation is
-    also checked at speeds between table entries. ``cache`` (a dict kept by the caller)
-    shares the sampled plants between the controllers of one rig."""
+    also checked between table entries (at speeds, or at the pressures that give the seal
+    coefficient it is scheduled on). ``cache`` (a dict kept by the caller) shares the
+    sampled plants between the controllers of one rig."""
     import numpy as np
 
     from .control.controller import ScheduledController
@@ -64,16 +65,25 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
                                   delay_samples=delay, rise=rise)
     from .control.controller import SPEED
     from .control.scheduled_digital import scheduled_digital
+    from .model.seal import pressure_for_k, seal_values
 
-    if controller.parameter != SPEED:
-        raise ConfigError(f"{method}: a controller scheduled on {controller.parameter!r} "
-                          "has no digital table yet (only speed-scheduled ones)")
-    W = np.asarray(controller.K.speeds_rad_s, float)
+    W = np.asarray(controller.K.speeds_rad_s, float)  # the LPV table's θ (speeds or SI)
     # between table entries at 1/8, 3/8, 5/8, 7/8 of the table: the interpolation judged
     mids = [(W[j] + W[j + 1]) / 2 for j in (np.arange(1, 8, 2) * (W.size - 1)) // 8]
-    speeds = [2 * math.pi * c[1] / 60.0 for c in conds] + mids
-    plants = [(w, plant(cfg.operating.pressure_bar, 60.0 * w / (2 * math.pi)))
-              for w in speeds]
+    if controller.parameter == SPEED:
+        speeds = [2 * math.pi * c[1] / 60.0 for c in conds] + mids
+        plants = [(w, plant(cfg.operating.pressure_bar, 60.0 * w / (2 * math.pi)))
+                  for w in speeds]
+    else:  # a seal's k: the judged pressures and those that give the θ between entries
+        if pressure_for_k(cfg.seal, controller.parameter, 0.0) is None:
+            raise ConfigError(f"{method}: no digital table for a controller scheduled on "
+                              f"{controller.parameter!r}: only on a seal's k affine in the "
+                              "pressure drop")
+        conds = [(p, cfg.operating.speed_rpm) for p in dict.fromkeys(
+            [c[0] for c in conds] + [pressure_for_k(cfg.seal, controller.parameter, th)
+                                     for th in mids])]
+        plants = [(seal_values(cfg.seal, p)[controller.parameter], plant(p, rpm))
+                  for p, rpm in conds]
     return scheduled_digital(controller, W, fs, plants, delay_samples=delay,
                              name=f"K_{method}")
 
@@ -130,40 +140,6 @@ def choice_margins(cfg, points, digital) -> list[dict]:
             for p, f, z, sd, sc in zip(pressures, speeds, c["max_abs_z"],
                                        c["sensitivity_peak"],
                                        c["sensitivity_peak_continuous"])]
-
-
-def frozen_at(K, point, design_cfg):
-    """The fixed controller that runs at ``point`` (with ``speed_rpm`` and ``pressure_bar``:
-    an OperatingPoint, or the rig's ``[operating]``): ``K``, a speed-scheduled one at the
-    speed, or one scheduled on a seal coefficient at the design rig's value at the pressure
-    drop (:func:`ambseal.control.controller.frozen`)."""
-    from .control.controller import frozen
-    from .model.seal import seal_values
-
-    return frozen(K, 2 * math.pi * point.speed_rpm / 60.0,
-                  seal_values(design_cfg.seal, point.pressure_bar))
-
-
-def judge_jobs(designs, digitals: dict, points, design_cfg) -> list[dict]:
-    """``ambseal run``'s cases: every design at every judged point, frozen there
-    (:func:`frozen_at`), with the delayed discrete controller that runs
-    (:func:`frozen_discrete`), for :func:`ambseal.analysis.judge.judge_case`."""
-    return [{"name": d.method, "point": p, "controller": frozen_at(d.controller, p, design_cfg),
-             "discrete": frozen_discrete(digitals.get(d.method),
-                                         2 * math.pi * p.speed_rpm / 60.0)}
-            for d in designs for p in points]
-
-
-def frozen_discrete(digital, speed_rad_s: float):
-    """The discrete controller (delay included) that runs at Ω, for the judgement;
-    ``None`` for a controller that cannot run (``digital`` None)."""
-    from .control.scheduled_digital import ScheduledDigital
-
-    if digital is None:
-        return None
-    if isinstance(digital, ScheduledDigital):
-        return digital.statespace_at(speed_rad_s, delayed=True)
-    return digital.statespace(delayed=True)
 
 
 def export_design(method: str, digital, summary_dict: dict, out: Path, judged=None

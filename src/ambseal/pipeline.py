@@ -138,12 +138,12 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         A controller that does not stabilise the full-order plant (without
         ``allow_unstable``).
     """
-    from .analysis.judge import (judge_case, judge_settings, judge_spinup, operating_points,
-                                 speed_scheduled, unstable_open_loop_poles)
+    from .analysis.judge import (frozen_at, judge_case, judge_jobs, judge_settings,
+                                 judge_spinup, operating_points, speed_scheduled,
+                                 unstable_open_loop_poles)
     from .analysis.sweep import run_cases
     from .control.specs import design_spec
-    from .commands import (digitals_for, export_all, facility_impulses, frozen_at,
-                           identification_stage, judge_jobs)
+    from .commands import digitals_for, export_all, facility_impulses, identification_stage
     from .model.rig import build_plant
     from .tracked import tracked_designs, tracked_ramp
     from .report.progress import StageProgress
@@ -205,7 +205,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
             designs += robust
             facility_impulses(cfg, truth_cfg, ident, digitals, out)
         design_cfg = cfg if ident is None else ident.design_cfg
-        designs += tracked_designs(cfg, design_cfg, say, cannot_run)  # [design] tracked
+        designs += tracked_designs(cfg, design_cfg, points, say, digitals, cannot_run)
         stages.begin("judge")
         jobs = judge_jobs(designs, digitals, points, design_cfg)
         judged = run_cases(judge_case, jobs, shared={"cfg": judge_cfg, "settings": settings},

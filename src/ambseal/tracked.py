@@ -15,18 +15,15 @@ from pathlib import Path
 
 from .errors import ConfigError
 
-__all__ = ["tracked_designs", "tracked_ramp", "NO_TABLE"]
-
-#: Why the tracked controller is judged continuous only (no digital table for a controller
-#: scheduled on a seal coefficient yet).
-NO_TABLE = ("tracked cannot run on the target yet, judged as designed (continuous) only: "
-            "no digital table for a controller scheduled on a seal coefficient")
+__all__ = ["tracked_designs", "tracked_ramp"]
 
 
-def tracked_designs(cfg, design_cfg, say, cannot_run: dict) -> list:
+def tracked_designs(cfg, design_cfg, points, say, digitals: dict, cannot_run: dict) -> list:
     """``[design] tracked``: ``[]`` when off, else the tracked controller as a design of the
-    main job (``pipeline.Designed``), designed on ``design_cfg``; ``cannot_run`` gets the
-    reason it is judged continuous only (:data:`NO_TABLE`).
+    main job (``pipeline.Designed``), designed on ``design_cfg``, with its digital table
+    (:func:`ambseal.commands.digitals_for`: discretisation chosen on the sampled full-order
+    loops with the target's delay at the judged pressures and between table entries) put
+    in ``digitals``, or the reason it cannot run in ``cannot_run``.
 
     Raises
     ------
@@ -35,6 +32,7 @@ def tracked_designs(cfg, design_cfg, say, cannot_run: dict) -> list:
         or that has no seal.
     """
     from .analysis.judge import speed_scheduled
+    from .commands import digitals_for
     from .control.seal_schedule import design_seal_scheduled
     from .pipeline import Designed
 
@@ -47,8 +45,11 @@ def tracked_designs(cfg, design_cfg, say, cannot_run: dict) -> list:
     say("designing tracked (LPV on the seal's k; minutes unless cached)", 0)
     d = design_seal_scheduled(design_cfg)
     say("tracked designed", 1)
-    cannot_run["tracked"] = NO_TABLE
-    return [Designed("tracked", d, d.to_dict(), d)]
+    out = [Designed("tracked", d, d.to_dict(), d)]
+    more, cannot = digitals_for(design_cfg, out, points, lambda m: say(m, 0))
+    digitals.update(more)
+    cannot_run.update(cannot)
+    return out
 
 
 def tracked_ramp(cfg, truth, designs, digitals: dict, ident, out: Path, say
@@ -62,6 +63,8 @@ def tracked_ramp(cfg, truth, designs, digitals: dict, ident, out: Path, say
     tracked = next(d.controller for d in designs if d.method == "tracked")
     fixed = {m: g.discrete for m, g in digitals.items() if m != "tracked"}
     r = ramp_simulation(cfg, truth, fixed, tracked, model_cfg=ident.result.identified,
+                        tracked_digital=digitals.get("tracked"),
+                        delay_samples=cfg.controller.delay_samples,
                         progress=lambda line: say(line, 0))
     t = r.tracking
     caption = (f"Pressure ramp 0 → {r.pressure_bar.max():.3g} bar in {r.time_s[-1]:.0f} s on "

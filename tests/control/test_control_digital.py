@@ -217,7 +217,7 @@ def test_export_round_trip_scheduled(turbo_lpv, turbo_digital, tmp_path, suffix)
     sd = turbo_digital["lpv"]
     back = load_controller(export_controller(sd, tmp_path / f"K{suffix}"))
     assert isinstance(back, ScheduledController)
-    W = sd.speeds_rad_s
+    W = sd.grid
     for w in (W[0], 0.3 * W[3] + 0.7 * W[4], W[-1]):
         for X, Y in zip(back.matrices_at(w), turbo_lpv.matrices_at(w)):
             np.testing.assert_allclose(X, Y, rtol=1e-12, atol=1e-12 * np.abs(Y).max())
@@ -239,7 +239,7 @@ def test_scheduled_c_interpolates_like_python(turbo_digital, tmp_path):
     n = 10_000
     rng = np.random.default_rng(3)
     y = 1e-6 * rng.standard_normal((n, len(sd.inputs)))
-    W = sd.speeds_rad_s
+    W = sd.grid
     speeds = np.linspace(0.9 * W[0], 1.1 * W[-1], n)
     x = np.zeros(sd.discrete[0].shape[1])
     ref = np.empty((n, len(sd.outputs)))

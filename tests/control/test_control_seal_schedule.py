@@ -67,3 +67,94 @@ def test_tracked_design_stable_in_zone_a_on_the_full_order_plant(testrig_cfg, te
     assert all(c["stable"] for c in cases)
     worst = max(max(c["sensitivity_peak_per_axis"].values()) for c in cases)
     assert worst <= 3.0
+
+
+@pytest.mark.slow
+def test_tracked_digital_table_stable_with_the_target_delay(testrig_cfg, testrig_tracked):
+    """Issue 14 (§2: exported like every scheduled controller): the tracked controller's
+    digital table (:func:`ambseal.commands.digital_for`: the method chosen on the sampled
+    full-order loops with the target's delay at the judged pressures and between table
+    entries). Reference: python-control, side by side — the full-order plant sampled by
+    ``sample_system`` (ZOH) in negative feedback with the delayed, interpolated table at
+    k = 0.3, 1.7 and 2.6× nominal (pressures the choice did not check): every closed-loop
+    pole inside the unit circle."""
+    import control
+
+    from ambseal.analysis.judge import operating_points
+    from ambseal.commands import digital_for
+    from ambseal.model.rig import build_plant
+    from ambseal.model.seal import pressure_for_k
+
+    cfg, d = testrig_cfg, testrig_tracked
+    sd = digital_for(cfg, "tracked", d, d, operating_points(cfg))
+    assert sd.parameter == "seal.k" and sd.delay_samples == cfg.controller.delay_samples
+    k_nom = d.grid[-1] / 3.0
+    for f in (0.3, 1.7, 2.6):
+        pl = build_plant(cfg, pressure_bar=pressure_for_k(cfg.seal, "seal.k", f * k_nom))
+        G = pl.select_inputs([pl.input_names[j] for j in pl.current_inputs()]).to_statespace()
+        Gd = control.sample_system(G, sd.Ts, method="zoh")
+        loop = control.feedback(Gd, sd.statespace_at(f * k_nom, delayed=True))
+        assert np.max(np.abs(loop.poles())) < 1.0, f
+
+
+def _seal_table(d):
+    """A ScheduledDigital on seal.k from ``d`` by hand: its physical matrices at θ = 0, 1,
+    2 MN/m and their ZOH equivalents at 10 kHz (what ``scheduled_digital`` tabulates once it
+    has chosen the method)."""
+    from ambseal.control.digital import discretize_as
+    from ambseal.control.scheduled_digital import ScheduledDigital
+
+    g = np.array([0.0, 1e6, 2e6])
+    cont = [d.matrices_at(t) for t in g]
+    disc = [discretize_as(m, 1e-4, "zoh") for m in cont]
+    st = [tuple(np.stack([m[i] for m in seq]) for i in range(4)) for seq in (cont, disc)]
+    return ScheduledDigital(g, st[0], st[0], st[1], ("y_A_zeta",), ("i_A_zeta",), "zoh",
+                            None, 1e4, 1, (), (), "K_tracked", "seal.k")
+
+
+@pytest.mark.parametrize("suffix", [".json", ".npz", ".mat"])
+def test_seal_scheduled_table_export_round_trip(tmp_path, suffix):
+    """Reference: the design's own scheduling law (linear in θ between its entries, the
+    hand-checked interpolation above) and the exported discrete table: read back by
+    load_controller, the table is still scheduled on seal.k over the same grid, its
+    continuous law equals the design at θ = 0.5 MN/m (between entries) and its discrete
+    controller at θ equals the exported one entry by entry; the interpolation law written
+    into the file names seal.k."""
+    from ambseal.control.export import export_controller, load_controller
+
+    d = _two_entry_design()
+    sd = _seal_table(d)
+    back = load_controller(export_controller(sd, tmp_path / f"K{suffix}"))
+    assert back.parameter == "seal.k" and back.schedule == (0.0, 2e6)
+    assert "seal.k" in back.interpolation
+    for X, Y in zip(back.matrices_at(0.5e6), d.matrices_at(0.5e6)):
+        np.testing.assert_allclose(X, Y, rtol=1e-12)
+    d0, d1 = back.discrete_at(1.3e6), sd.discrete_at(1.3e6)
+    for k in "ABCD":
+        np.testing.assert_array_equal(getattr(d0, k), getattr(d1, k))
+    with pytest.raises(ModelError, match="seal.k"):
+        frozen(back, 100.0)  # not silently frozen at a speed
+
+
+def test_seal_scheduled_c_interpolates_on_theta_like_python(tmp_path):
+    """Reference: ScheduledDigital.discrete_at run sample by sample while θ sweeps from
+    below the table to above it (1 000 samples of a random sensor signal): the generated C
+    module, called with θ in place of the speed, gives the same currents within 1e-9 of
+    their peak."""
+    from ambseal.control.codegen import write_c
+
+    from .test_control_digital import _compile_and_run
+
+    sd = _seal_table(_two_entry_design())
+    n = 1000
+    y = 1e-6 * np.random.default_rng(4).standard_normal((n, 1))
+    theta = np.linspace(-0.2e6, 2.2e6, n)
+    x, ref = np.zeros(1), np.empty((n, 1))
+    for k in range(n):
+        dk = sd.discrete_at(theta[k])
+        ref[k] = -(dk.C @ x + dk.D @ y[k])
+        x = dk.A @ x + dk.B @ y[k]
+    files = write_c(sd, tmp_path / "c", "amb_tracked")
+    assert "theta = seal.k" in files[0].read_text()
+    got = _compile_and_run(tmp_path, files, "amb_tracked", y, "double", speeds=theta)
+    assert np.max(np.abs(got - ref)) < 1e-9 * np.max(np.abs(ref))

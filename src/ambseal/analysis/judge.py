@@ -32,7 +32,8 @@ import numpy as np
 
 __all__ = ["JudgeSettings", "OperatingPoint", "judge", "judge_case", "judge_spinup",
            "sampled_plant", "operating_points", "speed_scheduled", "judge_settings",
-           "unstable_open_loop_poles"]
+           "unstable_open_loop_poles", "condition_values", "frozen_at", "frozen_discrete",
+           "judge_jobs"]
 
 
 @dataclass(frozen=True)
@@ -312,6 +313,50 @@ def _judge_loop(cfg, P, cur, force, controller, s: JudgeSettings, impulse: bool
         impulse_settling_s=_finite(imp.settling_time_s),
     )
     return case, curves
+
+
+def condition_values(point, design_cfg) -> tuple[float, dict]:
+    """(Ω in rad/s, every seal coefficient of the design rig by LFT name, SI) at ``point``
+    (with ``speed_rpm`` and ``pressure_bar``: an OperatingPoint, or the rig's
+    ``[operating]``): the values a scheduled controller is frozen at there."""
+    from ..model.seal import seal_values
+
+    return (2 * math.pi * point.speed_rpm / 60.0,
+            seal_values(design_cfg.seal, point.pressure_bar))
+
+
+def frozen_at(K, point, design_cfg):
+    """The fixed controller that runs at ``point``: ``K``, a speed-scheduled one at the
+    speed, or one scheduled on a seal coefficient at the design rig's value at the pressure
+    drop (:func:`ambseal.control.controller.frozen`, :func:`condition_values`)."""
+    from ..control.controller import frozen
+
+    return frozen(K, *condition_values(point, design_cfg))
+
+
+def judge_jobs(designs, digitals: dict, points, design_cfg) -> list[dict]:
+    """``ambseal run``'s cases: every design at every judged point, frozen there
+    (:func:`frozen_at`), with the delayed discrete controller that runs
+    (:func:`frozen_discrete`), for :func:`judge_case`."""
+    return [{"name": d.method, "point": p, "controller": frozen_at(d.controller, p, design_cfg),
+             "discrete": frozen_discrete(digitals.get(d.method), p, design_cfg)}
+            for d in designs for p in points]
+
+
+def frozen_discrete(digital, point, design_cfg):
+    """The discrete controller (delay included) that runs at ``point`` (a table at θ there,
+    :func:`condition_values`), for the judgement; ``None`` for a controller that cannot run
+    (``digital`` None)."""
+    from ..control.controller import SPEED
+    from ..control.scheduled_digital import ScheduledDigital
+
+    if digital is None:
+        return None
+    if isinstance(digital, ScheduledDigital):
+        w, values = condition_values(point, design_cfg)
+        return digital.statespace_at(w if digital.parameter == SPEED
+                                     else values[digital.parameter], delayed=True)
+    return digital.statespace(delayed=True)
 
 
 def judge_case(case: dict, cfg, settings: JudgeSettings | None = None) -> tuple[dict, dict]:

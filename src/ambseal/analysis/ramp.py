@@ -10,11 +10,14 @@ tracking_excitation`) plus the thesis's current impulse (P5 §5.1, the specifica
 amplitude and length on the first actuator axis) every ``impulse_every_s`` — and the same
 noise sequence go into every run, so the runs differ only by their controller.
 
-The tracked scheme runs in blocks of ``block_s``: at the start of each block the scheduled
-controller is frozen at the scheduling value and discretised (zero-order hold, the
-controller state carried across the switch; Tustin made every frozen discrete loop of the
-test rig's design unstable, |z| = 1.0008–1.0017 without delay, and lost the rotor at
-1.36× even scheduled on the true k), the block is run, and the tracker
+The tracked scheme runs in blocks of ``block_s``: at the start of each block the
+controller that runs is the digital table (:class:`~ambseal.control.scheduled_digital.
+ScheduledDigital`, ``tracked_digital``: the exported, judged discretisation) interpolated
+at the scheduling value, or without a table the scheduled controller frozen there and
+discretised by zero-order hold (Tustin made every frozen discrete loop of the test rig's
+design unstable, |z| = 1.0008–1.0017 without delay, and lost the rotor at 1.36× even
+scheduled on the true k); the controller state is carried across the switch, the block is
+run, and the tracker
 (:class:`~ambseal.identify.tracking.OnlineTracker`, started at the model's value at the
 starting pressure) is fed the block's displacements and current references. The
 scheduling value follows the estimate at the end of the previous block (causal, as on the
@@ -25,6 +28,10 @@ the estimate is then within 0.028–0.030 k_nom of the truth after 1 s and its 9
 interval covers the truth 99.9 % of the time; built from the rig file (τ_e = 0, Ki, Ks a
 few per cent off) 0.60 k_nom and 88 % (:mod:`ambseal.identify.tracking`, "The model must
 be the identified one").
+
+Every controller runs with ``delay_samples`` of computation delay (the target's,
+``[controller] delay_samples``; 0: the facility's own timing, output in the sample its
+input was read).
 
 Per impulse: the peak |y| on the impulse axis within 30 impulse lengths, and the settling
 time, after which |y| stays inside max(2 % of the peak, 3× the std of the 50 ms before
@@ -144,7 +151,8 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
                     top_factor: float = 3.0, step_s: float = 0.05, block_s: float = 0.05,
                     impulse_every_s: float = 2.0, transient_s: float = 1.0,
                     record_hz: float = 1000.0, seed: int = 0, settings=None,
-                    model_cfg=None, progress=None) -> RampResult:
+                    model_cfg=None, tracked_digital=None, delay_samples: int = 0,
+                    progress=None) -> RampResult:
     """Run the pressure ramp with each fixed controller and the tracked scheme.
 
     Parameters
@@ -173,6 +181,11 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
         The rig the tracker's model is built from: the identified rig (Ki, Ks, τ_e, the
         seal's coefficient curves; thesis stages (a)–(c)); default ``cfg`` (module
         docstring).
+    tracked_digital : ScheduledDigital, optional
+        The tracked controller's digital table (:func:`ambseal.commands.digital_for`);
+        default: the frozen controller discretised by ZOH at every switch.
+    delay_samples : int
+        Computation delay of every controller (samples; module docstring).
     progress : callable, optional
         Called with one line per run.
 
@@ -212,7 +225,9 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
         n0 = int(round(t0 * fs))
         p_of_n[n0:], k_of_n[n0:] = p, _pressure_values(cfg_t, truth, base, p)[param]
     k_nom = abs(_pressure_values(cfg_t, truth, base, cfg.operating.pressure_bar)[param])
-    noise_std = _noise_std(cfg, truth, controllers, tracked, e, fs)
+    run_as = _runner(tracked, tracked_digital, 1.0 / fs, delay_samples)
+    controllers = {n: run_as(K) for n, K in controllers.items()}
+    noise_std = _noise_std(cfg, truth, controllers, tracked, e, fs, run_as)
     noise, inoise = white * noise_std, iwhite * truth.current_noise_a
     dec = max(1, int(round(fs / record_hz)))
     runs = {}
@@ -227,9 +242,10 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
     tracking = {}
     if tracked is not None:
         fac = prepare_facility(cfg, truth, fs, pressure_bar=0.0, pressure_schedule=sched)
-        runs["tracked"], tracking = _run_tracked(model_cfg or cfg, fac, tracked, e, noise,
-                                                 inoise, fs, starts, n_len, dec, block_s,
-                                                 k_of_n, float(k_nom), transient_s, settings)
+        runs["tracked"], tracking = _run_tracked(model_cfg or cfg, fac, tracked, run_as, e,
+                                                 noise, inoise, fs, starts, n_len, dec,
+                                                 block_s, k_of_n, float(k_nom), transient_s,
+                                                 settings)
         if progress:
             progress(f"ramp: tracked {tracking}")
     t = np.arange(N)[::dec] / fs
@@ -237,7 +253,7 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
                       [n0 / fs for n0 in starts], tuple(fac0.axes), runs, tracking)
 
 
-def _noise_std(cfg, truth, controllers, tracked, e, fs):
+def _noise_std(cfg, truth, controllers, tracked, e, fs, run_as):
     """Sensor noise std per axis: the truth's floor plus ``noise_fraction`` × the RMS of a
     noise-free first second at 0 bar with the tracked controller (else the first one)."""
     from ..identify.rig_sim import prepare_facility
@@ -246,20 +262,28 @@ def _noise_std(cfg, truth, controllers, tracked, e, fs):
     std = np.full(k, truth.sensor_noise_m)
     if truth.noise_fraction <= 0:
         return std
-    Kd = (_discrete(tracked, tracked.schedule[0], 1.0 / fs) if tracked is not None
-          else next(iter(controllers.values())))
+    Kd = run_as(tracked.schedule[0]) if tracked is not None else next(iter(
+        controllers.values()))
     n = min(len(e), int(round(fs)))
     fac = prepare_facility(cfg, truth, fs, pressure_bar=0.0)
     y, _, _ = fac.run(Kd, np.zeros(Kd.A.shape[0]), e[:n], np.zeros((n, k)), np.zeros((n, k)))
     return std + truth.noise_fraction * np.sqrt(np.mean(y**2, axis=0))
 
 
-def _discrete(tracked, value: float, T: float):
-    """The tracked controller frozen at θ = ``value`` and discretised (ZOH, docstring)."""
-    from ..control.digital import discretize_as
+def _runner(tracked, table, T: float, delay: int):
+    """``run_as(K)``: the DiscreteController that runs, with ``delay`` samples of delay, for
+    a fixed DiscreteController ``K`` or for the tracked controller at θ = ``K`` (a number:
+    the table at θ, or without a table the design frozen at θ and discretised by ZOH)."""
+    from ..control.digital import discretize_as, with_delay
     from ..identify.loop import DiscreteController
 
-    return DiscreteController(*discretize_as(tracked.matrices_at(value), T, "zoh"), T)
+    def run_as(K):
+        if not isinstance(K, DiscreteController):
+            K = (table.discrete_at(K) if table is not None else
+                 DiscreteController(*discretize_as(tracked.matrices_at(K), T, "zoh"), T))
+        return DiscreteController(*with_delay((K.A, K.B, K.C, K.D), delay), T)
+
+    return run_as
 
 
 def _records(N: int, k: int):
@@ -289,8 +313,8 @@ def _run(name, y, ref, lost, fs, starts, dec, n_len, **extra) -> RampRun:
                    peaks, settle, **extra)
 
 
-def _run_tracked(cfg, fac, tracked, e, noise, inoise, fs, starts, n_len, dec, block_s,
-                 k_true, k_nom, transient_s, settings):
+def _run_tracked(cfg, fac, tracked, run_as, e, noise, inoise, fs, starts, n_len, dec,
+                 block_s, k_true, k_nom, transient_s, settings):
     """The tracked scheme over the ramp (module docstring); its run and the estimator's
     accuracy."""
     from ..identify.fit import ClosedLoopModel
@@ -303,14 +327,14 @@ def _run_tracked(cfg, fac, tracked, e, noise, inoise, fs, starts, n_len, dec, bl
     s = settings or TrackingSettings()
     plant = reduced_plant(cfg, 0.0, None, {}, s.cutoff_hz or fs / 2)
     theta = float(plant.parameter(tracked.parameter).nominal)
-    Kd = _discrete(tracked, theta, T)
+    Kd = run_as(theta)
     model = ClosedLoopModel(plant, actuator_matrices(cfg.actuator), Kd,
                             tau_e=cfg.actuator.eddy_time_constant)
     y, ref = _records(N, k)
     xc, lost, tr, nb = np.zeros(Kd.A.shape[0]), None, None, max(1, int(round(block_s * fs)))
     for a in range(0, N, nb):
         b = min(N, a + nb)
-        Kd = _discrete(tracked, theta, T)
+        Kd = run_as(theta)
         try:
             y[a:b], _, ref[a:b] = fac.run(Kd, xc, e[a:b], noise[a:b], inoise[a:b])
         except ModelError:

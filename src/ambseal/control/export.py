@@ -18,8 +18,10 @@ A continuous controller alone (a ``control.StateSpace``, e.g. for ``ambseal camp
 ``sweep --controller FILE``) is written with ``kind = "continuous"``, ``A … D`` continuous
 and ``Ts = 0`` (MATLAB's continuous time), and read back as that ``StateSpace``.
 
-A scheduled (LPV) controller adds ``kind = "scheduled"``, ``speeds_rad_s`` (n_t,) and
-``interpolation`` (the law, :data:`~ambseal.control.scheduled_digital.INTERPOLATION`); its
+A scheduled controller adds ``kind = "scheduled"``, ``parameter`` (θ: ``"speed"`` or an
+LFT parameter such as ``"seal.k"``), ``grid`` (n_t, θ of each table entry: rad/s for the
+speed, else SI; a speed-scheduled one also as ``speeds_rad_s``) and ``interpolation`` (the
+law, :func:`~ambseal.control.scheduled_digital.interpolation_law`); its
 matrices are stacks over the table, shape (n_t, …) in ``.npz``/``.json`` and (…, n_t) in
 ``.mat`` so that MATLAB's ``ss`` builds the model array directly.
 
@@ -42,7 +44,8 @@ from ..errors import DataError
 from ..files import atomic_write
 from ..identify.loop import DiscreteController
 from .digital import DigitalController
-from .scheduled_digital import INTERPOLATION, ScheduledDigital
+from .controller import SPEED
+from .scheduled_digital import ScheduledDigital
 
 __all__ = ["export_controller", "load_controller", "controller_document", "CONVENTION",
            "MATLAB_LINE"]
@@ -92,8 +95,10 @@ def controller_document(ctrl, judged=None) -> dict:
                  "judged_json": json.dumps(judged or [])}
     if isinstance(ctrl, ScheduledDigital):
         doc.update(kind="scheduled", name=ctrl.name, inputs=list(ctrl.inputs),
-                   outputs=list(ctrl.outputs), speeds_rad_s=np.asarray(ctrl.speeds_rad_s),
-                   interpolation=INTERPOLATION)
+                   outputs=list(ctrl.outputs), parameter=ctrl.parameter,
+                   grid=np.asarray(ctrl.grid), interpolation=ctrl.interpolation)
+        if ctrl.parameter == SPEED:
+            doc["speeds_rad_s"] = np.asarray(ctrl.grid)
         for suf, mats in (("", ctrl.discrete), ("_c", ctrl.continuous), ("_r", ctrl.reduced)):
             doc.update({f"{k}{suf}": np.asarray(X, float) for k, X in zip("ABCD", mats)})
         return doc
@@ -282,13 +287,15 @@ def load_controller(path):
     cands = tuple(meta.get("candidates", ()))
     arr = _arrays(doc, path, stacked=(kind == "scheduled"))
     if kind == "scheduled":
-        W = np.ravel(np.asarray(doc["speeds_rad_s"], float))
+        par = str(doc.get("parameter", SPEED))
+        key = "grid" if "grid" in doc else "speeds_rad_s"
+        W = np.ravel(np.asarray(doc.get(key, ()), float))
         if arr["A"].shape[0] != W.size:
             raise DataError(f"{path}: A holds {arr['A'].shape[0]} table entries but "
-                            f"speeds_rad_s has {W.size}")
+                            f"{key} has {W.size}")
         tab = {suf: tuple(arr[k + suf] for k in "ABCD") for suf in ("", "_c", "_r")}
         return ScheduledDigital(W, tab["_c"], tab["_r"], tab[""], tuple(ins), tuple(outs),
-                                method, pw, fs, delay, removed, cands, name)
+                                method, pw, fs, delay, removed, cands, name, par)
 
     def ss(suf, nm):
         return control.ss(*(arr[k + suf] for k in "ABCD"), inputs=ins, outputs=outs, name=nm)

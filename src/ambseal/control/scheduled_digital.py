@@ -1,15 +1,18 @@
-"""The scheduled (LPV) controller as it runs on the target: a table interpolated on speed.
+"""The scheduled (LPV) controller as it runs on the target: a table interpolated on θ.
 
 The LPV controller of :func:`ambseal.control.lpv_design.design_lpv` is a table of state-space
 matrices in one state basis at the speeds of its check grid, linearly interpolated in the
-rotor speed Ω between entries and held at the ends (:class:`~ambseal.control.lpv.LpvController`).
-The target runs the same law on discrete matrices: every entry is discretised by one method
-(:mod:`ambseal.control.digital`, chosen on the frozen loops), after the fast poles are
-removed in one basis common to all entries (the slow/fast split of the middle entry, so
-that interpolating the reduced entries still makes sense), and the discrete matrices are
-interpolated on the measured speed.
+rotor speed Ω between entries and held at the ends (:class:`~ambseal.control.lpv.LpvController`);
+the controller scheduled on a tracked seal coefficient
+(:func:`ambseal.control.seal_schedule.design_seal_scheduled`, issue 14) is the same kind of
+table on θ = that coefficient (SI). The target runs the same law on discrete matrices:
+every entry is discretised by one method (:mod:`ambseal.control.digital`, chosen on the
+frozen loops), after the fast poles are removed in one basis common to all entries (the
+slow/fast split of the middle entry, so that interpolating the reduced entries still makes
+sense), and the discrete matrices are interpolated on the measured speed (or the tracked
+estimate).
 
-The interpolation is judged between the grid points: the caller passes plants at speeds
+The interpolation is judged between the grid points: the caller passes plants at values
 between table entries, and the chosen method keeps every one of those sampled loops
 stable (``candidates``).
 """
@@ -17,7 +20,7 @@ stable (``candidates``).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import ClassVar, Sequence
+from typing import Sequence
 
 import numpy as np
 
@@ -28,12 +31,22 @@ from .digital import (FAST_FRACTION, METHODS, _json_safe, check_rate, choose_met
                       prewarp_frequency_hz, residualize, sampled_plants, split_fast,
                       with_delay)
 
-__all__ = ["ScheduledDigital", "scheduled_digital", "INTERPOLATION"]
+__all__ = ["ScheduledDigital", "scheduled_digital", "INTERPOLATION", "interpolation_law"]
 
-#: The interpolation law, as written into every export.
-INTERPOLATION = ("linear in the rotor speed (rad/s) between table entries, held constant "
-                 "outside the table: M(W) = (1 - t) M[j] + t M[j+1], "
-                 "t = (W - W[j]) / (W[j+1] - W[j])")
+
+def interpolation_law(parameter: str = SPEED) -> str:
+    """The interpolation law on ``parameter``, as written into every export."""
+    what = "the rotor speed (rad/s)" if parameter == SPEED else f"{parameter} (SI)"
+    return (f"linear in {what} between table entries, held constant outside the table: "
+            "M(W) = (1 - t) M[j] + t M[j+1], t = (W - W[j]) / (W[j+1] - W[j])")
+
+
+#: The interpolation law of a speed-scheduled controller.
+INTERPOLATION = interpolation_law()
+
+
+def _label(parameter: str, value: float) -> str:
+    return f"{value / (2 * np.pi):.4g} Hz" if parameter == SPEED else f"{parameter} = {value:.4g}"
 
 
 def _interp(x: float, grid: np.ndarray, stack: np.ndarray) -> np.ndarray:
@@ -44,12 +57,13 @@ def _interp(x: float, grid: np.ndarray, stack: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True, eq=False)
 class ScheduledDigital(ScheduledController):
-    """A speed-scheduled controller and its discrete table, ``i = −K(Ω) y``.
+    """A scheduled controller and its discrete table, ``i = −K(θ) y``.
 
     Attributes
     ----------
-    speeds_rad_s : ndarray, shape (n_t,)
-        Table speeds Ω (rad/s), increasing.
+    grid : ndarray, shape (n_t,)
+        θ of each table entry, increasing: speeds Ω (rad/s), or values of ``parameter``
+        (SI).
     continuous, reduced, discrete : tuple of 4 ndarray
         ``(A, B, C, D)`` stacks of shapes (n_t, n, n), (n_t, n, ny), (n_t, nu, n),
         (n_t, nu, ny): the designed physical controller (m → A), the same with the fast
@@ -58,10 +72,11 @@ class ScheduledDigital(ScheduledController):
     method, prewarp_hz, sample_rate_hz, delay_samples, removed_poles_hz, candidates
         As :class:`~ambseal.control.digital.DigitalController`.
     name : str
+    parameter : str
+        θ: :data:`~ambseal.control.controller.SPEED` or an LFT parameter (``"seal.k"``).
     """
 
-    parameter: ClassVar[str] = SPEED
-    speeds_rad_s: np.ndarray
+    grid: np.ndarray
     continuous: tuple = field(repr=False)
     reduced: tuple = field(repr=False)
     discrete: tuple = field(repr=False)
@@ -74,41 +89,48 @@ class ScheduledDigital(ScheduledController):
     removed_poles_hz: tuple = ()
     candidates: tuple = ()
     name: str = "K"
+    parameter: str = SPEED
 
     @property
     def schedule(self) -> tuple[float, float]:
-        """(Ω_min, Ω_max) of the table (rad/s)."""
-        return (float(self.speeds_rad_s[0]), float(self.speeds_rad_s[-1]))
+        """(θ_min, θ_max) of the table (rad/s for the speed, else SI)."""
+        return (float(self.grid[0]), float(self.grid[-1]))
+
+    @property
+    def interpolation(self) -> str:
+        """The interpolation law (:func:`interpolation_law`)."""
+        return interpolation_law(self.parameter)
 
     @property
     def Ts(self) -> float:
         """Sample time (s)."""
         return 1.0 / self.sample_rate_hz
 
-    def matrices_at(self, speed_rad_s: float) -> tuple[np.ndarray, ...]:
-        """The designed physical ``(A_K, B_K, C_K, D_K)`` at Ω (rad/s), interpolated."""
-        return tuple(_interp(speed_rad_s, self.speeds_rad_s, X) for X in self.continuous)
+    def matrices_at(self, value: float) -> tuple[np.ndarray, ...]:
+        """The designed physical ``(A_K, B_K, C_K, D_K)`` at θ, interpolated."""
+        return tuple(_interp(value, self.grid, X) for X in self.continuous)
 
-    def at(self, speed_rad_s: float, name: str | None = None):
-        """The frozen designed controller at Ω (rad/s), continuous ``control.StateSpace``."""
+    def at(self, value: float, name: str | None = None):
+        """The frozen designed controller at θ, continuous ``control.StateSpace``."""
         import control
 
-        return control.ss(*self.matrices_at(speed_rad_s), inputs=list(self.inputs),
+        return control.ss(*self.matrices_at(value), inputs=list(self.inputs),
                           outputs=list(self.outputs), name=name or self.name)
 
-    def discrete_at(self, speed_rad_s: float) -> DiscreteController:
-        """The discrete controller the target runs at Ω (rad/s): the interpolated table."""
-        mats = [_interp(speed_rad_s, self.speeds_rad_s, X) for X in self.discrete]
+    def discrete_at(self, value: float) -> DiscreteController:
+        """The discrete controller the target runs at θ: the interpolated table."""
+        mats = [_interp(value, self.grid, X) for X in self.discrete]
+        key = "speed_rad_s" if self.parameter == SPEED else self.parameter
         return DiscreteController(*mats, self.Ts, description={
             "type": "state_space", "name": self.name, "discretisation": self.method,
-            "speed_rad_s": float(speed_rad_s)})
+            key: float(value)})
 
-    def statespace_at(self, speed_rad_s: float, delayed: bool = False):
+    def statespace_at(self, value: float, delayed: bool = False):
         """:meth:`discrete_at` as a named discrete ``control.StateSpace`` (with the
         computation delay when ``delayed``)."""
         import control
 
-        d = self.discrete_at(speed_rad_s)
+        d = self.discrete_at(value)
         mats = (d.A, d.B, d.C, d.D)
         if delayed:
             mats = with_delay(mats, self.delay_samples)
@@ -120,15 +142,17 @@ class ScheduledDigital(ScheduledController):
         return _json_safe({
                 "method": self.method, "prewarp_hz": self.prewarp_hz,
                 "sample_rate_hz": self.sample_rate_hz, "Ts": self.Ts,
-                "delay_samples": self.delay_samples, "interpolation": INTERPOLATION,
-                "table_speeds_hz": (self.speeds_rad_s / (2 * np.pi)).tolist(),
+                "delay_samples": self.delay_samples, "interpolation": self.interpolation,
+                **({"table_speeds_hz": (self.grid / (2 * np.pi)).tolist()}
+                   if self.parameter == SPEED else
+                   {"parameter": self.parameter, "table_values": self.grid.tolist()}),
                 "fast_fraction_of_nyquist": FAST_FRACTION,
                 "removed_poles_hz": [float(f) for f in self.removed_poles_hz],
                 "order": int(self.discrete[0].shape[1]),
                 "candidates": [dict(c) for c in self.candidates]})
 
 
-def scheduled_digital(K: ScheduledController, speeds_rad_s, sample_rate_hz: float,
+def scheduled_digital(K: ScheduledController, grid, sample_rate_hz: float,
                       plants: Sequence[tuple[float, tuple]], *, delay_samples: int = 1,
                       methods: Sequence[str] = METHODS, name: str = "K_lpv"
                       ) -> ScheduledDigital:
@@ -137,12 +161,13 @@ def scheduled_digital(K: ScheduledController, speeds_rad_s, sample_rate_hz: floa
     Parameters
     ----------
     K : ScheduledController
-        Physical scheduled controller (``matrices_at(Ω)``, m → A, ``i = −K y``).
-    speeds_rad_s : array_like, shape (n_t,)
-        Table speeds (rad/s): those where ``K`` is exact (the LPV check grid), increasing.
+        Physical scheduled controller (``matrices_at(θ)``, m → A, ``i = −K y``) on
+        ``K.parameter`` (the speed, rad/s, or an LFT parameter, SI).
+    grid : array_like, shape (n_t,)
+        Table values of θ: those where ``K`` is exact (the LPV check grid), increasing.
     sample_rate_hz : float
-    plants : sequence of (speed_rad_s, (A, B, C, D))
-        Full-order continuous plants at the judged speeds (nominal first) and between
+    plants : sequence of (θ, (A, B, C, D))
+        Full-order continuous plants at the judged conditions (nominal first) and between
         table entries.
     delay_samples, methods
         As :func:`ambseal.control.digital.digital_controller`.
@@ -162,7 +187,7 @@ def scheduled_digital(K: ScheduledController, speeds_rad_s, sample_rate_hz: floa
     """
     check_rate(K, sample_rate_hz, delay_samples)
     fs, T = float(sample_rate_hz), 1.0 / float(sample_rate_hz)
-    W = np.asarray(speeds_rad_s, float)
+    W = np.asarray(grid, float)
     table = [tuple(np.asarray(X, float) for X in K.matrices_at(w)) for w in W]
     V, k, fast = split_fast(table[len(W) // 2][0], FAST_FRACTION * fs / 2)
     for w, mats in zip(W, table):
@@ -170,7 +195,7 @@ def scheduled_digital(K: ScheduledController, speeds_rad_s, sample_rate_hz: floa
         if A22.size and np.max(np.linalg.eigvals(A22).real) >= 0:
             raise SynthesisError(
                 f"controller.sample_rate_hz = {fs:g} Hz: the fast part of {name} at "
-                f"{w / (2 * np.pi):.4g} Hz is not stable and cannot be removed; raise the "
+                f"{_label(K.parameter, w)} is not stable and cannot be removed; raise the "
                 "sample rate")
     reduced = [residualize(m, V, k) for m in table]
     stacks = [tuple(np.stack([m[i] for m in seq]) for i in range(4))
@@ -189,12 +214,14 @@ def scheduled_digital(K: ScheduledController, speeds_rad_s, sample_rate_hz: floa
     discrete.tables = {}
     m, _, cands = choose_method(sampled_plants(G, fs), cont, discrete, int(delay_samples),
                                 methods, f_pw, name)
-    cands = tuple({**c, "speeds_hz": [s / (2 * np.pi) for s in sp]} for c in cands)
+    at = ({"speeds_hz": [s / (2 * np.pi) for s in sp]} if K.parameter == SPEED
+          else {"values": [float(s) for s in sp]})
+    cands = tuple({**c, **at} for c in cands)
     chans = K.at(float(W[0]))
     return ScheduledDigital(
-        speeds_rad_s=W, continuous=stacks[0], reduced=stacks[1], discrete=discrete.tables[m],
+        grid=W, continuous=stacks[0], reduced=stacks[1], discrete=discrete.tables[m],
         inputs=tuple(chans.input_labels), outputs=tuple(chans.output_labels), method=m,
         prewarp_hz=f_pw if m == "tustin_prewarp" else None, sample_rate_hz=fs,
         delay_samples=int(delay_samples),
         removed_poles_hz=tuple(sorted(float(abs(p)) / (2 * np.pi) for p in fast)),
-        candidates=cands, name=name)
+        candidates=cands, name=name, parameter=K.parameter)

@@ -23,7 +23,7 @@ from .lft import Channel
 from .rotor import X, Y, Mesh
 
 __all__ = ["COEFFICIENTS", "interp_table", "coefficient_value", "seal_coefficients",
-           "seal_values", "values_following_k", "SealElement"]
+           "seal_values", "pressure_for_k", "values_following_k", "SealElement"]
 
 COEFFICIENTS = ("K", "k", "C", "c", "M")
 """The seal coefficients in Childs' convention, in the order of the rig file."""
@@ -124,12 +124,23 @@ def seal_values(seals, pressure_bar: float) -> dict[str, float]:
             if not isinstance(getattr(s, n), FrequencyTable)}
 
 
+def pressure_for_k(seals, name: str, value: float) -> float | None:
+    """The pressure drop (bar) at which the seal named by ``name`` (``"<seal>.k"``) has the
+    cross-coupled stiffness k = ``value`` (N/m), k = k₀ + k'·p affine with k' ≠ 0:
+    p = max((k − k₀)/k', 0); None when ``name`` is no such k."""
+    seal_name, _, key = name.rpartition(".")
+    seal = next((s for s in seals if s.name == seal_name), None)
+    if key != "k" or seal is None or not isinstance(seal.k, Affine) or not seal.k.per_bar:
+        return None
+    return max((value - seal.k.at_zero) / seal.k.per_bar, 0.0)
+
+
 def values_following_k(seals, name: str, value: float, known) -> dict[str, float]:
     """``{name: value}`` and, when ``name`` is a seal's cross-coupled stiffness k affine in
     the pressure drop (k = k₀ + k'·p, k' ≠ 0), that seal's other coefficients K, C, c at
-    the pressure p = max((k − k₀)/k', 0) that gives k — the seal model's own structure
-    (thesis §7.4 item 2: the coefficients move together with the pressure); only those in
-    ``known`` (the plant's parameter names) are returned.
+    the pressure p = max((k − k₀)/k', 0) that gives k (:func:`pressure_for_k`) — the seal
+    model's own structure (thesis §7.4 item 2: the coefficients move together with the
+    pressure); only those in ``known`` (the plant's parameter names) are returned.
 
     Parameters
     ----------
@@ -145,13 +156,11 @@ def values_following_k(seals, name: str, value: float, known) -> dict[str, float
     -------
     dict
     """
-    from ..config import Affine
-
-    seal_name, _, key = name.rpartition(".")
-    seal = next((s for s in seals if s.name == seal_name), None)
-    if key != "k" or seal is None or not isinstance(seal.k, Affine) or not seal.k.per_bar:
+    p = pressure_for_k(seals, name, value)
+    if p is None:
         return {name: value}
-    p = max((value - seal.k.at_zero) / seal.k.per_bar, 0.0)
+    seal_name = name.rpartition(".")[0]
+    seal = next(s for s in seals if s.name == seal_name)
     out = {f"{seal_name}.{q}": coefficient_value(getattr(seal, q), p) for q in ("K", "C", "c")
            if f"{seal_name}.{q}" in known}
     return {**out, name: value}

@@ -372,19 +372,22 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
     ylab, ulab = list(P.output_labels)[sb.nz:], list(P.input_labels)[sb.nw:]
     K = ct.ss(*chosen.K, inputs=ylab, outputs=ulab, name="K",
               states=[f"xK{i}" for i in range(chosen.K[0].shape[0])])
+    cl = ct.ss(*chosen.closed_loop, inputs=list(P.input_labels)[:sb.nw],
+               outputs=list(P.output_labels)[:sb.nz], name="closed_loop")
     return HinfResult(K=K, gamma=float(chosen.gamma), gamma_opt=gamma_opt,
                       gamma_design=float(chosen.gamma_design), omega_peak=float(chosen.omega),
-                      closed_loop=lft_lower(P, K, nmeas, ncon), rcond=chosen.rcond,
+                      closed_loop=cl, rcond=chosen.rcond,
                       gamma_lower=gamma_lower, iterations=tests + len(tried))
 
 
 @dataclass(frozen=True)
 class _Attempt:
-    """A controller built at ``gamma_design`` (``K`` as matrices ``(A, B, C, D)``) and its
-    verified closed-loop norm ``gamma``."""
+    """A controller built at ``gamma_design`` (``K`` and ``closed_loop`` = F_l(P, K) as
+    matrices ``(A, B, C, D)``) and its verified closed-loop norm ``gamma``."""
 
     gamma_design: float
     K: tuple
+    closed_loop: tuple
     rcond: tuple
     gamma: float
     omega: float
@@ -518,7 +521,7 @@ class _Sb10:
         if pol.size and np.max(pol.real) >= -1e-12 * scl:
             raise SynthesisError(f"hinfsyn: closed loop unstable at γ={g:.6g}")
         gam, wpk = _linfnorm_matrices(*cl)
-        return _Attempt(g, Ks, tuple(float(x) for x in out[9]), gam, wpk)
+        return _Attempt(g, Ks, cl, tuple(float(x) for x in out[9]), gam, wpk)
 
 
 def _backoff_ladder(backoff: float, max_backoff: float) -> list[float]:

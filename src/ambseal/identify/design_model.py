@@ -146,7 +146,7 @@ def impulse_checks(cfg: RigConfig, identified: RigConfig, truth: TruthSection,
                                         str(exc)))
                 continue
             model = build_models(identified, [rec], controllers=[Kd])[0]
-            y, _ = model.simulate({}, np.asarray(ex.values_a))
+            y, _ = model.simulate({}, np.asarray(ex.values_a), currents=False)
             fit = nrmse_fit(np.asarray(rec.displacement_m), y)
             out.append(ImpulseCheck(name, float(p), np.asarray(rec.time_s),
                                     np.asarray(ex.values_a), np.asarray(rec.displacement_m), y,

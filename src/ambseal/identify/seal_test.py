@@ -116,8 +116,8 @@ def whirl_balance(cfg: RigConfig, controller: DiscreteController, seal: str,
             zeta, eta = _whirl(n, f, fs, a_f, a_b)
             for j, ax in enumerate(axes):
                 e[:, j] = zeta if ax.endswith("_zeta") else eta
-            up = model.simulate({**base, name: k0 + h}, e, n0)[0]
-            dn = model.simulate({**base, name: k0 - h}, e, n0)[0]
+            up = model.simulate({**base, name: k0 + h}, e, n0, currents=False)[0]
+            dn = model.simulate({**base, name: k0 - h}, e, n0, currents=False)[0]
             s.append(np.linalg.norm(up - dn))
         out.append(s[0] / max(s[1], 1e-300))
     return np.array(out)

@@ -65,7 +65,9 @@ def lft_lower_matrices(P: Matrices, K: Matrices, nmeas: int, ncon: int) -> Matri
     Dy = Ri @ D21
     Cu = np.hstack([np.zeros((ncon, n)), Ck]) + Dk @ Cy
     Du = Dk @ Dy
-    Acl = np.block([[A, np.zeros((n, nk))], [np.zeros((nk, n)), Ak]])
+    Acl = np.zeros((n + nk, n + nk))
+    Acl[:n, :n] = A
+    Acl[n:, n:] = Ak
     Acl = Acl + np.vstack([B2, np.zeros((nk, ncon))]) @ Cu
     Acl = Acl + np.vstack([np.zeros((n, nmeas)), Bk]) @ Cy
     Bcl = np.vstack([B1 + B2 @ Du, Bk @ Dy])
@@ -145,9 +147,10 @@ def feedback_matrices(G: Matrices, K: Matrices, Gf: tuple[np.ndarray, np.ndarray
     nf = Bf.shape[1]
     BP = np.hstack([B, Bf, B])
     CP = np.vstack([C, np.zeros((nu, A.shape[0])), C])
-    DP = np.block([[D, Df, D],
-                   [np.zeros((nu, nu + nf)), np.eye(nu)],
-                   [D, Df, D]])
+    DP = np.zeros((2 * ny + nu, 2 * nu + nf))
+    for rows in (slice(0, ny), slice(ny + nu, None)):
+        DP[rows] = np.hstack([D, Df, D])
+    DP[ny:ny + nu, nu + nf:] = np.eye(nu)
     return lft_lower_matrices((A, BP, CP, DP), (Ak, Bk, -Ck, -Dk), ny, nu)
 
 
@@ -173,14 +176,16 @@ def series_inputs(G: Matrices, block: Matrices, inputs: list[int] | None = None
         ``(k, n + n_a k)`` and ``(k, m)``.
     """
     A, B, C, D = G
-    Aa, Ba, Ca, Da = block
     n, m = B.shape
     idx = list(range(m)) if inputs is None else list(inputs)
     k = len(idx)
-    Ak, Bk, Ck, Dk = (np.kron(np.eye(k), X) for X in (Aa, Ba, Ca, Da))
+    Ak, Bk, Ck, Dk = (_repeat_diagonal(np.atleast_2d(np.asarray(X, float)), k) for X in block)
     na = Ak.shape[0]
     Bu = B[:, idx]
-    A2 = np.block([[A, Bu @ Ck], [np.zeros((na, n)), Ak]])
+    A2 = np.zeros((n + na, n + na))
+    A2[:n, :n] = A
+    A2[:n, n:] = Bu @ Ck
+    A2[n:, n:] = Ak
     B2 = np.zeros((n + na, m))
     B2[:n] = B
     B2[:n, idx] = Bu @ Dk
@@ -192,3 +197,13 @@ def series_inputs(G: Matrices, block: Matrices, inputs: list[int] | None = None
     D_out = np.zeros((k, m))
     D_out[:, idx] = Dk
     return A2, B2, C2, D2, C_out, D_out
+
+
+def _repeat_diagonal(X: np.ndarray, k: int) -> np.ndarray:
+    """``kron(I_k, X)``, ``k`` copies of ``X`` on the block diagonal (the same array; numpy's
+    ``kron`` costs more than the products around it for these small blocks)."""
+    r, c = X.shape
+    out = np.zeros((k * r, k * c))
+    for j in range(k):
+        out[j * r:(j + 1) * r, j * c:(j + 1) * c] = X
+    return out

@@ -42,7 +42,7 @@ from ..errors import ConfigError, SynthesisError
 from ..identify.loop import DiscreteController
 from ..lti.discrete import zoh
 from ..lti.freqresp import freqresp_at
-from ..lti.interconnect import feedback_matrices
+from ..lti.interconnect import feedback_matrices, feedback_poles
 
 __all__ = ["FAST_FRACTION", "METHODS", "DigitalController", "split_fast", "residualize",
            "discretize_as", "with_delay", "digital_controller", "design_rise", "check_rate",
@@ -291,7 +291,7 @@ def prewarp_frequency_hz(G_list, K: Matrices, fs: float) -> float | None:
     of Nyquist, the frequency where the discrete controller's phase matters most."""
     best, f_best = np.inf, None
     for G in G_list:
-        lam = np.linalg.eigvals(feedback_matrices(G, K)[0])
+        lam = feedback_poles(G, K)
         lam = lam[(lam.imag > 0) & (lam.imag < 2 * np.pi * FAST_FRACTION * fs / 2)]
         if lam.size:
             zeta = -lam.real / np.abs(lam)
@@ -371,7 +371,7 @@ def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int,
     """
     fs, T, w = sp.fs, 1.0 / sp.fs, sp.omega_rad_s
     Gd_list = sp.sampled
-    cont_stable = [np.max(np.linalg.eigvals(feedback_matrices(G, Kc)[0]).real) < 0
+    cont_stable = [np.max(feedback_poles(G, Kc).real) < 0
                    for G, Kc in zip(sp.plants, cont)]
     judged = [j for j, ok in enumerate(cont_stable) if ok]
     peak_c = {j: _so_peak(sp.continuous_response[j], freqresp_at(cont[j], 1j * w))

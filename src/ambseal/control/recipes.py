@@ -179,7 +179,7 @@ def full_order_check(cfg, K, conditions) -> dict:
         and ``damping`` (ζ = −Re λ/|λ|, negative when unstable). A pole counts as unstable
         when Re λ > 1e-9·max|λ| (the rounding level of the eigenvalue solver).
     """
-    from ..lti.interconnect import feedback_matrices
+    from ..lti.interconnect import feedback_poles
     from ..model.rig import build_plant
 
     Km = tuple(np.asarray(getattr(K, m), float) for m in ("A", "B", "C", "D"))
@@ -188,7 +188,7 @@ def full_order_check(cfg, K, conditions) -> dict:
         plant = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * f)
         cur = plant.current_inputs()
         G = (plant.A, plant.B[:, cur], plant.C, plant.D[:, cur])
-        lam = np.linalg.eigvals(feedback_matrices(G, Km)[0])
+        lam = feedback_poles(G, Km)
         k = int(np.argmax(lam.real))
         margin = lam[k].real / np.abs(lam).max()
         if worst is None or margin > worst[0]:

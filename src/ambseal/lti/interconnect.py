@@ -20,9 +20,10 @@ from typing import Any
 import numpy as np
 
 from ambseal.errors import ModelError
-from ambseal.lti.matrices import labels, ss_matrices
+from ambseal.lti.matrices import ArrayMemo, labels, ss_matrices
 
-__all__ = ["lft_lower_matrices", "lft_lower", "feedback_matrices", "series_inputs"]
+__all__ = ["lft_lower_matrices", "lft_lower", "feedback_matrices", "feedback_poles",
+           "series_inputs"]
 
 Matrices = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
@@ -152,6 +153,19 @@ def feedback_matrices(G: Matrices, K: Matrices, Gf: tuple[np.ndarray, np.ndarray
         DP[rows] = np.hstack([D, Df, D])
     DP[ny:ny + nu, nu + nf:] = np.eye(nu)
     return lft_lower_matrices((A, BP, CP, DP), (Ak, Bk, -Ck, -Dk), ny, nu)
+
+
+_POLES = ArrayMemo(keep=16)  # the last closed-loop state matrices decomposed
+
+
+def feedback_poles(G: Matrices, K: Matrices) -> np.ndarray:
+    """Eigenvalues of the state matrix of :func:`feedback_matrices` ``(G, K)`` (rad/s, or z
+    for a discrete loop), kept for the last few large loops
+    (:class:`~ambseal.lti.matrices.ArrayMemo`): the same full-order loop is checked by the
+    design (full-order stability), the discretisation's prewarp frequency and its stability
+    screen. The array is shared: do not modify it in place."""
+    Acl = feedback_matrices(G, K)[0]
+    return _POLES.get((Acl,), "eigvals", lambda: np.linalg.eigvals(Acl))
 
 
 def series_inputs(G: Matrices, block: Matrices, inputs: list[int] | None = None

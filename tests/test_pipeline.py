@@ -326,16 +326,18 @@ def test_run_not_on_a_terminal_logs_one_line_per_stage(turbo_run):
 
 
 def test_run_on_the_turboexpander_judges_lpv(turbo_run):
-    """`ambseal run examples/turboexpander.toml` (issue 5): H∞ at 140 Hz and the LPV
-    controller judged at frozen speeds over 20–300 Hz, every loop stable, the spin-up and
-    frozen-sensitivity comparison in metrics and report, the LPV table exported. The LPV
-    and 140 Hz designs are the session's (the same calls ``run`` makes; tests/conftest.py)."""
+    """`ambseal run examples/turboexpander.toml` (issues 5 and 9 §4): the PID derived from
+    the rig, H∞ and μ at 140 Hz and the LPV controller judged at frozen speeds over
+    20–300 Hz, every loop stable (continuous and as it runs), the spin-up and
+    frozen-sensitivity comparison of LPV and μ (P3 Figs. 11–12) in metrics and report, the
+    LPV table exported. The LPV and 140 Hz H∞ designs are the session's (the same calls
+    ``run`` makes; tests/conftest.py)."""
     tmp_path = turbo_run
     m = json.loads((tmp_path / "metrics.json").read_text())
     got = {(c["controller"], c["speed_hz"]) for c in m["cases"]}
-    assert got == {(c, f) for c in ("hinf", "lpv") for f in (20.0, 140.0, 300.0)}
+    assert got == {(c, f) for c in ("pid", "hinf", "mu", "lpv") for f in (20.0, 140.0, 300.0)}
     assert all(c["stable"] and c["discrete"]["stable"] for c in m["cases"])
-    assert set(m["spinup"]) == {"hinf", "lpv"}
+    assert set(m["spinup"]) == {"mu", "lpv"}
     for name in ("spinup.png", "frozen_sensitivity.png", "report.html"):
         assert (tmp_path / name).exists()
     from ambseal.control import ScheduledDigital, load_controller

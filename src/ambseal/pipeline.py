@@ -52,9 +52,10 @@ def _controllers(cfg: RigConfig, spec, say, allow_unstable: bool = False,
 
     Pressure-driven seals (the test rig): the reference PID, H∞ and μ (P5 §4), from the
     rig's design specification ``spec``. Speed-driven seals over a speed range (the
-    turboexpander, P3 §4): the PID if the rig has one, an H∞ controller designed at the
-    operating speed (the LTI comparison of P3 Fig. 11) and the LPV controller scheduled on
-    speed. ``say(message, steps)`` reports: one step per design, messages in between.
+    turboexpander, P3 §4): the reference PID, an H∞ controller designed at the operating
+    speed, the μ controller of the specification at the operating speed (the LTI
+    comparisons of P3 §3 and Fig. 11) and the LPV controller scheduled on speed.
+    ``say(message, steps)`` reports: one step per design, messages in between.
     ``methods`` limits the pressure-driven case (the PID alone before identification, H∞ and
     μ on the identified rig after it).
     """
@@ -74,11 +75,12 @@ def _controllers(cfg: RigConfig, spec, say, allow_unstable: bool = False,
     if speed_scheduled(cfg):
         from .control.lpv_design import design_frozen, design_lpv
 
-        out = [lti(design(cfg, "pid"))] if cfg.controller.pid else []
-        say("pid designed" if out else "", len(out))
+        out = [lti(design(cfg, "pid"))]
+        say("pid designed", 1)
         fz = design_frozen(cfg, cfg.operating.speed_rpm / 60.0, allow_unstable=allow_unstable)
         out.append(Designed("hinf", fz.K, fz.to_dict(), fz))
-        say("hinf designed; lpv next", 1)
+        say("hinf designed", 1)
+        out.append(robust("mu"))
         lpv = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz,
                          allow_unstable=allow_unstable)
         say("lpv designed", 1)
@@ -165,7 +167,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
     points = operating_points(cfg, spec)
     settings = judge_settings(cfg, spec)
     final = Path(out_dir)
-    n_designs = (2 + (cfg.controller.pid is not None)) if speed_scheduled(cfg) else 3
+    n_designs = 4 if speed_scheduled(cfg) else 3
     n_tr = int(cfg.design.tracked)  # issue 14, off by default: minutes of LMI synthesis
     totals = {"model": 1, "design": n_designs, "judge": (n_designs + n_tr) * len(points),
               "identification": None, "design (identified)": 2 + n_tr, "spin-up": 1,
@@ -231,8 +233,8 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
             metrics["identification"] = ident.summary
         if speed_scheduled(cfg):
             stages.begin("spin-up", "spin-up and frozen sensitivities")
-            metrics["spinup"], sims, sens = judge_spinup(
-                cfg, {d.method: d.controller for d in designs})
+            metrics["spinup"], sims, sens = judge_spinup(  # LPV against μ: P3 Fig. 11
+                cfg, {d.method: d.controller for d in designs if d.method in ("mu", "lpv")})
             figs += spinup_figures(out, sims, sens, cfg.operating.speed_range_hz)
             stages.step()
         if cfg.design.tracked and truth_cfg is not None:

@@ -62,6 +62,12 @@ def test_every_example_runs_end_to_end(rig, tmp_path, capsys):
     metrics, err = _run(rig, tmp_path / "out", capsys)
     _check_stable_or_stated(metrics, err)
     assert {c["controller"] for c in metrics["cases"]} >= {"pid", "hinf", "mu"}
+    # μ: ISO 14839-3 zone A (σ̄(S_o) < 3 per axis) at every judged condition, and the
+    # automatic order keeps the design's μ within 10 % (control.recipes.ORDER_RISE)
+    for c in (c for c in metrics["cases"] if c["controller"] == "mu"):
+        assert max(c["sensitivity_peak_per_axis"].values()) < 3.0, c
+    red = metrics["controllers"]["mu"]["reduction"]
+    assert red is None or red["mu"] <= 1.1 * red["mu_full"]
 
 
 def _testrig_without(kind: str) -> str:

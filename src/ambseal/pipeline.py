@@ -52,12 +52,10 @@ def _controllers(cfg: RigConfig, spec, say, allow_unstable: bool = False,
 
     Pressure-driven seals (the test rig): the reference PID, H∞ and μ (P5 §4), from the
     rig's design specification ``spec``. Speed-driven seals over a speed range (the
-    turboexpander, P3 §4): the reference PID, an H∞ controller designed at the operating
-    speed, the μ controller of the specification at the operating speed (the LTI
-    comparisons of P3 §3 and Fig. 11) and the LPV controller scheduled on speed.
-    ``say(message, steps)`` reports: one step per design, messages in between.
-    ``methods`` limits the pressure-driven case (the PID alone before identification, H∞ and
-    μ on the identified rig after it).
+    turboexpander, P3 §4): the reference PID, H∞ and μ at the operating speed (P3 §3,
+    Fig. 11) and the LPV controller scheduled on speed. ``say(message, steps)`` reports:
+    one step per design, messages in between. ``methods`` limits the pressure-driven case
+    (the PID alone before identification, H∞ and μ on the identified rig after it).
     """
     from .analysis.judge import speed_scheduled
     from .control.recipes import design

@@ -113,7 +113,8 @@ class ReductionResult:
 
 def reduce_controller(P, K, order: int, nmeas: int, ncon: int, *,
                       blocks: Sequence[Sequence[int]] | None = None, omega=None,
-                      alpha: float | None = None) -> ReductionResult:
+                      alpha: float | None = None, full: tuple | None = None
+                      ) -> ReductionResult:
     """Reduce K and report what it costs in closed-loop γ (and peak μ).
 
     Parameters
@@ -132,6 +133,9 @@ def reduce_controller(P, K, order: int, nmeas: int, ncon: int, *,
         Frequencies in rad/s for μ.
     alpha : float, optional
         Stability boundary for the stable/unstable split (see :func:`balred_controller`).
+    full : (float, float or None), optional
+        γ and peak μ of the full-order loop when already known (a search over orders
+        reduces the same controller several times); computed if omitted.
 
     Returns
     -------
@@ -142,16 +146,18 @@ def reduce_controller(P, K, order: int, nmeas: int, ncon: int, *,
     ConfigError
         Bad order; ``blocks`` without ``omega``.
     """
+    if blocks is not None and omega is None:
+        raise ConfigError("reduce_controller: blocks given without a frequency grid omega")
     Kr, hsv = balred_controller(K, order, alpha)
-    g_full, _ = hinfnorm(lft_lower(P, K, nmeas, ncon))
+    g_full, mu_full = full if full is not None else (
+        hinfnorm(lft_lower(P, K, nmeas, ncon))[0], None)
     g_red, _ = hinfnorm(lft_lower(P, Kr, nmeas, ncon))
-    mu_full = mu_red = None
+    mu_red = None
     if blocks is not None:
-        if omega is None:
-            raise ConfigError("reduce_controller: blocks given without a frequency grid omega")
         from ambseal.control.mu import mussv
 
-        mu_full = float(np.max(mussv(lft_lower(P, K, nmeas, ncon), blocks, omega).upper))
+        if mu_full is None:
+            mu_full = float(np.max(mussv(lft_lower(P, K, nmeas, ncon), blocks, omega).upper))
         mu_red = (float(np.max(mussv(lft_lower(P, Kr, nmeas, ncon), blocks, omega).upper))
                   if np.isfinite(g_red) else float("inf"))
     return ReductionResult(K=Kr, order_full=int(K.nstates), order=int(Kr.nstates),

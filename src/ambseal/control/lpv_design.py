@@ -21,15 +21,16 @@ W_p pole at ω_B A sets the slowest time scale of the LMIs; 3 rad/s rather than 
 keeps the SDP conditioned and costs a steady-state error of 1 % instead of 0.1 % of the
 scaled disturbance (the force step's steady deflection is 1.4 % of its peak, inside the 2 %
 band, so settling is not affected). W_u (P3 §3.3: "a high-pass filter with a crossover
-frequency at 1.4 kHz"): 0.05 on the current scaled by D_u = 1 A up to its zero at
-**1.4 kHz**, rising to **0.5** above ~14 kHz. Well above the design bandwidth it leaves the
-rigid-body loop alone (settling unchanged), but it rolls the controller off at the
-2 kHz bending modes left out of the design model: with a static W_u = 0.05, σ̄(S_o) on the
-full-order plant peaked at 4.4–6.7 there (spill-over); with the high-pass it stays
-≤ 1.8 over 20–300 Hz. The price is γ: 0.94 frozen, 1.05 rate-bounded, 1.07 constant
-(static: 0.88 / 0.98) — the weights are met within 7 %, and the acceptance itself (settling,
-σ̄(S_o)) is checked directly in ``tests/analysis/test_analysis_spinup.py``. A corner of
-1 kHz (hf 0.5) gives γ 1.11, one at 400 Hz (0.03 → 1.0) 1.14; both also meet σ̄ ≤ 3.
+frequency at 1.4 kHz") is derived from the rig (:mod:`ambseal.control.specs`, "LPV
+weights"): on the current scaled by D_u = bias/6 (0.42 A), a low-frequency gain that keeps
+the controller within 2.5× the reference PID's peak gain (0.037), rising tenfold above its
+corner at the actuator bandwidth (1.5 kHz); D_e = air gap/25 (20 µm). Well above the design
+bandwidth it leaves the rigid-body loop alone, but it rolls the controller off at the
+bending modes left out of the design model: with a static W_u, σ̄(S_o) on the full-order
+plant peaked at 4.4–6.7 there (spill-over). Measured on the turboexpander: constant-
+Lyapunov γ 1.10, σ̄(S_o) 1.66–1.68 at 20/140/300 Hz, every full-order loop stable (least
+damped: 1.95 kHz, ζ 0.005). Before the rule (0.05 → 0.5 at 1.4 kHz on D_u = 1 A): γ 0.94
+frozen, 1.05 rate-bounded, 1.07 constant, σ̄(S_o) 1.71–1.72.
 """
 
 from __future__ import annotations
@@ -212,6 +213,14 @@ def check_full_order(cfg, controller_at, name: str, allow_unstable: bool = False
     return worst
 
 
+def _spec_weights(cfg) -> Weights:
+    """The rig's LPV weights: ``[design.lpv]`` completed by the rules of
+    :func:`ambseal.control.specs.design_spec` (D_e, D_u and W_u from the machine)."""
+    from .specs import design_spec
+
+    return design_spec(cfg).weights["lpv"]
+
+
 def lpv_generalized_plants(L, weights: Weights, speeds_rad_s=None):
     """Generalised plants (P5 Figs. 8–9, nominal: inputs [d_i, d_o, u], outputs
     [z_p, z_u, y]) of the LPV plant ``L`` at its grid speeds (or ``speeds_rad_s``).
@@ -248,7 +257,8 @@ def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int = 10,
     lyapunov : str, optional
         ``"constant"``, ``"affine"`` or ``"quadratic"``; see :func:`lpvsyn`.
     weights : Weights, optional
-        ``default_weights("lpv")`` if omitted (module docstring).
+        The rig's ``[design.lpv]`` weights completed by the specification's rules if
+        omitted (module docstring).
     states : int
         Mechanical states of the design model (8: rigid body; 12 adds the first bending
         pair).
@@ -283,7 +293,7 @@ def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int = 10,
     from .lpv_plant import lpv_plant
 
     t0 = time.perf_counter()
-    w = weights or default_weights("lpv")
+    w = weights or _spec_weights(cfg)
     lo, hi = (float(x) for x in speeds_hz)
     if int(n_grid) < 2:
         raise SynthesisError(f"design_lpv: n_grid={n_grid}; the speed grid needs at least "
@@ -333,7 +343,8 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
         ``"mu"``: D–K iteration (:func:`musyn`) with the seal's k ± ``seal_k_uncertainty``
         (P3 §3.1: ±40 %); a few seconds per D–K iteration on the turboexpander.
     weights : Weights, optional
-        ``default_weights("lpv")`` if omitted (module docstring).
+        The rig's ``[design.lpv]`` weights completed by the specification's rules if
+        omitted (module docstring).
     states : int
         Mechanical states of the design model (same basis as :func:`design_lpv`).
     allow_unstable : bool
@@ -359,7 +370,7 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
     if method not in ("hinf", "mu"):
         raise ConfigError(f"design_frozen: method={method!r}, expected 'hinf' or 'mu'")
     t0 = time.perf_counter()
-    w = weights or default_weights("lpv")
+    w = weights or _spec_weights(cfg)
     f = float(speed_hz)
     if method == "hinf":
         from .hinf import hinfsyn

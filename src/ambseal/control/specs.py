@@ -43,6 +43,13 @@ the value the thesis used on its test facility, P5, where it names one):
   unbalance band, at most f_b/2 (test rig: 1.3 × 200 Hz = 260 Hz, below 557/2 Hz). The
   other weights are the method's tuning on the scaled plant
   (:func:`ambseal.control.weights.default_weights`).
+* **LPV weights** (P3 Eq. 11, §3.3): the same D_e and D_u; W_u a high-pass whose
+  low-frequency gain is μ's constant W_u (above) and which rises tenfold above its corner
+  at the actuator bandwidth f_a, rolling the controller off at the bending modes the
+  rigid-body LPV design model leaves out (turboexpander: D_u 0.42 A, W_u 0.037 → 0.37 at
+  1.5 kHz, where P3 §3.3 puts the crossover at 1.4 kHz and the tuning before this rule had
+  0.05 → 0.5 on D_u = 1 A). M = 2, ω_B = 2π·50 rad/s and A = 1e-2 stay the method's
+  tuning (P3's 20 ms settling; :mod:`ambseal.control.lpv_design`).
 * **Uncertainty** (μ): the cross-coupled stiffness k ± 100 % of every seal, by its own
   name (P5 §4.1); a seal with k = 0 at the design pressure, or a rig without a seal, has
   none (a note says so, and μ then designs for robust performance on the nominal plant).
@@ -72,6 +79,8 @@ OMEGA_B_TIMES_TI = 2.5
 WU_PID_PEAKS = 2.5
 #: μ's orbit demand in multiples of D_e (module docstring)
 ORBIT_PER_DE = 0.5
+#: the LPV design's W_u: high-frequency over low-frequency gain (module docstring)
+LPV_WU_RISE = 10.0
 
 
 def round_125(x: float) -> float:
@@ -439,17 +448,22 @@ def _weights(d, method: str, mach: Machine, d_e: float, d_u: float, band_hi: flo
 
     spec = getattr(d, method)
     w = default_weights(method)
-    if method != "lpv" and d_e is not None and d_u is not None:
+    if d_e is not None and d_u is not None:
         w = replace(w, d_e=d_e, d_u=d_u)
-    if method != "lpv":
+    if method in ("mu", "lpv") and d_e is not None and d_u is not None:
+        k_peak = pid["kp"] * (1 + 1 / pid["eps"])  # P5 Eq. 6 at high frequency
+        w = replace(w, wu_gain=_sig2(d_u / (WU_PID_PEAKS * d_e * k_peak)))
+        rules[f"{method}.wu_gain"] = (f"D_u/({WU_PID_PEAKS:g} D_e Kp (1 + 1/ε)): |K| ≤ "
+                                      f"{WU_PID_PEAKS:g}× the reference PID's peak where "
+                                      "S_o ≈ 1")
+    if method == "lpv":
+        w = replace(w, wu_hf_gain=LPV_WU_RISE * w.wu_gain, wu_corner_hz=mach.actuator_hz)
+        rules["lpv.wu_hf_gain"] = f"{LPV_WU_RISE:g}× wu_gain (P3 §3.3: a high-pass W_u)"
+        rules["lpv.wu_corner_hz"] = "the actuator bandwidth f_a (P3 §3.3: 1.4 kHz, f_a 1.5 kHz)"
+    else:
         w = replace(w, omega_b=OMEGA_B_TIMES_TI / pid["ti"])
         rules[f"{method}.omega_b_rad_s"] = (f"{OMEGA_B_TIMES_TI:g}/T_i of the reference PID "
                                             "(integral action like the PID's, P5 §4.3)")
-    if method == "mu" and d_e is not None and d_u is not None:
-        k_peak = pid["kp"] * (1 + 1 / pid["eps"])  # P5 Eq. 6 at high frequency
-        w = replace(w, wu_gain=_sig2(d_u / (WU_PID_PEAKS * d_e * k_peak)))
-        rules["mu.wu_gain"] = (f"D_u/({WU_PID_PEAKS:g} D_e Kp (1 + 1/ε)): |K| ≤ "
-                               f"{WU_PID_PEAKS:g}× the reference PID's peak where S_o ≈ 1")
     if method == "mu" and d_e is not None:
         roll = 1.3 * unb_range[1]
         if mach.first_bending_hz is not None:

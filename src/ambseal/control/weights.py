@@ -383,9 +383,9 @@ def default_weights(method: str) -> Weights:
     μ = 0.97 and a slower settling (0.110 s).
 
     ``"lpv"`` (LPV and frozen-speed designs, P3 Eq. 11, §3.3): M = 2, ω_B = 2π·50 rad/s,
-    A = 1e-2, high-pass W_u 0.05 → 0.5 with its corner at 1.4 kHz, D_e = 20 µm, D_u = 1 A
-    (the turboexpander's tuning; the reasoning is in :mod:`ambseal.control.lpv_design`;
-    not yet derived from the machine).
+    A = 1e-2 (the reasoning is in :mod:`ambseal.control.lpv_design`); W_u's gains and
+    corner and the scalings here are placeholders: the specification derives them from the
+    rig (:mod:`ambseal.control.specs`, "LPV weights").
 
     Raises
     ------

@@ -278,7 +278,7 @@ def _acquire(args: argparse.Namespace) -> int:
     from .files import writable_folder
     from .identify import signals
     from .identify.data import save_measurement
-    from .control.pid import reference_controller
+    from .commands import target_pid
     from .identify.stages import acquire
     from .model.amb import channel_names
 
@@ -321,7 +321,7 @@ def _acquire(args: argparse.Namespace) -> int:
     except ValueError as exc:
         raise ConfigError(f"acquire: {exc}") from None
     try:
-        meas = acquire(cfg, truth, ex, controller=reference_controller(cfg),
+        meas = acquire(cfg, truth, ex, controller=target_pid(cfg),
                        pressure_bar=args.pressure_bar, seed=args.seed)
     except AmbsealError as exc:  # the simulation runs on the truth file's values
         raise _named(exc, [args.truth], f"{args.truth} (with {args.rig})") from None

@@ -20,7 +20,7 @@ from .files import writable_folder, write_json, write_text
 __all__ = ["Identified", "identification_stage", "facility_impulses", "design_files",
            "identify_files", "export_design", "show_defaults",
            "validate_summary", "track_files", "export_all", "digital_for", "choice_margins",
-           "judged_margins", "digitals_for"]
+           "judged_margins", "digitals_for", "target_pid"]
 
 
 def _finite(x: float) -> float | None:
@@ -55,12 +55,13 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
         from .control.specs import design_spec
 
         om = design_omega(*design_spec(cfg).synthesis_band_hz)  # the μ design's grid
-        rise = ((lambda Kr: design_rise(result, Kr, om)) if method in ("hinf", "mu")
+        rise = ((lambda Kr: design_rise(result, Kr, om, fs / 2)) if method in ("hinf", "mu")
                 else None)
         check_rate(controller, fs, delay, removable=rise is not None)  # before the plants
         cache = {} if cache is None else cache
         if "plants" not in cache:
-            cache["plants"] = sampled_plants([plant(*c) for c in conds], fs)
+            cache["plants"] = sampled_plants([plant(*c) for c in conds], fs,
+                                             delay_samples=delay)
         return digital_controller(controller, fs, cache["plants"],
                                   delay_samples=delay, rise=rise)
     from .control.controller import SPEED
@@ -116,6 +117,26 @@ def digitals_for(cfg, designs, points, say=None) -> tuple[dict, dict]:
             if say is not None:
                 say(cannot_run[d.method])
     return digitals, cannot_run
+
+
+def target_pid(cfg):
+    """The rig's reference PID (``[controller.pid]``, else derived from the rig) as it runs
+    on the target: the discrete controller :func:`digital_for` chooses and ``ambseal run``
+    exports and judges (:class:`~ambseal.identify.loop.DiscreteController`, with its
+    discretisation in ``description``) — the one that levitates the virtual facility in
+    ``ambseal acquire`` and the main job's identification."""
+    from dataclasses import replace
+
+    from .analysis.judge import operating_points
+    from .control.recipes import design, pid_from_rig
+
+    res = design(cfg, "pid")
+    dc = digital_for(cfg, "pid", res.K, res, operating_points(cfg))
+    p = cfg.controller.pid
+    gains = ({k: getattr(p, k) for k in ("kp", "ti", "td", "eps")} if p is not None else
+             {k: pid_from_rig(cfg)[k] for k in ("kp", "ti", "td", "eps")})
+    return replace(dc.discrete, description={"type": "pid", **gains, "discretisation": dc.method,
+                                             "prewarp_hz": dc.prewarp_hz})
 
 
 def _conditions(cfg, points) -> list[tuple[float, float]]:

@@ -46,7 +46,7 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
 ``[controller]``
     ``sample_rate_hz``: the rate of the digital controller (default 10 kHz);
     ``delay_samples``: the target's computation delay in whole samples (default 1: output
-    from sample k applied at k + 1; :mod:`ambseal.control.digital`).
+    from sample k applied at k + 1; :mod:`ambseal.control.delay`).
 ``[operating]``
     ``speed_rpm``, ``pressure_bar`` (the nominal pressure drop across the seals),
     ``speed_range_hz`` (optional ``[low, high]``: the operating speed range, e.g. for a

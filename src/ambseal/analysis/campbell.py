@@ -146,16 +146,22 @@ class ClosedLoopModes:
 
 
 def closed_loop_state_matrix(cfg, controller=None, *, speed_hz: float,
-                             pressure_bar: float | None = None):
-    """The state matrix of the full-order loop of :func:`ambseal.analysis.judge.judge` and
-    the rig's mesh: ``(A_cl, mesh)``, states ``[q; q̇; actuator; controller]``.
+                             pressure_bar: float | None = None, delay: bool = False):
+    """The state matrix of the full-order loop and the rig's mesh: ``(A_cl, mesh)``, states
+    ``[q; q̇; actuator; controller]``; with ``delay`` ``[q; q̇; actuator; delay;
+    controller]``, the loop of :func:`ambseal.analysis.judge.judge` (the digital
+    controller's hold + computation delay as a Padé lag,
+    :func:`ambseal.control.delay.loop_delay`). The closed-loop modes are those of the
+    continuous controller (no delay: the lag's own poles are no rotor modes).
 
     Without a controller (or a rig without AMBs) the open-loop plant's A; a scheduled
     controller is frozen at the speed.
     """
     from ..control.controller import frozen
+    from ..control.delay import loop_delay
     from ..model.rig import build_plant
     from ..model.rotor import build_mesh
+    from .judge import delayed_plant
     from .loops import closed_loop
 
     plant = build_plant(cfg, pressure_bar=pressure_bar, speed_rpm=60.0 * speed_hz)
@@ -164,6 +170,9 @@ def closed_loop_state_matrix(cfg, controller=None, *, speed_hz: float,
         return plant.A, mesh
     G = plant.select_inputs([plant.input_names[j] for j in plant.current_inputs()]
                             ).to_statespace()
+    if delay:
+        L = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples).system
+        G = delayed_plant(G, list(range(G.ninputs)), L)
     K = frozen(controller, 2 * math.pi * speed_hz)
     return np.asarray(closed_loop(G, K).system.A), mesh
 

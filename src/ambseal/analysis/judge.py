@@ -7,6 +7,18 @@ Every number is taken on the full-order plant (flexible modes included), whateve
 the controller was designed on; peaks on frequency grids refined around the lightly damped
 closed-loop poles (:func:`ambseal.analysis.loops.resolved_grid`).
 
+**The controller's delay is part of the loop.** A digital controller acts through its
+zero-order hold and ``[controller] delay_samples`` of computation: about
+τ = (delay_samples + ½)/sample_rate_hz of pure delay (:mod:`ambseal.control.delay`). The
+continuous loop is judged with that delay as a Padé lag in every current input of the plant
+(:func:`ambseal.control.delay.loop_delay`: the lowest order within 5° of phase up to
+Nyquist; test rig 150 µs, order 4), so that its numbers are those of the controller as it
+will act; the case records it as ``delay`` (``delay_s``, ``pade_order``,
+``phase_error_deg``, ``band_top_hz``). On the
+test rig the PID's continuous σ̄(S_o) peaks then equal the sampled loop's to 0.1 %
+(13.36 against 13.37 at 2.04 bar, 7.43 against 7.43 at 0 bar; without the delay they were
+9.36 and 4.94).
+
 **What runs is judged too**: given the discrete controller of the target (with its
 computation delay, :class:`ambseal.control.digital.DigitalController`), the same numbers are
 taken on the loop of that controller with the full-order plant sampled exactly (zero-order
@@ -31,9 +43,9 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["JudgeSettings", "OperatingPoint", "judge", "judge_case", "judge_spinup",
-           "sampled_plant", "operating_points", "speed_scheduled", "judge_settings",
-           "unstable_open_loop_poles", "condition_values", "frozen_at", "frozen_discrete",
-           "judge_jobs"]
+           "sampled_plant", "delayed_plant", "operating_points", "speed_scheduled",
+           "judge_settings", "unstable_open_loop_poles", "condition_values", "frozen_at",
+           "frozen_discrete", "judge_jobs"]
 
 
 @dataclass(frozen=True)
@@ -207,6 +219,7 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
         ``poles`` (the closed-loop poles, rad/s); the discrete loop's under
         ``curves["discrete"]`` (its ``poles`` are z).
     """
+    from ..control.delay import loop_delay
     from ..model.rig import build_plant
 
     s = settings or judge_settings(cfg)
@@ -217,13 +230,29 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
     P = plant.to_statespace()
     case = {"controller": name, "pressure_bar": point.pressure_bar,
             "speed_hz": point.speed_rpm / 60.0}
-    body, curves = _judge_loop(cfg, P, cur, force, controller, s, impulse)
+    dl = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples)
+    body, curves = _judge_loop(cfg, delayed_plant(P, cur, dl.system), cur, force, controller,
+                               s, impulse)
     case.update(body)
+    case["delay"] = dl.to_dict()
     if discrete is not None:
         Pd = sampled_plant(P, float(discrete.dt))
         case["discrete"], curves["discrete"] = _judge_loop(cfg, Pd, cur, force, discrete,
                                                            s, impulse)
     return case, curves
+
+
+def delayed_plant(P, cur, delay):
+    """The continuous plant ``P`` with the SISO ``delay`` system in front of each current
+    input ``cur`` (:func:`ambseal.lti.interconnect.series_inputs`), signal names kept."""
+    import control
+
+    from ..lti.interconnect import series_inputs
+
+    L = tuple(np.asarray(getattr(delay, m), float) for m in ("A", "B", "C", "D"))
+    A, B, C, D = series_inputs(tuple(np.asarray(getattr(P, m), float) for m in ("A", "B", "C",
+                                                                               "D")), L, cur)[:4]
+    return control.ss(A, B, C, D, inputs=list(P.input_labels), outputs=list(P.output_labels))
 
 
 def sampled_plant(P, dt: float):

@@ -347,7 +347,8 @@ def boundary_case(case: dict, rig: dict, controllers: dict, tol_bar: float) -> f
     lo, hi = case["last_stable_bar"], case["first_unstable_bar"]
     while hi - lo > tol_bar:
         mid = 0.5 * (lo + hi)
-        A, _ = closed_loop_state_matrix(cfg, K, speed_hz=case["speed_hz"], pressure_bar=mid)
+        A, _ = closed_loop_state_matrix(cfg, K, speed_hz=case["speed_hz"], pressure_bar=mid,
+                                        delay=True)  # the loop judge() judges
         lo, hi = (mid, hi) if np.linalg.eigvals(A).real.max() < 0 else (lo, mid)
     return 0.5 * (lo + hi)
 

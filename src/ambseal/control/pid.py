@@ -189,8 +189,11 @@ def _corner_for_target(cfg, kp: float, ti: float, td: float) -> float:
 
 
 def reference_controller(cfg, method: str = "tustin"):
-    """The rig's reference PID (``[controller.pid]``) as the digital controller that runs
-    at ``[controller] sample_rate_hz`` (Tustin by default), described by its parameters.
+    """The rig's reference PID (``[controller.pid]``) discretised plainly at
+    ``[controller] sample_rate_hz`` (Tustin by default), described by its parameters: the
+    controller a record of a real rig names by its PID parameters. What ambseal runs on
+    the target (``ambseal acquire``, ``ambseal run``) is the discretisation chosen and
+    judged by :mod:`ambseal.control.digital` (:func:`ambseal.commands.target_pid`).
 
     Parameters
     ----------

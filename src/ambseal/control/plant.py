@@ -3,13 +3,17 @@
 Interconnection (all signals scaled, P5 §3.1.4: ``D_e^{-1} G_f D_u`` with D_e = 20 µm the
 largest allowed displacement error and D_u = 1 A the largest allowed current change)::
 
-    plant current    i   = D_u (u + W_1 d_i)                    (A; actuator G_act inside G)
+    plant current    i   = D_u (L u + W_1 d_i)                  (A; actuator G_act inside G)
     force            f   = W_f d_f                              (N, optional force inputs)
     perturbed plant  ẋ   = A_c x + B_Δ w_Δ + B i + B_f f         (G_fi, P5 Eq. 5)
                      z_Δ = C_Δ x + D_Δ i + D_Δf f,   w_Δ = Δ z_Δ
     error            e   = (C x + D i + D_f f) / D_e + W_2 d_o   (-, displacement / D_e)
     performance      z_p = W_p e,   z_u = W_u u
     measurement      y   = e
+
+L is the controller's hold + computation delay (a Padé system,
+:mod:`ambseal.control.delay`) when ``actuator_delay`` is given, else 1: the design then
+pays the phase the sampled loop loses; the disturbance ``d_i`` enters after it.
 
 P is built by connecting named signals (``control.interconnect``): the plant ``G`` with its
 Δ channels, ``E`` (error), ``I`` (current), and the weights, each a ``control.StateSpace``
@@ -295,6 +299,7 @@ def generalized_plant(
     output_disturbance: float = 1.0,
     force_disturbance: Any = None,
     force_positions: tuple = (),
+    actuator_delay: Any = None,
 ) -> GeneralizedPlant:
     """Build the generalised plant of P5 Figs. 8–9 from a rig or a plant.
 
@@ -336,6 +341,10 @@ def generalized_plant(
         ``d_o``. Needs force inputs: ``force_positions`` from a rig, or a plant built with them.
     force_positions : tuple of float
         Positions (m) of force inputs when building from a rig.
+    actuator_delay : control.StateSpace, optional
+        SISO stable approximation L of the controller's delay, put on every control channel
+        between ``u`` and the current (``DesignDelay.system`` of
+        :func:`ambseal.control.delay.design_delay`); its states join P after the weights'.
 
     Returns
     -------
@@ -366,7 +375,7 @@ def generalized_plant(
     params = _ranges(full.select_inputs([full.input_names[i] for i in cur]), uncertainty or {})
     centre = full.with_values({q.name: q.centre for q in params}) if params else full
     parts = _parts(centre, params, cur, fcols, Wp, Wu, input_disturbance, output_disturbance,
-                   force_disturbance, d_e, d_u)
+                   force_disturbance, d_e, d_u, actuator_delay)
     if parts.W1.nstates or (parts.Wf is not None and parts.Wf.nstates):
         parts = _balance(parts)
     P = _connect(parts)
@@ -384,6 +393,7 @@ class _Parts:
     W1: Any
     Wf: Any
     statics: tuple
+    delay: Any
     inputs: tuple   # internal names of P's inputs, in order
     outputs: tuple  # internal names of P's outputs, in order
     labels_in: tuple
@@ -419,13 +429,13 @@ def _source_plant(source, reduced, pressure_bar, states, force_positions, forces
     return full, cur, (fcols if forces else [])
 
 
-def _parts(centre, params, cur, fcols, Wp, Wu, W1, W2, Wf, d_e, d_u) -> _Parts:
+def _parts(centre, params, cur, fcols, Wp, Wu, W1, W2, Wf, d_e, d_u, L=None) -> _Parts:
     """The named subsystems of P5 Figs. 8–9 (module docstring):
 
     * ``G`` — the plant at the centre of the ranges with its Δ channels, inputs
       ``[w_Δ, i, f]``, outputs ``[z_Δ, y_m]`` (A, N → m); each channel w_θ = h δ z_θ with
       h split between B_θ and C_θ, D_θ so that both have similar norms (conditioning);
-    * ``E`` — ``e = y_m/D_e + W_2 d_o``; ``I`` — ``i = D_u (u + W_1 d_i)``;
+    * ``E`` — ``e = y_m/D_e + W_2 d_o``; ``I`` — ``i = D_u (L u + W_1 d_i)``;
     * the weights ``W_p`` (e → z_p), ``W_u`` (u → z_u), ``W_1`` (d_i), ``W_f`` (d_f → f).
     """
     import control
@@ -464,8 +474,10 @@ def _parts(centre, params, cur, fcols, Wp, Wu, W1, W2, Wf, d_e, d_u) -> _Parts:
                    inputs=wD + i_ + f_, outputs=zD + ym, name="G")
     E = control.ss([], [], [], np.hstack([np.eye(ny) / d_e, W2 * np.eye(ny)]),
                    inputs=ym + do, outputs=e, name="E")
+    ud = _sig("ud", chans) if L is not None else u
     I = control.ss([], [], [], np.hstack([d_u * np.eye(nu), d_u * np.eye(nu)]),
-                   inputs=u + diw, outputs=i_, name="I")
+                   inputs=ud + diw, outputs=i_, name="I")
+    L_d = _named(diagonal_weight(L, nu, "actuator_delay"), u, ud, "L") if L is not None else None
     Wp_d = _named(diagonal_weight(Wp, ny, "W_p"), e, zp, "Wp")
     Wu_d = _named(diagonal_weight(Wu, nu, "W_u", biproper=True), u, zu, "Wu")
     W1_d = _named(diagonal_weight(W1, nu, "W_1"), di, diw, "W1")
@@ -478,8 +490,9 @@ def _parts(centre, params, cur, fcols, Wp, Wu, W1, W2, Wf, d_e, d_u) -> _Parts:
                + [f"y_{c}" for c in outs])
     snames = (list(centre.state_names) + [f"Wp{i}" for i in range(Wp_d.nstates)]
               + [f"Wu{i}" for i in range(Wu_d.nstates)] + [f"W1_{i}" for i in range(W1_d.nstates)]
-              + ([f"Wf_{i}" for i in range(Wf_d.nstates)] if nf else []))
-    return _Parts(G, Wp_d, Wu_d, W1_d, Wf_d, (E, I), tuple(ins), tuple(outputs),
+              + ([f"Wf_{i}" for i in range(Wf_d.nstates)] if nf else [])
+              + ([f"L{i}" for i in range(L_d.nstates)] if L is not None else []))
+    return _Parts(G, Wp_d, Wu_d, W1_d, Wf_d, (E, I), L_d, tuple(ins), tuple(outputs),
                   tuple(lab_in), tuple(lab_out), tuple(snames), nd)
 
 
@@ -497,7 +510,7 @@ def _connect(parts: _Parts, W1=None, Wf=None):
     W1 = parts.W1 if W1 is None else W1
     Wf = parts.Wf if Wf is None else Wf
     syslist = [parts.G, parts.Wp, parts.Wu, W1] + ([Wf] if Wf is not None else []) \
-        + list(parts.statics)
+        + ([parts.delay] if parts.delay is not None else []) + list(parts.statics)
     return control.interconnect(syslist, inplist=list(parts.inputs),
                                 outlist=list(parts.outputs), inputs=list(parts.inputs),
                                 outputs=list(parts.outputs), check_unused=False)

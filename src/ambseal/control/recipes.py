@@ -99,6 +99,9 @@ class DesignResult:
         :func:`full_order_check` of the delivered controller.
     allow_unstable : bool
         True when an unstable full-order loop was accepted on request.
+    delay : dict or None
+        The controller's hold + computation delay the design model carries
+        (:meth:`ambseal.control.delay.DesignDelay.to_dict`); None for the PID.
     steps : tuple of str
         The automatic design-loop steps taken (model enlargements).
     notes : tuple of str
@@ -121,6 +124,7 @@ class DesignResult:
     design_states: int | None = None
     full_order: dict | None = None
     allow_unstable: bool = False
+    delay: dict | None = None
     steps: tuple = ()
     notes: tuple = ()
     verdict: str = ""
@@ -134,7 +138,8 @@ class DesignResult:
                 "uncertainty": {k: list(v) for k, v in self.uncertainty.items()},
                 "iterations": len(self.history), "reduction": self.reduction,
                 "design_states": self.design_states, "full_order": self.full_order,
-                "allow_unstable": self.allow_unstable, "steps": list(self.steps),
+                "allow_unstable": self.allow_unstable, "delay": self.delay,
+                "steps": list(self.steps),
                 "notes": list(self.notes), "verdict": self.verdict}
 
     def to_dict(self) -> dict:
@@ -164,7 +169,7 @@ def _pid(cfg, p):
                         notes=notes)
 
 
-def full_order_check(cfg, K, conditions) -> dict:
+def full_order_check(cfg, K, conditions, *, delay=None) -> dict:
     """Close a physical controller with the full-order plant at each condition.
 
     Parameters
@@ -173,6 +178,9 @@ def full_order_check(cfg, K, conditions) -> dict:
     K : control.StateSpace
         Displacements (m) → current references (A), negative feedback ``i = −K y``.
     conditions : iterable of (pressure_bar, speed_hz)
+    delay : control.StateSpace, optional
+        SISO delay model put after K on every channel (the design model's
+        :func:`~ambseal.control.delay.design_delay`): the loop the design was made for.
 
     Returns
     -------
@@ -182,7 +190,7 @@ def full_order_check(cfg, K, conditions) -> dict:
         and ``damping`` (ζ = −Re λ/|λ|, negative when unstable). A pole counts as unstable
         when Re λ > 1e-9·max|λ| (the rounding level of the eigenvalue solver).
     """
-    from ..lti.interconnect import feedback_poles
+    from ..lti.interconnect import feedback_poles, series_inputs
     from ..model.rig import build_plant
 
     Km = tuple(np.asarray(getattr(K, m), float) for m in ("A", "B", "C", "D"))
@@ -191,6 +199,8 @@ def full_order_check(cfg, K, conditions) -> dict:
         plant = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * f)
         cur = plant.current_inputs()
         G = (plant.A, plant.B[:, cur], plant.C, plant.D[:, cur])
+        if delay is not None:  # the same SISO delay on every channel: before G = after K
+            G = series_inputs(G, tuple(np.asarray(getattr(delay, m), float) for m in "ABCD"))[:4]
         lam = feedback_poles(G, Km)
         k = int(np.argmax(lam.real))
         margin = lam[k].real / np.abs(lam).max()
@@ -285,6 +295,7 @@ def design(
     >>> r.K.ninputs, r.K.noutputs                    # doctest: +SKIP
     (4, 4)
     """
+    from .delay import design_delay
     from .specs import design_spec
 
     if method not in METHODS:
@@ -305,12 +316,15 @@ def design(
     n = int(states or sp.model_states)
     om = None if omega is None else np.asarray(omega, float)
     conditions = [(q, f) for q in sp.pressures_bar for f in sp.speeds_hz]
+    dl = design_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples,
+                      sp.synthesis_band_hz[1], max_order=1)
     steps: list[str] = []
     t0 = time.perf_counter()
     for attempt in range(enlarge + 1):
         r = _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to,
-                        max_iter or sp.max_iter, sp.dk_order if dk_order is None else dk_order)
-        check = full_order_check(cfg, r.K, conditions)
+                        max_iter or sp.max_iter, sp.dk_order if dk_order is None else dk_order,
+                        dl)
+        check = full_order_check(cfg, r.K, conditions, delay=dl.system)
         if check["stable"] or attempt == enlarge or states is not None:
             break
         n_new = _states_to_keep(cfg, p, check["mode_hz"])
@@ -335,7 +349,7 @@ def design(
         uncertainty={q.name: (q.low, q.high) for q in r.gp.parameters},
         elapsed_s=time.perf_counter() - t0, reduction=r.reduction, plant=r.gp,
         design_states=n, full_order=check, allow_unstable=not check["stable"],
-        steps=tuple(steps), notes=tuple(sp.notes), verdict=_verdict(method, r, check))
+        delay=dl.to_dict(), steps=tuple(steps), notes=tuple(sp.notes), verdict=_verdict(method, r, check))
 
 
 @dataclass(frozen=True, eq=False)
@@ -351,7 +365,7 @@ class _Synthesis:
     mu_omega: float | None = None
 
 
-def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order):
+def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl):
     """One synthesis on an n-state design model, reduced, as a physical controller."""
     from .plant import generalized_plant
 
@@ -359,7 +373,8 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
     fpos = tuple(w.force_positions_m or sp.force_positions_m) if Wf is not None else ()
     gp = generalized_plant(cfg, w.Wp(), w.Wu(), uncertainty=unc if method == "mu" else None,
                            pressure_bar=p, states=n, input_disturbance=w.W1(),
-                           force_disturbance=Wf, force_positions=fpos, d_e=w.d_e, d_u=w.d_u)
+                           force_disturbance=Wf, force_positions=fpos, d_e=w.d_e, d_u=w.d_u,
+                           actuator_delay=dl.system)
     mu_omega = None
     if method == "hinf":
         from .hinf import hinfsyn
@@ -379,8 +394,8 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
         P_red, blocks, mu_omega = gp.P, gp.blocks, float(r.mu_omega)
     order_full = int(K_P.nstates)
     if reduce_to == "auto":
-        reduce_to = sp.order_max or (gp.design_plant.A.shape[0]
-                                     + gp.ncon * (gp.Wp.nstates + gp.Wu.nstates))
+        reduce_to = sp.order_max or (gp.design_plant.A.shape[0] + gp.ncon * (
+            gp.Wp.nstates + gp.Wu.nstates + dl.system.nstates))
         auto = not sp.order_max
     else:
         auto = False

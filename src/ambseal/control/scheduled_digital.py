@@ -28,8 +28,8 @@ from ..errors import SynthesisError
 from ..identify.loop import DiscreteController
 from .controller import SPEED, ScheduledController
 from .digital import (FAST_FRACTION, METHODS, _json_safe, check_rate, choose_method, discretize_as,
-                      prewarp_frequency_hz, residualize, sampled_plants, split_fast,
-                      with_delay)
+                      peak_difference, prewarp_frequency_hz, residualize, sampled_plants,
+                      split_fast, with_delay)
 
 __all__ = ["ScheduledDigital", "scheduled_digital", "INTERPOLATION", "interpolation_law"]
 
@@ -149,6 +149,8 @@ class ScheduledDigital(ScheduledController):
                 "fast_fraction_of_nyquist": FAST_FRACTION,
                 "removed_poles_hz": [float(f) for f in self.removed_poles_hz],
                 "order": int(self.discrete[0].shape[1]),
+                "peak_difference": peak_difference(self.method, self.candidates,
+                                                   self.removed_poles_hz),
                 "candidates": [dict(c) for c in self.candidates]})
 
 
@@ -212,8 +214,8 @@ def scheduled_digital(K: ScheduledController, grid, sample_rate_hz: float,
         return [tuple(_interp(s, W, X) for X in st) for s in sp]
 
     discrete.tables = {}
-    m, _, cands = choose_method(sampled_plants(G, fs), cont, discrete, int(delay_samples),
-                                methods, f_pw, name)
+    m, _, cands = choose_method(sampled_plants(G, fs, delay_samples=delay_samples), cont,
+                                discrete, int(delay_samples), methods, f_pw, name)
     at = ({"speeds_hz": [s / (2 * np.pi) for s in sp]} if K.parameter == SPEED
           else {"values": [float(s) for s in sp]})
     cands = tuple({**c, **at} for c in cands)

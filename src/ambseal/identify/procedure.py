@@ -138,7 +138,7 @@ def thesis_procedure(
         The facility's true values (never read by a fit).
     controller : DiscreteController
         The digital controller that levitates the rotor in every run (the rig's reference
-        PID: :func:`ambseal.control.pid.reference_controller`).
+        PID as it runs on the target: :func:`ambseal.commands.target_pid`).
     seed : int
         Seed of excitations and noise.
     progress : callable, optional

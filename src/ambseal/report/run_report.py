@@ -290,7 +290,12 @@ def _discrete_section(metrics: dict) -> list[dict]:
             f"{d['sample_rate_hz']:g} Hz, {disc.get('delay_samples', '?')} sample(s) delay")
     if not lines:
         return []
-    return [{"title": "On the target (discrete judgement)", "text": "; ".join(lines) + "."}]
+    why = [f"{m}: {d['peak_difference']['explanation']}" for m, c in metrics["controllers"].items()
+           for d in [c.get("discretisation") or {}]
+           if (d.get("peak_difference") or {}).get("explanation")]
+    head = ". ".join(why) + ". " if why else ""
+    return [{"title": "On the target (discrete judgement)",
+             "text": head + "; ".join(lines) + "."}]
 
 
 def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: list,

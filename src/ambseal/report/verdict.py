@@ -90,6 +90,10 @@ class Verdict:
         Worst unbalance orbit (µm), impulse peak (µm) and 2 % settling time (s).
     clearances_um : dict
         Clearances the orbit is set against, e.g. ``{"air gap": 500.0}`` (µm).
+    target_difference : float or None
+        Largest relative difference between the σ̄(S_o) peak of the controller as it runs
+        (the cases' ``discrete`` blocks) and the continuous one, over the conditions where
+        both loops are stable (-); None without discrete blocks.
     """
 
     controller: str
@@ -103,6 +107,7 @@ class Verdict:
     impulse_peak_um: float | None
     impulse_settling_s: float | None
     clearances_um: dict
+    target_difference: float | None = None
 
     @property
     def stable_range(self) -> str:
@@ -134,7 +139,20 @@ class Verdict:
         gap = [c for c in self.clearances_um.values() if c]
         if self.orbit_um is not None and gap and self.orbit_um > 0.5 * min(gap):
             text += f"; the unbalance orbit uses over half of the clearance"
+        from ..control.digital import PEAK_TOLERANCE
+
+        if self.target_difference is not None and self.target_difference > PEAK_TOLERANCE:
+            text += (f"; as it runs on the target its σ̄(S_o) peak differs from the continuous "
+                     f"one by {100 * self.target_difference:.0f} % (see “On the target”)")
         return text + "."
+
+
+def _target_difference(cs: Sequence[Mapping]) -> float | None:
+    """Largest |discrete − continuous| / continuous σ̄(S_o) peak over the cases."""
+    pairs = [(c["sensitivity_peak"], (c.get("discrete") or {}).get("sensitivity_peak"))
+             for c in cs if c.get("sensitivity_peak")]
+    diffs = [abs(d - x) / x for x, d in pairs if d is not None]
+    return max(diffs) if diffs else None
 
 
 def verdicts(cases: Sequence[Mapping], clearances_um: Mapping[str, float] | None = None
@@ -162,7 +180,7 @@ def verdicts(cases: Sequence[Mapping], clearances_um: Mapping[str, float] | None
             sigma_peak=peak("sensitivity_peak"), orbit_um=peak("unbalance_peak_um"),
             impulse_peak_um=peak("impulse_peak_um"),
             impulse_settling_s=peak("impulse_settling_s"),
-            clearances_um=dict(clearances_um or {})))
+            clearances_um=dict(clearances_um or {}), target_difference=_target_difference(cs)))
     return out
 
 

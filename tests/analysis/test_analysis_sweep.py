@@ -50,7 +50,8 @@ def _tiny_rig() -> dict:
     """A rigid rotor (shaft 10⁵ times stiffer than its supports, 16.17 kg) on two AMBs
     closed by proportional gains into k = 10⁶ N/m each, with a seal at mid-span; a 1 MHz
     controller, so that its delay barely moves the continuous-controller closed forms."""
-    return {"controller": {"sample_rate_hz": TINY_FS, "delay_samples": 1}, "materials": {"m": {"E": 2e16, "rho": 7850.0, "nu": 0.3}},
+    return {"controller": {"sample_rate_hz": TINY_FS, "delay_samples": 1},
+            "materials": {"m": {"E": 2e16, "rho": 7850.0, "nu": 0.3}},
             "shaft": [{"length": 0.4, "outer_diameter": 0.05, "material": "m",
                        "elements": 2}],
             "disk": [{"position": 0.2, "mass": 10.0, "Ip": 0.05, "Id": 0.1}],

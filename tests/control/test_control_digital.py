@@ -114,6 +114,59 @@ def test_export_round_trip_fixed(testrig_digital, tmp_path, suffix):
     assert [p.name for p in tmp_path.iterdir()] == [path.name]
 
 
+def _octave() -> str | None:
+    """octave-cli with the control package, or None."""
+    exe = shutil.which("octave-cli")
+    if exe is None:
+        return None
+    r = subprocess.run([exe, "--no-gui", "-q", "--eval", "pkg load control"],
+                       capture_output=True, text=True, timeout=120)
+    return exe if "error" not in r.stderr.replace("execution_exception", "") else None
+
+
+@pytest.mark.skipif(_octave() is None, reason="no octave-cli with the control package "
+                    "(Debian: apt-get install octave octave-control; .ci/run installs them "
+                    "where it can)")
+def test_mat_export_is_an_ss_in_octave(testrig_digital, tmp_path):
+    """Reference: GNU Octave's control package (peer implementation of MATLAB's ``ss``):
+    the one line documented in the README and the .mat (``pkg load control`` first) builds
+    a discrete ``ss`` with the file's Ts and channel names, whose step response (200
+    samples, every input) and frequency response (``freqresp`` at 5 frequencies up to
+    Nyquist) equal the Python discrete controller's recursion x[k+1] = A x + B y,
+    u = C x + D y and C (e^{jωT} I − A)⁻¹ B + D to 1e-9 of their largest value."""
+    from ambseal.control.export import MATLAB_LINE
+
+    dc = testrig_digital["hinf"]
+    path = export_controller(dc, tmp_path / "controller_hinf.mat")
+    line = MATLAB_LINE.format(name=path.name)
+    script = tmp_path / "check.m"
+    script.write_text("pkg load control\n" + line + "\n"
+                      "assert(isa(K, 'ss')); ts = K.Ts; names = K.InputName;\n"
+                      "y = step(K, 199 * s.Ts);\n"
+                      "w = 2 * pi * [1 30 557 2000 4900];\n"
+                      "H = freqresp(K, w);\n"
+                      "save('-v7', 'out.mat', 'y', 'H', 'ts', 'names');\n")
+    r = subprocess.run([_octave(), "--no-gui", "-q", script.name], cwd=tmp_path,
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    out = scipy.io.loadmat(tmp_path / "out.mat")
+    d = dc.discrete
+    assert float(out["ts"][0, 0]) == dc.Ts
+    assert [str(x[0]) for x in np.ravel(out["names"])] == dc.inputs
+    n, ny, nu = 200, d.C.shape[0], d.B.shape[1]
+    y = np.zeros((n, ny, nu))
+    for j in range(nu):
+        x = np.zeros(d.A.shape[0])
+        for k in range(n):
+            y[k, :, j] = d.C @ x + d.D[:, j]
+            x = d.A @ x + d.B[:, j]
+    np.testing.assert_allclose(out["y"], y, rtol=0, atol=1e-9 * np.abs(y).max())
+    z = np.exp(1j * 2 * np.pi * np.array([1, 30, 557, 2000, 4900]) * dc.Ts)
+    H = np.stack([d.C @ np.linalg.solve(zk * np.eye(d.A.shape[0]) - d.A, d.B) + d.D
+                  for zk in z], axis=-1)
+    np.testing.assert_allclose(out["H"], H, rtol=0, atol=1e-9 * np.abs(H).max())
+
+
 def test_load_controller_refuses_wrong_shapes(testrig_digital, tmp_path):
     """Reference: a controller file whose B does not match its inputs is refused with a
     DataError naming the key and the expected shape (the issue's bad-input case)."""

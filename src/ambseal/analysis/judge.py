@@ -14,10 +14,10 @@ continuous loop is judged with that delay as a Padé lag in every current input 
 (:func:`ambseal.control.delay.loop_delay`: the lowest order within 5° of phase up to
 Nyquist; test rig 150 µs, order 4), so that its numbers are those of the controller as it
 will act; the case records it as ``delay`` (``delay_s``, ``pade_order``,
-``phase_error_deg``, ``band_top_hz``). On the
-test rig the PID's continuous σ̄(S_o) peaks then equal the sampled loop's to 0.1 %
-(13.36 against 13.37 at 2.04 bar, 7.43 against 7.43 at 0 bar; without the delay they were
-9.36 and 4.94).
+``phase_error_deg``, ``band_top_hz``). On the test rig the PID's continuous σ̄(S_o) peaks
+then equal the sampled loop's to 0.1 % (13.36 against 13.37 at 2.04 bar, 7.43 against 7.43
+at 0 bar; without the delay they were 9.36 and 4.94). The closed-loop modes of
+:mod:`ambseal.analysis.campbell` stay those of the continuous controller.
 
 **What runs is judged too**: given the discrete controller of the target (with its
 computation delay, :class:`ambseal.control.digital.DigitalController`), the same numbers are
@@ -249,9 +249,10 @@ def delayed_plant(P, cur, delay):
 
     from ..lti.interconnect import series_inputs
 
-    L = tuple(np.asarray(getattr(delay, m), float) for m in ("A", "B", "C", "D"))
-    A, B, C, D = series_inputs(tuple(np.asarray(getattr(P, m), float) for m in ("A", "B", "C",
-                                                                               "D")), L, cur)[:4]
+    def mats(S):
+        return tuple(np.asarray(getattr(S, m), float) for m in ("A", "B", "C", "D"))
+
+    A, B, C, D = series_inputs(mats(P), mats(delay), cur)[:4]
     return control.ss(A, B, C, D, inputs=list(P.input_labels), outputs=list(P.output_labels))
 
 

@@ -40,7 +40,8 @@ import numpy as np
 from ..errors import ConfigError
 from ..lti.freqresp import freqresp
 
-__all__ = ["DesignDelay", "design_delay", "loop_delay", "PHASE_TOLERANCE_DEG", "MAX_ORDER"]
+__all__ = ["DesignDelay", "design_delay", "loop_delay", "check_timing", "PHASE_TOLERANCE_DEG",
+           "MAX_ORDER"]
 
 #: largest phase error (deg) of the Padé approximation allowed up to the design band's top
 PHASE_TOLERANCE_DEG = 5.0
@@ -76,6 +77,17 @@ class DesignDelay:
         """JSON-ready description (no matrices)."""
         return {"delay_s": self.delay_s, "pade_order": self.order,
                 "phase_error_deg": self.phase_error_deg, "band_top_hz": self.band_top_hz}
+
+
+def check_timing(sample_rate_hz: float, delay_samples) -> None:
+    """A finite rate > 0 Hz and a whole delay ≥ 0 samples, else ``ConfigError`` naming the
+    ``[controller]`` key."""
+    if not (math.isfinite(float(sample_rate_hz)) and sample_rate_hz > 0):
+        raise ConfigError(f"controller.sample_rate_hz: {sample_rate_hz!r}, expected a "
+                          "finite rate > 0 Hz")
+    if int(delay_samples) != delay_samples or delay_samples < 0:
+        raise ConfigError(f"controller.delay_samples: {delay_samples!r}, expected a whole "
+                          "number of samples >= 0")
 
 
 def loop_delay(sample_rate_hz: float, delay_samples: int) -> DesignDelay:
@@ -125,13 +137,8 @@ def design_delay(sample_rate_hz: float, delay_samples: int, band_top_hz: float, 
     >>> round(d.delay_s * 1e6, 3), d.order
     (150.0, 2)
     """
+    check_timing(sample_rate_hz, delay_samples)
     fs, top = float(sample_rate_hz), float(band_top_hz)
-    if not (math.isfinite(fs) and fs > 0):
-        raise ConfigError(f"controller.sample_rate_hz: {sample_rate_hz!r}, expected a "
-                          "finite rate > 0 Hz")
-    if int(delay_samples) != delay_samples or delay_samples < 0:
-        raise ConfigError(f"controller.delay_samples: {delay_samples!r}, expected a whole "
-                          "number of samples >= 0")
     if not (math.isfinite(top) and top > 0):
         raise ConfigError(f"design band top: {band_top_hz!r}, expected a finite frequency > 0 Hz")
     tau = (int(delay_samples) + 0.5) / fs

@@ -47,7 +47,8 @@ from ..lti.discrete import zoh
 from ..lti.freqresp import freqresp, freqresp_at
 from ..lti.interconnect import feedback_matrices, feedback_poles, series_inputs
 
-__all__ = ["FAST_FRACTION", "METHODS", "PEAK_TOLERANCE", "peak_difference", "DigitalController", "split_fast", "residualize",
+__all__ = ["FAST_FRACTION", "METHODS", "PEAK_TOLERANCE", "peak_difference",
+           "DigitalController", "split_fast", "residualize",
            "discretize_as", "with_delay", "digital_controller", "design_rise", "check_rate",
            "choose_method", "prewarp_frequency_hz", "SampledPlants", "sampled_plants"]
 
@@ -190,12 +191,9 @@ def check_rate(K, sample_rate_hz: float, delay_samples: int = 0, removable: bool
     removed (``removable``: a design whose γ or μ can be re-checked, or a scheduled one),
     a rate of at least twice its highest pole (Hz).
     """
-    if not (np.isfinite(sample_rate_hz) and sample_rate_hz > 0):
-        raise ConfigError(f"controller.sample_rate_hz: {sample_rate_hz!r}, expected a "
-                          "positive number of Hz")
-    if int(delay_samples) != delay_samples or delay_samples < 0:
-        raise ConfigError(f"controller.delay_samples: {delay_samples!r}, expected a whole "
-                          "number of samples >= 0")
+    from .delay import check_timing
+
+    check_timing(sample_rate_hz, delay_samples)
     A = np.asarray(getattr(K, "A", np.zeros((0, 0))), float)
     if not removable and A.size:
         f_max = float(np.abs(np.linalg.eigvals(A)).max()) / (2 * np.pi)

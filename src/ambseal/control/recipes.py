@@ -28,6 +28,14 @@ negative feedback ``i = −K y`` (:mod:`ambseal.analysis.loops`). Synthesis itse
 the scaled plant with the LFT's positive feedback ``u = K_P e``; the conversion
 ``K = −(D_u/D_e) K_P`` is :meth:`GeneralizedPlant.physical_controller`.
 
+The design model carries the digital controller's hold + computation delay,
+τ = (``[controller] delay_samples`` + ½)/``sample_rate_hz`` (150 µs on the test rig), as a
+first-order Padé lag on every control channel (:mod:`ambseal.control.delay`): first order
+because its pole, 2/τ (2.1 kHz), must stay below half of Nyquist, above which controller
+poles are removed before discretisation (a second-order lag's poles, √12/τ = 3.7 kHz,
+came back as controller poles and were removed); its phase is within 0.5° of the delay's
+up to 500 Hz and 3.5° up to 1 kHz. The full-order check below closes the loop with it.
+
 Design model versus judgement: the design model keeps every mode the controller can reach
 (the specification's rule; on the test rig the rigid-body modes and the first bending pair,
 12 states). After synthesis the controller is closed with the full-order plant at every
@@ -349,7 +357,8 @@ def design(
         uncertainty={q.name: (q.low, q.high) for q in r.gp.parameters},
         elapsed_s=time.perf_counter() - t0, reduction=r.reduction, plant=r.gp,
         design_states=n, full_order=check, allow_unstable=not check["stable"],
-        delay=dl.to_dict(), steps=tuple(steps), notes=tuple(sp.notes), verdict=_verdict(method, r, check))
+        delay=dl.to_dict(), steps=tuple(steps), notes=tuple(sp.notes),
+        verdict=_verdict(method, r, check))
 
 
 @dataclass(frozen=True, eq=False)

@@ -119,9 +119,9 @@ def _octave() -> str | None:
     exe = shutil.which("octave-cli")
     if exe is None:
         return None
-    r = subprocess.run([exe, "--no-gui", "-q", "--eval", "pkg load control"],
+    r = subprocess.run([exe, "--no-gui", "-q", "--eval", "pkg load control; disp(4242)"],
                        capture_output=True, text=True, timeout=120)
-    return exe if "error" not in r.stderr.replace("execution_exception", "") else None
+    return exe if r.returncode == 0 and "4242" in r.stdout else None
 
 
 @pytest.mark.skipif(_octave() is None, reason="no octave-cli with the control package "

@@ -192,6 +192,8 @@ def export_all(designs, digitals: dict, cases: list[dict], out: Path) -> dict:
     design summaries with their ``discretisation`` for ``metrics.json`` (``None`` for a
     controller without a digital one in ``digitals``: nothing of it is exported)."""
     from .control.codegen import write_c
+    from .control.digital import peak_difference
+    from .report.verdict import target_difference
 
     summaries = {}
     for d in designs:
@@ -202,7 +204,11 @@ def export_all(designs, digitals: dict, cases: list[dict], out: Path) -> dict:
         export_design(d.method, digital, d.result.to_dict(), out,
                       judged_margins(cases, d.method))
         write_c(digital, out, f"ambseal_{d.method}")
-        summaries[d.method] = {**d.summary, "discretisation": digital.to_dict()}
+        disc = digital.to_dict()  # the difference as judged (grids refined at the peaks)
+        disc["peak_difference"] = peak_difference(
+            target_difference([c for c in cases if c["controller"] == d.method]),
+            digital.method, digital.removed_poles_hz)
+        summaries[d.method] = {**d.summary, "discretisation": disc}
     return summaries
 
 

@@ -142,24 +142,35 @@ class DigitalController:
                 "removed_poles_hz": [float(f) for f in self.removed_poles_hz],
                 "order": int(self.discrete.A.shape[0]),
                 "reduction": self.reduction,
-                "peak_difference": peak_difference(self.method, self.candidates,
+                "peak_difference": peak_difference(_chosen_error(self), self.method,
                                                    self.removed_poles_hz),
                 "candidates": [dict(c) for c in self.candidates]})
 
 
-def peak_difference(method: str, candidates, removed_poles_hz) -> dict:
-    """How far the chosen discrete loop's σ̄(S_o) peaks are from the continuous ones.
+def _chosen_error(dc) -> float | None:
+    """The chosen candidate's largest relative σ̄(S_o) peak difference (choice grid)."""
+    c = next((c for c in dc.candidates if c["method"] == dc.method), None)
+    return None if c is None else c.get("sensitivity_peak_error")
+
+
+def peak_difference(err: float | None, method: str, removed_poles_hz) -> dict:
+    """How far the discrete loop's σ̄(S_o) peaks are from the continuous ones, explained.
+
+    Parameters
+    ----------
+    err : float or None
+        Largest relative difference over the conditions (-): the choice's (400-point grid)
+        or, after the judgement, the judged cases' (``ambseal run``).
+    method : str
+    removed_poles_hz : sequence of float
 
     Returns
     -------
     dict
-        ``relative`` (the chosen candidate's largest relative difference over the judged
-        conditions, -), ``within_tolerance`` (≤ :data:`PEAK_TOLERANCE`) and, when not,
-        ``explanation``: the removal of fast poles (named, Hz) when there was one (the
+        ``relative`` (``err``), ``within_tolerance`` (≤ :data:`PEAK_TOLERANCE`) and, when
+        not, ``explanation``: the removal of fast poles (named, Hz) when there was one (the
         continuous loop keeps them, the discrete one cannot), else the discretisation.
     """
-    c = next((c for c in candidates if c["method"] == method), None)
-    err = None if c is None else c.get("sensitivity_peak_error")
     out = {"relative": err, "tolerance": PEAK_TOLERANCE,
            "within_tolerance": err is not None and err <= PEAK_TOLERANCE}
     if err is not None and err > PEAK_TOLERANCE:

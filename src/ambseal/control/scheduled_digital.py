@@ -27,7 +27,8 @@ import numpy as np
 from ..errors import SynthesisError
 from ..identify.loop import DiscreteController
 from .controller import SPEED, ScheduledController
-from .digital import (FAST_FRACTION, METHODS, _json_safe, check_rate, choose_method, discretize_as,
+from .digital import (FAST_FRACTION, METHODS, _chosen_error, _json_safe, check_rate,
+                      choose_method, discretize_as,
                       peak_difference, prewarp_frequency_hz, residualize, sampled_plants,
                       split_fast, with_delay)
 
@@ -149,7 +150,7 @@ class ScheduledDigital(ScheduledController):
                 "fast_fraction_of_nyquist": FAST_FRACTION,
                 "removed_poles_hz": [float(f) for f in self.removed_poles_hz],
                 "order": int(self.discrete[0].shape[1]),
-                "peak_difference": peak_difference(self.method, self.candidates,
+                "peak_difference": peak_difference(_chosen_error(self), self.method,
                                                    self.removed_poles_hz),
                 "candidates": [dict(c) for c in self.candidates]})
 

@@ -21,7 +21,7 @@ from typing import Any, Mapping, Sequence
 
 __all__ = ["ZONE_COLOURS", "ZONE_WORDS", "Verdict", "verdicts", "condition_label",
            "verdict_table_html", "verdict_table_rich", "detail_table_html", "sig",
-           "axis_label"]
+           "axis_label", "target_difference"]
 
 #: Zone colours (green → red) of every table and figure.
 ZONE_COLOURS = {"A": "#1a9850", "B": "#91cf60", "C": "#fc8d59", "D": "#d73027"}
@@ -147,8 +147,9 @@ class Verdict:
         return text + "."
 
 
-def _target_difference(cs: Sequence[Mapping]) -> float | None:
-    """Largest |discrete − continuous| / continuous σ̄(S_o) peak over the cases."""
+def target_difference(cs: Sequence[Mapping]) -> float | None:
+    """Largest |discrete − continuous| / continuous σ̄(S_o) peak over the cases (their
+    ``discrete`` blocks), None without a pair."""
     pairs = [(c["sensitivity_peak"], (c.get("discrete") or {}).get("sensitivity_peak"))
              for c in cs if c.get("sensitivity_peak")]
     diffs = [abs(d - x) / x for x, d in pairs if d is not None]
@@ -180,7 +181,7 @@ def verdicts(cases: Sequence[Mapping], clearances_um: Mapping[str, float] | None
             sigma_peak=peak("sensitivity_peak"), orbit_um=peak("unbalance_peak_um"),
             impulse_peak_um=peak("impulse_peak_um"),
             impulse_settling_s=peak("impulse_settling_s"),
-            clearances_um=dict(clearances_um or {}), target_difference=_target_difference(cs)))
+            clearances_um=dict(clearances_um or {}), target_difference=target_difference(cs)))
     return out
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import shutil
 import subprocess
+from pathlib import Path
 
 import control as ct
 import numpy as np
@@ -46,6 +47,37 @@ def test_exported_controllers_keep_every_stable_loop_stable_with_a_sample_of_del
             cont = np.linalg.eigvals(feedback_matrices(G, _mats(dc.continuous))[0]).real.max()
             if cont < 0:
                 assert _max_abs_z(G, (K.A, K.B, K.C, K.D), T, 1) < 1.0, (m, p)
+
+
+def test_issue10_report_plain_tustin_of_the_old_hinf_is_unstable_ambseals_choice_is_not(
+        testrig_cfg, testrig_plants):
+    """Reference: issue 10's report, kept as data — the H∞ controller ambseal designed
+    before issue 10 (tests/data/hinf_issue10_delay_free.npz: delay-free design model,
+    order 24, real poles at 6.2 and 8.0 kHz above the 5 kHz Nyquist frequency; its
+    ``source`` names the commit). Plain Tustin of it (what was exported), closed with the
+    full-order plant sampled by ZOH at 10 kHz and one sample of delay, is unstable at 2.04
+    and 4.08 bar (|z| > 1 by numpy's eigenvalues) although its continuous loop is stable;
+    the discretisation ambseal chooses for it (control.digital.digital_controller) keeps
+    every one of those loops inside the unit circle. On the old behaviour (plain Tustin
+    exported) the second half fails."""
+    from ambseal.control.digital import digital_controller
+
+    d = np.load(Path(__file__).parents[1] / "data" / "hinf_issue10_delay_free.npz")
+    K = ct.ss(d["A"], d["B"], d["C"], d["D"], inputs=[str(x) for x in d["inputs"]],
+              outputs=[str(x) for x in d["outputs"]], name="K_hinf_issue10")
+    fs = float(d["sample_rate_hz"])
+    assert fs == testrig_cfg.controller.sample_rate_hz
+    assert np.sort(np.abs(np.linalg.eigvals(d["A"])))[-2] > np.pi * fs  # two poles > Nyquist
+    mats, T = _mats(K), 1.0 / fs
+    Gs = {p: _mats(testrig_plants[p][0]) for p in (0.0, 2.04, 4.08)}
+    for G in Gs.values():
+        assert np.linalg.eigvals(feedback_matrices(G, mats)[0]).real.max() < 0
+    tustin = discretize_as(mats, T, "tustin")
+    assert [_max_abs_z(G, tustin, T, 1) > 1.0 for G in Gs.values()] == [False, True, True]
+    chosen = digital_controller(K, fs, list(Gs.values()), delay_samples=1,
+                                rise=lambda K_reduced: None).discrete
+    for p, G in Gs.items():
+        assert _max_abs_z(G, (chosen.A, chosen.B, chosen.C, chosen.D), T, 1) < 1.0, p
 
 
 def test_residualisation_keeps_the_static_gain_and_the_slow_poles():

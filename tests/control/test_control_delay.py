@@ -81,7 +81,7 @@ def test_continuous_judgement_with_the_delay_predicts_the_sampled_loop(testrig_d
     model, to 2 %. The H∞ and μ designs record the delay they were made for: 150 µs."""
     for m, tol in (("pid", 0.01), ("mu", 0.02)):
         dc = testrig_digital[m]
-        chosen = next(c for c in dc.candidates if c["method"] == dc.method)
+        chosen = next(c for c in dc.candidates if c["method"] == dc.choice)
         assert chosen["sensitivity_peak_error"] < tol, (m, chosen["sensitivity_peak_error"])
     for m in ("hinf", "mu"):
         assert testrig_designs[m].delay["delay_s"] == pytest.approx(150e-6, rel=1e-12)

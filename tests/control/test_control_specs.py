@@ -254,7 +254,7 @@ def test_hinf_on_a_rig_without_seal_is_stable_on_the_full_order_plant(beam):
 
 @pytest.mark.slow
 def test_a_design_model_without_the_bending_mode_is_enlarged_and_said():
-    """The test rig's H∞ with a light control weight (W_u = 0.05, a sixth of the default) on
+    """The test rig's H∞ with a light control weight (W_u = 0.05, a quarter of the default) on
     its 8 rigid-body states destabilises the 557 Hz bending pair at 2× nominal pressure
     (thesis P5 §3.1.4 removed it; the full-order loop shows it): the design loop enlarges
     the model to keep that pair (12 states) and reports the step. (With the default W_u
@@ -270,7 +270,7 @@ def test_a_design_model_without_the_bending_mode_is_enlarged_and_said():
 
 
 def test_an_unstable_full_order_loop_is_refused_with_the_mode_and_the_key():
-    """The test rig's H∞ with a light control weight (W_u = 0.05, a sixth of the default 0.3:
+    """The test rig's H∞ with a light control weight (W_u = 0.05, a quarter of the default 0.2:
     more gain above the crossover) on its 8 rigid-body states (P5 §3.1.4 removed the
     bending modes) destabilises the 557 Hz bending pair at 2× nominal pressure on the
     full-order plant, with the controller's delay in the loop: with the design model fixed

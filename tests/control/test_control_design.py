@@ -110,10 +110,15 @@ def test_mu_reduction_cost_regression_pin(designs):
 def test_mu_delivers_the_candidate_with_lower_mu_after_reduction(designs):
     """Reference: the definition of the delivered controller (issue 11 §3): after the order
     reduction the μ design keeps, of D–G–K's controller and complex D–K's, the one whose
-    reduced loop has the lower peak μ, and reports both."""
+    reduced loop has the lower peak μ, and reports both. There are two candidates exactly
+    when a D–G–K step beat complex D–K at full order (``musyn_dgk``'s ``alternatives``);
+    on the test rig's rig-file design today D–G–K is skipped (the uncertainty does not set
+    D–K's μ peak), so only that equivalence and the reported μ are checked here."""
     mu = designs["mu"]
     red = mu.reduction
     cands = red.get("candidates", [])
+    dgk_won = min(mu.history, key=lambda h: h["mu"]).get("step") == "D-G-K"
+    assert bool(cands) == dgk_won
     if cands:
         assert {c["step"] for c in cands} == {"D-K", "D-G-K"}
         low = min(cands, key=lambda c: c["mu"])

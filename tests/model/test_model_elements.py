@@ -110,6 +110,32 @@ def test_affine_and_plain_coefficients_and_missing_frequency():
         coefficient_value(s.K, 0.0)
 
 
+def test_every_seal_follows_the_pressure_that_gives_a_tracked_k():
+    """Reference: examples/pump.toml's affine laws by hand. The balance drum's k = 4e4 N/m
+    per bar: k = 1.2 MN/m is 30 bar, where its K = 6e4·30 = 1.8 MN/m, C = 12 kN·s/m, c =
+    1.8 kN·s/m, and the impeller-eye labyrinth (the rig's one pressure drop acts on both
+    seals) has k = 1e4·30 = 0.3 MN/m and C = 50 + 10·30 = 350 N·s/m. Tracking both k's,
+    each seal follows its own k, a seal without a tracked k the first one's pressure; a
+    name that is no seal k follows nothing."""
+    from pathlib import Path
+
+    from ambseal.model.seal import values_following, values_following_k
+
+    seals = load_rig(Path(__file__).parents[2] / "examples" / "pump.toml").seal
+    known = {f"{s}.{q}" for s in ("balance_drum", "eye_labyrinth") for q in "KkCc"}
+    v = values_following_k(seals, "balance_drum.k", 1.2e6, known)
+    want = {"balance_drum.K": 1.8e6, "balance_drum.k": 1.2e6, "balance_drum.C": 1.2e4,
+            "balance_drum.c": 1.8e3, "eye_labyrinth.K": 0.0, "eye_labyrinth.k": 3e5,
+            "eye_labyrinth.C": 350.0, "eye_labyrinth.c": 0.0}
+    assert v.keys() == want.keys()
+    for n, x in want.items():
+        assert v[n] == pytest.approx(x, rel=1e-12, abs=1e-9), n
+    both = values_following(seals, {"balance_drum.k": 1.2e6, "eye_labyrinth.k": 1e5}, known)
+    assert both["balance_drum.K"] == pytest.approx(1.8e6)
+    assert both["eye_labyrinth.k"] == 1e5 and both["eye_labyrinth.C"] == pytest.approx(150.0)
+    assert values_following_k(seals, "balance_drum.C", 1.0, known) == {"balance_drum.C": 1.0}
+
+
 # ----------------------------------------------------------------------------- AMB
 
 def _force(N, A, s0, i0, alpha_deg, x, i):

@@ -96,11 +96,15 @@ class TrackingSettings:
         virtual facility is 0.2–0.5 s.
     follow_pressure : bool
         When a tracked parameter is a seal's k affine in the pressure drop, the model's
-        other coefficients of that seal (K, C, c) follow the pressure that gives k̂
-        (:func:`ambseal.model.seal.values_following_k`; default); False: they stay at the
-        record's pressure. Measured on the test rig's closed-loop 0 → 3× nominal ramp
-        (issue 14 §2, the tracker's model the identified rig): largest error after 1 s
-        0.029 k_nom following, 0.075 fixed (coverage 100 % and 92 %).
+        other seal coefficients (that seal's K, C, c and every other seal's) follow the
+        pressure that gives k̂ (:func:`ambseal.model.seal.values_following_k`; default);
+        False: they stay at the record's pressure. Measured on the closed-loop 0 → 3×
+        nominal ramps (issue 14 §2): test rig (the tracker's model the identified rig),
+        largest error after 1 s 0.029 k_nom following, 0.075 fixed (coverage 100 % and
+        92 %); examples/pump.toml (a second seal, the impeller-eye labyrinth, whose k
+        rises with the same pressure to a quarter of the balance drum's), 0.026 with every
+        seal following, 0.16 with only the tracked seal's K, C, c (coverage 99.4–99.7 %
+        and 38 %, seeds 0–2; the same with or without the facility's 16-bit ADC).
     """
 
     rate_per_s: float = 0.1
@@ -220,19 +224,17 @@ def _param_matrices(model: ClosedLoopModel, values: dict[str, float], names, dt:
 
 
 def _follower(cfg: RigConfig, model: ClosedLoopModel, names):
-    """values → the values with the coefficients that follow each tracked seal k (the
-    tracked values themselves win), or None when no tracked name has followers."""
-    from ..model.seal import values_following_k
+    """values → the values with the seal coefficients that follow the tracked seal k's
+    (:func:`ambseal.model.seal.values_following`; the tracked values themselves win), or
+    None when no tracked name is a seal k affine in the pressure."""
+    from ..model.seal import pressure_for_k, values_following
 
     known = model.plant.parameters
-    if all(len(values_following_k(cfg.seal, n, 0.0, known)) == 1 for n in names):
+    if all(pressure_for_k(cfg.seal, n, 0.0) is None for n in names):
         return None
 
     def expand(values: dict) -> dict:
-        out: dict = {}
-        for n, v in values.items():
-            out.update(values_following_k(cfg.seal, n, v, known))
-        return {**out, **values}
+        return values_following(cfg.seal, values, known)
 
     return expand
 

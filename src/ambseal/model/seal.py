@@ -137,10 +137,12 @@ def pressure_for_k(seals, name: str, value: float) -> float | None:
 
 def values_following_k(seals, name: str, value: float, known) -> dict[str, float]:
     """``{name: value}`` and, when ``name`` is a seal's cross-coupled stiffness k affine in
-    the pressure drop (k = k₀ + k'·p, k' ≠ 0), that seal's other coefficients K, C, c at
-    the pressure p = max((k − k₀)/k', 0) that gives k (:func:`pressure_for_k`) — the seal
-    model's own structure (thesis §7.4 item 2: the coefficients move together with the
-    pressure); only those in ``known`` (the plant's parameter names) are returned.
+    the pressure drop (k = k₀ + k'·p, k' ≠ 0), every other coefficient of every seal at the
+    pressure p = max((k − k₀)/k', 0) that gives k (:func:`pressure_for_k`,
+    :func:`seal_values`) — the seal model's own structure (thesis §7.4 item 2: the
+    coefficients move together with the pressure, and the rig has one pressure drop, which
+    every seal's coefficients follow); only those in ``known`` (the plant's parameter
+    names) are returned. :func:`values_following` for several tracked values.
 
     Parameters
     ----------
@@ -156,14 +158,25 @@ def values_following_k(seals, name: str, value: float, known) -> dict[str, float
     -------
     dict
     """
-    p = pressure_for_k(seals, name, value)
-    if p is None:
-        return {name: value}
-    seal_name = name.rpartition(".")[0]
-    seal = next(s for s in seals if s.name == seal_name)
-    out = {f"{seal_name}.{q}": coefficient_value(getattr(seal, q), p) for q in ("K", "C", "c")
-           if f"{seal_name}.{q}" in known}
-    return {**out, name: value}
+    return values_following(seals, {name: value}, known)
+
+
+def values_following(seals, values: dict, known) -> dict[str, float]:
+    """``values`` (name → SI) and the seal coefficients that follow them: every seal's
+    coefficients at the pressure that gives the first seal k affine in the pressure among
+    ``values`` (:func:`values_following_k`), the other coefficients of each seal whose k is
+    in ``values`` at the pressure of its own k; the given values win; only names in
+    ``known``."""
+    pressures = {n: pressure_for_k(seals, n, v) for n, v in values.items()}
+    pressures = {n.rpartition(".")[0]: p for n, p in pressures.items() if p is not None}
+    if not pressures:
+        return dict(values)
+    out = {n: v for n, v in seal_values(seals, next(iter(pressures.values()))).items()
+           if n in known}
+    for seal_name, p in pressures.items():
+        out.update({n: v for n, v in seal_values(seals, p).items()
+                    if n in known and n.rpartition(".")[0] == seal_name})
+    return {**out, **values}
 
 
 @dataclass(frozen=True)

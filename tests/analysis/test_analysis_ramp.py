@@ -17,6 +17,31 @@ def test_pressure_ramp_reaches_two_and_three_times_nominal():
     assert np.all(np.diff(p) > 0)
 
 
+def test_impulse_settling_closed_form_and_n_a_below_the_background():
+    """Reference: closed forms. An impulse response A e^{−t/τ} (A = 10 µm, τ = 2 ms) after
+    a quiet background settles into the 2 % band at τ ln 50 = 7.82 ms; the same response
+    with a background of std σ = 1 µm settles into the band 3σ at τ ln(A/3σ) = 2.41 ms;
+    a response of 2 µm below that band (3 µm) is not told apart from the background: its
+    settling time is n/a (None, not above the background), not 0 s."""
+    from ambseal.analysis.ramp import _impulse_metrics
+
+    fs, n_len, n0 = 10e3, 10, 1000
+    t = np.arange(30 * n_len) / fs
+    rng = np.random.default_rng(0)
+    for amp, sigma, want in ((10e-6, 0.0, 2e-3 * np.log(50)),
+                             (10e-6, 1e-6, 2e-3 * np.log(10 / 3)), (2e-6, 1e-6, None)):
+        y = np.zeros(n0 + 30 * n_len)
+        pre = rng.standard_normal(500)
+        y[n0 - 500:n0] = sigma * pre / np.std(pre)
+        y[n0:] = amp * np.exp(-t / 2e-3)
+        peaks, settle, seen = _impulse_metrics(y, [n0], fs, n_len, None)
+        assert peaks[0] == pytest.approx(amp * 1e6)
+        if want is None:
+            assert settle == [None] and seen == [False]
+        else:
+            assert seen == [True] and settle[0] == pytest.approx(want, abs=1.0 / fs)
+
+
 @pytest.mark.slow
 def test_ramp_losses_agree_with_the_frozen_full_order_loops(testrig_cfg, testrig_designs,
                                                             testrig_digital, testrig_tracked):

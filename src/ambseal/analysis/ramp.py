@@ -35,7 +35,10 @@ input was read).
 
 Per impulse: the peak |y| on the impulse axis within 30 impulse lengths, and the settling
 time, after which |y| stays inside max(2 % of the peak, 3× the std of the 50 ms before
-the impulse: noise and the PRBS's response); None when it never does within the window.
+the impulse: noise and the PRBS's response); None when it never does within the window,
+and None ("n/a", ``impulse_above_background`` False) when |y| never leaves that band: the
+impulse's response is then not told apart from the background and has no settling time
+(it used to read 0 s).
 """
 
 from __future__ import annotations
@@ -61,9 +64,13 @@ class RampRun:
     lost_at_s : float or None
         When the rotor left 90 % of the air gap (the loop went unstable), else None.
     impulse_peak_um, impulse_settling_s : list
-        Per impulse (None after a loss, or a settling never reached in the window).
+        Per impulse (None after a loss, or a settling never reached in the window, or
+        not measurable: see ``impulse_above_background``).
     estimate, ci95_low, ci95_high : ndarray (n,) or None
         The tracked scheme's k̂ and its 95 % interval (SI).
+    impulse_above_background : list of bool
+        Per impulse: its response left the background band (module docstring); False: its
+        settling time is n/a.
     """
 
     name: str
@@ -75,6 +82,7 @@ class RampRun:
     estimate: np.ndarray | None = field(default=None, repr=False)
     ci95_low: np.ndarray | None = field(default=None, repr=False)
     ci95_high: np.ndarray | None = field(default=None, repr=False)
+    impulse_above_background: list = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -100,7 +108,8 @@ class RampResult:
                 "pressure_top_bar": float(np.max(self.pressure_bar)),
                 "impulse_times_s": self.impulse_times_s, "tracking": self.tracking,
                 "runs": {n: {"lost_at_s": r.lost_at_s, "impulse_peak_um": r.impulse_peak_um,
-                             "impulse_settling_s": r.impulse_settling_s}
+                             "impulse_settling_s": r.impulse_settling_s,
+                             "impulse_above_background": r.impulse_above_background}
                          for n, r in self.runs.items()}}
 
 
@@ -128,23 +137,25 @@ def _excitation(cfg, N: int, fs: float, every_s: float, amplitude_a: float, n_le
 
 
 def _impulse_metrics(y: np.ndarray, starts, fs: float, n_len: int, lost_n: int | None):
-    """Peak |y| (µm) and settling time (s) of each impulse (module docstring)."""
-    peaks, settle = [], []
+    """Peak |y| (µm), settling time (s) and whether the response left the background band,
+    per impulse (module docstring)."""
+    peaks, settle, seen = [], [], []
     pre = int(round(0.05 * fs))
     for n0 in starts:
         end = n0 + 30 * n_len
         if lost_n is not None and end >= lost_n:
             peaks.append(None)
             settle.append(None)
+            seen.append(False)
             continue
         w = np.abs(y[n0:end])
         band = max(0.02 * float(np.max(w)), 3.0 * float(np.std(y[max(0, n0 - pre):n0])))
         peaks.append(float(np.max(w)) * 1e6)
         above = np.nonzero(w > band)[0]
-        settled = above.size == 0 or above[-1] < w.size - 1
-        settle.append(float((above[-1] + 1) / fs) if above.size and settled else
-                      (0.0 if settled else None))
-    return peaks, settle
+        seen.append(bool(above.size))
+        settle.append(float((above[-1] + 1) / fs) if above.size and above[-1] < w.size - 1
+                      else None)
+    return peaks, settle, seen
 
 
 def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: float = 30.0,
@@ -307,10 +318,10 @@ def _run_fixed(name, fac, Kd, e, noise, inoise, fs, starts, n_len, dec, block_s)
 
 def _run(name, y, ref, lost, fs, starts, dec, n_len, **extra) -> RampRun:
     """The run's record; ``lost`` = (first sample not recorded, sample of the loss)."""
-    peaks, settle = _impulse_metrics(y[:, 0], starts, fs, n_len,
-                                     None if lost is None else lost[0])
+    peaks, settle, seen = _impulse_metrics(y[:, 0], starts, fs, n_len,
+                                           None if lost is None else lost[0])
     return RampRun(name, y[::dec] * 1e6, ref[::dec], None if lost is None else lost[1] / fs,
-                   peaks, settle, **extra)
+                   peaks, settle, **extra, impulse_above_background=seen)
 
 
 def _run_tracked(cfg, fac, tracked, run_as, e, noise, inoise, fs, starts, n_len, dec,

@@ -90,13 +90,16 @@ def ramp_figure(path: str | os.PathLike, ramp, *, axis: int = 0) -> Path:
         if r.lost_at_s is not None:
             ax_y.axvline(r.lost_at_s, color=col[n], ls=":", lw=1.0)
             ax_y.plot([r.lost_at_s], [0.0], "x", color=col[n], ms=9, mew=2)
-        pk = [(ti, v, s_) for ti, v, s_ in zip(ramp.impulse_times_s, r.impulse_peak_um,
-                                                r.impulse_settling_s) if v is not None]
+        seen = r.impulse_above_background or [True] * len(r.impulse_peak_um)
+        pk = [(ti, v, s_ if ok else "n/a") for ti, v, s_, ok in zip(
+            ramp.impulse_times_s, r.impulse_peak_um, r.impulse_settling_s, seen)
+            if v is not None]
         if pk:
             ax_p.plot([a for a, _, _ in pk], [b for _, b, _ in pk], "o-", color=col[n],
                       ms=4, lw=0.8, label=n)
             for a, b, c in pk[::max(1, len(pk) // 5)]:
-                ax_p.annotate("—" if c is None else f"{1e3 * c:.0f} ms", (a, b), fontsize=6,
+                ax_p.annotate(c if isinstance(c, str) else "—" if c is None
+                              else f"{1e3 * c:.0f} ms", (a, b), fontsize=6,
                               color=col[n], xytext=(2, 3), textcoords="offset points")
     ax_y.set_ylabel(f"y {ramp.axes[axis]} (µm)")
     ax_i.set_ylabel(f"i_ref {ramp.axes[axis]} (A)")

@@ -133,3 +133,47 @@ def test_kept_decompositions_follow_the_matrix_content():
             Ad, _ = zoh(A, B, 0.01)
             np.testing.assert_allclose(Ad, scipy.linalg.expm(A * 0.01), rtol=1e-9, atol=1e-12)
             A[0, 1] += 0.5  # same array object, new content
+
+
+def _distillation_rp_plant():
+    """Skogestad & Postlethwaite (2005) §8.12.4: G = 1/(75s+1)·[87.8 −86.4; 108.2 −109.6],
+    W_I = (s+0.2)/(0.5s+1)·I, W_P = 0.5(10s+1)/(10s+1e-5)·I; inputs [w_Δ, w, u], outputs
+    [z_Δ, z, v] (benchmarks/bench_dk.py builds the same plant)."""
+    g0 = np.array([[87.8, -86.4], [108.2, -109.6]])
+    G = control.ss(control.tf([[[g0[i, j]] for j in range(2)] for i in range(2)],
+                              [[[75.0, 1.0]] * 2] * 2), inputs=["up0", "up1"],
+                   outputs=["yp0", "yp1"], name="G")
+
+    def diag(num, den, inp, out, name):
+        return control.ss(control.tf([[num, [0.0]], [[0.0], num]], [[den, [1.0]], [[1.0], den]]),
+                          inputs=inp, outputs=out, name=name)
+
+    parts = [G, diag([5.0, 0.5], [10.0, 1e-5], ["e0", "e1"], ["z0", "z1"], "Wp"),
+             diag([1.0, 0.2], [0.5, 1.0], ["u0", "u1"], ["zd0", "zd1"], "Wi")]
+    for k in range(2):
+        parts += [control.summing_junction(inputs=[f"u{k}", f"wd{k}"], output=f"up{k}"),
+                  control.summing_junction(inputs=[f"yp{k}", f"w{k}"], output=f"e{k}"),
+                  control.ss([], [], [], [[-1.0]], inputs=[f"e{k}"], outputs=[f"v{k}"])]
+    return control.interconnect(parts, inplist=["wd0", "wd1", "w0", "w1", "u0", "u1"],
+                                outlist=["zd0", "zd1", "z0", "z1", "v0", "v1"])
+
+
+def test_auto_keeps_the_modal_form_where_the_balanced_hessenberg_form_fails():
+    """Reference: python-control's frequency response (SLICOT TB05AD, unbalanced) and dense
+    solves, on the closed loop of the S&P distillation problem with control.hinfsyn's
+    controller (a −1.7e8 rad/s controller pole, W_P's −1e-6 rad/s pole, output matrix up to
+    9e7). The balanced Hessenberg form is off by 3e4 at 1e-3 rad/s on this loop (its σ̄ is
+    1.18 at every frequency); the modal form agrees to 1e-3, and "auto" must use it (it used
+    the Hessenberg form whenever the two disagreed: dkpy's controller then had μ 3.2e6 in
+    benchmarks/bench_dk.py)."""
+    from ambseal.lti.interconnect import lft_lower
+
+    P = _distillation_rp_plant()
+    K = control.hinfsyn(P, 2, 2)[0]
+    cl = lft_lower(P, K, 2, 2)
+    w = np.logspace(-3, 3, 25)
+    A, B, C, D = (np.asarray(M) for M in (cl.A, cl.B, cl.C, cl.D))
+    ref = np.moveaxis(cl(1j * w), -1, 0)
+    assert _rel(_dense(A, B, C, D, w), ref) < 1e-3  # the two references agree
+    assert _rel(fr.freqresp(cl, w), ref) < 2e-3
+    assert _rel(fr.freqresp(cl, w, method="modal"), ref) < 2e-3

@@ -128,11 +128,11 @@ def _linfnorm_matrices(A, B, C, D, rtol: float = 1e-10) -> tuple[float, float]:
 
 
 # --------------------------------------------------------------------------- checks
-def _pbh_fails(A, X, tol, rows):
-    """Eigenvalues of A (Re ≥ 0) at which [A - λI, X] (or its dual) loses rank."""
+def _pbh_fails(A, X, tol, rows, eigs):
+    """Eigenvalues ``eigs`` of A (Re ≥ 0) at which [A - λI, X] (or its dual) loses rank."""
     n = A.shape[0]
     bad = []
-    for lam in np.linalg.eigvals(A):
+    for lam in eigs:
         if lam.real < -tol:
             continue
         Mx = np.hstack([A - lam * np.eye(n), X]) if rows else np.vstack([A - lam * np.eye(n), X])
@@ -183,12 +183,13 @@ def check_plant(P, nmeas: int, ncon: int) -> None:
             f"D21 (y ← w, {nmeas}×{nw}) has not full row rank: every measurement must see "
             "exogenous noise directly (add a sensor-noise input)")
     if A.shape[0]:
-        bad = _pbh_fails(A, B2, tol, rows=True)
+        eigs = np.linalg.eigvals(A)
+        bad = _pbh_fails(A, B2, tol, True, eigs)
         if bad:
             raise SynthesisError(
                 f"(A, B2) is not stabilisable: mode(s) {np.round(bad, 6).tolist()} cannot be "
                 "moved by the control inputs")
-        bad = _pbh_fails(A, C2, tol, rows=False)
+        bad = _pbh_fails(A, C2, tol, False, eigs)
         if bad:
             raise SynthesisError(
                 f"(C2, A) is not detectable: mode(s) {np.round(bad, 6).tolist()} are not seen "
@@ -436,12 +437,13 @@ class _Sb10:
         row space of D21."""
         nz, nw, D = self.nz, self.nw, self.D
         D11, D12, D21 = D[:nz, :nw], D[:nz, nw:], D[nz:, :nw]
-        if D11.size == 0:
+        if D11.size == 0 or not np.any(D11):
             return 0.0
-        U = sla.null_space(D12.T)
-        V = sla.null_space(D21)
-        a = np.linalg.norm(U.T @ D11, 2) if U.size else 0.0
-        b = np.linalg.norm(D11 @ V, 2) if V.size else 0.0
+        # complements from full SVDs (D12 and D21 have full rank: check_plant)
+        U = np.linalg.svd(D12)[0][:, D12.shape[1]:]
+        V = np.linalg.svd(D21)[2][D21.shape[0]:].T
+        a = np.linalg.svd(U.T @ D11, compute_uv=False)[0] if U.size else 0.0
+        b = np.linalg.svd(D11 @ V, compute_uv=False)[0] if V.size else 0.0
         return float(max(a, b))
 
     def riccati_margin(self, g: float) -> float:

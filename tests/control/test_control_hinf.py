@@ -210,6 +210,22 @@ def test_hinfsyn_rejects_unstabilisable_plant():
         hinfsyn(ct.ss(A, B, C, D), 1, 1)
 
 
+def test_stabilisability_test_does_not_depend_on_the_state_scaling():
+    """Reference: γ_opt and stabilisability are invariant under a state similarity. The
+    unstable mode of A = [[1, 1], [0, −2]] is reached by u only through A₁₂; in the
+    coordinates x̃ = diag(1, 1e6)⁻¹ x the PBH matrix [Ã − I, B̃₂] has σ_min/σ_max below the
+    test's 1e-9 (as the test rig's D–G–K plant had: 2.9e-10), which the unbalanced rank test
+    took for "not stabilisable"."""
+    A = np.array([[1.0, 1.0], [0.0, -2.0]])
+    B = np.array([[1.0, 0.0], [1.0, 1.0]])
+    C = np.array([[1.0, 0.5], [1.0, 2.0]])
+    D = np.array([[0.0, 1.0], [1.0, 0.0]])
+    t = np.array([1.0, 1e6])
+    ref = hinfsyn(ct.ss(A, B, C, D), 1, 1)
+    r = hinfsyn(ct.ss(A * t[None, :] / t[:, None], B / t[:, None], C * t[None, :], D), 1, 1)
+    assert r.gamma_opt == pytest.approx(ref.gamma_opt, rel=1e-5)
+
+
 def test_hinfsyn_rejects_undetectable_plant():
     """Reference: PBH test — an unstable mode not seen by C2 cannot be detected."""
     A = np.diag([1.0, -2.0])

@@ -177,3 +177,23 @@ def test_auto_keeps_the_modal_form_where_the_balanced_hessenberg_form_fails():
     assert _rel(_dense(A, B, C, D, w), ref) < 1e-3  # the two references agree
     assert _rel(fr.freqresp(cl, w), ref) < 2e-3
     assert _rel(fr.freqresp(cl, w, method="modal"), ref) < 2e-3
+
+
+def test_auto_falls_back_to_dense_solves_where_both_fast_forms_fail():
+    """Reference: python-control's frequency response (SLICOT TB05AD) and dkpy 0.1.9's own μ
+    (1.03603, its LMI bound on python-control's response) of its D–K controller for the
+    S&P distillation problem (22 states, stored from benchmarks/bench_dk.py's dkpy run).
+    On that loop the modal form is off by 11 (σ̄ up to 180) and the balanced Hessenberg form
+    by 1.5e7; "auto" must notice and solve densely (it gave μ 8.2 instead of 1.036)."""
+    from pathlib import Path
+
+    from ambseal.control.mu import mussv
+    from ambseal.lti.interconnect import lft_lower
+
+    d = np.load(Path(__file__).parents[1] / "data" / "dkpy_distillation_K.npz")
+    cl = lft_lower(_distillation_rp_plant(), control.ss(d["A"], d["B"], d["C"], d["D"]), 2, 2)
+    w = np.logspace(-3, 3, 61)
+    ref = np.moveaxis(cl(1j * w), -1, 0)
+    assert _rel(fr.freqresp(cl, w), ref) < 1e-5
+    mu = mussv(cl, [(1, 1), (1, 1), (2, 2)], w).upper.max()
+    assert mu == pytest.approx(float(d["mu_dkpy"]), rel=1e-3)

@@ -108,6 +108,13 @@ class MuSpec(MethodSpec):
     max_iter: int | None = Field(default=None, ge=1, le=50)
     dk_order: int | None = Field(default=None, ge=0, le=8)
     iteration: Literal["dgk", "dk"] | None = None
+    gain_factor: float | None = Field(default=None, ge=0)
+    gain_band_hz: tuple[float, float] | None = None
+
+    @model_validator(mode="after")
+    def _gain_band(self) -> "MuSpec":
+        _band(self.gain_band_hz, "gain_band_hz")
+        return self
 
 
 class UncertainSpec(_Strict):

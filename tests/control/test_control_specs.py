@@ -113,17 +113,23 @@ def test_unbalance_law_speed_and_place(specs, testrig_cfg):
 
 def test_hinf_and_mu_weights_from_the_reference_pid(specs):
     """ω_B = 1/T_i of the reference PID (P5 §4.3: integral time close to the PID's; test
-    rig T_i = 0.2 s, P5 §4.2 → 5 rad/s); μ's W_u = D_u/(2.5 D_e Kp (1 + 1/ε)) = 1/(2.5 ·
-    20e-6 · 1.6e4 · 11) = 0.114 → 0.11 (hand values); orbit demand 0.5 D_e = 10 µm."""
+    rig T_i = 0.2 s, P5 §4.2 → 5 rad/s); μ's W_u = D_u/(3 D_e Kp (1 + 1/ε)) = 1/(3 ·
+    20e-6 · 1.6e4 · 11) = 0.0947 → 0.095 (hand values); orbit demand 0.5 D_e = 10 µm; the
+    gain demand W_K: factor 2 over 0.75–1.1× the 200 Hz top of the unbalance band, with
+    the rig file's PID (Kp 1.6e4 A/m, T_i 0.2 s)."""
     w = specs["testrig"].weights
     assert w["hinf"].omega_b == w["mu"].omega_b == pytest.approx(5.0)
-    assert w["mu"].wu_gain == 0.11 and w["mu"].wu_corner_hz is None
+    assert w["mu"].wu_gain == 0.095 and w["mu"].wu_corner_hz is None
     assert w["mu"].orbit_um == pytest.approx(10.0)
+    assert w["mu"].gain_factor == 2 and w["mu"].gain_band_hz == pytest.approx((150, 220))
+    assert w["mu"].pid_reference[:2] == pytest.approx((1.6e4, 0.2))
+    assert w["hinf"].Wk() is None
 
 
 def test_lpv_weights_from_the_rig(specs, turbo_cfg):
     """P3 Eq. 11, §3.3 made a rule: the scalings of H∞ and μ; W_u's low-frequency gain μ's
-    constant W_u, rising tenfold above the actuator bandwidth f_a — the turboexpander's
+    constant W_u with 2.5× the PID's peak (μ's 3×), rising tenfold above the actuator
+    bandwidth f_a — the turboexpander's
     1.5 kHz first-order cut-off (P3 §3.3 puts the crossover at 1.4 kHz) and the beam's F_A;
     on the turboexpander by hand D_u/(2.5 D_e Kp (1 + 1/ε)) with Kp = 1.5 Ks/Ki = 7500 A/m
     and D_u = 0.42 A. The LPV designs take these weights, and ``[design.lpv]`` keys over
@@ -135,7 +141,7 @@ def test_lpv_weights_from_the_rig(specs, turbo_cfg):
         sp = specs[name]
         w = sp.weights["lpv"]
         assert (w.d_e, w.d_u) == (sp.d_e, sp.d_u)
-        assert w.wu_gain == sp.weights["mu"].wu_gain
+        assert w.wu_gain == pytest.approx(sp.weights["mu"].wu_gain * 3 / 2.5, rel=0.06)
         assert w.wu_hf_gain == pytest.approx(10 * w.wu_gain)
         assert w.wu_corner_hz == pytest.approx(f_a)
     eps = pid_from_rig(turbo_cfg)["eps"]

@@ -59,3 +59,25 @@ def test_diagonal_weight_is_block_diagonal():
     D = diagonal_weight(W, 3, "W_p")
     val = D(5j)
     assert np.allclose(val, W(5j) * np.eye(3))
+
+
+def test_gain_weight_is_the_inverse_pid_in_its_band():
+    """μ's gain demand W_K (P5 Fig. 10) against a closed form written independently:
+    |W_K(jω)| = D_u/(c·3·D_e·|K_PID(jω)|)·|H_2(jω)|·|B_4(jω)| with the P5 Eq. 6 PID and the
+    Butterworth magnitudes 1/√(1 + (ω_l/ω)⁴) and 1/√(1 + (ω/ω_h)⁸); −3 dB at both corners."""
+    from ambseal.control.weights import Weights
+    from ambseal.errors import ConfigError
+
+    kp, ti, td, eps, lo, hi = 1.6e4, 0.2, 1.25e-3, 0.1, 150.0, 210.0
+    W = Weights(d_e=20e-6, d_u=1.0, gain_factor=2.0, gain_band_hz=(lo, hi),
+                pid_reference=(kp, ti, td, eps)).Wk()
+    f = np.array([10.0, 150.0, 180.0, 210.0, 1000.0])
+    s = 2j * np.pi * f
+    k_pid = np.abs(kp * (1 + 1 / (ti * s) + td * s / (eps * td * s + 1)))
+    want = (1.0 / (6 * 20e-6 * k_pid) / np.sqrt(1 + (lo / f) ** 4)
+            / np.sqrt(1 + (f / hi) ** 8))
+    got = np.abs(np.array([complex(W(x)) for x in s]).ravel())
+    np.testing.assert_allclose(got, want, rtol=1e-6)
+    assert Weights().Wk() is None
+    with pytest.raises(ConfigError, match="band"):
+        Weights(gain_factor=2.0, gain_band_hz=(210.0, 150.0), pid_reference=(1, 1, 1, 1)).Wk()

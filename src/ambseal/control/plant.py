@@ -300,6 +300,7 @@ def generalized_plant(
     force_disturbance: Any = None,
     force_positions: tuple = (),
     actuator_delay: Any = None,
+    gain_weight: Any = None,
 ) -> GeneralizedPlant:
     """Build the generalised plant of P5 Figs. 8–9 from a rig or a plant.
 
@@ -345,6 +346,10 @@ def generalized_plant(
         SISO stable approximation L of the controller's delay, put on every control channel
         between ``u`` and the current (``DesignDelay.system`` of
         :func:`ambseal.control.delay.design_delay`); its states join P after the weights'.
+    gain_weight : SISO weight, optional
+        W_K on every control channel, an extra performance output ``z_K = W_K u`` after
+        ``z_u`` (μ's gain demand, :meth:`ambseal.control.weights.Weights.Wk`); its states
+        join P last.
 
     Returns
     -------
@@ -375,7 +380,7 @@ def generalized_plant(
     params = _ranges(full.select_inputs([full.input_names[i] for i in cur]), uncertainty or {})
     centre = full.with_values({q.name: q.centre for q in params}) if params else full
     parts = _parts(centre, params, cur, fcols, Wp, Wu, input_disturbance, output_disturbance,
-                   force_disturbance, d_e, d_u, actuator_delay)
+                   force_disturbance, d_e, d_u, actuator_delay, gain_weight)
     if parts.W1.nstates or (parts.Wf is not None and parts.Wf.nstates):
         parts = _balance(parts)
     P = _connect(parts)
@@ -392,6 +397,7 @@ class _Parts:
     Wu: Any
     W1: Any
     Wf: Any
+    Wk: Any
     statics: tuple
     delay: Any
     inputs: tuple   # internal names of P's inputs, in order
@@ -429,7 +435,7 @@ def _source_plant(source, reduced, pressure_bar, states, force_positions, forces
     return full, cur, (fcols if forces else [])
 
 
-def _parts(centre, params, cur, fcols, Wp, Wu, W1, W2, Wf, d_e, d_u, L=None) -> _Parts:
+def _parts(centre, params, cur, fcols, Wp, Wu, W1, W2, Wf, d_e, d_u, L=None, Wk=None) -> _Parts:
     """The named subsystems of P5 Figs. 8–9 (module docstring):
 
     * ``G`` — the plant at the centre of the ranges with its Δ channels, inputs
@@ -482,17 +488,20 @@ def _parts(centre, params, cur, fcols, Wp, Wu, W1, W2, Wf, d_e, d_u, L=None) -> 
     Wu_d = _named(diagonal_weight(Wu, nu, "W_u", biproper=True), u, zu, "Wu")
     W1_d = _named(diagonal_weight(W1, nu, "W_1"), di, diw, "W1")
     Wf_d = _named(diagonal_weight(Wf, nf, "W_f"), df, f_, "Wf") if nf else None
+    zk = _sig("zk", chans) if Wk is not None else []
+    Wk_d = _named(diagonal_weight(Wk, nu, "W_K"), u, zk, "Wk") if Wk is not None else None
     ins = wD + di + do + df + u
-    outputs = zD + zp + zu + e
+    outputs = zD + zp + zu + zk + e
     lab_in = ([f"wD_{t}" for t in tags] + [f"di_{c}" for c in chans] + [f"do_{c}" for c in outs]
               + [f"df_{c}" for c in forces] + [f"u_{c}" for c in chans])
     lab_out = ([f"zD_{t}" for t in tags] + [f"zp_{c}" for c in outs] + [f"zu_{c}" for c in chans]
-               + [f"y_{c}" for c in outs])
+               + [f"zk_{c}" for c in chans if Wk is not None] + [f"y_{c}" for c in outs])
     snames = (list(centre.state_names) + [f"Wp{i}" for i in range(Wp_d.nstates)]
               + [f"Wu{i}" for i in range(Wu_d.nstates)] + [f"W1_{i}" for i in range(W1_d.nstates)]
               + ([f"Wf_{i}" for i in range(Wf_d.nstates)] if nf else [])
-              + ([f"L{i}" for i in range(L_d.nstates)] if L is not None else []))
-    return _Parts(G, Wp_d, Wu_d, W1_d, Wf_d, (E, I), L_d, tuple(ins), tuple(outputs),
+              + ([f"L{i}" for i in range(L_d.nstates)] if L is not None else [])
+              + ([f"Wk{i}" for i in range(Wk_d.nstates)] if Wk is not None else []))
+    return _Parts(G, Wp_d, Wu_d, W1_d, Wf_d, Wk_d, (E, I), L_d, tuple(ins), tuple(outputs),
                   tuple(lab_in), tuple(lab_out), tuple(snames), nd)
 
 
@@ -510,7 +519,8 @@ def _connect(parts: _Parts, W1=None, Wf=None):
     W1 = parts.W1 if W1 is None else W1
     Wf = parts.Wf if Wf is None else Wf
     syslist = [parts.G, parts.Wp, parts.Wu, W1] + ([Wf] if Wf is not None else []) \
-        + ([parts.delay] if parts.delay is not None else []) + list(parts.statics)
+        + ([parts.delay] if parts.delay is not None else []) \
+        + ([parts.Wk] if parts.Wk is not None else []) + list(parts.statics)
     return control.interconnect(syslist, inplist=list(parts.inputs),
                                 outlist=list(parts.outputs), inputs=list(parts.inputs),
                                 outputs=list(parts.outputs), check_unused=False)

@@ -383,7 +383,8 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
     gp = generalized_plant(cfg, w.Wp(), w.Wu(), uncertainty=unc if method == "mu" else None,
                            pressure_bar=p, states=n, input_disturbance=w.W1(),
                            force_disturbance=Wf, force_positions=fpos, d_e=w.d_e, d_u=w.d_u,
-                           actuator_delay=dl.system)
+                           actuator_delay=dl.system,
+                           gain_weight=w.Wk())
     mu_omega = None
     if method == "hinf":
         from .hinf import hinfsyn

@@ -42,16 +42,25 @@ the value the thesis used on its test facility, P5, where it names one):
   design: a heavier W_u (2× the PID's peak) gave 1.91× but μ 1.01 and σ̄(S_o) 3.19; M = 4
   gave 1.97× but σ̄(S_o) 3.06; ω_B = 0.5/T_i 1.98× but twice the impulse settling time;
   a W_u shaped like the PID's gain or peaking at 200–250 Hz gave μ 1.1–1.9. μ: W_u a
-  constant (P5 §4.3) = D_u/(2.5 D_e Kp (1 + 1/ε)), so that where S_o ≈ 1 the controller
-  gain stays below 2.5× the reference PID's peak Kp (1 + 1/ε) (test rig 0.11, |K| ≤ 1.9×
-  the PID's peak below Nyquist, where a high-pass W_u of 0.02 gave 7.6×); the orbit
-  demand 0.5 D_e (test rig 10 µm: the demand adds its force channel to the design, the
-  thesis's 8 µm is met with margin, 4.6 µm); W_f rolls off at 1.3× the top of the
-  unbalance band, at most f_b/2 (test rig: 1.3 × 200 Hz = 260 Hz, below 557/2 Hz). The
-  other weights are the method's tuning on the scaled plant
-  (:func:`ambseal.control.weights.default_weights`).
+  constant (P5 §4.3) = D_u/(3 D_e Kp (1 + 1/ε)), so that where S_o ≈ 1 the controller
+  gain stays below 3× the reference PID's peak Kp (1 + 1/ε) (P5 Fig. 10's bound; test rig
+  0.095, |K| ≤ 2.1–2.5× the PID's peak below Nyquist, where a high-pass W_u of 0.02 gave
+  7.6×), and beside it the gain demand W_K (:meth:`ambseal.control.weights.Weights.Wk`):
+  ``|K S_o| ≤ 2·3 |K_PID|`` over 0.75–1.1× the top of the unbalance band (test rig
+  150–220 Hz), i.e. the direct gain within 2× the PID's where |S_o| nears its zone-A
+  bound 3, the phase lead above the band left free. Why (``ambseal run``: identified rig,
+  truth, delay): with W_u alone the eddy lag (0.2 ms) and the 1.5-sample delay ask for a
+  lead that put the gain at 2.24× at 200 Hz (not the reduction: 2.23× at full order; not
+  the D–K iteration: 2.22–2.24× at each with μ ≤ 1); with W_K and M 3.45: μ 0.99, 1.98×,
+  σ̄(S_o) 2.43 per axis (whole loop 3.11); rig file 1.78×, σ̄(S_o) ≤ 2.73. Trials in
+  :func:`ambseal.control.weights.default_weights`. The orbit demand 0.5 D_e (test rig
+  10 µm: the demand adds its force channel to the design, the thesis's 8 µm is met with
+  margin, 4.6 µm); W_f rolls off at 1.3× the top of the unbalance band, at most f_b/2
+  (test rig: 1.3 × 200 Hz = 260 Hz, below 557/2 Hz). The other weights are the method's
+  tuning on the scaled plant (:func:`ambseal.control.weights.default_weights`).
 * **LPV weights** (P3 Eq. 11, §3.3): the same D_e and D_u; W_u a high-pass whose
-  low-frequency gain is μ's constant W_u (above) and which rises tenfold above its corner
+  low-frequency gain is D_u/(2.5 D_e Kp (1 + 1/ε)) (μ's form, above, before W_K made μ's
+  3×: the LPV designs have no W_K) and which rises tenfold above its corner
   at the actuator bandwidth f_a, rolling the controller off at the bending modes the
   rigid-body LPV design model leaves out (turboexpander: D_u 0.42 A, W_u 0.037 → 0.37 at
   1.5 kHz, where P3 §3.3 puts the crossover at 1.4 kHz and the tuning before this rule had
@@ -82,8 +91,11 @@ RIGID_STATES = 8  # 2 translations and 2 tilts of a rigid rotor, 2 states each
 SAMPLES_PER_IMPULSE = 100
 #: ω_B·T_i of the H∞ and μ performance weights (module docstring, "H∞ and μ weights")
 OMEGA_B_TIMES_TI = 1.0
-#: μ's 1/W_u in multiples of the reference PID's peak gain (module docstring)
-WU_PID_PEAKS = 2.5
+#: 1/W_u in multiples of the reference PID's peak gain, LPV and μ (module docstring)
+WU_PID_PEAKS, MU_WU_PID_PEAKS = 2.5, 3.0
+#: μ's gain demand W_K: |K| within 2× the PID's (P5 Fig. 10) over 0.75–1.1× the top of
+#: the unbalance band (module docstring)
+GAIN_FACTOR, GAIN_BAND = 2.0, (0.75, 1.1)
 #: μ's orbit demand in multiples of D_e (module docstring)
 ORBIT_PER_DE = 0.5
 #: the LPV design's W_u: high-frequency over low-frequency gain (module docstring)
@@ -293,7 +305,8 @@ def _toml_num(x) -> str:
 
 def _weight_lines(method: str, w, src: dict) -> list[str]:
     keys = ("M", "omega_b", "A", "wu_gain", "wu_corner_hz", "wu_hf_gain", "w1_gain",
-            "w1_corner_hz", "orbit_um", "wf_rolloff_hz")
+            "w1_corner_hz", "orbit_um", "wf_rolloff_hz") \
+        + (("gain_factor", "gain_band_hz") if method == "mu" else ())
     out = []
     for k in keys:
         v = getattr(w, k)
@@ -302,7 +315,9 @@ def _weight_lines(method: str, w, src: dict) -> list[str]:
             out.append(f"# {name}: none")
             continue
         rule = src.get(f"{method}.{name}", "")
-        out.append(f"{name} = {_toml_num(v)}" + (f"  # {rule}" if rule else ""))
+        val = (f"[{_toml_num(v[0])}, {_toml_num(v[1])}]" if isinstance(v, tuple)
+               else _toml_num(v))
+        out.append(f"{name} = {val}" + (f"  # {rule}" if rule else ""))
     return out
 
 
@@ -439,11 +454,11 @@ def _uncertainty(cfg, d, rules: dict, notes: list, pressure_bar: float) -> dict:
 
 
 def _reference_pid(cfg) -> dict:
-    """The reference PID's ``kp`` (A/m), ``ti`` (s), ``eps`` (-): ``[controller.pid]``, else
+    """The reference PID's ``kp`` (A/m), ``ti``, ``td`` (s), ``eps`` (-): ``[controller.pid]``, else
     :func:`ambseal.control.pid.pid_from_rig`."""
     pid = getattr(getattr(cfg, "controller", None), "pid", None)
     if pid is not None:
-        return {"kp": pid.kp, "ti": pid.ti, "eps": pid.eps}
+        return {"kp": pid.kp, "ti": pid.ti, "td": pid.td, "eps": pid.eps}
     from .pid import pid_from_rig
 
     return pid_from_rig(cfg)
@@ -459,10 +474,10 @@ def _weights(d, method: str, mach: Machine, d_e: float, d_u: float, band_hi: flo
         w = replace(w, d_e=d_e, d_u=d_u)
     if method in ("mu", "lpv") and d_e is not None and d_u is not None:
         k_peak = pid["kp"] * (1 + 1 / pid["eps"])  # P5 Eq. 6 at high frequency
-        w = replace(w, wu_gain=_sig2(d_u / (WU_PID_PEAKS * d_e * k_peak)))
-        rules[f"{method}.wu_gain"] = (f"D_u/({WU_PID_PEAKS:g} D_e Kp (1 + 1/ε)): |K| ≤ "
-                                      f"{WU_PID_PEAKS:g}× the reference PID's peak where "
-                                      "S_o ≈ 1")
+        peaks = MU_WU_PID_PEAKS if method == "mu" else WU_PID_PEAKS
+        w = replace(w, wu_gain=_sig2(d_u / (peaks * d_e * k_peak)))
+        rules[f"{method}.wu_gain"] = (f"D_u/({peaks:g} D_e Kp (1 + 1/ε)): |K| ≤ {peaks:g}× "
+                                      "the reference PID's peak where S_o ≈ 1")
     if method == "lpv":
         w = replace(w, wu_hf_gain=LPV_WU_RISE * w.wu_gain, wu_corner_hz=mach.actuator_hz)
         rules["lpv.wu_hf_gain"] = f"{LPV_WU_RISE:g}× wu_gain (P3 §3.3: a high-pass W_u)"
@@ -478,8 +493,14 @@ def _weights(d, method: str, mach: Machine, d_e: float, d_u: float, band_hi: flo
         w = replace(w, orbit_um=ORBIT_PER_DE * d_e * 1e6, wf_rolloff_hz=roll)
         rules["mu.orbit_um"] = f"{ORBIT_PER_DE:g} D_e"
         rules["mu.wf_rolloff_hz"] = "1.3× the top of the unbalance band, at most f_b/2"
+        w = replace(w, gain_factor=GAIN_FACTOR, gain_band_hz=tuple(b * unb_range[1] for b in
+                    GAIN_BAND), pid_reference=tuple(pid[k] for k in ("kp", "ti", "td", "eps")))
+        rules["mu.gain_factor"] = f"{GAIN_FACTOR:g} (P5 Fig. 10: within 2× the PID's)"
+        rules["mu.gain_band_hz"] = (f"[{GAIN_BAND[0]:g}, {GAIN_BAND[1]:g}]× the top of the "
+                                    "unbalance band")
     keys = {"omega_b_rad_s": "omega_b"}
-    changes = {keys.get(k, k): v for k, v in spec.model_dump(exclude_none=True).items()
+    changes = {keys.get(k, k): (tuple(v) if isinstance(v, list) else v)
+               for k, v in spec.model_dump(exclude_none=True).items()
                if k not in ("max_iter", "dk_order", "iteration")}
     if changes.get("orbit_um") == 0:
         changes["orbit_um"] = None

@@ -148,9 +148,10 @@ class DesignCache:
             return real_digital(cfg, method, controller, result, points, cache)
 
         def design(cfg, method="mu", **kw):
-            # the main job passes the rig's own specification and a progress callback
-            plain = set(kw) <= {"spec", "progress", "allow_unstable"} \
-                and not kw.get("allow_unstable")
+            # the main job passes the rig's own specification and a progress callback,
+            # `ambseal design` the operating pressure (None: the rig's)
+            plain = set(kw) <= {"spec", "progress", "allow_unstable", "pressure_bar"} \
+                and not kw.get("allow_unstable") and kw.get("pressure_bar") is None
             if rig == "testrig" and plain and _same(cfg, got["testrig_cfg"]):
                 self.hits.append(f"design:{method}")
                 return got["testrig_designs"][method]

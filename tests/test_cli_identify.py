@@ -178,12 +178,16 @@ def test_non_square_controller_in_metadata(record, tmp_path, capsys):
     assert code == 2 and len(err) == 1 and str(bad) in err[0] and "A has shape" in err[0]
 
 
-def test_design_hinf_exports_controller(tmp_path, capsys):
+def test_design_hinf_exports_controller(tmp_path, capsys, request, design_cache_for):
     """`design --method hinf`: the controller in .json/.npz/.mat as it runs (discrete, with
     its sample time, method and the continuous design) and its summary; the summary's γ is
     the verified closed-loop norm (finite, > 0); the discrete loops it was chosen on are
-    stable (|z| < 1) wherever the continuous loop is."""
-    code = main(["design", RIG, "--method", "hinf", "--out", str(tmp_path)])
+    stable (|z| < 1) wherever the continuous loop is. The design and its discretisation are
+    the session's (the same calls, tests/conftest.py): this tests the command's files."""
+    cache = design_cache_for(request)
+    with cache.patched("testrig"):
+        code = main(["design", RIG, "--method", "hinf", "--out", str(tmp_path)])
+    assert {"design:hinf", "digital:hinf"} <= set(cache.hits)
     summary = json.loads(capsys.readouterr().out)
     assert code == 0 and summary["method"] == "hinf" and summary["gamma"] > 0
     data = np.load(tmp_path / "controller_hinf.npz")

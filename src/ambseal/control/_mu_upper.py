@@ -413,23 +413,27 @@ def _continuation(P, z, tol, max_iter, stride, t0_factor, warm_factor):
     return best_z
 
 
-def _refine_peak(P, best_z, nrm, peak_tol, max_iter, t0_factor, max_peaks=4):
-    """Continue the method of centres to ``peak_tol`` on the stack's largest bound (the
-    reported μ) from its scalings, restarted at the level ``t0_factor·λ``; in place. Again
-    if another matrix's bound is then the largest (at most ``max_peaks`` matrices).
+def _refine_peak(P, best_z, nrm, tol, peak_tol, max_iter, max_peaks=16):
+    """Continue the method of centres to ``peak_tol`` on the stack's largest bounds (the
+    reported μ) from their scalings; in place. Every bound within ``2·tol`` of the peak (at
+    most ``max_peaks``, largest first) is refined at once, from the level ``(1 + 2·tol)·λ``
+    (their scalings are already optimal to about ``tol``); then again any other matrix
+    whose bound has become the largest (at most ``max_peaks`` in all).
     ``nrm``: the stack's normalisation (the bound of matrix k is sqrt(λ_k)·nrm_k)."""
     F = best_z.shape[0]
     lam = _gevp(*P.direct(best_z, np.arange(F)))
+    mu2 = lam * nrm ** 2
+    order = np.argsort(-mu2)[:max_peaks]
+    todo = order[mu2[order] >= (1.0 - 2.0 * tol) * mu2[order[0]]]
     done = set()
-    for _ in range(max_peaks):
+    while todo.size:
+        lam_k, z_k = _centres(P, best_z[todo], lam[todo] * (1.0 + 2.0 * tol) + 1e-12,
+                              peak_tol, max_iter, todo)
+        better = lam_k < lam[todo]
+        lam[todo[better]], best_z[todo[better]] = lam_k[better], z_k[better]
+        done.update(todo.tolist())
         k = int(np.argmax(lam * nrm ** 2))
-        if k in done:
-            break
-        done.add(k)
-        lam_k, z_k = _centres(P, best_z[[k]], lam[[k]] * t0_factor + 1e-12, peak_tol,
-                              max_iter, [k])
-        if lam_k[0] < lam[k]:
-            lam[k], best_z[k] = lam_k[0], z_k[0]
+        todo = np.array([k]) if k not in done and len(done) < max_peaks else todo[:0]
 
 
 def upper_bound(Mp, blks, tol, max_iter, gmax, *, stride=0, t0_factor=1.2, warm_factor=None,
@@ -447,9 +451,17 @@ def upper_bound(Mp, blks, tol, max_iter, gmax, *, stride=0, t0_factor=1.2, warm_
         0: every matrix solved cold from Osborne balancing. ``stride > 1``: the stack is an
         ordered, smooth family (a frequency grid); every ``stride``-th matrix is solved cold,
         then levels of halved spacing start from their solved neighbours' scalings.
+    t0_factor : float
+        Cold solves start at the level ``t0_factor·λ`` of their starting scalings.
+    warm_factor : float, optional
+        Warm starts begin at the level ``warm_factor·λ`` of the best neighbour-based
+        scalings; default ``1 + tol/2``: where the centre at that level lowers λ by less than
+        ``tol/2`` the solve stops after one centring (test rig's μ loop, 500 frequencies:
+        about 5 Newton steps per frequency instead of 10, and no larger error against a
+        ``tol = 1e-6`` solve: 7.4e-4 vs 9.8e-4 with ``1 + 2·tol``).
     peak_tol : float, optional
-        The largest bound of the stack is refined further, to this tolerance
-        (:func:`_refine_peak`); default ``tol·1e-3``.
+        The bounds within ``2·tol`` of the largest one are refined further, to this
+        tolerance (:func:`_refine_peak`); default ``tol·1e-3``.
 
     Returns
     -------
@@ -476,9 +488,9 @@ def upper_bound(Mp, blks, tol, max_iter, gmax, *, stride=0, t0_factor=1.2, warm_
         _, best_z = _centres(P, z, lam0 * t0_factor + 1e-12, tol, max_iter, idx)
     else:
         best_z = _continuation(P, z, tol, max_iter, stride, t0_factor,
-                               1.0 + 2.0 * tol if warm_factor is None else warm_factor)
+                               1.0 + 0.5 * tol if warm_factor is None else warm_factor)
     if P.p and peak_tol < tol:
-        _refine_peak(P, best_z, nrm, peak_tol, max_iter, t0_factor)
+        _refine_peak(P, best_z, nrm, tol, peak_tol, max_iter)
     # the returned bound is the generalised eigenvalue at the returned scalings
     D, A = P.direct(best_z, np.arange(F))
     upper = np.sqrt(np.maximum(_gevp(D, A), 0.0)) * nrm

@@ -163,7 +163,7 @@ TURBO_CONST_GAMMA_PIN = 1.14
 
 @pytest.fixture(scope="module")
 def turbo(turbo_cfg, turbo_lpv):
-    """The session's constant-Lyapunov design on a 10-point 20–300 Hz grid (P3 §4)."""
+    """The session's constant-Lyapunov design on the vertex grid of 20–300 Hz (P3 §4)."""
     return turbo_cfg, turbo_lpv
 
 

@@ -401,10 +401,11 @@ def judge_spinup(cfg, controllers: dict) -> tuple[dict, list, list]:
     """The speed-scheduled rig's time and frequency judgement (P3 §4, Figs. 11–12).
 
     A spin-up over ``[operating] speed_range_hz`` in 1 s with alternating 100 N force and
-    2 µm output steps on the first actuator axis, on the LPV model (grid speeds every
-    10 Hz, at least 8; the rigid-body modes and the first bending pair; the force at the
-    first AMB), and σ̄(S_o) on the full-order plant at 8 frozen speeds across the range
-    (turboexpander: 29 speeds over 20–300 Hz, 12 states).
+    2 µm output steps on the first actuator axis, on the LPV model (grid speeds: the
+    vertex grid, :func:`ambseal.control.lpv_plant.vertex_grid_hz`, between which it is
+    exact; the rigid-body modes and the first bending pair; the force at the first AMB),
+    and σ̄(S_o) on the full-order plant at 8 frozen speeds across the range
+    (turboexpander: 7 grid speeds over 20–300 Hz, 12 states).
 
     Parameters
     ----------
@@ -420,13 +421,13 @@ def judge_spinup(cfg, controllers: dict) -> tuple[dict, list, list]:
         :class:`~ambseal.analysis.spinup.SpinupResult` and
         :class:`~ambseal.analysis.spinup.FrozenSensitivity` of each controller in order.
     """
-    from ..control.lpv_plant import lpv_plant
+    from ..control.lpv_plant import lpv_plant, vertex_grid_hz
     from ..control.specs import RIGID_STATES
     from .spinup import frozen_sensitivity, spinup
 
     lo, hi = cfg.operating.speed_range_hz
-    n_grid = max(8, int(round((hi - lo) / 10.0)) + 1)
-    L = lpv_plant(cfg, np.linspace(lo, hi, n_grid), states=RIGID_STATES + 4,
+    # A(Ω) is affine between the vertex grid's speeds: the plant is exact along the ramp
+    L = lpv_plant(cfg, vertex_grid_hz(cfg, (lo, hi)), states=RIGID_STATES + 4,
                   force_positions=(cfg.amb[0].position,))
     speeds = np.linspace(lo, hi, 8)
     cache: dict = {}

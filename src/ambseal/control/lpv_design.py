@@ -235,7 +235,7 @@ def lpv_generalized_plants(L, weights: Weights, speeds_rad_s=None):
             for w in W]
 
 
-def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int = 10,
+def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int | None = None,
                rate_bound_hz_per_s: float | None = None, lyapunov: str | None = None,
                weights: Weights | None = None, states: int = 8,
                frozen_gamma: bool = True, allow_unstable: bool = False,
@@ -249,8 +249,12 @@ def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int = 10,
     speeds_hz : (float, float)
         Operating speed range (Hz), P3 §4: 20–300 Hz. (Not yet a config key; a future
         ``[operating] speed_range_hz`` would feed it.)
-    n_grid : int
-        Design grid points, equally spaced over the range (≥ 2).
+    n_grid : int, optional
+        Design grid points, equally spaced over the range (≥ 2). Default: with a constant
+        Lyapunov function the vertex grid (:func:`ambseal.control.lpv_plant.vertex_grid_hz`:
+        the range's ends and the seal-table points inside it), on which the LMIs hold at
+        every speed of the range (A(Ω) is piecewise affine between them); with a
+        parameter-dependent one (no such guarantee: S(Ω) multiplies A(Ω)) 10 points.
     rate_bound_hz_per_s : float, optional
         |Ω̇|/2π bound (Hz/s): with it the Lyapunov function S(Ω) is parameter dependent
         (``lyapunov`` defaults to ``"affine"``); without it constant (P3).
@@ -290,17 +294,21 @@ def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int = 10,
     >>> K = d.controller_at(140.0)                                 # doctest: +SKIP
     """
     from .lpv import lpvsyn
-    from .lpv_plant import lpv_plant
+    from .lpv_plant import lpv_plant, vertex_grid_hz
 
     t0 = time.perf_counter()
     w = weights or _spec_weights(cfg)
     lo, hi = (float(x) for x in speeds_hz)
-    if int(n_grid) < 2:
-        raise SynthesisError(f"design_lpv: n_grid={n_grid}; the speed grid needs at least "
-                             "2 points")
-    grid = np.linspace(lo, hi, int(n_grid))
     if lyapunov is None:
         lyapunov = "constant" if rate_bound_hz_per_s is None else "affine"
+    if n_grid is None and lyapunov == "constant":
+        grid = vertex_grid_hz(cfg, (lo, hi))
+    else:
+        n_grid = 10 if n_grid is None else int(n_grid)
+        if n_grid < 2:
+            raise SynthesisError(f"design_lpv: n_grid={n_grid}; the speed grid needs at "
+                                 "least 2 points")
+        grid = np.linspace(lo, hi, n_grid)
     nu = None if rate_bound_hz_per_s is None else _TWO_PI * float(rate_bound_hz_per_s)
     L = lpv_plant(cfg, grid, states=states)
     gps = lpv_generalized_plants(L, w)

@@ -32,7 +32,7 @@ import numpy as np
 
 from ..errors import ModelError
 
-__all__ = ["LpvPlant", "lpv_plant"]
+__all__ = ["LpvPlant", "lpv_plant", "vertex_grid_hz"]
 
 _TWO_PI = 2.0 * np.pi
 
@@ -121,6 +121,38 @@ class LpvPlant:
                 "inputs": list(self.input_names), "outputs": list(self.output_names),
                 "reference_speed_hz": self.reference_speed_rad_s / _TWO_PI,
                 "affine": self.affine is not None}
+
+
+def vertex_grid_hz(cfg, speeds_hz) -> np.ndarray:
+    """The speed grid on which A(Ω) is exactly piecewise affine: the ends of the range and
+    every seal-table frequency strictly inside it (Hz).
+
+    A(Ω) is affine in Ω between consecutive seal-table points (module docstring; the seal
+    tables are linear between their points), so it is the convex combination of its values
+    at these points. An LMI affine in A(Ω) with Ω-independent variables — the LPV
+    conditions with a constant Lyapunov function (:func:`ambseal.control.lpv.lpvsyn`,
+    thesis P3 §4) — that holds at them therefore holds at every speed of the range
+    (Apkarian, Gahinet & Becker 1995, polytopic LPV); a finer grid adds only cost. Without
+    a frequency table the grid is the two ends.
+
+    Parameters
+    ----------
+    cfg : ambseal.config.RigConfig
+    speeds_hz : (float, float)
+        Operating speed range (Hz), increasing.
+
+    Returns
+    -------
+    ndarray, shape (n_p,)
+        Strictly increasing speeds (Hz), n_p ≥ 2.
+    """
+    from ..config import FrequencyTable
+
+    lo, hi = (float(x) for x in speeds_hz)
+    inner = {float(f) for seal in cfg.seal for key in "KkCc"
+             if isinstance(c := getattr(seal, key), FrequencyTable)
+             for f in c.frequency_hz if lo < f < hi}
+    return np.array(sorted(inner | {lo, hi}))
 
 
 def lpv_plant(cfg, speeds_hz, *, reference_speed_hz: float | None = None,

@@ -23,8 +23,10 @@ Controller reconstruction at any Ω: with M = I, N(Ω) = I − S(Ω) R the linea
 variables (Scherer, Gahinet & Chilali 1997) turns the closed-loop bounded-real inequality
 into an LMI in (Â, B̂, Ĉ) (D_K = 0); its minimum-norm solution at a γ slightly above the
 design γ gives B_K = N⁻¹B̂, C_K = Ĉ, A_K = N⁻¹(Â − B̂ C2 R − S B2 Ĉ − S A R). Controllers
-are reconstructed on a table five times denser than the design grid, checked there (each
-frozen closed loop stable, its H∞ norm reported) and interpolated linearly in between.
+are reconstructed on a table ``check_density`` times denser than the design grid (5; 1 on
+a vertex grid with a constant S, where the linear interpolation meets the same γ:
+:func:`ambseal.control.lpv_design.design_lpv`), checked there (each frozen closed loop
+stable, its H∞ norm reported) and interpolated linearly in between.
 
 Code: validation and orchestration here (:func:`lpvsyn`, ``_validate``, ``_check_table``);
 scaling and the SDPs in :mod:`ambseal.control.lpv_lmi`; the controller reconstruction in

@@ -69,7 +69,7 @@ class LpvDesign(ScheduledController):
     frozen_gamma : ndarray, shape (n_p,)
         Verified H∞ γ of a frozen-point design at each grid speed (NaN if not computed).
     check_gamma : ndarray, shape (n_check,)
-        H∞ norm of the frozen LPV closed loops on the 5× denser check grid.
+        H∞ norm of the frozen LPV closed loops on the check grid (the controller table).
     speeds_hz, check_speeds_hz : ndarray
         Design grid and check grid (Hz).
     lyapunov : str
@@ -255,6 +255,13 @@ def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int | None = None,
         the range's ends and the seal-table points inside it), on which the LMIs hold at
         every speed of the range (A(Ω) is piecewise affine between them); with a
         parameter-dependent one (no such guarantee: S(Ω) multiplies A(Ω)) 10 points.
+        On the vertex grid the controller table is the grid itself (``check_density``
+        1): with R, S constant the linearised closed-loop LMI of the reconstruction
+        (Scherer, Gahinet & Chilali 1997) is affine in (A, Â, B̂, Ĉ) and A_K, B_K, C_K are
+        affine in them (M = I, N = I − S R), so the controller interpolated linearly
+        between two table speeds is the one of the interpolated variables and meets the
+        reconstruction's γ at every speed in between (turboexpander: frozen H∞ norm ≤ 1.080
+        at 54 speeds between the 7 table speeds, bound 1.02·γ_d = 1.178).
     rate_bound_hz_per_s : float, optional
         |Ω̇|/2π bound (Hz/s): with it the Lyapunov function S(Ω) is parameter dependent
         (``lyapunov`` defaults to ``"affine"``); without it constant (P3).
@@ -303,6 +310,8 @@ def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int | None = None,
         lyapunov = "constant" if rate_bound_hz_per_s is None else "affine"
     if n_grid is None and lyapunov == "constant":
         grid = vertex_grid_hz(cfg, (lo, hi))
+        # the controller on the vertex grid itself, linear in between: exact (docstring)
+        lpvsyn_kw.setdefault("check_density", 1)
     else:
         n_grid = 10 if n_grid is None else int(n_grid)
         if n_grid < 2:

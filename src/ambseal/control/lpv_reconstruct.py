@@ -1,8 +1,9 @@
 """Controller reconstruction of the gridded LPV synthesis (:func:`ambseal.control.lpv.lpvsyn`).
 
 From the LMI solution R, S(Ω) (:mod:`ambseal.control.lpv_lmi`) the controller is rebuilt at
-each speed of a table five times denser than the design grid, with the linearising change of
-variables of Scherer, Gahinet & Chilali (1997) (D_K = 0, M = I, N = I − S R) and Â
+each speed of a table ``check_density`` times denser than the design grid, with the
+linearising change of variables of Scherer, Gahinet & Chilali (1997) (D_K = 0, M = I,
+N = I − S R) and Â
 eliminated in closed form (:class:`_Reconstructor`); between table speeds the plant's A(Ω)
 is interpolated by :func:`interp_A`.
 """

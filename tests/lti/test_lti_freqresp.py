@@ -197,3 +197,27 @@ def test_auto_falls_back_to_dense_solves_where_both_fast_forms_fail():
     assert _rel(fr.freqresp(cl, w), ref) < 1e-5
     mu = mussv(cl, [(1, 1), (1, 1), (2, 2)], w).upper.max()
     assert mu == pytest.approx(float(d["mu_dkpy"]), rel=1e-3)
+
+
+def test_badly_scaled_states_use_the_modal_form_of_the_balanced_matrix(monkeypatch):
+    """Reference: dense solves of (jωI − A) X = B and python-control's response. The lightly
+    damped system in states scaled by 1e-5…1e5 (a diagonal similarity, as [q; q̇] of an FE
+    rotor with modes up to 100 kHz) has cond V > 1e8 unbalanced; "auto" takes the modal form
+    of the balanced system (cond V back near the unscaled one; no Hessenberg solve) and
+    agrees with both."""
+    A, B, C, D, _ = _lightly_damped(n=60, seed=3)
+    t = np.logspace(-5, 5, A.shape[0])
+    A, B, C = A * t[None, :] / t[:, None], B / t[:, None], C * t[None, :]
+    assert fr._modal_form(A, B, C, 1e8)[2] is None  # cond V > 1e8
+    assert fr._modal_form(A, B, C, 1e8, balance=True)[1] < 1e6
+    w = np.logspace(0, 4, 50)
+    ref = np.moveaxis(control.ss(A, B, C, D)(1j * w), -1, 0)
+    dense = _dense(A, B, C, D, w)
+
+    def no_hessenberg(*a):
+        raise AssertionError("Hessenberg path taken")
+
+    monkeypatch.setattr(fr, "_hessenberg_response", no_hessenberg)
+    H = fr.freqresp((A, B, C, D), w)
+    assert _rel(H, dense) < 1e-8
+    assert _rel(H, ref) < 1e-6

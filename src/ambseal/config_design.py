@@ -52,7 +52,7 @@ schema). Units are SI except where the key names its unit.
     judged pressures frozen at the identified k there, and run on the virtual facility's
     0 → 3× nominal pressure ramp with the other controllers and the tracker
     (:mod:`ambseal.analysis.ramp`). Off by default: its LMI synthesis takes minutes
-    (≈ 75 s of CPU on the test rig; cached in ``$AMBSEAL_CACHE_DIR``) and the ramp ≈ 20 s.
+    (≈ 130 s of CPU on the test rig; cached in ``$AMBSEAL_CACHE_DIR``) and the ramp ≈ 20 s.
 """
 
 from __future__ import annotations

@@ -11,8 +11,9 @@ S(θ) = S₀ + p S₁ and the rate bound |θ̇| ≤ ν from the expected pressur
 
 Defaults (each a rule on the rig): θ over [0, 3]× its value at the rig's operating
 pressure (the issue's ramp to 3× nominal), 5 grid points, ν = 0.1× that value per second
-(0 → 3× nominal in 30 s). When θ is a seal's k affine in the pressure drop, the seal's
-other coefficients (K, C, c) in each design plant are those at the pressure that gives θ.
+(0 → 3× nominal in 30 s). When θ is a seal's k affine in the pressure drop, every other
+seal coefficient in each design plant is the one at the pressure that gives θ
+(:func:`ambseal.model.seal.values_following_k`).
 
 Design model: the specification's (:func:`ambseal.control.specs.design_spec`: every mode
 below min(3 f_a, f_s/4); on the test rig the rigid-body modes and the 557 Hz bending pair,
@@ -22,19 +23,24 @@ see it loses it on the full-order plant from 2× nominal pressure (measured: the
 pair at Re λ = +0.72 1/s at 2×, +8.8 1/s at 3×).
 
 Weights: the nominal H∞ design's (the specification's ``hinf`` weights, P5 §4.4) with the
-W_p peak M = 2 of the LPV weights (P3 Eq. 11) instead of 2.5 and a third of its current
-weight, W_u = 0.1 instead of 0.3. One controller for the whole range costs γ (the LMI bound
-over the grid with the rate bound); with the nominal weights the frozen full-order loops
-on the test rig peaked at σ̄(S_o) = 3.2 per axis (B axes, at 134 Hz, every k), M = 2 alone
-gave 3.15, M = 2.2 with W_u = 0.2 gave 3.05; M = 2 with W_u = 0.1 gives γ = 1.66 and
-σ̄(S_o) ≤ 2.74 per axis at all 21 frozen k over 0–3× nominal (zone A, ISO 14839-3).
-These were measured with the nominal H∞ weights' former ω_B = 60 rad/s (P5 §4.4), kept
-here; the nominal H∞ design has since moved to ω_B = 12.5 rad/s (issue 16), which was
-not tried for the scheduled design.
+W_p peak M = 2 of the LPV weights (P3 Eq. 11) instead of 2.5, ω_B = 60 rad/s (P5 §4.4) and
+a tenth of its current weight, W_u = 0.02 instead of 0.2. The design model carries the
+controller's hold + computation delay in its actuator path, as the H∞/μ designs do
+(:func:`ambseal.control.delay.design_delay`, the same call as
+:func:`ambseal.control.recipes.design`): without it the tracked controller as it runs
+(one sample of delay at 10 kHz) peaked at σ̄(S_o) = 4.06–4.2 per axis on the test rig
+against 2.74 designed for. Measured with the delay (test rig, rig file, 21 frozen k over
+0–3× nominal, every loop with the delay): the former W_u = 0.1 gave γ = 2.02 and σ̄(S_o)
+3.21 (M = 1.8: 3.15), W_u = 0.05 2.99, W_u = 0.02 γ = 1.51 and 2.81; the specification's
+ω_B (5 rad/s, the PID's 1/T_i) gave 2.88 with W_u = 0.1 and 2.75 with 0.07, but its LMI
+reconstruction failed (solver "infeasible_inaccurate") with W_u = 0.05 on the test rig and
+with W_u = 0.1 on examples/pump.toml. examples/pump.toml with these weights: γ = 1.35,
+σ̄(S_o) ≤ 2.27 at 21 frozen k over 0–60 bar.
 
-Synthesis takes minutes (≈ 75 s of CPU on the test rig, 5 grid points, the 12-state
-design model; 10–12 min elapsed on the loaded 2-core machine): :func:`design_seal_scheduled` keeps each result in a cache folder keyed on the
-rig, the arguments and the synthesis code (``cache_dir``; :data:`CACHE_ENV`).
+Synthesis takes minutes (≈ 130 s of CPU on the test rig, 5 grid points, the 12-state
+design model and the delay's states; 10–20 min elapsed on the loaded 2-core machine):
+:func:`design_seal_scheduled` keeps each result in a cache folder keyed on the rig, the
+arguments and the synthesis code (``cache_dir``; :data:`CACHE_ENV`).
 """
 
 from __future__ import annotations
@@ -62,7 +68,7 @@ CACHE_ENV = "AMBSEAL_CACHE_DIR"
 
 #: The W_p peak, bandwidth (rad/s) and the W_u gain of the scheduled design (module
 #: docstring; P3 Eq. 11).
-M_TRACKED, OMEGA_B_TRACKED, WU_TRACKED = 2.0, 60.0, 0.1
+M_TRACKED, OMEGA_B_TRACKED, WU_TRACKED = 2.0, 60.0, 0.02
 
 
 @dataclass(frozen=True, eq=False)
@@ -91,6 +97,9 @@ class SealScheduledDesign(ScheduledController):
         Mechanical states of the design model.
     range_factor : (float, float)
         The schedule as multiples of θ at the operating pressure.
+    delay : dict
+        The controller's hold + computation delay in the design model's actuator path
+        (:meth:`ambseal.control.delay.DesignDelay.to_dict`).
     """
 
     parameter: str
@@ -105,6 +114,7 @@ class SealScheduledDesign(ScheduledController):
     synthesis_s: float = 0.0
     design_states: int = 0
     range_factor: tuple = (0.0, 3.0)
+    delay: dict = field(default_factory=dict)
 
     @property
     def schedule(self) -> tuple[float, float]:
@@ -133,7 +143,7 @@ class SealScheduledDesign(ScheduledController):
                 "check_gamma_max": float(np.max(self.check_gamma)),
                 "rate_bound_per_s": self.rate_bound, "order": self.K.order,
                 "design_states": self.design_states,
-                "range_factor": list(self.range_factor),
+                "range_factor": list(self.range_factor), "delay": self.delay,
                 "weights": self.weights.to_dict(), "synthesis_s": round(self.synthesis_s, 3)}
 
 
@@ -177,6 +187,7 @@ def design_seal_scheduled(cfg, parameter: str | None = None, *,
         From :func:`lpvsyn` (infeasible LMIs, an unstable frozen loop), or ``n_grid`` < 2.
     """
     from ..model.rig import build_plant
+    from .delay import design_delay
     from .specs import design_spec
 
     if parameter is None:
@@ -194,14 +205,16 @@ def design_seal_scheduled(cfg, parameter: str | None = None, *,
                          "pressure; no scale for its range")
     w = weights or replace(sp.weights["hinf"], M=M_TRACKED, omega_b=OMEGA_B_TRACKED,
                            wu_gain=WU_TRACKED)
+    dl = design_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples,
+                      sp.synthesis_band_hz[1], max_order=1)
     args = (parameter, tuple(map(float, range_factor)), int(n_grid), float(rate_factor_per_s),
-            w, n, sorted(lpvsyn_kw.items()))
+            w, n, sorted(lpvsyn_kw.items()), dl.to_dict())
     folder = cache_dir or os.environ.get(CACHE_ENV)
     path = Path(folder) / f"seal_scheduled-{_key(cfg, args)}.pkl" if folder else None
     if path is not None and path.is_file():
         with open(path, "rb") as fh:
             return pickle.load(fh)
-    d = _synthesise(cfg, plant, args, scale, lpvsyn_kw)
+    d = _synthesise(cfg, plant, args, scale, dl, lpvsyn_kw)
     if path is not None:
         from ..files import atomic_write
 
@@ -212,31 +225,33 @@ def design_seal_scheduled(cfg, parameter: str | None = None, *,
 
 def _key(cfg, args) -> str:
     """Cache key: the rig, the arguments and the source of the synthesis code."""
+    from ..model import seal
     from . import lpv, lpv_lmi, lpv_reconstruct, plant, weights
 
     h = hashlib.sha256(cfg.model_dump_json().encode())
     h.update(repr(args).encode())
-    for mod in (lpv, lpv_lmi, lpv_reconstruct, plant, weights):
+    for mod in (lpv, lpv_lmi, lpv_reconstruct, plant, weights, seal):
         h.update(Path(mod.__file__).read_bytes())
     h.update(Path(__file__).read_bytes())
     return h.hexdigest()[:20]
 
 
-def _synthesise(cfg, plant, args, scale: float, lpvsyn_kw) -> SealScheduledDesign:
-    """lpvsyn over the grid of θ (the design model at each grid value)."""
+def _synthesise(cfg, plant, args, scale: float, dl, lpvsyn_kw) -> SealScheduledDesign:
+    """lpvsyn over the grid of θ (the design model at each grid value, the controller's
+    delay ``dl`` in its actuator path)."""
     from ..model.seal import values_following_k
     from .lpv import lpvsyn
     from .plant import generalized_plant
 
-    parameter, rf, n_grid, rate, w, n, _ = args
+    parameter, rf, n_grid, rate, w, n = args[:6]
     t0 = time.perf_counter()
     grid = np.linspace(rf[0] * scale, rf[1] * scale, n_grid)
     gps = [generalized_plant(plant.with_values(values_following_k(
-        cfg.seal, parameter, th, plant.parameters)), w.Wp(), w.Wu(), d_e=w.d_e, d_u=w.d_u)
-        for th in grid]
+        cfg.seal, parameter, th, plant.parameters)), w.Wp(), w.Wu(), d_e=w.d_e, d_u=w.d_u,
+        actuator_delay=dl.system) for th in grid]
     nu = rate * scale
     r = lpvsyn([g.P_nominal for g in gps], grid, gps[0].nmeas, gps[0].ncon,
                lyapunov="affine", rate_bound=nu, **lpvsyn_kw)
     return SealScheduledDesign(parameter, r.K, r.gamma, r.gamma_design, grid,
                                r.check_rad_s, r.check_gamma, nu, w,
-                               time.perf_counter() - t0, n, rf)
+                               time.perf_counter() - t0, n, rf, dl.to_dict())

@@ -413,27 +413,30 @@ def _continuation(P, z, tol, max_iter, stride, t0_factor, warm_factor):
     return best_z
 
 
-def _refine_peak(P, best_z, nrm, tol, peak_tol, max_iter, max_peaks=16):
+def _refine_peak(P, best_z, nrm, tol, peak_tol, max_iter, batch=16, max_total=64):
     """Continue the method of centres to ``peak_tol`` on the stack's largest bounds (the
-    reported μ) from their scalings; in place. Every bound within ``2·tol`` of the peak (at
-    most ``max_peaks``, largest first) is refined at once, from the level ``(1 + 2·tol)·λ``
-    (their scalings are already optimal to about ``tol``); then again any other matrix
-    whose bound has become the largest (at most ``max_peaks`` in all).
+    reported μ) from their scalings; in place. The bounds within ``2·tol`` of the peak (at
+    most ``batch``, largest first) are refined at once, from the level ``(1 + 2·tol)·λ``
+    (their scalings are already optimal to about ``tol``); then, while the largest bound is
+    not a refined one, every unrefined bound above the largest refined one (at most
+    ``max_total`` matrices in all). The reported peak is then a refined bound, and no
+    other matrix's optimal bound can exceed it.
     ``nrm``: the stack's normalisation (the bound of matrix k is sqrt(λ_k)·nrm_k)."""
     F = best_z.shape[0]
     lam = _gevp(*P.direct(best_z, np.arange(F)))
     mu2 = lam * nrm ** 2
-    order = np.argsort(-mu2)[:max_peaks]
+    order = np.argsort(-mu2)[:batch]
     todo = order[mu2[order] >= (1.0 - 2.0 * tol) * mu2[order[0]]]
-    done = set()
+    done = np.zeros(F, bool)
     while todo.size:
         lam_k, z_k = _centres(P, best_z[todo], lam[todo] * (1.0 + 2.0 * tol) + 1e-12,
                               peak_tol, max_iter, todo)
         better = lam_k < lam[todo]
         lam[todo[better]], best_z[todo[better]] = lam_k[better], z_k[better]
-        done.update(todo.tolist())
-        k = int(np.argmax(lam * nrm ** 2))
-        todo = np.array([k]) if k not in done and len(done) < max_peaks else todo[:0]
+        done[todo] = True
+        mu2 = lam * nrm ** 2
+        above = np.flatnonzero(~done & (mu2 > mu2[done].max()))
+        todo = above[np.argsort(-mu2[above])][:max(0, min(batch, max_total - done.sum()))]
 
 
 def upper_bound(Mp, blks, tol, max_iter, gmax, *, stride=0, t0_factor=1.2, warm_factor=None,

@@ -160,12 +160,14 @@ def _response(A, B, C, D, s, method, max_cond, rtol) -> np.ndarray:
                 " use method='hessenberg'"
             )
         if method == "auto":
-            H = _balanced_modal(A, B, C, D, s, max_cond, rtol)
+            probe = _probes(s)
+            H = _balanced_modal(A, B, C, D, s, probe, _dense_response(A, B, C, D, probe),
+                                max_cond, rtol)
             if H is not None:
                 return H
         return _hessenberg_response(A, B, C, D, s)
     if method == "auto":
-        probe = s[np.unique([0, s.size // 2, s.size - 1])]
+        probe = _probes(s)
         Hm = _modal_eval(lam, Bm, Cm, D, probe)
         Hh = _hessenberg_response(A, B, C, D, probe)
         with np.errstate(invalid="ignore"):
@@ -206,17 +208,10 @@ def _arbitrated(A, B, C, D, s, probe, Hh, Hm, modal, max_cond, rtol) -> np.ndarr
     22-state controller there: error 11 on σ̄ 180, the dense solves agree with
     python-control's TB05AD to 4e-6 relative)."""
     Hd = _dense_response(A, B, C, D, probe)
-    with np.errstate(all="ignore"):
-        scale = np.maximum(np.max(np.abs(Hd), axis=(1, 2)), np.finfo(float).tiny)
-
-        def error(H):
-            return float(np.max(np.max(np.abs(H - Hd), axis=(1, 2)) / scale))
-
-        lam, _, Bb, Cb = _BALANCED.get((A, B, C), max_cond,
-                                       lambda: _modal_form(A, B, C, max_cond, balance=True))
-        if Bb is not None and error(_modal_eval(lam, Bb, Cb, D, probe)) <= rtol:
-            return _modal_eval(lam, Bb, Cb, D, s)
-        eh, em = error(Hh), error(Hm)
+    H = _balanced_modal(A, B, C, D, s, probe, Hd, max_cond, rtol)
+    if H is not None:
+        return H
+    eh, em = _error(Hh, Hd), _error(Hm, Hd)
     if np.isfinite(eh) and eh <= _ARBITER_RTOL and not em < eh:
         return _hessenberg_response(A, B, C, D, s)
     if np.isfinite(em) and em <= _ARBITER_RTOL:
@@ -224,9 +219,23 @@ def _arbitrated(A, B, C, D, s, probe, Hh, Hm, modal, max_cond, rtol) -> np.ndarr
     return _dense_response(A, B, C, D, s)
 
 
-def _balanced_modal(A, B, C, D, s, max_cond, rtol) -> np.ndarray | None:
-    """The response on ``s`` by the modal form of the balanced system where that of ``A``
-    is ill conditioned, if it is within ``rtol`` of dense solves at three probes; else None.
+def _probes(s: np.ndarray) -> np.ndarray:
+    """The three probe points of ``s`` (first, middle, last) at which the forms are checked."""
+    return s[np.unique([0, s.size // 2, s.size - 1])]
+
+
+def _error(H: np.ndarray, Hd: np.ndarray) -> float:
+    """Largest error of ``H`` against the dense solves ``Hd`` at the probes, relative to the
+    largest entry of ``Hd`` at each probe (``nan`` where either is not finite)."""
+    with np.errstate(all="ignore"):
+        scale = np.maximum(np.max(np.abs(Hd), axis=(1, 2)), np.finfo(float).tiny)
+        return float(np.max(np.max(np.abs(H - Hd), axis=(1, 2)) / scale))
+
+
+def _balanced_modal(A, B, C, D, s, probe, Hd, max_cond, rtol) -> np.ndarray | None:
+    """The response on ``s`` by the modal form of the balanced system if it is within
+    ``rtol`` of the dense solves ``Hd`` at ``probe``; else None. Used where the modal form of
+    ``A`` is ill conditioned, and by :func:`_arbitrated`.
 
     cond V depends on the state scaling: the blower's full-order plant (268 states, [q; q̇]
     with modes up to 280 kHz) has cond V 5.8e8 > 1e8, balanced 1.1e4, and its balanced
@@ -236,14 +245,9 @@ def _balanced_modal(A, B, C, D, s, max_cond, rtol) -> np.ndarray | None:
     scaling (see :func:`_arbitrated`)."""
     lam, _, Bb, Cb = _BALANCED.get((A, B, C), max_cond,
                                    lambda: _modal_form(A, B, C, max_cond, balance=True))
-    if Bb is None:
+    if Bb is None or not _error(_modal_eval(lam, Bb, Cb, D, probe), Hd) <= rtol:
         return None
-    probe = s[np.unique([0, s.size // 2, s.size - 1])]
-    Hd = _dense_response(A, B, C, D, probe)
-    with np.errstate(all="ignore"):
-        scale = np.maximum(np.max(np.abs(Hd), axis=(1, 2)), np.finfo(float).tiny)
-        err = np.max(np.abs(_modal_eval(lam, Bb, Cb, D, probe) - Hd), axis=(1, 2)) / scale
-    return _modal_eval(lam, Bb, Cb, D, s) if np.max(err) <= rtol else None
+    return _modal_eval(lam, Bb, Cb, D, s)
 
 
 def _dense_response(A, B, C, D, s) -> np.ndarray:

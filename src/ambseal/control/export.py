@@ -295,7 +295,8 @@ def load_controller(path):
                             f"{key} has {W.size}")
         tab = {suf: tuple(arr[k + suf] for k in "ABCD") for suf in ("", "_c", "_r")}
         return ScheduledDigital(W, tab["_c"], tab["_r"], tab[""], tuple(ins), tuple(outs),
-                                method, pw, fs, delay, removed, cands, name, par)
+                                method, pw, fs, delay, removed, cands, name, par,
+                                choice=str(meta.get("choice", "")))
 
     def ss(suf, nm):
         return control.ss(*(arr[k + suf] for k in "ABCD"), inputs=ins, outputs=outs, name=nm)
@@ -303,4 +304,5 @@ def load_controller(path):
     desc = {"type": "state_space", "name": name, "discretisation": method}
     disc = DiscreteController(*(arr[k] for k in "ABCD"), 1.0 / fs, description=desc)
     return DigitalController(ss("_c", name), ss("_r", f"{name}_r"), disc, method, pw, fs,
-                             delay, removed, meta.get("reduction"), cands)
+                             delay, removed, meta.get("reduction"), cands,
+                             str(meta.get("choice", "")))

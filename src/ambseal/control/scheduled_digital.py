@@ -9,8 +9,12 @@ table on θ = that coefficient (SI). The target runs the same law on discrete ma
 every entry is discretised by one method (:mod:`ambseal.control.digital`, chosen on the
 frozen loops), after the fast poles are removed in one basis common to all entries (the
 slow/fast split of the middle entry, so that interpolating the reduced entries still makes
-sense), and the discrete matrices are interpolated on the measured speed (or the tracked
-estimate).
+sense) or, for the hold equivalents, kept when at every entry they alias nothing
+(:func:`~ambseal.control.digital.hold_keeps`), and the discrete matrices are interpolated
+on the measured speed (or the tracked estimate). The tracked controller of the identified
+test rig needs the second: its 6.3–6.6 kHz pairs (ζ ≥ 0.998) residualised raised its
+σ̄(S_o) peak at 190 Hz from 2.94 to 3.16 (continuous, exact delay; Tustin pre-warped
+table 3.10–3.11 as it runs), kept under the triangle hold 2.93.
 
 The interpolation is judged between the grid points: the caller passes plants at values
 between table entries, and the chosen method keeps every one of those sampled loops
@@ -27,8 +31,8 @@ import numpy as np
 from ..errors import SynthesisError
 from ..identify.loop import DiscreteController
 from .controller import SPEED, ScheduledController
-from .digital import (FAST_FRACTION, METHODS, _chosen_error, _json_safe, check_rate,
-                      choose_method, discretize_as,
+from .digital import (FAST_FRACTION, HOLDS, KEPT, METHODS, _chosen_error, _json_safe,
+                      check_rate, choose_method, discretize_as, hold_keeps,
                       peak_difference, prewarp_frequency_hz, residualize, sampled_plants,
                       split_fast, with_delay)
 
@@ -67,10 +71,11 @@ class ScheduledDigital(ScheduledController):
         (SI).
     continuous, reduced, discrete : tuple of 4 ndarray
         ``(A, B, C, D)`` stacks of shapes (n_t, n, n), (n_t, n, ny), (n_t, nu, n),
-        (n_t, nu, ny): the designed physical controller (m → A), the same with the fast
-        poles removed, and its discrete equivalent at ``sample_rate_hz``.
+        (n_t, nu, ny): the designed physical controller (m → A), the one discretised (the
+        same with the fast poles removed, or ``continuous`` when they were kept), and its
+        discrete equivalent at ``sample_rate_hz``.
     inputs, outputs : tuple of str
-    method, prewarp_hz, sample_rate_hz, delay_samples, removed_poles_hz, candidates
+    method, prewarp_hz, sample_rate_hz, delay_samples, removed_poles_hz, candidates, choice
         As :class:`~ambseal.control.digital.DigitalController`.
     name : str
     parameter : str
@@ -91,6 +96,7 @@ class ScheduledDigital(ScheduledController):
     candidates: tuple = ()
     name: str = "K"
     parameter: str = SPEED
+    choice: str = ""
 
     @property
     def schedule(self) -> tuple[float, float]:
@@ -141,7 +147,8 @@ class ScheduledDigital(ScheduledController):
     def to_dict(self) -> dict:
         """JSON-ready description (no matrices)."""
         return _json_safe({
-                "method": self.method, "prewarp_hz": self.prewarp_hz,
+                "method": self.method, "choice": self.choice or self.method,
+                "prewarp_hz": self.prewarp_hz,
                 "sample_rate_hz": self.sample_rate_hz, "Ts": self.Ts,
                 "delay_samples": self.delay_samples, "interpolation": self.interpolation,
                 **({"table_speeds_hz": (self.grid / (2 * np.pi)).tolist()}
@@ -192,39 +199,55 @@ def scheduled_digital(K: ScheduledController, grid, sample_rate_hz: float,
     fs, T = float(sample_rate_hz), 1.0 / float(sample_rate_hz)
     W = np.asarray(grid, float)
     table = [tuple(np.asarray(X, float) for X in K.matrices_at(w)) for w in W]
-    V, k, fast = split_fast(table[len(W) // 2][0], FAST_FRACTION * fs / 2)
-    for w, mats in zip(W, table):
-        A22 = np.linalg.solve(V, mats[0] @ V)[k:, k:]
-        if A22.size and np.max(np.linalg.eigvals(A22).real) >= 0:
-            raise SynthesisError(
-                f"controller.sample_rate_hz = {fs:g} Hz: the fast part of {name} at "
-                f"{_label(K.parameter, w)} is not stable and cannot be removed; raise the "
-                "sample rate")
-    reduced = [residualize(m, V, k) for m in table]
+    reduced, fast, keep = _reduced_table(table, W, fs, K.parameter, name)
     stacks = [tuple(np.stack([m[i] for m in seq]) for i in range(4))
               for seq in (table, reduced)]
     sp = [p[0] for p in plants]
     G = [p[1] for p in plants]
     cont = [tuple(_interp(s, W, X) for X in stacks[0]) for s in sp]
     f_pw = prewarp_frequency_hz(G[:1], cont[0], fs)
+    tried = list(methods) + ([f"{m}{KEPT}" for m in HOLDS if m in methods] if keep else [])
 
     def discrete(m):
-        tab = [discretize_as(r, T, m, f_pw) for r in reduced]
+        src = table if m.endswith(KEPT) else reduced
+        tab = [discretize_as(r, T, m.removesuffix(KEPT), f_pw) for r in src]
         st = tuple(np.stack([t[i] for t in tab]) for i in range(4))
         discrete.tables[m] = st
         return [tuple(_interp(s, W, X) for X in st) for s in sp]
 
     discrete.tables = {}
-    m, _, cands = choose_method(sampled_plants(G, fs, delay_samples=delay_samples), cont,
-                                discrete, int(delay_samples), methods, f_pw, name)
+    choice, _, cands = choose_method(sampled_plants(G, fs, delay_samples=delay_samples), cont,
+                                     discrete, int(delay_samples), tried, f_pw, name)
+    m = choice.removesuffix(KEPT)
+    if choice.endswith(KEPT):  # the table as designed: nothing removed
+        stacks[1], fast = stacks[0], np.zeros(0)
     at = ({"speeds_hz": [s / (2 * np.pi) for s in sp]} if K.parameter == SPEED
           else {"values": [float(s) for s in sp]})
     cands = tuple({**c, **at} for c in cands)
     chans = K.at(float(W[0]))
     return ScheduledDigital(
-        grid=W, continuous=stacks[0], reduced=stacks[1], discrete=discrete.tables[m],
+        grid=W, continuous=stacks[0], reduced=stacks[1], discrete=discrete.tables[choice],
         inputs=tuple(chans.input_labels), outputs=tuple(chans.output_labels), method=m,
         prewarp_hz=f_pw if m == "tustin_prewarp" else None, sample_rate_hz=fs,
         delay_samples=int(delay_samples),
         removed_poles_hz=tuple(sorted(float(abs(p)) / (2 * np.pi) for p in fast)),
-        candidates=cands, name=name, parameter=K.parameter)
+        candidates=cands, name=name, parameter=K.parameter, choice=choice)
+
+
+def _reduced_table(table, W, fs: float, parameter: str, name: str):
+    """The entries with their fast poles removed in one basis (module docstring), the
+    middle entry's fast poles (rad/s), and whether the hold equivalents may keep them (at
+    every entry, :func:`~ambseal.control.digital.hold_keeps`)."""
+    f_cut = FAST_FRACTION * fs / 2
+    V, k, fast = split_fast(table[len(W) // 2][0], f_cut)
+    for w, mats in zip(W, table):
+        A22 = np.linalg.solve(V, mats[0] @ V)[k:, k:]
+        if A22.size and np.max(np.linalg.eigvals(A22).real) >= 0:
+            raise SynthesisError(
+                f"controller.sample_rate_hz = {fs:g} Hz: the fast part of {name} at "
+                f"{_label(parameter, w)} is not stable and cannot be removed; raise the "
+                "sample rate")
+    lam = [np.linalg.eigvals(m[0]) for m in table]
+    keep = bool(fast.size) and all(hold_keeps(x[np.abs(x) > 2 * np.pi * f_cut], fs)
+                                   for x in lam)
+    return [residualize(m, V, k) for m in table], fast, keep

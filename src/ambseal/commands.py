@@ -35,7 +35,7 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
     :class:`~ambseal.control.scheduled_digital.ScheduledDigital` whose interpolation is
     also checked between table entries (at speeds, or at the pressures that give the seal
     coefficient it is scheduled on). ``cache`` (a dict kept by the caller) shares the
-    sampled plants between the controllers of one rig."""
+    sampled plants and the μ design's grid between the controllers of one rig."""
     import numpy as np
 
     from .control.controller import ScheduledController
@@ -54,11 +54,12 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
         from .control.dk import design_omega
         from .control.specs import design_spec
 
-        om = design_omega(*design_spec(cfg).synthesis_band_hz)  # the μ design's grid
-        rise = ((lambda Kr: design_rise(result, Kr, om, fs / 2)) if method in ("hinf", "mu")
-                else None)
-        check_rate(controller, fs, delay, removable=rise is not None)  # before the plants
         cache = {} if cache is None else cache
+        if method in ("hinf", "mu") and "omega" not in cache:  # the μ design's grid
+            cache["omega"] = design_omega(*design_spec(cfg).synthesis_band_hz)
+        rise = ((lambda Kr: design_rise(result, Kr, cache["omega"], fs / 2))
+                if method in ("hinf", "mu") else None)
+        check_rate(controller, fs, delay, removable=rise is not None)  # before the plants
         if "plants" not in cache:
             cache["plants"] = sampled_plants([plant(*c) for c in conds], fs,
                                              delay_samples=delay)

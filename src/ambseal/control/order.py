@@ -133,9 +133,10 @@ def reduce_controller(P, K, order: int, nmeas: int, ncon: int, *,
         Frequencies in rad/s for μ.
     alpha : float, optional
         Stability boundary for the stable/unstable split (see :func:`balred_controller`).
-    full : (float, float or None), optional
+    full : (float or None, float or None), optional
         γ and peak μ of the full-order loop when already known (a search over orders
-        reduces the same controller several times); computed if omitted.
+        reduces the same controller several times; a μ design knows its μ on the same
+        grid); each one omitted or None is computed.
 
     Returns
     -------
@@ -149,8 +150,9 @@ def reduce_controller(P, K, order: int, nmeas: int, ncon: int, *,
     if blocks is not None and omega is None:
         raise ConfigError("reduce_controller: blocks given without a frequency grid omega")
     Kr, hsv = balred_controller(K, order, alpha)
-    g_full, mu_full = full if full is not None else (
-        hinfnorm(lft_lower(P, K, nmeas, ncon))[0], None)
+    g_full, mu_full = full if full is not None else (None, None)
+    if g_full is None:
+        g_full = hinfnorm(lft_lower(P, K, nmeas, ncon))[0]
     g_red, _ = hinfnorm(lft_lower(P, Kr, nmeas, ncon))
     mu_red = None
     if blocks is not None:

@@ -435,7 +435,8 @@ def _reduce_best(P, cands, order: int, auto: bool, gp, blocks, omega):
 
     rows, best = [], None
     for c in cands:
-        n, full = order, None
+        # a candidate's μ is the peak on this loop, structure and grid (musyn's, musyn_dgk's)
+        n, full = order, (None, c["mu"] if blocks is not None else None)
         while True:
             rr = reduce_controller(P, c["K"], min(n, int(c["K"].nstates)), gp.nmeas, gp.ncon,
                                    blocks=blocks, omega=omega, full=full)

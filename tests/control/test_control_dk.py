@@ -7,7 +7,10 @@ import pytest
 import control as ct
 
 from ambseal.control.dk import fit_dscale, fit_magnitude, musyn
-from ambseal.control.hinf import hinfsyn
+from ambseal.control.hinf import hinfsyn, lft_lower
+from ambseal.control.mu import mussv
+
+from ..distillation import distillation_rp_plant
 
 
 def rp_plant():
@@ -95,3 +98,66 @@ def test_musyn_rejects_mismatched_blocks():
         musyn(P, [(1, 1), (1, 0)], 1, 1)
     with pytest.raises(ValueError, match="0–4"):
         musyn(P, [(1, 1), (1, 1)], 1, 1, order=7)
+
+
+def test_dscale_parameters_round_trip():
+    """Reference: the D scales themselves. The direct D search of ``musyn`` works on the
+    section parameters of fitted scales; reading them back from a transfer function
+    (complex pairs, real pairs, first-order sections, orders 0–4) must give the same
+    magnitude on the grid (D enters μ only through |D(jω)|), and the state spaces the search
+    builds must be D and D⁻¹ (python-control's response of the transfer function)."""
+    from ambseal.control.dk import _realize, _tf_to_theta, _theta_to_tf
+    from ambseal.lti.freqresp import freqresp
+
+    w = np.logspace(-3, 3, 61)
+    scales = [ct.tf([0.3], [1]), ct.tf([2, 1], [1, 5]),
+              ct.tf(np.poly([-1, -20]) * 0.5, np.poly([-3 + 4j, -3 - 4j]).real),
+              ct.tf(2e-3 * np.poly([-1000.0, -0.25, -0.054]),
+                    np.poly([-0.013, -0.67 + 0.56j, -0.67 - 0.56j]).real),
+              ct.tf(np.poly([-0.1, -2, -30, -400]), np.poly([-1 + 1j, -1 - 1j, -7, -90]))]
+    for d in scales:
+        th, order = _tf_to_theta(d)
+        back = ct.tf(*_theta_to_tf(th, order))
+        np.testing.assert_allclose(np.abs(back(1j * w)), np.abs(d(1j * w)), rtol=1e-9)
+        fwd, inv = _realize(th, order)
+        assert fwd[0].shape == (order, order)
+        np.testing.assert_allclose(freqresp(fwd, w)[:, 0, 0], back(1j * w), rtol=1e-9)
+        np.testing.assert_allclose(freqresp(inv, w)[:, 0, 0], 1 / back(1j * w), rtol=1e-9)
+
+
+def test_published_optimal_dscale_reproduces_the_published_mu():
+    """Reference: Skogestad & Postlethwaite (2005) §8.12.4, eq. 8.144 and the book's Table
+    8.2 script (MATLAB μ toolbox): with d(s) = 2e-3 (s+1000)(s+0.25)(s+0.054)/((s+0.013)
+    (s² + 1.34s + 0.7625)), H∞ synthesis on diag(d, d, I) P diag(d, d, I)⁻¹ gives γ 0.9737
+    and peak μ 0.9737 on the 61-point grid 10⁻³…10³ rad/s (the published μ-optimal result
+    that D–K is measured against in benchmarks/bench_dk.py)."""
+    from ambseal.control.dk import _scaled_plant
+
+    P, blocks, w = distillation_rp_plant(), [(1, 1), (1, 1), (2, 2)], np.logspace(-3, 3, 61)
+    d = ct.tf(2e-3 * np.poly([-1000.0, -0.25, -0.054]),
+              np.poly([-0.013, -0.67 + 0.56j, -0.67 - 0.56j]).real)
+    h = hinfsyn(_scaled_plant(P, blocks, [d, d], 2, 2), 2, 2, backoff=1.0 + 1e-6)
+    assert h.gamma == pytest.approx(0.9737, abs=1e-3)
+    mu = mussv(lft_lower(P, h.K, 2, 2), blocks, w)
+    assert np.max(mu.upper) == pytest.approx(0.9737, abs=1e-3)
+    assert np.max(mu.upper) <= h.gamma * (1 + 1e-6)  # μ ≤ σ̄(D N D⁻¹) ≤ γ
+
+
+@pytest.mark.slow
+def test_dk_with_d_search_reaches_the_published_optimum_within_two_percent():
+    """Reference: the published μ-optimal value 0.9737 of Skogestad & Postlethwaite (2005)
+    §8.12.4 (eq. 8.144) and their D–K result after three iterations, 1.0189 (Table 8.2
+    script, MATLAB μ toolbox). Issue 11's goal: within 2 % of the optimum. Plain D–K stalls
+    above it (ours at 1.027, like MATLAB's); the direct D search must get below
+    1.02 · 0.9737, with a certificate: the γ of the scaled problem bounds μ at every
+    frequency, and the mixed power algorithm's lower bound meets the upper bound at the peak
+    (Packard & Doyle 1993)."""
+    P, blocks, w = distillation_rp_plant(), [(1, 1), (1, 1), (2, 2)], np.logspace(-3, 3, 61)
+    r = musyn(P, blocks, 2, 2, w, order="auto", backoff=1.001, rtol=2e-3, search=150)
+    assert r.history[r.best_iteration].get("step") == "D search"
+    assert r.mu <= 1.02 * 0.9737
+    assert r.mu <= r.gamma * (1 + 1e-6)
+    cl = lft_lower(P, r.K, 2, 2)
+    assert np.all(cl.poles().real < 0)
+    mu = mussv(cl, blocks, w)
+    assert np.max(mu.lower) >= 0.99 * np.max(mu.upper)

@@ -8,6 +8,7 @@ import pytest
 
 import ambseal.lti.freqresp as fr
 from ambseal.errors import ModelError
+from ..distillation import distillation_rp_plant
 
 
 def _dense(A, B, C, D, w):
@@ -135,29 +136,6 @@ def test_kept_decompositions_follow_the_matrix_content():
             A[0, 1] += 0.5  # same array object, new content
 
 
-def _distillation_rp_plant():
-    """Skogestad & Postlethwaite (2005) §8.12.4: G = 1/(75s+1)·[87.8 −86.4; 108.2 −109.6],
-    W_I = (s+0.2)/(0.5s+1)·I, W_P = 0.5(10s+1)/(10s+1e-5)·I; inputs [w_Δ, w, u], outputs
-    [z_Δ, z, v] (benchmarks/bench_dk.py builds the same plant)."""
-    g0 = np.array([[87.8, -86.4], [108.2, -109.6]])
-    G = control.ss(control.tf([[[g0[i, j]] for j in range(2)] for i in range(2)],
-                              [[[75.0, 1.0]] * 2] * 2), inputs=["up0", "up1"],
-                   outputs=["yp0", "yp1"], name="G")
-
-    def diag(num, den, inp, out, name):
-        return control.ss(control.tf([[num, [0.0]], [[0.0], num]], [[den, [1.0]], [[1.0], den]]),
-                          inputs=inp, outputs=out, name=name)
-
-    parts = [G, diag([5.0, 0.5], [10.0, 1e-5], ["e0", "e1"], ["z0", "z1"], "Wp"),
-             diag([1.0, 0.2], [0.5, 1.0], ["u0", "u1"], ["zd0", "zd1"], "Wi")]
-    for k in range(2):
-        parts += [control.summing_junction(inputs=[f"u{k}", f"wd{k}"], output=f"up{k}"),
-                  control.summing_junction(inputs=[f"yp{k}", f"w{k}"], output=f"e{k}"),
-                  control.ss([], [], [], [[-1.0]], inputs=[f"e{k}"], outputs=[f"v{k}"])]
-    return control.interconnect(parts, inplist=["wd0", "wd1", "w0", "w1", "u0", "u1"],
-                                outlist=["zd0", "zd1", "z0", "z1", "v0", "v1"])
-
-
 def test_auto_keeps_the_modal_form_where_the_balanced_hessenberg_form_fails():
     """Reference: python-control's frequency response (SLICOT TB05AD, unbalanced) and dense
     solves, on the closed loop of the S&P distillation problem with control.hinfsyn's
@@ -168,7 +146,7 @@ def test_auto_keeps_the_modal_form_where_the_balanced_hessenberg_form_fails():
     benchmarks/bench_dk.py)."""
     from ambseal.lti.interconnect import lft_lower
 
-    P = _distillation_rp_plant()
+    P = distillation_rp_plant()
     K = control.hinfsyn(P, 2, 2)[0]
     cl = lft_lower(P, K, 2, 2)
     w = np.logspace(-3, 3, 25)
@@ -191,7 +169,7 @@ def test_auto_falls_back_to_dense_solves_where_both_fast_forms_fail():
     from ambseal.lti.interconnect import lft_lower
 
     d = np.load(Path(__file__).parents[1] / "data" / "dkpy_distillation_K.npz")
-    cl = lft_lower(_distillation_rp_plant(), control.ss(d["A"], d["B"], d["C"], d["D"]), 2, 2)
+    cl = lft_lower(distillation_rp_plant(), control.ss(d["A"], d["B"], d["C"], d["D"]), 2, 2)
     w = np.logspace(-3, 3, 61)
     ref = np.moveaxis(cl(1j * w), -1, 0)
     assert _rel(fr.freqresp(cl, w), ref) < 1e-5

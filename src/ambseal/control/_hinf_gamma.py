@@ -52,10 +52,11 @@ def game_riccati(A, B, C1, D1, nw: int, g: float):
     return X
 
 
-def search_gamma(margin, lo: float, rtol: float, seen: dict | None = None):
-    """γ_opt from a γ test ``margin(γ) < 0 ⇔ admissible``: a ladder of factors 4 from the
-    cheap lower bound ``lo`` (or 1 in hinfsyn's scaled coordinates) to the first
-    change of admissibility, then Brent's method (:func:`scipy.optimize.brentq`: secant
+def search_gamma(margin, lo: float, rtol: float, seen: dict | None = None, *,
+                 start: float | None = None, factor: float = 4.0):
+    """γ_opt from a γ test ``margin(γ) < 0 ⇔ admissible``: a ladder of ``factor`` from
+    ``start`` (default: the cheap lower bound ``lo`` × 1.5, at least 1 in hinfsyn's scaled
+    coordinates) to the first change of admissibility, then Brent's method (:func:`scipy.optimize.brentq`: secant
     steps where the margin is smooth, bisection where it jumps) to ``hi/lo ≤ 1 + rtol``.
     ``seen`` holds margins already known. Returns ``(hi, lo, tests)``: smallest admissible
     and largest inadmissible γ tried, and the number of new margins computed."""
@@ -69,18 +70,19 @@ def search_gamma(margin, lo: float, rtol: float, seen: dict | None = None):
             seen[g] = margin(g)
         return seen[g]
 
-    g, hi, found_lo = max(1.5 * lo, 1.0), None, False
+    g = max(1.5 * lo, 1.0) if start is None else max(float(start), lo * (1 + rtol))
+    hi, found_lo = None, False
     while True:
         if m(g) < 0:
             hi = g
-            if found_lo or g / 4.0 <= max(lo, 1e-12):
+            if found_lo or g / factor <= max(lo, 1e-12):
                 break
-            g /= 4.0
+            g /= factor
         else:
             lo, found_lo = g, True
             if hi is not None:
                 break
-            g *= 4.0
+            g *= factor
             if g > 1e100:
                 raise SynthesisError("hinfsyn: no admissible γ up to 1e100")
     if not found_lo and lo <= 0:  # admissible down to the ladder's end: halve towards 0

@@ -38,7 +38,7 @@ from ambseal.control._hinf_gamma import sb10ad as _sb10ad
 from ambseal.control._hinf_gamma import search_gamma as _search_gamma
 from ambseal.lti.interconnect import lft_lower, lft_lower_matrices
 
-__all__ = ["HinfResult", "hinfsyn", "hinfnorm", "lft_lower", "check_plant"]
+__all__ = ["HinfResult", "hinfsyn", "hinf_gamma_opt", "hinfnorm", "lft_lower", "check_plant"]
 
 #: Plants with more states use the Riccati γ test in the γ search (measured: 3 states,
 #: SB10AD's test 0.2 ms vs 2 ms; 24 states, 31 ms vs 8 ms).
@@ -383,6 +383,22 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
                       gamma_design=float(chosen.gamma_design), omega_peak=float(chosen.omega),
                       closed_loop=cl, rcond=chosen.rcond,
                       gamma_lower=gamma_lower, iterations=tests + len(tried))
+
+
+def hinf_gamma_opt(P, nmeas: int, ncon: int, *, rtol: float = 1e-6,
+                   near: float | None = None) -> float:
+    """γ_opt of the H∞ problem of ``P`` (inputs ``[w, u]``, outputs ``[z, y]``; ``nmeas``
+    measurements, ``ncon`` controls) to relative tolerance ``rtol``, without a controller:
+    the γ search of :func:`hinfsyn` alone, for callers that compare many plants (the D-scale
+    search of :func:`ambseal.control.dk.musyn`). ``near``: a γ expected within a few % of
+    γ_opt; the search then starts there with steps of 5 % and uses the Riccati margin alone
+    (no SB10AD cross-check). Raises as :func:`hinfsyn` (ModelError, SynthesisError)."""
+    check_plant(P, nmeas, ncon)
+    sb = _Sb10(P, nmeas, ncon)
+    if near is None:
+        return float(sb.gamma_opt(rtol)[0])
+    return float(_search_gamma(sb.riccati_margin, sb.parrott_bound, rtol, start=near,
+                               factor=1.05)[0])
 
 
 @dataclass(frozen=True)

@@ -61,7 +61,8 @@ def _long_run_covariance(J: np.ndarray, R: np.ndarray, smooth: int = 2,
     JfH = np.conj(np.swapaxes(Jf, 1, 2))  # (F, p, c)
     # contractions as batched matrix products (a 4-operand einsum loops naively)
     if Hinv is not None:
-        h = (w / L)[:, None, None] * ((Jf @ Hinv) @ JfH)
+        G = Jf @ Hinv  # (F, c, p): each parameter's combination of the Jacobian's columns
+        h = (w / L)[:, None, None] * (G @ JfH)
         lam, V = np.linalg.eigh(np.eye(c) - h)
         M = (V / np.clip(lam, 0.1, None)[:, None, :]) @ np.conj(np.swapaxes(V, 1, 2))
         P = M @ P @ np.conj(np.swapaxes(M, 1, 2))
@@ -74,7 +75,6 @@ def _long_run_covariance(J: np.ndarray, R: np.ndarray, smooth: int = 2,
     S = np.real(np.sum(w[:, None, None] * (JfH @ (P @ Jf)), axis=0)) / L
     if Hinv is None:
         return S
-    G = Jf @ Hinv  # (F, c, p): each parameter's combination of the Jacobian's columns
     q = w[:, None] * np.real(np.sum(G.conj() * (P @ G), axis=1)) / L
     return S, np.apply_along_axis(lambda x: np.convolve(x, kernel, mode="same"), 0, q)
 

@@ -345,31 +345,33 @@ def _centres_chunk(P, z, t, tol, max_iter, idx, theta=0.25, n_newton=5, dec_tol=
             centred = dec < dec_tol
             if centred.all():
                 break
-            # inside the Dikin ellipsoid (step·dec < 1) the point stays feasible; the check
-            # below only guards against rounding
+            # inside the Dikin ellipsoid (r = step·dec < 1) the point stays feasible: each
+            # barrier matrix L has ‖L^-½ dL L^-½‖ ≤ r (its term's local norm is at most the
+            # Newton decrement's), so L + dL ⪰ (1 − r)·L (Nesterov & Nemirovskii 1994 §2.1).
+            # With r ≤ 1/2 it keeps half its smallest eigenvalue, so only the longer steps
+            # (dec > 1) are checked, against rounding, and halved where they fail
             step = np.where(dec < 0.25, 1.0, 1.0 / (1.0 + dec))
             dL1 = (dz[:, None, :] @ Lderf).reshape(Fa, N, N)
             dD = (dz @ P.Uf).reshape(Fa, N, N)
             dGr = (dz[:, pD:] @ P.BGrf).reshape(Fa, nr, nr) if pG else None
+            chk = np.flatnonzero(step * dec > 0.5)
             for _bt in range(12):
-                sc = step[:, None, None]
-                L1n, Dn = L1 + sc * dL1, D + sc * dD
-                if pG:
-                    Gn = Gr + sc * dGr
-                    ok = _pd_all(np.concatenate([L1n, Dn]), np.concatenate([Inr - Gn, Inr + Gn]))
-                    ok = ok[:Fa] & ok[Fa:]
-                else:
-                    ok = _pd_all(np.concatenate([L1n, Dn]))
-                    ok = ok[:Fa] & ok[Fa:]
-                if ok.all():
+                if chk.size == 0:
                     break
-                step = np.where(ok, step, 0.5 * step)
-            step = np.where(ok, step, 0.0)
-            if not ok.all():
-                sc = step[:, None, None]
-                L1n, Dn = L1 + sc * dL1, D + sc * dD
+                sc = step[chk, None, None]
+                mats = [np.concatenate([L1[chk] + sc * dL1[chk], D[chk] + sc * dD[chk]])]
                 if pG:
-                    Gn = Gr + sc * dGr
+                    Gc = Gr[chk] + sc * dGr[chk]
+                    mats.append(np.concatenate([Inr - Gc, Inr + Gc]))
+                ok = _pd_all(*mats)
+                ok = ok[:chk.size] & ok[chk.size:]
+                step[chk[~ok]] *= 0.5
+                chk = chk[~ok]
+            step[chk] = 0.0
+            sc = step[:, None, None]
+            L1n, Dn = L1 + sc * dL1, D + sc * dD
+            if pG:
+                Gn = Gr + sc * dGr
             za = za + step[:, None] * dz
             L1, D = L1n, Dn
             if pG:

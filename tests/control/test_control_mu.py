@@ -36,6 +36,10 @@ def test_rank_one_complex_scalars(seed):
     assert float(r.upper) == pytest.approx(exact, rel=1e-3)
     assert float(r.lower) == pytest.approx(exact, rel=1e-6)
     assert float(r.lower) <= float(r.upper) * (1 + 1e-9)
+    # without the lower bound (D–K's μ steps) the upper bound and scalings are the same
+    u = mussv(np.outer(a, b), [(1, 0)] * 4, lower=False)
+    assert float(u.upper) == float(r.upper) and np.array_equal(u.dscale, r.dscale)
+    assert np.isnan(u.lower)
 
 
 @pytest.mark.parametrize("seed", range(4))

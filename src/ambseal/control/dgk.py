@@ -324,7 +324,7 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
     best = (dk.mu, dk.best_iteration, dk.K, dk.gamma, np.asarray(dk.mu_curve), dk.scalings)
     K, stall = dk.K, 0
     for it in range(len(history), len(history) + max_iter):
-        mu_s = mussv(lft_lower(P, K, nmeas, ncon), sblocks, w)
+        mu_s = mussv(lft_lower(P, K, nmeas, ncon), sblocks, w, lower=False)
         beta = float(np.max(mu_s.upper))
         fits, jg_err = _dg_fits(mu_s, real, beta, w, fit_tol)
         try:
@@ -332,7 +332,7 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
                          backoff=backoff)
         except SynthesisError:
             break
-        mu_true = mussv(lft_lower(P, hr.K, nmeas, ncon), blocks, w)
+        mu_true = mussv(lft_lower(P, hr.K, nmeas, ncon), blocks, w, lower=False)
         peak = float(np.max(mu_true.upper))
         history.append({"iteration": it, "gamma": hr.gamma, "mu": peak, "order": hr.order,
                         "step": "D-G-K", "beta": beta, "jg_fit_error": jg_err})

@@ -538,7 +538,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
                 raise
             break
         cl = lft_lower(P, hr.K, nmeas, ncon)
-        mu_true = mussv(cl, blocks, w)
+        mu_true = mussv(cl, blocks, w, lower=False)
         peak = float(np.max(mu_true.upper))
         history.append({"iteration": it, "gamma": hr.gamma, "mu": peak, "order": hr.order})
         if console is not None:
@@ -552,7 +552,8 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
         if stall >= patience:
             break
         # D-step on the unscaled closed loop, diagonal (complexified) structure
-        mu_c = mussv(cl, cblocks, w) if cblocks != [tuple(b) for b in blocks] else mu_true
+        mu_c = mussv(cl, cblocks, w, lower=False) if cblocks != [tuple(b) for b in blocks] \
+            else mu_true
         ds = np.asarray(mu_c.dscale)  # (F, nblocks), last block = 1
         if order == "auto":
             wgt = (mu_c.upper / np.max(mu_c.upper)) ** 4
@@ -580,7 +581,7 @@ def _search_step(P, blocks, cblocks, nmeas, ncon, w, best, evals, backoff, histo
                      backoff=backoff)
     except SynthesisError:
         return best
-    mu = mussv(lft_lower(P, hr.K, nmeas, ncon), blocks, w)
+    mu = mussv(lft_lower(P, hr.K, nmeas, ncon), blocks, w, lower=False)
     peak = float(np.max(mu.upper))
     history.append({"iteration": len(history), "gamma": hr.gamma, "mu": peak,
                     "order": hr.order, "step": "D search", "evaluations": n})

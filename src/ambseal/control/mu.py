@@ -243,7 +243,8 @@ _STRIDE = 32  # cold solves on every 32nd frequency, warm starts in between
 
 
 def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
-          lower_iter: int = 20, gmax: float = 1e3, seed: int = 0) -> MuResult:
+          lower_iter: int = 20, gmax: float = 1e3, seed: int = 0,
+          lower: bool = True) -> MuResult:
     """Upper and lower bounds of the structured singular value μ_Δ(M).
 
     Parameters
@@ -272,6 +273,11 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
         Bound on ‖G‖ relative to the normalised problem (real blocks only).
     seed : int
         Seed of the random starts of the power iteration.
+    lower : bool
+        Compute the lower bound and the worst-case Δ (default). False: ``lower`` is NaN and
+        ``delta`` zero, for callers that read only the upper bound and its scalings (D–K's
+        D- and μ-steps: about 15 % of each μ evaluation on the test rig's loop); the upper
+        bound does not depend on it.
 
     Returns
     -------
@@ -332,9 +338,11 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
         np.all(np.diff(w) > 0) or np.all(np.diff(w) < 0))
     upper, D, Gp, offs = _upper_bound(Mp, blks, tol, max_iter, gmax,
                                       stride=_STRIDE if smooth else 0)
-    rng = np.random.default_rng(seed)
-    lower, delta = _lower_bound(Mf, blks, lower_iter, rng, upper=upper,
-                                starts=[_worst_direction(Mp, D, Gp, cols)])
+    if lower:
+        lower, delta = _lower_bound(Mf, blks, lower_iter, np.random.default_rng(seed),
+                                    upper=upper, starts=[_worst_direction(Mp, D, Gp, cols)])
+    else:
+        lower, delta = np.full(F, np.nan), np.zeros((F, m, n), complex)
 
     # scalings back in unpadded coordinates
     w_, V = np.linalg.eigh(D)

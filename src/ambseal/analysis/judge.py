@@ -306,12 +306,14 @@ def _judge_loop(cfg, P, cur, force, controller, s: JudgeSettings, impulse: bool
     Gw, Gfw = Pw[:, :, cur], Pw[:, :, force]
     ny_names, nu_names, f_names = G.output_labels, G.input_labels, Gf.input_labels
     resp = loop_responses_from(Gw[:w.size], Kw[:w.size], w, ny_names, nu_names)
-    iso = iso_assessment(resp.peaks("So"), stable=loop.stable)
-    curves: dict = {"So": (w / (2 * np.pi), sigma_max(resp.So)), "poles": loop.poles}
+    so = sigma_max(resp.So)  # once, for the peaks, the zone and the figure
+    so_peaks = resp.peaks("So", sigma=so)
+    iso = iso_assessment(so_peaks, stable=loop.stable)
+    curves: dict = {"So": (w / (2 * np.pi), so), "poles": loop.poles}
     case.update(
         sensitivity_peak=_finite(iso.sigma_max_peak),
         sensitivity_peak_per_axis={ax.removeprefix("y_"): (p.value if loop.stable else None)
-                                   for ax, p in zip(ny_names, resp.peaks("So").diagonal)},
+                                   for ax, p in zip(ny_names, so_peaks.diagonal)},
         iso_zone=iso.zone_sigma_max,
         iso_zone_per_axis={ax.removeprefix("y_"): z for ax, z in iso.zones_per_axis},
     )

@@ -221,10 +221,11 @@ class LoopResponse:
         """Largest singular value of ``which`` ∈ {"So", "Si", "To", "KS"} per frequency, (n_w,)."""
         return sigma_max(self._get(which)[0])
 
-    def peaks(self, which: str = "So") -> SensitivityPeaks:
-        """Peaks of σ̄ and of each diagonal element of ``which`` (diagonal of square part)."""
+    def peaks(self, which: str = "So", sigma: np.ndarray | None = None) -> SensitivityPeaks:
+        """Peaks of σ̄ and of each diagonal element of ``which`` (diagonal of square part);
+        ``sigma``: σ̄ of ``which`` per frequency when already computed (:meth:`sigma_max`)."""
         F, names = self._get(which)
-        return _peaks(F, self.omega_rad_s, names)
+        return _peaks(F, self.omega_rad_s, names, sigma)
 
     def to_dict(self) -> dict:
         """JSON-safe: frequency grid (Hz) and σ̄ of each function, plus S_o peaks."""
@@ -300,10 +301,12 @@ def peak_of(gain: np.ndarray, omega_rad_s: np.ndarray, channel: str = "sigma_max
     return Peak(float(g[k]), float(omega_rad_s[k] / _TWO_PI), channel)
 
 
-def _peaks(F: np.ndarray, w: np.ndarray, names: tuple[str, ...]) -> SensitivityPeaks:
+def _peaks(F: np.ndarray, w: np.ndarray, names: tuple[str, ...],
+           sigma: np.ndarray | None = None) -> SensitivityPeaks:
     m = min(F.shape[1], F.shape[2])
     diag = tuple(peak_of(np.abs(F[:, i, i]), w, names[i] if i < len(names) else f"[{i}]") for i in range(m))
-    return SensitivityPeaks(sigma_max=peak_of(sigma_max(F), w), diagonal=diag)
+    return SensitivityPeaks(sigma_max=peak_of(sigma_max(F) if sigma is None else sigma, w),
+                            diagonal=diag)
 
 
 def resolved_grid(omega: Any, poles: np.ndarray, *, zeta_max: float = 0.2,

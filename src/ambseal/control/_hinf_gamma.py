@@ -56,8 +56,9 @@ def search_gamma(margin, lo: float, rtol: float, seen: dict | None = None, *,
                  start: float | None = None, factor: float = 4.0):
     """γ_opt from a γ test ``margin(γ) < 0 ⇔ admissible``: a ladder of ``factor`` from
     ``start`` (default: the cheap lower bound ``lo`` × 1.5, at least 1 in hinfsyn's scaled
-    coordinates) to the first change of admissibility, then Brent's method (:func:`scipy.optimize.brentq`: secant
-    steps where the margin is smooth, bisection where it jumps) to ``hi/lo ≤ 1 + rtol``.
+    coordinates) to the first change of admissibility, then Brent's method
+    (:func:`scipy.optimize.brentq`: secant steps where the margin is smooth, bisection
+    where it jumps) to ``hi/lo ≤ 1 + rtol``.
     ``seen`` holds margins already known. Returns ``(hi, lo, tests)``: smallest admissible
     and largest inadmissible γ tried, and the number of new margins computed."""
     from scipy.optimize import brentq

@@ -70,7 +70,8 @@ FAST_FRACTION = 0.5
 PEAK_TOLERANCE = 0.10
 #: The candidate discretisations, in the order they are tried.
 METHODS = ("tustin", "tustin_prewarp", "zoh", "foh")
-#: The hold equivalents, also tried with real stable fast poles kept (suffix ``KEPT``).
+#: The hold equivalents, also tried with the fast poles kept where they alias nothing
+#: (:func:`hold_keeps`; suffix ``KEPT``).
 HOLDS, KEPT = ("zoh", "foh"), "+fast"
 
 Matrices = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
@@ -256,11 +257,23 @@ def split_fast(A: np.ndarray, f_cut_hz: float) -> tuple[np.ndarray, int, np.ndar
 
 
 def hold_keeps(fast: np.ndarray, fs: float) -> bool:
-    """Whether the hold equivalents may discretise a controller with its fast poles
-    ``fast`` (rad/s) kept (module docstring, step 1): some, every one stable with its
-    damped frequency |Im p| below ``FAST_FRACTION`` of the Nyquist frequency ``fs/2``
-    (Hz), so that ``z = e^{pT}`` lies inside the unit disc at an angle below
-    ``FAST_FRACTION·π`` and aliases no other frequency (Franklin et al. §6.3)."""
+    """Whether the hold equivalents may discretise a controller with its fast poles kept
+    (module docstring, step 1; Franklin, Powell & Workman §6.3).
+
+    Parameters
+    ----------
+    fast : array_like of complex, shape (n_f,)
+        The controller's poles above ``FAST_FRACTION`` of Nyquist (rad/s).
+    fs : float
+        Sample rate (Hz).
+
+    Returns
+    -------
+    bool
+        True when there is one at least and each is stable with |Im p| below
+        ``FAST_FRACTION`` of Nyquist ``fs/2``: ``z = e^{pT}`` inside the unit disc at an
+        angle below ``FAST_FRACTION·π``, aliasing no other frequency.
+    """
     fast = np.asarray(fast, complex)
     return bool(fast.size and np.all(fast.real < 0)
                 and np.all(np.abs(fast.imag) < 2 * np.pi * FAST_FRACTION * fs / 2))

@@ -289,7 +289,8 @@ class MusynResult:
         Verified H∞ norm of the D-scaled closed loop of the best iteration.
     history : tuple of dict
         Per iteration: ``iteration``, ``gamma`` (K-step), ``mu`` (peak upper bound),
-        ``order`` (controller states).
+        ``order`` (controller states); the D search's entry also ``step = "D search"`` and
+        ``evaluations`` (γ evaluations).
     best_iteration : int
         Index into ``history`` of ``K``.
     scalings : tuple

@@ -17,6 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ambseal.control._mu_newton import gevp, newton_steps
+
 __all__ = ["structure", "upper_bound"]
 
 
@@ -169,14 +171,11 @@ class _Problem:
         self.U = np.concatenate([self.BD, np.zeros_like(self.BG)])
         self.Uf = self.U.reshape(p, N * N)
         ri = S.realidx
-        self.BGr = self.BG[:, ri[:, None], ri[None, :]]
+        self.BGr = np.ascontiguousarray(self.BG[:, ri[:, None], ri[None, :]])
         self.BGrf = self.BGr.reshape(self.pG, ri.size ** 2)
-        # block-local D bases for the barrier −log det D (full blocks: scalar multiples of I)
-        self.dblk = []
-        for j, b in enumerate(blks):
-            o0, o1 = int(S.offs[j]), int(S.offs[j + 1])
-            Bk = self.BD[:, o0:o1, o0:o1]
-            self.dblk.append((o0, o1, b.kind == "full", Bk, Bk[:, 0, 0].real.copy()))
+        # blocks for the barrier −Σ log det D_k (full blocks: scalar multiples of I)
+        self.offs = np.asarray(S.offs, np.int64)
+        self.full = np.array([b.kind == "full" for b in blks], np.bool_)
 
     def affine(self, idx):
         """A_0 (F, N, N) and V (F, p, N, N) for the matrices M[idx]."""
@@ -216,20 +215,8 @@ class _Problem:
 
 
 def _gevp(D, A):
-    out = np.full(D.shape[0], np.inf)
-    try:
-        Lc = np.linalg.cholesky(D)
-        ok = np.ones(D.shape[0], bool)
-    except np.linalg.LinAlgError:
-        ok = np.linalg.eigvalsh(D)[:, 0] > 0
-        if not ok.any():
-            return out
-        Lc = np.linalg.cholesky(D[ok])
-        A = A[ok]
-    X = np.linalg.solve(Lc, A)
-    X = np.linalg.solve(Lc, _ct(X))
-    out[ok] = np.linalg.eigvalsh(_herm(X))[:, -1]
-    return out
+    """λ_max(D⁻¹ A) (F,) for Hermitian stacks; +inf where D is not positive definite."""
+    return gevp(np.ascontiguousarray(D, complex), np.ascontiguousarray(A, complex))
 
 
 def _pd_all(*stacks):
@@ -242,43 +229,6 @@ def _pd_all(*stacks):
         except np.linalg.LinAlgError:
             ok &= np.linalg.eigvalsh(L)[:, 0] > 0
     return ok
-
-
-def _barrier_derivs(P, X, Lder, D, Gr):
-    """Gradient (F, p) and Hessian (F, p, p) of the barrier at the current point.
-
-    φ = −log det(t D − A) − log det D − log det(gmax I − G) − log det(gmax I + G); for an
-    affine argument L(z) the term −log det L has gradient −tr(L⁻¹ L_i) and Hessian
-    tr(L⁻¹ L_i L⁻¹ L_j), computed as traces of R_i = L⁻¹ L_i.
-    """
-    F, p = Lder.shape[:2]
-    R = X[:, None] @ Lder
-    g = -np.einsum("fiaa->fi", R).real
-    Rf = R.reshape(F, p, -1)
-    H = (Rf @ np.swapaxes(np.swapaxes(R, -1, -2).reshape(F, p, -1), 1, 2)).real
-    pD, pG = P.pD, P.pG
-    for o0, o1, full, Bk, ck in (P.dblk if pD else ()):
-        if full:
-            dinv = 1.0 / D[:, o0, o0].real
-            k = o1 - o0
-            g[:, :pD] -= k * dinv[:, None] * ck
-            H[:, :pD, :pD] += k * (dinv**2)[:, None, None] * np.outer(ck, ck)
-        else:
-            Rk = np.linalg.inv(D[:, o0:o1, o0:o1])[:, None] @ Bk[None]
-            g[:, :pD] -= np.einsum("fiaa->fi", Rk).real
-            Rkf = Rk.reshape(F, pD, -1)
-            H[:, :pD, :pD] += (Rkf @ np.swapaxes(np.swapaxes(Rk, -1, -2).reshape(F, pD, -1), 1, 2)).real
-    if pG:
-        nr = Gr.shape[-1]
-        I = P.gmax * np.eye(nr)
-        X34 = np.linalg.inv(np.concatenate([I - Gr, I + Gr]))
-        R34 = X34[:, None] @ P.BGr[None]
-        tr = np.einsum("fiaa->fi", R34).real
-        g[:, pD:] += tr[:F] - tr[F:]
-        R34f = R34.reshape(2 * F, pG, -1)
-        h = (R34f @ np.swapaxes(np.swapaxes(R34, -1, -2).reshape(2 * F, pG, -1), 1, 2)).real
-        H[:, pD:, pD:] += h[:F] + h[F:]
-    return g, H
 
 
 _CHUNK_ELEMS = 2_000_000  # complex entries of the (F, p, N, N) derivative stack per chunk
@@ -311,7 +261,6 @@ def _centres_chunk(P, z, t, tol, max_iter, idx, theta=0.25, n_newton=5, dec_tol=
     best_z = z.copy()
     eyeN = np.eye(N)
     nr = P.S.realidx.size
-    Inr = gmax * np.eye(nr)
     active = np.arange(F) if p else np.arange(0)
     for _ in range(max_iter):
         if active.size == 0:
@@ -324,7 +273,6 @@ def _centres_chunk(P, z, t, tol, max_iter, idx, theta=0.25, n_newton=5, dec_tol=
         L1 = L0 + (za[:, None, :] @ Lderf).reshape(Fa, N, N)
         D = eyeN + (za @ P.Uf).reshape(Fa, N, N)
         Gr = (za[:, pD:] @ P.BGrf).reshape(Fa, nr, nr) if pG else None
-        centred = np.zeros(Fa, bool)
         bad = ~_pd_all(L1)
         if bad.any():  # lost interior (rounding): keep the best scalings found so far
             keep = ~bad
@@ -332,50 +280,12 @@ def _centres_chunk(P, z, t, tol, max_iter, idx, theta=0.25, n_newton=5, dec_tol=
             Lder, Lderf, L1, D = Lder[keep], Lderf[keep], L1[keep], D[keep]
             Gr = Gr[keep] if pG else None
             Fa = active.size
-            centred = centred[keep]
             if Fa == 0:
                 break
-        for _k in range(n_newton):
-            X = np.linalg.inv(L1)
-            g, H = _barrier_derivs(P, X, Lder, D, Gr)
-            H = 0.5 * (H + np.swapaxes(H, 1, 2))
-            H = H + 1e-12 * (np.trace(H, axis1=1, axis2=2) / p)[:, None, None] * np.eye(p)
-            dz = -np.linalg.solve(H, g[..., None])[..., 0]
-            dec = np.sqrt(np.maximum(-np.einsum("fi,fi->f", g, dz), 0.0))
-            centred = dec < dec_tol
-            if centred.all():
-                break
-            # inside the Dikin ellipsoid (r = step·dec < 1) the point stays feasible: each
-            # barrier matrix L has ‖L^-½ dL L^-½‖ ≤ r (its term's local norm is at most the
-            # Newton decrement's), so L + dL ⪰ (1 − r)·L (Nesterov & Nemirovskii 1994 §2.1).
-            # With r ≤ 1/2 it keeps half its smallest eigenvalue, so only the longer steps
-            # (dec > 1) are checked, against rounding, and halved where they fail
-            step = np.where(dec < 0.25, 1.0, 1.0 / (1.0 + dec))
-            dL1 = (dz[:, None, :] @ Lderf).reshape(Fa, N, N)
-            dD = (dz @ P.Uf).reshape(Fa, N, N)
-            dGr = (dz[:, pD:] @ P.BGrf).reshape(Fa, nr, nr) if pG else None
-            chk = np.flatnonzero(step * dec > 0.5)
-            for _bt in range(12):
-                if chk.size == 0:
-                    break
-                sc = step[chk, None, None]
-                mats = [np.concatenate([L1[chk] + sc * dL1[chk], D[chk] + sc * dD[chk]])]
-                if pG:
-                    Gc = Gr[chk] + sc * dGr[chk]
-                    mats.append(np.concatenate([Inr - Gc, Inr + Gc]))
-                ok = _pd_all(*mats)
-                ok = ok[:chk.size] & ok[chk.size:]
-                step[chk[~ok]] *= 0.5
-                chk = chk[~ok]
-            step[chk] = 0.0
-            sc = step[:, None, None]
-            L1n, Dn = L1 + sc * dL1, D + sc * dD
-            if pG:
-                Gn = Gr + sc * dGr
-            za = za + step[:, None] * dz
-            L1, D = L1n, Dn
-            if pG:
-                Gr = Gn
+        # damped Newton steps towards the centre (compiled, one matrix at a time; in place)
+        centred = newton_steps(L1, D, Gr if pG else np.zeros((Fa, 0, 0), complex), za, Lder,
+                               P.U, P.BD, P.BGr, P.offs, P.full, float(gmax), pD, n_newton,
+                               dec_tol)
         lam_a = _gevp(D, ta[:, None, None] * D - L1)
         better = lam_a < best_lam[active]
         best_lam[active[better]] = lam_a[better]

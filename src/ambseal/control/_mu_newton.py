@@ -48,6 +48,21 @@ def _pd(Y):
 
 
 @njit(cache=True)
+def _tril_inv(C):
+    """Inverse of a lower-triangular matrix (forward substitution)."""
+    n = C.shape[0]
+    Ci = np.zeros((n, n), np.complex128)
+    for j in range(n):
+        Ci[j, j] = 1.0 / C[j, j]
+        for i in range(j + 1, n):
+            v = 0.0j
+            for k in range(j, i):
+                v -= C[i, k] * Ci[k, j]
+            Ci[i, j] = v / C[i, i]
+    return Ci
+
+
+@njit(cache=True)
 def gevp(D, A):
     """λ_max(D⁻¹ A) (F,) for Hermitian stacks D, A (F, N, N); +inf where D is not positive
     definite. With D = C Cᴴ: the largest eigenvalue of C⁻¹ A C⁻ᴴ."""
@@ -57,18 +72,30 @@ def gevp(D, A):
         C, ok = _chol(D[f])
         if not ok:
             continue
-        Ci = np.zeros((n, n), np.complex128)
-        for j in range(n):
-            Ci[j, j] = 1.0 / C[j, j]
-            for i in range(j + 1, n):
-                v = 0.0j
-                for k in range(j, i):
-                    v -= C[i, k] * Ci[k, j]
-                Ci[i, j] = v / C[i, i]
+        Ci = _tril_inv(C)
         X = Ci @ np.ascontiguousarray(A[f]) @ np.ascontiguousarray(np.conj(Ci.T))
         X = 0.5 * (X + np.conj(X.T))
         out[f] = np.linalg.eigvalsh(X)[-1]
     return out
+
+
+@njit(cache=True)
+def _inv(Y):
+    """Inverse of a Hermitian positive definite Y (barrier matrices at feasible points):
+    LAPACK for large ones, Y⁻¹ = C⁻ᴴ C⁻¹ from the Cholesky factor in loops for tiny ones."""
+    n = Y.shape[0]
+    if n > 4:
+        return np.ascontiguousarray(np.linalg.inv(Y))  # numba's inv returns Fortran order
+    C, _ = _chol(Y)
+    Ci = _tril_inv(C)
+    X = np.zeros((n, n), np.complex128)
+    for a in range(n):
+        for b in range(n):
+            v = 0.0j
+            for k in range(max(a, b), n):
+                v += np.conj(Ci[k, a]) * Ci[k, b]
+            X[a, b] = v
+    return X
 
 
 @njit(cache=True)
@@ -77,28 +104,35 @@ def _add_term(Yinv, B, off, g, H):
     with R_i = Y⁻¹ B_i, g_i −= tr R_i and H_ij += Re tr(R_i R_j)."""
     q = B.shape[0]
     n = Yinv.shape[0]
-    Yc = np.ascontiguousarray(Yinv)  # numba's inv returns Fortran order
-    # rows: Re and Im of R_i (P) and of R_iᵀ with the sign of Im flipped (Q): H = P Qᵀ
-    P = np.empty((q, 2 * n * n))
-    Q = np.empty((q, 2 * n * n))
+    # R_i = RR[:, i n:(i + 1) n]: one product Y⁻¹ [B_0 … B_q-1] (loops for tiny blocks)
+    Bh = np.empty((n, q * n), np.complex128)
     for i in range(q):
-        if n > 4:
-            R = Yc @ B[i]
-        else:  # tiny blocks: loops beat a BLAS call
-            R = np.zeros((n, n), np.complex128)
-            for a in range(n):
-                for k in range(n):
-                    y = Yc[a, k]
-                    for b in range(n):
-                        R[a, b] += y * B[i, k, b]
+        for a in range(n):
+            for b in range(n):
+                Bh[a, i * n + b] = B[i, a, b]
+    if n > 4:
+        RR = Yinv @ Bh
+    else:
+        RR = np.zeros((n, q * n), np.complex128)
+        for a in range(n):
+            for k in range(n):
+                y = Yinv[a, k]
+                for c in range(q * n):
+                    RR[a, c] += y * Bh[k, c]
+    # rows: Re and Im of R_i (P) and of R_iᵀ with the sign of Im flipped (Q): H = P Qᵀ
+    nn = n * n
+    P = np.empty((q, 2 * nn))
+    Q = np.empty((q, 2 * nn))
+    for i in range(q):
         tr = 0.0
         for a in range(n):
-            tr += R[a, a].real
+            tr += RR[a, i * n + a].real
             for b in range(n):
-                P[i, a * n + b] = R[a, b].real
-                P[i, n * n + a * n + b] = R[a, b].imag
-                Q[i, b * n + a] = R[a, b].real
-                Q[i, n * n + b * n + a] = -R[a, b].imag
+                r = RR[a, i * n + b]
+                P[i, a * n + b] = r.real
+                P[i, nn + a * n + b] = r.imag
+                Q[i, b * n + a] = r.real
+                Q[i, nn + b * n + a] = -r.imag
         g[off + i] -= tr
     H[off:off + q, off:off + q] += P @ Q.T
 
@@ -109,7 +143,7 @@ def _derivs(L1, D, Gr, Lder, BD, BGr, offs, full, gmax, pD):
     p = Lder.shape[0]
     g = np.zeros(p)
     H = np.zeros((p, p))
-    _add_term(np.linalg.inv(L1), Lder, 0, g, H)
+    _add_term(_inv(L1), Lder, 0, g, H)
     for k in range(offs.size - 1):
         o0, o1 = offs[k], offs[k + 1]
         if full[k]:  # D block d·I: −k log d
@@ -121,7 +155,7 @@ def _derivs(L1, D, Gr, Lder, BD, BGr, offs, full, gmax, pD):
                 for j in range(pD):
                     H[i, j] += m * dinv * dinv * ci * BD[j, o0, o0].real
         else:
-            _add_term(np.linalg.inv(np.ascontiguousarray(D[o0:o1, o0:o1])),
+            _add_term(_inv(np.ascontiguousarray(D[o0:o1, o0:o1])),
                       np.ascontiguousarray(BD[:, o0:o1, o0:o1]), 0, g, H)
     nr = Gr.shape[0]
     if BGr.shape[0]:
@@ -129,12 +163,12 @@ def _derivs(L1, D, Gr, Lder, BD, BGr, offs, full, gmax, pD):
         for a in range(nr):
             Y[a, a] += gmax
         gm = np.zeros(p)
-        _add_term(np.linalg.inv(Y), BGr, pD, gm, H)
+        _add_term(_inv(Y), BGr, pD, gm, H)
         g[pD:] -= gm[pD:]  # d(gmax I − G)/dz_i = −B_i: the gradient's sign flips
         Y = Gr.copy()
         for a in range(nr):
             Y[a, a] += gmax
-        _add_term(np.linalg.inv(Y), BGr, pD, g, H)
+        _add_term(_inv(Y), BGr, pD, g, H)
     return g, H
 
 
@@ -201,12 +235,20 @@ def newton_steps(L1, D, Gr, za, Lder, U, BD, BGr, offs, full, gmax, pD, n_newton
             step = 1.0 if dec[f] < 0.25 else 1.0 / (1.0 + dec[f])
             dL1 = np.zeros((N, N), np.complex128)
             dD = np.zeros((N, N), np.complex128)
-            for i in range(p):
-                dL1 += dz[f, i] * Lder[f, i]
-                dD += dz[f, i] * U[i]
             dGr = np.zeros((nr, nr), np.complex128)
-            for i in range(pG):
-                dGr += dz[f, pD + i] * BGr[i]
+            for i in range(p):
+                c = dz[f, i]
+                for a in range(N):
+                    for b in range(N):
+                        dL1[a, b] += c * Lder[f, i, a, b]
+                if i < pD:
+                    for a in range(N):
+                        for b in range(N):
+                            dD[a, b] += c * U[i, a, b]
+                else:
+                    for a in range(nr):
+                        for b in range(nr):
+                            dGr[a, b] += c * BGr[i - pD, a, b]
             if step * dec[f] > 0.5:
                 ok = False
                 for _bt in range(12):
@@ -216,8 +258,13 @@ def newton_steps(L1, D, Gr, za, Lder, U, BD, BGr, offs, full, gmax, pD, n_newton
                     step *= 0.5
                 if not ok:
                     step = 0.0
-            L1[f] += step * dL1
-            D[f] += step * dD
-            Gr[f] += step * dGr
-            za[f] += step * dz[f]
+            for a in range(N):
+                for b in range(N):
+                    L1[f, a, b] += step * dL1[a, b]
+                    D[f, a, b] += step * dD[a, b]
+            for a in range(nr):
+                for b in range(nr):
+                    Gr[f, a, b] += step * dGr[a, b]
+            for i in range(p):
+                za[f, i] += step * dz[f, i]
     return centred

@@ -1,10 +1,12 @@
-"""Damped Newton steps of the D–G upper bound's method of centres, compiled with numba.
+"""Damped Newton steps of the D–G upper bound's method of centres and its generalised
+eigenvalue λ_max(D⁻¹A), compiled with numba.
 
-Private module behind :func:`ambseal.control._mu_upper._centres_chunk`. The same algorithm
-as the batched numpy form it replaces (Boyd & El Ghaoui 1993; Nesterov & Nemirovskii 1994
-§2.1 for the damped step), one matrix at a time: the stacks it runs on are mostly a few
-matrices (the finer levels of the frequency continuation and the last unconverged
-frequencies), where numpy's per-call overhead, not the 14 × 14 arithmetic, set the time.
+Private module behind :mod:`ambseal.control._mu_upper`. The same algorithm as the batched
+numpy form it replaced (Boyd & El Ghaoui 1993; Nesterov & Nemirovskii 1994 §2.1 for the
+damped step), one matrix at a time: the stacks it runs on are mostly a few matrices (the
+finer levels of the frequency continuation and the last unconverged frequencies), where
+numpy's per-call overhead, not the 14 × 14 arithmetic, set the time. Compiled on first use
+and cached in ``__pycache__`` (``cache=True``).
 
 The barrier of the level t is
 ``φ(z) = −log det L(z) − Σ_blocks log det D_k(z) − log det(gmax I − G) − log det(gmax I + G)``
@@ -67,25 +69,31 @@ def gevp(D, A):
     """λ_max(D⁻¹ A) (F,) for Hermitian stacks D, A (F, N, N); +inf where D is not positive
     definite. With D = C Cᴴ: the largest eigenvalue of C⁻¹ A C⁻ᴴ."""
     F, n = D.shape[0], D.shape[1]
-    out = np.full(F, np.inf)
+    out = np.empty(F)
     for f in range(F):
         C, ok = _chol(D[f])
+        out[f] = np.inf
         if not ok:
             continue
         Ci = _tril_inv(C)
-        X = Ci @ np.ascontiguousarray(A[f]) @ np.ascontiguousarray(np.conj(Ci.T))
-        X = 0.5 * (X + np.conj(X.T))
+        CiH = np.empty((n, n), np.complex128)
+        for a in range(n):
+            for b in range(n):
+                CiH[a, b] = np.conj(Ci[b, a])
+        Y = Ci @ np.ascontiguousarray(A[f]) @ CiH
+        X = np.empty((n, n), np.complex128)
+        for a in range(n):
+            for b in range(n):
+                X[a, b] = 0.5 * (Y[a, b] + np.conj(Y[b, a]))
         out[f] = np.linalg.eigvalsh(X)[-1]
     return out
 
 
 @njit(cache=True)
 def _inv(Y):
-    """Inverse of a Hermitian positive definite Y (barrier matrices at feasible points):
-    LAPACK for large ones, Y⁻¹ = C⁻ᴴ C⁻¹ from the Cholesky factor in loops for tiny ones."""
+    """Inverse of a Hermitian positive definite Y (barrier matrices at feasible points),
+    Y⁻¹ = C⁻ᴴ C⁻¹ from its Cholesky factor Y = C Cᴴ."""
     n = Y.shape[0]
-    if n > 4:
-        return np.ascontiguousarray(np.linalg.inv(Y))  # numba's inv returns Fortran order
     C, _ = _chol(Y)
     Ci = _tril_inv(C)
     X = np.zeros((n, n), np.complex128)
@@ -99,9 +107,10 @@ def _inv(Y):
 
 
 @njit(cache=True)
-def _add_term(Yinv, B, off, g, H):
+def _add_term(Yinv, B, off, sign, g, H):
     """Gradient and Hessian of −log det Y for directions B (q, n, n), coordinates off…off+q:
-    with R_i = Y⁻¹ B_i, g_i −= tr R_i and H_ij += Re tr(R_i R_j)."""
+    with R_i = Y⁻¹ B_i, g_i −= sign·tr R_i and H_ij += Re tr(R_i R_j) (sign −1: Y's
+    derivatives are −B_i)."""
     q = B.shape[0]
     n = Yinv.shape[0]
     # R_i = RR[:, i n:(i + 1) n]: one product Y⁻¹ [B_0 … B_q-1] (loops for tiny blocks)
@@ -133,8 +142,11 @@ def _add_term(Yinv, B, off, g, H):
                 P[i, nn + a * n + b] = r.imag
                 Q[i, b * n + a] = r.real
                 Q[i, nn + b * n + a] = -r.imag
-        g[off + i] -= tr
-    H[off:off + q, off:off + q] += P @ Q.T
+        g[off + i] -= sign * tr
+    Hq = P @ Q.T
+    for i in range(q):
+        for j in range(q):
+            H[off + i, off + j] += Hq[i, j]
 
 
 @njit(cache=True)
@@ -143,7 +155,8 @@ def _derivs(L1, D, Gr, Lder, BD, BGr, offs, full, gmax, pD):
     p = Lder.shape[0]
     g = np.zeros(p)
     H = np.zeros((p, p))
-    _add_term(_inv(L1), Lder, 0, g, H)
+    o = offs[0]  # = 0, typed int64 (a literal 0 would compile _add_term twice)
+    _add_term(_inv(L1), Lder, o, 1.0, g, H)
     for k in range(offs.size - 1):
         o0, o1 = offs[k], offs[k + 1]
         if full[k]:  # D block d·I: −k log d
@@ -156,20 +169,63 @@ def _derivs(L1, D, Gr, Lder, BD, BGr, offs, full, gmax, pD):
                     H[i, j] += m * dinv * dinv * ci * BD[j, o0, o0].real
         else:
             _add_term(_inv(np.ascontiguousarray(D[o0:o1, o0:o1])),
-                      np.ascontiguousarray(BD[:, o0:o1, o0:o1]), 0, g, H)
-    nr = Gr.shape[0]
-    if BGr.shape[0]:
-        Y = -Gr.copy()
-        for a in range(nr):
-            Y[a, a] += gmax
-        gm = np.zeros(p)
-        _add_term(_inv(Y), BGr, pD, gm, H)
-        g[pD:] -= gm[pD:]  # d(gmax I − G)/dz_i = −B_i: the gradient's sign flips
-        Y = Gr.copy()
-        for a in range(nr):
-            Y[a, a] += gmax
-        _add_term(_inv(Y), BGr, pD, g, H)
+                      np.ascontiguousarray(BD[:, o0:o1, o0:o1]), o, 1.0, g, H)
+    if BGr.shape[0]:  # gmax I ∓ G: derivatives ∓B_i
+        _add_term(_inv(_shift(Gr, -1.0, gmax)), BGr, pD, -1.0, g, H)
+        _add_term(_inv(_shift(Gr, 1.0, gmax)), BGr, pD, 1.0, g, H)
     return g, H
+
+
+@njit(cache=True)
+def _shift(X, s, c):
+    """c I + s X."""
+    n = X.shape[0]
+    Y = np.empty((n, n), np.complex128)
+    for a in range(n):
+        for b in range(n):
+            Y[a, b] = s * X[a, b]
+        Y[a, a] += c
+    return Y
+
+
+@njit(cache=True)
+def _axpy(X, s, dX):
+    """X + s dX."""
+    n = X.shape[0]
+    Y = np.empty((n, n), np.complex128)
+    for a in range(n):
+        for b in range(n):
+            Y[a, b] = X[a, b] + s * dX[a, b]
+    return Y
+
+
+@njit(cache=True)
+def _solve(H, g):
+    """H⁻¹ g for a small real H (destroyed) by Gaussian elimination with partial pivoting
+    (LAPACK's getrf/getrs algorithm, in loops: numba's np.linalg.solve costs seconds to
+    compile)."""
+    n = H.shape[0]
+    x = g.copy()
+    for k in range(n):
+        piv = k
+        for i in range(k + 1, n):
+            if abs(H[i, k]) > abs(H[piv, k]):
+                piv = i
+        if piv != k:
+            for j in range(n):
+                H[k, j], H[piv, j] = H[piv, j], H[k, j]
+            x[k], x[piv] = x[piv], x[k]
+        for i in range(k + 1, n):
+            m = H[i, k] / H[k, k]
+            for j in range(k + 1, n):
+                H[i, j] -= m * H[k, j]
+            x[i] -= m * x[k]
+    for k in range(n - 1, -1, -1):
+        v = x[k]
+        for j in range(k + 1, n):
+            v -= H[k, j] * x[j]
+        x[k] = v / H[k, k]
+    return x
 
 
 @njit(cache=True)
@@ -178,12 +234,15 @@ def _feasible(L1, D, Gr, gmax):
         return False
     if Gr.shape[0] == 0:
         return True
-    Y = -Gr.copy()
-    Z = Gr.copy()
-    for a in range(Gr.shape[0]):
-        Y[a, a] += gmax
-        Z[a, a] += gmax
-    return _pd(Y) and _pd(Z)
+    return _pd(_shift(Gr, -1.0, gmax)) and _pd(_shift(Gr, 1.0, gmax))
+
+
+@njit(cache=True)
+def _all(x):
+    for v in x:
+        if not v:
+            return False
+    return True
 
 
 @njit(cache=True)
@@ -223,11 +282,14 @@ def newton_steps(L1, D, Gr, za, Lder, U, BD, BGr, offs, full, gmax, pD, n_newton
                 tr += H[i, i]
             for i in range(p):
                 H[i, i] += 1e-12 * tr / p
-            d = -np.linalg.solve(H, g)
-            dz[f] = d
-            dec[f] = np.sqrt(max(-(g @ d), 0.0))
+            d = _solve(H, g)
+            gd = 0.0
+            for i in range(p):
+                dz[f, i] = -d[i]
+                gd += g[i] * d[i]
+            dec[f] = np.sqrt(max(gd, 0.0))
             centred[f] = dec[f] < dec_tol
-        if centred.all():
+        if _all(centred):
             break
         for f in range(F):
             # inside half the Dikin ellipsoid (step·dec ≤ 1/2) every barrier matrix keeps at
@@ -252,7 +314,8 @@ def newton_steps(L1, D, Gr, za, Lder, U, BD, BGr, offs, full, gmax, pD, n_newton
             if step * dec[f] > 0.5:
                 ok = False
                 for _bt in range(12):
-                    if _feasible(L1[f] + step * dL1, D[f] + step * dD, Gr[f] + step * dGr, gmax):
+                    if _feasible(_axpy(L1[f], step, dL1), _axpy(D[f], step, dD),
+                                 _axpy(Gr[f], step, dGr), gmax):
                         ok = True
                         break
                     step *= 0.5

@@ -3,11 +3,11 @@
 Private module. The bound of Fan, Tits & Doyle (1991): μ ≤ β if there are D ≻ 0 and
 G = Gᴴ commuting with the (padded, square) structure such that
 ``Mᴴ D M + j(G M − Mᴴ G) − β² D ⪯ 0``. The generalised-eigenvalue problem in (D, G) is solved
-by the method of centres (Boyd & El Ghaoui 1993) with damped Newton steps, vectorised over
-the stack. Over a frequency grid the solver runs coarse to fine: a cold solve on every
-``stride``-th frequency, then each finer level starts from the scalings of its solved
-neighbours (μ and the optimal scalings vary smoothly with ω), which needs a few Newton steps
-instead of a few dozen. The returned bound is always the generalised eigenvalue at the
+by the method of centres (Boyd & El Ghaoui 1993) with damped Newton steps (compiled, one
+matrix at a time: ``control/_mu_newton.py``). Over a frequency grid the solver runs coarse to
+fine: a cold solve on every ``stride``-th frequency, then each finer level starts from the
+scalings of its solved neighbours (μ and the optimal scalings vary smoothly with ω), which
+needs a few Newton steps instead of a few dozen. The returned bound is always the generalised eigenvalue at the
 returned (D, G): a certificate, whatever the solver's accuracy or starting point.
 """
 

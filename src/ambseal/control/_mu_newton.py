@@ -292,8 +292,11 @@ def newton_steps(L1, D, Gr, za, Lder, U, BD, BGr, offs, full, gmax, pD, n_newton
         if _all(centred):
             break
         for f in range(F):
-            # inside half the Dikin ellipsoid (step·dec ≤ 1/2) every barrier matrix keeps at
-            # least half of itself; longer steps are checked and halved (up to 12 times)
+            # inside the Dikin ellipsoid (r = step·dec < 1) the point stays feasible: each
+            # barrier matrix L has ‖L^-½ dL L^-½‖ ≤ r (its term's local norm is at most the
+            # Newton decrement's), so L + dL ⪰ (1 − r)·L (Nesterov & Nemirovskii 1994 §2.1).
+            # With r ≤ 1/2 it keeps half its smallest eigenvalue, so only the longer steps
+            # are checked, against rounding, and halved (up to 12 times) where they fail
             step = 1.0 if dec[f] < 0.25 else 1.0 / (1.0 + dec[f])
             dL1 = np.zeros((N, N), np.complex128)
             dD = np.zeros((N, N), np.complex128)

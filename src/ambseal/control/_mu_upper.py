@@ -7,8 +7,9 @@ by the method of centres (Boyd & El Ghaoui 1993) with damped Newton steps (compi
 matrix at a time: ``control/_mu_newton.py``). Over a frequency grid the solver runs coarse to
 fine: a cold solve on every ``stride``-th frequency, then each finer level starts from the
 scalings of its solved neighbours (μ and the optimal scalings vary smoothly with ω), which
-needs a few Newton steps instead of a few dozen. The returned bound is always the generalised eigenvalue at the
-returned (D, G): a certificate, whatever the solver's accuracy or starting point.
+needs a few Newton steps instead of a few dozen. The returned bound is always the generalised
+eigenvalue at the returned (D, G): a certificate, whatever the solver's accuracy or starting
+point.
 """
 
 from __future__ import annotations

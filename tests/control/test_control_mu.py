@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 import control as ct
@@ -40,6 +42,7 @@ def test_rank_one_complex_scalars(seed):
     u = mussv(np.outer(a, b), [(1, 0)] * 4, lower=False)
     assert float(u.upper) == float(r.upper) and np.array_equal(u.dscale, r.dscale)
     assert np.isnan(u.lower)
+    assert json.loads(json.dumps(u.to_dict(), allow_nan=False))["lower"] is None
 
 
 @pytest.mark.parametrize("seed", range(4))

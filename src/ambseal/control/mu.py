@@ -189,9 +189,12 @@ class MuResult:
         return float(self.omega[np.argmax(self.upper)])
 
     def to_dict(self) -> dict:
-        """JSON-ready bounds (scalings left out)."""
+        """JSON-ready bounds (scalings left out); ``lower`` is None when it was not
+        computed (``mussv(..., lower=False)``: NaN is not JSON)."""
+        low = np.asarray(self.lower)
         return {
-            "upper": np.asarray(self.upper).tolist(), "lower": np.asarray(self.lower).tolist(),
+            "upper": np.asarray(self.upper).tolist(),
+            "lower": None if np.isnan(low).all() else low.tolist(),
             "peak_upper": self.peak_upper,
             "omega_rad_s": None if self.omega is None else np.asarray(self.omega).tolist(),
             "blocks": [list(b) for b in self.blocks],

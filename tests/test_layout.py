@@ -88,5 +88,6 @@ def test_the_checker_sees_a_violation():
 @pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(SRC)))
 def test_module_size(path):
     n = len(path.read_text(encoding="utf-8").splitlines())
-    limit = 250 if path.name == "pipeline.py" else 600
+    # issue 8: the pipeline *under* 250 lines, every other module at most 600
+    limit = 249 if path.name == "pipeline.py" else 600
     assert n <= limit, f"{path.relative_to(SRC)}: {n} lines > {limit}"

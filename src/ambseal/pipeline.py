@@ -12,7 +12,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from .config import RigConfig, default_rig_path, load_rig
+from .config import RigConfig, default_rig_path, load_rig, load_truth
 from .errors import ConfigError
 from .files import RunFolder, write_json
 
@@ -156,11 +156,8 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         truth = default_truth_path()
     if not cfg.amb:
         raise ConfigError(f"{rig_path}: amb: the main job needs at least one [[amb]]")
-    truth_cfg = None
-    if identification and truth is not None:
-        from .config import load_truth
-
-        truth_cfg = load_truth(truth)  # refused before any work
+    # the truth file is refused before any work
+    truth_cfg = load_truth(truth) if identification and truth is not None else None
     spec = design_spec(cfg)
     points = operating_points(cfg, spec)
     settings = judge_settings(cfg, spec)

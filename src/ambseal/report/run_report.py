@@ -177,9 +177,10 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
 def _model_check_text(fit, errors: dict) -> str:
     """The verdict of a procedure fit's model check, with what each disputed fixed value
     is: the offset the data suggest, the uncertainty the intervals carry for it and, for a
-    seal coefficient, stage (c)'s estimate at 0 bar."""
+    seal coefficient, stage (c)'s estimate at 0 bar; a sensor lag the data ask for as well
+    is named after them (wrong held values can make it too)."""
     check = fit.model_check()
-    if not check["disputed"] or check["sensor_lag"]:
+    if not check["disputed"]:
         return html.escape(check["verdict"])
     b = fit.budget
     parts = []
@@ -193,11 +194,16 @@ def _model_check_text(fit, errors: dict) -> str:
                      f"({html.escape(b.source[j])}, σ = {100 * b.sigma_rel[j]:.3g} % in the "
                      f"intervals){seen}")
     failed = check["residuals_correlated"]
+    lag = ""
+    if check["sensor_lag"]:
+        tau, se = (1e6 * fit.sensor_lag[k] for k in ("suggested_tau_s", "suggested_tau_s_se"))
+        lag = (f"; the data also ask for a sensor lag of {tau:.3g} ± {se:.2g} µs, which the "
+               "wrong held values can make as well: fit them first")
     return ("model mismatch — the stage holds values the data dispute (score test): "
             + "; ".join(parts) + ". Its intervals carry those values' stated uncertainty "
             "(error budget); the estimates are biased by what the held values are off"
             + (f"; the residuals correlate with the excitation on {', '.join(failed)}, as "
-               "a wrong held value makes them" if failed else ""))
+               "a wrong held value makes them" if failed else "") + lag)
 
 
 def facility_impulse_report(out: Path, checks: list, design_note: dict

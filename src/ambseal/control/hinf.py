@@ -487,15 +487,11 @@ class _Sb10:
 
         Above ``_RICCATI_MIN_STATES`` states the γ test is the Riccati margin
         (:meth:`riccati_margin`, a number, so the search takes secant steps; two Schur
-        forms are cheaper than SB10AD's controller there), checked against SB10AD on the
-        ladder's first γ when the margin refuses it (a margin refusing what SB10AD admits
-        would lead the ladder away from γ_opt; one admitting what SB10AD refuses is caught
-        by the confirmation) and confirmed by SB10AD at the end: at the search's smallest
-        admissible γ, or, where Brent's last step landed within rounding of the root and
-        SB10AD (whose test is the stability of its closed loop) refuses it, at the top of
-        the tolerance band ``lo·(1 + rtol)`` (measured on the test rig's D–K plants:
-        margin −3e-11 refused, +1e-6 relative admitted). Otherwise, or where SB10AD
-        disagrees, :meth:`_ladder_job1`: SB10AD's test and its own bisection.
+        forms are cheaper than SB10AD's controller there), checked by SB10AD at the ladder's
+        first γ where the margin refuses it and confirmed by SB10AD at the end, at the top
+        of the tolerance band ``lo·(1 + rtol)`` if SB10AD (testing the stability of its
+        closed loop) refuses Brent's last step within rounding of the root (rig D–K plant:
+        margin −3e-11). Otherwise, or where SB10AD disagrees, :meth:`_ladder_job1`.
 
         Returns ``(hi, lo, tests)``: the smallest admissible γ found, the largest
         inadmissible one (a lower bound of γ_opt; the Parrott bound if none was tried) and
@@ -512,22 +508,20 @@ class _Sb10:
                 return self._ladder_job1(lo0, g0, sb0, rtol, tests)
         hi, lo, more = _search_gamma(self.riccati_margin, lo0, rtol, {g0: ric0})
         tests += more
-        for g in (hi, lo * (1.0 + rtol)):
+        for g in (hi, lo * (1.0 + rtol)) if lo * (1.0 + rtol) > hi else (hi,):
             tests += 1
-            if g >= hi and self.admissible(g):
+            if self.admissible(g):
                 return g, lo, tests
         return self._ladder_job1(lo0, g0, sb0, rtol, tests)
 
     def _ladder_job1(self, lo0: float, g0: float, sb0: float | None, rtol: float,
                      tests: int):
         """γ_opt with SB10AD only: a ladder of factors 4 from ``g0`` (SB10AD's γ test
-        ``sb0`` there; None: not made yet) to the first change of admissibility, then SB10AD's bisection (job 1)
-        from the ladder's admissible top in one call (job 1 bisects from 0 to the given γ,
-        whether that γ is admissible or not, so the top is tested first).
-
-        SB10AD's GTOL is absolute in γ (measured: the error of job 1 stays below GTOL
-        whatever the scale of γ_opt): ``rtol·lo``, with lo ≤ γ_opt, keeps the relative
-        tolerance ``rtol``."""
+        ``sb0`` there, None if not made) to the first change of admissibility, then SB10AD's
+        bisection (job 1) from the ladder's admissible top in one call (job 1 bisects from 0
+        to the given γ, admissible or not, so the top is tested first). SB10AD's GTOL is
+        absolute in γ (measured: job 1's error stays below GTOL whatever the scale of
+        γ_opt): ``rtol·lo``, with lo ≤ γ_opt, keeps the relative tolerance ``rtol``."""
         if sb0 is None:
             sb0, tests = (-1.0 if self.admissible(g0) else 1.0), tests + 1
         hi, lo, more = _search_gamma(lambda g: -1.0 if self.admissible(g) else 1.0,

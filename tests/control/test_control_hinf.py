@@ -257,3 +257,23 @@ def test_hinfsyn_rejects_bad_channels():
         hinfsyn(P, 0, 1)
     with pytest.raises(ValueError, match="StateSpace"):
         hinfsyn(np.eye(2), 1, 1)
+
+
+def test_gamma_search_confirms_at_band_top_when_sb10ad_refuses_the_root(monkeypatch):
+    """Reference: the unpatched search (SB10AD and the Riccati margin agree). When SB10AD
+    refuses Brent's last γ as rounding can make it do right at the root (seen on the rig's
+    D–K plant: margin −3e-11 refused, 1e-6 higher admitted), γ_opt is the top of the
+    tolerance band lo·(1 + rtol), within rtol of the true one, without SB10AD's bisection."""
+    from ambseal.control.hinf import _Sb10
+
+    G, w1, w2 = _mixsyn_cases()[1]
+    P = mixed_sensitivity(ct.ss(G), w1, w2)
+    monkeypatch.setattr("ambseal.control.hinf._RICCATI_MIN_STATES", 0)  # margin search
+    ref, ref_lo, _ = _Sb10(P, 2, 2).gamma_opt(1e-6)
+    sb = _Sb10(P, 2, 2)
+    plain = sb.admissible
+    monkeypatch.setattr(sb, "admissible", lambda g: g != ref and plain(g))
+    monkeypatch.setattr(sb, "_ladder_job1", lambda *a: pytest.fail("SB10AD bisection used"))
+    hi, lo, _ = sb.gamma_opt(1e-6)
+    assert (hi, lo) == (ref_lo * (1 + 1e-6), ref_lo)
+    assert ref < hi <= ref * (1 + 1e-6)

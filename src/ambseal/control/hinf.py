@@ -487,9 +487,11 @@ class _Sb10:
 
         Above ``_RICCATI_MIN_STATES`` states the γ test is the Riccati margin
         (:meth:`riccati_margin`, a number, so the search takes secant steps; two Schur
-        forms are cheaper than SB10AD's controller there), checked against SB10AD on the
-        ladder's first γ and confirmed by SB10AD at the end. Otherwise, or where SB10AD
-        disagrees, :meth:`_ladder_job1`: SB10AD's test and its own bisection.
+        forms are cheaper than SB10AD's controller there), checked by SB10AD at the ladder's
+        first γ where the margin refuses it and confirmed by SB10AD at the end, at the top
+        of the tolerance band ``lo·(1 + rtol)`` if SB10AD (testing the stability of its
+        closed loop) refuses Brent's last step within rounding of the root (rig D–K plant:
+        margin −3e-11). Otherwise, or where SB10AD disagrees, :meth:`_ladder_job1`.
 
         Returns ``(hi, lo, tests)``: the smallest admissible γ found, the largest
         inadmissible one (a lower bound of γ_opt; the Parrott bound if none was tried) and
@@ -497,27 +499,31 @@ class _Sb10:
         """
         lo0 = self.parrott_bound
         g0 = max(1.5 * lo0, 1.0)
-        sb0 = -1.0 if self.admissible(g0) else 1.0
-        tests = 1
-        if self.A.shape[0] > _RICCATI_MIN_STATES:
-            ric0 = self.riccati_margin(g0)
+        if self.A.shape[0] <= _RICCATI_MIN_STATES:
+            return self._ladder_job1(lo0, g0, None, rtol, 0)
+        ric0, tests, sb0 = self.riccati_margin(g0), 1, None
+        if ric0 >= 0:
+            sb0, tests = (-1.0 if self.admissible(g0) else 1.0), tests + 1
+            if sb0 < 0:
+                return self._ladder_job1(lo0, g0, sb0, rtol, tests)
+        hi, lo, more = _search_gamma(self.riccati_margin, lo0, rtol, {g0: ric0})
+        tests += more
+        for g in (hi, lo * (1.0 + rtol)) if lo * (1.0 + rtol) > hi else (hi,):
             tests += 1
-            if (ric0 < 0) == (sb0 < 0):
-                hi, lo, more = _search_gamma(self.riccati_margin, lo0, rtol, {g0: ric0})
-                tests += more + 1
-                if self.admissible(hi):
-                    return hi, lo, tests
+            if self.admissible(g):
+                return g, lo, tests
         return self._ladder_job1(lo0, g0, sb0, rtol, tests)
 
-    def _ladder_job1(self, lo0: float, g0: float, sb0: float, rtol: float, tests: int):
+    def _ladder_job1(self, lo0: float, g0: float, sb0: float | None, rtol: float,
+                     tests: int):
         """γ_opt with SB10AD only: a ladder of factors 4 from ``g0`` (SB10AD's γ test
-        ``sb0`` there) to the first change of admissibility, then SB10AD's bisection (job 1)
-        from the ladder's admissible top in one call (job 1 bisects from 0 to the given γ,
-        whether that γ is admissible or not, so the top is tested first).
-
-        SB10AD's GTOL is absolute in γ (measured: the error of job 1 stays below GTOL
-        whatever the scale of γ_opt): ``rtol·lo``, with lo ≤ γ_opt, keeps the relative
-        tolerance ``rtol``."""
+        ``sb0`` there, None if not made) to the first change of admissibility, then SB10AD's
+        bisection (job 1) from the ladder's admissible top in one call (job 1 bisects from 0
+        to the given γ, admissible or not, so the top is tested first). SB10AD's GTOL is
+        absolute in γ (measured: job 1's error stays below GTOL whatever the scale of
+        γ_opt): ``rtol·lo``, with lo ≤ γ_opt, keeps the relative tolerance ``rtol``."""
+        if sb0 is None:
+            sb0, tests = (-1.0 if self.admissible(g0) else 1.0), tests + 1
         hi, lo, more = _search_gamma(lambda g: -1.0 if self.admissible(g) else 1.0,
                                      lo0, 3.0, {g0: sb0})
         out, info = _sb10ad(self.A, self.B, self.C, self.D, self.ncon, self.nmeas, hi, 1,

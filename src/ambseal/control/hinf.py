@@ -514,8 +514,7 @@ class _Sb10:
                 return g, lo, tests
         return self._ladder_job1(lo0, g0, sb0, rtol, tests)
 
-    def _ladder_job1(self, lo0: float, g0: float, sb0: float | None, rtol: float,
-                     tests: int):
+    def _ladder_job1(self, lo0: float, g0: float, sb0: float | None, rtol: float, tests: int):
         """γ_opt with SB10AD only: a ladder of factors 4 from ``g0`` (SB10AD's γ test
         ``sb0`` there, None if not made) to the first change of admissibility, then SB10AD's
         bisection (job 1) from the ladder's admissible top in one call (job 1 bisects from 0

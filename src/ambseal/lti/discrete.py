@@ -15,6 +15,7 @@ the digital loop of the identification, the Youla signals) runs through these tw
 
 from __future__ import annotations
 
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -150,11 +151,9 @@ def simulate_lti(A: np.ndarray, B: np.ndarray, Cs: list[np.ndarray], u: np.ndarr
         CA.append(CA[-1] @ A)
         AB.append(A @ AB[-1])
     O = np.vstack(CA)  # (L p, n)
-    markov = np.zeros((L, p, m))  # by lag: C A^(j−1) B, none at lag 0
-    for j in range(1, L):
-        markov[j] = CA[j - 1] @ B
-    lag = np.subtract.outer(np.arange(L), np.arange(L))  # [j, i] → j − i
-    T = markov[np.clip(lag, 0, None)] * (lag > 0)[:, :, None, None]  # (L, L, p, m)
+    markov = np.zeros((L, p, m))  # by lag: C A^(j−1) B, none (zero) at lag 0
+    markov[1:] = O[:-p].reshape(L - 1, p, n) @ B
+    T = markov[_lags(L)]  # (L, L, p, m): [j, i] → lag j − i, lags ≤ 0 the zero one
     T = T.transpose(0, 2, 1, 3).reshape(L * p, L * m)
     G = np.hstack(AB[::-1])  # (n, L m): [A^(L−1) B … B]
     nb = -(-N // L)
@@ -164,9 +163,9 @@ def simulate_lti(A: np.ndarray, B: np.ndarray, Cs: list[np.ndarray], u: np.ndarr
     drive = Ub @ G.T  # (nb, n)
     AL = np.linalg.matrix_power(A, L)
     with np.errstate(over="ignore", invalid="ignore"):
-        Z = _block_states(np.ascontiguousarray(AL), np.ascontiguousarray(drive))
         b0 = min(max(start, 0), N) // L
-        Y = (Z[b0:] @ O.T + Ub[b0:] @ T.T).reshape((nb - b0) * L, p)
+        Z = _block_states(np.ascontiguousarray(AL), np.ascontiguousarray(drive), b0)
+        Y = (Z @ O.T + Ub[b0:] @ T.T).reshape((nb - b0) * L, p)
         Y = Y[start - b0 * L:N - b0 * L]
     out, row = [], 0
     for Ci in Cs:
@@ -175,15 +174,25 @@ def simulate_lti(A: np.ndarray, B: np.ndarray, Cs: list[np.ndarray], u: np.ndarr
     return out
 
 
+@lru_cache(maxsize=8)
+def _lags(L: int) -> np.ndarray:
+    """``max(j − i, 0)`` for j, i < L: the Markov parameter of each block-Toeplitz entry."""
+    lag = np.subtract.outer(np.arange(L), np.arange(L))
+    lag[lag < 0] = 0
+    lag.flags.writeable = False
+    return lag
+
+
 @njit(cache=True, nogil=True)
-def _block_states(AL: np.ndarray, drive: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
-    """States at the block starts, ``Z[b+1] = AL Z[b] + drive[b]`` from ``Z[0] = 0``: the
-    one sequential part of :func:`simulate_lti`, compiled (numba) because a Python loop
-    over the blocks of a long record cost more than the vectorised rest."""
+def _block_states(AL: np.ndarray, drive: np.ndarray, b0: int) -> np.ndarray:  # pragma: no cover - compiled
+    """States at the block starts ``b ≥ b0``, ``Z[b+1] = AL Z[b] + drive[b]`` from
+    ``Z[0] = 0``: the one sequential part of :func:`simulate_lti`, compiled (numba) because
+    a Python loop over the blocks of a long record cost more than the vectorised rest."""
     nb, n = drive.shape
-    Z = np.empty((nb, n))
+    Z = np.empty((nb - b0, n))
     z = np.zeros(n)
     for b in range(nb):
-        Z[b] = z
+        if b >= b0:
+            Z[b - b0] = z
         z = AL @ z + drive[b]
     return Z

@@ -57,10 +57,14 @@ def lft_lower_matrices(P: Matrices, K: Matrices, nmeas: int, ncon: int) -> Matri
     B1, B2 = B[:, :nw], B[:, nw:]
     C1, C2 = C[:nz], C[nz:]
     D11, D12, D21, D22 = D[:nz, :nw], D[:nz, nw:], D[nz:, :nw], D[nz:, nw:]
-    Rm = np.eye(nmeas) - D22 @ Dk
-    if np.linalg.cond(Rm) > 1e12:
+    DD = D22 @ Dk
+    Rm = np.eye(nmeas) - DD
+    if not DD.any():  # a strictly proper plant (the usual case): R = I, its inverse exactly
+        Ri = Rm
+    elif np.linalg.cond(Rm) > 1e12:
         raise ModelError("the loop is ill-posed: I - D22·D_K is singular")
-    Ri = np.linalg.inv(Rm)
+    else:
+        Ri = np.linalg.inv(Rm)
     # y = Ri (C2 x + D22 C_K x_K + D21 w);   u = C_K x_K + D_K y
     Cy = np.hstack([Ri @ C2, Ri @ D22 @ Ck])
     Dy = Ri @ D21

@@ -191,8 +191,11 @@ def _block_states(AL: np.ndarray, drive: np.ndarray, b0: int) -> np.ndarray:  # 
     nb, n = drive.shape
     Z = np.empty((nb - b0, n))
     z = np.zeros(n)
+    t = np.empty(n)
     for b in range(nb):
         if b >= b0:
             Z[b - b0] = z
-        z = AL @ z + drive[b]
+        np.dot(AL, z, t)  # the BLAS product of ``AL @ z``, into a buffer
+        for i in range(n):
+            z[i] = t[i] + drive[b, i]
     return Z

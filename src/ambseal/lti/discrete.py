@@ -146,16 +146,13 @@ def simulate_lti(A: np.ndarray, B: np.ndarray, Cs: list[np.ndarray], u: np.ndarr
     L = max(1, min(block, N))
     # C A^j and A^j B for j < L by products with the small side (p·n² and n²·m flops a
     # step, not n³), and A^L by repeated squaring
-    CA, AB = [C], [B]
-    for _ in range(1, L):
-        CA.append(CA[-1] @ A)
-        AB.append(A @ AB[-1])
-    O = np.vstack(CA)  # (L p, n)
+    CA, AB = _powers(*(np.ascontiguousarray(X, dtype=float) for X in (A, B, C)), L)
+    O = CA.reshape(L * p, n)
     markov = np.zeros((L, p, m))  # by lag: C A^(j−1) B, none (zero) at lag 0
-    markov[1:] = O[:-p].reshape(L - 1, p, n) @ B
+    markov[1:] = CA[:-1] @ B
     T = markov[_lags(L)]  # (L, L, p, m): [j, i] → lag j − i, lags ≤ 0 the zero one
     T = T.transpose(0, 2, 1, 3).reshape(L * p, L * m)
-    G = np.hstack(AB[::-1])  # (n, L m): [A^(L−1) B … B]
+    G = AB[::-1].transpose(1, 0, 2).reshape(n, L * m)  # [A^(L−1) B … B]
     nb = -(-N // L)
     U = np.zeros((nb * L, m))
     U[:N] = u
@@ -181,6 +178,21 @@ def _lags(L: int) -> np.ndarray:
     lag[lag < 0] = 0
     lag.flags.writeable = False
     return lag
+
+
+@njit(cache=True, nogil=True)
+def _powers(A: np.ndarray, B: np.ndarray, C: np.ndarray, L: int):  # pragma: no cover - compiled
+    """``C A^j`` (L, p, n) and ``A^j B`` (L, n, m) for j < L, each from the previous by one
+    BLAS product (compiled: in Python the 2L small products cost more in calls than in
+    arithmetic)."""
+    CA = np.empty((L, C.shape[0], A.shape[0]))
+    AB = np.empty((L, A.shape[0], B.shape[1]))
+    CA[0] = C
+    AB[0] = B
+    for j in range(1, L):
+        np.dot(CA[j - 1], A, CA[j])
+        np.dot(A, AB[j - 1], AB[j])
+    return CA, AB
 
 
 @njit(cache=True, nogil=True)

@@ -70,6 +70,17 @@ def facility_loop(Phi, Gam, seg_start, C_all, D_coil, D_ieff, Ac, Bc, Cc, Dc, e,
     u_in = np.zeros(2 * k)
     y = np.zeros(k)
     out = C_all @ z
+    # the products below go into buffers (np.dot with out: the BLAS call of ``@``, no
+    # allocation per sample and sub-step)
+    u = np.empty(Cc.shape[0])
+    tk = np.empty(Dc.shape[0])
+    xn = np.empty(xc.shape[0])
+    tx = np.empty(xc.shape[0])
+    coil = np.empty(k)
+    i_ff = np.empty(k)
+    iref = np.empty(k)
+    zn = np.empty(z.shape[0])
+    tz = np.empty(z.shape[0])
     for n in range(N):
         while seg + 1 < seg_start.shape[0] and n >= seg_start[seg + 1]:
             seg += 1
@@ -79,13 +90,16 @@ def facility_loop(Phi, Gam, seg_start, C_all, D_coil, D_ieff, Ac, Bc, Cc, Dc, e,
             if lsb > 0.0:
                 v = np.rint(v / lsb) * lsb
             y[a] = v
-        u = Cc @ xc + Dc @ y
-        iref = np.empty(k)
+        np.dot(Cc, xc, u)
+        np.dot(Dc, y, tk)
         for a in range(k):
-            iref[a] = min(max(-u[a] + e[n, a], -limit), limit)
-        xc[:] = Ac @ xc + Bc @ y
-        coil = D_coil @ iref
-        i_ff = D_ieff @ iref
+            iref[a] = min(max(-(u[a] + tk[a]) + e[n, a], -limit), limit)
+        np.dot(Ac, xc, xn)
+        np.dot(Bc, y, tx)
+        for j in range(xc.shape[0]):
+            xc[j] = xn[j] + tx[j]
+        np.dot(D_coil, iref, coil)
+        np.dot(D_ieff, iref, i_ff)
         for a in range(k):
             rec_y[n, a] = y[a]
             rec_ref[n, a] = iref[a]
@@ -103,6 +117,9 @@ def facility_loop(Phi, Gam, seg_start, C_all, D_coil, D_ieff, Ac, Bc, Cc, Dc, e,
                 dm = s0[a] + x
                 f = kf[a] * (ip * ip / (dp * dp) - im * im / (dm * dm))
                 u_in[k + a] = f - (ki[a] * i + ks[a] * x)
-            z[:] = Phi[seg] @ z + Gam[seg] @ u_in
-            out = C_all @ z
+            np.dot(Phi[seg], z, zn)
+            np.dot(Gam[seg], u_in, tz)
+            for j in range(z.shape[0]):
+                z[j] = zn[j] + tz[j]
+            np.dot(C_all, z, out)
     return -1

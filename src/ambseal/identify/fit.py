@@ -84,20 +84,36 @@ class ClosedLoopModel:
     controller: DiscreteController
     tau_e: float = 0.0
     tau_s: float = 0.0
-    _cache: dict = field(default_factory=dict, repr=False)
+    _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def matrices(self, values: dict[str, float]):
         """Continuous (A, B, C, C_i, D_i) of amplifier → lag → plant for parameter values:
         displacements y = C x, coil current i = C_i x + D_i i_ref."""
-        changes = {n: v - self.plant.parameter(n).nominal for n, v in values.items()
-                   if n not in (TAU_E, TAU_S)}
-        p = self.plant.with_changes(changes) if changes else self.plant
+        A, B, C = self._lft(values)
         tau = values.get(TAU_E, self.tau_e)
-        A, B, C = p.A, p.B, p.C
         for blocks in (eddy_lag_matrices(tau), self.actuator):
             A, B, C, _, Cout, Dout = series_inputs((A, B, C, np.zeros((C.shape[0], B.shape[1]))),
                                                    blocks)
         return A, B, C, Cout, Dout
+
+    def _lft(self, values: dict[str, float]):
+        """The plant's (A, B, C) with ``values`` applied through its LFT channels: the
+        arithmetic of :meth:`~ambseal.model.lft.Plant.with_changes`, with each channel's
+        products B_θC_θ, B_θD_θ formed once per model, not once per evaluation."""
+        p = self.plant
+        A, B = p.A, p.B
+        changes = [(n, v) for n, v in values.items() if n not in (TAU_E, TAU_S)]
+        if changes:
+            A, B = A.copy(), B.copy()
+        for name, v in changes:
+            par = p.parameter(name)
+            if name not in self._cache:
+                self._cache[name] = (par.B @ par.C, par.B @ par.D)
+            BC, BD = self._cache[name]
+            theta = v - par.nominal
+            A += theta * BC
+            B += theta * BD
+        return A, B, p.C
 
     def _sampled(self, values: dict[str, float]):
         """(A_d, B_d, C, C_i, D_i) sampled by ZOH at the controller's period, the sensors'
@@ -405,21 +421,21 @@ def fit_parameters(
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(se, se)
     e0, y0 = data[0][0], data[0][1]
-    ys, is_ = models[0].simulate(dict(zip(names, est)), e0)
-    fits = {f"{a}": v for a, v in zip(records[0].axes, nrmse_fit(y0, ys[start:]))}
+    ys, is_ = models[0].simulate(dict(zip(names, est)), e0, start, currents=current_weight > 0)
+    fits = {f"{a}": v for a, v in zip(records[0].axes, nrmse_fit(y0, ys))}
     bad_fit = [a for a, v in fits.items() if not np.isfinite(v) or v < 0]
     if bad_fit and converged:  # worse than the mean: the model does not describe the data
         converged = False
         message = f"NRMSE fit below 0 % on {', '.join(bad_fit)}"
     if current_weight > 0:
-        fi = nrmse_fit(data[0][3], is_[start:])
+        fi = nrmse_fit(data[0][3], is_)
         fits.update({f"current_{a}": v for a, v in zip(records[0].axes, fi)})
     return FitResult(
         names=tuple(names), estimate=est, initial=init, std_error=se,
         ci95_low=est - half, ci95_high=est + half, correlation=corr,
         nrmse_fit_pct=fits, converged=converged, message=message,
         iterations=int(sol.nfev), wall_time_s=time.perf_counter() - t0,
-        time_s=np.asarray(records[0].time_s)[start:stop], y_meas=y0, y_sim=ys[start:],
+        time_s=np.asarray(records[0].time_s)[start:stop], y_meas=y0, y_sim=ys,
         axes=tuple(records[0].axes), std_error_noise=se_noise, budget=budget,
         residuals=tests, dof_noise=dof,
         correlation_jacobian=jacobian_correlation(sol.jac), sensor_lag=lag,

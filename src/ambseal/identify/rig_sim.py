@@ -134,6 +134,8 @@ def reduced_plant(cfg: RigConfig, pressure_bar: float, speed_rpm: float | None,
     ModelError
         A value names a parameter the rig has no channel for; no mode below the cut-off.
     """
+    if speed_rpm is None:  # the rig's speed, as build_system takes it: one key for both
+        speed_rpm = cfg.operating.speed_rpm
     key = (cfg.model_dump_json(), pressure_bar, speed_rpm, tuple(sorted(values.items())),
            cutoff_hz)
     if key in _PLANTS:

@@ -15,6 +15,7 @@ the digital loop of the identification, the Youla signals) runs through these tw
 
 from __future__ import annotations
 
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -145,18 +146,13 @@ def simulate_lti(A: np.ndarray, B: np.ndarray, Cs: list[np.ndarray], u: np.ndarr
     L = max(1, min(block, N))
     # C A^j and A^j B for j < L by products with the small side (p·n² and n²·m flops a
     # step, not n³), and A^L by repeated squaring
-    CA, AB = [C], [B]
-    for _ in range(1, L):
-        CA.append(CA[-1] @ A)
-        AB.append(A @ AB[-1])
-    O = np.vstack(CA)  # (L p, n)
-    markov = np.zeros((L, p, m))  # by lag: C A^(j−1) B, none at lag 0
-    for j in range(1, L):
-        markov[j] = CA[j - 1] @ B
-    lag = np.subtract.outer(np.arange(L), np.arange(L))  # [j, i] → j − i
-    T = markov[np.clip(lag, 0, None)] * (lag > 0)[:, :, None, None]  # (L, L, p, m)
+    CA, AB = _powers(*(np.ascontiguousarray(X, dtype=float) for X in (A, B, C)), L)
+    O = CA.reshape(L * p, n)
+    markov = np.zeros((L, p, m))  # by lag: C A^(j−1) B, none (zero) at lag 0
+    markov[1:] = CA[:-1] @ B
+    T = markov[_lags(L)]  # (L, L, p, m): [j, i] → lag j − i, lags ≤ 0 the zero one
     T = T.transpose(0, 2, 1, 3).reshape(L * p, L * m)
-    G = np.hstack(AB[::-1])  # (n, L m): [A^(L−1) B … B]
+    G = AB[::-1].transpose(1, 0, 2).reshape(n, L * m)  # [A^(L−1) B … B]
     nb = -(-N // L)
     U = np.zeros((nb * L, m))
     U[:N] = u
@@ -164,9 +160,9 @@ def simulate_lti(A: np.ndarray, B: np.ndarray, Cs: list[np.ndarray], u: np.ndarr
     drive = Ub @ G.T  # (nb, n)
     AL = np.linalg.matrix_power(A, L)
     with np.errstate(over="ignore", invalid="ignore"):
-        Z = _block_states(np.ascontiguousarray(AL), np.ascontiguousarray(drive))
         b0 = min(max(start, 0), N) // L
-        Y = (Z[b0:] @ O.T + Ub[b0:] @ T.T).reshape((nb - b0) * L, p)
+        Z = _block_states(np.ascontiguousarray(AL), np.ascontiguousarray(drive), b0)
+        Y = (Z @ O.T + Ub[b0:] @ T.T).reshape((nb - b0) * L, p)
         Y = Y[start - b0 * L:N - b0 * L]
     out, row = [], 0
     for Ci in Cs:
@@ -175,15 +171,43 @@ def simulate_lti(A: np.ndarray, B: np.ndarray, Cs: list[np.ndarray], u: np.ndarr
     return out
 
 
+@lru_cache(maxsize=8)
+def _lags(L: int) -> np.ndarray:
+    """``max(j − i, 0)`` for j, i < L: the Markov parameter of each block-Toeplitz entry."""
+    lag = np.subtract.outer(np.arange(L), np.arange(L))
+    lag[lag < 0] = 0
+    lag.flags.writeable = False
+    return lag
+
+
 @njit(cache=True, nogil=True)
-def _block_states(AL: np.ndarray, drive: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
-    """States at the block starts, ``Z[b+1] = AL Z[b] + drive[b]`` from ``Z[0] = 0``: the
-    one sequential part of :func:`simulate_lti`, compiled (numba) because a Python loop
-    over the blocks of a long record cost more than the vectorised rest."""
+def _powers(A: np.ndarray, B: np.ndarray, C: np.ndarray, L: int):  # pragma: no cover - compiled
+    """``C A^j`` (L, p, n) and ``A^j B`` (L, n, m) for j < L, each from the previous by one
+    BLAS product (compiled: in Python the 2L small products cost more in calls than in
+    arithmetic)."""
+    CA = np.empty((L, C.shape[0], A.shape[0]))
+    AB = np.empty((L, A.shape[0], B.shape[1]))
+    CA[0] = C
+    AB[0] = B
+    for j in range(1, L):
+        np.dot(CA[j - 1], A, CA[j])
+        np.dot(A, AB[j - 1], AB[j])
+    return CA, AB
+
+
+@njit(cache=True, nogil=True)
+def _block_states(AL: np.ndarray, drive: np.ndarray, b0: int) -> np.ndarray:  # pragma: no cover - compiled
+    """States at the block starts ``b ≥ b0``, ``Z[b+1] = AL Z[b] + drive[b]`` from
+    ``Z[0] = 0``: the one sequential part of :func:`simulate_lti`, compiled (numba) because
+    a Python loop over the blocks of a long record cost more than the vectorised rest."""
     nb, n = drive.shape
-    Z = np.empty((nb, n))
+    Z = np.empty((nb - b0, n))
     z = np.zeros(n)
+    t = np.empty(n)
     for b in range(nb):
-        Z[b] = z
-        z = AL @ z + drive[b]
+        if b >= b0:
+            Z[b - b0] = z
+        np.dot(AL, z, t)  # the BLAS product of ``AL @ z``, into a buffer
+        for i in range(n):
+            z[i] = t[i] + drive[b, i]
     return Z

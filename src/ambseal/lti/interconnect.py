@@ -57,10 +57,14 @@ def lft_lower_matrices(P: Matrices, K: Matrices, nmeas: int, ncon: int) -> Matri
     B1, B2 = B[:, :nw], B[:, nw:]
     C1, C2 = C[:nz], C[nz:]
     D11, D12, D21, D22 = D[:nz, :nw], D[:nz, nw:], D[nz:, :nw], D[nz:, nw:]
-    Rm = np.eye(nmeas) - D22 @ Dk
-    if np.linalg.cond(Rm) > 1e12:
+    DD = D22 @ Dk
+    Rm = np.eye(nmeas) - DD
+    if not DD.any():  # a strictly proper plant (the usual case): R = I, its inverse exactly
+        Ri = Rm
+    elif np.linalg.cond(Rm) > 1e12:
         raise ModelError("the loop is ill-posed: I - D22·D_K is singular")
-    Ri = np.linalg.inv(Rm)
+    else:
+        Ri = np.linalg.inv(Rm)
     # y = Ri (C2 x + D22 C_K x_K + D21 w);   u = C_K x_K + D_K y
     Cy = np.hstack([Ri @ C2, Ri @ D22 @ Ck])
     Dy = Ri @ D21
@@ -191,11 +195,11 @@ def series_inputs(G: Matrices, block: Matrices, inputs: list[int] | None = None
     """
     A, B, C, D = G
     n, m = B.shape
-    idx = list(range(m)) if inputs is None else list(inputs)
-    k = len(idx)
+    idx = slice(None) if inputs is None else list(inputs)  # all: a slice, no copy
+    k = m if inputs is None else len(idx)
     Ak, Bk, Ck, Dk = (_repeat_diagonal(np.atleast_2d(np.asarray(X, float)), k) for X in block)
     na = Ak.shape[0]
-    Bu = B[:, idx]
+    Bu, Du = np.ascontiguousarray(B[:, idx]), np.ascontiguousarray(D[:, idx])
     A2 = np.zeros((n + na, n + na))
     A2[:n, :n] = A
     A2[:n, n:] = Bu @ Ck
@@ -204,9 +208,9 @@ def series_inputs(G: Matrices, block: Matrices, inputs: list[int] | None = None
     B2[:n] = B
     B2[:n, idx] = Bu @ Dk
     B2[n:, idx] = Bk
-    C2 = np.hstack([C, D[:, idx] @ Ck])
+    C2 = np.hstack([C, Du @ Ck])
     D2 = D.copy()
-    D2[:, idx] = D[:, idx] @ Dk
+    D2[:, idx] = Du @ Dk
     C_out = np.hstack([np.zeros((k, n)), Ck])
     D_out = np.zeros((k, m))
     D_out[:, idx] = Dk

@@ -88,7 +88,7 @@ def test_choice_closes_candidates_by_rank_until_one_is_stable():
     the list (k = 0.3, |z| 0.2 at both plants) is chosen; the rest, ranked after it, are
     not closed (``stable``/``max_abs_z`` None, a reason). On the old rule (every candidate
     closed) the last two carry numbers and no reason."""
-    from ambseal.control.digital import _first_stable
+    from ambseal.control._digital_choice import first_stable
 
     G = (np.array([[0.5]]), np.array([[1.0]]), np.array([[1.0]]), np.zeros((1, 1)))
     gain = lambda k: (np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.array([[k]]))
@@ -98,7 +98,7 @@ def test_choice_closes_candidates_by_rank_until_one_is_stable():
               "sensitivity_peak_continuous": [1.0, 1.0], "sensitivity_peak_error": errs[m],
               "stable": None} for m in ks]
     Kd = {m: (None, [gain(k)] * 2) for m, k in ks.items()}
-    best = _first_stable(cands, Kd, [G, G], [True, True])
+    best = first_stable(cands, Kd, [G, G], [True, True])
     a, b, c, d = cands
     assert best is b and b["stable"] and b["max_abs_z"] == pytest.approx([0.2, 0.2], abs=1e-15)
     assert a["stable"] is False and a["max_abs_z"] == pytest.approx([1.5, 1.5], abs=1e-15)

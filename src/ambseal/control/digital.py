@@ -54,7 +54,9 @@ from ..errors import ConfigError, SynthesisError
 from ..identify.loop import DiscreteController
 from ..lti.discrete import zoh
 from ..lti.freqresp import freqresp, freqresp_at
-from ..lti.interconnect import feedback_matrices, feedback_poles, series_inputs
+from ..lti.interconnect import feedback_poles, series_inputs
+from ._digital_choice import first_stable as _first_stable
+from ._digital_choice import so_peak as _so_peak
 
 __all__ = ["FAST_FRACTION", "METHODS", "PEAK_TOLERANCE", "peak_difference",
            "DigitalController", "split_fast", "residualize", "hold_keeps", "HOLDS", "KEPT",
@@ -410,18 +412,6 @@ def prewarp_frequency_hz(G_list, K: Matrices, fs: float) -> float | None:
     return f_best
 
 
-def _so_peak(Gw: np.ndarray, Kw: np.ndarray) -> float:
-    """Grid peak of σ̄((I + G K)⁻¹) from stacks of responses (n_w, ny, nu), (n_w, nu, ny)."""
-    ny = Gw.shape[1]
-    eye = np.broadcast_to(np.eye(ny), Gw.shape[:1] + (ny, ny))
-    S = np.linalg.solve(np.eye(ny) + Gw @ Kw, eye)
-    return float(np.max(np.linalg.svd(S, compute_uv=False)[:, 0]))
-
-
-def _max_abs_z(Gd: Matrices, Kd: Matrices) -> float:
-    return float(np.abs(np.linalg.eigvals(feedback_matrices(Gd, Kd)[0])).max())
-
-
 def _remove_fast(K, mats: Matrices, fs: float, rise: Callable | None):
     """Fast poles removed (module docstring, step 1): (matrices, StateSpace, poles, rise).
     Nothing is removed without ``rise`` (no design to report the cost on)."""
@@ -495,9 +485,10 @@ def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int,
     ``methods`` on a tie) among those stable wherever the design is. Each candidate's error
     comes from its frequency responses alone; the sampled loops' poles (one eigenvalue
     problem of the full-order loop per plant, most of the cost) are then computed in the
-    order of the errors, only until the first stable candidate (:func:`_first_stable`): a
-    candidate that ranks after it cannot be chosen, and is reported with ``stable`` and
-    ``max_abs_z`` ``None`` and the reason (``not_checked``).
+    order of the errors, only until the first stable candidate
+    (:func:`ambseal.control._digital_choice.first_stable`): a candidate that ranks after it
+    cannot be chosen, and is reported with ``stable`` and ``max_abs_z`` ``None`` and the
+    reason (``not_checked``).
     """
     fs, T, w = sp.fs, 1.0 / sp.fs, sp.omega_rad_s
 
@@ -534,40 +525,6 @@ def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int,
             f"stable where the continuous loop is (highest controller pole {poles:.4g} Hz; "
             "a sample rate below twice it cannot run it): raise the sample rate or redesign")
     return best["method"], Kd[best["method"]][0], tuple(cands)
-
-
-def _first_stable(cands: list, Kd: dict, sampled: list, cont_stable: list) -> dict | None:
-    """The chosen candidate of :func:`choose_method`: ``cands`` taken by increasing
-    ``sensitivity_peak_error`` (a stable sort: ``methods`` order on a tie, NaN last), each
-    closed with every sampled plant (``max_abs_z``) until one is stable wherever the design
-    is. A candidate found unstable keeps its peaks where its loop is stable only (and its
-    error over those, ``inf`` if none); the ones after the chosen one are marked
-    ``not_checked``. Fills the dicts in place."""
-    def key(c):
-        e = c["sensitivity_peak_error"]
-        return e if e == e else float("inf")
-
-    best = None
-    for c in sorted(cands, key=key):
-        if best is not None:
-            c["not_checked"] = (
-                f"σ̄(S_o) peak error {key(c):.4g} is not below the chosen {best['method']}'s "
-                f"{key(best):.4g}: it cannot be chosen, so its sampled loops' poles were not "
-                "computed (stable and max_abs_z unknown; its peaks are those of loops not "
-                "checked for stability)")
-            continue
-        z = c["max_abs_z"] = [_max_abs_z(G, K) for G, K in zip(sampled, Kd[c["method"]][1])]
-        c["stable"] = all(zj < 1 for zj, ok in zip(z, cont_stable) if ok)
-        if c["stable"]:
-            best = c
-            continue
-        peaks = c["sensitivity_peak"] = [p if p is not None and zj < 1 else None
-                                         for p, zj in zip(c["sensitivity_peak"], z)]
-        cont = c["sensitivity_peak_continuous"]
-        c["sensitivity_peak_error"] = max(
-            (abs(pd - pc) / pc for pd, pc in zip(peaks, cont) if pd is not None),
-            default=float("inf") if any(pc is not None for pc in cont) else 0.0)
-    return best
 
 
 def digital_controller(K, sample_rate_hz: float, plants, *,

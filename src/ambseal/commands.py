@@ -149,8 +149,10 @@ def _conditions(cfg, points) -> list[tuple[float, float]]:
 def choice_margins(cfg, points, digital) -> list[dict]:
     """The discrete margins the choice of discretisation judged (:mod:`ambseal.control.
     digital`): per condition the largest ``|z|`` and the σ̄(S_o) peaks of the chosen
-    method, with the loop's delay, on the sampled full-order plant."""
-    c = next(c for c in digital.candidates if c["method"] == digital.method)
+    candidate (``choice``: with ``+fast`` when its fast poles were kept, the controller
+    exported), with the loop's delay, on the sampled full-order plant."""
+    chosen = getattr(digital, "choice", "") or digital.method
+    c = next(c for c in digital.candidates if c["method"] == chosen)
     if "speeds_hz" in c:  # scheduled: the judged speeds and between table entries
         speeds = c["speeds_hz"]
         pressures = [cfg.operating.pressure_bar] * len(speeds)

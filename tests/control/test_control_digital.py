@@ -80,6 +80,35 @@ def test_issue10_report_plain_tustin_of_the_old_hinf_is_unstable_ambseals_choice
         assert _max_abs_z(G, (chosen.A, chosen.B, chosen.C, chosen.D), T, 1) < 1.0, p
 
 
+def test_choice_closes_candidates_by_rank_until_one_is_stable():
+    """Reference: a one-state sampled plant ``z⁺ = 0.5 z + u``, ``y = z``, under static
+    gains ``u = −k y``: the loop's pole is ``0.5 − k`` by hand. The candidate with the
+    smallest error (k = 2, |z| = 1.5) is refused with its peak removed where unstable and
+    its error over the stable plants only (none: inf); of the two tied at 0.2 the first in
+    the list (k = 0.3, |z| 0.2 at both plants) is chosen; the rest, ranked after it, are
+    not closed (``stable``/``max_abs_z`` None, a reason). On the old rule (every candidate
+    closed) the last two carry numbers and no reason."""
+    from ambseal.control._digital_choice import first_stable
+
+    G = (np.array([[0.5]]), np.array([[1.0]]), np.array([[1.0]]), np.zeros((1, 1)))
+    gain = lambda k: (np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.array([[k]]))
+    ks = {"a": 2.0, "b": 0.3, "c": 0.4, "d": 0.1}
+    errs = {"a": 0.1, "b": 0.2, "c": 0.3, "d": 0.2}
+    cands = [{"method": m, "max_abs_z": [None, None], "sensitivity_peak": [1.1, 1.2],
+              "sensitivity_peak_continuous": [1.0, 1.0], "sensitivity_peak_error": errs[m],
+              "stable": None} for m in ks]
+    Kd = {m: (None, [gain(k)] * 2) for m, k in ks.items()}
+    best = first_stable(cands, Kd, [G, G], [True, True])
+    a, b, c, d = cands
+    assert best is b and b["stable"] and b["max_abs_z"] == pytest.approx([0.2, 0.2], abs=1e-15)
+    assert a["stable"] is False and a["max_abs_z"] == pytest.approx([1.5, 1.5], abs=1e-15)
+    assert a["sensitivity_peak"] == [None, None] and a["sensitivity_peak_error"] == np.inf
+    for x in (c, d):
+        assert x["stable"] is None and x["max_abs_z"] == [None, None]
+        assert "cannot be chosen" in x["not_checked"]
+    assert "not_checked" not in a and "not_checked" not in b
+
+
 def test_residualisation_keeps_the_static_gain_and_the_slow_poles():
     """Reference: singular perturbation (Skogestad & Postlethwaite Eq. 11.26) keeps
     K(0) exactly and the slow poles of a block-diagonal system exactly; a random stable

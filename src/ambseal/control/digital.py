@@ -54,7 +54,9 @@ from ..errors import ConfigError, SynthesisError
 from ..identify.loop import DiscreteController
 from ..lti.discrete import zoh
 from ..lti.freqresp import freqresp, freqresp_at
-from ..lti.interconnect import feedback_matrices, feedback_poles, series_inputs
+from ..lti.interconnect import feedback_poles, series_inputs
+from ._digital_choice import first_stable as _first_stable
+from ._digital_choice import so_peak as _so_peak
 
 __all__ = ["FAST_FRACTION", "METHODS", "PEAK_TOLERANCE", "peak_difference",
            "DigitalController", "split_fast", "residualize", "hold_keeps", "HOLDS", "KEPT",
@@ -106,7 +108,9 @@ class DigitalController:
         Each candidate method: per condition ``max_abs_z`` and the σ̄(S_o) peaks
         ``sensitivity_peak`` (discrete, delay included) and ``sensitivity_peak_continuous``
         (``None`` where the loop is unstable), and ``sensitivity_peak_error`` (the largest
-        relative distance between them).
+        relative distance between them). A candidate whose error ranks after the chosen
+        one's was not closed with the sampled plants: ``stable`` and ``max_abs_z`` are
+        ``None`` and ``not_checked`` says why (:func:`choose_method`).
     choice : str
         The candidate kept (``method``, or ``method + KEPT`` when the fast poles were kept).
     """
@@ -408,18 +412,6 @@ def prewarp_frequency_hz(G_list, K: Matrices, fs: float) -> float | None:
     return f_best
 
 
-def _so_peak(Gw: np.ndarray, Kw: np.ndarray) -> float:
-    """Grid peak of σ̄((I + G K)⁻¹) from stacks of responses (n_w, ny, nu), (n_w, nu, ny)."""
-    ny = Gw.shape[1]
-    eye = np.broadcast_to(np.eye(ny), Gw.shape[:1] + (ny, ny))
-    S = np.linalg.solve(np.eye(ny) + Gw @ Kw, eye)
-    return float(np.max(np.linalg.svd(S, compute_uv=False)[:, 0]))
-
-
-def _max_abs_z(Gd: Matrices, Kd: Matrices) -> float:
-    return float(np.abs(np.linalg.eigvals(feedback_matrices(Gd, Kd)[0])).max())
-
-
 def _remove_fast(K, mats: Matrices, fs: float, rise: Callable | None):
     """Fast poles removed (module docstring, step 1): (matrices, StateSpace, poles, rise).
     Nothing is removed without ``rise`` (no design to report the cost on)."""
@@ -488,9 +480,17 @@ def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int,
 
     ``cont[j]`` is the continuous controller at plant j, ``discrete(method)`` the discrete
     controllers at every plant. Returns (best method, its discrete controllers, candidates).
+
+    The kept candidate is the one with the smallest σ̄(S_o) peak error (first in
+    ``methods`` on a tie) among those stable wherever the design is. Each candidate's error
+    comes from its frequency responses alone; the sampled loops' poles (one eigenvalue
+    problem of the full-order loop per plant, most of the cost) are then computed in the
+    order of the errors, only until the first stable candidate
+    (:func:`ambseal.control._digital_choice.first_stable`): a candidate that ranks after it
+    cannot be chosen, and is reported with ``stable`` and ``max_abs_z`` ``None`` and the
+    reason (``not_checked``).
     """
     fs, T, w = sp.fs, 1.0 / sp.fs, sp.omega_rad_s
-    Gd_list = sp.sampled
 
     def stable(plants):
         return [np.max(feedback_poles(G, Kc).real) < 0 for G, Kc in zip(plants, cont)]
@@ -501,24 +501,21 @@ def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int,
     judged = [j for j, ok in enumerate(stable(sp.plants)) if ok and cont_stable[j]]
     peak_c = {j: _so_peak(sp.continuous_response[j], freqresp_at(cont[j], 1j * w))
               for j in judged}
-    Gw_d = sp.sampled_response
-    cands, best = [], None
+    n = len(sp.sampled)
+    cands, Kd = [], {}
     for m in methods:
         if m == "tustin_prewarp" and f_pw is None:
             continue
         Kds = discrete(m)
-        Kdel = [with_delay(Kd, delay) for Kd in Kds]
-        zmax = [_max_abs_z(G, Kx) for G, Kx in zip(Gd_list, Kdel)]
-        peak_d = [_so_peak(Gw_d[j], freqresp_at(Kdel[j], np.exp(1j * w * T)))
-                  if j in peak_c and zmax[j] < 1 else None for j in range(len(zmax))]
-        err = max((abs(peak_d[j] - peak_c[j]) / peak_c[j] for j in judged
-                   if peak_d[j] is not None), default=float("inf") if judged else 0.0)
-        ok = all(z < 1 for z, c in zip(zmax, cont_stable) if c)
-        cands.append({"method": m, "max_abs_z": zmax, "sensitivity_peak": peak_d,
-                      "sensitivity_peak_continuous": [peak_c.get(j) for j in range(len(zmax))],
-                      "sensitivity_peak_error": err, "stable": ok})
-        if ok and (best is None or err < best[1]):
-            best = (m, err, Kds)
+        Kdel = [with_delay(K, delay) for K in Kds]
+        peak_d = [_so_peak(sp.sampled_response[j], freqresp_at(Kdel[j], np.exp(1j * w * T)))
+                  if j in peak_c else None for j in range(n)]
+        err = max((abs(peak_d[j] - peak_c[j]) / peak_c[j] for j in judged), default=0.0)
+        Kd[m] = Kds, Kdel
+        cands.append({"method": m, "max_abs_z": [None] * n, "sensitivity_peak": peak_d,
+                      "sensitivity_peak_continuous": [peak_c.get(j) for j in range(n)],
+                      "sensitivity_peak_error": err, "stable": None})
+    best = _first_stable(cands, Kd, sp.sampled, cont_stable)
     if best is None:
         poles = max((np.abs(np.linalg.eigvals(K[0])).max() / (2 * np.pi) if K[0].size else 0.0)
                     for K in cont)
@@ -527,7 +524,7 @@ def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int,
             f"discretisation of {name} ({', '.join(methods)}) keeps the sampled loop "
             f"stable where the continuous loop is (highest controller pole {poles:.4g} Hz; "
             "a sample rate below twice it cannot run it): raise the sample rate or redesign")
-    return best[0], best[2], tuple(cands)
+    return best["method"], Kd[best["method"]][0], tuple(cands)
 
 
 def digital_controller(K, sample_rate_hz: float, plants, *,

@@ -143,6 +143,31 @@ def test_riccati_gamma_test_agrees_with_sb10ad():
             assert (sb.riccati_margin(f * g) < 0) == sb.admissible(f * g) == (f > 1)
 
 
+def test_compiled_small_plant_margin_matches_the_schur_form(monkeypatch):
+    """Reference: the Riccati margin from ordered Schur forms (LAPACK DGEES), side by side
+    with the compiled eigenvector form small plants use, on the SGC97 plant at γ from half
+    to 8× the published γ_opt ≈ 9.5081 (both refuse below it, the same number above). On a
+    plant with identical channels (repeated eigenvalues) the eigenvectors are no basis: the
+    compiled form returns NaN and γ_opt comes from SB10AD's bisection, equal to the
+    Schur-form search's within the tolerance."""
+    from ambseal.control.hinf import _Sb10
+
+    sb = _Sb10(sgc97_plant(), 1, 1)
+    compiled = {f: sb._small_margin(f * 9.5081) for f in (0.5, 0.99, 1.01, 2.0, 8.0)}
+    monkeypatch.setattr("ambseal.control.hinf._SMALL_STATES", -1)
+    for f, m in compiled.items():
+        schur = sb.riccati_margin(f * 9.5081)
+        assert (m >= 0) == (schur >= 0) == (f < 1)
+        assert m == pytest.approx(schur, rel=1e-9)
+    G, w1, w2 = _mixsyn_cases()[1]
+    P = mixed_sensitivity(ct.ss(G), w1, w2)
+    g_schur = _Sb10(P, 2, 2).gamma_opt(1e-6)[0]
+    monkeypatch.setattr("ambseal.control.hinf._SMALL_STATES", 6)
+    sb = _Sb10(P, 2, 2)
+    assert np.isnan(sb._small_margin(1.2 * g_schur))
+    assert sb.gamma_opt(1e-6)[0] == pytest.approx(g_schur, rel=2e-6)
+
+
 def _mixsyn_cases():
     s = ct.tf("s")
     G1 = ct.tf([200], [10, 1]) * ct.tf([1], [0.05, 1]) ** 2
@@ -268,7 +293,7 @@ def test_gamma_search_confirms_at_band_top_when_sb10ad_refuses_the_root(monkeypa
 
     G, w1, w2 = _mixsyn_cases()[1]
     P = mixed_sensitivity(ct.ss(G), w1, w2)
-    monkeypatch.setattr("ambseal.control.hinf._RICCATI_MIN_STATES", 0)  # margin search
+    monkeypatch.setattr("ambseal.control.hinf._SMALL_STATES", -1)  # Schur-form margins
     ref, ref_lo, _ = _Sb10(P, 2, 2).gamma_opt(1e-6)
     sb = _Sb10(P, 2, 2)
     plain = sb.admissible

@@ -2,7 +2,9 @@
 
 :func:`game_riccati` solves one H∞ game Riccati equation (Glover & Doyle 1988, general D11
 form) from its Hamiltonian; :func:`search_gamma` brackets γ_opt from a cheap lower bound
-and closes in by Brent's method on a γ margin; :func:`sb10ad` calls SLICOT SB10AD.
+and closes in by Brent's method on a γ margin; :func:`sb10ad` calls SLICOT SB10AD;
+:func:`gamma_search` finds the γ whose controller is built (the back-off from γ_opt,
+:func:`backoff_ladder`).
 """
 
 from __future__ import annotations
@@ -11,7 +13,7 @@ import numpy as np
 
 from ambseal.errors import SynthesisError
 
-__all__ = ["game_riccati", "sb10ad", "search_gamma"]
+__all__ = ["backoff_ladder", "game_riccati", "gamma_search", "sb10ad", "search_gamma"]
 
 
 def game_riccati(A, B, C1, D1, nw: int, g: float):
@@ -143,3 +145,53 @@ def sb10ad(A, B, C, D, ncon, nmeas, gamma, job, gtol=1e-6):
     out = _wrapper.sb10ad(job, n, m, p, ncon, nmeas, gamma, A, B, C, D, gtol, 0.0,
                           liwork, ldwork)
     return out[:-1], int(out[-1])
+
+
+def backoff_ladder(backoff: float, max_backoff: float) -> list[float]:
+    """Back-off factors tried in turn: ``backoff``, then doubling its excess up to the cap."""
+    factors, f = [backoff], backoff
+    while f < max_backoff:
+        f = 1.0 + (f - 1.0) * 2.0 if f > 1.0 else 1.01
+        factors.append(min(f, max_backoff))
+    return factors
+
+
+def gamma_search(attempt, base_g: float, factors, backoff: float, *, fixed: bool):
+    """The γ search of :func:`ambseal.control.hinf.hinfsyn`, apart from the controller
+    construction.
+
+    ``attempt(g)`` builds the controller at γ = g (an ``hinf._Attempt``, or None when
+    SB10AD fails or the loop is unstable). Tries ``factors·base_g`` in turn and returns the
+    first consistent attempt (verified norm ≤ the γ it was built for; with ``fixed`` any
+    attempt). If none is: SB10AD's γ_opt can be wrong when D11 ≠ 0 — the controller built
+    at γ then has a closed-loop norm above γ — so search for the smallest γ whose
+    controller achieves ‖F_l(P, K)‖∞ ≤ γ, by doubling and then bisection on the verified
+    norm. Returns None if nothing was found.
+    """
+    for f in factors:
+        res = attempt(f * base_g)
+        if res is not None and (res.consistent or fixed):
+            return res
+    if fixed:
+        return None
+    lo, hi, res_hi = base_g * factors[-1], None, None
+    g = lo
+    for _ in range(60):
+        g *= 2.0
+        res = attempt(g)
+        if res is not None and res.consistent:
+            hi, res_hi = g, res
+            break
+        lo = g
+    if res_hi is None:
+        return None
+    for _ in range(40):
+        if hi / lo <= 1.0 + 0.5 * (backoff - 1.0) + 1e-6:
+            break
+        mid = np.sqrt(lo * hi)
+        res = attempt(mid)
+        if res is not None and res.consistent:
+            hi, res_hi = mid, res
+        else:
+            lo = mid
+    return res_hi

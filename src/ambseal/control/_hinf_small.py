@@ -36,16 +36,19 @@ def _game_riccati(A, B, C1, D1, nw, g):
     eigenvectors are an ill-conditioned basis, ``_MAX_BASIS_COND``)."""
     n = A.shape[0]
     X = np.zeros((n, n))
-    R = D1.T @ D1
+    # every product of C-ordered operands (numba compiles one per layout pair, each ~0.5 s)
+    # and inv rather than solve (compiled in a tenth of the time)
+    D1t, C1t, Bt = D1.T.copy(), C1.T.copy(), B.T.copy()
+    R = D1t @ D1
     for i in range(nw):
         R[i, i] -= g * g
-    S = np.linalg.solve(R, np.hstack((D1.T @ C1, B.T)))
-    RiDC, RiBt = np.ascontiguousarray(S[:, :n]), np.ascontiguousarray(S[:, n:])
+    Ri = np.linalg.inv(R)
+    RiDC, RiBt = Ri @ (D1t @ C1), Ri @ Bt
     Ah = A - B @ RiDC
     H = np.empty((2 * n, 2 * n))
     H[:n, :n] = Ah
-    H[:n, n:] = -B @ RiBt
-    H[n:, :n] = C1.T @ (D1 @ RiDC - C1)
+    H[:n, n:] = -(B @ RiBt)
+    H[n:, :n] = C1t @ (D1 @ RiDC - C1)
     H[n:, n:] = -Ah.T
     if not np.all(np.isfinite(H)):
         return X, 1
@@ -69,8 +72,8 @@ def _game_riccati(A, B, C1, D1, nw, g):
     sv = np.linalg.svd(U1)[1]
     if sv[-1] < 1e-12 * sv[0]:
         return X, 1
-    Xc = np.linalg.solve(U1.T.copy(), U2.T.copy()).T  # X = U2 U1⁻¹
-    X = 0.5 * (Xc.real + Xc.real.T)
+    Xr = (U2 @ np.linalg.inv(U1)).real
+    X = 0.5 * (Xr + Xr.T)
     if np.linalg.eigvalsh(X)[0] < -1e-9 * max(1.0, np.max(np.abs(X))):
         return X, 1
     return X, 0

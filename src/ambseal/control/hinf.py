@@ -505,14 +505,13 @@ class _Sb10:
 
         The γ test is the Riccati margin (:meth:`riccati_margin`, a number, so the search
         takes secant steps where SB10AD's job 1 halves from γ = 0: 15 margins of 0.06 ms
-        against 23 halvings of 0.1 ms on SGC97's 3 states; a small plant whose compiled
-        margin cannot decide at the first γ, e.g. one with identical channels, goes to
-        :meth:`_ladder_job1` at once, as the Schur form costs more than SB10AD's test
-        there), checked by SB10AD at the ladder's
-        first γ where the margin refuses it and confirmed by SB10AD at the end, at the top
-        of the tolerance band ``lo·(1 + rtol)`` if SB10AD (testing the stability of its
-        closed loop) refuses Brent's last step within rounding of the root (rig D–K plant:
-        margin −3e-11). Otherwise, or where SB10AD disagrees, :meth:`_ladder_job1`.
+        against 23 halvings of 0.1 ms on SGC97's 3 states), checked by SB10AD at the
+        ladder's first γ where the margin refuses it and confirmed by SB10AD at the end, at
+        the top of the tolerance band ``lo·(1 + rtol)`` if SB10AD (testing the stability of
+        its closed loop) refuses Brent's last step within rounding of the root (rig D–K
+        plant: margin −3e-11). Otherwise, where SB10AD disagrees, or on a small plant whose
+        compiled margin cannot decide at the first γ (e.g. identical channels: the Schur
+        form there costs more than SB10AD's test), :meth:`_ladder_job1`.
 
         Returns ``(hi, lo, tests)``: the smallest admissible γ found, the largest
         inadmissible one (a lower bound of γ_opt; the Parrott bound if none was tried) and

@@ -73,9 +73,9 @@ def _published_optimum(P, blocks, w) -> float:
     """Peak μ on ``w`` of our H∞ design on ``D P D⁻¹`` with S&P's d(s) (eq. 8.144)."""
     import control as ct
 
-    from ambseal.control.dk import _scaled_plant
-    from ambseal.control.hinf import hinfsyn, lft_lower
-    from ambseal.control.mu import mussv
+    from ambseal.robust.dk import _scaled_plant
+    from ambseal.robust.hinf import hinfsyn, lft_lower
+    from ambseal.robust.mu import mussv
 
     d = ct.tf(2e-3 * np.poly([-1000.0, -0.25, -0.054]), np.real(np.poly([-0.013, -0.67 + 0.56j,
                                                                          -0.67 - 0.56j])))
@@ -86,9 +86,9 @@ def _published_optimum(P, blocks, w) -> float:
 def main() -> None:
     import control as ct
 
-    from ambseal.control.dk import musyn
-    from ambseal.control.hinf import lft_lower
-    from ambseal.control.mu import mussv
+    from ambseal.robust.dk import musyn
+    from ambseal.robust.hinf import lft_lower
+    from ambseal.robust.mu import mussv
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--max-iter", type=int, default=8)

@@ -35,11 +35,11 @@ def main() -> None:
     opts = ap.parse_args()
 
     from ambseal.config import load_rig, load_truth
-    from ambseal.control.pid import reference_controller
+    from ambseal.design.pid import reference_controller
     from ambseal.identify import rig_sim
     from ambseal.identify.facility_loop import facility_loop
     from ambseal.identify.signals import prbs
-    from ambseal.pipeline import default_truth_path
+    from ambseal.app.pipeline import default_truth_path
 
     cfg = load_rig()
     truth = load_truth(default_truth_path()).model_copy(update={"adc_bits": 0})

@@ -41,12 +41,12 @@ def main() -> None:
     from scipy.optimize import least_squares
 
     from ambseal.config import TruthSection, load_rig, rig_with_values
-    from ambseal.control.pid import pid_controller
+    from ambseal.design.pid import pid_controller
     from ambseal.identify.fit import fit_parameters
-    from ambseal.identify.loop import closed_loop_matrices, discrete_controller
+    from ambseal.robust.digital_loop import closed_loop_matrices, discrete_controller
     from ambseal.lti.discrete import zoh
     from ambseal.identify.signals import prbs
-    from ambseal.control.pid import reference_controller
+    from ambseal.design.pid import reference_controller
     from ambseal.identify.stages import acquire, build_models, identify
     from ambseal.model.rig import build_plant
 

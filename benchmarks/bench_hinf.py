@@ -11,7 +11,7 @@ Cases:
 * ``testrig_nominal`` — the nominal H∞ problem of the embedded test rig
   (``design(cfg, "hinf")``'s generalised plant, 24 states).
 
-Ours: ``ambseal.control.hinf.hinfsyn`` — γ_opt between cheap bounds (Parrott's bound, a
+Ours: ``ambseal.robust.hinf.hinfsyn`` — γ_opt between cheap bounds (Parrott's bound, a
 ladder of factors 4; SB10AD's test and its own bisection called through slycot's compiled
 wrapper below 7 states, Brent's method on the Riccati margin above), then the controller at
 1.01·γ_opt with its closed loop checked stable and its norm recomputed. Baseline:
@@ -43,7 +43,7 @@ def sgc97():
 
 def testrig():
     from ambseal.config import load_rig
-    from ambseal.control.recipes import design
+    from ambseal.design.recipes import design
 
     gp = design(load_rig(), "hinf").plant
     return gp.P_nominal, gp.nmeas, gp.ncon
@@ -61,7 +61,7 @@ def _median_time(fn, repeats):
 def main() -> None:
     import control as ct
 
-    from ambseal.control.hinf import hinfsyn
+    from ambseal.robust.hinf import hinfsyn
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5)

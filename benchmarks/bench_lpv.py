@@ -1,7 +1,7 @@
 """Time the gridded LPV synthesis on the turboexpander (issue 5; thesis P3 §4).
 
 One JSON line per case on stdout: ``{"case", "ours_s", "gamma", "iterations", "status",
-"check_gamma_max"}`` — the CPU time of :func:`ambseal.control.lpv_design.design_lpv` over
+"check_gamma_max"}`` — the CPU time of :func:`ambseal.design.lpv_design.design_lpv` over
 20–300 Hz, with the γ stage's interior-point iterations: the default constant-Lyapunov
 design on the vertex grid (the range's ends and the seal-table points, 7 speeds; issue 9)
 against the 10-point equally spaced grid it replaced (baseline, same run, ``ratio`` =
@@ -25,7 +25,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 def main() -> None:
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
     from ambseal.config import load_rig
-    from ambseal.control.lpv_design import design_lpv
+    from ambseal.design.lpv_design import design_lpv
 
     cfg = load_rig(Path(__file__).resolve().parents[1] / "examples" / "turboexpander.toml")
     base = None

@@ -104,8 +104,8 @@ def lmi_upper(M, blocks, rtol=1e-3):
 def testrig_cases(args) -> None:
     """The test-rig μ problem: closed loop of the generalised plant with the μ controller."""
     from ambseal.config import load_rig
-    from ambseal.control.recipes import design
-    from ambseal.control.mu import mussv
+    from ambseal.design.recipes import design
+    from ambseal.robust.mu import mussv
     from ambseal.lti.freqresp import freqresp
 
     cfg = load_rig()
@@ -179,7 +179,7 @@ def main() -> None:
     if args.only_testrig:
         return
 
-    from ambseal.control.mu import mussv
+    from ambseal.robust.mu import mussv
     from ambseal.lti.freqresp import freqresp
 
     sys = rig_sized_system()

@@ -32,7 +32,7 @@ def main() -> None:
 
     from ambseal.analysis.sweep import stability_boundary, sweep
     from ambseal.config import load_rig
-    from ambseal.control.recipes import design
+    from ambseal.design.recipes import design
 
     cfg = load_rig()
     K = {"pid": design(cfg, "pid").K}

@@ -28,7 +28,7 @@ def main() -> None:
     import numpy as np
 
     from ambseal.config import TruthSection, load_rig
-    from ambseal.control.pid import reference_controller
+    from ambseal.design.pid import reference_controller
     from ambseal.identify.stages import acquire
     from ambseal.identify.tracking import TrackingSettings, track, tracking_excitation
 

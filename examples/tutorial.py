@@ -8,10 +8,10 @@ from pathlib import Path
 import control
 
 from ambseal.analysis.judge import judge, operating_points
-from ambseal.commands import digital_for
+from ambseal.app.commands import digital_for
 from ambseal.config import load_rig
-from ambseal.control.export import export_controller
-from ambseal.control.recipes import design
+from ambseal.export.controller_files import export_controller
+from ambseal.design.recipes import design
 from ambseal.model.rig import build_plant
 from ambseal.report.figures import sensitivity_figure
 

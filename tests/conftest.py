@@ -4,14 +4,14 @@ Each design below is made by the public function with the arguments ``ambseal ru
 so that the tests of the designs, of the analyses built on them and of the main job see the
 same controllers:
 
-* ``testrig_designs`` — PID, H∞ and μ of :func:`ambseal.control.recipes.design` on the
+* ``testrig_designs`` — PID, H∞ and μ of :func:`ambseal.design.recipes.design` on the
   embedded test facility (thesis P5 §4), a few seconds;
 * ``testrig_plants`` — the full-order test-facility plants over 0 … 4.08 bar (P5 Fig. 13);
 * ``turbo_lpv`` — the constant-Lyapunov LPV design of the turboexpander over its
   ``[operating] speed_range_hz`` with the frozen γ's (P3 §4), about half a minute;
 * ``turbo_frozen`` — the H∞ controller at the operating speed (140 Hz, P3 Fig. 11);
 * ``testrig_digital``, ``turbo_digital`` — the digital controllers of those designs as
-  ``ambseal run`` chooses them (:func:`ambseal.commands.digital_for`).
+  ``ambseal run`` chooses them (:func:`ambseal.app.commands.digital_for`).
 
 ``design_cache_for`` lets a test run the main job (``ambseal run``) on these designs instead
 of recomputing them: it replaces the design functions for the duration of the test by
@@ -51,7 +51,7 @@ def turbo_cfg():
 @pytest.fixture(scope="session")
 def testrig_designs(testrig_cfg):
     """{"pid", "hinf", "mu"} → DesignResult, as ``ambseal run`` makes them."""
-    from ambseal.control.recipes import design
+    from ambseal.design.recipes import design
 
     return {m: design(testrig_cfg, m) for m in ("pid", "hinf", "mu")}
 
@@ -75,7 +75,7 @@ def testrig_plants(testrig_cfg):
 @pytest.fixture(scope="session")
 def turbo_lpv(turbo_cfg):
     """Constant-Lyapunov LPV design over the rig's speed range, frozen γ's included."""
-    from ambseal.control.lpv_design import design_lpv
+    from ambseal.design.lpv_design import design_lpv
 
     return design_lpv(turbo_cfg, speeds_hz=turbo_cfg.operating.speed_range_hz)
 
@@ -83,14 +83,14 @@ def turbo_lpv(turbo_cfg):
 @pytest.fixture(scope="session")
 def turbo_frozen(turbo_cfg):
     """H∞ at the operating speed (8400 rpm = 140 Hz), the LTI comparison of P3 Fig. 11."""
-    from ambseal.control.lpv_design import design_frozen
+    from ambseal.design.lpv_design import design_frozen
 
     return design_frozen(turbo_cfg, turbo_cfg.operating.speed_rpm / 60.0)
 
 
 def _digital(cfg, designs: dict) -> dict:
     from ambseal.analysis.judge import operating_points
-    from ambseal.commands import digital_for
+    from ambseal.app.commands import digital_for
 
     pts, cache = operating_points(cfg), {}
     return {m: digital_for(cfg, m, getattr(d, "K", d) if m != "lpv" else d, d, pts, cache)
@@ -128,9 +128,9 @@ class DesignCache:
     @contextlib.contextmanager
     def patched(self, rig: str):
         """Replace the design functions for the duration of the ``with`` block."""
-        import ambseal.commands as cmod
-        import ambseal.control.recipes as dmod
-        import ambseal.control.lpv_design as lmod
+        import ambseal.app.commands as cmod
+        import ambseal.design.recipes as dmod
+        import ambseal.design.lpv_design as lmod
 
         got = {n: self._request.getfixturevalue(n) for n in self.FIXTURES[rig]}
         real_design, real_lpv, real_frozen = dmod.design, lmod.design_lpv, lmod.design_frozen
@@ -198,9 +198,9 @@ def design_cache_for():
 @pytest.fixture(scope="session")
 def testrig_tracked(testrig_cfg, tmp_path_factory):
     """The controller scheduled on the seal's k over 0–3× nominal (issue 14 §2), as
-    :func:`ambseal.control.seal_schedule.design_seal_scheduled` makes it by default
+    :func:`ambseal.design.seal_schedule.design_seal_scheduled` makes it by default
     (minutes of LMI synthesis: only the slow tests use it; ``$AMBSEAL_CACHE_DIR`` keeps
     it between sessions)."""
-    from ambseal.control.seal_schedule import design_seal_scheduled
+    from ambseal.design.seal_schedule import design_seal_scheduled
 
     return design_seal_scheduled(testrig_cfg)

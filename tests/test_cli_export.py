@@ -48,7 +48,7 @@ def test_sample_rate_below_twice_the_controller_pole_is_refused(tmp_path, capsys
 def test_controller_file_with_wrong_shapes_is_refused(tmp_path, capsys, testrig_digital):
     """Reference: the export format — B must be (states × inputs); a file whose B lost a
     column is refused naming B and the shape expected."""
-    from ambseal.control.export import export_controller
+    from ambseal.export.controller_files import export_controller
 
     path = export_controller(testrig_digital["pid"], tmp_path / "K.json")
     doc = json.loads(path.read_text())
@@ -61,7 +61,7 @@ def test_controller_file_with_wrong_shapes_is_refused(tmp_path, capsys, testrig_
 def test_export_c_from_a_controller_file(tmp_path, capsys, testrig_digital):
     """Reference: the C module declares the controller's dimensions (4 sensor inputs,
     4 current outputs, its states) and sample time, as written in the file."""
-    from ambseal.control.export import export_controller
+    from ambseal.export.controller_files import export_controller
 
     path = export_controller(testrig_digital["mu"], tmp_path / "K_mu.npz")
     assert main(["export", "x.toml", "--controller", str(path), "--c", str(tmp_path / "c")]) == 0

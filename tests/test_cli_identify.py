@@ -8,7 +8,7 @@ import pytest
 from ambseal.cli import main
 from ambseal.config import default_rig_path, load_rig
 from ambseal.model.amb import amb_factors
-from ambseal.pipeline import default_truth_path
+from ambseal.app.pipeline import default_truth_path
 
 RIG = str(default_rig_path())
 TRUTH = str(default_truth_path())

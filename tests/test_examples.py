@@ -7,7 +7,7 @@ The full runs are ``slow`` (15–50 s of CPU each). The default suite keeps the 
 parts: the test rig and the turboexpander run end to end in tests/test_pipeline.py (with
 the session's designs), and the part that broke the blower and the pump (their PID
 derived from the rig could not run on the target; a controller that cannot run stopped
-the run) is tests/control/test_control_pid_rule.py.
+the run) is tests/design/test_design_pid_rule.py.
 """
 
 from __future__ import annotations

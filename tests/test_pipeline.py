@@ -272,8 +272,8 @@ def test_run_with_the_tracked_controller(tmp_path, request, design_cache_for):
     10 % of the nominal k after 1 s, its 95 % interval covering the truth ≥ 90 % of the
     time; the tracked scheme keeps the rotor to 3×) and the frozen continuous loops of the
     reference PID (unstable from 1.5× nominal: lost on the ramp before 3×)."""
-    from ambseal.control.export import load_controller
-    from ambseal.pipeline import run
+    from ambseal.export.controller_files import load_controller
+    from ambseal.app.pipeline import run
 
     out = tmp_path / "run"
     with design_cache_for(request).patched("testrig"):
@@ -368,7 +368,8 @@ def test_run_on_the_turboexpander_judges_lpv(turbo_run):
     assert set(m["spinup"]) == {"mu", "lpv"}
     for name in ("spinup.png", "frozen_sensitivity.png", "report.html"):
         assert (tmp_path / name).exists()
-    from ambseal.control import ScheduledDigital, load_controller
+    from ambseal.export import load_controller
+    from ambseal.robust import ScheduledDigital
 
     for ext in (".json", ".npz", ".mat"):
         K = load_controller(tmp_path / "controllers" / f"controller_lpv{ext}")
@@ -393,7 +394,7 @@ def test_exported_hinf_closes_the_loop_by_name_in_python_control(metrics):
     from ambseal.config import load_rig, load_truth
     from ambseal.identify.design_model import truth_rig
     from ambseal.model.rig import build_plant
-    from ambseal.pipeline import default_truth_path
+    from ambseal.app.pipeline import default_truth_path
 
     out, m = metrics
     doc = json.loads((out / "controllers" / "controller_hinf.json").read_text())

@@ -139,7 +139,7 @@ def test_full_disk_refused_before_work(tmp_path, capsys, monkeypatch):
 def test_unwritable_output_refused_before_work(tmp_path, capsys, monkeypatch, command):
     """An output below a regular file cannot be created (ENOTDIR, as a read-only or missing
     mount would): one line naming it, exit 2, before any work."""
-    from ambseal.pipeline import default_truth_path
+    from ambseal.app.pipeline import default_truth_path
 
     (tmp_path / "file").write_text("x")
     out = tmp_path / "file" / "out"
@@ -151,7 +151,7 @@ def test_unwritable_output_refused_before_work(tmp_path, capsys, monkeypatch, co
             "acquire": ["acquire", str(default_truth_path().with_name("testrig.toml")),
                         "--truth", str(default_truth_path()), "--excitation", "prbs",
                         "--pressure-bar", "0", "--out", str(out / "r.csv")]}[command]
-    import ambseal.control.recipes as recipes
+    import ambseal.design.recipes as recipes
 
     def no_work(*a, **k):
         raise AssertionError("designing before the output was checked")

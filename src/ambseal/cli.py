@@ -51,7 +51,7 @@ import shlex
 import sys
 from pathlib import Path
 
-from .errors import AmbsealError
+from ambseal.errors import AmbsealError
 
 __all__ = ["main"]
 
@@ -125,7 +125,7 @@ class _Help(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpF
 
 
 def _parser() -> argparse.ArgumentParser:
-    from . import __version__
+    from ambseal import __version__
 
     p = _Parser(
         prog="ambseal",
@@ -232,7 +232,7 @@ def _parser() -> argparse.ArgumentParser:
     tr.add_argument("--rate-per-s", type=float, default=None,
                     help="expected drift per second as a fraction of each parameter's scale "
                          "(default 0.1)")
-    from .rotordynamics import add_parsers
+    from ambseal.app.rotordynamics import add_parsers
 
     add_parsers(sub, _positive_int)  # modes, campbell, sweep, import-ross
     _checked_numbers(p)
@@ -255,7 +255,7 @@ def _checked_numbers(parser: argparse.ArgumentParser) -> None:
 
 def _check_operating(args: argparse.Namespace) -> None:
     """The operating values given on the command line, by the rig file's rules."""
-    from .config import check_operating
+    from ambseal.config import check_operating
 
     values = {k: getattr(args, k, None) for k in ("pressure_bar", "speed_rpm")}
     check_operating({k: v for k, v in values.items() if isinstance(v, float)},
@@ -273,14 +273,14 @@ def _design_options(p: argparse.ArgumentParser) -> None:
 
 
 def _acquire(args: argparse.Namespace) -> int:
-    from .config import load_rig, load_truth
-    from .errors import ConfigError
-    from .files import writable_folder
-    from .identify import signals
-    from .identify.data import save_measurement
-    from .commands import target_pid
-    from .identify.stages import acquire
-    from .model.amb import channel_names
+    from ambseal.config import load_rig, load_truth
+    from ambseal.errors import ConfigError
+    from ambseal.files import writable_folder
+    from ambseal.identify import signals
+    from ambseal.identify.data import save_measurement
+    from ambseal.app.commands import target_pid
+    from ambseal.identify.stages import acquire
+    from ambseal.model.amb import channel_names
 
     cfg = load_rig(args.rig)
     truth = load_truth(args.truth)
@@ -296,7 +296,7 @@ def _acquire(args: argparse.Namespace) -> int:
                               f"{','.join(axes[:2])}; got {args.axes!r}")
     fs = cfg.controller.sample_rate_hz
     if args.excitation == "static":
-        from .identify.static_load import save_static_record, virtual_static_load
+        from ambseal.identify.static_load import save_static_record, virtual_static_load
 
         z, F, cur = virtual_static_load(cfg, truth, seed=args.seed)
         path = save_static_record(args.out, cfg, z, F, cur)
@@ -332,8 +332,8 @@ def _acquire(args: argparse.Namespace) -> int:
 
 
 def _design(args: argparse.Namespace) -> int:
-    from .commands import design_files, show_defaults
-    from .config import default_rig_path
+    from ambseal.app.commands import design_files, show_defaults
+    from ambseal.config import default_rig_path
 
     rig = args.rig if args.rig is not None else default_rig_path()
 
@@ -341,7 +341,7 @@ def _design(args: argparse.Namespace) -> int:
         print(show_defaults(rig, args.overrides), end="")
         return 0
     if args.method is None:
-        from .errors import ConfigError
+        from ambseal.errors import ConfigError
 
         raise ConfigError("design: --method is required (pid, hinf, mu or lpv) unless "
                           "--show-defaults")
@@ -352,14 +352,14 @@ def _design(args: argparse.Namespace) -> int:
 
 
 def _export(args: argparse.Namespace) -> int:
-    from .commands import design_files
-    from .errors import ConfigError
+    from ambseal.app.commands import design_files
+    from ambseal.errors import ConfigError
 
     if (args.method is None) == (args.controller is None):
         raise ConfigError("export: give exactly one of --method and --controller")
     if args.controller is not None:
-        from .control.codegen import write_c
-        from .control.export import load_controller
+        from ambseal.export.codegen import write_c
+        from ambseal.export.controller_files import load_controller
 
         ctrl = load_controller(args.controller)
         files = write_c(ctrl, args.c_dir or Path(args.out) / "c",
@@ -374,7 +374,7 @@ def _export(args: argparse.Namespace) -> int:
 
 
 def _identify(args: argparse.Namespace) -> int:
-    from .commands import identify_files
+    from ambseal.app.commands import identify_files
 
     summary = identify_files(args.rig, args.data, args.params.split(","), args.out,
                              current_weight=args.current_weight, refine=not args.no_refine,
@@ -385,7 +385,7 @@ def _identify(args: argparse.Namespace) -> int:
 
 
 def _track(args: argparse.Namespace) -> int:
-    from .commands import track_files
+    from ambseal.app.commands import track_files
 
     summary = track_files(args.rig, args.data, args.params.split(","), args.out,
                           rate_per_s=args.rate_per_s)
@@ -394,7 +394,7 @@ def _track(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from .pipeline import run
+    from ambseal.app.pipeline import run
 
     result = run(args.rig, args.out, truth=args.truth, identification=not args.no_identify,
                  overrides=tuple(args.overrides), allow_unstable=args.allow_unstable,
@@ -404,9 +404,9 @@ def _run(args: argparse.Namespace) -> int:
     if sys.stderr.isatty() and not args.quiet:
         from rich.console import Console
 
-        from .config import load_rig
-        from .report.run_report import rig_clearances_um
-        from .report.verdict import verdict_table_rich, verdicts
+        from ambseal.config import load_rig
+        from ambseal.report.run_report import rig_clearances_um
+        from ambseal.report.verdict import verdict_table_rich, verdicts
 
         console = Console(stderr=True)
         clear = rig_clearances_um(load_rig(args.rig))
@@ -428,7 +428,7 @@ def _plain(x) -> str:
 
 
 def _validate(args: argparse.Namespace) -> int:
-    from .commands import validate_summary
+    from ambseal.app.commands import validate_summary
 
     v = validate_summary(args.rig)
     if args.json:
@@ -475,7 +475,7 @@ def _named(exc: AmbsealError, files: list, source: str) -> AmbsealError:
 
 def _inputs(args: argparse.Namespace) -> tuple[list, str]:
     """The files a command reads and writes, and the one an unnamed error comes from."""
-    from .config import default_rig_path
+    from ambseal.config import default_rig_path
 
     rig = getattr(args, "rig", None) or default_rig_path()
     files = [rig, getattr(args, "truth", None), getattr(args, "out", None),
@@ -493,7 +493,7 @@ def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     args.command_line = shlex.join(["ambseal", *(sys.argv[1:] if argv is None else argv)])
     _logging(args)
-    from .rotordynamics import HANDLERS
+    from ambseal.app.rotordynamics import HANDLERS
 
     handler = {"acquire": _acquire, "identify": _identify, "design": _design,
                "track": _track, "export": _export, "run": _run, "validate": _validate, **HANDLERS}[args.command]

@@ -13,7 +13,7 @@ import tempfile
 from pathlib import Path
 from typing import Any, BinaryIO, Callable
 
-from .errors import AmbsealError
+from ambseal.errors import AmbsealError
 
 __all__ = ["atomic_write", "writable_folder", "read_text", "load_toml", "write_text", "write_json", "RunFolder", "check_manifest",
            "write_manifest"]

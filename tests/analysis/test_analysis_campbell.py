@@ -98,7 +98,7 @@ def test_closed_loop_with_controller_states_matches_python_control(testrig_cfg):
     every kept pole is a pole of python-control's ``feedback(G, K)`` (peer library) to 1e-8."""
     import control
 
-    from ambseal.control.recipes import design
+    from ambseal.design.recipes import design
     from ambseal.model.rig import build_plant
 
     Kpid = design(testrig_cfg, "pid").K
@@ -124,7 +124,7 @@ def test_cli_campbell_modes_and_bad_range(tmp_path, rigid, capsys):
     --controller FILE`` states speed, pressure, log decrement and whirl and writes the
     figure; a bad ``--speed-hz`` is one line on stderr and exit 2."""
     from ambseal.cli import main
-    from ambseal.control.export import export_controller
+    from ambseal.export.controller_files import export_controller
 
     cfg, Kp = rigid
     rig = tmp_path / "rigid.toml"

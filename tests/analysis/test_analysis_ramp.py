@@ -60,7 +60,7 @@ def test_ramp_losses_agree_with_the_frozen_full_order_loops(testrig_cfg, testrig
     from ambseal.analysis.ramp import ramp_simulation
     from ambseal.config import load_truth
     from ambseal.identify.procedure import thesis_procedure
-    from ambseal.pipeline import default_truth_path
+    from ambseal.app.pipeline import default_truth_path
 
     cfg = testrig_cfg
     p0, rpm = cfg.operating.pressure_bar, cfg.operating.speed_rpm

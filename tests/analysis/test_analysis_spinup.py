@@ -26,7 +26,7 @@ def runs(turbo_cfg, turbo_lpv, turbo_frozen):
     """Spin-ups and frozen sensitivities of the session's LPV design and of the H∞
     controller at the operating speed, 140 Hz (tests/conftest.py)."""
     from ambseal.analysis.spinup import frozen_sensitivity, spinup
-    from ambseal.control.lpv_plant import lpv_plant
+    from ambseal.design.lpv_plant import lpv_plant
 
     cfg, d, fz = turbo_cfg, turbo_lpv, turbo_frozen
     assert fz.speed_hz == 140.0
@@ -168,7 +168,7 @@ def test_figures(runs, tmp_path):
 def test_spinup_bad_input(runs):
     """A plant without force inputs and an inconsistent time step are refused."""
     from ambseal.analysis.spinup import spinup
-    from ambseal.control.lpv_plant import lpv_plant
+    from ambseal.design.lpv_plant import lpv_plant
 
     L, d, _, _, _ = runs
     with pytest.raises(ModelError, match="multiple of dt"):

@@ -8,8 +8,8 @@ import pickle
 import numpy as np
 import pytest
 
-from ambseal.analysis.sweep import (CaseError, parse_range, run_cases, stability_boundary,
-                                    sweep, sweep_case)
+from ambseal.analysis.cases import CaseError, run_cases
+from ambseal.analysis.sweep import parse_range, stability_boundary, sweep, sweep_case
 
 
 def test_pid_loses_the_embedded_rig_between_nominal_and_twice_nominal(testrig_cfg,
@@ -144,7 +144,7 @@ def test_cli_sweep_writes_table_boundary_and_map_and_keeps_failed_cases(tmp_path
 
     from ambseal.cli import main
     from ambseal.config import dump_rig, parse_rig
-    from ambseal.control.export import export_controller
+    from ambseal.export.controller_files import export_controller
 
     rig = tmp_path / "rig.toml"
     rig.write_text(dump_rig(parse_rig(_tiny_rig())))

@@ -128,7 +128,7 @@ def test_identified_intervals_become_mu_ranges(testrig_cfg, tmp_path):
     as model mismatch and a missing interval are refused, naming file and key."""
     import json
 
-    from ambseal.control.plant import generalized_plant
+    from ambseal.design.plant import generalized_plant
     from ambseal.errors import DataError
     from ambseal.identify.intervals import uncertainty_from_fit
 

@@ -5,7 +5,7 @@ import pytest
 
 from ambseal.config import TruthSection, load_rig
 from ambseal.identify.signals import prbs
-from ambseal.control.pid import reference_controller
+from ambseal.design.pid import reference_controller
 from ambseal.identify.stages import acquire, identify
 
 TRUE = {"A.Ki_zeta": 205.0, "A.Ki_eta": 201.0, "B.Ki_zeta": 254.0, "B.Ki_eta": 271.0,

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from ambseal.config import TruthSection, load_rig
-from ambseal.control.pid import pid_controller, pid_from_rig
+from ambseal.design.pid import pid_controller, pid_from_rig
 from ambseal.errors import ModelError
-from ambseal.identify.loop import discrete_controller
+from ambseal.robust.digital_loop import discrete_controller
 from ambseal.identify.rig_sim import prepare_facility, simulate_facility
 from ambseal.identify.stages import build_models
 from ambseal.model.amb import channel_names

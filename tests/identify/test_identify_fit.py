@@ -7,7 +7,7 @@ from ambseal.config import Affine, TruthSection, load_rig
 from ambseal.errors import IdentificationError
 from ambseal.identify.fit import fit_parameters, nrmse_fit
 from ambseal.identify.signals import prbs
-from ambseal.control.pid import reference_controller
+from ambseal.design.pid import reference_controller
 from ambseal.identify.stages import acquire, build_models, identify
 
 TRUE = {"A.Ki_zeta": 205.0, "A.Ki_eta": 201.0, "B.Ki_zeta": 254.0, "B.Ki_eta": 271.0,

@@ -8,7 +8,7 @@ import pytest
 from scipy.stats import t as student
 
 from ambseal.config import TruthSection
-from ambseal.control.pid import reference_controller
+from ambseal.design.pid import reference_controller
 from ambseal.identify.signals import prbs
 from ambseal.identify.stages import acquire, identify
 

@@ -38,12 +38,12 @@ def forty_hz(testrig_cfg):
     balance takes the seal as the impulse tests identify it (the procedure's order; here the
     truth file's values, which the impulse regression finds to within 1 %)."""
     from ambseal.config import load_truth
-    from ambseal.control.pid import reference_controller
+    from ambseal.design.pid import reference_controller
     from ambseal.identify.seal_test import seal_frequency_test
     from ambseal.identify.signals import stepped_sine
     from ambseal.identify.stages import acquire, identify
     from ambseal.model.amb import channel_names
-    from ambseal.pipeline import default_truth_path
+    from ambseal.app.pipeline import default_truth_path
 
     cfg, truth = testrig_cfg, load_truth(default_truth_path())
     K = reference_controller(cfg)

@@ -21,7 +21,7 @@ from ambseal.identify.static_load import (join_static, load_static_record, progr
                                           save_static_record, static_ki, virtual_static_load,
                                           StaticLoadResult)
 from ambseal.model.amb import amb_factors
-from ambseal.pipeline import default_truth_path
+from ambseal.app.pipeline import default_truth_path
 
 
 @pytest.fixture(scope="module")

@@ -8,14 +8,14 @@ import scipy.linalg as sla
 
 from ambseal.cli import main
 from ambseal.config import TruthSection
-from ambseal.control.pid import reference_controller
+from ambseal.design.pid import reference_controller
 from ambseal.errors import IdentificationError
 from ambseal.identify.data import save_measurement
 from ambseal.identify.fit import ClosedLoopModel
 from ambseal.identify.stages import acquire
 from ambseal.identify.tracking import (_param_matrices, flops_per_sample, track,
                                        tracking_excitation)
-from ambseal.identify.loop import DiscreteController
+from ambseal.robust.digital_loop import DiscreteController
 from ambseal.model.lft import Parameter, Plant
 from ambseal.model.seal import coefficient_value
 
@@ -172,7 +172,7 @@ def test_facility_run_in_blocks_equals_one_run(testrig_cfg):
     tracked scheme switches its controller between blocks) gives the same records."""
     from ambseal.config import load_truth
     from ambseal.identify.rig_sim import prepare_facility
-    from ambseal.pipeline import default_truth_path
+    from ambseal.app.pipeline import default_truth_path
 
     cfg = testrig_cfg
     truth = load_truth(default_truth_path())

@@ -184,7 +184,7 @@ def test_auto_falls_back_to_dense_solves_where_both_fast_forms_fail():
     dense solves by 4.6e-5), and the ill-conditioned low end moves with the LAPACK build."""
     from pathlib import Path
 
-    from ambseal.control.mu import mussv
+    from ambseal.robust.mu import mussv
     from ambseal.lti.interconnect import lft_lower
 
     d = np.load(Path(__file__).parents[1] / "data" / "dkpy_distillation_K.npz")

@@ -10,7 +10,8 @@ from ambseal.errors import ConfigError, ModelError
 from ambseal.model.amb import MU0, AmbElement, amb_factors, channel_names
 from ambseal.model.rig import build_system
 from ambseal.model.rotor import build_mesh
-from ambseal.model.seal import SealElement, coefficient_value, interp_table
+from ambseal.lti.tables import interp_table
+from ambseal.model.seal import SealElement, coefficient_value
 from ambseal.model.spring import SpringElement
 
 TABLE = {"frequency_hz": [20.0, 50.0, 100.0], "value": [6.0e6, 7.5e6, 10.0e6]}

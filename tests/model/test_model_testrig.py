@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from ambseal.config import load_rig
-from ambseal.control.pid import pid_controller
+from ambseal.design.pid import pid_controller
 from ambseal.model.modes import modes
 from ambseal.model.rig import build_plant, build_system
 from ambseal.model.rotor import assemble_rotor

@@ -9,9 +9,9 @@ closed-loop poles (:func:`ambseal.analysis.loops.resolved_grid`).
 
 **The controller's delay is part of the loop.** A digital controller acts through its
 zero-order hold and ``[controller] delay_samples`` of computation: about
-τ = (delay_samples + ½)/sample_rate_hz of pure delay (:mod:`ambseal.control.delay`). The
+τ = (delay_samples + ½)/sample_rate_hz of pure delay (:mod:`ambseal.robust.delay`). The
 continuous loop is judged with that delay as a Padé lag in every current input of the plant
-(:func:`ambseal.control.delay.loop_delay`: the lowest order within 5° of phase up to
+(:func:`ambseal.robust.delay.loop_delay`: the lowest order within 5° of phase up to
 Nyquist; test rig 150 µs, order 4), so that its numbers are those of the controller as it
 will act; the case records it as ``delay`` (``delay_s``, ``pade_order``,
 ``phase_error_deg``, ``band_top_hz``). On the test rig the PID's continuous σ̄(S_o) peaks
@@ -20,7 +20,7 @@ at 0 bar; without the delay they were 9.36 and 4.94). The closed-loop modes of
 :mod:`ambseal.analysis.campbell` stay those of the continuous controller.
 
 **What runs is judged too**: given the discrete controller of the target (with its
-computation delay, :class:`ambseal.control.digital.DigitalController`), the same numbers are
+computation delay, :class:`ambseal.robust.digital.DigitalController`), the same numbers are
 taken on the loop of that controller with the full-order plant sampled exactly (zero-order
 hold, the DAC) at its sample time — stability by ``|z| < 1``, σ̄(S_o) on a grid up to
 Nyquist, compliance and unbalance for a force held over each sample, the impulse response
@@ -29,7 +29,7 @@ keys plus ``max_abs_pole_z`` and ``sample_rate_hz``.
 
 The operating points (:func:`operating_points`) and the grids and disturbances
 (:func:`judge_settings`) are those of the rig's design specification
-(:func:`ambseal.control.specs.design_spec`): by default 0, nominal and 2× nominal pressure
+(:func:`ambseal.design.specs.design_spec`): by default 0, nominal and 2× nominal pressure
 drop for pressure-driven seals, or the ends and the middle of the speed range for rigs whose
 seals change with speed over a stated range (P3 §4); the band, the unbalance and the
 impulse are derived from the machine by the rules written there.
@@ -103,12 +103,12 @@ GRID_POINTS = 1200
 def judge_settings(cfg, spec=None) -> JudgeSettings:
     """The judgement's grids and disturbances from the rig's design specification.
 
-    The band, unbalance and impulse of :func:`ambseal.control.specs.design_spec`; the
+    The band, unbalance and impulse of :func:`ambseal.design.specs.design_spec`; the
     impulse starts after 5 impulse lengths and the window ends 30 lengths later, sampled at
     twice the controller's rate (test rig: 0.05 A for 10 ms at 0.05 s in 0.35 s, every
     50 µs, P5 §5.1).
     """
-    from ..control.specs import design_spec
+    from ambseal.design.specs import design_spec
 
     sp = spec or design_spec(cfg)
     t = sp.impulse_s
@@ -141,10 +141,10 @@ def speed_scheduled(cfg) -> bool:
 
 def operating_points(cfg, spec=None) -> list[OperatingPoint]:
     """Where every controller is judged: the design specification's pressures × speeds
-    (:func:`ambseal.control.specs.design_spec`; by default 0, nominal and 2× nominal
+    (:func:`ambseal.design.specs.design_spec`; by default 0, nominal and 2× nominal
     pressure drop, P5 §4, or the ends and the middle of the speed range of a rig whose
     seals change with speed, P3 §4, at the nominal pressure)."""
-    from ..control.specs import design_spec
+    from ambseal.design.specs import design_spec
 
     sp = spec or design_spec(cfg)
     ps, fs = sp.pressures_bar, sp.speeds_hz
@@ -172,7 +172,7 @@ def unstable_open_loop_poles(A: np.ndarray) -> np.ndarray:
     ------
     ModelError
         The model's conditioning makes the stability doubtful."""
-    from ..model.modes import classify_poles
+    from ambseal.model.modes import classify_poles
 
     lam = np.linalg.eigvals(A)
     lam = lam[classify_poles(lam, where="open-loop plant")[1]]
@@ -204,7 +204,7 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
     discrete : control.StateSpace, optional
         The controller that runs on the target, discrete (``dt`` its sample time) with its
         computation delay included
-        (:meth:`ambseal.control.digital.DigitalController.statespace` ``(delayed=True)``):
+        (:meth:`ambseal.robust.digital.DigitalController.statespace` ``(delayed=True)``):
         judged the same way on the plant sampled at ``dt`` (module docstring).
 
     Returns
@@ -219,8 +219,8 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
         ``poles`` (the closed-loop poles, rad/s); the discrete loop's under
         ``curves["discrete"]`` (its ``poles`` are z).
     """
-    from ..control.delay import loop_delay
-    from ..model.rig import build_plant
+    from ambseal.robust.delay import loop_delay
+    from ambseal.model.rig import build_plant
 
     s = settings or judge_settings(cfg)
     plant = build_plant(cfg, pressure_bar=point.pressure_bar, speed_rpm=point.speed_rpm,
@@ -247,7 +247,7 @@ def delayed_plant(P, cur, delay):
     input ``cur`` (:func:`ambseal.lti.interconnect.series_inputs`), signal names kept."""
     import control
 
-    from ..lti.interconnect import series_inputs
+    from ambseal.lti.interconnect import series_inputs
 
     def mats(S):
         return tuple(np.asarray(getattr(S, m), float) for m in ("A", "B", "C", "D"))
@@ -262,7 +262,7 @@ def sampled_plant(P, dt: float):
     Franklin, Powell & Workman §6.3), signal names kept."""
     import control
 
-    from ..lti.discrete import zoh
+    from ambseal.lti.discrete import zoh
 
     Ad, Bd = zoh(np.asarray(P.A, float), np.asarray(P.B, float), dt)
     return control.ss(Ad, Bd, np.asarray(P.C, float), np.asarray(P.D, float), dt,
@@ -282,12 +282,12 @@ def _judge_loop(cfg, P, cur, force, controller, s: JudgeSettings, impulse: bool
                 ) -> tuple[dict, dict]:
     """The case's numbers for one loop, continuous or discrete (``P.dt``): the plant ``P``
     with current inputs ``cur`` and force inputs ``force``."""
-    from ..lti.freqresp import freqresp_at
-    from .iso import iso_assessment
-    from .loops import (closed_loop, compliance_from, loop_responses_from, resolved_grid,
+    from ambseal.lti.freqresp import freqresp_at
+    from ambseal.analysis.iso import iso_assessment
+    from ambseal.analysis.loops import (closed_loop, compliance_from, loop_responses_from, resolved_grid,
                         response_points, sigma_max)
-    from .response import impulse_response_of
-    from .unbalance import unbalance_from_compliance
+    from ambseal.analysis.response import impulse_response_of
+    from ambseal.analysis.unbalance import unbalance_from_compliance
 
     G, Gf = _inputs(P, cur), _inputs(P, force)
     loop = closed_loop(G, controller, Gf)
@@ -351,7 +351,7 @@ def condition_values(point, design_cfg) -> tuple[float, dict]:
     """(Ω in rad/s, every seal coefficient of the design rig by LFT name, SI) at ``point``
     (with ``speed_rpm`` and ``pressure_bar``: an OperatingPoint, or the rig's
     ``[operating]``): the values a scheduled controller is frozen at there."""
-    from ..model.seal import seal_values
+    from ambseal.model.seal import seal_values
 
     return (2 * math.pi * point.speed_rpm / 60.0,
             seal_values(design_cfg.seal, point.pressure_bar))
@@ -360,8 +360,8 @@ def condition_values(point, design_cfg) -> tuple[float, dict]:
 def frozen_at(K, point, design_cfg):
     """The fixed controller that runs at ``point``: ``K``, a speed-scheduled one at the
     speed, or one scheduled on a seal coefficient at the design rig's value at the pressure
-    drop (:func:`ambseal.control.controller.frozen`, :func:`condition_values`)."""
-    from ..control.controller import frozen
+    drop (:func:`ambseal.robust.controller.frozen`, :func:`condition_values`)."""
+    from ambseal.robust.controller import frozen
 
     return frozen(K, *condition_values(point, design_cfg))
 
@@ -379,8 +379,8 @@ def frozen_discrete(digital, point, design_cfg):
     """The discrete controller (delay included) that runs at ``point`` (a table at θ there,
     :func:`condition_values`), for the judgement; ``None`` for a controller that cannot run
     (``digital`` None)."""
-    from ..control.controller import SPEED
-    from ..control.scheduled_digital import ScheduledDigital
+    from ambseal.robust.controller import SPEED
+    from ambseal.robust.scheduled_digital import ScheduledDigital
 
     if digital is None:
         return None
@@ -394,7 +394,7 @@ def frozen_discrete(digital, point, design_cfg):
 def judge_case(case: dict, cfg, settings: JudgeSettings | None = None) -> tuple[dict, dict]:
     """:func:`judge` of ``case = {"controller", "name", "point"}`` (and ``"discrete"``, the
     delayed discrete controller that runs): the main job's cases as run by
-    :func:`ambseal.analysis.sweep.run_cases`."""
+    :func:`ambseal.analysis.cases.run_cases`."""
     return judge(cfg, case["controller"], case["name"], case["point"], settings,
                  discrete=case.get("discrete"))
 
@@ -404,7 +404,7 @@ def judge_spinup(cfg, controllers: dict) -> tuple[dict, list, list]:
 
     A spin-up over ``[operating] speed_range_hz`` in 1 s with alternating 100 N force and
     2 µm output steps on the first actuator axis, on the LPV model (grid speeds: the
-    vertex grid, :func:`ambseal.control.lpv_plant.vertex_grid_hz`, between which it is
+    vertex grid, :func:`ambseal.design.lpv_plant.vertex_grid_hz`, between which it is
     exact; the rigid-body modes and the first bending pair; the force at the first AMB),
     and σ̄(S_o) on the full-order plant at 8 frozen speeds across the range
     (turboexpander: 7 grid speeds over 20–300 Hz, 12 states).
@@ -423,9 +423,9 @@ def judge_spinup(cfg, controllers: dict) -> tuple[dict, list, list]:
         :class:`~ambseal.analysis.spinup.SpinupResult` and
         :class:`~ambseal.analysis.spinup.FrozenSensitivity` of each controller in order.
     """
-    from ..control.lpv_plant import lpv_plant, vertex_grid_hz
-    from ..control.specs import RIGID_STATES
-    from .spinup import frozen_sensitivity, spinup
+    from ambseal.design.lpv_plant import lpv_plant, vertex_grid_hz
+    from ambseal.design.specs import RIGID_STATES
+    from ambseal.analysis.spinup import frozen_sensitivity, spinup
 
     lo, hi = cfg.operating.speed_range_hz
     # A(Ω) is affine between the vertex grid's speeds: the plant is exact along the ramp

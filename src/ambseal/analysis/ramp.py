@@ -11,7 +11,7 @@ amplitude and length on the first actuator axis) every ``impulse_every_s`` — a
 noise sequence go into every run, so the runs differ only by their controller.
 
 The tracked scheme runs in blocks of ``block_s``: at the start of each block the
-controller that runs is the digital table (:class:`~ambseal.control.scheduled_digital.
+controller that runs is the digital table (:class:`~ambseal.robust.scheduled_digital.
 ScheduledDigital`, ``tracked_digital``: the exported, judged discretisation) interpolated
 at the scheduling value, or without a table the scheduled controller frozen there and
 discretised by zero-order hold (Tustin made every frozen discrete loop of the test rig's
@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ModelError
+from ambseal.errors import ModelError
 
 __all__ = ["RampRun", "RampResult", "pressure_ramp", "ramp_simulation", "frozen_cases"]
 
@@ -126,7 +126,7 @@ def _excitation(cfg, N: int, fs: float, every_s: float, amplitude_a: float, n_le
                 seed: int):
     """(excitation (N, k), impulse start samples): the tracker's PRBS and the impulse train
     on axis 0 added to it."""
-    from ..identify.tracking import tracking_excitation
+    from ambseal.identify.tracking import tracking_excitation
 
     e = tracking_excitation(cfg, (N + 1) / fs, seed=seed).values_a[:N].copy()
     step = int(round(every_s * fs))
@@ -193,7 +193,7 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
         seal's coefficient curves; thesis stages (a)–(c)); default ``cfg`` (module
         docstring).
     tracked_digital : ScheduledDigital, optional
-        The tracked controller's digital table (:func:`ambseal.commands.digital_for`);
+        The tracked controller's digital table (:func:`ambseal.app.commands.digital_for`);
         default: the frozen controller discretised by ZOH at every switch.
     delay_samples : int
         Computation delay of every controller (samples; module docstring).
@@ -209,8 +209,8 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
     ModelError
         A rig without a seal, or without the parameter named by ``tracked.parameter``.
     """
-    from ..control.specs import design_spec
-    from ..identify.rig_sim import _pressure_values, prepare_facility, reduced_plant, true_rig
+    from ambseal.design.specs import design_spec
+    from ambseal.identify.rig_sim import _pressure_values, prepare_facility, reduced_plant, true_rig
 
     fs = cfg.controller.sample_rate_hz
     N = int(round(duration_s * fs))
@@ -267,7 +267,7 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
 def _noise_std(cfg, truth, controllers, tracked, e, fs, run_as):
     """Sensor noise std per axis: the truth's floor plus ``noise_fraction`` × the RMS of a
     noise-free first second at 0 bar with the tracked controller (else the first one)."""
-    from ..identify.rig_sim import prepare_facility
+    from ambseal.identify.rig_sim import prepare_facility
 
     k = e.shape[1]
     std = np.full(k, truth.sensor_noise_m)
@@ -285,8 +285,8 @@ def _runner(tracked, table, T: float, delay: int):
     """``run_as(K)``: the DiscreteController that runs, with ``delay`` samples of delay, for
     a fixed DiscreteController ``K`` or for the tracked controller at θ = ``K`` (a number:
     the table at θ, or without a table the design frozen at θ and discretised by ZOH)."""
-    from ..control.digital import discretize_as, with_delay
-    from ..identify.loop import DiscreteController
+    from ambseal.robust.digital import discretize_as, with_delay
+    from ambseal.robust.digital_loop import DiscreteController
 
     def run_as(K):
         if not isinstance(K, DiscreteController):
@@ -328,10 +328,10 @@ def _run_tracked(cfg, fac, tracked, run_as, e, noise, inoise, fs, starts, n_len,
                  block_s, k_true, k_nom, transient_s, settings):
     """The tracked scheme over the ramp (module docstring); its run and the estimator's
     accuracy."""
-    from ..identify.fit import ClosedLoopModel
-    from ..identify.rig_sim import reduced_plant
-    from ..identify.tracking import OnlineTracker, TrackingSettings
-    from ..model.amb import actuator_matrices
+    from ambseal.identify.fit import ClosedLoopModel
+    from ambseal.identify.rig_sim import reduced_plant
+    from ambseal.identify.tracking import OnlineTracker, TrackingSettings
+    from ambseal.model.amb import actuator_matrices
 
     N, k = e.shape
     T = 1.0 / fs
@@ -393,8 +393,8 @@ def frozen_cases(cfg, design, *, settings=None, impulse: bool = False) -> list[d
     -------
     list of dict
     """
-    from ..model.rig import build_plant
-    from .judge import OperatingPoint, judge, judge_settings
+    from ambseal.model.rig import build_plant
+    from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
 
     s = settings or judge_settings(cfg)
     p0, rpm = cfg.operating.pressure_bar, cfg.operating.speed_rpm

@@ -4,7 +4,7 @@ Figs. 11–12).
 * :func:`spinup` — time-varying simulation (an ODE solver): the speed ramps 20 → 300 Hz in 1 s while a
   100 N force step and a 2 µm output (sensor) step on A_x (the first actuator axis)
   alternate every 50 ms (P3 Fig. 11); the plant is taken at the instantaneous speed
-  (:meth:`ambseal.control.lpv_plant.LpvPlant.A_at`) and the controller is either scheduled
+  (:meth:`ambseal.design.lpv_plant.LpvPlant.A_at`) and the controller is either scheduled
   on the (measured) speed or fixed.
 * :func:`frozen_sensitivity` — σ̄(S_o) on the full-order plant at frozen speeds across the
   range (P3 Fig. 12), with closed-loop stability.
@@ -14,7 +14,7 @@ x = [x_plant; x_K], v = [forces; sensor offsets] (piecewise constant),
 
     ẋ = A_cl(Ω(t)) x + B_cl(Ω(t)) v,   A_cl = [[A(Ω) − B_i D_K C, −B_i C_K], [B_K C, A_K]],
 
-A(Ω) from :meth:`ambseal.control.lpv_plant.LpvPlant.A_at` (B, C, D constant), (A_K, B_K,
+A(Ω) from :meth:`ambseal.design.lpv_plant.LpvPlant.A_at` (B, C, D constant), (A_K, B_K,
 C_K, D_K)(Ω) from the scheduled controller (``matrices_at``: the LPV table interpolated
 linearly between its speeds) or constant for a fixed controller, i = −C_K x_K − D_K y.
 
@@ -68,11 +68,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..control.controller import frozen, matrices_at
-from ..errors import ModelError
-from ..lti.discrete import zoh
-from ..lti.interconnect import feedback_matrices
-from .response import settling_time
+from ambseal.robust.controller import frozen, matrices_at
+from ambseal.errors import ModelError
+from ambseal.lti.discrete import zoh
+from ambseal.lti.interconnect import feedback_matrices
+from ambseal.analysis.response import settling_time
 
 __all__ = ["StepResponse", "SpinupResult", "spinup", "FrozenSensitivity",
            "frozen_sensitivity"]
@@ -186,7 +186,7 @@ def spinup(plant, controller, *, name: str = "K", speeds_hz=(20.0, 300.0),
         (``lpv_plant(cfg, grid, force_positions=(amb_A_position,))``), D = 0 for the
         currents; its grid must cover ``speeds_hz``.
     controller : control.StateSpace or ScheduledController
-        Fixed or scheduled controller (:mod:`ambseal.control.controller`: m → A, negative
+        Fixed or scheduled controller (:mod:`ambseal.robust.controller`: m → A, negative
         feedback ``i = −K y``).
     name : str
         Label.
@@ -462,7 +462,7 @@ def frozen_sensitivity(cfg, controller, speeds_hz, *, name: str = "K", omega=Non
     ----------
     cfg : RigConfig
     controller : control.StateSpace or ScheduledController
-        Physical controller (:mod:`ambseal.control.controller`), m → A, negative feedback.
+        Physical controller (:mod:`ambseal.robust.controller`), m → A, negative feedback.
     speeds_hz : array_like
     omega : array_like, optional
         Frequencies (rad/s); default 400 points log-spaced 1 Hz … 3 kHz.
@@ -479,8 +479,8 @@ def frozen_sensitivity(cfg, controller, speeds_hz, *, name: str = "K", omega=Non
     -------
     FrozenSensitivity
     """
-    from ..model.rig import build_plant
-    from .loops import closed_loop, loop_responses, resolved_grid
+    from ambseal.model.rig import build_plant
+    from ambseal.analysis.loops import closed_loop, loop_responses, resolved_grid
 
     w = (_TWO_PI * np.logspace(0.0, np.log10(3000.0), 400) if omega is None
          else np.asarray(omega, float))

@@ -1,15 +1,7 @@
 """Stability and performance maps over pressure × speed × parameters, serial or on Dask.
 
-Two layers:
+The cases run on :func:`ambseal.analysis.cases.run_cases` (serial or Dask).
 
-* :func:`run_cases` — the one executor of every multi-case analysis (this module's sweeps,
-  the Campbell diagram's speeds, ``ambseal run``'s judged operating points): a pure function
-  ``fn(case, **shared)`` over a list of cases, run serially or on ``dask.distributed``
-  (a local cluster of processes with one BLAS thread each, or a running scheduler by
-  address). ``shared`` is sent to each worker once (``Client.scatter``, broadcast) and the
-  function is pickled by reference, so a worker imports ambseal once, not per case. Results
-  come back in input order; a case that raises is recorded as a :class:`CaseError` with its
-  message and the others go on. A progress bar (rich, on stderr) counts cases as they finish.
 * :func:`sweep` — the map: per (controller, pressure, speed, parameter values) case the
   judgement of :func:`ambseal.analysis.judge.judge` without the impulse response (closed-loop
   max real pole, σ̄(S_o) peak, ISO 14839-3 zone overall and per axis, unbalance peak) and the
@@ -25,156 +17,14 @@ each controller as its ``(A, B, C, D)`` arrays.
 from __future__ import annotations
 
 import itertools
-import os
-import sys
-from dataclasses import dataclass
-from typing import Callable, Sequence
 
 import numpy as np
 
-from ..errors import AmbsealError, ConfigError
+from ambseal.analysis.cases import CaseError, run_cases
+from ambseal.errors import ConfigError
 
-__all__ = ["CaseError", "run_cases", "dask_available", "SERIAL_BELOW", "sweep",
-           "sweep_case", "stability_boundary", "refine_boundary", "boundary_case",
+__all__ = ["sweep", "sweep_case", "stability_boundary", "refine_boundary", "boundary_case",
            "parse_range"]
-
-#: Sweeps with fewer cases than this run serially when no workers or scheduler are given:
-#: a local cluster costs a few seconds to start, about 20 cases of the embedded rig.
-SERIAL_BELOW = 64
-
-
-@dataclass(frozen=True)
-class CaseError:
-    """A case that failed: the case and the error's one-line message."""
-
-    case: dict
-    error: str
-
-
-def dask_available() -> bool:
-    """Whether ``dask.distributed`` can be imported (the ``[dask]`` extra)."""
-    try:
-        import distributed  # noqa: F401
-    except ImportError:
-        return False
-    return True
-
-
-def _call(case: dict, fn: Callable, shared: dict):
-    try:
-        return fn(case, **shared)
-    except Exception as exc:  # a failed case is recorded, not lost
-        return CaseError(dict(case), f"{type(exc).__name__}: {exc}")
-
-
-def run_cases(fn: Callable, cases: Sequence[dict], *, shared: dict | None = None,
-              workers: int | None = None, scheduler: str | None = None,
-              progress: bool = False, description: str = "cases",
-              raise_errors: bool = False, on_done: Callable | None = None) -> list:
-    """Run ``fn(case, **shared)`` for every case, serially or on Dask, in input order.
-
-    Parameters
-    ----------
-    fn : callable
-        A module-level (picklable) pure function.
-    cases : sequence of dict
-    shared : dict, optional
-        Keyword arguments common to every case (sent once per worker).
-    workers : int, optional
-        Local Dask worker processes (one thread, one BLAS thread each); ``1`` runs serially.
-        Default: serial below :data:`SERIAL_BELOW` cases or without dask, else one worker
-        per core.
-    scheduler : str, optional
-        Address of a running Dask scheduler (``tcp://host:8786``); wins over ``workers``.
-    progress : bool
-        A progress bar over the cases on stderr.
-    description : str
-        The bar's label.
-    raise_errors : bool
-        Re-raise the first failed case's error (as :class:`AmbsealError`) instead of
-        recording it.
-    on_done : callable, optional
-        Called with ``(index, result)`` as each case finishes (serial: in order).
-
-    Returns
-    -------
-    list
-        One result per case, in input order; a :class:`CaseError` for a case that raised.
-
-    Raises
-    ------
-    ConfigError
-        ``scheduler`` or ``workers > 1`` without dask installed, or a scheduler that cannot
-        be reached.
-    """
-    from rich.console import Console
-    from rich.progress import Progress
-
-    shared = dict(shared or {})
-    cases = list(cases)
-    distributed = scheduler is not None or (workers is not None and workers > 1) or (
-        workers is None and len(cases) >= SERIAL_BELOW and dask_available()
-        and (os.cpu_count() or 1) > 1)
-    if distributed and not dask_available():
-        raise ConfigError("dask.distributed is not installed (pip install 'ambseal[dask]'); "
-                          "leave out --scheduler/--workers to run serially")
-    with Progress(console=Console(stderr=True), disable=not progress, transient=True) as bar:
-        task = bar.add_task(description, total=len(cases))
-
-        def done(i: int, r) -> None:
-            if raise_errors and isinstance(r, CaseError):
-                raise AmbsealError(f"{description}: case {r.case}: {r.error}")
-            bar.advance(task)
-            if on_done is not None:
-                on_done(i, r)
-
-        if not distributed:
-            out = []
-            for i, case in enumerate(cases):
-                out.append(_call(case, fn, shared))
-                done(i, out[-1])
-            return out
-        return _run_dask(fn, cases, shared, workers, scheduler, done)
-
-
-def _run_dask(fn, cases, shared, workers, scheduler, done) -> list:
-    """The Dask path of :func:`run_cases`: futures, as completed, gathered in input order."""
-    from distributed import Client, LocalCluster, as_completed
-
-    cluster = None
-    try:
-        if scheduler is not None:
-            client = Client(scheduler, timeout="10s")
-        else:
-            import dask
-
-            n = workers or (os.cpu_count() or 1)
-            # Linux: workers forked from this process, which has ambseal, numpy, scipy and
-            # python-control imported already (spawned workers import them again: about
-            # 3 s of a 2-core machine per worker before the first case); elsewhere dask's
-            # default (spawn: fork is unsafe on macOS)
-            method = "fork" if sys.platform.startswith("linux") else "spawn"
-            with dask.config.set({"distributed.worker.multiprocessing-method": method}):
-                cluster = LocalCluster(
-                    n_workers=n, threads_per_worker=1, processes=True,
-                    dashboard_address=None,
-                    env={v: "1" for v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
-                                          "MKL_NUM_THREADS")})
-            client = Client(cluster)
-    except OSError as exc:
-        raise ConfigError(f"dask scheduler {scheduler!r}: cannot connect ({exc})") from None
-    try:
-        shared_f = client.scatter(shared, broadcast=True)
-        futures = client.map(_call, cases, fn=fn, shared=shared_f, pure=False)
-        index = {f.key: i for i, f in enumerate(futures)}
-        for f in as_completed(futures):
-            done(index[f.key], f.result())
-        return client.gather(futures)
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
-
 
 def parse_range(text: str, name: str) -> np.ndarray:
     """``a:b:n`` → n points from a to b; a single number → one point.
@@ -223,8 +73,8 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
     """
     import control
 
-    from .campbell import lowest_log_decrement
-    from .judge import OperatingPoint, judge
+    from ambseal.analysis.campbell import lowest_log_decrement
+    from ambseal.analysis.judge import OperatingPoint, judge
 
     cfg = _case_rig(rig, case.get("params"))
     K = control.ss(*controllers[case["controller"]])
@@ -243,7 +93,7 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
 
 
 def _case_rig(rig: dict, params: dict | None):
-    from ..config import parse_rig, rig_with_values
+    from ambseal.config import parse_rig, rig_with_values
 
     cfg = parse_rig(rig, "<sweep rig>")
     return rig_with_values(cfg, params) if params else cfg
@@ -283,7 +133,7 @@ def sweep(cfg, controllers: dict, pressures_bar, speeds_hz, params: dict | None 
         the nominal rig's :func:`~ambseal.analysis.judge.judge_settings` (the same grids and
         disturbances across the map, also when ``params`` change the rig).
     """
-    from ..model.modes import bending_limit_hz
+    from ambseal.model.modes import bending_limit_hz
 
     params = params or {}
     names = list(params)
@@ -291,7 +141,7 @@ def sweep(cfg, controllers: dict, pressures_bar, speeds_hz, params: dict | None 
               "params": dict(zip(names, (float(x) for x in vals)))}
              for c in controllers for p in pressures_bar for s in speeds_hz
              for vals in itertools.product(*(params[n] for n in names))]
-    from .judge import judge_settings
+    from ambseal.analysis.judge import judge_settings
 
     # one judgement across the map: the grids and disturbances of the nominal rig, derived
     # once (about 0.1 s per derivation, as long as a case's own judgement)
@@ -340,7 +190,7 @@ def boundary_case(case: dict, rig: dict, controllers: dict, tol_bar: float) -> f
     part of the closed-loop poles (the loop of :func:`sweep_case`)."""
     import control
 
-    from .campbell import closed_loop_state_matrix
+    from ambseal.analysis.campbell import closed_loop_state_matrix
 
     cfg = _case_rig(rig, case.get("params"))
     K = control.ss(*controllers[case["controller"]])

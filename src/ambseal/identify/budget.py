@@ -46,7 +46,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ConfigError
+from ambseal.errors import ConfigError
 
 __all__ = ["DEFAULT_UNCERTAINTY", "ErrorBudget", "fixed_uncertainty", "propagate", "kind_of"]
 

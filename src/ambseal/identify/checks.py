@@ -13,11 +13,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..config import Affine
-from .frf import FRF, closed_loop_frf, model_frf, plant_frf
-from .procedure import ProcedureResult
-from .signals import chirp
-from .stages import acquire, build_models
+from ambseal.config import Affine
+from ambseal.identify.frf import FRF, closed_loop_frf, model_frf, plant_frf
+from ambseal.identify.procedure import ProcedureResult
+from ambseal.identify.signals import chirp
+from ambseal.identify.stages import acquire, build_models
 
 __all__ = ["FrfChecks", "frf_checks", "truth_errors", "true_line"]
 
@@ -64,7 +64,7 @@ def frf_checks(cfg, truth, res: ProcedureResult, controller, *, seed: int = 99) 
     -------
     FrfChecks
     """
-    from ..model.rig import build_plant
+    from ambseal.model.rig import build_plant
 
     axes = res.amb.axes
     fs = cfg.controller.sample_rate_hz

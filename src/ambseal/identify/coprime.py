@@ -29,10 +29,10 @@ from typing import Sequence
 import numpy as np
 import scipy.linalg as sla
 
-from ..errors import DataError, IdentificationError
-from ..model.lft import Plant
-from ..lti.discrete import zoh
-from ..lti.freqresp import freqresp_at
+from ambseal.errors import DataError, IdentificationError
+from ambseal.model.lft import Plant
+from ambseal.lti.discrete import zoh
+from ambseal.lti.freqresp import freqresp_at
 
 __all__ = ["CoprimeFactors", "observer_gains", "coprime_factors", "youla_factorisation",
            "check_bezout"]
@@ -289,7 +289,7 @@ class CoprimeFactors:
         feedback : {"positive", "negative"}
             ``"positive"`` (P1, Zhou): u = K y with K = [A+BF+LC+LDF, −L; F, 0].
             ``"negative"``: the same controller for the project's convention u = −K y
-            (as :func:`ambseal.control.pid.pid_controller`), i.e. −K.
+            (as :func:`ambseal.design.pid.pid_controller`), i.e. −K.
 
         Returns
         -------

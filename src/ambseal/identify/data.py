@@ -35,7 +35,7 @@ Required by ``ambseal identify`` (the fit simulates the loop that ran, so it mus
   ``[controller.pid]`` (discretised by ambseal at ``sample_rate_hz``), or any description
   carrying the first form under ``"state_space"`` (what ``ambseal acquire`` writes).
 
-The timing these stand for (:mod:`ambseal.identify.loop`): at sample k the sensors give
+The timing these stand for (:mod:`ambseal.robust.digital_loop`): at sample k the sensors give
 y_k, the controller computes u_k = C x_c,k + D y_k in the same sample (no extra delay; a
 rig with a one-sample computation delay states it as a controller state), and the current
 reference ``current_ref`` = −u_k + ``excitation`` is held over the sample (zero-order hold)

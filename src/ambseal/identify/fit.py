@@ -10,7 +10,7 @@ bounds.
 The model is the reduced plant with the parameters entering through its LFT channels
 (A + B_θ θ C_θ, no rebuild per iteration), the amplifier and the τ_e lag in series, exactly
 discretised with a zero-order hold at the data's sample rate and closed with the digital
-controller that ran (:mod:`ambseal.identify.loop`).
+controller that ran (:mod:`ambseal.robust.digital_loop`).
 
 Uncertainty: the covariance of θ̂ from the Jacobian at the optimum. Closed-loop residuals
 are coloured (sensor noise runs through the loop), so the sandwich form
@@ -33,17 +33,17 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..errors import IdentificationError
-from ..model.amb import eddy_lag_matrices
-from ..model.lft import Plant
-from ..lti.discrete import simulate_lti, zoh
-from ..lti.interconnect import series_inputs
-from .budget import ErrorBudget, propagate
-from .loop import DiscreteController, closed_loop_matrices
-from .sandwich import _covariance, _long_run_covariance, _score_test, _t_quantile  # noqa: F401
-from .stats import jacobian_correlation
-from .residuals import MISMATCH, ResidualTests, residual_tests
-from .sensor_lag import TAU_S, lag_test_dict, with_sensor_lag
+from ambseal.errors import IdentificationError
+from ambseal.model.amb import eddy_lag_matrices
+from ambseal.model.lft import Plant
+from ambseal.lti.discrete import simulate_lti, zoh
+from ambseal.lti.interconnect import series_inputs
+from ambseal.identify.budget import ErrorBudget, propagate
+from ambseal.robust.digital_loop import DiscreteController, closed_loop_matrices
+from ambseal.identify.sandwich import _covariance, _long_run_covariance, _score_test, _t_quantile  # noqa: F401
+from ambseal.identify.stats import jacobian_correlation
+from ambseal.identify.residuals import MISMATCH, ResidualTests, residual_tests
+from ambseal.identify.sensor_lag import TAU_S, lag_test_dict, with_sensor_lag
 
 __all__ = ["FitResult", "ClosedLoopModel", "fit_parameters", "default_bounds", "nrmse_fit"]
 

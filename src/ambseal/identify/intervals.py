@@ -4,8 +4,8 @@ over the parameter ranges the identification leaves).
 ``ambseal identify`` writes ``fit.json`` with a 95 % interval per parameter that includes
 the error budget of the values it held fixed (:mod:`ambseal.identify.budget`);
 :func:`uncertainty_from_fit` reads those intervals into the ``{parameter: (low, high)}``
-ranges (SI) that :func:`ambseal.control.plant.generalized_plant` and
-:func:`ambseal.control.recipes.design` take as ``uncertainty``. Design on the identified
+ranges (SI) that :func:`ambseal.design.plant.generalized_plant` and
+:func:`ambseal.design.recipes.design` take as ``uncertainty``. Design on the identified
 rig (``identified.toml``), whose nominal values are the estimates the intervals surround.
 """
 
@@ -15,7 +15,7 @@ import json
 import math
 from pathlib import Path
 
-from ..errors import DataError
+from ambseal.errors import DataError
 
 __all__ = ["uncertainty_from_fit"]
 

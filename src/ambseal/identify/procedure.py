@@ -26,16 +26,16 @@ from typing import Callable
 
 import numpy as np
 
-from ..config import Affine, RigConfig, TruthSection, rig_with_values
-from ..errors import IdentificationError, ModelError
-from ..model.amb import channel_names
-from .fit import TAU_E, FitResult
-from .seal_test import fit_reliability, seal_frequency_test
-from .signals import impulse, prbs
-from .static_load import programme_repeats, static_ki, virtual_static_load, with_static
-from .loop import DiscreteController
-from .stages import acquire, identify
-from .stats import linear_regression
+from ambseal.config import Affine, RigConfig, TruthSection, rig_with_values
+from ambseal.errors import IdentificationError, ModelError
+from ambseal.model.amb import channel_names
+from ambseal.identify.fit import TAU_E, FitResult
+from ambseal.identify.seal_test import fit_reliability, seal_frequency_test
+from ambseal.identify.signals import impulse, prbs
+from ambseal.identify.static_load import programme_repeats, static_ki, virtual_static_load, with_static
+from ambseal.robust.digital_loop import DiscreteController
+from ambseal.identify.stages import acquire, identify
+from ambseal.identify.stats import linear_regression
 
 __all__ = ["ProcedureResult", "thesis_procedure", "SEAL_COEFFICIENTS"]
 
@@ -138,7 +138,7 @@ def thesis_procedure(
         The facility's true values (never read by a fit).
     controller : DiscreteController
         The digital controller that levitates the rotor in every run (the rig's reference
-        PID as it runs on the target: :func:`ambseal.commands.target_pid`).
+        PID as it runs on the target: :func:`ambseal.app.commands.target_pid`).
     seed : int
         Seed of excitations and noise.
     progress : callable, optional

@@ -16,7 +16,7 @@ A time-domain simulation of
 - the amplifier of ``[actuator]`` with current limits, then the eddy-current-like lag
   1/(τ_e s + 1) between coil current and force (thesis P2 §4, Fig. 2);
 - sensor noise and ADC quantisation, and the controller sampled at the rig's rate
-  (:mod:`ambseal.identify.loop` for the timing);
+  (:mod:`ambseal.robust.digital_loop` for the timing);
 - on request, a facility that differs from the rig file in model form (``[truth]`` ``beam``,
   ``mesh_factor``, ``modal_damping``, ``sensor_filter_hz``: :func:`true_rig`), so a fit can be
   tried on data its model did not make.
@@ -34,16 +34,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..config import RigConfig, TruthSection
-from ..errors import ModelError
-from ..model.amb import actuator_matrices, eddy_lag_matrices
-from ..model.reduction import modal_reduction
-from ..model.rig import build_system, mechanical_plant
-from ..model.seal import coefficient_value
-from ..lti.discrete import zoh
-from ..lti.interconnect import series_inputs
-from .facility_loop import facility_loop
-from .loop import DiscreteController, closed_loop_matrices
+from ambseal.config import RigConfig, TruthSection
+from ambseal.errors import ModelError
+from ambseal.model.amb import actuator_matrices, eddy_lag_matrices
+from ambseal.model.reduction import modal_reduction
+from ambseal.model.rig import build_system, mechanical_plant
+from ambseal.model.seal import coefficient_value
+from ambseal.lti.discrete import zoh
+from ambseal.lti.interconnect import series_inputs
+from ambseal.identify.facility_loop import facility_loop
+from ambseal.robust.digital_loop import DiscreteController, closed_loop_matrices
 
 __all__ = ["FacilityRecord", "Facility", "prepare_facility", "simulate_facility", "true_rig",
            "reduced_plant"]

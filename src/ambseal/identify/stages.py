@@ -8,16 +8,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..config import RigConfig, TruthSection
-from ..errors import DataError, IdentificationError, ModelError
-from ..model.amb import actuator_matrices
-from .budget import fixed_uncertainty
-from .data import Measurement, validate_measurement
-from .fit import TAU_E, ClosedLoopModel, FitResult, default_bounds, fit_parameters
-from .loop import DiscreteController
-from .rig_sim import reduced_plant, simulate_facility
-from .sensor_lag import TAU_S
-from .signals import Excitation
+from ambseal.config import RigConfig, TruthSection
+from ambseal.errors import DataError, IdentificationError, ModelError
+from ambseal.model.amb import actuator_matrices
+from ambseal.identify.budget import fixed_uncertainty
+from ambseal.identify.data import Measurement, validate_measurement
+from ambseal.identify.fit import TAU_E, ClosedLoopModel, FitResult, default_bounds, fit_parameters
+from ambseal.robust.digital_loop import DiscreteController
+from ambseal.identify.rig_sim import reduced_plant, simulate_facility
+from ambseal.identify.sensor_lag import TAU_S
+from ambseal.identify.signals import Excitation
 
 __all__ = ["controller_from_metadata", "check_controller", "sample_rate_of",
            "check_record_metadata", "acquire", "build_models", "identify", "record_spread",
@@ -36,7 +36,7 @@ def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<
     ``{"type": "state_space", A, B, C, D, dt}``, or any description (e.g. the PID of
     ``ambseal acquire``) carrying these under ``"state_space"``. A description without its
     matrices (``{"type": "pid", kp, ti, td, eps}`` from a real rig) is turned into them by
-    :func:`ambseal.control.pid.controller_from_metadata`, which the ``identify`` command
+    :func:`ambseal.design.pid.controller_from_metadata`, which the ``identify`` command
     calls: the identification stage takes the controller, it does not design one.
 
     Raises
@@ -52,7 +52,7 @@ def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<
     if c["type"] != "state_space" and not isinstance(c.get("state_space"), dict):
         raise DataError(f"{source}: metadata.controller.type: {c['type']!r} is unknown here, "
                         "or a description without its state space; pass the controller "
-                        "(ambseal.control.pid.controller_from_metadata builds a PID's, as "
+                        "(ambseal.design.pid.controller_from_metadata builds a PID's, as "
                         "`ambseal identify` does)")
     try:
         ctrl = DiscreteController.from_dict(c)

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import IdentificationError
+from ambseal.errors import IdentificationError
 
 __all__ = ["Regression", "linear_regression", "jacobian_correlation"]
 

@@ -50,12 +50,12 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from ..config import RigConfig
-from ..errors import DataError, IdentificationError, ModelError
-from ..model.rig import build_system, mechanical_plant
-from .data import Measurement
-from .fit import _DEFAULT_SCALE, ClosedLoopModel
-from .stages import build_models
+from ambseal.config import RigConfig
+from ambseal.errors import DataError, IdentificationError, ModelError
+from ambseal.model.rig import build_system, mechanical_plant
+from ambseal.identify.data import Measurement
+from ambseal.identify.fit import _DEFAULT_SCALE, ClosedLoopModel
+from ambseal.identify.stages import build_models
 
 __all__ = ["TrackingSettings", "TrackingResult", "track", "flops_per_sample",
            "linearised_model", "rpem_kernel", "OnlineTracker", "current_limit", "check_excitation",
@@ -227,7 +227,7 @@ def _follower(cfg: RigConfig, model: ClosedLoopModel, names):
     """values → the values with the seal coefficients that follow the tracked seal k's
     (:func:`ambseal.model.seal.values_following`; the tracked values themselves win), or
     None when no tracked name is a seal k affine in the pressure."""
-    from ..model.seal import pressure_for_k, values_following
+    from ambseal.model.seal import pressure_for_k, values_following
 
     known = model.plant.parameters
     if all(pressure_for_k(cfg.seal, n, 0.0) is None for n in names):
@@ -575,8 +575,8 @@ def tracking_excitation(cfg: RigConfig, duration_s: float, *, amplitude_a: float
     IdentificationError
         An amplitude above the current limit, or no limit and no amplitude.
     """
-    from ..model.amb import channel_names
-    from .signals import prbs
+    from ambseal.model.amb import channel_names
+    from ambseal.identify.signals import prbs
 
     fs = cfg.controller.sample_rate_hz
     limit = current_limit(cfg)

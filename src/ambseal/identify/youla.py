@@ -73,11 +73,11 @@ from typing import Mapping, Sequence
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..errors import IdentificationError
-from ..model.lft import Plant
-from .coprime import (CoprimeFactors, _as_2d, _ss, check_bezout, coprime_factors,
+from ambseal.errors import IdentificationError
+from ambseal.model.lft import Plant
+from ambseal.identify.coprime import (CoprimeFactors, _as_2d, _ss, check_bezout, coprime_factors,
                       observer_gains, youla_factorisation)
-from ..lti.discrete import simulate_lti, zoh
+from ambseal.lti.discrete import simulate_lti, zoh
 
 __all__ = [
     "CoprimeFactors",

@@ -39,9 +39,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..config import RigConfig, dump_rig, parse_rig
-from ..errors import ConfigError
-from ..files import write_text
+from ambseal.config import RigConfig, dump_rig, parse_rig
+from ambseal.errors import ConfigError
+from ambseal.files import write_text
 
 __all__ = ["RossImport", "from_ross", "load_ross", "import_ross_file", "ROSS_TESTED"]
 

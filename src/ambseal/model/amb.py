@@ -18,9 +18,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..config import Actuator, Amb, AxisPair, RigConfig
-from .lft import Channel
-from .rotor import X, Y, Mesh
+from ambseal.config import Actuator, Amb, AxisPair, RigConfig
+from ambseal.model.lft import Channel
+from ambseal.model.rotor import X, Y, Mesh
 
 __all__ = ["AXES", "MU0", "axes_rotation", "channel_names", "amb_factors_from_geometry",
            "amb_factors", "AmbElement", "actuator_matrices", "eddy_lag_matrices"]

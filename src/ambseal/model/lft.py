@@ -19,9 +19,9 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..errors import ModelError
-from ..lti.interconnect import series_inputs
-from ..lti.pickling import picklable
+from ambseal.errors import ModelError
+from ambseal.lti.interconnect import series_inputs
+from ambseal.lti.pickling import picklable
 
 __all__ = ["Channel", "Parameter", "Plant", "channel_tag"]
 
@@ -101,7 +101,7 @@ class Plant:
     Continuous time: ẋ = A x + B u, y = C x + D u. Inputs are the current references
     ``i_<axis>`` (A) per actuator axis, then any extra force inputs ``F<k>_<x|y>`` (N);
     outputs are the sensor displacements ``y_<axis>`` (m), ``<axis>`` such as ``A_zeta``.
-    A controller (:mod:`ambseal.control.controller`) has the reverse names, inputs
+    A controller (:mod:`ambseal.robust.controller`) has the reverse names, inputs
     ``y_<axis>`` and outputs ``i_<axis>``, so python-control's ``interconnect`` closes the
     loop by name (with the sign of ``i = −K y``).
     """

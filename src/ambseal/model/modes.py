@@ -23,8 +23,8 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..errors import ModelError
-from .rig import SecondOrderSystem, build_system
+from ambseal.errors import ModelError
+from ambseal.model.rig import SecondOrderSystem, build_system
 
 __all__ = ["Modes", "modes", "lowest_eigenvalues", "free_bending_hz", "bending_limit_hz",
            "classify_poles", "RIGID_BODY_RAD_S", "STABILITY_FLOOR_RAD_S"]

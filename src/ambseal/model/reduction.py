@@ -22,8 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from ..errors import ModelError
-from .lft import Plant
+from ambseal.errors import ModelError
+from ambseal.model.lft import Plant
 
 __all__ = ["ModalReduction", "modal_reduction"]
 

@@ -20,13 +20,13 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg as sla
 
-from ..config import RigConfig
-from ..errors import ModelError
-from .amb import AXES, AmbElement, actuator_matrices, eddy_lag_matrices
-from .lft import Channel, Parameter, Plant
-from .rotor import X, Y, Mesh, assemble_rotor, build_mesh
-from .seal import SealElement
-from .spring import SpringElement
+from ambseal.config import RigConfig
+from ambseal.errors import ModelError
+from ambseal.model.amb import AXES, AmbElement, actuator_matrices, eddy_lag_matrices
+from ambseal.model.lft import Channel, Parameter, Plant
+from ambseal.model.rotor import X, Y, Mesh, assemble_rotor, build_mesh
+from ambseal.model.seal import SealElement
+from ambseal.model.spring import SpringElement
 
 __all__ = ["SecondOrderSystem", "build_system", "mechanical_plant", "build_plant", "AXES"]
 
@@ -216,7 +216,7 @@ def build_plant(
     from ``[reduction]``, else 8 states). The actuator model of ``[actuator]`` is put in
     series with the current inputs after the reduction, as in thesis P5 Fig. 8.
     """
-    from .reduction import modal_reduction
+    from ambseal.model.reduction import modal_reduction
 
     sys = build_system(cfg, pressure_bar=pressure_bar, speed_rpm=speed_rpm,
                        force_positions=force_positions)

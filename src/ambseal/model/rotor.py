@@ -20,9 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from ..config import RigConfig
-from ..errors import ModelError
-from .fe import BeamElement, DiskElement
+from ambseal.config import RigConfig
+from ambseal.errors import ModelError
+from ambseal.model.fe import BeamElement, DiskElement
 
 __all__ = ["Mesh", "build_mesh", "RotorMatrices", "assemble_rotor", "dof"]
 

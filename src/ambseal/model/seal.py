@@ -17,12 +17,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..config import Affine, FrequencyTable, Seal
-from ..errors import ModelError
-from .lft import Channel
-from .rotor import X, Y, Mesh
+from ambseal.config import Affine, FrequencyTable, Seal
+from ambseal.lti.tables import interp_table
+from ambseal.errors import ModelError
+from ambseal.model.lft import Channel
+from ambseal.model.rotor import X, Y, Mesh
 
-__all__ = ["COEFFICIENTS", "interp_table", "coefficient_value", "seal_coefficients",
+__all__ = ["COEFFICIENTS", "coefficient_value", "seal_coefficients",
            "seal_values", "pressure_for_k", "values_following_k", "SealElement"]
 
 COEFFICIENTS = ("K", "k", "C", "c", "M")
@@ -30,38 +31,6 @@ COEFFICIENTS = ("K", "k", "C", "c", "M")
 
 _SKEW = np.array([[0.0, 1.0], [-1.0, 0.0]])
 _UNITS = {"K": "N/m", "k": "N/m", "C": "N*s/m", "c": "N*s/m"}
-
-
-def interp_table(x: float, grid, values):
-    """Linear interpolation in a table, held constant outside it.
-
-    Parameters
-    ----------
-    x : float
-        Where to evaluate, in the unit of ``grid``.
-    grid : array_like, shape (n,)
-        Strictly increasing abscissae (n ≥ 1).
-    values : array_like, shape (n,) or (n, ...)
-        Tabulated scalars, or a stack of arrays (e.g. matrices) along the first axis.
-
-    Returns
-    -------
-    float or ndarray
-        A float for scalar tables (exactly ``numpy.interp``); for stacks
-        (1 − t)·values[j] + t·values[j+1] with t = (x − grid[j])/(grid[j+1] − grid[j]),
-        shape ``values.shape[1:]``.
-    """
-    g = np.asarray(grid, float)
-    v = np.asarray(values, float)
-    if v.ndim == 1:
-        return float(np.interp(x, g, v))
-    if g.size == 1 or x <= g[0]:
-        return v[0].copy()
-    if x >= g[-1]:
-        return v[-1].copy()
-    j = int(np.clip(np.searchsorted(g, x) - 1, 0, g.size - 2))
-    t = (x - g[j]) / (g[j + 1] - g[j])
-    return (1 - t) * v[j] + t * v[j + 1]
 
 
 def coefficient_value(c: float | Affine | FrequencyTable, pressure_bar: float,

@@ -14,10 +14,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..config import Spring
-from .amb import axes_rotation
-from .lft import Channel
-from .rotor import X, Y, Mesh
+from ambseal.config import Spring
+from ambseal.model.amb import axes_rotation
+from ambseal.model.lft import Channel
+from ambseal.model.rotor import X, Y, Mesh
 
 __all__ = ["KEYS", "spring_label", "SpringElement"]
 

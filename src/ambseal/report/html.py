@@ -57,7 +57,7 @@ def _figure_html(path: str | os.PathLike, caption: str | None, alt: str) -> str:
 
 
 def _zone_legend() -> str:
-    from .verdict import ZONE_COLOURS, ZONE_WORDS
+    from ambseal.report.verdict import ZONE_COLOURS, ZONE_WORDS
 
     return ('<p class="legend">ISO 14839-3 zones: ' + " ".join(
         f'<span style="background:{c}">{z}</span>{_esc(ZONE_WORDS[z])}'
@@ -74,7 +74,7 @@ def render_report(
     clearances_um: Mapping[str, float] | None = None,
 ) -> str:
     """The report page as a string (see :func:`write_report`)."""
-    from .verdict import detail_table_html, verdict_table_html, verdicts
+    from ambseal.report.verdict import detail_table_html, verdict_table_html, verdicts
 
     parts = [
         "<!DOCTYPE html>",

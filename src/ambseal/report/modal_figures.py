@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from .figures import save_figure
+from ambseal.report.figures import save_figure
 
 __all__ = ["campbell_figure", "mode_shapes_figure", "stability_map_figure"]
 

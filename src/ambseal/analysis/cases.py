@@ -1,0 +1,159 @@
+"""The one executor of every multi-case analysis, serial or on Dask.
+
+:func:`run_cases` runs a pure function ``fn(case, **shared)`` over a list of cases (the
+sweeps' grid points, the Campbell diagram's speeds, ``ambseal run``'s judged operating
+points), serially or on ``dask.distributed`` (a local cluster of processes with one BLAS
+thread each, or a running scheduler by address). ``shared`` is sent to each worker once
+(``Client.scatter``, broadcast) and the function is pickled by reference, so a worker
+imports ambseal once, not per case. Results come back in input order; a case that raises is
+recorded as a :class:`CaseError` with its message and the others go on. A progress bar
+(rich, on stderr) counts cases as they finish.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from dataclasses import dataclass
+from typing import Callable, Sequence
+
+from ambseal.errors import AmbsealError, ConfigError
+
+__all__ = ["CaseError", "run_cases", "dask_available", "SERIAL_BELOW"]
+
+#: Sweeps with fewer cases than this run serially when no workers or scheduler are given:
+#: a local cluster costs a few seconds to start, about 20 cases of the embedded rig.
+SERIAL_BELOW = 64
+
+
+@dataclass(frozen=True)
+class CaseError:
+    """A case that failed: the case and the error's one-line message."""
+
+    case: dict
+    error: str
+
+
+def dask_available() -> bool:
+    """Whether ``dask.distributed`` can be imported (the ``[dask]`` extra)."""
+    try:
+        import distributed  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _call(case: dict, fn: Callable, shared: dict):
+    try:
+        return fn(case, **shared)
+    except Exception as exc:  # a failed case is recorded, not lost
+        return CaseError(dict(case), f"{type(exc).__name__}: {exc}")
+
+
+def run_cases(fn: Callable, cases: Sequence[dict], *, shared: dict | None = None,
+              workers: int | None = None, scheduler: str | None = None,
+              progress: bool = False, description: str = "cases",
+              raise_errors: bool = False, on_done: Callable | None = None) -> list:
+    """Run ``fn(case, **shared)`` for every case, serially or on Dask, in input order.
+
+    Parameters
+    ----------
+    fn : callable
+        A module-level (picklable) pure function.
+    cases : sequence of dict
+    shared : dict, optional
+        Keyword arguments common to every case (sent once per worker).
+    workers : int, optional
+        Local Dask worker processes (one thread, one BLAS thread each); ``1`` runs serially.
+        Default: serial below :data:`SERIAL_BELOW` cases or without dask, else one worker
+        per core.
+    scheduler : str, optional
+        Address of a running Dask scheduler (``tcp://host:8786``); wins over ``workers``.
+    progress : bool
+        A progress bar over the cases on stderr.
+    description : str
+        The bar's label.
+    raise_errors : bool
+        Re-raise the first failed case's error (as :class:`AmbsealError`) instead of
+        recording it.
+    on_done : callable, optional
+        Called with ``(index, result)`` as each case finishes (serial: in order).
+
+    Returns
+    -------
+    list
+        One result per case, in input order; a :class:`CaseError` for a case that raised.
+
+    Raises
+    ------
+    ConfigError
+        ``scheduler`` or ``workers > 1`` without dask installed, or a scheduler that cannot
+        be reached.
+    """
+    from rich.console import Console
+    from rich.progress import Progress
+
+    shared = dict(shared or {})
+    cases = list(cases)
+    distributed = scheduler is not None or (workers is not None and workers > 1) or (
+        workers is None and len(cases) >= SERIAL_BELOW and dask_available()
+        and (os.cpu_count() or 1) > 1)
+    if distributed and not dask_available():
+        raise ConfigError("dask.distributed is not installed (pip install 'ambseal[dask]'); "
+                          "leave out --scheduler/--workers to run serially")
+    with Progress(console=Console(stderr=True), disable=not progress, transient=True) as bar:
+        task = bar.add_task(description, total=len(cases))
+
+        def done(i: int, r) -> None:
+            if raise_errors and isinstance(r, CaseError):
+                raise AmbsealError(f"{description}: case {r.case}: {r.error}")
+            bar.advance(task)
+            if on_done is not None:
+                on_done(i, r)
+
+        if not distributed:
+            out = []
+            for i, case in enumerate(cases):
+                out.append(_call(case, fn, shared))
+                done(i, out[-1])
+            return out
+        return _run_dask(fn, cases, shared, workers, scheduler, done)
+
+
+def _run_dask(fn, cases, shared, workers, scheduler, done) -> list:
+    """The Dask path of :func:`run_cases`: futures, as completed, gathered in input order."""
+    from distributed import Client, LocalCluster, as_completed
+
+    cluster = None
+    try:
+        if scheduler is not None:
+            client = Client(scheduler, timeout="10s")
+        else:
+            import dask
+
+            n = workers or (os.cpu_count() or 1)
+            # Linux: workers forked from this process, which has ambseal, numpy, scipy and
+            # python-control imported already (spawned workers import them again: about
+            # 3 s of a 2-core machine per worker before the first case); elsewhere dask's
+            # default (spawn: fork is unsafe on macOS)
+            method = "fork" if sys.platform.startswith("linux") else "spawn"
+            with dask.config.set({"distributed.worker.multiprocessing-method": method}):
+                cluster = LocalCluster(
+                    n_workers=n, threads_per_worker=1, processes=True,
+                    dashboard_address=None,
+                    env={v: "1" for v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
+                                          "MKL_NUM_THREADS")})
+            client = Client(cluster)
+    except OSError as exc:
+        raise ConfigError(f"dask scheduler {scheduler!r}: cannot connect ({exc})") from None
+    try:
+        shared_f = client.scatter(shared, broadcast=True)
+        futures = client.map(_call, cases, fn=fn, shared=shared_f, pure=False)
+        index = {f.key: i for i, f in enumerate(futures)}
+        for f in as_completed(futures):
+            done(index[f.key], f.result())
+        return client.gather(futures)
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()

@@ -1,0 +1,611 @@
+"""The ``design``, ``identify``, ``validate`` and ``track`` commands: load, call the stage,
+write the files.
+
+Wiring only, like :mod:`ambseal.app.pipeline`: every number comes from :mod:`ambseal.design`
+and :mod:`ambseal.identify`, every figure from :mod:`ambseal.report`, every file through a
+temporary name and a rename (:mod:`ambseal.files`).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ambseal.config import load_rig
+from ambseal.errors import ConfigError
+from ambseal.files import writable_folder, write_json, write_text
+
+__all__ = ["Designed", "Identified", "identification_stage", "facility_impulses", "design_files",
+           "identify_files", "export_design", "show_defaults",
+           "validate_summary", "track_files", "export_all", "digital_for", "choice_margins",
+           "judged_margins", "digitals_for", "target_pid"]
+
+
+@dataclass(frozen=True)
+class Designed:
+    """A controller of the main job: its method, the controller (``control.StateSpace`` or
+    :class:`~ambseal.robust.controller.ScheduledController`), its design summary for
+    ``metrics.json`` and the full design result."""
+
+    method: str
+    controller: object
+    summary: dict
+    result: object
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
+
+
+def digital_for(cfg, method: str, controller, result, points, cache: dict | None = None
+                ) -> object:
+    """The digital controller of a design, its discretisation chosen on the full-order
+    plants at the judged conditions (:mod:`ambseal.robust.digital`): a
+    :class:`~ambseal.robust.digital.DigitalController`, or for a scheduled controller a
+    :class:`~ambseal.robust.scheduled_digital.ScheduledDigital` whose interpolation is
+    also checked between table entries (at speeds, or at the pressures that give the seal
+    coefficient it is scheduled on). ``cache`` (a dict kept by the caller) shares the
+    sampled plants and the μ design's grid between the controllers of one rig."""
+    import numpy as np
+
+    from ambseal.robust.controller import ScheduledController
+    from ambseal.robust.digital import check_rate, design_rise, digital_controller, sampled_plants
+    from ambseal.model.rig import build_plant
+
+    fs, delay = cfg.controller.sample_rate_hz, cfg.controller.delay_samples
+    conds = _conditions(cfg, points)
+
+    def plant(p_bar, rpm):
+        pl = build_plant(cfg, pressure_bar=p_bar, speed_rpm=rpm)
+        G = pl.select_inputs([pl.input_names[j] for j in pl.current_inputs()])
+        return tuple(np.asarray(X, float) for X in (G.A, G.B, G.C, G.D))
+
+    if not isinstance(controller, ScheduledController):
+        from ambseal.robust.dk import design_omega
+        from ambseal.design.specs import design_spec
+
+        cache = {} if cache is None else cache
+        if method in ("hinf", "mu") and "omega" not in cache:  # the μ design's grid
+            cache["omega"] = design_omega(*design_spec(cfg).synthesis_band_hz)
+        rise = ((lambda Kr: design_rise(result, Kr, cache["omega"], fs / 2))
+                if method in ("hinf", "mu") else None)
+        check_rate(controller, fs, delay, removable=rise is not None)  # before the plants
+        if "plants" not in cache:
+            cache["plants"] = sampled_plants([plant(*c) for c in conds], fs,
+                                             delay_samples=delay)
+        return digital_controller(controller, fs, cache["plants"],
+                                  delay_samples=delay, rise=rise)
+    from ambseal.robust.controller import SPEED
+    from ambseal.robust.scheduled_digital import scheduled_digital
+    from ambseal.model.seal import pressure_for_k, seal_values
+
+    W = np.asarray(controller.K.speeds_rad_s, float)  # the LPV table's θ (speeds or SI)
+    # between table entries at 1/8, 3/8, 5/8, 7/8 of the table: the interpolation judged
+    mids = [(W[j] + W[j + 1]) / 2 for j in (np.arange(1, 8, 2) * (W.size - 1)) // 8]
+    if controller.parameter == SPEED:
+        speeds = [2 * math.pi * c[1] / 60.0 for c in conds] + mids
+        plants = [(w, plant(cfg.operating.pressure_bar, 60.0 * w / (2 * math.pi)))
+                  for w in speeds]
+    else:  # a seal's k: the judged pressures and those that give the θ between entries
+        if pressure_for_k(cfg.seal, controller.parameter, 0.0) is None:
+            raise ConfigError(f"{method}: no digital table for a controller scheduled on "
+                              f"{controller.parameter!r}: only on a seal's k affine in the "
+                              "pressure drop")
+        conds = [(p, cfg.operating.speed_rpm) for p in dict.fromkeys(
+            [c[0] for c in conds] + [pressure_for_k(cfg.seal, controller.parameter, th)
+                                     for th in mids])]
+        plants = [(seal_values(cfg.seal, p)[controller.parameter], plant(p, rpm))
+                  for p, rpm in conds]
+    return scheduled_digital(controller, W, fs, plants, delay_samples=delay,
+                             name=f"K_{method}")
+
+
+def digitals_for(cfg, designs, points, say=None) -> tuple[dict, dict]:
+    """:func:`digital_for` of each of ``ambseal run``'s designs, sharing the sampled plants.
+
+    A controller that cannot run on the target (no discretisation keeps its sampled,
+    delayed loop stable where the continuous loop is, or an unstable pole too fast for the
+    rate: :class:`~ambseal.errors.SynthesisError`) is left out, the others go on;
+    ``say(line)``, if given, is called with the reason.
+
+    Returns
+    -------
+    (digitals, cannot_run)
+        ``{method: DigitalController}`` and ``{method: one line saying which controller
+        cannot run and why}``.
+    """
+    from ambseal.errors import SynthesisError
+
+    cache: dict = {}
+    digitals, cannot_run = {}, {}
+    for d in designs:
+        try:
+            digitals[d.method] = digital_for(cfg, d.method, d.controller, d.result, points,
+                                             cache)
+        except SynthesisError as exc:
+            cannot_run[d.method] = (f"{d.method} cannot run on the target, judged as designed "
+                                    f"(continuous) only: {exc}")
+            if say is not None:
+                say(cannot_run[d.method])
+    return digitals, cannot_run
+
+
+def target_pid(cfg):
+    """The rig's reference PID (``[controller.pid]``, else derived from the rig) as it runs
+    on the target: the discrete controller :func:`digital_for` chooses and ``ambseal run``
+    exports and judges (:class:`~ambseal.robust.digital_loop.DiscreteController`, with its
+    discretisation in ``description``) — the one that levitates the virtual facility in
+    ``ambseal acquire`` and the main job's identification."""
+    from dataclasses import replace
+
+    from ambseal.analysis.judge import operating_points
+    from ambseal.design.recipes import design, pid_from_rig
+
+    res = design(cfg, "pid")
+    dc = digital_for(cfg, "pid", res.K, res, operating_points(cfg))
+    p = cfg.controller.pid
+    gains = ({k: getattr(p, k) for k in ("kp", "ti", "td", "eps")} if p is not None else
+             {k: pid_from_rig(cfg)[k] for k in ("kp", "ti", "td", "eps")})
+    return replace(dc.discrete, description={"type": "pid", **gains, "discretisation": dc.method,
+                                             "prewarp_hz": dc.prewarp_hz})
+
+
+def _conditions(cfg, points) -> list[tuple[float, float]]:
+    """(pressure bar, speed rpm) of the judged points, the nominal one first."""
+    nominal = (cfg.operating.pressure_bar, cfg.operating.speed_rpm)
+    return sorted({(p.pressure_bar, p.speed_rpm) for p in points}, key=lambda c: c != nominal)
+
+
+def choice_margins(cfg, points, digital) -> list[dict]:
+    """The discrete margins the choice of discretisation judged (:mod:`ambseal.robust.
+    digital`): per condition the largest ``|z|`` and the σ̄(S_o) peaks of the chosen
+    candidate (``choice``: with ``+fast`` when its fast poles were kept, the controller
+    exported), with the loop's delay, on the sampled full-order plant."""
+    chosen = getattr(digital, "choice", "") or digital.method
+    c = next(c for c in digital.candidates if c["method"] == chosen)
+    if "speeds_hz" in c:  # scheduled: the judged speeds and between table entries
+        speeds = c["speeds_hz"]
+        pressures = [cfg.operating.pressure_bar] * len(speeds)
+    else:
+        pressures, rpms = zip(*_conditions(cfg, points))
+        speeds = [r / 60.0 for r in rpms]
+    return [{"pressure_bar": p, "speed_hz": f, "stable": z < 1, "max_abs_pole_z": z,
+             "sensitivity_peak": sd, "sensitivity_peak_continuous": sc}
+            for p, f, z, sd, sc in zip(pressures, speeds, c["max_abs_z"],
+                                       c["sensitivity_peak"],
+                                       c["sensitivity_peak_continuous"])]
+
+
+def export_design(method: str, digital, summary_dict: dict, out: Path, judged=None
+                  ) -> list[Path]:
+    """Write a designed controller as it runs (``controller_<method>.json/.npz/.mat``,
+    :func:`ambseal.export.controller_files.export_controller`) with the judged discrete margins,
+    and its design summary with the discretisation (``design_<method>.json``)."""
+    from ambseal.export.controller_files import export_controller
+
+    files = [export_controller(digital, out / f"controller_{method}{ext}", judged)
+             for ext in (".json", ".npz", ".mat")]
+    files.append(write_json(out / f"design_{method}.json",
+                            {**summary_dict, "discretisation": digital.to_dict()}))
+    return files
+
+
+def show_defaults(rig: str | Path, overrides=()) -> str:
+    """``ambseal design RIG --show-defaults``: the rig's resolved ``[design]`` part as TOML
+    with the rule behind each value (:meth:`ambseal.design.specs.DesignSpec.to_toml`)."""
+    from ambseal.design.specs import design_spec
+
+    cfg = load_rig(rig, overrides)
+    return f"# {cfg.rotor.name}: resolved design specification\n" + design_spec(cfg).to_toml()
+
+
+def export_all(designs, digitals: dict, cases: list[dict], out: Path) -> dict:
+    """``ambseal run``'s controllers: each as it runs (:func:`export_design` with its judged
+    discrete margins) and as C (:func:`ambseal.export.codegen.write_c`); returns the
+    design summaries with their ``discretisation`` for ``metrics.json`` (``None`` for a
+    controller without a digital one in ``digitals``: nothing of it is exported)."""
+    from ambseal.export.codegen import write_c
+    from ambseal.robust.digital import peak_difference
+    from ambseal.report.verdict import target_difference
+
+    summaries = {}
+    for d in designs:
+        digital = digitals.get(d.method)
+        if digital is None:  # cannot run on the target (metrics' "cannot_run"): no export
+            summaries[d.method] = {**d.summary, "discretisation": None}
+            continue
+        export_design(d.method, digital, d.result.to_dict(), out,
+                      judged_margins(cases, d.method))
+        write_c(digital, out, f"ambseal_{d.method}")
+        disc = digital.to_dict()  # the difference as judged (grids refined at the peaks)
+        disc["peak_difference"] = peak_difference(
+            target_difference([c for c in cases if c["controller"] == d.method]),
+            digital.method, digital.removed_poles_hz)
+        summaries[d.method] = {**d.summary, "discretisation": disc}
+    return summaries
+
+
+def judged_margins(cases: list[dict], method: str) -> list[dict]:
+    """The discrete blocks of one controller's cases, with their conditions."""
+    return [{"pressure_bar": c["pressure_bar"], "speed_hz": c["speed_hz"], **c["discrete"]}
+            for c in cases if c["controller"] == method and "discrete" in c]
+
+
+@dataclass
+class Identified:
+    """The identification stage of the main job: ``summary`` for ``metrics.json``, its
+    figures and report sections, the procedure's ``result``, the rig the robust controllers
+    are designed on (``design_cfg``, :func:`ambseal.identify.design_model.design_rig`) and
+    the truth they are judged on (``truth_cfg``)."""
+
+    summary: dict
+    figs: list
+    sections: list
+    result: object
+    design_cfg: object
+    truth_cfg: object
+    extra: dict = field(default_factory=dict)
+
+
+def identification_stage(cfg, truth, out: Path, say, controller) -> Identified:
+    """The thesis's identification procedure on the virtual facility, its files, the FRF
+    checks of the identified model, its figures and report section, and the rig to design
+    on. ``controller`` is the exported, judged discrete reference PID (the facility runs
+    exactly that object)."""
+    from ambseal.config import dump_rig
+    from ambseal.identify.checks import frf_checks, truth_errors
+    from ambseal.identify.design_model import design_rig, truth_rig
+    from ambseal.identify.procedure import thesis_procedure
+    from ambseal.report.run_report import identification_report
+
+    res = thesis_procedure(cfg, truth, controller, progress=say)
+    write_json(out / "identification.json", res.to_dict())
+    write_text(out / "identified_rig.toml",
+               dump_rig(res.identified, "Identified by `ambseal run` from the virtual test "
+                        "facility (thesis P2, P4, P5 procedure)"))
+    say("identification: chirp FRF check of the identified model")
+    checks = frf_checks(cfg, truth, res, controller)
+    seal = cfg.seal[0].name if cfg.seal else None
+    errors = truth_errors(res, seal)
+    figs, sections = identification_report(out, res, errors, checks, truth, seal,
+                                           cfg.operating.pressure_bar)
+    a = res.amb
+    design_cfg, note = design_rig(cfg, res)
+    summary = {"parameters": errors, "converged": bool(a.converged),
+               "model_check": a.model_check(),
+               "nrmse_fit_pct": {k: (float(v) if math.isfinite(v) else None)
+                                 for k, v in a.nrmse_fit_pct.items()},
+               "design": note, "judged_on": "virtual facility (truth file, full order)"}
+    return Identified(summary, figs, sections, res, design_cfg, truth_rig(cfg, truth))
+
+
+def facility_impulses(cfg, truth, ident: Identified, digitals: dict, out: Path) -> None:
+    """Each digital controller on the virtual facility and on the identified model: impulse
+    responses at 0 bar and the nominal pressure drop (P5 Figs. 15–16), into ``ident``'s
+    summary, figures and report sections."""
+    from ambseal.identify.design_model import impulse_checks
+    from ambseal.report.run_report import facility_impulse_report
+
+    ctrls = {m: d.discrete for m, d in digitals.items() if hasattr(d, "discrete")}
+    checks = impulse_checks(cfg, ident.result.identified, truth, ctrls,
+                            sorted({0.0, cfg.operating.pressure_bar}))
+    ident.summary["facility_impulse"] = [c.to_dict() for c in checks]
+    figs, sections = facility_impulse_report(out, checks, ident.summary["design"])
+    ident.figs += figs
+    ident.sections += sections
+
+
+def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
+                 pressure_bar: float | None = None, overrides=(),
+                 allow_unstable: bool = False, c_dir: str | Path | None = None,
+                 precision: str = "double") -> dict:
+    """``ambseal design``: design one controller and write it with its summary.
+
+    Files: ``controller_<method>.json``, ``.npz`` and ``.mat`` — the discrete controller
+    that runs at ``[controller] sample_rate_hz`` with ``delay_samples`` (discretisation
+    chosen and judged, :mod:`ambseal.robust.digital`; for ``lpv`` the scheduled table and
+    its interpolation law), the continuous design, channels with units and the judged
+    discrete margins (:mod:`ambseal.export.controller_files`) — and ``design_<method>.json``
+    (summary, weights, D–K history, discretisation). With ``c_dir`` also the C99 module
+    (:mod:`ambseal.export.codegen`) in ``precision`` ("double" or "float").
+
+    Raises
+    ------
+    ConfigError
+        A bad rig, a bad sample rate or delay, or ``lpv`` without a speed range.
+    SynthesisError
+        No discretisation keeps the sampled loop stable (the reason named).
+    """
+    from ambseal.design.recipes import design
+
+    cfg = load_rig(rig, overrides)
+    out = writable_folder(out_dir)  # before the design, not after it
+    if method == "lpv":
+        from ambseal.design.lpv_design import design_lpv
+
+        if cfg.operating.speed_range_hz is None:
+            raise ConfigError(f"{rig}: operating.speed_range_hz: an LPV design needs the "
+                              "speed range it is scheduled over, e.g. [20.0, 300.0]")
+        res = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz,
+                         allow_unstable=allow_unstable)
+        K, summary = res, res.to_dict()
+    else:
+        res = design(cfg, method, pressure_bar=pressure_bar, allow_unstable=allow_unstable,
+                     progress=lambda line: print(f"ambseal: {line}", file=sys.stderr))
+        K, summary = res.K, res.to_dict()
+    from ambseal.analysis.judge import operating_points
+
+    points = operating_points(cfg)
+    digital = digital_for(cfg, method, K, res, points)
+    judged = choice_margins(cfg, points, digital)
+    files = export_design(method, digital, summary, out, judged)
+    if c_dir is not None:
+        from ambseal.export.codegen import write_c
+
+        files += write_c(digital, c_dir, f"ambseal_{method}", precision=precision)
+    short = res.summary() if hasattr(res, "summary") else summary
+    return {**short, "discretisation": digital.to_dict(),
+            "files": [str(f) for f in files]}
+
+
+def _record_hash(meas) -> str:
+    """SHA-256 of a record's samples (time, excitation, currents, displacements)."""
+    import hashlib
+
+    h = hashlib.sha256()
+    for a in (meas.time_s, meas.excitation_a, meas.current_ref_a, meas.current_a,
+              meas.displacement_m):
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def _check_records(records: list, paths: list[str]) -> None:
+    """Refuse a record given twice (same samples: it would narrow the intervals by √2) and
+    a record without excitation (nothing to identify)."""
+    import numpy as np
+
+    from ambseal.errors import DataError
+
+    seen: dict[str, str] = {}
+    for meas, path in zip(records, paths):
+        digest = _record_hash(meas)
+        if digest in seen:
+            raise DataError(f"{path}: the same samples as {seen[digest]} (a record counts "
+                            "once; a copy would narrow the confidence intervals by √2)")
+        seen[digest] = str(path)
+        if not np.any(meas.excitation_a):
+            raise DataError(f"{path}: excitation_a: zero on every axis; a record without "
+                            "excitation identifies nothing")
+
+
+def _static_load(cfg, res, path: str) -> tuple:
+    """(the fit joined with the static-load Ki of ``path``, its summary)."""
+    from ambseal.identify.static_load import load_static_record, static_ki, with_static
+
+    return with_static(res, static_ki(cfg, *load_static_record(path, cfg),
+                                      values=dict(zip(res.names, res.estimate)),
+                                      source=str(path)))
+
+
+def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: str | Path, *,
+                   current_weight: float = 0.0, refine: bool = True,
+                   accept_unconverged: bool = False, static_load: str | None = None) -> dict:
+    """``ambseal identify``: fit ``names`` to recorded files; write the fit, its figures and
+    the identified rig to ``out_dir``. Returns a JSON-safe summary.
+
+    With ``static_load`` (a load-step CSV, :mod:`ambseal.identify.static_load`), Ki is also
+    found by static loading (P2 §5, its own interval, in ``fit.json`` as ``static_load``)
+    and joined with the fitted Ki's: the estimates, intervals and correlations written are
+    the joined ones, and ``static_load`` gives the Ki–Ks correlations before and after.
+
+    The intervals include the error budget of every parameter held fixed
+    (:mod:`ambseal.identify.budget`); the residuals are tested for independence of the
+    excitation (:mod:`ambseal.identify.residuals`); with several records of one condition,
+    each is also fitted alone and the spread of those estimates (RSD, thesis P2 Table 2)
+    is reported beside the pooled fit. ``warnings`` in the summary say which fixed values
+    dominate, whether seal coefficients are held at a non-zero pressure and whether the
+    model fails the residual test.
+
+    A fit that failed (not converged, singular Jacobian, an estimate at its bound, an NRMSE
+    fit below the floor of :func:`ambseal.identify.fit.fit_parameters`) writes ``fit.json``
+    for diagnosis but no figures and no ``identified.toml``, and raises, unless
+    ``accept_unconverged``.
+
+    Raises
+    ------
+    ConfigError, DataError, IdentificationError
+        A bad rig, a bad, duplicate, unexcited or mismatched record, a fit that cannot
+        start, or (without ``accept_unconverged``) a fit that failed.
+    """
+    from ambseal.config import dump_rig, rig_with_values
+    from ambseal.design.pid import controller_from_metadata
+    from ambseal.errors import DataError
+    from ambseal.identify.budget import advice
+    from ambseal.identify.data import load_measurement
+    from ambseal.identify.residuals import MISMATCH
+    from ambseal.identify.stages import check_record_metadata, identify, record_spread
+    from ambseal.model.amb import channel_names
+    from ambseal.report.identify_figures import (correlation_figure, error_budget_figure,
+                                          fit_timeseries_figure, residual_figure)
+
+    cfg = load_rig(rig)
+    out = writable_folder(out_dir)  # before the fit, not after it
+    axes = channel_names(cfg)
+    records, controllers = [], []
+    for path in data:
+        meas = load_measurement(path, axes=axes, min_samples=max(100, 10 * len(names)))
+        other = meas.metadata.get("rig")
+        if other is not None and other != cfg.rotor.name:
+            raise DataError(f"{path}: metadata.rig: recorded on {other!r}, but the rig is "
+                            f"{cfg.rotor.name!r}")
+        check_record_metadata(dict(meas.metadata), str(path))
+        records.append(meas)
+        controllers.append(controller_from_metadata(dict(meas.metadata), axes, str(path)))
+    _check_records(records, data)
+    sources = [str(d) for d in data]
+    res = identify(cfg, records, names, current_weight=current_weight, refine=refine,
+                   controllers=controllers, budget=True, sources=sources)
+    spread = record_spread(cfg, records, names, res, controllers=controllers,
+                           sources=sources) if len(records) > 1 else None
+    pressures = sorted({float(m.metadata.get("pressure_drop_pa", 0.0)) / 1e5 for m in records})
+    warnings = advice(res.budget, cfg, names, pressures)
+    static = _static_load(cfg, res, static_load) if static_load else None
+    if static is not None:
+        res, static = static
+    if res.residuals.failed:  # a disputed fixed value is told by advice() already
+        warnings.append(f"{MISMATCH} (residuals correlate with the excitation on "
+                        f"{', '.join(res.residuals.failed)})")
+    if res.sensor_lag and res.sensor_lag["flagged"]:
+        warnings.append(f"{MISMATCH} (the data ask for a sensor lag of "
+                        f"{res.sensor_lag['suggested_tau_s'] * 1e6:.3g} µs the model lacks: "
+                        + ("a wrong held value can also make it; fit the disputed values "
+                           "first, then tau_s if it remains)" if res.model_check()["disputed"]
+                           else "fit tau_s beside tau_e; Ki, Ks then hold, read "
+                           "tau_e + tau_s)"))
+    write_json(out / "fit.json", {**res.to_dict(), "warnings": warnings,
+                                  **({"per_record": spread} if spread else {}),
+                                  **({"static_load": static} if static else {})})
+    if not res.converged and not accept_unconverged:
+        from ambseal.errors import IdentificationError
+
+        (out / "identified.toml").unlink(missing_ok=True)  # an earlier fit's: not this one's
+        raise IdentificationError(f"identify: the fit failed ({res.message}); {out / 'fit.json'}"
+                                  " has the details, no identified rig was written "
+                                  "(--accept-unconverged writes it anyway)")
+    fit_timeseries_figure(out / "fit_timeseries.png", res.time_s, res.y_meas, res.y_sim,
+                          res.axes, nrmse_pct=[res.nrmse_fit_pct[a] for a in res.axes])
+    correlation_figure(out / "correlation.png", res.correlation, res.names)
+    residual_figure(out / "residuals.png", res.residuals)
+    error_budget_figure(out / "error_budget.png", res.names, res.estimate, res.std_error_noise,
+                        res.budget)
+    est = dict(zip(res.names, res.estimate))
+    lag = est.pop("tau_s", None)  # the sensors' lag: no rig-file value, told in the header
+    identified = rig_with_values(cfg, est)
+    header = (f"Identified by ambseal from {', '.join(str(d) for d in data)}\n"
+              f"parameters: {', '.join(res.names)}; converged: {res.converged}\n"
+              + (f"sensor lag tau_s = {lag:.4g} s (fitted; the rig file has no key for it: "
+                 "the model the controllers are designed on leaves it out)\n"
+                 if lag is not None else "") +
+              f"seal coefficients, if fitted, hold at the recorded pressure drop(s) "
+              f"{pressures} bar")
+    write_text(out / "identified.toml", dump_rig(identified, header))
+    return {"out": str(out), "converged": res.converged, "message": res.message,
+            "parameters": {
+                n: {"estimate": float(v), "ci95": [_finite(lo), _finite(hi)],
+                    **({"rsd_pct": spread[n]["rsd_pct"]} if spread else {})}
+                for n, v, lo, hi in zip(res.names, res.estimate, res.ci95_low, res.ci95_high)},
+            "nrmse_fit_pct": {k: _finite(v) for k, v in res.nrmse_fit_pct.items()},
+            "residual_test": res.residuals.to_dict()["verdict"],
+            "model_check": res.model_check()["verdict"],
+            **({"static_load": static} if static else {}),
+            "warnings": warnings}
+
+
+def validate_summary(rig: str | Path | None = None) -> dict:
+    """``ambseal validate``: parse and check a rig file; its model and the defaults a run takes.
+
+    Returns a JSON-ready dict: ``rig``, ``name``, ``mass_kg``, ``nodes``, ``axes``; the modes
+    of the full model at the nominal condition below the controller's Nyquist frequency
+    (``modes_below_hz``, ``modes`` as [f_Hz, ζ]); ``unstable_poles`` ([Re, Im] rad/s); and
+    ``defaults``: the reduced model's order, the judged conditions, the controller's sample
+    rate, the reference PID and the judgement's grids and disturbances.
+
+    Raises
+    ------
+    ConfigError
+        The rig file does not parse or check.
+    """
+    from dataclasses import asdict
+
+    from ambseal.analysis.judge import judge_settings, operating_points
+    from ambseal.config import default_rig_path
+    from ambseal.design.specs import design_spec
+    from ambseal.model.amb import channel_names
+    from ambseal.model.modes import modes
+    from ambseal.model.rig import build_plant, build_system
+    from ambseal.model.rotor import assemble_rotor, build_mesh
+
+    cfg = load_rig(rig)
+    spec = design_spec(cfg)
+    limit = cfg.controller.sample_rate_hz / 2
+    res = modes(build_system(cfg))
+    rows = [[f, z] for f, z in zip(res.natural_frequencies_hz, res.damping_ratios) if f < limit]
+    pid = cfg.controller.pid
+    return {
+        "rig": str(rig if rig is not None else default_rig_path()),
+        "name": cfg.rotor.name, "mass_kg": assemble_rotor(cfg).mass,
+        "nodes": build_mesh(cfg).n_nodes, "axes": list(channel_names(cfg)),
+        "modes_below_hz": limit, "modes": rows,
+        "unstable_poles": [list(p) for p in res.unstable_poles],
+        "defaults": {
+            "reduced_states": build_plant(cfg, reduced=True).n_states,
+            "judged_conditions": [p.label for p in operating_points(cfg, spec)],
+            "nominal_pressure_bar": cfg.operating.pressure_bar,
+            "nominal_speed_rpm": cfg.operating.speed_rpm,
+            "controller_sample_rate_hz": cfg.controller.sample_rate_hz,
+            "pid": None if pid is None else pid.model_dump(),
+            "judgement": asdict(judge_settings(cfg, spec)),
+        },
+    }
+
+
+def track_files(rig: str | Path, data: list[str], names: list[str], out_dir: str | Path, *,
+                rate_per_s: float | None = None) -> dict:
+    """``ambseal track``: track ``names`` through each recorded file
+    (:func:`ambseal.identify.tracking.track`); write ``track.json`` (summary),
+    ``track_<i>.csv`` (time, estimate, 95 % interval per parameter, decimated to ≤ 1 kHz)
+    and ``track_<i>.png`` per record. Returns a JSON-safe summary.
+
+    Raises
+    ------
+    ConfigError, DataError, IdentificationError
+        A bad rig; a bad record, one whose excitation exceeds the current limit, or one too
+        short; a name without an LFT channel.
+    """
+    import numpy as np
+
+    from ambseal.design.pid import controller_from_metadata
+    from ambseal.identify.data import load_measurement
+    from ambseal.identify.tracking import TrackingSettings, check_excitation, track
+    from ambseal.model.amb import channel_names
+    from ambseal.report.tracking_figures import tracking_figure
+
+    cfg = load_rig(rig)
+    axes = channel_names(cfg)
+    settings = TrackingSettings() if rate_per_s is None else TrackingSettings(
+        rate_per_s=rate_per_s)
+    out = writable_folder(out_dir)  # before the work, not after it
+    records = []
+    for path in data:
+        meas = load_measurement(path, axes=axes, min_samples=3)
+        check_excitation(cfg, meas, str(path))
+        # the model needs the controller only to be built (the tracker cuts the loop at the
+        # DAC); a real rig's PID description becomes its matrices as in `identify`
+        records.append((meas, controller_from_metadata(dict(meas.metadata), axes, str(path))))
+    summary = []
+    for i, (path, (meas, ctrl)) in enumerate(zip(data, records)):
+        res = track(cfg, meas, names, settings, source=str(path), controller=ctrl)
+        lo, hi = res.ci95()
+        step = max(1, int(round(1e-3 / (res.time_s[1] - res.time_s[0]))))
+        cols = [res.time_s[::step]] + [a[::step, j] for j in range(len(names))
+                                       for a in (res.estimate, lo, hi)]
+        head = ",".join(["time_s"] + [f"{n}{s}" for n in names for s in ("", "_ci95_low",
+                                                                         "_ci95_high")])
+        csv = "\n".join([head] + [",".join(f"{v:.9g}" for v in row)
+                                  for row in np.column_stack(cols)]) + "\n"
+        write_text(out / f"track_{i + 1}.csv", csv)
+        tracking_figure(out / f"track_{i + 1}.png", res.time_s, names, res.estimate, lo, hi,
+                        units=res.units, title=f"Tracked parameters: {Path(path).name}")
+        summary.append({"data": str(path), "csv": str(out / f"track_{i + 1}.csv"),
+                        "figure": str(out / f"track_{i + 1}.png"),
+                        "final": {n: {"estimate": float(res.estimate[-1, j]),
+                                      "std_error": float(res.std_error[-1, j]),
+                                      "ci95": [float(lo[-1, j]), float(hi[-1, j])]}
+                                  for j, n in enumerate(names)},
+                        "n_states": res.n_states, "flops_per_sample": res.flops_per_sample,
+                        "realtime_factor": res.realtime_factor})
+    result = {"out": str(out), "parameters": list(names), "records": summary}
+    write_json(out / "track.json", result)
+    return result

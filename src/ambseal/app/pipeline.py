@@ -1,0 +1,236 @@
+"""The main job, stage by stage: rig → model → (identification →) controllers → judgement → report.
+
+``ambseal run`` calls :func:`run`. It holds no numerics of its own: it wires
+:mod:`ambseal.model`, :mod:`ambseal.design`, :mod:`ambseal.analysis.judge`,
+:mod:`ambseal.identify` and :mod:`ambseal.report.run_report`, and writes every file through
+a temporary name and a rename.
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+from ambseal.config import RigConfig, default_rig_path, load_rig, load_truth
+from ambseal.app.commands import Designed
+from ambseal.errors import ConfigError
+from ambseal.files import RunFolder, write_json
+
+__all__ = ["RunResult", "run", "default_truth_path"]
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """Where the main job wrote its results, and the metrics it wrote."""
+
+    out_dir: Path
+    metrics_path: Path
+    report_path: Path
+    metrics: dict
+
+
+def default_truth_path() -> Path:
+    """The virtual facility's truth for the embedded test rig (``data/testrig_truth.toml``)."""
+    return Path(__file__).resolve().parents[1] / "data" / "testrig_truth.toml"
+
+
+def _controllers(cfg: RigConfig, spec, say, allow_unstable: bool = False,
+                 methods: tuple[str, ...] = ("pid", "hinf", "mu")) -> list[Designed]:
+    """The designed controllers of the main job.
+
+    Pressure-driven seals (the test rig): the reference PID, H∞ and μ (P5 §4), from the
+    rig's design specification ``spec``. Speed-driven seals over a speed range (the
+    turboexpander, P3 §4): the reference PID, H∞ and μ at the operating speed (P3 §3,
+    Fig. 11) and the LPV controller scheduled on speed. ``say(message, steps)`` reports:
+    one step per design, messages in between. ``methods`` limits the pressure-driven case
+    (the PID alone before identification, H∞ and μ on the identified rig after it).
+    """
+    from ambseal.analysis.judge import speed_scheduled
+    from ambseal.design.recipes import design
+
+    def lti(res) -> Designed:
+        return Designed(res.method, res.K, res.summary(), res)
+
+    def robust(m: str) -> Designed:
+        say(f"designing {m}", 0)
+        d = lti(design(cfg, m, spec=spec, allow_unstable=allow_unstable,
+                       progress=lambda msg: say(msg, 0)))
+        say(f"{m} designed", 1)
+        return d
+
+    if speed_scheduled(cfg):
+        from ambseal.design.lpv_design import design_frozen, design_lpv
+
+        out = [lti(design(cfg, "pid"))]
+        say("pid designed", 1)
+        fz = design_frozen(cfg, cfg.operating.speed_rpm / 60.0, allow_unstable=allow_unstable)
+        out.append(Designed("hinf", fz.K, fz.to_dict(), fz))
+        say("hinf designed", 1)
+        out.append(robust("mu"))
+        lpv = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz,
+                         allow_unstable=allow_unstable)
+        say("lpv designed", 1)
+        return out + [Designed("lpv", lpv, lpv.to_dict(), lpv)]
+    out = []
+    if "pid" in methods:
+        out.append(lti(design(cfg, "pid")))
+        say("pid designed", 1)
+    return out + [robust(m) for m in methods if m != "pid"]
+
+
+def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
+        progress: bool = True, truth: str | Path | None = None,
+        identification: bool = True, overrides: tuple[str, ...] = (),
+        allow_unstable: bool = False, command: str | None = None) -> RunResult:
+    """The main job: build and reduce the model, design, judge, identify, report.
+
+    Parameters
+    ----------
+    rig : path, optional
+        Rig file; the embedded thesis test facility when omitted.
+    out_dir : path
+        Output folder, created if needed, replaced as a whole at the end
+        (:class:`ambseal.files.RunFolder`: a staging folder beside it, a lock against a
+        second run, a manifest of the files written last).
+    progress : bool
+        Show a progress display on stderr when it is a terminal; stage lines go to the
+        ``"ambseal"`` logger in any case (:mod:`ambseal.report.progress`).
+    truth : path, optional
+        Truth file of the virtual test facility; with it (and by default for the embedded
+        rig) the run identifies the rig on the virtual facility by the thesis's procedure
+        (:mod:`ambseal.identify.procedure`) with the reference PID, designs H∞ and μ on the
+        identified rig (unless it equals the rig file within its intervals:
+        :func:`ambseal.identify.design_model.design_rig`), judges every controller on the
+        facility's full-order truth and runs their impulse responses on the facility
+        beside the identified model (P5 §3, Figs. 15–16).
+    identification : bool
+        Set False to skip the identification stage.
+    overrides : tuple of str
+        ``design.<key>=<value>`` settings applied to the rig file before validation
+        (:func:`ambseal.config.load_rig`).
+    allow_unstable : bool
+        Keep a controller whose full-order loop is unstable at a judged condition (marked
+        in ``metrics.json``) instead of stopping with a SynthesisError.
+    command : str, optional
+        The command line, for the report's stamp.
+
+    Returns
+    -------
+    RunResult
+
+    Raises
+    ------
+    ConfigError
+        A bad rig file, a rig without AMBs or without ``[controller.pid]``.
+    SynthesisError
+        A controller that does not stabilise the full-order plant (without
+        ``allow_unstable``).
+    """
+    from ambseal.analysis.judge import (frozen_at, judge_case, judge_jobs, judge_settings,
+                                 judge_spinup, operating_points, speed_scheduled,
+                                 unstable_open_loop_poles)
+    from ambseal.analysis.cases import run_cases
+    from ambseal.design.specs import design_spec
+    from ambseal.app.commands import digitals_for, export_all, facility_impulses, identification_stage
+    from ambseal.model.rig import build_plant
+    from ambseal.app.tracked import tracked_designs, tracked_ramp
+    from ambseal.report.progress import StageProgress
+    from ambseal.report.run_report import (gains_figure, rig_clearances_um, spinup_figures, stamp,
+                                    write_run_report)
+
+    rig_path = Path(rig) if rig is not None else default_rig_path()
+    cfg = load_rig(rig_path, overrides)
+    if truth is None and rig is None:
+        truth = default_truth_path()
+    if not cfg.amb:
+        raise ConfigError(f"{rig_path}: amb: the main job needs at least one [[amb]]")
+    # the truth file is refused before any work
+    truth_cfg = load_truth(truth) if identification and truth is not None else None
+    spec = design_spec(cfg)
+    points = operating_points(cfg, spec)
+    settings = judge_settings(cfg, spec)
+    final = Path(out_dir)
+    n_designs = 4 if speed_scheduled(cfg) else 3
+    n_tr = int(cfg.design.tracked)  # issue 14, off by default: minutes of LMI synthesis
+    totals = {"model": 1, "design": n_designs, "judge": (n_designs + n_tr) * len(points),
+              "identification": None, "design (identified)": 2 + n_tr, "spin-up": 1,
+              "ramp": 1, "report": 1}
+    # one run = one folder: written into a staging folder that replaces out_dir at the end
+    with RunFolder(final) as out, \
+            StageProgress(totals, display=progress and sys.stderr.isatty()) as stages:
+        (out / "controllers").mkdir()
+        stages.begin("model", "full order and modal reduction")
+        full = build_plant(cfg)
+        n_reduced = build_plant(cfg, reduced=True).n_states
+        unstable = unstable_open_loop_poles(full.A)
+        stages.step()
+        say = lambda msg, steps=0: stages.step(msg, steps)  # noqa: E731
+        stages.begin("design")
+        early = truth_cfg is not None and not speed_scheduled(cfg)  # P5 §3: identify first
+        designs = _controllers(cfg, spec, say, allow_unstable,
+                               ("pid",) if early else ("pid", "hinf", "mu"))
+        digitals, cannot_run = digitals_for(cfg, designs, points, lambda m: stages.step(m, 0))
+        ident, judge_cfg = None, cfg
+        if truth_cfg is not None:
+            if "pid" not in digitals:
+                raise ConfigError("controller.pid: the virtual facility runs the reference "
+                                  "PID during identification, and "
+                                  + cannot_run.get("pid", "the rig has none"))
+            stages.begin("identification")
+            ident = identification_stage(cfg, truth_cfg, out, stages.step,
+                                         digitals["pid"].discrete)
+            judge_cfg = ident.truth_cfg
+        if early:
+            stages.begin("design (identified)", ident.summary["design"]["designed_on"])
+            robust = _controllers(ident.design_cfg, spec, say, allow_unstable, ("hinf", "mu"))
+            more, more_cannot = digitals_for(ident.design_cfg, robust, points,
+                                             lambda m: stages.step(m, 0))
+            digitals.update(more)
+            cannot_run.update(more_cannot)
+            designs += robust
+            facility_impulses(cfg, truth_cfg, ident, digitals, out)
+        design_cfg = cfg if ident is None else ident.design_cfg
+        designs += tracked_designs(cfg, design_cfg, points, say, digitals, cannot_run)
+        stages.begin("judge")
+        jobs = judge_jobs(designs, digitals, points, design_cfg)
+        judged = run_cases(judge_case, jobs, shared={"cfg": judge_cfg, "settings": settings},
+                           workers=1, raise_errors=True,
+                           on_done=lambda i, r: stages.step(f"{jobs[i]['name']} at "
+                                                            f"{jobs[i]['point'].label}"))
+        cases = [case for case, _ in judged]
+        curves = [(j["name"], j["point"], case, c) for j, (case, c) in zip(jobs, judged)]
+        summaries = export_all(designs, digitals, cases, out / "controllers")
+        metrics = {
+            "rig": str(rig_path),
+            "rig_name": cfg.rotor.name,
+            "open_loop": {"unstable_poles": [[float(z.real), float(z.imag)] for z in unstable],
+                          "n_states_full": full.n_states, "n_states_reduced": n_reduced},
+            "unbalance": settings.unbalance_dict(),
+            "design_spec": spec.to_dict(),
+            "controllers": summaries,
+            "cannot_run": cannot_run,
+            "cases": cases,
+        }
+        figs, sections = ([], []) if ident is None else (ident.figs, ident.sections)
+        if ident is not None:
+            metrics["identification"] = ident.summary
+        if speed_scheduled(cfg):
+            stages.begin("spin-up", "spin-up and frozen sensitivities")
+            metrics["spinup"], sims, sens = judge_spinup(  # LPV against μ: P3 Fig. 11
+                cfg, {d.method: d.controller for d in designs if d.method in ("mu", "lpv")})
+            figs += spinup_figures(out, sims, sens, cfg.operating.speed_range_hz)
+            stages.step()
+        if cfg.design.tracked and truth_cfg is not None:
+            stages.begin("ramp", "0 → 3× nominal pressure on the virtual facility")
+            metrics["ramp"], fig = tracked_ramp(cfg, truth_cfg, designs, digitals, ident, out,
+                                                say)
+            figs.append(fig)
+        stages.begin("report")
+        write_json(out / "metrics.json", metrics)
+        figs.append(gains_figure(out, [(d.method, frozen_at(d.controller, cfg.operating,
+                                                            design_cfg)) for d in designs]))
+        write_run_report(out, f"ambseal — {cfg.rotor.name}", stamp(rig_path, command),
+                         metrics, curves, figs, sections, rig_clearances_um(cfg))
+        stages.step()
+    return RunResult(final, final / "metrics.json", final / "report.html", metrics)

@@ -1,0 +1,285 @@
+"""The rotordynamicist's commands: ``modes``, ``campbell``, ``sweep`` and ``import-ross``.
+
+Wiring only, like :mod:`ambseal.app.commands`: the numbers come from
+:mod:`ambseal.analysis.campbell`, :mod:`ambseal.analysis.sweep` and :mod:`ambseal.io.ross`,
+the figures from :mod:`ambseal.report.modal_figures`, and every file is written through a
+temporary name and a rename (:mod:`ambseal.files`). The CLI (:mod:`ambseal.cli`) adds these
+subcommands with :func:`add_parsers` and runs them with :data:`HANDLERS`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import json
+from pathlib import Path
+
+from ambseal.config import load_rig
+from ambseal.errors import ConfigError
+from ambseal.files import write_json, write_text
+
+__all__ = ["add_parsers", "HANDLERS", "controller_for", "write_table"]
+
+
+def controller_for(cfg, spec: str | None, pressure_bar: float | None = None):
+    """The controller ``spec`` names: ``pid``, ``hinf`` or ``mu`` (designed on the rig by
+    :func:`ambseal.design.recipes.design` at ``pressure_bar``), or a controller file of
+    ``ambseal design`` (.json, .npz, .mat); ``None`` or ``"none"`` for the open loop."""
+    if spec is None or spec == "none":
+        return None
+    from ambseal.design.recipes import METHODS, design
+
+    if spec in METHODS:
+        return design(cfg, spec, pressure_bar=pressure_bar).K
+    if Path(spec).suffix.lower() not in (".json", ".npz", ".mat"):
+        raise ConfigError(f"--controller: expected pid, hinf, mu, none or a controller file "
+                          f"(.json, .npz, .mat), got {spec!r}")
+    from ambseal.robust.digital import DigitalController
+    from ambseal.export.controller_files import load_controller
+
+    K = load_controller(spec)  # a judged digital controller: its continuous design
+    return K.continuous if isinstance(K, DigitalController) else K
+
+
+def write_table(path: Path, rows: list[dict]) -> list[Path]:
+    """Rows as CSV (columns: the union of keys, in first-seen order), and as Parquet beside
+    it when pyarrow is installed. Returns the files written."""
+    cols = list(dict.fromkeys(k for r in rows for k in r))
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=cols, lineterminator="\n")
+    w.writeheader()
+    w.writerows(rows)
+    files = [write_text(path, buf.getvalue())]
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except ImportError:
+        return files
+    from ambseal.files import atomic_write
+
+    table = pa.Table.from_pylist([{c: r.get(c) for c in cols} for r in rows])
+    pq_path = path.with_suffix(".parquet")
+    atomic_write(pq_path, lambda fh: pq.write_table(table, fh))
+    return files + [pq_path]
+
+
+def _positions(cfg) -> dict[str, list[float]]:
+    return {"AMB": [a.position for a in cfg.amb], "sensor": [a.sensor_position for a in cfg.amb],
+            "seal": [s.position for s in cfg.seal], "disk": [d.position for d in cfg.disk]}
+
+
+def _range(text: str | None, name: str):
+    from ambseal.analysis.sweep import parse_range
+
+    return None if text is None else parse_range(text, name)
+
+
+def _modes(args: argparse.Namespace) -> int:
+    from ambseal.analysis.campbell import closed_loop_modes, modes_of_state_matrix
+    from ambseal.model.modes import bending_limit_hz, modes
+    from ambseal.model.rig import build_system
+
+    cfg = load_rig(args.rig)
+    p = cfg.operating.pressure_bar if args.pressure_bar is None else args.pressure_bar
+    rpm = cfg.operating.speed_rpm if args.speed_rpm is None else args.speed_rpm
+    if args.controller is not None and (args.free or args.no_amb):
+        raise ConfigError("modes: --controller closes the loop over the AMBs; it cannot be "
+                          "combined with --free or --no-amb")
+    sys_ = build_system(cfg, speed_rpm=rpm, pressure_bar=p,
+                        include_amb=not (args.free or args.no_amb), include_seals=not args.free,
+                        include_springs=not args.free)
+    res = modes(sys_, n_modes=args.n_modes)
+    f_max = args.max_hz if args.max_hz is not None else (
+        max(res.natural_frequencies_hz, default=0.0) if args.n_modes else bending_limit_hz(cfg))
+    K = controller_for(cfg, args.controller, p)
+    if K is None:
+        m = modes_of_state_matrix(sys_.state_matrices()[0], sys_.mesh, speed_hz=rpm / 60.0,
+                                  pressure_bar=p, max_hz=f_max)
+    else:
+        m = closed_loop_modes(cfg, K, speed_hz=rpm / 60.0, pressure_bar=p, max_hz=f_max)
+    unstable = res.unstable_poles if K is None else [
+        (float(z.real), float(z.imag)) for z in m.poles if z.real > 0]
+    out = {"speed_hz": rpm / 60.0, "pressure_bar": p, "max_hz": f_max,
+           "controller": args.controller or "none",
+           "natural_frequencies_hz": [float(x) for x in m.frequency_hz],
+           "damping_ratios": [float(x) for x in m.damping_ratio],
+           "log_decrements": [float(x) for x in m.log_decrement], "whirl": list(m.whirl),
+           "unstable_poles": [list(z) for z in unstable]}
+    if args.shapes is not None:
+        from ambseal.report.modal_figures import mode_shapes_figure
+
+        out["shapes"] = str(mode_shapes_figure(Path(args.shapes), m, _positions(cfg)))
+    if args.json:
+        print(json.dumps(out, indent=2))
+        return 0
+    print(f"speed {rpm / 60.0:g} Hz ({rpm:g} rpm), pressure drop {p:g} bar, "
+          f"controller {out['controller']}, modes up to {f_max:.4g} Hz")
+    print(f"{'mode':>4}  {'f_d [Hz]':>12}  {'zeta [-]':>10}  {'log dec':>9}  whirl")
+    for i, (f, z, d, w) in enumerate(zip(m.frequency_hz, m.damping_ratio, m.log_decrement,
+                                         m.whirl), 1):
+        print(f"{i:>4}  {f:>12.3f}  {z:>10.4f}  {d:>9.4f}  {w}")
+    if unstable:
+        print("unstable poles [rad/s]:")
+        for re, im in unstable:
+            print(f"  {re:+.4g} {im:+.4g}j")
+    else:
+        print("no unstable poles")
+    if "shapes" in out:
+        print(f"mode shapes: {out['shapes']}")
+    return 0
+
+
+def _campbell(args: argparse.Namespace) -> int:
+    from ambseal.analysis.campbell import campbell
+    from ambseal.report.modal_figures import campbell_figure, mode_shapes_figure
+
+    cfg = load_rig(args.rig)
+    p = cfg.operating.pressure_bar if args.pressure_bar is None else args.pressure_bar
+    speeds = _range(args.speed_hz, "--speed-hz")
+    spec = args.controller or ("pid" if cfg.controller.pid is not None and cfg.amb else
+                               "hinf" if cfg.amb else None)
+    K = controller_for(cfg, spec, p)
+    c = campbell(cfg, K, speeds, pressure_bar=p,
+                 max_hz=args.max_hz, log_dec_limit=args.log_dec_limit, workers=args.workers,
+                 scheduler=args.scheduler, progress=True)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    tag = Path(spec).stem if spec else "open_loop"
+    title = f"{cfg.rotor.name}: {tag}, {p:g} bar"
+    files = [campbell_figure(out / f"campbell_{tag}.png", c, title=f"Campbell — {title}"),
+             mode_shapes_figure(out / f"mode_shapes_{tag}.png", c.points[0], _positions(cfg),
+                                title=f"Mode shapes — {cfg.rotor.name}: {tag}"),
+             write_json(out / f"campbell_{tag}.json",
+                        {"rig": str(args.rig), "controller": spec or "none",
+                         "pressure_bar": p, **c.to_dict()})]
+    files += write_table(out / f"campbell_{tag}.csv", c.rows())
+    print(json.dumps({"controller": spec or "none", "pressure_bar": p,
+                      "speeds_hz": [float(c.speeds_hz[0]), float(c.speeds_hz[-1]),
+                                    len(c.speeds_hz)],
+                      "stable_at_all_speeds": all(pt.stable for pt in c.points),
+                      "crossings": [x.to_dict() for x in c.crossings],
+                      "flagged_modes": len(c.flagged()), "log_dec_limit": c.log_dec_limit,
+                      "files": [str(f) for f in files]}))
+    return 0
+
+
+def _sweep(args: argparse.Namespace) -> int:
+    from ambseal.analysis.cases import dask_available
+    from ambseal.analysis.sweep import refine_boundary, stability_boundary, sweep
+    from ambseal.report.modal_figures import stability_map_figure
+
+    cfg = load_rig(args.rig)
+    pressures = _range(args.pressure_bar, "--pressure-bar")
+    speeds = _range(args.speed_hz, "--speed-hz")
+    specs = (args.controller or "pid").split(",")
+    ctrl = {Path(s).stem: controller_for(cfg, s, cfg.operating.pressure_bar) for s in specs}
+    if any(K is None for K in ctrl.values()):
+        raise ConfigError("sweep: every --controller must be a controller (pid, hinf, mu or "
+                          "a file), not none")
+    params = {}
+    for text in args.param or []:
+        name, sep, rng = text.partition("=")
+        if not sep:
+            raise ConfigError(f"--param: expected NAME=a:b:n, got {text!r}")
+        params[name.strip()] = _range(rng, f"--param {name}")
+    workers = args.workers
+    if workers is None and args.scheduler is None and not dask_available():
+        import sys
+
+        print("ambseal: note: dask is not installed; the sweep runs serially",
+              file=sys.stderr)
+        workers = 1
+    rows = sweep(cfg, ctrl, pressures, speeds, params, max_hz=args.max_hz,
+                 workers=workers, scheduler=args.scheduler, progress=True)
+    edge = refine_boundary(cfg, ctrl, stability_boundary(rows), tol_bar=args.tol_bar,
+                           workers=workers, scheduler=args.scheduler, progress=True)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    files = write_table(out / "sweep.csv", rows)
+    files.append(write_json(out / "stability_boundary.json", edge))
+    if not params:
+        files.append(stability_map_figure(out / "stability_map.png", rows, edge,
+                                          title=cfg.rotor.name))
+    print(json.dumps({"cases": len(rows), "failed": sum(r.get("error") is not None
+                                                         for r in rows),
+                      "boundary": edge, "files": [str(f) for f in files]}))
+    return 0
+
+
+def _import_ross(args: argparse.Namespace) -> int:
+    from ambseal.io.ross import import_ross_file
+
+    res = import_ross_file(args.file, args.out)
+    print(json.dumps(res))
+    return 0
+
+
+def add_parsers(sub, positive_int) -> None:
+    """Add ``modes``, ``campbell``, ``sweep`` and ``import-ross`` to the CLI's subparsers."""
+    m = sub.add_parser("modes", help="natural frequencies, damping, log decrement, whirl, "
+                                     "unstable poles and mode shapes")
+    m.add_argument("rig", nargs="?", help="rig file (TOML); default: the embedded thesis test "
+                                          "facility")
+    m.add_argument("--speed-rpm", type=float, default=None, help="spin speed (rpm)")
+    m.add_argument("--pressure-bar", type=float, default=None, help="seal pressure drop (bar)")
+    m.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    m.add_argument("--n-modes", type=positive_int, default=None,
+                   help="only the N lowest modes (sparse shift-invert; unstable poles up to "
+                        "the N-th mode only)")
+    m.add_argument("--max-hz", type=float, default=None,
+                   help="modes up to this frequency (Hz); default 1.25x the third free-free "
+                        "bending frequency")
+    m.add_argument("--controller", default=None,
+                   help="close the loop: pid, hinf, mu or a controller file (default: the "
+                        "open-loop model)")
+    m.add_argument("--shapes", nargs="?", const="mode_shapes.png", default=None,
+                   metavar="PNG", help="plot the mode shapes (default file mode_shapes.png)")
+    g = m.add_mutually_exclusive_group()
+    g.add_argument("--free", action="store_true", help="bare rotor: shaft and disks only")
+    g.add_argument("--no-amb", action="store_true", help="leave the AMBs out")
+
+    c = sub.add_parser("campbell", help="closed-loop Campbell diagram and log decrements")
+    c.add_argument("rig", help="rig file (TOML)")
+    c.add_argument("--controller", default=None,
+                   help="pid, hinf, mu, none or a controller file (default pid, else hinf)")
+    c.add_argument("--speed-hz", default=None, help="speeds a:b:n (Hz); default 0 to 1.2x "
+                   "the top speed (or the first free-free bending frequency), 31 points")
+    c.add_argument("--pressure-bar", type=float, default=None,
+                   help="seal pressure drop (bar); default [operating] pressure_bar")
+    c.add_argument("--max-hz", type=float, default=None, help="highest mode frequency (Hz)")
+    c.add_argument("--log-dec-limit", type=float, default=0.1,
+                   help="flag modes below this log decrement (API 684: 0.1)")
+    c.add_argument("--out", default="ambseal-campbell", help="output folder")
+    _executor_args(c)
+
+    s = sub.add_parser("sweep", help="stability and performance map over pressure x speed")
+    s.add_argument("rig", help="rig file (TOML)")
+    s.add_argument("--pressure-bar", required=True, help="pressure drops a:b:n (bar)")
+    s.add_argument("--speed-hz", default="0", help="speeds a:b:n (Hz), default 0")
+    s.add_argument("--controller", default=None,
+                   help="pid, hinf, mu or controller files, comma separated (default pid)")
+    s.add_argument("--param", action="append", metavar="NAME=a:b:n",
+                   help="a rig parameter to sweep too, e.g. seal.k=0:2e6:5 (repeatable)")
+    s.add_argument("--max-hz", type=float, default=None,
+                   help="modes of the lowest log decrement up to this frequency (Hz)")
+    s.add_argument("--tol-bar", type=float, default=0.01,
+                   help="the stability boundary is bisected to this pressure (bar)")
+    s.add_argument("--out", default="ambseal-sweep", help="output folder")
+    _executor_args(s)
+
+    r = sub.add_parser("import-ross", help="a ROSS rotor file (.toml/.json) as an ambseal rig")
+    r.add_argument("file", help="ROSS rotor file saved by ross.Rotor.save")
+    r.add_argument("--out", required=True, help="rig file to write (TOML)")
+
+
+def _executor_args(p) -> None:
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--workers", type=int, default=None,
+                   help="local Dask worker processes (1: serial; default: serial for small "
+                        "runs, one per core for large ones)")
+    g.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
+
+
+HANDLERS = {"modes": _modes, "campbell": _campbell, "sweep": _sweep,
+            "import-ross": _import_ross}

@@ -1,0 +1,79 @@
+"""``ambseal run``'s ``tracked`` controller (``[design] tracked = true``; issue 14 §3).
+
+Wiring only, beside :mod:`ambseal.app.commands`: the controller scheduled on the first seal's
+cross-coupled stiffness k (:func:`ambseal.design.seal_schedule.design_seal_scheduled`,
+designed on the rig the robust controllers are designed on), its value at each judged
+condition (the design rig's k at that pressure: the identified k when the run identified
+the rig), and the closed-loop pressure ramp on the virtual facility with every controller
+that runs on the target and the tracked scheme (:func:`ambseal.analysis.ramp.
+ramp_simulation`; the tracker's model is the identified rig).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ambseal.errors import ConfigError
+
+__all__ = ["tracked_designs", "tracked_ramp"]
+
+
+def tracked_designs(cfg, design_cfg, points, say, digitals: dict, cannot_run: dict) -> list:
+    """``[design] tracked``: ``[]`` when off, else the tracked controller as a design of the
+    main job (:class:`ambseal.app.commands.Designed`), designed on ``design_cfg``, with its digital table
+    (:func:`ambseal.app.commands.digitals_for`: discretisation chosen on the sampled full-order
+    loops with the target's delay at the judged pressures and between table entries) put
+    in ``digitals``, or the reason it cannot run in ``cannot_run``.
+
+    Raises
+    ------
+    ConfigError
+        A rig whose seal forces follow the speed (its LPV controller is the scheduled one)
+        or that has no seal.
+    """
+    from ambseal.analysis.judge import speed_scheduled
+    from ambseal.app.commands import digitals_for
+    from ambseal.design.seal_schedule import design_seal_scheduled
+    from ambseal.app.commands import Designed
+
+    if not cfg.design.tracked:
+        return []
+    if speed_scheduled(cfg) or not cfg.seal:
+        raise ConfigError("design.tracked: needs a rig whose [[seal]] k follows the pressure "
+                          "drop (this one " + ("is scheduled on speed)" if cfg.seal
+                                               else "has no [[seal]])"))
+    say("designing tracked (LPV on the seal's k; minutes unless cached)", 0)
+    d = design_seal_scheduled(design_cfg)
+    say("tracked designed", 1)
+    out = [Designed("tracked", d, d.to_dict(), d)]
+    more, cannot = digitals_for(design_cfg, out, points, lambda m: say(m, 0))
+    digitals.update(more)
+    cannot_run.update(cannot)
+    return out
+
+
+def tracked_ramp(cfg, truth, designs, digitals: dict, ident, out: Path, say
+                 ) -> tuple[dict, tuple[str, Path]]:
+    """The 0 → 3× nominal ramp on the virtual facility, the tracker's model the rig
+    identified by ``ident`` (``commands.Identified``): ``metrics.json``'s ``ramp`` and the
+    report's figure (caption, path); one step of ``say(message, steps)`` at the end."""
+    from ambseal.analysis.ramp import ramp_simulation
+    from ambseal.report.tracking_figures import ramp_figure
+
+    tracked = next(d.controller for d in designs if d.method == "tracked")
+    fixed = {m: g.discrete for m, g in digitals.items() if m != "tracked"}
+    r = ramp_simulation(cfg, truth, fixed, tracked, model_cfg=ident.result.identified,
+                        tracked_digital=digitals.get("tracked"),
+                        delay_samples=cfg.controller.delay_samples,
+                        progress=lambda line: say(line, 0))
+    t = r.tracking
+    caption = (f"Pressure ramp 0 → {r.pressure_bar.max():.3g} bar in {r.time_s[-1]:.0f} s on "
+               "the virtual facility with a current impulse every 2 s: true and tracked "
+               f"{r.parameter} (largest error after 1 s "
+               f"{100 * (t.get('max_error_rel') or float('nan')):.1f} % of nominal, 95 % "
+               f"interval coverage {100 * (t.get('coverage') or float('nan')):.1f} %), "
+               "displacement and current of every controller, impulse peaks and settling "
+               "times (issue 14)")
+    fig = ramp_figure(out / "ramp.png", r)
+    say("ramp done", 1)
+    return r.to_dict(), (caption, fig)

@@ -1,0 +1,17 @@
+"""ambseal.config: the rig file — its TOML format, validated with pydantic (strict).
+
+The one place that knows the file format (:mod:`ambseal.config.rig`: rotor, AMBs, seals,
+springs, controllers, operating points, the facility truth) and its ``[design]`` part
+(:mod:`ambseal.config.design`); rules that need more than one key live in
+:mod:`ambseal.config._checks`. Every other layer receives the typed models from here.
+"""
+
+from ambseal.config.rig import (Actuator, Affine, Amb, AxisPair, Coefficient, FrequencyTable,
+                                RigConfig, Seal, Spring, TruthSection, apply_overrides,
+                                check_operating, default_rig_path, dump_rig, load_rig,
+                                load_truth, parse_rig, rig_with_values)
+
+__all__ = ["Actuator", "Affine", "Amb", "AxisPair", "Coefficient", "FrequencyTable",
+           "RigConfig", "Seal", "Spring", "TruthSection", "apply_overrides",
+           "check_operating", "default_rig_path", "dump_rig", "load_rig", "load_truth",
+           "parse_rig", "rig_with_values"]

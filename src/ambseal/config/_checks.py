@@ -1,0 +1,127 @@
+"""Rules of the rig file that need more than one key: force factors, actuator model, and the
+whole rig (materials, positions, names, model size). Called by the validators of
+:mod:`ambseal.config`, which owns the format; duck-typed on its classes.
+"""
+
+from __future__ import annotations
+
+from ambseal.errors import ConfigError
+
+__all__ = ["MAX_ELEMENTS", "MAX_REDUCED_STATES", "check_amb", "check_actuator", "cross_check"]
+
+#: Beam elements in the whole shaft, the most a rig may ask for: the dense eigenvalues grow
+#: with the states³ (8 per node; measured ~1e-9 s·states³ on one core) and a run makes
+#: dozens of them; a 200-element shaft ran 982 s. 150 elements (1 208 states, ~2 s per
+#: eigen-decomposition) resolve any rotor's modes of interest.
+MAX_ELEMENTS = 150
+#: States of a reduced model for control design, at most (H∞/μ synthesis grows with n³ and
+#: beyond ~100 states is numerically fragile).
+MAX_REDUCED_STATES = 200
+
+
+def check_amb(self):  # noqa: N805 (the Amb being validated)
+    """An AMB's force factors: Ki > 0, Ks >= 0 (ambseal's sign convention), and either the
+    whole geometry or both factors (ValueError; pydantic names the AMB)."""
+    for key in ("ki", "ks"):
+        v = getattr(self, key)
+        for axis, x in ((("zeta", v.zeta), ("eta", v.eta)) if hasattr(v, "zeta")
+                        else (("", v),)):
+            if x is None:
+                continue
+            if key == "ki" and x <= 0:
+                raise ValueError(f"ki{'.' + axis if axis else ''}: expected Ki > 0 (N/A), "
+                                 f"got {x:g}")
+            if key == "ks" and x < 0:
+                raise ValueError(
+                    f"ks{'.' + axis if axis else ''}: expected Ks >= 0 (N/m), got {x:g}: "
+                    "ambseal's convention is f = Ki i + Ks x, Ks > 0 the destabilising "
+                    "negative stiffness of a biased AMB (P2 Eq. 1); give its magnitude")
+    geometry = {"turns": self.turns, "pole_area": self.pole_area,
+                "air_gap": self.air_gap, "bias_current": self.bias_current}
+    given = [k for k, v in geometry.items() if v is not None]
+    if len(given) == len(geometry):
+        return self
+    if given and not (set(given) <= {"air_gap", "bias_current"}
+                      and None not in (self.ki, self.ks)):
+        # with ki and ks, air_gap and bias_current alone are read by the design defaults
+        # (D_e, D_u, the impulse: ambseal.design.specs); other partial geometry is not
+        missing = [k for k in geometry if k not in given]
+        raise ValueError(f"partial geometry: {', '.join(given)} given without "
+                         f"{', '.join(missing)} (give all four, or ki and ks alone)")
+    if self.ki is None or self.ks is None:
+        raise ValueError(
+            "expected either the geometry (turns, pole_area, air_gap, bias_current) "
+            "or both ki (N/A) and ks (N/m)"
+        )
+    for key in ("ki", "ks"):
+        v = getattr(self, key)
+        if hasattr(v, "zeta") and None in (v.zeta, v.eta):
+            raise ValueError(f"{key}: expected both zeta and eta (or the geometry: "
+                             "turns, pole_area, air_gap, bias_current)")
+    return self
+
+
+def check_actuator(self):  # noqa: N805
+    """The actuator model has the keys it needs and no key it would ignore."""
+    if self.model == "first_order" and self.cutoff_hz is None:
+        raise ValueError("model = 'first_order' expects cutoff_hz")
+    if self.model == "second_order" and (
+        self.natural_frequency is None or self.damping_ratio is None
+    ):
+        raise ValueError("model = 'second_order' expects natural_frequency and damping_ratio")
+    unused = {"none": ("cutoff_hz", "natural_frequency", "damping_ratio"),
+              "first_order": ("natural_frequency", "damping_ratio"),
+              "second_order": ("cutoff_hz",)}[self.model]
+    ignored = [k for k in unused if getattr(self, k) is not None]
+    if ignored:
+        raise ValueError(f"{', '.join(ignored)}: not used by model = '{self.model}' "
+                         "(remove it, or choose the model that uses it)")
+    return self
+
+
+def cross_check(cfg, where: str) -> None:
+    """Checks that need the whole rig: materials exist, components lie on the shaft, the
+    mesh stays within ``MAX_ELEMENTS``, names are unique (ConfigError naming the key)."""
+    for i, s in enumerate(cfg.shaft):
+        if s.material not in cfg.materials:
+            known = ", ".join(sorted(cfg.materials)) or "none"
+            raise ConfigError(
+                f"{where}: shaft[{i}].material: unknown material {s.material!r} "
+                f"(expected one of: {known})"
+            )
+    length = cfg.length
+    tol = 1e-9 * max(length, 1.0)
+
+    def on_shaft(key: str, z: float) -> None:
+        if not (-tol <= z <= length + tol):
+            raise ConfigError(
+                f"{where}: {key}: position {z} m lies outside the shaft "
+                f"(expected 0 <= position <= {length:g} m)"
+            )
+
+    for kind in ("disk", "seal", "spring"):
+        for i, comp in enumerate(getattr(cfg, kind)):
+            on_shaft(f"{kind}[{i}].position", comp.position)
+    n_elements = sum(s.elements for s in cfg.shaft)
+    if n_elements > MAX_ELEMENTS:
+        raise ConfigError(
+            f"{where}: shaft: {n_elements} beam elements in all (at most {MAX_ELEMENTS}): "
+            f"the model would have {8 * (n_elements + 1)} states, about "
+            f"{(8 * (n_elements + 1)) ** 3 * 1e-9:.0f} s per eigen-decomposition on one core "
+            "and dozens per run; use fewer elements per section")
+    for kind in ("seal", "spring"):
+        seen: set[str] = set()
+        for i, comp in enumerate(getattr(cfg, kind)):
+            name = comp.name or f"spring{i}"
+            if name in seen:
+                raise ConfigError(f"{where}: {kind}[{i}].name: duplicate {kind} name {name!r} "
+                                  "(names make the parameter names, e.g. "
+                                  f"{name}.{'k' if kind == 'seal' else 'kxx'})")
+            seen.add(name)
+    names: set[str] = set()
+    for i, a in enumerate(cfg.amb):
+        on_shaft(f"amb[{i}].position", a.position)
+        on_shaft(f"amb[{i}].sensor_position", a.sensor_position)
+        if a.name in names:
+            raise ConfigError(f"{where}: amb[{i}].name: duplicate AMB name {a.name!r}")
+        names.add(a.name)

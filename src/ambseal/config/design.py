@@ -1,0 +1,260 @@
+"""The ``[design]`` part of the rig file: what the controllers are asked for.
+
+Every key is optional. A key left out is derived from the machine (its model and the rest
+of the rig file) by the rule written next to it in :mod:`ambseal.design.specs`;
+``ambseal design RIG --show-defaults`` prints the resolved values with their rules, and
+``--set design.mu.orbit_um=8`` overrides any key on the command line (validated by this
+schema). Units are SI except where the key names its unit.
+
+``[design]``
+    ``d_e_um`` (µm): D_e, the largest allowed displacement error, scaling of the error
+    channels (thesis P5 §3.1.4). ``d_u_a`` (A): D_u, the largest allowed current change,
+    scaling of the current channels.
+    ``model_states`` (even, ≥ 2): mechanical states of the design model (the lowest modes of
+    the supported rotor), or ``model_cutoff_hz``: every mode below this frequency (Hz).
+    ``band_hz`` = ``[low, high]`` (Hz): the synthesis band (the μ grid) and the judgement
+    band (σ̄(S_o), compliance). ``order_max``: the controller order limit (balanced
+    truncation above it). ``pressures_bar`` and ``speeds_hz``: the conditions every
+    controller is judged at.
+``[design.unbalance]``
+    ``grade_mm_s`` (ISO 21940-11 balance grade G, mm/s), ``mass_kg`` (the mass m of the
+    force law), ``law`` (``"iso21940"``, the default: F_u = m·G·Ω²/Ω_max, or
+    ``"constant_velocity"``: F_u = m·G·Ω; :mod:`ambseal.analysis.unbalance`),
+    ``max_speed_hz`` (the maximum service speed Ω_max/2π at which the grade holds, Hz),
+    ``force_at`` (the name of the seal, disk, AMB or spring where the unbalance force and
+    the compliance are taken; by default the bearings), ``range_hz`` = ``[low, high]`` (the
+    speeds of the unbalance response, Hz).
+``[design.impulse]``
+    ``amplitude_a`` (A) and ``duration_s`` (s) of the current impulse of the time-domain
+    judgement (P5 §5.1).
+``[[design.uncertainty]]`` (μ)
+    ``parameter``: any name of the model's LFT (``<seal>.k``, ``<seal>.K``, ``A.Ks_zeta``,
+    ``coupling.kxx``, ...); and either ``relative`` (± that fraction of the nominal value,
+    e.g. 1.0 for the thesis's k ± 100 %, P5 §4.1) or ``low`` and ``high`` (SI). Real.
+``[design] uncertainty_from_identification`` (μ)
+    The ``fit.json`` of an ``ambseal identify`` run (a path relative to the rig file; on
+    the command line, to the working folder): the 95 % intervals of its fitted model
+    parameters become their ``low``/``high`` ranges (``τ_e`` left out; a fit marked
+    "model mismatch" refused), so identified uncertainty flows into μ as the thesis
+    intends. Entries of ``[[design.uncertainty]]`` are added to them, and replace the
+    range of a parameter both name.
+``[design.hinf]``, ``[design.mu]``, ``[design.lpv]``
+    The weights of each method (:mod:`ambseal.design.weights`): ``M``, ``omega_b_rad_s``,
+    ``A`` (W_p, P5 Eq. 7), ``wu_gain``, ``wu_corner_hz``, ``wu_hf_gain`` (W_u, constant or
+    high-pass), ``w1_gain``, ``w1_corner_hz`` (W_1), ``orbit_um`` (the unbalance-orbit demand
+    in µm; 0 switches it off) and ``wf_rolloff_hz`` (the roll-off of its force weight W_f);
+    ``[design.mu]`` also ``max_iter`` and ``dk_order`` (D–K iterations, D-scale fit order)
+    and ``iteration``: ``"dgk"`` (default: D–G–K, the real parameters kept real in the
+    synthesis, Young 1996) or ``"dk"`` (complex D–K, every block treated as complex).
+``[design] tracked`` (bool, default false)
+    ``ambseal run`` adds the ``tracked`` controller (issue 14): scheduled on the first
+    seal's k as tracked on line (:mod:`ambseal.design.seal_schedule`), judged at the
+    judged pressures frozen at the identified k there, and run on the virtual facility's
+    0 → 3× nominal pressure ramp with the other controllers and the tracker
+    (:mod:`ambseal.analysis.ramp`). Off by default: its LMI synthesis takes minutes
+    (≈ 130 s of CPU on the test rig; cached in ``$AMBSEAL_CACHE_DIR``) and the ramp ≈ 20 s.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from ambseal.errors import ConfigError
+
+__all__ = ["Design", "MethodSpec", "MuSpec", "UncertainSpec", "UnbalanceSpec", "ImpulseSpec",
+           "check_design_names", "apply_overrides"]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+
+def _band(r, key: str):
+    if r is not None and not 0 < r[0] < r[1]:
+        raise ValueError(f"{key}: expected [low, high] with 0 < low < high")
+    return r
+
+
+class MethodSpec(_Strict):
+    """Weights of one synthesis method (:class:`ambseal.design.weights.Weights`)."""
+
+    M: float | None = Field(default=None, gt=0)
+    omega_b_rad_s: float | None = Field(default=None, gt=0)
+    A: float | None = Field(default=None, gt=0, lt=1)
+    wu_gain: float | None = Field(default=None, gt=0)
+    wu_corner_hz: float | None = Field(default=None, gt=0)
+    wu_hf_gain: float | None = Field(default=None, gt=0)
+    w1_gain: float | None = Field(default=None, gt=0)
+    w1_corner_hz: float | None = Field(default=None, gt=0)
+    orbit_um: float | None = Field(default=None, ge=0)
+    wf_rolloff_hz: float | None = Field(default=None, gt=0)
+
+    @model_validator(mode="after")
+    def _wu(self) -> "MethodSpec":
+        if self.wu_hf_gain is not None and self.wu_gain is not None \
+                and self.wu_hf_gain <= self.wu_gain:
+            raise ValueError("wu_hf_gain: expected a high-frequency gain > wu_gain")
+        return self
+
+
+class MuSpec(MethodSpec):
+    """The μ design's weights plus its D–K settings."""
+
+    max_iter: int | None = Field(default=None, ge=1, le=50)
+    dk_order: int | None = Field(default=None, ge=0, le=8)
+    iteration: Literal["dgk", "dk"] | None = None
+    gain_factor: float | None = Field(default=None, ge=0)
+    gain_band_hz: tuple[float, float] | None = None
+
+    @model_validator(mode="after")
+    def _gain_band(self) -> "MuSpec":
+        _band(self.gain_band_hz, "gain_band_hz")
+        return self
+
+
+class UncertainSpec(_Strict):
+    """One uncertain LFT parameter: ``relative`` or ``low``/``high`` (SI)."""
+
+    parameter: str = Field(min_length=1)
+    relative: float | None = Field(default=None, gt=0)
+    low: float | None = None
+    high: float | None = None
+
+    @model_validator(mode="after")
+    def _range(self) -> "UncertainSpec":
+        absolute = (self.low, self.high)
+        if self.relative is not None and any(v is not None for v in absolute):
+            raise ValueError("expected relative or low/high, not both")
+        if self.relative is None:
+            if None in absolute:
+                raise ValueError("expected relative (a fraction, e.g. 1.0 for ±100 %) or "
+                                 "both low and high (SI)")
+            if not self.high > self.low:
+                raise ValueError("expected low < high")
+        return self
+
+    @property
+    def range(self) -> float | tuple[float, float]:
+        """The fraction, or ``(low, high)``, as :func:`ambseal.design.plant.generalized_plant`
+        takes it."""
+        return self.relative if self.relative is not None else (self.low, self.high)
+
+
+class UnbalanceSpec(_Strict):
+    grade_mm_s: float | None = Field(default=None, gt=0)
+    mass_kg: float | None = Field(default=None, gt=0)
+    law: Literal["iso21940", "constant_velocity"] | None = None
+    max_speed_hz: float | None = Field(default=None, gt=0)
+    force_at: str | None = Field(default=None, min_length=1)
+    range_hz: tuple[float, float] | None = None
+
+    @model_validator(mode="after")
+    def _r(self) -> "UnbalanceSpec":
+        _band(self.range_hz, "range_hz")
+        return self
+
+
+class ImpulseSpec(_Strict):
+    amplitude_a: float | None = Field(default=None, gt=0)
+    duration_s: float | None = Field(default=None, gt=0)
+
+
+class Design(_Strict):
+    """The ``[design]`` part (module docstring); every key optional."""
+
+    d_e_um: float | None = Field(default=None, gt=0)
+    d_u_a: float | None = Field(default=None, gt=0)
+    model_states: int | None = Field(default=None, ge=2)
+    model_cutoff_hz: float | None = Field(default=None, gt=0)
+    band_hz: tuple[float, float] | None = None
+    order_max: int | None = Field(default=None, ge=1)
+    pressures_bar: list[float] | None = Field(default=None, min_length=1)
+    speeds_hz: list[float] | None = Field(default=None, min_length=1)
+    unbalance: UnbalanceSpec = UnbalanceSpec()
+    impulse: ImpulseSpec = ImpulseSpec()
+    uncertainty: list[UncertainSpec] | None = None
+    uncertainty_from_identification: str | None = Field(default=None, min_length=1)
+    hinf: MethodSpec = MethodSpec()
+    mu: MuSpec = MuSpec()
+    lpv: MethodSpec = MethodSpec()
+    tracked: bool = False
+
+    @model_validator(mode="after")
+    def _keys(self) -> "Design":
+        if self.model_states is not None and self.model_cutoff_hz is not None:
+            raise ValueError("expected model_states or model_cutoff_hz, not both")
+        if self.model_states is not None and self.model_states % 2:
+            raise ValueError("model_states: expected an even number (a mode has 2 states)")
+        _band(self.band_hz, "band_hz")
+        if self.pressures_bar is not None and min(self.pressures_bar) < 0:
+            raise ValueError("pressures_bar: expected pressure drops >= 0")
+        if self.speeds_hz is not None and min(self.speeds_hz) < 0:
+            raise ValueError("speeds_hz: expected speeds >= 0")
+        names = [u.parameter for u in self.uncertainty or ()]
+        if len(set(names)) != len(names):
+            raise ValueError("uncertainty: a parameter is listed twice")
+        return self
+
+
+def check_design_names(cfg) -> str | None:
+    """The first ``[design]`` name that the rig does not know, as a message (else None).
+
+    Checks ``unbalance.force_at`` against the names of the rig's seals, disks, AMBs and
+    springs, and the owner of each uncertain parameter (the part before the last '.')
+    against the seals, AMBs and springs (a spring without a name is ``spring<i>``), and
+    that ``tracked`` has a seal whose k is affine in the pressure drop.
+    """
+    d = cfg.design
+    parts = {s.name for s in cfg.seal} | {a.name for a in cfg.amb} | {
+        (s.name or f"spring{i}") for i, s in enumerate(cfg.spring)}
+    at = d.unbalance.force_at
+    known = parts | {x.name for x in cfg.disk if x.name}
+    if at is not None and at not in known:
+        return (f"design.unbalance.force_at: no component named {at!r} (expected one of: "
+                f"{', '.join(sorted(known)) or 'none'})")
+    if d.tracked and not any(getattr(s.k, "per_bar", 0.0) for s in cfg.seal):
+        return ("design.tracked: expected a [[seal]] whose k follows the pressure drop "
+                "(k = { at_zero = ..., per_bar = ... }, per_bar ≠ 0) to schedule on")
+    for i, u in enumerate(d.uncertainty or ()):
+        owner = u.parameter.rpartition(".")[0]
+        if owner not in parts:
+            return (f"design.uncertainty[{i}].parameter: {u.parameter!r} names no seal, AMB "
+                    f"or spring of the rig (known: {', '.join(sorted(parts)) or 'none'})")
+    return None
+
+
+def apply_overrides(data: dict, overrides, where: str = "--set") -> dict:
+    """The rig document with ``design.<key>=<TOML value>`` settings applied (in place).
+
+    Each override names a key of the ``[design]`` part by its dotted path
+    (``design.mu.orbit_um=8``, ``design.band_hz=[1, 3000]``,
+    ``design.uncertainty=[{parameter = "seal.k", relative = 0.5}]``); the value is read as
+    a TOML value, or as a string if it is not one. The result is validated with the rest
+    of the rig by :func:`parse_rig`.
+
+    Raises
+    ------
+    ConfigError
+        An override without ``=``, outside ``design.``, or through a key that is not a table.
+    """
+    for text in overrides:
+        key, eq, raw = str(text).partition("=")
+        key = key.strip()
+        path = key.split(".")
+        if not eq or path[0] != "design" or len(path) < 2 or "" in path:
+            raise ConfigError(f"{where} {text!r}: expected design.<key>=<value>, e.g. "
+                              "design.mu.orbit_um=8")
+        try:
+            value = tomllib.loads(f"v = {raw.strip()}")["v"]
+        except tomllib.TOMLDecodeError:
+            value = raw.strip()
+        node = data
+        for part in path[:-1]:
+            node = node.setdefault(part, {})
+            if not isinstance(node, dict):
+                raise ConfigError(f"{where} {text!r}: {part} is not a table")
+        node[path[-1]] = value
+    return data

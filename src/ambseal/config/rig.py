@@ -1,0 +1,600 @@
+"""The rig file: a TOML description of a rotor on AMBs, validated with pydantic.
+
+This is the only module that knows the file format. Positions are in metres from the
+shaft's left end, everything else in SI, except the keys with a unit in their name
+(``speed_rpm``, ``pressure_bar``, ``cutoff_hz``, ``axes_angle_deg``, ``pole_angle_deg``).
+
+Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
+
+``[rotor]``
+    ``beam`` = ``"timoshenko"`` (default) or ``"euler-bernoulli"``; ``name`` (optional);
+    ``modal_damping`` (ζ of every free–free bending mode of shaft and disks, default 0).
+``[materials.NAME]``
+    ``E`` (Pa), ``rho`` (kg/m³) and either ``G`` (Pa) or ``nu`` (-).
+``[[shaft]]`` (left to right)
+    ``length``, ``outer_diameter``, ``inner_diameter`` (default 0) in m, ``material`` (a
+    NAME of ``[materials]``), ``elements`` (beam elements in the section, default 1).
+``[[disk]]``
+    ``position`` (m), ``mass`` (kg), ``Ip``, ``Id`` (kg·m²), ``name`` (optional).
+``[[amb]]``
+    ``name``, ``position``, ``sensor_position`` (m), ``axes_angle_deg`` (actuator axes ζ, η
+    rotated from x, y) and either the geometry ``turns``, ``pole_area`` (m²), ``air_gap`` (m),
+    ``bias_current`` (A), ``pole_angle_deg`` (default 22.5, half the angle between the two
+    poles of a pole pair of an 8-pole heteropolar bearing) or ``ki`` (N/A) and ``ks`` (N/m),
+    each a number or ``{ zeta = ..., eta = ... }``; with the geometry, a factor given
+    explicitly (also for one axis only) wins over the geometry's
+    (:func:`ambseal.model.amb.amb_factors`). Also optional ``current_limit`` (A) and
+    ``backup_clearance`` (m, radial clearance of the backup bearing beside the AMB); the
+    report sets the worst unbalance orbit against it and against ``air_gap``.
+``[actuator]``
+    ``model`` = ``"none"`` | ``"first_order"`` (``cutoff_hz``) | ``"second_order"``
+    (``natural_frequency`` in rad/s, ``damping_ratio``); ``eddy_time_constant`` τ_e (s,
+    default 0): a first-order lag 1/(τ_e s + 1) between coil current and force (P2 §4).
+``[[seal]]``
+    ``name``, ``position``, ``K``, ``k`` (N/m), ``C``, ``c`` (N·s/m), ``M`` (kg), each a number,
+    ``{ at_zero = ..., per_bar = ... }`` (affine in the pressure drop) or
+    ``{ frequency_hz = [...], value = [...] }`` (a table against excitation frequency,
+    evaluated at the synchronous frequency, thesis P3 §4; see
+    :func:`ambseal.model.seal.coefficient_value`); Childs' convention
+    −f = [K k; −k K] q + [C c; −c C] q̇ + M q̈.
+``[[spring]]``
+    ``position``, ``kxx``, ``kyy`` and optional ``kxy``, ``kyx`` (N/m), ``cxx``, ``cyy``
+    (N·s/m), ``axes_angle_deg`` (the axes the coefficients are given in, default 0),
+    ``name`` (optional).
+``[controller.pid]``
+    ``kp`` (A/m), ``ti`` (s), ``td`` (s), ``eps`` (-): thesis P5 Eq. 6, per actuator axis.
+``[controller]``
+    ``sample_rate_hz``: the rate of the digital controller (default 10 kHz);
+    ``delay_samples``: the target's computation delay in whole samples (default 1: output
+    from sample k applied at k + 1; :mod:`ambseal.robust.delay`).
+``[operating]``
+    ``speed_rpm``, ``pressure_bar`` (the nominal pressure drop across the seals),
+    ``speed_range_hz`` (optional ``[low, high]``: the operating speed range, e.g. for a
+    controller scheduled on speed).
+``[reduction]``
+    ``states`` (the number of states kept, default 8) or ``cutoff_hz``.
+``[design]``
+    What the controllers are asked for, every key optional (:mod:`ambseal.config.design`).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from ambseal.config._checks import (MAX_ELEMENTS, MAX_REDUCED_STATES, check_actuator, check_amb,
+                            cross_check)
+from ambseal.config.design import Design, apply_overrides, check_design_names
+from ambseal.errors import PRIMITIVE_TAGS, ConfigError, describe_validation_error
+
+__all__ = [
+    "RigConfig",
+    "load_rig",
+    "parse_rig",
+    "check_operating",
+    "apply_overrides",
+    "default_rig_path",
+    "Coefficient",
+    "Affine",
+    "FrequencyTable",
+    "TruthSection",
+    "load_truth",
+    "rig_with_values",
+    "dump_rig",
+]
+
+
+_Big = Annotated[float, Field(ge=-1e12, le=1e12)]  # plausible bound of a force coefficient
+#: Names of AMBs, seals and springs make parameter and signal names (``A.Ki_zeta``):
+#: no '.', ',' or white space.
+_NAME = Field(min_length=1, max_length=64, pattern=r"^[^.,\s]+$")
+
+
+class _Strict(BaseModel):
+    # strict: no bool → number, no string → number, no float → int (issue 15 §1)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
+
+
+#: ``uncertainty = { key = σ }`` beside a component's values: the relative 1σ uncertainty
+#: (fraction) of each named value, used when an identification holds it fixed
+#: (:mod:`ambseal.identify.budget` reads the keys and their defaults).
+Uncertainty = dict[str, Annotated[float, Field(ge=0)]] | None
+
+
+class Material(_Strict):
+    """Linear elastic isotropic material: ``E`` (Pa), ``rho`` (kg/m³), ``G`` (Pa) or ``nu``."""
+
+    E: float = Field(ge=1e5, le=1e18)  # plausible: foams to a rigid-shaft idealisation
+    rho: float = Field(ge=1.0, le=1e5)
+    G: float | None = Field(default=None, ge=1e4, le=1e18)
+    nu: float | None = Field(default=None, gt=-1, lt=0.5)
+
+    @model_validator(mode="after")
+    def _g_or_nu(self) -> "Material":
+        if self.G is None and self.nu is None:
+            raise ValueError("expected either G (Pa) or nu")
+        if self.G is not None and self.nu is not None:
+            if abs(self.E / (2 * (1 + self.nu)) / self.G - 1) > 0.01:
+                raise ValueError("G and nu disagree (expected G = E/(2(1+nu)) within 1 %; "
+                                 "give one of them)")
+        return self
+
+    @property
+    def shear_modulus(self) -> float:
+        """Shear modulus G (Pa), from ``G`` or from E/(2(1+ν))."""
+        return self.G if self.G is not None else self.E / (2.0 * (1.0 + self.nu))
+
+    @property
+    def poisson(self) -> float:
+        """Poisson's ratio ν, from ``nu`` or from E/(2G) − 1."""
+        return self.nu if self.nu is not None else self.E / (2.0 * self.G) - 1.0
+
+
+class Rotor(_Strict):
+    beam: Literal["timoshenko", "euler-bernoulli"] = "timoshenko"
+    name: str = "rotor"
+    modal_damping: float = Field(default=0.0, ge=0, lt=1)
+
+
+class ShaftSection(_Strict):
+    length: float = Field(ge=1e-4, le=100.0)
+    outer_diameter: float = Field(ge=1e-4, le=10.0)
+    inner_diameter: float = Field(default=0.0, ge=0)
+    material: str
+    elements: int = Field(default=1, ge=1, le=MAX_ELEMENTS)
+
+    @model_validator(mode="after")
+    def _bore(self) -> "ShaftSection":
+        if self.inner_diameter >= self.outer_diameter:
+            raise ValueError("expected inner_diameter < outer_diameter")
+        return self
+
+
+class Disk(_Strict):
+    position: float = Field(ge=0)
+    mass: float = Field(ge=0, le=1e6)
+    Ip: float = Field(default=0.0, ge=0, le=1e6)
+    Id: float = Field(default=0.0, ge=0, le=1e6)
+    name: str | None = None
+
+
+class AxisPair(_Strict):
+    """A value per actuator axis: ``zeta`` and ``eta`` (one may be left out when the AMB's
+    geometry gives it)."""
+
+    zeta: float | None = Field(default=None, ge=-1e12, le=1e12)
+    eta: float | None = Field(default=None, ge=-1e12, le=1e12)
+
+    @model_validator(mode="after")
+    def _one(self) -> "AxisPair":
+        if self.zeta is None and self.eta is None:
+            raise ValueError("expected zeta and/or eta")
+        return self
+
+
+class Amb(_Strict):
+    name: str = _NAME
+    position: float = Field(ge=0)
+    sensor_position: float = Field(ge=0)
+    axes_angle_deg: float = 0.0
+    turns: int | None = Field(default=None, gt=0, le=100000)
+    pole_area: float | None = Field(default=None, gt=0, le=1.0)
+    air_gap: float | None = Field(default=None, ge=1e-6, le=0.1)
+    bias_current: float | None = Field(default=None, gt=0, le=1e4)
+    pole_angle_deg: float = Field(default=22.5, ge=0, lt=90)
+    ki: _Big | AxisPair | None = None
+    ks: _Big | AxisPair | None = None
+    current_limit: float | None = Field(default=None, gt=0, le=1e4)
+    backup_clearance: float | None = Field(default=None, gt=0, le=1.0)
+    uncertainty: Uncertainty = None
+
+    @model_validator(mode="after")
+    def _geometry_or_factors(self) -> "Amb":
+        return check_amb(self)
+
+
+class Actuator(_Strict):
+    model: Literal["none", "first_order", "second_order"] = "none"
+    cutoff_hz: float | None = Field(default=None, gt=0, le=1e7)
+    natural_frequency: float | None = Field(default=None, gt=0, le=1e8)
+    damping_ratio: float | None = Field(default=None, gt=0, le=100.0)
+    eddy_time_constant: float = Field(default=0.0, ge=0, le=1.0)
+    uncertainty: Uncertainty = None
+
+    @model_validator(mode="after")
+    def _needs(self) -> "Actuator":
+        return check_actuator(self)
+
+
+class Affine(_Strict):
+    """A coefficient affine in the pressure drop: ``at_zero + per_bar · pressure_bar``."""
+
+    at_zero: float = Field(default=0.0, ge=-1e12, le=1e12)
+    per_bar: float = Field(default=0.0, ge=-1e12, le=1e12)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _not_empty(cls, data):
+        if isinstance(data, dict) and not data:
+            raise ValueError("expected at_zero and/or per_bar, got an empty table")
+        return data
+
+
+class FrequencyTable(_Strict):
+    """A coefficient tabulated against excitation frequency (Hz), interpolated linearly and
+    held constant outside the table: ``{ frequency_hz = [...], value = [...] }``."""
+
+    frequency_hz: list[float] = Field(min_length=1, max_length=10000)
+    value: list[float] = Field(min_length=1, max_length=10000)
+
+    @model_validator(mode="after")
+    def _table(self) -> "FrequencyTable":
+        if len(self.frequency_hz) != len(self.value):
+            raise ValueError("expected frequency_hz and value of the same length")
+        if any(b <= a for a, b in zip(self.frequency_hz, self.frequency_hz[1:])):
+            raise ValueError("expected frequency_hz strictly increasing")
+        return self
+
+
+Coefficient = float | Affine
+SealCoefficient = float | Affine | FrequencyTable
+
+
+class Seal(_Strict):
+    name: str = _NAME
+    position: float = Field(ge=0)
+    K: SealCoefficient = 0.0
+    k: SealCoefficient = 0.0
+    C: SealCoefficient = 0.0
+    c: SealCoefficient = 0.0
+    M: SealCoefficient = 0.0
+    uncertainty: Uncertainty = None
+
+    @model_validator(mode="after")
+    def _plausible(self) -> "Seal":
+        for n in "KkCcM":  # a plain number, bounded like the affine form's terms
+            v = getattr(self, n)
+            if isinstance(v, float) and abs(v) > 1e12:
+                raise ValueError(f"{n}: expected a coefficient of at most 1e12 in size, "
+                                 f"got {v:g}")
+        return self
+
+    @property
+    def frequency_dependent(self) -> bool:
+        """Whether any coefficient is tabulated against frequency."""
+        return any(isinstance(getattr(self, n), FrequencyTable) for n in "KkCcM")
+
+
+class Spring(_Strict):
+    position: float = Field(ge=0)
+    kxx: float = Field(ge=-1e17, le=1e17)  # up to a stiff pin
+    kyy: float = Field(ge=-1e17, le=1e17)
+    kxy: float = Field(default=0.0, ge=-1e17, le=1e17)
+    kyx: float = Field(default=0.0, ge=-1e17, le=1e17)
+    cxx: float = Field(default=0.0, ge=-1e12, le=1e12)
+    cyy: float = Field(default=0.0, ge=-1e12, le=1e12)
+    axes_angle_deg: float = Field(default=0.0, ge=-360, le=360)
+    name: str | None = Field(default=None, min_length=1, max_length=64, pattern=r"^[^.,\s]+$")
+    uncertainty: Uncertainty = None
+
+
+class Pid(_Strict):
+    kp: float = Field(gt=0, le=1e9)
+    ti: float = Field(gt=0, le=1e4)
+    td: float = Field(ge=0, le=100.0)
+    eps: float = Field(gt=0, le=1e3)
+
+
+class Controllers(_Strict):
+    pid: Pid | None = None
+    # plausible digital AMB controllers: 100 Hz to 1 MHz
+    sample_rate_hz: float = Field(default=10000.0, ge=100.0, le=1e6)
+    delay_samples: int = Field(default=1, ge=0)
+
+
+class Operating(_Strict):
+    speed_rpm: float = Field(default=0.0, ge=-1e6, le=1e6)
+    pressure_bar: float = Field(default=0.0, ge=0, le=1e4)
+    speed_range_hz: tuple[float, float] | None = Field(default=None, strict=False)  # a list
+
+    @model_validator(mode="after")
+    def _range(self) -> "Operating":
+        r = self.speed_range_hz
+        if r is not None and not 0 < r[0] < r[1] <= 1e5:
+            raise ValueError("speed_range_hz: expected [low, high] with 0 < low < high "
+                             "<= 1e5 Hz")
+        if r is not None and not r[0] <= abs(self.speed_rpm) / 60 <= r[1]:
+            raise ValueError(f"speed_rpm: {self.speed_rpm:g} rpm = {abs(self.speed_rpm) / 60:g} "
+                             f"Hz lies outside speed_range_hz [{r[0]:g}, {r[1]:g}]: a "
+                             "controller scheduled over that range would be extrapolated")
+        return self
+
+
+class Reduction(_Strict):
+    states: int | None = Field(default=None, ge=1, le=MAX_REDUCED_STATES)
+    cutoff_hz: float | None = Field(default=None, gt=0, le=1e7)
+
+    @model_validator(mode="after")
+    def _one(self) -> "Reduction":
+        if self.states is not None and self.cutoff_hz is not None:
+            raise ValueError("expected states or cutoff_hz, not both")
+        return self
+
+
+class RigConfig(_Strict):
+    """A whole rig: rotor, materials, shaft, components, controller and operating point."""
+
+    rotor: Rotor = Rotor()
+    materials: dict[str, Material]
+    shaft: list[ShaftSection] = Field(min_length=1)
+    disk: list[Disk] = []
+    amb: list[Amb] = []
+    actuator: Actuator = Actuator()
+    seal: list[Seal] = []
+    spring: list[Spring] = []
+    controller: Controllers = Controllers()
+    operating: Operating = Operating()
+    reduction: Reduction = Reduction()
+    design: Design = Design()
+
+    @property
+    def length(self) -> float:
+        """Shaft length (m)."""
+        return sum(s.length for s in self.shaft)
+
+    @property
+    def speed(self) -> float:
+        """Rotational speed Ω (rad/s)."""
+        return self.operating.speed_rpm * 2.0 * math.pi / 60.0
+
+
+def _union_tags() -> set[str]:
+    """The branch names pydantic puts into an error's location: our model classes and the
+    primitive types of the unions."""
+    tags, todo = set(PRIMITIVE_TAGS), [_Strict]
+    while todo:
+        cls = todo.pop()
+        tags.add(cls.__name__)
+        todo += cls.__subclasses__()
+    return tags
+
+
+def _describe(exc: ValidationError) -> str:
+    return describe_validation_error(exc, _union_tags())
+
+
+def parse_rig(data: dict, where: str = "<rig>") -> RigConfig:
+    """Validate a rig given as a dict (as read from TOML).
+
+    Parameters
+    ----------
+    data : dict
+        The parsed TOML document.
+    where : str
+        Name of the source used in error messages (usually the file path).
+
+    Raises
+    ------
+    ConfigError
+        One line naming ``where``, the key path and what was expected.
+    """
+    try:
+        cfg = RigConfig.model_validate(data)
+    except ValidationError as exc:
+        raise ConfigError(f"{where}: {_describe(exc)}") from None
+    cross_check(cfg, where)
+    bad = check_design_names(cfg)
+    if bad:
+        raise ConfigError(f"{where}: {bad}")
+    return cfg
+
+
+def check_operating(values: dict, arg_names: dict[str, str]) -> None:
+    """Validate command-line operating values by the rig file's own rules (``[operating]``).
+
+    Parameters
+    ----------
+    values : dict
+        ``{key: value}`` of :class:`Operating` keys (``pressure_bar``, ``speed_rpm``); None
+        values are skipped.
+    arg_names : dict
+        The command-line argument of each key, named in the error.
+
+    Raises
+    ------
+    ConfigError
+        ``--pressure-bar: ...`` with what the rig format expects.
+    """
+    for key, value in values.items():
+        if value is None:
+            continue
+        try:
+            Operating.model_validate({key: value})
+        except ValidationError as exc:
+            msg = _describe(exc).split(": ", 1)[1]
+            raise ConfigError(f"{arg_names.get(key, key)}: {msg} (the rule of [operating] "
+                              f"{key} in a rig file)") from None
+
+
+def load_rig(path: str | Path | None = None, overrides=()) -> RigConfig:
+    """Read and validate a rig file (TOML).
+
+    Parameters
+    ----------
+    path : str or Path, optional
+        The rig file; the embedded thesis test facility when omitted.
+    overrides : iterable of str
+        ``design.<key>=<value>`` settings (:func:`apply_overrides`), validated with the file.
+
+    Raises
+    ------
+    ConfigError
+        The file is missing, is not valid TOML, does not match the rig format, or an
+        override is malformed or invalid (named with the file).
+    """
+    p = Path(path) if path is not None else default_rig_path()
+    data = _load_toml(p, "rig file")
+    design = data.get("design")
+    fit = design.get("uncertainty_from_identification") if isinstance(design, dict) else None
+    if isinstance(fit, str) and fit and not Path(fit).is_absolute():
+        design["uncertainty_from_identification"] = str(p.parent / fit)  # beside the rig
+    if overrides:
+        return parse_rig(apply_overrides(data, overrides), f"{p} (with --set)")
+    return parse_rig(data, str(p))
+
+
+def _load_toml(path: Path, what: str) -> dict:
+    """TOML of a rig or truth file; ConfigError naming the file when it cannot be read, is
+    not UTF-8 text (a byte-order mark is accepted), not TOML or nested too deeply."""
+    from ambseal.errors import AmbsealError
+    from ambseal.files import load_toml
+
+    try:
+        return load_toml(path, what)
+    except AmbsealError as exc:
+        raise ConfigError(str(exc)) from None
+
+
+def default_rig_path() -> Path:
+    """Path of the embedded thesis test facility (``ambseal/data/testrig.toml``)."""
+    return Path(__file__).resolve().parents[1] / "data" / "testrig.toml"
+
+
+class TruthSection(_Strict):
+    """The virtual test facility's true values, in a file of their own that a fit never reads.
+
+    ``parameters`` maps model parameter names (``A.Ki_zeta``, ``A.Ks_zeta``,
+    ``coupling.kxx``, ``seal.k``, ...) to a number or ``{ at_zero, per_bar }`` (values at a
+    pressure drop: :func:`ambseal.model.seal.coefficient_value`).
+    """
+
+    parameters: dict[str, Coefficient] = {}
+    tau_e: float = Field(default=0.0, ge=0)
+    bias_current: float = Field(default=6.0, gt=0)
+    current_limit: float | None = Field(default=None, gt=0)
+    sensor_noise_m: float = Field(default=0.0, ge=0)
+    noise_fraction: float = Field(default=0.0, ge=0)
+    current_noise_a: float = Field(default=0.0, ge=0)
+    adc_bits: int | None = Field(default=None, ge=2, le=32)
+    adc_range_m: float = Field(default=1.0e-3, gt=0)  # LSB = range / 2**bits (no clipping)
+    substeps: int = Field(default=4, ge=1, le=100)
+    max_mode_hz: float = Field(default=10000.0, gt=0)
+    # model-form mismatch of the facility against the rig file (None/1: as the rig file)
+    beam: Literal["timoshenko", "euler-bernoulli"] | None = None
+    mesh_factor: float = Field(default=1.0, gt=0)
+    modal_damping: float | None = Field(default=None, ge=0, lt=1)
+    sensor_filter_hz: float | None = Field(default=None, gt=0)
+
+
+class TruthConfig(_Strict):
+    truth: TruthSection
+
+
+def load_truth(path: str | Path) -> TruthSection:
+    """Read a truth file (TOML with a ``[truth]`` table); ConfigError on any fault.
+
+    Keys of ``[truth]``: ``tau_e`` (s), ``bias_current`` (A), ``current_limit`` (A, default
+    the AMBs' ``current_limit``), ``sensor_noise_m`` (std, m) or ``noise_fraction`` (std as
+    a fraction of each displacement channel's RMS), ``current_noise_a`` (std, A),
+    ``adc_bits`` and ``adc_range_m`` (quantisation step range/2^bits; the sensor does not
+    saturate: the rotor stops the run if it leaves the gap), ``substeps`` (integration steps
+    per controller sample), ``max_mode_hz`` (modes kept in the simulation, default 10 kHz),
+    and ``[truth.parameters]``. Model-form differences from the rig file (to test a fit on
+    data its model did not make): ``beam`` (``"timoshenko"`` or ``"euler-bernoulli"``),
+    ``mesh_factor`` (shaft elements per section × this, rounded, at least 1),
+    ``modal_damping`` (the rotor's, in place of the rig file's) and ``sensor_filter_hz`` (a
+    first-order low-pass in every displacement sensor, which the model does not have).
+    """
+    p = Path(path)
+    data = _load_toml(p, "truth file")
+    try:
+        return TruthConfig.model_validate(data).truth
+    except ValidationError as exc:
+        raise ConfigError(f"{p}: {_describe(exc)}") from None
+
+
+def rig_with_values(cfg: RigConfig, values: dict[str, Coefficient]) -> RigConfig:
+    """The rig with named model parameters set (SI), e.g. identified values.
+
+    Names are those of the model's LFT channels — ``{amb}.Ki_{zeta|eta}``,
+    ``{amb}.Ks_{zeta|eta}``, ``{spring}.{kxx|kyy|kxy|kyx|cxx|cyy}`` (a spring without a
+    ``name`` is ``spring{i}``), ``{seal}.{K|k|C|c}`` (a number or an :class:`Affine` in the
+    pressure drop) — and ``tau_e`` (the actuator's eddy-current lag).
+
+    Raises
+    ------
+    ConfigError
+        An unknown parameter name.
+    """
+    data = cfg.model_dump(exclude_none=True)
+    ambs = {a["name"]: a for a in data.get("amb", [])}
+    springs = {(s.get("name") or f"spring{i}"): s for i, s in enumerate(data.get("spring", []))}
+    seals = {s["name"]: s for s in data.get("seal", [])}
+    for name, v in values.items():
+        v = v.model_dump() if isinstance(v, Affine) else float(v)
+        owner, _, key = name.rpartition(".")
+        if name == "tau_e":
+            data.setdefault("actuator", {})["eddy_time_constant"] = v
+        elif owner in ambs and key[:3] in ("Ki_", "Ks_") and key[3:] in ("zeta", "eta"):
+            # per axis; an AMB given by its geometry keeps the geometry's other factors
+            amb, slot = ambs[owner], key[:2].lower()
+            if not isinstance(amb.get(slot), dict):
+                old = amb.get(slot)
+                amb[slot] = {} if old is None else {"zeta": old, "eta": old}
+            amb[slot][key[3:]] = v
+        elif owner in springs and key in ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy"):
+            springs[owner][key] = v
+        elif owner in seals and key in ("K", "k", "C", "c"):
+            seals[owner][key] = v
+        else:
+            raise ConfigError(f"rig parameters: unknown parameter {name!r}")
+    return parse_rig(data, "<identified rig>")
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, float)):
+        return repr(v) if isinstance(v, int) or math.isfinite(v) else "nan"
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    raise TypeError(f"cannot write {type(v).__name__} to TOML")
+
+
+def _toml_table(name: str, val: dict, lines: list[str]) -> None:
+    """``[name]`` with its scalar keys, then its sub-tables and arrays of tables."""
+    def is_tables(x) -> bool:
+        return isinstance(x, list) and bool(x) and all(isinstance(i, dict) for i in x)
+
+    plain = {k: x for k, x in val.items() if not (isinstance(x, dict) or is_tables(x))}
+    if plain:
+        lines += ["", f"[{name}]"] + [f"{k} = {_toml_value(x)}" for k, x in plain.items()]
+    for k, x in val.items():
+        if isinstance(x, dict) and x:
+            _toml_table(f"{name}.{k}", x, lines)
+        elif is_tables(x):
+            for item in x:
+                lines += ["", f"[[{name}.{k}]]"]
+                lines += [f"{j} = {_toml_value(y)}" for j, y in item.items()]
+
+
+def dump_rig(cfg: RigConfig, header: str = "") -> str:
+    """The rig as TOML text that :func:`load_rig` reads back to the same configuration."""
+    data = cfg.model_dump(exclude_none=True)
+    lines = [f"# {line}" for line in header.splitlines()]
+    for key, val in data.items():
+        if isinstance(val, list):
+            for item in val:
+                lines += ["", f"[[{key}]]"]
+                lines += [f"{k} = {_toml_value(x)}" for k, x in item.items()]
+        else:
+            _toml_table(key, val, lines)
+    return "\n".join(lines).lstrip("\n") + "\n"

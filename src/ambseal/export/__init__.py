@@ -1,0 +1,13 @@
+"""ambseal.export: controllers to files a real-time target runs, and back.
+
+* :func:`export_controller`, :func:`load_controller` — ``.json``, ``.npz`` and ``.mat``
+  files holding the discrete controller as it was judged
+  (:mod:`ambseal.export.controller_files`);
+* :func:`write_c` — a portable C99 header and source of the same controller
+  (:mod:`ambseal.export.codegen`).
+"""
+
+from ambseal.export.codegen import write_c
+from ambseal.export.controller_files import export_controller, load_controller
+
+__all__ = ["export_controller", "load_controller", "write_c"]

@@ -1,0 +1,308 @@
+"""Controllers to files a real-time target can run, and back: ``.json``, ``.npz``, ``.mat``.
+
+Every file holds the same document (:func:`controller_document`):
+
+* ``convention`` — ``i = −K y``: the target computes ``u[k] = C x[k] + D y[k]``,
+  ``x[k+1] = A x[k] + B y[k]`` from the sensor displacements ``y`` (m, ``inputs``) and
+  sets the current references ``i = −u`` (A, ``outputs``);
+* ``A, B, C, D`` — the **discrete** controller that was judged
+  (:mod:`ambseal.robust.digital`), ``Ts`` (s, MATLAB's name), ``sample_rate_hz``,
+  ``delay_samples`` (the computation delay it was judged with), ``method`` and
+  ``prewarp_hz`` (``NaN`` unless Tustin was pre-warped), ``removed_poles_hz``;
+* ``A_c … D_c`` — the continuous design, ``A_r … D_r`` the continuous controller that was
+  discretised (fast poles removed);
+* ``discretisation_json`` — the choice (candidates, their ``|z|``, the rise of γ/μ) and
+  ``judged_json`` — the judged discrete margins per condition, as JSON text.
+
+A continuous controller alone (a ``control.StateSpace``, e.g. for ``ambseal campbell`` or
+``sweep --controller FILE``) is written with ``kind = "continuous"``, ``A … D`` continuous
+and ``Ts = 0`` (MATLAB's continuous time), and read back as that ``StateSpace``.
+
+A scheduled controller adds ``kind = "scheduled"``, ``parameter`` (θ: ``"speed"`` or an
+LFT parameter such as ``"seal.k"``), ``grid`` (n_t, θ of each table entry: rad/s for the
+speed, else SI; a speed-scheduled one also as ``speeds_rad_s``) and ``interpolation`` (the
+law, :func:`~ambseal.robust.scheduled_digital.interpolation_law`); its
+matrices are stacks over the table, shape (n_t, …) in ``.npz``/``.json`` and (…, n_t) in
+``.mat`` so that MATLAB's ``ss`` builds the model array directly.
+
+MATLAB / Octave (``pkg load control`` first in Octave), one line::
+
+    s = load('controller_hinf.mat'); K = ss(s.A, s.B, s.C, s.D, s.Ts, 'InputName', s.inputs, 'OutputName', s.outputs);
+
+Files are written to a temporary name and renamed (:func:`ambseal.files.atomic_write`);
+:func:`load_controller` reads any of them back to the object that was judged.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ambseal.errors import DataError
+from ambseal.files import atomic_write
+from ambseal.robust.digital_loop import DiscreteController
+from ambseal.robust.digital import DigitalController
+from ambseal.robust.controller import SPEED
+from ambseal.robust.scheduled_digital import ScheduledDigital
+
+__all__ = ["export_controller", "load_controller", "controller_document", "CONVENTION",
+           "MATLAB_LINE"]
+
+_FORMATS = (".npz", ".mat", ".json")
+CONVENTION = ("i = -K y: u[k] = C x[k] + D y[k], x[k+1] = A x[k] + B y[k]; inputs y are "
+              "sensor displacements (m), outputs u; the current references are i = -u (A)")
+MATLAB_LINE = ("s = load('{name}'); K = ss(s.A, s.B, s.C, s.D, s.Ts, 'InputName', s.inputs, "
+               "'OutputName', s.outputs);")
+_ARRAYS = ("A", "B", "C", "D", "A_c", "B_c", "C_c", "D_c", "A_r", "B_r", "C_r", "D_r")
+
+
+def _nan(x):
+    return float("nan") if x is None else float(x)
+
+
+def _continuous_document(K) -> dict:
+    """The document of a continuous ``control.StateSpace`` (no sample time: ``Ts = 0``)."""
+    if not hasattr(K, "A") or K.isdtime(strict=True):
+        raise TypeError(f"export: expected a DigitalController, ScheduledDigital or a "
+                        f"continuous control.StateSpace, got {type(K).__name__}")
+    return {"convention": CONVENTION.split(":")[0] + " (continuous: dx/dt = A x + B y, "
+            "u = C x + D y, i = -u)", "input_unit": "m", "output_unit": "A",
+            "kind": "continuous", "name": str(K.name), "Ts": 0.0,
+            "inputs": list(K.input_labels), "outputs": list(K.output_labels),
+            **{k: np.asarray(getattr(K, k), float) for k in "ABCD"}}
+
+
+def controller_document(ctrl, judged=None) -> dict:
+    """The content of every export format: arrays and plain values (module docstring).
+
+    Parameters
+    ----------
+    ctrl : DigitalController, ScheduledDigital or a continuous control.StateSpace
+    judged : list of dict, optional
+        The judged discrete margins (``metrics.json`` cases' ``discrete`` blocks with the
+        condition), stored as ``judged_json``.
+    """
+    if not isinstance(ctrl, (DigitalController, ScheduledDigital)):
+        return _continuous_document(ctrl)
+    doc: dict = {"convention": CONVENTION, "input_unit": "m", "output_unit": "A",
+                 "Ts": ctrl.Ts, "sample_rate_hz": ctrl.sample_rate_hz,
+                 "delay_samples": int(ctrl.delay_samples), "method": ctrl.method,
+                 "prewarp_hz": _nan(ctrl.prewarp_hz),
+                 "removed_poles_hz": np.asarray(ctrl.removed_poles_hz, float),
+                 "discretisation_json": json.dumps(ctrl.to_dict()),
+                 "judged_json": json.dumps(judged or [])}
+    if isinstance(ctrl, ScheduledDigital):
+        doc.update(kind="scheduled", name=ctrl.name, inputs=list(ctrl.inputs),
+                   outputs=list(ctrl.outputs), parameter=ctrl.parameter,
+                   grid=np.asarray(ctrl.grid), interpolation=ctrl.interpolation)
+        if ctrl.parameter == SPEED:
+            doc["speeds_rad_s"] = np.asarray(ctrl.grid)
+        for suf, mats in (("", ctrl.discrete), ("_c", ctrl.continuous), ("_r", ctrl.reduced)):
+            doc.update({f"{k}{suf}": np.asarray(X, float) for k, X in zip("ABCD", mats)})
+        return doc
+    d = ctrl.discrete
+    doc.update(kind="fixed", name=str(ctrl.continuous.name), inputs=ctrl.inputs,
+               outputs=ctrl.outputs)
+    for suf, sys in (("_c", ctrl.continuous), ("_r", ctrl.reduced)):
+        doc.update({f"{k}{suf}": np.asarray(getattr(sys, k), float) for k in "ABCD"})
+    doc.update({k: np.asarray(getattr(d, k), float) for k in "ABCD"})
+    return doc
+
+
+def export_controller(ctrl, path, judged=None) -> Path:
+    """Write a digital controller to ``path`` (``.json``, ``.npz`` or ``.mat``).
+
+    Parameters
+    ----------
+    ctrl : DigitalController, ScheduledDigital or control.StateSpace
+        The controller as judged (:func:`ambseal.robust.digital.digital_controller`,
+        :func:`ambseal.robust.scheduled_digital.scheduled_digital`), or a continuous
+        controller alone (``kind = "continuous"``).
+    path : str or Path
+        Destination; the suffix picks the format.
+    judged : list of dict, optional
+        The judged discrete margins written with it.
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    DataError
+        Unknown suffix.
+    TypeError
+        Not a digital controller.
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in _FORMATS:
+        raise DataError(f"{path}: unknown controller format {suffix!r}, expected one of "
+                        f"{_FORMATS}")
+    doc = controller_document(ctrl, judged)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if suffix == ".npz":
+        arrays = {k: (np.array(v, dtype=str) if isinstance(v, (list, str)) else np.asarray(v))
+                  for k, v in doc.items()}
+        atomic_write(path, lambda fh: np.savez(fh, **arrays))
+    elif suffix == ".mat":
+        from scipy.io import savemat
+
+        mdict = {}
+        for k, v in doc.items():
+            if isinstance(v, list):
+                v = np.array(v, dtype=object)  # a cell array of names in MATLAB
+            elif isinstance(v, np.ndarray) and v.ndim == 3:
+                v = np.moveaxis(v, 0, -1)  # MATLAB's model arrays stack on the last axis
+            mdict[k] = v
+        mdict["matlab"] = MATLAB_LINE.format(name=path.name)
+        atomic_write(path, lambda fh: savemat(fh, mdict, oned_as="row"))
+    else:
+        out = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in doc.items()}
+        out = {k: (None if isinstance(v, float) and not np.isfinite(v) else v)
+               for k, v in out.items()}
+        text = json.dumps(out, indent=1).encode()
+        atomic_write(path, lambda fh: fh.write(text))
+    return path
+
+
+def _read(path: Path) -> dict:
+    suffix = path.suffix.lower()
+    if suffix not in _FORMATS:
+        raise DataError(f"{path}: unknown controller format {suffix!r}, expected one of "
+                        f"{_FORMATS}")
+    try:
+        if suffix == ".json":
+            raw = json.loads(path.read_text())
+            return {k: (float("nan") if v is None else v) for k, v in raw.items()}
+        if suffix == ".npz":
+            with np.load(path, allow_pickle=False) as z:
+                return {k: (z[k].tolist() if z[k].dtype.kind == "U" else z[k]) for k in z.files}
+        from scipy.io import loadmat
+
+        m = loadmat(path, squeeze_me=False, chars_as_strings=True)
+    except (OSError, ValueError, KeyError) as exc:
+        raise DataError(f"{path}: not a readable controller file ({exc})") from None
+    out = {}
+    for k, v in m.items():
+        if k.startswith("__"):
+            continue
+        if v.dtype == object:
+            out[k] = [str(np.ravel(x)[0]) for x in np.ravel(v)]
+        elif v.dtype.kind == "U":
+            out[k] = str(np.ravel(v)[0]) if v.size else ""
+        else:
+            out[k] = np.moveaxis(v, -1, 0) if v.ndim == 3 else v
+    return out
+
+
+def _arrays(doc: dict, path: Path, stacked: bool) -> dict:
+    """The matrices of a document, shape-checked: DataError naming the key."""
+    out = {}
+    try:
+        for k in _ARRAYS:
+            X = np.asarray(doc[k], float)
+            out[k] = X.reshape((-1,) + X.shape[-2:]) if stacked else np.atleast_2d(X)
+    except KeyError as exc:
+        raise DataError(f"{path}: missing key {exc}") from None
+    except ValueError as exc:
+        raise DataError(f"{path}: {exc}") from None
+    ny, nu = len(doc["inputs"]), len(doc["outputs"])
+    for suf in ("", "_c", "_r"):
+        A, B, C, D = (out[k + suf] for k in "ABCD")
+        n = A.shape[-1]
+        want = {"A": (n, n), "B": (n, ny), "C": (nu, n), "D": (nu, ny)}
+        for k, X in zip("ABCD", (A, B, C, D)):
+            if X.shape[-2:] != want[k] and not (n == 0 and X.size == 0 and k != "D"):
+                raise DataError(f"{path}: {k}{suf} has shape {X.shape[-2:]}, expected "
+                                f"{want[k]} ({nu} outputs, {ny} inputs, {n} states)")
+        if n == 0:
+            shape = A.shape[:-2]
+            out["A" + suf] = np.zeros(shape + (0, 0))
+            out["B" + suf] = np.zeros(shape + (0, ny))
+            out["C" + suf] = np.zeros(shape + (nu, 0))
+    return out
+
+
+def _continuous(doc: dict, path: Path):
+    """A continuous controller file back to a ``control.StateSpace``, shapes checked."""
+    import control
+
+    try:
+        ins, outs = [str(s) for s in doc["inputs"]], [str(s) for s in doc["outputs"]]
+        A, B, C, D = (np.atleast_2d(np.asarray(doc[k], float)) for k in "ABCD")
+    except KeyError as exc:
+        raise DataError(f"{path}: missing key {exc} (expected A, B, C, D, inputs, outputs "
+                        "as written by ambseal)") from None
+    except (TypeError, ValueError) as exc:
+        raise DataError(f"{path}: {exc}") from None
+    n = A.shape[0] if A.size else 0
+    want = {"A": (n, n), "B": (n, len(ins)), "C": (len(outs), n), "D": (len(outs), len(ins))}
+    for k, X in zip("ABCD", (A, B, C, D)):
+        if X.shape != want[k] and not (n == 0 and k != "D"):
+            raise DataError(f"{path}: {k} has shape {X.shape}, expected {want[k]}")
+    if n == 0:
+        A, B, C = np.zeros((0, 0)), np.zeros((0, len(ins))), np.zeros((len(outs), 0))
+    return control.ss(A, B, C, D, inputs=ins, outputs=outs, name=str(doc.get("name", "K")))
+
+
+def load_controller(path):
+    """Read a controller written by :func:`export_controller` (any format).
+
+    Returns
+    -------
+    DigitalController, ScheduledDigital or control.StateSpace
+        The object that was exported: the same matrices, method, sample time, delay and
+        (scheduled) table and interpolation law; a continuous controller alone (or a file
+        without ``kind``) as a ``control.StateSpace``.
+
+    Raises
+    ------
+    DataError
+        An unreadable file, a missing key, or matrices of the wrong shapes (named).
+    """
+    import control
+
+    path = Path(path)
+    doc = _read(path)
+    if str(doc.get("kind", "continuous")) == "continuous":
+        return _continuous(doc, path)
+    try:
+        kind, name = str(doc["kind"]), str(doc["name"])
+        ins, outs = [str(s) for s in doc["inputs"]], [str(s) for s in doc["outputs"]]
+        fs, delay = float(np.ravel(doc["sample_rate_hz"])[0]), int(np.ravel(doc["delay_samples"])[0])
+        method = str(doc["method"])
+        pw = float(np.ravel(doc["prewarp_hz"])[0])
+        removed = tuple(float(x) for x in np.ravel(doc["removed_poles_hz"]))
+        meta = json.loads(str(doc["discretisation_json"]))
+    except (KeyError, TypeError, ValueError, IndexError) as exc:
+        raise DataError(f"{path}: not a controller file of ambseal ({exc!r})") from None
+    doc["inputs"], doc["outputs"] = ins, outs
+    if not (np.isfinite(fs) and fs > 0) or delay < 0:
+        raise DataError(f"{path}: sample_rate_hz = {fs}, delay_samples = {delay}: expected a "
+                        "positive rate and a delay >= 0")
+    pw = pw if np.isfinite(pw) else None
+    cands = tuple(meta.get("candidates", ()))
+    arr = _arrays(doc, path, stacked=(kind == "scheduled"))
+    if kind == "scheduled":
+        par = str(doc.get("parameter", SPEED))
+        key = "grid" if "grid" in doc else "speeds_rad_s"
+        W = np.ravel(np.asarray(doc.get(key, ()), float))
+        if arr["A"].shape[0] != W.size:
+            raise DataError(f"{path}: A holds {arr['A'].shape[0]} table entries but "
+                            f"{key} has {W.size}")
+        tab = {suf: tuple(arr[k + suf] for k in "ABCD") for suf in ("", "_c", "_r")}
+        return ScheduledDigital(W, tab["_c"], tab["_r"], tab[""], tuple(ins), tuple(outs),
+                                method, pw, fs, delay, removed, cands, name, par,
+                                choice=str(meta.get("choice", "")))
+
+    def ss(suf, nm):
+        return control.ss(*(arr[k + suf] for k in "ABCD"), inputs=ins, outputs=outs, name=nm)
+
+    desc = {"type": "state_space", "name": name, "discretisation": method}
+    disc = DiscreteController(*(arr[k] for k in "ABCD"), 1.0 / fs, description=desc)
+    return DigitalController(ss("_c", name), ss("_r", f"{name}_r"), disc, method, pw, fs,
+                             delay, removed, meta.get("reduction"), cands,
+                             str(meta.get("choice", "")))

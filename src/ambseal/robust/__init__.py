@@ -1,0 +1,43 @@
+"""ambseal.robust: robust-control synthesis and analysis for any python-control plant.
+
+Nothing here knows a rotor: every function takes and returns ``control.StateSpace`` (or
+plain matrices) with python-control's signal names, so a control engineer can use it on a
+distillation column as well as on an AMB rotor.
+
+Synthesis (each returns the controller, the closed loop, the bound and a result record):
+
+* :func:`hinfsyn` — H∞ synthesis of a generalised plant ``P(nmeas, ncon)``;
+  :func:`hinfnorm` the H∞ norm;
+* :func:`musyn` — μ-synthesis by complex D–K iteration; :func:`musyn_dgk` — by D–G–K
+  iteration for mixed real/complex uncertainty;
+* :func:`lpvsyn` — gridded H∞ LPV synthesis by LMIs (cvxpy with Clarabel);
+* :func:`reduce_controller`, :func:`balred_controller` — order reduction with its cost.
+
+Analysis: :func:`mussv` — μ upper and lower bounds for mixed real/complex block structures.
+
+The controller that runs on a target: :func:`digital_controller` (fast poles removed, the
+discretisation chosen by the sampled loop), :func:`scheduled_digital` (a scheduled
+controller's interpolated table), :class:`DiscreteController` and the sample-and-hold
+delay of the design model (:func:`design_delay`).
+
+Controller sign convention, stated once (:mod:`ambseal.robust.controller`): ``u = −K y``.
+"""
+
+from ambseal.robust.controller import SPEED, ScheduledController, frozen, matrices_at
+from ambseal.robust.delay import DesignDelay, design_delay, loop_delay
+from ambseal.robust.dgk import musyn_dgk
+from ambseal.robust.digital import DigitalController, digital_controller
+from ambseal.robust.digital_loop import DiscreteController, discrete_controller
+from ambseal.robust.dk import MusynResult, fit_magnitude, musyn
+from ambseal.robust.hinf import HinfResult, hinfnorm, hinfsyn, lft_lower
+from ambseal.robust.lpv import LpvController, LpvSynResult, lpvsyn
+from ambseal.robust.mu import MuResult, mussv
+from ambseal.robust.order import ReductionResult, balred_controller, reduce_controller
+from ambseal.robust.scheduled_digital import ScheduledDigital, scheduled_digital
+
+__all__ = ["SPEED", "DesignDelay", "DigitalController", "DiscreteController", "HinfResult",
+           "LpvController", "LpvSynResult", "MuResult", "MusynResult", "ReductionResult",
+           "ScheduledController", "ScheduledDigital", "balred_controller", "design_delay",
+           "digital_controller", "discrete_controller", "fit_magnitude", "frozen",
+           "hinfnorm", "hinfsyn", "lft_lower", "loop_delay", "lpvsyn", "matrices_at",
+           "musyn", "musyn_dgk", "mussv", "reduce_controller", "scheduled_digital"]

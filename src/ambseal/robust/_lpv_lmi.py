@@ -1,0 +1,337 @@
+"""The LMI part of the gridded LPV synthesis (:func:`ambseal.robust.lpv.lpvsyn`).
+
+Scaling of the plant grid (one diagonal state scaling, a time scale ω₀, LQG balancing of the
+centre plant, unit-norm controls and measurements) and the SDPs in γ, R and S(Ω): the
+projected LMIs of Gahinet & Apkarian (1994) on every grid point, with a constant or
+parameter-dependent Lyapunov function (Apkarian & Adams 1998; Wu et al. 1996). The
+equations are in :mod:`ambseal.robust.lpv`. SDPs are solved by Clarabel through cvxpy
+(imported inside the functions); a status other than ``optimal`` raises
+:class:`~ambseal.errors.SynthesisError`.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import scipy.linalg as sla
+
+from ambseal.errors import SynthesisError
+
+__all__ = ["SolverReport", "Scaled", "scale_grid", "lmi_blocks", "solve_lmis", "basis",
+           "BASES"]
+
+BASES = {"constant": 1, "affine": 2, "quadratic": 3}
+#: Clarabel tolerances: a relative duality gap of 1e-6 (Clarabel's default 1e-8 stalls on
+#: these LMIs near 1e-7, and is then reported as "almost solved", i.e. inaccurate).
+_DEFAULT_TOL = {"tol_gap_abs": 1e-6, "tol_gap_rel": 1e-6, "tol_feas": 1e-8,
+                #: the projected LMIs are dense (the null-space bases mix every entry of
+                #: R, S): Clarabel's chordal decomposition only splits them into
+                #: overlapping cones and stalls ("almost solved") on the turboexpander
+                "chordal_decomposition_enable": False}
+
+
+
+@dataclass(frozen=True)
+class SolverReport:
+    """What the SDP solver said.
+
+    Attributes
+    ----------
+    stage : str
+        ``"gamma"`` (minimise γ), ``"centre"`` (re-solve at the backed-off γ for a
+        well-conditioned R, S) or ``"reconstruct"`` (all controller reconstructions).
+    status : str
+        cvxpy status (``"optimal"`` is the only one accepted).
+    iterations : int
+        Interior-point iterations (summed over reconstructions).
+    time_s : float
+        Wall time of setup and solve (s).
+    solver : str
+    """
+
+    stage: str
+    status: str
+    iterations: int
+    time_s: float
+    solver: str = "CLARABEL"
+
+    def to_dict(self) -> dict:
+        return {"stage": self.stage, "status": self.status, "iterations": self.iterations,
+                "time_s": self.time_s, "solver": self.solver}
+
+
+def _null(M: np.ndarray, tol: float = 1e-10) -> np.ndarray:
+    """Orthonormal basis of the null space of M (columns)."""
+    u, s, vh = np.linalg.svd(M)
+    rank = int(np.sum(s > tol * max(s[0] if s.size else 0.0, 1.0)))
+    return vh[rank:].T.conj()
+
+
+def _sym(X):
+    return 0.5 * (X + X.T)
+
+
+def basis(kind: str, p: float) -> tuple[np.ndarray, np.ndarray]:
+    """Basis values f_i(p) and derivatives df_i/dp for p ∈ [−1, 1]."""
+    nb = BASES[kind]
+    f = np.array([p**i for i in range(nb)], float)
+    df = np.array([i * p ** (i - 1) if i else 0.0 for i in range(nb)], float)
+    return f, df
+
+
+def _check_status(prob, stage: str, t0: float) -> SolverReport:
+    status = str(prob.status)
+    stats = prob.solver_stats
+    it = int(getattr(stats, "num_iters", 0) or 0)
+    rep = SolverReport(stage, status, it, time.perf_counter() - t0)
+    if status in ("infeasible", "infeasible_inaccurate"):
+        raise SynthesisError(
+            f"lpvsyn ({stage}): the LMIs are infeasible (solver status {status!r}): no "
+            "controller with this Lyapunov structure exists for the plant and weights; relax "
+            "the weights, the rate bound or the grid range")
+    if status != "optimal":
+        raise SynthesisError(
+            f"lpvsyn ({stage}): solver status {status!r} after {it} iterations — the solution "
+            "is not accurate enough to build a controller from; check the scaling of the "
+            "plant and weights or raise the iteration limit")
+    return rep
+
+
+def _solve(prob, stage: str, solver_options: dict):
+
+    t0 = time.perf_counter()
+    _solve_quiet(prob, stage, dict(solver_options))
+    return _check_status(prob, stage, t0)
+
+
+@dataclass(frozen=True)
+class Scaled:
+    A: np.ndarray  # (n_p, N, N)
+    dA: np.ndarray  # (n_p, N, N), per unit p
+    B: np.ndarray
+    C: np.ndarray
+    D: np.ndarray
+    T: np.ndarray  # x = T x̃ (after the time scale)
+    su: np.ndarray
+    sy: np.ndarray
+    w0: float
+    p_of: Any  # Ω (rad/s) → p ∈ [−1, 1]
+    dp_dW: float
+    sigma: np.ndarray  # balanced Riccati values (1 for diagonal scaling)
+
+    def to_scaled_A(self, A: np.ndarray) -> np.ndarray:
+        """A frozen physical A(Ω) in the scaled coordinates of the LMIs."""
+        return np.linalg.solve(self.T, A @ self.T) / self.w0
+
+
+def _riccati_balance(A, B1, B2, C1, C2, D12, D21) -> tuple[np.ndarray, np.ndarray]:
+    """Similarity T balancing the H2 (LQG) Riccati solutions of one frozen plant.
+
+    X (control, from (A, B2) with cost C1, D12) and Y (filter, from (A, C2) with noise B1,
+    D21) are the limits of the H∞ Riccati solutions X∞, Y∞ for γ → ∞; the LMI variables
+    S and R behave like γX∞ and γY∞. With T from the balancing of the pair (Jonckheere &
+    Silverman 1983 "LQG balancing"), TᵀXT = T⁻¹YT⁻ᵀ = Σ, both LMI variables are of the
+    order of Σ in the new coordinates, so neither a slow weight pole (large X) nor the fast
+    actuator states (large Y) dominate the conditioning of the SDP.
+    """
+    n = A.shape[0]
+    X = sla.solve_continuous_are(A, B2, C1.T @ C1, D12.T @ D12, s=C1.T @ D12)
+    Y = sla.solve_continuous_are(A.T, C2.T, B1 @ B1.T, D21 @ D21.T, s=B1 @ D21.T)
+    X, Y = _sym(X), _sym(Y)
+
+    def chol(M):
+        reg = 1e-12 * max(np.trace(M) / n, 1e-300)
+        w, V = np.linalg.eigh(M)
+        return V * np.sqrt(np.maximum(w, reg))[None, :]
+
+    Lx, Ly = chol(X), chol(Y)
+    U, sig, Vt = np.linalg.svd(Lx.T @ Ly)
+    T = Ly @ Vt.T / np.sqrt(sig)[None, :]
+    return T, sig
+
+
+def scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling: str = "riccati") -> Scaled:
+    """State, time and signal scaling for the whole grid (norm-preserving for w → z).
+
+    1. one diagonal state scaling balancing the envelope of |A(Ω_k)| against B and C;
+    2. the time scale t' = ω₀ t with ω₀ the geometric mean of the pole magnitudes;
+    3. ``scaling="riccati"``: the LQG-balancing similarity of the centre grid plant
+       (:func:`_riccati_balance`), which makes R and S of the order of its Σ (skipped, Σ
+       reported as NaN, when the centre plant has no stabilising Riccati solution — then
+       the LMIs are infeasible anyway and the solver says so);
+    4. controls and measurements to unit-norm columns/rows of [B2; D12] and [C2, D21].
+    """
+    n = As.shape[1]
+    env = np.max(np.abs(As), axis=0)
+    Mbal = np.zeros((n + 1, n + 1))
+    Mbal[:n, :n] = env
+    Mbal[:n, n] = np.abs(B).sum(1)
+    Mbal[n, :n] = np.abs(C).sum(0)
+    _, (t, _) = sla.matrix_balance(Mbal, permute=False, separate=True)
+    t = t[:n] / t[n]
+    lam = np.concatenate([np.abs(np.linalg.eigvals(A)) for A in As])
+    lam = lam[lam > 1e-9 * max(lam.max(), 1.0)]
+    w0 = float(np.sqrt(lam.min() * lam.max())) if lam.size else 1.0
+    T = np.diag(t)
+    Ds = D.copy()
+    Bs = B / t[:, None] / np.sqrt(w0)
+    Cs = C * t[None, :] / np.sqrt(w0)
+    cu = np.linalg.norm(np.vstack([Bs[:, nw:], Ds[:nz, nw:]]), axis=0)
+    su = 1.0 / np.where(cu > 0, cu, 1.0)
+    ry = np.linalg.norm(np.hstack([Cs[nz:], Ds[nz:, :nw]]), axis=1)
+    sy = 1.0 / np.where(ry > 0, ry, 1.0)
+    Bs[:, nw:] *= su
+    Ds[:, nw:] *= su
+    Cs[nz:] *= sy[:, None]
+    Ds[nz:] *= sy[:, None]
+    sig = np.ones(n)
+    if scaling == "riccati":
+        kc = len(As) // 2
+        Ac = As[kc] * (1.0 / t)[:, None] * t[None, :] / w0
+        try:
+            Tr, sig = _riccati_balance(Ac, Bs[:, :nw], Bs[:, nw:], Cs[:nz], Cs[nz:],
+                                       Ds[:nz, nw:], Ds[nz:, :nw])
+            ok = bool(np.all(np.isfinite(Tr)) and np.linalg.cond(Tr) < 1e12)
+        except (np.linalg.LinAlgError, ValueError):
+            ok = False  # not stabilisable/detectable there: the SDP will tell (infeasible)
+        if ok:
+            T = T @ Tr
+            Bs = np.linalg.solve(Tr, Bs)
+            Cs = Cs @ Tr
+        else:
+            sig = np.full(n, np.nan)
+    elif scaling != "diagonal":
+        raise SynthesisError(f"lpvsyn: scaling={scaling!r}; expected 'riccati' or 'diagonal'")
+    Tinv = np.linalg.inv(T)
+    As_s = np.einsum("ij,kjl,lm->kim", Tinv, As, T) / w0
+    half = 0.5 * (grid[-1] - grid[0])
+    mid = 0.5 * (grid[-1] + grid[0])
+    dAs_s = np.einsum("ij,kjl,lm->kim", Tinv, dAs, T) / w0 * half  # per unit p
+    return Scaled(As_s, dAs_s, Bs, Cs, Ds, T, su, sy, w0,
+                   lambda W: (np.asarray(W, float) - mid) / half, 1.0 / half, sig)
+
+
+def lmi_blocks(sc: Scaled, nw, nz, ncon, nmeas):
+    B1, B2 = sc.B[:, :nw], sc.B[:, nw:]
+    C1, C2 = sc.C[:nz], sc.C[nz:]
+    D11, D12, D21 = sc.D[:nz, :nw], sc.D[:nz, nw:], sc.D[nz:, :nw]
+    return B1, B2, C1, C2, D11, D12, D21
+
+
+def _sym_expr(X):
+    return 0.5 * (X + X.T)
+
+
+def _solve_quiet(prob, stage: str, solver_options: dict) -> None:
+    import warnings
+
+    import cvxpy as cp
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # status is checked by the caller
+            prob.solve(solver=cp.CLARABEL, **solver_options)
+    except cp.error.SolverError as exc:
+        raise SynthesisError(f"lpvsyn ({stage}): Clarabel failed: {exc}") from exc
+
+
+
+def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float, *,
+               backoff: float, margin: float, penalty: float, coupling_ratio: float,
+               centre: bool, solver_options: dict):
+    """The SDP stages of :func:`ambseal.robust.lpv.lpvsyn` on the scaled grid.
+
+    Parameters
+    ----------
+    sc : Scaled
+        The scaled plant grid (:func:`scale_grid`).
+    blocks : tuple of ndarray
+        ``(B1, B2, C1, C2, D11, D12, D21)`` of the scaled plant (:func:`lmi_blocks`).
+    grid : ndarray, shape (n_p,)
+        Design speeds (rad/s).
+    lyapunov : {"constant", "affine", "quadratic"}
+    nu_s : float
+        Rate bound in scaled units (dp/dt'), 0 without one.
+    backoff, margin, penalty, coupling_ratio, centre, solver_options
+        As in :func:`ambseal.robust.lpv.lpvsyn` (``solver_options`` complete).
+
+    Returns
+    -------
+    gamma : float
+        Optimal γ of stage 1.
+    gamma_design : float
+        ``backoff·γ``.
+    R : ndarray, shape (N, N)
+    S : list of ndarray, shape (N, N)
+        Coefficients S_i of S(p) = Σ f_i(p) S_i.
+    reports : list of SolverReport
+
+    Raises
+    ------
+    SynthesisError
+        Infeasible LMIs or a solver status other than ``optimal``.
+    """
+    import cvxpy as cp
+
+    B1, B2, C1, C2, D11, D12, D21 = blocks
+    N, nw, nz = B1.shape[0], B1.shape[1], C1.shape[0]
+    NR = sla.block_diag(_null(np.hstack([B2.T, D12.T])), np.eye(nw))
+    NS = sla.block_diag(_null(np.hstack([C2, D21])), np.eye(nz))
+    nb = BASES[lyapunov]
+    ps = sc.p_of(grid)
+    I_N = np.eye(N)
+
+    def build(gamma_fixed: float | None, alpha: float):
+        R = cp.Variable((N, N), symmetric=True)
+        Ss = [cp.Variable((N, N), symmetric=True) for _ in range(nb)]
+        g = cp.Variable(nonneg=True) if gamma_fixed is None else gamma_fixed
+        cons, trS = [], 0
+        eps = margin
+        for k in range(grid.size):
+            A = sc.A[k]
+            f, df = basis(lyapunov, float(ps[k]))
+            S = sum(fi * Si for fi, Si in zip(f, Ss))
+            dS = sum(dfi * Si for dfi, Si in zip(df, Ss)) if nb > 1 else None
+            MR = cp.bmat([[A @ R + R @ A.T, R @ C1.T, B1],
+                          [C1 @ R, -g * np.eye(nz), D11],
+                          [B1.T, D11.T, -g * np.eye(nw)]])
+            cons.append(_sym_expr(NR.T @ MR @ NR) << -eps * np.eye(NR.shape[1]))
+            signs = (1.0, -1.0) if (dS is not None and nu_s > 0) else (0.0,)
+            for sgn in signs:
+                top = A.T @ S + S @ A + (sgn * nu_s * dS if sgn else 0)
+                MS = cp.bmat([[top, S @ B1, C1.T],
+                              [B1.T @ S, -g * np.eye(nw), D11.T],
+                              [C1, D11, -g * np.eye(nz)]])
+                cons.append(_sym_expr(NS.T @ MS @ NS) << -eps * np.eye(NS.shape[1]))
+            if nb > 1 or k == 0:  # one coupling LMI suffices for a constant S
+                cons.append(_sym_expr(cp.bmat([[R, alpha * I_N], [alpha * I_N, S]])) >> 0)
+                trS = trS + cp.trace(S) / (grid.size if nb > 1 else 1)
+        return R, Ss, g, cons, cp.trace(R) + trS
+
+    reports = []
+    R, Ss, g, cons, tr = build(None, float(coupling_ratio) if not centre else 1.0)
+    prob = cp.Problem(cp.Minimize(g + penalty * tr / N), cons)
+    reports.append(_solve(prob, "gamma", solver_options))
+    gamma = float(g.value)
+    gamma_d = backoff * gamma
+    if centre:
+        # stage 2: centre R, S at the backed-off γ with S R ⪰ α² I
+        alpha, last = float(coupling_ratio), None
+        for _ in range(4):
+            R, Ss, _, cons, tr = build(gamma_d, alpha)
+            prob = cp.Problem(cp.Minimize(tr / N), cons)
+            try:
+                rep = _solve(prob, "centre", solver_options)
+                break
+            except SynthesisError as exc:
+                last = exc
+                alpha = 1.0 + 0.5 * (alpha - 1.0)
+        else:
+            raise last
+        reports.append(rep)
+    Rv = _sym(np.asarray(R.value))
+    Sv = [_sym(np.asarray(S.value)) for S in Ss]
+    return gamma, gamma_d, Rv, Sv, reports

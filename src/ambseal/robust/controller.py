@@ -1,0 +1,112 @@
+"""The controller types of ambseal and their one sign convention.
+
+**Convention** (thesis P5 Fig. 8, stated here once): a controller maps the sensor
+displacements ``y`` (m) to the current references ``i`` (A) with **negative feedback**,
+``i = −K y``; its inputs are named ``y_<axis>`` and its outputs ``i_<axis>``
+(``<axis>`` an AMB actuator axis such as ``A_zeta``), the reverse of the plant's
+(:class:`ambseal.model.lft.Plant`: inputs ``i_<axis>``, outputs ``y_<axis>``). The loop
+closes by name in python-control with the sign written into the connection::
+
+    loop = control.interconnect(
+        [G, K], connections=[[f"G.i_{a}", f"-K.i_{a}"] for a in axes]
+        + [[f"K.y_{a}", f"G.y_{a}"] for a in axes], outlist=list(G.output_labels))
+
+(with ``G`` and ``K`` given ``name="G"``/``name="K"``, ``axes = plant.axes``).
+
+* A **fixed** controller is a continuous ``control.StateSpace`` with that convention.
+* A **scheduled** controller is a :class:`ScheduledController` scheduled on one named
+  parameter θ: the rotor speed (``parameter == "speed"``, Ω in rad/s; the LPV controller of
+  P3) or an LFT parameter of the rig (e.g. ``"seal.k"`` in N/m, the controller scheduled on
+  the tracked seal coefficient, issue 14). ``at(θ)`` gives the frozen fixed controller at
+  θ inside ``schedule``.
+
+Analyses take either through :func:`frozen` and :func:`matrices_at`.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from typing import Mapping
+
+import numpy as np
+
+from ambseal.errors import ModelError
+
+__all__ = ["ScheduledController", "frozen", "matrices_at", "SPEED"]
+
+#: The name of the rotor speed as a scheduling parameter (Ω, rad/s).
+SPEED = "speed"
+
+
+class ScheduledController(ABC):
+    """A controller scheduled on one parameter θ, ``i = −K(θ) y``.
+
+    ``parameter`` names θ: :data:`SPEED` (the rotor speed Ω, rad/s) or an LFT parameter of
+    the rig (``"<element>.<coefficient>"``, SI units); ``schedule`` is the interval
+    (θ_min, θ_max) the schedule covers (held at its ends outside it).
+    """
+
+    #: The scheduling parameter: "speed" (Ω, rad/s) or an LFT parameter name (SI); set by
+    #: every subclass (a class variable for the speed-scheduled ones).
+    parameter: str
+
+    @property
+    @abstractmethod
+    def schedule(self) -> tuple[float, float]:
+        """(θ_min, θ_max), the values of ``parameter`` (SI) the schedule covers."""
+
+    @abstractmethod
+    def matrices_at(self, value: float) -> tuple[np.ndarray, ...]:
+        """Physical ``(A_K, B_K, C_K, D_K)`` at θ = ``value`` (SI),
+        ``i = −(C_K x_K + D_K y)``."""
+
+    @abstractmethod
+    def at(self, value: float, name: str = "K"):
+        """The frozen controller at θ = ``value`` (SI): a ``control.StateSpace``, m → A,
+        named signals, ``i = −K y``."""
+
+
+def _value(K: ScheduledController, speed_rad_s: float | None,
+           values: Mapping[str, float] | None) -> float:
+    """θ of ``K`` at the condition: the speed, or ``values[K.parameter]``."""
+    if K.parameter == SPEED and speed_rad_s is not None:
+        return float(speed_rad_s)
+    if values is not None and K.parameter in values:
+        return float(values[K.parameter])
+    raise ModelError(f"a controller scheduled on {K.parameter!r} needs its value to be "
+                     "frozen (values={...})")
+
+
+def frozen(K, speed_rad_s: float | None = None, values: Mapping[str, float] | None = None):
+    """The fixed controller that runs at a condition: ``K`` itself, or a scheduled one
+    frozen at the condition's value of its parameter.
+
+    Parameters
+    ----------
+    K : control.StateSpace or ScheduledController
+    speed_rad_s : float, optional
+        The rotor speed Ω (rad/s): θ of a speed-scheduled controller.
+    values : mapping, optional
+        ``{parameter: value}`` (SI): θ of a controller scheduled on another parameter.
+
+    Returns
+    -------
+    control.StateSpace
+
+    Raises
+    ------
+    ModelError
+        A scheduled controller whose parameter has no value given.
+    """
+    if isinstance(K, ScheduledController):
+        return K.at(_value(K, speed_rad_s, values))
+    return K
+
+
+def matrices_at(K, speed_rad_s: float | None = None,
+                values: Mapping[str, float] | None = None) -> tuple[np.ndarray, ...]:
+    """Physical ``(A_K, B_K, C_K, D_K)`` of a fixed or scheduled controller at a condition
+    (arguments and errors as :func:`frozen`)."""
+    if isinstance(K, ScheduledController):
+        return K.matrices_at(_value(K, speed_rad_s, values))
+    return tuple(np.asarray(M, float) for M in (K.A, K.B, K.C, K.D))

@@ -1,0 +1,362 @@
+"""Gridded H∞ LPV synthesis by LMIs, scheduled on one parameter (the spin speed Ω).
+
+Thesis P3 §4 designs an LPV controller with the LMIs of Apkarian & Adams (1998) and a
+constant Lyapunov function (stability and performance under arbitrarily fast speed
+changes); its conclusion suggests a parameter-dependent Lyapunov function with a bound on
+|Ω̇|. Both are here (Wu, Yang, Packard & Becker 1996; Apkarian & Adams 1998 §3):
+
+Generalised plant P(Ω) (inputs [w, u], outputs [z, y], as :func:`ambseal.robust.hinfsyn`)
+with A(Ω) varying and B, C, D constant (true for the rig: Ω enters through stiffness,
+damping and gyroscopic terms only), D22 = 0. Find γ, R = Rᵀ (constant) and
+S(Ω) = Σ_i f_i(Ω) S_i (f_0 = 1; ``"constant"``: S_0 only) such that on every grid point Ω_k
+and for Ω̇ = ±ν (``rate_bound``)::
+
+    N_Rᵀ [A R + R Aᵀ,  R C1ᵀ,  B1;  C1 R, −γI, D11;  B1ᵀ, D11ᵀ, −γI] N_R ≺ 0
+    N_Sᵀ [Aᵀ S + S A ± ν ∂S/∂Ω,  S B1,  C1ᵀ;  B1ᵀ S, −γI, D11ᵀ;  C1, D11, −γI] N_S ≺ 0
+    [R, I; I, S] ⪰ 0
+
+with N_R = diag(null[B2ᵀ D12ᵀ], I), N_S = diag(null[C2 D21], I) (the projected, or
+elimination, conditions of Gahinet & Apkarian 1994). Keeping R constant makes the controller
+independent of Ω̇ (Apkarian & Adams 1998 §3.2).
+
+Controller reconstruction at any Ω: with M = I, N(Ω) = I − S(Ω) R the linearising change of
+variables (Scherer, Gahinet & Chilali 1997) turns the closed-loop bounded-real inequality
+into an LMI in (Â, B̂, Ĉ) (D_K = 0); its minimum-norm solution at a γ slightly above the
+design γ gives B_K = N⁻¹B̂, C_K = Ĉ, A_K = N⁻¹(Â − B̂ C2 R − S B2 Ĉ − S A R). Controllers
+are reconstructed on a table ``check_density`` times denser than the design grid (5; 1 on
+a vertex grid with a constant S, where the linear interpolation meets the same γ:
+:func:`ambseal.design.lpv_design.design_lpv`), checked there (each frozen closed loop
+stable, its H∞ norm reported) and interpolated linearly in between.
+
+Code: validation and orchestration here (:func:`lpvsyn`, ``_validate``, ``_check_table``);
+scaling and the SDPs in :mod:`ambseal.robust._lpv_lmi`; the controller reconstruction in
+:mod:`ambseal.robust._lpv_reconstruct`.
+
+Numerics: the plants are balanced with one diagonal state scaling for the whole grid, time
+is scaled by ω₀ (norm-preserving), and controls/measurements are normalised, before the
+SDPs are solved with Clarabel through cvxpy (imported inside the functions). A solver status
+other than ``optimal`` raises :class:`~ambseal.errors.SynthesisError`: badly scaled LMIs
+fail silently, and a controller from an inaccurate solution is refused.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+import numpy as np
+
+from ambseal.errors import SynthesisError
+from ambseal.lti.interconnect import lft_lower_matrices
+from ambseal.robust._lpv_lmi import _DEFAULT_TOL, BASES, SolverReport, lmi_blocks, scale_grid, solve_lmis
+from ambseal.robust._lpv_reconstruct import interp_A, reconstruct_table
+
+__all__ = ["LpvController", "LpvSynResult", "lpvsyn", "SolverReport"]
+
+
+@dataclass(frozen=True, eq=False)
+class LpvController:
+    """A controller scheduled on Ω, tabulated and interpolated linearly between entries.
+
+    ``u = K(Ω) y`` in the generalised plant's convention (positive feedback, synthesis
+    units); :func:`ambseal.design.lpv_design.design_lpv` wraps it in physical units.
+
+    Attributes
+    ----------
+    speeds_rad_s : ndarray, shape (n_t,)
+        Table speeds Ω (rad/s), where the controller was reconstructed exactly.
+    AK, BK, CK, DK : ndarray, shapes (n_t, n_K, n_K), (n_t, n_K, ny), (n_t, nu, n_K), (n_t, nu, ny)
+    input_names, output_names : tuple of str
+    """
+
+    speeds_rad_s: np.ndarray
+    AK: np.ndarray = field(repr=False)
+    BK: np.ndarray = field(repr=False)
+    CK: np.ndarray = field(repr=False)
+    DK: np.ndarray = field(repr=False)
+    input_names: tuple[str, ...] = ()
+    output_names: tuple[str, ...] = ()
+
+    @property
+    def order(self) -> int:
+        return self.AK.shape[1]
+
+    def matrices(self, speed_rad_s: float) -> tuple[np.ndarray, ...]:
+        """(A_K, B_K, C_K, D_K) at Ω (rad/s), linear between table speeds, held at the ends."""
+        from ambseal.lti.tables import interp_table
+
+        return tuple(interp_table(float(speed_rad_s), self.speeds_rad_s, X)
+                     for X in (self.AK, self.BK, self.CK, self.DK))
+
+    def at(self, speed_rad_s: float, *, name: str = "K_lpv"):
+        """The frozen controller at Ω (rad/s) as a named ``control.StateSpace``, synthesis
+        units (the physical one: :meth:`ambseal.design.lpv_design.LpvDesign.controller_at`).
+        """
+        import control
+
+        A, B, C, D = self.matrices(speed_rad_s)
+        return control.ss(A, B, C, D,
+                          inputs=list(self.input_names), outputs=list(self.output_names),
+                          states=[f"xK{i}" for i in range(A.shape[0])], name=name)
+
+    def at_hz(self, speed_hz: float, **kw):
+        """:meth:`at` with the speed in Hz."""
+        return self.at(2 * np.pi * speed_hz, **kw)
+
+
+@dataclass(frozen=True, eq=False)
+class LpvSynResult:
+    """Result of :func:`lpvsyn`.
+
+    Attributes
+    ----------
+    K : LpvController
+        The scheduled controller (table on the check grid).
+    gamma : float
+        Optimal γ of the LMIs (upper bound of the L2 gain of the LPV closed loop for all
+        speed trajectories in the grid range with |Ω̇| ≤ ν; ν = ∞ for ``"constant"``).
+    gamma_design : float
+        Backed-off γ at which R, S and the controllers were computed.
+    lyapunov : str
+        ``"constant"``, ``"affine"`` or ``"quadratic"`` S(Ω).
+    rate_bound : float or None
+        ν (rad/s²).
+    grid_rad_s : ndarray
+        Design grid.
+    check_rad_s : ndarray
+        Check grid (= controller table).
+    check_gamma : ndarray
+        H∞ norm of each frozen closed loop on the check grid (inf if unstable).
+    check_stable : bool
+        Every frozen closed loop on the check grid (and at the table midpoints, with the
+        interpolated controller) is stable.
+    reports : tuple of SolverReport
+    time_s : float
+        Total wall time (s).
+    """
+
+    K: LpvController
+    gamma: float
+    gamma_design: float
+    lyapunov: str
+    rate_bound: float | None
+    grid_rad_s: np.ndarray = field(repr=False)
+    check_rad_s: np.ndarray = field(repr=False)
+    check_gamma: np.ndarray = field(repr=False)
+    check_stable: bool = False
+    reports: tuple = ()
+    time_s: float = 0.0
+
+    @property
+    def iterations(self) -> int:
+        """Interior-point iterations of the γ stage."""
+        return self.reports[0].iterations if self.reports else 0
+
+    def to_dict(self) -> dict:
+        return {"gamma": self.gamma, "gamma_design": self.gamma_design,
+                "lyapunov": self.lyapunov, "rate_bound_rad_s2": self.rate_bound,
+                "grid_hz": (self.grid_rad_s / (2 * np.pi)).tolist(),
+                "check_hz": (self.check_rad_s / (2 * np.pi)).tolist(),
+                "check_gamma": [float(g) if np.isfinite(g) else None for g in self.check_gamma],
+                "check_gamma_max": float(np.max(self.check_gamma)),
+                "check_stable": self.check_stable, "controller_order": self.K.order,
+                "reports": [r.to_dict() for r in self.reports], "time_s": self.time_s}
+
+
+# --------------------------------------------------------------------------- synthesis
+def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
+           dA: Sequence[np.ndarray] | None = None, lyapunov: str = "constant",
+           rate_bound: float | None = None, backoff: float = 1.05,
+           check_density: int = 5, solver_options: dict | None = None,
+           margin: float = 1e-6, scaling: str = "riccati", penalty: float = 1e-4,
+           coupling_ratio: float = 1.1, centre: bool = False) -> LpvSynResult:
+    """Gridded H∞ LPV controller (Apkarian & Adams 1998; Wu et al. 1996; thesis P3 §4).
+
+    Stages, each an SDP solved by Clarabel and each required to end ``optimal``:
+
+    1. ``"gamma"``: minimise γ + penalty·(tr R + mean_k tr S(Ω_k))/N subject to the
+       projected LMIs and [R, αI; αI, S(Ω_k)] ⪰ 0 with α = ``coupling_ratio`` > 1, i.e.
+       S R ⪰ α² I: I − S R then has its eigenvalues at distance ≥ α² − 1 from 0 and the
+       controller reconstruction is well conditioned, at a slightly higher γ (still a valid
+       upper bound). The small trace term keeps the SDP bounded near the optimum, where R
+       or S would otherwise grow without limit (a hard cap on R, S sits on the cap and
+       stalls the interior point).
+    2. ``"centre"`` (only with ``centre=True``): stage 1 with α = 1, then at
+       γ_d = backoff·γ minimise tr R + mean_k tr S(Ω_k) with α = ``coupling_ratio``
+       (lowered towards 1 if infeasible). Gives the least conservative γ, but on the
+       turboexpander with a dynamic W_u this second SDP ends "almost solved" (refused).
+    3. ``"reconstruct"``: the controller on the 5× denser table.
+
+    Parameters
+    ----------
+    plants : sequence of control.StateSpace, length n_p
+        Frozen generalised plants P(Ω_k), inputs ``[w, u]``, outputs ``[z, y]``, one state
+        basis; only A may differ between them; D22 = 0.
+    speeds_rad_s : array_like, shape (n_p,)
+        The grid Ω_k (rad/s), strictly increasing, n_p ≥ 2.
+    nmeas, ncon : int
+        Measurements (last outputs) and controls (last inputs).
+    dA : sequence of ndarray (n_p, N, N), optional
+        dA/dΩ at the grid points (1/s per rad/s); needed for a rate bound with a
+        parameter-dependent S. Default: finite differences of the grid.
+    lyapunov : {"constant", "affine", "quadratic"}
+        S(Ω) = S_0 (thesis P3), S_0 + p S_1, or S_0 + p S_1 + p² S_2 with
+        p = (Ω − Ω_mid)/Ω_half ∈ [−1, 1]. R is always constant.
+    rate_bound : float, optional
+        ν ≥ |Ω̇| (rad/s²); required for, and only allowed with, a parameter-dependent S.
+    backoff : float
+        R, S and controllers are computed at ``backoff·γ`` (≥ 1).
+    check_density : int
+        The controller table (and check grid) has ``check_density·(n_p − 1) + 1`` speeds.
+    solver_options : dict, optional
+        Passed to Clarabel (e.g. ``{"max_iter": 200}``); defaults: relative gap 1e-6,
+        feasibility 1e-8.
+    margin : float
+        Strictness margin of the LMIs (scaled units).
+    scaling : {"riccati", "diagonal"}
+        State scaling before the SDPs: ``"riccati"`` (default) balances the H2 Riccati
+        solutions of the centre plant (``lpv_lmi._riccati_balance``) after a diagonal balancing
+        and the time scale; ``"diagonal"`` stops after the diagonal balancing.
+    penalty : float
+        Weight of the trace term in stage 1 (scaled units; ≥ 0).
+    coupling_ratio : float
+        α of the coupling LMI (> 1).
+    centre : bool
+        Two-stage γ / centring instead of one stage with α in it.
+
+    Returns
+    -------
+    LpvSynResult
+
+    Raises
+    ------
+    SynthesisError
+        One grid point, a grid not increasing, plants that differ in B, C or D, D22 ≠ 0,
+        an unknown ``lyapunov``, a rate bound with ``"constant"`` (or none with a
+        parameter-dependent S), infeasible LMIs, a solver status other than ``optimal``,
+        or a reconstructed frozen closed loop that is unstable.
+
+    Examples
+    --------
+    >>> import control as ct, numpy as np
+    >>> P = [ct.ss([[a]], [[0., 1.]], [[0.], [1.]], [[0., 1.], [1., 0.]]) for a in (1., 2.)]
+    >>> r = lpvsyn(P, [1.0, 2.0], 1, 1)
+    >>> 2.0 <= r.gamma < 4.5 and r.check_stable
+    True
+    """
+
+    t_start = time.perf_counter()
+    grid, As, dAs, B, C, D, nw, nz = _validate(plants, speeds_rad_s, nmeas, ncon, dA,
+                                               lyapunov, rate_bound, backoff,
+                                               coupling_ratio, penalty)
+    sc = scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling)
+    blocks = lmi_blocks(sc, nw, nz, ncon, nmeas)
+    nu_s = 0.0 if rate_bound is None else float(rate_bound) / sc.w0 * sc.dp_dW  # dp/dt'
+    solver_options = {**_DEFAULT_TOL, **(solver_options or {})}
+    gamma, gamma_d, R, S, reports = solve_lmis(
+        sc, blocks, grid, lyapunov, nu_s, backoff=backoff, margin=margin, penalty=penalty,
+        coupling_ratio=coupling_ratio, centre=centre, solver_options=solver_options)
+
+    # controller table on the check grid
+    dens = max(int(check_density), 1)
+    table = np.concatenate([np.linspace(grid[j], grid[j + 1], dens + 1)[:-1]
+                            for j in range(grid.size - 1)] + [grid[-1:]])
+    A_of = interp_A(As, dAs, grid)
+    *mats, rep = reconstruct_table(sc, blocks, table, A_of, R, S, lyapunov, nu_s,
+                                   gamma_d * 1.02, margin, solver_options)
+    reports.append(rep)
+    in_names = tuple(list(getattr(plants[0], "output_labels", []))[nz:]) or \
+        tuple(f"y{i}" for i in range(nmeas))
+    out_names = tuple(list(getattr(plants[0], "input_labels", []))[nw:]) or \
+        tuple(f"u{i}" for i in range(ncon))
+    K = LpvController(table, *mats, in_names, out_names)
+    check_g = _check_table(K, A_of, B, C, D, nmeas, ncon)
+    return LpvSynResult(K=K, gamma=gamma, gamma_design=gamma_d, lyapunov=lyapunov,
+                        rate_bound=None if rate_bound is None else float(rate_bound),
+                        grid_rad_s=grid, check_rad_s=table, check_gamma=check_g,
+                        check_stable=True, reports=tuple(reports),
+                        time_s=time.perf_counter() - t_start)
+
+
+def _validate(plants, speeds_rad_s, nmeas, ncon, dA, lyapunov, rate_bound, backoff,
+              coupling_ratio, penalty):
+    """Checked grid and plant data of :func:`lpvsyn`: (grid, A stack, dA stack, B, C, D,
+    n_w, n_z); raises SynthesisError as documented there."""
+    grid = np.asarray(speeds_rad_s, float).ravel()
+    if grid.size < 2 or len(plants) != grid.size:
+        raise SynthesisError(f"lpvsyn: the speed grid needs at least 2 points with one plant "
+                             f"each; got {grid.size} speeds and {len(plants)} plants")
+    if np.any(np.diff(grid) <= 0) or not np.all(np.isfinite(grid)):
+        raise SynthesisError("lpvsyn: speeds_rad_s must be finite and strictly increasing")
+    if lyapunov not in BASES:
+        raise SynthesisError(f"lpvsyn: lyapunov={lyapunov!r}; expected one of {sorted(BASES)}")
+    if lyapunov == "constant" and rate_bound is not None:
+        raise SynthesisError(
+            "lpvsyn: a rate bound needs a parameter-dependent Lyapunov function "
+            "(lyapunov='affine' or 'quadratic'); a constant one already allows arbitrarily "
+            "fast speed changes")
+    if lyapunov != "constant" and (rate_bound is None or not np.isfinite(rate_bound)
+                                   or rate_bound < 0):
+        raise SynthesisError(f"lpvsyn: lyapunov={lyapunov!r} needs a finite rate_bound ≥ 0 "
+                             f"(rad/s²), got {rate_bound!r}")
+    if backoff < 1.0:
+        raise SynthesisError(f"lpvsyn: backoff={backoff} must be ≥ 1")
+    As = np.array([np.asarray(P.A, float) for P in plants])
+    B = np.asarray(plants[0].B, float)
+    C = np.asarray(plants[0].C, float)
+    D = np.asarray(plants[0].D, float)
+    for k, P in enumerate(plants[1:], 1):
+        for nm, X, Y in (("B", B, P.B), ("C", C, P.C), ("D", D, P.D)):
+            if np.shape(Y) != X.shape or not np.allclose(np.asarray(Y, float), X,
+                                                         rtol=1e-9, atol=1e-12 * max(1.0, np.abs(X).max())):
+                raise SynthesisError(f"lpvsyn: plant {k} differs from plant 0 in {nm}; only A "
+                                     "may depend on the speed (one state basis)")
+    nw, nz = B.shape[1] - ncon, C.shape[0] - nmeas
+    if nw <= 0 or nz <= 0 or ncon <= 0 or nmeas <= 0:
+        raise SynthesisError(f"lpvsyn: bad channel counts (nw={nw}, nz={nz}, ncon={ncon}, "
+                             f"nmeas={nmeas})")
+    if np.any(D[nz:, nw:] != 0):
+        raise SynthesisError("lpvsyn: D22 must be zero")
+    if dA is None:
+        dAs = np.gradient(As, grid, axis=0)
+    else:
+        dAs = np.array([np.asarray(X, float) for X in dA])
+        if dAs.shape != As.shape:
+            raise SynthesisError(f"lpvsyn: dA has shape {dAs.shape}, expected {As.shape}")
+    if not coupling_ratio > 1.0:
+        raise SynthesisError(f"lpvsyn: coupling_ratio={coupling_ratio} must be > 1")
+    if not penalty >= 0.0:
+        raise SynthesisError(f"lpvsyn: penalty={penalty} must be ≥ 0")
+    return grid, As, dAs, B, C, D, nw, nz
+
+
+def _check_table(K: LpvController, A_of, B, C, D, nmeas: int, ncon: int) -> np.ndarray:
+    """H∞ norms of the frozen closed loops at the table speeds (checked stable there and at
+    the table midpoints, with the interpolated controller).
+
+    Raises
+    ------
+    SynthesisError
+        If one of these frozen closed loops is unstable.
+    """
+    import control as ct
+
+    from ambseal.robust.hinf import hinfnorm
+
+    table = K.speeds_rad_s
+    check_g, stable = [], True
+    for W in table:
+        Acl, Bcl, Ccl, Dcl = lft_lower_matrices((A_of(W), B, C, D), K.matrices(W), nmeas, ncon)
+        if np.max(np.linalg.eigvals(Acl).real) >= 0:
+            check_g.append(np.inf)
+            stable = False
+            continue
+        check_g.append(hinfnorm(ct.ss(Acl, Bcl, Ccl, Dcl))[0])
+    for W in 0.5 * (table[1:] + table[:-1]):
+        Acl = lft_lower_matrices((A_of(W), B, C, D), K.matrices(W), nmeas, ncon)[0]
+        stable &= bool(np.max(np.linalg.eigvals(Acl).real) < 0)
+    if not stable:
+        raise SynthesisError(
+            "lpvsyn: a reconstructed frozen closed loop on the check grid is unstable; "
+            "refine the design grid")
+    return np.array(check_g)

@@ -1,0 +1,54 @@
+"""The speed-scheduled designs (LPV, frozen H∞) closed with the full-order plant at every
+judged condition before they are delivered, as H∞ and μ are (issue 9 §3)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ambseal.design.lpv_design import check_full_order
+from ambseal.design.specs import design_spec
+from ambseal.errors import SynthesisError
+from ambseal.model.rig import build_plant
+
+
+def _max_real_pole(cfg, K, p_bar: float, f_hz: float) -> float:
+    """python-control's closed loop (negative feedback i = −K y) of the full-order plant."""
+    import control
+
+    pl = build_plant(cfg, pressure_bar=p_bar, speed_rpm=60.0 * f_hz)
+    G = pl.select_inputs([pl.input_names[j] for j in pl.current_inputs()]).to_statespace()
+    return float(control.feedback(G, K).poles().real.max())
+
+
+def test_lpv_and_frozen_designs_carry_their_full_order_check(turbo_cfg, turbo_lpv,
+                                                             turbo_frozen):
+    """Reference: python-control's feedback poles at each judged speed (20, 140, 300 Hz
+    at the nominal pressure): the LPV controller frozen at that speed, and the 140 Hz H∞
+    controller, both stable; their ``full_order`` blocks say stable and name the least
+    damped mode of those loops."""
+    sp = design_spec(turbo_cfg)
+    conds = [(p, f) for p in sp.pressures_bar for f in sp.speeds_hz]
+    assert len(conds) == 3
+    frozen_at = lambda f: turbo_frozen.K  # noqa: E731 — one controller at every speed
+    for d, K_at in ((turbo_lpv, turbo_lpv.controller_at), (turbo_frozen, frozen_at)):
+        assert d.full_order["stable"] and d.to_dict()["full_order"] == d.full_order
+        assert all(_max_real_pole(turbo_cfg, K_at(f), p, f) < 0 for p, f in conds)
+        assert (d.full_order["pressure_bar"], d.full_order["speed_hz"]) in conds
+
+
+def test_an_unstable_scheduled_loop_is_refused_with_its_mode(turbo_cfg, turbo_frozen):
+    """Reference: python-control's feedback poles — the frozen controller with its sign
+    flipped (positive feedback) is unstable at every speed; the check refuses it naming
+    the condition, the mode's frequency and damping, and keeps it on request."""
+    import control
+
+    flipped = -1.0 * turbo_frozen.K
+    f = 140.0
+    assert _max_real_pole(turbo_cfg, flipped, turbo_cfg.operating.pressure_bar, f) > 0
+    with pytest.raises(SynthesisError, match=r"unstable at .* bar, .* Hz: the mode at .* "
+                                             r"Hz has ζ = -"):
+        check_full_order(turbo_cfg, lambda _: flipped, "flipped")
+    kept = check_full_order(turbo_cfg, lambda _: flipped, "flipped", allow_unstable=True)
+    assert not kept["stable"] and kept["damping"] < 0
+    assert np.isfinite(kept["mode_hz"]) and isinstance(flipped, control.StateSpace)

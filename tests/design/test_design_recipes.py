@@ -1,0 +1,242 @@
+"""Acceptance of the PID / H∞ / μ designs on the FULL-order test-facility plant.
+
+References: thesis P5 §4.1 (objectives), §4.4 and Figs. 11–13 (σ̄(S_o) of PID/H∞/μ over
+0 … 4.08 bar; the PID loses stability at high pressure), §4.4.1 and Fig. 12 (worst-case
+unbalance orbit, G2.5 at 500 Hz on the 69 kg rotor, ISO 21940-11: F_u = m·G·Ω²/Ω_max), ISO
+14839-3 (σ̄(S_o) < 3, zone A).
+Designs are made on the reduced model; every check uses ``build_plant(cfg, pressure_bar=p)``.
+
+σ̄(S_o) peaks are taken on the log grid PLUS a fine grid around every lightly damped
+closed-loop pole: the first bending mode (≈ 557 Hz) has closed-loop damping ratios down to
+≈ 0.002, a resonance the 800-point log grid steps over (the previous μ design read 2.8 on
+the log grid but 5.8 at 556.8 Hz, 4.08 bar).
+"""
+
+import numpy as np
+import pytest
+
+from ambseal.analysis.loops import closed_loop, compliance, loop_responses
+from ambseal.analysis.unbalance import unbalance_from_compliance
+from ambseal.design.recipes import design
+from ambseal.design.weights import Weights
+
+OMEGA = 2 * np.pi * np.logspace(-1, np.log10(3000.0), 800)
+#: ISO 14839-3:2006 zone A/B boundary of the sensitivity peak (3, i.e. 9.5 dB; P5 §4.1).
+ISO_ZONE_A_LIMIT = 3.0
+#: Thesis demand on the worst-case G2.5 unbalance orbit up to 200 Hz (P5 §4.4.1): 8 µm.
+ORBIT_DEMAND_UM = 8.0
+#: Regression pin, not a published value: order reduction of the μ controller (46 → 28
+#: states) raised the peak μ by 2.1 % (1.116 → 1.139) when this pin was set (issue 8);
+#: P5 §4.3 reduces its controllers without quoting the cost. 5 % flags a change.
+MU_REDUCTION_COST_PIN = 0.05
+
+
+@pytest.fixture(scope="module")
+def cfg(testrig_cfg):
+    return testrig_cfg
+
+
+@pytest.fixture(scope="module")
+def plants(testrig_plants, cfg):
+    """0 … 4.08 bar in 9 steps (P5 Fig. 13), full order (tests/conftest.py), with the
+    digital controller's hold + computation delay (1.5 samples at 10 kHz, Padé) in front
+    of the currents: the loop the H∞/μ designs are made for and every loop is judged on
+    (ambseal.robust.delay)."""
+    from ambseal.analysis.judge import delayed_plant
+    from ambseal.robust.delay import loop_delay
+
+    assert sorted(testrig_plants)[0] == 0.0 and sorted(testrig_plants)[-1] == 4.08
+    L = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples).system
+    return {p: (delayed_plant(G, list(range(G.ninputs)), L), Gf)
+            for p, (G, Gf) in testrig_plants.items()}
+
+
+@pytest.fixture(scope="module")
+def designs(testrig_designs):
+    return testrig_designs
+
+
+def _so_peak(G, K):
+    """Peak σ̄(S_o) with every lightly damped closed-loop resonance resolved (module doc)."""
+    p = closed_loop(G, K).poles
+    p = p[(p.imag > 0) & (p.imag < OMEGA[-1]) & (np.abs(p.real) < 0.1 * np.abs(p))]
+    w = np.sort(np.concatenate([OMEGA] + [q.imag + abs(q.real) * np.linspace(-4, 4, 81)
+                                         for q in p]))
+    return loop_responses(G, K, w[w > 0]).peaks("So").sigma_max.value
+
+
+def test_pid_is_p5_eq6_on_every_axis(cfg, designs):
+    """Reference: P5 Eq. 6 closed form, K(jω) = Kp (1 + 1/(Ti jω) + Td jω/(ε Td jω + 1)) with
+    the rig's [controller.pid] values, the same on the 4 axes and nothing across axes; from
+    displacement (m) to current (A), named per axis."""
+    K = designs["pid"].K
+    pid = cfg.controller.pid
+    for f in (0.5, 10.0, 100.0, 1000.0):
+        s = 2j * np.pi * f
+        want = pid.kp * (1 + 1 / (pid.ti * s) + pid.td * s / (pid.eps * pid.td * s + 1))
+        np.testing.assert_allclose(np.asarray(K(s)), want * np.eye(4), rtol=1e-10,
+                                   atol=1e-12 * abs(want))
+    assert K.input_labels == ["y_A_zeta", "y_A_eta", "y_B_zeta", "y_B_eta"]
+    assert K.output_labels == ["i_A_zeta", "i_A_eta", "i_B_zeta", "i_B_eta"]
+
+
+def test_hinf_gamma_is_the_verified_closed_loop_norm(designs):
+    """Reference: python-control side by side — γ of the H∞ design equals
+    control.norm(P.lft(K_P), 'inf') (slycot AB13DD) of the nominal generalised plant closed
+    by the synthesis-form controller K_P = −(D_e/D_u) K (DESIGN.md scaling), and that loop is
+    stable (its poles by python-control)."""
+    r = designs["hinf"]
+    gp = r.plant
+    g = -gp.d_e / gp.d_u
+    import control as ct
+
+    K_P = ct.ss(r.K.A, r.K.B, g * np.asarray(r.K.C), g * np.asarray(r.K.D))
+    cl = gp.P_nominal.lft(K_P, gp.nmeas, gp.ncon)
+    assert cl.poles().real.max() < 0
+    assert r.gamma == pytest.approx(ct.norm(cl, "inf"), rel=1e-5)
+    assert r.K.ninputs == r.K.noutputs == 4 and r.order == r.K.nstates
+
+
+def test_mu_reduction_cost_regression_pin(designs):
+    """Regression pin MU_REDUCTION_COST_PIN (module constant, own measurement): the reduced μ
+    controller's peak μ is within 5 % of the full-order one, and reduction did reduce."""
+    mu = designs["mu"]
+    red = mu.reduction
+    assert red is not None and red["order"] < red["order_full"] == mu.order_full
+    assert mu.order == mu.K.nstates == red["order"]
+    assert red["mu"] <= (1 + MU_REDUCTION_COST_PIN) * red["mu_full"]
+
+
+def test_mu_delivers_the_candidate_with_lower_mu_after_reduction(designs):
+    """Reference: the definition of the delivered controller (issue 11 §3): after the order
+    reduction the μ design keeps, of D–G–K's controller and complex D–K's, the one whose
+    reduced loop has the lower peak μ, and reports both. There are two candidates exactly
+    when a D–G–K step beat complex D–K at full order (``musyn_dgk``'s ``alternatives``);
+    on the test rig's rig-file design today D–G–K is skipped (the uncertainty does not set
+    D–K's μ peak), so only that equivalence and the reported μ are checked here."""
+    mu = designs["mu"]
+    red = mu.reduction
+    cands = red.get("candidates", [])
+    dgk_won = min(mu.history, key=lambda h: h["mu"]).get("step") == "D-G-K"
+    assert bool(cands) == dgk_won
+    if cands:
+        assert {c["step"] for c in cands} == {"D-K", "D-G-K"}
+        low = min(cands, key=lambda c: c["mu"])
+        assert red["kept"] == low["step"] and red["mu"] == low["mu"]
+        assert all(c["mu_full"] > 0 and c["order"] <= c["order_full"] for c in cands)
+    assert mu.mu == red["mu"]
+
+
+def test_hinf_beats_pid_at_nominal_pressure(designs, plants):
+    """P5 §4.4, Fig. 13: H∞ at its design point has a lower σ̄(S_o) peak than the PID."""
+    G, _ = plants[2.04]
+    for m in ("pid", "hinf"):
+        assert closed_loop(G, designs[m].K).stable
+    assert _so_peak(G, designs["hinf"].K) < _so_peak(G, designs["pid"].K)
+
+
+def test_pid_unstable_at_high_pressure(designs, plants):
+    """P5 Fig. 13: the decentralised PID stabilises the rig at 0 and at the nominal 2.04 bar
+    but not at 4.08 bar (2× nominal)."""
+    assert closed_loop(plants[0.0][0], designs["pid"].K).stable
+    assert closed_loop(plants[2.04][0], designs["pid"].K).stable
+    assert not closed_loop(plants[4.08][0], designs["pid"].K).stable
+
+
+def test_mu_robust_stability_and_sensitivity_over_pressure(designs, plants):
+    """P5 §4.1 items 2 and 4, §4.4.2: μ keeps the loop stable and σ̄(S_o) in ISO 14839-3
+    zone A (< 3) for 0 … 4.08 bar (measured ≈ 2.5 when written).
+
+    The seal's k goes from 0 to 2× its nominal value over this range (P5 §4.1 items 2–3).
+    """
+    K = designs["mu"].K
+    for p in sorted(plants):
+        G, _ = plants[p]
+        assert closed_loop(G, K).stable, f"unstable at {p} bar"
+        peak = _so_peak(G, K)
+        assert peak < ISO_ZONE_A_LIMIT, f"σ̄(S_o) = {peak:.2f} at {p} bar, not ISO zone A"
+
+
+def test_unbalance_orbit_hinf_and_mu_below_8um(designs, plants):
+    """P5 §4.4.1, Fig. 12: "Both the H∞ and μ controllers ensure an orbit below 8 µm over the
+    200 Hz frequency range": worst-case orbit σ̄(S_o G_f(jΩ))·F_u(Ω) for Ω ≤ 200 Hz.
+
+    F_u = m·G·Ω²/Ω_max (ISO 21940-11; G2.5 at Ω_max = 2π·500 rad/s on the 69 kg rotor, 541.9 N
+    at 500 Hz), the forces at the bearings A and B where P5 §4.4.1 takes the compliance,
+    orbit at the sensors, on the full-order plant at every pressure of the grid 0 … 4.08 bar.
+    The PID's orbit, where it is stable, is above 8 µm (the thesis names only H∞ and μ):
+    the demand is not met by accident.
+    """
+    w = 2 * np.pi * np.linspace(1.0, 200.0, 400)
+    worst = dict.fromkeys(("mu", "hinf", "pid"), 0.0)
+    for p in sorted(plants):  # plant outermost: its decompositions are shared by the three
+        G, Gf = plants[p]
+        for m in worst:
+            K = designs[m].K
+            if not closed_loop(G, K).stable:
+                continue
+            c = compliance(G, K, Gf, w)
+            worst[m] = max(worst[m], unbalance_from_compliance(
+                c, mass_kg=69.0, grade_mm_s=2.5, max_speed_rad_s=2 * np.pi * 500.0).peak_um)
+
+    assert worst["mu"] < ORBIT_DEMAND_UM
+    assert worst["hinf"] < ORBIT_DEMAND_UM
+    assert worst["pid"] > ORBIT_DEMAND_UM
+
+
+@pytest.mark.parametrize("law", ["iso21940", "constant_velocity"])
+def test_mu_force_weight_reads_as_orbit_bound(law):
+    """W_p·W_f/D_e = |F_u(jΩ)|·|B_4|/orbit (closed form): the force channel bounds the orbit;
+    F_u = m·G·Ω²/Ω_max (ISO 21940-11) or m·G·Ω, hand formulas."""
+    wmax = 2 * np.pi * 500.0
+    wts = Weights(M=3.0, omega_b=30.0, orbit_um=6.0, wf_rolloff_hz=260.0,
+                  unbalance_mass_kg=69.0, d_e=20e-6, unbalance_law=law, max_speed_rad_s=wmax)
+    Wp, Wf = wts.Wp(), wts.Wf()  # D_e = wts.d_e = 20 µm
+    for hz in (10.0, 100.0, 200.0, 557.0):
+        s = 2j * np.pi * hz
+        b4 = 1 / np.sqrt(1 + (hz / 260.0) ** 8)  # |Butterworth, 4th order|
+        force = 69.0 * 2.5e-3 * abs(s) * (abs(s) / wmax if law == "iso21940" else 1.0)
+        want = force * b4 / 6e-6
+        assert abs(complex(Wp(s)) * complex(Wf(s))) / 20e-6 == pytest.approx(want, rel=1e-6)
+    assert Weights().Wf() is None
+    with pytest.raises(ValueError, match="orbit_um"):
+        Weights(orbit_um=-1.0).Wf()
+    with pytest.raises(ValueError, match="max_speed_rad_s"):
+        Weights(orbit_um=6.0, wf_rolloff_hz=260.0, unbalance_mass_kg=69.0).Wf()
+
+
+def test_mu_robust_performance_and_moderate_gains(designs, cfg):
+    """P5 §4.1 objective 1 and Fig. 10, Ch. 7 item 2: the μ controller "guarantees robust
+    performance (μ ≤ 1) and simultaneously keeps the controller gains moderate": every
+    direct gain |K_ii| within a factor 2 of the reference PID's (P5 Eq. 6, closed form) from
+    1 to 200 Hz, and no gain |K_ij| above 3× the PID's peak Kp (1 + 1/ε) below Nyquist;
+    order 28: the thesis's μ controller order 24 (P5 §4.4) plus one state per current for
+    the digital controller's delay in the design model (first-order Padé,
+    ambseal.robust.delay)."""
+    from ambseal.lti.freqresp import freqresp
+
+    mu = designs["mu"]
+    assert mu.mu <= 1.0
+    pid = cfg.controller.pid
+    f = np.logspace(0, np.log10(0.5 * cfg.controller.sample_rate_hz), 400)
+    s = 2j * np.pi * f
+    k_pid = np.abs(pid.kp * (1 + 1 / (pid.ti * s) + pid.td * s / (pid.eps * pid.td * s + 1)))
+    H = np.abs(freqresp(mu.K, 2 * np.pi * f))
+    low = f <= 200.0
+    for i in range(4):
+        ratio = H[low, i, i] / k_pid[low]
+        assert 0.5 <= ratio.min() and ratio.max() <= 2.0, (i, ratio.min(), ratio.max())
+    assert H.max() <= 3 * pid.kp * (1 + 1 / pid.eps)
+    assert mu.order == 28
+
+
+def test_design_is_deterministic_and_validates(cfg, designs):
+    """Same input, same controller; bad method and bad weights give clear errors."""
+    again = design(cfg, "hinf")
+    assert np.allclose(np.asarray(again.K.D), np.asarray(designs["hinf"].K.D))
+    with pytest.raises(ValueError, match="method"):
+        design(cfg, "lqg")
+    with pytest.raises(ValueError, match="M="):
+        design(cfg, "hinf", weights=Weights(M=-1.0))
+    with pytest.raises(ValueError, match="zero or negative width"):
+        design(cfg, "mu", uncertainty={"seal.k": (2e6, 2e6)})

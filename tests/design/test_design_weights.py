@@ -1,0 +1,83 @@
+"""Weights of the robust designs (thesis P3 Eq. 11, P5 Eq. 7)."""
+
+import numpy as np
+import pytest
+import control as ct
+
+from ambseal.design.weights import (check_weight, control_weight, diagonal_weight,
+                                     performance_weight, wp_gain)
+
+
+def test_wp_low_high_and_bandwidth_values():
+    """|W_p(0)| = 1/A, |W_p(j∞)| = 1/M, |W_p(jω)| = √((ω/M)²+ω_B²)/√(ω²+(ω_B A)²) (P5 Eq. 7)."""
+    M, wb, A = 2.5, 30.0, 1e-3
+    W = performance_weight(M, wb, A)
+    assert abs(W(0)) == pytest.approx(1 / A, rel=1e-12)
+    assert abs(W(1e12j)) == pytest.approx(1 / M, rel=1e-6)
+    w = np.logspace(-3, 5, 50)
+    got = np.abs(W(1j * w))
+    assert np.allclose(got, wp_gain(w, M, wb, A), rtol=1e-12)
+    # the bound 1/|W_p| on |S| peaks at M (approached from below) and is A at DC
+    assert np.max(1 / got) < M and np.max(1 / got) > 0.99 * M
+
+
+def test_wp_crossover_near_bandwidth():
+    """1/|W_p| crosses 1 near ω_B (S&P 2005 Eq. 2.105: ω_B is the bandwidth requirement)."""
+    M, wb = 2.5, 30.0
+    w = np.logspace(-1, 4, 20001)
+    inv = 1 / wp_gain(w, M, wb)
+    wc = w[np.argmin(np.abs(inv - 1))]
+    # closed form: (ω/M)² + ω_B² = ω² (A → 0)  →  ω = ω_B / √(1 − 1/M²)
+    assert wc == pytest.approx(wb / np.sqrt(1 - 1 / M**2), rel=1e-2)
+
+
+def test_wu_high_pass_gains():
+    """W_u = k(1 + s/ω_z)/(1 + s/ω_p): low gain k, high gain k ω_p/ω_z (P3 §3.3)."""
+    W = control_weight(0.2, corner_hz=300.0, hf_gain=4.0)
+    assert abs(W(0)) == pytest.approx(0.2)
+    assert abs(W(1e12j)) == pytest.approx(4.0, rel=1e-6)
+    assert abs(control_weight(0.3)(1j)) == pytest.approx(0.3)
+
+
+def test_improper_weight_raises_naming_it():
+    """An improper weight (s + 1) is rejected with its name in the message."""
+    with pytest.raises(ValueError, match="W_p is not proper"):
+        check_weight(ct.tf([1, 1], [1]), "W_p")
+    with pytest.raises(ValueError, match="W_u"):
+        check_weight(ct.tf([1], [1, -1]), "W_u")  # unstable
+    with pytest.raises(ValueError, match="biproper"):
+        check_weight(ct.tf([1], [1, 1]), "W_u", biproper=True)
+    with pytest.raises(ValueError, match="M="):
+        performance_weight(-1.0, 10.0)
+    with pytest.raises(ValueError, match="hf_gain"):
+        control_weight(1.0, corner_hz=10.0, hf_gain=0.5)
+
+
+def test_diagonal_weight_is_block_diagonal():
+    """diag(W, W, W) evaluated at a frequency equals W(jω)·I."""
+    W = performance_weight(2.0, 100.0)
+    D = diagonal_weight(W, 3, "W_p")
+    val = D(5j)
+    assert np.allclose(val, W(5j) * np.eye(3))
+
+
+def test_gain_weight_is_the_inverse_pid_in_its_band():
+    """μ's gain demand W_K (P5 Fig. 10) against a closed form written independently:
+    |W_K(jω)| = D_u/(c·3·D_e·|K_PID(jω)|)·|H_2(jω)|·|B_4(jω)| with the P5 Eq. 6 PID and the
+    Butterworth magnitudes 1/√(1 + (ω_l/ω)⁴) and 1/√(1 + (ω/ω_h)⁸); −3 dB at both corners."""
+    from ambseal.design.weights import Weights
+    from ambseal.errors import ConfigError
+
+    kp, ti, td, eps, lo, hi = 1.6e4, 0.2, 1.25e-3, 0.1, 150.0, 210.0
+    W = Weights(d_e=20e-6, d_u=1.0, gain_factor=2.0, gain_band_hz=(lo, hi),
+                pid_reference=(kp, ti, td, eps)).Wk()
+    f = np.array([10.0, 150.0, 180.0, 210.0, 1000.0])
+    s = 2j * np.pi * f
+    k_pid = np.abs(kp * (1 + 1 / (ti * s) + td * s / (eps * td * s + 1)))
+    want = (1.0 / (6 * 20e-6 * k_pid) / np.sqrt(1 + (lo / f) ** 4)
+            / np.sqrt(1 + (f / hi) ** 8))
+    got = np.abs(np.array([complex(W(x)) for x in s]).ravel())
+    np.testing.assert_allclose(got, want, rtol=1e-6)
+    assert Weights().Wk() is None
+    with pytest.raises(ConfigError, match="band"):
+        Weights(gain_factor=2.0, gain_band_hz=(210.0, 150.0), pid_reference=(1, 1, 1, 1)).Wk()

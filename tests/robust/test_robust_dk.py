@@ -1,0 +1,163 @@
+"""Tests of ambseal.robust.dk: D-scale fitting and D–K iteration."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import control as ct
+
+from ambseal.robust.dk import fit_dscale, fit_magnitude, musyn
+from ambseal.robust.hinf import hinfsyn, lft_lower
+from ambseal.robust.mu import mussv
+
+from ..distillation import distillation_rp_plant
+
+
+def rp_plant():
+    """Robust-performance plant of Skogestad & Postlethwaite (2005) §8.12.4 (SISO, input
+    multiplicative uncertainty W_I, performance weight W_P, with a small leak instead of the
+    pure integrator). Inputs [w_Δ, w, u], outputs [z_Δ, e, y]."""
+    G = ct.ss(ct.tf([-6, 3], [50, 15, 1]), inputs=["up"], outputs=["yp"], name="G")
+    WI = ct.ss(ct.tf([1, 0.2], [0.5, 1]), inputs=["u"], outputs=["zd"], name="WI")
+    WP = ct.ss(ct.tf([0.5, 0.05], [1, 0.0005]), inputs=["v"], outputs=["e"], name="WP")
+    s1 = ct.summing_junction(inputs=["u", "wd"], output="up", name="s1")
+    s2 = ct.summing_junction(inputs=["yp", "w"], output="v", name="s2")
+    neg = ct.ss([], [], [], [[-1.0]], inputs=["v"], outputs=["y"], name="neg")
+    return ct.interconnect([G, WI, WP, s1, s2, neg], inplist=["wd", "w", "u"],
+                           outlist=["zd", "e", "y"], name="P")
+
+
+def test_fit_magnitude_recovers_minimum_phase_scale():
+    """Reference: a known stable minimum-phase D(s) = 2 (s+1)(s+10)/((s+3)(s+30)); its
+    magnitude is reproduced and all poles/zeros of the fit lie in the open LHP."""
+    D = ct.tf([2, 22, 20], [1, 33, 90])
+    w = np.logspace(-2, 3, 150)
+    mag = np.abs(D(1j * w))
+    fit = fit_magnitude(w, mag, 2)
+    np.testing.assert_allclose(np.abs(fit(1j * w)), mag, rtol=1e-3)
+    assert np.all(np.real(fit.poles()) < 0) and np.all(np.real(fit.zeros()) < 0)
+    c = fit_magnitude(w, np.full(w.size, 3.0), 0)
+    assert float(np.real(c(1j))) == pytest.approx(3.0)
+    with pytest.raises(ValueError, match="0–4"):
+        fit_magnitude(w, mag, 5)
+
+
+def test_fit_dscale_selects_the_lowest_sufficient_order():
+    """Reference: known stable minimum-phase scales. A constant needs order 0; the
+    second-order D(s) = 2 (s+1)(s+10)/((s+3)(s+30)) is reproduced within the tolerance by an
+    order ≤ 2 fit (MATLAB musyn's rule: the lowest order whose fit error is below a
+    tolerance), with every pole and zero in the open LHP."""
+    w = np.logspace(-2, 3, 80)
+    f0, o0, _ = fit_dscale(w, np.full(w.size, 0.3))
+    assert o0 == 0 and float(np.real(f0(1j))) == pytest.approx(0.3)
+    D = ct.tf([2, 22, 20], [1, 33, 90])
+    mag = np.abs(D(1j * w))
+    fit, order, err = fit_dscale(w, mag, tol=0.02)
+    assert 1 <= order <= 2 and err <= np.log1p(0.02)
+    np.testing.assert_allclose(np.abs(fit(1j * w)), mag, rtol=0.03)
+    assert np.all(np.real(fit.poles()) < 0) and np.all(np.real(fit.zeros()) < 0)
+
+
+def _mu_ab13md(cl, omega):
+    """Peak over ``omega`` of slycot AB13MD's μ upper bound for two 1×1 complex blocks,
+    on python-control's frequency response of ``cl``."""
+    from slycot import ab13md
+
+    H = np.moveaxis(ct.frequency_response(cl, omega, squeeze=False).complex, 2, 0)
+    return max(ab13md(Hk, np.array([1, 1]), np.array([2, 2]))[0] for Hk in H)
+
+
+def test_dk_improves_on_hinf_and_records_history():
+    """Reference: μ ≤ σ̄ with D = I (Packard & Doyle 1993), so D–K can only improve on the H∞
+    γ of the unscaled problem; for this two-block problem μ = inf_D σ̄(DMD⁻¹) and D–K from
+    γ ≈ 1.17 gets below 0.85 of it. The reported μ's (final and first iteration) are checked
+    side by side against slycot AB13MD on python-control's F_l (P.lft) of the same
+    controllers on the same grid; the final closed loop is stable (python-control poles)."""
+    P = rp_plant()
+    blocks = [(1, 1), (1, 1)]
+    h = hinfsyn(P, 1, 1)
+    r = musyn(P, blocks, 1, 1, order=2, max_iter=3)
+    assert r.mu <= h.gamma * (1 + 1e-3)
+    assert r.mu < 0.85 * h.gamma
+    assert 2 <= len(r.history) <= 3
+    assert all({"iteration", "gamma", "mu", "order"} <= set(hh) for hh in r.history)
+    cl = P.lft(r.K, 1, 1)
+    assert np.all(cl.poles().real < 0)
+    assert r.mu == pytest.approx(_mu_ab13md(cl, r.omega), rel=5e-3)
+    assert r.history[0]["mu"] == pytest.approx(_mu_ab13md(P.lft(h.K, 1, 1), r.omega),
+                                               rel=2e-2)
+    assert r.order == r.K.nstates and r.to_dict()["order"] == r.order
+
+
+def test_musyn_rejects_mismatched_blocks():
+    """Reference: the blocks must cover P's exogenous channels (2 inputs × 2 outputs here)."""
+    P = rp_plant()
+    with pytest.raises(ValueError, match="exogenous"):
+        musyn(P, [(1, 1), (2, 1)], 1, 1)
+    with pytest.raises(ValueError, match="performance"):
+        musyn(P, [(1, 1), (1, 0)], 1, 1)
+    with pytest.raises(ValueError, match="0–4"):
+        musyn(P, [(1, 1), (1, 1)], 1, 1, order=7)
+
+
+def test_dscale_parameters_round_trip():
+    """Reference: the D scales themselves. The direct D search of ``musyn`` works on the
+    section parameters of fitted scales; reading them back from a transfer function
+    (complex pairs, real pairs, first-order sections, orders 0–4) must give the same
+    magnitude on the grid (D enters μ only through |D(jω)|), and the state spaces the search
+    builds must be D and D⁻¹ (python-control's response of the transfer function)."""
+    from ambseal.robust.dk import _realize, _tf_to_theta, _theta_to_tf
+    from ambseal.lti.freqresp import freqresp
+
+    w = np.logspace(-3, 3, 61)
+    scales = [ct.tf([0.3], [1]), ct.tf([2, 1], [1, 5]),
+              ct.tf(np.poly([-1, -20]) * 0.5, np.poly([-3 + 4j, -3 - 4j]).real),
+              ct.tf(2e-3 * np.poly([-1000.0, -0.25, -0.054]),
+                    np.poly([-0.013, -0.67 + 0.56j, -0.67 - 0.56j]).real),
+              ct.tf(np.poly([-0.1, -2, -30, -400]), np.poly([-1 + 1j, -1 - 1j, -7, -90]))]
+    for d in scales:
+        th, order = _tf_to_theta(d)
+        back = ct.tf(*_theta_to_tf(th, order))
+        np.testing.assert_allclose(np.abs(back(1j * w)), np.abs(d(1j * w)), rtol=1e-9)
+        fwd, inv = _realize(th, order)
+        assert fwd[0].shape == (order, order)
+        np.testing.assert_allclose(freqresp(fwd, w)[:, 0, 0], back(1j * w), rtol=1e-9)
+        np.testing.assert_allclose(freqresp(inv, w)[:, 0, 0], 1 / back(1j * w), rtol=1e-9)
+
+
+def test_published_optimal_dscale_reproduces_the_published_mu():
+    """Reference: Skogestad & Postlethwaite (2005) §8.12.4, eq. 8.144 and the book's Table
+    8.2 script (MATLAB μ toolbox): with d(s) = 2e-3 (s+1000)(s+0.25)(s+0.054)/((s+0.013)
+    (s² + 1.34s + 0.7625)), H∞ synthesis on diag(d, d, I) P diag(d, d, I)⁻¹ gives γ 0.9737
+    and peak μ 0.9737 on the 61-point grid 10⁻³…10³ rad/s (the published μ-optimal result
+    that D–K is measured against in benchmarks/bench_dk.py)."""
+    from ambseal.robust.dk import _scaled_plant
+
+    P, blocks, w = distillation_rp_plant(), [(1, 1), (1, 1), (2, 2)], np.logspace(-3, 3, 61)
+    d = ct.tf(2e-3 * np.poly([-1000.0, -0.25, -0.054]),
+              np.poly([-0.013, -0.67 + 0.56j, -0.67 - 0.56j]).real)
+    h = hinfsyn(_scaled_plant(P, blocks, [d, d], 2, 2), 2, 2, backoff=1.0 + 1e-6)
+    assert h.gamma == pytest.approx(0.9737, abs=1e-3)
+    mu = mussv(lft_lower(P, h.K, 2, 2), blocks, w)
+    assert np.max(mu.upper) == pytest.approx(0.9737, abs=1e-3)
+    assert np.max(mu.upper) <= h.gamma * (1 + 1e-6)  # μ ≤ σ̄(D N D⁻¹) ≤ γ
+
+
+@pytest.mark.slow
+def test_dk_with_d_search_reaches_the_published_optimum_within_two_percent():
+    """Reference: the published μ-optimal value 0.9737 of Skogestad & Postlethwaite (2005)
+    §8.12.4 (eq. 8.144) and their D–K result after three iterations, 1.0189 (Table 8.2
+    script, MATLAB μ toolbox). Issue 11's goal: within 2 % of the optimum. Plain D–K stalls
+    above it (ours at 1.027, like MATLAB's); the direct D search must get below
+    1.02 · 0.9737, with a certificate: the γ of the scaled problem bounds μ at every
+    frequency, and the mixed power algorithm's lower bound meets the upper bound at the peak
+    (Packard & Doyle 1993)."""
+    P, blocks, w = distillation_rp_plant(), [(1, 1), (1, 1), (2, 2)], np.logspace(-3, 3, 61)
+    r = musyn(P, blocks, 2, 2, w, order="auto", backoff=1.001, rtol=2e-3, search=150)
+    assert r.history[r.best_iteration].get("step") == "D search"
+    assert r.mu <= 1.02 * 0.9737
+    assert r.mu <= r.gamma * (1 + 1e-6)
+    cl = lft_lower(P, r.K, 2, 2)
+    assert np.all(cl.poles().real < 0)
+    mu = mussv(cl, blocks, w)
+    assert np.max(mu.lower) >= 0.99 * np.max(mu.upper)

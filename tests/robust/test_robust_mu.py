@@ -1,0 +1,326 @@
+"""Tests of ambseal.robust.mu.mussv against closed forms and slycot's AB13MD."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import control as ct
+
+from ambseal.robust.mu import mussv
+from ambseal.lti.freqresp import freqresp
+
+
+def crandn(rng, *shape):
+    return rng.standard_normal(shape) + 1j * rng.standard_normal(shape)
+
+
+def test_full_block_is_max_singular_value():
+    """Reference: closed form, one full complex block ⇒ μ = σ̄(M) (Packard & Doyle 1993, §3)."""
+    rng = np.random.default_rng(0)
+    M = crandn(rng, 5, 3, 4)  # stack of 3×4 matrices, Δ is 4×3
+    r = mussv(M, [(4, 3)])
+    s = np.linalg.norm(M, 2, axis=(-2, -1))
+    assert r.upper.shape == (5,)
+    np.testing.assert_allclose(r.upper, s, rtol=1e-6)
+    np.testing.assert_allclose(r.lower, s, rtol=1e-6)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_rank_one_complex_scalars(seed):
+    """Reference: closed form for rank one M = a bᵀ and complex scalar blocks,
+    μ = Σ|a_i||b_i| (Packard & Doyle 1993, §9.3; Young 1993)."""
+    rng = np.random.default_rng(seed)
+    a, b = crandn(rng, 4), crandn(rng, 4)
+    r = mussv(np.outer(a, b), [(1, 0)] * 4)
+    exact = np.sum(np.abs(a) * np.abs(b))
+    assert float(r.upper) == pytest.approx(exact, rel=1e-3)
+    assert float(r.lower) == pytest.approx(exact, rel=1e-6)
+    assert float(r.lower) <= float(r.upper) * (1 + 1e-9)
+    # without the lower bound (D–K's μ steps) the upper bound and scalings are the same
+    u = mussv(np.outer(a, b), [(1, 0)] * 4, lower=False)
+    assert float(u.upper) == float(r.upper) and np.array_equal(u.dscale, r.dscale)
+    assert np.isnan(u.lower)
+    assert json.loads(json.dumps(u.to_dict(), allow_nan=False))["lower"] is None
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_repeated_real_scalar_is_largest_real_eigenvalue(seed):
+    """Reference: closed form, Δ = δ I with δ real ⇒ μ = max |λ| over real eigenvalues λ of M
+    (Packard & Doyle 1993, §3; the D–G bound is exact here)."""
+    rng = np.random.default_rng(100 + seed)
+    while True:
+        M = rng.standard_normal((4, 4))
+        lam = np.linalg.eigvals(M)
+        real = lam[np.abs(lam.imag) < 1e-12].real
+        if real.size:
+            break
+    exact = np.max(np.abs(real))
+    r = mussv(M, [(-4, 0)])
+    assert float(r.upper) == pytest.approx(exact, rel=1e-3)
+    assert float(r.lower) == pytest.approx(exact, rel=1e-6)
+    # a complex repeated scalar would give the spectral radius instead, which is larger here
+    assert np.max(np.abs(lam)) >= exact
+
+
+def test_repeated_complex_scalar_is_spectral_radius():
+    """Reference: closed form, Δ = δ I with δ complex ⇒ μ = ρ(M) (Packard & Doyle 1993)."""
+    rng = np.random.default_rng(7)
+    M = crandn(rng, 6, 3, 3)
+    r = mussv(M, [(3, 0)])
+    rho = np.max(np.abs(np.linalg.eigvals(M)), axis=-1)
+    np.testing.assert_allclose(r.upper, rho, rtol=1e-3)
+    np.testing.assert_allclose(r.lower, rho, rtol=1e-6)
+
+
+STRUCTURES = [
+    [(2, 0), (4, 6)],
+    [(-2, 0), (4, 6)],
+    [(-1, 0), (1, 0), (4, 6)],
+    [(1, 1), (2, 2), (3, 1)],
+    [(-1, 0), (-1, 0), (-1, 0), (1, 2)],
+]
+
+
+@pytest.mark.parametrize("blocks", STRUCTURES)
+def test_lower_le_upper_and_certificates(blocks):
+    """Reference: definition of μ and of the D–G bound (Fan, Tits & Doyle 1991): lower ≤ upper
+    ≤ σ̄(M); the returned (D, G) satisfy Mᴴ Dl² M + j(G M − Mᴴ Gᴴ) ⪯ upper² Dr²; the returned Δ is
+    structured, σ̄(Δ) = 1/lower and I − MΔ is singular."""
+    rng = np.random.default_rng(11)
+    n = sum(c if c else abs(r) for r, c in blocks)
+    m = sum(abs(r) for r, c in blocks)
+    M = crandn(rng, 40, n, m)
+    res = mussv(M, blocks)
+    assert np.all(res.lower <= res.upper * (1 + 1e-6))
+    assert np.all(res.upper <= np.linalg.norm(M, 2, axis=(-2, -1)) * (1 + 1e-9))
+    assert np.all(res.lower > 0)
+    for k in range(0, 40, 7):
+        Mk, Dl, Dr, G, u = M[k], res.Dl[k], res.Dr[k], res.G[k], res.upper[k]
+        L = Mk.conj().T @ Dl @ Dl @ Mk + 1j * (G @ Mk - Mk.conj().T @ G.conj().T) - u**2 * Dr @ Dr
+        assert np.linalg.eigvalsh(0.5 * (L + L.conj().T)).max() <= 1e-8 * u**2
+        Delta = res.delta[k]
+        assert np.linalg.norm(Delta, 2) == pytest.approx(1 / res.lower[k], rel=1e-6)
+        assert np.min(np.abs(np.linalg.eigvals(np.eye(n) - Mk @ Delta))) < 1e-8
+        # structure: zero outside the diagonal blocks, real where the block is real
+        ro = co = 0
+        mask = np.zeros((m, n), bool)
+        for r, c in blocks:
+            rr, cc = (abs(r), abs(r)) if c == 0 else (r, c)
+            blk = Delta[co:co + rr, ro:ro + cc]
+            if c == 0:
+                np.testing.assert_allclose(blk, blk[0, 0] * np.eye(rr), atol=1e-12)
+                if r < 0:
+                    assert abs(blk[0, 0].imag) <= 1e-9 * max(abs(blk[0, 0]), 1e-300)
+            mask[co:co + rr, ro:ro + cc] = True
+            ro, co = ro + cc, co + rr
+        assert np.all(Delta[~mask] == 0)
+
+
+def test_upper_matches_slycot_ab13md():
+    """Reference: slycot AB13MD (Fan–Tits–Doyle bound) run side by side on structures it
+    supports (scalar real blocks, square full complex blocks); both solve the same convex
+    problem, so the bounds agree to the solvers' tolerance."""
+    from slycot import ab13md
+
+    rng = np.random.default_rng(5)
+    cases = [([(-1, 0), (-1, 0), (3, 3)], [1, 1, 3], [1, 1, 2]),
+             ([(1, 0), (2, 2), (2, 2)], [1, 2, 2], [2, 2, 2]),
+             ([(-1, 0), (1, 0), (4, 4)], [1, 1, 4], [1, 2, 2])]
+    for blocks, nblock, itype in cases:
+        for _ in range(5):
+            M = crandn(rng, sum(nblock), sum(nblock))
+            ours = float(mussv(M, blocks).upper)
+            ref = ab13md(M, np.array(nblock), np.array(itype))[0]
+            assert ours == pytest.approx(ref, rel=5e-3)
+
+
+def test_frequency_grid_and_non_square_padding():
+    """Reference: mussv on a StateSpace equals mussv on its frequency response stack, and
+    for one full block it is σ̄(G(jω)) (closed form)."""
+    np.random.seed(2)
+    sys = ct.rss(5, 3, 2)
+    w = np.logspace(-1, 2, 25)
+    r = mussv(sys, [(2, 3)], w)
+    G = freqresp(sys, w)
+    ref = ct.frequency_response(sys, w)
+    np.testing.assert_allclose(G, np.moveaxis(ref.complex, -1, 0), rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(r.upper, np.linalg.norm(G, 2, axis=(-2, -1)), rtol=1e-6)
+    assert r.omega is not None and r.peak_omega in w
+    r2 = mussv(G, [(2, 3)])
+    np.testing.assert_allclose(r.upper, r2.upper, rtol=1e-12)
+    assert set(r.to_dict()) >= {"upper", "lower", "omega_rad_s", "blocks"}
+
+
+def test_bad_input_raises():
+    """Reference: the block structure must match M (Σc rows, Σr columns); malformed pairs
+    and a state space without a grid are rejected with the cause named."""
+    M = np.ones((3, 3))
+    with pytest.raises(ValueError, match="shape"):
+        mussv(M, [(1, 0), (1, 1)])
+    with pytest.raises(ValueError, match="non-zero"):
+        mussv(M, [(0, 0), (3, 3)])
+    with pytest.raises(ValueError, match="r > 0"):
+        mussv(M, [(-2, 3)])
+    with pytest.raises(ValueError, match="omega"):
+        mussv(ct.rss(2, 3, 3), [(3, 3)])
+    with pytest.raises(ValueError, match="non-finite"):
+        mussv(np.full((2, 2), np.nan), [(2, 2)])
+
+
+def _lightly_damped_system(seed=0):
+    """A stable 12-state, 6-input, 6-output system with lightly damped modes (rotor-like)."""
+    rng = np.random.default_rng(seed)
+    wn = np.logspace(np.log10(2 * np.pi * 5), np.log10(2 * np.pi * 800), 6)
+    A = np.zeros((12, 12))
+    for i, (w, z) in enumerate(zip(wn, rng.uniform(0.02, 0.3, 6))):
+        A[2 * i:2 * i + 2, 2 * i:2 * i + 2] = [[0, 1], [-w**2, -2 * z * w]]
+    T = rng.standard_normal((12, 12)) * 0.1 + np.eye(12)
+    A = np.linalg.solve(T, A @ T)
+    return ct.ss(A, rng.standard_normal((12, 6)) * 50, rng.standard_normal((6, 12)),
+                 rng.standard_normal((6, 6)) * 0.1)
+
+
+@pytest.mark.parametrize("blocks", [[(-2, 0), (4, 4)], [(-1, 0), (1, 0), (4, 4)]])
+def test_frequency_grid_warm_start_equals_cold_bound(blocks):
+    """Reference: the cold per-frequency D–G bound (Fan, Tits & Doyle 1991) of the same
+    solver. Over a frequency grid mussv solves coarse to fine, warm-starting each frequency
+    from its neighbours' scalings; on a smooth stack that must give the cold bound within
+    1e-3 relative, and the warm-started bound must still be certified by its own (D, G).
+    One matrix alone is its own peak, solved to tol·1e-3: no grid bound is below it, and
+    they are within 2·tol of it (tol bounds the method of centres' last step on upper², not
+    the distance to the optimum)."""
+    sys = _lightly_damped_system()
+    w = np.logspace(np.log10(2 * np.pi * 1), np.log10(2 * np.pi * 2000), 160)
+    warm = mussv(sys, blocks, w)  # frequency grid: coarse-to-fine continuation
+    Mw = freqresp(sys, w)
+    cold = mussv(Mw, blocks)  # matrix stack: every matrix solved cold (from Osborne balancing)
+    np.testing.assert_allclose(warm.upper, cold.upper, rtol=1e-3)
+    # the lower bound starts from the upper bound's worst direction: same local optimum
+    np.testing.assert_allclose(warm.lower, cold.lower, rtol=1e-4)
+    for k in (0, 57, 101):  # one matrix at a time
+        single = float(mussv(Mw[k], blocks).upper)
+        assert single <= min(warm.upper[k], cold.upper[k]) * (1 + 1e-9)
+        assert warm.upper[k] == pytest.approx(single, rel=2e-3)
+    assert np.all(warm.lower <= warm.upper * (1 + 1e-9))
+    for k in range(0, w.size, 9):
+        Mk, Dl, Dr, G, u = Mw[k], warm.Dl[k], warm.Dr[k], warm.G[k], warm.upper[k]
+        L = Mk.conj().T @ Dl @ Dl @ Mk + 1j * (G @ Mk - Mk.conj().T @ G.conj().T) - u**2 * Dr @ Dr
+        assert np.linalg.eigvalsh(0.5 * (L + L.conj().T)).max() <= 1e-8 * u**2
+
+
+def _rank_one_mu(z, real):
+    """Young (1994): for M = a bᴴ and scalar blocks, with zᵢ = aᵢ b̄ᵢ,
+    μ = min over real x of Σ_real |Re zᵢ + x Im zᵢ| + √(1+x²) Σ_complex |zᵢ|;
+    a convex piecewise-smooth function of x, minimised on its breakpoints and by a bounded
+    scalar search."""
+    from scipy.optimize import minimize_scalar
+
+    zr, c = z[real], np.sum(np.abs(z[~real]))
+
+    def f(x):
+        return np.sum(np.abs(zr.real + x * zr.imag)) + np.sqrt(1 + x * x) * c
+
+    brk = [-zi.real / zi.imag for zi in zr if zi.imag != 0] + [0.0]
+    r = minimize_scalar(f, bounds=(min(brk) - 1e3, max(brk) + 1e3), method="bounded",
+                        options={"xatol": 1e-12})
+    return min([f(x) for x in brk] + [r.fun])
+
+
+RANK_ONE_STRUCTURES = ["rc", "rrc", "rcc", "crrr", "rccrr"]
+
+
+@pytest.mark.parametrize("kinds", RANK_ONE_STRUCTURES)
+def test_rank_one_mixed_closed_form(kinds):
+    """Reference: the closed form of mixed μ for rank-one matrices (Young 1994, "The rank one
+    mixed μ problem and 'Kharitonov-type' analysis"; the D–G bound is exact there). 20 random
+    M = a bᴴ per structure, 100 in all: the upper and the lower bound within 1 %, and every
+    lower bound certified by its worst-case Δ (structured, σ̄(Δ) = 1/lower, I − MΔ singular)."""
+    rng = np.random.default_rng(sum(map(ord, kinds)))
+    real = np.array([k == "r" for k in kinds])
+    blocks = [(-1, 0) if r else (1, 0) for r in real]
+    a, b = crandn(rng, 20, len(kinds)), crandn(rng, 20, len(kinds))
+    M = a[:, :, None] * np.conj(b[:, None, :])
+    res = mussv(M, blocks)
+    exact = np.array([_rank_one_mu(a[k] * np.conj(b[k]), real) for k in range(20)])
+    np.testing.assert_allclose(res.upper, exact, rtol=1e-2)
+    np.testing.assert_allclose(res.lower, exact, rtol=1e-2)
+    assert np.all(res.lower <= exact * (1 + 1e-9))
+    for k in range(20):
+        D = res.delta[k]
+        assert np.allclose(D, np.diag(np.diag(D))) and np.all(np.abs(D[real, real].imag) == 0)
+        assert np.max(np.abs(np.diag(D))) == pytest.approx(1 / res.lower[k], rel=1e-9)
+        assert abs(np.linalg.det(np.eye(len(kinds)) - M[k] @ D)) < 1e-8
+
+
+@pytest.mark.parametrize("kinds", ["rrc", "crrr"])
+def test_peak_of_a_stack_with_many_near_peaks_is_exact(kinds):
+    """Reference: the rank-one closed form (Young 1994, as above). 30 rank-one matrices
+    scaled so that their exact μ are 1 − k·1e-5 (k = 0…29): all within the solver's
+    tolerance of the peak, so the largest bound at ``tol`` may sit on any of them. The
+    reported peak must still be the closed form's 1 within the peak tolerance (tol·1e-3 on
+    upper²); refining only the four largest bounds left it 4e-4 above."""
+    rng = np.random.default_rng(0)
+    real = np.array([k == "r" for k in kinds])
+    blocks = [(-1, 0) if r else (1, 0) for r in real]
+    a, b = crandn(rng, 30, len(kinds)), crandn(rng, 30, len(kinds))
+    exact = np.array([_rank_one_mu(a[k] * np.conj(b[k]), real) for k in range(30)])
+    target = 1.0 - 1e-5 * np.arange(30)
+    a = a * (target / exact)[:, None]
+    res = mussv(a[:, :, None] * np.conj(b[:, None, :]), blocks)
+    assert res.peak_upper == pytest.approx(1.0, rel=1e-6)
+    assert np.all(res.upper >= target * (1 - 1e-9))
+
+
+def test_slicot_ab13md_documented_example():
+    """Reference: the documented example of SLICOT AB13MD (AB13MD.dat / TAB13MD.res: two real
+    scalars, a 2×2 full complex block and two complex scalars on a 6×6 matrix; published
+    upper bound 41.74753408). At the default tolerance our D–G bound must agree within
+    0.01 % (the peak of a stack is solved to tol·1e-3); the lower bound must not exceed
+    it."""
+    rows = ["-1+6j 2-3j 3+8j 3+8j -5-9j -6+2j",
+            "4+2j -2+5j -6-7j -4+11j 8-7j 12-1j",
+            "5-4j -4-8j 1-3j -6+14j 2-5j 4+16j"]
+    Z = np.array([[complex(x) for x in r.split()] for r in rows * 2])
+    r = mussv(Z, [(-1, 0), (-1, 0), (2, 2), (1, 1), (1, 1)])
+    assert float(r.upper) == pytest.approx(41.74753408, rel=1e-4)
+    assert float(r.lower) <= float(r.upper) * (1 + 1e-9)
+    assert float(r.lower) > 0.9 * float(r.upper)
+
+
+def test_random_mixed_lower_below_upper():
+    """Reference: definition of μ and of its bounds (Young & Doyle 1997): on 200 random
+    complex matrices of a mixed structure (repeated real, complex scalar, full block) the
+    certified lower bound never exceeds the certified upper bound; the spread lower/upper is
+    measured (median above 0.9)."""
+    rng = np.random.default_rng(21)
+    blocks = [(-2, 0), (1, 0), (2, 3)]
+    M = crandn(rng, 200, 6, 5)
+    r = mussv(M, blocks)
+    ratio = r.lower / r.upper
+    assert np.all(ratio <= 1 + 1e-9)
+    assert np.median(ratio) > 0.9
+
+
+def test_compiled_generalised_eigenvalue_matches_scipy():
+    """The upper bound's certificate value λ_max(D⁻¹A) (compiled kernel) against
+    scipy.linalg.eigh(A, D)'s largest generalised eigenvalue (LAPACK zhegvd), and +inf where D
+    is indefinite (the D–G bound's feasibility convention)."""
+    import scipy.linalg
+    from ambseal.robust._mu_newton import gevp
+
+    rng = np.random.default_rng(7)
+    F, n = 12, 9
+    X = rng.standard_normal((F, n, n)) + 1j * rng.standard_normal((F, n, n))
+    D = X @ np.conj(np.swapaxes(X, 1, 2)) + 0.1 * np.eye(n)
+    Y = rng.standard_normal((F, n, n)) + 1j * rng.standard_normal((F, n, n))
+    A = Y + np.conj(np.swapaxes(Y, 1, 2))
+    D[3] -= 50.0 * np.eye(n)  # indefinite
+    got = gevp(D, A)
+    for f in range(F):
+        if f == 3:
+            assert got[f] == np.inf
+            continue
+        ref = scipy.linalg.eigh(A[f], D[f], eigvals_only=True)[-1]
+        assert got[f] == pytest.approx(ref, rel=1e-10, abs=1e-12)

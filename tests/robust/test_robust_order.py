@@ -1,0 +1,94 @@
+"""Tests of ambseal.robust.order: balanced truncation of controllers.
+
+References outside the module: the balanced-truncation error bounds (Zhou, Doyle & Glover
+1996, Thm 7.9), python-control run side by side (``control.balred``, ``control.hsvd``,
+``StateSpace.lft`` with Skogestad & Postlethwaite's positive-feedback F_l, and
+``control.norm(·, 'inf')``, i.e. slycot AB13DD).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import control as ct
+
+from ambseal.robust.hinf import hinfsyn
+from ambseal.robust.order import balred_controller, reduce_controller
+
+
+def _fresp(sys, w):
+    return np.moveaxis(ct.frequency_response(sys, w, squeeze=False).complex, 2, 0)
+
+
+def test_balanced_truncation_error_bound():
+    """Reference: Zhou, Doyle & Glover (1996) Thm 7.9 — σ_{r+1} ≤ ‖K − K_r‖∞ ≤ 2 Σ discarded
+    Hankel singular values for a stable K, the norm by control.norm (slycot AB13DD); the
+    Hankel singular values equal python-control's control.hsvd, and the reduced controller
+    has python-control's control.balred frequency response."""
+    np.random.seed(4)
+    K = ct.rss(10, 2, 2)
+    Kr, hsv = balred_controller(K, 4)
+    np.testing.assert_allclose(hsv, ct.hsvd(K), rtol=1e-6)
+    err = ct.norm(ct.ss(K) - Kr, "inf")
+    bound = 2 * np.sum(hsv[4:])
+    assert Kr.nstates == 4
+    assert hsv[4] * (1 - 1e-6) <= err <= bound * (1 + 1e-6)
+    w = np.logspace(-2, 3, 60)
+    ref = _fresp(ct.balred(K, 4), w)
+    np.testing.assert_allclose(_fresp(Kr, w), ref, rtol=1e-8, atol=1e-10 * np.abs(ref).max())
+    assert list(Kr.input_labels) == list(K.input_labels)
+
+
+def test_unstable_part_is_kept():
+    """Reference: AB09MD splits off the unstable part and keeps it exactly (Varga 1991): the
+    integrator and the pole at +2 of K = S + 1/(s(s−2)) survive the reduction to 4 states,
+    and the result matches python-control's control.balred on the same K; an order below
+    the two unstable/marginal poles is refused."""
+    np.random.seed(6)
+    S = ct.rss(6, 1, 1)
+    U = ct.tf([1], [1, 0]) * ct.tf([1], [1, -2])  # integrator and unstable pole at 2
+    K = ct.ss(S + ct.ss(U))
+    Kr, _ = balred_controller(K, 4)
+    pr = np.sort_complex(Kr.poles())
+    assert np.min(np.abs(pr - 2.0)) < 1e-8 and np.min(np.abs(pr)) < 1e-8
+    w = np.logspace(-1, 3, 60)
+    ref = _fresp(ct.balred(K, 4), w)
+    np.testing.assert_allclose(_fresp(Kr, w), ref, rtol=1e-8, atol=1e-10 * np.abs(ref).max())
+    with pytest.raises(ValueError, match="unstable"):
+        balred_controller(K, 1)
+
+
+def test_reduce_controller_reports_gamma_before_after():
+    """Reference: python-control side by side — the reported γ's equal
+    control.norm(P.lft(K), 'inf') (Skogestad & Postlethwaite's positive-feedback F_l, norm by
+    slycot AB13DD) for the full and the reduced (5 → 3 states) controller of an H∞ design on
+    a mixed-sensitivity problem with a proper W_2 (the reduced loop stays stable there);
+    the full-order γ is the synthesis γ."""
+    s = ct.tf("s")
+    G = ct.tf([200], [10, 1]) * ct.tf([1], [0.05, 1]) ** 2
+    P = ct.augw(ct.ss(G), w1=0.5 * (s + 10) / (s + 0.1), w2=0.01 * (s + 1) / (s / 100 + 1))
+    h = hinfsyn(P, 1, 1)
+    assert h.order == 5
+    res = reduce_controller(P, h.K, 3, 1, 1)
+    assert res.order == 3 and res.order_full == 5
+    assert res.gamma_full == pytest.approx(ct.norm(P.lft(h.K, 1, 1), "inf"), rel=1e-6)
+    assert res.gamma_full == pytest.approx(h.gamma, rel=1e-6)
+    cl = P.lft(res.K, 1, 1)
+    assert np.all(cl.poles().real < 0)
+    assert res.gamma == pytest.approx(ct.norm(cl, "inf"), rel=1e-6)
+    assert res.gamma > res.gamma_full  # truncation costs something here (0.79 vs 0.75)
+    assert list(res.K.input_labels) == list(h.K.input_labels)
+
+
+def test_reduction_that_destabilises_reports_infinite_gamma():
+    """Reference: definition — an unstable closed loop has no finite H∞ norm. Reducing the
+    4-state H∞ controller of a mixed-sensitivity problem with a near-integrator W_1 to 3
+    states leaves python-control's F_l (P.lft) with a pole at ≈ +2.5; γ must be inf, not
+    the L∞ norm on the imaginary axis that control.norm returns for it (≈ 1.19)."""
+    s = ct.tf("s")
+    G = ct.tf([200], [10, 1]) * ct.tf([1], [0.05, 1]) ** 2
+    P = ct.augw(ct.ss(G), w1=(s / 1.5 + 10) / (s + 1e-3), w2=ct.tf([0.1], [1]))
+    h = hinfsyn(P, 1, 1)
+    res = reduce_controller(P, h.K, h.order - 1, 1, 1)
+    assert P.lft(res.K, 1, 1).poles().real.max() > 1.0
+    assert np.isinf(res.gamma) and np.isfinite(res.gamma_full)

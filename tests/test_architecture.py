@@ -1,0 +1,103 @@
+"""The architecture as a contract (docs/architecture.md), checked on the source.
+
+``lint-imports`` (CI, ``[tool.importlinter]`` in ``pyproject.toml``) checks that the layers
+import downwards only and that the generic core knows no rotor. The tests here check what a
+contract cannot say: that the contract covers every package, that no two modules import
+each other in a circle (at module level or inside functions), and that the core's
+boundary holds on the contract itself.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+import grimp
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SRC = ROOT / "src" / "ambseal"
+
+
+def _contracts() -> list[dict]:
+    data = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    return data["tool"]["importlinter"]["contracts"]
+
+
+def _layers() -> list[set[str]]:
+    (layers,) = [c["layers"] for c in _contracts() if c["type"] == "layers"]
+    return [{m.strip() for m in layer.replace(":", "|").split("|")} for layer in layers]
+
+
+@pytest.fixture(scope="module")
+def graph():
+    return grimp.build_graph("ambseal")
+
+
+def test_the_layers_cover_every_package():
+    """A new package or top-level module must be placed in a layer on purpose."""
+    tops = {p.name.removesuffix(".py") for p in SRC.iterdir()
+            if (p.suffix == ".py" or (p / "__init__.py").exists())}
+    placed = {m.removeprefix("ambseal.") for layer in _layers() for m in layer}
+    assert tops - {"__init__", "__main__"} == placed
+
+
+def test_the_core_is_forbidden_every_rotor_layer():
+    """``robust`` and ``lti`` may import nothing above ``robust`` (the contract is complete)."""
+    (forbid,) = [c for c in _contracts() if c["type"] == "forbidden"]
+    assert set(forbid["source_modules"]) == {"ambseal.robust", "ambseal.lti"}
+    layers = _layers()
+    above = {m for layer in layers[:[i for i, l in enumerate(layers)
+                                     if "ambseal.robust" in l][0]] for m in layer}
+    assert above == set(forbid["forbidden_modules"])
+
+
+def _cycles(graph) -> list[list[str]]:
+    """Strongly connected components of more than one module (Tarjan, iterative)."""
+    index, low, on, stack, out = {}, {}, set(), [], []
+    for root in sorted(graph.modules):
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph.find_modules_directly_imported_by(root))))]
+        index[root] = low[root] = len(index)
+        stack.append(root), on.add(root)
+        while work:
+            v, it = work[-1]
+            w = next(it, None)
+            if w is not None:
+                if w not in index:
+                    index[w] = low[w] = len(index)
+                    stack.append(w), on.add(w)
+                    work.append((w, iter(sorted(graph.find_modules_directly_imported_by(w)))))
+                elif w in on:
+                    low[v] = min(low[v], index[w])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[v])
+            if low[v] == index[v]:
+                comp = []
+                while True:
+                    w = stack.pop()
+                    on.discard(w)
+                    comp.append(w)
+                    if w == v:
+                        break
+                if len(comp) > 1:
+                    out.append(sorted(comp))
+    return out
+
+
+def test_no_import_cycles_between_modules(graph):
+    assert _cycles(graph) == []
+
+
+def test_the_cycle_finder_sees_a_cycle():
+    """The finder reports a circle of three modules and ignores a chain (so the test above
+    can fail)."""
+    g = grimp.ImportGraph()
+    for m in ("p", "p.a", "p.b", "p.c", "p.d"):
+        g.add_module(m)
+    for a, b in (("p.a", "p.b"), ("p.b", "p.c"), ("p.c", "p.a"), ("p.d", "p.a")):
+        g.add_import(importer=a, imported=b)
+    assert _cycles(g) == [["p.a", "p.b", "p.c"]]

@@ -23,6 +23,7 @@ the real functions.
 from __future__ import annotations
 
 import contextlib
+import sys
 from pathlib import Path
 
 import pytest
@@ -128,7 +129,10 @@ class DesignCache:
     @contextlib.contextmanager
     def patched(self, rig: str):
         """Replace the design functions for the duration of the ``with`` block."""
+        # every module that imports the design functions, loaded before they are replaced
+        # (a module first imported inside the block would keep the replacement)
         import ambseal.app.commands as cmod
+        import ambseal.app.handlers  # noqa: F401
         import ambseal.design.recipes as dmod
         import ambseal.design.lpv_design as lmod
 
@@ -176,11 +180,20 @@ class DesignCache:
             return real_frozen(cfg, speed_hz, **kw)
 
         with pytest.MonkeyPatch.context() as mp:
-            mp.setattr(dmod, "design", design)
-            mp.setattr(lmod, "design_lpv", design_lpv)
-            mp.setattr(lmod, "design_frozen", design_frozen)
-            mp.setattr(cmod, "digital_for", digital_for)
+            for real, fake in ((real_design, design), (real_lpv, design_lpv),
+                               (real_frozen, design_frozen), (real_digital, digital_for)):
+                _replace_everywhere(mp, real, fake)
             yield self
+
+
+def _replace_everywhere(mp, real, fake) -> None:
+    """Replace ``real`` by ``fake`` in every ambseal module that holds it (modules import
+    the functions by name at their top)."""
+    for mod in list(sys.modules.values()):
+        name = getattr(mod, "__name__", "") or ""
+        if (name == "ambseal" or name.startswith("ambseal.")) and \
+                getattr(mod, real.__name__, None) is real:
+            mp.setattr(mod, real.__name__, fake)
 
 
 def _same(a, b) -> bool:
@@ -197,7 +210,7 @@ def design_cache_for():
 
 @pytest.fixture(scope="session")
 def testrig_tracked(testrig_cfg, tmp_path_factory):
-    """The controller scheduled on the seal's k over 0–3× nominal (issue 14 §2), as
+    """The controller scheduled on the seal's k over 0–3× nominal, as
     :func:`ambseal.design.seal_schedule.design_seal_scheduled` makes it by default
     (minutes of LMI synthesis: only the slow tests use it; ``$AMBSEAL_CACHE_DIR`` keeps
     it between sessions)."""

@@ -9,6 +9,8 @@ boundary holds on the contract itself.
 
 from __future__ import annotations
 
+import ast
+import re
 import tomllib
 from pathlib import Path
 
@@ -101,3 +103,45 @@ def test_the_cycle_finder_sees_a_cycle():
     for a, b in (("p.a", "p.b"), ("p.b", "p.c"), ("p.c", "p.a"), ("p.d", "p.a")):
         g.add_import(importer=a, imported=b)
     assert _cycles(g) == [["p.a", "p.b", "p.c"]]
+
+
+def _function_level_imports() -> list[tuple[str, int, str]]:
+    """(file, line, text) of every import statement inside a function or class."""
+    out = []
+    for path in sorted(SRC.rglob("*.py")):
+        text = path.read_text(encoding="utf-8")
+        tree = ast.parse(text)
+        top = set()
+        stack = list(tree.body)
+        while stack:  # module level includes the branches of if/try at module level
+            node = stack.pop()
+            top.add(id(node))
+            if isinstance(node, (ast.If, ast.Try)):
+                stack += node.body + node.orelse + getattr(node, "finalbody", [])
+                stack += [s for h in getattr(node, "handlers", []) for s in h.body]
+        lines = text.splitlines()
+        out += [(str(path.relative_to(SRC)), n.lineno, lines[n.lineno - 1])
+                for n in ast.walk(tree)
+                if isinstance(n, (ast.Import, ast.ImportFrom)) and id(n) not in top]
+    return out
+
+
+def test_imports_sit_at_the_top_of_modules():
+    """A function-level import only for an optional dependency or a measured start-up
+    cost, with a comment saying which (on its line or just above it); at most 20."""
+    found = _function_level_imports()
+    assert len(found) <= 20, found
+    for file, line, text in found:
+        above = (SRC / file).read_text(encoding="utf-8").splitlines()[line - 2].strip()
+        assert "#" in text or above.startswith("#"), f"{file}:{line}: {text.strip()}"
+
+
+def test_no_history_in_code_or_tests():
+    """Comments say why; history lives in git and CHANGELOG.md."""
+    pattern = re.compile(r"issue\s*#?\s*[0-9]", re.IGNORECASE)
+    hits = [f"{p.relative_to(ROOT)}:{i}" for base in (SRC, ROOT / "tests")
+            for p in sorted(base.rglob("*.py"))
+            for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
+            if pattern.search(line)]
+    assert hits == []
+

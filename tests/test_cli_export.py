@@ -1,4 +1,4 @@
-"""CLI: `ambseal export` — bad input ends with one line on stderr and exit 2 (issue 10)."""
+"""CLI: `ambseal export` — bad input ends with one line on stderr and exit 2."""
 
 import json
 import re

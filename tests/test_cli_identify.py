@@ -53,7 +53,7 @@ def test_identify_writes_fit_and_a_rig_the_other_commands_accept(record, tmp_pat
     rig = load_rig(out / "identified.toml")
     assert amb_factors(rig.amb[0])[0][0] == pytest.approx(summary["parameters"]["A.Ki_zeta"]["estimate"])
     assert (out / "fit_timeseries.png").exists() and (out / "correlation.png").exists()
-    # issue 17: the truth file's coupling is 3.75 % / 3.6 % off the rig file's, held fixed
+    # the truth file's coupling is 3.75 % / 3.6 % off the rig file's, held fixed
     # here: its budget is in the intervals, named among the dominant, and the user is told
     assert {"coupling.kxx", "coupling.kyy"} <= set(fit["error_budget"]["dominant"])
     assert any(w.startswith("coupling.") for w in summary["warnings"])
@@ -199,7 +199,7 @@ def test_design_hinf_exports_controller(tmp_path, capsys, request, design_cache_
 
 
 def test_identify_bad_pressure_names_the_file(record, tmp_path, capsys):
-    """Reference: issue 17 — metadata the fit reads (pressure_drop_pa) is checked naming
+    """Reference: the record format — metadata the fit reads (pressure_drop_pa) is checked naming
     the record file, not a placeholder; one line, exit status 2."""
     bad = _corrupt(record, tmp_path, lambda L: L)
     side = bad.with_name(bad.name + ".json")

@@ -1,4 +1,4 @@
-"""Every example rig end to end, and the unusual rigs of issue 9 §4 (a rig without a seal,
+"""Every example rig end to end, and unusual rigs (a rig without a seal,
 a rig with one AMB and one plain bearing): ``ambseal run --no-identify`` exits 0 and every
 controller is stable on the full-order plant at every judged condition, as designed and as
 it runs on the target — or the run states plainly which one cannot run and why.
@@ -56,7 +56,7 @@ def _check_stable_or_stated(metrics: dict, err: str) -> None:
 @pytest.mark.slow
 @pytest.mark.parametrize("rig", EXAMPLES, ids=lambda p: p.stem)
 def test_every_example_runs_end_to_end(rig, tmp_path, capsys):
-    """Issue 9 §4 acceptance: `ambseal run RIG --no-identify` on each example exits 0 with
+    """`ambseal run RIG --no-identify` on each example exits 0 with
     all three designs (PID, H∞, μ; LPV beside them on a speed-scheduled rig), and every
     loop is stable on the full-order plant (or the run says why not)."""
     metrics, err = _run(rig, tmp_path / "out", capsys)
@@ -83,7 +83,7 @@ def _testrig_without(kind: str) -> str:
 
 @pytest.mark.slow
 def test_a_rig_without_seal_runs_end_to_end_with_a_note(tmp_path, capsys):
-    """Issue 9 §2/§4: no seal — H∞ and μ designed without seal uncertainty, the summary
+    """No seal — H∞ and μ designed without seal uncertainty, the summary
     says so; every loop stable (the seal-less rig has nothing to destabilise at 2×)."""
     rig = tmp_path / "noseal.toml"
     rig.write_text(_testrig_without("seal"))
@@ -96,7 +96,7 @@ def test_a_rig_without_seal_runs_end_to_end_with_a_note(tmp_path, capsys):
 
 @pytest.mark.slow
 def test_a_rig_with_one_amb_and_a_plain_bearing_runs_or_is_refused_plainly(tmp_path, capsys):
-    """Issue 9 §4: one AMB (2 axes) and a stiff plain bearing (a 5e7 N/m spring) at AMB B's
+    """One AMB (2 axes) and a stiff plain bearing (a 5e7 N/m spring) at AMB B's
     place: run end to end, or refused with one line (exit 2) naming the mode the design
     destabilised and what to do. Measured: H∞, designed on the nominal plant, destabilises
     the 207 Hz mode at 0 bar (ζ −0.004): refused."""

@@ -1,4 +1,4 @@
-"""Property-based fuzz of the command line (issue 15 §4): mutated example rigs, truth files
+"""Property-based fuzz of the command line: mutated example rigs, truth files
 and records end either in exit 2 with one line on stderr naming the file, or in exit 0 with
 finite results — never in a traceback.
 

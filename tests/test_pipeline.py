@@ -65,7 +65,7 @@ def _on_a_terminal(argv: list[str], columns: int = 150) -> tuple[int, str]:
 def terminal_run(tmp_path_factory, request, design_cache_for):
     """``ambseal run`` on the embedded rig on a pseudo-terminal, with the session's PID
     (the same call ``run`` makes, computed once; tests/conftest.py). H∞ and μ are designed
-    on the rig identified from the virtual facility (issue 16 §3), so not from the cache."""
+    on the rig identified from the virtual facility, so not from the cache."""
     out = tmp_path_factory.mktemp("run")
     cache = design_cache_for(request)
     with cache.patched("testrig"):
@@ -112,7 +112,7 @@ def test_run_writes_the_contract(metrics):
     assert m["open_loop"]["n_states_full"] == 8 * n_nodes + 8
     for case in m["cases"]:
         assert KEYS <= set(case)
-        # the discrete block of issue 10: the same keys for the controller that runs
+        # the discrete block: the same keys for the controller that runs
         assert KEYS - {"controller", "pressure_bar"} | {"max_abs_pole_z"} <= set(case["discrete"])
         if case["stable"]:  # every recommended controller runs stably where it was designed to
             assert case["discrete"]["stable"] and case["discrete"]["max_abs_pole_z"] < 1.0
@@ -161,7 +161,7 @@ def test_run_identifies_the_virtual_facility(metrics):
     facility: every AMB factor within 2 %, τ_e within 10 %, the coupling within 5 % of the
     packaged truth, and the identified rig file loads (issue acceptance, seed fixed); the
     seal damping the joint AMB fit holds at the rig file's values (the truth's differ) is
-    disputed by its model check (issue 17). The seal's impulse run at 2.5 bar is skipped: the
+    disputed by its model check. The seal's impulse run at 2.5 bar is skipped: the
     reference PID does not hold the facility's rotor there ("the rotor-bearing-seal system
     with PID controller turns unstable for high pressures", P5 §5.1; the facility's loop
     poles are checked against the fit model's in tests/identify/test_identify_facility.py)."""
@@ -191,7 +191,7 @@ def test_run_identifies_the_virtual_facility(metrics):
 
 
 def test_run_explains_every_target_difference_above_10_percent(metrics):
-    """Issue 10 acceptance: on the embedded rig each controller's discrete σ̄(S_o) peak is
+    """On the embedded rig each controller's discrete σ̄(S_o) peak is
     within 10 % of its continuous one (the continuous loop with the controller's delay), or
     the run's summary explains the difference: ``peak_difference`` of every controller is
     the largest difference of its judged cases, carries an ``explanation`` exactly when it
@@ -217,7 +217,7 @@ def test_run_explains_every_target_difference_above_10_percent(metrics):
 
 
 def test_run_judges_hinf_and_mu_as_the_thesis_found(metrics):
-    """P5 §4.4, §5, judged on the virtual facility's truth (issue 16 §3): on the full-order plant the H∞ controller designed at nominal pressure
+    """P5 §4.4, §5, judged on the virtual facility's truth: on the full-order plant the H∞ controller designed at nominal pressure
     has a lower σ̄(S_o) peak than the PID there; the μ controller is stable from 0 to 2×
     nominal with σ̄(S_o) of every control axis in ISO 14839-3 zone A (< 3; the standard
     judges the sensitivity axis by axis; the MIMO σ̄ of the loop with the controller's
@@ -241,7 +241,7 @@ def test_run_judges_hinf_and_mu_as_the_thesis_found(metrics):
 
 
 def test_run_designs_from_the_identified_rig(metrics):
-    """Issue 16 §3 (P5 §3, Figs. 15–16): H∞ and μ designed on the identified rig (the truth
+    """P5 §3, Figs. 15–16: H∞ and μ designed on the identified rig (the truth
     file's Ki differ from the rig file's by ~3 %, far beyond the intervals), judged on the
     facility's truth, and their impulse responses on the facility matched by the identified
     model ("the experimental and simulated responses match well": NRMSE fit above 90 % on
@@ -265,7 +265,7 @@ def test_run_designs_from_the_identified_rig(metrics):
 
 @pytest.mark.slow
 def test_run_with_the_tracked_controller(tmp_path, request, design_cache_for):
-    """Issue 14 §3: ``[design] tracked = true`` adds the controller scheduled on the
+    """``[design] tracked = true`` adds the controller scheduled on the
     tracked seal k — judged at the judged pressures (continuous, and as it runs: its
     digital table with the target's delay), exported as a table on seal.k, and run on the
     0 → 3× nominal pressure ramp. References: the issue's acceptance (the estimate within
@@ -291,7 +291,7 @@ def test_run_with_the_tracked_controller(tmp_path, request, design_cache_for):
 
 
 def test_run_separates_the_seal_coefficients_and_static_ki(metrics):
-    """Issue 16 §4: at the nominal 2.04 bar and 40 Hz the stepped-sine seal fit's K–c and C–k
+    """At the nominal 2.04 bar and 40 Hz the stepped-sine seal fit's K–c and C–k
     correlations (Jacobian, P4 Table 4) are below 0.5; every seal fit carries its
     reliability; the static-load Ki (P2 §5) of every axis is within 2 % of the truth file's
     and joining it with the closed-loop fit brings every Ki–Ks correlation below 0.9 (the
@@ -387,7 +387,7 @@ def test_exported_hinf_closes_the_loop_by_name_in_python_control(metrics):
     on each axis; its closed-loop poles give the same largest real part as
     ``max_real_pole`` in metrics.json at every judged pressure (to 1e-5: python-control's
     companion form of the lag costs digits), on the plant the run judges on: the virtual
-    facility's truth (issue 16 §3)."""
+    facility's truth."""
     import control
     import numpy as np
 

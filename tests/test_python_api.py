@@ -1,4 +1,4 @@
-"""The Python API plugs into python-control and the standard library (issue 13 §3)."""
+"""The Python API plugs into python-control and the standard library."""
 
 from __future__ import annotations
 

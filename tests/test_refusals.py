@@ -1,4 +1,4 @@
-"""Bad input is refused with one line naming the file and key, exit 2 (issue 15 §1–§3).
+"""Bad input is refused with one line naming the file and key, exit 2.
 
 Each case is a regression test of a finding of the issue: a value that used to be accepted
 (silently coerced, silently ignored, or ending in a traceback). The reference is the rig

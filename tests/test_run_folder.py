@@ -1,4 +1,4 @@
-"""One output folder = one run (issue 15 §1): a run replaces its folder as a whole, a second
+"""One output folder = one run: a run replaces its folder as a whole, a second
 run into the same folder is refused, a killed run leaves the former complete set.
 
 The reference is the manifest's SHA-256 list (:func:`ambseal.files.check_manifest`): a
@@ -151,12 +151,14 @@ def test_unwritable_output_refused_before_work(tmp_path, capsys, monkeypatch, co
             "acquire": ["acquire", str(default_truth_path().with_name("testrig.toml")),
                         "--truth", str(default_truth_path()), "--excitation", "prbs",
                         "--pressure-bar", "0", "--out", str(out / "r.csv")]}[command]
-    import ambseal.design.recipes as recipes
+    import ambseal.app.commands as commands
+    import ambseal.app.pipeline as pipeline
 
     def no_work(*a, **k):
         raise AssertionError("designing before the output was checked")
 
-    monkeypatch.setattr(recipes, "design", no_work)
+    for module in (pipeline, commands):
+        monkeypatch.setattr(module, "design", no_work)
     assert main(args) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and str(tmp_path / "file") in err[0], err

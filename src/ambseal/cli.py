@@ -44,14 +44,16 @@ Any error on bad input prints one line on stderr and exits with status 2.
 from __future__ import annotations
 
 import argparse
-import json
+import logging
 import math
 import os
 import shlex
 import sys
-from pathlib import Path
+import warnings
 
-from ambseal.errors import AmbsealError
+from ambseal import __version__
+from ambseal.config import check_operating, default_rig_path
+from ambseal.errors import AmbsealError, with_source
 
 __all__ = ["main"]
 
@@ -125,8 +127,6 @@ class _Help(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpF
 
 
 def _parser() -> argparse.ArgumentParser:
-    from ambseal import __version__
-
     p = _Parser(
         prog="ambseal",
         description="Rotors on active magnetic bearings with destabilising seal forces.",
@@ -232,13 +232,78 @@ def _parser() -> argparse.ArgumentParser:
     tr.add_argument("--rate-per-s", type=float, default=None,
                     help="expected drift per second as a fraction of each parameter's scale "
                          "(default 0.1)")
-    from ambseal.app.rotordynamics import add_parsers
 
-    add_parsers(sub, _positive_int)  # modes, campbell, sweep, import-ross
+    _rotordynamics_parsers(sub)
     _checked_numbers(p)
     for parser in sub.choices.values():  # every command's help names its defaults
         parser.formatter_class = _Help
     return p
+
+
+def _rotordynamics_parsers(sub) -> None:
+    """Add ``modes``, ``campbell``, ``sweep`` and ``import-ross`` to the CLI's subparsers."""
+    m = sub.add_parser("modes", help="natural frequencies, damping, log decrement, whirl, "
+                                     "unstable poles and mode shapes")
+    m.add_argument("rig", nargs="?", help="rig file (TOML); default: the embedded thesis test "
+                                          "facility")
+    m.add_argument("--speed-rpm", type=float, default=None, help="spin speed (rpm)")
+    m.add_argument("--pressure-bar", type=float, default=None, help="seal pressure drop (bar)")
+    m.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    m.add_argument("--n-modes", type=_positive_int, default=None,
+                   help="only the N lowest modes (sparse shift-invert; unstable poles up to "
+                        "the N-th mode only)")
+    m.add_argument("--max-hz", type=float, default=None,
+                   help="modes up to this frequency (Hz); default 1.25x the third free-free "
+                        "bending frequency")
+    m.add_argument("--controller", default=None,
+                   help="close the loop: pid, hinf, mu or a controller file (default: the "
+                        "open-loop model)")
+    m.add_argument("--shapes", nargs="?", const="mode_shapes.png", default=None,
+                   metavar="PNG", help="plot the mode shapes (default file mode_shapes.png)")
+    g = m.add_mutually_exclusive_group()
+    g.add_argument("--free", action="store_true", help="bare rotor: shaft and disks only")
+    g.add_argument("--no-amb", action="store_true", help="leave the AMBs out")
+
+    c = sub.add_parser("campbell", help="closed-loop Campbell diagram and log decrements")
+    c.add_argument("rig", help="rig file (TOML)")
+    c.add_argument("--controller", default=None,
+                   help="pid, hinf, mu, none or a controller file (default pid, else hinf)")
+    c.add_argument("--speed-hz", default=None, help="speeds a:b:n (Hz); default 0 to 1.2x "
+                   "the top speed (or the first free-free bending frequency), 31 points")
+    c.add_argument("--pressure-bar", type=float, default=None,
+                   help="seal pressure drop (bar); default [operating] pressure_bar")
+    c.add_argument("--max-hz", type=float, default=None, help="highest mode frequency (Hz)")
+    c.add_argument("--log-dec-limit", type=float, default=0.1,
+                   help="flag modes below this log decrement (API 684: 0.1)")
+    c.add_argument("--out", default="ambseal-campbell", help="output folder")
+    _executor_args(c)
+
+    s = sub.add_parser("sweep", help="stability and performance map over pressure x speed")
+    s.add_argument("rig", help="rig file (TOML)")
+    s.add_argument("--pressure-bar", required=True, help="pressure drops a:b:n (bar)")
+    s.add_argument("--speed-hz", default="0", help="speeds a:b:n (Hz), default 0")
+    s.add_argument("--controller", default=None,
+                   help="pid, hinf, mu or controller files, comma separated (default pid)")
+    s.add_argument("--param", action="append", metavar="NAME=a:b:n",
+                   help="a rig parameter to sweep too, e.g. seal.k=0:2e6:5 (repeatable)")
+    s.add_argument("--max-hz", type=float, default=None,
+                   help="modes of the lowest log decrement up to this frequency (Hz)")
+    s.add_argument("--tol-bar", type=float, default=0.01,
+                   help="the stability boundary is bisected to this pressure (bar)")
+    s.add_argument("--out", default="ambseal-sweep", help="output folder")
+    _executor_args(s)
+
+    r = sub.add_parser("import-ross", help="a ROSS rotor file (.toml/.json) as an ambseal rig")
+    r.add_argument("file", help="ROSS rotor file saved by ross.Rotor.save")
+    r.add_argument("--out", required=True, help="rig file to write (TOML)")
+
+
+def _executor_args(p) -> None:
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--workers", type=int, default=None,
+                   help="local Dask worker processes (1: serial; default: serial for small "
+                        "runs, one per core for large ones)")
+    g.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
 
 
 def _checked_numbers(parser: argparse.ArgumentParser) -> None:
@@ -255,7 +320,6 @@ def _checked_numbers(parser: argparse.ArgumentParser) -> None:
 
 def _check_operating(args: argparse.Namespace) -> None:
     """The operating values given on the command line, by the rig file's rules."""
-    from ambseal.config import check_operating
 
     values = {k: getattr(args, k, None) for k in ("pressure_bar", "speed_rpm")}
     check_operating({k: v for k, v in values.items() if isinstance(v, float)},
@@ -272,186 +336,9 @@ def _design_options(p: argparse.ArgumentParser) -> None:
                         "condition (marked in every output) instead of stopping")
 
 
-def _acquire(args: argparse.Namespace) -> int:
-    from ambseal.config import load_rig, load_truth
-    from ambseal.errors import ConfigError
-    from ambseal.files import writable_folder
-    from ambseal.identify import signals
-    from ambseal.identify.data import save_measurement
-    from ambseal.app.commands import target_pid
-    from ambseal.identify.stages import acquire
-    from ambseal.model.amb import channel_names
-
-    cfg = load_rig(args.rig)
-    truth = load_truth(args.truth)
-    writable_folder(Path(args.out).parent)  # before the simulation
-    axes = channel_names(cfg)
-    if not axes:
-        raise ConfigError(f"{args.rig}: amb: acquisition needs at least one [[amb]]")
-    excited = None
-    if args.axes is not None:
-        excited = [a.strip() for a in args.axes.split(",")]
-        if not all(excited):
-            raise ConfigError(f"--axes: expected axis names separated by commas, e.g. "
-                              f"{','.join(axes[:2])}; got {args.axes!r}")
-    fs = cfg.controller.sample_rate_hz
-    if args.excitation == "static":
-        from ambseal.identify.static_load import save_static_record, virtual_static_load
-
-        z, F, cur = virtual_static_load(cfg, truth, seed=args.seed)
-        path = save_static_record(args.out, cfg, z, F, cur)
-        print(json.dumps({"out": str(path), "load_steps": int(z.size)}))
-        return 0
-    common = dict(sample_rate_hz=fs, axes=axes, excited=excited)
-    try:
-        if args.excitation == "prbs":
-            ex = signals.prbs(amplitude_a=args.amplitude_a, clock_period_s=args.clock_period_s,
-                              duration_s=args.duration_s, seed=args.seed, **common)
-        elif args.excitation == "sine":
-            freqs = [float(f) for f in args.frequencies_hz.split(",")]
-            ex = signals.stepped_sine(frequencies_hz=freqs, amplitude_a=args.amplitude_a,
-                                      cycles=args.cycles, settling_cycles=args.settling_cycles,
-                                      **common)
-        elif args.excitation == "chirp":
-            ex = signals.chirp(f0_hz=args.f0_hz, f1_hz=args.f1_hz, duration_s=args.duration_s,
-                               amplitude_a=args.amplitude_a, method=args.chirp, **common)
-        else:
-            ex = signals.impulse(amplitude_a=args.amplitude_a, width_s=args.width_s,
-                                 start_s=args.start_s, duration_s=args.duration_s, **common)
-    except ValueError as exc:
-        raise ConfigError(f"acquire: {exc}") from None
-    try:
-        meas = acquire(cfg, truth, ex, controller=target_pid(cfg),
-                       pressure_bar=args.pressure_bar, seed=args.seed)
-    except AmbsealError as exc:  # the simulation runs on the truth file's values
-        raise _named(exc, [args.truth], f"{args.truth} (with {args.rig})") from None
-    path = save_measurement(meas, args.out)
-    print(json.dumps({"out": str(path), "samples": meas.n_samples,
-                      "sample_rate_hz": fs}))
-    return 0
-
-
-def _design(args: argparse.Namespace) -> int:
-    from ambseal.app.commands import design_files, show_defaults
-    from ambseal.config import default_rig_path
-
-    rig = args.rig if args.rig is not None else default_rig_path()
-
-    if args.show_defaults:
-        print(show_defaults(rig, args.overrides), end="")
-        return 0
-    if args.method is None:
-        from ambseal.errors import ConfigError
-
-        raise ConfigError("design: --method is required (pid, hinf, mu or lpv) unless "
-                          "--show-defaults")
-    print(json.dumps(design_files(rig, args.method, args.out,
-                                  pressure_bar=args.pressure_bar, overrides=args.overrides,
-                                  allow_unstable=args.allow_unstable)))
-    return 0
-
-
-def _export(args: argparse.Namespace) -> int:
-    from ambseal.app.commands import design_files
-    from ambseal.errors import ConfigError
-
-    if (args.method is None) == (args.controller is None):
-        raise ConfigError("export: give exactly one of --method and --controller")
-    if args.controller is not None:
-        from ambseal.export.codegen import write_c
-        from ambseal.export.controller_files import load_controller
-
-        ctrl = load_controller(args.controller)
-        files = write_c(ctrl, args.c_dir or Path(args.out) / "c",
-                        f"ambseal_{Path(args.controller).stem}", precision=args.precision)
-        print(json.dumps({"files": [str(f) for f in files]}))
-        return 0
-    print(json.dumps(design_files(args.rig, args.method, args.out,
-                                  pressure_bar=args.pressure_bar,
-                                  c_dir=args.c_dir or Path(args.out) / "c",
-                                  precision=args.precision)))
-    return 0
-
-
-def _identify(args: argparse.Namespace) -> int:
-    from ambseal.app.commands import identify_files
-
-    summary = identify_files(args.rig, args.data, args.params.split(","), args.out,
-                             current_weight=args.current_weight, refine=not args.no_refine,
-                             accept_unconverged=args.accept_unconverged,
-                             static_load=args.static_load)
-    print(json.dumps(summary))
-    return 0
-
-
-def _track(args: argparse.Namespace) -> int:
-    from ambseal.app.commands import track_files
-
-    summary = track_files(args.rig, args.data, args.params.split(","), args.out,
-                          rate_per_s=args.rate_per_s)
-    print(json.dumps(summary))
-    return 0
-
-
-def _run(args: argparse.Namespace) -> int:
-    from ambseal.app.pipeline import run
-
-    result = run(args.rig, args.out, truth=args.truth, identification=not args.no_identify,
-                 overrides=tuple(args.overrides), allow_unstable=args.allow_unstable,
-                 command=args.command_line, progress=not (args.quiet or args.verbose))
-    for reason in result.metrics.get("cannot_run", {}).values():
-        print(f"ambseal: {reason}", file=sys.stderr)
-    if sys.stderr.isatty() and not args.quiet:
-        from rich.console import Console
-
-        from ambseal.config import load_rig
-        from ambseal.report.run_report import rig_clearances_um
-        from ambseal.report.verdict import verdict_table_rich, verdicts
-
-        console = Console(stderr=True)
-        clear = rig_clearances_um(load_rig(args.rig))
-        console.print(verdict_table_rich(verdicts(result.metrics["cases"], clear)))
-        console.print(f"report: {result.report_path.resolve()}")
-    print(json.dumps({"out": str(result.out_dir), "metrics": str(result.metrics_path),
-                      "report": str(result.report_path)}))
-    return 0
-
-
-def _plain(x) -> str:
-    """A value of ``validate``'s defaults as text: dicts as ``key value``, pairs as ranges."""
-    if isinstance(x, dict):
-        return ", ".join(f"{k} {_plain(w)}" for k, w in x.items())
-    if isinstance(x, (list, tuple)):
-        pair = len(x) == 2 and all(isinstance(y, (int, float)) for y in x)
-        return "–".join(map(_plain, x)) if pair else ", ".join(map(_plain, x))
-    return "none" if x is None else f"{x:g}" if isinstance(x, float) else str(x)
-
-
-def _validate(args: argparse.Namespace) -> int:
-    from ambseal.app.commands import validate_summary
-
-    v = validate_summary(args.rig)
-    if args.json:
-        print(json.dumps(v, indent=2))
-        return 0
-    print(f"{v['rig']}: valid — {v['name']}")
-    print(f"  rotor mass {v['mass_kg']:.4g} kg, {v['nodes']} nodes, AMB axes "
-          f"{', '.join(v['axes'])}")
-    print(f"  modes below {v['modes_below_hz']:g} Hz (controller Nyquist): "
-          + ", ".join(f"{f:.4g} Hz (ζ {z:.3g})" for f, z in v["modes"]))
-    poles = v["unstable_poles"]
-    print(f"  {len(poles)} unstable open-loop poles"
-          + (": " + ", ".join(f"{re:.4g}{im:+.4g}j rad/s" for re, im in poles) if poles else ""))
-    print("  defaults a run takes:")
-    for key, val in v["defaults"].items():
-        print(f"    {key}: {_plain(val)}")
-    return 0
-
-
 def _logging(args: argparse.Namespace) -> None:
     """Stage lines of the 'ambseal' logger to stderr: INFO by default, WARNING with
     --quiet, DEBUG with --verbose (a library user routes the logger as they like)."""
-    import logging
 
     log = logging.getLogger("ambseal")
     handler = logging.StreamHandler(sys.stderr)
@@ -465,17 +352,8 @@ def _logging(args: argparse.Namespace) -> None:
     log.setLevel(level)
 
 
-def _named(exc: AmbsealError, files: list, source: str) -> AmbsealError:
-    """``exc`` with ``source: `` in front unless its message names one of ``files``."""
-    msg = str(exc)
-    if any(str(f) in msg for f in files if f):
-        return exc
-    return type(exc)(f"{source}: {msg}")
-
-
 def _inputs(args: argparse.Namespace) -> tuple[list, str]:
     """The files a command reads and writes, and the one an unnamed error comes from."""
-    from ambseal.config import default_rig_path
 
     rig = getattr(args, "rig", None) or default_rig_path()
     files = [rig, getattr(args, "truth", None), getattr(args, "out", None),
@@ -488,22 +366,24 @@ def main(argv: list[str] | None = None) -> int:
 
     Warnings raised on the way (numpy's, say) are shown after a successful command and
     dropped when the command ends in the one error line."""
-    import warnings
 
     args = _parser().parse_args(argv)
     args.command_line = shlex.join(["ambseal", *(sys.argv[1:] if argv is None else argv)])
     _logging(args)
-    from ambseal.app.rotordynamics import HANDLERS
 
-    handler = {"acquire": _acquire, "identify": _identify, "design": _design,
-               "track": _track, "export": _export, "run": _run, "validate": _validate, **HANDLERS}[args.command]
+    # The commands' code loads python-control, scipy.signal and matplotlib (1.6 s of a
+    # 1.8 s start on a 2-core machine): imported once a command runs, so that --help and
+    # argument errors answer at once.
+    from ambseal.app.handlers import HANDLERS
+
+    handler = HANDLERS[args.command]
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("default")
         try:
             _check_operating(args)
             code = handler(args)
         except AmbsealError as exc:
-            print(f"ambseal: error: {_named(exc, *_inputs(args))}", file=sys.stderr)
+            print(f"ambseal: error: {with_source(exc, *_inputs(args))}", file=sys.stderr)
             return 2
         except MemoryError:
             print(f"ambseal: error: {args.command}: not enough memory for this input",

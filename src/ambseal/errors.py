@@ -7,7 +7,7 @@ CLI turns an :class:`AmbsealError` into one line on stderr and exit code 2.
 from __future__ import annotations
 
 __all__ = ["AmbsealError", "ConfigError", "DataError", "ModelError", "IdentificationError",
-           "SynthesisError", "describe_validation_error", "PRIMITIVE_TAGS"]
+           "SynthesisError", "describe_validation_error", "PRIMITIVE_TAGS", "with_source"]
 
 
 class AmbsealError(Exception):
@@ -101,3 +101,25 @@ def describe_validation_error(exc, tags: set[str]) -> str:
     elif msg.startswith("Value error, "):
         msg = msg[len("Value error, "):]
     return f"{_loc(err['loc'], tags)}: {msg}"
+
+
+def with_source(exc: AmbsealError, files: list, source: str) -> AmbsealError:
+    """``exc`` with ``source: `` in front unless its message names one of ``files``.
+
+    Parameters
+    ----------
+    exc : AmbsealError
+    files : list of str or path-like
+        The files the command read or wrote (None entries are skipped).
+    source : str
+        What to name when the message names none of ``files``.
+
+    Returns
+    -------
+    AmbsealError
+        ``exc`` itself, or a new error of its type with the source in front.
+    """
+    msg = str(exc)
+    if any(str(f) in msg for f in files if f):
+        return exc
+    return type(exc)(f"{source}: {msg}")

@@ -7,9 +7,16 @@ the new one, never half of one.
 
 from __future__ import annotations
 
+import ctypes
+import datetime
+import fcntl
+import hashlib
 import json
 import os
+import shutil
 import tempfile
+import tomllib
+import uuid
 from pathlib import Path
 from typing import Any, BinaryIO, Callable
 
@@ -86,7 +93,6 @@ def read_text(path: str | os.PathLike, what: str = "file") -> str:
 def load_toml(path: str | os.PathLike, what: str = "file") -> dict:
     """Parse a TOML file read by :func:`read_text`; AmbsealError (one line naming the
     file) if it is not valid TOML or nested too deeply to read."""
-    import tomllib
 
     text = read_text(path, what)
     try:
@@ -131,7 +137,6 @@ def _pid_alive(pid: int) -> bool:
 def _exchange(a: Path, b: Path) -> bool:
     """Swap two directories atomically (Linux renameat2 RENAME_EXCHANGE); False if the
     system cannot."""
-    import ctypes
 
     try:
         fn = ctypes.CDLL(None, use_errno=True).renameat2
@@ -149,8 +154,6 @@ def _is_run_output(folder: Path) -> bool:
 
 
 def _file_hash(path: Path) -> str:
-    import hashlib
-
     h = hashlib.sha256()
     with open(path, "rb") as fh:
         for block in iter(lambda: fh.read(1 << 20), b""):
@@ -160,7 +163,6 @@ def _file_hash(path: Path) -> str:
 
 def write_manifest(folder: Path, run_id: str) -> Path:
     """Write ``manifest.json``: the run id and the SHA-256 of every file in ``folder``."""
-    import datetime
 
     files = {p.relative_to(folder).as_posix(): _file_hash(p)
              for p in sorted(folder.rglob("*")) if p.is_file() and p.name != MANIFEST}
@@ -226,8 +228,6 @@ class RunFolder:
         return AmbsealError(f"{self.out}: cannot {what} ({exc.strerror or exc})")
 
     def _lock(self) -> None:
-        import fcntl
-
         try:
             self.parent.mkdir(parents=True, exist_ok=True)
             fd = os.open(self.lock_path, os.O_RDWR | os.O_CREAT, 0o644)
@@ -245,8 +245,6 @@ class RunFolder:
         self._lock_fd = fd
 
     def _clean_stale(self) -> None:
-        import shutil
-
         prefix = f".{self.out.name}."
         for p in self.parent.glob(prefix + "*"):
             kind, _, pid = p.name[len(prefix):].partition("-")
@@ -258,8 +256,6 @@ class RunFolder:
                 shutil.rmtree(p, ignore_errors=True)
 
     def __enter__(self) -> Path:
-        import shutil
-
         self._lock()
         try:
             self._clean_stale()
@@ -285,9 +281,6 @@ class RunFolder:
         return self.stage
 
     def __exit__(self, kind, exc, tb) -> None:
-        import shutil
-        import uuid
-
         try:
             if kind is not None:
                 shutil.rmtree(self.stage, ignore_errors=True)

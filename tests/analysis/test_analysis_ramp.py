@@ -1,4 +1,4 @@
-"""The closed-loop pressure ramp on the virtual facility (issue 14 §2)."""
+"""The closed-loop pressure ramp on the virtual facility."""
 
 import numpy as np
 import pytest

@@ -1,5 +1,5 @@
 """The speed-scheduled designs (LPV, frozen H∞) closed with the full-order plant at every
-judged condition before they are delivered, as H∞ and μ are (issue 9 §3)."""
+judged condition before they are delivered, as H∞ and μ are."""
 
 from __future__ import annotations
 

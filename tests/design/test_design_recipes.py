@@ -26,7 +26,7 @@ ISO_ZONE_A_LIMIT = 3.0
 #: Thesis demand on the worst-case G2.5 unbalance orbit up to 200 Hz (P5 §4.4.1): 8 µm.
 ORBIT_DEMAND_UM = 8.0
 #: Regression pin, not a published value: order reduction of the μ controller (46 → 28
-#: states) raised the peak μ by 2.1 % (1.116 → 1.139) when this pin was set (issue 8);
+#: states) raised the peak μ by 2.1 % (1.116 → 1.139) when this pin was set;
 #: P5 §4.3 reduces its controllers without quoting the cost. 5 % flags a change.
 MU_REDUCTION_COST_PIN = 0.05
 
@@ -108,7 +108,7 @@ def test_mu_reduction_cost_regression_pin(designs):
 
 
 def test_mu_delivers_the_candidate_with_lower_mu_after_reduction(designs):
-    """Reference: the definition of the delivered controller (issue 11 §3): after the order
+    """Reference: the definition of the delivered controller: after the order
     reduction the μ design keeps, of D–G–K's controller and complex D–K's, the one whose
     reduced loop has the lower peak μ, and reports both. There are two candidates exactly
     when a D–G–K step beat complex D–K at full order (``musyn_dgk``'s ``alternatives``);

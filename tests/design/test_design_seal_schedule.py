@@ -1,4 +1,4 @@
-"""The controller scheduled on a seal coefficient (issue 14 §2) and the one scheduled-
+"""The controller scheduled on a seal coefficient and the one scheduled-
 controller type it shares with the speed-scheduled LPV controller."""
 
 import numpy as np
@@ -52,7 +52,7 @@ def test_design_refuses_a_parameter_without_channel_and_a_one_point_grid(testrig
 
 @pytest.mark.slow
 def test_tracked_design_stable_in_zone_a_on_the_full_order_plant(testrig_cfg, testrig_tracked):
-    """Issue 14 acceptance (§2): at every frozen k on a grid 5× denser than the design grid
+    """At every frozen k on a grid 5× denser than the design grid
     over 0–3× nominal (21 pressures), the scheduled controller frozen at k is stable on the
     full-order plant (every mode, the 557 Hz bending pair included) with σ̄(S_o) ≤ 3 per
     axis — the ISO 14839-3 zone-A limit (the reference)."""
@@ -71,7 +71,7 @@ def test_tracked_design_stable_in_zone_a_on_the_full_order_plant(testrig_cfg, te
 
 @pytest.mark.slow
 def test_tracked_digital_table_stable_with_the_target_delay(testrig_cfg, testrig_tracked):
-    """Issue 14 (§2: exported like every scheduled controller): the tracked controller's
+    """Exported like every scheduled controller: the tracked controller's
     digital table (:func:`ambseal.app.commands.digital_for`: the method chosen on the sampled
     full-order loops with the target's delay at the judged pressures and between table
     entries). Reference: python-control, side by side — the full-order plant sampled by

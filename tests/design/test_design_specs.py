@@ -183,7 +183,7 @@ def test_design_part_validates_round_trips_and_overrides(testrig_cfg):
 
 
 def test_uncertainty_from_an_identification_file(testrig_cfg, tmp_path):
-    """Reference: issue 17's contract — ``[design] uncertainty_from_identification`` takes
+    """Reference: the identification's contract — ``[design] uncertainty_from_identification`` takes
     a fit.json's 95 % intervals unchanged as the μ ranges (τ_e left out), the path relative
     to the rig file; ``[[design.uncertainty]]`` adds to them and wins where both name a
     parameter; a fit marked model mismatch is refused naming the key."""

@@ -85,7 +85,7 @@ def test_rig_file_uncertainty_and_defaults(testrig_cfg):
 
 
 def test_seal_held_fixed_at_pressure_is_told(testrig_cfg):
-    """Reference: issue 17 — seal coefficients held at their rig values on a record at a
+    """Reference: the error budget's contract — seal coefficients held at their rig values on a record at a
     non-zero pressure drop draw a warning naming them; at 0 bar, or fitted, none."""
     assert any("seal.k" in w and "2.04 bar" in w
                for w in advice(None, testrig_cfg, ["A.Ks_zeta"], [2.04]))
@@ -123,7 +123,7 @@ def test_residual_tests_size_and_power():
 
 
 def test_identified_intervals_become_mu_ranges(testrig_cfg, tmp_path):
-    """Reference: the interface contract of issue 17 — a fit.json's 95 % intervals arrive
+    """Reference: the interface contract of fit.json — a fit.json's 95 % intervals arrive
     unchanged as the Δ ranges of the generalized plant; tau_e is left out; a fit flagged
     as model mismatch and a missing interval are refused, naming file and key."""
     import json

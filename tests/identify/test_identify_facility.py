@@ -1,5 +1,5 @@
-"""The virtual facility refuses a controller that does not stabilise its loop (issue 17:
-the pump's and the blower's records with the test rig's eddy lag in the truth)."""
+"""The virtual facility refuses a controller that does not stabilise its loop (the
+pump's and the blower's records with the test rig's eddy lag in the truth)."""
 
 from pathlib import Path
 

@@ -1,5 +1,5 @@
 """Intervals on data the model did not make: fixed parameters off their rig values and a
-different rotor discretisation on the virtual facility (issue 17)."""
+different rotor discretisation on the virtual facility."""
 
 import json
 
@@ -81,7 +81,7 @@ def test_budget_covers_a_coupling_held_wrong_and_names_it(testrig_cfg):
 
 @pytest.mark.slow
 def test_coverage_and_model_check_over_20_seeds(testrig_cfg):
-    """Issue 17 acceptance over 20 seeds (PRBS and noise both drawn anew), per case:
+    """Over 20 seeds (PRBS and noise both drawn anew), per case:
     coverage of the reported 95 % intervals, their width against matched records, and how
     often the model check flags the fit (residuals correlated with the excitation, a
     fixed value disputed by the score test, or a sensor lag asked for by its score test).

@@ -1,4 +1,4 @@
-"""Seal tests whose coefficients separate (issue 16 §4a): balanced forward and backward whirl.
+"""Seal tests whose coefficients separate: balanced forward and backward whirl.
 
 References: the whirl decomposition of a seal's force (Childs, *Turbomachinery
 Rotordynamics*, 1993, §4: forward and backward whirl see K ± ωc and ωC ∓ k), and thesis P4

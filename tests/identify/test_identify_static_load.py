@@ -1,4 +1,4 @@
-"""Ki by static loading (thesis P2 §5) and its join with the closed-loop fit (issue 16 §4b).
+"""Ki by static loading (thesis P2 §5) and its join with the closed-loop fit.
 
 References: the truth file of the virtual facility (whose FE statics make the loads'
 currents), the thesis's rigid-body balance (P2 §5: four equilibrium equations per load step),

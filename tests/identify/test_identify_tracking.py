@@ -1,4 +1,4 @@
-"""On-line tracking of seal coefficients (issue 14 §1) on the virtual test facility."""
+"""On-line tracking of seal coefficients on the virtual test facility."""
 
 from dataclasses import replace
 

@@ -1,4 +1,4 @@
-"""Rigid-body modes and unstable poles rest on the physics, not on the stiffest DOF (issue 15).
+"""Rigid-body modes and unstable poles rest on the physics, not on the stiffest DOF.
 
 A stiff pin, a disk a few micrometres off a node and a finer mesh spread the model's
 eigenvalues over more decades; none of them may change which poles count as unstable or

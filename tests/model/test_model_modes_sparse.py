@@ -18,7 +18,7 @@ from ambseal.model.rig import build_system
 TURBO = Path(__file__).resolve().parents[2] / "examples" / "turboexpander.toml"
 N = 8
 FREE = {"include_amb": False, "include_seals": False, "include_springs": False}
-# Issue 8 §4: the modes asked for equal the dense ones "to ~1e-8 relative".
+# The sparse path's contract: the modes asked for equal the dense ones "to ~1e-8 relative".
 RTOL = 1e-8
 
 

@@ -32,11 +32,11 @@ def _max_abs_z(G, K_discrete, T, delay):
 
 def test_exported_controllers_keep_every_stable_loop_stable_with_a_sample_of_delay(
         testrig_cfg, testrig_plants, testrig_digital, tmp_path):
-    """Reference: issue 10's report — the controller ambseal exports, reloaded from its
+    """Reference: the sampled loop — the controller ambseal exports, reloaded from its
     file, keeps every loop whose continuous loop is stable inside the unit circle with one
     sample of delay (full-order plant sampled by ZOH at 10 kHz, eigenvalues by numpy). On
-    issue 10's controllers the plain Tustin export (no pre-warp, no pole removal) was
-    unstable (|z| 1.0004 for H∞ at 2.04 bar); the moderate H∞ and μ of issue 16 no longer
+    controllers designed without the delay, the plain Tustin export (no pre-warp, no pole removal) was
+    unstable (|z| 1.0004 for H∞ at 2.04 bar); the moderate H∞ and μ of today no longer
     show it (|z| 0.99967), so that half of the check went."""
     T = 1.0 / testrig_cfg.controller.sample_rate_hz
     for m, dc in testrig_digital.items():
@@ -49,10 +49,10 @@ def test_exported_controllers_keep_every_stable_loop_stable_with_a_sample_of_del
                 assert _max_abs_z(G, (K.A, K.B, K.C, K.D), T, 1) < 1.0, (m, p)
 
 
-def test_issue10_report_plain_tustin_of_the_old_hinf_is_unstable_ambseals_choice_is_not(
+def test_plain_tustin_of_a_delay_free_hinf_is_unstable_ambseals_choice_is_not(
         testrig_cfg, testrig_plants):
-    """Reference: issue 10's report, kept as data — the H∞ controller ambseal designed
-    before issue 10 (tests/data/hinf_issue10_delay_free.npz: delay-free design model,
+    """Reference: a controller kept as data — the H∞ controller ambseal designed
+    on a delay-free design model (tests/data/hinf_delay_free_design.npz: delay-free design model,
     order 24, real poles at 6.2 and 8.0 kHz above the 5 kHz Nyquist frequency; its
     ``source`` names the commit). Plain Tustin of it (what was exported), closed with the
     full-order plant sampled by ZOH at 10 kHz and one sample of delay, is unstable at 2.04
@@ -62,9 +62,9 @@ def test_issue10_report_plain_tustin_of_the_old_hinf_is_unstable_ambseals_choice
     exported) the second half fails."""
     from ambseal.robust.digital import digital_controller
 
-    d = np.load(Path(__file__).parents[1] / "data" / "hinf_issue10_delay_free.npz")
+    d = np.load(Path(__file__).parents[1] / "data" / "hinf_delay_free_design.npz")
     K = ct.ss(d["A"], d["B"], d["C"], d["D"], inputs=[str(x) for x in d["inputs"]],
-              outputs=[str(x) for x in d["outputs"]], name="K_hinf_issue10")
+              outputs=[str(x) for x in d["outputs"]], name="K_hinf_delay_free")
     fs = float(d["sample_rate_hz"])
     assert fs == testrig_cfg.controller.sample_rate_hz
     assert np.sort(np.abs(np.linalg.eigvals(d["A"])))[-2] > np.pi * fs  # two poles > Nyquist

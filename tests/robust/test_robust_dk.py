@@ -147,7 +147,7 @@ def test_published_optimal_dscale_reproduces_the_published_mu():
 def test_dk_with_d_search_reaches_the_published_optimum_within_two_percent():
     """Reference: the published μ-optimal value 0.9737 of Skogestad & Postlethwaite (2005)
     §8.12.4 (eq. 8.144) and their D–K result after three iterations, 1.0189 (Table 8.2
-    script, MATLAB μ toolbox). Issue 11's goal: within 2 % of the optimum. Plain D–K stalls
+    script, MATLAB μ toolbox). The goal: within 2 % of the optimum. Plain D–K stalls
     above it (ours at 1.027, like MATLAB's); the direct D search must get below
     1.02 · 0.9737, with a certificate: the γ of the scaled problem bounds μ at every
     frequency, and the mixed power algorithm's lower bound meets the upper bound at the peak

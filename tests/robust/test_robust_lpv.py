@@ -153,9 +153,9 @@ def test_lpv_plant_affine_without_tables():
 
 # --------------------------------------------------------------------------- turboexpander
 #: Regression pins, not published values (P3 gives no γ for its LPV design): when set
-#: (issue 8) the turboexpander's max frozen H∞ γ was 0.943 (< 1: the weights are met at
+#: the turboexpander's max frozen H∞ γ was 0.943 (< 1: the weights are met at
 #: every frozen speed, which is the design's demand) and the constant-Lyapunov LPV γ 1.070
-#: (rate-bounded 1.051); with W_u and the scalings derived from the rig (issue 9) 0.942
+#: (rate-bounded 1.051); with W_u and the scalings derived from the rig 0.942
 #: and 1.105. A change beyond these bounds is a change of the design.
 TURBO_FROZEN_GAMMA_PIN = 1.0
 TURBO_CONST_GAMMA_PIN = 1.14

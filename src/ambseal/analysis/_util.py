@@ -16,7 +16,6 @@ from typing import Any
 import numpy as np
 
 
-
 def json_float(x: float | None) -> float | str | None:
     """Map a float to a JSON-safe value (``inf`` -> ``"inf"``, ``NaN`` -> ``None``)."""
     if x is None:

@@ -31,6 +31,14 @@ import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
 from ambseal.analysis._util import json_float, json_list
+from ambseal.analysis.cases import run_cases
+from ambseal.analysis.judge import delayed_plant
+from ambseal.analysis.loops import closed_loop
+from ambseal.model.modes import RIGID_BODY_RAD_S, bending_limit_hz, classify_poles, free_bending_hz
+from ambseal.model.rig import build_plant
+from ambseal.model.rotor import build_mesh
+from ambseal.robust.controller import frozen
+from ambseal.robust.delay import loop_delay
 
 __all__ = ["API684_LOG_DEC", "ClosedLoopModes", "Crossing", "Campbell",
            "log_decrement", "lowest_log_decrement", "whirl_of", "closed_loop_state_matrix",
@@ -54,7 +62,6 @@ def log_decrement(poles: np.ndarray) -> np.ndarray:
 def lowest_log_decrement(poles: np.ndarray, max_hz: float) -> tuple[float, float]:
     """(δ, f_d in Hz) of the least damped oscillating pole with f_d ≤ ``max_hz``, by log
     decrement; (nan, nan) when there is none."""
-    from ambseal.model.modes import RIGID_BODY_RAD_S
 
     p = np.asarray(poles, complex)
     p = p[(p.imag >= RIGID_BODY_RAD_S) & (p.imag <= 2 * np.pi * max_hz)]
@@ -157,12 +164,6 @@ def closed_loop_state_matrix(cfg, controller=None, *, speed_hz: float,
     Without a controller (or a rig without AMBs) the open-loop plant's A; a scheduled
     controller is frozen at the speed.
     """
-    from ambseal.robust.controller import frozen
-    from ambseal.robust.delay import loop_delay
-    from ambseal.model.rig import build_plant
-    from ambseal.model.rotor import build_mesh
-    from ambseal.analysis.judge import delayed_plant
-    from ambseal.analysis.loops import closed_loop
 
     plant = build_plant(cfg, pressure_bar=pressure_bar, speed_rpm=60.0 * speed_hz)
     mesh = build_mesh(cfg)
@@ -204,7 +205,6 @@ def closed_loop_modes(cfg, controller=None, *, speed_hz: float = 0.0,
     ModelError
         A model that cannot be built, or a controller of the wrong size.
     """
-    from ambseal.model.modes import bending_limit_hz
 
     p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
     f_max = bending_limit_hz(cfg) if max_hz is None else float(max_hz)
@@ -221,7 +221,6 @@ def modes_of_state_matrix(A: np.ndarray, mesh, *, speed_hz: float, pressure_bar:
     (:func:`~ambseal.model.modes.classify_poles`: absolute thresholds in rad/s; ModelError
     when the conditioning makes them doubtful).
     """
-    from ambseal.model.modes import RIGID_BODY_RAD_S, classify_poles
 
     lam, V = sla.eig(A)
     rigid, _ = classify_poles(lam, where="closed-loop modes")
@@ -391,8 +390,6 @@ def campbell(cfg, controller=None, speeds_hz=None, *, pressure_bar: float | None
     -------
     Campbell
     """
-    from ambseal.model.modes import bending_limit_hz, free_bending_hz
-    from ambseal.analysis.cases import run_cases
 
     f_max = bending_limit_hz(cfg) if max_hz is None else float(max_hz)
     if speeds_hz is None:

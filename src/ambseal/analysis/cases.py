@@ -17,6 +17,9 @@ import sys
 from dataclasses import dataclass
 from typing import Callable, Sequence
 
+from rich.console import Console
+from rich.progress import Progress
+
 from ambseal.errors import AmbsealError, ConfigError
 
 __all__ = ["CaseError", "run_cases", "dask_available", "SERIAL_BELOW"]
@@ -37,7 +40,7 @@ class CaseError:
 def dask_available() -> bool:
     """Whether ``dask.distributed`` can be imported (the ``[dask]`` extra)."""
     try:
-        import distributed  # noqa: F401
+        import distributed  # noqa: F401  (optional: the [dask] extra)
     except ImportError:
         return False
     return True
@@ -90,8 +93,6 @@ def run_cases(fn: Callable, cases: Sequence[dict], *, shared: dict | None = None
         ``scheduler`` or ``workers > 1`` without dask installed, or a scheduler that cannot
         be reached.
     """
-    from rich.console import Console
-    from rich.progress import Progress
 
     shared = dict(shared or {})
     cases = list(cases)
@@ -122,14 +123,14 @@ def run_cases(fn: Callable, cases: Sequence[dict], *, shared: dict | None = None
 
 def _run_dask(fn, cases, shared, workers, scheduler, done) -> list:
     """The Dask path of :func:`run_cases`: futures, as completed, gathered in input order."""
-    from distributed import Client, LocalCluster, as_completed
+    from distributed import Client, LocalCluster, as_completed  # optional: the [dask] extra
 
     cluster = None
     try:
         if scheduler is not None:
             client = Client(scheduler, timeout="10s")
         else:
-            import dask
+            import dask  # optional: the [dask] extra
 
             n = workers or (os.cpu_count() or 1)
             # Linux: workers forked from this process, which has ambseal, numpy, scipy and

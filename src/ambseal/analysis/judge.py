@@ -40,7 +40,32 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import control
 import numpy as np
+
+from ambseal.analysis.iso import iso_assessment
+from ambseal.analysis.loops import (
+    closed_loop,
+    compliance_from,
+    loop_responses_from,
+    resolved_grid,
+    response_points,
+    sigma_max,
+)
+from ambseal.analysis.response import impulse_response_of
+from ambseal.analysis.spinup import frozen_sensitivity, spinup
+from ambseal.analysis.unbalance import unbalance_from_compliance
+from ambseal.design.lpv_plant import lpv_plant, vertex_grid_hz
+from ambseal.design.specs import RIGID_STATES, design_spec
+from ambseal.lti.discrete import zoh
+from ambseal.lti.freqresp import freqresp_at
+from ambseal.lti.interconnect import series_inputs
+from ambseal.model.modes import classify_poles
+from ambseal.model.rig import build_plant
+from ambseal.model.seal import seal_values
+from ambseal.robust.controller import SPEED, frozen
+from ambseal.robust.delay import loop_delay
+from ambseal.robust.scheduled_digital import ScheduledDigital
 
 __all__ = ["JudgeSettings", "OperatingPoint", "judge", "judge_case", "judge_spinup",
            "sampled_plant", "delayed_plant", "operating_points", "speed_scheduled",
@@ -108,7 +133,6 @@ def judge_settings(cfg, spec=None) -> JudgeSettings:
     twice the controller's rate (test rig: 0.05 A for 10 ms at 0.05 s in 0.35 s, every
     50 µs, P5 §5.1).
     """
-    from ambseal.design.specs import design_spec
 
     sp = spec or design_spec(cfg)
     t = sp.impulse_s
@@ -144,7 +168,6 @@ def operating_points(cfg, spec=None) -> list[OperatingPoint]:
     (:func:`ambseal.design.specs.design_spec`; by default 0, nominal and 2× nominal
     pressure drop, P5 §4, or the ends and the middle of the speed range of a rig whose
     seals change with speed, P3 §4, at the nominal pressure)."""
-    from ambseal.design.specs import design_spec
 
     sp = spec or design_spec(cfg)
     ps, fs = sp.pressures_bar, sp.speeds_hz
@@ -172,7 +195,6 @@ def unstable_open_loop_poles(A: np.ndarray) -> np.ndarray:
     ------
     ModelError
         The model's conditioning makes the stability doubtful."""
-    from ambseal.model.modes import classify_poles
 
     lam = np.linalg.eigvals(A)
     lam = lam[classify_poles(lam, where="open-loop plant")[1]]
@@ -219,8 +241,6 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
         ``poles`` (the closed-loop poles, rad/s); the discrete loop's under
         ``curves["discrete"]`` (its ``poles`` are z).
     """
-    from ambseal.robust.delay import loop_delay
-    from ambseal.model.rig import build_plant
 
     s = settings or judge_settings(cfg)
     plant = build_plant(cfg, pressure_bar=point.pressure_bar, speed_rpm=point.speed_rpm,
@@ -245,9 +265,6 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
 def delayed_plant(P, cur, delay):
     """The continuous plant ``P`` with the SISO ``delay`` system in front of each current
     input ``cur`` (:func:`ambseal.lti.interconnect.series_inputs`), signal names kept."""
-    import control
-
-    from ambseal.lti.interconnect import series_inputs
 
     def mats(S):
         return tuple(np.asarray(getattr(S, m), float) for m in ("A", "B", "C", "D"))
@@ -260,9 +277,6 @@ def sampled_plant(P, dt: float):
     """The plant ``P`` sampled exactly with a zero-order hold at ``dt`` (s): inputs held
     over each sample, outputs read at the samples (:func:`ambseal.lti.discrete.zoh`;
     Franklin, Powell & Workman §6.3), signal names kept."""
-    import control
-
-    from ambseal.lti.discrete import zoh
 
     Ad, Bd = zoh(np.asarray(P.A, float), np.asarray(P.B, float), dt)
     return control.ss(Ad, Bd, np.asarray(P.C, float), np.asarray(P.D, float), dt,
@@ -271,7 +285,6 @@ def sampled_plant(P, dt: float):
 
 def _inputs(P, idx):
     """The state space ``P`` with only the inputs ``idx`` (names kept, same time base)."""
-    import control
 
     names = [P.input_labels[j] for j in idx]
     return control.ss(P.A, np.asarray(P.B)[:, idx], P.C, np.asarray(P.D)[:, idx], P.dt,
@@ -282,12 +295,6 @@ def _judge_loop(cfg, P, cur, force, controller, s: JudgeSettings, impulse: bool
                 ) -> tuple[dict, dict]:
     """The case's numbers for one loop, continuous or discrete (``P.dt``): the plant ``P``
     with current inputs ``cur`` and force inputs ``force``."""
-    from ambseal.lti.freqresp import freqresp_at
-    from ambseal.analysis.iso import iso_assessment
-    from ambseal.analysis.loops import (closed_loop, compliance_from, loop_responses_from, resolved_grid,
-                        response_points, sigma_max)
-    from ambseal.analysis.response import impulse_response_of
-    from ambseal.analysis.unbalance import unbalance_from_compliance
 
     G, Gf = _inputs(P, cur), _inputs(P, force)
     loop = closed_loop(G, controller, Gf)
@@ -351,7 +358,6 @@ def condition_values(point, design_cfg) -> tuple[float, dict]:
     """(Ω in rad/s, every seal coefficient of the design rig by LFT name, SI) at ``point``
     (with ``speed_rpm`` and ``pressure_bar``: an OperatingPoint, or the rig's
     ``[operating]``): the values a scheduled controller is frozen at there."""
-    from ambseal.model.seal import seal_values
 
     return (2 * math.pi * point.speed_rpm / 60.0,
             seal_values(design_cfg.seal, point.pressure_bar))
@@ -361,7 +367,6 @@ def frozen_at(K, point, design_cfg):
     """The fixed controller that runs at ``point``: ``K``, a speed-scheduled one at the
     speed, or one scheduled on a seal coefficient at the design rig's value at the pressure
     drop (:func:`ambseal.robust.controller.frozen`, :func:`condition_values`)."""
-    from ambseal.robust.controller import frozen
 
     return frozen(K, *condition_values(point, design_cfg))
 
@@ -379,8 +384,6 @@ def frozen_discrete(digital, point, design_cfg):
     """The discrete controller (delay included) that runs at ``point`` (a table at θ there,
     :func:`condition_values`), for the judgement; ``None`` for a controller that cannot run
     (``digital`` None)."""
-    from ambseal.robust.controller import SPEED
-    from ambseal.robust.scheduled_digital import ScheduledDigital
 
     if digital is None:
         return None
@@ -423,9 +426,6 @@ def judge_spinup(cfg, controllers: dict) -> tuple[dict, list, list]:
         :class:`~ambseal.analysis.spinup.SpinupResult` and
         :class:`~ambseal.analysis.spinup.FrozenSensitivity` of each controller in order.
     """
-    from ambseal.design.lpv_plant import lpv_plant, vertex_grid_hz
-    from ambseal.design.specs import RIGID_STATES
-    from ambseal.analysis.spinup import frozen_sensitivity, spinup
 
     lo, hi = cfg.operating.speed_range_hz
     # A(Ω) is affine between the vertex grid's speeds: the plant is exact along the ramp

@@ -23,10 +23,11 @@ are then ``z``, stable means ``|z| < 1``, and responses are taken at ``z = e^{jÏ
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
+import control
 import numpy as np
 
 from ambseal.analysis._util import json_float, json_list
@@ -382,7 +383,6 @@ def closed_loop(G: Any, K: Any, Gf: Any | None = None, *, atol: float = 0.0) -> 
         If the dimensions of ``G``, ``K`` (and ``Gf``) do not fit, ``Gf`` has a different
         ``A`` or ``C``, or ``I + D D_K`` is singular (ill-posed loop).
     """
-    import control
 
     (A, B, C, D), (Ak, Bk, Ck, Dk) = _check_pair(G, K)
     n, nu = B.shape

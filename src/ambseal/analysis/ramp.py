@@ -1,5 +1,4 @@
-"""A pressure ramp on the virtual facility with fixed controllers and the tracked scheme
-(issue 14 §2): the on-line estimator and the controller scheduled on its estimate running
+"""A pressure ramp on the virtual facility with fixed controllers and the tracked scheme: the on-line estimator and the controller scheduled on its estimate running
 together in the sampled, nonlinear loop.
 
 The facility (:mod:`ambseal.identify.rig_sim`: nonlinear AMB forces, amplifier limits,
@@ -47,7 +46,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
+from ambseal.design.specs import design_spec
 from ambseal.errors import ModelError
+from ambseal.identify.fit import ClosedLoopModel
+from ambseal.identify.rig_sim import _pressure_values, prepare_facility, reduced_plant, true_rig
+from ambseal.identify.tracking import OnlineTracker, TrackingSettings, tracking_excitation
+from ambseal.model.amb import actuator_matrices
+from ambseal.model.rig import build_plant
+from ambseal.robust.digital import discretize_as, with_delay
+from ambseal.robust.digital_loop import DiscreteController
 
 __all__ = ["RampRun", "RampResult", "pressure_ramp", "ramp_simulation", "frozen_cases"]
 
@@ -126,7 +134,6 @@ def _excitation(cfg, N: int, fs: float, every_s: float, amplitude_a: float, n_le
                 seed: int):
     """(excitation (N, k), impulse start samples): the tracker's PRBS and the impulse train
     on axis 0 added to it."""
-    from ambseal.identify.tracking import tracking_excitation
 
     e = tracking_excitation(cfg, (N + 1) / fs, seed=seed).values_a[:N].copy()
     step = int(round(every_s * fs))
@@ -209,8 +216,6 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
     ModelError
         A rig without a seal, or without the parameter named by ``tracked.parameter``.
     """
-    from ambseal.design.specs import design_spec
-    from ambseal.identify.rig_sim import _pressure_values, prepare_facility, reduced_plant, true_rig
 
     fs = cfg.controller.sample_rate_hz
     N = int(round(duration_s * fs))
@@ -267,7 +272,6 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
 def _noise_std(cfg, truth, controllers, tracked, e, fs, run_as):
     """Sensor noise std per axis: the truth's floor plus ``noise_fraction`` × the RMS of a
     noise-free first second at 0 bar with the tracked controller (else the first one)."""
-    from ambseal.identify.rig_sim import prepare_facility
 
     k = e.shape[1]
     std = np.full(k, truth.sensor_noise_m)
@@ -285,8 +289,6 @@ def _runner(tracked, table, T: float, delay: int):
     """``run_as(K)``: the DiscreteController that runs, with ``delay`` samples of delay, for
     a fixed DiscreteController ``K`` or for the tracked controller at θ = ``K`` (a number:
     the table at θ, or without a table the design frozen at θ and discretised by ZOH)."""
-    from ambseal.robust.digital import discretize_as, with_delay
-    from ambseal.robust.digital_loop import DiscreteController
 
     def run_as(K):
         if not isinstance(K, DiscreteController):
@@ -328,10 +330,6 @@ def _run_tracked(cfg, fac, tracked, run_as, e, noise, inoise, fs, starts, n_len,
                  block_s, k_true, k_nom, transient_s, settings):
     """The tracked scheme over the ramp (module docstring); its run and the estimator's
     accuracy."""
-    from ambseal.identify.fit import ClosedLoopModel
-    from ambseal.identify.rig_sim import reduced_plant
-    from ambseal.identify.tracking import OnlineTracker, TrackingSettings
-    from ambseal.model.amb import actuator_matrices
 
     N, k = e.shape
     T = 1.0 / fs
@@ -393,8 +391,6 @@ def frozen_cases(cfg, design, *, settings=None, impulse: bool = False) -> list[d
     -------
     list of dict
     """
-    from ambseal.model.rig import build_plant
-    from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
 
     s = settings or judge_settings(cfg)
     p0, rpm = cfg.operating.pressure_bar, cfg.operating.speed_rpm

@@ -67,12 +67,15 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.integrate import solve_ivp
 
-from ambseal.robust.controller import frozen, matrices_at
+from ambseal.analysis.loops import closed_loop, loop_responses, resolved_grid
+from ambseal.analysis.response import settling_time
 from ambseal.errors import ModelError
 from ambseal.lti.discrete import zoh
 from ambseal.lti.interconnect import feedback_matrices
-from ambseal.analysis.response import settling_time
+from ambseal.model.rig import build_plant
+from ambseal.robust.controller import frozen, matrices_at
 
 __all__ = ["StepResponse", "SpinupResult", "spinup", "FrozenSensitivity",
            "frozen_sensitivity"]
@@ -355,7 +358,6 @@ class _Ramp:
 
 def _run_ode(loop, wins, f0, f1, ramp_s, t, rtol, atol, solver, h):
     """The continuous time-varying loop with ``solve_ivp``, restarted at each step."""
-    from scipy.integrate import solve_ivp
 
     N = loop.n + loop.nk
     nt = t.size
@@ -479,8 +481,6 @@ def frozen_sensitivity(cfg, controller, speeds_hz, *, name: str = "K", omega=Non
     -------
     FrozenSensitivity
     """
-    from ambseal.model.rig import build_plant
-    from ambseal.analysis.loops import closed_loop, loop_responses, resolved_grid
 
     w = (_TWO_PI * np.logspace(0.0, np.log10(3000.0), 400) if omega is None
          else np.asarray(omega, float))

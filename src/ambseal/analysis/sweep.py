@@ -18,10 +18,15 @@ from __future__ import annotations
 
 import itertools
 
+import control
 import numpy as np
 
+from ambseal.analysis.campbell import closed_loop_state_matrix, lowest_log_decrement
 from ambseal.analysis.cases import CaseError, run_cases
+from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
+from ambseal.config import parse_rig, rig_with_values
 from ambseal.errors import ConfigError
+from ambseal.model.modes import bending_limit_hz
 
 __all__ = ["sweep", "sweep_case", "stability_boundary", "refine_boundary", "boundary_case",
            "parse_range"]
@@ -71,10 +76,6 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
         ``lowest_log_dec_hz``, ``sensitivity_peak`` (σ̄(S_o), -), ``iso_zone`` and
         ``iso_zone_<axis>``, ``unbalance_peak_um``.
     """
-    import control
-
-    from ambseal.analysis.campbell import lowest_log_decrement
-    from ambseal.analysis.judge import OperatingPoint, judge
 
     cfg = _case_rig(rig, case.get("params"))
     K = control.ss(*controllers[case["controller"]])
@@ -93,8 +94,6 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
 
 
 def _case_rig(rig: dict, params: dict | None):
-    from ambseal.config import parse_rig, rig_with_values
-
     cfg = parse_rig(rig, "<sweep rig>")
     return rig_with_values(cfg, params) if params else cfg
 
@@ -133,7 +132,6 @@ def sweep(cfg, controllers: dict, pressures_bar, speeds_hz, params: dict | None 
         the nominal rig's :func:`~ambseal.analysis.judge.judge_settings` (the same grids and
         disturbances across the map, also when ``params`` change the rig).
     """
-    from ambseal.model.modes import bending_limit_hz
 
     params = params or {}
     names = list(params)
@@ -141,7 +139,6 @@ def sweep(cfg, controllers: dict, pressures_bar, speeds_hz, params: dict | None 
               "params": dict(zip(names, (float(x) for x in vals)))}
              for c in controllers for p in pressures_bar for s in speeds_hz
              for vals in itertools.product(*(params[n] for n in names))]
-    from ambseal.analysis.judge import judge_settings
 
     # one judgement across the map: the grids and disturbances of the nominal rig, derived
     # once (about 0.1 s per derivation, as long as a case's own judgement)
@@ -188,9 +185,6 @@ def boundary_case(case: dict, rig: dict, controllers: dict, tol_bar: float) -> f
     """Bisect one bracket ``case = {controller, speed_hz, params, last_stable_bar,
     first_unstable_bar}`` of the stability boundary to ``tol_bar`` (bar) on the max real
     part of the closed-loop poles (the loop of :func:`sweep_case`)."""
-    import control
-
-    from ambseal.analysis.campbell import closed_loop_state_matrix
 
     cfg = _case_rig(rig, case.get("params"))
     K = control.ss(*controllers[case["controller"]])

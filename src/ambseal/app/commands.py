@@ -8,14 +8,57 @@ temporary name and a rename (:mod:`ambseal.files`).
 
 from __future__ import annotations
 
+import hashlib
 import math
 import sys
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
-from ambseal.config import load_rig
-from ambseal.errors import ConfigError
+import numpy as np
+
+from ambseal.analysis.judge import judge_settings, operating_points
+from ambseal.config import default_rig_path, dump_rig, load_rig, rig_with_values
+from ambseal.design.lpv_design import design_lpv
+from ambseal.design.pid import controller_from_metadata
+from ambseal.design.recipes import design, pid_from_rig
+from ambseal.design.specs import design_spec
+from ambseal.errors import ConfigError, DataError, IdentificationError, SynthesisError
+from ambseal.export.codegen import write_c
+from ambseal.export.controller_files import export_controller
 from ambseal.files import writable_folder, write_json, write_text
+from ambseal.identify.budget import advice
+from ambseal.identify.checks import frf_checks, truth_errors
+from ambseal.identify.data import load_measurement
+from ambseal.identify.design_model import design_rig, impulse_checks, truth_rig
+from ambseal.identify.procedure import thesis_procedure
+from ambseal.identify.residuals import MISMATCH
+from ambseal.identify.stages import check_record_metadata, identify, record_spread
+from ambseal.identify.static_load import load_static_record, static_ki, with_static
+from ambseal.identify.tracking import TrackingSettings, check_excitation, track
+from ambseal.model.amb import channel_names
+from ambseal.model.modes import modes
+from ambseal.model.rig import build_plant, build_system
+from ambseal.model.rotor import assemble_rotor, build_mesh
+from ambseal.model.seal import pressure_for_k, seal_values
+from ambseal.report.identify_figures import (
+    correlation_figure,
+    error_budget_figure,
+    fit_timeseries_figure,
+    residual_figure,
+)
+from ambseal.report.run_report import facility_impulse_report, identification_report
+from ambseal.report.tracking_figures import tracking_figure
+from ambseal.report.verdict import target_difference
+from ambseal.robust.controller import SPEED, ScheduledController
+from ambseal.robust.digital import (
+    check_rate,
+    design_rise,
+    digital_controller,
+    peak_difference,
+    sampled_plants,
+)
+from ambseal.robust.dk import design_omega
+from ambseal.robust.scheduled_digital import scheduled_digital
 
 __all__ = ["Designed", "Identified", "identification_stage", "facility_impulses", "design_files",
            "identify_files", "export_design", "show_defaults",
@@ -48,11 +91,6 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
     also checked between table entries (at speeds, or at the pressures that give the seal
     coefficient it is scheduled on). ``cache`` (a dict kept by the caller) shares the
     sampled plants and the μ design's grid between the controllers of one rig."""
-    import numpy as np
-
-    from ambseal.robust.controller import ScheduledController
-    from ambseal.robust.digital import check_rate, design_rise, digital_controller, sampled_plants
-    from ambseal.model.rig import build_plant
 
     fs, delay = cfg.controller.sample_rate_hz, cfg.controller.delay_samples
     conds = _conditions(cfg, points)
@@ -63,9 +101,6 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
         return tuple(np.asarray(X, float) for X in (G.A, G.B, G.C, G.D))
 
     if not isinstance(controller, ScheduledController):
-        from ambseal.robust.dk import design_omega
-        from ambseal.design.specs import design_spec
-
         cache = {} if cache is None else cache
         if method in ("hinf", "mu") and "omega" not in cache:  # the μ design's grid
             cache["omega"] = design_omega(*design_spec(cfg).synthesis_band_hz)
@@ -77,9 +112,6 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
                                              delay_samples=delay)
         return digital_controller(controller, fs, cache["plants"],
                                   delay_samples=delay, rise=rise)
-    from ambseal.robust.controller import SPEED
-    from ambseal.robust.scheduled_digital import scheduled_digital
-    from ambseal.model.seal import pressure_for_k, seal_values
 
     W = np.asarray(controller.K.speeds_rad_s, float)  # the LPV table's θ (speeds or SI)
     # between table entries at 1/8, 3/8, 5/8, 7/8 of the table: the interpolation judged
@@ -116,7 +148,6 @@ def digitals_for(cfg, designs, points, say=None) -> tuple[dict, dict]:
         ``{method: DigitalController}`` and ``{method: one line saying which controller
         cannot run and why}``.
     """
-    from ambseal.errors import SynthesisError
 
     cache: dict = {}
     digitals, cannot_run = {}, {}
@@ -138,10 +169,6 @@ def target_pid(cfg):
     exports and judges (:class:`~ambseal.robust.digital_loop.DiscreteController`, with its
     discretisation in ``description``) — the one that levitates the virtual facility in
     ``ambseal acquire`` and the main job's identification."""
-    from dataclasses import replace
-
-    from ambseal.analysis.judge import operating_points
-    from ambseal.design.recipes import design, pid_from_rig
 
     res = design(cfg, "pid")
     dc = digital_for(cfg, "pid", res.K, res, operating_points(cfg))
@@ -183,7 +210,6 @@ def export_design(method: str, digital, summary_dict: dict, out: Path, judged=No
     """Write a designed controller as it runs (``controller_<method>.json/.npz/.mat``,
     :func:`ambseal.export.controller_files.export_controller`) with the judged discrete margins,
     and its design summary with the discretisation (``design_<method>.json``)."""
-    from ambseal.export.controller_files import export_controller
 
     files = [export_controller(digital, out / f"controller_{method}{ext}", judged)
              for ext in (".json", ".npz", ".mat")]
@@ -195,7 +221,6 @@ def export_design(method: str, digital, summary_dict: dict, out: Path, judged=No
 def show_defaults(rig: str | Path, overrides=()) -> str:
     """``ambseal design RIG --show-defaults``: the rig's resolved ``[design]`` part as TOML
     with the rule behind each value (:meth:`ambseal.design.specs.DesignSpec.to_toml`)."""
-    from ambseal.design.specs import design_spec
 
     cfg = load_rig(rig, overrides)
     return f"# {cfg.rotor.name}: resolved design specification\n" + design_spec(cfg).to_toml()
@@ -206,9 +231,6 @@ def export_all(designs, digitals: dict, cases: list[dict], out: Path) -> dict:
     discrete margins) and as C (:func:`ambseal.export.codegen.write_c`); returns the
     design summaries with their ``discretisation`` for ``metrics.json`` (``None`` for a
     controller without a digital one in ``digitals``: nothing of it is exported)."""
-    from ambseal.export.codegen import write_c
-    from ambseal.robust.digital import peak_difference
-    from ambseal.report.verdict import target_difference
 
     summaries = {}
     for d in designs:
@@ -254,11 +276,6 @@ def identification_stage(cfg, truth, out: Path, say, controller) -> Identified:
     checks of the identified model, its figures and report section, and the rig to design
     on. ``controller`` is the exported, judged discrete reference PID (the facility runs
     exactly that object)."""
-    from ambseal.config import dump_rig
-    from ambseal.identify.checks import frf_checks, truth_errors
-    from ambseal.identify.design_model import design_rig, truth_rig
-    from ambseal.identify.procedure import thesis_procedure
-    from ambseal.report.run_report import identification_report
 
     res = thesis_procedure(cfg, truth, controller, progress=say)
     write_json(out / "identification.json", res.to_dict())
@@ -285,8 +302,6 @@ def facility_impulses(cfg, truth, ident: Identified, digitals: dict, out: Path) 
     """Each digital controller on the virtual facility and on the identified model: impulse
     responses at 0 bar and the nominal pressure drop (P5 Figs. 15–16), into ``ident``'s
     summary, figures and report sections."""
-    from ambseal.identify.design_model import impulse_checks
-    from ambseal.report.run_report import facility_impulse_report
 
     ctrls = {m: d.discrete for m, d in digitals.items() if hasattr(d, "discrete")}
     checks = impulse_checks(cfg, ident.result.identified, truth, ctrls,
@@ -318,13 +333,10 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
     SynthesisError
         No discretisation keeps the sampled loop stable (the reason named).
     """
-    from ambseal.design.recipes import design
 
     cfg = load_rig(rig, overrides)
     out = writable_folder(out_dir)  # before the design, not after it
     if method == "lpv":
-        from ambseal.design.lpv_design import design_lpv
-
         if cfg.operating.speed_range_hz is None:
             raise ConfigError(f"{rig}: operating.speed_range_hz: an LPV design needs the "
                               "speed range it is scheduled over, e.g. [20.0, 300.0]")
@@ -335,15 +347,12 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
         res = design(cfg, method, pressure_bar=pressure_bar, allow_unstable=allow_unstable,
                      progress=lambda line: print(f"ambseal: {line}", file=sys.stderr))
         K, summary = res.K, res.to_dict()
-    from ambseal.analysis.judge import operating_points
 
     points = operating_points(cfg)
     digital = digital_for(cfg, method, K, res, points)
     judged = choice_margins(cfg, points, digital)
     files = export_design(method, digital, summary, out, judged)
     if c_dir is not None:
-        from ambseal.export.codegen import write_c
-
         files += write_c(digital, c_dir, f"ambseal_{method}", precision=precision)
     short = res.summary() if hasattr(res, "summary") else summary
     return {**short, "discretisation": digital.to_dict(),
@@ -352,7 +361,6 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
 
 def _record_hash(meas) -> str:
     """SHA-256 of a record's samples (time, excitation, currents, displacements)."""
-    import hashlib
 
     h = hashlib.sha256()
     for a in (meas.time_s, meas.excitation_a, meas.current_ref_a, meas.current_a,
@@ -364,9 +372,6 @@ def _record_hash(meas) -> str:
 def _check_records(records: list, paths: list[str]) -> None:
     """Refuse a record given twice (same samples: it would narrow the intervals by √2) and
     a record without excitation (nothing to identify)."""
-    import numpy as np
-
-    from ambseal.errors import DataError
 
     seen: dict[str, str] = {}
     for meas, path in zip(records, paths):
@@ -382,7 +387,6 @@ def _check_records(records: list, paths: list[str]) -> None:
 
 def _static_load(cfg, res, path: str) -> tuple:
     """(the fit joined with the static-load Ki of ``path``, its summary)."""
-    from ambseal.identify.static_load import load_static_record, static_ki, with_static
 
     return with_static(res, static_ki(cfg, *load_static_record(path, cfg),
                                       values=dict(zip(res.names, res.estimate)),
@@ -419,16 +423,6 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
         A bad rig, a bad, duplicate, unexcited or mismatched record, a fit that cannot
         start, or (without ``accept_unconverged``) a fit that failed.
     """
-    from ambseal.config import dump_rig, rig_with_values
-    from ambseal.design.pid import controller_from_metadata
-    from ambseal.errors import DataError
-    from ambseal.identify.budget import advice
-    from ambseal.identify.data import load_measurement
-    from ambseal.identify.residuals import MISMATCH
-    from ambseal.identify.stages import check_record_metadata, identify, record_spread
-    from ambseal.model.amb import channel_names
-    from ambseal.report.identify_figures import (correlation_figure, error_budget_figure,
-                                          fit_timeseries_figure, residual_figure)
 
     cfg = load_rig(rig)
     out = writable_folder(out_dir)  # before the fit, not after it
@@ -468,8 +462,6 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
                                   **({"per_record": spread} if spread else {}),
                                   **({"static_load": static} if static else {})})
     if not res.converged and not accept_unconverged:
-        from ambseal.errors import IdentificationError
-
         (out / "identified.toml").unlink(missing_ok=True)  # an earlier fit's: not this one's
         raise IdentificationError(f"identify: the fit failed ({res.message}); {out / 'fit.json'}"
                                   " has the details, no identified rig was written "
@@ -517,15 +509,6 @@ def validate_summary(rig: str | Path | None = None) -> dict:
     ConfigError
         The rig file does not parse or check.
     """
-    from dataclasses import asdict
-
-    from ambseal.analysis.judge import judge_settings, operating_points
-    from ambseal.config import default_rig_path
-    from ambseal.design.specs import design_spec
-    from ambseal.model.amb import channel_names
-    from ambseal.model.modes import modes
-    from ambseal.model.rig import build_plant, build_system
-    from ambseal.model.rotor import assemble_rotor, build_mesh
 
     cfg = load_rig(rig)
     spec = design_spec(cfg)
@@ -564,13 +547,6 @@ def track_files(rig: str | Path, data: list[str], names: list[str], out_dir: str
         A bad rig; a bad record, one whose excitation exceeds the current limit, or one too
         short; a name without an LFT channel.
     """
-    import numpy as np
-
-    from ambseal.design.pid import controller_from_metadata
-    from ambseal.identify.data import load_measurement
-    from ambseal.identify.tracking import TrackingSettings, check_excitation, track
-    from ambseal.model.amb import channel_names
-    from ambseal.report.tracking_figures import tracking_figure
 
     cfg = load_rig(rig)
     axes = channel_names(cfg)

@@ -12,10 +12,40 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
+from ambseal.analysis.cases import run_cases
+from ambseal.analysis.judge import (
+    frozen_at,
+    judge_case,
+    judge_jobs,
+    judge_settings,
+    judge_spinup,
+    operating_points,
+    speed_scheduled,
+    unstable_open_loop_poles,
+)
+from ambseal.app.commands import (
+    Designed,
+    digitals_for,
+    export_all,
+    facility_impulses,
+    identification_stage,
+)
+from ambseal.app.tracked import tracked_designs, tracked_ramp
 from ambseal.config import RigConfig, default_rig_path, load_rig, load_truth
-from ambseal.app.commands import Designed
+from ambseal.design.lpv_design import design_frozen, design_lpv
+from ambseal.design.recipes import design
+from ambseal.design.specs import design_spec
 from ambseal.errors import ConfigError
 from ambseal.files import RunFolder, write_json
+from ambseal.model.rig import build_plant
+from ambseal.report.progress import StageProgress
+from ambseal.report.run_report import (
+    gains_figure,
+    rig_clearances_um,
+    spinup_figures,
+    stamp,
+    write_run_report,
+)
 
 __all__ = ["RunResult", "run", "default_truth_path"]
 
@@ -46,8 +76,6 @@ def _controllers(cfg: RigConfig, spec, say, allow_unstable: bool = False,
     one step per design, messages in between. ``methods`` limits the pressure-driven case
     (the PID alone before identification, H∞ and μ on the identified rig after it).
     """
-    from ambseal.analysis.judge import speed_scheduled
-    from ambseal.design.recipes import design
 
     def lti(res) -> Designed:
         return Designed(res.method, res.K, res.summary(), res)
@@ -60,8 +88,6 @@ def _controllers(cfg: RigConfig, spec, say, allow_unstable: bool = False,
         return d
 
     if speed_scheduled(cfg):
-        from ambseal.design.lpv_design import design_frozen, design_lpv
-
         out = [lti(design(cfg, "pid"))]
         say("pid designed", 1)
         fz = design_frozen(cfg, cfg.operating.speed_rpm / 60.0, allow_unstable=allow_unstable)
@@ -127,17 +153,6 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         A controller that does not stabilise the full-order plant (without
         ``allow_unstable``).
     """
-    from ambseal.analysis.judge import (frozen_at, judge_case, judge_jobs, judge_settings,
-                                 judge_spinup, operating_points, speed_scheduled,
-                                 unstable_open_loop_poles)
-    from ambseal.analysis.cases import run_cases
-    from ambseal.design.specs import design_spec
-    from ambseal.app.commands import digitals_for, export_all, facility_impulses, identification_stage
-    from ambseal.model.rig import build_plant
-    from ambseal.app.tracked import tracked_designs, tracked_ramp
-    from ambseal.report.progress import StageProgress
-    from ambseal.report.run_report import (gains_figure, rig_clearances_um, spinup_figures, stamp,
-                                    write_run_report)
 
     rig_path = Path(rig) if rig is not None else default_rig_path()
     cfg = load_rig(rig_path, overrides)
@@ -152,7 +167,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
     settings = judge_settings(cfg, spec)
     final = Path(out_dir)
     n_designs = 4 if speed_scheduled(cfg) else 3
-    n_tr = int(cfg.design.tracked)  # issue 14, off by default: minutes of LMI synthesis
+    n_tr = int(cfg.design.tracked)  # off by default: minutes of LMI synthesis
     totals = {"model": 1, "design": n_designs, "judge": (n_designs + n_tr) * len(points),
               "identification": None, "design (identified)": 2 + n_tr, "spin-up": 1,
               "ramp": 1, "report": 1}

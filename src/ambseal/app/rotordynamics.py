@@ -3,8 +3,8 @@
 Wiring only, like :mod:`ambseal.app.commands`: the numbers come from
 :mod:`ambseal.analysis.campbell`, :mod:`ambseal.analysis.sweep` and :mod:`ambseal.io.ross`,
 the figures from :mod:`ambseal.report.modal_figures`, and every file is written through a
-temporary name and a rename (:mod:`ambseal.files`). The CLI (:mod:`ambseal.cli`) adds these
-subcommands with :func:`add_parsers` and runs them with :data:`HANDLERS`.
+temporary name and a rename (:mod:`ambseal.files`). The CLI (:mod:`ambseal.cli`) parses these
+subcommands and runs them with :data:`HANDLERS`.
 """
 
 from __future__ import annotations
@@ -13,13 +13,24 @@ import argparse
 import csv
 import io
 import json
+import sys
 from pathlib import Path
 
+from ambseal.analysis.campbell import campbell, closed_loop_modes, modes_of_state_matrix
+from ambseal.analysis.cases import dask_available
+from ambseal.analysis.sweep import parse_range, refine_boundary, stability_boundary, sweep
 from ambseal.config import load_rig
+from ambseal.design.recipes import METHODS, design
 from ambseal.errors import ConfigError
-from ambseal.files import write_json, write_text
+from ambseal.export.controller_files import load_controller
+from ambseal.files import atomic_write, write_json, write_text
+from ambseal.io.ross import import_ross_file
+from ambseal.model.modes import bending_limit_hz, modes
+from ambseal.model.rig import build_system
+from ambseal.report.modal_figures import campbell_figure, mode_shapes_figure, stability_map_figure
+from ambseal.robust.digital import DigitalController
 
-__all__ = ["add_parsers", "HANDLERS", "controller_for", "write_table"]
+__all__ = ["HANDLERS", "controller_for", "write_table"]
 
 
 def controller_for(cfg, spec: str | None, pressure_bar: float | None = None):
@@ -28,15 +39,12 @@ def controller_for(cfg, spec: str | None, pressure_bar: float | None = None):
     ``ambseal design`` (.json, .npz, .mat); ``None`` or ``"none"`` for the open loop."""
     if spec is None or spec == "none":
         return None
-    from ambseal.design.recipes import METHODS, design
 
     if spec in METHODS:
         return design(cfg, spec, pressure_bar=pressure_bar).K
     if Path(spec).suffix.lower() not in (".json", ".npz", ".mat"):
         raise ConfigError(f"--controller: expected pid, hinf, mu, none or a controller file "
                           f"(.json, .npz, .mat), got {spec!r}")
-    from ambseal.robust.digital import DigitalController
-    from ambseal.export.controller_files import load_controller
 
     K = load_controller(spec)  # a judged digital controller: its continuous design
     return K.continuous if isinstance(K, DigitalController) else K
@@ -52,11 +60,10 @@ def write_table(path: Path, rows: list[dict]) -> list[Path]:
     w.writerows(rows)
     files = [write_text(path, buf.getvalue())]
     try:
-        import pyarrow as pa
-        import pyarrow.parquet as pq
+        import pyarrow as pa  # optional: Parquet tables where pyarrow is installed
+        import pyarrow.parquet as pq  # optional, as above
     except ImportError:
         return files
-    from ambseal.files import atomic_write
 
     table = pa.Table.from_pylist([{c: r.get(c) for c in cols} for r in rows])
     pq_path = path.with_suffix(".parquet")
@@ -70,16 +77,10 @@ def _positions(cfg) -> dict[str, list[float]]:
 
 
 def _range(text: str | None, name: str):
-    from ambseal.analysis.sweep import parse_range
-
     return None if text is None else parse_range(text, name)
 
 
 def _modes(args: argparse.Namespace) -> int:
-    from ambseal.analysis.campbell import closed_loop_modes, modes_of_state_matrix
-    from ambseal.model.modes import bending_limit_hz, modes
-    from ambseal.model.rig import build_system
-
     cfg = load_rig(args.rig)
     p = cfg.operating.pressure_bar if args.pressure_bar is None else args.pressure_bar
     rpm = cfg.operating.speed_rpm if args.speed_rpm is None else args.speed_rpm
@@ -107,8 +108,6 @@ def _modes(args: argparse.Namespace) -> int:
            "log_decrements": [float(x) for x in m.log_decrement], "whirl": list(m.whirl),
            "unstable_poles": [list(z) for z in unstable]}
     if args.shapes is not None:
-        from ambseal.report.modal_figures import mode_shapes_figure
-
         out["shapes"] = str(mode_shapes_figure(Path(args.shapes), m, _positions(cfg)))
     if args.json:
         print(json.dumps(out, indent=2))
@@ -131,9 +130,6 @@ def _modes(args: argparse.Namespace) -> int:
 
 
 def _campbell(args: argparse.Namespace) -> int:
-    from ambseal.analysis.campbell import campbell
-    from ambseal.report.modal_figures import campbell_figure, mode_shapes_figure
-
     cfg = load_rig(args.rig)
     p = cfg.operating.pressure_bar if args.pressure_bar is None else args.pressure_bar
     speeds = _range(args.speed_hz, "--speed-hz")
@@ -165,10 +161,6 @@ def _campbell(args: argparse.Namespace) -> int:
 
 
 def _sweep(args: argparse.Namespace) -> int:
-    from ambseal.analysis.cases import dask_available
-    from ambseal.analysis.sweep import refine_boundary, stability_boundary, sweep
-    from ambseal.report.modal_figures import stability_map_figure
-
     cfg = load_rig(args.rig)
     pressures = _range(args.pressure_bar, "--pressure-bar")
     speeds = _range(args.speed_hz, "--speed-hz")
@@ -185,8 +177,6 @@ def _sweep(args: argparse.Namespace) -> int:
         params[name.strip()] = _range(rng, f"--param {name}")
     workers = args.workers
     if workers is None and args.scheduler is None and not dask_available():
-        import sys
-
         print("ambseal: note: dask is not installed; the sweep runs serially",
               file=sys.stderr)
         workers = 1
@@ -208,77 +198,9 @@ def _sweep(args: argparse.Namespace) -> int:
 
 
 def _import_ross(args: argparse.Namespace) -> int:
-    from ambseal.io.ross import import_ross_file
-
     res = import_ross_file(args.file, args.out)
     print(json.dumps(res))
     return 0
-
-
-def add_parsers(sub, positive_int) -> None:
-    """Add ``modes``, ``campbell``, ``sweep`` and ``import-ross`` to the CLI's subparsers."""
-    m = sub.add_parser("modes", help="natural frequencies, damping, log decrement, whirl, "
-                                     "unstable poles and mode shapes")
-    m.add_argument("rig", nargs="?", help="rig file (TOML); default: the embedded thesis test "
-                                          "facility")
-    m.add_argument("--speed-rpm", type=float, default=None, help="spin speed (rpm)")
-    m.add_argument("--pressure-bar", type=float, default=None, help="seal pressure drop (bar)")
-    m.add_argument("--json", action="store_true", help="print JSON instead of a table")
-    m.add_argument("--n-modes", type=positive_int, default=None,
-                   help="only the N lowest modes (sparse shift-invert; unstable poles up to "
-                        "the N-th mode only)")
-    m.add_argument("--max-hz", type=float, default=None,
-                   help="modes up to this frequency (Hz); default 1.25x the third free-free "
-                        "bending frequency")
-    m.add_argument("--controller", default=None,
-                   help="close the loop: pid, hinf, mu or a controller file (default: the "
-                        "open-loop model)")
-    m.add_argument("--shapes", nargs="?", const="mode_shapes.png", default=None,
-                   metavar="PNG", help="plot the mode shapes (default file mode_shapes.png)")
-    g = m.add_mutually_exclusive_group()
-    g.add_argument("--free", action="store_true", help="bare rotor: shaft and disks only")
-    g.add_argument("--no-amb", action="store_true", help="leave the AMBs out")
-
-    c = sub.add_parser("campbell", help="closed-loop Campbell diagram and log decrements")
-    c.add_argument("rig", help="rig file (TOML)")
-    c.add_argument("--controller", default=None,
-                   help="pid, hinf, mu, none or a controller file (default pid, else hinf)")
-    c.add_argument("--speed-hz", default=None, help="speeds a:b:n (Hz); default 0 to 1.2x "
-                   "the top speed (or the first free-free bending frequency), 31 points")
-    c.add_argument("--pressure-bar", type=float, default=None,
-                   help="seal pressure drop (bar); default [operating] pressure_bar")
-    c.add_argument("--max-hz", type=float, default=None, help="highest mode frequency (Hz)")
-    c.add_argument("--log-dec-limit", type=float, default=0.1,
-                   help="flag modes below this log decrement (API 684: 0.1)")
-    c.add_argument("--out", default="ambseal-campbell", help="output folder")
-    _executor_args(c)
-
-    s = sub.add_parser("sweep", help="stability and performance map over pressure x speed")
-    s.add_argument("rig", help="rig file (TOML)")
-    s.add_argument("--pressure-bar", required=True, help="pressure drops a:b:n (bar)")
-    s.add_argument("--speed-hz", default="0", help="speeds a:b:n (Hz), default 0")
-    s.add_argument("--controller", default=None,
-                   help="pid, hinf, mu or controller files, comma separated (default pid)")
-    s.add_argument("--param", action="append", metavar="NAME=a:b:n",
-                   help="a rig parameter to sweep too, e.g. seal.k=0:2e6:5 (repeatable)")
-    s.add_argument("--max-hz", type=float, default=None,
-                   help="modes of the lowest log decrement up to this frequency (Hz)")
-    s.add_argument("--tol-bar", type=float, default=0.01,
-                   help="the stability boundary is bisected to this pressure (bar)")
-    s.add_argument("--out", default="ambseal-sweep", help="output folder")
-    _executor_args(s)
-
-    r = sub.add_parser("import-ross", help="a ROSS rotor file (.toml/.json) as an ambseal rig")
-    r.add_argument("file", help="ROSS rotor file saved by ross.Rotor.save")
-    r.add_argument("--out", required=True, help="rig file to write (TOML)")
-
-
-def _executor_args(p) -> None:
-    g = p.add_mutually_exclusive_group()
-    g.add_argument("--workers", type=int, default=None,
-                   help="local Dask worker processes (1: serial; default: serial for small "
-                        "runs, one per core for large ones)")
-    g.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
 
 
 HANDLERS = {"modes": _modes, "campbell": _campbell, "sweep": _sweep,

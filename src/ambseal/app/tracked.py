@@ -1,4 +1,4 @@
-"""``ambseal run``'s ``tracked`` controller (``[design] tracked = true``; issue 14 §3).
+"""``ambseal run``'s ``tracked`` controller (``[design] tracked = true``).
 
 Wiring only, beside :mod:`ambseal.app.commands`: the controller scheduled on the first seal's
 cross-coupled stiffness k (:func:`ambseal.design.seal_schedule.design_seal_scheduled`,
@@ -13,7 +13,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ambseal.analysis.judge import speed_scheduled
+from ambseal.analysis.ramp import ramp_simulation
+from ambseal.app.commands import Designed, digitals_for
+from ambseal.design.seal_schedule import design_seal_scheduled
 from ambseal.errors import ConfigError
+from ambseal.report.tracking_figures import ramp_figure
 
 __all__ = ["tracked_designs", "tracked_ramp"]
 
@@ -31,10 +36,6 @@ def tracked_designs(cfg, design_cfg, points, say, digitals: dict, cannot_run: di
         A rig whose seal forces follow the speed (its LPV controller is the scheduled one)
         or that has no seal.
     """
-    from ambseal.analysis.judge import speed_scheduled
-    from ambseal.app.commands import digitals_for
-    from ambseal.design.seal_schedule import design_seal_scheduled
-    from ambseal.app.commands import Designed
 
     if not cfg.design.tracked:
         return []
@@ -57,8 +58,6 @@ def tracked_ramp(cfg, truth, designs, digitals: dict, ident, out: Path, say
     """The 0 → 3× nominal ramp on the virtual facility, the tracker's model the rig
     identified by ``ident`` (``commands.Identified``): ``metrics.json``'s ``ramp`` and the
     report's figure (caption, path); one step of ``say(message, steps)`` at the end."""
-    from ambseal.analysis.ramp import ramp_simulation
-    from ambseal.report.tracking_figures import ramp_figure
 
     tracked = next(d.controller for d in designs if d.method == "tracked")
     fixed = {m: g.discrete for m, g in digitals.items() if m != "tracked"}
@@ -73,7 +72,7 @@ def tracked_ramp(cfg, truth, designs, digitals: dict, ident, out: Path, say
                f"{100 * (t.get('max_error_rel') or float('nan')):.1f} % of nominal, 95 % "
                f"interval coverage {100 * (t.get('coverage') or float('nan')):.1f} %), "
                "displacement and current of every controller, impulse peaks and settling "
-               "times (issue 14)")
+               "times")
     fig = ramp_figure(out / "ramp.png", r)
     say("ramp done", 1)
     return r.to_dict(), (caption, fig)

@@ -6,10 +6,26 @@ springs, controllers, operating points, the facility truth) and its ``[design]``
 :mod:`ambseal.config._checks`. Every other layer receives the typed models from here.
 """
 
-from ambseal.config.rig import (Actuator, Affine, Amb, AxisPair, Coefficient, FrequencyTable,
-                                RigConfig, Seal, Spring, TruthSection, apply_overrides,
-                                check_operating, default_rig_path, dump_rig, load_rig,
-                                load_truth, parse_rig, rig_with_values)
+from ambseal.config.rig import (
+                                Actuator,
+                                Affine,
+                                Amb,
+                                AxisPair,
+                                Coefficient,
+                                FrequencyTable,
+                                RigConfig,
+                                Seal,
+                                Spring,
+                                TruthSection,
+                                apply_overrides,
+                                check_operating,
+                                default_rig_path,
+                                dump_rig,
+                                load_rig,
+                                load_truth,
+                                parse_rig,
+                                rig_with_values,
+)
 
 __all__ = ["Actuator", "Affine", "Amb", "AxisPair", "Coefficient", "FrequencyTable",
            "RigConfig", "Seal", "Spring", "TruthSection", "apply_overrides",

@@ -47,7 +47,7 @@ schema). Units are SI except where the key names its unit.
     and ``iteration``: ``"dgk"`` (default: D–G–K, the real parameters kept real in the
     synthesis, Young 1996) or ``"dk"`` (complex D–K, every block treated as complex).
 ``[design] tracked`` (bool, default false)
-    ``ambseal run`` adds the ``tracked`` controller (issue 14): scheduled on the first
+    ``ambseal run`` adds the ``tracked`` controller: scheduled on the first
     seal's k as tracked on line (:mod:`ambseal.design.seal_schedule`), judged at the
     judged pressures frozen at the identified k there, and run on the virtual facility's
     0 → 3× nominal pressure ramp with the other controllers and the tracker

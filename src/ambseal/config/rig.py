@@ -61,15 +61,20 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-
 from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from ambseal.config._checks import (MAX_ELEMENTS, MAX_REDUCED_STATES, check_actuator, check_amb,
-                            cross_check)
+from ambseal.config._checks import (
+    MAX_ELEMENTS,
+    MAX_REDUCED_STATES,
+    check_actuator,
+    check_amb,
+    cross_check,
+)
 from ambseal.config.design import Design, apply_overrides, check_design_names
-from ambseal.errors import PRIMITIVE_TAGS, ConfigError, describe_validation_error
+from ambseal.errors import PRIMITIVE_TAGS, AmbsealError, ConfigError, describe_validation_error
+from ambseal.files import load_toml
 
 __all__ = [
     "RigConfig",
@@ -95,7 +100,7 @@ _NAME = Field(min_length=1, max_length=64, pattern=r"^[^.,\s]+$")
 
 
 class _Strict(BaseModel):
-    # strict: no bool → number, no string → number, no float → int (issue 15 §1)
+    # strict: no bool → number, no string → number, no float → int
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
 
 
@@ -450,8 +455,6 @@ def load_rig(path: str | Path | None = None, overrides=()) -> RigConfig:
 def _load_toml(path: Path, what: str) -> dict:
     """TOML of a rig or truth file; ConfigError naming the file when it cannot be read, is
     not UTF-8 text (a byte-order mark is accepted), not TOML or nested too deeply."""
-    from ambseal.errors import AmbsealError
-    from ambseal.files import load_toml
 
     try:
         return load_toml(path, what)

@@ -41,10 +41,16 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from ambseal.design.lpv_plant import lpv_plant, vertex_grid_hz
+from ambseal.design.plant import generalized_plant, physical_controller, physical_matrices
+from ambseal.design.recipes import full_order_check
+from ambseal.design.specs import design_spec
+from ambseal.design.weights import Weights, default_weights
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.robust.controller import SPEED, ScheduledController
-from ambseal.design.plant import physical_controller, physical_matrices
-from ambseal.design.weights import Weights, default_weights
+from ambseal.robust.dk import design_omega, musyn
+from ambseal.robust.hinf import hinfsyn
+from ambseal.robust.lpv import lpvsyn
 
 __all__ = ["LpvDesign", "FrozenDesign", "design_lpv", "design_frozen",
            "lpv_generalized_plants", "check_full_order"]
@@ -196,8 +202,6 @@ def check_full_order(cfg, controller_at, name: str, allow_unstable: bool = False
         A loop is unstable (unless ``allow_unstable``): the mode (Hz, ζ), the condition and
         the remedy (the design model keeps the rigid-body modes only, P3 §2.2).
     """
-    from ambseal.design.recipes import full_order_check
-    from ambseal.design.specs import design_spec
 
     sp = design_spec(cfg)
     checks = [full_order_check(cfg, controller_at(f), [(p, f)])
@@ -216,7 +220,6 @@ def check_full_order(cfg, controller_at, name: str, allow_unstable: bool = False
 def _spec_weights(cfg) -> Weights:
     """The rig's LPV weights: ``[design.lpv]`` completed by the rules of
     :func:`ambseal.design.specs.design_spec` (D_e, D_u and W_u from the machine)."""
-    from ambseal.design.specs import design_spec
 
     return design_spec(cfg).weights["lpv"]
 
@@ -227,7 +230,6 @@ def lpv_generalized_plants(L, weights: Weights, speeds_rad_s=None):
 
     Returns a list of :class:`ambseal.design.plant.GeneralizedPlant` in one state basis.
     """
-    from ambseal.design.plant import generalized_plant
 
     Wp, Wu = weights.Wp(), weights.Wu()
     W = L.speeds_rad_s if speeds_rad_s is None else np.asarray(speeds_rad_s, float)
@@ -300,8 +302,6 @@ def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int | None = None,
     >>> d = design_lpv(load_rig("examples/turboexpander.toml"))   # doctest: +SKIP
     >>> K = d.controller_at(140.0)                                 # doctest: +SKIP
     """
-    from ambseal.robust.lpv import lpvsyn
-    from ambseal.design.lpv_plant import lpv_plant, vertex_grid_hz
 
     t0 = time.perf_counter()
     w = weights or _spec_weights(cfg)
@@ -329,8 +329,6 @@ def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int | None = None,
     dA[:, :n, :n] = L.dA
     fg = np.full(grid.size, np.nan)
     if frozen_gamma:
-        from ambseal.robust.hinf import hinfsyn
-
         fg = np.array([hinfsyn(p, nmeas, ncon).gamma for p in P])
     r = lpvsyn(P, L.speeds_rad_s, nmeas, ncon, dA=dA, lyapunov=lyapunov, rate_bound=nu,
                **lpvsyn_kw)
@@ -382,7 +380,6 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
         From the synthesis; an unstable full-order loop at a judged condition
         (:func:`check_full_order`).
     """
-    from ambseal.design.lpv_plant import lpv_plant
 
     if method not in ("hinf", "mu"):
         raise ConfigError(f"design_frozen: method={method!r}, expected 'hinf' or 'mu'")
@@ -390,16 +387,11 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
     w = weights or _spec_weights(cfg)
     f = float(speed_hz)
     if method == "hinf":
-        from ambseal.robust.hinf import hinfsyn
-
         L = lpv_plant(cfg, [f, f + 1.0], states=states, reference_speed_hz=f)
         gp = lpv_generalized_plants(L, w, [_TWO_PI * f])[0]
         r = hinfsyn(gp.P_nominal, gp.nmeas, gp.ncon)
         K_P, gamma = r.K, float(r.gamma)
     else:
-        from ambseal.robust.dk import design_omega, musyn
-        from ambseal.design.plant import generalized_plant
-
         if not getattr(cfg, "seal", None):
             raise ConfigError("design_frozen(method='mu'): the uncertain parameter is the "
                               "seal's k, but the rig has no [[seal]]")
@@ -411,8 +403,6 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
                                d_e=w.d_e, d_u=w.d_u)
         om = kw.pop("omega", None)
         if om is None:
-            from ambseal.design.specs import design_spec
-
             om = design_omega(*design_spec(cfg_f).synthesis_band_hz)
         r = musyn(gp.P, gp.blocks, gp.nmeas, gp.ncon, om, **kw)
         K_P, gamma = r.K, float(r.mu)

@@ -26,11 +26,18 @@ parameter changes). The actuator (P3 Eq. 2) is then put in series, as in
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
+import scipy.linalg as sla
 
+from ambseal.config import FrequencyTable
 from ambseal.errors import ModelError
+from ambseal.model.amb import actuator_matrices, eddy_lag_matrices
+from ambseal.model.lft import Plant
+from ambseal.model.reduction import modal_reduction
+from ambseal.model.rig import build_system, mechanical_plant
+from ambseal.model.seal import coefficient_value
 
 __all__ = ["LpvPlant", "lpv_plant", "vertex_grid_hz"]
 
@@ -105,7 +112,6 @@ class LpvPlant:
 
     def plant_at(self, speed_rad_s: float):
         """The frozen plant at Ω as an :class:`ambseal.model.lft.Plant` (no LFT channels)."""
-        from ambseal.model.lft import Plant
 
         return Plant(A=self.A_at(speed_rad_s), B=self.B, C=self.C, D=self.D,
                      input_names=self.input_names, output_names=self.output_names,
@@ -146,7 +152,6 @@ def vertex_grid_hz(cfg, speeds_hz) -> np.ndarray:
     ndarray, shape (n_p,)
         Strictly increasing speeds (Hz), n_p ≥ 2.
     """
-    from ambseal.config import FrequencyTable
 
     lo, hi = (float(x) for x in speeds_hz)
     inner = {float(f) for seal in cfg.seal for key in "KkCc"
@@ -197,14 +202,6 @@ def lpv_plant(cfg, speeds_hz, *, reference_speed_hz: float | None = None,
         A grid with fewer than two points, not increasing, or a negative speed; a failing
         modal reduction.
     """
-    from dataclasses import replace
-
-    import scipy.linalg as sla
-
-    from ambseal.model.amb import actuator_matrices, eddy_lag_matrices
-    from ambseal.model.reduction import modal_reduction
-    from ambseal.model.rig import build_system, mechanical_plant
-    from ambseal.model.seal import coefficient_value
 
     f = np.asarray(speeds_hz, float).ravel()
     if f.size < 2:
@@ -216,8 +213,6 @@ def lpv_plant(cfg, speeds_hz, *, reference_speed_hz: float | None = None,
         states = cfg.reduction.states or 8
     for seal in cfg.seal:
         if not isinstance(seal.M, (int, float)) and seal.frequency_dependent:
-            from ambseal.config import FrequencyTable
-
             if isinstance(seal.M, FrequencyTable):
                 raise ModelError(f"LPV plant: seal {seal.name!r} has a frequency-tabulated "
                                  "mass coefficient M, which the LPV model does not support")

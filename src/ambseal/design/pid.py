@@ -4,7 +4,20 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import control
 import numpy as np
+
+from ambseal.design.conditions import judged_conditions
+from ambseal.errors import DataError
+from ambseal.identify import stages
+from ambseal.lti.discrete import zoh
+from ambseal.lti.interconnect import feedback_matrices
+from ambseal.lti.pickling import picklable
+from ambseal.model.amb import amb_factors, channel_names
+from ambseal.model.rig import build_plant
+from ambseal.model.rotor import assemble_rotor
+from ambseal.robust.digital import discretize_as, with_delay
+from ambseal.robust.digital_loop import discrete_controller
 
 __all__ = ["pid_controller", "pid_from_rig", "reference_controller", "controller_from_metadata",
            "PID_CORNERS_PER_FS"]
@@ -42,9 +55,6 @@ def pid_controller(
         Diagonal controller with 2 states per axis (integrator, derivative filter), used in
         negative feedback u = −K y.
     """
-    import control
-
-    from ambseal.lti.pickling import picklable
 
     picklable()
     # one axis: x1 integrator of e, x2 derivative filter state
@@ -99,7 +109,7 @@ def pid_from_rig(cfg) -> dict:
       rigid-body modes and raises σ̄(S_o) (test rig: 5.9 at f_s/10, 16 at f_s/20). P5's
       ε = 0.1 puts the corner at 10/(2π Td) whatever the rate: on
       the blower (20 kHz) and the pump (10 kHz) that corner (0.50 and 0.43 kHz) left the
-      sampled loop unstable at their bending modes (issue 9). Chosen: blower f_s/20 (none
+      sampled loop unstable at their bending modes. Chosen: blower f_s/20 (none
       keeps the floor there: ζ 0.0006 at 1.6 kHz), pump f_s/10, test rig f_s/14,
       turboexpander f_s/10; the phase lost at ω_n (1–2°) is
       stated in ``rule``. Raising Td to win that phase back was tried and made the test
@@ -113,8 +123,6 @@ def pid_from_rig(cfg) -> dict:
     dict
         ``kp`` (A/m), ``ti``, ``td`` (s), ``eps`` (-), ``corner_hz`` (Hz) and ``rule``.
     """
-    from ambseal.model.amb import amb_factors
-    from ambseal.model.rotor import assemble_rotor
 
     key = cfg.model_dump_json()
     if key in _DERIVED:
@@ -153,12 +161,6 @@ def _zeta_z(z: np.ndarray) -> np.ndarray:
 
 def _corner_for_target(cfg, kp: float, ti: float, td: float) -> float:
     """The derivative filter's corner (fraction of f_s) of :func:`pid_from_rig`."""
-    from ambseal.lti.discrete import zoh
-    from ambseal.lti.interconnect import feedback_matrices
-    from ambseal.model.amb import channel_names
-    from ambseal.model.rig import build_plant
-    from ambseal.robust.digital import discretize_as, with_delay
-    from ambseal.design.conditions import judged_conditions
 
     pressures, speeds = judged_conditions(cfg)
     fs, delay = cfg.controller.sample_rate_hz, cfg.controller.delay_samples
@@ -210,9 +212,6 @@ def reference_controller(cfg, method: str = "tustin"):
     DataError
         The rig has no ``[controller.pid]``.
     """
-    from ambseal.errors import DataError
-    from ambseal.robust.digital_loop import discrete_controller
-    from ambseal.model.amb import channel_names
 
     p = cfg.controller.pid
     if p is None:
@@ -236,9 +235,6 @@ def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<
     DataError
         Missing or malformed controller metadata, naming the file.
     """
-    from ambseal.errors import DataError
-    from ambseal.identify import stages
-    from ambseal.robust.digital_loop import discrete_controller
 
     c = meta.get("controller")
     if not (isinstance(c, dict) and c.get("type") == "pid" and "state_space" not in c):

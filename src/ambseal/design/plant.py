@@ -42,14 +42,19 @@ feedback ``i = −K y_m`` (:mod:`ambseal.analysis.loops`), so
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Mapping
 
+import control
 import numpy as np
 
+from ambseal.design.weights import diagonal_weight
 from ambseal.errors import ConfigError, ModelError
 from ambseal.lti.pickling import picklable
-from ambseal.design.weights import diagonal_weight
+from ambseal.model.lft import Plant
+from ambseal.model.rig import build_plant
+from ambseal.robust.hinf import lft_lower
+from ambseal.robust.mu import mussv
 
 __all__ = ["UncertainParameter", "GeneralizedPlant", "generalized_plant",
            "physical_controller", "physical_matrices"]
@@ -171,20 +176,17 @@ class GeneralizedPlant:
 
     def synthesis_controller(self, K):
         """Inverse of :meth:`physical_controller`: ``K_P = −(D_e/D_u) K``."""
-        import control
 
         return control.ss(*physical_matrices(_abcd(K), self.d_u, self.d_e))
 
     def closed_loop(self, K, *, nominal: bool = False):
         """``F_l(P, K_P)`` for a physical controller ``K`` (m → A, negative feedback)."""
-        from ambseal.robust.hinf import lft_lower
 
         P = self.P_nominal if nominal else self.P
         return lft_lower(P, self.synthesis_controller(K), self.nmeas, self.ncon)
 
     def mu(self, K, omega, **kw):
         """Structured singular value of ``F_l(P, K_P)`` on ``omega`` (rad/s), ``mussv`` result."""
-        from ambseal.robust.mu import mussv
 
         return mussv(self.closed_loop(K), self.blocks, omega, **kw)
 
@@ -246,7 +248,6 @@ def physical_controller(K_P, d_e: float, d_u: float, channels, name: str = "K"):
     control.StateSpace
         Physical controller, used as ``i = −K y``.
     """
-    import control
 
     picklable()
     A, B, C, D = physical_matrices(K_P, d_e, d_u)
@@ -415,13 +416,10 @@ def _sig(prefix: str, names) -> list[str]:
 
 def _source_plant(source, reduced, pressure_bar, states, force_positions, forces: bool):
     """The plant (current inputs, then force inputs), and the indices of both."""
-    from ambseal.model.lft import Plant
 
     if isinstance(source, Plant):
         full = source
     else:
-        from ambseal.model.rig import build_plant
-
         full = build_plant(source, reduced=reduced, pressure_bar=pressure_bar, states=states,
                            force_positions=tuple(force_positions))
     cur = full.current_inputs()
@@ -444,7 +442,6 @@ def _parts(centre, params, cur, fcols, Wp, Wu, W1, W2, Wf, d_e, d_u, L=None, Wk=
     * ``E`` — ``e = y_m/D_e + W_2 d_o``; ``I`` — ``i = D_u (L u + W_1 d_i)``;
     * the weights ``W_p`` (e → z_p), ``W_u`` (u → z_u), ``W_1`` (d_i), ``W_f`` (d_f → f).
     """
-    import control
 
     chans = list(centre.axes)
     outs = [n.removeprefix("y_") for n in centre.output_names]
@@ -506,15 +503,12 @@ def _parts(centre, params, cur, fcols, Wp, Wu, W1, W2, Wf, d_e, d_u, L=None, Wk=
 
 
 def _named(W, inputs, outputs, name):
-    import control
-
     return control.ss(W.A, W.B, W.C, W.D, inputs=list(inputs), outputs=list(outputs), name=name)
 
 
 def _connect(parts: _Parts, W1=None, Wf=None):
     """P by named interconnection (``control.interconnect``) of the parts; ``W1``/``Wf``
     replace the parts' weights when given."""
-    import control
 
     W1 = parts.W1 if W1 is None else W1
     Wf = parts.Wf if Wf is None else Wf
@@ -530,8 +524,6 @@ def _balance(parts: _Parts) -> _Parts:
     """The parts with the W_1 and W_f realisations balanced against the plant's (large)
     actuator input gain: their state scaled so that their input gain matches that of the
     columns of the unweighted P they feed (a similarity transformation: same weights)."""
-    import control
-    from dataclasses import replace
 
     def identity(W):
         return _named(control.ss([], [], [], np.eye(W.ninputs)), W.input_labels,
@@ -547,7 +539,6 @@ def _balance(parts: _Parts) -> _Parts:
 def _balanced(W, P0, cols):
     """W with its state scaled so that its input gain matches the gain of the plant
     columns ``cols`` of ``P0`` it feeds (a similarity transformation: same W)."""
-    import control
 
     if not W.nstates:
         return W
@@ -562,7 +553,6 @@ def _balanced(W, P0, cols):
 
 def _result(P, parts: _Parts, params, centre, cur, Wp, Wu, d_e, d_u) -> GeneralizedPlant:
     """The :class:`GeneralizedPlant` of the interconnected P (public channel labels)."""
-    import control
 
     sA, sB, sC, sD = (np.asarray(m, float) for m in (P.A, P.B, P.C, P.D))
     nd = parts.nd
@@ -583,6 +573,4 @@ def _result(P, parts: _Parts, params, centre, cur, Wp, Wu, d_e, d_u) -> Generali
 
 
 def _ss_weight(W):
-    import control
-
     return control.ss([], [], [], [[W]]) if np.isscalar(W) else control.ss(W)

@@ -53,10 +53,23 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ambseal.errors import ConfigError, SynthesisError
-from ambseal.model.amb import channel_names
-from ambseal.design.pid import pid_from_rig  # noqa: F401 — its home is control.pid; kept importable here
+from ambseal.design.pid import (
+    pid_controller,
+    pid_from_rig,  # noqa: F401 — its home is control.pid; kept importable here
+)
+from ambseal.design.plant import generalized_plant
+from ambseal.design.specs import design_spec
 from ambseal.design.weights import Weights
+from ambseal.errors import ConfigError, SynthesisError
+from ambseal.lti.freqresp import freqresp
+from ambseal.lti.interconnect import feedback_poles, lft_lower, series_inputs
+from ambseal.model.amb import channel_names
+from ambseal.model.rig import build_plant, build_system
+from ambseal.robust.delay import design_delay
+from ambseal.robust.dgk import musyn_dgk
+from ambseal.robust.dk import design_omega, musyn
+from ambseal.robust.hinf import hinfsyn
+from ambseal.robust.order import reduce_controller
 
 __all__ = ["DesignResult", "design", "full_order_check", "METHODS"]
 
@@ -162,8 +175,6 @@ class DesignResult:
 
 
 def _pid(cfg, p):
-    from ambseal.design.pid import pid_controller
-
     pid = getattr(getattr(cfg, "controller", None), "pid", None)
     notes = ()
     if pid is None:
@@ -198,8 +209,6 @@ def full_order_check(cfg, K, conditions, *, delay=None) -> dict:
         and ``damping`` (ζ = −Re λ/|λ|, negative when unstable). A pole counts as unstable
         when Re λ > 1e-9·max|λ| (the rounding level of the eigenvalue solver).
     """
-    from ambseal.lti.interconnect import feedback_poles, series_inputs
-    from ambseal.model.rig import build_plant
 
     Km = tuple(np.asarray(getattr(K, m), float) for m in ("A", "B", "C", "D"))
     worst = None
@@ -262,7 +271,7 @@ def design(
         :func:`~ambseal.robust.order.reduce_controller`); the rise of γ/μ is reported in
         ``reduction``. ``"auto"``: ``[design] order_max``, else the design model's states
         plus those of W_p and W_u (on the test rig 28 for μ: the force weight W_f and the
-        D and G scales of D–G–K raise the order; with the μ weights before issue 16 to 90
+        D and G scales of D–G–K raise the order; with the earlier μ weights (no W_K, M = 3.6) to 90
         states, and truncating to 28 raised μ from 1.115 to 1.136, 1.9 %), raised by one
         state per control channel while the reduced controller does not stabilise the
         design loop or raises its μ (H∞: γ) by more than ``ORDER_RISE`` = 10 % (the pump's
@@ -303,8 +312,6 @@ def design(
     >>> r.K.ninputs, r.K.noutputs                    # doctest: +SKIP
     (4, 4)
     """
-    from ambseal.robust.delay import design_delay
-    from ambseal.design.specs import design_spec
 
     if method not in METHODS:
         raise ConfigError(f"design: method={method!r}, expected one of {METHODS}")
@@ -346,8 +353,6 @@ def design(
         n = n_new
         top = 1.5 * check["mode_hz"]
         if om is None and top > sp.synthesis_band_hz[1]:
-            from ambseal.robust.dk import design_omega
-
             om = design_omega(sp.synthesis_band_hz[0], top)
     if not check["stable"] and not allow_unstable:
         raise SynthesisError(_unstable_message(method, check, n, steps, _top_mode_hz(cfg, p, n)))
@@ -376,7 +381,6 @@ class _Synthesis:
 
 def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl):
     """One synthesis on an n-state design model, reduced, as a physical controller."""
-    from ambseal.design.plant import generalized_plant
 
     Wf = w.Wf()
     fpos = tuple(w.force_positions_m or sp.force_positions_m) if Wf is not None else ()
@@ -387,15 +391,10 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
                            gain_weight=w.Wk())
     mu_omega = None
     if method == "hinf":
-        from ambseal.robust.hinf import hinfsyn
-
         r = hinfsyn(gp.P_nominal, gp.nmeas, gp.ncon)
         K_P, gamma, mu, hist = r.K, float(r.gamma), None, ()
         P_red, blocks = gp.P_nominal, None
     else:
-        from ambseal.robust.dgk import musyn_dgk
-        from ambseal.robust.dk import design_omega, musyn
-
         if om is None:
             om = design_omega(*sp.synthesis_band_hz)
         syn = musyn_dgk if sp.mu_iteration == "dgk" else musyn
@@ -431,7 +430,6 @@ def _reduce_best(P, cands, order: int, auto: bool, gp, blocks, omega):
 
     Returns ``(K, reduction dict, γ, μ)`` of the kept candidate; the dict lists every
     candidate's μ before and after (``candidates``) and the kept one (``kept``)."""
-    from ambseal.robust.order import reduce_controller
 
     rows, best = [], None
     for c in cands:
@@ -466,7 +464,6 @@ def _reduce_best(P, cands, order: int, auto: bool, gp, blocks, omega):
 
 def _top_mode_hz(cfg, p: float, n: int) -> float:
     """The highest mode (Hz) an n-state design model keeps."""
-    from ambseal.model.rig import build_system
 
     lam = np.sort(np.abs(build_system(cfg, pressure_bar=p).poles())) / (2 * np.pi)
     return float(lam[min(n, lam.size) - 1])
@@ -474,7 +471,6 @@ def _top_mode_hz(cfg, p: float, n: int) -> float:
 
 def _states_to_keep(cfg, p: float, mode_hz: float) -> int:
     """Design-model states that keep every mode of the supported rotor up to 1.1× mode_hz."""
-    from ambseal.model.rig import build_system
 
     lam = np.abs(build_system(cfg, pressure_bar=p).poles()) / (2 * np.pi)
     return int(np.sum(lam < 1.1 * mode_hz))
@@ -518,8 +514,6 @@ def _dominant_weight(r: _Synthesis) -> str:
     largest gain at the μ peak frequency (a guide to which weight to relax)."""
     if r.mu_omega is None or r.K_P is None:
         return ""
-    from ambseal.lti.freqresp import freqresp
-    from ambseal.lti.interconnect import lft_lower
 
     gp = r.gp
     cl = lft_lower(gp.P, r.K_P, gp.nmeas, gp.ncon)

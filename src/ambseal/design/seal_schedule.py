@@ -1,4 +1,4 @@
-"""An H∞ LPV controller scheduled on a tracked seal coefficient (issue 14 §2).
+"""An H∞ LPV controller scheduled on a tracked seal coefficient.
 
 The thesis closes (Ch. 7, §7.4 item 2) with the idea of following the seal coefficients
 instead of being robust to all of them at once. With the estimate θ̂ of a seal coefficient
@@ -55,10 +55,21 @@ from typing import Any
 
 import numpy as np
 
-from ambseal.errors import ModelError, SynthesisError
-from ambseal.robust.controller import ScheduledController
-from ambseal.design.plant import physical_controller, physical_matrices
+from ambseal.design import plant, weights
+from ambseal.design.plant import generalized_plant, physical_controller, physical_matrices
+from ambseal.design.specs import design_spec
 from ambseal.design.weights import Weights
+from ambseal.errors import ModelError, SynthesisError
+from ambseal.files import atomic_write
+from ambseal.model import seal
+from ambseal.model.rig import build_plant
+from ambseal.model.seal import values_following_k
+from ambseal.robust import _lpv_lmi as lpv_lmi
+from ambseal.robust import _lpv_reconstruct as lpv_reconstruct
+from ambseal.robust import lpv
+from ambseal.robust.controller import ScheduledController
+from ambseal.robust.delay import design_delay
+from ambseal.robust.lpv import lpvsyn
 
 __all__ = ["SealScheduledDesign", "design_seal_scheduled", "CACHE_ENV"]
 
@@ -186,9 +197,6 @@ def design_seal_scheduled(cfg, parameter: str | None = None, *,
     SynthesisError
         From :func:`lpvsyn` (infeasible LMIs, an unstable frozen loop), or ``n_grid`` < 2.
     """
-    from ambseal.model.rig import build_plant
-    from ambseal.robust.delay import design_delay
-    from ambseal.design.specs import design_spec
 
     if parameter is None:
         if not cfg.seal:
@@ -216,8 +224,6 @@ def design_seal_scheduled(cfg, parameter: str | None = None, *,
             return pickle.load(fh)
     d = _synthesise(cfg, plant, args, scale, dl, lpvsyn_kw)
     if path is not None:
-        from ambseal.files import atomic_write
-
         path.parent.mkdir(parents=True, exist_ok=True)
         atomic_write(path, lambda fh: pickle.dump(d, fh))
     return d
@@ -225,9 +231,6 @@ def design_seal_scheduled(cfg, parameter: str | None = None, *,
 
 def _key(cfg, args) -> str:
     """Cache key: the rig, the arguments and the source of the synthesis code."""
-    from ambseal.model import seal
-    from ambseal.design import plant, weights
-    from ambseal.robust import _lpv_lmi as lpv_lmi, _lpv_reconstruct as lpv_reconstruct, lpv
 
     h = hashlib.sha256(cfg.model_dump_json().encode())
     h.update(repr(args).encode())
@@ -240,9 +243,6 @@ def _key(cfg, args) -> str:
 def _synthesise(cfg, plant, args, scale: float, dl, lpvsyn_kw) -> SealScheduledDesign:
     """lpvsyn over the grid of θ (the design model at each grid value, the controller's
     delay ``dl`` in its actuator path)."""
-    from ambseal.model.seal import values_following_k
-    from ambseal.robust.lpv import lpvsyn
-    from ambseal.design.plant import generalized_plant
 
     parameter, rf, n_grid, rate, w, n = args[:6]
     t0 = time.perf_counter()

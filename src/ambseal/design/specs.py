@@ -35,11 +35,11 @@ the value the thesis used on its test facility, P5, where it names one):
   integral time is the PID's ("tuned to achieve an integral time close to the reference
   controller of 0.2 s"; test rig 5 rad/s): the direct gains then stay within 2× the
   PID's from 1 Hz to 200 Hz (P5 Fig. 10; ω_B = 60 rad/s gave 12× at 1 Hz). Why 1/T_i, not
-  the 2.5/T_i of issue 16: with the controller's hold + computation delay in the design
-  model (:mod:`ambseal.robust.delay`) μ needs phase lead at the crossover, and at
-  2.5/T_i its direct gain reached 2.06× the PID's at 200 Hz (test rig, rig-file design);
-  1/T_i gives 1.98× with σ̄(S_o) 2.85 (W_p's M = 3.6). The trade measured on the same
-  design: a heavier W_u (2× the PID's peak) gave 1.91× but μ 1.01 and σ̄(S_o) 3.19; M = 4
+  the 2.5/T_i of a delay-free design model: with the controller's hold + computation
+  delay in the design model (:mod:`ambseal.robust.delay`) μ needs phase lead at the
+  crossover, and at 2.5/T_i its direct gain reached 2.06× the PID's at 200 Hz (test rig,
+  rig-file design); 1/T_i gives 1.98× with σ̄(S_o) 2.85 (in that trial W_p's M = 3.6; the
+  default is 3.45). The trade measured on the same design: a heavier W_u (2× the PID's peak) gave 1.91× but μ 1.01 and σ̄(S_o) 3.19; M = 4
   gave 1.97× but σ̄(S_o) 3.06; ω_B = 0.5/T_i 1.98× but twice the impulse settling time;
   a W_u shaped like the PID's gain or peaking at 200–250 Hz gave μ 1.1–1.9. μ: W_u a
   constant (P5 §4.3) = D_u/(3 D_e Kp (1 + 1/ε)), so that where S_o ≈ 1 the controller
@@ -84,7 +84,15 @@ from dataclasses import asdict, dataclass, field, replace
 import numpy as np
 
 from ambseal.design.conditions import judged_conditions
-from ambseal.errors import ConfigError
+from ambseal.design.pid import pid_from_rig
+from ambseal.design.weights import default_weights
+from ambseal.errors import ConfigError, DataError
+from ambseal.identify.intervals import uncertainty_from_fit
+from ambseal.model.amb import amb_factors
+from ambseal.model.modes import modes
+from ambseal.model.rig import build_system
+from ambseal.model.rotor import assemble_rotor
+from ambseal.model.seal import coefficient_value
 
 __all__ = ["Machine", "DesignSpec", "machine", "design_spec", "round_125", "judged_conditions"]
 
@@ -138,10 +146,6 @@ class Machine:
 
 def machine(cfg) -> Machine:
     """The machine facts of a rig (module docstring, "Machine facts")."""
-    from ambseal.model.amb import amb_factors
-    from ambseal.model.modes import modes
-    from ambseal.model.rig import build_system
-    from ambseal.model.rotor import assemble_rotor
 
     free = build_system(cfg, speed_rpm=0.0, include_amb=False, include_seals=False,
                         include_springs=False)
@@ -353,7 +357,6 @@ def _scalings(d, mach: Machine, rules: dict, notes: list):
 
 def _design_model(cfg, d, mach: Machine, rules: dict) -> tuple[int, float]:
     """States and cut-off (Hz) of the design model (module docstring, "Design model")."""
-    from ambseal.model.rig import build_system
 
     lam = np.abs(build_system(cfg).poles()) / (2 * math.pi)
     if d.model_states is not None:
@@ -426,9 +429,6 @@ def _uncertainty(cfg, d, rules: dict, notes: list, pressure_bar: float) -> dict:
     if d.uncertainty_from_identification is not None or d.uncertainty is not None:
         out: dict = {}
         if d.uncertainty_from_identification is not None:
-            from ambseal.errors import DataError
-            from ambseal.identify.intervals import uncertainty_from_fit
-
             try:
                 out = dict(uncertainty_from_fit(d.uncertainty_from_identification))
             except DataError as exc:
@@ -438,7 +438,6 @@ def _uncertainty(cfg, d, rules: dict, notes: list, pressure_bar: float) -> dict:
             ([f"95 % intervals of {d.uncertainty_from_identification}"]
              if d.uncertainty_from_identification else []) + (["set"] if d.uncertainty else []))
         return out
-    from ambseal.model.seal import coefficient_value
 
     out = {}
     for s in cfg.seal:
@@ -460,14 +459,12 @@ def _reference_pid(cfg) -> dict:
     pid = getattr(getattr(cfg, "controller", None), "pid", None)
     if pid is not None:
         return {"kp": pid.kp, "ti": pid.ti, "td": pid.td, "eps": pid.eps}
-    from ambseal.design.pid import pid_from_rig
 
     return pid_from_rig(cfg)
 
 
 def _weights(d, method: str, mach: Machine, d_e: float, d_u: float, band_hi: float,
              unb_range, rules: dict, pid: dict):
-    from ambseal.design.weights import default_weights
 
     spec = getattr(d, method)
     w = default_weights(method)
@@ -536,7 +533,6 @@ def design_spec(cfg, pressure_bar: float | None = None) -> DesignSpec:
     p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
     d_e, d_u = _scalings(d, mach, rules, notes)
     n, cut = _design_model(cfg, d, mach, rules)
-    from ambseal.model.rig import build_system
 
     lam = np.sort(np.abs(build_system(cfg).poles()) / (2 * math.pi))
     band, synth = _bands(d, mach, float(lam[min(n, lam.size) - 1]), rules)

@@ -29,7 +29,9 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
+import control
 import numpy as np
+from scipy.signal import butter
 
 from ambseal.errors import ConfigError
 
@@ -70,7 +72,6 @@ def performance_weight(M: float, omega_b: float, A: float = 1e-3):
     >>> round(float(abs(W(0))), 3), round(float(abs(W(1e9j))), 3)
     (1000.0, 0.5)
     """
-    import control
 
     for name, v in (("M", M), ("omega_b", omega_b), ("A", A)):
         if not (np.isfinite(v) and v > 0):
@@ -116,7 +117,6 @@ def control_weight(gain: float, *, corner_hz: float | None = None,
     >>> round(float(abs(W(0))), 3), round(float(abs(W(1e9j))), 3)
     (0.5, 5.0)
     """
-    import control
 
     if not (np.isfinite(gain) and gain > 0):
         raise ConfigError(f"control_weight: gain={gain!r} must be finite and > 0")
@@ -156,7 +156,6 @@ def check_weight(W, name: str, *, biproper: bool = False):
         If the weight is not SISO, not proper (more zeros than poles), discrete-time, has
         a pole with ``Re ≥ 0``, non-finite coefficients, or (``biproper``) ``D = 0``.
     """
-    import control
 
     if np.isscalar(W):
         if not (np.isfinite(W) and W != 0):
@@ -194,7 +193,6 @@ def diagonal_weight(W, n: int, name: str, *, biproper: bool = False):
 
     Raises ConfigError as :func:`check_weight`.
     """
-    import control
 
     S = check_weight(W, name, biproper=biproper)
     eye = np.eye(n)
@@ -314,8 +312,6 @@ class Weights:
             A non-positive factor, Kp, T_i or ε, a negative T_d, or a band not
             ``0 < low < high``.
         """
-        import control
-        from scipy.signal import butter
 
         if not self.gain_factor:
             return None
@@ -344,7 +340,6 @@ class Weights:
         ConfigError
             A high-pass W_1 with a non-positive gain or corner.
         """
-        import control
 
         if self.w1_corner_hz is None:
             return float(self.w1_gain)
@@ -371,7 +366,6 @@ class Weights:
             A non-positive or non-finite orbit, mass, grade, maximum speed or roll-off, or
             an unknown law.
         """
-        import control
 
         if self.orbit_um is None:
             return None
@@ -420,7 +414,7 @@ def default_weights(method: str) -> Weights:
     ``"hinf"`` (nominal design, P5 §4.4): W_p with M = 2.5, A = 1/1000; W_u = 0.2 constant;
     a small constant W_1 = 0.05 (the same as μ's, so that the two differ only by W_u and
     what μ adds, as P5 §4.1 objective 1 wants them comparable). W_u was 0.3 before the
-    controller's delay entered the design model (issue 10): with the delay, 0.3 left the
+    controller's delay entered the design model: with the delay, 0.3 left the
     designed-on-the-identified-rig H∞ of ``ambseal run`` poorly damped at 0 bar on the
     truth (σ̄(S_o) 14.4, worst orbit 8.8 µm > the thesis's 8 µm); 0.2 gives 8.7 and
     5.5 µm (rig-file design: 6.6 and 4.8 µm).
@@ -430,7 +424,7 @@ def default_weights(method: str) -> Weights:
     A = 1/1000; a constant W_u (P5 §4.3); W_1 = 0.05; and, from the specification, the
     unbalance force at the bearings as a weighted input (:meth:`Weights.Wf`, ISO 21940-11
     law, P5 §4.4.1) with an orbit demand and a 4th-order roll-off, and the gain demand
-    :meth:`Weights.Wk` (P5 Fig. 10). M = 3.45 with W_K (issue 16): μ 0.92, σ̄(S_o) ≤ 2.73,
+    :meth:`Weights.Wk` (P5 Fig. 10). M = 3.45 with W_K: μ 0.92, σ̄(S_o) ≤ 2.73,
     direct gains ≤ 1.78× the PID's to 200 Hz on the rig-file design; designed on the
     identified rig and judged on the truth μ 0.99, 1.98×, σ̄(S_o) ≤ 2.43 per axis (3.11
     whole loop). Trials there: W_K from DC to 250 Hz (no high-pass) asking |K S_o| ≤
@@ -445,7 +439,7 @@ def default_weights(method: str) -> Weights:
 
     ω_B of both, μ's W_u gain (0.095 here is the test rig's), W_K, the orbit demand, W_f's
     roll-off and the scalings are rules of :func:`ambseal.design.specs.design_spec`.
-    Measured on the test rig's full-order plant over 0–4.08 bar (issue 16): μ = 0.885 on the
+    Measured on the test rig's full-order plant over 0–4.08 bar: μ = 0.885 on the
     design model, order 24 (the thesis's); σ̄(S_o) ≤ 2.2 per axis; orbit ≤ 4.6 µm; impulse
     settling 0.108 s at 0 bar against H∞'s 0.145 s; direct gains 1.0–1.9× the PID's from
     1 to 200 Hz, peak gain 1.7× the PID's peak. Why: a high-pass W_u of 0.02 rising to
@@ -453,7 +447,7 @@ def default_weights(method: str) -> Weights:
     and ω_B = 30–60 rad/s gave 5–12× the PID's gain at 1 Hz; a larger W_1 (0.2–1) or a
     high-pass W_1 slows the impulse's settling tail or raises the 1 Hz gain; M = 3 gives
     μ = 0.97 and a slower settling (0.110 s). With the controller's delay in the design
-    model (issue 10) and ω_B = 1/T_i: μ = 0.904, order 28 (24 + one delay state per
+    model and ω_B = 1/T_i: μ = 0.904, order 28 (24 + one delay state per
     channel), σ̄(S_o) ≤ 2.85 (2.27 per axis), orbit ≤ 4.7 µm, settling 0.167 s against
     H∞'s 0.227 s, direct gains ≤ 1.98× the PID's to 200 Hz; M = 3.5 gave 2.00×, M = 3.75
     σ̄(S_o) 2.93 (the reason for 3.6 is in :mod:`ambseal.design.specs`).

@@ -38,13 +38,15 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import control
 import numpy as np
+from scipy.io import loadmat, savemat
 
 from ambseal.errors import DataError
 from ambseal.files import atomic_write
-from ambseal.robust.digital_loop import DiscreteController
-from ambseal.robust.digital import DigitalController
 from ambseal.robust.controller import SPEED
+from ambseal.robust.digital import DigitalController
+from ambseal.robust.digital_loop import DiscreteController
 from ambseal.robust.scheduled_digital import ScheduledDigital
 
 __all__ = ["export_controller", "load_controller", "controller_document", "CONVENTION",
@@ -148,8 +150,6 @@ def export_controller(ctrl, path, judged=None) -> Path:
                   for k, v in doc.items()}
         atomic_write(path, lambda fh: np.savez(fh, **arrays))
     elif suffix == ".mat":
-        from scipy.io import savemat
-
         mdict = {}
         for k, v in doc.items():
             if isinstance(v, list):
@@ -180,7 +180,6 @@ def _read(path: Path) -> dict:
         if suffix == ".npz":
             with np.load(path, allow_pickle=False) as z:
                 return {k: (z[k].tolist() if z[k].dtype.kind == "U" else z[k]) for k in z.files}
-        from scipy.io import loadmat
 
         m = loadmat(path, squeeze_me=False, chars_as_strings=True)
     except (OSError, ValueError, KeyError) as exc:
@@ -228,7 +227,6 @@ def _arrays(doc: dict, path: Path, stacked: bool) -> dict:
 
 def _continuous(doc: dict, path: Path):
     """A continuous controller file back to a ``control.StateSpace``, shapes checked."""
-    import control
 
     try:
         ins, outs = [str(s) for s in doc["inputs"]], [str(s) for s in doc["outputs"]]
@@ -263,7 +261,6 @@ def load_controller(path):
     DataError
         An unreadable file, a missing key, or matrices of the wrong shapes (named).
     """
-    import control
 
     path = Path(path)
     doc = _read(path)

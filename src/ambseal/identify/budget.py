@@ -45,6 +45,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.stats import norm
 
 from ambseal.errors import ConfigError
 
@@ -203,7 +204,6 @@ class ErrorBudget:
         fixed values tested), largest |z| first."""
         if self.score_z is None:
             return []
-        from scipy.stats import norm
 
         z = np.abs(np.nan_to_num(self.test_z()))
         crit = norm.isf(level / (2 * max(len(self.fixed), 1)))

@@ -18,6 +18,7 @@ from ambseal.identify.frf import FRF, closed_loop_frf, model_frf, plant_frf
 from ambseal.identify.procedure import ProcedureResult
 from ambseal.identify.signals import chirp
 from ambseal.identify.stages import acquire, build_models
+from ambseal.model.rig import build_plant
 
 __all__ = ["FrfChecks", "frf_checks", "truth_errors", "true_line"]
 
@@ -64,7 +65,6 @@ def frf_checks(cfg, truth, res: ProcedureResult, controller, *, seed: int = 99) 
     -------
     FrfChecks
     """
-    from ambseal.model.rig import build_plant
 
     axes = res.amb.axes
     fs = cfg.controller.sample_rate_hz

@@ -26,13 +26,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Sequence
 
+import control
 import numpy as np
 import scipy.linalg as sla
 
 from ambseal.errors import DataError, IdentificationError
-from ambseal.model.lft import Plant
 from ambseal.lti.discrete import zoh
 from ambseal.lti.freqresp import freqresp_at
+from ambseal.model.lft import Plant
 
 __all__ = ["CoprimeFactors", "observer_gains", "coprime_factors", "youla_factorisation",
            "check_bezout"]
@@ -40,8 +41,6 @@ __all__ = ["CoprimeFactors", "observer_gains", "coprime_factors", "youla_factori
 
 # --------------------------------------------------------------------------- helpers
 def _ss(A, B, C, D, dt, inputs=None, outputs=None):
-    import control
-
     kw = {}
     if inputs is not None:
         kw["inputs"] = list(inputs)

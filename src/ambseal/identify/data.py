@@ -107,12 +107,23 @@ from pathlib import Path
 from typing import Sequence
 
 import numpy as np
+import scipy.io
 
 from ambseal.errors import AmbsealError, DataError
 from ambseal.files import atomic_write, read_text
-from ambseal.identify.measurement import (CHANNELS, CLIP_RTOL, CLIP_RUN, FORMAT_TAG,
-                                          TIME_RTOL, Measurement, _json_safe, _RATE_RTOL,
-                                          _RESERVED, column_names, validate_measurement)
+from ambseal.identify.measurement import (
+    _RATE_RTOL,
+    _RESERVED,
+    CHANNELS,
+    CLIP_RTOL,
+    CLIP_RUN,
+    FORMAT_TAG,
+    TIME_RTOL,
+    Measurement,
+    _json_safe,
+    column_names,
+    validate_measurement,
+)
 
 __all__ = [
     "FORMAT_TAG",
@@ -194,8 +205,6 @@ def save_measurement(meas: Measurement, path: str | os.PathLike) -> Path:
 
         _atomic_write(path, write_csv)
     else:
-        import scipy.io
-
         mdict = {c: table[:, i].reshape(-1, 1) for i, c in enumerate(cols)}
         mdict["metadata_json"] = json.dumps(header, allow_nan=False)
         _atomic_write(
@@ -270,8 +279,6 @@ def _read_csv(path: Path) -> tuple[list[str], np.ndarray]:
 
 
 def _read_mat(path: Path) -> tuple[dict, dict[str, np.ndarray]]:
-    import scipy.io
-
     try:
         raw = scipy.io.loadmat(str(path), squeeze_me=False, mat_dtype=False, chars_as_strings=True)
     except NotImplementedError:

@@ -20,12 +20,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from ambseal.config import Affine, RigConfig, TruthSection, rig_with_values
+from ambseal.errors import ModelError
 from ambseal.identify.fit import TAU_E, nrmse_fit
-from ambseal.robust.digital_loop import DiscreteController
 from ambseal.identify.procedure import ProcedureResult
 from ambseal.identify.rig_sim import true_rig
 from ambseal.identify.signals import impulse
 from ambseal.identify.stages import acquire, build_models
+from ambseal.model.amb import channel_names
+from ambseal.model.rig import build_system, mechanical_plant
+from ambseal.robust.digital_loop import DiscreteController
 
 __all__ = ["ImpulseCheck", "outside_intervals", "design_rig", "truth_rig", "impulse_checks"]
 
@@ -34,7 +37,6 @@ def outside_intervals(cfg: RigConfig, res: ProcedureResult) -> list[str]:
     """Identified values whose 95 % interval does not hold the rig file's value: the
     stage fits' parameters (Ki, Ks, τ_e, coupling) and the seal regression's intercept and
     slope against pressure (``{seal}.{c}.at_zero``, ``.per_bar``)."""
-    from ambseal.model.rig import build_system, mechanical_plant
 
     plant = mechanical_plant(build_system(cfg, pressure_bar=0.0))
     out = []
@@ -126,8 +128,6 @@ def impulse_checks(cfg: RigConfig, identified: RigConfig, truth: TruthSection,
     A controller that does not keep the rotor in the facility's air gap gets an
     :class:`ImpulseCheck` with its ``error``.
     """
-    from ambseal.errors import ModelError
-    from ambseal.model.amb import channel_names
 
     axes = channel_names(cfg)
     fs = cfg.controller.sample_rate_hz

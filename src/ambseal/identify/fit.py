@@ -30,20 +30,21 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 
+import control
 import numpy as np
 from scipy.optimize import least_squares
 
 from ambseal.errors import IdentificationError
-from ambseal.model.amb import eddy_lag_matrices
-from ambseal.model.lft import Plant
+from ambseal.identify.budget import ErrorBudget, propagate
+from ambseal.identify.residuals import MISMATCH, ResidualTests, residual_tests
+from ambseal.identify.sandwich import _covariance, _long_run_covariance, _score_test, _t_quantile  # noqa: F401
+from ambseal.identify.sensor_lag import TAU_S, lag_test_dict, with_sensor_lag
+from ambseal.identify.stats import jacobian_correlation
 from ambseal.lti.discrete import simulate_lti, zoh
 from ambseal.lti.interconnect import series_inputs
-from ambseal.identify.budget import ErrorBudget, propagate
+from ambseal.model.amb import eddy_lag_matrices
+from ambseal.model.lft import Plant
 from ambseal.robust.digital_loop import DiscreteController, closed_loop_matrices
-from ambseal.identify.sandwich import _covariance, _long_run_covariance, _score_test, _t_quantile  # noqa: F401
-from ambseal.identify.stats import jacobian_correlation
-from ambseal.identify.residuals import MISMATCH, ResidualTests, residual_tests
-from ambseal.identify.sensor_lag import TAU_S, lag_test_dict, with_sensor_lag
 
 __all__ = ["FitResult", "ClosedLoopModel", "fit_parameters", "default_bounds", "nrmse_fit"]
 
@@ -126,7 +127,6 @@ class ClosedLoopModel:
     def statespace(self, values: dict[str, float], axes: tuple[str, ...]):
         """The discrete closed loop from excitation (A) to displacement (m) as a
         ``control.StateSpace`` at the controller's sample time (for FRF checks)."""
-        import control
 
         Ad, Bd, C, _, _ = self._sampled(values)
         Acl, Bcl, Cy, _, _ = closed_loop_matrices(Ad, Bd, C, self.controller)

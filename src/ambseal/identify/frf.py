@@ -37,7 +37,9 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Sequence
 
+import control
 import numpy as np
+import scipy.signal
 
 from ambseal.errors import DataError, IdentificationError
 from ambseal.lti.freqresp import freqresp_at
@@ -196,7 +198,6 @@ def _as_2d(x: Any, name: str) -> np.ndarray:
 
 def _spectra(x: np.ndarray, nperseg: int, noverlap: int, window: Any) -> tuple[np.ndarray, int]:
     """Windowed segment spectra, shape (n_seg, n_f, channels), as scipy.signal.csd forms them."""
-    import scipy.signal
 
     w = scipy.signal.get_window(window, nperseg)
     step = nperseg - noverlap
@@ -523,7 +524,6 @@ def model_frf(
     >>> complex(frf.H[0, 0, 0])
     (1+0j)
     """
-    import control
 
     f = np.atleast_1d(np.asarray(frequency_hz, dtype=float))
     if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f)) or np.any(f < 0):

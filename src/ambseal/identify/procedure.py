@@ -28,14 +28,19 @@ import numpy as np
 
 from ambseal.config import Affine, RigConfig, TruthSection, rig_with_values
 from ambseal.errors import IdentificationError, ModelError
-from ambseal.model.amb import channel_names
 from ambseal.identify.fit import TAU_E, FitResult
 from ambseal.identify.seal_test import fit_reliability, seal_frequency_test
 from ambseal.identify.signals import impulse, prbs
-from ambseal.identify.static_load import programme_repeats, static_ki, virtual_static_load, with_static
-from ambseal.robust.digital_loop import DiscreteController
 from ambseal.identify.stages import acquire, identify
+from ambseal.identify.static_load import (
+    programme_repeats,
+    static_ki,
+    virtual_static_load,
+    with_static,
+)
 from ambseal.identify.stats import linear_regression
+from ambseal.model.amb import channel_names
+from ambseal.robust.digital_loop import DiscreteController
 
 __all__ = ["ProcedureResult", "thesis_procedure", "SEAL_COEFFICIENTS"]
 

@@ -26,6 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.signal import lfilter
 from scipy.stats import chi2
 
 __all__ = ["ResidualTests", "residual_tests", "MISMATCH"]
@@ -123,7 +124,6 @@ def _lagged(U: np.ndarray, m: int) -> np.ndarray:
 
 def _one_record(eps: np.ndarray, U: np.ndarray, m: int, na: int):
     """(ζ_w, M, ζ_u, dof, ρ_ε, ρ_εu) of one channel of one record."""
-    from scipy.signal import lfilter
 
     n = eps.size
     rho = _autocorr(eps, m)

@@ -36,13 +36,13 @@ import numpy as np
 
 from ambseal.config import RigConfig, TruthSection
 from ambseal.errors import ModelError
+from ambseal.identify.facility_loop import facility_loop
+from ambseal.lti.discrete import zoh
+from ambseal.lti.interconnect import series_inputs
 from ambseal.model.amb import actuator_matrices, eddy_lag_matrices
 from ambseal.model.reduction import modal_reduction
 from ambseal.model.rig import build_system, mechanical_plant
 from ambseal.model.seal import coefficient_value
-from ambseal.lti.discrete import zoh
-from ambseal.lti.interconnect import series_inputs
-from ambseal.identify.facility_loop import facility_loop
 from ambseal.robust.digital_loop import DiscreteController, closed_loop_matrices
 
 __all__ = ["FacilityRecord", "Facility", "prepare_facility", "simulate_facility", "true_rig",
@@ -169,7 +169,7 @@ class Facility:
     segment, force law, sensors and limits (built by :func:`prepare_facility`), and the
     state of the linear part and of the sensors' low-pass, carried from one :meth:`run`
     to the next so that a run can go on block by block (a controller switched between
-    blocks, issue 14 §2)."""
+    blocks)."""
 
     T: float
     axes: tuple

@@ -11,6 +11,7 @@ score test of a value the fit did not free uses the same long-run variance
 from __future__ import annotations
 
 import numpy as np
+from scipy.stats import t
 
 
 def _long_run_covariance(J: np.ndarray, R: np.ndarray, smooth: int = 2,
@@ -82,7 +83,6 @@ def _t_quantile(var_noise, var_total, dof_noise) -> np.ndarray:
     """Student's t 97.5 % quantile of each interval: the noise variance has ``dof_noise``
     degrees of freedom, the budget's part is taken as known, so ν = v_total² / (v_noise² /
     ν_noise) (Satterthwaite); 1.96 where ν is not finite."""
-    from scipy.stats import t
 
     with np.errstate(invalid="ignore", divide="ignore"):
         nu = np.asarray(var_total) ** 2 / (np.asarray(var_noise) ** 2 / np.asarray(dof_noise))

@@ -37,11 +37,12 @@ from __future__ import annotations
 import numpy as np
 
 from ambseal.config import RigConfig
-from ambseal.model.amb import actuator_matrices, channel_names
 from ambseal.identify.fit import TAU_E, ClosedLoopModel, FitResult
-from ambseal.robust.digital_loop import DiscreteController
 from ambseal.identify.rig_sim import reduced_plant
 from ambseal.identify.signals import Excitation, stepped_sine
+from ambseal.identify.stages import acquire, identify
+from ambseal.model.amb import actuator_matrices, channel_names
+from ambseal.robust.digital_loop import DiscreteController
 
 __all__ = ["whirl_balance", "whirl_stepped_sine", "seal_frequency_test", "fit_reliability",
            "MIN_FIT_PCT"]
@@ -199,7 +200,6 @@ def seal_frequency_test(cfg: RigConfig, truth, controller: DiscreteController, s
     -------
     list of (frequency_hz, FitResult)
     """
-    from ambseal.identify.stages import acquire, identify
 
     fs = 1.0 / controller.dt
     names = [f"{seal}.{c}" for c in ("K", "k", "C", "c")]

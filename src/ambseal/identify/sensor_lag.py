@@ -4,7 +4,7 @@ Displacement sensors and their conditioning often carry a low-pass the rig file 
 state. In closed loop such a lag looks almost like the eddy-current lag τ_e (both sit in
 the loop gain; they differ only in the excitation→displacement numerator, by the product
 of the two lags), so a fit without it moves τ_e and biases Ki/Ks by a fraction of a per
-cent — while its intervals claim less (issue 17). Two tools:
+cent — while its intervals claim less. Two tools:
 
 - **the extension**: ``tau_s`` (s), a first-order low-pass in every displacement sensor as
   sampled by the data acquisition, y[n] = a·y[n−1] + (1 − a)·x(nT) with a = τ_s/(τ_s + T):
@@ -21,7 +21,7 @@ cent — while its intervals claim less (issue 17). Two tools:
   its boundary, Silvapulle & Sen, *Constrained Statistical Inference*, 2005, §4.3). The
   one-step estimate of τ_s the data suggest comes with it. It looks in the one direction
   the residual independence test spreads over many degrees of freedom, so it has more power
-  against this fault (issue 17: a 1 kHz sensor low-pass flagged in every seed, against
+  against this fault (a 1 kHz sensor low-pass flagged in every seed, against
   65 % by the residual test).
 
 A wrong value the fit holds (a coupling stiffness 4 % off) can make the test ask for a lag

@@ -10,14 +10,14 @@ import numpy as np
 
 from ambseal.config import RigConfig, TruthSection
 from ambseal.errors import DataError, IdentificationError, ModelError
-from ambseal.model.amb import actuator_matrices
 from ambseal.identify.budget import fixed_uncertainty
 from ambseal.identify.data import Measurement, validate_measurement
 from ambseal.identify.fit import TAU_E, ClosedLoopModel, FitResult, default_bounds, fit_parameters
-from ambseal.robust.digital_loop import DiscreteController
 from ambseal.identify.rig_sim import reduced_plant, simulate_facility
 from ambseal.identify.sensor_lag import TAU_S
 from ambseal.identify.signals import Excitation
+from ambseal.model.amb import actuator_matrices
+from ambseal.robust.digital_loop import DiscreteController
 
 __all__ = ["controller_from_metadata", "check_controller", "sample_rate_of",
            "check_record_metadata", "acquire", "build_models", "identify", "record_spread",

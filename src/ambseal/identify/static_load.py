@@ -43,8 +43,11 @@ import numpy as np
 from ambseal.config import RigConfig, TruthSection
 from ambseal.errors import ConfigError, DataError
 from ambseal.files import atomic_write, read_text
-from ambseal.model.amb import amb_factors, channel_names
 from ambseal.identify.fit import FitResult
+from ambseal.identify.rig_sim import true_rig
+from ambseal.model.amb import amb_factors, channel_names
+from ambseal.model.rig import build_system, mechanical_plant
+from ambseal.model.seal import coefficient_value
 
 __all__ = ["StaticLoadResult", "static_ki", "load_steps", "virtual_static_load", "load_static_record",
            "save_static_record", "join_static", "with_static", "programme_repeats"]
@@ -117,7 +120,6 @@ def static_ki(cfg: RigConfig, position_m: np.ndarray, force_xy_n: np.ndarray,
     DataError
         Mismatched shapes, or loads that leave an axis' Ki undetermined.
     """
-    from ambseal.model.rig import build_system, mechanical_plant
 
     axes = channel_names(cfg)
     k = len(axes)
@@ -201,9 +203,6 @@ def virtual_static_load(cfg: RigConfig, truth: TruthSection, *, seed: int = 0,
     a one-second hold (the truth's ``current_noise_a`` over √(sample rate) samples). The
     programme of :func:`load_steps` runs ``repeats`` times (P2 §5 repeats it five times).
     """
-    from ambseal.model.rig import build_system, mechanical_plant
-    from ambseal.model.seal import coefficient_value
-    from ambseal.identify.rig_sim import true_rig
 
     z, F = load_steps(cfg, steps_per_direction, position_m)
     z, F = np.tile(z, repeats), np.tile(F, (repeats, 1))

@@ -34,7 +34,7 @@ The model must be the identified one. Only the tracked parameters move; every ot
 should be the one identified on site (thesis stages (a)–(c): ``ambseal identify``, or
 ``identified_rig.toml`` of ``ambseal run``), not the first-principles rig file. Measured on
 the test rig's virtual facility (the closed-loop 0 → 3× nominal ramp with the controller
-scheduled on k̂, issue 14 §2, its record re-tracked with each model): with the rig file's
+scheduled on k̂, its record re-tracked with each model): with the rig file's
 values (Ki, Ks a few per cent off, τ_e = 0 against the facility's 0.2 ms) the estimate
 wanders with a bias growing to +0.15–0.27 k_nom and a standard error of 0.13 k_nom
 (largest error 0.58 k_nom after 1 s, coverage 88 %); τ_e alone set right gives 0.15 k_nom,
@@ -47,15 +47,19 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 import scipy.linalg as sla
 
 from ambseal.config import RigConfig
 from ambseal.errors import DataError, IdentificationError, ModelError
-from ambseal.model.rig import build_system, mechanical_plant
 from ambseal.identify.data import Measurement
 from ambseal.identify.fit import _DEFAULT_SCALE, ClosedLoopModel
+from ambseal.identify.signals import prbs
 from ambseal.identify.stages import build_models
+from ambseal.model.amb import channel_names
+from ambseal.model.rig import build_system, mechanical_plant
+from ambseal.model.seal import pressure_for_k, values_following
 
 __all__ = ["TrackingSettings", "TrackingResult", "track", "flops_per_sample",
            "linearised_model", "rpem_kernel", "OnlineTracker", "current_limit", "check_excitation",
@@ -70,7 +74,7 @@ class TrackingSettings:
     ----------
     rate_per_s : float
         Expected drift of each parameter, as a fraction of its scale per second (0.1: the
-        seal's k from 0 to 3× nominal over 30 s, the ramp of issue 14); sets the random
+        seal's k from 0 to 3× nominal over 30 s, the main job's pressure ramp); sets the random
         walk Q_θ. Larger tracks faster with a noisier estimate.
     relinearise_s : float
         Period of re-linearisation at θ̂ (s); the predictor gain is solved again only when
@@ -99,7 +103,7 @@ class TrackingSettings:
         other seal coefficients (that seal's K, C, c and every other seal's) follow the
         pressure that gives k̂ (:func:`ambseal.model.seal.values_following_k`; default);
         False: they stay at the record's pressure. Measured on the closed-loop 0 → 3×
-        nominal ramps (issue 14 §2): test rig (the tracker's model the identified rig),
+        nominal ramps: test rig (the tracker's model the identified rig),
         largest error after 1 s 0.029 k_nom following, 0.075 fixed (coverage 100 % and
         92 %); examples/pump.toml (a second seal, the impeller-eye labyrinth, whose k
         rises with the same pressure to a quarter of the balance drum's), 0.026 with every
@@ -227,7 +231,6 @@ def _follower(cfg: RigConfig, model: ClosedLoopModel, names):
     """values → the values with the seal coefficients that follow the tracked seal k's
     (:func:`ambseal.model.seal.values_following`; the tracked values themselves win), or
     None when no tracked name is a seal k affine in the pressure."""
-    from ambseal.model.seal import pressure_for_k, values_following
 
     known = model.plant.parameters
     if all(pressure_for_k(cfg.seal, n, 0.0) is None for n in names):
@@ -361,8 +364,6 @@ def _kernel(compiled: bool):
     if not compiled:
         return rpem_kernel
     if "k" not in _JIT:
-        import numba
-
         _JIT["k"] = numba.njit(cache=False, fastmath=False)(rpem_kernel)
     return _JIT["k"]
 
@@ -435,7 +436,7 @@ def track(cfg: RigConfig, record: Measurement, names, settings: TrackingSettings
 
 class OnlineTracker:
     """The RPEM of :func:`track` fed block by block, as it runs beside a controller (the
-    closed-loop ramp of issue 14 §2): the state x̂, the sensitivities W, θ̂, P and Λ are
+    closed-loop pressure ramp): the state x̂, the sensitivities W, θ̂, P and Λ are
     carried from one :meth:`update` to the next, and feeding a record in any blocks gives
     the same estimate as :func:`track` on the whole record.
 
@@ -575,8 +576,6 @@ def tracking_excitation(cfg: RigConfig, duration_s: float, *, amplitude_a: float
     IdentificationError
         An amplitude above the current limit, or no limit and no amplitude.
     """
-    from ambseal.model.amb import channel_names
-    from ambseal.identify.signals import prbs
 
     fs = cfg.controller.sample_rate_hz
     limit = current_limit(cfg)

@@ -74,10 +74,17 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ambseal.errors import IdentificationError
-from ambseal.model.lft import Plant
-from ambseal.identify.coprime import (CoprimeFactors, _as_2d, _ss, check_bezout, coprime_factors,
-                      observer_gains, youla_factorisation)
+from ambseal.identify.coprime import (
+    CoprimeFactors,
+    _as_2d,
+    _ss,
+    check_bezout,
+    coprime_factors,
+    observer_gains,
+    youla_factorisation,
+)
 from ambseal.lti.discrete import simulate_lti, zoh
+from ambseal.model.lft import Plant
 
 __all__ = [
     "CoprimeFactors",

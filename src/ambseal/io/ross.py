@@ -32,8 +32,11 @@ the lateral [x, y, α, β], so ROSS's axial and torsional modes have no counterp
 from __future__ import annotations
 
 import contextlib
+import json
 import math
 import sys
+import tomllib
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -257,11 +260,10 @@ def load_ross(path: str | Path):
         raise ConfigError(f"{path}: expected a ROSS rotor file (.toml or .json)")
     with contextlib.redirect_stdout(sys.stderr):
         try:
-            import ross
+            import ross  # optional: the [ross] extra
         except ImportError:
             raise ConfigError("ross-rotordynamics is not installed (pip install "
                               "'ambseal[ross]')") from None
-        import warnings
 
         _check_file(path, ross)
         try:
@@ -277,8 +279,6 @@ def load_ross(path: str | Path):
 def _check_file(path: Path, ross) -> None:
     """Clear errors for what ROSS's own loader reports obscurely: not a rotor file, an
     element class ROSS does not have, a shaft element without its material."""
-    import json
-    import tomllib
 
     try:
         text = path.read_text(encoding="utf-8")
@@ -313,7 +313,7 @@ def import_ross_file(path: str | Path, out: str | Path) -> dict:
     ConfigError
         As :func:`load_ross` and :func:`from_ross`.
     """
-    import ross
+    import ross  # optional: the [ross] extra
 
     res = from_ross(load_ross(path), where=str(path))
     header = (f"Imported by ambseal from the ROSS rotor file {path} (ROSS {ross.__version__})"

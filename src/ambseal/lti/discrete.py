@@ -18,6 +18,7 @@ from __future__ import annotations
 from functools import lru_cache
 from typing import Any
 
+import control
 import numpy as np
 import scipy.linalg as sla
 from numba import njit
@@ -91,7 +92,6 @@ def discretize(sys: Any, dt_s: float, method: str = "tustin"):
     ModelError
         A bad sample time, an unknown method or a discrete-time input.
     """
-    import control
 
     if not (np.isfinite(dt_s) and dt_s > 0):
         raise ModelError(f"dt_s={dt_s!r}: the sample time must be a positive number of seconds")

@@ -33,6 +33,7 @@ from typing import Any, Literal
 
 import numpy as np
 import scipy.linalg
+from slycot import tb05ad
 
 from ambseal.errors import ModelError
 from ambseal.lti.matrices import ArrayMemo, as_omega, ss_matrices
@@ -337,7 +338,6 @@ def _hessenberg_form(A, B, C):
 
 def _slycot_response(Hs: np.ndarray, Bh: np.ndarray, Ch: np.ndarray, D: np.ndarray, s: np.ndarray) -> np.ndarray:
     """TB05AD with job 'NH' (A given in upper Hessenberg form): O(n²) per frequency."""
-    from slycot import tb05ad
 
     n, m = Bh.shape
     p = Ch.shape[0]

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from typing import Any
 
+import control
 import numpy as np
 
 from ambseal.errors import ModelError
@@ -104,7 +105,6 @@ def lft_lower(P: Any, K: Any, nmeas: int, ncon: int, name: str = "closed_loop"):
     ModelError
         If ``I − D22·D_K`` is singular (ill-posed loop).
     """
-    import control
 
     mats = lft_lower_matrices(ss_matrices(P, name="P", allow_discrete=True),
                               ss_matrices(K, name="K", allow_discrete=True), nmeas, ncon)

@@ -15,6 +15,7 @@ import hashlib
 from collections import OrderedDict
 from typing import Any, Callable
 
+import control
 import numpy as np
 
 from ambseal.errors import ModelError
@@ -53,8 +54,6 @@ def ss_matrices(sys: Any, *, name: str = "sys",
     if isinstance(sys, tuple) and len(sys) == 4:
         A, B, C, D = (np.atleast_2d(np.asarray(m, dtype=float)) for m in sys)
     else:
-        import control
-
         if not isinstance(sys, control.StateSpace):
             try:
                 sys = control.ss(sys)

@@ -16,14 +16,14 @@ from __future__ import annotations
 
 import copyreg
 
+import control
+
 __all__ = ["picklable"]
 
 _DONE = False
 
 
 def _rebuild(A, B, C, D, dt, inputs, outputs, states, name):
-    import control
-
     picklable()
     return control.ss(A, B, C, D, dt, inputs=inputs, outputs=outputs, states=states, name=name)
 
@@ -41,7 +41,6 @@ def picklable() -> None:
     global _DONE
     if _DONE:
         return
-    import control
 
     for cls in (control.StateSpace, getattr(control, "LinearICSystem", None)):
         if cls is not None:

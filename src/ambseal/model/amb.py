@@ -20,7 +20,7 @@ import numpy as np
 
 from ambseal.config import Actuator, Amb, AxisPair, RigConfig
 from ambseal.model.lft import Channel
-from ambseal.model.rotor import X, Y, Mesh
+from ambseal.model.rotor import Mesh, X, Y
 
 __all__ = ["AXES", "MU0", "axes_rotation", "channel_names", "amb_factors_from_geometry",
            "amb_factors", "AmbElement", "actuator_matrices", "eddy_lag_matrices"]

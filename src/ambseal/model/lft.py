@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 
+import control
 import numpy as np
 
 from ambseal.errors import ModelError
@@ -183,7 +184,6 @@ class Plant:
 
     def to_statespace(self):
         """The plant as a ``control.StateSpace`` with named inputs, outputs and states."""
-        import control
 
         picklable()
         return control.ss(
@@ -203,7 +203,6 @@ class Plant:
         gives the plant with changes θ. The θ channels are named ``w_<tag>``, ``z_<tag>``
         with :func:`channel_tag` (python-control allows no '.' in a signal name).
         """
-        import control
 
         picklable()
         Bt, Ct, Dt = self.channels(names)

@@ -29,7 +29,7 @@ from ambseal.model.rig import SecondOrderSystem, build_system
 __all__ = ["Modes", "modes", "lowest_eigenvalues", "free_bending_hz", "bending_limit_hz",
            "classify_poles", "RIGID_BODY_RAD_S", "STABILITY_FLOOR_RAD_S"]
 
-# Thresholds on the physics, not on the stiffest DOF (issue 15). A computed eigenvalue with
+# Thresholds on the physics, not on the stiffest DOF. A computed eigenvalue with
 # |λ| below RIGID_BODY_RAD_S = 2π·0.1 Hz is a rigid-body mode (λ = 0): a mode of interest of
 # a rotor on bearings, seals and springs lies well above 0.1 Hz (a 70-kg rotor would need a
 # support of 28 N/m to sit there). A pole is unstable when Re λ exceeds

@@ -24,7 +24,8 @@ from ambseal.config import RigConfig
 from ambseal.errors import ModelError
 from ambseal.model.amb import AXES, AmbElement, actuator_matrices, eddy_lag_matrices
 from ambseal.model.lft import Channel, Parameter, Plant
-from ambseal.model.rotor import X, Y, Mesh, assemble_rotor, build_mesh
+from ambseal.model.reduction import modal_reduction
+from ambseal.model.rotor import Mesh, X, Y, assemble_rotor, build_mesh
 from ambseal.model.seal import SealElement
 from ambseal.model.spring import SpringElement
 
@@ -216,7 +217,6 @@ def build_plant(
     from ``[reduction]``, else 8 states). The actuator model of ``[actuator]`` is put in
     series with the current inputs after the reduction, as in thesis P5 Fig. 8.
     """
-    from ambseal.model.reduction import modal_reduction
 
     sys = build_system(cfg, pressure_bar=pressure_bar, speed_rpm=speed_rpm,
                        force_positions=force_positions)

@@ -18,10 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ambseal.config import Affine, FrequencyTable, Seal
-from ambseal.lti.tables import interp_table
 from ambseal.errors import ModelError
+from ambseal.lti.tables import interp_table
 from ambseal.model.lft import Channel
-from ambseal.model.rotor import X, Y, Mesh
+from ambseal.model.rotor import Mesh, X, Y
 
 __all__ = ["COEFFICIENTS", "coefficient_value", "seal_coefficients",
            "seal_values", "pressure_for_k", "values_following_k", "SealElement"]

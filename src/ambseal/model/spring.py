@@ -17,7 +17,7 @@ import numpy as np
 from ambseal.config import Spring
 from ambseal.model.amb import axes_rotation
 from ambseal.model.lft import Channel
-from ambseal.model.rotor import X, Y, Mesh
+from ambseal.model.rotor import Mesh, X, Y
 
 __all__ = ["KEYS", "spring_label", "SpringElement"]
 

@@ -17,11 +17,12 @@ from typing import Mapping, Sequence
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from matplotlib.image import imsave
-from matplotlib.collections import LineCollection
 from matplotlib.ticker import LogLocator, NullFormatter, NullLocator, ScalarFormatter
 
+from ambseal.analysis.iso import ZONE_LIMITS, ZONES, zone_limit_db
 from ambseal.errors import AmbsealError
 from ambseal.files import atomic_write
 
@@ -208,7 +209,6 @@ def sensitivity_figure(
     -------
     pathlib.Path
     """
-    from ambseal.analysis.iso import ZONE_LIMITS, ZONES, zone_limit_db
 
     def zones(ax, cs):
         top = max(_finite_max(cs) * 1.5, 1.6 * ZONE_LIMITS[-1])

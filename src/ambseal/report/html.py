@@ -20,6 +20,13 @@ from typing import Any, Mapping, Sequence
 
 from ambseal.errors import AmbsealError
 from ambseal.files import write_text
+from ambseal.report.verdict import (
+    ZONE_COLOURS,
+    ZONE_WORDS,
+    detail_table_html,
+    verdict_table_html,
+    verdicts,
+)
 
 __all__ = ["render_report", "write_report"]
 
@@ -57,8 +64,6 @@ def _figure_html(path: str | os.PathLike, caption: str | None, alt: str) -> str:
 
 
 def _zone_legend() -> str:
-    from ambseal.report.verdict import ZONE_COLOURS, ZONE_WORDS
-
     return ('<p class="legend">ISO 14839-3 zones: ' + " ".join(
         f'<span style="background:{c}">{z}</span>{_esc(ZONE_WORDS[z])}'
         for z, c in ZONE_COLOURS.items()) + "</p>")
@@ -74,7 +79,6 @@ def render_report(
     clearances_um: Mapping[str, float] | None = None,
 ) -> str:
     """The report page as a string (see :func:`write_report`)."""
-    from ambseal.report.verdict import detail_table_html, verdict_table_html, verdicts
 
     parts = [
         "<!DOCTYPE html>",

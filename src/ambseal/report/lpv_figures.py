@@ -15,6 +15,7 @@ from typing import Mapping, Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
+from ambseal.analysis.iso import ZONE_LIMITS, zone_limit_db
 from ambseal.report.figures import save_figure
 
 __all__ = ["spinup_figure", "frozen_sensitivity_figure"]
@@ -81,7 +82,6 @@ def frozen_sensitivity_figure(path: str | os.PathLike, results: Sequence, *,
     -------
     pathlib.Path
     """
-    from ambseal.analysis.iso import ZONE_LIMITS, zone_limit_db
 
     n = max(len(results), 1)
     fig = Figure(figsize=(5 * n, 4.2))

@@ -12,6 +12,7 @@ import os
 from pathlib import Path
 
 import numpy as np
+from matplotlib.colors import TwoSlopeNorm
 from matplotlib.figure import Figure
 
 from ambseal.report.figures import save_figure
@@ -149,7 +150,6 @@ def stability_map_figure(path: str | os.PathLike, rows: list[dict], boundary: li
     boundary : list of dict
         :func:`ambseal.analysis.sweep.stability_boundary` of the same rows.
     """
-    from matplotlib.colors import TwoSlopeNorm
 
     names = list(dict.fromkeys(r["controller"] for r in rows))
     fig = Figure(figsize=(5.2 * len(names), 4.4))

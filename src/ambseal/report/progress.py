@@ -13,6 +13,9 @@ import logging
 import time
 from typing import Mapping
 
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
 __all__ = ["StageProgress", "LOGGER"]
 
 #: The logger of every stage line.
@@ -42,10 +45,6 @@ class StageProgress:
 
     def __enter__(self) -> "StageProgress":
         if self._display:
-            from rich.console import Console
-            from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn,
-                                       TimeElapsedColumn)
-
             self._progress = Progress(
                 TextColumn("{task.description:<15}"), BarColumn(bar_width=30),
                 MofNCompleteColumn(), TimeElapsedColumn(),

@@ -7,12 +7,32 @@ thesis's (P5 Figs. 10–15, P4 Figs. 9–12, P5 Fig. 7, P3 Figs. 11–12).
 
 from __future__ import annotations
 
+import datetime
+import hashlib
 import html
 import math
 from pathlib import Path
 
 import numpy as np
 
+from ambseal import __version__
+from ambseal.design.specs import machine
+from ambseal.identify.checks import true_line
+from ambseal.identify.seal_test import MIN_FIT_PCT, fit_reliability
+from ambseal.lti.freqresp import freqresp
+from ambseal.report import figures
+from ambseal.report.figures import case_style, controller_colours, controller_gains_figure
+from ambseal.report.html import write_report
+from ambseal.report.identify_figures import (
+    correlation_figure,
+    facility_impulse_figure,
+    fit_timeseries_figure,
+    frf_figure,
+    residual_figure,
+    seal_frequency_figure,
+    seal_pressure_figure,
+)
+from ambseal.report.lpv_figures import frozen_sensitivity_figure, spinup_figure
 from ambseal.report.verdict import axis_label, sig
 
 __all__ = ["gains_figure", "spinup_figures", "identification_report", "write_run_report",
@@ -21,10 +41,6 @@ __all__ = ["gains_figure", "spinup_figures", "identification_report", "write_run
 
 def stamp(rig_path: str | Path, command: str | None = None) -> str:
     """The report's stamp: ambseal version, date (UTC), rig file, its SHA-256 and the command."""
-    import datetime
-    import hashlib
-
-    from ambseal import __version__
 
     rig_path = Path(rig_path)
     digest = hashlib.sha256(rig_path.read_bytes()).hexdigest()[:16]
@@ -37,7 +53,6 @@ def rig_clearances_um(cfg) -> dict[str, float]:
     """Clearances (µm) the unbalance orbit is judged against: the nominal AMB air gap
     (:func:`ambseal.design.specs.machine`: ``air_gap``, or Ki·i0/Ks) and the smallest
     backup-bearing clearance (``[[amb]] backup_clearance``), those the rig gives."""
-    from ambseal.design.specs import machine
 
     out = {}
     gap = machine(cfg).air_gap_m if cfg.amb else None
@@ -52,10 +67,6 @@ def rig_clearances_um(cfg) -> dict[str, float]:
 def gains_figure(out: Path, controllers: list[tuple[str, object]]) -> tuple[str, Path]:
     """Direct and cross gains of physical controllers ``[(name, StateSpace)]`` (P5 Fig. 10),
     1 Hz – 2 kHz."""
-    from ambseal.lti.freqresp import freqresp
-    from ambseal.report.figures import controller_gains_figure
-
-    from ambseal.report.figures import case_style, controller_colours
 
     f = np.logspace(0, math.log10(2000.0), 300)
     rows = [(m, f, freqresp(K, 2 * np.pi * f)) for m, K in controllers]
@@ -69,8 +80,6 @@ def gains_figure(out: Path, controllers: list[tuple[str, object]]) -> tuple[str,
 def spinup_figures(out: Path, sims: list, sens: list, speeds_hz: tuple[float, float]
                    ) -> list[tuple[str, Path]]:
     """The spin-up (P3 Fig. 11) and σ̄(S_o) at frozen speeds (P3 Fig. 12)."""
-    from ambseal.report.figures import controller_colours
-    from ambseal.report.lpv_figures import frozen_sensitivity_figure, spinup_figure
 
     lo, hi = speeds_hz
     colours = controller_colours([r.name for r in sims])
@@ -102,10 +111,6 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
     (figures, sections)
         ``[(caption, png)]`` and ``[{"title", "html"}]`` for :func:`write_run_report`.
     """
-    from ambseal.identify.checks import true_line
-    from ambseal.identify.seal_test import MIN_FIT_PCT, fit_reliability
-    from ambseal.report.identify_figures import (correlation_figure, fit_timeseries_figure, frf_figure,
-                                   residual_figure, seal_frequency_figure, seal_pressure_figure)
 
     a = res.amb
     figs = [("Identification (a): measured and simulated displacements, PRBS at 0 bar",
@@ -210,7 +215,6 @@ def facility_impulse_report(out: Path, checks: list, design_note: dict
                             ) -> tuple[list, list]:
     """Figure and section: impulse responses on the virtual facility beside the identified
     model's (P5 Figs. 15–16), and which rig the robust controllers were designed on."""
-    from ambseal.report.identify_figures import facility_impulse_figure
 
     figs = [("Impulse responses, 0.05 A for 10 ms on the first bearing's ζ and the last "
              "bearing's η: virtual facility (dashed) against the identified model (solid), "
@@ -242,7 +246,6 @@ def facility_impulse_report(out: Path, checks: list, design_note: dict
 def _seal_table(res) -> str:
     """The stepped-sine seal fits per pressure and frequency: the K–c and C–k correlations
     (Jacobian, as P4 Table 4), the NRMSE fit and why a fit is unreliable."""
-    from ambseal.identify.seal_test import fit_reliability
 
     rows = []
     for p, fits in res.seal_vs_frequency.items():
@@ -269,7 +272,6 @@ def _seal_table(res) -> str:
 def _styles(curves: list) -> tuple[dict, dict]:
     """Label → style of every case (one colour per controller, one line style per condition),
     and label → style of the unstable ones (not drawn)."""
-    from ambseal.report.figures import case_style, controller_colours
 
     colours = controller_colours([m for m, _, _, _ in curves])
     styles = {f"{m}, {p.label}": case_style(colours[m], p.condition) for m, p, _, _ in curves}
@@ -315,8 +317,6 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
     "impulse"})]`` in the order of ``metrics["cases"]``; a case whose loop is unstable is
     listed in each figure's legend, not drawn. ``meta`` is the stamp (:func:`stamp`).
     """
-    from ambseal.report import figures
-    from ambseal.report.html import write_report
 
     styles, unstable = _styles(curves)
     kw = dict(styles=styles, unstable=unstable)

@@ -19,6 +19,13 @@ import math
 from dataclasses import dataclass
 from typing import Any, Mapping, Sequence
 
+from rich import box
+from rich.console import Group
+from rich.table import Table
+from rich.text import Text
+
+from ambseal.robust.digital import PEAK_TOLERANCE
+
 __all__ = ["ZONE_COLOURS", "ZONE_WORDS", "Verdict", "verdicts", "condition_label",
            "verdict_table_html", "verdict_table_rich", "detail_table_html", "sig",
            "axis_label", "target_difference"]
@@ -139,7 +146,6 @@ class Verdict:
         gap = [c for c in self.clearances_um.values() if c]
         if self.orbit_um is not None and gap and self.orbit_um > 0.5 * min(gap):
             text += f"; the unbalance orbit uses over half of the clearance"
-        from ambseal.robust.digital import PEAK_TOLERANCE
 
         if self.target_difference is not None and self.target_difference > PEAK_TOLERANCE:
             text += (f"; as it runs on the target its σ̄(S_o) peak differs from the continuous "
@@ -261,10 +267,6 @@ def verdict_table_rich(vs: Sequence[Verdict]):
     """The first screen for a terminal: a compact ``rich`` table (zones coloured, fits 80
     columns; the orbit against the first clearance the rig gives) and one line per
     controller with its verdict in words."""
-    from rich import box
-    from rich.console import Group
-    from rich.table import Table
-    from rich.text import Text
 
     gap = next(iter(vs[0].clearances_um.items()), None) if vs else None
     title = "Verdict — ISO 14839-3 zone: worst axis / σ̄" + (

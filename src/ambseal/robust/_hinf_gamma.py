@@ -10,6 +10,9 @@ and closes in by Brent's method on a γ margin; :func:`sb10ad` calls SLICOT SB10
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg.lapack import dgees
+from scipy.optimize import brentq
+from slycot import _wrapper
 
 from ambseal.errors import SynthesisError
 
@@ -22,7 +25,6 @@ def game_riccati(A, B, C1, D1, nw: int, g: float):
     (Glover & Doyle 1988), from the stable invariant subspace of its Hamiltonian (LAPACK
     DGEES with the stable eigenvalues ordered first); None if the Hamiltonian has
     imaginary-axis eigenvalues, the subspace is not a graph or X ⋡ 0."""
-    from scipy.linalg.lapack import dgees
 
     n = A.shape[0]
     if n == 0:
@@ -63,7 +65,6 @@ def search_gamma(margin, lo: float, rtol: float, seen: dict | None = None, *,
     where it jumps) to ``hi/lo ≤ 1 + rtol``.
     ``seen`` holds margins already known. Returns ``(hi, lo, tests)``: smallest admissible
     and largest inadmissible γ tried, and the number of new margins computed."""
-    from scipy.optimize import brentq
 
     seen = dict(seen or {})
     known = len(seen)
@@ -138,7 +139,6 @@ def sb10ad(A, B, C, D, ncon, nmeas, gamma, job, gtol=1e-6):
     since every γ is verified afterwards), to an absolute tolerance ``gtol`` in γ; job 4:
     the γ test and controller at ``gamma``.
     """
-    from slycot import _wrapper
 
     n, m, p = A.shape[0], B.shape[1], C.shape[0]
     liwork, ldwork = _sb10ad_workspace(n, m, p, ncon, nmeas)

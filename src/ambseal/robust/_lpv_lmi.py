@@ -12,9 +12,11 @@ equations are in :mod:`ambseal.robust.lpv`. SDPs are solved by Clarabel through 
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
+import cvxpy as cp
 import numpy as np
 import scipy.linalg as sla
 
@@ -101,7 +103,6 @@ def _check_status(prob, stage: str, t0: float) -> SolverReport:
 
 
 def _solve(prob, stage: str, solver_options: dict):
-
     t0 = time.perf_counter()
     _solve_quiet(prob, stage, dict(solver_options))
     return _check_status(prob, stage, t0)
@@ -226,9 +227,6 @@ def _sym_expr(X):
 
 
 def _solve_quiet(prob, stage: str, solver_options: dict) -> None:
-    import warnings
-
-    import cvxpy as cp
 
     try:
         with warnings.catch_warnings():
@@ -274,7 +272,6 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
     SynthesisError
         Infeasible LMIs or a solver status other than ``optimal``.
     """
-    import cvxpy as cp
 
     B1, B2, C1, C2, D11, D12, D21 = blocks
     N, nw, nz = B1.shape[0], B1.shape[1], C1.shape[0]

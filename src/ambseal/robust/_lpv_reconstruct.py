@@ -12,11 +12,20 @@ from __future__ import annotations
 
 import time
 
+import cvxpy as cp
 import numpy as np
 
 from ambseal.errors import SynthesisError
-from ambseal.robust._lpv_lmi import BASES, Scaled, SolverReport, _check_status, _solve_quiet, _sym, \
-    _sym_expr, basis
+from ambseal.robust._lpv_lmi import (
+    BASES,
+    Scaled,
+    SolverReport,
+    _check_status,
+    _solve_quiet,
+    _sym,
+    _sym_expr,
+    basis,
+)
 
 __all__ = ["interp_A", "reconstruct_table"]
 
@@ -136,7 +145,6 @@ class _Reconstructor:
 
     def __init__(self, B1, B2, C1, C2, D11, D12, D21, R, gamma, margin, n_signs,
                  solver_options):
-        import cvxpy as cp
 
         N = B1.shape[0]
         nw, nz = B1.shape[1], C1.shape[0]

@@ -17,7 +17,7 @@ closes by name in python-control with the sign written into the connection::
 * A **scheduled** controller is a :class:`ScheduledController` scheduled on one named
   parameter θ: the rotor speed (``parameter == "speed"``, Ω in rad/s; the LPV controller of
   P3) or an LFT parameter of the rig (e.g. ``"seal.k"`` in N/m, the controller scheduled on
-  the tracked seal coefficient, issue 14). ``at(θ)`` gives the frozen fixed controller at
+  the tracked seal coefficient). ``at(θ)`` gives the frozen fixed controller at
   θ inside ``schedule``.
 
 Analyses take either through :func:`frozen` and :func:`matrices_at`.

@@ -35,6 +35,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+import control
 import numpy as np
 
 from ambseal.errors import ConfigError
@@ -99,7 +100,6 @@ def loop_delay(sample_rate_hz: float, delay_samples: int) -> DesignDelay:
 def _pade_ss(tau: float, n: int):
     """The order-n Padé approximation of e^{−sτ} as a StateSpace realised in s·τ (entries
     of order one: A = A₁/τ, B = B₁/τ for the realisation (A₁, B₁, C₁, D) of N(−p)/N(p))."""
-    import control
 
     num, den = control.pade(1.0, n)
     A1, B1, C1, D1 = (np.asarray(m, float) for m in control.ssdata(control.tf(num, den)))

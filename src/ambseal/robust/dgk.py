@@ -43,11 +43,13 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Sequence
 
-import numpy as np
 import control as ct
+import numpy as np
+from rich.console import Console
 from scipy.optimize import least_squares
 
 from ambseal.errors import ConfigError, SynthesisError
+from ambseal.lti.freqresp import freqresp
 from ambseal.robust.dk import MusynResult, _diag_sys, _ss, default_omega, fit_dscale, musyn
 from ambseal.robust.hinf import hinfsyn, lft_lower
 from ambseal.robust.mu import check_blocks, mussv
@@ -250,7 +252,6 @@ def _uncertainty_idle(P, K, nmeas, ncon, blks, w, mu_peak, rtol) -> bool:
     (forced) reach 0.9019 (−0.26 %, below ``rtol``) for 6 s of CPU, of 15. (Mixed against
     complex μ of D–K's controller is no such test: on a ±90 % real gain they agree to 1e-5,
     and D–G–K still lowers μ by 20 %.)"""
-    from ambseal.lti.freqresp import freqresp
 
     nd_in, nd_out = sum(b.r for b in blks[:-1]), sum(b.c for b in blks[:-1])
     H = freqresp(lft_lower(P, K, nmeas, ncon), w)[:, nd_out:, nd_in:]
@@ -318,8 +319,6 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
         return replace(dk, history=tuple(history))
     console = None
     if progress:
-        from rich.console import Console
-
         console = Console(stderr=True)
     best = (dk.mu, dk.best_iteration, dk.K, dk.gamma, np.asarray(dk.mu_curve), dk.scalings)
     K, stall = dk.K, 0

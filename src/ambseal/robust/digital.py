@@ -47,16 +47,20 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Callable, Sequence
 
+import control
 import numpy as np
 import scipy.linalg as sla
+from scipy.signal import cont2discrete
 
 from ambseal.errors import ConfigError, SynthesisError
-from ambseal.robust.digital_loop import DiscreteController
 from ambseal.lti.discrete import zoh
 from ambseal.lti.freqresp import freqresp, freqresp_at
 from ambseal.lti.interconnect import feedback_poles, series_inputs
 from ambseal.robust._digital_choice import first_stable as _first_stable
 from ambseal.robust._digital_choice import so_peak as _so_peak
+from ambseal.robust.delay import check_timing, loop_delay
+from ambseal.robust.digital_loop import DiscreteController
+from ambseal.robust.hinf import hinfnorm
 
 __all__ = ["FAST_FRACTION", "METHODS", "PEAK_TOLERANCE", "peak_difference",
            "DigitalController", "split_fast", "residualize", "hold_keeps", "HOLDS", "KEPT",
@@ -143,7 +147,6 @@ class DigitalController:
     def statespace(self, delayed: bool = False):
         """The discrete controller as a named ``control.StateSpace`` (``dt = Ts``); with
         ``delayed`` the computation delay included (what the plant sees)."""
-        import control
 
         d = self.discrete
         mats = (d.A, d.B, d.C, d.D)
@@ -223,7 +226,6 @@ def check_rate(K, sample_rate_hz: float, delay_samples: int = 0, removable: bool
     removed (``removable``: a design whose γ or μ can be re-checked, or a scheduled one),
     a rate of at least twice its highest pole (Hz).
     """
-    from ambseal.robust.delay import check_timing
 
     check_timing(sample_rate_hz, delay_samples)
     A = np.asarray(getattr(K, "A", np.zeros((0, 0))), float)
@@ -313,8 +315,6 @@ def discretize_as(mats: Matrices, dt: float, method: str, prewarp_hz: float | No
     ConfigError
         Unknown method, or ``"tustin_prewarp"`` without a frequency below Nyquist.
     """
-    import control
-    from scipy.signal import cont2discrete
 
     A, B, C, D = mats
     if method == "zoh":
@@ -370,8 +370,6 @@ def design_rise(result, K_reduced, omega=None, nyquist_hz: float | None = None
     out = {"order_full": int(result.K.nstates), "order": int(K_reduced.nstates)}
     # the design's own verified γ / μ peak (same loop, same grid) is the "before"
     if method == "hinf":
-        from ambseal.robust.hinf import hinfnorm
-
         out["gamma_full"] = float(result.gamma)
         out["gamma"] = float(hinfnorm(gp.closed_loop(K_reduced, nominal=True))[0])
         out["rise"] = out["gamma"] / out["gamma_full"] - 1.0
@@ -415,7 +413,6 @@ def prewarp_frequency_hz(G_list, K: Matrices, fs: float) -> float | None:
 def _remove_fast(K, mats: Matrices, fs: float, rise: Callable | None):
     """Fast poles removed (module docstring, step 1): (matrices, StateSpace, poles, rise).
     Nothing is removed without ``rise`` (no design to report the cost on)."""
-    import control
 
     f_cut = FAST_FRACTION * fs / 2
     if not mats[0].size or rise is None:
@@ -460,7 +457,6 @@ def sampled_plants(plants: Sequence[Matrices], fs: float, n_grid: int = 400, *,
     sampled plant's modal form checked at rtol 1e-6, as in :mod:`ambseal.analysis.loops`);
     the continuous plants with the Padé lag of ``delay_samples`` + ½ samples
     (:func:`ambseal.robust.delay.loop_delay`)."""
-    from ambseal.robust.delay import loop_delay
 
     T = 1.0 / fs
     w = 2 * np.pi * np.logspace(0, np.log10(0.999 * fs / 2), n_grid)

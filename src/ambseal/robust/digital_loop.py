@@ -14,9 +14,8 @@ which :func:`ambseal.lti.discrete.simulate_lti` runs as an exact block recursion
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
-
 import math
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 

@@ -21,9 +21,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Sequence
 
-import numpy as np
 import control as ct
+import numpy as np
+from rich.console import Console
 from scipy.optimize import least_squares, minimize
+from scipy.signal import tf2ss
 
 from ambseal.errors import ConfigError, ModelError, SynthesisError
 from ambseal.robust.hinf import check_plant, hinf_gamma_opt, hinfsyn, lft_lower
@@ -363,7 +365,6 @@ def _diag_sys(parts):
 def _realize(theta, order):
     """State spaces (A, B, C, D) of the D scale of section parameters ``theta``
     (:func:`_theta_to_tf`) and of its inverse, by numpy alone (for the D search)."""
-    from scipy.signal import tf2ss
 
     if order == 0:
         a, b, c, d = np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), \
@@ -523,8 +524,6 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     cblocks = _complexify(blks)
     console = None
     if progress:
-        from rich.console import Console
-
         console = Console(stderr=True)
 
     history, best = [], None

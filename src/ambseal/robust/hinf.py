@@ -28,17 +28,19 @@ import functools
 from dataclasses import dataclass, field
 from typing import Any
 
+import control as ct
 import numpy as np
 import scipy.linalg as sla
-import control as ct
+from slycot import ab13dd
 
 from ambseal.errors import ConfigError, ModelError, SynthesisError
+from ambseal.lti.interconnect import lft_lower, lft_lower_matrices
 from ambseal.robust._hinf_gamma import backoff_ladder as _backoff_ladder
 from ambseal.robust._hinf_gamma import game_riccati as _game_riccati
 from ambseal.robust._hinf_gamma import gamma_search as _gamma_search
 from ambseal.robust._hinf_gamma import sb10ad as _sb10ad
 from ambseal.robust._hinf_gamma import search_gamma as _search_gamma
-from ambseal.lti.interconnect import lft_lower, lft_lower_matrices
+from ambseal.robust._hinf_small import small_margin
 
 __all__ = ["HinfResult", "hinfsyn", "hinf_gamma_opt", "hinfnorm", "lft_lower", "check_plant"]
 
@@ -119,7 +121,6 @@ def hinfnorm(sys, rtol: float = 1e-10) -> tuple[float, float]:
 def _linfnorm_matrices(A, B, C, D, rtol: float = 1e-10) -> tuple[float, float]:
     """L∞ norm and peak frequency of a continuous (A, B, C, D): SLICOT AB13DD through
     slycot, as ``control.linfnorm`` calls it, without building a system object."""
-    from slycot import ab13dd
 
     n, m, p = A.shape[0], B.shape[1], C.shape[0]
     if n == 0:
@@ -298,10 +299,13 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
             max_backoff: float = 4.0, rtol: float = 1e-6) -> HinfResult:
     """H∞ controller for a generalised plant (Paper 3 eq. 12; Paper 5 eq. 8).
 
-    Finds the optimal γ by bisection between cheap bounds — Parrott's bound on the
-    feedthrough, then a ladder of factors 4 to the first change of admissibility — each step
-    SB10AD's γ test (Glover & Doyle 1988), to a relative tolerance ``rtol``; python-control's
-    ``hinfsyn`` starts SB10AD's bisection and scan at γ = 1e100 instead. Then it builds the
+    Brackets the optimal γ between cheap bounds — Parrott's bound on the feedthrough, then
+    a ladder of factors 4 to the first change of admissibility — and closes in by Brent's
+    method on the Riccati γ margin ρ(X∞Y∞)/γ² − 1 (Glover & Doyle 1988; compiled for plants
+    of at most 6 states), to a relative tolerance ``rtol``; where the margin is undefined
+    (e.g. repeated Hamiltonian eigenvalues) SLICOT SB10AD's own bisection takes over, and
+    SB10AD's γ test confirms the result. python-control's ``hinfsyn`` starts SB10AD's
+    bisection and scan at γ = 1e100 instead. Then it builds the
     controller at ``backoff·γ_opt`` and checks that the closed loop is stable; the back-off
     grows (×1.01 … ×``max_backoff``) until it is. The reported γ is the recomputed norm of
     ``F_l(P, K)``.
@@ -322,7 +326,7 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
     max_backoff : float
         Largest back-off tried before giving up.
     rtol : float
-        Relative tolerance of γ_opt (the bisection stops at ``hi/lo ≤ 1 + rtol``).
+        Relative tolerance of γ_opt (the search stops at ``hi/lo ≤ 1 + rtol``).
 
     Returns
     -------
@@ -495,7 +499,6 @@ class _Sb10:
         the plant is larger."""
         if self.A.shape[0] > _SMALL_STATES:
             return float("nan")
-        from ambseal.robust._hinf_small import small_margin
 
         return float(small_margin(self.A, self.B, self.C, self.D, self.nw, self.nz,
                                   float(g)))

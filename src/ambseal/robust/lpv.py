@@ -44,12 +44,23 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Sequence
 
+import control
+import control as ct
 import numpy as np
 
 from ambseal.errors import SynthesisError
 from ambseal.lti.interconnect import lft_lower_matrices
-from ambseal.robust._lpv_lmi import _DEFAULT_TOL, BASES, SolverReport, lmi_blocks, scale_grid, solve_lmis
+from ambseal.lti.tables import interp_table
+from ambseal.robust._lpv_lmi import (
+    _DEFAULT_TOL,
+    BASES,
+    SolverReport,
+    lmi_blocks,
+    scale_grid,
+    solve_lmis,
+)
 from ambseal.robust._lpv_reconstruct import interp_A, reconstruct_table
+from ambseal.robust.hinf import hinfnorm
 
 __all__ = ["LpvController", "LpvSynResult", "lpvsyn", "SolverReport"]
 
@@ -83,7 +94,6 @@ class LpvController:
 
     def matrices(self, speed_rad_s: float) -> tuple[np.ndarray, ...]:
         """(A_K, B_K, C_K, D_K) at Ω (rad/s), linear between table speeds, held at the ends."""
-        from ambseal.lti.tables import interp_table
 
         return tuple(interp_table(float(speed_rad_s), self.speeds_rad_s, X)
                      for X in (self.AK, self.BK, self.CK, self.DK))
@@ -92,7 +102,6 @@ class LpvController:
         """The frozen controller at Ω (rad/s) as a named ``control.StateSpace``, synthesis
         units (the physical one: :meth:`ambseal.design.lpv_design.LpvDesign.controller_at`).
         """
-        import control
 
         A, B, C, D = self.matrices(speed_rad_s)
         return control.ss(A, B, C, D,
@@ -339,9 +348,6 @@ def _check_table(K: LpvController, A_of, B, C, D, nmeas: int, ncon: int) -> np.n
     SynthesisError
         If one of these frozen closed loops is unstable.
     """
-    import control as ct
-
-    from ambseal.robust.hinf import hinfnorm
 
     table = K.speeds_rad_s
     check_g, stable = [], True

@@ -39,10 +39,10 @@ from typing import Sequence
 
 import numpy as np
 
-from ambseal.robust._mu_lower import lower_bound as _lower_bound
-from ambseal.robust._mu_upper import upper_bound as _upper_bound
 from ambseal.errors import ModelError
 from ambseal.lti.freqresp import freqresp
+from ambseal.robust._mu_lower import lower_bound as _lower_bound
+from ambseal.robust._mu_upper import upper_bound as _upper_bound
 
 __all__ = ["MuResult", "mussv", "parse_blocks", "check_blocks"]
 

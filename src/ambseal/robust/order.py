@@ -13,11 +13,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Sequence
 
-import numpy as np
 import control as ct
+import numpy as np
+from slycot import ab09md
 
-from ambseal.robust.hinf import hinfnorm, lft_lower
 from ambseal.errors import ConfigError
+from ambseal.robust.hinf import hinfnorm, lft_lower
+from ambseal.robust.mu import mussv
 
 __all__ = ["ReductionResult", "balred_controller", "reduce_controller"]
 
@@ -61,7 +63,6 @@ def balred_controller(K, order: int, alpha: float | None = None):
     names = dict(inputs=list(K.input_labels), outputs=list(K.output_labels), name=f"{K.name}_r")
     if order == n:
         return ct.ss(A, B, C, D, **names), np.zeros(0)
-    from slycot import ab09md
 
     m, p = B.shape[1], C.shape[0]
     Nr, Ar, Br, Cr, Ns, hsv = ab09md("C", "B", "N", n, m, p, A, B, C, alpha=alpha,
@@ -156,8 +157,6 @@ def reduce_controller(P, K, order: int, nmeas: int, ncon: int, *,
     g_red, _ = hinfnorm(lft_lower(P, Kr, nmeas, ncon))
     mu_red = None
     if blocks is not None:
-        from ambseal.robust.mu import mussv
-
         if mu_full is None:
             mu_full = float(np.max(mussv(lft_lower(P, K, nmeas, ncon), blocks, omega).upper))
         mu_red = (float(np.max(mussv(lft_lower(P, Kr, nmeas, ncon), blocks, omega).upper))

@@ -4,7 +4,7 @@ The LPV controller of :func:`ambseal.design.lpv_design.design_lpv` is a table of
 matrices in one state basis at the speeds of its check grid, linearly interpolated in the
 rotor speed Ω between entries and held at the ends (:class:`~ambseal.robust.lpv.LpvController`);
 the controller scheduled on a tracked seal coefficient
-(:func:`ambseal.design.seal_schedule.design_seal_scheduled`, issue 14) is the same kind of
+(:func:`ambseal.design.seal_schedule.design_seal_scheduled`) is the same kind of
 table on θ = that coefficient (SI). The target runs the same law on discrete matrices:
 every entry is discretised by one method (:mod:`ambseal.robust.digital`, chosen on the
 frozen loops), after the fast poles are removed in one basis common to all entries (the
@@ -26,15 +26,31 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Sequence
 
+import control
 import numpy as np
 
 from ambseal.errors import SynthesisError
-from ambseal.robust.digital_loop import DiscreteController
+from ambseal.lti.tables import interp_table
 from ambseal.robust.controller import SPEED, ScheduledController
-from ambseal.robust.digital import (FAST_FRACTION, HOLDS, KEPT, METHODS, _chosen_error, _json_safe,
-                      check_rate, choose_method, discretize_as, hold_keeps,
-                      peak_difference, prewarp_frequency_hz, residualize, sampled_plants,
-                      split_fast, with_delay)
+from ambseal.robust.digital import (
+    FAST_FRACTION,
+    HOLDS,
+    KEPT,
+    METHODS,
+    _chosen_error,
+    _json_safe,
+    check_rate,
+    choose_method,
+    discretize_as,
+    hold_keeps,
+    peak_difference,
+    prewarp_frequency_hz,
+    residualize,
+    sampled_plants,
+    split_fast,
+    with_delay,
+)
+from ambseal.robust.digital_loop import DiscreteController
 
 __all__ = ["ScheduledDigital", "scheduled_digital", "INTERPOLATION", "interpolation_law"]
 
@@ -55,8 +71,6 @@ def _label(parameter: str, value: float) -> str:
 
 
 def _interp(x: float, grid: np.ndarray, stack: np.ndarray) -> np.ndarray:
-    from ambseal.lti.tables import interp_table
-
     return interp_table(float(x), grid, stack)
 
 
@@ -119,7 +133,6 @@ class ScheduledDigital(ScheduledController):
 
     def at(self, value: float, name: str | None = None):
         """The frozen designed controller at θ, continuous ``control.StateSpace``."""
-        import control
 
         return control.ss(*self.matrices_at(value), inputs=list(self.inputs),
                           outputs=list(self.outputs), name=name or self.name)
@@ -135,7 +148,6 @@ class ScheduledDigital(ScheduledController):
     def statespace_at(self, value: float, delayed: bool = False):
         """:meth:`discrete_at` as a named discrete ``control.StateSpace`` (with the
         computation delay when ``delayed``)."""
-        import control
 
         d = self.discrete_at(value)
         mats = (d.A, d.B, d.C, d.D)

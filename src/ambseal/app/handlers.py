@@ -1,0 +1,187 @@
+"""The command line's commands: each takes the parsed arguments, calls the stages and prints
+one JSON line (or a table) on stdout.
+
+Wiring only: the parser is :mod:`ambseal.cli`'s, which imports this module once a command
+runs (start-up cost); the files are written by :mod:`ambseal.app.commands` and
+:mod:`ambseal.app.pipeline`, the rotordynamicist's commands live in
+:mod:`ambseal.app.rotordynamics`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from rich.console import Console
+
+from ambseal.app import rotordynamics
+from ambseal.app.commands import (
+    design_files,
+    identify_files,
+    show_defaults,
+    target_pid,
+    track_files,
+    validate_summary,
+)
+from ambseal.app.pipeline import run
+from ambseal.config import default_rig_path, load_rig, load_truth
+from ambseal.errors import AmbsealError, ConfigError, with_source
+from ambseal.export.codegen import write_c
+from ambseal.export.controller_files import load_controller
+from ambseal.files import writable_folder
+from ambseal.identify import signals
+from ambseal.identify.data import save_measurement
+from ambseal.identify.stages import acquire
+from ambseal.identify.static_load import save_static_record, virtual_static_load
+from ambseal.model.amb import channel_names
+from ambseal.report.run_report import rig_clearances_um
+from ambseal.report.verdict import verdict_table_rich, verdicts
+
+__all__ = ["HANDLERS"]
+
+
+def _acquire_cmd(args: argparse.Namespace) -> int:
+    cfg = load_rig(args.rig)
+    truth = load_truth(args.truth)
+    writable_folder(Path(args.out).parent)  # before the simulation
+    axes = channel_names(cfg)
+    if not axes:
+        raise ConfigError(f"{args.rig}: amb: acquisition needs at least one [[amb]]")
+    excited = None
+    if args.axes is not None:
+        excited = [a.strip() for a in args.axes.split(",")]
+        if not all(excited):
+            raise ConfigError(f"--axes: expected axis names separated by commas, e.g. "
+                              f"{','.join(axes[:2])}; got {args.axes!r}")
+    fs = cfg.controller.sample_rate_hz
+    if args.excitation == "static":
+        z, F, cur = virtual_static_load(cfg, truth, seed=args.seed)
+        path = save_static_record(args.out, cfg, z, F, cur)
+        print(json.dumps({"out": str(path), "load_steps": int(z.size)}))
+        return 0
+    common = dict(sample_rate_hz=fs, axes=axes, excited=excited)
+    try:
+        if args.excitation == "prbs":
+            ex = signals.prbs(amplitude_a=args.amplitude_a, clock_period_s=args.clock_period_s,
+                              duration_s=args.duration_s, seed=args.seed, **common)
+        elif args.excitation == "sine":
+            freqs = [float(f) for f in args.frequencies_hz.split(",")]
+            ex = signals.stepped_sine(frequencies_hz=freqs, amplitude_a=args.amplitude_a,
+                                      cycles=args.cycles, settling_cycles=args.settling_cycles,
+                                      **common)
+        elif args.excitation == "chirp":
+            ex = signals.chirp(f0_hz=args.f0_hz, f1_hz=args.f1_hz, duration_s=args.duration_s,
+                               amplitude_a=args.amplitude_a, method=args.chirp, **common)
+        else:
+            ex = signals.impulse(amplitude_a=args.amplitude_a, width_s=args.width_s,
+                                 start_s=args.start_s, duration_s=args.duration_s, **common)
+    except ValueError as exc:
+        raise ConfigError(f"acquire: {exc}") from None
+    try:
+        meas = acquire(cfg, truth, ex, controller=target_pid(cfg),
+                       pressure_bar=args.pressure_bar, seed=args.seed)
+    except AmbsealError as exc:  # the simulation runs on the truth file's values
+        raise with_source(exc, [args.truth], f"{args.truth} (with {args.rig})") from None
+    path = save_measurement(meas, args.out)
+    print(json.dumps({"out": str(path), "samples": meas.n_samples,
+                      "sample_rate_hz": fs}))
+    return 0
+
+
+def _design(args: argparse.Namespace) -> int:
+    rig = args.rig if args.rig is not None else default_rig_path()
+
+    if args.show_defaults:
+        print(show_defaults(rig, args.overrides), end="")
+        return 0
+    if args.method is None:
+        raise ConfigError("design: --method is required (pid, hinf, mu or lpv) unless "
+                          "--show-defaults")
+    print(json.dumps(design_files(rig, args.method, args.out,
+                                  pressure_bar=args.pressure_bar, overrides=args.overrides,
+                                  allow_unstable=args.allow_unstable)))
+    return 0
+
+
+def _export(args: argparse.Namespace) -> int:
+    if (args.method is None) == (args.controller is None):
+        raise ConfigError("export: give exactly one of --method and --controller")
+    if args.controller is not None:
+        ctrl = load_controller(args.controller)
+        files = write_c(ctrl, args.c_dir or Path(args.out) / "c",
+                        f"ambseal_{Path(args.controller).stem}", precision=args.precision)
+        print(json.dumps({"files": [str(f) for f in files]}))
+        return 0
+    print(json.dumps(design_files(args.rig, args.method, args.out,
+                                  pressure_bar=args.pressure_bar,
+                                  c_dir=args.c_dir or Path(args.out) / "c",
+                                  precision=args.precision)))
+    return 0
+
+
+def _identify(args: argparse.Namespace) -> int:
+    summary = identify_files(args.rig, args.data, args.params.split(","), args.out,
+                             current_weight=args.current_weight, refine=not args.no_refine,
+                             accept_unconverged=args.accept_unconverged,
+                             static_load=args.static_load)
+    print(json.dumps(summary))
+    return 0
+
+
+def _track(args: argparse.Namespace) -> int:
+    summary = track_files(args.rig, args.data, args.params.split(","), args.out,
+                          rate_per_s=args.rate_per_s)
+    print(json.dumps(summary))
+    return 0
+
+
+def _run(args: argparse.Namespace) -> int:
+    result = run(args.rig, args.out, truth=args.truth, identification=not args.no_identify,
+                 overrides=tuple(args.overrides), allow_unstable=args.allow_unstable,
+                 command=args.command_line, progress=not (args.quiet or args.verbose))
+    for reason in result.metrics.get("cannot_run", {}).values():
+        print(f"ambseal: {reason}", file=sys.stderr)
+    if sys.stderr.isatty() and not args.quiet:
+        console = Console(stderr=True)
+        clear = rig_clearances_um(load_rig(args.rig))
+        console.print(verdict_table_rich(verdicts(result.metrics["cases"], clear)))
+        console.print(f"report: {result.report_path.resolve()}")
+    print(json.dumps({"out": str(result.out_dir), "metrics": str(result.metrics_path),
+                      "report": str(result.report_path)}))
+    return 0
+
+
+def _plain(x) -> str:
+    """A value of ``validate``'s defaults as text: dicts as ``key value``, pairs as ranges."""
+    if isinstance(x, dict):
+        return ", ".join(f"{k} {_plain(w)}" for k, w in x.items())
+    if isinstance(x, (list, tuple)):
+        pair = len(x) == 2 and all(isinstance(y, (int, float)) for y in x)
+        return "–".join(map(_plain, x)) if pair else ", ".join(map(_plain, x))
+    return "none" if x is None else f"{x:g}" if isinstance(x, float) else str(x)
+
+
+def _validate(args: argparse.Namespace) -> int:
+    v = validate_summary(args.rig)
+    if args.json:
+        print(json.dumps(v, indent=2))
+        return 0
+    print(f"{v['rig']}: valid — {v['name']}")
+    print(f"  rotor mass {v['mass_kg']:.4g} kg, {v['nodes']} nodes, AMB axes "
+          f"{', '.join(v['axes'])}")
+    print(f"  modes below {v['modes_below_hz']:g} Hz (controller Nyquist): "
+          + ", ".join(f"{f:.4g} Hz (ζ {z:.3g})" for f, z in v["modes"]))
+    poles = v["unstable_poles"]
+    print(f"  {len(poles)} unstable open-loop poles"
+          + (": " + ", ".join(f"{re:.4g}{im:+.4g}j rad/s" for re, im in poles) if poles else ""))
+    print("  defaults a run takes:")
+    for key, val in v["defaults"].items():
+        print(f"    {key}: {_plain(val)}")
+    return 0
+
+
+#: The command name → its handler (``args`` → exit status).
+HANDLERS = {"acquire": _acquire_cmd, "identify": _identify, "design": _design, "track": _track,
+            "export": _export, "run": _run, "validate": _validate, **rotordynamics.HANDLERS}

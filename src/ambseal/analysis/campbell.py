@@ -39,6 +39,7 @@ from ambseal.model.rig import build_plant
 from ambseal.model.rotor import build_mesh
 from ambseal.robust.controller import frozen
 from ambseal.robust.delay import loop_delay
+from ambseal.robust.stability import decay_rate, is_stable
 
 __all__ = ["API684_LOG_DEC", "ClosedLoopModes", "Crossing", "Campbell",
            "log_decrement", "lowest_log_decrement", "whirl_of", "closed_loop_state_matrix",
@@ -123,6 +124,8 @@ class ClosedLoopModes:
         Node positions (m).
     max_real_pole : float
         Largest real part of *all* closed-loop poles (1/s), whatever their frequency.
+    stable : bool
+        All closed-loop poles stable (:func:`ambseal.robust.stability.is_stable`).
     """
 
     speed_hz: float
@@ -137,10 +140,7 @@ class ClosedLoopModes:
     shapes: np.ndarray
     node_z_m: np.ndarray
     max_real_pole: float
-
-    @property
-    def stable(self) -> bool:
-        return self.max_real_pole < 0
+    stable: bool
 
     def to_dict(self) -> dict:
         return {"speed_hz": self.speed_hz, "pressure_bar": self.pressure_bar,
@@ -238,7 +238,7 @@ def modes_of_state_matrix(A: np.ndarray, mesh, *, speed_hz: float, pressure_bar:
         poles=z, frequency_hz=z.imag / (2 * np.pi), damping_ratio=-z.real / np.abs(z),
         log_decrement=log_decrement(z), whirl=tuple(w for w, _ in whirls),
         kappa=np.array([k for _, k in whirls]), shapes=shapes, node_z_m=np.asarray(mesh.z),
-        max_real_pole=float(lam.real.max()))
+        max_real_pole=decay_rate(lam), stable=is_stable(lam))
 
 
 @dataclass(frozen=True)

@@ -35,6 +35,7 @@ from ambseal.errors import ModelError
 from ambseal.lti.freqresp import freqresp_at
 from ambseal.lti.interconnect import feedback_matrices
 from ambseal.lti.matrices import as_omega, labels, ss_matrices
+from ambseal.robust.stability import decay_rate, is_stable
 
 __all__ = [
     "ClosedLoop",
@@ -77,7 +78,8 @@ class ClosedLoop:
         Largest real part of the poles (1/s); ``< 0`` means asymptotically stable. Of a
         discrete loop the same rate of its slowest-decaying pole, ``ln max|z| / dt``.
     stable : bool
-        ``max_real_pole < 0``.
+        The poles are stable by the package's one rule
+        (:func:`ambseal.robust.stability.is_stable`).
     n_plant_inputs, n_plant_outputs, n_force_inputs : int
         Channel counts, so ``system`` can be sliced without parsing names.
     dt : float
@@ -414,14 +416,9 @@ def closed_loop(G: Any, K: Any, Gf: Any | None = None, *, atol: float = 0.0) -> 
     sys = control.StateSpace(Acl, Bcl, Ccl, Dcl, dt, inputs=inputs, outputs=outputs,
                              states=states, name="closed_loop")
     poles = np.linalg.eigvals(Acl) if Acl.size else np.zeros(0, dtype=complex)
-    if dt:
-        poles = poles[np.argsort(-np.abs(poles), kind="stable")]
-        with np.errstate(divide="ignore"):
-            mrp = float(np.log(np.abs(poles[0])) / dt) if poles.size else float("-inf")
-    else:
-        poles = poles[np.argsort(-poles.real, kind="stable")]
-        mrp = float(poles.real.max()) if poles.size else float("-inf")
-    return ClosedLoop(sys, poles, mrp, bool(mrp < 0.0), nu, ny, nf, dt)
+    order = np.argsort(-np.abs(poles) if dt else -poles.real, kind="stable")
+    poles = poles[order]
+    return ClosedLoop(sys, poles, decay_rate(poles, dt), is_stable(poles, dt), nu, ny, nf, dt)
 
 
 def loop_responses(G: Any, K: Any, omega: Any) -> LoopResponse:

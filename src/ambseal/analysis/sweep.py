@@ -27,6 +27,7 @@ from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
 from ambseal.config import parse_rig, rig_with_values
 from ambseal.errors import ConfigError
 from ambseal.model.modes import bending_limit_hz
+from ambseal.robust.stability import is_stable
 
 __all__ = ["sweep", "sweep_case", "stability_boundary", "refine_boundary", "boundary_case",
            "parse_range"]
@@ -193,7 +194,7 @@ def boundary_case(case: dict, rig: dict, controllers: dict, tol_bar: float) -> f
         mid = 0.5 * (lo + hi)
         A, _ = closed_loop_state_matrix(cfg, K, speed_hz=case["speed_hz"], pressure_bar=mid,
                                         delay=True)  # the loop judge() judges
-        lo, hi = (mid, hi) if np.linalg.eigvals(A).real.max() < 0 else (lo, mid)
+        lo, hi = (mid, hi) if is_stable(np.linalg.eigvals(A)) else (lo, mid)
     return 0.5 * (lo + hi)
 
 

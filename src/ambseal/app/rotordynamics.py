@@ -29,6 +29,7 @@ from ambseal.model.modes import bending_limit_hz, modes
 from ambseal.model.rig import build_system
 from ambseal.report.modal_figures import campbell_figure, mode_shapes_figure, stability_map_figure
 from ambseal.robust.digital import DigitalController
+from ambseal.robust.stability import unstable_poles
 
 __all__ = ["HANDLERS", "controller_for", "write_table"]
 
@@ -100,7 +101,7 @@ def _modes(args: argparse.Namespace) -> int:
     else:
         m = closed_loop_modes(cfg, K, speed_hz=rpm / 60.0, pressure_bar=p, max_hz=f_max)
     unstable = res.unstable_poles if K is None else [
-        (float(z.real), float(z.imag)) for z in m.poles if z.real > 0]
+        (float(z.real), float(z.imag)) for z in unstable_poles(m.poles)]
     out = {"speed_hz": rpm / 60.0, "pressure_bar": p, "max_hz": f_max,
            "controller": args.controller or "none",
            "natural_frequencies_hz": [float(x) for x in m.frequency_hz],

@@ -18,6 +18,7 @@ from ambseal.model.rig import build_plant
 from ambseal.model.rotor import assemble_rotor
 from ambseal.robust.digital import discretize_as, with_delay
 from ambseal.robust.digital_loop import discrete_controller
+from ambseal.robust.stability import is_stable
 
 __all__ = ["pid_controller", "pid_from_rig", "reference_controller", "controller_from_metadata",
            "PID_CORNERS_PER_FS"]
@@ -179,7 +180,7 @@ def _corner_for_target(cfg, kp: float, ti: float, td: float) -> float:
         Kd = with_delay(discretize_as(mats, 1 / fs, "tustin"), delay)
         n_ok, zeta = 0, np.inf
         for G, Gd in plants:
-            if np.linalg.eigvals(feedback_matrices(G, mats)[0]).real.max() >= 0:
+            if not is_stable(np.linalg.eigvals(feedback_matrices(G, mats)[0])):
                 continue  # unstable as designed: nothing to keep as it runs
             z = _zeta_z(np.linalg.eigvals(feedback_matrices(Gd, Kd)[0])).min()
             n_ok, zeta = n_ok + (z > 0), min(zeta, z)

@@ -34,6 +34,7 @@ import numpy as np
 from scipy.signal import butter
 
 from ambseal.errors import ConfigError
+from ambseal.robust.stability import is_stable
 
 #: the ISO 14839-3 zone-A bound on |S_o| by which μ's gain demand on ``K S_o`` exceeds the one
 #: on K (:meth:`Weights.Wk`)
@@ -181,8 +182,9 @@ def check_weight(W, name: str, *, biproper: bool = False):
     mats = [np.asarray(m, float) for m in (S.A, S.B, S.C, S.D)]
     if not all(np.all(np.isfinite(m)) for m in mats):
         raise ConfigError(f"weight {name}: non-finite coefficients")
-    if S.nstates and np.max(np.linalg.eigvals(mats[0]).real) >= 0:
-        raise ConfigError(f"weight {name}: has a pole with Re ≥ 0; weights must be stable")
+    if not is_stable(np.linalg.eigvals(mats[0])):
+        raise ConfigError(f"weight {name}: has a pole that is not stable (Re ≥ 0); weights "
+                          "must be stable")
     if biproper and abs(float(mats[3][0, 0])) == 0.0:
         raise ConfigError(f"weight {name}: must be biproper (non-zero gain at high frequency)")
     return S

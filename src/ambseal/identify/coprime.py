@@ -34,6 +34,7 @@ from ambseal.errors import DataError, IdentificationError
 from ambseal.lti.discrete import zoh
 from ambseal.lti.freqresp import freqresp_at
 from ambseal.model.lft import Plant
+from ambseal.robust.stability import is_stable
 
 __all__ = ["CoprimeFactors", "observer_gains", "coprime_factors", "youla_factorisation",
            "check_bezout"]
@@ -49,14 +50,10 @@ def _ss(A, B, C, D, dt, inputs=None, outputs=None):
     return control.ss(A, B, C, D, 0 if dt is None else dt, **kw)
 
 
-def _is_stable(A: np.ndarray, dt: float | None, margin: float = 0.0) -> bool:
-    """All eigenvalues in the open left half plane (dt None) or open unit disc."""
-    if A.size == 0:
-        return True
-    lam = np.linalg.eigvals(A)
-    if dt is None:
-        return bool(np.all(lam.real < -margin))
-    return bool(np.all(np.abs(lam) < 1.0 - margin))
+def _is_stable(A: np.ndarray, dt: float | None) -> bool:
+    """All eigenvalues of ``A`` stable (continuous for ``dt`` None, else discrete), by the
+    package's one rule (:func:`ambseal.robust.stability.is_stable`)."""
+    return is_stable(np.linalg.eigvals(A) if A.size else np.zeros(0), dt or 0.0)
 
 
 def _as_2d(x, name: str, n_cols: int, n_rows: int | None = None) -> np.ndarray:

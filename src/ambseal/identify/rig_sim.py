@@ -44,6 +44,7 @@ from ambseal.model.reduction import modal_reduction
 from ambseal.model.rig import build_system, mechanical_plant
 from ambseal.model.seal import coefficient_value
 from ambseal.robust.digital_loop import DiscreteController, closed_loop_matrices
+from ambseal.robust.stability import is_stable, unstable_poles
 
 __all__ = ["FacilityRecord", "Facility", "prepare_facility", "simulate_facility", "true_rig",
            "reduced_plant"]
@@ -376,9 +377,9 @@ def _refuse_unstable(fac: Facility, controller: DiscreteController, cfg: RigConf
     loses the rotor (after a slow growth: |z| = 1.001 at 10 kHz e-folds in 0.1 s) or, before
     that, records a growing oscillation that no stable model fits — neither is data."""
     z = fac.loop_poles(controller)
-    worst = z[np.argmax(np.abs(z))]
-    if abs(worst) < 1.0:
+    if is_stable(z, fac.T):
         return
+    worst = unstable_poles(z, fac.T)[0]
     s = np.log(complex(worst)) / fac.T
     f_hz, zeta = abs(s.imag) / (2 * np.pi), -s.real / abs(s)
     seen = []

@@ -61,6 +61,7 @@ from ambseal.robust._digital_choice import so_peak as _so_peak
 from ambseal.robust.delay import check_timing, loop_delay
 from ambseal.robust.digital_loop import DiscreteController
 from ambseal.robust.hinf import hinfnorm
+from ambseal.robust.stability import is_stable
 
 __all__ = ["FAST_FRACTION", "METHODS", "PEAK_TOLERANCE", "peak_difference",
            "DigitalController", "split_fast", "residualize", "hold_keeps", "HOLDS", "KEPT",
@@ -281,7 +282,7 @@ def hold_keeps(fast: np.ndarray, fs: float) -> bool:
         angle below ``FAST_FRACTION·π``, aliasing no other frequency.
     """
     fast = np.asarray(fast, complex)
-    return bool(fast.size and np.all(fast.real < 0)
+    return bool(fast.size and is_stable(fast)
                 and np.all(np.abs(fast.imag) < 2 * np.pi * FAST_FRACTION * fs / 2))
 
 
@@ -420,7 +421,7 @@ def _remove_fast(K, mats: Matrices, fs: float, rise: Callable | None):
     V, k, fast = split_fast(mats[0], f_cut)
     if not fast.size:
         return mats, K, fast, None
-    if np.any(fast.real >= 0):
+    if not is_stable(fast):
         raise SynthesisError(
             f"controller.sample_rate_hz = {fs:g} Hz: {K.name} has unstable poles above "
             f"{f_cut:g} Hz (half of Nyquist), which cannot be removed; raise the sample "
@@ -489,7 +490,7 @@ def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int,
     fs, T, w = sp.fs, 1.0 / sp.fs, sp.omega_rad_s
 
     def stable(plants):
-        return [np.max(feedback_poles(G, Kc).real) < 0 for G, Kc in zip(plants, cont)]
+        return [is_stable(feedback_poles(G, Kc)) for G, Kc in zip(plants, cont)]
 
     # the sampled loop must be stable wherever the design is (its continuous loop without
     # the delay); the peaks are compared where the continuous loop with the delay is too

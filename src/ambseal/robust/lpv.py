@@ -61,6 +61,7 @@ from ambseal.robust._lpv_lmi import (
 )
 from ambseal.robust._lpv_reconstruct import interp_A, reconstruct_table
 from ambseal.robust.hinf import hinfnorm
+from ambseal.robust.stability import is_stable
 
 __all__ = ["LpvController", "LpvSynResult", "lpvsyn", "SolverReport"]
 
@@ -353,14 +354,14 @@ def _check_table(K: LpvController, A_of, B, C, D, nmeas: int, ncon: int) -> np.n
     check_g, stable = [], True
     for W in table:
         Acl, Bcl, Ccl, Dcl = lft_lower_matrices((A_of(W), B, C, D), K.matrices(W), nmeas, ncon)
-        if np.max(np.linalg.eigvals(Acl).real) >= 0:
+        if not is_stable(np.linalg.eigvals(Acl)):
             check_g.append(np.inf)
             stable = False
             continue
         check_g.append(hinfnorm(ct.ss(Acl, Bcl, Ccl, Dcl))[0])
     for W in 0.5 * (table[1:] + table[:-1]):
         Acl = lft_lower_matrices((A_of(W), B, C, D), K.matrices(W), nmeas, ncon)[0]
-        stable &= bool(np.max(np.linalg.eigvals(Acl).real) < 0)
+        stable &= is_stable(np.linalg.eigvals(Acl))
     if not stable:
         raise SynthesisError(
             "lpvsyn: a reconstructed frozen closed loop on the check grid is unstable; "

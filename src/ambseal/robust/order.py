@@ -55,6 +55,9 @@ def balred_controller(K, order: int, alpha: float | None = None):
     A, B, C, D = (np.asarray(X, float) for X in (K.A, K.B, K.C, K.D))
     lam = np.linalg.eigvals(A) if n else np.zeros(0)
     if alpha is None:
+        # not a stability verdict (that is ambseal.robust.stability's): the split of the
+        # balanced truncation, whose Gramians of nearly marginal poles are ill-conditioned,
+        # so slow poles within 1e-8 of the fastest are kept exactly with the unstable ones
         alpha = -1e-8 * max(1.0, float(np.max(np.abs(lam))) if n else 1.0)
     nu = int(np.sum(lam.real >= alpha))
     if order < nu:

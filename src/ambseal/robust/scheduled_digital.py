@@ -51,6 +51,7 @@ from ambseal.robust.digital import (
     with_delay,
 )
 from ambseal.robust.digital_loop import DiscreteController
+from ambseal.robust.stability import is_stable
 
 __all__ = ["ScheduledDigital", "scheduled_digital", "INTERPOLATION", "interpolation_law"]
 
@@ -254,7 +255,7 @@ def _reduced_table(table, W, fs: float, parameter: str, name: str):
     V, k, fast = split_fast(table[len(W) // 2][0], f_cut)
     for w, mats in zip(W, table):
         A22 = np.linalg.solve(V, mats[0] @ V)[k:, k:]
-        if A22.size and np.max(np.linalg.eigvals(A22).real) >= 0:
+        if not is_stable(np.linalg.eigvals(A22)):
             raise SynthesisError(
                 f"controller.sample_rate_hz = {fs:g} Hz: the fast part of {name} at "
                 f"{_label(parameter, w)} is not stable and cannot be removed; raise the "

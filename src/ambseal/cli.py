@@ -358,12 +358,13 @@ def _export(args: argparse.Namespace) -> int:
     if (args.method is None) == (args.controller is None):
         raise ConfigError("export: give exactly one of --method and --controller")
     if args.controller is not None:
-        from .control.codegen import write_c
+        from .control.codegen import c_identifier, write_c
         from .control.export import load_controller
 
         ctrl = load_controller(args.controller)
-        files = write_c(ctrl, args.c_dir or Path(args.out) / "c",
-                        f"ambseal_{Path(args.controller).stem}", precision=args.precision)
+        files = write_c(ctrl, args.c_dir or Path(args.out) / "c",  # the file name as C names
+                        f"ambseal_{c_identifier(Path(args.controller).stem)}",
+                        precision=args.precision)
         print(json.dumps({"files": [str(f) for f in files]}))
         return 0
     print(json.dumps(design_files(args.rig, args.method, args.out,

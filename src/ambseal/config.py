@@ -66,8 +66,8 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from .config_checks import (MAX_ELEMENTS, MAX_REDUCED_STATES, check_actuator, check_amb,
-                            cross_check)
+from .config_checks import (MAX_ELEMENTS, MAX_REDUCED_STATES, Label, Name, check_actuator,
+                            check_amb, cross_check)
 from .config_design import Design, apply_overrides, check_design_names
 from .errors import PRIMITIVE_TAGS, ConfigError, describe_validation_error
 
@@ -89,9 +89,6 @@ __all__ = [
 
 
 _Big = Annotated[float, Field(ge=-1e12, le=1e12)]  # plausible bound of a force coefficient
-#: Names of AMBs, seals and springs make parameter and signal names (``A.Ki_zeta``):
-#: no '.', ',' or white space.
-_NAME = Field(min_length=1, max_length=64, pattern=r"^[^.,\s]+$")
 
 
 class _Strict(BaseModel):
@@ -136,7 +133,7 @@ class Material(_Strict):
 
 class Rotor(_Strict):
     beam: Literal["timoshenko", "euler-bernoulli"] = "timoshenko"
-    name: str = "rotor"
+    name: Label = "rotor"
     modal_damping: float = Field(default=0.0, ge=0, lt=1)
 
 
@@ -159,7 +156,7 @@ class Disk(_Strict):
     mass: float = Field(ge=0, le=1e6)
     Ip: float = Field(default=0.0, ge=0, le=1e6)
     Id: float = Field(default=0.0, ge=0, le=1e6)
-    name: str | None = None
+    name: Label | None = None
 
 
 class AxisPair(_Strict):
@@ -177,7 +174,7 @@ class AxisPair(_Strict):
 
 
 class Amb(_Strict):
-    name: str = _NAME
+    name: Name
     position: float = Field(ge=0)
     sensor_position: float = Field(ge=0)
     axes_angle_deg: float = 0.0
@@ -245,7 +242,7 @@ SealCoefficient = float | Affine | FrequencyTable
 
 
 class Seal(_Strict):
-    name: str = _NAME
+    name: Name
     position: float = Field(ge=0)
     K: SealCoefficient = 0.0
     k: SealCoefficient = 0.0
@@ -278,7 +275,7 @@ class Spring(_Strict):
     cxx: float = Field(default=0.0, ge=-1e12, le=1e12)
     cyy: float = Field(default=0.0, ge=-1e12, le=1e12)
     axes_angle_deg: float = Field(default=0.0, ge=-360, le=360)
-    name: str | None = Field(default=None, min_length=1, max_length=64, pattern=r"^[^.,\s]+$")
+    name: Name | None = None
     uncertainty: Uncertainty = None
 
 
@@ -329,7 +326,7 @@ class RigConfig(_Strict):
     """A whole rig: rotor, materials, shaft, components, controller and operating point."""
 
     rotor: Rotor = Rotor()
-    materials: dict[str, Material]
+    materials: dict[Name, Material]
     shaft: list[ShaftSection] = Field(min_length=1)
     disk: list[Disk] = []
     amb: list[Amb] = []

@@ -31,8 +31,8 @@ def test_negative_delay_is_refused(tmp_path, capsys):
     """Reference: the rig-file contract — ``[controller] delay_samples`` is a whole number
     of samples >= 0; -1 is named with its key."""
     rig = _rig(tmp_path, "[controller]\ndelay_samples = -1")
-    _one_line_exit_2(capsys, ["export", str(rig), "--method", "pid", "--out", str(tmp_path)],
-                     "delay_samples")
+    _one_line_exit_2(capsys, ["export", str(rig), "--method", "pid", "--out",
+                              str(tmp_path / "out")], "delay_samples")
 
 
 def test_sample_rate_below_twice_the_controller_pole_is_refused(tmp_path, capsys):
@@ -41,7 +41,7 @@ def test_sample_rate_below_twice_the_controller_pole_is_refused(tmp_path, capsys
     them; the message names the key, the pole and the rate needed."""
     rig = _rig(tmp_path, "[controller]\nsample_rate_hz = 800.0")
     err = _one_line_exit_2(capsys, ["export", str(rig), "--method", "pid", "--out",
-                                    str(tmp_path)], "sample_rate_hz", "800")
+                                    str(tmp_path / "out")], "sample_rate_hz", "800")
     assert "455" in err or "454" in err
 
 

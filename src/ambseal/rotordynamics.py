@@ -17,7 +17,7 @@ from pathlib import Path
 
 from .config import load_rig
 from .errors import ConfigError
-from .files import write_json, write_text
+from .files import OwnedFolder, write_json, write_text
 
 __all__ = ["add_parsers", "HANDLERS", "controller_for", "write_table"]
 
@@ -130,6 +130,16 @@ def _modes(args: argparse.Namespace) -> int:
     return 0
 
 
+def _owns_out(handler):
+    """``handler`` with its ``--out`` folder claimed before any work
+    (:class:`ambseal.files.OwnedFolder`)."""
+    def run(args: argparse.Namespace) -> int:
+        with OwnedFolder(args.out):
+            return handler(args)
+    return run
+
+
+@_owns_out
 def _campbell(args: argparse.Namespace) -> int:
     from .analysis.campbell import campbell
     from .report.modal_figures import campbell_figure, mode_shapes_figure
@@ -164,6 +174,7 @@ def _campbell(args: argparse.Namespace) -> int:
     return 0
 
 
+@_owns_out
 def _sweep(args: argparse.Namespace) -> int:
     from .analysis.sweep import dask_available, refine_boundary, stability_boundary, sweep
     from .report.modal_figures import stability_map_figure

@@ -283,6 +283,7 @@ def _judge_loop(cfg, P, cur, force, controller, s: JudgeSettings, impulse: bool
     """The case's numbers for one loop, continuous or discrete (``P.dt``): the plant ``P``
     with current inputs ``cur`` and force inputs ``force``."""
     from ..lti.freqresp import freqresp_at
+    from ..lti.interconnect import wired
     from .iso import iso_assessment
     from .loops import (closed_loop, compliance_from, loop_responses_from, resolved_grid,
                         response_points, sigma_max)
@@ -290,6 +291,7 @@ def _judge_loop(cfg, P, cur, force, controller, s: JudgeSettings, impulse: bool
     from .unbalance import unbalance_from_compliance
 
     G, Gf = _inputs(P, cur), _inputs(P, force)
+    controller = wired(G, controller)  # by signal names, in the plant's order
     loop = closed_loop(G, controller, Gf)
     dt = loop.dt
     case = {"stable": loop.stable, "max_real_pole": loop.max_real_pole}

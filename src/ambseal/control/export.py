@@ -254,10 +254,22 @@ def _arrays(doc: dict, path: Path, stacked: bool) -> dict:
 
 
 def _continuous(doc: dict, path: Path):
-    """A continuous controller file back to a ``control.StateSpace``, shapes checked."""
+    """A continuous controller file back to a ``control.StateSpace``, shapes checked; a
+    file with neither ``inputs`` nor ``outputs`` gets python-control's ``u[i]``, ``y[i]``
+    and a warning that it will be connected by position."""
+    import warnings
+
     import control
 
     try:
+        if "inputs" not in doc and "outputs" not in doc:
+            D = np.atleast_2d(np.asarray(doc["D"], float))
+            doc = {**doc, "inputs": [f"u[{j}]" for j in range(D.shape[1])],
+                   "outputs": [f"y[{j}]" for j in range(D.shape[0])]}
+            warnings.warn(f"{path}: no signal names (inputs, outputs): the controller is "
+                          "connected by position, input j to the plant's j-th sensor and "
+                          "output j to its j-th current (the rig's [[amb]] order, zeta then "
+                          "eta)", stacklevel=3)
         ins, outs = _names(doc["inputs"], "inputs", path), _names(doc["outputs"], "outputs", path)
         A, B, C, D = (np.atleast_2d(np.asarray(doc[k], float)) for k in "ABCD")
     except KeyError as exc:

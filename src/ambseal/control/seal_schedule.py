@@ -292,7 +292,10 @@ def _read_cache(path: Path, key: str) -> SealScheduledDesign | None:
             return None
         names = {f.name for f in fields(Weights)}
         wd = doc["weights"]
-        if not isinstance(wd, dict) or set(wd) != names:
+        if not isinstance(wd, dict) or set(wd) != names or not all(
+                v is None or isinstance(v, (int, float, str)) and not isinstance(v, bool)
+                or isinstance(v, list) and all(isinstance(x, (int, float)) for x in v)
+                for v in wd.values()):
             return None
         w = Weights(**{f: (tuple(v) if isinstance(v, list) else v) for f, v in wd.items()})
         scalars = [float(doc[f]) for f in ("gamma", "gamma_design", "rate_bound",

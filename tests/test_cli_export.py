@@ -31,8 +31,8 @@ def test_negative_delay_is_refused(tmp_path, capsys):
     """Reference: the rig-file contract — ``[controller] delay_samples`` is a whole number
     of samples >= 0; -1 is named with its key."""
     rig = _rig(tmp_path, "[controller]\ndelay_samples = -1")
-    _one_line_exit_2(capsys, ["export", str(rig), "--method", "pid", "--out", str(tmp_path)],
-                     "delay_samples")
+    _one_line_exit_2(capsys, ["export", str(rig), "--method", "pid", "--out",
+                              str(tmp_path / "out")], "delay_samples")
 
 
 def test_sample_rate_below_twice_the_controller_pole_is_refused(tmp_path, capsys):
@@ -41,7 +41,7 @@ def test_sample_rate_below_twice_the_controller_pole_is_refused(tmp_path, capsys
     them; the message names the key, the pole and the rate needed."""
     rig = _rig(tmp_path, "[controller]\nsample_rate_hz = 800.0")
     err = _one_line_exit_2(capsys, ["export", str(rig), "--method", "pid", "--out",
-                                    str(tmp_path)], "sample_rate_hz", "800")
+                                    str(tmp_path / "out")], "sample_rate_hz", "800")
     assert "455" in err or "454" in err
 
 
@@ -69,3 +69,73 @@ def test_export_c_from_a_controller_file(tmp_path, capsys, testrig_digital):
     header = Path(files[0]).read_text()
     n = testrig_digital["mu"].discrete.A.shape[0]
     assert f"_NX {n}" in header and "_NY 4" in header and "_TS 0.0001" in header
+
+
+#: A name that closes a C comment and adds statements (a newline, a trigraph for '\', a
+#: line splice and non-ASCII text too).
+INJECTED = '*/ int ambseal_injected(void) { return system("x"); } /*\n#define X ??/\n\\ é'
+
+
+def _small_digital(name: str, inputs=("y_A_zeta",), outputs=("i_A_zeta",)):
+    """A one-state digital controller (the exported object) named ``name``."""
+    import control
+    import numpy as np
+
+    from ambseal.robust.digital import DigitalController
+    from ambseal.robust.digital_loop import DiscreteController
+
+    K = control.ss([[-100.0]], [[1.0]], [[2.0]], [[0.5]], inputs=list(inputs),
+                   outputs=list(outputs), name=name)
+    disc = DiscreteController(np.array([[0.99]]), np.array([[1e-4]]), np.array([[2.0]]),
+                              np.array([[0.5]]), 1e-4, description={})
+    return DigitalController(K, K, disc, "zoh", None, 1e4, 1, (), None, (), "zoh")
+
+
+def test_injected_names_never_reach_the_c_compiler(tmp_path):
+    """Reference: the C preprocessor's own output (``cc -E -P``, comments removed) of the
+    generated module holds no injected statement, the module compiles with -Werror
+    -pedantic, and a program printing ``<PREFIX>_NAME`` prints the controller's name exactly
+    as given (the string literal escapes it)."""
+    import shutil
+    import subprocess
+
+    from ambseal.export.codegen import write_c
+
+    cc = shutil.which("cc") or shutil.which("gcc")
+    ctrl = _small_digital(INJECTED, inputs=["*/ y_A; /*"], outputs=["i_A??/"])
+    files = write_c(ctrl, tmp_path / "c", "amb_k")
+    pre = subprocess.run([cc or "cpp", "-E", "-P", "-std=c99", str(files[1])],
+                         capture_output=True, text=True, check=True).stdout
+    assert "ambseal_injected" not in pre and "system" not in pre
+    if cc is None:
+        return
+    main_c = tmp_path / "main.c"
+    main_c.write_text('#include <stdio.h>\n#include "amb_k.h"\n'
+                      'int main(void) { fputs(AMB_K_NAME, stdout); return 0; }\n')
+    exe = tmp_path / "run"
+    subprocess.run([cc, "-std=c99", "-Wall", "-Werror", "-pedantic",
+                    f"-I{files[0].parent}", "-o", str(exe), str(main_c), str(files[1])],
+                   check=True)
+    out = subprocess.run([str(exe)], capture_output=True, check=True).stdout
+    assert out.decode("utf-8") == INJECTED
+
+
+def test_controller_file_with_an_injected_name_is_refused(tmp_path, capsys):
+    """Reference: the controller-file contract — names are plain labels. A file whose
+    ``name`` or input name carries C is refused at load (one line naming the key, exit 2,
+    no C written); a file name that is no C identifier is mapped to one."""
+    from ambseal.export.controller_files import export_controller
+
+    good = export_controller(_small_digital("K_small"), tmp_path / "K-1 v2.json")
+    assert main(["export", "x.toml", "--controller", str(good), "--c",
+                 str(tmp_path / "ok")]) == 0
+    files = json.loads(capsys.readouterr().out)["files"]
+    assert [Path(f).name for f in files] == ["ambseal_K_1_v2.h", "ambseal_K_1_v2.c"]
+    for key, value in (("name", INJECTED), ("inputs", ['y_A"; system("x"); /*'])):
+        doc = json.loads(good.read_text())
+        doc[key] = value
+        bad = tmp_path / "K.json"
+        bad.write_text(json.dumps(doc))
+        _one_line_exit_2(capsys, ["export", "x.toml", "--controller", str(bad), "--c",
+                                  str(tmp_path / "c")], str(bad), key, "not a plain name")
+        assert not (tmp_path / "c").exists()

@@ -4,6 +4,7 @@ run into the same folder is refused, a killed run leaves the former complete set
 The reference is the manifest's SHA-256 list (:func:`ambseal.files.check_manifest`): a
 folder mixing two runs fails it."""
 
+import json
 import os
 import random
 import signal
@@ -185,3 +186,105 @@ def test_killed_ambseal_run(tmp_path):
     subprocess.run(cmd, env=env, check=True, capture_output=True)
     assert check_manifest(out) != first
     assert sorted(p.name for p in tmp_path.iterdir()) == [".out.lock", "out"]
+
+
+def test_run_refuses_a_folder_with_a_users_notes_beside_metrics(tmp_path, capsys):
+    """A folder holding an earlier metrics.json (no manifest: ambseal cannot tell what it
+    made) and the user's notes: `ambseal run --out` on it is refused with one line naming
+    the notes, exit 2, and both files are kept as they were."""
+    out = tmp_path / "results"
+    out.mkdir()
+    (out / "metrics.json").write_text("{}")
+    (out / "notes.txt").write_text("my notes")
+    assert main(["run", "--no-identify", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "notes.txt" in err[0] and "--out" in err[0], err
+    assert (out / "notes.txt").read_text() == "my notes"
+    assert sorted(p.name for p in out.iterdir()) == ["metrics.json", "notes.txt"]
+
+
+def test_rerun_refuses_a_former_run_with_a_users_file(tmp_path):
+    """A former run's complete output (its manifest) plus a file the user put there, at the
+    top or in one of the run's folders: the rerun is refused before any work and the file
+    is kept; without it the rerun replaces the run's files."""
+    out = tmp_path / "out"
+    _write(out, "old")
+    for extra in (out / "notes.txt", out / "sub" / "mine.txt"):
+        extra.write_text("mine")
+        with pytest.raises(AmbsealError, match=extra.name):
+            _write(out, "new")
+        assert extra.read_text() == "mine" and _tags(out) == {"old"}
+        extra.unlink()
+    _write(out, "new")
+    assert _tags(out) == {"new"}
+
+
+def test_a_file_made_during_the_run_is_kept(tmp_path):
+    """A file the user saves into the output folder while a run writes its new set is not
+    lost with the former set: it is in the folder after the run, not in its manifest."""
+    out = tmp_path / "out"
+    _write(out, "old")
+    with RunFolder(out) as stage:
+        write_text(stage / "f0.txt", "new")
+        (out / "notes.txt").write_text("mine")
+    assert (out / "notes.txt").read_text() == "mine" and _tags(out) == {"new"}
+    with pytest.raises(AmbsealError, match="notes.txt"):
+        check_manifest(out)
+
+
+def _small_controller_file(tmp_path):
+    from ambseal.export.controller_files import export_controller
+
+    from .test_cli_export import _small_digital
+
+    return export_controller(_small_digital("K"), tmp_path / "K.json")
+
+
+def test_folder_commands_write_only_beside_their_own_files(tmp_path, capsys):
+    """`export --controller` writes its C module into --out and lists it in the folder's
+    manifest; a rerun replaces its files; a user's file there (at the top or in the C
+    folder) makes the next run refuse the folder (one line naming it, exit 2) and is kept;
+    removed, the rerun works again."""
+    K = _small_controller_file(tmp_path)
+    out = tmp_path / "export"
+    argv = ["export", "x.toml", "--controller", str(K), "--out", str(out)]
+    assert main(argv) == 0 and main(argv) == 0
+    assert {"c/ambseal_K.h", "c/ambseal_K.c"} <= set(
+        json.loads((out / "manifest.json").read_text())["files"])
+    check_manifest(out)
+    capsys.readouterr()
+    for extra in (out / "notes.txt", out / "c" / "mine.h"):
+        extra.write_text("mine")
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and extra.name in err[0], err
+        assert extra.read_text() == "mine"
+        extra.unlink()
+    assert main(argv) == 0
+
+
+@pytest.mark.parametrize("command", ["design", "export", "identify", "track", "campbell",
+                                     "sweep"])
+def test_every_folder_command_refuses_a_users_folder(tmp_path, capsys, monkeypatch, command):
+    """Each command that writes a folder refuses one holding a file it did not write,
+    before any work (the design would fail the test), one line naming the file, exit 2."""
+    import ambseal.design.recipes as recipes
+
+    def no_work(*a, **k):
+        raise AssertionError("working before the output folder was checked")
+
+    monkeypatch.setattr(recipes, "design", no_work)
+    rig = str(ROOT / "examples" / "testrig.toml")
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    argv = {"design": ["design", rig, "--method", "pid"],
+            "export": ["export", rig, "--method", "pid"],
+            "identify": ["identify", rig, "x.csv", "--params", "A.Ki_zeta"],
+            "track": ["track", rig, "x.csv", "--params", "seal.k"],
+            "campbell": ["campbell", rig, "--controller", "pid", "--speed-hz", "0:10:2"],
+            "sweep": ["sweep", rig, "--pressure-bar", "0:1:2"]}[command]
+    assert main(argv + ["--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "notes.txt" in err[0], err
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]

@@ -7,7 +7,8 @@ CLI turns an :class:`AmbsealError` into one line on stderr and exit code 2.
 from __future__ import annotations
 
 __all__ = ["AmbsealError", "ConfigError", "DataError", "ModelError", "IdentificationError",
-           "SynthesisError", "describe_validation_error", "PRIMITIVE_TAGS", "with_source"]
+           "SynthesisError", "describe_validation_error", "PRIMITIVE_TAGS", "NAME_PATTERN",
+           "LABEL_PATTERN", "with_source"]
 
 
 class AmbsealError(Exception):
@@ -36,6 +37,13 @@ class SynthesisError(AmbsealError):
 
 #: Type names pydantic puts into an error's location for the branches of a union.
 PRIMITIVE_TAGS = {"float", "int", "str", "bool", "list[float]", "tuple[float, float]"}
+#: A name that becomes part of parameter, signal and C names (``A.Ki_zeta``): a C identifier.
+NAME_PATTERN = r"^[A-Za-z_][A-Za-z0-9_]*$"
+#: A label (free text shown in reports): one line, no control characters.
+LABEL_PATTERN = r"^[^\x00-\x1f\x7f]*$"
+_PATTERNS = {NAME_PATTERN: "a name of ASCII letters, digits and '_' that does not start with "
+             "a digit (it makes parameter, signal and C names)",
+             LABEL_PATTERN: "text on one line (no control characters)"}
 
 
 def _loc(loc: tuple, tags: set[str]) -> str:
@@ -97,7 +105,8 @@ def describe_validation_error(exc, tags: set[str]) -> str:
     elif kind in ("list_type", "tuple_type"):
         msg = f"expected an array, got {type(value).__name__} {value!r}"
     elif kind == "string_pattern_mismatch":
-        msg = f"expected a name without '.', ',' or spaces, got {value!r}"
+        pattern = err.get("ctx", {}).get("pattern")
+        msg = f"expected {_PATTERNS.get(pattern, f'text matching {pattern}')}, got {value!r}"
     elif msg.startswith("Value error, "):
         msg = msg[len("Value error, "):]
     return f"{_loc(err['loc'], tags)}: {msg}"

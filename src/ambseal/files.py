@@ -3,6 +3,13 @@
 Every file ambseal writes goes to a temporary name in the target folder and is renamed
 into place (``os.replace``, atomic on POSIX): a killed run leaves either the old file or
 the new one, never half of one.
+
+An output folder (``--out``) is ambseal's only as far as its ``manifest.json`` says: the
+manifest lists the files (and folders) ambseal made there. A command writes into a folder
+that is new, empty, or holds nothing but what its manifest lists; a folder with anything
+else in it (a user's notes beside an earlier ``metrics.json``, a folder that never was an
+output) is refused before any work, and nothing that is not listed is ever replaced or
+removed (:class:`RunFolder`, :class:`OwnedFolder`).
 """
 
 from __future__ import annotations
@@ -13,6 +20,7 @@ import fcntl
 import hashlib
 import json
 import os
+import re
 import shutil
 import tempfile
 import tomllib
@@ -23,7 +31,7 @@ from typing import Any, BinaryIO, Callable
 from ambseal.errors import AmbsealError
 
 __all__ = ["atomic_write", "writable_folder", "read_text", "load_toml", "write_text", "write_json", "RunFolder", "check_manifest",
-           "write_manifest"]
+           "write_manifest", "OwnedFolder", "foreign_entries"]
 
 
 def atomic_write(path: str | os.PathLike, write: Callable[[BinaryIO], Any]) -> Path:
@@ -120,6 +128,8 @@ def write_json(path: str | os.PathLike, data: Any) -> Path:
 #: leaves room for larger rigs and the staging copy beside the old output.
 MIN_FREE_BYTES = 50 * 2**20
 MANIFEST = "manifest.json"
+#: The lock of an :class:`OwnedFolder`, inside it (ambseal's, never listed or refused).
+FOLDER_LOCK = ".ambseal.lock"
 _RENAME_EXCHANGE = 2  # linux/fs.h
 _AT_FDCWD = -100
 
@@ -146,11 +156,83 @@ def _exchange(a: Path, b: Path) -> bool:
     return fn(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE) == 0
 
 
-def _is_run_output(folder: Path) -> bool:
-    """Whether ``folder`` is empty or holds a former run's output (its manifest or
-    metrics.json), i.e. may be replaced as a whole."""
-    names = {p.name for p in folder.iterdir()}
-    return not names or MANIFEST in names or "metrics.json" in names
+#: The temporary name of :func:`atomic_write` (``tempfile.mkstemp``'s 8 random characters):
+#: a write killed half-way leaves one; it is ambseal's, not a user's file.
+_TEMPORARY = re.compile(r"\..+\.[a-z0-9_]{8}\.tmp")
+
+
+def _read_manifest(folder: Path) -> dict | None:
+    """The manifest of ``folder``: ``{"files": {path: sha256}, "folders": [path]}``, or None
+    when there is none or it is not one ambseal wrote."""
+    try:
+        man = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
+        files, folders = man["files"], man.get("folders", [])
+    except (OSError, ValueError, KeyError, TypeError, AttributeError, RecursionError):
+        return None
+    if not (isinstance(files, dict) and isinstance(folders, list)
+            and all(isinstance(k, str) for k in [*files, *folders])):
+        return None
+    return {"files": files, "folders": folders}
+
+
+def _listed(man: dict | None) -> tuple[set[str], set[str]]:
+    """(files, folders) a manifest lists; the folders holding a listed file included."""
+    if man is None:
+        return set(), set()
+    files, folders = set(man["files"]), set(man["folders"])
+    for f in files:
+        parts = f.split("/")[:-1]
+        folders.update("/".join(parts[:i]) for i in range(1, len(parts) + 1))
+    return files, folders
+
+
+def foreign_entries(folder: str | os.PathLike) -> list[str]:
+    """What ``folder`` holds that its manifest does not list (folders end in ``/``).
+
+    A folder without a valid ``manifest.json`` owns nothing: everything in it is foreign
+    (the manifest too). Temporary files of a killed write are not counted. Folders that are
+    not listed are not searched further.
+
+    Parameters
+    ----------
+    folder : path
+        An existing folder.
+
+    Returns
+    -------
+    list of str
+        Paths relative to ``folder``, sorted; empty when ambseal may write there.
+    """
+    folder = Path(folder)
+    man = _read_manifest(folder)
+    files, folders = _listed(man)
+    out: list[str] = []
+
+    def walk(path: str, rel: str) -> None:
+        with os.scandir(path) as entries:
+            for e in sorted(entries, key=lambda e: e.name):
+                r = rel + e.name
+                if (not rel and (e.name == FOLDER_LOCK or e.name == MANIFEST and man)) or \
+                        _TEMPORARY.fullmatch(e.name):
+                    continue
+                if e.is_dir(follow_symlinks=False):
+                    if r in folders:
+                        walk(e.path, r + "/")
+                    else:
+                        out.append(r + "/")
+                elif not (r in files and e.is_file(follow_symlinks=False)):
+                    out.append(r)
+
+    walk(str(folder), "")
+    return out
+
+
+def _not_ours(folder: Path, extra: list[str]) -> AmbsealError:
+    names = ", ".join(extra[:3]) + (f" and {len(extra) - 3} more" if len(extra) > 3 else "")
+    return AmbsealError(f"{folder}: not an ambseal output folder, or it holds files ambseal "
+                        f"did not write ({names}); ambseal replaces only the files its "
+                        f"{MANIFEST} lists: move those elsewhere or choose an empty or new "
+                        "--out")
 
 
 def _file_hash(path: Path) -> str:
@@ -161,14 +243,19 @@ def _file_hash(path: Path) -> str:
     return h.hexdigest()
 
 
-def write_manifest(folder: Path, run_id: str) -> Path:
-    """Write ``manifest.json``: the run id and the SHA-256 of every file in ``folder``."""
+def write_manifest(folder: Path, run_id: str, keep=None) -> Path:
+    """Write ``manifest.json``: the run id, the SHA-256 of every file in ``folder`` and its
+    sub-folders, and the sub-folders (only the paths that ``keep(relative_path)`` accepts,
+    when given)."""
 
-    files = {p.relative_to(folder).as_posix(): _file_hash(p)
-             for p in sorted(folder.rglob("*")) if p.is_file() and p.name != MANIFEST}
+    paths = [p for p in sorted(folder.rglob("*")) if p.name not in (MANIFEST, FOLDER_LOCK)
+             and not _TEMPORARY.fullmatch(p.name) and not p.is_symlink()
+             and (keep is None or keep(p.relative_to(folder).as_posix()))]
+    files = {p.relative_to(folder).as_posix(): _file_hash(p) for p in paths if p.is_file()}
+    folders = [p.relative_to(folder).as_posix() for p in paths if p.is_dir()]
     stamp = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
     return write_json(folder / MANIFEST, {"run_id": run_id, "finished_utc": stamp,
-                                          "files": files})
+                                          "files": files, "folders": folders})
 
 
 def check_manifest(folder: str | os.PathLike) -> str:
@@ -185,8 +272,8 @@ def check_manifest(folder: str | os.PathLike) -> str:
         listed = dict(man["files"])
     except (OSError, ValueError, KeyError, TypeError) as exc:
         raise AmbsealError(f"{folder / MANIFEST}: not a complete run output ({exc})") from None
-    present = {p.relative_to(folder).as_posix() for p in folder.rglob("*")
-               if p.is_file() and p.name != MANIFEST}
+    present = {p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file()
+               and p.name not in (MANIFEST, FOLDER_LOCK) and not _TEMPORARY.fullmatch(p.name)}
     if present != set(listed):
         odd = sorted(present ^ set(listed))[0]
         raise AmbsealError(f"{folder}: {odd}: not part of run {man.get('run_id')}")
@@ -206,13 +293,15 @@ class RunFolder:
     ``out``. On success the manifest is written last and the staging folder replaces
     ``out`` by one atomic exchange of the two directories (Linux ``renameat2``; elsewhere
     two renames, and a run killed between them is repaired by the next); on error or kill
-    ``out`` keeps the former run's complete set.
+    ``out`` keeps the former run's complete set. ``out`` may be replaced only when it holds
+    nothing but the files of its manifest (a file that appears there during the run is
+    moved into the new set, not lost).
 
     Raises
     ------
     AmbsealError
         The folder cannot be created or written, the disk is full, another run holds the
-        lock, or ``out`` holds files that are not an ambseal run's output.
+        lock, or ``out`` holds files its manifest does not list.
     """
 
     def __init__(self, out: str | os.PathLike):
@@ -259,10 +348,7 @@ class RunFolder:
         self._lock()
         try:
             self._clean_stale()
-            if self.out.exists() and not (self.out.is_dir() and _is_run_output(self.out)):
-                raise AmbsealError(f"{self.out}: exists and is not an ambseal output folder "
-                                   "(no metrics.json or manifest.json); choose an empty or "
-                                   "new --out")
+            self._check_ours()
             try:
                 self.stage.mkdir()
                 (self.stage / ".probe").write_bytes(b"0" * 4096)
@@ -285,8 +371,10 @@ class RunFolder:
             if kind is not None:
                 shutil.rmtree(self.stage, ignore_errors=True)
                 return
+            moved: list = []
             try:
                 write_manifest(self.stage, uuid.uuid4().hex)
+                self._keep_foreign(moved)
                 if not self.out.exists():
                     os.rename(self.stage, self.out)
                 elif _exchange(self.stage, self.out):
@@ -295,13 +383,121 @@ class RunFolder:
                     os.rename(self.out, self.old)
                     os.rename(self.stage, self.out)
                     shutil.rmtree(self.old, ignore_errors=True)
-            except OSError as exc:
+            except (OSError, AmbsealError) as exc:
+                for src, dst in reversed(moved):  # the user's files back where they were
+                    os.rename(dst, src)
                 shutil.rmtree(self.stage, ignore_errors=True)
+                if isinstance(exc, AmbsealError):
+                    raise
                 raise self._fail("replace the output folder", exc) from None
         finally:
             self._unlock()
+
+    def _check_ours(self) -> None:
+        """AmbsealError unless ``out`` is new, or a folder of nothing but its manifest's."""
+        if not os.path.lexists(self.out):
+            return
+        if self.out.is_symlink() or not self.out.is_dir():
+            raise AmbsealError(f"{self.out}: exists and is not a folder; choose an empty or "
+                               "new --out")
+        try:
+            extra = foreign_entries(self.out)
+        except OSError as exc:
+            raise self._fail("read the output folder", exc) from None
+        if extra:
+            raise _not_ours(self.out, extra)
+
+    def _keep_foreign(self, moved: list) -> None:
+        """Move what appeared in ``out`` during the run (not in its manifest) into the
+        staging folder, so that replacing ``out`` loses none of it; ``moved`` gets each
+        (source, destination) as it is moved."""
+        if not self.out.is_dir():
+            return
+        moves = [(self.out / rel.rstrip("/"), self.stage / rel.rstrip("/"))
+                 for rel in foreign_entries(self.out)]
+        for src, dst in moves:  # all checked before the first is moved
+            if os.path.lexists(dst):
+                raise AmbsealError(f"{src}: appeared during the run and has the name of one "
+                                   f"of its files; {self.out} keeps the former output")
+        for src, dst in moves:
+            dst.parent.mkdir(parents=True, exist_ok=True)
+            os.rename(src, dst)
+            moved.append((src, dst))
 
     def _unlock(self) -> None:
         if self._lock_fd is not None:
             os.close(self._lock_fd)
             self._lock_fd = None
+
+
+class OwnedFolder(RunFolder):
+    """An output folder that a command writes file by file (``design``, ``export``,
+    ``identify``, ``track``, ``campbell``, ``sweep``).
+
+    ``with OwnedFolder(out) as folder:`` refuses a folder that holds anything its manifest
+    does not list, creates ``out`` if needed, takes the lock :data:`FOLDER_LOCK` inside it
+    (a second command into the same folder is refused) and checks that a file can be
+    written there, all before any work. On leaving (after an error too) the manifest lists
+    what it listed before and is still there, and every file made during the command;
+    nothing else in the folder is touched. A folder that was created and got nothing is
+    removed again.
+
+    Raises
+    ------
+    AmbsealError
+        The folder cannot be created or written, another command holds the lock, or the
+        folder holds files its manifest does not list.
+    """
+
+    def __init__(self, out: str | os.PathLike):
+        super().__init__(out)
+        self.lock_path = self.out / FOLDER_LOCK
+
+    def _entries(self) -> set[str]:
+        return {p.relative_to(self.out).as_posix() for p in self.out.rglob("*")} - {
+            FOLDER_LOCK}
+
+    def __enter__(self) -> Path:
+        self._check_ours()
+        self._created = not self.out.exists()
+        try:
+            self.out.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise self._fail("create the output folder", exc) from None
+        self._lock()
+        try:
+            self._check_ours()  # again, under the lock
+            writable_folder(self.out)
+            self._before = self._entries()
+            self._listed = set().union(*_listed(_read_manifest(self.out)))
+        except BaseException:
+            self._release()
+            raise
+        return self.out
+
+    def __exit__(self, kind, exc, tb) -> None:
+
+        try:
+            mine = self._listed | (self._entries() - self._before)
+            if not (self._created and not self._entries()):
+                write_manifest(self.out, uuid.uuid4().hex, keep=mine.__contains__)
+        except OSError as exc:
+            if kind is None:
+                raise self._fail("write its manifest", exc) from None
+        finally:
+            self._release()
+
+    def _release(self) -> None:
+        """Unlock; a folder made for nothing is removed again, with its lock."""
+        try:
+            empty = self._created and not self._entries()
+        except OSError:
+            empty = False
+        if empty:
+            self.lock_path.unlink(missing_ok=True)
+        self._unlock()
+        if empty:
+            try:
+                self.out.rmdir()
+            except OSError:  # something appeared meanwhile: left as it is
+                pass

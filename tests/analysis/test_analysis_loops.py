@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import control
 import numpy as np
@@ -14,6 +15,7 @@ from ambseal.errors import ModelError
 from .amb_test_plants import NAMES, mass_1dof, rigid_rotor
 
 W = np.logspace(0, 4.5, 600)
+ROOT_RIG = Path(__file__).resolve().parents[2] / "examples" / "testrig.toml"
 
 
 def _static(D):
@@ -157,3 +159,107 @@ def test_resolved_grid_catches_a_lightly_damped_peak():
     exact = 1 / (2 * z * np.sqrt(1 - z**2))
     assert gain(w).max() < 0.8 * exact
     assert gain(resolved_grid(w, poles)).max() == pytest.approx(exact, rel=2e-3)
+
+
+def test_controller_wired_by_names_not_by_position():
+    """Reference: the same loop closed by python-control (control.feedback) on the plant
+    as named. A controller whose channels come in another order (B before A, η before ζ)
+    gives the same poles and per-axis S_o as in the plant's order; a renamed channel is an
+    error naming both sets; unnamed systems are wired by position."""
+    G, Gf, K = rigid_rotor()
+    K = control.ss(K.A, K.B, np.diag([1.0, 1.2, 1.5, 1.7]) @ K.C,
+                   np.diag([1.0, 1.2, 1.5, 1.7]) @ K.D, inputs=NAMES, outputs=NAMES)
+    order = [3, 2, 1, 0]
+    Kp = control.ss(K.A, K.B[:, order], K.C[order, :], K.D[np.ix_(order, order)],
+                    inputs=[NAMES[j] for j in order], outputs=[NAMES[j] for j in order])
+    ref = control.feedback(G, K, sign=-1)
+    cl = loops.closed_loop(G, Kp, Gf)
+    np.testing.assert_allclose(np.sort_complex(cl.poles), np.sort_complex(ref.poles()),
+                               rtol=1e-7)
+    p0, p1 = (loops.loop_responses(G, k, W).peaks("So") for k in (K, Kp))
+    assert [(p.channel, p.value) for p in p1.diagonal] == [(p.channel, p.value)
+                                                            for p in p0.diagonal]
+    c0, c1 = (loops.compliance(G, k, Gf, W).peak.value for k in (K, Kp))
+    assert c1 == pytest.approx(c0, rel=1e-12)
+    renamed = control.ss(K.A, K.B, K.C, K.D, inputs=["A_zeta", "A_eta", "B_zeta", "C_eta"],
+                         outputs=NAMES)
+    with pytest.raises(ModelError, match=r"C_eta.*B_eta"):
+        loops.closed_loop(G, renamed)
+    unnamed = control.ss(K.A, K.B, K.C, K.D)
+    np.testing.assert_allclose(np.sort_complex(loops.closed_loop(G, unnamed).poles),
+                               np.sort_complex(ref.poles()), rtol=1e-7)
+
+
+def _swapped_rig(tmp_path):
+    """The embedded rig file with its [[amb]] B listed before A."""
+    import tomllib
+
+    from ..toml_text import dump
+
+    data = tomllib.loads(ROOT_RIG.read_text())
+    assert [a["name"] for a in data["amb"]] == ["A", "B"]
+    data["amb"] = data["amb"][::-1]
+    path = tmp_path / "swapped.toml"
+    path.write_text(dump(data))
+    return path
+
+
+def test_loaded_controller_judged_alike_whatever_the_amb_order(testrig_cfg, tmp_path, capsys):
+    """A controller file (the reference PID with B's gains 1.2× A's, so that its channels
+    differ) judged on the rig and on the same rig with [[amb]] B listed first: the same
+    closed-loop poles, per-axis S_o peaks by axis name and compliance (the judged loop),
+    and `ambseal modes --controller` gives the same modes. By position the swapped rig
+    would run A's axes with B's gains. Reference: the original order, where names and
+    positions agree."""
+    from ambseal.analysis.judge import judge, operating_points
+    from ambseal.cli import main
+    from ambseal.config import load_rig
+    from ambseal.export.controller_files import export_controller, load_controller
+    from ambseal.design.recipes import design
+
+    K0 = design(testrig_cfg, "pid").K
+    g = np.diag([1.2 if n.startswith("i_B") else 1.0 for n in K0.output_labels])
+    K = control.ss(K0.A, K0.B, g @ K0.C, g @ K0.D, inputs=list(K0.input_labels),
+                   outputs=list(K0.output_labels), name="K_uneven")
+    path = export_controller(K, tmp_path / "K.json")
+    loaded = load_controller(path)
+    rig = _swapped_rig(tmp_path)
+    swapped = load_rig(rig)
+    assert [a.name for a in swapped.amb] == ["B", "A"]
+    point = operating_points(testrig_cfg)[1]
+    cases = [judge(c, loaded, "K", point, impulse=False)[0] for c in (testrig_cfg, swapped)]
+    for key in ("stable", "max_real_pole", "sensitivity_peak", "compliance_peak_m_per_n"):
+        assert cases[1][key] == pytest.approx(cases[0][key], rel=1e-6), key
+    per_axis = [c["sensitivity_peak_per_axis"] for c in cases]
+    assert set(per_axis[1]) == set(per_axis[0])
+    for axis, value in per_axis[0].items():
+        assert per_axis[1][axis] == pytest.approx(value, rel=1e-6), axis
+    modes = []
+    for r in (ROOT_RIG, rig):
+        assert main(["modes", str(r), "--controller", str(path), "--json"]) == 0
+        modes.append(json.loads(capsys.readouterr().out)["natural_frequencies_hz"])
+    np.testing.assert_allclose(modes[1], modes[0], rtol=1e-7)
+
+
+def test_loaded_controller_with_a_renamed_channel_is_refused(tmp_path, capsys):
+    """A controller file whose input B_eta was renamed: `modes` refuses it with one line
+    listing the controller's and the plant's signals (exit 2); a file without signal names
+    is connected by position and says so in a warning."""
+    from ambseal.cli import main
+
+    K = control.ss([], [], [], -np.eye(4) * 2e4,
+                   inputs=[f"y_{n}" for n in NAMES[:3]] + ["y_C_eta"],
+                   outputs=[f"i_{n}" for n in NAMES], name="K")
+    from ambseal.export.controller_files import export_controller
+
+    path = export_controller(K, tmp_path / "K.json")
+    assert main(["modes", str(ROOT_RIG), "--controller", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "y_C_eta" in err[0] and "y_B_eta" in err[0], err
+    doc = json.loads(path.read_text())
+    del doc["inputs"], doc["outputs"]
+    path.write_text(json.dumps(doc))
+    with pytest.warns(UserWarning, match="by position"):
+        from ambseal.export.controller_files import load_controller
+
+        load_controller(path)

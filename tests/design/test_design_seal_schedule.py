@@ -172,3 +172,76 @@ def test_seal_scheduled_c_interpolates_on_theta_like_python(tmp_path):
     assert "theta = seal.k" in files[0].read_text()
     got = _compile_and_run(tmp_path, files, "amb_tracked", y, "double", speeds=theta)
     assert np.max(np.abs(got - ref)) < 1e-9 * np.max(np.abs(ref))
+
+
+class _Planted:
+    """A pickle that, when loaded, creates the file ``marker`` (stands for any code)."""
+
+    def __init__(self, marker):
+        self.marker = str(marker)
+
+    def __reduce__(self):
+        import pathlib
+
+        return (pathlib.Path.touch, (pathlib.Path(self.marker),))
+
+
+def test_design_cache_is_data_never_code(testrig_cfg, tmp_path, monkeypatch):
+    """A cache entry is plain JSON keyed by the inputs and the package version: a second
+    call reads it back (the same table, no synthesis); a pickle planted under the former
+    name or in place of the entry, a malformed entry and an entry of another version are
+    never executed but ignored, and the design is recomputed. Reference: the marker file
+    the planted pickle would create (it must not exist) and the design's own arrays."""
+    import json
+    import pickle
+
+    import ambseal.design.seal_schedule as ss
+
+    calls = []
+
+    def fake_synthesis(cfg, plant, args, scale, dl, kw):
+        calls.append(args)
+        return _two_entry_design()
+
+    monkeypatch.setattr(ss, "_synthesise", fake_synthesis)
+    monkeypatch.delenv(ss.CACHE_ENV, raising=False)
+    cache = tmp_path / "cache"
+    first = design_seal_scheduled(testrig_cfg, cache_dir=cache)
+    (entry,) = cache.iterdir()
+    assert entry.suffix == ".json" and entry.name.startswith("seal_scheduled-")
+    again = design_seal_scheduled(testrig_cfg, cache_dir=cache)
+    assert len(calls) == 1
+    for X, Y in zip(again.matrices_at(0.7e6), first.matrices_at(0.7e6)):
+        np.testing.assert_array_equal(X, Y)
+    assert again.weights == first.weights and again.parameter == "seal.k"
+
+    marker = tmp_path / "executed"
+    planted = pickle.dumps(_Planted(marker))
+    entry.with_suffix(".pkl").write_bytes(planted)
+    for bad in (planted, b"{not json", b"[]", b'{"key": 1}'):
+        entry.write_bytes(bad)
+        d = design_seal_scheduled(testrig_cfg, cache_dir=cache)
+        assert not marker.exists()
+        assert d.schedule == first.schedule
+    assert len(calls) == 5
+    doc = json.loads(entry.read_text())
+    doc["ambseal_version"] = "0.0.0-other"
+    entry.write_text(json.dumps(doc))
+    design_seal_scheduled(testrig_cfg, cache_dir=cache)
+    assert len(calls) == 6 and not marker.exists()
+
+
+def test_no_deserialisation_of_code_in_the_package():
+    """Nothing ambseal reads from disk is unpickled: no pickle load, no
+    ``allow_pickle=True`` and no ``eval`` in the source."""
+    import re
+    from pathlib import Path
+
+    import ambseal
+
+    src = Path(ambseal.__file__).parent
+    bad = re.compile(r"pickle\.loads?\(|allow_pickle\s*=\s*True|\beval\(|marshal\.loads?\(")
+    found = [f"{p.relative_to(src)}:{i}" for p in src.rglob("*.py")
+             for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
+             if bad.search(line)]
+    assert not found, found

@@ -59,7 +59,7 @@ from ambseal.design.lpv_plant import lpv_plant, vertex_grid_hz
 from ambseal.design.specs import RIGID_STATES, design_spec
 from ambseal.lti.discrete import zoh
 from ambseal.lti.freqresp import freqresp_at
-from ambseal.lti.interconnect import series_inputs
+from ambseal.lti.interconnect import series_inputs, wired
 from ambseal.model.modes import classify_poles
 from ambseal.model.rig import build_plant
 from ambseal.model.seal import seal_values
@@ -297,6 +297,7 @@ def _judge_loop(cfg, P, cur, force, controller, s: JudgeSettings, impulse: bool
     with current inputs ``cur`` and force inputs ``force``."""
 
     G, Gf = _inputs(P, cur), _inputs(P, force)
+    controller = wired(G, controller)  # by signal names, in the plant's order
     loop = closed_loop(G, controller, Gf)
     dt = loop.dt
     case = {"stable": loop.stable, "max_real_pole": loop.max_real_pole}

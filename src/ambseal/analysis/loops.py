@@ -15,6 +15,11 @@ so a PID with positive ``K_p`` stabilises the negative-stiffness plant ``G`` (P5
 Frequencies are rad/s inside (``omega_rad_s``), Hz at the edges (``frequency_hz``).
 Peaks are grid maxima: pass a grid dense enough around resonances.
 
+The controller is connected by its signal names (:func:`ambseal.lti.interconnect.wired`):
+a controller for ``[[amb]]`` A, B drives the same axes on a rig that lists B first, and a
+missing, extra or renamed signal is an error; only a system without names is connected by
+position.
+
 The same functions close and evaluate **discrete** loops (plant and controller of one sample
 time ``dt``, e.g. the ZOH-sampled plant and the controller that runs on the target): poles
 are then ``z``, stable means ``|z| < 1``, and responses are taken at ``z = e^{jωdt}``
@@ -33,7 +38,7 @@ import numpy as np
 from ambseal.analysis._util import json_float, json_list
 from ambseal.errors import ModelError
 from ambseal.lti.freqresp import freqresp_at
-from ambseal.lti.interconnect import feedback_matrices
+from ambseal.lti.interconnect import feedback_matrices, wired
 from ambseal.lti.matrices import as_omega, labels, ss_matrices
 from ambseal.robust.stability import decay_rate, is_stable
 
@@ -343,7 +348,7 @@ def _dt(sys: Any) -> float:
 
 def _check_pair(G: Any, K: Any) -> tuple[tuple, tuple]:
     mg = ss_matrices(G, name="G", allow_discrete=True)
-    mk = ss_matrices(K, name="K", allow_discrete=True)
+    mk = ss_matrices(wired(G, K), name="K", allow_discrete=True)
     if abs(_dt(G) - _dt(K)) > 1e-12 * max(_dt(G), _dt(K)):
         raise ModelError(f"G (dt={_dt(G)}) and K (dt={_dt(K)}) must share one time base")
     ny, nu = mg[3].shape
@@ -452,6 +457,7 @@ def loop_responses(G: Any, K: Any, omega: Any) -> LoopResponse:
     """
     w = as_omega(omega)
     _check_pair(G, K)
+    K = wired(G, K)
     ny, nu = ss_matrices(G, name="G", allow_discrete=True)[3].shape
     pts, kw = response_points(w, _dt(G))
     return loop_responses_from(freqresp_at(G, pts, **kw), freqresp_at(K, pts), w,
@@ -510,6 +516,7 @@ def compliance(G: Any, K: Any, Gf: Any, omega: Any) -> ComplianceResponse:
     """
     w = as_omega(omega)
     _check_pair(G, K)
+    K = wired(G, K)
     pts, kw = response_points(w, _dt(G))
     Gfw = freqresp_at(Gf, pts, **kw)
     Gw = freqresp_at(G, pts, **kw)

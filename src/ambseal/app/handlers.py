@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from contextlib import ExitStack
 from pathlib import Path
 
 from rich.console import Console
@@ -28,9 +29,9 @@ from ambseal.app.commands import (
 from ambseal.app.pipeline import run
 from ambseal.config import default_rig_path, load_rig, load_truth
 from ambseal.errors import AmbsealError, ConfigError, with_source
-from ambseal.export.codegen import write_c
+from ambseal.export.codegen import c_identifier, write_c
 from ambseal.export.controller_files import load_controller
-from ambseal.files import writable_folder
+from ambseal.files import OwnedFolder, writable_folder
 from ambseal.identify import signals
 from ambseal.identify.data import save_measurement
 from ambseal.identify.stages import acquire
@@ -99,10 +100,24 @@ def _design(args: argparse.Namespace) -> int:
     if args.method is None:
         raise ConfigError("design: --method is required (pid, hinf, mu or lpv) unless "
                           "--show-defaults")
-    print(json.dumps(design_files(rig, args.method, args.out,
-                                  pressure_bar=args.pressure_bar, overrides=args.overrides,
-                                  allow_unstable=args.allow_unstable)))
+    with _owned(args.out):
+        summary = design_files(rig, args.method, args.out, pressure_bar=args.pressure_bar,
+                               overrides=args.overrides, allow_unstable=args.allow_unstable)
+    print(json.dumps(summary))
     return 0
+
+
+def _owned(out, c_dir=None):
+    """The folders a command writes, each claimed (:class:`ambseal.files.OwnedFolder`:
+    refused if it holds files ambseal did not write, its manifest updated at the end);
+    ``c_dir`` only when it is not inside ``out``."""
+    inside = None not in (out, c_dir) and Path(c_dir).absolute().is_relative_to(
+        Path(out).absolute())
+    with ExitStack() as claims:
+        for folder in (out, None if inside else c_dir):
+            if folder is not None:
+                claims.enter_context(OwnedFolder(folder))
+        return claims.pop_all()  # open for the command's with block, which closes them
 
 
 def _export(args: argparse.Namespace) -> int:
@@ -110,29 +125,35 @@ def _export(args: argparse.Namespace) -> int:
         raise ConfigError("export: give exactly one of --method and --controller")
     if args.controller is not None:
         ctrl = load_controller(args.controller)
-        files = write_c(ctrl, args.c_dir or Path(args.out) / "c",
-                        f"ambseal_{Path(args.controller).stem}", precision=args.precision)
+        with _owned(None if args.c_dir else args.out, args.c_dir):
+            files = write_c(ctrl, args.c_dir or Path(args.out) / "c",  # file name as C names
+                            f"ambseal_{c_identifier(Path(args.controller).stem)}",
+                            precision=args.precision)
         print(json.dumps({"files": [str(f) for f in files]}))
         return 0
-    print(json.dumps(design_files(args.rig, args.method, args.out,
-                                  pressure_bar=args.pressure_bar,
-                                  c_dir=args.c_dir or Path(args.out) / "c",
-                                  precision=args.precision)))
+    with _owned(args.out, args.c_dir):
+        summary = design_files(args.rig, args.method, args.out,
+                               pressure_bar=args.pressure_bar,
+                               c_dir=args.c_dir or Path(args.out) / "c",
+                               precision=args.precision)
+    print(json.dumps(summary))
     return 0
 
 
 def _identify(args: argparse.Namespace) -> int:
-    summary = identify_files(args.rig, args.data, args.params.split(","), args.out,
-                             current_weight=args.current_weight, refine=not args.no_refine,
-                             accept_unconverged=args.accept_unconverged,
-                             static_load=args.static_load)
+    with _owned(args.out):
+        summary = identify_files(args.rig, args.data, args.params.split(","), args.out,
+                                 current_weight=args.current_weight, refine=not args.no_refine,
+                                 accept_unconverged=args.accept_unconverged,
+                                 static_load=args.static_load)
     print(json.dumps(summary))
     return 0
 
 
 def _track(args: argparse.Namespace) -> int:
-    summary = track_files(args.rig, args.data, args.params.split(","), args.out,
-                          rate_per_s=args.rate_per_s)
+    with _owned(args.out):
+        summary = track_files(args.rig, args.data, args.params.split(","), args.out,
+                              rate_per_s=args.rate_per_s)
     print(json.dumps(summary))
     return 0
 

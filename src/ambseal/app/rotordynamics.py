@@ -23,7 +23,7 @@ from ambseal.config import load_rig
 from ambseal.design.recipes import METHODS, design
 from ambseal.errors import ConfigError
 from ambseal.export.controller_files import load_controller
-from ambseal.files import atomic_write, write_json, write_text
+from ambseal.files import OwnedFolder, atomic_write, write_json, write_text
 from ambseal.io.ross import import_ross_file
 from ambseal.model.modes import bending_limit_hz, modes
 from ambseal.model.rig import build_system
@@ -130,6 +130,16 @@ def _modes(args: argparse.Namespace) -> int:
     return 0
 
 
+def _owns_out(handler):
+    """``handler`` with its ``--out`` folder claimed before any work
+    (:class:`ambseal.files.OwnedFolder`)."""
+    def run(args: argparse.Namespace) -> int:
+        with OwnedFolder(args.out):
+            return handler(args)
+    return run
+
+
+@_owns_out
 def _campbell(args: argparse.Namespace) -> int:
     cfg = load_rig(args.rig)
     p = cfg.operating.pressure_bar if args.pressure_bar is None else args.pressure_bar
@@ -161,6 +171,7 @@ def _campbell(args: argparse.Namespace) -> int:
     return 0
 
 
+@_owns_out
 def _sweep(args: argparse.Namespace) -> int:
     cfg = load_rig(args.rig)
     pressures = _range(args.pressure_bar, "--pressure-bar")

@@ -5,9 +5,20 @@ whole rig (materials, positions, names, model size). Called by the validators of
 
 from __future__ import annotations
 
-from ambseal.errors import ConfigError
+from typing import Annotated
 
-__all__ = ["MAX_ELEMENTS", "MAX_REDUCED_STATES", "check_amb", "check_actuator", "cross_check"]
+from pydantic import Field
+
+from ambseal.errors import LABEL_PATTERN, NAME_PATTERN, ConfigError
+
+__all__ = ["MAX_ELEMENTS", "MAX_REDUCED_STATES", "check_amb", "check_actuator", "cross_check",
+           "Name", "Label"]
+
+#: Names of AMBs, seals, springs and materials make parameter, signal and C names
+#: (``A.Ki_zeta``, ``y_A_zeta``; :data:`ambseal.errors.NAME_PATTERN`), checked once here.
+Name = Annotated[str, Field(min_length=1, max_length=64, pattern=NAME_PATTERN)]
+#: Labels (the rotor's, a disk's) are free text for reports, on one line.
+Label = Annotated[str, Field(min_length=1, max_length=200, pattern=LABEL_PATTERN)]
 
 #: Beam elements in the whole shaft, the most a rig may ask for: the dense eigenvalues grow
 #: with the states³ (8 per node; measured ~1e-9 s·states³ on one core) and a run makes

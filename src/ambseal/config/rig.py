@@ -68,6 +68,8 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from ambseal.config._checks import (
     MAX_ELEMENTS,
     MAX_REDUCED_STATES,
+    Label,
+    Name,
     check_actuator,
     check_amb,
     cross_check,
@@ -94,9 +96,6 @@ __all__ = [
 
 
 _Big = Annotated[float, Field(ge=-1e12, le=1e12)]  # plausible bound of a force coefficient
-#: Names of AMBs, seals and springs make parameter and signal names (``A.Ki_zeta``):
-#: no '.', ',' or white space.
-_NAME = Field(min_length=1, max_length=64, pattern=r"^[^.,\s]+$")
 
 
 class _Strict(BaseModel):
@@ -141,7 +140,7 @@ class Material(_Strict):
 
 class Rotor(_Strict):
     beam: Literal["timoshenko", "euler-bernoulli"] = "timoshenko"
-    name: str = "rotor"
+    name: Label = "rotor"
     modal_damping: float = Field(default=0.0, ge=0, lt=1)
 
 
@@ -164,7 +163,7 @@ class Disk(_Strict):
     mass: float = Field(ge=0, le=1e6)
     Ip: float = Field(default=0.0, ge=0, le=1e6)
     Id: float = Field(default=0.0, ge=0, le=1e6)
-    name: str | None = None
+    name: Label | None = None
 
 
 class AxisPair(_Strict):
@@ -182,7 +181,7 @@ class AxisPair(_Strict):
 
 
 class Amb(_Strict):
-    name: str = _NAME
+    name: Name
     position: float = Field(ge=0)
     sensor_position: float = Field(ge=0)
     axes_angle_deg: float = 0.0
@@ -250,7 +249,7 @@ SealCoefficient = float | Affine | FrequencyTable
 
 
 class Seal(_Strict):
-    name: str = _NAME
+    name: Name
     position: float = Field(ge=0)
     K: SealCoefficient = 0.0
     k: SealCoefficient = 0.0
@@ -283,7 +282,7 @@ class Spring(_Strict):
     cxx: float = Field(default=0.0, ge=-1e12, le=1e12)
     cyy: float = Field(default=0.0, ge=-1e12, le=1e12)
     axes_angle_deg: float = Field(default=0.0, ge=-360, le=360)
-    name: str | None = Field(default=None, min_length=1, max_length=64, pattern=r"^[^.,\s]+$")
+    name: Name | None = None
     uncertainty: Uncertainty = None
 
 
@@ -334,7 +333,7 @@ class RigConfig(_Strict):
     """A whole rig: rotor, materials, shaft, components, controller and operating point."""
 
     rotor: Rotor = Rotor()
-    materials: dict[str, Material]
+    materials: dict[Name, Material]
     shaft: list[ShaftSection] = Field(min_length=1)
     disk: list[Disk] = []
     amb: list[Amb] = []

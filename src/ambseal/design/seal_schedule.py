@@ -40,27 +40,32 @@ with W_u = 0.1 on examples/pump.toml. examples/pump.toml with these weights: γ 
 Synthesis takes minutes (≈ 130 s of CPU on the test rig, 5 grid points, the 12-state
 design model and the delay's states; 10–20 min elapsed on the loaded 2-core machine):
 :func:`design_seal_scheduled` keeps each result in a cache folder keyed on the rig, the
-arguments and the synthesis code (``cache_dir``; :data:`CACHE_ENV`).
+arguments, the synthesis code and the package version (``cache_dir``; :data:`CACHE_ENV`). A
+cache entry is plain JSON (numbers and names, never code): an entry that does not parse,
+does not match its key or version, or does not make a consistent design is ignored and the
+design recomputed.
 """
 
 from __future__ import annotations
 
 import hashlib
+import json
+import math
 import os
-import pickle
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ambseal import __version__
 from ambseal.design import plant, weights
 from ambseal.design.plant import generalized_plant, physical_controller, physical_matrices
 from ambseal.design.specs import design_spec
 from ambseal.design.weights import Weights
 from ambseal.errors import ModelError, SynthesisError
-from ambseal.files import atomic_write
+from ambseal.files import write_json
 from ambseal.model import seal
 from ambseal.model.rig import build_plant
 from ambseal.model.seal import values_following_k
@@ -69,7 +74,7 @@ from ambseal.robust import _lpv_reconstruct as lpv_reconstruct
 from ambseal.robust import lpv
 from ambseal.robust.controller import ScheduledController
 from ambseal.robust.delay import design_delay
-from ambseal.robust.lpv import lpvsyn
+from ambseal.robust.lpv import LpvController, lpvsyn
 
 __all__ = ["SealScheduledDesign", "design_seal_scheduled", "CACHE_ENV"]
 
@@ -218,26 +223,99 @@ def design_seal_scheduled(cfg, parameter: str | None = None, *,
     args = (parameter, tuple(map(float, range_factor)), int(n_grid), float(rate_factor_per_s),
             w, n, sorted(lpvsyn_kw.items()), dl.to_dict())
     folder = cache_dir or os.environ.get(CACHE_ENV)
-    path = Path(folder) / f"seal_scheduled-{_key(cfg, args)}.pkl" if folder else None
-    if path is not None and path.is_file():
-        with open(path, "rb") as fh:
-            return pickle.load(fh)
+    key = _key(cfg, args)
+    path = Path(folder) / f"seal_scheduled-{key}.json" if folder else None
+    cached = _read_cache(path, key) if path is not None else None
+    if cached is not None:
+        return cached
     d = _synthesise(cfg, plant, args, scale, dl, lpvsyn_kw)
     if path is not None:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        atomic_write(path, lambda fh: pickle.dump(d, fh))
+        _write_cache(path, key, d)
     return d
 
 
 def _key(cfg, args) -> str:
-    """Cache key: the rig, the arguments and the source of the synthesis code."""
+    """Cache key: the rig, the arguments, the source of the synthesis code and the
+    package version."""
 
     h = hashlib.sha256(cfg.model_dump_json().encode())
+    h.update(f"ambseal {__version__}".encode())
     h.update(repr(args).encode())
     for mod in (lpv, lpv_lmi, lpv_reconstruct, plant, weights, seal):
         h.update(Path(mod.__file__).read_bytes())
     h.update(Path(__file__).read_bytes())
     return h.hexdigest()[:20]
+
+
+_TABLE = ("AK", "BK", "CK", "DK")
+
+
+def _write_cache(path: Path, key: str, d: SealScheduledDesign) -> None:
+    """Keep ``d`` as JSON at ``path`` (the key and version inside); a design with a
+    non-finite number is not kept (strict JSON has none)."""
+    K = d.K
+    doc = {"key": key, "ambseal_version": __version__, "parameter": d.parameter,
+           "gamma": d.gamma, "gamma_design": d.gamma_design, "rate_bound": d.rate_bound,
+           "synthesis_s": d.synthesis_s, "design_states": d.design_states,
+           "range_factor": list(d.range_factor), "delay": d.delay,
+           "weights": asdict(d.weights), "grid": d.grid.tolist(),
+           "check_grid": d.check_grid.tolist(), "check_gamma": d.check_gamma.tolist(),
+           "K": {"speeds_rad_s": K.speeds_rad_s.tolist(),
+                 **{k: np.asarray(getattr(K, k)).tolist() for k in _TABLE},
+                 "input_names": list(K.input_names), "output_names": list(K.output_names)}}
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write_json(path, doc)
+    except (OSError, ValueError):  # a read-only cache or a NaN: the design is still returned
+        pass
+
+
+def _floats(x, ndim: int) -> np.ndarray:
+    """A finite float array of ``ndim`` dimensions from JSON lists, else ValueError."""
+    a = np.asarray(x, dtype=float)
+    if a.ndim != ndim or not np.all(np.isfinite(a)):
+        raise ValueError(f"expected a finite {ndim}-d array")
+    return a
+
+
+def _read_cache(path: Path, key: str) -> SealScheduledDesign | None:
+    """The design kept at ``path`` for ``key``, or None when there is none or it is not a
+    consistent entry of this key and package version (it is then recomputed)."""
+    try:
+        if not path.is_file() or path.stat().st_size > 64 * 2**20:
+            return None
+        doc = json.loads(path.read_text(encoding="utf-8"))
+        if doc["key"] != key or doc["ambseal_version"] != __version__:
+            return None
+        k = doc["K"]
+        W, (A, B, C, D) = _floats(k["speeds_rad_s"], 1), (_floats(k[n], 3) for n in _TABLE)
+        n_t, n = W.size, A.shape[1]
+        ins, outs = [str(s) for s in k["input_names"]], [str(s) for s in k["output_names"]]
+        if not (A.shape == (n_t, n, n) and B.shape == (n_t, n, len(ins))
+                and C.shape == (n_t, len(outs), n) and D.shape == (n_t, len(outs), len(ins))):
+            return None
+        names = {f.name for f in fields(Weights)}
+        wd = doc["weights"]
+        if not isinstance(wd, dict) or set(wd) != names or not all(
+                v is None or isinstance(v, (int, float, str)) and not isinstance(v, bool)
+                or isinstance(v, list) and all(isinstance(x, (int, float)) for x in v)
+                for v in wd.values()):
+            return None
+        w = Weights(**{f: (tuple(v) if isinstance(v, list) else v) for f, v in wd.items()})
+        scalars = [float(doc[f]) for f in ("gamma", "gamma_design", "rate_bound",
+                                           "synthesis_s")]
+        rf = tuple(float(x) for x in doc["range_factor"])
+        if not all(map(math.isfinite, scalars + list(rf))) or len(rf) != 2 or \
+                not isinstance(doc["delay"], dict):
+            return None
+        return SealScheduledDesign(
+            str(doc["parameter"]), LpvController(W, A, B, C, D, tuple(ins), tuple(outs)),
+            scalars[0], scalars[1], _floats(doc["grid"], 1), _floats(doc["check_grid"], 1),
+            _floats(doc["check_gamma"], 1), scalars[2], w, scalars[3],
+            int(doc["design_states"]), rf, dict(doc["delay"]))
+    except (OSError, ValueError, TypeError, KeyError, IndexError, AttributeError,
+            RecursionError):
+        return None
 
 
 def _synthesise(cfg, plant, args, scale: float, dl, lpvsyn_kw) -> SealScheduledDesign:

@@ -21,10 +21,18 @@ zeros; Golub & Van Loan §7.4). A scheduled controller uses one orthogonal basis
 table (the Schur basis of its middle entry), so the linear interpolation on θ —
 the same law as in Python — stays exact. The computation delay of the target is not in the
 code: it is the time between reading ``y`` and writing ``i`` on the target itself.
+
+Only the prefix becomes C identifiers, and it must match ``[A-Za-z_][A-Za-z0-9_]*``
+(:func:`c_identifier` maps a file name to one). Every name that comes with the controller
+(its name, signals, scheduling parameter, method) is text from a file: in comments it is
+printable ASCII with ``*/``, ``/*`` and ``??`` broken apart and anything else written as
+``<U+XXXX>``, and the controller's name is kept as an escaped string literal
+(``<PREFIX>_NAME``).
 """
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -35,9 +43,55 @@ from ambseal.files import write_text
 from ambseal.robust.controller import SPEED
 from ambseal.robust.scheduled_digital import ScheduledDigital
 
-__all__ = ["write_c", "schur_realisation"]
+__all__ = ["write_c", "schur_realisation", "c_identifier"]
 
 _PRECISION = {"double": ("double", ""), "float": ("float", "f")}
+_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
+def c_identifier(text: str) -> str:
+    """``text`` mapped to a C identifier (``[A-Za-z_][A-Za-z0-9_]*``).
+
+    Parameters
+    ----------
+    text : str
+        Any name, e.g. a controller file's stem.
+
+    Returns
+    -------
+    str
+        ``text`` with every character outside ``[A-Za-z0-9_]`` replaced by ``_``, and
+        ``_`` in front of a leading digit or of an empty name.
+
+    Examples
+    --------
+    >>> c_identifier("K-1.v2")
+    'K_1_v2'
+    """
+    out = re.sub(r"[^A-Za-z0-9_]", "_", str(text))
+    return "_" + out if not out or out[0].isdigit() else out
+
+
+def _comment(text) -> str:
+    """``text`` safe inside a C block comment: printable ASCII but the backslash kept,
+    anything else as ``<U+XXXX>``; ``*/``, ``/*`` and trigraphs' ``??`` broken apart."""
+    out = "".join(c if " " <= c <= "~" and c != "\\" else f"<U+{ord(c):04X}>"
+                  for c in str(text))
+    while "*/" in out or "/*" in out or "??" in out:
+        out = out.replace("*/", "* /").replace("/*", "/ *").replace("??", "? ?")
+    return out
+
+
+def _string(text) -> str:
+    """``text`` as the body of a C string literal: printable ASCII kept, ``\\``, ``"`` and
+    ``?`` escaped, ``*``, ``/`` (no comment marker even for a naive reader) and every other
+    byte of its UTF-8 as a three-digit octal escape."""
+    out = []
+    for b in str(text).encode("utf-8"):
+        c = chr(b)
+        out.append("\\" + c if c in '\\"?' else c if 0x20 <= b < 0x7F and c not in "*/"
+                   else f"\\{b:03o}")
+    return "".join(out)
 
 
 def schur_realisation(A: np.ndarray, B: np.ndarray, C: np.ndarray, reference=None):
@@ -61,7 +115,7 @@ def _array(name: str, X: np.ndarray, ctype: str, suffix: str) -> str:
 
 
 def _header(p: str, ctype: str, n: int, ny: int, nu: int, ts: float, doc: str,
-            var: str | None) -> str:
+            var: str | None, name: str) -> str:
     P = p.upper()
     step = (f"void {p}_step({p}_state *s, {ctype} {var}, const {ctype} y[{P}_NY], "
             f"{ctype} i[{P}_NU]);" if var else
@@ -75,6 +129,7 @@ def _header(p: str, ctype: str, n: int, ny: int, nu: int, ts: float, doc: str,
 #define {P}_NY {ny}   /* inputs: sensor displacements (m) */
 #define {P}_NU {nu}   /* outputs: current references (A) */
 #define {P}_TS {ts!r}   /* sample time (s) */
+#define {P}_NAME "{_string(name)}"   /* the controller's name */
 
 typedef struct {{ {ctype} x[{P}_NX > 0 ? {P}_NX : 1]; }} {p}_state;
 
@@ -133,8 +188,9 @@ def write_c(ctrl, out_dir, prefix: str = "ambseal_controller", precision: str = 
     """
     if precision not in _PRECISION:
         raise ConfigError(f"precision={precision!r}: expected 'double' or 'float'")
-    if not prefix.isidentifier() or not prefix.isascii():
-        raise ConfigError(f"prefix={prefix!r}: expected a C identifier")
+    if not isinstance(prefix, str) or not _IDENTIFIER.fullmatch(prefix):
+        raise ConfigError(f"prefix={prefix!r}: expected a C identifier "
+                          "([A-Za-z_][A-Za-z0-9_]*)")
     ctype, suf = _PRECISION[precision]
     p, P = prefix, prefix.upper()
     scheduled = isinstance(ctrl, ScheduledDigital)
@@ -145,20 +201,22 @@ def write_c(ctrl, out_dir, prefix: str = "ambseal_controller", precision: str = 
         A, B, C = (np.stack([q[i] for q in parts]) for i in range(3))
         n, ny, nu = A.shape[1], D.shape[2], D.shape[1]
         var = "speed_rad_s" if ctrl.parameter == SPEED else "theta"
-        doc = (f"Scheduled controller {ctrl.name}: {A.shape[0]} table entries, interpolation "
-               f"{ctrl.interpolation}" + ("." if var != "theta" else
-                                          f"; theta = {ctrl.parameter} (SI)."))
+        name = str(ctrl.name)
+        doc = (f"Scheduled controller {_comment(name)}: {A.shape[0]} table entries, "
+               f"interpolation {_comment(ctrl.interpolation)}" + (
+                   "." if var != "theta" else f"; theta = {_comment(ctrl.parameter)} (SI)."))
     else:
         d = ctrl.discrete
         A, B, C = schur_realisation(d.A, d.B, d.C)
         D, var = d.D, None
         n, (nu, ny) = A.shape[0], D.shape
-        doc = f"Controller {ctrl.continuous.name}."
-    doc += (f"\nDiscretised by {ctrl.method} at {ctrl.sample_rate_hz:g} Hz, judged with "
-            f"{ctrl.delay_samples} sample(s) of computation delay.\nInputs (m): "
-            f"{', '.join(ctrl.inputs)}.\nOutputs (A): {', '.join(ctrl.outputs)}; "
-            "i = -K y.")
-    h = _header(p, ctype, n, ny, nu, ctrl.Ts, doc, var)
+        name = str(ctrl.continuous.name)
+        doc = f"Controller {_comment(name)}."
+    doc += (f"\nDiscretised by {_comment(ctrl.method)} at {float(ctrl.sample_rate_hz):g} Hz, "
+            f"judged with {int(ctrl.delay_samples)} sample(s) of computation delay.\n"
+            f"Inputs (m): {_comment(', '.join(ctrl.inputs))}.\n"
+            f"Outputs (A): {_comment(', '.join(ctrl.outputs))}; i = -K y.")
+    h = _header(p, ctype, n, ny, nu, float(ctrl.Ts), doc, var, name)
     src = [f"/* {p}.c — generated by ambseal; do not edit. */\n#include \"{p}.h\"\n\n"]
     src += [_array(f"{k}_", X, ctype, suf) for k, X in zip("ABCD", (A, B, C, D))]
     src.append(f"\nvoid {p}_reset({p}_state *s)\n{{\n    int r;\n"

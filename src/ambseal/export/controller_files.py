@@ -30,12 +30,16 @@ MATLAB / Octave (``pkg load control`` first in Octave), one line::
     s = load('controller_hinf.mat'); K = ss(s.A, s.B, s.C, s.D, s.Ts, 'InputName', s.inputs, 'OutputName', s.outputs);
 
 Files are written to a temporary name and renamed (:func:`ambseal.files.atomic_write`);
-:func:`load_controller` reads any of them back to the object that was judged.
+:func:`load_controller` reads any of them back to the object that was judged. The names a
+file carries (``name``, ``inputs``, ``outputs``, ``parameter``, ``method``) reach reports
+and generated C: a file whose names are not plain labels (:data:`LABEL`) is refused.
 """
 
 from __future__ import annotations
 
 import json
+import re
+import warnings
 from pathlib import Path
 
 import control
@@ -50,7 +54,7 @@ from ambseal.robust.digital_loop import DiscreteController
 from ambseal.robust.scheduled_digital import ScheduledDigital
 
 __all__ = ["export_controller", "load_controller", "controller_document", "CONVENTION",
-           "MATLAB_LINE"]
+           "MATLAB_LINE", "LABEL"]
 
 _FORMATS = (".npz", ".mat", ".json")
 CONVENTION = ("i = -K y: u[k] = C x[k] + D y[k], x[k+1] = A x[k] + B y[k]; inputs y are "
@@ -58,6 +62,30 @@ CONVENTION = ("i = -K y: u[k] = C x[k] + D y[k], x[k+1] = A x[k] + B y[k]; input
 MATLAB_LINE = ("s = load('{name}'); K = ss(s.A, s.B, s.C, s.D, s.Ts, 'InputName', s.inputs, "
                "'OutputName', s.outputs);")
 _ARRAYS = ("A", "B", "C", "D", "A_c", "B_c", "C_c", "D_c", "A_r", "B_r", "C_r", "D_r")
+#: A name a controller file may carry: letters, digits and ``_ . + - [ ]``, at most 100
+#: characters (``K_hinf``, ``y_A_zeta``, ``seal.k``, ``K_lpv_1e+03Hz``, ``sys[3]``).
+LABEL = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.+\-\[\]]{0,99}")
+
+
+def _names(value, key: str, path: Path) -> list[str]:
+    """The names under ``key`` (one string or a list), each a :data:`LABEL`, else a
+    DataError naming the file and the key."""
+    names = [value] if isinstance(value, str) else value
+    if not isinstance(names, (list, tuple)):
+        raise DataError(f"{path}: {key}: expected a name or a list of names, got "
+                        f"{type(value).__name__}")
+    for v in names:
+        if not (isinstance(v, str) and LABEL.fullmatch(v)):
+            raise DataError(f"{path}: {key}: {str(v)[:60]!r} is not a plain name (expected "
+                            "letters, digits and _ . + - [ ], at most 100 characters)")
+    return names
+
+
+def _name(value, key: str, path: Path) -> str:
+    """One :data:`LABEL` under ``key``, else a DataError naming the file and the key."""
+    if not isinstance(value, str):
+        raise DataError(f"{path}: {key}: expected a name, got {type(value).__name__}")
+    return _names(value, key, path)[0]
 
 
 def _nan(x):
@@ -226,10 +254,20 @@ def _arrays(doc: dict, path: Path, stacked: bool) -> dict:
 
 
 def _continuous(doc: dict, path: Path):
-    """A continuous controller file back to a ``control.StateSpace``, shapes checked."""
+    """A continuous controller file back to a ``control.StateSpace``, shapes checked; a
+    file with neither ``inputs`` nor ``outputs`` gets python-control's ``u[i]``, ``y[i]``
+    and a warning that it will be connected by position."""
 
     try:
-        ins, outs = [str(s) for s in doc["inputs"]], [str(s) for s in doc["outputs"]]
+        if "inputs" not in doc and "outputs" not in doc:
+            D = np.atleast_2d(np.asarray(doc["D"], float))
+            doc = {**doc, "inputs": [f"u[{j}]" for j in range(D.shape[1])],
+                   "outputs": [f"y[{j}]" for j in range(D.shape[0])]}
+            warnings.warn(f"{path}: no signal names (inputs, outputs): the controller is "
+                          "connected by position, input j to the plant's j-th sensor and "
+                          "output j to its j-th current (the rig's [[amb]] order, zeta then "
+                          "eta)", stacklevel=3)
+        ins, outs = _names(doc["inputs"], "inputs", path), _names(doc["outputs"], "outputs", path)
         A, B, C, D = (np.atleast_2d(np.asarray(doc[k], float)) for k in "ABCD")
     except KeyError as exc:
         raise DataError(f"{path}: missing key {exc} (expected A, B, C, D, inputs, outputs "
@@ -243,7 +281,8 @@ def _continuous(doc: dict, path: Path):
             raise DataError(f"{path}: {k} has shape {X.shape}, expected {want[k]}")
     if n == 0:
         A, B, C = np.zeros((0, 0)), np.zeros((0, len(ins))), np.zeros((len(outs), 0))
-    return control.ss(A, B, C, D, inputs=ins, outputs=outs, name=str(doc.get("name", "K")))
+    name = _name(doc.get("name", "K"), "name", path)
+    return control.ss(A, B, C, D, inputs=ins, outputs=outs, name=name)
 
 
 def load_controller(path):
@@ -267,10 +306,10 @@ def load_controller(path):
     if str(doc.get("kind", "continuous")) == "continuous":
         return _continuous(doc, path)
     try:
-        kind, name = str(doc["kind"]), str(doc["name"])
-        ins, outs = [str(s) for s in doc["inputs"]], [str(s) for s in doc["outputs"]]
+        kind, name = str(doc["kind"]), _name(doc["name"], "name", path)
+        ins, outs = _names(doc["inputs"], "inputs", path), _names(doc["outputs"], "outputs", path)
         fs, delay = float(np.ravel(doc["sample_rate_hz"])[0]), int(np.ravel(doc["delay_samples"])[0])
-        method = str(doc["method"])
+        method = _name(doc["method"], "method", path)
         pw = float(np.ravel(doc["prewarp_hz"])[0])
         removed = tuple(float(x) for x in np.ravel(doc["removed_poles_hz"]))
         meta = json.loads(str(doc["discretisation_json"]))
@@ -284,7 +323,7 @@ def load_controller(path):
     cands = tuple(meta.get("candidates", ()))
     arr = _arrays(doc, path, stacked=(kind == "scheduled"))
     if kind == "scheduled":
-        par = str(doc.get("parameter", SPEED))
+        par = _name(doc.get("parameter", SPEED), "parameter", path)
         key = "grid" if "grid" in doc else "speeds_rad_s"
         W = np.ravel(np.asarray(doc.get(key, ()), float))
         if arr["A"].shape[0] != W.size:

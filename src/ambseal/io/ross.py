@@ -71,6 +71,14 @@ def _bad(where: str, what: str) -> ConfigError:
     return ConfigError(f"{where}: {what}")
 
 
+def _name(tag, default: str) -> str:
+    """A ROSS tag as a rig-file name (letters, digits and ``_``, not starting with a
+    digit): ``"Bearing 0"`` → ``Bearing_0``."""
+    out = "".join(c if c.isascii() and (c.isalnum() or c == "_") else "_"
+                  for c in str(tag or default))
+    return "_" + out if not out or out[0].isdigit() else out
+
+
 def _coef(el, name: str) -> np.ndarray:
     v = getattr(el, name, None)
     return np.zeros(1) if v is None else np.atleast_1d(np.asarray(v, float))
@@ -86,7 +94,7 @@ def _materials(shafts, where: str) -> tuple[dict, list[str]]:
             raise _bad(where, f"shaft element {i} ({el.tag}): missing material (expected a "
                               "ross.Material with rho, E and G_s)")
         props = {"E": float(mat.E), "rho": float(mat.rho), "G": float(mat.G_s)}
-        base = "".join(c if c.isalnum() else "_" for c in str(mat.name or "material")) or "m"
+        base = _name(mat.name, "material")
         name, k = base, 1
         while name in table and table[name] != props:
             k += 1
@@ -143,7 +151,7 @@ def _bearing(el, z: float, where: str, i: int) -> tuple[str, dict]:
     c = {n: _coef(el, n) for n in names}
     freq = getattr(el, "frequency", None)
     constant = all(np.allclose(v, v[0], rtol=1e-12, atol=0.0) for v in c.values())
-    name = str(el.tag or f"bearing{i}")
+    name = _name(el.tag, f"bearing{i}")
     if constant and not any(c[n][0] for n in ("cxy", "cyx", "mxx", "myy", "mxy", "myx")):
         return "spring", {"name": name, "position": z,
                           **{n: float(c[n][0]) for n in ("kxx", "kyy", "kxy", "kyx",
@@ -169,7 +177,7 @@ def _amb(el, z: float, i: int) -> tuple[dict, str]:
         return {"zeta": float(v[0]), "eta": float(v[-1])}
 
     i0 = np.atleast_1d(np.asarray(el.i0, float))
-    name = str(el.tag or f"amb{i}").replace(" ", "_")
+    name = _name(el.tag, f"amb{i}")
     entry = {"name": name, "position": z, "sensor_position": z,
              "axes_angle_deg": math.degrees(float(el.sensors_axis_rotation)),
              "turns": int(round(float(el.nw))), "pole_area": float(el.ag),

@@ -11,10 +11,15 @@ python-control's ``control.lft`` and ``control.feedback`` compute the same syste
 by side); these matrix-level versions exist because the synthesis loops (D–K, LPV checks,
 spin-up tabulation) close thousands of loops and need neither signal bookkeeping nor object
 construction, and because ``control.feedback`` has no separate force inputs.
+
+A controller is connected to its plant by signal names (:func:`wired`): its inputs are the
+plant's outputs and its outputs the plant's inputs, in whatever order; only systems
+without names are connected by position.
 """
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import control
@@ -24,7 +29,7 @@ from ambseal.errors import ModelError
 from ambseal.lti.matrices import ArrayMemo, labels, ss_matrices
 
 __all__ = ["lft_lower_matrices", "lft_lower", "feedback_matrices", "feedback_poles",
-           "series_inputs"]
+           "series_inputs", "wired"]
 
 Matrices = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
@@ -225,3 +230,67 @@ def _repeat_diagonal(X: np.ndarray, k: int) -> np.ndarray:
     for j in range(k):
         out[j * r:(j + 1) * r, j * c:(j + 1) * c] = X
     return out
+
+
+#: python-control's names of an unnamed system's signals.
+_UNNAMED = re.compile(r"[uy]\[\d+\]")
+
+
+def _named(names) -> bool:
+    return not all(_UNNAMED.fullmatch(n) for n in names)
+
+
+def wired(G: Any, K: Any) -> Any:
+    """``K`` with its inputs in the order of ``G``'s outputs and its outputs in the order
+    of ``G``'s inputs, matched by signal name.
+
+    Parameters
+    ----------
+    G : control.StateSpace
+        Plant (e.g. current inputs → displacement outputs), continuous or discrete.
+    K : control.StateSpace or (A, B, C, D)
+        Controller in the feedback path: inputs are ``G``'s outputs, outputs ``G``'s inputs.
+
+    Returns
+    -------
+    control.StateSpace or (A, B, C, D)
+        ``K`` itself when its names are already in ``G``'s order, or when ``G`` or ``K``
+        has no signal names (python-control's ``u[i]``, ``y[i]``, or a tuple of matrices:
+        the loop is then wired by position); else ``K`` with its channels permuted (same
+        states, time base and name).
+
+    Raises
+    ------
+    ModelError
+        Both are named but the names differ: a missing, extra, repeated or renamed
+        channel. The message lists both sets.
+
+    Examples
+    --------
+    >>> import control
+    >>> G = control.ss([[0.0]], [[1.0, 0.0]], [[1.0], [0.0]], [[0.0, 0.0], [0.0, 0.0]],
+    ...                inputs=["i_A", "i_B"], outputs=["y_A", "y_B"])
+    >>> K = control.ss([], [], [], [[1.0, 0.0], [0.0, 2.0]], inputs=["y_B", "y_A"],
+    ...                outputs=["i_B", "i_A"])
+    >>> wired(G, K).D.tolist()
+    [[2.0, 0.0], [0.0, 1.0]]
+    """
+
+    (_, _, _, D), (Ak, Bk, Ck, Dk) = (ss_matrices(X, name=nm, allow_discrete=True)
+                                      for X, nm in ((G, "G"), (K, "K")))
+    g_out, g_in = labels(G, "output", D.shape[0], "y"), labels(G, "input", D.shape[1], "u")
+    k_in, k_out = labels(K, "input", Dk.shape[1], "u"), labels(K, "output", Dk.shape[0], "y")
+    if not all(map(_named, (g_out, g_in, k_in, k_out))) or (k_in, k_out) == (g_out, g_in):
+        return K
+    if not (sorted(k_in) == sorted(g_out) == sorted(set(g_out))
+            and sorted(k_out) == sorted(g_in) == sorted(set(g_in))):
+        raise ModelError(
+            f"controller {getattr(K, 'name', 'K')}: its signals do not match the plant's "
+            f"(they are connected by name): inputs {list(k_in)} against the plant's outputs "
+            f"{list(g_out)}, outputs {list(k_out)} against the plant's inputs {list(g_in)}")
+    i, o = [k_in.index(n) for n in g_out], [k_out.index(n) for n in g_in]
+    dt = getattr(K, "dt", 0)
+    return control.ss(Ak, Bk[:, i], Ck[o, :], Dk[np.ix_(o, i)], 0 if dt is None else dt,
+                      inputs=list(g_out), outputs=list(g_in),
+                      states=list(getattr(K, "state_labels", None) or []) or None,
+                      name=getattr(K, "name", None))

@@ -37,8 +37,11 @@ def _rates(poles, dt: float) -> np.ndarray:
     p = np.asarray(poles, dtype=complex).ravel()
     if not dt:
         return p
-    with np.errstate(divide="ignore"):
-        return np.log(p) / float(dt)
+    s = np.empty_like(p)
+    with np.errstate(divide="ignore"):  # z = 0: Re s = -inf
+        s.real = np.log(np.abs(p)) / float(dt)
+    s.imag = np.angle(p) / float(dt)
+    return s
 
 
 def stability_tolerance(poles, dt: float = 0.0) -> float:

@@ -139,3 +139,20 @@ def test_controller_file_with_an_injected_name_is_refused(tmp_path, capsys):
         _one_line_exit_2(capsys, ["export", "x.toml", "--controller", str(bad), "--c",
                                   str(tmp_path / "c")], str(bad), key, "not a plain name")
         assert not (tmp_path / "c").exists()
+
+
+def test_an_unstable_pid_is_not_exported_quietly(tmp_path, capsys):
+    """Reference: thesis P5 §4 — the reference PID loses the test rig between nominal and
+    twice nominal pressure drop (4.08 bar), a judged condition. `export --method pid` refuses
+    it in one line naming the condition; with --allow-unstable it exports, warns on stderr
+    and marks the design file."""
+    rig = str(ROOT / "examples" / "testrig.toml")
+    _one_line_exit_2(capsys, ["export", rig, "--method", "pid", "--out", str(tmp_path / "a")],
+                     "pid", "unstable at 4.08 bar", "--allow-unstable")
+    assert not (tmp_path / "a" / "controller_pid.json").exists()
+    out = tmp_path / "b"
+    assert main(["export", rig, "--method", "pid", "--out", str(out), "--allow-unstable"]) == 0
+    assert "warning" in capsys.readouterr().err
+    design = json.loads((out / "design_pid.json").read_text())
+    assert design["full_order"]["stable"] is False and design["allow_unstable"] is True
+    assert (out / "controller_pid.json").exists()

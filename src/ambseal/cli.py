@@ -207,6 +207,9 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--c", dest="c_dir", default=None, help="write the C99 module to this folder")
     e.add_argument("--precision", choices=["double", "float"], default="double",
                    help="floating-point type of the C module (default double)")
+    e.add_argument("--allow-unstable", action="store_true",
+                   help="export a controller whose full-order loop is unstable at a judged "
+                        "condition (marked in every file) instead of refusing it")
 
     i = sub.add_parser("identify", help="fit model parameters to closed-loop records")
     i.add_argument("rig", help="rig file (TOML)")

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from ambseal.analysis import loops
+from ambseal.robust.loop import closed_loop
 from ambseal.errors import ModelError
 
 from .amb_test_plants import NAMES, mass_1dof, rigid_rotor
@@ -28,7 +29,7 @@ def test_1dof_poles_and_sensitivity_closed_form():
     """Reference: closed form for the 1-DOF AMB axis with PD control (P5 Eq. 1, 6):
     poles = roots(denG·denK + numG·numK), S = 1/(1 + G K) with G, K as polynomials in jω."""
     G, K, (nG, dG), (nK, dK) = mass_1dof()
-    cl = loops.closed_loop(G, K)
+    cl = closed_loop(G, K)
     ref_poles = np.roots(np.polyadd(np.polymul(dG, dK), np.polymul(nG, nK)))
     np.testing.assert_allclose(np.sort_complex(cl.poles), np.sort_complex(ref_poles), rtol=1e-8)
     assert cl.stable and cl.max_real_pole == pytest.approx(ref_poles.real.max(), rel=1e-8)
@@ -49,7 +50,7 @@ def test_unstable_when_gain_below_negative_stiffness():
     """Reference: with kp·ki < ks the net static stiffness is negative, so a real closed-loop
     pole is positive (Routh: constant term of m s² + ... + (kp ki − ks) < 0)."""
     G, K, _, _ = mass_1dof(kp_factor=0.5)
-    cl = loops.closed_loop(G, K)
+    cl = closed_loop(G, K)
     assert not cl.stable and cl.max_real_pole > 0
     d = cl.to_dict()
     json.dumps(d)
@@ -61,7 +62,7 @@ def test_rigid_rotor_matches_python_control_feedback():
     d→y response; S_o = feedback(I, G K) and S_i = feedback(I, K G), K S_o, T_o = G K S_o, all by
     control.frequency_response; rigid rotor on two AMBs with a cross-coupled seal."""
     G, Gf, K = rigid_rotor()
-    cl = loops.closed_loop(G, K, Gf)
+    cl = closed_loop(G, K, Gf)
     ref = control.feedback(G, K, sign=-1)
     np.testing.assert_allclose(np.sort_complex(cl.poles), np.sort_complex(ref.poles()), rtol=1e-7)
     assert cl.stable
@@ -100,7 +101,7 @@ def test_compliance_matches_python_control():
     ref = control.feedback(_static(np.eye(4)), G * K) * Gf
     R = np.moveaxis(control.frequency_response(ref, w, squeeze=False).complex, 2, 0)
     np.testing.assert_allclose(comp.H_m_per_n, R, rtol=1e-6, atol=1e-9 * np.abs(R).max())
-    cl = loops.closed_loop(G, K, Gf)
+    cl = closed_loop(G, K, Gf)
     R2 = np.moveaxis(control.frequency_response(cl.system, w, squeeze=False).complex, 2, 0)[:, :4, 4:]
     np.testing.assert_allclose(comp.H_m_per_n, R2, rtol=1e-6, atol=1e-9 * np.abs(R).max())
     sm = np.linalg.svd(R, compute_uv=False)[:, 0]
@@ -117,10 +118,10 @@ def test_dimension_and_state_checks():
     an infinite 'peak'."""
     G, Gf, K = rigid_rotor()
     with pytest.raises(ModelError):
-        loops.closed_loop(G, _static(np.eye(2)))
+        closed_loop(G, _static(np.eye(2)))
     G2, Gf2, _ = rigid_rotor(k_seal=0.0)
     with pytest.raises(ModelError):
-        loops.closed_loop(G, K, Gf2)
+        closed_loop(G, K, Gf2)
     with pytest.raises(ModelError):
         loops.loop_responses(G, K, W).peaks("S")
     integ = control.ss(control.tf([1.0, 5.0], [1.0, 0.0]))  # PI-like factor, pole at s = 0
@@ -173,7 +174,7 @@ def test_controller_wired_by_names_not_by_position():
     Kp = control.ss(K.A, K.B[:, order], K.C[order, :], K.D[np.ix_(order, order)],
                     inputs=[NAMES[j] for j in order], outputs=[NAMES[j] for j in order])
     ref = control.feedback(G, K, sign=-1)
-    cl = loops.closed_loop(G, Kp, Gf)
+    cl = closed_loop(G, Kp, Gf)
     np.testing.assert_allclose(np.sort_complex(cl.poles), np.sort_complex(ref.poles()),
                                rtol=1e-7)
     p0, p1 = (loops.loop_responses(G, k, W).peaks("So") for k in (K, Kp))
@@ -184,9 +185,9 @@ def test_controller_wired_by_names_not_by_position():
     renamed = control.ss(K.A, K.B, K.C, K.D, inputs=["A_zeta", "A_eta", "B_zeta", "C_eta"],
                          outputs=NAMES)
     with pytest.raises(ModelError, match=r"C_eta.*B_eta"):
-        loops.closed_loop(G, renamed)
+        closed_loop(G, renamed)
     unnamed = control.ss(K.A, K.B, K.C, K.D)
-    np.testing.assert_allclose(np.sort_complex(loops.closed_loop(G, unnamed).poles),
+    np.testing.assert_allclose(np.sort_complex(closed_loop(G, unnamed).poles),
                                np.sort_complex(ref.poles()), rtol=1e-7)
 
 

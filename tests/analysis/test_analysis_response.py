@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from ambseal.analysis import loops, response
+from ambseal.robust.loop import closed_loop
 from ambseal.errors import ModelError
 
 from .amb_test_plants import NAMES, mass_1dof, rigid_rotor
@@ -63,7 +64,7 @@ def test_rigid_rotor_thesis_impulse_channels_and_json():
     assert r.output_names == tuple(NAMES) and r.input_names == tuple(NAMES)
     assert r.disturbance_a[:1000, 0].max() == 0.05 and r.disturbance_a[:, 1].max() == 0.0
     assert r.displacement_m.shape == (10001, 4) and r.current_a.shape == (10001, 4)
-    cl = loops.closed_loop(G, K)
+    cl = closed_loop(G, K)
     d = np.zeros((4, r.time_s.size))
     d[[0, 3], :] = np.where(r.time_s < 0.01 - 1e-12, 0.05, 0.0)
     ref = control.forced_response(control.feedback(G, K, sign=-1), r.time_s, d).outputs

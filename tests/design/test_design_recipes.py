@@ -15,7 +15,8 @@ the log grid but 5.8 at 556.8 Hz, 4.08 bar).
 import numpy as np
 import pytest
 
-from ambseal.analysis.loops import closed_loop, compliance, loop_responses
+from ambseal.analysis.loops import compliance, loop_responses
+from ambseal.robust.loop import closed_loop
 from ambseal.analysis.unbalance import unbalance_from_compliance
 from ambseal.design.recipes import design
 from ambseal.design.weights import Weights
@@ -42,7 +43,7 @@ def plants(testrig_plants, cfg):
     digital controller's hold + computation delay (1.5 samples at 10 kHz, Padé) in front
     of the currents: the loop the H∞/μ designs are made for and every loop is judged on
     (ambseal.robust.delay)."""
-    from ambseal.analysis.judge import delayed_plant
+    from ambseal.robust.loop import delayed_plant
     from ambseal.robust.delay import loop_delay
 
     assert sorted(testrig_plants)[0] == 0.0 and sorted(testrig_plants)[-1] == 4.08

@@ -30,15 +30,14 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
-from ambseal.analysis._util import json_float, json_list
 from ambseal.analysis.cases import run_cases
-from ambseal.analysis.judge import delayed_plant
-from ambseal.analysis.loops import closed_loop
+from ambseal.lti.json_safe import json_float, json_list
 from ambseal.model.modes import RIGID_BODY_RAD_S, bending_limit_hz, classify_poles, free_bending_hz
 from ambseal.model.rig import build_plant
 from ambseal.model.rotor import build_mesh
 from ambseal.robust.controller import frozen
 from ambseal.robust.delay import loop_delay
+from ambseal.robust.loop import judged_loop
 from ambseal.robust.stability import decay_rate, is_stable
 
 __all__ = ["API684_LOG_DEC", "ClosedLoopModes", "Crossing", "Campbell",
@@ -123,9 +122,11 @@ class ClosedLoopModes:
     node_z_m : ndarray, shape (n_nodes,)
         Node positions (m).
     max_real_pole : float
-        Largest real part of *all* closed-loop poles (1/s), whatever their frequency.
+        Largest real part of *all* poles of the judged loop (1/s), whatever their frequency:
+        the loop as it runs (:func:`ambseal.robust.loop.judged_loop`, the controller's
+        delay included), the loop whose modes these are without a controller.
     stable : bool
-        All closed-loop poles stable (:func:`ambseal.robust.stability.is_stable`).
+        The judged loop's verdict (:func:`ambseal.robust.stability.is_stable`).
     """
 
     speed_hz: float
@@ -171,11 +172,9 @@ def closed_loop_state_matrix(cfg, controller=None, *, speed_hz: float,
         return plant.A, mesh
     G = plant.select_inputs([plant.input_names[j] for j in plant.current_inputs()]
                             ).to_statespace()
-    if delay:
-        L = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples).system
-        G = delayed_plant(G, list(range(G.ninputs)), L)
+    L = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples).system
     K = frozen(controller, 2 * math.pi * speed_hz)
-    return np.asarray(closed_loop(G, K).system.A), mesh
+    return np.asarray(judged_loop(G, K, delay=L if delay else None).loop.system.A), mesh
 
 
 def closed_loop_modes(cfg, controller=None, *, speed_hz: float = 0.0,
@@ -209,13 +208,22 @@ def closed_loop_modes(cfg, controller=None, *, speed_hz: float = 0.0,
     p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
     f_max = bending_limit_hz(cfg) if max_hz is None else float(max_hz)
     A, mesh = closed_loop_state_matrix(cfg, controller, speed_hz=speed_hz, pressure_bar=p)
-    return modes_of_state_matrix(A, mesh, speed_hz=speed_hz, pressure_bar=p, max_hz=f_max)
+    judged = None
+    if controller is not None and cfg.amb:  # the verdict is the judged loop's, with the delay
+        judged = np.linalg.eigvals(closed_loop_state_matrix(
+            cfg, controller, speed_hz=speed_hz, pressure_bar=p, delay=True)[0])
+    return modes_of_state_matrix(A, mesh, speed_hz=speed_hz, pressure_bar=p, max_hz=f_max,
+                                 judged_poles=judged)
 
 
 def modes_of_state_matrix(A: np.ndarray, mesh, *, speed_hz: float, pressure_bar: float,
-                          max_hz: float) -> ClosedLoopModes:
+                          max_hz: float, judged_poles=None) -> ClosedLoopModes:
     """:class:`ClosedLoopModes` of a state matrix whose first ``mesh.n_dof`` states are the
     rotor's node DOFs q (any plant of :mod:`ambseal.model.rig`, open or closed loop).
+
+    ``stable`` and ``max_real_pole`` are those of ``judged_poles`` when given (the poles of
+    the loop as it runs, :func:`ambseal.robust.loop.judged_loop`: the controller's delay
+    included), else of ``A``'s eigenvalues.
 
     Rigid-body modes and oscillating ones as in :func:`ambseal.model.modes.modes`
     (:func:`~ambseal.model.modes.classify_poles`: absolute thresholds in rad/s; ModelError
@@ -233,12 +241,13 @@ def modes_of_state_matrix(A: np.ndarray, mesh, *, speed_hz: float, pressure_bar:
     shapes = shapes / np.where(size > 0, size, 1.0)[:, None, None]
     whirls = [whirl_of(s) for s in shapes]
     z = lam[keep]
+    verdict = lam if judged_poles is None else judged_poles
     return ClosedLoopModes(
         speed_hz=float(speed_hz), pressure_bar=float(pressure_bar), max_hz=float(max_hz),
         poles=z, frequency_hz=z.imag / (2 * np.pi), damping_ratio=-z.real / np.abs(z),
         log_decrement=log_decrement(z), whirl=tuple(w for w, _ in whirls),
         kappa=np.array([k for _, k in whirls]), shapes=shapes, node_z_m=np.asarray(mesh.z),
-        max_real_pole=decay_rate(lam), stable=is_stable(lam))
+        max_real_pole=decay_rate(verdict), stable=is_stable(verdict))
 
 
 @dataclass(frozen=True)

@@ -26,8 +26,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ambseal.analysis._util import json_float
 from ambseal.errors import ModelError
+from ambseal.lti.json_safe import json_float
 
 __all__ = ["ZONE_LIMITS", "ZONES", "zone_limit_db", "iso_zone", "IsoAssessment", "iso_assessment"]
 

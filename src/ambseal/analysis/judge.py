@@ -17,7 +17,8 @@ will act; the case records it as ``delay`` (``delay_s``, ``pade_order``,
 ``phase_error_deg``, ``band_top_hz``). On the test rig the PID's continuous σ̄(S_o) peaks
 then equal the sampled loop's to 0.1 % (13.36 against 13.37 at 2.04 bar, 7.43 against 7.43
 at 0 bar; without the delay they were 9.36 and 4.94). The closed-loop modes of
-:mod:`ambseal.analysis.campbell` stay those of the continuous controller.
+:mod:`ambseal.analysis.campbell` stay those of the continuous controller; their stability
+verdict is this loop's (:func:`ambseal.robust.loop.judged_loop`).
 
 **What runs is judged too**: given the discrete controller of the target (with its
 computation delay, :class:`ambseal.robust.digital.DigitalController`), the same numbers are
@@ -40,12 +41,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import control
 import numpy as np
 
 from ambseal.analysis.iso import iso_assessment
 from ambseal.analysis.loops import (
-    closed_loop,
     compliance_from,
     loop_responses_from,
     resolved_grid,
@@ -57,18 +56,18 @@ from ambseal.analysis.spinup import frozen_sensitivity, spinup
 from ambseal.analysis.unbalance import unbalance_from_compliance
 from ambseal.design.lpv_plant import lpv_plant, vertex_grid_hz
 from ambseal.design.specs import RIGID_STATES, design_spec
-from ambseal.lti.discrete import zoh
 from ambseal.lti.freqresp import freqresp_at
-from ambseal.lti.interconnect import series_inputs, wired
+from ambseal.lti.interconnect import wired
 from ambseal.model.modes import classify_poles
 from ambseal.model.rig import build_plant
 from ambseal.model.seal import seal_values
 from ambseal.robust.controller import SPEED, frozen
 from ambseal.robust.delay import loop_delay
+from ambseal.robust.loop import JudgedLoop, judged_loop
 from ambseal.robust.scheduled_digital import ScheduledDigital
 
 __all__ = ["JudgeSettings", "OperatingPoint", "judge", "judge_case", "judge_spinup",
-           "sampled_plant", "delayed_plant", "operating_points", "speed_scheduled",
+           "operating_points", "speed_scheduled",
            "judge_settings", "unstable_open_loop_poles", "condition_values", "frozen_at",
            "frozen_discrete", "judge_jobs"]
 
@@ -251,54 +250,24 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
     case = {"controller": name, "pressure_bar": point.pressure_bar,
             "speed_hz": point.speed_rpm / 60.0}
     dl = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples)
-    body, curves = _judge_loop(cfg, delayed_plant(P, cur, dl.system), cur, force, controller,
-                               s, impulse)
+    body, curves = _judge_loop(judged_loop(P, controller, cur, delay=dl.system), cur, force,
+                               controller, s, impulse)
     case.update(body)
     case["delay"] = dl.to_dict()
     if discrete is not None:
-        Pd = sampled_plant(P, float(discrete.dt))
-        case["discrete"], curves["discrete"] = _judge_loop(cfg, Pd, cur, force, discrete,
-                                                           s, impulse)
+        case["discrete"], curves["discrete"] = _judge_loop(judged_loop(P, discrete, cur), cur,
+                                                           force, discrete, s, impulse)
     return case, curves
 
 
-def delayed_plant(P, cur, delay):
-    """The continuous plant ``P`` with the SISO ``delay`` system in front of each current
-    input ``cur`` (:func:`ambseal.lti.interconnect.series_inputs`), signal names kept."""
-
-    def mats(S):
-        return tuple(np.asarray(getattr(S, m), float) for m in ("A", "B", "C", "D"))
-
-    A, B, C, D = series_inputs(mats(P), mats(delay), cur)[:4]
-    return control.ss(A, B, C, D, inputs=list(P.input_labels), outputs=list(P.output_labels))
-
-
-def sampled_plant(P, dt: float):
-    """The plant ``P`` sampled exactly with a zero-order hold at ``dt`` (s): inputs held
-    over each sample, outputs read at the samples (:func:`ambseal.lti.discrete.zoh`;
-    Franklin, Powell & Workman §6.3), signal names kept."""
-
-    Ad, Bd = zoh(np.asarray(P.A, float), np.asarray(P.B, float), dt)
-    return control.ss(Ad, Bd, np.asarray(P.C, float), np.asarray(P.D, float), dt,
-                      inputs=list(P.input_labels), outputs=list(P.output_labels))
-
-
-def _inputs(P, idx):
-    """The state space ``P`` with only the inputs ``idx`` (names kept, same time base)."""
-
-    names = [P.input_labels[j] for j in idx]
-    return control.ss(P.A, np.asarray(P.B)[:, idx], P.C, np.asarray(P.D)[:, idx], P.dt,
-                      inputs=names, outputs=list(P.output_labels))
-
-
-def _judge_loop(cfg, P, cur, force, controller, s: JudgeSettings, impulse: bool
+def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, impulse: bool
                 ) -> tuple[dict, dict]:
-    """The case's numbers for one loop, continuous or discrete (``P.dt``): the plant ``P``
-    with current inputs ``cur`` and force inputs ``force``."""
+    """The case's numbers for one judged loop, continuous or discrete: its plant with
+    current inputs ``cur`` and force inputs ``force``."""
 
-    G, Gf = _inputs(P, cur), _inputs(P, force)
+    P, loop = judged.plant, judged.loop
+    G, Gf = P[:, cur], P[:, force]
     controller = wired(G, controller)  # by signal names, in the plant's order
-    loop = closed_loop(G, controller, Gf)
     dt = loop.dt
     case = {"stable": loop.stable, "max_real_pole": loop.max_real_pole}
     if dt:

@@ -32,23 +32,20 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-import control
 import numpy as np
 
-from ambseal.analysis._util import json_float, json_list
 from ambseal.errors import ModelError
 from ambseal.lti.freqresp import freqresp_at
-from ambseal.lti.interconnect import feedback_matrices, wired
+from ambseal.lti.interconnect import wired
+from ambseal.lti.json_safe import json_float, json_list
 from ambseal.lti.matrices import as_omega, labels, ss_matrices
-from ambseal.robust.stability import decay_rate, is_stable
+from ambseal.robust.loop import loop_matrices, sample_time
 
 __all__ = [
-    "ClosedLoop",
     "LoopResponse",
     "Peak",
     "SensitivityPeaks",
     "ComplianceResponse",
-    "closed_loop",
     "loop_responses",
     "loop_responses_from",
     "sensitivity_peaks",
@@ -64,71 +61,6 @@ _TWO_PI = 2.0 * np.pi
 
 
 # --------------------------------------------------------------------------- results
-@dataclass(frozen=True, eq=False)
-class ClosedLoop:
-    """The closed loop of ``(G, K)`` with ``u = −K y + d`` and optional force inputs.
-
-    Attributes
-    ----------
-    system : control.StateSpace
-        Continuous, or discrete with sample time ``dt``. Inputs: ``d_<u>`` current disturbances added to the controller output (A), one per
-        plant input, then the force inputs of ``Gf`` under their own names (N), if given.
-        Outputs: the plant outputs under their own names (m), then ``i_<u>`` the controller
-        output ``−K y`` (A; the "control action" of P5 Fig. 14). States: plant states then
-        controller states.
-    poles : ndarray of complex, shape (n + n_K,)
-        Closed-loop poles (rad/s), sorted by decreasing real part; of a discrete loop the
-        ``z`` (sorted by decreasing ``|z|``).
-    max_real_pole : float
-        Largest real part of the poles (1/s); ``< 0`` means asymptotically stable. Of a
-        discrete loop the same rate of its slowest-decaying pole, ``ln max|z| / dt``.
-    stable : bool
-        The poles are stable by the package's one rule
-        (:func:`ambseal.robust.stability.is_stable`).
-    n_plant_inputs, n_plant_outputs, n_force_inputs : int
-        Channel counts, so ``system`` can be sliced without parsing names.
-    dt : float
-        Sample time (s) of a discrete loop, 0 for a continuous one.
-    """
-
-    system: Any
-    poles: np.ndarray
-    max_real_pole: float
-    stable: bool
-    n_plant_inputs: int
-    n_plant_outputs: int
-    n_force_inputs: int
-    dt: float = 0.0
-
-    @property
-    def s_poles(self) -> np.ndarray:
-        """The poles as continuous rates (rad/s): ``poles``, or ``ln z / dt`` (the
-        equivalent s-plane pole of each z, below Nyquist)."""
-        if not self.dt:
-            return self.poles
-        with np.errstate(divide="ignore"):
-            return np.log(self.poles.astype(complex)) / self.dt
-
-    @property
-    def max_abs_pole(self) -> float:
-        """Largest ``|z|`` of a discrete loop (``< 1``: stable); NaN for a continuous one."""
-        if not self.dt:
-            return float("nan")
-        return float(np.abs(self.poles).max()) if self.poles.size else 0.0
-
-    def to_dict(self) -> dict:
-        """JSON-safe summary (no state-space matrices): stability, poles (real/imag, rad/s)."""
-        return {
-            "n_states": int(self.system.nstates),
-            "stable": bool(self.stable),
-            "max_real_pole": json_float(self.max_real_pole),
-            "poles_real": json_list(self.poles.real),
-            "poles_imag": json_list(self.poles.imag),
-            "inputs": list(self.system.input_labels),
-            "outputs": list(self.system.output_labels),
-        }
-
-
 @dataclass(frozen=True)
 class Peak:
     """Peak of a gain over a frequency grid.
@@ -340,92 +272,6 @@ def resolved_grid(omega: Any, poles: np.ndarray, *, zeta_max: float = 0.2,
     return out[(out >= w.min()) & (out <= w.max())]
 
 
-def _dt(sys: Any) -> float:
-    """Sample time of a python-control system (0 if continuous or a matrix tuple)."""
-    dt = getattr(sys, "dt", 0)
-    return float(dt) if dt not in (None, True) else 0.0
-
-
-def _check_pair(G: Any, K: Any) -> tuple[tuple, tuple]:
-    mg = ss_matrices(G, name="G", allow_discrete=True)
-    mk = ss_matrices(wired(G, K), name="K", allow_discrete=True)
-    if abs(_dt(G) - _dt(K)) > 1e-12 * max(_dt(G), _dt(K)):
-        raise ModelError(f"G (dt={_dt(G)}) and K (dt={_dt(K)}) must share one time base")
-    ny, nu = mg[3].shape
-    if mk[3].shape != (nu, ny):
-        raise ModelError(
-            f"K has {mk[3].shape[1]} inputs and {mk[3].shape[0]} outputs; expected {ny} inputs"
-            f" (G outputs, m) and {nu} outputs (G inputs, A)"
-        )
-    return mg, mk
-
-
-def closed_loop(G: Any, K: Any, Gf: Any | None = None, *, atol: float = 0.0) -> ClosedLoop:
-    """Close the loop ``u = −K y + d`` around ``G`` (and ``Gf`` sharing its states).
-
-    Plant ``ẋ = A x + B u + B_f f``, ``y = C x + D u + D_f f``; controller
-    ``ẋ_K = A_K x_K + B_K y``, ``i = −(C_K x_K + D_K y)``, ``u = i + d``, closed by
-    :func:`ambseal.lti.interconnect.feedback_matrices`. Same result as
-    ``control.feedback(G, K, sign=-1)`` for the ``d → y`` channel (tested side by side).
-
-    Parameters
-    ----------
-    G : control.StateSpace
-        Plant, ``nu`` current inputs (A) → ``ny`` displacement outputs (m).
-    K : control.StateSpace
-        Controller, ``ny`` inputs (m) → ``nu`` outputs (A).
-    Gf : control.StateSpace, optional
-        Plant with the same states and outputs and force inputs (N), e.g. at mid-span.
-    atol : float
-        Tolerance when checking that ``Gf`` has the same ``A`` and ``C`` as ``G``
-        (compared relative to their norms: ``≤ atol + 1e-9 ‖·‖``).
-
-    Returns
-    -------
-    ClosedLoop
-
-    Raises
-    ------
-    ModelError
-        If the dimensions of ``G``, ``K`` (and ``Gf``) do not fit, ``Gf`` has a different
-        ``A`` or ``C``, or ``I + D D_K`` is singular (ill-posed loop).
-    """
-
-    (A, B, C, D), (Ak, Bk, Ck, Dk) = _check_pair(G, K)
-    n, nu = B.shape
-    ny = C.shape[0]
-    nk = Ak.shape[0]
-    dt = _dt(G)
-    if Gf is not None:
-        Af, Bf, Cf, Df = ss_matrices(Gf, name="Gf", allow_discrete=True)
-        if Af.shape != A.shape or Cf.shape != C.shape:
-            raise ModelError(f"Gf must share G's states and outputs: A{Af.shape} vs {A.shape}, C{Cf.shape} vs {C.shape}")
-        for nm, X, Y in (("A", Af, A), ("C", Cf, C)):
-            if np.max(np.abs(X - Y), initial=0.0) > atol + 1e-9 * max(np.max(np.abs(Y), initial=0.0), 1.0):
-                raise ModelError(f"Gf.{nm} differs from G.{nm}: Gf must have the same states as G")
-        nf = Bf.shape[1]
-    else:
-        Bf, Df, nf = np.zeros((n, 0)), np.zeros((ny, 0)), 0
-
-    try:
-        Acl, Bcl, Ccl, Dcl = feedback_matrices((A, B, C, D), (Ak, Bk, Ck, Dk), (Bf, Df))
-    except ModelError:
-        raise ModelError("closed_loop: I + D·D_K is singular; the loop is ill-posed") from None
-
-    u_names = labels(G, "input", nu, "u")
-    y_names = labels(G, "output", ny, "y")
-    f_names = labels(Gf, "input", nf, "f") if Gf is not None else ()
-    inputs = [f"d_{u}" for u in u_names] + list(f_names)
-    outputs = list(y_names) + [f"i_{u}" for u in u_names]
-    states = [f"x[{i}]" for i in range(n)] + [f"xK[{i}]" for i in range(nk)]
-    sys = control.StateSpace(Acl, Bcl, Ccl, Dcl, dt, inputs=inputs, outputs=outputs,
-                             states=states, name="closed_loop")
-    poles = np.linalg.eigvals(Acl) if Acl.size else np.zeros(0, dtype=complex)
-    order = np.argsort(-np.abs(poles) if dt else -poles.real, kind="stable")
-    poles = poles[order]
-    return ClosedLoop(sys, poles, decay_rate(poles, dt), is_stable(poles, dt), nu, ny, nf, dt)
-
-
 def loop_responses(G: Any, K: Any, omega: Any) -> LoopResponse:
     """S_o, S_i, T_o and K S_o of ``(G, K)`` on a frequency grid.
 
@@ -456,10 +302,10 @@ def loop_responses(G: Any, K: Any, omega: Any) -> LoopResponse:
     :func:`closed_loop` ``.stable`` before reading a peak as a robustness margin.
     """
     w = as_omega(omega)
-    _check_pair(G, K)
+    loop_matrices(G, K)
     K = wired(G, K)
     ny, nu = ss_matrices(G, name="G", allow_discrete=True)[3].shape
-    pts, kw = response_points(w, _dt(G))
+    pts, kw = response_points(w, sample_time(G))
     return loop_responses_from(freqresp_at(G, pts, **kw), freqresp_at(K, pts), w,
                                labels(G, "output", ny, "y"), labels(G, "input", nu, "u"))
 
@@ -515,9 +361,9 @@ def compliance(G: Any, K: Any, Gf: Any, omega: Any) -> ComplianceResponse:
         imaginary-axis pole of ``G``, ``K`` or ``Gf``.
     """
     w = as_omega(omega)
-    _check_pair(G, K)
+    loop_matrices(G, K)
     K = wired(G, K)
-    pts, kw = response_points(w, _dt(G))
+    pts, kw = response_points(w, sample_time(G))
     Gfw = freqresp_at(Gf, pts, **kw)
     Gw = freqresp_at(G, pts, **kw)
     if Gfw.shape[1] != Gw.shape[1]:

@@ -25,10 +25,10 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ambseal.analysis._util import json_float
-from ambseal.analysis.loops import ClosedLoop, closed_loop
 from ambseal.errors import ModelError
 from ambseal.lti.discrete import simulate_lti, zoh
+from ambseal.lti.json_safe import json_float
+from ambseal.robust.loop import ClosedLoop, closed_loop
 
 __all__ = ["ImpulseResponse", "impulse_response", "impulse_response_of", "settling_time"]
 

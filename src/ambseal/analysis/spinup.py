@@ -69,13 +69,14 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ambseal.analysis.loops import closed_loop, loop_responses, resolved_grid
+from ambseal.analysis.loops import loop_responses, resolved_grid
 from ambseal.analysis.response import settling_time
 from ambseal.errors import ModelError
 from ambseal.lti.discrete import zoh
 from ambseal.lti.interconnect import feedback_matrices
 from ambseal.model.rig import build_plant
 from ambseal.robust.controller import frozen, matrices_at
+from ambseal.robust.loop import closed_loop
 
 __all__ = ["StepResponse", "SpinupResult", "spinup", "FrozenSensitivity",
            "frozen_sensitivity"]

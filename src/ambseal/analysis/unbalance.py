@@ -36,9 +36,9 @@ from typing import Any
 
 import numpy as np
 
-from ambseal.analysis._util import json_float, json_list
 from ambseal.analysis.loops import ComplianceResponse, Peak, compliance, peak_of
 from ambseal.errors import ModelError
+from ambseal.lti.json_safe import json_float, json_list
 from ambseal.lti.matrices import as_omega
 
 __all__ = ["unbalance_force", "UnbalanceResponse", "unbalance_response", "unbalance_from_compliance",

@@ -20,7 +20,7 @@ from ambseal.analysis.judge import judge_settings, operating_points
 from ambseal.config import default_rig_path, dump_rig, load_rig, rig_with_values
 from ambseal.design.lpv_design import design_lpv
 from ambseal.design.pid import controller_from_metadata
-from ambseal.design.recipes import design, pid_from_rig
+from ambseal.design.recipes import design, full_order_check, pid_from_rig
 from ambseal.design.specs import design_spec
 from ambseal.errors import ConfigError, DataError, IdentificationError, SynthesisError
 from ambseal.export.codegen import write_c
@@ -350,6 +350,19 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
 
     points = operating_points(cfg)
     digital = digital_for(cfg, method, K, res, points)
+    if summary.get("full_order") is None and not isinstance(K, ScheduledController):
+        # the reference PID is given, not designed: judged here before it is handed over
+        check = full_order_check(cfg, K, [(q.pressure_bar, q.speed_rpm / 60.0) for q in points])
+        summary.update(full_order=check, allow_unstable=not check["stable"])
+        if not check["stable"]:
+            what = (f"{method}: the full-order loop is unstable at {check['pressure_bar']:g} "
+                    f"bar, {check['speed_hz']:g} Hz (the mode at {check['mode_hz']:.4g} Hz "
+                    f"has ζ = {check['damping']:.3g})")
+            if not allow_unstable:
+                raise SynthesisError(f"{what}; nothing exported. Pass --allow-unstable to "
+                                     f"export it anyway (marked in design_{method}.json)")
+            print(f"ambseal: warning: {what}; exported as asked (--allow-unstable), marked "
+                  f"in design_{method}.json", file=sys.stderr)
     judged = choice_margins(cfg, points, digital)
     files = export_design(method, digital, summary, out, judged)
     if c_dir is not None:

@@ -135,7 +135,7 @@ def _export(args: argparse.Namespace) -> int:
         summary = design_files(args.rig, args.method, args.out,
                                pressure_bar=args.pressure_bar,
                                c_dir=args.c_dir or Path(args.out) / "c",
-                               precision=args.precision)
+                               precision=args.precision, allow_unstable=args.allow_unstable)
     print(json.dumps(summary))
     return 0
 

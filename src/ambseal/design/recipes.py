@@ -62,13 +62,14 @@ from ambseal.design.specs import design_spec
 from ambseal.design.weights import Weights
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.lti.freqresp import freqresp
-from ambseal.lti.interconnect import feedback_poles, lft_lower, series_inputs
+from ambseal.lti.interconnect import lft_lower
 from ambseal.model.amb import channel_names
 from ambseal.model.rig import build_plant, build_system
-from ambseal.robust.delay import design_delay
+from ambseal.robust.delay import design_delay, loop_delay
 from ambseal.robust.dgk import musyn_dgk
 from ambseal.robust.dk import design_omega, musyn
 from ambseal.robust.hinf import hinfsyn
+from ambseal.robust.loop import judged_loop
 from ambseal.robust.order import reduce_controller
 
 __all__ = ["DesignResult", "design", "full_order_check", "METHODS"]
@@ -188,8 +189,10 @@ def _pid(cfg, p):
                         notes=notes)
 
 
-def full_order_check(cfg, K, conditions, *, delay=None) -> dict:
-    """Close a physical controller with the full-order plant at each condition.
+def full_order_check(cfg, K, conditions) -> dict:
+    """Close a physical controller with the full-order plant at each condition, as the
+    main job judges it (:func:`ambseal.robust.loop.judged_loop`: the target's hold and
+    computation delay as :func:`ambseal.robust.delay.loop_delay`'s lag).
 
     Parameters
     ----------
@@ -197,34 +200,28 @@ def full_order_check(cfg, K, conditions, *, delay=None) -> dict:
     K : control.StateSpace
         Displacements (m) → current references (A), negative feedback ``i = −K y``.
     conditions : iterable of (pressure_bar, speed_hz)
-    delay : control.StateSpace, optional
-        SISO delay model put after K on every channel (the design model's
-        :func:`~ambseal.robust.delay.design_delay`): the loop the design was made for.
 
     Returns
     -------
     dict
-        ``stable`` (bool) and, for the least stable condition, ``pressure_bar``,
-        ``speed_hz``, ``max_real_pole`` (1/s) and its mode: ``mode_hz`` (damped frequency)
-        and ``damping`` (ζ = −Re λ/|λ|, negative when unstable). A pole counts as unstable
-        when Re λ > 1e-9·max|λ| (the rounding level of the eigenvalue solver).
+        ``stable`` (bool: every judged loop stable by
+        :func:`ambseal.robust.stability.is_stable`) and, for the least stable condition,
+        ``pressure_bar``, ``speed_hz``, ``max_real_pole`` (1/s) and its mode: ``mode_hz``
+        (damped frequency) and ``damping`` (ζ = −Re λ/|λ|, negative when unstable).
     """
 
-    Km = tuple(np.asarray(getattr(K, m), float) for m in ("A", "B", "C", "D"))
+    L = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples).system
     worst = None
     for p, f in conditions:
         plant = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * f)
-        cur = plant.current_inputs()
-        G = (plant.A, plant.B[:, cur], plant.C, plant.D[:, cur])
-        if delay is not None:  # the same SISO delay on every channel: before G = after K
-            G = series_inputs(G, tuple(np.asarray(getattr(delay, m), float) for m in "ABCD"))[:4]
-        lam = feedback_poles(G, Km)
-        k = int(np.argmax(lam.real))
-        margin = lam[k].real / np.abs(lam).max()
-        if worst is None or margin > worst[0]:
-            worst = (margin, p, f, lam[k])
-    margin, p, f, z = worst
-    return {"stable": bool(margin <= 1e-9), "pressure_bar": float(p), "speed_hz": float(f),
+        judged = judged_loop(plant.to_statespace(), K, plant.current_inputs(), delay=L)
+        lam = judged.loop.poles
+        z = lam[int(np.argmax(lam.real))]
+        rank = (not judged.stable, z.real / np.abs(lam).max())
+        if worst is None or rank > worst[0]:
+            worst = (rank, p, f, z)
+    (unstable, _), p, f, z = worst
+    return {"stable": not unstable, "pressure_bar": float(p), "speed_hz": float(f),
             "max_real_pole": float(z.real), "mode_hz": float(abs(z.imag) / (2 * np.pi)),
             "damping": float(-z.real / max(abs(z), 1e-300))}
 
@@ -339,7 +336,7 @@ def design(
         r = _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to,
                         max_iter or sp.max_iter, sp.dk_order if dk_order is None else dk_order,
                         dl)
-        check = full_order_check(cfg, r.K, conditions, delay=dl.system)
+        check = full_order_check(cfg, r.K, conditions)
         if check["stable"] or attempt == enlarge or states is not None:
             break
         n_new = _states_to_keep(cfg, p, check["mode_hz"])

@@ -145,7 +145,7 @@ class Verdict:
             text += f" (σ̄ over all axes reaches {self.zone_sigma})"
         gap = [c for c in self.clearances_um.values() if c]
         if self.orbit_um is not None and gap and self.orbit_um > 0.5 * min(gap):
-            text += f"; the unbalance orbit uses over half of the clearance"
+            text += "; the unbalance orbit uses over half of the clearance"
 
         if self.target_difference is not None and self.target_difference > PEAK_TOLERANCE:
             text += (f"; as it runs on the target its σ̄(S_o) peak differs from the continuous "

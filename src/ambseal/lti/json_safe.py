@@ -1,6 +1,4 @@
-"""JSON helpers shared by the analysis modules (not public API).
-
-JSON conventions (used by every ``to_dict`` in :mod:`ambseal.analysis`):
+"""The JSON conventions of every result's ``to_dict`` (``metrics.json`` and the other files).
 
 * finite floats stay floats;
 * ``+inf`` becomes the string ``"inf"`` and ``-inf`` the string ``"-inf"``;

@@ -1,0 +1,294 @@
+"""The closed loop of a plant and a controller, and the one loop every verdict is taken on.
+
+**Convention** (:mod:`ambseal.robust.controller`): the controller ``K`` maps the plant's
+outputs ``y`` to its inputs with **negative feedback**, ``u = −K y + d``.
+
+* :func:`closed_loop` — close ``K`` around ``G`` (continuous, or discrete of one sample
+  time), with optional further inputs sharing ``G``'s states; its poles and the verdict of
+  :func:`ambseal.robust.stability.is_stable`.
+* :func:`judged_loop` — **the** loop a controller is judged on, as it will run: a
+  continuous controller acts through the target's hold and computation delay, modelled as
+  a lag (:func:`ambseal.robust.delay.loop_delay`) in front of every control input of the
+  plant; a discrete controller (its computation delay among its states) is closed on the
+  plant sampled exactly by a zero-order hold at its sample time (Franklin, Powell &
+  Workman, *Digital Control of Dynamic Systems*, 3rd ed., §6.3). Every command that says
+  "stable" — ``run``, ``design``, ``export``, ``sweep``, ``campbell``, ``modes`` — says it
+  of this loop, by the one rule.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import control
+import numpy as np
+
+from ambseal.errors import ModelError
+from ambseal.lti.discrete import zoh
+from ambseal.lti.interconnect import feedback_matrices, series_inputs, wired
+from ambseal.lti.json_safe import json_float, json_list
+from ambseal.lti.matrices import labels, ss_matrices
+from ambseal.robust.stability import decay_rate, is_stable
+
+__all__ = ["ClosedLoop", "JudgedLoop", "closed_loop", "judged_loop", "delayed_plant",
+           "sampled_plant", "loop_matrices", "sample_time"]
+
+
+@dataclass(frozen=True, eq=False)
+class ClosedLoop:
+    """The closed loop of ``(G, K)`` with ``u = −K y + d`` and optional force inputs.
+
+    Attributes
+    ----------
+    system : control.StateSpace
+        Continuous, or discrete with sample time ``dt``. Inputs: ``d_<u>`` current disturbances added to the controller output (A), one per
+        plant input, then the force inputs of ``Gf`` under their own names (N), if given.
+        Outputs: the plant outputs under their own names (m), then ``i_<u>`` the controller
+        output ``−K y`` (A; the "control action" of P5 Fig. 14). States: plant states then
+        controller states.
+    poles : ndarray of complex, shape (n + n_K,)
+        Closed-loop poles (rad/s), sorted by decreasing real part; of a discrete loop the
+        ``z`` (sorted by decreasing ``|z|``).
+    max_real_pole : float
+        Largest real part of the poles (1/s); ``< 0`` means asymptotically stable. Of a
+        discrete loop the same rate of its slowest-decaying pole, ``ln max|z| / dt``.
+    stable : bool
+        The poles are stable by the package's one rule
+        (:func:`ambseal.robust.stability.is_stable`).
+    n_plant_inputs, n_plant_outputs, n_force_inputs : int
+        Channel counts, so ``system`` can be sliced without parsing names.
+    dt : float
+        Sample time (s) of a discrete loop, 0 for a continuous one.
+    """
+
+    system: Any
+    poles: np.ndarray
+    max_real_pole: float
+    stable: bool
+    n_plant_inputs: int
+    n_plant_outputs: int
+    n_force_inputs: int
+    dt: float = 0.0
+
+    @property
+    def s_poles(self) -> np.ndarray:
+        """The poles as continuous rates (rad/s): ``poles``, or ``ln z / dt`` (the
+        equivalent s-plane pole of each z, below Nyquist)."""
+        if not self.dt:
+            return self.poles
+        with np.errstate(divide="ignore"):
+            return np.log(self.poles.astype(complex)) / self.dt
+
+    @property
+    def max_abs_pole(self) -> float:
+        """Largest ``|z|`` of a discrete loop (``< 1``: stable); NaN for a continuous one."""
+        if not self.dt:
+            return float("nan")
+        return float(np.abs(self.poles).max()) if self.poles.size else 0.0
+
+    def to_dict(self) -> dict:
+        """JSON-safe summary (no state-space matrices): stability, poles (real/imag, rad/s)."""
+        return {
+            "n_states": int(self.system.nstates),
+            "stable": bool(self.stable),
+            "max_real_pole": json_float(self.max_real_pole),
+            "poles_real": json_list(self.poles.real),
+            "poles_imag": json_list(self.poles.imag),
+            "inputs": list(self.system.input_labels),
+            "outputs": list(self.system.output_labels),
+        }
+
+
+def sample_time(sys: Any) -> float:
+    """Sample time of a python-control system (0 if continuous or a matrix tuple)."""
+    dt = getattr(sys, "dt", 0)
+    return float(dt) if dt not in (None, True) else 0.0
+
+
+def loop_matrices(G: Any, K: Any) -> tuple[tuple, tuple]:
+    """``(A, B, C, D)`` of the plant and of the controller wired to it by signal names
+    (:func:`ambseal.lti.interconnect.wired`), their time bases and shapes checked.
+
+    Raises
+    ------
+    ModelError
+        Different sample times, or a controller whose channels do not fit the plant's.
+    """
+    mg = ss_matrices(G, name="G", allow_discrete=True)
+    mk = ss_matrices(wired(G, K), name="K", allow_discrete=True)
+    if abs(sample_time(G) - sample_time(K)) > 1e-12 * max(sample_time(G), sample_time(K)):
+        raise ModelError(f"G (dt={sample_time(G)}) and K (dt={sample_time(K)}) must share one time base")
+    ny, nu = mg[3].shape
+    if mk[3].shape != (nu, ny):
+        raise ModelError(
+            f"K has {mk[3].shape[1]} inputs and {mk[3].shape[0]} outputs; expected {ny} inputs"
+            f" (G outputs, m) and {nu} outputs (G inputs, A)"
+        )
+    return mg, mk
+
+
+def closed_loop(G: Any, K: Any, Gf: Any | None = None, *, atol: float = 0.0) -> ClosedLoop:
+    """Close the loop ``u = −K y + d`` around ``G`` (and ``Gf`` sharing its states).
+
+    Plant ``ẋ = A x + B u + B_f f``, ``y = C x + D u + D_f f``; controller
+    ``ẋ_K = A_K x_K + B_K y``, ``i = −(C_K x_K + D_K y)``, ``u = i + d``, closed by
+    :func:`ambseal.lti.interconnect.feedback_matrices`. Same result as
+    ``control.feedback(G, K, sign=-1)`` for the ``d → y`` channel (tested side by side).
+
+    Parameters
+    ----------
+    G : control.StateSpace
+        Plant, ``nu`` current inputs (A) → ``ny`` displacement outputs (m).
+    K : control.StateSpace
+        Controller, ``ny`` inputs (m) → ``nu`` outputs (A).
+    Gf : control.StateSpace, optional
+        Plant with the same states and outputs and force inputs (N), e.g. at mid-span.
+    atol : float
+        Tolerance when checking that ``Gf`` has the same ``A`` and ``C`` as ``G``
+        (compared relative to their norms: ``≤ atol + 1e-9 ‖·‖``).
+
+    Returns
+    -------
+    ClosedLoop
+
+    Raises
+    ------
+    ModelError
+        If the dimensions of ``G``, ``K`` (and ``Gf``) do not fit, ``Gf`` has a different
+        ``A`` or ``C``, or ``I + D D_K`` is singular (ill-posed loop).
+    """
+
+    (A, B, C, D), (Ak, Bk, Ck, Dk) = loop_matrices(G, K)
+    n, nu = B.shape
+    ny = C.shape[0]
+    nk = Ak.shape[0]
+    dt = sample_time(G)
+    if Gf is not None:
+        Af, Bf, Cf, Df = ss_matrices(Gf, name="Gf", allow_discrete=True)
+        if Af.shape != A.shape or Cf.shape != C.shape:
+            raise ModelError(f"Gf must share G's states and outputs: A{Af.shape} vs {A.shape}, C{Cf.shape} vs {C.shape}")
+        for nm, X, Y in (("A", Af, A), ("C", Cf, C)):
+            if np.max(np.abs(X - Y), initial=0.0) > atol + 1e-9 * max(np.max(np.abs(Y), initial=0.0), 1.0):
+                raise ModelError(f"Gf.{nm} differs from G.{nm}: Gf must have the same states as G")
+        nf = Bf.shape[1]
+    else:
+        Bf, Df, nf = np.zeros((n, 0)), np.zeros((ny, 0)), 0
+
+    try:
+        Acl, Bcl, Ccl, Dcl = feedback_matrices((A, B, C, D), (Ak, Bk, Ck, Dk), (Bf, Df))
+    except ModelError:
+        raise ModelError("closed_loop: I + D·D_K is singular; the loop is ill-posed") from None
+
+    u_names = labels(G, "input", nu, "u")
+    y_names = labels(G, "output", ny, "y")
+    f_names = labels(Gf, "input", nf, "f") if Gf is not None else ()
+    inputs = [f"d_{u}" for u in u_names] + list(f_names)
+    outputs = list(y_names) + [f"i_{u}" for u in u_names]
+    states = [f"x[{i}]" for i in range(n)] + [f"xK[{i}]" for i in range(nk)]
+    sys = control.StateSpace(Acl, Bcl, Ccl, Dcl, dt, inputs=inputs, outputs=outputs,
+                             states=states, name="closed_loop")
+    poles = np.linalg.eigvals(Acl) if Acl.size else np.zeros(0, dtype=complex)
+    order = np.argsort(-np.abs(poles) if dt else -poles.real, kind="stable")
+    poles = poles[order]
+    return ClosedLoop(sys, poles, decay_rate(poles, dt), is_stable(poles, dt), nu, ny, nf, dt)
+
+
+@dataclass(frozen=True, eq=False)
+class JudgedLoop:
+    """A controller closed on a plant as it will run (:func:`judged_loop`).
+
+    Attributes
+    ----------
+    plant : control.StateSpace
+        The plant as the controller sees it: with the delay lag in front of its control
+        inputs (continuous), or sampled by a zero-order hold at the controller's sample
+        time (discrete); every input and output name kept.
+    loop : ClosedLoop
+        The closed loop (control inputs closed, the other inputs external); its
+        ``stable`` is the verdict.
+    """
+
+    plant: Any
+    loop: ClosedLoop
+
+    @property
+    def stable(self) -> bool:
+        """The verdict (:func:`ambseal.robust.stability.is_stable` on the loop's poles)."""
+        return self.loop.stable
+
+
+def delayed_plant(P, inputs, delay):
+    """The continuous plant ``P`` with the SISO ``delay`` system in front of each input in
+    ``inputs`` (:func:`ambseal.lti.interconnect.series_inputs`), signal names kept."""
+
+    def mats(S):
+        return tuple(np.asarray(getattr(S, m), float) for m in ("A", "B", "C", "D"))
+
+    A, B, C, D = series_inputs(mats(P), mats(delay), list(inputs))[:4]
+    return control.ss(A, B, C, D, inputs=list(P.input_labels), outputs=list(P.output_labels))
+
+
+def sampled_plant(P, dt: float):
+    """The plant ``P`` sampled exactly with a zero-order hold at ``dt`` (s): inputs held
+    over each sample, outputs read at the samples (:func:`ambseal.lti.discrete.zoh`),
+    signal names kept."""
+
+    Ad, Bd = zoh(np.asarray(P.A, float), np.asarray(P.B, float), dt)
+    return control.ss(Ad, Bd, np.asarray(P.C, float), np.asarray(P.D, float), dt,
+                      inputs=list(P.input_labels), outputs=list(P.output_labels))
+
+
+def _select(P, idx):
+    """``P`` with only the inputs ``idx`` (names kept, same time base)."""
+    names = [P.input_labels[j] for j in idx]
+    return control.ss(P.A, np.asarray(P.B)[:, idx], P.C, np.asarray(P.D)[:, idx], P.dt,
+                      inputs=names, outputs=list(P.output_labels))
+
+
+def judged_loop(P, K, control_inputs=None, *, delay=None) -> JudgedLoop:
+    """Close ``K`` on the continuous plant ``P`` as it will run (module docstring).
+
+    Parameters
+    ----------
+    P : control.StateSpace
+        Continuous plant (e.g. the full-order model), ``n`` states. Its inputs
+        ``control_inputs`` are driven by the controller; any others (forces, N) stay
+        external inputs of the loop.
+    K : control.StateSpace
+        Continuous controller, or a discrete one whose ``dt`` is its sample time (its
+        computation delay among its states); ``u = −K y``, wired by signal names.
+    control_inputs : sequence of int, optional
+        Indices of the inputs of ``P`` the controller drives (default: all).
+    delay : control.StateSpace, optional
+        SISO lag of a continuous controller's hold and computation delay
+        (:func:`ambseal.robust.delay.loop_delay` ``.system``); ignored for a discrete one,
+        whose delay is in its states.
+
+    Returns
+    -------
+    JudgedLoop
+        The plant as closed (delayed or sampled) and the closed loop: inputs ``d_<u>``
+        (disturbances added to the controller's output) then the external inputs, outputs
+        the plant's then ``i_<u>``.
+
+    Raises
+    ------
+    ModelError
+        ``P`` not continuous, or channels that do not fit (:func:`loop_matrices`).
+    """
+    if sample_time(P):
+        raise ModelError("judged_loop: the plant must be continuous; a discrete controller "
+                         "samples it itself")
+    cur = list(range(P.ninputs)) if control_inputs is None else list(control_inputs)
+    rest = [j for j in range(P.ninputs) if j not in cur]
+    dt = sample_time(K)
+    if dt:
+        Pj = sampled_plant(P, dt)
+    elif delay is not None:
+        Pj = delayed_plant(P, cur, delay)
+    else:
+        Pj = P
+    G = _select(Pj, cur)
+    Gf = _select(Pj, rest) if rest else None
+    return JudgedLoop(Pj, closed_loop(G, K, Gf))

@@ -1,0 +1,40 @@
+"""One verdict: the main job, export, sweep and campbell judge a borderline loop alike.
+
+Every command that says "stable" takes it of the same loop (the controller as it runs,
+:func:`ambseal.robust.loop.judged_loop`) by the same rule
+(:func:`ambseal.robust.stability.is_stable`). Reference: the stability boundary of the
+test rig's reference PID between nominal and twice nominal pressure drop (thesis P5 §4:
+stable at 2.04 bar, unstable at 4.08 bar), bisected to 1e-4 bar; just below it every
+command must say stable, just above it every command unstable.
+"""
+
+import numpy as np
+
+from ambseal.analysis.campbell import closed_loop_modes
+from ambseal.analysis.judge import OperatingPoint, judge
+from ambseal.analysis.sweep import boundary_case, sweep_case
+from ambseal.design.recipes import full_order_check
+from ambseal.model.modes import bending_limit_hz
+
+
+def test_commands_agree_on_either_side_of_the_stability_boundary(testrig_cfg,
+                                                                 testrig_designs):
+    cfg, K = testrig_cfg, testrig_designs["pid"].K
+    f = cfg.operating.speed_rpm / 60.0
+    p0 = cfg.operating.pressure_bar
+    rig = cfg.model_dump(exclude_none=True)
+    ctrls = {"pid": tuple(np.asarray(M, float) for M in (K.A, K.B, K.C, K.D))}
+    edge = boundary_case({"controller": "pid", "speed_hz": f, "params": None,
+                          "last_stable_bar": p0, "first_unstable_bar": 2 * p0},
+                         rig, ctrls, tol_bar=1e-4)
+    assert p0 < edge < 2 * p0
+    for p, stable in ((edge - 1e-3, True), (edge + 1e-3, False)):
+        verdicts = {
+            "run": judge(cfg, K, "pid", OperatingPoint(p, 60.0 * f, ""),
+                         impulse=False)[0]["stable"],
+            "export": full_order_check(cfg, K, [(p, f)])["stable"],
+            "sweep": sweep_case({"controller": "pid", "pressure_bar": p, "speed_hz": f},
+                                rig, ctrls, bending_limit_hz(cfg))["stable"],
+            "campbell": closed_loop_modes(cfg, K, speed_hz=f, pressure_bar=p).stable,
+        }
+        assert verdicts == dict.fromkeys(verdicts, stable), (p, verdicts)

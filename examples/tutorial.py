@@ -24,8 +24,8 @@ hinf = design(rig, "hinf")                                      # 3. H∞ design
 points, curves = operating_points(rig), []
 for point in points:                                            # 4. judged on the full model
     case, c = judge(rig, hinf.K, "hinf", point)  # grids from the rig: design --show-defaults
-    print(f"{point.label}: stable={case['stable']}, ISO zone per axis "
-          f"{case['iso_zone_per_axis']}, orbit {case['unbalance_peak_um']:.3g} µm")
+    print(f"{point.label}: stable={case.stable}, ISO zone per axis "
+          f"{case.iso_zone_per_axis}, orbit {case.unbalance_peak_um:.3g} µm")
     curves.append((point.label, *c["So"]))
 sensitivity_figure(out / "sensitivity.png", curves)
 dc = digital_for(rig, "hinf", hinf.K, hinf, points)  # 5. discretised, checked on the sampled plant

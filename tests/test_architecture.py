@@ -138,7 +138,7 @@ def test_imports_sit_at_the_top_of_modules():
 
 def test_no_history_in_code_or_tests():
     """Comments say why; history lives in git and CHANGELOG.md."""
-    pattern = re.compile(r"issue\s*#?\s*[0-9]", re.IGNORECASE)
+    pattern = re.compile(r"issues?\s*#?\s*[0-9]", re.IGNORECASE)
     hits = [f"{p.relative_to(ROOT)}:{i}" for base in (SRC, ROOT / "tests")
             for p in sorted(base.rglob("*.py"))
             for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)

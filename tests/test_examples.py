@@ -20,6 +20,8 @@ import pytest
 
 from ambseal.cli import main
 
+from .metrics_schema import validate_metrics
+
 EXAMPLES = sorted((Path(__file__).resolve().parents[1] / "examples").glob("*.toml"))
 TESTRIG = Path(__file__).resolve().parents[1] / "examples" / "testrig.toml"
 
@@ -60,6 +62,7 @@ def test_every_example_runs_end_to_end(rig, tmp_path, capsys):
     all three designs (PID, H∞, μ; LPV beside them on a speed-scheduled rig), and every
     loop is stable on the full-order plant (or the run says why not)."""
     metrics, err = _run(rig, tmp_path / "out", capsys)
+    validate_metrics(metrics)
     _check_stable_or_stated(metrics, err)
     assert {c["controller"] for c in metrics["cases"]} >= {"pid", "hinf", "mu"}
     # μ: ISO 14839-3 zone A (σ̄(S_o) < 3 per axis) at every judged condition, and the

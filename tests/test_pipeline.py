@@ -1,13 +1,16 @@
 """The main job on the embedded thesis test facility."""
 
+import copy
 import json
 import re
 
+import jsonschema
 import pytest
 
 from ambseal.cli import main
 
 from .browser import chromium, probe
+from .metrics_schema import validate_metrics
 
 #: ISO 14839-3:2006 zone A/B boundary of the sensitivity peak (3, i.e. 9.5 dB; P5 §4.1).
 ISO_ZONE_A_LIMIT = 3.0
@@ -80,6 +83,21 @@ def terminal_run(tmp_path_factory, request, design_cache_for):
 def metrics(terminal_run):
     """(output folder, metrics.json) of :func:`terminal_run`."""
     return terminal_run[:2]
+
+
+def test_metrics_json_fits_the_shipped_schema(metrics):
+    """Reference: JSON Schema 2020-12 — the embedded run's document validates; the same
+    document with a case's ``stable`` renamed, a wrong type, or another version does not."""
+    _, m = metrics
+    validate_metrics(m)
+    for break_it in (lambda d: d["cases"][0].update(ok=d["cases"][0].pop("stable")),
+                     lambda d: d["cases"][0].update(sensitivity_peak="high"),
+                     lambda d: d.update(schema_version="0.9.0"),
+                     lambda d: d["controllers"]["mu"].pop("order")):
+        broken = copy.deepcopy(m)
+        break_it(broken)
+        with pytest.raises(jsonschema.ValidationError):
+            validate_metrics(broken)
 
 
 def test_run_on_a_terminal_ends_with_the_verdict_and_the_report_path(terminal_run):
@@ -354,7 +372,7 @@ def test_run_not_on_a_terminal_logs_one_line_per_stage(turbo_run):
 
 
 def test_run_on_the_turboexpander_judges_lpv(turbo_run):
-    """`ambseal run examples/turboexpander.toml` (issues 5 and 9 §4): the PID derived from
+    """`ambseal run examples/turboexpander.toml`: the PID derived from
     the rig, H∞ and μ at 140 Hz and the LPV controller judged at frozen speeds over
     20–300 Hz, every loop stable (continuous and as it runs), the spin-up and
     frozen-sensitivity comparison of LPV and μ (P3 Figs. 11–12) in metrics and report, the
@@ -362,6 +380,7 @@ def test_run_on_the_turboexpander_judges_lpv(turbo_run):
     ``run`` makes; tests/conftest.py)."""
     tmp_path = turbo_run
     m = json.loads((tmp_path / "metrics.json").read_text())
+    validate_metrics(m)
     got = {(c["controller"], c["speed_hz"]) for c in m["cases"]}
     assert got == {(c, f) for c in ("pid", "hinf", "mu", "lpv") for f in (20.0, 140.0, 300.0)}
     assert all(c["stable"] and c["discrete"]["stable"] for c in m["cases"])

@@ -31,7 +31,7 @@ def test_commands_agree_on_either_side_of_the_stability_boundary(testrig_cfg,
     for p, stable in ((edge - 1e-3, True), (edge + 1e-3, False)):
         verdicts = {
             "run": judge(cfg, K, "pid", OperatingPoint(p, 60.0 * f, ""),
-                         impulse=False)[0]["stable"],
+                         impulse=False)[0].stable,
             "export": full_order_check(cfg, K, [(p, f)])["stable"],
             "sweep": sweep_case({"controller": "pid", "pressure_bar": p, "speed_hz": f},
                                 rig, ctrls, bending_limit_hz(cfg))["stable"],

@@ -228,7 +228,8 @@ def test_loaded_controller_judged_alike_whatever_the_amb_order(testrig_cfg, tmp_
     swapped = load_rig(rig)
     assert [a.name for a in swapped.amb] == ["B", "A"]
     point = operating_points(testrig_cfg)[1]
-    cases = [judge(c, loaded, "K", point, impulse=False)[0] for c in (testrig_cfg, swapped)]
+    cases = [judge(c, loaded, "K", point, impulse=False)[0].to_dict()
+             for c in (testrig_cfg, swapped)]
     for key in ("stable", "max_real_pole", "sensitivity_peak", "compliance_peak_m_per_n"):
         assert cases[1][key] == pytest.approx(cases[0][key], rel=1e-6), key
     per_axis = [c["sensitivity_peak_per_axis"] for c in cases]

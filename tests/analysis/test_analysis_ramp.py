@@ -65,7 +65,7 @@ def test_ramp_losses_agree_with_the_frozen_full_order_loops(testrig_cfg, testrig
     cfg = testrig_cfg
     p0, rpm = cfg.operating.pressure_bar, cfg.operating.speed_rpm
     frozen = {(m, f): judge(cfg, testrig_designs[m].K, m, OperatingPoint(f * p0, rpm, ""),
-                            impulse=False)[0]["stable"]
+                            impulse=False)[0].stable
               for m, f in (("pid", 1.25), ("pid", 1.5), ("mu", 3.0))}
     assert frozen == {("pid", 1.25): True, ("pid", 1.5): False, ("mu", 3.0): True}
     truth = load_truth(default_truth_path())

@@ -31,11 +31,11 @@ def test_impulse_response_of_a_badly_scaled_hinf_loop_is_well_conditioned(turbo_
 
     K = turbo_frozen.K
     point = operating_points(turbo_cfg)[0]
-    ref = judge(turbo_cfg, K, "hinf", point)[0]["impulse_peak_um"]
+    ref = judge(turbo_cfg, K, "hinf", point)[0].impulse_peak_um
     rng = np.random.default_rng(1)
     Kp = control.ss(K.A * (1 + 1e-12 * rng.standard_normal(K.A.shape)), K.B, K.C, K.D,
                     inputs=K.input_labels, outputs=K.output_labels)
-    got = judge(turbo_cfg, Kp, "hinf", point)[0]["impulse_peak_um"]
+    got = judge(turbo_cfg, Kp, "hinf", point)[0].impulse_peak_um
     assert abs(got / ref - 1) < 1e-9, (ref, got)
 
 

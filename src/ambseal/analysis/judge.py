@@ -39,7 +39,7 @@ impulse are derived from the machine by the rules written there.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -58,6 +58,7 @@ from ambseal.design.lpv_plant import lpv_plant, vertex_grid_hz
 from ambseal.design.specs import RIGID_STATES, design_spec
 from ambseal.lti.freqresp import freqresp_at
 from ambseal.lti.interconnect import wired
+from ambseal.lti.json_safe import json_float
 from ambseal.model.modes import classify_poles
 from ambseal.model.rig import build_plant
 from ambseal.model.seal import seal_values
@@ -66,7 +67,7 @@ from ambseal.robust.delay import loop_delay
 from ambseal.robust.loop import JudgedLoop, judged_loop
 from ambseal.robust.scheduled_digital import ScheduledDigital
 
-__all__ = ["JudgeSettings", "OperatingPoint", "judge", "judge_case", "judge_spinup",
+__all__ = ["JudgeSettings", "OperatingPoint", "LoopJudgement", "JudgedCase", "judge", "judge_case", "judge_spinup",
            "operating_points", "speed_scheduled",
            "judge_settings", "unstable_open_loop_poles", "condition_values", "frozen_at",
            "frozen_discrete", "judge_jobs"]
@@ -122,6 +123,93 @@ class JudgeSettings:
 
 #: points of the judgement's log grid (before the refinement around lightly damped poles)
 GRID_POINTS = 1200
+
+
+#: A number in ``metrics.json``: finite, or ``"inf"``/``"-inf"`` (:mod:`ambseal.lti.json_safe`).
+JsonFloat = float | str
+
+
+@dataclass(frozen=True)
+class LoopJudgement:
+    """The numbers of one judged loop, continuous or discrete (thesis P5 §4–5).
+
+    Attributes
+    ----------
+    stable : bool
+        The loop's verdict (:func:`ambseal.robust.stability.is_stable`).
+    max_real_pole : float
+        Decay rate of its slowest pole (1/s; ``ln max|z| / dt`` for a discrete loop).
+    sensitivity_peak : float or None
+        Peak of σ̄(S_o) (-); None for an unstable loop.
+    sensitivity_peak_per_axis : dict of str to float or None
+        Peak of each diagonal element of S_o, by AMB axis (ISO 14839-3 grades these).
+    iso_zone : str
+        ISO 14839-3 zone of σ̄(S_o) (``"A"``–``"D"``).
+    iso_zone_per_axis : dict of str to str
+    compliance_peak_m_per_n : float or None
+        Peak of σ̄ of the compliance at the unbalance force positions (m/N).
+    unbalance_peak_um : float or None
+        Worst-case unbalance response (µm) over the unbalance band (ISO 21940-11 grade).
+    impulse_peak_um, impulse_settling_s : float or None
+        The current-impulse response's peak displacement (µm) and settling time (s).
+    max_abs_pole_z, sample_rate_hz : float or None
+        Of a discrete loop only: its largest ``|z|`` and sample rate (Hz).
+    """
+
+    stable: bool
+    max_real_pole: JsonFloat
+    sensitivity_peak: float | None
+    sensitivity_peak_per_axis: dict[str, float | None]
+    iso_zone: str
+    iso_zone_per_axis: dict[str, str]
+    compliance_peak_m_per_n: float | None
+    unbalance_peak_um: float | None
+    impulse_peak_um: float | None
+    impulse_settling_s: float | None
+    max_abs_pole_z: float | None = None
+    sample_rate_hz: float | None = None
+
+    def to_dict(self) -> dict:
+        """The ``metrics.json`` form (a discrete loop's two extra keys only when set)."""
+        d = {f.name: getattr(self, f.name) for f in fields(self)}
+        d["max_real_pole"] = json_float(self.max_real_pole)
+        if self.sample_rate_hz is None:
+            del d["max_abs_pole_z"], d["sample_rate_hz"]
+        return d
+
+
+@dataclass(frozen=True)
+class JudgedCase(LoopJudgement):
+    """One controller judged at one operating point: the main job's case.
+
+    The continuous loop's numbers (:class:`LoopJudgement`, the controller with its delay
+    lag), the condition, the delay model and, when the discrete controller that runs was
+    judged too, its loop's numbers (``discrete``).
+
+    Attributes
+    ----------
+    controller : str
+    pressure_bar, speed_hz : float
+        The condition (bar, Hz).
+    delay : dict
+        The delay lag judged with (:meth:`ambseal.robust.delay.DesignDelay.to_dict`).
+    discrete : LoopJudgement or None
+    """
+
+    controller: str = ""
+    pressure_bar: float = 0.0
+    speed_hz: float = 0.0
+    delay: dict | None = None
+    discrete: LoopJudgement | None = None
+
+    def to_dict(self) -> dict:
+        """The ``metrics.json`` case."""
+        d = {"controller": self.controller, "pressure_bar": self.pressure_bar,
+             "speed_hz": self.speed_hz, **LoopJudgement.to_dict(self), "delay": self.delay}
+        if self.discrete is not None:
+            d["discrete"] = self.discrete.to_dict()
+        return d
+
 
 
 def judge_settings(cfg, spec=None) -> JudgeSettings:
@@ -206,7 +294,7 @@ def _finite(x: float) -> float | None:
 
 def judge(cfg, controller, name: str, point: OperatingPoint,
           settings: JudgeSettings | None = None, *, impulse: bool = True,
-          discrete=None) -> tuple[dict, dict]:
+          discrete=None) -> tuple[JudgedCase, dict]:
     """Judge one physical controller on the full-order plant at one operating point.
 
     Parameters
@@ -230,10 +318,10 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
 
     Returns
     -------
-    case : dict
-        The ``metrics.json`` case (values an unstable loop does not have are ``None``);
-        with ``discrete``, its numbers under ``case["discrete"]`` (same keys, plus
-        ``max_abs_pole_z`` and ``sample_rate_hz``).
+    case : JudgedCase
+        The case (values an unstable loop does not have are ``None``); with ``discrete``,
+        its loop's numbers in ``case.discrete`` (plus ``max_abs_pole_z`` and
+        ``sample_rate_hz``). ``case.to_dict()`` is the ``metrics.json`` form.
     curves : dict
         ``So``, ``compliance``, ``unbalance`` (frequency Hz, values) and ``impulse``
         (:class:`~ambseal.analysis.response.ImpulseResponse`) for the figures, and
@@ -247,21 +335,20 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
     cur = plant.current_inputs()
     force = [j for j in range(len(plant.input_names)) if j not in cur]
     P = plant.to_statespace()
-    case = {"controller": name, "pressure_bar": point.pressure_bar,
-            "speed_hz": point.speed_rpm / 60.0}
     dl = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples)
     body, curves = _judge_loop(judged_loop(P, controller, cur, delay=dl.system), cur, force,
                                controller, s, impulse)
-    case.update(body)
-    case["delay"] = dl.to_dict()
+    disc = None
     if discrete is not None:
-        case["discrete"], curves["discrete"] = _judge_loop(judged_loop(P, discrete, cur), cur,
-                                                           force, discrete, s, impulse)
+        disc, curves["discrete"] = _judge_loop(judged_loop(P, discrete, cur), cur, force,
+                                               discrete, s, impulse)
+    case = JudgedCase(**vars(body), controller=name, pressure_bar=point.pressure_bar,
+                      speed_hz=point.speed_rpm / 60.0, delay=dl.to_dict(), discrete=disc)
     return case, curves
 
 
 def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, impulse: bool
-                ) -> tuple[dict, dict]:
+                ) -> tuple[LoopJudgement, dict]:
     """The case's numbers for one judged loop, continuous or discrete: its plant with
     current inputs ``cur`` and force inputs ``force``."""
 
@@ -297,7 +384,7 @@ def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, im
     if not loop.stable:
         case.update(compliance_peak_m_per_n=None, unbalance_peak_um=None,
                     impulse_peak_um=None, impulse_settling_s=None)
-        return case, curves
+        return LoopJudgement(**case), curves
     c, cu = (compliance_from(Gw[sl], Kw[sl], Gfw[sl], grid, ny_names, f_names)
              for sl, grid in ((slice(0, w.size), w), (slice(w.size, None), wu)))
     curves["compliance"] = (w / (2 * np.pi), c.sigma_max_m_per_n)
@@ -308,7 +395,7 @@ def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, im
     case.update(compliance_peak_m_per_n=c.peak.value, unbalance_peak_um=unb.peak_um)
     if not impulse or s.impulse_a is None:
         case.update(impulse_peak_um=None, impulse_settling_s=None)
-        return case, curves
+        return LoopJudgement(**case), curves
     # the thesis's impulse axes A_ζ and B_η (P5 §5.1): first AMB's ζ, last AMB's η
     channels = (G.input_labels[0], G.input_labels[-1])
     step = dt or s.impulse_dt_s  # a discrete loop steps at its sample time
@@ -321,7 +408,7 @@ def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, im
         impulse_peak_um=imp.peak_displacement_um,
         impulse_settling_s=_finite(imp.settling_time_s),
     )
-    return case, curves
+    return LoopJudgement(**case), curves
 
 
 def condition_values(point, design_cfg) -> tuple[float, dict]:
@@ -364,7 +451,8 @@ def frozen_discrete(digital, point, design_cfg):
     return digital.statespace(delayed=True)
 
 
-def judge_case(case: dict, cfg, settings: JudgeSettings | None = None) -> tuple[dict, dict]:
+def judge_case(case: dict, cfg, settings: JudgeSettings | None = None
+               ) -> tuple[JudgedCase, dict]:
     """:func:`judge` of ``case = {"controller", "name", "point"}`` (and ``"discrete"``, the
     delayed discrete controller that runs): the main job's cases as run by
     :func:`ambseal.analysis.cases.run_cases`."""

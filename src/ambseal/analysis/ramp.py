@@ -400,5 +400,5 @@ def frozen_cases(cfg, design, *, settings=None, impulse: bool = False) -> list[d
         theta = float(build_plant(cfg, pressure_bar=p).parameter(design.parameter).nominal)
         case, _ = judge(cfg, design.at(theta), "tracked",
                         OperatingPoint(float(p), rpm, f"{p:.3g} bar"), s, impulse=impulse)
-        cases.append({**case, "value": theta})
+        cases.append({**case.to_dict(), "value": theta})
     return cases

@@ -26,6 +26,7 @@ from ambseal.analysis.cases import CaseError, run_cases
 from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
 from ambseal.config import parse_rig, rig_with_values
 from ambseal.errors import ConfigError
+from ambseal.lti.json_safe import json_float
 from ambseal.model.modes import bending_limit_hz
 from ambseal.robust.stability import is_stable
 
@@ -86,11 +87,11 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
     dec, dec_hz = lowest_log_decrement(curves["poles"], max_hz)
     row = {"controller": case["controller"], "pressure_bar": case["pressure_bar"],
            "speed_hz": case["speed_hz"], **(case.get("params") or {}),
-           "stable": res["stable"], "max_real_pole": res["max_real_pole"],
+           "stable": res.stable, "max_real_pole": json_float(res.max_real_pole),
            "lowest_log_dec": dec, "lowest_log_dec_hz": dec_hz,
-           "sensitivity_peak": res["sensitivity_peak"], "iso_zone": res["iso_zone"]}
-    row.update({f"iso_zone_{ax}": z for ax, z in res["iso_zone_per_axis"].items()})
-    row["unbalance_peak_um"] = res["unbalance_peak_um"]
+           "sensitivity_peak": res.sensitivity_peak, "iso_zone": res.iso_zone}
+    row.update({f"iso_zone_{ax}": z for ax, z in res.iso_zone_per_axis.items()})
+    row["unbalance_peak_um"] = res.unbalance_peak_um
     return row
 
 

@@ -30,6 +30,7 @@ from ambseal.app.commands import (
     facility_impulses,
     identification_stage,
 )
+from ambseal.app.metrics import SCHEMA_VERSION, ControllerSummary, OpenLoop, RunMetrics
 from ambseal.app.tracked import tracked_designs, tracked_ramp
 from ambseal.config import RigConfig, default_rig_path, load_rig, load_truth
 from ambseal.design.lpv_design import design_frozen, design_lpv
@@ -214,33 +215,31 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                            on_done=lambda i, r: stages.step(f"{jobs[i]['name']} at "
                                                             f"{jobs[i]['point'].label}"))
         cases = [case for case, _ in judged]
-        curves = [(j["name"], j["point"], case, c) for j, (case, c) in zip(jobs, judged)]
-        summaries = export_all(designs, digitals, cases, out / "controllers")
-        metrics = {
-            "rig": str(rig_path),
-            "rig_name": cfg.rotor.name,
-            "open_loop": {"unstable_poles": [[float(z.real), float(z.imag)] for z in unstable],
-                          "n_states_full": full.n_states, "n_states_reduced": n_reduced},
-            "unbalance": settings.unbalance_dict(),
-            "design_spec": spec.to_dict(),
-            "controllers": summaries,
-            "cannot_run": cannot_run,
-            "cases": cases,
-        }
+        case_dicts = [case.to_dict() for case in cases]
+        curves = [(j["name"], j["point"], case, c)
+                  for j, case, (_, c) in zip(jobs, case_dicts, judged)]
+        summaries = export_all(designs, digitals, case_dicts, out / "controllers")
         figs, sections = ([], []) if ident is None else (ident.figs, ident.sections)
-        if ident is not None:
-            metrics["identification"] = ident.summary
+        spinup = ramp = None
         if speed_scheduled(cfg):
             stages.begin("spin-up", "spin-up and frozen sensitivities")
-            metrics["spinup"], sims, sens = judge_spinup(  # LPV against μ: P3 Fig. 11
+            spinup, sims, sens = judge_spinup(  # LPV against μ: P3 Fig. 11
                 cfg, {d.method: d.controller for d in designs if d.method in ("mu", "lpv")})
             figs += spinup_figures(out, sims, sens, cfg.operating.speed_range_hz)
             stages.step()
         if cfg.design.tracked and truth_cfg is not None:
             stages.begin("ramp", "0 → 3× nominal pressure on the virtual facility")
-            metrics["ramp"], fig = tracked_ramp(cfg, truth_cfg, designs, digitals, ident, out,
-                                                say)
+            ramp, fig = tracked_ramp(cfg, truth_cfg, designs, digitals, ident, out, say)
             figs.append(fig)
+        metrics = RunMetrics(
+            schema_version=SCHEMA_VERSION, rig=str(rig_path), rig_name=cfg.rotor.name,
+            open_loop=OpenLoop([[float(z.real), float(z.imag)] for z in unstable],
+                               full.n_states, n_reduced),
+            unbalance=settings.unbalance_dict(), design_spec=spec.to_dict(),
+            controllers={m: ControllerSummary.from_dict(s) for m, s in summaries.items()},
+            cannot_run=cannot_run, cases=cases,
+            identification=None if ident is None else ident.summary, spinup=spinup,
+            ramp=ramp).to_dict()
         stages.begin("report")
         write_json(out / "metrics.json", metrics)
         figs.append(gains_figure(out, [(d.method, frozen_at(d.controller, cfg.operating,

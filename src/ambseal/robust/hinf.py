@@ -245,6 +245,11 @@ class HinfResult:
         """Number of controller states."""
         return int(self.K.nstates)
 
+    def __iter__(self):
+        """``K, CL, gamma, info = hinfsyn(P, nmeas, ncon)``, as python-control's
+        ``hinfsyn`` returns (controller, closed loop, γ, and this result for the rest)."""
+        return iter((self.K, self.closed_loop, self.gamma, self))
+
     def to_dict(self) -> dict:
         """JSON-ready summary (matrices as nested lists)."""
         K = self.K

@@ -43,7 +43,7 @@ import numpy as np
 
 from ambseal.design.lpv_plant import lpv_plant, vertex_grid_hz
 from ambseal.design.plant import generalized_plant, physical_controller, physical_matrices
-from ambseal.design.recipes import full_order_check
+from ambseal.design.recipes import bound_text, full_order_check
 from ambseal.design.specs import design_spec
 from ambseal.design.weights import Weights, default_weights
 from ambseal.errors import ConfigError, SynthesisError
@@ -148,7 +148,21 @@ class LpvDesign(ScheduledController):
                 "weights": self.weights.to_dict(),
                 "reports": [r.to_dict() for r in self.reports],
                 "synthesis_s": round(self.synthesis_s, 3),
-                "elapsed_s": round(self.elapsed_s, 3), "full_order": self.full_order}
+                "elapsed_s": round(self.elapsed_s, 3), "full_order": self.full_order,
+                "verdict": self.verdict}
+
+    @property
+    def verdict(self) -> str:
+        """One plain line: the LMI bound over the scheduled range, the frozen loops, and
+        the full-order stability."""
+        lo, hi = float(self.speeds_hz.min()), float(self.speeds_hz.max())
+        stab = ("full-order loop stable at every judged condition"
+                if self.full_order is None or self.full_order["stable"] else
+                f"FULL-ORDER LOOP UNSTABLE at {self.full_order['mode_hz']:.4g} Hz, "
+                f"{self.full_order['speed_hz']:g} Hz speed (accepted with allow_unstable)")
+        return (f"LPV γ = {bound_text(self.gamma)} over {lo:g}–{hi:g} Hz ({self.lyapunov} "
+                f"Lyapunov function), frozen loops γ ≤ {float(np.max(self.check_gamma)):.3g}"
+                f"; {stab}")
 
 
 @dataclass(frozen=True, eq=False)

@@ -72,7 +72,7 @@ from ambseal.robust.hinf import hinfsyn
 from ambseal.robust.loop import judged_loop
 from ambseal.robust.order import reduce_controller
 
-__all__ = ["DesignResult", "design", "full_order_check", "METHODS"]
+__all__ = ["DesignResult", "design", "full_order_check", "bound_text", "METHODS"]
 
 METHODS = ("pid", "hinf", "mu")
 #: the automatic controller order keeps μ (H∞: γ) of the design loop within this fraction
@@ -500,10 +500,19 @@ def _verdict(method, r: _Synthesis, check) -> str:
     if method == "hinf":
         return f"H∞ γ = {r.gamma:.3g} on the nominal design model; {stab}"
     if r.mu is not None and r.mu <= 1:
-        return f"robust performance met: μ = {r.mu:.3g} ≤ 1 on the design model; {stab}"
+        return (f"robust performance met: μ = {bound_text(r.mu)} ≤ 1 on the design model; "
+                f"{stab}")
     by = _dominant_weight(r)
-    return (f"robust performance NOT met: μ = {r.mu:.3g} > 1 (the demand is missed by "
-            f"{100 * (r.mu - 1):.0f} %){by}; {stab}")
+    return (f"robust performance NOT met: μ = {bound_text(r.mu)} > 1: missed by "
+            f"{100 * (r.mu - 1):.2g} %{by}; {stab}")
+
+
+def bound_text(x: float) -> str:
+    """A bound compared with 1 (μ, γ) in enough digits to be true on its side of 1:
+    1.004 and 0.9995, never "1 > 1"."""
+    gap = abs(x - 1.0)
+    digits = 3 if gap >= 0.05 else 4 if gap >= 5e-3 else 5 if gap >= 5e-4 else 7
+    return f"{x:.{digits}g}"
 
 
 def _dominant_weight(r: _Synthesis) -> str:

@@ -158,11 +158,11 @@ class Page:
         pass
 
     def _matlab(self, body, where):
-        octave = shutil.which("octave-cli")
+        octave = _octave()
         if octave is None:
-            return  # the .mat files are checked in Octave by tests/test_cli_export.py
+            return  # tests/robust/test_robust_digital.py checks the .mat in Octave too
         script = "pkg load control\n" + body
-        r = subprocess.run([octave, "--no-gui", "--quiet", "--eval", script],
+        r = subprocess.run([octave, "--no-gui", "-q", "--eval", script],
                            cwd=self.folder, capture_output=True, text=True, timeout=120)
         assert r.returncode == 0, f"{where}: octave: {r.stderr}"
 
@@ -212,6 +212,16 @@ class Page:
         shutil.copytree(src, self.folder / out, dirs_exist_ok=True)
         self.ran.append(" ".join(["ambseal", *argv]))
         return True
+
+
+def _octave() -> str | None:
+    """octave-cli with its control package, or None."""
+    exe = shutil.which("octave-cli")
+    if exe is None:
+        return None
+    r = subprocess.run([exe, "--no-gui", "-q", "--eval", "pkg load control; disp(4242)"],
+                       capture_output=True, text=True, timeout=120)
+    return exe if r.returncode == 0 and "4242" in r.stdout else None
 
 
 def _run_page(path: Path, tmp_path, monkeypatch, request, slow: bool) -> Page:

@@ -23,6 +23,7 @@ the real functions.
 from __future__ import annotations
 
 import contextlib
+import json
 import sys
 from pathlib import Path
 
@@ -217,3 +218,62 @@ def testrig_tracked(testrig_cfg, tmp_path_factory):
     from ambseal.design.seal_schedule import design_seal_scheduled
 
     return design_seal_scheduled(testrig_cfg)
+
+
+def _on_a_terminal(argv: list[str], columns: int = 150) -> tuple[int, str]:
+    """``main(argv)`` with stdout and stderr on a pseudo-terminal (POSIX ``pty``) of
+    ``columns`` × 50; its exit status and everything the terminal received."""
+    import fcntl
+    import os
+    import pty
+    import struct
+    import sys
+    import termios
+    import threading
+
+    from ambseal.cli import main
+
+    master, slave = pty.openpty()
+    fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 50, columns, 0, 0))
+    tty = os.fdopen(slave, "w", buffering=1, encoding="utf-8")
+    chunks: list[bytes] = []
+
+    def pump():
+        while True:
+            try:
+                data = os.read(master, 65536)
+            except OSError:
+                return
+            if not data:
+                return
+            chunks.append(data)
+
+    reader = threading.Thread(target=pump, daemon=True)
+    reader.start()
+    old = sys.stdout, sys.stderr
+    sys.stdout = sys.stderr = tty
+    try:
+        code = main(argv)
+    finally:
+        sys.stdout, sys.stderr = old
+        tty.close()
+        reader.join(timeout=10)
+        os.close(master)
+    return code, b"".join(chunks).decode("utf-8", "replace")
+
+
+@pytest.fixture(scope="session")
+def terminal_run(tmp_path_factory, request, design_cache_for):
+    """``ambseal run`` on the embedded rig on a pseudo-terminal, with the session's PID
+    (the same call ``run`` makes, computed once). H∞ and μ are designed on the rig
+    identified from the virtual facility, so not from the cache. Once per session: the
+    main-job tests (tests/test_pipeline.py) and the manual's ``ambseal run`` block
+    (tests/test_docs.py) read the same folder."""
+    out = tmp_path_factory.mktemp("run")
+    cache = design_cache_for(request)
+    with cache.patched("testrig"):
+        code, screen = _on_a_terminal(["run", "--out", str(out)])
+    assert code == 0, screen
+    assert {"design:pid", "digital:pid"} <= set(cache.hits)
+    assert not {"design:hinf", "design:mu"} & set(cache.hits)
+    return out, json.loads((out / "metrics.json").read_text()), screen

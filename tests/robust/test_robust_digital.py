@@ -240,11 +240,12 @@ def _octave() -> str | None:
                     "where it can)")
 def test_mat_export_is_an_ss_in_octave(testrig_digital, tmp_path):
     """Reference: GNU Octave's control package (peer implementation of MATLAB's ``ss``):
-    the one line documented in the README and the .mat (``pkg load control`` first) builds
-    a discrete ``ss`` with the file's Ts and channel names, whose step response (200
-    samples, every input) and frequency response (``freqresp`` at 5 frequencies up to
-    Nyquist) equal the Python discrete controller's recursion x[k+1] = A x + B y,
-    u = C x + D y and C (e^{jωT} I − A)⁻¹ B + D to 1e-9 of their largest value."""
+    the one line documented in the manual (docs/deploying.md) and the .mat (``pkg load
+    control`` first) builds a discrete ``ss`` with the file's Ts and channel names, whose
+    step response (200 samples, every input) and frequency response (``freqresp`` at 5
+    frequencies up to Nyquist) equal the Python discrete controller's recursion
+    x[k+1] = A x + B y, u = C x + D y and C (e^{jωT} I − A)⁻¹ B + D to 1e-9 of their
+    largest value."""
     from ambseal.export.controller_files import MATLAB_LINE
 
     dc = testrig_digital["hinf"]

@@ -19,25 +19,25 @@ C_K, D_K)(Ω) from the scheduled controller (``matrices_at``: the LPV table inte
 linearly between its speeds) or constant for a fixed controller, i = −C_K x_K − D_K y.
 
 ``scipy.integrate.solve_ivp`` on the continuous loop, Ω(t) exact at every instant. Solver ``"LSODA"`` (switches between Adams and BDF by itself — the loop
-  holds lightly damped bending modes next to fast, stiff poles; ``"BDF"`` and ``"Radau"``
-  give the same steps, 10–50 % slower), with the exact Jacobian A_cl(Ω(t)) passed (the
-  system is linear in x at fixed t). Step sizes are the solver's own (no ``max_step``: the
-  dense output, not the step, samples the 10 µs grid).
-  Tolerances: ``rtol = 1e-6``; ``atol = 1e-6`` × each state's scale, its largest |x_i| in the
-  frozen start-speed loop's responses to the force and to the output step (states are in
-  m, m/s, A and controller units, so one absolute tolerance would be too loose for some
-  and too tight for others). Tightening both to 1e-9 moves the step peaks by < 1e-7
-  relative and the settling times by < 1e-5 ms. The steps are discontinuities of v (and
-  an output step jumps y, hence the controller input, at once): a multistep solver
-  integrating across one would cut its step and order blindly and smear the jump, so the
-  solver is **restarted at every step**, each 50 ms window integrated from the previous
-  window's final state with its own constant v. The solution is read on the output grid
-  (``dt``, 10 µs; the solver's dense output) so peaks and settling times are computed on
-  samples. Speed: A_cl, B_cl, C_u, D_K are tabulated every ``schedule_s`` along the
-  ramp and blended linearly in t wherever the loop is affine in Ω (the plant is affine or
-  linear between grid speeds, the LPV table linear between its speeds; checked at each
-  interval's midpoint), evaluated exactly on the intervals holding a table speed — exact
-  up to rounding, and ≈ 1.5 s per spin-up instead of ≈ 9 s.
+holds lightly damped bending modes next to fast, stiff poles; ``"BDF"`` and ``"Radau"``
+give the same steps, 10–50 % slower), with the exact Jacobian A_cl(Ω(t)) passed (the
+system is linear in x at fixed t). Step sizes are the solver's own (no ``max_step``: the
+dense output, not the step, samples the 10 µs grid).
+Tolerances: ``rtol = 1e-6``; ``atol = 1e-6`` × each state's scale, its largest |x_i| in the
+frozen start-speed loop's responses to the force and to the output step (states are in
+m, m/s, A and controller units, so one absolute tolerance would be too loose for some
+and too tight for others). Tightening both to 1e-9 moves the step peaks by < 1e-7
+relative and the settling times by < 1e-5 ms. The steps are discontinuities of v (and
+an output step jumps y, hence the controller input, at once): a multistep solver
+integrating across one would cut its step and order blindly and smear the jump, so the
+solver is **restarted at every step**, each 50 ms window integrated from the previous
+window's final state with its own constant v. The solution is read on the output grid
+(``dt``, 10 µs; the solver's dense output) so peaks and settling times are computed on
+samples. Speed: A_cl, B_cl, C_u, D_K are tabulated every ``schedule_s`` along the
+ramp and blended linearly in t wherever the loop is affine in Ω (the plant is affine or
+linear between grid speeds, the LPV table linear between its speeds; checked at each
+interval's midpoint), evaluated exactly on the intervals holding a table speed — exact
+up to rounding, and ≈ 1.5 s per spin-up instead of ≈ 9 s.
 At a constant speed the loop is time-invariant, and the result equals python-control's
 ``forced_response`` of the frozen loop (``tests/analysis/test_analysis_spinup.py``).
 

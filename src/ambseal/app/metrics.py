@@ -154,9 +154,32 @@ class RunMetrics:
         return d
 
 
+def _described(node: dict) -> None:
+    """A type's description: its docstring's first paragraph; its properties' from the
+    docstring's numpydoc ``Attributes`` section (``name : type`` then indented text)."""
+    doc = node.get("description") or ""
+    node["description"] = " ".join(doc.split("\n\n")[0].split())
+    attrs = doc.split("Attributes\n----------\n", 1)[1] if "Attributes\n---" in doc else ""
+    texts: dict[str, list[str]] = {}
+    names: list[str] = []
+    for line in attrs.splitlines():
+        if line and not line.startswith(" "):
+            names = [n.strip() for n in line.split(":")[0].split(",")]
+            for n in names:
+                texts[n] = []
+        elif line.strip():
+            for n in names:
+                texts[n].append(line.strip())
+    for name, prop in node.get("properties", {}).items():
+        if texts.get(name):
+            prop["description"] = " ".join(texts[name])
+
+
 def metrics_schema() -> dict:
     """The JSON Schema (draft 2020-12) of :class:`RunMetrics`' JSON form."""
     schema = TypeAdapter(RunMetrics).json_schema(mode="serialization")
+    for node in [schema, *schema["$defs"].values()]:
+        _described(node)
     summary = schema["$defs"]["ControllerSummary"]  # details are written beside the rest
     summary["properties"].pop("details")
     summary["additionalProperties"] = True

@@ -52,6 +52,7 @@ from ambseal.errors import ConfigError
 __all__ = ["DEFAULT_UNCERTAINTY", "ErrorBudget", "fixed_uncertainty", "propagate", "kind_of"]
 
 #: Relative 1σ of a value the fit holds fixed, per kind, when the rig file states none.
+#:
 #: - ``force_factor`` (Ki, Ks not fitted) 5 %: the thesis's repeated tests scatter by
 #:   1.1–2.4 % (P2 Table 2), and a value from the AMB's geometry misses saturation and
 #:   leakage by more;

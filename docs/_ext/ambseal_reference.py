@@ -1,0 +1,722 @@
+"""The manual's generated references, as reStructuredText, from the code itself.
+
+* :func:`rig_keys_rst` — every key of the rig file and the truth file, walked from the
+  pydantic models of :mod:`ambseal.config` (type, default and bounds from the models; the
+  derived ``[design]`` defaults and their rules from :func:`ambseal.design.specs.design_spec`
+  on the embedded rig; unit and meaning from :data:`KEY_DOCS`, which must name exactly the
+  models' fields — a field without an entry, or an entry without a field, stops the build);
+* :func:`cli_rst` — every command and option of ``ambseal``, from :mod:`ambseal.cli`'s
+  argparse parser;
+* :func:`json_schema_rst` — a JSON Schema file rendered as a table of its properties, or a
+  note that it is not shipped yet.
+
+Pure Python (no Sphinx import), so that the tests can compare the pages with the code.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import tomllib
+import types
+import typing
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from pydantic import BaseModel
+
+# ---------------------------------------------------------------------------------------
+# Rig-file keys
+# ---------------------------------------------------------------------------------------
+
+#: Unit and meaning of every field of the configuration models, keyed ``Class.field``
+#: (inherited fields under the class that declares them). The only hand-written part of
+#: the key reference; :func:`missing_key_docs` checks it against the models.
+KEY_DOCS: dict[str, tuple[str, str]] = {
+    # [rotor]
+    "Rotor.beam": ("", "beam theory of the shaft elements (Timoshenko: shear and rotary "
+                       "inertia; Euler–Bernoulli: neither)"),
+    "Rotor.name": ("", "the machine's name, in every output and the report header"),
+    "Rotor.modal_damping": ("", "damping ratio ζ given to every free–free bending mode of "
+                                "shaft and disks (structural damping)"),
+    # [materials.NAME]
+    "Material.E": ("Pa", "Young's modulus"),
+    "Material.rho": ("kg/m³", "density"),
+    "Material.G": ("Pa", "shear modulus; give G or nu (both: they must agree within 1 %)"),
+    "Material.nu": ("", "Poisson's ratio; give G or nu"),
+    # [[shaft]]
+    "ShaftSection.length": ("m", "length of the section; sections follow each other from "
+                                 "the shaft's left end (z = 0)"),
+    "ShaftSection.outer_diameter": ("m", "outer diameter"),
+    "ShaftSection.inner_diameter": ("m", "bore (0: solid); less than outer_diameter"),
+    "ShaftSection.material": ("", "a NAME of ``[materials.NAME]``"),
+    "ShaftSection.elements": ("", "beam elements in the section (at most 150 in the whole "
+                                  "shaft)"),
+    # [[disk]]
+    "Disk.position": ("m", "axial position from the shaft's left end"),
+    "Disk.mass": ("kg", "mass of the rigid disk (impeller, lamination stack, sleeve, hub)"),
+    "Disk.Ip": ("kg·m²", "polar moment of inertia (gyroscopics)"),
+    "Disk.Id": ("kg·m²", "diametral (transverse) moment of inertia"),
+    "Disk.name": ("", "a name for outputs and for ``[design.unbalance] force_at``"),
+    # [[amb]]
+    "Amb.name": ("", "the bearing's name: it names the channels (``A_zeta``) and the "
+                     "parameters (``A.Ki_zeta``); no '.', ',' or spaces"),
+    "Amb.position": ("m", "axial position of the actuator"),
+    "Amb.sensor_position": ("m", "axial position of its displacement sensors (non-"
+                                 "collocated when it differs from position)"),
+    "Amb.axes_angle_deg": ("°", "actuator axes ζ, η rotated from x, y by this angle"),
+    "Amb.turns": ("", "windings per pole (geometry)"),
+    "Amb.pole_area": ("m²", "pole face area (geometry)"),
+    "Amb.air_gap": ("m", "nominal air gap (geometry); also sets the design scaling D_e"),
+    "Amb.bias_current": ("A", "bias current (geometry); also sets D_u and the impulse"),
+    "Amb.pole_angle_deg": ("°", "half the angle between the two poles of a pole pair "
+                               "(8-pole heteropolar bearing: 22.5)"),
+    "Amb.ki": ("N/A", "current gain Ki, a number or ``{ zeta, eta }``; wins over the "
+                      "geometry's; Ki > 0"),
+    "Amb.ks": ("N/m", "negative-stiffness magnitude Ks (f = Ki i + Ks x), a number or "
+                      "``{ zeta, eta }``; Ks ≥ 0"),
+    "Amb.current_limit": ("A", "amplifier current limit (clipping check, orbit against "
+                               "force capacity)"),
+    "Amb.backup_clearance": ("m", "radial clearance of the backup bearing beside the AMB; "
+                                  "the report sets the unbalance orbit against it"),
+    "Amb.uncertainty": ("", "``{ key = σ }``: relative 1σ uncertainty of a value the fit "
+                            "holds fixed (e.g. ``ki = 0.02``)"),
+    # { zeta, eta }
+    "AxisPair.zeta": ("as the key", "value on the ζ axis"),
+    "AxisPair.eta": ("as the key", "value on the η axis"),
+    # [actuator]
+    "Actuator.model": ("", "amplifier and coil from current reference to current"),
+    "Actuator.cutoff_hz": ("Hz", "corner of the first-order model (first_order only)"),
+    "Actuator.natural_frequency": ("rad/s", "ω_n of the second-order model (second_order "
+                                            "only)"),
+    "Actuator.damping_ratio": ("", "ζ of the second-order model (second_order only)"),
+    "Actuator.eddy_time_constant": ("s", "τ_e: first-order lag 1/(τ_e s + 1) between coil "
+                                         "current and force (eddy currents, P2 §4)"),
+    "Actuator.uncertainty": ("", "``{ key = σ }``: relative 1σ uncertainty of a value the "
+                                 "fit holds fixed"),
+    # [[seal]]
+    "Seal.name": ("", "the seal's name: it names its parameters (``seal.k``)"),
+    "Seal.position": ("m", "axial position"),
+    "Seal.K": ("N/m", "direct stiffness (Childs: −f = [K k; −k K] q + [C c; −c C] q̇ + M q̈)"),
+    "Seal.k": ("N/m", "cross-coupled stiffness: the destabilising term"),
+    "Seal.C": ("N·s/m", "direct damping"),
+    "Seal.c": ("N·s/m", "cross-coupled damping"),
+    "Seal.M": ("kg", "direct added mass"),
+    "Seal.uncertainty": ("", "``{ key = σ }``: relative 1σ uncertainty of a value the fit "
+                             "holds fixed"),
+    # { at_zero, per_bar }
+    "Affine.at_zero": ("as the key", "value at zero pressure drop"),
+    "Affine.per_bar": ("as the key, per bar", "rise per bar of pressure drop"),
+    # { frequency_hz, value }
+    "FrequencyTable.frequency_hz": ("Hz", "excitation frequencies, strictly increasing"),
+    "FrequencyTable.value": ("as the key", "the coefficient at each frequency; linear "
+                                           "between, held outside; evaluated at the "
+                                           "synchronous frequency"),
+    # [[spring]]
+    "Spring.position": ("m", "axial position (coupling, plain bearing, support)"),
+    "Spring.kxx": ("N/m", "direct stiffness in the spring's x axis"),
+    "Spring.kyy": ("N/m", "direct stiffness in the spring's y axis"),
+    "Spring.kxy": ("N/m", "cross-coupled stiffness"),
+    "Spring.kyx": ("N/m", "cross-coupled stiffness"),
+    "Spring.cxx": ("N·s/m", "direct damping"),
+    "Spring.cyy": ("N·s/m", "direct damping"),
+    "Spring.axes_angle_deg": ("°", "the axes the coefficients are given in, rotated from "
+                                   "x, y"),
+    "Spring.name": ("", "names its parameters (``coupling.kxx``); unnamed: ``spring<i>``"),
+    "Spring.uncertainty": ("", "``{ key = σ }``: relative 1σ uncertainty of a value the fit "
+                               "holds fixed"),
+    # [controller], [controller.pid]
+    "Controllers.pid": ("", "the reference PID; without it, derived from the rig "
+                            "(``ambseal.design.pid.pid_from_rig``)"),
+    "Controllers.sample_rate_hz": ("Hz", "the digital controller's sample rate f_s"),
+    "Controllers.delay_samples": ("samples", "computation delay of the target in whole "
+                                             "samples (1: output of sample k applied at "
+                                             "k + 1)"),
+    "Pid.kp": ("A/m", "proportional gain (thesis P5 Eq. 6), per actuator axis"),
+    "Pid.ti": ("s", "integral time T_i"),
+    "Pid.td": ("s", "derivative time T_d"),
+    "Pid.eps": ("", "derivative filter ε: the filter's time constant is ε T_d"),
+    # [operating]
+    "Operating.speed_rpm": ("rpm", "operating speed"),
+    "Operating.pressure_bar": ("bar", "nominal pressure drop across the seals"),
+    "Operating.speed_range_hz": ("Hz", "``[low, high]`` operating speed range: schedules "
+                                       "the LPV controller and sets the unbalance band; it "
+                                       "must hold speed_rpm"),
+    # [reduction]
+    "Reduction.states": ("", "states of the reduced model (give states or cutoff_hz; "
+                             "neither: 8)"),
+    "Reduction.cutoff_hz": ("Hz", "keep the modes below this frequency instead"),
+    # [design]
+    "Design.d_e_um": ("µm", "D_e: largest allowed displacement error, scales the error "
+                            "channels (P5 §3.1.4)"),
+    "Design.d_u_a": ("A", "D_u: largest allowed current change, scales the current "
+                          "channels"),
+    "Design.model_states": ("", "mechanical states of the design model (even)"),
+    "Design.model_cutoff_hz": ("Hz", "or: every mode below this frequency"),
+    "Design.band_hz": ("Hz", "``[low, high]``: synthesis (μ grid) and judgement band"),
+    "Design.order_max": ("", "controller order limit (balanced truncation above it); "
+                             "left out: the design model's states plus W_p's and W_u's, "
+                             "raised by one per channel while the reduction costs more "
+                             "than 10 % of γ or μ"),
+    "Design.pressures_bar": ("bar", "pressure drops every controller is judged at"),
+    "Design.speeds_hz": ("Hz", "speeds every controller is judged at"),
+    "Design.unbalance": ("", "the unbalance force (table below)"),
+    "Design.impulse": ("", "the current impulse of the time response (table below)"),
+    "Design.uncertainty": ("", "real uncertain parameters of μ (array of tables below)"),
+    "Design.uncertainty_from_identification": ("", "path of a ``fit.json`` of ``ambseal "
+                                                   "identify`` (relative to the rig file): "
+                                                   "its 95 % intervals become μ ranges"),
+    "Design.hinf": ("", "H∞ weights (table below)"),
+    "Design.mu": ("", "μ weights and D–K settings (table below)"),
+    "Design.lpv": ("", "LPV weights (table below)"),
+    "Design.tracked": ("", "``ambseal run`` adds the controller scheduled on the tracked "
+                           "seal k (LMI synthesis: minutes)"),
+    "UnbalanceSpec.grade_mm_s": ("mm/s", "ISO 21940-11 balance grade G"),
+    "UnbalanceSpec.mass_kg": ("kg", "mass m of the force law (left out: the assembled "
+                                    "rotor mass)"),
+    "UnbalanceSpec.law": ("", "``iso21940``: F = m G Ω²/Ω_max; ``constant_velocity``: "
+                              "F = m G Ω"),
+    "UnbalanceSpec.max_speed_hz": ("Hz", "maximum service speed Ω_max/2π at which the "
+                                         "grade holds"),
+    "UnbalanceSpec.force_at": ("", "seal, disk, AMB or spring where the force acts and the "
+                                   "compliance is taken"),
+    "UnbalanceSpec.range_hz": ("Hz", "``[low, high]`` speeds of the unbalance response"),
+    "ImpulseSpec.amplitude_a": ("A", "current impulse amplitude (P5 §5.1)"),
+    "ImpulseSpec.duration_s": ("s", "current impulse duration"),
+    "UncertainSpec.parameter": ("", "an LFT parameter name: ``<seal>.k``, ``A.Ks_zeta``, "
+                                    "``coupling.kxx``, …"),
+    "UncertainSpec.relative": ("", "± this fraction of the nominal value (1.0: ± 100 %)"),
+    "UncertainSpec.low": ("SI", "lower end (with high, instead of relative)"),
+    "UncertainSpec.high": ("SI", "upper end"),
+    "MethodSpec.M": ("", "W_p: high-frequency bound of the sensitivity (P5 Eq. 7)"),
+    "MethodSpec.omega_b_rad_s": ("rad/s", "W_p: bandwidth ω_B"),
+    "MethodSpec.A": ("", "W_p: low-frequency sensitivity bound (integral action)"),
+    "MethodSpec.wu_gain": ("", "W_u: gain on the scaled current"),
+    "MethodSpec.wu_corner_hz": ("Hz", "W_u: corner of a high-pass W_u"),
+    "MethodSpec.wu_hf_gain": ("", "W_u: high-frequency gain (> wu_gain)"),
+    "MethodSpec.w1_gain": ("", "W_1: input-disturbance weight"),
+    "MethodSpec.w1_corner_hz": ("Hz", "W_1: corner frequency"),
+    "MethodSpec.orbit_um": ("µm", "unbalance-orbit demand (0: off)"),
+    "MethodSpec.wf_rolloff_hz": ("Hz", "roll-off of the unbalance-force weight W_f"),
+    "MuSpec.max_iter": ("", "D–K iterations at most"),
+    "MuSpec.dk_order": ("", "order of the fitted D scales"),
+    "MuSpec.iteration": ("", "``dgk``: D–G–K, real parameters kept real (Young 1996); "
+                             "``dk``: complex D–K as the thesis"),
+    "MuSpec.gain_factor": ("", "W_K: controller gain within this factor × 3 × the PID's "
+                               "over gain_band_hz (0: off)"),
+    "MuSpec.gain_band_hz": ("Hz", "``[low, high]`` band of the gain demand W_K"),
+    # truth file
+    "TruthSection.parameters": ("SI", "true values of model parameters (``A.Ki_zeta``, "
+                                      "``seal.k``, …): a number or ``{ at_zero, per_bar }``"),
+    "TruthSection.tau_e": ("s", "true eddy-current lag"),
+    "TruthSection.bias_current": ("A", "bias current of the nonlinear force law"),
+    "TruthSection.current_limit": ("A", "amplifier saturation (default the AMBs')"),
+    "TruthSection.sensor_noise_m": ("m", "sensor noise standard deviation"),
+    "TruthSection.noise_fraction": ("", "or: noise std as a fraction of each channel's RMS"),
+    "TruthSection.current_noise_a": ("A", "current measurement noise std"),
+    "TruthSection.adc_bits": ("bits", "ADC resolution of the displacement sensors"),
+    "TruthSection.adc_range_m": ("m", "ADC range: quantisation step range/2^bits"),
+    "TruthSection.substeps": ("", "integration steps per controller sample"),
+    "TruthSection.max_mode_hz": ("Hz", "modes kept in the simulation"),
+    "TruthSection.beam": ("", "model-form difference: the facility's beam theory"),
+    "TruthSection.mesh_factor": ("", "model-form difference: elements per section × this"),
+    "TruthSection.modal_damping": ("", "model-form difference: the rotor's ζ"),
+    "TruthSection.sensor_filter_hz": ("Hz", "model-form difference: a first-order low-pass "
+                                            "in every sensor, absent from the model"),
+}
+
+
+@dataclass
+class KeyRow:
+    """One key of one table of the file."""
+
+    table: str          # "[[amb]]", "[design.mu]", "{ zeta, eta }", ...
+    key: str
+    type: str
+    default: str
+    unit: str
+    meaning: str
+    bounds: str = ""
+    rule: str = ""
+
+
+@dataclass
+class Section:
+    table: str
+    model: type
+    intro: str = ""
+    rows: list[KeyRow] = field(default_factory=list)
+
+
+def _models():
+    from ambseal.config import rig as r
+    from ambseal.config import design as d
+
+    return r, d
+
+
+def _is_model(t) -> bool:
+    return isinstance(t, type) and issubclass(t, BaseModel)
+
+
+def _args(ann) -> tuple:
+    """The members of a union (``X | Y``, ``Optional``, ``Annotated`` unwrapped)."""
+    origin = typing.get_origin(ann)
+    if origin is typing.Annotated:
+        return _args(typing.get_args(ann)[0])
+    if origin in (typing.Union, types.UnionType):
+        out = ()
+        for a in typing.get_args(ann):
+            out += _args(a)
+        return out
+    return (ann,)
+
+
+def _type_text(ann) -> str:
+    """A TOML reader's name for an annotation."""
+    r, _ = _models()
+    names = []
+    for a in _args(ann):
+        if a is type(None):
+            continue
+        origin = typing.get_origin(a)
+        if a is float:
+            names.append("number")
+        elif a is int:
+            names.append("integer")
+        elif a is bool:
+            names.append("true/false")
+        elif a is str:
+            names.append("string")
+        elif origin is typing.Literal:
+            names.append(" | ".join(f'``"{v}"``' for v in typing.get_args(a)))
+        elif origin is tuple:
+            names.append("``[low, high]``")
+        elif origin is list:
+            inner = typing.get_args(a)[0]
+            names.append("array of tables" if _is_model(inner) else "array of numbers")
+        elif origin is dict:
+            val = typing.get_args(a)[1]
+            names.append("``{ name = table }``" if _is_model(val) else "``{ key = number }``")
+        elif a is r.AxisPair:
+            names.append("``{ zeta, eta }``")
+        elif a is r.Affine:
+            names.append("``{ at_zero, per_bar }``")
+        elif a is r.FrequencyTable:
+            names.append("``{ frequency_hz, value }``")
+        elif _is_model(a):
+            names.append("table")
+        else:  # pragma: no cover - a new kind of annotation: say so in the build
+            raise TypeError(f"rig-key reference: no name for the annotation {a!r}")
+    return " or ".join(names)
+
+
+def _num(x) -> str:
+    if isinstance(x, bool):
+        return "true" if x else "false"
+    if isinstance(x, float):
+        return f"{x:g}".replace("e+0", "e").replace("e+", "e").replace("e-0", "e-")
+    return str(x)
+
+
+def _bounds(info) -> str:
+    out = []
+    for m in info.metadata:
+        for attr, sym in (("ge", "≥"), ("gt", ">"), ("le", "≤"), ("lt", "<")):
+            v = getattr(m, attr, None)
+            if v is not None and not (isinstance(v, (int, float)) and abs(v) >= 1e12):
+                out.append(f"{sym} {_num(v)}")
+        if getattr(m, "min_length", None) is not None and m.min_length > 1:
+            out.append(f"at least {m.min_length} items")
+        if getattr(m, "pattern", None):
+            out.append("no '.', ',' or spaces")
+    return ", ".join(out)
+
+
+def _default(info) -> str:
+    if info.is_required():
+        return "required"
+    d = info.default
+    if d is None:
+        return "none"
+    if _is_model(type(d)):
+        return "—"
+    if isinstance(d, (list, dict)) and not d:
+        return "none"
+    return f"``{_num(d)}``" if not isinstance(d, str) else f'``"{d}"``'
+
+
+def _doc(cls, name: str) -> tuple[str, str]:
+    for c in cls.__mro__:
+        key = f"{c.__name__}.{name}"
+        if key in KEY_DOCS:
+            return KEY_DOCS[key]
+    raise KeyError(f"{cls.__name__}.{name}")
+
+
+def _sections() -> list[Section]:
+    """The tables of a rig file and of a truth file, in the order a file has them."""
+    r, d = _models()
+    return [
+        Section("[rotor]", r.Rotor),
+        Section("[materials.NAME]", r.Material, "One table per material; NAME is what "
+                "``[[shaft]] material`` refers to."),
+        Section("[[shaft]]", r.ShaftSection, "One table per shaft section, left to right; "
+                "at least one."),
+        Section("[[disk]]", r.Disk, "Rigid disks: impellers, lamination stacks, sleeves, "
+                "hubs."),
+        Section("[[amb]]", r.Amb, "One table per radial bearing: either the geometry "
+                "(``turns``, ``pole_area``, ``air_gap``, ``bias_current``) or both ``ki`` "
+                "and ``ks`` (a factor given explicitly wins over the geometry's; with ki "
+                "and ks, ``air_gap`` and ``bias_current`` alone set the design scalings)."),
+        Section("[actuator]", r.Actuator, "Amplifier, coil and eddy currents, the same for "
+                "every axis."),
+        Section("[[seal]]", r.Seal, "Each coefficient is a number, ``{ at_zero, per_bar }`` "
+                "(affine in the pressure drop) or ``{ frequency_hz, value }`` (a table "
+                "against excitation frequency, evaluated at the synchronous frequency)."),
+        Section("[[spring]]", r.Spring, "Couplings, plain bearings, supports."),
+        Section("[controller]", r.Controllers),
+        Section("[controller.pid]", r.Pid, "All four keys, or leave the table out."),
+        Section("[operating]", r.Operating),
+        Section("[reduction]", r.Reduction, "The reduced model of ``validate`` and the "
+                "identification; the design model is ``[design] model_states``."),
+        Section("[design]", d.Design, "What the controllers are asked for. Every key is "
+                "optional: a key left out is derived from the machine by the rule shown "
+                "(the value is the embedded test facility's with no ``[design]`` part)."),
+        Section("[design.unbalance]", d.UnbalanceSpec),
+        Section("[design.impulse]", d.ImpulseSpec),
+        Section("[[design.uncertainty]]", d.UncertainSpec, "Real uncertain parameters of "
+                "the μ design: ``relative``, or ``low`` and ``high``."),
+        Section("[design.hinf]", d.MethodSpec, "The same keys in ``[design.lpv]``, and in "
+                "``[design.mu]`` with the μ keys below."),
+        Section("[design.mu]", d.MuSpec, "Every key of ``[design.hinf]``, and:"),
+        Section("{ zeta, eta }", r.AxisPair, "A value per actuator axis (``ki``, ``ks``); "
+                "with the geometry one axis may be left out."),
+        Section("{ at_zero, per_bar }", r.Affine, "A coefficient affine in the pressure "
+                "drop p (bar): at_zero + per_bar · p."),
+        Section("{ frequency_hz, value }", r.FrequencyTable, "A seal coefficient tabulated "
+                "against excitation frequency, of equal lengths."),
+        Section("[truth]", r.TruthSection, "The truth file of the virtual test facility "
+                "(``ambseal acquire --truth``, ``ambseal run --truth``): a file of its own "
+                "that a fit never reads."),
+    ]
+
+
+def _design_defaults() -> tuple[dict, dict]:
+    """Resolved ``[design]`` values and rules of the embedded rig without a ``[design]``
+    part: ``({"mu.orbit_um": 10.0, ...}, {"mu.orbit_um": "0.5 D_e", ...})``."""
+    from ambseal.config import default_rig_path, parse_rig
+    from ambseal.design.specs import design_spec
+
+    data = tomllib.loads(default_rig_path().read_text(encoding="utf-8"))
+    data.pop("design", None)
+    spec = design_spec(parse_rig(data, "<embedded rig without [design]>"))
+    doc = tomllib.loads(spec.to_toml())["design"]
+    values: dict = {}
+
+    def flat(prefix, node):
+        for k, v in node.items():
+            if isinstance(v, dict):
+                flat(f"{prefix}{k}.", v)
+            else:
+                values[f"{prefix}{k}"] = v
+    flat("", doc)
+    return values, dict(spec.sources)
+
+
+_SHARED = {"MethodSpec"}  # classes whose section stands for several tables
+#: ``[design]`` tables and the prefixes of their keys in the resolved specification;
+#: the section of ``[design.hinf]`` stands for ``[design.lpv]`` and ``[design.mu]`` too.
+_DESIGN_PREFIXES = {"[design]": ("",), "[design.unbalance]": ("unbalance.",),
+                    "[design.impulse]": ("impulse.",), "[design.hinf]": ("hinf.", "mu.", "lpv."),
+                    "[design.mu]": ("mu.",)}
+_METHOD = {"hinf.": "H∞", "mu.": "μ", "lpv.": "LPV"}
+
+
+def _derived(prefixes, name, values, rules) -> tuple[str, str]:
+    """(default, rule) of a ``[design]`` key from the resolved specification."""
+    defaults, rule_texts = [], []
+    for pre in prefixes:
+        key = f"{pre}{name}"
+        v = values.get(key)
+        label = f"{_METHOD[pre]} " if len(prefixes) > 1 else ""
+        if v is not None and not (isinstance(v, list) and v and isinstance(v[0], dict)):
+            defaults.append(f"{label}``{_num(v)}``")
+        rule = rules.get(key) or rules.get(pre.rstrip(".")) if pre else rules.get(key)
+        if rule and rule != "set":
+            rule_texts.append(f"{label}{rule}")
+    return ", ".join(defaults), "; ".join(dict.fromkeys(rule_texts))
+
+
+def rig_key_sections(design_defaults: bool = True) -> list[Section]:
+    """Every table with its keys (own fields only for a subclass shown after its base)."""
+    values, rules = _design_defaults() if design_defaults else ({}, {})
+    out = []
+    for sec in _sections():
+        inherited = set()
+        for base in sec.model.__mro__[1:]:
+            if _is_model(base) and base.__name__ in _SHARED:
+                inherited |= set(base.model_fields)
+        for name, info in sec.model.model_fields.items():
+            if name in inherited:
+                continue
+            unit, meaning = _doc(sec.model, name)
+            default, rule = _default(info), ""
+            prefixes = _DESIGN_PREFIXES.get(sec.table)
+            if prefixes and not _is_model(type(info.default)):
+                value, rule = _derived(prefixes, name, values, rules)
+                if value:
+                    default = value
+                elif rule and info.default is None:
+                    default = "derived"
+            sec.rows.append(KeyRow(sec.table, name, _type_text(info.annotation), default,
+                                   unit, meaning, _bounds(info), rule))
+        out.append(sec)
+    return out
+
+
+def model_keys() -> set[tuple[str, str]]:
+    """``(table, key)`` of every field of every model of a rig or truth file, walked from
+    :class:`~ambseal.config.RigConfig` and :class:`~ambseal.config.TruthSection`
+    independently of :func:`rig_key_sections` (the test compares the two)."""
+    r, d = _models()
+    keys: set[tuple[str, str]] = set()
+    seen: set[type] = set()
+
+    def walk(model):
+        if model in seen:
+            return
+        seen.add(model)
+        for name, info in model.model_fields.items():
+            keys.add((model.__name__, name))
+            for a in _args(info.annotation):
+                for b in (a, *typing.get_args(a)):
+                    for c in _args(b):
+                        if _is_model(c):
+                            walk(c)
+    walk(r.RigConfig)
+    walk(r.TruthSection)
+    # RigConfig's own fields are the tables themselves, each a section of its own
+    return {k for k in keys if k[0] != "RigConfig"}
+
+
+def missing_key_docs() -> tuple[list[str], list[str]]:
+    """(fields without a :data:`KEY_DOCS` entry, entries without a field)."""
+    r, d = _models()
+    have = set()
+    for cls_name, name in model_keys():
+        cls = getattr(r, cls_name, None) or getattr(d, cls_name)
+        for c in cls.__mro__:
+            if name in getattr(c, "__annotations__", {}):
+                have.add(f"{c.__name__}.{name}")
+                break
+    return sorted(have - set(KEY_DOCS)), sorted(set(KEY_DOCS) - have)
+
+
+def _cell(text: str) -> list[str]:
+    return (text or " ").splitlines() or [" "]
+
+
+def rig_keys_rst(design_defaults: bool = True) -> str:
+    """The key reference: one list-table per table of the file."""
+    missing, stale = missing_key_docs()
+    if missing or stale:
+        raise ValueError(f"docs/_ext/ambseal_reference.py KEY_DOCS: fields without an "
+                         f"entry {missing}, entries without a field {stale}")
+    lines: list[str] = []
+    for sec in rig_key_sections(design_defaults):
+        title = sec.table
+        lines += [title, "~" * len(title), ""]
+        if sec.intro:
+            lines += [sec.intro, ""]
+        lines += [".. list-table::", "   :header-rows: 1", "   :widths: 22 30 48",
+                  "   :class: rig-keys", "",
+                  "   * - key", "     - type, default", "     - unit, meaning, rule"]
+        for row in sec.rows:
+            unit = f"[{row.unit}] " if row.unit else ""
+            more = f" Bounds: {row.bounds}." if row.bounds else ""
+            rule = f" Rule: {row.rule}." if row.rule else ""
+            text = f"{unit}{row.meaning}.{more}{_rst_escape(rule)}".replace("..", ".")
+            lines += [f"   * - ``{row.key}``", f"     - {row.type}; {row.default}",
+                      f"     - {text}"]
+        lines.append("")
+    return "\n".join(lines)
+
+
+def page_keys(rst: str) -> set[tuple[str, str]]:
+    """``(table, key)`` pairs listed by :func:`rig_keys_rst`'s text (for the tests)."""
+    r, d = _models()
+    table_model = {s.table: s.model.__name__ for s in _sections()}
+    keys, table = set(), None
+    text = rst.splitlines()
+    for i, line in enumerate(text):
+        if i + 1 < len(text) and set(text[i + 1]) == {"~"} and line in table_model:
+            table = table_model[line]
+        elif line.startswith("   * - ``") and table:
+            keys.add((table, line.split("``")[1]))
+    # a subclass's section lists its own keys; the inherited ones are its base's
+    for sec in _sections():
+        for base in sec.model.__mro__[1:]:
+            if _is_model(base) and base.__name__ in _SHARED:
+                keys |= {(sec.model.__name__, k) for t, k in set(keys) if t == base.__name__}
+    return keys
+
+
+# ---------------------------------------------------------------------------------------
+# Command line
+# ---------------------------------------------------------------------------------------
+
+def _parser() -> argparse.ArgumentParser:
+    from ambseal.cli import _parser as p  # the one parser `ambseal` runs
+
+    return p()
+
+
+def _subparsers(parser) -> dict[str, argparse.ArgumentParser]:
+    for a in parser._actions:
+        if isinstance(a, argparse._SubParsersAction):
+            return dict(a.choices)
+    return {}
+
+
+def _help_of(parser) -> dict[str, str]:
+    for a in parser._actions:
+        if isinstance(a, argparse._SubParsersAction):
+            return {c.dest: c.help or "" for c in a._choices_actions}
+    return {}
+
+
+def _option_rows(parser) -> list[tuple[str, str]]:
+    rows = []
+    for a in parser._actions:
+        if isinstance(a, (argparse._HelpAction, argparse._SubParsersAction)):
+            continue
+        if a.option_strings:
+            meta = ""
+            if a.nargs != 0:
+                meta = " " + (a.metavar or (("{" + ",".join(map(str, a.choices)) + "}")
+                                            if a.choices else a.dest.upper()))
+                if a.nargs == "?":
+                    meta = f" [{meta.strip()}]"
+            name = ", ".join(f"{o}{meta}" for o in a.option_strings)
+        else:
+            name = a.metavar or a.dest
+            name = {"?": f"[{name}]", "+": f"{name} ...", "*": f"[{name} ...]"}.get(
+                str(a.nargs), name)
+        text = (a.help or "").replace("%(default)s", str(a.default))
+        extra = []
+        if a.required and a.option_strings:
+            extra.append("required")
+        if a.default not in (None, False, [], argparse.SUPPRESS) \
+                and not isinstance(a, argparse._VersionAction):
+            extra.append(f"default: ``{a.default}``")
+        if extra:
+            text = f"{text} ({'; '.join(extra)})" if text else "; ".join(extra)
+        rows.append((name, text))
+    return rows
+
+
+def _rst_escape(text: str) -> str:
+    return text.replace("\\", "\\\\").replace("*", "\\*").replace("`", "\\`").replace(
+        "|", "\\|").replace("_ ", "\\_ ")
+
+
+def cli_rst() -> str:
+    """Every command of ``ambseal`` with its usage, description and options."""
+    p = _parser()
+    subs, helps = _subparsers(p), _help_of(p)
+    lines = ["Global options", "~~~~~~~~~~~~~~", "", "::", "",
+             "   " + p.format_usage().strip().replace("usage: ", ""), ""]
+    lines += _option_list(_option_rows(p))
+    lines += ["Commands", "~~~~~~~~", ""]
+    lines += [".. list-table::", "   :header-rows: 1", "   :widths: 25 75", "",
+              "   * - command", "     - what it does"]
+    for name in subs:
+        lines += [f"   * - :ref:`ambseal {name} <cli-{name}>`",
+                  f"     - {_rst_escape(helps.get(name, ''))}"]
+    lines.append("")
+    for name, sp in subs.items():
+        title = f"ambseal {name}"
+        lines += [f".. _cli-{name}:", "", title, "~" * len(title), ""]
+        usage = sp.format_usage().strip().replace("usage: ", "")
+        lines += ["::", ""] + ["   " + u for u in _wrap_usage(usage)] + [""]
+        desc = sp.description or helps.get(name, "")
+        if desc:
+            lines += [_rst_escape(" ".join(desc.split())), ""]
+        lines += _option_list(_option_rows(sp))
+    return "\n".join(lines)
+
+
+def _wrap_usage(usage: str, width: int = 72) -> list[str]:
+    words, out, cur = usage.split(), [], ""
+    for w in words:
+        if cur and len(cur) + 1 + len(w) > width:
+            out.append(cur)
+            cur = "    " + w
+        else:
+            cur = f"{cur} {w}" if cur else w
+    return out + [cur]
+
+
+def _option_list(rows) -> list[str]:
+    lines = []
+    for name, text in rows:
+        lines += [f"``{name}``", f"   {_rst_escape(text) or 'no help text'}", ""]
+    return lines
+
+
+def cli_commands() -> set[str]:
+    """The commands of the parser (for the tests)."""
+    return set(_subparsers(_parser()))
+
+
+# ---------------------------------------------------------------------------------------
+# JSON Schema
+# ---------------------------------------------------------------------------------------
+
+def json_schema_rst(path: Path, shown_as: str) -> str:
+    """A JSON Schema file as a table of its properties (nested with dotted names) and the
+    file itself; if the file does not exist, a note saying that it is not shipped yet."""
+    if not path.is_file():
+        return "\n".join([
+            ".. note::", "",
+            f"   **Not shipped yet.** The JSON Schema of ``metrics.json`` will be "
+            f"``{shown_as}`` in the package; this page renders it from that file once it "
+            "exists. Until then the keys are described in :doc:`/getting-started` and "
+            "every ``metrics.json`` carries the run's keys as written.", ""])
+    schema = json.loads(path.read_text(encoding="utf-8"))
+    rows: list[tuple[str, str, str]] = []
+
+    def walk(node, prefix, depth):
+        if depth > 6 or not isinstance(node, dict):
+            return
+        req = set(node.get("required", ()))
+        for k, sub in (node.get("properties") or {}).items():
+            if not isinstance(sub, dict):
+                continue
+            t = sub.get("type", "")
+            t = " or ".join(t) if isinstance(t, list) else str(t)
+            desc = sub.get("description", "")
+            rows.append((f"{prefix}{k}", t + (" (required)" if k in req else ""), desc))
+            walk(sub, f"{prefix}{k}.", depth + 1)
+            if isinstance(sub.get("items"), dict):
+                walk(sub["items"], f"{prefix}{k}[].", depth + 1)
+            if isinstance(sub.get("additionalProperties"), dict):
+                walk(sub["additionalProperties"], f"{prefix}{k}.<name>.", depth + 1)
+    walk(schema, "", 0)
+    lines = [f"From ``{shown_as}``" + (f" ({schema['$id']})" if "$id" in schema else "")
+             + ".", ""]
+    if schema.get("description"):
+        lines += [_rst_escape(" ".join(schema["description"].split())), ""]
+    lines += [".. list-table::", "   :header-rows: 1", "   :widths: 35 20 45", "",
+              "   * - key", "     - type", "     - meaning"]
+    for k, t, desc in rows:
+        lines += [f"   * - ``{k}``", f"     - {_rst_escape(t) or ' '}",
+                  f"     - {_rst_escape(' '.join(desc.split())) or ' '}"]
+    lines += ["", ".. code-block:: json", ""]
+    lines += ["   " + line for line in path.read_text(encoding="utf-8").splitlines()] + [""]
+    return "\n".join(lines)
+
+
+__all__ = ["KEY_DOCS", "cli_commands", "cli_rst", "json_schema_rst", "missing_key_docs",
+           "model_keys", "page_keys", "rig_key_sections", "rig_keys_rst"]

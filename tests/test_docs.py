@@ -1,0 +1,260 @@
+"""Every code block of the manual runs (house rule: code in the README and the manual are
+tests, so the manual cannot rot).
+
+The blocks of one page run in order, in one temporary folder (holding a copy of
+``docs/rigs/`` and links to the repository's ``examples/`` and ``src/``, as a reader
+working from the repository's root sees them) and one Python namespace, as a reader
+would type them:
+
+* ``python`` — executed;
+* ``console`` — each ``$ command`` line runs: ``ambseal ...`` in this process
+  (:func:`ambseal.cli.main`), anything else (a C compiler, the program it built, Octave)
+  as a subprocess, its rest of the block skipped when the program is not installed. The
+  lines after a command are its output as shown: an output that starts with
+  ``ambseal: error:`` is checked — exit status 2 and that message on stderr, ``...``
+  matching anything — and any other command must exit with 0;
+* ``toml`` — parsed; with a first line ``# file: NAME`` also written to NAME;
+* ``c`` — with a first line ``/* file: NAME */`` written to NAME (a ``console`` block
+  compiles it); ``matlab`` — run by ``octave-cli`` when installed;
+* ``json`` — parsed; ``text`` — output shown, not run.
+
+A block after a line ``% test: slow`` runs only with ``pytest -m slow`` (minutes of
+synthesis); nothing later on its page may depend on it. ``ambseal run`` on the embedded
+rig is not run again: the folder of the session's run (``terminal_run`` in
+tests/conftest.py, the same command) is copied to where the page's command writes.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import re
+import shlex
+import shutil
+import subprocess
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+KINDS = {"python", "console", "toml", "c", "matlab", "json", "text"}
+
+
+@dataclass
+class Block:
+    page: str
+    line: int
+    kind: str
+    body: str
+    slow: bool
+
+
+_FENCE = re.compile(r"^(?P<indent>[ \t]*)(?P<fence>```+)(?P<info>[^\n]*)\n(?P<body>.*?)"
+                    r"^(?P=indent)(?P=fence)[ \t]*$", re.M | re.S)
+_RST = re.compile(r"^\.\. code-block:: *(?P<kind>\S+)\n(?:[ \t]+:[^\n]*\n)*\n"
+                  r"(?P<body>(?:(?:[ \t]+[^\n]*)?\n)+)", re.M)
+
+
+def blocks_of(path: Path) -> list[Block]:
+    """The page's code blocks in order (MyST fences in .md; ``code-block`` in .rst;
+    directives such as ``{literalinclude}`` are not code blocks)."""
+    text = path.read_text(encoding="utf-8")
+    rel = str(path.relative_to(DOCS))
+    out = []
+    if path.suffix == ".md":
+        for m in _FENCE.finditer(text):
+            info = m["info"].strip()
+            if info.startswith("{"):
+                continue
+            before = text[:m.start()].rstrip("\n").rsplit("\n", 1)[-1].strip()
+            n = len(m["indent"])
+            body = "".join(ln[n:] if ln[:n].strip() == "" else ln
+                           for ln in m["body"].splitlines(keepends=True))
+            out.append(Block(rel, text.count("\n", 0, m.start()) + 1, info.split()[0]
+                             if info else "", body, before == "% test: slow"))
+    else:
+        for m in _RST.finditer(text):
+            body = "\n".join(ln[3:] for ln in m["body"].splitlines())
+            out.append(Block(rel, text.count("\n", 0, m.start()) + 1, m["kind"], body, False))
+    return out
+
+
+PAGES = sorted(p for p in [*DOCS.rglob("*.md"), *DOCS.rglob("*.rst")]
+               if "_build" not in p.parts and "generated" not in p.parts)
+WITH_CODE = [p for p in PAGES if blocks_of(p)]
+WITH_SLOW = [p for p in WITH_CODE if any(b.slow for b in blocks_of(p))]
+
+
+def _ids(pages):
+    return [str(p.relative_to(DOCS)) for p in pages]
+
+
+def _commands(body: str) -> list[tuple[str, list[str]]]:
+    """(command, expected output lines) of a console block; ``\\`` continues a line."""
+    cmds: list[tuple[str, list[str]]] = []
+    pending = None
+    for line in body.splitlines():
+        if pending is not None:
+            pending += " " + line.strip().rstrip("\\").strip()
+            if not line.rstrip().endswith("\\"):
+                cmds.append((pending, []))
+                pending = None
+        elif line.startswith("$ "):
+            cmd = line[2:].strip()
+            if cmd.endswith("\\"):
+                pending = cmd.rstrip("\\").strip()
+            else:
+                cmds.append((cmd, []))
+        elif cmds:
+            cmds[-1][1].append(line)
+    return cmds
+
+
+def _matches(expected: list[str], got: str) -> bool:
+    """``expected`` (``...`` matching anything, white space folded) is in ``got``."""
+    want = " ".join(" ".join(expected).split())
+    pattern = ".*?".join(re.escape(part) for part in want.split("..."))
+    return re.search(pattern, " ".join(got.split()), re.S) is not None
+
+
+class Page:
+    """The state one page's blocks share: folder, namespace, the commands that ran."""
+
+    def __init__(self, folder: Path, request):
+        self.folder, self.request = folder, request
+        self.namespace: dict = {"__name__": "__manual__"}
+        self.ran: list[str] = []
+
+    def run(self, block: Block) -> None:
+        where = f"{block.page}:{block.line}"
+        if block.kind not in KINDS:
+            pytest.fail(f"{where}: a ```{block.kind} block: the manual's blocks are "
+                        f"{sorted(KINDS)} (tests/test_docs.py runs them)")
+        getattr(self, f"_{block.kind}")(block.body, where)
+
+    def _python(self, body, where):
+        exec(compile(body, where, "exec"), self.namespace)
+
+    def _toml(self, body, where):
+        tomllib.loads(body)
+        first = body.splitlines()[0] if body.strip() else ""
+        if first.startswith("# file: "):
+            (self.folder / first[len("# file: "):].strip()).write_text(body, encoding="utf-8")
+
+    def _c(self, body, where):
+        first = body.splitlines()[0]
+        m = re.match(r"/\* file: (\S+) \*/", first)
+        assert m, f"{where}: a C block starts with /* file: NAME */"
+        (self.folder / m[1]).write_text(body, encoding="utf-8")
+
+    def _json(self, body, where):
+        json.loads(body)
+
+    def _text(self, body, where):
+        pass
+
+    def _matlab(self, body, where):
+        octave = _octave()
+        if octave is None:
+            return  # tests/robust/test_robust_digital.py checks the .mat in Octave too
+        script = "pkg load control\n" + body
+        r = subprocess.run([octave, "--no-gui", "-q", "--eval", script],
+                           cwd=self.folder, capture_output=True, text=True, timeout=120)
+        assert r.returncode == 0, f"{where}: octave: {r.stderr}"
+
+    def _console(self, body, where):
+        for cmd, expected in _commands(body):
+            argv = shlex.split(cmd)
+            if argv[0] == "ambseal":
+                self._ambseal(argv[1:], expected, f"{where}: {cmd}")
+            else:
+                program = argv[0] if argv[0].startswith("./") else shutil.which(argv[0])
+                if program is None:
+                    return  # not installed here: the rest of the block needs it
+                r = subprocess.run([str(self.folder / argv[0]) if argv[0].startswith("./")
+                                    else program, *argv[1:]], cwd=self.folder,
+                                   capture_output=True, text=True, timeout=300)
+                assert r.returncode == 0, f"{where}: {cmd}: {r.stdout}{r.stderr}"
+                self.ran.append(cmd)
+
+    def _ambseal(self, argv, expected, where):
+        from ambseal.cli import main
+
+        error = bool(expected) and expected[0].startswith("ambseal: error:")
+        if argv and argv[0] == "run" and self._embedded_run(argv):
+            return
+        out, err = io.StringIO(), io.StringIO()
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            code = main(argv)
+        got = out.getvalue() + err.getvalue()
+        if error:
+            assert code == 2, f"{where}: expected the error, got exit {code}: {got}"
+            assert _matches(expected, err.getvalue()), (
+                f"{where}: the page shows\n{chr(10).join(expected)}\nambseal said\n{got}")
+        else:
+            assert code == 0, f"{where}: exit {code}: {got}"
+        self.ran.append(" ".join(["ambseal", *argv]))
+
+    def _embedded_run(self, argv) -> bool:
+        """``ambseal run [--out DIR]`` on the embedded rig: the session's folder copied."""
+        rest = argv[1:]
+        if rest and rest[0] == "--out" and len(rest) == 2:
+            out = rest[1]
+        elif not rest:
+            out = "ambseal-out"
+        else:
+            return False
+        src = self.request.getfixturevalue("terminal_run")[0]
+        shutil.copytree(src, self.folder / out, dirs_exist_ok=True)
+        self.ran.append(" ".join(["ambseal", *argv]))
+        return True
+
+
+def _octave() -> str | None:
+    """octave-cli with its control package, or None."""
+    exe = shutil.which("octave-cli")
+    if exe is None:
+        return None
+    r = subprocess.run([exe, "--no-gui", "-q", "--eval", "pkg load control; disp(4242)"],
+                       capture_output=True, text=True, timeout=120)
+    return exe if r.returncode == 0 and "4242" in r.stdout else None
+
+
+def _run_page(path: Path, tmp_path, monkeypatch, request, slow: bool) -> Page:
+    for rig in (DOCS / "rigs").glob("*"):
+        shutil.copy(rig, tmp_path / rig.name)
+    for folder in ("examples", "src"):  # the pages' commands run from the repository root
+        (tmp_path / folder).symlink_to(ROOT / folder, target_is_directory=True)
+    monkeypatch.chdir(tmp_path)
+    page = Page(tmp_path, request)
+    for block in blocks_of(path):
+        if block.slow and not slow:
+            continue
+        page.run(block)
+    return page
+
+
+def test_the_manual_has_code_blocks_of_known_kinds():
+    found = [b for p in PAGES for b in blocks_of(p)]
+    assert len(found) > 20
+    assert {b.kind for b in found} <= KINDS, {b.kind for b in found} - KINDS
+
+
+@pytest.mark.parametrize("path", WITH_CODE, ids=_ids(WITH_CODE))
+def test_page_runs(path, tmp_path, monkeypatch, request):
+    page = _run_page(path, tmp_path, monkeypatch, request, slow=False)
+    if path.name == "own-machine.md":
+        # the page's rig, written from the page alone, validates and runs modes and design
+        for command in ("ambseal validate compressor.toml", "ambseal modes compressor.toml",
+                        "ambseal design compressor.toml --method pid"):
+            assert any(c.startswith(command) for c in page.ran), command
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("path", WITH_SLOW, ids=_ids(WITH_SLOW))
+def test_page_runs_with_its_slow_blocks(path, tmp_path, monkeypatch, request):
+    _run_page(path, tmp_path, monkeypatch, request, slow=True)

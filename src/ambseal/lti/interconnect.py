@@ -28,7 +28,7 @@ import numpy as np
 from ambseal.errors import ModelError
 from ambseal.lti.matrices import ArrayMemo, labels, ss_matrices
 
-__all__ = ["lft_lower_matrices", "lft_lower", "feedback_matrices", "feedback_poles",
+__all__ = ["lft_lower_matrices", "lft_lower", "feedback_matrices", "feedback_poles", "state_poles",
            "series_inputs", "wired"]
 
 Matrices = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
@@ -167,14 +167,21 @@ def feedback_matrices(G: Matrices, K: Matrices, Gf: tuple[np.ndarray, np.ndarray
 _POLES = ArrayMemo(keep=16)  # the last closed-loop state matrices decomposed
 
 
+def state_poles(A: np.ndarray) -> np.ndarray:
+    """Eigenvalues of a state matrix ``A`` (rad/s, or z of a discrete system), kept for the
+    last few large ones (:class:`~ambseal.lti.matrices.ArrayMemo`): the same full-order
+    loop is judged by the design (full-order stability), the discretisation's prewarp
+    frequency and stability screen, and the judgement of the main job. The array is
+    shared: do not modify it in place."""
+    A = np.asarray(A, float)
+    if not A.size:
+        return np.zeros(0, dtype=complex)
+    return _POLES.get((A,), "eigvals", lambda: np.linalg.eigvals(A))
+
+
 def feedback_poles(G: Matrices, K: Matrices) -> np.ndarray:
-    """Eigenvalues of the state matrix of :func:`feedback_matrices` ``(G, K)`` (rad/s, or z
-    for a discrete loop), kept for the last few large loops
-    (:class:`~ambseal.lti.matrices.ArrayMemo`): the same full-order loop is checked by the
-    design (full-order stability), the discretisation's prewarp frequency and its stability
-    screen. The array is shared: do not modify it in place."""
-    Acl = feedback_matrices(G, K)[0]
-    return _POLES.get((Acl,), "eigvals", lambda: np.linalg.eigvals(Acl))
+    """:func:`state_poles` of the state matrix of :func:`feedback_matrices` ``(G, K)``."""
+    return state_poles(feedback_matrices(G, K)[0])
 
 
 def series_inputs(G: Matrices, block: Matrices, inputs: list[int] | None = None

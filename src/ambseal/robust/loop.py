@@ -26,7 +26,7 @@ import numpy as np
 
 from ambseal.errors import ModelError
 from ambseal.lti.discrete import zoh
-from ambseal.lti.interconnect import feedback_matrices, series_inputs, wired
+from ambseal.lti.interconnect import feedback_matrices, series_inputs, state_poles, wired
 from ambseal.lti.json_safe import json_float, json_list
 from ambseal.lti.matrices import labels, ss_matrices
 from ambseal.robust.stability import decay_rate, is_stable
@@ -188,9 +188,8 @@ def closed_loop(G: Any, K: Any, Gf: Any | None = None, *, atol: float = 0.0) -> 
     states = [f"x[{i}]" for i in range(n)] + [f"xK[{i}]" for i in range(nk)]
     sys = control.StateSpace(Acl, Bcl, Ccl, Dcl, dt, inputs=inputs, outputs=outputs,
                              states=states, name="closed_loop")
-    poles = np.linalg.eigvals(Acl) if Acl.size else np.zeros(0, dtype=complex)
-    order = np.argsort(-np.abs(poles) if dt else -poles.real, kind="stable")
-    poles = poles[order]
+    poles = state_poles(Acl)
+    poles = poles[np.argsort(-np.abs(poles) if dt else -poles.real, kind="stable")]
     return ClosedLoop(sys, poles, decay_rate(poles, dt), is_stable(poles, dt), nu, ny, nf, dt)
 
 

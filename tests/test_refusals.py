@@ -95,6 +95,21 @@ RIG_CASES = [
      "seal[0].K", "strictly increasing"),
     ("length mismatch", _set("seal/0/K", {"frequency_hz": [10.0, 20.0], "value": [1.0]}),
      "seal[0].K", "same length"),
+    # every form of a coefficient bounded alike: a table of 1e300 gave "no unstable poles"
+    ("1e300 table", _set("seal/0/k", {"frequency_hz": [0.0, 100.0], "value": [1e300, 1e300]}),
+     "seal[0].k.value[0]", "<= 1000000000000"),
+    ("1e300 table frequency", _set("seal/0/k", {"frequency_hz": [0.0, 1e300],
+                                                 "value": [1.0, 2.0]}),
+     "seal[0].k.frequency_hz[1]", "<= 10000000"),
+    ("1e300 number", _set("seal/0/C", 1e300), "seal[0].C", "<= 1000000000000"),
+    ("1e300 factor axis", _set("amb/0/ks", {"zeta": 1e300, "eta": 2.49e6}), "amb[0].ks.zeta",
+     "<= 1000000000000"),
+    ("delay 1e9 samples", _set("controller/delay_samples", 10**9),
+     "controller.delay_samples", "<= 100"),
+    ("axes angle 1e300", _set("amb/0/axes_angle_deg", 1e300), "amb[0].axes_angle_deg",
+     "<= 360"),
+    ("uncertainty 1e300", _set("amb/0/uncertainty", {"Ki": 1e300}), "amb[0].uncertainty.Ki",
+     "<= 10"),
 ]
 
 

@@ -35,7 +35,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..config import RigConfig, TruthSection
-from ..errors import ModelError
+from ..config_checks import MAX_ELEMENTS
+from ..errors import ConfigError, ModelError
 from ..model.amb import actuator_matrices, eddy_lag_matrices
 from ..model.reduction import modal_reduction
 from ..model.rig import build_system, mechanical_plant
@@ -87,6 +88,10 @@ def true_rig(cfg: RigConfig, truth: TruthSection) -> RigConfig:
         update["shaft"] = [s.model_copy(update={"elements": max(1, round(s.elements *
                                                                         truth.mesh_factor))})
                            for s in cfg.shaft]
+        n = sum(s.elements for s in update["shaft"])
+        if n > MAX_ELEMENTS:  # the rig file's own limit, for the same reason
+            raise ConfigError(f"truth.mesh_factor: {truth.mesh_factor:g} makes {n} beam "
+                              f"elements (at most {MAX_ELEMENTS} in all, as in a rig file)")
     return cfg.model_copy(update=update) if update else cfg
 
 

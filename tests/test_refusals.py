@@ -110,6 +110,21 @@ RIG_CASES = [
      "<= 360"),
     ("uncertainty 1e300", _set("amb/0/uncertainty", {"Ki": 1e300}), "amb[0].uncertainty.Ki",
      "<= 10"),
+    # [design] as strict as the rest of the rig file, and bounded
+    ("tracked yes", _set("design/tracked", "yes"), "design.tracked", "true or false"),
+    ("d_e_um string", _set("design/d_e_um", "20"), "design.d_e_um", "expected a number"),
+    ("band string", _set("design/band_hz", ["1", 2000.0]), "design.band_hz[0]",
+     "expected a number"),
+    ("design pressures 1e300", _set("design/pressures_bar", [0.0, 1e300]),
+     "design.pressures_bar[1]", "<= 10000"),
+    ("design speeds nan", _set("design/speeds_hz", [float("nan")]), "design.speeds_hz[0]",
+     "finite"),
+    ("design M 1e308", _set("design/hinf", {"M": 1e308}), "design.hinf.M", "<= 1000"),
+    ("design states 1e9", _set("design/model_states", 10**9), "design.model_states", "<= 200"),
+    ("impulse 1e300 s", _set("design/impulse", {"duration_s": 1e300}),
+     "design.impulse.duration_s", "controller samples"),
+    ("unbalance grade", _set("design/unbalance/grade_mm_s", 1e300),
+     "design.unbalance.grade_mm_s", "<= 4000"),
 ]
 
 
@@ -152,6 +167,10 @@ CLI_CASES = [
     (["acquire", RIG, "--truth", TRUTH, "--excitation", "prbs", "--pressure-bar", "0",
       "--out", "r.csv", "--duration-s", "1e9"], "duration_s", "GB"),
     (["run", "--truth", "MISSING.toml", "--out", "o"], "MISSING.toml", "cannot read"),
+    (["design", RIG, "--method", "hinf", "--set", "design.hinf.M=1e308", "--out", "o"],
+     "design.hinf.M", "<= 1000"),
+    (["design", RIG, "--method", "hinf", "--set", "design.tracked=yes", "--out", "o"],
+     "design.tracked", "true or false"),
 ]
 
 

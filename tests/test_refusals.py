@@ -171,6 +171,15 @@ CLI_CASES = [
      "design.hinf.M", "<= 1000"),
     (["design", RIG, "--method", "hinf", "--set", "design.tracked=yes", "--out", "o"],
      "design.tracked", "true or false"),
+    (["campbell", RIG, "--speed-hz", "0:100:1000000", "--out", "o"], "--speed-hz",
+     "count from 1 to 10000"),
+    (["campbell", RIG, "--speed-hz", "0:nan:5", "--out", "o"], "--speed-hz", "finite"),
+    (["campbell", RIG, "--speed-hz", "inf", "--out", "o"], "--speed-hz", "finite"),
+    (["sweep", RIG, "--pressure-bar", "0:4:1000", "--speed-hz", "0:100:1000", "--out", "o"],
+     "sweep", "at most 10000"),
+    (["sweep", RIG, "--pressure-bar", "0:1e300:3", "--out", "o"], "--pressure-bar", "finite"),
+    (["sweep", RIG, "--pressure-bar", "0:2e4:3", "--out", "o"], "--pressure-bar",
+     "[operating] pressure_bar"),
 ]
 
 

@@ -63,7 +63,8 @@ CSV (``*.csv``)
 MATLAB (``*.mat``, level 5 / v7, not v7.3)
     One variable per column, named as the column, a column vector of doubles (``n × 1``;
     a row vector is accepted), plus ``metadata_json``, a char array holding the same JSON
-    object as the sidecar. Read with :func:`scipy.io.loadmat`; nothing is ever unpickled.
+    object as the sidecar. Read with :func:`scipy.io.loadmat` in a child process
+    (:mod:`ambseal.identify.matlab_file`); nothing read from a file is ever unpickled.
 
 Validation (:func:`load_measurement`)
 -------------------------------------
@@ -110,6 +111,7 @@ import numpy as np
 
 from ambseal.errors import AmbsealError, DataError
 from ambseal.files import atomic_write, read_text
+from ambseal.identify.matlab_file import read_matlab
 from ambseal.identify.measurement import (CHANNELS, CLIP_RTOL, CLIP_RUN, FORMAT_TAG,
                                           TIME_RTOL, Measurement, _json_safe, _RATE_RTOL,
                                           _RESERVED, column_names, validate_measurement)
@@ -270,25 +272,21 @@ def _read_csv(path: Path) -> tuple[list[str], np.ndarray]:
 
 
 def _read_mat(path: Path) -> tuple[dict, dict[str, np.ndarray]]:
-    import scipy.io
-
-    try:
-        raw = scipy.io.loadmat(str(path), squeeze_me=False, mat_dtype=False, chars_as_strings=True)
-    except NotImplementedError:
-        raise DataError(f"{path}: MATLAB v7.3 (HDF5) files are not supported; save with -v7") from None
-    except Exception as exc:
-        raise DataError(f"{path}: not a readable MATLAB file ({exc})") from None
+    # in a child process: scipy's reader can crash on a malformed file (matlab_file)
+    raw = read_matlab(path, squeeze_me=False, mat_dtype=False, chars_as_strings=True)
     if "metadata_json" not in raw:
         raise DataError(f"{path}: missing variable 'metadata_json' (the JSON metadata)")
-    mj = raw["metadata_json"]
-    if mj.dtype.kind != "U" or mj.size != 1:
+    kind, mj = raw["metadata_json"]
+    if kind != "array" or mj.dtype.kind != "U" or mj.size != 1:
         raise DataError(f"{path}: variable 'metadata_json' must be a char row vector")
     header = _read_header_json(str(mj.reshape(-1)[0]), f"{path}: variable 'metadata_json'")
     cols = {}
-    for name, v in raw.items():
-        if name.startswith("__") or name == "metadata_json":
+    for name, (kind, arr) in raw.items():
+        if name == "metadata_json":
             continue
-        arr = np.asarray(v)
+        if kind != "array":
+            raise DataError(f"{path}: column {name!r}: expected a numeric vector, got a "
+                            f"{'struct' if kind == 'struct' else 'cell array'}")
         if arr.dtype.kind not in "fiub" or arr.ndim != 2 or min(arr.shape) > 1:
             raise DataError(f"{path}: column {name!r}: expected a numeric vector, got {arr.dtype} {arr.shape}")
         cols[name] = arr.astype(float).reshape(-1)

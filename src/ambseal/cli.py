@@ -478,8 +478,10 @@ def _inputs(args: argparse.Namespace) -> tuple[list, str]:
     from .config import default_rig_path
 
     rig = getattr(args, "rig", None) or default_rig_path()
+    ctrl = getattr(args, "controller", None)  # a file, or a method's name (pid, hinf, ...)
     files = [rig, getattr(args, "truth", None), getattr(args, "out", None),
-             *(getattr(args, "data", None) or [])]
+             *(getattr(args, "data", None) or []),
+             ctrl if ctrl and Path(ctrl).suffix.lower() in (".json", ".npz", ".mat") else None]
     return files, str(rig)
 
 

@@ -219,6 +219,10 @@ def _parser() -> argparse.ArgumentParser:
     i.add_argument("--accept-unconverged", action="store_true",
                    help="write the identified rig even when the fit failed or is not "
                         "identifiable (the exit status is then 0)")
+    i.add_argument("--accept-implausible", action="store_true",
+                   help="write the identified rig even when the estimates or intervals are "
+                        "implausible for the rig file (e.g. Ki or Ks 10x off: records in "
+                        "other units?); the exit status is then 0")
     i.add_argument("--no-refine", action="store_true",
                    help="skip the second pass on a model re-reduced at the estimate")
     i.add_argument("--static-load", default=None, metavar="CSV",
@@ -379,7 +383,8 @@ def _identify(args: argparse.Namespace) -> int:
     summary = identify_files(args.rig, args.data, args.params.split(","), args.out,
                              current_weight=args.current_weight, refine=not args.no_refine,
                              accept_unconverged=args.accept_unconverged,
-                             static_load=args.static_load)
+                             static_load=args.static_load,
+                             accept_implausible=args.accept_implausible)
     print(json.dumps(summary))
     return 0
 

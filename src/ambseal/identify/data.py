@@ -77,7 +77,8 @@ file it is the line after the header):
   cell that is not a number;
 * axes other than the rig's (``axes=`` argument): wrong count or names;
 * fewer than ``min_samples`` samples (and always fewer than 2);
-* NaN or ±inf in any column;
+* NaN or ±inf in any column; a displacement beyond ±0.1 m or a current beyond ±1e4 A (the
+  rig file's bounds of an air gap and of a current: no rotor moves or draws more);
 * time not increasing or not uniform: every step within ``time_rtol`` (relative) of the
   mean step; ``sample_rate_hz`` in the metadata disagreeing with it;
 * clipped currents: a run of at least :data:`CLIP_RUN` consecutive samples of a current

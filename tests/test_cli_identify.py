@@ -232,3 +232,59 @@ def test_static_load_from_the_facility_joined_in_identify(record, tmp_path, caps
     assert ki["ci95"][0] < ki["estimate"] < ki["ci95"][1]
     before = abs(static["ki_ks_correlation_dynamic"]["A.Ki_zeta"])
     assert abs(static["ki_ks_correlation_joined"]["A.Ki_zeta"]) < before
+
+
+def _scaled(record, tmp_path, prefix: str, factor: float):
+    """The record with every column starting ``prefix`` multiplied by ``factor``."""
+    def fn(lines):
+        cols = [i for i, n in enumerate(lines[0].split(",")) if n.startswith(prefix)]
+        out = [lines[0]]
+        for line in lines[1:]:
+            cells = line.split(",")
+            out.append(",".join(repr(float(c) * factor) if i in cols else c
+                                for i, c in enumerate(cells)))
+        return out
+    return _corrupt(record, tmp_path, fn)
+
+
+def test_identify_on_millimetres_is_a_failed_identification(record, tmp_path, capsys):
+    """Displacements recorded in mm (×1000) converge to intervals wider than their estimates
+    (A.Ki_zeta 179 N/A ± 24 000): reported as an implausible identification naming the
+    parameter — fit.json with the reasons, no identified.toml — unless
+    --accept-implausible (the rules: ambseal.identify.plausibility)."""
+    mm = _scaled(record, tmp_path, "displacement_", 1e3)
+    code, err = _identify(capsys, tmp_path, mm)
+    assert code == 2 and len(err) == 1 and "implausible identification" in err[0], err
+    assert "A.Ki_zeta" in err[0] and "--accept-implausible" in err[0]
+    out = tmp_path / "o"
+    fit = json.loads((out / "fit.json").read_text())
+    assert any("A.Ki_zeta" in w and "wider than the estimate" in w for w in fit["warnings"])
+    assert not (out / "identified.toml").exists()
+    code, err = _identify(capsys, tmp_path, mm, extra=["--accept-implausible"])
+    assert code == 0 and (out / "identified.toml").exists()
+
+
+def test_identify_on_samples_of_1e300_is_refused_before_writing(record, tmp_path, capsys):
+    """A record of 1e300 m displacements made the fit NaN and fit.json invalid JSON (a
+    traceback from json): no rotor moves beyond an air gap's bound, so the record is
+    refused naming the column and the row, and nothing is written."""
+    bad = _corrupt(record, tmp_path, _cell("displacement_A_zeta_m", None, "1e300"))
+    code, err = _identify(capsys, tmp_path, bad)
+    assert code == 2 and len(err) == 1, err
+    assert str(bad) in err[0] and "displacement_A_zeta_m" in err[0] and "row 1" in err[0]
+    assert not (tmp_path / "o" / "fit.json").exists()
+
+
+def test_identify_with_a_controller_the_model_cannot_run_names_the_record(record, tmp_path,
+                                                                         capsys):
+    """The record's controller is part of the simulated loop: an unstable one (a pole of
+    the PID's derivative filter at z = 750, found by the fuzz) makes the model impossible
+    to simulate, and the error names the record, not only the rig."""
+    bad = _corrupt(record, tmp_path, lambda L: L)
+    side = bad.with_name(bad.name + ".json")
+    meta = json.loads(side.read_text())
+    meta["controller"]["state_space"]["A"][7][7] = 750.0
+    side.write_text(json.dumps(meta))
+    code, err = _identify(capsys, tmp_path, bad)
+    assert code == 2 and len(err) == 1 and str(bad) in err[0], err
+    assert "cannot be simulated" in err[0]

@@ -1,9 +1,12 @@
-"""Property-based fuzz of the command line: mutated example rigs, truth files
-and records end either in exit 2 with one line on stderr naming the file, or in exit 0 with
-finite results — never in a traceback.
+"""Property-based fuzz of the command line: mutated example rigs, truth files,
+records, controller files and ranges end either in exit 2 with one line on stderr naming
+the file, or in exit 0 with finite results — never in a traceback (only the project's own
+errors), never in a hang (each case runs under a deadline), and never changing a file
+outside the command's output (each case runs in a folder of its own, compared before and
+after).
 
 The CLI's ``main()`` is called in-process (a subprocess per example would cost a second of
-imports each). About 40 s by default; ``-m slow`` runs ten times the examples, new random
+imports each). About 15 s by default; ``-m slow`` runs ten times the examples, new random
 ones each time (the default set is derandomized, the same in every CI run).
 """
 
@@ -12,7 +15,13 @@ import copy
 import io
 import json
 import math
+import os
+import signal
 import tomllib
+from pathlib import Path
+
+import numpy as np
+import scipy.io
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -75,7 +84,11 @@ def mutated(draw, doc: dict):
 
 def _garbage(draw, text: str) -> bytes:
     """``text`` as UTF-8 with random bytes spliced in (sometimes none)."""
-    data = text.encode()
+    return _spliced(draw, text.encode())
+
+
+def _spliced(draw, data: bytes) -> bytes:
+    """``data`` with random bytes spliced in (sometimes none)."""
     if draw(st.booleans()):
         return data
     at = draw(st.integers(0, len(data)))
@@ -90,6 +103,54 @@ def _call(args: list[str]) -> tuple[int, str, str]:
         except SystemExit as exc:  # argparse
             code = exc.code
     return code, out.getvalue(), err.getvalue()
+
+
+class Hang(BaseException):
+    """A case ran past its deadline (a BaseException: no ``except Exception`` swallows it)."""
+
+
+@contextlib.contextmanager
+def _deadline(seconds: float):
+    """Raise :class:`Hang` in the main thread after ``seconds`` (SIGALRM, POSIX)."""
+    def fire(signum, frame):
+        raise Hang(f"still running after {seconds:g} s")
+
+    old = signal.signal(signal.SIGALRM, fire)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+
+
+def _tree(folder: Path, outputs: list[Path]) -> dict:
+    """Every file under ``folder`` but the ``outputs`` (files or folders) → (size, mtime)."""
+    skip = [o.resolve() for o in outputs]
+    found = {}
+    for root, _, names in os.walk(folder):
+        for n in names:
+            p = Path(root, n).resolve()
+            if not any(p == o or o in p.parents for o in skip):
+                st = p.stat()
+                found[str(p)] = (st.st_size, st.st_mtime_ns)
+    return found
+
+
+def _sandboxed(folder: Path, args: list, outputs: list[Path], seconds: float = 60.0):
+    """``main(args)`` with ``folder`` as the working folder, under a deadline; asserts that
+    no file of ``folder`` outside ``outputs`` changed and that nothing appeared beside it."""
+    before, beside = _tree(folder, outputs), set(os.listdir(folder.parent))
+    cwd = os.getcwd()
+    os.chdir(folder)
+    try:
+        with _deadline(seconds):
+            result = _call([str(a) for a in args])
+    finally:
+        os.chdir(cwd)
+    assert _tree(folder, outputs) == before, (args, "a file outside the output changed")
+    assert set(os.listdir(folder.parent)) == beside, (args, "a file appeared beside it")
+    return result
 
 
 def _finite(obj) -> bool:
@@ -128,7 +189,7 @@ def _rig_case(tmp_path_factory, data):
     doc = data.draw(mutated(RIGS[name]))
     rig = tmp_path_factory.mktemp("fuzz") / name
     rig.write_bytes(_garbage(data.draw, dump(doc)))
-    code, out, err = _call(["modes", str(rig), "--json"])
+    code, out, err = _sandboxed(rig.parent, ["modes", rig, "--json"], [])
     _check(code, out, err, [str(rig)])
 
 
@@ -139,9 +200,10 @@ def _truth_case(tmp_path_factory, data):
     d = tmp_path_factory.mktemp("fuzz")
     truth = d / "truth.toml"
     truth.write_bytes(_garbage(data.draw, dump(doc)))
-    code, out, err = _call(["acquire", str(ROOT / "examples" / "testrig.toml"), "--truth",
-                            str(truth), "--excitation", "prbs", "--duration-s", "0.02",
-                            "--pressure-bar", "0", "--out", str(d / "r.csv")])
+    code, out, err = _sandboxed(d, ["acquire", ROOT / "examples" / "testrig.toml", "--truth",
+                                    truth, "--excitation", "prbs", "--duration-s", "0.02",
+                                    "--pressure-bar", "0", "--out", d / "r.csv"],
+                                [d / "r.csv", d / "r.csv.json"])
     _check(code, out, err, [str(truth), "r.csv"])
 
 
@@ -177,9 +239,88 @@ def _record_case(tmp_path_factory, record, data):
             del lines[data.draw(st.integers(1, len(lines) - 1))]
     csv.write_bytes(_garbage(data.draw, "\n".join(lines) + "\n"))
     side.write_bytes(_garbage(data.draw, json.dumps(meta, allow_nan=True)))
-    code, out, err = _call(["identify", str(ROOT / "examples" / "testrig.toml"), str(csv),
-                            "--params", "A.Ki_zeta", "--no-refine", "--out", str(d / "o")])
+    code, out, err = _sandboxed(d, ["identify", ROOT / "examples" / "testrig.toml", csv,
+                                    "--params", "A.Ki_zeta", "--no-refine", "--out", d / "o"],
+                                [d / "o"])
     _check(code, out, err, [str(csv), str(d / "o")])
+
+
+@pytest.fixture(scope="module")
+def controller(tmp_path_factory):
+    """The document of the reference PID as ``ambseal design`` writes it (JSON form)."""
+    d = tmp_path_factory.mktemp("ctl")
+    code, _, err = _call(["design", str(ROOT / "examples" / "testrig.toml"), "--method", "pid",
+                          "--out", str(d), "--allow-unstable"])
+    assert code == 0, err
+    return json.loads((d / "controller_pid.json").read_text())
+
+
+def _write_controller(doc: dict, path: Path) -> None:
+    """``doc`` in the format of ``path``'s suffix: JSON as is; .npz and .mat with each value
+    as numpy makes it (a list of mixed types becomes an object array, which .npz pickles
+    and the loader must refuse)."""
+    if path.suffix == ".json":
+        path.write_text(json.dumps(doc, allow_nan=True))
+        return
+    arrays = {}
+    for k, v in doc.items():
+        try:
+            arrays[k] = np.asarray(v)
+        except ValueError:  # ragged
+            arrays[k] = np.asarray(v, dtype=object)
+    with open(path, "wb") as fh:
+        if path.suffix == ".npz":
+            np.savez(fh, **arrays)
+        else:
+            scipy.io.savemat(fh, {k: (np.nan if v is None else v) for k, v in doc.items()})
+
+
+def _controller_case(tmp_path_factory, controller, data):
+    """``ambseal export --controller FILE``: a mutated controller document in any of the
+    three formats, sometimes with garbage bytes or truncated: refused naming the file, or
+    the C module written inside ``--out``."""
+    d = tmp_path_factory.mktemp("fuzz")
+    ext = data.draw(st.sampled_from([".json", ".npz", ".mat"]))
+    path = d / f"K{ext}"
+    doc = data.draw(mutated(controller))
+    try:
+        _write_controller(doc, path)
+    except Exception:  # a value numpy or scipy cannot write: the JSON form instead
+        path = d / "K.json"
+        _write_controller(doc, path)
+    raw = path.read_bytes()
+    cut = data.draw(st.sampled_from([None] * 4 + [0, 7, len(raw) // 2, len(raw) - 1]))
+    path.write_bytes(_spliced(data.draw, raw) if cut is None else raw[:cut])
+    code, out, err = _sandboxed(d, ["export", ROOT / "examples" / "testrig.toml",
+                                    "--controller", path, "--out", d / "o"], [d / "o"])
+    _check(code, out, err, [str(path), str(d / "o")])
+    if code == 0:
+        assert all(Path(f).resolve().is_relative_to((d / "o").resolve())
+                   for f in json.loads(out)["files"])
+
+
+#: Pieces of a range ``a:b:n``: numbers a user might type, non-finite ones, huge counts.
+_ENDS = st.sampled_from(["0", "-1", "1e300", "-1e300", "nan", "inf", "-inf", "2e5", "", "x",
+                         "1e-320"])
+_ODD_ENDS = st.sampled_from(["1e300", "-1e300", "nan", "inf", "-inf", "2e5", "", "x"])
+_COUNTS = st.sampled_from(["0", "-3", "2.5", "1e6", "1000000", "10001", "", "x", "nan",
+                           str(2**63)])
+
+
+def _range_case(tmp_path_factory, data):
+    """``ambseal campbell --speed-hz RANGE`` with a range that is not one to run (non-finite,
+    beyond the speed bound, no count or too many points): refused at once — before any
+    model or design — naming the argument."""
+    d = tmp_path_factory.mktemp("fuzz")
+    parts = [data.draw(_ODD_ENDS)] if data.draw(st.booleans()) else [
+        data.draw(_ENDS), data.draw(_ENDS), data.draw(_COUNTS)]
+    text = ":".join(parts)
+    code, out, err = _sandboxed(d, ["campbell", ROOT / "examples" / "testrig.toml",
+                                    "--controller", "none", f"--speed-hz={text}",
+                                    "--out", d / "o"], [d / "o"], seconds=10.0)
+    assert code == 2, (text, code, err)
+    _check(code, out, err, ["--speed-hz"])
+    assert not (d / "o").exists()
 
 
 @fuzz(150)
@@ -198,6 +339,34 @@ def test_fuzz_truth_files(tmp_path_factory, data):
 @given(data=st.data())
 def test_fuzz_records(tmp_path_factory, record, data):
     _record_case(tmp_path_factory, record, data)
+
+
+@fuzz(120)
+@given(data=st.data())
+def test_fuzz_controller_files(tmp_path_factory, controller, data):
+    _controller_case(tmp_path_factory, controller, data)
+
+
+@fuzz(60)
+@given(data=st.data())
+def test_fuzz_ranges(tmp_path_factory, data):
+    _range_case(tmp_path_factory, data)
+
+
+def test_the_fuzz_harness_sees_a_hang_and_a_stray_file(tmp_path):
+    """The deadline stops a case that runs too long and the sandbox sees a file written
+    outside the output (so the fuzz tests above can fail)."""
+    with pytest.raises(Hang):
+        with _deadline(0.2):
+            while True:
+                pass
+    (tmp_path / "in.txt").write_text("x")
+    before = _tree(tmp_path, [tmp_path / "o"])
+    (tmp_path / "o").mkdir()
+    (tmp_path / "o" / "fine.txt").write_text("y")
+    assert _tree(tmp_path, [tmp_path / "o"]) == before
+    (tmp_path / "in.txt").write_text("changed")
+    assert _tree(tmp_path, [tmp_path / "o"]) != before
 
 
 @pytest.mark.slow
@@ -219,3 +388,17 @@ def test_fuzz_truth_files_long(tmp_path_factory, data):
 @given(data=st.data())
 def test_fuzz_records_long(tmp_path_factory, record, data):
     _record_case(tmp_path_factory, record, data)
+
+
+@pytest.mark.slow
+@fuzz(120, slow=True)
+@given(data=st.data())
+def test_fuzz_controller_files_long(tmp_path_factory, controller, data):
+    _controller_case(tmp_path_factory, controller, data)
+
+
+@pytest.mark.slow
+@fuzz(60, slow=True)
+@given(data=st.data())
+def test_fuzz_ranges_long(tmp_path_factory, data):
+    _range_case(tmp_path_factory, data)

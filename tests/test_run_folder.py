@@ -268,12 +268,14 @@ def test_folder_commands_write_only_beside_their_own_files(tmp_path, capsys):
 def test_every_folder_command_refuses_a_users_folder(tmp_path, capsys, monkeypatch, command):
     """Each command that writes a folder refuses one holding a file it did not write,
     before any work (the design would fail the test), one line naming the file, exit 2."""
-    import ambseal.design.recipes as recipes
+    import ambseal.app.commands as commands
+    import ambseal.app.rotordynamics as rotordynamics
 
     def no_work(*a, **k):
         raise AssertionError("working before the output folder was checked")
 
-    monkeypatch.setattr(recipes, "design", no_work)
+    for module in (commands, rotordynamics):  # they hold the design function by name
+        monkeypatch.setattr(module, "design", no_work)
     rig = str(ROOT / "examples" / "testrig.toml")
     out = tmp_path / "mine"
     out.mkdir()

@@ -50,6 +50,7 @@ import os
 import shlex
 import sys
 import warnings
+from pathlib import Path
 
 from ambseal import __version__
 from ambseal.config import check_operating, default_rig_path
@@ -222,6 +223,10 @@ def _parser() -> argparse.ArgumentParser:
     i.add_argument("--accept-unconverged", action="store_true",
                    help="write the identified rig even when the fit failed or is not "
                         "identifiable (the exit status is then 0)")
+    i.add_argument("--accept-implausible", action="store_true",
+                   help="write the identified rig even when the estimates or intervals are "
+                        "implausible for the rig file (e.g. Ki or Ks 10x off: records in "
+                        "other units?); the exit status is then 0")
     i.add_argument("--no-refine", action="store_true",
                    help="skip the second pass on a model re-reduced at the estimate")
     i.add_argument("--static-load", default=None, metavar="CSV",
@@ -359,8 +364,10 @@ def _inputs(args: argparse.Namespace) -> tuple[list, str]:
     """The files a command reads and writes, and the one an unnamed error comes from."""
 
     rig = getattr(args, "rig", None) or default_rig_path()
+    ctrl = getattr(args, "controller", None)  # a file, or a method's name (pid, hinf, ...)
     files = [rig, getattr(args, "truth", None), getattr(args, "out", None),
-             *(getattr(args, "data", None) or [])]
+             *(getattr(args, "data", None) or []),
+             ctrl if ctrl and Path(ctrl).suffix.lower() in (".json", ".npz", ".mat") else None]
     return files, str(rig)
 
 

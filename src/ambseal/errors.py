@@ -46,12 +46,16 @@ _PATTERNS = {NAME_PATTERN: "a name of ASCII letters, digits and '_' that does no
              LABEL_PATTERN: "text on one line (no control characters)"}
 
 
+#: Prefixes of the branch names pydantic gives a constrained number or a validator.
+_BRANCH_PREFIXES = ("function-", "constrained-")
+
+
 def _loc(loc: tuple, tags: set[str]) -> str:
     out = ""
     for part in loc:
         if isinstance(part, int):
             out += f"[{part}]"
-        elif part in tags or "[" in str(part) or "function-" in str(part):
+        elif part in tags or "[" in str(part) or str(part).startswith(_BRANCH_PREFIXES):
             continue  # union branch names that pydantic inserts
         else:
             out += ("." if out else "") + str(part)
@@ -67,13 +71,18 @@ def _pick_error(exc, tags: set[str]) -> dict:
     same = [e for e in errs if _loc(e["loc"], tags).startswith(where.split(".")[0])]
     branches: dict[tuple, list] = {}
     for e in same:
-        tag = next((p for p in e["loc"] if p in tags), None)
-        if tag in PRIMITIVE_TAGS and isinstance(e.get("input"), (dict, list)):
+        tag = next((p for p in e["loc"] if p in tags or str(p).startswith("constrained-")),
+                   None)
+        number = tag in PRIMITIVE_TAGS or str(tag).startswith("constrained-")
+        if number and isinstance(e.get("input"), (dict, list)):
             continue  # the value is a table: the number branch's complaint is beside the point
         branches.setdefault(tag, []).append(e)
     if not branches:
         return errs[0]
-    return min(branches.values(), key=len)[0]
+    # a branch whose keys all fit (only its values are wrong) before one of another shape
+    shape = ("extra_forbidden", "missing", "model_type", "dict_type")
+    return min(branches.values(), key=lambda es: (sum(e["type"] in shape for e in es),
+                                                  len(es)))[0]
 
 
 _BOUNDS = {"greater_than": ">", "greater_than_equal": ">=", "less_than": "<",

@@ -287,3 +287,27 @@ def test_an_unstable_full_order_loop_is_refused_with_the_mode_and_the_key():
     cfg = load_rig(None, ["design.hinf.wu_gain=0.05"])
     with pytest.raises(SynthesisError, match=r"55\d(\.\d)? Hz.*design\.model_cutoff_hz"):
         design(cfg, "hinf", states=8)
+
+
+def test_an_amb_without_negative_stiffness_gives_no_air_gap():
+    """Ks = 0 (a bearing without bias flux stiffness, e.g. Lorentz-force) is a valid rig: the
+    linearisation's ratio s0 = Ki·i0/Ks (Schweitzer & Maslen 2009) gives no gap for it
+    (it was a ZeroDivisionError). With one such AMB the other's ratio gives the gap
+    (100·2/2e5 = 1 mm); with both none is derived, a note says D_e needs a key and the H∞
+    design asks for it by name, and the reference PID, whose rule scales with Ks, asks for
+    ``[controller.pid]``."""
+    from ambseal.design.recipes import design
+    from ambseal.design.specs import machine
+
+    one = {**BEAM, "amb": [{**BEAM["amb"][0], "ks": 0.0}, BEAM["amb"][1]]}
+    assert machine(parse_rig(one, "<one>")).air_gap_m == pytest.approx(1e-3)
+    both = {**BEAM, "amb": [{**a, "ks": 0.0} for a in BEAM["amb"]]}
+    with pytest.raises(ConfigError, match=r"controller\.pid: cannot be derived"):
+        design_spec(parse_rig(both, "<both>"))  # the PID rule scales with Ks
+    pid = {"kp": 2e3, "ti": 0.2, "td": 2e-3, "eps": 0.1}
+    cfg = parse_rig({**both, "controller": {"pid": pid}}, "<both>")
+    sp = design_spec(cfg)
+    assert sp.machine.air_gap_m is None and sp.d_e is None
+    assert any("design.d_e_um" in n for n in sp.notes)
+    with pytest.raises(ConfigError, match="design.d_e_um"):
+        design(cfg, "hinf")

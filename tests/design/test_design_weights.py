@@ -81,3 +81,15 @@ def test_gain_weight_is_the_inverse_pid_in_its_band():
     assert Weights().Wk() is None
     with pytest.raises(ConfigError, match="band"):
         Weights(gain_factor=2.0, gain_band_hz=(210.0, 150.0), pid_reference=(1, 1, 1, 1)).Wk()
+
+
+def test_weight_whose_realisation_overflows_is_a_config_error():
+    """W_p = (s/M + ω_B)/(s + ω_B A) with M = 1e308 (``--set design.hinf.M=1e308`` before
+    the rig file bounded M): its numerator's coefficients lie 308 orders of magnitude apart
+    and python-control's realisation raised numpy's LinAlgError; the weight's check names
+    the weight instead."""
+    from ambseal.design.weights import check_weight
+    from ambseal.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="weight W_p: no state-space realisation"):
+        check_weight(performance_weight(1e308, 5.0), "W_p")

@@ -17,6 +17,7 @@ each controller as its ``(A, B, C, D)`` arrays.
 from __future__ import annotations
 
 import itertools
+import math
 
 import control
 import numpy as np
@@ -30,27 +31,57 @@ from ambseal.lti.json_safe import json_float
 from ambseal.model.modes import bending_limit_hz
 from ambseal.robust.stability import is_stable
 
-__all__ = ["sweep", "sweep_case", "stability_boundary", "refine_boundary", "boundary_case",
-           "parse_range"]
+__all__ = ["MAX_RANGE_POINTS", "sweep", "sweep_case", "check_cases", "stability_boundary",
+           "refine_boundary", "boundary_case", "parse_range"]
+
+#: The most points a range ``a:b:n`` of the command line may ask for (:func:`parse_range`):
+#: each point of a Campbell diagram or a sweep is an eigen-decomposition or a judgement of
+#: the full model (tens of milliseconds to seconds), so 10 000 points are hours of work.
+MAX_RANGE_POINTS = 10000
 
 def parse_range(text: str, name: str) -> np.ndarray:
     """``a:b:n`` → n points from a to b; a single number → one point.
 
+    ``a`` and ``b`` are finite numbers below 1e12 in size (the command line's rule for
+    every number); ``n`` is a whole number from 1 to :data:`MAX_RANGE_POINTS`.
+
+    Parameters
+    ----------
+    text : str
+        The range as given on the command line.
+    name : str
+        The argument's name, for the error message.
+
+    Returns
+    -------
+    numpy.ndarray
+        The points, shape (n,).
+
     Raises
     ------
     ConfigError
-        Anything else (names ``name`` and what was expected).
+        Anything else (names ``name`` and what was expected), before any work.
+
+    Examples
+    --------
+    >>> parse_range("0:4:5", "--pressure-bar")
+    array([0., 1., 2., 3., 4.])
     """
     parts = text.split(":")
     try:
-        if len(parts) == 1:
-            return np.array([float(parts[0])])
-        if len(parts) == 3 and int(parts[2]) >= 1 and float(parts[2]) == int(parts[2]):
-            return np.linspace(float(parts[0]), float(parts[1]), int(parts[2]))
+        ends = [float(p) for p in (parts[:1] if len(parts) == 1 else parts[:2])]
+        count = 1 if len(parts) == 1 else int(parts[2]) if len(parts) == 3 else None
     except ValueError:
-        pass
-    raise ConfigError(f"{name}: expected a number or start:stop:count (e.g. 0:4.08:9), "
-                      f"got {text!r}")
+        count = None
+    if count is None:
+        raise ConfigError(f"{name}: expected a number or start:stop:count (e.g. 0:4.08:9), "
+                          f"got {text!r}")
+    if not all(np.isfinite(x) and abs(x) < 1e12 for x in ends):
+        raise ConfigError(f"{name}: expected finite numbers below 1e12 in size, got {text!r}")
+    if not 1 <= count <= MAX_RANGE_POINTS:
+        raise ConfigError(f"{name}: expected a count from 1 to {MAX_RANGE_POINTS}, got "
+                          f"{text!r}")
+    return np.linspace(ends[0], ends[-1], count)
 
 
 def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
@@ -107,6 +138,26 @@ def _shared(cfg, controllers: dict) -> dict:
                             for n, K in controllers.items()}}
 
 
+def check_cases(n: int, what: str) -> None:
+    """Refuse a map of more than :data:`MAX_RANGE_POINTS` cases before any work.
+
+    Parameters
+    ----------
+    n : int
+        Cases asked for (the product of the ranges and the controllers).
+    what : str
+        The command, for the message.
+
+    Raises
+    ------
+    ConfigError
+        ``n`` above :data:`MAX_RANGE_POINTS`.
+    """
+    if n > MAX_RANGE_POINTS:
+        raise ConfigError(f"{what}: {n} cases (the product of the ranges and controllers); "
+                          f"expected at most {MAX_RANGE_POINTS}: use fewer points per range")
+
+
 def sweep(cfg, controllers: dict, pressures_bar, speeds_hz, params: dict | None = None, *,
           max_hz: float | None = None, workers: int | None = None,
           scheduler: str | None = None, progress: bool = False) -> list[dict]:
@@ -137,6 +188,8 @@ def sweep(cfg, controllers: dict, pressures_bar, speeds_hz, params: dict | None 
 
     params = params or {}
     names = list(params)
+    check_cases(len(controllers) * len(pressures_bar) * len(speeds_hz)
+                * math.prod(len(params[n]) for n in names), "sweep")
     cases = [{"controller": c, "pressure_bar": float(p), "speed_hz": float(s),
               "params": dict(zip(names, (float(x) for x in vals)))}
              for c in controllers for p in pressures_bar for s in speeds_hz

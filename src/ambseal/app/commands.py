@@ -30,10 +30,13 @@ from ambseal.identify.budget import advice
 from ambseal.identify.checks import frf_checks, truth_errors
 from ambseal.identify.data import load_measurement
 from ambseal.identify.design_model import design_rig, impulse_checks, truth_rig
+from ambseal.identify.plausibility import fit_failure, implausible, require_finite
 from ambseal.identify.procedure import thesis_procedure
 from ambseal.identify.residuals import MISMATCH
 from ambseal.identify.stages import check_record_metadata, identify, record_spread
-from ambseal.identify.static_load import load_static_record, static_ki, with_static
+from ambseal.identify.static_load import (
+    with_static_record,
+)
 from ambseal.identify.tracking import TrackingSettings, check_excitation, track
 from ambseal.model.amb import channel_names
 from ambseal.model.modes import modes
@@ -398,17 +401,10 @@ def _check_records(records: list, paths: list[str]) -> None:
                             "excitation identifies nothing")
 
 
-def _static_load(cfg, res, path: str) -> tuple:
-    """(the fit joined with the static-load Ki of ``path``, its summary)."""
-
-    return with_static(res, static_ki(cfg, *load_static_record(path, cfg),
-                                      values=dict(zip(res.names, res.estimate)),
-                                      source=str(path)))
-
-
 def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: str | Path, *,
                    current_weight: float = 0.0, refine: bool = True,
-                   accept_unconverged: bool = False, static_load: str | None = None) -> dict:
+                   accept_unconverged: bool = False, static_load: str | None = None,
+                   accept_implausible: bool = False) -> dict:
     """``ambseal identify``: fit ``names`` to recorded files; write the fit, its figures and
     the identified rig to ``out_dir``. Returns a JSON-safe summary.
 
@@ -428,13 +424,14 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
     A fit that failed (not converged, singular Jacobian, an estimate at its bound, an NRMSE
     fit below the floor of :func:`ambseal.identify.fit.fit_parameters`) writes ``fit.json``
     for diagnosis but no figures and no ``identified.toml``, and raises, unless
-    ``accept_unconverged``.
+    ``accept_unconverged``; so does an implausible fit (:mod:`ambseal.identify.plausibility`)
+    unless ``accept_implausible``. Non-finite results are refused before anything is written.
 
     Raises
     ------
     ConfigError, DataError, IdentificationError
         A bad rig, a bad, duplicate, unexcited or mismatched record, a fit that cannot
-        start, or (without ``accept_unconverged``) a fit that failed.
+        start, or (unless accepted) a fit that failed or is implausible.
     """
 
     cfg = load_rig(rig)
@@ -458,7 +455,7 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
                            sources=sources) if len(records) > 1 else None
     pressures = sorted({float(m.metadata.get("pressure_drop_pa", 0.0)) / 1e5 for m in records})
     warnings = advice(res.budget, cfg, names, pressures)
-    static = _static_load(cfg, res, static_load) if static_load else None
+    static = with_static_record(cfg, res, static_load) if static_load else None
     if static is not None:
         res, static = static
     if res.residuals.failed:  # a disputed fixed value is told by advice() already
@@ -471,14 +468,16 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
                            "first, then tau_s if it remains)" if res.model_check()["disputed"]
                            else "fit tau_s beside tau_e; Ki, Ks then hold, read "
                            "tau_e + tau_s)"))
-    write_json(out / "fit.json", {**res.to_dict(), "warnings": warnings,
-                                  **({"per_record": spread} if spread else {}),
-                                  **({"static_load": static} if static else {})})
-    if not res.converged and not accept_unconverged:
+    reasons = implausible(cfg, res.names, res.estimate, res.ci95_low, res.ci95_high)
+    write_json(out / "fit.json", require_finite({**res.to_dict(), "warnings": warnings + reasons,
+                                                 **({"per_record": spread} if spread else {}),
+                                                 **({"static_load": static} if static else {})},
+                                                "identify: the fit"))
+    failed = fit_failure(res, reasons, accept_unconverged, accept_implausible)
+    if failed:
         (out / "identified.toml").unlink(missing_ok=True)  # an earlier fit's: not this one's
-        raise IdentificationError(f"identify: the fit failed ({res.message}); {out / 'fit.json'}"
-                                  " has the details, no identified rig was written "
-                                  "(--accept-unconverged writes it anyway)")
+        raise IdentificationError(f"identify: {failed[0]}; {out / 'fit.json'} has the details, "
+                                  f"no identified rig was written ({failed[1]} writes it anyway)")
     fit_timeseries_figure(out / "fit_timeseries.png", res.time_s, res.y_meas, res.y_sim,
                           res.axes, nrmse_pct=[res.nrmse_fit_pct[a] for a in res.axes])
     correlation_figure(out / "correlation.png", res.correlation, res.names)
@@ -505,7 +504,7 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
             "residual_test": res.residuals.to_dict()["verdict"],
             "model_check": res.model_check()["verdict"],
             **({"static_load": static} if static else {}),
-            "warnings": warnings}
+            "warnings": warnings + reasons}
 
 
 def validate_summary(rig: str | Path | None = None) -> dict:

@@ -145,7 +145,8 @@ def _identify(args: argparse.Namespace) -> int:
         summary = identify_files(args.rig, args.data, args.params.split(","), args.out,
                                  current_weight=args.current_weight, refine=not args.no_refine,
                                  accept_unconverged=args.accept_unconverged,
-                                 static_load=args.static_load)
+                                 static_load=args.static_load,
+                                 accept_implausible=args.accept_implausible)
     print(json.dumps(summary))
     return 0
 

@@ -13,13 +13,21 @@ import argparse
 import csv
 import io
 import json
+import math
 import sys
 from pathlib import Path
 
 from ambseal.analysis.campbell import campbell, closed_loop_modes, modes_of_state_matrix
 from ambseal.analysis.cases import dask_available
-from ambseal.analysis.sweep import parse_range, refine_boundary, stability_boundary, sweep
+from ambseal.analysis.sweep import (
+    check_cases,
+    parse_range,
+    refine_boundary,
+    stability_boundary,
+    sweep,
+)
 from ambseal.config import load_rig
+from ambseal.config._checks import MAX_COEFFICIENT, MAX_PRESSURE_BAR, MAX_SPEED_HZ
 from ambseal.design.recipes import METHODS, design
 from ambseal.errors import ConfigError
 from ambseal.export.controller_files import load_controller
@@ -77,8 +85,21 @@ def _positions(cfg) -> dict[str, list[float]]:
             "seal": [s.position for s in cfg.seal], "disk": [d.position for d in cfg.disk]}
 
 
-def _range(text: str | None, name: str):
-    return None if text is None else parse_range(text, name)
+def _range(text: str | None, name: str, low: float, high: float, rule: str):
+    """The points of ``a:b:n`` (:func:`~ambseal.analysis.sweep.parse_range`), each within
+    [low, high] by the rig file's ``rule``; None for None."""
+    if text is None:
+        return None
+    points = parse_range(text, name)
+    if not all(low <= x <= high for x in points):
+        raise ConfigError(f"{name}: expected values from {low:g} to {high:g} ({rule}), got "
+                          f"{text!r}")
+    return points
+
+
+#: The bounds of the ranges, by the rig file's rules (ambseal.config._checks).
+_SPEEDS = (-MAX_SPEED_HZ, MAX_SPEED_HZ, "the bound of [operating] speed_range_hz")
+_PRESSURES = (0.0, MAX_PRESSURE_BAR, "the rule of [operating] pressure_bar")
 
 
 def _modes(args: argparse.Namespace) -> int:
@@ -143,7 +164,7 @@ def _owns_out(handler):
 def _campbell(args: argparse.Namespace) -> int:
     cfg = load_rig(args.rig)
     p = cfg.operating.pressure_bar if args.pressure_bar is None else args.pressure_bar
-    speeds = _range(args.speed_hz, "--speed-hz")
+    speeds = _range(args.speed_hz, "--speed-hz", *_SPEEDS)
     spec = args.controller or ("pid" if cfg.controller.pid is not None and cfg.amb else
                                "hinf" if cfg.amb else None)
     K = controller_for(cfg, spec, p)
@@ -174,19 +195,22 @@ def _campbell(args: argparse.Namespace) -> int:
 @_owns_out
 def _sweep(args: argparse.Namespace) -> int:
     cfg = load_rig(args.rig)
-    pressures = _range(args.pressure_bar, "--pressure-bar")
-    speeds = _range(args.speed_hz, "--speed-hz")
+    pressures = _range(args.pressure_bar, "--pressure-bar", *_PRESSURES)
+    speeds = _range(args.speed_hz, "--speed-hz", *_SPEEDS)
     specs = (args.controller or "pid").split(",")
-    ctrl = {Path(s).stem: controller_for(cfg, s, cfg.operating.pressure_bar) for s in specs}
-    if any(K is None for K in ctrl.values()):
-        raise ConfigError("sweep: every --controller must be a controller (pid, hinf, mu or "
-                          "a file), not none")
     params = {}
     for text in args.param or []:
         name, sep, rng = text.partition("=")
         if not sep:
             raise ConfigError(f"--param: expected NAME=a:b:n, got {text!r}")
-        params[name.strip()] = _range(rng, f"--param {name}")
+        params[name.strip()] = _range(rng, f"--param {name}", -MAX_COEFFICIENT,
+                                      MAX_COEFFICIENT, "the bound of a force coefficient")
+    check_cases(len(specs) * len(pressures) * len(speeds)
+                * math.prod(len(v) for v in params.values()), "sweep")  # before any design
+    ctrl = {Path(s).stem: controller_for(cfg, s, cfg.operating.pressure_bar) for s in specs}
+    if any(K is None for K in ctrl.values()):
+        raise ConfigError("sweep: every --controller must be a controller (pid, hinf, mu or "
+                          "a file), not none")
     workers = args.workers
     if workers is None and args.scheduler is None and not dask_available():
         print("ambseal: note: dask is not installed; the sweep runs serially",

@@ -11,8 +11,10 @@ from pydantic import Field
 
 from ambseal.errors import LABEL_PATTERN, NAME_PATTERN, ConfigError
 
-__all__ = ["MAX_ELEMENTS", "MAX_REDUCED_STATES", "check_amb", "check_actuator", "cross_check",
-           "Name", "Label"]
+__all__ = ["MAX_ELEMENTS", "MAX_REDUCED_STATES", "MAX_COEFFICIENT", "MAX_FREQUENCY_HZ",
+           "MAX_SPEED_HZ", "MAX_PRESSURE_BAR", "MAX_CURRENT_A", "MAX_GAP_M",
+           "MAX_DELAY_SAMPLES", "MAX_RELATIVE", "BoundedCoefficient",
+           "BoundedFrequency", "check_amb", "check_actuator", "cross_check", "Name", "Label"]
 
 #: Names of AMBs, seals, springs and materials make parameter, signal and C names
 #: (``A.Ki_zeta``, ``y_A_zeta``; :data:`ambseal.errors.NAME_PATTERN`), checked once here.
@@ -28,6 +30,34 @@ MAX_ELEMENTS = 150
 #: States of a reduced model for control design, at most (H∞/μ synthesis grows with n³ and
 #: beyond ~100 states is numerically fragile).
 MAX_REDUCED_STATES = 200
+
+# Bounds of physical values that several tables share. None describes a machine: each is
+# far beyond any rotor on AMBs and exists so that a typo (1e300, a unit off by 10⁹) is
+# refused naming its key instead of overflowing in the model.
+#: A force coefficient (N/m, N·s/m, kg, N/A), in every form (number, affine, table): a
+#: bearing or seal stiffer than 1e12 N/m would be a rigid support, not a coefficient.
+MAX_COEFFICIENT = 1e12
+#: A frequency (Hz): ten times the fastest controller sample rate the rig file accepts
+#: (``[controller] sample_rate_hz`` ≤ 1 MHz), so any band a controller acts in fits.
+MAX_FREQUENCY_HZ = 1e7
+#: A rotational speed (Hz): the bound of ``[operating] speed_range_hz``.
+MAX_SPEED_HZ = 1e5
+#: A pressure drop (bar): the bound of ``[operating] pressure_bar`` (1 GPa).
+MAX_PRESSURE_BAR = 1e4
+#: A current (A): the bound of an AMB's ``bias_current`` and ``current_limit``.
+MAX_CURRENT_A = 1e4
+#: A displacement inside a bearing (m): the bound of an AMB's ``air_gap``.
+MAX_GAP_M = 0.1
+#: A computation delay (controller samples): each sample adds a state per controller output
+#: to every sampled loop; real-time targets delay by one or two samples, so 100 is ample.
+MAX_DELAY_SAMPLES = 100
+#: A relative uncertainty (1σ or ± range as a fraction of the value): beyond 10× the value
+#: the range says nothing about it.
+MAX_RELATIVE = 10.0
+#: A coefficient of a table against frequency, bounded like a number or the affine form.
+BoundedCoefficient = Annotated[float, Field(ge=-MAX_COEFFICIENT, le=MAX_COEFFICIENT)]
+#: A frequency of a table (Hz); negative for backward whirl excitation.
+BoundedFrequency = Annotated[float, Field(ge=-MAX_FREQUENCY_HZ, le=MAX_FREQUENCY_HZ)]
 
 
 def check_amb(self):  # noqa: N805 (the Amb being validated)

@@ -4,7 +4,9 @@ Every key is optional. A key left out is derived from the machine (its model and
 of the rig file) by the rule written next to it in :mod:`ambseal.design.specs`;
 ``ambseal design RIG --show-defaults`` prints the resolved values with their rules, and
 ``--set design.mu.orbit_um=8`` overrides any key on the command line (validated by this
-schema). Units are SI except where the key names its unit.
+schema). Units are SI except where the key names its unit. As in the rest of the rig file,
+values are strict (a string is no number and ``"yes"`` no boolean; an integer is a number)
+and bounded (the bounds beside each key in the code, with their reasons).
 
 ``[design]``
     ``d_e_um`` (µm): D_e, the largest allowed displacement error, scaling of the error
@@ -57,11 +59,22 @@ schema). Units are SI except where the key names its unit.
 
 from __future__ import annotations
 
+import math
 import tomllib
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from ambseal.config._checks import (
+    MAX_COEFFICIENT,
+    MAX_CURRENT_A,
+    MAX_FREQUENCY_HZ,
+    MAX_GAP_M,
+    MAX_PRESSURE_BAR,
+    MAX_REDUCED_STATES,
+    MAX_RELATIVE,
+    MAX_SPEED_HZ,
+)
 from ambseal.errors import ConfigError
 
 __all__ = ["Design", "MethodSpec", "MuSpec", "UncertainSpec", "UnbalanceSpec", "ImpulseSpec",
@@ -69,28 +82,53 @@ __all__ = ["Design", "MethodSpec", "MuSpec", "UncertainSpec", "UnbalanceSpec", "
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    # strict as the rest of the rig file: no string or bool taken for a number or a bool
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
 
 
-def _band(r, key: str):
-    if r is not None and not 0 < r[0] < r[1]:
-        raise ValueError(f"{key}: expected [low, high] with 0 < low < high")
+# Bounds of the keys below, beside the rig file's own (ambseal.config._checks):
+#: a weight's gain on a scaled signal (D_e, D_u make 1 the largest allowed value): beyond
+#: 1e6 (120 dB) either way the weight forbids or frees its signal outright, and the
+#: synthesis's Riccati equations meet coefficients 1e12 apart
+_GAIN = Field(default=None, ge=1e-6, le=1e6)
+#: W_p's high-frequency bound M on |S_o|: ISO 14839-3 judges peaks of 3 to 4; 1000 (60 dB)
+#: demands nothing of a loop
+MAX_SENSITIVITY = 1e3
+#: a frequency or frequency band (Hz)
+_HZ = Field(default=None, gt=0, le=MAX_FREQUENCY_HZ)
+#: judged conditions: each is a full judgement of every controller (seconds each)
+MAX_CONDITIONS = 100
+#: ISO 21940-11's coarsest balance quality grade (G 4000, mm/s)
+MAX_GRADE_MM_S = 4000.0
+#: the unbalance mass m (kg): the rig file's bound of a disk's mass
+MAX_MASS_KG = 1e6
+#: the longest current impulse in controller samples (the default is 100, P5 §5.1): the
+#: judgement simulates 35 impulse lengths at twice the sample rate, 70 000 steps at most
+MAX_IMPULSE_SAMPLES = 1000
+#: the largest controller order limit: a larger one is no limit (a design model of at most
+#: MAX_REDUCED_STATES states and its weights stays far below it)
+MAX_ORDER = 10 * MAX_REDUCED_STATES
+
+
+def _band(r, key: str, top: float = MAX_FREQUENCY_HZ):
+    if r is not None and not 0 < r[0] < r[1] <= top:
+        raise ValueError(f"{key}: expected [low, high] with 0 < low < high <= {top:g}")
     return r
 
 
 class MethodSpec(_Strict):
     """Weights of one synthesis method (:class:`ambseal.design.weights.Weights`)."""
 
-    M: float | None = Field(default=None, gt=0)
-    omega_b_rad_s: float | None = Field(default=None, gt=0)
-    A: float | None = Field(default=None, gt=0, lt=1)
-    wu_gain: float | None = Field(default=None, gt=0)
-    wu_corner_hz: float | None = Field(default=None, gt=0)
-    wu_hf_gain: float | None = Field(default=None, gt=0)
-    w1_gain: float | None = Field(default=None, gt=0)
-    w1_corner_hz: float | None = Field(default=None, gt=0)
-    orbit_um: float | None = Field(default=None, ge=0)
-    wf_rolloff_hz: float | None = Field(default=None, gt=0)
+    M: float | None = Field(default=None, gt=0, le=MAX_SENSITIVITY)
+    omega_b_rad_s: float | None = Field(default=None, gt=0, le=2 * math.pi * MAX_FREQUENCY_HZ)
+    A: float | None = Field(default=None, ge=1e-6, lt=1)  # as a gain: 1/A = |W_p(0)|
+    wu_gain: float | None = _GAIN
+    wu_corner_hz: float | None = _HZ
+    wu_hf_gain: float | None = _GAIN
+    w1_gain: float | None = _GAIN
+    w1_corner_hz: float | None = _HZ
+    orbit_um: float | None = Field(default=None, ge=0, le=MAX_GAP_M * 1e6)  # within a gap
+    wf_rolloff_hz: float | None = _HZ
 
     @model_validator(mode="after")
     def _wu(self) -> "MethodSpec":
@@ -106,8 +144,8 @@ class MuSpec(MethodSpec):
     max_iter: int | None = Field(default=None, ge=1, le=50)
     dk_order: int | None = Field(default=None, ge=0, le=8)
     iteration: Literal["dgk", "dk"] | None = None
-    gain_factor: float | None = Field(default=None, ge=0)
-    gain_band_hz: tuple[float, float] | None = None
+    gain_factor: float | None = Field(default=None, ge=0, le=1e6)  # as a weight's gain
+    gain_band_hz: tuple[float, float] | None = Field(default=None, strict=False)  # a list
 
     @model_validator(mode="after")
     def _gain_band(self) -> "MuSpec":
@@ -119,9 +157,10 @@ class UncertainSpec(_Strict):
     """One uncertain LFT parameter: ``relative`` or ``low``/``high`` (SI)."""
 
     parameter: str = Field(min_length=1)
-    relative: float | None = Field(default=None, gt=0)
-    low: float | None = None
-    high: float | None = None
+    relative: float | None = Field(default=None, gt=0, le=MAX_RELATIVE)
+    # every uncertain parameter is a force coefficient or factor (the rig file's bound)
+    low: float | None = Field(default=None, ge=-MAX_COEFFICIENT, le=MAX_COEFFICIENT)
+    high: float | None = Field(default=None, ge=-MAX_COEFFICIENT, le=MAX_COEFFICIENT)
 
     @model_validator(mode="after")
     def _range(self) -> "UncertainSpec":
@@ -144,35 +183,37 @@ class UncertainSpec(_Strict):
 
 
 class UnbalanceSpec(_Strict):
-    grade_mm_s: float | None = Field(default=None, gt=0)
-    mass_kg: float | None = Field(default=None, gt=0)
+    grade_mm_s: float | None = Field(default=None, gt=0, le=MAX_GRADE_MM_S)
+    mass_kg: float | None = Field(default=None, gt=0, le=MAX_MASS_KG)
     law: Literal["iso21940", "constant_velocity"] | None = None
-    max_speed_hz: float | None = Field(default=None, gt=0)
+    max_speed_hz: float | None = Field(default=None, gt=0, le=MAX_SPEED_HZ)
     force_at: str | None = Field(default=None, min_length=1)
-    range_hz: tuple[float, float] | None = None
+    range_hz: tuple[float, float] | None = Field(default=None, strict=False)  # a list
 
     @model_validator(mode="after")
     def _r(self) -> "UnbalanceSpec":
-        _band(self.range_hz, "range_hz")
+        _band(self.range_hz, "range_hz", MAX_SPEED_HZ)
         return self
 
 
 class ImpulseSpec(_Strict):
-    amplitude_a: float | None = Field(default=None, gt=0)
-    duration_s: float | None = Field(default=None, gt=0)
+    amplitude_a: float | None = Field(default=None, gt=0, le=MAX_CURRENT_A)
+    duration_s: float | None = Field(default=None, gt=0)  # bound: check_design_names
 
 
 class Design(_Strict):
     """The ``[design]`` part (module docstring); every key optional."""
 
-    d_e_um: float | None = Field(default=None, gt=0)
-    d_u_a: float | None = Field(default=None, gt=0)
-    model_states: int | None = Field(default=None, ge=2)
-    model_cutoff_hz: float | None = Field(default=None, gt=0)
-    band_hz: tuple[float, float] | None = None
-    order_max: int | None = Field(default=None, ge=1)
-    pressures_bar: list[float] | None = Field(default=None, min_length=1)
-    speeds_hz: list[float] | None = Field(default=None, min_length=1)
+    d_e_um: float | None = Field(default=None, gt=0, le=MAX_GAP_M * 1e6)  # within a gap
+    d_u_a: float | None = Field(default=None, gt=0, le=MAX_CURRENT_A)
+    model_states: int | None = Field(default=None, ge=2, le=MAX_REDUCED_STATES)
+    model_cutoff_hz: float | None = _HZ
+    band_hz: tuple[float, float] | None = Field(default=None, strict=False)  # a list
+    order_max: int | None = Field(default=None, ge=1, le=MAX_ORDER)
+    pressures_bar: list[Annotated[float, Field(ge=0, le=MAX_PRESSURE_BAR)]] | None = Field(
+        default=None, min_length=1, max_length=MAX_CONDITIONS)
+    speeds_hz: list[Annotated[float, Field(ge=0, le=MAX_SPEED_HZ)]] | None = Field(
+        default=None, min_length=1, max_length=MAX_CONDITIONS)
     unbalance: UnbalanceSpec = UnbalanceSpec()
     impulse: ImpulseSpec = ImpulseSpec()
     uncertainty: list[UncertainSpec] | None = None
@@ -189,10 +230,6 @@ class Design(_Strict):
         if self.model_states is not None and self.model_states % 2:
             raise ValueError("model_states: expected an even number (a mode has 2 states)")
         _band(self.band_hz, "band_hz")
-        if self.pressures_bar is not None and min(self.pressures_bar) < 0:
-            raise ValueError("pressures_bar: expected pressure drops >= 0")
-        if self.speeds_hz is not None and min(self.speeds_hz) < 0:
-            raise ValueError("speeds_hz: expected speeds >= 0")
         names = [u.parameter for u in self.uncertainty or ()]
         if len(set(names)) != len(names):
             raise ValueError("uncertainty: a parameter is listed twice")
@@ -205,9 +242,15 @@ def check_design_names(cfg) -> str | None:
     Checks ``unbalance.force_at`` against the names of the rig's seals, disks, AMBs and
     springs, and the owner of each uncertain parameter (the part before the last '.')
     against the seals, AMBs and springs (a spring without a name is ``spring<i>``), and
-    that ``tracked`` has a seal whose k is affine in the pressure drop.
+    that ``tracked`` has a seal whose k is affine in the pressure drop, and that the
+    impulse lasts at most :data:`MAX_IMPULSE_SAMPLES` controller samples.
     """
     d = cfg.design
+    fs = cfg.controller.sample_rate_hz
+    if d.impulse.duration_s is not None and d.impulse.duration_s * fs > MAX_IMPULSE_SAMPLES:
+        return (f"design.impulse.duration_s: expected at most {MAX_IMPULSE_SAMPLES} controller "
+                f"samples ({MAX_IMPULSE_SAMPLES / fs:g} s at {fs:g} Hz), got "
+                f"{d.impulse.duration_s:g} s")
     parts = {s.name for s in cfg.seal} | {a.name for a in cfg.amb} | {
         (s.name or f"spring{i}") for i, s in enumerate(cfg.spring)}
     at = d.unbalance.force_at

@@ -3,6 +3,9 @@
 This is the only module that knows the file format. Positions are in metres from the
 shaft's left end, everything else in SI, except the keys with a unit in their name
 (``speed_rpm``, ``pressure_bar``, ``cutoff_hz``, ``axes_angle_deg``, ``pole_angle_deg``).
+Values are strict (no string or boolean is taken for a number) and bounded: every physical
+value, in each form it may take (a number, an affine law, a table), within a range far
+beyond any machine (:mod:`ambseal.config._checks`), so a typo is refused naming its key.
 
 Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
 
@@ -66,8 +69,15 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from ambseal.config._checks import (
+    MAX_CURRENT_A,
+    MAX_DELAY_SAMPLES,
     MAX_ELEMENTS,
+    MAX_FREQUENCY_HZ,
+    MAX_GAP_M,
     MAX_REDUCED_STATES,
+    MAX_RELATIVE,
+    BoundedCoefficient,
+    BoundedFrequency,
     Label,
     Name,
     check_actuator,
@@ -95,7 +105,7 @@ __all__ = [
 ]
 
 
-_Big = Annotated[float, Field(ge=-1e12, le=1e12)]  # plausible bound of a force coefficient
+_Big = BoundedCoefficient  # plausible bound of a force coefficient (config._checks)
 
 
 class _Strict(BaseModel):
@@ -106,7 +116,7 @@ class _Strict(BaseModel):
 #: ``uncertainty = { key = σ }`` beside a component's values: the relative 1σ uncertainty
 #: (fraction) of each named value, used when an identification holds it fixed
 #: (:mod:`ambseal.identify.budget` reads the keys and their defaults).
-Uncertainty = dict[str, Annotated[float, Field(ge=0)]] | None
+Uncertainty = dict[str, Annotated[float, Field(ge=0, le=MAX_RELATIVE)]] | None
 
 
 class Material(_Strict):
@@ -184,7 +194,7 @@ class Amb(_Strict):
     name: Name
     position: float = Field(ge=0)
     sensor_position: float = Field(ge=0)
-    axes_angle_deg: float = 0.0
+    axes_angle_deg: float = Field(default=0.0, ge=-360, le=360)
     turns: int | None = Field(default=None, gt=0, le=100000)
     pole_area: float | None = Field(default=None, gt=0, le=1.0)
     air_gap: float | None = Field(default=None, ge=1e-6, le=0.1)
@@ -232,8 +242,8 @@ class FrequencyTable(_Strict):
     """A coefficient tabulated against excitation frequency (Hz), interpolated linearly and
     held constant outside the table: ``{ frequency_hz = [...], value = [...] }``."""
 
-    frequency_hz: list[float] = Field(min_length=1, max_length=10000)
-    value: list[float] = Field(min_length=1, max_length=10000)
+    frequency_hz: list[BoundedFrequency] = Field(min_length=1, max_length=10000)
+    value: list[_Big] = Field(min_length=1, max_length=10000)
 
     @model_validator(mode="after")
     def _table(self) -> "FrequencyTable":
@@ -244,8 +254,9 @@ class FrequencyTable(_Strict):
         return self
 
 
-Coefficient = float | Affine
-SealCoefficient = float | Affine | FrequencyTable
+# bounded alike in every form: a number, the affine form's terms, a table's values
+Coefficient = _Big | Affine
+SealCoefficient = _Big | Affine | FrequencyTable
 
 
 class Seal(_Strict):
@@ -257,15 +268,6 @@ class Seal(_Strict):
     c: SealCoefficient = 0.0
     M: SealCoefficient = 0.0
     uncertainty: Uncertainty = None
-
-    @model_validator(mode="after")
-    def _plausible(self) -> "Seal":
-        for n in "KkCcM":  # a plain number, bounded like the affine form's terms
-            v = getattr(self, n)
-            if isinstance(v, float) and abs(v) > 1e12:
-                raise ValueError(f"{n}: expected a coefficient of at most 1e12 in size, "
-                                 f"got {v:g}")
-        return self
 
     @property
     def frequency_dependent(self) -> bool:
@@ -297,7 +299,7 @@ class Controllers(_Strict):
     pid: Pid | None = None
     # plausible digital AMB controllers: 100 Hz to 1 MHz
     sample_rate_hz: float = Field(default=10000.0, ge=100.0, le=1e6)
-    delay_samples: int = Field(default=1, ge=0)
+    delay_samples: int = Field(default=1, ge=0, le=MAX_DELAY_SAMPLES)
 
 
 class Operating(_Strict):
@@ -475,21 +477,21 @@ class TruthSection(_Strict):
     """
 
     parameters: dict[str, Coefficient] = {}
-    tau_e: float = Field(default=0.0, ge=0)
-    bias_current: float = Field(default=6.0, gt=0)
-    current_limit: float | None = Field(default=None, gt=0)
-    sensor_noise_m: float = Field(default=0.0, ge=0)
-    noise_fraction: float = Field(default=0.0, ge=0)
-    current_noise_a: float = Field(default=0.0, ge=0)
+    tau_e: float = Field(default=0.0, ge=0, le=1.0)
+    bias_current: float = Field(default=6.0, gt=0, le=MAX_CURRENT_A)
+    current_limit: float | None = Field(default=None, gt=0, le=MAX_CURRENT_A)
+    sensor_noise_m: float = Field(default=0.0, ge=0, le=MAX_GAP_M)
+    noise_fraction: float = Field(default=0.0, ge=0, le=MAX_RELATIVE)
+    current_noise_a: float = Field(default=0.0, ge=0, le=MAX_CURRENT_A)
     adc_bits: int | None = Field(default=None, ge=2, le=32)
-    adc_range_m: float = Field(default=1.0e-3, gt=0)  # LSB = range / 2**bits (no clipping)
+    adc_range_m: float = Field(default=1.0e-3, gt=0, le=MAX_GAP_M)  # LSB = range / 2**bits
     substeps: int = Field(default=4, ge=1, le=100)
-    max_mode_hz: float = Field(default=10000.0, gt=0)
+    max_mode_hz: float = Field(default=10000.0, gt=0, le=MAX_FREQUENCY_HZ)
     # model-form mismatch of the facility against the rig file (None/1: as the rig file)
     beam: Literal["timoshenko", "euler-bernoulli"] | None = None
-    mesh_factor: float = Field(default=1.0, gt=0)
+    mesh_factor: float = Field(default=1.0, gt=0, le=MAX_ELEMENTS)  # in all: rig_sim.true_rig
     modal_damping: float | None = Field(default=None, ge=0, lt=1)
-    sensor_filter_hz: float | None = Field(default=None, gt=0)
+    sensor_filter_hz: float | None = Field(default=None, gt=0, le=MAX_FREQUENCY_HZ)
 
 
 class TruthConfig(_Strict):

@@ -8,7 +8,7 @@ import control
 import numpy as np
 
 from ambseal.design.conditions import judged_conditions
-from ambseal.errors import DataError
+from ambseal.errors import ConfigError, DataError
 from ambseal.identify import stages
 from ambseal.lti.discrete import zoh
 from ambseal.lti.interconnect import feedback_matrices
@@ -129,7 +129,10 @@ def pid_from_rig(cfg) -> dict:
     if key in _DERIVED:
         return dict(_DERIVED[key])
     ratio = [ks / ki for a in cfg.amb for ki, ks in zip(*amb_factors(a))]
-    ks_over_ki = float(np.mean(ratio))
+    ks_over_ki = float(np.mean(ratio)) if ratio else 0.0
+    if not ks_over_ki > 0:  # the rule scales every gain with Ks
+        raise ConfigError("controller.pid: cannot be derived (the rule scales with the AMBs' "
+                          "Ks, and the rig has no AMB with Ks > 0); set [controller.pid]")
     ki = float(np.mean([k for a in cfg.amb for k in amb_factors(a)[0]]))
     ks = ks_over_ki * ki
     m_b = assemble_rotor(cfg).mass / 2

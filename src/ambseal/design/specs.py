@@ -83,6 +83,7 @@ from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
+from ambseal.config._checks import MAX_GAP_M
 from ambseal.design.conditions import judged_conditions
 from ambseal.design.pid import pid_from_rig
 from ambseal.design.weights import default_weights
@@ -163,9 +164,8 @@ def machine(cfg) -> Machine:
     for a, b in zip(cfg.amb, biases):
         if a.air_gap is not None:
             gaps.append(a.air_gap)
-        elif b is not None:
-            ki, ks = amb_factors(a)
-            gaps += [k_i * b / k_s for k_i, k_s in zip(ki, ks)]
+        elif b is not None:  # none where Ks = 0 or Ki·i0/Ks exceeds an air_gap's bound
+            gaps += [k_i * b / k_s for k_i, k_s in zip(*amb_factors(a)) if k_i * b <= MAX_GAP_M * k_s]
     s0 = min(gaps) if gaps and len(gaps) >= len(cfg.amb) else None
     return Machine(float(assemble_rotor(cfg).mass), fb[0] if fb else None, float(fa), i0,
                    s0, float(fs))

@@ -176,7 +176,12 @@ def check_weight(W, name: str, *, biproper: bool = False):
                           f"got {type(W).__name__}")
     if W.isdtime(strict=True):
         raise ConfigError(f"weight {name}: must be continuous-time")
-    S = control.ss(W)
+    try:
+        S = control.ss(W)
+    except (np.linalg.LinAlgError, ValueError, OverflowError, ZeroDivisionError):
+        # coefficients so far apart (1/M = 1e-308 beside ω_B) that the realisation overflows
+        raise ConfigError(f"weight {name}: no state-space realisation of its coefficients "
+                          "(non-finite, or too many orders of magnitude apart)") from None
     if S.ninputs != 1 or S.noutputs != 1:
         raise ConfigError(f"weight {name}: must be SISO, got {S.noutputs}×{S.ninputs}")
     mats = [np.asarray(m, float) for m in (S.A, S.B, S.C, S.D)]

@@ -40,14 +40,17 @@ from __future__ import annotations
 import json
 import re
 import warnings
+import zipfile
 from pathlib import Path
 
 import control
 import numpy as np
-from scipy.io import loadmat, savemat
+from scipy.io import savemat
 
+from ambseal.config._checks import MAX_DELAY_SAMPLES, MAX_FREQUENCY_HZ
 from ambseal.errors import DataError
 from ambseal.files import atomic_write
+from ambseal.identify.matlab_file import read_matlab
 from ambseal.robust.controller import SPEED
 from ambseal.robust.digital import DigitalController
 from ambseal.robust.digital_loop import DiscreteController
@@ -121,8 +124,8 @@ def controller_document(ctrl, judged=None) -> dict:
                  "delay_samples": int(ctrl.delay_samples), "method": ctrl.method,
                  "prewarp_hz": _nan(ctrl.prewarp_hz),
                  "removed_poles_hz": np.asarray(ctrl.removed_poles_hz, float),
-                 "discretisation_json": json.dumps(ctrl.to_dict()),
-                 "judged_json": json.dumps(judged or [])}
+                 "discretisation_json": json.dumps(ctrl.to_dict(), allow_nan=False),
+                 "judged_json": json.dumps(judged or [], allow_nan=False)}
     if isinstance(ctrl, ScheduledDigital):
         doc.update(kind="scheduled", name=ctrl.name, inputs=list(ctrl.inputs),
                    outputs=list(ctrl.outputs), parameter=ctrl.parameter,
@@ -162,7 +165,7 @@ def export_controller(ctrl, path, judged=None) -> Path:
     Raises
     ------
     DataError
-        Unknown suffix.
+        Unknown suffix, or a NaN or inf among the numbers (nothing is written).
     TypeError
         Not a digital controller.
     """
@@ -171,7 +174,12 @@ def export_controller(ctrl, path, judged=None) -> Path:
     if suffix not in _FORMATS:
         raise DataError(f"{path}: unknown controller format {suffix!r}, expected one of "
                         f"{_FORMATS}")
-    doc = controller_document(ctrl, judged)
+    try:
+        doc = controller_document(ctrl, judged)
+    except ValueError:  # json.dumps of the choice or the margins, allow_nan=False
+        raise DataError(f"{path}: the controller's discretisation or judged margins hold NaN "
+                        "or inf; nothing was written") from None
+    _finite_arrays({k: v for k, v in doc.items() if isinstance(v, np.ndarray)}, path)
     path.parent.mkdir(parents=True, exist_ok=True)
     if suffix == ".npz":
         arrays = {k: (np.array(v, dtype=str) if isinstance(v, (list, str)) else np.asarray(v))
@@ -191,7 +199,7 @@ def export_controller(ctrl, path, judged=None) -> Path:
         out = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in doc.items()}
         out = {k: (None if isinstance(v, float) and not np.isfinite(v) else v)
                for k, v in out.items()}
-        text = json.dumps(out, indent=1).encode()
+        text = json.dumps(out, indent=1, allow_nan=False).encode()
         atomic_write(path, lambda fh: fh.write(text))
     return path
 
@@ -201,23 +209,30 @@ def _read(path: Path) -> dict:
     if suffix not in _FORMATS:
         raise DataError(f"{path}: unknown controller format {suffix!r}, expected one of "
                         f"{_FORMATS}")
+    if suffix == ".mat":  # in a child process: scipy's reader can crash on a malformed file
+        m = read_matlab(path, squeeze_me=False, chars_as_strings=True)
     try:
         if suffix == ".json":
-            raw = json.loads(path.read_text())
-            return {k: (float("nan") if v is None else v) for k, v in raw.items()}
-        if suffix == ".npz":
+            raw = json.loads(path.read_text(encoding="utf-8"))
+        elif suffix == ".npz":
             with np.load(path, allow_pickle=False) as z:
                 return {k: (z[k].tolist() if z[k].dtype.kind == "U" else z[k]) for k in z.files}
-
-        m = loadmat(path, squeeze_me=False, chars_as_strings=True)
-    except (OSError, ValueError, KeyError) as exc:
+    except RecursionError:
+        raise DataError(f"{path}: not a readable controller file (nested too deeply)") from None
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile, TypeError) as exc:
         raise DataError(f"{path}: not a readable controller file ({exc})") from None
+    if suffix == ".json":
+        if not isinstance(raw, dict):
+            raise DataError(f"{path}: expected a JSON object of keys (A, B, C, D, inputs, "
+                            f"outputs, ...), got a JSON {type(raw).__name__}")
+        return {k: (float("nan") if v is None else v) for k, v in raw.items()}
     out = {}
-    for k, v in m.items():
-        if k.startswith("__"):
-            continue
-        if v.dtype == object:
-            out[k] = [str(np.ravel(x)[0]) for x in np.ravel(v)]
+    for k, (kind, v) in m.items():
+        if kind == "struct":  # ambseal writes plain variables
+            raise DataError(f"{path}: {k}: a struct with fields {v}, expected a matrix, a "
+                            "number or text (one variable per key, as ambseal writes them)")
+        if kind == "cells":
+            out[k] = v
         elif v.dtype.kind == "U":
             out[k] = str(np.ravel(v)[0]) if v.size else ""
         else:
@@ -234,8 +249,9 @@ def _arrays(doc: dict, path: Path, stacked: bool) -> dict:
             out[k] = X.reshape((-1,) + X.shape[-2:]) if stacked else np.atleast_2d(X)
     except KeyError as exc:
         raise DataError(f"{path}: missing key {exc}") from None
-    except ValueError as exc:
-        raise DataError(f"{path}: {exc}") from None
+    except (TypeError, ValueError) as exc:
+        raise DataError(f"{path}: {k}: expected a matrix of numbers ({exc})") from None
+    _finite_arrays(out, path)
     ny, nu = len(doc["inputs"]), len(doc["outputs"])
     for suf in ("", "_c", "_r"):
         A, B, C, D = (out[k + suf] for k in "ABCD")
@@ -251,6 +267,14 @@ def _arrays(doc: dict, path: Path, stacked: bool) -> dict:
             out["B" + suf] = np.zeros(shape + (0, ny))
             out["C" + suf] = np.zeros(shape + (nu, 0))
     return out
+
+
+def _finite_arrays(arrays: dict, path: Path) -> None:
+    """DataError naming the first matrix with a NaN or ±inf entry (a controller file holds
+    none: every number of ambseal's is checked before it is written)."""
+    for k, X in arrays.items():
+        if not np.all(np.isfinite(X)):
+            raise DataError(f"{path}: {k}: expected finite numbers, got NaN or inf")
 
 
 def _continuous(doc: dict, path: Path):
@@ -274,6 +298,7 @@ def _continuous(doc: dict, path: Path):
                         "as written by ambseal)") from None
     except (TypeError, ValueError) as exc:
         raise DataError(f"{path}: {exc}") from None
+    _finite_arrays(dict(zip("ABCD", (A, B, C, D))), path)
     n = A.shape[0] if A.size else 0
     want = {"A": (n, n), "B": (n, len(ins)), "C": (len(outs), n), "D": (len(outs), len(ins))}
     for k, X in zip("ABCD", (A, B, C, D)):
@@ -288,6 +313,11 @@ def _continuous(doc: dict, path: Path):
 def load_controller(path):
     """Read a controller written by :func:`export_controller` (any format).
 
+    Parameters
+    ----------
+    path : str or Path
+        A ``.json``, ``.npz`` or ``.mat`` file.
+
     Returns
     -------
     DigitalController, ScheduledDigital or control.StateSpace
@@ -298,10 +328,24 @@ def load_controller(path):
     Raises
     ------
     DataError
-        An unreadable file, a missing key, or matrices of the wrong shapes (named).
+        Whatever is wrong with the file, in every format, naming it and the problem: not
+        readable (truncated, not UTF-8, nested too deeply, MATLAB v7.3), not a document of
+        keys, a missing key, a value of the wrong type or shape (named), a NaN or inf.
     """
-
     path = Path(path)
+    try:
+        return _load(path)
+    except (TypeError, ValueError, KeyError, IndexError, AttributeError, OverflowError,
+            RecursionError) as exc:  # a value of a type no check above foresaw
+        if isinstance(exc, DataError):
+            raise
+        raise DataError(f"{path}: not a controller file of ambseal ({type(exc).__name__}: "
+                        f"{exc})") from None
+
+
+def _load(path: Path):
+    """:func:`load_controller` without its last net for unforeseen values."""
+
     doc = _read(path)
     if str(doc.get("kind", "continuous")) == "continuous":
         return _continuous(doc, path)
@@ -316,9 +360,12 @@ def load_controller(path):
     except (KeyError, TypeError, ValueError, IndexError) as exc:
         raise DataError(f"{path}: not a controller file of ambseal ({exc!r})") from None
     doc["inputs"], doc["outputs"] = ins, outs
-    if not (np.isfinite(fs) and fs > 0) or delay < 0:
-        raise DataError(f"{path}: sample_rate_hz = {fs}, delay_samples = {delay}: expected a "
-                        "positive rate and a delay >= 0")
+    if not (0 < fs <= MAX_FREQUENCY_HZ) or not 0 <= delay <= MAX_DELAY_SAMPLES \
+            or not isinstance(meta, dict):
+        raise DataError(f"{path}: sample_rate_hz = {fs:.6g}, delay_samples = {delay:.6g}, "
+                        f"discretisation_json a {type(meta).__name__}: expected a rate from 0 "
+                        f"to {MAX_FREQUENCY_HZ:g} Hz, a delay from 0 to {MAX_DELAY_SAMPLES} "
+                        "samples and a JSON object (the rig file's bounds)")
     pw = pw if np.isfinite(pw) else None
     cands = tuple(meta.get("candidates", ()))
     arr = _arrays(doc, path, stacked=(kind == "scheduled"))
@@ -326,6 +373,7 @@ def load_controller(path):
         par = _name(doc.get("parameter", SPEED), "parameter", path)
         key = "grid" if "grid" in doc else "speeds_rad_s"
         W = np.ravel(np.asarray(doc.get(key, ()), float))
+        _finite_arrays({key: W}, path)
         if arr["A"].shape[0] != W.size:
             raise DataError(f"{path}: A holds {arr['A'].shape[0]} table entries but "
                             f"{key} has {W.size}")

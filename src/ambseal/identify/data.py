@@ -63,7 +63,8 @@ CSV (``*.csv``)
 MATLAB (``*.mat``, level 5 / v7, not v7.3)
     One variable per column, named as the column, a column vector of doubles (``n × 1``;
     a row vector is accepted), plus ``metadata_json``, a char array holding the same JSON
-    object as the sidecar. Read with :func:`scipy.io.loadmat`; nothing is ever unpickled.
+    object as the sidecar. Read with :func:`scipy.io.loadmat` in a child process
+    (:mod:`ambseal.identify.matlab_file`); nothing read from a file is ever unpickled.
 
 Validation (:func:`load_measurement`)
 -------------------------------------
@@ -76,7 +77,8 @@ file it is the line after the header):
   cell that is not a number;
 * axes other than the rig's (``axes=`` argument): wrong count or names;
 * fewer than ``min_samples`` samples (and always fewer than 2);
-* NaN or ±inf in any column;
+* NaN or ±inf in any column; a displacement beyond ±0.1 m or a current beyond ±1e4 A (the
+  rig file's bounds of an air gap and of a current: no rotor moves or draws more);
 * time not increasing or not uniform: every step within ``time_rtol`` (relative) of the
   mean step; ``sample_rate_hz`` in the metadata disagreeing with it;
 * clipped currents: a run of at least :data:`CLIP_RUN` consecutive samples of a current
@@ -111,6 +113,7 @@ import scipy.io
 
 from ambseal.errors import AmbsealError, DataError
 from ambseal.files import atomic_write, read_text
+from ambseal.identify.matlab_file import read_matlab
 from ambseal.identify.measurement import (
     _RATE_RTOL,
     _RESERVED,
@@ -279,23 +282,21 @@ def _read_csv(path: Path) -> tuple[list[str], np.ndarray]:
 
 
 def _read_mat(path: Path) -> tuple[dict, dict[str, np.ndarray]]:
-    try:
-        raw = scipy.io.loadmat(str(path), squeeze_me=False, mat_dtype=False, chars_as_strings=True)
-    except NotImplementedError:
-        raise DataError(f"{path}: MATLAB v7.3 (HDF5) files are not supported; save with -v7") from None
-    except Exception as exc:
-        raise DataError(f"{path}: not a readable MATLAB file ({exc})") from None
+    # in a child process: scipy's reader can crash on a malformed file (matlab_file)
+    raw = read_matlab(path, squeeze_me=False, mat_dtype=False, chars_as_strings=True)
     if "metadata_json" not in raw:
         raise DataError(f"{path}: missing variable 'metadata_json' (the JSON metadata)")
-    mj = raw["metadata_json"]
-    if mj.dtype.kind != "U" or mj.size != 1:
+    kind, mj = raw["metadata_json"]
+    if kind != "array" or mj.dtype.kind != "U" or mj.size != 1:
         raise DataError(f"{path}: variable 'metadata_json' must be a char row vector")
     header = _read_header_json(str(mj.reshape(-1)[0]), f"{path}: variable 'metadata_json'")
     cols = {}
-    for name, v in raw.items():
-        if name.startswith("__") or name == "metadata_json":
+    for name, (kind, arr) in raw.items():
+        if name == "metadata_json":
             continue
-        arr = np.asarray(v)
+        if kind != "array":
+            raise DataError(f"{path}: column {name!r}: expected a numeric vector, got a "
+                            f"{'struct' if kind == 'struct' else 'cell array'}")
         if arr.dtype.kind not in "fiub" or arr.ndim != 2 or min(arr.shape) > 1:
             raise DataError(f"{path}: column {name!r}: expected a numeric vector, got {arr.dtype} {arr.shape}")
         cols[name] = arr.astype(float).reshape(-1)

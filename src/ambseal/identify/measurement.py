@@ -14,6 +14,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+from ambseal.config._checks import MAX_CURRENT_A, MAX_GAP_M
 from ambseal.errors import DataError
 
 __all__ = ["FORMAT_TAG", "CLIP_RUN", "CLIP_RTOL", "TIME_RTOL", "CHANNELS", "Measurement", "column_names",
@@ -237,6 +238,14 @@ def validate_measurement(
     if bad.any():
         r, c = np.argwhere(bad)[0]
         raise DataError(f"{source}: column {names[c]!r}, row {r + 1}: {float(table[r, c])!r} is not a finite number")
+    limit = np.array([np.inf] + [MAX_GAP_M if unit == "m" else MAX_CURRENT_A
+                                 for _ in meas.axes for _, _, unit in CHANNELS])
+    over = np.abs(table) > limit
+    if over.any():  # no rotor moves further in its bearing, nor draws more current
+        r, c = np.argwhere(over)[0]
+        unit = "m (an air gap's bound" if names[c].endswith("_m") else "A (a current's bound"
+        raise DataError(f"{source}: column {names[c]!r}, row {r + 1}: {float(table[r, c]):g} "
+                        f"is beyond ±{limit[c]:g} {unit} in a rig file)")
     t = meas.time_s
     dt = np.diff(t)
     step = (t[-1] - t[0]) / (n - 1)

@@ -35,7 +35,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ambseal.config import RigConfig, TruthSection
-from ambseal.errors import ModelError
+from ambseal.config._checks import MAX_ELEMENTS
+from ambseal.errors import ConfigError, ModelError
 from ambseal.identify.facility_loop import facility_loop
 from ambseal.lti.discrete import zoh
 from ambseal.lti.interconnect import series_inputs
@@ -88,6 +89,10 @@ def true_rig(cfg: RigConfig, truth: TruthSection) -> RigConfig:
         update["shaft"] = [s.model_copy(update={"elements": max(1, round(s.elements *
                                                                         truth.mesh_factor))})
                            for s in cfg.shaft]
+        n = sum(s.elements for s in update["shaft"])
+        if n > MAX_ELEMENTS:  # the rig file's own limit, for the same reason
+            raise ConfigError(f"truth.mesh_factor: {truth.mesh_factor:g} makes {n} beam "
+                              f"elements (at most {MAX_ELEMENTS} in all, as in a rig file)")
     return cfg.model_copy(update=update) if update else cfg
 
 

@@ -224,8 +224,12 @@ def identify(cfg: RigConfig, records: list[Measurement], names: list[str], *,
         fixed = fixed_uncertainty(cfg, params, list(names) + list(known))
         if known_fit is not None:
             fixed, corr = _with_estimates(fixed, known, known_fit, names)
-    res = fit_parameters(records, models, names, current_weight=current_weight, window=window,
-                         bounds=bounds, fixed=fixed, fixed_correlation=corr)
+    try:
+        res = fit_parameters(records, models, names, current_weight=current_weight,
+                             window=window, bounds=bounds, fixed=fixed, fixed_correlation=corr)
+    except IdentificationError as exc:  # the records' controllers are part of the model
+        raise IdentificationError(f"{', '.join(sources)}: {exc}" if sources else str(exc)
+                                  ) from None
     if refine and res.converged:
         est = dict(zip(names, res.estimate))
         models = build_models(cfg, records, {**known, **est}, controllers=controllers,

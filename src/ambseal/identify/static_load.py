@@ -50,7 +50,8 @@ from ambseal.model.rig import build_system, mechanical_plant
 from ambseal.model.seal import coefficient_value
 
 __all__ = ["StaticLoadResult", "static_ki", "load_steps", "virtual_static_load", "load_static_record",
-           "save_static_record", "join_static", "with_static", "programme_repeats"]
+           "save_static_record", "join_static", "with_static", "with_static_record",
+           "programme_repeats"]
 
 
 @dataclass(frozen=True)
@@ -323,3 +324,13 @@ def with_static(dynamic: FitResult, static: StaticLoadResult) -> tuple[FitResult
 
     return joined, {**static.to_dict(), "ki_ks_correlation_dynamic": ki_ks(dynamic),
                     "ki_ks_correlation_joined": ki_ks(joined)}
+
+
+def with_static_record(cfg: RigConfig, dynamic: FitResult, path: str | Path
+                       ) -> tuple[FitResult, dict]:
+    """:func:`with_static` of the load steps in ``path`` (:func:`load_static_record`),
+    Ki found by :func:`static_ki` at the closed-loop fit's values of the other parameters.
+    """
+    return with_static(dynamic, static_ki(cfg, *load_static_record(path, cfg),
+                                          values=dict(zip(dynamic.names, dynamic.estimate)),
+                                          source=str(path)))

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import tomllib
 import types
 import typing
@@ -603,7 +604,7 @@ def _option_rows(parser) -> list[tuple[str, str]]:
             name = a.metavar or a.dest
             name = {"?": f"[{name}]", "+": f"{name} ...", "*": f"[{name} ...]"}.get(
                 str(a.nargs), name)
-        text = (a.help or "").replace("%(default)s", str(a.default))
+        text = _rst_escape((a.help or "").replace("%(default)s", str(a.default)))
         extra = []
         if a.required and a.option_strings:
             extra.append("required")
@@ -625,8 +626,10 @@ def cli_rst() -> str:
     """Every command of ``ambseal`` with its usage, description and options."""
     p = _parser()
     subs, helps = _subparsers(p), _help_of(p)
-    lines = ["Global options", "~~~~~~~~~~~~~~", "", "::", "",
-             "   " + p.format_usage().strip().replace("usage: ", ""), ""]
+    usage = " ".join(p.format_usage().replace("usage: ", "").split())
+    usage = re.sub(r"\{[^}]*\} \.\.\.$", "COMMAND ...", usage)  # the command list is below
+    lines = ["Global options", "~~~~~~~~~~~~~~", "", "::", ""]
+    lines += ["   " + u for u in _wrap_usage(usage)] + [""]
     lines += _option_list(_option_rows(p))
     lines += ["Commands", "~~~~~~~~", ""]
     lines += [".. list-table::", "   :header-rows: 1", "   :widths: 25 75", "",
@@ -661,7 +664,7 @@ def _wrap_usage(usage: str, width: int = 72) -> list[str]:
 def _option_list(rows) -> list[str]:
     lines = []
     for name, text in rows:
-        lines += [f"``{name}``", f"   {_rst_escape(text) or 'no help text'}", ""]
+        lines += [f"``{name}``", f"   {text or 'no help text'}", ""]
     return lines
 
 

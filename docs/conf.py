@@ -68,6 +68,10 @@ html_show_sourcelink = False
 copybutton_prompt_text = r"\$ "
 copybutton_prompt_is_regexp = True
 copybutton_only_copy_prompt_lines = True
+copybutton_line_continuation_character = "\\"
+
+# option names (--truth) and quotes stay as typed, not typographic dashes and quotes
+smartquotes = False
 
 pygments_style = "friendly"
 pygments_dark_style = "monokai"

@@ -94,23 +94,24 @@ def _ids(pages):
 
 
 def _commands(body: str) -> list[tuple[str, list[str]]]:
-    """(command, expected output lines) of a console block; ``\\`` continues a line."""
+    """(command, expected output lines) of a console block; a line ending in ``\\``
+    continues on the next one, as in a POSIX shell (the backslash and the line break
+    removed, nothing else)."""
     cmds: list[tuple[str, list[str]]] = []
     pending = None
     for line in body.splitlines():
         if pending is not None:
-            pending += " " + line.strip().rstrip("\\").strip()
-            if not line.rstrip().endswith("\\"):
-                cmds.append((pending, []))
-                pending = None
+            pending += line
         elif line.startswith("$ "):
-            cmd = line[2:].strip()
-            if cmd.endswith("\\"):
-                pending = cmd.rstrip("\\").strip()
-            else:
-                cmds.append((cmd, []))
+            pending = line[2:]
         elif cmds:
             cmds[-1][1].append(line)
+            continue
+        if pending is not None and pending.endswith("\\"):
+            pending = pending[:-1]
+        elif pending is not None:
+            cmds.append((pending.strip(), []))
+            pending = None
     return cmds
 
 

@@ -12,6 +12,7 @@ content). Directives:
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 
@@ -55,7 +56,8 @@ class JsonSchema(_RstDirective):
         rel = self.arguments[0]
         path = ROOT / rel
         self.env.note_dependency(str(path))
-        return ref.json_schema_rst(path, rel)
+        here = Path(self.env.doc2path(self.env.docname)).parent
+        return ref.json_schema_rst(path, rel, os.path.relpath(path, here))
 
 
 def _lenient_in_docstrings(app, domain, node) -> bool | None:

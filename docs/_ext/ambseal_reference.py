@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import tomllib
 import types
 import typing
@@ -603,7 +604,7 @@ def _option_rows(parser) -> list[tuple[str, str]]:
             name = a.metavar or a.dest
             name = {"?": f"[{name}]", "+": f"{name} ...", "*": f"[{name} ...]"}.get(
                 str(a.nargs), name)
-        text = (a.help or "").replace("%(default)s", str(a.default))
+        text = _rst_escape((a.help or "").replace("%(default)s", str(a.default)))
         extra = []
         if a.required and a.option_strings:
             extra.append("required")
@@ -625,8 +626,10 @@ def cli_rst() -> str:
     """Every command of ``ambseal`` with its usage, description and options."""
     p = _parser()
     subs, helps = _subparsers(p), _help_of(p)
-    lines = ["Global options", "~~~~~~~~~~~~~~", "", "::", "",
-             "   " + p.format_usage().strip().replace("usage: ", ""), ""]
+    usage = " ".join(p.format_usage().replace("usage: ", "").split())
+    usage = re.sub(r"\{[^}]*\} \.\.\.$", "COMMAND ...", usage)  # the command list is below
+    lines = ["Global options", "~~~~~~~~~~~~~~", "", "::", ""]
+    lines += ["   " + u for u in _wrap_usage(usage)] + [""]
     lines += _option_list(_option_rows(p))
     lines += ["Commands", "~~~~~~~~", ""]
     lines += [".. list-table::", "   :header-rows: 1", "   :widths: 25 75", "",
@@ -661,7 +664,7 @@ def _wrap_usage(usage: str, width: int = 72) -> list[str]:
 def _option_list(rows) -> list[str]:
     lines = []
     for name, text in rows:
-        lines += [f"``{name}``", f"   {_rst_escape(text) or 'no help text'}", ""]
+        lines += [f"``{name}``", f"   {text or 'no help text'}", ""]
     return lines
 
 
@@ -674,48 +677,89 @@ def cli_commands() -> set[str]:
 # JSON Schema
 # ---------------------------------------------------------------------------------------
 
-def json_schema_rst(path: Path, shown_as: str) -> str:
-    """A JSON Schema file as a table of its properties (nested with dotted names) and the
-    file itself; if the file does not exist, a note saying that it is not shipped yet."""
+def json_schema_rst(path: Path, shown_as: str, include_as: str | None = None) -> str:
+    """A JSON Schema file as a table of its properties (nested with dotted names, ``[]``
+    for array items, ``<name>`` for maps; local ``$ref`` resolved) and a link to the file;
+    if the file does not exist, a note saying that it is not shipped yet. ``include_as``:
+    the file's path relative to the page."""
     if not path.is_file():
         return "\n".join([
             ".. note::", "",
             f"   **Not shipped yet.** The JSON Schema of ``metrics.json`` will be "
             f"``{shown_as}`` in the package; this page renders it from that file once it "
-            "exists. Until then the keys are described in :doc:`/getting-started` and "
-            "every ``metrics.json`` carries the run's keys as written.", ""])
+            "exists. Until then :doc:`/getting-started` lists the keys.", ""])
     schema = json.loads(path.read_text(encoding="utf-8"))
     rows: list[tuple[str, str, str]] = []
 
+    def deref(node):
+        seen = 0
+        while isinstance(node, dict) and isinstance(node.get("$ref"), str) and seen < 20:
+            ref, seen = node["$ref"], seen + 1
+            if not ref.startswith("#/"):
+                break
+            target = schema
+            for part in ref[2:].split("/"):
+                target = target.get(part, {}) if isinstance(target, dict) else {}
+            node = {**target, **{k: v for k, v in node.items() if k != "$ref"}}
+        return node
+
+    def variants(node):
+        node = deref(node)
+        alts = node.get("anyOf") or node.get("oneOf")
+        return [deref(a) for a in alts] if isinstance(alts, list) else [node]
+
+    def type_of(node) -> str:
+        names = []
+        for v in variants(node):
+            t = v.get("type", "object" if "properties" in v else "")
+            for one in (t if isinstance(t, list) else [t]):
+                if one == "array" and isinstance(v.get("items"), dict):
+                    inner = type_of(v["items"])
+                    one = f"array of {inner}" if inner else "array"
+                if one and one not in names:
+                    names.append(one)
+        return " or ".join(names)
+
     def walk(node, prefix, depth):
-        if depth > 6 or not isinstance(node, dict):
+        if depth > 8:
             return
-        req = set(node.get("required", ()))
-        for k, sub in (node.get("properties") or {}).items():
-            if not isinstance(sub, dict):
-                continue
-            t = sub.get("type", "")
-            t = " or ".join(t) if isinstance(t, list) else str(t)
-            desc = sub.get("description", "")
-            rows.append((f"{prefix}{k}", t + (" (required)" if k in req else ""), desc))
-            walk(sub, f"{prefix}{k}.", depth + 1)
-            if isinstance(sub.get("items"), dict):
-                walk(sub["items"], f"{prefix}{k}[].", depth + 1)
-            if isinstance(sub.get("additionalProperties"), dict):
-                walk(sub["additionalProperties"], f"{prefix}{k}.<name>.", depth + 1)
+        for v in variants(node):
+            req = set(v.get("required", ()))
+            for k, sub in (v.get("properties") or {}).items():
+                if not isinstance(sub, dict):
+                    continue
+                d = deref(sub)
+                desc = d.get("description", "") or sub.get("description", "")
+                rows.append((f"{prefix}{k}", type_of(sub) + (" (required)" if k in req
+                                                             else ""), desc))
+                walk(sub, f"{prefix}{k}.", depth + 1)
+                for w in variants(sub):
+                    if isinstance(w.get("items"), dict):
+                        walk(w["items"], f"{prefix}{k}[].", depth + 1)
+                    if isinstance(w.get("additionalProperties"), dict):
+                        walk(w["additionalProperties"], f"{prefix}{k}.<name>.", depth + 1)
     walk(schema, "", 0)
-    lines = [f"From ``{shown_as}``" + (f" ({schema['$id']})" if "$id" in schema else "")
-             + ".", ""]
+    title = schema.get("title") or ""
+    lines = [f"From ``{shown_as}``" + (f" ({title})" if title else "") + ".", ""]
     if schema.get("description"):
-        lines += [_rst_escape(" ".join(schema["description"].split())), ""]
-    lines += [".. list-table::", "   :header-rows: 1", "   :widths: 35 20 45", "",
+        lines += [_prose(schema["description"]), ""]
+    lines += [".. list-table::", "   :header-rows: 1", "   :widths: 40 18 42",
+              "   :class: schema-keys", "",
               "   * - key", "     - type", "     - meaning"]
     for k, t, desc in rows:
         lines += [f"   * - ``{k}``", f"     - {_rst_escape(t) or ' '}",
-                  f"     - {_rst_escape(' '.join(desc.split())) or ' '}"]
-    lines += ["", ".. code-block:: json", ""]
-    lines += ["   " + line for line in path.read_text(encoding="utf-8").splitlines()] + [""]
+                  f"     - {_prose(desc) or ' '}"]
+    lines += ["", f"The file itself: :download:`{path.name} <{include_as or path}>`.", ""]
     return "\n".join(lines)
+
+
+def _prose(text: str) -> str:
+    """A schema description on one line: its ``literals`` kept, cross-references to the
+    code as literals (the page is strict, the code's private names are not in it), bars
+    outside literals escaped."""
+    text = re.sub(r":[a-z]+:`~?([^`]+)`", r"``\1``", " ".join(str(text).split()))
+    parts = re.split(r"(``.+?``)", text)
+    return "".join(p if k % 2 else p.replace("|", "\\|") for k, p in enumerate(parts))
 
 
 __all__ = ["KEY_DOCS", "cli_commands", "cli_rst", "json_schema_rst", "missing_key_docs",

@@ -263,8 +263,8 @@ def _uncertainty_idle(P, K, nmeas, ncon, blks, w, mu_peak, rtol) -> bool:
 def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None, *,
               order: int | str = "auto", max_iter: int = 8, rtol: float = 1e-2,
               patience: int = 2, backoff: float = 1.01, fit_tol: float = 0.05,
-              search: int | str = "auto", time_budget_s: float = 30.0,
-              progress: bool = False) -> MusynResult:
+              search: int | str = "auto", search_backoff: float = 1.001,
+              time_budget_s: float = 30.0, progress: bool = False) -> MusynResult:
     """μ-synthesis by D–G–K iteration for mixed real/complex structures (Young 1996).
 
     Complex D–K (:func:`~ambseal.control.dk.musyn`) first, then D–G–K steps from its best
@@ -285,10 +285,10 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
         Number of measurements and control inputs.
     omega : array_like, optional
         Frequency grid in rad/s (default: :func:`~ambseal.control.dk.default_omega`).
-    order, max_iter, rtol, patience, backoff, fit_tol, search, progress
+    order, max_iter, rtol, patience, backoff, fit_tol, search, search_backoff, progress
         As in :func:`~ambseal.control.dk.musyn`; ``order`` is the D fit order of the D–K
         phase (the D–G–K phase selects its orders automatically), ``max_iter`` bounds each
-        phase, ``search`` is the D search of the D–K phase.
+        phase, ``search`` and ``search_backoff`` are the D search's of the D–K phase.
     time_budget_s : float
         CPU-time budget (s) of both phases (:func:`~ambseal.control.dk.musyn`): no D–G–K
         step starts once it is spent.
@@ -317,7 +317,7 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
     w = default_omega(P) if omega is None else np.asarray(omega, float)
     dk = musyn(P, blocks, nmeas, ncon, w, order=order, max_iter=max_iter, rtol=rtol,
                patience=patience, backoff=backoff, fit_tol=fit_tol, search=search,
-               time_budget_s=time_budget_s, progress=progress)
+               search_backoff=search_backoff, time_budget_s=time_budget_s, progress=progress)
     deadline = t0 + float(time_budget_s)
     blks = check_blocks(P, blocks, nmeas, ncon)
     if not any(b.kind == "real" for b in blks):

@@ -529,8 +529,8 @@ def _check(P, K, blocks, nmeas, ncon, w, upper):
 def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None, *,
           order: int | str = "auto", max_iter: int = 8, rtol: float = 1e-2,
           patience: int = 2, backoff: float = 1.01, fit_tol: float = 0.05,
-          search: int | str = "auto", time_budget_s: float = 30.0,
-          progress: bool = False) -> MusynResult:
+          search: int | str = "auto", search_backoff: float = 1.001,
+          time_budget_s: float = 30.0, progress: bool = False) -> MusynResult:
     """μ-synthesis by complex D–K iteration (Balas et al. 1993; thesis Paper 3 §3.4), then a
     direct search over the D scales, within a time budget.
 
@@ -584,6 +584,12 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
         problem (§8.12.4) D–K stalls at μ 1.027–1.044 and the search reaches the published
         optimum 0.974 in a few seconds (benchmarks/bench_dk.py); on the test rig's design
         (80 states, a K-step 0.4 s) it is not started.
+    search_backoff : float
+        The controller of the D found by the search is built at ``search_backoff·γ_opt``:
+        the search minimised γ_opt, and a controller ``backoff`` (1 %) above it gives back
+        much of the gain (Mackenroth's aircraft, ``benchmarks/bench_dk.py``: μ 0.985 at
+        1.01·γ_opt, 0.978 at 1.001·γ_opt). :func:`~ambseal.control.hinf.hinfsyn` raises it
+        when the closed loop is not stable.
     time_budget_s : float
         Budget (s of this process's CPU time, so that a busy machine does not change the
         result) of the iterations and the search: no iteration starts and no γ evaluation is
@@ -627,6 +633,8 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     if not (search == "auto" or (isinstance(search, (int, np.integer)) and search >= 0)):
         raise ConfigError(f"search={search!r}: expected a number of γ evaluations ≥ 0 or "
                           f"'auto'")
+    if not (isinstance(search_backoff, (int, float)) and search_backoff >= 1):
+        raise ConfigError(f"search_backoff={search_backoff!r}: expected a number ≥ 1")
     if not (isinstance(time_budget_s, (int, float)) and time_budget_s > 0):
         raise ConfigError(f"time_budget_s={time_budget_s!r}: expected a positive number of "
                           f"seconds (inf: no budget)")
@@ -682,8 +690,8 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     finalists = [_finalist(best)]
     evals = _search_evals(search, best[4], deadline - time.process_time(), t_kstep)
     if evals:
-        found = _search_step(P, blocks, cblocks, nmeas, ncon, w, best, evals, backoff,
-                             history, console, deadline)
+        found = _search_step(P, blocks, cblocks, nmeas, ncon, w, best, evals,
+                             search_backoff, history, console, deadline)
         if found is not None:
             finalists.append(_finalist(found))
     return _result(P, blocks, nmeas, ncon, w, finalists, history, t0)

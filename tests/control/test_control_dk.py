@@ -105,6 +105,21 @@ def test_musyn_rejects_mismatched_blocks():
         musyn(P, [(1, 1), (1, 0)], 1, 1)
     with pytest.raises(ValueError, match="0–4"):
         musyn(P, [(1, 1), (1, 1)], 1, 1, order=7)
+    with pytest.raises(ValueError, match="search"):
+        musyn(P, [(1, 1), (1, 1)], 1, 1, search=-1)
+    with pytest.raises(ValueError, match="time_budget_s"):
+        musyn(P, [(1, 1), (1, 1)], 1, 1, time_budget_s=0)
+
+
+def test_spent_time_budget_stops_after_the_first_k_step():
+    """Reference: the first D–K iteration is plain H∞ synthesis (D = I), so with the budget
+    spent at once musyn returns :func:`hinfsyn`'s controller: same γ, one history entry, no
+    D search — and still its μ re-checked around the peaks (≥ the grid's)."""
+    P = rp_plant()
+    h = hinfsyn(P, 1, 1)
+    r = musyn(P, [(1, 1), (1, 1)], 1, 1, time_budget_s=1e-9)
+    assert len(r.history) == 1 and r.gamma == pytest.approx(h.gamma, rel=1e-9)
+    assert r.mu >= r.mu_grid and r.mu <= h.gamma * (1 + 1e-6)
 
 
 def test_dscale_parameters_round_trip():

@@ -180,7 +180,7 @@ def mu_ab13md(cl, omega, sizes, pad_cols: int = 0) -> float:
 
 def _published_optimum(P, blocks, w) -> float:
     """Peak μ on ``w`` of our H∞ design on ``D P D⁻¹`` with S&P's d(s) (eq. 8.144)."""
-    from ambseal.control.dk import _scaled_plant
+    from ambseal.control._dscale import _scaled_plant
     from ambseal.control.hinf import hinfsyn, lft_lower
     from ambseal.control.mu import mussv
 

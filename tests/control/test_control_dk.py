@@ -128,7 +128,7 @@ def test_dscale_parameters_round_trip():
     (complex pairs, real pairs, first-order sections, orders 0–4) must give the same
     magnitude on the grid (D enters μ only through |D(jω)|), and the state spaces the search
     builds must be D and D⁻¹ (python-control's response of the transfer function)."""
-    from ambseal.control.dk import _realize, _tf_to_theta, _theta_to_tf
+    from ambseal.control._dscale import _realize, _tf_to_theta, _theta_to_tf
     from ambseal.lti.freqresp import freqresp
 
     w = np.logspace(-3, 3, 61)
@@ -153,7 +153,7 @@ def test_published_optimal_dscale_reproduces_the_published_mu():
     (s² + 1.34s + 0.7625)), H∞ synthesis on diag(d, d, I) P diag(d, d, I)⁻¹ gives γ 0.9737
     and peak μ 0.9737 on the 61-point grid 10⁻³…10³ rad/s (the published μ-optimal result
     that D–K is measured against in benchmarks/bench_dk.py)."""
-    from ambseal.control.dk import _scaled_plant
+    from ambseal.control._dscale import _scaled_plant
 
     P, blocks, w = distillation_rp_plant(), [(1, 1), (1, 1), (2, 2)], np.logspace(-3, 3, 61)
     d = ct.tf(2e-3 * np.poly([-1000.0, -0.25, -0.054]),

@@ -49,8 +49,8 @@ import control as ct
 from scipy.optimize import least_squares
 
 from ambseal.errors import ConfigError, SynthesisError
-from ambseal.control.dk import MusynResult, _check, _diag_sys, _ss, default_omega, \
-    fit_dscale, musyn
+from ambseal.control._dscale import _diag_sys, _ss
+from ambseal.control.dk import MusynResult, _check, default_omega, fit_dscale, musyn
 from ambseal.control.hinf import hinfsyn, lft_lower
 from ambseal.control.mu import check_blocks, mussv
 

@@ -26,10 +26,12 @@ from typing import Any, Sequence
 
 import numpy as np
 import control as ct
-from scipy.optimize import least_squares, minimize
+from scipy.optimize import least_squares
 
 from ambseal.errors import ConfigError, ModelError, SynthesisError
-from ambseal.control.hinf import check_plant, hinf_gamma_opt, hinfsyn, lft_lower
+from ambseal.control._dscale import _complexify, _logmag, _scaled_plant, _search_evals, \
+    _search_step, _theta_to_tf
+from ambseal.control.hinf import check_plant, hinfsyn, lft_lower
 from ambseal.control.mu import check_blocks, mu_peak, mussv
 
 __all__ = ["MusynResult", "musyn", "fit_magnitude", "fit_dscale", "default_omega",
@@ -37,40 +39,6 @@ __all__ = ["MusynResult", "musyn", "fit_magnitude", "fit_dscale", "default_omega
 
 
 # --------------------------------------------------------------------------- D fitting
-def _logmag(theta, w, order):
-    """log|W(jω)| for W = k Π(num sections)/Π(den sections), all roots in the LHP."""
-    lk, rest = theta[0], theta[1:]
-    n2, n1 = divmod(order, 2)
-    out = np.full_like(w, lk)
-    i = 0
-    for sign in (1.0, -1.0):
-        for _ in range(n2):
-            b0, b1 = np.exp(rest[i]), np.exp(rest[i + 1])
-            out += sign * 0.5 * np.log((b0 - w**2) ** 2 + (b1 * w) ** 2)
-            i += 2
-        for _ in range(n1):
-            a = np.exp(rest[i])
-            out += sign * 0.5 * np.log(w**2 + a**2)
-            i += 1
-    return out
-
-
-def _theta_to_tf(theta, order):
-    k = np.exp(theta[0])
-    n2, n1 = divmod(order, 2)
-    polys, i = [], 0
-    for _ in range(2):
-        p = np.array([1.0])
-        for _ in range(n2):
-            p = np.polymul(p, [1.0, np.exp(theta[1 + i + 1]), np.exp(theta[1 + i])])
-            i += 2
-        for _ in range(n1):
-            p = np.polymul(p, [1.0, np.exp(theta[1 + i])])
-            i += 1
-        polys.append(p)
-    return k * polys[0], polys[1]
-
-
 def fit_magnitude(omega, mag, order: int):
     """Stable, minimum-phase, biproper W(s) with |W(jω)| ≈ mag (log-magnitude least squares).
 
@@ -353,173 +321,6 @@ class MusynResult:
 
 
 # --------------------------------------------------------------------------- D–K
-def _complexify(blks):
-    """Diagonal-D structure: repeated scalars → independent complex scalars."""
-    out, groups = [], []
-    for j, b in enumerate(blks):
-        if b.kind == "full":
-            out.append((b.r, b.c))
-            groups.append(j)
-        else:
-            out.extend([(1, 1)] * b.r)
-            groups.extend([j] * b.r)
-    return out
-
-
-def _ss(tf):
-    s = ct.ss(tf)
-    return np.asarray(s.A, float), np.asarray(s.B, float), np.asarray(s.C, float), np.asarray(s.D, float)
-
-
-def _diag_sys(parts):
-    """Block-diagonal state space of SISO (A, B, C, D) tuples."""
-    n = sum(p[0].shape[0] for p in parts)
-    k = len(parts)
-    A = np.zeros((n, n)); B = np.zeros((n, k)); C = np.zeros((k, n)); D = np.zeros((k, k))
-    o = 0
-    for i, (a, b, c, d) in enumerate(parts):
-        m = a.shape[0]
-        A[o:o + m, o:o + m] = a; B[o:o + m, i:i + 1] = b; C[i:i + 1, o:o + m] = c
-        D[i, i] = d[0, 0]
-        o += m
-    return ct.ss(A, B, C, D)
-
-
-def _realize(theta, order):
-    """State spaces (A, B, C, D) of the D scale of section parameters ``theta``
-    (:func:`_theta_to_tf`) and of its inverse, by numpy alone (for the D search)."""
-    from scipy.signal import tf2ss
-
-    if order == 0:
-        a, b, c, d = np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), \
-            np.exp(theta[:1]).reshape(1, 1)
-    else:
-        a, b, c, d = tf2ss(*_theta_to_tf(theta, order))
-    di = 1.0 / d
-    return (a, b, c, d), (a - b @ di @ c, b @ di, -di @ c, di)
-
-
-def _scaled_plant(P, cblocks, fits, nmeas, ncon):
-    """diag(D_l(s), I) · P · diag(D_r(s)⁻¹, I) for fitted scalars (last block: 1); each fit
-    a transfer function or its :func:`_realize` pair."""
-    left, right = [], []
-    one = (np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.ones((1, 1)))
-    for (r, c), f in zip(cblocks, list(fits) + [None]):
-        if f is None:
-            lf = rf = one
-        elif isinstance(f, tuple):
-            lf, rf = f
-        else:
-            lf = _ss(f)
-            rf = _ss(1 / f)
-        left.extend([lf] * c)
-        right.extend([rf] * r)
-    left.extend([one] * nmeas)
-    right.extend([one] * ncon)
-    Pb = ct.ss(P.A, P.B, P.C, P.D)
-    Ps = _diag_sys(left) * Pb * _diag_sys(right)
-    names_in, names_out = list(P.input_labels), list(P.output_labels)
-    return ct.ss(Ps.A, Ps.B, Ps.C, Ps.D, inputs=names_in, outputs=names_out, name="P_scaled")
-
-
-def _tf_to_theta(tf):
-    """Section parameters (:func:`_logmag`) of a fitted D scale and its order: the inverse
-    of :func:`_theta_to_tf` (complex root pairs first, then real roots paired by size)."""
-    num, den = (np.asarray(p, float) for p in (tf.num[0][0], tf.den[0][0]))
-    order = den.size - 1
-    th = [np.log(abs(num[0] / den[0]))]
-    for poly in (num, den):
-        r = np.roots(poly)
-        secs = [np.real(np.poly([x, np.conj(x)])) for x in r if x.imag > 1e-12 * abs(x)]
-        real = sorted((x.real for x in r if abs(x.imag) <= 1e-12 * abs(x)), key=abs)
-        while len(secs) < order // 2:
-            secs.append(np.poly([real.pop(0), real.pop(0)]))
-        th += [v for sec in secs for v in (np.log(sec[2]), np.log(sec[1]))]
-        th += [np.log(-a) for a in real]
-    return np.array(th), order
-
-
-class _OutOfTime(Exception):
-    """The time budget ran out inside the D search."""
-
-
-#: D search: Nelder–Mead evaluations per parameter of the fitted D scales. On Skogestad &
-#: Postlethwaite's distillation problem (two scales of order 4, 18 parameters, on their
-#: 61-point grid) the search reached μ 0.984 after 150 γ evaluations, 0.978 after 300 and
-#: 0.9736, the published optimum, after 600 (benchmarks/bench_dk.py): 33 per parameter;
-#: 50 leaves room for the restarts.
-SEARCH_EVALS_PER_PARAMETER = 50
-#: The search starts only when the time left affords this many γ evaluations per parameter
-#: (each timed by the last K-step, which costs more than a γ evaluation: a conservative
-#: estimate); a simplex over n parameters needs n + 1 evaluations to start and a few sweeps
-#: to move, so fewer rarely lower γ (the test rig's design, 80 states: 40 evaluations found
-#: no lower γ).
-SEARCH_MIN_EVALS_PER_PARAMETER = 20
-
-
-def _search_dscales(P, cblocks, fits, nmeas, ncon, evals, deadline=None, restarts=2):
-    """Direct search (Nelder–Mead, at most ``evals`` γ evaluations, until ``deadline``)
-    over the section parameters of the fitted D scales for the smallest γ_opt of
-    ``D P D⁻¹`` (γ to 1e-4).
-
-    D–K stalls above the μ-optimum because each D-step fits the pointwise-optimal D of the
-    *current* K; this searches the same rational D's for the best K-step directly. Every
-    parameter vector is a stable, minimum-phase D (:func:`_logmag`), and γ_opt of the scaled
-    problem bounds μ of its optimal controller at every frequency. When Nelder–Mead
-    converges before the evaluations run out it restarts from its best point with a fresh
-    simplex (at most ``restarts`` times): a converged simplex in a dozen dimensions has
-    often collapsed onto a subspace (Lagarias et al. 1998; the restart is the classical
-    remedy, Kelley 1999). Returns ``(fits, γ_opt, evaluations)``, with ``fits`` None when no
-    better D was found; the best D found so far when the deadline passes.
-    """
-    parts = [_tf_to_theta(f) for f in fits]
-    cuts = np.cumsum([0] + [th.size for th, _ in parts])
-
-    def sections(x):
-        return [(x[a:b], od) for (_, od), a, b in zip(parts, cuts[:-1], cuts[1:])]
-
-    best = {"x": None, "g": np.inf, "n": 0}
-
-    def gamma(x):
-        if deadline is not None and best["n"] > 0 and time.process_time() > deadline:
-            raise _OutOfTime
-        best["n"] += 1
-        try:
-            Ps = _scaled_plant(P, cblocks, [_realize(*t) for t in sections(x)], nmeas, ncon)
-            g = hinf_gamma_opt(Ps, nmeas, ncon, rtol=1e-4, near=near[0])
-        except (SynthesisError, ModelError, ValueError, np.linalg.LinAlgError):
-            return np.inf
-        near[0] = g if near[0] is None else min(near[0], g)
-        if g < best["g"]:
-            best.update(x=np.array(x, float), g=g)
-        return g
-
-    x0 = np.concatenate([th for th, _ in parts])
-    near = [None]
-    g0 = gamma(x0)
-    x = x0
-    for _ in range(int(restarts) + 1):
-        left = int(evals) - best["n"]
-        if left <= x.size + 1:
-            break
-        # first simplex: each parameter (a logarithm) moved by 0.3, i.e. by a factor 1.35
-        simplex = np.vstack([x, x + 0.3 * np.eye(x.size)])
-        g_start = best["g"]
-        try:
-            minimize(gamma, x, method="Nelder-Mead",
-                     options={"maxfev": left, "adaptive": True, "xatol": 1e-3,
-                              "fatol": 1e-5, "initial_simplex": simplex})
-        except _OutOfTime:
-            break
-        if not best["g"] < g_start * (1 - 1e-4):
-            break
-        x = best["x"]
-    if not best["g"] < g0:
-        return None, g0, best["n"]
-    return [ct.tf(*_theta_to_tf(*t)) for t in sections(best["x"])], float(best["g"]), \
-        best["n"]
-
-
 def _check(P, K, blocks, nmeas, ncon, w, upper):
     """μ of ``F_l(P, K)`` re-checked between the grid points around its peaks
     (:func:`~ambseal.control.mu.mu_peak`)."""
@@ -542,7 +343,8 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     stalls a few per cent above the μ-optimum: each D-step fits the D that is optimal for the
     *current* K, not the D whose K-step is best. So, when the time budget affords it, a
     direct search over the fitted scales' parameters for the smallest γ_opt of ``D P D⁻¹``
-    follows (:func:`_search_dscales`, Nelder–Mead with restarts). Finally μ of the kept
+    follows (:func:`~ambseal.control._dscale._search_dscales`, Nelder–Mead with
+    restarts). Finally μ of the kept
     controller is re-checked between the grid points around the curve's peaks
     (:func:`~ambseal.control.mu.mu_peak`): the reported μ is that value, and the result
     names the frequencies it was computed at.
@@ -576,14 +378,13 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
         Relative magnitude tolerance of the automatic D-scale fit order.
     search : int or "auto"
         The D search after the iterations: at most this many γ evaluations (0: none).
-        ``"auto"`` (default): ``SEARCH_EVALS_PER_PARAMETER`` (50) per parameter of the
-        fitted scales, started only when the time left affords
-        ``SEARCH_MIN_EVALS_PER_PARAMETER`` (20) per parameter at the cost of the last
-        K-step. Its controller (at ``backoff``) is kept when its μ is lower, recorded in
-        ``history`` with ``step = "D search"``. On Skogestad & Postlethwaite's distillation
-        problem (§8.12.4) D–K stalls at μ 1.027–1.044 and the search reaches the published
-        optimum 0.974 in a few seconds (benchmarks/bench_dk.py); on the test rig's design
-        (80 states, a K-step 0.4 s) it is not started.
+        ``"auto"`` (default): 50 per parameter of the fitted scales, started only when the
+        time left affords 20 per parameter at the cost of the last K-step. Its controller
+        (at ``search_backoff``) is kept when its μ is lower, recorded in ``history`` with
+        ``step = "D search"``. On Skogestad & Postlethwaite's distillation problem
+        (§8.12.4) D–K stalls at μ 1.027–1.044 and the search goes below the published
+        μ-optimal 0.974 (0.963) in about 3 s of CPU (benchmarks/bench_dk.py); on the test
+        rig's design (80 states, a K-step 0.4 s) it is not started.
     search_backoff : float
         The controller of the D found by the search is built at ``search_backoff·γ_opt``:
         the search minimised γ_opt, and a controller ``backoff`` (1 %) above it gives back
@@ -704,18 +505,6 @@ def _finalist(entry):
     return (peak, it, hr.K, float(hr.gamma), np.asarray(mu.upper, float), fits)
 
 
-def _search_evals(search, fits, time_left, t_eval) -> int:
-    """γ evaluations granted to the D search (0: no search); see :func:`musyn`."""
-    if not fits or search == 0:
-        return 0
-    n = sum(_tf_to_theta(f)[0].size for f in fits)
-    if search != "auto":
-        return int(search)
-    if time_left < SEARCH_MIN_EVALS_PER_PARAMETER * n * t_eval:
-        return 0
-    return SEARCH_EVALS_PER_PARAMETER * n
-
-
 def _result(P, blocks, nmeas, ncon, w, finalists, history, t0, alternatives=()):
     """The finalist ``(μ on the grid, index, K, γ, μ curve on w, fits)`` with the lowest μ
     re-checked around its peaks (:func:`_check`), as a MusynResult."""
@@ -726,25 +515,3 @@ def _result(P, blocks, nmeas, ncon, w, finalists, history, t0, alternatives=()):
                        scalings=fits, alternatives=tuple(alternatives), mu_grid=pk.grid_peak,
                        check_omega=pk.omega, check_mu=pk.upper, check=pk.describe(),
                        elapsed_s=time.process_time() - t0)
-
-
-def _search_step(P, blocks, cblocks, nmeas, ncon, w, best, evals, backoff, history, console,
-                 deadline=None):
-    """:func:`_search_dscales` from the best D–K iteration's fits; returns the finalist
-    ``(μ on the grid, index, HinfResult, MuResult, fits)`` of its controller, recorded in
-    ``history``, or None when the search found no D with a lower γ_opt."""
-    fits, _, n = _search_dscales(P, cblocks, best[4], nmeas, ncon, evals, deadline)
-    if fits is None:
-        return None
-    try:
-        hr = hinfsyn(_scaled_plant(P, cblocks, fits, nmeas, ncon), nmeas, ncon,
-                     backoff=backoff)
-    except SynthesisError:
-        return None
-    mu = mussv(lft_lower(P, hr.K, nmeas, ncon), blocks, w, lower=False)
-    peak = float(np.max(mu.upper))
-    history.append({"iteration": len(history), "gamma": hr.gamma, "mu": peak,
-                    "order": hr.order, "step": "D search", "evaluations": n})
-    if console is not None:
-        console.print(f"D search ({n} γ evaluations): γ = {hr.gamma:.4g}, μ = {peak:.4g}")
-    return (peak, len(history) - 1, hr, mu, tuple(fits))

@@ -65,30 +65,38 @@ BLOCKS = [(-1, 0), (1, 2)]
 
 @pytest.fixture(scope="module")
 def complex_dk():
-    """Complex D–K of :func:`gain_plant` by its real uncertainty ±r, computed once per r for
-    the tests of this module."""
+    """Complex D–K of :func:`gain_plant` by its real uncertainty ±r (with musyn's default D
+    search, or with ``search=0`` the iteration alone), computed once per case for the tests
+    of this module."""
     done = {}
 
-    def at(r: float):
-        if r not in done:
-            done[r] = musyn(gain_plant(r), BLOCKS, 1, 1, W_GRID, max_iter=6)
-        return done[r]
+    def at(r: float, search="auto"):
+        if (r, search) not in done:
+            done[r, search] = musyn(gain_plant(r), BLOCKS, 1, 1, W_GRID, max_iter=6,
+                                    search=search)
+        return done[r, search]
 
     return at
 
 
 def test_dgk_beats_complex_dk_and_holds_by_a_parameter_sweep(complex_dk):
-    """D–G–K's mixed μ is ≥ 10 % below complex D–K's on a real gain uncertainty (measured
-    3.24 → 2.54). Reference for the μ it reports: the main-loop theorem checked by brute
-    force — for every real δ with |δ| ≤ 1/μ the perturbed loop, rebuilt from G(1 + Rδ) and
-    K without the LFT, is stable and its performance σ̄ on the grid is ≤ μ."""
+    """D–G–K's mixed μ is ≥ 10 % below that of the complex D–K iteration's controller on a
+    real gain uncertainty (measured 3.24 → 2.54; complex D–K followed by its D search
+    reaches 2.59, and D–G–K starts from there). Reference for the μ it reports: the
+    main-loop theorem checked by brute force — for every real δ with |δ| ≤ 1/μ the perturbed
+    loop, rebuilt from G(1 + Rδ) and K without the LFT, is stable and its performance σ̄ on
+    the grid is ≤ μ."""
     P = gain_plant()
     w, blocks = W_GRID, BLOCKS
-    dk = complex_dk(R)
+    dk = complex_dk(R, search=0)
     r = musyn_dgk(P, blocks, 1, 1, w, max_iter=6)
-    assert r.mu < 0.9 * dk.mu
-    assert {h["step"] for h in r.history} == {"D-K", "D-G-K"}
-    assert r.mu == pytest.approx(float(np.max(mussv(lft_lower(P, r.K, 1, 1), blocks, w).upper)))
+    assert r.mu < 0.9 * dk.mu and r.mu <= complex_dk(R).mu
+    assert "D-G-K" in {h["step"] for h in r.history} <= {"D-K", "D search", "D-G-K"}
+    # the reported μ: the peak over the grid it names (W_GRID and the points added at its
+    # peaks), not below the grid's
+    mu_check = mussv(lft_lower(P, r.K, 1, 1), blocks, r.check_omega).upper
+    assert r.mu == pytest.approx(float(np.max(mu_check)), rel=1e-6)
+    assert r.mu >= float(np.max(mussv(lft_lower(P, r.K, 1, 1), blocks, w).upper)) * (1 - 1e-6)
     K = r.K
     Kw = np.asarray(K(1j * w)).ravel()
     Gw, Wpw, Wuw = (np.asarray(T(1j * w)).ravel() for T in (G0, WP, WU))
@@ -117,7 +125,7 @@ def test_dgk_skipped_where_nominal_performance_sets_the_peak(complex_dk):
         assert (dk.mu <= 1.01 * nominal) is idle
         if idle:
             res = musyn_dgk(P, blocks, 1, 1, w, max_iter=6)
-            assert {h["step"] for h in res.history} == {"D-K"}
+            assert "D-G-K" not in {h["step"] for h in res.history}
             assert res.mu == dk.mu and np.array_equal(res.K.A, dk.K.A)
 
 

@@ -40,6 +40,7 @@ performance (the seal's k alone has real μ ≈ 0): no D–G–K step is taken t
 
 from __future__ import annotations
 
+import time
 from dataclasses import replace
 from typing import Sequence
 
@@ -50,7 +51,8 @@ from scipy.optimize import least_squares
 
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.lti.freqresp import freqresp
-from ambseal.robust.dk import MusynResult, _diag_sys, _ss, default_omega, fit_dscale, musyn
+from ambseal.robust._dscale import _diag_sys, _ss
+from ambseal.robust.dk import MusynResult, _check, default_omega, fit_dscale, musyn
 from ambseal.robust.hinf import hinfsyn, lft_lower
 from ambseal.robust.mu import check_blocks, mussv
 
@@ -262,7 +264,8 @@ def _uncertainty_idle(P, K, nmeas, ncon, blks, w, mu_peak, rtol) -> bool:
 def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None, *,
               order: int | str = "auto", max_iter: int = 8, rtol: float = 1e-2,
               patience: int = 2, backoff: float = 1.01, fit_tol: float = 0.05,
-              progress: bool = False) -> MusynResult:
+              search: int | str = "auto", search_backoff: float = 1.001,
+              time_budget_s: float = 30.0, progress: bool = False) -> MusynResult:
     """μ-synthesis by D–G–K iteration for mixed real/complex structures (Young 1996).
 
     Complex D–K (:func:`~ambseal.robust.dk.musyn`) first, then D–G–K steps from its best
@@ -283,16 +286,20 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
         Number of measurements and control inputs.
     omega : array_like, optional
         Frequency grid in rad/s (default: :func:`~ambseal.robust.dk.default_omega`).
-    order, max_iter, rtol, patience, backoff, fit_tol, progress
+    order, max_iter, rtol, patience, backoff, fit_tol, search, search_backoff, progress
         As in :func:`~ambseal.robust.dk.musyn`; ``order`` is the D fit order of the D–K
         phase (the D–G–K phase selects its orders automatically), ``max_iter`` bounds each
-        phase.
+        phase, ``search`` and ``search_backoff`` are the D search's of the D–K phase.
+    time_budget_s : float
+        CPU-time budget (s) of both phases (:func:`~ambseal.robust.dk.musyn`): no D–G–K
+        step starts once it is spent.
 
     Returns
     -------
     MusynResult
-        The controller with the lowest mixed μ upper bound (on ``blocks`` as given).
-        ``history`` has one entry per K-step with ``step`` ``"D-K"`` or ``"D-G-K"`` (the
+        The controller with the lowest mixed μ upper bound (on ``blocks`` as given),
+        re-checked around the peaks as in :func:`~ambseal.robust.dk.musyn` (``mu``,
+        ``check_omega``; ``mu_grid`` on ``omega`` alone). ``history`` has one entry per K-step with ``step`` ``"D-K"`` or ``"D-G-K"`` (the
         latter also ``beta``, the level of its scalings, and ``jg_fit_error``);
         ``scalings`` holds the fits of the best iteration (D–G–K: ``(d, f, h)`` per block);
         ``alternatives`` the best complex D–K controller when D–G–K's is better at full
@@ -307,22 +314,29 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
     SynthesisError
         If the first K-step (plain H∞) fails.
     """
+    t0 = time.process_time()
     w = default_omega(P) if omega is None else np.asarray(omega, float)
     dk = musyn(P, blocks, nmeas, ncon, w, order=order, max_iter=max_iter, rtol=rtol,
-               patience=patience, backoff=backoff, fit_tol=fit_tol, progress=progress)
+               patience=patience, backoff=backoff, fit_tol=fit_tol, search=search,
+               search_backoff=search_backoff, time_budget_s=time_budget_s, progress=progress)
+    deadline = t0 + float(time_budget_s)
     blks = check_blocks(P, blocks, nmeas, ncon)
     if not any(b.kind == "real" for b in blks):
         return dk
     sblocks, real = _split(blks)
-    history = [dict(h, step="D-K") for h in dk.history]
-    if _uncertainty_idle(P, dk.K, nmeas, ncon, blks, w, dk.mu, rtol):
+    history = [dict(h, step=h.get("step", "D-K")) for h in dk.history]
+    if _uncertainty_idle(P, dk.K, nmeas, ncon, blks, w, dk.mu_grid, rtol):
         return replace(dk, history=tuple(history))
     console = None
     if progress:
+
         console = Console(stderr=True)
-    best = (dk.mu, dk.best_iteration, dk.K, dk.gamma, np.asarray(dk.mu_curve), dk.scalings)
+    # iterates compared by their peak on the grid, as in complex D–K
+    best = (dk.mu_grid, dk.best_iteration, dk.K, dk.gamma, np.asarray(dk.mu_curve), dk.scalings)
     K, stall = dk.K, 0
     for it in range(len(history), len(history) + max_iter):
+        if time.process_time() > deadline:
+            break
         mu_s = mussv(lft_lower(P, K, nmeas, ncon), sblocks, w, lower=False)
         beta = float(np.max(mu_s.upper))
         fits, jg_err = _dg_fits(mu_s, real, beta, w, fit_tol)
@@ -344,8 +358,15 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
         if stall >= patience:
             break
         K = hr.K
-    peak, it_best, K, gamma, curve, fits_best = best
-    alt = () if K is dk.K else ({"step": "D-K", "K": dk.K, "mu": dk.mu, "gamma": dk.gamma},)
-    return MusynResult(K=K, mu=peak, mu_omega=float(w[np.argmax(curve)]), mu_curve=curve,
-                       omega=w, gamma=gamma, history=tuple(history), best_iteration=it_best,
-                       scalings=fits_best, alternatives=alt)
+    if best[2] is dk.K:
+        return replace(dk, history=tuple(history), elapsed_s=time.process_time() - t0)
+    _, it_best, K, gamma, curve, fits_best = best
+    pk = _check(P, K, blocks, nmeas, ncon, w, curve)
+    if pk.peak >= dk.mu:  # complex D–K's controller is better once both are re-checked
+        return replace(dk, history=tuple(history), elapsed_s=time.process_time() - t0)
+    alt = ({"step": "D-K", "K": dk.K, "mu": dk.mu, "gamma": dk.gamma},)
+    return MusynResult(K=K, mu=pk.peak, mu_omega=pk.omega_peak, mu_curve=curve, omega=w,
+                       gamma=gamma, history=tuple(history), best_iteration=it_best,
+                       scalings=fits_best, alternatives=alt, mu_grid=pk.grid_peak,
+                       check_omega=pk.omega, check_mu=pk.upper, check=pk.describe(),
+                       elapsed_s=time.process_time() - t0)

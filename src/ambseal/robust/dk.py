@@ -7,9 +7,11 @@ functions and absorbed into the plant. References: Balas, Doyle, Glover, Packard
 (μ-Analysis and Synthesis Toolbox, 1993); Skogestad & Postlethwaite (2005) §8.12;
 Zhou, Doyle & Glover (1996) ch. 11.
 
-Optionally, when the iterations stop, a direct search over the fitted D scales' parameters
-for the smallest γ_opt of ``D P D⁻¹`` (``musyn(search=…)``): D–K stalls where each D-step's
-pointwise-optimal D of the current K is not the best D for the next K-step.
+When the iterations stop and the time budget affords it, a direct search over the fitted D
+scales' parameters for the smallest γ_opt of ``D P D⁻¹`` (``musyn(search=…)``): D–K stalls
+where each D-step's pointwise-optimal D of the current K is not the best D for the next
+K-step. The μ reported is the upper bound of the kept controller re-checked between the grid
+points around its peaks (:func:`~ambseal.robust.mu.mu_peak`), and the result names that grid.
 
 Simplifications (documented limits): real blocks are treated as complex and repeated scalars
 as independent scalars in the D-step (so D is diagonal, one scalar per channel group); the
@@ -18,58 +20,32 @@ reported μ is computed with the structure as given (mixed, repeated), which is 
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 from typing import Any, Sequence
 
 import control as ct
 import numpy as np
 from rich.console import Console
-from scipy.optimize import least_squares, minimize
-from scipy.signal import tf2ss
+from scipy.optimize import least_squares
 
 from ambseal.errors import ConfigError, ModelError, SynthesisError
-from ambseal.robust.hinf import check_plant, hinf_gamma_opt, hinfsyn, lft_lower
-from ambseal.robust.mu import check_blocks, mussv
+from ambseal.robust._dscale import (
+    _complexify,
+    _logmag,
+    _scaled_plant,
+    _search_evals,
+    _search_step,
+    _theta_to_tf,
+)
+from ambseal.robust.hinf import check_plant, hinfsyn, lft_lower
+from ambseal.robust.mu import check_blocks, mu_peak, mussv
 
 __all__ = ["MusynResult", "musyn", "fit_magnitude", "fit_dscale", "default_omega",
            "design_omega"]
 
 
 # --------------------------------------------------------------------------- D fitting
-def _logmag(theta, w, order):
-    """log|W(jω)| for W = k Π(num sections)/Π(den sections), all roots in the LHP."""
-    lk, rest = theta[0], theta[1:]
-    n2, n1 = divmod(order, 2)
-    out = np.full_like(w, lk)
-    i = 0
-    for sign in (1.0, -1.0):
-        for _ in range(n2):
-            b0, b1 = np.exp(rest[i]), np.exp(rest[i + 1])
-            out += sign * 0.5 * np.log((b0 - w**2) ** 2 + (b1 * w) ** 2)
-            i += 2
-        for _ in range(n1):
-            a = np.exp(rest[i])
-            out += sign * 0.5 * np.log(w**2 + a**2)
-            i += 1
-    return out
-
-
-def _theta_to_tf(theta, order):
-    k = np.exp(theta[0])
-    n2, n1 = divmod(order, 2)
-    polys, i = [], 0
-    for _ in range(2):
-        p = np.array([1.0])
-        for _ in range(n2):
-            p = np.polymul(p, [1.0, np.exp(theta[1 + i + 1]), np.exp(theta[1 + i])])
-            i += 2
-        for _ in range(n1):
-            p = np.polymul(p, [1.0, np.exp(theta[1 + i])])
-            i += 1
-        polys.append(p)
-    return k * polys[0], polys[1]
-
-
 def fit_magnitude(omega, mag, order: int):
     """Stable, minimum-phase, biproper W(s) with |W(jω)| ≈ mag (log-magnitude least squares).
 
@@ -280,7 +256,9 @@ class MusynResult:
     K : control.StateSpace
         Best controller found (lowest peak μ), named after P's measurement/control channels.
     mu : float
-        Peak μ upper bound of ``F_l(P, K)`` on ``omega`` with the given block structure.
+        Peak μ upper bound of ``F_l(P, K)`` with the given block structure, over ``omega``
+        and the points added around the curve's peaks (``check_omega``): a value an
+        independent check on a finer grid reproduces, not the grid's.
     mu_omega : float
         Frequency (rad/s) of that peak.
     mu_curve : ndarray, shape (len(omega),)
@@ -302,6 +280,17 @@ class MusynResult:
         Other candidate controllers worth keeping (D–G–K: the best complex D–K controller,
         when it is not ``K``), each ``{"step", "K", "mu", "gamma"}``: an order reduction
         may favour one of them (:func:`ambseal.design.recipes.design`).
+    mu_grid : float
+        Peak μ upper bound of ``K`` on ``omega`` alone (``mu ≥ mu_grid``).
+    check_omega : ndarray
+        The frequencies (rad/s) ``mu`` is the largest upper bound over: ``omega`` and the
+        points added around its local maxima (:func:`~ambseal.robust.mu.mu_peak`).
+    check_mu : ndarray
+        The upper bound at ``check_omega``.
+    check : str
+        One line naming that grid.
+    elapsed_s : float
+        CPU time of the synthesis (s, this process).
     """
 
     K: Any
@@ -314,6 +303,11 @@ class MusynResult:
     best_iteration: int = 0
     scalings: tuple = field(default=(), repr=False)
     alternatives: tuple = field(default=(), repr=False)
+    mu_grid: float = float("nan")
+    check_omega: np.ndarray | None = field(default=None, repr=False)
+    check_mu: np.ndarray | None = field(default=None, repr=False)
+    check: str = ""
+    elapsed_s: float = float("nan")
 
     @property
     def order(self) -> int:
@@ -322,143 +316,45 @@ class MusynResult:
 
     def to_dict(self) -> dict:
         """JSON-ready summary."""
-        return {"mu": self.mu, "mu_omega_rad_s": self.mu_omega, "gamma": self.gamma,
+        return {"mu": self.mu, "mu_omega_rad_s": self.mu_omega, "mu_grid": self.mu_grid,
+                "mu_check": self.check, "gamma": self.gamma,
                 "order": self.order, "best_iteration": self.best_iteration,
                 "history": [dict(h) for h in self.history],
                 "omega_rad_s": np.asarray(self.omega).tolist(),
-                "mu_curve": np.asarray(self.mu_curve).tolist()}
+                "mu_curve": np.asarray(self.mu_curve).tolist(),
+                "check_omega_rad_s": (None if self.check_omega is None
+                                      else np.asarray(self.check_omega).tolist()),
+                "elapsed_s": self.elapsed_s}
 
 
 # --------------------------------------------------------------------------- D–K
-def _complexify(blks):
-    """Diagonal-D structure: repeated scalars → independent complex scalars."""
-    out, groups = [], []
-    for j, b in enumerate(blks):
-        if b.kind == "full":
-            out.append((b.r, b.c))
-            groups.append(j)
-        else:
-            out.extend([(1, 1)] * b.r)
-            groups.extend([j] * b.r)
-    return out
-
-
-def _ss(tf):
-    s = ct.ss(tf)
-    return np.asarray(s.A, float), np.asarray(s.B, float), np.asarray(s.C, float), np.asarray(s.D, float)
-
-
-def _diag_sys(parts):
-    """Block-diagonal state space of SISO (A, B, C, D) tuples."""
-    n = sum(p[0].shape[0] for p in parts)
-    k = len(parts)
-    A = np.zeros((n, n)); B = np.zeros((n, k)); C = np.zeros((k, n)); D = np.zeros((k, k))
-    o = 0
-    for i, (a, b, c, d) in enumerate(parts):
-        m = a.shape[0]
-        A[o:o + m, o:o + m] = a; B[o:o + m, i:i + 1] = b; C[i:i + 1, o:o + m] = c
-        D[i, i] = d[0, 0]
-        o += m
-    return ct.ss(A, B, C, D)
-
-
-def _realize(theta, order):
-    """State spaces (A, B, C, D) of the D scale of section parameters ``theta``
-    (:func:`_theta_to_tf`) and of its inverse, by numpy alone (for the D search)."""
-
-    if order == 0:
-        a, b, c, d = np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), \
-            np.exp(theta[:1]).reshape(1, 1)
-    else:
-        a, b, c, d = tf2ss(*_theta_to_tf(theta, order))
-    di = 1.0 / d
-    return (a, b, c, d), (a - b @ di @ c, b @ di, -di @ c, di)
-
-
-def _scaled_plant(P, cblocks, fits, nmeas, ncon):
-    """diag(D_l(s), I) · P · diag(D_r(s)⁻¹, I) for fitted scalars (last block: 1); each fit
-    a transfer function or its :func:`_realize` pair."""
-    left, right = [], []
-    one = (np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.ones((1, 1)))
-    for (r, c), f in zip(cblocks, list(fits) + [None]):
-        if f is None:
-            lf = rf = one
-        elif isinstance(f, tuple):
-            lf, rf = f
-        else:
-            lf = _ss(f)
-            rf = _ss(1 / f)
-        left.extend([lf] * c)
-        right.extend([rf] * r)
-    left.extend([one] * nmeas)
-    right.extend([one] * ncon)
-    Pb = ct.ss(P.A, P.B, P.C, P.D)
-    Ps = _diag_sys(left) * Pb * _diag_sys(right)
-    names_in, names_out = list(P.input_labels), list(P.output_labels)
-    return ct.ss(Ps.A, Ps.B, Ps.C, Ps.D, inputs=names_in, outputs=names_out, name="P_scaled")
-
-
-def _tf_to_theta(tf):
-    """Section parameters (:func:`_logmag`) of a fitted D scale and its order: the inverse
-    of :func:`_theta_to_tf` (complex root pairs first, then real roots paired by size)."""
-    num, den = (np.asarray(p, float) for p in (tf.num[0][0], tf.den[0][0]))
-    order = den.size - 1
-    th = [np.log(abs(num[0] / den[0]))]
-    for poly in (num, den):
-        r = np.roots(poly)
-        secs = [np.real(np.poly([x, np.conj(x)])) for x in r if x.imag > 1e-12 * abs(x)]
-        real = sorted((x.real for x in r if abs(x.imag) <= 1e-12 * abs(x)), key=abs)
-        while len(secs) < order // 2:
-            secs.append(np.poly([real.pop(0), real.pop(0)]))
-        th += [v for sec in secs for v in (np.log(sec[2]), np.log(sec[1]))]
-        th += [np.log(-a) for a in real]
-    return np.array(th), order
-
-
-def _search_dscales(P, cblocks, fits, nmeas, ncon, evals):
-    """Direct search (Nelder–Mead, at most ``evals`` γ evaluations) over the section
-    parameters of the fitted D scales for the smallest γ_opt of ``D P D⁻¹`` (γ to 1e-4).
-
-    D–K stalls above the μ-optimum because each D-step fits the pointwise-optimal D of the
-    *current* K; this searches the same rational D's for the best K-step directly. Every
-    parameter vector is a stable, minimum-phase D (:func:`_logmag`), and γ_opt of the scaled
-    problem bounds μ of its optimal controller at every frequency. Returns
-    ``(fits, γ_opt, evaluations)``, with ``fits`` None when no better D was found.
-    """
-    parts = [_tf_to_theta(f) for f in fits]
-    cuts = np.cumsum([0] + [th.size for th, _ in parts])
-
-    def sections(x):
-        return [(x[a:b], od) for (_, od), a, b in zip(parts, cuts[:-1], cuts[1:])]
-
-    def gamma(x):
-        try:
-            Ps = _scaled_plant(P, cblocks, [_realize(*t) for t in sections(x)], nmeas, ncon)
-            g = hinf_gamma_opt(Ps, nmeas, ncon, rtol=1e-4, near=near[0])
-        except (SynthesisError, ModelError, ValueError, np.linalg.LinAlgError):
-            return np.inf
-        near[0] = g if near[0] is None else min(near[0], g)
-        return g
-
-    x0 = np.concatenate([th for th, _ in parts])
-    near = [None]
-    g0 = gamma(x0)
-    # first simplex: each parameter (a logarithm) moved by 0.3, i.e. by a factor 1.35
-    simplex = np.vstack([x0, x0 + 0.3 * np.eye(x0.size)])
-    res = minimize(gamma, x0, method="Nelder-Mead",
-                   options={"maxfev": int(evals), "adaptive": True, "xatol": 1e-3,
-                            "fatol": 1e-5, "initial_simplex": simplex})
-    if not res.fun < g0:
-        return None, g0, int(res.nfev) + 1
-    return [ct.tf(*_theta_to_tf(*t)) for t in sections(res.x)], float(res.fun), \
-        int(res.nfev) + 1
+def _check(P, K, blocks, nmeas, ncon, w, upper):
+    """μ of ``F_l(P, K)`` re-checked between the grid points around its peaks
+    (:func:`~ambseal.robust.mu.mu_peak`)."""
+    return mu_peak(lft_lower(P, K, nmeas, ncon), blocks, w, upper)
 
 
 def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None, *,
           order: int | str = "auto", max_iter: int = 8, rtol: float = 1e-2,
           patience: int = 2, backoff: float = 1.01, fit_tol: float = 0.05,
-          search: int = 0, progress: bool = False) -> MusynResult:
-    """μ-synthesis by complex D–K iteration (Balas et al. 1993; thesis Paper 3 §3.4).
+          search: int | str = "auto", search_backoff: float = 1.001,
+          time_budget_s: float = 30.0, progress: bool = False) -> MusynResult:
+    """μ-synthesis by complex D–K iteration (Balas et al. 1993; thesis Paper 3 §3.4), then a
+    direct search over the D scales, within a time budget.
+
+    The steps, after Balas et al. (1993) and MATLAB's ``musyn`` (D-K Iteration Process,
+    Robust Control Toolbox documentation): a K-step (H∞ synthesis on ``D P D⁻¹`` at
+    ``backoff·γ_opt``), the μ upper bound of the closed loop on ``omega``, a D-step (the
+    bound's scalings fitted by stable, minimum-phase functions of automatically chosen
+    order), until μ stops improving; the best iterate is kept, not the last. D–K then often
+    stalls a few per cent above the μ-optimum: each D-step fits the D that is optimal for the
+    *current* K, not the D whose K-step is best. So, when the time budget affords it, a
+    direct search over the fitted scales' parameters for the smallest γ_opt of ``D P D⁻¹``
+    follows (:func:`~ambseal.robust._dscale._search_dscales`, Nelder–Mead with
+    restarts). Finally μ of the kept
+    controller is re-checked between the grid points around the curve's peaks
+    (:func:`~ambseal.robust.mu.mu_peak`): the reported μ is that value, and the result
+    names the frequencies it was computed at.
 
     Parameters
     ----------
@@ -474,7 +370,8 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     order : int or "auto"
         Order (0–4) of each fitted D scale; ``"auto"``: per scale and iteration the lowest
         order whose fit, weighted by ``(μ(ω)/max μ)⁴``, is within ``fit_tol``
-        (:func:`fit_dscale`).
+        (:func:`fit_dscale`; MATLAB ``musyn`` also chooses its fit orders by the fit's
+        error).
     max_iter : int
         Maximum number of D–K iterations (the first is plain H∞).
     rtol : float
@@ -486,57 +383,94 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
         by :func:`~ambseal.robust.hinf.hinfsyn` (e.g. 1.001: within 0.1 % of the optimum).
     fit_tol : float
         Relative magnitude tolerance of the automatic D-scale fit order.
-    search : int
-        When the iterations stop: at most this many γ evaluations of a direct search
-        (Nelder–Mead) over the best iteration's D-fit parameters for the smallest γ_opt of
-        ``D P D⁻¹`` (:func:`_search_dscales`); its controller (at ``backoff``) is kept when
-        its μ is lower, recorded in ``history`` with ``step = "D search"``. 0 (default): no
-        search. On Skogestad & Postlethwaite's distillation problem (§8.12.4) D–K stalls at
-        μ 1.027 (MATLAB's recipe at 1.019) and 150 evaluations reach 0.984, 600 reach
-        0.9736, the published optimum 0.9737 (benchmarks/bench_dk.py; ≈ 13 ms per
-        evaluation there); on the test rig's design, where μ sits at the nominal-performance
-        floor, 40 evaluations found no lower γ.
+    search : int or "auto"
+        The D search after the iterations: at most this many γ evaluations (0: none).
+        ``"auto"`` (default): 50 per parameter of the fitted scales, started only when the
+        time left affords 20 per parameter at the cost of the last K-step. Its controller
+        (at ``search_backoff``) is kept when its μ is lower, recorded in ``history`` with
+        ``step = "D search"``. On Skogestad & Postlethwaite's distillation problem
+        (§8.12.4) D–K stalls at μ 1.027–1.044 and the search goes below the published
+        μ-optimal 0.974 (0.963) in about 3 s of CPU (benchmarks/bench_dk.py); on the test
+        rig's design (80 states, a K-step 0.4 s) it is not started.
+    search_backoff : float
+        The controller of the D found by the search is built at ``search_backoff·γ_opt``:
+        the search minimised γ_opt, and a controller ``backoff`` (1 %) above it gives back
+        much of the gain (Mackenroth's aircraft, ``benchmarks/bench_dk.py``: μ 0.985 at
+        1.01·γ_opt, 0.978 at 1.001·γ_opt). :func:`~ambseal.robust.hinf.hinfsyn` raises it
+        when the closed loop is not stable.
+    time_budget_s : float
+        Budget (s of this process's CPU time, so that a busy machine does not change the
+        result) of the iterations and the search: no iteration starts and no γ evaluation is
+        made once it is spent; the check of the final μ comes after it (a few μ
+        evaluations). Typical use: the search's length, which has no natural end; D–K
+        stops by ``max_iter`` and ``patience`` well within the default on the rig designs
+        (4–16 s CPU, the first run after an install up to 10 s more for the compilation of
+        the μ kernels). ``inf``: no budget.
     progress : bool
         Print one line per iteration on stderr (rich).
 
     Returns
     -------
     MusynResult
-        The best controller (not the last), its μ and the history.
+        The best controller (not the last); ``mu`` its μ re-checked around the peaks,
+        ``check_omega`` the frequencies of that check, ``mu_grid`` the peak on ``omega``
+        alone.
 
     Raises
     ------
     ModelError, ConfigError
-        Blocks that do not match P's exogenous channels (ModelError); bad order or grid
-        (ConfigError).
+        Blocks that do not match P's exogenous channels (ModelError); bad order, grid,
+        search or budget (ConfigError).
     SynthesisError
         If the first K-step fails (plant assumptions violated).
+
+    References
+    ----------
+    Balas, Doyle, Glover, Packard & Smith, μ-Analysis and Synthesis Toolbox (1993);
+    Skogestad & Postlethwaite, Multivariable Feedback Control (2005) §8.12; Lagarias, Reeds,
+    Wright & Wright, SIAM J. Optim. 9 (1998) 112–147 (Nelder–Mead); Kelley, Iterative
+    Methods for Optimization (1999) §8.1 (restarts).
     """
+    t0 = time.process_time()
     check_plant(P, nmeas, ncon)
     blks = check_blocks(P, blocks, nmeas, ncon)
     if blks[-1].kind != "full":
         raise ModelError("musyn: the last block must be the full complex performance block")
     if order != "auto" and not (isinstance(order, (int, np.integer)) and 0 <= order <= 4):
         raise ConfigError(f"order={order!r}: the D-scale fit order must be 0–4 or 'auto'")
+    if not (search == "auto" or (isinstance(search, (int, np.integer)) and search >= 0)):
+        raise ConfigError(f"search={search!r}: expected a number of γ evaluations ≥ 0 or "
+                          f"'auto'")
+    if not (isinstance(search_backoff, (int, float)) and search_backoff >= 1):
+        raise ConfigError(f"search_backoff={search_backoff!r}: expected a number ≥ 1")
+    if not (isinstance(time_budget_s, (int, float)) and time_budget_s > 0):
+        raise ConfigError(f"time_budget_s={time_budget_s!r}: expected a positive number of "
+                          f"seconds (inf: no budget)")
     w = default_omega(P) if omega is None else np.asarray(omega, float)
     if w.ndim != 1 or w.size < 2 or np.any(w <= 0) or not np.all(np.isfinite(w)):
         raise ConfigError("musyn: omega must be a 1-D grid of positive rad/s values")
+    deadline = t0 + float(time_budget_s)
     cblocks = _complexify(blks)
     console = None
     if progress:
+
         console = Console(stderr=True)
 
     history, best = [], None
     fits: list = []
-    stall = 0
+    stall, t_kstep = 0, np.inf
     for it in range(max_iter):
+        if it > 0 and time.process_time() > deadline:
+            break
         Ps = _scaled_plant(P, cblocks, fits, nmeas, ncon) if fits else P
+        tk = time.process_time()
         try:
             hr = hinfsyn(Ps, nmeas, ncon, backoff=backoff)
         except SynthesisError:
             if it == 0:
                 raise
             break
+        t_kstep = time.process_time() - tk
         cl = lft_lower(P, hr.K, nmeas, ncon)
         mu_true = mussv(cl, blocks, w, lower=False)
         peak = float(np.max(mu_true.upper))
@@ -560,31 +494,30 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
             fits = [fit_dscale(w, ds[:, j], wgt, tol=fit_tol)[0] for j in range(ds.shape[1] - 1)]
         else:
             fits = [fit_magnitude(w, ds[:, j], order) for j in range(ds.shape[1] - 1)]
-    if search > 0 and best[4]:
-        best = _search_step(P, blocks, cblocks, nmeas, ncon, w, best, search, backoff,
-                            history, console)
-    peak, it_best, hr, mu_true, fits_best = best
-    return MusynResult(K=hr.K, mu=peak, mu_omega=float(w[np.argmax(mu_true.upper)]),
-                       mu_curve=np.asarray(mu_true.upper), omega=w, gamma=hr.gamma,
-                       history=tuple(history), best_iteration=it_best, scalings=fits_best)
+    finalists = [_finalist(best)]
+    evals = _search_evals(search, best[4], deadline - time.process_time(), t_kstep)
+    if evals:
+        found = _search_step(P, blocks, cblocks, nmeas, ncon, w, best, evals,
+                             search_backoff, history, console, deadline)
+        if found is not None:
+            finalists.append(_finalist(found))
+    return _result(P, blocks, nmeas, ncon, w, finalists, history, t0)
 
 
-def _search_step(P, blocks, cblocks, nmeas, ncon, w, best, evals, backoff, history, console):
-    """:func:`_search_dscales` from the best D–K iteration's fits; its controller replaces
-    ``best`` (``(μ, index, HinfResult, MuResult, fits)``) when its μ on ``w`` is lower;
-    recorded in ``history`` when the search found a D with a lower γ_opt."""
-    fits, _, n = _search_dscales(P, cblocks, best[4], nmeas, ncon, evals)
-    if fits is None:
-        return best
-    try:
-        hr = hinfsyn(_scaled_plant(P, cblocks, fits, nmeas, ncon), nmeas, ncon,
-                     backoff=backoff)
-    except SynthesisError:
-        return best
-    mu = mussv(lft_lower(P, hr.K, nmeas, ncon), blocks, w, lower=False)
-    peak = float(np.max(mu.upper))
-    history.append({"iteration": len(history), "gamma": hr.gamma, "mu": peak,
-                    "order": hr.order, "step": "D search", "evaluations": n})
-    if console is not None:
-        console.print(f"D search ({n} γ evaluations): γ = {hr.gamma:.4g}, μ = {peak:.4g}")
-    return (peak, len(history) - 1, hr, mu, tuple(fits)) if peak < best[0] else best
+def _finalist(entry):
+    """``(μ on the grid, index, K, γ, μ curve, fits)`` of a ``(μ, index, HinfResult,
+    MuResult, fits)`` iterate."""
+    peak, it, hr, mu, fits = entry
+    return (peak, it, hr.K, float(hr.gamma), np.asarray(mu.upper, float), fits)
+
+
+def _result(P, blocks, nmeas, ncon, w, finalists, history, t0, alternatives=()):
+    """The finalist ``(μ on the grid, index, K, γ, μ curve on w, fits)`` with the lowest μ
+    re-checked around its peaks (:func:`_check`), as a MusynResult."""
+    checked = [(_check(P, f[2], blocks, nmeas, ncon, w, f[4]), f) for f in finalists]
+    pk, (_, it, K, gamma, curve, fits) = min(checked, key=lambda c: c[0].peak)
+    return MusynResult(K=K, mu=pk.peak, mu_omega=pk.omega_peak, mu_curve=curve, omega=w,
+                       gamma=gamma, history=tuple(history), best_iteration=it,
+                       scalings=fits, alternatives=tuple(alternatives), mu_grid=pk.grid_peak,
+                       check_omega=pk.omega, check_mu=pk.upper, check=pk.describe(),
+                       elapsed_s=time.process_time() - t0)

@@ -26,8 +26,7 @@ from ambseal.analysis.sweep import (
     stability_boundary,
     sweep,
 )
-from ambseal.config import load_rig
-from ambseal.config._checks import MAX_COEFFICIENT, MAX_PRESSURE_BAR, MAX_SPEED_HZ
+from ambseal.config import MAX_COEFFICIENT, MAX_PRESSURE_BAR, MAX_SPEED_HZ, load_rig
 from ambseal.design.recipes import METHODS, design
 from ambseal.errors import ConfigError
 from ambseal.export.controller_files import load_controller

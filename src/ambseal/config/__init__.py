@@ -3,31 +3,22 @@
 The one place that knows the file format (:mod:`ambseal.config.rig`: rotor, AMBs, seals,
 springs, controllers, operating points, the facility truth) and its ``[design]`` part
 (:mod:`ambseal.config.design`); rules that need more than one key live in
-:mod:`ambseal.config._checks`. Every other layer receives the typed models from here.
+:mod:`ambseal.config._checks`, with the bounds of the values (``MAX_*``, each with its
+reason there), which the other layers' checks of the same quantities share. Every other
+layer receives the typed models from here.
 """
 
-from ambseal.config.rig import (
-                                Actuator,
-                                Affine,
-                                Amb,
-                                AxisPair,
-                                Coefficient,
-                                FrequencyTable,
-                                RigConfig,
-                                Seal,
-                                Spring,
-                                TruthSection,
-                                apply_overrides,
-                                check_operating,
-                                default_rig_path,
-                                dump_rig,
-                                load_rig,
-                                load_truth,
-                                parse_rig,
-                                rig_with_values,
-)
+from ambseal.config._checks import (MAX_COEFFICIENT, MAX_CURRENT_A, MAX_DELAY_SAMPLES,
+                                    MAX_ELEMENTS, MAX_FREQUENCY_HZ, MAX_GAP_M,
+                                    MAX_PRESSURE_BAR, MAX_SPEED_HZ)
+from ambseal.config.rig import (Actuator, Affine, Amb, AxisPair, Coefficient, FrequencyTable,
+                                RigConfig, Seal, Spring, TruthSection, apply_overrides,
+                                check_operating, default_rig_path, dump_rig, load_rig,
+                                load_truth, parse_rig, rig_with_values)
 
-__all__ = ["Actuator", "Affine", "Amb", "AxisPair", "Coefficient", "FrequencyTable",
+__all__ = ["MAX_COEFFICIENT", "MAX_CURRENT_A", "MAX_DELAY_SAMPLES", "MAX_ELEMENTS",
+           "MAX_FREQUENCY_HZ", "MAX_GAP_M", "MAX_PRESSURE_BAR", "MAX_SPEED_HZ",
+           "Actuator", "Affine", "Amb", "AxisPair", "Coefficient", "FrequencyTable",
            "RigConfig", "Seal", "Spring", "TruthSection", "apply_overrides",
            "check_operating", "default_rig_path", "dump_rig", "load_rig", "load_truth",
            "parse_rig", "rig_with_values"]

@@ -83,7 +83,7 @@ from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
-from ambseal.config._checks import MAX_GAP_M
+from ambseal.config import MAX_GAP_M
 from ambseal.design.conditions import judged_conditions
 from ambseal.design.pid import pid_from_rig
 from ambseal.design.weights import default_weights

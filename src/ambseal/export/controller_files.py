@@ -47,7 +47,7 @@ import control
 import numpy as np
 from scipy.io import savemat
 
-from ambseal.config._checks import MAX_DELAY_SAMPLES, MAX_FREQUENCY_HZ
+from ambseal.config import MAX_DELAY_SAMPLES, MAX_FREQUENCY_HZ
 from ambseal.errors import DataError
 from ambseal.files import atomic_write
 from ambseal.identify.matlab_file import read_matlab

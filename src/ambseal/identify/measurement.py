@@ -14,7 +14,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ambseal.config._checks import MAX_CURRENT_A, MAX_GAP_M
+from ambseal.config import MAX_CURRENT_A, MAX_GAP_M
 from ambseal.errors import DataError
 
 __all__ = ["FORMAT_TAG", "CLIP_RUN", "CLIP_RTOL", "TIME_RTOL", "CHANNELS", "Measurement", "column_names",

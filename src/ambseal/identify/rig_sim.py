@@ -34,8 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ambseal.config import RigConfig, TruthSection
-from ambseal.config._checks import MAX_ELEMENTS
+from ambseal.config import MAX_ELEMENTS, RigConfig, TruthSection
 from ambseal.errors import ConfigError, ModelError
 from ambseal.identify.facility_loop import facility_loop
 from ambseal.lti.discrete import zoh

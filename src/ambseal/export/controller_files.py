@@ -288,6 +288,11 @@ def _continuous(doc: dict, path: Path):
 def load_controller(path):
     """Read a controller written by :func:`export_controller` (any format).
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ``.json``, ``.npz`` or ``.mat`` file; the suffix says which.
+
     Returns
     -------
     DigitalController, ScheduledDigital or control.StateSpace

@@ -172,7 +172,26 @@ def feedback_poles(G: Matrices, K: Matrices) -> np.ndarray:
     for a discrete loop), kept for the last few large loops
     (:class:`~ambseal.lti.matrices.ArrayMemo`): the same full-order loop is checked by the
     design (full-order stability), the discretisation's prewarp frequency and its stability
-    screen. The array is shared: do not modify it in place."""
+    screen.
+
+    Parameters
+    ----------
+    G : (A, B, C, D)
+        Plant, ``n`` states, ``nu`` current inputs → ``ny`` outputs.
+    K : (A_K, B_K, C_K, D_K)
+        Controller, ``n_K`` states, ``ny`` inputs → ``nu`` outputs, closed as ``u = −K y``.
+
+    Returns
+    -------
+    numpy.ndarray of complex, shape (n + n_K,)
+        The closed-loop poles, in no particular order. The array is shared: do not modify
+        it in place.
+
+    Raises
+    ------
+    ModelError
+        If ``I + D·D_K`` is singular (an ill-posed loop).
+    """
     Acl = feedback_matrices(G, K)[0]
     return _POLES.get((Acl,), "eigvals", lambda: np.linalg.eigvals(Acl))
 

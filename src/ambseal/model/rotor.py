@@ -129,7 +129,7 @@ class RotorMatrices:
     """Assembled shaft-and-disk matrices, each (n_dof, n_dof).
 
     M q̈ + (C + Ω G) q̇ + K q = f (Friswell et al. 2010, Eq. 5.95), q the node DOFs
-    ``[x, y, α, β]`` of :attr:`mesh`.
+    ``[x, y, α, β]`` of ``mesh``.
 
     Attributes
     ----------

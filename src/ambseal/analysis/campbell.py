@@ -54,7 +54,18 @@ _PLANAR = 0.01
 
 
 def log_decrement(poles: np.ndarray) -> np.ndarray:
-    """δ = −2π Re λ / Im λ of eigenvalues λ (rad/s) with Im λ > 0 (API 684; Friswell §3.6)."""
+    """δ = −2π Re λ / Im λ of eigenvalues λ (rad/s) with Im λ > 0 (API 684; Friswell §3.6).
+
+    Parameters
+    ----------
+    poles : array_like of complex
+        Eigenvalues λ (rad/s), any shape; those with Im λ ≤ 0 give no meaningful δ.
+
+    Returns
+    -------
+    ndarray of float
+        δ for each pole, the shape of ``poles`` (positive: decaying).
+    """
     p = np.asarray(poles, complex)
     return -2 * np.pi * p.real / p.imag
 
@@ -185,6 +196,7 @@ def closed_loop_modes(cfg, controller=None, *, speed_hz: float = 0.0,
     Parameters
     ----------
     cfg : RigConfig
+        The rig, at full order.
     controller : control.StateSpace or ScheduledController, optional
         Displacement (m) → current (A), ``i = −K y``; omitted: the open-loop rig.
     speed_hz : float

@@ -31,7 +31,15 @@ SERIAL_BELOW = 64
 
 @dataclass(frozen=True)
 class CaseError:
-    """A case that failed: the case and the error's one-line message."""
+    """A case that failed: the case and the error's one-line message.
+
+    Attributes
+    ----------
+    case : dict
+        The case as given to :func:`run_cases`.
+    error : str
+        ``"<ExceptionType>: <message>"`` of what it raised.
+    """
 
     case: dict
     error: str
@@ -64,6 +72,7 @@ def run_cases(fn: Callable, cases: Sequence[dict], *, shared: dict | None = None
     fn : callable
         A module-level (picklable) pure function.
     cases : sequence of dict
+        One dict per case, the first argument of ``fn`` (picklable for Dask).
     shared : dict, optional
         Keyword arguments common to every case (sent once per worker).
     workers : int, optional

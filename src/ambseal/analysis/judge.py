@@ -99,6 +99,9 @@ class JudgeSettings:
         The current impulse (P5 §5.1): amplitude (A) and length (s), started at
         ``impulse_start_s`` in a window of ``impulse_end_s`` sampled every ``impulse_dt_s``.
         No amplitude (None): no impulse response.
+    impulse_start_s, impulse_end_s, impulse_dt_s : float
+        Start of the impulse, end of the simulated window and sample time of the response
+        (s).
     """
 
     freq_hz: tuple[float, float, int]
@@ -219,6 +222,24 @@ def judge_settings(cfg, spec=None) -> JudgeSettings:
     impulse starts after 5 impulse lengths and the window ends 30 lengths later, sampled at
     twice the controller's rate (test rig: 0.05 A for 10 ms at 0.05 s in 0.35 s, every
     50 µs, P5 §5.1).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig (its controller's sample rate sets the impulse response's sampling).
+    spec : DesignSpec, optional
+        The rig's design specification; :func:`~ambseal.design.specs.design_spec` of
+        ``cfg`` if omitted.
+
+    Returns
+    -------
+    JudgeSettings
+        The log frequency grid (1200 points over the band), the unbalance and the impulse.
+
+    Raises
+    ------
+    ConfigError
+        A ``[design]`` default that cannot be derived (from ``design_spec``).
     """
 
     sp = spec or design_spec(cfg)
@@ -234,8 +255,20 @@ def judge_settings(cfg, spec=None) -> JudgeSettings:
 
 @dataclass(frozen=True)
 class OperatingPoint:
-    """A judged condition: pressure drop (bar), speed (rpm), its label, and whether it is
-    the rig's nominal condition or below (``"low"``) or above it (``"high"``)."""
+    """A judged condition of the rig.
+
+    Attributes
+    ----------
+    pressure_bar : float
+        Pressure drop across the seals (bar).
+    speed_rpm : float
+        Spin speed (rpm).
+    label : str
+        How reports name it, e.g. ``"2.04 bar"`` or ``"140 Hz"``.
+    condition : str
+        ``"nominal"`` (the rig's operating point), or ``"low"`` / ``"high"`` below or above
+        it (in speed when the speed varies, else in pressure drop).
+    """
 
     pressure_bar: float
     speed_rpm: float
@@ -254,7 +287,26 @@ def operating_points(cfg, spec=None) -> list[OperatingPoint]:
     """Where every controller is judged: the design specification's pressures × speeds
     (:func:`ambseal.design.specs.design_spec`; by default 0, nominal and 2× nominal
     pressure drop, P5 §4, or the ends and the middle of the speed range of a rig whose
-    seals change with speed, P3 §4, at the nominal pressure)."""
+    seals change with speed, P3 §4, at the nominal pressure).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig; its ``[operating]`` point is the nominal condition.
+    spec : DesignSpec, optional
+        The rig's design specification; :func:`~ambseal.design.specs.design_spec` of
+        ``cfg`` if omitted.
+
+    Returns
+    -------
+    list of OperatingPoint
+        Every pressure at each speed, speeds outermost.
+
+    Raises
+    ------
+    ConfigError
+        A ``[design]`` default that cannot be derived (from ``design_spec``).
+    """
 
     sp = spec or design_spec(cfg)
     ps, fs = sp.pressures_bar, sp.speeds_hz
@@ -455,7 +507,25 @@ def judge_case(case: dict, cfg, settings: JudgeSettings | None = None
                ) -> tuple[JudgedCase, dict]:
     """:func:`judge` of ``case = {"controller", "name", "point"}`` (and ``"discrete"``, the
     delayed discrete controller that runs): the main job's cases as run by
-    :func:`ambseal.analysis.cases.run_cases`."""
+    :func:`ambseal.analysis.cases.run_cases`.
+
+    Parameters
+    ----------
+    case : dict
+        ``controller`` (control.StateSpace, m → A, ``i = −K y``), ``name`` (str),
+        ``point`` (:class:`OperatingPoint`) and optionally ``discrete``.
+    cfg : RigConfig
+        The rig.
+    settings : JudgeSettings, optional
+        :func:`judge_settings` of the rig if omitted.
+
+    Returns
+    -------
+    case : JudgedCase
+        The judged case (:func:`judge`).
+    curves : dict
+        The curves for the figures (:func:`judge`).
+    """
     return judge(cfg, case["controller"], case["name"], case["point"], settings,
                  discrete=case.get("discrete"))
 

@@ -332,6 +332,27 @@ def sensitivity_peaks(G: Any, K: Any, omega: Any, which: str = "So") -> Sensitiv
     """Peaks of σ̄ and of each diagonal element of S_o (or ``which``) over ``omega`` (rad/s).
 
     Shortcut for ``loop_responses(G, K, omega).peaks(which)``; frequencies reported in Hz.
+
+    Parameters
+    ----------
+    G, K : control.StateSpace
+        Plant (A → m) and controller (m → A), negative feedback, as in
+        :func:`loop_responses`.
+    omega : array_like, shape (n_w,)
+        Frequencies (rad/s).
+    which : {"So", "Si", "To", "KS"}
+        The closed-loop function.
+
+    Returns
+    -------
+    SensitivityPeaks
+        The peak of σ̄ (thesis P5 §4.1) and of each diagonal element (ISO 14839-3, per
+        axis), each with its frequency (Hz).
+
+    Raises
+    ------
+    ModelError
+        As :func:`loop_responses`, or an unknown ``which``.
     """
     return loop_responses(G, K, omega).peaks(which)
 

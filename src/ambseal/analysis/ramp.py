@@ -97,7 +97,29 @@ class RampRun:
 class RampResult:
     """The ramp and every run; ``time_s``, ``pressure_bar`` and ``k_true`` decimated to
     ``record_hz``; ``tracking`` the estimator's accuracy (``max_error_rel`` of the nominal
-    k after ``transient_s``, ``coverage`` of the 95 % interval)."""
+    k after ``transient_s``, ``coverage`` of the 95 % interval).
+
+    Attributes
+    ----------
+    parameter : str
+        The seal parameter that follows the pressure, e.g. ``"seal.k"``.
+    time_s : ndarray (n,)
+        Record times (s).
+    pressure_bar : ndarray (n,)
+        Pressure drop along the ramp (bar).
+    k_true : ndarray (n,)
+        The facility's true value of ``parameter`` along the ramp (SI).
+    k_nominal : float
+        Its magnitude at the rig's operating pressure (SI), the scale of the errors.
+    impulse_times_s : list of float
+        Start of every current impulse (s).
+    axes : tuple of str
+        The actuator axes of the records.
+    runs : dict of str to RampRun
+        Every controller's run, ``"tracked"`` for the scheduled one with the estimator.
+    tracking : dict
+        The estimator's accuracy; empty without a tracked controller.
+    """
 
     parameter: str
     time_s: np.ndarray = field(repr=False)
@@ -125,7 +147,26 @@ def pressure_ramp(p_nominal_bar: float, duration_s: float, *, top_factor: float 
                   step_s: float = 0.05) -> list[tuple[float, float]]:
     """A linear ramp 0 → ``top_factor``·p_nominal over ``duration_s`` as
     ``[(start_s, pressure_bar), ...]`` steps of ``step_s`` (2× nominal at 2/3 of the way
-    for the default 3×)."""
+    for the default 3×).
+
+    Parameters
+    ----------
+    p_nominal_bar : float
+        The rig's nominal pressure drop (bar).
+    duration_s : float
+        Length of the ramp (s).
+    top_factor : float
+        The pressure drop at the end, as a multiple of ``p_nominal_bar``.
+    step_s : float
+        Time between steps (s).
+
+    Returns
+    -------
+    list of (float, float)
+        ``(start_s, pressure_bar)`` of each step, the first at ``step_s``, the last at
+        ``duration_s`` (a ``pressure_schedule`` of
+        :func:`ambseal.identify.rig_sim.simulate_facility`).
+    """
     t = np.arange(step_s, duration_s + 0.5 * step_s, step_s)
     return [(float(a), float(top_factor * p_nominal_bar * a / duration_s)) for a in t]
 

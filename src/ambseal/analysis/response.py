@@ -179,6 +179,12 @@ def impulse_response(G: Any, K: Any, **kwargs) -> ImpulseResponse:
         ``channels``, ``amplitude_a``, ``duration_s``, ``t_impulse_s``, ``t_end_s``,
         ``dt_s``, ``band`` as for :func:`impulse_response_of`.
 
+    Returns
+    -------
+    ImpulseResponse
+        Displacements (m) and currents (A) over time, peaks, settling times and the loop's
+        stability (:func:`impulse_response_of`).
+
     Raises
     ------
     ModelError

@@ -464,9 +464,13 @@ def frozen_sensitivity(cfg, controller, speeds_hz, *, name: str = "K", omega=Non
     Parameters
     ----------
     cfg : RigConfig
+        The rig, at full order and its ``[operating]`` pressure drop.
     controller : control.StateSpace or ScheduledController
         Physical controller (:mod:`ambseal.robust.controller`), m → A, negative feedback.
     speeds_hz : array_like
+        The frozen speeds (Hz); a scheduled controller is frozen at each.
+    name : str
+        The controller's name in the result.
     omega : array_like, optional
         Frequencies (rad/s); default 400 points log-spaced 1 Hz … 3 kHz.
     plants : dict, optional

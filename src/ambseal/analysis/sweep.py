@@ -209,7 +209,20 @@ def stability_boundary(rows: list[dict]) -> list[dict]:
     """Per (controller, speed, parameter values): the pressure drop (bar) where the loop
     loses stability, linearly interpolated in the max real pole between the last stable
     and the first unstable pressure; ``None`` if stable over the whole range, the lowest
-    pressure if unstable throughout."""
+    pressure if unstable throughout.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Rows of :func:`sweep` (``pressure_bar``, ``max_real_pole`` in rad/s, ...); rows
+        with an ``error`` are left out.
+
+    Returns
+    -------
+    list of dict
+        One row per group: its inputs, ``boundary_pressure_bar``, ``last_stable_bar`` and
+        ``first_unstable_bar`` (bar, or None).
+    """
     groups: dict[tuple, list[dict]] = {}
     for r in rows:
         if r.get("error") is None:
@@ -258,7 +271,36 @@ def refine_boundary(cfg, controllers: dict, edges: list[dict], *, tol_bar: float
     """The edges of :func:`stability_boundary` with ``boundary_pressure_bar`` bisected
     between the grid's last stable and first unstable pressure to ``tol_bar`` (bar), each
     bracket a case of :func:`run_cases`; edges without a bracket are returned as they are,
-    a failed bisection keeps the interpolated value and gets an ``error``."""
+    a failed bisection keeps the interpolated value and gets an ``error``.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig the sweep was made on.
+    controllers : dict
+        ``{name: control.StateSpace}``, the sweep's fixed controllers.
+    edges : list of dict
+        Rows of :func:`stability_boundary`.
+    tol_bar : float
+        Width (bar) of the final bracket; the boundary is its middle.
+    workers : int, optional
+        As in :func:`run_cases`.
+    scheduler : str, optional
+        As in :func:`run_cases`.
+    progress : bool
+        As in :func:`run_cases`.
+
+    Returns
+    -------
+    list of dict
+        Copies of ``edges``; bisected ones with ``boundary_pressure_bar`` and
+        ``boundary_tolerance_bar`` (bar).
+
+    Raises
+    ------
+    ConfigError
+        A Dask ``scheduler`` or ``workers`` that cannot be used (:func:`run_cases`).
+    """
     todo = [i for i, e in enumerate(edges)
             if e["last_stable_bar"] is not None and e["first_unstable_bar"] is not None]
     cases = [{k: v for k, v in edges[i].items() if k != "boundary_pressure_bar"}

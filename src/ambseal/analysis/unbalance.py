@@ -216,12 +216,24 @@ def unbalance_response(
         forces at the bearings, module docstring).
     omega : array_like, shape (n_w,)
         Speeds Ω (rad/s); the unbalance excites at Ω (synchronous).
-    mass_kg, grade_mm_s, max_speed_rad_s, law
-        As in :func:`unbalance_force`.
+    mass_kg : float
+        Rotor mass (kg), ``> 0``, as in :func:`unbalance_force`.
+    grade_mm_s : float
+        Balance quality grade G (mm/s), ``> 0``.
+    max_speed_rad_s : float, optional
+        Maximum service speed Ω_max (rad/s); needed by the ``"iso21940"`` law.
+    law : {"iso21940", "constant_velocity"}
+        The force law of :func:`unbalance_force` (ISO 21940-11 by default).
 
     Returns
     -------
     UnbalanceResponse
+        The force (N) and the response bound (m) per speed, and its peak (µm) and where.
+
+    Raises
+    ------
+    ModelError
+        As :func:`unbalance_force` and :func:`~ambseal.analysis.loops.compliance`.
     """
     return unbalance_from_compliance(
         compliance(G, K, Gf, as_omega(omega)), mass_kg=mass_kg, grade_mm_s=grade_mm_s,

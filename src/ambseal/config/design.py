@@ -278,6 +278,20 @@ def apply_overrides(data: dict, overrides, where: str = "--set") -> dict:
     a TOML value, or as a string if it is not one. The result is validated with the rest
     of the rig by :func:`parse_rig`.
 
+    Parameters
+    ----------
+    data : dict
+        The parsed rig document; changed in place.
+    overrides : iterable of str
+        ``design.<key>=<value>`` settings.
+    where : str
+        Where the overrides came from, named in errors (the command-line option).
+
+    Returns
+    -------
+    dict
+        ``data`` itself, with the overrides set.
+
     Raises
     ------
     ConfigError

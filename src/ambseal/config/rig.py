@@ -383,6 +383,11 @@ def parse_rig(data: dict, where: str = "<rig>") -> RigConfig:
     where : str
         Name of the source used in error messages (usually the file path).
 
+    Returns
+    -------
+    RigConfig
+        The validated, frozen configuration.
+
     Raises
     ------
     ConfigError
@@ -436,6 +441,11 @@ def load_rig(path: str | Path | None = None, overrides=()) -> RigConfig:
     overrides : iterable of str
         ``design.<key>=<value>`` settings (:func:`apply_overrides`), validated with the file.
 
+    Returns
+    -------
+    RigConfig
+        The validated, frozen configuration.
+
     Raises
     ------
     ConfigError
@@ -464,7 +474,13 @@ def _load_toml(path: Path, what: str) -> dict:
 
 
 def default_rig_path() -> Path:
-    """Path of the embedded thesis test facility (``ambseal/data/testrig.toml``)."""
+    """Path of the embedded thesis test facility (``ambseal/data/testrig.toml``).
+
+    Returns
+    -------
+    pathlib.Path
+        The file inside the installed package.
+    """
     return Path(__file__).resolve().parents[1] / "data" / "testrig.toml"
 
 
@@ -512,6 +528,21 @@ def load_truth(path: str | Path) -> TruthSection:
     ``mesh_factor`` (shaft elements per section × this, rounded, at least 1),
     ``modal_damping`` (the rotor's, in place of the rig file's) and ``sensor_filter_hz`` (a
     first-order low-pass in every displacement sensor, which the model does not have).
+
+    Parameters
+    ----------
+    path : str or Path
+        The truth file.
+
+    Returns
+    -------
+    TruthSection
+        The validated ``[truth]`` table.
+
+    Raises
+    ------
+    ConfigError
+        The file cannot be read, is not TOML or does not match the format (named).
     """
     p = Path(path)
     data = _load_toml(p, "truth file")
@@ -529,10 +560,22 @@ def rig_with_values(cfg: RigConfig, values: dict[str, Coefficient]) -> RigConfig
     ``name`` is ``spring{i}``), ``{seal}.{K|k|C|c}`` (a number or an :class:`Affine` in the
     pressure drop) — and ``tau_e`` (the actuator's eddy-current lag).
 
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig.
+    values : dict
+        ``{name: value}``, SI (a seal coefficient may be an :class:`Affine`).
+
+    Returns
+    -------
+    RigConfig
+        A new, validated configuration; ``cfg`` is unchanged.
+
     Raises
     ------
     ConfigError
-        An unknown parameter name.
+        An unknown parameter name, or a value the rig format does not accept.
     """
     data = cfg.model_dump(exclude_none=True)
     ambs = {a["name"]: a for a in data.get("amb", [])}
@@ -591,7 +634,20 @@ def _toml_table(name: str, val: dict, lines: list[str]) -> None:
 
 
 def dump_rig(cfg: RigConfig, header: str = "") -> str:
-    """The rig as TOML text that :func:`load_rig` reads back to the same configuration."""
+    """The rig as TOML text that :func:`load_rig` reads back to the same configuration.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig.
+    header : str
+        Text written first as ``#`` comment lines (none if empty).
+
+    Returns
+    -------
+    str
+        The TOML document, ending with a newline.
+    """
     data = cfg.model_dump(exclude_none=True)
     lines = [f"# {line}" for line in header.splitlines()]
     for key, val in data.items():

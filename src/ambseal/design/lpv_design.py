@@ -364,6 +364,7 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
     Parameters
     ----------
     cfg : RigConfig
+        The rig (its ``[design.lpv]`` weights and its seal).
     speed_hz : float
         Design speed (Hz).
     method : {"hinf", "mu"}
@@ -376,6 +377,9 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
         omitted (module docstring).
     states : int
         Mechanical states of the design model (same basis as :func:`design_lpv`).
+    seal_k_uncertainty : float
+        Relative uncertainty of the first seal's cross-coupled stiffness k (``"mu"`` only;
+        0.4: ±40 %, P3 §3.1).
     allow_unstable : bool
         Keep a controller whose full-order loop is unstable at a judged condition
         (:func:`check_full_order`) instead of raising.

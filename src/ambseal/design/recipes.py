@@ -128,6 +128,9 @@ class DesignResult:
         The automatic design-loop steps taken (model enlargements).
     notes : tuple of str
         The specification's notes (no seal, ...).
+    verdict : str
+        One plain line: robust performance met or not (H∞: γ), and the full-order
+        stability.
     """
 
     method: str

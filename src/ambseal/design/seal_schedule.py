@@ -173,6 +173,7 @@ def design_seal_scheduled(cfg, parameter: str | None = None, *,
     Parameters
     ----------
     cfg : RigConfig
+        The rig, at its ``[operating]`` pressure and speed.
     parameter : str, optional
         An LFT parameter of the rig; default the first seal's cross-coupled stiffness k.
     range_factor : (float, float)

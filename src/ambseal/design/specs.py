@@ -513,6 +513,7 @@ def design_spec(cfg, pressure_bar: float | None = None) -> DesignSpec:
     Parameters
     ----------
     cfg : RigConfig
+        The rig; its ``[design]`` part wins over every rule.
     pressure_bar : float, optional
         Design pressure drop (bar) for the default uncertainty; ``[operating]`` if omitted.
 

@@ -464,6 +464,17 @@ def default_weights(method: str) -> Weights:
     corner and the scalings here are placeholders: the specification derives them from the
     rig (:mod:`ambseal.design.specs`, "LPV weights").
 
+    Parameters
+    ----------
+    method : {"hinf", "mu", "lpv"}
+        The design method whose tuning is wanted.
+
+    Returns
+    -------
+    Weights
+        The method's machine-independent weights; the rest at their placeholders until
+        :func:`ambseal.design.specs.design_spec` derives them from the rig.
+
     Raises
     ------
     ConfigError

@@ -170,11 +170,15 @@ def write_c(ctrl, out_dir, prefix: str = "ambseal_controller", precision: str = 
     Parameters
     ----------
     ctrl : DigitalController or ScheduledDigital
+        The discrete controller as judged (its discretisation, delay and, scheduled, its
+        table against the parameter); the C code's ``step`` gives the current references
+        ``i = −K y`` (A) from the displacements ``y`` (m).
     out_dir : path
         Folder (created).
     prefix : str
         C identifier prefix and file name.
     precision : {"double", "float"}
+        C floating-point type of the matrices and the state.
 
     Returns
     -------

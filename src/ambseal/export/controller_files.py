@@ -315,8 +315,8 @@ def load_controller(path):
 
     Parameters
     ----------
-    path : str or Path
-        A ``.json``, ``.npz`` or ``.mat`` file.
+    path : str or os.PathLike
+        A ``.json``, ``.npz`` or ``.mat`` file; the suffix says which.
 
     Returns
     -------

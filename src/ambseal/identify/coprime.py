@@ -412,14 +412,19 @@ def coprime_factors(A, B, C, D, F, L, *, dt: float | None = None,
     A, B, C, D : array_like, shapes (n, n), (n, m), (p, n), (p, m)
         Nominal plant.
     F : array_like, shape (m, n)
+        State-feedback gain with A + BF stable (e.g. :func:`observer_gains`).
     L : array_like, shape (n, p)
+        Observer gain with A + LC stable.
     dt : float, optional
         Sample period (s) if the realisation is discrete.
     input_names, output_names : sequence of str
+        Names of u (m) and y (p).
     output_scale : float
         See :class:`CoprimeFactors`.
     check : bool
         Run :func:`check_bezout` with ``tol``.
+    tol : float
+        Largest accepted balanced Bezout error (with ``check``).
 
     Returns
     -------

@@ -176,6 +176,8 @@ def save_measurement(meas: Measurement, path: str | os.PathLike) -> Path:
     Parameters
     ----------
     meas : Measurement
+        The record: time, excitation, current reference, current and displacement per axis,
+        with its metadata.
     path : path-like
         ``*.csv`` or ``*.mat`` (case-insensitive).
 

@@ -347,6 +347,13 @@ def fit_parameters(
         Fixed values that an earlier fit estimated together, and the correlation (m, m) of
         those estimates (their σ in ``fixed`` are its relative standard errors).
 
+    Returns
+    -------
+    FitResult
+        Estimates (SI) with sandwich standard errors, 95 % intervals (Student's t) and
+        correlations, the NRMSE fit per channel, convergence, the error budget of ``fixed``
+        and the residual tests.
+
     Raises
     ------
     IdentificationError

@@ -211,10 +211,17 @@ def validate_measurement(
     Parameters
     ----------
     meas : Measurement
+        The record to check.
     source : str
         Name put at the front of every message (the file name when loading).
-    axes, min_samples, current_limit_a, time_rtol
-        As in :func:`load_measurement` (``axes`` must match in order here).
+    axes : sequence of str, optional
+        The rig's actuator axes; the record must have exactly these, in this order.
+    min_samples : int, optional
+        Fewest acceptable samples (at least 2 are always required).
+    current_limit_a : float, optional
+        Amplifier current limit (A) for the clipping check; no check when omitted.
+    time_rtol : float
+        Accepted relative deviation of each time step from the mean step.
 
     Returns
     -------

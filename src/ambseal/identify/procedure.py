@@ -146,8 +146,25 @@ def thesis_procedure(
         PID as it runs on the target: :func:`ambseal.app.commands.target_pid`).
     seed : int
         Seed of excitations and noise.
+    sine_frequencies_hz : tuple of float
+        Frequencies (Hz) of the balanced-whirl stepped sines of stage (c) (P4 §3.5.1).
+    impulse_pressures_bar : tuple of float
+        Pressure drops (bar) of the impulse runs of stage (c) (P5 §3.3); the facility must
+        hold the rotor at three of them at least.
     progress : callable, optional
         Called with a short description before each stage.
+
+    Returns
+    -------
+    ProcedureResult
+        Every stage's fit, the seal's regression against pressure and its coefficients
+        against frequency, the skipped pressures, the identified rig and the true values.
+
+    Raises
+    ------
+    IdentificationError
+        Fewer than three impulse pressures at which the controller holds the rotor, or a
+        fit that cannot start.
     """
     say = progress or (lambda _msg: None)
     fs = cfg.controller.sample_rate_hz

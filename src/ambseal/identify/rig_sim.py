@@ -240,7 +240,27 @@ class Facility:
 def prepare_facility(cfg: RigConfig, truth: TruthSection, sample_rate_hz: float, *,
                      pressure_bar: float,
                      pressure_schedule: list[tuple[float, float]] | None = None) -> Facility:
-    """The virtual facility at rest, ready to run (arguments as :func:`simulate_facility`).
+    """The virtual facility at rest, ready to run.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig (its nominal values are replaced by the truth where the truth names them).
+    truth : TruthSection
+        True values, noise, ADC, τ_e, bias and limit.
+    sample_rate_hz : float
+        The controller and acquisition rate (Hz).
+    pressure_bar : float
+        Pressure drop across the seals (bar).
+    pressure_schedule : list of (start_s, pressure_bar), optional
+        A piecewise-constant pressure drop (bar) from each start time (s) on, as in
+        :func:`simulate_facility`.
+
+    Returns
+    -------
+    Facility
+        The sampled linear part per pressure segment, the nonlinear force law, sensors and
+        limits, with its state at rest.
 
     Raises
     ------
@@ -333,6 +353,12 @@ def simulate_facility(
         plant at ``pressure_bar`` with the seal coefficients (then the truth's values) at
         its pressure through the LFT channels: the full-order change projected on one modal
         basis, so the state carries over a pressure step.
+
+    Returns
+    -------
+    FacilityRecord
+        Time, excitation, current reference, coil current (A) and measured displacement (m)
+        per axis, one row per sample.
 
     Raises
     ------

@@ -193,12 +193,46 @@ def seal_frequency_test(cfg: RigConfig, truth, controller: DiscreteController, s
     a ratio of 75 at 40 Hz against 93 with the identified one, and the K–c correlation
     (Jacobian) 0.46 against 0.32.
 
-    ``fit_kw`` go to :func:`~ambseal.identify.stages.identify` (e.g. ``known_fit``,
-    ``budget``).
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig as modelled.
+    truth : TruthSection
+        The facility's true values (never read by the fit).
+    controller : DiscreteController
+        The digital controller that levitates the rotor; its ``dt`` sets the sample rate.
+    seal : str
+        The seal's name in the rig file.
+    pressure_bar : float
+        Pressure drop across the seal (bar).
+    frequencies_hz : sequence of float
+        Step frequencies (Hz).
+    known : dict
+        Values found in earlier stages (SI), held in the fit and used for the balance.
+    seal_values : dict, optional
+        ``{"<seal>.<K|k|C|c>": value}`` (SI) the balance is computed with; the rig file's
+        seal if omitted.
+    amplitude_a : float
+        The larger of the forward and backward whirl amplitudes (A).
+    cycles : int
+        Periods per step in the analysis window, ≥ 1.
+    settling_cycles : int
+        Periods per step before the window, ≥ 0.
+    seed : int
+        Seed of the facility's noise.
+    **fit_kw
+        Passed to :func:`~ambseal.identify.stages.identify` (e.g. ``known_fit``,
+        ``budget``).
 
     Returns
     -------
-    list of (frequency_hz, FitResult)
+    list of (float, FitResult)
+        Per step frequency (Hz), the fit of K, k (N/m), C, c (N·s/m) on its window.
+
+    Raises
+    ------
+    ModelError
+        A controller that does not hold the rotor on the facility at ``pressure_bar``.
     """
 
     fs = 1.0 / controller.dt

@@ -386,8 +386,11 @@ def stepped_sine(
         Periods per step before the window, >= 0.
     sample_rate_hz : float
         Sampling rate (Hz).
-    axes, excited
-        As in :func:`prbs`; the same sine (times the gain) on every excited axis.
+    axes : sequence of str
+        All actuator axes of the rig (columns of ``values_a``), as in :func:`prbs`.
+    excited : sequence of str, mapping {axis: gain} or None
+        Axes that carry the signal, as in :func:`prbs`: the same sine (times the gain) on every
+        excited axis; ``None`` = all.
 
     Returns
     -------
@@ -480,8 +483,11 @@ def chirp(
         Sampling rate (Hz).
     method : {"linear", "logarithmic"}
         Sweep law.
-    axes, excited
-        As in :func:`prbs`; the same chirp (times the gain) on every excited axis.
+    axes : sequence of str
+        All actuator axes of the rig (columns of ``values_a``), as in :func:`prbs`.
+    excited : sequence of str, mapping {axis: gain} or None
+        Axes that carry the signal, as in :func:`prbs`: the same chirp (times the gain) on every
+        excited axis; ``None`` = all.
 
     Returns
     -------
@@ -549,8 +555,10 @@ def impulse(
         Record length (s); the pulse must end within it.
     sample_rate_hz : float
         Sampling rate (Hz).
-    axes, excited
-        As in :func:`prbs`.
+    axes : sequence of str
+        All actuator axes of the rig (columns of ``values_a``), as in :func:`prbs`.
+    excited : sequence of str, mapping {axis: gain} or None
+        Axes that carry the pulse (times the gain), as in :func:`prbs`; ``None`` = all.
 
     Returns
     -------

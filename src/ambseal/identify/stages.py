@@ -111,6 +111,29 @@ def acquire(cfg: RigConfig, truth: TruthSection, excitation: Excitation, *,
     ``pressure_schedule`` of :func:`~ambseal.identify.rig_sim.simulate_facility` in it as
     ``pressure_schedule_bar`` [[start_s, bar], ...]).
 
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig as modelled.
+    truth : TruthSection
+        The facility's true values, noise, ADC, τ_e, bias and current limit.
+    excitation : Excitation
+        The excitation currents (A) per actuator axis and their sample rate (Hz).
+    controller : DiscreteController
+        The digital controller that levitates the rotor, at the excitation's sample rate.
+    pressure_bar : float
+        Pressure drop across the seals (bar).
+    seed : int
+        Seed of the sensor and current noise.
+    pressure_schedule : list of (start_s, pressure_bar), optional
+        A piecewise-constant pressure drop (bar) from each start time (s) on.
+
+    Returns
+    -------
+    Measurement
+        The record in the measurement-file format, with the rig, sample rate, bias, pressure
+        drop (Pa), speed (rad/s), controller, excitation and current limit in its metadata.
+
     Raises
     ------
     DataError
@@ -189,12 +212,25 @@ def identify(cfg: RigConfig, records: list[Measurement], names: list[str], *,
 
     Parameters
     ----------
+    cfg : RigConfig
+        The rig; its model, at each record's pressure and speed, is the fit's start.
+    records : list of Measurement
+        Closed-loop records (metadata: pressure drop, speed, controller, sample rate).
+    names : list of str
+        Parameters to fit: LFT names of the model (``"A.Ki_zeta"``, ``"seal.k"``, ...),
+        ``"tau_e"`` or ``"tau_s"`` (:func:`~ambseal.identify.fit.fit_parameters`).
     known : dict, optional
         Values found in earlier stages (e.g. Ki/Ks when fitting the coupling, P4 §3.5).
+    current_weight : float
+        Weight of the coil-current residuals relative to the displacements (0: off; P4 §3.4
+        suggests currents lower the Ki–Ks correlation).
     refine : bool
         Fit again on a model re-reduced at the first estimate: the reduced LFT is exact only
         at the point of reduction (P2 §4.1 assumes it holds nearby), so the second pass
         removes that approximation from the estimate.
+    window : (int, int or None)
+        Samples ``[start, stop)`` of each record in the cost; the simulation always starts
+        at rest at sample 0.
     controllers : list of DiscreteController, optional
         The controller that ran for each record; by default from the records' metadata.
     budget : bool
@@ -207,10 +243,21 @@ def identify(cfg: RigConfig, records: list[Measurement], names: list[str], *,
     known_fit : FitResult, optional
         The earlier fit that found (some of) the ``known`` values.
 
+    Returns
+    -------
+    FitResult
+        Estimates (SI), standard errors, 95 % intervals and correlations, the fit per
+        channel and the residual tests; the refined pass when it converged.
+
     Raises
     ------
     ConfigError
         An ``uncertainty`` key that names no value (with ``budget``).
+    IdentificationError
+        A name without a channel or bounds, or a fit that cannot start
+        (:func:`~ambseal.identify.fit.fit_parameters`).
+    DataError
+        A record whose metadata lacks what the model needs (named with ``sources``).
     """
     known = dict(known or {})
     models = build_models(cfg, records, known, controllers=controllers, sources=sources)

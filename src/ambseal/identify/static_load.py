@@ -115,6 +115,14 @@ def static_ki(cfg: RigConfig, position_m: np.ndarray, force_xy_n: np.ndarray,
     values : dict, optional
         Parameter values (SI) found earlier, e.g. the closed-loop fit's Ks and coupling
         stiffness (Ki's and τ_e in it are ignored).
+    source : str
+        Where the loads come from, named in errors.
+
+    Returns
+    -------
+    StaticLoadResult
+        Ki (N/A) per axis with its cluster-robust standard errors (clustered by load step)
+        and correlation, and the residual of the equilibrium equations (m).
 
     Raises
     ------

@@ -397,14 +397,22 @@ def track(cfg: RigConfig, record: Measurement, names, settings: TrackingSettings
         Displacements (m) and current references (A) at a constant sample rate.
     names : sequence of str
         LFT parameters of the rig's model, e.g. ``"seal.k"`` (:meth:`Plant.parameter`).
+    settings : TrackingSettings, optional
+        The tracker's tuning; the defaults of :class:`TrackingSettings` if omitted.
     initial : dict, optional
         Starting values (SI); default the model's values at the record's pressure.
     compiled : bool
         Run the kernel compiled by numba (False: interpreted, the benchmark's baseline).
+    source : str
+        The record's name (its file), in errors.
+    controller : DiscreteController, optional
+        The controller that ran; by default from the record's metadata.
 
     Returns
     -------
     TrackingResult
+        The estimate (SI) at every sample with its standard error, and the recursion's
+        flops per sample and time.
 
     Raises
     ------
@@ -443,17 +451,22 @@ class OnlineTracker:
     Parameters
     ----------
     cfg : RigConfig
+        The rig; its model at the operating pressure sets each parameter's scale.
     model : ClosedLoopModel
         The tracker's model (:func:`linearised_model`).
     names : sequence of str
+        LFT parameters of the model to track, e.g. ``"seal.k"``.
     dt : float
         Sample time (s).
     y0, u0 : ndarray (N0, k), (N0, m)
         A stretch of displacements (m) and current references (A) that sets the
         predictor's noise levels (their RMS, as in :func:`track`).
     settings : TrackingSettings
+        The tracker's tuning.
     initial : dict, optional
         Starting values (SI); default the model's values.
+    compiled : bool
+        Run the kernel compiled by numba (False: interpreted).
     """
 
     def __init__(self, cfg: RigConfig, model: ClosedLoopModel, names, dt: float, y0, u0,

@@ -38,18 +38,26 @@ def zoh(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray
     Parameters
     ----------
     A : ndarray, shape (n, n)
+        Continuous state matrix (1/s).
     B : ndarray, shape (n, m)
+        Continuous input matrix (state unit per input unit and second).
     dt : float
         Sample time (s), > 0.
 
     Returns
     -------
     A_d : ndarray, shape (n, n)
+        ``e^{A dt}``.
     B_d : ndarray, shape (n, m)
+        ``∫₀^dt e^{Aτ} dτ B``: the input held constant over each sample.
 
-    The result for the last few large ``(A, B, dt)`` is kept
-    (:class:`~ambseal.lti.matrices.ArrayMemo`): the full-order plant of one operating point
-    is sampled once for every controller judged on it.
+    Notes
+    -----
+    Franklin, Powell & Workman, *Digital Control of Dynamic Systems*, 3rd ed., §6.3: one
+    ``expm`` of ``[[A, B], [0, 0]]·dt``, after a diagonal balancing of ``A``. The result for
+    the last few large ``(A, B, dt)`` is kept (:class:`~ambseal.lti.matrices.ArrayMemo`):
+    the full-order plant of one operating point is sampled once for every controller judged
+    on it.
     """
     Ad, Bd = _ZOH.get((np.asarray(A, float), np.asarray(B, float)), float(dt),
                       lambda: _zoh(A, B, dt))
@@ -125,9 +133,13 @@ def simulate_lti(A: np.ndarray, B: np.ndarray, Cs: list[np.ndarray], u: np.ndarr
     Parameters
     ----------
     A : ndarray, shape (n, n)
+        Discrete state matrix (e.g. ``A_d`` of :func:`zoh`).
     B : ndarray, shape (n, m)
+        Discrete input matrix.
     Cs : list of ndarray, shapes (p_i, n)
+        Output matrices; one output array is returned for each.
     u : ndarray, shape (N, m)
+        Input samples ``u_0 … u_{N−1}``, one row per sample.
     block : int
         Block length L.
     start : int
@@ -138,6 +150,7 @@ def simulate_lti(A: np.ndarray, B: np.ndarray, Cs: list[np.ndarray], u: np.ndarr
     Returns
     -------
     list of ndarray, shapes (N − start, p_i)
+        ``C_i z_k`` for ``k = start … N − 1``, one array per matrix of ``Cs``.
     """
     N, m = u.shape
     n = A.shape[0]

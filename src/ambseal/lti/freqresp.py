@@ -124,12 +124,17 @@ def freqresp_at(
         ``n`` states, ``nu`` inputs, ``ny`` outputs.
     points : array_like of complex, shape (n_p,)
         Evaluation points (finite).
-    method, max_cond, rtol
+    method : {"auto", "modal", "hessenberg"}
+        As for :func:`freqresp`.
+    max_cond : float
+        As for :func:`freqresp`.
+    rtol : float
         As for :func:`freqresp`.
 
     Returns
     -------
     numpy.ndarray of complex, shape (n_p, ny, nu)
+        ``C (p_k I − A)⁻¹ B + D`` for each point, in the units of outputs per unit input.
 
     Raises
     ------

@@ -180,7 +180,27 @@ def state_poles(A: np.ndarray) -> np.ndarray:
 
 
 def feedback_poles(G: Matrices, K: Matrices) -> np.ndarray:
-    """:func:`state_poles` of the state matrix of :func:`feedback_matrices` ``(G, K)``."""
+    """:func:`state_poles` of the state matrix of :func:`feedback_matrices` ``(G, K)``
+    (rad/s, or z for a discrete loop).
+
+    Parameters
+    ----------
+    G : (A, B, C, D)
+        Plant, ``n`` states, ``nu`` current inputs → ``ny`` outputs.
+    K : (A_K, B_K, C_K, D_K)
+        Controller, ``n_K`` states, ``ny`` inputs → ``nu`` outputs, closed as ``u = −K y``.
+
+    Returns
+    -------
+    numpy.ndarray of complex, shape (n + n_K,)
+        The closed-loop poles, in no particular order. The array is shared: do not modify
+        it in place.
+
+    Raises
+    ------
+    ModelError
+        If ``I + D·D_K`` is singular (an ill-posed loop).
+    """
     return state_poles(feedback_matrices(G, K)[0])
 
 

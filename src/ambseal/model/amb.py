@@ -33,7 +33,18 @@ MU0 = 4e-7 * math.pi
 
 
 def axes_rotation(angle_deg: float) -> np.ndarray:
-    """R (2, 2) with [ζ, η]ᵀ = R [x, y]ᵀ for axes rotated by ``angle_deg`` from x, y."""
+    """R (2, 2) with [ζ, η]ᵀ = R [x, y]ᵀ for axes rotated by ``angle_deg`` from x, y.
+
+    Parameters
+    ----------
+    angle_deg : float
+        Rotation of the axes about z (deg), positive from x towards y.
+
+    Returns
+    -------
+    ndarray, shape (2, 2)
+        R = [[cos φ, sin φ], [−sin φ, cos φ]].
+    """
     c, s = math.cos(math.radians(angle_deg)), math.sin(math.radians(angle_deg))
     return np.array([[c, s], [-s, c]])
 
@@ -42,7 +53,18 @@ def channel_names(cfg: RigConfig) -> tuple[str, ...]:
     """Names ``{amb}_{axis}`` of the AMB actuator axes (current inputs ``i_<axis>`` and sensor
     outputs ``y_<axis>`` of the plant), in the order of the plant's channels: every AMB of
     the rig file, ζ then η; e.g. ``("A_zeta", "A_eta", "B_zeta", "B_eta")`` for the thesis
-    test facility."""
+    test facility.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig; its AMBs in file order.
+
+    Returns
+    -------
+    tuple of str
+        Two names per AMB.
+    """
     return tuple(f"{a.name}_{axis}" for a in cfg.amb for axis in AXES)
 
 

@@ -177,6 +177,15 @@ class DiskElement:
 
     M = diag(m, m, Id, Id) and G with Ip coupling α and β so that
     Id α̈ + Ω Ip β̇ = M_x and Id β̈ − Ω Ip α̇ = M_y (Friswell et al. 2010, Eq. 3.70).
+
+    Attributes
+    ----------
+    mass : float
+        Mass m (kg).
+    Ip : float
+        Polar moment of inertia (kg·m²), the gyroscopic coupling.
+    Id : float
+        Diametral (transverse) moment of inertia (kg·m²).
     """
 
     mass: float

@@ -105,6 +105,26 @@ class Plant:
     A controller (:mod:`ambseal.robust.controller`) has the reverse names, inputs
     ``y_<axis>`` and outputs ``i_<axis>``, so python-control's ``interconnect`` closes the
     loop by name (with the sign of ``i = −K y``).
+
+    Attributes
+    ----------
+    A : ndarray, shape (n_states, n_states)
+        State matrix (1/s); the state is ``[q; q̇]`` of the full model or modal coordinates
+        of a reduced one.
+    B : ndarray, shape (n_states, n_inputs)
+        Input matrix.
+    C : ndarray, shape (n_outputs, n_states)
+        Output matrix (displacements in m).
+    D : ndarray, shape (n_outputs, n_inputs)
+        Feedthrough (zero for the rotor models).
+    input_names : tuple of str
+        ``i_<axis>`` (A), then ``F<k>_<x|y>`` (N).
+    output_names : tuple of str
+        ``y_<axis>`` (m).
+    state_names : tuple of str
+        One name per state.
+    parameters : dict of str to Parameter
+        The physical parameters' LFT channels (thesis P1 Eqs. 46–52), by name.
     """
 
     A: np.ndarray

@@ -328,6 +328,18 @@ def free_bending_hz(cfg, n_bending: int = BENDING_MODES) -> tuple[float, ...]:
     A free–free lateral rotor's bending modes come in pairs (the x–z and y–z planes, equal
     at standstill), so the k-th bending frequency is the 2k-th oscillating mode.
 
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig; only its shaft, materials and disks are used.
+    n_bending : int
+        How many bending frequencies (≥ 1).
+
+    Returns
+    -------
+    tuple of float
+        The bending frequencies (Hz), ascending.
+
     Raises
     ------
     ModelError
@@ -345,5 +357,22 @@ def bending_limit_hz(cfg, n_bending: int = BENDING_MODES) -> float:
 
     The limit keeps the rigid-body, actuator and controller modes of a closed loop and a
     few bending modes, not the whole FE spectrum.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig; only its shaft, materials and disks are used.
+    n_bending : int
+        The bending mode whose frequency sets the limit (≥ 1).
+
+    Returns
+    -------
+    float
+        The limit (Hz).
+
+    Raises
+    ------
+    ModelError
+        The rotor cannot be built.
     """
     return BENDING_MARGIN * free_bending_hz(cfg, n_bending)[-1]

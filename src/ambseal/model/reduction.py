@@ -69,6 +69,12 @@ def modal_reduction(
     cutoff_hz : float, optional
         Keep every mode with |λ| / 2π below this frequency (Hz).
 
+    Returns
+    -------
+    ModalReduction
+        The reduced plant (real modal coordinates, thesis P1 Eqs. 28–45) with its channels
+        transformed, T_L, T_R and the kept poles.
+
     Raises
     ------
     ModelError

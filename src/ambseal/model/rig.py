@@ -38,6 +38,8 @@ class SecondOrderSystem:
 
     Attributes
     ----------
+    mesh : Mesh
+        The rotor's nodes and beam elements; q holds ``[x, y, α, β]`` per node.
     M, C, G, K : ndarray, shape (n_dof, n_dof)
         Mass, damping, gyroscopic (per rad/s) and stiffness matrices (SI).
     B : ndarray, shape (n_dof, n_inputs)
@@ -46,6 +48,13 @@ class SecondOrderSystem:
         Sensor displacement outputs (m).
     speed : float
         Spin speed Ω (rad/s).
+    input_names : tuple of str
+        ``i_<amb>_<zeta|eta>`` (A), then ``F<k>_<x|y>`` (N).
+    output_names : tuple of str
+        ``y_<amb>_<zeta|eta>`` (m).
+    changes : tuple of Channel
+        Every named physical parameter as a low-rank change of K, C or B (thesis P1
+        Eqs. 48–50), from the AMBs, seals and springs.
     """
 
     mesh: Mesh
@@ -216,6 +225,36 @@ def build_plant(
     :func:`ambseal.model.reduction.modal_reduction` (``states`` or ``cutoff_hz``, defaults
     from ``[reduction]``, else 8 states). The actuator model of ``[actuator]`` is put in
     series with the current inputs after the reduction, as in thesis P5 Fig. 8.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig.
+    reduced : bool
+        Reduce to the lowest modes (thesis P1 §III.4–6) before adding the actuator.
+    pressure_bar : float, optional
+        Pressure drop across the seals (bar); ``[operating] pressure_bar`` if omitted.
+    speed_rpm : float, optional
+        Spin speed (rpm); ``[operating] speed_rpm`` if omitted.
+    force_positions : tuple of float
+        Positions (m) of extra force inputs, named ``F{k}_x``, ``F{k}_y`` (N).
+    states : int, optional
+        States kept by the reduction (with ``reduced``; this or ``cutoff_hz``, not both).
+    cutoff_hz : float, optional
+        Keep every mode with |λ|/2π below this frequency (Hz) instead.
+
+    Returns
+    -------
+    Plant
+        Inputs ``i_<axis>`` (A) and ``F{k}_{x|y}`` (N), outputs ``y_<axis>`` (m), the
+        physical parameters as LFT channels; the eddy-current lag and the ``[actuator]``
+        states appended after the mechanical (or modal) states.
+
+    Raises
+    ------
+    ModelError
+        A non-positive-definite mass matrix, a component or force position without a node,
+        or a reduction that cannot be made (:func:`~ambseal.model.reduction.modal_reduction`).
     """
 
     sys = build_system(cfg, pressure_bar=pressure_bar, speed_rpm=speed_rpm,

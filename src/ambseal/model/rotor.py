@@ -79,6 +79,12 @@ def build_mesh(cfg: RigConfig, extra_positions: tuple[float, ...] = ()) -> Mesh:
         The rig.
     extra_positions : tuple of float
         More positions (m) that need a node (e.g. extra force inputs).
+
+    Returns
+    -------
+    Mesh
+        A node at every section boundary and component position; each section divided into
+        its ``elements`` equal elements, split where a component falls inside one.
     """
     beam_tim = cfg.rotor.beam == "timoshenko"
     positions = [d.position for d in cfg.disk]
@@ -122,8 +128,22 @@ def build_mesh(cfg: RigConfig, extra_positions: tuple[float, ...] = ()) -> Mesh:
 class RotorMatrices:
     """Assembled shaft-and-disk matrices, each (n_dof, n_dof).
 
-    ``M`` mass, ``K`` stiffness, ``C`` structural (modal) damping, ``G`` gyroscopic per
-    unit spin speed (rad/s).
+    M q̈ + (C + Ω G) q̇ + K q = f (Friswell et al. 2010, Eq. 5.95), q the node DOFs
+    ``[x, y, α, β]`` of ``mesh``.
+
+    Attributes
+    ----------
+    mesh : Mesh
+        The nodes and elements; ``n_dof = 4·n_nodes``.
+    M : ndarray, shape (n_dof, n_dof)
+        Mass matrix (kg, kg·m²).
+    K : ndarray, shape (n_dof, n_dof)
+        Stiffness matrix (N/m, N·m/rad).
+    C : ndarray, shape (n_dof, n_dof)
+        Structural (modal) damping (N·s/m): the rotor's ``modal_damping`` on every
+        free–free elastic mode.
+    G : ndarray, shape (n_dof, n_dof)
+        Gyroscopic matrix per unit spin speed (multiplied by Ω in rad/s).
     """
 
     mesh: Mesh
@@ -141,7 +161,26 @@ class RotorMatrices:
 
 
 def assemble_rotor(cfg: RigConfig, mesh: Mesh | None = None) -> RotorMatrices:
-    """Assemble the free–free rotor (shaft elements and disks) of a rig."""
+    """Assemble the free–free rotor (shaft elements and disks) of a rig.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig: shaft, materials, disks and the rotor's modal damping.
+    mesh : Mesh, optional
+        The mesh to assemble on; :func:`build_mesh` of ``cfg`` if omitted.
+
+    Returns
+    -------
+    RotorMatrices
+        M, K, C and G of shaft and disks; no bearings, seals or springs (those are added by
+        :mod:`ambseal.model.rig`).
+
+    Raises
+    ------
+    ModelError
+        A disk whose position has no node in ``mesh``.
+    """
     mesh = mesh or build_mesh(cfg)
     n = mesh.n_dof
     M = np.zeros((n, n))

@@ -74,6 +74,20 @@ def seal_coefficients(seal: Seal, pressure_bar: float,
     """Coefficients K, k (N/m), C, c (N·s/m), M (kg) of a seal at a pressure drop (bar)
     and, for tabulated ones, an excitation frequency (Hz); see :func:`coefficient_value`.
 
+    Parameters
+    ----------
+    seal : Seal
+        A rig file's ``[[seal]]`` entry (Childs' convention, thesis P4 Eq. 3).
+    pressure_bar : float
+        Pressure drop across the seal (bar).
+    frequency_hz : float, optional
+        Excitation frequency (Hz) at which tabulated coefficients are interpolated.
+
+    Returns
+    -------
+    dict of str to float
+        ``{"K": …, "k": …, "C": …, "c": …, "M": …}`` in SI.
+
     Raises
     ------
     ModelError
@@ -87,7 +101,20 @@ def seal_values(seals, pressure_bar: float) -> dict[str, float]:
     """Every constant or pressure-dependent coefficient of every seal at a pressure drop
     (bar), by LFT name (``"<seal>.K"``, ...; SI): e.g. the value a controller scheduled on
     a seal coefficient is frozen at for a judged condition. Tabulated coefficients (they
-    need a frequency) are left out."""
+    need a frequency) are left out.
+
+    Parameters
+    ----------
+    seals : sequence of Seal
+        The rig's ``[[seal]]`` entries.
+    pressure_bar : float
+        Pressure drop across the seals (bar).
+
+    Returns
+    -------
+    dict of str to float
+        ``{"<seal>.<K|k|C|c|M>": value}``, SI.
+    """
     return {f"{s.name}.{n}": coefficient_value(getattr(s, n), pressure_bar)
             for s in seals for n in COEFFICIENTS
             if not isinstance(getattr(s, n), FrequencyTable)}
@@ -96,7 +123,23 @@ def seal_values(seals, pressure_bar: float) -> dict[str, float]:
 def pressure_for_k(seals, name: str, value: float) -> float | None:
     """The pressure drop (bar) at which the seal named by ``name`` (``"<seal>.k"``) has the
     cross-coupled stiffness k = ``value`` (N/m), k = k₀ + k'·p affine with k' ≠ 0:
-    p = max((k − k₀)/k', 0); None when ``name`` is no such k."""
+    p = max((k − k₀)/k', 0).
+
+    Parameters
+    ----------
+    seals : sequence of Seal
+        The rig's ``[[seal]]`` entries.
+    name : str
+        A parameter name; the rule applies to ``"<seal>.k"``.
+    value : float
+        The cross-coupled stiffness k (N/m).
+
+    Returns
+    -------
+    float or None
+        The pressure drop (bar), ≥ 0; None when ``name`` is no seal's k affine in the
+        pressure drop with k' ≠ 0.
+    """
     seal_name, _, key = name.rpartition(".")
     seal = next((s for s in seals if s.name == seal_name), None)
     if key != "k" or seal is None or not isinstance(seal.k, Affine) or not seal.k.per_bar:

@@ -84,6 +84,7 @@ def frozen(K, speed_rad_s: float | None = None, values: Mapping[str, float] | No
     Parameters
     ----------
     K : control.StateSpace or ScheduledController
+        The controller, displacements (m) → currents (A), ``i = −K y``.
     speed_rad_s : float, optional
         The rotor speed Ω (rad/s): θ of a speed-scheduled controller.
     values : mapping, optional
@@ -105,8 +106,28 @@ def frozen(K, speed_rad_s: float | None = None, values: Mapping[str, float] | No
 
 def matrices_at(K, speed_rad_s: float | None = None,
                 values: Mapping[str, float] | None = None) -> tuple[np.ndarray, ...]:
-    """Physical ``(A_K, B_K, C_K, D_K)`` of a fixed or scheduled controller at a condition
-    (arguments and errors as :func:`frozen`)."""
+    """Physical ``(A_K, B_K, C_K, D_K)`` of a fixed or scheduled controller at a condition.
+
+    Parameters
+    ----------
+    K : control.StateSpace or ScheduledController
+        The controller, displacements (m) → currents (A), ``i = −K y``.
+    speed_rad_s : float, optional
+        The rotor speed Ω (rad/s): θ of a speed-scheduled controller.
+    values : mapping, optional
+        ``{parameter: value}`` (SI): θ of a controller scheduled on another parameter.
+
+    Returns
+    -------
+    tuple of ndarray
+        ``(A_K, B_K, C_K, D_K)`` as float arrays, shapes ``(n_K, n_K)``, ``(n_K, p)``,
+        ``(m, n_K)``, ``(m, p)`` for ``p`` displacements and ``m`` currents.
+
+    Raises
+    ------
+    ModelError
+        A scheduled controller whose parameter has no value given.
+    """
     if isinstance(K, ScheduledController):
         return K.matrices_at(_value(K, speed_rad_s, values))
     return tuple(np.asarray(M, float) for M in (K.A, K.B, K.C, K.D))

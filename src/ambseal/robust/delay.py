@@ -93,7 +93,26 @@ def check_timing(sample_rate_hz: float, delay_samples) -> None:
 
 def loop_delay(sample_rate_hz: float, delay_samples: int) -> DesignDelay:
     """The delay the continuous analyses put in every loop: :func:`design_delay` checked
-    up to 0.999 of the Nyquist frequency (Hz)."""
+    up to 0.999 of the Nyquist frequency (Hz).
+
+    Parameters
+    ----------
+    sample_rate_hz : float
+        Controller sample rate f_s (Hz), > 0.
+    delay_samples : int
+        Computation delay n_d (samples), ≥ 0.
+
+    Returns
+    -------
+    DesignDelay
+        τ = (n_d + 1/2)/f_s as a Padé system whose phase is checked up to 0.999·f_s/2.
+
+    Raises
+    ------
+    ConfigError
+        A non-positive or non-finite ``sample_rate_hz``, a negative or fractional
+        ``delay_samples`` (named).
+    """
     return design_delay(sample_rate_hz, delay_samples, 0.999 * float(sample_rate_hz) / 2)
 
 
@@ -118,6 +137,9 @@ def design_delay(sample_rate_hz: float, delay_samples: int, band_top_hz: float, 
         Computation delay n_d (samples), ≥ 0.
     band_top_hz : float
         Top of the design band (Hz), > 0: the approximation's phase is checked up to it.
+    max_order : int
+        Highest Padé order tried (default :data:`MAX_ORDER`); returned when no lower order
+        meets the tolerance.
 
     Returns
     -------

@@ -286,13 +286,26 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
         Number of measurements and control inputs.
     omega : array_like, optional
         Frequency grid in rad/s (default: :func:`~ambseal.robust.dk.default_omega`).
-    order, max_iter, rtol, patience, backoff, fit_tol, search, search_backoff, progress
-        As in :func:`~ambseal.robust.dk.musyn`; ``order`` is the D fit order of the D–K
-        phase (the D–G–K phase selects its orders automatically), ``max_iter`` bounds each
-        phase, ``search`` and ``search_backoff`` are the D search's of the D–K phase.
+    order : int or "auto"
+        D-scale fit order (0–4) of the D–K phase, as in :func:`~ambseal.robust.dk.musyn`;
+        the D–G–K phase selects its orders automatically.
+    max_iter : int
+        Maximum number of iterations of each phase.
+    rtol : float
+        Relative improvement of peak μ below which an iteration counts as no progress.
+    patience : int
+        Stop a phase after this many iterations without progress.
+    backoff : float
+        K-step: the controller is built at ``backoff·γ_opt``.
+    fit_tol : float
+        Relative magnitude tolerance of the automatic scaling fit orders.
+    search, search_backoff : int or "auto", float
+        The D search of the D–K phase, as in :func:`~ambseal.robust.dk.musyn`.
     time_budget_s : float
         CPU-time budget (s) of both phases (:func:`~ambseal.robust.dk.musyn`): no D–G–K
         step starts once it is spent.
+    progress : bool
+        Print one line per iteration on stderr (rich).
 
     Returns
     -------

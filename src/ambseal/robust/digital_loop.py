@@ -29,8 +29,21 @@ __all__ = ["DiscreteController", "discrete_controller", "closed_loop_matrices"]
 class DiscreteController:
     """x_c,k+1 = A x_c,k + B y_k, u_k = C x_c,k + D y_k at ``dt`` (s); i_ref = −u + e.
 
-    ``description`` (optional) says what the matrices are, e.g. the PID parameters they
-    were discretised from; it is written with them into a record's metadata.
+    Attributes
+    ----------
+    A : ndarray, shape (n_c, n_c)
+        State matrix of the discrete controller.
+    B : ndarray, shape (n_c, p)
+        Input matrix; the inputs are the ``p`` displacements ``y_k`` (m).
+    C : ndarray, shape (m, n_c)
+        Output matrix; the outputs are the ``m`` currents ``u_k`` (A).
+    D : ndarray, shape (m, p)
+        Feedthrough (A/m).
+    dt : float
+        Sample time (s), > 0.
+    description : dict or None
+        What the matrices are, e.g. the PID parameters they were discretised from; written
+        with them into a record's metadata, not compared.
     """
 
     A: np.ndarray
@@ -78,9 +91,28 @@ class DiscreteController:
 
 
 def discrete_controller(K, dt: float, method: str = "tustin") -> DiscreteController:
-    """Discretise a continuous ``control.StateSpace`` controller at ``dt`` (s) by
-    :func:`ambseal.lti.discrete.discretize` (``"tustin"``, the usual choice for a digital
-    PID, or ``"zoh"``)."""
+    """Discretise a continuous ``control.StateSpace`` controller at ``dt`` (s).
+
+    Parameters
+    ----------
+    K : control.StateSpace
+        Continuous controller from displacements (m) to currents (A), ``u = K y``.
+    dt : float
+        Sample time (s), positive and finite.
+    method : {"tustin", "zoh"}
+        By :func:`ambseal.lti.discrete.discretize`: Tustin, the usual choice for a digital
+        PID, or the zero-order-hold equivalent.
+
+    Returns
+    -------
+    DiscreteController
+        The matrices at ``dt``, no description.
+
+    Raises
+    ------
+    ModelError
+        A bad sample time, an unknown method or a discrete-time ``K``.
+    """
     Kd = discretize(K, dt, method)
     return DiscreteController(np.asarray(Kd.A), np.asarray(Kd.B), np.asarray(Kd.C),
                               np.asarray(Kd.D), dt)

@@ -45,6 +45,18 @@ def test_metrics_json_fits_the_shipped_schema(metrics):
             validate_metrics(broken)
 
 
+def test_the_report_says_what_the_loops_were_judged_on(metrics):
+    """The embedded run judges on the virtual facility's truth, not the rig file: the
+    report's header says so, lists where the truth differs (its parameters and its
+    eddy-current lag) and links the manual's section that explains it."""
+    out, _ = metrics
+    page = (out / "report.html").read_text(encoding="utf-8")
+    line = page.split('<p class="judged">', 1)[1].split("</p>", 1)[0]
+    assert "virtual facility&#x27;s truth" in line and "testrig_truth.toml" in line
+    assert "τ_e" in line and "seal" in line
+    assert 'href="' in line and "getting-started.md#what-it-judged-on" in line
+
+
 def test_run_on_a_terminal_ends_with_the_verdict_and_the_report_path(terminal_run):
     """On a terminal (a pseudo-terminal here) the run shows its stages with their times,
     ends with the verdict table (the report's first screen in text) and the path of

@@ -42,6 +42,7 @@ from ambseal.model.rig import build_plant
 from ambseal.report.progress import StageProgress
 from ambseal.report.run_report import (
     gains_figure,
+    judged_on,
     rig_clearances_um,
     spinup_figures,
     stamp,
@@ -245,6 +246,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         figs.append(gains_figure(out, [(d.method, frozen_at(d.controller, cfg.operating,
                                                             design_cfg)) for d in designs]))
         write_run_report(out, f"ambseal — {cfg.rotor.name}", stamp(rig_path, command),
-                         metrics, curves, figs, sections, rig_clearances_um(cfg))
+                         metrics, curves, figs, sections, rig_clearances_um(cfg),
+                         judged_on(cfg, truth_cfg if ident is not None else None, truth))
         stages.step()
     return RunResult(final, final / "metrics.json", final / "report.html", metrics)

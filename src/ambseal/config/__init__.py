@@ -8,13 +8,36 @@ reason there), which the other layers' checks of the same quantities share. Ever
 layer receives the typed models from here.
 """
 
-from ambseal.config._checks import (MAX_COEFFICIENT, MAX_CURRENT_A, MAX_DELAY_SAMPLES,
-                                    MAX_ELEMENTS, MAX_FREQUENCY_HZ, MAX_GAP_M,
-                                    MAX_PRESSURE_BAR, MAX_SPEED_HZ)
-from ambseal.config.rig import (Actuator, Affine, Amb, AxisPair, Coefficient, FrequencyTable,
-                                RigConfig, Seal, Spring, TruthSection, apply_overrides,
-                                check_operating, default_rig_path, dump_rig, load_rig,
-                                load_truth, parse_rig, rig_with_values)
+from ambseal.config._checks import (
+                                    MAX_COEFFICIENT,
+                                    MAX_CURRENT_A,
+                                    MAX_DELAY_SAMPLES,
+                                    MAX_ELEMENTS,
+                                    MAX_FREQUENCY_HZ,
+                                    MAX_GAP_M,
+                                    MAX_PRESSURE_BAR,
+                                    MAX_SPEED_HZ,
+)
+from ambseal.config.rig import (
+                                    Actuator,
+                                    Affine,
+                                    Amb,
+                                    AxisPair,
+                                    Coefficient,
+                                    FrequencyTable,
+                                    RigConfig,
+                                    Seal,
+                                    Spring,
+                                    TruthSection,
+                                    apply_overrides,
+                                    check_operating,
+                                    default_rig_path,
+                                    dump_rig,
+                                    load_rig,
+                                    load_truth,
+                                    parse_rig,
+                                    rig_with_values,
+)
 
 __all__ = ["MAX_COEFFICIENT", "MAX_CURRENT_A", "MAX_DELAY_SAMPLES", "MAX_ELEMENTS",
            "MAX_FREQUENCY_HZ", "MAX_GAP_M", "MAX_PRESSURE_BAR", "MAX_SPEED_HZ",

@@ -38,7 +38,7 @@ th{background:#f0f0f0;text-align:center}td.text{text-align:left}tr.unstable td{b
 td.zone{text-align:center;font-weight:bold;color:#111}table.detail thead tr+tr th{white-space:nowrap}table.verdict{font-size:.92em}
 table.verdict td.verdict{min-width:22em;max-width:34em}
 figure{margin:.6em 0}figure img{max-width:100%;height:auto;border:1px solid #ddd}
-figcaption{font-size:.85em;color:#555}.meta{color:#666;font-size:.82em;margin-top:0;overflow-wrap:anywhere}
+figcaption{font-size:.85em;color:#555}.judged{font-size:.9em;margin-top:0}.meta{color:#666;font-size:.82em;margin-top:0;overflow-wrap:anywhere}
 .legend span{display:inline-block;padding:0 .5em;margin-right:.3em;font-weight:bold}
 """
 
@@ -77,6 +77,7 @@ def render_report(
     sections: Sequence[Mapping[str, Any]] = (),
     meta: str | None = None,
     clearances_um: Mapping[str, float] | None = None,
+    judged_on: tuple[str, str] | None = None,
 ) -> str:
     """The report page as a string (see :func:`write_report`)."""
 
@@ -88,6 +89,10 @@ def render_report(
     ]
     if meta:
         parts.append(f'<p class="meta">{_esc(meta)}</p>')
+    if judged_on:
+        text, href = judged_on
+        parts.append(f'<p class="judged"><b>Judged on:</b> {_esc(text)} '
+                     f'(<a href="{_esc(href)}">what the main job judges on</a>)</p>')
     if metrics:
         parts += ["<h2>Verdict</h2>", verdict_table_html(verdicts(metrics, clearances_um)),
                   _zone_legend(), "<h2>Every judged condition</h2>", detail_table_html(metrics)]
@@ -118,6 +123,7 @@ def write_report(
     sections: Sequence[Mapping[str, Any]] = (),
     meta: str | None = None,
     clearances_um: Mapping[str, float] | None = None,
+    judged_on: tuple[str, str] | None = None,
 ) -> Path:
     """Write one self-contained ``report.html``.
 
@@ -144,6 +150,9 @@ def write_report(
         A line under the title (escaped), e.g. rig file and version.
     clearances_um : mapping, optional
         Clearances (µm) the unbalance orbit is set against, e.g. ``{"air gap": 500}``.
+    judged_on : (str, str), optional
+        What the loops were judged on, in words, and a link to the manual's page that
+        explains it: a line under the stamp.
 
     Returns
     -------
@@ -158,6 +167,6 @@ def write_report(
     if not path.parent.is_dir():
         raise AmbsealError(f"report folder {str(path.parent)!r} does not exist")
     text = render_report(title=title, metrics=metrics, figures=figures, sections=sections,
-                         meta=meta, clearances_um=clearances_um)
+                         meta=meta, clearances_um=clearances_um, judged_on=judged_on)
     write_text(path, text)
     return path

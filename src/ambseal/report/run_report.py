@@ -49,6 +49,52 @@ def stamp(rig_path: str | Path, command: str | None = None) -> str:
             f"command: {command or 'ambseal.app.pipeline.run()'}")
 
 
+#: The manual's section on what the main job judges on (docs/getting-started.md).
+MANUAL_JUDGED_ON = "getting-started.md#what-it-judged-on"
+
+
+def judged_on(cfg, truth=None, truth_path: str | Path | None = None) -> tuple[str, str]:
+    """The report's "Judged on" line and its link into the manual.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig file's configuration.
+    truth : TruthSection, optional
+        The virtual facility's truth, when the loops were judged on it.
+    truth_path : str or Path, optional
+        Its file, named in the line.
+
+    Returns
+    -------
+    (str, str)
+        The line, and the manual page's address: the source tree's
+        ``docs/getting-started.md`` as a ``file:`` URI where it exists beside the package,
+        else its path in the manual.
+    """
+    docs = Path(__file__).resolve().parents[3] / "docs" / MANUAL_JUDGED_ON.split("#")[0]
+    href = (docs.as_uri() + "#" + MANUAL_JUDGED_ON.split("#")[1] if docs.is_file()
+            else "docs/" + MANUAL_JUDGED_ON)
+    if truth is None:
+        return ("the rig file's full-order model, each controller with the target's hold and "
+                "computation delay, and as it runs (sampled, delayed)", href)
+    diff = sorted(truth.parameters)
+    if truth.tau_e != cfg.actuator.eddy_time_constant:
+        diff.append(f"eddy-current lag τ_e {truth.tau_e * 1e3:.3g} ms (rig file "
+                    f"{cfg.actuator.eddy_time_constant * 1e3:.3g} ms)")
+    if truth.sensor_filter_hz is not None:
+        diff.append(f"a sensor low-pass at {truth.sensor_filter_hz:g} Hz")
+    if truth.beam is not None:
+        diff.append(f"{truth.beam} beams")
+    if truth.mesh_factor != 1.0:
+        diff.append(f"a mesh {truth.mesh_factor:g}× as fine")
+    if truth.modal_damping is not None:
+        diff.append(f"modal damping {truth.modal_damping:g}")
+    name = Path(truth_path).name if truth_path is not None else "its truth file"
+    return (f"the virtual facility's truth ({name}, full order), not the rig file; it "
+            f"differs from the rig file in: {', '.join(diff) or 'nothing'}", href)
+
+
 def rig_clearances_um(cfg) -> dict[str, float]:
     """Clearances (µm) the unbalance orbit is judged against: the nominal AMB air gap
     (:func:`ambseal.design.specs.machine`: ``air_gap``, or Ki·i0/Ks) and the smallest
@@ -308,7 +354,8 @@ def _discrete_section(metrics: dict) -> list[dict]:
 
 def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: list,
                      extra_figures: list, extra_sections: list,
-                     clearances_um: dict | None = None) -> Path:
+                     clearances_um: dict | None = None,
+                     judged_on: tuple[str, str] | None = None) -> Path:
     """``report.html`` of the main job: the verdict per controller and the table of every
     case (:mod:`ambseal.report.verdict`), σ̄(S_o) with the ISO 14839-3 zones, compliance,
     unbalance and impulse responses, then the extra figures and sections.
@@ -369,4 +416,4 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
     return write_report(out / "report.html", title=title, metrics=metrics["cases"],
                         figures=figs + list(extra_figures),
                         sections=sections + list(extra_sections), meta=meta,
-                        clearances_um=clearances_um)
+                        clearances_um=clearances_um, judged_on=judged_on)

@@ -382,4 +382,5 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
                        gamma=gamma, history=tuple(history), best_iteration=it_best,
                        scalings=fits_best, alternatives=alt, mu_grid=pk.grid_peak,
                        check_omega=pk.omega, check_mu=pk.upper, check=pk.describe(),
-                       elapsed_s=time.process_time() - t0)
+                       elapsed_s=time.process_time() - t0,
+                       closed_loop=lft_lower(P, K, nmeas, ncon))

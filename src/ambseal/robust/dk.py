@@ -291,6 +291,8 @@ class MusynResult:
         One line naming that grid.
     elapsed_s : float
         CPU time of the synthesis (s, this process).
+    closed_loop : control.StateSpace
+        ``F_l(P, K)`` from the exogenous inputs to the exogenous outputs.
     """
 
     K: Any
@@ -308,11 +310,17 @@ class MusynResult:
     check_mu: np.ndarray | None = field(default=None, repr=False)
     check: str = ""
     elapsed_s: float = float("nan")
+    closed_loop: Any = field(default=None, repr=False)
 
     @property
     def order(self) -> int:
         """Number of controller states."""
         return int(self.K.nstates)
+
+    def __iter__(self):
+        """``K, CL, mu, info = musyn(P, blocks, nmeas, ncon)``: controller, closed loop,
+        μ and this result, in the order of python-control's synthesis functions."""
+        return iter((self.K, self.closed_loop, self.mu, self))
 
     def to_dict(self) -> dict:
         """JSON-ready summary."""
@@ -519,4 +527,5 @@ def _result(P, blocks, nmeas, ncon, w, finalists, history, t0, alternatives=()):
                        gamma=gamma, history=tuple(history), best_iteration=it,
                        scalings=fits, alternatives=tuple(alternatives), mu_grid=pk.grid_peak,
                        check_omega=pk.omega, check_mu=pk.upper, check=pk.describe(),
-                       elapsed_s=time.process_time() - t0)
+                       elapsed_s=time.process_time() - t0,
+                       closed_loop=lft_lower(P, K, nmeas, ncon))

@@ -39,6 +39,8 @@ from pathlib import Path
 
 import pytest
 
+from .octave import octave_cli
+
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
 KINDS = {"python", "console", "toml", "c", "matlab", "json", "text"}
@@ -159,7 +161,7 @@ class Page:
         pass
 
     def _matlab(self, body, where):
-        octave = _octave()
+        octave = octave_cli()
         if octave is None:
             return  # tests/robust/test_robust_digital.py checks the .mat in Octave too
         script = "pkg load control\n" + body
@@ -213,16 +215,6 @@ class Page:
         shutil.copytree(src, self.folder / out, dirs_exist_ok=True)
         self.ran.append(" ".join(["ambseal", *argv]))
         return True
-
-
-def _octave() -> str | None:
-    """octave-cli with its control package, or None."""
-    exe = shutil.which("octave-cli")
-    if exe is None:
-        return None
-    r = subprocess.run([exe, "--no-gui", "-q", "--eval", "pkg load control; disp(4242)"],
-                       capture_output=True, text=True, timeout=120)
-    return exe if r.returncode == 0 and "4242" in r.stdout else None
 
 
 def _run_page(path: Path, tmp_path, monkeypatch, request, slow: bool) -> Page:

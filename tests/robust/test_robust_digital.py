@@ -13,11 +13,13 @@ import numpy as np
 import pytest
 import scipy.io
 
-from ambseal.robust.digital import (discretize_as, residualize, split_fast, with_delay)
-from ambseal.export.controller_files import export_controller, load_controller
 from ambseal.errors import DataError
+from ambseal.export.controller_files import export_controller, load_controller
 from ambseal.lti.discrete import zoh
 from ambseal.lti.interconnect import feedback_matrices
+from ambseal.robust.digital import discretize_as, residualize, split_fast, with_delay
+
+from ..octave import octave_cli
 
 
 def _mats(sys):
@@ -225,17 +227,7 @@ def test_export_round_trip_fixed(testrig_digital, tmp_path, suffix):
     assert [p.name for p in tmp_path.iterdir()] == [path.name]
 
 
-def _octave() -> str | None:
-    """octave-cli with the control package, or None."""
-    exe = shutil.which("octave-cli")
-    if exe is None:
-        return None
-    r = subprocess.run([exe, "--no-gui", "-q", "--eval", "pkg load control; disp(4242)"],
-                       capture_output=True, text=True, timeout=120)
-    return exe if r.returncode == 0 and "4242" in r.stdout else None
-
-
-@pytest.mark.skipif(_octave() is None, reason="no octave-cli with the control package "
+@pytest.mark.skipif(octave_cli() is None, reason="no octave-cli with the control package "
                     "(Debian: apt-get install octave octave-control; .ci/run installs them "
                     "where it can)")
 def test_mat_export_is_an_ss_in_octave(testrig_digital, tmp_path):
@@ -258,7 +250,7 @@ def test_mat_export_is_an_ss_in_octave(testrig_digital, tmp_path):
                       "w = 2 * pi * [1 30 557 2000 4900];\n"
                       "H = freqresp(K, w);\n"
                       "save('-v7', 'out.mat', 'y', 'H', 'ts', 'names');\n")
-    r = subprocess.run([_octave(), "--no-gui", "-q", script.name], cwd=tmp_path,
+    r = subprocess.run([octave_cli(), "--no-gui", "-q", script.name], cwd=tmp_path,
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     out = scipy.io.loadmat(tmp_path / "out.mat")

@@ -8,7 +8,7 @@ eigenvector matrix is well conditioned, checked at three probes) against
 ``method="hessenberg"`` (the Hessenberg reduction and SLICOT TB05AD per point, the
 fallback that the unbalanced modal form's cond V > 1e8 forced on the blower), on the
 full-order plant of the rig's nominal operating point (currents and the judgement's force
-inputs) over its judgement grid (``judge_settings(cfg).freq_hz``), each from a cold cache,
+inputs) over its judgement grid (``judge_settings(design_spec(cfg)).freq_hz``), each from a cold cache,
 medians of 3. ``modal_form``: ``"plain"`` (cond V ≤ 1e8 unbalanced), ``"balanced"`` (only
 after balancing) or null.
 ``max_rel_diff``: largest |ΔH| over max |H| per frequency.
@@ -48,6 +48,7 @@ def main() -> None:
     import numpy as np
 
     from ambseal.analysis.judge import judge_settings
+    from ambseal.design.specs import design_spec
     from ambseal.config import load_rig
     from ambseal.lti import freqresp as F
     from ambseal.lti.freqresp import freqresp_at
@@ -55,7 +56,7 @@ def main() -> None:
 
     for rig in ("blower", "turboexpander", "pump", "testrig"):
         cfg = load_rig(ROOT / "examples" / f"{rig}.toml")
-        s = judge_settings(cfg)
+        s = judge_settings(design_spec(cfg))
         P = build_plant(cfg, pressure_bar=cfg.operating.pressure_bar,
                         speed_rpm=cfg.operating.speed_rpm,
                         force_positions=tuple(s.force_positions_m)).to_statespace()

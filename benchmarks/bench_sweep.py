@@ -32,17 +32,20 @@ def main() -> None:
 
     from ambseal.analysis.sweep import stability_boundary, sweep
     from ambseal.config import load_rig
+    from ambseal.analysis.judge import judge_settings
     from ambseal.design.recipes import design
+    from ambseal.design.specs import design_spec
 
     cfg = load_rig()
     K = {"pid": design(cfg, "pid").K}
     n_p, n_s = (7, 4) if args.quick else (21, 16)
     pressures, speeds = np.linspace(0.0, 4.08, n_p), np.linspace(0.0, 150.0, n_s)
     t0 = time.perf_counter()
-    serial = sweep(cfg, K, pressures, speeds, workers=1)
+    settings = judge_settings(design_spec(cfg))
+    serial = sweep(cfg, K, pressures, speeds, workers=1, settings=settings)
     t_serial = time.perf_counter() - t0
     t0 = time.perf_counter()
-    dask = sweep(cfg, K, pressures, speeds, workers=2)
+    dask = sweep(cfg, K, pressures, speeds, workers=2, settings=settings)
     t_dask = time.perf_counter() - t0
     edge = [e["boundary_pressure_bar"] for e in stability_boundary(dask)]
     print(json.dumps({"case": f"sweep_{n_p}x{n_s}_pid", "ours": "dask LocalCluster 2 workers",

@@ -7,11 +7,11 @@ from pathlib import Path
 
 import control
 
-from ambseal.analysis.judge import judge, operating_points
+from ambseal.analysis.judge import judge, judge_settings, operating_points
 from ambseal.app.commands import digital_for
 from ambseal.config import load_rig
 from ambseal.export.controller_files import export_controller
-from ambseal.design.recipes import design
+from ambseal.design import design, design_spec
 from ambseal.model.rig import build_plant
 from ambseal.report.figures import sensitivity_figure
 
@@ -20,10 +20,10 @@ out.mkdir(parents=True, exist_ok=True)
 rig = load_rig(Path(__file__).with_name("testrig.toml"))        # 1. the rig file (TOML)
 model = build_plant(rig, reduced=True)                          # 2. the reduced model
 print(f"model: {model.n_states} states, axes {', '.join(model.axes)}")
-hinf = design(rig, "hinf")                                      # 3. H∞ design (thesis P5 §4)
-points, curves = operating_points(rig), []
+hinf = design(rig, "hinf", spec=(spec := design_spec(rig)))    # 3. H∞ design (thesis P5 §4)
+points, settings, curves = operating_points(spec), judge_settings(spec), []
 for point in points:                                            # 4. judged on the full model
-    case, c = judge(rig, hinf.K, "hinf", point)  # grids from the rig: design --show-defaults
+    case, c = judge(rig, hinf.K, "hinf", point, settings)
     print(f"{point.label}: stable={case.stable}, ISO zone per axis "
           f"{case.iso_zone_per_axis}, orbit {case.unbalance_peak_um:.3g} µm")
     curves.append((point.label, *c["So"]))

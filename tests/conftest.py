@@ -93,8 +93,9 @@ def turbo_frozen(turbo_cfg):
 def _digital(cfg, designs: dict) -> dict:
     from ambseal.analysis.judge import operating_points
     from ambseal.app.commands import digital_for
+    from ambseal.design.specs import design_spec
 
-    pts, cache = operating_points(cfg), {}
+    pts, cache = operating_points(design_spec(cfg)), {}
     return {m: digital_for(cfg, m, getattr(d, "K", d) if m != "lpv" else d, d, pts, cache)
             for m, d in designs.items()}
 

@@ -145,3 +145,39 @@ def test_no_history_in_code_or_tests():
             if pattern.search(line)]
     assert hits == []
 
+
+
+def _design_spec_calls() -> list[tuple[str, int, bool]]:
+    """Every call of ``design_spec`` in the package: (module, line, whether it is the
+    fallback ``spec or design_spec(...)`` of a function that takes ``spec``)."""
+    out = []
+    for path in sorted(SRC.rglob("*.py")):
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        fallbacks = set()
+        for fn in ast.walk(tree):
+            if not isinstance(fn, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                continue
+            params = {a.arg for a in fn.args.args + fn.args.kwonlyargs}
+            for node in ast.walk(fn):
+                if (isinstance(node, ast.BoolOp) and isinstance(node.op, ast.Or)
+                        and "spec" in params and isinstance(node.values[0], ast.Name)
+                        and node.values[0].id == "spec"):
+                    fallbacks |= {id(v) for v in node.values[1:]}
+        for node in ast.walk(tree):
+            if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+                    and node.func.id == "design_spec"):
+                out.append((str(path.relative_to(SRC)), node.lineno, id(node) in fallbacks))
+    return out
+
+
+def test_the_design_specification_is_built_by_the_commands_and_passed_down():
+    """The design specification is derived from the rig once, by the command that runs
+    (``app``), and passed to every stage; a design entry point a script calls alone
+    (``design(cfg, "hinf")``) derives it only when it was given none (``spec or ...``).
+    Nothing below ``design`` derives it (the judgement takes its settings)."""
+    calls = _design_spec_calls()
+    assert calls, "the finder sees no call at all"
+    stray = [(m, line) for m, line, fallback in calls
+             if not (m.startswith("app/") or (m.startswith("design/") and fallback))]
+    assert stray == []
+    assert not any(m.startswith("analysis/") for m, _, _ in calls)

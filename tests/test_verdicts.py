@@ -11,9 +11,10 @@ command must say stable, just above it every command unstable.
 import numpy as np
 
 from ambseal.analysis.campbell import closed_loop_modes
-from ambseal.analysis.judge import OperatingPoint, judge
+from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
 from ambseal.analysis.sweep import boundary_case, sweep_case
 from ambseal.design.recipes import full_order_check
+from ambseal.design.specs import design_spec
 from ambseal.model.modes import bending_limit_hz
 
 
@@ -28,13 +29,14 @@ def test_commands_agree_on_either_side_of_the_stability_boundary(testrig_cfg,
                           "last_stable_bar": p0, "first_unstable_bar": 2 * p0},
                          rig, ctrls, tol_bar=1e-4)
     assert p0 < edge < 2 * p0
+    settings = judge_settings(design_spec(cfg))
     for p, stable in ((edge - 1e-3, True), (edge + 1e-3, False)):
         verdicts = {
-            "run": judge(cfg, K, "pid", OperatingPoint(p, 60.0 * f, ""),
+            "run": judge(cfg, K, "pid", OperatingPoint(p, 60.0 * f, ""), settings,
                          impulse=False)[0].stable,
             "export": full_order_check(cfg, K, [(p, f)])["stable"],
             "sweep": sweep_case({"controller": "pid", "pressure_bar": p, "speed_hz": f},
-                                rig, ctrls, bending_limit_hz(cfg))["stable"],
+                                rig, ctrls, bending_limit_hz(cfg), settings)["stable"],
             "campbell": closed_loop_modes(cfg, K, speed_hz=f, pressure_bar=p).stable,
         }
         assert verdicts == dict.fromkeys(verdicts, stable), (p, verdicts)

@@ -212,7 +212,8 @@ def test_loaded_controller_judged_alike_whatever_the_amb_order(testrig_cfg, tmp_
     and `ambseal modes --controller` gives the same modes. By position the swapped rig
     would run A's axes with B's gains. Reference: the original order, where names and
     positions agree."""
-    from ambseal.analysis.judge import judge, operating_points
+    from ambseal.analysis.judge import judge, judge_settings, operating_points
+    from ambseal.design.specs import design_spec
     from ambseal.cli import main
     from ambseal.config import load_rig
     from ambseal.export.controller_files import export_controller, load_controller
@@ -227,8 +228,9 @@ def test_loaded_controller_judged_alike_whatever_the_amb_order(testrig_cfg, tmp_
     rig = _swapped_rig(tmp_path)
     swapped = load_rig(rig)
     assert [a.name for a in swapped.amb] == ["B", "A"]
-    point = operating_points(testrig_cfg)[1]
-    cases = [judge(c, loaded, "K", point, impulse=False)[0].to_dict()
+    spec = design_spec(testrig_cfg)
+    point = operating_points(spec)[1]
+    cases = [judge(c, loaded, "K", point, judge_settings(spec), impulse=False)[0].to_dict()
              for c in (testrig_cfg, swapped)]
     for key in ("stable", "max_real_pole", "sensitivity_peak", "compliance_peak_m_per_n"):
         assert cases[1][key] == pytest.approx(cases[0][key], rel=1e-6), key

@@ -56,7 +56,8 @@ def test_ramp_losses_agree_with_the_frozen_full_order_loops(testrig_cfg, testrig
     the rig identified by the thesis procedure on the same facility, meets the issue's
     acceptance against the truth's k (the truth file's k at each step's pressure): within
     10 % of the nominal k after 1 s, the 95 % interval covering it ≥ 90 % of the time."""
-    from ambseal.analysis.judge import OperatingPoint, judge
+    from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
+    from ambseal.design.specs import design_spec
     from ambseal.analysis.ramp import ramp_simulation
     from ambseal.config import load_truth
     from ambseal.identify.procedure import thesis_procedure
@@ -64,14 +65,16 @@ def test_ramp_losses_agree_with_the_frozen_full_order_loops(testrig_cfg, testrig
 
     cfg = testrig_cfg
     p0, rpm = cfg.operating.pressure_bar, cfg.operating.speed_rpm
+    settings = judge_settings(design_spec(cfg))
     frozen = {(m, f): judge(cfg, testrig_designs[m].K, m, OperatingPoint(f * p0, rpm, ""),
-                            impulse=False)[0].stable
+                            settings, impulse=False)[0].stable
               for m, f in (("pid", 1.25), ("pid", 1.5), ("mu", 3.0))}
     assert frozen == {("pid", 1.25): True, ("pid", 1.5): False, ("mu", 3.0): True}
     truth = load_truth(default_truth_path())
     ctrls = {m: testrig_digital[m].discrete for m in ("pid", "mu")}
     ident = thesis_procedure(cfg, truth, testrig_digital["pid"].discrete).identified
-    r = ramp_simulation(cfg, truth, ctrls, testrig_tracked, duration_s=30.0, model_cfg=ident)
+    r = ramp_simulation(cfg, truth, ctrls, testrig_tracked, duration_s=30.0, model_cfg=ident,
+                        judgement=settings)
     top = 3.0 * p0
     lost_p = r.runs["pid"].lost_at_s / 30.0 * top
     assert 1.1 * p0 < lost_p < 1.5 * p0

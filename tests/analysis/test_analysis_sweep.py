@@ -9,7 +9,9 @@ import numpy as np
 import pytest
 
 from ambseal.analysis.cases import CaseError, run_cases
+from ambseal.analysis.judge import judge_settings
 from ambseal.analysis.sweep import parse_range, stability_boundary, sweep, sweep_case
+from ambseal.design.specs import design_spec
 
 
 def test_pid_loses_the_embedded_rig_between_nominal_and_twice_nominal(testrig_cfg,
@@ -27,7 +29,8 @@ def test_pid_loses_the_embedded_rig_between_nominal_and_twice_nominal(testrig_cf
     fs, nd = testrig_cfg.controller.sample_rate_hz, testrig_cfg.controller.delay_samples
     L1 = control.ss(control.tf(*control.pade((nd + 0.5) / fs, 4)))
     L = control.append(*[L1] * 4)
-    rows = sweep(testrig_cfg, {"pid": K}, [0.0, 2.04, 4.08], [0.0], workers=1)
+    rows = sweep(testrig_cfg, {"pid": K}, [0.0, 2.04, 4.08], [0.0], workers=1,
+                 settings=judge_settings(design_spec(testrig_cfg)))
     assert [r["stable"] for r in rows] == [True, True, False]
     (edge,) = stability_boundary(rows)
     assert 2.04 < edge["boundary_pressure_bar"] < 4.08
@@ -79,7 +82,8 @@ def test_the_same_rows_on_a_dask_scheduler_by_address_and_a_failed_case_kept():
     K = control.ss([], [], [], (1e6 + 1e5) / 100.0 * np.eye(4))
     shared = {"rig": cfg.model_dump(exclude_none=True),
               "controllers": {"p": (np.zeros((0, 0)), np.zeros((0, 4)), np.zeros((4, 0)),
-                                    np.asarray(K.D))}, "max_hz": 2000.0}
+                                    np.asarray(K.D))}, "max_hz": 2000.0,
+              "settings": judge_settings(design_spec(cfg))}
     pickle.loads(pickle.dumps(shared))  # plain, picklable inputs
     cases = [{"controller": "p", "pressure_bar": p, "speed_hz": 0.0, "params": {}}
              for p in (0.0, 2.5, 4.0)]
@@ -111,8 +115,9 @@ def test_local_worker_processes_give_the_serial_rows():
 
     cfg = parse_rig(_tiny_rig())
     K = {"p": control.ss([], [], [], (1e6 + 1e5) / 100.0 * np.eye(4))}
-    serial = sweep(cfg, K, [0.0, 2.5, 4.0], [0.0, 5.0], workers=1)
-    forked = sweep(cfg, K, [0.0, 2.5, 4.0], [0.0, 5.0], workers=2)
+    settings = judge_settings(design_spec(cfg))
+    serial = sweep(cfg, K, [0.0, 2.5, 4.0], [0.0, 5.0], workers=1, settings=settings)
+    forked = sweep(cfg, K, [0.0, 2.5, 4.0], [0.0, 5.0], workers=2, settings=settings)
     assert json.dumps(serial) == json.dumps(forked)
     assert [r["stable"] for r in serial if r["speed_hz"] == 0.0] == [True, True, False]
 

@@ -48,7 +48,8 @@ def test_an_unstable_scheduled_loop_is_refused_with_its_mode(turbo_cfg, turbo_fr
     assert _max_real_pole(turbo_cfg, flipped, turbo_cfg.operating.pressure_bar, f) > 0
     with pytest.raises(SynthesisError, match=r"unstable at .* bar, .* Hz: the mode at .* "
                                              r"Hz has ζ = -"):
-        check_full_order(turbo_cfg, lambda _: flipped, "flipped")
-    kept = check_full_order(turbo_cfg, lambda _: flipped, "flipped", allow_unstable=True)
+        check_full_order(turbo_cfg, design_spec(turbo_cfg), lambda _: flipped, "flipped")
+    kept = check_full_order(turbo_cfg, design_spec(turbo_cfg), lambda _: flipped, "flipped",
+                            allow_unstable=True)
     assert not kept["stable"] and kept["damping"] < 0
     assert np.isfinite(kept["mode_hz"]) and isinstance(flipped, control.StateSpace)

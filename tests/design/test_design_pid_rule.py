@@ -12,6 +12,7 @@ import pytest
 from ambseal.analysis.judge import operating_points
 from ambseal.config import load_rig
 from ambseal.design.pid import PID_CORNERS_PER_FS, pid_controller, pid_from_rig
+from ambseal.design.specs import design_spec
 from ambseal.lti.interconnect import feedback_matrices
 from ambseal.model.amb import channel_names
 from ambseal.model.rig import build_plant
@@ -27,7 +28,7 @@ def rigs():
     out = {}
     for name in RIGS:
         cfg = load_rig(EXAMPLES / f"{name}.toml")
-        points = operating_points(cfg)
+        points = operating_points(design_spec(cfg))
         plants = []
         for p in points:
             pl = build_plant(cfg, pressure_bar=p.pressure_bar, speed_rpm=p.speed_rpm)

@@ -56,11 +56,13 @@ def test_tracked_design_stable_in_zone_a_on_the_full_order_plant(testrig_cfg, te
     over 0–3× nominal (21 pressures), the scheduled controller frozen at k is stable on the
     full-order plant (every mode, the 557 Hz bending pair included) with σ̄(S_o) ≤ 3 per
     axis — the ISO 14839-3 zone-A limit (the reference)."""
+    from ambseal.analysis.judge import judge_settings
     from ambseal.analysis.ramp import frozen_cases
+    from ambseal.design.specs import design_spec
 
     d = testrig_tracked
     assert d.design_states == 12  # the specification's model keeps the bending pair
-    cases = frozen_cases(testrig_cfg, d)
+    cases = frozen_cases(testrig_cfg, d, settings=judge_settings(design_spec(testrig_cfg)))
     assert len(cases) == 5 * (len(d.grid) - 1) + 1
     p0 = testrig_cfg.operating.pressure_bar
     assert cases[0]["pressure_bar"] == 0.0 and cases[-1]["pressure_bar"] == pytest.approx(3 * p0)
@@ -85,11 +87,12 @@ def test_tracked_digital_table_stable_with_the_target_delay(testrig_cfg, testrig
 
     from ambseal.analysis.judge import operating_points
     from ambseal.app.commands import digital_for
+    from ambseal.design.specs import design_spec
     from ambseal.model.rig import build_plant
     from ambseal.model.seal import pressure_for_k
 
     cfg, d = testrig_cfg, testrig_tracked
-    sd = digital_for(cfg, "tracked", d, d, operating_points(cfg))
+    sd = digital_for(cfg, "tracked", d, d, operating_points(design_spec(cfg)))
     assert sd.parameter == "seal.k" and sd.delay_samples == cfg.controller.delay_samples
     k_nom = d.grid[-1] / 3.0
     for f in (0.3, 1.7, 2.6):

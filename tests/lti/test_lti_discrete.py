@@ -27,15 +27,17 @@ def test_impulse_response_of_a_badly_scaled_hinf_loop_is_well_conditioned(turbo_
     a reference for the suite: nine minutes)."""
     import control
 
-    from ambseal.analysis.judge import judge, operating_points
+    from ambseal.analysis.judge import judge, judge_settings, operating_points
+    from ambseal.design.specs import design_spec
 
     K = turbo_frozen.K
-    point = operating_points(turbo_cfg)[0]
-    ref = judge(turbo_cfg, K, "hinf", point)[0].impulse_peak_um
+    spec = design_spec(turbo_cfg)
+    point, settings = operating_points(spec)[0], judge_settings(spec)
+    ref = judge(turbo_cfg, K, "hinf", point, settings)[0].impulse_peak_um
     rng = np.random.default_rng(1)
     Kp = control.ss(K.A * (1 + 1e-12 * rng.standard_normal(K.A.shape)), K.B, K.C, K.D,
                     inputs=K.input_labels, outputs=K.output_labels)
-    got = judge(turbo_cfg, Kp, "hinf", point)[0].impulse_peak_um
+    got = judge(turbo_cfg, Kp, "hinf", point, settings)[0].impulse_peak_um
     assert abs(got / ref - 1) < 1e-9, (ref, got)
 
 

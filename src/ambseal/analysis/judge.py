@@ -55,7 +55,7 @@ from ambseal.analysis.response import impulse_response_of
 from ambseal.analysis.spinup import frozen_sensitivity, spinup
 from ambseal.analysis.unbalance import unbalance_from_compliance
 from ambseal.design.lpv_plant import lpv_plant, vertex_grid_hz
-from ambseal.design.specs import RIGID_STATES, design_spec
+from ambseal.design.specs import RIGID_STATES
 from ambseal.lti.freqresp import freqresp_at
 from ambseal.lti.interconnect import wired
 from ambseal.lti.json_safe import json_float
@@ -215,7 +215,7 @@ class JudgedCase(LoopJudgement):
 
 
 
-def judge_settings(cfg, spec=None) -> JudgeSettings:
+def judge_settings(spec) -> JudgeSettings:
     """The judgement's grids and disturbances from the rig's design specification.
 
     The band, unbalance and impulse of :func:`ambseal.design.specs.design_spec`; the
@@ -225,24 +225,18 @@ def judge_settings(cfg, spec=None) -> JudgeSettings:
 
     Parameters
     ----------
-    cfg : RigConfig
-        The rig (its controller's sample rate sets the impulse response's sampling).
-    spec : DesignSpec, optional
-        The rig's design specification; :func:`~ambseal.design.specs.design_spec` of
-        ``cfg`` if omitted.
+    spec : DesignSpec
+        The rig's design specification (:func:`~ambseal.design.specs.design_spec`, built
+        once per rig by the caller); its machine's sample rate sets the impulse response's
+        sampling.
 
     Returns
     -------
     JudgeSettings
         The log frequency grid (1200 points over the band), the unbalance and the impulse.
-
-    Raises
-    ------
-    ConfigError
-        A ``[design]`` default that cannot be derived (from ``design_spec``).
     """
 
-    sp = spec or design_spec(cfg)
+    sp = spec
     t = sp.impulse_s
     return JudgeSettings(
         freq_hz=(sp.band_hz[0], sp.band_hz[1], GRID_POINTS),
@@ -250,7 +244,7 @@ def judge_settings(cfg, spec=None) -> JudgeSettings:
         unbalance_mass_kg=sp.unbalance_mass_kg, unbalance_law=sp.unbalance_law,
         unbalance_max_speed_hz=sp.unbalance_max_speed_hz, force_positions_m=sp.force_positions_m,
         impulse_a=sp.impulse_a, impulse_s=t, impulse_start_s=5 * t, impulse_end_s=35 * t,
-        impulse_dt_s=0.5 / cfg.controller.sample_rate_hz)
+        impulse_dt_s=0.5 / sp.machine.sample_rate_hz)
 
 
 @dataclass(frozen=True)
@@ -283,7 +277,7 @@ def speed_scheduled(cfg) -> bool:
         s.frequency_dependent for s in cfg.seal)
 
 
-def operating_points(cfg, spec=None) -> list[OperatingPoint]:
+def operating_points(spec) -> list[OperatingPoint]:
     """Where every controller is judged: the design specification's pressures × speeds
     (:func:`ambseal.design.specs.design_spec`; by default 0, nominal and 2× nominal
     pressure drop, P5 §4, or the ends and the middle of the speed range of a rig whose
@@ -291,31 +285,25 @@ def operating_points(cfg, spec=None) -> list[OperatingPoint]:
 
     Parameters
     ----------
-    cfg : RigConfig
-        The rig; its ``[operating]`` point is the nominal condition.
-    spec : DesignSpec, optional
-        The rig's design specification; :func:`~ambseal.design.specs.design_spec` of
-        ``cfg`` if omitted.
+    spec : DesignSpec
+        The rig's design specification (:func:`~ambseal.design.specs.design_spec`, built
+        once per rig by the caller); its nominal pressure and speed (the rig's
+        ``[operating]`` point) name each condition low, nominal or high.
 
     Returns
     -------
     list of OperatingPoint
         Every pressure at each speed, speeds outermost.
-
-    Raises
-    ------
-    ConfigError
-        A ``[design]`` default that cannot be derived (from ``design_spec``).
     """
 
-    sp = spec or design_spec(cfg)
+    sp = spec
     ps, fs = sp.pressures_bar, sp.speeds_hz
 
     def label(q, f):
         return ", ".join(([f"{q:g} bar"] if len(ps) > 1 or len(fs) == 1 else [])
                          + ([f"{f:g} Hz"] if len(fs) > 1 else []))
 
-    p0, f0 = cfg.operating.pressure_bar, cfg.operating.speed_rpm / 60.0
+    p0, f0 = sp.nominal_pressure_bar, sp.nominal_speed_hz
 
     def side(q, f):  # against the nominal of what varies (speed when it does)
         x, x0 = (f, f0) if len(fs) > 1 else (q, p0)
@@ -345,7 +333,7 @@ def _finite(x: float) -> float | None:
 
 
 def judge(cfg, controller, name: str, point: OperatingPoint,
-          settings: JudgeSettings | None = None, *, impulse: bool = True,
+          settings: JudgeSettings, *, impulse: bool = True,
           discrete=None) -> tuple[JudgedCase, dict]:
     """Judge one physical controller on the full-order plant at one operating point.
 
@@ -357,8 +345,9 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
     name : str
         The controller's name in the case.
     point : OperatingPoint
-    settings : JudgeSettings, optional
-        :func:`judge_settings` of the rig if omitted.
+    settings : JudgeSettings
+        The judgement's grids and disturbances (:func:`judge_settings` of the rig's design
+        specification).
     impulse : bool
         Set False to leave out the impulse response (the sweeps of
         :mod:`ambseal.analysis.sweep`); ``impulse_*`` are then ``None``.
@@ -381,7 +370,7 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
         ``curves["discrete"]`` (its ``poles`` are z).
     """
 
-    s = settings or judge_settings(cfg)
+    s = settings
     plant = build_plant(cfg, pressure_bar=point.pressure_bar, speed_rpm=point.speed_rpm,
                         force_positions=tuple(s.force_positions_m))
     cur = plant.current_inputs()
@@ -503,8 +492,7 @@ def frozen_discrete(digital, point, design_cfg):
     return digital.statespace(delayed=True)
 
 
-def judge_case(case: dict, cfg, settings: JudgeSettings | None = None
-               ) -> tuple[JudgedCase, dict]:
+def judge_case(case: dict, cfg, settings: JudgeSettings) -> tuple[JudgedCase, dict]:
     """:func:`judge` of ``case = {"controller", "name", "point"}`` (and ``"discrete"``, the
     delayed discrete controller that runs): the main job's cases as run by
     :func:`ambseal.analysis.cases.run_cases`.
@@ -516,8 +504,8 @@ def judge_case(case: dict, cfg, settings: JudgeSettings | None = None
         ``point`` (:class:`OperatingPoint`) and optionally ``discrete``.
     cfg : RigConfig
         The rig.
-    settings : JudgeSettings, optional
-        :func:`judge_settings` of the rig if omitted.
+    settings : JudgeSettings
+        :func:`judge_settings` of the rig's design specification.
 
     Returns
     -------

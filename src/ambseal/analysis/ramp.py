@@ -46,8 +46,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
-from ambseal.design.specs import design_spec
+from ambseal.analysis.judge import JudgeSettings, OperatingPoint, judge
 from ambseal.errors import ModelError
 from ambseal.identify.fit import ClosedLoopModel
 from ambseal.identify.rig_sim import _pressure_values, prepare_facility, reduced_plant, true_rig
@@ -211,7 +210,7 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
                     impulse_every_s: float = 2.0, transient_s: float = 1.0,
                     record_hz: float = 1000.0, seed: int = 0, settings=None,
                     model_cfg=None, tracked_digital=None, delay_samples: int = 0,
-                    progress=None) -> RampResult:
+                    judgement: JudgeSettings, progress=None) -> RampResult:
     """Run the pressure ramp with each fixed controller and the tracked scheme.
 
     Parameters
@@ -245,6 +244,9 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
         default: the frozen controller discretised by ZOH at every switch.
     delay_samples : int
         Computation delay of every controller (samples; module docstring).
+    judgement : JudgeSettings
+        The rig's judgement settings (:func:`ambseal.analysis.judge.judge_settings`): the
+        current impulse's amplitude and length.
     progress : callable, optional
         Called with one line per run.
 
@@ -262,9 +264,8 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
     N = int(round(duration_s * fs))
     sched = pressure_ramp(cfg.operating.pressure_bar, duration_s, top_factor=top_factor,
                           step_s=step_s)
-    sp = design_spec(cfg)
-    n_len = max(1, int(round(sp.impulse_s * fs)))
-    e, starts = _excitation(cfg, N, fs, impulse_every_s, sp.impulse_a, n_len, seed)
+    n_len = max(1, int(round(judgement.impulse_s * fs)))
+    e, starts = _excitation(cfg, N, fs, impulse_every_s, judgement.impulse_a, n_len, seed)
     fac0 = prepare_facility(cfg, truth, fs, pressure_bar=0.0, pressure_schedule=sched)
     k = len(fac0.axes)
     rng = np.random.default_rng(seed)
@@ -413,7 +414,8 @@ def _run_tracked(cfg, fac, tracked, run_as, e, noise, inoise, fs, starts, n_len,
     return run, acc
 
 
-def frozen_cases(cfg, design, *, settings=None, impulse: bool = False) -> list[dict]:
+def frozen_cases(cfg, design, *, settings: JudgeSettings, impulse: bool = False
+                 ) -> list[dict]:
     """The scheduled controller judged on the full-order plant at frozen pressures: the
     design's range (``range_factor`` × the operating pressure) on a grid 5× denser than
     its design grid, the controller frozen at the rig model's value of its parameter at
@@ -424,7 +426,8 @@ def frozen_cases(cfg, design, *, settings=None, impulse: bool = False) -> list[d
     ----------
     cfg : RigConfig
     design : SealScheduledDesign
-    settings : JudgeSettings, optional
+    settings : JudgeSettings
+        :func:`ambseal.analysis.judge.judge_settings` of the rig's design specification.
     impulse : bool
         Include the impulse response (off: the frequency-domain numbers only).
 
@@ -433,7 +436,7 @@ def frozen_cases(cfg, design, *, settings=None, impulse: bool = False) -> list[d
     list of dict
     """
 
-    s = settings or judge_settings(cfg)
+    s = settings
     p0, rpm = cfg.operating.pressure_bar, cfg.operating.speed_rpm
     lo, hi = design.range_factor
     cases = []

@@ -176,7 +176,7 @@ def _windows(n_sched: int, n_per: int, n_sub: int, schedule_s: float, nf: int, n
     return out
 
 
-def spinup(plant, controller, *, name: str = "K", speeds_hz=(20.0, 300.0),
+def spinup(plant, controller, *, name: str = "K", speeds_hz=None,
            ramp_s: float = 1.0, force_n: float = 100.0, output_m: float = 2e-6,
            period_s: float = 0.05, channel: int = 0, force_input: int = 0,
            schedule_s: float = 1e-3, dt: float = 1e-5,
@@ -194,8 +194,9 @@ def spinup(plant, controller, *, name: str = "K", speeds_hz=(20.0, 300.0),
         feedback ``i = −K y``).
     name : str
         Label.
-    speeds_hz : (float, float)
-        Ramp start and end speed (Hz), linear over ``ramp_s``.
+    speeds_hz : (float, float), optional
+        Ramp start and end speed (Hz), linear over ``ramp_s``; default the ends of the
+        plant's speed grid.
     ramp_s : float
         Duration (s).
     force_n, output_m : float
@@ -244,6 +245,8 @@ def spinup(plant, controller, *, name: str = "K", speeds_hz=(20.0, 300.0),
     def Kfn(W):
         return matrices_at(controller, W)
 
+    if speeds_hz is None:
+        speeds_hz = np.asarray(plant.speeds_rad_s, float)[[0, -1]] / (2 * np.pi)
     f0, f1 = (float(x) for x in speeds_hz)
     loop = _Loop(plant, Kfn, ncur, _TWO_PI * f0)
     nt = n_sched * n_sub + 1

@@ -24,7 +24,7 @@ import numpy as np
 
 from ambseal.analysis.campbell import closed_loop_state_matrix, lowest_log_decrement
 from ambseal.analysis.cases import CaseError, run_cases
-from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
+from ambseal.analysis.judge import JudgeSettings, OperatingPoint, judge
 from ambseal.config import parse_rig, rig_with_values
 from ambseal.errors import ConfigError
 from ambseal.lti.json_safe import json_float
@@ -85,7 +85,7 @@ def parse_range(text: str, name: str) -> np.ndarray:
 
 
 def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
-               settings=None) -> dict:
+               settings: JudgeSettings) -> dict:
     """One map point: the judgement without impulse and the lowest log decrement.
 
     Parameters
@@ -99,8 +99,8 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
         ``{name: (A, B, C, D)}``, displacement (m) → current (A), ``i = −K y``.
     max_hz : float
         Highest frequency (Hz) of the modes the lowest log decrement is taken over.
-    settings : JudgeSettings, optional
-        The rig's :func:`~ambseal.analysis.judge.judge_settings` if omitted.
+    settings : JudgeSettings
+        The nominal rig's :func:`~ambseal.analysis.judge.judge_settings`.
 
     Returns
     -------
@@ -159,7 +159,7 @@ def check_cases(n: int, what: str) -> None:
 
 
 def sweep(cfg, controllers: dict, pressures_bar, speeds_hz, params: dict | None = None, *,
-          max_hz: float | None = None, workers: int | None = None,
+          settings: JudgeSettings, max_hz: float | None = None, workers: int | None = None,
           scheduler: str | None = None, progress: bool = False) -> list[dict]:
     """The map over every (controller, pressure, speed, parameter values) combination.
 
@@ -171,6 +171,9 @@ def sweep(cfg, controllers: dict, pressures_bar, speeds_hz, params: dict | None 
     pressures_bar, speeds_hz : array_like
     params : dict, optional
         ``{name: values}`` of rig parameters (:func:`ambseal.config.rig_with_values` names).
+    settings : JudgeSettings
+        The nominal rig's :func:`~ambseal.analysis.judge.judge_settings`: every case is
+        judged on the same grids and disturbances, also when ``params`` change the rig.
     max_hz : float, optional
         Modes of the lowest log decrement; default
         :func:`ambseal.model.modes.bending_limit_hz`.
@@ -181,9 +184,7 @@ def sweep(cfg, controllers: dict, pressures_bar, speeds_hz, params: dict | None 
     -------
     list of dict
         One row per case in input order (controller outermost, then pressure, speed,
-        parameters); a failed case has its inputs and ``error``. Every case is judged with
-        the nominal rig's :func:`~ambseal.analysis.judge.judge_settings` (the same grids and
-        disturbances across the map, also when ``params`` change the rig).
+        parameters); a failed case has its inputs and ``error``.
     """
 
     params = params or {}
@@ -195,9 +196,7 @@ def sweep(cfg, controllers: dict, pressures_bar, speeds_hz, params: dict | None 
              for c in controllers for p in pressures_bar for s in speeds_hz
              for vals in itertools.product(*(params[n] for n in names))]
 
-    # one judgement across the map: the grids and disturbances of the nominal rig, derived
-    # once (about 0.1 s per derivation, as long as a case's own judgement)
-    shared = {**_shared(cfg, controllers), "settings": judge_settings(cfg),
+    shared = {**_shared(cfg, controllers), "settings": settings,
               "max_hz": bending_limit_hz(cfg) if max_hz is None else float(max_hz)}
     out = run_cases(sweep_case, cases, shared=shared, workers=workers, scheduler=scheduler,
                     progress=progress, description="sweep")

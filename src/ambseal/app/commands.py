@@ -60,7 +60,6 @@ from ambseal.robust.digital import (
     peak_difference,
     sampled_plants,
 )
-from ambseal.robust.dk import design_omega
 from ambseal.robust.scheduled_digital import scheduled_digital
 
 __all__ = ["Designed", "Identified", "identification_stage", "facility_impulses", "design_files",
@@ -93,7 +92,7 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
     :class:`~ambseal.robust.scheduled_digital.ScheduledDigital` whose interpolation is
     also checked between table entries (at speeds, or at the pressures that give the seal
     coefficient it is scheduled on). ``cache`` (a dict kept by the caller) shares the
-    sampled plants and the μ design's grid between the controllers of one rig."""
+    sampled plants between the controllers of one rig."""
 
     fs, delay = cfg.controller.sample_rate_hz, cfg.controller.delay_samples
     conds = _conditions(cfg, points)
@@ -105,9 +104,7 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
 
     if not isinstance(controller, ScheduledController):
         cache = {} if cache is None else cache
-        if method in ("hinf", "mu") and "omega" not in cache:  # the μ design's grid
-            cache["omega"] = design_omega(*design_spec(cfg).synthesis_band_hz)
-        rise = ((lambda Kr: design_rise(result, Kr, cache["omega"], fs / 2))
+        rise = ((lambda Kr: design_rise(result, Kr, getattr(result, "omega", None), fs / 2))
                 if method in ("hinf", "mu") else None)
         check_rate(controller, fs, delay, removable=rise is not None)  # before the plants
         if "plants" not in cache:
@@ -174,7 +171,7 @@ def target_pid(cfg):
     ``ambseal acquire`` and the main job's identification."""
 
     res = design(cfg, "pid")
-    dc = digital_for(cfg, "pid", res.K, res, operating_points(cfg))
+    dc = digital_for(cfg, "pid", res.K, res, operating_points(design_spec(cfg)))
     p = cfg.controller.pid
     gains = ({k: getattr(p, k) for k in ("kp", "ti", "td", "eps")} if p is not None else
              {k: pid_from_rig(cfg)[k] for k in ("kp", "ti", "td", "eps")})
@@ -339,19 +336,23 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
 
     cfg = load_rig(rig, overrides)
     out = writable_folder(out_dir)  # before the design, not after it
+    spec = design_spec(cfg)  # judged at the rig's conditions, whatever the design pressure
     if method == "lpv":
         if cfg.operating.speed_range_hz is None:
             raise ConfigError(f"{rig}: operating.speed_range_hz: an LPV design needs the "
                               "speed range it is scheduled over, e.g. [20.0, 300.0]")
         res = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz,
-                         allow_unstable=allow_unstable)
+                         allow_unstable=allow_unstable, spec=spec)
         K, summary = res, res.to_dict()
     else:
+        # another design pressure is another specification (its uncertainty is the seal's
+        # there)
         res = design(cfg, method, pressure_bar=pressure_bar, allow_unstable=allow_unstable,
+                     spec=spec if pressure_bar is None else design_spec(cfg, pressure_bar),
                      progress=lambda line: print(f"ambseal: {line}", file=sys.stderr))
         K, summary = res.K, res.to_dict()
 
-    points = operating_points(cfg)
+    points = operating_points(spec)
     digital = digital_for(cfg, method, K, res, points)
     if summary.get("full_order") is None and not isinstance(K, ScheduledController):
         # the reference PID is given, not designed: judged here before it is handed over
@@ -536,12 +537,12 @@ def validate_summary(rig: str | Path | None = None) -> dict:
         "unstable_poles": [list(p) for p in res.unstable_poles],
         "defaults": {
             "reduced_states": build_plant(cfg, reduced=True).n_states,
-            "judged_conditions": [p.label for p in operating_points(cfg, spec)],
+            "judged_conditions": [p.label for p in operating_points(spec)],
             "nominal_pressure_bar": cfg.operating.pressure_bar,
             "nominal_speed_rpm": cfg.operating.speed_rpm,
             "controller_sample_rate_hz": cfg.controller.sample_rate_hz,
             "pid": None if pid is None else pid.model_dump(),
-            "judgement": asdict(judge_settings(cfg, spec)),
+            "judgement": asdict(judge_settings(spec)),
         },
     }
 

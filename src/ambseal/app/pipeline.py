@@ -92,12 +92,13 @@ def _controllers(cfg: RigConfig, spec, say, allow_unstable: bool = False,
     if speed_scheduled(cfg):
         out = [lti(design(cfg, "pid"))]
         say("pid designed", 1)
-        fz = design_frozen(cfg, cfg.operating.speed_rpm / 60.0, allow_unstable=allow_unstable)
+        fz = design_frozen(cfg, cfg.operating.speed_rpm / 60.0, allow_unstable=allow_unstable,
+                           spec=spec)
         out.append(Designed("hinf", fz.K, fz.to_dict(), fz))
         say("hinf designed", 1)
         out.append(robust("mu"))
         lpv = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz,
-                         allow_unstable=allow_unstable)
+                         allow_unstable=allow_unstable, spec=spec)
         say("lpv designed", 1)
         return out + [Designed("lpv", lpv, lpv.to_dict(), lpv)]
     out = []
@@ -165,8 +166,8 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
     # the truth file is refused before any work
     truth_cfg = load_truth(truth) if identification and truth is not None else None
     spec = design_spec(cfg)
-    points = operating_points(cfg, spec)
-    settings = judge_settings(cfg, spec)
+    points = operating_points(spec)
+    settings = judge_settings(spec)
     final = Path(out_dir)
     n_designs = 4 if speed_scheduled(cfg) else 3
     n_tr = int(cfg.design.tracked)  # off by default: minutes of LMI synthesis
@@ -208,7 +209,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
             designs += robust
             facility_impulses(cfg, truth_cfg, ident, digitals, out)
         design_cfg = cfg if ident is None else ident.design_cfg
-        designs += tracked_designs(cfg, design_cfg, points, say, digitals, cannot_run)
+        designs += tracked_designs(cfg, design_cfg, spec, points, say, digitals, cannot_run)
         stages.begin("judge")
         jobs = judge_jobs(designs, digitals, points, design_cfg)
         judged = run_cases(judge_case, jobs, shared={"cfg": judge_cfg, "settings": settings},
@@ -230,7 +231,8 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
             stages.step()
         if cfg.design.tracked and truth_cfg is not None:
             stages.begin("ramp", "0 → 3× nominal pressure on the virtual facility")
-            ramp, fig = tracked_ramp(cfg, truth_cfg, designs, digitals, ident, out, say)
+            ramp, fig = tracked_ramp(cfg, truth_cfg, designs, digitals, ident, settings, out,
+                                     say)
             figs.append(fig)
         metrics = RunMetrics(
             schema_version=SCHEMA_VERSION, rig=str(rig_path), rig_name=cfg.rotor.name,

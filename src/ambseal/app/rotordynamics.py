@@ -19,6 +19,7 @@ from pathlib import Path
 
 from ambseal.analysis.campbell import campbell, closed_loop_modes, modes_of_state_matrix
 from ambseal.analysis.cases import dask_available
+from ambseal.analysis.judge import judge_settings
 from ambseal.analysis.sweep import (
     check_cases,
     parse_range,
@@ -28,6 +29,7 @@ from ambseal.analysis.sweep import (
 )
 from ambseal.config import MAX_COEFFICIENT, MAX_PRESSURE_BAR, MAX_SPEED_HZ, load_rig
 from ambseal.design.recipes import METHODS, design
+from ambseal.design.specs import design_spec
 from ambseal.errors import ConfigError
 from ambseal.export.controller_files import load_controller
 from ambseal.files import OwnedFolder, atomic_write, write_json, write_text
@@ -215,8 +217,8 @@ def _sweep(args: argparse.Namespace) -> int:
         print("ambseal: note: dask is not installed; the sweep runs serially",
               file=sys.stderr)
         workers = 1
-    rows = sweep(cfg, ctrl, pressures, speeds, params, max_hz=args.max_hz,
-                 workers=workers, scheduler=args.scheduler, progress=True)
+    rows = sweep(cfg, ctrl, pressures, speeds, params, settings=judge_settings(design_spec(cfg)),
+                 max_hz=args.max_hz, workers=workers, scheduler=args.scheduler, progress=True)
     edge = refine_boundary(cfg, ctrl, stability_boundary(rows), tol_bar=args.tol_bar,
                            workers=workers, scheduler=args.scheduler, progress=True)
     out = Path(args.out)

@@ -23,9 +23,11 @@ from ambseal.report.tracking_figures import ramp_figure
 __all__ = ["tracked_designs", "tracked_ramp"]
 
 
-def tracked_designs(cfg, design_cfg, points, say, digitals: dict, cannot_run: dict) -> list:
+def tracked_designs(cfg, design_cfg, spec, points, say, digitals: dict, cannot_run: dict
+                    ) -> list:
     """``[design] tracked``: ``[]`` when off, else the tracked controller as a design of the
-    main job (:class:`ambseal.app.commands.Designed`), designed on ``design_cfg``, with its digital table
+    main job (:class:`ambseal.app.commands.Designed`), designed on ``design_cfg`` to the
+    rig's design specification ``spec`` (as the robust controllers are), with its digital table
     (:func:`ambseal.app.commands.digitals_for`: discretisation chosen on the sampled full-order
     loops with the target's delay at the judged pressures and between table entries) put
     in ``digitals``, or the reason it cannot run in ``cannot_run``.
@@ -44,7 +46,7 @@ def tracked_designs(cfg, design_cfg, points, say, digitals: dict, cannot_run: di
                           "drop (this one " + ("is scheduled on speed)" if cfg.seal
                                                else "has no [[seal]])"))
     say("designing tracked (LPV on the seal's k; minutes unless cached)", 0)
-    d = design_seal_scheduled(design_cfg)
+    d = design_seal_scheduled(design_cfg, spec=spec)
     say("tracked designed", 1)
     out = [Designed("tracked", d, d.to_dict(), d)]
     more, cannot = digitals_for(design_cfg, out, points, lambda m: say(m, 0))
@@ -53,17 +55,18 @@ def tracked_designs(cfg, design_cfg, points, say, digitals: dict, cannot_run: di
     return out
 
 
-def tracked_ramp(cfg, truth, designs, digitals: dict, ident, out: Path, say
+def tracked_ramp(cfg, truth, designs, digitals: dict, ident, settings, out: Path, say
                  ) -> tuple[dict, tuple[str, Path]]:
     """The 0 → 3× nominal ramp on the virtual facility, the tracker's model the rig
-    identified by ``ident`` (``commands.Identified``): ``metrics.json``'s ``ramp`` and the
-    report's figure (caption, path); one step of ``say(message, steps)`` at the end."""
+    identified by ``ident`` (``commands.Identified``), its impulses those of the judgement
+    ``settings``: ``metrics.json``'s ``ramp`` and the report's figure (caption, path); one
+    step of ``say(message, steps)`` at the end."""
 
     tracked = next(d.controller for d in designs if d.method == "tracked")
     fixed = {m: g.discrete for m, g in digitals.items() if m != "tracked"}
     r = ramp_simulation(cfg, truth, fixed, tracked, model_cfg=ident.result.identified,
                         tracked_digital=digitals.get("tracked"),
-                        delay_samples=cfg.controller.delay_samples,
+                        delay_samples=cfg.controller.delay_samples, judgement=settings,
                         progress=lambda line: say(line, 0))
     t = r.tracking
     caption = (f"Pressure ramp 0 → {r.pressure_bar.max():.3g} bar in {r.time_s[-1]:.0f} s on "

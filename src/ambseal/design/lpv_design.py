@@ -44,7 +44,7 @@ import numpy as np
 from ambseal.design.lpv_plant import lpv_plant, vertex_grid_hz
 from ambseal.design.plant import generalized_plant, physical_controller, physical_matrices
 from ambseal.design.recipes import bound_text, full_order_check
-from ambseal.design.specs import design_spec
+from ambseal.design.specs import DesignSpec, design_spec
 from ambseal.design.weights import Weights, default_weights
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.robust.controller import SPEED, ScheduledController
@@ -198,9 +198,10 @@ class FrozenDesign:
                 "elapsed_s": round(self.elapsed_s, 3), "full_order": self.full_order}
 
 
-def check_full_order(cfg, controller_at, name: str, allow_unstable: bool = False) -> dict:
+def check_full_order(cfg, spec, controller_at, name: str, allow_unstable: bool = False
+                     ) -> dict:
     """Close a speed-scheduled design with the full-order plant at every judged condition
-    (the specification's pressures × speeds, :func:`ambseal.design.specs.design_spec`):
+    (``spec``'s pressures × speeds, :func:`ambseal.design.specs.design_spec`):
     at each, the physical controller ``controller_at(speed_hz)`` that runs there
     (:func:`ambseal.design.recipes.full_order_check`), as :func:`~ambseal.design.
     recipes.design` does for H∞ and μ.
@@ -217,9 +218,8 @@ def check_full_order(cfg, controller_at, name: str, allow_unstable: bool = False
         the remedy (the design model keeps the rigid-body modes only, P3 §2.2).
     """
 
-    sp = design_spec(cfg)
     checks = [full_order_check(cfg, controller_at(f), [(p, f)])
-              for p in sp.pressures_bar for f in sp.speeds_hz]
+              for p in spec.pressures_bar for f in spec.speeds_hz]
     worst = max(checks, key=lambda c: (not c["stable"], -c["damping"]))
     if not worst["stable"] and not allow_unstable:
         raise SynthesisError(
@@ -229,13 +229,6 @@ def check_full_order(cfg, controller_at, name: str, allow_unstable: bool = False
             "(P3 §2.2): a mode it leaves out went unstable; raise W_u's roll-off or accept "
             "it with --allow-unstable")
     return worst
-
-
-def _spec_weights(cfg) -> Weights:
-    """The rig's LPV weights: ``[design.lpv]`` completed by the rules of
-    :func:`ambseal.design.specs.design_spec` (D_e, D_u and W_u from the machine)."""
-
-    return design_spec(cfg).weights["lpv"]
 
 
 def lpv_generalized_plants(L, weights: Weights, speeds_rad_s=None):
@@ -251,11 +244,11 @@ def lpv_generalized_plants(L, weights: Weights, speeds_rad_s=None):
             for w in W]
 
 
-def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int | None = None,
+def design_lpv(cfg, *, speeds_hz=None, n_grid: int | None = None,
                rate_bound_hz_per_s: float | None = None, lyapunov: str | None = None,
                weights: Weights | None = None, states: int = 8,
                frozen_gamma: bool = True, allow_unstable: bool = False,
-               **lpvsyn_kw) -> LpvDesign:
+               spec: DesignSpec | None = None, **lpvsyn_kw) -> LpvDesign:
     """Speed-scheduled H∞ LPV controller for a rig (thesis P3 §4).
 
     Parameters
@@ -294,6 +287,9 @@ def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int | None = None,
     allow_unstable : bool
         Keep a controller whose full-order loop is unstable at a judged condition
         (:func:`check_full_order`) instead of raising.
+    spec : DesignSpec, optional
+        The rig's design specification (weights, judged conditions); built from ``cfg``
+        by :func:`~ambseal.design.specs.design_spec` when omitted.
     **lpvsyn_kw
         Passed to :func:`ambseal.robust.lpv.lpvsyn` (``backoff``, ``solver_options``, …).
 
@@ -318,7 +314,13 @@ def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int | None = None,
     """
 
     t0 = time.perf_counter()
-    w = weights or _spec_weights(cfg)
+    sp = spec or design_spec(cfg)
+    w = weights or sp.weights["lpv"]
+    if speeds_hz is None:
+        if cfg.operating.speed_range_hz is None:
+            raise ConfigError("design_lpv: no speed range to schedule on: set [operating] "
+                              "speed_range_hz or pass speeds_hz")
+        speeds_hz = cfg.operating.speed_range_hz
     lo, hi = (float(x) for x in speeds_hz)
     if lyapunov is None:
         lyapunov = "constant" if rate_bound_hz_per_s is None else "affine"
@@ -351,22 +353,23 @@ def design_lpv(cfg, *, speeds_hz=(20.0, 300.0), n_grid: int | None = None,
                   check_speeds_hz=r.check_rad_s / _TWO_PI, lyapunov=lyapunov,
                   rate_bound_hz_per_s=None if nu is None else float(rate_bound_hz_per_s),
                   weights=w, reports=r.reports, synthesis_s=r.time_s, plant=L)
-    check = check_full_order(cfg, d.controller_at, "lpv", allow_unstable)
+    check = check_full_order(cfg, sp, d.controller_at, "lpv", allow_unstable)
     return replace(d, full_order=check, elapsed_s=time.perf_counter() - t0)
 
 
-def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
+def design_frozen(cfg, speed_hz: float | None = None, *, method: str = "hinf",
                   weights: Weights | None = None, states: int = 8,
                   seal_k_uncertainty: float = 0.4, allow_unstable: bool = False,
-                  **kw) -> FrozenDesign:
-    """LTI controller at one speed: the comparison controller of P3 Fig. 11 (140 Hz).
+                  spec: DesignSpec | None = None, **kw) -> FrozenDesign:
+    """LTI controller at one speed: the comparison controller of P3 Fig. 11 (designed at
+    the operating speed, 140 Hz on the thesis's turboexpander).
 
     Parameters
     ----------
     cfg : RigConfig
         The rig (its ``[design.lpv]`` weights and its seal).
-    speed_hz : float
-        Design speed (Hz).
+    speed_hz : float, optional
+        Design speed (Hz); default the rig's operating speed.
     method : {"hinf", "mu"}
         ``"hinf"``: :func:`hinfsyn` on the nominal plant with the LPV weights (the same
         performance demand as the LPV design, so the comparison isolates the scheduling).
@@ -383,6 +386,9 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
     allow_unstable : bool
         Keep a controller whose full-order loop is unstable at a judged condition
         (:func:`check_full_order`) instead of raising.
+    spec : DesignSpec, optional
+        The rig's design specification (weights, judged conditions, the μ grid's band);
+        built from ``cfg`` by :func:`~ambseal.design.specs.design_spec` when omitted.
     **kw
         Passed to :func:`musyn` (``max_iter``, ``order``, ``omega``).
 
@@ -402,8 +408,9 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
     if method not in ("hinf", "mu"):
         raise ConfigError(f"design_frozen: method={method!r}, expected 'hinf' or 'mu'")
     t0 = time.perf_counter()
-    w = weights or _spec_weights(cfg)
-    f = float(speed_hz)
+    sp = spec or design_spec(cfg)
+    w = weights or sp.weights["lpv"]
+    f = float(cfg.operating.speed_rpm / 60.0 if speed_hz is None else speed_hz)
     if method == "hinf":
         L = lpv_plant(cfg, [f, f + 1.0], states=states, reference_speed_hz=f)
         gp = lpv_generalized_plants(L, w, [_TWO_PI * f])[0]
@@ -420,11 +427,11 @@ def design_frozen(cfg, speed_hz: float = 140.0, *, method: str = "hinf",
                                uncertainty={f"{cfg.seal[0].name}.k": seal_k_uncertainty},
                                d_e=w.d_e, d_u=w.d_u)
         om = kw.pop("omega", None)
-        if om is None:
-            om = design_omega(*design_spec(cfg_f).synthesis_band_hz)
+        if om is None:  # the specification's synthesis band: modes at the operating speed
+            om = design_omega(*sp.synthesis_band_hz)
         r = musyn(gp.P, gp.blocks, gp.nmeas, gp.ncon, om, **kw)
         K_P, gamma = r.K, float(r.mu)
     K = gp.physical_controller(K_P, name=f"K_{method}_{f:g}Hz")
-    check = check_full_order(cfg, lambda _: K, f"{method} at {f:g} Hz", allow_unstable)
+    check = check_full_order(cfg, sp, lambda _: K, f"{method} at {f:g} Hz", allow_unstable)
     return FrozenDesign(K=K, speed_hz=f, method=method, gamma=gamma, weights=w,
                         elapsed_s=time.perf_counter() - t0, full_order=check)

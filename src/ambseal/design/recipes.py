@@ -126,6 +126,9 @@ class DesignResult:
         (:meth:`ambseal.robust.delay.DesignDelay.to_dict`); None for the PID.
     steps : tuple of str
         The automatic design-loop steps taken (model enlargements).
+    omega : ndarray or None
+        The μ design's frequency grid (rad/s), on which its μ is stated (not serialised);
+        None for H∞ and the PID.
     notes : tuple of str
         The specification's notes (no seal, ...).
     verdict : str
@@ -153,6 +156,7 @@ class DesignResult:
     steps: tuple = ()
     notes: tuple = ()
     verdict: str = ""
+    omega: Any = field(default=None, repr=False)
 
     def summary(self) -> dict:
         """Short JSON-ready summary (no matrices)."""
@@ -363,7 +367,7 @@ def design(
         elapsed_s=time.perf_counter() - t0, reduction=r.reduction, plant=r.gp,
         design_states=n, full_order=check, allow_unstable=not check["stable"],
         delay=dl.to_dict(), steps=tuple(steps), notes=tuple(sp.notes),
-        verdict=_verdict(method, r, check))
+        verdict=_verdict(method, r, check), omega=r.omega)
 
 
 @dataclass(frozen=True, eq=False)
@@ -377,6 +381,7 @@ class _Synthesis:
     gp: Any
     K_P: Any = None
     mu_omega: float | None = None
+    omega: Any = None
 
 
 def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl):
@@ -417,7 +422,8 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
                                            om if method == "mu" else None)
         order_full = red["order_full"]
     K = gp.physical_controller(K_P, name=f"K_{method}")
-    return _Synthesis(K, gamma, mu, tuple(hist), order_full, red, gp, K_P, mu_omega)
+    return _Synthesis(K, gamma, mu, tuple(hist), order_full, red, gp, K_P, mu_omega,
+                      om if method == "mu" else None)
 
 
 def _reduce_best(P, cands, order: int, auto: bool, gp, blocks, omega):

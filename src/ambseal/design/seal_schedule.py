@@ -62,7 +62,7 @@ import numpy as np
 from ambseal import __version__
 from ambseal.design import plant, weights
 from ambseal.design.plant import generalized_plant, physical_controller, physical_matrices
-from ambseal.design.specs import design_spec
+from ambseal.design.specs import DesignSpec, design_spec
 from ambseal.design.weights import Weights
 from ambseal.errors import ModelError, SynthesisError
 from ambseal.files import write_json
@@ -167,7 +167,7 @@ def design_seal_scheduled(cfg, parameter: str | None = None, *,
                           range_factor: tuple[float, float] = (0.0, 3.0), n_grid: int = 5,
                           rate_factor_per_s: float = 0.1, weights: Weights | None = None,
                           states: int | None = None, cache_dir: str | os.PathLike | None = None,
-                          **lpvsyn_kw) -> SealScheduledDesign:
+                          spec: DesignSpec | None = None, **lpvsyn_kw) -> SealScheduledDesign:
     """H∞ LPV controller scheduled on a seal coefficient (module docstring).
 
     Parameters
@@ -189,6 +189,9 @@ def design_seal_scheduled(cfg, parameter: str | None = None, *,
         Mechanical states of the design model (default the specification's).
     cache_dir : path, optional
         Folder of cached designs (default ``$AMBSEAL_CACHE_DIR``; neither: no cache).
+    spec : DesignSpec, optional
+        The rig's design specification (weights, design model, band); built from ``cfg`` by
+        :func:`~ambseal.design.specs.design_spec` when omitted.
     **lpvsyn_kw
         Passed to :func:`ambseal.robust.lpv.lpvsyn`.
 
@@ -210,7 +213,7 @@ def design_seal_scheduled(cfg, parameter: str | None = None, *,
         parameter = f"{cfg.seal[0].name}.k"
     if int(n_grid) < 2:
         raise SynthesisError(f"design_seal_scheduled: n_grid={n_grid}; needs at least 2")
-    sp = design_spec(cfg)
+    sp = spec or design_spec(cfg)
     n = int(states or sp.model_states)
     plant = build_plant(cfg, reduced=True, pressure_bar=cfg.operating.pressure_bar, states=n)
     scale = abs(plant.parameter(parameter).nominal)  # ModelError naming the known ones

@@ -79,7 +79,9 @@ the value the thesis used on its test facility, P5, where it names one):
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field, replace
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, field, fields, replace
+from types import MappingProxyType
 
 import numpy as np
 
@@ -191,6 +193,9 @@ class DesignSpec:
         Controller order limit; None: the rule of :func:`ambseal.design.recipes.design`.
     pressures_bar, speeds_hz : tuple of float
         Judged conditions.
+    nominal_pressure_bar, nominal_speed_hz : float
+        The rig's operating point (``[operating]``): the judged conditions are named low,
+        nominal or high against it.
     unbalance_grade_mm_s, unbalance_mass_kg : float
     unbalance_law : str
         ``"iso21940"`` or ``"constant_velocity"`` (:mod:`ambseal.analysis.unbalance`).
@@ -202,15 +207,15 @@ class DesignSpec:
         Axial positions (m) of the force inputs: the AMBs', or the named component's.
     unbalance_range_hz : (float, float)
     impulse_a, impulse_s : float or None
-    uncertainty : dict
-        ``{parameter: fraction or (low, high)}``.
-    weights : dict
-        ``{"hinf" | "mu" | "lpv": Weights}``.
+    uncertainty : Mapping
+        ``{parameter: fraction or (low, high)}`` (read-only).
+    weights : Mapping
+        ``{"hinf" | "mu" | "lpv": Weights}`` (read-only).
     max_iter, dk_order : int
     mu_iteration : {"dgk", "dk"}
         μ synthesis: D–G–K (real parameters kept real, Young 1996) or complex D–K.
-    sources : dict
-        ``{key: "set" | rule text}``: where each value came from.
+    sources : Mapping
+        ``{key: "set" | rule text}``: where each value came from (read-only).
     notes : tuple of str
     """
 
@@ -224,6 +229,8 @@ class DesignSpec:
     order_max: int | None
     pressures_bar: tuple
     speeds_hz: tuple
+    nominal_pressure_bar: float
+    nominal_speed_hz: float
     unbalance_grade_mm_s: float
     unbalance_mass_kg: float
     unbalance_law: str
@@ -233,17 +240,19 @@ class DesignSpec:
     unbalance_range_hz: tuple
     impulse_a: float | None
     impulse_s: float
-    uncertainty: dict
-    weights: dict = field(repr=False)
+    uncertainty: Mapping
+    weights: Mapping = field(repr=False)
     max_iter: int = 6
     dk_order: int = 2
     mu_iteration: str = "dgk"
-    sources: dict = field(default_factory=dict, repr=False)
+    sources: Mapping = field(default_factory=dict, repr=False)
     notes: tuple = ()
 
     def to_dict(self) -> dict:
         """JSON-ready: the values (units in the keys), their sources and the notes."""
-        d = {k: v for k, v in asdict(self).items() if k not in ("weights", "machine")}
+        d = {f.name: getattr(self, f.name) for f in fields(self)
+             if f.name not in ("weights", "machine")}
+        d["sources"] = dict(self.sources)
         d["machine"] = asdict(self.machine)
         d["weights"] = {m: w.to_dict() for m, w in self.weights.items()}
         d["uncertainty"] = {k: (list(v) if isinstance(v, tuple) else v)
@@ -559,9 +568,13 @@ def design_spec(cfg, pressure_bar: float | None = None) -> DesignSpec:
         machine=mach, d_e=d_e, d_u=d_u, model_states=n, model_cutoff_hz=cut,
         band_hz=band, synthesis_band_hz=synth, order_max=d.order_max,
         pressures_bar=pressures, speeds_hz=speeds,
+        nominal_pressure_bar=float(cfg.operating.pressure_bar),
+        nominal_speed_hz=float(cfg.operating.speed_rpm) / 60.0,
         unbalance_grade_mm_s=grade, unbalance_mass_kg=mass, unbalance_law=law,
         unbalance_max_speed_hz=top, force_at=at, force_positions_m=pos, unbalance_range_hz=rng, impulse_a=imp_a, impulse_s=imp_s,
-        uncertainty=_uncertainty(cfg, d, rules, notes, p), weights=weights,
+        # read-only: one specification is shared by every stage of a run
+        uncertainty=MappingProxyType(_uncertainty(cfg, d, rules, notes, p)),
+        weights=MappingProxyType(weights),
         max_iter=mu.max_iter or 6, dk_order=mu.dk_order if mu.dk_order is not None else 2,
         mu_iteration=mu.iteration or "dgk",
-        sources=rules, notes=tuple(notes))
+        sources=MappingProxyType(rules), notes=tuple(notes))

@@ -36,15 +36,24 @@ Kdk, CLdk, mu_dk, dk = musyn(P, blocks, 2, 2, w, max_iter=3)   # the same unpack
 mu_cl = mussv(CLdk, blocks, dk.check_omega, tol=1e-5).upper.max()
 poles = [1 / 100, 1 / 75, 1 / 50]                   # an LPV family: the column's pole
 family = [distillation_rp_plant(a, wp_low=0.1) for a in poles]
-lpv = lpvsyn(family, poles, 2, 2)
+Klpv, CLlpv, gamma_lpv, lpv = lpvsyn(family, poles, 2, 2)   # CL: a function of the pole
 frozen = [hinfsyn(Pk, 2, 2).gamma_opt for Pk in family]
+wl = np.logspace(-4, 2, 40)
+cl_gap, cl_norm = [], []
+for a, Pk in zip(poles, family):                    # python-control's lower LFT, u = K y
+    ref_cl = Pk.lft(control.ss(Klpv.at(a)), 2, 2)
+    cl_gap.append(float(np.max(np.abs(CLlpv(a)(1j * wl) - ref_cl(1j * wl)))))
+    cl_norm.append(float(control.linfnorm(CLlpv(a))[0]))
 rotor = sorted({m.split(".")[1] for m in sys.modules if m.startswith("ambseal.")}
                - {"robust", "lti", "errors", "files"})
 print(json.dumps({
     "gamma": gamma, "gamma_opt": info.gamma_opt, "gamma_pc": control.hinfsyn(P, 2, 2)[2],
     "closed_loop_inputs": CL.ninputs, "K_inputs": list(K.input_labels),
+    "closed_loop_inputs_names": list(CL.input_labels),
     "mu_upper": mu.upper.tolist(), "mu_lower": mu.lower.tolist(), "mu_ab13md": ref,
-    "musyn_mu": mu_dk, "musyn_mu_of_its_loop": mu_cl, "lpv_gamma": lpv.gamma, "lpv_stable": lpv.check_stable,
+    "musyn_mu": mu_dk, "musyn_mu_of_its_loop": mu_cl, "lpv_gamma": gamma_lpv, "lpv_stable": lpv.check_stable,
+    "lpv_gamma_design": lpv.gamma_design, "lpv_cl_gap": cl_gap, "lpv_cl_norm": cl_norm,
+    "lpv_cl_inputs": list(CLlpv(poles[0]).input_labels),
     "frozen_gamma": frozen, "rotor_modules": rotor}))
 """
 
@@ -66,3 +75,8 @@ def test_the_core_runs_on_skogestads_column_with_no_rotor_in_sight():
     assert r["musyn_mu"] < up.max()
     assert abs(r["musyn_mu_of_its_loop"] - r["musyn_mu"]) <= 2e-3 * r["musyn_mu"]
     assert r["lpv_stable"] and r["lpv_gamma"] >= max(r["frozen_gamma"]) * (1 - 1e-6)
+    # the frozen closed loops lpvsyn hands back are python-control's lft of P and K(Ω),
+    # and each meets the reconstruction's bound (1.02 γ_design, lpvsyn's docstring)
+    assert max(r["lpv_cl_gap"]) < 1e-9
+    assert max(r["lpv_cl_norm"]) <= 1.02 * r["lpv_gamma_design"]
+    assert r["lpv_cl_inputs"] == r["closed_loop_inputs_names"]

@@ -63,7 +63,7 @@ from ambseal.robust._lpv_reconstruct import interp_A, reconstruct_table
 from ambseal.robust.hinf import hinfnorm
 from ambseal.robust.stability import is_stable
 
-__all__ = ["LpvController", "LpvSynResult", "lpvsyn", "SolverReport"]
+__all__ = ["FrozenClosedLoop", "LpvController", "LpvSynResult", "lpvsyn", "SolverReport"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -115,6 +115,37 @@ class LpvController:
 
 
 @dataclass(frozen=True, eq=False)
+class FrozenClosedLoop:
+    """Ω ↦ F_l(P(Ω), K(Ω)) of an LPV design: the plant's A interpolated between the grid
+    plants as :func:`lpvsyn` does (cubic Hermite with the slopes dA/dΩ where the data are
+    smooth, linear at kinks), the controller interpolated from its table.
+
+    Calling it with Ω (rad/s) gives a ``control.StateSpace`` with the plant's ``w`` inputs
+    and ``z`` outputs and their names.
+    """
+
+    grid_rad_s: np.ndarray = field(repr=False)
+    A: np.ndarray = field(repr=False)
+    dA: np.ndarray = field(repr=False)
+    B: np.ndarray = field(repr=False)
+    C: np.ndarray = field(repr=False)
+    D: np.ndarray = field(repr=False)
+    K: LpvController = field(repr=False)
+    nmeas: int = 0
+    ncon: int = 0
+    inputs: tuple = ()
+    outputs: tuple = ()
+
+    def __call__(self, speed_rad_s: float):
+        W = float(speed_rad_s)
+        A = interp_A(self.A, self.dA, self.grid_rad_s)(W)
+        Acl, Bcl, Ccl, Dcl = lft_lower_matrices((A, self.B, self.C, self.D),
+                                                self.K.matrices(W), self.nmeas, self.ncon)
+        return ct.ss(Acl, Bcl, Ccl, Dcl, inputs=list(self.inputs) or None,
+                     outputs=list(self.outputs) or None, name="CL")
+
+
+@dataclass(frozen=True, eq=False)
 class LpvSynResult:
     """Result of :func:`lpvsyn`.
 
@@ -143,6 +174,14 @@ class LpvSynResult:
     reports : tuple of SolverReport
     time_s : float
         Total wall time (s).
+    closed_loop : FrozenClosedLoop
+        Ω ↦ the frozen closed loop F_l(P(Ω), K(Ω)) as a named ``control.StateSpace``: the
+        LPV closed loop depends on the parameter, so it is a function, not one system.
+
+    Notes
+    -----
+    ``K, CL, gamma, info = lpvsyn(...)`` unpacks as :func:`~ambseal.robust.hinf.hinfsyn`
+    does, with ``CL`` the function :attr:`closed_loop` (``CL(Ω)``, rad/s).
     """
 
     K: LpvController
@@ -156,6 +195,12 @@ class LpvSynResult:
     check_stable: bool = False
     reports: tuple = ()
     time_s: float = 0.0
+    closed_loop: Any = field(default=None, repr=False)
+
+    def __iter__(self):
+        """``K, CL, gamma, info = lpvsyn(...)``: the scheduled controller, Ω ↦ the frozen
+        closed loop, γ, and this result for the rest."""
+        return iter((self.K, self.closed_loop, self.gamma, self))
 
     @property
     def iterations(self) -> int:
@@ -237,6 +282,8 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
     Returns
     -------
     LpvSynResult
+        Unpacks as ``K, CL, gamma, info`` (python-control's ``hinfsyn`` order), ``CL`` the
+        frozen closed loop as a function of Ω (:class:`FrozenClosedLoop`).
 
     Raises
     ------
@@ -281,11 +328,14 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
         tuple(f"u{i}" for i in range(ncon))
     K = LpvController(table, *mats, in_names, out_names)
     check_g = _check_table(K, A_of, B, C, D, nmeas, ncon)
+    names = (list(getattr(plants[0], "input_labels", []))[:nw],
+             list(getattr(plants[0], "output_labels", []))[:nz])
+    CL = FrozenClosedLoop(grid, As, dAs, B, C, D, K, nmeas, ncon, *map(tuple, names))
     return LpvSynResult(K=K, gamma=gamma, gamma_design=gamma_d, lyapunov=lyapunov,
                         rate_bound=None if rate_bound is None else float(rate_bound),
                         grid_rad_s=grid, check_rad_s=table, check_gamma=check_g,
                         check_stable=True, reports=tuple(reports),
-                        time_s=time.perf_counter() - t_start)
+                        time_s=time.perf_counter() - t_start, closed_loop=CL)
 
 
 def _validate(plants, speeds_rad_s, nmeas, ncon, dA, lyapunov, rate_bound, backoff,

@@ -166,17 +166,17 @@ class DesignCache:
         def design_lpv(cfg, **kw):
             tc = got.get("turbo_cfg")
             if (tc is not None and _same(cfg, tc) and not kw.get("allow_unstable")
-                    and set(kw) - {"allow_unstable"} == {"speeds_hz"}
+                    and set(kw) - {"allow_unstable", "spec"} == {"speeds_hz"}
                     and tuple(kw["speeds_hz"]) == tuple(tc.operating.speed_range_hz)):
                 self.hits.append("design_lpv")
                 return got["turbo_lpv"]
             return real_lpv(cfg, **kw)
 
-        def design_frozen(cfg, speed_hz=140.0, **kw):
+        def design_frozen(cfg, speed_hz=None, **kw):
             tc = got.get("turbo_cfg")
             if (tc is not None and not kw.get("allow_unstable")
-                    and not set(kw) - {"allow_unstable"} and _same(cfg, tc)
-                    and float(speed_hz) == tc.operating.speed_rpm / 60.0):
+                    and not set(kw) - {"allow_unstable", "spec"} and _same(cfg, tc)
+                    and speed_hz in (None, tc.operating.speed_rpm / 60.0)):
                 self.hits.append("design_frozen")
                 return got["turbo_frozen"]
             return real_frozen(cfg, speed_hz, **kw)

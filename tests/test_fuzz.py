@@ -323,6 +323,69 @@ def _range_case(tmp_path_factory, data):
     assert not (d / "o").exists()
 
 
+#: Rig-file keys that are physics of the closed loop ``ambseal modes --controller pid``
+#: sees at 100 Hz (the rotor, its supports, the AMBs with their actuator and sensors, the
+#: seals at the operating pressure, the reference PID; spinning, so that the polar inertia
+#: acts): changing one must change the modes or be refused. Keys outside it (names,
+#: [design], [reduction], bounds such as current_limit) are not physics of that loop.
+PHYSICS = {"modal_damping", "E", "rho", "nu", "length", "outer_diameter", "inner_diameter",
+           "mass", "Ip", "Id", "position", "sensor_position", "axes_angle_deg", "ki", "ks",
+           "natural_frequency", "damping_ratio", "K", "k", "C", "c", "M", "at_zero",
+           "per_bar", "kxx", "kyy", "kp", "ti", "td", "pressure_bar"}
+_MODES = ["modes", None, "--json", "--controller", "pid", "--speed-rpm", "6000"]
+_baseline: dict = {}
+
+
+def _physics_paths(doc: dict) -> list[tuple]:
+    """Paths to the non-zero numbers under a :data:`PHYSICS` key, and to the value list of
+    a tabulated coefficient as a whole (one entry far from the operating speed does not
+    reach the loop there; the table's frequencies are its grid, not a coefficient)."""
+    out = set()
+    for p in _paths(doc):
+        if p[0] in ("design", "reduction") or "frequency_hz" in p:
+            continue
+        if "value" in p:
+            out.add(p[:p.index("value") + 1])
+        elif (any(k in PHYSICS for k in p if isinstance(k, str))
+              and isinstance(_at(doc, p), (int, float)) and not isinstance(_at(doc, p), bool)
+              and _at(doc, p) != 0):
+            out.add(p)
+    return sorted(out, key=str)
+
+
+def _at(doc, path):
+    for k in path:
+        doc = doc[k]
+    return doc
+
+
+def _physics_case(tmp_path_factory, data):
+    """One physical value scaled by a plausible factor: ``modes --controller pid`` either
+    refuses the rig naming it, or its modes differ from the unmutated rig's (a value that
+    is read but not used would leave them as they were)."""
+    name = data.draw(st.sampled_from(sorted(RIGS)))
+    doc = copy.deepcopy(RIGS[name])
+    path = data.draw(st.sampled_from(_physics_paths(doc)))
+    factor = data.draw(st.sampled_from([0.5, 0.9, 1.1, 1.5, 3.0]))
+    parent = _at(doc, path[:-1])
+    value = parent[path[-1]]
+    parent[path[-1]] = [v * factor for v in value] if isinstance(value, list) else (
+        value * factor)
+    d = tmp_path_factory.mktemp("fuzz")
+    if name not in _baseline:
+        (d / "base.toml").write_text(dump(RIGS[name]))
+        _baseline[name] = _sandboxed(d, [a or d / "base.toml" for a in _MODES], [])
+    rig = d / name
+    rig.write_text(dump(doc))
+    code, out, err = _sandboxed(d, [a or rig for a in _MODES], [])
+    _check(code, out, err, [str(rig)])
+    if code == 0:
+        base = json.loads(_baseline[name][1])
+        new = json.loads(out)
+        keys = ("natural_frequencies_hz", "damping_ratios", "unstable_poles")
+        assert any(new.get(k) != base.get(k) for k in keys), (path, factor)
+
+
 @fuzz(150)
 @given(data=st.data())
 def test_fuzz_rig_files(tmp_path_factory, data):
@@ -351,6 +414,12 @@ def test_fuzz_controller_files(tmp_path_factory, controller, data):
 @given(data=st.data())
 def test_fuzz_ranges(tmp_path_factory, data):
     _range_case(tmp_path_factory, data)
+
+
+@fuzz(40)
+@given(data=st.data())
+def test_fuzz_physics_changes_show(tmp_path_factory, data):
+    _physics_case(tmp_path_factory, data)
 
 
 def test_the_fuzz_harness_sees_a_hang_and_a_stray_file(tmp_path):
@@ -395,6 +464,13 @@ def test_fuzz_records_long(tmp_path_factory, record, data):
 @given(data=st.data())
 def test_fuzz_controller_files_long(tmp_path_factory, controller, data):
     _controller_case(tmp_path_factory, controller, data)
+
+
+@pytest.mark.slow
+@fuzz(40, slow=True)
+@given(data=st.data())
+def test_fuzz_physics_changes_show_long(tmp_path_factory, data):
+    _physics_case(tmp_path_factory, data)
 
 
 @pytest.mark.slow

@@ -98,3 +98,47 @@ def test_run_allow_unstable_delivers_the_failed_controller_marked(tmp_path, caps
     assert m["failed"]["hinf"]["designed"]
     assert (out / "controllers" / "controller_hinf.json").is_file()
     assert "H∞: delivered as asked (allow_unstable) but fails" in capsys.readouterr().err
+
+
+#: example rigs with their seals' cross-coupling slopes, tripled in the strengthened runs
+STRONGER = {"pump.toml": ("k = { at_zero = 0.0, per_bar = 4.0e4 }",
+                          "k = { at_zero = 0.0, per_bar = 1.0e4 }"),
+            "blower.toml": ("k = { at_zero = 0.0, per_bar = 3.0e4 }",)}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("example", sorted(STRONGER))
+def test_run_on_a_stronger_seal_reports_every_controller(example, tmp_path, capsys):
+    """An example rig with its seals' cross-coupling per bar tripled: the run writes its
+    report; μ (robust to every seal's k over 0–2× nominal, which a tripled slope keeps
+    covering since k is proportional to the pressure drop) is stable at every judged
+    condition, continuous and as it runs; every other controller is either stable there
+    or listed in ``failed`` with exactly the conditions its cases are unstable at."""
+    from .conftest import ROOT
+
+    text = (ROOT / "examples" / example).read_text()
+    for line in STRONGER[example]:
+        assert text.count(line) == 1
+        slope = float(line.split("per_bar = ")[1].rstrip(" }"))
+        text = text.replace(line, line.replace(line.split("per_bar = ")[1].rstrip(" }"),
+                                               repr(3 * slope)))
+    rig = tmp_path / example
+    rig.write_text(text)
+    out = tmp_path / "run"
+    code = main(["run", str(rig), "--no-identify", "--out", str(out)])
+    err = capsys.readouterr().err
+    m = json.loads((out / "metrics.json").read_text())
+    assert (out / "report.html").is_file()
+    designed_failed = [k for k, f in m["failed"].items() if f["designed"]]
+    assert code == (1 if designed_failed else 0), err
+    by = {}
+    for c in m["cases"]:
+        by.setdefault(c["controller"], []).append(c)
+    assert all(c["stable"] and c["discrete"]["stable"] for c in by["mu"])
+    for name, cases in by.items():
+        bad = [c for c in cases if not (c["stable"] and (c.get("discrete") or {}).get(
+            "stable", True))]
+        assert (name in m["failed"]) == bool(bad)
+        if bad:
+            assert len(m["failed"][name]["conditions"]) == len(bad)
+            assert f"ambseal: {m['failed'][name]['reason']}" in err

@@ -154,10 +154,11 @@ class DesignCache:
             return real_digital(cfg, method, controller, result, points, cache)
 
         def design(cfg, method="mu", **kw):
-            # the main job passes the rig's own specification and a progress callback,
-            # `ambseal design` the operating pressure (None: the rig's)
+            # the main job passes the rig's own specification, a progress callback and
+            # allow_unstable=True (the judgement decides; the cached designs are stable, so
+            # it changes nothing), `ambseal design` the operating pressure (None: the rig's)
             plain = set(kw) <= {"spec", "progress", "allow_unstable", "pressure_bar"} \
-                and not kw.get("allow_unstable") and kw.get("pressure_bar") is None
+                and kw.get("pressure_bar") is None
             if rig == "testrig" and plain and _same(cfg, got["testrig_cfg"]):
                 self.hits.append(f"design:{method}")
                 return got["testrig_designs"][method]
@@ -165,7 +166,7 @@ class DesignCache:
 
         def design_lpv(cfg, **kw):
             tc = got.get("turbo_cfg")
-            if (tc is not None and _same(cfg, tc) and not kw.get("allow_unstable")
+            if (tc is not None and _same(cfg, tc)
                     and set(kw) - {"allow_unstable", "spec"} == {"speeds_hz"}
                     and tuple(kw["speeds_hz"]) == tuple(tc.operating.speed_range_hz)):
                 self.hits.append("design_lpv")
@@ -174,8 +175,7 @@ class DesignCache:
 
         def design_frozen(cfg, speed_hz=None, **kw):
             tc = got.get("turbo_cfg")
-            if (tc is not None and not kw.get("allow_unstable")
-                    and not set(kw) - {"allow_unstable", "spec"} and _same(cfg, tc)
+            if (tc is not None and not set(kw) - {"allow_unstable", "spec"} and _same(cfg, tc)
                     and speed_hz in (None, tc.operating.speed_rpm / 60.0)):
                 self.hits.append("design_frozen")
                 return got["turbo_frozen"]

@@ -5,7 +5,8 @@ Commands
 ``ambseal [--version] [-q | -v] COMMAND``
     ``--quiet``/``--verbose`` set the 'ambseal' logger (stage lines on stderr).
 ``ambseal run [RIG] [--out DIR]``
-    The main job on a rig (default: the embedded thesis test facility).
+    The main job on a rig (default: the embedded thesis test facility). Exit status 1: the
+    report is written but a designed controller failed (named on stderr).
 ``ambseal validate [RIG] [--json]``
     Parse and check a rig file; print its model summary and the defaults a run takes.
 ``ambseal modes [RIG] [--speed-rpm N] [--pressure-bar P] [--json] [--n-modes N] [--max-hz F]
@@ -38,7 +39,8 @@ Commands
     On-line (recursive) tracking of named parameters through records: the estimate over
     time with its 95 % interval (CSV, JSON summary, figure).
 
-Any error on bad input prints one line on stderr and exits with status 2.
+Any error on bad input prints one line on stderr and exits with status 2; ``run`` exits
+with status 1 when it wrote its report but a designed controller failed.
 """
 
 from __future__ import annotations
@@ -115,7 +117,15 @@ stability, σ̄(S_o) and ISO 14839-3 zones per axis, compliance, worst-case unba
 current-impulse response; for the embedded rig (or with --truth) identifies the rig on the
 virtual test facility; writes metrics.json, figures and report.html (verdict first) to
 --out. Progress on stderr (bars on a terminal, one line per stage otherwise); stdout gets
-one JSON line with the output paths."""
+one JSON line with the output paths.
+
+A controller whose loop is unstable at a judged condition, or whose design failed, does not
+stop the run: every controller is judged and reported, the failed ones marked (metrics.json
+"failed", the report's "Failed controllers" part) and named with the reason on stderr; a failed
+designed controller is not exported. Exit status: 0 all delivered; 1 the report is written
+but a designed controller failed (with --allow-unstable an unstable one is exported, still
+marked, and does not count); 2 bad input (nothing written). The reference PID of the rig
+file is marked the same way but never changes the status."""
 
 
 class _Help(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpFormatter):

@@ -170,9 +170,11 @@ def _run(args: argparse.Namespace) -> int:
         clear = rig_clearances_um(load_rig(args.rig))
         console.print(verdict_table_rich(verdicts(result.metrics["cases"], clear)))
         console.print(f"report: {result.report_path.resolve()}")
+    for f in result.failed.values():  # after the report is written: name each and why
+        print(f"ambseal: {f['reason']}", file=sys.stderr)
     print(json.dumps({"out": str(result.out_dir), "metrics": str(result.metrics_path),
                       "report": str(result.report_path)}))
-    return 0
+    return result.exit_status
 
 
 def _plain(x) -> str:

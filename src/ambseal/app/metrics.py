@@ -15,19 +15,20 @@ typed at their first level, where a script finds its way.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
 from pydantic import TypeAdapter
 
+from ambseal.analysis.delivery import FailedController
 from ambseal.analysis.judge import JudgedCase
 
 __all__ = ["SCHEMA_VERSION", "SCHEMA_PATH", "OpenLoop", "ControllerSummary", "RunMetrics",
            "metrics_schema", "schema_text"]
 
 #: Version of the ``metrics.json`` document (module docstring).
-SCHEMA_VERSION = "1.0.0"
+SCHEMA_VERSION = "1.1.0"
 #: The JSON Schema shipped with the package.
 SCHEMA_PATH = Path(__file__).resolve().parents[1] / "data" / "metrics.schema.json"
 
@@ -120,6 +121,10 @@ class RunMetrics:
         Controllers that cannot run on the target, and why.
     cases : list of JudgedCase
         Every controller at every judged condition.
+    failed : dict of str to FailedController
+        Controllers whose judged loop is unstable at a judged condition or whose design
+        failed, with the reason; a designed one is not delivered (not exported) unless the
+        run allowed it. Empty when every controller passed.
     identification, spinup, ramp : dict, optional
         The identification on the virtual facility, the spin-up of a speed-scheduled rig,
         the pressure ramp of the tracked controller — when the run did them.
@@ -134,6 +139,7 @@ class RunMetrics:
     controllers: dict[str, ControllerSummary]
     cannot_run: dict[str, str]
     cases: list[JudgedCase]
+    failed: dict[str, FailedController] = field(default_factory=dict)
     identification: dict[str, Any] | None = None
     spinup: dict[str, Any] | None = None
     ramp: dict[str, Any] | None = None
@@ -147,7 +153,8 @@ class RunMetrics:
                            "n_states_reduced": self.open_loop.n_states_reduced},
              "unbalance": self.unbalance, "design_spec": self.design_spec,
              "controllers": {k: v.to_dict() for k, v in self.controllers.items()},
-             "cannot_run": self.cannot_run, "cases": [c.to_dict() for c in self.cases]}
+             "cannot_run": self.cannot_run, "cases": [c.to_dict() for c in self.cases],
+             "failed": {m: asdict(f) for m, f in self.failed.items()}}
         for key in ("identification", "spinup", "ramp"):
             if getattr(self, key) is not None:
                 d[key] = getattr(self, key)

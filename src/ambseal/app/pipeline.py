@@ -9,10 +9,11 @@ a temporary name and a rename.
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ambseal.analysis.cases import run_cases
+from ambseal.analysis.delivery import FailedController, loop_failure, synthesis_failure
 from ambseal.analysis.judge import (
     frozen_at,
     judge_case,
@@ -36,7 +37,7 @@ from ambseal.config import RigConfig, default_rig_path, load_rig, load_truth
 from ambseal.design.lpv_design import design_frozen, design_lpv
 from ambseal.design.recipes import design
 from ambseal.design.specs import design_spec
-from ambseal.errors import ConfigError
+from ambseal.errors import ConfigError, SynthesisError
 from ambseal.files import RunFolder, write_json
 from ambseal.model.rig import build_plant
 from ambseal.report.progress import StageProgress
@@ -49,7 +50,11 @@ from ambseal.report.run_report import (
     write_run_report,
 )
 
-__all__ = ["RunResult", "run", "default_truth_path"]
+__all__ = ["RunResult", "run", "default_truth_path", "EXIT_FAILED"]
+
+#: ``ambseal run``'s exit status when the report is written but a designed controller
+#: failed (not delivered); 2 stays for bad input.
+EXIT_FAILED = 1
 
 
 @dataclass(frozen=True)
@@ -60,6 +65,11 @@ class RunResult:
     metrics_path: Path
     report_path: Path
     metrics: dict
+    #: controllers that failed (``metrics["failed"]``), by method
+    failed: dict = field(default_factory=dict)
+    #: the exit status ``ambseal run`` returns: 0, or :data:`EXIT_FAILED` when a designed
+    #: controller failed (an unstable one kept with ``allow_unstable`` does not count)
+    exit_status: int = 0
 
 
 def default_truth_path() -> Path:
@@ -67,7 +77,7 @@ def default_truth_path() -> Path:
     return Path(__file__).resolve().parents[1] / "data" / "testrig_truth.toml"
 
 
-def _controllers(cfg: RigConfig, spec, say, allow_unstable: bool = False,
+def _controllers(cfg: RigConfig, spec, say, failed: dict,
                  methods: tuple[str, ...] = ("pid", "hinf", "mu")) -> list[Designed]:
     """The designed controllers of the main job.
 
@@ -77,35 +87,51 @@ def _controllers(cfg: RigConfig, spec, say, allow_unstable: bool = False,
     Fig. 11) and the LPV controller scheduled on speed. ``say(message, steps)`` reports:
     one step per design, messages in between. ``methods`` limits the pressure-driven case
     (the PID alone before identification, H∞ and μ on the identified rig after it).
+
+    Every design is kept whatever its own full-order check says (the judgement decides,
+    :mod:`ambseal.analysis.delivery`); a design that raises a SynthesisError is left out
+    and recorded in ``failed`` (method → :class:`FailedController`) so that the run goes
+    on with the others.
     """
 
     def lti(res) -> Designed:
         return Designed(res.method, res.K, res.summary(), res)
 
-    def robust(m: str) -> Designed:
-        say(f"designing {m}", 0)
-        d = lti(design(cfg, m, spec=spec, allow_unstable=allow_unstable,
-                       progress=lambda msg: say(msg, 0)))
+    def guarded(m: str, make) -> list[Designed]:
+        try:
+            d = make()
+        except SynthesisError as exc:
+            failed[m] = synthesis_failure(m, str(exc))
+            say(f"{m} failed", 1)
+            return []
         say(f"{m} designed", 1)
-        return d
+        return [d]
+
+    def robust(m: str) -> list[Designed]:
+        say(f"designing {m}", 0)
+        return guarded(m, lambda: lti(design(cfg, m, spec=spec, allow_unstable=True,
+                                             progress=lambda msg: say(msg, 0))))
 
     if speed_scheduled(cfg):
         out = [lti(design(cfg, "pid"))]
         say("pid designed", 1)
-        fz = design_frozen(cfg, cfg.operating.speed_rpm / 60.0, allow_unstable=allow_unstable,
+
+        def frozen_hinf() -> Designed:
+            fz = design_frozen(cfg, cfg.operating.speed_rpm / 60.0, allow_unstable=True,
+                               spec=spec)
+            return Designed("hinf", fz.K, fz.to_dict(), fz)
+
+        def lpv() -> Designed:
+            d = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz, allow_unstable=True,
                            spec=spec)
-        out.append(Designed("hinf", fz.K, fz.to_dict(), fz))
-        say("hinf designed", 1)
-        out.append(robust("mu"))
-        lpv = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz,
-                         allow_unstable=allow_unstable, spec=spec)
-        say("lpv designed", 1)
-        return out + [Designed("lpv", lpv, lpv.to_dict(), lpv)]
+            return Designed("lpv", d, d.to_dict(), d)
+
+        return out + guarded("hinf", frozen_hinf) + robust("mu") + guarded("lpv", lpv)
     out = []
     if "pid" in methods:
         out.append(lti(design(cfg, "pid")))
         say("pid designed", 1)
-    return out + [robust(m) for m in methods if m != "pid"]
+    return out + [d for m in methods if m != "pid" for d in robust(m)]
 
 
 def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
@@ -139,22 +165,26 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         ``design.<key>=<value>`` settings applied to the rig file before validation
         (:func:`ambseal.config.load_rig`).
     allow_unstable : bool
-        Keep a controller whose full-order loop is unstable at a judged condition (marked
-        in ``metrics.json``) instead of stopping with a SynthesisError.
+        Deliver (export) a designed controller whose judged loop is unstable at a judged
+        condition; it stays marked in ``failed`` and the exit status is 0. Without it such a
+        controller is judged and reported but not exported, and ``exit_status`` is
+        :data:`EXIT_FAILED`.
     command : str, optional
         The command line, for the report's stamp.
 
     Returns
     -------
     RunResult
+        With ``failed``: every controller whose judged loop is unstable at a judged
+        condition, or whose design failed, with the reason
+        (:mod:`ambseal.analysis.delivery`; also ``metrics["failed"]`` and the report's
+        "Failed controllers" part). The run reports every controller it could design before
+        it says so.
 
     Raises
     ------
     ConfigError
         A bad rig file, a rig without AMBs or without ``[controller.pid]``.
-    SynthesisError
-        A controller that does not stabilise the full-order plant (without
-        ``allow_unstable``).
     """
 
     rig_path = Path(rig) if rig is not None else default_rig_path()
@@ -186,7 +216,8 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         say = lambda msg, steps=0: stages.step(msg, steps)  # noqa: E731
         stages.begin("design")
         early = truth_cfg is not None and not speed_scheduled(cfg)  # P5 §3: identify first
-        designs = _controllers(cfg, spec, say, allow_unstable,
+        failed: dict[str, FailedController] = {}
+        designs = _controllers(cfg, spec, say, failed,
                                ("pid",) if early else ("pid", "hinf", "mu"))
         digitals, cannot_run = digitals_for(cfg, designs, points, lambda m: stages.step(m, 0))
         ident, judge_cfg = None, cfg
@@ -201,7 +232,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
             judge_cfg = ident.truth_cfg
         if early:
             stages.begin("design (identified)", ident.summary["design"]["designed_on"])
-            robust = _controllers(ident.design_cfg, spec, say, allow_unstable, ("hinf", "mu"))
+            robust = _controllers(ident.design_cfg, spec, say, failed, ("hinf", "mu"))
             more, more_cannot = digitals_for(ident.design_cfg, robust, points,
                                              lambda m: stages.step(m, 0))
             digitals.update(more)
@@ -220,7 +251,17 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         case_dicts = [case.to_dict() for case in cases]
         curves = [(j["name"], j["point"], case, c)
                   for j, case, (_, c) in zip(jobs, case_dicts, judged)]
-        summaries = export_all(designs, digitals, case_dicts, out / "controllers")
+        for d in designs:  # the judged loops decide (continuous with delay, and as it runs)
+            f = loop_failure(d.method, [({**c, "label": j["point"].label}, crv)
+                                        for j, c, (_, crv) in zip(jobs, case_dicts, judged)
+                                        if j["name"] == d.method], designed=d.method != "pid",
+                             kept=allow_unstable)
+            if f is not None:
+                failed[d.method] = f
+        # a failed design is judged and reported, not delivered (unless asked for)
+        held = {m for m, f in failed.items() if f.designed and not allow_unstable}
+        summaries = export_all(designs, {m: g for m, g in digitals.items() if m not in held},
+                               case_dicts, out / "controllers")
         figs, sections = ([], []) if ident is None else (ident.figs, ident.sections)
         spinup = ramp = None
         if speed_scheduled(cfg):
@@ -240,7 +281,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                                full.n_states, n_reduced),
             unbalance=settings.unbalance_dict(), design_spec=spec.to_dict(),
             controllers={m: ControllerSummary.from_dict(s) for m, s in summaries.items()},
-            cannot_run=cannot_run, cases=cases,
+            cannot_run=cannot_run, cases=cases, failed=failed,
             identification=None if ident is None else ident.summary, spinup=spinup,
             ramp=ramp).to_dict()
         stages.begin("report")
@@ -251,4 +292,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                          metrics, curves, figs, sections, rig_clearances_um(cfg),
                          judged_on(cfg, truth_cfg if ident is not None else None, truth))
         stages.step()
-    return RunResult(final, final / "metrics.json", final / "report.html", metrics)
+    exit_status = EXIT_FAILED if any(f.designed and not (allow_unstable and f.judged)
+                                     for f in failed.values()) else 0
+    return RunResult(final, final / "metrics.json", final / "report.html", metrics,
+                     failed=metrics["failed"], exit_status=exit_status)

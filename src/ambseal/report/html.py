@@ -40,6 +40,7 @@ table.verdict td.verdict{min-width:22em;max-width:34em}
 figure{margin:.6em 0}figure img{max-width:100%;height:auto;border:1px solid #ddd}
 figcaption{font-size:.85em;color:#555}.judged{font-size:.9em;margin-top:0}.meta{color:#666;font-size:.82em;margin-top:0;overflow-wrap:anywhere}
 .legend span{display:inline-block;padding:0 .5em;margin-right:.3em;font-weight:bold}
+.failed{background:#fde8e8;border:2px solid #c0392b;padding:.4em .8em}.failed li{margin:.2em 0}
 """
 
 
@@ -78,6 +79,7 @@ def render_report(
     meta: str | None = None,
     clearances_um: Mapping[str, float] | None = None,
     judged_on: tuple[str, str] | None = None,
+    failed: Sequence[str] = (),
 ) -> str:
     """The report page as a string (see :func:`write_report`)."""
 
@@ -93,6 +95,9 @@ def render_report(
         text, href = judged_on
         parts.append(f'<p class="judged"><b>Judged on:</b> {_esc(text)} '
                      f'(<a href="{_esc(href)}">what the main job judges on</a>)</p>')
+    if failed:
+        parts += ['<h2>Failed controllers</h2><div class="failed"><ul>',
+                  *(f"<li>{_esc(line)}</li>" for line in failed), "</ul></div>"]
     if metrics:
         parts += ["<h2>Verdict</h2>", verdict_table_html(verdicts(metrics, clearances_um)),
                   _zone_legend(), "<h2>Every judged condition</h2>", detail_table_html(metrics)]
@@ -124,6 +129,7 @@ def write_report(
     meta: str | None = None,
     clearances_um: Mapping[str, float] | None = None,
     judged_on: tuple[str, str] | None = None,
+    failed: Sequence[str] = (),
 ) -> Path:
     """Write one self-contained ``report.html``.
 
@@ -153,6 +159,10 @@ def write_report(
     judged_on : (str, str), optional
         What the loops were judged on, in words, and a link to the manual's page that
         explains it: a line under the stamp.
+    failed : sequence of str
+        Controllers that failed, one plain line each with the reason
+        (:class:`ambseal.analysis.delivery.FailedController` ``reason``): shown first,
+        above the verdict, under "Failed controllers".
 
     Returns
     -------
@@ -167,6 +177,7 @@ def write_report(
     if not path.parent.is_dir():
         raise AmbsealError(f"report folder {str(path.parent)!r} does not exist")
     text = render_report(title=title, metrics=metrics, figures=figures, sections=sections,
-                         meta=meta, clearances_um=clearances_um, judged_on=judged_on)
+                         meta=meta, clearances_um=clearances_um, judged_on=judged_on,
+                         failed=failed)
     write_text(path, text)
     return path

@@ -334,7 +334,7 @@ def _discrete_section(metrics: dict) -> list[dict]:
         d = c.get("discrete")
         if d is None:
             continue
-        disc = metrics["controllers"].get(c["controller"], {}).get("discretisation", {})
+        disc = metrics["controllers"].get(c["controller"], {}).get("discretisation") or {}
         peak = lambda x: "–" if x is None else f"{x:.2f}"  # noqa: E731
         lines.append(
             f"{c['controller']} at {c['pressure_bar']:g} bar, {c['speed_hz']:g} Hz: "
@@ -362,7 +362,8 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
 
     ``curves = [(method, OperatingPoint, case, {"So", "compliance", "unbalance",
     "impulse"})]`` in the order of ``metrics["cases"]``; a case whose loop is unstable is
-    listed in each figure's legend, not drawn. ``meta`` is the stamp (:func:`stamp`).
+    listed in each figure's legend, not drawn. ``meta`` is the stamp (:func:`stamp`). The
+    controllers of ``metrics["failed"]`` are listed first with their reasons.
     """
 
     styles, unstable = _styles(curves)
@@ -416,4 +417,5 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
     return write_report(out / "report.html", title=title, metrics=metrics["cases"],
                         figures=figs + list(extra_figures),
                         sections=sections + list(extra_sections), meta=meta,
-                        clearances_um=clearances_um, judged_on=judged_on)
+                        clearances_um=clearances_um, judged_on=judged_on,
+                        failed=[f["reason"] for f in (metrics.get("failed") or {}).values()])

@@ -1,0 +1,126 @@
+"""Which controllers of a run failed, and why, in one plain line each.
+
+``ambseal run`` judges every controller it could design and reports all of them; a
+controller whose judged loop (:func:`ambseal.robust.loop.judged_loop`, the continuous loop
+with the target's delay or the discrete loop as it runs) is unstable at a judged condition,
+or that could not be designed at all, is *failed*. A designed controller that failed is not
+delivered (no controller files are written for it unless the user asks with
+``--allow-unstable``); the reference PID, given by the rig file rather than designed, is
+marked the same way but is the user's own controller, judged for comparison.
+
+The verdict is the judged cases' own (``stable`` of each case and of its ``discrete``
+block); the line names the least stable closed-loop mode of each failed condition by its
+damped frequency and damping ratio ζ = −Re λ/|λ| (negative: growing).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["FailedController", "METHOD_NAMES", "loop_failure", "synthesis_failure"]
+
+#: How reports name the controllers of a run.
+METHOD_NAMES = {"pid": "PID", "hinf": "H∞", "mu": "μ", "lpv": "LPV", "tracked": "tracked"}
+
+
+@dataclass(frozen=True)
+class FailedController:
+    """A controller of the run that failed.
+
+    Attributes
+    ----------
+    reason : str
+        One plain line: the controller, "not delivered" (or "reference PID"), and why.
+    designed : bool
+        True for a controller the run designed (H∞, μ, LPV, ...); False for the reference
+        PID given by the rig file.
+    judged : bool
+        True when the controller exists and was judged (its cases are in ``cases``); False
+        when its synthesis failed.
+    conditions : list of str
+        The judged conditions at which its loop is unstable (empty when not judged).
+    """
+
+    reason: str
+    designed: bool
+    judged: bool
+    conditions: list[str] = field(default_factory=list)
+
+
+def _name(method: str) -> str:
+    return METHOD_NAMES.get(method, method)
+
+
+def _head(method: str, designed: bool, kept: bool = False) -> str:
+    if not designed:
+        return f"{_name(method)} (reference, given by the rig file): fails"
+    return (f"{_name(method)}: delivered as asked (allow_unstable) but fails" if kept else
+            f"{_name(method)}: not delivered")
+
+
+def _mode_text(poles, discrete_dt: float | None = None) -> str:
+    """The least stable mode of closed-loop poles: 's' poles (rad/s), or 'z' poles of a
+    loop sampled at ``discrete_dt`` (s), mapped to s by λ = ln z / dt."""
+    lam = np.asarray(poles, complex).ravel()
+    if lam.size == 0:
+        return ""
+    if discrete_dt:
+        lam = np.log(lam[np.abs(lam) > 0]) / discrete_dt
+    z = lam[int(np.argmax(lam.real))]
+    zeta = -z.real / max(abs(z), 1e-300)
+    return f"mode at {abs(z.imag) / (2 * math.pi):.4g} Hz, ζ = {zeta:.2g}".replace("-", "−")
+
+
+def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
+                 kept: bool = False) -> FailedController | None:
+    """The failure of one controller from its judged cases, or None when every judged
+    loop (continuous and, where judged, discrete) is stable.
+
+    Parameters
+    ----------
+    method : str
+        The controller's method (``"pid"``, ``"hinf"``, ...).
+    judged : list of (case, curves)
+        Its cases (``JudgedCase.to_dict()``: ``stable``, ``pressure_bar``, ``speed_hz``,
+        optional ``discrete`` with ``stable`` and ``sample_rate_hz``) with the curves of
+        :func:`ambseal.analysis.judge.judge` (``poles``: closed-loop poles, rad/s; the
+        discrete loop's under ``curves["discrete"]["poles"]``, z), and the condition's
+        label under ``case["label"]`` when the caller has one.
+    designed : bool
+        False for the reference PID of the rig file.
+    kept : bool
+        True when the run delivers it all the same (``allow_unstable``): said in the line.
+
+    Returns
+    -------
+    FailedController or None
+    """
+
+    cont, disc_parts, where = [], [], []
+    for case, curves in judged:
+        label = case.get("label") or f"{case['pressure_bar']:g} bar"
+        if not case.get("stable"):
+            cont.append(f"{label} ({_mode_text(curves.get('poles', ()))})")
+            where.append(label)
+            continue
+        disc = case.get("discrete")
+        if disc is not None and not disc.get("stable"):
+            dt = 1.0 / disc["sample_rate_hz"]
+            mode = _mode_text((curves.get("discrete") or {}).get("poles", ()), dt)
+            disc_parts.append(f"{label} ({mode}, max |z| = {disc['max_abs_pole_z']:.5f})")
+            where.append(label)
+    parts = ([f"the full-order loop is unstable at {' and '.join(cont)}"] if cont else []) + (
+        [f"as it runs on the target (sampled, delayed) the loop is unstable at "
+         f"{' and '.join(disc_parts)}"] if disc_parts else [])
+    if not parts:
+        return None
+    return FailedController(f"{_head(method, designed, kept)} — " + "; ".join(parts), designed,
+                            True, where)
+
+
+def synthesis_failure(method: str, why: str) -> FailedController:
+    """The failure of a controller whose design raised (``why``: the error's message)."""
+    return FailedController(f"{_head(method, True)} — the design failed: {why}", True, False)

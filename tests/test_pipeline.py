@@ -256,7 +256,9 @@ def test_run_with_the_tracked_controller(tmp_path, request, design_cache_for):
     with design_cache_for(request).patched("testrig"):
         m = run(out_dir=out, progress=False, overrides=("design.tracked=true",)).metrics
     cases = [c for c in m["cases"] if c["controller"] == "tracked"]
-    assert sorted(c["pressure_bar"] for c in cases) == [0.0, 2.04, 4.08, 6.12]
+    # 3× nominal k on the identified rig: 3 × 2.04 bar up to its fitted k at 0 bar
+    assert sorted(c["pressure_bar"] for c in cases) == pytest.approx([0.0, 2.04, 4.08, 6.12],
+                                                                      abs=0.05)
     assert all(c["stable"] and c["discrete"]["stable"] for c in cases)
     assert max(max(c["discrete"]["sensitivity_peak_per_axis"].values()) for c in cases) <= 3.0
     assert max(c["discrete"]["sensitivity_peak"] for c in cases) <= 3.2

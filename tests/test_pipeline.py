@@ -241,11 +241,13 @@ def test_run_designs_from_the_identified_rig(metrics):
 @pytest.mark.slow
 def test_run_with_the_tracked_controller(tmp_path, request, design_cache_for):
     """``[design] tracked = true`` adds the controller scheduled on the
-    tracked seal k — judged at the judged pressures (continuous, and as it runs: its
-    digital table with the target's delay), exported as a table on seal.k, and run on the
-    0 → 3× nominal pressure ramp. References: the issue's acceptance (the estimate within
-    10 % of the nominal k after 1 s, its 95 % interval covering the truth ≥ 90 % of the
-    time; the tracked scheme keeps the rotor to 3×) and the frozen continuous loops of the
+    tracked seal k — judged over its schedule, 0–3× nominal (the judged pressures and 3×;
+    continuous, and as it runs: its digital table with the target's delay), exported as a
+    table on seal.k, and run on the 0 → 3× nominal pressure ramp. References: the issue's
+    acceptance (as it runs on the facility's truth, every case stable with σ̄(S_o) ≤ 3 per
+    axis, ISO 14839-3's zone-A limit, and ≤ 3.2 overall; the estimate within 10 % of the
+    nominal k after 1 s, its 95 % interval covering the truth ≥ 90 % of the time; the
+    tracked scheme keeps the rotor to 3×) and the frozen continuous loops of the
     reference PID (unstable from 1.5× nominal: lost on the ramp before 3×)."""
     from ambseal.export.controller_files import load_controller
     from ambseal.app.pipeline import run
@@ -254,8 +256,14 @@ def test_run_with_the_tracked_controller(tmp_path, request, design_cache_for):
     with design_cache_for(request).patched("testrig"):
         m = run(out_dir=out, progress=False, overrides=("design.tracked=true",)).metrics
     cases = [c for c in m["cases"] if c["controller"] == "tracked"]
-    assert sorted(c["pressure_bar"] for c in cases) == [0.0, 2.04, 4.08]
+    # 3× nominal k on the identified rig: 3 × 2.04 bar up to its fitted k at 0 bar
+    assert sorted(c["pressure_bar"] for c in cases) == pytest.approx([0.0, 2.04, 4.08, 6.12],
+                                                                      abs=0.05)
     assert all(c["stable"] and c["discrete"]["stable"] for c in cases)
+    assert max(max(c["discrete"]["sensitivity_peak_per_axis"].values()) for c in cases) <= 3.0
+    assert max(c["discrete"]["sensitivity_peak"] for c in cases) <= 3.2
+    assert sorted(c["pressure_bar"] for c in m["cases"] if c["controller"] == "pid") == [
+        0.0, 2.04, 4.08]
     assert "tracked" not in m["cannot_run"]
     assert load_controller(out / "controllers" / "controller_tracked.npz").parameter == "seal.k"
     ramp = m["ramp"]

@@ -52,8 +52,7 @@ def test_design_refuses_a_parameter_without_channel_and_a_one_point_grid(testrig
 
 @pytest.mark.slow
 def test_tracked_design_stable_in_zone_a_on_the_full_order_plant(testrig_cfg, testrig_tracked):
-    """At every frozen k on a grid 5× denser than the design grid
-    over 0–3× nominal (21 pressures), the scheduled controller frozen at k is stable on the
+    """At every frozen k of the controller table's size over 0–3× nominal (21 pressures), the scheduled controller frozen at k is stable on the
     full-order plant (every mode, the 557 Hz bending pair included) with σ̄(S_o) ≤ 3 per
     axis — the ISO 14839-3 zone-A limit (the reference)."""
     from ambseal.analysis.judge import judge_settings
@@ -63,7 +62,7 @@ def test_tracked_design_stable_in_zone_a_on_the_full_order_plant(testrig_cfg, te
     d = testrig_tracked
     assert d.design_states == 12  # the specification's model keeps the bending pair
     cases = frozen_cases(testrig_cfg, d, settings=judge_settings(design_spec(testrig_cfg)))
-    assert len(cases) == 5 * (len(d.grid) - 1) + 1
+    assert len(cases) == len(d.check_grid) == 21
     p0 = testrig_cfg.operating.pressure_bar
     assert cases[0]["pressure_bar"] == 0.0 and cases[-1]["pressure_bar"] == pytest.approx(3 * p0)
     assert all(c["stable"] for c in cases)
@@ -248,3 +247,26 @@ def test_no_deserialisation_of_code_in_the_package():
              for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
              if bad.search(line)]
     assert not found, found
+
+
+def test_a_seal_scheduled_controller_is_judged_over_its_whole_schedule(testrig_cfg):
+    """Reference: the test rig's seal k = 1.1 MN/m per bar from 0 (rig file), so a schedule
+    over k = 0–3× its value at the nominal 2.04 bar ends at 0 and 3 × 2.04 = 6.12 bar. The
+    specification's judged pressures (0, 2.04, 4.08 bar) stay, 6.12 bar is added after
+    them as a "high" condition; a fixed controller keeps the specification's points."""
+    from ambseal.analysis.judge import operating_points, points_for
+    from ambseal.design.specs import design_spec
+
+    cfg = testrig_cfg
+    points = operating_points(design_spec(cfg))
+    assert [p.pressure_bar for p in points] == pytest.approx([0.0, 2.04, 4.08])
+    k_nom = 1.1e6 * 2.04
+    g = np.array([0.0, 3.0 * k_nom])
+    K = LpvController(g, *(np.zeros((2, 1, 1)),) * 4, ("y_A_zeta",), ("u_A_zeta",))
+    d = SealScheduledDesign(f"{cfg.seal[0].name}.k", K, 1.0, 1.05, g, g, np.ones(2), 1e5,
+                            default_weights("hinf"))
+    judged = points_for(d, points, cfg)
+    assert [p.pressure_bar for p in judged] == pytest.approx([0.0, 2.04, 4.08, 6.12])
+    assert judged[:3] == points
+    assert (judged[3].label, judged[3].condition) == ("6.12 bar", "high")
+    assert points_for(object(), points, cfg) == points

@@ -61,8 +61,8 @@ from ambseal.lti.interconnect import wired
 from ambseal.lti.json_safe import json_float
 from ambseal.model.modes import classify_poles
 from ambseal.model.rig import build_plant
-from ambseal.model.seal import seal_values
-from ambseal.robust.controller import SPEED, frozen
+from ambseal.model.seal import pressure_for_k, seal_values
+from ambseal.robust.controller import SPEED, ScheduledController, frozen
 from ambseal.robust.delay import loop_delay
 from ambseal.robust.loop import JudgedLoop, judged_loop
 from ambseal.robust.scheduled_digital import ScheduledDigital
@@ -70,7 +70,7 @@ from ambseal.robust.scheduled_digital import ScheduledDigital
 __all__ = ["JudgeSettings", "OperatingPoint", "LoopJudgement", "JudgedCase", "judge", "judge_case", "judge_spinup",
            "operating_points", "speed_scheduled",
            "judge_settings", "unstable_open_loop_poles", "condition_values", "frozen_at",
-           "frozen_discrete", "judge_jobs"]
+           "frozen_discrete", "judge_jobs", "points_for"]
 
 
 @dataclass(frozen=True)
@@ -312,6 +312,53 @@ def operating_points(spec) -> list[OperatingPoint]:
     return [OperatingPoint(q, f * 60.0, label(q, f), side(q, f)) for f in fs for q in ps]
 
 
+def points_for(controller, points, design_cfg) -> list[OperatingPoint]:
+    """Where ``controller`` is judged: ``points`` (:func:`operating_points`), and for a
+    controller scheduled on a seal's k affine in the pressure drop also the pressure drops
+    that give the ends of its schedule on the design rig
+    (:func:`ambseal.model.seal.pressure_for_k`), so that it is judged over the whole range it
+    was designed for and not only at the specification's pressures (the tracked controller,
+    k over 0–3× nominal: 0, 1×, 2× and 3× nominal pressure on the test rig).
+
+    Parameters
+    ----------
+    controller : control.StateSpace or ScheduledController
+    points : list of OperatingPoint
+        The rig's judged conditions, one of them ``"nominal"``.
+    design_cfg : RigConfig
+        The rig the controller was designed on (its seals map k to a pressure drop).
+
+    Returns
+    -------
+    list of OperatingPoint
+        ``points`` for a fixed or speed-scheduled controller; else every pressure of
+        ``points`` and the schedule's ends at each speed, pressures ascending, labelled and
+        named low/nominal/high as :func:`operating_points` does.
+    """
+
+    if not isinstance(controller, ScheduledController) or controller.parameter == SPEED:
+        return list(points)
+    ends = [pressure_for_k(design_cfg.seal, controller.parameter, th)
+            for th in controller.schedule]
+    pressures = sorted({p.pressure_bar for p in points})
+    for q in ends:  # 12 digits: 3 × 2.04 bar is 6.12 bar, not 6.120000000000001
+        if q is not None and not any(math.isclose(q, x, abs_tol=1e-9) for x in pressures):
+            pressures.append(float(f"{q:.12g}"))
+    if len(pressures) == len({p.pressure_bar for p in points}):
+        return list(points)
+    speeds = list(dict.fromkeys(p.speed_rpm for p in points))
+    nominal = next((p for p in points if p.condition == "nominal"), points[0])
+    by_speed = len(speeds) > 1
+
+    def point(q, rpm):
+        label = f"{q:g} bar" + (f", {rpm / 60.0:g} Hz" if by_speed else "")
+        x, x0 = (rpm, nominal.speed_rpm) if by_speed else (q, nominal.pressure_bar)
+        side = "nominal" if x == x0 else ("low" if x < x0 else "high")
+        return OperatingPoint(q, rpm, label, side)
+
+    return [point(q, rpm) for rpm in speeds for q in sorted(pressures)]
+
+
 def unstable_open_loop_poles(A: np.ndarray) -> np.ndarray:
     """Eigenvalues of ``A`` with a positive real part, most unstable first (rad/s).
 
@@ -470,12 +517,13 @@ def frozen_at(K, point, design_cfg):
 
 
 def judge_jobs(designs, digitals: dict, points, design_cfg) -> list[dict]:
-    """``ambseal run``'s cases: every design at every judged point, frozen there
-    (:func:`frozen_at`), with the delayed discrete controller that runs
+    """``ambseal run``'s cases: every design at each of its judged points
+    (:func:`points_for`: ``points``, over its schedule for one scheduled on a seal's k),
+    frozen there (:func:`frozen_at`), with the delayed discrete controller that runs
     (:func:`frozen_discrete`), for :func:`judge_case`."""
     return [{"name": d.method, "point": p, "controller": frozen_at(d.controller, p, design_cfg),
              "discrete": frozen_discrete(digitals.get(d.method), p, design_cfg)}
-            for d in designs for p in points]
+            for d in designs for p in points_for(d.controller, points, design_cfg)]
 
 
 def frozen_discrete(digital, point, design_cfg):

@@ -417,8 +417,8 @@ def _run_tracked(cfg, fac, tracked, run_as, e, noise, inoise, fs, starts, n_len,
 def frozen_cases(cfg, design, *, settings: JudgeSettings, impulse: bool = False
                  ) -> list[dict]:
     """The scheduled controller judged on the full-order plant at frozen pressures: the
-    design's range (``range_factor`` × the operating pressure) on a grid 5× denser than
-    its design grid, the controller frozen at the rig model's value of its parameter at
+    design's range (``range_factor`` × the operating pressure) at as many equally spaced
+    pressures as its controller table has entries (``check_grid``: 21 by default), the controller frozen at the rig model's value of its parameter at
     each pressure (:func:`ambseal.analysis.judge.judge`; each case also has ``"value"``,
     θ in SI).
 
@@ -440,7 +440,7 @@ def frozen_cases(cfg, design, *, settings: JudgeSettings, impulse: bool = False
     p0, rpm = cfg.operating.pressure_bar, cfg.operating.speed_rpm
     lo, hi = design.range_factor
     cases = []
-    for p in np.linspace(lo * p0, hi * p0, 5 * (len(design.grid) - 1) + 1):
+    for p in np.linspace(lo * p0, hi * p0, len(design.check_grid)):
         theta = float(build_plant(cfg, pressure_bar=p).parameter(design.parameter).nominal)
         case, _ = judge(cfg, design.at(theta), "tracked",
                         OperatingPoint(float(p), rpm, f"{p:.3g} bar"), s, impulse=impulse)

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ambseal.analysis.judge import speed_scheduled
+from ambseal.analysis.judge import points_for, speed_scheduled
 from ambseal.analysis.ramp import ramp_simulation
 from ambseal.app.commands import Designed, digitals_for
 from ambseal.design.seal_schedule import design_seal_scheduled
@@ -30,7 +30,9 @@ def tracked_designs(cfg, design_cfg, spec, points, say, digitals: dict, cannot_r
     rig's design specification ``spec`` (as the robust controllers are), with its digital table
     (:func:`ambseal.app.commands.digitals_for`: discretisation chosen on the sampled full-order
     loops with the target's delay at the judged pressures and between table entries) put
-    in ``digitals``, or the reason it cannot run in ``cannot_run``.
+    in ``digitals``, or the reason it cannot run in ``cannot_run``. Its table is chosen and
+    checked over its whole schedule (:func:`ambseal.analysis.judge.points_for`: ``points``
+    and the pressures at the schedule's ends), where it is judged.
 
     Raises
     ------
@@ -49,7 +51,8 @@ def tracked_designs(cfg, design_cfg, spec, points, say, digitals: dict, cannot_r
     d = design_seal_scheduled(design_cfg, spec=spec)
     say("tracked designed", 1)
     out = [Designed("tracked", d, d.to_dict(), d)]
-    more, cannot = digitals_for(design_cfg, out, points, lambda m: say(m, 0))
+    more, cannot = digitals_for(design_cfg, out, points_for(d, points, design_cfg),
+                                lambda m: say(m, 0))
     digitals.update(more)
     cannot_run.update(cannot)
     return out

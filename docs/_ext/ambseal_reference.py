@@ -53,6 +53,12 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "ShaftSection.material": ("", "a NAME of ``[materials.NAME]``"),
     "ShaftSection.elements": ("", "beam elements in the section (at most 150 in the whole "
                                   "shaft)"),
+    "ShaftSection.layers": ("", "concentric tubes on the section's nodes, in parallel with "
+                                "its own (a sleeve, a hub; ROSS's layered elements)"),
+    "ShaftLayer.outer_diameter": ("m", "outer diameter of the layer"),
+    "ShaftLayer.inner_diameter": ("m", "its bore; at least the outer diameter of the tube "
+                                       "inside it (tubes do not overlap)"),
+    "ShaftLayer.material": ("", "a NAME of ``[materials.NAME]``"),
     # [[disk]]
     "Disk.position": ("m", "axial position from the shaft's left end"),
     "Disk.mass": ("kg", "mass of the rigid disk (impeller, lamination stack, sleeve, hub)"),
@@ -121,6 +127,8 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Spring.kyx": ("N/m", "cross-coupled stiffness"),
     "Spring.cxx": ("N·s/m", "direct damping"),
     "Spring.cyy": ("N·s/m", "direct damping"),
+    "Spring.cxy": ("N·s/m", "cross-coupled damping (fixed: not a parameter to identify)"),
+    "Spring.cyx": ("N·s/m", "cross-coupled damping (fixed: not a parameter to identify)"),
     "Spring.axes_angle_deg": ("°", "the axes the coefficients are given in, rotated from "
                                    "x, y"),
     "Spring.name": ("", "names its parameters (``coupling.kxx``); unnamed: ``spring<i>``"),
@@ -395,6 +403,9 @@ def _sections() -> list[Section]:
                 "with the geometry one axis may be left out."),
         Section("{ at_zero, per_bar }", r.Affine, "A coefficient affine in the pressure "
                 "drop p (bar): at_zero + per_bar · p."),
+        Section("{ outer_diameter, inner_diameter, material }", r.ShaftLayer, "A layer of "
+                "a ``[[shaft]]`` section (``layers = [{ ... }, ...]``): a tube of its own "
+                "material and shear parameter whose beam matrices add to the section's."),
         Section("{ frequency_hz, value }", r.FrequencyTable, "A seal coefficient tabulated "
                 "against excitation frequency, of equal lengths."),
         Section("[truth]", r.TruthSection, "The truth file of the virtual test facility "

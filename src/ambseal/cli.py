@@ -18,7 +18,7 @@ Commands
 ``ambseal sweep RIG --pressure-bar a:b:n [--speed-hz a:b:n] [--controller ...]
 [--param NAME=a:b:n] [--scheduler ADDRESS | --workers N]``
     Stability and performance map; serial or on Dask.
-``ambseal import-ross FILE --out RIG``
+``ambseal import-ross FILE --out RIG [--speed-rpm N]``
     A ROSS rotor file as an ambseal rig file.
 ``ambseal acquire RIG --truth TRUTH --excitation prbs|sine|chirp|impulse --pressure-bar P --out FILE``
     A record from the virtual test facility (CSV + JSON sidecar, or .mat).
@@ -314,6 +314,11 @@ def _rotordynamics_parsers(sub) -> None:
     r = sub.add_parser("import-ross", help="a ROSS rotor file (.toml/.json) as an ambseal rig")
     r.add_argument("file", help="ROSS rotor file saved by ross.Rotor.save")
     r.add_argument("--out", required=True, help="rig file to write (TOML)")
+    r.add_argument("--speed-rpm", type=float, default=None,
+                   help="take frequency-dependent bearing coefficients at this speed's "
+                        "synchronous frequency, as ROSS's run_modal(speed) does, and make it "
+                        "the rig's operating speed (default: the lowest frequency of ROSS's "
+                        "tables)")
 
 
 def _executor_args(p) -> None:
@@ -373,7 +378,8 @@ def _logging(args: argparse.Namespace) -> None:
 def _inputs(args: argparse.Namespace) -> tuple[list, str]:
     """The files a command reads and writes, and the one an unnamed error comes from."""
 
-    rig = getattr(args, "rig", None) or default_rig_path()
+    # a command's own input (a rig, or import-ross's ROSS file) is the source to name
+    rig = getattr(args, "rig", None) or getattr(args, "file", None) or default_rig_path()
     ctrl = getattr(args, "controller", None)  # a file, or a method's name (pid, hinf, ...)
     files = [rig, getattr(args, "truth", None), getattr(args, "out", None),
              *(getattr(args, "data", None) or []),

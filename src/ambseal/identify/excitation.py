@@ -147,7 +147,7 @@ def welch_segment(n_samples: int) -> int:
     return 2 ** max(3, int(math.floor(math.log2(max(n_samples, 1) / 4))))
 
 
-def excitation_plan(cfg: RigConfig) -> ExcitationPlan:
+def excitation_plan(cfg: RigConfig, *, amplitude_a: float | None = None) -> ExcitationPlan:
     """The identification excitations of ``cfg`` (module docstring for the rules).
 
     Parameters
@@ -155,6 +155,8 @@ def excitation_plan(cfg: RigConfig) -> ExcitationPlan:
     cfg : RigConfig
         The rig: its AMBs' bias currents (or current limits), its controller's sample rate
         and its ``[design.impulse]`` keys.
+    amplitude_a : float, optional
+        The amplitude (A) instead of the rig's (a command-line option).
 
     Returns
     -------
@@ -165,10 +167,10 @@ def excitation_plan(cfg: RigConfig) -> ExcitationPlan:
     Raises
     ------
     ConfigError
-        No amplitude: no ``[design.impulse] amplitude_a`` and no AMB bias current or
-        current limit to derive it from.
+        No amplitude: none given, no ``[design.impulse] amplitude_a`` and no AMB bias
+        current or current limit to derive it from.
     """
-    amplitude = impulse_amplitude(cfg)
+    amplitude = amplitude_a if amplitude_a is not None else impulse_amplitude(cfg)
     if amplitude is None:
         raise ConfigError("design.impulse.amplitude_a: the identification excitation's "
                           "amplitude cannot be derived (no [[amb]] bias_current or "

@@ -75,7 +75,8 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Amb.turns": ("", "windings per pole (geometry)"),
     "Amb.pole_area": ("m²", "pole face area (geometry)"),
     "Amb.air_gap": ("m", "nominal air gap (geometry); also sets the design scaling D_e"),
-    "Amb.bias_current": ("A", "bias current (geometry); also sets D_u and the impulse"),
+    "Amb.bias_current": ("A", "bias current (geometry); also sets D_u, the impulse and the "
+                               "identification excitations' amplitude"),
     "Amb.pole_angle_deg": ("°", "half the angle between the two poles of a pole pair "
                                "(8-pole heteropolar bearing: 22.5)"),
     "Amb.ki": ("N/A", "current gain Ki, a number or ``{ zeta, eta }``; wins over the "
@@ -190,8 +191,9 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "UnbalanceSpec.force_at": ("", "seal, disk, AMB or spring where the force acts and the "
                                    "compliance is taken"),
     "UnbalanceSpec.range_hz": ("Hz", "``[low, high]`` speeds of the unbalance response"),
-    "ImpulseSpec.amplitude_a": ("A", "current impulse amplitude (P5 §5.1)"),
-    "ImpulseSpec.duration_s": ("s", "current impulse duration"),
+    "ImpulseSpec.amplitude_a": ("A", "current impulse amplitude (P5 §5.1); also the "
+                                     "amplitude of every identification excitation"),
+    "ImpulseSpec.duration_s": ("s", "current impulse duration (judgement and identification)"),
     "UncertainSpec.parameter": ("", "an LFT parameter name: ``<seal>.k``, ``A.Ks_zeta``, "
                                     "``coupling.kxx``, …"),
     "UncertainSpec.relative": ("", "± this fraction of the nominal value (1.0: ± 100 %)"),

@@ -270,3 +270,9 @@ def test_a_seal_scheduled_controller_is_judged_over_its_whole_schedule(testrig_c
     assert judged[:3] == points
     assert (judged[3].label, judged[3].condition) == ("6.12 bar", "high")
     assert points_for(object(), points, cfg) == points
+    # an end inside the judged pressures (k = 1.1 kN/m: 1 mbar) extends nothing: not added
+    g = np.array([1.1e3, 3.0 * k_nom])
+    inside = SealScheduledDesign(f"{cfg.seal[0].name}.k", K, 1.0, 1.05, g, g, np.ones(2),
+                                 1e5, default_weights("hinf"))
+    assert [p.pressure_bar for p in points_for(inside, points, cfg)] == pytest.approx(
+        [0.0, 2.04, 4.08, 6.12])

@@ -316,9 +316,10 @@ def points_for(controller, points, design_cfg) -> list[OperatingPoint]:
     """Where ``controller`` is judged: ``points`` (:func:`operating_points`), and for a
     controller scheduled on a seal's k affine in the pressure drop also the pressure drops
     that give the ends of its schedule on the design rig
-    (:func:`ambseal.model.seal.pressure_for_k`), so that it is judged over the whole range it
-    was designed for and not only at the specification's pressures (the tracked controller,
-    k over 0–3× nominal: 0, 1×, 2× and 3× nominal pressure on the test rig).
+    (:func:`ambseal.model.seal.pressure_for_k`) that lie outside the judged pressures, so
+    that it is judged over the whole range it was designed for and not only at the
+    specification's pressures (the tracked controller, k over 0–3× nominal: 0, 1×, 2× and
+    3× nominal pressure on the test rig).
 
     Parameters
     ----------
@@ -341,8 +342,12 @@ def points_for(controller, points, design_cfg) -> list[OperatingPoint]:
     ends = [pressure_for_k(design_cfg.seal, controller.parameter, th)
             for th in controller.schedule]
     pressures = sorted({p.pressure_bar for p in points})
+    lo, hi = pressures[0], pressures[-1]
+    # an end inside the judged pressures adds nothing to the range judged (on an identified
+    # rig k is not exactly 0 at 0 bar: its k = 0 end sits a hair above 0 bar)
     for q in ends:  # 12 digits: 3 × 2.04 bar is 6.12 bar, not 6.120000000000001
-        if q is not None and not any(math.isclose(q, x, abs_tol=1e-9) for x in pressures):
+        if q is not None and q >= 0.0 and (q > hi or q < lo) and not any(
+                math.isclose(q, x, abs_tol=1e-9) for x in pressures):
             pressures.append(float(f"{q:.12g}"))
     if len(pressures) == len({p.pressure_bar for p in points}):
         return list(points)

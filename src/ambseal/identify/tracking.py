@@ -50,6 +50,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 import scipy.linalg as sla
+from scipy import stats
 
 from ambseal.config import RigConfig
 from ambseal.errors import DataError, IdentificationError, ModelError
@@ -109,6 +110,16 @@ class TrackingSettings:
         rises with the same pressure to a quarter of the balance drum's), 0.026 with every
         seal following, 0.16 with only the tracked seal's K, C, c (coverage 99.4–99.7 %
         and 38 %, seeds 0–2; the same with or without the facility's 16-bit ADC).
+    check_block_s, check_window_s : float
+        The model-consistency test (:meth:`OnlineTracker.consistency`): its batch length
+        (longer than the sensitivities' memory, the slowest closed-loop mode's few time
+        constants, so that batch sums are nearly independent) and its window (30 batches:
+        the Student t's tails close to the normal's).
+    check_alpha : float
+        False-refusal probability of one window's test of one held-known coefficient; the
+        threshold is the F(1, m − 1) quantile at 1 − α/(number of coefficients)
+        (Bonferroni). 1e-4: over a 30 s ramp (10 windows, three coefficients) a consistent
+        model is refused with probability ≤ 0.3 %.
     """
 
     rate_per_s: float = 0.1
@@ -122,6 +133,9 @@ class TrackingSettings:
     inflation_window_s: float = 0.5
     min_duration_s: float = 0.5
     follow_pressure: bool = True
+    check_block_s: float = 0.1
+    check_window_s: float = 3.0
+    check_alpha: float = 1e-4
 
 
 def _inflation(score: np.ndarray, info: np.ndarray, block: int, window: int) -> np.ndarray:
@@ -203,21 +217,29 @@ def flops_per_sample(n: int, k: int, m: int, p: int) -> int:
 
 
 def _param_matrices(model: ClosedLoopModel, values: dict[str, float], names, dt: float,
-                    expand=None):
+                    expand=None, probes=()):
     """A_d, B_d, C at ``values`` and ∂A_d/∂θ_j, ∂B_d/∂θ_j (Van Loan's block exponential:
     expm([[M, E], [0, M]] T) has d expm(M T)/dθ in its upper-right block, M = [[A, B],
     [0, 0]], E = ∂M/∂θ). ``expand`` maps the tracked values to every value the model
-    takes (the coefficients that follow a seal's k, :func:`_follower`); default none."""
+    takes (the coefficients that follow a seal's k, :func:`_follower`); default none.
+    ``probes``: held-known parameters whose derivatives follow those of ``names`` (taken
+    about the expanded values: the score test of :meth:`OnlineTracker.consistency`)."""
     expand = expand or dict
-    A, B, C, _, _ = model.matrices(expand(values))
+    full = expand(values)
+    A, B, C, _, _ = model.matrices(full)
     n, m = B.shape
     M = np.zeros((n + m, n + m))
     M[:n, :n], M[:n, n:] = A, B
     E0 = sla.expm(M * dt)
     dA, dB = [], []
-    for name in names:
-        h = 1e-6 * max(abs(values[name]), 1.0)
-        Ap, Bp, _, _, _ = model.matrices(expand({**values, name: values[name] + h}))
+    for name in (*names, *probes):
+        if name in probes:
+            v0 = float(full.get(name, model.plant.parameter(name).nominal))
+            h = 1e-6 * max(abs(v0), 1.0)
+            Ap, Bp, _, _, _ = model.matrices({**full, name: v0 + h})
+        else:
+            h = 1e-6 * max(abs(values[name]), 1.0)
+            Ap, Bp, _, _, _ = model.matrices(expand({**values, name: values[name] + h}))
         dM = np.zeros_like(M)
         dM[:n, :n], dM[:n, n:] = (Ap - A) / h, (Bp - B) / h  # exact for an LFT (affine in θ)
         big = np.block([[M, dM], [np.zeros_like(M), M]]) * dt
@@ -240,6 +262,21 @@ def _follower(cfg: RigConfig, model: ClosedLoopModel, names):
         return values_following(cfg.seal, values, known)
 
     return expand
+
+
+def _probes(cfg: RigConfig, model: ClosedLoopModel, names) -> tuple[str, ...]:
+    """The coefficients the tracker holds known and checks (:meth:`OnlineTracker.
+    consistency`): for each tracked ``<seal>.k`` of a ``[[seal]]``, that seal's K, C, c
+    that are parameters of the model and not tracked."""
+    seals = {q.name for q in cfg.seal}
+    known = model.plant.parameters
+    out = []
+    for n in names:
+        seal, _, coef = n.rpartition(".")
+        if coef == "k" and seal in seals:
+            out += [f"{seal}.{c}" for c in ("K", "C", "c")
+                    if f"{seal}.{c}" in known and f"{seal}.{c}" not in names]
+    return tuple(dict.fromkeys(out))
 
 
 def _scales(cfg: RigConfig, model: ClosedLoopModel, names) -> np.ndarray:
@@ -474,18 +511,23 @@ class OnlineTracker:
                  compiled: bool = True):
         s = self.settings = settings
         self.model, self.names, self.dt = model, tuple(names), float(dt)
+        self.probes = _probes(cfg, model, self.names)
         self.scale = _scales(cfg, model, self.names)
+        p, r = len(self.names), len(self.probes)
+        # θ, P and Q_θ carry the probes after the tracked values: θ = θ₀ = 0 and no
+        # variance, so they never move and never change the prediction; the kernel
+        # still forms their sensitivities and scores (the consistency test).
         self.theta = np.array([float((initial or {}).get(n, model.plant.parameter(n).nominal))
-                               for n in self.names])
-        self.initial = self.theta.copy()
+                               for n in self.names] + [0.0] * r)
+        self.initial = self.theta[:p].copy()
         sig = s.sensor_noise_fraction * np.sqrt(np.mean(np.asarray(y0) ** 2, axis=0))
         self.sigma_y = np.where(sig > 0, sig, 1e-9)
         self.sigma_u = np.full(np.shape(u0)[1], s.process_noise_a if s.process_noise_a
                                is not None else max(0.01 * float(np.sqrt(np.mean(
                                    np.asarray(u0) ** 2))), 1e-6))
-        p = len(self.names)
-        self.P = np.diag((s.initial_rel_std * self.scale) ** 2)
-        self.q = (s.rate_per_s * self.scale) ** 2 * dt
+        self.P = np.zeros((p + r, p + r))
+        self.P[:p, :p] = np.diag((s.initial_rel_std * self.scale) ** 2)
+        self.q = np.r_[(s.rate_per_s * self.scale) ** 2 * dt, np.zeros(r)]
         self.lam = self.sigma_y**2 * 1.0
         self.g = min(1.0, dt / s.innovation_time_s)
         self.chunk = max(1, int(round(s.relinearise_s / dt)))
@@ -494,32 +536,39 @@ class OnlineTracker:
         self._since = 0  # samples since the last re-linearisation
         self.x = self.W = self.K = self.theta_K = self.mats = None
         self._rows: list = []
+        self.refused_at_s: float | None = None
+        self.refusal = ""
         if compiled:  # compile outside the timing
-            Ad, Bd, C, dA, dB = _param_matrices(model, dict(zip(self.names, self.theta)),
-                                                self.names, dt, self.expand)
-            z = np.zeros((1, p))
+            Ad, Bd, C, dA, dB = self._matrices()
+            z = np.zeros((1, p + r))
             self.kern(np.zeros((1, C.shape[0])), np.zeros((1, Bd.shape[1])), Ad, Bd, C,
                       np.zeros(C.T.shape), dA, dB, self.theta.copy(), np.zeros(len(Ad)),
-                      np.zeros((p, len(Ad))), self.theta.copy(), self.P.copy(),
+                      np.zeros((p + r, len(Ad))), self.theta.copy(), self.P.copy(),
                       self.lam.copy(), self.q, self.g, z.copy(), z.copy(), z.copy(), z.copy(),
                       0, 0)
 
+    def _matrices(self):
+        return _param_matrices(self.model, dict(zip(self.names, self.theta)), self.names,
+                               self.dt, self.expand, self.probes)
+
     def _relinearise(self):
-        Ad, Bd, C, dA, dB = _param_matrices(self.model, dict(zip(self.names, self.theta)),
-                                            self.names, self.dt, self.expand)
+        Ad, Bd, C, dA, dB = self._matrices()
+        p = len(self.names)
         if self.x is None:
-            self.x, self.W = np.zeros(Ad.shape[0]), np.zeros((len(self.names), Ad.shape[0]))
-        if self.K is None or np.any(np.abs(self.theta - self.theta_K)
+            self.x, self.W = np.zeros(Ad.shape[0]), np.zeros((len(self.theta), Ad.shape[0]))
+        if self.K is None or np.any(np.abs(self.theta[:p] - self.theta_K)
                                     > self.settings.regain_rel * self.scale):
             self.K = _predictor_gain(Ad, Bd, C, self.sigma_y, self.sigma_u)
-            self.theta_K = self.theta.copy()
+            self.theta_K = self.theta[:p].copy()
         self.mats = (Ad, Bd, C, self.K, dA, dB, self.theta.copy())
 
     def update(self, y, u, source: str = "<data>") -> np.ndarray:
         """Run the recursion over ``y`` (N, k) and ``u`` (N, m); returns θ̂ after the last
-        sample (p,). Raises IdentificationError when the estimate diverges."""
+        sample (p,), and refuses (:attr:`refused_at_s`, :attr:`refusal`) at the first
+        window whose consistency test fails (:meth:`consistency`). Raises
+        IdentificationError when the estimate diverges."""
         y, u = np.ascontiguousarray(y, float), np.ascontiguousarray(u, float)
-        N, p = len(y), len(self.names)
+        N, p = len(y), len(self.theta)
         rows = [np.empty((N, p)) for _ in range(4)]
         start = 0
         while start < N:
@@ -536,17 +585,79 @@ class OnlineTracker:
             self._since += stop - start
             start = stop
         self._rows.append(rows)
-        return self.theta.copy()
+        if self.refused_at_s is None and self.probes:
+            check = self.consistency()
+            for w in check["windows"]:
+                if w["refused"]:
+                    self.refused_at_s = w["end_s"]
+                    worst = max(w["statistic"], key=w["statistic"].get)
+                    self.refusal = (
+                        f"its model cannot explain the data: the score of the held-known "
+                        f"{worst} is {w['statistic'][worst]:.3g} (F test over "
+                        f"{w['start_s']:.3g}–{w['end_s']:.3g} s; threshold "
+                        f"{check['threshold']:.3g} at α = {self.settings.check_alpha:g}), so that "
+                        f"coefficient is off and the estimate is biased")
+                    break
+        return self.theta[:len(self.names)].copy()
 
     @property
     def samples(self) -> int:
         """Samples fed so far."""
         return sum(len(r[0]) for r in self._rows)
 
+    def consistency(self) -> dict:
+        """The model-consistency test over every complete window fed so far: a Rao score
+        (Lagrange-multiplier) test that the coefficients the tracker holds known — the
+        tracked seal's K, C, c (:attr:`probes`) — are right.
+
+        Under a right model the score of a held-known coefficient θ_r, s_t = H_rᵀ Λ⁻¹ ε_t
+        (H_r = C W_r its output sensitivity, computed by the kernel beside the tracked
+        ones), has mean zero (Rao 1948; Engle, *Handbook of Econometrics* II, 1984, ch. 13
+        §4; Ljung, *System Identification*, 2nd ed., 1999, §16.6: a model is validated by
+        residuals uncorrelated with what they should not depend on). A coefficient that is
+        off leaves in ε a part of the response the model cannot make, which the tracked k̂
+        absorbs only in part: s_t then has a non-zero mean and k̂ a bias the standard error
+        does not show. The innovations are not white (the predictor's gain is fixed between
+        re-linearisations), so the score's variance is that of batch means: over a window of
+        m batches of ``check_block_s`` with sums S_b, t = √m · mean S / sd S is Student's t
+        with m − 1 degrees of freedom under the right model, and the window refuses when
+        t² exceeds the F(1, m − 1) quantile at 1 − α/r for any of the r coefficients
+        (``check_alpha``, Bonferroni). Windows are consecutive, the first after
+        ``min_duration_s`` (the predictor's start).
+
+        Returns
+        -------
+        dict
+            ``probes`` (names), ``threshold`` (the F quantile), ``windows``: per window
+            ``start_s``, ``end_s``, ``statistic`` (name → t²) and ``refused``.
+        """
+        s = self.settings
+        p, r = len(self.names), len(self.probes)
+        b = max(1, int(round(s.check_block_s / self.dt)))
+        m = max(2, int(round(s.check_window_s / s.check_block_s)))
+        thr = float(stats.f.ppf(1.0 - s.check_alpha / max(r, 1), 1, m - 1))
+        out = {"probes": list(self.probes), "threshold": thr, "windows": []}
+        if not r or not self._rows:
+            return out
+        score = np.vstack([rows[2][:, p:] for rows in self._rows])
+        n0 = int(round(s.min_duration_s / self.dt))
+        nb = (len(score) - n0) // b
+        S = score[n0:n0 + nb * b].reshape(nb, b, r).sum(axis=1)
+        for w in range(nb // m):
+            Sw = S[w * m:(w + 1) * m]
+            sd = np.std(Sw, axis=0, ddof=1)
+            t2 = m * np.mean(Sw, axis=0) ** 2 / np.maximum(sd**2, 1e-300)
+            out["windows"].append({
+                "start_s": (n0 + w * m * b) * self.dt, "end_s": (n0 + (w + 1) * m * b) * self.dt,
+                "statistic": dict(zip(self.probes, map(float, t2))),
+                "refused": bool(np.any(t2 > thr))})
+        return out
+
     def result(self, time_s, wall_s: float = 0.0, cpu_s: float = 0.0) -> TrackingResult:
         """Everything fed so far as a :class:`TrackingResult` (the standard error with the
         causal variance inflation of :func:`_inflation`)."""
-        est, se, score, info = (np.vstack([r[i] for r in self._rows]) for i in range(4))
+        p = len(self.names)
+        est, se, score, info = (np.vstack([r[i][:, :p] for r in self._rows]) for i in range(4))
         s = self.settings
         se = se * np.sqrt(_inflation(score, info, int(round(s.innovation_time_s / self.dt)),
                                      int(round(s.inflation_window_s / self.dt))))
@@ -554,7 +665,7 @@ class OnlineTracker:
         units = tuple(self.model.plant.parameter(q).unit for q in self.names)
         k, m = self.mats[2].shape[0], self.mats[1].shape[1]
         return TrackingResult(self.names, units, np.asarray(time_s, float), est, se,
-                              self.initial, n, flops_per_sample(n, k, m, len(self.names)),
+                              self.initial, n, flops_per_sample(n, k, m, len(self.theta)),
                               wall_s, cpu_s)
 
 

@@ -191,3 +191,77 @@ def test_facility_run_in_blocks_equals_one_run(testrig_cfg):
     for j in range(3):
         np.testing.assert_allclose(np.vstack([p[j] for p in parts]), ref[j], rtol=0,
                                    atol=1e-12 * np.max(np.abs(ref[j])))
+
+
+def _ar1(rng, n, phi):
+    """AR(1) noise of unit innovation variance: coloured like a score whose innovations are
+    not white."""
+    from scipy.signal import lfilter
+
+    return lfilter([1.0], [1.0, -phi], rng.standard_normal(n))
+
+
+def _block_sum_sd(block, phi):
+    """Standard deviation of a sum of ``block`` consecutive AR(1) values, from its
+    autocovariance γ(h) = φ^h / (1 − φ²) summed over every pair."""
+    h = np.abs(np.subtract.outer(np.arange(block), np.arange(block)))
+    return float(np.sqrt(np.sum(phi**h) / (1 - phi**2)))
+
+
+def test_score_test_refusal_rates_follow_the_central_and_noncentral_f():
+    """Reference: Student's t and its noncentral form (scipy.stats.f, ncf). Batch sums of a
+    coloured (AR(1), φ = 0.8) zero-mean score over 50-sample batches are nearly
+    independent normals, so a window of 30 batches refuses with probability α (here 0.01,
+    r = 1) — the test's false refusals — and a score of mean μ per sample refuses with
+    the noncentral F's tail at λ = 30 (50 μ / sd of a batch sum)² — its power. Each rate
+    over 1500 windows lies within the binomial 99.9 % interval of the reference."""
+    from scipy import stats
+
+    from ambseal.identify.tracking import score_test
+
+    rng = np.random.default_rng(3)
+    block, window, n_win, phi, alpha = 50, 30, 1500, 0.8, 0.01
+    n = block * window * n_win
+    sd = _block_sum_sd(block, phi)
+    mu = 0.5 * sd / block / np.sqrt(window) * 5.0  # λ = 6.25: power about one half
+    thr = stats.f.ppf(1 - alpha, 1, window - 1)
+    lam = window * (block * mu / sd) ** 2
+    for mean, p_ref in ((0.0, alpha), (mu, stats.ncf.sf(thr, 1, window - 1, lam))):
+        got_thr, windows = score_test((_ar1(rng, n, phi) + mean)[:, None], block, window,
+                                      alpha)
+        assert got_thr == pytest.approx(thr) and len(windows) == n_win
+        refused = sum(w[3] for w in windows)
+        lo, hi = stats.binom.interval(0.999, n_win, p_ref)
+        assert lo <= refused <= hi, (mean, refused, p_ref * n_win)
+
+
+def test_consistency_accepts_the_right_model_and_refuses_a_wrong_seal_stiffness(
+        testrig_cfg, nominal_record):
+    """Reference: the facility's own rig. The record's facility is the rig file (its
+    TruthSection changes no value): tracked with that model the seal's held-known K, C, c
+    pass the score test; with a model whose seal direct stiffness K is half the truth (the
+    kind of error the pump's identification made) K's score has a mean far from zero and
+    the tracker refuses."""
+    from ambseal.identify.tracking import OnlineTracker, TrackingSettings, linearised_model
+
+    cfg, rec = testrig_cfg, nominal_record
+    s = TrackingSettings(check_window_s=0.6, check_block_s=0.02)
+    y, u = rec.displacement_m, rec.current_ref_a
+    dt = float(rec.time_s[1] - rec.time_s[0])
+    seal = cfg.seal[0]
+    half = cfg.model_copy(update={"seal": [seal.model_copy(update={"K": _halved(seal.K)})]})
+    out = {}
+    for label, m in (("right", cfg), ("K halved", half)):
+        tr = OnlineTracker(m, linearised_model(m, rec, ["seal.k"], s), ["seal.k"], dt, y, u, s)
+        tr.update(y, u)
+        out[label] = tr
+    assert out["right"].probes == ("seal.K", "seal.C", "seal.c")
+    assert len(out["right"].consistency()["windows"]) == 1
+    assert out["right"].refused_at_s is None
+    assert out["K halved"].refused_at_s is not None
+    assert "seal.K" in out["K halved"].refusal
+
+
+def _halved(coef):
+    """A seal coefficient (an Affine) at half its value at every pressure."""
+    return coef.model_copy(update={"at_zero": coef.at_zero / 2, "per_bar": coef.per_bar / 2})

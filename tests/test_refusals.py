@@ -96,6 +96,15 @@ RIG_CASES = [
      ">= 0.0001"),
     ("1e30 elements", _set("shaft/1/elements", 10**18), "shaft[1].elements", "<= 150"),
     ("elements in all", _set("shaft/0/elements", 140), "shaft", "states"),
+    # a layer is a tube around the section's own, not through it
+    ("overlapping layer", _set("shaft/1/layers", [{"outer_diameter": 0.12,
+                                                   "inner_diameter": 0.08,
+                                                   "material": "steel"}]),
+     "shaft[1]", "overlap"),
+    ("unknown layer material", _set("shaft/1/layers", [{"outer_diameter": 0.12,
+                                                        "inner_diameter": 0.10,
+                                                        "material": "steal"}]),
+     "shaft[1].layers[0].material", "unknown material 'steal'"),
     # §3 nested values
     ("nan in affine", _set("seal/0/K", {"at_zero": float("nan"), "per_bar": 1.0}),
      "seal[0].K.at_zero", "finite"),

@@ -53,6 +53,12 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "ShaftSection.material": ("", "a NAME of ``[materials.NAME]``"),
     "ShaftSection.elements": ("", "beam elements in the section (at most 150 in the whole "
                                   "shaft)"),
+    "ShaftSection.layers": ("", "concentric tubes on the section's nodes, in parallel with "
+                                "its own (a sleeve, a hub; ROSS's layered elements)"),
+    "ShaftLayer.outer_diameter": ("m", "outer diameter of the layer"),
+    "ShaftLayer.inner_diameter": ("m", "its bore; at least the outer diameter of the tube "
+                                       "inside it (tubes do not overlap)"),
+    "ShaftLayer.material": ("", "a NAME of ``[materials.NAME]``"),
     # [[disk]]
     "Disk.position": ("m", "axial position from the shaft's left end"),
     "Disk.mass": ("kg", "mass of the rigid disk (impeller, lamination stack, sleeve, hub)"),
@@ -69,7 +75,8 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Amb.turns": ("", "windings per pole (geometry)"),
     "Amb.pole_area": ("m²", "pole face area (geometry)"),
     "Amb.air_gap": ("m", "nominal air gap (geometry); also sets the design scaling D_e"),
-    "Amb.bias_current": ("A", "bias current (geometry); also sets D_u and the impulse"),
+    "Amb.bias_current": ("A", "bias current (geometry); also sets D_u, the impulse and the "
+                               "identification excitations' amplitude"),
     "Amb.pole_angle_deg": ("°", "half the angle between the two poles of a pole pair "
                                "(8-pole heteropolar bearing: 22.5)"),
     "Amb.ki": ("N/A", "current gain Ki, a number or ``{ zeta, eta }``; wins over the "
@@ -121,6 +128,8 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Spring.kyx": ("N/m", "cross-coupled stiffness"),
     "Spring.cxx": ("N·s/m", "direct damping"),
     "Spring.cyy": ("N·s/m", "direct damping"),
+    "Spring.cxy": ("N·s/m", "cross-coupled damping (fixed: not a parameter to identify)"),
+    "Spring.cyx": ("N·s/m", "cross-coupled damping (fixed: not a parameter to identify)"),
     "Spring.axes_angle_deg": ("°", "the axes the coefficients are given in, rotated from "
                                    "x, y"),
     "Spring.name": ("", "names its parameters (``coupling.kxx``); unnamed: ``spring<i>``"),
@@ -182,8 +191,9 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "UnbalanceSpec.force_at": ("", "seal, disk, AMB or spring where the force acts and the "
                                    "compliance is taken"),
     "UnbalanceSpec.range_hz": ("Hz", "``[low, high]`` speeds of the unbalance response"),
-    "ImpulseSpec.amplitude_a": ("A", "current impulse amplitude (P5 §5.1)"),
-    "ImpulseSpec.duration_s": ("s", "current impulse duration"),
+    "ImpulseSpec.amplitude_a": ("A", "current impulse amplitude (P5 §5.1); also the "
+                                     "amplitude of every identification excitation"),
+    "ImpulseSpec.duration_s": ("s", "current impulse duration (judgement and identification)"),
     "UncertainSpec.parameter": ("", "an LFT parameter name: ``<seal>.k``, ``A.Ks_zeta``, "
                                     "``coupling.kxx``, …"),
     "UncertainSpec.relative": ("", "± this fraction of the nominal value (1.0: ± 100 %)"),
@@ -395,6 +405,9 @@ def _sections() -> list[Section]:
                 "with the geometry one axis may be left out."),
         Section("{ at_zero, per_bar }", r.Affine, "A coefficient affine in the pressure "
                 "drop p (bar): at_zero + per_bar · p."),
+        Section("{ outer_diameter, inner_diameter, material }", r.ShaftLayer, "A layer of "
+                "a ``[[shaft]]`` section (``layers = [{ ... }, ...]``): a tube of its own "
+                "material and shear parameter whose beam matrices add to the section's."),
         Section("{ frequency_hz, value }", r.FrequencyTable, "A seal coefficient tabulated "
                 "against excitation frequency, of equal lengths."),
         Section("[truth]", r.TruthSection, "The truth file of the virtual test facility "

@@ -18,7 +18,7 @@ Commands
 ``ambseal sweep RIG --pressure-bar a:b:n [--speed-hz a:b:n] [--controller ...]
 [--param NAME=a:b:n] [--scheduler ADDRESS | --workers N]``
     Stability and performance map; serial or on Dask.
-``ambseal import-ross FILE --out RIG``
+``ambseal import-ross FILE --out RIG [--speed-rpm N]``
     A ROSS rotor file as an ambseal rig file.
 ``ambseal acquire RIG --truth TRUTH --excitation prbs|sine|chirp|impulse --pressure-bar P --out FILE``
     A record from the virtual test facility (CSV + JSON sidecar, or .mat).
@@ -175,22 +175,32 @@ def _parser() -> argparse.ArgumentParser:
                         "the load-step CSV that identify --static-load reads")
     a.add_argument("--pressure-bar", type=_finite, required=True, help="seal pressure drop (bar)")
     a.add_argument("--out", required=True, help="record file: .csv (+ .csv.json) or .mat")
-    a.add_argument("--amplitude-a", type=_finite, default=0.05, help="excitation amplitude (A)")
-    a.add_argument("--duration-s", type=_finite, default=1.0, help="record length (s)")
+    # the excitation defaults follow from the rig (ambseal.identify.excitation)
+    a.add_argument("--amplitude-a", type=_finite, default=None,
+                   help="excitation amplitude (A; default [design.impulse] amplitude_a, else "
+                        "bias current / 120)")
+    a.add_argument("--duration-s", type=_finite, default=None,
+                   help="record length (s; default 1000 PRBS clock periods)")
     a.add_argument("--axes", default=None, help="excited axes, e.g. A_zeta,B_zeta (default all)")
-    a.add_argument("--clock-period-s", type=_finite, default=1e-3, help="PRBS clock period (s)")
+    a.add_argument("--clock-period-s", type=_finite, default=None,
+                   help="PRBS clock period (s; default 10 controller samples)")
     a.add_argument("--frequencies-hz", default="10,30,50,70,90,110,130,150,170,190",
                    help="stepped-sine frequencies (Hz), comma separated")
     a.add_argument("--cycles", type=_positive_int, default=10,
                    help="stepped sine: cycles per step")
     a.add_argument("--settling-cycles", type=_natural, default=5,
                    help="stepped sine: settling cycles")
-    a.add_argument("--f0-hz", type=_finite, default=1.0, help="chirp start frequency (Hz)")
-    a.add_argument("--f1-hz", type=_finite, default=150.0, help="chirp end frequency (Hz)")
+    a.add_argument("--f0-hz", type=_finite, default=None,
+                   help="chirp start frequency (Hz; default 1 / (1000 PRBS clock periods))")
+    a.add_argument("--f1-hz", type=_finite, default=None,
+                   help="chirp end frequency (Hz; default 0.75 × sample rate / 50)")
     a.add_argument("--chirp", choices=["linear", "logarithmic"], default="linear",
                    help="chirp frequency sweep")
-    a.add_argument("--width-s", type=_finite, default=0.01, help="impulse width (s)")
-    a.add_argument("--start-s", type=_finite, default=0.05, help="impulse start (s)")
+    a.add_argument("--width-s", type=_finite, default=None,
+                   help="impulse width (s; default [design.impulse] duration_s, else 100 "
+                        "controller samples)")
+    a.add_argument("--start-s", type=_finite, default=None,
+                   help="impulse start (s; default 5 impulse widths)")
     a.add_argument("--seed", type=_natural, default=0, help="seed of excitation and noise")
 
     d = sub.add_parser("design", help="design a controller (pid, hinf, mu, lpv) and export it")
@@ -314,6 +324,11 @@ def _rotordynamics_parsers(sub) -> None:
     r = sub.add_parser("import-ross", help="a ROSS rotor file (.toml/.json) as an ambseal rig")
     r.add_argument("file", help="ROSS rotor file saved by ross.Rotor.save")
     r.add_argument("--out", required=True, help="rig file to write (TOML)")
+    r.add_argument("--speed-rpm", type=float, default=None,
+                   help="take frequency-dependent bearing coefficients at this speed's "
+                        "synchronous frequency, as ROSS's run_modal(speed) does, and make it "
+                        "the rig's operating speed (default: the lowest frequency of ROSS's "
+                        "tables)")
 
 
 def _executor_args(p) -> None:
@@ -373,7 +388,8 @@ def _logging(args: argparse.Namespace) -> None:
 def _inputs(args: argparse.Namespace) -> tuple[list, str]:
     """The files a command reads and writes, and the one an unnamed error comes from."""
 
-    rig = getattr(args, "rig", None) or default_rig_path()
+    # a command's own input (a rig, or import-ross's ROSS file) is the source to name
+    rig = getattr(args, "rig", None) or getattr(args, "file", None) or default_rig_path()
     ctrl = getattr(args, "controller", None)  # a file, or a method's name (pid, hinf, ...)
     files = [rig, getattr(args, "truth", None), getattr(args, "out", None),
              *(getattr(args, "data", None) or []),

@@ -1,12 +1,17 @@
 """ROSS rotors in (io/ross.py), side by side with ROSS 2.3 (ross-rotordynamics, the ``ross``
-extra). ROSS's eigenvalues are those of ``Rotor._eigen(speed, sparse=False)``, the dense
-solve whose results ``run_modal`` reports (``run_modal`` itself adds a numba-compiled orbit
-post-processing that takes a minute to compile on first call)."""
+extra), on ROSS's own examples saved with ``Rotor.save``. ROSS's eigenvalues are those of
+``Rotor._eigen(speed, sparse=False)``, the dense solve whose |λ| ``run_modal(speed).wn``
+reports (``run_modal`` itself adds a numba-compiled orbit post-processing that takes a
+minute to compile on first call); like ``run_modal(speed)`` it takes frequency-dependent
+bearing coefficients at the frequency ``speed``."""
 
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import json
+import os
+import subprocess
 import sys
 import warnings
 
@@ -19,14 +24,46 @@ with contextlib.redirect_stdout(sys.stderr), warnings.catch_warnings():
                                             "installed")
 
 from ambseal.analysis.campbell import closed_loop_modes  # noqa: E402
-from ambseal.io.ross import from_ross  # noqa: E402
+from ambseal.config import parse_rig  # noqa: E402
+from ambseal.design.pid import pid_controller  # noqa: E402
+from ambseal.io.ross import _stdout_to_stderr, from_ross, load_ross  # noqa: E402
+from ambseal.model.amb import amb_factors, channel_names  # noqa: E402
+from ambseal.model.rig import build_system  # noqa: E402
+
+
+def _quiet(f, *args, **kw):
+    with contextlib.redirect_stdout(sys.stderr), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return f(*args, **kw)
 
 
 def _ross_eigenvalues(rotor, speed_rad_s: float) -> np.ndarray:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        lam, _ = rotor._eigen(speed_rad_s, sparse=False)
+    lam, _ = _quiet(rotor._eigen, speed_rad_s, sparse=False)
     return np.asarray(lam)
+
+
+def _assert_modes_equal_ross(rig, rotor, speed_rad_s: float, max_hz: float, n: int) -> None:
+    """Every lateral mode of ``rig`` up to ``max_hz`` equals one of ROSS's eigenvalues of
+    ``rotor`` at the same speed, and its |λ| (ROSS's ``wn``), to 1e-6 relative."""
+    ref = _ross_eigenvalues(rotor, speed_rad_s)
+    m = closed_loop_modes(rig, None, speed_hz=speed_rad_s / (2 * np.pi), max_hz=max_hz)
+    assert len(m.poles) == n
+    for lam in m.poles:
+        j = np.argmin(np.abs(ref - lam))
+        assert abs(ref[j] - lam) <= 1e-6 * abs(lam)
+        assert abs(lam) == pytest.approx(abs(ref[j]), rel=1e-6)
+
+
+@pytest.fixture(scope="module")
+def examples(tmp_path_factory):
+    """ROSS's three examples, in memory and saved by ``Rotor.save`` (as a user has them)."""
+    folder = tmp_path_factory.mktemp("ross")
+    out = {}
+    for name in ("rotor_example", "compressor_example", "rotor_amb_example"):
+        rotor = _quiet(getattr(rs, name))
+        _quiet(rotor.save, folder / f"{name}.toml")
+        out[name] = (rotor, folder / f"{name}.toml")
+    return out
 
 
 def _bearing_rotor():
@@ -56,26 +93,120 @@ def test_bearing_rotor_modes_equal_ross(speed_rpm):
         assert dec == pytest.approx(-2 * np.pi * ref[j].real / ref[j].imag, rel=1e-6)
 
 
-def test_amb_rotor_open_loop_unstable_poles_equal_ross():
-    """ROSS's AMB test rig (``rotor_amb_example``): the imported AMBs carry ROSS's Ki and
-    −Ks (ROSS's negative-stiffness sign), the controller and the shafts' Rayleigh damping are
-    reported as not imported, and the open-loop unstable poles (the AMBs' negative stiffness
-    alone) equal ROSS's frequency-domain AMB model with the controller term at zero — ROSS
-    bearings of stiffness ks — on the same rotor without Rayleigh damping, to 1e-6."""
-    from ambseal.model.amb import amb_factors
-    from ambseal.model.rig import build_system
+def test_rotor_example_file_modes_equal_ross(examples):
+    """ROSS's ``rotor_example`` as saved (bearings tagged "Bearing 0", "Bearing 1", with a
+    space): its 12 lateral modes up to 500 Hz at 0 and 3000 rpm equal ROSS's to 1e-6."""
+    rotor, path = examples["rotor_example"]
+    imp = from_ross(load_ross(path), where=str(path))
+    assert [s.name for s in imp.rig.spring] == ["Bearing_0", "Bearing_1"]
+    for w in (0.0, 100 * np.pi):
+        _assert_modes_equal_ross(imp.rig, rotor, w, 500.0, 12)
 
-    with contextlib.redirect_stdout(sys.stderr), warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        amb = rs.rotor_amb_example()
-    imp = from_ross(amb)
-    mbs = amb.bearing_elements
-    for a, mb in zip(imp.rig.amb, mbs):
+
+def test_compressor_example_layers_and_frequency_dependent_bearings(examples):
+    """ROSS's ``compressor_example``: 91 shaft elements on 55 node pairs (36 of them a
+    shaft and a sleeve of E = 1 psi in parallel) → 55 sections with 36 layers; its two
+    tilting-pad bearings and the anisotropic ``Seal 1`` (coefficients against frequency,
+    with cross-coupled damping) → springs at one frequency, the lowest their tables cover
+    (418.9 rad/s = 4000 rpm, ROSS's first table point), stated in the notes; the 11
+    isotropic skew seals → seal tables. At 4000 rpm, and at 4500 rpm between the tables'
+    points (springs then taken there), every lateral mode up to 2 kHz equals ROSS's to
+    1e-6."""
+    rotor, path = examples["compressor_example"]
+    loaded = load_ross(path)
+    imp = from_ross(loaded, where=str(path))
+    cfg = imp.rig
+    assert (len(cfg.shaft), sum(len(s.layers) for s in cfg.shaft)) == (55, 36)
+    assert (len(cfg.spring), len(cfg.seal), len(cfg.disk)) == (3, 11, 7)
+    table_start = max(min(b.frequency) for b in rotor.bearing_elements
+                      if b.tag in ("Bearing 0", "Bearing 13", "Seal 1"))
+    assert cfg.operating.speed_rpm == pytest.approx(table_start * 30 / np.pi, rel=1e-12)
+    assert cfg.operating.speed_rpm == pytest.approx(4000.0, rel=1e-9)
+    assert sum("taken at one frequency, 66.6667 Hz = 4000 rpm" in n for n in imp.notes) == 3
+    _assert_modes_equal_ross(cfg, rotor, cfg.speed, 2000.0, 12)
+    at = from_ross(loaded, where=str(path), speed_rpm=4500.0).rig
+    assert at.operating.speed_rpm == 4500.0
+    _assert_modes_equal_ross(at, rotor, at.speed, 2000.0, 12)
+
+
+def _amb_rotor(ki_pid: float):
+    """ROSS's ``rotor_amb_example`` with the integral gain ``ki_pid`` in both AMBs' PID
+    (ROSS's own has none)."""
+    ex = _quiet(rs.rotor_amb_example)
+    mbs = [_quiet(rs.MagneticBearingElement, n=b.n, g0=float(b.g0), i0=float(b.i0),
+                  ag=float(b.ag), nw=float(b.nw), alpha=float(b.alpha),
+                  kp_pid=float(b.kp_pid), kd_pid=float(b.kd_pid), ki_pid=ki_pid,
+                  n_f=float(b.n_f), k_amp=float(b.k_amp), k_sense=float(b.k_sense),
+                  sensors_axis_rotation=float(b.sensors_axis_rotation), tag=b.tag)
+           for b in ex.bearing_elements]
+    return _quiet(rs.Rotor, ex.shaft_elements, ex.disk_elements, mbs)
+
+
+@pytest.mark.parametrize("ki_pid", [0.0, 2.0e4])
+def test_amb_example_equivalent_bearings_equal_ross(examples, tmp_path, ki_pid):
+    """ROSS's ``rotor_amb_example`` (ki_pid = 0, as ROSS has it) and the same with integral
+    action, each saved and imported: the AMBs come back as [[amb]] with Ki = ROSS's ki and
+    Ks = −ROSS's ks. ROSS folds an AMB into bearing coefficients at one frequency ω,
+    k + jωc = ks + ki k_amp k_sense C(jω); comparable with ambseal is that equivalent
+    bearing: the imported rig with each AMB replaced by Ki·K(jω) − Ks — K being the
+    imported [controller.pid] when ROSS's PID has integral action (which must then equal
+    ROSS's own C(s)·k_amp·k_sense at every frequency, 1e-12), ROSS's C(s) otherwise — has
+    ROSS's modes with that AMB model at ω = 1000 rad/s to 1e-6 (without ROSS's Rayleigh
+    shaft damping, which is reported as left out)."""
+    if ki_pid:
+        rotor = _amb_rotor(ki_pid)
+        path = tmp_path / "amb.toml"
+        _quiet(rotor.save, path)
+    else:
+        rotor, path = examples["rotor_amb_example"]
+    imp = from_ross(load_ross(path), where=str(path))
+    cfg, mbs = imp.rig, rotor.bearing_elements
+    for a, mb in zip(cfg.amb, mbs):
         ki, ks = amb_factors(a)
         assert ki == pytest.approx((mb.ki, mb.ki), rel=1e-12)
         assert ks == pytest.approx((-mb.ks, -mb.ks), rel=1e-12) and ks[0] > 0
-    assert any("Rayleigh" in n for n in imp.unmapped)
-    assert sum("controller" in n for n in imp.unmapped) == 2
+    assert any("Rayleigh damping alpha=2.5" in n for n in imp.unmapped)
+    ross_c = mbs[0].get_analog_controller() * float(mbs[0].k_amp * mbs[0].k_sense)
+    if ki_pid:
+        p = cfg.controller.pid
+        K = pid_controller(p.kp, p.ti, p.td, p.eps, ["a"])
+        w = np.logspace(0, 4, 9)
+        assert (np.squeeze(K(1j * w)) == pytest.approx(np.squeeze(ross_c(1j * w)), rel=1e-12))
+    else:
+        assert cfg.controller.pid is None
+        assert any("integral action" in n and "kp=1000 A/m" in n for n in imp.unmapped)
+        K = ross_c
+    w0 = 1000.0
+    kc = [complex(np.squeeze(K(1j * w0))) * amb_factors(a)[0][0] - amb_factors(a)[1][0]
+          for a in cfg.amb]
+    data = cfg.model_dump(exclude_none=True)
+    data["amb"], data["actuator"] = [], {"model": "none"}
+    data["spring"] = [{"position": a.position, "kxx": k.real, "kyy": k.real,
+                       "cxx": k.imag / w0, "cyy": k.imag / w0} for a, k in zip(cfg.amb, kc)]
+    data.get("controller", {}).pop("pid", None)
+    shafts = [rs.ShaftElement(L=e.L, idl=e.idl, odl=e.odl, material=e.material, alpha=0.0)
+              for e in rotor.shaft_elements]
+    ross_eq = [_quiet(rs.MagneticBearingElement, n=b.n, g0=float(b.g0), i0=float(b.i0),
+                      ag=float(b.ag), nw=float(b.nw), alpha=float(b.alpha),
+                      kp_pid=float(b.kp_pid), kd_pid=float(b.kd_pid),
+                      ki_pid=float(b.ki_pid), n_f=float(b.n_f), k_amp=float(b.k_amp),
+                      k_sense=float(b.k_sense),
+                      sensors_axis_rotation=float(b.sensors_axis_rotation),
+                      frequency=np.array([w0, 2 * w0]))  # ROSS's formula at w0 exactly
+               for b in mbs]
+    reference = _quiet(rs.Rotor, shafts, rotor.disk_elements, ross_eq)
+    _assert_modes_equal_ross(parse_rig(data), reference, w0, 1500.0, 12)
+
+
+def test_amb_rotor_open_loop_unstable_poles_equal_ross():
+    """ROSS's AMB test rig (``rotor_amb_example``, in memory): the open-loop unstable poles
+    (the AMBs' negative stiffness alone) equal ROSS's frequency-domain AMB model with the
+    controller term at zero — ROSS bearings of stiffness ks — on the same rotor without
+    Rayleigh damping, to 1e-6."""
+    amb = _quiet(rs.rotor_amb_example)
+    imp = from_ross(amb)
+    mbs = amb.bearing_elements
+    assert sum("controller" in n for n in imp.unmapped) == 2  # the k(ω) model, the PID
     shafts = [rs.ShaftElement(L=e.L, idl=e.idl, odl=e.odl, material=e.material, alpha=0.0,
                               shear_effects=True, rotary_inertia=True, gyroscopic=True)
               for e in amb.shaft_elements]
@@ -86,13 +217,15 @@ def test_amb_rotor_open_loop_unstable_poles_equal_ross():
     got = np.sort(lam[lam.real > 1e-6].real)
     assert len(got) == 4 and np.all(np.abs(lam[lam.real > 1e-6].imag) < 1e-6 * got.max())
     assert got == pytest.approx(ref, rel=1e-6)
+    assert channel_names(imp.rig) == ("Magnetic_Bearing_0_zeta", "Magnetic_Bearing_0_eta",
+                                      "Magnetic_Bearing_1_zeta", "Magnetic_Bearing_1_eta")
 
 
 def test_import_ross_cli_round_trip_and_bad_files(tmp_path, capsys):
     """``ambseal import-ross`` on ROSS's own saved file writes a rig that loads back to the
     same modes as :func:`from_ross`; a tapered shaft element (unsupported), a shaft element
-    without its material and a file that is no ROSS rotor each give one line on stderr and
-    exit status 2."""
+    without its material and a file that is no ROSS rotor each give one line on stderr,
+    naming the user's file first (not the embedded rig's), and exit status 2."""
     from ambseal.cli import main
     from ambseal.config import load_rig
 
@@ -122,3 +255,52 @@ def test_import_ross_cli_round_trip_and_bad_files(tmp_path, capsys):
         assert main(["import-ross", str(tmp_path / name), "--out", str(out)]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and key in err and "Traceback" not in err
+        assert err.startswith(f"ambseal: error: {tmp_path / name}: ")
+        assert "testrig" not in err
+    # an error that names no file (a bad option) is put on the user's file, too
+    assert main(["import-ross", str(src), "--out", str(out), "--speed-rpm", "1e9"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"ambseal: error: {src}: --speed-rpm") and "testrig" not in err
+
+
+def test_import_chatter_goes_to_stderr(capfd):
+    """What a library writes to stdout while ROSS is imported — from Python, at the file
+    descriptor, or through C's buffered stdio as CoolProp's REFPROP banner does — ends up
+    on stderr; stdout works as before afterwards."""
+    libc = ctypes.CDLL(None)
+    c_stdout = ctypes.c_void_p.in_dll(libc, "stdout")  # glibc's, as on the CI machines
+    unbuffered = bool(os.environ.get("PYTHONUNBUFFERED")) or "-u" in sys.orig_argv
+    buf = ctypes.create_string_buffer(4096)
+    if unbuffered:  # python -u leaves C's stdio unbuffered; a user's python does not
+        libc.setvbuf(c_stdout, buf, 0, len(buf))  # _IOFBF
+    try:
+        with _stdout_to_stderr():
+            print("python chatter")
+            os.write(1, b"fd chatter\n")
+            libc.printf(b"C chatter\n")  # left in C's buffer: flushed by the guard
+        print("result")
+    finally:
+        if unbuffered:
+            libc.fflush(c_stdout)
+            libc.setvbuf(c_stdout, None, 2, 0)  # _IONBF, as it was
+    out, err = capfd.readouterr()
+    assert out == "result\n"
+    assert all(s in err for s in ("python chatter", "fd chatter", "C chatter"))
+
+
+@pytest.mark.slow  # a fresh interpreter importing ROSS: 10-20 s on 2 cores
+def test_import_ross_stdout_is_the_json_only(examples, tmp_path):
+    """In a fresh interpreter (where importing ROSS imports ccp, whose CoolProp prints a
+    REFPROP banner from C on stdout), ``ambseal import-ross`` of the AMB example writes
+    nothing but its JSON summary to stdout; the notes (what was left out, what was taken)
+    go to stderr and into the rig file's header."""
+    _, path = examples["rotor_amb_example"]
+    out = tmp_path / "rig.toml"
+    proc = subprocess.run([sys.executable, "-m", "ambseal.cli", "import-ross", str(path),
+                           "--out", str(out)], capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    summary = json.loads(proc.stdout)  # the whole of stdout is one JSON document
+    assert summary["ambs"] == 2 and summary["controller_pid"] is False
+    assert "ambseal: not imported: ROSS's AMB controllers" in proc.stderr
+    assert "# not imported: ROSS's AMB controllers" in out.read_text()

@@ -1,6 +1,7 @@
 """FE rotor against closed forms."""
 
 import numpy as np
+import pytest
 import scipy.linalg as sla
 
 from ambseal.config import parse_rig
@@ -177,3 +178,21 @@ def test_seal_cross_coupling_destabilises_forward_whirl():
     assert set(base) == set(pushed) == {"forward", "backward"}
     assert pushed["forward"].real > base["forward"].real + 5.0
     assert pushed["backward"].real < base["backward"].real - 5.0
+
+
+def test_layers_add_like_one_tube_for_euler_bernoulli():
+    """Reference: for Euler–Bernoulli beams (Φ = 0) the element matrices are linear in EI,
+    ρA and ρI, so a core and a sleeve of one material touching at d = 60 mm are the single
+    tube 0–80 mm: the same modes to 1e-9, round-off (a layer's matrices add to its
+    section's)."""
+    base = {"rotor": {"beam": "euler-bernoulli"},
+            "materials": {"s": {"E": E, "rho": RHO, "nu": NU}},
+            "spring": [{"position": 0.0, "kxx": 1e7, "kyy": 2e7},
+                       {"position": 0.6, "kxx": 1e7, "kyy": 2e7}]}
+    layered = parse_rig(base | {"shaft": [{
+        "length": 0.6, "outer_diameter": 0.06, "material": "s", "elements": 6,
+        "layers": [{"outer_diameter": 0.08, "inner_diameter": 0.06, "material": "s"}]}]})
+    solid = parse_rig(base | {"shaft": [{"length": 0.6, "outer_diameter": 0.08,
+                                          "material": "s", "elements": 6}]})
+    a, b = (np.sort(build_system(c).poles().imag) for c in (layered, solid))
+    assert len(a) == 56 and a == pytest.approx(b, rel=1e-9)

@@ -34,6 +34,7 @@ from ambseal.export.controller_files import load_controller
 from ambseal.files import OwnedFolder, writable_folder
 from ambseal.identify import signals
 from ambseal.identify.data import save_measurement
+from ambseal.identify.excitation import IMPULSE_LEAD, excitation_plan
 from ambseal.identify.stages import acquire
 from ambseal.identify.static_load import save_static_record, virtual_static_load
 from ambseal.model.amb import channel_names
@@ -63,21 +64,30 @@ def _acquire_cmd(args: argparse.Namespace) -> int:
         print(json.dumps({"out": str(path), "load_steps": int(z.size)}))
         return 0
     common = dict(sample_rate_hz=fs, axes=axes, excited=excited)
+    # defaults from the rig (ambseal.identify.excitation); an option given replaces one
+    plan = excitation_plan(cfg, amplitude_a=args.amplitude_a)
+    given = (lambda value, default: default if value is None else value)  # noqa: E731
+    amplitude, duration = plan.amplitude_a, given(args.duration_s, plan.prbs_duration_s)
     try:
         if args.excitation == "prbs":
-            ex = signals.prbs(amplitude_a=args.amplitude_a, clock_period_s=args.clock_period_s,
-                              duration_s=args.duration_s, seed=args.seed, **common)
+            ex = signals.prbs(amplitude_a=amplitude,
+                              clock_period_s=given(args.clock_period_s, plan.prbs_clock_s),
+                              duration_s=duration, seed=args.seed, **common)
         elif args.excitation == "sine":
             freqs = [float(f) for f in args.frequencies_hz.split(",")]
-            ex = signals.stepped_sine(frequencies_hz=freqs, amplitude_a=args.amplitude_a,
+            ex = signals.stepped_sine(frequencies_hz=freqs, amplitude_a=amplitude,
                                       cycles=args.cycles, settling_cycles=args.settling_cycles,
                                       **common)
         elif args.excitation == "chirp":
-            ex = signals.chirp(f0_hz=args.f0_hz, f1_hz=args.f1_hz, duration_s=args.duration_s,
-                               amplitude_a=args.amplitude_a, method=args.chirp, **common)
+            f0, f1 = plan.chirp_hz
+            ex = signals.chirp(f0_hz=given(args.f0_hz, f0), f1_hz=given(args.f1_hz, f1),
+                               duration_s=duration, amplitude_a=amplitude, method=args.chirp,
+                               **common)
         else:
-            ex = signals.impulse(amplitude_a=args.amplitude_a, width_s=args.width_s,
-                                 start_s=args.start_s, duration_s=args.duration_s, **common)
+            width = given(args.width_s, plan.impulse_s)
+            ex = signals.impulse(amplitude_a=amplitude, width_s=width,
+                                 start_s=given(args.start_s, IMPULSE_LEAD * width),
+                                 duration_s=duration, **common)
     except ValueError as exc:
         raise ConfigError(f"acquire: {exc}") from None
     try:

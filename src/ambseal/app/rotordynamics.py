@@ -235,7 +235,10 @@ def _sweep(args: argparse.Namespace) -> int:
 
 
 def _import_ross(args: argparse.Namespace) -> int:
-    res = import_ross_file(args.file, args.out)
+    res = import_ross_file(args.file, args.out, speed_rpm=args.speed_rpm)
+    for line in [f"not imported: {n}" for n in res["unmapped"]] + [
+            f"taken: {n}" for n in res["notes"]]:
+        print(f"ambseal: {line}", file=sys.stderr)
     print(json.dumps(res))
     return 0
 

@@ -11,8 +11,8 @@ from pydantic import Field
 
 from ambseal.errors import LABEL_PATTERN, NAME_PATTERN, ConfigError
 
-__all__ = ["MAX_ELEMENTS", "MAX_REDUCED_STATES", "MAX_COEFFICIENT", "MAX_FREQUENCY_HZ",
-           "MAX_SPEED_HZ", "MAX_PRESSURE_BAR", "MAX_CURRENT_A", "MAX_GAP_M",
+__all__ = ["MAX_ELEMENTS", "MAX_LAYERS", "MAX_REDUCED_STATES", "MAX_COEFFICIENT",
+           "MAX_FREQUENCY_HZ", "MAX_SPEED_HZ", "MAX_PRESSURE_BAR", "MAX_CURRENT_A", "MAX_GAP_M",
            "MAX_DELAY_SAMPLES", "MAX_RELATIVE", "BoundedCoefficient",
            "BoundedFrequency", "check_amb", "check_actuator", "cross_check", "Name", "Label"]
 
@@ -27,6 +27,9 @@ Label = Annotated[str, Field(min_length=1, max_length=200, pattern=LABEL_PATTERN
 #: dozens of them; a 200-element shaft ran 982 s. 150 elements (1 208 states, ~2 s per
 #: eigen-decomposition) resolve any rotor's modes of interest.
 MAX_ELEMENTS = 150
+#: Concentric layers on one shaft section, at most (a shaft, a sleeve and a hub is three;
+#: more only splits one tube into rings).
+MAX_LAYERS = 8
 #: States of a reduced model for control design, at most (H∞/μ synthesis grows with n³ and
 #: beyond ~100 states is numerically fragile).
 MAX_REDUCED_STATES = 200
@@ -124,12 +127,14 @@ def cross_check(cfg, where: str) -> None:
     """Checks that need the whole rig: materials exist, components lie on the shaft, the
     mesh stays within ``MAX_ELEMENTS``, names are unique (ConfigError naming the key)."""
     for i, s in enumerate(cfg.shaft):
-        if s.material not in cfg.materials:
-            known = ", ".join(sorted(cfg.materials)) or "none"
-            raise ConfigError(
-                f"{where}: shaft[{i}].material: unknown material {s.material!r} "
-                f"(expected one of: {known})"
-            )
+        for key, tube in [("material", s)] + [(f"layers[{j}].material", t)
+                                               for j, t in enumerate(s.layers)]:
+            if tube.material not in cfg.materials:
+                known = ", ".join(sorted(cfg.materials)) or "none"
+                raise ConfigError(
+                    f"{where}: shaft[{i}].{key}: unknown material {tube.material!r} "
+                    f"(expected one of: {known})"
+                )
     length = cfg.length
     tol = 1e-9 * max(length, 1.0)
 

@@ -16,7 +16,9 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     ``E`` (Pa), ``rho`` (kg/m³) and either ``G`` (Pa) or ``nu`` (-).
 ``[[shaft]]`` (left to right)
     ``length``, ``outer_diameter``, ``inner_diameter`` (default 0) in m, ``material`` (a
-    NAME of ``[materials]``), ``elements`` (beam elements in the section, default 1).
+    NAME of ``[materials]``), ``elements`` (beam elements in the section, default 1),
+    ``layers`` (optional concentric tubes ``{ outer_diameter, inner_diameter, material }``
+    on the same nodes, each a beam of its own whose matrices add to the section's).
 ``[[disk]]``
     ``position`` (m), ``mass`` (kg), ``Ip``, ``Id`` (kg·m²), ``name`` (optional).
 ``[[amb]]``
@@ -41,9 +43,9 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     :func:`ambseal.model.seal.coefficient_value`); Childs' convention
     −f = [K k; −k K] q + [C c; −c C] q̇ + M q̈.
 ``[[spring]]``
-    ``position``, ``kxx``, ``kyy`` and optional ``kxy``, ``kyx`` (N/m), ``cxx``, ``cyy``
-    (N·s/m), ``axes_angle_deg`` (the axes the coefficients are given in, default 0),
-    ``name`` (optional).
+    ``position``, ``kxx``, ``kyy`` and optional ``kxy``, ``kyx`` (N/m), ``cxx``, ``cyy``,
+    ``cxy``, ``cyx`` (N·s/m), ``axes_angle_deg`` (the axes the coefficients are given in,
+    default 0), ``name`` (optional).
 ``[controller.pid]``
     ``kp`` (A/m), ``ti`` (s), ``td`` (s), ``eps`` (-): thesis P5 Eq. 6, per actuator axis.
 ``[controller]``
@@ -74,6 +76,7 @@ from ambseal.config._checks import (
     MAX_ELEMENTS,
     MAX_FREQUENCY_HZ,
     MAX_GAP_M,
+    MAX_LAYERS,
     MAX_REDUCED_STATES,
     MAX_RELATIVE,
     BoundedCoefficient,
@@ -122,9 +125,11 @@ Uncertainty = dict[str, Annotated[float, Field(ge=0, le=MAX_RELATIVE)]] | None
 class Material(_Strict):
     """Linear elastic isotropic material: ``E`` (Pa), ``rho`` (kg/m³), ``G`` (Pa) or ``nu``."""
 
-    E: float = Field(ge=1e5, le=1e18)  # plausible: foams to a rigid-shaft idealisation
+    # plausible: a mass-only layer to a rigid-shaft idealisation (ROSS models a sleeve or
+    # hub that adds mass but no stiffness with E = G = 1 psi = 6.9 kPa)
+    E: float = Field(ge=1e3, le=1e18)
     rho: float = Field(ge=1.0, le=1e5)
-    G: float | None = Field(default=None, ge=1e4, le=1e18)
+    G: float | None = Field(default=None, ge=1e3, le=1e18)
     nu: float | None = Field(default=None, gt=-1, lt=0.5)
 
     @model_validator(mode="after")
@@ -154,17 +159,42 @@ class Rotor(_Strict):
     modal_damping: float = Field(default=0.0, ge=0, lt=1)
 
 
+class ShaftLayer(_Strict):
+    """A concentric tube on its section's nodes, in parallel with the section's own tube (a
+    sleeve, a shrink-fitted hub; ROSS's layered shaft elements): its own material and shear
+    parameter, its element matrices added to the section's."""
+
+    outer_diameter: float = Field(ge=1e-4, le=10.0)
+    inner_diameter: float = Field(default=0.0, ge=0)
+    material: str
+
+    @model_validator(mode="after")
+    def _bore(self) -> "ShaftLayer":
+        if self.inner_diameter >= self.outer_diameter:
+            raise ValueError("expected inner_diameter < outer_diameter")
+        return self
+
+
 class ShaftSection(_Strict):
     length: float = Field(ge=1e-4, le=100.0)
     outer_diameter: float = Field(ge=1e-4, le=10.0)
     inner_diameter: float = Field(default=0.0, ge=0)
     material: str
     elements: int = Field(default=1, ge=1, le=MAX_ELEMENTS)
+    layers: list[ShaftLayer] = Field(default=[], max_length=MAX_LAYERS)
 
     @model_validator(mode="after")
     def _bore(self) -> "ShaftSection":
         if self.inner_diameter >= self.outer_diameter:
             raise ValueError("expected inner_diameter < outer_diameter")
+        tubes = sorted([self, *self.layers], key=lambda t: t.inner_diameter)
+        for a, b in zip(tubes, tubes[1:]):
+            if b.inner_diameter < a.outer_diameter * (1 - 1e-12):
+                raise ValueError(
+                    f"layers: the tubes {a.inner_diameter:g}–{a.outer_diameter:g} m and "
+                    f"{b.inner_diameter:g}–{b.outer_diameter:g} m overlap (expected "
+                    "concentric tubes, each layer's inner_diameter >= the outer_diameter "
+                    "of the tube inside it)")
         return self
 
 
@@ -283,6 +313,8 @@ class Spring(_Strict):
     kyx: float = Field(default=0.0, ge=-1e17, le=1e17)
     cxx: float = Field(default=0.0, ge=-1e12, le=1e12)
     cyy: float = Field(default=0.0, ge=-1e12, le=1e12)
+    cxy: float = Field(default=0.0, ge=-1e12, le=1e12)
+    cyx: float = Field(default=0.0, ge=-1e12, le=1e12)
     axes_angle_deg: float = Field(default=0.0, ge=-360, le=360)
     name: Name | None = None
     uncertainty: Uncertainty = None
@@ -654,7 +686,8 @@ def dump_rig(cfg: RigConfig, header: str = "") -> str:
         if isinstance(val, list):
             for item in val:
                 lines += ["", f"[[{key}]]"]
-                lines += [f"{k} = {_toml_value(x)}" for k, x in item.items()]
+                # an empty list is its key's default (a section's layers)
+                lines += [f"{k} = {_toml_value(x)}" for k, x in item.items() if x != []]
         else:
             _toml_table(key, val, lines)
     return "\n".join(lines).lstrip("\n") + "\n"

@@ -71,7 +71,9 @@ the value the thesis used on its test facility, P5, where it names one):
   none (a note says so, and μ then designs for robust performance on the nominal plant).
 * **Controller order**: the design model's states plus those of W_p and W_u (the order of
   an H∞ controller on the design model; the D-scales and W_f are truncated).
-* **Impulse**: i0/120 for 100 controller samples (test rig: 0.05 A for 10 ms, P5 §5.1).
+* **Impulse**: i0/120 for 100 controller samples (test rig: 0.05 A for 10 ms, P5 §5.1);
+  the rule is the identification excitation's (:mod:`ambseal.identify.excitation`), written
+  there once.
 * **Judged conditions**: pressure drops 0, nominal and 2× nominal (P5 §4); the operating
   speed, or, for a rig whose seals change with speed over a range, its ends and middle.
 """
@@ -90,8 +92,14 @@ from ambseal.design.conditions import judged_conditions
 from ambseal.design.pid import pid_from_rig
 from ambseal.design.weights import default_weights
 from ambseal.errors import ConfigError, DataError
+from ambseal.identify.excitation import (
+    BIAS_PER_AMPLITUDE,
+    SAMPLES_PER_IMPULSE,
+    impulse_amplitude,
+    impulse_length,
+)
 from ambseal.identify.intervals import uncertainty_from_fit
-from ambseal.model.amb import amb_factors
+from ambseal.model.amb import amb_factors, bias_current, bias_currents
 from ambseal.model.modes import modes
 from ambseal.model.rig import build_system
 from ambseal.model.rotor import assemble_rotor
@@ -100,7 +108,6 @@ from ambseal.model.seal import coefficient_value
 __all__ = ["Machine", "DesignSpec", "machine", "design_spec", "round_125", "judged_conditions"]
 
 RIGID_STATES = 8  # 2 translations and 2 tilts of a rigid rotor, 2 states each
-SAMPLES_PER_IMPULSE = 100
 #: ω_B·T_i of the H∞ and μ performance weights (module docstring, "H∞ and μ weights")
 OMEGA_B_TIMES_TI = 1.0
 #: 1/W_u in multiples of the reference PID's peak gain, LPV and μ (module docstring)
@@ -159,9 +166,8 @@ def machine(cfg) -> Machine:
           "second_order": (act.natural_frequency or 0) / (2 * math.pi)}.get(act.model, fs / 10)
     if act.eddy_time_constant > 0:
         fa = min(fa, 1 / (2 * math.pi * act.eddy_time_constant))
-    biases = [a.bias_current or (a.current_limit / 2 if a.current_limit else None)
-              for a in cfg.amb]
-    i0 = min(biases) if biases and None not in biases else None
+    biases = bias_currents(cfg)
+    i0 = bias_current(cfg)
     gaps = []
     for a, b in zip(cfg.amb, biases):
         if a.air_gap is not None:
@@ -558,10 +564,9 @@ def design_spec(cfg, pressure_bar: float | None = None) -> DesignSpec:
                    if m != "lpv" else w) for m, w in weights.items()}
     if mach.bias_current_a is None and d.impulse.amplitude_a is None:
         notes.append("no bias current: the impulse amplitude needs design.impulse.amplitude_a")
-    imp_a = d.impulse.amplitude_a or (mach.bias_current_a / 120 if mach.bias_current_a
-                                      else None)
-    imp_s = d.impulse.duration_s or SAMPLES_PER_IMPULSE / mach.sample_rate_hz
-    rules["impulse"] = "bias current / 120 for 100 controller samples"
+    imp_a, imp_s = impulse_amplitude(cfg), impulse_length(cfg)  # the identification's too
+    rules["impulse"] = (f"bias current / {BIAS_PER_AMPLITUDE} for {SAMPLES_PER_IMPULSE} "
+                        "controller samples")
     pressures, speeds = judged_conditions(cfg, p)
     mu = d.mu
     return DesignSpec(

@@ -14,6 +14,7 @@ import math
 from dataclasses import dataclass
 
 from ambseal.config import Affine
+from ambseal.identify.excitation import ExcitationPlan, excitation_plan, welch_segment
 from ambseal.identify.frf import FRF, closed_loop_frf, model_frf, plant_frf
 from ambseal.identify.procedure import ProcedureResult
 from ambseal.identify.signals import chirp
@@ -31,10 +32,10 @@ class FrfChecks:
     ----------
     closed_loop, closed_loop_model : FRF
         Chirp excitation on the ζ axes of the first and last bearing → displacements
-        (m/A), 2–140 Hz.
+        (m/A), over the plan's ``closed_loop_band_hz`` (test rig 2–140 Hz).
     plant, plant_model : FRF
-        The plant from coil current to displacement (m/A), 2–200 Hz, and the output/input
-        pairs worth plotting.
+        The plant from coil current to displacement (m/A), over the plan's
+        ``plant_band_hz`` (test rig 2–200 Hz), and the output/input pairs worth plotting.
     plant_pairs : tuple of (str, str)
     """
 
@@ -45,7 +46,8 @@ class FrfChecks:
     plant_pairs: tuple
 
 
-def frf_checks(cfg, truth, res: ProcedureResult, controller, *, seed: int = 99) -> FrfChecks:
+def frf_checks(cfg, truth, res: ProcedureResult, controller, *, seed: int = 99,
+               excitation: ExcitationPlan | None = None) -> FrfChecks:
     """Frequency-domain checks of the identified rig (P4 Figs. 9–10).
 
     Parameters
@@ -53,33 +55,48 @@ def frf_checks(cfg, truth, res: ProcedureResult, controller, *, seed: int = 99) 
     cfg : RigConfig
         The rig as identified against (its controller ran on the facility).
     truth : TruthSection
-        The virtual facility's truth (a chirp record 1–150 Hz, 4 s, 0.05 A at 0 bar).
+        The virtual facility's truth (a linear chirp record at 0 bar: test rig 1–150 Hz,
+        4 s, 0.05 A).
     res : ProcedureResult
         The procedure's result (its identified rig and its stage (a) PRBS record).
     controller : DiscreteController
         The controller that levitates the rotor for the chirp record.
     seed : int
         Noise seed of the chirp record.
+    excitation : ExcitationPlan, optional
+        The chirp, the bands and the amplitude; default
+        :func:`~ambseal.identify.excitation.excitation_plan` of ``cfg`` (its rules: the
+        chirp to 0.75·f_s/50, the checks to 0.7·f_s/50 and f_s/50, Welch segments a
+        quarter of the record).
 
     Returns
     -------
     FrfChecks
+
+    Raises
+    ------
+    ConfigError
+        No excitation amplitude can be derived (:func:`excitation_plan`).
     """
 
     axes = res.amb.axes
     fs = cfg.controller.sample_rate_hz
-    ex = chirp(f0_hz=1.0, f1_hz=150.0, duration_s=4.0, amplitude_a=0.05, sample_rate_hz=fs,
-               axes=axes, excited={axes[0]: 1.0, axes[-2]: 1.0})
+    plan = excitation if excitation is not None else excitation_plan(cfg)
+    ex = chirp(f0_hz=plan.chirp_hz[0], f1_hz=plan.chirp_hz[1], duration_s=plan.chirp_s,
+               amplitude_a=plan.amplitude_a, sample_rate_hz=fs, axes=axes,
+               excited={axes[0]: 1.0, axes[-2]: 1.0})
     rec = acquire(cfg, truth, ex, controller=controller, pressure_bar=0.0, seed=seed)
-    measured = closed_loop_frf(rec, nperseg=8192, inputs=[axes[0]]).band(2.0, 140.0)
+    measured = closed_loop_frf(rec, nperseg=welch_segment(ex.n_samples),
+                               inputs=[axes[0]]).band(*plan.closed_loop_band_hz)
     model = build_models(res.identified, [rec], controllers=[controller])[0].statespace({}, axes)
     mf = model_frf(model[:, [0]] + model[:, [len(axes) - 2]], measured.frequency_hz,
                    input_names=measured.input_names, output_names=measured.output_names)
 
     rec_a = res.records["a"]  # four axes with independent sequences: MIMO H1
-    T_ye = closed_loop_frf(rec_a, nperseg=2048, method="mimo")
-    T_ie = closed_loop_frf(rec_a, nperseg=2048, method="mimo", response="current")
-    G = plant_frf(T_ye, T_ie).band(2.0, 200.0)
+    seg = welch_segment(len(rec_a.time_s))
+    T_ye = closed_loop_frf(rec_a, nperseg=seg, method="mimo")
+    T_ie = closed_loop_frf(rec_a, nperseg=seg, method="mimo", response="current")
+    G = plant_frf(T_ye, T_ie).band(*plan.plant_band_hz)
     bare = res.identified.model_copy(
         update={"actuator": res.identified.actuator.model_copy(update={"model": "none"})})
     Gm = model_frf(build_plant(bare, reduced=True, pressure_bar=0.0).to_statespace(),

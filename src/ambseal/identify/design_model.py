@@ -21,6 +21,7 @@ import numpy as np
 
 from ambseal.config import Affine, RigConfig, TruthSection, rig_with_values
 from ambseal.errors import ModelError
+from ambseal.identify.excitation import ExcitationPlan, excitation_plan
 from ambseal.identify.fit import TAU_E, nrmse_fit
 from ambseal.identify.procedure import ProcedureResult
 from ambseal.identify.rig_sim import true_rig
@@ -119,8 +120,11 @@ class ImpulseCheck:
 
 def impulse_checks(cfg: RigConfig, identified: RigConfig, truth: TruthSection,
                    controllers: dict[str, DiscreteController], pressures_bar, *,
-                   seed: int = 77) -> list[ImpulseCheck]:
-    """P5 Fig. 15 on the virtual facility: 0.05 A for 10 ms at 0.05 s on the first bearing's
+                   seed: int = 77, excitation: ExcitationPlan | None = None,
+                   ) -> list[ImpulseCheck]:
+    """P5 Fig. 15 on the virtual facility: the rig's impulse (``excitation``, default
+    :func:`~ambseal.identify.excitation.excitation_plan` of ``cfg``; test rig 0.05 A for
+    10 ms at 0.05 s in a 0.25 s record) on the first bearing's
     ζ and the last bearing's η at once (orthogonal directions at both ends), each controller
     running on the facility (``cfg`` with ``truth``) and on the identified model, at each
     pressure drop.
@@ -132,7 +136,9 @@ def impulse_checks(cfg: RigConfig, identified: RigConfig, truth: TruthSection,
     axes = channel_names(cfg)
     fs = cfg.controller.sample_rate_hz
     ambs = [a.name for a in cfg.amb]
-    ex = impulse(amplitude_a=0.05, width_s=0.01, start_s=0.05, duration_s=0.25,
+    plan = excitation if excitation is not None else excitation_plan(cfg)
+    ex = impulse(amplitude_a=plan.amplitude_a, width_s=plan.impulse_s,
+                 start_s=plan.impulse_start_s, duration_s=plan.check_record_s,
                  sample_rate_hz=fs, axes=axes,
                  excited={f"{ambs[0]}_zeta": 1.0, f"{ambs[-1]}_eta": 1.0})
     out = []

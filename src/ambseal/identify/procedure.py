@@ -10,6 +10,10 @@ sine of balanced forward and backward whirl (:mod:`.seal_test`, balanced on the 
 the regression's seal) at the nominal pressure, with a zero-pressure run as the bias
 reference (P4 Fig. 12); (d) the identified rig.
 
+Every excitation's amplitude, clock and length follow from the rig (its bias current and
+sample rate, :mod:`ambseal.identify.excitation`): the thesis's 0.05 A, 1 ms PRBS clock and
+10 ms impulse on its test rig.
+
 Every fit adds the error budget of the values it holds (:mod:`ambseal.identify.budget`):
 an earlier stage's estimates with that stage's standard errors and correlations, anything
 else (the seal in stages (a)–(b)) with its stated or default uncertainty; its model check
@@ -28,6 +32,7 @@ import numpy as np
 
 from ambseal.config import Affine, RigConfig, TruthSection, rig_with_values
 from ambseal.errors import IdentificationError, ModelError
+from ambseal.identify.excitation import ExcitationPlan, excitation_plan
 from ambseal.identify.fit import TAU_E, FitResult
 from ambseal.identify.seal_test import fit_reliability, seal_frequency_test
 from ambseal.identify.signals import impulse, prbs
@@ -131,6 +136,7 @@ def thesis_procedure(
     sine_frequencies_hz: tuple[float, ...] = (10, 20, 40, 60, 80, 100, 120, 140, 160, 180,
                                               200),
     impulse_pressures_bar: tuple[float, ...] = (0.5, 1.0, 1.5, 2.0, 2.5),
+    excitation: ExcitationPlan | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> ProcedureResult:
     """Run stages (a)–(d) on the virtual facility of ``cfg`` with ``truth``.
@@ -151,6 +157,9 @@ def thesis_procedure(
     impulse_pressures_bar : tuple of float
         Pressure drops (bar) of the impulse runs of stage (c) (P5 §3.3); the facility must
         hold the rotor at three of them at least.
+    excitation : ExcitationPlan, optional
+        Amplitudes, clock and lengths of the excitations; default
+        :func:`~ambseal.identify.excitation.excitation_plan` of ``cfg``.
     progress : callable, optional
         Called with a short description before each stage.
 
@@ -165,6 +174,8 @@ def thesis_procedure(
     IdentificationError
         Fewer than three impulse pressures at which the controller holds the rotor, or a
         fit that cannot start.
+    ConfigError
+        No excitation amplitude can be derived (:func:`excitation_plan`).
     """
     say = progress or (lambda _msg: None)
     fs = cfg.controller.sample_rate_hz
@@ -173,10 +184,11 @@ def thesis_procedure(
     seal = cfg.seal[0].name if cfg.seal else None
     spring = (cfg.spring[0].name or "spring0") if cfg.spring else None
     p_nom = cfg.operating.pressure_bar
+    plan = excitation if excitation is not None else excitation_plan(cfg)
 
     say("identification (a): Ki, Ks and tau_e from PRBS at 0 bar")
-    ex = prbs(amplitude_a=0.05, clock_period_s=1e-3, duration_s=1.0, sample_rate_hz=fs,
-              axes=axes, seed=seed)
+    ex = prbs(amplitude_a=plan.amplitude_a, clock_period_s=plan.prbs_clock_s,
+              duration_s=plan.prbs_duration_s, sample_rate_hz=fs, axes=axes, seed=seed)
     rec_a = acquire(cfg, truth, ex, controller=controller, pressure_bar=0.0, seed=seed)
     names_a = [f"{m}.{q}_{x}" for m in ambs for q in ("Ki", "Ks") for x in ("zeta", "eta")]
     names_a.append(TAU_E)
@@ -187,8 +199,9 @@ def thesis_procedure(
     records = {"a": rec_a}
     if spring is not None:
         say("identification (b): coupling stiffness from a second PRBS run")
-        ex = prbs(amplitude_a=0.05, clock_period_s=1e-3, duration_s=1.0, sample_rate_hz=fs,
-                  axes=axes, seed=seed + 1)
+        ex = prbs(amplitude_a=plan.amplitude_a, clock_period_s=plan.prbs_clock_s,
+                  duration_s=plan.prbs_duration_s, sample_rate_hz=fs, axes=axes,
+                  seed=seed + 1)
         rec_b = acquire(cfg, truth, ex, controller=controller, pressure_bar=0.0, seed=seed + 1)
         records["b"] = rec_b
         names_b = [f"{spring}.kxx", f"{spring}.kyy"]
@@ -216,7 +229,8 @@ def thesis_procedure(
         zeta = {f"{m}_zeta": 1.0 for m in ambs}
         for i, p in enumerate(impulse_pressures_bar):
             say(f"identification (c): seal coefficients by impulse at {p:g} bar")
-            ex = impulse(amplitude_a=0.05, width_s=0.01, start_s=0.05, duration_s=0.4,
+            ex = impulse(amplitude_a=plan.amplitude_a, width_s=plan.impulse_s,
+                         start_s=plan.impulse_start_s, duration_s=plan.impulse_record_s,
                          sample_rate_hz=fs, axes=axes, excited=zeta)
             try:
                 rec = acquire(cfg, truth, ex, controller=controller, pressure_bar=p,
@@ -244,6 +258,7 @@ def thesis_procedure(
             seal_freq[p] = seal_frequency_test(cfg, truth, controller, seal, p,
                                                sine_frequencies_hz, known=known,
                                                seal_values=at, seed=seed + 2,
+                                               amplitude_a=plan.amplitude_a,
                                                known_fit=known_fit, budget=True)
 
     say("identification (d): the identified rig")

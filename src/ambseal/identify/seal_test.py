@@ -37,6 +37,7 @@ from __future__ import annotations
 import numpy as np
 
 from ambseal.config import RigConfig
+from ambseal.identify.excitation import excitation_plan
 from ambseal.identify.fit import TAU_E, ClosedLoopModel, FitResult
 from ambseal.identify.rig_sim import reduced_plant
 from ambseal.identify.signals import Excitation, stepped_sine
@@ -180,7 +181,7 @@ def fit_reliability(res: FitResult, min_fit_pct: float = MIN_FIT_PCT) -> list[st
 
 def seal_frequency_test(cfg: RigConfig, truth, controller: DiscreteController, seal: str,
                         pressure_bar: float, frequencies_hz, *, known: dict,
-                        seal_values: dict | None = None, amplitude_a: float = 0.05,
+                        seal_values: dict | None = None, amplitude_a: float | None = None,
                         cycles: int = 10, settling_cycles: int = 5,
                         seed: int = 0, **fit_kw) -> list[tuple[float, FitResult]]:
     """The seal's K, k, C, c per frequency from a balanced-whirl stepped sine on the virtual
@@ -212,8 +213,10 @@ def seal_frequency_test(cfg: RigConfig, truth, controller: DiscreteController, s
     seal_values : dict, optional
         ``{"<seal>.<K|k|C|c>": value}`` (SI) the balance is computed with; the rig file's
         seal if omitted.
-    amplitude_a : float
-        The larger of the forward and backward whirl amplitudes (A).
+    amplitude_a : float, optional
+        The larger of the forward and backward whirl amplitudes (A); default the rig's
+        excitation amplitude (:func:`~ambseal.identify.excitation.impulse_amplitude`:
+        bias current / 120, 0.05 A on the test rig).
     cycles : int
         Periods per step in the analysis window, ≥ 1.
     settling_cycles : int
@@ -236,6 +239,8 @@ def seal_frequency_test(cfg: RigConfig, truth, controller: DiscreteController, s
     """
 
     fs = 1.0 / controller.dt
+    if amplitude_a is None:
+        amplitude_a = excitation_plan(cfg).amplitude_a
     names = [f"{seal}.{c}" for c in ("K", "k", "C", "c")]
     kw = dict(cycles=cycles, settling_cycles=settling_cycles)
     at = None if seal_values is None else [dict(seal_values)] * len(frequencies_hz)

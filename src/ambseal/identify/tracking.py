@@ -66,6 +66,7 @@ from scipy import stats
 from ambseal.config import RigConfig
 from ambseal.errors import DataError, IdentificationError, ModelError
 from ambseal.identify.data import Measurement
+from ambseal.identify.excitation import PRBS_CLOCK_SAMPLES
 from ambseal.identify.fit import _DEFAULT_SCALE, ClosedLoopModel
 from ambseal.identify.signals import prbs
 from ambseal.identify.stages import build_models
@@ -754,5 +755,6 @@ def tracking_excitation(cfg: RigConfig, duration_s: float, *, amplitude_a: float
     if limit is not None and amplitude_a > limit:
         raise IdentificationError(f"track: excitation amplitude {amplitude_a:.3g} A exceeds "
                                   f"the current limit {limit:.3g} A")
-    return prbs(amplitude_a=amplitude_a, clock_period_s=clock_period_s or 10 / fs,
+    return prbs(amplitude_a=amplitude_a,
+                clock_period_s=clock_period_s or PRBS_CLOCK_SAMPLES / fs,
                 duration_s=duration_s, sample_rate_hz=fs, axes=channel_names(cfg), seed=seed)

@@ -1,39 +1,58 @@
 """ROSS rotors in: a ``ross.Rotor`` (or ROSS's saved .toml/.json rotor file) as an ambseal rig.
 
-Tested with ross-rotordynamics 2.3 (Python 3.11, ``plotly<7``; ROSS 3 needs Python ≥ 3.12).
-The mapping, element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keeps
-the lateral [x, y, α, β], so ROSS's axial and torsional modes have no counterpart):
+Tested with ross-rotordynamics 2.3 (Python 3.11, ``plotly<7``; ROSS 3 needs Python ≥ 3.12) on
+ROSS's own ``rotor_example``, ``compressor_example`` and ``rotor_amb_example``. The mapping,
+element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keeps the lateral
+[x, y, α, β], so ROSS's axial and torsional modes have no counterpart):
 
-* ``ShaftElement`` → one ``[[shaft]]`` section of one element, node for node, with its
-  material (ROSS ``Material``: ρ, E, G_s; same-named materials with different values are
-  told apart). ROSS's Timoshenko element with Cowper's shear coefficient is ambseal's
-  ``beam = "timoshenko"``; without shear effects, ``"euler-bernoulli"`` (with rotary
-  inertia). Tapered or layered elements, elements without rotary inertia or gyroscopic
-  terms, and Hutchinson's shear coefficient have no equivalent: an error. ROSS's Rayleigh
-  damping of shaft elements (``alpha``, ``beta``) has none either: reported, left out.
+* ``ShaftElement`` → one ``[[shaft]]`` section per node pair, with its material (ROSS
+  ``Material``: ρ, E, G_s; same-named materials with different values are told apart).
+  Several elements on one node pair (ROSS's layered elements: a shaft and the sleeves or
+  hubs around it, which ROSS assembles by adding their matrices) → the innermost tube is the
+  section, the others its ``layers``, each a beam with its own material and shear
+  parameter, as ROSS has them. ROSS's Timoshenko element with Cowper's shear coefficient is
+  ambseal's ``beam = "timoshenko"``; without shear effects, ``"euler-bernoulli"`` (with
+  rotary inertia). Tapered elements, axial force or torque, elements without rotary
+  inertia or gyroscopic terms, and Hutchinson's shear coefficient have no equivalent: an
+  error. ROSS's Rayleigh damping of shaft elements (``alpha``, ``beta``) has none either:
+  reported, left out.
 * ``DiskElement`` → ``[[disk]]`` (m, Ip, Id); a ``PointMass`` on a shaft node → a disk
   without inertia.
-* ``BearingElement`` and its kinds (``SealElement``, fluid-film, ball, ...) with
-  coefficients that do not change with frequency and no cross-coupled damping or mass →
-  ``[[spring]]`` (kxx, kyy, kxy, kyx, cxx, cyy). Coefficients of the isotropic, skew form
-  (kxx = kyy, kxy = −kyx, cxx = cyy, cxy = −cyx, mxx = myy, no cross mass), constant or
-  against frequency → ``[[seal]]`` with K = kxx, k = kxy, C = cxx, c = cxy, M = mxx (Childs'
-  convention), tables against frequency in Hz (ROSS's rad/s / 2π), evaluated at the
-  synchronous frequency as ROSS's ``run_modal`` does. Anything else (frequency-dependent
-  anisotropic coefficients, a bearing on a support mass ``n_link``): an error.
+* ``BearingElement`` and its kinds (``SealElement``, fluid-film, ball, ...): coefficients of
+  the isotropic, skew form (kxx = kyy, kxy = −kyx, cxx = cyy, cxy = −cyx, mxx = myy, no cross
+  mass) → ``[[seal]]`` with K = kxx, k = kxy, C = cxx, c = cxy, M = mxx (Childs'
+  convention); against frequency, a table in Hz (ROSS's rad/s / 2π) of the values ROSS's
+  own interpolant gives at its frequencies (and at the operating frequency, when inside),
+  evaluated by ambseal at the synchronous frequency as ROSS's ``run_modal`` does (ambseal
+  interpolates linearly between the points, ROSS with a smoothing spline). Any other
+  coefficients without mass terms → ``[[spring]]`` (kxx, kyy, kxy, kyx, cxx, cyy, cxy, cyx);
+  against frequency, ROSS's interpolant at one frequency: the synchronous frequency of the
+  import speed (``speed_rpm``; by default the lowest frequency that every such table of
+  ROSS's covers), written as ``[operating] speed_rpm`` and reported, so that ambseal's
+  modes at that speed are ROSS's ``run_modal(speed)``. Mass terms that are not of the
+  seal's form, or a bearing on a support (``n_link``): an error.
 * ``MagneticBearingElement`` → ``[[amb]]`` with its geometry (turns, pole area, gap, bias,
   pole angle) and its factors: Ki = ROSS ``ki`` and Ks = −ROSS ``ks`` (ROSS stores the
   negative stiffness with its sign, ambseal the magnitude, P2 Eq. 1), actuator axes at
-  ROSS's ``sensors_axis_rotation``, sensor at the bearing (ROSS's AMB is collocated).
-  ROSS's AMB controller (PID gains or transfer function, amplifier and sensor gains) is not
-  imported — ambseal designs and judges its own (``ambseal design``): reported.
+  ROSS's ``sensors_axis_rotation``, sensor at the bearing (ROSS's AMB is collocated), no
+  amplifier dynamics (``[actuator] model = "none"``). ROSS's PID C(s) = kp + ki/s +
+  kd s/(1 + s/n_f), from sensor volts to amplifier volts, is the current per displacement
+  k_amp k_sense C(s): → ``[controller.pid]`` (P5 Eq. 6) with Kp = k_amp k_sense kp,
+  Ti = kp/ki, Td = kd/kp, ε = kp/(kd n_f) when every AMB has the same and it has that form
+  (integral action included); otherwise reported with what it would be. ROSS's
+  equivalent-bearing coefficients of the AMB (its closed loop folded into k(ω), c(ω)) are not
+  imported: ambseal closes the loop with the controller's dynamics. ROSS 2.3 saves an AMB
+  as a ``BearingElement`` table with the AMB's keys and loads it back as a plain bearing;
+  :func:`load_ross` rebuilds the ``MagneticBearingElement`` from the table.
 """
 
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import json
 import math
+import os
 import sys
 import tomllib
 import warnings
@@ -41,8 +60,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from pydantic import ValidationError
 
 from ambseal.config import RigConfig, dump_rig, parse_rig
+from ambseal.config.rig import Pid
 from ambseal.errors import ConfigError
 from ambseal.files import write_text
 
@@ -51,20 +72,29 @@ __all__ = ["RossImport", "from_ross", "load_ross", "import_ross_file", "ROSS_TES
 #: The ROSS version the importer is tested with.
 ROSS_TESTED = "2.3"
 
+_COEFFS = ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy", "cxy", "cyx", "mxx", "myy", "mxy", "myx")
+#: The keys of a saved ROSS AMB beyond a bearing's (ROSS 2.3 ``MagneticBearingElement``).
+_AMB_KEYS = ("g0", "i0", "ag", "nw")
+
 
 @dataclass(frozen=True)
 class RossImport:
-    """An imported ROSS rotor: the rig and what of ROSS's model it does not hold.
+    """An imported ROSS rotor: the rig, what of ROSS's model it does not hold and what it
+    took by a rule.
 
     Attributes
     ----------
     rig : RigConfig
     unmapped : tuple of str
         One sentence per thing left out (element tag and what).
+    notes : tuple of str
+        One sentence per value taken by a rule: frequency-dependent coefficients at one
+        frequency (which one, and why), ROSS's AMB controller as ``[controller.pid]``.
     """
 
     rig: RigConfig
     unmapped: tuple[str, ...]
+    notes: tuple[str, ...] = ()
 
 
 def _bad(where: str, what: str) -> ConfigError:
@@ -88,10 +118,10 @@ def _materials(shafts, where: str) -> tuple[dict, list[str]]:
     """ROSS materials as ``[materials]`` entries and the key of each shaft element."""
     table: dict[str, dict] = {}
     keys = []
-    for i, el in enumerate(shafts):
+    for el in shafts:
         mat = getattr(el, "material", None)
         if mat is None or not all(hasattr(mat, a) for a in ("rho", "E", "G_s")):
-            raise _bad(where, f"shaft element {i} ({el.tag}): missing material (expected a "
+            raise _bad(where, f"shaft element {el.n} ({el.tag}): missing material (expected a "
                               "ross.Material with rho, E and G_s)")
         props = {"E": float(mat.E), "rho": float(mat.rho), "G": float(mat.G_s)}
         base = _name(mat.name, "material")
@@ -104,33 +134,60 @@ def _materials(shafts, where: str) -> tuple[dict, list[str]]:
     return table, keys
 
 
+def _check_element(el, where: str) -> None:
+    tag = f"shaft element {el.n} ({el.tag})"
+    if not (math.isclose(el.idl, el.idr) and math.isclose(el.odl, el.odr)):
+        raise _bad(where, f"{tag}: tapered element (idl/idr, odl/odr differ) is not supported")
+    if not (el.rotary_inertia and el.gyroscopic):
+        raise _bad(where, f"{tag}: elements without rotary inertia or gyroscopic terms are "
+                          "not supported")
+    if el.shear_effects and el.shear_method_calc != "cowper":
+        raise _bad(where, f"{tag}: shear_method_calc {el.shear_method_calc!r} is not "
+                          "supported (expected 'cowper')")
+    if getattr(el, "axial_force", 0) or getattr(el, "torque", 0):
+        raise _bad(where, f"{tag}: axial_force / torque (their stiffening) have no ambseal "
+                          "equivalent")
+
+
 def _shaft(rotor, where: str) -> tuple[list[dict], dict, str, list[str]]:
-    shafts = sorted(rotor.shaft_elements, key=lambda e: e.n)
-    if [e.n for e in shafts] != list(range(len(shafts))):
-        raise _bad(where, "shaft elements: expected one element per node pair, left to right "
-                          "(layered or linked shaft elements are not supported)")
+    """``[[shaft]]`` sections (one per node pair, layered elements as ``layers``), the
+    materials, the beam type and what was left out."""
+    shafts = sorted(rotor.shaft_elements, key=lambda e: (e.n, e.idl))
+    pairs: dict[int, list] = {}
+    for el in shafts:
+        _check_element(el, where)
+        pairs.setdefault(int(el.n), []).append(el)
+    missing = sorted(set(range(max(pairs, default=-1) + 1)) - set(pairs))
+    if not pairs or missing:
+        raise _bad(where, "shaft elements: expected elements on every node pair from node 0, "
+                          f"left to right (none on node pair(s) {missing[:5]} or none at all)")
     mats, keys = _materials(shafts, where)
-    shear, notes, out = set(), [], []
-    for el, key in zip(shafts, keys):
-        tag = f"shaft element {el.n} ({el.tag})"
-        if not (math.isclose(el.idl, el.idr) and math.isclose(el.odl, el.odr)):
-            raise _bad(where, f"{tag}: tapered element (idl/idr, odl/odr differ) is not "
-                              "supported")
-        if not (el.rotary_inertia and el.gyroscopic):
-            raise _bad(where, f"{tag}: elements without rotary inertia or gyroscopic terms "
-                              "are not supported")
-        if el.shear_effects and el.shear_method_calc != "cowper":
-            raise _bad(where, f"{tag}: shear_method_calc {el.shear_method_calc!r} is not "
-                              "supported (expected 'cowper')")
-        shear.add(bool(el.shear_effects))
-        if el.alpha or el.beta:
-            notes.append(f"{tag}: Rayleigh damping alpha={el.alpha:g} 1/s, beta={el.beta:g} s "
-                         "left out (no equivalent; [rotor] modal_damping is modal)")
-        out.append({"length": float(el.L), "outer_diameter": float(el.odl),
-                    "inner_diameter": float(el.idl), "material": key, "elements": 1})
+    key_of = {id(el): k for el, k in zip(shafts, keys)}
+    shear = {bool(el.shear_effects) for el in shafts}
     if len(shear) > 1:
         raise _bad(where, "shaft elements mix shear_effects True and False (one beam type "
                           "per rig)")
+    out = []
+    for n in sorted(pairs):
+        group = pairs[n]
+        if not all(math.isclose(e.L, group[0].L, rel_tol=1e-9) for e in group):
+            raise _bad(where, f"shaft elements on node pair {n} "
+                              f"({', '.join(str(e.tag) for e in group)}): lengths differ "
+                              "(layered elements share their nodes)")
+        tubes = [{"outer_diameter": float(e.odl), "inner_diameter": float(e.idl),
+                  "material": key_of[id(e)]} for e in group]
+        section = {"length": float(group[0].L), **tubes[0], "elements": 1}
+        if len(tubes) > 1:
+            section["layers"] = tubes[1:]
+        out.append(section)
+    damped: dict[tuple[float, float], list] = {}
+    for el in shafts:
+        if el.alpha or el.beta:
+            damped.setdefault((float(el.alpha), float(el.beta)), []).append(str(el.tag))
+    notes = [f"Rayleigh damping alpha={a:g} 1/s, beta={b:g} s of {len(tags)} shaft "
+             f"element(s) ({tags[0]}{' ... ' + tags[-1] if len(tags) > 1 else ''}) left out "
+             "(no equivalent; [rotor] modal_damping is modal)"
+             for (a, b), tags in damped.items()]
     beam = "timoshenko" if shear == {True} else "euler-bernoulli"
     return out, mats, beam, notes
 
@@ -144,55 +201,105 @@ def _isotropic_skew(c: dict[str, np.ndarray]) -> bool:
             and not np.any(c["mxy"]) and not np.any(c["myx"]))
 
 
-def _bearing(el, z: float, where: str, i: int) -> tuple[str, dict]:
-    """("spring" | "seal", entry) of a ROSS bearing or seal."""
-    tag = f"bearing {i} ({el.tag}, node {el.n})"
-    names = ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy", "cxy", "cyx", "mxx", "myy", "mxy", "myx")
-    c = {n: _coef(el, n) for n in names}
-    freq = getattr(el, "frequency", None)
-    constant = all(np.allclose(v, v[0], rtol=1e-12, atol=0.0) for v in c.values())
-    name = _name(el.tag, f"bearing{i}")
-    if constant and not any(c[n][0] for n in ("cxy", "cyx", "mxx", "myy", "mxy", "myx")):
-        return "spring", {"name": name, "position": z,
-                          **{n: float(c[n][0]) for n in ("kxx", "kyy", "kxy", "kyx",
-                                                         "cxx", "cyy")}}
-    if not _isotropic_skew(c):
-        what = ("cross-coupled damping or mass" if constant else
-                "frequency-dependent anisotropic coefficients")
-        raise _bad(where, f"{tag}: {what} have no ambseal equivalent ([[spring]] takes "
-                          "kxx, kyy, kxy, kyx, cxx, cyy; [[seal]] the isotropic skew form)")
+def _kind(el, where: str, i: int) -> tuple[str, bool]:
+    """("seal" | "spring", whether its coefficients change with frequency) of a ROSS
+    bearing or seal."""
+    c = {n: _coef(el, n) for n in _COEFFS}
+    varies = not all(np.allclose(v, v[0], rtol=1e-12, atol=0.0) for v in c.values())
+    if _isotropic_skew(c):
+        plain = not any(np.any(c[n]) for n in ("cxy", "cyx", "mxx", "myy"))
+        return ("spring" if plain and not varies else "seal"), varies
+    if any(np.any(c[n]) for n in ("mxx", "myy", "mxy", "myx")):
+        raise _bad(where, f"bearing {i} ({el.tag}, node {el.n}): mass coefficients other than "
+                          "an isotropic mxx = myy have no ambseal equivalent ([[seal]] takes M "
+                          "with the isotropic skew form, [[spring]] no mass)")
+    return "spring", varies
+
+
+def _at(el, name: str, omega: float) -> float:
+    """ROSS's own value of a coefficient at ``omega`` (rad/s): the interpolant its
+    ``run_modal`` evaluates."""
+    f = getattr(el, f"{name}_interpolated", None)
+    if f is None:
+        return float(_coef(el, name)[0])
+    return float(np.asarray(f(omega), float))
+
+
+def _spring(el, z: float, i: int, varies: bool, omega: float) -> dict:
+    names = ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy", "cxy", "cyx")
+    vals = {n: (_at(el, n, omega) if varies else float(_coef(el, n)[0])) for n in names}
+    return {"name": _name(el.tag, f"bearing{i}"), "position": z, **vals}
+
+
+def _seal(el, z: float, i: int, varies: bool, omega: float) -> dict:
     keys = {"K": "kxx", "k": "kxy", "C": "cxx", "c": "cxy", "M": "mxx"}
-    if constant:
-        return "seal", {"name": name, "position": z,
-                        **{k: float(c[v][0]) for k, v in keys.items()}}
-    f_hz = [float(w) / (2 * math.pi) for w in np.atleast_1d(freq)]
-    return "seal", {"name": name, "position": z,
-                    **{k: {"frequency_hz": f_hz, "value": [float(x) for x in c[v]]}
-                       for k, v in keys.items()}}
+    entry = {"name": _name(el.tag, f"bearing{i}"), "position": z}
+    if not varies:
+        return entry | {k: float(_coef(el, v)[0]) for k, v in keys.items()}
+    w = sorted({float(x) for x in np.atleast_1d(el.frequency)})
+    if w[0] < omega < w[-1] and not any(math.isclose(omega, x) for x in w):
+        w = sorted(w + [omega])  # exact at the operating speed, too
+    return entry | {k: {"frequency_hz": [x / (2 * math.pi) for x in w],
+                        "value": [_at(el, v, x) for x in w]} for k, v in keys.items()}
 
 
-def _amb(el, z: float, i: int) -> tuple[dict, str]:
+def _pid(el) -> tuple[dict | None, str]:
+    """ROSS's AMB controller as ``[controller.pid]`` keys, or None and why not; and what
+    it is, in words."""
+    if getattr(el, "controller_transfer_function_num", None) is not None:
+        return None, "a controller transfer function (no PID form)"
+    gain = np.atleast_1d(np.asarray(el.k_amp, float)) * np.atleast_1d(
+        np.asarray(el.k_sense, float))
+    kp, ki, kd, nf = (float(el.kp_pid), float(el.ki_pid), float(el.kd_pid), float(el.n_f))
+    what = (f"PID kp={kp:g}, ki={ki:g}, kd={kd:g}, n_f={nf:g} rad/s, k_amp·k_sense="
+            f"{'/'.join(f'{g:g}' for g in gain)}")
+    if not np.allclose(gain, gain[0], rtol=1e-12, atol=0.0):
+        return None, f"{what}: k_amp·k_sense differs between the axes"
+    if kp <= 0 or ki <= 0:
+        return None, (f"{what}: [controller.pid] (P5 Eq. 6) needs kp > 0 and integral action "
+                      f"(ki > 0); it would be kp={gain[0] * kp:g} A/m, td="
+                      f"{kd / kp if kp > 0 else 0.0:g} s, eps="
+                      f"{kp / (kd * nf) if kd > 0 else 1.0:g}")
+    # with kd = 0 the filter ε is unused; 1 keeps the key valid
+    pid = {"kp": float(gain[0] * kp), "ti": kp / ki, "td": kd / kp,
+           "eps": kp / (kd * nf) if kd > 0 else 1.0}
+    try:
+        Pid.model_validate(pid)
+    except ValidationError as exc:
+        return None, f"{what}: outside [controller.pid]'s ranges ({exc.errors()[0]['loc']})"
+    return pid, what
+
+
+def _amb(el, z: float, i: int) -> tuple[dict, dict | None, str]:
     def pair(v):
         v = np.atleast_1d(np.asarray(v, float))
         return {"zeta": float(v[0]), "eta": float(v[-1])}
 
     i0 = np.atleast_1d(np.asarray(el.i0, float))
-    name = _name(el.tag, f"amb{i}")
-    entry = {"name": name, "position": z, "sensor_position": z,
+    entry = {"name": _name(el.tag, f"amb{i}"), "position": z, "sensor_position": z,
              "axes_angle_deg": math.degrees(float(el.sensors_axis_rotation)),
              "turns": int(round(float(el.nw))), "pole_area": float(el.ag),
              "air_gap": float(el.g0), "bias_current": float(i0.mean()),
              "pole_angle_deg": math.degrees(float(el.alpha)),
              "ki": pair(el.ki), "ks": pair(-np.asarray(el.ks, float))}
-    tf = getattr(el, "controller_transfer_function_num", None) is not None
-    ctrl = ("a controller transfer function" if tf else
-            f"PID kp={el.kp_pid:g}, ki={el.ki_pid:g}, kd={el.kd_pid:g}, n_f={el.n_f:g}")
-    return entry, (f"magnetic bearing {i} ({el.tag}): ROSS's AMB controller ({ctrl}; "
-                   f"k_amp={pair(el.k_amp)['zeta']:g}, k_sense={pair(el.k_sense)['zeta']:g}) "
-                   "not imported: ambseal designs and judges its own (ambseal design)")
+    pid, what = _pid(el)
+    return entry, pid, what
 
 
-def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>") -> RossImport:
+def _import_speed(freq_tables: list, speed_rpm: float | None) -> tuple[float, float, str]:
+    """The frequency (rad/s) at which coefficients ambseal holds as constants are taken, the
+    speed (rpm) it is the synchronous frequency of, and the rule that chose it."""
+    if speed_rpm is not None:
+        return abs(speed_rpm) * math.pi / 30, speed_rpm, "the import speed, --speed-rpm"
+    if not freq_tables:
+        return 0.0, 0.0, ""
+    omega = max(float(np.min(f)) for f in freq_tables)
+    return omega, omega * 30 / math.pi, ("the lowest frequency every such table of ROSS's "
+                                         "covers; choose with --speed-rpm")
+
+
+def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
+              speed_rpm: float | None = None) -> RossImport:
     """An ambseal rig from a ``ross.Rotor`` (module docstring: the mapping).
 
     Parameters
@@ -202,6 +309,11 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>") ->
         ``[rotor] name`` of the rig (default ROSS's ``tag`` or "ROSS rotor").
     where : str
         Name of the source in error messages (e.g. the file).
+    speed_rpm : float, optional
+        Speed (rpm) at whose synchronous frequency the frequency-dependent coefficients
+        that ambseal holds as constants (a ``[[spring]]``'s) are taken, as ROSS's
+        ``run_modal(speed)`` takes them; written as ``[operating] speed_rpm``. By default
+        the lowest frequency that every such table covers (none: 0 rpm).
 
     Returns
     -------
@@ -217,10 +329,10 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>") ->
     bearings = list(getattr(rotor, "bearing_elements", []))
     for el in getattr(rotor, "elements", []):
         kind = type(el).__name__
-        if kind not in known and el not in bearings:
+        if kind not in known and not any(el is b for b in bearings):
             raise _bad(where, f"unsupported element {kind} ({getattr(el, 'tag', '')}) with "
                               "no ambseal equivalent")
-    shaft, mats, beam, notes = _shaft(rotor, where)
+    shaft, mats, beam, unmapped = _shaft(rotor, where)
     nodes = np.concatenate([[0.0], np.cumsum([s["length"] for s in shaft])])
     rig: dict = {"rotor": {"beam": beam, "name": name or str(getattr(rotor, "tag", None)
                                                             or "ROSS rotor")},
@@ -235,6 +347,7 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>") ->
                               "mass) is not supported")
         rig["disk"].append({"name": str(p.tag), "position": float(nodes[p.n]),
                             "mass": float(p.m)})
+    plan, pids, notes = [], [], []
     for i, b in enumerate(bearings):
         if getattr(b, "n_link", None) is not None:
             raise _bad(where, f"bearing {i} ({b.tag}) linked to node {b.n_link} (support "
@@ -242,19 +355,108 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>") ->
         if b.n >= len(nodes):
             raise _bad(where, f"bearing {i} ({b.tag}) on node {b.n} off the shaft")
         if type(b).__name__ == "MagneticBearingElement":
-            entry, note = _amb(b, float(nodes[b.n]), i)
+            entry, pid, what = _amb(b, float(nodes[b.n]), i)
             rig["amb"].append(entry)
-            notes.append(note)
+            pids.append((b.tag, pid, what))
         else:
-            kind, entry = _bearing(b, float(nodes[b.n]), where, i)
-            rig[kind].append(entry)
+            plan.append((i, b, *_kind(b, where, i)))
+    one_freq = [np.atleast_1d(b.frequency) for _, b, kind, varies in plan
+                if varies and kind == "spring"]
+    omega, rpm, rule = _import_speed(one_freq, speed_rpm)
+    for i, b, kind, varies in plan:
+        z = float(nodes[b.n])
+        if kind == "seal":
+            rig["seal"].append(_seal(b, z, i, varies, omega))
+            continue
+        rig["spring"].append(_spring(b, z, i, varies, omega))
+        if varies:
+            f = np.atleast_1d(b.frequency) / (2 * math.pi)
+            out = "" if f.min() <= omega / (2 * math.pi) <= f.max() else (
+                " (outside the table: ROSS's interpolant extrapolated)")
+            notes.append(f"bearing {i} ({b.tag}, node {b.n}): frequency-dependent "
+                         f"coefficients (ROSS's table {f.min():.4g}–{f.max():.4g} Hz) taken "
+                         f"at one frequency, {omega / (2 * math.pi):.6g} Hz = "
+                         f"{abs(rpm):.6g} rpm ({rule}){out}: ambseal's modes at "
+                         "that [operating] speed are ROSS's run_modal there, at other speeds "
+                         "the coefficients stay")
+    tables = [s["name"] for s in rig["seal"] if isinstance(s["K"], dict)]
+    if tables:
+        notes.append(f"seal(s) {', '.join(tables)}: frequency tables of ROSS's values at its "
+                     "frequencies; ambseal interpolates linearly between them and holds the "
+                     "end values outside, ROSS's spline runs between them and extrapolates: "
+                     "the modes agree at the tables' frequencies"
+                     + (" and at the [operating] speed" if rpm else ""))
+    if rpm:
+        rig["operating"] = {"speed_rpm": rpm}
     if rig["amb"]:
         rig["actuator"] = {"model": "none"}
-    return RossImport(parse_rig(rig, where), tuple(notes))
+        unmapped.append("magnetic bearings: ROSS's equivalent-bearing coefficients k(ω), c(ω) "
+                        "(its controller folded in at each frequency) not imported: ambseal "
+                        "closes the loop with the controller's dynamics")
+        _controller(rig, pids, unmapped, notes)
+    return RossImport(parse_rig(rig, where), tuple(unmapped), tuple(notes))
+
+
+def _controller(rig: dict, pids: list, unmapped: list, notes: list) -> None:
+    """``[controller.pid]`` from ROSS's AMB controllers when they are one PID, else why not."""
+    found = [p for _, p, _ in pids]
+    if None not in found and all(all(math.isclose(p[k], found[0][k], rel_tol=1e-12)
+                                     for k in p) for p in found):
+        rig.setdefault("controller", {})["pid"] = found[0]
+        notes.append(f"ROSS's AMB controller ({pids[0][2]}) taken as [controller.pid] "
+                     + ", ".join(f"{k}={v:g}" for k, v in found[0].items())
+                     + " (Kp = k_amp·k_sense·kp, Ti = kp/ki, Td = kd/kp, eps = kp/(kd n_f))")
+        return
+    whats = list(dict.fromkeys(what for _, p, what in pids if p is None))
+    why = "they differ between the AMBs" if not whats else "; ".join(whats)
+    unmapped.append(f"ROSS's AMB controllers not imported ({why}): [controller.pid] is one "
+                    "PID for every axis; ambseal designs its own (ambseal design)")
+
+
+@contextlib.contextmanager
+def _stdout_to_stderr():
+    """Everything written to stdout — by Python, or by a C library at the file-descriptor
+    level, as CoolProp's REFPROP banner when ROSS imports ccp — goes to stderr instead, so
+    that a command's stdout holds its result only."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        os.dup2(2, 1)
+        with contextlib.redirect_stdout(sys.stderr):
+            yield
+    finally:
+        sys.stdout.flush()
+        with contextlib.suppress(Exception):  # C's stdio buffers; no libc on some platforms
+            ctypes.CDLL(None).fflush(None)
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def _ross():
+    """The ``ross`` module, imported with its import chatter kept off stdout."""
+    with _stdout_to_stderr(), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            import ross  # optional: the [ross] extra
+        except ImportError:
+            raise ConfigError("ross-rotordynamics is not installed (pip install "
+                              "'ambseal[ross]')") from None
+    return ross
 
 
 def load_ross(path: str | Path):
-    """``ross.Rotor.load(path)`` with ROSS's import chatter kept off stdout.
+    """``ross.Rotor.load(path)`` with ROSS's import chatter kept off stdout and its AMBs
+    restored (ROSS 2.3 saves a ``MagneticBearingElement`` as a bearing table with the AMB's
+    keys and loads it back as a plain ``BearingElement``).
+
+    Parameters
+    ----------
+    path : str or Path
+        A rotor file saved by ``ross.Rotor.save`` (.toml or .json).
+
+    Returns
+    -------
+    ross.Rotor
 
     Raises
     ------
@@ -266,27 +468,41 @@ def load_ross(path: str | Path):
         raise ConfigError(f"{path}: no such ROSS rotor file")
     if path.suffix.lower() not in (".toml", ".json"):
         raise ConfigError(f"{path}: expected a ROSS rotor file (.toml or .json)")
-    with contextlib.redirect_stdout(sys.stderr):
+    ross = _ross()
+    data = _check_file(path, ross)
+    with _stdout_to_stderr(), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
         try:
-            import ross  # optional: the [ross] extra
-        except ImportError:
-            raise ConfigError("ross-rotordynamics is not installed (pip install "
-                              "'ambseal[ross]')") from None
-
-        _check_file(path, ross)
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                return ross.Rotor.load(path)
+            rotor = ross.Rotor.load(path)
+            _restore_ambs(rotor, data, ross)
         except Exception as exc:  # ROSS raises anything from KeyError to TOML errors
             msg = str(exc).splitlines()[0] if str(exc) else ""
             raise ConfigError(f"{path}: not a ROSS rotor file ({type(exc).__name__}: "
                               f"{msg})") from None
+    return rotor
 
 
-def _check_file(path: Path, ross) -> None:
-    """Clear errors for what ROSS's own loader reports obscurely: not a rotor file, an
-    element class ROSS does not have, a shaft element without its material."""
+def _restore_ambs(rotor, data: dict, ross) -> None:
+    """Put back the ``MagneticBearingElement`` of every bearing table with the AMB's keys,
+    in place of the plain bearing ROSS loaded."""
+    for key, table in data.items():
+        if not (key.startswith("BearingElement_") and isinstance(table, dict)
+                and all(k in table for k in _AMB_KEYS)):
+            continue
+        mb = ross.MagneticBearingElement.read_toml_data(table)
+        for seq in (rotor.bearing_elements, rotor.elements):
+            for j, el in enumerate(seq):
+                if type(el).__name__ == "BearingElement" and el.tag == mb.tag and el.n == mb.n:
+                    for attr in ("dof_global_index", "n_l", "n_r"):  # set by the Rotor
+                        if hasattr(el, attr):
+                            setattr(mb, attr, getattr(el, attr))
+                    seq[j] = mb
+
+
+def _check_file(path: Path, ross) -> dict:
+    """The file's tables, with clear errors for what ROSS's own loader reports obscurely:
+    not a rotor file, an element class ROSS does not have, a shaft element without its
+    material."""
 
     try:
         text = path.read_text(encoding="utf-8")
@@ -305,29 +521,46 @@ def _check_file(path: Path, ross) -> None:
         if kind == "ShaftElement" and not isinstance(val.get("material"), dict):
             raise ConfigError(f"{path}: {key}: missing material (expected a table "
                               f"[\"{key}\".material] with rho, E, G_s)")
+    return data
 
 
-def import_ross_file(path: str | Path, out: str | Path) -> dict:
+def import_ross_file(path: str | Path, out: str | Path, *,
+                     speed_rpm: float | None = None) -> dict:
     """``ambseal import-ross``: read a ROSS rotor file, write the rig (TOML) to ``out``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ROSS rotor file (:func:`load_ross`).
+    out : str or Path
+        The rig file to write.
+    speed_rpm : float, optional
+        As :func:`from_ross`.
 
     Returns
     -------
     dict
-        ``out``, the counts of shaft elements, disks, springs, seals and AMBs, and
-        ``unmapped`` (what was left out, one sentence each).
+        ``out``, the counts of shaft sections (``shaft_elements``), layers, disks, springs,
+        seals and AMBs, ``speed_rpm`` (the rig's operating speed), ``controller_pid``
+        (whether ROSS's PID was taken), ``unmapped`` (what was left out) and ``notes``
+        (what was taken by a rule), one sentence each.
 
     Raises
     ------
     ConfigError
         As :func:`load_ross` and :func:`from_ross`.
     """
-    import ross  # optional: the [ross] extra
-
-    res = from_ross(load_ross(path), where=str(path))
-    header = (f"Imported by ambseal from the ROSS rotor file {path} (ROSS {ross.__version__})"
-              + "".join(f"\nnot imported: {n}" for n in res.unmapped))
+    rotor = load_ross(path)
+    res = from_ross(rotor, where=str(path), speed_rpm=speed_rpm)
+    header = (f"Imported by ambseal from the ROSS rotor file {path} "
+              f"(ROSS {_ross().__version__})"
+              + "".join(f"\nnot imported: {n}" for n in res.unmapped)
+              + "".join(f"\ntaken: {n}" for n in res.notes))
     write_text(out, dump_rig(res.rig, header))
     cfg = res.rig
-    return {"out": str(out), "shaft_elements": len(cfg.shaft), "disks": len(cfg.disk),
+    return {"out": str(out), "shaft_elements": len(cfg.shaft),
+            "layers": sum(len(s.layers) for s in cfg.shaft), "disks": len(cfg.disk),
             "springs": len(cfg.spring), "seals": len(cfg.seal), "ambs": len(cfg.amb),
-            "unmapped": list(res.unmapped)}
+            "speed_rpm": cfg.operating.speed_rpm,
+            "controller_pid": cfg.controller.pid is not None,
+            "unmapped": list(res.unmapped), "notes": list(res.notes)}

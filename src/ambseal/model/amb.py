@@ -22,7 +22,8 @@ from ambseal.config import Actuator, Amb, AxisPair, RigConfig
 from ambseal.model.lft import Channel
 from ambseal.model.rotor import Mesh, X, Y
 
-__all__ = ["AXES", "MU0", "axes_rotation", "channel_names", "amb_factors_from_geometry",
+__all__ = ["AXES", "MU0", "axes_rotation", "channel_names", "bias_currents", "bias_current",
+           "amb_factors_from_geometry",
            "amb_factors", "AmbElement", "actuator_matrices", "eddy_lag_matrices"]
 
 AXES = ("zeta", "eta")
@@ -66,6 +67,41 @@ def channel_names(cfg: RigConfig) -> tuple[str, ...]:
         Two names per AMB.
     """
     return tuple(f"{a.name}_{axis}" for a in cfg.amb for axis in AXES)
+
+
+def bias_currents(cfg: RigConfig) -> list[float | None]:
+    """Each AMB's bias current i0 (A): its ``bias_current``, else half its
+    ``current_limit`` (a coil current i0 ± i_c within [0, limit] then swings the control
+    current i_c furthest both ways), else None.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+
+    Returns
+    -------
+    list of float or None
+        One per AMB, in file order.
+    """
+    return [a.bias_current or (a.current_limit / 2 if a.current_limit else None)
+            for a in cfg.amb]
+
+
+def bias_current(cfg: RigConfig) -> float | None:
+    """The rig's bias current i0 (A): the smallest of :func:`bias_currents`, or None when
+    an AMB gives neither a bias current nor a current limit (or the rig has no AMB). The
+    design's scalings and the excitation amplitudes scale with it (thesis test rig: 6 A).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+
+    Returns
+    -------
+    float or None
+    """
+    biases = bias_currents(cfg)
+    return min(biases) if biases and None not in biases else None
 
 
 def amb_factors_from_geometry(

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["BeamElement", "DiskElement", "shear_coefficient"]
+__all__ = ["BeamElement", "LayeredBeam", "DiskElement", "shear_coefficient"]
 
 # Node-DOF index of each plane coordinate: x-plane (x, β) and y-plane (y, −α).
 _X, _Y, _A, _B = 0, 1, 2, 3
@@ -169,6 +169,44 @@ class BeamElement:
         g[:4, 4:] = mr
         g[4:, :4] = -mr
         return _to_nodes(g, coupled=True)
+
+
+@dataclass(frozen=True)
+class LayeredBeam:
+    """Concentric tubes between the same two nodes, in parallel: their matrices add.
+
+    Each tube is a :class:`BeamElement` of its own material and its own shear parameter Φ,
+    as ROSS assembles shaft elements that share a node pair (its layered elements).
+
+    Parameters
+    ----------
+    tubes : tuple of BeamElement
+        The tubes, all of one length.
+    """
+
+    tubes: tuple[BeamElement, ...]
+
+    @property
+    def length(self) -> float:
+        """Element length L (m)."""
+        return self.tubes[0].length
+
+    @property
+    def mass(self) -> float:
+        """Element mass (kg), all tubes."""
+        return sum(t.mass for t in self.tubes)
+
+    def M(self) -> np.ndarray:
+        """Mass matrix (8, 8): the sum of the tubes'."""
+        return sum(t.M() for t in self.tubes)
+
+    def K(self) -> np.ndarray:
+        """Stiffness matrix (8, 8): the sum of the tubes'."""
+        return sum(t.K() for t in self.tubes)
+
+    def G(self) -> np.ndarray:
+        """Gyroscopic matrix (8, 8) per unit spin speed: the sum of the tubes'."""
+        return sum(t.G() for t in self.tubes)
 
 
 @dataclass(frozen=True)

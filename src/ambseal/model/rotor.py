@@ -22,7 +22,7 @@ import scipy.linalg as sla
 
 from ambseal.config import RigConfig
 from ambseal.errors import ModelError
-from ambseal.model.fe import BeamElement, DiskElement
+from ambseal.model.fe import BeamElement, DiskElement, LayeredBeam
 
 __all__ = ["Mesh", "build_mesh", "RotorMatrices", "assemble_rotor", "dof"]
 
@@ -42,12 +42,13 @@ class Mesh:
     ----------
     z : ndarray, shape (n_nodes,)
         Node positions (m) from the shaft's left end.
-    elements : tuple of BeamElement
-        ``elements[e]`` joins nodes ``e`` and ``e + 1``.
+    elements : tuple of BeamElement or LayeredBeam
+        ``elements[e]`` joins nodes ``e`` and ``e + 1`` (a section with ``layers``: all its
+        tubes).
     """
 
     z: np.ndarray
-    elements: tuple[BeamElement, ...]
+    elements: tuple[BeamElement | LayeredBeam, ...]
 
     @property
     def n_nodes(self) -> int:
@@ -84,7 +85,8 @@ def build_mesh(cfg: RigConfig, extra_positions: tuple[float, ...] = ()) -> Mesh:
     -------
     Mesh
         A node at every section boundary and component position; each section divided into
-        its ``elements`` equal elements, split where a component falls inside one.
+        its ``elements`` equal elements, split where a component falls inside one; a
+        section with ``layers`` gives :class:`LayeredBeam` elements.
     """
     beam_tim = cfg.rotor.beam == "timoshenko"
     positions = [d.position for d in cfg.disk]
@@ -96,10 +98,9 @@ def build_mesh(cfg: RigConfig, extra_positions: tuple[float, ...] = ()) -> Mesh:
     tol = _snap(length)
 
     z_nodes = [0.0]
-    elements: list[BeamElement] = []
+    elements: list[BeamElement | LayeredBeam] = []
     z0 = 0.0
     for sec in cfg.shaft:
-        mat = cfg.materials[sec.material]
         z1 = z0 + sec.length
         cuts = set(np.linspace(z0, z1, sec.elements + 1)[1:-1].tolist())
         cuts |= {p for p in positions if z0 + tol < p < z1 - tol}
@@ -107,17 +108,19 @@ def build_mesh(cfg: RigConfig, extra_positions: tuple[float, ...] = ()) -> Mesh:
         for p in sorted(cuts) + [z1]:
             if p - left < tol or (p < z1 and z1 - p < tol):
                 continue
-            elements.append(
+            tubes = tuple(
                 BeamElement(
                     length=p - left,
-                    outer_diameter=sec.outer_diameter,
-                    inner_diameter=sec.inner_diameter,
-                    E=mat.E,
-                    shear_modulus=mat.shear_modulus,
-                    rho=mat.rho,
+                    outer_diameter=t.outer_diameter,
+                    inner_diameter=t.inner_diameter,
+                    E=cfg.materials[t.material].E,
+                    shear_modulus=cfg.materials[t.material].shear_modulus,
+                    rho=cfg.materials[t.material].rho,
                     timoshenko=beam_tim,
                 )
+                for t in (sec, *sec.layers)
             )
+            elements.append(tubes[0] if len(tubes) == 1 else LayeredBeam(tubes))
             z_nodes.append(p)
             left = p
         z0 = z1

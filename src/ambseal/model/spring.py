@@ -3,9 +3,11 @@
 Given in its own axes u, v, rotated by ``axes_angle_deg`` from x, y ([u, v]ᵀ = R [x, y]ᵀ,
 R of :func:`ambseal.model.amb.axes_rotation`), the spring force is
 
-    −f = Rᵀ [kxx kxy; kyx kyy] R q + Rᵀ diag(cxx, cyy) R q̇,   q = [x, y] of the node,
+    −f = Rᵀ [kxx kxy; kyx kyy] R q + Rᵀ [cxx cxy; cyx cyy] R q̇,   q = [x, y] of the node,
 
-the change of basis of a 2×2 stiffness (damping) tensor given in rotated axes.
+the change of basis of a 2×2 stiffness (damping) tensor given in rotated axes. The
+cross-coupled damping cxy, cyx (an imported plain bearing's) is fixed: not among the
+spring's parameters (:data:`KEYS`).
 """
 
 from __future__ import annotations
@@ -49,7 +51,7 @@ class SpringElement:
     k : ndarray, shape (2, 2)
         [kxx kxy; kyx kyy] (N/m) in the spring's axes.
     c : ndarray, shape (2, 2)
-        diag(cxx, cyy) (N·s/m) in the spring's axes.
+        [cxx cxy; cyx cyy] (N·s/m) in the spring's axes.
     """
 
     label: str
@@ -64,7 +66,7 @@ class SpringElement:
         return cls(spring_label(spring, index), mesh.node_at(spring.position),
                    axes_rotation(spring.axes_angle_deg),
                    np.array([[spring.kxx, spring.kxy], [spring.kyx, spring.kyy]]),
-                   np.diag([spring.cxx, spring.cyy]))
+                   np.array([[spring.cxx, spring.cxy], [spring.cyx, spring.cyy]]))
 
     def matrices(self) -> tuple[np.ndarray, np.ndarray]:
         """(K, C), each (2, 2) on [x, y] of the node: Rᵀ k R and Rᵀ c R."""
@@ -79,8 +81,8 @@ class SpringElement:
         C[i] += Ce
 
     def channels(self, n_dof: int) -> list[Channel]:
-        """One rank-1 channel per entry: Δ(kab) changes K by θ d_a d_bᵀ with d_a the
-        spring's axis a at the node in global DOFs (likewise cxx, cyy for C)."""
+        """One rank-1 channel per entry of :data:`KEYS`: Δ(kab) changes K by θ d_a d_bᵀ with
+        d_a the spring's axis a at the node in global DOFs (likewise cxx, cyy for C)."""
         d = []
         for a in range(2):
             v = np.zeros(n_dof)

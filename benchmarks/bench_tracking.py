@@ -117,6 +117,7 @@ def ramp(args) -> None:
                           "refused_at_s": t["refused_at_s"], "fallback": t["fallback"],
                           "fallback_from_s": t["fallback_from_s"],
                           "check_largest": t["check_largest"],
+                          "check_largest_bias_se": t["check_largest_bias_se"],
                           "threshold": t["check_threshold"],
                           "tracked_lost_at_s": r.runs["tracked"].lost_at_s,
                           "mu_lost_at_s": r.runs["mu"].lost_at_s,

@@ -34,8 +34,10 @@ C, c explain the data). When it refuses, its estimate is biased beyond its inter
 the tracked run hands over to the ``fallback`` fixed controller (μ) at the next block,
 from rest, for the rest of the ramp; the tracker keeps running so that its accuracy is
 still reported. ``tracking`` then says ``refused``, ``refused_at_s``, ``refusal`` (why),
-``fallback`` and ``fallback_from_s``, with the test's ``check_threshold`` and each
-coefficient's largest statistic ``check_largest``. Measured: examples/pump.toml on
+``fallback`` and ``fallback_from_s``, with the test's ``check_threshold``, each
+coefficient's largest statistic ``check_largest`` and the largest bias its error causes in
+k̂, in k̂'s standard errors, ``check_largest_bias_se`` (a window refuses when both exceed
+their limits). Measured: examples/pump.toml on
 tests/data/pump_truth.toml (its identified balance-drum K 0.48 MN/m at 20 bar against the
 truth's 1.2 MN/m) refuses at 3.5 s on 20 seeds of 20 and the μ controller keeps the rotor;
 the test rig's identified model is not refused.
@@ -434,7 +436,9 @@ def _run_tracked(cfg, fac, tracked, run_as, e, noise, inoise, fs, starts, n_len,
            "fallback": fallback[0] if switched is not None else None,
            "fallback_from_s": switched, "check_threshold": check["threshold"],
            "check_largest": {q: max((w["statistic"][q] for w in check["windows"]),
-                                    default=None) for q in check["probes"]}}
+                                    default=None) for q in check["probes"]},
+           "check_largest_bias_se": {q: max((w["bias_se"][q] for w in check["windows"]),
+                                            default=None) for q in check["probes"]}}
     if n > after.start:
         acc["max_error_rel"] = float(np.max(np.abs(est[after] - kt[after])) / k_nom)
         acc["coverage"] = float(np.mean((lo[after] <= kt[after]) & (kt[after] <= hi[after])))

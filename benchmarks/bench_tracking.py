@@ -10,6 +10,18 @@ time: on a shared machine elapsed time measures the other jobs), ``realtime_fact
 the same on elapsed time, the goal ≥ 10, and the flops per sample.
 
     PYTHONPATH=src python benchmarks/bench_tracking.py [--duration-s 3] [--rig RIG]
+
+``--ramp RUN_DIR``: instead, the tracked scheme's closed-loop 0 → 3× nominal ramp
+(:func:`ambseal.analysis.ramp.ramp_simulation`) over ``--seeds`` seeds, from the output of
+one ``ambseal run RIG --truth TRUTH --set design.tracked=true`` (its identified rig, the
+tracked controller's table and the μ controller, the fallback) and the tracked design
+from ``--design-cache`` (the run's ``$AMBSEAL_CACHE_DIR`` file; read without its key
+check, as the synthesis takes minutes). Prints one JSON line per seed: the 95 %
+interval's coverage of the true k, the largest error, and whether the tracker refused
+(its consistency test) and when the μ controller took over.
+
+    PYTHONPATH=src python benchmarks/bench_tracking.py --rig examples/pump.toml \
+        --truth tests/data/pump_truth.toml --ramp OUT --design-cache CACHE.json --seeds 20
 """
 
 from __future__ import annotations
@@ -37,7 +49,14 @@ def main() -> None:
     ap.add_argument("--param", default=None, help="default: the first seal's k")
     ap.add_argument("--duration-s", type=float, default=3.0)
     ap.add_argument("--baseline-s", type=float, default=0.02)
+    ap.add_argument("--ramp", default=None, help="an `ambseal run` output folder")
+    ap.add_argument("--truth", default=None)
+    ap.add_argument("--design-cache", default=None)
+    ap.add_argument("--seeds", type=int, default=20)
+    ap.add_argument("--first-seed", type=int, default=0)
     args = ap.parse_args()
+    if args.ramp:
+        return ramp(args)
     cfg = load_rig(args.rig)
     name = args.param or f"{cfg.seal[0].name}.k"
     print(f"recording {args.duration_s} s on the virtual facility ...", file=sys.stderr)
@@ -66,6 +85,43 @@ def main() -> None:
         "realtime_factor": res.realtime_factor,
         "realtime_factor_wall": rec.time_s[-1] / res.wall_time_s,
         "goal_realtime_factor": 10.0}))
+
+
+def ramp(args) -> None:
+    import time
+    from pathlib import Path
+
+    from ambseal.analysis.judge import judge_settings
+    from ambseal.analysis.ramp import ramp_simulation
+    from ambseal.config import load_rig, load_truth
+    from ambseal.design.seal_schedule import _read_cache
+    from ambseal.design.specs import design_spec
+    from ambseal.export.controller_files import load_controller
+
+    run = Path(args.ramp)
+    cfg, truth = load_rig(args.rig), load_truth(args.truth)
+    ident = load_rig(run / "identified_rig.toml")
+    cache = Path(args.design_cache)
+    tracked = _read_cache(cache, json.loads(cache.read_text())["key"])
+    table = load_controller(run / "controllers" / "controller_tracked.npz")
+    mu = load_controller(run / "controllers" / "controller_mu.npz").discrete
+    judgement = judge_settings(design_spec(cfg))
+    for seed in range(args.first_seed, args.first_seed + args.seeds):
+        t0 = time.process_time()
+        r = ramp_simulation(cfg, truth, {"mu": mu}, tracked, model_cfg=ident,
+                            tracked_digital=table, delay_samples=cfg.controller.delay_samples,
+                            judgement=judgement, seed=seed)
+        t = r.tracking
+        print(json.dumps({"seed": seed, "coverage": t["coverage"],
+                          "max_error_rel": t["max_error_rel"], "refused": t["refused"],
+                          "refused_at_s": t["refused_at_s"], "fallback": t["fallback"],
+                          "fallback_from_s": t["fallback_from_s"],
+                          "check_largest": t["check_largest"],
+                          "check_largest_bias_se": t["check_largest_bias_se"],
+                          "threshold": t["check_threshold"],
+                          "tracked_lost_at_s": r.runs["tracked"].lost_at_s,
+                          "mu_lost_at_s": r.runs["mu"].lost_at_s,
+                          "cpu_s": time.process_time() - t0}), flush=True)
 
 
 if __name__ == "__main__":

@@ -55,7 +55,8 @@ def test_ramp_losses_agree_with_the_frozen_full_order_loops(testrig_cfg, testrig
     plant``) keeps the rotor too, with the estimator in the loop; the estimator, its model
     the rig identified by the thesis procedure on the same facility, meets the issue's
     acceptance against the truth's k (the truth file's k at each step's pressure): within
-    10 % of the nominal k after 1 s, the 95 % interval covering it ≥ 90 % of the time."""
+    10 % of the nominal k after 1 s, the 95 % interval covering it ≥ 90 % of the time; and
+    its consistency test (the seal's held-known K, C, c) does not refuse it."""
     from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
     from ambseal.design.specs import design_spec
     from ambseal.analysis.ramp import ramp_simulation
@@ -80,6 +81,8 @@ def test_ramp_losses_agree_with_the_frozen_full_order_loops(testrig_cfg, testrig
     assert 1.1 * p0 < lost_p < 1.5 * p0
     assert r.runs["mu"].lost_at_s is None
     assert r.runs["tracked"].lost_at_s is None
+    print(r.tracking)
     assert r.tracking["max_error_rel"] < 0.10 and r.tracking["coverage"] >= 0.90
+    assert not r.tracking["refused"] and r.tracking["fallback"] is None
     peaks = [x for x in r.runs["mu"].impulse_peak_um if x is not None]
     assert len(peaks) == len(r.impulse_times_s) and max(peaks) < 2 * min(peaks)

@@ -191,3 +191,125 @@ def test_facility_run_in_blocks_equals_one_run(testrig_cfg):
     for j in range(3):
         np.testing.assert_allclose(np.vstack([p[j] for p in parts]), ref[j], rtol=0,
                                    atol=1e-12 * np.max(np.abs(ref[j])))
+
+
+def _ar1(rng, n, phi):
+    """AR(1) noise of unit innovation variance: coloured like a score whose innovations are
+    not white."""
+    from scipy.signal import lfilter
+
+    return lfilter([1.0], [1.0, -phi], rng.standard_normal(n))
+
+
+def _block_sum_sd(block, phi):
+    """Standard deviation of a sum of ``block`` consecutive AR(1) values, from its
+    autocovariance γ(h) = φ^h / (1 − φ²) summed over every pair."""
+    h = np.abs(np.subtract.outer(np.arange(block), np.arange(block)))
+    return float(np.sqrt(np.sum(phi**h) / (1 - phi**2)))
+
+
+def test_score_test_refusal_rates_follow_the_central_and_noncentral_f():
+    """Reference: Student's t and its noncentral form (scipy.stats.f, ncf). Batch sums of a
+    coloured (AR(1), φ = 0.8) zero-mean score over 50-sample batches are nearly
+    independent normals, so a window of 30 batches refuses with probability α (here 0.01,
+    r = 1) — the test's false refusals — and a score of mean μ per sample refuses with
+    the noncentral F's tail at λ = 30 (50 μ / sd of a batch sum)² — its power. Each rate
+    over 1500 windows lies within the binomial 99.9 % interval of the reference."""
+    from scipy import stats
+
+    from ambseal.identify.tracking import score_test
+
+    rng = np.random.default_rng(3)
+    block, window, n_win, phi, alpha = 50, 30, 1500, 0.8, 0.01
+    n = block * window * n_win
+    sd = _block_sum_sd(block, phi)
+    mu = 0.5 * sd / block / np.sqrt(window) * 5.0  # λ = 6.25: power about one half
+    thr = stats.f.ppf(1 - alpha, 1, window - 1)
+    lam = window * (block * mu / sd) ** 2
+    for mean, p_ref in ((0.0, alpha), (mu, stats.ncf.sf(thr, 1, window - 1, lam))):
+        got_thr, windows = score_test((_ar1(rng, n, phi) + mean)[:, None], block, window,
+                                      alpha)
+        assert got_thr == pytest.approx(thr) and len(windows) == n_win
+        refused = sum(w[3] for w in windows)
+        lo, hi = stats.binom.interval(0.999, n_win, p_ref)
+        assert lo <= refused <= hi, (mean, refused, p_ref * n_win)
+
+
+def test_consistency_refuses_only_the_seal_errors_that_bias_k(testrig_cfg, nominal_record):
+    """Reference: the facility's own rig, whose seal coefficients are the truth. Tracked
+    with that model the held-known K, C, c pass. With the seal's direct stiffness K halved
+    the score test finds the error (t² above the threshold) and its Gauss–Newton estimate
+    is the truth's difference, K(p)/2 = 5.1e4 N/m, within 5 %; but K's sensitivity is
+    nearly orthogonal to k's, so k̂'s bias stays far below its standard error (measured:
+    the mean of (k̂ − k)/SE after 0.5 s) and the tracker does not refuse. With the direct
+    damping C left out (error C(p) = 202 N s/m) the bias it predicts exceeds one standard
+    error, k̂'s measured mean error agrees with it within 0.5 SE, and the tracker refuses
+    naming C."""
+    from ambseal.identify.tracking import OnlineTracker, TrackingSettings, linearised_model
+
+    cfg, rec = testrig_cfg, nominal_record
+    s = TrackingSettings(check_window_s=0.6, check_block_s=0.02)
+    y, u = rec.displacement_m, rec.current_ref_a
+    dt = float(rec.time_s[1] - rec.time_s[0])
+    seal, p_bar = cfg.seal[0], rec.metadata["pressure_drop_pa"] / 1e5
+    k_true = seal.k.at_zero + seal.k.per_bar * p_bar
+    out, err = {}, {}
+    for label, name, f in (("right", "K", 1.0), ("K halved", "K", 0.5), ("no C", "C", 0.0)):
+        m = cfg.model_copy(update={"seal": [seal.model_copy(
+            update={name: _scaled(getattr(seal, name), f)})]})
+        tr = OnlineTracker(m, linearised_model(m, rec, ["seal.k"], s), ["seal.k"], dt, y, u, s)
+        tr.update(y, u)
+        res = tr.result(rec.time_s)
+        after = int(round(s.min_duration_s / dt))
+        err[label] = float(np.mean((res.estimate[after:, 0] - k_true)
+                                   / res.std_error[after:, 0]))
+        out[label] = tr
+    checks = {k: v.consistency() for k, v in out.items()}
+    assert out["right"].probes == ("seal.K", "seal.C", "seal.c")
+    assert all(len(c["windows"]) == 1 for c in checks.values())
+    assert out["right"].refused_at_s is None
+    w, thr = checks["K halved"]["windows"][0], checks["K halved"]["threshold"]
+    assert w["statistic"]["seal.K"] > thr
+    assert w["delta"]["seal.K"] == pytest.approx((seal.K.at_zero + seal.K.per_bar * p_bar) / 2,
+                                                 rel=0.05)
+    assert w["bias_se"]["seal.K"] < 1.0 and abs(err["K halved"]) < 1.0
+    assert out["K halved"].refused_at_s is None
+    w = checks["no C"]["windows"][0]
+    assert w["bias_se"]["seal.C"] > 1.0 and abs(err["no C"]) > 1.0
+    assert abs(w["bias_se"]["seal.C"] - abs(err["no C"])) < 0.5
+    assert out["no C"].refused_at_s is not None and "seal.C" in out["no C"].refusal
+
+
+def test_held_error_check_refuses_a_relevant_error_not_a_merely_significant_one():
+    """Reference: least squares with two regressors. y = h_k k + h_j δ + e; the tracked k
+    is fitted alone (its score zero), the held-known coefficient's true value is δ away.
+    The check's δ must be the two-regressor fit's (numpy.linalg.lstsq) and its bias the
+    one-regressor fit's actual error k̂ − k. With h_j nearly orthogonal to h_k
+    (correlation 0.05) a δ that the score test finds (t² ≫ threshold) leaves k̂ within its
+    standard error and is accepted; a δ six times larger biases k̂ by more and is refused."""
+    from ambseal.identify.tracking import held_error_check
+
+    rng = np.random.default_rng(11)
+    n, block, window, sigma, k = 60_000, 2_000, 30, 1.0, 2.0
+    hk = rng.standard_normal(n)
+    hj = 0.05 * hk + np.sqrt(1 - 0.05**2) * rng.standard_normal(n)
+    e = sigma * rng.standard_normal(n)
+    for delta, refuse in ((0.05, False), (0.30, True)):
+        y = hk * k + hj * delta + e
+        k_hat = hk @ y / (hk @ hk)
+        eps = y - hk * k_hat
+        se_k = sigma / np.sqrt(hk @ hk)
+        score, info = (hj * eps / sigma**2)[:, None], (hj * hj / sigma**2)[:, None]
+        cross = np.stack([hk * hk, hk * hj], axis=1)[:, None, :] / sigma**2
+        thr, (w,) = held_error_check(score, info, cross, np.full((n, 1), se_k), block,
+                                     window, 1e-4, 1.0)
+        both = np.linalg.lstsq(np.c_[hk, hj], y, rcond=None)[0]
+        assert w["delta"][0] == pytest.approx(both[1], rel=1e-9)
+        assert w["bias_se"][0] == pytest.approx(abs(k_hat - both[0]) / se_k, rel=1e-9)
+        assert w["t2"][0] > thr
+        assert w["refused"] is refuse
+
+
+def _scaled(coef, f):
+    """A seal coefficient (an Affine) times ``f`` at every pressure."""
+    return coef.model_copy(update={"at_zero": coef.at_zero * f, "per_bar": coef.per_bar * f})

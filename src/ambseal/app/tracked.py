@@ -20,7 +20,21 @@ from ambseal.design.seal_schedule import design_seal_scheduled
 from ambseal.errors import ConfigError
 from ambseal.report.tracking_figures import ramp_figure
 
-__all__ = ["tracked_designs", "tracked_ramp"]
+__all__ = ["tracked_designs", "tracked_ramp", "refusal_sentence"]
+
+
+def refusal_sentence(tracking: dict) -> str:
+    """The report's words on the tracker's consistency test (``ramp.tracking``): empty when
+    it did not refuse, else that k cannot be tracked on this rig, why, and which
+    controller ran instead (:func:`ambseal.analysis.ramp.ramp_simulation`)."""
+    if not tracking.get("refused"):
+        return ""
+    name = {"mu": "μ", "hinf": "H∞"}.get(tracking.get("fallback"), tracking.get("fallback"))
+    ran = (f"the {name} controller ran instead from "
+           f"{tracking['fallback_from_s']:.3g} s" if tracking.get("fallback")
+           else "no fallback controller ran: the scheduled one kept the biased estimate")
+    return (f" The tracker cannot track k on this rig: at {tracking['refused_at_s']:.3g} s "
+            f"{tracking['refusal']}; {ran}.")
 
 
 def tracked_designs(cfg, design_cfg, spec, points, say, digitals: dict, cannot_run: dict
@@ -63,7 +77,9 @@ def tracked_ramp(cfg, truth, designs, digitals: dict, ident, settings, out: Path
     """The 0 → 3× nominal ramp on the virtual facility, the tracker's model the rig
     identified by ``ident`` (``commands.Identified``), its impulses those of the judgement
     ``settings``: ``metrics.json``'s ``ramp`` and the report's figure (caption, path); one
-    step of ``say(message, steps)`` at the end."""
+    step of ``say(message, steps)`` at the end. When the tracker refuses (its consistency
+    test), the μ controller runs the rest of the ramp in the tracked run and the caption
+    and the progress line say so (:func:`refusal_sentence`)."""
 
     tracked = next(d.controller for d in designs if d.method == "tracked")
     fixed = {m: g.discrete for m, g in digitals.items() if m != "tracked"}
@@ -72,13 +88,15 @@ def tracked_ramp(cfg, truth, designs, digitals: dict, ident, settings, out: Path
                         delay_samples=cfg.controller.delay_samples, judgement=settings,
                         progress=lambda line: say(line, 0))
     t = r.tracking
+    if t.get("refused"):
+        say("ramp:" + refusal_sentence(t), 0)
     caption = (f"Pressure ramp 0 → {r.pressure_bar.max():.3g} bar in {r.time_s[-1]:.0f} s on "
                "the virtual facility with a current impulse every 2 s: true and tracked "
                f"{r.parameter} (largest error after 1 s "
                f"{100 * (t.get('max_error_rel') or float('nan')):.1f} % of nominal, 95 % "
                f"interval coverage {100 * (t.get('coverage') or float('nan')):.1f} %), "
                "displacement and current of every controller, impulse peaks and settling "
-               "times")
+               "times." + refusal_sentence(t))
     fig = ramp_figure(out / "ramp.png", r)
     say("ramp done", 1)
     return r.to_dict(), (caption, fig)

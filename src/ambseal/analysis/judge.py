@@ -356,7 +356,7 @@ def points_for(controller, points, design_cfg) -> list[OperatingPoint]:
     by_speed = len(speeds) > 1
 
     def point(q, rpm):
-        label = f"{q:g} bar" + (f", {rpm / 60.0:g} Hz" if by_speed else "")
+        label = f"{q:.4g} bar" + (f", {rpm / 60.0:g} Hz" if by_speed else "")
         x, x0 = (rpm, nominal.speed_rpm) if by_speed else (q, nominal.pressure_bar)
         side = "nominal" if x == x0 else ("low" if x < x0 else "high")
         return OperatingPoint(q, rpm, label, side)

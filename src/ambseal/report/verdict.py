@@ -72,7 +72,7 @@ def _speed_varies(cases: Sequence[Mapping]) -> bool:
 
 def condition_label(case: Mapping, by_speed: bool) -> str:
     """``"2.04 bar"`` or, when the judged conditions differ in speed, ``"140 Hz"``."""
-    return f"{case['speed_hz']:g} Hz" if by_speed else f"{case['pressure_bar']:g} bar"
+    return f"{case['speed_hz']:g} Hz" if by_speed else f"{case['pressure_bar']:.4g} bar"
 
 
 def _worst(zones) -> str | None:

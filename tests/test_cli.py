@@ -204,7 +204,8 @@ def test_version_and_helps_with_defaults(capsys):
     assert "report.html (verdict first)" in text
     with pytest.raises(SystemExit):
         main(["acquire", "--help"])
-    assert "(default: 0.05)" in " ".join(capsys.readouterr().out.split())
+    assert "(A; default [design.impulse] amplitude_a, else bias current / 120)" in " ".join(
+        capsys.readouterr().out.split())
 
 
 def test_validate_and_modes_default_to_the_embedded_rig(capsys):

@@ -436,9 +436,52 @@ class _Sb10:
         self.nw, self.nz = B0.shape[1] - ncon, C0.shape[0] - nmeas
         A, B, C, D, _, self.su, self.sy = _scale(A0, B0, C0, D0, self.nw, self.nz)
         self.A, self.B, self.C, self.D = (np.ascontiguousarray(M) for M in (A, B, C, D))
+        #: smallest γ not refused by SB10AD's lower-bound check so far (:meth:`sb10ad`)
+        self._bound_above = np.inf
+
+    def sb10ad(self, g: float, job: int, gtol: float = 1e-6):
+        """SLICOT SB10AD on the scaled plant at γ = g (job 4: test and controller at g; job
+        1: bisection below g to ``gtol``), past SB10AD's wrong lower bound of γ.
+
+        SB10AD first refuses (info 6) every γ at or below its bound
+        ``max(σ̄[D1111, D1112], σ̄[D1111ᵀ, D1121ᵀ])``, but in SLICOT 5.8 (SB10AD, "Workspace
+        usage 2") the workspace of the second singular value decomposition starts inside
+        the first one's result, so the bound it compares with is whatever LAPACK left there:
+        on a plant with 3 performance outputs and 2 exogenous inputs, DGESVD's optimal
+        workspace size (67 with this LAPACK) — every γ ≤ 67 refused whatever the plant. Its
+        true value is Parrott's bound (:meth:`parrott`), so an info 6 above that bound is
+        this defect, and SB10AD is asked again from ``g0 = g·2^K`` with K large enough that
+        ``g0 − bound`` rounds to ``g0``: its bisection (job 1) then halves exactly down the
+        ladder g0, g0/2, … to g (job 4: stopping there, ``gtol = 1.5·g``; a γ of the ladder
+        refused leaves it above g, and g is refused) or on below g to ``gtol`` (job 1).
+        python-control's ``hinfsyn`` gets past the bound the same way, from γ = 1e100.
+        """
+        args = (self.A, self.B, self.C, self.D, self.ncon, self.nmeas)
+        out, info = _sb10ad(*args, g, job, gtol)
+        if info != 6:
+            self._bound_above = min(self._bound_above, g)
+            return out, info
+        if g <= self.parrott_bound * (1.0 + 1e-9):
+            return out, info
+        top = self._bound_above
+        up = 256.0
+        while top == np.inf:  # find a γ above SB10AD's bound: a ladder of factors 2^8
+            if g * up > 1e100:
+                return out, info
+            if _sb10ad(*args, g * up, 4)[1] != 6:
+                top = self._bound_above = g * up
+            up *= 256.0
+        K = int(np.ceil(np.log2(top / g))) + 56
+        g0 = float(np.ldexp(g, K))
+        if g0 > 1e100:  # (γ² must not overflow inside SB10AD)
+            return out, info
+        out2, info2 = _sb10ad(*args, g0, 1, 1.5 * g if job == 4 else gtol)
+        if job == 4 and not info2 and out2[0] != g:
+            return out, 12  # the ladder was left above g: g is not admissible
+        return out2, info2
 
     def call(self, g: float, job: int):
-        out, info = _sb10ad(self.A, self.B, self.C, self.D, self.ncon, self.nmeas, g, job)
+        out, info = self.sb10ad(g, job)
         if info:
             raise SynthesisError(f"hinfsyn: SB10AD failed at γ={g:.6g}: "
                                  f"{_SB10AD_INFO.get(info, 'argument error')} (info={info})")
@@ -446,7 +489,7 @@ class _Sb10:
 
     def admissible(self, g: float) -> bool:
         """SB10AD's γ test (job 4: the Riccati conditions of Glover & Doyle 1988 at γ)."""
-        info = _sb10ad(self.A, self.B, self.C, self.D, self.ncon, self.nmeas, g, 4)[1]
+        info = self.sb10ad(g, 4)[1]
         if info in (6, 7, 8, 12):
             return False
         if info:
@@ -551,8 +594,7 @@ class _Sb10:
             sb0, tests = (-1.0 if self.admissible(g0) else 1.0), tests + 1
         hi, lo, more = _search_gamma(lambda g: -1.0 if self.admissible(g) else 1.0,
                                      lo0, 3.0, {g0: sb0})
-        out, info = _sb10ad(self.A, self.B, self.C, self.D, self.ncon, self.nmeas, hi, 1,
-                            gtol=rtol * lo)
+        out, info = self.sb10ad(hi, 1, gtol=rtol * lo)
         g = hi if info else float(out[0])  # on failure keep the bracket's admissible top
         return (g if lo < g <= hi else hi), lo, tests + more + 1
 

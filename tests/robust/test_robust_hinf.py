@@ -243,6 +243,31 @@ def test_hinfsyn_reaches_gamma_opt_where_sb10ad_misjudges_its_lower_bound():
     assert r.gamma_lower <= r.gamma_opt
 
 
+def test_hinfsyn_says_when_its_controller_misses_the_gamma_claimed(monkeypatch):
+    """Reference: Glover (1986), optimum ‖KS‖∞ = 2 for G = 1/(s − 1), and the closed
+    loop's norm by ``control.linfnorm``. When SB10AD builds no controller near γ_opt (here
+    made to refuse below 3·γ_opt) the controller returned is the upward search's, whose
+    norm is above the back-off claimed: ``on_target`` says so; by default it holds."""
+    from ambseal.robust.hinf import _Sb10
+
+    P = ct.ss([[1.]], [[0., 1.]], [[0.], [1.]], [[0., 1.], [1., 0.]])
+    r = hinfsyn(P, 1, 1, max_backoff=1.02)
+    assert r.on_target and r.gamma_opt == pytest.approx(2.0, rel=1e-5)
+    plain = _Sb10.controller
+
+    def refuse_near_opt(self, g):
+        if g < 3 * 2.0:
+            raise SynthesisError("refused")
+        return plain(self, g)
+
+    monkeypatch.setattr(_Sb10, "controller", refuse_near_opt)
+    r = hinfsyn(P, 1, 1, max_backoff=1.02)
+    norm = ct.linfnorm(lft_lower(P, r.K, 1, 1))[0]
+    assert norm == pytest.approx(r.gamma, rel=1e-6)
+    assert norm > 1.02 * 2.0 * (1 + 1e-3)
+    assert not r.on_target and r.to_dict()["on_target"] is False
+
+
 # --------------------------------------------------------------------------- errors
 def test_hinfsyn_rejects_unstabilisable_plant():
     """Reference: PBH test — an unstable mode not reached by B2 cannot be stabilised."""

@@ -9,14 +9,17 @@ eq. (8) of the thesis::
     γ = ‖F_l(P, K)‖_∞
 
 Synthesis uses SLICOT's Riccati-based solver SB10AD (Glover & Doyle 1988 formulas, via
-slycot). Two traps are handled here rather than left to the user:
+slycot). Three traps are handled here rather than left to the user:
 
 * the controller at exactly the optimal γ can be unstable or ill-conditioned, so the
   controller is built at a small back-off ``backoff·γ_opt`` and the closed-loop poles are
   checked (the back-off grows until they are stable);
 * SB10AD's γ can be below the true closed-loop norm when ``D11 ≠ 0``; every γ reported here
   is the norm of the closed loop recomputed by :func:`hinfnorm` (SLICOT AB13DD through
-  python-control, Bruinsma & Steinbuch 1990).
+  python-control, Bruinsma & Steinbuch 1990);
+* SB10AD's check of γ against its lower bound reads a bound LAPACK has overwritten (67 on
+  some plants whose γ_opt is 2.3): above Parrott's bound its refusal is set aside
+  (:meth:`_Sb10.sb10ad`).
 
 References: Skogestad & Postlethwaite (2005) ch. 9; Zhou, Doyle & Glover (1996) ch. 14–17;
 Boyd, Balakrishnan & Kabamba (1989); Bruinsma & Steinbuch (1990).
@@ -228,6 +231,13 @@ class HinfResult:
         if every γ tried was admissible; nan for a given ``gamma``).
     iterations : int
         SB10AD calls: γ tests of the search plus controllers built.
+    on_target : bool
+        Whether ``gamma`` is within the back-off of the γ claimed: ``gamma ≤
+        max_backoff·gamma_opt·(1 + 1e-3)`` after a search, ``gamma ≤ γ·(1 + 1e-3)`` for a
+        given γ. False when SB10AD's controllers near that γ miss the γ they were built for
+        (D–G-scaled plants: built for 0.93, norm 30.9) and the controller returned is the
+        best one the upward search verified: a valid controller, far from the optimum.
+        Reported rather than raised: D–G–K then tries the controller at its own level.
     """
 
     K: Any
@@ -239,6 +249,7 @@ class HinfResult:
     rcond: tuple = ()
     gamma_lower: float = float("nan")
     iterations: int = 0
+    on_target: bool = True
 
     @property
     def order(self) -> int:
@@ -256,6 +267,7 @@ class HinfResult:
         return {
             "gamma": self.gamma, "gamma_opt": self.gamma_opt, "gamma_design": self.gamma_design,
             "gamma_lower": self.gamma_lower, "iterations": self.iterations,
+            "on_target": self.on_target,
             "omega_peak_rad_s": self.omega_peak, "order": self.order,
             "rcond": list(self.rcond),
             "K": {"A": np.asarray(K.A).tolist(), "B": np.asarray(K.B).tolist(),
@@ -340,7 +352,10 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
         Wrong system type or channel counts (ModelError); backoff < 1 (ConfigError).
     SynthesisError
         Plant not stabilisable/detectable, ``D12``/``D21`` rank deficient, jω-axis zeros,
-        inadmissible ``gamma`` or no stabilising controller found.
+        inadmissible ``gamma`` or no stabilising controller found; or a controller's
+        verified norm below the largest γ the search found inadmissible (the search
+        contradicted, so ``gamma_opt`` would be wrong). A verified norm far above the γ
+        claimed is reported instead (``HinfResult.on_target`` False).
 
     Examples
     --------
@@ -382,6 +397,13 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
         raise SynthesisError(
             f"hinfsyn: no stabilising controller found from γ={base_g:.6g} upwards "
             f"({last_err[0]})")
+    if gamma is None and chosen.gamma < gamma_lower * (1.0 - 1e-6):
+        # a controller beats a γ the search found inadmissible: its γ_opt is wrong
+        raise SynthesisError(
+            f"hinfsyn: the γ search is contradicted: a controller achieves "
+            f"{chosen.gamma:.6g} below γ={gamma_lower:.6g} found inadmissible "
+            f"(γ_opt {gamma_opt:.6g} is not the optimum)")
+    claimed = max_backoff * gamma_opt if gamma is None else float(gamma)
     ylab, ulab = list(P.output_labels)[sb.nz:], list(P.input_labels)[sb.nw:]
     K = ct.ss(*chosen.K, inputs=ylab, outputs=ulab, name="K",
               states=[f"xK{i}" for i in range(chosen.K[0].shape[0])])
@@ -390,7 +412,8 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
     return HinfResult(K=K, gamma=float(chosen.gamma), gamma_opt=gamma_opt,
                       gamma_design=float(chosen.gamma_design), omega_peak=float(chosen.omega),
                       closed_loop=cl, rcond=chosen.rcond,
-                      gamma_lower=gamma_lower, iterations=tests + len(tried))
+                      gamma_lower=gamma_lower, iterations=tests + len(tried),
+                      on_target=bool(chosen.gamma <= claimed * (1.0 + 1e-3)))
 
 
 def hinf_gamma_opt(P, nmeas: int, ncon: int, *, rtol: float = 1e-6,

@@ -470,8 +470,9 @@ class _Sb10:
         ``max(σ̄[D1111, D1112], σ̄[D1111ᵀ, D1121ᵀ])``, but in SLICOT 5.8 (SB10AD, "Workspace
         usage 2") the workspace of the second singular value decomposition starts inside
         the first one's result, so the bound it compares with is whatever LAPACK left there:
-        with 3 performance outputs, 2 exogenous inputs, 1 control and 1 measurement, DGESVD's optimal
-        workspace size (67 with this LAPACK) — every γ ≤ 67 refused whatever the plant. Its
+        with 3 performance outputs, 2 exogenous inputs, 1 control and 1 measurement,
+        DGESVD's optimal workspace size (67 with this LAPACK) — every γ ≤ 67 refused
+        whatever the plant. Its
         true value is Parrott's bound (:meth:`parrott`), so an info 6 above that bound is
         this defect, and SB10AD is asked again from ``g0 = g·2^K`` with K large enough that
         ``g0 − bound`` rounds to ``g0``: its bisection (job 1) then halves exactly down the

@@ -9,14 +9,17 @@ eq. (8) of the thesis::
     γ = ‖F_l(P, K)‖_∞
 
 Synthesis uses SLICOT's Riccati-based solver SB10AD (Glover & Doyle 1988 formulas, via
-slycot). Two traps are handled here rather than left to the user:
+slycot). Three traps are handled here rather than left to the user:
 
 * the controller at exactly the optimal γ can be unstable or ill-conditioned, so the
   controller is built at a small back-off ``backoff·γ_opt`` and the closed-loop poles are
   checked (the back-off grows until they are stable);
 * SB10AD's γ can be below the true closed-loop norm when ``D11 ≠ 0``; every γ reported here
   is the norm of the closed loop recomputed by :func:`hinfnorm` (SLICOT AB13DD through
-  python-control, Bruinsma & Steinbuch 1990).
+  python-control, Bruinsma & Steinbuch 1990);
+* SB10AD's check of γ against its lower bound reads a bound LAPACK has overwritten (67 on
+  some plants whose γ_opt is 2.3): above Parrott's bound its refusal is set aside
+  (:meth:`_Sb10.sb10ad`).
 
 References: Skogestad & Postlethwaite (2005) ch. 9; Zhou, Doyle & Glover (1996) ch. 14–17;
 Boyd, Balakrishnan & Kabamba (1989); Bruinsma & Steinbuch (1990).
@@ -228,6 +231,13 @@ class HinfResult:
         if every γ tried was admissible; nan for a given ``gamma``).
     iterations : int
         SB10AD calls: γ tests of the search plus controllers built.
+    on_target : bool
+        Whether ``gamma`` is within the back-off of the γ claimed: ``gamma ≤
+        max_backoff·gamma_opt·(1 + 1e-3)`` after a search, ``gamma ≤ γ·(1 + 1e-3)`` for a
+        given γ. False when SB10AD's controllers near that γ miss the γ they were built for
+        (D–G-scaled plants: built for 0.93, norm 30.9) and the controller returned is the
+        best one the upward search verified: a valid controller, far from the optimum.
+        Reported rather than raised: D–G–K then tries the controller at its own level.
     """
 
     K: Any
@@ -239,6 +249,7 @@ class HinfResult:
     rcond: tuple = ()
     gamma_lower: float = float("nan")
     iterations: int = 0
+    on_target: bool = True
 
     @property
     def order(self) -> int:
@@ -256,6 +267,7 @@ class HinfResult:
         return {
             "gamma": self.gamma, "gamma_opt": self.gamma_opt, "gamma_design": self.gamma_design,
             "gamma_lower": self.gamma_lower, "iterations": self.iterations,
+            "on_target": self.on_target,
             "omega_peak_rad_s": self.omega_peak, "order": self.order,
             "rcond": list(self.rcond),
             "K": {"A": np.asarray(K.A).tolist(), "B": np.asarray(K.B).tolist(),
@@ -340,7 +352,10 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
         Wrong system type or channel counts (ModelError); backoff < 1 (ConfigError).
     SynthesisError
         Plant not stabilisable/detectable, ``D12``/``D21`` rank deficient, jω-axis zeros,
-        inadmissible ``gamma`` or no stabilising controller found.
+        inadmissible ``gamma`` or no stabilising controller found; or a controller's
+        verified norm below the largest γ the search found inadmissible (the search
+        contradicted, so ``gamma_opt`` would be wrong). A verified norm far above the γ
+        claimed is reported instead (``HinfResult.on_target`` False).
 
     Examples
     --------
@@ -382,6 +397,13 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
         raise SynthesisError(
             f"hinfsyn: no stabilising controller found from γ={base_g:.6g} upwards "
             f"({last_err[0]})")
+    if gamma is None and chosen.gamma < gamma_lower * (1.0 - 1e-6):
+        # a controller beats a γ the search found inadmissible: its γ_opt is wrong
+        raise SynthesisError(
+            f"hinfsyn: the γ search is contradicted: a controller achieves "
+            f"{chosen.gamma:.6g} below γ={gamma_lower:.6g} found inadmissible "
+            f"(γ_opt {gamma_opt:.6g} is not the optimum)")
+    claimed = max_backoff * gamma_opt if gamma is None else float(gamma)
     ylab, ulab = list(P.output_labels)[sb.nz:], list(P.input_labels)[sb.nw:]
     K = ct.ss(*chosen.K, inputs=ylab, outputs=ulab, name="K",
               states=[f"xK{i}" for i in range(chosen.K[0].shape[0])])
@@ -390,7 +412,8 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
     return HinfResult(K=K, gamma=float(chosen.gamma), gamma_opt=gamma_opt,
                       gamma_design=float(chosen.gamma_design), omega_peak=float(chosen.omega),
                       closed_loop=cl, rcond=chosen.rcond,
-                      gamma_lower=gamma_lower, iterations=tests + len(tried))
+                      gamma_lower=gamma_lower, iterations=tests + len(tried),
+                      on_target=bool(chosen.gamma <= claimed * (1.0 + 1e-3)))
 
 
 def hinf_gamma_opt(P, nmeas: int, ncon: int, *, rtol: float = 1e-6,
@@ -436,9 +459,53 @@ class _Sb10:
         self.nw, self.nz = B0.shape[1] - ncon, C0.shape[0] - nmeas
         A, B, C, D, _, self.su, self.sy = _scale(A0, B0, C0, D0, self.nw, self.nz)
         self.A, self.B, self.C, self.D = (np.ascontiguousarray(M) for M in (A, B, C, D))
+        #: smallest γ not refused by SB10AD's lower-bound check so far (:meth:`sb10ad`)
+        self._bound_above = np.inf
+
+    def sb10ad(self, g: float, job: int, gtol: float = 1e-6):
+        """SLICOT SB10AD on the scaled plant at γ = g (job 4: test and controller at g; job
+        1: bisection below g to ``gtol``), past SB10AD's wrong lower bound of γ.
+
+        SB10AD first refuses (info 6) every γ at or below its bound
+        ``max(σ̄[D1111, D1112], σ̄[D1111ᵀ, D1121ᵀ])``, but in SLICOT 5.8 (SB10AD, "Workspace
+        usage 2") the workspace of the second singular value decomposition starts inside
+        the first one's result, so the bound it compares with is whatever LAPACK left there:
+        with 3 performance outputs, 2 exogenous inputs, 1 control and 1 measurement,
+        DGESVD's optimal workspace size (67 with this LAPACK) — every γ ≤ 67 refused
+        whatever the plant. Its
+        true value is Parrott's bound (:meth:`parrott`), so an info 6 above that bound is
+        this defect, and SB10AD is asked again from ``g0 = g·2^K`` with K large enough that
+        ``g0 − bound`` rounds to ``g0``: its bisection (job 1) then halves exactly down the
+        ladder g0, g0/2, … to g (job 4: stopping there, ``gtol = 1.5·g``; a γ of the ladder
+        refused leaves it above g, and g is refused) or on below g to ``gtol`` (job 1).
+        python-control's ``hinfsyn`` gets past the bound the same way, from γ = 1e100.
+        """
+        args = (self.A, self.B, self.C, self.D, self.ncon, self.nmeas)
+        out, info = _sb10ad(*args, g, job, gtol)
+        if info != 6:
+            self._bound_above = min(self._bound_above, g)
+            return out, info
+        if g <= self.parrott_bound * (1.0 + 1e-9):
+            return out, info
+        top = self._bound_above
+        up = 256.0
+        while top == np.inf:  # find a γ above SB10AD's bound: a ladder of factors 2^8
+            if g * up > 1e100:
+                return out, info
+            if _sb10ad(*args, g * up, 4)[1] != 6:
+                top = self._bound_above = g * up
+            up *= 256.0
+        K = int(np.ceil(np.log2(top / g))) + 56
+        g0 = float(np.ldexp(g, K))
+        if g0 > 1e100:  # (γ² must not overflow inside SB10AD)
+            return out, info
+        out2, info2 = _sb10ad(*args, g0, 1, 1.5 * g if job == 4 else gtol)
+        if job == 4 and not info2 and out2[0] != g:
+            return out, 12  # the ladder was left above g: g is not admissible
+        return out2, info2
 
     def call(self, g: float, job: int):
-        out, info = _sb10ad(self.A, self.B, self.C, self.D, self.ncon, self.nmeas, g, job)
+        out, info = self.sb10ad(g, job)
         if info:
             raise SynthesisError(f"hinfsyn: SB10AD failed at γ={g:.6g}: "
                                  f"{_SB10AD_INFO.get(info, 'argument error')} (info={info})")
@@ -446,7 +513,7 @@ class _Sb10:
 
     def admissible(self, g: float) -> bool:
         """SB10AD's γ test (job 4: the Riccati conditions of Glover & Doyle 1988 at γ)."""
-        info = _sb10ad(self.A, self.B, self.C, self.D, self.ncon, self.nmeas, g, 4)[1]
+        info = self.sb10ad(g, 4)[1]
         if info in (6, 7, 8, 12):
             return False
         if info:
@@ -551,8 +618,7 @@ class _Sb10:
             sb0, tests = (-1.0 if self.admissible(g0) else 1.0), tests + 1
         hi, lo, more = _search_gamma(lambda g: -1.0 if self.admissible(g) else 1.0,
                                      lo0, 3.0, {g0: sb0})
-        out, info = _sb10ad(self.A, self.B, self.C, self.D, self.ncon, self.nmeas, hi, 1,
-                            gtol=rtol * lo)
+        out, info = self.sb10ad(hi, 1, gtol=rtol * lo)
         g = hi if info else float(out[0])  # on failure keep the bracket's admissible top
         return (g if lo < g <= hi else hi), lo, tests + more + 1
 

@@ -280,21 +280,6 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
     nb = BASES[lyapunov]
     ps = sc.p_of(grid)
     I_N = np.eye(N)
-    # Constraints implied by others are left out (each one is a large dense cone of the
-    # SDP, and the interior point's cost grows with them; the optimum is the same): the
-    # coupling LMI is affine in S, so with S affine in p (or constant) it holds on the whole
-    # range when it holds at the two ends; the R LMI is affine in A, so it holds at a grid
-    # point whose A lies on the straight line between its neighbours' (A affine in the
-    # parameter, as an LFT parameter's A₀ + B_θ θ C_θ is) when it holds at those.
-    ends = {0, grid.size - 1}
-    coupled = {0} if nb == 1 else ends if nb == 2 else set(range(grid.size))
-    implied_R = set()
-    for k in range(1, grid.size - 1):
-        t = (grid[k] - grid[k - 1]) / (grid[k + 1] - grid[k - 1])
-        line = (1 - t) * sc.A[k - 1] + t * sc.A[k + 1]
-        if np.allclose(sc.A[k], line, rtol=0, atol=1e-10 * max(np.abs(sc.A[k]).max(), 1.0)) \
-                and k - 1 not in implied_R:
-            implied_R.add(k)
 
     def build(gamma_fixed: float | None, alpha: float):
         R = cp.Variable((N, N), symmetric=True)
@@ -307,11 +292,10 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
             f, df = basis(lyapunov, float(ps[k]))
             S = sum(fi * Si for fi, Si in zip(f, Ss))
             dS = sum(dfi * Si for dfi, Si in zip(df, Ss)) if nb > 1 else None
-            if k not in implied_R:
-                MR = cp.bmat([[A @ R + R @ A.T, R @ C1.T, B1],
-                              [C1 @ R, -g * np.eye(nz), D11],
-                              [B1.T, D11.T, -g * np.eye(nw)]])
-                cons.append(_sym_expr(NR.T @ MR @ NR) << -eps * np.eye(NR.shape[1]))
+            MR = cp.bmat([[A @ R + R @ A.T, R @ C1.T, B1],
+                          [C1 @ R, -g * np.eye(nz), D11],
+                          [B1.T, D11.T, -g * np.eye(nw)]])
+            cons.append(_sym_expr(NR.T @ MR @ NR) << -eps * np.eye(NR.shape[1]))
             signs = (1.0, -1.0) if (dS is not None and nu_s > 0) else (0.0,)
             for sgn in signs:
                 top = A.T @ S + S @ A + (sgn * nu_s * dS if sgn else 0)
@@ -319,9 +303,8 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
                               [B1.T @ S, -g * np.eye(nw), D11.T],
                               [C1, D11, -g * np.eye(nz)]])
                 cons.append(_sym_expr(NS.T @ MS @ NS) << -eps * np.eye(NS.shape[1]))
-            if k in coupled:
+            if nb > 1 or k == 0:  # one coupling LMI suffices for a constant S
                 cons.append(_sym_expr(cp.bmat([[R, alpha * I_N], [alpha * I_N, S]])) >> 0)
-            if nb > 1 or k == 0:
                 trS = trS + cp.trace(S) / (grid.size if nb > 1 else 1)
         return R, Ss, g, cons, cp.trace(R) + trS
 

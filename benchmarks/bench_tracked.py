@@ -1,6 +1,9 @@
 """Time the synthesis of ``ambseal run``'s tracked controller (the H∞ LPV controller
 scheduled on the seal's k over 0–3× nominal, :func:`ambseal.design.seal_schedule.
-design_seal_scheduled`) on the embedded test rig.
+design_seal_scheduled`) on the embedded test rig and on the rig ``ambseal run`` designs it
+on: the test rig as identified on the virtual facility (``tests/data/
+testrig_identified_seed0.toml``, seed 0; identified seal coefficients and an eddy-current lag,
+32 design-plant states instead of 28).
 
 One JSON line per case on stdout: ``{"case", "ours_s", "baseline", "baseline_s", "ratio",
 "gamma", "check_gamma_max", "table"}`` — the CPU time of the whole design (design plants,
@@ -10,7 +13,7 @@ previous default of 5 design points (baseline, same run, ``ratio`` = ours/baseli
 tabulate the controller at the same 21 values of k, where its frozen loops are checked.
 
 Run from the repository root: ``PYTHONPATH=src python benchmarks/bench_tracked.py``
-(about 2–3 minutes of CPU).
+(about 3–4 minutes of CPU).
 """
 
 from __future__ import annotations
@@ -33,6 +36,14 @@ def main() -> None:
 
     cfg = load_rig()
     spec = design_spec(cfg)
+    root = Path(__file__).resolve().parents[1]
+    t0 = time.process_time()
+    d = design_seal_scheduled(load_rig(root / "tests" / "data" / "testrig_identified_seed0.toml"),
+                              spec=spec, cache_dir=None)
+    print(json.dumps({"case": "tracked_identified", "ours_s": round(time.process_time() - t0, 2),
+                      "gamma": round(d.gamma, 4),
+                      "check_gamma_max": round(float(d.check_gamma.max()), 4),
+                      "table": int(d.check_grid.size)}), flush=True)
     base = None
     for case, kw in (("tracked_5pt", {"n_grid": 5, "check_density": 5}),
                      ("tracked_default", {})):

@@ -38,7 +38,41 @@ a shared machine) and the medians are reported. BLAS runs single-threaded by def
 (``--threads``): on a small, busy machine multi-threaded OpenBLAS spends most of its time
 spinning, which makes every timing meaningless.
 
-Run: ``PYTHONPATH=src python benchmarks/bench_model.py [--quick] [--threads N]``.
+The fine-mesh cases (``--only fine``; also after the cases above by default) take the
+embedded test facility (``ambseal/data/testrig.toml``) with its three ``[[shaft]]``
+sections refined to 230 beam elements in all (13 + 204 + 13; 234 after the component
+splits, 1 880 states):
+
+``fine_modes_cli``
+    ``ambseal modes RIG --json`` as a child process, wall and CPU time, interpreter start
+    included; goal 10 s. Its first six modes against the default 34-element mesh's
+    (``max_rel_diff_default_mesh``: the mesh's convergence).
+``fine_modes``
+    The same command's numerics in this process (CPU time): ours is what ``modes`` runs
+    now — ``modes(sys)`` (dense eigenvalues of the state matrix, for every unstable pole)
+    and ``open_loop_modes`` (the modes up to the limit and their shapes from the
+    shift-invert path); the baseline is what it ran before, ``modes(sys)`` and
+    ``modes_of_state_matrix`` (a second, dense eig with eigenvectors). ``max_rel_diff``:
+    largest relative difference of the listed frequencies.
+``fine_reduced_plant``
+    ``build_plant(cfg, reduced=True, states=12)`` (the μ design's model), ours with the
+    lowest eigenpairs by shift-invert (``ambseal.lti.lowest``), the baseline with the
+    dense eig with left and right eigenvectors it used before (forced by
+    ``DENSE_STATES``). ``max_rel_diff``: of the two reduced plants' frequency responses
+    over 0.5 Hz–2 kHz.
+``fine_ross``
+    The same 230-element rotor on two plain bearings (1e6/0.8e6 N/m, 150/90 N·s/m) at the
+    AMBs' positions, no seal, coupling or modal damping, at 0 and 6000 rpm: ours
+    ``build_system`` → ``modes(sys)`` → ``open_loop_modes``; ROSS elements on the same
+    mesh → ``rs.Rotor`` → ``_eigen(speed, num_modes=12, sparse=True)`` (its dense eig of
+    2 800 states takes about a minute). ``max_rel_diff``: largest |Δλ|/|λ| of the first
+    six modes.
+
+``--fine-design`` adds ``fine_design_mu``: ``design(cfg, "mu")`` at 230 and 400 elements
+(CPU time, with μ and the full-order verdict; minutes).
+
+Run: ``PYTHONPATH=src python benchmarks/bench_model.py [--quick] [--threads N]
+[--only coarse|fine] [--fine-design]``.
 """
 
 from __future__ import annotations
@@ -55,6 +89,10 @@ def _args() -> argparse.Namespace:
     ap.add_argument("--quick", action="store_true", help="fewer repeats (smoke run)")
     ap.add_argument("--threads", type=int, default=1,
                     help="BLAS threads for both tools (default 1; 0 keeps the environment's)")
+    ap.add_argument("--only", choices=("coarse", "fine"), default=None,
+                    help="only the 40-element cases or only the fine-mesh ones")
+    ap.add_argument("--fine-design", action="store_true",
+                    help="also the μ design at 230 and 400 elements (minutes)")
     return ap.parse_args()
 
 
@@ -70,8 +108,14 @@ _OUT = os.fdopen(os.dup(1), "w", buffering=1)
 os.dup2(2, 1)
 sys.stdout = sys.stderr
 
+import re  # noqa: E402
+import resource  # noqa: E402
 import statistics  # noqa: E402
+import subprocess  # noqa: E402
+import tempfile  # noqa: E402
+import tomllib  # noqa: E402
 import warnings  # noqa: E402
+from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
@@ -147,8 +191,8 @@ def ross_num_modes(rs) -> int:
 
 def ours_frf(omega: np.ndarray, **kw) -> np.ndarray:
     """(n_w, 4, 4): outputs A_x, A_y, B_x, B_y per input force at A, B (N)."""
-    from ambseal.lti.freqresp import freqresp
     from ambseal.config import parse_rig
+    from ambseal.lti.freqresp import freqresp
     from ambseal.model.rig import build_plant
 
     p = build_plant(parse_rig(rig_dict()), speed_rpm=0.0)
@@ -226,15 +270,202 @@ def emit(rec: dict) -> None:
     _OUT.flush()
 
 
+# ---------------------------------------------------------------- the fine mesh
+FINE_ELEMENTS = 230
+FINE_BEARING = {"kxx": 1.0e6, "kyy": 0.8e6, "cxx": 150.0, "cyy": 90.0}
+FINE_SPEEDS_RPM = (0.0, 6000.0)
+N_FINE = 6  # modes compared
+
+
+def fine_rig_text(total: int) -> str:
+    """The embedded rig file with ``total`` beam elements in all: each section but the
+    longest its share by length (rounded), the longest the rest (tests/finemesh.py)."""
+    from ambseal.config import default_rig_path
+
+    text = default_rig_path().read_text(encoding="utf-8")
+    lengths = [float(x) for x in re.findall(r"^\[\[shaft\]\]\nlength = ([0-9.eE+-]+)",
+                                            text, flags=re.M)]
+    share = [max(1, round(total * x / sum(lengths))) for x in lengths]
+    k = lengths.index(max(lengths))
+    share[k] = total - (sum(share) - share[k])
+    counts = iter(share)
+    return re.sub(r"^elements = \d+$", lambda m: f"elements = {next(counts)}", text,
+                  flags=re.M)
+
+
+def fine_bearing_cfg(total: int):
+    """The fine rotor on plain bearings at the AMBs' positions (the ROSS comparison)."""
+    from ambseal.config import parse_rig
+
+    data = tomllib.loads(fine_rig_text(total))
+    data["rotor"]["modal_damping"] = 0.0
+    data["spring"] = [{"position": a["position"], "name": f"bearing_{a['name']}",
+                       **FINE_BEARING} for a in data.pop("amb")]
+    for key in ("seal", "controller", "design"):
+        data.pop(key, None)
+    return parse_rig(data)
+
+
+def fine_ross_rotor(rs, cfg):
+    from ambseal.model.rotor import build_mesh
+
+    mesh = build_mesh(cfg)
+    (mat,) = cfg.materials.values()
+    steel = rs.Material(name="fine_steel", rho=mat.rho, E=mat.E, G_s=mat.shear_modulus)
+    shafts = [rs.ShaftElement(L=e.length, idl=e.inner_diameter, odl=e.outer_diameter,
+                              material=steel, n=i, shear_method_calc="cowper")
+              for i, e in enumerate(mesh.elements)]
+    disks = [rs.DiskElement(n=mesh.node_at(d.position), m=d.mass, Id=d.Id, Ip=d.Ip)
+             for d in cfg.disk]
+    brgs = [rs.BearingElement(mesh.node_at(s.position), **FINE_BEARING) for s in cfg.spring]
+    return rs.Rotor(shafts, disks, brgs)
+
+
+#: 1.25× the test rig's third free–free bending frequency: the limit ``modes`` lists to.
+FINE_MAX_HZ = 2931.0
+
+
+def ours_open_loop(sys_, before: bool = False):
+    """What ``ambseal modes`` computes without a controller (``before``: the dense eig
+    with eigenvectors it used until the fine-mesh change)."""
+    from ambseal.analysis.campbell import modes_of_state_matrix, open_loop_modes
+    from ambseal.model.modes import modes
+
+    res = modes(sys_)
+    kw = {"speed_hz": sys_.speed / (2 * np.pi), "pressure_bar": 0.0, "max_hz": FINE_MAX_HZ}
+    if before:
+        return modes_of_state_matrix(sys_.state_matrices()[0], sys_.mesh, **kw)
+    return open_loop_modes(sys_, judged_poles=res.poles, **kw)
+
+
+def cpu_timed(fn, reps: int):
+    """Median CPU time (this process) of ``fn()`` and its last result."""
+    times, out = [], None
+    for _ in range(reps):
+        t0 = time.process_time()
+        out = fn()
+        times.append(time.process_time() - t0)
+    return statistics.median(times), out
+
+
+def child_timed(args: list[str], reps: int):
+    """Median wall and CPU time (children's user + system) of a child process."""
+    walls, cpus, out = [], [], None
+    for _ in range(reps):
+        r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        t0 = time.perf_counter()
+        proc = subprocess.run(args, capture_output=True, text=True, check=True)
+        walls.append(time.perf_counter() - t0)
+        r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpus.append(r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
+        out = proc.stdout
+    return statistics.median(walls), statistics.median(cpus), out
+
+
+def fine_cases(reps: int) -> None:
+    import ambseal.lti.lowest as low
+    from ambseal.config import default_rig_path, load_rig, parse_rig
+    from ambseal.lti.freqresp import freqresp
+    from ambseal.model.rig import build_plant, build_system
+
+    common = {"n_elements": FINE_ELEMENTS, "blas_threads": ARGS.threads or None}
+    with tempfile.TemporaryDirectory() as tmp:
+        rig = Path(tmp) / f"testrig_{FINE_ELEMENTS}.toml"
+        rig.write_text(fine_rig_text(FINE_ELEMENTS), encoding="utf-8")
+        log(f"case fine_modes_cli ({FINE_ELEMENTS} elements)")
+        cmd = [sys.executable, "-m", "ambseal.cli", "modes"]
+        wall, cpu, out = child_timed(cmd + [str(rig), "--json"], reps)
+        fine = json.loads(out)["natural_frequencies_hz"][:N_FINE]
+        _, _, out = child_timed(cmd + [str(default_rig_path()), "--json"], 1)
+        coarse = json.loads(out)["natural_frequencies_hz"][:N_FINE]
+        emit({"case": "fine_modes_cli", "ours_s": wall, "ours_cpu_s": cpu, "goal_s": 10.0,
+              "meets_goal": wall < 10.0, "call": "ambseal modes RIG --json",
+              "max_rel_diff_default_mesh": float(np.max(np.abs(np.subtract(fine, coarse))
+                                                        / np.abs(coarse))),
+              "first_modes_hz": [round(x, 4) for x in fine], **common})
+        cfg = load_rig(rig)
+
+    log("case fine_modes (in process, CPU)")
+    sys_ = build_system(cfg)
+    t_ours, m = cpu_timed(lambda: ours_open_loop(sys_), reps)
+    t_base, mb = cpu_timed(lambda: ours_open_loop(sys_, before=True), reps)
+    emit({"case": "fine_modes", "ours_s": t_ours, "baseline": "ambseal before (dense eig "
+          "with eigenvectors)", "baseline_s": t_base, "ratio": t_base / t_ours,
+          "max_rel_diff": float(np.max(np.abs(m.frequency_hz - mb.frequency_hz)
+                                       / mb.frequency_hz)),
+          "n_modes": int(m.frequency_hz.size), "max_hz": FINE_MAX_HZ, **common})
+
+    log("case fine_reduced_plant (CPU)")
+    w = 2 * np.pi * np.logspace(np.log10(0.5), np.log10(2000.0), 200)
+    t_ours, p = cpu_timed(lambda: build_plant(cfg, reduced=True, states=12), reps)
+    dense_states, low.DENSE_STATES = low.DENSE_STATES, 10**9
+    try:
+        t_base, pb = cpu_timed(lambda: build_plant(cfg, reduced=True, states=12), reps)
+    finally:
+        low.DENSE_STATES = dense_states
+    H, Hb = (freqresp((q.A, q.B, q.C, q.D), w) for q in (p, pb))
+    emit({"case": "fine_reduced_plant", "ours_s": t_ours,
+          "baseline": "ambseal before (dense eig, left and right eigenvectors)",
+          "baseline_s": t_base, "ratio": t_base / t_ours,
+          "max_rel_diff": float(np.max(np.abs(H - Hb)) / np.max(np.abs(Hb))),
+          "states": 12, **common})
+
+    log("case fine_ross")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        import ross as rs
+    baseline = "ross " + ".".join(rs.__version__.split(".")[:2])
+    bcfg = fine_bearing_cfg(FINE_ELEMENTS)
+    for rpm in FINE_SPEEDS_RPM:
+        def ours():
+            return ours_open_loop(build_system(bcfg, speed_rpm=rpm))
+
+        def ross():
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                return fine_ross_rotor(rs, bcfg)._eigen(rpm * np.pi / 30, num_modes=12,
+                                                         sparse=True)[0]
+
+        t_ours, m, t_base, ref = timed(ours, max(1, reps // 2), ross, 1)
+        lam = m.poles[:N_FINE]
+        ref = np.asarray(ref)
+        near = ref[np.abs(ref[None, :] - lam[:, None]).argmin(axis=1)]
+        emit({"case": "fine_ross", "speed_rpm": rpm, "ours_s": t_ours, "baseline": baseline,
+              "baseline_s": t_base, "ratio": t_base / t_ours,
+              "max_rel_diff": float(np.max(np.abs(lam - near) / np.abs(near))),
+              "first_modes_hz": [round(float(x), 4) for x in lam.imag / (2 * np.pi)],
+              "baseline_call": "_eigen(speed, num_modes=12, sparse=True)", **common})
+
+    if ARGS.fine_design:
+        from ambseal.design.recipes import design
+
+        for n in (FINE_ELEMENTS, 400):
+            log(f"case fine_design_mu ({n} elements)")
+            c = parse_rig(tomllib.loads(fine_rig_text(n)))
+            t, r = cpu_timed(lambda: design(c, "mu"), 1)
+            emit({"case": "fine_design_mu", "n_elements": n, "ours_s": t, "mu": r.mu,
+                  "mu_full": (r.reduction or {}).get("mu_full"),
+                  "full_order_stable": r.full_order["stable"],
+                  "blas_threads": ARGS.threads or None})
+
+
 # ---------------------------------------------------------------- main
 def main() -> int:
     rep_ours = 3 if ARGS.quick else 9
+    if ARGS.only != "fine":
+        coarse_cases(rep_ours)
+    if ARGS.only != "coarse":
+        fine_cases(1 if ARGS.quick else 3)
+    return 0
+
+
+def coarse_cases(rep_ours: int) -> None:
     rep_modal = 3 if ARGS.quick else 9
     rep_frf = 1 if ARGS.quick else 3
 
     t0 = time.perf_counter()
-    import ambseal.lti.freqresp  # noqa: F401
     import ambseal.config  # noqa: F401
+    import ambseal.lti.freqresp  # noqa: F401
     import ambseal.model.modes  # noqa: F401
     import ambseal.model.rig  # noqa: F401
     log(f"import ambseal (model, modes, freqresp): {time.perf_counter() - t0:.2f} s")
@@ -285,7 +516,6 @@ def main() -> int:
           "n_freq": int(OMEGA.size), "f_hz": [1.0, 500.0], "shape": list(H.shape),
           "baseline_call": "run_freq_response(speed_range=w, free_free=True)",
           "repeats_baseline": rep_frf, **common})
-    return 0
 
 
 if __name__ == "__main__":

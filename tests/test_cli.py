@@ -154,6 +154,21 @@ def test_modes_n_lowest_equal_the_dense_ones(capsys):
     assert exc.value.code == 2
 
 
+@pytest.mark.parametrize("n", [4, 6, 10])
+def test_modes_n_lists_n_modes_on_the_supported_rig(capsys, n):
+    """``--n-modes N`` on the embedded rig (AMBs, seal, coupling): exactly the N lowest
+    modes, the damped frequencies of the dense path's (1e-8) — the N-th mode is listed
+    although its frequency is the limit taken from another eigen-solve."""
+    assert main(["modes", "--json"]) == 0
+    dense = json.loads(capsys.readouterr().out)
+    assert main(["modes", "--json", "--n-modes", str(n)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert len(out["natural_frequencies_hz"]) == n
+    assert out["natural_frequencies_hz"] == pytest.approx(dense["natural_frequencies_hz"][:n],
+                                                          rel=1e-8)
+    assert out["max_hz"] == pytest.approx(out["natural_frequencies_hz"][-1], rel=1e-8)
+
+
 def test_design_show_defaults_prints_a_design_part_that_reads_back(capsys):
     """``design --show-defaults``: TOML whose [design] table the schema accepts, with the
     test rig's P5 §3.1.4 scalings; ``--set`` changes the value shown."""

@@ -51,7 +51,7 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "ShaftSection.outer_diameter": ("m", "outer diameter"),
     "ShaftSection.inner_diameter": ("m", "bore (0: solid); less than outer_diameter"),
     "ShaftSection.material": ("", "a NAME of ``[materials.NAME]``"),
-    "ShaftSection.elements": ("", "beam elements in the section (at most 150 in the whole "
+    "ShaftSection.elements": ("", "beam elements in the section (at most 400 in the whole "
                                   "shaft)"),
     "ShaftSection.layers": ("", "concentric tubes on the section's nodes, in parallel with "
                                 "its own (a sleeve, a hub; ROSS's layered elements)"),

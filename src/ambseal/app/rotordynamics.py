@@ -17,7 +17,7 @@ import math
 import sys
 from pathlib import Path
 
-from ambseal.analysis.campbell import campbell, closed_loop_modes, modes_of_state_matrix
+from ambseal.analysis.campbell import campbell, closed_loop_modes, open_loop_modes
 from ambseal.analysis.cases import dask_available
 from ambseal.analysis.judge import judge_settings
 from ambseal.analysis.sweep import (
@@ -117,11 +117,14 @@ def _modes(args: argparse.Namespace) -> int:
     f_max = args.max_hz if args.max_hz is not None else (
         max(res.natural_frequencies_hz, default=0.0) if args.n_modes else bending_limit_hz(cfg))
     K = controller_for(cfg, args.controller, p)
-    if K is None:
-        m = modes_of_state_matrix(sys_.state_matrices()[0], sys_.mesh, speed_hz=rpm / 60.0,
-                                  pressure_bar=p, max_hz=f_max)
+    # --n-modes: the N-th frequency comes from another eigen-solve than the modes listed, so
+    # it may lie a rounding below theirs (the solvers agree to 1e-8, model.modes.modes)
+    keep_hz = f_max * (1 + 1e-8) if args.n_modes and args.max_hz is None else f_max
+    if K is None:  # the shapes from the lowest eigenpairs; the verdict from every pole computed
+        m = open_loop_modes(sys_, speed_hz=rpm / 60.0, pressure_bar=p, max_hz=keep_hz,
+                            judged_poles=res.poles)
     else:
-        m = closed_loop_modes(cfg, K, speed_hz=rpm / 60.0, pressure_bar=p, max_hz=f_max)
+        m = closed_loop_modes(cfg, K, speed_hz=rpm / 60.0, pressure_bar=p, max_hz=keep_hz)
     unstable = res.unstable_poles if K is None else [
         (float(z.real), float(z.imag)) for z in unstable_poles(m.poles)]
     out = {"speed_hz": rpm / 60.0, "pressure_bar": p, "max_hz": f_max,

@@ -22,11 +22,17 @@ Name = Annotated[str, Field(min_length=1, max_length=64, pattern=NAME_PATTERN)]
 #: Labels (the rotor's, a disk's) are free text for reports, on one line.
 Label = Annotated[str, Field(min_length=1, max_length=200, pattern=LABEL_PATTERN)]
 
-#: Beam elements in the whole shaft, the most a rig may ask for: the dense eigenvalues grow
-#: with the states³ (8 per node; measured ~1e-9 s·states³ on one core) and a run makes
-#: dozens of them; a 200-element shaft ran 982 s. 150 elements (1 208 states, ~2 s per
-#: eigen-decomposition) resolve any rotor's modes of interest.
-MAX_ELEMENTS = 150
+#: Beam elements in the whole shaft, the most a rig may ask for. What a fine mesh costs: 8
+#: states per node, and judging a controller closes loops on every state, each loop's
+#: stability by a dense eigenvalue problem (~2.5e-10 s·states³ on one core: ~9 s at 400
+#: elements, 3 240 states; memory 8·states² bytes per matrix, 84 MB). Everything that needs
+#: only the lowest modes — the design model (a modal reduction of the FE model, P3/P5), the
+#: spec's mode counts, the shapes ``ambseal modes`` lists — takes them by shift-invert
+#: Arnoldi instead (``ambseal.lti.lowest``, ``ambseal.model.modes.poles_near_zero``):
+#: measured at 400 elements ``ambseal modes`` 20 s and a μ design 51 s of CPU, at 230
+#: elements 4.6 s and 14 s. 400 elements (L/400 per element) resolve a long rotor's modes
+#: of interest and a mesh-convergence check of a shorter one.
+MAX_ELEMENTS = 400
 #: Concentric layers on one shaft section, at most (a shaft, a sleeve and a hub is three;
 #: more only splits one tube into rings).
 MAX_LAYERS = 8
@@ -153,8 +159,8 @@ def cross_check(cfg, where: str) -> None:
         raise ConfigError(
             f"{where}: shaft: {n_elements} beam elements in all (at most {MAX_ELEMENTS}): "
             f"the model would have {8 * (n_elements + 1)} states, about "
-            f"{(8 * (n_elements + 1)) ** 3 * 1e-9:.0f} s per eigen-decomposition on one core "
-            "and dozens per run; use fewer elements per section")
+            f"{(8 * (n_elements + 1)) ** 3 * 2.5e-10:.0f} s per full-order loop judged on one "
+            "core and dozens per run; use fewer elements per section")
     for kind in ("seal", "spring"):
         seen: set[str] = set()
         for i, comp in enumerate(getattr(cfg, kind)):

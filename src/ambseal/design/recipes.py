@@ -64,6 +64,7 @@ from ambseal.errors import ConfigError, SynthesisError
 from ambseal.lti.freqresp import freqresp
 from ambseal.lti.interconnect import lft_lower
 from ambseal.model.amb import channel_names
+from ambseal.model.modes import poles_near_zero
 from ambseal.model.rig import build_plant, build_system
 from ambseal.robust.delay import design_delay, loop_delay
 from ambseal.robust.dgk import musyn_dgk
@@ -471,15 +472,15 @@ def _reduce_best(P, cands, order: int, auto: bool, gp, blocks, omega):
 def _top_mode_hz(cfg, p: float, n: int) -> float:
     """The highest mode (Hz) an n-state design model keeps."""
 
-    lam = np.sort(np.abs(build_system(cfg, pressure_bar=p).poles())) / (2 * np.pi)
-    return float(lam[min(n, lam.size) - 1])
+    lam = np.abs(poles_near_zero(build_system(cfg, pressure_bar=p), count=n).poles)
+    return float(lam[min(n, lam.size) - 1] / (2 * np.pi))
 
 
 def _states_to_keep(cfg, p: float, mode_hz: float) -> int:
     """Design-model states that keep every mode of the supported rotor up to 1.1× mode_hz."""
 
-    lam = np.abs(build_system(cfg, pressure_bar=p).poles()) / (2 * np.pi)
-    return int(np.sum(lam < 1.1 * mode_hz))
+    disk = poles_near_zero(build_system(cfg, pressure_bar=p), radius_rad_s=2.2 * np.pi * mode_hz)
+    return int(np.sum(np.abs(disk.poles) / (2 * np.pi) < 1.1 * mode_hz))
 
 
 def _unstable_message(method, check, n, steps, cut_hz) -> str:

@@ -100,7 +100,7 @@ from ambseal.identify.excitation import (
 )
 from ambseal.identify.intervals import uncertainty_from_fit
 from ambseal.model.amb import amb_factors, bias_current, bias_currents
-from ambseal.model.modes import modes
+from ambseal.model.modes import modes_from_poles, poles_near_zero
 from ambseal.model.rig import build_system
 from ambseal.model.rotor import assemble_rotor
 from ambseal.model.seal import coefficient_value
@@ -159,7 +159,8 @@ def machine(cfg) -> Machine:
 
     free = build_system(cfg, speed_rpm=0.0, include_amb=False, include_seals=False,
                         include_springs=False)
-    fb = [f for f in modes(free).natural_frequencies_hz if f > 0]
+    disk = poles_near_zero(free, oscillating=1)  # a fine mesh: its lowest modes only
+    fb = [f for f in modes_from_poles(disk.poles, disk.w_max).natural_frequencies_hz if f > 0]
     act = cfg.actuator
     fs = cfg.controller.sample_rate_hz
     fa = {"first_order": act.cutoff_hz,
@@ -370,14 +371,18 @@ def _scalings(d, mach: Machine, rules: dict, notes: list):
     return d_e, d_u
 
 
-def _design_model(cfg, d, mach: Machine, rules: dict) -> tuple[int, float]:
-    """States and cut-off (Hz) of the design model (module docstring, "Design model")."""
+def _design_model(cfg, d, mach: Machine, rules: dict) -> tuple[int, float, float]:
+    """States and cut-off (Hz) of the design model (module docstring, "Design model"), and
+    the highest mode it keeps (Hz); from the supported rotor's lowest eigenvalues only
+    (:func:`~ambseal.model.modes.poles_near_zero`: a fine mesh has thousands)."""
 
-    lam = np.abs(build_system(cfg).poles()) / (2 * math.pi)
+    sys = build_system(cfg)
     if d.model_states is not None:
         rules["model_states"] = "set"
         n = int(d.model_states)
-        return n, float(lam[min(n, lam.size) - 1])
+        lam = np.abs(poles_near_zero(sys, count=n).poles) / (2 * math.pi)
+        top = float(lam[min(n, lam.size) - 1])
+        return n, top, top
     if d.model_cutoff_hz is not None:
         rules["model_states"] = "set (model_cutoff_hz)"
         cut = float(d.model_cutoff_hz)
@@ -385,8 +390,10 @@ def _design_model(cfg, d, mach: Machine, rules: dict) -> tuple[int, float]:
         cut = min(3 * mach.actuator_hz, mach.sample_rate_hz / 4)
         rules["model_states"] = (f"every mode below min(3 f_a, f_s/4) = {cut:.4g} Hz, "
                                  f"at least the {RIGID_STATES} rigid-body states")
+    lam = np.abs(poles_near_zero(sys, count=RIGID_STATES,
+                                 radius_rad_s=2 * math.pi * cut).poles) / (2 * math.pi)
     n = max(RIGID_STATES, int(np.sum(lam < cut)))
-    return n, cut
+    return n, cut, float(lam[min(n, lam.size) - 1])
 
 
 def _bands(d, mach: Machine, top_mode_hz: float, rules: dict):
@@ -548,10 +555,8 @@ def design_spec(cfg, pressure_bar: float | None = None) -> DesignSpec:
     notes: list = []
     p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
     d_e, d_u = _scalings(d, mach, rules, notes)
-    n, cut = _design_model(cfg, d, mach, rules)
-
-    lam = np.sort(np.abs(build_system(cfg).poles()) / (2 * math.pi))
-    band, synth = _bands(d, mach, float(lam[min(n, lam.size) - 1]), rules)
+    n, cut, top_mode = _design_model(cfg, d, mach, rules)
+    band, synth = _bands(d, mach, top_mode, rules)
     rng, at, pos, law, top = _unbalance(cfg, d, mach, rules, notes)
     pid = _reference_pid(cfg)
     weights = {m: _weights(d, m, mach, d_e, d_u, band[1], rng, rules, pid)

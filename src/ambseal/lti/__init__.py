@@ -14,6 +14,8 @@ The lowest numerical layer (it imports only :mod:`ambseal.errors`); each idea on
   Powell & Workman, *Digital Control of Dynamic Systems*, 3rd ed., §6.3), Tustin, and the
   discrete recursion every time response runs through;
 * :func:`interp_table` — the one rule for tables against a parameter;
+* :func:`lowest_eigenpairs` — the eigenvalues of smallest |λ| of a large state matrix with
+  right and left eigenvectors (shift-invert Arnoldi; a modal reduction's input);
 * :func:`picklable` — ``control.StateSpace`` through :mod:`pickle` (Dask workers).
 
 ``freqresp`` is not re-exported here: it shares its module's name, and re-exporting it
@@ -30,9 +32,10 @@ from ambseal.lti.interconnect import (
     lft_lower_matrices,
     wired,
 )
+from ambseal.lti.lowest import lowest_eigenpairs
 from ambseal.lti.pickling import picklable
 from ambseal.lti.tables import interp_table
 
 __all__ = ["discretize", "feedback_matrices", "feedback_poles", "freqresp_at",
-           "interp_table", "lft_lower", "lft_lower_matrices", "picklable", "simulate_lti",
-           "wired", "zoh"]
+           "interp_table", "lft_lower", "lft_lower_matrices", "lowest_eigenpairs", "picklable",
+           "simulate_lti", "wired", "zoh"]

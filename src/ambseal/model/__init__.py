@@ -16,7 +16,9 @@ Each element owns its matrices and parameter channels; the rig only assembles th
   :class:`Channel`; P1 Eqs. 46–52);
 * :func:`modal_reduction` → :class:`ModalReduction` — the small real model (P1 §III.4–6);
 * :class:`Modes`, :func:`classify_poles`, :func:`free_bending_hz`,
-  :func:`bending_limit_hz` — damped natural frequencies, damping, unstable poles.
+  :func:`bending_limit_hz` — damped natural frequencies, damping, unstable poles;
+  :func:`poles_near_zero` → :class:`PoleDisk` — the lowest eigenvalues and mode shapes of a
+  fine mesh without a dense eigendecomposition.
 
 ``modes`` itself is not re-exported: it shares its module's name, and re-exporting it would
 hide :mod:`ambseal.model.modes` (``from ambseal.model import modes`` would then give the
@@ -28,7 +30,14 @@ Units are SI throughout (m, kg, s, N, A, rad/s, Pa); node DOFs are ``[x, y, α, 
 from ambseal.model.amb import AmbElement, axes_rotation, channel_names
 from ambseal.model.fe import BeamElement, DiskElement
 from ambseal.model.lft import Channel, Parameter, Plant
-from ambseal.model.modes import Modes, bending_limit_hz, classify_poles, free_bending_hz
+from ambseal.model.modes import (
+    Modes,
+    PoleDisk,
+    bending_limit_hz,
+    classify_poles,
+    free_bending_hz,
+    poles_near_zero,
+)
 from ambseal.model.reduction import ModalReduction, modal_reduction
 from ambseal.model.rig import SecondOrderSystem, build_plant, build_system
 from ambseal.model.rotor import Mesh, RotorMatrices, assemble_rotor, build_mesh
@@ -36,8 +45,8 @@ from ambseal.model.seal import SealElement, pressure_for_k, seal_coefficients, s
 from ambseal.model.spring import SpringElement
 
 __all__ = ["AmbElement", "BeamElement", "Channel", "DiskElement", "Mesh", "ModalReduction",
-           "Modes", "Parameter", "Plant", "RotorMatrices", "SealElement",
+           "Modes", "Parameter", "Plant", "PoleDisk", "RotorMatrices", "SealElement",
            "SecondOrderSystem", "SpringElement", "assemble_rotor", "axes_rotation",
            "bending_limit_hz", "build_mesh", "build_plant", "build_system", "channel_names",
-           "classify_poles", "free_bending_hz", "modal_reduction", "pressure_for_k",
-           "seal_coefficients", "seal_values"]
+           "classify_poles", "free_bending_hz", "modal_reduction", "poles_near_zero",
+           "pressure_for_k", "seal_coefficients", "seal_values"]

@@ -12,6 +12,11 @@ Two paths, one result type:
   modal damping fills C) and about 4n + 40 solves (the Arnoldi basis) instead of the QR
   iteration on the whole state matrix. It sees only the eigenvalues nearest zero, so an
   unstable pole beyond them is not reported.
+
+``poles_near_zero(sys, ...)`` gives the eigenvalues (and, if asked, the mode shapes) inside a
+disk around 0 that holds what the caller needs — a count, a radius, some oscillating modes —
+for the lowest modes of a fine mesh (the design model's size, the modes a command lists):
+dense up to :data:`ambseal.lti.lowest.DENSE_STATES` states, the shift-invert path above.
 """
 
 from __future__ import annotations
@@ -24,10 +29,12 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ambseal.errors import ModelError
+from ambseal.lti.lowest import DENSE_STATES
 from ambseal.model.rig import SecondOrderSystem, build_system
 
-__all__ = ["Modes", "modes", "lowest_eigenvalues", "free_bending_hz", "bending_limit_hz",
-           "classify_poles", "RIGID_BODY_RAD_S", "STABILITY_FLOOR_RAD_S"]
+__all__ = ["Modes", "modes", "modes_from_poles", "lowest_eigenvalues", "PoleDisk",
+           "poles_near_zero", "free_bending_hz", "bending_limit_hz", "classify_poles",
+           "RIGID_BODY_RAD_S", "STABILITY_FLOOR_RAD_S"]
 
 # Thresholds on the physics, not on the stiffest DOF. A computed eigenvalue with
 # |λ| below RIGID_BODY_RAD_S = 2π·0.1 Hz is a rigid-body mode (λ = 0): a mode of interest of
@@ -130,12 +137,12 @@ def modes(sys: SecondOrderSystem, n_modes: int | None = None) -> Modes:
     """
     if n_modes is None:
         lam = sys.poles()
-        return _summarise(lam, float(np.abs(lam).max()))
+        return modes_from_poles(lam, float(np.abs(lam).max()))
     if int(n_modes) != n_modes or n_modes < 1:
         raise ModelError(f"n_modes must be a positive integer, got {n_modes!r}")
     n_modes = int(n_modes)
     lam, w_ref = lowest_eigenvalues(sys, n_modes)
-    return _summarise(lam, max(w_ref, float(np.abs(lam).max(initial=0.0))), n_modes)
+    return modes_from_poles(lam, max(w_ref, float(np.abs(lam).max(initial=0.0))), n_modes)
 
 
 def classify_poles(lam: np.ndarray, w_max: float | None = None,
@@ -198,10 +205,29 @@ def _fmt(z: complex) -> str:
     return f"{z.real:.4g}{z.imag:+.4g}j"
 
 
-def _summarise(lam: np.ndarray, w_max: float, n_modes: int | None = None) -> Modes:
-    """Modes from eigenvalues ``lam`` (rad/s) of a model whose largest |λ| is ``w_max``
-    (:func:`classify_poles`); with ``n_modes``, the first ``n_modes`` oscillating ones by
-    |λ| and the poles up to them."""
+def modes_from_poles(lam: np.ndarray, w_max: float, n_modes: int | None = None) -> Modes:
+    """:class:`Modes` from eigenvalues of a second-order system, e.g. a
+    :class:`PoleDisk`'s (what :func:`modes` returns for the eigenvalues it computes).
+
+    Parameters
+    ----------
+    lam : ndarray of complex
+        Eigenvalues (rad/s): all of them, or every one inside a disk around 0.
+    w_max : float
+        The largest |λ| of the model (rad/s), the scale of :func:`classify_poles`.
+    n_modes : int, optional
+        Keep the first ``n_modes`` oscillating modes by |λ| and the poles up to them.
+
+    Returns
+    -------
+    Modes
+
+    Raises
+    ------
+    ModelError
+        The conditioning makes the rigid-body modes or the stability doubtful
+        (:func:`classify_poles`).
+    """
     lam = lam[np.argsort(np.abs(lam), kind="stable")]
     rigid, unstable = classify_poles(lam, w_max)
     osc = lam[(lam.imag >= RIGID_BODY_RAD_S) & ~rigid]
@@ -269,30 +295,133 @@ def lowest_eigenvalues(sys: SecondOrderSystem, n_modes: int) -> tuple[np.ndarray
         The mass matrix is not positive definite, or ARPACK fails to converge.
     """
     sys.mass_factor()  # ModelError unless M is positive definite, as in the dense path
+    w_ref = _w_ref(sys)
+
+    def enough(lam: np.ndarray, radius: float) -> bool:
+        osc = np.sort(np.abs(lam[lam.imag >= RIGID_BODY_RAD_S]))
+        return osc.size >= n_modes and radius >= 1.5 * osc[n_modes - 1]
+
+    got = _arnoldi_disk(sys, w_ref, 2 * n_modes + EXTRA_EIGENVALUES, enough, vectors=False)
+    return (sys.poles(), w_ref) if got is None else (got[0], w_ref)
+
+
+@dataclass(frozen=True)
+class PoleDisk:
+    """Every eigenvalue of a second-order system inside a disk |λ| < ``radius_rad_s``.
+
+    Attributes
+    ----------
+    poles : ndarray of complex, shape (k,)
+        The eigenvalues (rad/s), sorted by |λ|.
+    shapes : ndarray of complex, shape (n_dof, k), or None
+        The displacement part q of each eigenvector (x = [q; λq]), if asked for.
+    radius_rad_s : float
+        Radius of the disk (rad/s); ``inf`` when every eigenvalue was computed (dense).
+    w_max : float
+        The scale (rad/s) for :func:`classify_poles`: the largest |λ| when dense, else
+        ω_ref of :func:`lowest_eigenvalues`.
+    """
+
+    poles: np.ndarray
+    shapes: np.ndarray | None
+    radius_rad_s: float
+    w_max: float
+
+
+def poles_near_zero(sys: SecondOrderSystem, *, count: int = 0, radius_rad_s: float = 0.0,
+                    oscillating: int = 0, vectors: bool = False) -> PoleDisk:
+    """Every eigenvalue of M λ²q + (C + ΩG) λq + K q = 0 inside a disk around 0 that holds
+    at least ``count`` eigenvalues, at least ``oscillating`` oscillating modes
+    (Im λ ≥ ``RIGID_BODY_RAD_S``) and every eigenvalue with |λ| < ``radius_rad_s``.
+
+    Up to :data:`ambseal.lti.lowest.DENSE_STATES` states (2·n_dof; 1 000, where the dense
+    eigenvalues take 0.3 s) every eigenvalue, by a dense eig of the state matrix (the disk
+    is then the whole plane); above, the shift-invert Arnoldi iteration of
+    :func:`lowest_eigenvalues` on the quadratic pencil (Tisseur & Meerbergen 2001), whose
+    k eigenvalues nearest σ hold every eigenvalue with |λ| < r − |σ| (r the largest
+    |λ − σ| among them), k doubled until that disk holds what is asked; the dense eig when
+    k would reach ARPACK's limit n_state − 1. Eigenvectors of the shifted-and-inverted
+    operator are those of the pencil, x = [q; λq].
+
+    Parameters
+    ----------
+    sys : SecondOrderSystem
+        The model (n_dof DOFs).
+    count : int
+        Eigenvalues the disk holds at least (the lowest ``count`` by |λ| are then exact).
+    radius_rad_s : float
+        Radius (rad/s) the disk has at least.
+    oscillating : int
+        Oscillating modes (each a conjugate pair) the disk holds at least.
+    vectors : bool
+        Also return the displacement part of each eigenvector.
+
+    Returns
+    -------
+    PoleDisk
+        The eigenvalues sorted by |λ| (and the shapes, columns in the same order).
+
+    Raises
+    ------
+    ModelError
+        The mass matrix is not positive definite, or ARPACK fails to converge.
+    """
+    if 2 * sys.n_dof > DENSE_STATES:
+        sys.mass_factor()  # ModelError unless M is positive definite, as in the dense path
+        w_ref = _w_ref(sys)
+
+        def enough(lam: np.ndarray, radius: float) -> bool:
+            n_osc = np.count_nonzero(lam.imag >= RIGID_BODY_RAD_S)
+            return lam.size >= count and n_osc >= oscillating and radius > radius_rad_s
+
+        k = max(count, 2 * oscillating) + EXTRA_EIGENVALUES
+        got = _arnoldi_disk(sys, w_ref, k, enough, vectors)
+        if got is not None:
+            return PoleDisk(got[0], got[1], got[2], w_ref)
+    A = sys.state_matrices()[0]
+    if vectors:
+        lam, X = sla.eig(A)
+    else:
+        lam, X = sla.eigvals(A), None
+    order = np.argsort(np.abs(lam), kind="stable")
+    return PoleDisk(lam[order], None if X is None else X[:sys.n_dof, order], np.inf,
+                    float(np.abs(lam).max(initial=0.0)))
+
+
+def _w_ref(sys: SecondOrderSystem) -> float:
+    """ω_ref = sqrt(max_i |K_ii|/M_ii) (rad/s), the scale of the shift (``lowest_eigenvalues``)."""
+    return float(np.sqrt(np.max(np.abs(np.diag(sys.K)) / np.diag(sys.M))))
+
+
+def _arnoldi_disk(sys: SecondOrderSystem, w_ref: float, k: int, enough, vectors: bool):
+    """``(lam, Q, radius)``: the eigenvalues inside the complete disk |λ| < radius of the
+    k nearest σ = −``SHIFT_FRACTION``·ω_ref, sorted by |λ|, with the displacement parts Q
+    of their eigenvectors (or None), k doubled until ``enough(lam, radius)``; None when k
+    would reach n_state − 1 (the caller goes dense)."""
     M, K = sys.M, sys.K
     D = sys.C + sys.speed * sys.G
     n = sys.n_dof
-    w_ref = float(np.sqrt(np.max(np.abs(np.diag(K)) / np.diag(M))))
     sigma = -SHIFT_FRACTION * w_ref
-    k = 2 * n_modes + EXTRA_EIGENVALUES
     op = None
     while k < 2 * n - 1:
         if op is None:
             op = _shift_invert_operator(M, D, K, sigma)
         try:
-            mu = spla.eigs(op, k=k, which="LM", v0=np.ones(2 * n),
-                           ncv=min(2 * n, 2 * k + NCV_EXTRA), return_eigenvectors=False)
+            out = spla.eigs(op, k=k, which="LM", v0=np.ones(2 * n),
+                            ncv=min(2 * n, 2 * k + NCV_EXTRA), return_eigenvectors=vectors)
         except spla.ArpackError as exc:  # includes ArpackNoConvergence
             raise ModelError(f"ARPACK did not converge for the {k} eigenvalues nearest "
                              f"σ = {sigma:.3g} rad/s ({exc})") from None
+        mu, X = out if vectors else (out, None)
         lam = sigma + 1.0 / mu
-        radius = np.max(np.abs(lam - sigma)) - abs(sigma)
-        lam = lam[np.abs(lam) < radius]
-        osc = np.sort(np.abs(lam[lam.imag >= RIGID_BODY_RAD_S]))
-        if osc.size >= n_modes and radius >= 1.5 * osc[n_modes - 1]:
-            return lam[np.argsort(np.abs(lam), kind="stable")], w_ref
+        radius = float(np.max(np.abs(lam - sigma)) - abs(sigma))
+        inside = np.abs(lam) < radius
+        lam = lam[inside]
+        if enough(lam, radius):
+            order = np.argsort(np.abs(lam), kind="stable")
+            return lam[order], (None if X is None else X[:n][:, inside][:, order]), radius
         k *= 2
-    return sys.poles(), w_ref
+    return None
 
 
 def _shift_invert_operator(M: np.ndarray, D: np.ndarray, K: np.ndarray,

@@ -20,9 +20,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 
 from ambseal.errors import ModelError
+from ambseal.lti.lowest import lowest_eigenpairs
 from ambseal.model.lft import Plant
 
 __all__ = ["ModalReduction", "modal_reduction"]
@@ -84,13 +84,13 @@ def modal_reduction(
     """
     if (states is None) == (cutoff_hz is None):
         raise ModelError("modal reduction expects exactly one of states or cutoff_hz")
-    lam, W, V = sla.eig(plant.A, left=True, right=True)
-    order = np.argsort(np.abs(lam), kind="stable")
-    lam, W, V = lam[order], W[:, order], V[:, order]
-    scale = max(np.abs(lam).max(), 1.0)
+    n_full = plant.A.shape[0]
+    if states is not None and not 1 <= states <= n_full:
+        raise ModelError(f"states = {states}: expected 1 to {n_full}")
+    lam, V, W, scale = lowest_eigenpairs(
+        plant.A, count=0 if states is None else states + 1,
+        radius=0.0 if cutoff_hz is None else 2 * np.pi * cutoff_hz, left=True)
     if states is not None:
-        if not 1 <= states <= len(lam):
-            raise ModelError(f"states = {states}: expected 1 to {len(lam)}")
         n_keep = states
     else:
         n_keep = int(np.sum(np.abs(lam) <= 2 * np.pi * cutoff_hz))

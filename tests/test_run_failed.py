@@ -77,6 +77,12 @@ def test_run_with_a_failing_controller_writes_the_report_and_exits_1(tmp_path, c
                 if not (c["stable"] and c["discrete"]["stable"])]
     assert unstable and f["conditions"] == unstable and f["designed"] and f["judged"]
     assert f["reason"].startswith("H∞: not delivered — the full-order loop is unstable at ")
+    # before that, the remedies: designed at the least stable failing condition, then with
+    # the performance bandwidth halved there; neither holds on this rig
+    worst = max((c for c in by["hinf"] if not c["stable"]), key=lambda c: c["max_real_pole"])
+    assert f"Tried: designed at {worst['pressure_bar']:g} bar (still unstable at " in f["reason"]
+    assert "designed there with ω_B × 0.5" in f["reason"]
+    assert f["reason"].endswith("μ is the robust controller")
     assert f"ambseal: {f['reason']}" in err
     # the reference PID fails too (unstable from 2.04 bar) but is the user's: marked only
     assert not m["failed"]["pid"]["designed"]

@@ -32,6 +32,7 @@ from ambseal.app.commands import (
     identification_stage,
 )
 from ambseal.app.metrics import SCHEMA_VERSION, ControllerSummary, OpenLoop, RunMetrics
+from ambseal.app.remedies import REMEDIABLE, remedy
 from ambseal.app.tracked import tracked_designs, tracked_ramp
 from ambseal.config import RigConfig, default_rig_path, load_rig, load_truth
 from ambseal.design.lpv_design import design_frozen, design_lpv
@@ -70,6 +71,12 @@ class RunResult:
     #: the exit status ``ambseal run`` returns: 0, or :data:`EXIT_FAILED` when a designed
     #: controller failed (an unstable one kept with ``allow_unstable`` does not count)
     exit_status: int = 0
+
+
+def _labelled(method: str, jobs: list, judged: list) -> list[tuple[dict, dict]]:
+    """``method``'s judged cases as (case dict with its condition's ``label``, curves)."""
+    return [({**case.to_dict(), "label": j["point"].label}, crv)
+            for j, (case, crv) in zip(jobs, judged) if j["name"] == method]
 
 
 def default_truth_path() -> Path:
@@ -242,22 +249,36 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         design_cfg = cfg if ident is None else ident.design_cfg
         designs += tracked_designs(cfg, design_cfg, spec, points, say, digitals, cannot_run)
         stages.begin("judge")
-        jobs = judge_jobs(designs, digitals, points, design_cfg)
-        judged = run_cases(judge_case, jobs, shared={"cfg": judge_cfg, "settings": settings},
-                           workers=1, raise_errors=True,
-                           on_done=lambda i, r: stages.step(f"{jobs[i]['name']} at "
-                                                            f"{jobs[i]['point'].label}"))
+
+        def judge_designs(ds, digs, steps=1):
+            js = judge_jobs(ds, digs, points, design_cfg)
+            return js, run_cases(judge_case, js, shared={"cfg": judge_cfg, "settings": settings},
+                                 workers=1, raise_errors=True,
+                                 on_done=lambda i, r: stages.step(
+                                     f"{js[i]['name']} at {js[i]['point'].label}", steps))
+
+        jobs, judged = judge_designs(designs, digitals)
+        for d in designs:  # the judged loops decide (continuous with delay, and as it runs)
+            f = loop_failure(d.method, _labelled(d.method, jobs, judged),
+                             designed=d.method != "pid", kept=allow_unstable)
+            if f is not None:
+                failed[d.method] = f
+        for m in [m for m, f in failed.items() if f.designed and f.judged
+                  and m in REMEDIABLE and not speed_scheduled(cfg)]:
+            fixed, failed[m] = remedy(
+                m, failed[m], [c for c, _ in _labelled(m, jobs, judged)], design_cfg, spec,
+                points, lambda ds, digs: judge_designs(ds, digs, 0), lambda s: say(s, 0))
+            if fixed is not None:  # the remedied design replaces the failed one
+                del failed[m]
+                designs = [fixed.design if d.method == m else d for d in designs]
+                digitals[m] = fixed.digital
+                new = iter(zip(fixed.jobs, fixed.judged))
+                jobs, judged = map(list, zip(*[next(new) if j["name"] == m else (j, r)
+                                               for j, r in zip(jobs, judged)]))
         cases = [case for case, _ in judged]
         case_dicts = [case.to_dict() for case in cases]
         curves = [(j["name"], j["point"], case, c)
                   for j, case, (_, c) in zip(jobs, case_dicts, judged)]
-        for d in designs:  # the judged loops decide (continuous with delay, and as it runs)
-            f = loop_failure(d.method, [({**c, "label": j["point"].label}, crv)
-                                        for j, c, (_, crv) in zip(jobs, case_dicts, judged)
-                                        if j["name"] == d.method], designed=d.method != "pid",
-                             kept=allow_unstable)
-            if f is not None:
-                failed[d.method] = f
         # a failed design is judged and reported, not delivered (unless asked for)
         held = {m for m, f in failed.items() if f.designed and not allow_unstable}
         summaries = export_all(designs, {m: g for m, g in digitals.items() if m not in held},

@@ -1,0 +1,147 @@
+"""What ``ambseal run`` tries before it reports a designed controller failed.
+
+The H∞ and μ recipes (:func:`ambseal.design.recipes.design`) design at the rig's operating
+pressure. When the judgement finds a condition where the controller's full-order loop is
+unstable (continuous with the delay, or sampled and delayed as it runs), the run tries, in
+this order, and judges each attempt at every condition like the first design:
+
+1. **the worst condition**: the same recipe designed at the pressure of the failing case
+   whose loop is least stable (largest closed-loop real part; for a loop unstable only as
+   it runs, largest |z|) — the plant the design missed is the one it is designed for;
+2. **a wider margin**: that design with the performance weight's bandwidth ω_B halved — the
+   controller asks for less and leaves more phase margin to the seal-driven modes it
+   does not see exactly (Skogestad & Postlethwaite 2005, §2.8 and §3.4.6: a lower ω_B
+   trades performance for robustness).
+
+The first attempt that holds at every judged condition replaces the design, its summary
+saying so (``remedy``). When none holds, the failure line lists what was tried; the μ
+controller, robust to the specification's uncertainty (thesis P5 §4), is the run's robust
+one. A speed-scheduled rig's designs (frozen at a speed, or scheduled on it) get no
+remedy here: their schedule is the remedy.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+from ambseal.analysis.delivery import FailedController, loop_failure
+from ambseal.app.commands import Designed, digitals_for
+from ambseal.design.recipes import design
+from ambseal.errors import SynthesisError
+
+__all__ = ["REMEDIABLE", "Remedied", "remedy", "worst_case"]
+
+#: The designs the remedies apply to: those of :func:`ambseal.design.recipes.design`.
+REMEDIABLE = ("hinf", "mu")
+
+#: Factor on the performance weight's bandwidth ω_B in the second attempt.
+OMEGA_B_FACTOR = 0.5
+
+
+@dataclass(frozen=True)
+class Remedied:
+    """A design that holds at every judged condition after a remedy.
+
+    Attributes
+    ----------
+    design : Designed
+        The new design (its summary has ``remedy``: what was done and why).
+    digital : object
+        Its digital controller.
+    jobs, judged : list
+        Its judged cases, as the run's judgement makes them.
+    """
+
+    design: Designed
+    digital: object
+    jobs: list
+    judged: list
+
+
+def worst_case(cases: list[dict]) -> dict:
+    """The least stable failing case: the largest continuous closed-loop real part among
+    the continuously unstable ones, else the largest |z| among those unstable as they run.
+
+    Parameters
+    ----------
+    cases : list of dict
+        Judged cases (``JudgedCase.to_dict()``) of one controller, at least one failing.
+
+    Raises
+    ------
+    ValueError
+        No case fails.
+    """
+    cont = [c for c in cases if not c.get("stable")]
+    if cont:
+        return max(cont, key=lambda c: c["max_real_pole"])
+    disc = [c for c in cases if not (c.get("discrete") or {}).get("stable", True)]
+    if not disc:
+        raise ValueError("worst_case: no failing case")
+    return max(disc, key=lambda c: c["discrete"]["max_abs_pole_z"])
+
+
+def remedy(method: str, failure: FailedController, cases: list[dict], design_cfg, spec,
+           points, judge: Callable, say: Callable[[str], None]
+           ) -> tuple[Remedied | None, FailedController]:
+    """Try the remedies of the module docstring for one failed design.
+
+    Parameters
+    ----------
+    method : {"hinf", "mu"}
+    failure : FailedController
+        Its failure as judged.
+    cases : list of dict
+        Its judged cases (``JudgedCase.to_dict()`` with ``label``).
+    design_cfg : RigConfig
+        The rig the run designs on (the identified one after identification).
+    spec : DesignSpec
+        The rig's design specification (weights, design model, grids).
+    points : list of OperatingPoint
+        The judged conditions.
+    judge : callable
+        ``judge(designs, digitals) -> (jobs, judged)``: the run's judgement of designs
+        (:func:`ambseal.analysis.judge.judge_jobs` and the cases' curves).
+    say : callable
+        Progress lines.
+
+    Returns
+    -------
+    (Remedied or None, FailedController)
+        The first design that holds and the original failure, or None and the failure with
+        the remedies tried added to its reason.
+    """
+    worst = worst_case(cases)
+    p = float(worst["pressure_bar"])
+    base = spec.weights[method]
+    wider = replace(base, omega_b=base.omega_b * OMEGA_B_FACTOR)
+    attempts = [(f"designed at {worst.get('label') or f'{p:g} bar'}", base),
+                (f"designed there with ω_B × {OMEGA_B_FACTOR:g} ({wider.omega_b:.3g} rad/s)",
+                 wider)]
+    tried = []
+    for label, w in attempts:
+        say(f"{method}: remedy — {label}")
+        try:
+            res = design(design_cfg, method, pressure_bar=p, weights=w, spec=spec,
+                         allow_unstable=True)
+        except SynthesisError as exc:
+            tried.append(f"{label} (the design failed: {exc})")
+            continue
+        d = Designed(method, res.K, {**res.summary(), "remedy": (
+            f"{label}: the design at the operating point lost the loop at "
+            f"{', '.join(failure.conditions)}")}, res)
+        digitals, cannot = digitals_for(design_cfg, [d], points)
+        if method not in digitals:
+            tried.append(f"{label} (cannot run on the target: {cannot.get(method, '')})")
+            continue
+        jobs, judged = judge([d], digitals)
+        again = loop_failure(method, [({**c.to_dict(), "label": j["point"].label}, crv)
+                                      for j, (c, crv) in zip(jobs, judged)], designed=True)
+        if again is None:
+            say(f"{method}: {label} holds at every judged condition")
+            return Remedied(d, digitals[method], jobs, judged), failure
+        tried.append(f"{label} (still unstable at {', '.join(again.conditions)})")
+    why = "; ".join(tried)
+    return None, replace(failure, reason=f"{failure.reason}. Tried: {why}"
+                         + ("" if method == "mu" else "; μ is the robust controller"))

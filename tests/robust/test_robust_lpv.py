@@ -246,3 +246,20 @@ def test_turbo_frozen_mu_design(turbo_cfg):
     fs = frozen_sensitivity(cfg, mu.K, np.array([300.0]), name="mu",
                             omega=2 * np.pi * np.logspace(0, np.log10(3000.0), 200))
     assert fs.stable.all() and fs.peak.max() <= 3.0
+
+
+def test_affine_grid_is_recognised_and_a_curved_one_is_not():
+    """The LMIs affine in p are imposed at the range's ends only when every A(p_k) lies on
+    the line through the ends' (then they hold between them): A₀ + p dA is affine, adding
+    p² dA₂ is not (closed forms on p = −1, −0.2, 0.5, 1)."""
+    from ambseal.robust._lpv_lmi import _affine_in_p, basis
+
+    rng = np.random.default_rng(0)
+    A0, dA, dA2 = (rng.standard_normal((4, 4)) for _ in range(3))
+    ps = np.array([-1.0, -0.2, 0.5, 1.0])
+    assert _affine_in_p(np.array([A0 + p * dA for p in ps]), ps)
+    assert not _affine_in_p(np.array([A0 + p * dA + 1e-6 * p**2 * dA2 for p in ps]), ps)
+    # the affine Lyapunov basis: the hat functions, S(±1) the end matrices, dS/dp constant
+    for p in ps:
+        f, df = basis("affine", p)
+        assert f == pytest.approx([(1 - p) / 2, (1 + p) / 2]) and df == pytest.approx([-.5, .5])

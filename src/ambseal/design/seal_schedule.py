@@ -45,8 +45,9 @@ reconstruction failed (solver "infeasible_inaccurate") with W_u = 0.05 on the te
 with W_u = 0.1 on examples/pump.toml. examples/pump.toml with these weights: γ = 1.35,
 σ̄(S_o) ≤ 2.27 at 21 frozen k over 0–60 bar.
 
-Synthesis takes about a minute (≈ 50 s of CPU on the test rig, most of it the γ SDP in
-Clarabel; 2 min elapsed on the loaded 2-core machine):
+Synthesis takes minutes, most of it the γ SDP in Clarabel (``benchmarks/README.md``,
+bench_tracked): on the test rig's file 80–90 s of CPU, on the rig the main job identifies
+(its eddy-current lag: 32 design-plant states) about 2 min elapsed:
 :func:`design_seal_scheduled` keeps each result in a cache folder keyed on the rig, the
 arguments, the synthesis code and the package version (``cache_dir``; :data:`CACHE_ENV`). A
 cache entry is plain JSON (numbers and names, never code): an entry that does not parse,

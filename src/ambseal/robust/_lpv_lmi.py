@@ -77,8 +77,17 @@ def _sym(X):
 
 
 def basis(kind: str, p: float) -> tuple[np.ndarray, np.ndarray]:
-    """Basis values f_i(p) and derivatives df_i/dp for p ∈ [−1, 1]."""
+    """Basis values f_i(p) and derivatives df_i/dp for p ∈ [−1, 1].
+
+    ``"affine"``: the two hat functions (1 − p)/2 and (1 + p)/2, so S₀ and S₁ are the
+    Lyapunov matrices at the range's ends, S(p) = (1 − p)/2 S₀ + (1 + p)/2 S₁ — the same
+    family as S₀ + p S₁, but an LMI at one end holds only that end's matrix. With the
+    monomials every LMI held both, and Clarabel's factorisation of the SDP's KKT system
+    joined the fronts of all of them (:func:`solve_lmis`). ``"quadratic"``: 1, p, p².
+    """
     nb = BASES[kind]
+    if kind == "affine":
+        return np.array([(1.0 - p) / 2, (1.0 + p) / 2]), np.array([-0.5, 0.5])
     f = np.array([p**i for i in range(nb)], float)
     df = np.array([i * p ** (i - 1) if i else 0.0 for i in range(nb)], float)
     return f, df
@@ -237,6 +246,15 @@ def _solve_quiet(prob, stage: str, solver_options: dict) -> None:
 
 
 
+def _affine_in_p(As: np.ndarray, ps: np.ndarray, rtol: float = 1e-9) -> bool:
+    """Whether every A(p_k) of the grid lies on the line through the two ends' (to
+    ``rtol`` of the largest entry)."""
+    lo, hi = As[0], As[-1]
+    line = [(1 - p) / 2 * lo + (1 + p) / 2 * hi for p in ps]
+    scale = max(float(np.max(np.abs(As))), 1e-300)
+    return bool(np.max(np.abs(As - np.array(line))) <= rtol * scale)
+
+
 def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float, *,
                backoff: float, margin: float, penalty: float, coupling_ratio: float,
                centre: bool, solver_options: dict):
@@ -280,6 +298,12 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
     nb = BASES[lyapunov]
     ps = sc.p_of(grid)
     I_N = np.eye(N)
+    # LMIs affine in p that hold at both ends of the range hold between them (a convex
+    # combination): the coupling LMI of an affine S always, the R-LMI when A(p) is affine
+    # over the grid (a seal coefficient through its LFT channel, gyroscopics in speed).
+    # Inner grid points keep only the S-LMIs of a parameter-dependent S, which are
+    # quadratic in p (A(p)ᵀS(p)); with a constant S and an affine A(p) they go too.
+    a_affine = _affine_in_p(sc.A, ps)
 
     def build(gamma_fixed: float | None, alpha: float):
         R = cp.Variable((N, N), symmetric=True)
@@ -289,22 +313,25 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
         eps = margin
         for k in range(grid.size):
             A = sc.A[k]
+            inner = 0 < k < grid.size - 1
             f, df = basis(lyapunov, float(ps[k]))
             S = sum(fi * Si for fi, Si in zip(f, Ss))
             dS = sum(dfi * Si for dfi, Si in zip(df, Ss)) if nb > 1 else None
-            MR = cp.bmat([[A @ R + R @ A.T, R @ C1.T, B1],
-                          [C1 @ R, -g * np.eye(nz), D11],
-                          [B1.T, D11.T, -g * np.eye(nw)]])
-            cons.append(_sym_expr(NR.T @ MR @ NR) << -eps * np.eye(NR.shape[1]))
+            if not (inner and a_affine):
+                MR = cp.bmat([[A @ R + R @ A.T, R @ C1.T, B1],
+                              [C1 @ R, -g * np.eye(nz), D11],
+                              [B1.T, D11.T, -g * np.eye(nw)]])
+                cons.append(_sym_expr(NR.T @ MR @ NR) << -eps * np.eye(NR.shape[1]))
             signs = (1.0, -1.0) if (dS is not None and nu_s > 0) else (0.0,)
-            for sgn in signs:
+            for sgn in signs if not (inner and a_affine and nb == 1) else ():
                 top = A.T @ S + S @ A + (sgn * nu_s * dS if sgn else 0)
                 MS = cp.bmat([[top, S @ B1, C1.T],
                               [B1.T @ S, -g * np.eye(nw), D11.T],
                               [C1, D11, -g * np.eye(nz)]])
                 cons.append(_sym_expr(NS.T @ MS @ NS) << -eps * np.eye(NS.shape[1]))
-            if nb > 1 or k == 0:  # one coupling LMI suffices for a constant S
+            if k == 0 or (nb == 2 and not inner) or nb > 2:  # constant S: one suffices
                 cons.append(_sym_expr(cp.bmat([[R, alpha * I_N], [alpha * I_N, S]])) >> 0)
+            if nb > 1 or k == 0:
                 trS = trS + cp.trace(S) / (grid.size if nb > 1 else 1)
         return R, Ss, g, cons, cp.trace(R) + trS
 

@@ -55,7 +55,9 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import sys
 import time
+from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
@@ -63,6 +65,10 @@ os.environ.setdefault("MKL_NUM_THREADS", "1")
 
 import control as ct
 import numpy as np
+
+# the spring–mass plant is the tests' (tests/spring_mass.py), imported from the repository root
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from tests.spring_mass import spring_mass_plant  # noqa: E402
 
 
 # --------------------------------------------------------------------------- plants
@@ -139,33 +145,6 @@ def aircraft_lateral_plant():
                         outlist=["zd0", "zd1"] + [f"zp{i}" for i in range(4)]
                         + [f"zu{i}" for i in range(4)] + ["r_n"] + meas)
     return ct.minreal(P, verbose=False)
-
-
-def spring_mass_plant():
-    """Barros, Fekri & Athans (2005): inputs [w_k1, w_delay, disturbance, noise, f1],
-    outputs [z_k1, z_delay, W_p z2, W_u f1, measured z2]."""
-    m1, m2, k2, b1, b2, k10, dk = 1.0, 2.0, 1.0, 0.05, 0.05, 2.0, 0.8
-    v = np.array([0.0, 0.0, -1 / m1, 1 / m2])
-    A = np.column_stack([v * k10, -v * k10 + np.array([0.0, 0.0, 0.0, -k2 / m2]),
-                         [1.0, 0.0, -b1 / m1, b1 / m2], [0.0, 1.0, b1 / m1, -(b1 + b2) / m2]])
-    # k1 = k10 + dk·δ enters as v·(k1)·(z1 − z2): the LFT channel z_k = dk·(z1 − z2)
-    B = np.column_stack([v, [0.0, 0.0, 1 / m1, 0.0], [0.0, 0.0, 0.0, 1 / m2]])
-    C = np.array([[dk, -dk, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]])
-    plant = ct.ss(A, B, C, np.zeros((2, 3)), inputs=["wk", "f1a", "f2"],
-                  outputs=["zk", "z2"], name="plant")
-    parts = [plant,
-             ct.ss(ct.tf([2.6, 0.0], [1.0, 40.0]), inputs=["f1"], outputs=["zdel"],
-                   name="wunm"),
-             ct.summing_junction(inputs=["f1", "wdel"], output="f1a"),
-             ct.ss(ct.tf([0.25], [1.0, 0.25]), inputs=["dist"], outputs=["f2"],
-                   name="wdist"),
-             ct.ss(10 * ct.tf([1.0, 10.0], [1.0, 1000.0]), inputs=["f1"], outputs=["zu"],
-                   name="wu"),
-             ct.ss(80 * ct.tf([0.1], [1.0, 0.1]), inputs=["z2"], outputs=["zp"], name="wp"),
-             ct.ss([], [], [], [[0.001]], inputs=["noise"], outputs=["wn"]),
-             ct.summing_junction(inputs=["z2", "wn"], output="z2n")]
-    return ct.interconnect(parts, inplist=["wk", "wdel", "dist", "noise", "f1"],
-                           outlist=["zk", "zdel", "zp", "zu", "z2n"])
 
 
 # --------------------------------------------------------------------------- checks

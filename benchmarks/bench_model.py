@@ -108,7 +108,6 @@ _OUT = os.fdopen(os.dup(1), "w", buffering=1)
 os.dup2(2, 1)
 sys.stdout = sys.stderr
 
-import re  # noqa: E402
 import resource  # noqa: E402
 import statistics  # noqa: E402
 import subprocess  # noqa: E402
@@ -118,6 +117,11 @@ import warnings  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
+
+# the fine-mesh rig and its ROSS twin are the tests' (tests/finemesh.py), imported from the
+# repository root
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from tests.finemesh import fine_bearing_data, fine_rig_text, fine_ross_rotor  # noqa: E402
 
 # ---------------------------------------------------------------- the rotor (both sides)
 N_EL = 40
@@ -272,53 +276,15 @@ def emit(rec: dict) -> None:
 
 # ---------------------------------------------------------------- the fine mesh
 FINE_ELEMENTS = 230
-FINE_BEARING = {"kxx": 1.0e6, "kyy": 0.8e6, "cxx": 150.0, "cyy": 90.0}
 FINE_SPEEDS_RPM = (0.0, 6000.0)
 N_FINE = 6  # modes compared
-
-
-def fine_rig_text(total: int) -> str:
-    """The embedded rig file with ``total`` beam elements in all: each section but the
-    longest its share by length (rounded), the longest the rest (tests/finemesh.py)."""
-    from ambseal.config import default_rig_path
-
-    text = default_rig_path().read_text(encoding="utf-8")
-    lengths = [float(x) for x in re.findall(r"^\[\[shaft\]\]\nlength = ([0-9.eE+-]+)",
-                                            text, flags=re.M)]
-    share = [max(1, round(total * x / sum(lengths))) for x in lengths]
-    k = lengths.index(max(lengths))
-    share[k] = total - (sum(share) - share[k])
-    counts = iter(share)
-    return re.sub(r"^elements = \d+$", lambda m: f"elements = {next(counts)}", text,
-                  flags=re.M)
 
 
 def fine_bearing_cfg(total: int):
     """The fine rotor on plain bearings at the AMBs' positions (the ROSS comparison)."""
     from ambseal.config import parse_rig
 
-    data = tomllib.loads(fine_rig_text(total))
-    data["rotor"]["modal_damping"] = 0.0
-    data["spring"] = [{"position": a["position"], "name": f"bearing_{a['name']}",
-                       **FINE_BEARING} for a in data.pop("amb")]
-    for key in ("seal", "controller", "design"):
-        data.pop(key, None)
-    return parse_rig(data)
-
-
-def fine_ross_rotor(rs, cfg):
-    from ambseal.model.rotor import build_mesh
-
-    mesh = build_mesh(cfg)
-    (mat,) = cfg.materials.values()
-    steel = rs.Material(name="fine_steel", rho=mat.rho, E=mat.E, G_s=mat.shear_modulus)
-    shafts = [rs.ShaftElement(L=e.length, idl=e.inner_diameter, odl=e.outer_diameter,
-                              material=steel, n=i, shear_method_calc="cowper")
-              for i, e in enumerate(mesh.elements)]
-    disks = [rs.DiskElement(n=mesh.node_at(d.position), m=d.mass, Id=d.Id, Ip=d.Ip)
-             for d in cfg.disk]
-    brgs = [rs.BearingElement(mesh.node_at(s.position), **FINE_BEARING) for s in cfg.spring]
-    return rs.Rotor(shafts, disks, brgs)
+    return parse_rig(fine_bearing_data(total))
 
 
 #: 1.25× the test rig's third free–free bending frequency: the limit ``modes`` lists to.
@@ -423,7 +389,7 @@ def fine_cases(reps: int) -> None:
         def ross():
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                return fine_ross_rotor(rs, bcfg)._eigen(rpm * np.pi / 30, num_modes=12,
+                return fine_ross_rotor(rs, bcfg)[0]._eigen(rpm * np.pi / 30, num_modes=12,
                                                          sparse=True)[0]
 
         t_ours, m, t_base, ref = timed(ours, max(1, reps // 2), ross, 1)

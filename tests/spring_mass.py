@@ -1,6 +1,6 @@
 """The mixed-μ spring–mass problem of Barros, Fekri & Athans (2005), as MathWorks' Robust
 Control Toolbox example "Control of a Spring-Mass-Damper System Using Mixed-Mu Synthesis"
-states it, for tests (benchmarks/bench_dk.py builds the same plant)."""
+states it, for the tests and benchmarks/bench_dk.py."""
 
 import control
 import numpy as np

@@ -13,7 +13,6 @@ import json
 import os
 import subprocess
 import sys
-import tomllib
 import warnings
 
 import numpy as np
@@ -37,7 +36,7 @@ def _quiet(f, *args, **kw):
         warnings.simplefilter("ignore")
         return f(*args, **kw)
 
-from ..finemesh import fine_rig_text  # noqa: E402
+from ..finemesh import fine_bearing_data, fine_ross_rotor  # noqa: E402
 from ..toml_text import dump  # noqa: E402
 
 
@@ -311,44 +310,12 @@ def test_import_ross_stdout_is_the_json_only(examples, tmp_path):
 
 
 
-#: Plain bearings of the fine-mesh comparison (anisotropic and damped, as ``_bearing_rotor``'s).
-FINE_BEARING = {"kxx": 1.0e6, "kyy": 0.8e6, "cxx": 150.0, "cyy": 90.0}
-
-
 def _fine_bearing_rig(path, total: int):
-    """The embedded rotor — shaft and disks — meshed with ``total`` beam elements, on two
-    plain bearings at its AMBs' positions instead of AMBs, seal and coupling (ROSS's AMB
-    model is not the reference), without modal damping (ROSS has none)."""
+    """:func:`fine_bearing_data` written to ``path`` and loaded."""
     from ambseal.config import load_rig
 
-    data = tomllib.loads(fine_rig_text(total))
-    data["rotor"]["modal_damping"] = 0.0
-    data["spring"] = [{"position": a["position"], "name": f"bearing_{a['name']}",
-                       **FINE_BEARING} for a in data.pop("amb")]
-    for key in ("seal", "controller", "design"):
-        data.pop(key, None)
-    path.write_text(dump(data), encoding="utf-8")
+    path.write_text(dump(fine_bearing_data(total)), encoding="utf-8")
     return load_rig(path)
-
-
-def _ross_of(cfg):
-    """The same rotor in ROSS, element by element on ambseal's mesh (Cowper's shear
-    coefficient on both sides)."""
-    from ambseal.model.rotor import build_mesh
-
-    mesh = build_mesh(cfg)
-    (mat,) = cfg.materials.values()
-    steel = rs.Material(name="fine_steel", rho=mat.rho, E=mat.E, G_s=mat.shear_modulus)
-    shafts = [rs.ShaftElement(L=e.length, idl=e.inner_diameter, odl=e.outer_diameter,
-                              material=steel, n=i, shear_method_calc="cowper")
-              for i, e in enumerate(mesh.elements)]
-    disks = [rs.DiskElement(n=mesh.node_at(d.position), m=d.mass, Id=d.Id, Ip=d.Ip)
-             for d in cfg.disk]
-    bearings = [rs.BearingElement(mesh.node_at(s.position), **FINE_BEARING, tag=s.name)
-                for s in cfg.spring]
-    with contextlib.redirect_stdout(sys.stderr), warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return rs.Rotor(shafts, disks, bearings), len(mesh.elements)
 
 
 @pytest.mark.slow
@@ -365,7 +332,7 @@ def test_fine_mesh_modes_equal_ross_on_the_same_mesh(tmp_path, capsys):
 
     rig = tmp_path / "fine_bearings.toml"
     cfg = _fine_bearing_rig(rig, 230)
-    rotor, n_el = _ross_of(cfg)
+    rotor, n_el = fine_ross_rotor(rs, cfg)
     assert sum(s.elements for s in cfg.shaft) == 230 and n_el >= 230
     for rpm in (0.0, 6000.0):
         assert main(["modes", str(rig), "--json", "--speed-rpm", str(rpm)]) == 0

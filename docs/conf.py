@@ -56,7 +56,7 @@ numpydoc_validation_checks = set()  # another page's job: no validation in the b
 
 # nitpicky (-n): references the docstrings make to names outside ambseal
 nitpick_ignore_regex = [
-    (r"py:.*", r"(control|np|numpy|scipy|cvxpy|pydantic|dask|matplotlib|typing)\..*"),
+    (r"py:.*", r"(control|np|numpy|scipy|cvxopt|pydantic|dask|matplotlib|typing)\..*"),
 ]
 
 html_theme = "furo"

@@ -211,9 +211,9 @@ def test_invalid_arguments_raise_valueerror_naming_argument(func, kwargs, name):
 def test_excitation_module_is_light():
     """Reference: DESIGN.md 'light imports' (no plotting at import) — importing the module
     in a fresh interpreter loads neither matplotlib nor the numerics stack it does not need
-    (python-control, scipy, cvxpy); checked on sys.modules of a subprocess."""
+    (python-control, scipy, cvxopt); checked on sys.modules of a subprocess."""
     code = ("import sys, ambseal.identify.signals\n"
-            "heavy = [m for m in ('matplotlib', 'control', 'scipy', 'cvxpy')\n"
+            "heavy = [m for m in ('matplotlib', 'control', 'scipy', 'cvxopt')\n"
             "         if any(k == m or k.startswith(m + '.') for k in sys.modules)]\n"
             "assert not heavy, heavy\n")
     subprocess.run([sys.executable, "-c", code], check=True)

@@ -23,7 +23,7 @@
 The names load on first use (PEP 562 ``__getattr__``, the lazy loading of scientific
 Python's SPEC 1), because importing any module of this package runs this file first and
 :mod:`ambseal.identify.signals` and :mod:`ambseal.identify.measurement` are light on
-purpose: they load neither python-control nor scipy nor cvxpy
+purpose: they load neither python-control nor scipy nor cvxopt
 (``tests/identify/test_identify_signals.py``), which an eager face would, with the fit.
 """
 

@@ -10,7 +10,7 @@ Synthesis (each returns the controller, the closed loop, the bound and a result 
   :func:`hinfnorm` the H∞ norm;
 * :func:`musyn` — μ-synthesis by complex D–K iteration; :func:`musyn_dgk` — by D–G–K
   iteration for mixed real/complex uncertainty;
-* :func:`lpvsyn` — gridded H∞ LPV synthesis by LMIs (cvxpy with Clarabel);
+* :func:`lpvsyn` — gridded H∞ LPV synthesis by LMIs (CVXOPT, structured);
 * :func:`reduce_controller`, :func:`balred_controller` — order reduction with its cost.
 
 Analysis: :func:`mussv` — μ upper and lower bounds for mixed real/complex block structures.

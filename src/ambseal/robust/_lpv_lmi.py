@@ -4,36 +4,32 @@ Scaling of the plant grid (one diagonal state scaling, a time scale ω₀, LQG b
 centre plant, unit-norm controls and measurements) and the SDPs in γ, R and S(Ω): the
 projected LMIs of Gahinet & Apkarian (1994) on every grid point, with a constant or
 parameter-dependent Lyapunov function (Apkarian & Adams 1998; Wu et al. 1996). The
-equations are in :mod:`ambseal.robust.lpv`. SDPs are solved by Clarabel through cvxpy
-(imported inside the functions); a status other than ``optimal`` raises
+equations are in :mod:`ambseal.robust.lpv`. The SDPs are solved by CVXOPT with a KKT solver
+that forms their Schur complement from the LMIs' Kronecker structure
+(:mod:`ambseal.robust._lmi_sdp`); a status other than ``optimal`` raises
 :class:`~ambseal.errors.SynthesisError`.
 """
 
 from __future__ import annotations
 
 import time
-import warnings
 from dataclasses import dataclass
 from typing import Any
 
-import cvxpy as cp
 import numpy as np
 import scipy.linalg as sla
 
 from ambseal.errors import SynthesisError
+from ambseal.robust import _lmi_sdp as _sdp
 
 __all__ = ["SolverReport", "Scaled", "scale_grid", "lmi_blocks", "solve_lmis", "basis",
            "BASES"]
 
 BASES = {"constant": 1, "affine": 2, "quadratic": 3}
-#: Clarabel tolerances: a relative duality gap of 1e-6 (Clarabel's default 1e-8 stalls on
-#: these LMIs near 1e-7, and is then reported as "almost solved", i.e. inaccurate).
-_DEFAULT_TOL = {"tol_gap_abs": 1e-6, "tol_gap_rel": 1e-6, "tol_feas": 1e-8,
-                #: the projected LMIs are dense (the null-space bases mix every entry of
-                #: R, S): Clarabel's chordal decomposition only splits them into
-                #: overlapping cones and stalls ("almost solved") on the turboexpander
-                "chordal_decomposition_enable": False}
-
+#: CVXOPT's options for the γ and centring SDPs (:mod:`ambseal.robust._lmi_sdp`): its own
+#: defaults (a feasibility tolerance of 1e-8 stalls on these LMIs at 7e-8 and ends "unknown")
+DEFAULT_TOL = {"abstol": 1e-7, "reltol": 1e-6, "feastol": 1e-7}
+SOLVER_KEYS = ("abstol", "reltol", "feastol", "maxiters", "refinement")
 
 
 @dataclass(frozen=True)
@@ -46,19 +42,21 @@ class SolverReport:
         ``"gamma"`` (minimise γ), ``"centre"`` (re-solve at the backed-off γ for a
         well-conditioned R, S) or ``"reconstruct"`` (all controller reconstructions).
     status : str
-        cvxpy status (``"optimal"`` is the only one accepted).
+        The SDP's status (``"optimal"`` is the only one accepted); for the reconstruction,
+        ``"optimal"`` or at how many table speeds its LMIs hold.
     iterations : int
-        Interior-point iterations (summed over reconstructions).
+        Interior-point iterations (0 for the closed-form reconstruction).
     time_s : float
         Wall time of setup and solve (s).
     solver : str
+        ``"CVXOPT"`` or ``"closed form"``.
     """
 
     stage: str
     status: str
     iterations: int
     time_s: float
-    solver: str = "CLARABEL"
+    solver: str = "CVXOPT"
 
     def to_dict(self) -> dict:
         return {"stage": self.stage, "status": self.status, "iterations": self.iterations,
@@ -91,30 +89,6 @@ def basis(kind: str, p: float) -> tuple[np.ndarray, np.ndarray]:
     f = np.array([p**i for i in range(nb)], float)
     df = np.array([i * p ** (i - 1) if i else 0.0 for i in range(nb)], float)
     return f, df
-
-
-def _check_status(prob, stage: str, t0: float) -> SolverReport:
-    status = str(prob.status)
-    stats = prob.solver_stats
-    it = int(getattr(stats, "num_iters", 0) or 0)
-    rep = SolverReport(stage, status, it, time.perf_counter() - t0)
-    if status in ("infeasible", "infeasible_inaccurate"):
-        raise SynthesisError(
-            f"lpvsyn ({stage}): the LMIs are infeasible (solver status {status!r}): no "
-            "controller with this Lyapunov structure exists for the plant and weights; relax "
-            "the weights, the rate bound or the grid range")
-    if status != "optimal":
-        raise SynthesisError(
-            f"lpvsyn ({stage}): solver status {status!r} after {it} iterations — the solution "
-            "is not accurate enough to build a controller from; check the scaling of the "
-            "plant and weights or raise the iteration limit")
-    return rep
-
-
-def _solve(prob, stage: str, solver_options: dict):
-    t0 = time.perf_counter()
-    _solve_quiet(prob, stage, dict(solver_options))
-    return _check_status(prob, stage, t0)
 
 
 @dataclass(frozen=True)
@@ -231,21 +205,6 @@ def lmi_blocks(sc: Scaled, nw, nz, ncon, nmeas):
     return B1, B2, C1, C2, D11, D12, D21
 
 
-def _sym_expr(X):
-    return 0.5 * (X + X.T)
-
-
-def _solve_quiet(prob, stage: str, solver_options: dict) -> None:
-
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", UserWarning)  # status is checked by the caller
-            prob.solve(solver=cp.CLARABEL, **solver_options)
-    except cp.error.SolverError as exc:
-        raise SynthesisError(f"lpvsyn ({stage}): Clarabel failed: {exc}") from exc
-
-
-
 def _affine_in_p(As: np.ndarray, ps: np.ndarray, rtol: float = 1e-9) -> bool:
     """Whether every A(p_k) of the grid lies on the line through the two ends' (to
     ``rtol`` of the largest entry)."""
@@ -271,8 +230,10 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
     lyapunov : {"constant", "affine", "quadratic"}
     nu_s : float
         Rate bound in scaled units (dp/dt'), 0 without one.
-    backoff, margin, penalty, coupling_ratio, centre, solver_options
-        As in :func:`ambseal.robust.lpv.lpvsyn` (``solver_options`` complete).
+    backoff, margin, penalty, coupling_ratio, centre
+        As in :func:`ambseal.robust.lpv.lpvsyn`.
+    solver_options : dict
+        CVXOPT options, complete (:data:`DEFAULT_TOL` and the user's).
 
     Returns
     -------
@@ -297,65 +258,100 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
     NS = sla.block_diag(_null(np.hstack([C2, D21])), np.eye(nz))
     nb = BASES[lyapunov]
     ps = sc.p_of(grid)
-    I_N = np.eye(N)
     # LMIs affine in p that hold at both ends of the range hold between them (a convex
     # combination): the coupling LMI of an affine S always, the R-LMI when A(p) is affine
     # over the grid (a seal coefficient through its LFT channel, gyroscopics in speed).
     # Inner grid points keep only the S-LMIs of a parameter-dependent S, which are
     # quadratic in p (A(p)ᵀS(p)); with a constant S and an affine A(p) they go too.
     a_affine = _affine_in_p(sc.A, ps)
+    Z = np.zeros
+    # rows [x; z; w] of the R-LMI and [x; w; z] of the S-LMI; the variable X enters as
+    # J X Uᵀ + U X Jᵀ (module _lmi_sdp), negated as s = −εI − (…) ⪰ 0
+    JR = NR.T @ np.vstack([np.eye(N), Z((nz + nw, N))])
+    JS = NS.T @ np.vstack([np.eye(N), Z((nw + nz, N))])
+    cR = NR.T @ np.block([[Z((N, N)), Z((N, nz)), B1], [Z((nz, N)), Z((nz, nz)), D11],
+                          [B1.T, D11.T, Z((nw, nw))]]) @ NR
+    cS = NS.T @ np.block([[Z((N, N)), Z((N, nw)), C1.T], [Z((nw, N)), Z((nw, nw)), D11.T],
+                          [C1, D11, Z((nz, nz))]]) @ NS
+    gR = NR.T @ sla.block_diag(Z((N, N)), np.eye(nz + nw)) @ NR
+    gS = NS.T @ sla.block_diag(Z((N, N)), np.eye(nw + nz)) @ NS
+    E1 = np.vstack([np.eye(N), Z((N, N))])
+    E2 = np.vstack([Z((N, N)), np.eye(N)])
 
     def build(gamma_fixed: float | None, alpha: float):
-        R = cp.Variable((N, N), symmetric=True)
-        Ss = [cp.Variable((N, N), symmetric=True) for _ in range(nb)]
-        g = cp.Variable(nonneg=True) if gamma_fixed is None else gamma_fixed
-        cons, trS = [], 0
-        eps = margin
+        lmis = []
+
+        def add(const, gam, terms):
+            if gamma_fixed is not None and gam is not None:
+                const, gam = const + gamma_fixed * gam, None
+            lmis.append(_sdp.Lmi(const, gam, tuple(terms)))
+
+        trS = np.zeros(nb)
         for k in range(grid.size):
             A = sc.A[k]
             inner = 0 < k < grid.size - 1
             f, df = basis(lyapunov, float(ps[k]))
-            S = sum(fi * Si for fi, Si in zip(f, Ss))
-            dS = sum(dfi * Si for dfi, Si in zip(df, Ss)) if nb > 1 else None
             if not (inner and a_affine):
-                MR = cp.bmat([[A @ R + R @ A.T, R @ C1.T, B1],
-                              [C1 @ R, -g * np.eye(nz), D11],
-                              [B1.T, D11.T, -g * np.eye(nw)]])
-                cons.append(_sym_expr(NR.T @ MR @ NR) << -eps * np.eye(NR.shape[1]))
-            signs = (1.0, -1.0) if (dS is not None and nu_s > 0) else (0.0,)
+                UR = NR.T @ np.vstack([A, C1, Z((nw, N))])
+                add(-margin * np.eye(JR.shape[0]) - cR, gR, [_sdp.LmiTerm(0, JR, -UR)])
+            signs = (1.0, -1.0) if (nb > 1 and nu_s > 0) else (0.0,)
             for sgn in signs if not (inner and a_affine and nb == 1) else ():
-                top = A.T @ S + S @ A + (sgn * nu_s * dS if sgn else 0)
-                MS = cp.bmat([[top, S @ B1, C1.T],
-                              [B1.T @ S, -g * np.eye(nw), D11.T],
-                              [C1, D11, -g * np.eye(nz)]])
-                cons.append(_sym_expr(NS.T @ MS @ NS) << -eps * np.eye(NS.shape[1]))
+                US = NS.T @ np.vstack([A.T, B1.T, Z((nz, N))])
+                terms = [_sdp.LmiTerm(1 + i, JS, -(f[i] * US + 0.5 * sgn * nu_s * df[i] * JS))
+                         for i in range(nb) if f[i] != 0 or (sgn and df[i] != 0)]
+                add(-margin * np.eye(JS.shape[0]) - cS, gS, terms)
             if k == 0 or (nb == 2 and not inner) or nb > 2:  # constant S: one suffices
-                cons.append(_sym_expr(cp.bmat([[R, alpha * I_N], [alpha * I_N, S]])) >> 0)
+                terms = [_sdp.LmiTerm(0, E1, 0.5 * E1)]
+                terms += [_sdp.LmiTerm(1 + i, E2, 0.5 * f[i] * E2) for i in range(nb)
+                          if f[i] != 0]
+                add(alpha * np.block([[Z((N, N)), np.eye(N)], [np.eye(N), Z((N, N))]]),
+                    None, terms)
             if nb > 1 or k == 0:
-                trS = trS + cp.trace(S) / (grid.size if nb > 1 else 1)
-        return R, Ss, g, cons, cp.trace(R) + trS
+                trS += f / (grid.size if nb > 1 else 1)
+        return lmis, np.concatenate([[1.0], trS]) / N
 
     reports = []
-    R, Ss, g, cons, tr = build(None, float(coupling_ratio) if not centre else 1.0)
-    prob = cp.Problem(cp.Minimize(g + penalty * tr / N), cons)
-    reports.append(_solve(prob, "gamma", solver_options))
-    gamma = float(g.value)
+    lmis, tr = build(None, float(coupling_ratio) if not centre else 1.0)
+    sol = _solve_sdp(lmis, N, nb, 1.0, penalty * tr, solver_options, "gamma", reports)
+    gamma = float(sol.gamma)
     gamma_d = backoff * gamma
     if centre:
         # stage 2: centre R, S at the backed-off γ with S R ⪰ α² I
         alpha, last = float(coupling_ratio), None
         for _ in range(4):
-            R, Ss, _, cons, tr = build(gamma_d, alpha)
-            prob = cp.Problem(cp.Minimize(tr / N), cons)
+            lmis, tr = build(gamma_d, alpha)
             try:
-                rep = _solve(prob, "centre", solver_options)
+                sol = _solve_sdp(lmis, N, nb, None, tr, solver_options, "centre", reports)
                 break
             except SynthesisError as exc:
                 last = exc
                 alpha = 1.0 + 0.5 * (alpha - 1.0)
         else:
             raise last
-        reports.append(rep)
-    Rv = _sym(np.asarray(R.value))
-    Sv = [_sym(np.asarray(S.value)) for S in Ss]
+    Rv = _sym(sol.X[0])
+    Sv = [_sym(S) for S in sol.X[1:]]
     return gamma, gamma_d, Rv, Sv, reports
+
+
+def _solve_sdp(lmis, N, nb, cost_gamma, cost_trace, options, stage, reports):
+    """One SDP stage by :func:`ambseal.robust._lmi_sdp.solve_lmis`; its report appended."""
+    t0 = time.perf_counter()
+    try:
+        sol = _sdp.solve_lmis(lmis, N, nb + 1, cost_gamma, cost_trace, options)
+    except (ArithmeticError, ValueError) as exc:  # CVXOPT: a singular scaling or KKT system
+        raise SynthesisError(
+            f"lpvsyn ({stage}): CVXOPT stopped on a singular system ({exc!r}): the LMIs are "
+            "badly conditioned; check the scaling of the plant and weights") from exc
+    rep = SolverReport(stage, sol.status, sol.iterations, time.perf_counter() - t0, "CVXOPT")
+    if sol.status == "infeasible":
+        raise SynthesisError(
+            f"lpvsyn ({stage}): the LMIs are infeasible (CVXOPT: primal infeasibility "
+            "certificate): no controller with this Lyapunov structure exists for the plant "
+            "and weights; relax the weights, the rate bound or the grid range")
+    if sol.status != "optimal":
+        raise SynthesisError(
+            f"lpvsyn ({stage}): solver status {sol.status!r} after {sol.iterations} "
+            "iterations — the solution is not accurate enough to build a controller from; "
+            "check the scaling of the plant and weights")
+    reports.append(rep)
+    return sol

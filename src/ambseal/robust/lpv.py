@@ -34,9 +34,10 @@ scaling and the SDPs in :mod:`ambseal.robust._lpv_lmi`; the controller reconstru
 
 Numerics: the plants are balanced with one diagonal state scaling for the whole grid, time
 is scaled by ω₀ (norm-preserving), and controls/measurements are normalised, before the
-SDPs are solved with Clarabel through cvxpy (imported inside the functions). A solver status
-other than ``optimal`` raises :class:`~ambseal.errors.SynthesisError`: badly scaled LMIs
-fail silently, and a controller from an inaccurate solution is refused.
+SDPs are solved by CVXOPT with a Schur complement formed from the LMIs' Kronecker structure
+(:mod:`ambseal.robust._lmi_sdp`). A solver status other than ``optimal`` raises
+:class:`~ambseal.errors.SynthesisError`: badly scaled LMIs fail silently, and a controller
+from an inaccurate solution is refused.
 """
 from __future__ import annotations
 
@@ -52,8 +53,9 @@ from ambseal.errors import SynthesisError
 from ambseal.lti.interconnect import lft_lower_matrices
 from ambseal.lti.tables import interp_table
 from ambseal.robust._lpv_lmi import (
-    _DEFAULT_TOL,
     BASES,
+    DEFAULT_TOL,
+    SOLVER_KEYS,
     SolverReport,
     lmi_blocks,
     scale_grid,
@@ -227,7 +229,7 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
            coupling_ratio: float = 1.1, centre: bool = False) -> LpvSynResult:
     """Gridded H∞ LPV controller (Apkarian & Adams 1998; Wu et al. 1996; thesis P3 §4).
 
-    Stages, each an SDP solved by Clarabel and each required to end ``optimal``:
+    Stages, the first two SDPs solved by CVXOPT and required to end ``optimal``:
 
     1. ``"gamma"``: minimise γ + penalty·(tr R + mean_k tr S(Ω_k))/N subject to the
        projected LMIs and [R, αI; αI, S(Ω_k)] ⪰ 0 with α = ``coupling_ratio`` > 1, i.e.
@@ -239,8 +241,10 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
     2. ``"centre"`` (only with ``centre=True``): stage 1 with α = 1, then at
        γ_d = backoff·γ minimise tr R + mean_k tr S(Ω_k) with α = ``coupling_ratio``
        (lowered towards 1 if infeasible). Gives the least conservative γ, but on the
-       turboexpander with a dynamic W_u this second SDP ends "almost solved" (refused).
-    3. ``"reconstruct"``: the controller on the 5× denser table.
+       turboexpander with a dynamic W_u this second SDP ended "almost solved" with the
+       former solver, Clarabel (refused).
+    3. ``"reconstruct"``: the controller on the 5× denser table, in closed form
+       (central solutions of the reconstruction LMIs, ``robust/_lpv_reconstruct.py``).
 
     Parameters
     ----------
@@ -264,8 +268,9 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
     check_density : int
         The controller table (and check grid) has ``check_density·(n_p − 1) + 1`` speeds.
     solver_options : dict, optional
-        Passed to Clarabel (e.g. ``{"max_iter": 200}``); defaults: relative gap 1e-6,
-        feasibility 1e-8.
+        CVXOPT's ``abstol``, ``reltol``, ``feastol``, ``maxiters``, ``refinement``
+        (e.g. ``{"maxiters": 200}``); defaults: CVXOPT's own (gaps 1e-7 absolute, 1e-6
+        relative, feasibility 1e-7).
     margin : float
         Strictness margin of the LMIs (scaled units).
     scaling : {"riccati", "diagonal"}
@@ -290,8 +295,9 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
     SynthesisError
         One grid point, a grid not increasing, plants that differ in B, C or D, D22 ≠ 0,
         an unknown ``lyapunov``, a rate bound with ``"constant"`` (or none with a
-        parameter-dependent S), infeasible LMIs, a solver status other than ``optimal``,
-        or a reconstructed frozen closed loop that is unstable.
+        parameter-dependent S), an unknown key in ``solver_options``, infeasible LMIs, a
+        solver status other than ``optimal``, or a reconstructed frozen closed loop that is
+        unstable.
 
     Examples
     --------
@@ -309,7 +315,11 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
     sc = scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling)
     blocks = lmi_blocks(sc, nw, nz, ncon, nmeas)
     nu_s = 0.0 if rate_bound is None else float(rate_bound) / sc.w0 * sc.dp_dW  # dp/dt'
-    solver_options = {**_DEFAULT_TOL, **(solver_options or {})}
+    unknown = sorted(set(solver_options or {}) - set(SOLVER_KEYS))
+    if unknown:
+        raise SynthesisError(f"lpvsyn: solver_options {unknown} unknown; expected some of "
+                             f"{', '.join(SOLVER_KEYS)} (CVXOPT's options)")
+    solver_options = {**DEFAULT_TOL, **(solver_options or {})}
     gamma, gamma_d, R, S, reports = solve_lmis(
         sc, blocks, grid, lyapunov, nu_s, backoff=backoff, margin=margin, penalty=penalty,
         coupling_ratio=coupling_ratio, centre=centre, solver_options=solver_options)
@@ -320,7 +330,7 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
                             for j in range(grid.size - 1)] + [grid[-1:]])
     A_of = interp_A(As, dAs, grid)
     *mats, rep = reconstruct_table(sc, blocks, table, A_of, R, S, lyapunov, nu_s,
-                                   gamma_d * 1.02, margin, solver_options)
+                                   gamma_d * 1.02, margin)
     reports.append(rep)
     in_names = tuple(list(getattr(plants[0], "output_labels", []))[nz:]) or \
         tuple(f"y{i}" for i in range(nmeas))

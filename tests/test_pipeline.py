@@ -271,6 +271,7 @@ def test_run_with_the_tracked_controller(tmp_path, request, design_cache_for):
     assert ramp["runs"]["pid"]["lost_at_s"] is not None
     assert ramp["tracking"]["max_error_rel"] < 0.10 and ramp["tracking"]["coverage"] >= 0.90
     assert (out / "ramp.png").stat().st_size > 0
+    validate_metrics(m)  # the tracked summary carries every key the schema asks of one
 
 
 def test_run_separates_the_seal_coefficients_and_static_ki(metrics):

@@ -116,6 +116,30 @@ def test_same_optimum_as_cvxopts_dense_solver():
         np.testing.assert_allclose(sol.X[v], Xr, rtol=1e-5, atol=1e-5 * np.abs(Xr).max())
 
 
+def test_schur_complement_is_its_definition():
+    """H = Σ_j 𝒜_jᵀ 𝒜_j (scaled LMIs, Z = I) entry by entry from unit vectors: terms on
+    three variables in any order, one variable twice in an LMI, LMIs with and without γ."""
+    rng = np.random.default_rng(4)
+    n = 4
+
+    def sym(k):
+        M = rng.standard_normal((k, k))
+        return M + M.T
+
+    def term(v, d):
+        return sdp.LmiTerm(v, rng.standard_normal((d, n)), rng.standard_normal((d, n)))
+
+    lmis = [sdp.Lmi(sym(5), sym(5), (term(0, 5), term(1, 5), term(2, 5))),
+            sdp.Lmi(sym(6), None, (term(2, 6), term(1, 6), term(1, 6))),
+            sdp.Lmi(sym(3), sym(3), (term(1, 3), term(0, 3)))]
+    lay = sdp._Layout(n, 3, True)
+    E = np.eye(lay.size)
+    ref = np.array([[sum(np.sum(sdp._lin(lmi, lay, E[i]) * sdp._lin(lmi, lay, E[k]))
+                         for lmi in lmis) for k in range(lay.size)] for i in range(lay.size)])
+    np.testing.assert_allclose(sdp._schur(lmis, lay), ref, rtol=1e-12,
+                               atol=1e-12 * np.abs(ref).max())
+
+
 def test_infeasible_lmis_are_reported():
     """X ⪯ −I and X ⪰ 0 together: CVXOPT's primal infeasibility certificate."""
     n = 2

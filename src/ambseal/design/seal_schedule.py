@@ -47,7 +47,7 @@ with W_u = 0.1 on examples/pump.toml. examples/pump.toml with these weights: γ 
 
 Synthesis is the γ SDP (``benchmarks/README.md``, bench_tracked; the reconstruction is in
 closed form): on the rig the main job identifies (its eddy-current lag: 32 design-plant
-states) about 14 s, 0.5 s per interior-point iteration. lpvsyn's trace penalty stays at its
+states) about 3 s, 0.1 s per interior-point iteration. lpvsyn's trace penalty stays at its
 default 1e-4: at 1e-5 the identified test rig's σ̄(S_o) fell from 3.01 to 2.70, but the
 identified pump's tracked loop lost stability at 3× nominal pressure on its facility truth
 (a 301 Hz mode, ζ = −0.004), where the identified model is poor (``benchmarks/README.md``).

@@ -20,9 +20,10 @@ X ↦ P X Qᵀ + Q X Pᵀ its blocks are sums of Kronecker products of n × n ma
     𝒜_tᵀ (Z ⊗ Z) 𝒜_u : X ↦ (P_tᵀZP_u) X (Q_uᵀZQ_t) + (P_tᵀZQ_u) X (P_uᵀZQ_t)
                             + (Q_tᵀZP_u) X (Q_uᵀZP_t) + (Q_tᵀZQ_u) X (P_uᵀZP_t),
 
-formed in O(n⁴) per pair of terms. CVXOPT's ``conelp`` runs the interior-point method (its
-documented interface for a user KKT solver and a matrix-free G, "Exploiting structure",
-Andersen, Dahl & Vandenberghe); :func:`solve_lmis` supplies G and the KKT solver.
+formed with O(n⁴) operations (:func:`_schur`). CVXOPT's ``conelp`` runs the interior-point
+method (its documented interface for a user KKT solver and a matrix-free G, "Exploiting
+structure", Andersen, Dahl & Vandenberghe); :func:`solve_lmis` supplies G and the KKT
+solver.
 
 Storage follows CVXOPT: the 's' part of a vector is each d × d matrix in column-major
 order, of which only the lower triangle is read (the upper triangle is written
@@ -89,6 +90,11 @@ class _Layout:
         #: Dᵀ vec(Y) for symmetric Y: the diagonal once, each off-diagonal entry twice
         self.w = np.where(self.I == self.J, 1.0, 2.0)
         self.off_q = (self.I != self.J).astype(float)
+        # flat indices into T[(i, k), (l, j)] = Σ L[i, k] R[l, j] (n² × n²) of the two reads
+        # of [Dᵀ Op D]_pq (see _schur): (I_p I_q, J_q J_p) and (I_p J_q, I_q J_p)
+        I, J, n2 = self.I[:, None], self.J[:, None], n * n
+        self.read1 = (I * n + self.I[None, :]) * n2 + self.J[None, :] * n + J
+        self.read2 = (I * n + self.J[None, :]) * n2 + self.I[None, :] * n + J
 
     def unpack(self, x: np.ndarray, v: int) -> np.ndarray:
         X = np.zeros((self.n, self.n))
@@ -139,32 +145,41 @@ def _scaled(lmi: Lmi, rti: np.ndarray) -> Lmi:
 
 def _schur(scaled, lay: _Layout) -> np.ndarray:
     """H = Σ_j 𝒜_jᵀ (Z_j ⊗ Z_j) 𝒜_j in the vech coordinates (module docstring), from the
-    scaled LMIs (:func:`_scaled`, Z = I)."""
+    scaled LMIs (:func:`_scaled`, Z = I).
+
+    Each pair of terms (t on X_v, u on X_w) adds the operator X ↦ Σ_k L_k X R_k of the
+    module docstring to the block (v, w). Its entries in the vech coordinates,
+    [Dᵀ Op D]_pq = w_p (Op(E_q + E_qᵀ))_{I_p J_p}, are two reads of the n² × n² array
+    T[(i, k), (l, j)] = Σ_k L_k[i, k] R_k[l, j], which is linear in the pairs: T is summed
+    over every LMI and pair of terms first (one matrix product per block) and read once.
+    """
     H = np.zeros((lay.size, lay.size))
-    I, J, w, offq, m = lay.I, lay.J, lay.w, lay.off_q, lay.m
+    m = lay.m
+    factors: dict = {}
     for lmi in scaled:
         for a, ta in enumerate(lmi.terms):
-            for b in range(a, len(lmi.terms)):
-                tb = lmi.terms[b]
-                # Op(X) = Σ_k L_k X R_k with (L_k, R_k) from the module docstring
-                pairs = ((ta.P.T @ tb.P, tb.Q.T @ ta.Q), (ta.P.T @ tb.Q, tb.P.T @ ta.Q),
-                         (ta.Q.T @ tb.P, tb.Q.T @ ta.P), (ta.Q.T @ tb.Q, tb.P.T @ ta.P))
-                blk = np.zeros((m, m))
-                for L, Rm in pairs:
-                    # [Dᵀ Op D]_{pq}: Op(E_q + E_qᵀ) read at (I_p, J_p), weighted by w_p
-                    blk += L[np.ix_(I, I)] * Rm[np.ix_(J, J)].T
-                    blk += offq[None, :] * (L[np.ix_(I, J)] * Rm[np.ix_(I, J)].T)
-                blk *= w[:, None]
-                oa, ob = lay.off[ta.var], lay.off[tb.var]
-                H[oa:oa + m, ob:ob + m] += blk
-                if b != a:
-                    H[ob:ob + m, oa:oa + m] += blk.T
+            for tb in lmi.terms[a:]:
+                # blocks (v, w) with v ≤ w only; (w, v) is added as the transpose
+                pairs = [(ta, tb)] if ta is tb else [(ta, tb), (tb, ta)]
+                for s, t in pairs:
+                    if s.var > t.var:
+                        continue
+                    Ls, Rs = factors.setdefault((s.var, t.var), ([], []))
+                    Ls += [s.P.T @ t.P, s.P.T @ t.Q, s.Q.T @ t.P, s.Q.T @ t.Q]
+                    Rs += [t.Q.T @ s.Q, t.P.T @ s.Q, t.Q.T @ s.P, t.P.T @ s.P]
         if lmi.gamma is not None:
             H[0, 0] += float(np.sum(lmi.gamma * lmi.gamma))
             col = np.zeros(lay.size)
             _lin_adjoint(Lmi(lmi.const, None, lmi.terms), lay, lmi.gamma, col)
             H[0, :] += col
             H[1:, 0] += col[1:]
+    for (v, w), (Ls, Rs) in factors.items():
+        T = (np.array([L.ravel() for L in Ls]).T @ np.array([R.ravel() for R in Rs])).ravel()
+        blk = lay.w[:, None] * (T[lay.read1] + lay.off_q[None, :] * T[lay.read2])
+        ov, ow = lay.off[v], lay.off[w]
+        H[ov:ov + m, ow:ow + m] += blk
+        if v != w:
+            H[ow:ow + m, ov:ov + m] += blk.T
     return H
 
 

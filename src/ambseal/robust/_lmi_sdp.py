@@ -82,7 +82,7 @@ class _Layout:
     """Offsets of γ and of each vech(X_v) in x, and the vech index arrays."""
 
     def __init__(self, n: int, n_vars: int, with_gamma: bool):
-        self.n, self.n_vars, self.with_gamma = n, n_vars, with_gamma
+        self.n, self.with_gamma = n, with_gamma
         self.I, self.J = np.tril_indices(n)
         self.m = self.I.size
         self.off = [int(with_gamma) + v * self.m for v in range(n_vars)]

@@ -57,6 +57,7 @@ from pathlib import Path
 from ambseal import __version__
 from ambseal.config import check_operating, default_rig_path
 from ambseal.errors import AmbsealError, with_source
+from ambseal.threads import DEFAULT_THREADS, ENV_VAR, blas_threads, numerics_threads
 
 __all__ = ["main"]
 
@@ -149,6 +150,11 @@ def _parser() -> argparse.ArgumentParser:
                       help="no progress and no stage lines; errors only (stdout unchanged)")
     loud.add_argument("-v", "--verbose", action="store_true",
                       help="log every step (DEBUG on the 'ambseal' logger) instead of bars")
+    p.add_argument("--blas-threads", default=None, metavar="N",
+                   help="BLAS/OpenMP threads of the numerics: a whole number or 'inherit' "
+                        f"(leave them as the environment sets them); default "
+                        f"${ENV_VAR}, else {DEFAULT_THREADS} (fastest for ambseal's many "
+                        f"small matrices)")
     sub = p.add_subparsers(dest="command", required=True)
 
     run = sub.add_parser("run", help="the main job: model, designs, judgement, "
@@ -403,7 +409,14 @@ def main(argv: list[str] | None = None) -> int:
     Warnings raised on the way (numpy's, say) are shown after a successful command and
     dropped when the command ends in the one error line."""
 
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args = parser.parse_args(argv)
+    try:
+        blas_threads(args.blas_threads)
+    except AmbsealError as exc:
+        parser.error(str(exc))
+    if args.blas_threads is not None:  # the policy of this command and of its children
+        os.environ[ENV_VAR] = args.blas_threads
     args.command_line = shlex.join(["ambseal", *(sys.argv[1:] if argv is None else argv)])
     _logging(args)
 
@@ -417,7 +430,8 @@ def main(argv: list[str] | None = None) -> int:
         warnings.simplefilter("default")
         try:
             _check_operating(args)
-            code = handler(args)
+            with numerics_threads():
+                code = handler(args)
         except AmbsealError as exc:
             print(f"ambseal: error: {with_source(exc, *_inputs(args))}", file=sys.stderr)
             return 2

@@ -21,6 +21,7 @@ from rich.console import Console
 from rich.progress import Progress
 
 from ambseal.errors import AmbsealError, ConfigError
+from ambseal.threads import with_numerics_threads
 
 __all__ = ["CaseError", "run_cases", "dask_available", "SERIAL_BELOW"]
 
@@ -54,6 +55,7 @@ def dask_available() -> bool:
     return True
 
 
+@with_numerics_threads
 def _call(case: dict, fn: Callable, shared: dict):
     try:
         return fn(case, **shared)

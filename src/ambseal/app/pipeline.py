@@ -50,6 +50,7 @@ from ambseal.report.run_report import (
     stamp,
     write_run_report,
 )
+from ambseal.threads import with_numerics_threads
 
 __all__ = ["RunResult", "run", "default_truth_path", "EXIT_FAILED"]
 
@@ -141,6 +142,7 @@ def _controllers(cfg: RigConfig, spec, say, failed: dict,
     return out + [d for m in methods if m != "pid" for d in robust(m)]
 
 
+@with_numerics_threads
 def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         progress: bool = True, truth: str | Path | None = None,
         identification: bool = True, overrides: tuple[str, ...] = (),

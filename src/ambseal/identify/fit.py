@@ -45,6 +45,7 @@ from ambseal.lti.interconnect import series_inputs
 from ambseal.model.amb import eddy_lag_matrices
 from ambseal.model.lft import Plant
 from ambseal.robust.digital_loop import DiscreteController, closed_loop_matrices
+from ambseal.threads import with_numerics_threads
 
 __all__ = ["FitResult", "ClosedLoopModel", "fit_parameters", "default_bounds", "nrmse_fit"]
 
@@ -303,6 +304,7 @@ def default_bounds(model: ClosedLoopModel, names) -> dict[str, tuple[float, floa
     return out
 
 
+@with_numerics_threads
 def fit_parameters(
     records: list,
     models: list[ClosedLoopModel],

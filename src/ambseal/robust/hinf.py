@@ -45,6 +45,7 @@ from ambseal.robust._hinf_gamma import sb10ad as _sb10ad
 from ambseal.robust._hinf_gamma import search_gamma as _search_gamma
 from ambseal.robust._hinf_small import small_margin
 from ambseal.robust.stability import is_stable, unstable_poles
+from ambseal.threads import with_numerics_threads
 
 __all__ = ["HinfResult", "hinfsyn", "hinf_gamma_opt", "hinfnorm", "lft_lower", "check_plant"]
 
@@ -70,6 +71,7 @@ _SB10AD_INFO = {
 
 
 # --------------------------------------------------------------------------- norm
+@with_numerics_threads
 def hinfnorm(sys, rtol: float = 1e-10) -> tuple[float, float]:
     """H∞ norm of a continuous-time LTI system and the frequency of its peak.
 
@@ -308,6 +310,7 @@ def _scale(A, B, C, D, nw, nz):
     return A, B, C, D, t, su, sy
 
 
+@with_numerics_threads
 def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | None = None,
             max_backoff: float = 4.0, rtol: float = 1e-6) -> HinfResult:
     """H∞ controller for a generalised plant (Paper 3 eq. 12; Paper 5 eq. 8).

@@ -64,6 +64,7 @@ from ambseal.robust._lpv_lmi import (
 from ambseal.robust._lpv_reconstruct import interp_A, reconstruct_table
 from ambseal.robust.hinf import hinfnorm
 from ambseal.robust.stability import is_stable
+from ambseal.threads import with_numerics_threads
 
 __all__ = ["FrozenClosedLoop", "LpvController", "LpvSynResult", "lpvsyn", "SolverReport"]
 
@@ -221,6 +222,7 @@ class LpvSynResult:
 
 
 # --------------------------------------------------------------------------- synthesis
+@with_numerics_threads
 def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
            dA: Sequence[np.ndarray] | None = None, lyapunov: str = "constant",
            rate_bound: float | None = None, backoff: float = 1.05,

@@ -43,6 +43,7 @@ from ambseal.errors import ModelError
 from ambseal.lti.freqresp import freqresp
 from ambseal.robust._mu_lower import lower_bound as _lower_bound
 from ambseal.robust._mu_upper import upper_bound as _upper_bound
+from ambseal.threads import with_numerics_threads
 
 __all__ = ["MuResult", "MuPeak", "mussv", "mu_peak", "parse_blocks", "check_blocks"]
 
@@ -245,6 +246,7 @@ def _worst_direction(Mp, D, G, cols):
 _STRIDE = 32  # cold solves on every 32nd frequency, warm starts in between
 
 
+@with_numerics_threads
 def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
           lower_iter: int = 20, gmax: float = 1e3, seed: int = 0,
           lower: bool = True, peak_tol: float | None = None) -> MuResult:

@@ -11,8 +11,7 @@ One JSON line per case (``case, ours_s, baseline, baseline_s, ratio`` and the μ
     The robust-performance distillation problem of Skogestad & Postlethwaite (2005),
     §8.12.4, Table 8.1 — G = 1/(75s+1)·[87.8 −86.4; 108.2 −109.6], W_I = (s+0.2)/(0.5s+1)·I,
     W_P = 0.5(10s+1)/(10s+1e-5)·I; blocks [(1, 1), (1, 1), (2, 2)] — designed by
-    ``musyn(P, blocks, 2, 2)`` with every default (its own frequency grid, D search, time
-    budget). ``mu_ab13md_301``: the peak of SLICOT AB13MD's μ upper bound (slycot, on
+    ``musyn(P, blocks, 2, 2)`` with every default (its own frequency grid, D search). ``mu_ab13md_301``: the peak of SLICOT AB13MD's μ upper bound (slycot, on
     python-control's frequency response of ``P.lft(K)``) on 301 points log-spaced over
     10⁻³…10³ rad/s, an independent check of the controller; ``mu_reported``: the μ musyn
     states (its upper bound re-checked around the peaks); ``rel_reported_to_ab13md``.

@@ -72,6 +72,7 @@ from ambseal.robust.dk import design_omega, musyn
 from ambseal.robust.hinf import hinfsyn
 from ambseal.robust.loop import judged_loop
 from ambseal.robust.order import reduce_controller
+from ambseal.threads import with_numerics_threads
 
 __all__ = ["DesignResult", "design", "full_order_check", "bound_text", "METHODS"]
 
@@ -132,6 +133,10 @@ class DesignResult:
         None for H∞ and the PID.
     notes : tuple of str
         The specification's notes (no seal, ...).
+    stopping : dict or None
+        μ designs: the rule that ended each phase of the synthesis, its iterations and
+        the D search's γ evaluations (:attr:`ambseal.robust.dk.MusynResult.stopping`);
+        None otherwise.
     verdict : str
         One plain line: robust performance met or not (H∞: γ), and the full-order
         stability.
@@ -158,6 +163,7 @@ class DesignResult:
     notes: tuple = ()
     verdict: str = ""
     omega: Any = field(default=None, repr=False)
+    stopping: dict | None = None
 
     def summary(self) -> dict:
         """Short JSON-ready summary (no matrices)."""
@@ -170,7 +176,8 @@ class DesignResult:
                 "design_states": self.design_states, "full_order": self.full_order,
                 "allow_unstable": self.allow_unstable, "delay": self.delay,
                 "steps": list(self.steps),
-                "notes": list(self.notes), "verdict": self.verdict}
+                "notes": list(self.notes), "verdict": self.verdict,
+                "stopping": self.stopping}
 
     def to_dict(self) -> dict:
         """Summary plus the controller matrices (lists) and the D–K history."""
@@ -234,6 +241,7 @@ def full_order_check(cfg, K, conditions) -> dict:
             "damping": float(-z.real / max(abs(z), 1e-300))}
 
 
+@with_numerics_threads
 def design(
     cfg,
     method: str = "mu",
@@ -368,7 +376,7 @@ def design(
         elapsed_s=time.perf_counter() - t0, reduction=r.reduction, plant=r.gp,
         design_states=n, full_order=check, allow_unstable=not check["stable"],
         delay=dl.to_dict(), steps=tuple(steps), notes=tuple(sp.notes),
-        verdict=_verdict(method, r, check), omega=r.omega)
+        verdict=_verdict(method, r, check), omega=r.omega, stopping=r.stopping)
 
 
 @dataclass(frozen=True, eq=False)
@@ -383,6 +391,7 @@ class _Synthesis:
     K_P: Any = None
     mu_omega: float | None = None
     omega: Any = None
+    stopping: dict | None = None
 
 
 def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl):
@@ -399,6 +408,7 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
     if method == "hinf":
         r = hinfsyn(gp.P_nominal, gp.nmeas, gp.ncon)
         K_P, gamma, mu, hist = r.K, float(r.gamma), None, ()
+        stopping = None
         P_red, blocks = gp.P_nominal, None
     else:
         if om is None:
@@ -406,6 +416,7 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
         syn = musyn_dgk if sp.mu_iteration == "dgk" else musyn
         r = syn(gp.P, gp.blocks, gp.nmeas, gp.ncon, om, order=dk_order, max_iter=max_iter)
         K_P, gamma, mu, hist = r.K, float(r.gamma), float(r.mu), r.history
+        stopping = r.stopping
         P_red, blocks, mu_omega = gp.P, gp.blocks, float(r.mu_omega)
     order_full = int(K_P.nstates)
     if reduce_to == "auto":
@@ -424,7 +435,7 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
         order_full = red["order_full"]
     K = gp.physical_controller(K_P, name=f"K_{method}")
     return _Synthesis(K, gamma, mu, tuple(hist), order_full, red, gp, K_P, mu_omega,
-                      om if method == "mu" else None)
+                      om if method == "mu" else None, stopping)
 
 
 def _reduce_best(P, cands, order: int, auto: bool, gp, blocks, omega):

@@ -18,8 +18,6 @@ Iterative Methods for Optimization (1999) §8.1 (restarts).
 
 from __future__ import annotations
 
-import time
-
 import control as ct
 import numpy as np
 from scipy.optimize import minimize
@@ -148,28 +146,25 @@ def _tf_to_theta(tf):
     return np.array(th), order
 
 
-class _OutOfTime(Exception):
-    """The time budget ran out inside the D search."""
-
-
 #: D search: Nelder–Mead evaluations per parameter of the fitted D scales. On Skogestad &
-#: Postlethwaite's distillation problem (two scales of order 4, 18 parameters, on their
-#: 61-point grid) the search reached μ 0.984 after 150 γ evaluations, 0.978 after 300 and
-#: 0.9736, the published optimum, after 600 (benchmarks/bench_dk.py): 33 per parameter;
-#: 50 leaves room for the restarts.
-SEARCH_EVALS_PER_PARAMETER = 50
-#: The search starts only when the time left affords this many γ evaluations per parameter
-#: (each timed by the last K-step, which costs more than a γ evaluation: a conservative
-#: estimate); a simplex over n parameters needs n + 1 evaluations to start and a few sweeps
-#: to move, so fewer rarely lower γ (the test rig's design, 80 states: 40 evaluations found
-#: no lower γ).
-SEARCH_MIN_EVALS_PER_PARAMETER = 20
+#: Postlethwaite's distillation problem (18 parameters on their 61-point grid, 14 on
+#: ``default_omega``'s) 150 γ evaluations reached μ 0.984, 300 0.978 and 600 0.9736, the
+#: published optimum (benchmarks/bench_dk.py); 25 per parameter (350–450) is within 1 % of
+#: the optimum at half the cost of 50.
+SEARCH_EVALS_PER_PARAMETER = 25
+#: The work ``search="auto"`` may spend, counted in γ evaluations × n³, n the states of the
+#: scaled plant: a γ evaluation (Riccati equations and Hamiltonian eigenvalues of the scaled
+#: plant) costs ∝ n³. A count, not a clock, so the same problem gets the same search on
+#: every machine, quiet or loaded. The distillation column's full search is 450 × 22³ ≈
+#: 4.8·10⁶; on a 92-state scaled plant (a rotor's μ design, 10 parameters) it would be
+#: 250 × 92³ ≈ 1.9·10⁸, at a K-step of 0.4 s a minute for a μ 0.1 % lower
+#: (benchmarks/README.md, bench_dk): the limit lies between.
+SEARCH_WORK = 5e7
 
 
-def _search_dscales(P, cblocks, fits, nmeas, ncon, evals, deadline=None, restarts=2):
-    """Direct search (Nelder–Mead, at most ``evals`` γ evaluations, until ``deadline``)
-    over the section parameters of the fitted D scales for the smallest γ_opt of
-    ``D P D⁻¹`` (γ to 1e-4).
+def _search_dscales(P, cblocks, fits, nmeas, ncon, evals, restarts=2):
+    """Direct search (Nelder–Mead, at most ``evals`` γ evaluations) over the section
+    parameters of the fitted D scales for the smallest γ_opt of ``D P D⁻¹`` (γ to 1e-4).
 
     D–K stalls above the μ-optimum because each D-step fits the pointwise-optimal D of the
     *current* K; this searches the same rational D's for the best K-step directly. Every
@@ -178,8 +173,8 @@ def _search_dscales(P, cblocks, fits, nmeas, ncon, evals, deadline=None, restart
     converges before the evaluations run out it restarts from its best point with a fresh
     simplex (at most ``restarts`` times): a converged simplex in a dozen dimensions has
     often collapsed onto a subspace (Lagarias et al. 1998; the restart is the classical
-    remedy, Kelley 1999). Returns ``(fits, γ_opt, evaluations)``, with ``fits`` None when no
-    better D was found; the best D found so far when the deadline passes.
+    remedy, Kelley 1999). Returns ``(fits, γ_opt, evaluations, rule)``, with ``fits`` None
+    when no better D was found and ``rule`` the one that ended the search.
     """
     parts = [_tf_to_theta(f) for f in fits]
     cuts = np.cumsum([0] + [th.size for th, _ in parts])
@@ -190,8 +185,6 @@ def _search_dscales(P, cblocks, fits, nmeas, ncon, evals, deadline=None, restart
     best = {"x": None, "g": np.inf, "n": 0}
 
     def gamma(x):
-        if deadline is not None and best["n"] > 0 and time.process_time() > deadline:
-            raise _OutOfTime
         best["n"] += 1
         try:
             Ps = _scaled_plant(P, cblocks, [_realize(*t) for t in sections(x)], nmeas, ncon)
@@ -207,57 +200,65 @@ def _search_dscales(P, cblocks, fits, nmeas, ncon, evals, deadline=None, restart
     near = [None]
     g0 = gamma(x0)
     x = x0
+    rule = f"{int(restarts)} restarts done"
     for _ in range(int(restarts) + 1):
         left = int(evals) - best["n"]
         if left <= x.size + 1:
+            rule = "evaluations spent"
             break
         # first simplex: each parameter (a logarithm) moved by 0.3, i.e. by a factor 1.35
         simplex = np.vstack([x, x + 0.3 * np.eye(x.size)])
         g_start = best["g"]
-        try:
-            minimize(gamma, x, method="Nelder-Mead",
-                     options={"maxfev": left, "adaptive": True, "xatol": 1e-3,
-                              "fatol": 1e-5, "initial_simplex": simplex})
-        except _OutOfTime:
-            break
+        minimize(gamma, x, method="Nelder-Mead",
+                 options={"maxfev": left, "adaptive": True, "xatol": 1e-3,
+                          "fatol": 1e-5, "initial_simplex": simplex})
         if not best["g"] < g_start * (1 - 1e-4):
+            rule = "converged: a restart lowered γ by less than 1e-4"
             break
         x = best["x"]
     if not best["g"] < g0:
-        return None, g0, best["n"]
+        return None, g0, best["n"], rule
     return [ct.tf(*_theta_to_tf(*t)) for t in sections(best["x"])], float(best["g"]), \
-        best["n"]
+        best["n"], rule
 
 
-def _search_evals(search, fits, time_left, t_eval) -> int:
-    """γ evaluations granted to the D search (0: no search); see :func:`musyn`."""
-    if not fits or search == 0:
-        return 0
+def _search_evals(search, fits, n_states: int) -> tuple[int, str]:
+    """γ evaluations granted to the D search (0: no search) on a scaled plant of
+    ``n_states`` states, and the rule that granted them; see :func:`musyn`."""
+    if not fits:
+        return 0, "no D scales fitted"
+    if search == 0:
+        return 0, "search=0"
     n = sum(_tf_to_theta(f)[0].size for f in fits)
     if search != "auto":
-        return int(search)
-    if time_left < SEARCH_MIN_EVALS_PER_PARAMETER * n * t_eval:
-        return 0
-    return SEARCH_EVALS_PER_PARAMETER * n
+        return int(search), f"search={int(search)}"
+    full = SEARCH_EVALS_PER_PARAMETER * n
+    work = full * float(n_states) ** 3
+    if work <= SEARCH_WORK:
+        return full, f"auto: {SEARCH_EVALS_PER_PARAMETER} per parameter of {n}"
+    return 0, (f"auto: not started, {full} evaluations on a {n_states}-state plant exceed "
+               f"the work limit ({work:.2g} > {SEARCH_WORK:.0e} evaluations × states³)")
 
 
-def _search_step(P, blocks, cblocks, nmeas, ncon, w, best, evals, backoff, history, console,
-                 deadline=None):
-    """:func:`_search_dscales` from the best D–K iteration's fits; returns the finalist
+def _search_step(P, blocks, cblocks, nmeas, ncon, w, best, evals, backoff, history,
+                 console):
+    """:func:`_search_dscales` from the best D–K iteration's fits. Returns the finalist
     ``(μ on the grid, index, HinfResult, MuResult, fits)`` of its controller, recorded in
-    ``history``, or None when the search found no D with a lower γ_opt."""
-    fits, _, n = _search_dscales(P, cblocks, best[4], nmeas, ncon, evals, deadline)
+    ``history`` (None when the search found no D with a lower γ_opt), and
+    ``{"evaluations", "rule"}``: the γ evaluations made and the rule that ended it."""
+    fits, _, n, rule = _search_dscales(P, cblocks, best[4], nmeas, ncon, evals)
+    done = {"evaluations": int(n), "rule": rule}
     if fits is None:
-        return None
+        return None, dict(done, rule=f"{rule}; no D with a lower γ_opt found")
     try:
         hr = hinfsyn(_scaled_plant(P, cblocks, fits, nmeas, ncon), nmeas, ncon,
                      backoff=backoff)
     except SynthesisError:
-        return None
+        return None, dict(done, rule=f"{rule}; its K-step failed")
     mu = mussv(lft_lower(P, hr.K, nmeas, ncon), blocks, w, lower=False)
     peak = float(np.max(mu.upper))
     history.append({"iteration": len(history), "gamma": hr.gamma, "mu": peak,
                     "order": hr.order, "step": "D search", "evaluations": n})
     if console is not None:
         console.print(f"D search ({n} γ evaluations): γ = {hr.gamma:.4g}, μ = {peak:.4g}")
-    return (peak, len(history) - 1, hr, mu, tuple(fits))
+    return (peak, len(history) - 1, hr, mu, tuple(fits)), done

@@ -69,6 +69,7 @@ from ambseal.robust._dgscale import (
 from ambseal.robust.dk import MusynResult, _check, default_omega, fit_dscale, musyn
 from ambseal.robust.hinf import hinfsyn, lft_lower
 from ambseal.robust.mu import check_blocks, mussv
+from ambseal.threads import with_numerics_threads
 
 __all__ = ["musyn_dgk", "fit_g"]
 
@@ -183,11 +184,12 @@ def _k_step(Ps, nmeas, ncon, level):
     return hr
 
 
+@with_numerics_threads
 def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None, *,
               order: int | str = "auto", max_iter: int = 8, rtol: float = 1e-2,
               patience: int = 2, backoff: float = 1.01, fit_tol: float = 0.05,
               search: int | str = "auto", search_backoff: float = 1.001,
-              time_budget_s: float = 30.0, progress: bool = False) -> MusynResult:
+              progress: bool = False) -> MusynResult:
     """μ-synthesis by D–G–K iteration for mixed real/complex structures (Young 1996).
 
     Complex D–K (:func:`~ambseal.robust.dk.musyn`) first, then D–G–K steps from its best
@@ -223,9 +225,6 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
         Relative magnitude tolerance of the automatic scaling fit orders.
     search, search_backoff : int or "auto", float
         The D search of the D–K phase, as in :func:`~ambseal.robust.dk.musyn`.
-    time_budget_s : float
-        CPU-time budget (s) of both phases (:func:`~ambseal.robust.dk.musyn`): no D–G–K
-        step starts once it is spent.
     progress : bool
         Print one line per iteration on stderr (rich).
 
@@ -254,8 +253,7 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
     w = default_omega(P) if omega is None else np.asarray(omega, float)
     dk = musyn(P, blocks, nmeas, ncon, w, order=order, max_iter=max_iter, rtol=rtol,
                patience=patience, backoff=backoff, fit_tol=fit_tol, search=search,
-               search_backoff=search_backoff, time_budget_s=time_budget_s, progress=progress)
-    deadline = t0 + float(time_budget_s)
+               search_backoff=search_backoff, progress=progress)
     blks = check_blocks(P, blocks, nmeas, ncon)
     if not any(b.kind == "real" for b in blks):
         return dk
@@ -267,10 +265,9 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
         console = Console(stderr=True)
     # iterates compared by their peak on the grid, as in complex D–K
     best = (dk.mu_grid, dk.best_iteration, dk.K, dk.gamma, np.asarray(dk.mu_curve), dk.scalings)
-    K, stall = dk.K, 0
-    for it in range(len(history), len(history) + max_iter):
-        if time.process_time() > deadline:
-            break
+    K, stall, rule = dk.K, 0, f"max_iter={max_iter}"
+    first = len(history)
+    for it in range(first, first + max_iter):
         mu_s = mussv(lft_lower(P, K, nmeas, ncon), sblocks, w, lower=False)
         beta = float(np.max(mu_s.upper))
         fits, jg_err, level = _dg_step_scalings(P, K, nmeas, ncon, mu_s, real, beta, w,
@@ -278,7 +275,8 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
         try:
             hr = _k_step(scaled_plant_dg(P, sblocks, fits, beta, nmeas, ncon), nmeas, ncon,
                          level)
-        except SynthesisError:
+        except SynthesisError as exc:
+            rule = f"K-step {it} failed ({exc})"
             break
         mu_true = mussv(lft_lower(P, hr.K, nmeas, ncon), blocks, w, lower=False)
         peak = float(np.max(mu_true.upper))
@@ -292,18 +290,22 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
         if peak < best[0]:
             best = (peak, it, hr.K, hr.gamma, np.asarray(mu_true.upper), tuple(fits))
         if stall >= patience:
+            rule = f"patience={patience}: {stall} iterations without a μ gain of rtol={rtol:g}"
             break
         K = hr.K
+    stopping = dict(dk.stopping, dgk={"iterations": len(history) - first, "rule": rule})
     if best[2] is dk.K:
-        return replace(dk, history=tuple(history), elapsed_s=time.process_time() - t0)
+        return replace(dk, history=tuple(history), stopping=stopping,
+                       elapsed_s=time.process_time() - t0)
     _, it_best, K, gamma, curve, fits_best = best
     pk = _check(P, K, blocks, nmeas, ncon, w, curve)
     if pk.peak >= dk.mu:  # complex D–K's controller is better once both are re-checked
-        return replace(dk, history=tuple(history), elapsed_s=time.process_time() - t0)
+        return replace(dk, history=tuple(history), stopping=stopping,
+                       elapsed_s=time.process_time() - t0)
     alt = ({"step": "D-K", "K": dk.K, "mu": dk.mu, "gamma": dk.gamma},)
     return MusynResult(K=K, mu=pk.peak, mu_omega=pk.omega_peak, mu_curve=curve, omega=w,
                        gamma=gamma, history=tuple(history), best_iteration=it_best,
                        scalings=fits_best, alternatives=alt, mu_grid=pk.grid_peak,
                        check_omega=pk.omega, check_mu=pk.upper, check=pk.describe(),
-                       elapsed_s=time.process_time() - t0,
+                       elapsed_s=time.process_time() - t0, stopping=stopping,
                        closed_loop=lft_lower(P, K, nmeas, ncon))

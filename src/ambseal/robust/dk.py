@@ -7,11 +7,16 @@ functions and absorbed into the plant. References: Balas, Doyle, Glover, Packard
 (μ-Analysis and Synthesis Toolbox, 1993); Skogestad & Postlethwaite (2005) §8.12;
 Zhou, Doyle & Glover (1996) ch. 11.
 
-When the iterations stop and the time budget affords it, a direct search over the fitted D
+When the iterations stop, a direct search over the fitted D
 scales' parameters for the smallest γ_opt of ``D P D⁻¹`` (``musyn(search=…)``): D–K stalls
 where each D-step's pointwise-optimal D of the current K is not the best D for the next
 K-step. The μ reported is the upper bound of the kept controller re-checked between the grid
 points around its peaks (:func:`~ambseal.robust.mu.mu_peak`), and the result names that grid.
+
+Every stop is decided by counts and tolerances (iterations, ``patience``, γ evaluations,
+the search's work in γ evaluations × states³), never by a clock: the same problem gives the
+same controller on every machine, quiet or loaded; ``MusynResult.stopping`` says which rule
+ended each phase.
 
 Simplifications (documented limits): real blocks are treated as complex and repeated scalars
 as independent scalars in the D-step (so D is diagonal, one scalar per channel group); the
@@ -40,6 +45,7 @@ from ambseal.robust._dscale import (
 )
 from ambseal.robust.hinf import check_plant, hinfsyn, lft_lower
 from ambseal.robust.mu import check_blocks, mu_peak, mussv
+from ambseal.threads import with_numerics_threads
 
 __all__ = ["MusynResult", "musyn", "fit_magnitude", "fit_dscale", "default_omega",
            "design_omega"]
@@ -290,7 +296,10 @@ class MusynResult:
     check : str
         One line naming that grid.
     elapsed_s : float
-        CPU time of the synthesis (s, this process).
+        CPU time of the synthesis (s, this process): a measurement, never a stopping rule.
+    stopping : dict
+        Why each phase ended: ``dk`` (and with D–G–K ``dgk``) ``{"iterations", "rule"}``,
+        ``search`` ``{"granted", "evaluations", "rule"}`` (γ evaluations allowed and made).
     closed_loop : control.StateSpace
         ``F_l(P, K)`` from the exogenous inputs to the exogenous outputs.
     """
@@ -310,6 +319,7 @@ class MusynResult:
     check_mu: np.ndarray | None = field(default=None, repr=False)
     check: str = ""
     elapsed_s: float = float("nan")
+    stopping: dict = field(default_factory=dict)
     closed_loop: Any = field(default=None, repr=False)
 
     @property
@@ -332,23 +342,40 @@ class MusynResult:
                 "mu_curve": np.asarray(self.mu_curve).tolist(),
                 "check_omega_rad_s": (None if self.check_omega is None
                                       else np.asarray(self.check_omega).tolist()),
-                "elapsed_s": self.elapsed_s}
+                "elapsed_s": self.elapsed_s, "stopping": self.stopping}
 
 
 # --------------------------------------------------------------------------- D–K
+def _check_counts(**values) -> None:
+    """The stopping rules' counts and tolerances: ``max_iter`` and ``patience`` whole numbers
+    ≥ 1, ``rtol`` ≥ 0, ``backoff`` ≥ 1 and ``fit_tol`` > 0, all finite (ConfigError)."""
+    for name, x in values.items():
+        if name in ("max_iter", "patience"):
+            ok = isinstance(x, (int, np.integer)) and not isinstance(x, bool) and x >= 1
+            want = "a whole number ≥ 1"
+        else:
+            low = {"rtol": 0.0, "backoff": 1.0}.get(name)
+            ok = isinstance(x, (int, float, np.floating)) and np.isfinite(x) and (
+                x >= low if low is not None else x > 0)
+            want = f"a finite number ≥ {low:g}" if low is not None else "a finite number > 0"
+        if not ok:
+            raise ConfigError(f"{name}={x!r}: expected {want}")
+
+
 def _check(P, K, blocks, nmeas, ncon, w, upper):
     """μ of ``F_l(P, K)`` re-checked between the grid points around its peaks
     (:func:`~ambseal.robust.mu.mu_peak`)."""
     return mu_peak(lft_lower(P, K, nmeas, ncon), blocks, w, upper)
 
 
+@with_numerics_threads
 def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None, *,
           order: int | str = "auto", max_iter: int = 8, rtol: float = 1e-2,
           patience: int = 2, backoff: float = 1.01, fit_tol: float = 0.05,
           search: int | str = "auto", search_backoff: float = 1.001,
-          time_budget_s: float = 30.0, progress: bool = False) -> MusynResult:
+          progress: bool = False) -> MusynResult:
     """μ-synthesis by complex D–K iteration (Balas et al. 1993; thesis Paper 3 §3.4), then a
-    direct search over the D scales, within a time budget.
+    direct search over the D scales.
 
     The steps, after Balas et al. (1993) and MATLAB's ``musyn`` (D-K Iteration Process,
     Robust Control Toolbox documentation): a K-step (H∞ synthesis on ``D P D⁻¹`` at
@@ -356,8 +383,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     bound's scalings fitted by stable, minimum-phase functions of automatically chosen
     order), until μ stops improving; the best iterate is kept, not the last. D–K then often
     stalls a few per cent above the μ-optimum: each D-step fits the D that is optimal for the
-    *current* K, not the D whose K-step is best. So, when the time budget affords it, a
-    direct search over the fitted scales' parameters for the smallest γ_opt of ``D P D⁻¹``
+    *current* K, not the D whose K-step is best. So a direct search over the fitted scales' parameters for the smallest γ_opt of ``D P D⁻¹``
     follows (:func:`~ambseal.robust._dscale._search_dscales`, Nelder–Mead with
     restarts). Finally μ of the kept controller is re-checked between the grid points
     around the curve's peaks (:func:`~ambseal.robust.mu.mu_peak`): the reported μ is that
@@ -392,27 +418,21 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
         Relative magnitude tolerance of the automatic D-scale fit order.
     search : int or "auto"
         The D search after the iterations: at most this many γ evaluations (0: none).
-        ``"auto"`` (default): 50 per parameter of the fitted scales, started only when the
-        time left affords 20 per parameter at the cost of the last K-step. Its controller
-        (at ``search_backoff``) is kept when its μ is lower, recorded in ``history`` with
+        ``"auto"`` (default): 25 per parameter of the fitted scales when their work, γ
+        evaluations × n³ with n the states of the scaled plant, is within ``SEARCH_WORK``
+        (5·10⁷), else none: a γ evaluation costs ∝ n³, so this bounds the search's cost by
+        a count that is the same on every machine. Its controller (at
+        ``search_backoff``) is kept when its μ is lower, recorded in ``history`` with
         ``step = "D search"``. On Skogestad & Postlethwaite's distillation problem
         (§8.12.4) D–K stalls at μ 1.027–1.044 and the search goes below the published
-        μ-optimal 0.974 (0.963) in about 3 s of CPU (benchmarks/bench_dk.py); on the test
-        rig's design (80 states, a K-step 0.4 s) it is not started.
+        μ-optimal 0.974 (benchmarks/bench_dk.py); on plants of 80 states or more it is not
+        started.
     search_backoff : float
         The controller of the D found by the search is built at ``search_backoff·γ_opt``:
         the search minimised γ_opt, and a controller ``backoff`` (1 %) above it gives back
         much of the gain (Mackenroth's aircraft, ``benchmarks/bench_dk.py``: μ 0.985 at
         1.01·γ_opt, 0.978 at 1.001·γ_opt). :func:`~ambseal.robust.hinf.hinfsyn` raises it
         when the closed loop is not stable.
-    time_budget_s : float
-        Budget (s of this process's CPU time, so that a busy machine does not change the
-        result) of the iterations and the search: no iteration starts and no γ evaluation is
-        made once it is spent; the check of the final μ comes after it (a few μ
-        evaluations). Typical use: the search's length, which has no natural end; D–K
-        stops by ``max_iter`` and ``patience`` well within the default on the rig designs
-        (4–16 s CPU, the first run after an install up to 10 s more for the compilation of
-        the μ kernels). ``inf``: no budget.
     progress : bool
         Print one line per iteration on stderr (rich).
 
@@ -421,13 +441,13 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     MusynResult
         The best controller (not the last); ``mu`` its μ re-checked around the peaks,
         ``check_omega`` the frequencies of that check, ``mu_grid`` the peak on ``omega``
-        alone.
+        alone, ``stopping`` the rule that ended the iterations and the search.
 
     Raises
     ------
     ModelError, ConfigError
         Blocks that do not match P's exogenous channels (ModelError); bad order, grid,
-        search or budget (ConfigError).
+        counts or tolerances (ConfigError).
     SynthesisError
         If the first K-step fails (plant assumptions violated).
 
@@ -450,13 +470,11 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
                           f"'auto'")
     if not (isinstance(search_backoff, (int, float)) and search_backoff >= 1):
         raise ConfigError(f"search_backoff={search_backoff!r}: expected a number ≥ 1")
-    if not (isinstance(time_budget_s, (int, float)) and time_budget_s > 0):
-        raise ConfigError(f"time_budget_s={time_budget_s!r}: expected a positive number of "
-                          f"seconds (inf: no budget)")
+    _check_counts(max_iter=max_iter, patience=patience, rtol=rtol, backoff=backoff,
+                  fit_tol=fit_tol)
     w = default_omega(P) if omega is None else np.asarray(omega, float)
     if w.ndim != 1 or w.size < 2 or np.any(w <= 0) or not np.all(np.isfinite(w)):
         raise ConfigError("musyn: omega must be a 1-D grid of positive rad/s values")
-    deadline = t0 + float(time_budget_s)
     cblocks = _complexify(blks)
     console = None
     if progress:
@@ -465,19 +483,16 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
 
     history, best = [], None
     fits: list = []
-    stall, t_kstep = 0, np.inf
+    stall, rule = 0, f"max_iter={max_iter}"
     for it in range(max_iter):
-        if it > 0 and time.process_time() > deadline:
-            break
         Ps = _scaled_plant(P, cblocks, fits, nmeas, ncon) if fits else P
-        tk = time.process_time()
         try:
             hr = hinfsyn(Ps, nmeas, ncon, backoff=backoff)
-        except SynthesisError:
+        except SynthesisError as exc:
             if it == 0:
                 raise
+            rule = f"K-step {it} failed ({exc})"
             break
-        t_kstep = time.process_time() - tk
         cl = lft_lower(P, hr.K, nmeas, ncon)
         mu_true = mussv(cl, blocks, w, lower=False)
         peak = float(np.max(mu_true.upper))
@@ -491,6 +506,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
         if best is None or peak < best[0]:
             best = (peak, it, hr, mu_true, tuple(fits))
         if stall >= patience:
+            rule = f"patience={patience}: {stall} iterations without a μ gain of rtol={rtol:g}"
             break
         # D-step on the unscaled closed loop, diagonal (complexified) structure
         mu_c = mussv(cl, cblocks, w, lower=False) if cblocks != [tuple(b) for b in blocks] \
@@ -502,13 +518,17 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
         else:
             fits = [fit_magnitude(w, ds[:, j], order) for j in range(ds.shape[1] - 1)]
     finalists = [_finalist(best)]
-    evals = _search_evals(search, best[4], deadline - time.process_time(), t_kstep)
+    n_scaled = _scaled_plant(P, cblocks, best[4], nmeas, ncon).nstates if best[4] else 0
+    evals, granted = _search_evals(search, best[4], n_scaled)
+    stopping = {"dk": {"iterations": len(history), "rule": rule},
+                "search": {"granted": evals, "evaluations": 0, "rule": granted}}
     if evals:
-        found = _search_step(P, blocks, cblocks, nmeas, ncon, w, best, evals,
-                             search_backoff, history, console, deadline)
+        found, done = _search_step(P, blocks, cblocks, nmeas, ncon, w, best, evals,
+                                   search_backoff, history, console)
+        stopping["search"].update(done, rule=f"{granted}; {done['rule']}")
         if found is not None:
             finalists.append(_finalist(found))
-    return _result(P, blocks, nmeas, ncon, w, finalists, history, t0)
+    return _result(P, blocks, nmeas, ncon, w, finalists, history, t0, stopping=stopping)
 
 
 def _finalist(entry):
@@ -518,7 +538,8 @@ def _finalist(entry):
     return (peak, it, hr.K, float(hr.gamma), np.asarray(mu.upper, float), fits)
 
 
-def _result(P, blocks, nmeas, ncon, w, finalists, history, t0, alternatives=()):
+def _result(P, blocks, nmeas, ncon, w, finalists, history, t0, alternatives=(),
+            stopping=None):
     """The finalist ``(μ on the grid, index, K, γ, μ curve on w, fits)`` with the lowest μ
     re-checked around its peaks (:func:`_check`), as a MusynResult."""
     checked = [(_check(P, f[2], blocks, nmeas, ncon, w, f[4]), f) for f in finalists]
@@ -527,5 +548,5 @@ def _result(P, blocks, nmeas, ncon, w, finalists, history, t0, alternatives=()):
                        gamma=gamma, history=tuple(history), best_iteration=it,
                        scalings=fits, alternatives=tuple(alternatives), mu_grid=pk.grid_peak,
                        check_omega=pk.omega, check_mu=pk.upper, check=pk.describe(),
-                       elapsed_s=time.process_time() - t0,
+                       elapsed_s=time.process_time() - t0, stopping=dict(stopping or {}),
                        closed_loop=lft_lower(P, K, nmeas, ncon))

@@ -26,12 +26,25 @@ EXAMPLES = sorted((Path(__file__).resolve().parents[1] / "examples").glob("*.tom
 TESTRIG = Path(__file__).resolve().parents[1] / "examples" / "testrig.toml"
 
 
-def _run(rig: Path, out: Path, capsys) -> tuple[dict, str]:
+#: Controllers that fail an example's speed range, measured: the blower's H∞ and μ,
+#: designed at 600 Hz, lose its ~930 Hz bending mode (split by the gyroscopic moments)
+#: below the top speed, at every pressure.
+FAIL_BELOW_TOP = {"blower": {"hinf", "mu"}}
+
+
+def _run(rig: Path, out: Path, capsys, failing: set = frozenset()) -> tuple[dict, str]:
     code = main(["--quiet", "run", str(rig), "--no-identify", "--out", str(out)])
     err = capsys.readouterr().err
-    assert code == 0, err
+    assert code == (1 if failing else 0), err
     assert "Traceback" not in err
-    return json.loads((out / "metrics.json").read_text()), err
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert set(metrics["failed"]) == set(failing), metrics["failed"]
+    top = max(c["speed_hz"] for c in metrics["stability"]) if failing else None
+    for m in failing:  # only in the speed range, below the top speed
+        assert all(c["speed_hz"] < top for c in metrics["stability"]
+                   if c["controller"] == m and not c["stable"])
+        assert all(c["stable"] for c in metrics["cases"] if c["controller"] == m)
+    return metrics, err
 
 
 def _check_stable_or_stated(metrics: dict, err: str) -> None:
@@ -60,8 +73,9 @@ def _check_stable_or_stated(metrics: dict, err: str) -> None:
 def test_every_example_runs_end_to_end(rig, tmp_path, capsys):
     """`ambseal run RIG --no-identify` on each example exits 0 with
     all three designs (PID, H∞, μ; LPV beside them on a speed-scheduled rig), and every
-    loop is stable on the full-order plant (or the run says why not)."""
-    metrics, err = _run(rig, tmp_path / "out", capsys)
+    loop is stable on the full-order plant (or the run says why not) — from standstill to
+    the top speed, but for the measured :data:`FAIL_BELOW_TOP`, which exit 1."""
+    metrics, err = _run(rig, tmp_path / "out", capsys, FAIL_BELOW_TOP.get(rig.stem, set()))
     validate_metrics(metrics)
     _check_stable_or_stated(metrics, err)
     assert {c["controller"] for c in metrics["cases"]} >= {"pid", "hinf", "mu"}
@@ -117,3 +131,24 @@ def test_a_rig_with_one_amb_and_a_plain_bearing_runs_or_is_refused_plainly(tmp_p
     metrics = json.loads((tmp_path / "o" / "metrics.json").read_text())
     _check_stable_or_stated(metrics, err)
     assert all(len(c["iso_zone_per_axis"]) == 2 for c in metrics["cases"] if c["stable"])
+
+
+@pytest.mark.slow
+def test_the_manuals_compressor_is_judged_from_standstill_to_the_top_speed(tmp_path, capsys):
+    """The manual's compressor (docs/rigs/compressor.toml, 150 Hz, range 60–165 Hz): its H∞
+    controller holds at the operating speed but not below it (a 348 Hz mode loses its
+    damping at standstill and low speed, measured), so the run marks it failed with those
+    conditions and exits 1 — instead of calling it zone A at 150 Hz alone. Every
+    controller is closed at each judged pressure from 0 to 165 Hz in quarters."""
+    rig = Path(__file__).resolve().parents[1] / "docs" / "rigs" / "compressor.toml"
+    code = main(["--quiet", "run", str(rig), "--no-identify", "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert code == 1 and "Traceback" not in err
+    m = json.loads((tmp_path / "o" / "metrics.json").read_text())
+    validate_metrics(m)
+    speeds = {c["speed_hz"] for c in m["stability"]}
+    assert speeds == {0.0, 41.25, 60.0, 82.5, 123.75, 165.0}
+    hinf_bad = [c for c in m["stability"] if c["controller"] == "hinf" and not c["stable"]]
+    assert any(c["speed_hz"] == 0.0 for c in hinf_bad)
+    assert all(c["label"] in m["failed"]["hinf"]["conditions"] for c in hinf_bad)
+    assert "0 Hz" in err and "H∞: not delivered" in err

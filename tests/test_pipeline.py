@@ -331,7 +331,8 @@ def test_run_not_on_a_terminal_logs_one_line_per_stage(turbo_run):
     stages = [re.match(r"ambseal: ([a-z-]+): done in [0-9.]+ s, elapsed ([0-9.]+) s$", ln)
               for ln in lines]
     assert all(stages), lines
-    assert [m.group(1) for m in stages] == ["model", "design", "judge", "spin-up", "report"]
+    assert [m.group(1) for m in stages] == ["model", "design", "judge", "speed-range", "spin-up",
+                                           "report"]
     elapsed = [float(m.group(2)) for m in stages]
     assert elapsed == sorted(elapsed)
     assert "\x1b" not in "".join(lines)
@@ -350,6 +351,13 @@ def test_run_on_the_turboexpander_judges_lpv(turbo_run):
     got = {(c["controller"], c["speed_hz"]) for c in m["cases"]}
     assert got == {(c, f) for c in ("pid", "hinf", "mu", "lpv") for f in (20.0, 140.0, 300.0)}
     assert all(c["stable"] and c["discrete"]["stable"] for c in m["cases"])
+    # from standstill to the top speed (300 Hz in quarters), where it is not judged in full
+    st = {(c["controller"], c["speed_hz"]): c for c in m["stability"]}
+    assert set(st) == {(c, f) for c in ("pid", "hinf", "mu", "lpv")
+                       for f in (0.0, 75.0, 150.0, 225.0)}
+    unstable = {c for (c, _), v in st.items()
+                if not v["stable"] or not v["discrete"]["stable"]}
+    assert unstable == set(m["failed"]), (unstable, m["failed"])
     assert set(m["spinup"]) == {"mu", "lpv"}
     for name in ("spinup.png", "frozen_sensitivity.png", "report.html"):
         assert (tmp_path / name).exists()

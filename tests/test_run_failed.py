@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from ambseal.analysis.delivery import loop_failure
+from ambseal.analysis.delivery import also_failed, loop_failure
 from ambseal.cli import main
 from ambseal.config import default_rig_path
 
@@ -50,6 +50,42 @@ def test_loop_failure_names_the_least_stable_mode():
     assert loop_failure("mu", cases[:1], designed=True) is None
     pid = loop_failure("pid", cases[1:2], designed=False)
     assert pid.reason.startswith("PID (reference, given by the rig file)") and not pid.designed
+
+
+def test_many_unstable_conditions_are_listed_with_the_least_stable_mode():
+    """Beyond four unstable conditions the line lists them and names the mode of the one
+    with the rightmost pole (σ = 2 of 0.1–2 here: a 50 Hz pair, ζ = −2/|λ|, closed form)."""
+    cases = []
+    for k, sigma in enumerate((0.1, 0.5, 2.0, 0.3, 0.2)):
+        lam = sigma + 2j * math.pi * (50.0 if sigma == 2.0 else 80.0)
+        cases.append(({"stable": False, "label": f"0 bar, {10 * k} Hz", "max_real_pole": sigma},
+                      {"poles": np.array([lam, lam.conjugate()])}))
+    f = loop_failure("mu", cases, designed=True)
+    zeta = -2.0 / abs(2.0 + 2j * math.pi * 50.0)
+    assert ("unstable at 5 conditions: 0 bar, 0 Hz; 0 bar, 10 Hz; 0 bar, 20 Hz; "
+            "0 bar, 30 Hz; 0 bar, 40 Hz (the least stable 0 bar, 20 Hz: mode at 50 Hz, "
+            f"ζ = {zeta:.2g})").replace("-", "−") in f.reason
+    assert f.conditions == [f"0 bar, {10 * k} Hz" for k in range(5)]
+
+
+def test_a_failure_found_later_adds_its_conditions():
+    """A controller that failed at a judged condition (with the remedies tried in its
+    reason) and fails again from standstill to the top speed: one line, the first reason
+    whole, then the new conditions without a second head; the conditions of both."""
+    w = 2 * math.pi * 300.0
+    up = np.array([0.5 + 1j * w, 0.5 - 1j * w])
+    first = loop_failure("hinf", [({"stable": False, "label": "4.08 bar"}, {"poles": up})],
+                         designed=True)
+    first = type(first)(first.reason + ". Tried: designed at 4.08 bar (still unstable)",
+                        first.designed, first.judged, first.conditions)
+    more = loop_failure("hinf", [({"stable": False, "label": "0 bar, 0 Hz"}, {"poles": up})],
+                        designed=True)
+    both = also_failed(first, more)
+    assert both.reason.startswith(first.reason + "; the full-order loop is unstable at "
+                                  "0 bar, 0 Hz (mode at 300 Hz")
+    assert both.reason.count("not delivered") == 1
+    assert both.conditions == ["4.08 bar", "0 bar, 0 Hz"]
+    assert also_failed(None, more) is more
 
 
 def test_run_with_a_failing_controller_writes_the_report_and_exits_1(tmp_path, capsys):

@@ -170,6 +170,9 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                              "than 10 % of γ or μ"),
     "Design.pressures_bar": ("bar", "pressure drops every controller is judged at"),
     "Design.speeds_hz": ("Hz", "speeds every controller is judged at"),
+    "Design.stability_speeds_hz": ("Hz", "speeds where every controller's full-order loop "
+                                   "must be stable at each judged pressure (default: "
+                                   "standstill to the top speed in quarters)"),
     "Design.unbalance": ("", "the unbalance force (table below)"),
     "Design.impulse": ("", "the current impulse of the time response (table below)"),
     "Design.uncertainty": ("", "real uncertain parameters of μ (array of tables below)"),

@@ -315,7 +315,9 @@ def _rotordynamics_parsers(sub) -> None:
     s = sub.add_parser("sweep", help="stability and performance map over pressure x speed")
     s.add_argument("rig", help="rig file (TOML)")
     s.add_argument("--pressure-bar", required=True, help="pressure drops a:b:n (bar)")
-    s.add_argument("--speed-hz", default="0", help="speeds a:b:n (Hz), default 0")
+    s.add_argument("--speed-hz", default=None,
+                   help="speeds a:b:n (Hz); default the rig's [design] stability_speeds_hz "
+                        "(standstill to the top speed, as `run` checks)")
     s.add_argument("--controller", default=None,
                    help="pid, hinf, mu or controller files, comma separated (default pid)")
     s.add_argument("--param", action="append", metavar="NAME=a:b:n",

@@ -91,6 +91,31 @@ def test_verdict_grades_each_axis_as_iso_14839_3_does():
     assert v.zone_axis == "B" and v.zone_sigma == "D" and "σ̄ over all axes reaches D" in v.words()
 
 
+def test_verdict_holds_only_where_the_machine_runs_up_too():
+    """A controller stable and zone B at its judged condition but unstable at standstill
+    (a ``metrics["stability"]`` case) is not acceptable, zone D, its speed-range failures
+    counted and named (the discrete loop's too); stable over the whole speed range, the
+    sentence says so and keeps the judged zone."""
+    from ambseal.report.verdict import verdicts
+
+    case = _metrics()[0]
+    ok = {"controller": case["controller"], "stable": True,
+          "discrete": {"stable": True}}
+    st = [dict(ok, label="2.04 bar, 0 Hz", stable=False),
+          dict(ok, label="2.04 bar, 50 Hz", discrete={"stable": False}),
+          dict(ok, label="2.04 bar, 100 Hz")]
+    v = verdicts([case], None, st)[0]
+    assert v.zone_axis == "D" and v.speed_checked == 3
+    assert v.speed_unstable == ("2.04 bar, 0 Hz", "2.04 bar, 50 Hz")
+    assert v.stable_range == "2.04 bar; unstable at 2 of 3 speed-range conditions"
+    assert v.words() == ("Not acceptable: the loop is unstable at 2.04 bar, 0 Hz; "
+                         "2.04 bar, 50 Hz (where the machine runs up).")
+    good = verdicts([case], None, st[2:])[0]
+    assert good.zone_axis == "B" and good.stable_range == "2.04 bar, standstill to top speed"
+    assert good.words().startswith("Zone B on every axis over 2.04 bar: fit for")
+    assert "stable from standstill to the top speed" in good.words()
+
+
 def test_bad_inputs_raise(tmp_path):
     """Reference: interface contract — a non-PNG figure or an empty section raises AmbsealError."""
     bad = tmp_path / "x.png"

@@ -20,8 +20,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["FailedController", "METHOD_NAMES", "loop_failure", "synthesis_failure"]
+__all__ = ["FailedController", "METHOD_NAMES", "loop_failure", "synthesis_failure",
+           "also_failed"]
 
+#: Between a failure's head (the controller, delivered or not) and why.
+_SEP = " — "
 #: How reports name the controllers of a run.
 METHOD_NAMES = {"pid": "PID", "hinf": "H∞", "mu": "μ", "lpv": "LPV", "tracked": "tracked"}
 
@@ -74,6 +77,23 @@ def _mode_text(poles, discrete_dt: float | None = None) -> str:
     return f"mode at {abs(z.imag) / (2 * math.pi):.4g} Hz, ζ = {zeta:.2g}".replace("-", "−")
 
 
+#: Unstable conditions a failure names one by one; beyond them it lists the conditions and
+#: names the least stable one's mode.
+_NAMED = 4
+
+
+def _listed(found: list[tuple]) -> str:
+    """``(label, mode text, rank)`` of each unstable condition as one phrase: each with its
+    mode, or, beyond :data:`_NAMED`, the labels and the mode of the highest rank (the
+    rightmost pole's real part, or max |z|)."""
+    if len(found) <= _NAMED:
+        return " and ".join(f"{lb} ({mode})" for lb, mode, _ in found)
+    worst = max(found, key=lambda f: -math.inf if f[2] is None or isinstance(f[2], str)
+                else f[2])
+    return (f"{len(found)} conditions: {'; '.join(lb for lb, _, _ in found)} "
+            f"(the least stable {worst[0]}: {worst[1]})")
+
+
 def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
                  kept: bool = False) -> FailedController | None:
     """The failure of one controller from its judged cases, or None when every judged
@@ -103,24 +123,48 @@ def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
     for case, curves in judged:
         label = case.get("label") or f"{case['pressure_bar']:g} bar"
         if not case.get("stable"):
-            cont.append(f"{label} ({_mode_text(curves.get('poles', ()))})")
+            cont.append((label, _mode_text(curves.get('poles', ())),
+                         case.get("max_real_pole")))
             where.append(label)
             continue
         disc = case.get("discrete")
         if disc is not None and not disc.get("stable"):
             dt = 1.0 / disc["sample_rate_hz"]
             mode = _mode_text((curves.get("discrete") or {}).get("poles", ()), dt)
-            disc_parts.append(f"{label} ({mode}, max |z| = {disc['max_abs_pole_z']:.5f})")
+            disc_parts.append((label, f"{mode}, max |z| = {disc['max_abs_pole_z']:.5f}",
+                               disc["max_abs_pole_z"]))
             where.append(label)
-    parts = ([f"the full-order loop is unstable at {' and '.join(cont)}"] if cont else []) + (
+    parts = ([f"the full-order loop is unstable at {_listed(cont)}"] if cont else []) + (
         [f"as it runs on the target (sampled, delayed) the loop is unstable at "
-         f"{' and '.join(disc_parts)}"] if disc_parts else [])
+         f"{_listed(disc_parts)}"] if disc_parts else [])
     if not parts:
         return None
-    return FailedController(f"{_head(method, designed, kept)} — " + "; ".join(parts), designed,
-                            True, where)
+    return FailedController(f"{_head(method, designed, kept)}{_SEP}" + "; ".join(parts),
+                            designed, True, where)
 
 
 def synthesis_failure(method: str, why: str) -> FailedController:
     """The failure of a controller whose design raised (``why``: the error's message)."""
-    return FailedController(f"{_head(method, True)} — the design failed: {why}", True, False)
+    return FailedController(f"{_head(method, True)}{_SEP}the design failed: {why}", True, False)
+
+
+def also_failed(first: FailedController | None, more: FailedController) -> FailedController:
+    """One controller's failure with what another judgement found added: ``more``'s reason
+    (without its head) and conditions after ``first``'s; ``more`` when ``first`` is None.
+
+    Parameters
+    ----------
+    first : FailedController or None
+        The failure found first (with any remedies tried in its reason).
+    more : FailedController
+        The same controller's failure at further conditions (:func:`loop_failure`).
+
+    Returns
+    -------
+    FailedController
+    """
+    if first is None:
+        return more
+    why = more.reason.split(_SEP, 1)[-1]
+    return FailedController(f"{first.reason}; {why}", first.designed, first.judged,
+                            [*first.conditions, *more.conditions])

@@ -23,12 +23,13 @@ from pydantic import TypeAdapter
 
 from ambseal.analysis.delivery import FailedController
 from ambseal.analysis.judge import JudgedCase
+from ambseal.analysis.speed_range import StabilityCase
 
 __all__ = ["SCHEMA_VERSION", "SCHEMA_PATH", "OpenLoop", "ControllerSummary", "RunMetrics",
            "metrics_schema", "schema_text"]
 
 #: Version of the ``metrics.json`` document (module docstring).
-SCHEMA_VERSION = "1.1.0"
+SCHEMA_VERSION = "1.2.0"
 #: The JSON Schema shipped with the package.
 SCHEMA_PATH = Path(__file__).resolve().parents[1] / "data" / "metrics.schema.json"
 
@@ -121,6 +122,9 @@ class RunMetrics:
         Controllers that cannot run on the target, and why.
     cases : list of JudgedCase
         Every controller at every judged condition.
+    stability : list of StabilityCase
+        Every controller's loop at each judged pressure and each stability speed
+        (standstill to the top speed) that is not a judged condition: stability only.
     failed : dict of str to FailedController
         Controllers whose judged loop is unstable at a judged condition or whose design
         failed, with the reason; a designed one is not delivered (not exported) unless the
@@ -139,6 +143,7 @@ class RunMetrics:
     controllers: dict[str, ControllerSummary]
     cannot_run: dict[str, str]
     cases: list[JudgedCase]
+    stability: list[StabilityCase] = field(default_factory=list)
     failed: dict[str, FailedController] = field(default_factory=dict)
     identification: dict[str, Any] | None = None
     spinup: dict[str, Any] | None = None
@@ -154,6 +159,7 @@ class RunMetrics:
              "unbalance": self.unbalance, "design_spec": self.design_spec,
              "controllers": {k: v.to_dict() for k, v in self.controllers.items()},
              "cannot_run": self.cannot_run, "cases": [c.to_dict() for c in self.cases],
+             "stability": [c.to_dict() for c in self.stability],
              "failed": {m: asdict(f) for m, f in self.failed.items()}}
         for key in ("identification", "spinup", "ramp"):
             if getattr(self, key) is not None:

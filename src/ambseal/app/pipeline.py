@@ -13,7 +13,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ambseal.analysis.cases import run_cases
-from ambseal.analysis.delivery import FailedController, loop_failure, synthesis_failure
+from ambseal.analysis.delivery import (
+    FailedController,
+    also_failed,
+    loop_failure,
+    synthesis_failure,
+)
 from ambseal.analysis.judge import (
     frozen_at,
     judge_case,
@@ -24,6 +29,7 @@ from ambseal.analysis.judge import (
     speed_scheduled,
     unstable_open_loop_poles,
 )
+from ambseal.analysis.speed_range import stability_case, stability_points
 from ambseal.app.commands import (
     Designed,
     digitals_for,
@@ -78,6 +84,30 @@ def _labelled(method: str, jobs: list, judged: list) -> list[tuple[dict, dict]]:
     """``method``'s judged cases as (case dict with its condition's ``label``, curves)."""
     return [({**case.to_dict(), "label": j["point"].label}, crv)
             for j, (case, crv) in zip(jobs, judged) if j["name"] == method]
+
+
+def _speed_range(designs, digitals, spec, points, design_cfg, judge_cfg, stages, failed,
+                 allow_unstable: bool) -> list:
+    """Every design closed at each judged pressure and stability speed not judged in full
+    (:mod:`ambseal.analysis.speed_range`); a loop unstable there fails its controller, its
+    line naming those conditions after any found before (``failed`` is updated). Returns
+    the stability cases."""
+    spoints = stability_points(spec.pressures_bar, spec.stability_speeds_hz, points)
+    if not spoints:
+        return []
+    stages.begin("speed-range", f"stability from standstill to "
+                 f"{max(spec.stability_speeds_hz):g} Hz")
+    jobs = judge_jobs(designs, digitals, spoints, design_cfg)
+    done = run_cases(stability_case, jobs, shared={"cfg": judge_cfg}, workers=1,
+                     raise_errors=True,
+                     on_done=lambda i, r: stages.step(f"{jobs[i]['name']} at "
+                                                      f"{jobs[i]['point'].label}"))
+    for d in designs:
+        f = loop_failure(d.method, _labelled(d.method, jobs, done),
+                         designed=d.method != "pid", kept=allow_unstable)
+        if f is not None:
+            failed[d.method] = also_failed(failed.get(d.method), f)
+    return [case for case, _ in done]
 
 
 def default_truth_path() -> Path:
@@ -211,7 +241,8 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
     n_designs = 4 if speed_scheduled(cfg) else 3
     n_tr = int(cfg.design.tracked)  # off by default: minutes of LMI synthesis
     totals = {"model": 1, "design": n_designs, "judge": (n_designs + n_tr) * len(points),
-              "identification": None, "design (identified)": 2 + n_tr, "spin-up": 1,
+              "identification": None, "design (identified)": 2 + n_tr, "speed-range": None,
+              "spin-up": 1,
               "ramp": 1, "report": 1}
     # one run = one folder: written into a staging folder that replaces out_dir at the end
     with RunFolder(final) as out, \
@@ -277,6 +308,8 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                 new = iter(zip(fixed.jobs, fixed.judged))
                 jobs, judged = map(list, zip(*[next(new) if j["name"] == m else (j, r)
                                                for j, r in zip(jobs, judged)]))
+        stability = _speed_range(designs, digitals, spec, points, design_cfg, judge_cfg, stages,
+                                 failed, allow_unstable)
         cases = [case for case, _ in judged]
         case_dicts = [case.to_dict() for case in cases]
         curves = [(j["name"], j["point"], case, c)
@@ -304,7 +337,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                                full.n_states, n_reduced),
             unbalance=settings.unbalance_dict(), design_spec=spec.to_dict(),
             controllers={m: ControllerSummary.from_dict(s) for m, s in summaries.items()},
-            cannot_run=cannot_run, cases=cases, failed=failed,
+            cannot_run=cannot_run, cases=cases, stability=stability, failed=failed,
             identification=None if ident is None else ident.summary, spinup=spinup,
             ramp=ramp).to_dict()
         stages.begin("report")

@@ -28,7 +28,7 @@ from dataclasses import dataclass, replace
 from ambseal.analysis.delivery import FailedController, loop_failure
 from ambseal.app.commands import Designed, digitals_for
 from ambseal.design.recipes import design
-from ambseal.errors import SynthesisError
+from ambseal.errors import ConfigError, SynthesisError
 
 __all__ = ["REMEDIABLE", "Remedied", "remedy", "worst_case"]
 
@@ -125,7 +125,9 @@ def remedy(method: str, failure: FailedController, cases: list[dict], design_cfg
         try:
             res = design(design_cfg, method, pressure_bar=p, weights=w, spec=spec,
                          allow_unstable=True)
-        except SynthesisError as exc:
+        except (SynthesisError, ConfigError) as exc:
+            # ConfigError: the specification does not hold there (a relative uncertainty
+            # of a coefficient that is 0 at that pressure): that remedy cannot be tried
             tried.append(f"{label} (the design failed: {exc})")
             continue
         d = Designed(method, res.K, {**res.summary(), "remedy": (

@@ -200,7 +200,9 @@ def _campbell(args: argparse.Namespace) -> int:
 def _sweep(args: argparse.Namespace) -> int:
     cfg = load_rig(args.rig)
     pressures = _range(args.pressure_bar, "--pressure-bar", *_PRESSURES)
-    speeds = _range(args.speed_hz, "--speed-hz", *_SPEEDS)
+    spec = design_spec(cfg)
+    speeds = (_range(args.speed_hz, "--speed-hz", *_SPEEDS) if args.speed_hz is not None
+              else list(spec.stability_speeds_hz))
     specs = (args.controller or "pid").split(",")
     params = {}
     for text in args.param or []:
@@ -220,7 +222,7 @@ def _sweep(args: argparse.Namespace) -> int:
         print("ambseal: note: dask is not installed; the sweep runs serially",
               file=sys.stderr)
         workers = 1
-    rows = sweep(cfg, ctrl, pressures, speeds, params, settings=judge_settings(design_spec(cfg)),
+    rows = sweep(cfg, ctrl, pressures, speeds, params, settings=judge_settings(spec),
                  max_hz=args.max_hz, workers=workers, scheduler=args.scheduler, progress=True)
     edge = refine_boundary(cfg, ctrl, stability_boundary(rows), tol_bar=args.tol_bar,
                            workers=workers, scheduler=args.scheduler, progress=True)

@@ -17,7 +17,9 @@ and bounded (the bounds beside each key in the code, with their reasons).
     ``band_hz`` = ``[low, high]`` (Hz): the synthesis band (the μ grid) and the judgement
     band (σ̄(S_o), compliance). ``order_max``: the controller order limit (balanced
     truncation above it). ``pressures_bar`` and ``speeds_hz``: the conditions every
-    controller is judged at.
+    controller is judged at. ``stability_speeds_hz``: the speeds (Hz) where, at each of
+    those pressures, every controller's full-order loop must also be stable (default:
+    standstill to the top speed, :mod:`ambseal.design.conditions`).
 ``[design.unbalance]``
     ``grade_mm_s`` (ISO 21940-11 balance grade G, mm/s), ``mass_kg`` (the mass m of the
     force law), ``law`` (``"iso21940"``, the default: F_u = m·G·Ω²/Ω_max, or
@@ -215,6 +217,8 @@ class Design(_Strict):
     pressures_bar: list[Annotated[float, Field(ge=0, le=MAX_PRESSURE_BAR)]] | None = Field(
         default=None, min_length=1, max_length=MAX_CONDITIONS)
     speeds_hz: list[Annotated[float, Field(ge=0, le=MAX_SPEED_HZ)]] | None = Field(
+        default=None, min_length=1, max_length=MAX_CONDITIONS)
+    stability_speeds_hz: list[Annotated[float, Field(ge=0, le=MAX_SPEED_HZ)]] | None = Field(
         default=None, min_length=1, max_length=MAX_CONDITIONS)
     unbalance: UnbalanceSpec = UnbalanceSpec()
     impulse: ImpulseSpec = ImpulseSpec()

@@ -343,7 +343,9 @@ def design(
     unc = dict(uncertainty) if uncertainty is not None else dict(sp.uncertainty)
     n = int(states or sp.model_states)
     om = None if omega is None else np.asarray(omega, float)
-    conditions = [(q, f) for q in sp.pressures_bar for f in sp.speeds_hz]
+    # held where it is judged and wherever the machine runs, standstill to the top speed
+    conditions = [(q, f) for q in sp.pressures_bar
+                  for f in sorted({*sp.speeds_hz, *sp.stability_speeds_hz})]
     dl = design_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples,
                       sp.synthesis_band_hz[1], max_order=1)
     steps: list[str] = []

@@ -76,6 +76,8 @@ the value the thesis used on its test facility, P5, where it names one):
   there once.
 * **Judged conditions**: pressure drops 0, nominal and 2× nominal (P5 §4); the operating
   speed, or, for a rig whose seals change with speed over a range, its ends and middle.
+  Stability is also required from standstill to the top speed (the top of the speed range,
+  else the operating speed) in quarters, at each judged pressure.
 """
 
 from __future__ import annotations
@@ -88,7 +90,7 @@ from types import MappingProxyType
 import numpy as np
 
 from ambseal.config import MAX_GAP_M
-from ambseal.design.conditions import judged_conditions
+from ambseal.design.conditions import judged_conditions, stability_speeds
 from ambseal.design.pid import pid_from_rig
 from ambseal.design.weights import default_weights
 from ambseal.errors import ConfigError, DataError
@@ -200,6 +202,9 @@ class DesignSpec:
         Controller order limit; None: the rule of :func:`ambseal.design.recipes.design`.
     pressures_bar, speeds_hz : tuple of float
         Judged conditions.
+    stability_speeds_hz : tuple of float
+        Speeds (Hz, standstill to the top) where the full-order loop must be stable at
+        every judged pressure (:func:`ambseal.design.conditions.stability_speeds`).
     nominal_pressure_bar, nominal_speed_hz : float
         The rig's operating point (``[operating]``): the judged conditions are named low,
         nominal or high against it.
@@ -236,6 +241,7 @@ class DesignSpec:
     order_max: int | None
     pressures_bar: tuple
     speeds_hz: tuple
+    stability_speeds_hz: tuple
     nominal_pressure_bar: float
     nominal_speed_hz: float
     unbalance_grade_mm_s: float
@@ -294,6 +300,8 @@ class DesignSpec:
                 "# order_max: design model states + W_p and W_u states (H∞ order)",
                 f"pressures_bar = [{', '.join(fmt(x) for x in self.pressures_bar)}]",
                 f"speeds_hz = [{', '.join(fmt(x) for x in self.speeds_hz)}]",
+                line("stability_speeds_hz",
+                     f"[{', '.join(fmt(x) for x in self.stability_speeds_hz)}]"),
                 "", "[design.unbalance]",
                 f"grade_mm_s = {fmt(self.unbalance_grade_mm_s)}",
                 f"mass_kg = {fmt(self.unbalance_mass_kg)}  # assembled rotor mass",
@@ -573,11 +581,12 @@ def design_spec(cfg, pressure_bar: float | None = None) -> DesignSpec:
     rules["impulse"] = (f"bias current / {BIAS_PER_AMPLITUDE} for {SAMPLES_PER_IMPULSE} "
                         "controller samples")
     pressures, speeds = judged_conditions(cfg, p)
+    stability, rules["stability_speeds_hz"] = stability_speeds(cfg)
     mu = d.mu
     return DesignSpec(
         machine=mach, d_e=d_e, d_u=d_u, model_states=n, model_cutoff_hz=cut,
         band_hz=band, synthesis_band_hz=synth, order_max=d.order_max,
-        pressures_bar=pressures, speeds_hz=speeds,
+        pressures_bar=pressures, speeds_hz=speeds, stability_speeds_hz=stability,
         nominal_pressure_bar=float(cfg.operating.pressure_bar),
         nominal_speed_hz=float(cfg.operating.speed_rpm) / 60.0,
         unbalance_grade_mm_s=grade, unbalance_mass_kg=mass, unbalance_law=law,

@@ -80,6 +80,7 @@ def render_report(
     clearances_um: Mapping[str, float] | None = None,
     judged_on: tuple[str, str] | None = None,
     failed: Sequence[str] = (),
+    stability: Sequence[Mapping[str, Any]] = (),
 ) -> str:
     """The report page as a string (see :func:`write_report`)."""
 
@@ -99,7 +100,7 @@ def render_report(
         parts += ['<h2>Failed controllers</h2><div class="failed"><ul>',
                   *(f"<li>{_esc(line)}</li>" for line in failed), "</ul></div>"]
     if metrics:
-        parts += ["<h2>Verdict</h2>", verdict_table_html(verdicts(metrics, clearances_um)),
+        parts += ["<h2>Verdict</h2>", verdict_table_html(verdicts(metrics, clearances_um, stability)),
                   _zone_legend(), "<h2>Every judged condition</h2>", detail_table_html(metrics)]
     for caption, path in figures:
         parts += [f"<h2>{_esc(caption)}</h2>", _figure_html(path, None, caption)]
@@ -130,6 +131,7 @@ def write_report(
     clearances_um: Mapping[str, float] | None = None,
     judged_on: tuple[str, str] | None = None,
     failed: Sequence[str] = (),
+    stability: Sequence[Mapping[str, Any]] = (),
 ) -> Path:
     """Write one self-contained ``report.html``.
 
@@ -163,6 +165,9 @@ def write_report(
         Controllers that failed, one plain line each with the reason
         (:class:`ambseal.analysis.delivery.FailedController` ``reason``): shown first,
         above the verdict, under "Failed controllers".
+    stability : sequence of mapping
+        ``metrics.json`` ``stability``: every controller's loop from standstill to the top
+        speed (stability only); an unstable one makes its verdict "not acceptable".
 
     Returns
     -------
@@ -178,6 +183,6 @@ def write_report(
         raise AmbsealError(f"report folder {str(path.parent)!r} does not exist")
     text = render_report(title=title, metrics=metrics, figures=figures, sections=sections,
                          meta=meta, clearances_um=clearances_um, judged_on=judged_on,
-                         failed=failed)
+                         failed=failed, stability=stability)
     write_text(path, text)
     return path

@@ -353,6 +353,34 @@ def _discrete_section(metrics: dict) -> list[dict]:
              "text": head + "; ".join(lines) + "."}]
 
 
+def _speed_range_section(metrics: dict) -> list[dict]:
+    """A table of ``metrics["stability"]``: a row per controller, a column per speed; a cell
+    says "stable" when the loop (continuous and as it runs) is stable at every judged
+    pressure there, else the pressures where it is not."""
+    cases = metrics.get("stability") or []
+    if not cases:
+        return []
+    speeds = sorted({c["speed_hz"] for c in cases})
+    names = list(dict.fromkeys(c["controller"] for c in cases))
+    rows = []
+    for n in names:
+        cells = []
+        for f in speeds:
+            at = [c for c in cases if c["controller"] == n and c["speed_hz"] == f]
+            bad = [c["pressure_bar"] for c in at if not c["stable"]
+                   or not (c.get("discrete") or {}).get("stable", True)]
+            cells.append('<td>—</td>' if not at else '<td>stable</td>' if not bad else
+                         '<td class="unstable">unstable at '
+                         + html.escape(", ".join(f"{q:g}" for q in bad)) + " bar</td>")
+        rows.append(f"<tr><td>{html.escape(n)}</td>{''.join(cells)}</tr>")
+    head = "".join(f"<th>{f:g} Hz</th>" for f in speeds)
+    table = (f"<table><tr><th>Controller</th>{head}</tr>{''.join(rows)}</table>")
+    text = ("Every controller closed on the full-order plant at each judged pressure and "
+            "each speed from standstill to the top speed that is not a judged condition, "
+            "continuous with the target's delay and as it runs (sampled): stability only.")
+    return [{"title": "From standstill to the top speed", "text": text, "html": table}]
+
+
 def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: list,
                      extra_figures: list, extra_sections: list,
                      clearances_um: dict | None = None,
@@ -417,9 +445,10 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
     sections = [{"title": f"{METHOD_NAMES.get(m, m)}: redesigned", "text": (
         f"{s['remedy']}; the new design holds at every judged condition.")}
         for m, s in metrics["controllers"].items() if s.get("remedy")] + sections
-    sections += _discrete_section(metrics)
+    sections = _speed_range_section(metrics) + sections + _discrete_section(metrics)
     return write_report(out / "report.html", title=title, metrics=metrics["cases"],
                         figures=figs + list(extra_figures),
                         sections=sections + list(extra_sections), meta=meta,
                         clearances_um=clearances_um, judged_on=judged_on,
-                        failed=[f["reason"] for f in (metrics.get("failed") or {}).values()])
+                        failed=[f["reason"] for f in (metrics.get("failed") or {}).values()],
+                        stability=metrics.get("stability") or ())

@@ -39,6 +39,8 @@ ZONE_WORDS = {"A": "as good as newly commissioned",
               "D": "not acceptable (damage likely)"}
 _ORDER = "ABCD"
 _TERMINAL_ZONE = {"A": "green", "B": "bright_green", "C": "yellow", "D": "red"}
+#: Unstable conditions a verdict sentence names before it counts the rest.
+_NAMED = 4
 
 
 def sig(v: Any, digits: int = 3) -> str:
@@ -101,6 +103,10 @@ class Verdict:
         Largest relative difference between the σ̄(S_o) peak of the controller as it runs
         (the cases' ``discrete`` blocks) and the continuous one, over the conditions where
         both loops are stable (-); None without discrete blocks.
+    speed_checked, speed_unstable : int, tuple of str
+        How many conditions of the speed range (standstill to the top speed, stability
+        only: ``metrics["stability"]``) were checked, and those where the loop, continuous
+        or as it runs, is unstable (``"0 bar, 0 Hz"``).
     """
 
     controller: str
@@ -115,15 +121,32 @@ class Verdict:
     impulse_settling_s: float | None
     clearances_um: dict
     target_difference: float | None = None
+    speed_checked: int = 0
+    speed_unstable: tuple[str, ...] = ()
 
     @property
-    def stable_range(self) -> str:
-        """``"0–4.08 bar"`` when stable everywhere, else the stable conditions, or ``none``."""
+    def judged_range(self) -> str:
+        """``"0–4.08 bar"`` when stable at every judged condition, else the stable ones, or
+        ``none``."""
         if not self.stable_at:
             return "none"
         if not self.unstable_at and len(self.conditions) > 1:
             return f"{self.conditions[0].split()[0]}–{self.conditions[-1]}"
         return ", ".join(self.stable_at)
+
+    @property
+    def stable_range(self) -> str:
+        """:attr:`judged_range`, with the speed range: ``"…, standstill to top speed"``, or
+        how many of its conditions the loop is unstable at."""
+        text = self.judged_range
+        if text == "none":
+            return text
+        if self.speed_unstable:
+            text += (f"; unstable at {len(self.speed_unstable)} of {self.speed_checked} "
+                     f"speed-range conditions")
+        elif self.speed_checked:
+            text += ", standstill to top speed"
+        return text
 
     def orbit_text(self) -> str:
         """``"3.1 µm (0.6 % of the air gap)"``."""
@@ -135,14 +158,21 @@ class Verdict:
 
     def words(self) -> str:
         """The verdict in one sentence."""
-        if self.unstable_at:
-            tail = (f"; stable only at {', '.join(self.stable_at)}" if self.stable_at else "")
-            return f"Not acceptable: the loop is unstable at {', '.join(self.unstable_at)}{tail}."
+        if self.unstable_at or self.speed_unstable:
+            bad = [*self.unstable_at, *self.speed_unstable]
+            where = "; ".join(bad[:_NAMED]) + (f" and {len(bad) - _NAMED} more"
+                                               if len(bad) > _NAMED else "")
+            tail = (f"; stable only at {', '.join(self.stable_at)}" if self.stable_at
+                    and self.unstable_at else "")
+            run = " (where the machine runs up)" if self.speed_unstable else ""
+            return f"Not acceptable: the loop is unstable at {where}{run}{tail}."
         z = self.zone_axis or "?"
-        text = (f"Zone {z} on every axis over {self.stable_range}: "
+        text = (f"Zone {z} on every axis over {self.judged_range}: "
                 f"{ZONE_WORDS.get(z, 'not graded')}")
         if self.zone_sigma and self.zone_sigma != z:
             text += f" (σ̄ over all axes reaches {self.zone_sigma})"
+        if self.speed_checked:
+            text += "; stable from standstill to the top speed"
         gap = [c for c in self.clearances_um.values() if c]
         if self.orbit_um is not None and gap and self.orbit_um > 0.5 * min(gap):
             text += "; the unbalance orbit uses over half of the clearance"
@@ -162,9 +192,15 @@ def target_difference(cs: Sequence[Mapping]) -> float | None:
     return max(diffs) if diffs else None
 
 
-def verdicts(cases: Sequence[Mapping], clearances_um: Mapping[str, float] | None = None
-             ) -> list[Verdict]:
-    """One :class:`Verdict` per controller of ``metrics["cases"]`` (in order of appearance)."""
+def _unstable(case: Mapping) -> bool:
+    """The loop of a stability case is unstable, continuous or as it runs."""
+    return not case.get("stable") or not (case.get("discrete") or {}).get("stable", True)
+
+
+def verdicts(cases: Sequence[Mapping], clearances_um: Mapping[str, float] | None = None,
+             stability: Sequence[Mapping] = ()) -> list[Verdict]:
+    """One :class:`Verdict` per controller of ``metrics["cases"]`` (in order of appearance),
+    with its ``metrics["stability"]`` cases (the speed range) counted in."""
     by_speed = _speed_varies(cases)
     names = list(dict.fromkeys(c["controller"] for c in cases))
     out = []
@@ -179,6 +215,9 @@ def verdicts(cases: Sequence[Mapping], clearances_um: Mapping[str, float] | None
 
         axis_zones = [z for c in cs for z in (c.get("iso_zone_per_axis") or {}).values()]
         axis_zones += ["D" for c in cs if not c.get("stable")]
+        sc = [c for c in stability if c["controller"] == name]
+        speed_bad = tuple(c["label"] for c in sc if _unstable(c))
+        axis_zones += ["D"] if speed_bad else []
         out.append(Verdict(
             controller=name, conditions=tuple(label),
             stable_at=tuple(lb for lb, c in zip(label, cs) if c.get("stable")),
@@ -187,7 +226,8 @@ def verdicts(cases: Sequence[Mapping], clearances_um: Mapping[str, float] | None
             sigma_peak=peak("sensitivity_peak"), orbit_um=peak("unbalance_peak_um"),
             impulse_peak_um=peak("impulse_peak_um"),
             impulse_settling_s=peak("impulse_settling_s"),
-            clearances_um=dict(clearances_um or {}), target_difference=target_difference(cs)))
+            clearances_um=dict(clearances_um or {}), target_difference=target_difference(cs),
+            speed_checked=len(sc), speed_unstable=speed_bad))
     return out
 
 
@@ -212,7 +252,8 @@ def verdict_table_html(vs: Sequence[Verdict]) -> str:
     for v in vs:
         st = v.impulse_settling_s
         rows.append(
-            f'<tr class="{"unstable" if v.unstable_at else "ok"}"><td class="text"><b>'
+            f'<tr class="{"unstable" if v.unstable_at or v.speed_unstable else "ok"}">'
+            f'<td class="text"><b>'
             f"{_esc(v.controller)}</b></td><td class=\"text\">{_esc(v.stable_range)}</td>"
             + _zone_cell(v.zone_axis) + _zone_cell(v.zone_sigma)
             + f"<td>{sig(v.sigma_peak)}</td><td class=\"text\">{_esc(v.orbit_text())}</td>"

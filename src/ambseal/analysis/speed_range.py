@@ -1,0 +1,126 @@
+"""Stability from standstill to the top speed: where the machine runs, not only where it is
+judged.
+
+A rotor on AMBs is levitated at standstill and run up through every speed to its top, so a
+controller judged at the operating point alone can still lose the rotor on the way (the
+gyroscopic splitting of the modes moves them against the controller's phase). ``ambseal
+run`` therefore closes every controller on the full-order plant at each judged pressure and
+each of the specification's stability speeds (:func:`ambseal.design.conditions.stability_speeds`:
+standstill to the top speed) that is not already a judged condition, in the same loop as the
+judgement (:func:`ambseal.robust.loop.judged_loop`): continuous with the target's hold and
+computation delay, and the discrete controller as it runs on the plant sampled at its rate.
+Only stability is asked there; an unstable loop at any of those conditions fails the
+controller like one at a judged condition (:func:`ambseal.analysis.delivery.loop_failure`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ambseal.analysis.judge import OperatingPoint
+from ambseal.lti.json_safe import json_float
+from ambseal.model.rig import build_plant
+from ambseal.robust.delay import loop_delay
+from ambseal.robust.loop import judged_loop
+
+__all__ = ["StabilityCase", "stability_points", "stability_case"]
+
+
+@dataclass(frozen=True)
+class StabilityCase:
+    """One controller's loop at one condition of the speed range: stability only.
+
+    Attributes
+    ----------
+    controller : str
+        The controller's name (its method).
+    label : str
+        The condition as reports name it (``"2.04 bar, 0 Hz"``).
+    pressure_bar, speed_hz : float
+        The condition: seal pressure drop (bar) and spin speed (Hz).
+    stable : bool
+        The continuous loop with the target's delay is stable.
+    max_real_pole : float or None
+        Its rightmost pole's real part (1/s).
+    discrete : dict or None
+        The loop of the discrete controller as it runs: ``stable``, ``max_abs_pole_z`` and
+        ``sample_rate_hz`` (Hz); None for a controller that cannot run on the target.
+    """
+
+    controller: str
+    label: str
+    pressure_bar: float
+    speed_hz: float
+    stable: bool
+    max_real_pole: float | None
+    discrete: dict | None = None
+
+    def to_dict(self) -> dict:
+        """The ``metrics.json`` form."""
+        return {"controller": self.controller, "label": self.label,
+                "pressure_bar": self.pressure_bar, "speed_hz": self.speed_hz,
+                "stable": self.stable, "max_real_pole": self.max_real_pole,
+                "discrete": self.discrete}
+
+
+def stability_points(pressures_bar, speeds_hz, judged) -> list[OperatingPoint]:
+    """The conditions of the speed range not already judged: every pressure (bar) at every
+    speed (Hz), less the ``judged`` operating points.
+
+    Parameters
+    ----------
+    pressures_bar : sequence of float
+        Judged seal pressure drops (bar).
+    speeds_hz : sequence of float
+        Stability speeds (Hz), standstill to the top.
+    judged : sequence of OperatingPoint
+        The conditions the run judges in full.
+
+    Returns
+    -------
+    list of OperatingPoint
+        Speeds outermost, labelled ``"<p> bar, <f> Hz"``.
+    """
+    done = {(round(p.pressure_bar, 12), round(p.speed_rpm / 60.0, 9)) for p in judged}
+    return [OperatingPoint(q, 60.0 * f, f"{q:g} bar, {f:g} Hz",
+                           "low" if f < max(speeds_hz) else "high")
+            for f in speeds_hz for q in pressures_bar
+            if (round(q, 12), round(f, 9)) not in done]
+
+
+def stability_case(case: dict, cfg) -> tuple[StabilityCase, dict]:
+    """Close one controller on the full-order plant at one condition, continuous with the
+    target's delay and, when it runs there, discrete as it runs; stability only.
+
+    Parameters
+    ----------
+    case : dict
+        ``name`` (str), ``point`` (:class:`~ambseal.analysis.judge.OperatingPoint`),
+        ``controller`` (control.StateSpace, m → A, ``i = −K y``) and ``discrete`` (the
+        delayed discrete controller that runs, or None): a job of
+        :func:`ambseal.analysis.judge.judge_jobs`.
+    cfg : RigConfig
+        The rig judged on.
+
+    Returns
+    -------
+    case : StabilityCase
+    curves : dict
+        ``poles`` (rad/s) of the continuous loop and ``discrete.poles`` (z) of the sampled
+        one, for :func:`ambseal.analysis.delivery.loop_failure`.
+    """
+    point = case["point"]
+    plant = build_plant(cfg, pressure_bar=point.pressure_bar, speed_rpm=point.speed_rpm)
+    P, cur = plant.to_statespace(), plant.current_inputs()
+    dl = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples)
+    loop = judged_loop(P, case["controller"], cur, delay=dl.system).loop
+    curves: dict = {"poles": loop.poles}
+    disc = None
+    if case.get("discrete") is not None:
+        dloop = judged_loop(P, case["discrete"], cur).loop
+        disc = {"stable": bool(dloop.stable), "max_abs_pole_z": float(dloop.max_abs_pole),
+                "sample_rate_hz": 1.0 / dloop.dt}
+        curves["discrete"] = {"poles": dloop.poles}
+    return StabilityCase(case["name"], point.label, float(point.pressure_bar),
+                         float(point.speed_rpm) / 60.0, bool(loop.stable),
+                         json_float(loop.max_real_pole), disc), curves

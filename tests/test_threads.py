@@ -150,3 +150,38 @@ def test_threadpool_restored_in_this_process():
     before = [i["num_threads"] for i in threadpool_info()]
     hinfnorm(control.ss([[-1.0]], [[1.0]], [[1.0]], [[0.0]]))
     assert [i["num_threads"] for i in threadpool_info()] == before
+
+
+#: Keys of metrics.json that are measurements of time, not results.
+_TIMES = {"elapsed_s", "synthesis_s", "wall_time_s", "time_s", "cpu_s"}
+
+
+def _same_numbers(a, b, path="metrics") -> list[str]:
+    """Where two JSON documents differ: numbers beyond 1e-9 relative, anything else
+    unequal; the time measurements left out."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        if set(a) != set(b):
+            return [f"{path}: keys {sorted(set(a) ^ set(b))}"]
+        return [d for k in a if k not in _TIMES for d in _same_numbers(a[k], b[k], f"{path}.{k}")]
+    if isinstance(a, list) and isinstance(b, list):
+        if len(a) != len(b):
+            return [f"{path}: lengths {len(a)} and {len(b)}"]
+        return [d for i, (x, y) in enumerate(zip(a, b)) for d in _same_numbers(x, y, f"{path}[{i}]")]
+    if isinstance(a, float) and isinstance(b, float):
+        return [] if a == pytest.approx(b, rel=1e-9, abs=1e-300) else [f"{path}: {a} and {b}"]
+    return [] if a == b else [f"{path}: {a!r} and {b!r}"]
+
+
+@pytest.mark.slow
+def test_main_job_metrics_are_the_same_with_one_or_two_blas_threads(tmp_path):
+    """``ambseal run --no-identify`` with ``OPENBLAS_NUM_THREADS`` 1 and 2 in the
+    environment: metrics.json equal to 1e-9 (the policy runs both on one thread)."""
+    docs = []
+    for n in (1, 2):
+        out = tmp_path / f"out{n}"
+        proc = subprocess.run([sys.executable, "-m", "ambseal.cli", "-q", "run", "--no-identify",
+                               "--out", str(out)], env=_env(OPENBLAS_NUM_THREADS=n),
+                              capture_output=True, text=True, timeout=900, cwd=tmp_path)
+        assert proc.returncode in (0, 1), proc.stderr
+        docs.append(json.loads((out / "metrics.json").read_text()))
+    assert _same_numbers(*docs) == []

@@ -179,7 +179,8 @@ def _run(args: argparse.Namespace) -> int:
         console = Console(stderr=True)
         clear = rig_clearances_um(load_rig(args.rig))
         console.print(verdict_table_rich(verdicts(result.metrics["cases"], clear,
-                                                     result.metrics.get("stability", ()))))
+                                                     result.metrics.get("stability", ()),
+                                                     result.metrics["controllers"])))
         console.print(f"report: {result.report_path.resolve()}")
     for f in result.failed.values():  # after the report is written: name each and why
         print(f"ambseal: {f['reason']}", file=sys.stderr)

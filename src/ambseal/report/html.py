@@ -41,6 +41,11 @@ figure{margin:.6em 0}figure img{max-width:100%;height:auto;border:1px solid #ddd
 figcaption{font-size:.85em;color:#555}.judged{font-size:.9em;margin-top:0}.meta{color:#666;font-size:.82em;margin-top:0;overflow-wrap:anywhere}
 .legend span{display:inline-block;padding:0 .5em;margin-right:.3em;font-weight:bold}
 .failed{background:#fde8e8;border:2px solid #c0392b;padding:.4em .8em}.failed li{margin:.2em 0}
+.scroll{overflow-x:auto;max-width:100%}td.unstable{background:#fde8e8}
+@media (max-width:1000px){table.verdict,table.verdict tbody,table.verdict tr,table.verdict td{display:block;width:auto;max-width:none;min-width:0}
+table.verdict thead{display:none}table.verdict tr{border:1px solid #bbb;margin:.5em 0}
+table.verdict td{border:none;border-bottom:1px solid #eee;text-align:left}
+table.verdict td::before{content:attr(data-label) ": ";font-weight:normal;color:#555}}
 """
 
 
@@ -81,6 +86,7 @@ def render_report(
     judged_on: tuple[str, str] | None = None,
     failed: Sequence[str] = (),
     stability: Sequence[Mapping[str, Any]] = (),
+    designs: Mapping[str, Mapping[str, Any]] | None = None,
 ) -> str:
     """The report page as a string (see :func:`write_report`)."""
 
@@ -100,8 +106,9 @@ def render_report(
         parts += ['<h2>Failed controllers</h2><div class="failed"><ul>',
                   *(f"<li>{_esc(line)}</li>" for line in failed), "</ul></div>"]
     if metrics:
-        parts += ["<h2>Verdict</h2>", verdict_table_html(verdicts(metrics, clearances_um, stability)),
-                  _zone_legend(), "<h2>Every judged condition</h2>", detail_table_html(metrics)]
+        parts += ["<h2>Verdict</h2>", verdict_table_html(verdicts(metrics, clearances_um, stability, designs)),
+                  _zone_legend(), "<h2>Every judged condition</h2>",
+                  f'<div class="scroll">{detail_table_html(metrics)}</div>']
     for caption, path in figures:
         parts += [f"<h2>{_esc(caption)}</h2>", _figure_html(path, None, caption)]
     for i, sec in enumerate(sections):
@@ -132,6 +139,7 @@ def write_report(
     judged_on: tuple[str, str] | None = None,
     failed: Sequence[str] = (),
     stability: Sequence[Mapping[str, Any]] = (),
+    designs: Mapping[str, Mapping[str, Any]] | None = None,
 ) -> Path:
     """Write one self-contained ``report.html``.
 
@@ -168,6 +176,9 @@ def write_report(
     stability : sequence of mapping
         ``metrics.json`` ``stability``: every controller's loop from standstill to the top
         speed (stability only); an unstable one makes its verdict "not acceptable".
+    designs : mapping, optional
+        ``metrics.json`` ``controllers``: each design's bound (γ, μ and whether robust
+        performance is met) beside its verdict.
 
     Returns
     -------
@@ -183,6 +194,6 @@ def write_report(
         raise AmbsealError(f"report folder {str(path.parent)!r} does not exist")
     text = render_report(title=title, metrics=metrics, figures=figures, sections=sections,
                          meta=meta, clearances_um=clearances_um, judged_on=judged_on,
-                         failed=failed, stability=stability)
+                         failed=failed, stability=stability, designs=designs)
     write_text(path, text)
     return path

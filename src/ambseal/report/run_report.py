@@ -374,7 +374,8 @@ def _speed_range_section(metrics: dict) -> list[dict]:
                          + html.escape(", ".join(f"{q:g}" for q in bad)) + " bar</td>")
         rows.append(f"<tr><td>{html.escape(n)}</td>{''.join(cells)}</tr>")
     head = "".join(f"<th>{f:g} Hz</th>" for f in speeds)
-    table = (f"<table><tr><th>Controller</th>{head}</tr>{''.join(rows)}</table>")
+    table = (f'<div class="scroll"><table><tr><th>Controller</th>{head}</tr>'
+             f"{''.join(rows)}</table></div>")
     text = ("Every controller closed on the full-order plant at each judged pressure and "
             "each speed from standstill to the top speed that is not a judged condition, "
             "continuous with the target's delay and as it runs (sampled): stability only.")
@@ -451,4 +452,5 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
                         sections=sections + list(extra_sections), meta=meta,
                         clearances_um=clearances_um, judged_on=judged_on,
                         failed=[f["reason"] for f in (metrics.get("failed") or {}).values()],
-                        stability=metrics.get("stability") or ())
+                        stability=metrics.get("stability") or (),
+                        designs=metrics.get("controllers"))

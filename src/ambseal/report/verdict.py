@@ -107,6 +107,10 @@ class Verdict:
         How many conditions of the speed range (standstill to the top speed, stability
         only: ``metrics["stability"]``) were checked, and those where the loop, continuous
         or as it runs, is unstable (``"0 bar, 0 Hz"``).
+    design_bound : str or None
+        The design's own bound: ``"H∞ γ = 1.05 on the nominal design model"`` or
+        ``"robust performance met: μ = 0.9942 ≤ 1 on the design model"`` (its summary's
+        verdict, up to the full-order check); None for the PID.
     """
 
     controller: str
@@ -123,6 +127,7 @@ class Verdict:
     target_difference: float | None = None
     speed_checked: int = 0
     speed_unstable: tuple[str, ...] = ()
+    design_bound: str | None = None
 
     @property
     def judged_range(self) -> str:
@@ -198,9 +203,11 @@ def _unstable(case: Mapping) -> bool:
 
 
 def verdicts(cases: Sequence[Mapping], clearances_um: Mapping[str, float] | None = None,
-             stability: Sequence[Mapping] = ()) -> list[Verdict]:
+             stability: Sequence[Mapping] = (),
+             designs: Mapping[str, Mapping] | None = None) -> list[Verdict]:
     """One :class:`Verdict` per controller of ``metrics["cases"]`` (in order of appearance),
-    with its ``metrics["stability"]`` cases (the speed range) counted in."""
+    with its ``metrics["stability"]`` cases (the speed range) counted in and its design's
+    bound from ``metrics["controllers"]`` (``designs``)."""
     by_speed = _speed_varies(cases)
     names = list(dict.fromkeys(c["controller"] for c in cases))
     out = []
@@ -227,7 +234,9 @@ def verdicts(cases: Sequence[Mapping], clearances_um: Mapping[str, float] | None
             impulse_peak_um=peak("impulse_peak_um"),
             impulse_settling_s=peak("impulse_settling_s"),
             clearances_um=dict(clearances_um or {}), target_difference=target_difference(cs),
-            speed_checked=len(sc), speed_unstable=speed_bad))
+            speed_checked=len(sc), speed_unstable=speed_bad,
+            design_bound=((designs or {}).get(name, {}).get("verdict") or "").split(";")[0]
+            or None))
     return out
 
 
@@ -235,10 +244,11 @@ def _esc(s: Any) -> str:
     return _html.escape(str(s), quote=True)
 
 
-def _zone_cell(z: str | None, extra: str = "") -> str:
+def _zone_cell(z: str | None, extra: str = "", label: str = "") -> str:
+    lab = f' data-label="{_esc(label)}"' if label else ""
     if z is None:
-        return "<td>—</td>"
-    return (f'<td class="zone" style="background:{ZONE_COLOURS.get(z, "#eee")}">'
+        return f"<td{lab}>—</td>"
+    return (f'<td class="zone"{lab} style="background:{ZONE_COLOURS.get(z, "#eee")}">'
             f"{_esc(z)}{extra}</td>")
 
 
@@ -247,18 +257,27 @@ def verdict_table_html(vs: Sequence[Verdict]) -> str:
     head = ("<tr><th>Controller</th><th>Stable over</th><th>ISO 14839-3 zone<br>worst axis"
             "</th><th>zone of<br>σ̄(S_o)</th><th>σ̄(S_o) peak (–)</th><th>Worst unbalance "
             "orbit</th><th>Impulse peak (µm)</th><th>Settling 2 % (ms)</th>"
-            "<th class=\"text\">Verdict</th></tr>")
+            "<th class=\"text\">Design bound (γ, μ)</th><th class=\"text\">Verdict</th></tr>")
     rows = []
     for v in vs:
         st = v.impulse_settling_s
-        rows.append(
-            f'<tr class="{"unstable" if v.unstable_at or v.speed_unstable else "ok"}">'
-            f'<td class="text"><b>'
-            f"{_esc(v.controller)}</b></td><td class=\"text\">{_esc(v.stable_range)}</td>"
-            + _zone_cell(v.zone_axis) + _zone_cell(v.zone_sigma)
-            + f"<td>{sig(v.sigma_peak)}</td><td class=\"text\">{_esc(v.orbit_text())}</td>"
-            f"<td>{sig(v.impulse_peak_um)}</td><td>{sig(None if st is None else st * 1e3)}</td>"
-            f'<td class="text verdict">{_esc(v.words())}</td></tr>')
+        # data-label: the column's name, shown beside each value when a narrow screen
+        # stacks the row (the page's CSS)
+        cells = [f'<td class="text" data-label="Controller"><b>{_esc(v.controller)}</b></td>',
+                 f'<td class="text" data-label="Stable over">{_esc(v.stable_range)}</td>',
+                 _zone_cell(v.zone_axis, label="ISO 14839-3 zone, worst axis"),
+                 _zone_cell(v.zone_sigma, label="zone of σ̄(S_o)"),
+                 f'<td data-label="σ̄(S_o) peak">{sig(v.sigma_peak)}</td>',
+                 f'<td class="text" data-label="Worst unbalance orbit">'
+                 f"{_esc(v.orbit_text())}</td>",
+                 f'<td data-label="Impulse peak (µm)">{sig(v.impulse_peak_um)}</td>',
+                 f'<td data-label="Settling 2 % (ms)">'
+                 f"{sig(None if st is None else st * 1e3)}</td>",
+                 f'<td class="text" data-label="Design bound">'
+                 f'{_esc(v.design_bound or "—")}</td>',
+                 f'<td class="text verdict" data-label="Verdict">{_esc(v.words())}</td>']
+        rows.append(f'<tr class="{"unstable" if v.unstable_at or v.speed_unstable else "ok"}">'
+                    + "".join(cells) + "</tr>")
     return (f'<table class="verdict" id="verdict"><thead>{head}</thead>'
             f"<tbody>{''.join(rows)}</tbody></table>")
 
@@ -331,5 +350,7 @@ def verdict_table_rich(vs: Sequence[Verdict]):
                   sig(v.sigma_peak), orb, sig(v.impulse_peak_um),
                   sig(None if st is None else st * 1e3),
                   style="red" if v.unstable_at else None)
-    lines = [Text.assemble((f"{v.controller}: ", "bold"), v.words()) for v in vs]
+    lines = [Text.assemble((f"{v.controller}: ", "bold"), v.words()
+                           + (f" Design: {v.design_bound}." if v.design_bound else ""))
+             for v in vs]
     return Group(t, *lines)

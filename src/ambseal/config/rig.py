@@ -526,7 +526,7 @@ class TruthSection(_Strict):
 
     parameters: dict[str, Coefficient] = {}
     tau_e: float = Field(default=0.0, ge=0, le=1.0)
-    bias_current: float = Field(default=6.0, gt=0, le=MAX_CURRENT_A)
+    bias_current: float | None = Field(default=None, gt=0, le=MAX_CURRENT_A)
     current_limit: float | None = Field(default=None, gt=0, le=MAX_CURRENT_A)
     sensor_noise_m: float = Field(default=0.0, ge=0, le=MAX_GAP_M)
     noise_fraction: float = Field(default=0.0, ge=0, le=MAX_RELATIVE)
@@ -549,8 +549,9 @@ class TruthConfig(_Strict):
 def load_truth(path: str | Path) -> TruthSection:
     """Read a truth file (TOML with a ``[truth]`` table); ConfigError on any fault.
 
-    Keys of ``[truth]``: ``tau_e`` (s), ``bias_current`` (A), ``current_limit`` (A, default
-    the AMBs' ``current_limit``), ``sensor_noise_m`` (std, m) or ``noise_fraction`` (std as
+    Keys of ``[truth]``: ``tau_e`` (s), ``bias_current`` (A, default the rig's:
+    :func:`ambseal.model.amb.bias_current`), ``current_limit`` (A, default the AMBs'
+    ``current_limit``), ``sensor_noise_m`` (std, m) or ``noise_fraction`` (std as
     a fraction of each displacement channel's RMS), ``current_noise_a`` (std, A),
     ``adc_bits`` and ``adc_range_m`` (quantisation step range/2^bits; the sensor does not
     saturate: the rotor stops the run if it leaves the gap), ``substeps`` (integration steps

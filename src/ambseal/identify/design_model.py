@@ -31,7 +31,8 @@ from ambseal.model.amb import channel_names
 from ambseal.model.rig import build_system, mechanical_plant
 from ambseal.robust.digital_loop import DiscreteController
 
-__all__ = ["ImpulseCheck", "outside_intervals", "design_rig", "truth_rig", "impulse_checks"]
+__all__ = ["ImpulseCheck", "outside_intervals", "non_physical", "design_rig", "truth_rig",
+           "impulse_checks"]
 
 
 def outside_intervals(cfg: RigConfig, res: ProcedureResult) -> list[str]:
@@ -60,16 +61,41 @@ def outside_intervals(cfg: RigConfig, res: ProcedureResult) -> list[str]:
     return out
 
 
+def non_physical(cfg: RigConfig, res: ProcedureResult) -> list[str]:
+    """The seal's identified regressions that are not physical over the pressure drops the
+    rig runs at (0 to 2× nominal, or to the highest of ``[design] pressures_bar``): direct
+    damping C below zero at either end (an affine law is extreme at its ends). Such a line
+    extrapolates its tests into a seal that feeds energy by its direct damping, which no
+    annular seal does; it is never designed on."""
+    if not res.regression or not cfg.seal:
+        return []
+    top = max(2.0 * cfg.operating.pressure_bar, *(cfg.design.pressures_bar or [0.0]))
+    reg = res.regression.get("C")
+    if reg is None:
+        return []
+    low = min(reg.intercept, reg.intercept + reg.slope * top)
+    return [f"{cfg.seal[0].name}.C"] if low < 0 else []
+
+
 def design_rig(cfg: RigConfig, res: ProcedureResult) -> tuple[RigConfig, dict]:
-    """The rig to design on (module rule) and a JSON note of the choice."""
+    """The rig to design on (module rule) and a JSON note of the choice; an identified seal
+    coefficient that is not physical over the rig's pressures (:func:`non_physical`) is
+    replaced by the rig file's, named under ``non_physical``."""
     differ = outside_intervals(cfg, res)
     if not differ:
         return cfg, {"designed_on": "rig file", "reason": "every identified value holds the "
                      "rig file's inside its 95 % interval"}
-    return res.identified, {"designed_on": "identified rig",
-                            "reason": "identified values differ from the rig file beyond "
-                                      "their 95 % intervals",
-                            "outside_intervals": differ}
+    bad = non_physical(cfg, res)
+    note = {"designed_on": "identified rig",
+            "reason": "identified values differ from the rig file beyond their 95 % intervals",
+            "outside_intervals": differ}
+    if not bad:
+        return res.identified, note
+    seal = cfg.seal[0]
+    kept = {n: getattr(seal, n.rsplit(".", 1)[1]) for n in bad}
+    note.update(non_physical=bad, reason=note["reason"] + "; the rig file's " + ", ".join(bad)
+                + " kept: the identified line turns negative within 0–2× nominal pressure")
+    return rig_with_values(res.identified, kept), note
 
 
 def truth_rig(cfg: RigConfig, truth: TruthSection) -> RigConfig:

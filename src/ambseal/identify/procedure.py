@@ -1,9 +1,10 @@
 """The thesis's identification procedure as one stage (P2 §5, P4 §3.4–3.5, P5 §3.3).
 
 (a) the eight Ki/Ks and τ_e from a PRBS run at zero pressure; (b) the coupling stiffness
-from a second PRBS run, with (a) known, then both jointly on both records; (a') Ki by
+(on a rig with a ``[[spring]]``) from a second PRBS run, with (a) known, then both jointly on both records; (a') Ki by
 static loading (P2 §5, :mod:`.static_load`) joined with that fit; (c) the seal's K, k, C, c
-per pressure drop from impulse runs (0.05 A for 10 ms on both bearings in ζ, P5 §3.3) with
+per pressure drop from impulse runs (0.05 A for 10 ms on both bearings in ζ, P5 §3.3) at a
+quarter to 1.25× the nominal pressure drop (:func:`seal_test_pressures`) with
 regression lines against pressure (P5 Fig. 7; a pressure where the controller does not
 hold the rotor is skipped and told — the facility refuses an unstable loop), then per excitation frequency from a stepped
 sine of balanced forward and backward whirl (:mod:`.seal_test`, balanced on the model with
@@ -31,7 +32,7 @@ from typing import Callable
 import numpy as np
 
 from ambseal.config import Affine, RigConfig, TruthSection, rig_with_values
-from ambseal.errors import IdentificationError, ModelError
+from ambseal.errors import ConfigError, IdentificationError, ModelError
 from ambseal.identify.excitation import ExcitationPlan, excitation_plan
 from ambseal.identify.fit import TAU_E, FitResult
 from ambseal.identify.seal_test import fit_reliability, seal_frequency_test
@@ -47,7 +48,8 @@ from ambseal.identify.stats import linear_regression
 from ambseal.model.amb import channel_names
 from ambseal.robust.digital_loop import DiscreteController
 
-__all__ = ["ProcedureResult", "thesis_procedure", "SEAL_COEFFICIENTS"]
+__all__ = ["ProcedureResult", "thesis_procedure", "seal_test_pressures", "SEAL_COEFFICIENTS",
+           "SEAL_TEST_STEPS"]
 
 SEAL_COEFFICIENTS = ("K", "k", "C", "c")
 
@@ -60,8 +62,8 @@ class ProcedureResult:
     ----------
     amb : FitResult
         Stage (a): Ki, Ks per axis and τ_e.
-    coupling : FitResult
-        Stage (b).
+    coupling : FitResult or None
+        Stage (b); None on a rig without a ``[[spring]]`` (nothing to identify).
     seal_vs_frequency : dict
         ``{pressure_bar: [(frequency_hz, FitResult), ...]}`` for the nominal pressure and
         the zero-pressure reference.
@@ -83,7 +85,7 @@ class ProcedureResult:
     """
 
     amb: FitResult
-    coupling: FitResult
+    coupling: FitResult | None
     seal_vs_frequency: dict
     seal_vs_pressure: list
     regression: dict
@@ -99,7 +101,7 @@ class ProcedureResult:
 
         return {
             "amb": fit(self.amb),
-            "coupling": fit(self.coupling),
+            "coupling": None if self.coupling is None else fit(self.coupling),
             "seal_vs_frequency": {
                 str(p): [{"frequency_hz": f, **fit(r), "unreliable": fit_reliability(r)}
                          for f, r in rows]
@@ -127,6 +129,37 @@ def _subset(res: FitResult, names: list[str]) -> FitResult:
                    correlation=res.correlation[np.ix_(idx, idx)])
 
 
+#: The seal's impulse tests run at the nominal pressure drop × k/SEAL_TEST_STEPS for
+#: k = 1 … SEAL_TEST_STEPS + 1: from a quarter of the nominal to 1.25× it, the span the
+#: thesis covered on its rig (0.5–2.5 bar at a nominal 2.04 bar, P5 §3.3) on any rig.
+SEAL_TEST_STEPS = 4
+
+
+def seal_test_pressures(cfg: RigConfig) -> tuple[float, ...]:
+    """The pressure drops (bar) of the seal's impulse tests: :data:`SEAL_TEST_STEPS` + 1
+    steps of a quarter of the rig's nominal pressure drop (``[operating] pressure_bar``,
+    else the highest of ``[design] pressures_bar``), the nominal among them.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+
+    Returns
+    -------
+    tuple of float
+
+    Raises
+    ------
+    ConfigError
+        A rig with a seal but no pressure drop to test it at.
+    """
+    p = cfg.operating.pressure_bar or max(cfg.design.pressures_bar or [0.0])
+    if not p > 0:
+        raise ConfigError("identification (c): the seal is tested at pressure drops "
+                          "around the nominal one; set [operating] pressure_bar (bar)")
+    return tuple(p * k / SEAL_TEST_STEPS for k in range(1, SEAL_TEST_STEPS + 2))
+
+
 def thesis_procedure(
     cfg: RigConfig,
     truth: TruthSection,
@@ -135,7 +168,7 @@ def thesis_procedure(
     seed: int = 0,
     sine_frequencies_hz: tuple[float, ...] = (10, 20, 40, 60, 80, 100, 120, 140, 160, 180,
                                               200),
-    impulse_pressures_bar: tuple[float, ...] = (0.5, 1.0, 1.5, 2.0, 2.5),
+    impulse_pressures_bar: tuple[float, ...] | None = None,
     excitation: ExcitationPlan | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> ProcedureResult:
@@ -154,9 +187,9 @@ def thesis_procedure(
         Seed of excitations and noise.
     sine_frequencies_hz : tuple of float
         Frequencies (Hz) of the balanced-whirl stepped sines of stage (c) (P4 §3.5.1).
-    impulse_pressures_bar : tuple of float
+    impulse_pressures_bar : tuple of float, optional
         Pressure drops (bar) of the impulse runs of stage (c) (P5 §3.3); the facility must
-        hold the rotor at three of them at least.
+        hold the rotor at three of them at least. Default :func:`seal_test_pressures`.
     excitation : ExcitationPlan, optional
         Amplitudes, clock and lengths of the excitations; default
         :func:`~ambseal.identify.excitation.excitation_plan` of ``cfg``.
@@ -225,6 +258,8 @@ def thesis_procedure(
     skipped: list = []
     regression: dict = {}
     if seal is not None:
+        if impulse_pressures_bar is None:
+            impulse_pressures_bar = seal_test_pressures(cfg)
         names_s = [f"{seal}.{c}" for c in SEAL_COEFFICIENTS]
         zeta = {f"{m}_zeta": 1.0 for m in ambs}
         for i, p in enumerate(impulse_pressures_bar):

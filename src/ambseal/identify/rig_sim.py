@@ -39,7 +39,7 @@ from ambseal.errors import ConfigError, ModelError
 from ambseal.identify.facility_loop import facility_loop
 from ambseal.lti.discrete import zoh
 from ambseal.lti.interconnect import series_inputs
-from ambseal.model.amb import actuator_matrices, eddy_lag_matrices
+from ambseal.model.amb import actuator_matrices, bias_current, eddy_lag_matrices
 from ambseal.model.reduction import modal_reduction
 from ambseal.model.rig import build_system, mechanical_plant
 from ambseal.model.seal import coefficient_value
@@ -47,7 +47,7 @@ from ambseal.robust.digital_loop import DiscreteController, closed_loop_matrices
 from ambseal.robust.stability import is_stable, unstable_poles
 
 __all__ = ["FacilityRecord", "Facility", "prepare_facility", "simulate_facility", "true_rig",
-           "reduced_plant"]
+           "reduced_plant", "facility_bias_current"]
 
 
 @dataclass(frozen=True)
@@ -74,6 +74,32 @@ class FacilityRecord:
     axes: tuple[str, ...]
     noise_std_m: np.ndarray
 
+
+
+def facility_bias_current(cfg: RigConfig, truth: TruthSection) -> float:
+    """The virtual facility's bias current i0 (A): the truth file's ``bias_current``, else
+    the rig's own (:func:`ambseal.model.amb.bias_current`: its AMBs' bias, or half their
+    current limit).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+    truth : TruthSection
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ConfigError
+        Neither the truth file nor the rig gives a bias current.
+    """
+    i0 = truth.bias_current if truth.bias_current is not None else bias_current(cfg)
+    if i0 is None:
+        raise ConfigError("truth: bias_current: the rig's [[amb]] give neither bias_current "
+                          "nor current_limit; set [truth] bias_current (A)")
+    return float(i0)
 
 def true_rig(cfg: RigConfig, truth: TruthSection) -> RigConfig:
     """The rig as the facility builds it: the rig file with the truth's model-form changes
@@ -279,7 +305,7 @@ def prepare_facility(cfg: RigConfig, truth: TruthSection, sample_rate_hz: float,
     axes = plant.axes
     k = len(axes)
     names = [a.rsplit("_", 1) for a in axes]
-    i0 = truth.bias_current
+    i0 = facility_bias_current(cfg, truth)
     ki, ks, s0, kf = _force_law(plant, names, i0)
     limits = [a.current_limit for a in cfg.amb for _ in range(2)]
     limit = truth.current_limit or (min(x for x in limits if x) if any(limits) else np.inf)

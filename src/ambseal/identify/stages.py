@@ -13,7 +13,7 @@ from ambseal.errors import DataError, IdentificationError, ModelError
 from ambseal.identify.budget import fixed_uncertainty
 from ambseal.identify.data import Measurement, validate_measurement
 from ambseal.identify.fit import TAU_E, ClosedLoopModel, FitResult, default_bounds, fit_parameters
-from ambseal.identify.rig_sim import reduced_plant, simulate_facility
+from ambseal.identify.rig_sim import facility_bias_current, reduced_plant, simulate_facility
 from ambseal.identify.sensor_lag import TAU_S
 from ambseal.identify.signals import Excitation
 from ambseal.model.amb import actuator_matrices
@@ -145,7 +145,7 @@ def acquire(cfg: RigConfig, truth: TruthSection, excitation: Excitation, *,
     meta = {
         "rig": cfg.rotor.name,
         "sample_rate_hz": excitation.sample_rate_hz,
-        "bias_current_a": truth.bias_current,
+        "bias_current_a": facility_bias_current(cfg, truth),
         "pressure_drop_pa": pressure_bar * 1e5,
         "speed_rad_s": cfg.speed,
         "controller": controller.to_dict(),

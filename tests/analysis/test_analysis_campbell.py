@@ -151,3 +151,26 @@ def test_cli_campbell_modes_and_bad_range(tmp_path, rigid, capsys):
     assert main(["campbell", str(rig), "--speed-hz", "0:200", "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--speed-hz" in err
+
+
+def test_overdamped_lines_cross_apart():
+    """Two lines over 0–100 Hz: a lightly damped mode at 50 Hz (ζ = 0.05, log decrement
+    2πζ/√(1−ζ²)) and a heavily damped controller pole whose damped frequency rises from 20
+    to 80 Hz (ζ = 0.95). Both meet the 1× line at 50 Hz, a grid speed (counted once); only
+    the first is a crossing with a resonance, the second is listed apart (ζ ≥ 1/√2: no
+    resonance peak)."""
+    from types import SimpleNamespace
+
+    from ambseal.analysis.campbell import OVERDAMPED_ZETA, Campbell, _crossings
+
+    speeds = np.linspace(0.0, 100.0, 11)
+    z1, z2 = 0.05, 0.95
+    pts = tuple(SimpleNamespace(
+        frequency_hz=np.array([50.0, 20.0 + 0.6 * s]), damping_ratio=np.array([z1, z2]),
+        log_decrement=2 * np.pi * np.array([z1, z2]) / np.sqrt(1 - np.array([z1, z2]) ** 2),
+        whirl=("forward", "backward")) for s in speeds)
+    c = Campbell(speeds, pts, np.tile([0, 1], (11, 1)), ())
+    crossings, over = _crossings(c)
+    assert [(x.track, x.speed_hz) for x in crossings] == [(0, 50.0)]
+    assert [(x.track, x.speed_hz) for x in over] == [(1, 50.0)]
+    assert z2 >= OVERDAMPED_ZETA > z1

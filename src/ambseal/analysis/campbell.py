@@ -46,12 +46,15 @@ from ambseal.robust.delay import loop_delay
 from ambseal.robust.loop import judged_loop
 from ambseal.robust.stability import decay_rate, is_stable
 
-__all__ = ["API684_LOG_DEC", "ClosedLoopModes", "Crossing", "Campbell",
+__all__ = ["API684_LOG_DEC", "OVERDAMPED_ZETA", "ClosedLoopModes", "Crossing", "Campbell",
            "log_decrement", "lowest_log_decrement", "whirl_of", "closed_loop_state_matrix",
            "closed_loop_modes", "modes_of_state_matrix", "open_loop_modes", "campbell"]
 
 #: API 684 (2nd ed., 2005) level-I stability screening: log decrement of every mode ≥ 0.1.
 API684_LOG_DEC = 0.1
+#: A mode damped at ζ ≥ 1/√2 has no resonance peak (its second-order response falls
+#: monotonically with frequency): its 1× crossing is no critical speed and is listed apart.
+OVERDAMPED_ZETA = 1.0 / math.sqrt(2.0)
 #: A node counts in the whirl classification when it moves more than this share of the
 #: largest node amplitude of the mode.
 _MOVING = 0.01
@@ -373,9 +376,13 @@ class Campbell:
         ``tracks[i, j]`` the index into ``points[i]``'s modes of line ``j`` (−1 where the line
         has no mode at that speed), lines followed by nearest eigenvalue.
     crossings : tuple of Crossing
-        Where a line meets f = speed (linear interpolation between grid speeds).
+        Where a line meets f = speed (linear interpolation between grid speeds), of modes
+        with a resonance: damping ratio below :data:`OVERDAMPED_ZETA`.
     log_dec_limit : float
         The limit below which a mode is flagged (API 684: 0.1).
+    overdamped : tuple of Crossing
+        The crossings of lines damped at ζ ≥ :data:`OVERDAMPED_ZETA` there (a controller's
+        or an eddy-current pole with a small imaginary part): no resonance, listed apart.
     """
 
     speeds_hz: np.ndarray
@@ -383,6 +390,7 @@ class Campbell:
     tracks: np.ndarray
     crossings: tuple[Crossing, ...]
     log_dec_limit: float = API684_LOG_DEC
+    overdamped: tuple[Crossing, ...] = ()
 
     def line(self, j: int, field: str = "frequency_hz") -> np.ndarray:
         """Values of ``field`` along line ``j`` (nan where absent), shape (n_s,)."""
@@ -415,6 +423,7 @@ class Campbell:
                 "stable": [p.stable for p in self.points],
                 "max_real_pole": [json_float(p.max_real_pole) for p in self.points],
                 "crossings": [c.to_dict() for c in self.crossings],
+                "overdamped_crossings": [c.to_dict() for c in self.overdamped],
                 "flagged": self.flagged(), "points": [p.to_dict() for p in self.points]}
 
 
@@ -438,21 +447,26 @@ def _tracks(points: list[ClosedLoopModes]) -> np.ndarray:
     return np.array(lines, dtype=int).T.reshape(len(points), len(lines))
 
 
-def _crossings(c: Campbell) -> tuple[Crossing, ...]:
-    out = []
+def _crossings(c: Campbell) -> tuple[tuple[Crossing, ...], tuple[Crossing, ...]]:
+    """The 1× crossings of the lines: (those with a resonance, the overdamped ones)."""
+    out, over = [], []
     s = c.speeds_hz
     for j in range(c.tracks.shape[1]):
-        f, d = c.line(j), c.line(j, "log_decrement")
+        f, d, z = c.line(j), c.line(j, "log_decrement"), c.line(j, "damping_ratio")
         g = f - s
         for i in range(len(s) - 1):
+            # a line through a grid speed meets it at the start of one interval only
+            ends_on_it = g[i + 1] == 0 and i + 2 < len(s)
             if np.isfinite(g[i]) and np.isfinite(g[i + 1]) and g[i] * g[i + 1] <= 0 \
-                    and g[i] != g[i + 1]:
+                    and g[i] != g[i + 1] and not ends_on_it:
                 t = g[i] / (g[i] - g[i + 1])
                 k = c.tracks[i + (t > 0.5), j]
-                out.append(Crossing(j, float(s[i] + t * (s[i + 1] - s[i])),
-                                    float(d[i] + t * (d[i + 1] - d[i])),
-                                    c.points[i + (t > 0.5)].whirl[k]))
-    return tuple(sorted(out, key=lambda x: x.speed_hz))
+                x = Crossing(j, float(s[i] + t * (s[i + 1] - s[i])),
+                             float(d[i] + t * (d[i + 1] - d[i])),
+                             c.points[i + (t > 0.5)].whirl[k])
+                (over if z[i] + t * (z[i + 1] - z[i]) >= OVERDAMPED_ZETA else out).append(x)
+    return (tuple(sorted(out, key=lambda x: x.speed_hz)),
+            tuple(sorted(over, key=lambda x: x.speed_hz)))
 
 
 def campbell(cfg, controller=None, speeds_hz=None, *, pressure_bar: float | None = None,
@@ -497,7 +511,8 @@ def campbell(cfg, controller=None, speeds_hz=None, *, pressure_bar: float | None
                         description="campbell", raise_errors=True)
     pts = list(results)
     c = Campbell(s, tuple(pts), _tracks(pts), (), log_dec_limit)
-    return Campbell(s, c.points, c.tracks, _crossings(c), log_dec_limit)
+    crossings, overdamped = _crossings(c)
+    return Campbell(s, c.points, c.tracks, crossings, log_dec_limit, overdamped)
 
 
 def _modes_case(case: dict, cfg, controller, pressure_bar, max_hz) -> ClosedLoopModes:

@@ -191,6 +191,7 @@ def _campbell(args: argparse.Namespace) -> int:
                                     len(c.speeds_hz)],
                       "stable_at_all_speeds": all(pt.stable for pt in c.points),
                       "crossings": [x.to_dict() for x in c.crossings],
+                      "overdamped_crossings": len(c.overdamped),
                       "flagged_modes": len(c.flagged()), "log_dec_limit": c.log_dec_limit,
                       "files": [str(f) for f in files]}))
     return 0

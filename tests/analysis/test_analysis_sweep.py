@@ -151,10 +151,15 @@ def test_cli_sweep_writes_table_boundary_and_map_and_keeps_failed_cases(tmp_path
     from ambseal.config import dump_rig, parse_rig
     from ambseal.export.controller_files import export_controller
 
+    from ambseal.model.amb import channel_names
+
     rig = tmp_path / "rig.toml"
-    rig.write_text(dump_rig(parse_rig(_tiny_rig())))
-    kfile = export_controller(control.ss([], [], [], 1.1e4 * np.eye(4), inputs=4, outputs=4),
-                              tmp_path / "P.json")
+    cfg = parse_rig(_tiny_rig())
+    rig.write_text(dump_rig(cfg))
+    ch = channel_names(cfg)
+    kfile = export_controller(control.ss([], [], [], 1.1e4 * np.eye(4),
+                                         inputs=[f"y_{c}" for c in ch],
+                                         outputs=[f"i_{c}" for c in ch]), tmp_path / "P.json")
     out = tmp_path / "sw"
     args = ["sweep", str(rig), "--pressure-bar", "0:4:3", "--controller", str(kfile),
             "--out", str(out), "--workers", "1", "--tol-bar", "1e-5"]

@@ -34,6 +34,7 @@ from ambseal.errors import ConfigError
 from ambseal.export.controller_files import load_controller
 from ambseal.files import OwnedFolder, atomic_write, write_json, write_text
 from ambseal.io.ross import import_ross_file
+from ambseal.model.amb import channel_names
 from ambseal.model.modes import bending_limit_hz, modes
 from ambseal.model.rig import build_system
 from ambseal.report.modal_figures import campbell_figure, mode_shapes_figure, stability_map_figure
@@ -46,7 +47,9 @@ __all__ = ["HANDLERS", "controller_for", "write_table"]
 def controller_for(cfg, spec: str | None, pressure_bar: float | None = None):
     """The controller ``spec`` names: ``pid``, ``hinf`` or ``mu`` (designed on the rig by
     :func:`ambseal.design.recipes.design` at ``pressure_bar``), or a controller file of
-    ``ambseal design`` (.json, .npz, .mat); ``None`` or ``"none"`` for the open loop."""
+    ``ambseal design`` (.json, .npz, .mat) — its kind checked and wired to the rig's
+    channels by signal name (:func:`~ambseal.export.controller_files.load_controller`);
+    ``None`` or ``"none"`` for the open loop."""
     if spec is None or spec == "none":
         return None
 
@@ -56,7 +59,7 @@ def controller_for(cfg, spec: str | None, pressure_bar: float | None = None):
         raise ConfigError(f"--controller: expected pid, hinf, mu, none or a controller file "
                           f"(.json, .npz, .mat), got {spec!r}")
 
-    K = load_controller(spec)  # a judged digital controller: its continuous design
+    K = load_controller(spec, channel_names(cfg))  # a judged digital one: its continuous design
     return K.continuous if isinstance(K, DigitalController) else K
 
 

@@ -140,9 +140,10 @@ def test_cli_sweep_writes_table_boundary_and_map_and_keeps_failed_cases(tmp_path
     """``ambseal sweep`` on the rigid rotor with a controller file: the table has every
     case in order, the grid brackets and the bisection finds the Jeffcott threshold
     k = c·ω_n (Childs 1993, §1.5: m s² + c s + K − jk = 0 has a root on the imaginary axis
-    where k = c·√(K/m)) to 1e-4 relative, the map is written; a ``--param`` the rig does not
-    have fails every case, each kept in the table with its error, and the command still
-    ends normally."""
+    where k = c·√(K/m)) to 1e-4 relative, the map is written; ``--param`` values the rig format
+    refuses (a negative eddy-current lag) fail every case, each kept in the table with its
+    error, and the command still ends normally; a parameter name the rig does not have is
+    refused before any case."""
     import csv
 
     import control
@@ -176,8 +177,12 @@ def test_cli_sweep_writes_table_boundary_and_map_and_keeps_failed_cases(tmp_path
     k_crit = (900.0 - 2 * 1.1e6 * TINY_TAU) * np.sqrt(2e6 / m)
     assert edge["boundary_pressure_bar"] == pytest.approx(k_crit / 1e5, rel=1e-4)
     assert (out / "stability_map.png").stat().st_size > 10_000
-    assert main(args + ["--param", "nope.k=0:1:2"]) == 0
+    assert main(args + ["--param", "tau_e=-2:-1:2"]) == 0  # no rig has a negative lag
     summary = json.loads(capsys.readouterr().out)
     assert summary["cases"] == 6 and summary["failed"] == 6
     rows = list(csv.DictReader((out / "sweep.csv").open()))
-    assert all("unknown parameter 'nope.k'" in r["error"] for r in rows)
+    assert all("eddy_time_constant" in r["error"] for r in rows)
+    # a name the rig does not have: refused before any case, naming the rig's names
+    assert main(args + ["--param", "nope.k=0:1:2"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "unknown parameter 'nope.k'" in err[0] and "s.k" in err[0]

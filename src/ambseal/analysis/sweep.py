@@ -268,6 +268,8 @@ def boundary_case(case: dict, rig: dict, controllers: dict, tol_bar: float) -> f
     lo, hi = case["last_stable_bar"], case["first_unstable_bar"]
     while hi - lo > tol_bar:
         mid = 0.5 * (lo + hi)
+        if not lo < mid < hi:  # the bracket is two adjacent floats: no narrower one exists
+            break
         A, _ = closed_loop_state_matrix(cfg, K, speed_hz=case["speed_hz"], pressure_bar=mid,
                                         delay=True)  # the loop judge() judges
         lo, hi = (mid, hi) if is_stable(np.linalg.eigvals(A)) else (lo, mid)
@@ -308,8 +310,11 @@ def refine_boundary(cfg, controllers: dict, edges: list[dict], *, tol_bar: float
     Raises
     ------
     ConfigError
-        A Dask ``scheduler`` or ``workers`` that cannot be used (:func:`run_cases`).
+        ``tol_bar`` not a finite number above 0, or a Dask ``scheduler`` or ``workers``
+        that cannot be used (:func:`run_cases`).
     """
+    if not (math.isfinite(tol_bar) and tol_bar > 0):
+        raise ConfigError(f"tol_bar: expected a finite pressure above 0 bar, got {tol_bar!r}")
     todo = [i for i, e in enumerate(edges)
             if e["last_stable_bar"] is not None and e["first_unstable_bar"] is not None]
     cases = [{k: v for k, v in edges[i].items() if k != "boundary_pressure_bar"}

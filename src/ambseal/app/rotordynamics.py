@@ -27,7 +27,13 @@ from ambseal.analysis.sweep import (
     stability_boundary,
     sweep,
 )
-from ambseal.config import MAX_COEFFICIENT, MAX_PRESSURE_BAR, MAX_SPEED_HZ, load_rig
+from ambseal.config import (
+    MAX_COEFFICIENT,
+    MAX_PRESSURE_BAR,
+    MAX_SPEED_HZ,
+    load_rig,
+    rig_parameter_names,
+)
 from ambseal.design.recipes import METHODS, design
 from ambseal.design.specs import design_spec
 from ambseal.errors import ConfigError
@@ -205,13 +211,17 @@ def _sweep(args: argparse.Namespace) -> int:
     pressures = _range(args.pressure_bar, "--pressure-bar", *_PRESSURES)
     speeds = _range(args.speed_hz, "--speed-hz", *_SPEEDS)
     specs = (args.controller or "pid").split(",")
-    params = {}
+    params, known = {}, rig_parameter_names(cfg)
     for text in args.param or []:
         name, sep, rng = text.partition("=")
         if not sep:
             raise ConfigError(f"--param: expected NAME=a:b:n, got {text!r}")
-        params[name.strip()] = _range(rng, f"--param {name}", -MAX_COEFFICIENT,
-                                      MAX_COEFFICIENT, "the bound of a force coefficient")
+        name = name.strip()
+        if name not in known:  # before any design: a misspelt name would fail every case
+            raise ConfigError(f"--param: unknown parameter {name!r}; the rig's parameters "
+                              f"are {', '.join(known)}")
+        params[name] = _range(rng, f"--param {name}", -MAX_COEFFICIENT,
+                              MAX_COEFFICIENT, "the bound of a force coefficient")
     check_cases(len(specs) * len(pressures) * len(speeds)
                 * math.prod(len(v) for v in params.values()), "sweep")  # before any design
     ctrl = {Path(s).stem: controller_for(cfg, s, cfg.operating.pressure_bar) for s in specs}

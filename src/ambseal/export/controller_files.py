@@ -50,7 +50,7 @@ from scipy.io import savemat
 
 from ambseal.config import MAX_DELAY_SAMPLES, MAX_FREQUENCY_HZ
 from ambseal.errors import AmbsealError, DataError
-from ambseal.files import atomic_write
+from ambseal.files import atomic_write, input_file
 from ambseal.identify.matlab_file import read_matlab
 from ambseal.robust.controller import SPEED
 from ambseal.robust.digital import DigitalController, discretize_as
@@ -210,6 +210,10 @@ def _read(path: Path) -> dict:
     if suffix not in _FORMATS:
         raise DataError(f"{path}: unknown controller format {suffix!r}, expected one of "
                         f"{_FORMATS}")
+    try:  # a device, a FIFO or a file beyond any controller: refused before reading
+        input_file(path, "controller file")
+    except AmbsealError as exc:
+        raise DataError(str(exc)) from None
     if suffix == ".mat":  # in a child process: scipy's reader can crash on a malformed file
         m = read_matlab(path, squeeze_me=False, chars_as_strings=True)
     try:

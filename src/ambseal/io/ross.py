@@ -64,8 +64,8 @@ from pydantic import ValidationError
 
 from ambseal.config import RigConfig, dump_rig, parse_rig
 from ambseal.config.rig import Pid
-from ambseal.errors import ConfigError
-from ambseal.files import write_text
+from ambseal.errors import AmbsealError, ConfigError
+from ambseal.files import read_text, write_text
 
 __all__ = ["RossImport", "from_ross", "load_ross", "import_ross_file", "ROSS_TESTED"]
 
@@ -505,8 +505,10 @@ def _check_file(path: Path, ross) -> dict:
     material."""
 
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_text(path, "ROSS rotor file")
         data = json.loads(text) if path.suffix.lower() == ".json" else tomllib.loads(text)
+    except AmbsealError as exc:
+        raise ConfigError(str(exc)) from None
     except (OSError, ValueError) as exc:
         raise ConfigError(f"{path}: not a ROSS rotor file ({exc})") from None
     if not isinstance(data, dict) or not isinstance(data.get("parameters"), dict):

@@ -186,3 +186,63 @@ def test_cli_sweep_writes_table_boundary_and_map_and_keeps_failed_cases(tmp_path
     assert main(args + ["--param", "nope.k=0:1:2"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "unknown parameter 'nope.k'" in err[0] and "s.k" in err[0]
+
+
+@pytest.fixture
+def silent_peer():
+    """The address of a TCP socket that accepts connections and never answers (a wrong
+    port, a stalled host)."""
+    import socket
+    import threading
+
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(8)
+    held, stop = [], threading.Event()
+
+    def accept():
+        srv.settimeout(0.2)
+        while not stop.is_set():
+            try:
+                held.append(srv.accept()[0])
+            except OSError:
+                continue
+
+    t = threading.Thread(target=accept, daemon=True)
+    t.start()
+    yield f"tcp://127.0.0.1:{srv.getsockname()[1]}"
+    stop.set()
+    t.join()
+    for c in held:
+        c.close()
+    srv.close()
+
+
+def test_a_scheduler_that_never_answers_is_refused_in_time(silent_peer, tmp_path, capsys,
+                                                           monkeypatch):
+    """A Dask scheduler address whose peer accepts and stays silent: ``run_cases`` and
+    ``ambseal sweep --scheduler`` end within the deadline (here 1 s) in one error naming
+    the address, the sweep before any design (distributed's Client alone waits without
+    end); a real scheduler answers the same probe."""
+    import time
+
+    distributed = pytest.importorskip("distributed")
+    from ambseal.analysis import cases
+    from ambseal.cli import main
+    from ambseal.config import default_rig_path
+    from ambseal.errors import ConfigError
+
+    monkeypatch.setattr(cases, "SCHEDULER_TIMEOUT_S", 1.0)
+    t0 = time.monotonic()
+    with pytest.raises(ConfigError, match="no answer within 1 s"):
+        cases.run_cases(sweep_case, [{}], scheduler=silent_peer)
+    t1 = time.monotonic()
+    assert main(["sweep", str(default_rig_path()), "--pressure-bar", "1", "--scheduler",
+                 silent_peer, "--out", str(tmp_path / "o")]) == 2
+    t2 = time.monotonic()
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and silent_peer in err[0] and "no answer" in err[0], err
+    assert t1 - t0 < 5.0 and t2 - t1 < 5.0
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster:
+        cases.probe_scheduler(cluster.scheduler_address)

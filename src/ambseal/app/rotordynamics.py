@@ -18,7 +18,7 @@ import sys
 from pathlib import Path
 
 from ambseal.analysis.campbell import campbell, closed_loop_modes, open_loop_modes
-from ambseal.analysis.cases import dask_available
+from ambseal.analysis.cases import dask_available, probe_scheduler
 from ambseal.analysis.judge import judge_settings
 from ambseal.analysis.sweep import (
     check_cases,
@@ -180,6 +180,8 @@ def _campbell(args: argparse.Namespace) -> int:
     speeds = _range(args.speed_hz, "--speed-hz", *_SPEEDS)
     spec = args.controller or ("pid" if cfg.controller.pid is not None and cfg.amb else
                                "hinf" if cfg.amb else None)
+    if args.scheduler is not None:  # before any design: an address that never answers
+        probe_scheduler(args.scheduler)
     K = controller_for(cfg, spec, p)
     c = campbell(cfg, K, speeds, pressure_bar=p,
                  max_hz=args.max_hz, log_dec_limit=args.log_dec_limit, workers=args.workers,
@@ -224,6 +226,8 @@ def _sweep(args: argparse.Namespace) -> int:
                               MAX_COEFFICIENT, "the bound of a force coefficient")
     check_cases(len(specs) * len(pressures) * len(speeds)
                 * math.prod(len(v) for v in params.values()), "sweep")  # before any design
+    if args.scheduler is not None:  # likewise: an address that never answers
+        probe_scheduler(args.scheduler)
     ctrl = {Path(s).stem: controller_for(cfg, s, cfg.operating.pressure_bar) for s in specs}
     if any(K is None for K in ctrl.values()):
         raise ConfigError("sweep: every --controller must be a controller (pid, hinf, mu or "

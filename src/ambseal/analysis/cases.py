@@ -12,6 +12,7 @@ recorded as a :class:`CaseError` with its message and the others go on. A progre
 
 from __future__ import annotations
 
+import asyncio
 import os
 import sys
 from dataclasses import dataclass
@@ -155,8 +156,6 @@ def probe_scheduler(address: str, timeout_s: float | None = None) -> None:
         dask.distributed is not installed, or the address cannot be reached, does not
         answer in time or is no Dask scheduler; the message names the address.
     """
-    import asyncio
-
     if not dask_available():
         raise ConfigError("dask.distributed is not installed (pip install 'ambseal[dask]'); "
                           "leave out --scheduler to run serially")

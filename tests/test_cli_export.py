@@ -54,7 +54,7 @@ def test_controller_file_with_wrong_shapes_is_refused(tmp_path, capsys, testrig_
     doc = json.loads(path.read_text())
     doc["B"] = [row[:-1] for row in doc["B"]]
     path.write_text(json.dumps(doc))
-    _one_line_exit_2(capsys, ["export", "x.toml", "--controller", str(path), "--c",
+    _one_line_exit_2(capsys, ["export", RIG, "--controller", str(path), "--c",
                               str(tmp_path / "c")], "B has shape", "expected")
 
 
@@ -64,7 +64,7 @@ def test_export_c_from_a_controller_file(tmp_path, capsys, testrig_digital):
     from ambseal.export.controller_files import export_controller
 
     path = export_controller(testrig_digital["mu"], tmp_path / "K_mu.npz")
-    assert main(["export", "x.toml", "--controller", str(path), "--c", str(tmp_path / "c")]) == 0
+    assert main(["export", RIG, "--controller", str(path), "--c", str(tmp_path / "c")]) == 0
     files = json.loads(capsys.readouterr().out)["files"]
     header = Path(files[0]).read_text()
     n = testrig_digital["mu"].discrete.A.shape[0]
@@ -76,18 +76,28 @@ def test_export_c_from_a_controller_file(tmp_path, capsys, testrig_digital):
 INJECTED = '*/ int ambseal_injected(void) { return system("x"); } /*\n#define X ??/\n\\ é'
 
 
-def _small_digital(name: str, inputs=("y_A_zeta",), outputs=("i_A_zeta",)):
-    """A one-state digital controller (the exported object) named ``name``."""
+#: The embedded rig's AMB channels, as a controller file for it names its signals.
+CHANNELS = ("A_zeta", "A_eta", "B_zeta", "B_eta")
+RIG = str(ROOT / "examples" / "testrig.toml")
+
+
+def _small_digital(name: str, inputs=None, outputs=None):
+    """A one-state digital controller (the exported object) named ``name``, for the
+    embedded rig's channels unless ``inputs``/``outputs`` are given: its discrete matrices
+    are the ZOH discretisation of its continuous ones at 10 kHz, as the file states."""
     import control
     import numpy as np
 
-    from ambseal.robust.digital import DigitalController
+    from ambseal.robust.digital import DigitalController, discretize_as
     from ambseal.robust.digital_loop import DiscreteController
 
-    K = control.ss([[-100.0]], [[1.0]], [[2.0]], [[0.5]], inputs=list(inputs),
-                   outputs=list(outputs), name=name)
-    disc = DiscreteController(np.array([[0.99]]), np.array([[1e-4]]), np.array([[2.0]]),
-                              np.array([[0.5]]), 1e-4, description={})
+    inputs = list(inputs or [f"y_{c}" for c in CHANNELS])
+    outputs = list(outputs or [f"i_{c}" for c in CHANNELS])
+    ny, nu = len(inputs), len(outputs)
+    mats = (np.array([[-100.0]]), np.ones((1, ny)), 2.0 * np.ones((nu, 1)),
+            0.5 * np.eye(nu, ny))
+    K = control.ss(*mats, inputs=inputs, outputs=outputs, name=name)
+    disc = DiscreteController(*discretize_as(mats, 1e-4, "zoh"), 1e-4, description={})
     return DigitalController(K, K, disc, "zoh", None, 1e4, 1, (), None, (), "zoh")
 
 
@@ -127,7 +137,7 @@ def test_controller_file_with_an_injected_name_is_refused(tmp_path, capsys):
     from ambseal.export.controller_files import export_controller
 
     good = export_controller(_small_digital("K_small"), tmp_path / "K-1 v2.json")
-    assert main(["export", "x.toml", "--controller", str(good), "--c",
+    assert main(["export", RIG, "--controller", str(good), "--c",
                  str(tmp_path / "ok")]) == 0
     files = json.loads(capsys.readouterr().out)["files"]
     assert [Path(f).name for f in files] == ["ambseal_K_1_v2.h", "ambseal_K_1_v2.c"]
@@ -136,7 +146,7 @@ def test_controller_file_with_an_injected_name_is_refused(tmp_path, capsys):
         doc[key] = value
         bad = tmp_path / "K.json"
         bad.write_text(json.dumps(doc))
-        _one_line_exit_2(capsys, ["export", "x.toml", "--controller", str(bad), "--c",
+        _one_line_exit_2(capsys, ["export", RIG, "--controller", str(bad), "--c",
                                   str(tmp_path / "c")], str(bad), key, "not a plain name")
         assert not (tmp_path / "c").exists()
 

@@ -200,6 +200,21 @@ CLI_CASES = [
     (["sweep", RIG, "--pressure-bar", "0:1e300:3", "--out", "o"], "--pressure-bar", "finite"),
     (["sweep", RIG, "--pressure-bar", "0:2e4:3", "--out", "o"], "--pressure-bar",
      "[operating] pressure_bar"),
+    (["sweep", RIG, "--pressure-bar", "0:4:3", "--tol-bar", "-1", "--out", "o"], "--tol-bar",
+     "> 0"),
+    (["sweep", RIG, "--pressure-bar", "0:4:3", "--tol-bar", "0", "--out", "o"], "--tol-bar",
+     "> 0"),
+    (["sweep", RIG, "--pressure-bar", "0:4:3", "--max-hz", "-5", "--out", "o"], "--max-hz",
+     "> 0"),
+    (["sweep", RIG, "--pressure-bar", "0:4:3", "--workers", "100000", "--out", "o"],
+     "--workers", "per core"),
+    (["sweep", RIG, "--pressure-bar", "0:4:3", "--param", "seal.kk=0:1e6:3", "--out", "o"],
+     "unknown parameter 'seal.kk'", "seal.k, seal.C"),
+    (["design", RIG, "--method", "pid", "--set", "design.band_hz=[1, 3000]\ndesign.x=1",
+      "--out", "o"], "--set", "one line"),
+    (["track", RIG, "x.csv", "--params", "seal.k", "--rate-per-s", "-1", "--out", "o"],
+     "--rate-per-s", "> 0"),
+    (["modes", "/dev/zero"], "/dev/zero", "not a regular file"),
 ]
 
 
@@ -248,3 +263,32 @@ def test_gains_figure_of_a_one_amb_rig(tmp_path):
     K = np.ones((30, 2, 2)) * (1 + 1j)
     path = controller_gains_figure(tmp_path / "g.png", [("pid", f, K)], ["A_zeta", "A_eta"])
     assert path.stat().st_size > 1000
+
+
+def test_input_sizes_are_bounded_before_work(tmp_path, capsys):
+    """Reference: the rig format's bounds (ambseal.config._checks): at most MAX_COMPONENTS
+    disks and a mesh of at most MAX_ELEMENTS beam elements however the components split it
+    (2 000 small disks made a dense model of 16 000 states), each refused in one line
+    naming the key, in seconds; an identification file that is a device (``/dev/zero``)
+    is refused without reading it."""
+    import time
+
+    from ambseal.config import MAX_COMPONENTS, MAX_ELEMENTS
+
+    data = copy.deepcopy(BASE)
+    length = sum(s["length"] for s in data["shaft"])
+    for n, where, expect in ((2000, "disk", f"at most {MAX_COMPONENTS}"),
+                             (MAX_ELEMENTS - 10, "shaft", f"more than {MAX_ELEMENTS} beam")):
+        data["disk"] = BASE["disk"] + [{"name": f"d{i}", "position": length * (i + 0.5) / n,
+                                        "mass": 0.01} for i in range(n)]
+        rig = tmp_path / f"disks{n}.toml"
+        rig.write_text(dump(data))
+        t0 = time.process_time()
+        refused(capsys, ["validate", rig], str(rig), where, expect)
+        assert time.process_time() - t0 < 10.0
+    data = copy.deepcopy(BASE)
+    data.setdefault("design", {})["uncertainty_from_identification"] = "/dev/zero"
+    rig = tmp_path / "zero.toml"
+    rig.write_text(dump(data))
+    refused(capsys, ["design", rig, "--method", "mu", "--out", tmp_path / "o"],
+            "uncertainty_from_identification", "/dev/zero", "not a regular file")

@@ -82,6 +82,30 @@ def _finite(text: str) -> float:
     return x
 
 
+def _positive(text: str) -> float:
+    """A finite number above 0 (a tolerance, a frequency limit, a duration)."""
+    x = _finite(text)
+    if x <= 0:
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}")
+    return x
+
+
+#: Local Dask worker processes per core at most: each is a Python process with ambseal,
+#: numpy and scipy loaded (about 150 MB) running one case at a time on one BLAS thread, so
+#: more than a few per core only add start-up time and memory.
+WORKERS_PER_CORE = 4
+
+
+def _workers(text: str) -> int:
+    """A count of local worker processes: 1 to :data:`WORKERS_PER_CORE` per core."""
+    most = WORKERS_PER_CORE * (os.cpu_count() or 1)
+    n = _whole(text, 1) if text.strip().lstrip("+").isdigit() else 0
+    if not 1 <= n <= most:
+        raise argparse.ArgumentTypeError(f"expected a whole number from 1 to {most} "
+                                         f"({WORKERS_PER_CORE} per core), got {text!r}")
+    return n
+
+
 def _nonnegative(text: str) -> float:
     x = _finite(text)
     if x < 0:
@@ -182,13 +206,13 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("--pressure-bar", type=_finite, required=True, help="seal pressure drop (bar)")
     a.add_argument("--out", required=True, help="record file: .csv (+ .csv.json) or .mat")
     # the excitation defaults follow from the rig (ambseal.identify.excitation)
-    a.add_argument("--amplitude-a", type=_finite, default=None,
+    a.add_argument("--amplitude-a", type=_positive, default=None,
                    help="excitation amplitude (A; default [design.impulse] amplitude_a, else "
                         "bias current / 120)")
-    a.add_argument("--duration-s", type=_finite, default=None,
+    a.add_argument("--duration-s", type=_positive, default=None,
                    help="record length (s; default 1000 PRBS clock periods)")
     a.add_argument("--axes", default=None, help="excited axes, e.g. A_zeta,B_zeta (default all)")
-    a.add_argument("--clock-period-s", type=_finite, default=None,
+    a.add_argument("--clock-period-s", type=_positive, default=None,
                    help="PRBS clock period (s; default 10 controller samples)")
     a.add_argument("--frequencies-hz", default="10,30,50,70,90,110,130,150,170,190",
                    help="stepped-sine frequencies (Hz), comma separated")
@@ -202,7 +226,7 @@ def _parser() -> argparse.ArgumentParser:
                    help="chirp end frequency (Hz; default 0.75 × sample rate / 50)")
     a.add_argument("--chirp", choices=["linear", "logarithmic"], default="linear",
                    help="chirp frequency sweep")
-    a.add_argument("--width-s", type=_finite, default=None,
+    a.add_argument("--width-s", type=_positive, default=None,
                    help="impulse width (s; default [design.impulse] duration_s, else 100 "
                         "controller samples)")
     a.add_argument("--start-s", type=_finite, default=None,
@@ -263,7 +287,7 @@ def _parser() -> argparse.ArgumentParser:
     tr.add_argument("data", nargs="+", help="record files (.csv with sidecar, or .mat)")
     tr.add_argument("--params", required=True, help="LFT parameters, e.g. seal.k,seal.K")
     tr.add_argument("--out", default="ambseal-track", help="output folder")
-    tr.add_argument("--rate-per-s", type=float, default=None,
+    tr.add_argument("--rate-per-s", type=_positive, default=None,
                     help="expected drift per second as a fraction of each parameter's scale "
                          "(default 0.1)")
 
@@ -286,7 +310,7 @@ def _rotordynamics_parsers(sub) -> None:
     m.add_argument("--n-modes", type=_positive_int, default=None,
                    help="only the N lowest modes (sparse shift-invert; unstable poles up to "
                         "the N-th mode only)")
-    m.add_argument("--max-hz", type=float, default=None,
+    m.add_argument("--max-hz", type=_positive, default=None,
                    help="modes up to this frequency (Hz); default 1.25x the third free-free "
                         "bending frequency")
     m.add_argument("--controller", default=None,
@@ -306,7 +330,7 @@ def _rotordynamics_parsers(sub) -> None:
                    "the top speed (or the first free-free bending frequency), 31 points")
     c.add_argument("--pressure-bar", type=float, default=None,
                    help="seal pressure drop (bar); default [operating] pressure_bar")
-    c.add_argument("--max-hz", type=float, default=None, help="highest mode frequency (Hz)")
+    c.add_argument("--max-hz", type=_positive, default=None, help="highest mode frequency (Hz)")
     c.add_argument("--log-dec-limit", type=float, default=0.1,
                    help="flag modes below this log decrement (API 684: 0.1)")
     c.add_argument("--out", default="ambseal-campbell", help="output folder")
@@ -322,9 +346,9 @@ def _rotordynamics_parsers(sub) -> None:
                    help="pid, hinf, mu or controller files, comma separated (default pid)")
     s.add_argument("--param", action="append", metavar="NAME=a:b:n",
                    help="a rig parameter to sweep too, e.g. seal.k=0:2e6:5 (repeatable)")
-    s.add_argument("--max-hz", type=float, default=None,
+    s.add_argument("--max-hz", type=_positive, default=None,
                    help="modes of the lowest log decrement up to this frequency (Hz)")
-    s.add_argument("--tol-bar", type=float, default=0.01,
+    s.add_argument("--tol-bar", type=_positive, default=0.01,
                    help="the stability boundary is bisected to this pressure (bar)")
     s.add_argument("--out", default="ambseal-sweep", help="output folder")
     _executor_args(s)
@@ -341,7 +365,7 @@ def _rotordynamics_parsers(sub) -> None:
 
 def _executor_args(p) -> None:
     g = p.add_mutually_exclusive_group()
-    g.add_argument("--workers", type=int, default=None,
+    g.add_argument("--workers", type=_workers, default=None,
                    help="local Dask worker processes (1: serial; default: serial for small "
                         "runs, one per core for large ones)")
     g.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")

@@ -22,6 +22,7 @@ import json
 import os
 import re
 import shutil
+import stat
 import tempfile
 import tomllib
 import uuid
@@ -30,7 +31,7 @@ from typing import Any, BinaryIO, Callable
 
 from ambseal.errors import AmbsealError
 
-__all__ = ["atomic_write", "writable_folder", "read_text", "load_toml", "write_text", "write_json", "RunFolder", "check_manifest",
+__all__ = ["atomic_write", "writable_folder", "input_file", "MAX_READ_BYTES", "read_text", "load_toml", "write_text", "write_json", "RunFolder", "check_manifest",
            "write_manifest", "OwnedFolder", "foreign_entries"]
 
 
@@ -80,15 +81,57 @@ def writable_folder(folder: str | os.PathLike) -> Path:
     return folder
 
 
-def read_text(path: str | os.PathLike, what: str = "file") -> str:
-    """The UTF-8 text of ``path`` (a byte-order mark is dropped).
+#: The largest file ambseal reads (bytes): a record of the most samples an excitation may
+#: have (``ambseal.identify.signals.MAX_SAMPLES``, 2e6) with 16 columns of 25 characters
+#: is 0.8 GB of CSV; anything larger is no input of ambseal's and would only exhaust memory.
+MAX_READ_BYTES = 2**30
+
+
+def input_file(path: str | os.PathLike, what: str = "file") -> Path:
+    """``path`` checked before it is read: a regular file (not a device such as
+    ``/dev/zero``, a FIFO or a folder) of at most :data:`MAX_READ_BYTES`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file to read.
+    what : str
+        What it is, for the message ("rig file", "identification").
+
+    Returns
+    -------
+    Path
 
     Raises
     ------
     AmbsealError
-        One line naming the file: it cannot be read, or is not UTF-8 text.
+        One line naming the file: missing, not a regular file, or too large.
     """
     path = Path(path)
+    try:
+        st = path.stat()
+    except OSError as exc:
+        raise AmbsealError(f"{path}: cannot read {what} ({exc.strerror or exc})") from None
+    if not stat.S_ISREG(st.st_mode):
+        raise AmbsealError(f"{path}: {what}: not a regular file (a device, a pipe or a "
+                           "folder is not read)")
+    if st.st_size > MAX_READ_BYTES:
+        raise AmbsealError(f"{path}: {what}: {st.st_size} bytes, expected at most "
+                           f"{MAX_READ_BYTES} bytes")
+    return path
+
+
+def read_text(path: str | os.PathLike, what: str = "file") -> str:
+    """The UTF-8 text of ``path`` (a byte-order mark is dropped), checked by
+    :func:`input_file` before it is read.
+
+    Raises
+    ------
+    AmbsealError
+        One line naming the file: it cannot be read, is not a regular file, is larger
+        than :data:`MAX_READ_BYTES`, or is not UTF-8 text.
+    """
+    path = input_file(path, what)
     try:
         return path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError as exc:

@@ -35,7 +35,12 @@ def rigid():
 
     from ambseal.config import parse_rig
 
-    return parse_rig(_rig()), control.ss([], [], [], (K + KS) / KI * np.eye(4))
+    from ambseal.model.amb import channel_names
+
+    cfg = parse_rig(_rig())
+    ch = channel_names(cfg)  # named as a controller file for the rig must be
+    return cfg, control.ss([], [], [], (K + KS) / KI * np.eye(4), inputs=[f"y_{c}" for c in ch],
+                           outputs=[f"i_{c}" for c in ch])
 
 
 def _closed_form(speed_hz: float) -> tuple[np.ndarray, np.ndarray]:

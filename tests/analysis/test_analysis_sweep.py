@@ -140,9 +140,10 @@ def test_cli_sweep_writes_table_boundary_and_map_and_keeps_failed_cases(tmp_path
     """``ambseal sweep`` on the rigid rotor with a controller file: the table has every
     case in order, the grid brackets and the bisection finds the Jeffcott threshold
     k = c·ω_n (Childs 1993, §1.5: m s² + c s + K − jk = 0 has a root on the imaginary axis
-    where k = c·√(K/m)) to 1e-4 relative, the map is written; a ``--param`` the rig does not
-    have fails every case, each kept in the table with its error, and the command still
-    ends normally."""
+    where k = c·√(K/m)) to 1e-4 relative, the map is written; ``--param`` values the rig format
+    refuses (a negative eddy-current lag) fail every case, each kept in the table with its
+    error, and the command still ends normally; a parameter name the rig does not have is
+    refused before any case."""
     import csv
 
     import control
@@ -151,10 +152,15 @@ def test_cli_sweep_writes_table_boundary_and_map_and_keeps_failed_cases(tmp_path
     from ambseal.config import dump_rig, parse_rig
     from ambseal.export.controller_files import export_controller
 
+    from ambseal.model.amb import channel_names
+
     rig = tmp_path / "rig.toml"
-    rig.write_text(dump_rig(parse_rig(_tiny_rig())))
-    kfile = export_controller(control.ss([], [], [], 1.1e4 * np.eye(4), inputs=4, outputs=4),
-                              tmp_path / "P.json")
+    cfg = parse_rig(_tiny_rig())
+    rig.write_text(dump_rig(cfg))
+    ch = channel_names(cfg)
+    kfile = export_controller(control.ss([], [], [], 1.1e4 * np.eye(4),
+                                         inputs=[f"y_{c}" for c in ch],
+                                         outputs=[f"i_{c}" for c in ch]), tmp_path / "P.json")
     out = tmp_path / "sw"
     args = ["sweep", str(rig), "--pressure-bar", "0:4:3", "--controller", str(kfile),
             "--out", str(out), "--workers", "1", "--tol-bar", "1e-5"]
@@ -171,8 +177,72 @@ def test_cli_sweep_writes_table_boundary_and_map_and_keeps_failed_cases(tmp_path
     k_crit = (900.0 - 2 * 1.1e6 * TINY_TAU) * np.sqrt(2e6 / m)
     assert edge["boundary_pressure_bar"] == pytest.approx(k_crit / 1e5, rel=1e-4)
     assert (out / "stability_map.png").stat().st_size > 10_000
-    assert main(args + ["--param", "nope.k=0:1:2"]) == 0
+    assert main(args + ["--param", "tau_e=-2:-1:2"]) == 0  # no rig has a negative lag
     summary = json.loads(capsys.readouterr().out)
     assert summary["cases"] == 6 and summary["failed"] == 6
     rows = list(csv.DictReader((out / "sweep.csv").open()))
-    assert all("unknown parameter 'nope.k'" in r["error"] for r in rows)
+    assert all("eddy_time_constant" in r["error"] for r in rows)
+    # a name the rig does not have: refused before any case, naming the rig's names
+    assert main(args + ["--param", "nope.k=0:1:2"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "unknown parameter 'nope.k'" in err[0] and "s.k" in err[0]
+
+
+@pytest.fixture
+def silent_peer():
+    """The address of a TCP socket that accepts connections and never answers (a wrong
+    port, a stalled host)."""
+    import socket
+    import threading
+
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(8)
+    held, stop = [], threading.Event()
+
+    def accept():
+        srv.settimeout(0.2)
+        while not stop.is_set():
+            try:
+                held.append(srv.accept()[0])
+            except OSError:
+                continue
+
+    t = threading.Thread(target=accept, daemon=True)
+    t.start()
+    yield f"tcp://127.0.0.1:{srv.getsockname()[1]}"
+    stop.set()
+    t.join()
+    for c in held:
+        c.close()
+    srv.close()
+
+
+def test_a_scheduler_that_never_answers_is_refused_in_time(silent_peer, tmp_path, capsys,
+                                                           monkeypatch):
+    """A Dask scheduler address whose peer accepts and stays silent: ``run_cases`` and
+    ``ambseal sweep --scheduler`` end within the deadline (here 1 s) in one error naming
+    the address, the sweep before any design (distributed's Client alone waits without
+    end); a real scheduler answers the same probe."""
+    import time
+
+    distributed = pytest.importorskip("distributed")
+    from ambseal.analysis import cases
+    from ambseal.cli import main
+    from ambseal.config import default_rig_path
+    from ambseal.errors import ConfigError
+
+    monkeypatch.setattr(cases, "SCHEDULER_TIMEOUT_S", 1.0)
+    t0 = time.monotonic()
+    with pytest.raises(ConfigError, match="no answer within 1 s"):
+        cases.run_cases(sweep_case, [{}], scheduler=silent_peer)
+    t1 = time.monotonic()
+    assert main(["sweep", str(default_rig_path()), "--pressure-bar", "1", "--scheduler",
+                 silent_peer, "--out", str(tmp_path / "o")]) == 2
+    t2 = time.monotonic()
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and silent_peer in err[0] and "no answer" in err[0], err
+    assert t1 - t0 < 5.0 and t2 - t1 < 5.0
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster:
+        cases.probe_scheduler(cluster.scheduler_address)

@@ -310,6 +310,24 @@ def test_import_ross_stdout_is_the_json_only(examples, tmp_path):
 
 
 
+
+def test_ross_is_imported_with_refprop_away_from_the_working_directory(monkeypatch):
+    """In this process too (:func:`load_ross`; ``import-ross`` runs ROSS in a child
+    process, tests/test_adversarial.py plants a library for it): while ROSS (ccp) is
+    imported without a user's ``RPPREFIX``, ``RPPREFIX`` names an empty folder that is not the working
+    directory, and is unset again afterwards; a user's own ``RPPREFIX`` is kept."""
+    from ambseal.io.ross import _no_refprop_from_cwd
+
+    monkeypatch.delenv("RPPREFIX", raising=False)
+    monkeypatch.delitem(sys.modules, "ccp", raising=False)
+    with _no_refprop_from_cwd():
+        folder = os.environ["RPPREFIX"]
+        assert os.listdir(folder) == [] and os.path.abspath(folder) != os.getcwd()
+    assert "RPPREFIX" not in os.environ
+    monkeypatch.setenv("RPPREFIX", "/opt/refprop")
+    with _no_refprop_from_cwd():
+        assert os.environ["RPPREFIX"] == "/opt/refprop"
+
 def _fine_bearing_rig(path, total: int):
     """:func:`fine_bearing_data` written to ``path`` and loaded."""
     from ambseal.config import load_rig

@@ -12,6 +12,7 @@ recorded as a :class:`CaseError` with its message and the others go on. A progre
 
 from __future__ import annotations
 
+import asyncio
 import os
 import sys
 from dataclasses import dataclass
@@ -23,11 +24,17 @@ from rich.progress import Progress
 from ambseal.errors import AmbsealError, ConfigError
 from ambseal.threads import with_numerics_threads
 
-__all__ = ["CaseError", "run_cases", "dask_available", "SERIAL_BELOW"]
+__all__ = ["CaseError", "run_cases", "dask_available", "SERIAL_BELOW", "SCHEDULER_TIMEOUT_S",
+           "probe_scheduler"]
 
 #: Sweeps with fewer cases than this run serially when no workers or scheduler are given:
 #: a local cluster costs a few seconds to start, about 20 cases of the embedded rig.
 SERIAL_BELOW = 64
+#: The longest a Dask scheduler given by address may take to connect and to answer an
+#: ``identity`` request (s): a scheduler answers in milliseconds, a remote one across a
+#: slow link in well under a second; anything that accepts a connection and stays silent
+#: (a wrong port, a stalled host) is refused after this instead of waiting forever.
+SCHEDULER_TIMEOUT_S = 10.0
 
 
 @dataclass(frozen=True)
@@ -102,7 +109,7 @@ def run_cases(fn: Callable, cases: Sequence[dict], *, shared: dict | None = None
     ------
     ConfigError
         ``scheduler`` or ``workers > 1`` without dask installed, or a scheduler that cannot
-        be reached.
+        be reached or does not answer within :data:`SCHEDULER_TIMEOUT_S`.
     """
 
     shared = dict(shared or {})
@@ -132,17 +139,66 @@ def run_cases(fn: Callable, cases: Sequence[dict], *, shared: dict | None = None
         return _run_dask(fn, cases, shared, workers, scheduler, done)
 
 
+def probe_scheduler(address: str, timeout_s: float | None = None) -> None:
+    """Check that a Dask scheduler at ``address`` connects and answers an ``identity``
+    request within ``timeout_s`` (distributed's ``Client`` waits without end for the
+    handshake of a peer that accepts a connection and never answers).
+
+    Parameters
+    ----------
+    address : str
+        The scheduler's address, e.g. ``tcp://host:8786``.
+    timeout_s : float, optional
+        The deadline of connecting and answering together (s); default
+        :data:`SCHEDULER_TIMEOUT_S`.
+
+    Raises
+    ------
+    ConfigError
+        dask.distributed is not installed, or the address cannot be reached, does not
+        answer in time or is no Dask scheduler; the message names the address.
+    """
+    if not dask_available():
+        raise ConfigError("dask.distributed is not installed (pip install 'ambseal[dask]'); "
+                          "leave out --scheduler to run serially")
+    from distributed.comm import connect  # optional: the [dask] extra
+
+    timeout_s = SCHEDULER_TIMEOUT_S if timeout_s is None else float(timeout_s)
+
+    async def identity():
+        comm = await connect(address, timeout=timeout_s)
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    try:
+        answer = asyncio.run(asyncio.wait_for(identity(), timeout_s))
+    except (TimeoutError, asyncio.TimeoutError):
+        raise ConfigError(f"dask scheduler {address!r}: no answer within {timeout_s:g} s "
+                          "(is a Dask scheduler listening there?)") from None
+    except Exception as exc:  # refused, unreachable, not an address, not Dask's protocol
+        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise ConfigError(f"dask scheduler {address!r}: cannot connect ({msg})") from None
+    if not (isinstance(answer, dict) and answer.get("type") == "Scheduler"):
+        raise ConfigError(f"dask scheduler {address!r}: the peer is not a Dask scheduler "
+                          f"(it answered {str(answer)[:80]!r})")
+
+
 def _run_dask(fn, cases, shared, workers, scheduler, done) -> list:
     """The Dask path of :func:`run_cases`: futures, as completed, gathered in input order."""
-    from distributed import Client, LocalCluster, as_completed  # optional: the [dask] extra
+    import dask  # optional: the [dask] extra
+    from distributed import Client, LocalCluster, as_completed  # optional, as above
 
     cluster = None
     try:
         if scheduler is not None:
-            client = Client(scheduler, timeout="10s")
+            probe_scheduler(scheduler)
+            deadline = f"{SCHEDULER_TIMEOUT_S:g}s"  # distributed's own, for what follows
+            with dask.config.set({"distributed.comm.timeouts.connect": deadline}):
+                client = Client(scheduler, timeout=deadline)
         else:
-            import dask  # optional: the [dask] extra
-
             n = workers or (os.cpu_count() or 1)
             # Linux: workers forked from this process, which has ambseal, numpy, scipy and
             # python-control imported already (spawned workers import them again: about

@@ -11,7 +11,7 @@ The cases run on :func:`ambseal.analysis.cases.run_cases` (serial or Dask).
   the same bisected on the closed-loop poles to a stated tolerance.
 
 Inputs of a sweep case are plain and picklable: the rig as a dict (``RigConfig.model_dump``),
-each controller as its ``(A, B, C, D)`` arrays.
+each controller as its ``(A, B, C, D)`` arrays and signal names.
 """
 
 from __future__ import annotations
@@ -96,7 +96,9 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
     rig : dict
         The rig (``RigConfig.model_dump()``).
     controllers : dict
-        ``{name: (A, B, C, D)}``, displacement (m) → current (A), ``i = −K y``.
+        ``{name: (A, B, C, D, inputs, outputs)}``, displacement (m) → current (A),
+        ``i = −K y``, wired to the plant by its signal names; ``(A, B, C, D)`` alone is
+        taken in the plant's channel order.
     max_hz : float
         Highest frequency (Hz) of the modes the lowest log decrement is taken over.
     settings : JudgeSettings
@@ -111,7 +113,7 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
     """
 
     cfg = _case_rig(rig, case.get("params"))
-    K = control.ss(*controllers[case["controller"]])
+    K = _controller(controllers[case["controller"]])
     point = OperatingPoint(case["pressure_bar"], 60.0 * case["speed_hz"], "")
     res, curves = judge(cfg, K, case["controller"], point, settings,
                         impulse=False)
@@ -132,10 +134,18 @@ def _case_rig(rig: dict, params: dict | None):
 
 
 def _shared(cfg, controllers: dict) -> dict:
-    """The plain, picklable inputs every case of a sweep shares."""
+    """The plain, picklable inputs every case of a sweep shares; each controller keeps its
+    signal names, so that the case wires it to the plant by name."""
     return {"rig": cfg.model_dump(exclude_none=True),
-            "controllers": {n: tuple(np.asarray(M, float) for M in (K.A, K.B, K.C, K.D))
+            "controllers": {n: (*(np.asarray(M, float) for M in (K.A, K.B, K.C, K.D)),
+                                list(K.input_labels), list(K.output_labels))
                             for n, K in controllers.items()}}
+
+
+def _controller(entry: tuple):
+    """A case's controller, ``(A, B, C, D[, inputs, outputs])``, as a StateSpace."""
+    mats, names = entry[:4], entry[4:]
+    return control.ss(*mats, **dict(zip(("inputs", "outputs"), names)))
 
 
 def check_cases(n: int, what: str) -> None:
@@ -254,10 +264,12 @@ def boundary_case(case: dict, rig: dict, controllers: dict, tol_bar: float) -> f
     part of the closed-loop poles (the loop of :func:`sweep_case`)."""
 
     cfg = _case_rig(rig, case.get("params"))
-    K = control.ss(*controllers[case["controller"]])
+    K = _controller(controllers[case["controller"]])
     lo, hi = case["last_stable_bar"], case["first_unstable_bar"]
     while hi - lo > tol_bar:
         mid = 0.5 * (lo + hi)
+        if not lo < mid < hi:  # the bracket is two adjacent floats: no narrower one exists
+            break
         A, _ = closed_loop_state_matrix(cfg, K, speed_hz=case["speed_hz"], pressure_bar=mid,
                                         delay=True)  # the loop judge() judges
         lo, hi = (mid, hi) if is_stable(np.linalg.eigvals(A)) else (lo, mid)
@@ -298,8 +310,11 @@ def refine_boundary(cfg, controllers: dict, edges: list[dict], *, tol_bar: float
     Raises
     ------
     ConfigError
-        A Dask ``scheduler`` or ``workers`` that cannot be used (:func:`run_cases`).
+        ``tol_bar`` not a finite number above 0, or a Dask ``scheduler`` or ``workers``
+        that cannot be used (:func:`run_cases`).
     """
+    if not (math.isfinite(tol_bar) and tol_bar > 0):
+        raise ConfigError(f"tol_bar: expected a finite pressure above 0 bar, got {tol_bar!r}")
     todo = [i for i, e in enumerate(edges)
             if e["last_stable_bar"] is not None and e["first_unstable_bar"] is not None]
     cases = [{k: v for k, v in edges[i].items() if k != "boundary_pressure_bar"}

@@ -134,7 +134,8 @@ def _export(args: argparse.Namespace) -> int:
     if (args.method is None) == (args.controller is None):
         raise ConfigError("export: give exactly one of --method and --controller")
     if args.controller is not None:
-        ctrl = load_controller(args.controller)
+        # the rig is read first: the file must be this rig's controller, wired by name
+        ctrl = load_controller(args.controller, channel_names(load_rig(args.rig)))
         with _owned(None if args.c_dir else args.out, args.c_dir):
             files = write_c(ctrl, args.c_dir or Path(args.out) / "c",  # file name as C names
                             f"ambseal_{c_identifier(Path(args.controller).stem)}",

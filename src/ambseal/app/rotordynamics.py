@@ -18,7 +18,7 @@ import sys
 from pathlib import Path
 
 from ambseal.analysis.campbell import campbell, closed_loop_modes, open_loop_modes
-from ambseal.analysis.cases import dask_available
+from ambseal.analysis.cases import dask_available, probe_scheduler
 from ambseal.analysis.judge import judge_settings
 from ambseal.analysis.sweep import (
     check_cases,
@@ -27,13 +27,20 @@ from ambseal.analysis.sweep import (
     stability_boundary,
     sweep,
 )
-from ambseal.config import MAX_COEFFICIENT, MAX_PRESSURE_BAR, MAX_SPEED_HZ, load_rig
+from ambseal.config import (
+    MAX_COEFFICIENT,
+    MAX_PRESSURE_BAR,
+    MAX_SPEED_HZ,
+    load_rig,
+    rig_parameter_names,
+)
 from ambseal.design.recipes import METHODS, design
 from ambseal.design.specs import design_spec
 from ambseal.errors import ConfigError
 from ambseal.export.controller_files import load_controller
 from ambseal.files import OwnedFolder, atomic_write, write_json, write_text
 from ambseal.io.ross import import_ross_file
+from ambseal.model.amb import channel_names
 from ambseal.model.modes import bending_limit_hz, modes
 from ambseal.model.rig import build_system
 from ambseal.report.modal_figures import campbell_figure, mode_shapes_figure, stability_map_figure
@@ -46,7 +53,9 @@ __all__ = ["HANDLERS", "controller_for", "write_table"]
 def controller_for(cfg, spec: str | None, pressure_bar: float | None = None):
     """The controller ``spec`` names: ``pid``, ``hinf`` or ``mu`` (designed on the rig by
     :func:`ambseal.design.recipes.design` at ``pressure_bar``), or a controller file of
-    ``ambseal design`` (.json, .npz, .mat); ``None`` or ``"none"`` for the open loop."""
+    ``ambseal design`` (.json, .npz, .mat) — its kind checked and wired to the rig's
+    channels by signal name (:func:`~ambseal.export.controller_files.load_controller`);
+    ``None`` or ``"none"`` for the open loop."""
     if spec is None or spec == "none":
         return None
 
@@ -56,7 +65,7 @@ def controller_for(cfg, spec: str | None, pressure_bar: float | None = None):
         raise ConfigError(f"--controller: expected pid, hinf, mu, none or a controller file "
                           f"(.json, .npz, .mat), got {spec!r}")
 
-    K = load_controller(spec)  # a judged digital controller: its continuous design
+    K = load_controller(spec, channel_names(cfg))  # a judged digital one: its continuous design
     return K.continuous if isinstance(K, DigitalController) else K
 
 
@@ -171,6 +180,8 @@ def _campbell(args: argparse.Namespace) -> int:
     speeds = _range(args.speed_hz, "--speed-hz", *_SPEEDS)
     spec = args.controller or ("pid" if cfg.controller.pid is not None and cfg.amb else
                                "hinf" if cfg.amb else None)
+    if args.scheduler is not None:  # before any design: an address that never answers
+        probe_scheduler(args.scheduler)
     K = controller_for(cfg, spec, p)
     c = campbell(cfg, K, speeds, pressure_bar=p,
                  max_hz=args.max_hz, log_dec_limit=args.log_dec_limit, workers=args.workers,
@@ -205,15 +216,21 @@ def _sweep(args: argparse.Namespace) -> int:
     speeds = (_range(args.speed_hz, "--speed-hz", *_SPEEDS) if args.speed_hz is not None
               else list(spec.stability_speeds_hz))
     specs = (args.controller or "pid").split(",")
-    params = {}
+    params, known = {}, rig_parameter_names(cfg)
     for text in args.param or []:
         name, sep, rng = text.partition("=")
         if not sep:
             raise ConfigError(f"--param: expected NAME=a:b:n, got {text!r}")
-        params[name.strip()] = _range(rng, f"--param {name}", -MAX_COEFFICIENT,
-                                      MAX_COEFFICIENT, "the bound of a force coefficient")
+        name = name.strip()
+        if name not in known:  # before any design: a misspelt name would fail every case
+            raise ConfigError(f"--param: unknown parameter {name!r}; the rig's parameters "
+                              f"are {', '.join(known)}")
+        params[name] = _range(rng, f"--param {name}", -MAX_COEFFICIENT,
+                              MAX_COEFFICIENT, "the bound of a force coefficient")
     check_cases(len(specs) * len(pressures) * len(speeds)
                 * math.prod(len(v) for v in params.values()), "sweep")  # before any design
+    if args.scheduler is not None:  # likewise: an address that never answers
+        probe_scheduler(args.scheduler)
     ctrl = {Path(s).stem: controller_for(cfg, s, cfg.operating.pressure_bar) for s in specs}
     if any(K is None for K in ctrl.values()):
         raise ConfigError("sweep: every --controller must be a controller (pid, hinf, mu or "

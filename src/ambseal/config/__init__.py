@@ -9,7 +9,9 @@ layer receives the typed models from here.
 """
 
 from ambseal.config._checks import (
+                                    MAX_AMBS,
                                     MAX_COEFFICIENT,
+                                    MAX_COMPONENTS,
                                     MAX_CURRENT_A,
                                     MAX_DELAY_SAMPLES,
                                     MAX_ELEMENTS,
@@ -36,12 +38,13 @@ from ambseal.config.rig import (
                                     load_rig,
                                     load_truth,
                                     parse_rig,
+                                    rig_parameter_names,
                                     rig_with_values,
 )
 
-__all__ = ["MAX_COEFFICIENT", "MAX_CURRENT_A", "MAX_DELAY_SAMPLES", "MAX_ELEMENTS",
+__all__ = ["MAX_AMBS", "MAX_COEFFICIENT", "MAX_COMPONENTS", "MAX_CURRENT_A", "MAX_DELAY_SAMPLES", "MAX_ELEMENTS",
            "MAX_FREQUENCY_HZ", "MAX_GAP_M", "MAX_PRESSURE_BAR", "MAX_SPEED_HZ",
            "Actuator", "Affine", "Amb", "AxisPair", "Coefficient", "FrequencyTable",
            "RigConfig", "Seal", "Spring", "TruthSection", "apply_overrides",
            "check_operating", "default_rig_path", "dump_rig", "load_rig", "load_truth",
-           "parse_rig", "rig_with_values"]
+           "parse_rig", "rig_parameter_names", "rig_with_values"]

@@ -11,7 +11,7 @@ from pydantic import Field
 
 from ambseal.errors import LABEL_PATTERN, NAME_PATTERN, ConfigError
 
-__all__ = ["MAX_ELEMENTS", "MAX_LAYERS", "MAX_REDUCED_STATES", "MAX_COEFFICIENT",
+__all__ = ["MAX_ELEMENTS", "MAX_COMPONENTS", "MAX_AMBS", "MAX_LAYERS", "MAX_REDUCED_STATES", "MAX_COEFFICIENT",
            "MAX_FREQUENCY_HZ", "MAX_SPEED_HZ", "MAX_PRESSURE_BAR", "MAX_CURRENT_A", "MAX_GAP_M",
            "MAX_DELAY_SAMPLES", "MAX_RELATIVE", "BoundedCoefficient",
            "BoundedFrequency", "check_amb", "check_actuator", "cross_check", "Name", "Label"]
@@ -33,6 +33,14 @@ Label = Annotated[str, Field(min_length=1, max_length=200, pattern=LABEL_PATTERN
 #: elements 4.6 s and 14 s. 400 elements (L/400 per element) resolve a long rotor's modes
 #: of interest and a mesh-convergence check of a shorter one.
 MAX_ELEMENTS = 400
+#: Shaft sections, disks, seals and springs of a rig, at most of each: every one puts a node
+#: (a section at least one element) into the mesh, whose elements in all are bounded by
+#: ``MAX_ELEMENTS`` (``ambseal.model.rotor.build_mesh`` checks the mesh they make).
+MAX_COMPONENTS = MAX_ELEMENTS
+#: Magnetic bearings of a rig, at most: each adds two channels to every controller
+#: synthesis and judged loop (H∞ and μ grow with the cube of the channels); machines carry
+#: two to five radial AMBs.
+MAX_AMBS = 16
 #: Concentric layers on one shaft section, at most (a shaft, a sleeve and a hub is three;
 #: more only splits one tube into rings).
 MAX_LAYERS = 8

@@ -301,9 +301,14 @@ def apply_overrides(data: dict, overrides, where: str = "--set") -> dict:
     Raises
     ------
     ConfigError
-        An override without ``=``, outside ``design.``, or through a key that is not a table.
+        An override without ``=``, outside ``design.``, through a key that is not a table,
+        or holding a newline or another control character (TOML would read the first line
+        only and drop the rest).
     """
     for text in overrides:
+        if any(ord(c) < 32 or ord(c) == 127 for c in str(text)):
+            raise ConfigError(f"{where} {str(text)[:80]!r}: expected design.<key>=<value> on "
+                              "one line, got a newline or another control character")
         key, eq, raw = str(text).partition("=")
         key = key.strip()
         path = key.split(".")

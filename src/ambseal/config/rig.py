@@ -71,6 +71,8 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from ambseal.config._checks import (
+    MAX_AMBS,
+    MAX_COMPONENTS,
     MAX_CURRENT_A,
     MAX_DELAY_SAMPLES,
     MAX_ELEMENTS,
@@ -104,6 +106,7 @@ __all__ = [
     "TruthSection",
     "load_truth",
     "rig_with_values",
+    "rig_parameter_names",
     "dump_rig",
 ]
 
@@ -368,12 +371,12 @@ class RigConfig(_Strict):
 
     rotor: Rotor = Rotor()
     materials: dict[Name, Material]
-    shaft: list[ShaftSection] = Field(min_length=1)
-    disk: list[Disk] = []
-    amb: list[Amb] = []
+    shaft: list[ShaftSection] = Field(min_length=1, max_length=MAX_COMPONENTS)
+    disk: list[Disk] = Field(default=[], max_length=MAX_COMPONENTS)
+    amb: list[Amb] = Field(default=[], max_length=MAX_AMBS)
     actuator: Actuator = Actuator()
-    seal: list[Seal] = []
-    spring: list[Spring] = []
+    seal: list[Seal] = Field(default=[], max_length=MAX_COMPONENTS)
+    spring: list[Spring] = Field(default=[], max_length=MAX_COMPONENTS)
     controller: Controllers = Controllers()
     operating: Operating = Operating()
     reduction: Reduction = Reduction()
@@ -585,6 +588,33 @@ def load_truth(path: str | Path) -> TruthSection:
         raise ConfigError(f"{p}: {_describe(exc)}") from None
 
 
+def rig_parameter_names(cfg: RigConfig) -> tuple[str, ...]:
+    """The names :func:`rig_with_values` accepts for this rig, in the rig file's order.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig.
+
+    Returns
+    -------
+    tuple of str
+        ``{amb}.Ki_zeta``, ``{amb}.Ki_eta``, ``{amb}.Ks_zeta``, ``{amb}.Ks_eta`` per AMB,
+        ``{spring}.kxx`` … ``{spring}.cyy`` per spring, ``{seal}.K``, ``.k``, ``.C``, ``.c``
+        per seal, and ``tau_e``.
+    """
+    names = [f"{a.name}.{k}_{ax}" for a in cfg.amb for k in ("Ki", "Ks")
+             for ax in ("zeta", "eta")]
+    names += [f"{s.name or f'spring{i}'}.{k}" for i, s in enumerate(cfg.spring)
+              for k in _SPRING_KEYS]
+    names += [f"{s.name}.{k}" for s in cfg.seal for k in _SEAL_KEYS]
+    return (*names, "tau_e")
+
+
+_SPRING_KEYS = ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy")
+_SEAL_KEYS = ("K", "k", "C", "c")
+
+
 def rig_with_values(cfg: RigConfig, values: dict[str, Coefficient]) -> RigConfig:
     """The rig with named model parameters set (SI), e.g. identified values.
 
@@ -626,12 +656,13 @@ def rig_with_values(cfg: RigConfig, values: dict[str, Coefficient]) -> RigConfig
                 old = amb.get(slot)
                 amb[slot] = {} if old is None else {"zeta": old, "eta": old}
             amb[slot][key[3:]] = v
-        elif owner in springs and key in ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy"):
+        elif owner in springs and key in _SPRING_KEYS:
             springs[owner][key] = v
-        elif owner in seals and key in ("K", "k", "C", "c"):
+        elif owner in seals and key in _SEAL_KEYS:
             seals[owner][key] = v
         else:
-            raise ConfigError(f"rig parameters: unknown parameter {name!r}")
+            raise ConfigError(f"rig parameters: unknown parameter {name!r} (expected one of "
+                              f"{', '.join(rig_parameter_names(cfg))})")
     return parse_rig(data, "<identified rig>")
 
 

@@ -38,6 +38,7 @@ and generated C: a file whose names are not plain labels (:data:`LABEL`) is refu
 from __future__ import annotations
 
 import json
+import math
 import re
 import warnings
 import zipfile
@@ -48,11 +49,11 @@ import numpy as np
 from scipy.io import savemat
 
 from ambseal.config import MAX_DELAY_SAMPLES, MAX_FREQUENCY_HZ
-from ambseal.errors import DataError
-from ambseal.files import atomic_write
+from ambseal.errors import AmbsealError, DataError
+from ambseal.files import atomic_write, input_file
 from ambseal.identify.matlab_file import read_matlab
 from ambseal.robust.controller import SPEED
-from ambseal.robust.digital import DigitalController
+from ambseal.robust.digital import DigitalController, discretize_as
 from ambseal.robust.digital_loop import DiscreteController
 from ambseal.robust.scheduled_digital import ScheduledDigital
 
@@ -209,6 +210,10 @@ def _read(path: Path) -> dict:
     if suffix not in _FORMATS:
         raise DataError(f"{path}: unknown controller format {suffix!r}, expected one of "
                         f"{_FORMATS}")
+    try:  # a device, a FIFO or a file beyond any controller: refused before reading
+        input_file(path, "controller file")
+    except AmbsealError as exc:
+        raise DataError(str(exc)) from None
     if suffix == ".mat":  # in a child process: scipy's reader can crash on a malformed file
         m = read_matlab(path, squeeze_me=False, chars_as_strings=True)
     try:
@@ -277,13 +282,19 @@ def _finite_arrays(arrays: dict, path: Path) -> None:
             raise DataError(f"{path}: {k}: expected finite numbers, got NaN or inf")
 
 
-def _continuous(doc: dict, path: Path):
-    """A continuous controller file back to a ``control.StateSpace``, shapes checked; a
-    file with neither ``inputs`` nor ``outputs`` gets python-control's ``u[i]``, ``y[i]``
-    and a warning that it will be connected by position."""
+def _continuous(doc: dict, path: Path, channels):
+    """A continuous controller file back to a ``control.StateSpace``, shapes checked and
+    wired to ``channels`` (:func:`_wiring`); without ``channels``, a file with neither
+    ``inputs`` nor ``outputs`` gets python-control's ``u[i]``, ``y[i]`` and a warning that
+    it will be connected by position."""
 
+    ts = np.ravel(np.asarray(doc.get("Ts", 0.0), float))
+    if ts.size != 1 or ts[0] != 0:
+        raise DataError(f"{path}: kind 'continuous' with Ts = {ts.tolist()}: a continuous "
+                        "controller has Ts = 0 (a discrete one is written with kind 'fixed' "
+                        "or 'scheduled', its sample rate and method)")
     try:
-        if "inputs" not in doc and "outputs" not in doc:
+        if "inputs" not in doc and "outputs" not in doc and channels is None:
             D = np.atleast_2d(np.asarray(doc["D"], float))
             doc = {**doc, "inputs": [f"u[{j}]" for j in range(D.shape[1])],
                    "outputs": [f"y[{j}]" for j in range(D.shape[0])]}
@@ -307,16 +318,95 @@ def _continuous(doc: dict, path: Path):
     if n == 0:
         A, B, C = np.zeros((0, 0)), np.zeros((0, len(ins))), np.zeros((len(outs), 0))
     name = _name(doc.get("name", "K"), "name", path)
+    if channels is not None:
+        arr = _wired(dict(zip("ABCD", (A, B, C, D))), ("",), _wiring(ins, outs, channels, path))
+        A, B, C, D = (arr[k] for k in "ABCD")
+        ins, outs = _signals(channels)
     return control.ss(A, B, C, D, inputs=ins, outputs=outs, name=name)
 
 
-def load_controller(path):
-    """Read a controller written by :func:`export_controller` (any format).
+def _signals(channels) -> tuple[list[str], list[str]]:
+    """A rig controller's inputs (the sensors ``y_<channel>``) and outputs (the currents
+    ``i_<channel>``), in the rig's channel order."""
+    return [f"y_{c}" for c in channels], [f"i_{c}" for c in channels]
+
+
+def _wiring(ins: list, outs: list, channels, path: Path) -> tuple[list[int], list[int]]:
+    """The columns and rows that put a file's inputs and outputs in the order of the rig's
+    ``channels``, matched by name; DataError naming the file and both sets of signals when
+    they are not the same set (a missing, extra, repeated or renamed channel)."""
+    want_in, want_out = _signals(channels)
+    if sorted(ins) != sorted(want_in) or sorted(outs) != sorted(want_out):
+        raise DataError(f"{path}: its channels are not the rig's (a controller file is wired "
+                        f"by signal name): inputs {list(ins)}, outputs {list(outs)}; the rig "
+                        f"has inputs {want_in}, outputs {want_out}")
+    return [ins.index(n) for n in want_in], [outs.index(n) for n in want_out]
+
+
+def _wired(arr: dict, suffixes, wiring) -> dict:
+    """``arr``'s ``B, C, D`` (with each suffix; table stacks on the leading axis) with
+    their columns and rows in the rig's order (:func:`_wiring`)."""
+    i, o = wiring
+    out = dict(arr)
+    for suf in suffixes:
+        out["B" + suf] = arr["B" + suf][..., :, i]
+        out["C" + suf] = arr["C" + suf][..., o, :]
+        out["D" + suf] = arr["D" + suf][..., o, :][..., :, i]
+    return out
+
+
+#: How closely a discrete controller's matrices must equal the discretisation its file
+#: states (method, sample time, pre-warp) of its own continuous ``A_r … D_r``, relative to
+#: the largest entry: the file holds them as written (JSON's shortest repr, .npz and .mat
+#: doubles), so only the rounding of recomputing them separates the two.
+_KIND_RTOL = 1e-6
+
+
+def _check_kind(arr: dict, method: str, fs: float, prewarp_hz, ts, path: Path) -> None:
+    """DataError unless the file's discrete ``A … D`` are the ``method`` discretisation at
+    ``1/fs`` of its continuous ``A_r … D_r`` (entry by entry of a table), and its ``Ts``
+    (when given) is ``1/fs``: a continuous controller marked discrete, or one discretised
+    at another rate, is refused before it reaches a target."""
+    T = 1.0 / fs
+    if ts is not None and not math.isclose(ts, T, rel_tol=1e-9):
+        raise DataError(f"{path}: Ts = {ts:.9g} s but sample_rate_hz = {fs:.9g} Hz (1/Ts = "
+                        f"{1.0 / ts if ts else math.inf:.9g} Hz): expected Ts = 1/sample_rate_hz")
+    stacked = arr["A"].ndim == 3
+    cont = [tuple(arr[k + "_r"][j] if stacked else arr[k + "_r"] for k in "ABCD")
+            for j in range(arr["A"].shape[0] if stacked else 1)]
+    for j, mats in enumerate(cont):
+        try:  # a static gain (no states) is its own discretisation by every method
+            want = mats if mats[0].size == 0 else discretize_as(mats, T, method, prewarp_hz)
+        except AmbsealError as exc:
+            raise DataError(f"{path}: method: {exc}") from None
+        got = [arr[k][j] if stacked else arr[k] for k in "ABCD"]
+        scale = max([1.0] + [float(np.max(np.abs(X))) for X in want if X.size])
+        worst = max((float(np.max(np.abs(g - w))) for g, w in zip(got, want) if w.size),
+                    default=0.0)
+        if worst > _KIND_RTOL * scale:
+            rho = float(np.max(np.abs(np.linalg.eigvals(got[0])), initial=0.0))
+            at = f" (table entry {j})" if stacked else ""
+            raise DataError(f"{path}: its discrete A, B, C, D{at} are not the {method} "
+                            f"discretisation at Ts = {T:.6g} s of its continuous A_r ... D_r "
+                            f"(largest difference {worst:.3g}; spectral radius of A "
+                            f"{rho:.4g}): the file's kind does not match its matrices (a "
+                            "continuous controller marked discrete, or another sample rate?)")
+
+
+def load_controller(path, channels=None):
+    """Read a controller written by :func:`export_controller` (any format), check that its
+    stated kind matches its matrices and, given the rig's ``channels``, wire it to them by
+    signal name.
 
     Parameters
     ----------
     path : str or os.PathLike
         A ``.json``, ``.npz`` or ``.mat`` file; the suffix says which.
+    channels : sequence of str, optional
+        The rig's AMB channels in its order (:func:`ambseal.model.amb.channel_names`): the
+        controller's inputs must be ``y_<channel>`` and its outputs ``i_<channel>``, in any
+        order; they come back in the rig's order (columns and rows permuted). Without
+        them the file's order is kept.
 
     Returns
     -------
@@ -330,11 +420,15 @@ def load_controller(path):
     DataError
         Whatever is wrong with the file, in every format, naming it and the problem: not
         readable (truncated, not UTF-8, nested too deeply, MATLAB v7.3), not a document of
-        keys, a missing key, a value of the wrong type or shape (named), a NaN or inf.
+        keys, a missing key, a value of the wrong type or shape (named), a NaN or inf;
+        a kind its matrices contradict (a continuous controller marked discrete: its
+        discrete matrices are not its stated discretisation of its continuous ones, or
+        ``Ts`` is not ``1/sample_rate_hz``; or ``Ts`` ≠ 0 on a continuous one); signals
+        that are not the rig's ``channels`` (the message lists both).
     """
     path = Path(path)
     try:
-        return _load(path)
+        return _load(path, None if channels is None else tuple(channels))
     except (TypeError, ValueError, KeyError, IndexError, AttributeError, OverflowError,
             RecursionError) as exc:  # a value of a type no check above foresaw
         if isinstance(exc, DataError):
@@ -343,12 +437,12 @@ def load_controller(path):
                         f"{exc})") from None
 
 
-def _load(path: Path):
+def _load(path: Path, channels):
     """:func:`load_controller` without its last net for unforeseen values."""
 
     doc = _read(path)
     if str(doc.get("kind", "continuous")) == "continuous":
-        return _continuous(doc, path)
+        return _continuous(doc, path, channels)
     try:
         kind, name = str(doc["kind"]), _name(doc["name"], "name", path)
         ins, outs = _names(doc["inputs"], "inputs", path), _names(doc["outputs"], "outputs", path)
@@ -360,6 +454,9 @@ def _load(path: Path):
     except (KeyError, TypeError, ValueError, IndexError) as exc:
         raise DataError(f"{path}: not a controller file of ambseal ({exc!r})") from None
     doc["inputs"], doc["outputs"] = ins, outs
+    if kind not in ("fixed", "scheduled"):
+        raise DataError(f"{path}: kind: {kind[:60]!r}, expected 'continuous', 'fixed' or "
+                        "'scheduled'")
     if not (0 < fs <= MAX_FREQUENCY_HZ) or not 0 <= delay <= MAX_DELAY_SAMPLES \
             or not isinstance(meta, dict):
         raise DataError(f"{path}: sample_rate_hz = {fs:.6g}, delay_samples = {delay:.6g}, "
@@ -369,6 +466,11 @@ def _load(path: Path):
     pw = pw if np.isfinite(pw) else None
     cands = tuple(meta.get("candidates", ()))
     arr = _arrays(doc, path, stacked=(kind == "scheduled"))
+    ts = float(np.ravel(doc["Ts"])[0]) if "Ts" in doc else None
+    _check_kind(arr, method, fs, pw, ts, path)
+    if channels is not None:
+        arr = _wired(arr, ("", "_c", "_r"), _wiring(ins, outs, channels, path))
+        ins, outs = _signals(channels)
     if kind == "scheduled":
         par = _name(doc.get("parameter", SPEED), "parameter", path)
         key = "grid" if "grid" in doc else "speeds_rad_s"

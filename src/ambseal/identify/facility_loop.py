@@ -14,12 +14,13 @@ go through BLAS in both), so records agree with the interpreted loop to rounding
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from ambseal.lti.compiled import cached_njit
 
 __all__ = ["facility_loop"]
 
 
-@njit(cache=True, nogil=True)
+@cached_njit(nogil=True)
 def facility_loop(Phi, Gam, seg_start, C_all, D_coil, D_ieff, Ac, Bc, Cc, Dc, e, noise, inoise,
                   lsb, limit, i0, s0, kf, ki, ks, substeps, lp_a, z, xc, yf, rec_y, rec_i,
                   rec_ref):

@@ -15,7 +15,8 @@ import json
 import math
 from pathlib import Path
 
-from ambseal.errors import DataError
+from ambseal.errors import AmbsealError, DataError
+from ambseal.files import read_text
 
 __all__ = ["uncertainty_from_fit"]
 
@@ -49,9 +50,9 @@ def uncertainty_from_fit(path: str | Path, names=None) -> dict[str, tuple[float,
     """
     p = Path(path)
     try:
-        fit = json.loads(p.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise DataError(f"{p}: cannot read identification ({exc.strerror or exc})") from None
+        fit = json.loads(read_text(p, "identification"))
+    except AmbsealError as exc:  # missing, not a regular file, too large, not UTF-8
+        raise DataError(str(exc)) from None
     except json.JSONDecodeError as exc:
         raise DataError(f"{p}: not valid JSON ({exc.msg}, line {exc.lineno})") from None
     params = fit.get("parameters") if isinstance(fit, dict) else None

@@ -23,7 +23,8 @@ from pathlib import Path
 import numpy as np
 import scipy.io
 
-from ambseal.errors import DataError
+from ambseal.errors import AmbsealError, DataError
+from ambseal.files import input_file
 
 __all__ = ["read_matlab", "READ_TIMEOUT_S"]
 
@@ -80,10 +81,15 @@ def read_matlab(path: str | Path, timeout_s: float = READ_TIMEOUT_S,
     Raises
     ------
     DataError
-        MATLAB v7.3 (HDF5), an unreadable or malformed file, or a reader that crashed or
-        ran past ``timeout_s``; the message names the file.
+        MATLAB v7.3 (HDF5), an unreadable or malformed file, not a regular file or one
+        above :data:`ambseal.files.MAX_READ_BYTES`, or a reader that crashed or ran past
+        ``timeout_s``; the message names the file.
     """
 
+    try:  # a device, a FIFO or a file beyond any record: refused before the child reads it
+        input_file(path, "MATLAB file")
+    except AmbsealError as exc:
+        raise DataError(str(exc)) from None
     method = "fork" if sys.platform.startswith("linux") else "spawn"  # fork is unsafe on macOS
     ctx = multiprocessing.get_context(method)
     recv, send = ctx.Pipe(duplex=False)

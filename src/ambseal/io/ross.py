@@ -53,7 +53,9 @@ import ctypes
 import json
 import math
 import os
+import subprocess
 import sys
+import tempfile
 import tomllib
 import warnings
 from dataclasses import dataclass
@@ -64,13 +66,18 @@ from pydantic import ValidationError
 
 from ambseal.config import RigConfig, dump_rig, parse_rig
 from ambseal.config.rig import Pid
-from ambseal.errors import ConfigError
-from ambseal.files import write_text
+from ambseal.errors import AmbsealError, ConfigError
+from ambseal.files import read_text, write_text
 
-__all__ = ["RossImport", "from_ross", "load_ross", "import_ross_file", "ROSS_TESTED"]
+__all__ = ["RossImport", "from_ross", "load_ross", "import_ross_file", "ROSS_TESTED",
+           "ROSS_TIMEOUT_S"]
 
 #: The ROSS version the importer is tested with.
 ROSS_TESTED = "2.3"
+#: The longest :func:`import_ross_file`'s child process may take (s): importing ROSS takes
+#: 10–20 s on a 2-core machine, loading and mapping a rotor of hundreds of elements a few
+#: seconds more.
+ROSS_TIMEOUT_S = 300.0
 
 _COEFFS = ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy", "cxy", "cyx", "mxx", "myy", "mxy", "myx")
 #: The keys of a saved ROSS AMB beyond a bearing's (ROSS 2.3 ``MagneticBearingElement``).
@@ -432,9 +439,27 @@ def _stdout_to_stderr():
         os.close(saved)
 
 
+@contextlib.contextmanager
+def _no_refprop_from_cwd():
+    """ccp (imported by ROSS) loads REFPROP's ``librefprop.so`` from ``RPPREFIX``, else from
+    the working directory: unless the user set ``RPPREFIX``, point it at an empty folder
+    while ccp is imported, so that a library planted in the working directory is not
+    loaded (ambseal needs no REFPROP)."""
+    if "RPPREFIX" in os.environ or "ccp" in sys.modules:
+        yield
+        return
+    with tempfile.TemporaryDirectory(prefix="ambseal-norefprop-") as empty:
+        os.environ["RPPREFIX"] = empty
+        try:
+            yield
+        finally:
+            os.environ.pop("RPPREFIX", None)
+
+
 def _ross():
-    """The ``ross`` module, imported with its import chatter kept off stdout."""
-    with _stdout_to_stderr(), warnings.catch_warnings():
+    """The ``ross`` module, imported with its import chatter kept off stdout and no REFPROP
+    library taken from the working directory."""
+    with _stdout_to_stderr(), warnings.catch_warnings(), _no_refprop_from_cwd():
         warnings.simplefilter("ignore")
         try:
             import ross  # optional: the [ross] extra
@@ -448,6 +473,10 @@ def load_ross(path: str | Path):
     """``ross.Rotor.load(path)`` with ROSS's import chatter kept off stdout and its AMBs
     restored (ROSS 2.3 saves a ``MagneticBearingElement`` as a bearing table with the AMB's
     keys and loads it back as a plain ``BearingElement``).
+
+    ROSS is imported in this process (with ccp's REFPROP folder away from the working
+    directory, :func:`_ross`); :func:`import_ross_file` runs the whole import in a child
+    process in an empty folder instead, which is what ``ambseal import-ross`` does.
 
     Parameters
     ----------
@@ -499,14 +528,16 @@ def _restore_ambs(rotor, data: dict, ross) -> None:
                     seq[j] = mb
 
 
-def _check_file(path: Path, ross) -> dict:
+def _check_file(path: Path, ross=None) -> dict:
     """The file's tables, with clear errors for what ROSS's own loader reports obscurely:
-    not a rotor file, an element class ROSS does not have, a shaft element without its
-    material."""
+    not a rotor file, an element class ROSS does not have (checked given ``ross``), a
+    shaft element without its material."""
 
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_text(path, "ROSS rotor file")
         data = json.loads(text) if path.suffix.lower() == ".json" else tomllib.loads(text)
+    except AmbsealError as exc:
+        raise ConfigError(str(exc)) from None
     except (OSError, ValueError) as exc:
         raise ConfigError(f"{path}: not a ROSS rotor file ({exc})") from None
     if not isinstance(data, dict) or not isinstance(data.get("parameters"), dict):
@@ -515,7 +546,7 @@ def _check_file(path: Path, ross) -> dict:
         if key in ("parameters", "ross_version") or key.startswith("_"):
             continue
         kind = key.split("_")[0]
-        if not hasattr(ross, kind) or not isinstance(val, dict):
+        if (ross is not None and not hasattr(ross, kind)) or not isinstance(val, dict):
             raise ConfigError(f"{path}: {key}: unsupported element {kind!r} (not a ROSS "
                               "element class)")
         if kind == "ShaftElement" and not isinstance(val.get("material"), dict):
@@ -524,9 +555,61 @@ def _check_file(path: Path, ross) -> dict:
     return data
 
 
+def _child() -> None:
+    """The ROSS import of :func:`_in_clean_process`, run as the child's program: argv is
+    the file (absolute), its name for messages, the speed (JSON) and the result file."""
+    path, where, out = Path(sys.argv[1]), sys.argv[2], Path(sys.argv[4])
+    try:
+        rotor = load_ross(path)
+        res = from_ross(rotor, where=where, speed_rpm=json.loads(sys.argv[3]))
+        doc = {"rig": res.rig.model_dump(exclude_none=True), "unmapped": list(res.unmapped),
+               "notes": list(res.notes), "ross_version": str(_ross().__version__)}
+    except AmbsealError as exc:  # the user's name of the file, not the absolute one
+        doc = {"error": str(exc).replace(str(path), where, 1)}
+    out.write_text(json.dumps(doc, allow_nan=False), encoding="utf-8")
+
+
+def _in_clean_process(path: Path, speed_rpm: float | None) -> dict:
+    """Load and map a ROSS file in a child process whose working directory is a new, empty
+    folder: importing ROSS imports ccp, which loads ``librefprop.so`` (REFPROP) from the
+    working directory — a library planted beside the user's files would run as code.
+    The child gets the file's absolute path, no script folder on ``sys.path`` (``-P``) and
+    ``RPPREFIX`` (ccp's REFPROP folder) set to the empty folder; its output (ROSS's
+    chatter) is dropped. Returns the child's result: the rig as a dict, ``unmapped``,
+    ``notes`` and ``ross_version``."""
+    root = str(Path(__file__).resolve().parents[2])  # the folder ambseal is imported from
+    with tempfile.TemporaryDirectory(prefix="ambseal-ross-") as tmp:
+        empty, result = Path(tmp) / "cwd", Path(tmp) / "result.json"
+        empty.mkdir()
+        env = {**os.environ, "RPPREFIX": str(empty), "OPENBLAS_NUM_THREADS": "1",
+               "PYTHONPATH": os.pathsep.join([root] + [p for p in [os.environ.get(
+                   "PYTHONPATH")] if p])}
+        cmd = [sys.executable, "-P", "-c", "from ambseal.io.ross import _child; _child()",
+               str(path.resolve()), str(path), json.dumps(speed_rpm), str(result)]
+        try:
+            proc = subprocess.run(cmd, cwd=empty, env=env, stdin=subprocess.DEVNULL,
+                                  capture_output=True, text=True, errors="replace",
+                                  timeout=ROSS_TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            raise ConfigError(f"{path}: the ROSS import took more than {ROSS_TIMEOUT_S:g} s"
+                              ) from None
+        if proc.returncode != 0 or not result.is_file():
+            last = (proc.stderr.strip().splitlines() or ["no message"])[-1]
+            raise ConfigError(f"{path}: the ROSS import failed (exit status "
+                              f"{proc.returncode}: {last[:300]})")
+        doc = json.loads(result.read_text(encoding="utf-8"))
+    if "error" in doc:
+        raise ConfigError(str(doc["error"]))
+    return doc
+
+
 def import_ross_file(path: str | Path, out: str | Path, *,
                      speed_rpm: float | None = None) -> dict:
     """``ambseal import-ross``: read a ROSS rotor file, write the rig (TOML) to ``out``.
+
+    ROSS is imported in a child process in an empty working directory
+    (:func:`_in_clean_process`): nothing in the user's working directory or the file's
+    folder is loaded as code. The checks that need no ROSS run first, in this process.
 
     Parameters
     ----------
@@ -548,12 +631,20 @@ def import_ross_file(path: str | Path, out: str | Path, *,
     Raises
     ------
     ConfigError
-        As :func:`load_ross` and :func:`from_ross`.
+        As :func:`load_ross` and :func:`from_ross`, or the child process failed or ran
+        past :data:`ROSS_TIMEOUT_S`.
     """
-    rotor = load_ross(path)
-    res = from_ross(rotor, where=str(path), speed_rpm=speed_rpm)
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"{path}: no such ROSS rotor file")
+    if path.suffix.lower() not in (".toml", ".json"):
+        raise ConfigError(f"{path}: expected a ROSS rotor file (.toml or .json)")
+    _check_file(path)  # before ROSS's import: a file that is no rotor, a missing material
+    doc = _in_clean_process(path, speed_rpm)
+    res = RossImport(parse_rig(doc["rig"], str(path)), tuple(doc["unmapped"]),
+                     tuple(doc["notes"]))
     header = (f"Imported by ambseal from the ROSS rotor file {path} "
-              f"(ROSS {_ross().__version__})"
+              f"(ROSS {doc['ross_version']})"
               + "".join(f"\nnot imported: {n}" for n in res.unmapped)
               + "".join(f"\ntaken: {n}" for n in res.notes))
     write_text(out, dump_rig(res.rig, header))

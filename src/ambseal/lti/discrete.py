@@ -21,9 +21,9 @@ from typing import Any
 import control
 import numpy as np
 import scipy.linalg as sla
-from numba import njit
 
 from ambseal.errors import ModelError
+from ambseal.lti.compiled import cached_njit
 from ambseal.lti.matrices import ArrayMemo
 
 __all__ = ["zoh", "discretize", "simulate_lti"]
@@ -193,7 +193,7 @@ def _lags(L: int) -> np.ndarray:
     return lag
 
 
-@njit(cache=True, nogil=True)
+@cached_njit(nogil=True)
 def _powers(A: np.ndarray, B: np.ndarray, C: np.ndarray, L: int):  # pragma: no cover - compiled
     """``C A^j`` (L, p, n) and ``A^j B`` (L, n, m) for j < L, each from the previous by one
     BLAS product (compiled: in Python the 2L small products cost more in calls than in
@@ -208,7 +208,7 @@ def _powers(A: np.ndarray, B: np.ndarray, C: np.ndarray, L: int):  # pragma: no 
     return CA, AB
 
 
-@njit(cache=True, nogil=True)
+@cached_njit(nogil=True)
 def _block_states(AL: np.ndarray, drive: np.ndarray, b0: int) -> np.ndarray:  # pragma: no cover - compiled
     """States at the block starts ``b ≥ b0``, ``Z[b+1] = AL Z[b] + drive[b]`` from
     ``Z[0] = 0``: the one sequential part of :func:`simulate_lti`, compiled (numba) because

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from ambseal.config import RigConfig
-from ambseal.errors import ModelError
+from ambseal.config import MAX_ELEMENTS, RigConfig
+from ambseal.errors import ConfigError, ModelError
 from ambseal.model.fe import BeamElement, DiskElement, LayeredBeam
 
 __all__ = ["Mesh", "build_mesh", "RotorMatrices", "assemble_rotor", "dof"]
@@ -124,6 +124,13 @@ def build_mesh(cfg: RigConfig, extra_positions: tuple[float, ...] = ()) -> Mesh:
             z_nodes.append(p)
             left = p
         z0 = z1
+        if len(elements) > MAX_ELEMENTS:  # before any matrix: a dense model would not fit
+            raise ConfigError(
+                f"shaft: the mesh has more than {MAX_ELEMENTS} beam elements (the sections' "
+                f"{sum(s.elements for s in cfg.shaft)} elements, split at each of "
+                f"{len(set(positions))} component positions): at most {MAX_ELEMENTS}, the "
+                "rig file's bound; use fewer elements or place components on element "
+                "boundaries")
     return Mesh(z=np.asarray(z_nodes), elements=tuple(elements))
 
 

@@ -16,7 +16,8 @@ Reference: Glover & Doyle (1988), Thm 3.1 (general D11 form); Zhou, Doyle & Glov
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from ambseal.lti.compiled import cached_njit
 
 __all__ = ["small_margin"]
 
@@ -27,7 +28,7 @@ __all__ = ["small_margin"]
 _MAX_BASIS_COND = 1e6
 
 
-@njit(cache=True)
+@cached_njit()
 def _game_riccati(A, B, C1, D1, nw, g):
     """``(X, status)``: the stabilising X ⪰ 0 of the H∞ game Riccati equation (as
     :func:`ambseal.robust._hinf_gamma.game_riccati`) from the Hamiltonian's stable
@@ -79,7 +80,7 @@ def _game_riccati(A, B, C1, D1, nw, g):
     return X, 0
 
 
-@njit(cache=True)
+@cached_njit()
 def small_margin(A, B, C, D, nw, nz, g):
     """``ρ(X∞Y∞)/γ² − 1`` (< 0: γ admissible), +1 when X∞ ⪰ 0 or Y∞ ⪰ 0 does not exist,
     NaN when the eigenvector method cannot decide (:func:`_game_riccati`, status 2):

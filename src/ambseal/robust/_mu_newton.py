@@ -6,7 +6,7 @@ numpy form it replaced (Boyd & El Ghaoui 1993; Nesterov & Nemirovskii 1994 §2.1
 damped step), one matrix at a time: the stacks it runs on are mostly a few matrices (the
 finer levels of the frequency continuation and the last unconverged frequencies), where
 numpy's per-call overhead, not the 14 × 14 arithmetic, set the time. Compiled on first use
-and cached in ``__pycache__`` (``cache=True``).
+and cached on disk where a cache folder is writable (:mod:`ambseal.lti.compiled`).
 
 The barrier of the level t is
 ``φ(z) = −log det L(z) − Σ_blocks log det D_k(z) − log det(gmax I − G) − log det(gmax I + G)``
@@ -17,12 +17,13 @@ with ``L = t D − A`` affine in z; a term ``−log det Y`` with derivatives ``Y
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from ambseal.lti.compiled import cached_njit
 
 __all__ = ["gevp", "newton_steps"]
 
 
-@njit(cache=True)
+@cached_njit()
 def _chol(Y):
     """Lower Cholesky factor of the Hermitian Y and whether Y is positive definite."""
     n = Y.shape[0]
@@ -43,13 +44,13 @@ def _chol(Y):
     return C, True
 
 
-@njit(cache=True)
+@cached_njit()
 def _pd(Y):
     """True if the Hermitian matrix Y is positive definite (Cholesky pivots > 0)."""
     return _chol(Y)[1]
 
 
-@njit(cache=True)
+@cached_njit()
 def _tril_inv(C):
     """Inverse of a lower-triangular matrix (forward substitution)."""
     n = C.shape[0]
@@ -64,7 +65,7 @@ def _tril_inv(C):
     return Ci
 
 
-@njit(cache=True)
+@cached_njit()
 def gevp(D, A):
     """λ_max(D⁻¹ A) (F,) for Hermitian stacks D, A (F, N, N); +inf where D is not positive
     definite. With D = C Cᴴ: the largest eigenvalue of C⁻¹ A C⁻ᴴ."""
@@ -89,7 +90,7 @@ def gevp(D, A):
     return out
 
 
-@njit(cache=True)
+@cached_njit()
 def _inv(Y):
     """Inverse of a Hermitian positive definite Y (barrier matrices at feasible points),
     Y⁻¹ = C⁻ᴴ C⁻¹ from its Cholesky factor Y = C Cᴴ."""
@@ -106,7 +107,7 @@ def _inv(Y):
     return X
 
 
-@njit(cache=True)
+@cached_njit()
 def _add_term(Yinv, B, off, sign, g, H):
     """Gradient and Hessian of −log det Y for directions B (q, n, n), coordinates off…off+q:
     with R_i = Y⁻¹ B_i, g_i −= sign·tr R_i and H_ij += Re tr(R_i R_j) (sign −1: Y's
@@ -149,7 +150,7 @@ def _add_term(Yinv, B, off, sign, g, H):
             H[off + i, off + j] += Hq[i, j]
 
 
-@njit(cache=True)
+@cached_njit()
 def _derivs(L1, D, Gr, Lder, BD, BGr, offs, full, gmax, pD):
     """Gradient (p,) and Hessian (p, p) of the barrier at one matrix's current point."""
     p = Lder.shape[0]
@@ -176,7 +177,7 @@ def _derivs(L1, D, Gr, Lder, BD, BGr, offs, full, gmax, pD):
     return g, H
 
 
-@njit(cache=True)
+@cached_njit()
 def _shift(X, s, c):
     """c I + s X."""
     n = X.shape[0]
@@ -188,7 +189,7 @@ def _shift(X, s, c):
     return Y
 
 
-@njit(cache=True)
+@cached_njit()
 def _axpy(X, s, dX):
     """X + s dX."""
     n = X.shape[0]
@@ -199,7 +200,7 @@ def _axpy(X, s, dX):
     return Y
 
 
-@njit(cache=True)
+@cached_njit()
 def _solve(H, g):
     """H⁻¹ g for a small real H (destroyed) by Gaussian elimination with partial pivoting
     (LAPACK's getrf/getrs algorithm, in loops: numba's np.linalg.solve costs seconds to
@@ -228,7 +229,7 @@ def _solve(H, g):
     return x
 
 
-@njit(cache=True)
+@cached_njit()
 def _feasible(L1, D, Gr, gmax):
     if not (_pd(L1) and _pd(D)):
         return False
@@ -237,7 +238,7 @@ def _feasible(L1, D, Gr, gmax):
     return _pd(_shift(Gr, -1.0, gmax)) and _pd(_shift(Gr, 1.0, gmax))
 
 
-@njit(cache=True)
+@cached_njit()
 def _all(x):
     for v in x:
         if not v:
@@ -245,7 +246,7 @@ def _all(x):
     return True
 
 
-@njit(cache=True)
+@cached_njit()
 def newton_steps(L1, D, Gr, za, Lder, U, BD, BGr, offs, full, gmax, pD, n_newton, dec_tol):
     """Up to ``n_newton`` damped Newton steps on every matrix of the stack; in place.
 

@@ -24,7 +24,9 @@ from __future__ import annotations
 
 import contextlib
 import json
+import socket
 import sys
+import threading
 from pathlib import Path
 
 import pytest
@@ -278,3 +280,30 @@ def terminal_run(tmp_path_factory, request, design_cache_for):
     assert {"design:pid", "digital:pid"} <= set(cache.hits)
     assert not {"design:hinf", "design:mu"} & set(cache.hits)
     return out, json.loads((out / "metrics.json").read_text()), screen
+
+
+@pytest.fixture
+def silent_peer():
+    """The address of a TCP socket on this machine that accepts connections and never
+    answers (a wrong port, a stalled host): a Dask scheduler that would hang a client."""
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(8)
+    srv.settimeout(0.2)
+    held, stop = [], threading.Event()
+
+    def accept():
+        while not stop.is_set():
+            try:
+                held.append(srv.accept()[0])
+            except OSError:
+                continue
+
+    t = threading.Thread(target=accept, daemon=True)
+    t.start()
+    yield f"tcp://127.0.0.1:{srv.getsockname()[1]}"
+    stop.set()
+    t.join()
+    for c in held:
+        c.close()
+    srv.close()

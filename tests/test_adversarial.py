@@ -19,10 +19,8 @@ import json
 import multiprocessing
 import os
 import shutil
-import socket
 import subprocess
 import sys
-import threading
 import tomllib
 from pathlib import Path
 
@@ -186,32 +184,6 @@ def test_refused_in_one_line(tmp_path, make, words):
     proc = _ambseal(tmp_path, make(tmp_path))
     _refused(proc, *words)
     assert not (tmp_path / "o").exists() and not (tmp_path / "c").exists()
-
-
-@pytest.fixture
-def silent_peer():
-    """A TCP address that accepts connections and never answers."""
-    srv = socket.socket()
-    srv.bind(("127.0.0.1", 0))
-    srv.listen(8)
-    srv.settimeout(0.2)
-    held, stop = [], threading.Event()
-
-    def accept():
-        while not stop.is_set():
-            try:
-                held.append(srv.accept()[0])
-            except OSError:
-                continue
-
-    t = threading.Thread(target=accept, daemon=True)
-    t.start()
-    yield f"tcp://127.0.0.1:{srv.getsockname()[1]}"
-    stop.set()
-    t.join()
-    for c in held:
-        c.close()
-    srv.close()
 
 
 def test_a_silent_scheduler_is_refused_before_any_work(tmp_path, silent_peer):

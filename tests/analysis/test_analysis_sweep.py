@@ -188,36 +188,6 @@ def test_cli_sweep_writes_table_boundary_and_map_and_keeps_failed_cases(tmp_path
     assert len(err) == 1 and "unknown parameter 'nope.k'" in err[0] and "s.k" in err[0]
 
 
-@pytest.fixture
-def silent_peer():
-    """The address of a TCP socket that accepts connections and never answers (a wrong
-    port, a stalled host)."""
-    import socket
-    import threading
-
-    srv = socket.socket()
-    srv.bind(("127.0.0.1", 0))
-    srv.listen(8)
-    held, stop = [], threading.Event()
-
-    def accept():
-        srv.settimeout(0.2)
-        while not stop.is_set():
-            try:
-                held.append(srv.accept()[0])
-            except OSError:
-                continue
-
-    t = threading.Thread(target=accept, daemon=True)
-    t.start()
-    yield f"tcp://127.0.0.1:{srv.getsockname()[1]}"
-    stop.set()
-    t.join()
-    for c in held:
-        c.close()
-    srv.close()
-
-
 def test_a_scheduler_that_never_answers_is_refused_in_time(silent_peer, tmp_path, capsys,
                                                            monkeypatch):
     """A Dask scheduler address whose peer accepts and stays silent: ``run_cases`` and

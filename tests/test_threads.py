@@ -14,7 +14,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from threadpoolctl import threadpool_info
 
 from ambseal.errors import ConfigError
 from ambseal.threads import ENV_VAR, blas_threads, numerics_threads
@@ -140,16 +139,6 @@ def test_synthesis_is_the_same_whatever_the_threads_and_load():
         h = np.array(r["re"]) + 1j * np.array(r["im"])
         assert np.max(np.abs(h - h_ref)) <= 1e-7 * np.max(np.abs(h_ref))
         assert r["stopping"] == ref["stopping"]
-
-
-def test_threadpool_restored_in_this_process():
-    """The decorated entry points leave this process's thread pools as they found them."""
-    from ambseal.robust import hinfnorm
-    import control
-
-    before = [i["num_threads"] for i in threadpool_info()]
-    hinfnorm(control.ss([[-1.0]], [[1.0]], [[1.0]], [[0.0]]))
-    assert [i["num_threads"] for i in threadpool_info()] == before
 
 
 #: Keys of metrics.json that are measurements of time, not results.

@@ -35,7 +35,7 @@ class StabilityCase:
     controller : str
         The controller's name (its method).
     label : str
-        The condition as reports name it (``"2.04 bar, 0 Hz"``).
+        The condition as reports name it (``"<p> bar, <f> Hz"``).
     pressure_bar, speed_hz : float
         The condition: seal pressure drop (bar) and spin speed (Hz).
     stable : bool

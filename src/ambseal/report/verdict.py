@@ -108,8 +108,8 @@ class Verdict:
         only: ``metrics["stability"]``) were checked, and those where the loop, continuous
         or as it runs, is unstable (``"0 bar, 0 Hz"``).
     design_bound : str or None
-        The design's own bound: ``"H∞ γ = 1.05 on the nominal design model"`` or
-        ``"robust performance met: μ = 0.9942 ≤ 1 on the design model"`` (its summary's
+        The design's own bound: ``"H∞ γ = <γ> on the nominal design model"`` or
+        ``"robust performance met: μ = <μ> ≤ 1 on the design model"`` (its summary's
         verdict, up to the full-order check); None for the PID.
     """
 
@@ -131,7 +131,7 @@ class Verdict:
 
     @property
     def judged_range(self) -> str:
-        """``"0–4.08 bar"`` when stable at every judged condition, else the stable ones, or
+        """``"<low>–<high> bar"`` when stable at every judged condition, else the stable ones, or
         ``none``."""
         if not self.stable_at:
             return "none"

@@ -255,7 +255,7 @@ def _search_step(P, blocks, cblocks, nmeas, ncon, w, best, evals, backoff, histo
                      backoff=backoff)
     except SynthesisError:
         return None, dict(done, rule=f"{rule}; its K-step failed")
-    mu = mussv(lft_lower(P, hr.K, nmeas, ncon), blocks, w, lower=False)
+    mu = mussv(lft_lower(P, hr.K, nmeas, ncon), blocks, w, lower=False, peak=False)
     peak = float(np.max(mu.upper))
     history.append({"iteration": len(history), "gamma": hr.gamma, "mu": peak,
                     "order": hr.order, "step": "D search", "evaluations": n})

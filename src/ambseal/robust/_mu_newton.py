@@ -93,9 +93,13 @@ def gevp(D, A):
 @cached_njit()
 def _inv(Y):
     """Inverse of a Hermitian positive definite Y (barrier matrices at feasible points),
-    Y⁻¹ = C⁻ᴴ C⁻¹ from its Cholesky factor Y = C Cᴴ."""
+    Y⁻¹ = C⁻ᴴ C⁻¹ from its Cholesky factor Y = C Cᴴ, and whether Y is positive definite
+    (where rounding has taken a point to the boundary it is not; the inverse is then
+    zero)."""
     n = Y.shape[0]
-    C, _ = _chol(Y)
+    C, ok = _chol(Y)
+    if not ok:
+        return np.zeros((n, n), np.complex128), False
     Ci = _tril_inv(C)
     X = np.zeros((n, n), np.complex128)
     for a in range(n):
@@ -104,7 +108,7 @@ def _inv(Y):
             for k in range(max(a, b), n):
                 v += np.conj(Ci[k, a]) * Ci[k, b]
             X[a, b] = v
-    return X
+    return X, True
 
 
 @cached_njit()
@@ -152,12 +156,16 @@ def _add_term(Yinv, B, off, sign, g, H):
 
 @cached_njit()
 def _derivs(L1, D, Gr, Lder, BD, BGr, offs, full, gmax, pD):
-    """Gradient (p,) and Hessian (p, p) of the barrier at one matrix's current point."""
+    """Gradient (p,) and Hessian (p, p) of the barrier at one matrix's current point, and
+    whether the point is inside the barrier's domain (every matrix positive definite)."""
     p = Lder.shape[0]
     g = np.zeros(p)
     H = np.zeros((p, p))
     o = offs[0]  # = 0, typed int64 (a literal 0 would compile _add_term twice)
-    _add_term(_inv(L1), Lder, o, 1.0, g, H)
+    Yinv, inside = _inv(L1)
+    if not inside:
+        return g, H, False
+    _add_term(Yinv, Lder, o, 1.0, g, H)
     for k in range(offs.size - 1):
         o0, o1 = offs[k], offs[k + 1]
         if full[k]:  # D block d·I: −k log d
@@ -169,12 +177,17 @@ def _derivs(L1, D, Gr, Lder, BD, BGr, offs, full, gmax, pD):
                 for j in range(pD):
                     H[i, j] += m * dinv * dinv * ci * BD[j, o0, o0].real
         else:
-            _add_term(_inv(np.ascontiguousarray(D[o0:o1, o0:o1])),
-                      np.ascontiguousarray(BD[:, o0:o1, o0:o1]), o, 1.0, g, H)
+            Yinv, ok = _inv(np.ascontiguousarray(D[o0:o1, o0:o1]))
+            inside = inside and ok
+            _add_term(Yinv, np.ascontiguousarray(BD[:, o0:o1, o0:o1]), o, 1.0, g, H)
     if BGr.shape[0]:  # gmax I ∓ G: derivatives ∓B_i
-        _add_term(_inv(_shift(Gr, -1.0, gmax)), BGr, pD, -1.0, g, H)
-        _add_term(_inv(_shift(Gr, 1.0, gmax)), BGr, pD, 1.0, g, H)
-    return g, H
+        Yinv, ok = _inv(_shift(Gr, -1.0, gmax))
+        inside = inside and ok
+        _add_term(Yinv, BGr, pD, -1.0, g, H)
+        Yinv, ok = _inv(_shift(Gr, 1.0, gmax))
+        inside = inside and ok
+        _add_term(Yinv, BGr, pD, 1.0, g, H)
+    return g, H, inside
 
 
 @cached_njit()
@@ -267,17 +280,30 @@ def newton_steps(L1, D, Gr, za, Lder, U, BD, BGr, offs, full, gmax, pD, n_newton
     -------
     centred : (F,) bool, Newton decrement below ``dec_tol`` at the last step. As the batched
         form: every matrix steps until all are centred or ``n_newton`` steps are done.
+    lost : (F,) bool, rounding has taken the point out of the barrier's domain (a matrix
+        no longer positive definite; near a level t just above a λ of zero, t D − A is
+        singular to working precision): it stays where it is, counted as centred, for the
+        caller to stop at its best scalings.
     """
     F, p = za.shape
     N = L1.shape[1]
     nr = Gr.shape[1]
     pG = p - pD
     centred = np.zeros(F, np.bool_)
+    lost = np.zeros(F, np.bool_)
     dz = np.empty((F, p))
     dec = np.empty(F)
     for _k in range(n_newton):
         for f in range(F):
-            g, H = _derivs(L1[f], D[f], Gr[f], Lder[f], BD, BGr, offs, full, gmax, pD)
+            g, H, inside = _derivs(L1[f], D[f], Gr[f], Lder[f], BD, BGr, offs, full, gmax,
+                                   pD)
+            if lost[f] or not inside:
+                lost[f] = True
+                centred[f] = True
+                dec[f] = 0.0
+                for i in range(p):
+                    dz[f, i] = 0.0
+                continue
             tr = 0.0
             for i in range(p):
                 tr += H[i, i]
@@ -334,4 +360,4 @@ def newton_steps(L1, D, Gr, za, Lder, U, BD, BGr, offs, full, gmax, pD, n_newton
                     Gr[f, a, b] += step * dGr[a, b]
             for i in range(p):
                 za[f, i] += step * dz[f, i]
-    return centred
+    return centred, lost

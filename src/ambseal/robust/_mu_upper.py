@@ -284,9 +284,9 @@ def _centres_chunk(P, z, t, tol, max_iter, idx, theta=0.25, n_newton=5, dec_tol=
             if Fa == 0:
                 break
         # damped Newton steps towards the centre (compiled, one matrix at a time; in place)
-        centred = newton_steps(L1, D, Gr if pG else np.zeros((Fa, 0, 0), complex), za, Lder,
-                               P.U, P.BD, P.BGr, P.offs, P.full, float(gmax), pD, n_newton,
-                               dec_tol)
+        centred, lost = newton_steps(L1, D, Gr if pG else np.zeros((Fa, 0, 0), complex), za,
+                                     Lder, P.U, P.BD, P.BGr, P.offs, P.full, float(gmax), pD,
+                                     n_newton, dec_tol)
         lam_a = _gevp(D, ta[:, None, None] * D - L1)
         better = lam_a < best_lam[active]
         best_lam[active[better]] = lam_a[better]
@@ -294,7 +294,9 @@ def _centres_chunk(P, z, t, tol, max_iter, idx, theta=0.25, n_newton=5, dec_tol=
         z[active] = za
         gap = ta - lam_a
         t[active] = lam_a + theta * gap
-        done = centred & (gap <= tol * np.maximum(lam_a, 1e-300) + 1e-14)
+        # lost: rounding left the interior (t D − A singular to working precision), so
+        # the level cannot come closer to λ; the best scalings found so far stand
+        done = lost | (centred & (gap <= tol * np.maximum(lam_a, 1e-300) + 1e-14))
         active = active[~done]
     return best_lam, best_z
 

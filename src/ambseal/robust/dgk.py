@@ -268,7 +268,7 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
     K, stall, rule = dk.K, 0, f"max_iter={max_iter}"
     first = len(history)
     for it in range(first, first + max_iter):
-        mu_s = mussv(lft_lower(P, K, nmeas, ncon), sblocks, w, lower=False)
+        mu_s = mussv(lft_lower(P, K, nmeas, ncon), sblocks, w, lower=False, peak=False)
         beta = float(np.max(mu_s.upper))
         fits, jg_err, level = _dg_step_scalings(P, K, nmeas, ncon, mu_s, real, beta, w,
                                                 fit_tol)
@@ -278,7 +278,8 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
         except SynthesisError as exc:
             rule = f"K-step {it} failed ({exc})"
             break
-        mu_true = mussv(lft_lower(P, hr.K, nmeas, ncon), blocks, w, lower=False)
+        mu_true = mussv(lft_lower(P, hr.K, nmeas, ncon), blocks, w, lower=False,
+                        peak=False)
         peak = float(np.max(mu_true.upper))
         history.append({"iteration": it, "gamma": hr.gamma, "mu": peak, "order": hr.order,
                         "step": "D-G-K", "beta": beta, "jg_fit_error": jg_err,

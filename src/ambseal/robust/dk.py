@@ -494,7 +494,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
             rule = f"K-step {it} failed ({exc})"
             break
         cl = lft_lower(P, hr.K, nmeas, ncon)
-        mu_true = mussv(cl, blocks, w, lower=False)
+        mu_true = mussv(cl, blocks, w, lower=False, peak=False)
         peak = float(np.max(mu_true.upper))
         history.append({"iteration": it, "gamma": hr.gamma, "mu": peak, "order": hr.order})
         if console is not None:
@@ -509,7 +509,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
             rule = f"patience={patience}: {stall} iterations without a μ gain of rtol={rtol:g}"
             break
         # D-step on the unscaled closed loop, diagonal (complexified) structure
-        mu_c = mussv(cl, cblocks, w, lower=False) if cblocks != [tuple(b) for b in blocks] \
+        mu_c = mussv(cl, cblocks, w, lower=False, peak=False) if cblocks != [tuple(b) for b in blocks] \
             else mu_true
         ds = np.asarray(mu_c.dscale)  # (F, nblocks), last block = 1
         if order == "auto":

@@ -161,8 +161,10 @@ def reduce_controller(P, K, order: int, nmeas: int, ncon: int, *,
     mu_red = None
     if blocks is not None:
         if mu_full is None:
-            mu_full = float(np.max(mussv(lft_lower(P, K, nmeas, ncon), blocks, omega).upper))
-        mu_red = (float(np.max(mussv(lft_lower(P, Kr, nmeas, ncon), blocks, omega).upper))
+            mu_full = float(np.max(mussv(lft_lower(P, K, nmeas, ncon), blocks, omega,
+                                         peak=False).upper))
+        mu_red = (float(np.max(mussv(lft_lower(P, Kr, nmeas, ncon), blocks, omega,
+                                           peak=False).upper))
                   if np.isfinite(g_red) else float("inf"))
     return ReductionResult(K=Kr, order_full=int(K.nstates), order=int(Kr.nstates),
                            gamma_full=float(g_full), gamma=float(g_red), mu_full=mu_full,

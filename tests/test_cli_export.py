@@ -164,5 +164,5 @@ def test_an_unstable_pid_is_not_exported_quietly(tmp_path, capsys):
     assert main(["export", rig, "--method", "pid", "--out", str(out), "--allow-unstable"]) == 0
     assert "warning" in capsys.readouterr().err
     design = json.loads((out / "design_pid.json").read_text())
-    assert design["full_order"]["stable"] is False and design["allow_unstable"] is True
+    assert design["full_order"]["stable"] is False and design["kept_unstable"] is True
     assert (out / "controller_pid.json").exists()

@@ -80,7 +80,12 @@ def test_verdict_grades_each_axis_as_iso_14839_3_does():
     cases = _metrics()
     stable_only = verdicts(cases[:1], {"air gap": 500.0})[0]
     assert stable_only.zone_axis == "B" and stable_only.zone_sigma == "B"
-    assert stable_only.words().startswith("Zone B on every axis over 2.04 bar")
+    # the axes differ (A ζ zone A, B η zone B): the zone is the worst axis's, named
+    assert stable_only.worst_axis == "B η at 2.04 bar" and not stable_only.axes_alike
+    assert stable_only.words().startswith(
+        "Zone B on its worst axis (B η at 2.04 bar) over 2.04 bar: fit for unrestricted")
+    alike = dict(cases[0], iso_zone_per_axis={"A_zeta": "B", "B_eta": "B"})
+    assert verdicts([alike])[0].words().startswith("Zone B on every axis over 2.04 bar: fit")
     assert stable_only.orbit_text() == "7.9 µm (1.6 % of the air gap)"
     both = verdicts(cases)[0]
     assert both.zone_axis == "D" and both.unstable_at == ("4.08 bar",)
@@ -88,7 +93,10 @@ def test_verdict_grades_each_axis_as_iso_14839_3_does():
     assert both.words().startswith("Not acceptable: the loop is unstable at 4.08 bar")
     spiky = dict(cases[0], iso_zone="D", sensitivity_peak=5.5)
     v = verdicts([spiky])[0]
-    assert v.zone_axis == "B" and v.zone_sigma == "D" and "σ̄ over all axes reaches D" in v.words()
+    # σ̄(S_o) in zone D: the sentence must not call the loop fit for long-term operation
+    assert v.zone_axis == "B" and v.zone_sigma == "D"
+    assert ("but σ̄(S_o) over all axes reaches zone D (peak 5.5): not acceptable (damage "
+            "likely)") in v.words() and "unrestricted" not in v.words()
 
 
 def test_verdict_holds_only_where_the_machine_runs_up_too():
@@ -112,7 +120,8 @@ def test_verdict_holds_only_where_the_machine_runs_up_too():
                          "2.04 bar, 50 Hz (where the machine runs up).")
     good = verdicts([case], None, st[2:])[0]
     assert good.zone_axis == "B" and good.stable_range == "2.04 bar, standstill to top speed"
-    assert good.words().startswith("Zone B on every axis over 2.04 bar: fit for")
+    assert good.words().startswith("Zone B on its worst axis (B η at 2.04 bar) over 2.04 "
+                                   "bar: fit for")
     assert "stable from standstill to the top speed" in good.words()
 
 

@@ -357,7 +357,7 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
     if summary.get("full_order") is None and not isinstance(K, ScheduledController):
         # the reference PID is given, not designed: judged here before it is handed over
         check = full_order_check(cfg, K, [(q.pressure_bar, q.speed_rpm / 60.0) for q in points])
-        summary.update(full_order=check, allow_unstable=not check["stable"])
+        summary.update(full_order=check, kept_unstable=not check["stable"])
         if not check["stable"]:
             what = (f"{method}: the full-order loop is unstable at {check['pressure_bar']:g} "
                     f"bar, {check['speed_hz']:g} Hz (the mode at {check['mode_hz']:.4g} Hz "

@@ -159,7 +159,7 @@ class LpvDesign(ScheduledController):
         stab = ("full-order loop stable at every judged condition"
                 if self.full_order is None or self.full_order["stable"] else
                 f"FULL-ORDER LOOP UNSTABLE at {self.full_order['mode_hz']:.4g} Hz, "
-                f"{self.full_order['speed_hz']:g} Hz speed (accepted with allow_unstable)")
+                f"{self.full_order['speed_hz']:g} Hz speed (kept unstable: allow_unstable)")
         return (f"LPV γ = {bound_text(self.gamma)} over {lo:g}–{hi:g} Hz ({self.lyapunov} "
                 f"Lyapunov function), frozen loops γ ≤ {float(np.max(self.check_gamma)):.3g}"
                 f"; {stab}")

@@ -121,8 +121,10 @@ class DesignResult:
         Mechanical states of the design model the controller was made on.
     full_order : dict or None
         :func:`full_order_check` of the delivered controller.
-    allow_unstable : bool
-        True when an unstable full-order loop was accepted on request.
+    kept_unstable : bool
+        True when the design's own full-order loop is unstable and it was returned all
+        the same because the caller passed ``allow_unstable`` (the main job does, so that
+        its judgement can mark the design failed); not the user's flag.
     delay : dict or None
         The controller's hold + computation delay the design model carries
         (:meth:`ambseal.robust.delay.DesignDelay.to_dict`); None for the PID.
@@ -157,7 +159,7 @@ class DesignResult:
     plant: Any = field(default=None, repr=False)
     design_states: int | None = None
     full_order: dict | None = None
-    allow_unstable: bool = False
+    kept_unstable: bool = False
     delay: dict | None = None
     steps: tuple = ()
     notes: tuple = ()
@@ -174,7 +176,7 @@ class DesignResult:
                 "uncertainty": {k: list(v) for k, v in self.uncertainty.items()},
                 "iterations": len(self.history), "reduction": self.reduction,
                 "design_states": self.design_states, "full_order": self.full_order,
-                "allow_unstable": self.allow_unstable, "delay": self.delay,
+                "kept_unstable": self.kept_unstable, "delay": self.delay,
                 "steps": list(self.steps),
                 "notes": list(self.notes), "verdict": self.verdict,
                 "stopping": self.stopping}
@@ -376,7 +378,7 @@ def design(
         order_full=r.order_full, history=tuple(r.history), weights=w,
         uncertainty={q.name: (q.low, q.high) for q in r.gp.parameters},
         elapsed_s=time.perf_counter() - t0, reduction=r.reduction, plant=r.gp,
-        design_states=n, full_order=check, allow_unstable=not check["stable"],
+        design_states=n, full_order=check, kept_unstable=not check["stable"],
         delay=dl.to_dict(), steps=tuple(steps), notes=tuple(sp.notes),
         verdict=_verdict(method, r, check), omega=r.omega, stopping=r.stopping)
 
@@ -521,7 +523,7 @@ def _verdict(method, r: _Synthesis, check) -> str:
     """One plain line: robust performance met or not, and the full-order stability."""
     stab = ("full-order loop stable at every judged condition" if check["stable"] else
             f"FULL-ORDER LOOP UNSTABLE at {check['mode_hz']:.4g} Hz, {check['pressure_bar']:g} "
-            "bar (accepted with allow_unstable)")
+            "bar (kept unstable: allow_unstable)")
     if method == "hinf":
         return f"H∞ γ = {r.gamma:.3g} on the nominal design model; {stab}"
     if r.mu is not None and r.mu <= 1:

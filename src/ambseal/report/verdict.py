@@ -111,6 +111,11 @@ class Verdict:
         The design's own bound: ``"H∞ γ = <γ> on the nominal design model"`` or
         ``"robust performance met: μ = <μ> ≤ 1 on the design model"`` (its summary's
         verdict, up to the full-order check); None for the PID.
+    worst_axis : str or None
+        The axis and condition of the largest per-axis sensitivity peak over the stable
+        conditions, e.g. ``"A ζ at 4.08 bar"``; None without per-axis peaks.
+    axes_alike : bool
+        Every axis is in the same zone at every stable condition.
     """
 
     controller: str
@@ -128,6 +133,8 @@ class Verdict:
     speed_checked: int = 0
     speed_unstable: tuple[str, ...] = ()
     design_bound: str | None = None
+    worst_axis: str | None = None
+    axes_alike: bool = True
 
     @property
     def judged_range(self) -> str:
@@ -172,10 +179,16 @@ class Verdict:
             run = " (where the machine runs up)" if self.speed_unstable else ""
             return f"Not acceptable: the loop is unstable at {where}{run}{tail}."
         z = self.zone_axis or "?"
-        text = (f"Zone {z} on every axis over {self.judged_range}: "
-                f"{ZONE_WORDS.get(z, 'not graded')}")
-        if self.zone_sigma and self.zone_sigma != z:
-            text += f" (σ̄ over all axes reaches {self.zone_sigma})"
+        where = ("on every axis" if self.axes_alike or self.worst_axis is None else
+                 f"on its worst axis ({self.worst_axis})")
+        text = f"Zone {z} {where} over {self.judged_range}"
+        # σ̄(S_o) bounds every axis's peak from above, so its zone is never the better one;
+        # where it is worse, the words follow it: the loop is judged as the MIMO loop it is
+        worse = self.zone_sigma if self.zone_sigma and self.zone_sigma != z else None
+        if worse is not None:
+            text += (f", but σ̄(S_o) over all axes reaches zone {worse} (peak "
+                     f"{sig(self.sigma_peak)})")
+        text += f": {ZONE_WORDS.get(worse or z, 'not graded')}"
         if self.speed_checked:
             text += "; stable from standstill to the top speed"
         gap = [c for c in self.clearances_um.values() if c]
@@ -221,6 +234,11 @@ def verdicts(cases: Sequence[Mapping], clearances_um: Mapping[str, float] | None
             return max(vals) if vals else None
 
         axis_zones = [z for c in cs for z in (c.get("iso_zone_per_axis") or {}).values()]
+        stable_zones = {z for c in ok for z in (c.get("iso_zone_per_axis") or {}).values()}
+        per_axis = [(pk, a, lb) for lb, c in zip(label, cs) if c.get("stable")
+                    for a, pk in (c.get("sensitivity_peak_per_axis") or {}).items()
+                    if pk is not None]
+        top = max(per_axis, default=None)
         axis_zones += ["D" for c in cs if not c.get("stable")]
         sc = [c for c in stability if c["controller"] == name]
         speed_bad = tuple(c["label"] for c in sc if _unstable(c))
@@ -236,7 +254,9 @@ def verdicts(cases: Sequence[Mapping], clearances_um: Mapping[str, float] | None
             clearances_um=dict(clearances_um or {}), target_difference=target_difference(cs),
             speed_checked=len(sc), speed_unstable=speed_bad,
             design_bound=((designs or {}).get(name, {}).get("verdict") or "").split(";")[0]
-            or None))
+            or None,
+            worst_axis=None if top is None else f"{axis_label(top[1])} at {top[2]}",
+            axes_alike=len(stable_zones) <= 1))
     return out
 
 

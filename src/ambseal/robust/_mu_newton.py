@@ -65,29 +65,40 @@ def _tril_inv(C):
     return Ci
 
 
-@cached_njit()
 def gevp(D, A):
     """λ_max(D⁻¹ A) (F,) for Hermitian stacks D, A (F, N, N); +inf where D is not positive
-    definite. With D = C Cᴴ: the largest eigenvalue of C⁻¹ A C⁻ᴴ."""
+    definite. With D = C Cᴴ: the largest eigenvalue of C⁻¹ A C⁻ᴴ (the whitening compiled,
+    the eigenvalues by numpy's batched LAPACK: numba's ``eigvalsh`` took seconds to compile
+    on a command's first run)."""
+    X, ok = _whiten(D, A)
+    out = np.full(D.shape[0], np.inf)
+    if ok.any():
+        out[ok] = np.linalg.eigvalsh(X[ok])[:, -1]
+    return out
+
+
+@cached_njit()
+def _whiten(D, A):
+    """C⁻¹ A C⁻ᴴ (Hermitian part) per matrix with D = C Cᴴ, and whether D is positive
+    definite (where it is not, the matrix is left zero)."""
     F, n = D.shape[0], D.shape[1]
-    out = np.empty(F)
+    X = np.zeros((F, n, n), np.complex128)
+    ok = np.zeros(F, np.bool_)
     for f in range(F):
-        C, ok = _chol(D[f])
-        out[f] = np.inf
-        if not ok:
+        C, pd = _chol(D[f])
+        if not pd:
             continue
+        ok[f] = True
         Ci = _tril_inv(C)
         CiH = np.empty((n, n), np.complex128)
         for a in range(n):
             for b in range(n):
                 CiH[a, b] = np.conj(Ci[b, a])
         Y = Ci @ np.ascontiguousarray(A[f]) @ CiH
-        X = np.empty((n, n), np.complex128)
         for a in range(n):
             for b in range(n):
-                X[a, b] = 0.5 * (Y[a, b] + np.conj(Y[b, a]))
-        out[f] = np.linalg.eigvalsh(X)[-1]
-    return out
+                X[f, a, b] = 0.5 * (Y[a, b] + np.conj(Y[b, a]))
+    return X, ok
 
 
 @cached_njit()

@@ -163,10 +163,12 @@ def test_modes_n_lists_n_modes_on_the_supported_rig(capsys, n):
     dense = json.loads(capsys.readouterr().out)
     assert main(["modes", "--json", "--n-modes", str(n)]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert len(out["natural_frequencies_hz"]) == n
-    assert out["natural_frequencies_hz"] == pytest.approx(dense["natural_frequencies_hz"][:n],
-                                                          rel=1e-8)
-    assert out["max_hz"] == pytest.approx(out["natural_frequencies_hz"][-1], rel=1e-8)
+    def every(d):  # the natural frequencies and the overdamped pairs listed apart
+        return sorted(d["natural_frequencies_hz"] + [o["frequency_hz"] for o in d["overdamped"]])
+
+    assert len(every(out)) == n
+    assert every(out) == pytest.approx(every(dense)[:n], rel=1e-8)
+    assert out["max_hz"] == pytest.approx(every(out)[-1], rel=1e-8)
 
 
 def test_design_show_defaults_prints_a_design_part_that_reads_back(capsys):
@@ -239,8 +241,14 @@ def test_validate_and_modes_default_to_the_embedded_rig(capsys):
     assert v["defaults"]["judged_conditions"] == ["0 bar", "2.04 bar", "4.08 bar"]
     assert main(["modes", "--json"]) == 0
     m = json.loads(capsys.readouterr().out)
-    shown = [f for f in freqs if f <= m["max_hz"]]
-    assert m["natural_frequencies_hz"] == pytest.approx(shown, rel=1e-6)
+    # modes lists the pairs damped at ζ ≥ 1/√2 (no resonance) apart from the natural
+    # frequencies; validate lists every pair with its ζ
+    shown = [(f, z) for f, z in v["modes"] if f <= m["max_hz"]]
+    assert m["natural_frequencies_hz"] == pytest.approx(
+        [f for f, z in shown if z < 2 ** -0.5], rel=1e-6)
+    assert [o["frequency_hz"] for o in m["overdamped"]] == pytest.approx(
+        [f for f, z in shown if z >= 2 ** -0.5], rel=1e-6)
+    assert all(o["damping_ratio"] >= 2 ** -0.5 for o in m["overdamped"])
     assert main(["validate"]) == 0
     text = capsys.readouterr().out
     assert "valid" in text and "unstable open-loop poles" in text and "None" not in text

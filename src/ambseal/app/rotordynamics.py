@@ -17,7 +17,12 @@ import math
 import sys
 from pathlib import Path
 
-from ambseal.analysis.campbell import campbell, closed_loop_modes, open_loop_modes
+from ambseal.analysis.campbell import (
+    OVERDAMPED_ZETA,
+    campbell,
+    closed_loop_modes,
+    open_loop_modes,
+)
 from ambseal.analysis.cases import dask_available, probe_scheduler
 from ambseal.analysis.judge import judge_settings
 from ambseal.analysis.sweep import (
@@ -136,11 +141,19 @@ def _modes(args: argparse.Namespace) -> int:
         m = closed_loop_modes(cfg, K, speed_hz=rpm / 60.0, pressure_bar=p, max_hz=keep_hz)
     unstable = res.unstable_poles if K is None else [
         (float(z.real), float(z.imag)) for z in unstable_poles(m.poles)]
+    # a pair damped at ζ ≥ 1/√2 has no resonance (|H(jω)| of its mode falls monotonically):
+    # no natural frequency to avoid, listed apart as `campbell` lists its crossings
+    over = m.damping_ratio >= OVERDAMPED_ZETA
+    res_ = ~over
     out = {"speed_hz": rpm / 60.0, "pressure_bar": p, "max_hz": f_max,
            "controller": args.controller or "none",
-           "natural_frequencies_hz": [float(x) for x in m.frequency_hz],
-           "damping_ratios": [float(x) for x in m.damping_ratio],
-           "log_decrements": [float(x) for x in m.log_decrement], "whirl": list(m.whirl),
+           "natural_frequencies_hz": [float(x) for x in m.frequency_hz[res_]],
+           "damping_ratios": [float(x) for x in m.damping_ratio[res_]],
+           "log_decrements": [float(x) for x in m.log_decrement[res_]],
+           "whirl": [w for w, r in zip(m.whirl, res_) if r],
+           "overdamped": [{"frequency_hz": float(f), "damping_ratio": float(z), "whirl": w}
+                          for f, z, w, o in zip(m.frequency_hz, m.damping_ratio, m.whirl, over)
+                          if o],
            "unstable_poles": [list(z) for z in unstable]}
     if args.shapes is not None:
         out["shapes"] = str(mode_shapes_figure(Path(args.shapes), m, _positions(cfg)))
@@ -150,9 +163,13 @@ def _modes(args: argparse.Namespace) -> int:
     print(f"speed {rpm / 60.0:g} Hz ({rpm:g} rpm), pressure drop {p:g} bar, "
           f"controller {out['controller']}, modes up to {f_max:.4g} Hz")
     print(f"{'mode':>4}  {'f_d [Hz]':>12}  {'zeta [-]':>10}  {'log dec':>9}  whirl")
-    for i, (f, z, d, w) in enumerate(zip(m.frequency_hz, m.damping_ratio, m.log_decrement,
-                                         m.whirl), 1):
+    for i, (f, z, d, w) in enumerate(zip(out["natural_frequencies_hz"], out["damping_ratios"],
+                                         out["log_decrements"], out["whirl"]), 1):
         print(f"{i:>4}  {f:>12.3f}  {z:>10.4f}  {d:>9.4f}  {w}")
+    if out["overdamped"]:
+        print(f"overdamped (zeta >= {OVERDAMPED_ZETA:.3f}, no resonance): "
+              + ", ".join(f"{o['frequency_hz']:.4g} Hz (zeta {o['damping_ratio']:.3f})"
+                          for o in out["overdamped"]))
     if unstable:
         print("unstable poles [rad/s]:")
         for re, im in unstable:

@@ -181,3 +181,22 @@ def test_the_design_specification_is_built_by_the_commands_and_passed_down():
              if not (m.startswith("app/") or (m.startswith("design/") and fallback))]
     assert stray == []
     assert not any(m.startswith("analysis/") for m, _, _ in calls)
+
+
+#: Words of a lab notebook or a ticket, not of a contract: code and tests say what holds and
+#: why, history goes to benchmarks/README.md and CHANGELOG.md (the words are split so that
+#: this file does not match itself)
+_HISTORY = re.compile("|".join([r"\bused " + "to\b", r"\bas " + r"before\b",
+                                r"\bearlier " + r"tuning\b", r"\bthe " + r"issue\b",
+                                r"\bissue" + r"'s\b", r"\bissue " + r"\d+"]), re.IGNORECASE)
+
+
+def test_no_history_or_ticket_words_in_code_and_tests():
+    """Docstrings state the contract (house rule): none of :data:`_HISTORY`'s words of a
+    past state or of a ticket in src/ or tests/."""
+    found = []
+    for path in sorted([*SRC.rglob("*.py"), *(ROOT / "tests").rglob("*.py")]):
+        for k, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+            if _HISTORY.search(line):
+                found.append(f"{path.relative_to(ROOT)}:{k}: {line.strip()}")
+    assert not found, "\n".join(found)

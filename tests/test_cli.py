@@ -72,7 +72,7 @@ BAD = [
 
 @pytest.mark.parametrize("label,text,key,expected", BAD, ids=[b[0] for b in BAD])
 def test_bad_rig_file_one_line_exit_2(tmp_path, capsys, label, text, key, expected):
-    """Each bad rig file of the issue's list: exit 2, one stderr line with file, key, what."""
+    """Each bad rig file of a user's kind: exit 2, one stderr line with file, key, what."""
     rig, code = run(tmp_path, text)
     err = capsys.readouterr().err
     assert code == 2
@@ -93,7 +93,7 @@ def test_cli_no_traceback_in_a_real_process(tmp_path):
 
 
 def test_modes_json_keys_and_unstable_poles(tmp_path, capsys):
-    """``modes --json``: the issue's keys; AMB negative stiffness gives real unstable poles
+    """``modes --json``: its documented keys; AMB negative stiffness gives real unstable poles
     of √(Ks_total/m) for the translation (closed form, rigid rotor), and --no-amb has none."""
     _, code = run(tmp_path, GOOD, "--json")
     out = json.loads(capsys.readouterr().out)

@@ -74,7 +74,7 @@ def test_run_on_a_terminal_ends_with_the_verdict_and_the_report_path(terminal_ru
 
 
 def test_run_writes_the_contract(metrics):
-    """metrics.json keys of the issue, the figures and a self-contained report, and no
+    """metrics.json keys of its schema, the figures and a self-contained report, and no
     temporary file left behind (writes go through a rename)."""
     out, m = metrics
     assert {"rig", "open_loop", "cases"} <= set(m)
@@ -245,8 +245,8 @@ def test_run_with_the_tracked_controller(tmp_path, request, design_cache_for):
     """``[design] tracked = true`` adds the controller scheduled on the
     tracked seal k — judged over its schedule, 0–3× nominal (the judged pressures and 3×;
     continuous, and as it runs: its digital table with the target's delay), exported as a
-    table on seal.k, and run on the 0 → 3× nominal pressure ramp. References: the issue's
-    acceptance (as it runs on the facility's truth, every case stable with σ̄(S_o) ≤ 3 per
+    table on seal.k, and run on the 0 → 3× nominal pressure ramp. References: the tracked
+    scheme's acceptance (as it runs on the facility's truth, every case stable with σ̄(S_o) ≤ 3 per
     axis, ISO 14839-3's zone-A limit, and ≤ 3.2 overall; the estimate within 10 % of the
     nominal k after 1 s, its 95 % interval covering the truth ≥ 90 % of the time; the
     tracked scheme keeps the rotor to 3×) and the frozen continuous loops of the

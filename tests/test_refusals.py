@@ -1,7 +1,7 @@
 """Bad input is refused with one line naming the file and key, exit 2.
 
-Each case is a regression test of a finding of the issue: a value that used to be accepted
-(silently coerced, silently ignored, or ending in a traceback). The reference is the rig
+Each case is a value a user may write that must not be accepted silently (coerced,
+ignored) nor end in a traceback. The reference is the rig
 format (ambseal.config's docstring) and the CLI's promise: one line on stderr, status 2.
 """
 

@@ -53,7 +53,7 @@ def test_ramp_losses_agree_with_the_frozen_full_order_loops(testrig_cfg, testrig
     its impulse peaks stay within a factor 2 along the ramp. The tracked scheme (its
     frozen loops stable to 3×, ``test_tracked_design_stable_in_zone_a_on_the_full_order_
     plant``) keeps the rotor too, with the estimator in the loop; the estimator, its model
-    the rig identified by the thesis procedure on the same facility, meets the issue's
+    the rig identified by the thesis procedure on the same facility, meets the tracked scheme's
     acceptance against the truth's k (the truth file's k at each step's pressure): within
     10 % of the nominal k after 1 s, the 95 % interval covering it ≥ 90 % of the time; and
     its consistency test (the seal's held-known K, C, c) does not refuse it."""

@@ -26,7 +26,7 @@ def test_the_thesis_rig_gets_the_thesis_excitations(testrig_cfg):
     """Reference: the published settings on the test rig (6 A bias, 10 kHz): 0.05 A for
     10 ms from 0.05 s (P5 §3.3), a 0–150 Hz chirp (P4 §3.4, Figs. 9–10), and the run's
     1 ms, 1 s PRBS, 4 s chirp and 2–140 Hz / 2–200 Hz checks (exactly, so that
-    ``ambseal run`` on the embedded rig identifies bit for bit as before the rules)."""
+    ``ambseal run`` on the embedded rig identifies bit for bit with and without the rules' defaults spelt out)."""
     p = excitation_plan(testrig_cfg)
     assert (p.amplitude_a, p.impulse_s, p.impulse_start_s) == (0.05, 0.01, 0.05)
     assert (p.impulse_record_s, p.check_record_s) == (0.4, 0.25)

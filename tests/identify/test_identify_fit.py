@@ -111,7 +111,7 @@ def test_sandwich_intervals_cover_on_a_resonant_regression():
     white noise through lightly damped resonances (40–300 Hz at 10 kHz), two channels, three
     parameters. Reference: Monte Carlo over 200 noise draws with the true θ known — the 95 %
     intervals (leverage-corrected sandwich, Student's t with the Satterthwaite degrees of
-    freedom) cover each parameter in ≥ 90 % of draws, the issue's bar. Without the
+    freedom) cover each parameter in ≥ 90 % of draws. Without the
     corrections (1.96 × the plain sandwich) the first parameter, whose regressor and noise
     share the 40 Hz resonance, is covered in 83 %."""
     from scipy.signal import lfilter

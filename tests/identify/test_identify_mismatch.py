@@ -65,8 +65,8 @@ def _run(cfg, case: str, seeds, duration_s: float, free_lag: bool = False):
 
 
 def test_budget_covers_a_coupling_held_wrong_and_names_it(testrig_cfg):
-    """Two seeds, coupling held 4 % off: the noise-only intervals miss A's Ks (the bias of
-    several standard errors the issue reports), the intervals with the fixed-parameter
+    """Two seeds, coupling held 4 % off: the noise-only intervals miss A's Ks (a bias of
+    several standard errors), the intervals with the fixed-parameter
     budget contain every truth, the budget names the coupling as dominant and the score
     test disputes both coupling values, which marks the fit a model mismatch. Reference: the facility's truth (the rig file's
     coupling is known to be 4 % off)."""
@@ -91,11 +91,11 @@ def test_coverage_and_model_check_over_20_seeds(testrig_cfg):
     budget in every seed, disputed and flagged in ≥ 90 %. The rotor's model form: ≥ 90 %
     coverage within 5× the width (the loop, 40–130 Hz, sits far below the first bending
     mode: nothing for a test to flag). A 1 kHz sensor filter the model lacks: τ_e absorbs
-    most of it and Ki/Ks move by 0.5–1 %, so the intervals miss; the issue's bar is that
-    such fits are flagged — asserted: the intervals cover or the fit is flagged in ≥ 90 %
+    most of it and Ki/Ks move by 0.5–1 %, so the intervals miss; such fits must be
+    flagged — asserted: the intervals cover or the fit is flagged in ≥ 90 %
     of seeds, and with ``tau_s`` freed (the check's advice) the Ki/Ks intervals cover
     ≥ 90 %. Reference: the facility's truth;
-    90 % is the issue's bar (a binomial 95 % tolerance of nominal 95 % over 20 seeds is
+    90 % is the bar (a binomial 95 % tolerance of nominal 95 % over 20 seeds is
     ±9.6 %, over 180 intervals ±3.2 %)."""
     seeds = range(20)
     out = {}

@@ -269,7 +269,7 @@ def test_import_ross_cli_round_trip_and_bad_files(tmp_path, capsys):
 def test_import_chatter_goes_to_stderr(capfd):
     """What a library writes to stdout while ROSS is imported — from Python, at the file
     descriptor, or through C's buffered stdio as CoolProp's REFPROP banner does — ends up
-    on stderr; stdout works as before afterwards."""
+    on stderr; stdout works afterwards."""
     libc = ctypes.CDLL(None)
     c_stdout = ctypes.c_void_p.in_dll(libc, "stdout")  # glibc's, as on the CI machines
     unbuffered = bool(os.environ.get("PYTHONUNBUFFERED")) or "-u" in sys.orig_argv

@@ -273,7 +273,7 @@ def test_mat_export_is_an_ss_in_octave(testrig_digital, tmp_path):
 
 def test_load_controller_refuses_wrong_shapes(testrig_digital, tmp_path):
     """Reference: a controller file whose B does not match its inputs is refused with a
-    DataError naming the key and the expected shape (the issue's bad-input case)."""
+    DataError naming the key and the expected shape (a bad-input case)."""
     path = export_controller(testrig_digital["pid"], tmp_path / "K.json")
     doc = json.loads(path.read_text())
     doc["B"] = [row[:-1] for row in doc["B"]]
@@ -351,8 +351,8 @@ def test_generated_c_matches_python(testrig_digital, testrig_plants, tmp_path, p
     """Reference: the Python discrete controller (the exported object) run sample by sample
     on 10 000 samples of a closed-loop sensor record of the embedded rig (H∞ loop, sampled
     full-order plant, random current excitation): the compiled C99 module gives the same
-    current references within 1e-9 (double) and 1e-4 (float) of their peak, the issue's
-    limits."""
+    current references within 1e-9 (double) and 1e-4 (float) of their peak, a
+    target's float precision."""
     from ambseal.export.codegen import write_c
 
     dc = testrig_digital["hinf"]

@@ -361,8 +361,8 @@ def test_sharp_real_mu_peak_is_found_between_the_grid_points():
     within about ζω of it, between the points of a 100-point grid. The refined peak must
     reach the lower bound found on a dense grid around it — a real diagonal Δ with
     σ̄(Δ) = 1/μ that makes I − M(jω)Δ singular (checked here with numpy) — while the grid
-    alone stays more than 1 % below it. The same grid used to end in a ZeroDivisionError
-    where μ falls to zero above the modes (the barrier's Cholesky factor at rounding)."""
+    alone stays more than 1 % below it. Above the modes μ falls to zero, where the method of
+    centres meets the rounding level of its barrier: every bound stays finite."""
     sys = _two_lightly_damped_modes()
     blocks = [(-1, 0), (-1, 0)]
     w = np.logspace(-1, 2, 100)

@@ -51,7 +51,7 @@ time, after which |y| stays inside max(2 % of the peak, 3× the std of the 50 ms
 the impulse: noise and the PRBS's response); None when it never does within the window,
 and None ("n/a", ``impulse_above_background`` False) when |y| never leaves that band: the
 impulse's response is then not told apart from the background and has no settling time
-(it used to read 0 s).
+(not 0 s).
 """
 
 from __future__ import annotations

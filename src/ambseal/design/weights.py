@@ -450,7 +450,7 @@ def default_weights(method: str) -> Weights:
     design model, order 24 (the thesis's); σ̄(S_o) ≤ 2.2 per axis; orbit ≤ 4.6 µm; impulse
     settling 0.108 s at 0 bar against H∞'s 0.145 s; direct gains 1.0–1.9× the PID's from
     1 to 200 Hz, peak gain 1.7× the PID's peak. Why: a high-pass W_u of 0.02 rising to
-    0.2 above 800 Hz (the earlier tuning) let the gain reach 7.6× the PID's peak at 465 Hz,
+    0.2 above 800 Hz lets the gain reach 7.6× the PID's peak at 465 Hz,
     and ω_B = 30–60 rad/s gave 5–12× the PID's gain at 1 Hz; a larger W_1 (0.2–1) or a
     high-pass W_1 slows the impulse's settling tail or raises the 1 Hz gain; M = 3 gives
     μ = 0.97 and a slower settling (0.110 s). With the controller's delay in the design

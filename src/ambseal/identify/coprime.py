@@ -185,8 +185,8 @@ class CoprimeFactors:
     input_names, output_names : tuple of str
         Names of u (m) and y (p).
     output_scale : float
-        Size of a typical output relative to a typical input (y_s/u_s, e.g. m/A), used to
-        balance the units in :meth:`bezout_error`; the peak gain of N if 0.
+        Size of a typical output relative to a typical input (y_s/u_s, e.g. m/A), which
+        balances the units in :meth:`bezout_error`; the peak gain of N if 0.
     """
 
     A: np.ndarray

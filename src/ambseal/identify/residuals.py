@@ -14,7 +14,7 @@ Two tests per displacement channel, each a χ² statistic against its 99 % quant
 
 What a failure means here: the model is an *output-error* model and the loop is closed, so
 even a correct model leaves ε = S_o n — the sensor noise coloured by the output sensitivity —
-and the whiteness test is expected to fail; it is reported, not used to judge the model
+and the whiteness test is expected to fail; it is reported, and the model is not judged by it
 (Ljung §16.6: with no noise model estimated, the independence test is the relevant one). The
 excitation is the only signal independent of the noise, so residuals correlated with it mean
 dynamics the model does not reproduce: "model mismatch: intervals understate the

@@ -15,8 +15,8 @@ elsewhere any scaling that meets the level β does, and the pointwise optimum ju
 neighbouring frequencies (Barros, Fekri & Athans' spring–mass case, tests/spring_mass.py,
 first step: the stiffness channel's D falls from 5.1 to 0.1 and ĝ leaps from −0.5 to
 +1000 between 1.05 and 1.67 rad/s, where μ falls to 54 % of its peak). Fitted with
-weights towards the peak, as before, such data gave scalings that no longer certified the
-current controller between the peaks (σ̄(S) 1.28 at 1.2 rad/s), and the K-steps made μ
+weights towards the peak, such data give scalings that no longer certify the
+current controller between the peaks (σ̄(S) 1.28 at 1.2 rad/s), and the K-steps make μ
 worse. So, in turn:
 
 * :func:`relax_pointwise` moves each frequency's scalings towards those interpolated from

@@ -72,8 +72,8 @@ __all__ = ["FAST_FRACTION", "METHODS", "PEAK_TOLERANCE", "peak_difference",
 #: discretisation (at half of Nyquist a Tustin pole is warped by 27 % in frequency and a
 #: ZOH one already aliases its neighbourhood).
 FAST_FRACTION = 0.5
-#: Largest relative difference between the discrete and the continuous σ̄(S_o) peaks the
-#: issue's acceptance allows (10 %); a larger one is explained (:func:`peak_difference`).
+#: Largest relative difference between the discrete and the continuous σ̄(S_o) peaks taken
+#: as the same loop (10 %); a larger one is explained (:func:`peak_difference`).
 PEAK_TOLERANCE = 0.10
 #: The candidate discretisations, in the order they are tried.
 METHODS = ("tustin", "tustin_prewarp", "zoh", "foh")

@@ -20,7 +20,13 @@ discretisation chosen by the sampled loop), :func:`scheduled_digital` (a schedul
 controller's interpolated table), :class:`DiscreteController` and the sample-and-hold
 delay of the design model (:func:`design_delay`).
 
-Controller sign convention, stated once (:mod:`ambseal.robust.controller`): ``u = −K y``.
+Sign conventions. The synthesis functions and :func:`lft_lower` work on the lower LFT
+``F_l(P, K)``: their controllers close ``u = K y`` (positive feedback), as python-control's
+``hinfsyn`` and MATLAB's ``lft`` do. The controllers a machine runs —
+:class:`ScheduledController`, :class:`DigitalController`, :class:`DiscreteController` and
+the files exported from them — map measurements to actuator commands with negative
+feedback, ``u = −K y`` (:mod:`ambseal.robust.controller`); the design layer converts one
+into the other.
 """
 
 from ambseal.robust.controller import SPEED, ScheduledController, frozen, matrices_at

@@ -66,7 +66,7 @@ def test_dense_grid_closed_loops_stable(toy_designs):
     table points); the reported check norms are those norms."""
     grid, _, _, const, rate = toy_designs
     for r in (const, rate):
-        speeds = r.check_rad_s
+        speeds = r.check_grid
         assert speeds.size == 5 * (grid.size - 1) + 1
         assert np.allclose(speeds, np.linspace(grid[0], grid[-1], speeds.size))
         norms = []
@@ -98,7 +98,7 @@ def test_controller_at_any_speed(toy_designs):
     _, plants, _, const, _ = toy_designs
     K = const.K.at(13.3)
     assert K.ninputs == 2 and K.noutputs == 2 and K.nstates == plants[0].nstates
-    g = const.K.speeds_rad_s
+    g = const.K.theta
     j = int(np.searchsorted(g, 13.3)) - 1
     t = (13.3 - g[j]) / (g[j + 1] - g[j])
     K0, K1 = const.K.at(g[j]), const.K.at(g[j + 1])

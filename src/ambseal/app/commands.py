@@ -18,6 +18,7 @@ import numpy as np
 
 from ambseal.analysis.judge import judge_settings, operating_points
 from ambseal.config import default_rig_path, dump_rig, load_rig, rig_with_values
+from ambseal.design.fast_poles import design_rise
 from ambseal.design.lpv_design import design_lpv
 from ambseal.design.pid import controller_from_metadata
 from ambseal.design.recipes import design, full_order_check, pid_from_rig
@@ -55,7 +56,6 @@ from ambseal.report.verdict import target_difference
 from ambseal.robust.controller import SPEED, ScheduledController
 from ambseal.robust.digital import (
     check_rate,
-    design_rise,
     digital_controller,
     peak_difference,
     sampled_plants,
@@ -113,7 +113,7 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
         return digital_controller(controller, fs, cache["plants"],
                                   delay_samples=delay, rise=rise)
 
-    W = np.asarray(controller.K.speeds_rad_s, float)  # the LPV table's θ (speeds or SI)
+    W = np.asarray(controller.K.theta, float)  # the LPV table's θ (speeds or SI)
     # between table entries at 1/8, 3/8, 5/8, 7/8 of the table: the interpolation judged
     mids = [(W[j] + W[j + 1]) / 2 for j in (np.arange(1, 8, 2) * (W.size - 1)) // 8]
     if controller.parameter == SPEED:

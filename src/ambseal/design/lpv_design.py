@@ -350,7 +350,7 @@ def design_lpv(cfg, *, speeds_hz=None, n_grid: int | None = None,
                **lpvsyn_kw)
     d = LpvDesign(K=r.K, gamma=r.gamma, gamma_design=r.gamma_design, frozen_gamma=fg,
                   check_gamma=r.check_gamma, speeds_hz=grid,
-                  check_speeds_hz=r.check_rad_s / _TWO_PI, lyapunov=lyapunov,
+                  check_speeds_hz=r.check_grid / _TWO_PI, lyapunov=lyapunov,
                   rate_bound_hz_per_s=None if nu is None else float(rate_bound_hz_per_s),
                   weights=w, reports=r.reports, synthesis_s=r.time_s, plant=L)
     check = check_full_order(cfg, sp, d.controller_at, "lpv", allow_unstable)

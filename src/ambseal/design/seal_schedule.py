@@ -114,7 +114,7 @@ class SealScheduledDesign(ScheduledController):
     parameter : str
         The scheduling parameter, e.g. ``"seal.k"``.
     K : LpvController
-        The table in synthesis units, its ``speeds_rad_s`` holding θ values (SI).
+        The table in synthesis units, its ``theta`` holding the parameter's values (SI).
     gamma, gamma_design : float
         LMI γ and the back-off γ of the construction.
     grid, check_grid : ndarray
@@ -285,7 +285,7 @@ def _write_cache(path: Path, key: str, d: SealScheduledDesign) -> None:
            "range_factor": list(d.range_factor), "delay": d.delay,
            "weights": asdict(d.weights), "grid": d.grid.tolist(),
            "check_grid": d.check_grid.tolist(), "check_gamma": d.check_gamma.tolist(),
-           "K": {"speeds_rad_s": K.speeds_rad_s.tolist(),
+           "K": {"theta": K.theta.tolist(),
                  **{k: np.asarray(getattr(K, k)).tolist() for k in _TABLE},
                  "input_names": list(K.input_names), "output_names": list(K.output_names)}}
     try:
@@ -313,7 +313,7 @@ def _read_cache(path: Path, key: str) -> SealScheduledDesign | None:
         if doc["key"] != key or doc["ambseal_version"] != __version__:
             return None
         k = doc["K"]
-        W, (A, B, C, D) = _floats(k["speeds_rad_s"], 1), (_floats(k[n], 3) for n in _TABLE)
+        W, (A, B, C, D) = _floats(k["theta"], 1), (_floats(k[n], 3) for n in _TABLE)
         n_t, n = W.size, A.shape[1]
         ins, outs = [str(s) for s in k["input_names"]], [str(s) for s in k["output_names"]]
         if not (A.shape == (n_t, n, n) and B.shape == (n_t, n, len(ins))
@@ -357,5 +357,5 @@ def _synthesise(cfg, plant, args, scale: float, dl, lpvsyn_kw) -> SealScheduledD
     r = lpvsyn([g.P_nominal for g in gps], grid, gps[0].nmeas, gps[0].ncon,
                lyapunov="affine", rate_bound=nu, **lpvsyn_kw)
     return SealScheduledDesign(parameter, r.K, r.gamma, r.gamma_design, grid,
-                               r.check_rad_s, r.check_gamma, nu, w,
+                               r.check_grid, r.check_gamma, nu, w,
                                time.perf_counter() - t0, n, rf, dl.to_dict())

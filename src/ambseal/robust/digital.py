@@ -9,8 +9,9 @@ Systems*, 3rd ed., ch. 6):
    W_u, which no discretisation maps faithfully — are removed by singular perturbation
    (residualisation: the fast states held at their steady state, so the static gain is
    kept; Skogestad & Postlethwaite §11.4) in one state basis, the ordered real Schur basis
-   of the slow poles. The rise of γ (H∞) or μ that this costs is reported
-   (:func:`design_rise`); a fast pole that is unstable is refused. A fast pole that is
+   of the slow poles. The rise of γ (H∞) or μ that this costs is reported by the
+   caller's ``rise`` (the design layer's :func:`ambseal.design.fast_poles.design_rise`);
+   a fast pole that is unstable is refused. A fast pole that is
    stable and whose damped frequency |Im p|/2π lies below the same fraction of Nyquist
    aliases nothing under a hold equivalent (``z = e^{pT}`` inside the unit disc at an
    angle below π/2; a real pole, or a pair damped at ζ near 1, :func:`hold_keeps`), so
@@ -54,18 +55,17 @@ from scipy.signal import cont2discrete
 
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.lti.discrete import zoh
-from ambseal.lti.freqresp import freqresp, freqresp_at
+from ambseal.lti.freqresp import freqresp_at
 from ambseal.lti.interconnect import feedback_poles, series_inputs
 from ambseal.robust._digital_choice import first_stable as _first_stable
 from ambseal.robust._digital_choice import so_peak as _so_peak
 from ambseal.robust.delay import check_timing, loop_delay
 from ambseal.robust.digital_loop import DiscreteController
-from ambseal.robust.hinf import hinfnorm
 from ambseal.robust.stability import is_stable
 
 __all__ = ["FAST_FRACTION", "METHODS", "PEAK_TOLERANCE", "peak_difference",
            "DigitalController", "split_fast", "residualize", "hold_keeps", "HOLDS", "KEPT",
-           "discretize_as", "with_delay", "digital_controller", "design_rise", "check_rate",
+           "discretize_as", "with_delay", "digital_controller", "check_rate",
            "choose_method", "prewarp_frequency_hz", "SampledPlants", "sampled_plants"]
 
 #: Controller poles above this fraction of the Nyquist frequency are removed before
@@ -107,8 +107,8 @@ class DigitalController:
     removed_poles_hz : tuple of float
         |p|/2π of the removed controller poles (Hz).
     reduction : dict or None
-        The cost of the removal: ``order_full``, ``order`` and ``gamma_full``/``gamma`` or
-        ``mu_full``/``mu`` (:func:`design_rise`).
+        The cost of the removal as the caller's ``rise`` reports it (the design layer:
+        ``order_full``, ``order`` and ``gamma_full``/``gamma`` or ``mu_full``/``mu``).
     candidates : tuple of dict
         Each candidate method: per condition ``max_abs_z`` and the σ̄(S_o) peaks
         ``sensitivity_peak`` (discrete, delay included) and ``sensitivity_peak_continuous``
@@ -349,53 +349,6 @@ def with_delay(mats: Matrices, n: int) -> Matrices:
     return A, B, C, D
 
 
-def design_rise(result, K_reduced, omega=None, nyquist_hz: float | None = None
-                ) -> dict | None:
-    """γ (H∞) or peak μ (μ design, on the design's frequency grid ``omega``, rad/s) of the
-    design loop with the controller before and after the removal of fast poles, from a
-    :class:`~ambseal.design.recipes.DesignResult` with its generalised plant; ``None`` for
-    a design without one (PID, LPV) or a μ design without ``omega``.
-
-    γ is the H∞ norm over all frequencies (``gamma_full``, ``gamma``, ``rise``) and, with
-    ``nyquist_hz``, the peak of σ̄ up to the Nyquist frequency (``gamma_to_nyquist_full``,
-    ``gamma_to_nyquist``, ``rise_to_nyquist``): the fair number, since above Nyquist the
-    sampled controller does not act as either continuous one. On the test rig's H∞ design
-    (delay modelled) both rise alike, 2.19 → 3.09 (+41 %): the cost lies below Nyquist,
-    which is why the hold equivalents are also tried with real fast poles kept. The μ grid
-    ends at the top of the design band, below Nyquist."""
-    gp = getattr(result, "plant", None)
-    method = getattr(result, "method", None)
-    if (gp is None or method not in ("hinf", "mu") or not hasattr(gp, "closed_loop")
-            or (method == "mu" and omega is None)):
-        return None
-    out = {"order_full": int(result.K.nstates), "order": int(K_reduced.nstates)}
-    # the design's own verified γ / μ peak (same loop, same grid) is the "before"
-    if method == "hinf":
-        out["gamma_full"] = float(result.gamma)
-        out["gamma"] = float(hinfnorm(gp.closed_loop(K_reduced, nominal=True))[0])
-        out["rise"] = out["gamma"] / out["gamma_full"] - 1.0
-        if nyquist_hz:
-            g0, g1 = (_peak_to(gp.closed_loop(K, nominal=True), nyquist_hz)
-                      for K in (result.K, K_reduced))
-            out.update(gamma_to_nyquist_full=g0, gamma_to_nyquist=g1,
-                       rise_to_nyquist=g1 / g0 - 1.0)
-    else:
-        out["mu_full"] = float(result.mu)
-        out["mu"] = float(np.max(gp.mu(K_reduced, omega, peak=False).upper))
-        out["rise"] = out["mu"] / out["mu_full"] - 1.0
-    return out
-
-
-def _peak_to(sys, f_hz: float, n: int = 1600) -> float:
-    """Peak of σ̄(sys(jω)) for ω up to 2π f_hz: a log grid from f_hz/10⁵ with the damped
-    frequencies of the system's poles below f_hz added (a lightly damped peak is hit)."""
-    lam = np.linalg.eigvals(np.asarray(sys.A, float))
-    wp = np.abs(lam.imag)
-    w = np.concatenate([2 * np.pi * np.logspace(np.log10(f_hz) - 5, np.log10(f_hz), n),
-                        wp[(wp > 0) & (wp < 2 * np.pi * f_hz)]])
-    return float(np.max(np.linalg.svd(freqresp(sys, np.sort(w)), compute_uv=False)[:, 0]))
-
-
 def prewarp_frequency_hz(G_list, K: Matrices, fs: float) -> float | None:
     """Damped frequency (Hz) of the least-damped pole of the continuous loops below half
     of Nyquist, the frequency where the discrete controller's phase matters most."""
@@ -542,7 +495,7 @@ def digital_controller(K, sample_rate_hz: float, plants, *,
         Computation delay of the target (samples).
     rise : callable, optional
         ``rise(K_reduced) → dict or None`` reporting the cost of removing fast poles
-        (e.g. ``lambda Kr: design_rise(result, Kr)``); without it the controller's poles
+        (e.g. the rise of a design's H∞ norm or μ); without it the controller's poles
         are not removed and a rate below twice the highest is refused.
     methods : sequence of str
         Candidates, a subset of :data:`METHODS`.

@@ -1,25 +1,28 @@
-"""Gridded H∞ LPV synthesis by LMIs, scheduled on one parameter (the spin speed Ω).
+"""Gridded H∞ LPV synthesis by LMIs, scheduled on one measured parameter θ.
+
+θ is whatever the plants are gridded on, in its own unit (in ambseal's rotor layers the
+spin speed Ω in rad/s, or a seal coefficient in N/m); nothing here knows which.
 
 Thesis P3 §4 designs an LPV controller with the LMIs of Apkarian & Adams (1998) and a
-constant Lyapunov function (stability and performance under arbitrarily fast speed
+constant Lyapunov function (stability and performance under arbitrarily fast parameter
 changes); its conclusion suggests a parameter-dependent Lyapunov function with a bound on
-|Ω̇|. Both are here (Wu, Yang, Packard & Becker 1996; Apkarian & Adams 1998 §3):
+|θ̇|. Both are here (Wu, Yang, Packard & Becker 1996; Apkarian & Adams 1998 §3):
 
-Generalised plant P(Ω) (inputs [w, u], outputs [z, y], as :func:`ambseal.robust.hinfsyn`)
-with A(Ω) varying and B, C, D constant (true for the rig: Ω enters through stiffness,
-damping and gyroscopic terms only), D22 = 0. Find γ, R = Rᵀ (constant) and
-S(Ω) = Σ_i f_i(Ω) S_i (f_0 = 1; ``"constant"``: S_0 only) such that on every grid point Ω_k
-and for Ω̇ = ±ν (``rate_bound``)::
+Generalised plant P(θ) (inputs [w, u], outputs [z, y], as :func:`ambseal.robust.hinfsyn`)
+with A(θ) varying and B, C, D constant (true for a rotor scheduled on its speed: Ω
+enters through stiffness, damping and gyroscopic terms only), D22 = 0. Find γ, R = Rᵀ (constant) and
+S(θ) = Σ_i f_i(θ) S_i (f_0 = 1; ``"constant"``: S_0 only) such that on every grid point θ_k
+and for θ̇ = ±ν (``rate_bound``)::
 
     N_Rᵀ [A R + R Aᵀ,  R C1ᵀ,  B1;  C1 R, −γI, D11;  B1ᵀ, D11ᵀ, −γI] N_R ≺ 0
-    N_Sᵀ [Aᵀ S + S A ± ν ∂S/∂Ω,  S B1,  C1ᵀ;  B1ᵀ S, −γI, D11ᵀ;  C1, D11, −γI] N_S ≺ 0
+    N_Sᵀ [Aᵀ S + S A ± ν ∂S/∂θ,  S B1,  C1ᵀ;  B1ᵀ S, −γI, D11ᵀ;  C1, D11, −γI] N_S ≺ 0
     [R, I; I, S] ⪰ 0
 
 with N_R = diag(null[B2ᵀ D12ᵀ], I), N_S = diag(null[C2 D21], I) (the projected, or
 elimination, conditions of Gahinet & Apkarian 1994). Keeping R constant makes the controller
-independent of Ω̇ (Apkarian & Adams 1998 §3.2).
+independent of θ̇ (Apkarian & Adams 1998 §3.2).
 
-Controller reconstruction at any Ω: with M = I, N(Ω) = I − S(Ω) R the linearising change of
+Controller reconstruction at any θ: with M = I, N(θ) = I − S(θ) R the linearising change of
 variables (Scherer, Gahinet & Chilali 1997) turns the closed-loop bounded-real inequality
 into an LMI in (Â, B̂, Ĉ) (D_K = 0); its minimum-norm solution at a γ slightly above the
 design γ gives B_K = N⁻¹B̂, C_K = Ĉ, A_K = N⁻¹(Â − B̂ C2 R − S B2 Ĉ − S A R). Controllers
@@ -71,20 +74,22 @@ __all__ = ["FrozenClosedLoop", "LpvController", "LpvSynResult", "lpvsyn", "Solve
 
 @dataclass(frozen=True, eq=False)
 class LpvController:
-    """A controller scheduled on Ω, tabulated and interpolated linearly between entries.
+    """A controller scheduled on a parameter θ, tabulated and interpolated linearly between
+    entries.
 
-    ``u = K(Ω) y`` in the generalised plant's convention (positive feedback, synthesis
-    units); :func:`ambseal.design.lpv_design.design_lpv` wraps it in physical units.
+    ``u = K(θ) y`` in the generalised plant's convention (the lower LFT F_l(P, K),
+    positive feedback); θ is whatever the plants were gridded on, in its own unit (a
+    rotor speed in rad/s, a stiffness in N/m, …).
 
     Attributes
     ----------
-    speeds_rad_s : ndarray, shape (n_t,)
-        Table speeds Ω (rad/s), where the controller was reconstructed exactly.
+    theta : ndarray, shape (n_t,)
+        Table values of θ, where the controller was reconstructed exactly.
     AK, BK, CK, DK : ndarray, shapes (n_t, n_K, n_K), (n_t, n_K, ny), (n_t, nu, n_K), (n_t, nu, ny)
     input_names, output_names : tuple of str
     """
 
-    speeds_rad_s: np.ndarray
+    theta: np.ndarray
     AK: np.ndarray = field(repr=False)
     BK: np.ndarray = field(repr=False)
     CK: np.ndarray = field(repr=False)
@@ -96,38 +101,33 @@ class LpvController:
     def order(self) -> int:
         return self.AK.shape[1]
 
-    def matrices(self, speed_rad_s: float) -> tuple[np.ndarray, ...]:
-        """(A_K, B_K, C_K, D_K) at Ω (rad/s), linear between table speeds, held at the ends."""
+    def matrices(self, theta: float) -> tuple[np.ndarray, ...]:
+        """(A_K, B_K, C_K, D_K) at θ, linear between table values, held at the ends."""
 
-        return tuple(interp_table(float(speed_rad_s), self.speeds_rad_s, X)
+        return tuple(interp_table(float(theta), self.theta, X)
                      for X in (self.AK, self.BK, self.CK, self.DK))
 
-    def at(self, speed_rad_s: float, *, name: str = "K_lpv"):
-        """The frozen controller at Ω (rad/s) as a named ``control.StateSpace``, synthesis
-        units (the physical one: :meth:`ambseal.design.lpv_design.LpvDesign.controller_at`).
-        """
+    def at(self, theta: float, *, name: str = "K_lpv"):
+        """The frozen controller at θ as a named ``control.StateSpace`` (the generalised
+        plant's signals and convention)."""
 
-        A, B, C, D = self.matrices(speed_rad_s)
+        A, B, C, D = self.matrices(theta)
         return control.ss(A, B, C, D,
                           inputs=list(self.input_names), outputs=list(self.output_names),
                           states=[f"xK{i}" for i in range(A.shape[0])], name=name)
 
-    def at_hz(self, speed_hz: float, **kw):
-        """:meth:`at` with the speed in Hz."""
-        return self.at(2 * np.pi * speed_hz, **kw)
-
 
 @dataclass(frozen=True, eq=False)
 class FrozenClosedLoop:
-    """Ω ↦ F_l(P(Ω), K(Ω)) of an LPV design: the plant's A interpolated between the grid
-    plants as :func:`lpvsyn` does (cubic Hermite with the slopes dA/dΩ where the data are
+    """θ ↦ F_l(P(θ), K(θ)) of an LPV design: the plant's A interpolated between the grid
+    plants as :func:`lpvsyn` does (cubic Hermite with the slopes dA/dθ where the data are
     smooth, linear at kinks), the controller interpolated from its table.
 
-    Calling it with Ω (rad/s) gives a ``control.StateSpace`` with the plant's ``w`` inputs
+    Calling it with θ gives a ``control.StateSpace`` with the plant's ``w`` inputs
     and ``z`` outputs and their names.
     """
 
-    grid_rad_s: np.ndarray = field(repr=False)
+    grid: np.ndarray = field(repr=False)
     A: np.ndarray = field(repr=False)
     dA: np.ndarray = field(repr=False)
     B: np.ndarray = field(repr=False)
@@ -139,9 +139,9 @@ class FrozenClosedLoop:
     inputs: tuple = ()
     outputs: tuple = ()
 
-    def __call__(self, speed_rad_s: float):
-        W = float(speed_rad_s)
-        A = interp_A(self.A, self.dA, self.grid_rad_s)(W)
+    def __call__(self, theta: float):
+        W = float(theta)
+        A = interp_A(self.A, self.dA, self.grid)(W)
         Acl, Bcl, Ccl, Dcl = lft_lower_matrices((A, self.B, self.C, self.D),
                                                 self.K.matrices(W), self.nmeas, self.ncon)
         return ct.ss(Acl, Bcl, Ccl, Dcl, inputs=list(self.inputs) or None,
@@ -158,16 +158,16 @@ class LpvSynResult:
         The scheduled controller (table on the check grid).
     gamma : float
         Optimal γ of the LMIs (upper bound of the L2 gain of the LPV closed loop for all
-        speed trajectories in the grid range with |Ω̇| ≤ ν; ν = ∞ for ``"constant"``).
+        parameter trajectories in the grid range with |θ̇| ≤ ν; ν = ∞ for ``"constant"``).
     gamma_design : float
         Backed-off γ at which R, S and the controllers were computed.
     lyapunov : str
-        ``"constant"``, ``"affine"`` or ``"quadratic"`` S(Ω).
+        ``"constant"``, ``"affine"`` or ``"quadratic"`` S(θ).
     rate_bound : float or None
-        ν (rad/s²).
-    grid_rad_s : ndarray
+        ν (θ's unit per second).
+    grid : ndarray
         Design grid.
-    check_rad_s : ndarray
+    check_grid : ndarray
         Check grid (= controller table).
     check_gamma : ndarray
         H∞ norm of each frozen closed loop on the check grid (inf if unstable).
@@ -178,13 +178,13 @@ class LpvSynResult:
     time_s : float
         Total wall time (s).
     closed_loop : FrozenClosedLoop
-        Ω ↦ the frozen closed loop F_l(P(Ω), K(Ω)) as a named ``control.StateSpace``: the
+        θ ↦ the frozen closed loop F_l(P(θ), K(θ)) as a named ``control.StateSpace``: the
         LPV closed loop depends on the parameter, so it is a function, not one system.
 
     Notes
     -----
     ``K, CL, gamma, info = lpvsyn(...)`` unpacks as :func:`~ambseal.robust.hinf.hinfsyn`
-    does, with ``CL`` the function :attr:`closed_loop` (``CL(Ω)``, rad/s).
+    does, with ``CL`` the function :attr:`closed_loop` (``CL(θ)``).
     """
 
     K: LpvController
@@ -192,8 +192,8 @@ class LpvSynResult:
     gamma_design: float
     lyapunov: str
     rate_bound: float | None
-    grid_rad_s: np.ndarray = field(repr=False)
-    check_rad_s: np.ndarray = field(repr=False)
+    grid: np.ndarray = field(repr=False)
+    check_grid: np.ndarray = field(repr=False)
     check_gamma: np.ndarray = field(repr=False)
     check_stable: bool = False
     reports: tuple = ()
@@ -201,7 +201,7 @@ class LpvSynResult:
     closed_loop: Any = field(default=None, repr=False)
 
     def __iter__(self):
-        """``K, CL, gamma, info = lpvsyn(...)``: the scheduled controller, Ω ↦ the frozen
+        """``K, CL, gamma, info = lpvsyn(...)``: the scheduled controller, θ ↦ the frozen
         closed loop, γ, and this result for the rest."""
         return iter((self.K, self.closed_loop, self.gamma, self))
 
@@ -213,8 +213,7 @@ class LpvSynResult:
     def to_dict(self) -> dict:
         return {"gamma": self.gamma, "gamma_design": self.gamma_design,
                 "lyapunov": self.lyapunov, "rate_bound_rad_s2": self.rate_bound,
-                "grid_hz": (self.grid_rad_s / (2 * np.pi)).tolist(),
-                "check_hz": (self.check_rad_s / (2 * np.pi)).tolist(),
+                "grid": self.grid.tolist(), "check_grid": self.check_grid.tolist(),
                 "check_gamma": [float(g) if np.isfinite(g) else None for g in self.check_gamma],
                 "check_gamma_max": float(np.max(self.check_gamma)),
                 "check_stable": self.check_stable, "controller_order": self.K.order,
@@ -223,7 +222,7 @@ class LpvSynResult:
 
 # --------------------------------------------------------------------------- synthesis
 @with_numerics_threads
-def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
+def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
            dA: Sequence[np.ndarray] | None = None, lyapunov: str = "constant",
            rate_bound: float | None = None, backoff: float = 1.05,
            check_density: int = 5, solver_options: dict | None = None,
@@ -233,15 +232,15 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
 
     Stages, the first two SDPs solved by CVXOPT and required to end ``optimal``:
 
-    1. ``"gamma"``: minimise γ + penalty·(tr R + mean_k tr S(Ω_k))/N subject to the
-       projected LMIs and [R, αI; αI, S(Ω_k)] ⪰ 0 with α = ``coupling_ratio`` > 1, i.e.
+    1. ``"gamma"``: minimise γ + penalty·(tr R + mean_k tr S(θ_k))/N subject to the
+       projected LMIs and [R, αI; αI, S(θ_k)] ⪰ 0 with α = ``coupling_ratio`` > 1, i.e.
        S R ⪰ α² I: I − S R then has its eigenvalues at distance ≥ α² − 1 from 0 and the
        controller reconstruction is well conditioned, at a slightly higher γ (still a valid
        upper bound). The small trace term keeps the SDP bounded near the optimum, where R
        or S would otherwise grow without limit (a hard cap on R, S sits on the cap and
        stalls the interior point).
     2. ``"centre"`` (only with ``centre=True``): stage 1 with α = 1, then at
-       γ_d = backoff·γ minimise tr R + mean_k tr S(Ω_k) with α = ``coupling_ratio``
+       γ_d = backoff·γ minimise tr R + mean_k tr S(θ_k) with α = ``coupling_ratio``
        (lowered towards 1 if infeasible). Gives the least conservative γ, but on the
        turboexpander with a dynamic W_u this second SDP ended "almost solved" with the
        former solver, Clarabel (refused).
@@ -251,24 +250,24 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
     Parameters
     ----------
     plants : sequence of control.StateSpace, length n_p
-        Frozen generalised plants P(Ω_k), inputs ``[w, u]``, outputs ``[z, y]``, one state
+        Frozen generalised plants P(θ_k), inputs ``[w, u]``, outputs ``[z, y]``, one state
         basis; only A may differ between them; D22 = 0.
-    speeds_rad_s : array_like, shape (n_p,)
-        The grid Ω_k (rad/s), strictly increasing, n_p ≥ 2.
+    theta : array_like, shape (n_p,)
+        The grid θ_k (θ's unit), strictly increasing, n_p ≥ 2.
     nmeas, ncon : int
         Measurements (last outputs) and controls (last inputs).
     dA : sequence of ndarray (n_p, N, N), optional
-        dA/dΩ at the grid points (1/s per rad/s); needed for a rate bound with a
+        dA/dθ at the grid points (1/s per unit of θ); needed for a rate bound with a
         parameter-dependent S. Default: finite differences of the grid.
     lyapunov : {"constant", "affine", "quadratic"}
-        S(Ω) = S_0 (thesis P3), S_0 + p S_1, or S_0 + p S_1 + p² S_2 with
-        p = (Ω − Ω_mid)/Ω_half ∈ [−1, 1]. R is always constant.
+        S(θ) = S_0 (thesis P3), S_0 + p S_1, or S_0 + p S_1 + p² S_2 with
+        p = (θ − θ_mid)/θ_half ∈ [−1, 1]. R is always constant.
     rate_bound : float, optional
-        ν ≥ |Ω̇| (rad/s²); required for, and only allowed with, a parameter-dependent S.
+        ν ≥ |θ̇| (θ's unit per second); required for, and only allowed with, a parameter-dependent S.
     backoff : float
         R, S and controllers are computed at ``backoff·γ`` (≥ 1).
     check_density : int
-        The controller table (and check grid) has ``check_density·(n_p − 1) + 1`` speeds.
+        The controller table (and check grid) has ``check_density·(n_p − 1) + 1`` values.
     solver_options : dict, optional
         CVXOPT's ``abstol``, ``reltol``, ``feastol``, ``maxiters``, ``refinement``
         (e.g. ``{"maxiters": 200}``); defaults: CVXOPT's own (gaps 1e-7 absolute, 1e-6
@@ -290,7 +289,7 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
     -------
     LpvSynResult
         Unpacks as ``K, CL, gamma, info`` (python-control's ``hinfsyn`` order), ``CL`` the
-        frozen closed loop as a function of Ω (:class:`FrozenClosedLoop`).
+        frozen closed loop as a function of θ (:class:`FrozenClosedLoop`).
 
     Raises
     ------
@@ -311,7 +310,7 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
     """
 
     t_start = time.perf_counter()
-    grid, As, dAs, B, C, D, nw, nz = _validate(plants, speeds_rad_s, nmeas, ncon, dA,
+    grid, As, dAs, B, C, D, nw, nz = _validate(plants, theta, nmeas, ncon, dA,
                                                lyapunov, rate_bound, backoff,
                                                coupling_ratio, penalty)
     sc = scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling)
@@ -345,32 +344,32 @@ def lpvsyn(plants: Sequence[Any], speeds_rad_s, nmeas: int, ncon: int, *,
     CL = FrozenClosedLoop(grid, As, dAs, B, C, D, K, nmeas, ncon, *map(tuple, names))
     return LpvSynResult(K=K, gamma=gamma, gamma_design=gamma_d, lyapunov=lyapunov,
                         rate_bound=None if rate_bound is None else float(rate_bound),
-                        grid_rad_s=grid, check_rad_s=table, check_gamma=check_g,
+                        grid=grid, check_grid=table, check_gamma=check_g,
                         check_stable=True, reports=tuple(reports),
                         time_s=time.perf_counter() - t_start, closed_loop=CL)
 
 
-def _validate(plants, speeds_rad_s, nmeas, ncon, dA, lyapunov, rate_bound, backoff,
+def _validate(plants, theta, nmeas, ncon, dA, lyapunov, rate_bound, backoff,
               coupling_ratio, penalty):
     """Checked grid and plant data of :func:`lpvsyn`: (grid, A stack, dA stack, B, C, D,
     n_w, n_z); raises SynthesisError as documented there."""
-    grid = np.asarray(speeds_rad_s, float).ravel()
+    grid = np.asarray(theta, float).ravel()
     if grid.size < 2 or len(plants) != grid.size:
-        raise SynthesisError(f"lpvsyn: the speed grid needs at least 2 points with one plant "
-                             f"each; got {grid.size} speeds and {len(plants)} plants")
+        raise SynthesisError(f"lpvsyn: the θ grid needs at least 2 points with one plant "
+                             f"each; got {grid.size} values and {len(plants)} plants")
     if np.any(np.diff(grid) <= 0) or not np.all(np.isfinite(grid)):
-        raise SynthesisError("lpvsyn: speeds_rad_s must be finite and strictly increasing")
+        raise SynthesisError("lpvsyn: theta must be finite and strictly increasing")
     if lyapunov not in BASES:
         raise SynthesisError(f"lpvsyn: lyapunov={lyapunov!r}; expected one of {sorted(BASES)}")
     if lyapunov == "constant" and rate_bound is not None:
         raise SynthesisError(
             "lpvsyn: a rate bound needs a parameter-dependent Lyapunov function "
             "(lyapunov='affine' or 'quadratic'); a constant one already allows arbitrarily "
-            "fast speed changes")
+            "fast parameter changes")
     if lyapunov != "constant" and (rate_bound is None or not np.isfinite(rate_bound)
                                    or rate_bound < 0):
         raise SynthesisError(f"lpvsyn: lyapunov={lyapunov!r} needs a finite rate_bound ≥ 0 "
-                             f"(rad/s²), got {rate_bound!r}")
+                             f"(θ's unit per second), got {rate_bound!r}")
     if backoff < 1.0:
         raise SynthesisError(f"lpvsyn: backoff={backoff} must be ≥ 1")
     As = np.array([np.asarray(P.A, float) for P in plants])
@@ -382,7 +381,7 @@ def _validate(plants, speeds_rad_s, nmeas, ncon, dA, lyapunov, rate_bound, backo
             if np.shape(Y) != X.shape or not np.allclose(np.asarray(Y, float), X,
                                                          rtol=1e-9, atol=1e-12 * max(1.0, np.abs(X).max())):
                 raise SynthesisError(f"lpvsyn: plant {k} differs from plant 0 in {nm}; only A "
-                                     "may depend on the speed (one state basis)")
+                                     "may depend on θ (one state basis)")
     nw, nz = B.shape[1] - ncon, C.shape[0] - nmeas
     if nw <= 0 or nz <= 0 or ncon <= 0 or nmeas <= 0:
         raise SynthesisError(f"lpvsyn: bad channel counts (nw={nw}, nz={nz}, ncon={ncon}, "
@@ -403,7 +402,7 @@ def _validate(plants, speeds_rad_s, nmeas, ncon, dA, lyapunov, rate_bound, backo
 
 
 def _check_table(K: LpvController, A_of, B, C, D, nmeas: int, ncon: int) -> np.ndarray:
-    """H∞ norms of the frozen closed loops at the table speeds (checked stable there and at
+    """H∞ norms of the frozen closed loops at the table values (checked stable there and at
     the table midpoints, with the interpolated controller).
 
     Raises
@@ -412,7 +411,7 @@ def _check_table(K: LpvController, A_of, B, C, D, nmeas: int, ncon: int) -> np.n
         If one of these frozen closed loops is unstable.
     """
 
-    table = K.speeds_rad_s
+    table = K.theta
     check_g, stable = [], True
     for W in table:
         Acl, Bcl, Ccl, Dcl = lft_lower_matrices((A_of(W), B, C, D), K.matrices(W), nmeas, ncon)

@@ -58,7 +58,7 @@ def test_rerun_replaces_the_folder_as_a_whole(tmp_path):
     _write(out, "new", n=2)
     assert check_manifest(out) != first
     assert _tags(out) == {"new"} and not (out / "f4.txt").exists()
-    assert sorted(p.name for p in tmp_path.iterdir()) == [".out.lock", "out"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no lock left
 
 
 def test_failed_run_keeps_the_former_set(tmp_path):
@@ -121,7 +121,7 @@ def test_killed_runs_never_leave_a_mix(tmp_path):
         check_manifest(out)
         assert len(_tags(out)) == 1
     _write(out, "last", n=1)
-    assert sorted(p.name for p in tmp_path.iterdir()) == [".out.lock", "out"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no lock left
 
 
 def test_full_disk_refused_before_work(tmp_path, capsys, monkeypatch):
@@ -186,7 +186,7 @@ def test_killed_ambseal_run(tmp_path):
     assert (out / "metrics.json").exists() and (out / "report.html").exists()
     subprocess.run(cmd, env=env, check=True, capture_output=True)
     assert check_manifest(out) != first
-    assert sorted(p.name for p in tmp_path.iterdir()) == [".out.lock", "out"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no lock left
 
 
 def test_run_refuses_a_folder_with_a_users_notes_beside_metrics(tmp_path, capsys):

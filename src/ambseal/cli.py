@@ -205,6 +205,9 @@ def _parser() -> argparse.ArgumentParser:
                         "the load-step CSV that identify --static-load reads")
     a.add_argument("--pressure-bar", type=_finite, required=True, help="seal pressure drop (bar)")
     a.add_argument("--out", required=True, help="record file: .csv (+ .csv.json) or .mat")
+    a.add_argument("--force", action="store_true",
+                   help="replace --out (and its sidecar) even if ambseal did not write them "
+                        "(a link is replaced, never written through)")
     # the excitation defaults follow from the rig (ambseal.identify.excitation)
     a.add_argument("--amplitude-a", type=_positive, default=None,
                    help="excitation amplitude (A; default [design.impulse] amplitude_a, else "
@@ -318,6 +321,9 @@ def _rotordynamics_parsers(sub) -> None:
                         "open-loop model)")
     m.add_argument("--shapes", nargs="?", const="mode_shapes.png", default=None,
                    metavar="PNG", help="plot the mode shapes (default file mode_shapes.png)")
+    m.add_argument("--force", action="store_true",
+                   help="replace the --shapes file even if ambseal did not write it (a link "
+                        "is replaced, never written through)")
     g = m.add_mutually_exclusive_group()
     g.add_argument("--free", action="store_true", help="bare rotor: shaft and disks only")
     g.add_argument("--no-amb", action="store_true", help="leave the AMBs out")
@@ -356,6 +362,9 @@ def _rotordynamics_parsers(sub) -> None:
     r = sub.add_parser("import-ross", help="a ROSS rotor file (.toml/.json) as an ambseal rig")
     r.add_argument("file", help="ROSS rotor file saved by ross.Rotor.save")
     r.add_argument("--out", required=True, help="rig file to write (TOML)")
+    r.add_argument("--force", action="store_true",
+                   help="replace --out even if ambseal did not write it (a link is "
+                        "replaced, never written through)")
     r.add_argument("--speed-rpm", type=float, default=None,
                    help="take frequency-dependent bearing coefficients at this speed's "
                         "synchronous frequency, as ROSS's run_modal(speed) does, and make it "
@@ -424,6 +433,7 @@ def _inputs(args: argparse.Namespace) -> tuple[list, str]:
     rig = getattr(args, "rig", None) or getattr(args, "file", None) or default_rig_path()
     ctrl = getattr(args, "controller", None)  # a file, or a method's name (pid, hinf, ...)
     files = [rig, getattr(args, "truth", None), getattr(args, "out", None),
+             getattr(args, "shapes", None), getattr(args, "c_dir", None),
              *(getattr(args, "data", None) or []),
              ctrl if ctrl and Path(ctrl).suffix.lower() in (".json", ".npz", ".mat") else None]
     return files, str(rig)

@@ -23,6 +23,7 @@ import os
 import re
 import shutil
 import stat
+import sys
 import tempfile
 import tomllib
 import uuid
@@ -31,8 +32,10 @@ from typing import Any, BinaryIO, Callable
 
 from ambseal.errors import AmbsealError
 
-__all__ = ["atomic_write", "writable_folder", "input_file", "MAX_READ_BYTES", "read_text", "load_toml", "write_text", "write_json", "RunFolder", "check_manifest",
-           "write_manifest", "OwnedFolder", "foreign_entries"]
+__all__ = ["atomic_write", "writable_folder", "input_file", "MAX_READ_BYTES", "read_text",
+           "load_toml", "write_text", "write_json", "RunFolder", "check_manifest",
+           "write_manifest", "OwnedFolder", "foreign_entries", "claim_file", "stamp_text",
+           "stamp_holds"]
 
 
 def atomic_write(path: str | os.PathLike, write: Callable[[BinaryIO], Any]) -> Path:
@@ -164,6 +167,80 @@ def write_json(path: str | os.PathLike, data: Any) -> Path:
     return write_text(path, json.dumps(data, indent=2, allow_nan=False) + "\n")
 
 
+# --- one output file ------------------------------------------------------------------
+
+#: The key of the first line of a text file ambseal writes on its own (a rig from
+#: ``import-ross``): ``<comment> ambseal-sha256: <SHA-256 of the lines below>``.
+STAMP_KEY = "ambseal-sha256"
+_STAMP = re.compile(rb"^\S{1,3} " + STAMP_KEY.encode() + rb": ([0-9a-f]{64})[^\n]*\n")
+
+
+def stamp_text(text: str, comment: str = "#") -> str:
+    """``text`` after a first line ``<comment> ambseal-sha256: <hex>``, the SHA-256 of the
+    UTF-8 ``text``: the mark by which ambseal knows the file as its own and unchanged
+    (:func:`stamp_holds`)."""
+    digest = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    return f"{comment} {STAMP_KEY}: {digest}\n{text}"
+
+
+def stamp_holds(path: str | os.PathLike) -> bool:
+    """True if ``path`` is a regular file that :func:`stamp_text` made and nobody changed
+    since (its first line's hash is the hash of the rest)."""
+    try:
+        data = input_file(path).read_bytes()
+    except (AmbsealError, OSError):
+        return False
+    m = _STAMP.match(data)
+    return m is not None and hashlib.sha256(data[m.end():]).hexdigest() == m.group(1).decode()
+
+
+def claim_file(path: str | os.PathLike, *, force: bool = False,
+               ours: Callable[[Path], bool] = stamp_holds) -> Path:
+    """``path`` checked before a command writes it as one file (a rig, a record, a figure).
+
+    The rule of every output of ambseal: it writes a path that does not exist, or one that
+    it wrote itself and nobody changed since (``ours(path)``: the file's own mark — the
+    stamp of :func:`stamp_text`, a record's sidecar, a figure's PNG text), or any regular
+    file or symbolic link when the user passes ``--force`` (a link is then replaced, never
+    written through: :func:`atomic_write` renames over it).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file to write.
+    force : bool
+        The user's ``--force``.
+    ours : callable
+        ``ours(path) → bool``, whether ambseal wrote the existing file (default
+        :func:`stamp_holds`).
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    AmbsealError
+        One line naming the path and the way out: it exists and is not ambseal's (or was
+        changed), it is a symbolic link, or it is a folder or another non-file.
+    """
+    path = Path(path)
+    if not os.path.lexists(path):
+        return path
+    if path.is_symlink():
+        if force:
+            return path
+        raise AmbsealError(f"{path}: is a symbolic link; ambseal does not write through "
+                           "links: choose a new name, or pass --force to replace the link "
+                           "(not its target)")
+    if not path.is_file():
+        raise AmbsealError(f"{path}: exists and is not a file; choose a new name")
+    if force or ours(path):
+        return path
+    raise AmbsealError(f"{path}: exists and ambseal did not write it (or it was changed "
+                       "since); choose a new name, or pass --force to replace it")
+
+
 # --- one output folder = one run -------------------------------------------------------
 
 #: Free space (bytes) a run needs in its output folder's file system, checked before any
@@ -177,14 +254,20 @@ _RENAME_EXCHANGE = 2  # linux/fs.h
 _AT_FDCWD = -100
 
 
-def _pid_alive(pid: int) -> bool:
+def _open_lock(path: Path, fail) -> int:
+    """The lock file's descriptor, created exclusively or opened, never through a symbolic
+    link; ``fail(what, exc)`` makes the error."""
+    flags = os.O_RDWR | os.O_CLOEXEC | os.O_NOFOLLOW
     try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
+        try:
+            return os.open(path, flags | os.O_CREAT | os.O_EXCL, 0o644)
+        except FileExistsError:
+            return os.open(path, flags)
+    except OSError as exc:
+        if os.path.islink(path):
+            raise AmbsealError(f"{path}: the lock file is a symbolic link; ambseal does not "
+                               "write through links: remove it") from None
+        raise fail("create its lock", exc) from None
 
 
 def _exchange(a: Path, b: Path) -> bool:
@@ -355,23 +438,47 @@ class RunFolder:
         self.stage = self.parent / f".{name}.staging-{os.getpid()}"
         self.old = self.parent / f".{name}.old-{os.getpid()}"
         self._lock_fd: int | None = None
+        self.stale_pid: int | None = None
+        self.stale_since = 0.0
 
     def _fail(self, what: str, exc: OSError) -> AmbsealError:
         return AmbsealError(f"{self.out}: cannot {what} ({exc.strerror or exc})")
 
     def _lock(self) -> None:
+        """Take the lock file: created or opened without following a symbolic link
+        (``O_NOFOLLOW``: a link planted there is refused, its target never touched), then
+        ``flock``; a lock left by a process that is gone (``kill -9``) is taken over with a
+        note on stderr. The lock file holds the owner's pid and is removed on release."""
         try:
             self.parent.mkdir(parents=True, exist_ok=True)
-            fd = os.open(self.lock_path, os.O_RDWR | os.O_CREAT, 0o644)
         except OSError as exc:
             raise self._fail("create the output folder", exc) from None
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            owner = os.pread(fd, 32, 0).decode("ascii", "replace").strip() or "?"
-            os.close(fd)
-            raise AmbsealError(f"{self.out}: another ambseal run (pid {owner}) is writing "
-                               "this folder; wait for it or choose another --out") from None
+        for _ in range(8):  # the file may be removed by its owner between open and flock
+            fd = _open_lock(self.lock_path, self._fail)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                owner = os.pread(fd, 32, 0).decode("ascii", "replace").strip() or "?"
+                os.close(fd)
+                raise AmbsealError(f"{self.out}: another ambseal run (pid {owner}) is writing "
+                                   "this folder; wait for it or choose another --out") from None
+            try:
+                same = os.fstat(fd).st_ino == os.stat(self.lock_path,
+                                                      follow_symlinks=False).st_ino
+            except OSError:
+                same = False
+            if same:
+                break
+            os.close(fd)  # locked a file its owner had just removed: take the new one
+        else:
+            raise AmbsealError(f"{self.lock_path}: the lock keeps changing hands; try again")
+        previous = os.pread(fd, 32, 0).decode("ascii", "replace").split()
+        self.stale_since = os.fstat(fd).st_mtime  # when the former owner took it
+        self.stale_pid = int(previous[0]) if previous and previous[0].isdigit() \
+            and int(previous[0]) != os.getpid() else None
+        if self.stale_pid is not None:
+            print(f"ambseal: note: {self.out}: took over the lock of pid {self.stale_pid}, "
+                  "which is no longer running", file=sys.stderr)
         os.ftruncate(fd, 0)
         os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
         self._lock_fd = fd
@@ -436,15 +543,16 @@ class RunFolder:
         finally:
             self._unlock()
 
-    def _check_ours(self) -> None:
-        """AmbsealError unless ``out`` is new, or a folder of nothing but its manifest's."""
+    def _check_ours(self, adopted: frozenset = frozenset()) -> None:
+        """AmbsealError unless ``out`` is new, or a folder of nothing but its manifest's
+        (and the ``adopted`` entries)."""
         if not os.path.lexists(self.out):
             return
         if self.out.is_symlink() or not self.out.is_dir():
             raise AmbsealError(f"{self.out}: exists and is not a folder; choose an empty or "
                                "new --out")
         try:
-            extra = foreign_entries(self.out)
+            extra = [e for e in foreign_entries(self.out) if e.rstrip("/") not in adopted]
         except OSError as exc:
             raise self._fail("read the output folder", exc) from None
         if extra:
@@ -468,7 +576,15 @@ class RunFolder:
             moved.append((src, dst))
 
     def _unlock(self) -> None:
+        """Release the lock and remove its file (while holding it, and only the file this
+        process locked): nothing is left beside or in the output."""
         if self._lock_fd is not None:
+            try:
+                if os.fstat(self._lock_fd).st_ino == os.stat(
+                        self.lock_path, follow_symlinks=False).st_ino:
+                    os.unlink(self.lock_path)
+            except OSError:
+                pass
             os.close(self._lock_fd)
             self._lock_fd = None
 
@@ -501,7 +617,8 @@ class OwnedFolder(RunFolder):
             FOLDER_LOCK}
 
     def __enter__(self) -> Path:
-        self._check_ours()
+        if not os.path.lexists(self.lock_path):  # else perhaps a killed command's: see below
+            self._check_ours()
         self._created = not self.out.exists()
         try:
             self.out.mkdir(parents=True, exist_ok=True)
@@ -509,14 +626,32 @@ class OwnedFolder(RunFolder):
             raise self._fail("create the output folder", exc) from None
         self._lock()
         try:
-            self._check_ours()  # again, under the lock
+            adopted = self._killed_outputs()
+            self._check_ours(adopted)  # again, under the lock
             writable_folder(self.out)
             self._before = self._entries()
-            self._listed = set().union(*_listed(_read_manifest(self.out)))
+            self._listed = set().union(*_listed(_read_manifest(self.out))) | adopted
         except BaseException:
             self._release()
             raise
         return self.out
+
+    def _killed_outputs(self) -> frozenset:
+        """The entries a command killed in this folder left (its lock, now taken over, was
+        still there): those not in the manifest that changed after it took the lock. They
+        are ambseal's partial outputs, replaced by this command (noted on stderr)."""
+        if self.stale_pid is None:
+            return frozenset()
+        try:
+            rel = [e.rstrip("/") for e in foreign_entries(self.out)]
+            out = frozenset(e for e in rel if os.lstat(self.out / e).st_mtime
+                            >= self.stale_since - 1.0)
+        except OSError:
+            return frozenset()
+        if out:
+            print(f"ambseal: note: {self.out}: {', '.join(sorted(out))}: left by the killed "
+                  f"command (pid {self.stale_pid}); taken as ambseal's", file=sys.stderr)
+        return out
 
     def __exit__(self, kind, exc, tb) -> None:
 
@@ -536,9 +671,7 @@ class OwnedFolder(RunFolder):
             empty = self._created and not self._entries()
         except OSError:
             empty = False
-        if empty:
-            self.lock_path.unlink(missing_ok=True)
-        self._unlock()
+        self._unlock()  # removes the lock file too
         if empty:
             try:
                 self.out.rmdir()

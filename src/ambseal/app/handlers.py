@@ -31,9 +31,9 @@ from ambseal.config import default_rig_path, load_rig, load_truth
 from ambseal.errors import AmbsealError, ConfigError, with_source
 from ambseal.export.codegen import c_identifier, write_c
 from ambseal.export.controller_files import load_controller
-from ambseal.files import OwnedFolder, writable_folder
+from ambseal.files import OwnedFolder, claim_file, stamp_holds, writable_folder
 from ambseal.identify import signals
-from ambseal.identify.data import save_measurement
+from ambseal.identify.data import record_is_ours, save_measurement
 from ambseal.identify.excitation import IMPULSE_LEAD, excitation_plan
 from ambseal.identify.stages import acquire
 from ambseal.identify.static_load import save_static_record, virtual_static_load
@@ -47,7 +47,13 @@ __all__ = ["HANDLERS"]
 def _acquire_cmd(args: argparse.Namespace) -> int:
     cfg = load_rig(args.rig)
     truth = load_truth(args.truth)
-    writable_folder(Path(args.out).parent)  # before the simulation
+    out = Path(args.out)
+    writable_folder(out.parent)  # before the simulation
+    # a record and its sidecar are written as a pair: each new, or the pair ambseal wrote
+    claim_file(out, force=args.force,
+               ours=record_is_ours if args.excitation != "static" else stamp_holds)
+    if out.suffix.lower() == ".csv" and args.excitation != "static":
+        claim_file(out.with_name(out.name + ".json"), force=args.force, ours=record_is_ours)
     axes = channel_names(cfg)
     if not axes:
         raise ConfigError(f"{args.rig}: amb: acquisition needs at least one [[amb]]")
@@ -120,9 +126,10 @@ def _design(args: argparse.Namespace) -> int:
 def _owned(out, c_dir=None):
     """The folders a command writes, each claimed (:class:`ambseal.files.OwnedFolder`:
     refused if it holds files ambseal did not write, its manifest updated at the end);
-    ``c_dir`` only when it is not inside ``out``."""
-    inside = None not in (out, c_dir) and Path(c_dir).absolute().is_relative_to(
-        Path(out).absolute())
+    ``c_dir`` only when it is not inside ``out`` (paths resolved first: ``out/../x`` is
+    not inside ``out``)."""
+    inside = None not in (out, c_dir) and Path(c_dir).resolve().is_relative_to(
+        Path(out).resolve())
     with ExitStack() as claims:
         for folder in (out, None if inside else c_dir):
             if folder is not None:

@@ -43,11 +43,12 @@ from ambseal.design.recipes import METHODS, design
 from ambseal.design.specs import design_spec
 from ambseal.errors import ConfigError
 from ambseal.export.controller_files import load_controller
-from ambseal.files import OwnedFolder, atomic_write, write_json, write_text
+from ambseal.files import OwnedFolder, atomic_write, claim_file, write_json, write_text
 from ambseal.io.ross import import_ross_file
 from ambseal.model.amb import channel_names
 from ambseal.model.modes import bending_limit_hz, modes
 from ambseal.model.rig import build_system
+from ambseal.report.figures import figure_is_ours
 from ambseal.report.modal_figures import campbell_figure, mode_shapes_figure, stability_map_figure
 from ambseal.robust.digital import DigitalController
 from ambseal.robust.stability import unstable_poles
@@ -119,6 +120,8 @@ _PRESSURES = (0.0, MAX_PRESSURE_BAR, "the rule of [operating] pressure_bar")
 
 def _modes(args: argparse.Namespace) -> int:
     cfg = load_rig(args.rig)
+    if args.shapes is not None:  # before any work
+        claim_file(args.shapes, force=args.force, ours=figure_is_ours)
     p = cfg.operating.pressure_bar if args.pressure_bar is None else args.pressure_bar
     rpm = cfg.operating.speed_rpm if args.speed_rpm is None else args.speed_rpm
     if args.controller is not None and (args.free or args.no_amb):
@@ -275,7 +278,7 @@ def _sweep(args: argparse.Namespace) -> int:
 
 
 def _import_ross(args: argparse.Namespace) -> int:
-    res = import_ross_file(args.file, args.out, speed_rpm=args.speed_rpm)
+    res = import_ross_file(args.file, args.out, speed_rpm=args.speed_rpm, force=args.force)
     for line in [f"not imported: {n}" for n in res["unmapped"]] + [
             f"taken: {n}" for n in res["notes"]]:
         print(f"ambseal: {line}", file=sys.stderr)

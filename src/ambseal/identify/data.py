@@ -100,6 +100,7 @@ Example
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
 import json
 import math
@@ -112,7 +113,7 @@ import numpy as np
 import scipy.io
 
 from ambseal.errors import AmbsealError, DataError
-from ambseal.files import atomic_write, read_text
+from ambseal.files import atomic_write, input_file, read_text
 from ambseal.identify.matlab_file import read_matlab
 from ambseal.identify.measurement import (
     _RATE_RTOL,
@@ -139,6 +140,8 @@ __all__ = [
     "save_measurement",
     "load_measurement",
     "validate_measurement",
+    "record_is_ours",
+    "RECORD_MARK",
 ]
 
 def _atomic_write(path: Path, write) -> None:
@@ -149,6 +152,39 @@ def _atomic_write(path: Path, write) -> None:
 
 def _sidecar(path: Path) -> Path:
     return path.with_name(path.name + ".json")
+
+
+#: The sidecar key holding the SHA-256 of the CSV table ambseal wrote with it
+RECORD_MARK = "ambseal_sha256"
+
+
+def record_is_ours(path: str | os.PathLike) -> bool:
+    """True if ``path`` (a ``.csv`` record, or its ``.csv.json`` sidecar) is a record that
+    :func:`save_measurement` wrote and nobody changed since: the sidecar's
+    ``ambseal_sha256`` is the hash of the table. A ``.mat`` record carries no such mark.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The table or its sidecar.
+
+    Returns
+    -------
+    bool
+    """
+    path = Path(path)
+    table = path.with_name(path.name[:-len(".json")]) if path.name.endswith(".csv.json") \
+        else path
+    if table.suffix.lower() != ".csv":
+        return False
+    try:
+        header = json.loads(read_text(_sidecar(table), "sidecar"))
+        mark = header.get(RECORD_MARK) if isinstance(header, dict) else None
+        return (header.get("format") == FORMAT_TAG and isinstance(mark, str)
+                and hashlib.sha256(input_file(table, "record").read_bytes()).hexdigest()
+                == mark)
+    except (AmbsealError, OSError, ValueError, RecursionError):
+        return False
 
 
 def _header(meas: Measurement, path: Path) -> dict:
@@ -200,15 +236,15 @@ def save_measurement(meas: Measurement, path: str | os.PathLike) -> Path:
     cols = column_names(meas.axes)
     table = meas.table()
     if suffix == ".csv":
+        buf = io.StringIO()
+        np.savetxt(buf, table, fmt="%.17g", delimiter=",", header=",".join(cols), comments="")
+        data = buf.getvalue().encode("ascii")
+        # the table's hash in the sidecar: the mark by which ambseal knows the pair as its
+        # own and unchanged (record_is_ours)
+        header[RECORD_MARK] = hashlib.sha256(data).hexdigest()
         text = json.dumps(header, indent=2, allow_nan=False) + "\n"
         _atomic_write(_sidecar(path), lambda fh: fh.write(text.encode("utf-8")))
-
-        def write_csv(fh):
-            buf = io.StringIO()
-            np.savetxt(buf, table, fmt="%.17g", delimiter=",", header=",".join(cols), comments="")
-            fh.write(buf.getvalue().encode("ascii"))
-
-        _atomic_write(path, write_csv)
+        _atomic_write(path, lambda fh: fh.write(data))
     else:
         mdict = {c: table[:, i].reshape(-1, 1) for i, c in enumerate(cols)}
         mdict["metadata_json"] = json.dumps(header, allow_nan=False)

@@ -67,7 +67,7 @@ from pydantic import ValidationError
 from ambseal.config import RigConfig, dump_rig, parse_rig
 from ambseal.config.rig import Pid
 from ambseal.errors import AmbsealError, ConfigError
-from ambseal.files import read_text, write_text
+from ambseal.files import claim_file, read_text, stamp_text, write_text
 
 __all__ = ["RossImport", "from_ross", "load_ross", "import_ross_file", "ROSS_TESTED",
            "ROSS_TIMEOUT_S"]
@@ -604,7 +604,7 @@ def _in_clean_process(path: Path, speed_rpm: float | None) -> dict:
 
 
 def import_ross_file(path: str | Path, out: str | Path, *,
-                     speed_rpm: float | None = None) -> dict:
+                     speed_rpm: float | None = None, force: bool = False) -> dict:
     """``ambseal import-ross``: read a ROSS rotor file, write the rig (TOML) to ``out``.
 
     ROSS is imported in a child process in an empty working directory
@@ -616,9 +616,13 @@ def import_ross_file(path: str | Path, out: str | Path, *,
     path : str or Path
         The ROSS rotor file (:func:`load_ross`).
     out : str or Path
-        The rig file to write.
+        The rig file to write: a new file, one this command wrote before and nobody
+        changed (its first line's stamp, :func:`ambseal.files.stamp_text`), or any file
+        with ``force``.
     speed_rpm : float, optional
         As :func:`from_ross`.
+    force : bool
+        Replace ``out`` whatever it holds (the user's ``--force``).
 
     Returns
     -------
@@ -633,8 +637,11 @@ def import_ross_file(path: str | Path, out: str | Path, *,
     ConfigError
         As :func:`load_ross` and :func:`from_ross`, or the child process failed or ran
         past :data:`ROSS_TIMEOUT_S`.
+    AmbsealError
+        ``out`` exists and is not this command's unchanged output (without ``force``).
     """
     path = Path(path)
+    claim_file(out, force=force)  # before any work
     if not path.is_file():
         raise ConfigError(f"{path}: no such ROSS rotor file")
     if path.suffix.lower() not in (".toml", ".json"):
@@ -647,7 +654,7 @@ def import_ross_file(path: str | Path, out: str | Path, *,
               f"(ROSS {doc['ross_version']})"
               + "".join(f"\nnot imported: {n}" for n in res.unmapped)
               + "".join(f"\ntaken: {n}" for n in res.notes))
-    write_text(out, dump_rig(res.rig, header))
+    write_text(out, stamp_text(dump_rig(res.rig, header)))
     cfg = res.rig
     return {"out": str(out), "shaft_elements": len(cfg.shaft),
             "layers": sum(len(s.layers) for s in cfg.shaft), "disks": len(cfg.disk),

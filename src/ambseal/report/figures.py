@@ -11,6 +11,7 @@ one curve per (controller, pressure) case, as in the thesis figures (P5 Fig. 11â
 
 from __future__ import annotations
 
+import hashlib
 import os
 from pathlib import Path
 from typing import Mapping, Sequence
@@ -21,10 +22,11 @@ from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from matplotlib.image import imsave
 from matplotlib.ticker import LogLocator, NullFormatter, NullLocator, ScalarFormatter
+from PIL import Image, UnidentifiedImageError
 
 from ambseal.analysis.iso import ZONE_LIMITS, ZONES, zone_limit_db
 from ambseal.errors import AmbsealError
-from ambseal.files import atomic_write
+from ambseal.files import atomic_write, input_file
 
 __all__ = [
     "controller_gains_figure",
@@ -97,10 +99,28 @@ def save_figure(fig: Figure, path: str | os.PathLike, *, dpi: int = 120,
         fig.tight_layout()
     fig.set_dpi(dpi)
     canvas.draw()
-    atomic_write(path, lambda fh: imsave(fh, canvas.buffer_rgba(), format="png",
-                                         origin="upper", dpi=dpi,
-                                         pil_kwargs={"compress_level": 3}))
+    rgba = canvas.buffer_rgba()
+    mark = {FIGURE_MARK: hashlib.sha256(bytes(rgba)).hexdigest()}
+    atomic_write(path, lambda fh: imsave(fh, rgba, format="png", origin="upper", dpi=dpi,
+                                         metadata=mark, pil_kwargs={"compress_level": 3}))
     return path
+
+
+#: The PNG text key of a figure ambseal drew: the SHA-256 of its RGBA pixels
+FIGURE_MARK = "ambseal-sha256"
+
+
+def figure_is_ours(path: str | os.PathLike) -> bool:
+    """True if ``path`` is a PNG that :func:`save_figure` wrote and nobody changed since
+    (its ``ambseal-sha256`` text is the hash of its pixels): the ownership mark by which a
+    command may replace it (:func:`ambseal.files.claim_file`)."""
+    try:
+        with Image.open(input_file(path, "figure")) as im:
+            mark = getattr(im, "text", {}).get(FIGURE_MARK)
+            return mark is not None and mark == hashlib.sha256(
+                im.convert("RGBA").tobytes()).hexdigest()
+    except (AmbsealError, OSError, UnidentifiedImageError, ValueError):
+        return False
 
 
 def _light_log_axes(fig: Figure) -> None:

@@ -617,7 +617,8 @@ class OwnedFolder(RunFolder):
             FOLDER_LOCK}
 
     def __enter__(self) -> Path:
-        if not os.path.lexists(self.lock_path):  # else perhaps a killed command's: see below
+        # with a lock left there, perhaps a killed command's (see below); a link is refused
+        if self.out.is_symlink() or not os.path.lexists(self.lock_path):
             self._check_ours()
         self._created = not self.out.exists()
         try:

@@ -167,6 +167,45 @@ def test_run_identifies_the_virtual_facility(metrics):
     assert [r["pressure_bar"] for r in runs["seal_pressures_skipped"]] == pytest.approx([2.55])
 
 
+def test_run_sets_its_intervals_against_the_facilitys_truth(metrics):
+    """Reference: the packaged truth file. Each scalar interval's ``covered`` flag is
+    ``lo ≤ truth ≤ hi`` recounted here, each seal line's is both coefficients within 1.96
+    standard errors of the true line; the interval check counts them. A truth moved just
+    outside one interval is one miss in fifteen (chance: a binomial tail of 54 % at a 5 %
+    miss rate); three such misses (tail 3.6 %) or one by three interval widths are called a
+    mismatch, with the name, the estimate, the interval and the truth in the verdict."""
+    from ambseal.identify.checks import interval_check
+
+    _, m = metrics
+    errors = m["identification"]["parameters"]
+    n = 0
+    for name, e in errors.items():
+        t = e["truth"]
+        if "ci95" in e and isinstance(t, float):
+            assert e["covered"] == (e["ci95"][0] <= t <= e["ci95"][1]), name
+            n += 1
+        elif isinstance(t, dict):
+            assert e["covered"] == (abs(e["intercept"] - t["at_zero"]) <= 1.96 * e["intercept_se"]
+                                    and abs(e["slope"] - t["per_bar"]) <= 1.96 * e["slope_se"])
+            n += 1
+    check = m["identification"]["interval_check"]
+    assert check["checked"] == n and check == interval_check(errors)
+    ki = dict(errors["A.Ki_zeta"])
+    lo, hi = ki["ci95"]
+    near = {**errors, "A.Ki_zeta": {**ki, "truth": hi + 0.01 * (hi - lo), "covered": False}}
+    assert not interval_check(near)["mismatch"]
+    three = dict(near)
+    for name in ("A.Ks_zeta", "B.Ki_eta"):
+        e = errors[name]
+        three[name] = {**e, "truth": e["ci95"][0] - 0.01 * (e["ci95"][1] - e["ci95"][0]),
+                       "covered": False}
+    assert interval_check(three)["mismatch"] and len(interval_check(three)["missed"]) == 3
+    far = {**errors, "A.Ki_zeta": {**ki, "truth": hi + 3 * (hi - lo), "covered": False}}
+    verdict = interval_check(far)
+    assert verdict["mismatch"] and verdict["missed"][-1] == "A.Ki_zeta"
+    assert "A.Ki_zeta" in verdict["verdict"] and "understate" in verdict["verdict"]
+
+
 def test_run_explains_every_target_difference_above_10_percent(metrics):
     """On the embedded rig each controller's discrete σ̄(S_o) peak is
     within 10 % of its continuous one (the continuous loop with the controller's delay), or

@@ -28,7 +28,7 @@ from ambseal.export.codegen import write_c
 from ambseal.export.controller_files import export_controller
 from ambseal.files import writable_folder, write_json, write_text
 from ambseal.identify.budget import advice
-from ambseal.identify.checks import frf_checks, truth_errors
+from ambseal.identify.checks import frf_checks, interval_check, truth_errors
 from ambseal.identify.data import load_measurement
 from ambseal.identify.design_model import design_rig, impulse_checks, truth_rig
 from ambseal.identify.plausibility import fit_failure, implausible, require_finite
@@ -291,7 +291,7 @@ def identification_stage(cfg, truth, out: Path, say, controller) -> Identified:
     a = res.amb
     design_cfg, note = design_rig(cfg, res)
     summary = {"parameters": errors, "converged": bool(a.converged),
-               "model_check": a.model_check(),
+               "model_check": a.model_check(), "interval_check": interval_check(errors),
                "nrmse_fit_pct": {k: (float(v) if math.isfinite(v) else None)
                                  for k, v in a.nrmse_fit_pct.items()},
                "design": note, "judged_on": "virtual facility (truth file, full order)"}

@@ -13,6 +13,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from scipy.stats import binom
+
 from ambseal.config import Affine
 from ambseal.identify.excitation import ExcitationPlan, excitation_plan, welch_segment
 from ambseal.identify.frf import FRF, closed_loop_frf, model_frf, plant_frf
@@ -21,7 +23,7 @@ from ambseal.identify.signals import chirp
 from ambseal.identify.stages import acquire, build_models
 from ambseal.model.rig import build_plant
 
-__all__ = ["FrfChecks", "frf_checks", "truth_errors", "true_line"]
+__all__ = ["FrfChecks", "frf_checks", "truth_errors", "true_line", "interval_check"]
 
 
 @dataclass(frozen=True)
@@ -126,12 +128,80 @@ def truth_errors(res: ProcedureResult, seal_name: str | None) -> dict:
         for i, n in enumerate(r.names):
             t = res.truth.get(n)
             err = None if not isinstance(t, float) or t == 0 else 100 * (r.estimate[i] / t - 1)
-            out[n] = {"estimate": float(r.estimate[i]), "truth": t,
-                      "ci95": [_finite(r.ci95_low[i]), _finite(r.ci95_high[i])],
-                      "error_pct": err}
+            lo, hi = _finite(r.ci95_low[i]), _finite(r.ci95_high[i])
+            covered = (None if not isinstance(t, float) or lo is None or hi is None
+                       else bool(lo <= t <= hi))
+            out[n] = {"estimate": float(r.estimate[i]), "truth": t, "ci95": [lo, hi],
+                      "error_pct": err, "covered": covered}
     for c, reg in res.regression.items():
-        out[f"{seal_name}.{c}"] = {**reg.to_dict(), "truth": res.truth.get(f"{seal_name}.{c}")}
+        t = res.truth.get(f"{seal_name}.{c}")
+        covered = None
+        if isinstance(t, dict):  # the line's 95 % intervals (normal: the points' se known)
+            covered = bool(abs(reg.intercept - t["at_zero"]) <= Z95 * reg.intercept_se
+                           and abs(reg.slope - t["per_bar"]) <= Z95 * reg.slope_se)
+        elif isinstance(t, float):  # a constant truth: the line's intercept, slope 0
+            covered = bool(abs(reg.intercept - t) <= Z95 * reg.intercept_se
+                           and abs(reg.slope) <= Z95 * reg.slope_se)
+        out[f"{seal_name}.{c}"] = {**reg.to_dict(), "truth": t, "covered": covered}
     return out
+
+
+#: the two-sided 95 % quantile of the normal distribution
+Z95 = 1.959963984540054
+
+
+def interval_check(errors: dict) -> dict:
+    """The identification's 95 % intervals against the facility's true values.
+
+    On the virtual facility the truth is known: an interval that misses it says the fit
+    understates its error — a model mismatch or a held value that is off, whether or not
+    the residual tests (:meth:`~ambseal.identify.fit.FitResult.model_check`) saw it. One
+    in twenty intervals misses by chance; the mismatch is more misses than chance makes
+    plausible (a binomial tail below 5 % at a 5 % miss rate: 3 of 15) or any miss by more
+    than its interval's width.
+
+    Parameters
+    ----------
+    errors : dict
+        :func:`truth_errors` of a procedure.
+
+    Returns
+    -------
+    dict
+        ``checked`` (intervals compared), ``missed`` (names, each with the estimate, the
+        interval and the truth in the verdict), ``mismatch`` (bool, the rule above) and
+        ``verdict`` (text).
+    """
+    checked = [n for n, e in errors.items() if e.get("covered") is not None]
+    missed = [n for n in checked if not errors[n]["covered"]]
+
+    def far(n):  # the truth lies more than one interval width outside the interval
+        e = errors[n]
+        if "ci95" not in e:
+            return False
+        lo, hi = e["ci95"]
+        return min(abs(e["truth"] - lo), abs(e["truth"] - hi)) > (hi - lo)
+
+    unlikely = bool(missed) and binom.sf(len(missed) - 1, len(checked), 0.05) < 0.05
+    mismatch = unlikely or any(far(n) for n in missed)
+
+    def text(n):
+        e = errors[n]
+        if "ci95" in e:
+            lo, hi = e["ci95"]
+            return f"{n} {e['estimate']:.4g} in [{lo:.4g}, {hi:.4g}], truth {e['truth']:.4g}"
+        return f"{n}'s line against pressure"
+    if not checked:
+        verdict = "no truth to compare the intervals with"
+    elif not missed:
+        verdict = f"every 95 % interval holds the facility's true value ({len(checked)})"
+    else:
+        verdict = (f"{len(missed)} of {len(checked)} 95 % intervals miss the facility's true "
+                   f"value: {'; '.join(text(n) for n in missed)}"
+                   + (" — the intervals understate the error: a model mismatch or a held "
+                      "value that is off" if mismatch else " (one in twenty may, by chance)"))
+    return {"checked": len(checked), "missed": missed, "mismatch": bool(mismatch),
+            "verdict": verdict}
 
 
 def true_line(truth, name: str):

@@ -18,7 +18,7 @@ import numpy as np
 from ambseal import __version__
 from ambseal.analysis.delivery import METHOD_NAMES
 from ambseal.design.specs import machine
-from ambseal.identify.checks import true_line
+from ambseal.identify.checks import interval_check, true_line
 from ambseal.identify.seal_test import MIN_FIT_PCT, fit_reliability
 from ambseal.lti.freqresp import freqresp
 from ambseal.report import figures
@@ -212,6 +212,12 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
     fits = ", ".join(f"{k} {v:.1f} %" for k, v in a.nrmse_fit_pct.items())
     if a.residuals is not None:
         fits += f". Model check of stage (a)+(b): {_model_check_text(a, errors)}"
+    truth_check = interval_check(errors)
+    if truth_check["checked"]:
+        fits += (". Against the facility's truth: "
+                 + ("<b>" if truth_check["mismatch"] else "")
+                 + html.escape(truth_check["verdict"])
+                 + ("</b>" if truth_check["mismatch"] else ""))
     for p, why in res.skipped:
         fits += f". Seal impulse at {p:g} bar skipped: {html.escape(why)}"
     section = {

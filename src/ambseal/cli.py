@@ -217,8 +217,13 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("--axes", default=None, help="excited axes, e.g. A_zeta,B_zeta (default all)")
     a.add_argument("--clock-period-s", type=_positive, default=None,
                    help="PRBS clock period (s; default 10 controller samples)")
-    a.add_argument("--frequencies-hz", default="10,30,50,70,90,110,130,150,170,190",
-                   help="stepped-sine frequencies (Hz), comma separated")
+    a.add_argument("--speed-hz", type=_finite, default=None,
+                   help="spin speed of the run (Hz; default the rig's operating speed; "
+                        "standstill up to the top of [operating] speed_range_hz)")
+    a.add_argument("--frequencies-hz", default=None,
+                   help="stepped-sine frequencies (Hz), comma separated (default: f_top/20, "
+                        "then f_top/10 to f_top in 10 steps; f_top the larger of the "
+                        "sample rate/50 and 1.1x the top speed)")
     a.add_argument("--cycles", type=_positive_int, default=10,
                    help="stepped sine: cycles per step")
     a.add_argument("--settling-cycles", type=_natural, default=5,

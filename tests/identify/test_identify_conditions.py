@@ -78,3 +78,57 @@ def test_a_seal_damping_line_that_turns_negative_is_not_designed_on():
 def replace_identified(res, identified):
     res.identified = identified
     return res
+
+
+def test_stepped_sine_follows_the_rig():
+    """The balanced-whirl stepped sine: f_top/20, then f_top/10 … f_top, f_top the larger of
+    the PRBS's flat band (sample rate / 50) and 1.1× the top speed. The embedded rig (at rest,
+    10 kHz) gets the thesis procedure's 10, 20, 40, …, 200 Hz (P4 §3.5.1: 5–200 Hz); the
+    blower (20 kHz, to 600 Hz) reaches 660 Hz, past its top synchronous whirl."""
+    from ambseal.identify.excitation import excitation_plan
+
+    assert excitation_plan(load_rig(default_rig_path())).sine_hz == (
+        10.0, 20.0, 40.0, 60.0, 80.0, 100.0, 120.0, 140.0, 160.0, 180.0, 200.0)
+    blower = excitation_plan(load_rig(ROOT / "examples" / "blower.toml")).sine_hz
+    assert blower[0] == pytest.approx(33.0) and blower[-1] == pytest.approx(660.0)
+    assert blower[1:] == pytest.approx([66.0 * k for k in range(1, 11)])
+
+
+def test_records_at_the_speeds_the_rig_runs():
+    """Reference: gyroscopic coupling. On the pump at 0 bar, a noise-free facility excited
+    in ζ only: at rest the η axes do not move (the rotor and AMBs are axisymmetric, no seal
+    force at 0 bar), at speed they do, first order in Ω (the η peak at 110 Hz is twice
+    that at 55 Hz within 5 %). Each record carries its speed; a speed above the top of the
+    rig's range is refused before any simulation."""
+    import numpy as np
+
+    from ambseal.app.commands import target_pid
+    from ambseal.config import load_truth
+    from ambseal.identify import signals
+    from ambseal.identify.excitation import excitation_plan
+    from ambseal.identify.stages import acquire
+    from ambseal.model.amb import channel_names
+
+    cfg = load_rig(ROOT / "examples" / "pump.toml")
+    quiet = load_truth(ROOT / "tests" / "data" / "pump_truth.toml").model_copy(
+        update={"sensor_noise_m": 0.0, "noise_fraction": 0.0, "current_noise_a": 0.0,
+                "adc_bits": None})
+    plan, axes = excitation_plan(cfg), channel_names(cfg)
+    ex = signals.impulse(amplitude_a=plan.amplitude_a, width_s=plan.impulse_s,
+                         start_s=plan.impulse_start_s, duration_s=plan.impulse_record_s,
+                         sample_rate_hz=cfg.controller.sample_rate_hz, axes=axes,
+                         excited={"A_zeta": 1.0, "B_zeta": 1.0})
+    K = target_pid(cfg)
+    eta = [axes.index("A_eta"), axes.index("B_eta")]
+    peaks = {}
+    for f in (0.0, 55.0, 110.0):
+        m = acquire(cfg, quiet, ex, controller=K, pressure_bar=0.0, speed_hz=f)
+        assert m.metadata["speed_rad_s"] == pytest.approx(2 * np.pi * f)
+        y = np.abs(np.asarray(m.displacement_m))
+        peaks[f] = y[:, eta].max(axis=0)
+        zeta_peak = y[:, axes.index("A_zeta")].max()
+    assert np.all(peaks[0.0] < 1e-9 * zeta_peak)
+    assert np.all(peaks[110.0] > 1e-3 * zeta_peak)
+    assert peaks[110.0] / peaks[55.0] == pytest.approx([2.0, 2.0], rel=0.05)
+    with pytest.raises(ConfigError, match="standstill to 110 Hz"):
+        acquire(cfg, quiet, ex, controller=K, pressure_bar=0.0, speed_hz=500.0)

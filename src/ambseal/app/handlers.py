@@ -35,7 +35,7 @@ from ambseal.files import OwnedFolder, claim_file, stamp_holds, writable_folder
 from ambseal.identify import signals
 from ambseal.identify.data import record_is_ours, save_measurement
 from ambseal.identify.excitation import IMPULSE_LEAD, excitation_plan
-from ambseal.identify.stages import acquire
+from ambseal.identify.stages import acquire, at_speed
 from ambseal.identify.static_load import save_static_record, virtual_static_load
 from ambseal.model.amb import channel_names
 from ambseal.report.run_report import rig_clearances_um
@@ -47,6 +47,10 @@ __all__ = ["HANDLERS"]
 def _acquire_cmd(args: argparse.Namespace) -> int:
     cfg = load_rig(args.rig)
     truth = load_truth(args.truth)
+    if args.speed_hz is not None and args.excitation == "static":
+        raise ConfigError("--speed-hz: static loads are applied at rest; leave it out with "
+                          "--excitation static")
+    at_speed(cfg, args.speed_hz, "--speed-hz")  # a speed the rig runs, before any work
     out = Path(args.out)
     writable_folder(out.parent)  # before the simulation
     # a record and its sidecar are written as a pair: each new, or the pair ambseal wrote
@@ -80,7 +84,8 @@ def _acquire_cmd(args: argparse.Namespace) -> int:
                               clock_period_s=given(args.clock_period_s, plan.prbs_clock_s),
                               duration_s=duration, seed=args.seed, **common)
         elif args.excitation == "sine":
-            freqs = [float(f) for f in args.frequencies_hz.split(",")]
+            freqs = (list(plan.sine_hz) if args.frequencies_hz is None
+                     else [float(f) for f in args.frequencies_hz.split(",")])
             ex = signals.stepped_sine(frequencies_hz=freqs, amplitude_a=amplitude,
                                       cycles=args.cycles, settling_cycles=args.settling_cycles,
                                       **common)
@@ -98,7 +103,8 @@ def _acquire_cmd(args: argparse.Namespace) -> int:
         raise ConfigError(f"acquire: {exc}") from None
     try:
         meas = acquire(cfg, truth, ex, controller=target_pid(cfg),
-                       pressure_bar=args.pressure_bar, seed=args.seed)
+                       pressure_bar=args.pressure_bar, seed=args.seed,
+                       speed_hz=args.speed_hz)
     except AmbsealError as exc:  # the simulation runs on the truth file's values
         raise with_source(exc, [args.truth], f"{args.truth} (with {args.rig})") from None
     path = save_measurement(meas, args.out)

@@ -21,6 +21,12 @@ follows from the rig by the rule beside it, each reproducing the thesis rig's va
 * **Chirp** (linear): from f_r to :data:`CHIRP_TOP` · f_P (1–150 Hz: the thesis's 150 Hz
   as a fraction of the band the PRBS covers, the DC end lifted to the PRBS's resolution),
   :data:`CHIRP_RECORDS` PRBS records long (4 s).
+* **Stepped sine** of the seal's frequency test (P4 §3.5.1, balanced whirl): up to f_top,
+  the larger of the PRBS's flat band f_P and :data:`SYNC_MARGIN` times the top speed's
+  synchronous frequency, in :data:`SINE_STEPS` steps of f_top / 10 from f_top / 10 with
+  f_top / 20 before them (10, 20, 40, …, 200 Hz at rest: the thesis's 5–200 Hz in 10–20 Hz
+  steps), so the seal's coefficients are seen over the band the other runs identify the
+  rig in and at every synchronous whirl the machine runs.
 * **FRF checks**: the chirp's closed loop over 2 f_r … :data:`CHECK_TOP` · f_P (2–140 Hz:
   the sweep's ends, where the response has not built up, left out); the plant from the PRBS
   record over 2 f_r … f_P (2–200 Hz, where the PRBS is flat).
@@ -60,6 +66,9 @@ PRBS_FLAT = 0.2
 #: the chirp's top and the closed-loop check's top as fractions of f_P, and the chirp's
 #: length in PRBS records (150 Hz, 140 Hz and 4 s on the thesis rig, P4 §3.4)
 CHIRP_TOP, CHECK_TOP, CHIRP_RECORDS = 0.75, 0.7, 4
+#: the stepped sine's steps of f_top / SINE_STEPS up to f_top, after one at half a step,
+#: and f_top's margin above the top speed's synchronous frequency
+SINE_STEPS, SYNC_MARGIN = 10, 1.1
 
 
 @dataclass(frozen=True)
@@ -81,6 +90,8 @@ class ExcitationPlan:
         The chirp's length (s).
     closed_loop_band_hz, plant_band_hz : (float, float)
         The bands of the closed-loop (chirp) and plant (PRBS) FRF checks (Hz).
+    sine_hz : tuple of float
+        The stepped sine's frequencies (Hz).
     """
 
     amplitude_a: float
@@ -94,6 +105,7 @@ class ExcitationPlan:
     chirp_s: float
     closed_loop_band_hz: tuple[float, float]
     plant_band_hz: tuple[float, float]
+    sine_hz: tuple[float, ...] = ()
 
 
 def impulse_amplitude(cfg: RigConfig) -> float | None:
@@ -162,7 +174,8 @@ def excitation_plan(cfg: RigConfig, *, amplitude_a: float | None = None) -> Exci
     -------
     ExcitationPlan
         Thesis test rig: 0.05 A; impulse 10 ms from 0.05 s in 0.4 s; PRBS clock 1 ms for
-        1 s; chirp 1–150 Hz in 4 s; checks 2–140 Hz and 2–200 Hz.
+        1 s; chirp 1–150 Hz in 4 s; checks 2–140 Hz and 2–200 Hz; stepped sine at 10, 20,
+        40, …, 200 Hz.
 
     Raises
     ------
@@ -182,10 +195,17 @@ def excitation_plan(cfg: RigConfig, *, amplitude_a: float | None = None) -> Exci
     prbs_s = PRBS_CLOCKS * clock
     flat = PRBS_FLAT / clock
     resolution = 1.0 / prbs_s
+    op = cfg.operating
+    top_speed_hz = op.speed_range_hz[1] if op.speed_range_hz else abs(op.speed_rpm) / 60.0
+    top = max(flat, SYNC_MARGIN * top_speed_hz)
     return ExcitationPlan(
         amplitude_a=float(amplitude), impulse_s=float(width),
         impulse_start_s=IMPULSE_LEAD * width, impulse_record_s=IMPULSE_RECORD * width,
         check_record_s=CHECK_RECORD * width, prbs_clock_s=clock, prbs_duration_s=prbs_s,
         chirp_hz=(resolution, CHIRP_TOP * flat), chirp_s=CHIRP_RECORDS * prbs_s,
         closed_loop_band_hz=(2 * resolution, CHECK_TOP * flat),
-        plant_band_hz=(2 * resolution, flat))
+        plant_band_hz=(2 * resolution, flat),
+        # rounded to 1e-9 Hz: f_top / 10 · k in floating point, not a step off the rule
+        sine_hz=tuple(round(f, 9) for f in
+                      [top / (2 * SINE_STEPS)] + [top * k / SINE_STEPS
+                                                  for k in range(1, SINE_STEPS + 1)]))

@@ -166,10 +166,10 @@ def thesis_procedure(
     controller: DiscreteController,
     *,
     seed: int = 0,
-    sine_frequencies_hz: tuple[float, ...] = (10, 20, 40, 60, 80, 100, 120, 140, 160, 180,
-                                              200),
+    sine_frequencies_hz: tuple[float, ...] | None = None,
     impulse_pressures_bar: tuple[float, ...] | None = None,
     excitation: ExcitationPlan | None = None,
+    amb_speed_hz: float | None = 0.0,
     progress: Callable[[str], None] | None = None,
 ) -> ProcedureResult:
     """Run stages (a)–(d) on the virtual facility of ``cfg`` with ``truth``.
@@ -185,14 +185,22 @@ def thesis_procedure(
         PID as it runs on the target: :func:`ambseal.app.commands.target_pid`).
     seed : int
         Seed of excitations and noise.
-    sine_frequencies_hz : tuple of float
-        Frequencies (Hz) of the balanced-whirl stepped sines of stage (c) (P4 §3.5.1).
+    sine_frequencies_hz : tuple of float, optional
+        Frequencies (Hz) of the balanced-whirl stepped sines of stage (c) (P4 §3.5.1);
+        default the rig's (:func:`~ambseal.identify.excitation.excitation_plan`: 10, 20,
+        40, …, 200 Hz on the thesis rig).
     impulse_pressures_bar : tuple of float, optional
         Pressure drops (bar) of the impulse runs of stage (c) (P5 §3.3); the facility must
         hold the rotor at three of them at least. Default :func:`seal_test_pressures`.
     excitation : ExcitationPlan, optional
         Amplitudes, clock and lengths of the excitations; default
         :func:`~ambseal.identify.excitation.excitation_plan` of ``cfg``.
+    amb_speed_hz : float or None
+        Spin speed (Hz) of the zero-pressure PRBS runs of stages (a) and (b)
+        (:func:`~ambseal.identify.stages.at_speed`): default standstill, where the AMBs
+        are commissioned before the machine spins and no gyroscopic coupling enters; None:
+        the operating speed. The seal's runs are at the operating speed, where its
+        coefficients matter.
     progress : callable, optional
         Called with a short description before each stage.
 
@@ -218,11 +226,15 @@ def thesis_procedure(
     spring = (cfg.spring[0].name or "spring0") if cfg.spring else None
     p_nom = cfg.operating.pressure_bar
     plan = excitation if excitation is not None else excitation_plan(cfg)
+    if sine_frequencies_hz is None:
+        sine_frequencies_hz = plan.sine_hz
 
-    say("identification (a): Ki, Ks and tau_e from PRBS at 0 bar")
+    say("identification (a): Ki, Ks and tau_e from PRBS at 0 bar"
+        + ("" if amb_speed_hz is None else f", {amb_speed_hz:g} Hz"))
     ex = prbs(amplitude_a=plan.amplitude_a, clock_period_s=plan.prbs_clock_s,
               duration_s=plan.prbs_duration_s, sample_rate_hz=fs, axes=axes, seed=seed)
-    rec_a = acquire(cfg, truth, ex, controller=controller, pressure_bar=0.0, seed=seed)
+    rec_a = acquire(cfg, truth, ex, controller=controller, pressure_bar=0.0, seed=seed,
+                    speed_hz=amb_speed_hz)
     names_a = [f"{m}.{q}_{x}" for m in ambs for q in ("Ki", "Ks") for x in ("zeta", "eta")]
     names_a.append(TAU_E)
     amb = identify(cfg, [rec_a], names_a, budget=True)
@@ -235,7 +247,8 @@ def thesis_procedure(
         ex = prbs(amplitude_a=plan.amplitude_a, clock_period_s=plan.prbs_clock_s,
                   duration_s=plan.prbs_duration_s, sample_rate_hz=fs, axes=axes,
                   seed=seed + 1)
-        rec_b = acquire(cfg, truth, ex, controller=controller, pressure_bar=0.0, seed=seed + 1)
+        rec_b = acquire(cfg, truth, ex, controller=controller, pressure_bar=0.0, seed=seed + 1,
+                        speed_hz=amb_speed_hz)
         records["b"] = rec_b
         names_b = [f"{spring}.kxx", f"{spring}.kyy"]
         coupling = identify(cfg, [rec_b], names_b, known=known, known_fit=amb, budget=True)

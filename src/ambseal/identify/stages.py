@@ -6,10 +6,12 @@ These wire :mod:`~ambseal.identify.rig_sim`, :mod:`~ambseal.identify.data` and
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ambseal.config import RigConfig, TruthSection
-from ambseal.errors import DataError, IdentificationError, ModelError
+from ambseal.errors import ConfigError, DataError, IdentificationError, ModelError
 from ambseal.identify.budget import fixed_uncertainty
 from ambseal.identify.data import Measurement, validate_measurement
 from ambseal.identify.fit import TAU_E, ClosedLoopModel, FitResult, default_bounds, fit_parameters
@@ -20,7 +22,7 @@ from ambseal.model.amb import actuator_matrices
 from ambseal.robust.digital_loop import DiscreteController
 
 __all__ = ["controller_from_metadata", "check_controller", "sample_rate_of",
-           "check_record_metadata", "acquire", "build_models", "identify", "record_spread",
+           "check_record_metadata", "acquire", "at_speed", "build_models", "identify", "record_spread",
            "FIT_CUTOFF_HZ"]
 
 #: Modes kept in the fit's reduced model (Hz). The rigid-body modes alone (8 states, P2 §3.2)
@@ -103,9 +105,49 @@ def _positive(meta: dict, key: str, source: str, default: float | None = None) -
     return x
 
 
+def at_speed(cfg: RigConfig, speed_hz: float | None, what: str = "speed_hz") -> RigConfig:
+    """``cfg`` with its rotor spinning at ``speed_hz`` (the operating speed's direction), for
+    a test at a speed the machine runs; ``cfg`` itself when ``speed_hz`` is None.
+
+    The speeds a rig runs are standstill up to the top of ``[operating] speed_range_hz``
+    (without a range, up to the operating speed): every AMB machine levitates at rest
+    before it spins, and no test runs it faster than it is built for.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+    speed_hz : float or None
+        Spin speed (Hz), ≥ 0.
+    what : str
+        The option or key that gave it, for the message.
+
+    Returns
+    -------
+    RigConfig
+
+    Raises
+    ------
+    ConfigError
+        A speed that is not finite or outside 0 … the rig's top speed.
+    """
+    if speed_hz is None:
+        return cfg
+    op = cfg.operating
+    top = op.speed_range_hz[1] if op.speed_range_hz else abs(op.speed_rpm) / 60.0
+    f = float(speed_hz)
+    if not math.isfinite(f) or f < 0 or f > top * (1 + 1e-12):
+        raise ConfigError(f"{what}: {speed_hz!r} Hz; the rig runs from standstill to "
+                          f"{top:g} Hz ([operating] speed_range_hz, else its speed_rpm)")
+    rpm = math.copysign(60.0 * f, op.speed_rpm if op.speed_rpm else 1.0)
+    # a test speed may lie outside the range the machine operates in (standstill below it):
+    # the copy keeps the rig's validated range and takes the test's speed
+    return cfg.model_copy(update={"operating": op.model_copy(update={"speed_rpm": rpm})})
+
+
 def acquire(cfg: RigConfig, truth: TruthSection, excitation: Excitation, *,
             controller: DiscreteController, pressure_bar: float, seed: int = 0,
-            pressure_schedule: list[tuple[float, float]] | None = None) -> Measurement:
+            pressure_schedule: list[tuple[float, float]] | None = None,
+            speed_hz: float | None = None) -> Measurement:
     """Run the virtual facility with ``controller`` levitating the rotor and return the
     record as a :class:`Measurement` (the controller in its metadata; a
     ``pressure_schedule`` of :func:`~ambseal.identify.rig_sim.simulate_facility` in it as
@@ -127,6 +169,10 @@ def acquire(cfg: RigConfig, truth: TruthSection, excitation: Excitation, *,
         Seed of the sensor and current noise.
     pressure_schedule : list of (start_s, pressure_bar), optional
         A piecewise-constant pressure drop (bar) from each start time (s) on.
+    speed_hz : float, optional
+        Spin speed of the run (Hz, :func:`at_speed`); default the rig's operating speed.
+        The record's metadata carries it (``speed_rad_s``), and the fit takes its model
+        there.
 
     Returns
     -------
@@ -140,7 +186,10 @@ def acquire(cfg: RigConfig, truth: TruthSection, excitation: Excitation, *,
         A controller that does not fit the axes or the excitation's sample rate.
     ModelError
         See :func:`~ambseal.identify.rig_sim.simulate_facility`.
+    ConfigError
+        A speed the rig does not run (:func:`at_speed`).
     """
+    cfg = at_speed(cfg, speed_hz)
     axes = excitation.axes
     meta = {
         "rig": cfg.rotor.name,

@@ -176,6 +176,9 @@ def load_steps(cfg: RigConfig, steps_per_direction: int = 5, position_m: float |
     the four directions ±x, ±y (P2 §5: "spanning both increasing and decreasing external
     loads in all four loading directions"), at the mid-point between the bearings (the
     calibration clamp at the shaft's centre, P2 Fig. 1d) unless ``position_m`` is given.
+    With more than two AMBs the programme runs at the mid-point of each pair of
+    neighbouring AMBs in turn: loads at one position fix only two of three bearing forces
+    in a plane (force and moment balance), loads at two positions fix all of them.
 
     The largest load is the force both AMBs make together with a quarter of the smallest
     bias current (or current limit) of the rig file, with its smallest Ki: well within the
@@ -193,10 +196,13 @@ def load_steps(cfg: RigConfig, steps_per_direction: int = 5, position_m: float |
     F = []
     for d in (np.array([1.0, 0]), np.array([-1.0, 0]), np.array([0, 1.0]), np.array([0, -1.0])):
         F += [lv * d for lv in levels]
-    z = position_m if position_m is not None else float(
-        np.mean([a.position for a in cfg.amb]))
+    if position_m is not None:
+        zs = [float(position_m)]
+    else:
+        at = sorted(a.position for a in cfg.amb)
+        zs = [0.5 * (a + b) for a, b in zip(at[:-1], at[1:])] or [float(at[0])]
     F = np.array(F)
-    return np.full(len(F), z), F
+    return np.repeat(zs, len(F)), np.tile(F, (len(zs), 1))
 
 
 def virtual_static_load(cfg: RigConfig, truth: TruthSection, *, seed: int = 0,

@@ -45,7 +45,7 @@ from an inaccurate solution is refused.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Sequence
 
 import control
@@ -180,6 +180,8 @@ class LpvSynResult:
     closed_loop : FrozenClosedLoop
         θ ↦ the frozen closed loop F_l(P(θ), K(θ)) as a named ``control.StateSpace``: the
         LPV closed loop depends on the parameter, so it is a function, not one system.
+    scaling : str
+        The state scaling the SDPs ran with (``"riccati"`` or ``"diagonal"``).
 
     Notes
     -----
@@ -199,6 +201,7 @@ class LpvSynResult:
     reports: tuple = ()
     time_s: float = 0.0
     closed_loop: Any = field(default=None, repr=False)
+    scaling: str = "riccati"
 
     def __iter__(self):
         """``K, CL, gamma, info = lpvsyn(...)``: the scheduled controller, θ ↦ the frozen
@@ -217,6 +220,7 @@ class LpvSynResult:
                 "check_gamma": [float(g) if np.isfinite(g) else None for g in self.check_gamma],
                 "check_gamma_max": float(np.max(self.check_gamma)),
                 "check_stable": self.check_stable, "controller_order": self.K.order,
+                "scaling": self.scaling,
                 "reports": [r.to_dict() for r in self.reports], "time_s": self.time_s}
 
 
@@ -226,7 +230,7 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
            dA: Sequence[np.ndarray] | None = None, lyapunov: str = "constant",
            rate_bound: float | None = None, backoff: float = 1.05,
            check_density: int = 5, solver_options: dict | None = None,
-           margin: float = 1e-6, scaling: str = "riccati", penalty: float = 1e-4,
+           margin: float = 1e-6, scaling: str = "auto", penalty: float = 1e-4,
            coupling_ratio: float = 1.1, centre: bool = False) -> LpvSynResult:
     """Gridded H∞ LPV controller (Apkarian & Adams 1998; Wu et al. 1996; thesis P3 §4).
 
@@ -274,10 +278,13 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
         relative, feasibility 1e-7).
     margin : float
         Strictness margin of the LMIs (scaled units).
-    scaling : {"riccati", "diagonal"}
-        State scaling before the SDPs: ``"riccati"`` (default) balances the H2 Riccati
-        solutions of the centre plant (``lpv_lmi._riccati_balance``) after a diagonal balancing
-        and the time scale; ``"diagonal"`` stops after the diagonal balancing.
+    scaling : {"auto", "riccati", "diagonal"}
+        State scaling before the SDPs: ``"riccati"`` balances the H2 Riccati solutions of
+        the centre plant (``lpv_lmi._riccati_balance``) after a diagonal balancing and the
+        time scale; ``"diagonal"`` stops after the diagonal balancing. ``"auto"``
+        (default): ``"riccati"``, and where it fails (the SDP solver stops, or a
+        reconstructed loop is unstable: small plants whose balancing is near singular)
+        ``"diagonal"``; the result says which (``scaling``).
     penalty : float
         Weight of the trace term in stage 1 (scaled units; ≥ 0).
     coupling_ratio : float
@@ -313,14 +320,39 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
     grid, As, dAs, B, C, D, nw, nz = _validate(plants, theta, nmeas, ncon, dA,
                                                lyapunov, rate_bound, backoff,
                                                coupling_ratio, penalty)
-    sc = scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling)
-    blocks = lmi_blocks(sc, nw, nz, ncon, nmeas)
-    nu_s = 0.0 if rate_bound is None else float(rate_bound) / sc.w0 * sc.dp_dW  # dp/dt'
     unknown = sorted(set(solver_options or {}) - set(SOLVER_KEYS))
     if unknown:
         raise SynthesisError(f"lpvsyn: solver_options {unknown} unknown; expected some of "
                              f"{', '.join(SOLVER_KEYS)} (CVXOPT's options)")
+    if scaling not in ("auto", "riccati", "diagonal"):
+        raise SynthesisError(f"lpvsyn: scaling={scaling!r}; expected 'auto', 'riccati' or "
+                             "'diagonal'")
     solver_options = {**DEFAULT_TOL, **(solver_options or {})}
+    data = (plants, grid, As, dAs, B, C, D, nw, nz, nmeas, ncon)
+    settings = dict(lyapunov=lyapunov, rate_bound=rate_bound, backoff=backoff,
+                    check_density=check_density, solver_options=solver_options,
+                    margin=margin, penalty=penalty, coupling_ratio=coupling_ratio,
+                    centre=centre)
+    if scaling != "auto":
+        r = _synthesise(data, scaling, **settings)
+    else:
+        try:
+            r = _synthesise(data, "riccati", **settings)
+        except SynthesisError as first:
+            try:  # a plant the balancing does not suit: the diagonal scaling alone
+                r = _synthesise(data, "diagonal", **settings)
+            except SynthesisError:
+                raise first from None
+    return replace(r, time_s=time.perf_counter() - t_start)
+
+
+def _synthesise(data, scaling: str, *, lyapunov, rate_bound, backoff, check_density,
+                solver_options, margin, penalty, coupling_ratio, centre) -> LpvSynResult:
+    """Stages 1–3 of :func:`lpvsyn` with one state scaling; SynthesisError as there."""
+    plants, grid, As, dAs, B, C, D, nw, nz, nmeas, ncon = data
+    sc = scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling)
+    blocks = lmi_blocks(sc, nw, nz, ncon, nmeas)
+    nu_s = 0.0 if rate_bound is None else float(rate_bound) / sc.w0 * sc.dp_dW  # dp/dt'
     gamma, gamma_d, R, S, reports = solve_lmis(
         sc, blocks, grid, lyapunov, nu_s, backoff=backoff, margin=margin, penalty=penalty,
         coupling_ratio=coupling_ratio, centre=centre, solver_options=solver_options)
@@ -345,8 +377,8 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
     return LpvSynResult(K=K, gamma=gamma, gamma_design=gamma_d, lyapunov=lyapunov,
                         rate_bound=None if rate_bound is None else float(rate_bound),
                         grid=grid, check_grid=table, check_gamma=check_g,
-                        check_stable=True, reports=tuple(reports),
-                        time_s=time.perf_counter() - t_start, closed_loop=CL)
+                        check_stable=True, reports=tuple(reports), closed_loop=CL,
+                        scaling=scaling)
 
 
 def _validate(plants, theta, nmeas, ncon, dA, lyapunov, rate_bound, backoff,

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 import control as ct
@@ -346,3 +348,38 @@ def test_gamma_search_confirms_at_band_top_when_sb10ad_refuses_the_root(monkeypa
     hi, lo, _ = sb.gamma_opt(1e-6)
     assert (hi, lo) == (ref_lo * (1 + 1e-6), ref_lo)
     assert ref < hi <= ref * (1 + 1e-6)
+
+
+def test_python_controls_own_hinfsyn_test_plant():
+    """Reference: python-control's ``testHinfsyn`` (control/tests/robust_test.py), whose
+    values come from Octave's hinfsyn (SB10AD): P = ss(-1, [1 1], [1; 1], [0 1; 1 0]),
+    optimal γ 0, controller A = −3, B = 1, C = −1, D = 0 and closed loop A = [[−1, −1],
+    [1, −3]]. A γ_opt of 0 is no contradiction: the verified norm decides."""
+    P = ct.ss(-1, [[1, 1]], [[1], [1]], [[0, 1], [1, 0]])
+    r = hinfsyn(P, 1, 1)
+    assert r.gamma < 1e-12 and r.gamma_opt <= r.gamma + 1e-15
+    np.testing.assert_allclose([r.K.A, r.K.B, r.K.C, r.K.D],
+                               [[[-3.0]], [[1.0]], [[-1.0]], [[0.0]]], atol=1e-6)
+    np.testing.assert_allclose(r.closed_loop.A, [[-1.0, -1.0], [1.0, -3.0]], atol=1e-6)
+
+
+@pytest.mark.parametrize("design, gamma_pc", [(1, 1.365925226789438), (2, 2.2082657125486898)])
+def test_skogestad_postlethwaite_example_2_11_as_python_control_designs_it(design, gamma_pc):
+    """Reference: python-control's examples/robust_siso.py (Skogestad & Postlethwaite,
+    Ex. 2.11): mixed sensitivity for G = 200/((10s+1)(0.05s+1)²), design 1 with
+    w_P = (s/M + ω_B)/(s + ω_B A), design 2 with its square (M = 1.5, ω_B = 10, A = 1e-4),
+    w_u = 1; γ_opt as python-control's mixsyn (SB10AD's bisection) finds it, 1.3659 and
+    2.2083, within 1e-5. Design 2's weight pole at −1e-3, squared, makes the Riccati
+    margin refuse γ's that SB10AD (and a controller) admit; the search asks SB10AD there."""
+    s = ct.tf([1, 0], 1)
+    g = 200 / (10 * s + 1) / (0.05 * s + 1) ** 2
+    wp = (s / 1.5 + 10) / (s + 1e-3) if design == 1 else (s / 1.5 ** 0.5 + 10) ** 2 / (s + 1e-3) ** 2
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FutureWarning)  # augw's connect()
+        P = ct.augw(g, wp, ct.tf(1, 1))
+    r = hinfsyn(P, 1, 1)
+    assert r.gamma_opt == pytest.approx(gamma_pc, rel=1e-5)
+    assert gamma_pc <= r.gamma <= 1.011 * gamma_pc  # the controller at 1.01·γ_opt
+    cl = P.lft(r.K, 1, 1)  # python-control closes the same loop: u = K y
+    assert np.all(cl.poles().real < 0)
+    assert hinfnorm(cl)[0] == pytest.approx(r.gamma, rel=1e-6)

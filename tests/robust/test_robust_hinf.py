@@ -307,16 +307,35 @@ def test_hinfsyn_rejects_undetectable_plant():
         hinfsyn(ct.ss(A, B, C, D), 1, 1)
 
 
-def test_hinfsyn_rejects_rank_deficient_d12_d21():
+def test_hinfsyn_rejects_rank_deficient_d12_d21_without_regularisation():
     """Reference: assumption (A2) of SB10AD / Zhou et al. §17.1 — D12, D21 full rank."""
     P = ks_plant(1.0)
     D = np.array(P.D)
     D12 = D.copy(); D12[0, 1] = 0.0
     with pytest.raises(SynthesisError, match="D12"):
-        hinfsyn(ct.ss(P.A, P.B, P.C, D12), 1, 1)
+        hinfsyn(ct.ss(P.A, P.B, P.C, D12), 1, 1, regularise=None)
     D21 = D.copy(); D21[1, 0] = 0.0
     with pytest.raises(SynthesisError, match="D21"):
-        hinfsyn(ct.ss(P.A, P.B, P.C, D21), 1, 1)
+        hinfsyn(ct.ss(P.A, P.B, P.C, D21), 1, 1, regularise=None)
+
+
+@pytest.mark.parametrize("singular", ["D12", "D21"])
+def test_hinfsyn_regularises_a_singular_d12_or_d21_and_says_so(singular):
+    """Reference: the infimum is 0 (closed form). ẋ = −x + w + u, z = x, y = x + w: with
+    D12 = 0 (no control penalty) a controller of gain → ∞ rejects w entirely; with D21 = 0
+    instead (y = x, z = x + u) likewise. The ε-channels (Zhou, Doyle & Glover §17.1) make the
+    problem regular: γ of the given plant's loop is below ε, and the regularisation is
+    stated with its ε (1e-4 of the channels' size, here 1)."""
+    if singular == "D12":
+        P = ct.ss([[-1.0]], [[1.0, 1.0]], [[1.0], [1.0]], [[0.0, 0.0], [1.0, 0.0]])
+    else:
+        P = ct.ss([[-1.0]], [[1.0, 1.0]], [[1.0], [1.0]], [[0.0, 1.0], [0.0, 0.0]])
+    r = hinfsyn(P, 1, 1)
+    other = "D21" if singular == "D12" else "D12"
+    assert r.regularisation == {singular: pytest.approx(1e-4), other: None}
+    assert r.closed_loop.ninputs == 1 and r.closed_loop.noutputs == 1  # the given plant's
+    assert r.gamma == pytest.approx(hinfnorm(lft_lower(P, r.K, 1, 1))[0], rel=1e-9)
+    assert 0.0 <= r.gamma < 1e-4 <= r.gamma_opt * 1.001
 
 
 def test_hinfsyn_rejects_bad_channels():

@@ -47,7 +47,8 @@ from ambseal.robust._hinf_small import small_margin
 from ambseal.robust.stability import is_stable, unstable_poles
 from ambseal.threads import with_numerics_threads
 
-__all__ = ["HinfResult", "hinfsyn", "hinf_gamma_opt", "hinfnorm", "lft_lower", "check_plant"]
+__all__ = ["HinfResult", "hinfsyn", "hinf_gamma_opt", "hinfnorm", "lft_lower", "check_plant",
+           "regularise_plant"]
 
 #: Plants with at most this many states take the compiled eigenvector form of the Riccati
 #: γ test (:mod:`ambseal.robust._hinf_small`; measured on 3 states: 0.06 ms against 0.4 ms
@@ -204,6 +205,69 @@ def check_plant(P, nmeas: int, ncon: int) -> None:
                     "seen by the measurements")
 
 
+#: ε of :func:`regularise_plant` relative to the size of the channels it joins
+REGULARISE_REL = 1e-4
+
+
+def regularise_plant(P, nmeas: int, ncon: int, rel: float = REGULARISE_REL):
+    """``P`` with a rank-deficient ``D12`` or ``D21`` made full rank by ε-channels, the
+    standard regularisation (Zhou, Doyle & Glover 1996 §17.1; Skogestad & Postlethwaite
+    §9.3.2: a small control-effort output and sensor-noise input).
+
+    ``D12`` without full column rank: the outputs ``z_reg_u<j> = ε_u·u_j`` are appended to
+    z, ε_u = ``rel``·max(σ̄(C1), σ̄[D11 D12]) (the size of the other performance outputs).
+    ``D21`` without full row rank: the inputs ``w_reg_y<j>`` are appended to w, entering
+    the measurements as ε_w·w, ε_w = ``rel``·max(σ̄(B1), σ̄[D11; D21]). The regularised
+    plant's γ_opt bounds the given one's from above, and the gap closes as ε → 0 (with
+    controller gains growing like 1/ε).
+
+    Parameters
+    ----------
+    P : control.StateSpace
+        Generalised plant, inputs ``[w, u]``, outputs ``[z, y]``.
+    nmeas, ncon : int
+        Measurements and controls.
+    rel : float
+        ε relative to the channels' size (> 0).
+
+    Returns
+    -------
+    (control.StateSpace, dict or None)
+        The plant (``P`` itself when both have full rank) and ``{"D12": ε_u, "D21": ε_w}``
+        (None for a full-rank one), or None when nothing was added.
+    """
+    A, B, C, D = (np.asarray(M, float) for M in (P.A, P.B, P.C, P.D))
+    nw, nz = B.shape[1] - ncon, C.shape[0] - nmeas
+
+    def deficient(M, k):
+        return M.shape[0 if k == M.shape[1] else 1] < k or np.linalg.matrix_rank(
+            M, tol=1e-10 * max(1.0, np.abs(M).max() if M.size else 1.0)) < k
+
+    def size(*Ms):
+        return max([np.linalg.norm(M, 2) for M in Ms if M.size] + [1e-300])
+
+    reg12 = deficient(D[:nz, nw:], ncon)
+    reg21 = deficient(D[nz:, :nw], nmeas)
+    if not (reg12 or reg21):
+        return P, None
+    ins, outs = list(P.input_labels), list(P.output_labels)
+    eps_u = float(rel * size(C[:nz], D[:nz])) if reg12 else None
+    eps_w = float(rel * size(B[:, :nw], D[:, :nw])) if reg21 else None
+    if reg12:  # z ← [z; ε_u u]
+        C = np.vstack([C[:nz], np.zeros((ncon, C.shape[1])), C[nz:]])
+        Dz = np.hstack([np.zeros((ncon, nw)), eps_u * np.eye(ncon)])
+        D = np.vstack([D[:nz], Dz, D[nz:]])
+        outs = outs[:nz] + [f"z_reg_u{j}" for j in range(ncon)] + outs[nz:]
+        nz += ncon
+    if reg21:  # w ← [w; w_reg], y += ε_w w_reg
+        B = np.hstack([B[:, :nw], np.zeros((B.shape[0], nmeas)), B[:, nw:]])
+        Dw = np.vstack([np.zeros((nz, nmeas)), eps_w * np.eye(nmeas)])
+        D = np.hstack([D[:, :nw], Dw, D[:, nw:]])
+        ins = ins[:nw] + [f"w_reg_y{j}" for j in range(nmeas)] + ins[nw:]
+    return (ct.ss(A, B, C, D, inputs=ins, outputs=outs, name=P.name),
+            {"D12": eps_u, "D21": eps_w})
+
+
 # --------------------------------------------------------------------------- synthesis
 @dataclass(frozen=True)
 class HinfResult:
@@ -239,6 +303,11 @@ class HinfResult:
         (D–G-scaled plants: built for 0.93, norm 30.9) and the controller returned is the
         best one the upward search verified: a valid controller, far from the optimum.
         Reported rather than raised: D–G–K then tries the controller at its own level.
+    regularisation : dict or None
+        ``{"D12": ε_u, "D21": ε_w}`` (None entries where the plant had full rank) when the
+        synthesis ran on the regularised plant (:func:`regularise_plant`): ``gamma_opt``,
+        ``gamma_design`` and ``gamma_lower`` are then that plant's, ``gamma`` and
+        ``closed_loop`` the given plant's.
     """
 
     K: Any
@@ -251,6 +320,7 @@ class HinfResult:
     gamma_lower: float = float("nan")
     iterations: int = 0
     on_target: bool = True
+    regularisation: dict | None = None
 
     @property
     def order(self) -> int:
@@ -268,7 +338,7 @@ class HinfResult:
         return {
             "gamma": self.gamma, "gamma_opt": self.gamma_opt, "gamma_design": self.gamma_design,
             "gamma_lower": self.gamma_lower, "iterations": self.iterations,
-            "on_target": self.on_target,
+            "on_target": self.on_target, "regularisation": self.regularisation,
             "omega_peak_rad_s": self.omega_peak, "order": self.order,
             "rcond": list(self.rcond),
             "K": {"A": np.asarray(K.A).tolist(), "B": np.asarray(K.B).tolist(),
@@ -311,7 +381,8 @@ def _scale(A, B, C, D, nw, nz):
 
 @with_numerics_threads
 def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | None = None,
-            max_backoff: float = 4.0, rtol: float = 1e-6) -> HinfResult:
+            max_backoff: float = 4.0, rtol: float = 1e-6,
+            regularise: float | None = REGULARISE_REL) -> HinfResult:
     """H∞ controller for a generalised plant (Paper 3 eq. 12; Paper 5 eq. 8).
 
     Brackets the optimal γ between cheap bounds — Parrott's bound on the feedthrough, then
@@ -342,6 +413,10 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
         Largest back-off tried before giving up.
     rtol : float
         Relative tolerance of γ_opt (the search stops at ``hi/lo ≤ 1 + rtol``).
+    regularise : float or None
+        A ``D12`` or ``D21`` without full rank is made full rank by ε-channels of this
+        relative size (:func:`regularise_plant`; stated in ``HinfResult.regularisation``);
+        None refuses such a plant instead.
 
     Returns
     -------
@@ -370,6 +445,10 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
     >>> 2.0 <= r.gamma <= 2.05
     True
     """
+    given, reg = P, None
+    if regularise is not None and isinstance(P, ct.StateSpace) and 0 < ncon < P.ninputs \
+            and 0 < nmeas < P.noutputs:
+        P, reg = regularise_plant(P, nmeas, ncon, regularise)
     check_plant(P, nmeas, ncon)
     if backoff < 1.0:
         raise ConfigError(f"backoff={backoff} must be ≥ 1")
@@ -411,11 +490,21 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
               states=[f"xK{i}" for i in range(chosen.K[0].shape[0])])
     cl = ct.ss(*chosen.closed_loop, inputs=list(P.input_labels)[:sb.nw],
                outputs=list(P.output_labels)[:sb.nz], name="closed_loop")
-    return HinfResult(K=K, gamma=float(chosen.gamma), gamma_opt=gamma_opt,
-                      gamma_design=float(chosen.gamma_design), omega_peak=float(chosen.omega),
+    achieved, w_peak = float(chosen.gamma), float(chosen.omega)
+    if reg is not None:  # the given plant's loop, without the ε-channels
+        nw0, nz0 = given.ninputs - ncon, given.noutputs - nmeas
+        cl = ct.ss(*lft_lower_matrices(tuple(np.asarray(M, float) for M in
+                                             (given.A, given.B, given.C, given.D)),
+                                       chosen.K, nmeas, ncon),
+                   inputs=list(given.input_labels)[:nw0],
+                   outputs=list(given.output_labels)[:nz0], name="closed_loop")
+        achieved, w_peak = (float(v) for v in hinfnorm(cl))
+    return HinfResult(K=K, gamma=achieved, gamma_opt=gamma_opt,
+                      gamma_design=float(chosen.gamma_design), omega_peak=w_peak,
                       closed_loop=cl, rcond=chosen.rcond,
                       gamma_lower=gamma_lower, iterations=tests + len(tried),
-                      on_target=bool(chosen.gamma <= claimed * (1.0 + 1e-3)))
+                      on_target=bool(chosen.gamma <= claimed * (1.0 + 1e-3)),
+                      regularisation=reg)
 
 
 def hinf_gamma_opt(P, nmeas: int, ncon: int, *, rtol: float = 1e-6,

@@ -1,11 +1,14 @@
-"""The controller types of ambseal and their one sign convention.
+"""The controllers a machine runs, and their sign convention.
 
-**Convention** (thesis P5 Fig. 8, stated here once): a controller maps the sensor
-displacements ``y`` (m) to the current references ``i`` (A) with **negative feedback**,
-``i = −K y``; its inputs are named ``y_<axis>`` and its outputs ``i_<axis>``
-(``<axis>`` an AMB actuator axis such as ``A_zeta``), the reverse of the plant's
-(:class:`ambseal.model.lft.Plant`: inputs ``i_<axis>``, outputs ``y_<axis>``). The loop
-closes by name in python-control with the sign written into the connection::
+**Convention** (thesis P5 Fig. 8): a controller that runs on a machine maps its
+measurements ``y`` to its actuator commands ``u`` with **negative feedback**, ``u = −K y``;
+its inputs are named ``y_<channel>`` and its outputs ``i_<channel>``, the reverse of the
+plant's (inputs ``i_<channel>``, outputs ``y_<channel>``). This is not the convention of
+the synthesis functions (:func:`~ambseal.robust.hinf.hinfsyn` and the others return
+controllers for the lower LFT F_l(P, K), u = K y); the layers that design for a machine
+convert one into the other. In ambseal's rotor layers a channel is an AMB actuator axis
+(``A_zeta``), ``y`` the displacements (m) and ``u`` the current references ``i`` (A). The
+loop closes by name in python-control with the sign written into the connection::
 
     loop = control.interconnect(
         [G, K], connections=[[f"G.i_{a}", f"-K.i_{a}"] for a in axes]
@@ -15,10 +18,10 @@ closes by name in python-control with the sign written into the connection::
 
 * A **fixed** controller is a continuous ``control.StateSpace`` with that convention.
 * A **scheduled** controller is a :class:`ScheduledController` scheduled on one named
-  parameter θ: the rotor speed (``parameter == "speed"``, Ω in rad/s; the LPV controller of
-  P3) or an LFT parameter of the rig (e.g. ``"seal.k"`` in N/m, the controller scheduled on
-  the tracked seal coefficient). ``at(θ)`` gives the frozen fixed controller at
-  θ inside ``schedule``.
+  parameter θ in its own unit: :data:`SPEED` (a rotor speed Ω in rad/s; the LPV controller
+  of P3) or any other named parameter (e.g. ``"seal.k"`` in N/m, the controller scheduled
+  on a tracked seal coefficient). ``at(θ)`` gives the frozen fixed controller at θ inside
+  ``schedule``.
 
 Analyses take either through :func:`frozen` and :func:`matrices_at`.
 """

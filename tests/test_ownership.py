@@ -171,3 +171,18 @@ def test_a_killed_command_is_recovered_by_the_next(tmp_path):
         assert "took over the lock" in rerun.stderr
         assert FOLDER_LOCK not in {p.name for p in out.iterdir()}
         check_manifest(out)  # every file listed with its hash, nothing else there
+
+
+def test_a_link_planted_in_an_output_folder_is_refused_and_its_target_kept(tmp_path,
+                                                                         capsys):
+    """A folder command (``campbell``) whose output folder holds a link where it writes a
+    figure: the link is not the manifest's, so the folder is refused by name before any
+    work, and the link's target keeps its bytes."""
+    out = tmp_path / "out"
+    out.mkdir()
+    doc = tmp_path / "document.txt"
+    doc.write_bytes(USER)
+    (out / "campbell_pid.png").symlink_to(doc)
+    assert main(["campbell", RIG, "--speed-hz", "0:10:2", "--out", str(out)]) == 2
+    _one_error(capsys, "campbell_pid.png")
+    assert doc.read_bytes() == USER and (out / "campbell_pid.png").is_symlink()

@@ -38,8 +38,17 @@ def _run(rig: Path, out: Path, capsys, failing: set = frozenset()) -> tuple[dict
     assert code == (1 if failing else 0), err
     assert "Traceback" not in err
     metrics = json.loads((out / "metrics.json").read_text())
-    assert set(metrics["failed"]) == set(failing), metrics["failed"]
-    top = max(c["speed_hz"] for c in metrics["stability"]) if failing else None
+    failed = metrics["failed"]
+    assert {m for m, f in failed.items() if f["designed"]} == set(failing), failed
+    # the reference PID (given, not designed) may fail above the nominal pressure only, as
+    # the thesis's does (P5 Fig. 13): reported, not counted in the exit status
+    nominal = metrics["controllers"].get("pid", {}).get("pressure_bar", 0.0)
+    for m, f in failed.items():
+        if not f["designed"]:
+            assert all(c["pressure_bar"] > nominal + 1e-9 for c in metrics["cases"]
+                       if c["controller"] == m and not c["stable"]), f
+    speeds = [c["speed_hz"] for c in [*metrics["cases"], *metrics["stability"]]]
+    top = max(speeds) if speeds else None
     for m in failing:  # only in the speed range, below the top speed
         assert all(c["speed_hz"] < top for c in metrics["stability"]
                    if c["controller"] == m and not c["stable"])
@@ -115,8 +124,9 @@ def test_a_rig_without_seal_runs_end_to_end_with_a_note(tmp_path, capsys):
 def test_a_rig_with_one_amb_and_a_plain_bearing_runs_or_is_refused_plainly(tmp_path, capsys):
     """One AMB (2 axes) and a stiff plain bearing (a 5e7 N/m spring) at AMB B's
     place: run end to end, or refused with one line (exit 2) naming the mode the design
-    destabilised and what to do. Measured: H∞, designed on the nominal plant, destabilises
-    the 207 Hz mode at 0 bar (ζ −0.004): refused."""
+    destabilised and what to do, or run with the controllers that fail named in
+    ``failed`` with their conditions (exit 1). Measured: H∞, designed on the nominal
+    plant, destabilises the 207 Hz mode at 0 bar (ζ −0.004)."""
     rig = tmp_path / "oneamb.toml"
     rig.write_text(_testrig_without("amb"))
     code = main(["--quiet", "run", str(rig), "--no-identify", "--out", str(tmp_path / "o")])
@@ -127,9 +137,15 @@ def test_a_rig_with_one_amb_and_a_plain_bearing_runs_or_is_refused_plainly(tmp_p
         assert re.search(r"the mode at [0-9.]+ Hz has damping ζ = -", line)
         assert "--allow-unstable" in line
         return
-    assert code == 0
     metrics = json.loads((tmp_path / "o" / "metrics.json").read_text())
-    _check_stable_or_stated(metrics, err)
+    designed_failed = {m for m, f in metrics["failed"].items() if f["designed"]}
+    assert code == (1 if designed_failed else 0), err
+    for m in designed_failed:  # named with the conditions its loops are unstable at
+        f = metrics["failed"][m]
+        assert f["conditions"] and f"ambseal: {f['reason']}" in err
+    ok = {c["controller"] for c in metrics["cases"]} - set(metrics["failed"])
+    _check_stable_or_stated({**metrics, "cases": [c for c in metrics["cases"]
+                                                  if c["controller"] in ok]}, err)
     assert all(len(c["iso_zone_per_axis"]) == 2 for c in metrics["cases"] if c["stable"])
 
 

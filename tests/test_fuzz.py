@@ -341,8 +341,12 @@ def _physics_paths(doc: dict) -> list[tuple]:
     a tabulated coefficient as a whole (one entry far from the operating speed does not
     reach the loop there; the table's frequencies are its grid, not a coefficient)."""
     out = set()
+    # the pressure drop reaches the model only through coefficients affine in it
+    pressure_driven = "per_bar" in json.dumps(doc.get("seal", []))
     for p in _paths(doc):
         if p[0] in ("design", "reduction") or "frequency_hz" in p:
+            continue
+        if p == ("operating", "pressure_bar") and not pressure_driven:
             continue
         if "value" in p:
             out.add(p[:p.index("value") + 1])

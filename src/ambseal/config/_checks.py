@@ -11,7 +11,7 @@ from pydantic import Field
 
 from ambseal.errors import LABEL_PATTERN, NAME_PATTERN, ConfigError
 
-__all__ = ["MAX_ELEMENTS", "MAX_COMPONENTS", "MAX_AMBS", "MAX_LAYERS", "MAX_REDUCED_STATES", "MAX_COEFFICIENT",
+__all__ = ["MIN_CURRENT_A", "MIN_TIME_CONSTANT_S", "MAX_ELEMENTS", "MAX_COMPONENTS", "MAX_AMBS", "MAX_LAYERS", "MAX_REDUCED_STATES", "MAX_COEFFICIENT",
            "MAX_FREQUENCY_HZ", "MAX_SPEED_HZ", "MAX_PRESSURE_BAR", "MAX_CURRENT_A", "MAX_GAP_M",
            "MAX_DELAY_SAMPLES", "MAX_RELATIVE", "BoundedCoefficient",
            "BoundedFrequency", "check_amb", "check_actuator", "cross_check", "Name", "Label"]
@@ -63,6 +63,12 @@ MAX_SPEED_HZ = 1e5
 MAX_PRESSURE_BAR = 1e4
 #: A current (A): the bound of an AMB's ``bias_current`` and ``current_limit``.
 MAX_CURRENT_A = 1e4
+#: The least bias current or current limit (A): the smallest AMBs run on tens of mA; below
+#: a microampere the force law's gains (∝ 1/i0) overflow the facility's arithmetic.
+MIN_CURRENT_A = 1e-6
+#: The least non-zero time constant of the facility's lag (s): far below one sample of
+#: any controller, and above what makes its rate (1/τ) overflow.
+MIN_TIME_CONSTANT_S = 1e-9
 #: A displacement inside a bearing (m): the bound of an AMB's ``air_gap``.
 MAX_GAP_M = 0.1
 #: A computation delay (controller samples): each sample adds a state per controller output

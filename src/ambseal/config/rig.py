@@ -68,7 +68,14 @@ import math
 from pathlib import Path
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from ambseal.config._checks import (
     MAX_AMBS,
@@ -81,6 +88,8 @@ from ambseal.config._checks import (
     MAX_LAYERS,
     MAX_REDUCED_STATES,
     MAX_RELATIVE,
+    MIN_CURRENT_A,
+    MIN_TIME_CONSTANT_S,
     BoundedCoefficient,
     BoundedFrequency,
     Label,
@@ -231,11 +240,11 @@ class Amb(_Strict):
     turns: int | None = Field(default=None, gt=0, le=100000)
     pole_area: float | None = Field(default=None, gt=0, le=1.0)
     air_gap: float | None = Field(default=None, ge=1e-6, le=0.1)
-    bias_current: float | None = Field(default=None, gt=0, le=1e4)
+    bias_current: float | None = Field(default=None, ge=MIN_CURRENT_A, le=MAX_CURRENT_A)
     pole_angle_deg: float = Field(default=22.5, ge=0, lt=90)
     ki: _Big | AxisPair | None = None
     ks: _Big | AxisPair | None = None
-    current_limit: float | None = Field(default=None, gt=0, le=1e4)
+    current_limit: float | None = Field(default=None, ge=MIN_CURRENT_A, le=MAX_CURRENT_A)
     backup_clearance: float | None = Field(default=None, gt=0, le=1.0)
     uncertainty: Uncertainty = None
 
@@ -529,8 +538,8 @@ class TruthSection(_Strict):
 
     parameters: dict[str, Coefficient] = {}
     tau_e: float = Field(default=0.0, ge=0, le=1.0)
-    bias_current: float | None = Field(default=None, gt=0, le=MAX_CURRENT_A)
-    current_limit: float | None = Field(default=None, gt=0, le=MAX_CURRENT_A)
+    bias_current: float | None = Field(default=None, ge=MIN_CURRENT_A, le=MAX_CURRENT_A)
+    current_limit: float | None = Field(default=None, ge=MIN_CURRENT_A, le=MAX_CURRENT_A)
     sensor_noise_m: float = Field(default=0.0, ge=0, le=MAX_GAP_M)
     noise_fraction: float = Field(default=0.0, ge=0, le=MAX_RELATIVE)
     current_noise_a: float = Field(default=0.0, ge=0, le=MAX_CURRENT_A)
@@ -543,6 +552,13 @@ class TruthSection(_Strict):
     mesh_factor: float = Field(default=1.0, gt=0, le=MAX_ELEMENTS)  # in all: rig_sim.true_rig
     modal_damping: float | None = Field(default=None, ge=0, lt=1)
     sensor_filter_hz: float | None = Field(default=None, gt=0, le=MAX_FREQUENCY_HZ)
+
+    @field_validator("tau_e")
+    @classmethod
+    def _lag(cls, v: float) -> float:
+        if 0 < v < MIN_TIME_CONSTANT_S:
+            raise ValueError(f"expected 0 (no lag) or at least {MIN_TIME_CONSTANT_S:g} s")
+        return v
 
 
 class TruthConfig(_Strict):

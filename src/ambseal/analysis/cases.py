@@ -13,6 +13,7 @@ recorded as a :class:`CaseError` with its message and the others go on. A progre
 from __future__ import annotations
 
 import asyncio
+import multiprocessing
 import os
 import sys
 from dataclasses import dataclass
@@ -200,11 +201,16 @@ def _run_dask(fn, cases, shared, workers, scheduler, done) -> list:
                 client = Client(scheduler, timeout=deadline)
         else:
             n = workers or (os.cpu_count() or 1)
-            # Linux: workers forked from this process, which has ambseal, numpy, scipy and
-            # python-control imported already (spawned workers import them again: about
-            # 3 s of a 2-core machine per worker before the first case); elsewhere dask's
-            # default (spawn: fork is unsafe on macOS)
-            method = "fork" if sys.platform.startswith("linux") else "spawn"
+            # Linux: workers forked by a fork server, a single-threaded process that has
+            # imported ambseal's numerics once (spawned workers import them each: about
+            # 3 s of a 2-core machine per worker before the first case). Not forked from
+            # this process: it runs threads (Dask's, a caller's), and a fork that catches
+            # one holding a lock (a logging stream's) hangs the worker for good.
+            # Elsewhere dask's default (spawn).
+            method = "forkserver" if sys.platform.startswith("linux") else "spawn"
+            if method == "forkserver":
+                multiprocessing.get_context("forkserver").set_forkserver_preload(
+                    ["ambseal.analysis.cases"])
             with dask.config.set({"distributed.worker.multiprocessing-method": method}):
                 cluster = LocalCluster(
                     n_workers=n, threads_per_worker=1, processes=True,

@@ -35,7 +35,7 @@ from ambseal.errors import AmbsealError
 __all__ = ["atomic_write", "writable_folder", "input_file", "MAX_READ_BYTES", "read_text",
            "load_toml", "write_text", "write_json", "RunFolder", "check_manifest",
            "write_manifest", "OwnedFolder", "foreign_entries", "claim_file", "stamp_text",
-           "stamp_holds"]
+           "stamp_holds", "STAMP_KEY"]
 
 
 def atomic_write(path: str | os.PathLike, write: Callable[[BinaryIO], Any]) -> Path:
@@ -169,8 +169,9 @@ def write_json(path: str | os.PathLike, data: Any) -> Path:
 
 # --- one output file ------------------------------------------------------------------
 
-#: The key of the first line of a text file ambseal writes on its own (a rig from
-#: ``import-ross``): ``<comment> ambseal-sha256: <SHA-256 of the lines below>``.
+#: ambseal's mark on a file it writes on its own, beside the SHA-256 of what it wrote: the
+#: first line of a text file (a rig from ``import-ross``: ``<comment> ambseal-sha256:
+#: <hash of the lines below>``), a record's sidecar key, a figure's PNG text key.
 STAMP_KEY = "ambseal-sha256"
 _STAMP = re.compile(rb"^\S{1,3} " + STAMP_KEY.encode() + rb": ([0-9a-f]{64})[^\n]*\n")
 

@@ -31,7 +31,7 @@ from ambseal.config import default_rig_path, load_rig, load_truth
 from ambseal.errors import AmbsealError, ConfigError, with_source
 from ambseal.export.codegen import c_identifier, write_c
 from ambseal.export.controller_files import load_controller
-from ambseal.files import OwnedFolder, claim_file, stamp_holds, writable_folder
+from ambseal.files import OwnedFolder, claim_file, writable_folder
 from ambseal.identify import signals
 from ambseal.identify.data import record_is_ours, save_measurement
 from ambseal.identify.excitation import IMPULSE_LEAD, excitation_plan
@@ -53,11 +53,13 @@ def _acquire_cmd(args: argparse.Namespace) -> int:
     at_speed(cfg, args.speed_hz, "--speed-hz")  # a speed the rig runs, before any work
     out = Path(args.out)
     writable_folder(out.parent)  # before the simulation
-    # a record and its sidecar are written as a pair: each new, or the pair ambseal wrote
-    claim_file(out, force=args.force,
-               ours=record_is_ours if args.excitation != "static" else stamp_holds)
-    if out.suffix.lower() == ".csv" and args.excitation != "static":
-        claim_file(out.with_name(out.name + ".json"), force=args.force, ours=record_is_ours)
+    if args.excitation == "static":  # a load-step table carries no mark: new, or --force
+        claim_file(out, force=args.force)
+    else:  # a record and its sidecar as a pair: each new, or the pair ambseal wrote
+        claim_file(out, force=args.force, ours=record_is_ours)
+        if out.suffix.lower() == ".csv":
+            claim_file(out.with_name(out.name + ".json"), force=args.force,
+                       ours=record_is_ours)
     axes = channel_names(cfg)
     if not axes:
         raise ConfigError(f"{args.rig}: amb: acquisition needs at least one [[amb]]")

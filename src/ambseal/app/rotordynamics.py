@@ -147,13 +147,13 @@ def _modes(args: argparse.Namespace) -> int:
     # a pair damped at ζ ≥ 1/√2 has no resonance (|H(jω)| of its mode falls monotonically):
     # no natural frequency to avoid, listed apart as `campbell` lists its crossings
     over = m.damping_ratio >= OVERDAMPED_ZETA
-    res_ = ~over
+    resonant = ~over
     out = {"speed_hz": rpm / 60.0, "pressure_bar": p, "max_hz": f_max,
            "controller": args.controller or "none",
-           "natural_frequencies_hz": [float(x) for x in m.frequency_hz[res_]],
-           "damping_ratios": [float(x) for x in m.damping_ratio[res_]],
-           "log_decrements": [float(x) for x in m.log_decrement[res_]],
-           "whirl": [w for w, r in zip(m.whirl, res_) if r],
+           "natural_frequencies_hz": [float(x) for x in m.frequency_hz[resonant]],
+           "damping_ratios": [float(x) for x in m.damping_ratio[resonant]],
+           "log_decrements": [float(x) for x in m.log_decrement[resonant]],
+           "whirl": [w for w, r in zip(m.whirl, resonant) if r],
            "overdamped": [{"frequency_hz": float(f), "damping_ratio": float(z), "whirl": w}
                           for f, z, w, o in zip(m.frequency_hz, m.damping_ratio, m.whirl, over)
                           if o],

@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from scipy.stats import binom
+from scipy.stats import binom, norm
 
 from ambseal.config import Affine
 from ambseal.identify.excitation import ExcitationPlan, excitation_plan, welch_segment
@@ -147,7 +147,7 @@ def truth_errors(res: ProcedureResult, seal_name: str | None) -> dict:
 
 
 #: the two-sided 95 % quantile of the normal distribution
-Z95 = 1.959963984540054
+Z95 = float(norm.ppf(0.975))
 
 
 def interval_check(errors: dict) -> dict:

@@ -113,7 +113,7 @@ import numpy as np
 import scipy.io
 
 from ambseal.errors import AmbsealError, DataError
-from ambseal.files import atomic_write, input_file, read_text
+from ambseal.files import STAMP_KEY, atomic_write, input_file, read_text
 from ambseal.identify.matlab_file import read_matlab
 from ambseal.identify.measurement import (
     _RATE_RTOL,
@@ -154,14 +154,15 @@ def _sidecar(path: Path) -> Path:
     return path.with_name(path.name + ".json")
 
 
-#: The sidecar key holding the SHA-256 of the CSV table ambseal wrote with it
-RECORD_MARK = "ambseal_sha256"
+#: The sidecar key holding the SHA-256 of the CSV table ambseal wrote with it (ambseal's
+#: file mark)
+RECORD_MARK = STAMP_KEY
 
 
 def record_is_ours(path: str | os.PathLike) -> bool:
     """True if ``path`` (a ``.csv`` record, or its ``.csv.json`` sidecar) is a record that
     :func:`save_measurement` wrote and nobody changed since: the sidecar's
-    ``ambseal_sha256`` is the hash of the table. A ``.mat`` record carries no such mark.
+    ``ambseal-sha256`` is the hash of the table. A ``.mat`` record carries no such mark.
 
     Parameters
     ----------

@@ -26,7 +26,7 @@ from PIL import Image, UnidentifiedImageError
 
 from ambseal.analysis.iso import ZONE_LIMITS, ZONES, zone_limit_db
 from ambseal.errors import AmbsealError
-from ambseal.files import atomic_write, input_file
+from ambseal.files import STAMP_KEY, atomic_write, input_file
 
 __all__ = [
     "controller_gains_figure",
@@ -106,8 +106,9 @@ def save_figure(fig: Figure, path: str | os.PathLike, *, dpi: int = 120,
     return path
 
 
-#: The PNG text key of a figure ambseal drew: the SHA-256 of its RGBA pixels
-FIGURE_MARK = "ambseal-sha256"
+#: The PNG text key of a figure ambseal drew (ambseal's file mark): the SHA-256 of its RGBA
+#: pixels
+FIGURE_MARK = STAMP_KEY
 
 
 def figure_is_ours(path: str | os.PathLike) -> bool:

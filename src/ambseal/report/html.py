@@ -45,7 +45,8 @@ figcaption{font-size:.85em;color:#555}.judged{font-size:.9em;margin-top:0}.meta{
 @media (max-width:1000px){table.verdict,table.verdict tbody,table.verdict tr,table.verdict td{display:block;width:auto;max-width:none;min-width:0}
 table.verdict thead{display:none}table.verdict tr{border:1px solid #bbb;margin:.5em 0}
 table.verdict td{border:none;border-bottom:1px solid #eee;text-align:left}
-table.verdict td::before{content:attr(data-label) ": ";font-weight:normal;color:#555}}
+table.verdict td::before{content:attr(data-label) ": ";font-weight:normal;color:#555}
+table.verdict td.zone::before{color:inherit}}
 """
 
 

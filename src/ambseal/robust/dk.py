@@ -509,8 +509,8 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
             rule = f"patience={patience}: {stall} iterations without a μ gain of rtol={rtol:g}"
             break
         # D-step on the unscaled closed loop, diagonal (complexified) structure
-        mu_c = mussv(cl, cblocks, w, lower=False, peak=False) if cblocks != [tuple(b) for b in blocks] \
-            else mu_true
+        mu_c = (mussv(cl, cblocks, w, lower=False, peak=False)
+                if cblocks != [tuple(b) for b in blocks] else mu_true)
         ds = np.asarray(mu_c.dscale)  # (F, nblocks), last block = 1
         if order == "auto":
             wgt = (mu_c.upper / np.max(mu_c.upper)) ** 4

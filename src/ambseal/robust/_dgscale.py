@@ -47,7 +47,9 @@ import numpy as np
 from scipy.optimize import least_squares, minimize
 
 from ambseal.lti.freqresp import freqresp
-from ambseal.robust._dscale import _diag_sys, _ss, _tf_to_theta, _theta_to_tf
+from ambseal.robust._dscale import (
+    _d_logmag_jac, _d_sections, _d_theta, _diag_sys, _ss, _tf_to_theta, _theta_to_tf,
+)
 from ambseal.robust.hinf import hinfnorm, lft_lower
 
 
@@ -135,50 +137,6 @@ def fit_allpass_pair(w, g, wgt, tol):
 
 
 # --------------------------------------------------------------------------- D sections
-def _d_sections(order):
-    """Indices in θ (:func:`~ambseal.robust._dscale._logmag`) of the second-order
-    sections' log ω_n², of their log 2ζω_n (index + 1), and of the first-order log a."""
-    n2, n1 = divmod(order, 2)
-    sec = np.array([1 + 2 * i + off * (2 * n2 + n1) for off in (0, 1) for i in range(n2)], int)
-    first = np.array([1 + 2 * n2 + i + off * (2 * n2 + n1) for off in (0, 1)
-                      for i in range(n1)], int)
-    return sec, first
-
-
-def _d_theta(x, order):
-    """θ of :func:`~ambseal.robust._dscale._logmag` from x, where x holds log 2ζ in place
-    of log 2ζω_n (so that the damping can be bounded)."""
-    th = np.array(x, float)
-    sec, _ = _d_sections(order)
-    th[sec + 1] = x[sec + 1] + 0.5 * x[sec]
-    return th
-
-
-def _d_logmag_jac(x, w, order):
-    """log|d(jω)| and its gradient in x (:func:`_d_theta`), shapes (F,) and (F, 1 + 2·order)."""
-    th = _d_theta(x, order)
-    sec, first = _d_sections(order)
-    half = sec.size // 2, first.size // 2
-    w2 = w ** 2
-    val = np.full(w.size, th[0])
-    J = np.zeros((w.size, th.size))
-    J[:, 0] = 1.0
-    for k, i in enumerate(sec):
-        sign = 1.0 if k < half[0] else -1.0
-        b0, b1 = np.exp(th[i]), np.exp(th[i + 1])
-        q = (b0 - w2) ** 2 + (b1 * w) ** 2
-        val += sign * 0.5 * np.log(q)
-        J[:, i] = sign * b0 * (b0 - w2) / q
-        J[:, i + 1] = sign * (b1 * w) ** 2 / q
-    for k, i in enumerate(first):
-        sign = 1.0 if k < half[1] else -1.0
-        a2 = np.exp(2 * th[i])
-        val += sign * 0.5 * np.log(w2 + a2)
-        J[:, i] = sign * a2 / (w2 + a2)
-    J[:, sec] += 0.5 * J[:, sec + 1]  # chain rule of θ[i + 1] = x[i + 1] + x[i]/2
-    return val, J
-
-
 def _d_bounds(w, order):
     lw = np.log(w)
     lo, hi = lw.min() - np.log(10.0), lw.max() + np.log(10.0)

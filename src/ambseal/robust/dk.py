@@ -37,6 +37,7 @@ from scipy.optimize import least_squares
 from ambseal.errors import ConfigError, ModelError, SynthesisError
 from ambseal.robust._dscale import (
     _complexify,
+    _d_theta,
     _logmag,
     _scaled_plant,
     _search_evals,
@@ -125,13 +126,8 @@ def _fit_weighted(w, y, order, wgt, starts):
     lo_b, hi_b = lw.min() - np.log(10.0), lw.max() + np.log(10.0)
     sq = np.sqrt(wgt)
     # x: per second-order section (log ωn², log 2ζ); θ of _logmag: (log ωn², log 2ζωn)
-    sec_idx = np.array([1 + 2 * i + off * (2 * n2 + n1) for off in (0, 1) for i in range(n2)],
-                       int)
-
     def theta(x):
-        t = x.copy()
-        t[sec_idx + 1] = x[sec_idx + 1] + 0.5 * x[sec_idx]
-        return t
+        return _d_theta(x, order)
 
     best, best_err = None, np.inf
     for cen0, spread in starts:

@@ -389,12 +389,12 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
     a ladder of factors 4 to the first change of admissibility — and closes in by Brent's
     method on the Riccati γ margin ρ(X∞Y∞)/γ² − 1 (Glover & Doyle 1988; compiled for plants
     of at most 6 states), to a relative tolerance ``rtol``; where the margin is undefined
-    (e.g. repeated Hamiltonian eigenvalues) SLICOT SB10AD's own bisection takes over, and
-    SB10AD's γ test confirms the result. python-control's ``hinfsyn`` starts SB10AD's
-    bisection and scan at γ = 1e100 instead. Then it builds the
-    controller at ``backoff·γ_opt`` and checks that the closed loop is stable; the back-off
-    grows (×1.01 … ×``max_backoff``) until it is. The reported γ is the recomputed norm of
-    ``F_l(P, K)``.
+    (e.g. repeated Hamiltonian eigenvalues) SLICOT SB10AD's own bisection takes over; where
+    SB10AD and the margin disagree, a controller's closed loop decides.
+    python-control's ``hinfsyn`` starts SB10AD's bisection and scan at γ = 1e100 instead.
+    Then it builds the controller at ``backoff·γ_opt`` and checks that the closed loop is
+    stable and keeps that γ; the back-off grows (×1.01 … ×``max_backoff``) until it does.
+    The reported γ is the recomputed norm of ``F_l(P, K)``.
 
     Parameters
     ----------
@@ -454,7 +454,7 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
         raise ConfigError(f"backoff={backoff} must be ≥ 1")
     sb = _Sb10(P, nmeas, ncon)
     if gamma is None:
-        gamma_opt, gamma_lower, tests = sb.gamma_opt(rtol)
+        gamma_opt, gamma_lower, tests = sb.gamma_opt(rtol, confirm=False)
         base_g, factors = gamma_opt, _backoff_ladder(backoff, max_backoff)
     else:
         gamma_opt, gamma_lower, tests = float("nan"), float("nan"), 0
@@ -662,7 +662,8 @@ class _Sb10:
         return float(small_margin(self.A, self.B, self.C, self.D, self.nw, self.nz,
                                   float(g)))
 
-    def gamma_opt(self, rtol: float = 1e-6) -> tuple[float, float, int]:
+    def gamma_opt(self, rtol: float = 1e-6, confirm: bool = True
+                  ) -> tuple[float, float, int]:
         """γ_opt by a search between cheap bounds (:func:`_search_gamma`).
 
         The γ test is the Riccati margin (:meth:`riccati_margin`, a number, so the search
@@ -675,9 +676,21 @@ class _Sb10:
         compiled margin cannot decide at the first γ (e.g. identical channels: the Schur
         form there costs more than SB10AD's test), :meth:`_ladder_job1`.
 
+        Where SB10AD admits a γ that the margin refuses (the first γ, or the search's
+        lower end), the closed loop decides: SB10AD's test passes some γ just below γ_opt
+        (its Riccati solutions near singular there; the rig's D–G–K plant: 0.99957 where
+        controllers reach no norm below 1.00001), and a controller built at such a γ has a
+        closed-loop norm above it. Only a controller that keeps its γ
+        (:meth:`_keeps_gamma`) sends the search to :meth:`_ladder_job1`; otherwise the
+        margin's result stands.
+
+        ``confirm=False`` leaves out SB10AD's confirmation at the end, for a caller that
+        builds a controller near the result and checks its closed loop itself
+        (:func:`hinfsyn`).
+
         Returns ``(hi, lo, tests)``: the smallest admissible γ found, the largest
         inadmissible one (a lower bound of γ_opt; the Parrott bound if none was tried) and
-        the number of γ tests (SB10AD calls and Riccati margins).
+        the number of γ tests (SB10AD calls, Riccati margins and controllers).
         """
         lo0 = self.parrott_bound
         g0 = max(1.5 * lo0, 1.0)
@@ -689,7 +702,10 @@ class _Sb10:
         if ric0 >= 0:
             sb0, tests = (-1.0 if self.admissible(g0) else 1.0), tests + 1
             if sb0 < 0:
-                return self._ladder_job1(lo0, g0, sb0, rtol, tests)
+                tests += 1
+                if self._keeps_gamma(g0):
+                    return self._ladder_job1(lo0, g0, sb0, rtol, tests)
+                sb0 = 1.0
         hi, lo, more = _search_gamma(self.riccati_margin, lo0, rtol, {g0: ric0})
         tests += more
         if lo > lo0 * (1.0 + 1e-9) and self.riccati_margin(lo) >= 1.0:
@@ -699,13 +715,26 @@ class _Sb10:
             # root. SB10AD's own test decides there (S&P Ex. 2.11, design 2: the margin
             # refused 2.5 where SB10AD and a controller of norm 2.46 admit it).
             tests += 2
-            if self.admissible(lo):
-                return self._ladder_job1(lo0, g0, sb0, rtol, tests)
+            if self.admissible(lo) and self._keeps_gamma(lo):
+                return self._ladder_job1(lo0, g0, sb0, rtol, tests + 1)
+        if not confirm:  # (hi is a γ the margin admits: _search_gamma)
+            return hi, lo, tests
         for g in (hi, lo * (1.0 + rtol)) if lo * (1.0 + rtol) > hi else (hi,):
             tests += 1
             if self.admissible(g):
                 return g, lo, tests
         return self._ladder_job1(lo0, g0, sb0, rtol, tests)
+
+    def _keeps_gamma(self, g: float) -> bool:
+        """The closed loop's word on a γ that SB10AD admits and the margin refuses: a
+        controller built at γ = g has a stable closed loop of norm at most g (the central
+        controller of an admissible γ keeps ‖F_l(P, K)‖∞ < γ; Glover & Doyle 1988, Thm
+        3.1). No slack: below γ_opt, where SB10AD's test can still pass, the norm lies
+        above g, however little."""
+        try:
+            return self.controller(g).gamma <= g
+        except SynthesisError:
+            return False
 
     def _ladder_job1(self, lo0: float, g0: float, sb0: float | None, rtol: float, tests: int):
         """γ_opt with SB10AD only: a ladder of factors 4 from ``g0`` (SB10AD's γ test

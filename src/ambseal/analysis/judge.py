@@ -58,7 +58,7 @@ from ambseal.design.lpv_plant import lpv_plant, vertex_grid_hz
 from ambseal.design.specs import RIGID_STATES
 from ambseal.lti.freqresp import freqresp_at
 from ambseal.lti.interconnect import wired
-from ambseal.lti.json_safe import json_float
+from ambseal.lti.json_safe import finite_or_none, json_float
 from ambseal.model.modes import classify_poles
 from ambseal.model.rig import build_plant
 from ambseal.model.seal import pressure_for_k, seal_values
@@ -212,7 +212,6 @@ class JudgedCase(LoopJudgement):
         if self.discrete is not None:
             d["discrete"] = self.discrete.to_dict()
         return d
-
 
 
 def judge_settings(spec) -> JudgeSettings:
@@ -380,10 +379,6 @@ def unstable_open_loop_poles(A: np.ndarray) -> np.ndarray:
     return lam[np.argsort(-lam.real)]
 
 
-def _finite(x: float) -> float | None:
-    return float(x) if math.isfinite(x) else None
-
-
 def judge(cfg, controller, name: str, point: OperatingPoint,
           settings: JudgeSettings, *, impulse: bool = True,
           discrete=None) -> tuple[JudgedCase, dict]:
@@ -468,7 +463,7 @@ def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, im
     iso = iso_assessment(so_peaks, stable=loop.stable)
     curves: dict = {"So": (w / (2 * np.pi), so), "poles": loop.poles}
     case.update(
-        sensitivity_peak=_finite(iso.sigma_max_peak),
+        sensitivity_peak=finite_or_none(iso.sigma_max_peak),
         sensitivity_peak_per_axis={ax.removeprefix("y_"): (p.value if loop.stable else None)
                                    for ax, p in zip(ny_names, so_peaks.diagonal)},
         iso_zone=iso.zone_sigma_max,
@@ -499,7 +494,7 @@ def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, im
     curves["impulse"] = imp
     case.update(
         impulse_peak_um=imp.peak_displacement_um,
-        impulse_settling_s=_finite(imp.settling_time_s),
+        impulse_settling_s=finite_or_none(imp.settling_time_s),
     )
     return LoopJudgement(**case), curves
 

@@ -20,8 +20,8 @@ from ambseal.analysis.judge import judge_settings, operating_points
 from ambseal.config import default_rig_path, dump_rig, load_rig, rig_with_values
 from ambseal.design.fast_poles import design_rise
 from ambseal.design.lpv_design import design_lpv
-from ambseal.design.pid import controller_from_metadata
-from ambseal.design.recipes import design, full_order_check, pid_from_rig
+from ambseal.design.pid import controller_from_metadata, reference_pid
+from ambseal.design.recipes import design, full_order_check
 from ambseal.design.specs import design_spec
 from ambseal.errors import ConfigError, DataError, IdentificationError, SynthesisError
 from ambseal.export.codegen import write_c
@@ -39,6 +39,7 @@ from ambseal.identify.static_load import (
     with_static_record,
 )
 from ambseal.identify.tracking import TrackingSettings, check_excitation, track
+from ambseal.lti.json_safe import finite_or_none
 from ambseal.model.amb import channel_names
 from ambseal.model.modes import modes
 from ambseal.model.rig import build_plant, build_system
@@ -78,10 +79,6 @@ class Designed:
     controller: object
     summary: dict
     result: object
-
-
-def _finite(x: float) -> float | None:
-    return float(x) if math.isfinite(x) else None
 
 
 def digital_for(cfg, method: str, controller, result, points, cache: dict | None = None
@@ -172,9 +169,8 @@ def target_pid(cfg):
 
     res = design(cfg, "pid")
     dc = digital_for(cfg, "pid", res.K, res, operating_points(design_spec(cfg)))
-    p = cfg.controller.pid
-    gains = ({k: getattr(p, k) for k in ("kp", "ti", "td", "eps")} if p is not None else
-             {k: pid_from_rig(cfg)[k] for k in ("kp", "ti", "td", "eps")})
+    p = reference_pid(cfg)
+    gains = {k: p[k] for k in ("kp", "ti", "td", "eps")}
     return replace(dc.discrete, description={"type": "pid", **gains, "discretisation": dc.method,
                                              "prewarp_hz": dc.prewarp_hz})
 
@@ -498,10 +494,10 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
     write_text(out / "identified.toml", dump_rig(identified, header))
     return {"out": str(out), "converged": res.converged, "message": res.message,
             "parameters": {
-                n: {"estimate": float(v), "ci95": [_finite(lo), _finite(hi)],
+                n: {"estimate": float(v), "ci95": [finite_or_none(lo), finite_or_none(hi)],
                     **({"rsd_pct": spread[n]["rsd_pct"]} if spread else {})}
                 for n, v, lo, hi in zip(res.names, res.estimate, res.ci95_low, res.ci95_high)},
-            "nrmse_fit_pct": {k: _finite(v) for k, v in res.nrmse_fit_pct.items()},
+            "nrmse_fit_pct": {k: finite_or_none(v) for k, v in res.nrmse_fit_pct.items()},
             "residual_test": res.residuals.to_dict()["verdict"],
             "model_check": res.model_check()["verdict"],
             **({"static_load": static} if static else {}),

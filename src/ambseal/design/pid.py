@@ -20,7 +20,7 @@ from ambseal.robust.digital import discretize_as, with_delay
 from ambseal.robust.digital_loop import discrete_controller
 from ambseal.robust.stability import is_stable
 
-__all__ = ["pid_controller", "pid_from_rig", "reference_controller", "controller_from_metadata",
+__all__ = ["pid_controller", "pid_from_rig", "reference_pid", "reference_controller", "controller_from_metadata",
            "PID_CORNERS_PER_FS"]
 
 #: the derived PID (no [controller.pid]): k_eq = K_EQ_PER_KS·Ks, ζ on the rigid-body modes,
@@ -194,8 +194,29 @@ def _corner_for_target(cfg, kp: float, ti: float, td: float) -> float:
     return best[1]
 
 
+def reference_pid(cfg) -> dict:
+    """The rig's reference PID (P5 Eq. 6): ``[controller.pid]`` as given, else derived from
+    the rig by :func:`pid_from_rig` — the one rule by which the PID design, the weights of
+    the design specification and the acquisition's controller find it.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+
+    Returns
+    -------
+    dict
+        ``kp`` (A/m), ``ti``, ``td`` (s), ``eps`` (-); derived ones also carry the ``rule``
+        of :func:`pid_from_rig`.
+    """
+    pid = getattr(getattr(cfg, "controller", None), "pid", None)
+    if pid is not None:
+        return {"kp": pid.kp, "ti": pid.ti, "td": pid.td, "eps": pid.eps}
+    return pid_from_rig(cfg)
+
+
 def reference_controller(cfg, method: str = "tustin"):
-    """The rig's reference PID (``[controller.pid]``) discretised plainly at
+    """The rig's reference PID (:func:`reference_pid`) discretised plainly at
     ``[controller] sample_rate_hz`` (Tustin by default), described by its parameters: the
     controller a record of a real rig names by its PID parameters. What ambseal runs on
     the target (``ambseal acquire``, ``ambseal run``) is the discretisation chosen and
@@ -210,20 +231,13 @@ def reference_controller(cfg, method: str = "tustin"):
     -------
     ambseal.robust.digital_loop.DiscreteController
         With ``description = {"type": "pid", kp, ti, td, eps, "discretisation"}``.
-
-    Raises
-    ------
-    DataError
-        The rig has no ``[controller.pid]``.
     """
 
-    p = cfg.controller.pid
-    if p is None:
-        raise DataError("controller.pid: the rig has no reference PID to run the acquisition")
-    K = pid_controller(p.kp, p.ti, p.td, p.eps, channel_names(cfg))
+    p = reference_pid(cfg)
+    K = pid_controller(p["kp"], p["ti"], p["td"], p["eps"], channel_names(cfg))
     ctrl = discrete_controller(K, 1.0 / cfg.controller.sample_rate_hz, method)
-    return replace(ctrl, description={"type": "pid", "kp": p.kp, "ti": p.ti, "td": p.td,
-                                      "eps": p.eps, "discretisation": method})
+    return replace(ctrl, description={"type": "pid", **{k: p[k] for k in (
+        "kp", "ti", "td", "eps")}, "discretisation": method})
 
 
 def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<data>"):
@@ -232,7 +246,7 @@ def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<
 
     ``{"type": "pid", kp, ti, td, eps, "discretisation": "tustin"|"zoh"}`` (P5 Eq. 6 at the
     record's sample rate) is discretised here; anything else is read by
-    :func:`ambseal.identify.stages.controller_from_metadata`.
+    :func:`ambseal.identify.stages.state_space_from_metadata`.
 
     Raises
     ------
@@ -242,7 +256,7 @@ def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<
 
     c = meta.get("controller")
     if not (isinstance(c, dict) and c.get("type") == "pid" and "state_space" not in c):
-        return stages.controller_from_metadata(meta, axes, source)
+        return stages.state_space_from_metadata(meta, axes, source)
     fs = stages.sample_rate_of(meta, source)
     try:
         kp, ti, td, eps = (float(c[k]) for k in ("kp", "ti", "td", "eps"))

@@ -53,10 +53,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ambseal.design.pid import (
-    pid_controller,
-    pid_from_rig,  # noqa: F401 — its home is control.pid; kept importable here
-)
+from ambseal.design.pid import pid_controller, reference_pid
 from ambseal.design.plant import generalized_plant
 from ambseal.design.specs import design_spec
 from ambseal.design.weights import Weights
@@ -193,15 +190,10 @@ class DesignResult:
 
 
 def _pid(cfg, p):
-    pid = getattr(getattr(cfg, "controller", None), "pid", None)
-    notes = ()
-    if pid is None:
-        d = pid_from_rig(cfg)
-        kp, ti, td, eps = d["kp"], d["ti"], d["td"], d["eps"]
-        notes = (f"PID designed from the rig (no [controller.pid]): {d['rule']}",)
-    else:
-        kp, ti, td, eps = pid.kp, pid.ti, pid.td, pid.eps
-    K = pid_controller(kp, ti, td, eps, channel_names(cfg))
+    d = reference_pid(cfg)
+    notes = (f"PID designed from the rig (no [controller.pid]): {d['rule']}",) \
+        if "rule" in d else ()
+    K = pid_controller(d["kp"], d["ti"], d["td"], d["eps"], channel_names(cfg))
     return DesignResult("pid", K, p, order=int(K.nstates), order_full=int(K.nstates),
                         notes=notes)
 

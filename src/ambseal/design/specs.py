@@ -31,7 +31,7 @@ the value the thesis used on its test facility, P5, where it names one):
   500 Hz", P5 §4.4.1); the force at the bearings, where P5 §4.4.1 takes the compliance
   (the reason is in :mod:`ambseal.analysis.unbalance`).
 * **H∞ and μ weights** (P5 Eq. 7, §4.1 objective 1, §4.3): ω_B = 1/T_i of the reference
-  PID (``[controller.pid]``, else :func:`ambseal.design.pid.pid_from_rig`), so the
+  PID (:func:`ambseal.design.pid.reference_pid`), so the
   integral time is the PID's ("tuned to achieve an integral time close to the reference
   controller of 0.2 s"; test rig 5 rad/s): the direct gains then stay within 2× the
   PID's from 1 Hz to 200 Hz (P5 Fig. 10; ω_B = 60 rad/s gave 12× at 1 Hz). Why 1/T_i, not
@@ -91,7 +91,7 @@ import numpy as np
 
 from ambseal.config import MAX_GAP_M
 from ambseal.design.conditions import judged_conditions, stability_speeds
-from ambseal.design.pid import pid_from_rig
+from ambseal.design.pid import reference_pid
 from ambseal.design.weights import default_weights
 from ambseal.errors import ConfigError, DataError
 from ambseal.identify.excitation import (
@@ -483,16 +483,6 @@ def _uncertainty(cfg, d, rules: dict, notes: list, pressure_bar: float) -> dict:
     return out
 
 
-def _reference_pid(cfg) -> dict:
-    """The reference PID's ``kp`` (A/m), ``ti``, ``td`` (s), ``eps`` (-): ``[controller.pid]``, else
-    :func:`ambseal.design.pid.pid_from_rig`."""
-    pid = getattr(getattr(cfg, "controller", None), "pid", None)
-    if pid is not None:
-        return {"kp": pid.kp, "ti": pid.ti, "td": pid.td, "eps": pid.eps}
-
-    return pid_from_rig(cfg)
-
-
 def _weights(d, method: str, mach: Machine, d_e: float, d_u: float, band_hi: float,
              unb_range, rules: dict, pid: dict):
 
@@ -566,7 +556,7 @@ def design_spec(cfg, pressure_bar: float | None = None) -> DesignSpec:
     n, cut, top_mode = _design_model(cfg, d, mach, rules)
     band, synth = _bands(d, mach, top_mode, rules)
     rng, at, pos, law, top = _unbalance(cfg, d, mach, rules, notes)
-    pid = _reference_pid(cfg)
+    pid = reference_pid(cfg)
     weights = {m: _weights(d, m, mach, d_e, d_u, band[1], rng, rules, pid)
                for m in ("hinf", "mu", "lpv")}
     grade = d.unbalance.grade_mm_s or 2.5

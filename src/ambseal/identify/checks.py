@@ -10,7 +10,6 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 from scipy.stats import binom, norm
@@ -21,6 +20,7 @@ from ambseal.identify.frf import FRF, closed_loop_frf, model_frf, plant_frf
 from ambseal.identify.procedure import ProcedureResult
 from ambseal.identify.signals import chirp
 from ambseal.identify.stages import acquire, build_models
+from ambseal.lti.json_safe import finite_or_none
 from ambseal.model.rig import build_plant
 
 __all__ = ["FrfChecks", "frf_checks", "truth_errors", "true_line", "interval_check"]
@@ -108,10 +108,6 @@ def frf_checks(cfg, truth, res: ProcedureResult, controller, *, seed: int = 99,
     return FrfChecks(measured, mf, G, Gm, pairs)
 
 
-def _finite(x: float) -> float | None:
-    return float(x) if math.isfinite(x) else None
-
-
 def truth_errors(res: ProcedureResult, seal_name: str | None) -> dict:
     """Each estimate of the procedure beside its truth (the virtual facility's).
 
@@ -128,7 +124,7 @@ def truth_errors(res: ProcedureResult, seal_name: str | None) -> dict:
         for i, n in enumerate(r.names):
             t = res.truth.get(n)
             err = None if not isinstance(t, float) or t == 0 else 100 * (r.estimate[i] / t - 1)
-            lo, hi = _finite(r.ci95_low[i]), _finite(r.ci95_high[i])
+            lo, hi = finite_or_none(r.ci95_low[i]), finite_or_none(r.ci95_high[i])
             covered = (None if not isinstance(t, float) or lo is None or hi is None
                        else bool(lo <= t <= hi))
             out[n] = {"estimate": float(r.estimate[i]), "truth": t, "ci95": [lo, hi],

@@ -16,6 +16,7 @@ import numpy as np
 
 from ambseal.config import MAX_CURRENT_A, MAX_GAP_M
 from ambseal.errors import DataError
+from ambseal.lti.json_safe import finite_or_none
 
 __all__ = ["FORMAT_TAG", "CLIP_RUN", "CLIP_RTOL", "TIME_RTOL", "CHANNELS", "Measurement", "column_names",
            "validate_measurement"]
@@ -160,7 +161,7 @@ class Measurement:
             "format": FORMAT_TAG,
             "axes": list(self.axes),
             "n_samples": self.n_samples,
-            "sample_rate_hz": _finite_or_none(self.sample_rate_hz),
+            "sample_rate_hz": finite_or_none(self.sample_rate_hz),
             "metadata": _json_safe(self.metadata, "metadata"),
         }
         if include_samples:
@@ -170,9 +171,6 @@ class Measurement:
 
 
 # --------------------------------------------------------------------------- helpers
-def _finite_or_none(x: float) -> float | None:
-    return float(x) if math.isfinite(x) else None
-
 
 def _json_safe(obj: Any, where: str) -> Any:
     """Convert numpy values to Python ones; reject NaN/inf and unknown objects."""
@@ -193,7 +191,6 @@ def _json_safe(obj: Any, where: str) -> Any:
             raise DataError(f"{where}: {obj!r} is not allowed in JSON metadata")
         return float(obj)
     raise DataError(f"{where}: {type(obj).__name__} is not JSON-serialisable")
-
 
 
 # --------------------------------------------------------------------------- validate

@@ -21,7 +21,7 @@ from ambseal.identify.signals import Excitation
 from ambseal.model.amb import actuator_matrices
 from ambseal.robust.digital_loop import DiscreteController
 
-__all__ = ["controller_from_metadata", "check_controller", "sample_rate_of",
+__all__ = ["state_space_from_metadata", "check_controller", "sample_rate_of",
            "check_record_metadata", "acquire", "at_speed", "build_models", "identify", "record_spread",
            "FIT_CUTOFF_HZ"]
 
@@ -31,9 +31,10 @@ __all__ = ["controller_from_metadata", "check_controller", "sample_rate_of",
 FIT_CUTOFF_HZ = 10000.0
 
 
-def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<data>"
-                             ) -> DiscreteController:
-    """The digital controller that ran, from a record's ``controller`` metadata.
+def state_space_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<data>"
+                              ) -> DiscreteController:
+    """The digital controller that ran, from the state space in a record's ``controller``
+    metadata.
 
     ``{"type": "state_space", A, B, C, D, dt}``, or any description (e.g. the PID of
     ``ambseal acquire``) carrying these under ``"state_space"``. A description without its
@@ -238,7 +239,7 @@ def build_models(cfg: RigConfig, records: list[Measurement], values: dict | None
     models = []
     sources = sources or [f"record {i + 1}" for i in range(len(records))]
     if controllers is None:
-        controllers = [controller_from_metadata(dict(r.metadata), r.axes, src)
+        controllers = [state_space_from_metadata(dict(r.metadata), r.axes, src)
                        for r, src in zip(records, sources)]
     for rec, Kd, src in zip(records, controllers, sources):
         meta = dict(rec.metadata)

@@ -3,7 +3,10 @@
 * finite floats stay floats;
 * ``+inf`` becomes the string ``"inf"`` and ``-inf`` the string ``"-inf"``;
 * ``NaN`` becomes ``None``;
-* numpy scalars and arrays become Python ``float``/``int``/``bool`` and lists.
+* numpy scalars and arrays become Python ``float``/``int``/``bool`` and lists;
+* a quantity that has no value where it is not finite (the σ̄ peak or the settling time of
+  an unstable loop, an interval bound that could not be computed) becomes ``None`` there
+  (:func:`finite_or_none`), not ``"inf"``.
 """
 
 from __future__ import annotations
@@ -24,6 +27,12 @@ def json_float(x: float | None) -> float | str | None:
     if math.isinf(x):
         return "inf" if x > 0 else "-inf"
     return x
+
+
+def finite_or_none(x: float) -> float | None:
+    """``float(x)``, or ``None`` where ``x`` is not finite (the module's last rule)."""
+    x = float(x)
+    return x if math.isfinite(x) else None
 
 
 def json_list(a: Any) -> list:

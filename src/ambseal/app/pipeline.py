@@ -122,7 +122,10 @@ def _controllers(cfg: RigConfig, spec, say, failed: dict,
     Pressure-driven seals (the test rig): the reference PID, H∞ and μ (P5 §4), from the
     rig's design specification ``spec``. Speed-driven seals over a speed range (the
     turboexpander, P3 §4): the reference PID, H∞ and μ at the operating speed (P3 §3,
-    Fig. 11) and the LPV controller scheduled on speed. ``say(message, steps)`` reports:
+    Fig. 11) and the LPV controller scheduled on speed. Where H∞ or μ, designed at the
+    operating speed, loses the rotor at another speed of the machine's range, the LPV on
+    speed from standstill to the top speed joins them (:func:`_lost_over_speed`).
+    ``say(message, steps)`` reports:
     one step per design, messages in between. ``methods`` limits the pressure-driven case
     (the PID alone before identification, H∞ and μ on the identified rig after it).
 
@@ -169,7 +172,39 @@ def _controllers(cfg: RigConfig, spec, say, failed: dict,
     if "pid" in methods:
         out.append(lti(design(cfg, "pid")))
         say("pid designed", 1)
-    return out + [d for m in methods if m != "pid" for d in robust(m)]
+    out += [d for m in methods if m != "pid" for d in robust(m)]
+    lost = _lost_over_speed(cfg, out)
+    if lost:
+        top = max(spec.stability_speeds_hz)
+        say(f"{' and '.join(lost)} designed at {cfg.operating.speed_rpm / 60.0:g} Hz lose the "
+            f"rotor at other speeds: designing the LPV on speed, 0–{top:g} Hz", 0)
+
+        def speed_lpv() -> Designed:
+            d = design_lpv(cfg, speeds_hz=(0.0, top), states=spec.model_states,
+                           allow_unstable=True, spec=spec)
+            return Designed("lpv", d, d.to_dict(), d)
+
+        out += guarded("lpv", speed_lpv)
+    return out
+
+
+def _lost_over_speed(cfg: RigConfig, designs: list[Designed]) -> list[str]:
+    """The fixed designs (H∞, μ; designed at the operating speed) whose full-order loop is
+    unstable at another speed of the machine's range, standstill to the top speed: where
+    the gyroscopics move the modes out of what one frozen design holds. For them the main
+    job adds the speed-scheduled LPV controller (:func:`ambseal.design.lpv_design.
+    design_lpv`, thesis P3 §4) over standstill to the top speed, on the same design model
+    (``[design] model_states``) — a rig with a speed range only."""
+    if cfg.operating.speed_range_hz is None:
+        return []
+    f0 = cfg.operating.speed_rpm / 60.0
+    out = []
+    for d in designs:
+        fo = getattr(d.result, "full_order", None)
+        if d.method in ("hinf", "mu") and fo and not fo["stable"] \
+                and abs(fo["speed_hz"] - f0) > 1e-9 * max(f0, 1.0):
+            out.append(d.method)
+    return out
 
 
 @with_numerics_threads

@@ -201,7 +201,8 @@ class FrozenDesign:
 def check_full_order(cfg, spec, controller_at, name: str, allow_unstable: bool = False
                      ) -> dict:
     """Close a speed-scheduled design with the full-order plant at every judged condition
-    (``spec``'s pressures × speeds, :func:`ambseal.design.specs.design_spec`):
+    (``spec``'s pressures × its judged and stability speeds, standstill to the top speed,
+    :func:`ambseal.design.specs.design_spec`):
     at each, the physical controller ``controller_at(speed_hz)`` that runs there
     (:func:`ambseal.design.recipes.full_order_check`), as :func:`~ambseal.design.
     recipes.design` does for H∞ and μ.
@@ -218,8 +219,10 @@ def check_full_order(cfg, spec, controller_at, name: str, allow_unstable: bool =
         the remedy (the design model keeps the rigid-body modes only, P3 §2.2).
     """
 
+    # where it is judged and wherever the machine runs, standstill to the top speed
     checks = [full_order_check(cfg, controller_at(f), [(p, f)])
-              for p in spec.pressures_bar for f in spec.speeds_hz]
+              for p in spec.pressures_bar
+              for f in sorted({*spec.speeds_hz, *spec.stability_speeds_hz})]
     worst = max(checks, key=lambda c: (not c["stable"], -c["damping"]))
     if not worst["stable"] and not allow_unstable:
         raise SynthesisError(

@@ -9,7 +9,7 @@ a temporary name and a rename.
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ambseal.analysis.cases import run_cases
@@ -345,6 +345,11 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                                                for j, r in zip(jobs, judged)]))
         stability = _speed_range(designs, digitals, spec, points, design_cfg, judge_cfg, stages,
                                  failed, allow_unstable)
+        if not speed_scheduled(cfg) and "lpv" in {d.method for d in designs} \
+                and "lpv" not in failed:  # the controller for the speed range: say so
+            for m in [m for m in ("hinf", "mu") if m in failed and failed[m].judged]:
+                failed[m] = replace(failed[m], reason=f"{failed[m].reason}; the LPV on speed "
+                                                       "holds the rotor over the speed range")
         cases = [case for case, _ in judged]
         case_dicts = [case.to_dict() for case in cases]
         curves = [(j["name"], j["point"], case, c)

@@ -63,7 +63,7 @@ import numpy as np
 from ambseal.analysis.judge import JudgeSettings, OperatingPoint, judge
 from ambseal.errors import ModelError
 from ambseal.identify.fit import ClosedLoopModel
-from ambseal.identify.rig_sim import _pressure_values, prepare_facility, reduced_plant, true_rig
+from ambseal.identify.rig_sim import prepare_facility, pressure_values, reduced_plant, true_rig
 from ambseal.identify.tracking import OnlineTracker, TrackingSettings, tracking_excitation
 from ambseal.model.amb import actuator_matrices
 from ambseal.model.rig import build_plant
@@ -298,11 +298,11 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
     if param not in base.parameters:
         raise ModelError(f"ramp: the rig has no parameter {param!r}")
     p_of_n = np.zeros(N)
-    k_of_n = np.full(N, _pressure_values(cfg_t, truth, base, 0.0).get(param, 0.0))
+    k_of_n = np.full(N, pressure_values(cfg_t, truth, base, 0.0).get(param, 0.0))
     for t0, p in sched:
         n0 = int(round(t0 * fs))
-        p_of_n[n0:], k_of_n[n0:] = p, _pressure_values(cfg_t, truth, base, p)[param]
-    k_nom = abs(_pressure_values(cfg_t, truth, base, cfg.operating.pressure_bar)[param])
+        p_of_n[n0:], k_of_n[n0:] = p, pressure_values(cfg_t, truth, base, p)[param]
+    k_nom = abs(pressure_values(cfg_t, truth, base, cfg.operating.pressure_bar)[param])
     run_as = _runner(tracked, tracked_digital, 1.0 / fs, delay_samples)
     controllers = {n: run_as(K) for n, K in controllers.items()}
     noise_std = _noise_std(cfg, truth, controllers, tracked, e, fs, run_as)

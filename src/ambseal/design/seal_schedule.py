@@ -52,10 +52,10 @@ default 1e-4: at 1e-5 the identified test rig's σ̄(S_o) fell from 3.01 to 2.70
 identified pump's tracked loop lost stability at 3× nominal pressure on its facility truth
 (a 301 Hz mode, ζ = −0.004), where the identified model is poor (``benchmarks/README.md``).
 :func:`design_seal_scheduled` keeps each result in a cache folder keyed on the rig, the
-arguments, the synthesis code and the package version (``cache_dir``; :data:`CACHE_ENV`). A
-cache entry is plain JSON (numbers and names, never code): an entry that does not parse,
-does not match its key or version, or does not make a consistent design is ignored and the
-design recomputed.
+arguments, the package version and :data:`SYNTHESIS_VERSION` (``cache_dir``;
+:data:`CACHE_ENV`). A cache entry is plain JSON (numbers and names, never code): an entry
+that does not parse, does not match its key or version, or does not make a consistent
+design is ignored and the design recomputed.
 """
 
 from __future__ import annotations
@@ -72,19 +72,13 @@ from typing import Any
 import numpy as np
 
 from ambseal import __version__
-from ambseal.design import plant, weights
 from ambseal.design.plant import generalized_plant, physical_controller, physical_matrices
 from ambseal.design.specs import DesignSpec, design_spec
 from ambseal.design.weights import Weights
 from ambseal.errors import ModelError, SynthesisError
 from ambseal.files import write_json
-from ambseal.model import seal
 from ambseal.model.rig import build_plant
 from ambseal.model.seal import values_following_k
-from ambseal.robust import _lmi_sdp as lmi_sdp
-from ambseal.robust import _lpv_lmi as lpv_lmi
-from ambseal.robust import _lpv_reconstruct as lpv_reconstruct
-from ambseal.robust import lpv
 from ambseal.robust.controller import ScheduledController
 from ambseal.robust.delay import design_delay
 from ambseal.robust.lpv import LpvController, lpvsyn
@@ -259,16 +253,19 @@ def design_seal_scheduled(cfg, parameter: str | None = None, *,
     return d
 
 
+#: The version of what a cached design depends on besides the rig and the arguments (this
+#: recipe, its weights and plant, :func:`~ambseal.robust.lpv.lpvsyn`): raise it with any
+#: change that moves a scheduled design's numbers, and every cached design is recomputed.
+SYNTHESIS_VERSION = 1
+
+
 def _key(cfg, args) -> str:
-    """Cache key: the rig, the arguments, the source of the synthesis code and the
-    package version."""
+    """Cache key: the rig, the arguments, the package version and
+    :data:`SYNTHESIS_VERSION`."""
 
     h = hashlib.sha256(cfg.model_dump_json().encode())
-    h.update(f"ambseal {__version__}".encode())
+    h.update(f"ambseal {__version__} synthesis {SYNTHESIS_VERSION}".encode())
     h.update(repr(args).encode())
-    for mod in (lpv, lpv_lmi, lmi_sdp, lpv_reconstruct, plant, weights, seal):
-        h.update(Path(mod.__file__).read_bytes())
-    h.update(Path(__file__).read_bytes())
     return h.hexdigest()[:20]
 
 

@@ -47,7 +47,7 @@ from ambseal.robust.digital_loop import DiscreteController, closed_loop_matrices
 from ambseal.robust.stability import is_stable, unstable_poles
 
 __all__ = ["FacilityRecord", "Facility", "prepare_facility", "simulate_facility", "true_rig",
-           "reduced_plant", "facility_bias_current"]
+           "reduced_plant", "facility_bias_current", "pressure_values"]
 
 
 @dataclass(frozen=True)
@@ -181,9 +181,26 @@ def reduced_plant(cfg: RigConfig, pressure_bar: float, speed_rpm: float | None,
     return plant
 
 
-def _pressure_values(cfg: RigConfig, truth: TruthSection, plant, pressure_bar: float) -> dict:
-    """Every seal coefficient of the rig's model, then the truth's values, at a pressure
-    drop (SI), for a segment of a pressure schedule."""
+def pressure_values(cfg: RigConfig, truth: TruthSection, plant, pressure_bar: float) -> dict:
+    """The facility's parameter values at a pressure drop, for a segment of a pressure
+    schedule: every seal coefficient of the rig's model, then the truth's values over them.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig (its seals' coefficient laws).
+    truth : TruthSection
+        The facility's truth (its parameter values or laws).
+    plant : ambseal.model.lft.Plant
+        The facility's plant; only the seal coefficients it has as parameters are set.
+    pressure_bar : float
+        Pressure drop (bar).
+
+    Returns
+    -------
+    dict
+        Parameter name → value (SI).
+    """
     out = {}
     for seal in cfg.seal:
         for key in ("K", "k", "C", "c"):
@@ -301,7 +318,7 @@ def prepare_facility(cfg: RigConfig, truth: TruthSection, sample_rate_hz: float,
     segments = [(0, plant.A)]
     for start_s, p_bar in sorted(pressure_schedule or []):
         segments.append((int(round(start_s * sample_rate_hz)),
-                         plant.with_values(_pressure_values(cfg_t, truth, plant, p_bar)).A))
+                         plant.with_values(pressure_values(cfg_t, truth, plant, p_bar)).A))
     axes = plant.axes
     k = len(axes)
     names = [a.rsplit("_", 1) for a in axes]

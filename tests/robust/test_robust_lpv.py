@@ -293,6 +293,43 @@ def test_lpvsyn_defaults_reach_the_hinf_optimum_on_an_lti_family():
     with pytest.raises(SynthesisError):
         lpvsyn([P] * 3, [1.0, 2.0, 3.0], 1, 1, scaling="riccati")
     r = lpvsyn([P] * 3, [1.0, 2.0, 3.0], 1, 1)
-    g_opt = hinfsyn(P, 1, 1).gamma_opt
+    h = hinfsyn(P, 1, 1)
+    g_opt = h.gamma_opt
     assert r.scaling == "diagonal" and r.check_stable
     assert g_opt <= r.gamma <= 1.01 * g_opt
+    # the best frozen-point design is hinfsyn's controller (at its back-off), the same at
+    # every grid point: its worst frozen γ is that controller's norm, and the LMIs beat it
+    assert r.frozen_best_gamma == pytest.approx(h.gamma, rel=1e-9)
+    assert r.kind == "lpv" and max(r.check_gamma) <= r.frozen_best_gamma
+
+
+def _lti_family_plant():
+    import control as ct
+
+    A = [[0.0, 1.0], [-4.0, -0.2]]
+    mode = ct.ss(A, [[0.0], [1.0]], [[1.0, 0.0]], [[0.0]], inputs="u", outputs="x",
+                 name="mode")
+    We = ct.ss(ct.tf([0.5, 0.5], [1.0, 5e-4]), inputs="e", outputs="z_e", name="We")
+    Wu = ct.ss([], [], [], [[0.1]], inputs="u", outputs="z_u", name="Wu")
+    err = ct.summing_junction(inputs=["r", "-x"], output="e")
+    return ct.interconnect([mode, We, Wu, err], inplist=["r", "u"],
+                           outlist=["z_e", "z_u", "e"])
+
+
+def test_lpvsyn_is_never_worse_than_the_best_frozen_design():
+    """Reference: hinfsyn's controller and its norm (AB13DD), and lpvsyn's own LMI
+    solution without the comparison. A trace penalty of 10 (against the default 1e-4)
+    spoils the LMI solution on the LTI family; the frozen-point design is then better at
+    every θ, and its bound for any trajectory (one Lyapunov matrix, certified by the
+    eigenvalues of the bounded-real inequality) is below the spoilt LMI γ: lpvsyn delivers
+    that design, as a constant table."""
+    P = _lti_family_plant()
+    h = hinfsyn(P, 1, 1)
+    spoilt = lpvsyn([P] * 3, [1.0, 2.0, 3.0], 1, 1, penalty=10.0, frozen_check=False)
+    r = lpvsyn([P] * 3, [1.0, 2.0, 3.0], 1, 1, penalty=10.0)
+    assert max(spoilt.check_gamma) > h.gamma
+    assert r.kind == "frozen" and r.frozen_best_theta in (1.0, 2.0, 3.0)
+    np.testing.assert_allclose(r.check_gamma, h.gamma, rtol=1e-9)
+    assert h.gamma <= r.gamma <= spoilt.gamma
+    for t in (1.0, 1.7, 3.0):
+        np.testing.assert_allclose(r.K.at(t).A, h.K.A)

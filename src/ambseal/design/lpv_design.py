@@ -47,6 +47,7 @@ from ambseal.design.recipes import bound_text, full_order_check
 from ambseal.design.specs import DesignSpec, design_spec
 from ambseal.design.weights import Weights, default_weights
 from ambseal.errors import ConfigError, SynthesisError
+from ambseal.lti.json_safe import json_float
 from ambseal.robust.controller import SPEED, ScheduledController
 from ambseal.robust.dk import design_omega, musyn
 from ambseal.robust.hinf import hinfsyn
@@ -91,6 +92,11 @@ class LpvDesign(ScheduledController):
         The design model (not serialised).
     full_order : dict or None
         :func:`check_full_order` of the controller at the judged conditions.
+    kind : str
+        What :func:`lpvsyn` delivered: ``"lpv"`` (the LMIs' scheduled controller) or
+        ``"frozen"`` (the best frozen-point design, better at every frozen speed).
+    frozen_best_gamma : float
+        That frozen-point design's worst γ on the check grid (NaN if not compared).
     """
 
     parameter: ClassVar[str] = SPEED
@@ -109,6 +115,8 @@ class LpvDesign(ScheduledController):
     elapsed_s: float = 0.0
     plant: Any = field(default=None, repr=False)
     full_order: dict | None = None
+    kind: str = "lpv"
+    frozen_best_gamma: float = float("nan")
 
     @property
     def order(self) -> int:
@@ -149,6 +157,7 @@ class LpvDesign(ScheduledController):
                 "reports": [r.to_dict() for r in self.reports],
                 "synthesis_s": round(self.synthesis_s, 3),
                 "elapsed_s": round(self.elapsed_s, 3), "full_order": self.full_order,
+                "kind": self.kind, "frozen_best_gamma": json_float(self.frozen_best_gamma),
                 "verdict": self.verdict}
 
     @property
@@ -355,7 +364,8 @@ def design_lpv(cfg, *, speeds_hz=None, n_grid: int | None = None,
                   check_gamma=r.check_gamma, speeds_hz=grid,
                   check_speeds_hz=r.check_grid / _TWO_PI, lyapunov=lyapunov,
                   rate_bound_hz_per_s=None if nu is None else float(rate_bound_hz_per_s),
-                  weights=w, reports=r.reports, synthesis_s=r.time_s, plant=L)
+                  weights=w, reports=r.reports, synthesis_s=r.time_s, plant=L,
+                  kind=r.kind, frozen_best_gamma=r.frozen_best_gamma)
     check = check_full_order(cfg, sp, d.controller_at, "lpv", allow_unstable)
     return replace(d, full_order=check, elapsed_s=time.perf_counter() - t0)
 

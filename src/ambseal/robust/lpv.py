@@ -54,6 +54,7 @@ import numpy as np
 
 from ambseal.errors import SynthesisError
 from ambseal.lti.interconnect import lft_lower_matrices
+from ambseal.lti.json_safe import json_float
 from ambseal.lti.tables import interp_table
 from ambseal.robust._lpv_lmi import (
     BASES,
@@ -64,6 +65,7 @@ from ambseal.robust._lpv_lmi import (
     scale_grid,
     solve_lmis,
 )
+from ambseal.robust._lpv_frozen import frozen_reference, quadratic_gamma
 from ambseal.robust._lpv_reconstruct import interp_A, reconstruct_table
 from ambseal.robust.hinf import hinfnorm
 from ambseal.robust.stability import is_stable
@@ -182,6 +184,17 @@ class LpvSynResult:
         LPV closed loop depends on the parameter, so it is a function, not one system.
     scaling : str
         The state scaling the SDPs ran with (``"riccati"`` or ``"diagonal"``).
+    frozen_best_gamma : float
+        The best frozen-point design's worst γ on the check grid: the H∞ controller of
+        one grid point (the one at ``frozen_best_theta``) closed with the plant at every
+        check-grid θ (``nan`` when not computed, ``inf`` when none holds the whole grid).
+    frozen_best_theta : float
+        The grid point of that design.
+    kind : str
+        ``"lpv"``: the scheduled controller of the LMIs; ``"frozen"``: that design,
+        better at every frozen θ and no worse under a varying one, delivered in its place
+        as a constant table with ``gamma`` its quadratic-performance bound over the check
+        grid.
 
     Notes
     -----
@@ -202,6 +215,9 @@ class LpvSynResult:
     time_s: float = 0.0
     closed_loop: Any = field(default=None, repr=False)
     scaling: str = "riccati"
+    frozen_best_gamma: float = float("nan")
+    frozen_best_theta: float = float("nan")
+    kind: str = "lpv"
 
     def __iter__(self):
         """``K, CL, gamma, info = lpvsyn(...)``: the scheduled controller, θ ↦ the frozen
@@ -220,7 +236,9 @@ class LpvSynResult:
                 "check_gamma": [float(g) if np.isfinite(g) else None for g in self.check_gamma],
                 "check_gamma_max": float(np.max(self.check_gamma)),
                 "check_stable": self.check_stable, "controller_order": self.K.order,
-                "scaling": self.scaling,
+                "scaling": self.scaling, "kind": self.kind,
+                "frozen_best_gamma": json_float(self.frozen_best_gamma),
+                "frozen_best_theta": json_float(self.frozen_best_theta),
                 "reports": [r.to_dict() for r in self.reports], "time_s": self.time_s}
 
 
@@ -231,7 +249,8 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
            rate_bound: float | None = None, backoff: float = 1.05,
            check_density: int = 5, solver_options: dict | None = None,
            margin: float = 1e-6, scaling: str = "auto", penalty: float = 1e-4,
-           coupling_ratio: float = 1.1, centre: bool = False) -> LpvSynResult:
+           coupling_ratio: float = 1.1, centre: bool = False,
+           frozen_check: bool = True) -> LpvSynResult:
     """Gridded H∞ LPV controller (Apkarian & Adams 1998; Wu et al. 1996; thesis P3 §4).
 
     Stages, the first two SDPs solved by CVXOPT and required to end ``optimal``:
@@ -291,6 +310,14 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
         α of the coupling LMI (> 1).
     centre : bool
         Two-stage γ / centring instead of one stage with α in it.
+    frozen_check : bool
+        Compare with the best frozen-point design (:mod:`ambseal.robust._lpv_frozen`):
+        the H∞ controller of each grid point closed with the plant on the whole check grid.
+        Where the scheduled controller's worst frozen γ is higher than that design's and
+        that design's quadratic-performance γ (one Lyapunov matrix over the check grid,
+        a bound under any trajectory of θ) is not above the scheduled one's, the design is
+        delivered instead (``kind = "frozen"``). Costs one H∞ synthesis per grid point and
+        one norm per grid point and check-grid value (``benchmarks/README.md``).
 
     Returns
     -------
@@ -343,7 +370,38 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
                 r = _synthesise(data, "diagonal", **settings)
             except SynthesisError:
                 raise first from None
+    if frozen_check:
+        r = _against_frozen(r, data, solver_options, margin)
     return replace(r, time_s=time.perf_counter() - t_start)
+
+
+#: Relative margin by which the best frozen-point design must beat the scheduled
+#: controller's worst frozen γ before it is delivered instead.
+FROZEN_RTOL = 1e-3
+
+
+def _against_frozen(r: LpvSynResult, data, solver_options, margin) -> LpvSynResult:
+    """``r`` with the best frozen-point design's worst γ recorded, or that design in its
+    place where it is better (``frozen_check`` of :func:`lpvsyn`)."""
+    plants, grid, As, dAs, B, C, D, nw, nz, nmeas, ncon = data
+    A_of = interp_A(As, dAs, grid)
+    ref = frozen_reference(plants, grid, r.check_grid, A_of, B, C, D, nmeas, ncon)
+    r = replace(r, frozen_best_gamma=ref.gamma, frozen_best_theta=ref.theta)
+    if not ref.gamma < float(np.max(r.check_gamma)) * (1.0 - FROZEN_RTOL):
+        return r
+    loops = [lft_lower_matrices((A_of(t), B, C, D), ref.K, nmeas, ncon) for t in r.check_grid]
+    try:
+        g = quadratic_gamma(loops, solver_options, level=ref.gamma, margin=margin)
+    except SynthesisError:
+        return r  # no bound for every trajectory: the scheduled controller keeps its own
+    if g > r.gamma:  # better at every frozen θ, worse for a varying one: a trade, not a gain
+        return r
+    n_t = r.check_grid.size
+    K = LpvController(r.check_grid, *(np.repeat(X[None], n_t, axis=0) for X in ref.K),
+                      r.K.input_names, r.K.output_names)
+    CL = replace(r.closed_loop, K=K)
+    return replace(r, K=K, gamma=g, gamma_design=g, check_gamma=ref.check_gamma,
+                   closed_loop=CL, kind="frozen")
 
 
 def _synthesise(data, scaling: str, *, lyapunov, rate_bound, backoff, check_density,

@@ -1,6 +1,10 @@
-"""The generic core against SLICOT's documented examples (SLICOT-Reference,
-``examples/data/*.dat`` and ``examples/results/*.res``): each case's data as published, its
-result to the digits printed there."""
+"""The generic core against published cases: SLICOT's documented examples
+(SLICOT-Reference, ``examples/data/*.dat`` and ``examples/results/*.res``: each case's data
+as published, its result to the digits printed there), Skogestad & Postlethwaite's
+Example 3.8, and closed forms from the literature (Young's rank-one mixed μ, Packard &
+Doyle's full-block and scalar μ, the second-order resonant peak). The other published
+cases of the core are beside the code they test; ``benchmarks/README.md`` lists them all
+with their times against python-control and SLICOT."""
 
 from __future__ import annotations
 
@@ -75,3 +79,120 @@ def test_ab13md_example_mixed_mu():
     assert float(r.upper) == pytest.approx(0.4174753408e2, rel=1e-6)
     assert float(r.lower) <= float(r.upper) * (1 + 1e-9)
     assert float(r.lower) == pytest.approx(0.4174753408e2, rel=1e-6)
+
+
+def test_ab13fd_example_complex_stability_radius():
+    """SLICOT AB13FD example: the complex stability radius β(A) = min_ω σ_min(A − jωI) of a
+    4 × 4 stable matrix, 0.39196472317·10⁻² at ω = 0.98966520430. β(A) = 1/‖(sI − A)⁻¹‖∞,
+    so the H∞ norm of ``ss(A, I, I, 0)`` is its inverse (to 1e-9 relative); the peak is
+    flat (σ_min is quadratic in ω there), so its frequency is fixed only to about the square
+    root of that: 1e-5."""
+    A = np.array([[246.5, 242.5, 202.5, -197.5], [-252.5, -248.5, -207.5, 202.5],
+                  [-302.5, -297.5, -248.5, 242.5], [-307.5, -302.5, -252.5, 246.5]])
+    norm, w = hinfnorm(ct.ss(A, np.eye(4), np.eye(4), np.zeros((4, 4))))
+    assert norm == pytest.approx(1.0 / 0.39196472317e-2, rel=1e-9)
+    assert w == pytest.approx(0.98966520430, rel=1e-5)
+
+
+def _sp_weight(wb: float, m: float, a: float):
+    s = ct.tf([1, 0], [1])
+    return ct.ss((s / m + wb) / (s + wb * a))
+
+
+@pytest.mark.parametrize("wb, published", [((0.25, 0.25), 2.80), ((0.25, 25.0), 2.92),
+                                           ((25.0, 0.25), 6.73)],
+                         ids=["design1", "design2", "design3"])
+def test_skogestad_example_3_8_mixed_sensitivity(wb, published):
+    """Skogestad & Postlethwaite, *Multivariable Feedback Control* (1st ed.), Example 3.8,
+    as python-control's ``examples/robust_mimo.py`` sets it up: the 2 × 2 plant with a RHP
+    zero at s = 0.5, W_P = diag((s/M + ω_B)/(s + ω_B A)), M = 1.5, A = 1e-4, W_u = I; the
+    book's γ 2.80, 2.92 and 6.73 for (ω_B1, ω_B2) = (0.25, 0.25), (0.25, 25), (25, 0.25).
+    γ_opt within 0.5 % of the book (3 digits from MATLAB's bisection, which stops above the
+    optimum), and python-control's mixsyn on the same problem to 1e-6."""
+    den = [0.2, 1.2, 1]
+    g = ct.ss(ct.tf([[[1], [1]], [[2, 1], [2]]], [[den, den], [den, den]]))
+    wp = _sp_weight(wb[0], 1.5, 1e-4).append(_sp_weight(wb[1], 1.5, 1e-4))
+    wu = ct.ss([], [], [], np.eye(2))
+    r = hinfsyn(ct.augw(g, wp, wu), 2, 2)
+    assert r.gamma_opt == pytest.approx(published, rel=5e-3)
+    assert r.gamma_opt == pytest.approx(ct.mixsyn(g, wp, wu)[2][0], rel=1e-6)
+
+
+def _rank_one_mu(m: np.ndarray, real: np.ndarray) -> float:
+    """Young's closed form for a rank-one M = a bᴴ with scalar blocks (Young 1994, "The
+    rank one mixed μ problem and 'Kharitonov-type' analysis", Automatica 30(12), Thm 2):
+    μ = inf_x Σ_real |Re m_i + x Im m_i| + Σ_complex |m_i| √(1 + x²), m_i = a_i b̄_i.
+    The function of x is convex and piecewise smooth: its minimum is at a kink
+    (x = −Re m_i / Im m_i of a real block) or a stationary point between them."""
+    from scipy.optimize import minimize_scalar
+
+    def f(x):
+        return (np.sum(np.abs(m[real].real + x * m[real].imag))
+                + np.sum(np.abs(m[~real])) * np.sqrt(1 + x * x))
+
+    kinks = sorted(-m[real].real / m[real].imag)
+    edges = [kinks[0] - 1e3, *kinks, kinks[-1] + 1e3] if kinks else [-1e3, 1e3]
+    best = min(f(x) for x in kinks) if kinks else np.inf
+    for lo, hi in zip(edges[:-1], edges[1:]):
+        r = minimize_scalar(f, bounds=(lo, hi), method="bounded",
+                            options={"xatol": 1e-13 * max(1.0, abs(hi))})
+        best = min(best, r.fun)
+    return float(best)
+
+
+@pytest.mark.parametrize("kinds", ["rrr", "ccc", "rrcc", "rrrrc"])
+def test_rank_one_mixed_mu_closed_form(kinds):
+    """Reference: Young's closed form of μ for rank-one matrices (:func:`_rank_one_mu`),
+    where the D–G upper bound is exact (Young 1994): three real scalars, three complex
+    scalars (μ = Σ|a_i b_i|), and two mixed structures; M = a bᴴ from seeded complex a,
+    b. The upper bound to 1e-5 (run at tol 1e-8), the lower bound not above it."""
+    rng = np.random.default_rng(len(kinds) * 7 + kinds.count("r"))
+    n = len(kinds)
+    a = rng.standard_normal(n) + 1j * rng.standard_normal(n)
+    b = rng.standard_normal(n) + 1j * rng.standard_normal(n)
+    M = np.outer(a, b.conj())
+    real = np.array([k == "r" for k in kinds])
+    mu = _rank_one_mu(np.diag(M), real)
+    r = mussv(M, [(-1, 0) if k == "r" else (1, 1) for k in kinds], tol=1e-8)
+    assert float(r.upper) == pytest.approx(mu, rel=1e-5)
+    assert float(r.lower) <= mu * (1 + 1e-9)
+
+
+def test_mu_of_a_full_complex_block_is_the_largest_singular_value():
+    """Packard & Doyle (1993), "The complex structured singular value", Automatica 29(1),
+    §3: for one full complex block μ(M) = σ̄(M), and for a repeated complex scalar δI,
+    μ(M) = ρ(M) (1e-9; bounds to 1e-6)."""
+    rng = np.random.default_rng(11)
+    M = rng.standard_normal((4, 4)) + 1j * rng.standard_normal((4, 4))
+    full = mussv(M, [(4, 4)])
+    assert float(full.upper) == pytest.approx(np.linalg.norm(M, 2), rel=1e-6)
+    assert float(full.lower) == pytest.approx(np.linalg.norm(M, 2), rel=1e-6)
+    scalar = mussv(M, [(4, 0)])
+    rho = float(np.max(np.abs(np.linalg.eigvals(M))))
+    assert float(scalar.lower) == pytest.approx(rho, rel=1e-6)
+    assert float(scalar.upper) >= rho * (1 - 1e-9)
+
+
+@pytest.mark.parametrize("m, mu", [(2.5, 2.5), (-0.4, 0.4), (1.0 + 1.0j, 0.0)],
+                         ids=["real", "negative", "complex"])
+def test_real_mu_of_a_scalar(m, mu):
+    """Packard & Doyle (1993), §9: for one real scalar block μ(m) = |m| when m is real
+    and 0 otherwise (no real δ makes 1 − δm vanish): the bounds to 1e-9."""
+    r = mussv(np.array([[m]], dtype=complex), [(-1, 0)])
+    assert float(r.upper) == pytest.approx(mu, abs=1e-9)
+    assert float(r.lower) == pytest.approx(mu, abs=1e-9)
+
+
+def test_three_complex_full_blocks_have_no_gap():
+    """Doyle (1982), "Analysis of feedback systems with structured uncertainties", IEE
+    Proc. D 129(6), Thm 6.4: for at most three complex full blocks μ equals its upper bound
+    inf_D σ̄(D M D⁻¹); so the lower bound (a perturbation that makes I − ΔM singular, checked
+    here by its determinant) meets the upper one, to the bound's tolerance (1e-5 at tol
+    1e-8)."""
+    rng = np.random.default_rng(3)
+    M = rng.standard_normal((5, 5)) + 1j * rng.standard_normal((5, 5))
+    r = mussv(M, [(1, 1), (2, 2), (2, 2)], tol=1e-8)
+    assert float(r.lower) == pytest.approx(float(r.upper), rel=1e-5)
+    Delta = np.asarray(r.delta)
+    assert np.linalg.norm(Delta, 2) == pytest.approx(1.0 / float(r.lower), rel=1e-9)
+    assert abs(np.linalg.det(np.eye(5) - M @ Delta)) < 1e-9

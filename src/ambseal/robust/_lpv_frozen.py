@@ -73,19 +73,22 @@ def _norm(cl) -> float:
 def quadratic_gamma(loops, options: dict, level: float = 1.0, margin: float = 1e-7) -> float:
     """Smallest γ with one X ≻ 0 such that every closed loop ``(A, B, C, D)`` of ``loops``
     meets the bounded-real inequality [AᵀX + XA, XB, Cᵀ; BᵀX, −γI, Dᵀ; C, D, −γI] ≺ 0: a
-    bound of the L2 gain under any parameter trajectory within the table (linear
-    interpolation between its entries keeps the loops in their convex hull only where the
-    loop matrices are affine in θ; the table is what was checked).
+    bound of the L2 gain under any trajectory of the parameter over the table's loops (at
+    values between the entries only where the loop matrices are affine in θ, which keeps
+    them in the loops' convex hull).
 
     The loops are scaled first: time by the largest eigenvalue modulus ω₀ (A/ω₀, B and C
     by 1/√ω₀; norm-preserving), the states by one diagonal balancing of Σ|A_i|, and the
     gain by ``level`` (an estimate of the result, e.g. the largest frozen norm), so that the
     SDP's γ is near 1.
 
+    Returns the SDP's γ raised by ``CERTIFY_RTOL``, at which its X is checked by the
+    eigenvalues of each inequality (:func:`_certified`).
+
     Raises
     ------
     SynthesisError
-        No common X exists (CVXOPT's status is not ``optimal``).
+        No X certified: the SDP found none, or its X fails an inequality at that γ.
     """
     loops = [tuple(np.asarray(M, float) for M in L) for L in loops]
     w0 = max(float(np.max(np.abs(np.linalg.eigvals(L[0])))) for L in loops) or 1.0

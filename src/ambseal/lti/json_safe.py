@@ -6,7 +6,8 @@
 * numpy scalars and arrays become Python ``float``/``int``/``bool`` and lists;
 * a quantity that has no value where it is not finite (the σ̄ peak or the settling time of
   an unstable loop, an interval bound that could not be computed) becomes ``None`` there
-  (:func:`finite_or_none`), not ``"inf"``.
+  (:func:`finite_or_none`; through a whole record, :func:`finite_or_none_tree`), not
+  ``"inf"``.
 """
 
 from __future__ import annotations
@@ -33,6 +34,18 @@ def finite_or_none(x: float) -> float | None:
     """``float(x)``, or ``None`` where ``x`` is not finite (the module's last rule)."""
     x = float(x)
     return x if math.isfinite(x) else None
+
+
+def finite_or_none_tree(x: Any) -> Any:
+    """``x`` with :func:`finite_or_none` applied to every float in it, walking dicts, lists
+    and tuples (tuples become lists); other values unchanged."""
+    if isinstance(x, dict):
+        return {k: finite_or_none_tree(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [finite_or_none_tree(v) for v in x]
+    if isinstance(x, (float, np.floating)):
+        return finite_or_none(x)
+    return x
 
 
 def json_list(a: Any) -> list:

@@ -57,13 +57,14 @@ from ambseal.errors import ConfigError, SynthesisError
 from ambseal.lti.discrete import zoh
 from ambseal.lti.freqresp import freqresp_at
 from ambseal.lti.interconnect import feedback_poles, series_inputs
+from ambseal.lti.json_safe import finite_or_none_tree
 from ambseal.robust._digital_choice import first_stable as _first_stable
 from ambseal.robust._digital_choice import so_peak as _so_peak
 from ambseal.robust.delay import check_timing, loop_delay
 from ambseal.robust.digital_loop import DiscreteController
 from ambseal.robust.stability import is_stable
 
-__all__ = ["FAST_FRACTION", "METHODS", "PEAK_TOLERANCE", "peak_difference",
+__all__ = ["FAST_FRACTION", "DISCRETISATIONS", "PEAK_TOLERANCE", "peak_difference",
            "DigitalController", "split_fast", "residualize", "hold_keeps", "HOLDS", "KEPT",
            "discretize_as", "with_delay", "digital_controller", "check_rate",
            "choose_method", "prewarp_frequency_hz", "SampledPlants", "sampled_plants"]
@@ -76,7 +77,7 @@ FAST_FRACTION = 0.5
 #: as the same loop (10 %); a larger one is explained (:func:`peak_difference`).
 PEAK_TOLERANCE = 0.10
 #: The candidate discretisations, in the order they are tried.
-METHODS = ("tustin", "tustin_prewarp", "zoh", "foh")
+DISCRETISATIONS = ("tustin", "tustin_prewarp", "zoh", "foh")
 #: The hold equivalents, also tried with the fast poles kept where they alias nothing
 #: (:func:`hold_keeps`; suffix ``KEPT``).
 HOLDS, KEPT = ("zoh", "foh"), "+fast"
@@ -98,7 +99,7 @@ class DigitalController:
     discrete : DiscreteController
         ``x[k+1] = A x[k] + B y[k]``, ``u[k] = C x[k] + D y[k]``, ``i = −u`` at ``dt = Ts``.
     method : str
-        One of :data:`METHODS`.
+        One of :data:`DISCRETISATIONS`.
     prewarp_hz : float or None
         Pre-warping frequency (Hz) of ``"tustin_prewarp"``.
     sample_rate_hz : float
@@ -158,7 +159,7 @@ class DigitalController:
 
     def to_dict(self) -> dict:
         """JSON-ready description (no matrices; non-finite numbers as ``None``)."""
-        return _json_safe({"method": self.method, "choice": self.choice or self.method,
+        return finite_or_none_tree({"method": self.method, "choice": self.choice or self.method,
                 "prewarp_hz": self.prewarp_hz,
                 "sample_rate_hz": self.sample_rate_hz, "Ts": self.Ts,
                 "delay_samples": self.delay_samples,
@@ -206,17 +207,6 @@ def peak_difference(err: float | None, method: str, removed_poles_hz) -> dict:
         out["explanation"] = (f"discrete σ̄(S_o) peak differs from the continuous one by "
                               f"{100 * err:.0f} % (> {100 * PEAK_TOLERANCE:.0f} %): {why}")
     return out
-
-
-def _json_safe(x):
-    """``x`` with every non-finite float replaced by ``None`` (for strict JSON)."""
-    if isinstance(x, dict):
-        return {k: _json_safe(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_json_safe(v) for v in x]
-    if isinstance(x, (float, np.floating)):
-        return float(x) if np.isfinite(x) else None
-    return x
 
 
 def check_rate(K, sample_rate_hz: float, delay_samples: int = 0, removable: bool = True
@@ -305,7 +295,7 @@ def residualize(mats: Matrices, V: np.ndarray, k: int) -> Matrices:
 
 def discretize_as(mats: Matrices, dt: float, method: str, prewarp_hz: float | None = None
                   ) -> Matrices:
-    """Discrete equivalent of continuous ``(A, B, C, D)`` by one of :data:`METHODS`.
+    """Discrete equivalent of continuous ``(A, B, C, D)`` by one of :data:`DISCRETISATIONS`.
 
     ``"tustin"``/``"tustin_prewarp"``: python-control's bilinear transform (with
     ``prewarp_frequency`` 2π·``prewarp_hz``); ``"zoh"``: :func:`ambseal.lti.discrete.zoh`;
@@ -325,7 +315,7 @@ def discretize_as(mats: Matrices, dt: float, method: str, prewarp_hz: float | No
         Ad, Bd, Cd, Dd, _ = cont2discrete((A, B, C, D), dt, method="foh")
         return tuple(np.asarray(X, float) for X in (Ad, Bd, Cd, Dd))
     if method not in ("tustin", "tustin_prewarp"):
-        raise ConfigError(f"discretisation method {method!r}: expected one of {METHODS}")
+        raise ConfigError(f"discretisation method {method!r}: expected one of {DISCRETISATIONS}")
     w0 = None
     if method == "tustin_prewarp":
         if prewarp_hz is None or not 0 < prewarp_hz < 0.5 / dt:
@@ -479,7 +469,7 @@ def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int,
 
 def digital_controller(K, sample_rate_hz: float, plants, *,
                        delay_samples: int = 1, rise: Callable | None = None,
-                       methods: Sequence[str] = METHODS) -> DigitalController:
+                       methods: Sequence[str] = DISCRETISATIONS) -> DigitalController:
     """Choose the discrete controller that runs on the target (module docstring).
 
     Parameters
@@ -498,7 +488,7 @@ def digital_controller(K, sample_rate_hz: float, plants, *,
         (e.g. the rise of a design's H∞ norm or μ); without it the controller's poles
         are not removed and a rate below twice the highest is refused.
     methods : sequence of str
-        Candidates, a subset of :data:`METHODS`.
+        Candidates, a subset of :data:`DISCRETISATIONS`.
 
     Returns
     -------

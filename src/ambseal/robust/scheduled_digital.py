@@ -30,15 +30,15 @@ import control
 import numpy as np
 
 from ambseal.errors import SynthesisError
+from ambseal.lti.json_safe import finite_or_none_tree
 from ambseal.lti.tables import interp_table
 from ambseal.robust.controller import SPEED, ScheduledController
 from ambseal.robust.digital import (
+    DISCRETISATIONS,
     FAST_FRACTION,
     HOLDS,
     KEPT,
-    METHODS,
     _chosen_error,
-    _json_safe,
     check_rate,
     choose_method,
     discretize_as,
@@ -159,7 +159,7 @@ class ScheduledDigital(ScheduledController):
 
     def to_dict(self) -> dict:
         """JSON-ready description (no matrices)."""
-        return _json_safe({
+        return finite_or_none_tree({
                 "method": self.method, "choice": self.choice or self.method,
                 "prewarp_hz": self.prewarp_hz,
                 "sample_rate_hz": self.sample_rate_hz, "Ts": self.Ts,
@@ -177,7 +177,7 @@ class ScheduledDigital(ScheduledController):
 
 def scheduled_digital(K: ScheduledController, grid, sample_rate_hz: float,
                       plants: Sequence[tuple[float, tuple]], *, delay_samples: int = 1,
-                      methods: Sequence[str] = METHODS, name: str = "K_lpv"
+                      methods: Sequence[str] = DISCRETISATIONS, name: str = "K_lpv"
                       ) -> ScheduledDigital:
     """Tabulate, reduce and discretise a scheduled controller for the target.
 

@@ -200,3 +200,24 @@ def test_no_history_or_ticket_words_in_code_and_tests():
             if _HISTORY.search(line):
                 found.append(f"{path.relative_to(ROOT)}:{k}: {line.strip()}")
     assert not found, "\n".join(found)
+
+
+#: Words of the machine ambseal is for, and the layers above the generic core: the core
+#: (robust, lti) states its contracts for any plant (the rotor layers say what a rotor is)
+_MACHINE = re.compile(
+    r"\b(rotors?|seals?|bearings?|AMBs?|rigs?|thesis|gyroscopic\w*|impellers?|turbo\w+|"
+    r"levitat\w*|Campbell|P[1-5] §|Paper [1-5])\b"
+    r"|ambseal\.(design|analysis|identify|app|model|config|report|export|io|cli)\b")
+
+
+def test_the_generic_core_mentions_no_machine():
+    """The generic core — ``ambseal.robust`` and ``ambseal.lti`` — neither imports a rotor
+    layer (import-linter's contract) nor speaks of one: no rotor word and no module above
+    it in its code, comments or docstrings (:data:`_MACHINE`)."""
+    found = []
+    for pkg in ("robust", "lti"):
+        for path in sorted((SRC / pkg).rglob("*.py")):
+            for k, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+                if _MACHINE.search(line):
+                    found.append(f"{path.relative_to(ROOT)}:{k}: {line.strip()}")
+    assert not found, "\n".join(found)

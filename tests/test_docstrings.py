@@ -28,9 +28,9 @@ FACES = ["lti", "robust", "config", "model", "identify", "design", "analysis", "
 #: Public modules that are a face of their own (no package around them).
 MODULE_FACES = ["threads"]
 #: Public names that share their module's name and are kept (part of a published face); the
-#: module is then reached by its dotted name (``from ambseal.robust.scheduled_digital
+#: module is then reached by its dotted name (``from ambseal.machine.scheduled_digital
 #: import …``), not as the package's attribute.
-HIDING = {"ambseal.robust.scheduled_digital"}
+HIDING = {"ambseal.machine.scheduled_digital"}
 
 _TABLE = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))[
     "tool"]["numpydoc_validation"]

@@ -403,7 +403,7 @@ def test_run_on_the_turboexpander_judges_lpv(turbo_run):
     for name in ("spinup.png", "frozen_sensitivity.png", "report.html"):
         assert (tmp_path / name).exists()
     from ambseal.export import load_controller
-    from ambseal.robust import ScheduledDigital
+    from ambseal.machine import ScheduledDigital
 
     for ext in (".json", ".npz", ".mat"):
         K = load_controller(tmp_path / "controllers" / f"controller_lpv{ext}")

@@ -15,7 +15,7 @@ def test_designs_plants_and_controllers_pickle(testrig_cfg, testrig_designs, tur
     """Reference: the standard library's pickle round trip (what a worker process gets):
     the same matrices, the same signal names and the same frequency response of every
     controller, at a frequency inside the loop's bandwidth."""
-    from ambseal.robust.controller import frozen
+    from ambseal.machine.controller import frozen
     from ambseal.lti.freqresp import freqresp_at
     from ambseal.model.rig import build_plant
 

@@ -1,7 +1,7 @@
 """One verdict: the main job, export, sweep and campbell judge a borderline loop alike.
 
 Every command that says "stable" takes it of the same loop (the controller as it runs,
-:func:`ambseal.robust.loop.judged_loop`) by the same rule
+:func:`ambseal.machine.loop.judged_loop`) by the same rule
 (:func:`ambseal.robust.stability.is_stable`). Reference: the stability boundary of the
 test rig's reference PID between nominal and twice nominal pressure drop (thesis P5 §4:
 stable at 2.04 bar, unstable at 4.08 bar), bisected to 1e-4 bar; just below it every

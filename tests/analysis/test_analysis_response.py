@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from ambseal.analysis import loops, response
-from ambseal.robust.loop import closed_loop
+from ambseal.machine.loop import closed_loop
 from ambseal.errors import ModelError
 
 from .amb_test_plants import NAMES, mass_1dof, rigid_rotor

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from ambseal.analysis.loops import compliance, loop_responses
-from ambseal.robust.loop import closed_loop
+from ambseal.machine.loop import closed_loop
 from ambseal.analysis.unbalance import unbalance_from_compliance
 from ambseal.design.recipes import design
 from ambseal.design.weights import Weights
@@ -43,7 +43,7 @@ def plants(testrig_plants, cfg):
     digital controller's hold + computation delay (1.5 samples at 10 kHz, Padé) in front
     of the currents: the loop the H∞/μ designs are made for and every loop is judged on
     (ambseal.robust.delay)."""
-    from ambseal.robust.loop import delayed_plant
+    from ambseal.machine.loop import delayed_plant
     from ambseal.robust.delay import loop_delay
 
     assert sorted(testrig_plants)[0] == 0.0 and sorted(testrig_plants)[-1] == 4.08

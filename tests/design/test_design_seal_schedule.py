@@ -4,7 +4,7 @@ controller type it shares with the speed-scheduled LPV controller."""
 import numpy as np
 import pytest
 
-from ambseal.robust.controller import ScheduledController, frozen, matrices_at
+from ambseal.machine.controller import ScheduledController, frozen, matrices_at
 from ambseal.robust.lpv import LpvController
 from ambseal.design.seal_schedule import SealScheduledDesign, design_seal_scheduled
 from ambseal.design.weights import default_weights
@@ -118,7 +118,7 @@ def _seal_table(d):
     2 MN/m and their ZOH equivalents at 10 kHz (what ``scheduled_digital`` tabulates once it
     has chosen the method)."""
     from ambseal.robust.digital import discretize_as
-    from ambseal.robust.scheduled_digital import ScheduledDigital
+    from ambseal.machine.scheduled_digital import ScheduledDigital
 
     g = np.array([0.0, 1e6, 2e6])
     cont = [d.matrices_at(t) for t in g]

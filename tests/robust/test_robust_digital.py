@@ -163,9 +163,9 @@ def test_scheduled_table_keeps_well_damped_fast_poles_and_matches_the_continuous
     (above half of Nyquist, ζ = 0.998: z = e^{pT} at an angle of 0.26 rad, no alias) is
     kept under a hold equivalent; residualised, the peak was 55 % off. A 3 kHz pair at
     ζ = 0.1 (angle 1.9 rad) or an unstable pole is not kept."""
-    from ambseal.robust.controller import ScheduledController
+    from ambseal.machine.controller import ScheduledController
     from ambseal.robust.digital import hold_keeps
-    from ambseal.robust.scheduled_digital import scheduled_digital
+    from ambseal.machine.scheduled_digital import scheduled_digital
 
     class Lead(ScheduledController):
         parameter, schedule = "seal.k", (0.0, 1.0)
@@ -369,7 +369,7 @@ def test_export_round_trip_scheduled(turbo_lpv, turbo_digital, tmp_path, suffix)
     linear between table entries): the controller read back by load_controller is a
     ScheduledController equal to the design at grid speeds and between them, and its
     discrete table is the exported one."""
-    from ambseal.robust.controller import ScheduledController
+    from ambseal.machine.controller import ScheduledController
 
     sd = turbo_digital["lpv"]
     back = load_controller(export_controller(sd, tmp_path / f"K{suffix}"))

@@ -41,9 +41,9 @@ from ambseal.model.modes import (
 )
 from ambseal.model.rig import build_plant
 from ambseal.model.rotor import build_mesh
-from ambseal.robust.controller import frozen
+from ambseal.machine.controller import frozen
 from ambseal.robust.delay import loop_delay
-from ambseal.robust.loop import judged_loop
+from ambseal.machine.loop import judged_loop
 from ambseal.robust.stability import decay_rate, is_stable
 
 __all__ = ["API684_LOG_DEC", "OVERDAMPED_ZETA", "ClosedLoopModes", "Crossing", "Campbell",
@@ -143,7 +143,7 @@ class ClosedLoopModes:
         Node positions (m).
     max_real_pole : float
         Largest real part of *all* poles of the judged loop (1/s), whatever their frequency:
-        the loop as it runs (:func:`ambseal.robust.loop.judged_loop`, the controller's
+        the loop as it runs (:func:`ambseal.machine.loop.judged_loop`, the controller's
         delay included), the loop whose modes these are without a controller.
     stable : bool
         The judged loop's verdict (:func:`ambseal.robust.stability.is_stable`).
@@ -243,7 +243,7 @@ def modes_of_state_matrix(A: np.ndarray, mesh, *, speed_hz: float, pressure_bar:
     rotor's node DOFs q (any plant of :mod:`ambseal.model.rig`, open or closed loop).
 
     ``stable`` and ``max_real_pole`` are those of ``judged_poles`` when given (the poles of
-    the loop as it runs, :func:`ambseal.robust.loop.judged_loop`: the controller's delay
+    the loop as it runs, :func:`ambseal.machine.loop.judged_loop`: the controller's delay
     included), else of ``A``'s eigenvalues.
 
     Rigid-body modes and oscillating ones as in :func:`ambseal.model.modes.modes`

@@ -1,7 +1,7 @@
 """Which controllers of a run failed, and why, in one plain line each.
 
 ``ambseal run`` judges every controller it could design and reports all of them; a
-controller whose judged loop (:func:`ambseal.robust.loop.judged_loop`, the continuous loop
+controller whose judged loop (:func:`ambseal.machine.loop.judged_loop`, the continuous loop
 with the target's delay or the discrete loop as it runs) is unstable at a judged condition,
 or that could not be designed at all, is *failed*. A designed controller that failed is not
 delivered (no controller files are written for it unless the user asks with

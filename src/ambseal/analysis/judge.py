@@ -18,7 +18,7 @@ will act; the case records it as ``delay`` (``delay_s``, ``pade_order``,
 then equal the sampled loop's to 0.1 % (13.36 against 13.37 at 2.04 bar, 7.43 against 7.43
 at 0 bar; without the delay they were 9.36 and 4.94). The closed-loop modes of
 :mod:`ambseal.analysis.campbell` stay those of the continuous controller; their stability
-verdict is this loop's (:func:`ambseal.robust.loop.judged_loop`).
+verdict is this loop's (:func:`ambseal.machine.loop.judged_loop`).
 
 **What runs is judged too**: given the discrete controller of the target (with its
 computation delay, :class:`ambseal.robust.digital.DigitalController`), the same numbers are
@@ -62,10 +62,10 @@ from ambseal.lti.json_safe import finite_or_none, json_float
 from ambseal.model.modes import classify_poles
 from ambseal.model.rig import build_plant
 from ambseal.model.seal import pressure_for_k, seal_values
-from ambseal.robust.controller import SPEED, ScheduledController, frozen
+from ambseal.machine.controller import SPEED, ScheduledController, frozen
 from ambseal.robust.delay import loop_delay
-from ambseal.robust.loop import JudgedLoop, judged_loop
-from ambseal.robust.scheduled_digital import ScheduledDigital
+from ambseal.machine.loop import JudgedLoop, judged_loop
+from ambseal.machine.scheduled_digital import ScheduledDigital
 
 __all__ = ["JudgeSettings", "OperatingPoint", "LoopJudgement", "JudgedCase", "judge", "judge_case", "judge_spinup",
            "operating_points", "speed_scheduled",
@@ -511,7 +511,7 @@ def condition_values(point, design_cfg) -> tuple[float, dict]:
 def frozen_at(K, point, design_cfg):
     """The fixed controller that runs at ``point``: ``K``, a speed-scheduled one at the
     speed, or one scheduled on a seal coefficient at the design rig's value at the pressure
-    drop (:func:`ambseal.robust.controller.frozen`, :func:`condition_values`)."""
+    drop (:func:`ambseal.machine.controller.frozen`, :func:`condition_values`)."""
 
     return frozen(K, *condition_values(point, design_cfg))
 

@@ -39,7 +39,7 @@ from ambseal.lti.freqresp import freqresp_at
 from ambseal.lti.interconnect import wired
 from ambseal.lti.json_safe import json_float, json_list
 from ambseal.lti.matrices import as_omega, labels, ss_matrices
-from ambseal.robust.loop import loop_matrices, sample_time
+from ambseal.machine.loop import loop_matrices, sample_time
 
 __all__ = [
     "LoopResponse",

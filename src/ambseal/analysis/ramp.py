@@ -10,7 +10,7 @@ amplitude and length on the first actuator axis) every ``impulse_every_s`` — a
 noise sequence go into every run, so the runs differ only by their controller.
 
 The tracked scheme runs in blocks of ``block_s``: at the start of each block the
-controller that runs is the digital table (:class:`~ambseal.robust.scheduled_digital.
+controller that runs is the digital table (:class:`~ambseal.machine.scheduled_digital.
 ScheduledDigital`, ``tracked_digital``: the exported, judged discretisation) interpolated
 at the scheduling value, or without a table the scheduled controller frozen there and
 discretised by zero-order hold (Tustin made every frozen discrete loop of the test rig's

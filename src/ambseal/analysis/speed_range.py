@@ -7,7 +7,7 @@ gyroscopic splitting of the modes moves them against the controller's phase). ``
 run`` therefore closes every controller on the full-order plant at each judged pressure and
 each of the specification's stability speeds (:func:`ambseal.design.conditions.stability_speeds`:
 standstill to the top speed) that is not already a judged condition, in the same loop as the
-judgement (:func:`ambseal.robust.loop.judged_loop`): continuous with the target's hold and
+judgement (:func:`ambseal.machine.loop.judged_loop`): continuous with the target's hold and
 computation delay, and the discrete controller as it runs on the plant sampled at its rate.
 Only stability is asked there; an unstable loop at any of those conditions fails the
 controller like one at a judged condition (:func:`ambseal.analysis.delivery.loop_failure`).
@@ -21,7 +21,7 @@ from ambseal.analysis.judge import OperatingPoint
 from ambseal.lti.json_safe import json_float
 from ambseal.model.rig import build_plant
 from ambseal.robust.delay import loop_delay
-from ambseal.robust.loop import judged_loop
+from ambseal.machine.loop import judged_loop
 
 __all__ = ["StabilityCase", "stability_points", "stability_case"]
 

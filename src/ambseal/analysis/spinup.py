@@ -75,8 +75,8 @@ from ambseal.errors import ModelError
 from ambseal.lti.discrete import zoh
 from ambseal.lti.interconnect import feedback_matrices
 from ambseal.model.rig import build_plant
-from ambseal.robust.controller import frozen, matrices_at
-from ambseal.robust.loop import closed_loop
+from ambseal.machine.controller import frozen, matrices_at
+from ambseal.machine.loop import closed_loop
 
 __all__ = ["StepResponse", "SpinupResult", "spinup", "FrozenSensitivity",
            "frozen_sensitivity"]
@@ -190,7 +190,7 @@ def spinup(plant, controller, *, name: str = "K", speeds_hz=None,
         (``lpv_plant(cfg, grid, force_positions=(amb_A_position,))``), D = 0 for the
         currents; its grid must cover ``speeds_hz``.
     controller : control.StateSpace or ScheduledController
-        Fixed or scheduled controller (:mod:`ambseal.robust.controller`: m → A, negative
+        Fixed or scheduled controller (:mod:`ambseal.machine.controller`: m → A, negative
         feedback ``i = −K y``).
     name : str
         Label.
@@ -469,7 +469,7 @@ def frozen_sensitivity(cfg, controller, speeds_hz, *, name: str = "K", omega=Non
     cfg : RigConfig
         The rig, at full order and its ``[operating]`` pressure drop.
     controller : control.StateSpace or ScheduledController
-        Physical controller (:mod:`ambseal.robust.controller`), m → A, negative feedback.
+        Physical controller (:mod:`ambseal.machine.controller`), m → A, negative feedback.
     speeds_hz : array_like
         The frozen speeds (Hz); a scheduled controller is frozen at each.
     name : str

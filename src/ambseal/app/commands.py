@@ -54,14 +54,14 @@ from ambseal.report.identify_figures import (
 from ambseal.report.run_report import facility_impulse_report, identification_report
 from ambseal.report.tracking_figures import tracking_figure
 from ambseal.report.verdict import target_difference
-from ambseal.robust.controller import SPEED, ScheduledController
+from ambseal.machine.controller import SPEED, ScheduledController
 from ambseal.robust.digital import (
     check_rate,
     digital_controller,
     peak_difference,
     sampled_plants,
 )
-from ambseal.robust.scheduled_digital import scheduled_digital
+from ambseal.machine.scheduled_digital import scheduled_digital
 
 __all__ = ["Designed", "Identified", "identification_stage", "facility_impulses", "design_files",
            "identify_files", "export_design", "show_defaults",
@@ -72,7 +72,7 @@ __all__ = ["Designed", "Identified", "identification_stage", "facility_impulses"
 @dataclass(frozen=True)
 class Designed:
     """A controller of the main job: its method, the controller (``control.StateSpace`` or
-    :class:`~ambseal.robust.controller.ScheduledController`), its design summary for
+    :class:`~ambseal.machine.controller.ScheduledController`), its design summary for
     ``metrics.json`` and the full design result."""
 
     method: str
@@ -86,7 +86,7 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
     """The digital controller of a design, its discretisation chosen on the full-order
     plants at the judged conditions (:mod:`ambseal.robust.digital`): a
     :class:`~ambseal.robust.digital.DigitalController`, or for a scheduled controller a
-    :class:`~ambseal.robust.scheduled_digital.ScheduledDigital` whose interpolation is
+    :class:`~ambseal.machine.scheduled_digital.ScheduledDigital` whose interpolation is
     also checked between table entries (at speeds, or at the pressures that give the seal
     coefficient it is scheduled on). ``cache`` (a dict kept by the caller) shares the
     sampled plants between the controllers of one rig."""

@@ -48,7 +48,7 @@ from ambseal.design.specs import DesignSpec, design_spec
 from ambseal.design.weights import Weights, default_weights
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.lti.json_safe import json_float
-from ambseal.robust.controller import SPEED, ScheduledController
+from ambseal.machine.controller import SPEED, ScheduledController
 from ambseal.robust.dk import design_omega, musyn
 from ambseal.robust.hinf import hinfsyn
 from ambseal.robust.lpv import lpvsyn
@@ -130,7 +130,7 @@ class LpvDesign(ScheduledController):
     def at(self, speed_rad_s: float, name: str = "K_lpv"):
         """Frozen physical controller at Ω (rad/s): a ``control.StateSpace``
         from displacements (m) to current references (A), negative feedback ``i = −K y``
-        (:mod:`ambseal.robust.controller`; :func:`ambseal.design.plant.physical_controller`)."""
+        (:mod:`ambseal.machine.controller`; :func:`ambseal.design.plant.physical_controller`)."""
         chans = [n[2:] if n.startswith("y_") else n for n in self.K.input_names]
         return physical_controller(self.K.matrices(float(speed_rad_s)),
                                    self.weights.d_e, self.weights.d_u, chans, name=name)

@@ -67,7 +67,7 @@ from ambseal.robust.delay import design_delay, loop_delay
 from ambseal.robust.dgk import musyn_dgk
 from ambseal.robust.dk import design_omega, musyn
 from ambseal.robust.hinf import hinfsyn
-from ambseal.robust.loop import judged_loop
+from ambseal.machine.loop import judged_loop
 from ambseal.robust.order import reduce_controller
 from ambseal.threads import with_numerics_threads
 
@@ -200,7 +200,7 @@ def _pid(cfg, p):
 
 def full_order_check(cfg, K, conditions) -> dict:
     """Close a physical controller with the full-order plant at each condition, as the
-    main job judges it (:func:`ambseal.robust.loop.judged_loop`: the target's hold and
+    main job judges it (:func:`ambseal.machine.loop.judged_loop`: the target's hold and
     computation delay as :func:`ambseal.robust.delay.loop_delay`'s lag).
 
     Parameters

@@ -79,7 +79,7 @@ from ambseal.errors import ModelError, SynthesisError
 from ambseal.files import write_json
 from ambseal.model.rig import build_plant
 from ambseal.model.seal import values_following_k
-from ambseal.robust.controller import ScheduledController
+from ambseal.machine.controller import ScheduledController
 from ambseal.robust.delay import design_delay
 from ambseal.robust.lpv import LpvController, lpvsyn
 
@@ -101,7 +101,7 @@ TABLE_INTERVALS = 20
 @dataclass(frozen=True, eq=False)
 class SealScheduledDesign(ScheduledController):
     """A controller scheduled on a seal coefficient θ (SI), ``i = −K(θ) y``
-    (:class:`~ambseal.robust.controller.ScheduledController` on ``parameter``).
+    (:class:`~ambseal.machine.controller.ScheduledController` on ``parameter``).
 
     Attributes
     ----------

@@ -2,7 +2,7 @@
 
 The module implements exactly the discrete controller that was judged and exported
 (:class:`~ambseal.robust.digital.DigitalController`, or the table of a
-:class:`~ambseal.robust.scheduled_digital.ScheduledDigital`), in ``double`` or ``float``::
+:class:`~ambseal.machine.scheduled_digital.ScheduledDigital`), in ``double`` or ``float``::
 
     #include "ambseal_hinf.h"
     ambseal_hinf_state s;
@@ -40,8 +40,8 @@ import scipy.linalg as sla
 
 from ambseal.errors import ConfigError
 from ambseal.files import write_text
-from ambseal.robust.controller import SPEED
-from ambseal.robust.scheduled_digital import ScheduledDigital
+from ambseal.machine.controller import SPEED
+from ambseal.machine.scheduled_digital import ScheduledDigital
 
 __all__ = ["write_c", "schur_realisation", "c_identifier"]
 

@@ -21,7 +21,7 @@ and ``Ts = 0`` (MATLAB's continuous time), and read back as that ``StateSpace``.
 A scheduled controller adds ``kind = "scheduled"``, ``parameter`` (θ: ``"speed"`` or an
 LFT parameter such as ``"seal.k"``), ``grid`` (n_t, θ of each table entry: rad/s for the
 speed, else SI; a speed-scheduled one also as ``speeds_rad_s``) and ``interpolation`` (the
-law, :func:`~ambseal.robust.scheduled_digital.interpolation_law`); its
+law, :func:`~ambseal.machine.scheduled_digital.interpolation_law`); its
 matrices are stacks over the table, shape (n_t, …) in ``.npz``/``.json`` and (…, n_t) in
 ``.mat`` so that MATLAB's ``ss`` builds the model array directly.
 
@@ -52,10 +52,10 @@ from ambseal.config import MAX_DELAY_SAMPLES, MAX_FREQUENCY_HZ
 from ambseal.errors import AmbsealError, DataError
 from ambseal.files import atomic_write, input_file
 from ambseal.identify.matlab_file import read_matlab
-from ambseal.robust.controller import SPEED
+from ambseal.machine.controller import SPEED
 from ambseal.robust.digital import DigitalController, discretize_as
 from ambseal.robust.digital_loop import DiscreteController
-from ambseal.robust.scheduled_digital import ScheduledDigital
+from ambseal.machine.scheduled_digital import ScheduledDigital
 
 __all__ = ["export_controller", "load_controller", "controller_document", "CONVENTION",
            "MATLAB_LINE", "LABEL"]
@@ -152,7 +152,7 @@ def export_controller(ctrl, path, judged=None) -> Path:
     ----------
     ctrl : DigitalController, ScheduledDigital or control.StateSpace
         The controller as judged (:func:`ambseal.robust.digital.digital_controller`,
-        :func:`ambseal.robust.scheduled_digital.scheduled_digital`), or a continuous
+        :func:`ambseal.machine.scheduled_digital.scheduled_digital`), or a continuous
         controller alone (``kind = "continuous"``).
     path : str or Path
         Destination; the suffix picks the format.

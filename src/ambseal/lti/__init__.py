@@ -8,7 +8,7 @@ The lowest numerical layer (it imports only :mod:`ambseal.errors`); each idea on
   continuous models, modal or Hessenberg (Laub, IEEE TAC 26(2), 1981);
 * :func:`lft_lower`, :func:`lft_lower_matrices` — ``F_l(P, K)`` (Skogestad &
   Postlethwaite, *Multivariable Feedback Control*, 2nd ed., Eq. 3.111);
-  :func:`feedback_matrices`, :func:`feedback_poles` — the AMB loop ``u = −K y + d``;
+  :func:`feedback_matrices`, :func:`feedback_poles` — the negative-feedback loop ``u = −K y + d``;
   :func:`wired` — a controller matched to its plant by signal names;
 * :func:`zoh`, :func:`discretize`, :func:`simulate_lti` — exact zero-order hold (Franklin,
   Powell & Workman, *Digital Control of Dynamic Systems*, 3rd ed., §6.3), Tustin, and the

@@ -23,8 +23,8 @@ the same checks (a fine FE mesh: its own eigenvectors are never well enough cond
 So neither a (nearly) defective ``A`` nor a badly balanced Hessenberg form silently spoils
 the answer.
 
-The rotor models of the thesis (P5 §3.1.4: 40 FE nodes, 320 states, lightly damped,
-open-loop unstable) are the intended use.
+Lightly damped, open-loop unstable FE models of a few hundred to a few thousand states are
+the intended use.
 
 If a frequency coincides with a pole on the imaginary axis (e.g. ω = 0 with an integrator),
 the corresponding entries are ``inf``/``nan``; no error is raised.
@@ -48,7 +48,7 @@ _USE_SLYCOT = True  # set False (tests) to force the pure-numpy Hessenberg solve
 _MODAL = ArrayMemo()  # (λ, V, cond V, V⁻¹B, CV) of the last large (A, B, C)
 #: States above which cond V is LAPACK's 1-norm estimate from the LU of V (``gecon``, O(n²)
 #: after the LU that V⁻¹B needs anyway) instead of the 2-norm by an SVD: at 3 248 states
-#: (the test rig at 400 beam elements) the SVD took 25.6 s, more than the eig itself
+#: (an FE model of 400 beam elements) the SVD took 25.6 s, more than the eig itself
 #: (18 s), the LU and the estimate 2.3 s. The two norms' condition numbers lie within a
 #: factor n of each other (Higham, *Accuracy and Stability of Numerical Algorithms*, 2nd
 #: ed., 2002, §15.3); cond V only decides whether the modal form is tried — ``"auto"``
@@ -212,11 +212,11 @@ def _arbitrated(A, B, C, D, s, probe, Hh, Hm, modal, max_cond, rtol) -> np.ndarr
     itself); else the one of the two fast forms closer to the dense solves if it is within
     ``_ARBITER_RTOL`` of them, else dense solves on the whole grid.
 
-    The balanced modal form is what FE plants in [q; q̇] form need: on the thesis rig's
-    320-state plant cond V falls from 5.6e7 to 1.8e4 and the modal error against the dense
+    The balanced modal form is what FE plants in [q; q̇] form need: on a 320-state
+    FE plant cond V falls from 5.6e7 to 1.8e4 and the modal error against the dense
     solves from 4e-8 to 1.2e-9 of the peak (the Hessenberg form: 9e-10), so the grid costs
-    ``O(n)`` per frequency instead of TB05AD's ``O(n²)`` (sampled_plants of the rig's three
-    judged plants, 400 points each: 1.3 → 0.6 s). It is not the first choice because
+    ``O(n)`` per frequency instead of TB05AD's ``O(n²)`` (three such plants, 400 points
+    each: 1.3 → 0.6 s). It is not the first choice because
     balancing is also what spoils both balanced forms on the loop below, where only the
     comparison with the dense solves notices it.
 
@@ -277,7 +277,7 @@ def _balanced_modal_checked(A, B, C, D, s, max_cond, rtol) -> np.ndarray | None:
 
     Where ``cond V`` of ``A`` itself is too large, and first of all on a large model
     (above ``_SVD_COND_STATES`` states): an FE plant in [q; q̇] form there has cond V far
-    above ``max_cond`` unbalanced (3e9 at 1 888 states, the test rig at 230 beam
+    above ``max_cond`` unbalanced (3e9 at 1 888 states, 230 beam
     elements), so trying ``A``'s own eigenvectors first cost an eig of the whole model for
     nothing (18 s at 3 248 states)."""
     probe = _probes(s)
@@ -297,12 +297,12 @@ def _balanced_modal_as_good(A, B, C, D, s, probe, Hd, max_cond) -> np.ndarray | 
     ``rtol`` against the dense solves ``Hd`` at ``probe`` but is as close to them as the
     Hessenberg form (within ``_AS_GOOD`` times its error, and ``_ARBITER_RTOL``); else None.
 
-    Where the spectrum spans many decades neither fast form meets 1e-8: the test rig at
-    230 beam elements (1 888 states, eigenvalues from 39 Hz to 1.1 MHz) has the balanced modal
+    Where the spectrum spans many decades neither fast form meets 1e-8: an FE model
+    of 230 beam elements (1 888 states, eigenvalues from 39 Hz to 1.1 MHz) has the balanced modal
     form 2.78e-8 and the Hessenberg form 2.76e-8 of the peak from the dense solves refined
     in extended precision (the plain dense solves 1e-9). They are equally good, but the
-    Hessenberg form costs O(n²) per point (TB05AD: 17 ms at 1 888 states, 314 s of that
-    rig's ``ambseal run``) against O(n) for the modal one."""
+    Hessenberg form costs O(n²) per point (TB05AD: 17 ms at 1 888 states, 314 s of a
+    judged run of that model) against O(n) for the modal one."""
     lam, _, Bb, Cb = _BALANCED.get((A, B, C), max_cond,
                                    lambda: _modal_form(A, B, C, max_cond, balance=True))
     if Bb is None:

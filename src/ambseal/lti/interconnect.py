@@ -1,9 +1,9 @@
-"""Closing loops: the lower linear fractional transformation and AMB negative feedback.
+"""Closing loops: the lower linear fractional transformation and negative feedback.
 
 One implementation serves every stage: the H∞/μ/LPV syntheses close ``F_l(P, K)``
 (Skogestad & Postlethwaite, *Multivariable Feedback Control*, 2nd ed., Eq. 3.111, with a
-general ``D22``), and the AMB loop ``u = −K y + d`` of the analyses and of the digital loop of
-the identification is the same transformation of an augmented plant
+general ``D22``), and the negative-feedback loop ``u = −K y + d`` of the analyses and of a
+digital loop is the same transformation of an augmented plant
 (:func:`feedback_matrices`). The algebra does not depend on the time base, so the same
 functions close continuous and discrete loops.
 
@@ -122,11 +122,12 @@ def lft_lower(P: Any, K: Any, nmeas: int, ncon: int, name: str = "closed_loop"):
 
 def feedback_matrices(G: Matrices, K: Matrices, Gf: tuple[np.ndarray, np.ndarray] | None = None
                       ) -> Matrices:
-    """The AMB loop ``u = −K y + d`` (plus external inputs ``f``) as one state space.
+    """The negative-feedback loop ``u = −K y + d`` (plus external inputs ``f``) as one
+    state space.
 
     Plant ``ẋ = A x + B u + B_f f``, ``y = C x + D u + D_f f``; controller
-    ``ẋ_K = A_K x_K + B_K y``, ``i = −(C_K x_K + D_K y)``, ``u = i + d`` (thesis P5 Fig. 8:
-    the controller maps displacements to current references, negative feedback). Computed as
+    ``ẋ_K = A_K x_K + B_K y``, ``i = −(C_K x_K + D_K y)``, ``u = i + d`` (the controller maps
+    measurements to commands, negative feedback). Computed as
     :func:`lft_lower_matrices` of the plant augmented with the outputs ``i`` and the
     controller ``−K``; the same as ``control.feedback(G, K, sign=-1)`` on the ``d → y``
     channel.

@@ -5,10 +5,9 @@ update and output functions), which the standard :mod:`pickle` refuses. :func:`p
 registers, once per process, a :mod:`copyreg` reducer that stores a system as its
 matrices, time base, signal and state names and name, and rebuilds it with
 ``control.ss``. It is called by the functions that hand out ambseal's state-space objects
-(:meth:`ambseal.model.lft.Plant.to_statespace`, the controller constructors, the
-generalised plant), so every ``Plant``, ``DesignResult`` and controller made through
-ambseal pickles with the standard library; unpickling imports this module and registers
-it there too. An interconnected system (``LinearICSystem``) comes back as a plain
+(the plant and controller constructors of the layers above), so every system made
+through ambseal pickles with the standard library; unpickling imports this module and
+registers it there too. An interconnected system (``LinearICSystem``) comes back as a plain
 ``StateSpace`` with the same matrices and names.
 """
 

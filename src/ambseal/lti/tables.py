@@ -1,7 +1,7 @@
 """Tables against one parameter: linear interpolation, held constant outside the table.
 
-One rule for every tabulated quantity of ambseal — seal coefficients against frequency, and
-the state-space matrices of scheduled controllers against their parameter.
+One rule for every tabulated quantity of ambseal — coefficients against frequency, and the
+state-space matrices of scheduled controllers against their parameter.
 """
 
 from __future__ import annotations

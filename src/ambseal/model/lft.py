@@ -102,7 +102,7 @@ class Plant:
     Continuous time: ẋ = A x + B u, y = C x + D u. Inputs are the current references
     ``i_<axis>`` (A) per actuator axis, then any extra force inputs ``F<k>_<x|y>`` (N);
     outputs are the sensor displacements ``y_<axis>`` (m), ``<axis>`` such as ``A_zeta``.
-    A controller (:mod:`ambseal.robust.controller`) has the reverse names, inputs
+    A controller (:mod:`ambseal.machine.controller`) has the reverse names, inputs
     ``y_<axis>`` and outputs ``i_<axis>``, so python-control's ``interconnect`` closes the
     loop by name (with the sign of ``i = −K y``).
 

@@ -1,8 +1,8 @@
 """ambseal.robust: robust-control synthesis and analysis for any python-control plant.
 
-Nothing here knows a rotor: every function takes and returns ``control.StateSpace`` (or
-plain matrices) with python-control's signal names, so a control engineer can use it on a
-distillation column as well as on an AMB rotor.
+Nothing here knows the machine it is used on: every function takes and returns
+``control.StateSpace`` (or plain matrices) with python-control's signal names, so a control
+engineer can use it on a distillation column as well as on an aircraft or a compressor.
 
 Synthesis (each returns the controller, the closed loop, the bound and a result record):
 
@@ -16,20 +16,17 @@ Synthesis (each returns the controller, the closed loop, the bound and a result 
 Analysis: :func:`mussv` — μ upper and lower bounds for mixed real/complex block structures.
 
 The controller that runs on a target: :func:`digital_controller` (fast poles removed, the
-discretisation chosen by the sampled loop), :func:`scheduled_digital` (a scheduled
-controller's interpolated table), :class:`DiscreteController` and the sample-and-hold
-delay of the design model (:func:`design_delay`).
+discretisation chosen by the sampled loop), :class:`DiscreteController` and the
+sample-and-hold delay of the design model (:func:`design_delay`).
 
 Sign conventions. The synthesis functions and :func:`lft_lower` work on the lower LFT
 ``F_l(P, K)``: their controllers close ``u = K y`` (positive feedback), as python-control's
-``hinfsyn`` and MATLAB's ``lft`` do. The controllers a machine runs —
-:class:`ScheduledController`, :class:`DigitalController`, :class:`DiscreteController` and
-the files exported from them — map measurements to actuator commands with negative
-feedback, ``u = −K y`` (:mod:`ambseal.robust.controller`); the design layer converts one
-into the other.
+``hinfsyn`` and MATLAB's ``lft`` do. The controllers that run on a target —
+:class:`DigitalController`, :class:`DiscreteController` — map measurements to actuator
+commands with negative feedback, ``u = −K y``; the caller converts one into the other
+(ambseal's own layers: :mod:`ambseal.machine`).
 """
 
-from ambseal.robust.controller import SPEED, ScheduledController, frozen, matrices_at
 from ambseal.robust.delay import DesignDelay, design_delay, loop_delay
 from ambseal.robust.dgk import musyn_dgk
 from ambseal.robust.digital import DigitalController, digital_controller
@@ -39,11 +36,9 @@ from ambseal.robust.hinf import HinfResult, hinfnorm, hinfsyn, lft_lower
 from ambseal.robust.lpv import LpvController, LpvSynResult, lpvsyn
 from ambseal.robust.mu import MuResult, mussv
 from ambseal.robust.order import ReductionResult, balred_controller, reduce_controller
-from ambseal.robust.scheduled_digital import ScheduledDigital, scheduled_digital
 
-__all__ = ["SPEED", "DesignDelay", "DigitalController", "DiscreteController", "HinfResult",
+__all__ = ["DesignDelay", "DigitalController", "DiscreteController", "HinfResult",
            "LpvController", "LpvSynResult", "MuResult", "MusynResult", "ReductionResult",
-           "ScheduledController", "ScheduledDigital", "balred_controller", "design_delay",
-           "digital_controller", "discrete_controller", "fit_magnitude", "frozen",
-           "hinfnorm", "hinfsyn", "lft_lower", "loop_delay", "lpvsyn", "matrices_at",
-           "musyn", "musyn_dgk", "mussv", "reduce_controller", "scheduled_digital"]
+           "balred_controller", "design_delay", "digital_controller", "discrete_controller",
+           "fit_magnitude", "hinfnorm", "hinfsyn", "lft_lower", "loop_delay", "lpvsyn",
+           "musyn", "musyn_dgk", "mussv", "reduce_controller"]

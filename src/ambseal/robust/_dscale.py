@@ -200,7 +200,7 @@ SEARCH_EVALS_PER_PARAMETER = 25
 #: scaled plant: a γ evaluation (Riccati equations and Hamiltonian eigenvalues of the scaled
 #: plant) costs ∝ n³. A count, not a clock, so the same problem gets the same search on
 #: every machine, quiet or loaded. The distillation column's full search is 450 × 22³ ≈
-#: 4.8·10⁶; on a 92-state scaled plant (a rotor's μ design, 10 parameters) it would be
+#: 4.8·10⁶; on a 92-state scaled plant (10 parameters) it would be
 #: 250 × 92³ ≈ 1.9·10⁸, at a K-step of 0.4 s a minute for a μ 0.1 % lower
 #: (benchmarks/README.md, bench_dk): the limit lies between.
 SEARCH_WORK = 5e7

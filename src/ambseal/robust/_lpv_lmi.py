@@ -260,7 +260,7 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
     ps = sc.p_of(grid)
     # LMIs affine in p that hold at both ends of the range hold between them (a convex
     # combination): the coupling LMI of an affine S always, the R-LMI when A(p) is affine
-    # over the grid (a seal coefficient through its LFT channel, gyroscopics in speed).
+    # over the grid (a parameter entering through an LFT channel, or linearly in A).
     # Inner grid points keep only the S-LMIs of a parameter-dependent S, which are
     # quadratic in p (A(p)ᵀS(p)); with a constant S and an affine A(p) they go too.
     a_affine = _affine_in_p(sc.A, ps)

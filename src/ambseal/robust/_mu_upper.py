@@ -374,7 +374,7 @@ def upper_bound(Mp, blks, tol, max_iter, gmax, *, stride=0, t0_factor=1.2, warm_
     warm_factor : float, optional
         Warm starts begin at the level ``warm_factor·λ`` of the best neighbour-based
         scalings; default ``1 + tol/2``: where the centre at that level lowers λ by less than
-        ``tol/2`` the solve stops after one centring (test rig's μ loop, 500 frequencies:
+        ``tol/2`` the solve stops after one centring (a 108-state loop, 500 frequencies:
         about 5 Newton steps per frequency instead of 10, and no larger error against a
         ``tol = 1e-6`` solve: 7.4e-4 vs 9.8e-4 with ``1 + 2·tol``).
     peak_tol : float, optional

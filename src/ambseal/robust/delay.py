@@ -5,27 +5,23 @@ A controller that runs at ``f_s`` with ``n_d`` samples of computation delay
 zero-order hold, whose phase is that of a delay of half a sample, and through the
 computation delay itself: in total, up to the Nyquist frequency, nearly a pure delay ::
 
-    τ = (n_d + 1/2) / f_s          (test rig: 1.5 samples at 10 kHz = 150 µs)
+    τ = (n_d + 1/2) / f_s          (e.g. 1.5 samples at 10 kHz = 150 µs)
 
 (Franklin, Powell & Workman, *Digital Control of Dynamic Systems*, 3rd ed. 1998, §5.3.1:
 the ZOH is ``e^{−sT/2}·sinc(ωT/2)``; the sinc's gain loss, 1 − 2/π ≈ 36 % at Nyquist,
-is left out). The robust designs (:mod:`ambseal.design.recipes`) put this delay into the
-actuator path of their generalised plant (:func:`ambseal.design.plant.generalized_plant`,
-``actuator_delay``) as a Padé approximation ``e^{−sτ} ≈ N(−sτ)/N(sτ)``
-(``control.pade``), so that the continuous design already pays the phase the sampled
-loop will lose: without it the discrete σ̄(S_o) peaks of the test rig's H∞/μ designs were
-up to 49 % above the continuous ones (lightly damped rigid-body modes at 40–130 Hz,
-where 2–7° of phase move the peak a lot).
+is left out). A design puts this delay into the actuator path of its generalised plant
+as a Padé approximation ``e^{−sτ} ≈ N(−sτ)/N(sτ)`` (``control.pade``), so that the
+continuous design already pays the phase the sampled loop will lose: without it the
+discrete σ̄(S_o) peaks of H∞/μ designs with lightly damped modes at 40–130 Hz were up to
+49 % above the continuous ones (2–7° of phase move such a peak a lot;
+``benchmarks/README.md``).
 
-The continuous analyses (:func:`ambseal.analysis.judge.judge`, the closed-loop modes of
-:mod:`ambseal.analysis.campbell`, the sweeps, the choice of discretisation) close every
-loop with the same delay, up to the Nyquist frequency (:func:`loop_delay`; test rig:
-order 4, within 1.3° up to 5 kHz): the PID's continuous σ̄(S_o) peaks of the test rig then
-equal those of the exactly sampled loop to 0.1 %.
+A continuous analysis closes its loop with the same delay, up to the Nyquist frequency
+(:func:`loop_delay`; at 10 kHz with 1.5 samples: order 4, within 1.3° up to 5 kHz): a
+PID's continuous σ̄(S_o) peaks then equal those of the exactly sampled loop to 0.1 %.
 
 Order rule: the smallest Padé order (1 … :data:`MAX_ORDER`) whose phase error stays
-below :data:`PHASE_TOLERANCE_DEG` up to the top of the design band (test rig: 150 µs up
-to 2 kHz, ωτ = 1.9: order 1 errs 21.5°, order 2 1.5° → order 2; its zeros lie at
+below :data:`PHASE_TOLERANCE_DEG` up to the top of the design band (150 µs up to 2 kHz, ωτ = 1.9: order 1 errs 21.5°, order 2 1.5° → order 2; its zeros lie at
 |s| = √12/τ ≈ 3.7 kHz, above the band).
 """
 

@@ -1,9 +1,8 @@
 """μ-synthesis for mixed real/complex uncertainty by D–G–K iteration (Young 1996).
 
-Complex D–K (:func:`ambseal.robust.dk.musyn`) treats a real parameter — the seal's
-cross-coupled stiffness k of the thesis, P5 §4.1 — as if it could also be complex: its
-phase is free, which is the conservatism behind the thesis's "non-conservative controller"
-aim (Ch. 7, 7.2 item 2). D–G–K keeps the G scalings of the mixed μ upper bound
+Complex D–K (:func:`ambseal.robust.dk.musyn`) treats a real parameter — a stiffness, a
+gain known only within bounds — as if it could also be complex: its phase is free, which
+makes the design conservative. D–G–K keeps the G scalings of the mixed μ upper bound
 (Fan, Tits & Doyle 1991) in the synthesis (Young 1996, "Controller design for mixed
 uncertainties using a D-G-K iteration"; the scheme of MATLAB's ``musyn`` for ureal blocks):
 
@@ -42,8 +41,8 @@ example "Control of a Spring-Mass-Damper System Using Mixed-Mu Synthesis" states
 complex D–K ends at μ 1.082 and D–G–K, with every default, at 0.941 (SLICOT AB13MD's mixed
 bound agrees to 1e-4), below 1 as the example's mixed μ-synthesis; the worst-case gain over
 k1 ∈ [1.2, 2.8] and the delay is 0.941 against the example's 0.88 for MATLAB's controller.
-On the embedded test rig (seal k real ±100 %) two D–G–K steps lower μ from 0.919 to 0.910
-(0.920 → 0.911 after reduction) for about 6 s more CPU.
+On a 92-state problem with one real parameter (±100 %) two D–G–K steps lower μ from 0.919
+to 0.910 (0.920 → 0.911 after reduction) for about 6 s more CPU (benchmarks/README.md).
 """
 
 from __future__ import annotations

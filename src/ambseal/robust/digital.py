@@ -1,7 +1,7 @@
 """The controller that runs on the target: its discretisation chosen, not assumed.
 
-A continuous controller (``i = −K y``, m → A) becomes the digital controller of the rig's
-real-time target in three steps (Franklin, Powell & Workman, *Digital Control of Dynamic
+A continuous controller (``u = −K y``) becomes the digital controller of a real-time
+target in three steps (Franklin, Powell & Workman, *Digital Control of Dynamic
 Systems*, 3rd ed., ch. 6):
 
 1. **Fast poles removed.** Controller poles above ``FAST_FRACTION`` (one half) of the
@@ -10,17 +10,17 @@ Systems*, 3rd ed., ch. 6):
    (residualisation: the fast states held at their steady state, so the static gain is
    kept; Skogestad & Postlethwaite §11.4) in one state basis, the ordered real Schur basis
    of the slow poles. The rise of γ (H∞) or μ that this costs is reported by the
-   caller's ``rise`` (the design layer's :func:`ambseal.design.fast_poles.design_rise`);
+   caller's ``rise``;
    a fast pole that is unstable is refused. A fast pole that is
    stable and whose damped frequency |Im p|/2π lies below the same fraction of Nyquist
    aliases nothing under a hold equivalent (``z = e^{pT}`` inside the unit disc at an
    angle below π/2; a real pole, or a pair damped at ζ near 1, :func:`hold_keeps`), so
    when every fast pole does, the hold equivalents are also tried on the controller as
-   designed (candidates ``zoh+fast``, ``foh+fast``; the test rig's H∞ controller, whose
-   5.9 and 7.9 kHz poles are real, keeps them: its discrete σ̄(S_o) peaks are then those
-   of the continuous loop to 0.1–3 % instead of up to 145 %; the tracked LPV table's
-   6.3–6.6 kHz pairs, ζ ≥ 0.998, cost +7.5 % at its 190 Hz σ̄(S_o) peak when residualised,
-   −0.3 % when kept under the triangle hold).
+   designed (candidates ``zoh+fast``, ``foh+fast``; an H∞ controller with real poles at
+   5.9 and 7.9 kHz keeps them: its discrete σ̄(S_o) peaks are then those of the
+   continuous loop to 0.1–3 % instead of up to 145 %; an LPV table's 6.3–6.6 kHz pairs,
+   ζ ≥ 0.998, cost +7.5 % at its 190 Hz σ̄(S_o) peak when residualised, −0.3 % when kept
+   under the triangle hold; benchmarks/README.md).
 2. **Candidates.** Tustin, Tustin pre-warped at the frequency that matters (the
    least-damped pole of the continuous loop on the full-order plant: where the loop is
    closest to instability, the controller's phase must be right), the zero-order-hold
@@ -32,15 +32,14 @@ Systems*, 3rd ed., ch. 6):
    candidate kept is stable wherever the continuous loop is, and among those the one
    whose σ̄(S_o) peaks (log grid up to Nyquist) are closest to the continuous loop's
    (the largest relative difference over the conditions where the continuous loop is
-   stable). The continuous loop here is the one :func:`ambseal.analysis.judge.judge`
-   judges: the plant with the hold + computation delay as a Padé lag
-   (:mod:`ambseal.robust.delay`), so the choice keeps the discrete loop closest to the
+   stable). The continuous loop here is the plant with the hold + computation delay as
+   a Padé lag (:mod:`ambseal.robust.delay`), so the choice keeps the discrete loop closest to the
    continuous prediction of what runs. If none is, the controller is refused
    (:class:`~ambseal.errors.SynthesisError`) with the reason.
 
 The result, :class:`DigitalController`, holds the one discrete controller object
-(:class:`~ambseal.robust.digital_loop.DiscreteController`) that the export, the discrete
-judgement (:func:`ambseal.analysis.judge.judge`) and the virtual facility all use.
+(:class:`~ambseal.robust.digital_loop.DiscreteController`) that an export, a discrete
+judgement and a simulation of the loop as it runs can all share.
 """
 
 from __future__ import annotations
@@ -398,7 +397,7 @@ def sampled_plants(plants: Sequence[Matrices], fs: float, n_grid: int = 400, *,
     """:class:`SampledPlants` of continuous ``(A, B, C, D)`` plants at ``fs`` (Hz):
     :func:`ambseal.lti.discrete.zoh` and :func:`ambseal.lti.freqresp.freqresp_at` at
     ``jω`` and ``e^{jωT}`` on ``n_grid`` log-spaced frequencies from 1 Hz to Nyquist (the
-    sampled plant's modal form checked at rtol 1e-6, as in :mod:`ambseal.analysis.loops`);
+    sampled plant's modal form checked at rtol 1e-6);
     the continuous plants with the Padé lag of ``delay_samples`` + ½ samples
     (:func:`ambseal.robust.delay.loop_delay`)."""
 

@@ -1,8 +1,8 @@
-"""The digital closed loop shared by the virtual test facility and the output-error fit.
+"""The digital closed loop of a sampled plant and a discrete controller, as it runs.
 
-Timing (one sample of the rig's controller, period T = 1/f_s): at sample k the sensors
+Timing (one sample of the controller, period T = 1/f_s): at sample k the sensors
 give y_k; the controller computes u_k = C_c x_c,k + D_c y_k; the current reference
-i_ref,k = −u_k + e_k (e the excitation, thesis P2 Fig. 2) is held over [kT, (k+1)T)
+i_ref,k = −u_k + e_k (e an excitation added to the command) is held over [kT, (k+1)T)
 (zero-order hold, the DAC); x_c,k+1 = A_c x_c,k + B_c y_k.
 
 A plant discretised exactly with a zero-order hold then gives the closed loop

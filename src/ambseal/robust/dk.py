@@ -1,7 +1,6 @@
 """μ-synthesis by D–K iteration (complex D–K).
 
-The thesis designs its μ controllers this way (Paper 3 §3.4 "Reduce conservatism by
-D-scaling"; Paper 5 §4.3): H∞ synthesis on ``D P D⁻¹`` (K-step), then frequency-wise D scales
+The classical μ-synthesis: H∞ synthesis on ``D P D⁻¹`` (K-step), then frequency-wise D scales
 from the μ upper bound of the closed loop (D-step), fitted by stable, minimum-phase rational
 functions and absorbed into the plant. References: Balas, Doyle, Glover, Packard & Smith
 (μ-Analysis and Synthesis Toolbox, 1993); Skogestad & Postlethwaite (2005) §8.12;
@@ -224,17 +223,11 @@ def default_omega(P, n: int = 120) -> np.ndarray:
 
 
 def design_omega(f_min_hz: float, f_max_hz: float, n: int = 60) -> np.ndarray:
-    """The μ grid of the rig designs (rad/s): ``n`` points log-spaced over f_min … f_max (Hz).
-
-    Used by the μ designs of :func:`ambseal.design.recipes.design` and
-    :func:`ambseal.design.lpv_design.design_frozen` (D-step, μ peak and the order
-    reduction's check) over the rig's synthesis band
-    (:func:`ambseal.design.specs.design_spec`: the rigid-body band, the speed range and the
-    modes the actuator reaches; 1 Hz … 2 kHz on the test rig); 60 points (≈ 18 per decade
-    over 3.3 decades) resolve the D scales, which vary slowly, and keep a D–K iteration at
-    seconds. A lightly damped peak between grid
-    points is missed by the μ peak on the grid; the designs are judged afterwards on the
-    full-order plant on a dense grid (:mod:`ambseal.analysis`).
+    """A μ design grid (rad/s): ``n`` points log-spaced over f_min … f_max (Hz), the
+    synthesis band (the D-step, the μ peak and an order reduction's check); 60 points
+    (≈ 18 per decade over 3.3 decades) resolve the D scales, which vary slowly, and keep a
+    D–K iteration at seconds. A lightly damped peak between grid points is missed by the μ
+    peak on the grid: a design is to be judged afterwards on a dense grid.
 
     Raises
     ------
@@ -281,7 +274,7 @@ class MusynResult:
     alternatives : tuple of dict
         Other candidate controllers worth keeping (D–G–K: the best complex D–K controller,
         when it is not ``K``), each ``{"step", "K", "mu", "gamma"}``: an order reduction
-        may favour one of them (:func:`ambseal.design.recipes.design`).
+        may favour one of them.
     mu_grid : float
         Peak μ upper bound of ``K`` on ``omega`` alone (``mu ≥ mu_grid``).
     check_omega : ndarray
@@ -370,7 +363,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
           patience: int = 2, backoff: float = 1.01, fit_tol: float = 0.05,
           search: int | str = "auto", search_backoff: float = 1.001,
           progress: bool = False) -> MusynResult:
-    """μ-synthesis by complex D–K iteration (Balas et al. 1993; thesis Paper 3 §3.4), then a
+    """μ-synthesis by complex D–K iteration (Balas et al. 1993), then a
     direct search over the D scales.
 
     The steps, after Balas et al. (1993) and MATLAB's ``musyn`` (D-K Iteration Process,

@@ -3,8 +3,8 @@
 The generalised plant ``P`` is a :class:`control.StateSpace` whose inputs are ordered
 ``[w, u]`` (exogenous, control) and outputs ``[z, y]`` (performance, measurement); in the
 robust-control setting ``w = [w_Δ, w_perf]`` and ``z = [z_Δ, z_perf]``. The controller
-``u = K y`` closes the lower loop and the design goal is Paper 3, eq. (12) and Paper 5,
-eq. (8) of the thesis::
+``u = K y`` closes the lower loop and the design goal is (Zhou, Doyle & Glover 1996,
+ch. 14)::
 
     γ = ‖F_l(P, K)‖_∞
 
@@ -78,8 +78,9 @@ def hinfnorm(sys, rtol: float = 1e-10) -> tuple[float, float]:
 
     The L∞ norm of python-control (``control.linfnorm``: SLICOT AB13DD through slycot,
     the two-step Hamiltonian algorithm of Bruinsma & Steinbuch 1990), made an H∞ norm by
-    refusing unstable systems. Measured against a Hamiltonian bisection (closed loops of the test rig's H∞ and μ designs, 48 and 66 states, and random
-    30-state systems): the same norm to 5e-10 relative, 2.5–4× faster.
+    refusing unstable systems. Measured against a Hamiltonian bisection (closed loops of
+    48 and 66 states, and random 30-state systems): the same norm to 5e-10 relative,
+    2.5–4× faster.
 
     Parameters
     ----------
@@ -190,8 +191,8 @@ def check_plant(P, nmeas: int, ncon: int) -> None:
     if A.shape[0]:
         eigs = np.linalg.eigvals(A)
         if _pbh_fails(A, B2, True, eigs) or _pbh_fails(A, C2, False, eigs):
-            # the rank tests are not scale-invariant (the test rig's D–G–K plant: σ_min/σ_max
-            # 2.9e-10 unbalanced at its unstable AMB modes): judge on the balanced plant
+            # the rank tests are not scale-invariant (a 104-state D–G–K plant: σ_min/σ_max
+            # 2.9e-10 unbalanced at its unstable modes): judge on the balanced plant
             A, B, C, *_ = _scale(A, B, C, D, nw, nz)
             bad = _pbh_fails(A, B[:, nw:], True, eigs)
             if bad:
@@ -279,7 +280,7 @@ class HinfResult:
         Controller ``u = K y`` (inputs named after P's measurements, outputs after P's
         control inputs).
     gamma : float
-        Verified closed-loop norm ``‖F_l(P, K)‖_∞`` (thesis Paper 3 eq. 12), dimensionless.
+        Verified closed-loop norm ``‖F_l(P, K)‖_∞``, dimensionless.
     gamma_opt : float
         SB10AD's estimate of the optimal γ (may be below ``gamma`` when ``D11 ≠ 0``).
     gamma_design : float
@@ -383,7 +384,8 @@ def _scale(A, B, C, D, nw, nz):
 def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | None = None,
             max_backoff: float = 4.0, rtol: float = 1e-6,
             regularise: float | None = REGULARISE_REL) -> HinfResult:
-    """H∞ controller for a generalised plant (Paper 3 eq. 12; Paper 5 eq. 8).
+    """H∞ controller for a generalised plant (Glover & Doyle 1988; Zhou, Doyle & Glover
+    1996, ch. 14).
 
     Brackets the optimal γ between cheap bounds — Parrott's bound on the feedthrough, then
     a ladder of factors 4 to the first change of admissibility — and closes in by Brent's
@@ -671,14 +673,14 @@ class _Sb10:
         against 23 halvings of 0.1 ms on SGC97's 3 states), checked by SB10AD at the
         ladder's first γ where the margin refuses it and confirmed by SB10AD at the end, at
         the top of the tolerance band ``lo·(1 + rtol)`` if SB10AD (testing the stability of
-        its closed loop) refuses Brent's last step within rounding of the root (rig D–K
-        plant: margin −3e-11). Otherwise, where SB10AD disagrees, or on a small plant whose
+        its closed loop) refuses Brent's last step within rounding of the root (a 92-state
+        D–K plant: margin −3e-11). Otherwise, where SB10AD disagrees, or on a small plant whose
         compiled margin cannot decide at the first γ (e.g. identical channels: the Schur
         form there costs more than SB10AD's test), :meth:`_ladder_job1`.
 
         Where SB10AD admits a γ that the margin refuses (the first γ, or the search's
         lower end), the closed loop decides: SB10AD's test passes some γ just below γ_opt
-        (its Riccati solutions near singular there; the rig's D–G–K plant: 0.99957 where
+        (its Riccati solutions near singular there; a 106-state D–G–K plant: 0.99957 where
         controllers reach no norm below 1.00001), and a controller built at such a γ has a
         closed-loop norm above it. Only a controller that keeps its γ
         (:meth:`_keeps_gamma`) sends the search to :meth:`_ladder_job1`; otherwise the

@@ -1,16 +1,15 @@
 """Gridded H∞ LPV synthesis by LMIs, scheduled on one measured parameter θ.
 
-θ is whatever the plants are gridded on, in its own unit (in ambseal's rotor layers the
-spin speed Ω in rad/s, or a seal coefficient in N/m); nothing here knows which.
+θ is whatever the plants are gridded on, in its own unit (a speed in rad/s, a stiffness
+in N/m, …); nothing here knows which.
 
-Thesis P3 §4 designs an LPV controller with the LMIs of Apkarian & Adams (1998) and a
-constant Lyapunov function (stability and performance under arbitrarily fast parameter
-changes); its conclusion suggests a parameter-dependent Lyapunov function with a bound on
-|θ̇|. Both are here (Wu, Yang, Packard & Becker 1996; Apkarian & Adams 1998 §3):
+Two Lyapunov functions: a constant one (Apkarian & Adams 1998: stability and performance
+under arbitrarily fast parameter changes) and a parameter-dependent one with a bound on
+|θ̇| (Wu, Yang, Packard & Becker 1996; Apkarian & Adams 1998 §3):
 
 Generalised plant P(θ) (inputs [w, u], outputs [z, y], as :func:`ambseal.robust.hinfsyn`)
-with A(θ) varying and B, C, D constant (true for a rotor scheduled on its speed: Ω
-enters through stiffness, damping and gyroscopic terms only), D22 = 0. Find γ, R = Rᵀ (constant) and
+with A(θ) varying and B, C, D constant (true where θ enters through stiffness- and
+damping-like terms of the state equation only), D22 = 0. Find γ, R = Rᵀ (constant) and
 S(θ) = Σ_i f_i(θ) S_i (f_0 = 1; ``"constant"``: S_0 only) such that on every grid point θ_k
 and for θ̇ = ±ν (``rate_bound``)::
 
@@ -27,8 +26,8 @@ variables (Scherer, Gahinet & Chilali 1997) turns the closed-loop bounded-real i
 into an LMI in (Â, B̂, Ĉ) (D_K = 0); its minimum-norm solution at a γ slightly above the
 design γ gives B_K = N⁻¹B̂, C_K = Ĉ, A_K = N⁻¹(Â − B̂ C2 R − S B2 Ĉ − S A R). Controllers
 are reconstructed on a table ``check_density`` times denser than the design grid (5; 1 on
-a vertex grid with a constant S, where the linear interpolation meets the same γ:
-:func:`ambseal.design.lpv_design.design_lpv`), checked there (each frozen closed loop
+a vertex grid with a constant S, where the linear interpolation meets the same γ),
+checked there (each frozen closed loop
 stable, its H∞ norm reported) and interpolated linearly in between.
 
 Code: validation and orchestration here (:func:`lpvsyn`, ``_validate``, ``_check_table``);
@@ -81,7 +80,7 @@ class LpvController:
 
     ``u = K(θ) y`` in the generalised plant's convention (the lower LFT F_l(P, K),
     positive feedback); θ is whatever the plants were gridded on, in its own unit (a
-    rotor speed in rad/s, a stiffness in N/m, …).
+    speed in rad/s, a stiffness in N/m, …).
 
     Attributes
     ----------
@@ -251,7 +250,7 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
            margin: float = 1e-6, scaling: str = "auto", penalty: float = 1e-4,
            coupling_ratio: float = 1.1, centre: bool = False,
            frozen_check: bool = True) -> LpvSynResult:
-    """Gridded H∞ LPV controller (Apkarian & Adams 1998; Wu et al. 1996; thesis P3 §4).
+    """Gridded H∞ LPV controller (Apkarian & Adams 1998; Wu et al. 1996).
 
     Stages, the first two SDPs solved by CVXOPT and required to end ``optimal``:
 
@@ -264,9 +263,8 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
        stalls the interior point).
     2. ``"centre"`` (only with ``centre=True``): stage 1 with α = 1, then at
        γ_d = backoff·γ minimise tr R + mean_k tr S(θ_k) with α = ``coupling_ratio``
-       (lowered towards 1 if infeasible). Gives the least conservative γ, but on the
-       turboexpander with a dynamic W_u this second SDP ended "almost solved" with the
-       former solver, Clarabel (refused).
+       (lowered towards 1 if infeasible). Gives the least conservative γ, but with a
+       dynamic W_u this second SDP can end short of optimal (then refused).
     3. ``"reconstruct"``: the controller on the 5× denser table, in closed form
        (central solutions of the reconstruction LMIs, ``robust/_lpv_reconstruct.py``).
 
@@ -283,7 +281,7 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
         dA/dθ at the grid points (1/s per unit of θ); needed for a rate bound with a
         parameter-dependent S. Default: finite differences of the grid.
     lyapunov : {"constant", "affine", "quadratic"}
-        S(θ) = S_0 (thesis P3), S_0 + p S_1, or S_0 + p S_1 + p² S_2 with
+        S(θ) = S_0, S_0 + p S_1, or S_0 + p S_1 + p² S_2 with
         p = (θ − θ_mid)/θ_half ∈ [−1, 1]. R is always constant.
     rate_bound : float, optional
         ν ≥ |θ̇| (θ's unit per second); required for, and only allowed with, a parameter-dependent S.

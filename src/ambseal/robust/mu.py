@@ -9,8 +9,9 @@ Block structures follow MATLAB's ``mussv`` notation: a list of pairs ``(r, c)``
 Δ = blockdiag(Δ_1, …) is ``m × n`` for ``M`` of shape ``n × m``: block ``j`` reads ``c_j``
 rows of ``M`` (its outputs) and drives ``r_j`` columns (its inputs), so ``Σ c_j = n`` and
 ``Σ r_j = m``; scalar blocks count ``k`` for both. μ_Δ(M) = 1 / min{σ̄(Δ) : det(I − MΔ) = 0}.
-In the thesis (Paper 3 §3.4, Paper 5 §4.3) Δ̂ = diag(Δ, Δ_P) collects the seal uncertainty and
-the fictitious performance block; robust performance holds when sup_ω μ < 1.
+For robust performance Δ̂ = diag(Δ, Δ_P) collects the model uncertainty and the fictitious
+performance block; robust performance holds when sup_ω μ < 1 (Skogestad & Postlethwaite
+2005, §8.10).
 
 Upper bound
     The D–G bound of Fan, Tits & Doyle (1991) (Young, Newlin & Doyle 1995): μ ≤ β if there
@@ -273,10 +274,10 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
     tol : float
         Relative stopping tolerance on ``upper²`` (method-of-centres gap); the bound is a
         certificate either way, ``tol`` only sets how close it gets to the optimal D–G bound
-        (measured up to about ``tol`` relative on rig-sized grids). The bounds within
+        (measured up to about ``tol`` relative on 500-point grids of 100-state loops). The bounds within
         ``2·tol`` of the largest one — the reported peak μ — are solved again to ``tol·1e-3``,
         then any other bound that still exceeds them, until the largest is a refined one
-        (measured on the test rig's μ loop, 500 frequencies: peak within 3e-10 of a
+        (measured on a 108-state loop, 500 frequencies: peak within 3e-10 of a
         ``tol = 1e-6`` solve; refining only the largest, one at a time, had left it 2.6e-4
         above).
     max_iter : int
@@ -290,7 +291,7 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
     lower : bool
         Compute the lower bound and the worst-case Δ (default). False: ``lower`` is NaN and
         ``delta`` zero, for callers that read only the upper bound and its scalings (D–K's
-        D- and μ-steps: about 15 % of each μ evaluation on the test rig's loop); the upper
+        D- and μ-steps: about 15 % of each μ evaluation on a 108-state loop); the upper
         bound does not depend on it.
     peak_tol : float, optional
         Tolerance of the second solve of the bounds near the largest one (default

@@ -3,8 +3,8 @@
 Balanced truncation of the stable part of the controller, the unstable part (poles with
 ``Re ≥ -α``) kept exactly: SLICOT AB09MD (square-root balance & truncate, stable/unstable
 split; Varga 1991), via slycot. Reference: Zhou, Doyle & Glover (1996) ch. 7;
-Skogestad & Postlethwaite (2005) §11.4. μ and D–K controllers are of high order (thesis
-Paper 5 §4.3: orders 20 and 24); reduction should cost little in γ or μ — this module says
+Skogestad & Postlethwaite (2005) §11.4. μ and D–K controllers are of high order (the
+plant's, the weights' and the D scales' states); reduction should cost little in γ or μ — this module says
 how much.
 """
 

@@ -12,7 +12,7 @@ sample time ``dt`` mapped to the same rates by ``s = ln z / dt``, are stable whe
 
 ε the machine epsilon: every mode decays, by more than rounding can fake. The dense QR
 eigenvalues of a state matrix whose largest |λ| is ω_max move by about ε·ω_max (a balanced
-state matrix has a norm of that order); on the test rig's models and their variants the
+state matrix has a norm of that order); on the FE models and loops it was measured on the
 real parts moved by up to 100 ε·ω_max, and RTOL keeps a margin of 10 over that. A loop with
 an undamped mode (a lossless resonance that nothing damps) is therefore not stable. A
 discrete pole at ``z = 0`` (a pure delay) has ``Re(s) = −∞`` and counts as stable.

@@ -1,6 +1,6 @@
 """The closed loop of a plant and a controller, and the one loop every verdict is taken on.
 
-**Convention** (:mod:`ambseal.robust.controller`): the controller ``K`` maps the plant's
+**Convention** (:mod:`ambseal.machine.controller`): the controller ``K`` maps the plant's
 outputs ``y`` to its inputs with **negative feedback**, ``u = −K y + d``.
 
 * :func:`closed_loop` — close ``K`` around ``G`` (continuous, or discrete of one sample

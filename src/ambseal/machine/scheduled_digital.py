@@ -32,7 +32,7 @@ import numpy as np
 from ambseal.errors import SynthesisError
 from ambseal.lti.json_safe import finite_or_none_tree
 from ambseal.lti.tables import interp_table
-from ambseal.robust.controller import SPEED, ScheduledController
+from ambseal.machine.controller import SPEED, ScheduledController
 from ambseal.robust.digital import (
     DISCRETISATIONS,
     FAST_FRACTION,
@@ -94,7 +94,7 @@ class ScheduledDigital(ScheduledController):
         As :class:`~ambseal.robust.digital.DigitalController`.
     name : str
     parameter : str
-        θ: :data:`~ambseal.robust.controller.SPEED` or an LFT parameter (``"seal.k"``).
+        θ: :data:`~ambseal.machine.controller.SPEED` or an LFT parameter (``"seal.k"``).
     """
 
     grid: np.ndarray

@@ -1,0 +1,19 @@
+"""ambseal.machine: the controllers a machine runs and the loop they are judged on.
+
+Above the generic core (:mod:`ambseal.robust`, which works on any plant and returns
+controllers for the lower LFT ``F_l(P, K)``, ``u = K y``), this layer holds what a
+controller on a machine is: negative feedback ``u = −K y`` from its measurements
+``y_<channel>`` to its commands, fixed or scheduled on one named parameter θ — the rotor
+speed (:data:`SPEED`) or any other (:mod:`ambseal.machine.controller`); the one loop every
+verdict is taken on, with the target's hold and computation delay
+(:mod:`ambseal.machine.loop`); and a scheduled controller's table as it runs on the target
+(:mod:`ambseal.machine.scheduled_digital`).
+"""
+
+from ambseal.machine.controller import SPEED, ScheduledController, frozen, matrices_at
+from ambseal.machine.loop import ClosedLoop, JudgedLoop, closed_loop, judged_loop
+from ambseal.machine.scheduled_digital import ScheduledDigital, scheduled_digital
+
+__all__ = ["SPEED", "ScheduledController", "frozen", "matrices_at", "ClosedLoop",
+           "JudgedLoop", "closed_loop", "judged_loop", "ScheduledDigital",
+           "scheduled_digital"]

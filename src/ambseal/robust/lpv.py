@@ -27,8 +27,8 @@ into an LMI in (Â, B̂, Ĉ) (D_K = 0); its minimum-norm solution at a γ slight
 design γ gives B_K = N⁻¹B̂, C_K = Ĉ, A_K = N⁻¹(Â − B̂ C2 R − S B2 Ĉ − S A R). Controllers
 are reconstructed on a table ``check_density`` times denser than the design grid (5; 1 on
 a vertex grid with a constant S, where the linear interpolation meets the same γ),
-checked there (each frozen closed loop
-stable, its H∞ norm reported) and interpolated linearly in between.
+checked there (each frozen closed loop stable, its H∞ norm reported) and interpolated
+linearly in between.
 
 Code: validation and orchestration here (:func:`lpvsyn`, ``_validate``, ``_check_table``);
 scaling and the SDPs in :mod:`ambseal.robust._lpv_lmi`; the controller reconstruction in
@@ -383,7 +383,10 @@ def _against_frozen(r: LpvSynResult, data, solver_options, margin) -> LpvSynResu
     place where it is better (``frozen_check`` of :func:`lpvsyn`)."""
     plants, grid, As, dAs, B, C, D, nw, nz, nmeas, ncon = data
     A_of = interp_A(As, dAs, grid)
-    ref = frozen_reference(plants, grid, r.check_grid, A_of, B, C, D, nmeas, ncon)
+    try:
+        ref = frozen_reference(plants, grid, r.check_grid, A_of, B, C, D, nmeas, ncon)
+    except SynthesisError:  # no grid point has an H∞ controller: nothing to compare with
+        return r
     r = replace(r, frozen_best_gamma=ref.gamma, frozen_best_theta=ref.theta)
     if not ref.gamma < float(np.max(r.check_gamma)) * (1.0 - FROZEN_RTOL):
         return r

@@ -38,8 +38,8 @@ from ambseal.robust.digital import (
     FAST_FRACTION,
     HOLDS,
     KEPT,
-    _chosen_error,
     check_rate,
+    chosen_error,
     choose_method,
     discretize_as,
     hold_keeps,
@@ -170,7 +170,7 @@ class ScheduledDigital(ScheduledController):
                 "fast_fraction_of_nyquist": FAST_FRACTION,
                 "removed_poles_hz": [float(f) for f in self.removed_poles_hz],
                 "order": int(self.discrete[0].shape[1]),
-                "peak_difference": peak_difference(_chosen_error(self), self.method,
+                "peak_difference": peak_difference(chosen_error(self), self.method,
                                                    self.removed_poles_hz),
                 "candidates": [dict(c) for c in self.candidates]})
 

@@ -63,10 +63,11 @@ from ambseal.robust.delay import check_timing, loop_delay
 from ambseal.robust.digital_loop import DiscreteController
 from ambseal.robust.stability import is_stable
 
-__all__ = ["FAST_FRACTION", "DISCRETISATIONS", "PEAK_TOLERANCE", "peak_difference",
-           "DigitalController", "split_fast", "residualize", "hold_keeps", "HOLDS", "KEPT",
-           "discretize_as", "with_delay", "digital_controller", "check_rate",
-           "choose_method", "prewarp_frequency_hz", "SampledPlants", "sampled_plants"]
+__all__ = ["FAST_FRACTION", "DISCRETISATIONS", "PEAK_TOLERANCE", "chosen_error",
+           "peak_difference", "DigitalController", "split_fast", "residualize",
+           "hold_keeps", "HOLDS", "KEPT", "discretize_as", "with_delay",
+           "digital_controller", "check_rate", "choose_method", "prewarp_frequency_hz",
+           "SampledPlants", "sampled_plants"]
 
 #: Controller poles above this fraction of the Nyquist frequency are removed before
 #: discretisation (at half of Nyquist a Tustin pole is warped by 27 % in frequency and a
@@ -166,13 +167,25 @@ class DigitalController:
                 "removed_poles_hz": [float(f) for f in self.removed_poles_hz],
                 "order": int(self.discrete.A.shape[0]),
                 "reduction": self.reduction,
-                "peak_difference": peak_difference(_chosen_error(self), self.method,
+                "peak_difference": peak_difference(chosen_error(self), self.method,
                                                    self.removed_poles_hz),
                 "candidates": [dict(c) for c in self.candidates]})
 
 
-def _chosen_error(dc) -> float | None:
-    """The chosen candidate's largest relative σ̄(S_o) peak difference (choice grid)."""
+def chosen_error(dc) -> float | None:
+    """The chosen candidate's largest relative σ̄(S_o) peak difference on the choice grid.
+
+    Parameters
+    ----------
+    dc : DigitalController or a scheduled controller's digital table
+        Anything with ``choice`` (or ``method``) and the ``candidates`` of
+        :func:`choose_method`.
+
+    Returns
+    -------
+    float or None
+        ``sensitivity_peak_error`` of the chosen candidate; None if it has none.
+    """
     name = getattr(dc, "choice", "") or dc.method
     c = next((c for c in dc.candidates if c["method"] == name), None)
     return None if c is None else c.get("sensitivity_peak_error")

@@ -226,9 +226,9 @@ def test_amb_rotor_open_loop_unstable_poles_equal_ross():
 
 def test_import_ross_cli_round_trip_and_bad_files(tmp_path, capsys):
     """``ambseal import-ross`` on ROSS's own saved file writes a rig that loads back to the
-    same modes as :func:`from_ross`; a shaft element under torque (unsupported), a shaft
-    element without its material and a file that is no ROSS rotor each give one line on
-    stderr, naming the user's file first (not the embedded rig's), and exit status 2."""
+    same modes as :func:`from_ross`; a tapered shaft element (unsupported), a shaft element
+    without its material and a file that is no ROSS rotor each give one line on stderr,
+    naming the user's file first (not the embedded rig's), and exit status 2."""
     from ambseal.cli import main
     from ambseal.config import load_rig
 
@@ -245,15 +245,15 @@ def test_import_ross_cli_round_trip_and_bad_files(tmp_path, capsys):
 
     ex = rs.rotor_example()
     e0 = ex.shaft_elements[0]
-    torqued = [rs.ShaftElement(L=e0.L, idl=0.0, odl=0.05, material=e0.material,
-                               torque=100.0)] + ex.shaft_elements[1:]
-    rs.Rotor(torqued, ex.disk_elements, ex.bearing_elements).save(tmp_path / "torque.toml")
+    tapered = [rs.ShaftElement(L=e0.L, idl=0.0, odl=0.05, idr=0.0, odr=0.04,
+                               material=e0.material)] + ex.shaft_elements[1:]
+    rs.Rotor(tapered, ex.disk_elements, ex.bearing_elements).save(tmp_path / "tapered.toml")
     lines = src.read_text().splitlines()  # drop the first shaft element's material table
     i = next(k for k, ln in enumerate(lines) if ln.endswith('Element 0".material]'))
     j = next(k for k in range(i + 1, len(lines)) if lines[k].startswith("["))
     (tmp_path / "nomat.toml").write_text("\n".join(lines[:i] + lines[j:]))
     (tmp_path / "junk.json").write_text('{"parameters": 1}')
-    for name, key in (("torque.toml", "torque"), ("nomat.toml", "material"),
+    for name, key in (("tapered.toml", "tapered"), ("nomat.toml", "material"),
                       ("junk.json", "not a ROSS rotor")):
         assert main(["import-ross", str(tmp_path / name), "--out", str(out)]) == 2
         err = capsys.readouterr().err
@@ -437,42 +437,3 @@ def test_axial_force_geometric_stiffness_equals_ross(force):
         rig, None, speed_hz=0.0, max_hz=500.0).poles)
     unloaded = f0(from_ross(ex).rig)
     assert (f0(imp.rig) > unloaded) == (force > 0)
-
-
-def _tapered_rotor(split: int):
-    """:func:`_bearing_rotor` with its end elements tapered (outer diameter to 60 % over
-    the element), each of ROSS's tapered elements split in ``split`` tapered ones."""
-    ex = rs.rotor_example()
-    els = []
-    for i, e in enumerate(ex.shaft_elements):
-        odl, odr = {0: (e.odl, 0.6 * e.odl), 5: (0.6 * e.odl, e.odl)}.get(i, (e.odl, e.odl))
-        for k in range(split):
-            a, c = k / split, (k + 1) / split
-            els.append(rs.ShaftElement(L=e.L / split, idl=0.0, idr=0.0,
-                                       odl=odl + a * (odr - odl), odr=odl + c * (odr - odl),
-                                       material=e.material))
-    disks = [rs.DiskElement(n=d.n * split, m=d.m, Id=d.Id, Ip=d.Ip) for d in ex.disk_elements]
-    bearings = [rs.BearingElement(n * split, kxx=1e6, kyy=0.8e6, cxx=150.0, cyy=90.0,
-                                  tag=f"B{n}") for n in (0, 6)]
-    return rs.Rotor(els, disks, bearings)
-
-
-def test_a_tapered_element_is_imported_as_uniform_sections(monkeypatch):
-    """ROSS's tapered elements (outer diameter to 60 % over an element) are imported as
-    ``TAPER_SECTIONS`` uniform sections with the diameters at their middles. Reference:
-    ROSS's own model of the cone meshed 16 times finer (its single tapered element is
-    itself 2.5 % off that on this taper). The stepped sections converge to it as 1/m²
-    (8 → 16 sections: the error at least halves) and 8, the default, are within 0.5 % on
-    every lateral mode up to 500 Hz (benchmarks/README.md)."""
-    import ambseal.io.ross as ross_io
-
-    ref = _ross_eigenvalues(_tapered_rotor(16), 0.0)
-    errors = {}
-    for m in (8, 16):
-        monkeypatch.setattr(ross_io, "TAPER_SECTIONS", m)
-        rig = from_ross(_tapered_rotor(1)).rig
-        assert len(rig.shaft) == 4 + 2 * m
-        poles = closed_loop_modes(rig, None, speed_hz=0.0, max_hz=500.0).poles
-        errors[m] = max(np.min(np.abs(ref - lam)) / abs(lam) for lam in poles)
-    assert errors[16] < errors[8] / 2
-    assert errors[8] < 5e-3

@@ -14,9 +14,8 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
   ambseal's ``beam = "timoshenko"``; without shear effects, ``"euler-bernoulli"``;
   ``rotary_inertia`` and ``gyroscopic`` off → ``[rotor] rotary_inertia`` and
   ``gyroscopic = false`` (one setting for all shaft elements); ``axial_force`` → the
-  section's ``axial_force`` (its geometric stiffness). A tapered element → ``TAPER_SECTIONS``
-  uniform sections with the diameters at their middles. Torque and Hutchinson's shear
-  coefficient have no equivalent: an error. ROSS's Rayleigh damping of
+  section's ``axial_force`` (its geometric stiffness). Tapered elements, torque, and
+  Hutchinson's shear coefficient have no equivalent: an error. ROSS's Rayleigh damping of
   shaft elements (``alpha``, ``beta``) has none either: reported, left out.
 * ``DiskElement`` → ``[[disk]]`` (m, Ip, Id); a ``PointMass`` on a shaft node → a disk
   without inertia.
@@ -143,18 +142,10 @@ def _materials(shafts, where: str) -> tuple[dict, list[str]]:
     return table, keys
 
 
-#: Uniform sections a tapered ROSS element becomes, each with the diameters at its middle
-#: (the taper's steps shrink as 1/TAPER_SECTIONS²; the error against ROSS's own tapered
-#: element is measured in tests/io/test_io_ross.py and benchmarks/README.md).
-TAPER_SECTIONS = 8
-
-
-def _tapered(el) -> bool:
-    return not (math.isclose(el.idl, el.idr) and math.isclose(el.odl, el.odr))
-
-
 def _check_element(el, where: str) -> None:
     tag = f"shaft element {el.n} ({el.tag})"
+    if not (math.isclose(el.idl, el.idr) and math.isclose(el.odl, el.odr)):
+        raise _bad(where, f"{tag}: tapered element (idl/idr, odl/odr differ) is not supported")
     if el.shear_effects and el.shear_method_calc != "cowper":
         raise _bad(where, f"{tag}: shear_method_calc {el.shear_method_calc!r} is not "
                           "supported (expected 'cowper')")
@@ -203,18 +194,7 @@ def _shaft(rotor, where: str) -> tuple[list[dict], dict, str, list[str]]:
         if getattr(group[0], "axial_force", 0):
             section["axial_force"] = float(group[0].axial_force)
         if len(tubes) > 1:
-            if any(_tapered(e) for e in group):
-                raise _bad(where, f"shaft elements on node pair {n}: a tapered layered "
-                                  "element has no ambseal equivalent")
             section["layers"] = tubes[1:]
-        if _tapered(group[0]):  # a stepped approximation of the cone (TAPER_SECTIONS)
-            e, m = group[0], TAPER_SECTIONS
-            for k in range(m):
-                t = (k + 0.5) / m
-                out.append({**section, "length": float(e.L) / m,
-                            "outer_diameter": float(e.odl + t * (e.odr - e.odl)),
-                            "inner_diameter": float(e.idl + t * (e.idr - e.idl))})
-            continue
         out.append(section)
     damped: dict[tuple[float, float], list] = {}
     for el in shafts:
@@ -369,8 +349,7 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
             raise _bad(where, f"unsupported element {kind} ({getattr(el, 'tag', '')}) with "
                               "no ambseal equivalent")
     shaft, mats, beam, unmapped = _shaft(rotor, where)
-    lengths = {int(e.n): float(e.L) for e in rotor.shaft_elements}  # ROSS's nodes
-    nodes = np.concatenate([[0.0], np.cumsum([lengths[n] for n in sorted(lengths)])])
+    nodes = np.concatenate([[0.0], np.cumsum([s["length"] for s in shaft])])
     flags = {f: bool(getattr(rotor.shaft_elements[0], f))
              for f in ("rotary_inertia", "gyroscopic")}
     rig: dict = {"rotor": {"beam": beam, **{f: v for f, v in flags.items() if not v},

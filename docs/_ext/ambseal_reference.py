@@ -56,9 +56,6 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "ShaftSection.outer_diameter": ("m", "outer diameter"),
     "ShaftSection.inner_diameter": ("m", "bore (0: solid); less than outer_diameter"),
     "ShaftSection.material": ("", "a NAME of ``[materials.NAME]``"),
-    "ShaftSection.axial_force": ("N", "axial force in the section, tension positive "
-                                      "(compression negative): its geometric stiffness on "
-                                      "the section's own tube"),
     "ShaftSection.elements": ("", "beam elements in the section (at most 400 in the whole "
                                   "shaft)"),
     "ShaftSection.layers": ("", "concentric tubes on the section's nodes, in parallel with "

@@ -19,8 +19,7 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     ``length``, ``outer_diameter``, ``inner_diameter`` (default 0) in m, ``material`` (a
     NAME of ``[materials]``), ``elements`` (beam elements in the section, default 1),
     ``layers`` (optional concentric tubes ``{ outer_diameter, inner_diameter, material }``
-    on the same nodes, each a beam of its own whose matrices add to the section's),
-    ``axial_force`` (N, tension positive, default 0: its geometric stiffness).
+    on the same nodes, each a beam of its own whose matrices add to the section's).
 ``[[disk]]``
     ``position`` (m), ``mass`` (kg), ``Ip``, ``Id`` (kg·m²), ``name`` (optional).
 ``[[amb]]``
@@ -198,7 +197,6 @@ class ShaftSection(_Strict):
     material: str
     elements: int = Field(default=1, ge=1, le=MAX_ELEMENTS)
     layers: list[ShaftLayer] = Field(default=[], max_length=MAX_LAYERS)
-    axial_force: float = Field(default=0.0, ge=-1e9, le=1e9)
 
     @model_validator(mode="after")
     def _bore(self) -> "ShaftSection":

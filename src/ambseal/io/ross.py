@@ -13,10 +13,9 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
   parameter, as ROSS has them. ROSS's Timoshenko element with Cowper's shear coefficient is
   ambseal's ``beam = "timoshenko"``; without shear effects, ``"euler-bernoulli"``;
   ``rotary_inertia`` and ``gyroscopic`` off → ``[rotor] rotary_inertia`` and
-  ``gyroscopic = false`` (one setting for all shaft elements); ``axial_force`` → the
-  section's ``axial_force`` (its geometric stiffness). Tapered elements, torque, and
-  Hutchinson's shear coefficient have no equivalent: an error. ROSS's Rayleigh damping of
-  shaft elements (``alpha``, ``beta``) has none either: reported, left out.
+  ``gyroscopic = false`` (one setting for all shaft elements). Tapered elements, axial
+  force or torque, and Hutchinson's shear coefficient have no equivalent: an error. ROSS's Rayleigh damping of shaft elements (``alpha``, ``beta``) has none either:
+  reported, left out.
 * ``DiskElement`` → ``[[disk]]`` (m, Ip, Id); a ``PointMass`` on a shaft node → a disk
   without inertia.
 * ``BearingElement`` and its kinds (``SealElement``, fluid-film, ball, ...): coefficients of
@@ -149,8 +148,8 @@ def _check_element(el, where: str) -> None:
     if el.shear_effects and el.shear_method_calc != "cowper":
         raise _bad(where, f"{tag}: shear_method_calc {el.shear_method_calc!r} is not "
                           "supported (expected 'cowper')")
-    if getattr(el, "torque", 0):
-        raise _bad(where, f"{tag}: torque (its geometric stiffness) has no ambseal "
+    if getattr(el, "axial_force", 0) or getattr(el, "torque", 0):
+        raise _bad(where, f"{tag}: axial_force / torque (their stiffening) have no ambseal "
                           "equivalent")
 
 
@@ -185,14 +184,7 @@ def _shaft(rotor, where: str) -> tuple[list[dict], dict, str, list[str]]:
                               "(layered elements share their nodes)")
         tubes = [{"outer_diameter": float(e.odl), "inner_diameter": float(e.idl),
                   "material": key_of[id(e)]} for e in group]
-        if any(getattr(e, "axial_force", 0) for e in group[1:]):
-            raise _bad(where, f"shaft elements on node pair {n}: an axial force on a "
-                              "layered element other than the innermost has no ambseal "
-                              "equivalent ([[shaft]] axial_force acts on the section's "
-                              "own tube)")
         section = {"length": float(group[0].L), **tubes[0], "elements": 1}
-        if getattr(group[0], "axial_force", 0):
-            section["axial_force"] = float(group[0].axial_force)
         if len(tubes) > 1:
             section["layers"] = tubes[1:]
         out.append(section)

@@ -80,9 +80,6 @@ class BeamElement:
     gyroscopic : bool
         The sections' gyroscopic moments (Eq. 5.64), or none (a shaft whose polar inertia
         is left to its disks, as ROSS's ``gyroscopic=False``).
-    axial_force : float
-        Axial force P in the element (N, tension positive): its geometric stiffness, the
-        consistent Timoshenko form (:meth:`K`).
     """
 
     length: float
@@ -94,7 +91,6 @@ class BeamElement:
     timoshenko: bool = True
     rotary_inertia: bool = True
     gyroscopic: bool = True
-    axial_force: float = 0.0
 
     @property
     def area(self) -> float:
@@ -160,8 +156,7 @@ class BeamElement:
         return _to_nodes(mt + mr)
 
     def K(self) -> np.ndarray:
-        """Stiffness matrix (8, 8) in N/m, N, N·m (Friswell Eq. 5.61), with the geometric
-        stiffness of ``axial_force``."""
+        """Stiffness matrix (8, 8) in N/m, N, N·m (Friswell Eq. 5.61)."""
         L, p = self.length, self.phi
         k = np.array(
             [
@@ -171,20 +166,6 @@ class BeamElement:
                 [6 * L, (2 - p) * L**2, -6 * L, (4 + p) * L**2],
             ]
         ) * (self.E * self.inertia / (L**3 * (1 + p)))
-        if self.axial_force:
-            # the geometric stiffness of an axial force P with the Timoshenko element's
-            # shape functions: P/(30 L (1 + Φ)²) [[a, 3L, −a, 3L], [3L, b L², −3L, −c L²], …]
-            # with a = 36 + 60Φ + 30Φ², b = 4 + 5Φ + 5Φ²/2, c = 1 + 5Φ + 5Φ²/2 (Φ = 0:
-            # Przemieniecki's P/(30 L)[[36, 3L, ...]]; as ROSS's ShaftElement has it)
-            a, b, c = 36 + 60 * p + 30 * p**2, 4 + 5 * p + 2.5 * p**2, 1 + 5 * p + 2.5 * p**2
-            k = k + np.array(
-                [
-                    [a, 3 * L, -a, 3 * L],
-                    [3 * L, b * L**2, -3 * L, -c * L**2],
-                    [-a, -3 * L, a, -3 * L],
-                    [3 * L, -c * L**2, -3 * L, b * L**2],
-                ]
-            ) * (self.axial_force / (30 * L * (1 + p) ** 2))
         return _to_nodes(k)
 
     def G(self) -> np.ndarray:

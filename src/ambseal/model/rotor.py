@@ -119,8 +119,6 @@ def build_mesh(cfg: RigConfig, extra_positions: tuple[float, ...] = ()) -> Mesh:
                     timoshenko=beam_tim,
                     rotary_inertia=cfg.rotor.rotary_inertia,
                     gyroscopic=cfg.rotor.gyroscopic,
-                    # the section's axial force acts on its own tube (a layer carries none)
-                    axial_force=sec.axial_force if t is sec else 0.0,
                 )
                 for t in (sec, *sec.layers)
             )

@@ -35,13 +35,8 @@ from pydantic import BaseModel
 #: the key reference; :func:`missing_key_docs` checks it against the models.
 KEY_DOCS: dict[str, tuple[str, str]] = {
     # [rotor]
-    "Rotor.beam": ("", "beam theory of the shaft elements: Timoshenko (shear deformation) "
-                       "or Euler–Bernoulli (none); their rotary inertia is rotary_inertia"),
-    "Rotor.rotary_inertia": ("", "the shaft elements' diametral rotary inertia in the mass "
-                                 "matrix (false: translational inertia only, as ROSS's "
-                                 "rotary_inertia=False); the disks keep theirs"),
-    "Rotor.gyroscopic": ("", "the shaft elements' gyroscopic moments (false: none, as ROSS's "
-                             "gyroscopic=False); the disks keep theirs"),
+    "Rotor.beam": ("", "beam theory of the shaft elements (Timoshenko: shear and rotary "
+                       "inertia; Euler–Bernoulli: neither)"),
     "Rotor.name": ("", "the machine's name, in every output and the report header"),
     "Rotor.modal_damping": ("", "damping ratio ζ given to every free–free bending mode of "
                                 "shaft and disks (structural damping)"),

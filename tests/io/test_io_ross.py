@@ -393,26 +393,3 @@ def test_a_coaxial_rotor_is_refused_with_what_is_not_supported(tmp_path, capsys)
     assert err.count("\n") == 1 and "Traceback" not in err
     assert "2 shafts" in err and "0–10 and 11–17" in err and "not supported" in err
     assert not (tmp_path / "rig.toml").exists()
-
-
-@pytest.mark.parametrize("flags", [{"rotary_inertia": False},
-                                   {"gyroscopic": False},
-                                   {"rotary_inertia": False, "gyroscopic": False,
-                                    "shear_effects": False}],
-                         ids=["no-rotary-inertia", "no-gyroscopic", "euler-bernoulli-bare"])
-def test_shaft_elements_without_rotary_inertia_or_gyroscopics_equal_ross(flags):
-    """ROSS's shaft elements with ``rotary_inertia`` or ``gyroscopic`` off (as in ROSS's
-    ``rotor_example_6dof``, whose elements have no rotary inertia), on the plain-bearing
-    rotor of :func:`_bearing_rotor`: the import sets ``[rotor] rotary_inertia`` /
-    ``gyroscopic = false`` and every lateral mode up to 500 Hz equals one of ROSS's
-    eigenvalues to 1e-6, at standstill and at 4000 rpm (where the gyroscopics split the
-    whirl modes)."""
-    ex = _bearing_rotor()
-    shaft = [rs.ShaftElement(L=e.L, idl=e.idl, odl=e.odl, material=e.material,
-                             **{"shear_effects": True, **flags}) for e in ex.shaft_elements]
-    rotor = rs.Rotor(shaft, ex.disk_elements, ex.bearing_elements)
-    imp = from_ross(rotor)
-    for f in ("rotary_inertia", "gyroscopic"):
-        assert getattr(imp.rig.rotor, f) is flags.get(f, True)
-    for rpm in (0.0, 4000.0):
-        _assert_modes_equal_ross(imp.rig, rotor, rpm * np.pi / 30, 500.0, 12)

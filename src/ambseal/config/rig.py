@@ -10,8 +10,7 @@ beyond any machine (:mod:`ambseal.config._checks`), so a typo is refused naming 
 Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
 
 ``[rotor]``
-    ``beam`` = ``"timoshenko"`` (default) or ``"euler-bernoulli"``; ``rotary_inertia`` and
-    ``gyroscopic`` of the shaft elements (default true); ``name`` (optional);
+    ``beam`` = ``"timoshenko"`` (default) or ``"euler-bernoulli"``; ``name`` (optional);
     ``modal_damping`` (ζ of every free–free bending mode of shaft and disks, default 0).
 ``[materials.NAME]``
     ``E`` (Pa), ``rho`` (kg/m³) and either ``G`` (Pa) or ``nu`` (-).
@@ -168,8 +167,6 @@ class Material(_Strict):
 
 class Rotor(_Strict):
     beam: Literal["timoshenko", "euler-bernoulli"] = "timoshenko"
-    rotary_inertia: bool = True
-    gyroscopic: bool = True
     name: Label = "rotor"
     modal_damping: float = Field(default=0.0, ge=0, lt=1)
 

@@ -11,10 +11,10 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
   hubs around it, which ROSS assembles by adding their matrices) → the innermost tube is the
   section, the others its ``layers``, each a beam with its own material and shear
   parameter, as ROSS has them. ROSS's Timoshenko element with Cowper's shear coefficient is
-  ambseal's ``beam = "timoshenko"``; without shear effects, ``"euler-bernoulli"``;
-  ``rotary_inertia`` and ``gyroscopic`` off → ``[rotor] rotary_inertia`` and
-  ``gyroscopic = false`` (one setting for all shaft elements). Tapered elements, axial
-  force or torque, and Hutchinson's shear coefficient have no equivalent: an error. ROSS's Rayleigh damping of shaft elements (``alpha``, ``beta``) has none either:
+  ambseal's ``beam = "timoshenko"``; without shear effects, ``"euler-bernoulli"`` (with
+  rotary inertia). Tapered elements, axial force or torque, elements without rotary
+  inertia or gyroscopic terms, and Hutchinson's shear coefficient have no equivalent: an
+  error. ROSS's Rayleigh damping of shaft elements (``alpha``, ``beta``) has none either:
   reported, left out.
 * ``DiskElement`` → ``[[disk]]`` (m, Ip, Id); a ``PointMass`` on a shaft node → a disk
   without inertia.
@@ -145,6 +145,9 @@ def _check_element(el, where: str) -> None:
     tag = f"shaft element {el.n} ({el.tag})"
     if not (math.isclose(el.idl, el.idr) and math.isclose(el.odl, el.odr)):
         raise _bad(where, f"{tag}: tapered element (idl/idr, odl/odr differ) is not supported")
+    if not (el.rotary_inertia and el.gyroscopic):
+        raise _bad(where, f"{tag}: elements without rotary inertia or gyroscopic terms are "
+                          "not supported")
     if el.shear_effects and el.shear_method_calc != "cowper":
         raise _bad(where, f"{tag}: shear_method_calc {el.shear_method_calc!r} is not "
                           "supported (expected 'cowper')")
@@ -171,10 +174,6 @@ def _shaft(rotor, where: str) -> tuple[list[dict], dict, str, list[str]]:
     if len(shear) > 1:
         raise _bad(where, "shaft elements mix shear_effects True and False (one beam type "
                           "per rig)")
-    for flag in ("rotary_inertia", "gyroscopic"):
-        if len({bool(getattr(el, flag)) for el in shafts}) > 1:
-            raise _bad(where, f"shaft elements mix {flag} True and False (one setting per "
-                              f"rig: [rotor] {flag})")
     out = []
     for n in sorted(pairs):
         group = pairs[n]
@@ -342,10 +341,8 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
                               "no ambseal equivalent")
     shaft, mats, beam, unmapped = _shaft(rotor, where)
     nodes = np.concatenate([[0.0], np.cumsum([s["length"] for s in shaft])])
-    flags = {f: bool(getattr(rotor.shaft_elements[0], f))
-             for f in ("rotary_inertia", "gyroscopic")}
-    rig: dict = {"rotor": {"beam": beam, **{f: v for f, v in flags.items() if not v},
-                           "name": name or str(getattr(rotor, "tag", None) or "ROSS rotor")},
+    rig: dict = {"rotor": {"beam": beam, "name": name or str(getattr(rotor, "tag", None)
+                                                            or "ROSS rotor")},
                  "materials": mats, "shaft": shaft, "disk": [], "amb": [], "seal": [],
                  "spring": []}
     for d in rotor.disk_elements:

@@ -72,14 +72,8 @@ class BeamElement:
     E, shear_modulus, rho : float
         Young's modulus (Pa), shear modulus (Pa), density (kg/m³).
     timoshenko : bool
-        Shear deformation on (Timoshenko, Φ > 0) or off (Euler–Bernoulli, Φ = 0).
-    rotary_inertia : bool
-        The sections' diametral rotary inertia in the mass matrix (Friswell et al. 2010,
-        Eq. 5.63), or only their translational inertia (Rayleigh's correction left out, as
-        ROSS's ``rotary_inertia=False``).
-    gyroscopic : bool
-        The sections' gyroscopic moments (Eq. 5.64), or none (a shaft whose polar inertia
-        is left to its disks, as ROSS's ``gyroscopic=False``).
+        Shear deformation on (Timoshenko, Φ > 0) or off (Euler–Bernoulli with rotary
+        inertia, Φ = 0).
     """
 
     length: float
@@ -89,8 +83,6 @@ class BeamElement:
     shear_modulus: float
     rho: float
     timoshenko: bool = True
-    rotary_inertia: bool = True
-    gyroscopic: bool = True
 
     @property
     def area(self) -> float:
@@ -133,8 +125,7 @@ class BeamElement:
         ) / (L * (1 + p) ** 2)
 
     def M(self) -> np.ndarray:
-        """Mass matrix (8, 8) in kg, kg·m, kg·m²: translational plus rotary inertia (the
-        latter only with ``rotary_inertia``)."""
+        """Mass matrix (8, 8) in kg, kg·m, kg·m²: translational plus rotary inertia."""
         L, p = self.length, self.phi
         m1 = 13 / 35 + 7 * p / 10 + p**2 / 3
         m2 = 11 / 210 + 11 * p / 120 + p**2 / 24
@@ -150,8 +141,6 @@ class BeamElement:
                 [-m4 * L, -m6 * L**2, -m2 * L, m5 * L**2],
             ]
         ) * (self.rho * self.area * L / (1 + p) ** 2)
-        if not self.rotary_inertia:
-            return _to_nodes(mt)
         mr = self._rotary_plane() * (self.rho * self.inertia)
         return _to_nodes(mt + mr)
 
@@ -169,17 +158,14 @@ class BeamElement:
         return _to_nodes(k)
 
     def G(self) -> np.ndarray:
-        """Gyroscopic matrix (8, 8), skew-symmetric, per unit spin speed (kg·m², ...); zero
-        without ``gyroscopic``.
+        """Gyroscopic matrix (8, 8), skew-symmetric, per unit spin speed (kg·m², ...).
 
         The polar inertia per length is 2ρI, so in plane coordinates G = [[0, 2M_R],
         [−2M_R, 0]] with M_R the rotary-inertia matrix (Friswell Eq. 5.64); the sign follows
         from H = I_p Ω (β, −α, 1) for a spinning section: I_d α̈ + I_p Ω β̇ = M_x.
         """
-        g = np.zeros((8, 8))
-        if not self.gyroscopic:
-            return g
         mr = self._rotary_plane() * (2 * self.rho * self.inertia)
+        g = np.zeros((8, 8))
         g[:4, 4:] = mr
         g[4:, :4] = -mr
         return _to_nodes(g, coupled=True)

@@ -117,8 +117,6 @@ def build_mesh(cfg: RigConfig, extra_positions: tuple[float, ...] = ()) -> Mesh:
                     shear_modulus=cfg.materials[t.material].shear_modulus,
                     rho=cfg.materials[t.material].rho,
                     timoshenko=beam_tim,
-                    rotary_inertia=cfg.rotor.rotary_inertia,
-                    gyroscopic=cfg.rotor.gyroscopic,
                 )
                 for t in (sec, *sec.layers)
             )

@@ -366,30 +366,3 @@ def test_fine_mesh_modes_equal_ross_on_the_same_mesh(tmp_path, capsys):
         near = ref[np.abs(ref[None, :] - lam[:, None]).argmin(axis=1)]
         err = np.abs(lam - near) / np.abs(near)
         assert np.all(err <= 1e-6), (rpm, err)
-
-
-def test_a_coaxial_rotor_is_refused_with_what_is_not_supported(tmp_path, capsys):
-    """ROSS's own coaxial rotor (``ross/tests/test_rotor_assembly.py``, fixture
-    ``coaxrotor``: a 10-element shaft and a 6-element hollow shaft around it, linked by a
-    bearing), saved by ROSS — whose loader cannot read it back — ends with one line saying
-    that several shafts are not supported, where their nodes are, and exit status 2."""
-    from ambseal.cli import main
-    from ross.materials import steel
-
-    inner = [rs.ShaftElement(0.25, 0.0, 0.05, material=steel) for _ in range(10)]
-    outer = [rs.ShaftElement(0.25, 0.25, 0.30, material=steel) for _ in range(6)]
-    disks = [rs.DiskElement.from_geometry(n=n, material=steel, width=0.07, i_d=i, o_d=o)
-             for n, i, o in ((1, 0.05, 0.28), (9, 0.05, 0.28), (13, 0.2, 0.48),
-                             (15, 0.2, 0.48))]
-    bearings = [rs.BearingElement(n, kxx=1e6, kyy=1e6, cxx=0) for n in (0, 10, 11)]
-    bearings.append(rs.BearingElement(8, n_link=17, kxx=1e6, kyy=1e6, cxx=0))
-    with warnings.catch_warnings(), _stdout_to_stderr():
-        warnings.simplefilter("ignore")
-        rs.CoAxialRotor([inner, outer], disks, bearings).save(tmp_path / "coax.toml")
-    capsys.readouterr()
-    assert main(["import-ross", str(tmp_path / "coax.toml"),
-                 "--out", str(tmp_path / "rig.toml")]) == 2
-    err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "Traceback" not in err
-    assert "2 shafts" in err and "0–10 and 11–17" in err and "not supported" in err
-    assert not (tmp_path / "rig.toml").exists()

@@ -552,27 +552,7 @@ def _check_file(path: Path, ross=None) -> dict:
         if kind == "ShaftElement" and not isinstance(val.get("material"), dict):
             raise ConfigError(f"{path}: {key}: missing material (expected a table "
                               f"[\"{key}\".material] with rho, E, G_s)")
-    _one_shaft(path, data)
     return data
-
-
-def _one_shaft(path: Path, data: dict) -> None:
-    """Refuse a file of several shafts (ROSS's ``CoAxialRotor``, saved as a plain rotor
-    whose loader then fails): its shaft elements' nodes form more than one chain."""
-    ns = sorted({int(v["n"]) for k, v in data.items() if k.startswith("ShaftElement_")
-                 and isinstance(v, dict) and isinstance(v.get("n"), (int, float))})
-    chains, start = [], ns[0] if ns else None
-    for a, b in zip(ns, ns[1:]):
-        if b != a + 1:
-            chains.append((start, a + 1))
-            start = b
-    if ns:
-        chains.append((start, ns[-1] + 1))
-    if len(chains) > 1:
-        spans = " and ".join(f"{a}–{b}" for a, b in chains)
-        raise ConfigError(f"{path}: {len(chains)} shafts (shaft elements on nodes {spans}: "
-                          "a coaxial rotor); ambseal models one shaft, so rotors of several "
-                          "shafts linked by bearings are not supported")
 
 
 def _child() -> None:

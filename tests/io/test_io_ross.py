@@ -366,3 +366,39 @@ def test_fine_mesh_modes_equal_ross_on_the_same_mesh(tmp_path, capsys):
         near = ref[np.abs(ref[None, :] - lam[:, None]).argmin(axis=1)]
         err = np.abs(lam - near) / np.abs(near)
         assert np.all(err <= 1e-6), (rpm, err)
+
+
+def _coaxial_rotor():
+    """ROSS's co-axial rotor as ROSS's tests build it (``test_rotor_assembly.coaxrotor``):
+    two shafts, four disks, three bearings to ground and one linking the shafts."""
+    steel = rs.materials.steel
+    inner = [rs.ShaftElement(0.25, 0.0, 0.05, material=steel) for _ in range(10)]
+    outer = [rs.ShaftElement(0.25, 0.25, 0.30, material=steel) for _ in range(6)]
+    disks = [rs.DiskElement.from_geometry(n=n, material=steel, width=0.07, i_d=i, o_d=o)
+             for n, i, o in ((1, 0.05, 0.28), (9, 0.05, 0.28), (13, 0.20, 0.48),
+                             (15, 0.20, 0.48))]
+    bearings = [rs.BearingElement(0, kxx=1e6, kyy=1e6, cxx=0),
+                rs.BearingElement(10, kxx=1e6, kyy=1e6, cxx=0),
+                rs.BearingElement(11, kxx=1e6, kyy=1e6, cxx=0),
+                rs.BearingElement(8, n_link=17, kxx=1e6, kyy=1e6, cxx=0)]
+    return _quiet(rs.CoAxialRotor, [inner, outer], disks, bearings)
+
+
+def test_coaxial_rotor_is_refused_naming_its_shafts(tmp_path, capsys):
+    """ROSS's co-axial rotor, saved by ROSS (whose own loader fails on it with "10 is not
+    in list"): ``import-ross`` exits 2 with one line that names the file and says that its
+    two shafts are not supported; :func:`from_ross` on the rotor in memory says the same."""
+    from ambseal.cli import main
+    from ambseal.errors import ConfigError
+
+    rotor = _coaxial_rotor()
+    src = tmp_path / "coaxial.toml"
+    _quiet(rotor.save, src)
+    assert main(["import-ross", str(src), "--out", str(tmp_path / "rig.toml")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert err.startswith(f"ambseal: error: {src}: 2 shafts (nodes 0–10, nodes 11–17")
+    assert "several shafts are not supported" in err and "not in list" not in err
+    assert not (tmp_path / "rig.toml").exists()
+    with pytest.raises(ConfigError, match="2 shafts .*several shafts are not supported"):
+        from_ross(rotor)

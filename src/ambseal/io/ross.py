@@ -15,7 +15,8 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
   rotary inertia). Tapered elements, axial force or torque, elements without rotary
   inertia or gyroscopic terms, and Hutchinson's shear coefficient have no equivalent: an
   error. ROSS's Rayleigh damping of shaft elements (``alpha``, ``beta``) has none either:
-  reported, left out.
+  reported, left out. Several shafts (ROSS's ``CoAxialRotor``, its shafts linked by
+  bearings): an error naming them (an ambseal rig has one shaft).
 * ``DiskElement`` → ``[[disk]]`` (m, Ip, Id); a ``PointMass`` on a shaft node → a disk
   without inertia.
 * ``BearingElement`` and its kinds (``SealElement``, fluid-film, ball, ...): coefficients of
@@ -160,6 +161,7 @@ def _shaft(rotor, where: str) -> tuple[list[dict], dict, str, list[str]]:
     """``[[shaft]]`` sections (one per node pair, layered elements as ``layers``), the
     materials, the beam type and what was left out."""
     shafts = sorted(rotor.shaft_elements, key=lambda e: (e.n, e.idl))
+    _one_shaft([int(el.n) for el in shafts], where)
     pairs: dict[int, list] = {}
     for el in shafts:
         _check_element(el, where)
@@ -552,7 +554,28 @@ def _check_file(path: Path, ross=None) -> dict:
         if kind == "ShaftElement" and not isinstance(val.get("material"), dict):
             raise ConfigError(f"{path}: {key}: missing material (expected a table "
                               f"[\"{key}\".material] with rho, E, G_s)")
+    pairs = [v.get("n") for k, v in data.items() if k.startswith("ShaftElement_")]
+    if pairs and all(isinstance(n, int) and not isinstance(n, bool) for n in pairs):
+        _one_shaft(pairs, str(path))
     return data
+
+
+def _one_shaft(pairs, where: str) -> None:
+    """Refuse shaft elements that form several shafts: ROSS numbers the nodes of a
+    ``CoAxialRotor``'s shafts one after the other, so its second shaft starts one node past
+    the first one's end, and its saved file does not say which shaft an element is on —
+    the gap in the node pairs is what tells (ROSS's own loader then fails obscurely)."""
+    runs: list[list[int]] = []
+    for n in sorted(set(pairs)):
+        if runs and n == runs[-1][1]:
+            runs[-1][1] = n + 1
+        else:
+            runs.append([n, n + 1])
+    if len(runs) > 1:
+        spans = ", ".join(f"nodes {a}–{b}" for a, b in runs[:4]) + (
+            ", ..." if len(runs) > 4 else "")
+        raise ConfigError(f"{where}: {len(runs)} shafts ({spans}; a ROSS CoAxialRotor): "
+                          "several shafts are not supported (an ambseal rig has one shaft)")
 
 
 def _child() -> None:

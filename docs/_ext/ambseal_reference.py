@@ -53,12 +53,21 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "ShaftSection.material": ("", "a NAME of ``[materials.NAME]``"),
     "ShaftSection.elements": ("", "beam elements in the section (at most 400 in the whole "
                                   "shaft)"),
+    "ShaftSection.rotary_inertia": ("", "the rotary inertia of the section's elements "
+                                        "(false: their mass matrices are the translational "
+                                        "ones only; ROSS's ``rotary_inertia=False``)"),
+    "ShaftSection.gyroscopic": ("", "the gyroscopic matrices of the section's elements "
+                                    "(false: none; ROSS's ``gyroscopic=False``); "
+                                    "independent of rotary_inertia"),
     "ShaftSection.layers": ("", "concentric tubes on the section's nodes, in parallel with "
                                 "its own (a sleeve, a hub; ROSS's layered elements)"),
     "ShaftLayer.outer_diameter": ("m", "outer diameter of the layer"),
     "ShaftLayer.inner_diameter": ("m", "its bore; at least the outer diameter of the tube "
                                        "inside it (tubes do not overlap)"),
     "ShaftLayer.material": ("", "a NAME of ``[materials.NAME]``"),
+    "ShaftLayer.rotary_inertia": ("", "the layer's rotary inertia (false: its mass matrix "
+                                      "is the translational one only)"),
+    "ShaftLayer.gyroscopic": ("", "the layer's gyroscopic matrix (false: none)"),
     # [[disk]]
     "Disk.position": ("m", "axial position from the shaft's left end"),
     "Disk.mass": ("kg", "mass of the rigid disk (impeller, lamination stack, sleeve, hub)"),

@@ -18,7 +18,9 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     ``length``, ``outer_diameter``, ``inner_diameter`` (default 0) in m, ``material`` (a
     NAME of ``[materials]``), ``elements`` (beam elements in the section, default 1),
     ``layers`` (optional concentric tubes ``{ outer_diameter, inner_diameter, material }``
-    on the same nodes, each a beam of its own whose matrices add to the section's).
+    on the same nodes, each a beam of its own whose matrices add to the section's);
+    per tube (section and layer) ``rotary_inertia`` and ``gyroscopic`` (default true: the
+    element's rotary-inertia and gyroscopic matrices, either may be left out).
 ``[[disk]]``
     ``position`` (m), ``mass`` (kg), ``Ip``, ``Id`` (kg·m²), ``name`` (optional).
 ``[[amb]]``
@@ -179,6 +181,8 @@ class ShaftLayer(_Strict):
     outer_diameter: float = Field(ge=1e-4, le=10.0)
     inner_diameter: float = Field(default=0.0, ge=0)
     material: str
+    rotary_inertia: bool = True
+    gyroscopic: bool = True
 
     @model_validator(mode="after")
     def _bore(self) -> "ShaftLayer":
@@ -194,6 +198,8 @@ class ShaftSection(_Strict):
     material: str
     elements: int = Field(default=1, ge=1, le=MAX_ELEMENTS)
     layers: list[ShaftLayer] = Field(default=[], max_length=MAX_LAYERS)
+    rotary_inertia: bool = True
+    gyroscopic: bool = True
 
     @model_validator(mode="after")
     def _bore(self) -> "ShaftSection":
@@ -713,6 +719,11 @@ def _toml_table(name: str, val: dict, lines: list[str]) -> None:
                 lines += [f"{j} = {_toml_value(y)}" for j, y in item.items()]
 
 
+#: The options of a shaft tube (section or layer) and their defaults, which
+#: :func:`dump_rig` leaves out.
+_TUBE_DEFAULTS = {"rotary_inertia": True, "gyroscopic": True}
+
+
 def dump_rig(cfg: RigConfig, header: str = "") -> str:
     """The rig as TOML text that :func:`load_rig` reads back to the same configuration.
 
@@ -729,6 +740,12 @@ def dump_rig(cfg: RigConfig, header: str = "") -> str:
         The TOML document, ending with a newline.
     """
     data = cfg.model_dump(exclude_none=True)
+    # the per-tube options at their defaults are left out: most rigs use none of them
+    for sec in data.get("shaft", []):
+        for tube in (sec, *sec.get("layers", [])):
+            for k, default in _TUBE_DEFAULTS.items():
+                if k in tube and tube[k] == default:
+                    del tube[k]
     lines = [f"# {line}" for line in header.splitlines()]
     for key, val in data.items():
         if isinstance(val, list):

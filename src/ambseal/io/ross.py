@@ -11,10 +11,10 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
   hubs around it, which ROSS assembles by adding their matrices) → the innermost tube is the
   section, the others its ``layers``, each a beam with its own material and shear
   parameter, as ROSS has them. ROSS's Timoshenko element with Cowper's shear coefficient is
-  ambseal's ``beam = "timoshenko"``; without shear effects, ``"euler-bernoulli"`` (with
-  rotary inertia). Tapered elements, axial force or torque, elements without rotary
-  inertia or gyroscopic terms, and Hutchinson's shear coefficient have no equivalent: an
-  error. ROSS's Rayleigh damping of shaft elements (``alpha``, ``beta``) has none either:
+  ambseal's ``beam = "timoshenko"``; without shear effects, ``"euler-bernoulli"``.
+  ROSS's ``rotary_inertia`` and ``gyroscopic`` flags of each element → the tube's keys of
+  the same names. Tapered elements, axial force or torque, and Hutchinson's shear
+  coefficient have no equivalent: an error. ROSS's Rayleigh damping of shaft elements (``alpha``, ``beta``) has none either:
   reported, left out. Several shafts (ROSS's ``CoAxialRotor``, its shafts linked by
   bearings): an error naming them (an ambseal rig has one shaft).
 * ``DiskElement`` → ``[[disk]]`` (m, Ip, Id); a ``PointMass`` on a shaft node → a disk
@@ -146,9 +146,6 @@ def _check_element(el, where: str) -> None:
     tag = f"shaft element {el.n} ({el.tag})"
     if not (math.isclose(el.idl, el.idr) and math.isclose(el.odl, el.odr)):
         raise _bad(where, f"{tag}: tapered element (idl/idr, odl/odr differ) is not supported")
-    if not (el.rotary_inertia and el.gyroscopic):
-        raise _bad(where, f"{tag}: elements without rotary inertia or gyroscopic terms are "
-                          "not supported")
     if el.shear_effects and el.shear_method_calc != "cowper":
         raise _bad(where, f"{tag}: shear_method_calc {el.shear_method_calc!r} is not "
                           "supported (expected 'cowper')")
@@ -184,7 +181,8 @@ def _shaft(rotor, where: str) -> tuple[list[dict], dict, str, list[str]]:
                               f"({', '.join(str(e.tag) for e in group)}): lengths differ "
                               "(layered elements share their nodes)")
         tubes = [{"outer_diameter": float(e.odl), "inner_diameter": float(e.idl),
-                  "material": key_of[id(e)]} for e in group]
+                  "material": key_of[id(e)], "rotary_inertia": bool(e.rotary_inertia),
+                  "gyroscopic": bool(e.gyroscopic)} for e in group]
         section = {"length": float(group[0].L), **tubes[0], "elements": 1}
         if len(tubes) > 1:
             section["layers"] = tubes[1:]

@@ -74,6 +74,14 @@ class BeamElement:
     timoshenko : bool
         Shear deformation on (Timoshenko, Φ > 0) or off (Euler–Bernoulli with rotary
         inertia, Φ = 0).
+    rotary_inertia : bool
+        The rotary inertia of the section in :meth:`M` (Friswell et al. 2010, Eq. 5.63);
+        off, M is the translational mass matrix alone (Rayleigh's beam without its rotary
+        term, as ROSS's ``rotary_inertia=False``).
+    gyroscopic : bool
+        The gyroscopic matrix :meth:`G` (Friswell Eq. 5.64); off, G = 0 (ROSS's
+        ``gyroscopic=False``). Independent of ``rotary_inertia``: a section may spin with
+        its polar inertia while its diametral rotary inertia is left out, as in ROSS.
     """
 
     length: float
@@ -83,6 +91,8 @@ class BeamElement:
     shear_modulus: float
     rho: float
     timoshenko: bool = True
+    rotary_inertia: bool = True
+    gyroscopic: bool = True
 
     @property
     def area(self) -> float:
@@ -125,7 +135,8 @@ class BeamElement:
         ) / (L * (1 + p) ** 2)
 
     def M(self) -> np.ndarray:
-        """Mass matrix (8, 8) in kg, kg·m, kg·m²: translational plus rotary inertia."""
+        """Mass matrix (8, 8) in kg, kg·m, kg·m²: translational plus rotary inertia (the
+        latter without ``rotary_inertia``)."""
         L, p = self.length, self.phi
         m1 = 13 / 35 + 7 * p / 10 + p**2 / 3
         m2 = 11 / 210 + 11 * p / 120 + p**2 / 24
@@ -141,6 +152,8 @@ class BeamElement:
                 [-m4 * L, -m6 * L**2, -m2 * L, m5 * L**2],
             ]
         ) * (self.rho * self.area * L / (1 + p) ** 2)
+        if not self.rotary_inertia:
+            return _to_nodes(mt)
         mr = self._rotary_plane() * (self.rho * self.inertia)
         return _to_nodes(mt + mr)
 
@@ -163,7 +176,10 @@ class BeamElement:
         The polar inertia per length is 2ρI, so in plane coordinates G = [[0, 2M_R],
         [−2M_R, 0]] with M_R the rotary-inertia matrix (Friswell Eq. 5.64); the sign follows
         from H = I_p Ω (β, −α, 1) for a spinning section: I_d α̈ + I_p Ω β̇ = M_x.
+        Zero without ``gyroscopic``.
         """
+        if not self.gyroscopic:
+            return np.zeros((8, 8))
         mr = self._rotary_plane() * (2 * self.rho * self.inertia)
         g = np.zeros((8, 8))
         g[:4, 4:] = mr

@@ -117,6 +117,8 @@ def build_mesh(cfg: RigConfig, extra_positions: tuple[float, ...] = ()) -> Mesh:
                     shear_modulus=cfg.materials[t.material].shear_modulus,
                     rho=cfg.materials[t.material].rho,
                     timoshenko=beam_tim,
+                    rotary_inertia=t.rotary_inertia,
+                    gyroscopic=t.gyroscopic,
                 )
                 for t in (sec, *sec.layers)
             )

@@ -59,6 +59,13 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "ShaftSection.gyroscopic": ("", "the gyroscopic matrices of the section's elements "
                                     "(false: none; ROSS's ``gyroscopic=False``); "
                                     "independent of rotary_inertia"),
+    "ShaftSection.axial_force": ("N", "axial force in the section's tube (tension "
+                                      "positive, ROSS's ``axial_force``): the geometric "
+                                      "stiffness P∫w'² of each element (tension stiffens, "
+                                      "compression softens)"),
+    "ShaftSection.torque": ("N·m", "torque the section's tube carries (ROSS's "
+                                   "``torque``): its geometric stiffness, which couples the "
+                                   "two bending planes (not symmetric)"),
     "ShaftSection.layers": ("", "concentric tubes on the section's nodes, in parallel with "
                                 "its own (a sleeve, a hub; ROSS's layered elements)"),
     "ShaftLayer.outer_diameter": ("m", "outer diameter of the layer"),
@@ -68,6 +75,9 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "ShaftLayer.rotary_inertia": ("", "the layer's rotary inertia (false: its mass matrix "
                                       "is the translational one only)"),
     "ShaftLayer.gyroscopic": ("", "the layer's gyroscopic matrix (false: none)"),
+    "ShaftLayer.axial_force": ("N", "axial force the layer carries (tension positive): its "
+                                    "geometric stiffness"),
+    "ShaftLayer.torque": ("N·m", "torque the layer carries: its geometric stiffness"),
     # [[disk]]
     "Disk.position": ("m", "axial position from the shaft's left end"),
     "Disk.mass": ("kg", "mass of the rigid disk (impeller, lamination stack, sleeve, hub)"),

@@ -20,7 +20,8 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     ``layers`` (optional concentric tubes ``{ outer_diameter, inner_diameter, material }``
     on the same nodes, each a beam of its own whose matrices add to the section's);
     per tube (section and layer) ``rotary_inertia`` and ``gyroscopic`` (default true: the
-    element's rotary-inertia and gyroscopic matrices, either may be left out).
+    element's rotary-inertia and gyroscopic matrices, either may be left out),
+    ``axial_force`` (N, tension positive) and ``torque`` (N·m): their geometric stiffness.
 ``[[disk]]``
     ``position`` (m), ``mass`` (kg), ``Ip``, ``Id`` (kg·m²), ``name`` (optional).
 ``[[amb]]``
@@ -183,6 +184,10 @@ class ShaftLayer(_Strict):
     material: str
     rotary_inertia: bool = True
     gyroscopic: bool = True
+    # plausible: a tie bolt's preload or a turbine shaft's thrust is up to some MN, its
+    # torque some MN·m; 1e9 N and 1e8 N·m keep a typo out without bounding any machine
+    axial_force: float = Field(default=0.0, ge=-1e9, le=1e9)
+    torque: float = Field(default=0.0, ge=-1e8, le=1e8)
 
     @model_validator(mode="after")
     def _bore(self) -> "ShaftLayer":
@@ -200,6 +205,10 @@ class ShaftSection(_Strict):
     layers: list[ShaftLayer] = Field(default=[], max_length=MAX_LAYERS)
     rotary_inertia: bool = True
     gyroscopic: bool = True
+    # plausible: a tie bolt's preload or a turbine shaft's thrust is up to some MN, its
+    # torque some MN·m; 1e9 N and 1e8 N·m keep a typo out without bounding any machine
+    axial_force: float = Field(default=0.0, ge=-1e9, le=1e9)
+    torque: float = Field(default=0.0, ge=-1e8, le=1e8)
 
     @model_validator(mode="after")
     def _bore(self) -> "ShaftSection":
@@ -721,7 +730,8 @@ def _toml_table(name: str, val: dict, lines: list[str]) -> None:
 
 #: The options of a shaft tube (section or layer) and their defaults, which
 #: :func:`dump_rig` leaves out.
-_TUBE_DEFAULTS = {"rotary_inertia": True, "gyroscopic": True}
+_TUBE_DEFAULTS = {"rotary_inertia": True, "gyroscopic": True, "axial_force": 0.0,
+                  "torque": 0.0}
 
 
 def dump_rig(cfg: RigConfig, header: str = "") -> str:

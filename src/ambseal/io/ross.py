@@ -13,8 +13,9 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
   parameter, as ROSS has them. ROSS's Timoshenko element with Cowper's shear coefficient is
   ambseal's ``beam = "timoshenko"``; without shear effects, ``"euler-bernoulli"``.
   ROSS's ``rotary_inertia`` and ``gyroscopic`` flags of each element → the tube's keys of
-  the same names. Tapered elements, axial force or torque, and Hutchinson's shear
-  coefficient have no equivalent: an error. ROSS's Rayleigh damping of shaft elements (``alpha``, ``beta``) has none either:
+  the same names, its ``axial_force`` (N) and ``torque`` (N·m) → the tube's keys of the
+  same names (their geometric stiffness, :meth:`ambseal.model.fe.BeamElement._geometric`).
+  Tapered elements and Hutchinson's shear coefficient have no equivalent: an error. ROSS's Rayleigh damping of shaft elements (``alpha``, ``beta``) has none either:
   reported, left out. Several shafts (ROSS's ``CoAxialRotor``, its shafts linked by
   bearings): an error naming them (an ambseal rig has one shaft).
 * ``DiskElement`` → ``[[disk]]`` (m, Ip, Id); a ``PointMass`` on a shaft node → a disk
@@ -149,9 +150,6 @@ def _check_element(el, where: str) -> None:
     if el.shear_effects and el.shear_method_calc != "cowper":
         raise _bad(where, f"{tag}: shear_method_calc {el.shear_method_calc!r} is not "
                           "supported (expected 'cowper')")
-    if getattr(el, "axial_force", 0) or getattr(el, "torque", 0):
-        raise _bad(where, f"{tag}: axial_force / torque (their stiffening) have no ambseal "
-                          "equivalent")
 
 
 def _shaft(rotor, where: str) -> tuple[list[dict], dict, str, list[str]]:
@@ -182,7 +180,8 @@ def _shaft(rotor, where: str) -> tuple[list[dict], dict, str, list[str]]:
                               "(layered elements share their nodes)")
         tubes = [{"outer_diameter": float(e.odl), "inner_diameter": float(e.idl),
                   "material": key_of[id(e)], "rotary_inertia": bool(e.rotary_inertia),
-                  "gyroscopic": bool(e.gyroscopic)} for e in group]
+                  "gyroscopic": bool(e.gyroscopic), "axial_force": float(e.axial_force),
+                  "torque": float(e.torque)} for e in group]
         section = {"length": float(group[0].L), **tubes[0], "elements": 1}
         if len(tubes) > 1:
             section["layers"] = tubes[1:]

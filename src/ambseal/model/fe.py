@@ -42,6 +42,34 @@ def shear_coefficient(nu: float, inner_diameter: float, outer_diameter: float) -
     return 6 * (1 + nu) * (1 + m2) ** 2 / ((7 + 6 * nu) * (1 + m2) ** 2 + (20 + 12 * nu) * m2)
 
 
+#: 5-point Gauss–Legendre rule on [0, 1]: exact for polynomials up to degree 9, which the
+#: products of the element's cubic interpolation (and a section's quartic I(z)) stay below.
+_GAUSS = ((np.polynomial.legendre.leggauss(5)[0] + 1) / 2,
+          np.polynomial.legendre.leggauss(5)[1] / 2)
+
+
+def _shape(xi: np.ndarray, L: float, p: float) -> tuple[np.ndarray, ...]:
+    """The Timoshenko element's interpolation at ξ = z/L (Nelson 1980; Friswell et al. 2010
+    §5.4.4), rows per point, columns the plane coordinates [w1, φ1, w2, φ2]: N_w, ∂N_w/∂z,
+    N_ψ (the section rotation), ∂N_ψ/∂z. Φ = 0 gives the Hermite cubics with ψ = w'."""
+    xi = np.asarray(xi, float)[:, None]
+    o, x2, x3 = np.ones_like(xi), xi**2, xi**3
+    k = 1 / (1 + p)
+    nw = np.hstack([1 - 3 * x2 + 2 * x3 + p * (1 - xi),
+                    L * (xi - 2 * x2 + x3 + p / 2 * (xi - x2)),
+                    3 * x2 - 2 * x3 + p * xi,
+                    L * (-x2 + x3 - p / 2 * (xi - x2))]) * k
+    dnw = np.hstack([(-6 * xi + 6 * x2 - p) / L,
+                     1 - 4 * xi + 3 * x2 + p / 2 * (1 - 2 * xi),
+                     (6 * xi - 6 * x2 + p) / L,
+                     -2 * xi + 3 * x2 - p / 2 * (1 - 2 * xi)]) * k
+    npsi = np.hstack([6 * (x2 - xi) / L, 1 - 4 * xi + 3 * x2 + p * (1 - xi),
+                      -6 * (x2 - xi) / L, -2 * xi + 3 * x2 + p * xi]) * k
+    dnpsi = np.hstack([6 * (2 * xi - 1) / L**2, (-4 + 6 * xi - p) / L,
+                       -6 * (2 * xi - 1) / L**2, (-2 + 6 * xi + p) / L]) * k
+    return nw, dnw, npsi, dnpsi + 0 * o
+
+
 def _to_nodes(plane: np.ndarray, coupled: bool = False) -> np.ndarray:
     """Map plane-coordinate matrices to the 8 element DOFs.
 
@@ -82,6 +110,12 @@ class BeamElement:
         The gyroscopic matrix :meth:`G` (Friswell Eq. 5.64); off, G = 0 (ROSS's
         ``gyroscopic=False``). Independent of ``rotary_inertia``: a section may spin with
         its polar inertia while its diametral rotary inertia is left out, as in ROSS.
+    axial_force : float
+        Axial force P (N), tension positive: its geometric stiffness in :meth:`K`
+        (:meth:`_geometric`).
+    torque : float
+        Torque T (N·m) the element carries: its geometric stiffness in :meth:`K`, which
+        couples the bending planes and is not symmetric (:meth:`_geometric`).
     """
 
     length: float
@@ -93,6 +127,8 @@ class BeamElement:
     timoshenko: bool = True
     rotary_inertia: bool = True
     gyroscopic: bool = True
+    axial_force: float = 0.0
+    torque: float = 0.0
 
     @property
     def area(self) -> float:
@@ -108,6 +144,48 @@ class BeamElement:
     def mass(self) -> float:
         """Element mass (kg)."""
         return self.rho * self.area * self.length
+
+    def _geometric(self) -> np.ndarray:
+        """Geometric stiffness (8, 8) of the axial force P and the torque T (N/m, N, N·m).
+
+        Axial force: the work of P through the slopes, ½ P ∫ (∂w/∂z)² dz per bending plane,
+        with the element's own interpolation of w (the Timoshenko one, Φ > 0, or the
+        Hermite cubics, Φ = 0): K_P = P ∫ N_w'ᵀ N_w' dz, which for Φ = 0 is the classical
+        P/(30L)·[36, 3L, 4L², −L²] matrix (Przemieniecki, *Theory of Matrix Structural
+        Analysis*, 1968) and with shear P/(30L(1+Φ)²)·[36+60Φ+30Φ², 3L, (4+5Φ+2.5Φ²)L²,
+        −(1+5Φ+2.5Φ²)L²]. P > 0 is tension (it stiffens the shaft), as in ROSS.
+
+        Torque: T carried along the bent axis couples the two planes. With displacements and
+        section rotations (ψ_x = β, ψ_y = −α) interpolated linearly over the element, its
+        virtual work gives K_T = T ∫ [y'ψ_x' − x'ψ_y'] (both ways, symmetric) + T ∫ [ψ_x ψ_y'
+        (row ψ_x) − ψ_y ψ_x' (row ψ_y)] dz: entries ±T/L between a displacement and the
+        other plane's rotation, ±T/2 between the rotations; the latter part is not
+        symmetric (a circulatory term). This is ROSS 2.3's torque term, for which ROSS cites
+        no source; Zorzi & Nelson, "The dynamics of rotor-bearing systems with axial torque
+        — a finite element approach", J. Mech. Des. 102 (1980), derive the consistent
+        (cubic) counterpart. T in N·m, positive along +z.
+        """
+        out = np.zeros((8, 8))
+        L, P, T = self.length, self.axial_force, self.torque
+        if P:
+            x, wts = _GAUSS
+            dn = _shape(x, L, self.phi)[1]
+            out += _to_nodes(P * L * (dn.T * wts) @ dn)
+        if T:
+            # plane coordinates [x, ψx, x2, ψx2 | y, ψy, y2, ψy2], linear interpolation
+            c = np.zeros((8, 8))
+            d = np.array([-1.0, 1.0])  # ∫ N_i' N_j' dz · L  and  ∫ N_i N_j' dz · 2
+            tw = np.outer(d, d) / L  # T ∫ N_i' N_j' dz per unit T
+            rr = np.outer([1.0, 1.0], d) / 2  # ∫ N_i N_j' dz
+            wx, px, wy, py = [0, 2], [1, 3], [4, 6], [5, 7]
+            c[np.ix_(wy, px)] += tw
+            c[np.ix_(px, wy)] += tw
+            c[np.ix_(wx, py)] -= tw
+            c[np.ix_(py, wx)] -= tw
+            c[np.ix_(px, py)] += rr
+            c[np.ix_(py, px)] -= rr
+            out += _to_nodes(T * c, coupled=True)
+        return out
 
     @property
     def phi(self) -> float:
@@ -168,7 +246,7 @@ class BeamElement:
                 [6 * L, (2 - p) * L**2, -6 * L, (4 + p) * L**2],
             ]
         ) * (self.E * self.inertia / (L**3 * (1 + p)))
-        return _to_nodes(k)
+        return _to_nodes(k) + self._geometric()
 
     def G(self) -> np.ndarray:
         """Gyroscopic matrix (8, 8), skew-symmetric, per unit spin speed (kg·m², ...).

@@ -119,6 +119,8 @@ def build_mesh(cfg: RigConfig, extra_positions: tuple[float, ...] = ()) -> Mesh:
                     timoshenko=beam_tim,
                     rotary_inertia=t.rotary_inertia,
                     gyroscopic=t.gyroscopic,
+                    axial_force=t.axial_force,
+                    torque=t.torque,
                 )
                 for t in (sec, *sec.layers)
             )
@@ -150,7 +152,7 @@ class RotorMatrices:
     M : ndarray, shape (n_dof, n_dof)
         Mass matrix (kg, kg·m²).
     K : ndarray, shape (n_dof, n_dof)
-        Stiffness matrix (N/m, N·m/rad).
+        Stiffness matrix (N/m, N·m/rad); not symmetric where a section carries torque.
     C : ndarray, shape (n_dof, n_dof)
         Structural (modal) damping (N·s/m): the rotor's ``modal_damping`` on every
         free–free elastic mode.
@@ -208,7 +210,10 @@ def assemble_rotor(cfg: RigConfig, mesh: Mesh | None = None) -> RotorMatrices:
         s = slice(4 * mesh.node_at(d.position), 4 * mesh.node_at(d.position) + 4)
         M[s, s] += de.M()
         G[s, s] += de.G()
-    return RotorMatrices(mesh=mesh, M=M, K=K, C=modal_damping(M, K, cfg.rotor.modal_damping), G=G)
+    # a torque's stiffness has a circulatory (skew) part: the free–free modes that the
+    # structural damping is set on are those of the conservative part
+    C = modal_damping(M, (K + K.T) / 2, cfg.rotor.modal_damping)
+    return RotorMatrices(mesh=mesh, M=M, K=K, C=C, G=G)
 
 
 def modal_damping(M: np.ndarray, K: np.ndarray, zeta: float) -> np.ndarray:

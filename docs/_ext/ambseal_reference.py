@@ -66,6 +66,14 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "ShaftSection.torque": ("N·m", "torque the section's tube carries (ROSS's "
                                    "``torque``): its geometric stiffness, which couples the "
                                    "two bending planes (not symmetric)"),
+    "ShaftSection.outer_diameter_right": ("m", "outer diameter at the section's right "
+                                               "end: a tapered (conical) section, its "
+                                               "diameters linear from end to end, each "
+                                               "element Genta & Gugliotta's exact conical "
+                                               "element (ROSS's); default outer_diameter"),
+    "ShaftSection.inner_diameter_right": ("m", "bore at the right end; less than "
+                                               "outer_diameter_right (default "
+                                               "inner_diameter)"),
     "ShaftSection.layers": ("", "concentric tubes on the section's nodes, in parallel with "
                                 "its own (a sleeve, a hub; ROSS's layered elements)"),
     "ShaftLayer.outer_diameter": ("m", "outer diameter of the layer"),
@@ -78,6 +86,10 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "ShaftLayer.axial_force": ("N", "axial force the layer carries (tension positive): its "
                                     "geometric stiffness"),
     "ShaftLayer.torque": ("N·m", "torque the layer carries: its geometric stiffness"),
+    "ShaftLayer.outer_diameter_right": ("m", "outer diameter at the section's right end "
+                                             "(a tapered layer; default outer_diameter)"),
+    "ShaftLayer.inner_diameter_right": ("m", "bore at the right end (default "
+                                             "inner_diameter)"),
     # [[disk]]
     "Disk.position": ("m", "axial position from the shaft's left end"),
     "Disk.mass": ("kg", "mass of the rigid disk (impeller, lamination stack, sleeve, hub)"),

@@ -18,6 +18,7 @@ import warnings
 
 import numpy as np
 import pytest
+import scipy.linalg as sla
 
 with contextlib.redirect_stdout(sys.stderr), warnings.catch_warnings():
     warnings.simplefilter("ignore")
@@ -227,7 +228,8 @@ def test_amb_rotor_open_loop_unstable_poles_equal_ross():
 
 def test_import_ross_cli_round_trip_and_bad_files(tmp_path, capsys):
     """``ambseal import-ross`` on ROSS's own saved file writes a rig that loads back to the
-    same modes as :func:`from_ross`; a tapered shaft element (unsupported), a shaft element
+    same modes as :func:`from_ross`; a shaft element with Hutchinson's shear coefficient
+    (unsupported), a shaft element
     without its material and a file that is no ROSS rotor each give one line on stderr,
     naming the user's file first (not the embedded rig's), and exit status 2."""
     from ambseal.cli import main
@@ -246,15 +248,15 @@ def test_import_ross_cli_round_trip_and_bad_files(tmp_path, capsys):
 
     ex = rs.rotor_example()
     e0 = ex.shaft_elements[0]
-    tapered = [rs.ShaftElement(L=e0.L, idl=0.0, odl=0.05, idr=0.0, odr=0.04,
-                               material=e0.material)] + ex.shaft_elements[1:]
-    rs.Rotor(tapered, ex.disk_elements, ex.bearing_elements).save(tmp_path / "tapered.toml")
+    hutchinson = [rs.ShaftElement(L=e0.L, idl=0.0, odl=0.05, material=e0.material,
+                                  shear_method_calc="hutchinson")] + ex.shaft_elements[1:]
+    rs.Rotor(hutchinson, ex.disk_elements, ex.bearing_elements).save(tmp_path / "hut.toml")
     lines = src.read_text().splitlines()  # drop the first shaft element's material table
     i = next(k for k, ln in enumerate(lines) if ln.endswith('Element 0".material]'))
     j = next(k for k in range(i + 1, len(lines)) if lines[k].startswith("["))
     (tmp_path / "nomat.toml").write_text("\n".join(lines[:i] + lines[j:]))
     (tmp_path / "junk.json").write_text('{"parameters": 1}')
-    for name, key in (("tapered.toml", "tapered"), ("nomat.toml", "material"),
+    for name, key in (("hut.toml", "hutchinson"), ("nomat.toml", "material"),
                       ("junk.json", "not a ROSS rotor")):
         assert main(["import-ross", str(tmp_path / name), "--out", str(out)]) == 2
         err = capsys.readouterr().err
@@ -494,3 +496,71 @@ def test_axial_force_and_torque_equal_ross(tmp_path, load, asserted):
         _assert_modes_equal_ross(cfg_soft, soft, 4000 * np.pi / 30, 200.0, 8)
         low = closed_loop_modes(cfg_soft, None, speed_hz=4000 / 60, max_hz=200.0)
         assert np.sort(low.poles.imag)[0] < 0.85 * asserted[0]
+
+
+def _conical_rotor(k: float):
+    """ROSS's ``rotor_conical`` as ROSS's tests build it (``test_rotor_assembly``): a solid
+    cone 0.5 m long from d = 100 mm to 10 mm in four conical elements, on bearings of
+    stiffness ``k`` at its ends (ROSS's 1e20 N/m is beyond the rig file's 1e12)."""
+    n, odl, odr = 4, 0.1, 0.01
+    dd = (odl - odr) / n
+    shaft = [rs.ShaftElement(n=i, idl=0.0, odl=odl - i * dd, idr=0.0, odr=odl - (i + 1) * dd,
+                             material=rs.materials.steel, L=0.5 / n) for i in range(n)]
+    bearings = [rs.BearingElement(n=i, kxx=k, kyy=k, cxx=0) for i in (0, n)]
+    return _quiet(rs.Rotor, shaft_elements=shaft, bearing_elements=bearings)
+
+
+def test_conical_rotor_equals_ross_and_its_asserted_frequencies(tmp_path):
+    """ROSS's conical rotor, saved and imported: four tapered sections (Genta & Gugliotta's
+    conical element, as ROSS's); on 1e12 N/m bearings every lateral mode up to 5 kHz equals
+    ROSS's to 1e-6 at standstill and at 30 000 rpm. Pinned at both ends — the limit of
+    ROSS's 1e20 N/m bearings — the imported shaft's natural frequencies are those ROSS's
+    ``test_rotor_conical_frequencies`` asserts (1630.75, 9899.54, 21074.45 rad/s, each
+    twice) to 1e-7, the spread of ROSS's own pairs. The cone as one section of four
+    elements (``outer_diameter_right``, diameters interpolated by the mesh) has the same
+    modes to 1e-12."""
+    from ambseal.model.rotor import assemble_rotor
+
+    rotor = _conical_rotor(1e12)
+    path = tmp_path / "conical.toml"
+    _quiet(rotor.save, path)
+    cfg = from_ross(load_ross(path), where=str(path)).rig
+    assert [s.outer_diameter_right for s in cfg.shaft] == pytest.approx(
+        [0.0775, 0.055, 0.0325, 0.01], rel=1e-12)
+    for rpm in (0.0, 30000.0):
+        _assert_modes_equal_ross(cfg, rotor, rpm * np.pi / 30, 5000.0, 6)
+    r = assemble_rotor(cfg)
+    n = r.K.shape[0]
+    keep = np.array([i for i in range(n) if i not in (0, 1, n - 4, n - 3)])
+    w = np.sqrt(sla.eigh(r.K[np.ix_(keep, keep)], r.M[np.ix_(keep, keep)],
+                         eigvals_only=True)[:6])
+    asserted = [1630.7509182, 1630.75091824, 9899.54379138, 9899.54396231,
+                21074.45440319, 21074.45440372]
+    assert w == pytest.approx(asserted, rel=1e-7)
+    data = cfg.model_dump(exclude_none=True)
+    data["shaft"] = [{"length": 0.5, "outer_diameter": 0.1, "outer_diameter_right": 0.01,
+                      "material": cfg.shaft[0].material, "elements": 4}]
+    one = closed_loop_modes(parse_rig(data), None, speed_hz=0.0, max_hz=5000.0)
+    four = closed_loop_modes(cfg, None, speed_hz=0.0, max_hz=5000.0)
+    assert one.poles == pytest.approx(four.poles, rel=1e-12)
+
+
+@pytest.mark.parametrize("shear", [True, False])
+def test_hollow_tapered_elements_with_loads_equal_ross(shear):
+    """ROSS's ``rotor_example`` with its shaft made of hollow cones (bore and outside
+    tapering, widening and narrowing in turn) carrying an axial force and a torque, on the
+    Timoshenko and the E–B element: every lateral mode up to 1 kHz equals ROSS's to 1e-6 at
+    0 and 6000 rpm."""
+    ex = rs.rotor_example()
+    ends = [(0.0, 0.05), (0.01, 0.06), (0.0, 0.045), (0.012, 0.055), (0.005, 0.05),
+            (0.0, 0.04), (0.01, 0.05)]
+    shafts = [rs.ShaftElement(e.L, ends[i][0], ends[i][1], idr=ends[i + 1][0],
+                              odr=ends[i + 1][1], material=e.material, shear_effects=shear,
+                              axial_force=2e4, torque=-1e3)
+              for i, e in enumerate(ex.shaft_elements)]
+    b = [rs.BearingElement(n, kxx=1e6, kyy=0.8e6, cxx=150.0, cyy=90.0) for n in (0, 6)]
+    rotor = _quiet(rs.Rotor, shafts, ex.disk_elements, b)
+    cfg = from_ross(rotor).rig
+    assert all(s.inner_diameter_right is not None for s in cfg.shaft[:5])
+    for rpm in (0.0, 6000.0):
+        _assert_modes_equal_ross(cfg, rotor, rpm * np.pi / 30, 1000.0, 14)

@@ -14,8 +14,11 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
   ambseal's ``beam = "timoshenko"``; without shear effects, ``"euler-bernoulli"``.
   ROSS's ``rotary_inertia`` and ``gyroscopic`` flags of each element → the tube's keys of
   the same names, its ``axial_force`` (N) and ``torque`` (N·m) → the tube's keys of the
-  same names (their geometric stiffness, :meth:`ambseal.model.fe.BeamElement._geometric`).
-  Tapered elements and Hutchinson's shear coefficient have no equivalent: an error. ROSS's Rayleigh damping of shaft elements (``alpha``, ``beta``) has none either:
+  same names (their geometric stiffness, :meth:`ambseal.model.fe.BeamElement._geometric`);
+  a tapered element (``odr``, ``idr`` differ from ``odl``, ``idl``) → a section with
+  ``outer_diameter_right``, ``inner_diameter_right``, whose element is Genta & Gugliotta's
+  conical one as ROSS's (:class:`ambseal.model.fe.BeamElement`). Hutchinson's shear
+  coefficient has no equivalent: an error. ROSS's Rayleigh damping of shaft elements (``alpha``, ``beta``) has none either:
   reported, left out. Several shafts (ROSS's ``CoAxialRotor``, its shafts linked by
   bearings): an error naming them (an ambseal rig has one shaft).
 * ``DiskElement`` → ``[[disk]]`` (m, Ip, Id); a ``PointMass`` on a shaft node → a disk
@@ -145,8 +148,6 @@ def _materials(shafts, where: str) -> tuple[dict, list[str]]:
 
 def _check_element(el, where: str) -> None:
     tag = f"shaft element {el.n} ({el.tag})"
-    if not (math.isclose(el.idl, el.idr) and math.isclose(el.odl, el.odr)):
-        raise _bad(where, f"{tag}: tapered element (idl/idr, odl/odr differ) is not supported")
     if el.shear_effects and el.shear_method_calc != "cowper":
         raise _bad(where, f"{tag}: shear_method_calc {el.shear_method_calc!r} is not "
                           "supported (expected 'cowper')")
@@ -181,7 +182,9 @@ def _shaft(rotor, where: str) -> tuple[list[dict], dict, str, list[str]]:
         tubes = [{"outer_diameter": float(e.odl), "inner_diameter": float(e.idl),
                   "material": key_of[id(e)], "rotary_inertia": bool(e.rotary_inertia),
                   "gyroscopic": bool(e.gyroscopic), "axial_force": float(e.axial_force),
-                  "torque": float(e.torque)} for e in group]
+                  "torque": float(e.torque)}
+                 | ({"outer_diameter_right": float(e.odr), "inner_diameter_right": float(e.idr)}
+                    if (e.odr, e.idr) != (e.odl, e.idl) else {}) for e in group]
         section = {"length": float(group[0].L), **tubes[0], "elements": 1}
         if len(tubes) > 1:
             section["layers"] = tubes[1:]

@@ -89,14 +89,25 @@ def _to_nodes(plane: np.ndarray, coupled: bool = False) -> np.ndarray:
 
 @dataclass(frozen=True)
 class BeamElement:
-    """A uniform circular (hollow) shaft element between two nodes.
+    """A circular (hollow) shaft element between two nodes: uniform or conical.
+
+    A uniform element has the closed-form matrices of Friswell et al. (2010) §5.4. A conical
+    one (``outer_diameter_right`` / ``inner_diameter_right`` differ from the left end's) is
+    Genta & Gugliotta's element ("A conical element for finite element rotor dynamics",
+    J. Sound Vib. 120 (1988) 175–182): the uniform Timoshenko element's interpolation, with
+    Φ and κ of the section at mid-length, integrated exactly against the section's A(z)
+    (quadratic in z) and I(z) (quartic): M = ρ∫A N_wᵀN_w + ρ∫I N_ψᵀN_ψ, K = E∫I N_ψ'ᵀN_ψ' +
+    κG∫A γᵀγ (γ = w' − ψ), G from 2ρ∫I N_ψᵀN_ψ. So a conical element is exact in its
+    geometry, not a stepped approximation; the integrals are taken by a 5-point Gauss rule,
+    exact for these polynomials (degree ≤ 8). ROSS 2.3's ``ShaftElement`` is the same
+    element: the matrices agree to round-off.
 
     Parameters
     ----------
     length : float
         Element length L (m).
     outer_diameter, inner_diameter : float
-        Diameters (m).
+        Diameters (m), at the left end (node 1) of a conical element.
     E, shear_modulus, rho : float
         Young's modulus (Pa), shear modulus (Pa), density (kg/m³).
     timoshenko : bool
@@ -116,6 +127,8 @@ class BeamElement:
     torque : float
         Torque T (N·m) the element carries: its geometric stiffness in :meth:`K`, which
         couples the bending planes and is not symmetric (:meth:`_geometric`).
+    outer_diameter_right, inner_diameter_right : float, optional
+        Diameters (m) at the right end (node 2); None: the left end's (uniform).
     """
 
     length: float
@@ -129,21 +142,78 @@ class BeamElement:
     gyroscopic: bool = True
     axial_force: float = 0.0
     torque: float = 0.0
+    outer_diameter_right: float | None = None
+    inner_diameter_right: float | None = None
+
+    def _diameters(self, xi) -> tuple[np.ndarray, np.ndarray]:
+        """Outer and inner diameter (m) at ξ = z/L: linear between the ends."""
+        do_r = self.outer_diameter if self.outer_diameter_right is None else (
+            self.outer_diameter_right)
+        di_r = self.inner_diameter if self.inner_diameter_right is None else (
+            self.inner_diameter_right)
+        xi = np.asarray(xi, float)
+        return (self.outer_diameter + (do_r - self.outer_diameter) * xi,
+                self.inner_diameter + (di_r - self.inner_diameter) * xi)
+
+    @property
+    def tapered(self) -> bool:
+        """Whether the element is conical (its ends' diameters differ)."""
+        do, di = self._diameters(1.0)
+        return bool(do != self.outer_diameter or di != self.inner_diameter)
+
+    def _area_at(self, xi) -> np.ndarray:
+        do, di = self._diameters(xi)
+        return np.pi / 4 * (do**2 - di**2)
+
+    def _inertia_at(self, xi) -> np.ndarray:
+        do, di = self._diameters(xi)
+        return np.pi / 64 * (do**4 - di**4)
 
     @property
     def area(self) -> float:
-        """Cross-section area A (m²)."""
-        return np.pi / 4 * (self.outer_diameter**2 - self.inner_diameter**2)
+        """Cross-section area A (m²); of a conical element, at mid-length (Φ's)."""
+        return float(self._area_at(0.5))
 
     @property
     def inertia(self) -> float:
-        """Diametral second moment of area I (m⁴); the polar one is 2I."""
-        return np.pi / 64 * (self.outer_diameter**4 - self.inner_diameter**4)
+        """Diametral second moment of area I (m⁴), at mid-length of a conical element; the
+        polar one is 2I."""
+        return float(self._inertia_at(0.5))
 
     @property
     def mass(self) -> float:
-        """Element mass (kg)."""
-        return self.rho * self.area * self.length
+        """Element mass (kg): ρ∫A dz (a conical element's frustum)."""
+        if not self.tapered:
+            return self.rho * self.area * self.length
+        x, w = _GAUSS
+        return float(self.rho * self.length * w @ self._area_at(x))
+
+    def _rotary(self) -> np.ndarray:
+        """∫ I N_ψᵀ N_ψ dz (m⁵) in plane coordinates: the rotary inertia per unit ρ."""
+        if not self.tapered:
+            return self._rotary_plane() * self.inertia
+        x, w = _GAUSS
+        npsi = _shape(x, self.length, self.phi)[2]
+        return self.length * (npsi.T * (w * self._inertia_at(x))) @ npsi
+
+    def _conical_mass(self) -> np.ndarray:
+        """ρ∫A N_wᵀ N_w dz (plane coordinates) of a conical element."""
+        x, w = _GAUSS
+        nw = _shape(x, self.length, self.phi)[0]
+        return self.rho * self.length * (nw.T * (w * self._area_at(x))) @ nw
+
+    def _conical_stiffness(self) -> np.ndarray:
+        """E∫I N_ψ'ᵀN_ψ' dz + κG∫A γᵀγ dz (plane coordinates) of a conical element, κG
+        from Φ = 12EI/(κGAL²) at mid-length."""
+        x, w = _GAUSS
+        L, p = self.length, self.phi
+        _, dnw, npsi, dnpsi = _shape(x, L, p)
+        k = self.E * L * (dnpsi.T * (w * self._inertia_at(x))) @ dnpsi
+        if p > 0:
+            gamma = dnw - npsi  # constant along the element
+            kappa_g = 12 * self.E * self.inertia / (p * self.area * L**2)
+            k += kappa_g * L * (gamma.T * (w * self._area_at(x))) @ gamma
+        return k
 
     def _geometric(self) -> np.ndarray:
         """Geometric stiffness (8, 8) of the axial force P and the torque T (N/m, N, N·m).
@@ -193,7 +263,8 @@ class BeamElement:
         if not self.timoshenko:
             return 0.0
         nu = self.E / (2 * self.shear_modulus) - 1
-        kappa = shear_coefficient(nu, self.inner_diameter, self.outer_diameter)
+        do, di = self._diameters(0.5)
+        kappa = shear_coefficient(nu, float(di), float(do))
         return 12 * self.E * self.inertia / (kappa * self.shear_modulus * self.area * self.length**2)
 
     def _rotary_plane(self) -> np.ndarray:
@@ -216,6 +287,9 @@ class BeamElement:
         """Mass matrix (8, 8) in kg, kg·m, kg·m²: translational plus rotary inertia (the
         latter without ``rotary_inertia``)."""
         L, p = self.length, self.phi
+        if self.tapered:
+            mt = self._conical_mass()
+            return _to_nodes(mt + self.rho * self._rotary() if self.rotary_inertia else mt)
         m1 = 13 / 35 + 7 * p / 10 + p**2 / 3
         m2 = 11 / 210 + 11 * p / 120 + p**2 / 24
         m3 = 9 / 70 + 3 * p / 10 + p**2 / 6
@@ -236,7 +310,11 @@ class BeamElement:
         return _to_nodes(mt + mr)
 
     def K(self) -> np.ndarray:
-        """Stiffness matrix (8, 8) in N/m, N, N·m (Friswell Eq. 5.61)."""
+        """Stiffness matrix (8, 8) in N/m, N, N·m (Friswell Eq. 5.61; a conical element's
+        by Genta & Gugliotta 1988), with the geometric stiffness of the axial force and the
+        torque."""
+        if self.tapered:
+            return _to_nodes(self._conical_stiffness()) + self._geometric()
         L, p = self.length, self.phi
         k = np.array(
             [
@@ -258,7 +336,7 @@ class BeamElement:
         """
         if not self.gyroscopic:
             return np.zeros((8, 8))
-        mr = self._rotary_plane() * (2 * self.rho * self.inertia)
+        mr = self._rotary() * (2 * self.rho)
         g = np.zeros((8, 8))
         g[:4, 4:] = mr
         g[4:, :4] = -mr

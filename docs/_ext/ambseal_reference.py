@@ -53,12 +53,43 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "ShaftSection.material": ("", "a NAME of ``[materials.NAME]``"),
     "ShaftSection.elements": ("", "beam elements in the section (at most 400 in the whole "
                                   "shaft)"),
+    "ShaftSection.rotary_inertia": ("", "the rotary inertia of the section's elements "
+                                        "(false: their mass matrices are the translational "
+                                        "ones only; ROSS's ``rotary_inertia=False``)"),
+    "ShaftSection.gyroscopic": ("", "the gyroscopic matrices of the section's elements "
+                                    "(false: none; ROSS's ``gyroscopic=False``); "
+                                    "independent of rotary_inertia"),
+    "ShaftSection.axial_force": ("N", "axial force in the section's tube (tension "
+                                      "positive, ROSS's ``axial_force``): the geometric "
+                                      "stiffness P∫w'² of each element (tension stiffens, "
+                                      "compression softens)"),
+    "ShaftSection.torque": ("N·m", "torque the section's tube carries (ROSS's "
+                                   "``torque``): its geometric stiffness, which couples the "
+                                   "two bending planes (not symmetric)"),
+    "ShaftSection.outer_diameter_right": ("m", "outer diameter at the section's right "
+                                               "end: a tapered (conical) section, its "
+                                               "diameters linear from end to end, each "
+                                               "element Genta & Gugliotta's exact conical "
+                                               "element (ROSS's); default outer_diameter"),
+    "ShaftSection.inner_diameter_right": ("m", "bore at the right end; less than "
+                                               "outer_diameter_right (default "
+                                               "inner_diameter)"),
     "ShaftSection.layers": ("", "concentric tubes on the section's nodes, in parallel with "
                                 "its own (a sleeve, a hub; ROSS's layered elements)"),
     "ShaftLayer.outer_diameter": ("m", "outer diameter of the layer"),
     "ShaftLayer.inner_diameter": ("m", "its bore; at least the outer diameter of the tube "
                                        "inside it (tubes do not overlap)"),
     "ShaftLayer.material": ("", "a NAME of ``[materials.NAME]``"),
+    "ShaftLayer.rotary_inertia": ("", "the layer's rotary inertia (false: its mass matrix "
+                                      "is the translational one only)"),
+    "ShaftLayer.gyroscopic": ("", "the layer's gyroscopic matrix (false: none)"),
+    "ShaftLayer.axial_force": ("N", "axial force the layer carries (tension positive): its "
+                                    "geometric stiffness"),
+    "ShaftLayer.torque": ("N·m", "torque the layer carries: its geometric stiffness"),
+    "ShaftLayer.outer_diameter_right": ("m", "outer diameter at the section's right end "
+                                             "(a tapered layer; default outer_diameter)"),
+    "ShaftLayer.inner_diameter_right": ("m", "bore at the right end (default "
+                                             "inner_diameter)"),
     # [[disk]]
     "Disk.position": ("m", "axial position from the shaft's left end"),
     "Disk.mass": ("kg", "mass of the rigid disk (impeller, lamination stack, sleeve, hub)"),

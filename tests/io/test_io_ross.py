@@ -13,10 +13,12 @@ import json
 import os
 import subprocess
 import sys
+import tomllib
 import warnings
 
 import numpy as np
 import pytest
+import scipy.linalg as sla
 
 with contextlib.redirect_stdout(sys.stderr), warnings.catch_warnings():
     warnings.simplefilter("ignore")
@@ -24,7 +26,7 @@ with contextlib.redirect_stdout(sys.stderr), warnings.catch_warnings():
                                             "installed")
 
 from ambseal.analysis.campbell import closed_loop_modes  # noqa: E402
-from ambseal.config import parse_rig  # noqa: E402
+from ambseal.config import dump_rig, parse_rig  # noqa: E402
 from ambseal.design.pid import pid_controller  # noqa: E402
 from ambseal.io.ross import _stdout_to_stderr, from_ross, load_ross  # noqa: E402
 from ambseal.model.amb import amb_factors, channel_names  # noqa: E402
@@ -226,7 +228,8 @@ def test_amb_rotor_open_loop_unstable_poles_equal_ross():
 
 def test_import_ross_cli_round_trip_and_bad_files(tmp_path, capsys):
     """``ambseal import-ross`` on ROSS's own saved file writes a rig that loads back to the
-    same modes as :func:`from_ross`; a tapered shaft element (unsupported), a shaft element
+    same modes as :func:`from_ross`; a shaft element with Hutchinson's shear coefficient
+    (unsupported), a shaft element
     without its material and a file that is no ROSS rotor each give one line on stderr,
     naming the user's file first (not the embedded rig's), and exit status 2."""
     from ambseal.cli import main
@@ -245,15 +248,15 @@ def test_import_ross_cli_round_trip_and_bad_files(tmp_path, capsys):
 
     ex = rs.rotor_example()
     e0 = ex.shaft_elements[0]
-    tapered = [rs.ShaftElement(L=e0.L, idl=0.0, odl=0.05, idr=0.0, odr=0.04,
-                               material=e0.material)] + ex.shaft_elements[1:]
-    rs.Rotor(tapered, ex.disk_elements, ex.bearing_elements).save(tmp_path / "tapered.toml")
+    hutchinson = [rs.ShaftElement(L=e0.L, idl=0.0, odl=0.05, material=e0.material,
+                                  shear_method_calc="hutchinson")] + ex.shaft_elements[1:]
+    rs.Rotor(hutchinson, ex.disk_elements, ex.bearing_elements).save(tmp_path / "hut.toml")
     lines = src.read_text().splitlines()  # drop the first shaft element's material table
     i = next(k for k, ln in enumerate(lines) if ln.endswith('Element 0".material]'))
     j = next(k for k in range(i + 1, len(lines)) if lines[k].startswith("["))
     (tmp_path / "nomat.toml").write_text("\n".join(lines[:i] + lines[j:]))
     (tmp_path / "junk.json").write_text('{"parameters": 1}')
-    for name, key in (("tapered.toml", "tapered"), ("nomat.toml", "material"),
+    for name, key in (("hut.toml", "hutchinson"), ("nomat.toml", "material"),
                       ("junk.json", "not a ROSS rotor")):
         assert main(["import-ross", str(tmp_path / name), "--out", str(out)]) == 2
         err = capsys.readouterr().err
@@ -366,3 +369,198 @@ def test_fine_mesh_modes_equal_ross_on_the_same_mesh(tmp_path, capsys):
         near = ref[np.abs(ref[None, :] - lam[:, None]).argmin(axis=1)]
         err = np.abs(lam - near) / np.abs(near)
         assert np.all(err <= 1e-6), (rpm, err)
+
+
+def _coaxial_rotor():
+    """ROSS's co-axial rotor as ROSS's tests build it (``test_rotor_assembly.coaxrotor``):
+    two shafts, four disks, three bearings to ground and one linking the shafts."""
+    steel = rs.materials.steel
+    inner = [rs.ShaftElement(0.25, 0.0, 0.05, material=steel) for _ in range(10)]
+    outer = [rs.ShaftElement(0.25, 0.25, 0.30, material=steel) for _ in range(6)]
+    disks = [rs.DiskElement.from_geometry(n=n, material=steel, width=0.07, i_d=i, o_d=o)
+             for n, i, o in ((1, 0.05, 0.28), (9, 0.05, 0.28), (13, 0.20, 0.48),
+                             (15, 0.20, 0.48))]
+    bearings = [rs.BearingElement(0, kxx=1e6, kyy=1e6, cxx=0),
+                rs.BearingElement(10, kxx=1e6, kyy=1e6, cxx=0),
+                rs.BearingElement(11, kxx=1e6, kyy=1e6, cxx=0),
+                rs.BearingElement(8, n_link=17, kxx=1e6, kyy=1e6, cxx=0)]
+    return _quiet(rs.CoAxialRotor, [inner, outer], disks, bearings)
+
+
+def test_coaxial_rotor_is_refused_naming_its_shafts(tmp_path, capsys):
+    """ROSS's co-axial rotor, saved by ROSS (whose own loader fails on it with "10 is not
+    in list"): ``import-ross`` exits 2 with one line that names the file and says that its
+    two shafts are not supported; :func:`from_ross` on the rotor in memory says the same."""
+    from ambseal.cli import main
+    from ambseal.errors import ConfigError
+
+    rotor = _coaxial_rotor()
+    src = tmp_path / "coaxial.toml"
+    _quiet(rotor.save, src)
+    assert main(["import-ross", str(src), "--out", str(tmp_path / "rig.toml")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert err.startswith(f"ambseal: error: {src}: 2 shafts (nodes 0–10, nodes 11–17")
+    assert "several shafts are not supported" in err and "not in list" not in err
+    assert not (tmp_path / "rig.toml").exists()
+    with pytest.raises(ConfigError, match="2 shafts .*several shafts are not supported"):
+        from_ross(rotor)
+
+
+def _flags_rotor(shear: bool):
+    """ROSS's ``rotor_example_6dof`` shaft (6 elements) with the rotary inertia and
+    gyroscopic terms switched off element by element in every combination, two disks, on
+    anisotropic damped bearings."""
+    ex = _quiet(rs.rotor_example_6dof)
+    flags = [(False, True), (True, False), (False, False), (True, True), (False, True),
+             (True, False)]
+    shafts = [rs.ShaftElement(e.L, e.idl, e.odl, material=e.material, shear_effects=shear,
+                              rotary_inertia=ri, gyroscopic=gy)
+              for e, (ri, gy) in zip(ex.shaft_elements, flags)]
+    b = [rs.BearingElement(n, kxx=1e6, kyy=0.8e6, cxx=150.0, cyy=90.0) for n in (0, 6)]
+    return _quiet(rs.Rotor, shafts, ex.disk_elements, b)
+
+
+def test_rotor_example_6dof_without_rotary_inertia_equals_ross(tmp_path):
+    """ROSS's ``rotor_example_6dof`` (E–B elements without rotary inertia, with gyroscopic
+    terms), saved and imported: every section has ``rotary_inertia = false``, and its 12
+    lateral modes up to 500 Hz at 0 and 100 rad/s equal ROSS's to 1e-6; at 100 rad/s its
+    lateral natural frequencies are those ROSS's doctest prints (91.84, 96.36, 274.44 rad/s,
+    to its two decimals; ROSS's first, 47.62, is the axial mode on kzz)."""
+    rotor = _quiet(rs.rotor_example_6dof)
+    path = tmp_path / "6dof.toml"
+    _quiet(rotor.save, path)
+    cfg = from_ross(load_ross(path), where=str(path)).rig
+    assert all(not s.rotary_inertia and s.gyroscopic for s in cfg.shaft)
+    assert cfg.rotor.beam == "euler-bernoulli"
+    for w in (0.0, 100.0):
+        _assert_modes_equal_ross(cfg, rotor, w, 500.0, 12)
+    m = closed_loop_modes(cfg, None, speed_hz=100.0 / (2 * np.pi), max_hz=60.0)
+    assert np.round(np.abs(m.poles[:3]), 2) == pytest.approx([91.84, 96.36, 274.44])
+
+
+@pytest.mark.parametrize("shear", [True, False])
+def test_rotary_inertia_and_gyroscopic_per_element_equal_ross(shear):
+    """Each combination of ROSS's ``rotary_inertia`` and ``gyroscopic`` flags, element by
+    element, on Timoshenko and E–B elements: the imported sections carry them, and every
+    lateral mode up to 1 kHz (damped frequency and log decrement) equals ROSS's at 0 and
+    5000 rpm to 1e-6."""
+    rotor = _flags_rotor(shear)
+    cfg = from_ross(rotor).rig
+    assert [(s.rotary_inertia, s.gyroscopic) for s in cfg.shaft] == [
+        (e.rotary_inertia, e.gyroscopic) for e in rotor.shaft_elements]
+    for rpm in (0.0, 5000.0):
+        _assert_modes_equal_ross(cfg, rotor, rpm * np.pi / 30, 1000.0, 16)
+
+
+def _loaded_rotor(**load):
+    """The rotor of ROSS's ``test_axial_force`` and ``test_torque`` (six 0.25 m Timoshenko
+    elements of d = 50 mm, two disks from geometry, bearings of 1e6 N/m), each element
+    carrying ``load`` (``axial_force`` in N and/or ``torque`` in N·m)."""
+    steel = rs.Material("steel", E=211e9, G_s=81.2e9, rho=7810)
+    bearings = [rs.BearingElement(n=n, kxx=1e6, cxx=0, scale_factor=2) for n in (0, 6)]
+    disks = [rs.DiskElement.from_geometry(n=n, material=steel, width=0.07, i_d=0.05, o_d=o,
+                                          scale_factor="mass")
+             for n, o in ((2, 0.28), (4, 0.35))]
+    shaft = [rs.ShaftElement(L=0.25, idl=0, odl=0.05, material=steel, **load)
+             for _ in range(6)]
+    return _quiet(rs.Rotor, shaft_elements=shaft, disk_elements=disks,
+                  bearing_elements=bearings)
+
+
+@pytest.mark.parametrize(("load", "asserted"), [
+    ({"axial_force": 100e3}, [93.416071, 95.2335, 267.475281, 309.918575, 634.40757]),
+    ({"torque": 100e3}, [81.324905, 84.769077, 242.822862, 286.158147, 591.519983]),
+])
+def test_axial_force_and_torque_equal_ross(tmp_path, load, asserted):
+    """ROSS's ``test_axial_force`` (100 kN) and ``test_torque`` (100 kN·m) rotors, saved and
+    imported: every section carries the load, every lateral mode up to 200 Hz equals
+    ROSS's to 1e-6 at 0 and 4000 rpm, and at 4000 rpm the damped natural frequencies are
+    the five lateral ones ROSS's tests assert (rad/s; ROSS's sixth, 650.41 rad/s, is the
+    torsional mode, the same in both and without a load). A compressive force of the same
+    size softens the shaft, as ROSS has it too."""
+    rotor = _loaded_rotor(**load)
+    path = tmp_path / "loaded.toml"
+    _quiet(rotor.save, path)
+    cfg = from_ross(load_ross(path), where=str(path)).rig
+    (key, value), = load.items()
+    assert all(getattr(s, key) == value for s in cfg.shaft)
+    assert parse_rig(tomllib.loads(dump_rig(cfg))) == cfg
+    for rpm in (0.0, 4000.0):
+        _assert_modes_equal_ross(cfg, rotor, rpm * np.pi / 30, 200.0, 8)
+    m = closed_loop_modes(cfg, None, speed_hz=4000 / 60, max_hz=200.0)
+    assert np.sort(m.poles.imag)[:5] == pytest.approx(asserted, rel=1e-6)
+    if key == "axial_force":
+        soft = _loaded_rotor(axial_force=-value)
+        cfg_soft = from_ross(soft).rig
+        _assert_modes_equal_ross(cfg_soft, soft, 4000 * np.pi / 30, 200.0, 8)
+        low = closed_loop_modes(cfg_soft, None, speed_hz=4000 / 60, max_hz=200.0)
+        assert np.sort(low.poles.imag)[0] < 0.85 * asserted[0]
+
+
+def _conical_rotor(k: float):
+    """ROSS's ``rotor_conical`` as ROSS's tests build it (``test_rotor_assembly``): a solid
+    cone 0.5 m long from d = 100 mm to 10 mm in four conical elements, on bearings of
+    stiffness ``k`` at its ends (ROSS's 1e20 N/m is beyond the rig file's 1e12)."""
+    n, odl, odr = 4, 0.1, 0.01
+    dd = (odl - odr) / n
+    shaft = [rs.ShaftElement(n=i, idl=0.0, odl=odl - i * dd, idr=0.0, odr=odl - (i + 1) * dd,
+                             material=rs.materials.steel, L=0.5 / n) for i in range(n)]
+    bearings = [rs.BearingElement(n=i, kxx=k, kyy=k, cxx=0) for i in (0, n)]
+    return _quiet(rs.Rotor, shaft_elements=shaft, bearing_elements=bearings)
+
+
+def test_conical_rotor_equals_ross_and_its_asserted_frequencies(tmp_path):
+    """ROSS's conical rotor, saved and imported: four tapered sections (Genta & Gugliotta's
+    conical element, as ROSS's); on 1e12 N/m bearings every lateral mode up to 5 kHz equals
+    ROSS's to 1e-6 at standstill and at 30 000 rpm. Pinned at both ends — the limit of
+    ROSS's 1e20 N/m bearings — the imported shaft's natural frequencies are those ROSS's
+    ``test_rotor_conical_frequencies`` asserts (1630.75, 9899.54, 21074.45 rad/s, each
+    twice) to 1e-7, the spread of ROSS's own pairs. The cone as one section of four
+    elements (``outer_diameter_right``, diameters interpolated by the mesh) has the same
+    modes to 1e-12."""
+    from ambseal.model.rotor import assemble_rotor
+
+    rotor = _conical_rotor(1e12)
+    path = tmp_path / "conical.toml"
+    _quiet(rotor.save, path)
+    cfg = from_ross(load_ross(path), where=str(path)).rig
+    assert [s.outer_diameter_right for s in cfg.shaft] == pytest.approx(
+        [0.0775, 0.055, 0.0325, 0.01], rel=1e-12)
+    for rpm in (0.0, 30000.0):
+        _assert_modes_equal_ross(cfg, rotor, rpm * np.pi / 30, 5000.0, 6)
+    r = assemble_rotor(cfg)
+    n = r.K.shape[0]
+    keep = np.array([i for i in range(n) if i not in (0, 1, n - 4, n - 3)])
+    w = np.sqrt(sla.eigh(r.K[np.ix_(keep, keep)], r.M[np.ix_(keep, keep)],
+                         eigvals_only=True)[:6])
+    asserted = [1630.7509182, 1630.75091824, 9899.54379138, 9899.54396231,
+                21074.45440319, 21074.45440372]
+    assert w == pytest.approx(asserted, rel=1e-7)
+    data = cfg.model_dump(exclude_none=True)
+    data["shaft"] = [{"length": 0.5, "outer_diameter": 0.1, "outer_diameter_right": 0.01,
+                      "material": cfg.shaft[0].material, "elements": 4}]
+    one = closed_loop_modes(parse_rig(data), None, speed_hz=0.0, max_hz=5000.0)
+    four = closed_loop_modes(cfg, None, speed_hz=0.0, max_hz=5000.0)
+    assert one.poles == pytest.approx(four.poles, rel=1e-12)
+
+
+@pytest.mark.parametrize("shear", [True, False])
+def test_hollow_tapered_elements_with_loads_equal_ross(shear):
+    """ROSS's ``rotor_example`` with its shaft made of hollow cones (bore and outside
+    tapering, widening and narrowing in turn) carrying an axial force and a torque, on the
+    Timoshenko and the E–B element: every lateral mode up to 1 kHz equals ROSS's to 1e-6 at
+    0 and 6000 rpm."""
+    ex = rs.rotor_example()
+    ends = [(0.0, 0.05), (0.01, 0.06), (0.0, 0.045), (0.012, 0.055), (0.005, 0.05),
+            (0.0, 0.04), (0.01, 0.05)]
+    shafts = [rs.ShaftElement(e.L, ends[i][0], ends[i][1], idr=ends[i + 1][0],
+                              odr=ends[i + 1][1], material=e.material, shear_effects=shear,
+                              axial_force=2e4, torque=-1e3)
+              for i, e in enumerate(ex.shaft_elements)]
+    b = [rs.BearingElement(n, kxx=1e6, kyy=0.8e6, cxx=150.0, cyy=90.0) for n in (0, 6)]
+    rotor = _quiet(rs.Rotor, shafts, ex.disk_elements, b)
+    cfg = from_ross(rotor).rig
+    assert all(s.inner_diameter_right is not None for s in cfg.shaft[:5])
+    for rpm in (0.0, 6000.0):
+        _assert_modes_equal_ross(cfg, rotor, rpm * np.pi / 30, 1000.0, 14)

@@ -18,7 +18,12 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     ``length``, ``outer_diameter``, ``inner_diameter`` (default 0) in m, ``material`` (a
     NAME of ``[materials]``), ``elements`` (beam elements in the section, default 1),
     ``layers`` (optional concentric tubes ``{ outer_diameter, inner_diameter, material }``
-    on the same nodes, each a beam of its own whose matrices add to the section's).
+    on the same nodes, each a beam of its own whose matrices add to the section's);
+    per tube (section and layer) ``rotary_inertia`` and ``gyroscopic`` (default true: the
+    element's rotary-inertia and gyroscopic matrices, either may be left out),
+    ``axial_force`` (N, tension positive) and ``torque`` (N·m): their geometric stiffness;
+    ``outer_diameter_right``, ``inner_diameter_right`` (m, default: the left end's): a
+    tapered (conical) tube, its diameters linear along the section.
 ``[[disk]]``
     ``position`` (m), ``mass`` (kg), ``Ip``, ``Id`` (kg·m²), ``name`` (optional).
 ``[[amb]]``
@@ -179,12 +184,37 @@ class ShaftLayer(_Strict):
     outer_diameter: float = Field(ge=1e-4, le=10.0)
     inner_diameter: float = Field(default=0.0, ge=0)
     material: str
+    rotary_inertia: bool = True
+    gyroscopic: bool = True
+    # plausible: a tie bolt's preload or a turbine shaft's thrust is up to some MN, its
+    # torque some MN·m; 1e9 N and 1e8 N·m keep a typo out without bounding any machine
+    axial_force: float = Field(default=0.0, ge=-1e9, le=1e9)
+    torque: float = Field(default=0.0, ge=-1e8, le=1e8)
+    outer_diameter_right: float | None = Field(default=None, ge=1e-4, le=10.0)
+    inner_diameter_right: float | None = Field(default=None, ge=0)
 
     @model_validator(mode="after")
     def _bore(self) -> "ShaftLayer":
-        if self.inner_diameter >= self.outer_diameter:
-            raise ValueError("expected inner_diameter < outer_diameter")
+        _check_bore(self)
         return self
+
+
+def _right_end(tube) -> tuple[float, float]:
+    """(outer, inner) diameter (m) at a tube's right end: the ``_right`` keys, else the
+    left end's (a uniform tube)."""
+    return (tube.outer_diameter if tube.outer_diameter_right is None
+            else tube.outer_diameter_right,
+            tube.inner_diameter if tube.inner_diameter_right is None
+            else tube.inner_diameter_right)
+
+
+def _check_bore(tube) -> None:
+    if tube.inner_diameter >= tube.outer_diameter:
+        raise ValueError("expected inner_diameter < outer_diameter")
+    do_r, di_r = _right_end(tube)
+    if di_r >= do_r:
+        raise ValueError(f"expected inner_diameter_right ({di_r:g} m) < "
+                         f"outer_diameter_right ({do_r:g} m) (a tapered tube's right end)")
 
 
 class ShaftSection(_Strict):
@@ -194,19 +224,30 @@ class ShaftSection(_Strict):
     material: str
     elements: int = Field(default=1, ge=1, le=MAX_ELEMENTS)
     layers: list[ShaftLayer] = Field(default=[], max_length=MAX_LAYERS)
+    rotary_inertia: bool = True
+    gyroscopic: bool = True
+    # plausible: a tie bolt's preload or a turbine shaft's thrust is up to some MN, its
+    # torque some MN·m; 1e9 N and 1e8 N·m keep a typo out without bounding any machine
+    axial_force: float = Field(default=0.0, ge=-1e9, le=1e9)
+    torque: float = Field(default=0.0, ge=-1e8, le=1e8)
+    outer_diameter_right: float | None = Field(default=None, ge=1e-4, le=10.0)
+    inner_diameter_right: float | None = Field(default=None, ge=0)
 
     @model_validator(mode="after")
     def _bore(self) -> "ShaftSection":
-        if self.inner_diameter >= self.outer_diameter:
-            raise ValueError("expected inner_diameter < outer_diameter")
-        tubes = sorted([self, *self.layers], key=lambda t: t.inner_diameter)
-        for a, b in zip(tubes, tubes[1:]):
-            if b.inner_diameter < a.outer_diameter * (1 - 1e-12):
-                raise ValueError(
-                    f"layers: the tubes {a.inner_diameter:g}–{a.outer_diameter:g} m and "
-                    f"{b.inner_diameter:g}–{b.outer_diameter:g} m overlap (expected "
-                    "concentric tubes, each layer's inner_diameter >= the outer_diameter "
-                    "of the tube inside it)")
+        _check_bore(self)
+        # the diameters run linearly from end to end: tubes apart at both ends are apart
+        # everywhere between
+        for end, ends in (("left", [(t.outer_diameter, t.inner_diameter)
+                                    for t in (self, *self.layers)]),
+                          ("right", [_right_end(t) for t in (self, *self.layers)])):
+            tubes = sorted(ends, key=lambda t: t[1])
+            for (ao, ai), (bo, bi) in zip(tubes, tubes[1:]):
+                if bi < ao * (1 - 1e-12):
+                    raise ValueError(
+                        f"layers: the tubes {ai:g}–{ao:g} m and {bi:g}–{bo:g} m overlap "
+                        f"at the {end} end (expected concentric tubes, each layer's inner "
+                        "diameter >= the outer diameter of the tube inside it)")
         return self
 
 
@@ -713,6 +754,12 @@ def _toml_table(name: str, val: dict, lines: list[str]) -> None:
                 lines += [f"{j} = {_toml_value(y)}" for j, y in item.items()]
 
 
+#: The options of a shaft tube (section or layer) and their defaults, which
+#: :func:`dump_rig` leaves out.
+_TUBE_DEFAULTS = {"rotary_inertia": True, "gyroscopic": True, "axial_force": 0.0,
+                  "torque": 0.0}  # the right end's diameters: None, left out as any None
+
+
 def dump_rig(cfg: RigConfig, header: str = "") -> str:
     """The rig as TOML text that :func:`load_rig` reads back to the same configuration.
 
@@ -729,6 +776,12 @@ def dump_rig(cfg: RigConfig, header: str = "") -> str:
         The TOML document, ending with a newline.
     """
     data = cfg.model_dump(exclude_none=True)
+    # the per-tube options at their defaults are left out: most rigs use none of them
+    for sec in data.get("shaft", []):
+        for tube in (sec, *sec.get("layers", [])):
+            for k, default in _TUBE_DEFAULTS.items():
+                if k in tube and tube[k] == default:
+                    del tube[k]
     lines = [f"# {line}" for line in header.splitlines()]
     for key, val in data.items():
         if isinstance(val, list):

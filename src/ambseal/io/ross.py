@@ -11,11 +11,16 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
   hubs around it, which ROSS assembles by adding their matrices) → the innermost tube is the
   section, the others its ``layers``, each a beam with its own material and shear
   parameter, as ROSS has them. ROSS's Timoshenko element with Cowper's shear coefficient is
-  ambseal's ``beam = "timoshenko"``; without shear effects, ``"euler-bernoulli"`` (with
-  rotary inertia). Tapered elements, axial force or torque, elements without rotary
-  inertia or gyroscopic terms, and Hutchinson's shear coefficient have no equivalent: an
-  error. ROSS's Rayleigh damping of shaft elements (``alpha``, ``beta``) has none either:
-  reported, left out.
+  ambseal's ``beam = "timoshenko"``; without shear effects, ``"euler-bernoulli"``.
+  ROSS's ``rotary_inertia`` and ``gyroscopic`` flags of each element → the tube's keys of
+  the same names, its ``axial_force`` (N) and ``torque`` (N·m) → the tube's keys of the
+  same names (their geometric stiffness, :meth:`ambseal.model.fe.BeamElement._geometric`);
+  a tapered element (``odr``, ``idr`` differ from ``odl``, ``idl``) → a section with
+  ``outer_diameter_right``, ``inner_diameter_right``, whose element is Genta & Gugliotta's
+  conical one as ROSS's (:class:`ambseal.model.fe.BeamElement`). Hutchinson's shear
+  coefficient has no equivalent: an error. ROSS's Rayleigh damping of shaft elements (``alpha``, ``beta``) has none either:
+  reported, left out. Several shafts (ROSS's ``CoAxialRotor``, its shafts linked by
+  bearings): an error naming them (an ambseal rig has one shaft).
 * ``DiskElement`` → ``[[disk]]`` (m, Ip, Id); a ``PointMass`` on a shaft node → a disk
   without inertia.
 * ``BearingElement`` and its kinds (``SealElement``, fluid-film, ball, ...): coefficients of
@@ -143,23 +148,16 @@ def _materials(shafts, where: str) -> tuple[dict, list[str]]:
 
 def _check_element(el, where: str) -> None:
     tag = f"shaft element {el.n} ({el.tag})"
-    if not (math.isclose(el.idl, el.idr) and math.isclose(el.odl, el.odr)):
-        raise _bad(where, f"{tag}: tapered element (idl/idr, odl/odr differ) is not supported")
-    if not (el.rotary_inertia and el.gyroscopic):
-        raise _bad(where, f"{tag}: elements without rotary inertia or gyroscopic terms are "
-                          "not supported")
     if el.shear_effects and el.shear_method_calc != "cowper":
         raise _bad(where, f"{tag}: shear_method_calc {el.shear_method_calc!r} is not "
                           "supported (expected 'cowper')")
-    if getattr(el, "axial_force", 0) or getattr(el, "torque", 0):
-        raise _bad(where, f"{tag}: axial_force / torque (their stiffening) have no ambseal "
-                          "equivalent")
 
 
 def _shaft(rotor, where: str) -> tuple[list[dict], dict, str, list[str]]:
     """``[[shaft]]`` sections (one per node pair, layered elements as ``layers``), the
     materials, the beam type and what was left out."""
     shafts = sorted(rotor.shaft_elements, key=lambda e: (e.n, e.idl))
+    _one_shaft([int(el.n) for el in shafts], where)
     pairs: dict[int, list] = {}
     for el in shafts:
         _check_element(el, where)
@@ -182,7 +180,11 @@ def _shaft(rotor, where: str) -> tuple[list[dict], dict, str, list[str]]:
                               f"({', '.join(str(e.tag) for e in group)}): lengths differ "
                               "(layered elements share their nodes)")
         tubes = [{"outer_diameter": float(e.odl), "inner_diameter": float(e.idl),
-                  "material": key_of[id(e)]} for e in group]
+                  "material": key_of[id(e)], "rotary_inertia": bool(e.rotary_inertia),
+                  "gyroscopic": bool(e.gyroscopic), "axial_force": float(e.axial_force),
+                  "torque": float(e.torque)}
+                 | ({"outer_diameter_right": float(e.odr), "inner_diameter_right": float(e.idr)}
+                    if (e.odr, e.idr) != (e.odl, e.idl) else {}) for e in group]
         section = {"length": float(group[0].L), **tubes[0], "elements": 1}
         if len(tubes) > 1:
             section["layers"] = tubes[1:]
@@ -552,7 +554,28 @@ def _check_file(path: Path, ross=None) -> dict:
         if kind == "ShaftElement" and not isinstance(val.get("material"), dict):
             raise ConfigError(f"{path}: {key}: missing material (expected a table "
                               f"[\"{key}\".material] with rho, E, G_s)")
+    pairs = [v.get("n") for k, v in data.items() if k.startswith("ShaftElement_")]
+    if pairs and all(isinstance(n, int) and not isinstance(n, bool) for n in pairs):
+        _one_shaft(pairs, str(path))
     return data
+
+
+def _one_shaft(pairs, where: str) -> None:
+    """Refuse shaft elements that form several shafts: ROSS numbers the nodes of a
+    ``CoAxialRotor``'s shafts one after the other, so its second shaft starts one node past
+    the first one's end, and its saved file does not say which shaft an element is on —
+    the gap in the node pairs is what tells (ROSS's own loader then fails obscurely)."""
+    runs: list[list[int]] = []
+    for n in sorted(set(pairs)):
+        if runs and n == runs[-1][1]:
+            runs[-1][1] = n + 1
+        else:
+            runs.append([n, n + 1])
+    if len(runs) > 1:
+        spans = ", ".join(f"nodes {a}–{b}" for a, b in runs[:4]) + (
+            ", ..." if len(runs) > 4 else "")
+        raise ConfigError(f"{where}: {len(runs)} shafts ({spans}; a ROSS CoAxialRotor): "
+                          "several shafts are not supported (an ambseal rig has one shaft)")
 
 
 def _child() -> None:

@@ -10,7 +10,8 @@ bearing/seal/spring terms added by :mod:`ambseal.model.rig`.
 
 The mesh puts a node at every section boundary and at every component position (disks,
 AMBs, sensors, seals, springs); each ``[[shaft]]`` section is first divided into its
-``elements`` equal elements and those are split where a component falls inside one.
+``elements`` equal elements and those are split where a component falls inside one; the
+parts of a tapered section are conical elements with the section's diameters at their ends.
 """
 
 from __future__ import annotations
@@ -71,6 +72,26 @@ def _snap(length: float) -> float:
     return 1e-6 * max(length, 1.0)
 
 
+def _piece(tube, a: float, b: float) -> dict:
+    """The diameters of the part ξ ∈ [a, b] of a (possibly tapered) tube, ξ = z/length
+    along its section: a tapered tube's diameters are linear in z, so every part of it is
+    a conical element of its own, with no stepping."""
+    do_r = tube.outer_diameter if tube.outer_diameter_right is None else (
+        tube.outer_diameter_right)
+    di_r = tube.inner_diameter if tube.inner_diameter_right is None else (
+        tube.inner_diameter_right)
+    if do_r == tube.outer_diameter and di_r == tube.inner_diameter:
+        return {"outer_diameter": tube.outer_diameter, "inner_diameter": tube.inner_diameter}
+
+    def at(left, right, x):
+        return left + (right - left) * x
+
+    return {"outer_diameter": at(tube.outer_diameter, do_r, a),
+            "inner_diameter": at(tube.inner_diameter, di_r, a),
+            "outer_diameter_right": at(tube.outer_diameter, do_r, b),
+            "inner_diameter_right": at(tube.inner_diameter, di_r, b)}
+
+
 def build_mesh(cfg: RigConfig, extra_positions: tuple[float, ...] = ()) -> Mesh:
     """Mesh the shaft of a rig.
 
@@ -111,12 +132,15 @@ def build_mesh(cfg: RigConfig, extra_positions: tuple[float, ...] = ()) -> Mesh:
             tubes = tuple(
                 BeamElement(
                     length=p - left,
-                    outer_diameter=t.outer_diameter,
-                    inner_diameter=t.inner_diameter,
+                    **_piece(t, (left - z0) / sec.length, (p - z0) / sec.length),
                     E=cfg.materials[t.material].E,
                     shear_modulus=cfg.materials[t.material].shear_modulus,
                     rho=cfg.materials[t.material].rho,
                     timoshenko=beam_tim,
+                    rotary_inertia=t.rotary_inertia,
+                    gyroscopic=t.gyroscopic,
+                    axial_force=t.axial_force,
+                    torque=t.torque,
                 )
                 for t in (sec, *sec.layers)
             )
@@ -148,7 +172,7 @@ class RotorMatrices:
     M : ndarray, shape (n_dof, n_dof)
         Mass matrix (kg, kg·m²).
     K : ndarray, shape (n_dof, n_dof)
-        Stiffness matrix (N/m, N·m/rad).
+        Stiffness matrix (N/m, N·m/rad); not symmetric where a section carries torque.
     C : ndarray, shape (n_dof, n_dof)
         Structural (modal) damping (N·s/m): the rotor's ``modal_damping`` on every
         free–free elastic mode.
@@ -206,7 +230,10 @@ def assemble_rotor(cfg: RigConfig, mesh: Mesh | None = None) -> RotorMatrices:
         s = slice(4 * mesh.node_at(d.position), 4 * mesh.node_at(d.position) + 4)
         M[s, s] += de.M()
         G[s, s] += de.G()
-    return RotorMatrices(mesh=mesh, M=M, K=K, C=modal_damping(M, K, cfg.rotor.modal_damping), G=G)
+    # a torque's stiffness has a circulatory (skew) part: the free–free modes that the
+    # structural damping is set on are those of the conservative part
+    C = modal_damping(M, (K + K.T) / 2, cfg.rotor.modal_damping)
+    return RotorMatrices(mesh=mesh, M=M, K=K, C=C, G=G)
 
 
 def modal_damping(M: np.ndarray, K: np.ndarray, zeta: float) -> np.ndarray:

@@ -35,8 +35,9 @@ from pydantic import BaseModel
 #: the key reference; :func:`missing_key_docs` checks it against the models.
 KEY_DOCS: dict[str, tuple[str, str]] = {
     # [rotor]
-    "Rotor.beam": ("", "beam theory of the shaft elements (Timoshenko: shear and rotary "
-                       "inertia; Euler–Bernoulli: neither)"),
+    "Rotor.beam": ("", "beam theory of the shaft elements: Timoshenko (shear deformation) "
+                       "or Euler–Bernoulli (none); their rotary inertia is each section's "
+                       "rotary_inertia"),
     "Rotor.name": ("", "the machine's name, in every output and the report header"),
     "Rotor.modal_damping": ("", "damping ratio ζ given to every free–free bending mode of "
                                 "shaft and disks (structural damping)"),

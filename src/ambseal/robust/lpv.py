@@ -1,7 +1,7 @@
 """Gridded H∞ LPV synthesis by LMIs, scheduled on one measured parameter θ.
 
-θ is whatever the plants are gridded on, in its own unit (a speed in rad/s, a stiffness
-in N/m, …); nothing here knows which.
+θ is whatever the plants are gridded on, in its own unit (an angular velocity in rad/s, a
+stiffness in N/m, …); nothing here knows which.
 
 Two Lyapunov functions: a constant one (Apkarian & Adams 1998: stability and performance
 under arbitrarily fast parameter changes) and a parameter-dependent one with a bound on
@@ -79,8 +79,8 @@ class LpvController:
     entries.
 
     ``u = K(θ) y`` in the generalised plant's convention (the lower LFT F_l(P, K),
-    positive feedback); θ is whatever the plants were gridded on, in its own unit (a
-    speed in rad/s, a stiffness in N/m, …).
+    positive feedback); θ is whatever the plants were gridded on, in its own unit (an
+    angular velocity in rad/s, a stiffness in N/m, …).
 
     Attributes
     ----------

@@ -103,7 +103,7 @@ class Scaled:
     sy: np.ndarray
     w0: float
     p_of: Any  # θ (its own unit) → p ∈ [−1, 1]
-    dp_dW: float
+    dp_dtheta: float
     sigma: np.ndarray  # balanced Riccati values (1 for diagonal scaling)
 
     def to_scaled_A(self, A: np.ndarray) -> np.ndarray:
@@ -195,7 +195,7 @@ def scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling: str = "ricc
     mid = 0.5 * (grid[-1] + grid[0])
     dAs_s = np.einsum("ij,kjl,lm->kim", Tinv, dAs, T) / w0 * half  # per unit p
     return Scaled(As_s, dAs_s, Bs, Cs, Ds, T, su, sy, w0,
-                   lambda W: (np.asarray(W, float) - mid) / half, 1.0 / half, sig)
+                   lambda th: (np.asarray(th, float) - mid) / half, 1.0 / half, sig)
 
 
 def lmi_blocks(sc: Scaled, nw, nz, ncon, nmeas):

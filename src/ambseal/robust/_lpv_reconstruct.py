@@ -63,9 +63,9 @@ def reconstruct_table(sc: Scaled, blocks, table: np.ndarray, A_of, R: np.ndarray
     n_held, t_rec = 0, time.perf_counter()
     rec = _Reconstructor(B1, B2, C1, C2, D11, D12, D21, R, gamma, margin,
                          2 if (nb > 1 and nu_s > 0) else 1)
-    for W in table:
-        A_s = sc.to_scaled_A(A_of(W))
-        p = float(sc.p_of(W))
+    for th in table:
+        A_s = sc.to_scaled_A(A_of(th))
+        p = float(sc.p_of(th))
         f, df = basis(lyapunov, p)
         Sw = sum(fi * Si for fi, Si in zip(f, S))
         dS = sum(dfi * Si for dfi, Si in zip(df, S)) if nb > 1 else None
@@ -84,10 +84,10 @@ def reconstruct_table(sc: Scaled, blocks, table: np.ndarray, A_of, R: np.ndarray
 
 def interp_A(As, dAs, grid):
     """A(θ) between grid points: cubic Hermite with the given slopes (exact for affine A)."""
-    def f(W: float) -> np.ndarray:
-        j = int(np.clip(np.searchsorted(grid, W) - 1, 0, len(grid) - 2))
+    def f(th: float) -> np.ndarray:
+        j = int(np.clip(np.searchsorted(grid, th) - 1, 0, len(grid) - 2))
         h = grid[j + 1] - grid[j]
-        t = (W - grid[j]) / h
+        t = (th - grid[j]) / h
         if t <= 1e-12:
             return As[j]
         if t >= 1 - 1e-12:
@@ -114,8 +114,8 @@ class _Reconstructor:
     2 = x_S, 3 = (w, z), choosing ``Â + Aᵀ = P23 P33⁻¹ P13ᵀ`` makes the Schur complement
     with respect to P33 ≺ 0 block diagonal, so the LMI holds iff the two small LMIs in
     rows {1, 3} (Ĉ: a state-feedback H∞ LMI with R fixed) and rows {2, 3} (B̂: the
-    filter LMI with S(θ) fixed, for Ṡ = ±ν ∂S/∂θ) hold — the feasibility of which is what
-    the projected LMIs guarantee (Gahinet & Apkarian 1994, elimination lemma).
+    filter LMI with S(θ) fixed, for Ṡ = ±ν ∂S/∂θ) hold — the feasibility of which is
+    what the projected LMIs guarantee (Gahinet & Apkarian 1994, elimination lemma).
 
     With D_K = 0 both are quadratic in their unknown with a positive definite leading
     term, so completing the square solves them. Ĉ-side, after the Schur complements of the

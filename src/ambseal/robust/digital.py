@@ -389,10 +389,11 @@ def _remove_fast(K, mats: Matrices, fs: float, rise: Callable | None):
 
 @dataclass(frozen=True, eq=False)
 class SampledPlants:
-    """The full-order plants the choice is made on, continuous (``plants``: with the hold + computation
-    delay of ``delay_samples`` as a Padé lag on every input) and ZOH-sampled at ``fs``
-    (``sampled``: without, the delay is the discrete controller's; ``ideal``: the continuous
-    plants without the delay, where the design must run stably), with their frequency
+    """The full-order plants the choice is made on, continuous (``plants``: with the
+    hold + computation delay of ``delay_samples`` as a Padé lag on every input) and
+    ZOH-sampled at ``fs`` (``sampled``: without, the delay is the discrete controller's;
+    ``ideal``: the continuous plants without the delay, where the design must run
+    stably), with their frequency
     responses on a log grid up to Nyquist: computed once, shared by every controller
     chosen for the same conditions (:func:`sampled_plants`)."""
 

@@ -1,4 +1,4 @@
-"""ambseal.lti: state-space numerics every stage shares, and nothing physical.
+"""ambseal.lti: state-space numerics every layer shares, and nothing physical.
 
 The lowest numerical layer (it imports only :mod:`ambseal.errors`); each idea once, on
 ``control.StateSpace`` or plain ``(A, B, C, D)`` matrices:

@@ -10,7 +10,7 @@
 
 A continuous system driven by a piecewise-constant input is simulated exactly by
 ``simulate_lti(*zoh(A, B, dt), ...)``: every time response of ambseal (impulse responses,
-the digital loop of the identification, the Youla signals) runs through these two.
+digital closed loops, filtered signals) runs through these two.
 """
 
 from __future__ import annotations
@@ -56,8 +56,7 @@ def zoh(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray
     Franklin, Powell & Workman, *Digital Control of Dynamic Systems*, 3rd ed., §6.3: one
     ``expm`` of ``[[A, B], [0, 0]]·dt``, after a diagonal balancing of ``A``. The result for
     the last few large ``(A, B, dt)`` is kept (:class:`~ambseal.lti.matrices.ArrayMemo`):
-    the full-order plant of one operating point is sampled once for every controller judged
-    on it.
+    a large plant is sampled once for every controller closed with it.
     """
     Ad, Bd = _ZOH.get((np.asarray(A, float), np.asarray(B, float)), float(dt),
                       lambda: _zoh(A, B, dt))

@@ -128,7 +128,7 @@ def freqresp_at(
     """``C (pI − A)⁻¹ B + D`` at arbitrary complex points ``p``, by the method of :func:`freqresp`.
 
     For a discrete-time model pass ``p = exp(jω dt)`` (the unit circle); for a continuous
-    one ``p = jω`` (what :func:`freqresp` does) or any ``s`` off the axis.
+    one ``p = jω`` (what :func:`freqresp` does) or any ``s`` off the imaginary axis.
 
     Parameters
     ----------
@@ -257,10 +257,10 @@ def _balanced_modal(A, B, C, D, s, probe, Hd, max_cond, rtol) -> np.ndarray | No
     ``rtol`` of the dense solves ``Hd`` at ``probe``; else None. Used where the modal form of
     ``A`` is ill conditioned, and by :func:`_arbitrated`.
 
-    cond V depends on the state scaling: the blower's full-order plant (268 states, [q; q̇]
-    with modes up to 280 kHz) has cond V 5.8e8 > 1e8, balanced 1.1e4, and its balanced
-    modal response agrees with the dense solves to 5e-9 at the probes of its judgement grid
-    (before, each of its judged responses was TB05AD point by point: ~26 s of its 45 s run).
+    cond V depends on the state scaling: a 268-state second-order plant ([q; q̇] with
+    modes up to 280 kHz) has cond V 5.8e8 > 1e8, balanced 1.1e4, and its balanced modal
+    response agrees with the dense solves to 5e-9 at the probes of its frequency grid
+    (TB05AD point by point instead: ~26 s of a 45 s analysis of that plant).
     Checked against the dense solves, not the Hessenberg form: both balanced forms share the
     scaling (see :func:`_arbitrated`)."""
     lam, _, Bb, Cb = _BALANCED.get((A, B, C), max_cond,
@@ -301,8 +301,8 @@ def _balanced_modal_as_good(A, B, C, D, s, probe, Hd, max_cond) -> np.ndarray | 
     of 230 beam elements (1 888 states, eigenvalues from 39 Hz to 1.1 MHz) has the balanced modal
     form 2.78e-8 and the Hessenberg form 2.76e-8 of the peak from the dense solves refined
     in extended precision (the plain dense solves 1e-9). They are equally good, but the
-    Hessenberg form costs O(n²) per point (TB05AD: 17 ms at 1 888 states, 314 s of a
-    judged run of that model) against O(n) for the modal one."""
+    Hessenberg form costs O(n²) per point (TB05AD: 17 ms at 1 888 states, 314 s of an
+    analysis of that model) against O(n) for the modal one."""
     lam, _, Bb, Cb = _BALANCED.get((A, B, C), max_cond,
                                    lambda: _modal_form(A, B, C, max_cond, balance=True))
     if Bb is None:

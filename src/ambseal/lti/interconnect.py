@@ -1,6 +1,6 @@
 """Closing loops: the lower linear fractional transformation and negative feedback.
 
-One implementation serves every stage: the H∞/μ/LPV syntheses close ``F_l(P, K)``
+One implementation serves every caller: the H∞/μ/LPV syntheses close ``F_l(P, K)``
 (Skogestad & Postlethwaite, *Multivariable Feedback Control*, 2nd ed., Eq. 3.111, with a
 general ``D22``), and the negative-feedback loop ``u = −K y + d`` of the analyses and of a
 digital loop is the same transformation of an augmented plant
@@ -9,7 +9,7 @@ functions close continuous and discrete loops.
 
 python-control's ``control.lft`` and ``control.feedback`` compute the same systems (tested side
 by side); these matrix-level versions exist because the synthesis loops (D–K, LPV checks,
-spin-up tabulation) close thousands of loops and need neither signal bookkeeping nor object
+scheduled-controller tables) close thousands of loops and need neither signal bookkeeping nor object
 construction, and because ``control.feedback`` has no separate force inputs.
 
 A controller is connected to its plant by signal names (:func:`wired`): its inputs are the
@@ -135,7 +135,7 @@ def feedback_matrices(G: Matrices, K: Matrices, Gf: tuple[np.ndarray, np.ndarray
     Parameters
     ----------
     G : (A, B, C, D)
-        Plant, ``nu`` current inputs → ``ny`` outputs.
+        Plant, ``nu`` inputs → ``ny`` outputs.
     K : (A_K, B_K, C_K, D_K)
         Controller, ``ny`` inputs → ``nu`` outputs.
     Gf : (B_f, D_f), optional
@@ -170,9 +170,9 @@ _POLES = ArrayMemo(keep=16)  # the last closed-loop state matrices decomposed
 
 def state_poles(A: np.ndarray) -> np.ndarray:
     """Eigenvalues of a state matrix ``A`` (rad/s, or z of a discrete system), kept for the
-    last few large ones (:class:`~ambseal.lti.matrices.ArrayMemo`): the same full-order
-    loop is judged by the design (full-order stability), the discretisation's prewarp
-    frequency and stability screen, and the judgement of the main job. The array is
+    last few large ones (:class:`~ambseal.lti.matrices.ArrayMemo`): a caller asks for the
+    poles of the same large loop several times (its stability after a synthesis, a
+    discretisation's prewarp frequency and stability screen, a later analysis). The array is
     shared: do not modify it in place."""
     A = np.asarray(A, float)
     if not A.size:
@@ -187,7 +187,7 @@ def feedback_poles(G: Matrices, K: Matrices) -> np.ndarray:
     Parameters
     ----------
     G : (A, B, C, D)
-        Plant, ``n`` states, ``nu`` current inputs → ``ny`` outputs.
+        Plant, ``n`` states, ``nu`` inputs → ``ny`` outputs.
     K : (A_K, B_K, C_K, D_K)
         Controller, ``n_K`` states, ``ny`` inputs → ``nu`` outputs, closed as ``u = −K y``.
 
@@ -275,7 +275,7 @@ def wired(G: Any, K: Any) -> Any:
     Parameters
     ----------
     G : control.StateSpace
-        Plant (e.g. current inputs → displacement outputs), continuous or discrete.
+        Plant (command inputs → measured outputs), continuous or discrete.
     K : control.StateSpace or (A, B, C, D)
         Controller in the feedback path: inputs are ``G``'s outputs, outputs ``G``'s inputs.
 

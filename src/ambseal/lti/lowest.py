@@ -3,7 +3,7 @@
 A modal reduction keeps the lowest modes of a model (modal truncation; Gawronski, *Dynamics
 and Control of Structures: A Modal Approach*, 1998) and needs only
 their right and left eigenvectors, not all of them: for the state matrix of a fine FE mesh
-(1 880 states for a 230-element shaft) a dense ``scipy.linalg.eig`` with both sets of
+(1 880 states for 230 beam elements) a dense ``scipy.linalg.eig`` with both sets of
 eigenvectors took 7–10 s on one core, shift-invert Arnoldi (ARPACK through
 ``scipy.sparse.linalg.eigs``: one LU and a few hundred triangular solves) 0.8–1.5 s.
 Small matrices keep the dense eig (``DENSE_STATES``).
@@ -21,7 +21,7 @@ from ambseal.errors import ModelError
 __all__ = ["DENSE_STATES", "lowest_eigenpairs"]
 
 #: States up to which every eigenvalue is taken densely (LAPACK geev): measured on one core
-#: 0.2 s for the eigenvalues of 840 states (a 100-element shaft) and 0.5 s at 1 240, growing
+#: 0.2 s for the eigenvalues of 840 states (100 beam elements) and 0.5 s at 1 240, growing
 #: with states³ (1.6 s at 1 880, 9–11 s at 3 240; about twice that with eigenvectors),
 #: against 0.015–0.07 s for the shift-invert path. Up to here the dense solve is cheap,
 #: needs no iteration that could fail to converge, and keeps the numbers small models

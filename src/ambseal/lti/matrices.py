@@ -1,12 +1,12 @@
-"""Checks and conversions of state-space data shared by every stage (not public API).
+"""Checks and conversions of state-space data shared by every module (not public API).
 
 * :func:`ss_matrices` — ``(A, B, C, D)`` as float arrays from a ``control.StateSpace`` (or
   anything python-control converts) or a tuple;
 * :func:`as_omega` — a checked frequency grid in rad/s;
 * :func:`labels` — signal names of a python-control system, or generated ones;
 * :class:`ArrayMemo` — results of an expensive function of large arrays, kept for the last
-  few distinct inputs (the full-order plant of one condition is decomposed once, not once
-  per controller judged on it).
+  few distinct inputs (a large plant is decomposed once, not once per controller closed
+  with it).
 """
 
 from __future__ import annotations
@@ -83,7 +83,7 @@ class ArrayMemo:
     (BLAKE2b) of the input arrays' shapes, dtypes and bytes plus ``extra``.
 
     Used where one large matrix is decomposed again and again with the same content (the
-    full-order plant of one operating point, judged with every controller): hashing a
+    large plant closed with one controller after another): hashing a
     320 × 320 matrix costs about 1 ms, its eigendecomposition about 60 ms. Only inputs
     with at least ``min_states`` rows are kept (small systems are cheaper to recompute
     than to hash). Cached results are shared: callers must not modify them in place.

@@ -21,7 +21,7 @@ def interp_table(x: float, grid, values):
     grid : array_like, shape (n,)
         Strictly increasing abscissae (n ≥ 1).
     values : array_like, shape (n,) or (n, ...)
-        Tabulated scalars, or a stack of arrays (e.g. matrices) along the first axis.
+        Tabulated scalars, or a stack of arrays (e.g. matrices) stacked along the first dimension.
 
     Returns
     -------

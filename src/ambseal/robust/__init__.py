@@ -17,14 +17,14 @@ Analysis: :func:`mussv` — μ upper and lower bounds for mixed real/complex blo
 
 The controller that runs on a target: :func:`digital_controller` (fast poles removed, the
 discretisation chosen by the sampled loop), :class:`DiscreteController` and the
-sample-and-hold delay of the design model (:func:`design_delay`).
+sample-and-hold delay a synthesis model carries (:func:`design_delay`).
 
 Sign conventions. The synthesis functions and :func:`lft_lower` work on the lower LFT
 ``F_l(P, K)``: their controllers close ``u = K y`` (positive feedback), as python-control's
 ``hinfsyn`` and MATLAB's ``lft`` do. The controllers that run on a target —
 :class:`DigitalController`, :class:`DiscreteController` — map measurements to actuator
 commands with negative feedback, ``u = −K y``; the caller converts one into the other
-(ambseal's own layers: :mod:`ambseal.machine`).
+(the layer that knows which signals are measurements and which are commands).
 """
 
 from ambseal.robust.delay import DesignDelay, design_delay, loop_delay

@@ -41,7 +41,7 @@ def game_riccati(A, B, C1, D1, nw: int, g: float):
     if not np.all(np.isfinite(H)):
         return None
     _, sdim, wr, wi, Z, _, info = dgees(lambda x, y: x < 0.0, H, sort_t=1)
-    if info or sdim != n:  # (info = n+1, n+2: eigenvalues on the axis to rounding)
+    if info or sdim != n:  # (info = n+1, n+2: eigenvalues on the imaginary axis to rounding)
         return None
     if np.min(np.abs(wr[:n])) <= 1e-12 * max(1.0, float(np.max(np.hypot(wr, wi)))):
         return None

@@ -1,7 +1,7 @@
 """The LMI part of the gridded LPV synthesis (:func:`ambseal.robust.lpv.lpvsyn`).
 
 Scaling of the plant grid (one diagonal state scaling, a time scale ω₀, LQG balancing of the
-centre plant, unit-norm controls and measurements) and the SDPs in γ, R and S(Ω): the
+centre plant, unit-norm controls and measurements) and the SDPs in γ, R and S(θ): the
 projected LMIs of Gahinet & Apkarian (1994) on every grid point, with a constant or
 parameter-dependent Lyapunov function (Apkarian & Adams 1998; Wu et al. 1996). The
 equations are in :mod:`ambseal.robust.lpv`. The SDPs are solved by CVXOPT with a KKT solver
@@ -43,7 +43,7 @@ class SolverReport:
         well-conditioned R, S) or ``"reconstruct"`` (all controller reconstructions).
     status : str
         The SDP's status (``"optimal"`` is the only one accepted); for the reconstruction,
-        ``"optimal"`` or at how many table speeds its LMIs hold.
+        ``"optimal"`` or at how many table points θ its LMIs hold.
     iterations : int
         Interior-point iterations (0 for the closed-form reconstruction).
     time_s : float
@@ -102,12 +102,12 @@ class Scaled:
     su: np.ndarray
     sy: np.ndarray
     w0: float
-    p_of: Any  # Ω (rad/s) → p ∈ [−1, 1]
-    dp_dW: float
+    p_of: Any  # θ (its own unit) → p ∈ [−1, 1]
+    dp_dtheta: float
     sigma: np.ndarray  # balanced Riccati values (1 for diagonal scaling)
 
     def to_scaled_A(self, A: np.ndarray) -> np.ndarray:
-        """A frozen physical A(Ω) in the scaled coordinates of the LMIs."""
+        """A frozen physical A(θ) in the scaled coordinates of the LMIs."""
         return np.linalg.solve(self.T, A @ self.T) / self.w0
 
 
@@ -140,7 +140,7 @@ def _riccati_balance(A, B1, B2, C1, C2, D12, D21) -> tuple[np.ndarray, np.ndarra
 def scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling: str = "riccati") -> Scaled:
     """State, time and signal scaling for the whole grid (norm-preserving for w → z).
 
-    1. one diagonal state scaling balancing the envelope of |A(Ω_k)| against B and C;
+    1. one diagonal state scaling balancing the envelope of |A(θ_k)| against B and C;
     2. the time scale t' = ω₀ t with ω₀ the geometric mean of the pole magnitudes;
     3. ``scaling="riccati"``: the LQG-balancing similarity of the centre grid plant
        (:func:`_riccati_balance`), which makes R and S of the order of its Σ (skipped, Σ
@@ -195,7 +195,7 @@ def scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling: str = "ricc
     mid = 0.5 * (grid[-1] + grid[0])
     dAs_s = np.einsum("ij,kjl,lm->kim", Tinv, dAs, T) / w0 * half  # per unit p
     return Scaled(As_s, dAs_s, Bs, Cs, Ds, T, su, sy, w0,
-                   lambda W: (np.asarray(W, float) - mid) / half, 1.0 / half, sig)
+                   lambda th: (np.asarray(th, float) - mid) / half, 1.0 / half, sig)
 
 
 def lmi_blocks(sc: Scaled, nw, nz, ncon, nmeas):
@@ -226,7 +226,7 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
     blocks : tuple of ndarray
         ``(B1, B2, C1, C2, D11, D12, D21)`` of the scaled plant (:func:`lmi_blocks`).
     grid : ndarray, shape (n_p,)
-        Design speeds (rad/s).
+        The grid θ_k (θ's unit), strictly increasing.
     lyapunov : {"constant", "affine", "quadratic"}
     nu_s : float
         Rate bound in scaled units (dp/dt'), 0 without one.

@@ -1,10 +1,10 @@
 """Controller reconstruction of the gridded LPV synthesis (:func:`ambseal.robust.lpv.lpvsyn`).
 
-From the LMI solution R, S(Ω) (:mod:`ambseal.robust._lpv_lmi`) the controller is rebuilt at
-each speed of a table ``check_density`` times denser than the design grid, with the
+From the LMI solution R, S(θ) (:mod:`ambseal.robust._lpv_lmi`) the controller is rebuilt at
+each θ of a table ``check_density`` times denser than the synthesis grid, with the
 linearising change of variables of Scherer, Gahinet & Chilali (1997) (D_K = 0, M = I,
-N = I − S R), all of it in closed form (:class:`_Reconstructor`); between table speeds the
-plant's A(Ω) is interpolated by :func:`interp_A`.
+N = I − S R), all of it in closed form (:class:`_Reconstructor`); between table points the
+plant's A(θ) is interpolated by :func:`interp_A`.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ __all__ = ["interp_A", "reconstruct_table"]
 
 def reconstruct_table(sc: Scaled, blocks, table: np.ndarray, A_of, R: np.ndarray, S: list,
                       lyapunov: str, nu_s: float, gamma: float, margin: float):
-    """Physical-time controller matrices at each table speed (synthesis units).
+    """Physical-time controller matrices at each table point θ (synthesis units).
 
     Parameters
     ----------
@@ -30,9 +30,9 @@ def reconstruct_table(sc: Scaled, blocks, table: np.ndarray, A_of, R: np.ndarray
     blocks : tuple of ndarray
         ``(B1, B2, C1, C2, D11, D12, D21)`` of the scaled plant.
     table : ndarray, shape (n_t,)
-        Speeds Ω (rad/s).
+        Table values of θ (θ's unit).
     A_of : callable
-        Ω → A(Ω) of the (unscaled) generalised plant (:func:`interp_A`).
+        θ → A(θ) of the (unscaled) generalised plant (:func:`interp_A`).
     R, S : ndarray and list of ndarray
         LMI solution (:func:`ambseal.robust._lpv_lmi.solve_lmis`).
     lyapunov : str
@@ -41,15 +41,15 @@ def reconstruct_table(sc: Scaled, blocks, table: np.ndarray, A_of, R: np.ndarray
     gamma : float
         γ of the reconstruction LMIs (a little above the design γ).
     margin : float
-        The reconstruction LMIs hold at a table speed when their residuals are below −margin.
+        The reconstruction LMIs hold at a table point when their residuals are below −margin.
 
     Returns
     -------
     AK, BK, CK, DK : ndarray, shapes (n_t, n, n), (n_t, n, ny), (n_t, nu, n), (n_t, nu, ny)
-        ``u = K(Ω) y`` in the generalised plant's units (positive feedback).
+        ``u = K(θ) y`` in the generalised plant's units (positive feedback).
     report : SolverReport
         Stage ``"reconstruct"``, solver ``"closed form"``; status ``"optimal"`` when the
-        reconstruction LMIs hold at every table speed, else at how many they hold.
+        reconstruction LMIs hold at every table point, else at how many they hold.
 
     Raises
     ------
@@ -63,9 +63,9 @@ def reconstruct_table(sc: Scaled, blocks, table: np.ndarray, A_of, R: np.ndarray
     n_held, t_rec = 0, time.perf_counter()
     rec = _Reconstructor(B1, B2, C1, C2, D11, D12, D21, R, gamma, margin,
                          2 if (nb > 1 and nu_s > 0) else 1)
-    for W in table:
-        A_s = sc.to_scaled_A(A_of(W))
-        p = float(sc.p_of(W))
+    for th in table:
+        A_s = sc.to_scaled_A(A_of(th))
+        p = float(sc.p_of(th))
         f, df = basis(lyapunov, p)
         Sw = sum(fi * Si for fi, Si in zip(f, S))
         dS = sum(dfi * Si for dfi, Si in zip(df, S)) if nb > 1 else None
@@ -77,17 +77,17 @@ def reconstruct_table(sc: Scaled, blocks, table: np.ndarray, A_of, R: np.ndarray
         CKs.append(np.sqrt(sc.w0) * sc.su[:, None] * Ck)
         DKs.append(np.zeros((ncon, nmeas)))
     status = ("optimal" if n_held == len(table)
-              else f"LMIs hold at {n_held} of {len(table)} table speeds")
+              else f"LMIs hold at {n_held} of {len(table)} table points")
     report = SolverReport("reconstruct", status, 0, time.perf_counter() - t_rec, "closed form")
     return np.array(AKs), np.array(BKs), np.array(CKs), np.array(DKs), report
 
 
 def interp_A(As, dAs, grid):
-    """A(Ω) between grid points: cubic Hermite with the given slopes (exact for affine A)."""
-    def f(W: float) -> np.ndarray:
-        j = int(np.clip(np.searchsorted(grid, W) - 1, 0, len(grid) - 2))
+    """A(θ) between grid points: cubic Hermite with the given slopes (exact for affine A)."""
+    def f(th: float) -> np.ndarray:
+        j = int(np.clip(np.searchsorted(grid, th) - 1, 0, len(grid) - 2))
         h = grid[j + 1] - grid[j]
-        t = (W - grid[j]) / h
+        t = (th - grid[j]) / h
         if t <= 1e-12:
             return As[j]
         if t >= 1 - 1e-12:
@@ -106,7 +106,7 @@ def interp_A(As, dAs, grid):
 
 
 class _Reconstructor:
-    """Controller at one speed from R, S(Ω) (Scherer, Gahinet & Chilali 1997; D_K = 0,
+    """Controller at one θ from R, S(θ) (Scherer, Gahinet & Chilali 1997; D_K = 0,
     M = I, N = I − S R), with Â eliminated and Ĉ, B̂ in closed form.
 
     The linearised closed-loop bounded-real LMI in (Â, B̂, Ĉ) has rows [x_R; x_S; w; z];
@@ -114,8 +114,8 @@ class _Reconstructor:
     2 = x_S, 3 = (w, z), choosing ``Â + Aᵀ = P23 P33⁻¹ P13ᵀ`` makes the Schur complement
     with respect to P33 ≺ 0 block diagonal, so the LMI holds iff the two small LMIs in
     rows {1, 3} (Ĉ: a state-feedback H∞ LMI with R fixed) and rows {2, 3} (B̂: the
-    filter LMI with S(Ω) fixed, for Ṡ = ±ν ∂S/∂Ω) hold — the feasibility of which is what
-    the projected LMIs guarantee (Gahinet & Apkarian 1994, elimination lemma).
+    filter LMI with S(θ) fixed, for Ṡ = ±ν ∂S/∂θ) hold — the feasibility of which is
+    what the projected LMIs guarantee (Gahinet & Apkarian 1994, elimination lemma).
 
     With D_K = 0 both are quadratic in their unknown with a positive definite leading
     term, so completing the square solves them. Ĉ-side, after the Schur complements of the
@@ -127,14 +127,15 @@ class _Reconstructor:
     so Ĉ* makes L smallest (in the semidefinite order): it is feasible iff any Ĉ is. It is
     the LMI counterpart of the central H∞ state feedback −(D12ᵀD12)⁻¹(B2ᵀX + D12ᵀC1)
     (Doyle, Glover, Khargonekar & Francis 1989), and with R constant it does not depend on
-    Ω. The B̂-side is the dual (Ψ = γI − D11ᵀD11/γ, F = S B1 + C1ᵀ D11/γ):
+    θ. The B̂-side is the dual (Ψ = γI − D11ᵀD11/γ, F = S B1 + C1ᵀ D11/γ):
     B̂* = −(C2ᵀ + F Ψ⁻¹ D21ᵀ)(D21 Ψ⁻¹ D21ᵀ)⁻¹, the same for both signs of Ṡ, which
-    enter only L0. Between design grid points the projected LMIs (quadratic in p with a
+    enter only L0. Between synthesis grid points the projected LMIs (quadratic in p with a
     parameter-dependent S) need not hold; there the central solutions are still the best in
     the semidefinite order, and the frozen loops are checked on the table by
     :func:`ambseal.robust.lpv.lpvsyn` as everywhere else, so a violated residual is
-    counted (the report's status), not refused: the SDPs this replaced (2 per table speed,
-    ≈ 1.5 s each on a 32-state plant) refused such speeds as "infeasible".
+    counted (the report's status), not refused: solving the reconstruction LMIs as SDPs
+    instead (2 per table point, ≈ 1.5 s each on a 32-state plant) refuses such points as
+    "infeasible".
     """
 
     def __init__(self, B1, B2, C1, C2, D11, D12, D21, R, gamma, margin, n_signs):
@@ -155,7 +156,7 @@ class _Reconstructor:
         H = D12.T @ self.Phi_i @ D12
         G = B2 + E.T @ self.Phi_i @ D12
         self.Ch = -np.linalg.solve(H, G.T)
-        #: L0 − G H⁻¹ Gᵀ without the speed-dependent A R + R Aᵀ
+        #: L0 − G H⁻¹ Gᵀ without the θ-dependent A R + R Aᵀ
         self.QC = B1 @ B1.T / g + E.T @ self.Phi_i @ E - G @ np.linalg.solve(H, G.T)
         self.H2 = D21 @ self.Psi_i @ D21.T
 
@@ -163,7 +164,7 @@ class _Reconstructor:
         return bool(np.linalg.eigvalsh(_sym(Q)).max() < -self.margin)
 
     def __call__(self, A, S, dS, nu_s):
-        """(A_K, B_K, C_K, whether both LMIs hold) at one speed (scaled units)."""
+        """(A_K, B_K, C_K, whether both LMIs hold) at one θ (scaled units)."""
         R, B1, B2, C1, C2, D21 = self.R, self.B1, self.B2, self.C1, self.C2, self.D21
         N = A.shape[0]
         holds = self._holds(A @ R + R @ A.T + self.QC)

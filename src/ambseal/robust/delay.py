@@ -1,7 +1,7 @@
 """The sample-and-hold and computation delay of the digital controller, for the design model.
 
 A controller that runs at ``f_s`` with ``n_d`` samples of computation delay
-(``[controller] sample_rate_hz``, ``delay_samples``) acts on the plant through a
+(``sample_rate_hz``, ``delay_samples``) acts on the plant through a
 zero-order hold, whose phase is that of a delay of half a sample, and through the
 computation delay itself: in total, up to the Nyquist frequency, nearly a pure delay ::
 
@@ -42,7 +42,7 @@ __all__ = ["DesignDelay", "design_delay", "loop_delay", "check_timing", "PHASE_T
 
 #: largest phase error (deg) of the Padé approximation allowed up to the design band's top
 PHASE_TOLERANCE_DEG = 5.0
-#: highest Padé order tried (4 channels × order states join the design model)
+#: highest Padé order tried (order states per actuator channel join the synthesis model)
 MAX_ORDER = 4
 
 
@@ -78,7 +78,7 @@ class DesignDelay:
 
 def check_timing(sample_rate_hz: float, delay_samples) -> None:
     """A finite rate > 0 Hz and a whole delay ≥ 0 samples, else ``ConfigError`` naming the
-    ``[controller]`` key."""
+    setting."""
     if not (math.isfinite(float(sample_rate_hz)) and sample_rate_hz > 0):
         raise ConfigError(f"controller.sample_rate_hz: {sample_rate_hz!r}, expected a "
                           "finite rate > 0 Hz")

@@ -28,7 +28,7 @@ Systems*, 3rd ed., ch. 6):
    method is SISO only; the triangle hold is its state-space cousin for a MIMO
    controller (poles mapped as ``z = e^{sT}``, Franklin et al. §6.3.2).
 3. **Choice.** Each candidate, delayed by ``delay_samples`` samples of computation, is
-   closed with the full-order plant sampled exactly (ZOH) at each judged condition; the
+   closed with the full-order plant sampled exactly (ZOH) at each given condition; the
    candidate kept is stable wherever the continuous loop is, and among those the one
    whose σ̄(S_o) peaks (log grid up to Nyquist) are closest to the continuous loop's
    (the largest relative difference over the conditions where the continuous loop is
@@ -39,7 +39,7 @@ Systems*, 3rd ed., ch. 6):
 
 The result, :class:`DigitalController`, holds the one discrete controller object
 (:class:`~ambseal.robust.digital_loop.DiscreteController`) that an export, a discrete
-judgement and a simulation of the loop as it runs can all share.
+analysis and a simulation of the loop as it runs can all share.
 """
 
 from __future__ import annotations
@@ -92,12 +92,12 @@ class DigitalController:
     Attributes
     ----------
     continuous : control.StateSpace
-        The designed controller (m → A, ``i = −K y``).
+        The continuous controller, measurements → commands, ``command = −K y``.
     reduced : control.StateSpace
         The continuous controller that was discretised (fast poles removed; ``continuous``
         when none were).
     discrete : DiscreteController
-        ``x[k+1] = A x[k] + B y[k]``, ``u[k] = C x[k] + D y[k]``, ``i = −u`` at ``dt = Ts``.
+        ``x[k+1] = A x[k] + B y[k]``, ``u[k] = C x[k] + D y[k]``, command ``−u`` at ``dt = Ts``.
     method : str
         One of :data:`DISCRETISATIONS`.
     prewarp_hz : float or None
@@ -108,8 +108,8 @@ class DigitalController:
     removed_poles_hz : tuple of float
         |p|/2π of the removed controller poles (Hz).
     reduction : dict or None
-        The cost of the removal as the caller's ``rise`` reports it (the design layer:
-        ``order_full``, ``order`` and ``gamma_full``/``gamma`` or ``mu_full``/``mu``).
+        The cost of the removal as the caller's ``rise`` reports it (e.g. ``order_full``,
+        ``order`` and ``gamma_full``/``gamma`` or ``mu_full``/``mu``).
     candidates : tuple of dict
         Each candidate method: per condition ``max_abs_z`` and the σ̄(S_o) peaks
         ``sensitivity_peak`` (discrete, delay included) and ``sensitivity_peak_continuous``
@@ -198,7 +198,7 @@ def peak_difference(err: float | None, method: str, removed_poles_hz) -> dict:
     ----------
     err : float or None
         Largest relative difference over the conditions (-): the choice's (400-point grid)
-        or, after the judgement, the judged cases' (``ambseal run``).
+        or a later analysis's over its own conditions.
     method : str
     removed_poles_hz : sequence of float
 
@@ -389,10 +389,11 @@ def _remove_fast(K, mats: Matrices, fs: float, rise: Callable | None):
 
 @dataclass(frozen=True, eq=False)
 class SampledPlants:
-    """The judged full-order plants, continuous (``plants``: with the hold + computation
-    delay of ``delay_samples`` as a Padé lag on every input) and ZOH-sampled at ``fs``
-    (``sampled``: without, the delay is the discrete controller's; ``ideal``: the continuous
-    plants without the delay, where the design must run stably), with their frequency
+    """The full-order plants the choice is made on, continuous (``plants``: with the
+    hold + computation delay of ``delay_samples`` as a Padé lag on every input) and
+    ZOH-sampled at ``fs`` (``sampled``: without, the delay is the discrete controller's;
+    ``ideal``: the continuous plants without the delay, where the design must run
+    stably), with their frequency
     responses on a log grid up to Nyquist: computed once, shared by every controller
     chosen for the same conditions (:func:`sampled_plants`)."""
 
@@ -487,12 +488,12 @@ def digital_controller(K, sample_rate_hz: float, plants, *,
     Parameters
     ----------
     K : control.StateSpace
-        Continuous controller, m → A, ``i = −K y``.
+        Continuous controller, measurements → commands, ``command = −K y``.
     sample_rate_hz : float
         The target's sample rate (Hz).
     plants : sequence of (A, B, C, D), or SampledPlants
-        Full-order continuous plants (currents, A → displacements, m) at the judged
-        conditions (or :func:`sampled_plants` of them at ``sample_rate_hz``).
+        Full-order continuous plants (commands → measurements) at the conditions the
+        controller must run at (or :func:`sampled_plants` of them at ``sample_rate_hz``).
     delay_samples : int
         Computation delay of the target (samples).
     rise : callable, optional

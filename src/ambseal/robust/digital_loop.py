@@ -1,8 +1,8 @@
 """The digital closed loop of a sampled plant and a discrete controller, as it runs.
 
 Timing (one sample of the controller, period T = 1/f_s): at sample k the sensors
-give y_k; the controller computes u_k = C_c x_c,k + D_c y_k; the current reference
-i_ref,k = −u_k + e_k (e an excitation added to the command) is held over [kT, (k+1)T)
+give y_k; the controller computes u_k = C_c x_c,k + D_c y_k; the command
+i_ref,k = −u_k + e_k (e an excitation added to it) is held over [kT, (k+1)T)
 (zero-order hold, the DAC); x_c,k+1 = A_c x_c,k + B_c y_k.
 
 A plant discretised exactly with a zero-order hold then gives the closed loop
@@ -34,11 +34,11 @@ class DiscreteController:
     A : ndarray, shape (n_c, n_c)
         State matrix of the discrete controller.
     B : ndarray, shape (n_c, p)
-        Input matrix; the inputs are the ``p`` displacements ``y_k`` (m).
+        Input matrix; the inputs are the ``p`` measurements ``y_k``.
     C : ndarray, shape (m, n_c)
-        Output matrix; the outputs are the ``m`` currents ``u_k`` (A).
+        Output matrix; the outputs are the ``m`` controls ``u_k`` (command ``−u_k``).
     D : ndarray, shape (m, p)
-        Feedthrough (A/m).
+        Feedthrough (command unit per measurement unit).
     dt : float
         Sample time (s), > 0.
     description : dict or None
@@ -96,7 +96,7 @@ def discrete_controller(K, dt: float, method: str = "tustin") -> DiscreteControl
     Parameters
     ----------
     K : control.StateSpace
-        Continuous controller from displacements (m) to currents (A), ``u = K y``.
+        Continuous controller from measurements to controls, ``u = K y``.
     dt : float
         Sample time (s), positive and finite.
     method : {"tustin", "zoh"}
@@ -119,7 +119,7 @@ def discrete_controller(K, dt: float, method: str = "tustin") -> DiscreteControl
 
 
 def closed_loop_matrices(Ad, Bd, C, ctrl: DiscreteController):
-    """The discrete closed loop from e (current excitation) to the plant state.
+    """The discrete closed loop from e (an excitation added to the command) to the plant state.
 
     :func:`ambseal.lti.interconnect.feedback_matrices` of the sampled plant and the
     controller, with the excitation as the loop's input disturbance.

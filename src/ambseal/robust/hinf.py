@@ -712,7 +712,7 @@ class _Sb10:
         tests += more
         if lo > lo0 * (1.0 + 1e-9) and self.riccati_margin(lo) >= 1.0:
             # the margin refused lo for want of a stabilising X∞ ⪰ 0 or Y∞ ⪰ 0 — which a
-            # Hamiltonian with eigenvalues near the axis (a weight's pole near zero) also
+            # Hamiltonian with eigenvalues near the imaginary axis (a weight's pole near zero) also
             # makes — rather than by ρ(X∞Y∞) ≥ γ²: the search jumped, it did not cross a
             # root. SB10AD's own test decides there (S&P Ex. 2.11, design 2: the margin
             # refused 2.5 where SB10AD and a controller of norm 2.46 admit it).

@@ -1,7 +1,7 @@
 """Gridded H∞ LPV synthesis by LMIs, scheduled on one measured parameter θ.
 
-θ is whatever the plants are gridded on, in its own unit (a speed in rad/s, a stiffness
-in N/m, …); nothing here knows which.
+θ is whatever the plants are gridded on, in its own unit (an angular velocity in rad/s, a
+stiffness in N/m, …); nothing here knows which.
 
 Two Lyapunov functions: a constant one (Apkarian & Adams 1998: stability and performance
 under arbitrarily fast parameter changes) and a parameter-dependent one with a bound on
@@ -79,8 +79,8 @@ class LpvController:
     entries.
 
     ``u = K(θ) y`` in the generalised plant's convention (the lower LFT F_l(P, K),
-    positive feedback); θ is whatever the plants were gridded on, in its own unit (a
-    speed in rad/s, a stiffness in N/m, …).
+    positive feedback); θ is whatever the plants were gridded on, in its own unit (an
+    angular velocity in rad/s, a stiffness in N/m, …).
 
     Attributes
     ----------
@@ -141,10 +141,10 @@ class FrozenClosedLoop:
     outputs: tuple = ()
 
     def __call__(self, theta: float):
-        W = float(theta)
-        A = interp_A(self.A, self.dA, self.grid)(W)
+        th = float(theta)
+        A = interp_A(self.A, self.dA, self.grid)(th)
         Acl, Bcl, Ccl, Dcl = lft_lower_matrices((A, self.B, self.C, self.D),
-                                                self.K.matrices(W), self.nmeas, self.ncon)
+                                                self.K.matrices(th), self.nmeas, self.ncon)
         return ct.ss(Acl, Bcl, Ccl, Dcl, inputs=list(self.inputs) or None,
                      outputs=list(self.outputs) or None, name="CL")
 
@@ -411,7 +411,7 @@ def _synthesise(data, scaling: str, *, lyapunov, rate_bound, backoff, check_dens
     plants, grid, As, dAs, B, C, D, nw, nz, nmeas, ncon = data
     sc = scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling)
     blocks = lmi_blocks(sc, nw, nz, ncon, nmeas)
-    nu_s = 0.0 if rate_bound is None else float(rate_bound) / sc.w0 * sc.dp_dW  # dp/dt'
+    nu_s = 0.0 if rate_bound is None else float(rate_bound) / sc.w0 * sc.dp_dtheta  # dp/dt'
     gamma, gamma_d, R, S, reports = solve_lmis(
         sc, blocks, grid, lyapunov, nu_s, backoff=backoff, margin=margin, penalty=penalty,
         coupling_ratio=coupling_ratio, centre=centre, solver_options=solver_options)
@@ -504,15 +504,15 @@ def _check_table(K: LpvController, A_of, B, C, D, nmeas: int, ncon: int) -> np.n
 
     table = K.theta
     check_g, stable = [], True
-    for W in table:
-        Acl, Bcl, Ccl, Dcl = lft_lower_matrices((A_of(W), B, C, D), K.matrices(W), nmeas, ncon)
+    for th in table:
+        Acl, Bcl, Ccl, Dcl = lft_lower_matrices((A_of(th), B, C, D), K.matrices(th), nmeas, ncon)
         if not is_stable(np.linalg.eigvals(Acl)):
             check_g.append(np.inf)
             stable = False
             continue
         check_g.append(hinfnorm(ct.ss(Acl, Bcl, Ccl, Dcl))[0])
-    for W in 0.5 * (table[1:] + table[:-1]):
-        Acl = lft_lower_matrices((A_of(W), B, C, D), K.matrices(W), nmeas, ncon)[0]
+    for th in 0.5 * (table[1:] + table[:-1]):
+        Acl = lft_lower_matrices((A_of(th), B, C, D), K.matrices(th), nmeas, ncon)[0]
         stable &= is_stable(np.linalg.eigvals(Acl))
     if not stable:
         raise SynthesisError(

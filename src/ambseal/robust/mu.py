@@ -557,8 +557,8 @@ def mu_peak(M, blocks, omega, upper=None, *, candidates: int = 2, band: float = 
     evaluated = int(new_w.size)
     # the rounds solved each bound to tol/10, enough to locate the peak; the best few are
     # solved again like the grid's largest ones (mussv's second solve, tol·1e-3) and only
-    # these join the grid. (Bounds solved to tol alone ranked the points wrongly on the pump
-    # example's four real scalars: they exceeded their second solve by up to 0.4 %.)
+    # these join the grid. (Bounds solved to tol alone ranked the points wrongly on a problem
+    # with four real scalar blocks: they exceeded their second solve by up to 0.4 %.)
     keep = np.argsort(-new_u)[:max(int(resolve), 1)] if new_u.size else np.zeros(0, int)
     keep = keep[np.argsort(new_w[keep])]
     new_w = new_w[keep]

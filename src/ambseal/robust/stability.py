@@ -3,7 +3,7 @@
 Every verdict of the package — a judged closed loop, a synthesised controller's loop, a
 sampled loop, a frozen point of a scheduled controller, a weight or a controller part that
 must be stable — is taken by :func:`is_stable` on the poles, so a borderline design cannot
-be "stable" in one command and "unstable" in another.
+be "stable" for one caller and "unstable" for another.
 
 **The rule.** Poles ``p`` of a continuous system (rad/s), or ``z`` of a discrete one of
 sample time ``dt`` mapped to the same rates by ``s = ln z / dt``, are stable when
@@ -89,7 +89,7 @@ def is_stable(poles, dt: float = 0.0) -> bool:
     --------
     >>> is_stable([-1 + 10j, -1 - 10j])
     True
-    >>> is_stable([0j, -5 + 0j])            # a pole on the axis is not stable
+    >>> is_stable([0j, -5 + 0j])            # a pole on the imaginary axis: not stable
     False
     >>> is_stable([0.5, 0.0], dt=1e-3)       # discrete: |z| < 1
     True

@@ -87,7 +87,7 @@ def _norm_cases(ct, np):
 
 
 def _mu_cases(np):
-    from tests.robust.test_published_cases import _rank_one_mu
+    from tests.robust.test_published_cases import rank_one_case
 
     z = [(-1, 6), (2, -3), (3, 8), (3, 8), (-5, -9), (-6, 2), (4, 2), (-2, 5), (-6, -7),
          (-4, 11), (8, -7), (12, -1), (5, -4), (-4, -8), (1, -3), (-6, 14), (2, -5), (4, 16)]
@@ -95,15 +95,8 @@ def _mu_cases(np):
             np.array([complex(a, b) for a, b in z * 2]).reshape(6, 6),
             [(-1, 0), (-1, 0), (2, 2), (1, 1), (1, 1)])]
     for kinds in ("rrr", "ccc", "rrcc", "rrrrc"):
-        rng = np.random.default_rng(len(kinds) * 7 + kinds.count("r"))
-        n = len(kinds)
-        a = rng.standard_normal(n) + 1j * rng.standard_normal(n)
-        b = rng.standard_normal(n) + 1j * rng.standard_normal(n)
-        M = np.outer(a, b.conj())
-        real = np.array([k == "r" for k in kinds])
-        out.append((f"rank-one μ {kinds}", "Young 1994 closed form",
-                    _rank_one_mu(np.diag(M), real), M,
-                    [(-1, 0) if k == "r" else (1, 1) for k in kinds]))
+        M, blocks, mu = rank_one_case(kinds)
+        out.append((f"rank-one μ {kinds}", "Young 1994 closed form", mu, M, blocks))
     rng = np.random.default_rng(3)
     M = rng.standard_normal((5, 5)) + 1j * rng.standard_normal((5, 5))
     out.append(("three full blocks", "Doyle 1982 (no gap)", None, M, [(1, 1), (2, 2), (2, 2)]))

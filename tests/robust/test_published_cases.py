@@ -140,20 +140,26 @@ def _rank_one_mu(m: np.ndarray, real: np.ndarray) -> float:
     return float(best)
 
 
-@pytest.mark.parametrize("kinds", ["rrr", "ccc", "rrcc", "rrrrc"])
-def test_rank_one_mixed_mu_closed_form(kinds):
-    """Reference: Young's closed form of μ for rank-one matrices (:func:`_rank_one_mu`),
-    where the D–G upper bound is exact (Young 1994): three real scalars, three complex
-    scalars (μ = Σ|a_i b_i|), and two mixed structures; M = a bᴴ from seeded complex a,
-    b. The upper bound to 1e-5 (run at tol 1e-8), the lower bound not above it."""
+def rank_one_case(kinds: str):
+    """A seeded rank-one M = a bᴴ with one scalar block per letter of ``kinds`` (``r`` real,
+    ``c`` complex): ``(M, blocks, μ)``, μ by :func:`_rank_one_mu`."""
     rng = np.random.default_rng(len(kinds) * 7 + kinds.count("r"))
     n = len(kinds)
     a = rng.standard_normal(n) + 1j * rng.standard_normal(n)
     b = rng.standard_normal(n) + 1j * rng.standard_normal(n)
     M = np.outer(a, b.conj())
     real = np.array([k == "r" for k in kinds])
-    mu = _rank_one_mu(np.diag(M), real)
-    r = mussv(M, [(-1, 0) if k == "r" else (1, 1) for k in kinds], tol=1e-8)
+    return M, [(-1, 0) if k == "r" else (1, 1) for k in kinds], _rank_one_mu(np.diag(M), real)
+
+
+@pytest.mark.parametrize("kinds", ["rrr", "ccc", "rrcc", "rrrrc"])
+def test_rank_one_mixed_mu_closed_form(kinds):
+    """Reference: Young's closed form of μ for rank-one matrices (:func:`_rank_one_mu`),
+    where the D–G upper bound is exact (Young 1994): three real scalars, three complex
+    scalars (μ = Σ|a_i b_i|), and two mixed structures; M = a bᴴ from seeded complex a,
+    b. The upper bound to 1e-5 (run at tol 1e-8), the lower bound not above it."""
+    M, blocks, mu = rank_one_case(kinds)
+    r = mussv(M, blocks, tol=1e-8)
     assert float(r.upper) == pytest.approx(mu, rel=1e-5)
     assert float(r.lower) <= mu * (1 + 1e-9)
 

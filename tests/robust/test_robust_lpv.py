@@ -281,15 +281,7 @@ def test_lpvsyn_defaults_reach_the_hinf_optimum_on_an_lti_family():
     the Riccati balancing alone leaves the reconstructed loop unstable; with the defaults
     (scaling "auto") lpvsyn falls back to the diagonal scaling and ends within 1 % of γ_opt,
     saying so."""
-    import control as ct
-
-    A = [[0.0, 1.0], [-4.0, -0.2]]
-    mode = ct.ss(A, [[0.0], [1.0]], [[1.0, 0.0]], [[0.0]], inputs="u", outputs="x",
-                 name="mode")
-    We = ct.ss(ct.tf([0.5, 0.5], [1.0, 5e-4]), inputs="e", outputs="z_e", name="We")
-    Wu = ct.ss([], [], [], [[0.1]], inputs="u", outputs="z_u", name="Wu")
-    err = ct.summing_junction(inputs=["r", "-x"], output="e")
-    P = ct.interconnect([mode, We, Wu, err], inplist=["r", "u"], outlist=["z_e", "z_u", "e"])
+    P = _lti_family_plant()
     with pytest.raises(SynthesisError):
         lpvsyn([P] * 3, [1.0, 2.0, 3.0], 1, 1, scaling="riccati")
     r = lpvsyn([P] * 3, [1.0, 2.0, 3.0], 1, 1)

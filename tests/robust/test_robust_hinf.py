@@ -64,6 +64,37 @@ def test_hinfnorm_matches_dense_sweep():
         assert g == pytest.approx(ref, rel=1e-5)
 
 
+def test_hinfnorm_balances_where_ab13dd_does_not_converge(monkeypatch):
+    """AB13DD's QR iteration fails to converge on some badly scaled loops (a μ design's
+    224-state loop on examples/pump.toml). Reference: closed form of
+    1/(s²+2ζs+1), realised with states scaled 1 : 10⁶; AB13DD made to fail on every
+    realisation but the balanced one, then on that one too."""
+    import ambseal.robust.hinf as hinf
+    from slycot.exceptions import SlycotArithmeticError
+
+    zeta, T = 0.2, np.diag([1.0, 1e6])
+    A0 = np.array([[0.0, 1.0], [-1.0, -2 * zeta]])
+    sys = ct.ss(np.linalg.solve(T, A0 @ T), np.linalg.solve(T, [[0.0], [1.0]]),
+                np.array([[1.0, 0.0]]) @ T, [[0.0]])
+    real, seen = hinf.ab13dd, []
+
+    def fails_on(given):
+        def ab13dd(*args):
+            seen.append(args[7].copy())
+            if given(args[7]):
+                raise SlycotArithmeticError("QR did not converge", 3)
+            return real(*args)
+        return ab13dd
+
+    monkeypatch.setattr(hinf, "ab13dd", fails_on(lambda A: len(seen) == 1))
+    g, w = hinfnorm(sys)
+    assert g == pytest.approx(1 / (2 * zeta * np.sqrt(1 - zeta**2)), rel=1e-9)
+    assert len(seen) == 2 and not np.array_equal(seen[0], seen[1])
+    monkeypatch.setattr(hinf, "ab13dd", fails_on(lambda A: True))
+    with pytest.raises(SynthesisError, match="AB13DD did not converge"):
+        hinfnorm(sys)
+
+
 def test_hinfnorm_unstable_is_infinite():
     """Reference: definition — an unstable system has no finite H∞ norm."""
     g, w = hinfnorm(ct.tf([1], [1, -1]))

@@ -35,6 +35,7 @@ import control as ct
 import numpy as np
 import scipy.linalg as sla
 from slycot import ab13dd
+from slycot.exceptions import SlycotArithmeticError
 
 from ambseal.errors import ConfigError, ModelError, SynthesisError
 from ambseal.lti.interconnect import lft_lower, lft_lower_matrices
@@ -102,6 +103,8 @@ def hinfnorm(sys, rtol: float = 1e-10) -> tuple[float, float]:
     ------
     ModelError
         If ``sys`` is discrete-time.
+    SynthesisError
+        If SLICOT AB13DD does not converge on ``sys`` or on its balanced realisation.
 
     Examples
     --------
@@ -125,13 +128,27 @@ def hinfnorm(sys, rtol: float = 1e-10) -> tuple[float, float]:
 
 def _linfnorm_matrices(A, B, C, D, rtol: float = 1e-10) -> tuple[float, float]:
     """L∞ norm and peak frequency of a continuous (A, B, C, D): SLICOT AB13DD through
-    slycot, as ``control.linfnorm`` calls it, without building a system object."""
+    slycot, as ``control.linfnorm`` calls it, without building a system object.
+
+    Where AB13DD's QR iteration does not converge (a badly scaled realisation: a
+    224-state μ-design loop whose balancing spreads over 3e7), the norm, a similarity
+    invariant, is that of the realisation balanced by ``scipy.linalg.matrix_balance``
+    (powers of 2, no permutation: exact). SynthesisError if AB13DD fails on that one too."""
 
     n, m, p = A.shape[0], B.shape[1], C.shape[0]
     if n == 0:
         return float(np.linalg.norm(D, 2)) if D.size else 0.0, 0.0
     jobd = "D" if np.any(D) else "Z"
-    gamma, w_pk = ab13dd("C", "I", "S", jobd, n, m, p, A, np.eye(n), B, C, D, rtol)
+    try:
+        gamma, w_pk = ab13dd("C", "I", "S", jobd, n, m, p, A, np.eye(n), B, C, D, rtol)
+    except SlycotArithmeticError:
+        Ab, (sc, _) = sla.matrix_balance(A, permute=False, separate=True)
+        try:
+            gamma, w_pk = ab13dd("C", "I", "S", jobd, n, m, p, Ab, np.eye(n),
+                                 B / sc[:, None], C * sc[None, :], D, rtol)
+        except SlycotArithmeticError as exc:
+            raise SynthesisError(f"L∞ norm of a {n}-state system: SLICOT AB13DD did not "
+                                 "converge, on the system or its balanced form") from exc
     w_pk = float(w_pk)
     return float(gamma), (w_pk if np.isfinite(w_pk) else 0.0)
 

@@ -55,6 +55,12 @@ _MODAL = ArrayMemo()  # (λ, V, cond V, V⁻¹B, CV) of the last large (A, B, C)
 #: then checks it against the Hessenberg form or the dense solves at the probes.
 _SVD_COND_STATES = 1000
 _BALANCED = ArrayMemo()  # the same of the balanced system (:func:`_arbitrated`)
+#: Spread (largest over smallest) of the diagonal balancing of ``A`` above which
+#: ``"auto"`` tries the balanced modal form first, checked against dense solves at the
+#: probes (:func:`_balanced_modal`): entries over that many decades are an FE plant's
+#: [q; q̇] form (spread 3e10 on a 336-state plant), whose own modal form fails its check
+#: and ends in the balanced one anyway, after an eigendecomposition for nothing.
+_SPREAD_BALANCED_FIRST = 1e6
 _HESSENBERG = ArrayMemo()  # balanced upper-Hessenberg form of the last large (A, B, C)
 
 
@@ -173,6 +179,12 @@ def _response(A, B, C, D, s, method, max_cond, rtol) -> np.ndarray:
         H = _balanced_modal_checked(A, B, C, D, s, max_cond, rtol)  # large: balanced first
         if H is not None:
             return H
+    elif method == "auto" and _badly_scaled(A):
+        probe = _probes(s)
+        H = _balanced_modal(A, B, C, D, s, probe, _dense_response(A, B, C, D, probe),
+                            max_cond, rtol)
+        if H is not None:
+            return H
 
     lam, cond, Bm, Cm = _MODAL.get((A, B, C), max_cond, lambda: _modal_form(A, B, C, max_cond))
     if not np.isfinite(cond) or cond > max_cond:
@@ -237,6 +249,15 @@ def _arbitrated(A, B, C, D, s, probe, Hh, Hm, modal, max_cond, rtol) -> np.ndarr
     if np.isfinite(em) and em <= _ARBITER_RTOL:
         return _modal_eval(*modal, D, s)
     return _dense_response(A, B, C, D, s)
+
+
+def _badly_scaled(A: np.ndarray) -> bool:
+    """Whether the diagonal balancing of ``A`` spreads over more than
+    :data:`_SPREAD_BALANCED_FIRST` (O(n²); only for the models :class:`ArrayMemo` keeps)."""
+    if A.shape[0] < _MODAL.min_states:
+        return False
+    _, (sc, _) = scipy.linalg.matrix_balance(A, permute=False, separate=True)
+    return bool(sc.max() > _SPREAD_BALANCED_FIRST * sc.min())
 
 
 def _probes(s: np.ndarray) -> np.ndarray:

@@ -64,7 +64,27 @@ def _synthesis_cases(ct, np):
         wp = wsp(wb[0]).append(wsp(wb[1]))
         out.append((f"S&P Ex. 3.8 design {k}", "S&P 1st ed.; examples/robust_mimo.py", pub,
                     ct.augw(g38, wp, ct.ss([], [], [], np.eye(2))), 2, 2))
+    from tests.robust.test_published_cases import ncf_plant, sb10dd_bilinear_plant
+
+    out.append(("SB10DD example (z = (1+s)/(1−s))", "SLICOT examples", 111.294,
+                sb10dd_bilinear_plant(), 2, 2))
+    ncf = [([[1.0]], [[1.0]], [[1.0]]), ([[0.0, 1.0], [-1.0, -0.2]], [[0.0], [1.0]], [[1.0, 0.0]]),
+           ([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, -2.0, -1.0]], [[0, 0], [1, 0], [0, 1]],
+            [[1, 0, 0], [0, 0, 1]])]
+    for name, (A, B, C) in zip(("1/(s − 1)", "resonance", "MIMO 3 states"), ncf):
+        A, B, C = (np.array(M, float) for M in (A, B, C))
+        out.append((f"NCF robust stabilisation, {name}", "McFarlane & Glover 1990; ZDG ch. 18",
+                    _ncf_closed_form(np, A, B, C), ncf_plant(A, B, C), C.shape[0], B.shape[1]))
     return out
+
+
+def _ncf_closed_form(np, A, B, C):
+    """√(1 + ρ(XZ)) from the control and filter Riccati equations (SciPy)."""
+    from scipy.linalg import solve_continuous_are
+
+    X = solve_continuous_are(A, B, C.T @ C, np.eye(B.shape[1]))
+    Z = solve_continuous_are(A.T, C.T, B @ B.T, np.eye(C.shape[0]))
+    return float(np.sqrt(1.0 + np.max(np.linalg.eigvals(X @ Z).real)))
 
 
 def _norm_cases(ct, np):

@@ -1,8 +1,10 @@
 """The generic core against published cases: SLICOT's documented examples
 (SLICOT-Reference, ``examples/data/*.dat`` and ``examples/results/*.res``: each case's data
-as published, its result to the digits printed there), Skogestad & Postlethwaite's
-Example 3.8, and closed forms from the literature (Young's rank-one mixed μ, Packard &
-Doyle's full-block and scalar μ, the second-order resonant peak). The other published
+as published, its result to the digits printed there; SB10DD's discrete problem through
+the bilinear map), Skogestad & Postlethwaite's Example 3.8, and closed forms from the
+literature (McFarlane & Glover's normalised coprime factor stabilisation, Young's
+rank-one mixed μ, Packard & Doyle's full-block and scalar μ, the second-order resonant
+peak). The other published
 cases of the core are beside the code they test; ``benchmarks/README.md`` lists them all
 with their times against python-control and SLICOT."""
 
@@ -53,6 +55,122 @@ def test_sb10fd_example_controller_at_gamma_15():
     np.testing.assert_allclose(got, published, rtol=5e-5, atol=5e-5)
     assert r.gamma < 15.0  # the verified norm of the loop built for γ = 15
 
+
+#: SB10DD's example plant (discrete time; 6 states, 5 inputs, 5 outputs; 2 controls, 2
+#: measurements)
+_SB10DD_A = [[-0.7, 0.0, 0.3, 0.0, -0.5, -0.1], [-0.6, 0.2, -0.4, -0.3, 0.0, 0.0],
+             [-0.5, 0.7, -0.1, 0.0, 0.0, -0.8], [-0.7, 0.0, 0.0, -0.5, -1.0, 0.0],
+             [0.0, 0.3, 0.6, -0.9, 0.1, -0.4], [0.5, -0.8, 0.0, 0.0, 0.2, -0.9]]
+_SB10DD_B = [[-1, -2, -2, 1, 0], [1, 0, 1, -2, 1], [-3, -4, 0, 2, -2], [1, -2, 1, 0, -1],
+             [0, 1, -2, 0, 3], [1, 0, 3, -1, -2]]
+_SB10DD_C = [[1, -1, 2, -2, 0, -3], [-3, 0, 1, -1, 1, 0], [0, 2, 0, -4, 0, -2],
+             [1, -3, 0, 0, 3, 1], [0, 1, -2, 1, 0, -2]]
+_SB10DD_D = [[1, -1, -2, 0, 0], [0, 1, 0, 1, 0], [2, -1, -3, 0, 1], [0, 1, 0, 1, -1],
+             [0, 0, 1, 2, 1]]
+
+
+def bilinear(A, B, C, D, inverse=False):
+    """z = (1 + s)/(1 − s) (``inverse``: s = (z − 1)/(z + 1)): maps the unit disc onto the
+    left half-plane and the unit circle onto the imaginary axis, so it keeps stability and
+    the H∞ norm of every loop (Zhou, Doyle & Glover, *Robust and Optimal Control*, §21.1)."""
+    n = A.shape[0]
+    M = np.linalg.inv(np.eye(n) - A) if inverse else np.linalg.inv(A + np.eye(n))
+    Am = M @ (np.eye(n) + A) if inverse else M @ (A - np.eye(n))
+    Dm = D + C @ M @ B if inverse else D - C @ M @ B
+    return Am, np.sqrt(2.0) * M @ B, np.sqrt(2.0) * C @ M, Dm
+
+
+def sb10dd_bilinear_plant():
+    """SB10DD's example plant mapped to continuous time by z = (1 + s)/(1 − s)."""
+    return ct.ss(*bilinear(*(np.array(M, float)
+                             for M in (_SB10DD_A, _SB10DD_B, _SB10DD_C, _SB10DD_D))))
+
+
+def test_sb10dd_example_discrete_gamma_through_the_bilinear_map():
+    """SLICOT SB10DD example (discrete time, γ = 111.294). Its controller as printed closes
+    a stable loop of H∞ norm within 1 % of that γ (a controller this near the optimum is
+    sensitive: rounding it to the 4 printed decimals lifts the norm 0.5 %). Mapped by z = (1+s)/(1−s), the
+    plant is a continuous problem with the same γ_opt; ours is SB10DD's own optimum (SB10DD
+    solves the discrete problem at γ_opt·(1 + 1e-6) and refuses it at γ_opt·(1 − 1e-6)),
+    just below the example's γ, and our controller mapped back closes the discrete loop
+    stable with a norm within 1e-6 of the γ it was built for."""
+    from slycot import sb10dd
+    from slycot.exceptions import SlycotError
+    from ambseal.lti.interconnect import lft_lower
+
+    A, B, C, D = (np.array(M, float) for M in (_SB10DD_A, _SB10DD_B, _SB10DD_C, _SB10DD_D))
+    Pd = ct.ss(A, B, C, D, 1)
+    AK = [[-18.0030, 52.0376, 26.0831, -0.4271, -40.9022, 18.0857],
+          [18.8203, -57.6244, -29.0938, 0.5870, 45.3309, -19.8644],
+          [-26.5994, 77.9693, 39.0368, -1.4020, -60.1129, 26.6910],
+          [-21.4163, 62.1719, 30.7507, -0.9201, -48.6221, 21.8351],
+          [-0.8911, 4.2787, 2.3286, -0.2424, -3.0376, 1.2169],
+          [-5.3286, 16.1955, 8.4824, -0.2489, -12.2348, 5.1590]]
+    BK = [[16.9788, 14.1648], [-18.9215, -15.6726], [25.2046, 21.2848], [20.1122, 16.8322],
+          [1.4104, 1.2040], [5.3181, 4.5149]]
+    CK = [[-9.1941, 27.5165, 13.7364, -0.3639, -21.5983, 9.6025],
+          [3.6490, -10.6194, -5.2772, 0.2432, 8.1108, -3.6293]]
+    DK = [[9.0317, 7.5348], [-3.4006, -2.8219]]
+    published = lft_lower(Pd, ct.ss(AK, BK, CK, DK, 1), 2, 2)
+    assert np.abs(np.linalg.eigvals(published.A)).max() < 1.0
+    assert ct.linfnorm(published)[0] == pytest.approx(111.294, rel=1e-2)
+
+    r = hinfsyn(sb10dd_bilinear_plant(), 2, 2)
+
+    def sb10dd_solves(gamma):
+        try:
+            sb10dd(6, 5, 5, 2, 2, gamma, A, B, C, D, 1e-8)
+        except SlycotError:
+            return False
+        return True
+
+    assert sb10dd_solves(r.gamma_opt * (1 + 1e-6))
+    assert not sb10dd_solves(r.gamma_opt * (1 - 1e-6))
+    assert 111.29 < r.gamma_opt < 111.294
+    Kd = ct.ss(*bilinear(*(np.asarray(M, float) for M in (r.K.A, r.K.B, r.K.C, r.K.D)),
+                          inverse=True), 1)
+    loop = lft_lower(Pd, Kd, 2, 2)
+    assert np.abs(np.linalg.eigvals(loop.A)).max() < 1.0
+    assert ct.linfnorm(loop)[0] == pytest.approx(r.gamma, rel=1e-6)
+
+
+def ncf_plant(A, B, C):
+    """The generalised plant of ‖[I; K](I − GK)⁻¹[I, G]‖∞ for G = (A, B, C, 0): w = (w₁,
+    w₂) enters at G's output and input, z = (y, u), the measurement is y."""
+    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    D = np.zeros((2 * p + m, p + 2 * m))
+    D[:p, :p] = np.eye(p)
+    D[p:p + m, p + m:] = np.eye(m)
+    D[p + m:, :p] = np.eye(p)
+    return ct.ss(A, np.hstack([np.zeros((n, p)), B, B]), np.vstack([C, np.zeros((m, n)), C]),
+                 D)
+
+
+@pytest.mark.parametrize("A, B, C", [
+    ([[1.0]], [[1.0]], [[1.0]]),
+    ([[-2.0]], [[1.0]], [[1.0]]),
+    ([[0.0, 1.0], [-1.0, -0.2]], [[0.0], [1.0]], [[1.0, 0.0]]),
+    ([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, -2.0, -1.0]], [[0, 0], [1, 0], [0, 1]],
+     [[1, 0, 0], [0, 0, 1]]),
+], ids=["unstable-1", "stable-1", "resonance-2", "mimo-3"])
+def test_normalised_coprime_factor_stabilisation_closed_form(A, B, C):
+    """Robust stabilisation of a normalised coprime factorisation (McFarlane & Glover,
+    1990; Zhou, Doyle & Glover, *Robust and Optimal Control*, 1996, ch. 18): the optimal
+    ‖[I; K](I − GK)⁻¹[I, G]‖∞ is √(1 + ρ(XZ)), X and Z the stabilising solutions of
+    A'X + XA − XBB'X + C'C = 0 and AZ + ZA' − ZC'CZ + BB' = 0 (SciPy's Riccati solver). For
+    G = 1/(s − a) it is √(1 + (a + √(a² + 1))²): 2.6131 at a = 1, 1.0275 at a = −2. γ_opt
+    within the search's own tolerance, 1e-6."""
+    from scipy.linalg import solve_continuous_are
+
+    A, B, C = (np.array(M, float) for M in (A, B, C))
+    X = solve_continuous_are(A, B, C.T @ C, np.eye(B.shape[1]))
+    Z = solve_continuous_are(A.T, C.T, B @ B.T, np.eye(C.shape[0]))
+    closed_form = np.sqrt(1.0 + np.max(np.linalg.eigvals(X @ Z).real))
+    if A.shape == (1, 1):
+        a = A[0, 0]
+        assert closed_form == pytest.approx(np.sqrt(1 + (a + np.sqrt(a * a + 1)) ** 2), 1e-12)
+    r = hinfsyn(ncf_plant(A, B, C), C.shape[0], B.shape[1])
+    assert r.gamma_opt == pytest.approx(closed_form, rel=1e-6)
 
 def test_ab13dd_example_linf_norm_and_peak():
     """SLICOT AB13DD example: three lightly damped modes; the L∞ norm 0.5000000001·10⁶ at

@@ -20,7 +20,12 @@ its goal.
 ``--env default`` runs the children as a user's shell does: no BLAS variable set
 (ambseal's own thread policy, :mod:`ambseal.threads`). ``--cold`` gives the main job an
 empty numba cache (``NUMBA_CACHE_DIR``), as on the first run after an install. The main
-job's CPU goals: 30 s warm, 45 s cold (``cpu_goal_s``, ``meets_cpu_goal``).
+job's CPU goals: 30 s warm, 45 s cold (``cpu_goal_s``, ``meets_cpu_goal``). Beside the main
+job, a fixed peer workload (``_REFERENCE``: python-control's ``hinfsyn`` on a 3-state
+problem, the best of five batches of 20 calls) gives the machine's speed,
+``reference_cpu_s`` (the mean of one before and one after the run: a shared machine's
+speed drifts), and the run's CPU in its units, ``cpu_per_reference``: the same code
+measures about the same ratio on a slower machine.
 
 The child finds ambseal the way this script does: the package this interpreter imports
 (an installed one, or ``src/`` on ``PYTHONPATH``) — the script puts that folder first on
@@ -118,11 +123,49 @@ def case_run(rig: str | None, default: bool = False, cold: bool = False) -> dict
         env = child_env(default)
         if cold:
             env["NUMBA_CACHE_DIR"] = cache
+        before = machine_reference()
         elapsed, rc, _, cpu = timed_child(cmd, Path(out), env)
+        ref = (before + machine_reference()) / 2
     goal = CPU_GOALS_S["cold" if cold else "warm"]
-    return record("ambseal_run", elapsed, rc, cpu, rig=rig or "embedded test rig",
+    return record("ambseal_run", elapsed, rc, cpu, reference_cpu_s=ref,
+                  cpu_per_reference=cpu / ref, rig=rig or "embedded test rig",
                   blas_threads="default" if default else 1, numba_cache="empty" if cold
                   else "as found", cpu_goal_s=goal, meets_cpu_goal=rc == 0 and cpu <= goal)
+
+
+#: A fixed peer workload that tells this machine's speed: python-control's ``hinfsyn``
+#: (SLICOT SB10AD's γ bisection from 1e100) on Scherer, Gahinet & Chilali's Example 7, the
+#: baseline of ``bench_hinf.py``: the least CPU time of five batches of 20 calls, in a child
+#: with one BLAS thread. A run's
+#: ``cpu_per_reference`` compares machines and days that the seconds alone cannot.
+_REFERENCE = """
+import control as ct
+P = ct.ss([[0.0, 10.0, 2.0], [-1.0, 1.0, 0.0], [0.0, 2.0, -5.0]],
+          [[1.0, 0.0], [0.0, 1.0], [1.0, 0.0]],
+          [[1.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+          [[0.0, 0.0], [0.0, 1.0], [2.0, 0.0]])
+ct.hinfsyn(P, 1, 1)
+import resource
+def cpu():
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    return r.ru_utime + r.ru_stime
+best = float("inf")
+for _ in range(5):
+    t0 = cpu()
+    for _ in range(20):
+        ct.hinfsyn(P, 1, 1)
+    best = min(best, cpu() - t0)
+print(best)
+"""
+
+
+def machine_reference() -> float:
+    """CPU seconds (user + system) of the peer workload ``_REFERENCE`` on this machine."""
+    with tempfile.TemporaryDirectory(prefix="ambseal-bench-") as cwd:
+        proc = subprocess.run([sys.executable, "-c", _REFERENCE], cwd=cwd, env=child_env(),
+                              stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
+                              check=True)
+    return float(proc.stdout.split()[-1])
 
 
 def case_pytest(pytest_args: str | None) -> dict:

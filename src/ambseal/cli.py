@@ -55,7 +55,7 @@ import warnings
 from pathlib import Path
 
 from ambseal import __version__
-from ambseal.config import check_operating, default_rig_path
+from ambseal.config import check_operating, default_rig_path, method_names
 from ambseal.errors import AmbsealError, with_source
 from ambseal.threads import DEFAULT_THREADS, ENV_VAR, blas_threads, numerics_threads
 
@@ -241,9 +241,10 @@ def _parser() -> argparse.ArgumentParser:
                    help="impulse start (s; default 5 impulse widths)")
     a.add_argument("--seed", type=_natural, default=0, help="seed of excitation and noise")
 
-    d = sub.add_parser("design", help="design a controller (pid, hinf, mu, lpv) and export it")
+    options = list(method_names(option=True))
+    d = sub.add_parser("design", help=f"design a controller ({', '.join(options)}) and export it")
     d.add_argument("rig", nargs="?", help=_RIG_HELP)
-    d.add_argument("--method", choices=["pid", "hinf", "mu", "lpv"],
+    d.add_argument("--method", choices=options,
                    help="the method (required unless --show-defaults)")
     d.add_argument("--show-defaults", action="store_true",
                    help="print the rig's resolved [design] part (values and their rules) "
@@ -255,7 +256,7 @@ def _parser() -> argparse.ArgumentParser:
 
     e = sub.add_parser("export", help="a controller for the real-time target: files and C code")
     e.add_argument("rig", help="rig file (TOML)")
-    e.add_argument("--method", choices=["pid", "hinf", "mu", "lpv"],
+    e.add_argument("--method", choices=options,
                    help="design this controller (or give --controller)")
     e.add_argument("--controller", default=None,
                    help="a controller file written by ambseal (.json/.npz/.mat) to export "

@@ -89,11 +89,12 @@ def sb10dd_bilinear_plant():
 def test_sb10dd_example_discrete_gamma_through_the_bilinear_map():
     """SLICOT SB10DD example (discrete time, γ = 111.294). Its controller as printed closes
     a stable loop of H∞ norm within 1 % of that γ (a controller this near the optimum is
-    sensitive: rounding it to the 4 printed decimals lifts the norm 0.5 %). Mapped by z = (1+s)/(1−s), the
-    plant is a continuous problem with the same γ_opt; ours is SB10DD's own optimum (SB10DD
-    solves the discrete problem at γ_opt·(1 + 1e-6) and refuses it at γ_opt·(1 − 1e-6)),
-    just below the example's γ, and our controller mapped back closes the discrete loop
-    stable with a norm within 1e-6 of the γ it was built for."""
+    sensitive: rounding it to the 4 printed decimals lifts the norm 0.5 %). Mapped by
+    z = (1+s)/(1−s), the plant is a continuous problem with the same γ_opt; ours is
+    SB10DD's own optimum (SB10DD solves the discrete problem at γ_opt·(1 + 1e-6) and
+    refuses it at γ_opt·(1 − 1e-6)), just below the example's γ, and our controller mapped
+    back closes the discrete loop stable with a norm within 1e-6 of the γ it was built
+    for."""
     from slycot import sb10dd
     from slycot.exceptions import SlycotError
     from ambseal.lti.interconnect import lft_lower

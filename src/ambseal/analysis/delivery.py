@@ -20,13 +20,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["FailedController", "METHOD_NAMES", "loop_failure", "synthesis_failure",
-           "also_failed"]
+from ambseal.config import method_label
+
+__all__ = ["FailedController", "loop_failure", "synthesis_failure", "also_failed"]
 
 #: Between a failure's head (the controller, delivered or not) and why.
 _SEP = " — "
-#: How reports name the controllers of a run.
-METHOD_NAMES = {"pid": "PID", "hinf": "H∞", "mu": "μ", "lpv": "LPV", "tracked": "tracked"}
 
 
 @dataclass(frozen=True)
@@ -54,7 +53,7 @@ class FailedController:
 
 
 def _name(method: str) -> str:
-    return METHOD_NAMES.get(method, method)
+    return method_label(method)
 
 
 def _head(method: str, designed: bool, kept: bool = False) -> str:

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ambseal.analysis.judge import judge_settings, operating_points
-from ambseal.config import default_rig_path, dump_rig, load_rig, rig_with_values
+from ambseal.config import default_rig_path, dump_rig, load_rig, method_names, rig_with_values
 from ambseal.design.fast_poles import design_rise
 from ambseal.design.lpv_design import design_lpv
 from ambseal.design.pid import controller_from_metadata, reference_pid
@@ -102,7 +102,7 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
     if not isinstance(controller, ScheduledController):
         cache = {} if cache is None else cache
         rise = ((lambda Kr: design_rise(result, Kr, getattr(result, "omega", None), fs / 2))
-                if method in ("hinf", "mu") else None)
+                if method in method_names(synthesised=True) else None)
         check_rate(controller, fs, delay, removable=rise is not None)  # before the plants
         if "plants" not in cache:
             cache["plants"] = sampled_plants([plant(*c) for c in conds], fs,

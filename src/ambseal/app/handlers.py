@@ -27,7 +27,7 @@ from ambseal.app.commands import (
     validate_summary,
 )
 from ambseal.app.pipeline import run
-from ambseal.config import default_rig_path, load_rig, load_truth
+from ambseal.config import default_rig_path, load_rig, load_truth, method_names
 from ambseal.errors import AmbsealError, ConfigError, with_source
 from ambseal.export.codegen import c_identifier, write_c
 from ambseal.export.controller_files import load_controller
@@ -122,8 +122,8 @@ def _design(args: argparse.Namespace) -> int:
         print(show_defaults(rig, args.overrides), end="")
         return 0
     if args.method is None:
-        raise ConfigError("design: --method is required (pid, hinf, mu or lpv) unless "
-                          "--show-defaults")
+        raise ConfigError(f"design: --method is required "
+                          f"({', '.join(method_names(option=True))}) unless --show-defaults")
     with _owned(args.out):
         summary = design_files(rig, args.method, args.out, pressure_bar=args.pressure_bar,
                                overrides=args.overrides, allow_unstable=args.allow_unstable)

@@ -38,9 +38,9 @@ from ambseal.app.commands import (
     identification_stage,
 )
 from ambseal.app.metrics import SCHEMA_VERSION, ControllerSummary, OpenLoop, RunMetrics
-from ambseal.app.remedies import REMEDIABLE, remedy
+from ambseal.app.remedies import remedy
 from ambseal.app.tracked import tracked_designs, tracked_ramp
-from ambseal.config import RigConfig, default_rig_path, load_rig, load_truth
+from ambseal.config import RigConfig, default_rig_path, load_rig, load_truth, method_names
 from ambseal.design.lpv_design import design_frozen, design_lpv
 from ambseal.design.recipes import design
 from ambseal.design.specs import design_spec
@@ -169,10 +169,12 @@ def _controllers(cfg: RigConfig, spec, say, failed: dict,
 
         return out + guarded("hinf", frozen_hinf) + robust("mu") + guarded("lpv", lpv)
     out = []
-    if "pid" in methods:
-        out.append(lti(design(cfg, "pid")))
-        say("pid designed", 1)
-    out += [d for m in methods if m != "pid" for d in robust(m)]
+    for m in methods:
+        if m in method_names(synthesised=True):
+            out += robust(m)
+        else:  # derived from the rig (the reference PID): no synthesis that can fail
+            out.append(lti(design(cfg, m)))
+            say(f"{m} designed", 1)
     lost = _lost_over_speed(cfg, out)
     if lost:
         top = max(spec.stability_speeds_hz)
@@ -273,12 +275,12 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
     points = operating_points(spec)
     settings = judge_settings(spec)
     final = Path(out_dir)
-    n_designs = 4 if speed_scheduled(cfg) else 3
+    lti_methods, synthesised = method_names(fixed=True), method_names(synthesised=True)
+    n_designs = len(lti_methods) + int(speed_scheduled(cfg))  # and the LPV on speed
     n_tr = int(cfg.design.tracked)  # off by default: minutes of LMI synthesis
     totals = {"model": 1, "design": n_designs, "judge": (n_designs + n_tr) * len(points),
-              "identification": None, "design (identified)": 2 + n_tr, "speed-range": None,
-              "spin-up": 1,
-              "ramp": 1, "report": 1}
+              "identification": None, "design (identified)": len(synthesised) + n_tr,
+              "speed-range": None, "spin-up": 1, "ramp": 1, "report": 1}
     # one run = one folder: written into a staging folder that replaces out_dir at the end
     with RunFolder(final) as out, \
             StageProgress(totals, display=progress and sys.stderr.isatty()) as stages:
@@ -293,7 +295,8 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         early = truth_cfg is not None and not speed_scheduled(cfg)  # P5 §3: identify first
         failed: dict[str, FailedController] = {}
         designs = _controllers(cfg, spec, say, failed,
-                               ("pid",) if early else ("pid", "hinf", "mu"))
+                               tuple(m for m in lti_methods if m not in synthesised)
+                               if early else lti_methods)
         digitals, cannot_run = digitals_for(cfg, designs, points, lambda m: stages.step(m, 0))
         ident, judge_cfg = None, cfg
         if truth_cfg is not None:
@@ -307,7 +310,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
             judge_cfg = ident.truth_cfg
         if early:
             stages.begin("design (identified)", ident.summary["design"]["designed_on"])
-            robust = _controllers(ident.design_cfg, spec, say, failed, ("hinf", "mu"))
+            robust = _controllers(ident.design_cfg, spec, say, failed, synthesised)
             more, more_cannot = digitals_for(ident.design_cfg, robust, points,
                                              lambda m: stages.step(m, 0))
             digitals.update(more)
@@ -332,7 +335,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
             if f is not None:
                 failed[d.method] = f
         for m in [m for m, f in failed.items() if f.designed and f.judged
-                  and m in REMEDIABLE and not speed_scheduled(cfg)]:
+                  and m in synthesised and not speed_scheduled(cfg)]:
             fixed, failed[m] = remedy(
                 m, failed[m], [c for c, _ in _labelled(m, jobs, judged)], design_cfg, spec,
                 points, lambda ds, digs: judge_designs(ds, digs, 0), lambda s: say(s, 0))

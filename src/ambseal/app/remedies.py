@@ -30,10 +30,7 @@ from ambseal.app.commands import Designed, digitals_for
 from ambseal.design.recipes import design
 from ambseal.errors import ConfigError, SynthesisError
 
-__all__ = ["REMEDIABLE", "Remedied", "remedy", "worst_case"]
-
-#: The designs the remedies apply to: those of :func:`ambseal.design.recipes.design`.
-REMEDIABLE = ("hinf", "mu")
+__all__ = ["Remedied", "remedy", "worst_case"]
 
 #: Factor on the performance weight's bandwidth ω_B in the second attempt.
 OMEGA_B_FACTOR = 0.5

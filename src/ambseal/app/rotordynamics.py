@@ -37,9 +37,10 @@ from ambseal.config import (
     MAX_PRESSURE_BAR,
     MAX_SPEED_HZ,
     load_rig,
+    method_names,
     rig_parameter_names,
 )
-from ambseal.design.recipes import METHODS, design
+from ambseal.design.recipes import design
 from ambseal.design.specs import design_spec
 from ambseal.errors import ConfigError
 from ambseal.export.controller_files import load_controller
@@ -65,10 +66,11 @@ def controller_for(cfg, spec: str | None, pressure_bar: float | None = None):
     if spec is None or spec == "none":
         return None
 
-    if spec in METHODS:
+    if spec in method_names(fixed=True):
         return design(cfg, spec, pressure_bar=pressure_bar).K
     if Path(spec).suffix.lower() not in (".json", ".npz", ".mat"):
-        raise ConfigError(f"--controller: expected pid, hinf, mu, none or a controller file "
+        raise ConfigError(f"--controller: expected {', '.join(method_names(fixed=True))}, "
+                          f"none or a controller file "
                           f"(.json, .npz, .mat), got {spec!r}")
 
     K = load_controller(spec, channel_names(cfg))  # a judged digital one: its continuous design

@@ -2,7 +2,8 @@
 
 The one place that knows the file format (:mod:`ambseal.config.rig`: rotor, AMBs, seals,
 springs, controllers, operating points, the facility truth) and its ``[design]`` part
-(:mod:`ambseal.config.design`); rules that need more than one key live in
+(:mod:`ambseal.config.design`) with the controller methods it names
+(:mod:`ambseal.config.methods`); rules that need more than one key live in
 :mod:`ambseal.config._checks`, with the bounds of the values (``MAX_*``, each with its
 reason there), which the other layers' checks of the same quantities share. Every other
 layer receives the typed models from here.
@@ -20,6 +21,7 @@ from ambseal.config._checks import (
                                     MAX_PRESSURE_BAR,
                                     MAX_SPEED_HZ,
 )
+from ambseal.config.methods import METHODS, Method, method, method_label, method_names
 from ambseal.config.rig import (
                                     Actuator,
                                     Affine,
@@ -43,7 +45,8 @@ from ambseal.config.rig import (
 )
 
 __all__ = ["MAX_AMBS", "MAX_COEFFICIENT", "MAX_COMPONENTS", "MAX_CURRENT_A", "MAX_DELAY_SAMPLES", "MAX_ELEMENTS",
-           "MAX_FREQUENCY_HZ", "MAX_GAP_M", "MAX_PRESSURE_BAR", "MAX_SPEED_HZ",
+           "MAX_FREQUENCY_HZ", "MAX_GAP_M", "MAX_PRESSURE_BAR", "MAX_SPEED_HZ", "METHODS",
+           "Method", "method", "method_label", "method_names",
            "Actuator", "Affine", "Amb", "AxisPair", "Coefficient", "FrequencyTable",
            "RigConfig", "Seal", "Spring", "TruthSection", "apply_overrides",
            "check_operating", "default_rig_path", "dump_rig", "load_rig", "load_truth",

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ambseal.config import method_names
 from ambseal.design.recipes import DesignResult
 from ambseal.lti.freqresp import freqresp
 from ambseal.robust.hinf import hinfnorm
@@ -51,7 +52,7 @@ def design_rise(result, K_reduced, omega=None, nyquist_hz: float | None = None
     which is why the hold equivalents are also tried with real fast poles kept. The μ grid
     ends at the top of the design band, below Nyquist."""
     if (not isinstance(result, DesignResult) or result.plant is None
-            or result.method not in ("hinf", "mu") or (result.method == "mu" and omega is None)):
+            or result.method not in method_names(synthesised=True) or (result.method == "mu" and omega is None)):
         return None
     gp, method = result.plant, result.method
     out = {"order_full": int(result.K.nstates), "order": int(K_reduced.nstates)}

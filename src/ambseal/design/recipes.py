@@ -53,6 +53,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from ambseal.config import method_names
 from ambseal.design.pid import pid_controller, reference_pid
 from ambseal.design.plant import generalized_plant
 from ambseal.design.specs import design_spec
@@ -71,9 +72,8 @@ from ambseal.machine.loop import judged_loop
 from ambseal.robust.order import reduce_controller
 from ambseal.threads import with_numerics_threads
 
-__all__ = ["DesignResult", "design", "full_order_check", "bound_text", "METHODS"]
+__all__ = ["DesignResult", "design", "full_order_check", "bound_text"]
 
-METHODS = ("pid", "hinf", "mu")
 #: the automatic controller order keeps μ (H∞: γ) of the design loop within this fraction
 #: of the full-order controller's (:func:`design`, ``reduce_to="auto"``)
 ORDER_RISE = 0.1
@@ -320,8 +320,9 @@ def design(
     (4, 4)
     """
 
-    if method not in METHODS:
-        raise ConfigError(f"design: method={method!r}, expected one of {METHODS}")
+    if method not in method_names(fixed=True):
+        raise ConfigError(f"design: method={method!r}, expected one of "
+                          f"{method_names(fixed=True)}")
     p = float(cfg.operating.pressure_bar if pressure_bar is None else pressure_bar)
     if method == "pid":
         return _pid(cfg, p)

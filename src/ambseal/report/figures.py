@@ -25,6 +25,7 @@ from matplotlib.ticker import LogLocator, NullFormatter, NullLocator, ScalarForm
 from PIL import Image, UnidentifiedImageError
 
 from ambseal.analysis.iso import ZONE_LIMITS, ZONES, zone_limit_db
+from ambseal.config import METHODS
 from ambseal.errors import AmbsealError
 from ambseal.files import STAMP_KEY, atomic_write, input_file
 
@@ -46,19 +47,19 @@ Curve = tuple[str, Sequence[float], Sequence[float]]
 #: Line style of each judged condition, as thesis P5 Figs. 11–13: nominal solid, high
 #: (pressure or speed) dashed, low dash-dot.
 CONDITION_STYLES = {"nominal": "-", "high": "--", "low": "-."}
-#: Colours given to controllers in order of appearance (matplotlib's tab10 cycle).
+#: Colours given to controllers in order of appearance (matplotlib's tab10 cycle; the
+#: methods' own, :data:`ambseal.config.METHODS`, are its first).
 _PALETTE = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2",
             "#17becf")
 
 
-#: The designs' own colours, the same in every report; other names take the palette's rest.
-_METHOD_COLOURS = {"pid": _PALETTE[0], "hinf": _PALETTE[1], "mu": _PALETTE[2],
-                   "lpv": _PALETTE[3]}
+#: The methods' own colours, the same in every report; other names take the palette's rest.
+_METHOD_COLOURS = {m.name: m.colour for m in METHODS if m.colour is not None}
 
 
 def controller_colours(names: Sequence[str]) -> dict[str, str]:
-    """One colour per controller name, the same in every figure (and, for the designs
-    ``pid``, ``hinf``, ``mu``, ``lpv``, in every report)."""
+    """One colour per controller name, the same in every figure (and, for a method with
+    its own colour, :data:`ambseal.config.METHODS`, in every report)."""
     uniq = list(dict.fromkeys(names))
     spare = [c for c in _PALETTE if c not in _METHOD_COLOURS.values()]
     others = [n for n in uniq if n not in _METHOD_COLOURS]

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ambseal import __version__
-from ambseal.analysis.delivery import METHOD_NAMES
+from ambseal.config import method_label
 from ambseal.design.specs import machine
 from ambseal.identify.checks import interval_check, true_line
 from ambseal.identify.seal_test import MIN_FIT_PCT, fit_reliability
@@ -449,7 +449,7 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
                           f"{ol['n_states_reduced']} reduced.")}]
     sections = [{"title": "Cannot run on the target", "text": reason}
                 for reason in (metrics.get("cannot_run") or {}).values()] + sections
-    sections = [{"title": f"{METHOD_NAMES.get(m, m)}: redesigned", "text": (
+    sections = [{"title": f"{method_label(m)}: redesigned", "text": (
         f"{s['remedy']}; the new design holds at every judged condition.")}
         for m, s in metrics["controllers"].items() if s.get("remedy")] + sections
     sections = _speed_range_section(metrics) + sections + _discrete_section(metrics)

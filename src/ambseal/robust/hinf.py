@@ -130,10 +130,9 @@ def _linfnorm_matrices(A, B, C, D, rtol: float = 1e-10) -> tuple[float, float]:
     """L∞ norm and peak frequency of a continuous (A, B, C, D): SLICOT AB13DD through
     slycot, as ``control.linfnorm`` calls it, without building a system object.
 
-    Where AB13DD's QR iteration does not converge (a badly scaled realisation: a
-    224-state μ-design loop whose balancing spreads over 3e7), the norm, a similarity
-    invariant, is that of the realisation balanced by ``scipy.linalg.matrix_balance``
-    (powers of 2, no permutation: exact). SynthesisError if AB13DD fails on that one too."""
+    Where AB13DD's QR iteration does not converge (a badly scaled realisation), the norm,
+    a similarity invariant, is that of the realisation balanced by
+    ``scipy.linalg.matrix_balance`` (powers of 2, no permutation: exact). SynthesisError if AB13DD fails on that one too."""
 
     n, m, p = A.shape[0], B.shape[1], C.shape[0]
     if n == 0:

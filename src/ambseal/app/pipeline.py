@@ -20,6 +20,8 @@ from ambseal.analysis.delivery import (
     synthesis_failure,
 )
 from ambseal.analysis.judge import (
+    JudgeSettings,
+    OperatingPoint,
     frozen_at,
     judge_case,
     judge_jobs,
@@ -32,6 +34,7 @@ from ambseal.analysis.judge import (
 from ambseal.analysis.speed_range import stability_case, stability_points
 from ambseal.app.commands import (
     Designed,
+    Identified,
     digitals_for,
     export_all,
     facility_impulses,
@@ -40,10 +43,17 @@ from ambseal.app.commands import (
 from ambseal.app.metrics import SCHEMA_VERSION, ControllerSummary, OpenLoop, RunMetrics
 from ambseal.app.remedies import remedy
 from ambseal.app.tracked import tracked_designs, tracked_ramp
-from ambseal.config import RigConfig, default_rig_path, load_rig, load_truth, method_names
+from ambseal.config import (
+    RigConfig,
+    TruthSection,
+    default_rig_path,
+    load_rig,
+    load_truth,
+    method_names,
+)
 from ambseal.design.lpv_design import design_frozen, design_lpv
 from ambseal.design.recipes import design
-from ambseal.design.specs import design_spec
+from ambseal.design.specs import DesignSpec, design_spec
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.files import RunFolder, write_json
 from ambseal.model.rig import build_plant
@@ -273,125 +283,216 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
     truth_cfg = load_truth(truth) if identification and truth is not None else None
     spec = design_spec(cfg)
     points = operating_points(spec)
-    settings = judge_settings(spec)
     final = Path(out_dir)
-    lti_methods, synthesised = method_names(fixed=True), method_names(synthesised=True)
-    n_designs = len(lti_methods) + int(speed_scheduled(cfg))  # and the LPV on speed
-    n_tr = int(cfg.design.tracked)  # off by default: minutes of LMI synthesis
-    totals = {"model": 1, "design": n_designs, "judge": (n_designs + n_tr) * len(points),
-              "identification": None, "design (identified)": len(synthesised) + n_tr,
-              "speed-range": None, "spin-up": 1, "ramp": 1, "report": 1}
     # one run = one folder: written into a staging folder that replaces out_dir at the end
     with RunFolder(final) as out, \
-            StageProgress(totals, display=progress and sys.stderr.isatty()) as stages:
+            StageProgress(_stage_totals(cfg, points),
+                          display=progress and sys.stderr.isatty()) as stages:
         (out / "controllers").mkdir()
-        stages.begin("model", "full order and modal reduction")
-        full = build_plant(cfg)
-        n_reduced = build_plant(cfg, reduced=True).n_states
-        unstable = unstable_open_loop_poles(full.A)
-        stages.step()
-        say = lambda msg, steps=0: stages.step(msg, steps)  # noqa: E731
-        stages.begin("design")
-        early = truth_cfg is not None and not speed_scheduled(cfg)  # P5 §3: identify first
-        failed: dict[str, FailedController] = {}
-        designs = _controllers(cfg, spec, say, failed,
-                               tuple(m for m in lti_methods if m not in synthesised)
-                               if early else lti_methods)
-        digitals, cannot_run = digitals_for(cfg, designs, points, lambda m: stages.step(m, 0))
-        ident, judge_cfg = None, cfg
-        if truth_cfg is not None:
-            if "pid" not in digitals:
-                raise ConfigError("controller.pid: the virtual facility runs the reference "
-                                  "PID during identification, and "
-                                  + cannot_run.get("pid", "the rig has none"))
-            stages.begin("identification")
-            ident = identification_stage(cfg, truth_cfg, out, stages.step,
-                                         digitals["pid"].discrete)
-            judge_cfg = ident.truth_cfg
-        if early:
-            stages.begin("design (identified)", ident.summary["design"]["designed_on"])
-            robust = _controllers(ident.design_cfg, spec, say, failed, synthesised)
-            more, more_cannot = digitals_for(ident.design_cfg, robust, points,
-                                             lambda m: stages.step(m, 0))
-            digitals.update(more)
-            cannot_run.update(more_cannot)
-            designs += robust
-            facility_impulses(cfg, truth_cfg, ident, digitals, out)
-        design_cfg = cfg if ident is None else ident.design_cfg
-        designs += tracked_designs(cfg, design_cfg, spec, points, say, digitals, cannot_run)
-        stages.begin("judge")
-
-        def judge_designs(ds, digs, steps=1):
-            js = judge_jobs(ds, digs, points, design_cfg)
-            return js, run_cases(judge_case, js, shared={"cfg": judge_cfg, "settings": settings},
-                                 workers=1, raise_errors=True,
-                                 on_done=lambda i, r: stages.step(
-                                     f"{js[i]['name']} at {js[i]['point'].label}", steps))
-
-        jobs, judged = judge_designs(designs, digitals)
-        for d in designs:  # the judged loops decide (continuous with delay, and as it runs)
-            f = loop_failure(d.method, _labelled(d.method, jobs, judged),
-                             designed=d.method != "pid", kept=allow_unstable)
-            if f is not None:
-                failed[d.method] = f
-        for m in [m for m, f in failed.items() if f.designed and f.judged
-                  and m in synthesised and not speed_scheduled(cfg)]:
-            fixed, failed[m] = remedy(
-                m, failed[m], [c for c, _ in _labelled(m, jobs, judged)], design_cfg, spec,
-                points, lambda ds, digs: judge_designs(ds, digs, 0), lambda s: say(s, 0))
-            if fixed is not None:  # the remedied design replaces the failed one
-                del failed[m]
-                designs = [fixed.design if d.method == m else d for d in designs]
-                digitals[m] = fixed.digital
-                new = iter(zip(fixed.jobs, fixed.judged))
-                jobs, judged = map(list, zip(*[next(new) if j["name"] == m else (j, r)
-                                               for j, r in zip(jobs, judged)]))
-        stability = _speed_range(designs, digitals, spec, points, design_cfg, judge_cfg, stages,
-                                 failed, allow_unstable)
-        if not speed_scheduled(cfg) and "lpv" in {d.method for d in designs} \
-                and "lpv" not in failed:  # the controller for the speed range: say so
-            for m in [m for m in ("hinf", "mu") if m in failed and failed[m].judged]:
-                failed[m] = replace(failed[m], reason=f"{failed[m].reason}; the LPV on speed "
-                                                       "holds the rotor over the speed range")
-        cases = [case for case, _ in judged]
-        case_dicts = [case.to_dict() for case in cases]
-        curves = [(j["name"], j["point"], case, c)
-                  for j, case, (_, c) in zip(jobs, case_dicts, judged)]
-        # a failed design is judged and reported, not delivered (unless asked for)
-        held = {m for m, f in failed.items() if f.designed and not allow_unstable}
-        summaries = export_all(designs, {m: g for m, g in digitals.items() if m not in held},
-                               case_dicts, out / "controllers")
-        figs, sections = ([], []) if ident is None else (ident.figs, ident.sections)
-        spinup = ramp = None
-        if speed_scheduled(cfg):
-            stages.begin("spin-up", "spin-up and frozen sensitivities")
-            spinup, sims, sens = judge_spinup(  # LPV against μ: P3 Fig. 11
-                cfg, {d.method: d.controller for d in designs if d.method in ("mu", "lpv")})
-            figs += spinup_figures(out, sims, sens, cfg.operating.speed_range_hz)
-            stages.step()
-        if cfg.design.tracked and truth_cfg is not None:
-            stages.begin("ramp", "0 → 3× nominal pressure on the virtual facility")
-            ramp, fig = tracked_ramp(cfg, truth_cfg, designs, digitals, ident, settings, out,
-                                     say)
-            figs.append(fig)
-        metrics = RunMetrics(
-            schema_version=SCHEMA_VERSION, rig=str(rig_path), rig_name=cfg.rotor.name,
-            open_loop=OpenLoop([[float(z.real), float(z.imag)] for z in unstable],
-                               full.n_states, n_reduced),
-            unbalance=settings.unbalance_dict(), design_spec=spec.to_dict(),
-            controllers={m: ControllerSummary.from_dict(s) for m, s in summaries.items()},
-            cannot_run=cannot_run, cases=cases, stability=stability, failed=failed,
-            identification=None if ident is None else ident.summary, spinup=spinup,
-            ramp=ramp).to_dict()
-        stages.begin("report")
-        write_json(out / "metrics.json", metrics)
-        figs.append(gains_figure(out, [(d.method, frozen_at(d.controller, cfg.operating,
-                                                            design_cfg)) for d in designs]))
-        write_run_report(out, f"ambseal — {cfg.rotor.name}", stamp(rig_path, command),
-                         metrics, curves, figs, sections, rig_clearances_um(cfg),
-                         judged_on(cfg, truth_cfg if ident is not None else None, truth))
-        stages.step()
+        st = _RunState(cfg, spec, points, judge_settings(spec), out, stages, allow_unstable,
+                       truth_cfg)
+        model = _model_stage(st)
+        _design_stage(st)
+        _judge_stage(st)
+        stability = _speed_range(st.designs, st.digitals, spec, points, st.design_cfg,
+                                 st.judge_cfg, stages, st.failed, allow_unstable)
+        _note_speed_lpv(st)
+        metrics = _deliver_and_report(st, model, stability, rig_path, truth, command)
     exit_status = EXIT_FAILED if any(f.designed and not (allow_unstable and f.judged)
-                                     for f in failed.values()) else 0
+                                     for f in st.failed.values()) else 0
     return RunResult(final, final / "metrics.json", final / "report.html", metrics,
                      failed=metrics["failed"], exit_status=exit_status)
+
+
+def _stage_totals(cfg: RigConfig, points: list[OperatingPoint]) -> dict[str, int | None]:
+    """Steps per stage of the progress display (None: counted as they come)."""
+    n_designs = len(method_names(fixed=True)) + int(speed_scheduled(cfg))  # and the LPV
+    n_tr = int(cfg.design.tracked)  # off by default: minutes of LMI synthesis
+    return {"model": 1, "design": n_designs, "judge": (n_designs + n_tr) * len(points),
+            "identification": None,
+            "design (identified)": len(method_names(synthesised=True)) + n_tr,
+            "speed-range": None, "spin-up": 1, "ramp": 1, "report": 1}
+
+
+@dataclass
+class _RunState:
+    """What the main job's stages hand on: the rig, its specification and judged
+    conditions, and what each stage has made so far."""
+
+    cfg: RigConfig
+    spec: DesignSpec
+    points: list[OperatingPoint]
+    settings: JudgeSettings
+    out: Path
+    stages: StageProgress
+    allow_unstable: bool
+    truth_cfg: TruthSection | None
+    failed: dict[str, FailedController] = field(default_factory=dict)
+    designs: list[Designed] = field(default_factory=list)
+    #: method → its digital controller (:func:`ambseal.app.commands.digitals_for`)
+    digitals: dict = field(default_factory=dict)
+    #: method → why it has no digital controller
+    cannot_run: dict[str, str] = field(default_factory=dict)
+    ident: Identified | None = None
+    #: the judged cases: one job per design and condition, and its (case, curves)
+    jobs: list[dict] = field(default_factory=list)
+    judged: list[tuple] = field(default_factory=list)
+
+    @property
+    def design_cfg(self) -> RigConfig:
+        """The rig the controllers are designed on: the identified one after identification."""
+        return self.cfg if self.ident is None else self.ident.design_cfg
+
+    @property
+    def judge_cfg(self) -> RigConfig:
+        """The rig the loops are judged on: the facility's truth after identification."""
+        return self.cfg if self.ident is None else self.ident.truth_cfg
+
+    def say(self, msg: str, steps: int = 0) -> None:
+        self.stages.step(msg, steps)
+
+
+@dataclass(frozen=True)
+class _Model:
+    n_states: int
+    n_reduced: int
+    unstable: list
+
+
+def _model_stage(st: _RunState) -> _Model:
+    st.stages.begin("model", "full order and modal reduction")
+    full = build_plant(st.cfg)
+    model = _Model(full.n_states, build_plant(st.cfg, reduced=True).n_states,
+                   unstable_open_loop_poles(full.A))
+    st.stages.step()
+    return model
+
+
+def _design_stage(st: _RunState) -> None:
+    """The controllers; with a truth file the reference PID first, the identification on
+    the virtual facility with it, then the synthesised designs on the identified rig
+    (P5 §3)."""
+    cfg, spec, points = st.cfg, st.spec, st.points
+    lti_methods, synthesised = method_names(fixed=True), method_names(synthesised=True)
+    st.stages.begin("design")
+    early = st.truth_cfg is not None and not speed_scheduled(cfg)  # P5 §3: identify first
+    st.designs = _controllers(cfg, spec, st.say, st.failed,
+                              tuple(m for m in lti_methods if m not in synthesised)
+                              if early else lti_methods)
+    st.digitals, st.cannot_run = digitals_for(cfg, st.designs, points,
+                                              lambda m: st.stages.step(m, 0))
+    if st.truth_cfg is not None:
+        if "pid" not in st.digitals:
+            raise ConfigError("controller.pid: the virtual facility runs the reference "
+                              "PID during identification, and "
+                              + st.cannot_run.get("pid", "the rig has none"))
+        st.stages.begin("identification")
+        st.ident = identification_stage(cfg, st.truth_cfg, st.out, st.stages.step,
+                                        st.digitals["pid"].discrete)
+    if early:
+        st.stages.begin("design (identified)", st.ident.summary["design"]["designed_on"])
+        robust = _controllers(st.ident.design_cfg, spec, st.say, st.failed, synthesised)
+        more, more_cannot = digitals_for(st.ident.design_cfg, robust, points,
+                                         lambda m: st.stages.step(m, 0))
+        st.digitals.update(more)
+        st.cannot_run.update(more_cannot)
+        st.designs += robust
+        facility_impulses(cfg, st.truth_cfg, st.ident, st.digitals, st.out)
+    st.designs += tracked_designs(cfg, st.design_cfg, spec, points, st.say, st.digitals,
+                                  st.cannot_run)
+
+
+def _judge_designs(st: _RunState, designs, digitals, steps: int = 1):
+    """Each design closed at each judged condition: (jobs, [(case, curves)])."""
+    js = judge_jobs(designs, digitals, st.points, st.design_cfg)
+    return js, run_cases(judge_case, js, shared={"cfg": st.judge_cfg, "settings": st.settings},
+                         workers=1, raise_errors=True,
+                         on_done=lambda i, r: st.stages.step(
+                             f"{js[i]['name']} at {js[i]['point'].label}", steps))
+
+
+def _judge_stage(st: _RunState) -> None:
+    """The judged loops decide (continuous with delay, and as it runs); a synthesised
+    design that fails its judgement is remedied where it can be (:mod:`ambseal.app.
+    remedies`), the remedied design replacing it."""
+    st.stages.begin("judge")
+    st.jobs, st.judged = _judge_designs(st, st.designs, st.digitals)
+    for d in st.designs:
+        f = loop_failure(d.method, _labelled(d.method, st.jobs, st.judged),
+                         designed=d.method != "pid", kept=st.allow_unstable)
+        if f is not None:
+            st.failed[d.method] = f
+    if speed_scheduled(st.cfg):
+        return
+    for m in [m for m, f in st.failed.items() if f.designed and f.judged
+              and m in method_names(synthesised=True)]:
+        fixed, st.failed[m] = remedy(
+            m, st.failed[m], [c for c, _ in _labelled(m, st.jobs, st.judged)],
+            st.design_cfg, st.spec, st.points,
+            lambda ds, digs: _judge_designs(st, ds, digs, 0), lambda s: st.say(s, 0))
+        if fixed is not None:  # the remedied design replaces the failed one
+            del st.failed[m]
+            st.designs = [fixed.design if d.method == m else d for d in st.designs]
+            st.digitals[m] = fixed.digital
+            new = iter(zip(fixed.jobs, fixed.judged))
+            st.jobs, st.judged = map(list, zip(*[next(new) if j["name"] == m else (j, r)
+                                                 for j, r in zip(st.jobs, st.judged)]))
+
+
+def _note_speed_lpv(st: _RunState) -> None:
+    """Where the LPV on speed holds the rotor over the speed range that a fixed design
+    lost, that design's failure says so."""
+    if speed_scheduled(st.cfg) or "lpv" not in {d.method for d in st.designs} \
+            or "lpv" in st.failed:
+        return
+    for m in [m for m in ("hinf", "mu") if m in st.failed and st.failed[m].judged]:
+        st.failed[m] = replace(st.failed[m], reason=f"{st.failed[m].reason}; the LPV on "
+                                                     "speed holds the rotor over the speed "
+                                                     "range")
+
+
+def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path: Path,
+                        truth, command: str | None) -> dict:
+    """Export the delivered controllers, run the speed-scheduled and tracked extras, write
+    metrics.json and the report; returns the metrics as written."""
+    cfg, out, stages = st.cfg, st.out, st.stages
+    cases = [case for case, _ in st.judged]
+    case_dicts = [case.to_dict() for case in cases]
+    curves = [(j["name"], j["point"], case, c)
+              for j, case, (_, c) in zip(st.jobs, case_dicts, st.judged)]
+    # a failed design is judged and reported, not delivered (unless asked for)
+    held = {m for m, f in st.failed.items() if f.designed and not st.allow_unstable}
+    summaries = export_all(st.designs, {m: g for m, g in st.digitals.items() if m not in held},
+                           case_dicts, out / "controllers")
+    ident = st.ident
+    figs, sections = ([], []) if ident is None else (ident.figs, ident.sections)
+    spinup = ramp = None
+    if speed_scheduled(cfg):
+        stages.begin("spin-up", "spin-up and frozen sensitivities")
+        spinup, sims, sens = judge_spinup(  # LPV against μ: P3 Fig. 11
+            cfg, {d.method: d.controller for d in st.designs if d.method in ("mu", "lpv")})
+        figs += spinup_figures(out, sims, sens, cfg.operating.speed_range_hz)
+        stages.step()
+    if cfg.design.tracked and st.truth_cfg is not None:
+        stages.begin("ramp", "0 → 3× nominal pressure on the virtual facility")
+        ramp, fig = tracked_ramp(cfg, st.truth_cfg, st.designs, st.digitals, ident,
+                                 st.settings, out, st.say)
+        figs.append(fig)
+    metrics = RunMetrics(
+        schema_version=SCHEMA_VERSION, rig=str(rig_path), rig_name=cfg.rotor.name,
+        open_loop=OpenLoop([[float(z.real), float(z.imag)] for z in model.unstable],
+                           model.n_states, model.n_reduced),
+        unbalance=st.settings.unbalance_dict(), design_spec=st.spec.to_dict(),
+        controllers={m: ControllerSummary.from_dict(s) for m, s in summaries.items()},
+        cannot_run=st.cannot_run, cases=cases, stability=stability, failed=st.failed,
+        identification=None if ident is None else ident.summary, spinup=spinup,
+        ramp=ramp).to_dict()
+    stages.begin("report")
+    write_json(out / "metrics.json", metrics)
+    figs.append(gains_figure(out, [(d.method, frozen_at(d.controller, cfg.operating,
+                                                        st.design_cfg)) for d in st.designs]))
+    write_run_report(out, f"ambseal — {cfg.rotor.name}", stamp(rig_path, command),
+                     metrics, curves, figs, sections, rig_clearances_um(cfg),
+                     judged_on(cfg, st.truth_cfg if ident is not None else None, truth))
+    stages.step()
+    return metrics

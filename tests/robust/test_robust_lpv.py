@@ -308,13 +308,14 @@ def _lti_family_plant():
                            outlist=["z_e", "z_u", "e"])
 
 
-def test_lpvsyn_is_never_worse_than_the_best_frozen_design():
+def test_lpvsyn_is_never_worse_than_the_best_frozen_design(monkeypatch):
     """Reference: hinfsyn's controller and its norm (AB13DD), and lpvsyn's own LMI
-    solution without the comparison. A trace penalty of 10 (against the default 1e-4)
-    spoils the LMI solution on the LTI family; the frozen-point design is then better at
-    every θ, and its bound for any trajectory (one Lyapunov matrix, certified by the
-    eigenvalues of the bounded-real inequality) is below the spoilt LMI γ: lpvsyn delivers
-    that design, as a constant table."""
+    solution without the comparison. A trace penalty of 10 (against the default 1e-4),
+    held there (no lowering of its weight), spoils the LMI solution on the LTI family; the
+    frozen-point design is then better at every θ, and its bound for any trajectory (one
+    Lyapunov matrix, certified by the eigenvalues of the bounded-real inequality) is below
+    the spoilt LMI γ: lpvsyn delivers that design, as a constant table."""
+    monkeypatch.setattr("ambseal.robust._lpv_lmi.PENALTY_STEPS", 0)
     P = _lti_family_plant()
     h = hinfsyn(P, 1, 1)
     spoilt = lpvsyn([P] * 3, [1.0, 2.0, 3.0], 1, 1, penalty=10.0, frozen_check=False)
@@ -325,3 +326,88 @@ def test_lpvsyn_is_never_worse_than_the_best_frozen_design():
     assert h.gamma <= r.gamma <= spoilt.gamma
     for t in (1.0, 1.7, 3.0):
         np.testing.assert_allclose(r.K.at(t).A, h.K.A)
+
+
+
+def wu1996_plant(rho: float):
+    """Wu, Yang, Packard & Becker (1996, after Meyer & Cicolani 1981), as LPVTools' tutorial
+    "Synthesis for gridded LPV systems" interconnects it: an unstable plant whose two
+    actuators (10/(s + 10)) act through the rotation R(ρ), weights W_u = I/280, W_p = I,
+    W_n = 10(s + 10)/(s + 1000), W_r = 20/(s + 0.2), W_f = 1. Inputs [d_f, d_r(2), d_n(2),
+    u(2)], outputs [W_u u, v − W_r d_r, v − W_r d_r + W_n d_n]; states [plant(2),
+    actuators(2), W_r(2), W_n(2)]."""
+    c, s = np.cos(rho), np.sin(rho)
+    A = np.zeros((8, 8))
+    A[:4, :4] = [[0.75, 2.0, c, s], [0.0, 0.5, -s, c], [0, 0, -10, 0], [0, 0, 0, -10]]
+    A[4:6, 4:6] = -0.2 * np.eye(2)
+    A[6:, 6:] = -1000.0 * np.eye(2)
+    B = np.zeros((8, 7))
+    B[1, 0] = 3.0
+    B[2:4, 5:] = 10.0 * np.eye(2)
+    B[4:6, 1:3] = np.eye(2)
+    B[6:, 3:5] = np.eye(2)
+    C = np.zeros((6, 8))
+    D = np.zeros((6, 7))
+    D[:2, 5:] = np.eye(2) / 280.0
+    for rows in (slice(2, 4), slice(4, 6)):
+        C[rows, :2] = np.eye(2)
+        C[rows, 4:6] = -20.0 * np.eye(2)
+    C[4:, 6:] = (100.0 - 10.0 * 1000.0) * np.eye(2)  # 10(s+10)/(s+1000) = 10 − 9900/(s+1000)
+    D[4:, 3:5] = 10.0 * np.eye(2)
+    return ct.ss(A, B, C, D)
+
+
+@pytest.fixture(scope="module")
+def wu1996():
+    """lpvsyn's defaults on Wu et al.'s plant over ±30° (5 points) and ±60° (9 points: the
+    first grid's points among them)."""
+    return {half: (th, [wu1996_plant(t) for t in th], lpvsyn([wu1996_plant(t) for t in th],
+                                                             th, 2, 2))
+            for half, n in ((np.pi / 6, 5), (np.pi / 3, 9))
+            for th in [np.linspace(-half, half, n)]}
+
+
+def test_wu1996_weights_as_published():
+    """Reference: the weights' own frequency responses — W_r(0) = 100, W_n(∞) = 10,
+    W_n(0) = 0.1 — read through the plant's channels at ρ = 0."""
+    P = wu1996_plant(0.0)
+    dc = P(0)  # at s = 0
+    np.testing.assert_allclose(dc[2:4, 1:3], -100.0 * np.eye(2), rtol=1e-12)
+    np.testing.assert_allclose(dc[4:, 3:5], 0.1 * np.eye(2), rtol=1e-12)
+    np.testing.assert_allclose(P(1e9j)[4:, 3:5], 10.0 * np.eye(2), rtol=1e-6)
+
+
+def test_wu1996_full_rotation_is_refused_as_infeasible():
+    """Reference: a proof. With R constant (lpvsyn's structure) and ρ and ρ + π both on
+    the grid, the actuator block R(ρ) of A changes sign between them, so the average of
+    the two R-LMIs asks A₁₁R₁₁ + R₁₁A₁₁ᵀ ≺ 0 for the unstable A₁₁ = [0.75 2; 0 0.5]: no
+    solution. lpvsyn says the LMIs are infeasible (the solver's certificate), not that the
+    scaling is bad."""
+    th = np.linspace(-np.pi, np.pi, 7)
+    with pytest.raises(SynthesisError, match="infeasible"):
+        lpvsyn([wu1996_plant(t) for t in th], th, 2, 2)
+
+
+def test_wu1996_gamma_bounds_and_nested_grids(wu1996):
+    """References: the frozen H∞ optimum (python-control's hinfsyn, SB10AD's γ: the same at
+    every ρ, the rotation being a change of input basis) bounds the LPV γ from below; the
+    ±30° grid's LMIs are among the ±60° grid's, so its γ is no larger. With the trace
+    term's weight held at its start the ±30° γ was 18.9, above the ±60° one's 8.8: the
+    price of bounded R and S, not of the plant."""
+    frozen = ct.hinfsyn(wu1996_plant(0.3), 2, 2)[2]
+    narrow, wide = (wu1996[h][2] for h in (np.pi / 6, np.pi / 3))
+    assert frozen <= narrow.gamma <= wide.gamma
+    for r in (narrow, wide):
+        assert r.check_stable and max(r.check_gamma) <= r.gamma_design * 1.02  # its table
+
+
+def test_wu1996_scheduled_loops_against_python_control(wu1996):
+    """Reference: python-control's ``lft`` and ``linfnorm`` of F_l(P(ρ), K(ρ)) (u = K y) at
+    ρ on and between the controller's table points: stable, and within the γ the LMIs
+    certify for every trajectory."""
+    th, _, r = wu1996[np.pi / 3]
+    for rho in (th[0], 0.123, th[-1] - 0.05):
+        K = r.K.at(rho)
+        cl = wu1996_plant(rho).lft(ct.ss(K.A, K.B, K.C, K.D), 2, 2)
+        assert np.max(np.linalg.eigvals(cl.A).real) < 0
+        assert ct.linfnorm(cl)[0] <= r.gamma * (1 + 1e-6)

@@ -22,14 +22,23 @@ import scipy.linalg as sla
 from ambseal.errors import SynthesisError
 from ambseal.robust import _lmi_sdp as _sdp
 
-__all__ = ["SolverReport", "Scaled", "scale_grid", "lmi_blocks", "solve_lmis", "basis",
+__all__ = ["LmiInfeasible", "SolverReport", "Scaled", "scale_grid", "lmi_blocks", "solve_lmis", "basis",
            "BASES"]
 
 BASES = {"constant": 1, "affine": 2, "quadratic": 3}
+#: The largest share of stage 1's cost the trace term may take before its weight is
+#: lowered, and how many times it is (:func:`solve_lmis`)
+PENALTY_SHARE = 1e-2
+PENALTY_STEPS = 3
 #: CVXOPT's options for the γ and centring SDPs (:mod:`ambseal.robust._lmi_sdp`): its own
 #: defaults (a feasibility tolerance of 1e-8 stalls on these LMIs at 7e-8 and ends "unknown")
 DEFAULT_TOL = {"abstol": 1e-7, "reltol": 1e-6, "feastol": 1e-7}
 SOLVER_KEYS = ("abstol", "reltol", "feastol", "maxiters", "refinement")
+
+
+class LmiInfeasible(SynthesisError):
+    """The SDP solver's certificate that the LMIs have no solution. Unlike a stalled solve it
+    does not depend on the state basis the LMIs were written in."""
 
 
 @dataclass(frozen=True)
@@ -245,6 +254,8 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
     S : list of ndarray, shape (N, N)
         Coefficients S_i of S(p) = Σ f_i(p) S_i.
     reports : list of SolverReport
+    penalty_share : float
+        The trace term's share of stage 1's cost at its last solve (relative to γ).
 
     Raises
     ------
@@ -313,6 +324,29 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
     reports = []
     lmis, tr = build(None, float(coupling_ratio) if not centre else 1.0)
     sol = _solve_sdp(lmis, N, nb, 1.0, penalty * tr, solver_options, "gamma", reports)
+    # The trace term keeps R and S bounded, but where they must grow large it also buys a
+    # smaller trace with a larger γ: while its share of the cost exceeds PENALTY_SHARE the
+    # weight is lowered to half that share and the SDP solved again (at most
+    # PENALTY_STEPS times; a solve that fails or does not lower γ ends the continuation).
+    def share_of(sol, weight):
+        return weight * float(tr @ [np.trace(X) for X in sol.X]) / max(float(sol.gamma),
+                                                                       1e-300)
+
+    weight = penalty
+    share = share_of(sol, weight)
+    for _ in range(PENALTY_STEPS):
+        if share <= PENALTY_SHARE:
+            break
+        lower_weight = weight * 0.5 * PENALTY_SHARE / share  # aim inside the bound
+        try:
+            lower = _solve_sdp(lmis, N, nb, 1.0, lower_weight * tr, solver_options, "gamma",
+                               reports)
+        except SynthesisError:
+            break
+        if not float(lower.gamma) < float(sol.gamma):
+            break
+        sol, weight = lower, lower_weight
+        share = share_of(sol, weight)
     gamma = float(sol.gamma)
     gamma_d = backoff * gamma
     if centre:
@@ -330,7 +364,7 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
             raise last
     Rv = _sym(sol.X[0])
     Sv = [_sym(S) for S in sol.X[1:]]
-    return gamma, gamma_d, Rv, Sv, reports
+    return gamma, gamma_d, Rv, Sv, reports, share
 
 
 def _solve_sdp(lmis, N, nb, cost_gamma, cost_trace, options, stage, reports):
@@ -344,7 +378,7 @@ def _solve_sdp(lmis, N, nb, cost_gamma, cost_trace, options, stage, reports):
             "badly conditioned; check the scaling of the plant and weights") from exc
     rep = SolverReport(stage, sol.status, sol.iterations, time.perf_counter() - t0, "CVXOPT")
     if sol.status == "infeasible":
-        raise SynthesisError(
+        raise LmiInfeasible(
             f"lpvsyn ({stage}): the LMIs are infeasible (CVXOPT: primal infeasibility "
             "certificate): no controller with this Lyapunov structure exists for the plant "
             "and weights; relax the weights, the rate bound or the grid range")

@@ -58,6 +58,8 @@ from ambseal.lti.tables import interp_table
 from ambseal.robust._lpv_lmi import (
     BASES,
     DEFAULT_TOL,
+    PENALTY_SHARE,
+    LmiInfeasible,
     SOLVER_KEYS,
     SolverReport,
     lmi_blocks,
@@ -194,6 +196,10 @@ class LpvSynResult:
         better at every frozen θ and no worse under a varying one, delivered in its place
         as a constant table with ``gamma`` its quadratic-performance bound over the check
         grid.
+    penalty_share : float
+        The trace term's share of the γ stage's cost at its last solve, relative to γ
+        (1 % or less unless the SDP could not be solved with a smaller weight): how much
+        of ``gamma`` may be the price of bounded R and S rather than of the plant.
 
     Notes
     -----
@@ -217,6 +223,7 @@ class LpvSynResult:
     frozen_best_gamma: float = float("nan")
     frozen_best_theta: float = float("nan")
     kind: str = "lpv"
+    penalty_share: float = 0.0
 
     def __iter__(self):
         """``K, CL, gamma, info = lpvsyn(...)``: the scheduled controller, θ ↦ the frozen
@@ -225,8 +232,8 @@ class LpvSynResult:
 
     @property
     def iterations(self) -> int:
-        """Interior-point iterations of the γ stage."""
-        return self.reports[0].iterations if self.reports else 0
+        """Interior-point iterations of the γ stage (all its solves)."""
+        return sum(r.iterations for r in self.reports if r.stage == "gamma")
 
     def to_dict(self) -> dict:
         return {"gamma": self.gamma, "gamma_design": self.gamma_design,
@@ -238,6 +245,7 @@ class LpvSynResult:
                 "scaling": self.scaling, "kind": self.kind,
                 "frozen_best_gamma": json_float(self.frozen_best_gamma),
                 "frozen_best_theta": json_float(self.frozen_best_theta),
+                "penalty_share": self.penalty_share,
                 "reports": [r.to_dict() for r in self.reports], "time_s": self.time_s}
 
 
@@ -260,7 +268,10 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
        controller reconstruction is well conditioned, at a slightly higher γ (still a valid
        upper bound). The small trace term keeps the SDP bounded near the optimum, where R
        or S would otherwise grow without limit (a hard cap on R, S sits on the cap and
-       stalls the interior point).
+       stalls the interior point). Where that term takes more than 1 % of the cost (R, S
+       must be large: then it would raise γ), its weight is lowered to half that share and
+       the SDP solved again, up to three times while γ falls (``penalty_share`` says where
+       it ended).
     2. ``"centre"`` (only with ``centre=True``): stage 1 with α = 1, then at
        γ_d = backoff·γ minimise tr R + mean_k tr S(θ_k) with α = ``coupling_ratio``
        (lowered towards 1 if infeasible). Gives the least conservative γ, but with a
@@ -301,9 +312,13 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
         time scale; ``"diagonal"`` stops after the diagonal balancing. ``"auto"``
         (default): ``"riccati"``, and where it fails (the SDP solver stops, or a
         reconstructed loop is unstable: small plants whose balancing is near singular)
-        ``"diagonal"``; the result says which (``scaling``).
+        ``"diagonal"``, also where the Riccati scaling's γ stays held up by the trace
+        term (``penalty_share`` above its bound) and the diagonal one reaches a lower γ;
+        the result says which (``scaling``). When both fail, the error is
+        the diagonal scaling's if it is the solver's certificate that the LMIs are
+        infeasible (true in any state basis), else the Riccati scaling's.
     penalty : float
-        Weight of the trace term in stage 1 (scaled units; ≥ 0).
+        Starting weight of the trace term in stage 1 (scaled units; ≥ 0).
     coupling_ratio : float
         α of the coupling LMI (> 1).
     centre : bool
@@ -363,9 +378,18 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
     else:
         try:
             r = _synthesise(data, "riccati", **settings)
+            if r.penalty_share > PENALTY_SHARE:  # γ held up by the trace term: try the other
+                try:
+                    alt = _synthesise(data, "diagonal", **settings)
+                    if alt.gamma < r.gamma:
+                        r = alt
+                except SynthesisError:
+                    pass
         except SynthesisError as first:
             try:  # a plant the balancing does not suit: the diagonal scaling alone
                 r = _synthesise(data, "diagonal", **settings)
+            except LmiInfeasible as proof:  # a certificate holds in every state basis
+                raise proof from None
             except SynthesisError:
                 raise first from None
     if frozen_check:
@@ -412,7 +436,7 @@ def _synthesise(data, scaling: str, *, lyapunov, rate_bound, backoff, check_dens
     sc = scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling)
     blocks = lmi_blocks(sc, nw, nz, ncon, nmeas)
     nu_s = 0.0 if rate_bound is None else float(rate_bound) / sc.w0 * sc.dp_dtheta  # dp/dt'
-    gamma, gamma_d, R, S, reports = solve_lmis(
+    gamma, gamma_d, R, S, reports, share = solve_lmis(
         sc, blocks, grid, lyapunov, nu_s, backoff=backoff, margin=margin, penalty=penalty,
         coupling_ratio=coupling_ratio, centre=centre, solver_options=solver_options)
 
@@ -437,7 +461,7 @@ def _synthesise(data, scaling: str, *, lyapunov, rate_bound, backoff, check_dens
                         rate_bound=None if rate_bound is None else float(rate_bound),
                         grid=grid, check_grid=table, check_gamma=check_g,
                         check_stable=True, reports=tuple(reports), closed_loop=CL,
-                        scaling=scaling)
+                        scaling=scaling, penalty_share=share)
 
 
 def _validate(plants, theta, nmeas, ncon, dA, lyapunov, rate_bound, backoff,

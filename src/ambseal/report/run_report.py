@@ -195,20 +195,7 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
                  "against the identified model",
                  frf_figure(out / "ident_plant_frf.png", checks.plant, checks.plant_model,
                             pairs=list(checks.plant_pairs))))
-    rows = []
-    for n, e in errors.items():
-        if "estimate" in e:
-            lo, hi = (math.nan if v is None else v for v in e["ci95"])
-            err = "" if e["error_pct"] is None else f"{e['error_pct']:+.2f} %"
-            rows.append(f"<tr><td class=\"text\">{html.escape(n)}</td>"
-                        f"<td>{sig(e['estimate'], 4)}</td><td>{sig(e['truth'], 4)}</td>"
-                        f"<td>[{sig(lo, 4)}, {sig(hi, 4)}]</td><td>{err}</td></tr>")
-        else:
-            t = e["truth"]
-            tl = f"{t['at_zero']:.4g} + {t['per_bar']:.4g}·p" if isinstance(t, dict) else str(t)
-            rows.append(f"<tr><td>{html.escape(n)} (vs p, bar)</td><td>{e['intercept']:.4g} + "
-                        f"{e['slope']:.4g}·p</td><td>{tl}</td><td>slope ± "
-                        f"{1.96 * e['slope_se']:.3g}</td><td></td></tr>")
+    rows = [_truth_row(n, e) for n, e in errors.items()]
     fits = ", ".join(f"{k} {v:.1f} %" for k, v in a.nrmse_fit_pct.items())
     if a.residuals is not None:
         fits += f". Model check of stage (a)+(b): {_model_check_text(a, errors)}"
@@ -230,6 +217,22 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
                  + _seal_table(res)),
     }
     return figs, [section]
+
+
+def _truth_row(name: str, e: dict) -> str:
+    """One row of the identified-against-truth table: an estimate with its interval, or a
+    regression on pressure."""
+    if "estimate" in e:
+        lo, hi = (math.nan if v is None else v for v in e["ci95"])
+        err = "" if e["error_pct"] is None else f"{e['error_pct']:+.2f} %"
+        return (f"<tr><td class=\"text\">{html.escape(name)}</td>"
+                f"<td>{sig(e['estimate'], 4)}</td><td>{sig(e['truth'], 4)}</td>"
+                f"<td>[{sig(lo, 4)}, {sig(hi, 4)}]</td><td>{err}</td></tr>")
+    t = e["truth"]
+    tl = f"{t['at_zero']:.4g} + {t['per_bar']:.4g}·p" if isinstance(t, dict) else str(t)
+    return (f"<tr><td>{html.escape(name)} (vs p, bar)</td><td>{e['intercept']:.4g} + "
+            f"{e['slope']:.4g}·p</td><td>{tl}</td><td>slope ± "
+            f"{1.96 * e['slope_se']:.3g}</td><td></td></tr>")
 
 
 def _model_check_text(fit, errors: dict) -> str:
@@ -401,7 +404,18 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
     listed in each figure's legend, not drawn. ``meta`` is the stamp (:func:`stamp`). The
     controllers of ``metrics["failed"]`` are listed first with their reasons.
     """
+    return write_report(out / "report.html", title=title, metrics=metrics["cases"],
+                        figures=_run_figures(out, metrics, curves) + list(extra_figures),
+                        sections=_run_sections(metrics) + list(extra_sections), meta=meta,
+                        clearances_um=clearances_um, judged_on=judged_on,
+                        failed=[f["reason"] for f in (metrics.get("failed") or {}).values()],
+                        stability=metrics.get("stability") or (),
+                        designs=metrics.get("controllers"))
 
+
+def _run_figures(out: Path, metrics: dict, curves: list) -> list:
+    """The main job's figures, (caption, path): σ̄(S_o) continuous and as it runs,
+    compliance, unbalance and impulse responses of every stable judged loop."""
     styles, unstable = _styles(curves)
     kw = dict(styles=styles, unstable=unstable)
     drawn = [(f"{m}, {p.label}", c) for m, p, case, c in curves if case.get("stable")]
@@ -409,17 +423,7 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
              figures.sensitivity_figure(out / "sensitivity.png",
                                         [(lb, *c["So"]) for lb, c in drawn if "So" in c], **kw))]
     comp = [(lb, *c["compliance"]) for lb, c in drawn if "compliance" in c]
-    # the discrete loops in the same colours and line styles; an unstable one listed only
-    dstable = {f"{m}, {p.label}": bool((case.get("discrete") or {}).get("stable"))
-               for m, p, case, c in curves if "discrete" in c}
-    disc = [(lb, *c["discrete"]["So"]) for lb, c in
-            ((f"{m}, {p.label}", c) for m, p, _, c in curves) if dstable.get(lb)]
-    if disc:
-        figs.append(("σ̄(S_o) of the controllers as they run: sampled plant, discrete "
-                     "controller and its computation delay, up to Nyquist",
-                     figures.sensitivity_figure(
-                         out / "sensitivity_discrete.png", disc, styles=styles,
-                         unstable={lb: styles[lb] for lb, ok in dstable.items() if not ok})))
+    figs += _discrete_figure(out, curves, styles)
     if comp:
         at = (metrics.get("design_spec") or {}).get("force_at") or "the bearings"
         figs.append((f"Compliance σ̄(S_o G_f), forces at {at} (P5 Fig. 11)",
@@ -429,18 +433,45 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
         grade = metrics["unbalance"]["grade_mm_s"]
         figs.append((f"Worst-case unbalance response, G{grade:g} (P5 Fig. 12)",
                      figures.unbalance_figure(out / "unbalance.png", unb, **kw)))
-    imp = [(lb, c["impulse"]) for lb, c in drawn if "impulse" in c]
-    if imp:
-        first = imp[0][1]
-        names = [axis_label(n.removeprefix("y_")) for n in first.output_names]
-        figs.append((
-            f"Response to {first.amplitude_a:g} A for {first.duration_s * 1e3:g} ms on "
-            f"{' and '.join(axis_label(c.removeprefix('i_')) for c in first.channels)} "
-            "(P5 Fig. 14)",
-            figures.impulse_figure(
-                out / "impulse.png", [(lb, r.time_ms, r.displacement_um) for lb, r in imp],
-                names, currents=[(lb, r.time_ms, r.current_a) for lb, r in imp],
-                styles=styles)))
+    return figs + _impulse_figure(out, [(lb, c["impulse"]) for lb, c in drawn
+                                        if "impulse" in c], styles)
+
+
+def _discrete_figure(out: Path, curves: list, styles: dict) -> list:
+    """σ̄(S_o) of the loops as they run, in the continuous loops' colours and line styles;
+    an unstable one listed only (none drawn: no figure)."""
+    dstable = {f"{m}, {p.label}": bool((case.get("discrete") or {}).get("stable"))
+               for m, p, case, c in curves if "discrete" in c}
+    disc = [(lb, *c["discrete"]["So"]) for lb, c in
+            ((f"{m}, {p.label}", c) for m, p, _, c in curves) if dstable.get(lb)]
+    if not disc:
+        return []
+    return [("σ̄(S_o) of the controllers as they run: sampled plant, discrete "
+             "controller and its computation delay, up to Nyquist",
+             figures.sensitivity_figure(
+                 out / "sensitivity_discrete.png", disc, styles=styles,
+                 unstable={lb: styles[lb] for lb, ok in dstable.items() if not ok}))]
+
+
+def _impulse_figure(out: Path, imp: list, styles: dict) -> list:
+    """The impulse responses ``imp = [(label, response)]`` (none: no figure)."""
+    if not imp:
+        return []
+    first = imp[0][1]
+    names = [axis_label(n.removeprefix("y_")) for n in first.output_names]
+    return [(
+        f"Response to {first.amplitude_a:g} A for {first.duration_s * 1e3:g} ms on "
+        f"{' and '.join(axis_label(c.removeprefix('i_')) for c in first.channels)} "
+        "(P5 Fig. 14)",
+        figures.impulse_figure(
+            out / "impulse.png", [(lb, r.time_ms, r.displacement_um) for lb, r in imp],
+            names, currents=[(lb, r.time_ms, r.current_a) for lb, r in imp],
+            styles=styles))]
+
+
+def _run_sections(metrics: dict) -> list[dict]:
+    """The main job's text sections: the speed range, redesigns, what cannot run on the
+    target, the open loop and the discretisations."""
     ol = metrics["open_loop"]
     sections = [{"title": "Open loop",
                  "text": (f"{len(ol['unstable_poles'])} unstable poles (rad/s): "
@@ -452,11 +483,4 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
     sections = [{"title": f"{method_label(m)}: redesigned", "text": (
         f"{s['remedy']}; the new design holds at every judged condition.")}
         for m, s in metrics["controllers"].items() if s.get("remedy")] + sections
-    sections = _speed_range_section(metrics) + sections + _discrete_section(metrics)
-    return write_report(out / "report.html", title=title, metrics=metrics["cases"],
-                        figures=figs + list(extra_figures),
-                        sections=sections + list(extra_sections), meta=meta,
-                        clearances_um=clearances_um, judged_on=judged_on,
-                        failed=[f["reason"] for f in (metrics.get("failed") or {}).values()],
-                        stability=metrics.get("stability") or (),
-                        designs=metrics.get("controllers"))
+    return _speed_range_section(metrics) + sections + _discrete_section(metrics)

@@ -223,41 +223,50 @@ def verdicts(cases: Sequence[Mapping], clearances_um: Mapping[str, float] | None
     bound from ``metrics["controllers"]`` (``designs``)."""
     by_speed = _speed_varies(cases)
     names = list(dict.fromkeys(c["controller"] for c in cases))
-    out = []
-    for name in names:
-        cs = [c for c in cases if c["controller"] == name]
-        label = [condition_label(c, by_speed) for c in cs]
-        ok = [c for c in cs if c.get("stable")]
+    return [_verdict(name, [c for c in cases if c["controller"] == name], by_speed,
+                     [c for c in stability if c["controller"] == name], clearances_um,
+                     (designs or {}).get(name, {}))
+            for name in names]
 
-        def peak(key, pool=ok):
-            vals = [c[key] for c in pool if c.get(key) is not None]
-            return max(vals) if vals else None
 
-        axis_zones = [z for c in cs for z in (c.get("iso_zone_per_axis") or {}).values()]
-        stable_zones = {z for c in ok for z in (c.get("iso_zone_per_axis") or {}).values()}
-        per_axis = [(pk, a, lb) for lb, c in zip(label, cs) if c.get("stable")
-                    for a, pk in (c.get("sensitivity_peak_per_axis") or {}).items()
-                    if pk is not None]
-        top = max(per_axis, default=None)
-        axis_zones += ["D" for c in cs if not c.get("stable")]
-        sc = [c for c in stability if c["controller"] == name]
-        speed_bad = tuple(c["label"] for c in sc if _unstable(c))
-        axis_zones += ["D"] if speed_bad else []
-        out.append(Verdict(
-            controller=name, conditions=tuple(label),
-            stable_at=tuple(lb for lb, c in zip(label, cs) if c.get("stable")),
-            unstable_at=tuple(lb for lb, c in zip(label, cs) if not c.get("stable")),
-            zone_axis=_worst(axis_zones), zone_sigma=_worst(c.get("iso_zone") for c in cs),
-            sigma_peak=peak("sensitivity_peak"), orbit_um=peak("unbalance_peak_um"),
-            impulse_peak_um=peak("impulse_peak_um"),
-            impulse_settling_s=peak("impulse_settling_s"),
-            clearances_um=dict(clearances_um or {}), target_difference=target_difference(cs),
-            speed_checked=len(sc), speed_unstable=speed_bad,
-            design_bound=((designs or {}).get(name, {}).get("verdict") or "").split(";")[0]
-            or None,
-            worst_axis=None if top is None else f"{axis_label(top[1])} at {top[2]}",
-            axes_alike=len(stable_zones) <= 1))
-    return out
+def _verdict(name: str, cs: list, by_speed: bool, sc: list,
+             clearances_um: Mapping[str, float] | None, design: Mapping) -> Verdict:
+    """The verdict of one controller from its judged cases ``cs``, its speed-range cases
+    ``sc`` and its design's summary."""
+    label = [condition_label(c, by_speed) for c in cs]
+    ok = [c for c in cs if c.get("stable")]
+
+    def peak(key):
+        vals = [c[key] for c in ok if c.get(key) is not None]
+        return max(vals) if vals else None
+
+    stable_zones = {z for c in ok for z in (c.get("iso_zone_per_axis") or {}).values()}
+    speed_bad = tuple(c["label"] for c in sc if _unstable(c))
+    # an unstable loop, judged or at a speed of the range, is zone D
+    axis_zones = ([z for c in cs for z in (c.get("iso_zone_per_axis") or {}).values()]
+                  + ["D" for c in cs if not c.get("stable")] + (["D"] if speed_bad else []))
+    top = _worst_axis(label, cs)
+    return Verdict(
+        controller=name, conditions=tuple(label),
+        stable_at=tuple(lb for lb, c in zip(label, cs) if c.get("stable")),
+        unstable_at=tuple(lb for lb, c in zip(label, cs) if not c.get("stable")),
+        zone_axis=_worst(axis_zones), zone_sigma=_worst(c.get("iso_zone") for c in cs),
+        sigma_peak=peak("sensitivity_peak"), orbit_um=peak("unbalance_peak_um"),
+        impulse_peak_um=peak("impulse_peak_um"),
+        impulse_settling_s=peak("impulse_settling_s"),
+        clearances_um=dict(clearances_um or {}), target_difference=target_difference(cs),
+        speed_checked=len(sc), speed_unstable=speed_bad,
+        design_bound=(design.get("verdict") or "").split(";")[0] or None,
+        worst_axis=None if top is None else f"{axis_label(top[1])} at {top[2]}",
+        axes_alike=len(stable_zones) <= 1)
+
+
+def _worst_axis(labels: list[str], cs: list) -> tuple | None:
+    """(σ̄ peak, axis, condition label) of the highest per-axis σ̄(S_o) peak among the
+    stable cases, or None."""
+    return max(((pk, a, lb) for lb, c in zip(labels, cs) if c.get("stable")
+                for a, pk in (c.get("sensitivity_peak_per_axis") or {}).items()
+                if pk is not None), default=None)
 
 
 def _esc(s: Any) -> str:

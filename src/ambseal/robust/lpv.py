@@ -474,27 +474,16 @@ def _validate(plants, theta, nmeas, ncon, dA, lyapunov, rate_bound, backoff,
                              f"each; got {grid.size} values and {len(plants)} plants")
     if np.any(np.diff(grid) <= 0) or not np.all(np.isfinite(grid)):
         raise SynthesisError("lpvsyn: theta must be finite and strictly increasing")
-    if lyapunov not in BASES:
-        raise SynthesisError(f"lpvsyn: lyapunov={lyapunov!r}; expected one of {sorted(BASES)}")
-    if lyapunov == "constant" and rate_bound is not None:
-        raise SynthesisError(
-            "lpvsyn: a rate bound needs a parameter-dependent Lyapunov function "
-            "(lyapunov='affine' or 'quadratic'); a constant one already allows arbitrarily "
-            "fast parameter changes")
-    if lyapunov != "constant" and (rate_bound is None or not np.isfinite(rate_bound)
-                                   or rate_bound < 0):
-        raise SynthesisError(f"lpvsyn: lyapunov={lyapunov!r} needs a finite rate_bound ≥ 0 "
-                             f"(θ's unit per second), got {rate_bound!r}")
-    if backoff < 1.0:
-        raise SynthesisError(f"lpvsyn: backoff={backoff} must be ≥ 1")
+    _validate_settings(lyapunov, rate_bound, backoff, coupling_ratio, penalty)
     As = np.array([np.asarray(P.A, float) for P in plants])
     B = np.asarray(plants[0].B, float)
     C = np.asarray(plants[0].C, float)
     D = np.asarray(plants[0].D, float)
     for k, P in enumerate(plants[1:], 1):
         for nm, X, Y in (("B", B, P.B), ("C", C, P.C), ("D", D, P.D)):
-            if np.shape(Y) != X.shape or not np.allclose(np.asarray(Y, float), X,
-                                                         rtol=1e-9, atol=1e-12 * max(1.0, np.abs(X).max())):
+            atol = 1e-12 * max(1.0, np.abs(X).max())
+            if np.shape(Y) != X.shape or not np.allclose(np.asarray(Y, float), X, rtol=1e-9,
+                                                         atol=atol):
                 raise SynthesisError(f"lpvsyn: plant {k} differs from plant 0 in {nm}; only A "
                                      "may depend on θ (one state basis)")
     nw, nz = B.shape[1] - ncon, C.shape[0] - nmeas
@@ -509,11 +498,28 @@ def _validate(plants, theta, nmeas, ncon, dA, lyapunov, rate_bound, backoff,
         dAs = np.array([np.asarray(X, float) for X in dA])
         if dAs.shape != As.shape:
             raise SynthesisError(f"lpvsyn: dA has shape {dAs.shape}, expected {As.shape}")
+    return grid, As, dAs, B, C, D, nw, nz
+
+
+def _validate_settings(lyapunov, rate_bound, backoff, coupling_ratio, penalty) -> None:
+    """:func:`lpvsyn`'s settings; raises SynthesisError as documented there."""
+    if lyapunov not in BASES:
+        raise SynthesisError(f"lpvsyn: lyapunov={lyapunov!r}; expected one of {sorted(BASES)}")
+    if lyapunov == "constant" and rate_bound is not None:
+        raise SynthesisError(
+            "lpvsyn: a rate bound needs a parameter-dependent Lyapunov function "
+            "(lyapunov='affine' or 'quadratic'); a constant one already allows arbitrarily "
+            "fast parameter changes")
+    if lyapunov != "constant" and (rate_bound is None or not np.isfinite(rate_bound)
+                                   or rate_bound < 0):
+        raise SynthesisError(f"lpvsyn: lyapunov={lyapunov!r} needs a finite rate_bound ≥ 0 "
+                             f"(θ's unit per second), got {rate_bound!r}")
+    if backoff < 1.0:
+        raise SynthesisError(f"lpvsyn: backoff={backoff} must be ≥ 1")
     if not coupling_ratio > 1.0:
         raise SynthesisError(f"lpvsyn: coupling_ratio={coupling_ratio} must be > 1")
     if not penalty >= 0.0:
         raise SynthesisError(f"lpvsyn: penalty={penalty} must be ≥ 0")
-    return grid, As, dAs, B, C, D, nw, nz
 
 
 def _check_table(K: LpvController, A_of, B, C, D, nmeas: int, ncon: int) -> np.ndarray:

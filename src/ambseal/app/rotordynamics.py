@@ -146,27 +146,38 @@ def _modes(args: argparse.Namespace) -> int:
         m = closed_loop_modes(cfg, K, speed_hz=rpm / 60.0, pressure_bar=p, max_hz=keep_hz)
     unstable = res.unstable_poles if K is None else [
         (float(z.real), float(z.imag)) for z in unstable_poles(m.poles)]
-    # a pair damped at ζ ≥ 1/√2 has no resonance (|H(jω)| of its mode falls monotonically):
-    # no natural frequency to avoid, listed apart as `campbell` lists its crossings
-    over = m.damping_ratio >= OVERDAMPED_ZETA
-    resonant = ~over
     out = {"speed_hz": rpm / 60.0, "pressure_bar": p, "max_hz": f_max,
-           "controller": args.controller or "none",
-           "natural_frequencies_hz": [float(x) for x in m.frequency_hz[resonant]],
-           "damping_ratios": [float(x) for x in m.damping_ratio[resonant]],
-           "log_decrements": [float(x) for x in m.log_decrement[resonant]],
-           "whirl": [w for w, r in zip(m.whirl, resonant) if r],
-           "overdamped": [{"frequency_hz": float(f), "damping_ratio": float(z), "whirl": w}
-                          for f, z, w, o in zip(m.frequency_hz, m.damping_ratio, m.whirl, over)
-                          if o],
+           "controller": args.controller or "none", **_mode_lists(m),
            "unstable_poles": [list(z) for z in unstable]}
     if args.shapes is not None:
         out["shapes"] = str(mode_shapes_figure(Path(args.shapes), m, _positions(cfg)))
     if args.json:
         print(json.dumps(out, indent=2))
-        return 0
-    print(f"speed {rpm / 60.0:g} Hz ({rpm:g} rpm), pressure drop {p:g} bar, "
-          f"controller {out['controller']}, modes up to {f_max:.4g} Hz")
+    else:
+        _print_modes(out, rpm)
+    return 0
+
+
+def _mode_lists(m) -> dict:
+    """The modes' frequencies, damping, log decrements and whirl, the overdamped ones
+    apart: a pair damped at ζ ≥ 1/√2 has no resonance (|H(jω)| of its mode falls
+    monotonically), no natural frequency to avoid, listed apart as `campbell` lists its
+    crossings."""
+    over = m.damping_ratio >= OVERDAMPED_ZETA
+    resonant = ~over
+    return {"natural_frequencies_hz": [float(x) for x in m.frequency_hz[resonant]],
+            "damping_ratios": [float(x) for x in m.damping_ratio[resonant]],
+            "log_decrements": [float(x) for x in m.log_decrement[resonant]],
+            "whirl": [w for w, r in zip(m.whirl, resonant) if r],
+            "overdamped": [{"frequency_hz": float(f), "damping_ratio": float(z), "whirl": w}
+                           for f, z, w, o in zip(m.frequency_hz, m.damping_ratio, m.whirl,
+                                                 over) if o]}
+
+
+def _print_modes(out: dict, rpm: float) -> None:
+    """``ambseal modes``' table (``out`` as its JSON) on stdout."""
+    print(f"speed {rpm / 60.0:g} Hz ({rpm:g} rpm), pressure drop {out['pressure_bar']:g} bar, "
+          f"controller {out['controller']}, modes up to {out['max_hz']:.4g} Hz")
     print(f"{'mode':>4}  {'f_d [Hz]':>12}  {'zeta [-]':>10}  {'log dec':>9}  whirl")
     for i, (f, z, d, w) in enumerate(zip(out["natural_frequencies_hz"], out["damping_ratios"],
                                          out["log_decrements"], out["whirl"]), 1):
@@ -175,15 +186,14 @@ def _modes(args: argparse.Namespace) -> int:
         print(f"overdamped (zeta >= {OVERDAMPED_ZETA:.3f}, no resonance): "
               + ", ".join(f"{o['frequency_hz']:.4g} Hz (zeta {o['damping_ratio']:.3f})"
                           for o in out["overdamped"]))
-    if unstable:
+    if out["unstable_poles"]:
         print("unstable poles [rad/s]:")
-        for re, im in unstable:
+        for re, im in out["unstable_poles"]:
             print(f"  {re:+.4g} {im:+.4g}j")
     else:
         print("no unstable poles")
     if "shapes" in out:
         print(f"mode shapes: {out['shapes']}")
-    return 0
 
 
 def _owns_out(handler):

@@ -37,10 +37,7 @@ still reported. ``tracking`` then says ``refused``, ``refused_at_s``, ``refusal`
 ``fallback`` and ``fallback_from_s``, with the test's ``check_threshold``, each
 coefficient's largest statistic ``check_largest`` and the largest bias its error causes in
 k̂, in k̂'s standard errors, ``check_largest_bias_se`` (a window refuses when both exceed
-their limits). Measured: examples/pump.toml on
-tests/data/pump_truth.toml (its identified balance-drum K 0.48 MN/m at 20 bar against the
-truth's 1.2 MN/m) refuses at 3.5 s on 20 seeds of 20 and the μ controller keeps the rotor;
-the test rig's identified model is not refused.
+their limits).
 
 Every controller runs with ``delay_samples`` of computation delay (the target's,
 ``[controller] delay_samples``; 0: the facility's own timing, output in the sample its

@@ -27,10 +27,8 @@ the controller within 2.5× the reference PID's peak gain (0.037), rising tenfol
 corner at the actuator bandwidth (1.5 kHz); D_e = air gap/25 (20 µm). Well above the design
 bandwidth it leaves the rigid-body loop alone, but it rolls the controller off at the
 bending modes left out of the design model: with a static W_u, σ̄(S_o) on the full-order
-plant peaked at 4.4–6.7 there (spill-over). Measured on the turboexpander: constant-
-Lyapunov γ 1.10, σ̄(S_o) 1.66–1.68 at 20/140/300 Hz, every full-order loop stable (least
-damped: 1.95 kHz, ζ 0.005). Before the rule (0.05 → 0.5 at 1.4 kHz on D_u = 1 A): γ 0.94
-frozen, 1.05 rate-bounded, 1.07 constant, σ̄(S_o) 1.71–1.72.
+plant peaked at 4.4–6.7 there (spill-over). The turboexpander's numbers with and
+without the rule: benchmarks/README.md ("Where the design defaults come from").
 """
 
 from __future__ import annotations

@@ -277,14 +277,12 @@ def design(
         Reduce the controller to this order (balanced truncation,
         :func:`~ambseal.robust.order.reduce_controller`); the rise of γ/μ is reported in
         ``reduction``. ``"auto"``: ``[design] order_max``, else the design model's states
-        plus those of W_p and W_u (on the test rig 28 for μ: the force weight W_f and the
-        D and G scales of D–G–K raise the order; with the earlier μ weights (no W_K, M = 3.6) to 90
-        states, and truncating to 28 raised μ from 1.115 to 1.136, 1.9 %), raised by one
+        plus those of W_p and W_u (the force weight W_f and the D and G scales of D–G–K
+        raise the order, not kept), raised by one
         state per control channel while the reduced controller does not stabilise the
-        design loop or raises its μ (H∞: γ) by more than ``ORDER_RISE`` = 10 % (the pump's
-        μ: 76 → 28 states gave μ 0.66 → 2.85 and σ̄(S_o) 7.7 at 0 bar; 36 states keep
-        0.66 and σ̄(S_o) ≤ 1.8). With D–G–K both its controller and complex D–K's are
-        reduced and the one with the lower μ is delivered. ``None``: none.
+        design loop or raises its μ (H∞: γ) by more than ``ORDER_RISE`` = 10 %. With D–G–K
+        both its controller and complex D–K's are reduced and the one with the lower μ is
+        delivered. ``None``: none.
     max_iter, dk_order : int, optional
         D–K iterations and D-scale fit order (μ only); the specification's if omitted.
     allow_unstable : bool

@@ -34,26 +34,15 @@ the value the thesis used on its test facility, P5, where it names one):
   PID (:func:`ambseal.design.pid.reference_pid`), so the
   integral time is the PID's ("tuned to achieve an integral time close to the reference
   controller of 0.2 s"; test rig 5 rad/s): the direct gains then stay within 2× the
-  PID's from 1 Hz to 200 Hz (P5 Fig. 10; ω_B = 60 rad/s gave 12× at 1 Hz). Why 1/T_i, not
-  the 2.5/T_i of a delay-free design model: with the controller's hold + computation
-  delay in the design model (:mod:`ambseal.robust.delay`) μ needs phase lead at the
-  crossover, and at 2.5/T_i its direct gain reached 2.06× the PID's at 200 Hz (test rig,
-  rig-file design); 1/T_i gives 1.98× with σ̄(S_o) 2.85 (in that trial W_p's M = 3.6; the
-  default is 3.45). The trade measured on the same design: a heavier W_u (2× the PID's peak) gave 1.91× but μ 1.01 and σ̄(S_o) 3.19; M = 4
-  gave 1.97× but σ̄(S_o) 3.06; ω_B = 0.5/T_i 1.98× but twice the impulse settling time;
-  a W_u shaped like the PID's gain or peaking at 200–250 Hz gave μ 1.1–1.9. μ: W_u a
+  PID's from 1 Hz to 200 Hz (P5 Fig. 10). μ: W_u a
   constant (P5 §4.3) = D_u/(3 D_e Kp (1 + 1/ε)), so that where S_o ≈ 1 the controller
   gain stays below 3× the reference PID's peak Kp (1 + 1/ε) (P5 Fig. 10's bound; test rig
   0.095, |K| ≤ 2.1–2.5× the PID's peak below Nyquist, where a high-pass W_u of 0.02 gave
   7.6×), and beside it the gain demand W_K (:meth:`ambseal.design.weights.Weights.Wk`):
   ``|K S_o| ≤ 2·3 |K_PID|`` over 0.75–1.1× the top of the unbalance band (test rig
   150–220 Hz), i.e. the direct gain within 2× the PID's where |S_o| nears its zone-A
-  bound 3, the phase lead above the band left free. Why (``ambseal run``: identified rig,
-  truth, delay): with W_u alone the eddy lag (0.2 ms) and the 1.5-sample delay ask for a
-  lead that put the gain at 2.24× at 200 Hz (not the reduction: 2.23× at full order; not
-  the D–K iteration: 2.22–2.24× at each with μ ≤ 1); with W_K and M 3.45: μ 0.99, 1.98×,
-  σ̄(S_o) 2.43 per axis (whole loop 3.11); rig file 1.78×, σ̄(S_o) ≤ 2.73. Trials in
-  :func:`ambseal.design.weights.default_weights`. The orbit demand 0.5 D_e (test rig
+  bound 3, the phase lead above the band left free (the trials behind ω_B, W_u and W_K:
+  benchmarks/README.md, "Where the design defaults come from"). The orbit demand 0.5 D_e (test rig
   10 µm: the demand adds its force channel to the design, the thesis's 8 µm is met with
   margin, 4.6 µm); W_f rolls off at 1.3× the top of the unbalance band, at most f_b/2
   (test rig: 1.3 × 200 Hz = 260 Hz, below 557/2 Hz). The other weights are the method's
@@ -63,9 +52,8 @@ the value the thesis used on its test facility, P5, where it names one):
   3×: the LPV designs have no W_K) and which rises tenfold above its corner
   at the actuator bandwidth f_a, rolling the controller off at the bending modes the
   rigid-body LPV design model leaves out (turboexpander: D_u 0.42 A, W_u 0.037 → 0.37 at
-  1.5 kHz, where P3 §3.3 puts the crossover at 1.4 kHz and the tuning before this rule had
-  0.05 → 0.5 on D_u = 1 A). M = 2, ω_B = 2π·50 rad/s and A = 1e-2 stay the method's
-  tuning (P3's 20 ms settling; :mod:`ambseal.design.lpv_design`).
+  1.5 kHz, where P3 §3.3 puts the crossover at 1.4 kHz). M = 2, ω_B = 2π·50 rad/s and
+  A = 1e-2 stay the method's tuning (P3's 20 ms settling; :mod:`ambseal.design.lpv_design`).
 * **Uncertainty** (μ): the cross-coupled stiffness k ± 100 % of every seal, by its own
   name (P5 §4.1); a seal with k = 0 at the design pressure, or a rig without a seal, has
   none (a note says so, and μ then designs for robust performance on the nominal plant).

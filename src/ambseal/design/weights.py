@@ -420,44 +420,19 @@ def default_weights(method: str) -> Weights:
 
     ``"hinf"`` (nominal design, P5 §4.4): W_p with M = 2.5, A = 1/1000; W_u = 0.2 constant;
     a small constant W_1 = 0.05 (the same as μ's, so that the two differ only by W_u and
-    what μ adds, as P5 §4.1 objective 1 wants them comparable). W_u was 0.3 before the
-    controller's delay entered the design model: with the delay, 0.3 left the
-    designed-on-the-identified-rig H∞ of ``ambseal run`` poorly damped at 0 bar on the
-    truth (σ̄(S_o) 14.4, worst orbit 8.8 µm > the thesis's 8 µm); 0.2 gives 8.7 and
-    5.5 µm (rig-file design: 6.6 and 4.8 µm).
+    what μ adds, as P5 §4.1 objective 1 wants them comparable).
 
     ``"mu"`` (P5 §4.3–4.4): W_p with M = 3.45 (the peak is judged on the full-order plant
     with the controller's delay: σ̄(S_o) ≤ 2.73 on the test rig, ISO 14839-3 zone A),
     A = 1/1000; a constant W_u (P5 §4.3); W_1 = 0.05; and, from the specification, the
     unbalance force at the bearings as a weighted input (:meth:`Weights.Wf`, ISO 21940-11
     law, P5 §4.4.1) with an orbit demand and a 4th-order roll-off, and the gain demand
-    :meth:`Weights.Wk` (P5 Fig. 10). M = 3.45 with W_K: μ 0.92, σ̄(S_o) ≤ 2.73,
-    direct gains ≤ 1.78× the PID's to 200 Hz on the rig-file design; designed on the
-    identified rig and judged on the truth μ 0.99, 1.98×, σ̄(S_o) ≤ 2.43 per axis (3.11
-    whole loop). Trials there: W_K from DC to 250 Hz (no high-pass) asking |K S_o| ≤
-    2|K_PID| gave μ 1.78 (gain 1.5×), ≤ 4|K_PID| μ 1.28 (1.66×); M = 3.2–3.35 brought the
-    whole-loop σ̄(S_o) to 2.98–3.07 but traded μ (1.00–1.03) against the gain
-    (2.0–2.03×); M = 3.0, or W_p raised 1.1× over 15–100 Hz where the peak lies, reached
-    3.00 only at μ 1.02–1.05 and 2.04–2.08×. The 3.11 is the eddy lag's and the delay's,
-    not the identification's: the controller reads 3.115 on the identified rig it was
-    designed on, and a design on the rig file with τ_e = 0.2 ms added reads 3.08 on it.
-    The lag's phase lead is paid in gain above 200 Hz: W_u = 0.01 gives σ̄(S_o) 2.23 and
-    1.99× at 200 Hz, but 17× the PID's peak gain (the bound is 3×, above).
+    :meth:`Weights.Wk` (P5 Fig. 10).
 
     ω_B of both, μ's W_u gain (0.095 here is the test rig's), W_K, the orbit demand, W_f's
     roll-off and the scalings are rules of :func:`ambseal.design.specs.design_spec`.
-    Measured on the test rig's full-order plant over 0–4.08 bar: μ = 0.885 on the
-    design model, order 24 (the thesis's); σ̄(S_o) ≤ 2.2 per axis; orbit ≤ 4.6 µm; impulse
-    settling 0.108 s at 0 bar against H∞'s 0.145 s; direct gains 1.0–1.9× the PID's from
-    1 to 200 Hz, peak gain 1.7× the PID's peak. Why: a high-pass W_u of 0.02 rising to
-    0.2 above 800 Hz lets the gain reach 7.6× the PID's peak at 465 Hz,
-    and ω_B = 30–60 rad/s gave 5–12× the PID's gain at 1 Hz; a larger W_1 (0.2–1) or a
-    high-pass W_1 slows the impulse's settling tail or raises the 1 Hz gain; M = 3 gives
-    μ = 0.97 and a slower settling (0.110 s). With the controller's delay in the design
-    model and ω_B = 1/T_i: μ = 0.904, order 28 (24 + one delay state per
-    channel), σ̄(S_o) ≤ 2.85 (2.27 per axis), orbit ≤ 4.7 µm, settling 0.167 s against
-    H∞'s 0.227 s, direct gains ≤ 1.98× the PID's to 200 Hz; M = 3.5 gave 2.00×, M = 3.75
-    σ̄(S_o) 2.93 (the reason for 3.6 is in :mod:`ambseal.design.specs`).
+    The trials behind these values are in benchmarks/README.md ("Where the design
+    defaults come from").
 
     ``"lpv"`` (LPV and frozen-speed designs, P3 Eq. 11, §3.3): M = 2, ω_B = 2π·50 rad/s,
     A = 1e-2 (the reasoning is in :mod:`ambseal.design.lpv_design`); W_u's gains and

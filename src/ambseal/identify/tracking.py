@@ -32,14 +32,8 @@ standard error.
 The model must be the identified one. Only the tracked parameters move; every other value
 (Ki, Ks, τ_e, the coupling, the seal's other coefficients) is taken as known, so the rig
 should be the one identified on site (thesis stages (a)–(c): ``ambseal identify``, or
-``identified_rig.toml`` of ``ambseal run``), not the first-principles rig file. Measured on
-the test rig's virtual facility (the closed-loop 0 → 3× nominal ramp with the controller
-scheduled on k̂, its record re-tracked with each model): with the rig file's
-values (Ki, Ks a few per cent off, τ_e = 0 against the facility's 0.2 ms) the estimate
-wanders with a bias growing to +0.15–0.27 k_nom and a standard error of 0.13 k_nom
-(largest error 0.58 k_nom after 1 s, coverage 88 %); τ_e alone set right gives 0.15 k_nom,
-τ_e with Ki, Ks 0.084, and with the seal's K, C, c following k̂ 0.030 (standard error
-0.013 k_nom). The identified rig (its errors ≤ 0.2 %) gives 0.029, coverage 100 %.
+``identified_rig.toml`` of ``ambseal run``), not the first-principles rig file (why, measured
+on the test rig: benchmarks/README.md, "Where the design defaults come from").
 
 When the model is wrong the tracker says so (:meth:`OnlineTracker.consistency`): a score
 (Lagrange-multiplier) test, every window of ``check_window_s``, that the coefficients it
@@ -53,16 +47,8 @@ significant *and* the error matters (:func:`held_error_check`): the coefficient'
 δ_j, one Gauss–Newton step on the efficient score, and the bias it leaves in k̂,
 b = I_kk⁻¹ I_kj δ_j (the omitted-variable bias of least squares; Ljung 1999 §8.3, §9.3),
 must exceed k̂'s own standard error (``check_bias_se``): the limit is the tracker's stated
-accuracy, beyond which its 95 % interval covers < 83 % of the time. Checked on the test
-rig (1.2 s records): with K halved δ_K = 5.11e4 N/m against the truth's 5.1e4, t² 40 but
-bias 0.04 SE (k̂'s measured mean error 0.05 SE): accepted; C left out, bias 1.34 SE
-predicted, 1.46 SE measured: refused. Measured: examples/pump.toml on
-tests/data/pump_truth.toml, its identified rig's balance-drum K = 1.0e5 + 1.9e4·p N/m
-against the truth's 6e4·p, K's statistic 600–1300 against the threshold 24
-(F(1, 29) at 1 − 1e-4/3), bias 2.4–3.0 SE from K and 3.1–5.3 from C, coverage 23–32 %:
-refused at the first window (seeds 0–9 with this rule); the rig file's model (Ki, Ks a few per
-cent off, the seal right) statistic 13 (coverage 73 %, bias −4 %, not a seal error); the
-truth's 1.5–8.
+accuracy, beyond which its 95 % interval covers < 83 % of the time. The checks on the test
+rig and the pump are in benchmarks/README.md ("Where the design defaults come from").
 """
 
 from __future__ import annotations
@@ -128,13 +114,8 @@ class TrackingSettings:
         When a tracked parameter is a seal's k affine in the pressure drop, the model's
         other seal coefficients (that seal's K, C, c and every other seal's) follow the
         pressure that gives k̂ (:func:`ambseal.model.seal.values_following_k`; default);
-        False: they stay at the record's pressure. Measured on the closed-loop 0 → 3×
-        nominal ramps: test rig (the tracker's model the identified rig),
-        largest error after 1 s 0.029 k_nom following, 0.075 fixed (coverage 100 % and
-        92 %); examples/pump.toml (a second seal, the impeller-eye labyrinth, whose k
-        rises with the same pressure to a quarter of the balance drum's), 0.026 with every
-        seal following, 0.16 with only the tracked seal's K, C, c (coverage 99.4–99.7 %
-        and 38 %, seeds 0–2; the same with or without the facility's 16-bit ADC).
+        False: they stay at the record's pressure. (Measurements: benchmarks/README.md, "Where the
+        design defaults come from".)
     check_block_s, check_window_s : float
         The model-consistency test (:meth:`OnlineTracker.consistency`): its batch length
         (longer than the sensitivities' memory, the slowest closed-loop mode's few time

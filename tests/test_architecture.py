@@ -202,6 +202,15 @@ def test_no_history_or_ticket_words_in_code_and_tests():
     assert not found, "\n".join(found)
 
 
+def test_no_measurement_records_in_src():
+    """A measurement behind a default ("Measured: …") is a record for benchmarks/README.md
+    ("Where the design defaults come from"), not a contract of the code that holds it."""
+    found = [f"{p.relative_to(ROOT)}:{k}" for p in sorted(SRC.rglob("*.py"))
+             for k, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
+             if re.search(r"\bMeasured:", line)]
+    assert found == []
+
+
 #: Words of the machine ambseal is for, and the layers above the generic core: the core
 #: (robust, lti) states its contracts for any plant (the rotor layers say what a rotor is).
 #: Its grid is a parameter θ, not a speed Ω. Acronyms, paper labels and symbols are matched

@@ -22,8 +22,8 @@ import scipy.linalg as sla
 from ambseal.errors import SynthesisError
 from ambseal.robust import _lmi_sdp as _sdp
 
-__all__ = ["LmiInfeasible", "SolverReport", "Scaled", "scale_grid", "lmi_blocks", "solve_lmis", "basis",
-           "BASES"]
+__all__ = ["LmiInfeasible", "SolverReport", "Scaled", "scale_grid", "lmi_blocks", "solve_lmis",
+           "basis", "BASES"]
 
 BASES = {"constant": 1, "affine": 2, "quadratic": 3}
 #: The largest share of stage 1's cost the trace term may take before its weight is

@@ -334,19 +334,38 @@ def design(
                           f"--set design.{key}=...")
     w = weights or sp.weights[method]
     unc = dict(uncertainty) if uncertainty is not None else dict(sp.uncertainty)
-    n = int(states or sp.model_states)
-    om = None if omega is None else np.asarray(omega, float)
-    # held where it is judged and wherever the machine runs, standstill to the top speed
-    conditions = [(q, f) for q in sp.pressures_bar
-                  for f in sorted({*sp.speeds_hz, *sp.stability_speeds_hz})]
     dl = design_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples,
                       sp.synthesis_band_hz[1], max_order=1)
     steps: list[str] = []
     t0 = time.perf_counter()
+    r, check, n = _synthesise_enlarging(
+        cfg, method, p, w, unc, sp, states, None if omega is None else np.asarray(omega, float),
+        reduce_to, max_iter or sp.max_iter, sp.dk_order if dk_order is None else dk_order, dl,
+        enlarge, steps, progress)
+    if not check["stable"] and not allow_unstable:
+        raise SynthesisError(_unstable_message(method, check, n, steps, _top_mode_hz(cfg, p, n)))
+    return DesignResult(
+        method, r.K, p, gamma=r.gamma, mu=r.mu, order=int(r.K.nstates),
+        order_full=r.order_full, history=tuple(r.history), weights=w,
+        uncertainty={q.name: (q.low, q.high) for q in r.gp.parameters},
+        elapsed_s=time.perf_counter() - t0, reduction=r.reduction, plant=r.gp,
+        design_states=n, full_order=check, kept_unstable=not check["stable"],
+        delay=dl.to_dict(), steps=tuple(steps), notes=tuple(sp.notes),
+        verdict=_verdict(method, r, check), omega=r.omega, stopping=r.stopping)
+
+
+def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max_iter,
+                          dk_order, dl, enlarge, steps, progress):
+    """:func:`_synthesise` on the specification's design model, enlarged (at most
+    ``enlarge`` times, unless ``states`` fixes it) while the full-order loop is unstable
+    at a mode the model left out; each enlargement is appended to ``steps`` and reported
+    to ``progress``. Returns (synthesis, full-order check, design states)."""
+    n = int(states or sp.model_states)
+    # held where it is judged and wherever the machine runs, standstill to the top speed
+    conditions = [(q, f) for q in sp.pressures_bar
+                  for f in sorted({*sp.speeds_hz, *sp.stability_speeds_hz})]
     for attempt in range(enlarge + 1):
-        r = _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to,
-                        max_iter or sp.max_iter, sp.dk_order if dk_order is None else dk_order,
-                        dl)
+        r = _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl)
         check = full_order_check(cfg, r.K, conditions)
         if check["stable"] or attempt == enlarge or states is not None:
             break
@@ -362,16 +381,7 @@ def design(
         top = 1.5 * check["mode_hz"]
         if om is None and top > sp.synthesis_band_hz[1]:
             om = design_omega(sp.synthesis_band_hz[0], top)
-    if not check["stable"] and not allow_unstable:
-        raise SynthesisError(_unstable_message(method, check, n, steps, _top_mode_hz(cfg, p, n)))
-    return DesignResult(
-        method, r.K, p, gamma=r.gamma, mu=r.mu, order=int(r.K.nstates),
-        order_full=r.order_full, history=tuple(r.history), weights=w,
-        uncertainty={q.name: (q.low, q.high) for q in r.gp.parameters},
-        elapsed_s=time.perf_counter() - t0, reduction=r.reduction, plant=r.gp,
-        design_states=n, full_order=check, kept_unstable=not check["stable"],
-        delay=dl.to_dict(), steps=tuple(steps), notes=tuple(sp.notes),
-        verdict=_verdict(method, r, check), omega=r.omega, stopping=r.stopping)
+    return r, check, n
 
 
 @dataclass(frozen=True, eq=False)

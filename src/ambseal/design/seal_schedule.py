@@ -256,7 +256,7 @@ def design_seal_scheduled(cfg, parameter: str | None = None, *,
 #: The version of what a cached design depends on besides the rig and the arguments (this
 #: recipe, its weights and plant, :func:`~ambseal.robust.lpv.lpvsyn`): raise it with any
 #: change that moves a scheduled design's numbers, and every cached design is recomputed.
-SYNTHESIS_VERSION = 1
+SYNTHESIS_VERSION = 2
 
 
 def _key(cfg, args) -> str:
@@ -309,21 +309,9 @@ def _read_cache(path: Path, key: str) -> SealScheduledDesign | None:
         doc = json.loads(path.read_text(encoding="utf-8"))
         if doc["key"] != key or doc["ambseal_version"] != __version__:
             return None
-        k = doc["K"]
-        W, (A, B, C, D) = _floats(k["theta"], 1), (_floats(k[n], 3) for n in _TABLE)
-        n_t, n = W.size, A.shape[1]
-        ins, outs = [str(s) for s in k["input_names"]], [str(s) for s in k["output_names"]]
-        if not (A.shape == (n_t, n, n) and B.shape == (n_t, n, len(ins))
-                and C.shape == (n_t, len(outs), n) and D.shape == (n_t, len(outs), len(ins))):
+        K, w = _cached_controller(doc["K"]), _cached_weights(doc["weights"])
+        if K is None or w is None:
             return None
-        names = {f.name for f in fields(Weights)}
-        wd = doc["weights"]
-        if not isinstance(wd, dict) or set(wd) != names or not all(
-                v is None or isinstance(v, (int, float, str)) and not isinstance(v, bool)
-                or isinstance(v, list) and all(isinstance(x, (int, float)) for x in v)
-                for v in wd.values()):
-            return None
-        w = Weights(**{f: (tuple(v) if isinstance(v, list) else v) for f, v in wd.items()})
         scalars = [float(doc[f]) for f in ("gamma", "gamma_design", "rate_bound",
                                            "synthesis_s")]
         rf = tuple(float(x) for x in doc["range_factor"])
@@ -331,13 +319,35 @@ def _read_cache(path: Path, key: str) -> SealScheduledDesign | None:
                 not isinstance(doc["delay"], dict):
             return None
         return SealScheduledDesign(
-            str(doc["parameter"]), LpvController(W, A, B, C, D, tuple(ins), tuple(outs)),
-            scalars[0], scalars[1], _floats(doc["grid"], 1), _floats(doc["check_grid"], 1),
-            _floats(doc["check_gamma"], 1), scalars[2], w, scalars[3],
+            str(doc["parameter"]), K, scalars[0], scalars[1], _floats(doc["grid"], 1),
+            _floats(doc["check_grid"], 1), _floats(doc["check_gamma"], 1), scalars[2], w,
+            scalars[3],
             int(doc["design_states"]), rf, dict(doc["delay"]))
     except (OSError, ValueError, TypeError, KeyError, IndexError, AttributeError,
             RecursionError):
         return None
+
+
+def _cached_controller(k: dict) -> LpvController | None:
+    """The controller table of a cache entry, or None where its shapes disagree."""
+    W, (A, B, C, D) = _floats(k["theta"], 1), (_floats(k[n], 3) for n in _TABLE)
+    n_t, n = W.size, A.shape[1]
+    ins, outs = [str(s) for s in k["input_names"]], [str(s) for s in k["output_names"]]
+    if not (A.shape == (n_t, n, n) and B.shape == (n_t, n, len(ins))
+            and C.shape == (n_t, len(outs), n) and D.shape == (n_t, len(outs), len(ins))):
+        return None
+    return LpvController(W, A, B, C, D, tuple(ins), tuple(outs))
+
+
+def _cached_weights(wd: Any) -> Weights | None:
+    """The weights of a cache entry: every field of :class:`Weights` and nothing else, each
+    a number, a string, a list of numbers or null; None otherwise."""
+    if not isinstance(wd, dict) or set(wd) != {f.name for f in fields(Weights)} or not all(
+            v is None or isinstance(v, (int, float, str)) and not isinstance(v, bool)
+            or isinstance(v, list) and all(isinstance(x, (int, float)) for x in v)
+            for v in wd.values()):
+        return None
+    return Weights(**{f: (tuple(v) if isinstance(v, list) else v) for f, v in wd.items()})
 
 
 def _synthesise(cfg, plant, args, scale: float, dl, lpvsyn_kw) -> SealScheduledDesign:

@@ -347,28 +347,9 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
                                                             or "ROSS rotor")},
                  "materials": mats, "shaft": shaft, "disk": [], "amb": [], "seal": [],
                  "spring": []}
-    for d in rotor.disk_elements:
-        rig["disk"].append({"name": str(d.tag), "position": float(nodes[d.n]),
-                            "mass": float(d.m), "Ip": float(d.Ip), "Id": float(d.Id)})
-    for p in getattr(rotor, "point_mass_elements", []):
-        if p.n >= len(nodes):
-            raise _bad(where, f"point mass {p.tag} on node {p.n} off the shaft (a support "
-                              "mass) is not supported")
-        rig["disk"].append({"name": str(p.tag), "position": float(nodes[p.n]),
-                            "mass": float(p.m)})
-    plan, pids, notes = [], [], []
-    for i, b in enumerate(bearings):
-        if getattr(b, "n_link", None) is not None:
-            raise _bad(where, f"bearing {i} ({b.tag}) linked to node {b.n_link} (support "
-                              "structures are not supported)")
-        if b.n >= len(nodes):
-            raise _bad(where, f"bearing {i} ({b.tag}) on node {b.n} off the shaft")
-        if type(b).__name__ == "MagneticBearingElement":
-            entry, pid, what = _amb(b, float(nodes[b.n]), i)
-            rig["amb"].append(entry)
-            pids.append((b.tag, pid, what))
-        else:
-            plan.append((i, b, *_kind(b, where, i)))
+    rig["disk"] = _masses(rotor, nodes, where)
+    pids, notes = [], []
+    plan = _supports(bearings, nodes, where, rig, pids)
     one_freq = [np.atleast_1d(b.frequency) for _, b, kind, varies in plan
                 if varies and kind == "spring"]
     omega, rpm, rule = _import_speed(one_freq, speed_rpm)
@@ -379,15 +360,7 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
             continue
         rig["spring"].append(_spring(b, z, i, varies, omega))
         if varies:
-            f = np.atleast_1d(b.frequency) / (2 * math.pi)
-            out = "" if f.min() <= omega / (2 * math.pi) <= f.max() else (
-                " (outside the table: ROSS's interpolant extrapolated)")
-            notes.append(f"bearing {i} ({b.tag}, node {b.n}): frequency-dependent "
-                         f"coefficients (ROSS's table {f.min():.4g}–{f.max():.4g} Hz) taken "
-                         f"at one frequency, {omega / (2 * math.pi):.6g} Hz = "
-                         f"{abs(rpm):.6g} rpm ({rule}){out}: ambseal's modes at "
-                         "that [operating] speed are ROSS's run_modal there, at other speeds "
-                         "the coefficients stay")
+            notes.append(_one_frequency_note(i, b, omega, rpm, rule))
     tables = [s["name"] for s in rig["seal"] if isinstance(s["K"], dict)]
     if tables:
         notes.append(f"seal(s) {', '.join(tables)}: frequency tables of ROSS's values at its "
@@ -404,6 +377,52 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
                         "closes the loop with the controller's dynamics")
         _controller(rig, pids, unmapped, notes)
     return RossImport(parse_rig(rig, where), tuple(unmapped), tuple(notes))
+
+
+def _masses(rotor, nodes: np.ndarray, where: str) -> list[dict]:
+    """``[[disk]]`` entries of ROSS's disks and point masses on the shaft."""
+    out = [{"name": str(d.tag), "position": float(nodes[d.n]), "mass": float(d.m),
+            "Ip": float(d.Ip), "Id": float(d.Id)} for d in rotor.disk_elements]
+    for p in getattr(rotor, "point_mass_elements", []):
+        if p.n >= len(nodes):
+            raise _bad(where, f"point mass {p.tag} on node {p.n} off the shaft (a support "
+                              "mass) is not supported")
+        out.append({"name": str(p.tag), "position": float(nodes[p.n]), "mass": float(p.m)})
+    return out
+
+
+def _supports(bearings: list, nodes: np.ndarray, where: str, rig: dict,
+              pids: list) -> list[tuple]:
+    """ROSS's magnetic bearings into ``rig["amb"]`` (their controllers into ``pids``); the
+    other bearings and seals as (index, element, kind, frequency-dependent), to place once
+    the import's speed is known."""
+    plan = []
+    for i, b in enumerate(bearings):
+        if getattr(b, "n_link", None) is not None:
+            raise _bad(where, f"bearing {i} ({b.tag}) linked to node {b.n_link} (support "
+                              "structures are not supported)")
+        if b.n >= len(nodes):
+            raise _bad(where, f"bearing {i} ({b.tag}) on node {b.n} off the shaft")
+        if type(b).__name__ == "MagneticBearingElement":
+            entry, pid, what = _amb(b, float(nodes[b.n]), i)
+            rig["amb"].append(entry)
+            pids.append((b.tag, pid, what))
+        else:
+            plan.append((i, b, *_kind(b, where, i)))
+    return plan
+
+
+def _one_frequency_note(i: int, b, omega: float, rpm: float, rule: str) -> str:
+    """What the import did with a bearing's frequency-dependent coefficients."""
+    f = np.atleast_1d(b.frequency) / (2 * math.pi)
+    out = "" if f.min() <= omega / (2 * math.pi) <= f.max() else (
+        " (outside the table: ROSS's interpolant extrapolated)")
+    return (f"bearing {i} ({b.tag}, node {b.n}): frequency-dependent "
+            f"coefficients (ROSS's table {f.min():.4g}–{f.max():.4g} Hz) taken "
+            f"at one frequency, {omega / (2 * math.pi):.6g} Hz = "
+            f"{abs(rpm):.6g} rpm ({rule}){out}: ambseal's modes at "
+            "that [operating] speed are ROSS's run_modal there, at other speeds "
+            "the coefficients stay")
 
 
 def _controller(rig: dict, pids: list, unmapped: list, notes: list) -> None:

@@ -384,40 +384,10 @@ def load_measurement(
         raise DataError(f"{path}: unknown measurement file type {path.suffix!r}, expected .csv or .mat")
     if not path.is_file():
         raise DataError(f"{path}: file not found")
-    if suffix == ".csv":
-        side = _sidecar(path)
-        if not side.is_file():
-            raise DataError(f"{path}: missing metadata sidecar {side.name!r}")
-        header = _read_header_json(_read(side, "sidecar"), str(side))
-        names, data = _read_csv(path)
-        seen = set()
-        for c in names:
-            if c in seen:
-                raise DataError(f"{path}: column {c!r} appears twice in the header")
-            seen.add(c)
-        cols = {c: data[:, i] for i, c in enumerate(names)}
-    else:
-        header, cols = _read_mat(path)
-    file_axes = tuple(header["axes"])
-    if axes is not None:
-        want = tuple(str(a) for a in axes)
-        if len(file_axes) != len(want) or set(file_axes) != set(want):
-            raise DataError(
-                f"{path}: column axes: file has {len(file_axes)} axes {list(file_axes)}, "
-                f"the rig expects {len(want)} {list(want)}"
-            )
-        file_axes = want
-    expected = column_names(file_axes)
-    for c in expected:
-        if c not in cols:
-            raise DataError(f"{path}: missing column {c!r}")
-    for c in cols:
-        if c not in expected:
-            raise DataError(f"{path}: column {c!r} is unexpected for axes {list(file_axes)}")
+    header, cols = _read_csv_with_sidecar(path) if suffix == ".csv" else _read_mat(path)
+    file_axes = _file_axes(path, tuple(header["axes"]), axes)
+    _check_columns(path, cols, column_names(file_axes), file_axes)
     n = cols["time_s"].size
-    for c in expected:
-        if cols[c].size != n:
-            raise DataError(f"{path}: column {c!r} has {cols[c].size} samples, time_s has {n}")
     meta = {k: v for k, v in header.items() if k not in _RESERVED}
     try:
         meas = Measurement(
@@ -438,3 +408,46 @@ def load_measurement(
     return validate_measurement(
         meas, source=str(path), min_samples=min_samples, current_limit_a=current_limit_a, time_rtol=time_rtol
     )
+
+
+def _read_csv_with_sidecar(path: Path) -> tuple[dict, dict]:
+    """(header, columns) of a CSV record and its JSON sidecar; a column named twice is
+    refused."""
+    side = _sidecar(path)
+    if not side.is_file():
+        raise DataError(f"{path}: missing metadata sidecar {side.name!r}")
+    header = _read_header_json(_read(side, "sidecar"), str(side))
+    names, data = _read_csv(path)
+    seen = set()
+    for c in names:
+        if c in seen:
+            raise DataError(f"{path}: column {c!r} appears twice in the header")
+        seen.add(c)
+    return header, {c: data[:, i] for i, c in enumerate(names)}
+
+
+def _file_axes(path: Path, file_axes: tuple, axes: Sequence[str] | None) -> tuple:
+    """The record's axes in the rig's order (``axes``), which the file must have exactly."""
+    if axes is None:
+        return file_axes
+    want = tuple(str(a) for a in axes)
+    if len(file_axes) != len(want) or set(file_axes) != set(want):
+        raise DataError(
+            f"{path}: column axes: file has {len(file_axes)} axes {list(file_axes)}, "
+            f"the rig expects {len(want)} {list(want)}"
+        )
+    return want
+
+
+def _check_columns(path: Path, cols: dict, expected: list, file_axes: tuple) -> None:
+    """Exactly the ``expected`` columns, each as long as ``time_s``."""
+    for c in expected:
+        if c not in cols:
+            raise DataError(f"{path}: missing column {c!r}")
+    for c in cols:
+        if c not in expected:
+            raise DataError(f"{path}: column {c!r} is unexpected for axes {list(file_axes)}")
+    n = cols["time_s"].size
+    for c in expected:
+        if cols[c].size != n:
+            raise DataError(f"{path}: column {c!r} has {cols[c].size} samples, time_s has {n}")

@@ -402,14 +402,7 @@ def fit_parameters(
         raise IdentificationError("fit: the model cannot be simulated at the start values")
     sol = _solve(residuals, x0, r0, ((lo - init) / scale, (hi - init) / scale), max_nfev)
     est = init + sol.x * scale
-    converged = bool(sol.status > 0)
-    message = str(sol.message)
-    width = np.where(np.isfinite(hi - lo), hi - lo, np.inf)
-    at_bound = [n for n, v, a, b, w in zip(names, est, lo, hi, width)
-                if np.isfinite(w) and min(v - a, b - v) <= 1e-6 * w]
-    if at_bound:  # an estimate stopped by its bound is not an optimum of J(θ)
-        converged = False
-        message = f"estimate at its bound: {', '.join(at_bound)}"
+    converged, message = _stopped(sol, names, est, lo, hi)
 
     blocks = _blocks_at(sol, residual_blocks, [(d[1].shape[0], d[1].shape[1] *
                                                 (2 if current_weight > 0 else 1)) for d in data])
@@ -434,11 +427,10 @@ def fit_parameters(
     fits = {f"{a}": v for a, v in zip(records[0].axes, nrmse_fit(y0, ys))}
     bad_fit = [a for a, v in fits.items() if not np.isfinite(v) or v < 0]
     if bad_fit and converged:  # worse than the mean: the model does not describe the data
-        converged = False
-        message = f"NRMSE fit below 0 % on {', '.join(bad_fit)}"
+        converged, message = False, f"NRMSE fit below 0 % on {', '.join(bad_fit)}"
     if current_weight > 0:
-        fi = nrmse_fit(data[0][3], is_)
-        fits.update({f"current_{a}": v for a, v in zip(records[0].axes, fi)})
+        fits.update({f"current_{a}": v for a, v in zip(records[0].axes,
+                                                        nrmse_fit(data[0][3], is_))})
     return FitResult(
         names=tuple(names), estimate=est, initial=init, std_error=se,
         ci95_low=est - half, ci95_high=est + half, correlation=corr,
@@ -449,6 +441,17 @@ def fit_parameters(
         residuals=tests, dof_noise=dof,
         correlation_jacobian=jacobian_correlation(sol.jac), sensor_lag=lag,
     )
+
+
+def _stopped(sol, names, est, lo, hi) -> tuple[bool, str]:
+    """(converged, message) of the optimiser's stop: not converged where it says so or
+    where an estimate sits on its bound (then not an optimum of J(θ))."""
+    width = np.where(np.isfinite(hi - lo), hi - lo, np.inf)
+    at_bound = [n for n, v, a, b, w in zip(names, est, lo, hi, width)
+                if np.isfinite(w) and min(v - a, b - v) <= 1e-6 * w]
+    if at_bound:
+        return False, f"estimate at its bound: {', '.join(at_bound)}"
+    return bool(sol.status > 0), str(sol.message)
 
 
 def _solve(residuals, x0, r0, bounds, max_nfev: int):
@@ -496,9 +499,9 @@ def _lag_test(J, r, blocks, residual_blocks, x) -> dict:
 def _budget(J, scale, names, fixed, models, residual_blocks, x, noise_var, r, blocks,
             correlated=None) -> ErrorBudget | None:
     """The fixed parameters' error budget by forward differences of the residuals in each
-    fixed value (relative step 10⁻³, every model alike; central ones cost twice), with each fixed value's score test
-    (:func:`_score_test`) and the correlation of those an earlier fit estimated together
-    (``correlated`` = (names, R)); None without fixed values."""
+    fixed value (relative step 10⁻³, every model alike; central ones cost twice), with each
+    fixed value's score test (:func:`_score_test`) and the correlation of those an earlier
+    fit estimated together (``correlated`` = (names, R)); None without fixed values."""
     use = [(n, s, src) for n, (s, src) in (fixed or {}).items()
            if s > 0 and any(_nominal(m, n) != 0 for m in models)]
     if not use:

@@ -271,33 +271,11 @@ def thesis_procedure(
     skipped: list = []
     regression: dict = {}
     if seal is not None:
-        if impulse_pressures_bar is None:
-            impulse_pressures_bar = seal_test_pressures(cfg)
         names_s = [f"{seal}.{c}" for c in SEAL_COEFFICIENTS]
-        zeta = {f"{m}_zeta": 1.0 for m in ambs}
-        for i, p in enumerate(impulse_pressures_bar):
-            say(f"identification (c): seal coefficients by impulse at {p:g} bar")
-            ex = impulse(amplitude_a=plan.amplitude_a, width_s=plan.impulse_s,
-                         start_s=plan.impulse_start_s, duration_s=plan.impulse_record_s,
-                         sample_rate_hz=fs, axes=axes, excited=zeta)
-            try:
-                rec = acquire(cfg, truth, ex, controller=controller, pressure_bar=p,
-                              seed=seed + 10 + i)
-            except ModelError as exc:  # the controller does not hold the rotor there
-                skipped.append((p, str(exc)))
-                say(f"identification (c): {p:g} bar skipped: {exc}")
-                continue
-            seal_press.append((p, identify(cfg, [rec], names_s, known=known, refine=False,
-                                           known_fit=known_fit, budget=True)))
-        if len(seal_press) < 3:
-            raise IdentificationError(
-                f"identification (c): the facility held the rotor at {len(seal_press)} of the "
-                f"impulse pressures {list(impulse_pressures_bar)} bar; the seal's regression "
-                f"needs three ({'; '.join(f'{p:g} bar: {w}' for p, w in skipped)})")
-        for j, c in enumerate(SEAL_COEFFICIENTS):
-            regression[c] = linear_regression(
-                [p for p, _ in seal_press], [r.estimate[j] for _, r in seal_press],
-                [r.std_error[j] for _, r in seal_press])
+        seal_press, skipped, regression = _seal_by_impulse(
+            cfg, truth, controller, names_s,
+            seal_test_pressures(cfg) if impulse_pressures_bar is None else impulse_pressures_bar,
+            plan, known, known_fit, seed, say)
         for p in (0.0, p_nom):
             say(f"identification (c): seal coefficients by balanced-whirl stepped sine at "
                 f"{p:g} bar")
@@ -315,6 +293,48 @@ def thesis_procedure(
         values[f"{seal}.{c}"] = Affine(at_zero=reg.intercept, per_bar=reg.slope)
     identified = rig_with_values(cfg, values)
 
+    return ProcedureResult(amb, coupling, seal_freq, seal_press, regression, identified,
+                           _true_values(values, truth), records, static, skipped)
+
+
+def _seal_by_impulse(cfg: RigConfig, truth: TruthSection, controller: DiscreteController,
+                     names_s: list[str], pressures_bar, plan: ExcitationPlan, known: dict,
+                     known_fit: FitResult, seed: int, say) -> tuple[list, list, dict]:
+    """Stage (c), impulses: the seal's K, k, C, c fitted at each pressure where the
+    controller holds the rotor, and their regressions on the pressure (P5 §3.3). Returns
+    ([(p, fit)], [(p, why skipped)], {coefficient: regression}); raises
+    IdentificationError with fewer than three pressures held."""
+    axes = channel_names(cfg)
+    zeta = {f"{a.name}_zeta": 1.0 for a in cfg.amb}
+    seal_press, skipped = [], []
+    for i, p in enumerate(pressures_bar):
+        say(f"identification (c): seal coefficients by impulse at {p:g} bar")
+        ex = impulse(amplitude_a=plan.amplitude_a, width_s=plan.impulse_s,
+                     start_s=plan.impulse_start_s, duration_s=plan.impulse_record_s,
+                     sample_rate_hz=cfg.controller.sample_rate_hz, axes=axes, excited=zeta)
+        try:
+            rec = acquire(cfg, truth, ex, controller=controller, pressure_bar=p,
+                          seed=seed + 10 + i)
+        except ModelError as exc:  # the controller does not hold the rotor there
+            skipped.append((p, str(exc)))
+            say(f"identification (c): {p:g} bar skipped: {exc}")
+            continue
+        seal_press.append((p, identify(cfg, [rec], names_s, known=known, refine=False,
+                                       known_fit=known_fit, budget=True)))
+    if len(seal_press) < 3:
+        raise IdentificationError(
+            f"identification (c): the facility held the rotor at {len(seal_press)} of the "
+            f"impulse pressures {list(pressures_bar)} bar; the seal's regression "
+            f"needs three ({'; '.join(f'{p:g} bar: {w}' for p, w in skipped)})")
+    regression = {c: linear_regression([p for p, _ in seal_press],
+                                       [r.estimate[j] for _, r in seal_press],
+                                       [r.std_error[j] for _, r in seal_press])
+                  for j, c in enumerate(SEAL_COEFFICIENTS)}
+    return seal_press, skipped, regression
+
+
+def _true_values(values: dict, truth: TruthSection) -> dict:
+    """The facility's true value of each identified name (SI; an affine one as its dict)."""
     true = {}
     for name in values:
         if name == TAU_E:
@@ -322,8 +342,7 @@ def thesis_procedure(
         elif name in truth.parameters:
             v = truth.parameters[name]
             true[name] = v.model_dump() if isinstance(v, Affine) else float(v)
-    return ProcedureResult(amb, coupling, seal_freq, seal_press, regression, identified, true,
-                           records, static, skipped)
+    return true
 
 
 def _with_static_load(cfg: RigConfig, truth: TruthSection, amb: FitResult, known: dict,

@@ -90,13 +90,7 @@ def frf_figure(
         raise AmbsealError(f"frf_figure: magnitude must be 'log' or 'db', got {magnitude!r}")
     f, H = _check(measured, "measured")
     outs, ins = list(measured.output_names), list(measured.input_names)
-    if pairs is None:
-        pairs = [(o, i) for i in ins for o in outs]
-    sel = []
-    for o, i in pairs:
-        if o not in outs or i not in ins:
-            raise AmbsealError(f"frf_figure: pair ({o!r}, {i!r}) not in measured outputs {outs} × inputs {ins}")
-        sel.append((o, i))
+    sel = _pairs(pairs, outs, ins)
     if model is not None:
         fm, Hm = _check(model, "model")
         m_outs, m_ins = list(model.output_names), list(model.input_names)
@@ -112,21 +106,6 @@ def frf_figure(
     units = str(getattr(measured, "units", "") or "")
     colours = [f"C{k % 10}" for k in range(len(outs))]
 
-    def mag(h: np.ndarray) -> np.ndarray:
-        a = np.abs(h)
-        if magnitude == "db":
-            with np.errstate(divide="ignore"):
-                return 20.0 * np.log10(a)
-        return a
-
-    def phase(h: np.ndarray) -> np.ndarray:
-        ok = np.isfinite(h) & (h != 0)  # the phase of an exact zero means nothing
-        out = np.full(h.shape, np.nan)
-        if ok.any():
-            ph = np.angle(h[ok])
-            out[ok] = np.degrees(np.unwrap(ph) if unwrap_phase else ph)
-        return out
-
     for c, inp in enumerate(col_inputs):
         j = ins.index(inp)
         for o, i in sel:
@@ -135,15 +114,18 @@ def frf_figure(
             k = outs.index(o)
             colour = colours[k]
             h = H[mask, k, j]
-            axes[0, c].plot(f[mask], mag(h), color=colour, lw=1, label=f"{o} (measured)")
-            axes[1, c].plot(f[mask], phase(h), color=colour, lw=1)
+            axes[0, c].plot(f[mask], _magnitude(h, magnitude), color=colour, lw=1,
+                            label=f"{o} (measured)")
+            axes[1, c].plot(f[mask], _phase_deg(h, unwrap_phase), color=colour, lw=1)
             if coh is not None:
                 axes[2, c].plot(f[mask], np.asarray(coh)[mask, k, j], color=colour, lw=1)
             if model is not None and o in m_outs and inp in m_ins:
                 mm = (fm >= lo) & (fm <= hi) & (fm > 0)
                 hm = Hm[mm, m_outs.index(o), m_ins.index(inp)]
-                axes[0, c].plot(fm[mm], mag(hm), color=colour, lw=1.2, ls="--", label=f"{o} (model)")
-                axes[1, c].plot(fm[mm], phase(hm), color=colour, lw=1.2, ls="--")
+                axes[0, c].plot(fm[mm], _magnitude(hm, magnitude), color=colour, lw=1.2,
+                                ls="--", label=f"{o} (model)")
+                axes[1, c].plot(fm[mm], _phase_deg(hm, unwrap_phase), color=colour, lw=1.2,
+                                ls="--")
         axes[0, c].set_title(f"from {inp}", fontsize=10)
         if magnitude == "log":
             axes[0, c].set_yscale("log")
@@ -152,19 +134,56 @@ def frf_figure(
             axes[r, c].grid(True, which="both", alpha=0.3)
         axes[-1, c].set_xlabel("Frequency (Hz)")
         axes[0, c].legend(fontsize=7)
+    _frf_labels(axes, units, magnitude, unwrap_phase, coh is not None)
+    fig.suptitle(title)
+    return save_figure(fig, path, tight=True)
+
+
+def _pairs(pairs, outs: list, ins: list) -> list[tuple[str, str]]:
+    """The (output, input) pairs to draw, every one by default; an unknown one refused."""
+    if pairs is None:
+        return [(o, i) for i in ins for o in outs]
+    for o, i in pairs:
+        if o not in outs or i not in ins:
+            raise AmbsealError(f"frf_figure: pair ({o!r}, {i!r}) not in measured outputs "
+                               f"{outs} × inputs {ins}")
+    return [(o, i) for o, i in pairs]
+
+
+def _magnitude(h: np.ndarray, magnitude: str) -> np.ndarray:
+    """|H|, or 20 log10 |H| for ``magnitude="db"``."""
+    a = np.abs(h)
+    if magnitude == "db":
+        with np.errstate(divide="ignore"):
+            return 20.0 * np.log10(a)
+    return a
+
+
+def _phase_deg(h: np.ndarray, unwrap: bool) -> np.ndarray:
+    """Phase in degrees, NaN where H is zero or not finite (its phase means nothing)."""
+    ok = np.isfinite(h) & (h != 0)
+    out = np.full(h.shape, np.nan)
+    if ok.any():
+        ph = np.angle(h[ok])
+        out[ok] = np.degrees(np.unwrap(ph) if unwrap else ph)
+    return out
+
+
+def _frf_labels(axes, units: str, magnitude: str, unwrap_phase: bool, coherence: bool) -> None:
+    """The rows' labels and the phase and coherence axes' limits."""
     unit_label = f" ({units})" if units else ""
-    axes[0, 0].set_ylabel(f"|H|{unit_label}" if magnitude == "log" else f"|H| (dB re 1 {units or 'unit'})")
+    axes[0, 0].set_ylabel(f"|H|{unit_label}" if magnitude == "log"
+                          else f"|H| (dB re 1 {units or 'unit'})")
     axes[1, 0].set_ylabel("Phase (deg)")
+    ncol = axes.shape[1]
     if not unwrap_phase:
         for c in range(ncol):
             axes[1, c].set_ylim(-200, 200)
             axes[1, c].set_yticks([-180, -90, 0, 90, 180])
-    if coh is not None:
+    if coherence:
         axes[2, 0].set_ylabel("Coherence γ² (-)")
         for c in range(ncol):
             axes[2, c].set_ylim(0, 1.05)
-    fig.suptitle(title)
-    return save_figure(fig, path, tight=True)
 
 
 def fit_timeseries_figure(path: str | os.PathLike, time_s: Sequence[float], y_meas: np.ndarray,

@@ -447,23 +447,8 @@ def _parts(centre, params, cur, fcols, Wp, Wu, W1, W2, Wf, d_e, d_u, L=None, Wk=
     outs = [n.removeprefix("y_") for n in centre.output_names]
     forces = [centre.input_names[i] for i in fcols]
     ny, nu, nf = len(outs), len(chans), len(fcols)
-    Bd, Cd, Di, Df = [], [], [], []
-    for p in params:
-        q = centre.parameter(p.name)
-        h = p.half_width
-        nb = max(np.linalg.norm(q.B), 1e-300)
-        nc = max(np.linalg.norm(np.hstack([q.C, q.D[:, cur] * d_u])), 1e-300)
-        a = np.sqrt(h * nc / nb)
-        Bd.append(q.B * a)
-        Cd.append(q.C * (h / a))
-        Di.append(q.D[:, cur] * (h / a))
-        Df.append(q.D[:, fcols] * (h / a))
-    n = centre.A.shape[0]
+    Bd, Cd, Di, Df = _delta_channels(centre, params, cur, fcols, d_u)
     nd = sum(p.repeats for p in params)
-    Bd = np.hstack(Bd) if params else np.zeros((n, 0))
-    Cd = np.vstack(Cd) if params else np.zeros((0, n))
-    Di = np.vstack(Di) if params else np.zeros((0, nu))
-    Df = np.vstack(Df) if params else np.zeros((0, nf))
     tags = [f"{p.name.replace('.', '_')}_{j}" for p in params for j in range(p.repeats)]
     wD, zD = _sig("wD", tags), _sig("zD", tags)
     i_, f_, ym = _sig("i", chans), _sig("f", forces), _sig("ym", outs)
@@ -493,13 +478,36 @@ def _parts(centre, params, cur, fcols, Wp, Wu, W1, W2, Wf, d_e, d_u, L=None, Wk=
               + [f"df_{c}" for c in forces] + [f"u_{c}" for c in chans])
     lab_out = ([f"zD_{t}" for t in tags] + [f"zp_{c}" for c in outs] + [f"zu_{c}" for c in chans]
                + [f"zk_{c}" for c in chans if Wk is not None] + [f"y_{c}" for c in outs])
-    snames = (list(centre.state_names) + [f"Wp{i}" for i in range(Wp_d.nstates)]
-              + [f"Wu{i}" for i in range(Wu_d.nstates)] + [f"W1_{i}" for i in range(W1_d.nstates)]
-              + ([f"Wf_{i}" for i in range(Wf_d.nstates)] if nf else [])
-              + ([f"L{i}" for i in range(L_d.nstates)] if L is not None else [])
-              + ([f"Wk{i}" for i in range(Wk_d.nstates)] if Wk is not None else []))
+    snames = list(centre.state_names) + _weight_state_names(
+        [("Wp", Wp_d), ("Wu", Wu_d), ("W1_", W1_d), ("Wf_", Wf_d), ("L", L_d), ("Wk", Wk_d)])
     return _Parts(G, Wp_d, Wu_d, W1_d, Wf_d, Wk_d, (E, I), L_d, tuple(ins), tuple(outputs),
                   tuple(lab_in), tuple(lab_out), tuple(snames), nd)
+
+
+def _delta_channels(centre, params, cur, fcols, d_u) -> tuple[np.ndarray, ...]:
+    """(B_Δ, C_Δ, D_Δi, D_Δf) of the parameters' LFT channels, each channel's half-width h
+    split between its B and its C, D so that both have similar norms (conditioning)."""
+    n, nu, nf = centre.A.shape[0], len(cur), len(fcols)
+    if not params:
+        return np.zeros((n, 0)), np.zeros((0, n)), np.zeros((0, nu)), np.zeros((0, nf))
+    Bd, Cd, Di, Df = [], [], [], []
+    for p in params:
+        q = centre.parameter(p.name)
+        h = p.half_width
+        nb = max(np.linalg.norm(q.B), 1e-300)
+        nc = max(np.linalg.norm(np.hstack([q.C, q.D[:, cur] * d_u])), 1e-300)
+        a = np.sqrt(h * nc / nb)
+        Bd.append(q.B * a)
+        Cd.append(q.C * (h / a))
+        Di.append(q.D[:, cur] * (h / a))
+        Df.append(q.D[:, fcols] * (h / a))
+    return np.hstack(Bd), np.vstack(Cd), np.vstack(Di), np.vstack(Df)
+
+
+def _weight_state_names(weights) -> list[str]:
+    """``prefix + index`` for each state of each (prefix, weight) given (None: none)."""
+    return [f"{prefix}{i}" for prefix, W in weights if W is not None
+            for i in range(W.nstates)]
 
 
 def _named(W, inputs, outputs, name):

@@ -372,9 +372,9 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     bound's scalings fitted by stable, minimum-phase functions of automatically chosen
     order), until μ stops improving; the best iterate is kept, not the last. D–K then often
     stalls a few per cent above the μ-optimum: each D-step fits the D that is optimal for the
-    *current* K, not the D whose K-step is best. So a direct search over the fitted scales' parameters for the smallest γ_opt of ``D P D⁻¹``
-    follows (:func:`~ambseal.robust._dscale._search_dscales`, Nelder–Mead with
-    restarts). Finally μ of the kept controller is re-checked between the grid points
+    *current* K, not the D whose K-step is best. So a direct search over the fitted
+    scales' parameters for the smallest γ_opt of ``D P D⁻¹`` follows
+    (:func:`~ambseal.robust._dscale._search_dscales`, Nelder–Mead with restarts). Finally μ of the kept controller is re-checked between the grid points
     around the curve's peaks (:func:`~ambseal.robust.mu.mu_peak`): the reported μ is that
     value, and the result names the frequencies it was computed at.
 
@@ -452,13 +452,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     blks = check_blocks(P, blocks, nmeas, ncon)
     if blks[-1].kind != "full":
         raise ModelError("musyn: the last block must be the full complex performance block")
-    if order != "auto" and not (isinstance(order, (int, np.integer)) and 0 <= order <= 4):
-        raise ConfigError(f"order={order!r}: the D-scale fit order must be 0–4 or 'auto'")
-    if not (search == "auto" or (isinstance(search, (int, np.integer)) and search >= 0)):
-        raise ConfigError(f"search={search!r}: expected a number of γ evaluations ≥ 0 or "
-                          f"'auto'")
-    if not (isinstance(search_backoff, (int, float)) and search_backoff >= 1):
-        raise ConfigError(f"search_backoff={search_backoff!r}: expected a number ≥ 1")
+    _check_settings(order, search, search_backoff)
     _check_counts(max_iter=max_iter, patience=patience, rtol=rtol, backoff=backoff,
                   fit_tol=fit_tol)
     w = default_omega(P) if omega is None else np.asarray(omega, float)
@@ -497,15 +491,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
         if stall >= patience:
             rule = f"patience={patience}: {stall} iterations without a μ gain of rtol={rtol:g}"
             break
-        # D-step on the unscaled closed loop, diagonal (complexified) structure
-        mu_c = (mussv(cl, cblocks, w, lower=False, peak=False)
-                if cblocks != [tuple(b) for b in blocks] else mu_true)
-        ds = np.asarray(mu_c.dscale)  # (F, nblocks), last block = 1
-        if order == "auto":
-            wgt = (mu_c.upper / np.max(mu_c.upper)) ** 4
-            fits = [fit_dscale(w, ds[:, j], wgt, tol=fit_tol)[0] for j in range(ds.shape[1] - 1)]
-        else:
-            fits = [fit_magnitude(w, ds[:, j], order) for j in range(ds.shape[1] - 1)]
+        fits = _d_step(cl, blocks, cblocks, w, mu_true, order, fit_tol)
     finalists = [_finalist(best)]
     n_scaled = _scaled_plant(P, cblocks, best[4], nmeas, ncon).nstates if best[4] else 0
     evals, granted = _search_evals(search, best[4], n_scaled)
@@ -518,6 +504,30 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
         if found is not None:
             finalists.append(_finalist(found))
     return _result(P, blocks, nmeas, ncon, w, finalists, history, t0, stopping=stopping)
+
+
+def _check_settings(order, search, search_backoff) -> None:
+    """:func:`musyn`'s D-scale order, search and search back-off; ConfigError if bad."""
+    if order != "auto" and not (isinstance(order, (int, np.integer)) and 0 <= order <= 4):
+        raise ConfigError(f"order={order!r}: the D-scale fit order must be 0–4 or 'auto'")
+    if not (search == "auto" or (isinstance(search, (int, np.integer)) and search >= 0)):
+        raise ConfigError(f"search={search!r}: expected a number of γ evaluations ≥ 0 or "
+                          f"'auto'")
+    if not (isinstance(search_backoff, (int, float)) and search_backoff >= 1):
+        raise ConfigError(f"search_backoff={search_backoff!r}: expected a number ≥ 1")
+
+
+def _d_step(cl, blocks, cblocks, w, mu_true, order, fit_tol) -> list:
+    """The D-step on the unscaled closed loop ``cl``, diagonal (complexified) structure:
+    the D scales' fits, one per block but the last (weighted by μ⁴ towards its peak with
+    ``order="auto"``)."""
+    mu_c = (mussv(cl, cblocks, w, lower=False, peak=False)
+            if cblocks != [tuple(b) for b in blocks] else mu_true)
+    ds = np.asarray(mu_c.dscale)  # (F, nblocks), last block = 1
+    if order == "auto":
+        wgt = (mu_c.upper / np.max(mu_c.upper)) ** 4
+        return [fit_dscale(w, ds[:, j], wgt, tol=fit_tol)[0] for j in range(ds.shape[1] - 1)]
+    return [fit_magnitude(w, ds[:, j], order) for j in range(ds.shape[1] - 1)]
 
 
 def _finalist(entry):

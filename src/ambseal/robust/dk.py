@@ -375,8 +375,9 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     *current* K, not the D whose K-step is best. So a direct search over the fitted
     scales' parameters for the smallest γ_opt of ``D P D⁻¹`` follows
     (:func:`~ambseal.robust._dscale._search_dscales`, Nelder–Mead with restarts). Finally
-    μ of the kept controller is re-checked between the grid points around the curve's peaks (:func:`~ambseal.robust.mu.mu_peak`): the reported μ is that
-    value, and the result names the frequencies it was computed at.
+    μ of the kept controller is re-checked between the grid points around the curve's
+    peaks (:func:`~ambseal.robust.mu.mu_peak`): the reported μ is that value, and the
+    result names the frequencies it was computed at.
 
     Parameters
     ----------

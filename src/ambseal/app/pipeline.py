@@ -213,7 +213,7 @@ def _lost_over_speed(cfg: RigConfig, designs: list[Designed]) -> list[str]:
     out = []
     for d in designs:
         fo = getattr(d.result, "full_order", None)
-        if d.method in ("hinf", "mu") and fo and not fo["stable"] \
+        if d.method in method_names(synthesised=True) and fo and not fo["stable"] \
                 and abs(fo["speed_hz"] - f0) > 1e-9 * max(f0, 1.0):
             out.append(d.method)
     return out
@@ -445,7 +445,8 @@ def _note_speed_lpv(st: _RunState) -> None:
     if speed_scheduled(st.cfg) or "lpv" not in {d.method for d in st.designs} \
             or "lpv" in st.failed:
         return
-    for m in [m for m in ("hinf", "mu") if m in st.failed and st.failed[m].judged]:
+    for m in [m for m in method_names(synthesised=True)
+              if m in st.failed and st.failed[m].judged]:
         st.failed[m] = replace(st.failed[m], reason=f"{st.failed[m].reason}; the LPV on "
                                                      "speed holds the rotor over the speed "
                                                      "range")

@@ -27,6 +27,7 @@ from dataclasses import dataclass, replace
 
 from ambseal.analysis.delivery import FailedController, loop_failure
 from ambseal.app.commands import Designed, digitals_for
+from ambseal.config import method_label, method_names
 from ambseal.design.recipes import design
 from ambseal.errors import ConfigError, SynthesisError
 
@@ -143,4 +144,6 @@ def remedy(method: str, failure: FailedController, cases: list[dict], design_cfg
         tried.append(f"{label} (still unstable at {', '.join(again.conditions)})")
     why = "; ".join(tried)
     return None, replace(failure, reason=f"{failure.reason}. Tried: {why}"
-                         + ("" if method == "mu" else "; μ is the robust controller"))
+                         + ("" if method in method_names(robust=True) else
+                            f"; {' and '.join(map(method_label, method_names(robust=True)))} "
+                            "is the robust controller"))

@@ -38,6 +38,10 @@ class Method:
         (:mod:`ambseal.app.remedies`) where its full-order loop fails.
     option : bool
         A choice of ``ambseal design --method`` and ``ambseal export --method``.
+    robust : bool
+        Synthesised against the specification's uncertain parameters (μ, thesis P5 §4.3):
+        on the perturbed plant, judged by μ on a frequency grid; the method ``ambseal run``
+        names as the robust controller.
     """
 
     name: str
@@ -46,6 +50,7 @@ class Method:
     fixed: bool
     synthesised: bool
     option: bool
+    robust: bool = False
 
 
 #: Every method, in the order runs design them and reports list them. The colours are the
@@ -53,7 +58,7 @@ class Method:
 METHODS: tuple[Method, ...] = (
     Method("pid", "PID", "#1f77b4", fixed=True, synthesised=False, option=True),
     Method("hinf", "H∞", "#d62728", fixed=True, synthesised=True, option=True),
-    Method("mu", "μ", "#2ca02c", fixed=True, synthesised=True, option=True),
+    Method("mu", "μ", "#2ca02c", fixed=True, synthesised=True, option=True, robust=True),
     Method("lpv", "LPV", "#9467bd", fixed=False, synthesised=False, option=True),
     Method("tracked", "tracked", None, fixed=False, synthesised=False, option=False),
 )
@@ -102,19 +107,19 @@ def method_label(name: str) -> str:
 
 
 def method_names(*, fixed: bool | None = None, synthesised: bool | None = None,
-                 option: bool | None = None) -> tuple[str, ...]:
+                 option: bool | None = None, robust: bool | None = None) -> tuple[str, ...]:
     """The names of the methods with the given properties (None: either), in
     :data:`METHODS`' order.
 
     Parameters
     ----------
-    fixed, synthesised, option : bool or None
+    fixed, synthesised, option, robust : bool or None
         Properties of :class:`Method` to select on.
 
     Returns
     -------
     tuple of str
     """
-    want = {"fixed": fixed, "synthesised": synthesised, "option": option}
+    want = {"fixed": fixed, "synthesised": synthesised, "option": option, "robust": robust}
     return tuple(m.name for m in METHODS
                  if all(v is None or getattr(m, k) == v for k, v in want.items()))

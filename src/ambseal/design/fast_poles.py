@@ -52,12 +52,13 @@ def design_rise(result, K_reduced, omega=None, nyquist_hz: float | None = None
     which is why the hold equivalents are also tried with real fast poles kept. The μ grid
     ends at the top of the design band, below Nyquist."""
     if (not isinstance(result, DesignResult) or result.plant is None
-            or result.method not in method_names(synthesised=True) or (result.method == "mu" and omega is None)):
+            or result.method not in method_names(synthesised=True)
+            or (result.method in method_names(robust=True) and omega is None)):
         return None
-    gp, method = result.plant, result.method
+    gp = result.plant
     out = {"order_full": int(result.K.nstates), "order": int(K_reduced.nstates)}
     # the design's own verified γ / μ peak (same loop, same grid) is the "before"
-    if method == "hinf":
+    if result.method not in method_names(robust=True):
         out["gamma_full"] = float(result.gamma)
         out["gamma"] = float(hinfnorm(gp.closed_loop(K_reduced, nominal=True))[0])
         out["rise"] = out["gamma"] / out["gamma_full"] - 1.0

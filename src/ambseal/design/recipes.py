@@ -402,15 +402,16 @@ class _Synthesis:
 def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl):
     """One synthesis on an n-state design model, reduced, as a physical controller."""
 
+    robust = method in method_names(robust=True)  # against the uncertain parameters
     Wf = w.Wf()
     fpos = tuple(w.force_positions_m or sp.force_positions_m) if Wf is not None else ()
-    gp = generalized_plant(cfg, w.Wp(), w.Wu(), uncertainty=unc if method == "mu" else None,
+    gp = generalized_plant(cfg, w.Wp(), w.Wu(), uncertainty=unc if robust else None,
                            pressure_bar=p, states=n, input_disturbance=w.W1(),
                            force_disturbance=Wf, force_positions=fpos, d_e=w.d_e, d_u=w.d_u,
                            actuator_delay=dl.system,
                            gain_weight=w.Wk())
     mu_omega = None
-    if method == "hinf":
+    if not robust:  # nominal H∞
         r = hinfsyn(gp.P_nominal, gp.nmeas, gp.ncon)
         K_P, gamma, mu, hist = r.K, float(r.gamma), None, ()
         stopping = {"hinf": {"iterations": r.iterations,
@@ -436,13 +437,13 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
     if reduce_to is not None and reduce_to < order_full:
         cands = [{"step": hist[r.best_iteration].get("step", "D-K") if hist else "H-inf",
                   "K": K_P, "mu": mu, "gamma": gamma}]
-        cands += list(getattr(r, "alternatives", ()) if method == "mu" else ())
+        cands += list(getattr(r, "alternatives", ()) if robust else ())
         K_P, red, gamma, mu = _reduce_best(P_red, cands, int(reduce_to), auto, gp, blocks,
-                                           om if method == "mu" else None)
+                                           om if robust else None)
         order_full = red["order_full"]
     K = gp.physical_controller(K_P, name=f"K_{method}")
     return _Synthesis(K, gamma, mu, tuple(hist), order_full, red, gp, K_P, mu_omega,
-                      om if method == "mu" else None, stopping)
+                      om if robust else None, stopping)
 
 
 def _reduce_best(P, cands, order: int, auto: bool, gp, blocks, omega):

@@ -297,9 +297,6 @@ def newton_steps(L1, D, Gr, za, Lder, U, BD, BGr, offs, full, gmax, pD, n_newton
         caller to stop at its best scalings.
     """
     F, p = za.shape
-    N = L1.shape[1]
-    nr = Gr.shape[1]
-    pG = p - pD
     centred = np.zeros(F, np.bool_)
     lost = np.zeros(F, np.bool_)
     dz = np.empty((F, p))
@@ -315,60 +312,78 @@ def newton_steps(L1, D, Gr, za, Lder, U, BD, BGr, offs, full, gmax, pD, n_newton
                 for i in range(p):
                     dz[f, i] = 0.0
                 continue
-            tr = 0.0
-            for i in range(p):
-                tr += H[i, i]
-            for i in range(p):
-                H[i, i] += 1e-12 * tr / p
-            d = _solve(H, g)
-            gd = 0.0
-            for i in range(p):
-                dz[f, i] = -d[i]
-                gd += g[i] * d[i]
-            dec[f] = np.sqrt(max(gd, 0.0))
+            dec[f] = _newton_direction(g, H, dz[f])
             centred[f] = dec[f] < dec_tol
         if _all(centred):
             break
         for f in range(F):
-            # inside the Dikin ellipsoid (r = step·dec < 1) the point stays feasible: each
-            # barrier matrix L has ‖L^-½ dL L^-½‖ ≤ r (its term's local norm is at most the
-            # Newton decrement's), so L + dL ⪰ (1 − r)·L (Nesterov & Nemirovskii 1994 §2.1).
-            # With r ≤ 1/2 it keeps half its smallest eigenvalue, so only the longer steps
-            # are checked, against rounding, and halved (up to 12 times) where they fail
-            step = 1.0 if dec[f] < 0.25 else 1.0 / (1.0 + dec[f])
-            dL1 = np.zeros((N, N), np.complex128)
-            dD = np.zeros((N, N), np.complex128)
-            dGr = np.zeros((nr, nr), np.complex128)
-            for i in range(p):
-                c = dz[f, i]
-                for a in range(N):
-                    for b in range(N):
-                        dL1[a, b] += c * Lder[f, i, a, b]
-                if i < pD:
-                    for a in range(N):
-                        for b in range(N):
-                            dD[a, b] += c * U[i, a, b]
-                else:
-                    for a in range(nr):
-                        for b in range(nr):
-                            dGr[a, b] += c * BGr[i - pD, a, b]
-            if step * dec[f] > 0.5:
-                ok = False
-                for _bt in range(12):
-                    if _feasible(_axpy(L1[f], step, dL1), _axpy(D[f], step, dD),
-                                 _axpy(Gr[f], step, dGr), gmax):
-                        ok = True
-                        break
-                    step *= 0.5
-                if not ok:
-                    step = 0.0
+            _damped_step(L1[f], D[f], Gr[f], za[f], Lder[f], U, BGr, dz[f], dec[f], pD, gmax)
+    return centred, lost
+
+
+@cached_njit()
+def _newton_direction(g, H, dz):
+    """The Newton direction −H⁻¹g into ``dz`` (H regularised by 1e-12 of its mean diagonal)
+    and the Newton decrement √(gᵀH⁻¹g)."""
+    p = g.shape[0]
+    tr = 0.0
+    for i in range(p):
+        tr += H[i, i]
+    for i in range(p):
+        H[i, i] += 1e-12 * tr / p
+    d = _solve(H, g)
+    gd = 0.0
+    for i in range(p):
+        dz[i] = -d[i]
+        gd += g[i] * d[i]
+    return np.sqrt(max(gd, 0.0))
+
+
+@cached_njit()
+def _damped_step(L1, D, Gr, za, Lder, U, BGr, dz, dec, pD, gmax):
+    """One damped Newton step of one matrix along ``dz``, in place.
+
+    Inside the Dikin ellipsoid (r = step·dec < 1) the point stays feasible: each barrier
+    matrix L has ‖L^-½ dL L^-½‖ ≤ r (its term's local norm is at most the Newton
+    decrement's), so L + dL ⪰ (1 − r)·L (Nesterov & Nemirovskii 1994 §2.1). With r ≤ 1/2 it
+    keeps half its smallest eigenvalue, so only the longer steps are checked, against
+    rounding, and halved (up to 12 times) where they fail."""
+    N = L1.shape[0]
+    nr = Gr.shape[0]
+    p = dz.shape[0]
+    step = 1.0 if dec < 0.25 else 1.0 / (1.0 + dec)
+    dL1 = np.zeros((N, N), np.complex128)
+    dD = np.zeros((N, N), np.complex128)
+    dGr = np.zeros((nr, nr), np.complex128)
+    for i in range(p):
+        c = dz[i]
+        for a in range(N):
+            for b in range(N):
+                dL1[a, b] += c * Lder[i, a, b]
+        if i < pD:
             for a in range(N):
                 for b in range(N):
-                    L1[f, a, b] += step * dL1[a, b]
-                    D[f, a, b] += step * dD[a, b]
+                    dD[a, b] += c * U[i, a, b]
+        else:
             for a in range(nr):
                 for b in range(nr):
-                    Gr[f, a, b] += step * dGr[a, b]
-            for i in range(p):
-                za[f, i] += step * dz[f, i]
-    return centred, lost
+                    dGr[a, b] += c * BGr[i - pD, a, b]
+    if step * dec > 0.5:
+        ok = False
+        for _bt in range(12):
+            if _feasible(_axpy(L1, step, dL1), _axpy(D, step, dD), _axpy(Gr, step, dGr),
+                         gmax):
+                ok = True
+                break
+            step *= 0.5
+        if not ok:
+            step = 0.0
+    for a in range(N):
+        for b in range(N):
+            L1[a, b] += step * dL1[a, b]
+            D[a, b] += step * dD[a, b]
+    for a in range(nr):
+        for b in range(nr):
+            Gr[a, b] += step * dGr[a, b]
+    for i in range(p):
+        za[i] += step * dz[i]

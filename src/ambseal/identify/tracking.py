@@ -57,6 +57,7 @@ import time
 from dataclasses import dataclass
 
 import numba
+from numba.extending import register_jitable
 import numpy as np
 import scipy.linalg as sla
 from scipy import stats
@@ -430,7 +431,7 @@ def rpem_kernel(y, u, Ad, Bd, C, K, dA, dB, theta0, x, W, theta, P, lam, q, g,
     the tracked parameters' information with every parameter (the consistency test's
     relevance, :func:`held_error_check`). Plain loops so that numba compiles it (the
     interpreted form is the benchmark's baseline)."""
-    n, k, m, p = Ad.shape[0], C.shape[0], Bd.shape[1], theta.shape[0]
+    n, k, p = Ad.shape[0], C.shape[0], theta.shape[0]
     nt = cross.shape[1]
     xn = np.empty(n)
     Wn = np.empty((p, n))
@@ -451,60 +452,9 @@ def rpem_kernel(y, u, Ad, Bd, C, K, dA, dB, theta0, x, W, theta, P, lam, q, g,
             for a in range(n):
                 s -= C[i, a] * x[a]
             eps[i] = s
-        for j in range(p):  # ∂A x̂ + ∂B u
-            for a in range(n):
-                s = 0.0
-                for b in range(n):
-                    s += dA[j, a, b] * x[b]
-                for b in range(m):
-                    s += dB[j, a, b] * u[t, b]
-                dx[j, a] = s
-        for a in range(n):  # predictor at θ̂ (first order about θ₀)
-            s = 0.0
-            for b in range(n):
-                s += Ad[a, b] * x[b]
-            for b in range(m):
-                s += Bd[a, b] * u[t, b]
-            for i in range(k):
-                s += K[a, i] * eps[i]
-            for j in range(p):
-                s += (theta[j] - theta0[j]) * dx[j, a]
-            xn[a] = s
-        for j in range(p):  # H = C W, then the sensitivity recursion
-            for i in range(k):
-                s = 0.0
-                for a in range(n):
-                    s += C[i, a] * W[j, a]
-                H[i, j] = s
-            for a in range(n):
-                s = dx[j, a]
-                for b in range(n):
-                    s += Ad[a, b] * W[j, b]
-                for i in range(k):
-                    s -= K[a, i] * H[i, j]
-                Wn[j, a] = s
+        _predict(u, t, Ad, Bd, C, K, dA, dB, theta0, x, W, theta, eps, dx, xn, H, Wn)
         for i in range(k):  # Λ, then one scalar Kalman update per channel
-            lam[i] += g * (eps[i] * eps[i] - lam[i])
-            s = lam[i]
-            for j in range(p):
-                v = 0.0
-                for l in range(p):
-                    v += P[j, l] * H[i, l]
-                ph[j] = v
-                s += H[i, j] * v
-            for j in range(p):
-                score[t, j] += H[i, j] * eps[i] / lam[i]
-                info[t, j] += H[i, j] * H[i, j] / lam[i]
-                for a in range(nt):
-                    cross[t, a, j] += H[i, a] * H[i, j] / lam[i]
-            r = eps[i]  # the residual at the θ̂ already updated by earlier channels
-            for j in range(p):
-                r -= H[i, j] * (theta[j] - th0[j])
-            for j in range(p):
-                theta[j] += ph[j] * r / s
-            for j in range(p):
-                for l in range(p):
-                    P[j, l] -= ph[j] * ph[l] / s
+            _channel_update(i, t, H, eps, lam, g, P, theta, th0, ph, score, info, cross)
         for j in range(p):
             P[j, j] += q[j]
             est[t, j] = theta[j]
@@ -513,6 +463,74 @@ def rpem_kernel(y, u, Ad, Bd, C, K, dA, dB, theta0, x, W, theta, P, lam, q, g,
             x[a] = xn[a]
             for j in range(p):
                 W[j, a] = Wn[j, a]
+
+
+@register_jitable
+def _predict(u, t, Ad, Bd, C, K, dA, dB, theta0, x, W, theta, eps, dx, xn, H, Wn):
+    """Sample ``t``'s prediction (:func:`rpem_kernel`): ∂A x̂ + ∂B u into ``dx``, the
+    predictor at θ̂ (first order about θ₀) into ``xn``, H = C W and the sensitivity
+    recursion into ``H`` and ``Wn``."""
+    n, k, m, p = Ad.shape[0], C.shape[0], Bd.shape[1], theta.shape[0]
+    for j in range(p):  # ∂A x̂ + ∂B u
+        for a in range(n):
+            s = 0.0
+            for b in range(n):
+                s += dA[j, a, b] * x[b]
+            for b in range(m):
+                s += dB[j, a, b] * u[t, b]
+            dx[j, a] = s
+    for a in range(n):  # predictor at θ̂ (first order about θ₀)
+        s = 0.0
+        for b in range(n):
+            s += Ad[a, b] * x[b]
+        for b in range(m):
+            s += Bd[a, b] * u[t, b]
+        for i in range(k):
+            s += K[a, i] * eps[i]
+        for j in range(p):
+            s += (theta[j] - theta0[j]) * dx[j, a]
+        xn[a] = s
+    for j in range(p):  # H = C W, then the sensitivity recursion
+        for i in range(k):
+            s = 0.0
+            for a in range(n):
+                s += C[i, a] * W[j, a]
+            H[i, j] = s
+        for a in range(n):
+            s = dx[j, a]
+            for b in range(n):
+                s += Ad[a, b] * W[j, b]
+            for i in range(k):
+                s -= K[a, i] * H[i, j]
+            Wn[j, a] = s
+
+
+@register_jitable
+def _channel_update(i, t, H, eps, lam, g, P, theta, th0, ph, score, info, cross):
+    """Channel ``i``'s part of sample ``t`` (:func:`rpem_kernel`): its Λ, score,
+    information and cross-information, then its scalar Kalman update of θ̂ and P."""
+    p, nt = theta.shape[0], cross.shape[1]
+    lam[i] += g * (eps[i] * eps[i] - lam[i])
+    s = lam[i]
+    for j in range(p):
+        v = 0.0
+        for jj in range(p):
+            v += P[j, jj] * H[i, jj]
+        ph[j] = v
+        s += H[i, j] * v
+    for j in range(p):
+        score[t, j] += H[i, j] * eps[i] / lam[i]
+        info[t, j] += H[i, j] * H[i, j] / lam[i]
+        for a in range(nt):
+            cross[t, a, j] += H[i, a] * H[i, j] / lam[i]
+    r = eps[i]  # the residual at the θ̂ already updated by earlier channels
+    for j in range(p):
+        r -= H[i, j] * (theta[j] - th0[j])
+    for j in range(p):
+        theta[j] += ph[j] * r / s
+    for j in range(p):
+        for jj in range(p):
+            P[j, jj] -= ph[j] * ph[jj] / s
 
 
 _JIT = {}

@@ -13,7 +13,7 @@ that forms their Schur complement from the LMIs' Kronecker structure
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -23,7 +23,7 @@ from ambseal.errors import SynthesisError
 from ambseal.robust import _lmi_sdp as _sdp
 
 __all__ = ["LmiInfeasible", "SolverReport", "Scaled", "scale_grid", "lmi_blocks", "solve_lmis",
-           "basis", "BASES"]
+           "basis", "basis_at", "is_constant", "rebalanced", "BASES"]
 
 BASES = {"constant": 1, "affine": 2, "quadratic": 3}
 #: The largest share of stage 1's cost the trace term may take before its weight is
@@ -84,7 +84,7 @@ def _sym(X):
 
 
 def basis(kind: str, p: float) -> tuple[np.ndarray, np.ndarray]:
-    """Basis values f_i(p) and derivatives df_i/dp for p ∈ [−1, 1].
+    """Basis values f_i(p) and derivatives df_i/dp of a built-in basis, p ∈ [−1, 1].
 
     ``"affine"``: the two hat functions (1 − p)/2 and (1 + p)/2, so S₀ and S₁ are the
     Lyapunov matrices at the range's ends, S(p) = (1 − p)/2 S₀ + (1 + p)/2 S₁ — the same
@@ -98,6 +98,31 @@ def basis(kind: str, p: float) -> tuple[np.ndarray, np.ndarray]:
     f = np.array([p**i for i in range(nb)], float)
     df = np.array([i * p ** (i - 1) if i else 0.0 for i in range(nb)], float)
     return f, df
+
+
+def is_constant(kind) -> bool:
+    """Whether a Lyapunov basis (a name of :data:`BASES` or a user's callable) is the
+    constant one."""
+    return isinstance(kind, str) and kind == "constant"
+
+
+def basis_at(kind, theta: float, sc: Scaled) -> tuple[np.ndarray, np.ndarray]:
+    """Basis values f_i and derivatives df_i/dp at θ (θ's unit), p the scaled parameter.
+
+    ``kind`` is a name of :data:`BASES` (functions of p) or a user's callable
+    θ ↦ (f(θ), df/dθ(θ)) (:func:`ambseal.robust.lpv.lpvsyn`), whose derivatives are
+    converted to p by dθ/dp.
+    """
+    if callable(kind):
+        f, df = kind(float(theta))
+        return np.asarray(f, float).ravel(), np.asarray(df, float).ravel() / sc.dp_dtheta
+    return basis(kind, float(sc.p_of(theta)))
+
+
+def _convex_in_p(kind) -> bool:
+    """Whether the basis is affine in p: an LMI affine in the basis that holds at the
+    range's ends then holds between them."""
+    return isinstance(kind, str) and kind in ("constant", "affine")
 
 
 @dataclass(frozen=True)
@@ -207,6 +232,28 @@ def scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling: str = "ricc
                    lambda th: (np.asarray(th, float) - mid) / half, 1.0 / half, sig)
 
 
+def rebalanced(sc: Scaled, R: list, S: list, grid: np.ndarray, lyapunov,
+               lyapunov_r) -> Scaled:
+    """``sc`` in the diagonal state scaling that equalises the diagonals of a solution's R
+    and S: x̃ = D⁻¹x with d_i = (r_i/s_i)^¼, r and s the diagonals of R(θ_k) and S(θ_k)
+    averaged over the grid, so that R̃ = D⁻¹RD⁻¹ and S̃ = DSD have the diagonal √(r s).
+
+    Where R must be large in some directions (the range of B2 under a cheap control
+    weight) and S small in them, the trace term pays for r + s; in the new coordinates
+    for 2√(r s), and the SDP's γ is no longer held up by it (:func:`solve_lmis`).
+    """
+    def diag_mean(X, kind):
+        return np.mean([np.diag(sum(f * Xi for f, Xi in zip(basis_at(kind, th, sc)[0], X)))
+                        for th in grid], axis=0)
+
+    r, s = diag_mean(R, lyapunov_r), diag_mean(S, lyapunov)
+    d = (np.maximum(r, 1e-300) / np.maximum(s, 1e-300)) ** 0.25
+    d = d / np.exp(np.mean(np.log(d)))  # the overall size is the time scale's business
+    return replace(sc, A=sc.A * d[None, None, :] / d[None, :, None],
+                   dA=sc.dA * d[None, None, :] / d[None, :, None], B=sc.B / d[:, None],
+                   C=sc.C * d[None, :], T=sc.T * d[None, :])
+
+
 def lmi_blocks(sc: Scaled, nw, nz, ncon, nmeas):
     B1, B2 = sc.B[:, :nw], sc.B[:, nw:]
     C1, C2 = sc.C[:nz], sc.C[nz:]
@@ -223,9 +270,9 @@ def _affine_in_p(As: np.ndarray, ps: np.ndarray, rtol: float = 1e-9) -> bool:
     return bool(np.max(np.abs(As - np.array(line))) <= rtol * scale)
 
 
-def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float, *,
+def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
                backoff: float, margin: float, penalty: float, coupling_ratio: float,
-               centre: bool, solver_options: dict):
+               centre: bool, solver_options: dict, lyapunov_r="constant"):
     """The SDP stages of :func:`ambseal.robust.lpv.lpvsyn` on the scaled grid.
 
     Parameters
@@ -236,7 +283,8 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
         ``(B1, B2, C1, C2, D11, D12, D21)`` of the scaled plant (:func:`lmi_blocks`).
     grid : ndarray, shape (n_p,)
         The grid θ_k (θ's unit), strictly increasing.
-    lyapunov : {"constant", "affine", "quadratic"}
+    lyapunov, lyapunov_r : str or callable
+        The bases of S(θ) and R(θ) (:func:`basis_at`).
     nu_s : float
         Rate bound in scaled units (dp/dt'), 0 without one.
     backoff, margin, penalty, coupling_ratio, centre
@@ -250,9 +298,8 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
         Optimal γ of stage 1.
     gamma_design : float
         ``backoff·γ``.
-    R : ndarray, shape (N, N)
-    S : list of ndarray, shape (N, N)
-        Coefficients S_i of S(p) = Σ f_i(p) S_i.
+    R, S : list of ndarray, shape (N, N)
+        Coefficients R_j, S_i of R(θ) = Σ g_j(θ) R_j and S(θ) = Σ f_i(θ) S_i.
     reports : list of SolverReport
     penalty_share : float
         The trace term's share of stage 1's cost at its last solve (relative to γ).
@@ -267,17 +314,21 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
     N, nw, nz = B1.shape[0], B1.shape[1], C1.shape[0]
     NR = sla.block_diag(_null(np.hstack([B2.T, D12.T])), np.eye(nw))
     NS = sla.block_diag(_null(np.hstack([C2, D21])), np.eye(nz))
-    nb = BASES[lyapunov]
-    ps = sc.p_of(grid)
+    at = [(basis_at(lyapunov_r, th, sc), basis_at(lyapunov, th, sc)) for th in grid]
+    nbR, nbS = at[0][0][0].size, at[0][1][0].size
+    r_const, s_const = is_constant(lyapunov_r), is_constant(lyapunov)
     # LMIs affine in p that hold at both ends of the range hold between them (a convex
-    # combination): the coupling LMI of an affine S always, the R-LMI when A(p) is affine
-    # over the grid (a parameter entering through an LFT channel, or linearly in A).
-    # Inner grid points keep only the S-LMIs of a parameter-dependent S, which are
-    # quadratic in p (A(p)ᵀS(p)); with a constant S and an affine A(p) they go too.
-    a_affine = _affine_in_p(sc.A, ps)
+    # combination): the coupling LMI of affine R and S always, the R-LMI of a constant R
+    # when A(p) is affine over the grid (a parameter entering through an LFT channel, or
+    # linearly in A). Inner grid points keep the S-LMIs (R-LMIs) of a parameter-dependent
+    # S (R), which are quadratic in p (A(p)ᵀS(p)); with a constant S and an affine A(p)
+    # they go too.
+    a_affine = _affine_in_p(sc.A, sc.p_of(grid))
+    coupling_convex = _convex_in_p(lyapunov) and _convex_in_p(lyapunov_r)
     Z = np.zeros
     # rows [x; z; w] of the R-LMI and [x; w; z] of the S-LMI; the variable X enters as
-    # J X Uᵀ + U X Jᵀ (module _lmi_sdp), negated as s = −εI − (…) ⪰ 0
+    # J X Uᵀ + U X Jᵀ (module _lmi_sdp), negated as s = −εI − (…) ⪰ 0; variables
+    # R_0 … R_{nbR−1}, S_0 … S_{nbS−1}
     JR = NR.T @ np.vstack([np.eye(N), Z((nz + nw, N))])
     JS = NS.T @ np.vstack([np.eye(N), Z((nw + nz, N))])
     cR = NR.T @ np.block([[Z((N, N)), Z((N, nz)), B1], [Z((nz, N)), Z((nz, nz)), D11],
@@ -289,6 +340,16 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
     E1 = np.vstack([np.eye(N), Z((N, N))])
     E2 = np.vstack([Z((N, N)), np.eye(N)])
 
+    def projected(J, U, f, df, first, const, skip):
+        """The projected LMI at one grid point for each sign of θ̇ (±ν; the derivative
+        term ±ν Σ df_i X_i enters as ν df_i J X_i Jᵀ, both signs required)."""
+        if skip:
+            return []
+        signs = (1.0, -1.0) if (not const and nu_s > 0) else (0.0,)
+        return [[_sdp.LmiTerm(first + i, J, -(f[i] * U + 0.5 * sgn * nu_s * df[i] * J))
+                 for i in range(f.size) if f[i] != 0 or (sgn and df[i] != 0)]
+                for sgn in signs]
+
     def build(gamma_fixed: float | None, alpha: float):
         lmis = []
 
@@ -297,33 +358,31 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
                 const, gam = const + gamma_fixed * gam, None
             lmis.append(_sdp.Lmi(const, gam, tuple(terms)))
 
-        trS = np.zeros(nb)
         for k in range(grid.size):
             A = sc.A[k]
             inner = 0 < k < grid.size - 1
-            f, df = basis(lyapunov, float(ps[k]))
-            if not (inner and a_affine):
-                UR = NR.T @ np.vstack([A, C1, Z((nw, N))])
-                add(-margin * np.eye(JR.shape[0]) - cR, gR, [_sdp.LmiTerm(0, JR, -UR)])
-            signs = (1.0, -1.0) if (nb > 1 and nu_s > 0) else (0.0,)
-            for sgn in signs if not (inner and a_affine and nb == 1) else ():
-                US = NS.T @ np.vstack([A.T, B1.T, Z((nz, N))])
-                terms = [_sdp.LmiTerm(1 + i, JS, -(f[i] * US + 0.5 * sgn * nu_s * df[i] * JS))
-                         for i in range(nb) if f[i] != 0 or (sgn and df[i] != 0)]
+            (fR, dfR), (fS, dfS) = at[k]
+            UR = NR.T @ np.vstack([A, C1, Z((nw, N))])
+            for terms in projected(JR, UR, fR, dfR, 0, r_const, r_const and inner and a_affine):
+                add(-margin * np.eye(JR.shape[0]) - cR, gR, terms)
+            US = NS.T @ np.vstack([A.T, B1.T, Z((nz, N))])
+            for terms in projected(JS, US, fS, dfS, nbR, s_const,
+                                   s_const and inner and a_affine):
                 add(-margin * np.eye(JS.shape[0]) - cS, gS, terms)
-            if k == 0 or (nb == 2 and not inner) or nb > 2:  # constant S: one suffices
-                terms = [_sdp.LmiTerm(0, E1, 0.5 * E1)]
-                terms += [_sdp.LmiTerm(1 + i, E2, 0.5 * f[i] * E2) for i in range(nb)
-                          if f[i] != 0]
+            if k == 0 or not (r_const and s_const) and not (coupling_convex and inner):
+                terms = [_sdp.LmiTerm(j, E1, 0.5 * fR[j] * E1) for j in range(nbR) if fR[j]]
+                terms += [_sdp.LmiTerm(nbR + i, E2, 0.5 * fS[i] * E2) for i in range(nbS)
+                          if fS[i]]
                 add(alpha * np.block([[Z((N, N)), np.eye(N)], [np.eye(N), Z((N, N))]]),
                     None, terms)
-            if nb > 1 or k == 0:
-                trS += f / (grid.size if nb > 1 else 1)
-        return lmis, np.concatenate([[1.0], trS]) / N
+        # the trace term: tr R(θ) + tr S(θ) averaged over the grid
+        mean = np.mean([np.concatenate([fR, fS]) for (fR, _), (fS, _) in at], axis=0)
+        return lmis, mean / N
 
     reports = []
+    n_vars = nbR + nbS
     lmis, tr = build(None, float(coupling_ratio) if not centre else 1.0)
-    sol = _solve_sdp(lmis, N, nb, 1.0, penalty * tr, solver_options, "gamma", reports)
+    sol = _solve_sdp(lmis, N, n_vars, 1.0, penalty * tr, solver_options, "gamma", reports)
     # The trace term keeps R and S bounded, but where they must grow large it also buys a
     # smaller trace with a larger γ: while its share of the cost exceeds PENALTY_SHARE the
     # weight is lowered to half that share and the SDP solved again (at most
@@ -339,8 +398,8 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
             break
         lower_weight = weight * 0.5 * PENALTY_SHARE / share  # aim inside the bound
         try:
-            lower = _solve_sdp(lmis, N, nb, 1.0, lower_weight * tr, solver_options, "gamma",
-                               reports)
+            lower = _solve_sdp(lmis, N, n_vars, 1.0, lower_weight * tr, solver_options,
+                               "gamma", reports)
         except SynthesisError:
             break
         if not float(lower.gamma) < float(sol.gamma):
@@ -355,23 +414,23 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov: str, nu_s: float,
         for _ in range(4):
             lmis, tr = build(gamma_d, alpha)
             try:
-                sol = _solve_sdp(lmis, N, nb, None, tr, solver_options, "centre", reports)
+                sol = _solve_sdp(lmis, N, n_vars, None, tr, solver_options, "centre",
+                                 reports)
                 break
             except SynthesisError as exc:
                 last = exc
                 alpha = 1.0 + 0.5 * (alpha - 1.0)
         else:
             raise last
-    Rv = _sym(sol.X[0])
-    Sv = [_sym(S) for S in sol.X[1:]]
-    return gamma, gamma_d, Rv, Sv, reports, share
+    X = [_sym(X) for X in sol.X]
+    return gamma, gamma_d, X[:nbR], X[nbR:], reports, share
 
 
-def _solve_sdp(lmis, N, nb, cost_gamma, cost_trace, options, stage, reports):
+def _solve_sdp(lmis, N, n_vars, cost_gamma, cost_trace, options, stage, reports):
     """One SDP stage by :func:`ambseal.robust._lmi_sdp.solve_lmis`; its report appended."""
     t0 = time.perf_counter()
     try:
-        sol = _sdp.solve_lmis(lmis, N, nb + 1, cost_gamma, cost_trace, options)
+        sol = _sdp.solve_lmis(lmis, N, n_vars, cost_gamma, cost_trace, options)
     except (ArithmeticError, ValueError) as exc:  # CVXOPT: a singular scaling or KKT system
         raise SynthesisError(
             f"lpvsyn ({stage}): CVXOPT stopped on a singular system ({exc!r}): the LMIs are "

@@ -9,17 +9,18 @@ under arbitrarily fast parameter changes) and a parameter-dependent one with a b
 
 Generalised plant P(θ) (inputs [w, u], outputs [z, y], as :func:`ambseal.robust.hinfsyn`)
 with A(θ) varying and B, C, D constant (true where θ enters through stiffness- and
-damping-like terms of the state equation only), D22 = 0. Find γ, R = Rᵀ (constant) and
-S(θ) = Σ_i f_i(θ) S_i (f_0 = 1; ``"constant"``: S_0 only) such that on every grid point θ_k
-and for θ̇ = ±ν (``rate_bound``)::
+damping-like terms of the state equation only), D22 = 0. Find γ, R(θ) = Σ_j g_j(θ) R_j and
+S(θ) = Σ_i f_i(θ) S_i (``"constant"``: R_0 or S_0 only; R is constant by default) such that
+on every grid point θ_k and for θ̇ = ±ν (``rate_bound``)::
 
-    N_Rᵀ [A R + R Aᵀ,  R C1ᵀ,  B1;  C1 R, −γI, D11;  B1ᵀ, D11ᵀ, −γI] N_R ≺ 0
+    N_Rᵀ [A R + R Aᵀ ∓ ν ∂R/∂θ,  R C1ᵀ,  B1;  C1 R, −γI, D11;  B1ᵀ, D11ᵀ, −γI] N_R ≺ 0
     N_Sᵀ [Aᵀ S + S A ± ν ∂S/∂θ,  S B1,  C1ᵀ;  B1ᵀ S, −γI, D11ᵀ;  C1, D11, −γI] N_S ≺ 0
     [R, I; I, S] ⪰ 0
 
 with N_R = diag(null[B2ᵀ D12ᵀ], I), N_S = diag(null[C2 D21], I) (the projected, or
-elimination, conditions of Gahinet & Apkarian 1994). Keeping R constant makes the controller
-independent of θ̇ (Apkarian & Adams 1998 §3.2).
+elimination, conditions of Gahinet & Apkarian 1994; Wu et al. 1996 Theorem 4.2 with both
+matrices parameter-dependent). Keeping R constant makes the controller independent of θ̇
+(Apkarian & Adams 1998 §3.2); with R(θ) it takes θ̇, as Wu et al.'s and LPVTools' do.
 
 Controller reconstruction at any θ: with M = I, N(θ) = I − S(θ) R the linearising change of
 variables (Scherer, Gahinet & Chilali 1997) turns the closed-loop bounded-real inequality
@@ -62,7 +63,9 @@ from ambseal.robust._lpv_lmi import (
     LmiInfeasible,
     SOLVER_KEYS,
     SolverReport,
+    is_constant,
     lmi_blocks,
+    rebalanced,
     scale_grid,
     solve_lmis,
 )
@@ -82,7 +85,8 @@ class LpvController:
 
     ``u = K(θ) y`` in the generalised plant's convention (the lower LFT F_l(P, K),
     positive feedback); θ is whatever the plants were gridded on, in its own unit (an
-    angular velocity in rad/s, a stiffness in N/m, …).
+    angular velocity in rad/s, a stiffness in N/m, …). A controller of a
+    parameter-dependent R also takes θ̇: A_K(θ, θ̇) = AK(θ) + θ̇·AK_rate(θ).
 
     Attributes
     ----------
@@ -90,6 +94,8 @@ class LpvController:
         Table values of θ, where the controller was reconstructed exactly.
     AK, BK, CK, DK : ndarray, shapes (n_t, n_K, n_K), (n_t, n_K, ny), (n_t, nu, n_K), (n_t, nu, ny)
     input_names, output_names : tuple of str
+    AK_rate : ndarray, shape (n_t, n_K, n_K), or None
+        ∂A_K/∂θ̇ (seconds per unit of θ); None when the controller does not take θ̇.
     """
 
     theta: np.ndarray
@@ -99,22 +105,32 @@ class LpvController:
     DK: np.ndarray = field(repr=False)
     input_names: tuple[str, ...] = ()
     output_names: tuple[str, ...] = ()
+    AK_rate: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def order(self) -> int:
         return self.AK.shape[1]
 
-    def matrices(self, theta: float) -> tuple[np.ndarray, ...]:
-        """(A_K, B_K, C_K, D_K) at θ, linear between table values, held at the ends."""
+    @property
+    def takes_rate(self) -> bool:
+        """Whether A_K depends on θ̇ (a parameter-dependent R in :func:`lpvsyn`)."""
+        return self.AK_rate is not None and bool(np.any(self.AK_rate))
 
-        return tuple(interp_table(float(theta), self.theta, X)
-                     for X in (self.AK, self.BK, self.CK, self.DK))
+    def matrices(self, theta: float, theta_dot: float = 0.0) -> tuple[np.ndarray, ...]:
+        """(A_K, B_K, C_K, D_K) at θ and θ̇ (θ's unit per second; it enters only where
+        :attr:`takes_rate`), linear between table values, held at the ends."""
 
-    def at(self, theta: float, *, name: str = "K_lpv"):
-        """The frozen controller at θ as a named ``control.StateSpace`` (the generalised
-        plant's signals and convention)."""
+        A, B, C, D = (interp_table(float(theta), self.theta, X)
+                      for X in (self.AK, self.BK, self.CK, self.DK))
+        if theta_dot and self.takes_rate:
+            A = A + float(theta_dot) * interp_table(float(theta), self.theta, self.AK_rate)
+        return A, B, C, D
 
-        A, B, C, D = self.matrices(theta)
+    def at(self, theta: float, theta_dot: float = 0.0, *, name: str = "K_lpv"):
+        """The frozen controller at θ (and θ̇) as a named ``control.StateSpace`` (the
+        generalised plant's signals and convention)."""
+
+        A, B, C, D = self.matrices(theta, theta_dot)
         return control.ss(A, B, C, D,
                           inputs=list(self.input_names), outputs=list(self.output_names),
                           states=[f"xK{i}" for i in range(A.shape[0])], name=name)
@@ -164,8 +180,9 @@ class LpvSynResult:
         parameter trajectories in the grid range with |θ̇| ≤ ν; ν = ∞ for ``"constant"``).
     gamma_design : float
         Backed-off γ at which R, S and the controllers were computed.
-    lyapunov : str
-        ``"constant"``, ``"affine"`` or ``"quadratic"`` S(θ).
+    lyapunov, lyapunov_r : str or callable
+        The bases of S(θ) and R(θ) as given (``"constant"``, ``"affine"``,
+        ``"quadratic"`` or a user's callable).
     rate_bound : float or None
         ν (θ's unit per second).
     grid : ndarray
@@ -210,7 +227,7 @@ class LpvSynResult:
     K: LpvController
     gamma: float
     gamma_design: float
-    lyapunov: str
+    lyapunov: Any
     rate_bound: float | None
     grid: np.ndarray = field(repr=False)
     check_grid: np.ndarray = field(repr=False)
@@ -224,6 +241,7 @@ class LpvSynResult:
     frozen_best_theta: float = float("nan")
     kind: str = "lpv"
     penalty_share: float = 0.0
+    lyapunov_r: Any = "constant"
 
     def __iter__(self):
         """``K, CL, gamma, info = lpvsyn(...)``: the scheduled controller, θ ↦ the frozen
@@ -237,7 +255,10 @@ class LpvSynResult:
 
     def to_dict(self) -> dict:
         return {"gamma": self.gamma, "gamma_design": self.gamma_design,
-                "lyapunov": self.lyapunov, "rate_bound_rad_s2": self.rate_bound,
+                "lyapunov": _basis_name(self.lyapunov),
+                "lyapunov_r": _basis_name(self.lyapunov_r),
+                "controller_takes_rate": self.K.takes_rate,
+                "rate_bound_rad_s2": self.rate_bound,
                 "grid": self.grid.tolist(), "check_grid": self.check_grid.tolist(),
                 "check_gamma": [float(g) if np.isfinite(g) else None for g in self.check_gamma],
                 "check_gamma_max": float(np.max(self.check_gamma)),
@@ -252,8 +273,8 @@ class LpvSynResult:
 # --------------------------------------------------------------------------- synthesis
 @with_numerics_threads
 def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
-           dA: Sequence[np.ndarray] | None = None, lyapunov: str = "constant",
-           rate_bound: float | None = None, backoff: float = 1.05,
+           dA: Sequence[np.ndarray] | None = None, lyapunov="constant",
+           lyapunov_r="constant", rate_bound: float | None = None, backoff: float = 1.05,
            check_density: int = 5, solver_options: dict | None = None,
            margin: float = 1e-6, scaling: str = "auto", penalty: float = 1e-4,
            coupling_ratio: float = 1.1, centre: bool = False,
@@ -291,11 +312,19 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
     dA : sequence of ndarray (n_p, N, N), optional
         dA/dθ at the grid points (1/s per unit of θ); needed for a rate bound with a
         parameter-dependent S. Default: finite differences of the grid.
-    lyapunov : {"constant", "affine", "quadratic"}
-        S(θ) = S_0, S_0 + p S_1, or S_0 + p S_1 + p² S_2 with
-        p = (θ − θ_mid)/θ_half ∈ [−1, 1]. R is always constant.
+    lyapunov : {"constant", "affine", "quadratic"} or callable
+        The basis of S(θ): S_0, S_0 + p S_1, or S_0 + p S_1 + p² S_2 with
+        p = (θ − θ_mid)/θ_half ∈ [−1, 1]; or a user's basis, a callable
+        θ ↦ (f(θ), df/dθ(θ)) returning two arrays of length n_b (e.g.
+        ``lambda t: ([1, cos t, sin t], [0, -sin t, cos t])``, LPVTools' ``basis``),
+        linearly independent over the grid.
+    lyapunov_r : str or callable
+        The basis of R(θ), as ``lyapunov`` (default ``"constant"``). A parameter-dependent
+        R gives a controller that takes θ̇ (:attr:`LpvController.AK_rate`); with R
+        constant it does not.
     rate_bound : float, optional
-        ν ≥ |θ̇| (θ's unit per second); required for, and only allowed with, a parameter-dependent S.
+        ν ≥ |θ̇| (θ's unit per second); required for, and only allowed with, a
+        parameter-dependent S or R.
     backoff : float
         R, S and controllers are computed at ``backoff·γ`` (≥ 1).
     check_density : int
@@ -342,8 +371,10 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
     ------
     SynthesisError
         One grid point, a grid not increasing, plants that differ in B, C or D, D22 ≠ 0,
-        an unknown ``lyapunov``, a rate bound with ``"constant"`` (or none with a
-        parameter-dependent S), an unknown key in ``solver_options``, infeasible LMIs, a
+        an unknown ``lyapunov`` or ``lyapunov_r`` (or a basis whose values are not two
+        finite arrays of one length, or dependent over the grid), a rate bound with both
+        constant (or none with a parameter-dependent S or R), an unknown key in
+        ``solver_options``, infeasible LMIs, a
         solver status other than ``optimal``, or a reconstructed frozen closed loop that is
         unstable.
 
@@ -358,7 +389,7 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
 
     t_start = time.perf_counter()
     grid, As, dAs, B, C, D, nw, nz = _validate(plants, theta, nmeas, ncon, dA,
-                                               lyapunov, rate_bound, backoff,
+                                               (lyapunov, lyapunov_r), rate_bound, backoff,
                                                coupling_ratio, penalty)
     unknown = sorted(set(solver_options or {}) - set(SOLVER_KEYS))
     if unknown:
@@ -369,7 +400,8 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
                              "'diagonal'")
     solver_options = {**DEFAULT_TOL, **(solver_options or {})}
     data = (plants, grid, As, dAs, B, C, D, nw, nz, nmeas, ncon)
-    settings = dict(lyapunov=lyapunov, rate_bound=rate_bound, backoff=backoff,
+    settings = dict(lyapunov=lyapunov, lyapunov_r=lyapunov_r, rate_bound=rate_bound,
+                    backoff=backoff,
                     check_density=check_density, solver_options=solver_options,
                     margin=margin, penalty=penalty, coupling_ratio=coupling_ratio,
                     centre=centre)
@@ -429,42 +461,64 @@ def _against_frozen(r: LpvSynResult, data, solver_options, margin) -> LpvSynResu
                    closed_loop=CL, kind="frozen")
 
 
-def _synthesise(data, scaling: str, *, lyapunov, rate_bound, backoff, check_density,
-                solver_options, margin, penalty, coupling_ratio, centre) -> LpvSynResult:
+def _synthesise(data, scaling: str, *, lyapunov, lyapunov_r, rate_bound, backoff,
+                check_density, solver_options, margin, penalty, coupling_ratio,
+                centre) -> LpvSynResult:
     """Stages 1–3 of :func:`lpvsyn` with one state scaling; SynthesisError as there."""
     plants, grid, As, dAs, B, C, D, nw, nz, nmeas, ncon = data
     sc = scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling)
-    blocks = lmi_blocks(sc, nw, nz, ncon, nmeas)
     nu_s = 0.0 if rate_bound is None else float(rate_bound) / sc.w0 * sc.dp_dtheta  # dp/dt'
-    gamma, gamma_d, R, S, reports, share = solve_lmis(
-        sc, blocks, grid, lyapunov, nu_s, backoff=backoff, margin=margin, penalty=penalty,
-        coupling_ratio=coupling_ratio, centre=centre, solver_options=solver_options)
+    lmi_kw = dict(backoff=backoff, margin=margin, penalty=penalty,
+                  coupling_ratio=coupling_ratio, centre=centre,
+                  solver_options=solver_options, lyapunov_r=lyapunov_r)
+    blocks = lmi_blocks(sc, nw, nz, ncon, nmeas)
+    gamma, gamma_d, R, S, reports, share = solve_lmis(sc, blocks, grid, lyapunov, nu_s,
+                                                      **lmi_kw)
+    if share > PENALTY_SHARE:  # γ held up by the trace term: R and S of one size, again
+        sc2 = rebalanced(sc, R, S, grid, lyapunov, lyapunov_r)
+        blocks2 = lmi_blocks(sc2, nw, nz, ncon, nmeas)
+        try:
+            again = solve_lmis(sc2, blocks2, grid, lyapunov, nu_s, **lmi_kw)
+        except SynthesisError:
+            again = None
+        if again is not None and again[0] < gamma:
+            sc, blocks = sc2, blocks2
+            gamma, gamma_d, R, S, more, share = again
+            reports = reports + more
 
     # controller table on the check grid
     dens = max(int(check_density), 1)
     table = np.concatenate([np.linspace(grid[j], grid[j + 1], dens + 1)[:-1]
                             for j in range(grid.size - 1)] + [grid[-1:]])
     A_of = interp_A(As, dAs, grid)
-    *mats, rep = reconstruct_table(sc, blocks, table, A_of, R, S, lyapunov, nu_s,
-                                   gamma_d * 1.02, margin)
+    AK, AK_rate, BK, CK, DK, rep = reconstruct_table(sc, blocks, table, A_of, R, S, lyapunov,
+                                                     nu_s, gamma_d * 1.02, margin,
+                                                     lyapunov_r)
     reports.append(rep)
     in_names = tuple(list(getattr(plants[0], "output_labels", []))[nz:]) or \
         tuple(f"y{i}" for i in range(nmeas))
     out_names = tuple(list(getattr(plants[0], "input_labels", []))[nw:]) or \
         tuple(f"u{i}" for i in range(ncon))
-    K = LpvController(table, *mats, in_names, out_names)
+    K = LpvController(table, AK, BK, CK, DK, in_names, out_names,
+                      None if is_constant(lyapunov_r) else AK_rate)
     check_g = _check_table(K, A_of, B, C, D, nmeas, ncon)
     names = (list(getattr(plants[0], "input_labels", []))[:nw],
              list(getattr(plants[0], "output_labels", []))[:nz])
     CL = FrozenClosedLoop(grid, As, dAs, B, C, D, K, nmeas, ncon, *map(tuple, names))
     return LpvSynResult(K=K, gamma=gamma, gamma_design=gamma_d, lyapunov=lyapunov,
+                        lyapunov_r=lyapunov_r,
                         rate_bound=None if rate_bound is None else float(rate_bound),
                         grid=grid, check_grid=table, check_gamma=check_g,
                         check_stable=True, reports=tuple(reports), closed_loop=CL,
                         scaling=scaling, penalty_share=share)
 
 
-def _validate(plants, theta, nmeas, ncon, dA, lyapunov, rate_bound, backoff,
+def _basis_name(kind) -> str:
+    """A Lyapunov basis for JSON: its name, or a user's callable's."""
+    return kind if isinstance(kind, str) else f"user: {getattr(kind, '__name__', 'basis')}"
+
+
+def _validate(plants, theta, nmeas, ncon, dA, bases, rate_bound, backoff,
               coupling_ratio, penalty):
     """Checked grid and plant data of :func:`lpvsyn`: (grid, A stack, dA stack, B, C, D,
     n_w, n_z); raises SynthesisError as documented there."""
@@ -474,7 +528,9 @@ def _validate(plants, theta, nmeas, ncon, dA, lyapunov, rate_bound, backoff,
                              f"each; got {grid.size} values and {len(plants)} plants")
     if np.any(np.diff(grid) <= 0) or not np.all(np.isfinite(grid)):
         raise SynthesisError("lpvsyn: theta must be finite and strictly increasing")
-    _validate_settings(lyapunov, rate_bound, backoff, coupling_ratio, penalty)
+    for name, kind in zip(("lyapunov", "lyapunov_r"), bases):
+        _validate_basis(name, kind, grid)
+    _validate_settings(bases, rate_bound, backoff, coupling_ratio, penalty)
     As = np.array([np.asarray(P.A, float) for P in plants])
     B = np.asarray(plants[0].B, float)
     C = np.asarray(plants[0].C, float)
@@ -501,19 +557,53 @@ def _validate(plants, theta, nmeas, ncon, dA, lyapunov, rate_bound, backoff,
     return grid, As, dAs, B, C, D, nw, nz
 
 
-def _validate_settings(lyapunov, rate_bound, backoff, coupling_ratio, penalty) -> None:
+def _validate_basis(name: str, kind, grid: np.ndarray) -> None:
+    """A Lyapunov basis of :func:`lpvsyn`: a name of ``BASES``, or a callable whose values
+    on the grid are two finite arrays of one length, linearly independent over the grid."""
+    if isinstance(kind, str):
+        if kind not in BASES:
+            raise SynthesisError(f"lpvsyn: {name}={kind!r}; expected one of {sorted(BASES)} "
+                                 "or a callable θ ↦ (f(θ), df/dθ(θ))")
+        return
+    if not callable(kind):
+        raise SynthesisError(f"lpvsyn: {name}={kind!r}; expected one of {sorted(BASES)} or a "
+                             "callable θ ↦ (f(θ), df/dθ(θ))")
+    rows = []
+    for th in grid:
+        try:
+            f, df = (np.asarray(v, float).ravel() for v in kind(float(th)))
+        except (TypeError, ValueError) as exc:
+            raise SynthesisError(f"lpvsyn: {name} at θ = {th:g} did not return two arrays "
+                                 f"(f, df/dθ): {exc}") from None
+        if f.size == 0 or f.shape != df.shape or not np.all(np.isfinite(f)) \
+                or not np.all(np.isfinite(df)):
+            raise SynthesisError(f"lpvsyn: {name} at θ = {th:g} gave f of shape {f.shape} "
+                                 f"and df/dθ of shape {df.shape}; expected two finite arrays "
+                                 "of one length")
+        if rows and f.size != rows[0].size:
+            raise SynthesisError(f"lpvsyn: {name} has {f.size} functions at θ = {th:g} and "
+                                 f"{rows[0].size} at θ = {grid[0]:g}")
+        rows.append(f)
+    F = np.array(rows)
+    if np.linalg.matrix_rank(F) < F.shape[1]:
+        raise SynthesisError(f"lpvsyn: {name}'s {F.shape[1]} functions are linearly dependent "
+                             f"on the grid (rank {np.linalg.matrix_rank(F)}); the LMIs "
+                             "would not determine their matrices")
+
+
+def _validate_settings(bases, rate_bound, backoff, coupling_ratio, penalty) -> None:
     """:func:`lpvsyn`'s settings; raises SynthesisError as documented there."""
-    if lyapunov not in BASES:
-        raise SynthesisError(f"lpvsyn: lyapunov={lyapunov!r}; expected one of {sorted(BASES)}")
-    if lyapunov == "constant" and rate_bound is not None:
+    dependent = not all(is_constant(kind) for kind in bases)
+    if not dependent and rate_bound is not None:
         raise SynthesisError(
             "lpvsyn: a rate bound needs a parameter-dependent Lyapunov function "
-            "(lyapunov='affine' or 'quadratic'); a constant one already allows arbitrarily "
-            "fast parameter changes")
-    if lyapunov != "constant" and (rate_bound is None or not np.isfinite(rate_bound)
-                                   or rate_bound < 0):
-        raise SynthesisError(f"lpvsyn: lyapunov={lyapunov!r} needs a finite rate_bound ≥ 0 "
-                             f"(θ's unit per second), got {rate_bound!r}")
+            "(lyapunov or lyapunov_r 'affine', 'quadratic' or a basis); constant ones "
+            "already allow arbitrarily fast parameter changes")
+    if dependent and (rate_bound is None or not np.isfinite(rate_bound) or rate_bound < 0):
+        raise SynthesisError(f"lpvsyn: a parameter-dependent Lyapunov function "
+                             f"(lyapunov={_basis_name(bases[0])!r}, "
+                             f"lyapunov_r={_basis_name(bases[1])!r}) needs a finite "
+                             f"rate_bound ≥ 0 (θ's unit per second), got {rate_bound!r}")
     if backoff < 1.0:
         raise SynthesisError(f"lpvsyn: backoff={backoff} must be ≥ 1")
     if not coupling_ratio > 1.0:

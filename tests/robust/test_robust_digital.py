@@ -407,3 +407,26 @@ def test_scheduled_c_interpolates_like_python(turbo_digital, tmp_path):
     files = write_c(sd, tmp_path / "c", "amb_lpv")
     got = _compile_and_run(tmp_path, files, "amb_lpv", y, "double", speeds=speeds)
     assert np.max(np.abs(got - ref)) < 1e-9 * np.max(np.abs(ref))
+
+
+def test_sampled_plants_responses_are_those_of_their_state_spaces():
+    """Reference: dense solves of each state space ``sampled_plants`` returns — the plant
+    with the Padé lag before every input at jω, the ZOH plant at e^{jωT} — on a two-input,
+    lightly damped plant whose modes straddle Nyquist."""
+    from ambseal.robust.digital import sampled_plants
+
+    rng = np.random.default_rng(3)
+    A = np.zeros((8, 8))
+    for i, (wn, zeta) in enumerate(((2 * np.pi * 80, 0.02), (2 * np.pi * 900, 0.01),
+                                    (2 * np.pi * 3100, 0.005), (2 * np.pi * 12000, 0.002))):
+        A[2 * i:2 * i + 2, 2 * i:2 * i + 2] = [[0.0, 1.0], [-wn**2, -2 * zeta * wn]]
+    B, C = rng.standard_normal((8, 2)), rng.standard_normal((2, 8))
+    fs = 5000.0
+    sp = sampled_plants([(A, B, C, np.zeros((2, 2)))], fs, n_grid=60)
+    w, T = sp.omega_rad_s, 1.0 / fs
+    for (Ag, Bg, Cg, Dg), H, pts in ((sp.plants[0], sp.continuous_response[0], 1j * w),
+                                     (sp.sampled[0], sp.sampled_response[0],
+                                      np.exp(1j * w * T))):
+        n = Ag.shape[0]
+        ref = np.array([Cg @ np.linalg.solve(p * np.eye(n) - Ag, Bg) + Dg for p in pts])
+        assert np.max(np.abs(H - ref)) <= 1e-9 * np.max(np.abs(ref))

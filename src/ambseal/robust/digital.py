@@ -54,7 +54,7 @@ from scipy.signal import cont2discrete
 
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.lti.discrete import zoh
-from ambseal.lti.freqresp import freqresp_at
+from ambseal.lti.freqresp import freqresp_at, sampled_response_at
 from ambseal.lti.interconnect import feedback_poles, series_inputs
 from ambseal.lti.json_safe import finite_or_none_tree
 from ambseal.robust._digital_choice import first_stable as _first_stable
@@ -409,11 +409,12 @@ class SampledPlants:
 def sampled_plants(plants: Sequence[Matrices], fs: float, n_grid: int = 400, *,
                    delay_samples: int = 1) -> SampledPlants:
     """:class:`SampledPlants` of continuous ``(A, B, C, D)`` plants at ``fs`` (Hz):
-    :func:`ambseal.lti.discrete.zoh` and :func:`ambseal.lti.freqresp.freqresp_at` at
-    ``jω`` and ``e^{jωT}`` on ``n_grid`` log-spaced frequencies from 1 Hz to Nyquist (the
-    sampled plant's modal form checked at rtol 1e-6);
-    the continuous plants with the Padé lag of ``delay_samples`` + ½ samples
-    (:func:`ambseal.robust.delay.loop_delay`)."""
+    :func:`ambseal.lti.discrete.zoh`, and the responses on ``n_grid`` log-spaced
+    frequencies from 1 Hz to Nyquist — at ``jω`` the plant's (:func:`freqresp_at`) times
+    the Padé lag's of ``delay_samples`` + ½ samples
+    (:func:`ambseal.robust.delay.loop_delay`), at ``e^{jωT}`` the sampled plant's from
+    the continuous plant's modal form (:func:`ambseal.lti.freqresp.sampled_response_at`,
+    checked at rtol 1e-6) — and the continuous plants with that lag before every input."""
 
     T = 1.0 / fs
     w = 2 * np.pi * np.logspace(0, np.log10(0.999 * fs / 2), n_grid)
@@ -421,9 +422,12 @@ def sampled_plants(plants: Sequence[Matrices], fs: float, n_grid: int = 400, *,
     L = loop_delay(fs, delay_samples).system
     L = tuple(np.asarray(getattr(L, m), float) for m in ("A", "B", "C", "D"))
     delayed = [series_inputs(tuple(np.asarray(X, float) for X in G), L)[:4] for G in plants]
+    # the lag is one SISO block before every input: the delayed plant's response is the
+    # plant's times the lag's, and the sampled plant's comes from the plant's modal form
+    lag = freqresp_at(L, 1j * w)[:, :1, :1]
     return SampledPlants(delayed, sampled, float(fs), w,
-                         [freqresp_at(G, 1j * w) for G in delayed],
-                         [freqresp_at(G, np.exp(1j * w * T), rtol=1e-6) for G in sampled],
+                         [freqresp_at(G, 1j * w) * lag for G in plants],
+                         [sampled_response_at(G, T, w) for G in plants],
                          list(plants))
 
 

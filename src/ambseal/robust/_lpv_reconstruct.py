@@ -166,23 +166,16 @@ class _Reconstructor:
         self.F_c = C1.T @ D11 / g
         self.H = D12.T @ self.Phi_i @ D12
         self.H2 = D21 @ self.Psi_i @ D21.T
-        self._c_side = (None, None)
 
     def _holds(self, Q: np.ndarray) -> bool:
         return bool(np.linalg.eigvalsh(_sym(Q)).max() < -self.margin)
 
     def c_side(self, R):
-        """(Ĉ*, L0 − G H⁻¹ Gᵀ without the θ-dependent A R + R Aᵀ) for R; the last one
-        kept (a constant R is solved once)."""
-        last, value = self._c_side
-        if last is not None and (last is R or np.array_equal(last, R)):
-            return value
+        """(Ĉ*, L0 − G H⁻¹ Gᵀ without the θ-dependent A R + R Aᵀ) for R."""
         E = self.C1 @ R + self.D11 @ self.B1.T / self.g
         G = self.B2 + E.T @ self.Phi_i @ self.D12
         Ch = -np.linalg.solve(self.H, G.T)
-        QC = self.B1 @ self.B1.T / self.g + E.T @ self.Phi_i @ E + G @ Ch
-        self._c_side = (R, (Ch, QC))
-        return Ch, QC
+        return Ch, self.B1 @ self.B1.T / self.g + E.T @ self.Phi_i @ E + G @ Ch
 
     def __call__(self, A, R, dR, S, dS, nu_s):
         """(A_K, A_K per dp/dt', B_K, C_K, whether both LMIs hold) at one θ (scaled

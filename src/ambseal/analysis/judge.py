@@ -452,9 +452,10 @@ def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, im
     w = resolved_grid(w, loop.s_poles)  # a 0.5 %-damped bending mode must not slip through
     wu = resolved_grid(2 * np.pi * np.linspace(*s.unbalance_range_hz, 400), loop.s_poles)
     # the plant (currents and force share its A) and the controller evaluated once, on both
-    # grids: one eigendecomposition each instead of one per loop function
-    pts, kw = response_points(np.concatenate([w, wu]), dt)
-    Pw, Kw = freqresp_at(P, pts, **kw), freqresp_at(controller, pts)
+    # grids: from the continuous plant's modal form, shared by every controller judged there
+    ww = np.concatenate([w, wu])
+    pts, _ = response_points(ww, dt)  # (refuses a grid above Nyquist)
+    Pw, Kw = judged.plant_response(ww), freqresp_at(controller, pts)
     Gw, Gfw = Pw[:, :, cur], Pw[:, :, force]
     ny_names, nu_names, f_names = G.output_labels, G.input_labels, Gf.input_labels
     resp = loop_responses_from(Gw[:w.size], Kw[:w.size], w, ny_names, nu_names)

@@ -279,7 +279,7 @@ def impulse_response_of(
     C = np.asarray(sys.C, dtype=float)
     D = np.asarray(sys.D, dtype=float)[:, :nu]
     # exact for the piecewise-constant pulse: the ZOH equivalent of its single input column
-    Ad, bd = (A, b[:, None]) if loop.dt else zoh(A, b[:, None], dt_s)
+    Ad, bd = (A, b[:, None]) if loop.dt else zoh(A, b[:, None], dt_s, keep=False)
     t = np.arange(n_end + 1) * dt_s
     pulse = np.zeros((n_end + 1, 1))
     pulse[k0:k1] = 1.0

@@ -32,7 +32,8 @@ _METHODS = ("tustin", "zoh")
 _ZOH = ArrayMemo()  # the last large (A, B, dt) sampled
 
 
-def zoh(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
+def zoh(A: np.ndarray, B: np.ndarray, dt: float, *, keep: bool = True
+        ) -> tuple[np.ndarray, np.ndarray]:
     """Exact zero-order-hold discretisation ``(e^{A dt}, ∫₀^dt e^{Aτ} dτ B)``.
 
     Parameters
@@ -43,6 +44,9 @@ def zoh(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray
         Continuous input matrix (state unit per input unit and second).
     dt : float
         Sample time (s), > 0.
+    keep : bool
+        Keep the result for the next call with the same arrays (set False for a system
+        sampled once, e.g. a closed loop simulated once: it would push a plant out).
 
     Returns
     -------
@@ -58,6 +62,8 @@ def zoh(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray
     the last few large ``(A, B, dt)`` is kept (:class:`~ambseal.lti.matrices.ArrayMemo`):
     a large plant is sampled once for every controller closed with it.
     """
+    if not keep:
+        return _zoh(A, B, dt)
     Ad, Bd = _ZOH.get((np.asarray(A, float), np.asarray(B, float)), float(dt),
                       lambda: _zoh(A, B, dt))
     return Ad.copy(), Bd.copy()

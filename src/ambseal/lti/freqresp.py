@@ -56,6 +56,12 @@ _MODAL = ArrayMemo()  # (λ, V, cond V, V⁻¹B, CV) of the last large (A, B, C)
 #: then checks it against the Hessenberg form or the dense solves at the probes.
 _SVD_COND_STATES = 1000
 _BALANCED = ArrayMemo()  # the same of the balanced system (:func:`_arbitrated`)
+#: (λ, cond V, LU of V, CV, balancing) of the last large (A, C), balanced or not: one
+#: eigendecomposition per plant whatever its inputs (the LU of V is n² complex numbers,
+#: 57 MB at 1 888 states; a loop is judged with a few plants at once). Smaller systems
+#: are kept by (A, B, C) in _MODAL and _BALANCED only.
+_EIG = ArrayMemo(keep=6, min_states=500)
+_PROBED = ArrayMemo(keep=64)  # C (sI − A)⁻¹ B + D at single probes s of large (A, B, C)
 #: Spread (largest over smallest) of the diagonal balancing of ``A`` above which
 #: ``"auto"`` tries the balanced modal form first, checked against dense solves at the
 #: probes (:func:`_balanced_modal`): entries over that many decades are an FE plant's
@@ -215,8 +221,8 @@ def sampled_response_at(sys: Any, dt: float, omega: Any, *, max_cond: float = 1e
     if n == 0:
         return freqresp_at((Ad, Bd, C, D), z)
     probe = _probes(z)
-    Hd = _dense_response(Ad, Bd, C, D, probe)
-    forms = ((_BALANCED, True), (_MODAL, False)) if n > _SVD_COND_STATES else \
+    Hd = _probe_response(Ad, Bd, C, D, probe)
+    forms = ((_BALANCED, True), (_MODAL, False)) if _balanced_first(A) else \
         ((_MODAL, False), (_BALANCED, True))
     for memo, balance in forms:
         lam, _, Bm, Cm = memo.get((A, B, C), max_cond,
@@ -244,9 +250,9 @@ def _response(A, B, C, D, s, method, max_cond, rtol) -> np.ndarray:
         H = _balanced_modal_checked(A, B, C, D, s, max_cond, rtol)  # large: balanced first
         if H is not None:
             return H
-    elif method == "auto" and _badly_scaled(A):
+    elif method == "auto" and _balanced_first(A):
         probe = _probes(s)
-        H = _balanced_modal(A, B, C, D, s, probe, _dense_response(A, B, C, D, probe),
+        H = _balanced_modal(A, B, C, D, s, probe, _probe_response(A, B, C, D, probe),
                             max_cond, rtol)
         if H is not None:
             return H
@@ -304,7 +310,7 @@ def _arbitrated(A, B, C, D, s, probe, Hh, Hm, modal, max_cond, rtol) -> np.ndarr
     it loses every digit at low frequency, and the modal form can lose them too (dkpy's
     22-state controller there: error 11 on σ̄ 180, the dense solves agree with
     python-control's TB05AD to 4e-6 relative)."""
-    Hd = _dense_response(A, B, C, D, probe)
+    Hd = _probe_response(A, B, C, D, probe)
     H = _balanced_modal(A, B, C, D, s, probe, Hd, max_cond, rtol)
     if H is not None:
         return H
@@ -316,9 +322,13 @@ def _arbitrated(A, B, C, D, s, probe, Hh, Hm, modal, max_cond, rtol) -> np.ndarr
     return _dense_response(A, B, C, D, s)
 
 
-def _badly_scaled(A: np.ndarray) -> bool:
-    """Whether the diagonal balancing of ``A`` spreads over more than
-    :data:`_SPREAD_BALANCED_FIRST` (O(n²); only for the models :class:`ArrayMemo` keeps)."""
+def _balanced_first(A: np.ndarray) -> bool:
+    """Whether the balanced system's modal form is tried first: above
+    ``_SVD_COND_STATES`` states, or where the diagonal balancing of ``A`` spreads over more
+    than :data:`_SPREAD_BALANCED_FIRST` (O(n²); only for the models :class:`ArrayMemo`
+    keeps)."""
+    if A.shape[0] > _SVD_COND_STATES:
+        return True
     if A.shape[0] < _MODAL.min_states:
         return False
     _, (sc, _) = scipy.linalg.matrix_balance(A, permute=False, separate=True)
@@ -326,8 +336,24 @@ def _badly_scaled(A: np.ndarray) -> bool:
 
 
 def _probes(s: np.ndarray) -> np.ndarray:
-    """The three probe points of ``s`` (first, middle, last) at which the forms are checked."""
-    return s[np.unique([0, s.size // 2, s.size - 1])]
+    """The probe points of ``s`` at which the forms are checked: the first, the last and
+    one between. On the imaginary axis (``jω``) or the unit circle (``e^{jωT}``) the one
+    between is at the geometric mean of the ends' frequencies, on the grid or not, so that
+    grids with the same ends (one plant's responses on grids refined around different
+    loops' poles) share their probes (:data:`_PROBED`); elsewhere the middle point."""
+    ends = s[np.unique([0, s.size - 1])]
+    if s.size < 3:
+        return ends
+    a, b = s[0], s[-1]
+    with np.errstate(all="ignore"):
+        if np.all(s.real == 0) and a.imag > 0 and b.imag > 0:
+            mid = 1j * np.sqrt(a.imag * b.imag)
+        elif np.allclose(np.abs(s), 1.0, rtol=0, atol=1e-12) and np.angle(a) > 0 \
+                and np.angle(b) > 0:
+            mid = np.exp(1j * np.sqrt(np.angle(a) * np.angle(b)))
+        else:
+            mid = s[s.size // 2]
+    return np.array([a, mid, b])
 
 
 def _error(H: np.ndarray, Hd: np.ndarray) -> float:
@@ -367,7 +393,7 @@ def _balanced_modal_checked(A, B, C, D, s, max_cond, rtol) -> np.ndarray | None:
     elements), so trying ``A``'s own eigenvectors first cost an eig of the whole model for
     nothing (18 s at 3 248 states)."""
     probe = _probes(s)
-    Hd = _dense_response(A, B, C, D, probe)
+    Hd = _probe_response(A, B, C, D, probe)
     H = _balanced_modal(A, B, C, D, s, probe, Hd, max_cond, rtol)
     return H if H is not None else _balanced_modal_as_good(A, B, C, D, s, probe, Hd, max_cond)
 
@@ -400,6 +426,16 @@ def _balanced_modal_as_good(A, B, C, D, s, probe, Hd, max_cond) -> np.ndarray | 
     return _modal_eval(lam, Bb, Cb, D, s)
 
 
+def _probe_response(A, B, C, D, probe) -> np.ndarray:
+    """:func:`_dense_response` at the probe points, each kept for the last large systems
+    (:data:`_PROBED`): the grids of one plant's responses share their ends."""
+    out = np.empty((probe.size, C.shape[0], B.shape[1]), dtype=complex)
+    for k, p in enumerate(probe):
+        out[k] = _PROBED.get((A, B, C, D), complex(p),
+                             lambda p=p: _dense_response(A, B, C, D, np.array([p]))[0])
+    return out
+
+
 def _dense_response(A, B, C, D, s) -> np.ndarray:
     """``C (sI − A)⁻¹ B + D`` by one LU solve per point (stacked); ``nan`` where singular."""
     n = A.shape[0]
@@ -423,23 +459,36 @@ def _dense_response(A, B, C, D, s) -> np.ndarray:
 def _modal_form(A, B, C, max_cond, balance: bool = False):
     """(λ, cond V, V⁻¹B, CV) of ``A = V diag(λ) V⁻¹``; ``V⁻¹B``, ``CV`` None when
     ``cond V > max_cond`` (not used then). ``balance``: of the system balanced first
-    (``A, B, C`` → ``T⁻¹AT, T⁻¹B, CT`` with ``T`` diagonal, as for the Hessenberg form)."""
+    (``A, B, C`` → ``T⁻¹AT, T⁻¹B, CT`` with ``T`` diagonal, as for the Hessenberg form).
+    The eigendecomposition (λ, the LU of V, CV) is kept for the last large ``(A, C)``
+    (:data:`_EIG`): the plant with its current inputs and with its force inputs too shares
+    one."""
+    lam, cond, lu, Cm, sc = _EIG.get((A, C), (max_cond, balance),
+                                     lambda: _eig_form(A, C, max_cond, balance))
+    if lu is None:
+        return lam, cond, None, None
+    B = B / sc[:, None] if balance else B
+    return lam, cond, scipy.linalg.lu_solve(lu, B.astype(lu[0].dtype), check_finite=False), Cm
+
+
+def _eig_form(A, C, max_cond, balance):
+    """(λ, cond V, LU of V, CV, balancing scale) of :func:`_modal_form`; the LU and CV
+    None when ``cond V > max_cond``."""
+    sc = np.ones(A.shape[0])
     if balance:
         A, (sc, _) = scipy.linalg.matrix_balance(A, permute=False, separate=True)
-        B, C = B / sc[:, None], C * sc
-    lam, V = scipy.linalg.eig(A)
-    if V.shape[0] <= _SVD_COND_STATES:
-        cond = np.linalg.cond(V)
-        if not np.isfinite(cond) or cond > max_cond:
-            return lam, cond, None, None
-        return lam, cond, scipy.linalg.solve(V, B.astype(complex)), C @ V
-    lu = scipy.linalg.lu_factor(V, check_finite=False)
-    gecon, = scipy.linalg.get_lapack_funcs(("gecon",), (lu[0],))
-    rcond, info = gecon(lu[0], np.linalg.norm(V, 1), norm="1")
-    cond = 1.0 / rcond if info == 0 and rcond > 0 else np.inf
+        C = C * sc
+    lam, V = scipy.linalg.eig(A, overwrite_a=balance)  # (the balanced A is a copy)
+    Cm, norm = C @ V, np.linalg.norm(V, 1)
+    cond = np.linalg.cond(V) if V.shape[0] <= _SVD_COND_STATES else None
+    lu = scipy.linalg.lu_factor(V, overwrite_a=True, check_finite=False)  # V not kept
+    if cond is None:
+        gecon, = scipy.linalg.get_lapack_funcs(("gecon",), (lu[0],))
+        rcond, info = gecon(lu[0], norm, norm="1")
+        cond = 1.0 / rcond if info == 0 and rcond > 0 else np.inf
     if not np.isfinite(cond) or cond > max_cond:
-        return lam, cond, None, None
-    return lam, cond, scipy.linalg.lu_solve(lu, B.astype(V.dtype), check_finite=False), C @ V
+        return lam, cond, None, None, sc
+    return lam, cond, lu, Cm, sc
 
 
 def _modal_eval(lam: np.ndarray, Bm: np.ndarray, Cm: np.ndarray, D: np.ndarray, s: np.ndarray) -> np.ndarray:

@@ -165,7 +165,9 @@ def feedback_matrices(G: Matrices, K: Matrices, Gf: tuple[np.ndarray, np.ndarray
     return lft_lower_matrices((A, BP, CP, DP), (Ak, Bk, -Ck, -Dk), ny, nu)
 
 
-_POLES = ArrayMemo(keep=16)  # the last closed-loop state matrices decomposed
+# the last closed-loop state matrices decomposed: a design's loops at every judged condition,
+# continuous and sampled, are closed again by the judgement (eigenvalues only: small)
+_POLES = ArrayMemo(keep=64)
 
 
 def state_poles(A: np.ndarray) -> np.ndarray:

@@ -26,6 +26,7 @@ import numpy as np
 
 from ambseal.errors import ModelError
 from ambseal.lti.discrete import zoh
+from ambseal.lti.freqresp import freqresp_at, sampled_response_at
 from ambseal.lti.interconnect import feedback_matrices, series_inputs, state_poles, wired
 from ambseal.lti.json_safe import json_float, json_list
 from ambseal.lti.matrices import labels, ss_matrices
@@ -206,15 +207,55 @@ class JudgedLoop:
     loop : ClosedLoop
         The closed loop (control inputs closed, the other inputs external); its
         ``stable`` is the verdict.
+    source : control.StateSpace
+        The continuous plant ``plant`` was made from.
+    delay : control.StateSpace or None
+        The lag in front of the control inputs of a continuous ``plant``.
+    control_inputs : tuple of int
+        The inputs of ``plant`` the controller drives.
     """
 
     plant: Any
     loop: ClosedLoop
+    source: Any
+    delay: Any
+    control_inputs: tuple
 
     @property
     def stable(self) -> bool:
         """The verdict (:func:`ambseal.robust.stability.is_stable` on the loop's poles)."""
         return self.loop.stable
+
+    def plant_response(self, w: np.ndarray) -> np.ndarray:
+        """``plant``'s frequency response at ``w`` (rad/s; at ``e^{jω dt}`` for a sampled
+        plant), from the modal form of the continuous plant it was made from: the delayed
+        plant's is the plant's times the lag's on the control inputs, the sampled plant's
+        :func:`ambseal.lti.freqresp.sampled_response_at` — no eigendecomposition of the
+        delayed or sampled plant.
+
+        Parameters
+        ----------
+        w : ndarray, shape (n_w,)
+            Angular frequencies (rad/s), at most Nyquist for a sampled plant.
+
+        Returns
+        -------
+        ndarray of complex, shape (n_w, ny, nu)
+            Outputs per input of ``plant`` (all its inputs, in its order).
+        """
+        dt = sample_time(self.plant)
+        if dt:  # per input group, as sampled_plant samples them
+            P, cur = self.source, list(self.control_inputs)
+            H = np.empty((w.size, P.noutputs, P.ninputs), dtype=complex)
+            for group in (cur, [j for j in range(P.ninputs) if j not in cur]):
+                if group:
+                    H[:, :, group] = sampled_response_at(_select(P, group), dt, w)
+            return H
+        H = freqresp_at(self.source, 1j * w)
+        if self.delay is not None:
+            cur = list(self.control_inputs)
+            H[:, :, cur] *= freqresp_at(self.delay, 1j * w)[:, :1, :1]
+        return H
 
 
 def delayed_plant(P, inputs, delay):
@@ -228,12 +269,21 @@ def delayed_plant(P, inputs, delay):
     return control.ss(A, B, C, D, inputs=list(P.input_labels), outputs=list(P.output_labels))
 
 
-def sampled_plant(P, dt: float):
+def sampled_plant(P, dt: float, inputs=None):
     """The plant ``P`` sampled exactly with a zero-order hold at ``dt`` (s): inputs held
     over each sample, outputs read at the samples (:func:`ambseal.lti.discrete.zoh`),
-    signal names kept."""
+    signal names kept. ``inputs`` (indices; default all) are sampled together and give
+    ``A_d``, the others apart: the controller's loop then has the state matrix of the
+    plant sampled with its control inputs alone, as the discretisation chosen for it
+    (:func:`ambseal.robust.digital.sampled_plants`), and their poles are computed once."""
 
-    Ad, Bd = zoh(np.asarray(P.A, float), np.asarray(P.B, float), dt)
+    A, B = np.asarray(P.A, float), np.asarray(P.B, float)
+    cur = list(range(B.shape[1])) if inputs is None else list(inputs)
+    rest = [j for j in range(B.shape[1]) if j not in cur]
+    Bd = np.empty_like(B)
+    Ad, Bd[:, cur] = zoh(A, B[:, cur], dt)
+    if rest:
+        Bd[:, rest] = zoh(A, B[:, rest], dt)[1]
     return control.ss(Ad, Bd, np.asarray(P.C, float), np.asarray(P.D, float), dt,
                       inputs=list(P.input_labels), outputs=list(P.output_labels))
 
@@ -283,11 +333,11 @@ def judged_loop(P, K, control_inputs=None, *, delay=None) -> JudgedLoop:
     rest = [j for j in range(P.ninputs) if j not in cur]
     dt = sample_time(K)
     if dt:
-        Pj = sampled_plant(P, dt)
+        Pj = sampled_plant(P, dt, cur)
     elif delay is not None:
         Pj = delayed_plant(P, cur, delay)
     else:
         Pj = P
     G = _select(Pj, cur)
     Gf = _select(Pj, rest) if rest else None
-    return JudgedLoop(Pj, closed_loop(G, K, Gf))
+    return JudgedLoop(Pj, closed_loop(G, K, Gf), P, None if dt else delay, tuple(cur))

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ambseal.lti.interconnect import feedback_matrices
+from ambseal.lti.interconnect import feedback_poles
 
 Matrices = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
@@ -22,8 +22,10 @@ def so_peak(Gw: np.ndarray, Kw: np.ndarray) -> float:
 
 
 def max_abs_z(Gd: Matrices, Kd: Matrices) -> float:
-    """Largest |z| of the sampled loop of ``Gd`` and ``Kd`` (numpy's eigenvalues)."""
-    return float(np.abs(np.linalg.eigvals(feedback_matrices(Gd, Kd)[0])).max())
+    """Largest |z| of the sampled loop of ``Gd`` and ``Kd``
+    (:func:`~ambseal.lti.interconnect.feedback_poles`: kept for the judgement of the same
+    loop)."""
+    return float(np.abs(feedback_poles(Gd, Kd)).max())
 
 
 def first_stable(cands: list, Kd: dict, sampled: list, cont_stable: list) -> dict | None:

@@ -60,6 +60,10 @@ def _documented(obj) -> set[str]:
 
 
 def _signature(obj) -> set[str]:
+    """The constructor's or the function's parameters; none of a protocol, which is never
+    constructed (its signature is typing's ``*args, **kwargs``)."""
+    if getattr(obj, "_is_protocol", False):
+        return set()
     try:
         return set(inspect.signature(obj).parameters)
     except (TypeError, ValueError):

@@ -105,11 +105,13 @@ def test_a_controller_that_cannot_run_is_stated_and_the_others_go_on(rigs):
     the delay, and delivers the derived PID beside it."""
     from ambseal.app.commands import digitals_for
     from ambseal.app.commands import Designed
+    from ambseal.design import DesignResult
 
     cfg, points, _, d = rigs["pump"]
     good = pid_controller(d["kp"], d["ti"], d["td"], d["eps"], channel_names(cfg))
     bad = pid_controller(d["kp"], d["ti"], d["td"], 0.1, channel_names(cfg))
-    designs = [Designed("pid", good, {}, None), Designed("old_pid", bad, {}, None)]
+    designs = [Designed(DesignResult("pid", good, 0.0)),
+               Designed(DesignResult("old_pid", bad, 0.0))]
     said = []
     digitals, cannot = digitals_for(cfg, designs, points, said.append)
     assert list(digitals) == ["pid"] and list(cannot) == ["old_pid"]

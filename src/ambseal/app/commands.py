@@ -14,10 +14,12 @@ import sys
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
+import control
 import numpy as np
 
 from ambseal.analysis.judge import judge_settings, operating_points
 from ambseal.config import default_rig_path, dump_rig, load_rig, method_names, rig_with_values
+from ambseal.design import Design
 from ambseal.design.fast_poles import design_rise
 from ambseal.design.lpv_design import design_lpv
 from ambseal.design.pid import controller_from_metadata, reference_pid
@@ -71,14 +73,26 @@ __all__ = ["Designed", "Identified", "identification_stage", "facility_impulses"
 
 @dataclass(frozen=True)
 class Designed:
-    """A controller of the main job: its method, the controller (``control.StateSpace`` or
-    :class:`~ambseal.machine.controller.ScheduledController`), its design summary for
-    ``metrics.json`` and the full design result."""
+    """A controller of the main job: its design and the summary ``metrics.json`` gives it
+    (by default the design's own, :meth:`~ambseal.design.Design.summary`; the run adds
+    to it where it says more: a remedy, this run's design time)."""
 
-    method: str
-    controller: object
-    summary: dict
-    result: object
+    result: Design
+    summary: dict | None = None
+
+    def __post_init__(self):
+        if self.summary is None:
+            object.__setattr__(self, "summary", self.result.summary())
+
+    @property
+    def method(self) -> str:
+        """The design's method (:data:`ambseal.config.METHODS`)."""
+        return self.result.method
+
+    @property
+    def controller(self) -> control.StateSpace | ScheduledController:
+        """The controller that runs (:attr:`ambseal.design.Design.controller`)."""
+        return self.result.controller
 
 
 def digital_for(cfg, method: str, controller, result, points, cache: dict | None = None

@@ -145,9 +145,6 @@ def _controllers(cfg: RigConfig, spec, say, failed: dict,
     on with the others.
     """
 
-    def lti(res) -> Designed:
-        return Designed(res.method, res.K, res.summary(), res)
-
     def guarded(m: str, make) -> list[Designed]:
         try:
             d = make()
@@ -160,22 +157,22 @@ def _controllers(cfg: RigConfig, spec, say, failed: dict,
 
     def robust(m: str) -> list[Designed]:
         say(f"designing {m}", 0)
-        return guarded(m, lambda: lti(design(cfg, m, spec=spec, allow_unstable=True,
+        return guarded(m, lambda: Designed(design(cfg, m, spec=spec, allow_unstable=True,
                                              progress=lambda msg: say(msg, 0))))
 
     if speed_scheduled(cfg):
-        out = [lti(design(cfg, "pid"))]
+        out = [Designed(design(cfg, "pid"))]
         say("pid designed", 1)
 
         def frozen_hinf() -> Designed:
             fz = design_frozen(cfg, cfg.operating.speed_rpm / 60.0, allow_unstable=True,
                                spec=spec)
-            return Designed("hinf", fz.K, fz.to_dict(), fz)
+            return Designed(fz)
 
         def lpv() -> Designed:
             d = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz, allow_unstable=True,
                            spec=spec)
-            return Designed("lpv", d, d.to_dict(), d)
+            return Designed(d)
 
         return out + guarded("hinf", frozen_hinf) + robust("mu") + guarded("lpv", lpv)
     out = []
@@ -183,7 +180,7 @@ def _controllers(cfg: RigConfig, spec, say, failed: dict,
         if m in method_names(synthesised=True):
             out += robust(m)
         else:  # derived from the rig (the reference PID): no synthesis that can fail
-            out.append(lti(design(cfg, m)))
+            out.append(Designed(design(cfg, m)))
             say(f"{m} designed", 1)
     lost = _lost_over_speed(cfg, out)
     if lost:
@@ -194,7 +191,7 @@ def _controllers(cfg: RigConfig, spec, say, failed: dict,
         def speed_lpv() -> Designed:
             d = design_lpv(cfg, speeds_hz=(0.0, top), states=spec.model_states,
                            allow_unstable=True, spec=spec)
-            return Designed("lpv", d, d.to_dict(), d)
+            return Designed(d)
 
         out += guarded("lpv", speed_lpv)
     return out
@@ -212,7 +209,7 @@ def _lost_over_speed(cfg: RigConfig, designs: list[Designed]) -> list[str]:
     f0 = cfg.operating.speed_rpm / 60.0
     out = []
     for d in designs:
-        fo = getattr(d.result, "full_order", None)
+        fo = d.result.full_order
         if d.method in method_names(synthesised=True) and fo and not fo["stable"] \
                 and abs(fo["speed_hz"] - f0) > 1e-9 * max(f0, 1.0):
             out.append(d.method)

@@ -128,9 +128,9 @@ def remedy(method: str, failure: FailedController, cases: list[dict], design_cfg
             # of a coefficient that is 0 at that pressure): that remedy cannot be tried
             tried.append(f"{label} (the design failed: {exc})")
             continue
-        d = Designed(method, res.K, {**res.summary(), "remedy": (
+        d = Designed(res, {**res.summary(), "remedy": (
             f"{label}: the design at the operating point lost the loop at "
-            f"{', '.join(failure.conditions)}")}, res)
+            f"{', '.join(failure.conditions)}")})
         digitals, cannot = digitals_for(design_cfg, [d], points)
         if method not in digitals:
             tried.append(f"{label} (cannot run on the target: {cannot.get(method, '')})")

@@ -68,7 +68,7 @@ def tracked_designs(cfg, design_cfg, spec, points, say, digitals: dict, cannot_r
     # elapsed_s is this run's design time, as for every controller (a cache hit: its read)
     summary = {**d.to_dict(), "elapsed_s": round(time.perf_counter() - t0, 3)}
     say("tracked designed", 1)
-    out = [Designed("tracked", d, summary, d)]
+    out = [Designed(d, summary)]
     more, cannot = digitals_for(design_cfg, out, points_for(d, points, design_cfg),
                                 lambda m: say(m, 0))
     digitals.update(more)

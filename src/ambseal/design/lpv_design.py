@@ -37,6 +37,7 @@ import time
 from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar
 
+import control
 import numpy as np
 
 from ambseal.design.lpv_plant import lpv_plant, vertex_grid_hz
@@ -98,6 +99,7 @@ class LpvDesign(ScheduledController):
     """
 
     parameter: ClassVar[str] = SPEED
+    method: ClassVar[str] = "lpv"
     K: Any = field(repr=False)
     gamma: float
     gamma_design: float
@@ -142,6 +144,16 @@ class LpvDesign(ScheduledController):
         return physical_matrices(self.K.matrices(speed_rad_s), self.weights.d_e,
                                  self.weights.d_u)
 
+    @property
+    def controller(self) -> LpvDesign:
+        """The design itself: it is the scheduled controller
+        (:class:`~ambseal.design.Design`)."""
+        return self
+
+    def summary(self) -> dict:
+        """:meth:`to_dict` (:class:`~ambseal.design.Design`)."""
+        return self.to_dict()
+
     def to_dict(self) -> dict:
         """JSON-ready summary (no matrices)."""
         fg = [float(x) if np.isfinite(x) else None for x in self.frozen_gamma]
@@ -163,13 +175,17 @@ class LpvDesign(ScheduledController):
         """One plain line: the LMI bound over the scheduled range, the frozen loops, and
         the full-order stability."""
         lo, hi = float(self.speeds_hz.min()), float(self.speeds_hz.max())
-        stab = ("full-order loop stable at every judged condition"
-                if self.full_order is None or self.full_order["stable"] else
-                f"FULL-ORDER LOOP UNSTABLE at {self.full_order['mode_hz']:.4g} Hz, "
-                f"{self.full_order['speed_hz']:g} Hz speed (kept unstable: allow_unstable)")
         return (f"LPV γ = {bound_text(self.gamma)} over {lo:g}–{hi:g} Hz ({self.lyapunov} "
                 f"Lyapunov function), frozen loops γ ≤ {float(np.max(self.check_gamma)):.3g}"
-                f"; {stab}")
+                f"; {_stability_over_speed(self.full_order)}")
+
+
+def _stability_over_speed(check: dict | None) -> str:
+    """The verdict's words on :func:`check_full_order` of a design judged over speed."""
+    if check is None or check["stable"]:
+        return "full-order loop stable at every judged condition"
+    return (f"FULL-ORDER LOOP UNSTABLE at {check['mode_hz']:.4g} Hz, {check['speed_hz']:g} Hz "
+            "speed (kept unstable: allow_unstable)")
 
 
 @dataclass(frozen=True, eq=False)
@@ -191,7 +207,7 @@ class FrozenDesign:
         :func:`check_full_order` of the controller at the judged conditions.
     """
 
-    K: Any = field(repr=False)
+    K: control.StateSpace = field(repr=False)
     speed_hz: float
     method: str
     gamma: float
@@ -199,7 +215,25 @@ class FrozenDesign:
     elapsed_s: float = 0.0
     full_order: dict | None = None
 
+    @property
+    def controller(self) -> control.StateSpace:
+        """``K`` (:class:`~ambseal.design.Design`)."""
+        return self.K
+
+    @property
+    def verdict(self) -> str:
+        """One plain line: the design loop's bound at its speed and the full-order
+        stability."""
+        bound = "H∞ γ" if self.method == "hinf" else "μ"
+        return (f"{bound} = {bound_text(self.gamma)} at {self.speed_hz:g} Hz; "
+                f"{_stability_over_speed(self.full_order)}")
+
+    def summary(self) -> dict:
+        """:meth:`to_dict` (:class:`~ambseal.design.Design`)."""
+        return self.to_dict()
+
     def to_dict(self) -> dict:
+        """JSON-ready summary (no matrices)."""
         return {"method": self.method, "speed_hz": self.speed_hz, "gamma": self.gamma,
                 "order": int(self.K.nstates), "weights": self.weights.to_dict(),
                 "elapsed_s": round(self.elapsed_s, 3), "full_order": self.full_order}

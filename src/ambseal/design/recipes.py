@@ -51,6 +51,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
+import control
 import numpy as np
 
 from ambseal.config import method_names
@@ -81,7 +82,7 @@ ORDER_RISE = 0.1
 
 @dataclass(frozen=True, eq=False)
 class DesignResult:
-    """A designed controller and how it was obtained.
+    """A designed controller and how it was obtained (a :class:`~ambseal.design.Design`).
 
     Attributes
     ----------
@@ -142,7 +143,7 @@ class DesignResult:
     """
 
     method: str
-    K: Any = field(repr=False)
+    K: control.StateSpace = field(repr=False)
     pressure_bar: float
     gamma: float | None = None
     mu: float | None = None
@@ -163,6 +164,11 @@ class DesignResult:
     verdict: str = ""
     omega: Any = field(default=None, repr=False)
     stopping: dict | None = None
+
+    @property
+    def controller(self) -> control.StateSpace:
+        """``K`` (:class:`~ambseal.design.Design`)."""
+        return self.K
 
     def summary(self) -> dict:
         """Short JSON-ready summary (no matrices)."""

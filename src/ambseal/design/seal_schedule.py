@@ -67,12 +67,13 @@ import os
 import time
 from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from ambseal import __version__
 from ambseal.design.plant import generalized_plant, physical_controller, physical_matrices
+from ambseal.design.recipes import bound_text
 from ambseal.design.specs import DesignSpec, design_spec
 from ambseal.design.weights import Weights
 from ambseal.errors import ModelError, SynthesisError
@@ -130,6 +131,7 @@ class SealScheduledDesign(ScheduledController):
         (:meth:`ambseal.robust.delay.DesignDelay.to_dict`).
     """
 
+    method: ClassVar[str] = "tracked"
     parameter: str
     K: Any = field(repr=False)
     gamma: float
@@ -163,6 +165,29 @@ class SealScheduledDesign(ScheduledController):
         chans = [n[2:] if n.startswith("y_") else n for n in self.K.input_names]
         return physical_controller(self.K.matrices(float(theta)), self.weights.d_e,
                                    self.weights.d_u, chans, name=name)
+
+    @property
+    def controller(self) -> SealScheduledDesign:
+        """The design itself: it is the scheduled controller
+        (:class:`~ambseal.design.Design`)."""
+        return self
+
+    @property
+    def full_order(self) -> None:
+        """None: the design makes no full-order check of its own (the main job judges it
+        over its schedule, :func:`ambseal.analysis.judge.points_for`)."""
+        return None
+
+    @property
+    def verdict(self) -> str:
+        """One plain line: the LMI bound over the schedule."""
+        lo, hi = self.schedule
+        return (f"LPV on {self.parameter} γ = {bound_text(self.gamma)} over {lo:.4g}–{hi:.4g}"
+                f" (SI), frozen loops γ ≤ {float(np.max(self.check_gamma)):.3g}")
+
+    def summary(self) -> dict:
+        """:meth:`to_dict` (:class:`~ambseal.design.Design`)."""
+        return self.to_dict()
 
     def to_dict(self) -> dict:
         """JSON-ready summary (no matrices)."""

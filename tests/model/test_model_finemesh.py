@@ -99,9 +99,9 @@ def _hessenberg_calls(monkeypatch) -> list:
 
     calls, real = [], fr._hessenberg_response
 
-    def counted(A, B, C, D, s):
+    def counted(A, B, C, D, s, **kw):
         calls.append(s.size)
-        return real(A, B, C, D, s)
+        return real(A, B, C, D, s, **kw)
 
     monkeypatch.setattr(fr, "_hessenberg_response", counted)
     return calls

@@ -420,19 +420,29 @@ def _balanced_modal_as_good(A, B, C, D, s, probe, Hd, max_cond) -> np.ndarray | 
     if Bb is None:
         return None
     eb = _error(_modal_eval(lam, Bb, Cb, D, probe), Hd)
-    eh = _error(_hessenberg_response(A, B, C, D, probe), Hd)
+    eh = _error(_probe_response(A, B, C, D, probe, "hessenberg"), Hd)
     if not (eb <= _ARBITER_RTOL and np.isfinite(eh) and eb <= _AS_GOOD * eh):
         return None
     return _modal_eval(lam, Bb, Cb, D, s)
 
 
-def _probe_response(A, B, C, D, probe) -> np.ndarray:
-    """:func:`_dense_response` at the probe points, each kept for the last large systems
-    (:data:`_PROBED`): the grids of one plant's responses share their ends."""
+def _probe_response(A, B, C, D, probe, form: str = "dense") -> np.ndarray:
+    """``C (sI − A)⁻¹ B + D`` at the probe points by dense solves (:func:`_dense_response`)
+    or by the Hessenberg form (``form="hessenberg"``, the form itself not kept), each point
+    kept for the last large systems (:data:`_PROBED`): the grids of one plant's responses
+    share their probes (:func:`_probes`)."""
+    solve = _dense_response if form == "dense" else \
+        (lambda *m: _hessenberg_response(*m, keep=False))
+    computed: list = []
+
+    def at(k):  # a miss computes every probe at once (one Hessenberg form, not three)
+        if not computed:
+            computed.append(solve(A, B, C, D, probe))
+        return computed[0][k]
+
     out = np.empty((probe.size, C.shape[0], B.shape[1]), dtype=complex)
     for k, p in enumerate(probe):
-        out[k] = _PROBED.get((A, B, C, D), complex(p),
-                             lambda p=p: _dense_response(A, B, C, D, np.array([p]))[0])
+        out[k] = _PROBED.get((A, B, C, D), (form, complex(p)), lambda k=k: at(k))
     return out
 
 
@@ -508,18 +518,20 @@ def _modal_eval(lam: np.ndarray, Bm: np.ndarray, Cm: np.ndarray, D: np.ndarray, 
     return out
 
 
-def _hessenberg_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, s: np.ndarray) -> np.ndarray:
+def _hessenberg_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray,
+                         s: np.ndarray, keep: bool = True) -> np.ndarray:
     """``C (sI − A)⁻¹ B + D`` via one Hessenberg reduction and O(n²) solves per s.
 
     ``A`` is balanced first (diagonal similarity, ``scipy.linalg.matrix_balance``; Parlett &
     Reinsch 1969): FE models in [q; q̇] form have entries from 1 to 1e12 and lose several
     digits without it. The orthogonal reduction to upper Hessenberg form (LAPACK
     ``dgehrd``, as SLICOT ``TB05AD`` does it) is kept for the last large systems
-    (:class:`~ambseal.lti.matrices.ArrayMemo`). The solves use ``TB05AD`` (job ``'NH'``)
+    (:class:`~ambseal.lti.matrices.ArrayMemo`) unless ``keep`` is False. The solves use ``TB05AD`` (job ``'NH'``)
     through slycot when it is installed (Fortran loop, the routine python-control also
     uses), else the vectorised :func:`hessenberg_solve`.
     """
-    Hs, Bh, Ch = _HESSENBERG.get((A, B, C), None, lambda: _hessenberg_form(A, B, C))
+    Hs, Bh, Ch = _HESSENBERG.get((A, B, C), None, lambda: _hessenberg_form(A, B, C)) \
+        if keep else _hessenberg_form(A, B, C)
     if _USE_SLYCOT:
         try:
             return _slycot_response(Hs, Bh, Ch, D, s)

@@ -31,7 +31,7 @@ import scipy.linalg as sla
 from scipy.optimize import linear_sum_assignment
 
 from ambseal.analysis.cases import run_cases
-from ambseal.lti.json_safe import json_float, json_list
+from ambseal.lti import json_float, json_list
 from ambseal.model.modes import (
     RIGID_BODY_RAD_S,
     bending_limit_hz,

@@ -27,7 +27,7 @@ import math
 from dataclasses import dataclass
 
 from ambseal.errors import ModelError
-from ambseal.lti.json_safe import json_float
+from ambseal.lti import json_float
 
 __all__ = ["ZONE_LIMITS", "ZONES", "zone_limit_db", "iso_zone", "IsoAssessment", "iso_assessment"]
 

@@ -56,9 +56,7 @@ from ambseal.analysis.spinup import frozen_sensitivity, spinup
 from ambseal.analysis.unbalance import unbalance_from_compliance
 from ambseal.design.lpv_plant import lpv_plant, vertex_grid_hz
 from ambseal.design.specs import RIGID_STATES
-from ambseal.lti.freqresp import freqresp_at
-from ambseal.lti.interconnect import wired
-from ambseal.lti.json_safe import finite_or_none, json_float
+from ambseal.lti import finite_or_none, freqresp_at, json_float, wired
 from ambseal.model.modes import classify_poles
 from ambseal.model.rig import build_plant
 from ambseal.model.seal import pressure_for_k, seal_values

@@ -35,10 +35,7 @@ from typing import Any
 import numpy as np
 
 from ambseal.errors import ModelError
-from ambseal.lti.freqresp import freqresp_at
-from ambseal.lti.interconnect import wired
-from ambseal.lti.json_safe import json_float, json_list
-from ambseal.lti.matrices import as_omega, labels, ss_matrices
+from ambseal.lti import as_omega, freqresp_at, json_float, json_list, labels, ss_matrices, wired
 from ambseal.machine.loop import loop_matrices, sample_time
 
 __all__ = [

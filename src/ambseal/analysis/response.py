@@ -26,8 +26,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from ambseal.errors import ModelError
-from ambseal.lti.discrete import simulate_lti, zoh
-from ambseal.lti.json_safe import json_float
+from ambseal.lti import json_float, simulate_lti, zoh
 from ambseal.machine.loop import ClosedLoop, closed_loop
 
 __all__ = ["ImpulseResponse", "impulse_response", "impulse_response_of", "settling_time"]

@@ -18,7 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ambseal.analysis.judge import OperatingPoint
-from ambseal.lti.json_safe import json_float
+from ambseal.lti import json_float
 from ambseal.model.rig import build_plant
 from ambseal.robust.delay import loop_delay
 from ambseal.machine.loop import judged_loop

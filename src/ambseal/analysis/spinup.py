@@ -72,8 +72,7 @@ from scipy.integrate import solve_ivp
 from ambseal.analysis.loops import loop_responses, resolved_grid
 from ambseal.analysis.response import settling_time
 from ambseal.errors import ModelError
-from ambseal.lti.discrete import zoh
-from ambseal.lti.interconnect import feedback_matrices
+from ambseal.lti import feedback_matrices, zoh
 from ambseal.model.rig import build_plant
 from ambseal.machine.controller import frozen, matrices_at
 from ambseal.machine.loop import closed_loop

@@ -27,7 +27,7 @@ from ambseal.analysis.cases import CaseError, run_cases
 from ambseal.analysis.judge import JudgeSettings, OperatingPoint, judge
 from ambseal.config import parse_rig, rig_with_values
 from ambseal.errors import ConfigError
-from ambseal.lti.json_safe import json_float
+from ambseal.lti import json_float
 from ambseal.model.modes import bending_limit_hz
 from ambseal.robust.stability import is_stable
 

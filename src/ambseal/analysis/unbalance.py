@@ -38,8 +38,7 @@ import numpy as np
 
 from ambseal.analysis.loops import ComplianceResponse, Peak, compliance, peak_of
 from ambseal.errors import ModelError
-from ambseal.lti.json_safe import json_float, json_list
-from ambseal.lti.matrices import as_omega
+from ambseal.lti import as_omega, json_float, json_list
 
 __all__ = ["unbalance_force", "UnbalanceResponse", "unbalance_response", "unbalance_from_compliance",
            "UNBALANCE_LAWS"]

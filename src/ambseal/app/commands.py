@@ -41,7 +41,7 @@ from ambseal.identify.static_load import (
     with_static_record,
 )
 from ambseal.identify.tracking import TrackingSettings, check_excitation, track
-from ambseal.lti.json_safe import finite_or_none
+from ambseal.lti import finite_or_none
 from ambseal.model.amb import channel_names
 from ambseal.model.modes import modes
 from ambseal.model.rig import build_plant, build_system

@@ -46,7 +46,7 @@ from ambseal.design.recipes import bound_text, full_order_check
 from ambseal.design.specs import DesignSpec, design_spec
 from ambseal.design.weights import Weights, default_weights
 from ambseal.errors import ConfigError, SynthesisError
-from ambseal.lti.json_safe import json_float
+from ambseal.lti import json_float
 from ambseal.machine.controller import SPEED, ScheduledController
 from ambseal.robust.dk import design_omega, musyn
 from ambseal.robust.hinf import hinfsyn

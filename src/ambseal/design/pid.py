@@ -10,9 +10,7 @@ import numpy as np
 from ambseal.design.conditions import judged_conditions
 from ambseal.errors import ConfigError, DataError
 from ambseal.identify import stages
-from ambseal.lti.discrete import zoh
-from ambseal.lti.interconnect import feedback_matrices
-from ambseal.lti.pickling import picklable
+from ambseal.lti import feedback_matrices, picklable, zoh
 from ambseal.model.amb import amb_factors, channel_names
 from ambseal.model.rig import build_plant
 from ambseal.model.rotor import assemble_rotor

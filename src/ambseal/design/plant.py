@@ -50,7 +50,7 @@ import numpy as np
 
 from ambseal.design.weights import diagonal_weight
 from ambseal.errors import ConfigError, ModelError
-from ambseal.lti.pickling import picklable
+from ambseal.lti import picklable
 from ambseal.model.lft import Plant
 from ambseal.model.rig import build_plant
 from ambseal.robust.hinf import lft_lower

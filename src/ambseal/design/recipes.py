@@ -60,8 +60,8 @@ from ambseal.design.plant import generalized_plant
 from ambseal.design.specs import design_spec
 from ambseal.design.weights import Weights
 from ambseal.errors import ConfigError, SynthesisError
+from ambseal.lti import lft_lower
 from ambseal.lti.freqresp import freqresp
-from ambseal.lti.interconnect import lft_lower
 from ambseal.model.amb import channel_names
 from ambseal.model.modes import poles_near_zero
 from ambseal.model.rig import build_plant, build_system

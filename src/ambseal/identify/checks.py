@@ -20,7 +20,7 @@ from ambseal.identify.frf import FRF, closed_loop_frf, model_frf, plant_frf
 from ambseal.identify.procedure import ProcedureResult
 from ambseal.identify.signals import chirp
 from ambseal.identify.stages import acquire, build_models
-from ambseal.lti.json_safe import finite_or_none
+from ambseal.lti import finite_or_none
 from ambseal.model.rig import build_plant
 
 __all__ = ["FrfChecks", "frf_checks", "truth_errors", "true_line", "interval_check"]

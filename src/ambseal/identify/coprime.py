@@ -31,8 +31,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ambseal.errors import DataError, IdentificationError
-from ambseal.lti.discrete import zoh
-from ambseal.lti.freqresp import freqresp_at
+from ambseal.lti import freqresp_at, zoh
 from ambseal.model.lft import Plant
 from ambseal.robust.stability import is_stable
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ambseal.lti.compiled import cached_njit
+from ambseal.lti import cached_njit
 
 __all__ = ["facility_loop"]
 

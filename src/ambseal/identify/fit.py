@@ -40,8 +40,7 @@ from ambseal.identify.residuals import MISMATCH, ResidualTests, residual_tests
 from ambseal.identify.sandwich import _covariance, _long_run_covariance, _score_test, _t_quantile  # noqa: F401
 from ambseal.identify.sensor_lag import TAU_S, lag_test_dict, with_sensor_lag
 from ambseal.identify.stats import jacobian_correlation
-from ambseal.lti.discrete import simulate_lti, zoh
-from ambseal.lti.interconnect import series_inputs
+from ambseal.lti import series_inputs, simulate_lti, zoh
 from ambseal.model.amb import eddy_lag_matrices
 from ambseal.model.lft import Plant
 from ambseal.robust.digital_loop import DiscreteController, closed_loop_matrices

@@ -42,7 +42,7 @@ import numpy as np
 import scipy.signal
 
 from ambseal.errors import DataError, IdentificationError
-from ambseal.lti.freqresp import freqresp_at
+from ambseal.lti import freqresp_at
 
 __all__ = [
     "FRF",

@@ -16,7 +16,7 @@ import numpy as np
 
 from ambseal.config import MAX_CURRENT_A, MAX_GAP_M
 from ambseal.errors import DataError
-from ambseal.lti.json_safe import finite_or_none
+from ambseal.lti import finite_or_none
 
 __all__ = ["FORMAT_TAG", "CLIP_RUN", "CLIP_RTOL", "TIME_RTOL", "CHANNELS", "Measurement", "column_names",
            "validate_measurement"]

@@ -37,8 +37,7 @@ import numpy as np
 from ambseal.config import MAX_ELEMENTS, RigConfig, TruthSection
 from ambseal.errors import ConfigError, ModelError
 from ambseal.identify.facility_loop import facility_loop
-from ambseal.lti.discrete import zoh
-from ambseal.lti.interconnect import series_inputs
+from ambseal.lti import series_inputs, zoh
 from ambseal.model.amb import actuator_matrices, bias_current, eddy_lag_matrices
 from ambseal.model.reduction import modal_reduction
 from ambseal.model.rig import build_system, mechanical_plant

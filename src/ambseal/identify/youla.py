@@ -83,7 +83,7 @@ from ambseal.identify.coprime import (
     observer_gains,
     youla_factorisation,
 )
-from ambseal.lti.discrete import simulate_lti, zoh
+from ambseal.lti import simulate_lti, zoh
 from ambseal.model.lft import Plant
 
 __all__ = [

@@ -16,26 +16,39 @@ The lowest numerical layer (it imports only :mod:`ambseal.errors`); each idea on
 * :func:`interp_table` — the one rule for tables against a parameter;
 * :func:`lowest_eigenpairs` — the eigenvalues of smallest |λ| of a large state matrix with
   right and left eigenvectors (shift-invert Arnoldi; a modal reduction's input);
-* :func:`picklable` — ``control.StateSpace`` through :mod:`pickle` (Dask workers).
+* :func:`picklable` — ``control.StateSpace`` through :mod:`pickle` (Dask workers);
+* what every layer shares beneath them: :func:`ss_matrices`, :func:`as_omega`,
+  :func:`labels` (checked matrices, grids and signal names), :func:`state_poles`,
+  :func:`series_inputs`, :func:`sampled_response_at`, :func:`cached_njit` (numba's cached
+  compilation), :data:`DENSE_STATES`, and the JSON conventions of every result
+  (:func:`json_float`, :func:`json_list`, :func:`finite_or_none`,
+  :func:`finite_or_none_tree`).
 
 ``freqresp`` is not re-exported here: it shares its module's name, and re-exporting it
 would hide :mod:`ambseal.lti.freqresp` (``import ambseal.lti.freqresp as fr`` would then
 give the function).
 """
 
+from ambseal.lti.compiled import cached_njit
 from ambseal.lti.discrete import discretize, simulate_lti, zoh
-from ambseal.lti.freqresp import freqresp_at
+from ambseal.lti.freqresp import freqresp_at, sampled_response_at
 from ambseal.lti.interconnect import (
     feedback_matrices,
     feedback_poles,
     lft_lower,
     lft_lower_matrices,
+    series_inputs,
+    state_poles,
     wired,
 )
-from ambseal.lti.lowest import lowest_eigenpairs
+from ambseal.lti.json_safe import finite_or_none, finite_or_none_tree, json_float, json_list
+from ambseal.lti.lowest import DENSE_STATES, lowest_eigenpairs
+from ambseal.lti.matrices import as_omega, labels, ss_matrices
 from ambseal.lti.pickling import picklable
 from ambseal.lti.tables import interp_table
 
-__all__ = ["discretize", "feedback_matrices", "feedback_poles", "freqresp_at",
-           "interp_table", "lft_lower", "lft_lower_matrices", "lowest_eigenpairs", "picklable",
-           "simulate_lti", "wired", "zoh"]
+__all__ = ["DENSE_STATES", "as_omega", "cached_njit", "discretize", "feedback_matrices",
+           "feedback_poles", "finite_or_none", "finite_or_none_tree", "freqresp_at",
+           "interp_table", "json_float", "json_list", "labels", "lft_lower",
+           "lft_lower_matrices", "lowest_eigenpairs", "picklable", "sampled_response_at",
+           "series_inputs", "simulate_lti", "ss_matrices", "state_poles", "wired", "zoh"]

@@ -174,8 +174,18 @@ def state_poles(A: np.ndarray) -> np.ndarray:
     """Eigenvalues of a state matrix ``A`` (rad/s, or z of a discrete system), kept for the
     last few large ones (:class:`~ambseal.lti.matrices.ArrayMemo`): a caller asks for the
     poles of the same large loop several times (its stability after a synthesis, a
-    discretisation's prewarp frequency and stability screen, a later analysis). The array is
-    shared: do not modify it in place."""
+    discretisation's prewarp frequency and stability screen, a later analysis).
+
+    Parameters
+    ----------
+    A : numpy.ndarray, shape (n, n)
+        The state matrix.
+
+    Returns
+    -------
+    numpy.ndarray of complex, shape (n,)
+        Its eigenvalues; the array is shared, do not modify it in place.
+    """
     A = np.asarray(A, float)
     if not A.size:
         return np.zeros(0, dtype=complex)

@@ -1,4 +1,4 @@
-"""Checks and conversions of state-space data shared by every module (not public API).
+"""Checks and conversions of state-space data shared by every module.
 
 * :func:`ss_matrices` — ``(A, B, C, D)`` as float arrays from a ``control.StateSpace`` (or
   anything python-control converts) or a tuple;
@@ -26,6 +26,18 @@ __all__ = ["as_omega", "ss_matrices", "labels", "ArrayMemo"]
 def as_omega(omega: Any, *, name: str = "omega") -> np.ndarray:
     """Check and return a 1-D float frequency grid in rad/s.
 
+    Parameters
+    ----------
+    omega : float or array_like
+        Frequencies, rad/s (a scalar is a grid of one).
+    name : str, optional
+        What the error message calls the grid.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (n,)
+        The grid, rad/s.
+
     Raises
     ------
     ModelError
@@ -45,6 +57,20 @@ def ss_matrices(sys: Any, *, name: str = "sys",
 
     Accepts a ``control.StateSpace`` (or anything python-control converts to one, e.g. a
     transfer function) or a tuple ``(A, B, C, D)``.
+
+    Parameters
+    ----------
+    sys : control.StateSpace or (A, B, C, D)
+        The system; a tuple's entries are made 2-D float arrays.
+    name : str, optional
+        What the error messages call the system.
+    allow_discrete : bool, optional
+        Accept a discrete-time system (its matrices are returned as they are).
+
+    Returns
+    -------
+    A, B, C, D : numpy.ndarray of float
+        Shapes ``(n, n)``, ``(n, m)``, ``(p, n)`` and ``(p, m)``.
 
     Raises
     ------
@@ -71,7 +97,24 @@ def ss_matrices(sys: Any, *, name: str = "sys",
 
 
 def labels(sys: Any, kind: str, count: int, prefix: str) -> tuple[str, ...]:
-    """Input or output labels of a python-control system, or generated ones."""
+    """Input or output labels of a python-control system, or generated ones.
+
+    Parameters
+    ----------
+    sys : object
+        A python-control system, or anything without ``<kind>_labels`` (a tuple of
+        matrices).
+    kind : {"input", "output"}
+        Which labels.
+    count : int
+        How many signals there are; the system's labels are used only if it has this many.
+    prefix : str
+        The generated labels' stem: ``prefix[0]``, ``prefix[1]``, ….
+
+    Returns
+    -------
+    tuple of str, length ``count``
+    """
     names = getattr(sys, f"{kind}_labels", None)
     if names is not None and len(names) == count:
         return tuple(str(s) for s in names)

@@ -25,11 +25,19 @@ import control
 import numpy as np
 
 from ambseal.errors import ModelError
-from ambseal.lti.discrete import zoh
-from ambseal.lti.freqresp import freqresp_at, sampled_response_at
-from ambseal.lti.interconnect import feedback_matrices, series_inputs, state_poles, wired
-from ambseal.lti.json_safe import json_float, json_list
-from ambseal.lti.matrices import labels, ss_matrices
+from ambseal.lti import (
+    feedback_matrices,
+    freqresp_at,
+    json_float,
+    json_list,
+    labels,
+    sampled_response_at,
+    series_inputs,
+    ss_matrices,
+    state_poles,
+    wired,
+    zoh,
+)
 from ambseal.robust.stability import decay_rate, is_stable
 
 __all__ = ["ClosedLoop", "JudgedLoop", "closed_loop", "judged_loop", "delayed_plant",

@@ -30,8 +30,7 @@ import control
 import numpy as np
 
 from ambseal.errors import SynthesisError
-from ambseal.lti.json_safe import finite_or_none_tree
-from ambseal.lti.tables import interp_table
+from ambseal.lti import finite_or_none_tree, interp_table
 from ambseal.machine.controller import SPEED, ScheduledController
 from ambseal.robust.digital import (
     DISCRETISATIONS,

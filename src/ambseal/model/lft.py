@@ -21,8 +21,7 @@ import control
 import numpy as np
 
 from ambseal.errors import ModelError
-from ambseal.lti.interconnect import series_inputs
-from ambseal.lti.pickling import picklable
+from ambseal.lti import picklable, series_inputs
 
 __all__ = ["Channel", "Parameter", "Plant", "channel_tag"]
 

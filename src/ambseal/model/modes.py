@@ -29,7 +29,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ambseal.errors import ModelError
-from ambseal.lti.lowest import DENSE_STATES
+from ambseal.lti import DENSE_STATES
 from ambseal.model.rig import SecondOrderSystem, build_system
 
 __all__ = ["Modes", "modes", "modes_from_poles", "lowest_eigenvalues", "PoleDisk",

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ambseal.errors import ModelError
-from ambseal.lti.lowest import lowest_eigenpairs
+from ambseal.lti import lowest_eigenpairs
 from ambseal.model.lft import Plant
 
 __all__ = ["ModalReduction", "modal_reduction"]

@@ -19,7 +19,7 @@ import numpy as np
 
 from ambseal.config import Affine, FrequencyTable, Seal
 from ambseal.errors import ModelError
-from ambseal.lti.tables import interp_table
+from ambseal.lti import interp_table
 from ambseal.model.lft import Channel
 from ambseal.model.rotor import Mesh, X, Y
 

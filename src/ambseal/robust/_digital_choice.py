@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ambseal.lti.interconnect import feedback_poles
+from ambseal.lti import feedback_poles
 
 Matrices = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ambseal.lti.compiled import cached_njit
+from ambseal.lti import cached_njit
 
 __all__ = ["small_margin"]
 

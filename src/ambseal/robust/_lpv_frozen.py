@@ -21,7 +21,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ambseal.errors import SynthesisError
-from ambseal.lti.interconnect import lft_lower_matrices
+from ambseal.lti import lft_lower_matrices
 from ambseal.robust._lmi_sdp import Lmi, LmiTerm, solve_lmis
 from ambseal.robust.hinf import hinfnorm, hinfsyn
 from ambseal.robust.stability import is_stable

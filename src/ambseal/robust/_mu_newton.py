@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ambseal.lti.compiled import cached_njit
+from ambseal.lti import cached_njit
 
 __all__ = ["gevp", "newton_steps"]
 

@@ -53,10 +53,14 @@ import scipy.linalg as sla
 from scipy.signal import cont2discrete
 
 from ambseal.errors import ConfigError, SynthesisError
-from ambseal.lti.discrete import zoh
-from ambseal.lti.freqresp import freqresp_at, sampled_response_at
-from ambseal.lti.interconnect import feedback_poles, series_inputs
-from ambseal.lti.json_safe import finite_or_none_tree
+from ambseal.lti import (
+    feedback_poles,
+    finite_or_none_tree,
+    freqresp_at,
+    sampled_response_at,
+    series_inputs,
+    zoh,
+)
 from ambseal.robust._digital_choice import first_stable as _first_stable
 from ambseal.robust._digital_choice import so_peak as _so_peak
 from ambseal.robust.delay import check_timing, loop_delay

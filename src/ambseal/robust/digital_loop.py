@@ -19,8 +19,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ambseal.lti.discrete import discretize
-from ambseal.lti.interconnect import feedback_matrices
+from ambseal.lti import discretize, feedback_matrices
 
 __all__ = ["DiscreteController", "discrete_controller", "closed_loop_matrices"]
 

@@ -38,7 +38,7 @@ from slycot import ab13dd
 from slycot.exceptions import SlycotArithmeticError
 
 from ambseal.errors import ConfigError, ModelError, SynthesisError
-from ambseal.lti.interconnect import lft_lower, lft_lower_matrices
+from ambseal.lti import lft_lower, lft_lower_matrices
 from ambseal.robust._hinf_gamma import backoff_ladder as _backoff_ladder
 from ambseal.robust._hinf_gamma import game_riccati as _game_riccati
 from ambseal.robust._hinf_gamma import gamma_search as _gamma_search

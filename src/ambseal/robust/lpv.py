@@ -53,9 +53,7 @@ import control as ct
 import numpy as np
 
 from ambseal.errors import SynthesisError
-from ambseal.lti.interconnect import lft_lower_matrices
-from ambseal.lti.json_safe import json_float
-from ambseal.lti.tables import interp_table
+from ambseal.lti import interp_table, json_float, lft_lower_matrices
 from ambseal.robust._lpv_lmi import (
     BASES,
     DEFAULT_TOL,

@@ -24,7 +24,8 @@ from numpydoc.docscrape import get_doc_object
 from numpydoc.validate import get_validation_checks, validate
 
 ROOT = Path(__file__).resolve().parents[1]
-FACES = ["lti", "robust", "config", "model", "identify", "design", "analysis", "export"]
+FACES = ["lti", "robust", "machine", "config", "model", "identify", "design", "analysis",
+         "export"]
 #: Public modules that are a face of their own (no package around them).
 MODULE_FACES = ["threads"]
 #: Public names that share their module's name and are kept (part of a published face); the

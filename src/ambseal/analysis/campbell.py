@@ -41,10 +41,8 @@ from ambseal.model.modes import (
 )
 from ambseal.model.rig import build_plant
 from ambseal.model.rotor import build_mesh
-from ambseal.machine.controller import frozen
-from ambseal.robust.delay import loop_delay
-from ambseal.machine.loop import judged_loop
-from ambseal.robust.stability import decay_rate, is_stable
+from ambseal.machine import frozen, judged_loop
+from ambseal.robust import decay_rate, is_stable, loop_delay
 
 __all__ = ["API684_LOG_DEC", "OVERDAMPED_ZETA", "ClosedLoopModes", "Crossing", "Campbell",
            "log_decrement", "lowest_log_decrement", "whirl_of", "closed_loop_state_matrix",

@@ -60,10 +60,15 @@ from ambseal.lti import finite_or_none, freqresp_at, json_float, wired
 from ambseal.model.modes import classify_poles
 from ambseal.model.rig import build_plant
 from ambseal.model.seal import pressure_for_k, seal_values
-from ambseal.machine.controller import SPEED, ScheduledController, frozen
-from ambseal.robust.delay import loop_delay
-from ambseal.machine.loop import JudgedLoop, judged_loop
-from ambseal.machine.scheduled_digital import ScheduledDigital
+from ambseal.machine import (
+    SPEED,
+    JudgedLoop,
+    ScheduledController,
+    ScheduledDigital,
+    frozen,
+    judged_loop,
+)
+from ambseal.robust import loop_delay
 
 __all__ = ["JudgeSettings", "OperatingPoint", "LoopJudgement", "JudgedCase", "judge", "judge_case", "judge_spinup",
            "operating_points", "speed_scheduled",

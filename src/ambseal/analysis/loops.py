@@ -36,7 +36,7 @@ import numpy as np
 
 from ambseal.errors import ModelError
 from ambseal.lti import as_omega, freqresp_at, json_float, json_list, labels, ss_matrices, wired
-from ambseal.machine.loop import loop_matrices, sample_time
+from ambseal.machine import loop_matrices, sample_time
 
 __all__ = [
     "LoopResponse",

@@ -64,8 +64,7 @@ from ambseal.identify.rig_sim import prepare_facility, pressure_values, reduced_
 from ambseal.identify.tracking import OnlineTracker, TrackingSettings, tracking_excitation
 from ambseal.model.amb import actuator_matrices
 from ambseal.model.rig import build_plant
-from ambseal.robust.digital import discretize_as, with_delay
-from ambseal.robust.digital_loop import DiscreteController
+from ambseal.robust import DiscreteController, discretize_as, with_delay
 
 __all__ = ["RampRun", "RampResult", "pressure_ramp", "ramp_simulation", "frozen_cases"]
 

@@ -27,7 +27,7 @@ import numpy as np
 
 from ambseal.errors import ModelError
 from ambseal.lti import json_float, simulate_lti, zoh
-from ambseal.machine.loop import ClosedLoop, closed_loop
+from ambseal.machine import ClosedLoop, closed_loop
 
 __all__ = ["ImpulseResponse", "impulse_response", "impulse_response_of", "settling_time"]
 

@@ -74,8 +74,7 @@ from ambseal.analysis.response import settling_time
 from ambseal.errors import ModelError
 from ambseal.lti import feedback_matrices, zoh
 from ambseal.model.rig import build_plant
-from ambseal.machine.controller import frozen, matrices_at
-from ambseal.machine.loop import closed_loop
+from ambseal.machine import closed_loop, frozen, matrices_at
 
 __all__ = ["StepResponse", "SpinupResult", "spinup", "FrozenSensitivity",
            "frozen_sensitivity"]

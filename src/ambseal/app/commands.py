@@ -56,14 +56,8 @@ from ambseal.report.identify_figures import (
 from ambseal.report.run_report import facility_impulse_report, identification_report
 from ambseal.report.tracking_figures import tracking_figure
 from ambseal.report.verdict import target_difference
-from ambseal.machine.controller import SPEED, ScheduledController
-from ambseal.robust.digital import (
-    check_rate,
-    digital_controller,
-    peak_difference,
-    sampled_plants,
-)
-from ambseal.machine.scheduled_digital import scheduled_digital
+from ambseal.machine import SPEED, ScheduledController, scheduled_digital
+from ambseal.robust import check_rate, digital_controller, peak_difference, sampled_plants
 
 __all__ = ["Designed", "Identified", "identification_stage", "facility_impulses", "design_files",
            "identify_files", "export_design", "show_defaults",

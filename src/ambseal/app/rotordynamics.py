@@ -51,8 +51,7 @@ from ambseal.model.modes import bending_limit_hz, modes
 from ambseal.model.rig import build_system
 from ambseal.report.figures import figure_is_ours
 from ambseal.report.modal_figures import campbell_figure, mode_shapes_figure, stability_map_figure
-from ambseal.robust.digital import DigitalController
-from ambseal.robust.stability import unstable_poles
+from ambseal.robust import DigitalController, unstable_poles
 
 __all__ = ["HANDLERS", "controller_for", "write_table"]
 

@@ -13,7 +13,7 @@ import numpy as np
 from ambseal.config import method_names
 from ambseal.design.recipes import DesignResult
 from ambseal.lti.freqresp import freqresp
-from ambseal.robust.hinf import hinfnorm
+from ambseal.robust import hinfnorm
 
 __all__ = ["design_rise"]
 

@@ -47,10 +47,8 @@ from ambseal.design.specs import DesignSpec, design_spec
 from ambseal.design.weights import Weights, default_weights
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.lti import json_float
-from ambseal.machine.controller import SPEED, ScheduledController
-from ambseal.robust.dk import design_omega, musyn
-from ambseal.robust.hinf import hinfsyn
-from ambseal.robust.lpv import lpvsyn
+from ambseal.machine import SPEED, ScheduledController
+from ambseal.robust import design_omega, hinfsyn, lpvsyn, musyn
 
 __all__ = ["LpvDesign", "FrozenDesign", "design_lpv", "design_frozen",
            "lpv_generalized_plants", "check_full_order"]

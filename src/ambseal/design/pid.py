@@ -14,9 +14,7 @@ from ambseal.lti import feedback_matrices, picklable, zoh
 from ambseal.model.amb import amb_factors, channel_names
 from ambseal.model.rig import build_plant
 from ambseal.model.rotor import assemble_rotor
-from ambseal.robust.digital import discretize_as, with_delay
-from ambseal.robust.digital_loop import discrete_controller
-from ambseal.robust.stability import is_stable
+from ambseal.robust import discrete_controller, discretize_as, is_stable, with_delay
 
 __all__ = ["pid_controller", "pid_from_rig", "reference_pid", "reference_controller", "controller_from_metadata",
            "PID_CORNERS_PER_FS"]

@@ -53,8 +53,7 @@ from ambseal.errors import ConfigError, ModelError
 from ambseal.lti import picklable
 from ambseal.model.lft import Plant
 from ambseal.model.rig import build_plant
-from ambseal.robust.hinf import lft_lower
-from ambseal.robust.mu import mussv
+from ambseal.robust import lft_lower, mussv
 
 __all__ = ["UncertainParameter", "GeneralizedPlant", "generalized_plant",
            "physical_controller", "physical_matrices"]

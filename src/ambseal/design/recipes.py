@@ -65,12 +65,16 @@ from ambseal.lti.freqresp import freqresp
 from ambseal.model.amb import channel_names
 from ambseal.model.modes import poles_near_zero
 from ambseal.model.rig import build_plant, build_system
-from ambseal.robust.delay import design_delay, loop_delay
-from ambseal.robust.dgk import musyn_dgk
-from ambseal.robust.dk import design_omega, musyn
-from ambseal.robust.hinf import hinfsyn
-from ambseal.machine.loop import judged_loop
-from ambseal.robust.order import reduce_controller
+from ambseal.robust import (
+    design_delay,
+    design_omega,
+    hinfsyn,
+    loop_delay,
+    musyn,
+    musyn_dgk,
+    reduce_controller,
+)
+from ambseal.machine import judged_loop
 from ambseal.threads import with_numerics_threads
 
 __all__ = ["DesignResult", "design", "full_order_check", "bound_text"]

@@ -80,9 +80,8 @@ from ambseal.errors import ModelError, SynthesisError
 from ambseal.files import write_json
 from ambseal.model.rig import build_plant
 from ambseal.model.seal import values_following_k
-from ambseal.machine.controller import ScheduledController
-from ambseal.robust.delay import design_delay
-from ambseal.robust.lpv import LpvController, lpvsyn
+from ambseal.machine import ScheduledController
+from ambseal.robust import LpvController, design_delay, lpvsyn
 
 __all__ = ["SealScheduledDesign", "design_seal_scheduled", "CACHE_ENV"]
 

@@ -34,7 +34,7 @@ import numpy as np
 from scipy.signal import butter
 
 from ambseal.errors import ConfigError
-from ambseal.robust.stability import is_stable
+from ambseal.robust import is_stable
 
 #: the ISO 14839-3 zone-A bound on |S_o| by which μ's gain demand on ``K S_o`` exceeds the one
 #: on K (:meth:`Weights.Wk`)

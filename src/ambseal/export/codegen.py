@@ -40,8 +40,7 @@ import scipy.linalg as sla
 
 from ambseal.errors import ConfigError
 from ambseal.files import write_text
-from ambseal.machine.controller import SPEED
-from ambseal.machine.scheduled_digital import ScheduledDigital
+from ambseal.machine import SPEED, ScheduledDigital
 
 __all__ = ["write_c", "schur_realisation", "c_identifier"]
 

@@ -52,10 +52,8 @@ from ambseal.config import MAX_DELAY_SAMPLES, MAX_FREQUENCY_HZ
 from ambseal.errors import AmbsealError, DataError
 from ambseal.files import atomic_write, input_file
 from ambseal.identify.matlab_file import read_matlab
-from ambseal.machine.controller import SPEED
-from ambseal.robust.digital import DigitalController, discretize_as
-from ambseal.robust.digital_loop import DiscreteController
-from ambseal.machine.scheduled_digital import ScheduledDigital
+from ambseal.machine import SPEED, ScheduledDigital
+from ambseal.robust import DigitalController, DiscreteController, discretize_as
 
 __all__ = ["export_controller", "load_controller", "controller_document", "CONVENTION",
            "MATLAB_LINE", "LABEL"]

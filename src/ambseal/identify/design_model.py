@@ -29,7 +29,7 @@ from ambseal.identify.signals import impulse
 from ambseal.identify.stages import acquire, build_models
 from ambseal.model.amb import channel_names
 from ambseal.model.rig import build_system, mechanical_plant
-from ambseal.robust.digital_loop import DiscreteController
+from ambseal.robust import DiscreteController
 
 __all__ = ["ImpulseCheck", "outside_intervals", "non_physical", "design_rig", "truth_rig",
            "impulse_checks"]

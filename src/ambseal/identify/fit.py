@@ -43,7 +43,7 @@ from ambseal.identify.stats import jacobian_correlation
 from ambseal.lti import series_inputs, simulate_lti, zoh
 from ambseal.model.amb import eddy_lag_matrices
 from ambseal.model.lft import Plant
-from ambseal.robust.digital_loop import DiscreteController, closed_loop_matrices
+from ambseal.robust import DiscreteController, closed_loop_matrices
 from ambseal.threads import with_numerics_threads
 
 __all__ = ["FitResult", "ClosedLoopModel", "fit_parameters", "default_bounds", "nrmse_fit"]

@@ -46,7 +46,7 @@ from ambseal.identify.static_load import (
 )
 from ambseal.identify.stats import linear_regression
 from ambseal.model.amb import channel_names
-from ambseal.robust.digital_loop import DiscreteController
+from ambseal.robust import DiscreteController
 
 __all__ = ["ProcedureResult", "thesis_procedure", "seal_test_pressures", "SEAL_COEFFICIENTS",
            "SEAL_TEST_STEPS"]

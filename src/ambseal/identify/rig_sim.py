@@ -42,8 +42,7 @@ from ambseal.model.amb import actuator_matrices, bias_current, eddy_lag_matrices
 from ambseal.model.reduction import modal_reduction
 from ambseal.model.rig import build_system, mechanical_plant
 from ambseal.model.seal import coefficient_value
-from ambseal.robust.digital_loop import DiscreteController, closed_loop_matrices
-from ambseal.robust.stability import is_stable, unstable_poles
+from ambseal.robust import DiscreteController, closed_loop_matrices, is_stable, unstable_poles
 
 __all__ = ["FacilityRecord", "Facility", "prepare_facility", "simulate_facility", "true_rig",
            "reduced_plant", "facility_bias_current", "pressure_values"]

@@ -43,7 +43,7 @@ from ambseal.identify.rig_sim import reduced_plant
 from ambseal.identify.signals import Excitation, stepped_sine
 from ambseal.identify.stages import acquire, identify
 from ambseal.model.amb import actuator_matrices, channel_names
-from ambseal.robust.digital_loop import DiscreteController
+from ambseal.robust import DiscreteController
 
 __all__ = ["whirl_balance", "whirl_stepped_sine", "seal_frequency_test", "fit_reliability",
            "MIN_FIT_PCT"]

@@ -19,7 +19,7 @@ from ambseal.identify.rig_sim import facility_bias_current, reduced_plant, simul
 from ambseal.identify.sensor_lag import TAU_S
 from ambseal.identify.signals import Excitation
 from ambseal.model.amb import actuator_matrices
-from ambseal.robust.digital_loop import DiscreteController
+from ambseal.robust import DiscreteController
 
 __all__ = ["state_space_from_metadata", "check_controller", "sample_rate_of",
            "check_record_metadata", "acquire", "at_speed", "build_models", "identify", "record_spread",

@@ -6,14 +6,22 @@ controller on a machine is: negative feedback ``u = −K y`` from its measuremen
 ``y_<channel>`` to its commands, fixed or scheduled on one named parameter θ — the rotor
 speed (:data:`SPEED`) or any other (:mod:`ambseal.machine.controller`); the one loop every
 verdict is taken on, with the target's hold and computation delay
-(:mod:`ambseal.machine.loop`); and a scheduled controller's table as it runs on the target
+(:mod:`ambseal.machine.loop`; :func:`loop_matrices` and :func:`sample_time` check a
+plant and a controller before they are closed); and a scheduled controller's table as it runs on the target
 (:mod:`ambseal.machine.scheduled_digital`).
 """
 
 from ambseal.machine.controller import SPEED, ScheduledController, frozen, matrices_at
-from ambseal.machine.loop import ClosedLoop, JudgedLoop, closed_loop, judged_loop
+from ambseal.machine.loop import (
+    ClosedLoop,
+    JudgedLoop,
+    closed_loop,
+    judged_loop,
+    loop_matrices,
+    sample_time,
+)
 from ambseal.machine.scheduled_digital import ScheduledDigital, scheduled_digital
 
 __all__ = ["SPEED", "ScheduledController", "frozen", "matrices_at", "ClosedLoop",
-           "JudgedLoop", "closed_loop", "judged_loop", "ScheduledDigital",
-           "scheduled_digital"]
+           "JudgedLoop", "closed_loop", "judged_loop", "loop_matrices", "sample_time",
+           "ScheduledDigital", "scheduled_digital"]

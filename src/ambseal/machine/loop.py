@@ -38,7 +38,7 @@ from ambseal.lti import (
     wired,
     zoh,
 )
-from ambseal.robust.stability import decay_rate, is_stable
+from ambseal.robust import decay_rate, is_stable
 
 __all__ = ["ClosedLoop", "JudgedLoop", "closed_loop", "judged_loop", "delayed_plant",
            "sampled_plant", "loop_matrices", "sample_time"]
@@ -110,7 +110,19 @@ class ClosedLoop:
 
 
 def sample_time(sys: Any) -> float:
-    """Sample time of a python-control system (0 if continuous or a matrix tuple)."""
+    """Sample time of a python-control system (0 if continuous or a matrix tuple).
+
+    Parameters
+    ----------
+    sys : control.StateSpace or (A, B, C, D)
+        The system.
+
+    Returns
+    -------
+    float
+        Sample time (s); 0 for a continuous system, a tuple, or python-control's
+        unspecified ``dt=True``.
+    """
     dt = getattr(sys, "dt", 0)
     return float(dt) if dt not in (None, True) else 0.0
 
@@ -118,6 +130,19 @@ def sample_time(sys: Any) -> float:
 def loop_matrices(G: Any, K: Any) -> tuple[tuple, tuple]:
     """``(A, B, C, D)`` of the plant and of the controller wired to it by signal names
     (:func:`ambseal.lti.interconnect.wired`), their time bases and shapes checked.
+
+    Parameters
+    ----------
+    G : control.StateSpace or (A, B, C, D)
+        The plant, ``nu`` inputs → ``ny`` outputs, continuous or discrete.
+    K : control.StateSpace or (A, B, C, D)
+        The controller, measurements → commands (``u = −K y``), on the plant's time base.
+
+    Returns
+    -------
+    G, K : (A, B, C, D)
+        The plant's matrices, and the controller's with its inputs and outputs in the
+        plant's order (``ny`` inputs, ``nu`` outputs).
 
     Raises
     ------

@@ -32,16 +32,18 @@ import numpy as np
 from ambseal.errors import SynthesisError
 from ambseal.lti import finite_or_none_tree, interp_table
 from ambseal.machine.controller import SPEED, ScheduledController
-from ambseal.robust.digital import (
+from ambseal.robust import (
     DISCRETISATIONS,
     FAST_FRACTION,
     HOLDS,
     KEPT,
+    DiscreteController,
     check_rate,
-    chosen_error,
     choose_method,
+    chosen_error,
     discretize_as,
     hold_keeps,
+    is_stable,
     peak_difference,
     prewarp_frequency_hz,
     residualize,
@@ -49,8 +51,6 @@ from ambseal.robust.digital import (
     split_fast,
     with_delay,
 )
-from ambseal.robust.digital_loop import DiscreteController
-from ambseal.robust.stability import is_stable
 
 __all__ = ["ScheduledDigital", "scheduled_digital", "INTERPOLATION", "interpolation_law"]
 

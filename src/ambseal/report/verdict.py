@@ -24,7 +24,7 @@ from rich.console import Group
 from rich.table import Table
 from rich.text import Text
 
-from ambseal.robust.digital import PEAK_TOLERANCE
+from ambseal.robust import PEAK_TOLERANCE
 
 __all__ = ["ZONE_COLOURS", "ZONE_WORDS", "Verdict", "verdicts", "condition_label",
            "verdict_table_html", "verdict_table_rich", "detail_table_html", "sig",

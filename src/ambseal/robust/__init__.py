@@ -17,7 +17,14 @@ Analysis: :func:`mussv` — μ upper and lower bounds for mixed real/complex blo
 
 The controller that runs on a target: :func:`digital_controller` (fast poles removed, the
 discretisation chosen by the sampled loop), :class:`DiscreteController` and the
-sample-and-hold delay a synthesis model carries (:func:`design_delay`).
+sample-and-hold delay a synthesis model carries (:func:`design_delay`). Its steps, for a
+caller that discretises a family of controllers (a scheduled one): :func:`check_rate`,
+:func:`split_fast`, :func:`hold_keeps`, :func:`residualize`, :func:`discretize_as`,
+:func:`with_delay`, :func:`prewarp_frequency_hz`, :func:`sampled_plants`,
+:func:`choose_method`, :func:`chosen_error`, :func:`peak_difference` and their constants;
+:func:`closed_loop_matrices` — the sampled loop as it runs.
+
+The one stability rule: :func:`is_stable`, :func:`unstable_poles`, :func:`decay_rate`.
 
 Sign conventions. The synthesis functions and :func:`lft_lower` work on the lower LFT
 ``F_l(P, K)``: their controllers close ``u = K y`` (positive feedback), as python-control's
@@ -29,16 +36,45 @@ commands with negative feedback, ``u = −K y``; the caller converts one into th
 
 from ambseal.robust.delay import DesignDelay, design_delay, loop_delay
 from ambseal.robust.dgk import musyn_dgk
-from ambseal.robust.digital import DigitalController, digital_controller
-from ambseal.robust.digital_loop import DiscreteController, discrete_controller
-from ambseal.robust.dk import MusynResult, fit_magnitude, musyn
+from ambseal.robust.digital import (
+    DISCRETISATIONS,
+    FAST_FRACTION,
+    HOLDS,
+    KEPT,
+    PEAK_TOLERANCE,
+    DigitalController,
+    check_rate,
+    choose_method,
+    chosen_error,
+    digital_controller,
+    discretize_as,
+    hold_keeps,
+    peak_difference,
+    prewarp_frequency_hz,
+    residualize,
+    sampled_plants,
+    split_fast,
+    with_delay,
+)
+from ambseal.robust.digital_loop import (
+    DiscreteController,
+    closed_loop_matrices,
+    discrete_controller,
+)
+from ambseal.robust.dk import MusynResult, design_omega, fit_magnitude, musyn
 from ambseal.robust.hinf import HinfResult, hinfnorm, hinfsyn, lft_lower
 from ambseal.robust.lpv import LpvController, LpvSynResult, lpvsyn
 from ambseal.robust.mu import MuResult, mussv
 from ambseal.robust.order import ReductionResult, balred_controller, reduce_controller
+from ambseal.robust.stability import decay_rate, is_stable, unstable_poles
 
-__all__ = ["DesignDelay", "DigitalController", "DiscreteController", "HinfResult",
+__all__ = ["DISCRETISATIONS", "FAST_FRACTION", "HOLDS", "KEPT", "PEAK_TOLERANCE",
+           "DesignDelay", "DigitalController", "DiscreteController", "HinfResult",
            "LpvController", "LpvSynResult", "MuResult", "MusynResult", "ReductionResult",
-           "balred_controller", "design_delay", "digital_controller", "discrete_controller",
-           "fit_magnitude", "hinfnorm", "hinfsyn", "lft_lower", "loop_delay", "lpvsyn",
-           "musyn", "musyn_dgk", "mussv", "reduce_controller"]
+           "balred_controller", "check_rate", "choose_method",
+           "chosen_error", "closed_loop_matrices", "decay_rate", "design_delay",
+           "design_omega", "digital_controller", "discrete_controller", "discretize_as",
+           "fit_magnitude", "hinfnorm", "hinfsyn", "hold_keeps", "is_stable", "lft_lower",
+           "loop_delay", "lpvsyn", "musyn", "musyn_dgk", "mussv", "peak_difference",
+           "prewarp_frequency_hz", "reduce_controller", "residualize", "sampled_plants",
+           "split_fast", "unstable_poles", "with_delay"]

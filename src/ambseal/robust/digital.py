@@ -204,7 +204,9 @@ def peak_difference(err: float | None, method: str, removed_poles_hz) -> dict:
         Largest relative difference over the conditions (-): the choice's (400-point grid)
         or a later analysis's over its own conditions.
     method : str
+        The chosen discretisation, named in the explanation when no fast pole was removed.
     removed_poles_hz : sequence of float
+        The controller poles removed before discretisation (Hz); may be empty.
 
     Returns
     -------
@@ -232,6 +234,24 @@ def check_rate(K, sample_rate_hz: float, delay_samples: int = 0, removable: bool
     A positive rate, a whole delay ≥ 0 and, unless the controller's fast poles may be
     removed (``removable``: a design whose γ or μ can be re-checked, or a scheduled one),
     a rate of at least twice its highest pole (Hz).
+
+    Parameters
+    ----------
+    K : control.StateSpace or None
+        The continuous controller (anything with a state matrix ``A``; a static gain or
+        ``None`` has no poles to check).
+    sample_rate_hz : float
+        The target's sample rate (Hz).
+    delay_samples : int, optional
+        Computation delay (samples).
+    removable : bool, optional
+        Whether poles above half of Nyquist may be removed before discretisation; if not,
+        the rate must be at least twice the highest pole.
+
+    Raises
+    ------
+    ConfigError
+        A rate or delay the target cannot run, naming ``controller.sample_rate_hz``.
     """
 
     check_timing(sample_rate_hz, delay_samples)
@@ -249,6 +269,13 @@ def split_fast(A: np.ndarray, f_cut_hz: float) -> tuple[np.ndarray, int, np.ndar
     """A basis ``V`` (n × n, real) in which ``A`` is block-diagonal: the ``k`` poles with
     ``|λ| ≤ 2π f_cut`` first, the fast ones after (ordered real Schur form, then a
     Sylvester equation removes the coupling block; Golub & Van Loan §7.6.3).
+
+    Parameters
+    ----------
+    A : ndarray, shape (n, n)
+        A real state matrix (rad/s).
+    f_cut_hz : float
+        The boundary (Hz): poles of modulus up to ``2π f_cut_hz`` are slow.
 
     Returns
     -------
@@ -295,7 +322,22 @@ def hold_keeps(fast: np.ndarray, fs: float) -> bool:
 def residualize(mats: Matrices, V: np.ndarray, k: int) -> Matrices:
     """Singular perturbation of ``(A, B, C, D)`` in the basis ``V``: the last ``n − k``
     states held at steady state, ``x₂ = −A₂₂⁻¹ (A₂₁ x₁ + B₂ y)`` (keeps the static gain;
-    Skogestad & Postlethwaite, *Multivariable Feedback Control*, Eq. 11.26)."""
+    Skogestad & Postlethwaite, *Multivariable Feedback Control*, Eq. 11.26).
+
+    Parameters
+    ----------
+    mats : (A, B, C, D)
+        A continuous system, ``n`` states.
+    V : ndarray, shape (n, n)
+        The state basis (:func:`split_fast`): ``V⁻¹ A V`` block-diagonal, slow block first.
+    k : int
+        States kept (the slow block).
+
+    Returns
+    -------
+    (A, B, C, D)
+        The residualised system, ``k`` states, the same inputs and outputs.
+    """
     A, B, C, D = mats
     At = np.linalg.solve(V, A @ V)
     Bt = np.linalg.solve(V, B)
@@ -316,6 +358,22 @@ def discretize_as(mats: Matrices, dt: float, method: str, prewarp_hz: float | No
     ``"tustin"``/``"tustin_prewarp"``: python-control's bilinear transform (with
     ``prewarp_frequency`` 2π·``prewarp_hz``); ``"zoh"``: :func:`ambseal.lti.discrete.zoh`;
     ``"foh"``: SciPy's triangle-hold equivalent (``cont2discrete(method="foh")``).
+
+    Parameters
+    ----------
+    mats : (A, B, C, D)
+        The continuous system.
+    dt : float
+        Sample time (s).
+    method : str
+        One of :data:`DISCRETISATIONS`.
+    prewarp_hz : float, optional
+        The frequency matched exactly by ``"tustin_prewarp"`` (Hz), below Nyquist.
+
+    Returns
+    -------
+    (A, B, C, D)
+        The discrete system at ``dt``, float arrays, the same number of states.
 
     Raises
     ------
@@ -344,7 +402,20 @@ def discretize_as(mats: Matrices, dt: float, method: str, prewarp_hz: float | No
 
 def with_delay(mats: Matrices, n: int) -> Matrices:
     """The discrete controller followed by ``n`` samples of delay, ``u[k] = v[k − n]``:
-    ``n·nu`` extra states holding the last outputs."""
+    ``n·nu`` extra states holding the last outputs.
+
+    Parameters
+    ----------
+    mats : (A, B, C, D)
+        A discrete system, ``nu`` outputs.
+    n : int
+        Delay (samples), ≥ 0.
+
+    Returns
+    -------
+    (A, B, C, D)
+        The delayed system, ``n·nu`` states more.
+    """
     A, B, C, D = mats
     for _ in range(int(n)):
         nk, (nu, ny) = A.shape[0], D.shape
@@ -357,7 +428,23 @@ def with_delay(mats: Matrices, n: int) -> Matrices:
 
 def prewarp_frequency_hz(G_list, K: Matrices, fs: float) -> float | None:
     """Damped frequency (Hz) of the least-damped pole of the continuous loops below half
-    of Nyquist, the frequency where the discrete controller's phase matters most."""
+    of Nyquist, the frequency where the discrete controller's phase matters most.
+
+    Parameters
+    ----------
+    G_list : sequence of (A, B, C, D)
+        The continuous plants, each closed with ``K`` as ``u = −K y``.
+    K : (A, B, C, D)
+        The continuous controller.
+    fs : float
+        Sample rate (Hz).
+
+    Returns
+    -------
+    float or None
+        The frequency (Hz); ``None`` if no loop has a pole with a damped frequency between
+        0 and ``FAST_FRACTION`` of Nyquist.
+    """
     best, f_best = np.inf, None
     for G in G_list:
         lam = feedback_poles(G, K)
@@ -418,7 +505,23 @@ def sampled_plants(plants: Sequence[Matrices], fs: float, n_grid: int = 400, *,
     the Padé lag's of ``delay_samples`` + ½ samples
     (:func:`ambseal.robust.delay.loop_delay`), at ``e^{jωT}`` the sampled plant's from
     the continuous plant's modal form (:func:`ambseal.lti.freqresp.sampled_response_at`,
-    checked at rtol 1e-6) — and the continuous plants with that lag before every input."""
+    checked at rtol 1e-6) — and the continuous plants with that lag before every input.
+
+    Parameters
+    ----------
+    plants : sequence of (A, B, C, D)
+        The continuous full-order plants, one per condition.
+    fs : float
+        Sample rate (Hz).
+    n_grid : int, optional
+        Frequencies of the grid.
+    delay_samples : int, optional
+        Computation delay (samples) of the target.
+
+    Returns
+    -------
+    SampledPlants
+    """
 
     T = 1.0 / fs
     w = 2 * np.pi * np.logspace(0, np.log10(0.999 * fs / 2), n_grid)
@@ -439,15 +542,48 @@ def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int,
                   f_pw: float | None, name: str):
     """Step 3 of the module docstring: the candidates closed with each sampled plant.
 
-    ``cont[j]`` is the continuous controller at plant j, ``discrete(method)`` the discrete
-    controllers at every plant. Returns (best method, its discrete controllers, candidates).
+    Parameters
+    ----------
+    sp : SampledPlants
+        The plants, continuous and sampled, with their responses (:func:`sampled_plants`).
+    cont : list of (A, B, C, D)
+        The continuous controller at each plant (``u = −K y``).
+    discrete : callable
+        ``discrete(method)`` → the discrete controllers (matrices) at every plant.
+    delay : int
+        Computation delay (samples), appended to each discrete controller.
+    methods : sequence of str
+        The candidates tried, in order (:data:`DISCRETISATIONS`, the hold equivalents with
+        :data:`KEPT`).
+    f_pw : float or None
+        Prewarp frequency (Hz) of ``"tustin_prewarp"``; ``None`` skips that candidate.
+    name : str
+        The controller's name in the error message.
+
+    Returns
+    -------
+    method : str
+        The chosen candidate.
+    discrete : list of (A, B, C, D)
+        Its discrete controllers, one per plant, without the delay.
+    candidates : tuple of dict
+        Every candidate tried: ``method``, ``stable``, ``max_abs_z``, the σ̄(S_o) peaks
+        and ``sensitivity_peak_error``.
+
+    Raises
+    ------
+    SynthesisError
+        No candidate keeps every sampled loop stable where the continuous loop is.
+
+    Notes
+    -----
 
     The kept candidate is the one with the smallest σ̄(S_o) peak error (first in
     ``methods`` on a tie) among those stable wherever the design is. Each candidate's error
     comes from its frequency responses alone; the sampled loops' poles (one eigenvalue
     problem of the full-order loop per plant, most of the cost) are then computed in the
     order of the errors, only until the first stable candidate
-    (:func:`ambseal.robust._digital_choice.first_stable`): a candidate that ranks after it
+    (``first_stable`` of the module ``_digital_choice``): a candidate that ranks after it
     cannot be chosen, and is reported with ``stable`` and ``max_abs_z`` ``None`` and the
     reason (``not_checked``).
     """

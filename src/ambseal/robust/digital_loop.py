@@ -123,8 +123,22 @@ def closed_loop_matrices(Ad, Bd, C, ctrl: DiscreteController):
     :func:`ambseal.lti.interconnect.feedback_matrices` of the sampled plant and the
     controller, with the excitation as the loop's input disturbance.
 
-    Returns (A_cl, B_cl, C_y, C_iref, D_iref): state [x; x_c]; y = C_y z;
-    i_ref = C_iref z + D_iref e.
+    Parameters
+    ----------
+    Ad : ndarray, shape (n, n)
+        The sampled plant's state matrix.
+    Bd : ndarray, shape (n, m)
+        Its input matrix (``m`` current references).
+    C : ndarray, shape (k, n)
+        Its output matrix (``k`` measurements; no feedthrough).
+    ctrl : DiscreteController
+        The controller at the plant's sample time.
+
+    Returns
+    -------
+    (A_cl, B_cl, C_y, C_iref, D_iref)
+        State ``z = [x; x_c]``, input ``e``: ``y = C_y z``,
+        ``i_ref = C_iref z + D_iref e``.
     """
     k = C.shape[0]
     Acl, Bcl, Ccl, Dcl = feedback_matrices((Ad, Bd, C, np.zeros((k, Bd.shape[1]))),

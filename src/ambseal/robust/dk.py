@@ -229,6 +229,18 @@ def design_omega(f_min_hz: float, f_max_hz: float, n: int = 60) -> np.ndarray:
     D–K iteration at seconds. A lightly damped peak between grid points is missed by the μ
     peak on the grid: a design is to be judged afterwards on a dense grid.
 
+    Parameters
+    ----------
+    f_min_hz, f_max_hz : float
+        The band (Hz).
+    n : int, optional
+        Points of the grid.
+
+    Returns
+    -------
+    numpy.ndarray of float, shape (n,)
+        The grid (rad/s).
+
     Raises
     ------
     ConfigError

@@ -101,7 +101,20 @@ def is_stable(poles, dt: float = 0.0) -> bool:
 
 
 def unstable_poles(poles, dt: float = 0.0) -> np.ndarray:
-    """The poles that break the rule (as given: rad/s, or z), largest real rate first."""
+    """The poles that break the rule (as given: rad/s, or z), largest real rate first.
+
+    Parameters
+    ----------
+    poles : array_like of complex
+        Eigenvalues of a state matrix (rad/s), or ``z`` of a discrete one.
+    dt : float
+        Sample time (s) of a discrete system; 0 for a continuous one.
+
+    Returns
+    -------
+    numpy.ndarray of complex
+        The poles that are not stable by :func:`is_stable`'s rule; empty if none.
+    """
     p = np.asarray(poles, dtype=complex).ravel()
     s = _rates(p, dt)
     bad = s.real >= -stability_tolerance(s)

@@ -32,15 +32,15 @@ from scipy.optimize import linear_sum_assignment
 
 from ambseal.analysis.cases import run_cases
 from ambseal.lti import json_float, json_list
-from ambseal.model.modes import (
+from ambseal.model import (
     RIGID_BODY_RAD_S,
     bending_limit_hz,
+    build_mesh,
+    build_plant,
     classify_poles,
     free_bending_hz,
     poles_near_zero,
 )
-from ambseal.model.rig import build_plant
-from ambseal.model.rotor import build_mesh
 from ambseal.machine import frozen, judged_loop
 from ambseal.robust import decay_rate, is_stable, loop_delay
 

@@ -57,9 +57,7 @@ from ambseal.analysis.unbalance import unbalance_from_compliance
 from ambseal.design.lpv_plant import lpv_plant, vertex_grid_hz
 from ambseal.design.specs import RIGID_STATES
 from ambseal.lti import finite_or_none, freqresp_at, json_float, wired
-from ambseal.model.modes import classify_poles
-from ambseal.model.rig import build_plant
-from ambseal.model.seal import pressure_for_k, seal_values
+from ambseal.model import build_plant, classify_poles, pressure_for_k, seal_values
 from ambseal.machine import (
     SPEED,
     JudgedLoop,

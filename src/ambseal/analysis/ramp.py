@@ -62,8 +62,7 @@ from ambseal.errors import ModelError
 from ambseal.identify.fit import ClosedLoopModel
 from ambseal.identify.rig_sim import prepare_facility, pressure_values, reduced_plant, true_rig
 from ambseal.identify.tracking import OnlineTracker, TrackingSettings, tracking_excitation
-from ambseal.model.amb import actuator_matrices
-from ambseal.model.rig import build_plant
+from ambseal.model import actuator_matrices, build_plant
 from ambseal.robust import DiscreteController, discretize_as, with_delay
 
 __all__ = ["RampRun", "RampResult", "pressure_ramp", "ramp_simulation", "frozen_cases"]

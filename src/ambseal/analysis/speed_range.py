@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 from ambseal.analysis.judge import OperatingPoint
 from ambseal.lti import json_float
-from ambseal.model.rig import build_plant
+from ambseal.model import build_plant
 from ambseal.robust import loop_delay
 from ambseal.machine import judged_loop
 

@@ -28,7 +28,7 @@ from ambseal.analysis.judge import JudgeSettings, OperatingPoint, judge
 from ambseal.config import parse_rig, rig_with_values
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
-from ambseal.model.modes import bending_limit_hz
+from ambseal.model import bending_limit_hz
 from ambseal.robust import is_stable
 
 __all__ = ["MAX_RANGE_POINTS", "sweep", "sweep_case", "check_cases", "stability_boundary",

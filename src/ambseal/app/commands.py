@@ -42,11 +42,16 @@ from ambseal.identify.static_load import (
 )
 from ambseal.identify.tracking import TrackingSettings, check_excitation, track
 from ambseal.lti import finite_or_none
-from ambseal.model.amb import channel_names
+from ambseal.model import (
+    assemble_rotor,
+    build_mesh,
+    build_plant,
+    build_system,
+    channel_names,
+    pressure_for_k,
+    seal_values,
+)
 from ambseal.model.modes import modes
-from ambseal.model.rig import build_plant, build_system
-from ambseal.model.rotor import assemble_rotor, build_mesh
-from ambseal.model.seal import pressure_for_k, seal_values
 from ambseal.report.identify_figures import (
     correlation_figure,
     error_budget_figure,

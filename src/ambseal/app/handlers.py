@@ -37,7 +37,7 @@ from ambseal.identify.data import record_is_ours, save_measurement
 from ambseal.identify.excitation import IMPULSE_LEAD, excitation_plan
 from ambseal.identify.stages import acquire, at_speed
 from ambseal.identify.static_load import save_static_record, virtual_static_load
-from ambseal.model.amb import channel_names
+from ambseal.model import channel_names
 from ambseal.report.run_report import rig_clearances_um
 from ambseal.report.verdict import verdict_table_rich, verdicts
 

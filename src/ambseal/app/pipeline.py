@@ -56,7 +56,7 @@ from ambseal.design.recipes import design
 from ambseal.design.specs import DesignSpec, design_spec
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.files import RunFolder, write_json
-from ambseal.model.rig import build_plant
+from ambseal.model import build_plant
 from ambseal.report.progress import StageProgress
 from ambseal.report.run_report import (
     gains_figure,

@@ -46,9 +46,8 @@ from ambseal.errors import ConfigError
 from ambseal.export.controller_files import load_controller
 from ambseal.files import OwnedFolder, atomic_write, claim_file, write_json, write_text
 from ambseal.io.ross import import_ross_file
-from ambseal.model.amb import channel_names
-from ambseal.model.modes import bending_limit_hz, modes
-from ambseal.model.rig import build_system
+from ambseal.model import bending_limit_hz, build_system, channel_names
+from ambseal.model.modes import modes
 from ambseal.report.figures import figure_is_ours
 from ambseal.report.modal_figures import campbell_figure, mode_shapes_figure, stability_map_figure
 from ambseal.robust import DigitalController, unstable_poles

@@ -33,11 +33,15 @@ import scipy.linalg as sla
 
 from ambseal.config import FrequencyTable
 from ambseal.errors import ModelError
-from ambseal.model.amb import actuator_matrices, eddy_lag_matrices
-from ambseal.model.lft import Plant
-from ambseal.model.reduction import modal_reduction
-from ambseal.model.rig import build_system, mechanical_plant
-from ambseal.model.seal import coefficient_value
+from ambseal.model import (
+    Plant,
+    actuator_matrices,
+    build_system,
+    coefficient_value,
+    eddy_lag_matrices,
+    mechanical_plant,
+    modal_reduction,
+)
 
 __all__ = ["LpvPlant", "lpv_plant", "vertex_grid_hz"]
 

@@ -11,9 +11,7 @@ from ambseal.design.conditions import judged_conditions
 from ambseal.errors import ConfigError, DataError
 from ambseal.identify import stages
 from ambseal.lti import feedback_matrices, picklable, zoh
-from ambseal.model.amb import amb_factors, channel_names
-from ambseal.model.rig import build_plant
-from ambseal.model.rotor import assemble_rotor
+from ambseal.model import amb_factors, assemble_rotor, build_plant, channel_names
 from ambseal.robust import discrete_controller, discretize_as, is_stable, with_delay
 
 __all__ = ["pid_controller", "pid_from_rig", "reference_pid", "reference_controller", "controller_from_metadata",

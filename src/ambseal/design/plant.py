@@ -51,8 +51,7 @@ import numpy as np
 from ambseal.design.weights import diagonal_weight
 from ambseal.errors import ConfigError, ModelError
 from ambseal.lti import picklable
-from ambseal.model.lft import Plant
-from ambseal.model.rig import build_plant
+from ambseal.model import Plant, build_plant
 from ambseal.robust import lft_lower, mussv
 
 __all__ = ["UncertainParameter", "GeneralizedPlant", "generalized_plant",

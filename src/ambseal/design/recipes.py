@@ -62,9 +62,7 @@ from ambseal.design.weights import Weights
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.lti import lft_lower
 from ambseal.lti.freqresp import freqresp
-from ambseal.model.amb import channel_names
-from ambseal.model.modes import poles_near_zero
-from ambseal.model.rig import build_plant, build_system
+from ambseal.model import build_plant, build_system, channel_names, poles_near_zero
 from ambseal.robust import (
     design_delay,
     design_omega,

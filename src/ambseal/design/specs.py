@@ -89,11 +89,16 @@ from ambseal.identify.excitation import (
     impulse_length,
 )
 from ambseal.identify.intervals import uncertainty_from_fit
-from ambseal.model.amb import amb_factors, bias_current, bias_currents
-from ambseal.model.modes import modes_from_poles, poles_near_zero
-from ambseal.model.rig import build_system
-from ambseal.model.rotor import assemble_rotor
-from ambseal.model.seal import coefficient_value
+from ambseal.model import (
+    amb_factors,
+    assemble_rotor,
+    bias_current,
+    bias_currents,
+    build_system,
+    coefficient_value,
+    modes_from_poles,
+    poles_near_zero,
+)
 
 __all__ = ["Machine", "DesignSpec", "machine", "design_spec", "round_125", "judged_conditions"]
 

@@ -21,7 +21,7 @@ from ambseal.identify.procedure import ProcedureResult
 from ambseal.identify.signals import chirp
 from ambseal.identify.stages import acquire, build_models
 from ambseal.lti import finite_or_none
-from ambseal.model.rig import build_plant
+from ambseal.model import build_plant
 
 __all__ = ["FrfChecks", "frf_checks", "truth_errors", "true_line", "interval_check"]
 

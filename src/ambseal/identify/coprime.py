@@ -32,7 +32,7 @@ import scipy.linalg as sla
 
 from ambseal.errors import DataError, IdentificationError
 from ambseal.lti import freqresp_at, zoh
-from ambseal.model.lft import Plant
+from ambseal.model import Plant
 from ambseal.robust import is_stable
 
 __all__ = ["CoprimeFactors", "observer_gains", "coprime_factors", "youla_factorisation",

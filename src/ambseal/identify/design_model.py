@@ -27,8 +27,7 @@ from ambseal.identify.procedure import ProcedureResult
 from ambseal.identify.rig_sim import true_rig
 from ambseal.identify.signals import impulse
 from ambseal.identify.stages import acquire, build_models
-from ambseal.model.amb import channel_names
-from ambseal.model.rig import build_system, mechanical_plant
+from ambseal.model import build_system, channel_names, mechanical_plant
 from ambseal.robust import DiscreteController
 
 __all__ = ["ImpulseCheck", "outside_intervals", "non_physical", "design_rig", "truth_rig",

@@ -46,7 +46,7 @@ from dataclasses import dataclass
 
 from ambseal.config import RigConfig
 from ambseal.errors import ConfigError
-from ambseal.model.amb import bias_current
+from ambseal.model import bias_current
 
 __all__ = ["ExcitationPlan", "excitation_plan", "impulse_amplitude", "impulse_length",
            "welch_segment", "SAMPLES_PER_IMPULSE", "PRBS_CLOCK_SAMPLES"]

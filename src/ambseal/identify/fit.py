@@ -41,8 +41,7 @@ from ambseal.identify.sandwich import _covariance, _long_run_covariance, _score_
 from ambseal.identify.sensor_lag import TAU_S, lag_test_dict, with_sensor_lag
 from ambseal.identify.stats import jacobian_correlation
 from ambseal.lti import series_inputs, simulate_lti, zoh
-from ambseal.model.amb import eddy_lag_matrices
-from ambseal.model.lft import Plant
+from ambseal.model import Plant, eddy_lag_matrices
 from ambseal.robust import DiscreteController, closed_loop_matrices
 from ambseal.threads import with_numerics_threads
 

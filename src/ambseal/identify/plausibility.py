@@ -33,7 +33,7 @@ import math
 import numpy as np
 
 from ambseal.errors import IdentificationError
-from ambseal.model.amb import amb_factors
+from ambseal.model import amb_factors
 
 __all__ = ["RATIO", "implausible", "fit_failure", "first_nonfinite", "require_finite"]
 

@@ -45,7 +45,7 @@ from ambseal.identify.static_load import (
     with_static,
 )
 from ambseal.identify.stats import linear_regression
-from ambseal.model.amb import channel_names
+from ambseal.model import channel_names
 from ambseal.robust import DiscreteController
 
 __all__ = ["ProcedureResult", "thesis_procedure", "seal_test_pressures", "SEAL_COEFFICIENTS",

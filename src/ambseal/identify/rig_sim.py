@@ -38,10 +38,15 @@ from ambseal.config import MAX_ELEMENTS, RigConfig, TruthSection
 from ambseal.errors import ConfigError, ModelError
 from ambseal.identify.facility_loop import facility_loop
 from ambseal.lti import series_inputs, zoh
-from ambseal.model.amb import actuator_matrices, bias_current, eddy_lag_matrices
-from ambseal.model.reduction import modal_reduction
-from ambseal.model.rig import build_system, mechanical_plant
-from ambseal.model.seal import coefficient_value
+from ambseal.model import (
+    actuator_matrices,
+    bias_current,
+    build_system,
+    coefficient_value,
+    eddy_lag_matrices,
+    mechanical_plant,
+    modal_reduction,
+)
 from ambseal.robust import DiscreteController, closed_loop_matrices, is_stable, unstable_poles
 
 __all__ = ["FacilityRecord", "Facility", "prepare_facility", "simulate_facility", "true_rig",

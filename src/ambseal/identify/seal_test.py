@@ -42,7 +42,7 @@ from ambseal.identify.fit import TAU_E, ClosedLoopModel, FitResult
 from ambseal.identify.rig_sim import reduced_plant
 from ambseal.identify.signals import Excitation, stepped_sine
 from ambseal.identify.stages import acquire, identify
-from ambseal.model.amb import actuator_matrices, channel_names
+from ambseal.model import actuator_matrices, channel_names
 from ambseal.robust import DiscreteController
 
 __all__ = ["whirl_balance", "whirl_stepped_sine", "seal_frequency_test", "fit_reliability",

@@ -18,7 +18,7 @@ from ambseal.identify.fit import TAU_E, ClosedLoopModel, FitResult, default_boun
 from ambseal.identify.rig_sim import facility_bias_current, reduced_plant, simulate_facility
 from ambseal.identify.sensor_lag import TAU_S
 from ambseal.identify.signals import Excitation
-from ambseal.model.amb import actuator_matrices
+from ambseal.model import actuator_matrices
 from ambseal.robust import DiscreteController
 
 __all__ = ["state_space_from_metadata", "check_controller", "sample_rate_of",

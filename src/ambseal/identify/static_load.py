@@ -45,9 +45,13 @@ from ambseal.errors import ConfigError, DataError
 from ambseal.files import atomic_write, read_text
 from ambseal.identify.fit import FitResult
 from ambseal.identify.rig_sim import true_rig
-from ambseal.model.amb import amb_factors, channel_names
-from ambseal.model.rig import build_system, mechanical_plant
-from ambseal.model.seal import coefficient_value
+from ambseal.model import (
+    amb_factors,
+    build_system,
+    channel_names,
+    coefficient_value,
+    mechanical_plant,
+)
 
 __all__ = ["StaticLoadResult", "static_ki", "load_steps", "virtual_static_load", "load_static_record",
            "save_static_record", "join_static", "with_static", "with_static_record",

@@ -69,9 +69,13 @@ from ambseal.identify.excitation import PRBS_CLOCK_SAMPLES
 from ambseal.identify.fit import _DEFAULT_SCALE, ClosedLoopModel
 from ambseal.identify.signals import prbs
 from ambseal.identify.stages import build_models
-from ambseal.model.amb import channel_names
-from ambseal.model.rig import build_system, mechanical_plant
-from ambseal.model.seal import pressure_for_k, values_following
+from ambseal.model import (
+    build_system,
+    channel_names,
+    mechanical_plant,
+    pressure_for_k,
+    values_following,
+)
 
 __all__ = ["TrackingSettings", "TrackingResult", "track", "flops_per_sample",
            "linearised_model", "rpem_kernel", "OnlineTracker", "score_test", "held_error_check",

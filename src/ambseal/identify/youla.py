@@ -84,7 +84,7 @@ from ambseal.identify.coprime import (
     youla_factorisation,
 )
 from ambseal.lti import simulate_lti, zoh
-from ambseal.model.lft import Plant
+from ambseal.model import Plant
 
 __all__ = [
     "CoprimeFactors",

@@ -69,8 +69,7 @@ from pathlib import Path
 import numpy as np
 from pydantic import ValidationError
 
-from ambseal.config import RigConfig, dump_rig, parse_rig
-from ambseal.config.rig import Pid
+from ambseal.config import Pid, RigConfig, dump_rig, parse_rig
 from ambseal.errors import AmbsealError, ConfigError
 from ambseal.files import claim_file, read_text, stamp_text, write_text
 

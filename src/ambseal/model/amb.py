@@ -77,6 +77,7 @@ def bias_currents(cfg: RigConfig) -> list[float | None]:
     Parameters
     ----------
     cfg : RigConfig
+        The rig; its AMBs in file order.
 
     Returns
     -------
@@ -95,6 +96,7 @@ def bias_current(cfg: RigConfig) -> float | None:
     Parameters
     ----------
     cfg : RigConfig
+        The rig.
 
     Returns
     -------
@@ -139,6 +141,18 @@ def amb_factors(amb: Amb) -> tuple[tuple[float, float], tuple[float, float]]:
     Each factor of each axis given explicitly (``ki``, ``ks``: a number or per axis) wins;
     the others come from the geometry through :func:`amb_factors_from_geometry`
     (Schweitzer & Maslen 2009, Eqs. 3.27–3.30), the same for both axes.
+
+    Parameters
+    ----------
+    amb : Amb
+        One ``[[amb]]`` of the rig file.
+
+    Returns
+    -------
+    ki : (float or None, float or None)
+        (Ki_ζ, Ki_η), N/A; ``None`` for an axis given neither a factor nor the geometry.
+    ks : (float or None, float or None)
+        (Ks_ζ, Ks_η), N/m; likewise.
     """
     geo = (None, None)
     if None not in (amb.turns, amb.pole_area, amb.air_gap, amb.bias_current):
@@ -243,7 +257,15 @@ def actuator_matrices(act: Actuator) -> tuple[np.ndarray, np.ndarray, np.ndarray
       equation drops the 2 and a square, the standard form is meant: ω_n = 1360 rad/s,
       ζ = 0.9 give the 216 Hz, well-damped amplifier the papers describe).
 
-    Returns arrays of shapes (n, n), (n, 1), (1, n), (1, 1) with unit DC gain.
+    Parameters
+    ----------
+    act : Actuator
+        The rig file's ``actuator`` of an AMB (model, cutoff, natural frequency, damping).
+
+    Returns
+    -------
+    (A, B, C, D)
+        Shapes (n, n), (n, 1), (1, n), (1, 1), n = 0, 1 or 2, with unit DC gain.
     """
     if act.model == "none":
         return np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.ones((1, 1))
@@ -257,7 +279,18 @@ def actuator_matrices(act: Actuator) -> tuple[np.ndarray, np.ndarray, np.ndarray
 
 def eddy_lag_matrices(tau_e: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(A, B, C, D) of the eddy-current lag 1/(τ_e s + 1) between coil current and force
-    (thesis P2 §4, Fig. 2, "unknown actuator dynamics"); a unit gain for τ_e = 0."""
+    (thesis P2 §4, Fig. 2, "unknown actuator dynamics"); a unit gain for τ_e = 0.
+
+    Parameters
+    ----------
+    tau_e : float
+        The lag's time constant (s), ≥ 0.
+
+    Returns
+    -------
+    (A, B, C, D)
+        Shapes (1, 1), (1, 1), (1, 1), (1, 1); for τ_e = 0, (0, 0), (0, 1), (1, 0), (1, 1).
+    """
     if tau_e <= 0:
         return np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.ones((1, 1))
     return np.array([[-1.0 / tau_e]]), np.array([[1.0 / tau_e]]), np.ones((1, 1)), np.zeros((1, 1))

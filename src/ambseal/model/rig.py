@@ -180,6 +180,18 @@ def mechanical_plant(sys: SecondOrderSystem) -> Plant:
 
     A stiffness change θ U Vᵀ gives B_θ = [0; −M⁻¹U], C_θ = [Vᵀ, 0]; a damping change
     C_θ = [0, Vᵀ]; a force-factor change B_θ = [0; M⁻¹U], D_θ = e_jᵀ (thesis P1 Eqs. 48–50).
+
+    Parameters
+    ----------
+    sys : SecondOrderSystem
+        The assembled model (:func:`build_system`) with its parameter changes.
+
+    Returns
+    -------
+    Plant
+        State ``[q; q̇]`` (``2 n_dof`` states), the inputs and outputs of ``sys``
+        (``input_names``, ``output_names``; no actuator dynamics), one :class:`Parameter`
+        per change of ``sys``.
     """
     A, B, C = sys.state_matrices()
     n, m = sys.n_dof, B.shape[1]

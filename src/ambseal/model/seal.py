@@ -165,10 +165,12 @@ def values_following_k(seals, name: str, value: float, known) -> dict[str, float
     value : float
         Its value (SI).
     known : container of str
+        The names that may be returned (the plant's parameter names).
 
     Returns
     -------
     dict
+        Parameter name → value (SI).
     """
     return values_following(seals, {name: value}, known)
 
@@ -178,7 +180,22 @@ def values_following(seals, values: dict, known) -> dict[str, float]:
     coefficients at the pressure that gives the first seal k affine in the pressure among
     ``values`` (:func:`values_following_k`), the other coefficients of each seal whose k is
     in ``values`` at the pressure of its own k; the given values win; only names in
-    ``known``."""
+    ``known``.
+
+    Parameters
+    ----------
+    seals : sequence of Seal
+        The rig's ``[[seal]]`` entries.
+    values : dict
+        Parameter name → value (SI), the tracked or fitted ones.
+    known : container of str
+        The names that may be returned besides ``values`` (the plant's parameter names).
+
+    Returns
+    -------
+    dict
+        Parameter name → value (SI): ``values`` and the coefficients that follow them.
+    """
     pressures = {n: pressure_for_k(seals, n, v) for n, v in values.items()}
     pressures = {n.rpartition(".")[0]: p for n, p in pressures.items() if p is not None}
     if not pressures:

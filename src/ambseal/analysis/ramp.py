@@ -59,9 +59,16 @@ import numpy as np
 
 from ambseal.analysis.judge import JudgeSettings, OperatingPoint, judge
 from ambseal.errors import ModelError
-from ambseal.identify.fit import ClosedLoopModel
-from ambseal.identify.rig_sim import prepare_facility, pressure_values, reduced_plant, true_rig
-from ambseal.identify.tracking import OnlineTracker, TrackingSettings, tracking_excitation
+from ambseal.identify import (
+    ClosedLoopModel,
+    OnlineTracker,
+    TrackingSettings,
+    prepare_facility,
+    pressure_values,
+    reduced_plant,
+    tracking_excitation,
+    true_rig,
+)
 from ambseal.model import actuator_matrices, build_plant
 from ambseal.robust import DiscreteController, discretize_as, with_delay
 

@@ -29,18 +29,28 @@ from ambseal.errors import ConfigError, DataError, IdentificationError, Synthesi
 from ambseal.export.codegen import write_c
 from ambseal.export.controller_files import export_controller
 from ambseal.files import writable_folder, write_json, write_text
-from ambseal.identify.budget import advice
-from ambseal.identify.checks import frf_checks, interval_check, truth_errors
-from ambseal.identify.data import load_measurement
-from ambseal.identify.design_model import design_rig, impulse_checks, truth_rig
-from ambseal.identify.plausibility import fit_failure, implausible, require_finite
-from ambseal.identify.procedure import thesis_procedure
-from ambseal.identify.residuals import MISMATCH
-from ambseal.identify.stages import check_record_metadata, identify, record_spread
-from ambseal.identify.static_load import (
+from ambseal.identify import (
+    MISMATCH,
+    TrackingSettings,
+    advice,
+    check_excitation,
+    check_record_metadata,
+    design_rig,
+    fit_failure,
+    frf_checks,
+    identify,
+    implausible,
+    impulse_checks,
+    interval_check,
+    load_measurement,
+    record_spread,
+    require_finite,
+    thesis_procedure,
+    track,
+    truth_errors,
+    truth_rig,
     with_static_record,
 )
-from ambseal.identify.tracking import TrackingSettings, check_excitation, track
 from ambseal.lti import finite_or_none
 from ambseal.model import (
     assemble_rotor,

@@ -32,11 +32,20 @@ from ambseal.errors import AmbsealError, ConfigError, with_source
 from ambseal.export.codegen import c_identifier, write_c
 from ambseal.export.controller_files import load_controller
 from ambseal.files import OwnedFolder, claim_file, writable_folder
-from ambseal.identify import signals
-from ambseal.identify.data import record_is_ours, save_measurement
-from ambseal.identify.excitation import IMPULSE_LEAD, excitation_plan
-from ambseal.identify.stages import acquire, at_speed
-from ambseal.identify.static_load import save_static_record, virtual_static_load
+from ambseal.identify import (
+    IMPULSE_LEAD,
+    acquire,
+    at_speed,
+    chirp,
+    excitation_plan,
+    impulse,
+    prbs,
+    record_is_ours,
+    save_measurement,
+    save_static_record,
+    stepped_sine,
+    virtual_static_load,
+)
 from ambseal.model import channel_names
 from ambseal.report.run_report import rig_clearances_um
 from ambseal.report.verdict import verdict_table_rich, verdicts
@@ -82,25 +91,25 @@ def _acquire_cmd(args: argparse.Namespace) -> int:
     amplitude, duration = plan.amplitude_a, given(args.duration_s, plan.prbs_duration_s)
     try:
         if args.excitation == "prbs":
-            ex = signals.prbs(amplitude_a=amplitude,
-                              clock_period_s=given(args.clock_period_s, plan.prbs_clock_s),
-                              duration_s=duration, seed=args.seed, **common)
+            ex = prbs(amplitude_a=amplitude,
+                      clock_period_s=given(args.clock_period_s, plan.prbs_clock_s),
+                      duration_s=duration, seed=args.seed, **common)
         elif args.excitation == "sine":
             freqs = (list(plan.sine_hz) if args.frequencies_hz is None
                      else [float(f) for f in args.frequencies_hz.split(",")])
-            ex = signals.stepped_sine(frequencies_hz=freqs, amplitude_a=amplitude,
-                                      cycles=args.cycles, settling_cycles=args.settling_cycles,
-                                      **common)
+            ex = stepped_sine(frequencies_hz=freqs, amplitude_a=amplitude,
+                              cycles=args.cycles, settling_cycles=args.settling_cycles,
+                              **common)
         elif args.excitation == "chirp":
             f0, f1 = plan.chirp_hz
-            ex = signals.chirp(f0_hz=given(args.f0_hz, f0), f1_hz=given(args.f1_hz, f1),
-                               duration_s=duration, amplitude_a=amplitude, method=args.chirp,
-                               **common)
+            ex = chirp(f0_hz=given(args.f0_hz, f0), f1_hz=given(args.f1_hz, f1),
+                       duration_s=duration, amplitude_a=amplitude, method=args.chirp,
+                       **common)
         else:
             width = given(args.width_s, plan.impulse_s)
-            ex = signals.impulse(amplitude_a=amplitude, width_s=width,
-                                 start_s=given(args.start_s, IMPULSE_LEAD * width),
-                                 duration_s=duration, **common)
+            ex = impulse(amplitude_a=amplitude, width_s=width,
+                         start_s=given(args.start_s, IMPULSE_LEAD * width),
+                         duration_s=duration, **common)
     except ValueError as exc:
         raise ConfigError(f"acquire: {exc}") from None
     try:

@@ -9,7 +9,7 @@ import numpy as np
 
 from ambseal.design.conditions import judged_conditions
 from ambseal.errors import ConfigError, DataError
-from ambseal.identify import stages
+from ambseal.identify import check_controller, sample_rate_of, state_space_from_metadata
 from ambseal.lti import feedback_matrices, picklable, zoh
 from ambseal.model import amb_factors, assemble_rotor, build_plant, channel_names
 from ambseal.robust import discrete_controller, discretize_as, is_stable, with_delay
@@ -250,8 +250,8 @@ def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<
 
     c = meta.get("controller")
     if not (isinstance(c, dict) and c.get("type") == "pid" and "state_space" not in c):
-        return stages.state_space_from_metadata(meta, axes, source)
-    fs = stages.sample_rate_of(meta, source)
+        return state_space_from_metadata(meta, axes, source)
+    fs = sample_rate_of(meta, source)
     try:
         kp, ti, td, eps = (float(c[k]) for k in ("kp", "ti", "td", "eps"))
         if not (kp > 0 and ti > 0 and td >= 0 and eps > 0):
@@ -260,4 +260,4 @@ def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<
         ctrl = discrete_controller(pid_controller(kp, ti, td, eps, axes), 1.0 / fs, method)
     except (KeyError, TypeError, ValueError) as exc:
         raise DataError(f"{source}: metadata.controller: {exc}") from None
-    return stages.check_controller(replace(ctrl, description=dict(c)), axes, fs, source)
+    return check_controller(replace(ctrl, description=dict(c)), axes, fs, source)

@@ -82,13 +82,13 @@ from ambseal.design.conditions import judged_conditions, stability_speeds
 from ambseal.design.pid import reference_pid
 from ambseal.design.weights import default_weights
 from ambseal.errors import ConfigError, DataError
-from ambseal.identify.excitation import (
+from ambseal.identify import (
     BIAS_PER_AMPLITUDE,
     SAMPLES_PER_IMPULSE,
     impulse_amplitude,
     impulse_length,
+    uncertainty_from_fit,
 )
-from ambseal.identify.intervals import uncertainty_from_fit
 from ambseal.model import (
     amb_factors,
     assemble_rotor,

@@ -51,7 +51,7 @@ from scipy.io import savemat
 from ambseal.config import MAX_DELAY_SAMPLES, MAX_FREQUENCY_HZ
 from ambseal.errors import AmbsealError, DataError
 from ambseal.files import atomic_write, input_file
-from ambseal.identify.matlab_file import read_matlab
+from ambseal.identify import read_matlab
 from ambseal.machine import SPEED, ScheduledDigital
 from ambseal.robust import DigitalController, DiscreteController, discretize_as
 

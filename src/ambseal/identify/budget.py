@@ -288,12 +288,20 @@ def advice(budget: ErrorBudget | None, cfg, fitted, pressures_bar, share: float 
     Parameters
     ----------
     budget : ErrorBudget or None
+        The fit's error budget; None gives only the seal warning.
     cfg : RigConfig
+        The rig fitted (its seals).
     fitted : iterable of str
+        The fitted parameters.
     pressures_bar : iterable of float
         The records' pressure drops (bar).
     share : float
         Share of an estimate's variance above which a fixed value dominates it.
+
+    Returns
+    -------
+    list of str
+        One sentence per warning; empty when there is none.
     """
     out = []
     if budget is not None:

@@ -111,6 +111,13 @@ def frf_checks(cfg, truth, res: ProcedureResult, controller, *, seed: int = 99,
 def truth_errors(res: ProcedureResult, seal_name: str | None) -> dict:
     """Each estimate of the procedure beside its truth (the virtual facility's).
 
+    Parameters
+    ----------
+    res : ProcedureResult
+        The identification.
+    seal_name : str or None
+        The seal whose regressions are compared; None for none.
+
     Returns
     -------
     dict
@@ -201,7 +208,20 @@ def interval_check(errors: dict) -> dict:
 
 
 def true_line(truth, name: str):
-    """The true coefficient against pressure (bar) as a function, or None if not in the truth."""
+    """The true coefficient against pressure (bar) as a function, or None if not in the truth.
+
+    Parameters
+    ----------
+    truth : TruthSection
+        The facility's truth.
+    name : str
+        A parameter name (``"<seal>.k"``).
+
+    Returns
+    -------
+    callable or None
+        ``f(pressure_bar) → value`` (SI): the truth's affine law, or its constant.
+    """
     v = truth.parameters.get(name)
     if v is None:
         return None

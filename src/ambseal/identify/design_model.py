@@ -79,7 +79,24 @@ def non_physical(cfg: RigConfig, res: ProcedureResult) -> list[str]:
 def design_rig(cfg: RigConfig, res: ProcedureResult) -> tuple[RigConfig, dict]:
     """The rig to design on (module rule) and a JSON note of the choice; an identified seal
     coefficient that is not physical over the rig's pressures (:func:`non_physical`) is
-    replaced by the rig file's, named under ``non_physical``."""
+    replaced by the rig file's, named under ``non_physical``.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig file.
+    res : ProcedureResult
+        The identification (its identified rig, intervals and seal regressions).
+
+    Returns
+    -------
+    rig : RigConfig
+        ``cfg`` when every identified value holds the rig file's inside its 95 % interval,
+        else the identified rig (with any non-physical seal coefficient the rig file's).
+    note : dict
+        ``designed_on``, ``reason`` and, as they apply, ``outside_intervals`` and
+        ``non_physical`` (JSON-ready).
+    """
     differ = outside_intervals(cfg, res)
     if not differ:
         return cfg, {"designed_on": "rig file", "reason": "every identified value holds the "
@@ -99,7 +116,19 @@ def design_rig(cfg: RigConfig, res: ProcedureResult) -> tuple[RigConfig, dict]:
 
 def truth_rig(cfg: RigConfig, truth: TruthSection) -> RigConfig:
     """The virtual facility as a rig: the truth's model form and values, τ_e included (the
-    full-order plant the designs are judged on)."""
+    full-order plant the designs are judged on).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig file.
+    truth : TruthSection
+        The facility's truth.
+
+    Returns
+    -------
+    RigConfig
+    """
     return rig_with_values(true_rig(cfg, truth), {**truth.parameters, TAU_E: truth.tau_e})
 
 
@@ -156,6 +185,28 @@ def impulse_checks(cfg: RigConfig, identified: RigConfig, truth: TruthSection,
 
     A controller that does not keep the rotor in the facility's air gap gets an
     :class:`ImpulseCheck` with its ``error``.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig file.
+    identified : RigConfig
+        The identified rig.
+    truth : TruthSection
+        The facility's truth.
+    controllers : dict of str to DiscreteController
+        The controllers checked, by name, at the rig's sample rate.
+    pressures_bar : iterable of float
+        The pressure drops (bar).
+    seed : int, optional
+        Seed of the facility's noise.
+    excitation : ExcitationPlan, optional
+        The impulse (default: the rig's).
+
+    Returns
+    -------
+    list of ImpulseCheck
+        One per controller and pressure drop.
     """
 
     axes = channel_names(cfg)

@@ -115,6 +115,7 @@ def impulse_amplitude(cfg: RigConfig) -> float | None:
     Parameters
     ----------
     cfg : RigConfig
+        The rig (its ``[design.impulse]`` and AMBs).
 
     Returns
     -------
@@ -132,6 +133,7 @@ def impulse_length(cfg: RigConfig) -> float:
     Parameters
     ----------
     cfg : RigConfig
+        The rig (its ``[design.impulse]`` and controller sample rate).
 
     Returns
     -------

@@ -135,6 +135,11 @@ def require_finite(tree, what: str):
     what : str
         What it is, at the front of the message.
 
+    Returns
+    -------
+    dict or list
+        ``tree`` itself.
+
     Raises
     ------
     IdentificationError

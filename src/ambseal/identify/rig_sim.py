@@ -106,7 +106,19 @@ def facility_bias_current(cfg: RigConfig, truth: TruthSection) -> float:
 
 def true_rig(cfg: RigConfig, truth: TruthSection) -> RigConfig:
     """The rig as the facility builds it: the rig file with the truth's model-form changes
-    (beam theory, shaft elements × ``mesh_factor``, rotor modal damping)."""
+    (beam theory, shaft elements × ``mesh_factor``, rotor modal damping).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig file.
+    truth : TruthSection
+        The facility's truth.
+
+    Returns
+    -------
+    RigConfig
+    """
     rotor = {}
     if truth.beam is not None:
         rotor["beam"] = truth.beam
@@ -162,6 +174,24 @@ def reduced_plant(cfg: RigConfig, pressure_bar: float, speed_rpm: float | None,
     eigendecomposition are built once for them: the result is kept, keyed on the rig's
     content (not its identity) and the arguments, for the last ``_PLANTS_KEPT`` calls.
     Plants are immutable, so sharing them is safe.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig.
+    pressure_bar : float
+        Pressure drop across the seals (bar).
+    speed_rpm : float or None
+        Rotor speed (rpm); None for the rig's operating speed.
+    values : dict
+        Parameter name → value (SI), applied to the full-order plant.
+    cutoff_hz : float
+        The modes kept lie below it (Hz).
+
+    Returns
+    -------
+    Plant
+        The reduced plant, shared between calls (immutable).
 
     Raises
     ------

@@ -164,7 +164,20 @@ def whirl_stepped_sine(frequencies_hz, balance, *, amplitude_a: float, cycles: i
 def fit_reliability(res: FitResult, min_fit_pct: float = MIN_FIT_PCT) -> list[str]:
     """Why a fit is unreliable (empty when it is not): not converged, an NRMSE fit below
     ``min_fit_pct`` on some channel, or a failed model check (residuals correlated with the
-    excitation, or a held value the data dispute: :meth:`FitResult.model_check`)."""
+    excitation, or a held value the data dispute: :meth:`FitResult.model_check`).
+
+    Parameters
+    ----------
+    res : FitResult
+        A fit.
+    min_fit_pct : float, optional
+        The lowest NRMSE fit (%) of a displacement channel taken as reliable.
+
+    Returns
+    -------
+    list of str
+        One reason per finding.
+    """
     why = []
     if not res.converged:
         why.append(f"not converged ({res.message})")

@@ -42,6 +42,20 @@ def state_space_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "
     :func:`ambseal.design.pid.controller_from_metadata`, which the ``identify`` command
     calls: the identification stage takes the controller, it does not design one.
 
+    Parameters
+    ----------
+    meta : dict
+        A record's metadata (its ``controller`` and ``sample_rate_hz``).
+    axes : tuple of str
+        The rig's actuator axes (:func:`ambseal.model.amb.channel_names`).
+    source : str, optional
+        The record's file, for the messages.
+
+    Returns
+    -------
+    DiscreteController
+        One input and output per axis, at the record's sample time.
+
     Raises
     ------
     DataError
@@ -67,7 +81,29 @@ def state_space_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "
 def check_controller(ctrl: DiscreteController, axes: tuple[str, ...], fs: float,
                      source: str = "<data>") -> DiscreteController:
     """``ctrl`` if it has one input and output per axis and runs at ``fs`` (Hz), else a
-    DataError naming ``source``."""
+    DataError naming ``source``.
+
+    Parameters
+    ----------
+    ctrl : DiscreteController
+        The controller of a record.
+    axes : tuple of str
+        The rig's actuator axes.
+    fs : float
+        The record's sample rate (Hz).
+    source : str, optional
+        The record's file, for the message.
+
+    Returns
+    -------
+    DiscreteController
+        ``ctrl`` itself.
+
+    Raises
+    ------
+    DataError
+        Another number of inputs or outputs, or another sample time.
+    """
     k = len(axes)
     if ctrl.B.shape[1] != k or ctrl.D.shape != (k, k):
         raise DataError(f"{source}: metadata.controller: expected {k} inputs and outputs "
@@ -79,14 +115,45 @@ def check_controller(ctrl: DiscreteController, axes: tuple[str, ...], fs: float,
 
 
 def sample_rate_of(meta: dict, source: str = "<data>") -> float:
-    """A record's ``sample_rate_hz`` metadata (Hz), or a DataError naming ``source``."""
+    """A record's ``sample_rate_hz`` metadata (Hz), or a DataError naming ``source``.
+
+    Parameters
+    ----------
+    meta : dict
+        A record's metadata.
+    source : str, optional
+        The record's file, for the message.
+
+    Returns
+    -------
+    float
+        The sample rate (Hz), finite and positive.
+
+    Raises
+    ------
+    DataError
+        A missing, non-numeric, non-finite or non-positive ``sample_rate_hz``.
+    """
     return _positive(meta, "sample_rate_hz", source)
 
 
 def check_record_metadata(meta: dict, source: str) -> None:
     """The operating point of a record's metadata within the rig format's ranges:
     ``pressure_drop_pa`` at most 1e9 Pa (1e4 bar) and ``speed_rad_s`` at most 1.05e5 rad/s
-    (1e6 rpm); a DataError naming ``source`` otherwise."""
+    (1e6 rpm); a DataError naming ``source`` otherwise.
+
+    Parameters
+    ----------
+    meta : dict
+        A record's metadata; absent keys are not checked.
+    source : str
+        The record's file, for the message.
+
+    Raises
+    ------
+    DataError
+        A value that is not a finite number ≥ 0, or one beyond its bound.
+    """
     for key, high in (("pressure_drop_pa", 1e9), ("speed_rad_s", 1e6 * 2 * np.pi / 60)):
         if meta.get(key) is not None and _positive(meta, key, source, default=0.0) > high:
             raise DataError(f"{source}: metadata.{key}: {meta[key]!r} is beyond the plausible "
@@ -117,6 +184,7 @@ def at_speed(cfg: RigConfig, speed_hz: float | None, what: str = "speed_hz") -> 
     Parameters
     ----------
     cfg : RigConfig
+        The rig.
     speed_hz : float or None
         Spin speed (Hz), ≥ 0.
     what : str
@@ -363,6 +431,21 @@ def record_spread(cfg: RigConfig, records: list[Measurement], names: list[str],
     tests (P2 Table 2, 1.1–2.4 %): a spread wider than the pooled interval claims says the
     records differ by more than their noise (model error, drift). Single-record fits take
     one pass (no refinement) from the rig's values.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig the records were taken on.
+    records : list of Measurement
+        The records of the pooled fit.
+    names : list of str
+        The fitted parameters.
+    pooled : FitResult
+        The fit of all records together.
+    controllers : list, optional
+        The controller of each record, where its metadata does not carry it.
+    sources : list of str, optional
+        The records' files, for the messages (default ``record 1``, …).
 
     Returns
     -------

@@ -216,11 +216,38 @@ def virtual_static_load(cfg: RigConfig, truth: TruthSection, *, seed: int = 0,
     """Static load steps on the virtual facility: the full-order FE rotor with the truth's
     values, in equilibrium with each load and the sensors held at zero (integral action).
 
-    Returns ``(position_m (n,), force_xy_n (n, 2), current_a (n, n_axes))``: the forces as
-    a load cell reads them (Gaussian error of ``force_noise_fraction`` of the reading; 0.5 %
-    is a class-0.5 transducer) and the currents as the amplifiers' sensors average them over
-    a one-second hold (the truth's ``current_noise_a`` over √(sample rate) samples). The
-    programme of :func:`load_steps` runs ``repeats`` times (P2 §5 repeats it five times).
+    The forces are as a load cell reads them (Gaussian error of ``force_noise_fraction`` of
+    the reading; 0.5 % is a class-0.5 transducer) and the currents as the amplifiers'
+    sensors average them over a one-second hold (the truth's ``current_noise_a`` over
+    √(sample rate) samples). The programme of :func:`load_steps` runs ``repeats`` times
+    (P2 §5 repeats it five times).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig file.
+    truth : TruthSection
+        The facility's truth.
+    seed : int, optional
+        Seed of the noise.
+    force_noise_fraction : float, optional
+        Standard deviation of the load cell's error, as a fraction of the reading.
+    steps_per_direction : int, optional
+        Load steps in each direction (:func:`load_steps`).
+    repeats : int, optional
+        Runs of the programme.
+    position_m : float, optional
+        Axial position of the load (m); default: mid-way between the bearings
+        (:func:`load_steps`).
+
+    Returns
+    -------
+    position_m : numpy.ndarray, shape (n,)
+        Axial position of each load (m).
+    force_xy_n : numpy.ndarray, shape (n, 2)
+        The load as read, x and y (N).
+    current_a : numpy.ndarray, shape (n, n_axes)
+        The mean coil current of each axis (A).
     """
 
     z, F = load_steps(cfg, steps_per_direction, position_m)
@@ -248,7 +275,26 @@ def virtual_static_load(cfg: RigConfig, truth: TruthSection, *, seed: int = 0,
 
 def save_static_record(path: str | Path, cfg: RigConfig, position_m, force_xy_n, current_a
                        ) -> Path:
-    """Write load steps as the CSV :func:`load_static_record` reads (temp name, rename)."""
+    """Write load steps as the CSV :func:`load_static_record` reads (temp name, rename).
+
+    Parameters
+    ----------
+    path : str or Path
+        The CSV file.
+    cfg : RigConfig
+        The rig (its axes name the current columns).
+    position_m : array_like, shape (n,)
+        Axial position of each load (m).
+    force_xy_n : array_like, shape (n, 2)
+        The load, x and y (N).
+    current_a : array_like, shape (n, n_axes)
+        The mean coil current of each axis (A).
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
     axes = channel_names(cfg)
     head = ["position_m", "force_x_n", "force_y_n"] + [f"current_{a}_a" for a in axes]
     data = np.column_stack([position_m, force_xy_n, current_a])
@@ -348,6 +394,22 @@ def with_static_record(cfg: RigConfig, dynamic: FitResult, path: str | Path
                        ) -> tuple[FitResult, dict]:
     """:func:`with_static` of the load steps in ``path`` (:func:`load_static_record`),
     Ki found by :func:`static_ki` at the closed-loop fit's values of the other parameters.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig.
+    dynamic : FitResult
+        The closed-loop fit.
+    path : str or Path
+        The static-load CSV.
+
+    Returns
+    -------
+    joined : FitResult
+        The closed-loop fit with the static Ki joined.
+    summary : dict
+        The static result and the Ki–Ks correlations, alone and joined (JSON-ready).
     """
     return with_static(dynamic, static_ki(cfg, *load_static_record(path, cfg),
                                           values=dict(zip(dynamic.names, dynamic.estimate)),

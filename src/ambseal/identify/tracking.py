@@ -839,7 +839,22 @@ def current_limit(cfg: RigConfig, meta: dict | None = None) -> float | None:
 
 
 def check_excitation(cfg: RigConfig, record: Measurement, source: str = "<data>") -> None:
-    """DataError when the record's excitation exceeds the current limit."""
+    """DataError when the record's excitation exceeds the current limit.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig (its AMBs' current limits).
+    record : Measurement
+        The record; its metadata may state the limit.
+    source : str, optional
+        The record's file, for the message.
+
+    Raises
+    ------
+    DataError
+        A peak excitation current above the limit (none is checked without a limit).
+    """
     limit = current_limit(cfg, dict(record.metadata))
     peak = float(np.max(np.abs(record.excitation_a))) if np.size(record.excitation_a) else 0.0
     if limit is not None and peak > limit:
@@ -854,6 +869,24 @@ def tracking_excitation(cfg: RigConfig, duration_s: float, *, amplitude_a: float
     Defaults: amplitude 1 % of the current limit (0.06 A on a 6 A amplifier, the thesis's
     PRBS level of P2 Fig. 5 halved: small against the bias and the limit), clock period ten
     samples (flat spectrum to ≈ 0.044 f_s, past the rigid-body and first bending modes).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig (its axes, current limit and controller sample rate).
+    duration_s : float
+        Length of the excitation (s).
+    amplitude_a : float, optional
+        PRBS amplitude (A).
+    clock_period_s : float, optional
+        PRBS clock period (s).
+    seed : int, optional
+        Seed of the sequence.
+
+    Returns
+    -------
+    Excitation
+        The excitation currents on every axis (:func:`ambseal.identify.signals.prbs`).
 
     Raises
     ------

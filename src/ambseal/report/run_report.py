@@ -18,8 +18,7 @@ import numpy as np
 from ambseal import __version__
 from ambseal.config import method_label
 from ambseal.design.specs import machine
-from ambseal.identify.checks import interval_check, true_line
-from ambseal.identify.seal_test import MIN_FIT_PCT, fit_reliability
+from ambseal.identify import MIN_FIT_PCT, fit_reliability, interval_check, true_line
 from ambseal.lti.freqresp import freqresp
 from ambseal.report import figures
 from ambseal.report.figures import case_style, controller_colours, controller_gains_figure

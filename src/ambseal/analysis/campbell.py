@@ -32,6 +32,7 @@ from scipy.optimize import linear_sum_assignment
 
 from ambseal.analysis.cases import run_cases
 from ambseal.lti import json_float, json_list
+from ambseal.machine import frozen, judged_loop
 from ambseal.model import (
     RIGID_BODY_RAD_S,
     bending_limit_hz,
@@ -41,7 +42,6 @@ from ambseal.model import (
     free_bending_hz,
     poles_near_zero,
 )
-from ambseal.machine import frozen, judged_loop
 from ambseal.robust import decay_rate, is_stable, loop_delay
 
 __all__ = ["API684_LOG_DEC", "OVERDAMPED_ZETA", "ClosedLoopModes", "Crossing", "Campbell",

@@ -55,7 +55,12 @@ class CaseError:
 
 
 def dask_available() -> bool:
-    """Whether ``dask.distributed`` can be imported (the ``[dask]`` extra)."""
+    """Whether ``dask.distributed`` can be imported (the ``[dask]`` extra).
+
+    Returns
+    -------
+    bool
+    """
     try:
         import distributed  # noqa: F401  (optional: the [dask] extra)
     except ImportError:
@@ -162,20 +167,9 @@ def probe_scheduler(address: str, timeout_s: float | None = None) -> None:
     if not dask_available():
         raise ConfigError("dask.distributed is not installed (pip install 'ambseal[dask]'); "
                           "leave out --scheduler to run serially")
-    from distributed.comm import connect  # optional: the [dask] extra
-
     timeout_s = SCHEDULER_TIMEOUT_S if timeout_s is None else float(timeout_s)
-
-    async def identity():
-        comm = await connect(address, timeout=timeout_s)
-        try:
-            await comm.write({"op": "identity", "reply": True})
-            return await comm.read()
-        finally:
-            comm.abort()
-
     try:
-        answer = asyncio.run(asyncio.wait_for(identity(), timeout_s))
+        answer = asyncio.run(asyncio.wait_for(_identity(address, timeout_s), timeout_s))
     except (TimeoutError, asyncio.TimeoutError):
         raise ConfigError(f"dask scheduler {address!r}: no answer within {timeout_s:g} s "
                           "(is a Dask scheduler listening there?)") from None
@@ -185,6 +179,18 @@ def probe_scheduler(address: str, timeout_s: float | None = None) -> None:
     if not (isinstance(answer, dict) and answer.get("type") == "Scheduler"):
         raise ConfigError(f"dask scheduler {address!r}: the peer is not a Dask scheduler "
                           f"(it answered {str(answer)[:80]!r})")
+
+
+async def _identity(address: str, timeout_s: float):
+    """The answer of the peer at ``address`` to an ``identity`` request."""
+    from distributed.comm import connect  # optional: the [dask] extra
+
+    comm = await connect(address, timeout=timeout_s)
+    try:
+        await comm.write({"op": "identity", "reply": True})
+        return await comm.read()
+    finally:
+        comm.abort()
 
 
 def _run_dask(fn, cases, shared, workers, scheduler, done) -> list:

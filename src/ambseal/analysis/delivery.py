@@ -143,7 +143,20 @@ def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
 
 
 def synthesis_failure(method: str, why: str) -> FailedController:
-    """The failure of a controller whose design raised (``why``: the error's message)."""
+    """The failure of a controller whose design raised (``why``: the error's message).
+
+    Parameters
+    ----------
+    method : str
+        The controller method (a key of :data:`ambseal.config.METHODS`).
+    why : str
+        The synthesis error's message.
+
+    Returns
+    -------
+    FailedController
+        Designed, not judged.
+    """
     return FailedController(f"{_head(method, True)}{_SEP}the design failed: {why}", True, False)
 
 

@@ -38,7 +38,13 @@ ZONES: tuple[str, str, str, str] = ("A", "B", "C", "D")
 
 
 def zone_limit_db() -> tuple[float, float, float]:
-    """The zone limits in dB: ``(9.54, 12.04, 13.98)`` (the standard rounds to 9.5, 12, 14)."""
+    """The zone limits in dB: ``(9.54, 12.04, 13.98)`` (the standard rounds to 9.5, 12, 14).
+
+    Returns
+    -------
+    (float, float, float)
+        The A/B, B/C and C/D limits of :data:`ZONE_LIMITS`, dB.
+    """
     return tuple(20.0 * math.log10(x) for x in ZONE_LIMITS)  # type: ignore[return-value]
 
 

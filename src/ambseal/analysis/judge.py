@@ -54,10 +54,9 @@ from ambseal.analysis.loops import (
 from ambseal.analysis.response import impulse_response_of
 from ambseal.analysis.spinup import frozen_sensitivity, spinup
 from ambseal.analysis.unbalance import unbalance_from_compliance
-from ambseal.design.lpv_plant import lpv_plant, vertex_grid_hz
-from ambseal.design.specs import RIGID_STATES
+from ambseal.design import RIGID_STATES, vertex_grid_hz
+from ambseal.design.lpv_plant import lpv_plant
 from ambseal.lti import finite_or_none, freqresp_at, json_float, wired
-from ambseal.model import build_plant, classify_poles, pressure_for_k, seal_values
 from ambseal.machine import (
     SPEED,
     JudgedLoop,
@@ -66,6 +65,7 @@ from ambseal.machine import (
     frozen,
     judged_loop,
 )
+from ambseal.model import build_plant, classify_poles, pressure_for_k, seal_values
 from ambseal.robust import loop_delay
 
 __all__ = ["JudgeSettings", "OperatingPoint", "LoopJudgement", "JudgedCase", "judge", "judge_case", "judge_spinup",
@@ -272,7 +272,17 @@ class OperatingPoint:
 
 def speed_scheduled(cfg) -> bool:
     """Whether the rig's seals change with speed over a stated speed range (P3 §4): its
-    controllers are then judged at frozen speeds rather than at pressure drops."""
+    controllers are then judged at frozen speeds rather than at pressure drops.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig (its ``[operating] speed_range_hz`` and seals).
+
+    Returns
+    -------
+    bool
+    """
     return cfg.operating.speed_range_hz is not None and any(
         s.frequency_dependent for s in cfg.seal)
 
@@ -324,6 +334,7 @@ def points_for(controller, points, design_cfg) -> list[OperatingPoint]:
     Parameters
     ----------
     controller : control.StateSpace or ScheduledController
+        The physical controller (``i = −K y``), fixed or scheduled.
     points : list of OperatingPoint
         The rig's judged conditions, one of them ``"nominal"``.
     design_cfg : RigConfig
@@ -370,10 +381,21 @@ def unstable_open_loop_poles(A: np.ndarray) -> np.ndarray:
     Unstable and refused as doubtful by :func:`ambseal.model.modes.classify_poles`
     (absolute thresholds in rad/s, not relative to the stiffest mode).
 
+    Parameters
+    ----------
+    A : numpy.ndarray, shape (n, n)
+        An open-loop plant's state matrix.
+
+    Returns
+    -------
+    numpy.ndarray of complex
+        The unstable eigenvalues (rad/s); empty for a stable plant.
+
     Raises
     ------
     ModelError
-        The model's conditioning makes the stability doubtful."""
+        The model's conditioning makes the stability doubtful.
+    """
 
     lam = np.linalg.eigvals(A)
     lam = lam[classify_poles(lam, where="open-loop plant")[1]]
@@ -513,7 +535,22 @@ def condition_values(point, design_cfg) -> tuple[float, dict]:
 def frozen_at(K, point, design_cfg):
     """The fixed controller that runs at ``point``: ``K``, a speed-scheduled one at the
     speed, or one scheduled on a seal coefficient at the design rig's value at the pressure
-    drop (:func:`ambseal.machine.controller.frozen`, :func:`condition_values`)."""
+    drop (:func:`ambseal.machine.controller.frozen`, :func:`condition_values`).
+
+    Parameters
+    ----------
+    K : control.StateSpace or ScheduledController
+        The physical controller (``i = −K y``).
+    point : OperatingPoint
+        Where it runs (its ``speed_rpm`` and ``pressure_bar``).
+    design_cfg : RigConfig
+        The rig the controller was designed on (its seals give the coefficient values).
+
+    Returns
+    -------
+    control.StateSpace
+        ``K`` itself when fixed, else frozen at the point.
+    """
 
     return frozen(K, *condition_values(point, design_cfg))
 
@@ -522,7 +559,27 @@ def judge_jobs(designs, digitals: dict, points, design_cfg) -> list[dict]:
     """``ambseal run``'s cases: every design at each of its judged points
     (:func:`points_for`: ``points``, over its schedule for one scheduled on a seal's k),
     frozen there (:func:`frozen_at`), with the delayed discrete controller that runs
-    (:func:`frozen_discrete`), for :func:`judge_case`."""
+    (:func:`frozen_discrete`), for :func:`judge_case`.
+
+    Parameters
+    ----------
+    designs : iterable of DesignResult
+        The run's designs (their ``method`` and ``controller``).
+    digitals : dict
+        Method → the digital controller that runs (:class:`~ambseal.robust.DigitalController`
+        or :class:`~ambseal.machine.ScheduledDigital`); a missing one judges the continuous
+        loop alone.
+    points : list of OperatingPoint
+        The rig's judged conditions (:func:`operating_points`).
+    design_cfg : RigConfig
+        The rig the controllers were designed on.
+
+    Returns
+    -------
+    list of dict
+        One case per design and point: ``name``, ``point``, ``controller`` and
+        ``discrete`` (the delayed discrete controller, or None).
+    """
     return [{"name": d.method, "point": p, "controller": frozen_at(d.controller, p, design_cfg),
              "discrete": frozen_discrete(digitals.get(d.method), p, design_cfg)}
             for d in designs for p in points_for(d.controller, points, design_cfg)]

@@ -233,6 +233,7 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
     Parameters
     ----------
     cfg : RigConfig
+        The rig file the facility is built from (with ``truth``).
     truth : TruthSection
         The facility's truth (noise, ADC, limits; ``noise_fraction`` sets the sensor noise
         as a fraction of the RMS displacement of a noise-free run).
@@ -251,7 +252,10 @@ def ramp_simulation(cfg, truth, controllers: dict, tracked=None, *, duration_s: 
         The estimator's initial transient left out of its accuracy (s).
     record_hz : float
         Rate of the returned records (Hz).
+    seed : int
+        Seed of the excitation and the noise.
     settings : TrackingSettings, optional
+        The on-line estimator's settings (default ``TrackingSettings()``).
     model_cfg : RigConfig, optional
         The rig the tracker's model is built from: the identified rig (Ki, Ks, τ_e, the
         seal's coefficient curves; thesis stages (a)–(c)); default ``cfg`` (module

@@ -19,9 +19,9 @@ from dataclasses import dataclass
 
 from ambseal.analysis.judge import OperatingPoint
 from ambseal.lti import json_float
+from ambseal.machine import judged_loop
 from ambseal.model import build_plant
 from ambseal.robust import loop_delay
-from ambseal.machine import judged_loop
 
 __all__ = ["StabilityCase", "stability_points", "stability_case"]
 

@@ -73,8 +73,8 @@ from ambseal.analysis.loops import loop_responses, resolved_grid
 from ambseal.analysis.response import settling_time
 from ambseal.errors import ModelError
 from ambseal.lti import feedback_matrices, zoh
-from ambseal.model import build_plant
 from ambseal.machine import closed_loop, frozen, matrices_at
+from ambseal.model import build_plant
 
 __all__ = ["StepResponse", "SpinupResult", "spinup", "FrozenSensitivity",
            "frozen_sensitivity"]

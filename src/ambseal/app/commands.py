@@ -17,14 +17,18 @@ from pathlib import Path
 import control
 import numpy as np
 
-from ambseal.analysis.judge import judge_settings, operating_points
+from ambseal.analysis import judge_settings, operating_points
 from ambseal.config import default_rig_path, dump_rig, load_rig, method_names, rig_with_values
-from ambseal.design import Design
-from ambseal.design.fast_poles import design_rise
-from ambseal.design.lpv_design import design_lpv
-from ambseal.design.pid import controller_from_metadata, reference_pid
-from ambseal.design.recipes import design, full_order_check
-from ambseal.design.specs import design_spec
+from ambseal.design import (
+    Design,
+    controller_from_metadata,
+    design,
+    design_lpv,
+    design_rise,
+    design_spec,
+    full_order_check,
+    reference_pid,
+)
 from ambseal.errors import ConfigError, DataError, IdentificationError, SynthesisError
 from ambseal.export.codegen import write_c
 from ambseal.export.controller_files import export_controller

@@ -21,9 +21,7 @@ from typing import Any
 
 from pydantic import TypeAdapter
 
-from ambseal.analysis.delivery import FailedController
-from ambseal.analysis.judge import JudgedCase
-from ambseal.analysis.speed_range import StabilityCase
+from ambseal.analysis import FailedController, JudgedCase, StabilityCase
 
 __all__ = ["SCHEMA_VERSION", "SCHEMA_PATH", "OpenLoop", "ControllerSummary", "RunMetrics",
            "metrics_schema", "schema_text"]

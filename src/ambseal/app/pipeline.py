@@ -12,26 +12,25 @@ import sys
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from ambseal.analysis.cases import run_cases
-from ambseal.analysis.delivery import (
+from ambseal.analysis import (
     FailedController,
-    also_failed,
-    loop_failure,
-    synthesis_failure,
-)
-from ambseal.analysis.judge import (
     JudgeSettings,
     OperatingPoint,
+    also_failed,
     frozen_at,
     judge_case,
     judge_jobs,
     judge_settings,
     judge_spinup,
+    loop_failure,
     operating_points,
+    run_cases,
     speed_scheduled,
+    stability_case,
+    stability_points,
+    synthesis_failure,
     unstable_open_loop_poles,
 )
-from ambseal.analysis.speed_range import stability_case, stability_points
 from ambseal.app.commands import (
     Designed,
     Identified,
@@ -51,9 +50,7 @@ from ambseal.config import (
     load_truth,
     method_names,
 )
-from ambseal.design.lpv_design import design_frozen, design_lpv
-from ambseal.design.recipes import design
-from ambseal.design.specs import DesignSpec, design_spec
+from ambseal.design import DesignSpec, design, design_frozen, design_lpv, design_spec
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.files import RunFolder, write_json
 from ambseal.model import build_plant

@@ -25,10 +25,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
-from ambseal.analysis.delivery import FailedController, loop_failure
+from ambseal.analysis import FailedController, loop_failure
 from ambseal.app.commands import Designed, digitals_for
 from ambseal.config import method_label, method_names
-from ambseal.design.recipes import design
+from ambseal.design import design
 from ambseal.errors import ConfigError, SynthesisError
 
 __all__ = ["Remedied", "remedy", "worst_case"]

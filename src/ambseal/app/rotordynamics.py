@@ -17,21 +17,20 @@ import math
 import sys
 from pathlib import Path
 
-from ambseal.analysis.campbell import (
+from ambseal.analysis import (
     OVERDAMPED_ZETA,
-    campbell,
-    closed_loop_modes,
-    open_loop_modes,
-)
-from ambseal.analysis.cases import dask_available, probe_scheduler
-from ambseal.analysis.judge import judge_settings
-from ambseal.analysis.sweep import (
     check_cases,
+    closed_loop_modes,
+    dask_available,
+    judge_settings,
+    open_loop_modes,
     parse_range,
+    probe_scheduler,
     refine_boundary,
     stability_boundary,
-    sweep,
 )
+from ambseal.analysis.campbell import campbell
+from ambseal.analysis.sweep import sweep
 from ambseal.config import (
     MAX_COEFFICIENT,
     MAX_PRESSURE_BAR,
@@ -40,8 +39,7 @@ from ambseal.config import (
     method_names,
     rig_parameter_names,
 )
-from ambseal.design.recipes import design
-from ambseal.design.specs import design_spec
+from ambseal.design import design, design_spec
 from ambseal.errors import ConfigError
 from ambseal.export.controller_files import load_controller
 from ambseal.files import OwnedFolder, atomic_write, claim_file, write_json, write_text

@@ -14,10 +14,9 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from ambseal.analysis.judge import points_for, speed_scheduled
-from ambseal.analysis.ramp import ramp_simulation
+from ambseal.analysis import points_for, ramp_simulation, speed_scheduled
 from ambseal.app.commands import Designed, digitals_for
-from ambseal.design.seal_schedule import design_seal_scheduled
+from ambseal.design import design_seal_scheduled
 from ambseal.errors import ConfigError
 from ambseal.report.tracking_figures import ramp_figure
 

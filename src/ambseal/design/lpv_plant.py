@@ -148,6 +148,7 @@ def vertex_grid_hz(cfg, speeds_hz) -> np.ndarray:
     Parameters
     ----------
     cfg : ambseal.config.RigConfig
+        The rig (its seal tables' frequencies).
     speeds_hz : (float, float)
         Operating speed range (Hz), increasing.
 
@@ -188,14 +189,6 @@ def lpv_plant(cfg, speeds_hz, *, reference_speed_hz: float | None = None,
         Step (Hz) of the central differences for dA/dΩ (exact for the gyroscopic term; the
         one-sided slope of a seal table at its own points is averaged).
 
-    Notes
-    -----
-    The full-order model is assembled once, at the reference speed. A(Ω) then follows
-    without re-assembly: the projected gyroscopic term (Ω − Ω_ref)·T_L [[0, 0], [0, −M⁻¹G]] T_R
-    plus the seal coefficient changes through their projected LFT channels
-    Δθ·(T_L B_θ)(C_θ T_R) (P3 Eqs. 7–10) — the same matrices as projecting a rebuilt
-    full-order model, at a fraction of the cost.
-
     Returns
     -------
     LpvPlant
@@ -205,6 +198,14 @@ def lpv_plant(cfg, speeds_hz, *, reference_speed_hz: float | None = None,
     ModelError
         A grid with fewer than two points, not increasing, or a negative speed; a failing
         modal reduction.
+
+    Notes
+    -----
+    The full-order model is assembled once, at the reference speed. A(Ω) then follows
+    without re-assembly: the projected gyroscopic term (Ω − Ω_ref)·T_L [[0, 0], [0, −M⁻¹G]] T_R
+    plus the seal coefficient changes through their projected LFT channels
+    Δθ·(T_L B_θ)(C_θ T_R) (P3 Eqs. 7–10) — the same matrices as projecting a rebuilt
+    full-order model, at a fraction of the cost.
     """
 
     f = np.asarray(speeds_hz, float).ravel()

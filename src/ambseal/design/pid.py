@@ -196,6 +196,7 @@ def reference_pid(cfg) -> dict:
     Parameters
     ----------
     cfg : RigConfig
+        The rig (its ``[controller.pid]``, else what :func:`pid_from_rig` derives from).
 
     Returns
     -------
@@ -241,6 +242,20 @@ def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<
     ``{"type": "pid", kp, ti, td, eps, "discretisation": "tustin"|"zoh"}`` (P5 Eq. 6 at the
     record's sample rate) is discretised here; anything else is read by
     :func:`ambseal.identify.stages.state_space_from_metadata`.
+
+    Parameters
+    ----------
+    meta : dict
+        A record's metadata (its ``controller`` and ``sample_rate_hz``).
+    axes : tuple of str
+        The rig's actuator axes, one controller input and output each.
+    source : str, optional
+        The record's file, for the messages.
+
+    Returns
+    -------
+    DiscreteController
+        The controller at the record's sample time, ``u = −K y``.
 
     Raises
     ------

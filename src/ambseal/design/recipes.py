@@ -62,6 +62,7 @@ from ambseal.design.weights import Weights
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.lti import lft_lower
 from ambseal.lti.freqresp import freqresp
+from ambseal.machine import judged_loop
 from ambseal.model import build_plant, build_system, channel_names, poles_near_zero
 from ambseal.robust import (
     design_delay,
@@ -72,7 +73,6 @@ from ambseal.robust import (
     musyn_dgk,
     reduce_controller,
 )
-from ambseal.machine import judged_loop
 from ambseal.threads import with_numerics_threads
 
 __all__ = ["DesignResult", "design", "full_order_check", "bound_text"]
@@ -214,9 +214,11 @@ def full_order_check(cfg, K, conditions) -> dict:
     Parameters
     ----------
     cfg : RigConfig
+        The rig; its full-order plant is built at each condition.
     K : control.StateSpace
         Displacements (m) → current references (A), negative feedback ``i = −K y``.
     conditions : iterable of (pressure_bar, speed_hz)
+        The judged conditions: pressure drop (bar) and speed (Hz).
 
     Returns
     -------

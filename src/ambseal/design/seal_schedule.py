@@ -78,8 +78,8 @@ from ambseal.design.specs import DesignSpec, design_spec
 from ambseal.design.weights import Weights
 from ambseal.errors import ModelError, SynthesisError
 from ambseal.files import write_json
-from ambseal.model import build_plant, values_following_k
 from ambseal.machine import ScheduledController
+from ambseal.model import build_plant, values_following_k
 from ambseal.robust import LpvController, design_delay, lpvsyn
 
 __all__ = ["SealScheduledDesign", "design_seal_scheduled", "CACHE_ENV"]

@@ -150,7 +150,17 @@ class Machine:
 
 
 def machine(cfg) -> Machine:
-    """The machine facts of a rig (module docstring, "Machine facts")."""
+    """The machine facts of a rig (module docstring, "Machine facts").
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig.
+
+    Returns
+    -------
+    Machine
+    """
 
     free = build_system(cfg, speed_rpm=0.0, include_amb=False, include_seals=False,
                         include_springs=False)

@@ -24,7 +24,7 @@ from matplotlib.image import imsave
 from matplotlib.ticker import LogLocator, NullFormatter, NullLocator, ScalarFormatter
 from PIL import Image, UnidentifiedImageError
 
-from ambseal.analysis.iso import ZONE_LIMITS, ZONES, zone_limit_db
+from ambseal.analysis import ZONES, ZONE_LIMITS, zone_limit_db
 from ambseal.config import METHODS
 from ambseal.errors import AmbsealError
 from ambseal.files import STAMP_KEY, atomic_write, input_file

@@ -15,7 +15,7 @@ from typing import Mapping, Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
-from ambseal.analysis.iso import ZONE_LIMITS, zone_limit_db
+from ambseal.analysis import ZONE_LIMITS, zone_limit_db
 from ambseal.report.figures import save_figure
 
 __all__ = ["spinup_figure", "frozen_sensitivity_figure"]

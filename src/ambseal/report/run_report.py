@@ -17,7 +17,7 @@ import numpy as np
 
 from ambseal import __version__
 from ambseal.config import method_label
-from ambseal.design.specs import machine
+from ambseal.design import machine
 from ambseal.identify import MIN_FIT_PCT, fit_reliability, interval_check, true_line
 from ambseal.lti.freqresp import freqresp
 from ambseal.report import figures

@@ -25,7 +25,7 @@ from numpydoc.validate import get_validation_checks, validate
 
 ROOT = Path(__file__).resolve().parents[1]
 FACES = ["lti", "robust", "machine", "config", "model", "identify", "design", "analysis",
-         "export"]
+         "report", "export", "io", "app"]
 #: Public modules that are a face of their own (no package around them).
 MODULE_FACES = ["threads"]
 #: Public names that share their module's name and are kept (part of a published face); the

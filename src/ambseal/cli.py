@@ -465,7 +465,7 @@ def main(argv: list[str] | None = None) -> int:
     # The commands' code loads python-control, scipy.signal and matplotlib (1.6 s of a
     # 1.8 s start on a 2-core machine): imported once a command runs, so that --help and
     # argument errors answer at once.
-    from ambseal.app.handlers import HANDLERS
+    from ambseal.app import HANDLERS
 
     handler = HANDLERS[args.command]
     with warnings.catch_warnings(record=True) as caught:

@@ -30,8 +30,7 @@ from ambseal.design import (
     reference_pid,
 )
 from ambseal.errors import ConfigError, DataError, IdentificationError, SynthesisError
-from ambseal.export.codegen import write_c
-from ambseal.export.controller_files import export_controller
+from ambseal.export import export_controller, write_c
 from ambseal.files import writable_folder, write_json, write_text
 from ambseal.identify import (
     MISMATCH,
@@ -56,6 +55,7 @@ from ambseal.identify import (
     with_static_record,
 )
 from ambseal.lti import finite_or_none
+from ambseal.machine import SPEED, ScheduledController, scheduled_digital
 from ambseal.model import (
     assemble_rotor,
     build_mesh,
@@ -66,16 +66,16 @@ from ambseal.model import (
     seal_values,
 )
 from ambseal.model.modes import modes
-from ambseal.report.identify_figures import (
+from ambseal.report import (
     correlation_figure,
     error_budget_figure,
+    facility_impulse_report,
     fit_timeseries_figure,
+    identification_report,
     residual_figure,
+    target_difference,
+    tracking_figure,
 )
-from ambseal.report.run_report import facility_impulse_report, identification_report
-from ambseal.report.tracking_figures import tracking_figure
-from ambseal.report.verdict import target_difference
-from ambseal.machine import SPEED, ScheduledController, scheduled_digital
 from ambseal.robust import check_rate, digital_controller, peak_difference, sampled_plants
 
 __all__ = ["Designed", "Identified", "identification_stage", "facility_impulses", "design_files",

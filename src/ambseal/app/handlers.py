@@ -29,8 +29,7 @@ from ambseal.app.commands import (
 from ambseal.app.pipeline import run
 from ambseal.config import default_rig_path, load_rig, load_truth, method_names
 from ambseal.errors import AmbsealError, ConfigError, with_source
-from ambseal.export.codegen import c_identifier, write_c
-from ambseal.export.controller_files import load_controller
+from ambseal.export import c_identifier, load_controller, write_c
 from ambseal.files import OwnedFolder, claim_file, writable_folder
 from ambseal.identify import (
     IMPULSE_LEAD,
@@ -47,8 +46,7 @@ from ambseal.identify import (
     virtual_static_load,
 )
 from ambseal.model import channel_names
-from ambseal.report.run_report import rig_clearances_um
-from ambseal.report.verdict import verdict_table_rich, verdicts
+from ambseal.report import rig_clearances_um, verdict_table_rich, verdicts
 
 __all__ = ["HANDLERS"]
 

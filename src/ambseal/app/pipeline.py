@@ -54,8 +54,8 @@ from ambseal.design import DesignSpec, design, design_frozen, design_lpv, design
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.files import RunFolder, write_json
 from ambseal.model import build_plant
-from ambseal.report.progress import StageProgress
-from ambseal.report.run_report import (
+from ambseal.report import (
+    StageProgress,
     gains_figure,
     judged_on,
     rig_clearances_um,

@@ -41,13 +41,12 @@ from ambseal.config import (
 )
 from ambseal.design import design, design_spec
 from ambseal.errors import ConfigError
-from ambseal.export.controller_files import load_controller
+from ambseal.export import load_controller
 from ambseal.files import OwnedFolder, atomic_write, claim_file, write_json, write_text
-from ambseal.io.ross import import_ross_file
+from ambseal.io import import_ross_file
 from ambseal.model import bending_limit_hz, build_system, channel_names
 from ambseal.model.modes import modes
-from ambseal.report.figures import figure_is_ours
-from ambseal.report.modal_figures import campbell_figure, mode_shapes_figure, stability_map_figure
+from ambseal.report import campbell_figure, figure_is_ours, mode_shapes_figure, stability_map_figure
 from ambseal.robust import DigitalController, unstable_poles
 
 __all__ = ["HANDLERS", "controller_for", "write_table"]

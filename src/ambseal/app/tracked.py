@@ -18,7 +18,7 @@ from ambseal.analysis import points_for, ramp_simulation, speed_scheduled
 from ambseal.app.commands import Designed, digitals_for
 from ambseal.design import design_seal_scheduled
 from ambseal.errors import ConfigError
-from ambseal.report.tracking_figures import ramp_figure
+from ambseal.report import ramp_figure
 
 __all__ = ["tracked_designs", "tracked_ramp", "refusal_sentence"]
 

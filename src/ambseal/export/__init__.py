@@ -4,10 +4,10 @@
   files holding the discrete controller as it was judged
   (:mod:`ambseal.export.controller_files`);
 * :func:`write_c` — a portable C99 header and source of the same controller
-  (:mod:`ambseal.export.codegen`).
+  (:mod:`ambseal.export.codegen`); :func:`c_identifier` — a name as a C identifier.
 """
 
-from ambseal.export.codegen import write_c
+from ambseal.export.codegen import c_identifier, write_c
 from ambseal.export.controller_files import export_controller, load_controller
 
-__all__ = ["export_controller", "load_controller", "write_c"]
+__all__ = ["c_identifier", "export_controller", "load_controller", "write_c"]

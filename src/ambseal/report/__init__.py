@@ -1,6 +1,53 @@
-"""ambseal.report: figures (:mod:`ambseal.report.figures`, matplotlib Agg) and the
-self-contained HTML page (:mod:`ambseal.report.html`).
+"""ambseal.report: figures (matplotlib, Agg) and the self-contained HTML report.
 
-Import the submodules directly; this package imports nothing, so ``import ambseal.report``
-does not load matplotlib.
+* :func:`write_run_report`, :func:`stamp`, :func:`judged_on`, :func:`rig_clearances_um` —
+  the main job's ``report.html`` (:mod:`ambseal.report.run_report`), its figures
+  (:func:`gains_figure`, :func:`spinup_figures`) and sections
+  (:func:`identification_report`, :func:`facility_impulse_report`);
+* :func:`verdicts`, :func:`verdict_table_rich`, :func:`target_difference` — the verdict
+  per controller (:mod:`ambseal.report.verdict`);
+* :func:`campbell_figure`, :func:`mode_shapes_figure`, :func:`stability_map_figure` —
+  rotordynamics (:mod:`ambseal.report.modal_figures`);
+* :func:`fit_timeseries_figure`, :func:`correlation_figure`, :func:`residual_figure`,
+  :func:`error_budget_figure` — an identification (:mod:`ambseal.report.identify_figures`);
+* :func:`tracking_figure`, :func:`ramp_figure` — on-line tracking and the pressure ramp;
+* :func:`figure_is_ours` — whether a PNG is one ambseal wrote (:mod:`ambseal.report.figures`);
+* :class:`StageProgress` — a long job's progress, stage by stage.
+
+The names load on first use (PEP 562 ``__getattr__``, as :mod:`ambseal.identify` does), so
+``import ambseal.report`` does not load matplotlib.
 """
+
+import importlib
+
+#: Each public name (``__all__``) and the module that defines it.
+_FROM = {
+    "figure_is_ours": "figures",
+    "correlation_figure": "identify_figures", "error_budget_figure": "identify_figures",
+    "fit_timeseries_figure": "identify_figures", "residual_figure": "identify_figures",
+    "campbell_figure": "modal_figures", "mode_shapes_figure": "modal_figures",
+    "stability_map_figure": "modal_figures",
+    "StageProgress": "progress",
+    "facility_impulse_report": "run_report", "gains_figure": "run_report",
+    "identification_report": "run_report", "judged_on": "run_report",
+    "rig_clearances_um": "run_report", "spinup_figures": "run_report",
+    "stamp": "run_report", "write_run_report": "run_report",
+    "ramp_figure": "tracking_figures", "tracking_figure": "tracking_figures",
+    "target_difference": "verdict", "verdict_table_rich": "verdict", "verdicts": "verdict",
+}
+
+__all__ = sorted(_FROM)
+
+
+def __getattr__(name: str):
+    """Import a public name from its module on first use (PEP 562)."""
+    if name not in _FROM:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"{__name__}.{_FROM[name]}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    """The module's names, the lazily loaded ones included."""
+    return sorted(set(globals()) | set(__all__))

@@ -24,7 +24,7 @@ from matplotlib.image import imsave
 from matplotlib.ticker import LogLocator, NullFormatter, NullLocator, ScalarFormatter
 from PIL import Image, UnidentifiedImageError
 
-from ambseal.analysis import ZONES, ZONE_LIMITS, zone_limit_db
+from ambseal.analysis import ZONE_LIMITS, ZONES, zone_limit_db
 from ambseal.config import METHODS
 from ambseal.errors import AmbsealError
 from ambseal.files import STAMP_KEY, atomic_write, input_file
@@ -115,7 +115,17 @@ FIGURE_MARK = STAMP_KEY
 def figure_is_ours(path: str | os.PathLike) -> bool:
     """True if ``path`` is a PNG that :func:`save_figure` wrote and nobody changed since
     (its ``ambseal-sha256`` text is the hash of its pixels): the ownership mark by which a
-    command may replace it (:func:`ambseal.files.claim_file`)."""
+    command may replace it (:func:`ambseal.files.claim_file`).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Any file; a missing or unreadable one, or not a PNG, is not ours.
+
+    Returns
+    -------
+    bool
+    """
     try:
         with Image.open(input_file(path, "figure")) as im:
             mark = getattr(im, "text", {}).get(FIGURE_MARK)

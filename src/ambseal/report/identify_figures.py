@@ -191,7 +191,28 @@ def fit_timeseries_figure(path: str | os.PathLike, time_s: Sequence[float], y_me
                           nrmse_pct: Sequence[float] | None = None,
                           title: str = "Measured and simulated displacements") -> Path:
     """Measured (solid) against simulated (dashed) displacement per channel, in µm against
-    s (thesis P2 Fig. 5, P4 Fig. 8), with the NRMSE fit in each panel's title."""
+    s (thesis P2 Fig. 5, P4 Fig. 8), with the NRMSE fit in each panel's title.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The PNG to write.
+    time_s : sequence of float, length N
+        Sample times (s).
+    y_meas, y_sim : numpy.ndarray, shape (N, k)
+        Measured and simulated displacements (m).
+    channel_names : sequence of str
+        The ``k`` channels.
+    nrmse_pct : sequence of float, optional
+        The NRMSE fit (%) of each channel.
+    title : str, optional
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The PNG written.
+    """
     t = np.asarray(time_s, float)
     ym, ys = np.asarray(y_meas, float) * 1e6, np.asarray(y_sim, float) * 1e6
     k = ym.shape[1]
@@ -213,7 +234,24 @@ def fit_timeseries_figure(path: str | os.PathLike, time_s: Sequence[float], y_me
 
 def correlation_figure(path: str | os.PathLike, correlation: np.ndarray,
                        names: Sequence[str], *, title: str = "Parameter correlation") -> Path:
-    """The correlation matrix of the estimates with its values (thesis P4 Tables 2, 4)."""
+    """The correlation matrix of the estimates with its values (thesis P4 Tables 2, 4).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The PNG to write.
+    correlation : numpy.ndarray, shape (p, p)
+        The estimates' correlation matrix.
+    names : sequence of str
+        The ``p`` parameter names.
+    title : str, optional
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The PNG written.
+    """
     R = np.asarray(correlation, float)
     n = R.shape[0]
     fig = Figure(figsize=(1.0 + 0.75 * n, 0.8 + 0.7 * n), layout="constrained")
@@ -234,8 +272,22 @@ def residual_figure(path: str | os.PathLike, tests: Any, *,
                     title: str = "Residual analysis (Ljung §16.6)") -> Path:
     """Per channel: the residual's autocorrelation (left) and the cross-correlation of the
     prewhitened residual with the same axis's excitation (right), with the 99 % band; the
-    χ² statistics against their limits in the titles. ``tests``: a
-    :class:`ambseal.identify.residuals.ResidualTests`."""
+    χ² statistics against their limits in the titles.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The PNG to write.
+    tests : ResidualTests
+        :func:`ambseal.identify.residuals.residual_tests` of a fit.
+    title : str, optional
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The PNG written.
+    """
     ch = list(tests.channels)
     m = tests.lags
     fig = Figure(figsize=(10, 1.8 * len(ch) + 0.6), layout="constrained")
@@ -264,8 +316,31 @@ def error_budget_figure(path: str | os.PathLike, names: Sequence[str], estimate:
                         title: str = "Error budget: 1σ per source, % of the estimate") -> Path:
     """Horizontal stacked variance bars per estimate: the noise part and each fixed
     parameter's (the ``top`` largest named, the rest summed), in % of the estimate's 1σ²
-    expressed as σ (bar length = total 1σ in % of the estimate). ``budget``: an
-    :class:`ambseal.identify.budget.ErrorBudget` or None."""
+    expressed as σ (bar length = total 1σ in % of the estimate).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The PNG to write.
+    names : sequence of str
+        The ``p`` fitted parameters.
+    estimate : array_like, shape (p,)
+        Their estimates (SI).
+    std_error_noise : array_like, shape (p,)
+        Their standard errors from the noise alone (SI).
+    budget : ErrorBudget or None
+        The fixed parameters' contributions (:class:`ambseal.identify.budget.ErrorBudget`);
+        None draws the noise part alone.
+    top : int, optional
+        Fixed parameters named; the others are summed.
+    title : str, optional
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The PNG written.
+    """
     est = np.abs(np.asarray(estimate, float))
     noise = np.asarray(std_error_noise, float)
     parts = [("noise", noise ** 2)]

@@ -34,8 +34,16 @@ def campbell_figure(path: str | os.PathLike, c, *, title: str = "Closed-loop Cam
     Parameters
     ----------
     path : path-like
+        The PNG to write.
     c : ambseal.analysis.campbell.Campbell
+        The Campbell diagram's data.
     title : str
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The PNG written.
     """
     fig = Figure(figsize=(8, 7.5))
     ax, axd = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 2]})
@@ -94,11 +102,20 @@ def mode_shapes_figure(path: str | os.PathLike, m, positions: dict[str, list[flo
     Parameters
     ----------
     path : path-like
+        The PNG to write.
     m : ambseal.analysis.campbell.ClosedLoopModes
+        The closed-loop modes with their shapes.
     positions : dict
         ``{"AMB": [z, ...], "sensor": [...], "seal": [...], "disk": [...]}`` (m).
     n_modes : int
         Modes drawn (the lowest; one panel each).
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The PNG written.
     """
     idx = [i for i, z in enumerate(m.damping_ratio) if z < 2**-0.5][:n_modes]
     k = len(idx)
@@ -145,10 +162,18 @@ def stability_map_figure(path: str | os.PathLike, rows: list[dict], boundary: li
     Parameters
     ----------
     path : path-like
+        The PNG to write.
     rows : list of dict
         Rows of :func:`ambseal.analysis.sweep.sweep` (one parameter set).
     boundary : list of dict
         :func:`ambseal.analysis.sweep.stability_boundary` of the same rows.
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The PNG written.
     """
 
     names = list(dict.fromkeys(r["controller"] for r in rows))

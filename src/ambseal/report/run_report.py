@@ -40,7 +40,20 @@ __all__ = ["gains_figure", "spinup_figures", "identification_report", "write_run
 
 
 def stamp(rig_path: str | Path, command: str | None = None) -> str:
-    """The report's stamp: ambseal version, date (UTC), rig file, its SHA-256 and the command."""
+    """The report's stamp: ambseal version, date (UTC), rig file, its SHA-256 and the command.
+
+    Parameters
+    ----------
+    rig_path : str or Path
+        The rig file (read for its hash).
+    command : str, optional
+        The command line that ran.
+
+    Returns
+    -------
+    str
+        One line.
+    """
 
     rig_path = Path(rig_path)
     digest = hashlib.sha256(rig_path.read_bytes()).hexdigest()[:16]
@@ -98,7 +111,18 @@ def judged_on(cfg, truth=None, truth_path: str | Path | None = None) -> tuple[st
 def rig_clearances_um(cfg) -> dict[str, float]:
     """Clearances (µm) the unbalance orbit is judged against: the nominal AMB air gap
     (:func:`ambseal.design.specs.machine`: ``air_gap``, or Ki·i0/Ks) and the smallest
-    backup-bearing clearance (``[[amb]] backup_clearance``), those the rig gives."""
+    backup-bearing clearance (``[[amb]] backup_clearance``), those the rig gives.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig.
+
+    Returns
+    -------
+    dict of str to float
+        ``"air gap"`` and ``"backup bearing"`` (µm), those the rig gives.
+    """
 
     out = {}
     gap = machine(cfg).air_gap_m if cfg.amb else None
@@ -112,7 +136,20 @@ def rig_clearances_um(cfg) -> dict[str, float]:
 
 def gains_figure(out: Path, controllers: list[tuple[str, object]]) -> tuple[str, Path]:
     """Direct and cross gains of physical controllers ``[(name, StateSpace)]`` (P5 Fig. 10),
-    1 Hz – 2 kHz."""
+    1 Hz – 2 kHz.
+
+    Parameters
+    ----------
+    out : Path
+        Folder of the figure (``controller_gains.png``).
+    controllers : list of (str, control.StateSpace)
+        Method and physical controller (``i = −K y``), one input per measurement.
+
+    Returns
+    -------
+    (str, Path)
+        The caption and the PNG written.
+    """
 
     f = np.logspace(0, math.log10(2000.0), 300)
     rows = [(m, f, freqresp(K, 2 * np.pi * f)) for m, K in controllers]
@@ -125,7 +162,24 @@ def gains_figure(out: Path, controllers: list[tuple[str, object]]) -> tuple[str,
 
 def spinup_figures(out: Path, sims: list, sens: list, speeds_hz: tuple[float, float]
                    ) -> list[tuple[str, Path]]:
-    """The spin-up (P3 Fig. 11) and σ̄(S_o) at frozen speeds (P3 Fig. 12)."""
+    """The spin-up (P3 Fig. 11) and σ̄(S_o) at frozen speeds (P3 Fig. 12).
+
+    Parameters
+    ----------
+    out : Path
+        Folder of the figures (``spinup.png``, ``frozen_sensitivity.png``).
+    sims : list of SpinupResult
+        One spin-up per controller.
+    sens : list of FrozenSensitivity
+        σ̄(S_o) at frozen speeds, one per controller.
+    speeds_hz : (float, float)
+        The spin-up's start and end speeds (Hz), for the caption.
+
+    Returns
+    -------
+    list of (str, Path)
+        Caption and PNG of each figure.
+    """
 
     lo, hi = speeds_hz
     colours = controller_colours([r.name for r in sims])
@@ -144,11 +198,15 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
     out : Path
         Folder of the figures.
     res : ProcedureResult
+        The identification.
     errors : dict
         :func:`ambseal.identify.checks.truth_errors` of ``res``.
     checks : FrfChecks
+        The frequency-response checks of the identified model.
     truth : TruthSection
+        The facility's truth, drawn beside the estimates.
     seal_name : str or None
+        The seal whose coefficients are drawn against pressure; None for none.
     nominal_bar : float
         The rig's nominal pressure drop (bar), marked in the pressure figure.
 
@@ -269,7 +327,22 @@ def _model_check_text(fit, errors: dict) -> str:
 def facility_impulse_report(out: Path, checks: list, design_note: dict
                             ) -> tuple[list, list]:
     """Figure and section: impulse responses on the virtual facility beside the identified
-    model's (P5 Figs. 15–16), and which rig the robust controllers were designed on."""
+    model's (P5 Figs. 15–16), and which rig the robust controllers were designed on.
+
+    Parameters
+    ----------
+    out : Path
+        Folder of the figure.
+    checks : list of ImpulseCheck
+        :func:`ambseal.identify.design_model.impulse_checks`.
+    design_note : dict
+        The rig the designs took and why (:func:`ambseal.identify.design_model.design_rig`).
+
+    Returns
+    -------
+    (figures, sections)
+        ``[(caption, png)]`` and ``[{"title", "html"}]`` for :func:`write_run_report`.
+    """
 
     figs = [("Impulse responses, 0.05 A for 10 ms on the first bearing's ζ and the last "
              "bearing's η: virtual facility (dashed) against the identified model (solid), "
@@ -400,8 +473,36 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
 
     ``curves = [(method, OperatingPoint, case, {"So", "compliance", "unbalance",
     "impulse"})]`` in the order of ``metrics["cases"]``; a case whose loop is unstable is
-    listed in each figure's legend, not drawn. ``meta`` is the stamp (:func:`stamp`). The
-    controllers of ``metrics["failed"]`` are listed first with their reasons.
+    listed in each figure's legend, not drawn. The controllers of ``metrics["failed"]``
+    are listed first with their reasons.
+
+    Parameters
+    ----------
+    out : Path
+        The run's folder: ``report.html`` and its figures.
+    title : str
+        The page's title.
+    meta : str
+        The stamp (:func:`stamp`).
+    metrics : dict
+        The run's ``metrics.json`` document (``cases``, ``failed``, ``stability``,
+        ``controllers``).
+    curves : list
+        ``(method, OperatingPoint, case, {"So", "compliance", "unbalance", "impulse"})``
+        per case, in the order of ``metrics["cases"]``.
+    extra_figures : list of (str, Path)
+        Caption and PNG of each further figure.
+    extra_sections : list of dict
+        ``{"title", "html"}`` of each further section.
+    clearances_um : dict, optional
+        :func:`rig_clearances_um` of the rig, for the unbalance orbit.
+    judged_on : (str, str), optional
+        :func:`judged_on`'s line and link.
+
+    Returns
+    -------
+    Path
+        ``report.html``.
     """
     return write_report(out / "report.html", title=title, metrics=metrics["cases"],
                         figures=_run_figures(out, metrics, curves) + list(extra_figures),

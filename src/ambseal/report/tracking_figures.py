@@ -23,16 +23,32 @@ def tracking_figure(path: str | os.PathLike, time_s: Sequence[float], names: Seq
     """The estimate of each parameter (SI) over time with its 95 % interval as a band, and
     an optional reference (e.g. the facility's true value), one panel per parameter.
 
-    Parameters
-    ----------
-    time_s : (N,)
-    estimate, low, high : (N, p)
-    reference : (N, p), optional
-    units : sequence of str, optional
-        The SI unit of each parameter, for the axis labels.
-
     The vertical range follows the estimate after its first 5 % (the initial transient
     from the starting value is drawn but does not set the scale).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The PNG to write.
+    time_s : sequence of float, shape (N,)
+        Times (s).
+    names : sequence of str
+        The ``p`` parameters.
+    estimate, low, high : numpy.ndarray, shape (N, p)
+        The estimate and its 95 % interval (SI).
+    reference : numpy.ndarray, shape (N, p), optional
+        A reference value of each parameter (SI).
+    reference_label : str, optional
+        The reference's legend label.
+    units : sequence of str, optional
+        The SI unit of each parameter, for the axis labels.
+    title : str, optional
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The PNG written.
     """
     t = np.asarray(time_s, float)
     est, lo, hi = (np.asarray(a, float) for a in (estimate, low, high))
@@ -65,7 +81,22 @@ def ramp_figure(path: str | os.PathLike, ramp, *, axis: int = 0) -> Path:
     true and the estimated seal coefficient with its 95 % interval and the pressure drop;
     the displacement and the current reference on the impulse axis for every controller
     (a loss of the rotor marked ×); the impulse peaks along the ramp with their settling
-    times written next to them."""
+    times written next to them.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The PNG to write.
+    ramp : RampResult
+        The ramp's runs.
+    axis : int, optional
+        The actuator axis drawn (index into the rig's axes).
+
+    Returns
+    -------
+    Path
+        The PNG written.
+    """
     t = np.asarray(ramp.time_s, float)
     names = list(ramp.runs)
     col = controller_colours(names)

@@ -203,7 +203,18 @@ class Verdict:
 
 def target_difference(cs: Sequence[Mapping]) -> float | None:
     """Largest |discrete − continuous| / continuous σ̄(S_o) peak over the cases (their
-    ``discrete`` blocks), None without a pair."""
+    ``discrete`` blocks), None without a pair.
+
+    Parameters
+    ----------
+    cs : sequence of mapping
+        Cases of ``metrics.json`` (their ``sensitivity_peak`` and ``discrete`` blocks).
+
+    Returns
+    -------
+    float or None
+        The relative difference (-).
+    """
     pairs = [(c["sensitivity_peak"], (c.get("discrete") or {}).get("sensitivity_peak"))
              for c in cs if c.get("sensitivity_peak")]
     diffs = [abs(d - x) / x for x, d in pairs if d is not None]
@@ -220,7 +231,24 @@ def verdicts(cases: Sequence[Mapping], clearances_um: Mapping[str, float] | None
              designs: Mapping[str, Mapping] | None = None) -> list[Verdict]:
     """One :class:`Verdict` per controller of ``metrics["cases"]`` (in order of appearance),
     with its ``metrics["stability"]`` cases (the speed range) counted in and its design's
-    bound from ``metrics["controllers"]`` (``designs``)."""
+    bound from ``metrics["controllers"]`` (``designs``).
+
+    Parameters
+    ----------
+    cases : sequence of mapping
+        ``metrics["cases"]``.
+    clearances_um : mapping of str to float, optional
+        The rig's clearances (µm) the unbalance orbit is set against.
+    stability : sequence of mapping, optional
+        ``metrics["stability"]``: the loops over the speed range.
+    designs : mapping of str to mapping, optional
+        ``metrics["controllers"]``: each design's bound.
+
+    Returns
+    -------
+    list of Verdict
+        One per controller, in order of appearance.
+    """
     by_speed = _speed_varies(cases)
     names = list(dict.fromkeys(c["controller"] for c in cases))
     return [_verdict(name, [c for c in cases if c["controller"] == name], by_speed,
@@ -355,7 +383,18 @@ def detail_table_html(cases: Sequence[Mapping]) -> str:
 def verdict_table_rich(vs: Sequence[Verdict]):
     """The first screen for a terminal: a compact ``rich`` table (zones coloured, fits 80
     columns; the orbit against the first clearance the rig gives) and one line per
-    controller with its verdict in words."""
+    controller with its verdict in words.
+
+    Parameters
+    ----------
+    vs : sequence of Verdict
+        :func:`verdicts` of the run.
+
+    Returns
+    -------
+    rich.console.Group
+        The table and the lines, for ``rich.console.Console.print``.
+    """
 
     gap = next(iter(vs[0].clearances_um.items()), None) if vs else None
     title = "Verdict — ISO 14839-3 zone: worst axis / σ̄" + (

@@ -3,13 +3,16 @@
 ``lint-imports`` (CI, ``[tool.importlinter]`` in ``pyproject.toml``) checks that the layers
 import downwards only and that the generic core knows no rotor. The tests here check what a
 contract cannot say: that the contract covers every package, that no two modules import
-each other in a circle (at module level or inside functions), and that the core's
-boundary holds on the contract itself.
+each other in a circle (at module level or inside functions), that the core's boundary
+holds on the contract itself, and that one package takes another's names only through its
+face (its ``__init__.py``).
 """
 
 from __future__ import annotations
 
 import ast
+import importlib
+import inspect
 import re
 import tomllib
 from pathlib import Path
@@ -103,6 +106,95 @@ def test_the_cycle_finder_sees_a_cycle():
     for a, b in (("p.a", "p.b"), ("p.b", "p.c"), ("p.c", "p.a"), ("p.d", "p.a")):
         g.add_import(importer=a, imported=b)
     assert _cycles(g) == [["p.a", "p.b", "p.c"]]
+
+
+#: Functions that share their module's name are not re-exported by their package's face
+#: (re-exporting one would hide the module, tests/test_docstrings.py), so the packages above
+#: import each from its module: ``(module, name)``.
+FACE_EXCEPTIONS = {
+    ("ambseal.lti.freqresp", "freqresp"),
+    ("ambseal.model.modes", "modes"),
+    ("ambseal.design.lpv_plant", "lpv_plant"),
+    ("ambseal.analysis.campbell", "campbell"),
+    ("ambseal.analysis.sweep", "sweep"),
+}
+
+
+def _face_names(face: str) -> set[str]:
+    """``__all__`` of a package's face, or of a top-level module (its own face)."""
+    return set(importlib.import_module(face).__all__)
+
+
+def _face_bypasses(root: Path = SRC) -> list[str]:
+    """``file:line: import`` of every import in ``root`` (the ``ambseal`` package's folder),
+    module or function level, that takes a name from another top-level package or module
+    of ambseal other than from its face: a module path below the face (outside
+    :data:`FACE_EXCEPTIONS`), a name the face does not list in ``__all__`` (a submodule, a
+    helper), or a ``_private`` name. Imports within one package are its own business."""
+    found = []
+    for path in sorted(root.rglob("*.py")):
+        rel = path.relative_to(root)
+        mine = "ambseal" if rel == Path("__init__.py") else rel.parts[0].removesuffix(".py")
+        text = path.read_text(encoding="utf-8")
+        lines = text.splitlines()
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, ast.Import):
+                modules = [(a.name, []) for a in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                modules = [(node.module, [a.name for a in node.names])]
+            else:
+                continue
+            for module, names in modules:
+                parts = module.split(".")
+                if parts[0] != "ambseal" or (parts[1:2] or ["ambseal"])[0] == mine:
+                    continue
+                face = ".".join(parts[:2])
+                if len(parts) > 2:
+                    bad = [n for n in names if (module, n) not in FACE_EXCEPTIONS] or not names
+                else:
+                    bad = [n for n in names if n.startswith("_") and not n.startswith("__")
+                           or n not in _face_names(face)]
+                if bad:
+                    found.append(f"{rel}:{node.lineno}: {lines[node.lineno - 1].strip()}")
+    return found
+
+
+def test_packages_import_each_other_through_their_faces():
+    """One package takes another's names from its face only (``from ambseal.lti import
+    zoh``, not ``from ambseal.lti.discrete import zoh``), and only the names the face lists:
+    the face is a package's whole public surface, and its modules can move behind it."""
+    found = _face_bypasses()
+    assert not found, "imports past a package's face:\n" + "\n".join(found)
+
+
+def test_the_face_check_sees_a_bypass(tmp_path):
+    """A planted module with each kind of bypass is caught, line by line, and the allowed
+    imports are not (so the test above can fail)."""
+    (tmp_path / "machine").mkdir()
+    (tmp_path / "machine" / "planted.py").write_text("\n".join([
+        "from ambseal.lti.discrete import zoh",            # 1: below the face
+        "from ambseal.lti import zoh",                     # 2: the face
+        "from ambseal.lti.freqresp import freqresp",       # 3: a listed exception
+        "from ambseal.robust.hinf import _SMALL_STATES",   # 4: private, below the face
+        "from ambseal.identify import stages",             # 5: a submodule, not listed
+        "import ambseal.model.rig",                        # 6: below the face
+        "from ambseal.machine.loop import closed_loop",    # 7: its own package
+        "from ambseal.errors import ModelError",           # 8: a module that is a face
+        "from ambseal import __version__",                 # 9: the package's own face
+        "def f():",
+        "    from ambseal.model.rig import build_plant",   # 11: inside a function
+    ]) + "\n")
+    lines = [int(hit.split(":")[1]) for hit in _face_bypasses(tmp_path)]
+    assert lines == [1, 4, 5, 6, 11]
+
+
+def test_the_face_exceptions_hide_a_module():
+    """Each exception is a function named as its module, which its face leaves out (else it
+    would be no exception)."""
+    for module, name in sorted(FACE_EXCEPTIONS):
+        assert module.rsplit(".", 1)[1] == name
+        assert inspect.isfunction(getattr(importlib.import_module(module), name))
+        assert name not in _face_names(".".join(module.split(".")[:2]))
 
 
 def _function_level_imports() -> list[tuple[str, int, str]]:

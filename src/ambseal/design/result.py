@@ -14,7 +14,7 @@ from typing import Protocol, runtime_checkable
 
 import control
 
-from ambseal.machine.controller import ScheduledController
+from ambseal.machine import ScheduledController
 
 __all__ = ["Design"]
 

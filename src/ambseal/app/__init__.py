@@ -8,28 +8,15 @@
 
 The command line itself is :mod:`ambseal.cli`; it runs a command through :data:`HANDLERS`
 (:mod:`ambseal.app.handlers`: the command's name → its handler). The name loads on first
-use (PEP 562 ``__getattr__``, as :mod:`ambseal.identify` does), so that ``import
+use (PEP 562 ``__getattr__``, ``ambseal.lazy.lazy_face``), so that ``import
 ambseal.app`` — and the command line's ``--help`` — loads none of the commands' numerics.
 """
 
-import importlib
+from ambseal.lazy import lazy_face
 
 #: Each public name (``__all__``) and the module that defines it.
 _FROM = {"HANDLERS": "handlers"}
 
 __all__ = sorted(_FROM)
 
-
-def __getattr__(name: str):
-    """Import a public name from its module on first use (PEP 562)."""
-    if name not in _FROM:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f"{__name__}.{_FROM[name]}"), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    """The module's names, the lazily loaded ones included."""
-    return sorted(set(globals()) | set(__all__))
-
+__getattr__, __dir__ = lazy_face(__name__, _FROM)

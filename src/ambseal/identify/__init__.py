@@ -38,7 +38,7 @@ purpose: they load neither python-control nor scipy nor cvxopt
 (``tests/identify/test_identify_signals.py``), which an eager face would, with the fit.
 """
 
-import importlib
+from ambseal.lazy import lazy_face
 
 #: Each public name (``__all__``) and the module that defines it.
 _FROM = {
@@ -81,16 +81,4 @@ _FROM = {
 
 __all__ = sorted(_FROM)
 
-
-def __getattr__(name: str):
-    """Import a public name from its module on first use (PEP 562)."""
-    if name not in _FROM:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f"{__name__}.{_FROM[name]}"), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    """The module's names, the lazily loaded ones included."""
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_face(__name__, _FROM)

@@ -4,7 +4,7 @@ Case ``facility_loop_1s_10khz``: the embedded test rig's virtual facility (truth
 ``data/testrig_truth.toml``, 4 sub-steps per sample) levitated by the reference PID, a
 PRBS current excitation of 1 s at 10 kHz (10 000 samples).
 
-- Ours: :func:`ambseal.identify.facility_loop.facility_loop`, compiled by numba (the
+- Ours: :func:`ambseal.identify.facility.facility_loop.facility_loop`, compiled by numba (the
   compilation is done in an untimed warm-up run, as it is cached on disk after the first
   run of ``ambseal``).
 - Baseline: the same function's Python source, ``facility_loop.py_func``, run by the
@@ -36,9 +36,9 @@ def main() -> None:
 
     from ambseal.config import load_rig, load_truth
     from ambseal.design.pid import reference_controller
-    from ambseal.identify import rig_sim
-    from ambseal.identify.facility_loop import facility_loop
-    from ambseal.identify.signals import prbs
+    from ambseal.identify.facility import rig_sim
+    from ambseal.identify.facility.facility_loop import facility_loop
+    from ambseal.identify.excitation.signals import prbs
     from ambseal.app.pipeline import default_truth_path
 
     cfg = load_rig()

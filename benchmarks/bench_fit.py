@@ -3,7 +3,7 @@
 Case ``fit_9_params_1s_10khz``: one PRBS record of 1 s at 10 kHz from the virtual test
 facility (1 % sensor noise); fit the eight Ki/Ks and τ_e.
 
-- Ours: :func:`ambseal.identify.fit.fit_parameters` on the reduced model with the
+- Ours: :func:`ambseal.identify.fitting.fit.fit_parameters` on the reduced model with the
   parameters in its LFT channels, exact ZOH discretisation, block-recursive closed-loop
   simulation (``ours_s``; ``ours_identify_s`` adds model building and the refinement pass).
 - Baseline ("naive"): ``scipy.optimize.least_squares`` with finite differences over
@@ -42,12 +42,12 @@ def main() -> None:
 
     from ambseal.config import TruthSection, load_rig, rig_with_values
     from ambseal.design.pid import pid_controller
-    from ambseal.identify.fit import fit_parameters
+    from ambseal.identify.fitting.fit import fit_parameters
     from ambseal.robust.digital_loop import closed_loop_matrices, discrete_controller
     from ambseal.lti.discrete import zoh
-    from ambseal.identify.signals import prbs
+    from ambseal.identify.excitation.signals import prbs
     from ambseal.design.pid import reference_controller
-    from ambseal.identify.stages import acquire, build_models, identify
+    from ambseal.identify.fitting.stages import acquire, build_models, identify
     from ambseal.model.rig import build_plant
 
     cfg = load_rig()

@@ -41,7 +41,7 @@ def main() -> None:
 
     from ambseal.config import TruthSection, load_rig
     from ambseal.design.pid import reference_controller
-    from ambseal.identify.stages import acquire
+    from ambseal.identify.fitting.stages import acquire
     from ambseal.identify.tracking import TrackingSettings, track, tracking_excitation
 
     ap = argparse.ArgumentParser()

@@ -251,7 +251,7 @@ def test_identify_on_millimetres_is_a_failed_identification(record, tmp_path, ca
     """Displacements recorded in mm (×1000) converge to intervals wider than their estimates
     (A.Ki_zeta 179 N/A ± 24 000): reported as an implausible identification naming the
     parameter — fit.json with the reasons, no identified.toml — unless
-    --accept-implausible (the rules: ambseal.identify.plausibility)."""
+    --accept-implausible (the rules: ambseal.identify.fitting.plausibility)."""
     mm = _scaled(record, tmp_path, "displacement_", 1e3)
     code, err = _identify(capsys, tmp_path, mm)
     assert code == 2 and len(err) == 1 and "implausible identification" in err[0], err

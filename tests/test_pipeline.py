@@ -174,7 +174,7 @@ def test_run_sets_its_intervals_against_the_facilitys_truth(metrics):
     outside one interval is one miss in fifteen (chance: a binomial tail of 54 % at a 5 %
     miss rate); three such misses (tail 3.6 %) or one by three interval widths are called a
     mismatch, with the name, the estimate, the interval and the truth in the verdict."""
-    from ambseal.identify.checks import interval_check
+    from ambseal.identify.fitting.checks import interval_check
 
     _, m = metrics
     errors = m["identification"]["parameters"]
@@ -426,7 +426,7 @@ def test_exported_hinf_closes_the_loop_by_name_in_python_control(metrics):
     import numpy as np
 
     from ambseal.config import load_rig, load_truth
-    from ambseal.identify.design_model import truth_rig
+    from ambseal.identify.facility.design_model import truth_rig
     from ambseal.model.rig import build_plant
     from ambseal.app.pipeline import default_truth_path
 

@@ -14,7 +14,7 @@ import pytest
 
 from ambseal.cli import main
 from ambseal.config import default_rig_path, load_rig
-from ambseal.identify.procedure import seal_test_pressures
+from ambseal.identify.fitting.procedure import seal_test_pressures
 
 from .metrics_schema import validate_metrics
 

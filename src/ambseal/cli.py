@@ -208,7 +208,7 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("--force", action="store_true",
                    help="replace --out (and its sidecar) even if ambseal did not write them "
                         "(a link is replaced, never written through)")
-    # the excitation defaults follow from the rig (ambseal.identify.excitation)
+    # the excitation defaults follow from the rig (ambseal.identify.excitation.plan)
     a.add_argument("--amplitude-a", type=_positive, default=None,
                    help="excitation amplitude (A; default [design.impulse] amplitude_a, else "
                         "bias current / 120)")

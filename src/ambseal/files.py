@@ -85,7 +85,7 @@ def writable_folder(folder: str | os.PathLike) -> Path:
 
 
 #: The largest file ambseal reads (bytes): a record of the most samples an excitation may
-#: have (``ambseal.identify.signals.MAX_SAMPLES``, 2e6) with 16 columns of 25 characters
+#: have (``ambseal.identify.excitation.signals.MAX_SAMPLES``, 2e6) with 16 columns of 25 characters
 #: is 0.8 GB of CSV; anything larger is no input of ambseal's and would only exhaust memory.
 MAX_READ_BYTES = 2**30
 

@@ -61,7 +61,7 @@ def test_ramp_losses_agree_with_the_frozen_full_order_loops(testrig_cfg, testrig
     from ambseal.design.specs import design_spec
     from ambseal.analysis.ramp import ramp_simulation
     from ambseal.config import load_truth
-    from ambseal.identify.procedure import thesis_procedure
+    from ambseal.identify.fitting.procedure import thesis_procedure
     from ambseal.app.pipeline import default_truth_path
 
     cfg = testrig_cfg

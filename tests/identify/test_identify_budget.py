@@ -6,8 +6,8 @@ from scipy.signal import lfilter
 
 from ambseal.config import parse_rig
 from ambseal.errors import ConfigError
-from ambseal.identify.budget import DEFAULT_UNCERTAINTY, advice, fixed_uncertainty, propagate
-from ambseal.identify.residuals import residual_tests
+from ambseal.identify.fitting.budget import DEFAULT_UNCERTAINTY, advice, fixed_uncertainty, propagate
+from ambseal.identify.fitting.residuals import residual_tests
 
 
 def test_sensitivity_to_a_fixed_regressor_closed_form():
@@ -130,7 +130,7 @@ def test_identified_intervals_become_mu_ranges(testrig_cfg, tmp_path):
 
     from ambseal.design.plant import generalized_plant
     from ambseal.errors import DataError
-    from ambseal.identify.intervals import uncertainty_from_fit
+    from ambseal.identify.fitting.intervals import uncertainty_from_fit
 
     fit = {"parameters": {"seal.k": {"estimate": 2.2e6, "ci95": [1.9e6, 2.5e6]},
                           "tau_e": {"estimate": 2e-4, "ci95": [1.9e-4, 2.1e-4]}},
@@ -171,7 +171,7 @@ def test_facility_model_form_options(testrig_cfg):
     Euler–Bernoulli (no shear flexibility) gives a higher first free bending mode than
     Timoshenko (Nelson 1980: shear and rotary inertia lower the frequencies)."""
     from ambseal.config import TruthSection
-    from ambseal.identify.rig_sim import true_rig
+    from ambseal.identify.facility.rig_sim import true_rig
     from ambseal.model.modes import modes
     from ambseal.model.rig import build_system
 

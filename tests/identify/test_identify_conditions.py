@@ -1,10 +1,10 @@
 """The identification's test conditions come from the rig, and a non-physical seal fit is
-never designed on (ambseal.identify.procedure.seal_test_pressures,
-ambseal.identify.design_model.non_physical / design_rig, rig_sim.facility_bias_current).
+never designed on (ambseal.identify.fitting.procedure.seal_test_pressures,
+ambseal.identify.facility.design_model.non_physical / design_rig, rig_sim.facility_bias_current).
 
 References: the rules as written; the thesis's own test pressures (0.5–2.5 bar at a nominal
 2.04 bar, P5 §3.3) as the case the rule reproduces to 2 %; a linear regression of
-``ambseal.identify.stats.linear_regression`` through chosen points as the seal fit."""
+``ambseal.identify.fitting.stats.linear_regression`` through chosen points as the seal fit."""
 
 from __future__ import annotations
 
@@ -15,10 +15,10 @@ import pytest
 
 from ambseal.config import Affine, TruthSection, default_rig_path, load_rig, rig_with_values
 from ambseal.errors import ConfigError
-from ambseal.identify.design_model import design_rig, non_physical
-from ambseal.identify.procedure import seal_test_pressures
-from ambseal.identify.rig_sim import facility_bias_current
-from ambseal.identify.stats import linear_regression
+from ambseal.identify.facility.design_model import design_rig, non_physical
+from ambseal.identify.fitting.procedure import seal_test_pressures
+from ambseal.identify.facility.rig_sim import facility_bias_current
+from ambseal.identify.fitting.stats import linear_regression
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -85,7 +85,7 @@ def test_stepped_sine_follows_the_rig():
     the PRBS's flat band (sample rate / 50) and 1.1× the top speed. The embedded rig (at rest,
     10 kHz) gets the thesis procedure's 10, 20, 40, …, 200 Hz (P4 §3.5.1: 5–200 Hz); the
     blower (20 kHz, to 600 Hz) reaches 660 Hz, past its top synchronous whirl."""
-    from ambseal.identify.excitation import excitation_plan
+    from ambseal.identify.excitation.plan import excitation_plan
 
     assert excitation_plan(load_rig(default_rig_path())).sine_hz == (
         10.0, 20.0, 40.0, 60.0, 80.0, 100.0, 120.0, 140.0, 160.0, 180.0, 200.0)
@@ -104,9 +104,9 @@ def test_records_at_the_speeds_the_rig_runs():
 
     from ambseal.app.commands import target_pid
     from ambseal.config import load_truth
-    from ambseal.identify import signals
-    from ambseal.identify.excitation import excitation_plan
-    from ambseal.identify.stages import acquire
+    from ambseal.identify.excitation import signals
+    from ambseal.identify.excitation.plan import excitation_plan
+    from ambseal.identify.fitting.stages import acquire
     from ambseal.model.amb import channel_names
 
     cfg = load_rig(ROOT / "examples" / "pump.toml")

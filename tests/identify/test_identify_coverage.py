@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from ambseal.config import TruthSection, load_rig
-from ambseal.identify.signals import prbs
+from ambseal.identify.excitation.signals import prbs
 from ambseal.design.pid import reference_controller
-from ambseal.identify.stages import acquire, identify
+from ambseal.identify.fitting.stages import acquire, identify
 
 TRUE = {"A.Ki_zeta": 205.0, "A.Ki_eta": 201.0, "B.Ki_zeta": 254.0, "B.Ki_eta": 271.0,
         "A.Ks_zeta": 2.45e6, "A.Ks_eta": 2.42e6, "B.Ks_zeta": 3.06e6, "B.Ks_eta": 3.25e6}

@@ -1,4 +1,4 @@
-"""Tests of ambseal.identify.data: the measurement file format (CSV + sidecar, .mat) and its checks."""
+"""Tests of ambseal.identify.records.data: the measurement file format (CSV + sidecar, .mat) and its checks."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 import scipy.io
 
 from ambseal.errors import DataError
-from ambseal.identify.data import (
+from ambseal.identify.records.data import (
     FORMAT_TAG,
     Measurement,
     column_names,
@@ -17,7 +17,7 @@ from ambseal.identify.data import (
     save_measurement,
     validate_measurement,
 )
-from ambseal.identify.signals import DEFAULT_AXES, prbs
+from ambseal.identify.excitation.signals import DEFAULT_AXES, prbs
 
 FS = 5000.0
 N = 600
@@ -79,7 +79,7 @@ def test_round_trip_exact(tmp_path, suffix):
 
 
 def test_csv_layout_and_sidecar(tmp_path):
-    """Reference: the format spec in ambseal.identify.data — header `time_s` then per axis
+    """Reference: the format spec in ambseal.identify.records.data — header `time_s` then per axis
     excitation/current_ref/current/displacement columns; sidecar `<file>.json` with the format
     tag and the axes at top level beside the metadata."""
     m = _meas()

@@ -1,4 +1,4 @@
-"""The identification excitations follow from the rig (ambseal.identify.excitation)."""
+"""The identification excitations follow from the rig (ambseal.identify.excitation.plan)."""
 
 import tomllib
 
@@ -9,8 +9,8 @@ from scipy.signal import welch
 from ambseal.config import load_rig, parse_rig
 from ambseal.design.specs import design_spec
 from ambseal.errors import ConfigError
-from ambseal.identify.excitation import excitation_plan, welch_segment
-from ambseal.identify.signals import impulse, prbs
+from ambseal.identify.excitation.plan import excitation_plan, welch_segment
+from ambseal.identify.excitation.signals import impulse, prbs
 from ambseal.model.amb import channel_names
 
 from ..conftest import ROOT

@@ -10,8 +10,8 @@ from ambseal.config import TruthSection, load_rig
 from ambseal.design.pid import pid_controller, pid_from_rig
 from ambseal.errors import ModelError
 from ambseal.robust.digital_loop import discrete_controller
-from ambseal.identify.rig_sim import prepare_facility, simulate_facility
-from ambseal.identify.stages import build_models
+from ambseal.identify.facility.rig_sim import prepare_facility, simulate_facility
+from ambseal.identify.fitting.stages import build_models
 from ambseal.model.amb import channel_names
 
 PUMP = Path(__file__).resolve().parents[2] / "examples" / "pump.toml"

@@ -5,10 +5,10 @@ import pytest
 
 from ambseal.config import Affine, TruthSection, load_rig
 from ambseal.errors import IdentificationError
-from ambseal.identify.fit import fit_parameters, nrmse_fit
-from ambseal.identify.signals import prbs
+from ambseal.identify.fitting.fit import fit_parameters, nrmse_fit
+from ambseal.identify.excitation.signals import prbs
 from ambseal.design.pid import reference_controller
-from ambseal.identify.stages import acquire, build_models, identify
+from ambseal.identify.fitting.stages import acquire, build_models, identify
 
 TRUE = {"A.Ki_zeta": 205.0, "A.Ki_eta": 201.0, "B.Ki_zeta": 254.0, "B.Ki_eta": 271.0,
         "A.Ks_zeta": 2.45e6, "A.Ks_eta": 2.42e6, "B.Ks_zeta": 3.06e6, "B.Ks_eta": 3.25e6}
@@ -106,7 +106,7 @@ def test_unknown_parameter_is_one_clear_error(rig, prbs_fit):
 
 
 def test_sandwich_intervals_cover_on_a_resonant_regression():
-    """The covariance and intervals of :func:`ambseal.identify.fit._covariance` on a linear
+    """The covariance and intervals of :func:`ambseal.identify.fitting.fit._covariance` on a linear
     least-squares problem shaped like a closed-loop fit: regressors and noise both a PRBS or
     white noise through lightly damped resonances (40–300 Hz at 10 kHz), two channels, three
     parameters. Reference: Monte Carlo over 200 noise draws with the true θ known — the 95 %
@@ -117,7 +117,7 @@ def test_sandwich_intervals_cover_on_a_resonant_regression():
     from scipy.signal import lfilter
     from scipy.stats import t as student
 
-    from ambseal.identify.fit import _covariance
+    from ambseal.identify.fitting.fit import _covariance
 
     rng = np.random.default_rng(0)
     n, fs = 3000, 1e4
@@ -156,7 +156,7 @@ def test_record_spread_is_the_rsd_of_single_record_fits(rig, truth):
     import dataclasses
     import statistics
 
-    from ambseal.identify.stages import record_spread
+    from ambseal.identify.fitting.stages import record_spread
 
     names = ["A.Ki_zeta", "A.Ks_zeta"]
     ctrl = reference_controller(rig)

@@ -1,4 +1,4 @@
-"""Tests of ambseal.identify.frf (Welch H1, coherence, plant from closed loops, model FRF) and
+"""Tests of ambseal.identify.fitting.frf (Welch H1, coherence, plant from closed loops, model FRF) and
 of ambseal.report.identify_figures.frf_figure."""
 
 from __future__ import annotations
@@ -11,9 +11,9 @@ import pytest
 import scipy.signal
 
 from ambseal.errors import AmbsealError, IdentificationError
-from ambseal.identify.data import Measurement
-from ambseal.identify.frf import FRF, closed_loop_frf, estimate_frf, model_frf, plant_frf
-from ambseal.identify.signals import prbs
+from ambseal.identify.records.data import Measurement
+from ambseal.identify.fitting.frf import FRF, closed_loop_frf, estimate_frf, model_frf, plant_frf
+from ambseal.identify.excitation.signals import prbs
 from ambseal.report.identify_figures import frf_figure
 
 FS = 5000.0

@@ -1,4 +1,4 @@
-"""MATLAB files are read in a child process (ambseal.identify.matlab_file): scipy's compiled
+"""MATLAB files are read in a child process (ambseal.identify.records.matlab_file): scipy's compiled
 reader ends the whole process with a segmentation fault on some malformed files (found by
 the fuzz of controller files: a few bytes changed in a valid file), which must be one
 DataError naming the file instead. The child is forked, so a reader replaced here (a crash,
@@ -13,7 +13,7 @@ import pytest
 import scipy.io
 
 from ambseal.errors import DataError
-from ambseal.identify.matlab_file import read_matlab
+from ambseal.identify.records.matlab_file import read_matlab
 
 
 @pytest.fixture

@@ -9,8 +9,8 @@ from scipy.stats import t as student
 
 from ambseal.config import TruthSection
 from ambseal.design.pid import reference_controller
-from ambseal.identify.signals import prbs
-from ambseal.identify.stages import acquire, identify
+from ambseal.identify.excitation.signals import prbs
+from ambseal.identify.fitting.stages import acquire, identify
 
 # Ki/Ks of the facility, a few per cent from the rig file's (the fit's start)
 TRUE = {"A.Ki_zeta": 205.0, "A.Ki_eta": 201.0, "B.Ki_zeta": 254.0, "B.Ki_eta": 271.0,
@@ -135,13 +135,13 @@ def test_coverage_and_model_check_over_20_seeds(testrig_cfg):
 
 
 def test_sensor_lag_model_reproduces_the_facility_filter(testrig_cfg):
-    """The fit's sensor lag τ_s (``ambseal.identify.sensor_lag``: y[n] = a y[n−1] +
+    """The fit's sensor lag τ_s (``ambseal.identify.fitting.sensor_lag``: y[n] = a y[n−1] +
     (1 − a) x(nT), a = τ_s/(τ_s + T)) against the virtual facility's 1 kHz sensor low-pass
     (its own compiled loop, a = e^{−2π·1000·T}): with τ_s = aT/(1 − a) the model reproduces
     the facility's noise-free record to within a few times the facility's own departure
     from the model without a filter (nonlinear force law, sub-steps), and without τ_s it
     misses by hundreds of times more."""
-    from ambseal.identify.stages import build_models
+    from ambseal.identify.fitting.stages import build_models
 
     kw = dict(parameters=TRUE, tau_e=TAU)
     ex = prbs(amplitude_a=0.05, clock_period_s=1e-3, duration_s=0.1, sample_rate_hz=1e4,

@@ -1,4 +1,4 @@
-"""The plausibility rules of an identification (ambseal.identify.plausibility), each checked
+"""The plausibility rules of an identification (ambseal.identify.fitting.plausibility), each checked
 against its statement in the module docstring on the embedded rig (A: Ki_ζ 199.2 N/A,
 Ks_ζ 2.39e6 N/m; coupling kxx 0.40e6 N/m; the seal's k affine in the pressure drop)."""
 
@@ -9,7 +9,7 @@ import pytest
 
 from ambseal.config import load_rig, parse_rig
 from ambseal.errors import IdentificationError
-from ambseal.identify.plausibility import (RATIO, first_nonfinite, implausible,
+from ambseal.identify.fitting.plausibility import (RATIO, first_nonfinite, implausible,
                                            require_finite)
 
 

@@ -5,10 +5,10 @@ import pytest
 
 from ambseal.config import TruthSection, load_rig, parse_rig, rig_with_values
 from ambseal.errors import DataError, IdentificationError, ModelError
-from ambseal.identify.fit import _long_run_covariance, fit_parameters
-from ambseal.identify.signals import prbs
+from ambseal.identify.fitting.fit import _long_run_covariance, fit_parameters
+from ambseal.identify.excitation.signals import prbs
 from ambseal.design.pid import controller_from_metadata, reference_controller
-from ambseal.identify.stages import acquire, build_models, identify
+from ambseal.identify.fitting.stages import acquire, build_models, identify
 from ambseal.model.amb import amb_factors
 
 AXES = ("A_zeta", "A_eta", "B_zeta", "B_eta")

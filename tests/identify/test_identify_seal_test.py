@@ -12,7 +12,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from ambseal.identify.seal_test import fit_reliability, whirl_stepped_sine
+from ambseal.identify.fitting.seal_test import fit_reliability, whirl_stepped_sine
 
 
 def test_whirl_directions_and_orthogonality():
@@ -39,9 +39,9 @@ def forty_hz(testrig_cfg):
     truth file's values, which the impulse regression finds to within 1 %)."""
     from ambseal.config import load_truth
     from ambseal.design.pid import reference_controller
-    from ambseal.identify.seal_test import seal_frequency_test
-    from ambseal.identify.signals import stepped_sine
-    from ambseal.identify.stages import acquire, identify
+    from ambseal.identify.fitting.seal_test import seal_frequency_test
+    from ambseal.identify.excitation.signals import stepped_sine
+    from ambseal.identify.fitting.stages import acquire, identify
     from ambseal.model.amb import channel_names
     from ambseal.app.pipeline import default_truth_path
 

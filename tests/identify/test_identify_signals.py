@@ -1,4 +1,4 @@
-"""Tests of ambseal.identify.signals: PRBS, stepped sine, chirp and impulse excitations."""
+"""Tests of ambseal.identify.excitation.signals: PRBS, stepped sine, chirp and impulse excitations."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 
-from ambseal.identify.signals import DEFAULT_AXES, Excitation, chirp, impulse, prbs, stepped_sine
+from ambseal.identify.excitation.signals import DEFAULT_AXES, Excitation, chirp, impulse, prbs, stepped_sine
 
 FS = 10_000.0
 
@@ -212,7 +212,7 @@ def test_excitation_module_is_light():
     """Reference: DESIGN.md 'light imports' (no plotting at import) — importing the module
     in a fresh interpreter loads neither matplotlib nor the numerics stack it does not need
     (python-control, scipy, cvxopt); checked on sys.modules of a subprocess."""
-    code = ("import sys, ambseal.identify.signals\n"
+    code = ("import sys, ambseal.identify.excitation.signals\n"
             "heavy = [m for m in ('matplotlib', 'control', 'scipy', 'cvxopt')\n"
             "         if any(k == m or k.startswith(m + '.') for k in sys.modules)]\n"
             "assert not heavy, heavy\n")

@@ -16,8 +16,8 @@ import pytest
 
 from ambseal.config import load_truth
 from ambseal.errors import DataError
-from ambseal.identify.fit import FitResult
-from ambseal.identify.static_load import (join_static, load_static_record, programme_repeats,
+from ambseal.identify.fitting.fit import FitResult
+from ambseal.identify.fitting.static_load import (join_static, load_static_record, programme_repeats,
                                           save_static_record, static_ki, virtual_static_load,
                                           StaticLoadResult)
 from ambseal.model.amb import amb_factors

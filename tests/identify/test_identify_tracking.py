@@ -10,9 +10,9 @@ from ambseal.cli import main
 from ambseal.config import TruthSection
 from ambseal.design.pid import reference_controller
 from ambseal.errors import IdentificationError
-from ambseal.identify.data import save_measurement
-from ambseal.identify.fit import ClosedLoopModel
-from ambseal.identify.stages import acquire
+from ambseal.identify.records.data import save_measurement
+from ambseal.identify.fitting.fit import ClosedLoopModel
+from ambseal.identify.fitting.stages import acquire
 from ambseal.identify.tracking import (_param_matrices, flops_per_sample, track,
                                        tracking_excitation)
 from ambseal.robust.digital_loop import DiscreteController
@@ -171,7 +171,7 @@ def test_facility_run_in_blocks_equals_one_run(testrig_cfg):
     three blocks with the state of the plant, sensors and controller carried over (as the
     tracked scheme switches its controller between blocks) gives the same records."""
     from ambseal.config import load_truth
-    from ambseal.identify.rig_sim import prepare_facility
+    from ambseal.identify.facility.rig_sim import prepare_facility
     from ambseal.app.pipeline import default_truth_path
 
     cfg = testrig_cfg

@@ -1,4 +1,4 @@
-"""Tests of ambseal.identify.youla: the Youla/dual-Youla (Hansen) identification of thesis P1 §II.
+"""Tests of ambseal.identify.fitting.youla: the Youla/dual-Youla (Hansen) identification of thesis P1 §II.
 
 The P1 case (§IV): a 50 % change of one AMB's negative stiffness in one direction (here
 ``B.Ks_eta`` of the embedded test rig, reduced plant with amplifiers, 0 rpm, no seal
@@ -24,8 +24,8 @@ import scipy.linalg as sla
 
 from ambseal.config import load_rig
 from ambseal.errors import DataError, IdentificationError
-from ambseal.identify.signals import prbs
-from ambseal.identify.youla import (
+from ambseal.identify.excitation.signals import prbs
+from ambseal.identify.fitting.youla import (
     CoprimeFactors,
     check_bezout,
     coprime_factors,

@@ -15,7 +15,7 @@ _CHILD = textwrap.dedent("""
         print("numba found a cache folder")
     except RuntimeError:
         pass
-    from ambseal.identify import facility_loop  # noqa: F401  (its kernels compile on import)
+    from ambseal.identify.facility import facility_loop  # noqa: F401  (its kernels compile on import)
     from ambseal.lti.discrete import simulate_lti
     from ambseal.robust import _hinf_small, _mu_newton  # noqa: F401  (likewise)
 

@@ -1,7 +1,7 @@
 """A pressure ramp on the virtual facility with fixed controllers and the tracked scheme: the on-line estimator and the controller scheduled on its estimate running
 together in the sampled, nonlinear loop.
 
-The facility (:mod:`ambseal.identify.rig_sim`: nonlinear AMB forces, amplifier limits,
+The facility (:mod:`ambseal.identify.facility.rig_sim`: nonlinear AMB forces, amplifier limits,
 eddy lag, sensor noise, ADC, the digital controller at the rig's rate) runs a
 piecewise-constant pressure drop from 0 to ``top_factor``× nominal in ``step_s`` steps;
 the same excitation — the tracker's PRBS (:func:`~ambseal.identify.tracking.
@@ -180,7 +180,7 @@ def pressure_ramp(p_nominal_bar: float, duration_s: float, *, top_factor: float 
     list of (float, float)
         ``(start_s, pressure_bar)`` of each step, the first at ``step_s``, the last at
         ``duration_s`` (a ``pressure_schedule`` of
-        :func:`ambseal.identify.rig_sim.simulate_facility`).
+        :func:`ambseal.identify.facility.rig_sim.simulate_facility`).
     """
     t = np.arange(step_s, duration_s + 0.5 * step_s, step_s)
     return [(float(a), float(top_factor * p_nominal_bar * a / duration_s)) for a in t]

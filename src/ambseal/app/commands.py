@@ -282,7 +282,7 @@ def judged_margins(cases: list[dict], method: str) -> list[dict]:
 class Identified:
     """The identification stage of the main job: ``summary`` for ``metrics.json``, its
     figures and report sections, the procedure's ``result``, the rig the robust controllers
-    are designed on (``design_cfg``, :func:`ambseal.identify.design_model.design_rig`) and
+    are designed on (``design_cfg``, :func:`ambseal.identify.facility.design_model.design_rig`) and
     the truth they are judged on (``truth_cfg``)."""
 
     summary: dict
@@ -432,23 +432,23 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
     """``ambseal identify``: fit ``names`` to recorded files; write the fit, its figures and
     the identified rig to ``out_dir``. Returns a JSON-safe summary.
 
-    With ``static_load`` (a load-step CSV, :mod:`ambseal.identify.static_load`), Ki is also
+    With ``static_load`` (a load-step CSV, :mod:`ambseal.identify.fitting.static_load`), Ki is also
     found by static loading (P2 §5, its own interval, in ``fit.json`` as ``static_load``)
     and joined with the fitted Ki's: the estimates, intervals and correlations written are
     the joined ones, and ``static_load`` gives the Ki–Ks correlations before and after.
 
     The intervals include the error budget of every parameter held fixed
-    (:mod:`ambseal.identify.budget`); the residuals are tested for independence of the
-    excitation (:mod:`ambseal.identify.residuals`); with several records of one condition,
+    (:mod:`ambseal.identify.fitting.budget`); the residuals are tested for independence of the
+    excitation (:mod:`ambseal.identify.fitting.residuals`); with several records of one condition,
     each is also fitted alone and the spread of those estimates (RSD, thesis P2 Table 2)
     is reported beside the pooled fit. ``warnings`` in the summary say which fixed values
     dominate, whether seal coefficients are held at a non-zero pressure and whether the
     model fails the residual test.
 
     A fit that failed (not converged, singular Jacobian, an estimate at its bound, an NRMSE
-    fit below the floor of :func:`ambseal.identify.fit.fit_parameters`) writes ``fit.json``
+    fit below the floor of :func:`ambseal.identify.fitting.fit.fit_parameters`) writes ``fit.json``
     for diagnosis but no figures and no ``identified.toml``, and raises, unless
-    ``accept_unconverged``; so does an implausible fit (:mod:`ambseal.identify.plausibility`)
+    ``accept_unconverged``; so does an implausible fit (:mod:`ambseal.identify.fitting.plausibility`)
     unless ``accept_implausible``. Non-finite results are refused before anything is written.
 
     Raises

@@ -83,7 +83,7 @@ def _acquire_cmd(args: argparse.Namespace) -> int:
         print(json.dumps({"out": str(path), "load_steps": int(z.size)}))
         return 0
     common = dict(sample_rate_hz=fs, axes=axes, excited=excited)
-    # defaults from the rig (ambseal.identify.excitation); an option given replaces one
+    # defaults from the rig (ambseal.identify.excitation.plan); an option given replaces one
     plan = excitation_plan(cfg, amplitude_a=args.amplitude_a)
     given = (lambda value, default: default if value is None else value)  # noqa: E731
     amplitude, duration = plan.amplitude_a, given(args.duration_s, plan.prbs_duration_s)

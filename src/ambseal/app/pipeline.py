@@ -234,9 +234,9 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
     truth : path, optional
         Truth file of the virtual test facility; with it (and by default for the embedded
         rig) the run identifies the rig on the virtual facility by the thesis's procedure
-        (:mod:`ambseal.identify.procedure`) with the reference PID, designs H∞ and μ on the
+        (:mod:`ambseal.identify.fitting.procedure`) with the reference PID, designs H∞ and μ on the
         identified rig (unless it equals the rig file within its intervals:
-        :func:`ambseal.identify.design_model.design_rig`), judges every controller on the
+        :func:`ambseal.identify.facility.design_model.design_rig`), judges every controller on the
         facility's full-order truth and runs their impulse responses on the facility
         beside the identified model (P5 §3, Figs. 15–16).
     identification : bool

@@ -32,7 +32,7 @@ and bounded (the bounds beside each key in the code, with their reasons).
     ``amplitude_a`` (A) and ``duration_s`` (s) of the current impulse of the time-domain
     judgement (P5 §5.1) and of the identification on the virtual facility (P5 §3.3), whose
     PRBS, chirp and stepped sine take the same amplitude
-    (:mod:`ambseal.identify.excitation`).
+    (:mod:`ambseal.identify.excitation.plan`).
 ``[[design.uncertainty]]`` (μ)
     ``parameter``: any name of the model's LFT (``<seal>.k``, ``<seal>.K``, ``A.Ks_zeta``,
     ``coupling.kxx``, ...); and either ``relative`` (± that fraction of the nominal value,

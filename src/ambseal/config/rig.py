@@ -135,7 +135,7 @@ class _Strict(BaseModel):
 
 #: ``uncertainty = { key = σ }`` beside a component's values: the relative 1σ uncertainty
 #: (fraction) of each named value, used when an identification holds it fixed
-#: (:mod:`ambseal.identify.budget` reads the keys and their defaults).
+#: (:mod:`ambseal.identify.fitting.budget` reads the keys and their defaults).
 Uncertainty = dict[str, Annotated[float, Field(ge=0, le=MAX_RELATIVE)]] | None
 
 

@@ -241,7 +241,7 @@ def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<
 
     ``{"type": "pid", kp, ti, td, eps, "discretisation": "tustin"|"zoh"}`` (P5 Eq. 6 at the
     record's sample rate) is discretised here; anything else is read by
-    :func:`ambseal.identify.stages.state_space_from_metadata`.
+    :func:`ambseal.identify.fitting.stages.state_space_from_metadata`.
 
     Parameters
     ----------

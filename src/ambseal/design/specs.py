@@ -60,7 +60,7 @@ the value the thesis used on its test facility, P5, where it names one):
 * **Controller order**: the design model's states plus those of W_p and W_u (the order of
   an H∞ controller on the design model; the D-scales and W_f are truncated).
 * **Impulse**: i0/120 for 100 controller samples (test rig: 0.05 A for 10 ms, P5 §5.1);
-  the rule is the identification excitation's (:mod:`ambseal.identify.excitation`), written
+  the rule is the identification excitation's (:mod:`ambseal.identify.excitation.plan`), written
   there once.
 * **Judged conditions**: pressure drops 0, nominal and 2× nominal (P5 §4); the operating
   speed, or, for a rig whose seals change with speed over a range, its ends and middle.

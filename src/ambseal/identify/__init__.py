@@ -1,7 +1,7 @@
 """ambseal.identify: closed-loop identification of a rig on site (thesis P1, P2, P4, P5 §3).
 
 * :func:`load_measurement`, :func:`save_measurement` → :class:`Measurement` — the record
-  format (:mod:`ambseal.identify.data`); :func:`validate_measurement` its checks;
+  format (:mod:`ambseal.identify.records.data`); :func:`validate_measurement` its checks;
 * :func:`prbs`, :func:`stepped_sine`, :func:`chirp`, :func:`impulse` → :class:`Excitation`
   — excitation currents (P2 §4.2, P4 §3.3–3.5, P5 §3.3);
 * :func:`prepare_facility`, :func:`simulate_facility` → :class:`FacilityRecord`,
@@ -33,7 +33,7 @@
 
 The names load on first use (PEP 562 ``__getattr__``, the lazy loading of scientific
 Python's SPEC 1), because importing any module of this package runs this file first and
-:mod:`ambseal.identify.signals` and :mod:`ambseal.identify.measurement` are light on
+:mod:`ambseal.identify.excitation.signals` and :mod:`ambseal.identify.records.measurement` are light on
 purpose: they load neither python-control nor scipy nor cvxopt
 (``tests/identify/test_identify_signals.py``), which an eager face would, with the fit.
 """
@@ -42,41 +42,47 @@ from ambseal.lazy import lazy_face
 
 #: Each public name (``__all__``) and the module that defines it.
 _FROM = {
-    "Excitation": "signals", "chirp": "signals", "impulse": "signals", "prbs": "signals",
-    "stepped_sine": "signals",
-    "Measurement": "measurement", "validate_measurement": "measurement",
-    "load_measurement": "data", "record_is_ours": "data", "save_measurement": "data",
-    "read_matlab": "matlab_file",
-    "BIAS_PER_AMPLITUDE": "excitation", "IMPULSE_LEAD": "excitation",
-    "SAMPLES_PER_IMPULSE": "excitation", "excitation_plan": "excitation",
-    "impulse_amplitude": "excitation", "impulse_length": "excitation",
-    "FacilityRecord": "rig_sim", "prepare_facility": "rig_sim",
-    "pressure_values": "rig_sim", "reduced_plant": "rig_sim", "simulate_facility": "rig_sim",
-    "true_rig": "rig_sim",
-    "acquire": "stages", "at_speed": "stages", "check_controller": "stages",
-    "check_record_metadata": "stages", "identify": "stages", "record_spread": "stages",
-    "sample_rate_of": "stages", "state_space_from_metadata": "stages",
-    "ClosedLoopModel": "fit", "FitResult": "fit", "fit_parameters": "fit",
-    "MISMATCH": "residuals", "ResidualTests": "residuals", "residual_tests": "residuals",
-    "uncertainty_from_fit": "intervals",
-    "advice": "budget",
-    "frf_checks": "checks", "interval_check": "checks", "true_line": "checks",
-    "truth_errors": "checks",
-    "fit_failure": "plausibility", "implausible": "plausibility",
-    "require_finite": "plausibility",
-    "ProcedureResult": "procedure", "thesis_procedure": "procedure",
-    "design_rig": "design_model", "impulse_checks": "design_model", "truth_rig": "design_model",
-    "StaticLoadResult": "static_load", "save_static_record": "static_load",
-    "static_ki": "static_load", "virtual_static_load": "static_load",
-    "with_static_record": "static_load",
-    "MIN_FIT_PCT": "seal_test", "fit_reliability": "seal_test",
-    "seal_frequency_test": "seal_test",
-    "FRF": "frf", "estimate_frf": "frf", "model_frf": "frf", "plant_frf": "frf",
-    "CoprimeFactors": "coprime", "coprime_factors": "coprime",
-    "YoulaResult": "youla", "identify_youla": "youla",
-    "OnlineTracker": "tracking", "TrackingResult": "tracking",
-    "TrackingSettings": "tracking", "check_excitation": "tracking", "track": "tracking",
-    "tracking_excitation": "tracking",
+    "Excitation": "excitation.signals", "chirp": "excitation.signals",
+    "impulse": "excitation.signals", "prbs": "excitation.signals",
+    "stepped_sine": "excitation.signals",
+    "Measurement": "records.measurement", "validate_measurement": "records.measurement",
+    "load_measurement": "records.data", "record_is_ours": "records.data",
+    "save_measurement": "records.data",
+    "read_matlab": "records.matlab_file",
+    "BIAS_PER_AMPLITUDE": "excitation.plan", "IMPULSE_LEAD": "excitation.plan",
+    "SAMPLES_PER_IMPULSE": "excitation.plan", "excitation_plan": "excitation.plan",
+    "impulse_amplitude": "excitation.plan", "impulse_length": "excitation.plan",
+    "FacilityRecord": "facility.rig_sim", "prepare_facility": "facility.rig_sim",
+    "pressure_values": "facility.rig_sim", "reduced_plant": "facility.rig_sim",
+    "simulate_facility": "facility.rig_sim", "true_rig": "facility.rig_sim",
+    "acquire": "fitting.stages", "at_speed": "fitting.stages",
+    "check_controller": "fitting.stages", "check_record_metadata": "fitting.stages",
+    "identify": "fitting.stages", "record_spread": "fitting.stages",
+    "sample_rate_of": "fitting.stages", "state_space_from_metadata": "fitting.stages",
+    "ClosedLoopModel": "fitting.fit", "FitResult": "fitting.fit",
+    "fit_parameters": "fitting.fit",
+    "MISMATCH": "fitting.residuals", "ResidualTests": "fitting.residuals",
+    "residual_tests": "fitting.residuals",
+    "uncertainty_from_fit": "fitting.intervals",
+    "advice": "fitting.budget",
+    "frf_checks": "fitting.checks", "interval_check": "fitting.checks",
+    "true_line": "fitting.checks", "truth_errors": "fitting.checks",
+    "fit_failure": "fitting.plausibility", "implausible": "fitting.plausibility",
+    "require_finite": "fitting.plausibility",
+    "ProcedureResult": "fitting.procedure", "thesis_procedure": "fitting.procedure",
+    "design_rig": "facility.design_model", "impulse_checks": "facility.design_model",
+    "truth_rig": "facility.design_model",
+    "StaticLoadResult": "fitting.static_load", "save_static_record": "fitting.static_load",
+    "static_ki": "fitting.static_load", "virtual_static_load": "fitting.static_load",
+    "with_static_record": "fitting.static_load",
+    "MIN_FIT_PCT": "fitting.seal_test", "fit_reliability": "fitting.seal_test",
+    "seal_frequency_test": "fitting.seal_test",
+    "FRF": "fitting.frf", "estimate_frf": "fitting.frf", "model_frf": "fitting.frf",
+    "plant_frf": "fitting.frf",
+    "CoprimeFactors": "fitting.coprime", "coprime_factors": "fitting.coprime",
+    "YoulaResult": "fitting.youla", "identify_youla": "fitting.youla",
+    "OnlineTracker": "tracking", "TrackingResult": "tracking", "TrackingSettings": "tracking",
+    "check_excitation": "tracking", "track": "tracking", "tracking_excitation": "tracking",
 }
 
 __all__ = sorted(_FROM)

@@ -4,7 +4,7 @@ Method: a recursive prediction-error method (RPEM; Ljung & Söderström, *Theory
 Practice of Recursive Identification*, 1983, §3.7 and §4.4; Ljung, *System
 Identification*, 2nd ed., §11.4) in its Kalman-filter form for parameters that drift as
 random walks. The model is the rig's reduced plant with the amplifier and eddy lag in
-series (:meth:`ambseal.identify.fit.ClosedLoopModel.matrices`), driven by the *measured*
+series (:meth:`ambseal.identify.fitting.fit.ClosedLoopModel.matrices`), driven by the *measured*
 current references: the loop is cut at the DAC, so the controller that ran only needs to
 have produced the references (it is not simulated), and an unstable open-loop plant is
 tracked through the predictor's gain. With x the model state, u = i_ref, y the sensors:
@@ -64,11 +64,11 @@ from scipy import stats
 
 from ambseal.config import RigConfig
 from ambseal.errors import DataError, IdentificationError, ModelError
-from ambseal.identify.data import Measurement
-from ambseal.identify.excitation import PRBS_CLOCK_SAMPLES
-from ambseal.identify.fit import _DEFAULT_SCALE, ClosedLoopModel
-from ambseal.identify.signals import prbs
-from ambseal.identify.stages import build_models
+from ambseal.identify.records.data import Measurement
+from ambseal.identify.excitation.plan import PRBS_CLOCK_SAMPLES
+from ambseal.identify.fitting.fit import _DEFAULT_SCALE, ClosedLoopModel
+from ambseal.identify.excitation.signals import prbs
+from ambseal.identify.fitting.stages import build_models
 from ambseal.model import (
     build_system,
     channel_names,
@@ -886,7 +886,7 @@ def tracking_excitation(cfg: RigConfig, duration_s: float, *, amplitude_a: float
     Returns
     -------
     Excitation
-        The excitation currents on every axis (:func:`ambseal.identify.signals.prbs`).
+        The excitation currents on every axis (:func:`ambseal.identify.excitation.signals.prbs`).
 
     Raises
     ------

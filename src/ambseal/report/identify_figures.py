@@ -5,7 +5,7 @@ Agg canvas, no pyplot, written atomically by :func:`ambseal.report.figures.save_
 
 The FRF objects are taken by duck typing (anything with ``frequency_hz``, ``H``,
 ``coherence``, ``input_names``, ``output_names`` and optionally ``units``, e.g.
-:class:`ambseal.identify.frf.FRF`), so this module does not import the identification code.
+:class:`ambseal.identify.fitting.frf.FRF`), so this module does not import the identification code.
 """
 
 from __future__ import annotations
@@ -279,7 +279,7 @@ def residual_figure(path: str | os.PathLike, tests: Any, *,
     path : str or os.PathLike
         The PNG to write.
     tests : ResidualTests
-        :func:`ambseal.identify.residuals.residual_tests` of a fit.
+        :func:`ambseal.identify.fitting.residuals.residual_tests` of a fit.
     title : str, optional
         The figure's title.
 
@@ -329,7 +329,7 @@ def error_budget_figure(path: str | os.PathLike, names: Sequence[str], estimate:
     std_error_noise : array_like, shape (p,)
         Their standard errors from the noise alone (SI).
     budget : ErrorBudget or None
-        The fixed parameters' contributions (:class:`ambseal.identify.budget.ErrorBudget`);
+        The fixed parameters' contributions (:class:`ambseal.identify.fitting.budget.ErrorBudget`);
         None draws the noise part alone.
     top : int, optional
         Fixed parameters named; the others are summed.
@@ -381,7 +381,7 @@ def seal_frequency_figure(path: str | os.PathLike, curves: Sequence[tuple],
     """Identified seal coefficients with ±1.96σ bars against frequency, one curve per
     pressure (thesis P4 Fig. 12). ``curves``: (label, frequency_hz (n,), estimate (n, 4),
     std_error (n, 4)[, unreliable (n,) bool]); unreliable fits are drawn as open markers
-    without bars (:func:`ambseal.identify.seal_test.fit_reliability`)."""
+    without bars (:func:`ambseal.identify.fitting.seal_test.fit_reliability`)."""
     fig = Figure(figsize=(10, 6), layout="constrained")
     axes = fig.subplots(2, 2).ravel()
     for label, f, est, se, *rest in curves:
@@ -445,7 +445,7 @@ def facility_impulse_figure(path: str | os.PathLike, checks: Sequence[Any],
     of each excited axis on the facility (dashed, "experimental") and in the identified
     model (solid, "simulated"), µm against s. ``checks``: objects with ``controller``,
     ``pressure_bar``, ``time_s``, ``excitation_a``, ``facility_m``, ``model_m``, ``axes``,
-    ``nrmse_fit_pct`` and ``error`` (:class:`ambseal.identify.design_model.ImpulseCheck`)."""
+    ``nrmse_fit_pct`` and ``error`` (:class:`ambseal.identify.facility.design_model.ImpulseCheck`)."""
     names = list(dict.fromkeys(c.controller for c in checks))
     pressures = sorted({c.pressure_bar for c in checks})
     fig = Figure(figsize=(3.6 * len(names) + 0.6, 2.6 * len(pressures) + 0.6),

@@ -1,7 +1,7 @@
 """The main job's report: its figures, the identification section and ``report.html``.
 
 Everything here draws or formats results computed elsewhere (:mod:`ambseal.analysis.judge`,
-:mod:`ambseal.identify.procedure`, :mod:`ambseal.identify.checks`); figures follow the
+:mod:`ambseal.identify.fitting.procedure`, :mod:`ambseal.identify.fitting.checks`); figures follow the
 thesis's (P5 Figs. 10–15, P4 Figs. 9–12, P5 Fig. 7, P3 Figs. 11–12).
 """
 
@@ -200,7 +200,7 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
     res : ProcedureResult
         The identification.
     errors : dict
-        :func:`ambseal.identify.checks.truth_errors` of ``res``.
+        :func:`ambseal.identify.fitting.checks.truth_errors` of ``res``.
     checks : FrfChecks
         The frequency-response checks of the identified model.
     truth : TruthSection
@@ -334,9 +334,9 @@ def facility_impulse_report(out: Path, checks: list, design_note: dict
     out : Path
         Folder of the figure.
     checks : list of ImpulseCheck
-        :func:`ambseal.identify.design_model.impulse_checks`.
+        :func:`ambseal.identify.facility.design_model.impulse_checks`.
     design_note : dict
-        The rig the designs took and why (:func:`ambseal.identify.design_model.design_rig`).
+        The rig the designs took and why (:func:`ambseal.identify.facility.design_model.design_rig`).
 
     Returns
     -------

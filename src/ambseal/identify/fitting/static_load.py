@@ -43,8 +43,8 @@ import numpy as np
 from ambseal.config import RigConfig, TruthSection
 from ambseal.errors import ConfigError, DataError
 from ambseal.files import atomic_write, read_text
-from ambseal.identify.fit import FitResult
-from ambseal.identify.rig_sim import true_rig
+from ambseal.identify.fitting.fit import FitResult
+from ambseal.identify.facility.rig_sim import true_rig
 from ambseal.model import (
     amb_factors,
     build_system,

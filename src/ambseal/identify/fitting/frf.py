@@ -347,7 +347,7 @@ def closed_loop_frf(
     window: Any = "hann",
     samples: slice | None = None,
 ) -> FRF:
-    """Closed-loop FRF of a :class:`~ambseal.identify.data.Measurement` from its excitation.
+    """Closed-loop FRF of a :class:`~ambseal.identify.records.data.Measurement` from its excitation.
 
     Parameters
     ----------

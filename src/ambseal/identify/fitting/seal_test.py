@@ -28,7 +28,7 @@ with ζ alone to 0.27.
 
 Reliability: a fit is marked ``unreliable`` when it did not converge, when its NRMSE fit
 on some channel is below :data:`MIN_FIT_PCT`, or when its model check fails (residuals
-correlated with the excitation, :mod:`ambseal.identify.residuals`, or a held value the
+correlated with the excitation, :mod:`ambseal.identify.fitting.residuals`, or a held value the
 data dispute: the intervals then understate the uncertainty).
 """
 
@@ -37,11 +37,11 @@ from __future__ import annotations
 import numpy as np
 
 from ambseal.config import RigConfig
-from ambseal.identify.excitation import excitation_plan
-from ambseal.identify.fit import TAU_E, ClosedLoopModel, FitResult
-from ambseal.identify.rig_sim import reduced_plant
-from ambseal.identify.signals import Excitation, stepped_sine
-from ambseal.identify.stages import acquire, identify
+from ambseal.identify.excitation.plan import excitation_plan
+from ambseal.identify.fitting.fit import TAU_E, ClosedLoopModel, FitResult
+from ambseal.identify.facility.rig_sim import reduced_plant
+from ambseal.identify.excitation.signals import Excitation, stepped_sine
+from ambseal.identify.fitting.stages import acquire, identify
 from ambseal.model import actuator_matrices, channel_names
 from ambseal.robust import DiscreteController
 
@@ -131,7 +131,7 @@ def whirl_stepped_sine(frequencies_hz, balance, *, amplitude_a: float, cycles: i
 
     Step m: ζ = (a_f + a_b) sin ω_m t, η = (a_b − a_f) cos ω_m t on every AMB (parallel motion,
     P4 §3.5.1), with a_b/a_f = ``balance[m]`` (:func:`whirl_balance`) and the larger of the
-    two equal to ``amplitude_a``. Windows and timing as :func:`~ambseal.identify.signals.stepped_sine`.
+    two equal to ``amplitude_a``. Windows and timing as :func:`~ambseal.identify.excitation.signals.stepped_sine`.
 
     Returns
     -------
@@ -228,7 +228,7 @@ def seal_frequency_test(cfg: RigConfig, truth, controller: DiscreteController, s
         seal if omitted.
     amplitude_a : float, optional
         The larger of the forward and backward whirl amplitudes (A); default the rig's
-        excitation amplitude (:func:`~ambseal.identify.excitation.impulse_amplitude`:
+        excitation amplitude (:func:`~ambseal.identify.excitation.plan.impulse_amplitude`:
         bias current / 120, 0.05 A on the test rig).
     cycles : int
         Periods per step in the analysis window, ≥ 1.
@@ -237,7 +237,7 @@ def seal_frequency_test(cfg: RigConfig, truth, controller: DiscreteController, s
     seed : int
         Seed of the facility's noise.
     **fit_kw
-        Passed to :func:`~ambseal.identify.stages.identify` (e.g. ``known_fit``,
+        Passed to :func:`~ambseal.identify.fitting.stages.identify` (e.g. ``known_fit``,
         ``budget``).
 
     Returns

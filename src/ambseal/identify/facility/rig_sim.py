@@ -36,7 +36,7 @@ import numpy as np
 
 from ambseal.config import MAX_ELEMENTS, RigConfig, TruthSection
 from ambseal.errors import ConfigError, ModelError
-from ambseal.identify.facility_loop import facility_loop
+from ambseal.identify.facility.facility_loop import facility_loop
 from ambseal.lti import series_inputs, zoh
 from ambseal.model import (
     actuator_matrices,

@@ -3,7 +3,7 @@
 :class:`Measurement` holds the columns of one record (thesis P2 §5: excitation, current
 reference, coil current and displacement per actuator axis) with its metadata;
 :func:`validate_measurement` checks the sample values. Files are read and written by
-:mod:`ambseal.identify.data`, whose docstring gives the format and the checks.
+:mod:`ambseal.identify.records.data`, whose docstring gives the format and the checks.
 """
 
 from __future__ import annotations

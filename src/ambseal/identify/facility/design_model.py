@@ -21,12 +21,12 @@ import numpy as np
 
 from ambseal.config import Affine, RigConfig, TruthSection, rig_with_values
 from ambseal.errors import ModelError
-from ambseal.identify.excitation import ExcitationPlan, excitation_plan
-from ambseal.identify.fit import TAU_E, nrmse_fit
-from ambseal.identify.procedure import ProcedureResult
-from ambseal.identify.rig_sim import true_rig
-from ambseal.identify.signals import impulse
-from ambseal.identify.stages import acquire, build_models
+from ambseal.identify.excitation.plan import ExcitationPlan, excitation_plan
+from ambseal.identify.fitting.fit import TAU_E, nrmse_fit
+from ambseal.identify.fitting.procedure import ProcedureResult
+from ambseal.identify.facility.rig_sim import true_rig
+from ambseal.identify.excitation.signals import impulse
+from ambseal.identify.fitting.stages import acquire, build_models
 from ambseal.model import build_system, channel_names, mechanical_plant
 from ambseal.robust import DiscreteController
 
@@ -177,7 +177,7 @@ def impulse_checks(cfg: RigConfig, identified: RigConfig, truth: TruthSection,
                    seed: int = 77, excitation: ExcitationPlan | None = None,
                    ) -> list[ImpulseCheck]:
     """P5 Fig. 15 on the virtual facility: the rig's impulse (``excitation``, default
-    :func:`~ambseal.identify.excitation.excitation_plan` of ``cfg``; test rig 0.05 A for
+    :func:`~ambseal.identify.excitation.plan.excitation_plan` of ``cfg``; test rig 0.05 A for
     10 ms at 0.05 s in a 0.25 s record) on the first bearing's
     ζ and the last bearing's η at once (orthogonal directions at both ends), each controller
     running on the facility (``cfg`` with ``truth``) and on the identified model, at each

@@ -15,11 +15,11 @@ from dataclasses import dataclass
 from scipy.stats import binom, norm
 
 from ambseal.config import Affine
-from ambseal.identify.excitation import ExcitationPlan, excitation_plan, welch_segment
-from ambseal.identify.frf import FRF, closed_loop_frf, model_frf, plant_frf
-from ambseal.identify.procedure import ProcedureResult
-from ambseal.identify.signals import chirp
-from ambseal.identify.stages import acquire, build_models
+from ambseal.identify.excitation.plan import ExcitationPlan, excitation_plan, welch_segment
+from ambseal.identify.fitting.frf import FRF, closed_loop_frf, model_frf, plant_frf
+from ambseal.identify.fitting.procedure import ProcedureResult
+from ambseal.identify.excitation.signals import chirp
+from ambseal.identify.fitting.stages import acquire, build_models
 from ambseal.lti import finite_or_none
 from ambseal.model import build_plant
 
@@ -67,7 +67,7 @@ def frf_checks(cfg, truth, res: ProcedureResult, controller, *, seed: int = 99,
         Noise seed of the chirp record.
     excitation : ExcitationPlan, optional
         The chirp, the bands and the amplitude; default
-        :func:`~ambseal.identify.excitation.excitation_plan` of ``cfg`` (its rules: the
+        :func:`~ambseal.identify.excitation.plan.excitation_plan` of ``cfg`` (its rules: the
         chirp to 0.75·f_s/50, the checks to 0.7·f_s/50 and f_s/50, Welch segments a
         quarter of the record).
 
@@ -158,7 +158,7 @@ def interval_check(errors: dict) -> dict:
 
     On the virtual facility the truth is known: an interval that misses it says the fit
     understates its error — a model mismatch or a held value that is off, whether or not
-    the residual tests (:meth:`~ambseal.identify.fit.FitResult.model_check`) saw it. One
+    the residual tests (:meth:`~ambseal.identify.fitting.fit.FitResult.model_check`) saw it. One
     in twenty intervals misses by chance; the mismatch is more misses than chance makes
     plausible (a binomial tail below 5 % at a 5 % miss rate: 3 of 15) or any miss by more
     than its interval's width.

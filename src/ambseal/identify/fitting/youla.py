@@ -61,7 +61,7 @@ Parameters are *normalised* as in P1 ("θ = 1 corresponds to a 100 % change"): t
 SI is θ·scale, the scale being |nominal| by default. P1 §IV: a 50 % change of one bearing's
 Ks in one direction, θ = 0.5, identified as 0.502.
 
-The factorisation itself, with a runnable example, is in :mod:`ambseal.identify.coprime`.
+The factorisation itself, with a runnable example, is in :mod:`ambseal.identify.fitting.coprime`.
 """
 
 from __future__ import annotations
@@ -74,7 +74,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ambseal.errors import IdentificationError
-from ambseal.identify.coprime import (
+from ambseal.identify.fitting.coprime import (
     CoprimeFactors,
     _as_2d,
     _ss,

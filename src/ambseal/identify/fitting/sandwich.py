@@ -5,7 +5,7 @@ of θ̂ is the sandwich (JᵀJ)⁻¹ S (JᵀJ)⁻¹ with S = Var(Jᵀr) from the
 (:func:`_long_run_covariance`, leverage-corrected), the 95 % intervals take Student's t with
 the Satterthwaite degrees of freedom (:func:`_covariance`, :func:`_t_quantile`), and the
 score test of a value the fit did not free uses the same long-run variance
-(:func:`_score_test`). Used by :mod:`ambseal.identify.fit` (module docstring there).
+(:func:`_score_test`). Used by :mod:`ambseal.identify.fitting.fit` (module docstring there).
 """
 
 from __future__ import annotations

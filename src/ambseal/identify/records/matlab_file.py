@@ -9,7 +9,7 @@ text arrays, and the field names of a struct or the text of a cell array — nev
 object scipy built from the file. A crash, a hang or an unreadable file is one
 :class:`~ambseal.errors.DataError` naming the file.
 
-Records (:mod:`ambseal.identify.data`) and controller files (:mod:`ambseal.export.controller_files`)
+Records (:mod:`ambseal.identify.records.data`) and controller files (:mod:`ambseal.export.controller_files`)
 read their ``.mat`` form through it.
 """
 

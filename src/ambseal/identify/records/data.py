@@ -1,7 +1,7 @@
 """Measurement files: what a rig records during an identification run, and how it is read.
 
-A real rig and the virtual one (:mod:`ambseal.identify.rig_sim`) write the same format, so the
-identification (:mod:`ambseal.identify.fit`, :mod:`ambseal.identify.frf`) cannot tell them
+A real rig and the virtual one (:mod:`ambseal.identify.facility.rig_sim`) write the same format, so the
+identification (:mod:`ambseal.identify.fitting.fit`, :mod:`ambseal.identify.fitting.frf`) cannot tell them
 apart. This docstring is the user-facing specification of that format.
 
 Content
@@ -47,7 +47,7 @@ Recommended, all SI:
 * ``bias_current_a`` — bias current (A), a number or ``{axis: number}``;
 * ``pressure_drop_pa`` — pressure drop across the seal (Pa; default 0);
 * ``speed_rad_s`` — rotor speed (rad/s; default the rig's ``[operating]`` speed);
-* ``excitation`` — :attr:`ambseal.identify.signals.Excitation.params`;
+* ``excitation`` — :attr:`ambseal.identify.excitation.signals.Excitation.params`;
 * ``current_limit_a`` — amplifier current limit (A), used for the clipping check.
 
 Any other JSON value may be added.
@@ -64,7 +64,7 @@ MATLAB (``*.mat``, level 5 / v7, not v7.3)
     One variable per column, named as the column, a column vector of doubles (``n × 1``;
     a row vector is accepted), plus ``metadata_json``, a char array holding the same JSON
     object as the sidecar. Read with :func:`scipy.io.loadmat` in a child process
-    (:mod:`ambseal.identify.matlab_file`); nothing read from a file is ever unpickled.
+    (:mod:`ambseal.identify.records.matlab_file`); nothing read from a file is ever unpickled.
 
 Validation (:func:`load_measurement`)
 -------------------------------------
@@ -114,8 +114,8 @@ import scipy.io
 
 from ambseal.errors import AmbsealError, DataError
 from ambseal.files import STAMP_KEY, atomic_write, input_file, read_text
-from ambseal.identify.matlab_file import read_matlab
-from ambseal.identify.measurement import (
+from ambseal.identify.records.matlab_file import read_matlab
+from ambseal.identify.records.measurement import (
     _RATE_RTOL,
     _RESERVED,
     CHANNELS,

@@ -4,7 +4,7 @@ Closed-loop identification (thesis P2 §4.2, P4 §3.3) perturbs the levitated ro
 excitation current ``i_e`` added to the controller output of one or more actuator axes while
 the rig records currents and displacements. This module builds those signals, sampled at the
 rig's rate, for every axis of the rig — an axis that is not excited carries zeros, so the
-array can be written straight into a measurement file (:mod:`ambseal.identify.data`).
+array can be written straight into a measurement file (:mod:`ambseal.identify.records.data`).
 
 Four kinds, one result type (:class:`Excitation`):
 
@@ -32,7 +32,7 @@ raise ``ValueError`` naming the argument.
 
 Example
 -------
->>> from ambseal.identify.signals import prbs
+>>> from ambseal.identify.excitation.signals import prbs
 >>> ex = prbs(amplitude_a=0.1, clock_period_s=1e-3, duration_s=1.0, sample_rate_hz=5000.0,
 ...           excited=("A_zeta", "B_zeta"), seed=1)
 >>> ex.values_a.shape, ex.axes

@@ -2,7 +2,7 @@
 over the parameter ranges the identification leaves).
 
 ``ambseal identify`` writes ``fit.json`` with a 95 % interval per parameter that includes
-the error budget of the values it held fixed (:mod:`ambseal.identify.budget`);
+the error budget of the values it held fixed (:mod:`ambseal.identify.fitting.budget`);
 :func:`uncertainty_from_fit` reads those intervals into the ``{parameter: (low, high)}``
 ranges (SI) that :func:`ambseal.design.plant.generalized_plant` and
 :func:`ambseal.design.recipes.design` take as ``uncertainty``. Design on the identified
@@ -44,7 +44,7 @@ def uncertainty_from_fit(path: str | Path, names=None) -> dict[str, tuple[float,
         an interval that is missing or not finite (a fit whose covariance failed), naming
         the file and the parameter. A fit whose intervals understate the uncertainty is
         refused too: residuals that correlate with the excitation, a sensor lag the data
-        ask for (:mod:`ambseal.identify.sensor_lag`), or a fixed value the data dispute
+        ask for (:mod:`ambseal.identify.fitting.sensor_lag`), or a fixed value the data dispute
         by more than the 95 % band of its stated uncertainty (the offset the score test
         suggests beyond 1.96 σ: the budget in the intervals does not cover it).
     """

@@ -7,12 +7,12 @@ A + LC are stable,
     [[Ṽ, −Ũ], [−Ñ, M̃]] = [A+LC | −(B+LD), L;  F | I, 0;  C | −D, I],
 
 G = N M⁻¹ = M̃⁻¹ Ñ, K = U V⁻¹ = Ṽ⁻¹ Ũ, and the double Bezout identity is checked
-numerically. Used by the Youla (Hansen) identification scheme of :mod:`ambseal.identify.youla`.
+numerically. Used by the Youla (Hansen) identification scheme of :mod:`ambseal.identify.fitting.youla`.
 
 Example
 -------
 >>> import numpy as np
->>> from ambseal.identify.coprime import coprime_factors, observer_gains
+>>> from ambseal.identify.fitting.coprime import coprime_factors, observer_gains
 >>> A = np.array([[0.0, 1.0], [100.0, 0.0]]); B = np.array([[0.0], [1.0]])
 >>> C = np.array([[1.0, 0.0]]); D = np.zeros((1, 1))
 >>> F, L = observer_gains(A, B, C)

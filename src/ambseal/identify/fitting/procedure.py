@@ -12,10 +12,10 @@ the regression's seal) at the nominal pressure, with a zero-pressure run as the 
 reference (P4 Fig. 12); (d) the identified rig.
 
 Every excitation's amplitude, clock and length follow from the rig (its bias current and
-sample rate, :mod:`ambseal.identify.excitation`): the thesis's 0.05 A, 1 ms PRBS clock and
+sample rate, :mod:`ambseal.identify.excitation.plan`): the thesis's 0.05 A, 1 ms PRBS clock and
 10 ms impulse on its test rig.
 
-Every fit adds the error budget of the values it holds (:mod:`ambseal.identify.budget`):
+Every fit adds the error budget of the values it holds (:mod:`ambseal.identify.fitting.budget`):
 an earlier stage's estimates with that stage's standard errors and correlations, anything
 else (the seal in stages (a)–(b)) with its stated or default uncertainty; its model check
 says when the data dispute a held value.
@@ -33,18 +33,18 @@ import numpy as np
 
 from ambseal.config import Affine, RigConfig, TruthSection, rig_with_values
 from ambseal.errors import ConfigError, IdentificationError, ModelError
-from ambseal.identify.excitation import ExcitationPlan, excitation_plan
-from ambseal.identify.fit import TAU_E, FitResult
-from ambseal.identify.seal_test import fit_reliability, seal_frequency_test
-from ambseal.identify.signals import impulse, prbs
-from ambseal.identify.stages import acquire, identify
-from ambseal.identify.static_load import (
+from ambseal.identify.excitation.plan import ExcitationPlan, excitation_plan
+from ambseal.identify.fitting.fit import TAU_E, FitResult
+from ambseal.identify.fitting.seal_test import fit_reliability, seal_frequency_test
+from ambseal.identify.excitation.signals import impulse, prbs
+from ambseal.identify.fitting.stages import acquire, identify
+from ambseal.identify.fitting.static_load import (
     programme_repeats,
     static_ki,
     virtual_static_load,
     with_static,
 )
-from ambseal.identify.stats import linear_regression
+from ambseal.identify.fitting.stats import linear_regression
 from ambseal.model import channel_names
 from ambseal.robust import DiscreteController
 
@@ -187,17 +187,17 @@ def thesis_procedure(
         Seed of excitations and noise.
     sine_frequencies_hz : tuple of float, optional
         Frequencies (Hz) of the balanced-whirl stepped sines of stage (c) (P4 §3.5.1);
-        default the rig's (:func:`~ambseal.identify.excitation.excitation_plan`: 10, 20,
+        default the rig's (:func:`~ambseal.identify.excitation.plan.excitation_plan`: 10, 20,
         40, …, 200 Hz on the thesis rig).
     impulse_pressures_bar : tuple of float, optional
         Pressure drops (bar) of the impulse runs of stage (c) (P5 §3.3); the facility must
         hold the rotor at three of them at least. Default :func:`seal_test_pressures`.
     excitation : ExcitationPlan, optional
         Amplitudes, clock and lengths of the excitations; default
-        :func:`~ambseal.identify.excitation.excitation_plan` of ``cfg``.
+        :func:`~ambseal.identify.excitation.plan.excitation_plan` of ``cfg``.
     amb_speed_hz : float or None
         Spin speed (Hz) of the zero-pressure PRBS runs of stages (a) and (b)
-        (:func:`~ambseal.identify.stages.at_speed`): default standstill, where the AMBs
+        (:func:`~ambseal.identify.fitting.stages.at_speed`): default standstill, where the AMBs
         are commissioned before the machine spins and no gyroscopic coupling enters; None:
         the operating speed. The seal's runs are at the operating speed, where its
         coefficients matter.

@@ -32,7 +32,7 @@ An ``uncertainty = { key = σ }`` table beside the values in the rig file (σ re
 ``eddy_time_constant``), else :data:`DEFAULT_UNCERTAINTY` per kind. A value of zero carries
 no uncertainty in this relative form (a seal's pressure-driven K, k at 0 bar, say).
 
-Values an earlier fit found (``known`` of :func:`ambseal.identify.stages.identify` with
+Values an earlier fit found (``known`` of :func:`ambseal.identify.fitting.stages.identify` with
 that fit's result, as the procedure of ``ambseal run`` does from stage to stage) carry that
 fit's standard errors *and correlations*: their block of the fixed values' covariance is the
 earlier fit's, C = diag(σ) R diag(σ), and the added covariance is G C Gᵀ. The shares below

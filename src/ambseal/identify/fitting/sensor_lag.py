@@ -11,7 +11,7 @@ cent — while its intervals claim less. Two tools:
   τ_s is its delay at low frequency (the group delay a·T/(1 − a)), and the pole
   a = e^{−2π f_c T} of a corner f_c is the sampled equivalent of the analogue first-order
   lag 1/(2π f_c) (pole matching). τ_s = 0 is no filter. Fit it beside τ_e when the test
-  below asks for it (``names`` of :func:`ambseal.identify.fit.fit_parameters`).
+  below asks for it (``names`` of :func:`ambseal.identify.fitting.fit.fit_parameters`).
 - **the score test** of that extension at τ_s = 0 (Rao's score test; Ljung, *System
   Identification*, 2nd ed., §16.6, testing an extended model structure without fitting
   it): the cost's gradient in τ_s at the optimum with every fitted θ free (the τ_s column

@@ -35,11 +35,11 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ambseal.errors import IdentificationError
-from ambseal.identify.budget import ErrorBudget, propagate
-from ambseal.identify.residuals import MISMATCH, ResidualTests, residual_tests
-from ambseal.identify.sandwich import _covariance, _long_run_covariance, _score_test, _t_quantile  # noqa: F401
-from ambseal.identify.sensor_lag import TAU_S, lag_test_dict, with_sensor_lag
-from ambseal.identify.stats import jacobian_correlation
+from ambseal.identify.fitting.budget import ErrorBudget, propagate
+from ambseal.identify.fitting.residuals import MISMATCH, ResidualTests, residual_tests
+from ambseal.identify.fitting.sandwich import _covariance, _long_run_covariance, _score_test, _t_quantile  # noqa: F401
+from ambseal.identify.fitting.sensor_lag import TAU_S, lag_test_dict, with_sensor_lag
+from ambseal.identify.fitting.stats import jacobian_correlation
 from ambseal.lti import series_inputs, simulate_lti, zoh
 from ambseal.model import Plant, eddy_lag_matrices
 from ambseal.robust import DiscreteController, closed_loop_matrices
@@ -76,7 +76,7 @@ class ClosedLoopModel:
         Nominal eddy-current lag (s).
     tau_s : float
         Sensor lag (s) of the displacement sensors' low-pass, 0 for none
-        (:mod:`ambseal.identify.sensor_lag`).
+        (:mod:`ambseal.identify.fitting.sensor_lag`).
     """
 
     plant: Plant
@@ -172,9 +172,9 @@ class FitResult:
         The noise part of ``std_error`` (sandwich covariance); ``std_error`` adds the fixed
         parameters' budget to it.
     budget : ErrorBudget or None
-        What the fixed parameters' uncertainty adds (:mod:`ambseal.identify.budget`).
+        What the fixed parameters' uncertainty adds (:mod:`ambseal.identify.fitting.budget`).
     residuals : ResidualTests or None
-        Whiteness and independence tests (:mod:`ambseal.identify.residuals`).
+        Whiteness and independence tests (:mod:`ambseal.identify.fitting.residuals`).
     dof_noise : ndarray (p,) or None
         Effective degrees of freedom of the noise variance (Satterthwaite); the intervals
         take Student's t with these, combined with the budget's (known, infinite) part.
@@ -182,7 +182,7 @@ class FitResult:
         Correlation of (JᵀJ)⁻¹ at the optimum: "calculated based on the Jacobian matrix"
         (P4 Tables 2, 4), the experiment's design alone; ``correlation`` carries the misfit.
     sensor_lag : dict or None
-        Score test of a sensor lag the model lacks (:mod:`ambseal.identify.sensor_lag`);
+        Score test of a sensor lag the model lacks (:mod:`ambseal.identify.fitting.sensor_lag`);
         None when ``tau_s`` is fitted.
     """
 
@@ -216,10 +216,10 @@ class FitResult:
 
     def model_check(self) -> dict:
         """The fit's verdict on its own model: a mismatch when the residuals correlate with
-        the excitation (:mod:`ambseal.identify.residuals`, Ljung §16.6), the data dispute
-        a value the fit held fixed (score test, :mod:`ambseal.identify.budget`), or they
+        the excitation (:mod:`ambseal.identify.fitting.residuals`, Ljung §16.6), the data dispute
+        a value the fit held fixed (score test, :mod:`ambseal.identify.fitting.budget`), or they
         ask for a sensor lag the model lacks (score test,
-        :mod:`ambseal.identify.sensor_lag`) — unmodelled dynamics in general, a wrong value
+        :mod:`ambseal.identify.fitting.sensor_lag`) — unmodelled dynamics in general, a wrong value
         of a modelled parameter, and the one unmodelled element τ_e would otherwise absorb.
 
         Returns
@@ -322,12 +322,12 @@ def fit_parameters(
     ----------
     records : list
         Records with ``time_s`` (N,), ``excitation_a`` (N, k), ``displacement_m`` (N, k),
-        ``current_a`` (N, k) and ``axes`` (e.g. :class:`ambseal.identify.data.Measurement`).
+        ``current_a`` (N, k) and ``axes`` (e.g. :class:`ambseal.identify.records.data.Measurement`).
     models : list of ClosedLoopModel
         One per record (its pressure, its controller), sharing parameter names.
     names : list of str
         Parameters to fit (model names, ``"tau_e"``, or ``"tau_s"``: a sensor lag the rig
-        file does not state, :mod:`ambseal.identify.sensor_lag`).
+        file does not state, :mod:`ambseal.identify.fitting.sensor_lag`).
     initial, bounds : dict, optional
         Start values and (low, high) bounds in SI; default start the model's nominal
         values, default bounds [0.2, 5]× nominal for positive factors (Ki, Ks, spring
@@ -341,7 +341,7 @@ def fit_parameters(
         simulation always starts at rest at sample 0.
     fixed : dict, optional
         ``{name: (σ relative, source)}`` of parameters held at the models' values
-        (:func:`ambseal.identify.budget.fixed_uncertainty`); their error budget is added to
+        (:func:`ambseal.identify.fitting.budget.fixed_uncertainty`); their error budget is added to
         the covariance and the intervals. None: the noise covariance alone.
     fixed_correlation : (names, R), optional
         Fixed values that an earlier fit estimated together, and the correlation (m, m) of
@@ -484,7 +484,7 @@ def _nominal(model: ClosedLoopModel, name: str) -> float:
 
 
 def _lag_test(J, r, blocks, residual_blocks, x) -> dict:
-    """Score test of a sensor lag at τ_s = 0 (:mod:`ambseal.identify.sensor_lag`): the
+    """Score test of a sensor lag at τ_s = 0 (:mod:`ambseal.identify.fitting.sensor_lag`): the
     residuals' derivative in τ_s by a forward step of 1 µs (a = 0.01 at 10 kHz; y moves by
     a·(x[n] − x[n−1]), linear in the step)."""
     h = 1e-6

@@ -1,7 +1,7 @@
 """Identification stages: acquire a record, build the models a fit needs, fit and refine.
 
-These wire :mod:`~ambseal.identify.rig_sim`, :mod:`~ambseal.identify.data` and
-:mod:`~ambseal.identify.fit` to a rig description; the CLI and the pipeline call them.
+These wire :mod:`~ambseal.identify.facility.rig_sim`, :mod:`~ambseal.identify.records.data` and
+:mod:`~ambseal.identify.fitting.fit` to a rig description; the CLI and the pipeline call them.
 """
 
 from __future__ import annotations
@@ -12,12 +12,12 @@ import numpy as np
 
 from ambseal.config import RigConfig, TruthSection
 from ambseal.errors import ConfigError, DataError, IdentificationError, ModelError
-from ambseal.identify.budget import fixed_uncertainty
-from ambseal.identify.data import Measurement, validate_measurement
-from ambseal.identify.fit import TAU_E, ClosedLoopModel, FitResult, default_bounds, fit_parameters
-from ambseal.identify.rig_sim import facility_bias_current, reduced_plant, simulate_facility
-from ambseal.identify.sensor_lag import TAU_S
-from ambseal.identify.signals import Excitation
+from ambseal.identify.fitting.budget import fixed_uncertainty
+from ambseal.identify.records.data import Measurement, validate_measurement
+from ambseal.identify.fitting.fit import TAU_E, ClosedLoopModel, FitResult, default_bounds, fit_parameters
+from ambseal.identify.facility.rig_sim import facility_bias_current, reduced_plant, simulate_facility
+from ambseal.identify.fitting.sensor_lag import TAU_S
+from ambseal.identify.excitation.signals import Excitation
 from ambseal.model import actuator_matrices
 from ambseal.robust import DiscreteController
 
@@ -219,7 +219,7 @@ def acquire(cfg: RigConfig, truth: TruthSection, excitation: Excitation, *,
             speed_hz: float | None = None) -> Measurement:
     """Run the virtual facility with ``controller`` levitating the rotor and return the
     record as a :class:`Measurement` (the controller in its metadata; a
-    ``pressure_schedule`` of :func:`~ambseal.identify.rig_sim.simulate_facility` in it as
+    ``pressure_schedule`` of :func:`~ambseal.identify.facility.rig_sim.simulate_facility` in it as
     ``pressure_schedule_bar`` [[start_s, bar], ...]).
 
     Parameters
@@ -254,7 +254,7 @@ def acquire(cfg: RigConfig, truth: TruthSection, excitation: Excitation, *,
     DataError
         A controller that does not fit the axes or the excitation's sample rate.
     ModelError
-        See :func:`~ambseal.identify.rig_sim.simulate_facility`.
+        See :func:`~ambseal.identify.facility.rig_sim.simulate_facility`.
     ConfigError
         A speed the rig does not run (:func:`at_speed`).
     """
@@ -336,7 +336,7 @@ def identify(cfg: RigConfig, records: list[Measurement], names: list[str], *,
         Closed-loop records (metadata: pressure drop, speed, controller, sample rate).
     names : list of str
         Parameters to fit: LFT names of the model (``"A.Ki_zeta"``, ``"seal.k"``, ...),
-        ``"tau_e"`` or ``"tau_s"`` (:func:`~ambseal.identify.fit.fit_parameters`).
+        ``"tau_e"`` or ``"tau_s"`` (:func:`~ambseal.identify.fitting.fit.fit_parameters`).
     known : dict, optional
         Values found in earlier stages (e.g. Ki/Ks when fitting the coupling, P4 §3.5).
     current_weight : float
@@ -354,7 +354,7 @@ def identify(cfg: RigConfig, records: list[Measurement], names: list[str], *,
     budget : bool
         Add the error budget of every parameter held fixed to the intervals: values neither
         fitted nor ``known`` with the uncertainty the rig file states or the defaults of
-        :mod:`ambseal.identify.budget`; ``known`` values that ``known_fit`` estimated with
+        :mod:`ambseal.identify.fitting.budget`; ``known`` values that ``known_fit`` estimated with
         its standard errors and correlations; other ``known`` values as exact.
     sources : list of str, optional
         The records' file names, for errors.
@@ -373,7 +373,7 @@ def identify(cfg: RigConfig, records: list[Measurement], names: list[str], *,
         An ``uncertainty`` key that names no value (with ``budget``).
     IdentificationError
         A name without a channel or bounds, or a fit that cannot start
-        (:func:`~ambseal.identify.fit.fit_parameters`).
+        (:func:`~ambseal.identify.fitting.fit.fit_parameters`).
     DataError
         A record whose metadata lacks what the model needs (named with ``sources``).
     """

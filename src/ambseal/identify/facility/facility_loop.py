@@ -1,6 +1,6 @@
 """The virtual facility's sample loop, compiled with numba.
 
-The facility (:mod:`ambseal.identify.rig_sim`) cannot be vectorised over time: every
+The facility (:mod:`ambseal.identify.facility.rig_sim`) cannot be vectorised over time: every
 sample the digital controller reads the noisy, quantised sensors, the amplifier saturates,
 and the nonlinear AMB force law feeds back into the linear rotor over ``substeps``
 sub-steps. In pure Python that loop cost about 1 µs per arithmetic statement and was the

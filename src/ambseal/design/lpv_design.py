@@ -234,7 +234,8 @@ class FrozenDesign:
         """JSON-ready summary (no matrices)."""
         return {"method": self.method, "speed_hz": self.speed_hz, "gamma": self.gamma,
                 "order": int(self.K.nstates), "weights": self.weights.to_dict(),
-                "elapsed_s": round(self.elapsed_s, 3), "full_order": self.full_order}
+                "elapsed_s": round(self.elapsed_s, 3), "full_order": self.full_order,
+                "verdict": self.verdict}
 
 
 def check_full_order(cfg, spec, controller_at, name: str, allow_unstable: bool = False

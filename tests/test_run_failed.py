@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from ambseal.analysis.delivery import also_failed, loop_failure
+from ambseal.analysis.speed_range import SampledStability, StabilityCase
 from ambseal.cli import main
 from ambseal.config import default_rig_path
 
@@ -26,6 +27,14 @@ def _strong_seal_rig(tmp_path, factor: float):
     return rig
 
 
+def _case(p_bar, stable, label="", max_real_pole=None, discrete=None):
+    """A judged condition's stability (the cases the main job's judgements make)."""
+    return StabilityCase("hinf", label, p_bar, 0.0, stable,
+                         max_real_pole if max_real_pole is not None else (0.7 if not stable
+                                                                          else -3.0),
+                         discrete)
+
+
 def test_loop_failure_names_the_least_stable_mode():
     """The reason names the condition and the mode with the largest real part: a 557 Hz
     pair with σ = +0.7 1/s has ζ = −σ/|λ| = −0.7/(2π·557) = −2.0e-4 (closed form); a
@@ -35,11 +44,9 @@ def test_loop_failure_names_the_least_stable_mode():
     ok = np.array([-3 + 1j, -3 - 1j])
     dt = 1e-4
     zdisc = np.exp(np.array([0.2 + 2j * math.pi * 900, -1.0]) * dt)  # growing 900 Hz
-    cases = [({"stable": True, "pressure_bar": 0.0}, {"poles": ok}),
-             ({"stable": False, "pressure_bar": 4.08, "label": "4.08 bar"}, {"poles": bad}),
-             ({"stable": True, "pressure_bar": 2.04,
-               "discrete": {"stable": False, "sample_rate_hz": 1 / dt,
-                            "max_abs_pole_z": float(abs(zdisc[0]))}},
+    cases = [(_case(0.0, True), {"poles": ok}),
+             (_case(4.08, False, "4.08 bar"), {"poles": bad}),
+             (_case(2.04, True, discrete=SampledStability(False, float(abs(zdisc[0])), 1 / dt)),
               {"poles": ok, "discrete": {"poles": zdisc}})]
     f = loop_failure("hinf", cases, designed=True)
     assert f.reason.startswith("H∞: not delivered — the full-order loop is unstable at 4.08 bar")
@@ -58,7 +65,7 @@ def test_many_unstable_conditions_are_listed_with_the_least_stable_mode():
     cases = []
     for k, sigma in enumerate((0.1, 0.5, 2.0, 0.3, 0.2)):
         lam = sigma + 2j * math.pi * (50.0 if sigma == 2.0 else 80.0)
-        cases.append(({"stable": False, "label": f"0 bar, {10 * k} Hz", "max_real_pole": sigma},
+        cases.append((_case(0.0, False, f"0 bar, {10 * k} Hz", sigma),
                       {"poles": np.array([lam, lam.conjugate()])}))
     f = loop_failure("mu", cases, designed=True)
     zeta = -2.0 / abs(2.0 + 2j * math.pi * 50.0)
@@ -74,11 +81,11 @@ def test_a_failure_found_later_adds_its_conditions():
     whole, then the new conditions without a second head; the conditions of both."""
     w = 2 * math.pi * 300.0
     up = np.array([0.5 + 1j * w, 0.5 - 1j * w])
-    first = loop_failure("hinf", [({"stable": False, "label": "4.08 bar"}, {"poles": up})],
+    first = loop_failure("hinf", [(_case(4.08, False, "4.08 bar"), {"poles": up})],
                          designed=True)
     first = type(first)(first.reason + ". Tried: designed at 4.08 bar (still unstable)",
                         first.designed, first.judged, first.conditions)
-    more = loop_failure("hinf", [({"stable": False, "label": "0 bar, 0 Hz"}, {"poles": up})],
+    more = loop_failure("hinf", [(_case(0.0, False, "0 bar, 0 Hz"), {"poles": up})],
                         designed=True)
     both = also_failed(first, more)
     assert both.reason.startswith(first.reason + "; the full-order loop is unstable at "

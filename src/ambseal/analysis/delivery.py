@@ -103,11 +103,12 @@ def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
     method : str
         The controller's method (``"pid"``, ``"hinf"``, ...).
     judged : list of (case, curves)
-        Its cases (``JudgedCase.to_dict()``: ``stable``, ``pressure_bar``, ``speed_hz``,
-        optional ``discrete`` with ``stable`` and ``sample_rate_hz``) with the curves of
+        Its cases — :class:`~ambseal.analysis.judge.JudgedCase` or
+        :class:`~ambseal.analysis.speed_range.StabilityCase`: ``label``, ``pressure_bar``,
+        ``stable``, ``max_real_pole`` and ``discrete`` (None, or with ``stable``,
+        ``max_abs_pole_z`` and ``sample_rate_hz``) — with the curves of
         :func:`ambseal.analysis.judge.judge` (``poles``: closed-loop poles, rad/s; the
-        discrete loop's under ``curves["discrete"]["poles"]``, z), and the condition's
-        label under ``case["label"]`` when the caller has one.
+        discrete loop's under ``curves["discrete"]["poles"]``, z).
     designed : bool
         False for the reference PID of the rig file.
     kept : bool
@@ -120,18 +121,17 @@ def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
 
     cont, disc_parts, where = [], [], []
     for case, curves in judged:
-        label = case.get("label") or f"{case['pressure_bar']:g} bar"
-        if not case.get("stable"):
-            cont.append((label, _mode_text(curves.get('poles', ())),
-                         case.get("max_real_pole")))
+        label = case.label or f"{case.pressure_bar:g} bar"
+        if not case.stable:
+            cont.append((label, _mode_text(curves.get('poles', ())), case.max_real_pole))
             where.append(label)
             continue
-        disc = case.get("discrete")
-        if disc is not None and not disc.get("stable"):
-            dt = 1.0 / disc["sample_rate_hz"]
-            mode = _mode_text((curves.get("discrete") or {}).get("poles", ()), dt)
-            disc_parts.append((label, f"{mode}, max |z| = {disc['max_abs_pole_z']:.5f}",
-                               disc["max_abs_pole_z"]))
+        disc = case.discrete
+        if disc is not None and not disc.stable:
+            mode = _mode_text((curves.get("discrete") or {}).get("poles", ()),
+                              1.0 / disc.sample_rate_hz)
+            disc_parts.append((label, f"{mode}, max |z| = {disc.max_abs_pole_z:.5f}",
+                               disc.max_abs_pole_z))
             where.append(label)
     parts = ([f"the full-order loop is unstable at {_listed(cont)}"] if cont else []) + (
         [f"as it runs on the target (sampled, delayed) the loop is unstable at "

@@ -195,6 +195,8 @@ class JudgedCase(LoopJudgement):
     controller : str
     pressure_bar, speed_hz : float
         The condition (bar, Hz).
+    label : str
+        The condition as reports name it (:attr:`OperatingPoint.label`).
     delay : dict
         The delay lag judged with (:meth:`ambseal.robust.delay.DesignDelay.to_dict`).
     discrete : LoopJudgement or None
@@ -203,13 +205,15 @@ class JudgedCase(LoopJudgement):
     controller: str = ""
     pressure_bar: float = 0.0
     speed_hz: float = 0.0
+    label: str = ""
     delay: dict | None = None
     discrete: LoopJudgement | None = None
 
     def to_dict(self) -> dict:
         """The ``metrics.json`` case."""
         d = {"controller": self.controller, "pressure_bar": self.pressure_bar,
-             "speed_hz": self.speed_hz, **LoopJudgement.to_dict(self), "delay": self.delay}
+             "speed_hz": self.speed_hz, "label": self.label, **LoopJudgement.to_dict(self),
+             "delay": self.delay}
         if self.discrete is not None:
             d["discrete"] = self.discrete.to_dict()
         return d
@@ -454,7 +458,8 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
         disc, curves["discrete"] = _judge_loop(judged_loop(P, discrete, cur), cur, force,
                                                discrete, s, impulse)
     case = JudgedCase(**vars(body), controller=name, pressure_bar=point.pressure_bar,
-                      speed_hz=point.speed_rpm / 60.0, delay=dl.to_dict(), discrete=disc)
+                      speed_hz=point.speed_rpm / 60.0, label=point.label, delay=dl.to_dict(),
+                      discrete=disc)
     return case, curves
 
 

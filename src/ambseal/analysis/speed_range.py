@@ -23,7 +23,7 @@ from ambseal.machine import judged_loop
 from ambseal.model import build_plant
 from ambseal.robust import loop_delay
 
-__all__ = ["StabilityCase", "stability_points", "stability_case"]
+__all__ = ["SampledStability", "StabilityCase", "stability_points", "stability_case"]
 
 
 @dataclass(frozen=True)
@@ -42,9 +42,9 @@ class StabilityCase:
         The continuous loop with the target's delay is stable.
     max_real_pole : float or None
         Its rightmost pole's real part (1/s).
-    discrete : dict or None
-        The loop of the discrete controller as it runs: ``stable``, ``max_abs_pole_z`` and
-        ``sample_rate_hz`` (Hz); None for a controller that cannot run on the target.
+    discrete : SampledStability or None
+        The loop of the discrete controller as it runs; None for a controller that cannot
+        run on the target.
     """
 
     controller: str
@@ -53,14 +53,38 @@ class StabilityCase:
     speed_hz: float
     stable: bool
     max_real_pole: float | None
-    discrete: dict | None = None
+    discrete: SampledStability | None = None
 
     def to_dict(self) -> dict:
         """The ``metrics.json`` form."""
         return {"controller": self.controller, "label": self.label,
                 "pressure_bar": self.pressure_bar, "speed_hz": self.speed_hz,
                 "stable": self.stable, "max_real_pole": self.max_real_pole,
-                "discrete": self.discrete}
+                "discrete": None if self.discrete is None else self.discrete.to_dict()}
+
+
+@dataclass(frozen=True)
+class SampledStability:
+    """The stability of a discrete controller's loop as it runs (sampled plant, delay).
+
+    Attributes
+    ----------
+    stable : bool
+        Every pole inside the unit circle (:func:`ambseal.robust.is_stable`).
+    max_abs_pole_z : float
+        The largest pole modulus |z|.
+    sample_rate_hz : float
+        The controller's sample rate (Hz).
+    """
+
+    stable: bool
+    max_abs_pole_z: float
+    sample_rate_hz: float
+
+    def to_dict(self) -> dict:
+        """The ``metrics.json`` form."""
+        return {"stable": self.stable, "max_abs_pole_z": self.max_abs_pole_z,
+                "sample_rate_hz": self.sample_rate_hz}
 
 
 def stability_points(pressures_bar, speeds_hz, judged) -> list[OperatingPoint]:
@@ -118,8 +142,7 @@ def stability_case(case: dict, cfg) -> tuple[StabilityCase, dict]:
     disc = None
     if case.get("discrete") is not None:
         dloop = judged_loop(P, case["discrete"], cur).loop
-        disc = {"stable": bool(dloop.stable), "max_abs_pole_z": float(dloop.max_abs_pole),
-                "sample_rate_hz": 1.0 / dloop.dt}
+        disc = SampledStability(bool(dloop.stable), float(dloop.max_abs_pole), 1.0 / dloop.dt)
         curves["discrete"] = {"poles": dloop.poles}
     return StabilityCase(case["name"], point.label, float(point.pressure_bar),
                          float(point.speed_rpm) / 60.0, bool(loop.stable),

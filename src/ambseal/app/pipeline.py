@@ -87,10 +87,9 @@ class RunResult:
     exit_status: int = 0
 
 
-def _labelled(method: str, jobs: list, judged: list) -> list[tuple[dict, dict]]:
-    """``method``'s judged cases as (case dict with its condition's ``label``, curves)."""
-    return [({**case.to_dict(), "label": j["point"].label}, crv)
-            for j, (case, crv) in zip(jobs, judged) if j["name"] == method]
+def _judged_of(method: str, jobs: list, judged: list) -> list[tuple]:
+    """``method``'s judged cases with their curves."""
+    return [done for j, done in zip(jobs, judged) if j["name"] == method]
 
 
 def _speed_range(designs, digitals, spec, points, design_cfg, judge_cfg, stages, failed,
@@ -110,7 +109,7 @@ def _speed_range(designs, digitals, spec, points, design_cfg, judge_cfg, stages,
                      on_done=lambda i, r: stages.step(f"{jobs[i]['name']} at "
                                                       f"{jobs[i]['point'].label}"))
     for d in designs:
-        f = loop_failure(d.method, _labelled(d.method, jobs, done),
+        f = loop_failure(d.method, _judged_of(d.method, jobs, done),
                          designed=d.method != "pid", kept=allow_unstable)
         if f is not None:
             failed[d.method] = also_failed(failed.get(d.method), f)
@@ -412,7 +411,7 @@ def _judge_stage(st: _RunState) -> None:
     st.stages.begin("judge")
     st.jobs, st.judged = _judge_designs(st, st.designs, st.digitals)
     for d in st.designs:
-        f = loop_failure(d.method, _labelled(d.method, st.jobs, st.judged),
+        f = loop_failure(d.method, _judged_of(d.method, st.jobs, st.judged),
                          designed=d.method != "pid", kept=st.allow_unstable)
         if f is not None:
             st.failed[d.method] = f
@@ -421,7 +420,7 @@ def _judge_stage(st: _RunState) -> None:
     for m in [m for m, f in st.failed.items() if f.designed and f.judged
               and m in method_names(synthesised=True)]:
         fixed, st.failed[m] = remedy(
-            m, st.failed[m], [c for c, _ in _labelled(m, st.jobs, st.judged)],
+            m, st.failed[m], [c for c, _ in _judged_of(m, st.jobs, st.judged)],
             st.design_cfg, st.spec, st.points,
             lambda ds, digs: _judge_designs(st, ds, digs, 0), lambda s: st.say(s, 0))
         if fixed is not None:  # the remedied design replaces the failed one

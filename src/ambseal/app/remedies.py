@@ -25,7 +25,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
-from ambseal.analysis import FailedController, loop_failure
+from ambseal.analysis import FailedController, JudgedCase, loop_failure
 from ambseal.app.commands import Designed, digitals_for
 from ambseal.config import method_label, method_names
 from ambseal.design import design
@@ -57,30 +57,35 @@ class Remedied:
     judged: list
 
 
-def worst_case(cases: list[dict]) -> dict:
+def worst_case(cases: list[JudgedCase]) -> JudgedCase:
     """The least stable failing case: the largest continuous closed-loop real part among
     the continuously unstable ones, else the largest |z| among those unstable as they run.
 
     Parameters
     ----------
-    cases : list of dict
-        Judged cases (``JudgedCase.to_dict()``) of one controller, at least one failing.
+    cases : list of JudgedCase or StabilityCase
+        Judged cases of one controller (``stable``, ``max_real_pole``, ``discrete``), at
+        least one failing.
+
+    Returns
+    -------
+    JudgedCase or StabilityCase
 
     Raises
     ------
     ValueError
         No case fails.
     """
-    cont = [c for c in cases if not c.get("stable")]
+    cont = [c for c in cases if not c.stable]
     if cont:
-        return max(cont, key=lambda c: c["max_real_pole"])
-    disc = [c for c in cases if not (c.get("discrete") or {}).get("stable", True)]
+        return max(cont, key=lambda c: c.max_real_pole)
+    disc = [c for c in cases if c.discrete is not None and not c.discrete.stable]
     if not disc:
         raise ValueError("worst_case: no failing case")
-    return max(disc, key=lambda c: c["discrete"]["max_abs_pole_z"])
+    return max(disc, key=lambda c: c.discrete.max_abs_pole_z)
 
 
-def remedy(method: str, failure: FailedController, cases: list[dict], design_cfg, spec,
+def remedy(method: str, failure: FailedController, cases: list[JudgedCase], design_cfg, spec,
            points, judge: Callable, say: Callable[[str], None]
            ) -> tuple[Remedied | None, FailedController]:
     """Try the remedies of the module docstring for one failed design.
@@ -90,8 +95,8 @@ def remedy(method: str, failure: FailedController, cases: list[dict], design_cfg
     method : {"hinf", "mu"}
     failure : FailedController
         Its failure as judged.
-    cases : list of dict
-        Its judged cases (``JudgedCase.to_dict()`` with ``label``).
+    cases : list of JudgedCase
+        Its judged cases.
     design_cfg : RigConfig
         The rig the run designs on (the identified one after identification).
     spec : DesignSpec
@@ -111,10 +116,10 @@ def remedy(method: str, failure: FailedController, cases: list[dict], design_cfg
         the remedies tried added to its reason.
     """
     worst = worst_case(cases)
-    p = float(worst["pressure_bar"])
+    p = float(worst.pressure_bar)
     base = spec.weights[method]
     wider = replace(base, omega_b=base.omega_b * OMEGA_B_FACTOR)
-    attempts = [(f"designed at {worst.get('label') or f'{p:g} bar'}", base),
+    attempts = [(f"designed at {worst.label or f'{p:g} bar'}", base),
                 (f"designed there with ω_B × {OMEGA_B_FACTOR:g} ({wider.omega_b:.3g} rad/s)",
                  wider)]
     tried = []
@@ -136,8 +141,7 @@ def remedy(method: str, failure: FailedController, cases: list[dict], design_cfg
             tried.append(f"{label} (cannot run on the target: {cannot.get(method, '')})")
             continue
         jobs, judged = judge([d], digitals)
-        again = loop_failure(method, [({**c.to_dict(), "label": j["point"].label}, crv)
-                                      for j, (c, crv) in zip(jobs, judged)], designed=True)
+        again = loop_failure(method, judged, designed=True)
         if again is None:
             say(f"{method}: {label} holds at every judged condition")
             return Remedied(d, digitals[method], jobs, judged), failure

@@ -24,8 +24,8 @@ sampled with its delay) on the full-order plant:
   (:func:`ambseal.analysis.campbell.campbell` → :class:`Campbell`);
 * :func:`stability_boundary`, :func:`refine_boundary` — on the rows of
   :func:`ambseal.analysis.sweep.sweep` (:func:`parse_range`, :func:`check_cases`);
-  :func:`stability_case`, :func:`stability_points` → :class:`StabilityCase` — the stability
-  of the loops over the speed range;
+  :func:`stability_case`, :func:`stability_points` → :class:`StabilityCase` (with a
+  :class:`SampledStability`) — the stability of the loops over the speed range;
 * :func:`frozen_sensitivity` → :class:`FrozenSensitivity`, :class:`SpinupResult` — a
   speed-scheduled rotor spinning up (P3 §4, Figs. 11–12;
   :func:`ambseal.analysis.spinup.spinup`);
@@ -83,7 +83,12 @@ from ambseal.analysis.loops import (
 )
 from ambseal.analysis.ramp import RampResult, pressure_ramp, ramp_simulation
 from ambseal.analysis.response import ImpulseResponse, impulse_response
-from ambseal.analysis.speed_range import StabilityCase, stability_case, stability_points
+from ambseal.analysis.speed_range import (
+    SampledStability,
+    StabilityCase,
+    stability_case,
+    stability_points,
+)
 from ambseal.analysis.spinup import FrozenSensitivity, SpinupResult, frozen_sensitivity
 from ambseal.analysis.sweep import check_cases, parse_range, refine_boundary, stability_boundary
 from ambseal.analysis.unbalance import UnbalanceResponse, unbalance_force, unbalance_response
@@ -92,7 +97,7 @@ __all__ = ["OVERDAMPED_ZETA", "ZONES", "ZONE_LIMITS", "Campbell", "CaseError",
            "ClosedLoopModes", "ComplianceResponse", "FailedController", "FrozenSensitivity",
            "ImpulseResponse", "IsoAssessment", "JudgeSettings", "JudgedCase", "LoopJudgement",
            "LoopResponse", "OperatingPoint", "RampResult", "SensitivityPeaks", "SpinupResult",
-           "StabilityCase", "UnbalanceResponse", "also_failed", "check_cases",
+           "SampledStability", "StabilityCase", "UnbalanceResponse", "also_failed", "check_cases",
            "closed_loop_modes", "compliance", "dask_available", "frozen_at",
            "frozen_sensitivity", "impulse_response", "iso_assessment", "judge_case",
            "judge_jobs", "judge_settings", "judge_spinup", "log_decrement", "loop_failure",

@@ -4,7 +4,7 @@ which condition is the worst, and that a design which then holds replaces the fa
 import pytest
 
 from ambseal.analysis.delivery import FailedController
-from ambseal.analysis.judge import operating_points
+from ambseal.analysis.judge import JudgeJob, operating_points
 from ambseal.analysis.speed_range import SampledStability, StabilityCase
 from ambseal.app.remedies import Remedied, remedy, worst_case
 from ambseal.config import load_rig
@@ -42,7 +42,7 @@ def test_a_design_that_holds_after_the_first_remedy_replaces_the_failed_one():
 
     def judge(designs, digitals):
         seen.append((designs[0].summary["pressure_bar"], set(digitals)))
-        jobs = [{"name": "hinf", "point": p} for p in points]
+        jobs = [JudgeJob("hinf", p, None) for p in points]
         return jobs, [(_case(p.pressure_bar, True, -5.0, SampledStability(True, 0.5, 1e4),
                              p.label), {}) for p in points]
 

@@ -13,7 +13,7 @@ import control
 import numpy as np
 import pytest
 
-from ambseal.analysis.judge import OperatingPoint
+from ambseal.analysis.judge import JudgeJob, OperatingPoint
 from ambseal.analysis.speed_range import stability_case, stability_points
 from ambseal.config import load_rig
 from ambseal.design.conditions import STABILITY_STEPS, stability_speeds
@@ -55,8 +55,7 @@ def test_stability_case_is_python_controls_closed_loop(speed_hz):
     cfg = load_rig(ROOT / "docs" / "rigs" / "compressor.toml")
     K = design(cfg, "pid").K
     point = OperatingPoint(30.0, 60.0 * speed_hz, "")
-    case, curves = stability_case({"name": "pid", "point": point, "controller": K,
-                                   "discrete": None}, cfg)
+    case, curves = stability_case(JudgeJob("pid", point, K), cfg)
     plant = build_plant(cfg, pressure_bar=30.0, speed_rpm=60.0 * speed_hz)
     P = plant.to_statespace()
     lag = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples).system

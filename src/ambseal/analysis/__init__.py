@@ -60,6 +60,7 @@ from ambseal.analysis.delivery import (
 from ambseal.analysis.iso import ZONE_LIMITS, ZONES, IsoAssessment, iso_assessment, zone_limit_db
 from ambseal.analysis.judge import (
     JudgedCase,
+    JudgeJob,
     JudgeSettings,
     LoopJudgement,
     OperatingPoint,
@@ -95,10 +96,11 @@ from ambseal.analysis.unbalance import UnbalanceResponse, unbalance_force, unbal
 
 __all__ = ["OVERDAMPED_ZETA", "ZONES", "ZONE_LIMITS", "Campbell", "CaseError",
            "ClosedLoopModes", "ComplianceResponse", "FailedController", "FrozenSensitivity",
-           "ImpulseResponse", "IsoAssessment", "JudgeSettings", "JudgedCase", "LoopJudgement",
-           "LoopResponse", "OperatingPoint", "RampResult", "SensitivityPeaks", "SpinupResult",
-           "SampledStability", "StabilityCase", "UnbalanceResponse", "also_failed", "check_cases",
-           "closed_loop_modes", "compliance", "dask_available", "frozen_at",
+           "ImpulseResponse", "IsoAssessment", "JudgeJob", "JudgeSettings", "JudgedCase",
+           "LoopJudgement", "LoopResponse", "OperatingPoint", "RampResult", "SensitivityPeaks",
+           "SpinupResult", "SampledStability", "StabilityCase", "UnbalanceResponse",
+           "also_failed", "check_cases", "closed_loop_modes", "compliance", "dask_available",
+           "frozen_at",
            "frozen_sensitivity", "impulse_response", "iso_assessment", "judge_case",
            "judge_jobs", "judge_settings", "judge_spinup", "log_decrement", "loop_failure",
            "loop_responses", "open_loop_modes", "operating_points", "parse_range",

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
+from typing import Any
 
 import numpy as np
 
@@ -68,7 +69,7 @@ from ambseal.machine import (
 from ambseal.model import build_plant, classify_poles, pressure_for_k, seal_values
 from ambseal.robust import loop_delay
 
-__all__ = ["JudgeSettings", "OperatingPoint", "LoopJudgement", "JudgedCase", "judge", "judge_case", "judge_spinup",
+__all__ = ["JudgeSettings", "OperatingPoint", "LoopJudgement", "JudgedCase", "JudgeJob", "judge", "judge_case", "judge_spinup",
            "operating_points", "speed_scheduled",
            "judge_settings", "unstable_open_loop_poles", "condition_values", "frozen_at",
            "frozen_discrete", "judge_jobs", "points_for"]
@@ -581,13 +582,36 @@ def judge_jobs(designs, digitals: dict, points, design_cfg) -> list[dict]:
 
     Returns
     -------
-    list of dict
-        One case per design and point: ``name``, ``point``, ``controller`` and
-        ``discrete`` (the delayed discrete controller, or None).
+    list of JudgeJob
+        One job per design and point.
     """
-    return [{"name": d.method, "point": p, "controller": frozen_at(d.controller, p, design_cfg),
-             "discrete": frozen_discrete(digitals.get(d.method), p, design_cfg)}
+    return [JudgeJob(d.method, p, frozen_at(d.controller, p, design_cfg),
+                     frozen_discrete(digitals.get(d.method), p, design_cfg))
             for d in designs for p in points_for(d.controller, points, design_cfg)]
+
+
+@dataclass(frozen=True)
+class JudgeJob:
+    """One case of the main job to judge (:func:`judge_jobs`): a controller, fixed at one
+    operating point.
+
+    Attributes
+    ----------
+    name : str
+        The controller's name (its method).
+    point : OperatingPoint
+        Where it is judged.
+    controller : control.StateSpace
+        The continuous controller that runs there, m → A, ``i = −K y``.
+    discrete : control.StateSpace or None
+        The delayed discrete controller that runs there (its sample time ``dt``); None for
+        a controller that cannot run on the target.
+    """
+
+    name: str
+    point: OperatingPoint
+    controller: Any
+    discrete: Any = None
 
 
 def frozen_discrete(digital, point, design_cfg):
@@ -604,16 +628,14 @@ def frozen_discrete(digital, point, design_cfg):
     return digital.statespace(delayed=True)
 
 
-def judge_case(case: dict, cfg, settings: JudgeSettings) -> tuple[JudgedCase, dict]:
-    """:func:`judge` of ``case = {"controller", "name", "point"}`` (and ``"discrete"``, the
-    delayed discrete controller that runs): the main job's cases as run by
+def judge_case(case: JudgeJob, cfg, settings: JudgeSettings) -> tuple[JudgedCase, dict]:
+    """:func:`judge` of one job of :func:`judge_jobs`: the main job's cases as run by
     :func:`ambseal.analysis.cases.run_cases`.
 
     Parameters
     ----------
-    case : dict
-        ``controller`` (control.StateSpace, m → A, ``i = −K y``), ``name`` (str),
-        ``point`` (:class:`OperatingPoint`) and optionally ``discrete``.
+    case : JudgeJob
+        The controller, its name and point, and the discrete controller that runs.
     cfg : RigConfig
         The rig.
     settings : JudgeSettings
@@ -626,8 +648,8 @@ def judge_case(case: dict, cfg, settings: JudgeSettings) -> tuple[JudgedCase, di
     curves : dict
         The curves for the figures (:func:`judge`).
     """
-    return judge(cfg, case["controller"], case["name"], case["point"], settings,
-                 discrete=case.get("discrete"))
+    return judge(cfg, case.controller, case.name, case.point, settings,
+                 discrete=case.discrete)
 
 
 def judge_spinup(cfg, controllers: dict) -> tuple[dict, list, list]:

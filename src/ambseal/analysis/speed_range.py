@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ambseal.analysis.judge import OperatingPoint
+from ambseal.analysis.judge import JudgeJob, OperatingPoint
 from ambseal.lti import json_float
 from ambseal.machine import judged_loop
 from ambseal.model import build_plant
@@ -112,17 +112,15 @@ def stability_points(pressures_bar, speeds_hz, judged) -> list[OperatingPoint]:
             if (round(q, 12), round(f, 9)) not in done]
 
 
-def stability_case(case: dict, cfg) -> tuple[StabilityCase, dict]:
+def stability_case(case: JudgeJob, cfg) -> tuple[StabilityCase, dict]:
     """Close one controller on the full-order plant at one condition, continuous with the
     target's delay and, when it runs there, discrete as it runs; stability only.
 
     Parameters
     ----------
-    case : dict
-        ``name`` (str), ``point`` (:class:`~ambseal.analysis.judge.OperatingPoint`),
-        ``controller`` (control.StateSpace, m → A, ``i = −K y``) and ``discrete`` (the
-        delayed discrete controller that runs, or None): a job of
-        :func:`ambseal.analysis.judge.judge_jobs`.
+    case : JudgeJob
+        A job of :func:`ambseal.analysis.judge.judge_jobs`: the controller, its name and
+        point, and the discrete controller that runs (or None).
     cfg : RigConfig
         The rig judged on.
 
@@ -133,17 +131,17 @@ def stability_case(case: dict, cfg) -> tuple[StabilityCase, dict]:
         ``poles`` (rad/s) of the continuous loop and ``discrete.poles`` (z) of the sampled
         one, for :func:`ambseal.analysis.delivery.loop_failure`.
     """
-    point = case["point"]
+    point = case.point
     plant = build_plant(cfg, pressure_bar=point.pressure_bar, speed_rpm=point.speed_rpm)
     P, cur = plant.to_statespace(), plant.current_inputs()
     dl = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples)
-    loop = judged_loop(P, case["controller"], cur, delay=dl.system).loop
+    loop = judged_loop(P, case.controller, cur, delay=dl.system).loop
     curves: dict = {"poles": loop.poles}
     disc = None
-    if case.get("discrete") is not None:
-        dloop = judged_loop(P, case["discrete"], cur).loop
+    if case.discrete is not None:
+        dloop = judged_loop(P, case.discrete, cur).loop
         disc = SampledStability(bool(dloop.stable), float(dloop.max_abs_pole), 1.0 / dloop.dt)
         curves["discrete"] = {"poles": dloop.poles}
-    return StabilityCase(case["name"], point.label, float(point.pressure_bar),
+    return StabilityCase(case.name, point.label, float(point.pressure_bar),
                          float(point.speed_rpm) / 60.0, bool(loop.stable),
                          json_float(loop.max_real_pole), disc), curves

@@ -89,7 +89,7 @@ class RunResult:
 
 def _judged_of(method: str, jobs: list, judged: list) -> list[tuple]:
     """``method``'s judged cases with their curves."""
-    return [done for j, done in zip(jobs, judged) if j["name"] == method]
+    return [done for j, done in zip(jobs, judged) if j.name == method]
 
 
 def _speed_range(designs, digitals, spec, points, design_cfg, judge_cfg, stages, failed,
@@ -106,8 +106,8 @@ def _speed_range(designs, digitals, spec, points, design_cfg, judge_cfg, stages,
     jobs = judge_jobs(designs, digitals, spoints, design_cfg)
     done = run_cases(stability_case, jobs, shared={"cfg": judge_cfg}, workers=1,
                      raise_errors=True,
-                     on_done=lambda i, r: stages.step(f"{jobs[i]['name']} at "
-                                                      f"{jobs[i]['point'].label}"))
+                     on_done=lambda i, r: stages.step(f"{jobs[i].name} at "
+                                                      f"{jobs[i].point.label}"))
     for d in designs:
         f = loop_failure(d.method, _judged_of(d.method, jobs, done),
                          designed=d.method != "pid", kept=allow_unstable)
@@ -401,7 +401,7 @@ def _judge_designs(st: _RunState, designs, digitals, steps: int = 1):
     return js, run_cases(judge_case, js, shared={"cfg": st.judge_cfg, "settings": st.settings},
                          workers=1, raise_errors=True,
                          on_done=lambda i, r: st.stages.step(
-                             f"{js[i]['name']} at {js[i]['point'].label}", steps))
+                             f"{js[i].name} at {js[i].point.label}", steps))
 
 
 def _judge_stage(st: _RunState) -> None:
@@ -428,7 +428,7 @@ def _judge_stage(st: _RunState) -> None:
             st.designs = [fixed.design if d.method == m else d for d in st.designs]
             st.digitals[m] = fixed.digital
             new = iter(zip(fixed.jobs, fixed.judged))
-            st.jobs, st.judged = map(list, zip(*[next(new) if j["name"] == m else (j, r)
+            st.jobs, st.judged = map(list, zip(*[next(new) if j.name == m else (j, r)
                                                  for j, r in zip(st.jobs, st.judged)]))
 
 
@@ -452,7 +452,7 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
     cfg, out, stages = st.cfg, st.out, st.stages
     cases = [case for case, _ in st.judged]
     case_dicts = [case.to_dict() for case in cases]
-    curves = [(j["name"], j["point"], case, c)
+    curves = [(j.name, j.point, case, c)
               for j, case, (_, c) in zip(st.jobs, case_dicts, st.judged)]
     # a failed design is judged and reported, not delivered (unless asked for)
     held = {m for m, f in st.failed.items() if f.designed and not st.allow_unstable}

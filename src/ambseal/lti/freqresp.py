@@ -46,7 +46,7 @@ __all__ = ["freqresp", "freqresp_at", "sampled_response_at"]
 
 _CHUNK_BYTES = 32 * 2**20  # memory budget of one chunk (complex n×n per frequency)
 _USE_SLYCOT = True  # set False (tests) to force the pure-numpy Hessenberg solver
-_MODAL = ArrayMemo()  # (λ, V, cond V, V⁻¹B, CV) of the last large (A, B, C)
+_MODAL = ArrayMemo()  # (λ, cond V, V⁻¹B, CV) of the last large (A, B, C)
 #: States above which cond V is LAPACK's 1-norm estimate from the LU of V (``gecon``, O(n²)
 #: after the LU that V⁻¹B needs anyway) instead of the 2-norm by an SVD: at 3 248 states
 #: (an FE model of 400 beam elements) the SVD took 25.6 s, more than the eig itself

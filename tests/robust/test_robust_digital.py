@@ -92,7 +92,9 @@ def test_choice_closes_candidates_by_rank_until_one_is_stable():
     closed) the last two carry numbers and no reason."""
     from ambseal.robust._digital_choice import first_stable
 
-    G = (np.array([[0.5]]), np.array([[1.0]]), np.array([[1.0]]), np.zeros((1, 1)))
+    # continuous, sampled at T = 1 s: A_d = 0.5, B_d = 1
+    rate = np.log(0.5)
+    G = (np.array([[rate]]), np.array([[-2.0 * rate]]), np.array([[1.0]]), np.zeros((1, 1)))
     gain = lambda k: (np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.array([[k]]))
     ks = {"a": 2.0, "b": 0.3, "c": 0.4, "d": 0.1}
     errs = {"a": 0.1, "b": 0.2, "c": 0.3, "d": 0.2}
@@ -100,10 +102,10 @@ def test_choice_closes_candidates_by_rank_until_one_is_stable():
               "sensitivity_peak_continuous": [1.0, 1.0], "sensitivity_peak_error": errs[m],
               "stable": None} for m in ks]
     Kd = {m: (None, [gain(k)] * 2) for m, k in ks.items()}
-    best = first_stable(cands, Kd, [G, G], [True, True])
+    best = first_stable(cands, Kd, [G, G], 1.0, [True, True])
     a, b, c, d = cands
-    assert best is b and b["stable"] and b["max_abs_z"] == pytest.approx([0.2, 0.2], abs=1e-15)
-    assert a["stable"] is False and a["max_abs_z"] == pytest.approx([1.5, 1.5], abs=1e-15)
+    assert best is b and b["stable"] and b["max_abs_z"] == pytest.approx([0.2, 0.2], abs=1e-14)
+    assert a["stable"] is False and a["max_abs_z"] == pytest.approx([1.5, 1.5], abs=1e-14)
     assert a["sensitivity_peak"] == [None, None] and a["sensitivity_peak_error"] == np.inf
     for x in (c, d):
         assert x["stable"] is None and x["max_abs_z"] == [None, None]

@@ -42,7 +42,7 @@ from ambseal.errors import ModelError
 from ambseal.lti.discrete import zoh
 from ambseal.lti.matrices import ArrayMemo, as_omega, ss_matrices
 
-__all__ = ["freqresp", "freqresp_at", "sampled_response_at"]
+__all__ = ["freqresp", "freqresp_at", "modal_form", "sampled_response_at"]
 
 _CHUNK_BYTES = 32 * 2**20  # memory budget of one chunk (complex n×n per frequency)
 _USE_SLYCOT = True  # set False (tests) to force the pure-numpy Hessenberg solver
@@ -464,6 +464,31 @@ def _dense_response(A, B, C, D, s) -> np.ndarray:
                     except np.linalg.LinAlgError:
                         out[i + k] = np.nan
     return out
+
+
+def modal_form(A: np.ndarray, B: np.ndarray, C: np.ndarray, *, max_cond: float = 1e8):
+    """``(λ, V⁻¹B, CV)`` of the balanced system (``A, B, C`` → ``T⁻¹AT, T⁻¹B, CT``, ``T``
+    diagonal; the eigendecomposition kept per ``(A, C)`` and shared with the frequency
+    responses), or ``None`` when ``cond V > max_cond``.
+
+    Parameters
+    ----------
+    A : numpy.ndarray, shape (n, n)
+        State matrix.
+    B : numpy.ndarray, shape (n, m)
+        Input matrix.
+    C : numpy.ndarray, shape (p, n)
+        Output matrix.
+    max_cond : float
+        Largest accepted condition number of ``V`` (as for :func:`freqresp`).
+
+    Returns
+    -------
+    tuple (λ (n,), V⁻¹B (n, m), CV (p, n)) of complex arrays, or None
+        Shared arrays: do not modify them in place.
+    """
+    lam, _, Bm, Cm = _modal_form(A, B, C, max_cond, balance=True)
+    return None if Bm is None else (lam, Bm, Cm)
 
 
 def _modal_form(A, B, C, max_cond, balance: bool = False):

@@ -26,10 +26,13 @@ import control
 import numpy as np
 
 from ambseal.errors import ModelError
+from ambseal.lti.discrete import zoh
+from ambseal.lti.freqresp import modal_form
 from ambseal.lti.matrices import ArrayMemo, labels, ss_matrices
+from ambseal.lti.modal_loop import modal_loop_poles
 
 __all__ = ["lft_lower_matrices", "lft_lower", "feedback_matrices", "feedback_poles", "state_poles",
-           "series_inputs", "wired"]
+           "series_inputs", "wired", "STRUCTURED_STATES"]
 
 Matrices = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
@@ -192,9 +195,15 @@ def state_poles(A: np.ndarray) -> np.ndarray:
     return _POLES.get((A,), "eigvals", lambda: np.linalg.eigvals(A))
 
 
-def feedback_poles(G: Matrices, K: Matrices) -> np.ndarray:
-    """:func:`state_poles` of the state matrix of :func:`feedback_matrices` ``(G, K)``
-    (rad/s, or z for a discrete loop).
+def feedback_poles(G: Matrices, K: Matrices, *, lag: Matrices | None = None,
+                   dt: float | None = None, hold: float | None = None,
+                   state_matrix: np.ndarray | None = None) -> np.ndarray:
+    """The poles of the loop ``u = −K y`` (rad/s, or z for a discrete loop): of the state
+    matrix of :func:`feedback_matrices` ``(G, K)`` by :func:`state_poles`, or, for a large
+    continuous plant without feedthrough (``STRUCTURED_STATES`` states or more, closed
+    continuous with ``dt=0`` or sampled with ``hold``), from the plant's modal form with a
+    certificate (:func:`ambseal.lti.modal_loop.modal_loop_poles`: no dense eigenvalue
+    problem of the loop) where that certifies them.
 
     Parameters
     ----------
@@ -202,10 +211,24 @@ def feedback_poles(G: Matrices, K: Matrices) -> np.ndarray:
         Plant, ``n`` states, ``nu`` inputs → ``ny`` outputs.
     K : (A_K, B_K, C_K, D_K)
         Controller, ``n_K`` states, ``ny`` inputs → ``nu`` outputs, closed as ``u = −K y``.
+    lag : (A_L, B_L, C_L, D_L), optional
+        A SISO lag between the controller and every plant input (a hold and computation
+        delay), ``n_L`` states; its copies join the controller's states.
+    dt : float, optional
+        Sample time (s) of a discrete loop, 0 for a continuous one; without it the loop's
+        time base is unknown and the dense eigenvalues are taken.
+    hold : float, optional
+        ``G`` is continuous and runs sampled by a zero-order hold of this sample time (s),
+        all its inputs together (:func:`ambseal.lti.discrete.zoh`); ``K`` is discrete on
+        it (``dt`` is then ``hold``). Its modal form is ``e^{λT}``, the rows of ``V⁻¹B``
+        times ``(e^{λT} − 1)/λ``.
+    state_matrix : numpy.ndarray, optional
+        The loop's state matrix if the caller has built it (with the lag's states after
+        the plant's): its eigenvalues are taken where the modal path is not.
 
     Returns
     -------
-    numpy.ndarray of complex, shape (n + n_K,)
+    numpy.ndarray of complex, shape (n + n_K + nu·n_L,)
         The closed-loop poles, in no particular order. The array is shared: do not modify
         it in place.
 
@@ -214,7 +237,52 @@ def feedback_poles(G: Matrices, K: Matrices) -> np.ndarray:
     ModelError
         If ``I + D·D_K`` is singular (an ill-posed loop).
     """
-    return state_poles(feedback_matrices(G, K)[0])
+    A, B, C, D = (np.asarray(X, float) for X in G)
+    if (dt == 0.0 or hold) and A.shape[0] >= STRUCTURED_STATES and not np.any(D):
+        Kf = _lagged(K, lag, B.shape[1]) if lag is not None else \
+            tuple(np.asarray(X, float) for X in K)
+        poles = _POLES.get((A, B, C) + Kf, ("modal", hold),
+                           lambda: _modal_poles(A, B, C, Kf, hold))
+        if poles is not None:
+            return poles
+    if state_matrix is not None:
+        return state_poles(state_matrix)
+    if lag is not None:  # the lag in front of the plant (the same matrix as a delayed plant's)
+        A, B, C, D = series_inputs((A, B, C, D), tuple(np.asarray(X, float) for X in lag))[:4]
+    if hold:
+        A, B = zoh(A, B, hold)
+    return state_poles(feedback_matrices((A, B, C, D), K)[0])
+
+
+#: States from which :func:`feedback_poles` of a continuous plant takes its modal form:
+#: the plant's eigendecomposition is then kept and shared by its frequency responses and
+#: every loop closed on it (a dense eigenvalue problem of a 500-state loop costs 0.1 s,
+#: of a 1 916-state one 2 s; the modal path 0.5 s there, measured in benchmarks/README.md).
+STRUCTURED_STATES = 500
+
+
+def _modal_poles(A, B, C, K, hold):
+    form = modal_form(A, B, C)
+    if form is None:
+        return None
+    lam, Bm, Cm = form
+    if not hold:
+        return modal_loop_poles(lam, Bm, Cm, K)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        phi = np.where(lam == 0, hold, np.expm1(lam * hold) / lam)
+    return modal_loop_poles(np.exp(lam * hold), Bm * phi[:, None], Cm, K, discrete=True)
+
+
+def _lagged(K: Matrices, lag: Matrices, nu: int) -> Matrices:
+    """``K`` followed by the SISO ``lag`` on each of its ``nu`` outputs."""
+    Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(X, float)) for X in K)
+    Al, Bl, Cl, Dl = (_repeat_diagonal(np.atleast_2d(np.asarray(X, float)), nu) for X in lag)
+    nk, nl = Ak.shape[0] if Bk.size else 0, Al.shape[0]
+    A = np.zeros((nk + nl, nk + nl))
+    A[:nk, :nk] = Ak.reshape(nk, nk)
+    A[nk:, :nk] = Bl @ Ck
+    A[nk:, nk:] = Al
+    return (A, np.vstack([Bk.reshape(nk, -1), Bl @ Dk]), np.hstack([Dl @ Ck, Cl]), Dl @ Dk)
 
 
 def series_inputs(G: Matrices, block: Matrices, inputs: list[int] | None = None

@@ -27,6 +27,7 @@ import numpy as np
 from ambseal.errors import ModelError
 from ambseal.lti import (
     feedback_matrices,
+    feedback_poles,
     freqresp_at,
     json_float,
     json_list,
@@ -34,7 +35,6 @@ from ambseal.lti import (
     sampled_response_at,
     series_inputs,
     ss_matrices,
-    state_poles,
     wired,
     zoh,
 )
@@ -192,7 +192,14 @@ def closed_loop(G: Any, K: Any, Gf: Any | None = None, *, atol: float = 0.0) -> 
         If the dimensions of ``G``, ``K`` (and ``Gf``) do not fit, ``Gf`` has a different
         ``A`` or ``C``, or ``I + D D_K`` is singular (ill-posed loop).
     """
+    return _closed(G, K, Gf, atol, None)
 
+
+def _closed(G, K, Gf, atol, source) -> ClosedLoop:
+    """:func:`closed_loop`; ``source``: ``(G₀, how)`` when ``G`` was made from the
+    continuous ``G₀`` — with a lag in front of every input (``how = {"lag": matrices}``) or
+    sampled by a zero-order hold (``{"hold": dt}``) — whose modal form then gives the poles
+    (:func:`ambseal.lti.interconnect.feedback_poles`)."""
     (A, B, C, D), (Ak, Bk, Ck, Dk) = loop_matrices(G, K)
     n, nu = B.shape
     ny = C.shape[0]
@@ -222,7 +229,11 @@ def closed_loop(G: Any, K: Any, Gf: Any | None = None, *, atol: float = 0.0) -> 
     states = [f"x[{i}]" for i in range(n)] + [f"xK[{i}]" for i in range(nk)]
     sys = control.StateSpace(Acl, Bcl, Ccl, Dcl, dt, inputs=inputs, outputs=outputs,
                              states=states, name="closed_loop")
-    poles = state_poles(Acl)
+    if source is None:
+        poles = feedback_poles((A, B, C, D), (Ak, Bk, Ck, Dk), dt=dt, state_matrix=Acl)
+    else:
+        poles = feedback_poles(ss_matrices(source[0]), (Ak, Bk, Ck, Dk), dt=dt,
+                               state_matrix=Acl, **source[1])
     poles = poles[np.argsort(-np.abs(poles) if dt else -poles.real, kind="stable")]
     return ClosedLoop(sys, poles, decay_rate(poles, dt), is_stable(poles, dt), nu, ny, nf, dt)
 
@@ -365,12 +376,16 @@ def judged_loop(P, K, control_inputs=None, *, delay=None) -> JudgedLoop:
     cur = list(range(P.ninputs)) if control_inputs is None else list(control_inputs)
     rest = [j for j in range(P.ninputs) if j not in cur]
     dt = sample_time(K)
+    source = None
     if dt:
         Pj = sampled_plant(P, dt, cur)
+        source = (_select(P, cur), {"hold": dt})
     elif delay is not None:
         Pj = delayed_plant(P, cur, delay)
+        source = (_select(P, cur), {"lag": tuple(np.asarray(getattr(delay, m), float)
+                                               for m in "ABCD")})
     else:
         Pj = P
     G = _select(Pj, cur)
     Gf = _select(Pj, rest) if rest else None
-    return JudgedLoop(Pj, closed_loop(G, K, Gf), P, None if dt else delay, tuple(cur))
+    return JudgedLoop(Pj, _closed(G, K, Gf, 0.0, source), P, None if dt else delay, tuple(cur))

@@ -21,14 +21,15 @@ def so_peak(Gw: np.ndarray, Kw: np.ndarray) -> float:
     return float(np.max(np.linalg.svd(S, compute_uv=False)[:, 0]))
 
 
-def max_abs_z(Gd: Matrices, Kd: Matrices) -> float:
-    """Largest |z| of the sampled loop of ``Gd`` and ``Kd``
-    (:func:`~ambseal.lti.interconnect.feedback_poles`: kept for the judgement of the same
-    loop)."""
-    return float(np.abs(feedback_poles(Gd, Kd)).max())
+def max_abs_z(G: Matrices, Kd: Matrices, T: float) -> float:
+    """Largest |z| of the loop of ``Kd`` and the continuous ``G`` sampled by a zero-order
+    hold at ``T`` (s) (:func:`~ambseal.lti.interconnect.feedback_poles`: kept for the
+    judgement of the same loop)."""
+    return float(np.abs(feedback_poles(G, Kd, hold=T)).max())
 
 
-def first_stable(cands: list, Kd: dict, sampled: list, cont_stable: list) -> dict | None:
+def first_stable(cands: list, Kd: dict, plants: list, T: float, cont_stable: list
+                 ) -> dict | None:
     """The chosen candidate of :func:`~ambseal.robust.digital.choose_method`.
 
     ``cands`` are taken by increasing ``sensitivity_peak_error`` (a stable sort: the order
@@ -46,8 +47,10 @@ def first_stable(cands: list, Kd: dict, sampled: list, cont_stable: list) -> dic
         chosen one, whose ``stable`` and ``max_abs_z`` stay ``None``.
     Kd : dict
         method → (discrete controllers, the same delayed), one per plant.
-    sampled : list of (A, B, C, D)
-        The sampled plants.
+    plants : list of (A, B, C, D)
+        The continuous plants, each sampled by a zero-order hold.
+    T : float
+        Sample time (s).
     cont_stable : list of bool
         Where the design's continuous loop is stable (where the sampled one must be).
 
@@ -69,7 +72,7 @@ def first_stable(cands: list, Kd: dict, sampled: list, cont_stable: list) -> dic
                 "computed (stable and max_abs_z unknown; its peaks are those of loops not "
                 "checked for stability)")
             continue
-        z = c["max_abs_z"] = [max_abs_z(G, K) for G, K in zip(sampled, Kd[c["method"]][1])]
+        z = c["max_abs_z"] = [max_abs_z(G, K, T) for G, K in zip(plants, Kd[c["method"]][1])]
         c["stable"] = all(zj < 1 for zj, ok in zip(z, cont_stable) if ok)
         if c["stable"]:
             best = c

@@ -426,7 +426,8 @@ def with_delay(mats: Matrices, n: int) -> Matrices:
     return A, B, C, D
 
 
-def prewarp_frequency_hz(G_list, K: Matrices, fs: float) -> float | None:
+def prewarp_frequency_hz(G_list, K: Matrices, fs: float, *, lag: Matrices | None = None
+                         ) -> float | None:
     """Damped frequency (Hz) of the least-damped pole of the continuous loops below half
     of Nyquist, the frequency where the discrete controller's phase matters most.
 
@@ -438,6 +439,8 @@ def prewarp_frequency_hz(G_list, K: Matrices, fs: float) -> float | None:
         The continuous controller.
     fs : float
         Sample rate (Hz).
+    lag : (A, B, C, D), optional
+        A SISO lag in front of every plant input (the hold and computation delay).
 
     Returns
     -------
@@ -447,7 +450,7 @@ def prewarp_frequency_hz(G_list, K: Matrices, fs: float) -> float | None:
     """
     best, f_best = np.inf, None
     for G in G_list:
-        lam = feedback_poles(G, K)
+        lam = feedback_poles(G, K, lag=lag, dt=0.0)
         lam = lam[(lam.imag > 0) & (lam.imag < 2 * np.pi * FAST_FRACTION * fs / 2)]
         if lam.size:
             zeta = -lam.real / np.abs(lam)
@@ -494,7 +497,15 @@ class SampledPlants:
     omega_rad_s: np.ndarray
     continuous_response: list
     sampled_response: list
-    ideal: list = field(default_factory=list)
+    ideal: list
+    lag: tuple
+
+    def delayed_poles(self, j: int, K: Matrices) -> np.ndarray:
+        """Poles of ``K`` closed on plant ``j`` with the lag (``plants[j]``): from the
+        plant without it and the lag joined to the controller
+        (:func:`~ambseal.lti.interconnect.feedback_poles`), the plant's modal form then
+        shared with its frequency responses."""
+        return feedback_poles(self.ideal[j], K, lag=self.lag, dt=0.0)
 
 
 def sampled_plants(plants: Sequence[Matrices], fs: float, n_grid: int = 400, *,
@@ -535,7 +546,7 @@ def sampled_plants(plants: Sequence[Matrices], fs: float, n_grid: int = 400, *,
     return SampledPlants(delayed, sampled, float(fs), w,
                          [freqresp_at(G, 1j * w) * lag for G in plants],
                          [sampled_response_at(G, T, w) for G in plants],
-                         list(plants))
+                         list(plants), L)
 
 
 def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int, methods,
@@ -589,13 +600,11 @@ def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int,
     """
     fs, T, w = sp.fs, 1.0 / sp.fs, sp.omega_rad_s
 
-    def stable(plants):
-        return [is_stable(feedback_poles(G, Kc)) for G, Kc in zip(plants, cont)]
-
     # the sampled loop must be stable wherever the design is (its continuous loop without
     # the delay); the peaks are compared where the continuous loop with the delay is too
-    cont_stable = stable(sp.ideal or sp.plants)
-    judged = [j for j, ok in enumerate(stable(sp.plants)) if ok and cont_stable[j]]
+    cont_stable = [is_stable(feedback_poles(G, Kc, dt=0.0)) for G, Kc in zip(sp.ideal, cont)]
+    judged = [j for j, Kc in enumerate(cont) if cont_stable[j]
+              and is_stable(sp.delayed_poles(j, Kc))]
     peak_c = {j: _so_peak(sp.continuous_response[j], freqresp_at(cont[j], 1j * w))
               for j in judged}
     n = len(sp.sampled)
@@ -612,7 +621,7 @@ def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int,
         cands.append({"method": m, "max_abs_z": [None] * n, "sensitivity_peak": peak_d,
                       "sensitivity_peak_continuous": [peak_c.get(j) for j in range(n)],
                       "sensitivity_peak_error": err, "stable": None})
-    best = _first_stable(cands, Kd, sp.sampled, cont_stable)
+    best = _first_stable(cands, Kd, sp.ideal, T, cont_stable)
     if best is None:
         poles = max((np.abs(np.linalg.eigvals(K[0])).max() / (2 * np.pi) if K[0].size else 0.0)
                     for K in cont)
@@ -668,7 +677,7 @@ def digital_controller(K, sample_rate_hz: float, plants, *,
     if abs(sp.fs - fs) > 1e-9 * fs:
         raise ConfigError(f"digital_controller: plants sampled at {sp.fs} Hz, not {fs} Hz")
     n = len(sp.plants)
-    f_pw = prewarp_frequency_hz(sp.plants, mats, fs)
+    f_pw = prewarp_frequency_hz(sp.ideal, mats, fs, lag=sp.lag)
     keep = hold_keeps(fast, fs)
     tried = list(methods) + ([f"{m}{KEPT}" for m in HOLDS if m in methods] if keep else [])
 

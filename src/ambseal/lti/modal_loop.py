@@ -1,0 +1,422 @@
+"""Poles of a loop closed around a large plant given in modal form, without a dense
+eigenvalue problem of the whole loop.
+
+The plant ``G(p) = Σ_i c_i b_iᵀ / (p − λ_i)`` (``λ`` its poles, ``b_iᵀ`` the rows of
+``V⁻¹B``, ``c_i`` the columns of ``CV``; ``p = s``, or ``z`` of a sampled plant) is closed
+with a small controller ``K`` as ``u = −K y``. A large lightly damped model has thousands
+of modes of which the controller moves a few: the others lie far above its bandwidth and
+couple to it through tiny residues. The modes are split on that measure — mode ``i`` is
+*weak* when ``‖b_i‖ ‖K(λ_i)‖ ‖c_i‖``, the size of its first-order shift, is below ``WEAK``
+times its distance to the stability boundary — and the loop's poles are found in two
+parts, each from an exact (Schur complement) equation solved by fixed-point iteration:
+
+* the **strong part**: the controller and the strong modes closed as a small dense loop
+  ``M_R`` (eigenvalues ``μ``, eigenvectors ``X``), with the weak modes' static part
+  ``G_T(a)`` as the plant's feedthrough (``a = 0``, or ``z = 1``: their residual
+  flexibility, first order in the strong poles). The rest, ``G_T(p) − G_T(a)``, is
+  evaluated at the pole itself: ``p ∈ spec S(p)``, ``S`` the state matrix of the small
+  loop with feedthrough ``G_T(p)``. Each cluster of ``μ`` is iterated on its invariant
+  subspace, ``p ∈ spec(X_c⁻¹ S(p) X_c)``; where the second-order term this projection
+  neglects (bounded from the coupling and the separation) exceeds the tolerance, on
+  ``S(p)`` itself;
+* each **weak mode** (or cluster of nearly equal ones, such as the repeated poles of a
+  system symmetric in two planes) sees the rest of the loop as a controller:
+  ``p ∈ spec(Λ_c − B_c Q(p) C_c)``, ``Q = (I + K G_rest)⁻¹ K``.
+
+The iterations stop when a step moves no pole by more than the rounding level of a dense
+QR of the loop, ``4ε`` times the larger of its largest |pole| and the balanced strong
+loop's norm. Two checks make the result a certificate:
+
+* **nothing missed on the unstable side.** On a boundary — the line ``Re s = α`` or the
+  circle ``|z| = ρ`` between the weak modes and the stability boundary — the small-gain
+  bound ``‖G_T(p) − G_T(a)‖ ‖Q_R(p)‖ < 1/2`` (``Q_R = (I + K G_R)⁻¹ K`` of the strong
+  part) is proved band by band with bounds by the triangle inequality on the poles'
+  residues (``‖G_T(p) − G_T(a)‖ ≤ Σ ‖c_i‖ ‖b_i‖ |p − a| / (|λ_i − a| |p − λ_i|)``, the
+  same for ``Q_R`` over ``μ``, and its Neumann expansion at high frequency), bands bisected
+  where the bound is too coarse. Scaling the weak modes' coupling from 0 to 1 then moves
+  no pole across the boundary (``det(I + t (G_T − G_T(a)) Q_R) ≠ 0`` on it), so the loop
+  has as many poles beyond it as ``M_R`` — the homotopy argument of the small-gain
+  theorem (Zhou, Doyle & Glover, *Robust and Optimal Control*, 1996, Thm 9.1);
+* **nothing lost or counted twice.** The poles' sum equals the loop's trace (from the
+  modal form, O(n)) to rounding, and the poles found beyond the boundary are as many as
+  ``M_R``'s.
+
+When any part fails (a modal form too ill-conditioned, too many strong modes, an
+iteration that does not settle, a bound that does not prove) :func:`modal_loop_poles`
+returns ``None`` and the caller takes the dense eigenvalues. Measured against the roots
+of ``det(I + K G) = 0`` refined by Newton with dense solves of the plant, these poles are
+within 1e-8 where the dense QR eigenvalues of the same loop are off by up to 2e-6
+(relative; tests/lti/test_modal_loop.py).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg
+
+__all__ = ["WEAK", "modal_loop_poles"]
+
+#: A mode is weak when its first-order shift is at most this fraction of its distance to
+#: the stability boundary: the neglected second-order terms of the projection are then
+#: far below rounding, and the small-gain bound is met with a wide margin.
+WEAK = 1e-6
+_EPS = float(np.finfo(float).eps)
+#: The strong part is solved densely: above this fraction of the loop's order (its dense
+#: problem then costs an eighth of the loop's, plus the iterations) the structured path
+#: is not taken.
+_MAX_STRONG_FRACTION = 0.5
+_MAX_ITER = 30
+_BISECTIONS = 14
+
+
+def modal_loop_poles(lam, Bm, Cm, K, *, discrete: bool = False) -> np.ndarray | None:
+    """All poles of the plant in modal form closed with ``K`` as ``u = −K y``, certified
+    (module docstring), or ``None`` where the structured path cannot certify them.
+
+    Parameters
+    ----------
+    lam : numpy.ndarray of complex, shape (n,)
+        The plant's poles (rad/s, or z of a sampled plant).
+    Bm : numpy.ndarray of complex, shape (n, m)
+        ``V⁻¹ B``, the modes' input rows.
+    Cm : numpy.ndarray of complex, shape (p, n)
+        ``C V``, the modes' output columns (the plant has no feedthrough).
+    K : (A_K, B_K, C_K, D_K)
+        Controller, ``n_K`` states, ``p`` inputs → ``m`` outputs, continuous or on the
+        plant's sample time.
+    discrete : bool
+        ``lam`` and ``K`` are discrete (stability boundary ``|z| = 1``).
+
+    Returns
+    -------
+    numpy.ndarray of complex, shape (n + n_K,), or None
+        The closed-loop poles, in no particular order; ``None`` when not certified.
+    """
+    lam = np.asarray(lam, complex)
+    Bm, Cm = np.asarray(Bm, complex), np.asarray(Cm, complex)
+    Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(X, float)) for X in K)
+    Ak = Ak.reshape(Bk.shape[0], Bk.shape[0]) if Bk.size else np.zeros((0, 0))
+    n, nk = lam.size, Ak.shape[0]
+    if not n or not (np.all(np.isfinite(Bm)) and np.all(np.isfinite(Cm))):
+        return None
+    b = np.linalg.norm(Bm, axis=1)
+    c = np.linalg.norm(Cm, axis=0)
+    gap = 1.0 - np.abs(lam) if discrete else -lam.real  # to the stability boundary, > 0 inside
+    with np.errstate(divide="ignore", invalid="ignore"):
+        shift = b * c * np.linalg.norm(_K_at(K, lam), ord=2, axis=(1, 2))
+        weak = (gap > 0) & (shift <= WEAK * gap)
+    strong = np.flatnonzero(~weak)
+    weak = np.flatnonzero(weak)
+    if strong.size + nk > _MAX_STRONG_FRACTION * (n + nk) or not weak.size:
+        return None
+    # the weak modes' static part G_T(0) (z = 1) is the strong loop's feedthrough (their
+    # residual flexibility: first order in the strong poles); what the iterations and the
+    # certificate treat is G_T − G_T(0)
+    D0 = _modal_sum(np.ones(1) if discrete else np.zeros(1), lam[weak], Bm[weak], Cm[:, weak])[0]
+    part = _StrongPart(lam[strong], Bm[strong], Cm[:, strong], (Ak, Bk, Ck, Dk), D0)
+    if part.X is None:
+        return None
+    # the rounding level of a dense QR of the loop: ε times its balanced norm
+    scale = max(1.0, float(np.abs(lam).max()), part.norm)
+    tol = 4 * _EPS * scale
+    lamT, BT, CT = lam[weak], Bm[weak], Cm[:, weak]
+    boundary = _Boundary.between(part.mu, lamT, discrete)
+    if boundary is None or not _certified(boundary, part, lamT, b[weak] * c[weak]):
+        return None
+    p_strong = part.refine(lamT, BT, CT, tol)
+    p_weak = _weak_poles(lam, Bm, Cm, weak, (Ak, Bk, Ck, Dk), tol)
+    if p_strong is None or p_weak is None:
+        return None
+    poles = np.concatenate([p_strong, p_weak])
+    trace = lam.sum() - np.einsum("im,mp,pi->", Bm, Dk, Cm) + np.trace(Ak)
+    if abs(poles.sum() - trace) > 1e3 * _EPS * float(np.abs(poles).sum()):
+        return None
+    beyond = boundary.beyond
+    if np.count_nonzero(beyond(p_strong)) != np.count_nonzero(beyond(part.mu)) \
+            or np.any(beyond(p_weak)):
+        return None
+    return poles
+
+
+def _K_at(K, p):
+    """``K(p)`` at each point, shape (n_p, m, p_out): batched solves (the controller is small)."""
+    Ak, Bk, Ck, Dk = K
+    p = np.atleast_1d(p)
+    out = np.empty((p.size,) + Dk.shape, complex)
+    if not Ak.size:
+        out[:] = Dk
+        return out
+    eye = np.eye(Ak.shape[0])
+    step = 512
+    for k in range(0, p.size, step):
+        s = p[k:k + step]
+        X = np.linalg.solve(s[:, None, None] * eye - Ak, np.broadcast_to(Bk, (s.size,) + Bk.shape))
+        out[k:k + step] = Ck @ X + Dk
+    return out
+
+
+def _modal_sum(p, lam, Bm, Cm):
+    """``Σ_i c_i b_iᵀ / (p − λ_i)`` at each point, shape (n_p, p_out, m)."""
+    W = (Cm.T[:, :, None] * Bm[:, None, :]).reshape(lam.size, -1)
+    R = 1.0 / (np.atleast_1d(p)[:, None] - lam[None, :])
+    return (R @ W).reshape(-1, Cm.shape[0], Bm.shape[1])
+
+
+class _StrongPart:
+    """The controller and the strong modes closed as one small dense loop ``M_R``; its
+    eigendecomposition, and the state matrix ``S(p)`` with the weak modes as feedthrough."""
+
+    def __init__(self, lam, Bm, Cm, K, D0):
+        self.lam, self.Bm, self.Cm, self.K = lam, Bm, Cm, K
+        self.M = self.state_matrix(D0)
+        # the small-gain loop: from a signal added to y to −u (module docstring), the
+        # plant's feedthrough D0 included: y = F (C x − D0 C_K x_K + w)
+        _, Bk, Ck, Dk = K
+        F = np.linalg.inv(np.eye(D0.shape[0]) + D0 @ Dk)
+        self.Bq = np.vstack([-Bm @ Dk @ F, Bk @ F])
+        self.Cq = np.hstack([Dk @ F @ Cm, Ck - Dk @ F @ D0 @ Ck])
+        self.Dq = Dk @ F
+        # balanced first: modal and controller coordinates differ in scale by decades
+        # (cond X 4e11 unbalanced, 1.4e2 balanced on a 230-element plant's strong part)
+        Mb, (sc, _) = scipy.linalg.matrix_balance(self.M, permute=False, separate=True)
+        self.norm = float(np.linalg.norm(Mb, 1))
+        self.mu, Xb = np.linalg.eig(Mb)
+        self.X = self.Xi = None
+        if np.linalg.cond(Xb) < 1e8:
+            self.X, self.Xi = sc[:, None] * Xb, np.linalg.inv(Xb) / sc[None, :]
+
+    def state_matrix(self, DT):
+        """State matrix of the small loop with plant feedthrough ``DT`` (p_out × m)."""
+        Ak, Bk, Ck, Dk = self.K
+        lam, Bm, Cm = self.lam, self.Bm, self.Cm
+        nr = lam.size
+        F = np.linalg.inv(np.eye(DT.shape[0]) + DT @ Dk)  # y = F (C x − DT Ck xk)
+        yx, yk = F @ Cm, -F @ DT @ Ck
+        M = np.empty((nr + Ak.shape[0],) * 2, complex)
+        M[:nr, :nr] = np.diag(lam) - Bm @ Dk @ yx
+        M[:nr, nr:] = -Bm @ (Ck + Dk @ yk)
+        M[nr:, :nr] = Bk @ yx
+        M[nr:, nr:] = Ak + Bk @ yk
+        return M
+
+    def refine(self, lamT, BT, CT, tol):
+        """The strong poles with the weak modes' feedthrough at each pole: each cluster of
+        ``μ`` on its invariant subspace, ``p ∈ spec(X_c⁻¹ S(p) X_c)``, or, where the
+        second-order term that projection neglects exceeds ``tol``, ``p ∈ spec S(p)``
+        itself (the nearest eigenvalues); ``None`` if an iteration does not settle."""
+        out = np.empty_like(self.mu)
+        for idx in _clusters(self.mu, tol):
+            p = self._projected(idx, lamT, BT, CT, tol)
+            if p is None:
+                p = self._exact(idx, lamT, BT, CT, tol)
+            if p is None:
+                return None
+            out[idx] = p
+        return out
+
+    def _projected(self, idx, lamT, BT, CT, tol):
+        mu, X, Xi = self.mu, self.X, self.Xi
+        p = mu[idx].copy()
+        for _ in range(_MAX_ITER):
+            dS = self.state_matrix(_modal_sum(p.mean(), lamT, BT, CT)[0]) - self.M
+            E = Xi @ dS @ X
+            new = _matched(np.linalg.eigvals(np.diag(mu[idx]) + E[np.ix_(idx, idx)]), p)
+            done = np.max(np.abs(new - p)) <= tol
+            p = new
+            if done:
+                break
+        else:
+            return None
+        rest = np.setdiff1d(np.arange(mu.size), idx)
+        if rest.size:
+            sep = float(np.min(np.abs(mu[rest][:, None] - p[None, :])))
+            second = (np.linalg.norm(E[np.ix_(idx, rest)], 2)
+                      * np.linalg.norm(E[np.ix_(rest, idx)], 2) / max(sep, tol))
+            if second > tol:
+                return None
+        return p
+
+    def _exact(self, idx, lamT, BT, CT, tol):
+        p = self.mu[idx].copy()
+        for _ in range(_MAX_ITER):
+            ev = np.linalg.eigvals(self.state_matrix(_modal_sum(p.mean(), lamT, BT, CT)[0]))
+            new = _matched(ev[np.argsort(np.abs(ev - p.mean()))[:idx.size]], p)
+            done = np.max(np.abs(new - p)) <= tol
+            p = new
+            if done:
+                return p
+        return None
+
+
+def _matched(new, old):
+    """``new`` reordered to follow ``old`` (nearest first, greedily; clusters are small)."""
+    new, out = list(new), np.empty_like(old)
+    for j in np.argsort(-np.abs(old)):
+        k = min(range(len(new)), key=lambda i: abs(new[i] - old[j]))
+        out[j] = new.pop(k)
+    return out
+
+
+def _clusters(p, tol):
+    """Index groups of poles closer than ``sqrt(tol · scale)`` to a neighbour (chains):
+    nearly equal poles are iterated together."""
+    order = np.lexsort((p.imag, p.real))
+    radius = np.sqrt(tol * max(1.0, float(np.abs(p).max(initial=1.0))))
+    groups, cur = [], [order[0]] if order.size else []
+    for i in order[1:]:
+        if min(abs(p[i] - p[j]) for j in cur[-4:]) <= radius:
+            cur.append(i)
+        else:
+            groups.append(np.array(cur))
+            cur = [i]
+    if cur:
+        groups.append(np.array(cur))
+    return groups
+
+
+def _weak_poles(lam, Bm, Cm, weak, K, tol):
+    """Each weak mode's (or cluster's) pole from ``p ∈ spec(Λ_c − B_c Q(p) C_c)``,
+    ``Q = (I + K G_rest)⁻¹ K`` with the rest of the plant; ``None`` if it does not settle."""
+    groups = _clusters(lam[weak], tol)
+    groups = [weak[g] for g in groups]
+    out = np.empty(weak.size, complex)
+    pos = {int(i): k for k, i in enumerate(weak)}
+    p = [lam[g].copy() for g in groups]
+    W = (Cm.T[:, :, None] * Bm[:, None, :]).reshape(lam.size, -1)
+    pending = list(range(len(groups)))
+    for _ in range(_MAX_ITER):
+        if not pending:
+            break
+        centres = np.array([p[g].mean() for g in pending])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            R = 1.0 / (centres[:, None] - lam[None, :])
+        for k, g in enumerate(pending):  # the rest of the plant: without the cluster
+            R[k, groups[g]] = 0.0
+        G = (R @ W).reshape(-1, Cm.shape[0], Bm.shape[1])
+        Kp = _K_at(K, centres)
+        still = []
+        for k, g in enumerate(pending):
+            idx = groups[g]
+            Q = np.linalg.solve(np.eye(Kp.shape[1]) + Kp[k] @ G[k], Kp[k])
+            P = np.diag(lam[idx]) - Bm[idx] @ Q @ Cm[:, idx]
+            new = P[0, 0][None] if idx.size == 1 else _matched(np.linalg.eigvals(P), p[g])
+            if np.max(np.abs(new - p[g])) > tol:
+                still.append(g)
+            p[g] = np.atleast_1d(new)
+        pending = still
+    if pending:
+        return None
+    for g, idx in enumerate(groups):
+        for i, v in zip(idx, p[g]):
+            out[pos[int(i)]] = v
+    return out
+
+
+class _Boundary:
+    """The curve of the certificate, between the weak modes and the stability boundary:
+    the line ``Re s = α`` (continuous) or the circle ``|z| = ρ`` (discrete), parametrised
+    by ``Im s`` or ``arg z``; ``anchor`` is the point where the weak modes' part is taken
+    as static (``s = 0``, ``z = 1``)."""
+
+    def __init__(self, value: float, discrete: bool):
+        self.value, self.discrete = value, discrete
+        self.anchor = 1.0 if discrete else 0.0
+
+    @classmethod
+    def between(cls, mu, lamT, discrete):
+        """The curve as far from the strong poles as five candidates between the weak
+        modes and the stability boundary go; ``None`` if a weak mode is not strictly stable."""
+        worst = float(np.abs(lamT).max() if discrete else lamT.real.max())
+        edge = 1.0 if discrete else 0.0
+        if worst >= edge:
+            return None
+        cands = worst + (edge - worst) * np.array([0.5, 0.75, 0.25, 0.875, 0.125])
+        at = np.abs(mu) if discrete else mu.real
+        dist = [np.min(np.abs(at - v), initial=np.inf) for v in cands]
+        return cls(float(cands[int(np.argmax(dist))]), discrete)
+
+    def beyond(self, p):
+        """Whether each point lies on the unstable side of the curve (or on it)."""
+        return np.abs(p) >= self.value if self.discrete else p.real >= self.value
+
+    def bands(self, points):
+        """The initial bands (lo, hi) of the parameter, and the curve's ends outside them
+        (rays of the line; none for the circle)."""
+        if self.discrete:
+            edges = np.linspace(-np.pi, np.pi, 4097)
+            return edges[:-1], edges[1:], None
+        top = 10.0 * float(np.abs(points).max(initial=1.0))
+        low = max(1e-3, 1e-3 * float(np.abs(points).min(initial=1.0)))
+        pos = np.concatenate([[0.0], np.geomspace(low, top, 2048)])
+        edges = np.concatenate([-pos[:0:-1], pos])
+        return edges[:-1], edges[1:], (np.array([edges[-1], -np.inf]), np.array([np.inf, edges[0]]))
+
+    def dist(self, points, lo, hi):
+        """Distance from each point to each band, shape (n_bands, n_points)."""
+        if self.discrete:
+            th = np.angle(points)[None, :]
+            on = (th >= lo[:, None]) & (th <= hi[:, None])
+            ends = np.minimum(np.abs(points[None, :] - self.value * np.exp(1j * lo[:, None])),
+                              np.abs(points[None, :] - self.value * np.exp(1j * hi[:, None])))
+            return np.where(on, np.abs(np.abs(points) - self.value)[None, :], ends)
+        y = points.imag[None, :]
+        dy = np.where(y < lo[:, None], lo[:, None] - y,
+                      np.where(y > hi[:, None], y - hi[:, None], 0.0))
+        return np.hypot(points.real[None, :] - self.value, dy)
+
+    def farthest(self, lo, hi):
+        """The largest distance from ``anchor`` to a point of each band (``inf`` on a ray)."""
+        if self.discrete:  # |ρ e^{jθ} − 1| grows with |θ| on [0, π]
+            return np.abs(self.value * np.exp(1j * np.maximum(np.abs(lo), np.abs(hi))) - 1.0)
+        return np.hypot(self.value, np.maximum(np.abs(lo), np.abs(hi)))
+
+
+def _certified(boundary, part, lamT, aT) -> bool:
+    """Whether ``‖G_T − G_T(anchor)‖ ‖Q_R‖ < 1/2`` is proved on every band of the
+    boundary, bands bisected where the bound is too coarse (module docstring)."""
+    mu, X, Xi = part.mu, part.X, part.Xi
+    XiBq = Xi @ part.Bq
+    terms = [np.linalg.norm(part.Cq @ X, axis=0) * np.linalg.norm(XiBq, axis=1)]
+    dq = float(np.linalg.norm(part.Dq, 2)) if part.Dq.size else 0.0
+    heads = []
+    if not boundary.discrete:
+        # Neumann expansion at large |s|: Q = D + Σ_(k<N) C Aᵏ B / s^(k+1) + C Aᴺ (s−A)⁻¹ B / sᴺ
+        CA = part.Cq
+        for _ in range(3):
+            heads.append(float(np.linalg.norm(CA @ part.Bq, 2)))
+            CA = CA @ part.M
+            terms.append(np.linalg.norm(CA @ X, axis=0) * np.linalg.norm(XiBq, axis=1))
+    args = (boundary, mu, terms, heads, dq, lamT, aT)
+    lo, hi, ends = boundary.bands(np.concatenate([lamT, mu]))
+    if ends is not None and not _bands_ok(*ends, *args).all():
+        return False
+    for _ in range(_BISECTIONS + 1):
+        bad = ~_bands_ok(lo, hi, *args)
+        if not bad.any():
+            return True
+        mid = 0.5 * (lo[bad] + hi[bad])
+        lo, hi = np.concatenate([lo[bad], mid]), np.concatenate([mid, hi[bad]])
+    return False
+
+
+def _bands_ok(lo, hi, boundary, mu, terms, heads, dq, lamT, aT):
+    ok = np.empty(lo.size, bool)
+    step = max(1, 2**22 // max(1, lamT.size))
+    off = np.abs(lamT - boundary.anchor)[None, :]
+    for k in range(0, lo.size, step):
+        sl = slice(k, k + step)
+        with np.errstate(divide="ignore"):
+            # ‖G_T(p) − G_T(a)‖ ≤ Σ a_i |p − a| / (|λ_i − a| |p − λ_i|)
+            #                  ≤ Σ a_i (1/|p − λ_i| + 1/|λ_i − a|)
+            dT = boundary.dist(lamT, lo[sl], hi[sl])
+            far = boundary.farthest(lo[sl], hi[sl])[:, None]
+            g = (aT[None, :] * np.minimum(far / (off * dT), 1.0 / dT + 1.0 / off)).sum(axis=1)
+            dR = boundary.dist(mu, lo[sl], hi[sl])
+            q = (terms[0][None, :] / dR).sum(axis=1)
+            if heads:  # the smallest |s| on the band: its distance to the origin
+                smin = boundary.dist(np.zeros(1, complex), lo[sl], hi[sl])[:, 0]
+                for N in range(1, len(heads) + 1):
+                    head = sum(h / smin ** (j + 1) for j, h in enumerate(heads[:N]))
+                    q = np.minimum(q, head + (terms[N][None, :] / dR).sum(axis=1) / smin ** N)
+        ok[sl] = np.nan_to_num(g * (q + dq), nan=np.inf) < 0.5
+    return ok

@@ -469,7 +469,9 @@ def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, im
     """The case's numbers for one judged loop, continuous or discrete: its plant with
     current inputs ``cur`` and force inputs ``force``."""
 
-    P, loop = judged.plant, judged.loop
+    # signal names from the continuous plant: a sampled one is not formed (its modal
+    # form serves the responses, the poles and the impulse response)
+    P, loop = judged.source, judged.loop
     G, Gf = P[:, cur], P[:, force]
     controller = wired(G, controller)  # by signal names, in the plant's order
     dt = loop.dt

@@ -12,7 +12,9 @@ The lowest numerical layer (it imports only :mod:`ambseal.errors`); each idea on
   :func:`wired` — a controller matched to its plant by signal names;
 * :func:`zoh`, :func:`discretize`, :func:`simulate_lti` — exact zero-order hold (Franklin,
   Powell & Workman, *Digital Control of Dynamic Systems*, 3rd ed., §6.3), Tustin, and the
-  discrete recursion every time response runs through;
+  discrete recursion every time response runs through; :func:`sampled_modal_form` and
+  :func:`simulate_modal_loop` — a large plant sampled from its modal form (no ``expm``),
+  and a discrete loop stepped on it;
 * :func:`interp_table` — the one rule for tables against a parameter;
 * :func:`lowest_eigenpairs` — the eigenvalues of smallest |λ| of a large state matrix with
   right and left eigenvectors (shift-invert Arnoldi; a modal reduction's input);
@@ -20,7 +22,7 @@ The lowest numerical layer (it imports only :mod:`ambseal.errors`); each idea on
 * what every layer shares beneath them: :func:`ss_matrices`, :func:`as_omega`,
   :func:`labels` (checked matrices, grids and signal names), :func:`state_poles`,
   :func:`series_inputs`, :func:`sampled_response_at`, :func:`cached_njit` (numba's cached
-  compilation), :data:`DENSE_STATES`, and the JSON conventions of every result
+  compilation), :data:`DENSE_STATES`, :data:`STRUCTURED_STATES`, and the JSON conventions of every result
   (:func:`json_float`, :func:`json_list`, :func:`finite_or_none`,
   :func:`finite_or_none_tree`).
 
@@ -30,8 +32,13 @@ give the function).
 """
 
 from ambseal.lti.compiled import cached_njit
-from ambseal.lti.discrete import discretize, simulate_lti, zoh
-from ambseal.lti.freqresp import freqresp_at, sampled_response_at
+from ambseal.lti.discrete import discretize, simulate_lti, simulate_modal_loop, zoh
+from ambseal.lti.freqresp import (
+    STRUCTURED_STATES,
+    freqresp_at,
+    sampled_modal_form,
+    sampled_response_at,
+)
 from ambseal.lti.interconnect import (
     feedback_matrices,
     feedback_poles,
@@ -47,8 +54,8 @@ from ambseal.lti.matrices import as_omega, labels, ss_matrices
 from ambseal.lti.pickling import picklable
 from ambseal.lti.tables import interp_table
 
-__all__ = ["DENSE_STATES", "as_omega", "cached_njit", "discretize", "feedback_matrices",
+__all__ = ["DENSE_STATES", "STRUCTURED_STATES", "as_omega", "cached_njit", "discretize", "feedback_matrices",
            "feedback_poles", "finite_or_none", "finite_or_none_tree", "freqresp_at",
            "interp_table", "json_float", "json_list", "labels", "lft_lower",
-           "lft_lower_matrices", "lowest_eigenpairs", "picklable", "sampled_response_at",
-           "series_inputs", "simulate_lti", "ss_matrices", "state_poles", "wired", "zoh"]
+           "lft_lower_matrices", "lowest_eigenpairs", "picklable", "sampled_modal_form",
+           "sampled_response_at", "series_inputs", "simulate_lti", "simulate_modal_loop", "ss_matrices", "state_poles", "wired", "zoh"]

@@ -26,7 +26,7 @@ from ambseal.errors import ModelError
 from ambseal.lti.compiled import cached_njit
 from ambseal.lti.matrices import ArrayMemo
 
-__all__ = ["zoh", "discretize", "simulate_lti"]
+__all__ = ["zoh", "discretize", "simulate_lti", "simulate_modal_loop"]
 
 _METHODS = ("tustin", "zoh")
 _ZOH = ArrayMemo()  # the last large (A, B, dt) sampled
@@ -186,6 +186,70 @@ def simulate_lti(A: np.ndarray, B: np.ndarray, Cs: list[np.ndarray], u: np.ndarr
     for Ci in Cs:
         out.append(Y[:, row:row + Ci.shape[0]])
         row += Ci.shape[0]
+    return out
+
+
+def simulate_modal_loop(mu: np.ndarray, Bz: np.ndarray, Cm: np.ndarray, K, d: np.ndarray
+                        ) -> np.ndarray:
+    """Simulate, from rest, a discrete loop whose real plant is given in modal form:
+    ``O(n m)`` a step, no ``n × n`` matrix.
+
+    Plant ``x_{k+1} = diag(μ) x_k + B_z u_k``, ``y_k = C_m x_k`` (the complex modal form of
+    a real plant: :func:`ambseal.lti.freqresp.sampled_modal_form`); controller
+    ``x_{K,k+1} = A_K x_{K,k} + B_K y_k``, ``i_k = −(C_K x_{K,k} + D_K y_k)``;
+    ``u_k = i_k + d_k``. The real system is stepped, not its complex copy: one mode of
+    each conjugate pair (``Im μ > 0``, its output counted twice, ``y = Re(…)``) and the
+    real modes with real rows and columns. Stepping every complex mode and dropping
+    ``Im y`` would leave the part where partners drift from conjugacy without feedback,
+    and an open-loop unstable mode grows there until its rounding reaches the output. The same samples as :func:`simulate_lti` of the loop's
+    dense state space with ``A_d = V diag(μ) V⁻¹``, exactly in exact arithmetic. A
+    diverging loop gives ``inf``/``nan`` samples, no error.
+
+    Parameters
+    ----------
+    mu : numpy.ndarray of complex, shape (n,)
+        The sampled plant's poles ``e^{λ dt}``, in conjugate pairs and real values.
+    Bz : numpy.ndarray of complex, shape (n, nu)
+        Its modal input rows.
+    Cm : numpy.ndarray of complex, shape (ny, n)
+        Its modal output columns (the plant has no feedthrough).
+    K : (A_K, B_K, C_K, D_K)
+        Discrete controller on the plant's sample time, ``ny`` inputs → ``nu`` outputs.
+    d : numpy.ndarray, shape (N, nu)
+        The disturbances added to the controller's output, one row per sample.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, ny + nu)
+        ``[y_k, i_k]`` for ``k = 0 … N − 1``.
+
+    Raises
+    ------
+    ModelError
+        If ``mu`` is not closed under conjugation (not a real plant's form).
+    """
+    pos, real = mu.imag > 0, mu.imag == 0
+    if np.count_nonzero(pos) != np.count_nonzero(mu.imag < 0) or not np.array_equal(
+            np.sort_complex(mu[pos]), np.sort_complex(np.conj(mu[mu.imag < 0]))):
+        raise ModelError("simulate_modal_loop: the poles are not in conjugate pairs "
+                         "(not the modal form of a real plant)")
+    mu = np.concatenate([mu[pos], mu[real].real])
+    Bz = np.concatenate([Bz[pos], Bz[real].real])
+    Cm = np.concatenate([2 * Cm[:, pos], Cm[:, real].real], axis=1)
+    Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(X, float)) for X in K)
+    nk = Bk.shape[0] if Bk.size else 0
+    Ak, Bk, Ck = Ak.reshape(nk, nk), Bk.reshape(nk, -1), Ck.reshape(-1, nk)
+    ny = Cm.shape[0]
+    N = d.shape[0]
+    out = np.empty((N, ny + Dk.shape[0]))
+    x, xk = np.zeros(mu.size, complex), np.zeros(nk)
+    with np.errstate(over="ignore", invalid="ignore"):
+        for k in range(N):
+            y = (Cm @ x).real
+            i = -(Ck @ xk + Dk @ y)
+            out[k, :ny], out[k, ny:] = y, i
+            x = mu * x + Bz @ (i + d[k])
+            xk = Ak @ xk + Bk @ y
     return out
 
 

@@ -42,7 +42,8 @@ from ambseal.errors import ModelError
 from ambseal.lti.discrete import zoh
 from ambseal.lti.matrices import ArrayMemo, as_omega, ss_matrices
 
-__all__ = ["freqresp", "freqresp_at", "modal_form", "sampled_response_at"]
+__all__ = ["freqresp", "freqresp_at", "modal_form", "sampled_modal_form", "sampled_response_at",
+           "STRUCTURED_STATES"]
 
 _CHUNK_BYTES = 32 * 2**20  # memory budget of one chunk (complex n×n per frequency)
 _USE_SLYCOT = True  # set False (tests) to force the pure-numpy Hessenberg solver
@@ -60,7 +61,14 @@ _BALANCED = ArrayMemo()  # the same of the balanced system (:func:`_arbitrated`)
 #: eigendecomposition per plant whatever its inputs (the LU of V is n² complex numbers,
 #: 57 MB at 1 888 states; a loop is judged with a few plants at once). Smaller systems
 #: are kept by (A, B, C) in _MODAL and _BALANCED only.
-_EIG = ArrayMemo(keep=6, min_states=500)
+#: States from which a plant's eigendecomposition is kept per (A, C) and serves every use of
+#: that plant: its responses, the poles of the loops closed on it
+#: (:func:`ambseal.lti.interconnect.feedback_poles`) and its sampled form
+#: (:func:`sampled_modal_form`) — a dense eigenvalue problem or ``expm`` of a 500-state
+#: matrix costs 0.1 s, of a 1 888-state one 2–3.5 s (benchmarks/README.md).
+STRUCTURED_STATES = 500
+_EIG = ArrayMemo(keep=6, min_states=STRUCTURED_STATES)
+_SAMPLED = ArrayMemo(keep=8, min_states=STRUCTURED_STATES)  # sampled_modal_form's results
 _PROBED = ArrayMemo(keep=64)  # C (sI − A)⁻¹ B + D at single probes s of large (A, B, C)
 #: Spread (largest over smallest) of the diagonal balancing of ``A`` above which
 #: ``"auto"`` tries the balanced modal form first, checked against dense solves at the
@@ -184,7 +192,9 @@ def sampled_response_at(sys: Any, dt: float, omega: Any, *, max_cond: float = 1e
     ``G_d(z) = C V diag(φ(λ)/(z − e^{λ dt})) V⁻¹ B + D`` (Franklin, Powell & Workman,
     *Digital Control of Dynamic Systems*, 3rd ed., §6.3): the modal form of the continuous
     plant (kept for its other responses) serves the sampled one too, with no
-    eigendecomposition of ``A_d``. That form — the balanced one first above
+    eigendecomposition of ``A_d``. From ``STRUCTURED_STATES`` states that form is
+    :func:`sampled_modal_form`'s, certified on the continuous plant (no ``expm``). Else, or
+    where that is not certified, the form — the balanced one first above
     ``_SVD_COND_STATES`` states, as :func:`freqresp` — is taken where it is within ``rtol``
     of dense solves of ``(zI − A_d) X = B_d`` at three probe frequencies; else
     :func:`freqresp_at` of ``(A_d, B_d, C, D)``.
@@ -216,25 +226,81 @@ def sampled_response_at(sys: Any, dt: float, omega: Any, *, max_cond: float = 1e
     if w.ndim != 1 or not np.all(np.isfinite(w)):
         raise ModelError("sampled_response_at: expected a 1-D array of finite frequencies")
     z = np.exp(1j * w * dt)
-    Ad, Bd = zoh(A, B, dt)
     n = A.shape[0]
+    if n >= STRUCTURED_STATES:
+        form = sampled_modal_form(A, B, C, D, dt, max_cond=max_cond, rtol=rtol)
+        if form is not None:
+            return _modal_eval(*form, D, z)
+    Ad, Bd = zoh(A, B, dt)
     if n == 0:
         return freqresp_at((Ad, Bd, C, D), z)
     probe = _probes(z)
     Hd = _probe_response(Ad, Bd, C, D, probe)
-    forms = ((_BALANCED, True), (_MODAL, False)) if _balanced_first(A) else \
-        ((_MODAL, False), (_BALANCED, True))
-    for memo, balance in forms:
-        lam, _, Bm, Cm = memo.get((A, B, C), max_cond,
-                                  lambda b=balance: _modal_form(A, B, C, max_cond, balance=b))
-        if Bm is None:
-            continue
-        with np.errstate(divide="ignore", invalid="ignore"):
-            phi = np.where(lam == 0, dt, np.expm1(lam * dt) / lam)
-        mu, Bz = np.exp(lam * dt), Bm * phi[:, None]
+    for lam, Bm, Cm in _modal_forms(A, B, C, max_cond):
+        mu, Bz = _sampled(lam, Bm, dt)
         if _error(_modal_eval(mu, Bz, Cm, D, probe), Hd) <= rtol:
             return _modal_eval(mu, Bz, Cm, D, z)
     return freqresp_at((Ad, Bd, C, D), z, rtol=rtol)
+
+
+def sampled_modal_form(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray,
+                       dt: float, *, max_cond: float = 1e8, rtol: float = 1e-6):
+    """The plant sampled by a zero-order hold at ``dt`` in modal form, without sampling
+    ``A`` itself: ``(e^{λ dt}, rows of V⁻¹B times φ(λ), CV)`` (:func:`sampled_response_at`)
+    from the continuous plant's modal form, or ``None`` where that form is not certified.
+
+    The form — balanced first where :func:`freqresp` would try that first — is certified
+    when ``C V diag(1/(s − λ)) V⁻¹ B + D`` is within ``rtol`` (relative to the largest
+    entry) of dense LU solves of ``(sI − A) X = B`` at ``s = jω``, ``ω = π/dt`` times
+    1e-3, √(1e-3 · 0.999) and 0.999 (the band of the sampled plant, and its geometric
+    middle). The sampled form shares ``V`` and ``λ``, so an error of the eigendecomposition
+    shows in both; no ``expm`` of the ``n``-state plant and no dense solve of the sampled
+    plant is needed (2–3.5 s each at 1 888 states). The result is kept for the last large
+    plants.
+
+    Parameters
+    ----------
+    A, B, C, D : numpy.ndarray
+        The continuous plant, ``n`` states, ``nu`` inputs, ``ny`` outputs.
+    dt : float
+        Sample time (s), > 0.
+    max_cond, rtol : float
+        As for :func:`freqresp_at`.
+
+    Returns
+    -------
+    tuple (μ (n,), B_z (n, nu), C_m (ny, n)) of complex arrays, or None
+        ``G_d(z) = C_m diag(1/(z − μ)) B_z + D``. Shared arrays: do not modify them in
+        place.
+    """
+    def certified():
+        probe = 1j * (np.pi / dt) * np.array([1e-3, np.sqrt(1e-3 * 0.999), 0.999])
+        Hd = _probe_response(A, B, C, D, probe)
+        for lam, Bm, Cm in _modal_forms(A, B, C, max_cond):
+            if _error(_modal_eval(lam, Bm, Cm, D, probe), Hd) <= rtol:
+                return (*_sampled(lam, Bm, dt), Cm)
+        return None
+
+    return _SAMPLED.get((A, B, C, D), (float(dt), max_cond, rtol), certified)
+
+
+def _modal_forms(A, B, C, max_cond):
+    """The modal forms ``(λ, V⁻¹B, CV)`` of ``A`` and of the balanced system that exist
+    (``cond V ≤ max_cond``), in the order :func:`freqresp` tries them (lazily)."""
+    order = (True, False) if _balanced_first(A) else (False, True)
+    for balance in order:
+        memo = _BALANCED if balance else _MODAL
+        lam, _, Bm, Cm = memo.get((A, B, C), max_cond,
+                                  lambda b=balance: _modal_form(A, B, C, max_cond, balance=b))
+        if Bm is not None:
+            yield lam, Bm, Cm
+
+
+def _sampled(lam, Bm, dt):
+    """``(e^{λ dt}, rows of Bm times φ(λ))``, ``φ(λ) = (e^{λ dt} − 1)/λ`` (``dt`` at 0)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        phi = np.where(lam == 0, dt, np.expm1(lam * dt) / lam)
+    return np.exp(lam * dt), Bm * phi[:, None]
 
 
 def _response(A, B, C, D, s, method, max_cond, rtol) -> np.ndarray:

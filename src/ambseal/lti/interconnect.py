@@ -27,12 +27,12 @@ import numpy as np
 
 from ambseal.errors import ModelError
 from ambseal.lti.discrete import zoh
-from ambseal.lti.freqresp import modal_form
+from ambseal.lti.freqresp import STRUCTURED_STATES, modal_form
 from ambseal.lti.matrices import ArrayMemo, labels, ss_matrices
 from ambseal.lti.modal_loop import modal_loop_poles
 
 __all__ = ["lft_lower_matrices", "lft_lower", "feedback_matrices", "feedback_poles", "state_poles",
-           "series_inputs", "wired", "STRUCTURED_STATES"]
+           "series_inputs", "wired"]
 
 Matrices = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
@@ -252,13 +252,6 @@ def feedback_poles(G: Matrices, K: Matrices, *, lag: Matrices | None = None,
     if hold:
         A, B = zoh(A, B, hold)
     return state_poles(feedback_matrices((A, B, C, D), K)[0])
-
-
-#: States from which :func:`feedback_poles` of a continuous plant takes its modal form:
-#: the plant's eigendecomposition is then kept and shared by its frequency responses and
-#: every loop closed on it (a dense eigenvalue problem of a 500-state loop costs 0.1 s,
-#: of a 1 916-state one 2 s; the modal path 0.5 s there, measured in benchmarks/README.md).
-STRUCTURED_STATES = 500
 
 
 def _modal_poles(A, B, C, K, hold):

@@ -18,7 +18,9 @@ outputs ``y`` to its inputs with **negative feedback**, ``u = −K y + d``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import control
@@ -26,14 +28,17 @@ import numpy as np
 
 from ambseal.errors import ModelError
 from ambseal.lti import (
+    STRUCTURED_STATES,
     feedback_matrices,
     feedback_poles,
     freqresp_at,
     json_float,
     json_list,
     labels,
+    sampled_modal_form,
     sampled_response_at,
     series_inputs,
+    simulate_modal_loop,
     ss_matrices,
     wired,
     zoh,
@@ -69,9 +74,16 @@ class ClosedLoop:
         Channel counts, so ``system`` can be sliced without parsing names.
     dt : float
         Sample time (s) of a discrete loop, 0 for a continuous one.
+    inputs, outputs : tuple of str
+        The names of ``system``'s inputs and outputs.
+
+    ``system`` is built when first asked for: a loop on a large plant sampled by
+    :func:`judged_loop` has its poles and its time response (:meth:`modal_response`)
+    from the continuous plant's modal form, and its dense state space costs an ``expm``
+    of the plant.
     """
 
-    system: Any
+    _build: Callable[[], Any] = field(repr=False)
     poles: np.ndarray
     max_real_pole: float
     stable: bool
@@ -79,6 +91,41 @@ class ClosedLoop:
     n_plant_outputs: int
     n_force_inputs: int
     dt: float = 0.0
+    inputs: tuple = ()
+    outputs: tuple = ()
+    #: (continuous plant (A, B, C, D) of the control inputs, controller matrices) of a
+    #: discrete loop on a large plant sampled by a zero-order hold; else None
+    _sampled_from: tuple | None = field(default=None, repr=False)
+
+    @cached_property
+    def system(self) -> Any:
+        """The closed loop as a ``control.StateSpace`` (inputs, outputs and states above)."""
+        return self._build()
+
+    def modal_response(self, d: np.ndarray) -> np.ndarray | None:
+        """The outputs (``y`` then ``i``) of a discrete loop on a large sampled plant for
+        the disturbances ``d`` added to the controller's outputs, from rest, stepped in the
+        continuous plant's certified modal form
+        (:func:`ambseal.lti.freqresp.sampled_modal_form`,
+        :func:`ambseal.lti.discrete.simulate_modal_loop`): the samples of
+        :func:`ambseal.lti.discrete.simulate_lti` on ``system`` without forming it.
+
+        Parameters
+        ----------
+        d : numpy.ndarray, shape (N, n_plant_inputs)
+            Disturbances (A), one row per sample.
+
+        Returns
+        -------
+        numpy.ndarray, shape (N, n_plant_outputs + n_plant_inputs), or None
+            ``None`` for any other loop, or where the modal form is not certified: take
+            ``system`` then.
+        """
+        if self._sampled_from is None:
+            return None
+        G, K = self._sampled_from
+        form = sampled_modal_form(*G, self.dt)
+        return None if form is None else simulate_modal_loop(*form, K, d)
 
     @property
     def s_poles(self) -> np.ndarray:
@@ -99,13 +146,13 @@ class ClosedLoop:
     def to_dict(self) -> dict:
         """JSON-safe summary (no state-space matrices): stability, poles (real/imag, rad/s)."""
         return {
-            "n_states": int(self.system.nstates),
+            "n_states": int(self.poles.size),
             "stable": bool(self.stable),
             "max_real_pole": json_float(self.max_real_pole),
             "poles_real": json_list(self.poles.real),
             "poles_imag": json_list(self.poles.imag),
-            "inputs": list(self.system.input_labels),
-            "outputs": list(self.system.output_labels),
+            "inputs": list(self.inputs),
+            "outputs": list(self.outputs),
         }
 
 
@@ -196,10 +243,37 @@ def closed_loop(G: Any, K: Any, Gf: Any | None = None, *, atol: float = 0.0) -> 
 
 
 def _closed(G, K, Gf, atol, source) -> ClosedLoop:
-    """:func:`closed_loop`; ``source``: ``(G₀, how)`` when ``G`` was made from the
-    continuous ``G₀`` — with a lag in front of every input (``how = {"lag": matrices}``) or
-    sampled by a zero-order hold (``{"hold": dt}``) — whose modal form then gives the poles
-    (:func:`ambseal.lti.interconnect.feedback_poles`)."""
+    """:func:`closed_loop`; ``source``: ``(G₀, lag)`` when ``G`` was made from the
+    continuous ``G₀`` with the SISO ``lag`` (matrices) in front of every input, whose modal
+    form then gives the poles (:func:`ambseal.lti.interconnect.feedback_poles`)."""
+    (A, B, C, D), mk, sys, Acl = _loop_system(G, K, Gf, atol)
+    dt = sample_time(G)
+    if source is None:
+        poles = feedback_poles((A, B, C, D), mk, dt=dt, state_matrix=Acl)
+    else:
+        poles = feedback_poles(ss_matrices(source[0]), mk, dt=dt, state_matrix=Acl,
+                               lag=source[1])
+    return _loop(lambda: sys, poles, dt, B.shape[1], C.shape[0],
+                 (tuple(sys.input_labels), tuple(sys.output_labels)))
+
+
+def _loop(build, poles, dt, nu, ny, names, sampled_from=None) -> ClosedLoop:
+    poles = poles[np.argsort(-np.abs(poles) if dt else -poles.real, kind="stable")]
+    return ClosedLoop(build, poles, decay_rate(poles, dt), is_stable(poles, dt), nu, ny,
+                      len(names[0]) - nu, dt, *names, sampled_from)
+
+
+def _names(G, Gf, nu, ny, nf) -> tuple[list, list]:
+    """The closed loop's input and output names (:class:`ClosedLoop`)."""
+    u_names = labels(G, "input", nu, "u")
+    f_names = labels(Gf, "input", nf, "f") if Gf is not None else ()
+    return ([f"d_{u}" for u in u_names] + list(f_names),
+            list(labels(G, "output", ny, "y")) + [f"i_{u}" for u in u_names])
+
+
+def _loop_system(G, K, Gf, atol):
+    """(G's matrices, K's wired matrices, the closed loop's ``control.StateSpace``, its
+    state matrix) of :func:`closed_loop`."""
     (A, B, C, D), (Ak, Bk, Ck, Dk) = loop_matrices(G, K)
     n, nu = B.shape
     ny = C.shape[0]
@@ -221,21 +295,37 @@ def _closed(G, K, Gf, atol, source) -> ClosedLoop:
     except ModelError:
         raise ModelError("closed_loop: I + D·D_K is singular; the loop is ill-posed") from None
 
-    u_names = labels(G, "input", nu, "u")
-    y_names = labels(G, "output", ny, "y")
-    f_names = labels(Gf, "input", nf, "f") if Gf is not None else ()
-    inputs = [f"d_{u}" for u in u_names] + list(f_names)
-    outputs = list(y_names) + [f"i_{u}" for u in u_names]
+    inputs, outputs = _names(G, Gf, nu, ny, nf)
     states = [f"x[{i}]" for i in range(n)] + [f"xK[{i}]" for i in range(nk)]
     sys = control.StateSpace(Acl, Bcl, Ccl, Dcl, dt, inputs=inputs, outputs=outputs,
                              states=states, name="closed_loop")
-    if source is None:
-        poles = feedback_poles((A, B, C, D), (Ak, Bk, Ck, Dk), dt=dt, state_matrix=Acl)
-    else:
-        poles = feedback_poles(ss_matrices(source[0]), (Ak, Bk, Ck, Dk), dt=dt,
-                               state_matrix=Acl, **source[1])
-    poles = poles[np.argsort(-np.abs(poles) if dt else -poles.real, kind="stable")]
-    return ClosedLoop(sys, poles, decay_rate(poles, dt), is_stable(poles, dt), nu, ny, nf, dt)
+    return (A, B, C, D), (Ak, Bk, Ck, Dk), sys, Acl
+
+
+def _sampled_loop(P, K, cur, rest, dt) -> ClosedLoop:
+    """The discrete ``K`` closed on the continuous ``P`` sampled at ``dt`` (its inputs
+    ``cur`` driven): poles from the continuous plant with the hold
+    (:func:`ambseal.lti.interconnect.feedback_poles`), and, for a large plant without
+    feedthrough, the time response from its modal form (:meth:`ClosedLoop.modal_response`);
+    the sampled plant's dense state space only when ``system`` is asked for."""
+    G0 = _select(P, cur)
+    mg = ss_matrices(G0)
+    mk = ss_matrices(wired(G0, K), name="K", allow_discrete=True)
+    ny, nu = mg[3].shape
+    if mk[3].shape != (nu, ny):
+        raise ModelError(
+            f"K has {mk[3].shape[1]} inputs and {mk[3].shape[0]} outputs; expected {ny} inputs"
+            f" (G outputs, m) and {nu} outputs (G inputs, A)")
+    poles = feedback_poles(mg, mk, dt=dt, hold=dt)
+
+    def build():
+        Pj = sampled_plant(P, dt, cur)
+        return _loop_system(_select(Pj, cur), K, _select(Pj, rest) if rest else None, 0.0)[2]
+
+    structured = mg[0].shape[0] >= STRUCTURED_STATES and not np.any(mg[3])
+    names = _names(G0, _select(P, rest) if rest else None, nu, ny, len(rest))
+    return _loop(build, poles, dt, nu, ny, tuple(map(tuple, names)),
+                 (mg, mk) if structured else None)
 
 
 @dataclass(frozen=True, eq=False)
@@ -259,11 +349,17 @@ class JudgedLoop:
         The inputs of ``plant`` the controller drives.
     """
 
-    plant: Any
+    _plant: Callable[[], Any] = field(repr=False)
     loop: ClosedLoop
     source: Any
     delay: Any
     control_inputs: tuple
+
+    @cached_property
+    def plant(self) -> Any:
+        """The plant as the controller sees it (above); a sampled one is formed when first
+        asked for (an ``expm`` of the plant)."""
+        return self._plant()
 
     @property
     def stable(self) -> bool:
@@ -287,7 +383,7 @@ class JudgedLoop:
         ndarray of complex, shape (n_w, ny, nu)
             Outputs per input of ``plant`` (all its inputs, in its order).
         """
-        dt = sample_time(self.plant)
+        dt = self.loop.dt
         if dt:  # per input group, as sampled_plant samples them
             P, cur = self.source, list(self.control_inputs)
             H = np.empty((w.size, P.noutputs, P.ninputs), dtype=complex)
@@ -376,16 +472,15 @@ def judged_loop(P, K, control_inputs=None, *, delay=None) -> JudgedLoop:
     cur = list(range(P.ninputs)) if control_inputs is None else list(control_inputs)
     rest = [j for j in range(P.ninputs) if j not in cur]
     dt = sample_time(K)
-    source = None
     if dt:
-        Pj = sampled_plant(P, dt, cur)
-        source = (_select(P, cur), {"hold": dt})
-    elif delay is not None:
+        return JudgedLoop(lambda: sampled_plant(P, dt, cur), _sampled_loop(P, K, cur, rest, dt),
+                          P, None, tuple(cur))
+    source = None
+    if delay is not None:
         Pj = delayed_plant(P, cur, delay)
-        source = (_select(P, cur), {"lag": tuple(np.asarray(getattr(delay, m), float)
-                                               for m in "ABCD")})
+        source = (_select(P, cur), tuple(np.asarray(getattr(delay, m), float) for m in "ABCD"))
     else:
         Pj = P
     G = _select(Pj, cur)
     Gf = _select(Pj, rest) if rest else None
-    return JudgedLoop(Pj, _closed(G, K, Gf, 0.0, source), P, None if dt else delay, tuple(cur))
+    return JudgedLoop(lambda: Pj, _closed(G, K, Gf, 0.0, source), P, delay, tuple(cur))

@@ -45,6 +45,7 @@ analysis and a simulation of the loop as it runs can all share.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any, Callable, Sequence
 
 import control
@@ -483,22 +484,31 @@ def _remove_fast(K, mats: Matrices, fs: float, rise: Callable | None):
 
 @dataclass(frozen=True, eq=False)
 class SampledPlants:
-    """The full-order plants the choice is made on, continuous (``plants``: with the
-    hold + computation delay of ``delay_samples`` as a Padé lag on every input) and
-    ZOH-sampled at ``fs`` (``sampled``: without, the delay is the discrete controller's;
-    ``ideal``: the continuous plants without the delay, where the design must run
-    stably), with their frequency
+    """The full-order plants the choice is made on, continuous (``ideal``: where the
+    design must run stably; ``plants``: with the hold + computation delay of
+    ``delay_samples`` as the Padé lag ``lag`` on every input) and ZOH-sampled at ``fs``
+    (``sampled``: without, the delay is the discrete controller's), with their frequency
     responses on a log grid up to Nyquist: computed once, shared by every controller
-    chosen for the same conditions (:func:`sampled_plants`)."""
+    chosen for the same conditions (:func:`sampled_plants`). The choice itself needs only
+    ``ideal`` and ``lag`` (its loops' poles come from the plants' modal forms);
+    ``plants`` and ``sampled`` are formed when first asked for."""
 
-    plants: list
-    sampled: list
     fs: float
     omega_rad_s: np.ndarray
     continuous_response: list
     sampled_response: list
     ideal: list
     lag: tuple
+
+    @cached_property
+    def plants(self) -> list:
+        """The continuous plants with the lag before every input, ``(A, B, C, D)``."""
+        return [series_inputs(G, self.lag)[:4] for G in self.ideal]
+
+    @cached_property
+    def sampled(self) -> list:
+        """The plants sampled by a zero-order hold at ``fs`` (:func:`zoh`), ``(A, B, C, D)``."""
+        return [(*zoh(G[0], G[1], 1.0 / self.fs), G[2], G[3]) for G in self.ideal]
 
     def delayed_poles(self, j: int, K: Matrices) -> np.ndarray:
         """Poles of ``K`` closed on plant ``j`` with the lag (``plants[j]``): from the
@@ -510,13 +520,12 @@ class SampledPlants:
 
 def sampled_plants(plants: Sequence[Matrices], fs: float, n_grid: int = 400, *,
                    delay_samples: int = 1) -> SampledPlants:
-    """:class:`SampledPlants` of continuous ``(A, B, C, D)`` plants at ``fs`` (Hz):
-    :func:`ambseal.lti.discrete.zoh`, and the responses on ``n_grid`` log-spaced
-    frequencies from 1 Hz to Nyquist — at ``jω`` the plant's (:func:`freqresp_at`) times
-    the Padé lag's of ``delay_samples`` + ½ samples
+    """:class:`SampledPlants` of continuous ``(A, B, C, D)`` plants at ``fs`` (Hz): the
+    responses on ``n_grid`` log-spaced frequencies from 1 Hz to Nyquist — at ``jω`` the
+    plant's (:func:`freqresp_at`) times the Padé lag's of ``delay_samples`` + ½ samples
     (:func:`ambseal.robust.delay.loop_delay`), at ``e^{jωT}`` the sampled plant's from
     the continuous plant's modal form (:func:`ambseal.lti.freqresp.sampled_response_at`,
-    checked at rtol 1e-6) — and the continuous plants with that lag before every input.
+    checked at rtol 1e-6); the delayed and sampled plants themselves when asked for.
 
     Parameters
     ----------
@@ -536,17 +545,14 @@ def sampled_plants(plants: Sequence[Matrices], fs: float, n_grid: int = 400, *,
 
     T = 1.0 / fs
     w = 2 * np.pi * np.logspace(0, np.log10(0.999 * fs / 2), n_grid)
-    sampled = [(*zoh(G[0], G[1], T), G[2], G[3]) for G in plants]
+    plants = [tuple(np.asarray(X, float) for X in G) for G in plants]
     L = loop_delay(fs, delay_samples).system
     L = tuple(np.asarray(getattr(L, m), float) for m in ("A", "B", "C", "D"))
-    delayed = [series_inputs(tuple(np.asarray(X, float) for X in G), L)[:4] for G in plants]
     # the lag is one SISO block before every input: the delayed plant's response is the
     # plant's times the lag's, and the sampled plant's comes from the plant's modal form
     lag = freqresp_at(L, 1j * w)[:, :1, :1]
-    return SampledPlants(delayed, sampled, float(fs), w,
-                         [freqresp_at(G, 1j * w) * lag for G in plants],
-                         [sampled_response_at(G, T, w) for G in plants],
-                         list(plants), L)
+    return SampledPlants(float(fs), w, [freqresp_at(G, 1j * w) * lag for G in plants],
+                         [sampled_response_at(G, T, w) for G in plants], plants, L)
 
 
 def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int, methods,
@@ -607,7 +613,7 @@ def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int,
               and is_stable(sp.delayed_poles(j, Kc))]
     peak_c = {j: _so_peak(sp.continuous_response[j], freqresp_at(cont[j], 1j * w))
               for j in judged}
-    n = len(sp.sampled)
+    n = len(sp.ideal)
     cands, Kd = [], {}
     for m in methods:
         if m == "tustin_prewarp" and f_pw is None:
@@ -676,7 +682,7 @@ def digital_controller(K, sample_rate_hz: float, plants, *,
         plants, fs, delay_samples=delay_samples)
     if abs(sp.fs - fs) > 1e-9 * fs:
         raise ConfigError(f"digital_controller: plants sampled at {sp.fs} Hz, not {fs} Hz")
-    n = len(sp.plants)
+    n = len(sp.ideal)
     f_pw = prewarp_frequency_hz(sp.ideal, mats, fs, lag=sp.lag)
     keep = hold_keeps(fast, fs)
     tried = list(methods) + ([f"{m}{KEPT}" for m in HOLDS if m in methods] if keep else [])

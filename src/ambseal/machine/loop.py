@@ -76,6 +76,12 @@ class ClosedLoop:
         Sample time (s) of a discrete loop, 0 for a continuous one.
     inputs, outputs : tuple of str
         The names of ``system``'s inputs and outputs.
+    _build : callable
+        Makes ``system`` (no arguments); called once, when ``system`` is first read.
+    _sampled_from : tuple or None
+        ``(G, K)``, matrices of the continuous plant's control inputs and of the
+        controller, for a discrete loop on a large plant sampled by a zero-order hold
+        (:meth:`modal_response`); else None.
 
     ``system`` is built when first asked for: a loop on a large plant sampled by
     :func:`judged_loop` has its poles and its time response (:meth:`modal_response`)
@@ -93,8 +99,6 @@ class ClosedLoop:
     dt: float = 0.0
     inputs: tuple = ()
     outputs: tuple = ()
-    #: (continuous plant (A, B, C, D) of the control inputs, controller matrices) of a
-    #: discrete loop on a large plant sampled by a zero-order hold; else None
     _sampled_from: tuple | None = field(default=None, repr=False)
 
     @cached_property
@@ -347,6 +351,8 @@ class JudgedLoop:
         The lag in front of the control inputs of a continuous ``plant``.
     control_inputs : tuple of int
         The inputs of ``plant`` the controller drives.
+    _plant : callable
+        Makes ``plant`` (no arguments); called once, when ``plant`` is first read.
     """
 
     _plant: Callable[[], Any] = field(repr=False)

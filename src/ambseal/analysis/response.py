@@ -276,7 +276,7 @@ def impulse_response_of(
     pulse = np.zeros((n_end + 1, 1))
     pulse[k0:k1] = 1.0
     dk = pulse * d_vec
-    Y = loop.modal_response(dk) if loop.dt else None  # a large sampled plant: no expm
+    Y = loop.modal_response(dk, dt_s)  # a large plant: from its modal form, no expm
     if Y is None:
         sys = loop.system
         A = np.asarray(sys.A, dtype=float)

@@ -8,7 +8,9 @@ The lowest numerical layer (it imports only :mod:`ambseal.errors`); each idea on
   continuous models, modal or Hessenberg (Laub, IEEE TAC 26(2), 1981);
 * :func:`lft_lower`, :func:`lft_lower_matrices` — ``F_l(P, K)`` (Skogestad &
   Postlethwaite, *Multivariable Feedback Control*, 2nd ed., Eq. 3.111);
-  :func:`feedback_matrices`, :func:`feedback_poles` — the negative-feedback loop ``u = −K y + d``;
+  :func:`feedback_matrices`, :func:`feedback_poles`, :func:`feedback_response` — the
+  negative-feedback loop ``u = −K y + d``, its poles and time response (of a large plant
+  from its modal form);
   :func:`wired` — a controller matched to its plant by signal names;
 * :func:`zoh`, :func:`discretize`, :func:`simulate_lti` — exact zero-order hold (Franklin,
   Powell & Workman, *Digital Control of Dynamic Systems*, 3rd ed., §6.3), Tustin, and the
@@ -42,6 +44,7 @@ from ambseal.lti.freqresp import (
 from ambseal.lti.interconnect import (
     feedback_matrices,
     feedback_poles,
+    feedback_response,
     lft_lower,
     lft_lower_matrices,
     series_inputs,
@@ -54,8 +57,9 @@ from ambseal.lti.matrices import as_omega, labels, ss_matrices
 from ambseal.lti.pickling import picklable
 from ambseal.lti.tables import interp_table
 
-__all__ = ["DENSE_STATES", "STRUCTURED_STATES", "as_omega", "cached_njit", "discretize", "feedback_matrices",
-           "feedback_poles", "finite_or_none", "finite_or_none_tree", "freqresp_at",
-           "interp_table", "json_float", "json_list", "labels", "lft_lower",
-           "lft_lower_matrices", "lowest_eigenpairs", "picklable", "sampled_modal_form",
-           "sampled_response_at", "series_inputs", "simulate_lti", "simulate_modal_loop", "ss_matrices", "state_poles", "wired", "zoh"]
+__all__ = ["DENSE_STATES", "STRUCTURED_STATES", "as_omega", "cached_njit", "discretize",
+           "feedback_matrices", "feedback_poles", "feedback_response", "finite_or_none",
+           "finite_or_none_tree", "freqresp_at", "interp_table", "json_float", "json_list",
+           "labels", "lft_lower", "lft_lower_matrices", "lowest_eigenpairs", "picklable",
+           "sampled_modal_form", "sampled_response_at", "series_inputs", "simulate_lti",
+           "simulate_modal_loop", "ss_matrices", "state_poles", "wired", "zoh"]

@@ -29,10 +29,10 @@ from ambseal.errors import ModelError
 from ambseal.lti.discrete import zoh
 from ambseal.lti.freqresp import STRUCTURED_STATES, modal_form
 from ambseal.lti.matrices import ArrayMemo, labels, ss_matrices
-from ambseal.lti.modal_loop import modal_loop_poles
+from ambseal.lti.modal_loop import modal_loop_poles, modal_loop_response
 
-__all__ = ["lft_lower_matrices", "lft_lower", "feedback_matrices", "feedback_poles", "state_poles",
-           "series_inputs", "wired"]
+__all__ = ["lft_lower_matrices", "lft_lower", "feedback_matrices", "feedback_poles",
+           "feedback_response", "state_poles", "series_inputs", "wired"]
 
 Matrices = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
@@ -252,6 +252,57 @@ def feedback_poles(G: Matrices, K: Matrices, *, lag: Matrices | None = None,
     if hold:
         A, B = zoh(A, B, hold)
     return state_poles(feedback_matrices((A, B, C, D), K)[0])
+
+
+def feedback_response(G: Matrices, K: Matrices, d: np.ndarray, h: float, *,
+                      lag: Matrices | None = None) -> np.ndarray | None:
+    """The loop ``u = −K y + d`` of a large continuous plant without feedthrough
+    (``STRUCTURED_STATES`` states or more), ``d`` held over steps of ``h``, from rest, from
+    the plant's modal form (:func:`ambseal.lti.modal_loop.modal_loop_response`: the loop
+    split along its invariant subspaces, certified; no ``expm`` of the loop), or ``None``
+    where that path does not apply or is not certified (the caller then samples the loop's
+    state space).
+
+    Parameters
+    ----------
+    G : (A, B, C, D)
+        Continuous plant, ``n`` states, ``nu`` inputs → ``ny`` outputs.
+    K : (A_K, B_K, C_K, D_K)
+        Continuous controller, ``ny`` inputs → ``nu`` outputs.
+    d : numpy.ndarray, shape (N, nu)
+        The disturbances added to the controller's outputs, one row per step.
+    h : float
+        The step (s).
+    lag : (A_L, B_L, C_L, D_L), optional
+        A SISO lag in front of every plant input, the disturbance included (as
+        :func:`series_inputs` of the plant with it).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, ny + nu), or None
+        The plant's outputs, then the controller's ``−K y``, at ``t = k h``: the samples of
+        :func:`ambseal.lti.discrete.simulate_lti` on the loop sampled by
+        :func:`ambseal.lti.discrete.zoh`.
+    """
+    A, B, C, D = (np.asarray(X, float) for X in G)
+    if A.shape[0] < STRUCTURED_STATES or np.any(D):
+        return None
+    form = modal_form(A, B, C)
+    if form is None:
+        return None
+    Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(X, float)) for X in K)
+    nk, nu = (Ak.shape[0] if Bk.size else 0), B.shape[1]
+    Ck = Ck.reshape(nu, nk)
+    if lag is None:
+        Kl, E = (Ak.reshape(nk, nk), Bk.reshape(nk, -1), Ck, Dk), (np.zeros((nk, nu)), np.eye(nu))
+    else:
+        # the lag's states in the loop u = −K' y are those of the signal K y: the
+        # disturbance, added to −K y, enters them with the opposite sign
+        Kl = _lagged(K, lag, nu)
+        Bl, Dl = (_repeat_diagonal(np.atleast_2d(np.asarray(X, float)), nu) for X in lag[1::2])
+        E = (np.vstack([np.zeros((nk, nu)), -Bl]), Dl)
+    F = np.hstack([-Ck, np.zeros((nu, Kl[0].shape[0] - nk))])
+    return modal_loop_response(*form, Kl, E, (F, -Dk), np.asarray(d, float), h)
 
 
 def _modal_poles(A, B, C, K, hold):

@@ -51,10 +51,15 @@ within 1e-8 where the dense QR eigenvalues of the same loop are off by up to 2e-
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 import scipy.linalg
+from scipy.spatial import cKDTree
 
-__all__ = ["WEAK", "modal_loop_poles"]
+from ambseal.lti.matrices import ArrayMemo
+
+__all__ = ["WEAK", "modal_loop_poles", "modal_loop_response"]
 
 #: A mode is weak when its first-order shift is at most this fraction of its distance to
 #: the stability boundary: the neglected second-order terms of the projection are then
@@ -66,6 +71,9 @@ _EPS = float(np.finfo(float).eps)
 #: is not taken.
 _MAX_STRONG_FRACTION = 0.5
 _MAX_ITER = 30
+#: The split of the last loops (:class:`_Solved`): a loop's poles and its time response
+#: share one.
+_SOLVED = ArrayMemo(keep=16)
 _BISECTIONS = 14
 
 
@@ -92,6 +100,29 @@ def modal_loop_poles(lam, Bm, Cm, K, *, discrete: bool = False) -> np.ndarray | 
     numpy.ndarray of complex, shape (n + n_K,), or None
         The closed-loop poles, in no particular order; ``None`` when not certified.
     """
+    solved = _solve(lam, Bm, Cm, K, discrete)
+    return None if solved is None else solved.poles
+
+
+class _Solved(NamedTuple):
+    """What :func:`modal_loop_poles` certified: the poles, and how they were found."""
+
+    poles: np.ndarray
+    part: "_StrongPart"
+    p_strong: np.ndarray  # the strong part's poles, in the order of part.mu
+    strong: np.ndarray  # plant modes of the strong part
+    groups: list  # plant modes of each weak cluster
+    p_groups: list  # their poles
+
+
+def _solve(lam, Bm, Cm, K, discrete) -> _Solved | None:
+    """The split and the certified poles of :func:`modal_loop_poles` (kept: :data:`_SOLVED`)."""
+    arrays = tuple(np.asarray(X, complex) for X in (lam, Bm, Cm)) + \
+        tuple(np.atleast_2d(np.asarray(X, float)) for X in K)
+    return _SOLVED.get(arrays, bool(discrete), lambda: _split(lam, Bm, Cm, K, discrete))
+
+
+def _split(lam, Bm, Cm, K, discrete) -> _Solved | None:
     lam = np.asarray(lam, complex)
     Bm, Cm = np.asarray(Bm, complex), np.asarray(Cm, complex)
     Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(X, float)) for X in K)
@@ -124,9 +155,10 @@ def modal_loop_poles(lam, Bm, Cm, K, *, discrete: bool = False) -> np.ndarray | 
     if boundary is None or not _certified(boundary, part, lamT, b[weak] * c[weak]):
         return None
     p_strong = part.refine(lamT, BT, CT, tol)
-    p_weak = _weak_poles(lam, Bm, Cm, weak, (Ak, Bk, Ck, Dk), tol)
-    if p_strong is None or p_weak is None:
+    found = _weak_poles(lam, Bm, Cm, weak, (Ak, Bk, Ck, Dk), tol)
+    if p_strong is None or found is None:
         return None
+    p_weak, groups, p_groups = found
     poles = np.concatenate([p_strong, p_weak])
     trace = lam.sum() - np.einsum("im,mp,pi->", Bm, Dk, Cm) + np.trace(Ak)
     if abs(poles.sum() - trace) > 1e3 * _EPS * float(np.abs(poles).sum()):
@@ -135,7 +167,7 @@ def modal_loop_poles(lam, Bm, Cm, K, *, discrete: bool = False) -> np.ndarray | 
     if np.count_nonzero(beyond(p_strong)) != np.count_nonzero(beyond(part.mu)) \
             or np.any(beyond(p_weak)):
         return None
-    return poles
+    return _Solved(poles, part, p_strong, strong, groups, p_groups)
 
 
 def _K_at(K, p):
@@ -276,7 +308,8 @@ def _clusters(p, tol):
 
 def _weak_poles(lam, Bm, Cm, weak, K, tol):
     """Each weak mode's (or cluster's) pole from ``p ∈ spec(Λ_c − B_c Q(p) C_c)``,
-    ``Q = (I + K G_rest)⁻¹ K`` with the rest of the plant; ``None`` if it does not settle."""
+    ``Q = (I + K G_rest)⁻¹ K`` with the rest of the plant: (the poles in the order of
+    ``weak``, the clusters' plant modes, their poles); ``None`` if it does not settle."""
     groups = _clusters(lam[weak], tol)
     groups = [weak[g] for g in groups]
     out = np.empty(weak.size, complex)
@@ -309,7 +342,7 @@ def _weak_poles(lam, Bm, Cm, weak, K, tol):
     for g, idx in enumerate(groups):
         for i, v in zip(idx, p[g]):
             out[pos[int(i)]] = v
-    return out
+    return out, groups, p
 
 
 class _Boundary:
@@ -420,3 +453,245 @@ def _bands_ok(lo, hi, boundary, mu, terms, heads, dq, lamT, aT):
                     q = np.minimum(q, head + (terms[N][None, :] / dR).sum(axis=1) / smin ** N)
         ok[sl] = np.nan_to_num(g * (q + dq), nan=np.inf) < 0.5
     return ok
+
+
+def modal_loop_response(lam, Bm, Cm, K, E, Z, d: np.ndarray, h: float) -> np.ndarray | None:
+    """The sampled response, from rest, of a continuous loop closed around a plant in modal
+    form, without ``expm`` of the loop, or ``None`` where it is not certified.
+
+    The loop: plant ``ẋ = diag(λ) x + B_m u``, ``y = C_m x``; controller ``ẋ_K = A_K x_K +
+    B_K y + E_x d``, ``u = −(C_K x_K + D_K y) + E_u d``; outputs ``[y, F x_K + G y]``; the
+    disturbances ``d`` held over each step of ``h`` (a zero-order hold, as
+    :func:`ambseal.lti.discrete.zoh` of the loop). The loop is split along its invariant
+    subspaces as :func:`modal_loop_poles` splits its poles:
+
+    * each **weak** pole (or cluster of nearly equal ones — the repeated modes of a system
+      symmetric in two planes) by its spectral projector ``V (WᵀV)⁻¹ Wᵀ``: exact right and
+      left eigenvectors of the loop from its Schur complement ``Λ_c − B_c Q(p) C_c``, the
+      eliminated components included in ``WᵀV``; these poles are far from one another
+      relative to their coupling, so the projectors are well conditioned;
+    * the **strong** part as one small matrix on its invariant subspace,
+      ``M_S = A_SS + E_S Y`` (``A_SS`` the strong modes and the controller closed without
+      the weak modes, ``Y`` the weak modes' share of that subspace seen at ``y``, from the
+      strong poles' eigenvectors of the small loop ``S(p)``), stepped exactly by the
+      ``expm`` of that small matrix — not diagonalised: nearly defective pairs there (two
+      planes split by a small cross-coupling) lose digits in per-pole residues; its input
+      is the disturbance minus the weak projectors' part.
+
+    Certificate: the split's transfer function equals the loop's own (from ``G(s)`` and
+    ``K(s)``) at probe points on the imaginary axis (the strong poles' frequencies and a
+    grid over the plant's band) within 1e-9 of the largest value there, and ``M_S``'s
+    eigenvalues and the weak poles are :func:`modal_loop_poles`'s.
+
+    Parameters
+    ----------
+    lam, Bm, Cm : numpy.ndarray of complex
+        The plant's modal form, shapes (n,), (n, m), (p, n) (a real plant: conjugate
+        pairs), no feedthrough.
+    K : (A_K, B_K, C_K, D_K)
+        Continuous controller, ``n_K`` states, ``p`` inputs → ``m`` outputs.
+    E : (E_x, E_u)
+        Where the disturbances enter: shapes (n_K, m_d) and (m, m_d).
+    Z : (F, G)
+        The outputs after ``y``: shapes (q, n_K) and (q, p).
+    d : numpy.ndarray, shape (N, m_d)
+        The disturbance samples.
+    h : float
+        The step (s).
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, p + q), or None
+        ``[y, F x_K + G y]`` at ``t = k h``, ``k = 0 … N − 1`` (before ``d_k`` acts).
+    """
+    solved = _solve(lam, Bm, Cm, K, False)
+    if solved is None:
+        return None
+    lam, Bm, Cm = (np.asarray(X, complex) for X in (lam, Bm, Cm))
+    Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(X, float)) for X in K)
+    Ak = Ak.reshape(Bk.shape[0], Bk.shape[0]) if Bk.size else np.zeros((0, 0))
+    loop = _Loop(lam, Bm, Cm, (Ak, Bk, Ck, Dk), *(np.atleast_2d(np.asarray(X, float))
+                                                   for X in (*E, *Z)))
+    weak = [loop.weak_group(idx, p, solved.strong)
+            for idx, p in zip(solved.groups, solved.p_groups)]
+    strong = loop.strong_block(solved)
+    if strong is None or any(x is None for x in weak):
+        return None
+    mu, out, inp, V1 = (np.concatenate([x[k] for x in weak]) for k in range(4))
+    M, C1 = strong
+    B1 = loop.input_block(solved.strong) - V1.T @ inp
+    scale = max(1.0, float(np.abs(solved.poles).max()))
+    found = np.concatenate([np.linalg.eigvals(M), mu])
+    near, _ = cKDTree(np.c_[solved.poles.real, solved.poles.imag]).query(
+        np.c_[found.real, found.imag])
+    if found.size != solved.poles.size or np.max(near) > 1e-9 * scale:
+        return None
+    if not loop.certified((M, C1, B1), (mu, out, inp), solved):
+        return None
+    return _held(M, C1, B1, d, h) + _stepped(mu, out, inp, d, h)
+
+
+class _Loop:
+    """The loop of :func:`modal_loop_response` and the parts of its split."""
+
+    def __init__(self, lam, Bm, Cm, K, Ex, Eu, F, G):
+        self.lam, self.Bm, self.Cm, self.K = lam, Bm, Cm, K
+        self.Ex, self.Eu, self.F, self.G = Ex, Eu, F, G
+        self.W = (Cm.T[:, :, None] * Bm[:, None, :]).reshape(lam.size, -1)
+
+    def _sums(self, p, skip):
+        """``Σ c bᵀ/(p − λ)`` and ``Σ c bᵀ/(p − λ)²`` over the modes not in ``skip``."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = 1.0 / (p - self.lam)
+        r[skip] = 0.0
+        shape = (self.Cm.shape[0], self.Bm.shape[1])
+        return (r @ self.W).reshape(shape), ((r * r) @ self.W).reshape(shape)
+
+    def _controller(self, p):
+        """``(pI − A_K)⁻¹ B_K``, ``(pI − A_K)⁻¹ E_x`` and ``K(p)``."""
+        Ak, Bk, Ck, Dk = self.K
+        if not Ak.size:
+            return (np.zeros((0, Bk.shape[1])), np.zeros((0, self.Ex.shape[1])),
+                    Dk.astype(complex))
+        R = np.linalg.solve(p * np.eye(Ak.shape[0]) - Ak, np.hstack([Bk, self.Ex]))
+        RB, RE = R[:, :Bk.shape[1]], R[:, Bk.shape[1]:]
+        return RB, RE, Ck @ RB + Dk
+
+    def weak_group(self, idx, p_group, strong):
+        """A weak cluster (plant modes ``idx``): its poles, ``C V`` and ``(WᵀV)⁻¹ WᵀB``
+        (rows, one per pole), and its right eigenvectors' components on the strong part
+        (the strong modes, then the controller; rows)."""
+        p = complex(np.mean(p_group))
+        Gr, G2 = self._sums(p, idx)
+        RB, RE, Kp = self._controller(p)
+        Ak, Bk, Ck, Dk = self.K
+        Be, Ce = self.Bm[idx], self.Cm[:, idx]
+        M = np.linalg.inv(np.eye(Gr.shape[0]) + Gr @ Kp)  # y = M C_E ξ
+        P = np.diag(self.lam[idx]) - Be @ Kp @ M @ Ce
+        if idx.size == 1:
+            mu, vr, eta = P[0], np.ones((1, 1)), np.ones((1, 1))
+        else:
+            mu, vl, vr = scipy.linalg.eig(P, left=True, right=True)
+            eta = vl.conj()  # ηᵀ P = μ ηᵀ
+        y = M @ Ce @ vr
+        u = -Kp @ y
+        xk = RB @ y
+        nu_l = np.linalg.solve((np.eye(Kp.shape[0]) + Kp @ Gr).T, Be.T @ eta)
+        zeta = -Kp.T @ nu_l
+        wk = -np.linalg.solve((p * np.eye(Ak.shape[0]) - Ak).T, Ck.T @ nu_l) if Ak.size \
+            else np.zeros((0, mu.size))
+        WV = eta.T @ vr + zeta.T @ G2 @ u + wk.T @ xk
+        if np.linalg.cond(WV) > 1e8:
+            return None
+        WB = nu_l.T @ self.Eu + wk.T @ self.Ex
+        out = np.vstack([y, self.F @ xk + self.G @ y]).T
+        xs = (self.Bm[strong] @ u) / (p - self.lam[strong])[:, None]
+        return mu, out, np.linalg.solve(WV, WB), np.vstack([xs, xk]).T
+
+    def strong_block(self, solved):
+        """``(M_S, C_S)``: the strong part's matrix on its invariant subspace (the strong
+        modes, then the controller) and its outputs there; ``None`` if its eigenvectors
+        do not span it well."""
+        part, strong = solved.part, solved.strong
+        ns = part.lam.size
+        Q = np.empty((part.mu.size,) * 2, complex)
+        Yq = np.empty((self.Cm.shape[0], part.mu.size), complex)
+        k = 0
+        Ak, Bk, Ck, Dk = self.K
+        for g in _clusters(solved.p_strong, _cluster_tol(solved)):
+            p = complex(np.mean(solved.p_strong[g]))
+            GT, _ = self._sums(p, strong)  # the weak modes' transfer at p
+            # balanced first, as the strong part's own eigendecomposition
+            Sb, (sc, _) = scipy.linalg.matrix_balance(part.state_matrix(GT), permute=False,
+                                                      separate=True)
+            ev, vr = scipy.linalg.eig(Sb)
+            q = sc[:, None] * vr[:, np.argsort(np.abs(ev - p))[:g.size]]
+            xk = q[ns:]
+            Fy = np.linalg.inv(np.eye(GT.shape[0]) + GT @ Dk)
+            y = Fy @ (part.Cm @ q[:ns] - GT @ Ck @ xk)
+            Q[:, k:k + g.size], Yq[:, k:k + g.size] = q, y - part.Cm @ q[:ns]
+            k += g.size
+        # conditioned as scaled: the rows mix modal and controller coordinates
+        Qs = Q / np.abs(Q).max(axis=1, keepdims=True)
+        if k != Q.shape[0] or np.linalg.cond(Qs / np.linalg.norm(Qs, axis=0)) > 1e8:
+            return None
+        Y = np.linalg.solve(Q.T, Yq.T).T  # the weak modes at y, per strong coordinate
+        Es = np.vstack([-part.Bm @ Dk, Bk])
+        M = part.state_matrix(np.zeros_like(Y @ Es)) + Es @ Y
+        Cy = np.hstack([part.Cm, np.zeros((part.Cm.shape[0], Ak.shape[0]))]) + Y
+        Fx = np.hstack([np.zeros((self.F.shape[0], ns)), self.F])
+        return M, np.vstack([Cy, self.G @ Cy + Fx])
+
+    def input_block(self, strong):
+        """The disturbances' input to the strong modes and the controller."""
+        return np.vstack([self.Bm[strong] @ self.Eu, self.Ex])
+
+    def transfer(self, s):
+        """The loop's transfer ``d → [y, F x_K + G y]`` at ``s`` from ``G(s)``, ``K(s)``."""
+        Gs, _ = self._sums(s, np.zeros(0, int))
+        RB, RE, Ks = self._controller(s)
+        Kd = self.Eu - self.K[2] @ RE
+        y = np.linalg.solve(np.eye(Gs.shape[0]) + Gs @ Ks, Gs @ Kd)
+        return np.vstack([y, self.F @ (RB @ y + RE) + self.G @ y])
+
+    def certified(self, block, weak, solved) -> bool:
+        """Whether the split's transfer is the loop's at the probes (module docstring)."""
+        M, C1, B1 = block
+        mu, out, inp = weak
+        ps = solved.p_strong
+        lo, hi = np.abs(self.lam).min(), np.abs(self.lam).max()
+        probes = 1j * np.concatenate([np.sort(np.abs(ps.imag[ps.imag > 0]))[:8],
+                                      np.geomspace(max(lo, 1e-3), hi, 8)])
+        eye = np.eye(M.shape[0])
+        T = np.array([self.transfer(s) for s in probes])
+        R = np.array([C1 @ np.linalg.solve(s * eye - M, B1) + (out.T / (s - mu)) @ inp
+                      for s in probes])
+        return bool(np.max(np.abs(R - T)) <= 1e-9 * np.max(np.abs(T)))
+
+
+def _cluster_tol(solved):
+    return 4 * _EPS * max(1.0, float(np.abs(solved.poles).max()), solved.part.norm)
+
+
+def _held(M, C, B, d, h):
+    """``Re C z_k`` of ``ż = M z + B d`` with ``d`` held over each step ``h``, from rest:
+    the exact hold of the small matrix (``expm`` of ``[[M, B], [0, 0]] h``, balanced)."""
+    q, md = B.shape
+    aug = np.zeros((q + md, q + md), complex)
+    aug[:q, :q], aug[:q, q:] = M * h, B * h
+    ab, (sc, _) = scipy.linalg.matrix_balance(aug, permute=False, separate=True)
+    Ed = sc[:, None] * scipy.linalg.expm(ab) / sc[None, :]
+    A1, G1 = Ed[:q, :q], Ed[:q, q:]
+    drive = d @ G1.T
+    Y = np.empty((d.shape[0], C.shape[0]))
+    z = np.zeros(q, complex)
+    for k in range(d.shape[0]):
+        Y[k] = (C @ z).real
+        z = A1 @ z + drive[k]
+    return Y
+
+
+def _stepped(mu, out, inp, d, h, block: int = 256):
+    """``Re Σ_k out_k ξ_k`` at each step, ``ξ_{j+1} = e^{μh} ξ_j + φ(μ) inp d_j`` (the exact
+    hold of each pole's first-order part). A block of steps without disturbance is the
+    closed form ``ξ_{j+i} = e^{μhi} ξ_j`` (one product for the block)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        phi = np.where(mu == 0, h, np.expm1(mu * h) / mu)
+    e = np.exp(mu * h)
+    with np.errstate(over="ignore", invalid="ignore"):
+        powers = e[None, :] ** np.arange(block)[:, None]  # (block, n_poles)
+    Y = np.empty((d.shape[0], out.shape[1]))
+    xi = np.zeros(mu.size, complex)
+    outT = np.ascontiguousarray(out.T)
+    with np.errstate(over="ignore", invalid="ignore"):
+        for k0 in range(0, d.shape[0], block):
+            dk = d[k0:k0 + block]
+            if not np.any(dk):
+                X = powers[:dk.shape[0]] * xi
+                Y[k0:k0 + dk.shape[0]] = (X @ out).real
+                xi = X[-1] * e
+                continue
+            for k, row in enumerate(dk, start=k0):
+                Y[k] = (outT @ xi).real
+                xi = e * xi + phi * (inp @ row)
+    return Y

@@ -31,6 +31,7 @@ from ambseal.lti import (
     STRUCTURED_STATES,
     feedback_matrices,
     feedback_poles,
+    feedback_response,
     freqresp_at,
     json_float,
     json_list,
@@ -78,10 +79,11 @@ class ClosedLoop:
         The names of ``system``'s inputs and outputs.
     _build : callable
         Makes ``system`` (no arguments); called once, when ``system`` is first read.
-    _sampled_from : tuple or None
-        ``(G, K)``, matrices of the continuous plant's control inputs and of the
-        controller, for a discrete loop on a large plant sampled by a zero-order hold
-        (:meth:`modal_response`); else None.
+    _modal_from : tuple or None
+        ``(G, K, lag)`` for a loop on a large plant: matrices of the continuous plant's
+        control inputs, of the controller, and of the lag in front of the plant (None:
+        none, or a discrete loop on the plant sampled by a zero-order hold); the loop's
+        time response then comes from the plant's modal form (:meth:`modal_response`).
 
     ``system`` is built when first asked for: a loop on a large plant sampled by
     :func:`judged_loop` has its poles and its time response (:meth:`modal_response`)
@@ -99,35 +101,41 @@ class ClosedLoop:
     dt: float = 0.0
     inputs: tuple = ()
     outputs: tuple = ()
-    _sampled_from: tuple | None = field(default=None, repr=False)
+    _modal_from: tuple | None = field(default=None, repr=False)
 
     @cached_property
     def system(self) -> Any:
         """The closed loop as a ``control.StateSpace`` (inputs, outputs and states above)."""
         return self._build()
 
-    def modal_response(self, d: np.ndarray) -> np.ndarray | None:
-        """The outputs (``y`` then ``i``) of a discrete loop on a large sampled plant for
-        the disturbances ``d`` added to the controller's outputs, from rest, stepped in the
-        continuous plant's certified modal form
-        (:func:`ambseal.lti.freqresp.sampled_modal_form`,
-        :func:`ambseal.lti.discrete.simulate_modal_loop`): the samples of
-        :func:`ambseal.lti.discrete.simulate_lti` on ``system`` without forming it.
+    def modal_response(self, d: np.ndarray, h: float) -> np.ndarray | None:
+        """The outputs (``y`` then ``i``) of a loop on a large plant for the disturbances
+        ``d`` added to the controller's outputs, held over steps of ``h``, from rest,
+        without forming ``system``: a discrete loop stepped in the continuous plant's
+        certified sampled modal form (:func:`ambseal.lti.freqresp.sampled_modal_form`,
+        :func:`ambseal.lti.discrete.simulate_modal_loop`), a continuous one from its split
+        along the plant's modal form (:func:`ambseal.lti.interconnect.feedback_response`).
+        The samples of :func:`ambseal.lti.discrete.simulate_lti` on ``system`` (sampled
+        by :func:`ambseal.lti.discrete.zoh` if continuous).
 
         Parameters
         ----------
         d : numpy.ndarray, shape (N, n_plant_inputs)
-            Disturbances (A), one row per sample.
+            Disturbances (A), one row per step.
+        h : float
+            The step (s); a discrete loop's own sample time.
 
         Returns
         -------
         numpy.ndarray, shape (N, n_plant_outputs + n_plant_inputs), or None
-            ``None`` for any other loop, or where the modal form is not certified: take
+            ``None`` for any other loop, or where the modal path is not certified: take
             ``system`` then.
         """
-        if self._sampled_from is None:
+        if self._modal_from is None:
             return None
-        G, K = self._sampled_from
+        G, K, lag = self._modal_from
+        if not self.dt:
+            return feedback_response(G, K, d, h, lag=lag)
         form = sampled_modal_form(*G, self.dt)
         return None if form is None else simulate_modal_loop(*form, K, d)
 
@@ -252,19 +260,22 @@ def _closed(G, K, Gf, atol, source) -> ClosedLoop:
     form then gives the poles (:func:`ambseal.lti.interconnect.feedback_poles`)."""
     (A, B, C, D), mk, sys, Acl = _loop_system(G, K, Gf, atol)
     dt = sample_time(G)
+    names = (tuple(sys.input_labels), tuple(sys.output_labels))
     if source is None:
         poles = feedback_poles((A, B, C, D), mk, dt=dt, state_matrix=Acl)
-    else:
-        poles = feedback_poles(ss_matrices(source[0]), mk, dt=dt, state_matrix=Acl,
-                               lag=source[1])
-    return _loop(lambda: sys, poles, dt, B.shape[1], C.shape[0],
-                 (tuple(sys.input_labels), tuple(sys.output_labels)))
+        return _loop(lambda: sys, poles, dt, B.shape[1], C.shape[0], names)
+    G0 = ss_matrices(source[0])
+    poles = feedback_poles(G0, mk, dt=dt, state_matrix=Acl, lag=source[1])
+    return _loop(lambda: sys, poles, dt, B.shape[1], C.shape[0], names, (G0, mk, source[1]))
 
 
-def _loop(build, poles, dt, nu, ny, names, sampled_from=None) -> ClosedLoop:
+def _loop(build, poles, dt, nu, ny, names, modal_from=None) -> ClosedLoop:
     poles = poles[np.argsort(-np.abs(poles) if dt else -poles.real, kind="stable")]
+    G = modal_from[0] if modal_from else None
+    if G is not None and (G[0].shape[0] < STRUCTURED_STATES or np.any(G[3])):
+        modal_from = None  # the modal paths take large plants without feedthrough
     return ClosedLoop(build, poles, decay_rate(poles, dt), is_stable(poles, dt), nu, ny,
-                      len(names[0]) - nu, dt, *names, sampled_from)
+                      len(names[0]) - nu, dt, *names, modal_from)
 
 
 def _names(G, Gf, nu, ny, nf) -> tuple[list, list]:
@@ -326,10 +337,8 @@ def _sampled_loop(P, K, cur, rest, dt) -> ClosedLoop:
         Pj = sampled_plant(P, dt, cur)
         return _loop_system(_select(Pj, cur), K, _select(Pj, rest) if rest else None, 0.0)[2]
 
-    structured = mg[0].shape[0] >= STRUCTURED_STATES and not np.any(mg[3])
     names = _names(G0, _select(P, rest) if rest else None, nu, ny, len(rest))
-    return _loop(build, poles, dt, nu, ny, tuple(map(tuple, names)),
-                 (mg, mk) if structured else None)
+    return _loop(build, poles, dt, nu, ny, tuple(map(tuple, names)), (mg, mk, None))
 
 
 @dataclass(frozen=True, eq=False)

@@ -1,6 +1,6 @@
-"""The discrete loop on a large plant (the embedded rig at 100 beam elements, 848 states)
-judged without sampling the plant: the sampled plant's response, the loop's poles and its
-impulse response from the continuous plant's modal form
+"""Loops on a large plant (the embedded rig at 100 beam elements, 848 states) judged from
+the plant's modal form, without ``expm`` of the plant or of the loop. The discrete loop:
+the sampled plant's response, the loop's poles and its impulse response
 (:func:`ambseal.lti.freqresp.sampled_modal_form`), against independent references — the
 plant sampled by SciPy's ``cont2discrete`` (zero-order hold, Franklin, Powell & Workman,
 *Digital Control of Dynamic Systems*, 3rd ed., §6.3) with dense solves, and the dense
@@ -8,8 +8,11 @@ closed loop of that sampled plant stepped by :func:`ambseal.lti.discrete.simulat
 The references sample the plant diagonally balanced first (``scipy.linalg.matrix_balance``,
 the same transfer function): the FE plant's entries span 1 to 1e9, and ``expm`` of the
 unbalanced matrix loses up to 7 digits (an impulse response off by 20 % of its peak).
-``expm`` is made to fail while the structured path runs, so these tests also prove that
-the plant is never sampled there."""
+The continuous loop with the delay lag: its impulse response from its split along the
+plant's modal form (:func:`ambseal.lti.modal_loop.modal_loop_response`) against the dense
+loop sampled by :func:`ambseal.lti.discrete.zoh`. ``expm`` of anything plant-sized is made
+to fail while the structured paths run, so these tests also prove that no dense
+``expm`` is taken there."""
 
 from __future__ import annotations
 
@@ -20,11 +23,22 @@ import scipy.linalg
 from scipy.signal import cont2discrete
 
 import ambseal.lti.freqresp as fr
+import ambseal.lti.modal_loop as ml
 from ambseal.analysis.response import impulse_response_of
 from ambseal.config import load_rig
-from ambseal.lti import STRUCTURED_STATES, sampled_response_at
-from ambseal.machine.loop import closed_loop, judged_loop
+from ambseal.lti import (
+    STRUCTURED_STATES,
+    feedback_matrices,
+    feedback_response,
+    sampled_response_at,
+    simulate_lti,
+    ss_matrices,
+    wired,
+    zoh,
+)
+from ambseal.machine.loop import closed_loop, delayed_plant, judged_loop
 from ambseal.model.rig import build_plant
+from ambseal.robust.delay import loop_delay
 
 from ..finemesh import fine_rig_text
 
@@ -38,12 +52,22 @@ def fine_plant(tmp_path_factory):
     plant = build_plant(cfg, force_positions=(cfg.amb[0].position,))
     P = plant.to_statespace()
     assert P.nstates >= STRUCTURED_STATES
-    return P, list(plant.current_inputs()), 1.0 / cfg.controller.sample_rate_hz
+    return P, list(plant.current_inputs()), 1.0 / cfg.controller.sample_rate_hz, cfg
 
 
 def _refuse(*args, **kwargs):
     """In place of ``expm``: a path that samples the plant fails."""
     raise AssertionError("the plant was sampled (expm called)")
+
+
+_expm = scipy.linalg.expm
+
+
+def _small_expm(M, *args, **kwargs):
+    """``expm`` of small matrices only (a controller-sized block); plant-sized ones fail."""
+    if np.shape(M)[0] >= 200:
+        raise AssertionError(f"expm of a {np.shape(M)[0]}-state matrix")
+    return _expm(M, *args, **kwargs)
 
 
 def _mats(S, inputs=None):
@@ -73,7 +97,7 @@ def test_sampled_response_from_the_modal_form_equals_the_sampled_plant(fine_plan
     """``G_d(e^{jωT})`` of the plant's current inputs on a grid from 1 Hz to Nyquist, with
     ``expm`` refused: within 1e-6 of the largest entry at each frequency of dense solves
     of the plant sampled by SciPy (the check the modal form passes is at rtol 1e-6)."""
-    P, cur, T = fine_plant
+    P, cur, T, _ = fine_plant
     G = _mats(P, cur)
     w = 2 * np.pi * np.logspace(0, np.log10(0.999 / (2 * T)), 60)
     with monkeypatch.context() as m:
@@ -88,7 +112,7 @@ def test_a_wrong_modal_form_is_not_certified(fine_plant, monkeypatch):
     """Modal input rows off by 1e-4 (relative) fail the check against the dense probes:
     ``sampled_modal_form`` gives None, and the response is still the sampled plant's (the
     dense path, ``expm`` allowed)."""
-    P, cur, T = fine_plant
+    P, cur, T, _ = fine_plant
     G = _mats(P, cur)
     forms = fr._modal_forms
 
@@ -112,14 +136,14 @@ def test_judged_discrete_loop_on_a_large_plant_equals_the_dense_loop(fine_plant,
     the dense loop of the plant sampled by SciPy, the same names, and an impulse response
     (a current pulse of 10 samples on the first and last axes) within 1e-8 of the dense
     loop's peak at every sample, its peak and settling time equal to 1e-8."""
-    P, cur, T = fine_plant
+    P, cur, T, _ = fine_plant
     Kd = testrig_digital["hinf"].statespace(delayed=True)
     assert abs(float(Kd.dt) - T) < 1e-15
     with monkeypatch.context() as m:
         m.setattr(scipy.linalg, "expm", _refuse)
         judged = judged_loop(P, Kd, cur)
         loop = judged.loop
-        assert loop._sampled_from is not None
+        assert loop._modal_from is not None
         args = dict(channels=(loop.inputs[0][2:], loop.inputs[len(cur) - 1][2:]),
                     amplitude_a=0.5, duration_s=10 * T, t_impulse_s=20 * T, t_end_s=0.2,
                     dt_s=T)
@@ -140,3 +164,80 @@ def test_judged_discrete_loop_on_a_large_plant_equals_the_dense_loop(fine_plant,
     # the dense system is still there when asked for: the loop of the sampled plant
     assert np.allclose(np.sort_complex(np.linalg.eigvals(loop.system.A)),
                        np.sort_complex(np.linalg.eigvals(dense.system.A)), rtol=0, atol=1e-9)
+
+
+def _impulse_args(loop, T, cur):
+    return dict(channels=(loop.inputs[0][2:], loop.inputs[len(cur) - 1][2:]),
+                amplitude_a=0.5, duration_s=10 * T, t_impulse_s=20 * T, t_end_s=0.2,
+                dt_s=T / 2)
+
+
+@pytest.mark.parametrize("method", ["pid", "hinf"])
+def test_judged_continuous_loop_on_a_large_plant_equals_the_dense_loop(fine_plant,
+                                                                       testrig_designs,
+                                                                       monkeypatch, method):
+    """The default mesh's PID (a feedthrough) and H∞ controllers on the 100-element plant
+    with the delay lag, judged as the run judges them: the impulse response from the
+    loop's split along the plant's modal form, ``expm`` of plant-sized matrices refused,
+    within 1e-7 of each channel's peak of the dense loop's (the delayed plant closed by
+    :func:`closed_loop`, sampled by ``zoh``; measured 1e-8), peak and settling time to
+    1e-7 relative."""
+    P, cur, T, cfg = fine_plant
+    K = testrig_designs[method].K
+    lag = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples).system
+    with monkeypatch.context() as m:
+        m.setattr(scipy.linalg, "expm", _small_expm)
+        loop = judged_loop(P, K, cur, delay=lag).loop
+        args = _impulse_args(loop, T, cur)
+        d = np.zeros((round(args["t_end_s"] / args["dt_s"]) + 1, len(cur)))
+        assert loop.modal_response(d, args["dt_s"]) is not None
+        fast = impulse_response_of(loop, **args)
+    rest = [j for j in range(P.ninputs) if j not in cur]
+    Pd = delayed_plant(P, cur, lag)
+    dense = closed_loop(Pd[:, cur], K, Pd[:, rest])
+    assert loop.stable and dense.stable
+    ref = impulse_response_of(dense, **args)
+    for got, want in ((fast.displacement_m, ref.displacement_m),
+                      (fast.current_a, ref.current_a)):
+        assert np.all(np.max(np.abs(got - want), axis=0)
+                      <= 1e-7 * np.max(np.abs(want), axis=0))
+    assert fast.peak_displacement_um == pytest.approx(ref.peak_displacement_um, rel=1e-7)
+    assert fast.settling_time_s == pytest.approx(ref.settling_time_s, rel=1e-7)
+
+
+def test_a_wrong_split_is_not_certified(fine_plant, testrig_designs, monkeypatch):
+    """The strong part's matrix off by 1e-6 (relative) in one entry: its transfer misses
+    the loop's at the probes, and the modal response is refused (None), not returned."""
+    P, cur, T, cfg = fine_plant
+    lag = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples).system
+    loop = judged_loop(P, testrig_designs["hinf"].K, cur, delay=lag).loop
+    d = np.zeros((50, len(cur)))
+    d[5:10, 0] = 1.0
+    assert loop.modal_response(d, T / 2) is not None
+    block = ml._Loop.strong_block
+
+    def spoiled(self, solved):
+        M, C1 = block(self, solved)
+        M = M.copy()
+        M[0, 0] *= 1 + 1e-6
+        return M, C1
+
+    monkeypatch.setattr(ml._Loop, "strong_block", spoiled)
+    assert loop.modal_response(d, T / 2) is None
+
+
+def test_continuous_loop_without_lag_equals_the_dense_loop(fine_plant, testrig_designs):
+    """``feedback_response`` without a lag (the disturbance added to the controller's
+    output straight at the plant): the μ controller on the 100-element plant, a pulse on
+    two axes, within 1e-7 of each channel's peak of the dense loop sampled by ``zoh``."""
+    P, cur, T, _ = fine_plant
+    G = _mats(P, cur)
+    K = ss_matrices(wired(P[:, cur], testrig_designs["mu"].K))
+    d = np.zeros((2001, len(cur)))
+    d[40:60, 0], d[40:60, -1] = 0.5, -0.3
+    fast = feedback_response(G, K, d, T / 2)
+    assert fast is not None
+    A, B, C, _ = feedback_matrices(G, K)
+    Ad, Bd = zoh(A, B, T / 2, keep=False)
+    (ref,) = simulate_lti(Ad, Bd, [C], d)
+    assert np.all(np.max(np.abs(fast - ref), axis=0) <= 1e-7 * np.max(np.abs(ref), axis=0))

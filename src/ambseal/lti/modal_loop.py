@@ -71,10 +71,16 @@ _EPS = float(np.finfo(float).eps)
 #: is not taken.
 _MAX_STRONG_FRACTION = 0.5
 _MAX_ITER = 30
-#: The split of the last loops (:class:`_Solved`): a loop's poles and its time response
-#: share one.
-_SOLVED = ArrayMemo(keep=16)
-_BISECTIONS = 14
+#: The split of the last loops (:class:`_Solved`, no n × n array: 0.6 MB at 1 888
+#: states): a loop's poles and its time response share one, also when the design's check
+#: of a loop comes many loops before its judgement (as many as the loops' poles kept).
+_SOLVED = ArrayMemo(keep=64)
+#: Initial bands of the certificate's curve (per side of the line; the circle has twice
+#: as many), each bisected up to ``_BISECTIONS`` times where its bound is too coarse: the
+#: finest band is 1/2¹⁷ of a first one. Few first bands, since on the loops of fine FE
+#: meshes every first band is proved at once.
+_BANDS = 256
+_BISECTIONS = 17
 
 
 def modal_loop_poles(lam, Bm, Cm, K, *, discrete: bool = False) -> np.ndarray | None:
@@ -376,11 +382,11 @@ class _Boundary:
         """The initial bands (lo, hi) of the parameter, and the curve's ends outside them
         (rays of the line; none for the circle)."""
         if self.discrete:
-            edges = np.linspace(-np.pi, np.pi, 4097)
+            edges = np.linspace(-np.pi, np.pi, 2 * _BANDS + 1)
             return edges[:-1], edges[1:], None
         top = 10.0 * float(np.abs(points).max(initial=1.0))
         low = max(1e-3, 1e-3 * float(np.abs(points).min(initial=1.0)))
-        pos = np.concatenate([[0.0], np.geomspace(low, top, 2048)])
+        pos = np.concatenate([[0.0], np.geomspace(low, top, _BANDS)])
         edges = np.concatenate([-pos[:0:-1], pos])
         return edges[:-1], edges[1:], (np.array([edges[-1], -np.inf]), np.array([np.inf, edges[0]]))
 

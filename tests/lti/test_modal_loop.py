@@ -94,7 +94,7 @@ def test_sampled_loop_poles_equal_the_dense_eigenvalues(plant, testrig_digital):
     assert _matched_error(poles, ref) < 1e-5
 
 
-@pytest.mark.parametrize("method", ["hinf", "mu"])
+@pytest.mark.parametrize("method", ["hinf", pytest.param("mu", marks=pytest.mark.slow)])
 def test_poles_solve_the_characteristic_equation(plant, testrig_designs, method):
     """The eight poles where the modal and the dense eigenvalues differ most, refined by
     Newton's method on ``det(I + K(s) G(s))`` with ``G(s)`` by dense LU solves of the

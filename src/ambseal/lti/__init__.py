@@ -22,7 +22,8 @@ The lowest numerical layer (it imports only :mod:`ambseal.errors`); each idea on
   right and left eigenvectors (shift-invert Arnoldi; a modal reduction's input);
 * :func:`picklable` — ``control.StateSpace`` through :mod:`pickle` (Dask workers);
 * what every layer shares beneath them: :func:`ss_matrices`, :func:`as_omega`,
-  :func:`labels` (checked matrices, grids and signal names), :func:`state_poles`,
+  :func:`labels` (checked matrices, grids and signal names), :class:`ArrayMemo` (results
+  of expensive functions of large arrays, kept by their digest), :func:`state_poles`,
   :func:`series_inputs`, :func:`sampled_response_at`, :func:`cached_njit` (numba's cached
   compilation), :data:`DENSE_STATES`, :data:`STRUCTURED_STATES`, and the JSON conventions of every result
   (:func:`json_float`, :func:`json_list`, :func:`finite_or_none`,
@@ -53,11 +54,11 @@ from ambseal.lti.interconnect import (
 )
 from ambseal.lti.json_safe import finite_or_none, finite_or_none_tree, json_float, json_list
 from ambseal.lti.lowest import DENSE_STATES, lowest_eigenpairs
-from ambseal.lti.matrices import as_omega, labels, ss_matrices
+from ambseal.lti.matrices import ArrayMemo, as_omega, labels, ss_matrices
 from ambseal.lti.pickling import picklable
 from ambseal.lti.tables import interp_table
 
-__all__ = ["DENSE_STATES", "STRUCTURED_STATES", "as_omega", "cached_njit", "discretize",
+__all__ = ["ArrayMemo", "DENSE_STATES", "STRUCTURED_STATES", "as_omega", "cached_njit", "discretize",
            "feedback_matrices", "feedback_poles", "feedback_response", "finite_or_none",
            "finite_or_none_tree", "freqresp_at", "interp_table", "json_float", "json_list",
            "labels", "lft_lower", "lft_lower_matrices", "lowest_eigenpairs", "picklable",

@@ -76,7 +76,10 @@ _PROBED = ArrayMemo(keep=64)  # C (sI − A)⁻¹ B + D at single probes s of la
 #: [q; q̇] form (spread 3e10 on a 336-state plant), whose own modal form fails its check
 #: and ends in the balanced one anyway, after an eigendecomposition for nothing.
 _SPREAD_BALANCED_FIRST = 1e6
-_HESSENBERG = ArrayMemo()  # balanced upper-Hessenberg form of the last large (A, B, C)
+#: (H, Q, balancing) of the last large ``A`` (:func:`_hessenberg_form`): the plant's grid and
+#: probe responses, whatever its inputs and outputs, share one reduction (two n² matrices:
+#: 57 MB at 1 888 states)
+_HESSENBERG = ArrayMemo(keep=2)
 
 
 def freqresp(
@@ -494,11 +497,10 @@ def _balanced_modal_as_good(A, B, C, D, s, probe, Hd, max_cond) -> np.ndarray | 
 
 def _probe_response(A, B, C, D, probe, form: str = "dense") -> np.ndarray:
     """``C (sI − A)⁻¹ B + D`` at the probe points by dense solves (:func:`_dense_response`)
-    or by the Hessenberg form (``form="hessenberg"``, the form itself not kept), each point
+    or by the Hessenberg form (``form="hessenberg"``), each point
     kept for the last large systems (:data:`_PROBED`): the grids of one plant's responses
     share their probes (:func:`_probes`)."""
-    solve = _dense_response if form == "dense" else \
-        (lambda *m: _hessenberg_response(*m, keep=False))
+    solve = _dense_response if form == "dense" else _hessenberg_response
     computed: list = []
 
     def at(k):  # a miss computes every probe at once (one Hessenberg form, not three)
@@ -507,29 +509,74 @@ def _probe_response(A, B, C, D, probe, form: str = "dense") -> np.ndarray:
         return computed[0][k]
 
     out = np.empty((probe.size, C.shape[0], B.shape[1]), dtype=complex)
+    digest = _PROBED.digest((A, B, C, D))
     for k, p in enumerate(probe):
-        out[k] = _PROBED.get((A, B, C, D), (form, complex(p)), lambda k=k: at(k))
+        out[k] = _PROBED.get_digested(digest, (form, complex(p)), lambda k=k: at(k))
     return out
 
 
 def _dense_response(A, B, C, D, s) -> np.ndarray:
-    """``C (sI − A)⁻¹ B + D`` by one LU solve per point (stacked); ``nan`` where singular."""
-    n = A.shape[0]
+    """``C (sI − A)⁻¹ B + D`` by one LU solve per point (stacked); ``nan`` where singular.
+
+    Rows of ``A`` that only say ``ẋ_i = x_j`` (one entry, 1, off the diagonal; no input) —
+    the ``q̇ = v`` half of a second-order model's ``[q; v]`` form — are eliminated first
+    (:func:`_kinematic_rows`): ``s x_i = x_j`` puts ``x_j = s x_i`` into the other rows,
+    which leaves one complex LU of ``n − k`` unknowns per point instead of ``n`` (the
+    second-order form ``(s²M + sD + K) q = f`` after ``M⁻¹``; at 1 888 states, 940 such
+    rows: 1/8 of the LU's work and 1/4 of its memory)."""
+    I, J = _kinematic_rows(A, B)
+    n, k = A.shape[0], I.size
+    E = np.setdiff1d(np.arange(n), I)  # the equations kept
+    R = np.setdiff1d(E, J)  # the unknowns kept besides x_I
+    pos = np.empty(n, dtype=int)
+    pos[E] = np.arange(E.size)
+    A_EI, A_EJ, A_ER = (A[np.ix_(E, X)] for X in (I, J, R))
+    Bc = B[E].astype(complex)
+    rows_J, rows_R = pos[J], pos[R]
     out = np.empty((s.size, C.shape[0], B.shape[1]), dtype=complex)
-    step = max(1, _CHUNK_BYTES // (16 * n * n))
-    eye, Bc = np.eye(n), B.astype(complex)
+    step = max(1, _CHUNK_BYTES // (16 * E.size * E.size))
     with np.errstate(all="ignore"):
         for i in range(0, s.size, step):
-            M = s[i:i + step, None, None] * eye - A
-            try:
-                out[i:i + step] = C @ np.linalg.solve(M, Bc) + D
-            except np.linalg.LinAlgError:  # a point on a pole: one at a time
-                for k, Mk in enumerate(M):
-                    try:
-                        out[i + k] = C @ np.linalg.solve(Mk, Bc) + D
-                    except np.linalg.LinAlgError:
-                        out[i + k] = np.nan
+            sk = s[i:i + step, None, None]
+            M = np.empty((sk.shape[0], E.size, E.size), dtype=complex)
+            M[:, :, :k] = -A_EI - sk * A_EJ
+            M[:, rows_J, np.arange(k)] += sk[:, :, 0] ** 2
+            M[:, :, k:] = -A_ER
+            M[:, rows_R, k + np.arange(R.size)] += sk[:, :, 0]
+            for m, X in enumerate(_stacked_solve(M, Bc)):
+                xI = X[:k]
+                out[i + m] = (C[:, I] + s[i + m] * C[:, J]) @ xI + C[:, R] @ X[k:] + D
     return out
+
+
+def _stacked_solve(M: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """``M_k⁻¹ R`` for each ``k`` (one LAPACK call for the stack); ``nan`` where ``M_k`` is
+    singular (a point on a pole)."""
+    try:
+        return np.linalg.solve(M, R)
+    except np.linalg.LinAlgError:  # one at a time
+        X = np.full((M.shape[0], *R.shape), np.nan + 0j)
+        for k, Mk in enumerate(M):
+            try:
+                X[k] = np.linalg.solve(Mk, R)
+            except np.linalg.LinAlgError:
+                pass
+        return X
+
+
+def _kinematic_rows(A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(I, J)``: the rows ``i ∈ I`` of ``A`` whose only entry is ``A[i, j] = 1`` with
+    ``j ∉ I`` and ``B[i] = 0`` (``ẋ_i = x_j``), each ``j ∈ J`` once; empty where there are
+    none. O(n²)."""
+    nz = A != 0
+    cand = np.flatnonzero((nz.sum(axis=1) == 1) & ~np.any(B != 0, axis=1))
+    j = np.argmax(nz[cand], axis=1)
+    ok = A[cand, j] == 1.0
+    cand, j = cand[ok], j[ok]
+    _, first = np.unique(j, return_index=True)  # each x_j replaced once
+    cand, j = cand[first], j[first]
+    keep = ~np.isin(j, cand)
+    return cand[keep], j[keep]
 
 
 def modal_form(A: np.ndarray, B: np.ndarray, C: np.ndarray, *, max_cond: float = 1e8):
@@ -610,19 +657,19 @@ def _modal_eval(lam: np.ndarray, Bm: np.ndarray, Cm: np.ndarray, D: np.ndarray, 
 
 
 def _hessenberg_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray,
-                         s: np.ndarray, keep: bool = True) -> np.ndarray:
+                         s: np.ndarray) -> np.ndarray:
     """``C (sI − A)⁻¹ B + D`` via one Hessenberg reduction and O(n²) solves per s.
 
     ``A`` is balanced first (diagonal similarity, ``scipy.linalg.matrix_balance``; Parlett &
     Reinsch 1969): FE models in [q; q̇] form have entries from 1 to 1e12 and lose several
     digits without it. The orthogonal reduction to upper Hessenberg form (LAPACK
-    ``dgehrd``, as SLICOT ``TB05AD`` does it) is kept for the last large systems
-    (:class:`~ambseal.lti.matrices.ArrayMemo`) unless ``keep`` is False. The solves use ``TB05AD`` (job ``'NH'``)
+    ``dgehrd``, as SLICOT ``TB05AD`` does it) is kept for the last large ``A``
+    (:data:`_HESSENBERG`; any ``B``, ``C``). The solves use ``TB05AD`` (job ``'NH'``)
     through slycot when it is installed (Fortran loop, the routine python-control also
     uses), else the vectorised :func:`hessenberg_solve`.
     """
-    Hs, Bh, Ch = _HESSENBERG.get((A, B, C), None, lambda: _hessenberg_form(A, B, C)) \
-        if keep else _hessenberg_form(A, B, C)
+    Hs, Q, sc = _HESSENBERG.get((A,), None, lambda: _hessenberg_form(A))
+    Bh, Ch = Q.T @ (B / sc[:, None]), (C * sc[None, :]) @ Q
     if _USE_SLYCOT:
         try:
             return _slycot_response(Hs, Bh, Ch, D, s)
@@ -638,11 +685,12 @@ def _hessenberg_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndar
     return out
 
 
-def _hessenberg_form(A, B, C):
-    """``(H, QᵀB̃, C̃Q)`` with ``H = QᵀÃQ`` upper Hessenberg, ``Ã, B̃, C̃`` balanced."""
+def _hessenberg_form(A):
+    """``(H, Q, T)`` with ``H = Qᵀ T⁻¹AT Q`` upper Hessenberg, ``T = diag(sc)`` the balancing
+    (``B̃ = QᵀT⁻¹B``, ``C̃ = CTQ``)."""
     A, (sc, _) = scipy.linalg.matrix_balance(A, permute=False, separate=True)
-    Hs, Q = scipy.linalg.hessenberg(A, calc_q=True)
-    return Hs, Q.T @ (B / sc[:, None]), (C * sc[None, :]) @ Q
+    Hs, Q = scipy.linalg.hessenberg(A, calc_q=True, overwrite_a=True)
+    return Hs, Q, sc
 
 
 def _slycot_response(Hs: np.ndarray, Bh: np.ndarray, Ch: np.ndarray, D: np.ndarray, s: np.ndarray) -> np.ndarray:

@@ -57,7 +57,7 @@ from ambseal.analysis.spinup import frozen_sensitivity, spinup
 from ambseal.analysis.unbalance import unbalance_from_compliance
 from ambseal.design import RIGID_STATES, vertex_grid_hz
 from ambseal.design.lpv_plant import lpv_plant
-from ambseal.lti import finite_or_none, freqresp_at, json_float, wired
+from ambseal.lti import eigenvalues, finite_or_none, freqresp_at, json_float, wired
 from ambseal.machine import (
     SPEED,
     JudgedLoop,
@@ -380,7 +380,7 @@ def points_for(controller, points, design_cfg) -> list[OperatingPoint]:
     return [point(q, rpm) for rpm in speeds for q in sorted(pressures)]
 
 
-def unstable_open_loop_poles(A: np.ndarray) -> np.ndarray:
+def unstable_open_loop_poles(A: np.ndarray, C: np.ndarray | None = None) -> np.ndarray:
     """Eigenvalues of ``A`` with a positive real part, most unstable first (rad/s).
 
     Unstable and refused as doubtful by :func:`ambseal.model.modes.classify_poles`
@@ -390,6 +390,9 @@ def unstable_open_loop_poles(A: np.ndarray) -> np.ndarray:
     ----------
     A : numpy.ndarray, shape (n, n)
         An open-loop plant's state matrix.
+    C : numpy.ndarray, shape (p, n), optional
+        Its output matrix: a large plant's eigendecomposition is then kept for its
+        responses and loops (:func:`ambseal.lti.eigenvalues`).
 
     Returns
     -------
@@ -402,7 +405,7 @@ def unstable_open_loop_poles(A: np.ndarray) -> np.ndarray:
         The model's conditioning makes the stability doubtful.
     """
 
-    lam = np.linalg.eigvals(A)
+    lam = eigenvalues(A, C)
     lam = lam[classify_poles(lam, where="open-loop plant")[1]]
     return lam[np.argsort(-lam.real)]
 

@@ -356,7 +356,7 @@ def _model_stage(st: _RunState) -> _Model:
     st.stages.begin("model", "full order and modal reduction")
     full = build_plant(st.cfg)
     model = _Model(full.n_states, build_plant(st.cfg, reduced=True).n_states,
-                   unstable_open_loop_poles(full.A))
+                   unstable_open_loop_poles(full.A, full.C))
     st.stages.step()
     return model
 

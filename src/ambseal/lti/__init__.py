@@ -17,6 +17,8 @@ The lowest numerical layer (it imports only :mod:`ambseal.errors`); each idea on
   discrete recursion every time response runs through; :func:`sampled_modal_form` and
   :func:`simulate_modal_loop` — a large plant sampled from its modal form (no ``expm``),
   and a discrete loop stepped on it;
+* :func:`eigenvalues` — of a large system's state matrix, from the decomposition its
+  responses and loops share;
 * :func:`interp_table` — the one rule for tables against a parameter;
 * :func:`lowest_eigenpairs` — the eigenvalues of smallest |λ| of a large state matrix with
   right and left eigenvectors (shift-invert Arnoldi; a modal reduction's input);
@@ -38,6 +40,7 @@ from ambseal.lti.compiled import cached_njit
 from ambseal.lti.discrete import discretize, simulate_lti, simulate_modal_loop, zoh
 from ambseal.lti.freqresp import (
     STRUCTURED_STATES,
+    eigenvalues,
     freqresp_at,
     sampled_modal_form,
     sampled_response_at,
@@ -59,7 +62,7 @@ from ambseal.lti.pickling import picklable
 from ambseal.lti.tables import interp_table
 
 __all__ = ["ArrayMemo", "DENSE_STATES", "STRUCTURED_STATES", "as_omega", "cached_njit", "discretize",
-           "feedback_matrices", "feedback_poles", "feedback_response", "finite_or_none",
+           "eigenvalues", "feedback_matrices", "feedback_poles", "feedback_response", "finite_or_none",
            "finite_or_none_tree", "freqresp_at", "interp_table", "json_float", "json_list",
            "labels", "lft_lower", "lft_lower_matrices", "lowest_eigenpairs", "picklable",
            "sampled_modal_form", "sampled_response_at", "series_inputs", "simulate_lti",

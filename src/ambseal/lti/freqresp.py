@@ -42,9 +42,10 @@ from ambseal.errors import ModelError
 from ambseal.lti.discrete import zoh
 from ambseal.lti.matrices import ArrayMemo, as_omega, ss_matrices
 
-__all__ = ["freqresp", "freqresp_at", "modal_form", "sampled_modal_form", "sampled_response_at",
-           "STRUCTURED_STATES"]
+__all__ = ["eigenvalues", "freqresp", "freqresp_at", "modal_form", "sampled_modal_form",
+           "sampled_response_at", "STRUCTURED_STATES"]
 
+_MAX_COND = 1e8  # the default max_cond of the functions here: the kept decompositions' key
 _CHUNK_BYTES = 32 * 2**20  # memory budget of one chunk (complex n×n per frequency)
 _USE_SLYCOT = True  # set False (tests) to force the pure-numpy Hessenberg solver
 _MODAL = ArrayMemo()  # (λ, cond V, V⁻¹B, CV) of the last large (A, B, C)
@@ -76,10 +77,10 @@ _PROBED = ArrayMemo(keep=64)  # C (sI − A)⁻¹ B + D at single probes s of la
 #: [q; q̇] form (spread 3e10 on a 336-state plant), whose own modal form fails its check
 #: and ends in the balanced one anyway, after an eigendecomposition for nothing.
 _SPREAD_BALANCED_FIRST = 1e6
-#: (H, Q, balancing) of the last large ``A`` (:func:`_hessenberg_form`): the plant's grid and
-#: probe responses, whatever its inputs and outputs, share one reduction (two n² matrices:
-#: 57 MB at 1 888 states)
-_HESSENBERG = ArrayMemo(keep=2)
+#: The Hessenberg reduction of the last large ``A`` (:func:`_hessenberg_form`): a plant's grid
+#: and probe responses, whatever its inputs and outputs, share one (an n² matrix: 28 MB at
+#: 1 888 states); a loop is judged at three operating points, on a plant each.
+_HESSENBERG = ArrayMemo(keep=3)
 
 
 def freqresp(
@@ -579,6 +580,32 @@ def _kinematic_rows(A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return cand[keep], j[keep]
 
 
+def eigenvalues(A: np.ndarray, C: np.ndarray | None = None) -> np.ndarray:
+    """Eigenvalues of ``A``; with ``C`` and from ``STRUCTURED_STATES`` states, those of the
+    balanced eigendecomposition kept for ``(A, C)`` — the one the system's frequency
+    responses, its loops' poles and its sampled form share — so that a system whose
+    eigenvalues are asked first is decomposed once, not twice (an ``eigvals`` of 1 888
+    states takes 3 s, the decomposition 5 s).
+
+    Parameters
+    ----------
+    A : numpy.ndarray, shape (n, n)
+        State matrix.
+    C : numpy.ndarray, shape (p, n), optional
+        The system's output matrix (names the kept decomposition).
+
+    Returns
+    -------
+    numpy.ndarray of complex, shape (n,)
+        In no particular order; shared with the kept decomposition: do not modify it.
+    """
+    A = np.asarray(A, float)
+    if C is None or A.shape[0] < STRUCTURED_STATES:
+        return np.linalg.eigvals(A)
+    C = np.asarray(C, float)
+    return _EIG.get((A, C), (_MAX_COND, True), lambda: _eig_form(A, C, _MAX_COND, True))[0]
+
+
 def modal_form(A: np.ndarray, B: np.ndarray, C: np.ndarray, *, max_cond: float = 1e8):
     """``(λ, V⁻¹B, CV)`` of the balanced system (``A, B, C`` → ``T⁻¹AT, T⁻¹B, CT``, ``T``
     diagonal; the eigendecomposition kept per ``(A, C)`` and shared with the frequency
@@ -668,8 +695,8 @@ def _hessenberg_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndar
     through slycot when it is installed (Fortran loop, the routine python-control also
     uses), else the vectorised :func:`hessenberg_solve`.
     """
-    Hs, Q, sc = _HESSENBERG.get((A,), None, lambda: _hessenberg_form(A))
-    Bh, Ch = Q.T @ (B / sc[:, None]), (C * sc[None, :]) @ Q
+    Hs, Bh, Ch = _hessenberg_system(_HESSENBERG.get((A,), None, lambda: _hessenberg_form(A)),
+                                    B, C)
     if _USE_SLYCOT:
         try:
             return _slycot_response(Hs, Bh, Ch, D, s)
@@ -686,11 +713,45 @@ def _hessenberg_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndar
 
 
 def _hessenberg_form(A):
-    """``(H, Q, T)`` with ``H = Qᵀ T⁻¹AT Q`` upper Hessenberg, ``T = diag(sc)`` the balancing
-    (``B̃ = QᵀT⁻¹B``, ``C̃ = CTQ``)."""
+    """``(R, τ, sc)``: LAPACK ``dgehrd`` of the balanced ``T⁻¹AT`` (``T = diag(sc)``) —
+    ``H = Qᵀ T⁻¹AT Q`` on and above the first subdiagonal of ``R``, ``Q``'s Householder
+    vectors below it — without forming ``Q`` (``dorghr``: a quarter of the work and an
+    n × n matrix more to keep)."""
     A, (sc, _) = scipy.linalg.matrix_balance(A, permute=False, separate=True)
-    Hs, Q = scipy.linalg.hessenberg(A, calc_q=True, overwrite_a=True)
-    return Hs, Q, sc
+    n = A.shape[0]
+    if n < 3:  # nothing to reduce
+        return A, np.zeros(max(n - 1, 0)), sc
+    gehrd, gehrd_lwork = scipy.linalg.get_lapack_funcs(("gehrd", "gehrd_lwork"), (A,))
+    work, _ = gehrd_lwork(n, lo=0, hi=n - 1)
+    lwork = int(np.real(work))
+    R, tau, info = gehrd(A, lo=0, hi=n - 1, lwork=lwork, overwrite_a=1)
+    if info != 0:
+        raise ModelError(f"freqresp: the Hessenberg reduction failed (LAPACK dgehrd info={info})")
+    return R, tau, sc
+
+
+def _hessenberg_system(form, B, C):
+    """``(H, QᵀT⁻¹B, CTQ)`` from :func:`_hessenberg_form`'s ``form``: ``Q = diag(1, Q₁)`` with
+    ``Q₁`` the product of the reflectors stored as a QR factorisation's in ``R[1:, :n−1]``,
+    applied by ``dormqr``."""
+    R, tau, sc = form
+    n = R.shape[0]
+    Bt, Ct = B / sc[:, None], C * sc[None, :]
+    if n < 3:
+        return R, Bt, Ct
+    ormqr, = scipy.linalg.get_lapack_funcs(("ormqr",), (R,))
+    V = R[1:, :n - 1]
+    Bh, Ch = Bt.copy(), Ct.copy()
+    for side, trans, X, rows in (("L", "T", Bh, np.s_[1:, :]), ("R", "N", Ch, np.s_[:, 1:])):
+        if X.size:
+            part = X[rows]
+            _, work, _ = ormqr(side, trans, V, tau, part, -1)  # the workspace query
+            out, _, info = ormqr(side, trans, V, tau, part, int(np.real(work[0])))
+            if info != 0:
+                raise ModelError(f"freqresp: applying the Hessenberg reflectors failed "
+                                 f"(LAPACK dormqr info={info})")
+            X[rows] = out
+    return np.triu(R, -1), Bh, Ch
 
 
 def _slycot_response(Hs: np.ndarray, Bh: np.ndarray, Ch: np.ndarray, D: np.ndarray, s: np.ndarray) -> np.ndarray:

@@ -142,6 +142,13 @@ class ArrayMemo:
     320 × 320 matrix costs about 1 ms, its eigendecomposition about 60 ms. Only inputs
     with at least ``min_states`` rows are kept (small systems are cheaper to recompute
     than to hash). Cached results are shared: callers must not modify them in place.
+
+    Parameters
+    ----------
+    keep : int
+        How many distinct inputs' results are kept (the least recently used goes first).
+    min_states : int
+        Inputs whose first array has fewer rows are computed every time, not kept.
     """
 
     def __init__(self, keep: int = 8, min_states: int = 64):

@@ -154,7 +154,8 @@ def test_dense_solves_eliminate_the_velocity_identity_rows():
     C[0, 5], C[1, m + 9], C[2, 2 * m + 1] = 1.0, 1.0, 1.0
     D = np.zeros((3, 2))
     I, J = fr._kinematic_rows(A, B)
-    assert np.array_equal(np.sort(I), np.arange(m)) and np.array_equal(np.sort(J), np.arange(m, 2 * m))
+    assert np.array_equal(np.sort(I), np.arange(m))
+    assert np.array_equal(np.sort(J), np.arange(m, 2 * m))
     s = 1j * np.array([1e-2, 3.0, 40.0, 300.0, 1e4, 1e6])
     ref = _refined(A, B, C, D, s)
     H = fr._dense_response(A, B, C, D, s)

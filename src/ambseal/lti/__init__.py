@@ -61,9 +61,10 @@ from ambseal.lti.matrices import ArrayMemo, as_omega, labels, ss_matrices
 from ambseal.lti.pickling import picklable
 from ambseal.lti.tables import interp_table
 
-__all__ = ["ArrayMemo", "DENSE_STATES", "STRUCTURED_STATES", "as_omega", "cached_njit", "discretize",
-           "eigenvalues", "feedback_matrices", "feedback_poles", "feedback_response", "finite_or_none",
-           "finite_or_none_tree", "freqresp_at", "interp_table", "json_float", "json_list",
-           "labels", "lft_lower", "lft_lower_matrices", "lowest_eigenpairs", "picklable",
-           "sampled_modal_form", "sampled_response_at", "series_inputs", "simulate_lti",
-           "simulate_modal_loop", "ss_matrices", "state_poles", "wired", "zoh"]
+__all__ = ["ArrayMemo", "DENSE_STATES", "STRUCTURED_STATES", "as_omega", "cached_njit",
+           "discretize", "eigenvalues", "feedback_matrices", "feedback_poles",
+           "feedback_response", "finite_or_none", "finite_or_none_tree", "freqresp_at",
+           "interp_table", "json_float", "json_list", "labels", "lft_lower",
+           "lft_lower_matrices", "lowest_eigenpairs", "picklable", "sampled_modal_form",
+           "sampled_response_at", "series_inputs", "simulate_lti", "simulate_modal_loop",
+           "ss_matrices", "state_poles", "wired", "zoh"]

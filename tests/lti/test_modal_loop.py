@@ -148,7 +148,7 @@ def test_nearest_subspace_is_the_invariant_subspace_of_the_nearest_eigenvalues()
     part is, and balanced as strong_block balances it. The inverse iteration's basis spans
     the known eigenvectors of the pair (its largest principal angle to them at rounding,
     1.4e-13; eig's 1.6e-13), of a single eigenvalue too; a shift exactly on an eigenvalue
-    of a diagonal matrix falls back to ``eig``."""
+    of a diagonal matrix (``S − pI`` singular) still gives that eigenvalue's vector."""
     import scipy.linalg
 
     rng = np.random.default_rng(11)

@@ -278,10 +278,10 @@ def _loop(build, poles, dt, nu, ny, names, modal_from=None) -> ClosedLoop:
                       len(names[0]) - nu, dt, *names, modal_from)
 
 
-def _names(G, Gf, nu, ny, nf) -> tuple[list, list]:
-    """The closed loop's input and output names (:class:`ClosedLoop`)."""
+def _names(G, f_names, nu, ny) -> tuple[list, list]:
+    """The closed loop's input and output names (:class:`ClosedLoop`): ``G``'s, and
+    ``f_names`` of the external inputs."""
     u_names = labels(G, "input", nu, "u")
-    f_names = labels(Gf, "input", nf, "f") if Gf is not None else ()
     return ([f"d_{u}" for u in u_names] + list(f_names),
             list(labels(G, "output", ny, "y")) + [f"i_{u}" for u in u_names])
 
@@ -310,7 +310,8 @@ def _loop_system(G, K, Gf, atol):
     except ModelError:
         raise ModelError("closed_loop: I + D·D_K is singular; the loop is ill-posed") from None
 
-    inputs, outputs = _names(G, Gf, nu, ny, nf)
+    inputs, outputs = _names(G, labels(Gf, "input", nf, "f") if Gf is not None else (),
+                             nu, ny)
     states = [f"x[{i}]" for i in range(n)] + [f"xK[{i}]" for i in range(nk)]
     sys = control.StateSpace(Acl, Bcl, Ccl, Dcl, dt, inputs=inputs, outputs=outputs,
                              states=states, name="closed_loop")
@@ -337,7 +338,7 @@ def _sampled_loop(P, K, cur, rest, dt) -> ClosedLoop:
         Pj = sampled_plant(P, dt, cur)
         return _loop_system(_select(Pj, cur), K, _select(Pj, rest) if rest else None, 0.0)[2]
 
-    names = _names(G0, _select(P, rest) if rest else None, nu, ny, len(rest))
+    names = _names(G0, [P.input_labels[j] for j in rest], nu, ny)
     return _loop(build, poles, dt, nu, ny, tuple(map(tuple, names)), (mg, mk, None))
 
 

@@ -47,6 +47,13 @@ __all__ = ["eigenvalues", "freqresp", "freqresp_at", "modal_form", "sampled_moda
 
 _MAX_COND = 1e8  # the default max_cond of the functions here: the kept decompositions' key
 _CHUNK_BYTES = 32 * 2**20  # memory budget of one chunk (complex n×n per frequency)
+#: ... of the modal form's chunk (complex n per frequency) of a large model
+#: (``STRUCTURED_STATES`` states or more): a judgement's peak memory is reached there, and
+#: the product with W is faster on chunks that stay in cache (3 000 points of 1 888
+#: states: 0.096 s in chunks of 32 MB, 0.057 s of 2 MB). Smaller models keep
+#: ``_CHUNK_BYTES``: the chunking decides the product's rounding, and a D–G–K iteration,
+#: which follows its loops' responses to the last bit, takes another path on another one.
+_LARGE_MODAL_CHUNK_BYTES = 4 * 2**20
 _USE_SLYCOT = True  # set False (tests) to force the pure-numpy Hessenberg solver
 _MODAL = ArrayMemo()  # (λ, cond V, V⁻¹B, CV) of the last large (A, B, C)
 #: States above which cond V is LAPACK's 1-norm estimate from the LU of V (``gecon``, O(n²)
@@ -673,10 +680,12 @@ def _modal_eval(lam: np.ndarray, Bm: np.ndarray, Cm: np.ndarray, D: np.ndarray, 
     nu = Bm.shape[1]
     W = (Cm.T[:, :, None] * Bm[:, None, :]).reshape(n, ny * nu)
     out = np.empty((s.size, ny, nu), dtype=complex)
-    step = max(1, _CHUNK_BYTES // (16 * max(1, n)))
+    budget = _CHUNK_BYTES if n < STRUCTURED_STATES else _LARGE_MODAL_CHUNK_BYTES
+    step = max(1, budget // (16 * max(1, n)))
     with np.errstate(divide="ignore", invalid="ignore"):
         for i in range(0, s.size, step):
-            r = 1.0 / (s[i : i + step, None] - lam[None, :])  # (k, n)
+            r = s[i : i + step, None] - lam[None, :]  # (k, n)
+            np.divide(1.0, r, out=r)
             out[i : i + step] = (r @ W).reshape(-1, ny, nu) + D
     return out
 

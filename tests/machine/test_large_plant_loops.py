@@ -242,3 +242,46 @@ def test_continuous_loop_without_lag_equals_the_dense_loop(fine_plant, testrig_d
     Ad, Bd = zoh(A, B, T / 2, keep=False)
     (ref,) = simulate_lti(Ad, Bd, [C], d)
     assert np.all(np.max(np.abs(fast - ref), axis=0) <= 1e-7 * np.max(np.abs(ref), axis=0))
+
+
+def _arrays(obj, depth=6, seen=None):
+    """The NumPy arrays reachable from ``obj``: attributes, containers, closures' cells
+    and defaults (what a judged loop keeps alive)."""
+    seen = set() if seen is None else seen
+    if id(obj) in seen or depth < 0:
+        return []
+    seen.add(id(obj))
+    if isinstance(obj, np.ndarray):
+        return [obj]
+    if isinstance(obj, dict):
+        items = list(obj.values())
+    elif isinstance(obj, (list, tuple, set)):
+        items = list(obj)
+    elif callable(obj) and hasattr(obj, "__code__"):
+        items = [c.cell_contents for c in obj.__closure__ or ()] + list(obj.__defaults__ or ())
+    elif hasattr(obj, "__dict__"):
+        items = list(vars(obj).values())
+    else:
+        return []
+    return [a for x in items for a in _arrays(x, depth - 1, seen)]
+
+
+def test_judged_loop_keeps_no_copy_of_the_plant(fine_plant, testrig_designs):
+    """A judged loop with the delay lag, as the run keeps one per design and condition:
+    no array of the plant's size reachable from it but the plant's own ``A``, shared
+    read-only; its ``system``, made when asked for, equals the delayed plant closed by
+    :func:`closed_loop` with python-control's own selections (``P[:, idx]``), matrices and
+    signal names."""
+    P, cur, _, cfg = fine_plant
+    lag = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples).system
+    judged = judged_loop(P, testrig_designs["hinf"].K, cur, delay=lag)
+    big = [a for a in _arrays(judged) if a.size >= P.nstates ** 2]
+    assert big and all(np.shares_memory(a, P.A) for a in big)
+    assert not any(a.flags.writeable for a in big if a is not P.A)
+    rest = [j for j in range(P.ninputs) if j not in cur]
+    Pd = delayed_plant(P, cur, lag)
+    dense = closed_loop(Pd[:, cur], testrig_designs["hinf"].K, Pd[:, rest]).system
+    got = judged.loop.system
+    for m in "ABCD":
+        np.testing.assert_array_equal(getattr(got, m), getattr(dense, m))
+    assert (got.input_labels, got.output_labels) == (dense.input_labels, dense.output_labels)

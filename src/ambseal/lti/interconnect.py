@@ -222,9 +222,10 @@ def feedback_poles(G: Matrices, K: Matrices, *, lag: Matrices | None = None,
         all its inputs together (:func:`ambseal.lti.discrete.zoh`); ``K`` is discrete on
         it (``dt`` is then ``hold``). Its modal form is ``e^{λT}``, the rows of ``V⁻¹B``
         times ``(e^{λT} − 1)/λ``.
-    state_matrix : numpy.ndarray, optional
+    state_matrix : numpy.ndarray or callable, optional
         The loop's state matrix if the caller has built it (with the lag's states after
-        the plant's): its eigenvalues are taken where the modal path is not.
+        the plant's), or a function of no arguments that builds it (called only where it
+        is needed): its eigenvalues are taken where the modal path is not.
 
     Returns
     -------
@@ -246,7 +247,7 @@ def feedback_poles(G: Matrices, K: Matrices, *, lag: Matrices | None = None,
         if poles is not None:
             return poles
     if state_matrix is not None:
-        return state_poles(state_matrix)
+        return state_poles(state_matrix() if callable(state_matrix) else state_matrix)
     if lag is not None:  # the lag in front of the plant (the same matrix as a delayed plant's)
         A, B, C, D = series_inputs((A, B, C, D), tuple(np.asarray(X, float) for X in lag))[:4]
     if hold:

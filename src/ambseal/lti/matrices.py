@@ -96,6 +96,58 @@ def ss_matrices(sys: Any, *, name: str = "sys",
     return A, B, C, D
 
 
+def shared_ss(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray, dt: float = 0,
+              **names: Any) -> Any:
+    """``control.ss(A, B, C, D, dt, **names)`` whose ``A`` is ``A`` itself, not a copy.
+
+    ``control.ss`` copies every matrix it is given: the systems made from one large plant
+    (its selections of inputs, one per loop and judged condition) would each hold an
+    n × n copy of its state matrix (28 MB at 1 888 states) for as long as they live.
+
+    Parameters
+    ----------
+    A, B, C, D : numpy.ndarray
+        State-space matrices, shapes ``(n, n)``, ``(n, m)``, ``(p, n)``, ``(p, m)``.
+    dt : float
+        Sample time (s); 0 for a continuous system.
+    **names
+        ``inputs``, ``outputs``, ``states``, ``name`` as for ``control.ss``.
+
+    Returns
+    -------
+    control.StateSpace
+        Its ``A`` a read-only view of ``A`` (as float): neither may be written into while
+        the other is in use.
+    """
+    sys = control.ss(A, B, C, D, dt, **names)
+    shared = np.asarray(A, float).view()
+    shared.flags.writeable = False
+    sys.A = shared
+    return sys
+
+
+def select_inputs(sys: Any, idx: Any) -> Any:
+    """``sys`` with only the inputs ``idx``, its state matrix shared (:func:`shared_ss`).
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        The system, ``n`` states, ``m`` inputs, ``p`` outputs.
+    idx : sequence of int
+        The inputs kept, in this order.
+
+    Returns
+    -------
+    control.StateSpace
+        The same time base, states and output names; the inputs ``idx`` under their names;
+        ``A`` a read-only view of ``sys.A``.
+    """
+    idx = list(idx)
+    return shared_ss(sys.A, np.asarray(sys.B)[:, idx], sys.C, np.asarray(sys.D)[:, idx],
+                     sys.dt, inputs=[sys.input_labels[j] for j in idx],
+                     outputs=list(sys.output_labels), states=list(sys.state_labels))
+
+
 def labels(sys: Any, kind: str, count: int, prefix: str) -> tuple[str, ...]:
     """Input or output labels of a python-control system, or generated ones.
 

@@ -21,9 +21,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any
+from typing import Any, NamedTuple
 
-import control
 import numpy as np
 
 from ambseal.errors import ModelError
@@ -38,7 +37,9 @@ from ambseal.lti import (
     labels,
     sampled_modal_form,
     sampled_response_at,
+    select_inputs,
     series_inputs,
+    shared_ss,
     simulate_modal_loop,
     ss_matrices,
     wired,
@@ -254,19 +255,37 @@ def closed_loop(G: Any, K: Any, Gf: Any | None = None, *, atol: float = 0.0) -> 
     return _closed(G, K, Gf, atol, None)
 
 
-def _closed(G, K, Gf, atol, source) -> ClosedLoop:
+def _closed(G, K, Gf, atol, source, remake=None) -> ClosedLoop:
     """:func:`closed_loop`; ``source``: ``(G₀, lag)`` when ``G`` was made from the
     continuous ``G₀`` with the SISO ``lag`` (matrices) in front of every input, whose modal
-    form then gives the poles (:func:`ambseal.lti.interconnect.feedback_poles`)."""
-    (A, B, C, D), mk, sys, Acl = _loop_system(G, K, Gf, atol)
-    dt = sample_time(G)
-    names = (tuple(sys.input_labels), tuple(sys.output_labels))
-    if source is None:
-        poles = feedback_poles((A, B, C, D), mk, dt=dt, state_matrix=Acl)
-        return _loop(lambda: sys, poles, dt, B.shape[1], C.shape[0], names)
-    G0 = ss_matrices(source[0])
-    poles = feedback_poles(G0, mk, dt=dt, state_matrix=Acl, lag=source[1])
-    return _loop(lambda: sys, poles, dt, B.shape[1], C.shape[0], names, (G0, mk, source[1]))
+    form then gives the poles (:func:`ambseal.lti.interconnect.feedback_poles`);
+    ``remake``: makes ``(G, Gf)`` again (default: returns them).
+
+    The state space of a loop on a large plant without feedthrough (``STRUCTURED_STATES``
+    states or more) is built from ``remake`` only when its dense eigenvalues or
+    ``system`` are asked for, and not kept: the judgement holds a design's loops at every
+    condition at once, each would keep n² numbers (28 MB at 1 888 states) that the modal
+    paths never read, and the eigendecomposition of the plant that they do read peaks
+    while they are closed."""
+    parts = _loop_parts(G, K, Gf, atol)
+    (A, B, C, D), mk, dt = parts.g, parts.k, parts.dt
+    names = (parts.inputs, parts.outputs)
+    G0, lag = (A, B, C, D), None
+    if source is not None:
+        G0, lag = ss_matrices(source[0]), source[1]
+    modal_from = None if source is None else (G0, mk, lag)
+    if A.shape[0] < STRUCTURED_STATES or np.any(D):  # (an ill-posed loop raises here)
+        sys = _loop_system(parts)
+        poles = feedback_poles(G0, mk, dt=dt, state_matrix=sys.A, lag=lag)
+        return _loop(lambda: sys, poles, dt, B.shape[1], C.shape[0], names, modal_from)
+    remake = remake or (lambda G=G, Gf=Gf: (G, Gf))
+
+    def build():  # neither the loop nor (with remake) G is kept
+        G1, Gf1 = remake()
+        return _loop_system(_loop_parts(G1, K, Gf1, atol))
+
+    poles = feedback_poles(G0, mk, dt=dt, state_matrix=lambda: build().A, lag=lag)
+    return _loop(build, poles, dt, B.shape[1], C.shape[0], names, modal_from)
 
 
 def _loop(build, poles, dt, nu, ny, names, modal_from=None) -> ClosedLoop:
@@ -286,36 +305,57 @@ def _names(G, f_names, nu, ny) -> tuple[list, list]:
             list(labels(G, "output", ny, "y")) + [f"i_{u}" for u in u_names])
 
 
-def _loop_system(G, K, Gf, atol):
-    """(G's matrices, K's wired matrices, the closed loop's ``control.StateSpace``, its
-    state matrix) of :func:`closed_loop`."""
-    (A, B, C, D), (Ak, Bk, Ck, Dk) = loop_matrices(G, K)
+def _loop_parts(G, K, Gf, atol):
+    """(G's matrices, K's wired matrices, ``(B_f, D_f)``, the closed loop's input and
+    output names) of :func:`closed_loop`, checked."""
+    (A, B, C, D), mk = loop_matrices(G, K)
     n, nu = B.shape
     ny = C.shape[0]
-    nk = Ak.shape[0]
-    dt = sample_time(G)
     if Gf is not None:
         Af, Bf, Cf, Df = ss_matrices(Gf, name="Gf", allow_discrete=True)
         if Af.shape != A.shape or Cf.shape != C.shape:
             raise ModelError(f"Gf must share G's states and outputs: A{Af.shape} vs {A.shape}, C{Cf.shape} vs {C.shape}")
         for nm, X, Y in (("A", Af, A), ("C", Cf, C)):
+            if _same(X, Y):  # two selections of one plant (an n² difference saved)
+                continue
             if np.max(np.abs(X - Y), initial=0.0) > atol + 1e-9 * max(np.max(np.abs(Y), initial=0.0), 1.0):
                 raise ModelError(f"Gf.{nm} differs from G.{nm}: Gf must have the same states as G")
         nf = Bf.shape[1]
     else:
         Bf, Df, nf = np.zeros((n, 0)), np.zeros((ny, 0)), 0
-
-    try:
-        Acl, Bcl, Ccl, Dcl = feedback_matrices((A, B, C, D), (Ak, Bk, Ck, Dk), (Bf, Df))
-    except ModelError:
-        raise ModelError("closed_loop: I + D·D_K is singular; the loop is ill-posed") from None
-
     inputs, outputs = _names(G, labels(Gf, "input", nf, "f") if Gf is not None else (),
                              nu, ny)
-    states = [f"x[{i}]" for i in range(n)] + [f"xK[{i}]" for i in range(nk)]
-    sys = control.StateSpace(Acl, Bcl, Ccl, Dcl, dt, inputs=inputs, outputs=outputs,
-                             states=states, name="closed_loop")
-    return (A, B, C, D), (Ak, Bk, Ck, Dk), sys, Acl
+    return _Parts((A, B, C, D), mk, (Bf, Df), tuple(inputs), tuple(outputs), sample_time(G))
+
+
+class _Parts(NamedTuple):
+    """A loop before it is closed (:func:`_loop_parts`)."""
+
+    g: tuple  # the plant's (A, B, C, D)
+    k: tuple  # the controller's, wired to it
+    f: tuple  # (B_f, D_f) of the external inputs
+    inputs: tuple  # the closed loop's input names
+    outputs: tuple  # and output names
+    dt: float
+
+
+def _same(X, Y) -> bool:
+    """Whether the arrays are views of the same numbers (same memory, shape and strides)."""
+    return (X.shape == Y.shape and X.strides == Y.strides and X.dtype == Y.dtype
+            and X.__array_interface__["data"][0] == Y.__array_interface__["data"][0])
+
+
+def _loop_system(parts):
+    """The closed loop's ``control.StateSpace`` (:class:`ClosedLoop`) from
+    :func:`_loop_parts`."""
+    try:
+        Acl, Bcl, Ccl, Dcl = feedback_matrices(parts.g, parts.k, parts.f)
+    except ModelError:
+        raise ModelError("closed_loop: I + D·D_K is singular; the loop is ill-posed") from None
+    n = parts.g[0].shape[0]
+    states = [f"x[{i}]" for i in range(n)] + [f"xK[{i}]" for i in range(Acl.shape[0] - n)]
+    return shared_ss(Acl, Bcl, Ccl, Dcl, parts.dt, inputs=list(parts.inputs),
+                     outputs=list(parts.outputs), states=states, name="closed_loop")
 
 
 def _sampled_loop(P, K, cur, rest, dt) -> ClosedLoop:
@@ -324,7 +364,7 @@ def _sampled_loop(P, K, cur, rest, dt) -> ClosedLoop:
     (:func:`ambseal.lti.interconnect.feedback_poles`), and, for a large plant without
     feedthrough, the time response from its modal form (:meth:`ClosedLoop.modal_response`);
     the sampled plant's dense state space only when ``system`` is asked for."""
-    G0 = _select(P, cur)
+    G0 = select_inputs(P, cur)
     mg = ss_matrices(G0)
     mk = ss_matrices(wired(G0, K), name="K", allow_discrete=True)
     ny, nu = mg[3].shape
@@ -336,7 +376,8 @@ def _sampled_loop(P, K, cur, rest, dt) -> ClosedLoop:
 
     def build():
         Pj = sampled_plant(P, dt, cur)
-        return _loop_system(_select(Pj, cur), K, _select(Pj, rest) if rest else None, 0.0)[2]
+        Gf = select_inputs(Pj, rest) if rest else None
+        return _loop_system(_loop_parts(select_inputs(Pj, cur), K, Gf, 0.0))
 
     names = _names(G0, [P.input_labels[j] for j in rest], nu, ny)
     return _loop(build, poles, dt, nu, ny, tuple(map(tuple, names)), (mg, mk, None))
@@ -405,7 +446,7 @@ class JudgedLoop:
             H = np.empty((w.size, P.noutputs, P.ninputs), dtype=complex)
             for group in (cur, [j for j in range(P.ninputs) if j not in cur]):
                 if group:
-                    H[:, :, group] = sampled_response_at(_select(P, group), dt, w)
+                    H[:, :, group] = sampled_response_at(select_inputs(P, group), dt, w)
             return H
         H = freqresp_at(self.source, 1j * w)
         if self.delay is not None:
@@ -422,7 +463,7 @@ def delayed_plant(P, inputs, delay):
         return tuple(np.asarray(getattr(S, m), float) for m in ("A", "B", "C", "D"))
 
     A, B, C, D = series_inputs(mats(P), mats(delay), list(inputs))[:4]
-    return control.ss(A, B, C, D, inputs=list(P.input_labels), outputs=list(P.output_labels))
+    return shared_ss(A, B, C, D, inputs=list(P.input_labels), outputs=list(P.output_labels))
 
 
 def sampled_plant(P, dt: float, inputs=None):
@@ -440,15 +481,8 @@ def sampled_plant(P, dt: float, inputs=None):
     Ad, Bd[:, cur] = zoh(A, B[:, cur], dt)
     if rest:
         Bd[:, rest] = zoh(A, B[:, rest], dt)[1]
-    return control.ss(Ad, Bd, np.asarray(P.C, float), np.asarray(P.D, float), dt,
-                      inputs=list(P.input_labels), outputs=list(P.output_labels))
-
-
-def _select(P, idx):
-    """``P`` with only the inputs ``idx`` (names kept, same time base)."""
-    names = [P.input_labels[j] for j in idx]
-    return control.ss(P.A, np.asarray(P.B)[:, idx], P.C, np.asarray(P.D)[:, idx], P.dt,
-                      inputs=names, outputs=list(P.output_labels))
+    return shared_ss(Ad, Bd, np.asarray(P.C, float), np.asarray(P.D, float), dt,
+                     inputs=list(P.input_labels), outputs=list(P.output_labels))
 
 
 def judged_loop(P, K, control_inputs=None, *, delay=None) -> JudgedLoop:
@@ -491,12 +525,15 @@ def judged_loop(P, K, control_inputs=None, *, delay=None) -> JudgedLoop:
     if dt:
         return JudgedLoop(lambda: sampled_plant(P, dt, cur), _sampled_loop(P, K, cur, rest, dt),
                           P, None, tuple(cur))
-    source = None
-    if delay is not None:
+    if delay is None:
+        G, Gf = select_inputs(P, cur), (select_inputs(P, rest) if rest else None)
+        return JudgedLoop(lambda: P, _closed(G, K, Gf, 0.0, None), P, None, tuple(cur))
+
+    def parts():  # the delayed plant's: made again, not kept, when asked for
         Pj = delayed_plant(P, cur, delay)
-        source = (_select(P, cur), tuple(np.asarray(getattr(delay, m), float) for m in "ABCD"))
-    else:
-        Pj = P
-    G = _select(Pj, cur)
-    Gf = _select(Pj, rest) if rest else None
-    return JudgedLoop(lambda: Pj, _closed(G, K, Gf, 0.0, source), P, delay, tuple(cur))
+        return select_inputs(Pj, cur), (select_inputs(Pj, rest) if rest else None)
+
+    source = (select_inputs(P, cur), tuple(np.asarray(getattr(delay, m), float) for m in "ABCD"))
+    G, Gf = parts()
+    loop = _closed(G, K, Gf, 0.0, source, parts)
+    return JudgedLoop(lambda: delayed_plant(P, cur, delay), loop, P, delay, tuple(cur))

@@ -21,7 +21,7 @@ import control
 import numpy as np
 
 from ambseal.errors import ModelError
-from ambseal.lti import picklable, series_inputs
+from ambseal.lti import picklable, series_inputs, shared_ss
 
 __all__ = ["Channel", "Parameter", "Plant", "channel_tag"]
 
@@ -202,10 +202,11 @@ class Plant:
         )
 
     def to_statespace(self):
-        """The plant as a ``control.StateSpace`` with named inputs, outputs and states."""
+        """The plant as a ``control.StateSpace`` with named inputs, outputs and states; its
+        ``A`` shared with the plant's (:func:`ambseal.lti.shared_ss`), not copied."""
 
         picklable()
-        return control.ss(
+        return shared_ss(
             self.A,
             self.B,
             self.C,

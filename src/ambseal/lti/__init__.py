@@ -25,12 +25,12 @@ The lowest numerical layer (it imports only :mod:`ambseal.errors`); each idea on
 * :func:`picklable` — ``control.StateSpace`` through :mod:`pickle` (Dask workers);
 * what every layer shares beneath them: :func:`ss_matrices`, :func:`as_omega`,
   :func:`labels`, :func:`shared_ss`, :func:`select_inputs` (checked matrices, grids, signal
-  names, and systems sharing a large state matrix instead of copying it), :class:`ArrayMemo` (results
-  of expensive functions of large arrays, kept by their digest), :func:`state_poles`,
-  :func:`series_inputs`, :func:`sampled_response_at`, :func:`cached_njit` (numba's cached
-  compilation), :data:`DENSE_STATES`, :data:`STRUCTURED_STATES`, and the JSON conventions of every result
-  (:func:`json_float`, :func:`json_list`, :func:`finite_or_none`,
-  :func:`finite_or_none_tree`).
+  names, and systems sharing a large state matrix instead of copying it),
+  :class:`ArrayMemo` (results of expensive functions of large arrays, kept by their
+  digest), :func:`state_poles`, :func:`series_inputs`, :func:`sampled_response_at`,
+  :func:`cached_njit` (numba's cached compilation), :data:`DENSE_STATES`,
+  :data:`STRUCTURED_STATES`, and the JSON conventions of every result (:func:`json_float`,
+  :func:`json_list`, :func:`finite_or_none`, :func:`finite_or_none_tree`).
 
 ``freqresp`` is not re-exported here: it shares its module's name, and re-exporting it
 would hide :mod:`ambseal.lti.freqresp` (``import ambseal.lti.freqresp as fr`` would then
@@ -58,7 +58,14 @@ from ambseal.lti.interconnect import (
 )
 from ambseal.lti.json_safe import finite_or_none, finite_or_none_tree, json_float, json_list
 from ambseal.lti.lowest import DENSE_STATES, lowest_eigenpairs
-from ambseal.lti.matrices import ArrayMemo, as_omega, labels, select_inputs, shared_ss, ss_matrices
+from ambseal.lti.matrices import (
+    ArrayMemo,
+    as_omega,
+    labels,
+    select_inputs,
+    shared_ss,
+    ss_matrices,
+)
 from ambseal.lti.pickling import picklable
 from ambseal.lti.tables import interp_table
 
@@ -67,5 +74,5 @@ __all__ = ["ArrayMemo", "DENSE_STATES", "STRUCTURED_STATES", "as_omega", "cached
            "feedback_response", "finite_or_none", "finite_or_none_tree", "freqresp_at",
            "interp_table", "json_float", "json_list", "labels", "lft_lower",
            "lft_lower_matrices", "lowest_eigenpairs", "picklable", "sampled_modal_form",
-           "sampled_response_at", "select_inputs", "series_inputs", "shared_ss", "simulate_lti", "simulate_modal_loop",
-           "ss_matrices", "state_poles", "wired", "zoh"]
+           "sampled_response_at", "select_inputs", "series_inputs", "shared_ss",
+           "simulate_lti", "simulate_modal_loop", "ss_matrices", "state_poles", "wired", "zoh"]

@@ -171,6 +171,8 @@ def _split(lam, Bm, Cm, K, discrete) -> _Solved | None:
         return None
     p_weak, groups, p_groups = found
     poles = np.concatenate([p_strong, p_weak])
+    if not np.all(np.isfinite(poles)):
+        return None
     trace = lam.sum() - np.einsum("im,mp,pi->", Bm, Dk, Cm) + np.trace(Ak)
     if abs(poles.sum() - trace) > 1e3 * _EPS * float(np.abs(poles).sum()):
         return None
@@ -321,39 +323,44 @@ def _weak_poles(lam, Bm, Cm, weak, K, tol):
     """Each weak mode's (or cluster's) pole from ``p ∈ spec(Λ_c − B_c Q(p) C_c)``,
     ``Q = (I + K G_rest)⁻¹ K`` with the rest of the plant: (the poles in the order of
     ``weak``, the clusters' plant modes, their poles); ``None`` if it does not settle."""
-    groups = _clusters(lam[weak], tol)
-    groups = [weak[g] for g in groups]
-    out = np.empty(weak.size, complex)
-    pos = {int(i): k for k, i in enumerate(weak)}
-    p = [lam[g].copy() for g in groups]
+    groups = [weak[g] for g in _clusters(lam[weak], tol)]
+    single = np.array([g.size == 1 for g in groups])
+    first = np.array([g[0] for g in groups])  # a single mode's index
+    cur = lam.copy()  # each weak mode's pole as found so far
     W = (Cm.T[:, :, None] * Bm[:, None, :]).reshape(lam.size, -1)
-    pending = list(range(len(groups)))
+    pending = np.arange(len(groups))
     for _ in range(_MAX_ITER):
-        if not pending:
+        if not pending.size:
             break
-        centres = np.array([p[g].mean() for g in pending])
+        ones = single[pending]
+        k1, kn = np.flatnonzero(ones), np.flatnonzero(~ones)
+        i1 = first[pending[k1]]
+        centres = np.empty(pending.size, complex)
+        centres[k1] = cur[i1]
+        centres[kn] = [cur[groups[g]].mean() for g in pending[kn]]
         with np.errstate(divide="ignore", invalid="ignore"):
             R = 1.0 / (centres[:, None] - lam[None, :])
-        for k, g in enumerate(pending):  # the rest of the plant: without the cluster
-            R[k, groups[g]] = 0.0
+        R[k1, i1] = 0.0  # the rest of the plant: without the cluster
+        for k in kn:
+            R[k, groups[pending[k]]] = 0.0
         G = (R @ W).reshape(-1, Cm.shape[0], Bm.shape[1])
         Kp = _K_at(K, centres)
-        still = []
-        for k, g in enumerate(pending):
-            idx = groups[g]
-            Q = np.linalg.solve(np.eye(Kp.shape[1]) + Kp[k] @ G[k], Kp[k])
-            P = np.diag(lam[idx]) - Bm[idx] @ Q @ Cm[:, idx]
-            new = P[0, 0][None] if idx.size == 1 else _matched(np.linalg.eigvals(P), p[g])
-            if np.max(np.abs(new - p[g])) > tol:
-                still.append(g)
-            p[g] = np.atleast_1d(new)
-        pending = still
-    if pending:
+        # Q = (I + K G_rest)⁻¹ K at each centre: one LAPACK call for the stack
+        Q = np.linalg.solve(np.eye(Kp.shape[1]) + Kp @ G, Kp)
+        moved = np.empty(pending.size)
+        new = lam[i1] - np.einsum("km,kmp,pk->k", Bm[i1], Q[k1], Cm[:, i1])
+        moved[k1] = np.abs(new - cur[i1])
+        cur[i1] = new
+        for k in kn:
+            idx = groups[pending[k]]
+            P = np.diag(lam[idx]) - Bm[idx] @ Q[k] @ Cm[:, idx]
+            new = _matched(np.linalg.eigvals(P), cur[idx])
+            moved[k] = np.max(np.abs(new - cur[idx]))
+            cur[idx] = new
+        pending = pending[~(moved <= tol)]  # nan: not settled
+    if pending.size:
         return None
-    for g, idx in enumerate(groups):
-        for i, v in zip(idx, p[g]):
-            out[pos[int(i)]] = v
-    return out, groups, p
+    return cur[weak], groups, [cur[idx] for idx in groups]
 
 
 class _Boundary:
@@ -523,8 +530,13 @@ def modal_loop_response(lam, Bm, Cm, K, E, Z, d: np.ndarray, h: float) -> np.nda
     Ak = Ak.reshape(Bk.shape[0], Bk.shape[0]) if Bk.size else np.zeros((0, 0))
     loop = _Loop(lam, Bm, Cm, (Ak, Bk, Ck, Dk), *(np.atleast_2d(np.asarray(X, float))
                                                    for X in (*E, *Z)))
+    ones = [k for k, idx in enumerate(solved.groups) if idx.size == 1]
     weak = [loop.weak_group(idx, p, solved.strong)
-            for idx, p in zip(solved.groups, solved.p_groups)]
+            for idx, p in zip(solved.groups, solved.p_groups) if idx.size > 1]
+    if ones:
+        weak.append(loop.weak_singles(np.array([solved.groups[k][0] for k in ones]),
+                                      np.array([solved.p_groups[k][0] for k in ones]),
+                                      solved.strong))
     strong = loop.strong_block(solved)
     if strong is None or any(x is None for x in weak):
         return None
@@ -598,6 +610,51 @@ class _Loop:
         out = np.vstack([y, self.F @ xk + self.G @ y]).T
         xs = (self.Bm[strong] @ u) / (p - self.lam[strong])[:, None]
         return mu, out, np.linalg.solve(WV, WB), np.vstack([xs, xk]).T
+
+    def weak_singles(self, modes, poles, strong, chunk: int = 256):
+        """:meth:`weak_group` of every weak pole that is a cluster of one plant mode
+        (``modes``, their poles ``poles``) at once: the same algebra with the Schur
+        complement 1 × 1 (its eigenvector 1), stacked over the poles in chunks (the
+        controller's resolvents are ``chunk`` n_K × n_K matrices); ``None`` where a pole's
+        left and right eigenvectors are orthogonal (not a simple pole)."""
+        parts = [self._singles(modes[k:k + chunk], poles[k:k + chunk], strong)
+                 for k in range(0, modes.size, chunk)]
+        if any(x is None for x in parts):
+            return None
+        return tuple(np.concatenate([x[k] for x in parts]) for k in range(4))
+
+    def _singles(self, modes, poles, strong):
+        Ak, Bk, Ck, Dk = self.K
+        nk, ny, nu = Ak.shape[0], self.Cm.shape[0], self.Bm.shape[1]
+        T = lambda Z: np.swapaxes(Z, 1, 2)  # noqa: E731  (transpose of each matrix)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = 1.0 / (poles[:, None] - self.lam[None, :])
+        r[np.arange(modes.size), modes] = 0.0  # the rest of the plant
+        Gr = (r @ self.W).reshape(-1, ny, nu)
+        G2 = ((r * r) @ self.W).reshape(-1, ny, nu)
+        if nk:
+            resolvent = poles[:, None, None] * np.eye(nk) - Ak
+            RB = np.linalg.solve(resolvent, np.broadcast_to(Bk, (poles.size, nk, ny)))
+            Kp = Ck @ RB + Dk
+        else:
+            RB = np.zeros((poles.size, 0, ny))
+            Kp = np.broadcast_to(Dk.astype(complex), (poles.size, nu, ny))
+        ce = self.Cm.T[modes][:, :, None]  # (k, ny, 1)
+        be = self.Bm[modes][:, None, :]  # (k, 1, nu)
+        y = np.linalg.solve(np.eye(ny) + Gr @ Kp, ce)  # y = (I + G_rest K)⁻¹ C_E ξ
+        mu = self.lam[modes] - (be @ Kp @ y)[:, 0, 0]
+        u = -Kp @ y
+        xk = RB @ y
+        nu_l = np.linalg.solve(T(np.eye(nu) + Kp @ Gr), T(be))
+        zeta = -T(Kp) @ nu_l
+        wk = -np.linalg.solve(T(resolvent), Ck.T @ nu_l) if nk else np.zeros((poles.size, 0, 1))
+        WV = (1.0 + T(zeta) @ G2 @ u + T(wk) @ xk)[:, 0, 0]
+        if not np.all(np.abs(WV) > 0):
+            return None
+        WB = (T(nu_l) @ self.Eu + T(wk) @ self.Ex)[:, 0, :]
+        out = np.concatenate([y, self.F @ xk + self.G @ y], axis=1)[:, :, 0]
+        xs = (self.Bm[strong] @ u[:, :, 0].T) / (poles[None, :] - self.lam[strong][:, None])
+        return mu, out, WB / WV[:, None], np.vstack([xs, xk[:, :, 0].T]).T
 
     def strong_block(self, solved):
         """``(M_S, C_S)``: the strong part's matrix on its invariant subspace (the strong

@@ -86,8 +86,12 @@ _PROBED = ArrayMemo(keep=64)  # C (sI − A)⁻¹ B + D at single probes s of la
 _SPREAD_BALANCED_FIRST = 1e6
 #: The Hessenberg reduction of the last large ``A`` (:func:`_hessenberg_form`): a plant's grid
 #: and probe responses, whatever its inputs and outputs, share one (an n² matrix: 28 MB at
-#: 1 888 states); a loop is judged at three operating points, on a plant each.
+#: 1 888 states); a loop is judged at three operating points, on a plant each. Those from
+#: ``STRUCTURED_STATES`` states are kept apart from the smaller ones, which a design
+#: reduces by the dozen between a plant's first probes and its judgement (a 250-state
+#: form costs 10 ms, a 1 888-state one 1.1 s).
 _HESSENBERG = ArrayMemo(keep=3)
+_HESSENBERG_LARGE = ArrayMemo(keep=3, min_states=STRUCTURED_STATES)
 
 
 def freqresp(
@@ -702,8 +706,8 @@ def _hessenberg_response(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndar
     through slycot when it is installed (Fortran loop, the routine python-control also
     uses), else the vectorised :func:`hessenberg_solve`.
     """
-    Hs, Bh, Ch = _hessenberg_system(_HESSENBERG.get((A,), None, lambda: _hessenberg_form(A)),
-                                    B, C)
+    memo = _HESSENBERG_LARGE if A.shape[0] >= STRUCTURED_STATES else _HESSENBERG
+    Hs, Bh, Ch = _hessenberg_system(memo.get((A,), None, lambda: _hessenberg_form(A)), B, C)
     if _USE_SLYCOT:
         try:
             return _slycot_response(Hs, Bh, Ch, D, s)

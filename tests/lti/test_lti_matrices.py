@@ -41,3 +41,62 @@ def test_shared_ss_is_control_ss_without_the_copy():
     assert (got.input_labels, got.output_labels) == (want.input_labels, want.output_labels)
     assert np.shares_memory(got.A, A)
     np.testing.assert_allclose(control.evalfr(got, 2j), control.evalfr(want, 2j), rtol=1e-15)
+
+
+def test_digest_of_a_frozen_array_is_kept_and_follows_the_content():
+    """Reference: hashlib's SHA-256 of the bytes. A frozen array's digest is kept (a second
+    lookup hashes nothing) and equals that of a writeable copy of the same content; an
+    array whose memory can still be written (a read-only view of a writeable array) is
+    hashed at every lookup, so a change in place gives another digest."""
+    import hashlib
+
+    import ambseal.lti.matrices as mx
+
+    rng = np.random.default_rng(5)
+    A = rng.standard_normal((400, 400))  # 1.3 MB: above the kept size
+    copy = A.copy()
+    view = A.view()
+    view.flags.writeable = False  # its owner A stays writeable
+    d_view = mx.array_digest((view,))
+    A[0, 0] += 1.0
+    assert mx.array_digest((view,)) != d_view  # hashed again: the content changed
+    assert mx.array_digest((copy,)) == d_view
+    frozen = mx.freeze(copy)
+    assert frozen is copy and not copy.flags.writeable
+    with pytest.raises(ValueError):
+        copy[0, 0] = 0.0
+    hashed = []
+    real = hashlib.sha256
+
+    def counted(*data):
+        hashed.append(sum(memoryview(x).nbytes for x in data))
+        return real(*data)
+
+    mx.hashlib.sha256 = counted
+    try:
+        twice = [mx.array_digest((copy,)) for _ in range(2)]
+        big = max(hashed)
+        hashed.clear()
+        mx.array_digest((copy.view(),))  # another view object of the same memory
+        kept = max(hashed)
+        hashed.clear()
+        half = [mx.array_digest((copy[:, :200],)) for _ in range(2)]  # 640 kB: not kept
+        small = sorted(hashed)[-2:]
+    finally:
+        mx.hashlib.sha256 = real
+    assert twice == [d_view, d_view] and big == copy.nbytes and kept < 1000
+    assert small == [copy.nbytes // 2] * 2
+    assert half[0] == half[1] == mx.array_digest((np.ascontiguousarray(copy[:, :200]),))
+
+
+def test_a_plants_state_matrix_is_frozen():
+    """A plant's state matrix is read-only from its construction on (its systems share it
+    and the memos keep its digest): a write raises instead of changing them silently."""
+    from ambseal.model.lft import Plant
+
+    A = np.array([[0.0, 1.0], [-4.0, -0.4]])
+    p = Plant(A, np.array([[0.0], [1.0]]), np.array([[1.0, 0.0]]), np.zeros((1, 1)),
+              ("i_x",), ("y_x",), ("q", "v"))
+    with pytest.raises(ValueError):
+        p.A[0, 0] = 1.0
+    assert not A.flags.writeable and np.shares_memory(p.to_statespace().A, A)

@@ -27,7 +27,8 @@ The lowest numerical layer (it imports only :mod:`ambseal.errors`); each idea on
   :func:`labels`, :func:`shared_ss`, :func:`select_inputs` (checked matrices, grids, signal
   names, and systems sharing a large state matrix instead of copying it),
   :class:`ArrayMemo` (results of expensive functions of large arrays, kept by their
-  digest), :func:`state_poles`, :func:`series_inputs`, :func:`sampled_response_at`,
+  digest), :func:`freeze` (an array made read-only, its digest then computed once),
+  :func:`state_poles`, :func:`series_inputs`, :func:`sampled_response_at`,
   :func:`cached_njit` (numba's cached compilation), :data:`DENSE_STATES`,
   :data:`STRUCTURED_STATES`, and the JSON conventions of every result (:func:`json_float`,
   :func:`json_list`, :func:`finite_or_none`, :func:`finite_or_none_tree`).
@@ -61,6 +62,7 @@ from ambseal.lti.lowest import DENSE_STATES, lowest_eigenpairs
 from ambseal.lti.matrices import (
     ArrayMemo,
     as_omega,
+    freeze,
     labels,
     select_inputs,
     shared_ss,
@@ -71,7 +73,7 @@ from ambseal.lti.tables import interp_table
 
 __all__ = ["ArrayMemo", "DENSE_STATES", "STRUCTURED_STATES", "as_omega", "cached_njit",
            "discretize", "eigenvalues", "feedback_matrices", "feedback_poles",
-           "feedback_response", "finite_or_none", "finite_or_none_tree", "freqresp_at",
+           "feedback_response", "finite_or_none", "finite_or_none_tree", "freeze", "freqresp_at",
            "interp_table", "json_float", "json_list", "labels", "lft_lower",
            "lft_lower_matrices", "lowest_eigenpairs", "picklable", "sampled_modal_form",
            "sampled_response_at", "select_inputs", "series_inputs", "shared_ss",

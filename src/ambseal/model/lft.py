@@ -21,7 +21,7 @@ import control
 import numpy as np
 
 from ambseal.errors import ModelError
-from ambseal.lti import picklable, series_inputs, shared_ss
+from ambseal.lti import freeze, picklable, series_inputs, shared_ss
 
 __all__ = ["Channel", "Parameter", "Plant", "channel_tag"]
 
@@ -134,6 +134,12 @@ class Plant:
     output_names: tuple[str, ...]
     state_names: tuple[str, ...]
     parameters: dict[str, Parameter] = field(default_factory=dict)
+
+    def __post_init__(self):
+        # read-only from here: the systems made from the plant share its state matrix
+        # (to_statespace), and the memos of its decompositions key it by its digest,
+        # computed once for a frozen array (ambseal.lti.freeze)
+        freeze(self.A)
 
     @property
     def n_states(self) -> int:

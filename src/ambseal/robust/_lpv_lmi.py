@@ -30,6 +30,14 @@ BASES = {"constant": 1, "affine": 2, "quadratic": 3}
 #: lowered, and how many times it is (:func:`solve_lmis`)
 PENALTY_SHARE = 1e-2
 PENALTY_STEPS = 3
+#: A step of that continuation is kept only while rounding leaves the controller's
+#: reconstruction digits: ε ‖S(θ)‖ ‖R(θ)‖ / σ_min(I − S(θ) R(θ)), the relative error with
+#: which R and S rounded to double determine the inverse of I − S R that the
+#: reconstruction takes, at most this at every grid point. Without it the continuation
+#: went on as long as CVXOPT returned "optimal", which depends on its BLAS's rounding: on
+#: Wu et al.'s rotation one machine stopped at ‖R‖‖S‖ = 8e10 (γ 12.0), another went on to
+#: 7e14 (γ 0.93, a loss of 0.4), whose controller fails the bounded-real lemma.
+RECONSTRUCTION_LOSS = 1e-4
 #: CVXOPT's options for the γ and centring SDPs (:mod:`ambseal.robust._lmi_sdp`): its own
 #: defaults (a feasibility tolerance of 1e-8 stalls on these LMIs at 7e-8 and ends "unknown")
 DEFAULT_TOL = {"abstol": 1e-7, "reltol": 1e-6, "feastol": 1e-7}
@@ -386,7 +394,8 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
     # The trace term keeps R and S bounded, but where they must grow large it also buys a
     # smaller trace with a larger γ: while its share of the cost exceeds PENALTY_SHARE the
     # weight is lowered to half that share and the SDP solved again (at most
-    # PENALTY_STEPS times; a solve that fails or does not lower γ ends the continuation).
+    # PENALTY_STEPS times; a solve that fails, does not lower γ or leaves R and S too
+    # large for the controller's reconstruction, RECONSTRUCTION_LOSS, ends the continuation).
     def share_of(sol, weight):
         return weight * float(tr @ [np.trace(X) for X in sol.X]) / max(float(sol.gamma),
                                                                        1e-300)
@@ -402,7 +411,8 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
                                "gamma", reports)
         except SynthesisError:
             break
-        if not float(lower.gamma) < float(sol.gamma):
+        if not float(lower.gamma) < float(sol.gamma) or \
+                _reconstruction_loss(lower.X[:nbR], lower.X[nbR:], at) > RECONSTRUCTION_LOSS:
             break
         sol, weight = lower, lower_weight
         share = share_of(sol, weight)
@@ -424,6 +434,20 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
             raise last
     X = [_sym(X) for X in sol.X]
     return gamma, gamma_d, X[:nbR], X[nbR:], reports, share
+
+
+def _reconstruction_loss(R, S, at) -> float:
+    """The largest ε ‖S‖ ‖R‖ / σ_min(I − S R) over the grid (:data:`RECONSTRUCTION_LOSS`);
+    ``at`` holds each grid point's basis values ``((f_R, df_R), (f_S, df_S))``."""
+    eps, worst = np.finfo(float).eps, 0.0
+    for (fR, _), (fS, _) in at:
+        Rt = _sym(sum(f * X for f, X in zip(fR, R)))
+        St = _sym(sum(f * X for f, X in zip(fS, S)))
+        smin = np.linalg.svd(np.eye(Rt.shape[0]) - St @ Rt, compute_uv=False)[-1]
+        loss = eps * np.linalg.norm(St, 2) * np.linalg.norm(Rt, 2) / smin if smin > 0 \
+            else np.inf
+        worst = max(worst, float(loss))
+    return worst
 
 
 def _solve_sdp(lmis, N, n_vars, cost_gamma, cost_trace, options, stage, reports):

@@ -88,6 +88,10 @@ class Parameter:
     C: np.ndarray
     D: np.ndarray
 
+    def __post_init__(self):
+        for X in (self.B, self.C, self.D):  # read-only: shared with every copy of the plant
+            freeze(X)
+
     @property
     def repeats(self) -> int:
         """How many times θ appears (r)."""
@@ -137,9 +141,11 @@ class Plant:
 
     def __post_init__(self):
         # read-only from here: the systems made from the plant share its state matrix
-        # (to_statespace), and the memos of its decompositions key it by its digest,
-        # computed once for a frozen array (ambseal.lti.freeze)
-        freeze(self.A)
+        # (to_statespace), the memos of its decompositions key it by its digest, computed
+        # once for a frozen array (ambseal.lti.freeze), and build_plant hands the same
+        # plant to every caller
+        for X in (self.A, self.B, self.C, self.D):
+            freeze(X)
 
     @property
     def n_states(self) -> int:

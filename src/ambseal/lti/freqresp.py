@@ -197,8 +197,8 @@ def freqresp_at(
     return _response(A, B, C, D, pts, method, max_cond, rtol)
 
 
-def sampled_response_at(sys: Any, dt: float, omega: Any, *, max_cond: float = 1e8,
-                        rtol: float = 1e-6) -> np.ndarray:
+def sampled_response_at(sys: Any, dt: float, omega: Any, *, groups: Any = None,
+                        max_cond: float = 1e8, rtol: float = 1e-6) -> np.ndarray:
     """The zero-order-hold sampled plant's response ``G_d(e^{jω dt})``, from the continuous
     plant's modal form.
 
@@ -223,6 +223,12 @@ def sampled_response_at(sys: Any, dt: float, omega: Any, *, max_cond: float = 1e
         Sample time (s), > 0.
     omega : array_like of float, shape (n_w,)
         Frequencies (rad/s).
+    groups : sequence of sequences of int, optional
+        Input indices whose sampled forms are certified and kept apart, each input in
+        one group (a plant's control inputs and its force inputs: the loop closed on the
+        control inputs shares their form); by default one group of all. The response is
+        the same; where the groups' forms share the plant's decomposition it is
+        evaluated in one pass over the modes.
     max_cond, rtol : float
         As for :func:`freqresp_at`.
 
@@ -233,7 +239,8 @@ def sampled_response_at(sys: Any, dt: float, omega: Any, *, max_cond: float = 1e
     Raises
     ------
     ModelError
-        Non-finite frequencies, inconsistent shapes or ``dt`` not positive.
+        Non-finite frequencies, inconsistent shapes, ``dt`` not positive, or ``groups``
+        not a partition of the inputs.
     """
     if not (np.isfinite(dt) and dt > 0):
         raise ModelError(f"sampled_response_at: dt must be a positive sample time, got {dt!r}")
@@ -242,6 +249,12 @@ def sampled_response_at(sys: Any, dt: float, omega: Any, *, max_cond: float = 1e
     if w.ndim != 1 or not np.all(np.isfinite(w)):
         raise ModelError("sampled_response_at: expected a 1-D array of finite frequencies")
     z = np.exp(1j * w * dt)
+    groups = [list(range(B.shape[1]))] if groups is None else [list(g) for g in groups if len(g)]
+    if sorted(j for g in groups for j in g) != list(range(B.shape[1])):
+        raise ModelError(f"sampled_response_at: groups {groups} are not a partition of the "
+                         f"{B.shape[1]} inputs")
+    if len(groups) > 1:
+        return _grouped(A, B, C, D, dt, w, groups, max_cond, rtol)
     n = A.shape[0]
     if n >= STRUCTURED_STATES:
         form = sampled_modal_form(A, B, C, D, dt, max_cond=max_cond, rtol=rtol)
@@ -257,6 +270,25 @@ def sampled_response_at(sys: Any, dt: float, omega: Any, *, max_cond: float = 1e
         if _error(_modal_eval(mu, Bz, Cm, D, probe), Hd) <= rtol:
             return _modal_eval(mu, Bz, Cm, D, z)
     return freqresp_at((Ad, Bd, C, D), z, rtol=rtol)
+
+
+def _grouped(A, B, C, D, dt, w, groups, max_cond, rtol) -> np.ndarray:
+    """:func:`sampled_response_at` of each input group; the groups' certified forms in one
+    :func:`_modal_eval` where they share ``e^{λ dt}`` and ``C V`` (one decomposition)."""
+    H = np.empty((w.size, C.shape[0], B.shape[1]), dtype=complex)
+    if A.shape[0] >= STRUCTURED_STATES:
+        forms = [sampled_modal_form(A, B[:, g], C, D[:, g], dt, max_cond=max_cond, rtol=rtol)
+                 for g in groups]
+        if all(f is not None and np.array_equal(f[0], forms[0][0])
+               and np.array_equal(f[2], forms[0][2]) for f in forms):
+            order = np.concatenate(groups)
+            H[:, :, order] = _modal_eval(forms[0][0], np.hstack([f[1] for f in forms]),
+                                         forms[0][2], D[:, order], np.exp(1j * w * dt))
+            return H
+    for g in groups:
+        H[:, :, g] = sampled_response_at((A, B[:, g], C, D[:, g]), dt, w, max_cond=max_cond,
+                                         rtol=rtol)
+    return H
 
 
 def sampled_modal_form(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray,
@@ -533,6 +565,16 @@ def _backward_error(A, B, C, probe, max_cond) -> float:
     LU factors, no n × n product."""
     if A.shape[0] < STRUCTURED_STATES:
         return np.inf
+    return _BACKWARD.get((A, B, C), (max_cond, tuple(complex(p) for p in probe)),
+                         lambda: _backward_error_of(A, B, C, probe, max_cond))
+
+
+#: :func:`_backward_error` of the last large systems: the grids of one plant's responses,
+#: refined around different loops' poles, share their probes (:func:`_probes`)
+_BACKWARD = ArrayMemo(keep=16, min_states=STRUCTURED_STATES)
+
+
+def _backward_error_of(A, B, C, probe, max_cond) -> float:
     lam, _, lu, _, sc = _EIG.get((A, C), (max_cond, True),
                                  lambda: _eig_form(A, C, max_cond, True))
     if lu is None:

@@ -443,11 +443,8 @@ class JudgedLoop:
         dt = self.loop.dt
         if dt:  # per input group, as sampled_plant samples them
             P, cur = self.source, list(self.control_inputs)
-            H = np.empty((w.size, P.noutputs, P.ninputs), dtype=complex)
-            for group in (cur, [j for j in range(P.ninputs) if j not in cur]):
-                if group:
-                    H[:, :, group] = sampled_response_at(select_inputs(P, group), dt, w)
-            return H
+            return sampled_response_at(P, dt, w, groups=(
+                cur, [j for j in range(P.ninputs) if j not in cur]))
         H = freqresp_at(self.source, 1j * w)
         if self.delay is not None:
             cur = list(self.control_inputs)

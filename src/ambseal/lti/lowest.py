@@ -17,6 +17,7 @@ import scipy.sparse.linalg as spla
 from scipy.optimize import linear_sum_assignment
 
 from ambseal.errors import ModelError
+from ambseal.lti.matrices import ArrayMemo
 
 __all__ = ["DENSE_STATES", "lowest_eigenpairs"]
 
@@ -33,6 +34,9 @@ DENSE_STATES = 1000
 SHIFT_FRACTION = 1e-3
 EXTRA = 10
 NCV_EXTRA = 20
+#: The last sparse results, by matrix and request: a plant with and without force inputs
+#: (one state matrix) is reduced twice by a design. Shared arrays: not to be modified.
+_LOWEST = ArrayMemo(keep=4, min_states=DENSE_STATES)
 
 
 def lowest_eigenpairs(A: np.ndarray, *, count: int = 0, radius: float = 0.0,
@@ -85,7 +89,8 @@ def lowest_eigenpairs(A: np.ndarray, *, count: int = 0, radius: float = 0.0,
         them), when ``left``.
     scale : float
         The size of A's spectrum for rounding tolerances: the largest |λ| (dense), or the
-        1-norm of the balanced matrix, an upper bound of it (sparse).
+        1-norm of the balanced matrix, an upper bound of it (sparse). The sparse path's
+        arrays are kept for the last matrices and requests, shared: do not modify them.
 
     Raises
     ------
@@ -95,7 +100,7 @@ def lowest_eigenpairs(A: np.ndarray, *, count: int = 0, radius: float = 0.0,
     A = np.asarray(A, dtype=float)
     n = A.shape[0]
     if n > DENSE_STATES:
-        got = _arnoldi(A, count, radius, left)
+        got = _LOWEST.get((A,), (count, radius, left), lambda: _arnoldi(A, count, radius, left))
         if got is not None:
             return got
     if left:

@@ -283,6 +283,7 @@ class _StrongPart:
         # balanced first: modal and controller coordinates differ in scale by decades
         # (cond X 4e11 unbalanced, 1.4e2 balanced on a 230-element plant's strong part)
         Mb, (sc, _) = scipy.linalg.matrix_balance(self.M, permute=False, separate=True)
+        self.sc = sc
         self.norm = float(np.linalg.norm(Mb, 1))
         self.mu, Xb = np.linalg.eig(Mb)
         self.X = self.Xi = None
@@ -358,9 +359,9 @@ class _StrongPart:
 
     def _exact(self, idx, feedthrough, tol):
         p = self.mu[idx].copy()
+        sc = self.sc  # balanced as M_R: S(p) differs by the weak modes' feedthrough
         for _ in range(_MAX_ITER):
-            S, _ = scipy.linalg.matrix_balance(self.state_matrix(feedthrough(p.mean())),
-                                               permute=False)
+            S = self.state_matrix(feedthrough(p.mean())) * (1.0 / sc)[:, None] * sc[None, :]
             new = _matched(_nearest_eigenvalues(S, p.mean(), idx.size), p)
             done = np.max(np.abs(new - p)) <= tol
             p = new
@@ -741,9 +742,10 @@ class _Loop:
         for g in _clusters(solved.p_strong, _cluster_tol(solved)):
             p = complex(np.mean(solved.p_strong[g]))
             GT, _ = self._sums(p, strong)  # the weak modes' transfer at p
-            # balanced first, as the strong part's own eigendecomposition
-            Sb, (sc, _) = scipy.linalg.matrix_balance(part.state_matrix(GT), permute=False,
-                                                      separate=True)
+            # balanced first, by the strong part's own balancing: S(p) is M_R but for the
+            # weak modes' small feedthrough
+            sc = part.sc
+            Sb = part.state_matrix(GT) * (1.0 / sc)[:, None] * sc[None, :]
             q = sc[:, None] * _nearest_subspace(Sb, p, g.size)
             xk = q[ns:]
             Fy = np.linalg.inv(np.eye(GT.shape[0]) + GT @ Dk)

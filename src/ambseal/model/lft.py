@@ -109,6 +109,9 @@ class Plant:
     ``y_<axis>`` and outputs ``i_<axis>``, so python-control's ``interconnect`` closes the
     loop by name (with the sign of ``i = −K y``).
 
+    Immutable: its arrays, and the arrays they are views of, are made read-only
+    (:func:`ambseal.lti.freeze`); changes give new plants (:meth:`with_changes`).
+
     Attributes
     ----------
     A : ndarray, shape (n_states, n_states)

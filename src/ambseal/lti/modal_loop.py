@@ -154,7 +154,9 @@ def _split(lam, Bm, Cm, K, discrete) -> _Solved | None:
     # the weak modes' static part G_T(0) (z = 1) is the strong loop's feedthrough (their
     # residual flexibility: first order in the strong poles); what the iterations and the
     # certificate treat is G_T − G_T(0)
-    D0 = _modal_sum(np.ones(1) if discrete else np.zeros(1), lam[weak], Bm[weak], Cm[:, weak])[0]
+    WT = (Cm[:, weak].T[:, :, None] * Bm[weak][:, None, :]).reshape(weak.size, -1)
+    D0 = _sums_at(np.ones(1, complex) if discrete else np.zeros(1, complex), lam[weak],
+                  WT).reshape(Cm.shape[0], Bm.shape[1])
     part = _StrongPart(lam[strong], Bm[strong], Cm[:, strong], (Ak, Bk, Ck, Dk), D0)
     if part.X is None:
         return None
@@ -249,13 +251,6 @@ def _sums_at(points, lam, W, drop=(np.zeros(0, int), np.zeros(0, int)), square=F
             np.multiply(r, r, out=r)
             out2[k0:k1] = r @ W
     return (out, out2) if square else out
-
-
-def _modal_sum(p, lam, Bm, Cm):
-    """``Σ_i c_i b_iᵀ / (p − λ_i)`` at each point, shape (n_p, p_out, m)."""
-    W = (Cm.T[:, :, None] * Bm[:, None, :]).reshape(lam.size, -1)
-    R = 1.0 / (np.atleast_1d(p)[:, None] - lam[None, :])
-    return (R @ W).reshape(-1, Cm.shape[0], Bm.shape[1])
 
 
 class _StrongPart:
@@ -640,11 +635,11 @@ class _Loop:
 
     def _sums(self, p, skip):
         """``Σ c bᵀ/(p − λ)`` and ``Σ c bᵀ/(p − λ)²`` over the modes not in ``skip``."""
-        with np.errstate(divide="ignore", invalid="ignore"):
-            r = 1.0 / (p - self.lam)
-        r[skip] = 0.0
+        skip = np.asarray(skip, int)
+        G, G2 = _sums_at(np.array([p], complex), self.lam, self.W,
+                         (np.zeros(skip.size, int), skip), square=True)
         shape = (self.Cm.shape[0], self.Bm.shape[1])
-        return (r @ self.W).reshape(shape), ((r * r) @ self.W).reshape(shape)
+        return G.reshape(shape), G2.reshape(shape)
 
     def _controller(self, p):
         """``(pI − A_K)⁻¹ B_K``, ``(pI − A_K)⁻¹ E_x`` and ``K(p)``."""

@@ -2,9 +2,11 @@
 
 A face that imported its modules eagerly would load their heavy dependencies with the
 package: ``import ambseal.report`` would load matplotlib, ``ambseal --help`` the numerics of
-every command. The faces of :mod:`ambseal.identify`, :mod:`ambseal.io`,
-:mod:`ambseal.report` and :mod:`ambseal.app` list each public name with the module that
-defines it and load it when it is first asked for.
+every command, ``ambseal modes`` python-control. The faces of :mod:`ambseal.lti`,
+:mod:`ambseal.model`, :mod:`ambseal.robust`, :mod:`ambseal.analysis`,
+:mod:`ambseal.identify`, :mod:`ambseal.io`, :mod:`ambseal.report` and :mod:`ambseal.app`
+list each public name with the module that defines it and load it when it is first asked
+for.
 """
 
 from __future__ import annotations

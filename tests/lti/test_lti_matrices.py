@@ -50,7 +50,7 @@ def test_digest_of_a_frozen_array_is_kept_and_follows_the_content():
     hashed at every lookup, so a change in place gives another digest."""
     import hashlib
 
-    import ambseal.lti.matrices as mx
+    import ambseal.lti.memo as mx
 
     rng = np.random.default_rng(5)
     A = rng.standard_normal((400, 400))  # 1.3 MB: above the kept size

@@ -18,7 +18,7 @@ import ambseal.lti.modal_loop as ml
 from ambseal.config import load_rig
 from ambseal.lti import feedback_matrices, feedback_poles, series_inputs, zoh
 from ambseal.lti.freqresp import modal_form
-from ambseal.lti.matrices import ArrayMemo
+from ambseal.lti.memo import ArrayMemo
 from ambseal.machine.loop import loop_matrices
 from ambseal.model.rig import build_plant
 from ambseal.robust.delay import loop_delay

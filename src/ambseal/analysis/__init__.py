@@ -38,74 +38,41 @@ sampled with its delay) on the full-order plant:
 module's name, and re-exporting it would hide the module (``from ambseal.analysis import
 judge`` would give the function, and the manual's module pages would document it instead).
 
+Each name loads its module on first use (PEP 562 ``__getattr__``,
+:func:`ambseal.lazy.lazy_face`): ``ambseal modes`` of the open loop loads its modes, not the
+judgement's python-control loops.
+
 Conventions: rad/s inside, Hz at the edges (``*_hz``); results are frozen dataclasses with
 ``to_dict()`` (JSON-safe, ``inf`` → ``"inf"``, ``NaN`` → ``None``).
 """
 
-from ambseal.analysis.campbell import (
-    OVERDAMPED_ZETA,
-    Campbell,
-    ClosedLoopModes,
-    closed_loop_modes,
-    log_decrement,
-    open_loop_modes,
-)
-from ambseal.analysis.cases import CaseError, dask_available, probe_scheduler, run_cases
-from ambseal.analysis.delivery import (
-    FailedController,
-    also_failed,
-    loop_failure,
-    synthesis_failure,
-)
-from ambseal.analysis.iso import ZONE_LIMITS, ZONES, IsoAssessment, iso_assessment, zone_limit_db
-from ambseal.analysis.judge import (
-    JudgedCase,
-    JudgeJob,
-    JudgeSettings,
-    LoopJudgement,
-    OperatingPoint,
-    frozen_at,
-    judge_case,
-    judge_jobs,
-    judge_settings,
-    judge_spinup,
-    operating_points,
-    points_for,
-    speed_scheduled,
-    unstable_open_loop_poles,
-)
-from ambseal.analysis.loops import (
-    ComplianceResponse,
-    LoopResponse,
-    SensitivityPeaks,
-    compliance,
-    loop_responses,
-    sensitivity_peaks,
-)
-from ambseal.analysis.ramp import RampResult, pressure_ramp, ramp_simulation
-from ambseal.analysis.response import ImpulseResponse, impulse_response
-from ambseal.analysis.speed_range import (
-    SampledStability,
-    StabilityCase,
-    stability_case,
-    stability_points,
-)
-from ambseal.analysis.spinup import FrozenSensitivity, SpinupResult, frozen_sensitivity
-from ambseal.analysis.sweep import check_cases, parse_range, refine_boundary, stability_boundary
-from ambseal.analysis.unbalance import UnbalanceResponse, unbalance_force, unbalance_response
+from ambseal.lazy import lazy_face
 
-__all__ = ["OVERDAMPED_ZETA", "ZONES", "ZONE_LIMITS", "Campbell", "CaseError",
-           "ClosedLoopModes", "ComplianceResponse", "FailedController", "FrozenSensitivity",
-           "ImpulseResponse", "IsoAssessment", "JudgeJob", "JudgeSettings", "JudgedCase",
-           "LoopJudgement", "LoopResponse", "OperatingPoint", "RampResult", "SensitivityPeaks",
-           "SpinupResult", "SampledStability", "StabilityCase", "UnbalanceResponse",
-           "also_failed", "check_cases", "closed_loop_modes", "compliance", "dask_available",
-           "frozen_at",
-           "frozen_sensitivity", "impulse_response", "iso_assessment", "judge_case",
-           "judge_jobs", "judge_settings", "judge_spinup", "log_decrement", "loop_failure",
-           "loop_responses", "open_loop_modes", "operating_points", "parse_range",
-           "points_for", "pressure_ramp", "probe_scheduler", "ramp_simulation",
-           "refine_boundary", "run_cases", "sensitivity_peaks", "speed_scheduled",
-           "stability_boundary", "stability_case", "stability_points", "synthesis_failure",
-           "unbalance_force", "unbalance_response", "unstable_open_loop_poles",
-           "zone_limit_db"]
+#: Each public name (``__all__``) and the module that defines it.
+_FROM = {
+    "closed_loop_modes": "campbell", "log_decrement": "campbell",
+    "open_loop_modes": "campbell", "Campbell": "campbell", "ClosedLoopModes": "campbell",
+    "OVERDAMPED_ZETA": "campbell", "dask_available": "cases", "probe_scheduler": "cases",
+    "run_cases": "cases", "CaseError": "cases", "also_failed": "delivery",
+    "loop_failure": "delivery", "synthesis_failure": "delivery",
+    "FailedController": "delivery", "iso_assessment": "iso", "zone_limit_db": "iso",
+    "IsoAssessment": "iso", "ZONES": "iso", "ZONE_LIMITS": "iso", "frozen_at": "judge",
+    "judge_case": "judge", "judge_jobs": "judge", "judge_settings": "judge",
+    "judge_spinup": "judge", "operating_points": "judge", "points_for": "judge",
+    "speed_scheduled": "judge", "unstable_open_loop_poles": "judge", "JudgeJob": "judge",
+    "JudgeSettings": "judge", "JudgedCase": "judge", "LoopJudgement": "judge",
+    "OperatingPoint": "judge", "compliance": "loops", "loop_responses": "loops",
+    "sensitivity_peaks": "loops", "ComplianceResponse": "loops", "LoopResponse": "loops",
+    "SensitivityPeaks": "loops", "pressure_ramp": "ramp", "ramp_simulation": "ramp",
+    "RampResult": "ramp", "impulse_response": "response", "ImpulseResponse": "response",
+    "stability_case": "speed_range", "stability_points": "speed_range",
+    "SampledStability": "speed_range", "StabilityCase": "speed_range",
+    "frozen_sensitivity": "spinup", "FrozenSensitivity": "spinup", "SpinupResult": "spinup",
+    "check_cases": "sweep", "parse_range": "sweep", "refine_boundary": "sweep",
+    "stability_boundary": "sweep", "unbalance_force": "unbalance",
+    "unbalance_response": "unbalance", "UnbalanceResponse": "unbalance",
+}
+
+__all__ = sorted(_FROM)
+
+__getattr__, __dir__ = lazy_face(__name__, _FROM)

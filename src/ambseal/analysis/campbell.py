@@ -32,7 +32,6 @@ from scipy.optimize import linear_sum_assignment
 
 from ambseal.analysis.cases import run_cases
 from ambseal.lti import json_float, json_list
-from ambseal.machine import frozen, judged_loop
 from ambseal.model import (
     RIGID_BODY_RAD_S,
     bending_limit_hz,
@@ -42,7 +41,7 @@ from ambseal.model import (
     free_bending_hz,
     poles_near_zero,
 )
-from ambseal.robust import decay_rate, is_stable, loop_delay
+from ambseal.robust import decay_rate, is_stable
 
 __all__ = ["API684_LOG_DEC", "OVERDAMPED_ZETA", "ClosedLoopModes", "Crossing", "Campbell",
            "log_decrement", "lowest_log_decrement", "whirl_of", "closed_loop_state_matrix",
@@ -188,6 +187,11 @@ def closed_loop_state_matrix(cfg, controller=None, *, speed_hz: float,
     mesh = build_mesh(cfg)
     if controller is None or not cfg.amb:
         return plant.A, mesh
+    # imported here: the open loop's modes (``ambseal modes``) need none of the loop's
+    # python-control machinery, which costs 1 s of start-up
+    from ambseal.machine import frozen, judged_loop
+    from ambseal.robust import loop_delay  # python-control, as above
+
     G = plant.select_inputs([plant.input_names[j] for j in plant.current_inputs()]
                             ).to_statespace()
     L = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples).system

@@ -36,45 +36,31 @@ The lowest numerical layer (it imports only :mod:`ambseal.errors`); each idea on
 ``freqresp`` is not re-exported here: it shares its module's name, and re-exporting it
 would hide :mod:`ambseal.lti.freqresp` (``import ambseal.lti.freqresp as fr`` would then
 give the function).
+
+Each name loads its module on first use (PEP 562 ``__getattr__``,
+:func:`ambseal.lazy.lazy_face`): the modules on ``control.StateSpace`` load python-control
+(1 s of start-up), which the model's modes do not need.
 """
 
-from ambseal.lti.compiled import cached_njit
-from ambseal.lti.discrete import discretize, simulate_lti, simulate_modal_loop, zoh
-from ambseal.lti.freqresp import (
-    STRUCTURED_STATES,
-    eigenvalues,
-    freqresp_at,
-    sampled_modal_form,
-    sampled_response_at,
-)
-from ambseal.lti.interconnect import (
-    feedback_matrices,
-    feedback_poles,
-    feedback_response,
-    lft_lower,
-    lft_lower_matrices,
-    series_inputs,
-    state_poles,
-    wired,
-)
-from ambseal.lti.json_safe import finite_or_none, finite_or_none_tree, json_float, json_list
-from ambseal.lti.lowest import DENSE_STATES, lowest_eigenpairs
-from ambseal.lti.matrices import (
-    ArrayMemo,
-    as_omega,
-    freeze,
-    labels,
-    select_inputs,
-    shared_ss,
-    ss_matrices,
-)
-from ambseal.lti.pickling import picklable
-from ambseal.lti.tables import interp_table
+from ambseal.lazy import lazy_face
 
-__all__ = ["ArrayMemo", "DENSE_STATES", "STRUCTURED_STATES", "as_omega", "cached_njit",
-           "discretize", "eigenvalues", "feedback_matrices", "feedback_poles",
-           "feedback_response", "finite_or_none", "finite_or_none_tree", "freeze", "freqresp_at",
-           "interp_table", "json_float", "json_list", "labels", "lft_lower",
-           "lft_lower_matrices", "lowest_eigenpairs", "picklable", "sampled_modal_form",
-           "sampled_response_at", "select_inputs", "series_inputs", "shared_ss",
-           "simulate_lti", "simulate_modal_loop", "ss_matrices", "state_poles", "wired", "zoh"]
+#: Each public name (``__all__``) and the module that defines it.
+_FROM = {
+    "cached_njit": "compiled", "discretize": "discrete", "simulate_lti": "discrete",
+    "simulate_modal_loop": "discrete", "zoh": "discrete", "STRUCTURED_STATES": "freqresp",
+    "eigenvalues": "freqresp", "freqresp_at": "freqresp", "sampled_modal_form": "freqresp",
+    "sampled_response_at": "freqresp", "feedback_matrices": "interconnect",
+    "feedback_poles": "interconnect", "feedback_response": "interconnect",
+    "lft_lower": "interconnect", "lft_lower_matrices": "interconnect",
+    "series_inputs": "interconnect", "state_poles": "interconnect", "wired": "interconnect",
+    "finite_or_none": "json_safe", "finite_or_none_tree": "json_safe",
+    "json_float": "json_safe", "json_list": "json_safe", "DENSE_STATES": "lowest",
+    "lowest_eigenpairs": "lowest", "ArrayMemo": "memo", "as_omega": "matrices",
+    "freeze": "memo", "labels": "matrices", "select_inputs": "matrices",
+    "shared_ss": "matrices", "ss_matrices": "matrices", "picklable": "pickling",
+    "interp_table": "tables",
+}
+
+__all__ = sorted(_FROM)
+
+__getattr__, __dir__ = lazy_face(__name__, _FROM)

@@ -24,7 +24,7 @@ import scipy.linalg as sla
 
 from ambseal.errors import ModelError
 from ambseal.lti.compiled import cached_njit
-from ambseal.lti.matrices import ArrayMemo
+from ambseal.lti.memo import ArrayMemo
 
 __all__ = ["zoh", "discretize", "simulate_lti", "simulate_modal_loop"]
 
@@ -59,7 +59,7 @@ def zoh(A: np.ndarray, B: np.ndarray, dt: float, *, keep: bool = True
     -----
     Franklin, Powell & Workman, *Digital Control of Dynamic Systems*, 3rd ed., §6.3: one
     ``expm`` of ``[[A, B], [0, 0]]·dt``, after a diagonal balancing of ``A``. The result for
-    the last few large ``(A, B, dt)`` is kept (:class:`~ambseal.lti.matrices.ArrayMemo`):
+    the last few large ``(A, B, dt)`` is kept (:class:`~ambseal.lti.memo.ArrayMemo`):
     a large plant is sampled once for every controller closed with it.
     """
     if not keep:

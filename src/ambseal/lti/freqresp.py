@@ -40,7 +40,8 @@ from slycot import tb05ad
 
 from ambseal.errors import ModelError
 from ambseal.lti.discrete import zoh
-from ambseal.lti.matrices import ArrayMemo, as_omega, ss_matrices
+from ambseal.lti.matrices import as_omega, ss_matrices
+from ambseal.lti.memo import ArrayMemo
 
 __all__ = ["eigenvalues", "freqresp", "freqresp_at", "modal_form", "sampled_modal_form",
            "sampled_response_at", "STRUCTURED_STATES"]

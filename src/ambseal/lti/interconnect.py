@@ -28,7 +28,8 @@ import numpy as np
 from ambseal.errors import ModelError
 from ambseal.lti.discrete import zoh
 from ambseal.lti.freqresp import STRUCTURED_STATES, modal_form
-from ambseal.lti.matrices import ArrayMemo, labels, ss_matrices
+from ambseal.lti.matrices import labels, ss_matrices
+from ambseal.lti.memo import ArrayMemo
 from ambseal.lti.modal_loop import modal_loop_poles, modal_loop_response
 
 __all__ = ["lft_lower_matrices", "lft_lower", "feedback_matrices", "feedback_poles",
@@ -175,7 +176,7 @@ _POLES = ArrayMemo(keep=64)
 
 def state_poles(A: np.ndarray) -> np.ndarray:
     """Eigenvalues of a state matrix ``A`` (rad/s, or z of a discrete system), kept for the
-    last few large ones (:class:`~ambseal.lti.matrices.ArrayMemo`): a caller asks for the
+    last few large ones (:class:`~ambseal.lti.memo.ArrayMemo`): a caller asks for the
     poles of the same large loop several times (its stability after a synthesis, a
     discretisation's prewarp frequency and stability screen, a later analysis).
 

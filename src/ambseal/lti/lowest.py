@@ -17,7 +17,7 @@ import scipy.sparse.linalg as spla
 from scipy.optimize import linear_sum_assignment
 
 from ambseal.errors import ModelError
-from ambseal.lti.matrices import ArrayMemo
+from ambseal.lti.memo import ArrayMemo
 
 __all__ = ["DENSE_STATES", "lowest_eigenpairs"]
 

@@ -62,7 +62,7 @@ import numpy as np
 import scipy.linalg
 from scipy.spatial import cKDTree
 
-from ambseal.lti.matrices import ArrayMemo
+from ambseal.lti.memo import ArrayMemo
 
 __all__ = ["WEAK", "modal_loop_poles", "modal_loop_response"]
 

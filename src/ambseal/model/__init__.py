@@ -30,51 +30,32 @@ Each element owns its matrices and parameter channels; the rig only assembles th
 hide :mod:`ambseal.model.modes` (``from ambseal.model import modes`` would then give the
 function); call :func:`ambseal.model.modes.modes`.
 
+Each name loads its module on first use (PEP 562 ``__getattr__``,
+:func:`ambseal.lazy.lazy_face`): ``ambseal modes`` loads the rotor, its supports and their
+modes, not the plant's python-control form.
+
 Units are SI throughout (m, kg, s, N, A, rad/s, Pa); node DOFs are ``[x, y, α, β]``.
 """
 
-from ambseal.model.amb import (
-    AmbElement,
-    actuator_matrices,
-    amb_factors,
-    axes_rotation,
-    bias_current,
-    bias_currents,
-    channel_names,
-    eddy_lag_matrices,
-)
-from ambseal.model.fe import BeamElement, DiskElement
-from ambseal.model.lft import Channel, Parameter, Plant
-from ambseal.model.modes import (
-    RIGID_BODY_RAD_S,
-    Modes,
-    PoleDisk,
-    bending_limit_hz,
-    classify_poles,
-    free_bending_hz,
-    modes_from_poles,
-    poles_near_zero,
-)
-from ambseal.model.reduction import ModalReduction, modal_reduction
-from ambseal.model.rig import SecondOrderSystem, build_plant, build_system, mechanical_plant
-from ambseal.model.rotor import Mesh, RotorMatrices, assemble_rotor, build_mesh
-from ambseal.model.seal import (
-    SealElement,
-    coefficient_value,
-    pressure_for_k,
-    seal_coefficients,
-    seal_values,
-    values_following,
-    values_following_k,
-)
-from ambseal.model.spring import SpringElement
+from ambseal.lazy import lazy_face
 
-__all__ = ["RIGID_BODY_RAD_S", "AmbElement", "BeamElement", "Channel", "DiskElement", "Mesh",
-           "ModalReduction", "Modes", "Parameter", "Plant", "PoleDisk", "RotorMatrices",
-           "SealElement", "SecondOrderSystem", "SpringElement", "actuator_matrices",
-           "amb_factors", "assemble_rotor", "axes_rotation", "bending_limit_hz",
-           "bias_current", "bias_currents", "build_mesh", "build_plant", "build_system",
-           "channel_names", "classify_poles", "coefficient_value", "eddy_lag_matrices",
-           "free_bending_hz", "mechanical_plant", "modal_reduction", "modes_from_poles",
-           "poles_near_zero", "pressure_for_k", "seal_coefficients", "seal_values",
-           "values_following", "values_following_k"]
+#: Each public name (``__all__``) and the module that defines it.
+_FROM = {
+    "AmbElement": "amb", "actuator_matrices": "amb", "amb_factors": "amb",
+    "axes_rotation": "amb", "bias_current": "amb", "bias_currents": "amb",
+    "channel_names": "amb", "eddy_lag_matrices": "amb", "BeamElement": "fe",
+    "DiskElement": "fe", "Channel": "lft", "Parameter": "lft", "Plant": "lft",
+    "Modes": "modes", "PoleDisk": "modes", "RIGID_BODY_RAD_S": "modes",
+    "bending_limit_hz": "modes", "classify_poles": "modes", "free_bending_hz": "modes",
+    "modes_from_poles": "modes", "poles_near_zero": "modes", "ModalReduction": "reduction",
+    "modal_reduction": "reduction", "SecondOrderSystem": "rig", "build_plant": "rig",
+    "build_system": "rig", "mechanical_plant": "rig", "Mesh": "rotor",
+    "RotorMatrices": "rotor", "assemble_rotor": "rotor", "build_mesh": "rotor",
+    "SealElement": "seal", "coefficient_value": "seal", "pressure_for_k": "seal",
+    "seal_coefficients": "seal", "seal_values": "seal", "values_following": "seal",
+    "values_following_k": "seal", "SpringElement": "spring",
+}
+
+__all__ = sorted(_FROM)
+
+__getattr__, __dir__ = lazy_face(__name__, _FROM)

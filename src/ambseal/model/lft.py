@@ -17,11 +17,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 
-import control
 import numpy as np
 
+import ambseal.lti as lti
 from ambseal.errors import ModelError
-from ambseal.lti import freeze, picklable, series_inputs, shared_ss
+
+# ``lti.name`` is looked up where it is used (ambseal.lti loads each name's module on first
+# use), and python-control is imported in the one method that calls it: the model's modes
+# (``ambseal modes``) use the channels of the rotor's elements only, and python-control
+# costs 1 s of start-up.
 
 __all__ = ["Channel", "Parameter", "Plant", "channel_tag"]
 
@@ -90,7 +94,7 @@ class Parameter:
 
     def __post_init__(self):
         for X in (self.B, self.C, self.D):  # read-only: shared with every copy of the plant
-            freeze(X)
+            lti.freeze(X)
 
     @property
     def repeats(self) -> int:
@@ -148,7 +152,7 @@ class Plant:
         # once for a frozen array (ambseal.lti.freeze), and build_plant hands the same
         # plant to every caller
         for X in (self.A, self.B, self.C, self.D):
-            freeze(X)
+            lti.freeze(X)
 
     @property
     def n_states(self) -> int:
@@ -219,9 +223,8 @@ class Plant:
     def to_statespace(self):
         """The plant as a ``control.StateSpace`` with named inputs, outputs and states; its
         ``A`` shared with the plant's (:func:`ambseal.lti.shared_ss`), not copied."""
-
-        picklable()
-        return shared_ss(
+        lti.picklable()
+        return lti.shared_ss(
             self.A,
             self.B,
             self.C,
@@ -238,8 +241,9 @@ class Plant:
         gives the plant with changes θ. The θ channels are named ``w_<tag>``, ``z_<tag>``
         with :func:`channel_tag` (python-control allows no '.' in a signal name).
         """
+        import control  # start-up: see the imports
 
-        picklable()
+        lti.picklable()
         Bt, Ct, Dt = self.channels(names)
         r = Bt.shape[1]
         tags = [channel_tag(n, j) for n in names for j in range(self.parameter(n).repeats)]
@@ -284,7 +288,7 @@ class Plant:
         The actuator states are appended; a parameter whose D_θ acted on the actuated input
         (a force factor Ki) then acts through C_θ on the actuator's output, so Ki enters A.
         """
-        A, B, C, D, C_out, D_out = series_inputs((self.A, self.B, self.C, self.D),
+        A, B, C, D, C_out, D_out = lti.series_inputs((self.A, self.B, self.C, self.D),
                                                  (Aa, Ba, Ca, Da), inputs)
         na = Aa.shape[0]
         params = {}

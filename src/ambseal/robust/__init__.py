@@ -32,49 +32,34 @@ Sign conventions. The synthesis functions and :func:`lft_lower` work on the lowe
 :class:`DigitalController`, :class:`DiscreteController` — map measurements to actuator
 commands with negative feedback, ``u = −K y``; the caller converts one into the other
 (the layer that knows which signals are measurements and which are commands).
+
+Each name loads its module on first use (PEP 562 ``__getattr__``,
+:func:`ambseal.lazy.lazy_face`): the stability rule needs neither python-control nor the
+SDP solver.
 """
 
-from ambseal.robust.delay import DesignDelay, design_delay, loop_delay
-from ambseal.robust.dgk import musyn_dgk
-from ambseal.robust.digital import (
-    DISCRETISATIONS,
-    FAST_FRACTION,
-    HOLDS,
-    KEPT,
-    PEAK_TOLERANCE,
-    DigitalController,
-    check_rate,
-    choose_method,
-    chosen_error,
-    digital_controller,
-    discretize_as,
-    hold_keeps,
-    peak_difference,
-    prewarp_frequency_hz,
-    residualize,
-    sampled_plants,
-    split_fast,
-    with_delay,
-)
-from ambseal.robust.digital_loop import (
-    DiscreteController,
-    closed_loop_matrices,
-    discrete_controller,
-)
-from ambseal.robust.dk import MusynResult, design_omega, fit_magnitude, musyn
-from ambseal.robust.hinf import HinfResult, hinfnorm, hinfsyn, lft_lower
-from ambseal.robust.lpv import LpvController, LpvSynResult, lpvsyn
-from ambseal.robust.mu import MuResult, mussv
-from ambseal.robust.order import ReductionResult, balred_controller, reduce_controller
-from ambseal.robust.stability import decay_rate, is_stable, unstable_poles
+from ambseal.lazy import lazy_face
 
-__all__ = ["DISCRETISATIONS", "FAST_FRACTION", "HOLDS", "KEPT", "PEAK_TOLERANCE",
-           "DesignDelay", "DigitalController", "DiscreteController", "HinfResult",
-           "LpvController", "LpvSynResult", "MuResult", "MusynResult", "ReductionResult",
-           "balred_controller", "check_rate", "choose_method",
-           "chosen_error", "closed_loop_matrices", "decay_rate", "design_delay",
-           "design_omega", "digital_controller", "discrete_controller", "discretize_as",
-           "fit_magnitude", "hinfnorm", "hinfsyn", "hold_keeps", "is_stable", "lft_lower",
-           "loop_delay", "lpvsyn", "musyn", "musyn_dgk", "mussv", "peak_difference",
-           "prewarp_frequency_hz", "reduce_controller", "residualize", "sampled_plants",
-           "split_fast", "unstable_poles", "with_delay"]
+#: Each public name (``__all__``) and the module that defines it.
+_FROM = {
+    "design_delay": "delay", "loop_delay": "delay", "DesignDelay": "delay",
+    "musyn_dgk": "dgk", "check_rate": "digital", "choose_method": "digital",
+    "chosen_error": "digital", "digital_controller": "digital", "discretize_as": "digital",
+    "hold_keeps": "digital", "peak_difference": "digital",
+    "prewarp_frequency_hz": "digital", "residualize": "digital",
+    "sampled_plants": "digital", "split_fast": "digital", "with_delay": "digital",
+    "DISCRETISATIONS": "digital", "DigitalController": "digital",
+    "FAST_FRACTION": "digital", "HOLDS": "digital", "KEPT": "digital",
+    "PEAK_TOLERANCE": "digital", "closed_loop_matrices": "digital_loop",
+    "discrete_controller": "digital_loop", "DiscreteController": "digital_loop",
+    "design_omega": "dk", "fit_magnitude": "dk", "musyn": "dk", "MusynResult": "dk",
+    "hinfnorm": "hinf", "hinfsyn": "hinf", "lft_lower": "hinf", "HinfResult": "hinf",
+    "lpvsyn": "lpv", "LpvController": "lpv", "LpvSynResult": "lpv", "mussv": "mu",
+    "MuResult": "mu", "balred_controller": "order", "reduce_controller": "order",
+    "ReductionResult": "order", "decay_rate": "stability", "is_stable": "stability",
+    "unstable_poles": "stability",
+}
+
+__all__ = sorted(_FROM)
+
+__getattr__, __dir__ = lazy_face(__name__, _FROM)

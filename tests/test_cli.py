@@ -105,6 +105,23 @@ def test_modes_json_keys_and_unstable_poles(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["unstable_poles"] == []
 
 
+def test_modes_of_the_open_loop_loads_no_control_numerics():
+    """``ambseal modes`` without ``--controller`` or ``--shapes`` loads neither
+    python-control, numba, matplotlib nor CVXOPT (1.8 s of start-up: a third of ``modes`` on
+    a 230-element rotor); checked on ``sys.modules`` of a subprocess, and with
+    ``--controller pid`` python-control is loaded (so the check can fail)."""
+    code = ("import sys\nfrom ambseal.cli import main\n"
+            "assert main(['modes', '--json'] + sys.argv[1:]) == 0\n"
+            "print([m for m in ('control', 'numba', 'matplotlib', 'cvxopt')\n"
+            "       if m in sys.modules])\n")
+    run_ = [sys.executable, "-c", code]
+    lean = subprocess.run(run_, capture_output=True, text=True, check=True)
+    assert lean.stdout.strip().splitlines()[-1] == "[]"
+    closed = subprocess.run(run_ + ["--controller", "pid"], capture_output=True, text=True,
+                            check=True)
+    assert "'control'" in closed.stdout.strip().splitlines()[-1]
+
+
 def test_plain_bearing_rig_is_valid_for_modes(tmp_path, capsys):
     """A rotor on two plain bearings (springs, no AMB): a valid rig; its first mode is the
     rigid translation at √(2k/m)/2π for stiff shafts (closed form)."""

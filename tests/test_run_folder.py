@@ -270,12 +270,12 @@ def test_every_folder_command_refuses_a_users_folder(tmp_path, capsys, monkeypat
     """Each command that writes a folder refuses one holding a file it did not write,
     before any work (the design would fail the test), one line naming the file, exit 2."""
     import ambseal.app.commands as commands
-    import ambseal.app.rotordynamics as rotordynamics
+    import ambseal.app.controllers as controllers
 
     def no_work(*a, **k):
         raise AssertionError("working before the output folder was checked")
 
-    for module in (commands, rotordynamics):  # they hold the design function by name
+    for module in (commands, controllers):  # they hold the design function by name
         monkeypatch.setattr(module, "design", no_work)
     rig = str(ROOT / "examples" / "testrig.toml")
     out = tmp_path / "mine"

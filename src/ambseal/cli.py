@@ -464,10 +464,14 @@ def main(argv: list[str] | None = None) -> int:
 
     # The commands' code loads python-control, scipy.signal and matplotlib (1.6 s of a
     # 1.8 s start on a 2-core machine): imported once a command runs, so that --help and
-    # argument errors answer at once.
-    from ambseal.app import HANDLERS
+    # argument errors answer at once; `modes`, a quick look at a model, loads its own
+    # module only (ambseal.app.modes).
+    if args.command == "modes":
+        from ambseal.app import modes_command as handler  # start-up, as above
+    else:
+        from ambseal.app import HANDLERS  # start-up, as above
 
-    handler = HANDLERS[args.command]
+        handler = HANDLERS[args.command]
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("default")
         try:

@@ -231,3 +231,33 @@ def test_open_loop_modes_sparse_equal_dense(rigs, monkeypatch, speed_rpm):
     np.testing.assert_allclose(np.abs(got.shapes), np.abs(ref.shapes), atol=1e-4)
     assert got.stable == ref.stable is False and got.max_real_pole == pytest.approx(
         ref.max_real_pole, rel=1e-8)
+
+
+def test_open_loop_modes_take_the_disk_the_judged_poles_ask(rigs, monkeypatch):
+    """Reference: the dense eig with eigenvectors (``modes_of_state_matrix``). Below 4 Hz
+    the test rig has two heavily damped pairs (ζ ≈ 0.998, |λ| ≈ 320 rad/s), outside the
+    disk of 2π·4 Hz: once the judged poles show them the disk is enlarged, and they are
+    listed as the dense path lists them — the same with the judged poles as an array or as
+    a callable (``ambseal modes`` computes them in another thread meanwhile), called once;
+    without judged poles they are not seen."""
+    from ambseal.analysis.campbell import modes_of_state_matrix, open_loop_modes
+
+    monkeypatch.setattr(modes_mod, "DENSE_STATES", 0)
+    monkeypatch.setattr(modes_mod, "EXTRA_EIGENVALUES", 2)  # a first disk of 4 eigenvalues
+    sys = build_system(rigs["testrig"])
+    kw = {"speed_hz": 0.0, "pressure_bar": 2.04, "max_hz": 4.0}
+    ref = modes_of_state_matrix(sys.state_matrices()[0], sys.mesh, **kw)
+    assert ref.poles.size == 2 and np.all(np.abs(ref.poles) > 10 * 2 * np.pi * 4.0)
+    calls = []
+
+    def every_pole():
+        calls.append(1)
+        return sys.poles()
+
+    got = open_loop_modes(sys, judged_poles=every_pole, **kw)
+    assert calls == [1]
+    np.testing.assert_allclose(got.frequency_hz, ref.frequency_hz, rtol=1e-8)
+    np.testing.assert_allclose(got.damping_ratio, ref.damping_ratio, rtol=1e-6)
+    np.testing.assert_array_equal(
+        open_loop_modes(sys, judged_poles=sys.poles(), **kw).poles, got.poles)
+    assert open_loop_modes(sys, **kw).poles.size == 0

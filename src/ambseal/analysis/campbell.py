@@ -281,10 +281,13 @@ def open_loop_modes(sys, *, speed_hz: float, pressure_bar: float, max_hz: float,
         Where the model was taken (recorded in the result).
     max_hz : float
         Highest damped frequency kept (Hz).
-    judged_poles : array_like of complex, optional
+    judged_poles : array_like of complex, or callable, optional
         Eigenvalues (rad/s) that decide ``stable`` and ``max_real_pole``, e.g. every pole of
         the model (:meth:`~ambseal.model.rig.SecondOrderSystem.poles`); default those
-        computed here (the disk only, on a fine mesh).
+        computed here (the disk only, on a fine mesh). A callable returning them is called
+        once the disk is computed: a dense eig running in another thread meanwhile
+        (``ambseal modes``) takes the wall time of the longer of the two, and the result
+        is the same as with the array.
 
     Returns
     -------
@@ -299,14 +302,20 @@ def open_loop_modes(sys, *, speed_hz: float, pressure_bar: float, max_hz: float,
     """
 
     radius = 2 * np.pi * float(max_hz)
+    disk = poles_near_zero(sys, radius_rad_s=radius * (1 + 1e-6), vectors=True)
     w_max = None
+    if callable(judged_poles):
+        judged_poles = judged_poles()
     if judged_poles is not None:
         judged_poles = np.asarray(judged_poles, dtype=complex)
         w_max = float(np.abs(judged_poles).max(initial=0.0))
         osc = judged_poles[(judged_poles.imag >= RIGID_BODY_RAD_S)
                            & (judged_poles.imag <= radius)]
         radius = max(radius, float(np.abs(osc).max(initial=0.0)))
-    disk = poles_near_zero(sys, radius_rad_s=radius * (1 + 1e-6), vectors=True)
+        if not disk.radius_rad_s > radius * (1 + 1e-6):
+            # a larger disk; the one above stopped at the first k whose disk held the
+            # smaller radius, so asking the larger one first would give the same eigenpairs
+            disk = poles_near_zero(sys, radius_rad_s=radius * (1 + 1e-6), vectors=True)
     return _modes_of_pairs(disk.poles, disk.shapes, sys.mesh, speed_hz=speed_hz,
                            pressure_bar=pressure_bar, max_hz=max_hz,
                            verdict=disk.poles if judged_poles is None else judged_poles,

@@ -4,7 +4,8 @@ Wiring only, like :mod:`ambseal.app.commands`: the numbers come from
 :mod:`ambseal.analysis.campbell`, :mod:`ambseal.analysis.sweep` and :mod:`ambseal.io.ross`,
 the figures from :mod:`ambseal.report.modal_figures`, and every file is written through a
 temporary name and a rename (:mod:`ambseal.files`). The CLI (:mod:`ambseal.cli`) parses these
-subcommands and runs them with :data:`HANDLERS`.
+subcommands and runs them with :data:`HANDLERS`; ``modes`` is :mod:`ambseal.app.modes`',
+which the CLI loads alone.
 """
 
 from __future__ import annotations
@@ -18,12 +19,9 @@ import sys
 from pathlib import Path
 
 from ambseal.analysis import (
-    OVERDAMPED_ZETA,
     check_cases,
-    closed_loop_modes,
     dask_available,
     judge_settings,
-    open_loop_modes,
     parse_range,
     probe_scheduler,
     refine_boundary,
@@ -31,45 +29,22 @@ from ambseal.analysis import (
 )
 from ambseal.analysis.campbell import campbell
 from ambseal.analysis.sweep import sweep
+from ambseal.app.controllers import controller_for
+from ambseal.app.modes import mode_positions, modes_command
 from ambseal.config import (
     MAX_COEFFICIENT,
     MAX_PRESSURE_BAR,
     MAX_SPEED_HZ,
     load_rig,
-    method_names,
     rig_parameter_names,
 )
-from ambseal.design import design, design_spec
+from ambseal.design import design_spec
 from ambseal.errors import ConfigError
-from ambseal.export import load_controller
-from ambseal.files import OwnedFolder, atomic_write, claim_file, write_json, write_text
+from ambseal.files import OwnedFolder, atomic_write, write_json, write_text
 from ambseal.io import import_ross_file
-from ambseal.model import bending_limit_hz, build_system, channel_names
-from ambseal.model.modes import modes
-from ambseal.report import campbell_figure, figure_is_ours, mode_shapes_figure, stability_map_figure
-from ambseal.robust import DigitalController, unstable_poles
+from ambseal.report import campbell_figure, mode_shapes_figure, stability_map_figure
 
-__all__ = ["HANDLERS", "controller_for", "write_table"]
-
-
-def controller_for(cfg, spec: str | None, pressure_bar: float | None = None):
-    """The controller ``spec`` names: ``pid``, ``hinf`` or ``mu`` (designed on the rig by
-    :func:`ambseal.design.recipes.design` at ``pressure_bar``), or a controller file of
-    ``ambseal design`` (.json, .npz, .mat) — its kind checked and wired to the rig's
-    channels by signal name (:func:`~ambseal.export.controller_files.load_controller`);
-    ``None`` or ``"none"`` for the open loop."""
-    if spec is None or spec == "none":
-        return None
-
-    if spec in method_names(fixed=True):
-        return design(cfg, spec, pressure_bar=pressure_bar).K
-    if Path(spec).suffix.lower() not in (".json", ".npz", ".mat"):
-        raise ConfigError(f"--controller: expected {', '.join(method_names(fixed=True))}, "
-                          f"none or a controller file "
-                          f"(.json, .npz, .mat), got {spec!r}")
-
-    K = load_controller(spec, channel_names(cfg))  # a judged digital one: its continuous design
-    return K.continuous if isinstance(K, DigitalController) else K
+__all__ = ["HANDLERS", "write_table"]
 
 
 def write_table(path: Path, rows: list[dict]) -> list[Path]:
@@ -93,11 +68,6 @@ def write_table(path: Path, rows: list[dict]) -> list[Path]:
     return files + [pq_path]
 
 
-def _positions(cfg) -> dict[str, list[float]]:
-    return {"AMB": [a.position for a in cfg.amb], "sensor": [a.sensor_position for a in cfg.amb],
-            "seal": [s.position for s in cfg.seal], "disk": [d.position for d in cfg.disk]}
-
-
 def _range(text: str | None, name: str, low: float, high: float, rule: str):
     """The points of ``a:b:n`` (:func:`~ambseal.analysis.sweep.parse_range`), each within
     [low, high] by the rig file's ``rule``; None for None."""
@@ -113,82 +83,6 @@ def _range(text: str | None, name: str, low: float, high: float, rule: str):
 #: The bounds of the ranges, by the rig file's rules (ambseal.config._checks).
 _SPEEDS = (-MAX_SPEED_HZ, MAX_SPEED_HZ, "the bound of [operating] speed_range_hz")
 _PRESSURES = (0.0, MAX_PRESSURE_BAR, "the rule of [operating] pressure_bar")
-
-
-def _modes(args: argparse.Namespace) -> int:
-    cfg = load_rig(args.rig)
-    if args.shapes is not None:  # before any work
-        claim_file(args.shapes, force=args.force, ours=figure_is_ours)
-    p = cfg.operating.pressure_bar if args.pressure_bar is None else args.pressure_bar
-    rpm = cfg.operating.speed_rpm if args.speed_rpm is None else args.speed_rpm
-    if args.controller is not None and (args.free or args.no_amb):
-        raise ConfigError("modes: --controller closes the loop over the AMBs; it cannot be "
-                          "combined with --free or --no-amb")
-    sys_ = build_system(cfg, speed_rpm=rpm, pressure_bar=p,
-                        include_amb=not (args.free or args.no_amb), include_seals=not args.free,
-                        include_springs=not args.free)
-    res = modes(sys_, n_modes=args.n_modes)
-    f_max = args.max_hz if args.max_hz is not None else (
-        max(res.natural_frequencies_hz, default=0.0) if args.n_modes else bending_limit_hz(cfg))
-    K = controller_for(cfg, args.controller, p)
-    # --n-modes: the N-th frequency comes from another eigen-solve than the modes listed, so
-    # it may lie a rounding below theirs (the solvers agree to 1e-8, model.modes.modes)
-    keep_hz = f_max * (1 + 1e-8) if args.n_modes and args.max_hz is None else f_max
-    if K is None:  # the shapes from the lowest eigenpairs; the verdict from every pole computed
-        m = open_loop_modes(sys_, speed_hz=rpm / 60.0, pressure_bar=p, max_hz=keep_hz,
-                            judged_poles=res.poles)
-    else:
-        m = closed_loop_modes(cfg, K, speed_hz=rpm / 60.0, pressure_bar=p, max_hz=keep_hz)
-    unstable = res.unstable_poles if K is None else [
-        (float(z.real), float(z.imag)) for z in unstable_poles(m.poles)]
-    out = {"speed_hz": rpm / 60.0, "pressure_bar": p, "max_hz": f_max,
-           "controller": args.controller or "none", **_mode_lists(m),
-           "unstable_poles": [list(z) for z in unstable]}
-    if args.shapes is not None:
-        out["shapes"] = str(mode_shapes_figure(Path(args.shapes), m, _positions(cfg)))
-    if args.json:
-        print(json.dumps(out, indent=2))
-    else:
-        _print_modes(out, rpm)
-    return 0
-
-
-def _mode_lists(m) -> dict:
-    """The modes' frequencies, damping, log decrements and whirl, the overdamped ones
-    apart: a pair damped at ζ ≥ 1/√2 has no resonance (|H(jω)| of its mode falls
-    monotonically), no natural frequency to avoid, listed apart as `campbell` lists its
-    crossings."""
-    over = m.damping_ratio >= OVERDAMPED_ZETA
-    resonant = ~over
-    return {"natural_frequencies_hz": [float(x) for x in m.frequency_hz[resonant]],
-            "damping_ratios": [float(x) for x in m.damping_ratio[resonant]],
-            "log_decrements": [float(x) for x in m.log_decrement[resonant]],
-            "whirl": [w for w, r in zip(m.whirl, resonant) if r],
-            "overdamped": [{"frequency_hz": float(f), "damping_ratio": float(z), "whirl": w}
-                           for f, z, w, o in zip(m.frequency_hz, m.damping_ratio, m.whirl,
-                                                 over) if o]}
-
-
-def _print_modes(out: dict, rpm: float) -> None:
-    """``ambseal modes``' table (``out`` as its JSON) on stdout."""
-    print(f"speed {rpm / 60.0:g} Hz ({rpm:g} rpm), pressure drop {out['pressure_bar']:g} bar, "
-          f"controller {out['controller']}, modes up to {out['max_hz']:.4g} Hz")
-    print(f"{'mode':>4}  {'f_d [Hz]':>12}  {'zeta [-]':>10}  {'log dec':>9}  whirl")
-    for i, (f, z, d, w) in enumerate(zip(out["natural_frequencies_hz"], out["damping_ratios"],
-                                         out["log_decrements"], out["whirl"]), 1):
-        print(f"{i:>4}  {f:>12.3f}  {z:>10.4f}  {d:>9.4f}  {w}")
-    if out["overdamped"]:
-        print(f"overdamped (zeta >= {OVERDAMPED_ZETA:.3f}, no resonance): "
-              + ", ".join(f"{o['frequency_hz']:.4g} Hz (zeta {o['damping_ratio']:.3f})"
-                          for o in out["overdamped"]))
-    if out["unstable_poles"]:
-        print("unstable poles [rad/s]:")
-        for re, im in out["unstable_poles"]:
-            print(f"  {re:+.4g} {im:+.4g}j")
-    else:
-        print("no unstable poles")
-    if "shapes" in out:
-        print(f"mode shapes: {out['shapes']}")
 
 
 def _owns_out(handler):
@@ -218,7 +112,7 @@ def _campbell(args: argparse.Namespace) -> int:
     tag = Path(spec).stem if spec else "open_loop"
     title = f"{cfg.rotor.name}: {tag}, {p:g} bar"
     files = [campbell_figure(out / f"campbell_{tag}.png", c, title=f"Campbell — {title}"),
-             mode_shapes_figure(out / f"mode_shapes_{tag}.png", c.points[0], _positions(cfg),
+             mode_shapes_figure(out / f"mode_shapes_{tag}.png", c.points[0], mode_positions(cfg),
                                 title=f"Mode shapes — {cfg.rotor.name}: {tag}"),
              write_json(out / f"campbell_{tag}.json",
                         {"rig": str(args.rig), "controller": spec or "none",
@@ -293,5 +187,5 @@ def _import_ross(args: argparse.Namespace) -> int:
     return 0
 
 
-HANDLERS = {"modes": _modes, "campbell": _campbell, "sweep": _sweep,
+HANDLERS = {"modes": modes_command, "campbell": _campbell, "sweep": _sweep,
             "import-ross": _import_ross}

@@ -97,7 +97,9 @@ class SecondOrderSystem:
 
     def poles(self) -> np.ndarray:
         """Eigenvalues (rad/s) of the first-order form, sorted by |λ|."""
-        lam = sla.eigvals(self.state_matrices()[0])
+        # numpy's eigvals: the same LAPACK dgeev as scipy's (the same numbers) without
+        # holding the GIL, so that `ambseal modes` computes the lowest modes meanwhile
+        lam = np.linalg.eigvals(self.state_matrices()[0])
         return lam[np.argsort(np.abs(lam), kind="stable")]
 
 

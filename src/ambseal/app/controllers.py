@@ -1,0 +1,35 @@
+"""The controller a command's ``--controller`` names: designed on the rig, or read from a
+file ``ambseal design`` wrote (``modes``, ``campbell``, ``sweep``)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ambseal.config import method_names
+from ambseal.design import design
+from ambseal.errors import ConfigError
+from ambseal.export import load_controller
+from ambseal.model import channel_names
+from ambseal.robust import DigitalController
+
+__all__ = ["controller_for"]
+
+
+def controller_for(cfg, spec: str | None, pressure_bar: float | None = None):
+    """The controller ``spec`` names: ``pid``, ``hinf`` or ``mu`` (designed on the rig by
+    :func:`ambseal.design.recipes.design` at ``pressure_bar``), or a controller file of
+    ``ambseal design`` (.json, .npz, .mat) — its kind checked and wired to the rig's
+    channels by signal name (:func:`~ambseal.export.controller_files.load_controller`);
+    ``None`` or ``"none"`` for the open loop."""
+    if spec is None or spec == "none":
+        return None
+
+    if spec in method_names(fixed=True):
+        return design(cfg, spec, pressure_bar=pressure_bar).K
+    if Path(spec).suffix.lower() not in (".json", ".npz", ".mat"):
+        raise ConfigError(f"--controller: expected {', '.join(method_names(fixed=True))}, "
+                          f"none or a controller file "
+                          f"(.json, .npz, .mat), got {spec!r}")
+
+    K = load_controller(spec, channel_names(cfg))  # a judged digital one: its continuous design
+    return K.continuous if isinstance(K, DigitalController) else K

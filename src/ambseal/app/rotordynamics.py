@@ -4,8 +4,8 @@ Wiring only, like :mod:`ambseal.app.commands`: the numbers come from
 :mod:`ambseal.analysis.campbell`, :mod:`ambseal.analysis.sweep` and :mod:`ambseal.io.ross`,
 the figures from :mod:`ambseal.report.modal_figures`, and every file is written through a
 temporary name and a rename (:mod:`ambseal.files`). The CLI (:mod:`ambseal.cli`) parses these
-subcommands and runs them with :data:`HANDLERS`; ``modes`` is :mod:`ambseal.app.modes`',
-which the CLI loads alone.
+subcommands and runs them with :data:`HANDLERS`; ``modes`` lives in
+:mod:`ambseal.app.modes`, which the CLI loads alone.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """``ambseal modes``: the rig's modes at one operating point, and every unstable pole.
 
-Wiring only, like :mod:`ambseal.app.rotordynamics` (whose ``HANDLERS`` run it): the numbers
+Wiring only, like :mod:`ambseal.app.rotordynamics` (whose ``HANDLERS`` list it too): the numbers
 come from :func:`ambseal.model.modes.modes` and :mod:`ambseal.analysis.campbell`, the figure
 from :mod:`ambseal.report.modal_figures`.
 

@@ -124,7 +124,8 @@ class ArrayMemo:
 
     def get_digested(self, digest: bytes | None, extra: Any, compute: Callable[[], Any]) -> Any:
         """As :meth:`get` for arrays whose :func:`array_digest` is ``digest`` (one digest
-        for several lookups); ``None`` (too small to keep) computes."""
+        for several lookups), or for any input a digest names (a configuration's, say);
+        ``None`` (too small to keep) computes."""
         if digest is None:
             return compute()
         key = (digest, repr(extra))

@@ -15,7 +15,7 @@ The state is x = [q; q̇]; A = [[0, I], [−M⁻¹K, −M⁻¹(C + ΩG)]].
 
 from __future__ import annotations
 
-from collections import OrderedDict
+import hashlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -23,6 +23,7 @@ import scipy.linalg as sla
 
 from ambseal.config import RigConfig
 from ambseal.errors import ModelError
+from ambseal.lti import ArrayMemo
 from ambseal.model.amb import AXES, AmbElement, actuator_matrices, eddy_lag_matrices
 from ambseal.model.lft import Channel, Parameter, Plant
 from ambseal.model.reduction import modal_reduction
@@ -275,25 +276,19 @@ def build_plant(
     pressure_bar = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
     speed_rpm = cfg.operating.speed_rpm if speed_rpm is None else float(speed_rpm)
     force_positions = tuple(float(z) for z in force_positions)
-    key = (cfg.model_dump_json(), reduced, pressure_bar, speed_rpm, force_positions, states,
-           cutoff_hz)
-    if key in _PLANTS:
-        _PLANTS.move_to_end(key)
-        return _PLANTS[key]
-    plant = _build_plant(cfg, reduced, pressure_bar, speed_rpm, force_positions, states,
-                         cutoff_hz)
-    _PLANTS[key] = plant
-    if len(_PLANTS) > _KEEP_PLANTS:
-        _PLANTS.popitem(last=False)
-    return plant
+    # the rig by the digest of its validated form, the arguments as the memo's extra key
+    rig = hashlib.sha256(cfg.model_dump_json().encode()).digest()
+    return _PLANTS.get_digested(
+        rig, (reduced, pressure_bar, speed_rpm, force_positions, states, cutoff_hz),
+        lambda: _build_plant(cfg, reduced, pressure_bar, speed_rpm, force_positions, states,
+                             cutoff_hz))
 
 
 #: The last plants built, by rig and arguments: a run asks for the same few plants (its
 #: judged pressures, with and without force inputs) in every design's check, digital
 #: choice and judgement — 22 builds of 8 plants on the test facility, 0.2 s each at 1 888
 #: states. A plant is immutable (its arrays are frozen), so one is handed to every caller.
-_PLANTS: OrderedDict = OrderedDict()
-_KEEP_PLANTS = 4
+_PLANTS = ArrayMemo(keep=4)
 
 
 def _build_plant(cfg, reduced, pressure_bar, speed_rpm, force_positions, states, cutoff_hz):

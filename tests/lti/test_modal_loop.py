@@ -142,6 +142,30 @@ def test_a_lost_pole_is_not_certified(plant, testrig_designs, monkeypatch):
     assert ml.modal_loop_poles(*form, K) is None
 
 
+def test_a_bound_no_band_proves_gives_up_within_a_dense_eigenvalue_problems_work(
+        plant, testrig_designs, monkeypatch):
+    """A small-gain bound that no bisection proves (as when a weak mode sits close to a
+    strong pole) ends the certificate, ``None``, once its bands have cost about what the
+    dense eigenvalues of the loop cost (Golub & Van Loan §7.5.6: ~10 N³ flops, N states):
+    every band and point of the bound counted, at most N³ band points (~40 flops each),
+    where bisecting each band 17 times evaluated 512·(2¹⁸ − 1) bands, 10⁴–10⁵ times more."""
+    P, _ = plant
+    G, K = loop_matrices(P, testrig_designs["hinf"].K)
+    form = modal_form(*G[:3])
+    n = form[0].size + K[0].shape[0]
+    spent = []
+
+    def never(lo, hi, boundary, mu, terms, heads, dq, lamT, aT):
+        rays = np.isinf(lo) | np.isinf(hi)  # the line's two ends proved: the bands are not
+        spent.append(np.count_nonzero(~rays) * (lamT.size + mu.size * len(terms)))
+        return rays
+
+    monkeypatch.setattr(ml, "_bands_ok", never)
+    monkeypatch.setattr(ml, "_SOLVED", ArrayMemo())
+    assert ml.modal_loop_poles(*form, K) is None
+    assert spent and sum(spent) <= n**3
+
+
 def test_nearest_subspace_is_the_invariant_subspace_of_the_nearest_eigenvalues():
     """Reference: a matrix built from known eigenvectors and eigenvalues — a pair 1e-9
     apart (two planes nearly symmetric), others far — scaled over six decades as a strong

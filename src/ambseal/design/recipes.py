@@ -201,7 +201,7 @@ def _pid(cfg, p):
     d = reference_pid(cfg)
     notes = (f"PID designed from the rig (no [controller.pid]): {d['rule']}",) \
         if "rule" in d else ()
-    K = pid_controller(d["kp"], d["ti"], d["td"], d["eps"], channel_names(cfg))
+    K = pid_controller(d["kp"], d["ti"], d["td"], d["eps"], channel_names(cfg), d["filters"])
     return DesignResult("pid", K, p, order=int(K.nstates), order_full=int(K.nstates),
                         notes=notes)
 
@@ -376,6 +376,9 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
                   for f in sorted({*sp.speeds_hz, *sp.stability_speeds_hz})]
     for attempt in range(enlarge + 1):
         r = _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl)
+        if progress:
+            progress(f"{method}: synthesised on {n} design-model states; closing it with the "
+                     f"full-order plant at {len(conditions)} conditions")
         check = full_order_check(cfg, r.K, conditions)
         if check["stable"] or attempt == enlarge or states is not None:
             break

@@ -28,8 +28,10 @@ TESTRIG = Path(__file__).resolve().parents[1] / "examples" / "testrig.toml"
 
 #: Controllers that fail an example's speed range, measured: the blower's H∞ and μ,
 #: designed at 600 Hz, lose its ~930 Hz bending mode (split by the gyroscopic moments)
-#: below the top speed, at every pressure. The run then adds the LPV on speed.
-FAIL_BELOW_TOP = {"blower": {"hinf", "mu"}}
+#: below the top speed, at every pressure; the back-to-back compressor's, designed at
+#: 183 Hz, its first bending mode (241/271 Hz there, 254–263 Hz at standstill, ζ down
+#: to −0.04) from standstill to 139 Hz. The run then adds the LPV on speed.
+FAIL_BELOW_TOP = {"blower": {"hinf", "mu"}, "b2b_compressor": {"hinf", "mu"}}
 
 
 def _lpv_holds_everywhere(metrics: dict) -> None:

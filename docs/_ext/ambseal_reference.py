@@ -178,6 +178,17 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Pid.ti": ("s", "integral time T_i"),
     "Pid.td": ("s", "derivative time T_d"),
     "Pid.eps": ("", "derivative filter ε: the filter's time constant is ε T_d"),
+    "Controllers.filter": ("", "filters in series with the PID on every axis; left out, "
+                               "a derived PID carries its derived filters and a given PID "
+                               "none (``filter = []``: none)"),
+    "PidFilter.kind": ("", "``notch``, ``lead``, ``lag`` or ``lowpass``"),
+    "PidFilter.frequency_hz": ("Hz", "centre of a notch, largest phase change of a lead "
+                                     "or lag, corner of a low-pass"),
+    "PidFilter.width_hz": ("Hz", "a notch's width between its −3 dB points"),
+    "PidFilter.depth_db": ("dB", "a notch's attenuation at its centre"),
+    "PidFilter.phase_deg": ("°", "phase a lead adds (a lag takes) at ``frequency_hz``; "
+                                 "gain 1 at standstill"),
+    "PidFilter.damping": ("", "a low-pass filter's damping ratio ζ"),
     # [operating]
     "Operating.speed_rpm": ("rpm", "operating speed"),
     "Operating.pressure_bar": ("bar", "nominal pressure drop across the seals"),
@@ -423,6 +434,9 @@ def _sections() -> list[Section]:
         Section("[[spring]]", r.Spring, "Couplings, plain bearings, supports."),
         Section("[controller]", r.Controllers),
         Section("[controller.pid]", r.Pid, "All four keys, or leave the table out."),
+        Section("[[controller.filter]]", r.PidFilter, "A notch, lead, lag or low-pass "
+                "filter in series with the PID (``ambseal.design.pid.pid_controller``), "
+                "with the keys of its kind only."),
         Section("[operating]", r.Operating),
         Section("[reduction]", r.Reduction, "The reduced model of ``validate`` and the "
                 "identification; the design model is ``[design] model_states``."),

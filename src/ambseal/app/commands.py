@@ -27,6 +27,7 @@ from ambseal.design import (
     design_rise,
     design_spec,
     full_order_check,
+    pid_description,
     reference_pid,
 )
 from ambseal.errors import ConfigError, DataError, IdentificationError, SynthesisError
@@ -196,9 +197,8 @@ def target_pid(cfg):
 
     res = design(cfg, "pid")
     dc = digital_for(cfg, "pid", res.K, res, operating_points(design_spec(cfg)))
-    p = reference_pid(cfg)
-    gains = {k: p[k] for k in ("kp", "ti", "td", "eps")}
-    return replace(dc.discrete, description={"type": "pid", **gains, "discretisation": dc.method,
+    return replace(dc.discrete, description={"type": "pid", **pid_description(reference_pid(cfg)),
+                                             "discretisation": dc.method,
                                              "prewarp_hz": dc.prewarp_hz})
 
 

@@ -30,6 +30,7 @@ from ambseal.config.rig import (
                                     Coefficient,
                                     FrequencyTable,
                                     Pid,
+                                    PidFilter,
                                     RigConfig,
                                     Seal,
                                     Spring,
@@ -49,6 +50,6 @@ __all__ = ["MAX_AMBS", "MAX_COEFFICIENT", "MAX_COMPONENTS", "MAX_CURRENT_A", "MA
            "MAX_FREQUENCY_HZ", "MAX_GAP_M", "MAX_PRESSURE_BAR", "MAX_SPEED_HZ", "METHODS",
            "Method", "method", "method_label", "method_names",
            "Actuator", "Affine", "Amb", "AxisPair", "Coefficient", "FrequencyTable",
-           "Pid", "RigConfig", "Seal", "Spring", "TruthSection", "apply_overrides",
+           "Pid", "PidFilter", "RigConfig", "Seal", "Spring", "TruthSection", "apply_overrides",
            "check_operating", "default_rig_path", "dump_rig", "load_rig", "load_truth",
            "parse_rig", "rig_parameter_names", "rig_with_values"]

@@ -13,7 +13,7 @@ from ambseal.errors import LABEL_PATTERN, NAME_PATTERN, ConfigError
 
 __all__ = ["MIN_CURRENT_A", "MIN_TIME_CONSTANT_S", "MAX_ELEMENTS", "MAX_COMPONENTS", "MAX_AMBS", "MAX_LAYERS", "MAX_REDUCED_STATES", "MAX_COEFFICIENT",
            "MAX_FREQUENCY_HZ", "MAX_SPEED_HZ", "MAX_PRESSURE_BAR", "MAX_CURRENT_A", "MAX_GAP_M",
-           "MAX_DELAY_SAMPLES", "MAX_RELATIVE", "BoundedCoefficient",
+           "MAX_DELAY_SAMPLES", "MAX_PID_FILTERS", "MAX_RELATIVE", "BoundedCoefficient",
            "BoundedFrequency", "check_amb", "check_actuator", "cross_check", "Name", "Label"]
 
 #: Names of AMBs, seals, springs and materials make parameter, signal and C names
@@ -74,6 +74,8 @@ MAX_GAP_M = 0.1
 #: A computation delay (controller samples): each sample adds a state per controller output
 #: to every sampled loop; real-time targets delay by one or two samples, so 100 is ample.
 MAX_DELAY_SAMPLES = 100
+#: filters in series with the PID: one or two per flexible mode within its reach
+MAX_PID_FILTERS = 16
 #: A relative uncertainty (1σ or ± range as a fraction of the value): beyond 10× the value
 #: the range says nothing about it.
 MAX_RELATIVE = 10.0

@@ -53,6 +53,12 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     default 0), ``name`` (optional).
 ``[controller.pid]``
     ``kp`` (A/m), ``ti`` (s), ``td`` (s), ``eps`` (-): thesis P5 Eq. 6, per actuator axis.
+``[[controller.filter]]``
+    Filters in series with the PID on every axis (:class:`PidFilter`): ``kind`` =
+    ``"notch"`` (``frequency_hz``, ``width_hz``, ``depth_db`` default 20), ``"lead"`` or
+    ``"lag"`` (``frequency_hz``, ``phase_deg``), ``"lowpass"`` (``frequency_hz``,
+    ``damping`` default 0.7). Left out, a PID derived from the rig carries the filters
+    derived with it and a given PID none; ``filter = []`` asks for none.
 ``[controller]``
     ``sample_rate_hz``: the rate of the digital controller (default 10 kHz);
     ``delay_samples``: the target's computation delay in whole samples (default 1: output
@@ -91,6 +97,7 @@ from ambseal.config._checks import (
     MAX_FREQUENCY_HZ,
     MAX_GAP_M,
     MAX_LAYERS,
+    MAX_PID_FILTERS,
     MAX_REDUCED_STATES,
     MAX_RELATIVE,
     MIN_CURRENT_A,
@@ -380,8 +387,48 @@ class Pid(_Strict):
     eps: float = Field(gt=0, le=1e3)
 
 
+class PidFilter(_Strict):
+    """A filter in series with the reference PID on every axis (the commissioning
+    engineer's gain or phase stabilisation of a flexible mode, Schweitzer & Maslen 2009
+    §8.4; :func:`ambseal.design.pid.pid_controller`): ``kind`` = ``"notch"``
+    (``frequency_hz``, ``width_hz`` between the −3 dB points of a deep notch,
+    ``depth_db``), ``"lead"`` or ``"lag"`` (``phase_deg``, the phase added, or taken, at
+    ``frequency_hz``, unity gain at standstill) or ``"lowpass"`` (second order,
+    ``frequency_hz``, ``damping``)."""
+
+    kind: Literal["notch", "lead", "lag", "lowpass"]
+    frequency_hz: float = Field(gt=0, le=MAX_FREQUENCY_HZ)
+    width_hz: float | None = Field(default=None, gt=0, le=MAX_FREQUENCY_HZ)
+    # a notch deeper than 60 dB removes the mode's frequency outright; a phase filter of
+    # 80° or more has corner frequencies more than 130× apart
+    depth_db: float = Field(default=20.0, gt=0, le=60.0)
+    phase_deg: float | None = Field(default=None, gt=0, lt=80.0)
+    damping: float = Field(default=0.7, gt=0, le=10.0)
+
+    @model_validator(mode="after")
+    def _keys(self) -> "PidFilter":
+        need, may = {"notch": (("width_hz",), ("depth_db",)),
+                     "lead": (("phase_deg",), ()), "lag": (("phase_deg",), ()),
+                     "lowpass": ((), ("damping",))}[self.kind]
+        for key in need:
+            if getattr(self, key) is None:
+                raise ValueError(f"a {self.kind} filter needs {key}")
+        # a default written back by dump_rig is no key of the user's
+        other = sorted(k for k in self.model_fields_set - {"kind", "frequency_hz", *need, *may}
+                       if getattr(self, k) != type(self).model_fields[k].default)
+        if other:
+            raise ValueError(f"{other[0]}: not a key of a {self.kind} filter (expected "
+                             f"{', '.join(('frequency_hz', *need, *may))})")
+        if self.kind == "notch" and self.width_hz >= 2 * self.frequency_hz:
+            raise ValueError("width_hz: expected less than twice frequency_hz (a notch, "
+                             "not a band-stop over every frequency below it)")
+        return self
+
+
 class Controllers(_Strict):
     pid: Pid | None = None
+    # None: a PID derived from the rig gets the filters derived with it, a given one none
+    filter: list[PidFilter] | None = Field(default=None, max_length=MAX_PID_FILTERS)
     # plausible digital AMB controllers: 100 Hz to 1 MHz
     sample_rate_hz: float = Field(default=10000.0, ge=100.0, le=1e6)
     delay_samples: int = Field(default=1, ge=0, le=MAX_DELAY_SAMPLES)

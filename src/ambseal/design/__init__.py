@@ -24,7 +24,12 @@ The synthesis itself is :mod:`ambseal.robust`'s, which knows nothing of rotors.
 from ambseal.design.fast_poles import design_rise
 from ambseal.design.lpv_design import design_frozen, design_lpv
 from ambseal.design.lpv_plant import vertex_grid_hz
-from ambseal.design.pid import controller_from_metadata, pid_controller, reference_pid
+from ambseal.design.pid import (
+    controller_from_metadata,
+    pid_controller,
+    pid_description,
+    reference_pid,
+)
 from ambseal.design.plant import generalized_plant, physical_controller
 from ambseal.design.recipes import DesignResult, design, full_order_check
 from ambseal.design.result import Design
@@ -36,4 +41,4 @@ __all__ = ["RIGID_STATES", "Design", "DesignResult", "DesignSpec", "Machine", "W
            "controller_from_metadata", "default_weights", "design", "design_frozen",
            "design_lpv", "design_rise", "design_seal_scheduled", "design_spec",
            "full_order_check", "generalized_plant", "machine",
-           "physical_controller", "pid_controller", "reference_pid", "vertex_grid_hz"]
+           "physical_controller", "pid_controller", "pid_description", "reference_pid", "vertex_grid_hz"]

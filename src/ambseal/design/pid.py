@@ -6,7 +6,9 @@ from dataclasses import replace
 
 import control
 import numpy as np
+from pydantic import ValidationError
 
+from ambseal.config import PidFilter
 from ambseal.design.conditions import judged_conditions
 from ambseal.errors import ConfigError, DataError
 from ambseal.identify import check_controller, sample_rate_of, state_space_from_metadata
@@ -14,7 +16,8 @@ from ambseal.lti import feedback_matrices, picklable, zoh
 from ambseal.model import amb_factors, assemble_rotor, build_plant, channel_names
 from ambseal.robust import discrete_controller, discretize_as, is_stable, with_delay
 
-__all__ = ["pid_controller", "pid_from_rig", "reference_pid", "reference_controller", "controller_from_metadata",
+__all__ = ["pid_controller", "pid_from_rig", "reference_pid", "reference_controller",
+           "controller_from_metadata", "filter_matrices", "pid_description",
            "PID_CORNERS_PER_FS"]
 
 #: the derived PID (no [controller.pid]): k_eq = K_EQ_PER_KS·Ks, ζ on the rigid-body modes,
@@ -26,11 +29,23 @@ KEEP_OF_STRUCTURAL = 0.2
 
 
 def pid_controller(
-    kp: float, ti: float, td: float, eps: float, channels: list[str] | tuple[str, ...]
+    kp: float, ti: float, td: float, eps: float, channels: list[str] | tuple[str, ...],
+    filters=(),
 ):
-    """Decentralised PID, the same on every actuator axis.
+    """Decentralised PID, the same on every actuator axis, with filters in series.
 
-    K_PID(s) = Kp (1 + 1/(Ti s) + Td s/(ε Td s + 1))   (thesis P5 Eq. 6)
+    K_PID(s) = Kp (1 + 1/(Ti s) + Td s/(ε Td s + 1)) · Π F_k(s)   (thesis P5 Eq. 6)
+
+    The filters are the commissioning engineer's (Schweitzer & Maslen, *Magnetic
+    Bearings*, 2009, §8.4), with ω_c = 2π ``frequency_hz``:
+
+    * notch: F = (s² + 2ζ_z ω_c s + ω_c²)/(s² + 2ζ_p ω_c s + ω_c²), ζ_p = ``width_hz``/(2
+      ``frequency_hz``) (the −3 dB width of a deep notch), ζ_z = ζ_p·10^(−depth_db/20): the
+      gain at ω_c is 10^(−depth_db/20), 1 far from it;
+    * lead, lag: F = (1 + s/ω_z)/(1 + s/ω_p), ω_z = ω_c/√α, ω_p = ω_c·√α, with
+      α = (1 + sin φ)/(1 − sin φ) for a lead of φ = ``phase_deg`` (α → 1/α for a lag): the
+      largest phase change, ±φ, at ω_c; gain 1 at standstill, √α at ω_c (a lag: 1/√α);
+    * lowpass: F = ω_c²/(s² + 2ζ ω_c s + ω_c²), ζ = ``damping``.
 
     Parameters
     ----------
@@ -43,12 +58,16 @@ def pid_controller(
     channels : sequence of str
         Axis names, e.g. ``("A_zeta", "A_eta", "B_zeta", "B_eta")``: inputs are the
         displacements (m), outputs the current references (A) of the same axes.
+    filters : sequence of PidFilter or dict, optional
+        ``[[controller.filter]]`` entries (:class:`ambseal.config.rig.PidFilter`, or dicts
+        of its keys), applied in order.
 
     Returns
     -------
     control.StateSpace
-        Diagonal controller with 2 states per axis (integrator, derivative filter), used in
-        negative feedback u = −K y.
+        Diagonal controller with 2 states per axis (integrator, derivative filter) plus
+        the filters' (2 per notch or lowpass, 1 per lead or lag), used in negative
+        feedback u = −K y.
     """
 
     picklable()
@@ -62,6 +81,8 @@ def pid_controller(
     else:
         a, b = np.zeros((1, 1)), np.ones((1, 1))
         c, d = np.array([[kp / ti]]), np.array([[kp]])
+    for f in filters:
+        a, b, c, d = _series((a, b, c, d), filter_matrices(f))
     n = len(channels)
     eye = np.eye(n)
     A, B, C, D = (np.kron(eye, m) for m in (a, b, c, d))
@@ -72,6 +93,51 @@ def pid_controller(
         outputs=[f"i_{c}" for c in channels],
         states=[f"pid_{c}_{k}" for c in channels for k in range(ns)], name="K_pid",
     )
+
+
+def filter_matrices(f) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(a, b, c, d) of one SISO filter of :func:`pid_controller` (its formulas), the
+    second-order ones with states scaled by ω_c (entries of the size of ω_c, not ω_c²).
+
+    Parameters
+    ----------
+    f : PidFilter or dict
+        ``kind``, ``frequency_hz`` and the kind's keys (a dict is validated as a
+        :class:`~ambseal.config.rig.PidFilter`).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        Shapes (n, n), (n, 1), (1, n), (1, 1) with n = 2 (notch, lowpass) or 1 (lead, lag).
+    """
+    g = f if isinstance(f, PidFilter) else PidFilter.model_validate(f)
+    w = 2 * np.pi * g.frequency_hz
+    if g.kind in ("lead", "lag"):
+        s = np.sin(np.radians(g.phase_deg))
+        alpha = (1 + s) / (1 - s)
+        alpha = alpha if g.kind == "lead" else 1 / alpha
+        wz, wp = w / np.sqrt(alpha), w * np.sqrt(alpha)
+        k = wp / wz
+        return (np.array([[-wp]]), np.ones((1, 1)), np.array([[k * (wz - wp)]]),
+                np.array([[k]]))
+    if g.kind == "notch":
+        zp = g.width_hz / (2 * g.frequency_hz)
+        zz = zp * 10 ** (-g.depth_db / 20)
+        zeta, c, d = zp, np.array([[0.0, 2 * w * (zz - zp)]]), np.ones((1, 1))
+    else:  # lowpass: ω²/(s² + 2ζωs + ω²)
+        zeta, c, d = g.damping, np.array([[w, 0.0]]), np.zeros((1, 1))
+    # x1' = ω x2, x2' = −ω x1 − 2ζω x2 + u: x1 = ω U/(s² + 2ζωs + ω²), x2 = s U/(...)
+    a = np.array([[0.0, w], [-w, -2 * zeta * w]])
+    return a, np.array([[0.0], [1.0]]), c, d
+
+
+def _series(first, second):
+    """SISO ``second`` after ``first`` (state [x_first; x_second])."""
+    a1, b1, c1, d1 = first
+    a2, b2, c2, d2 = second
+    n1, n2 = a1.shape[0], a2.shape[0]
+    a = np.block([[a1, np.zeros((n1, n2))], [b2 @ c1, a2]])
+    return a, np.vstack([b1, b2 @ d1]), np.hstack([d2 @ c1, c2]), d2 @ d1
 
 
 _DERIVED: dict = {}  # pid_from_rig by the rig's JSON: the corner's check samples plants
@@ -201,13 +267,22 @@ def reference_pid(cfg) -> dict:
     Returns
     -------
     dict
-        ``kp`` (A/m), ``ti``, ``td`` (s), ``eps`` (-); derived ones also carry the ``rule``
-        of :func:`pid_from_rig`.
+        ``kp`` (A/m), ``ti``, ``td`` (s), ``eps`` (-), ``filters`` (the
+        ``[[controller.filter]]`` entries as dicts, in series with the PID; left out of the
+        rig file, none for a given PID); derived ones also carry the ``rule`` of
+        :func:`pid_from_rig`.
     """
-    pid = getattr(getattr(cfg, "controller", None), "pid", None)
+    ctrl = getattr(cfg, "controller", None)
+    pid = getattr(ctrl, "pid", None)
+    given = getattr(ctrl, "filter", None)
     if pid is not None:
-        return {"kp": pid.kp, "ti": pid.ti, "td": pid.td, "eps": pid.eps}
-    return pid_from_rig(cfg)
+        out = {"kp": pid.kp, "ti": pid.ti, "td": pid.td, "eps": pid.eps, "filters": []}
+    else:
+        out = pid_from_rig(cfg)
+        out.setdefault("filters", [])
+    if given is not None:
+        out["filters"] = [f.model_dump(exclude_none=True) for f in given]
+    return out
 
 
 def reference_controller(cfg, method: str = "tustin"):
@@ -229,10 +304,31 @@ def reference_controller(cfg, method: str = "tustin"):
     """
 
     p = reference_pid(cfg)
-    K = pid_controller(p["kp"], p["ti"], p["td"], p["eps"], channel_names(cfg))
+    K = pid_controller(p["kp"], p["ti"], p["td"], p["eps"], channel_names(cfg), p["filters"])
     ctrl = discrete_controller(K, 1.0 / cfg.controller.sample_rate_hz, method)
-    return replace(ctrl, description={"type": "pid", **{k: p[k] for k in (
-        "kp", "ti", "td", "eps")}, "discretisation": method})
+    return replace(ctrl, description={"type": "pid", **pid_description(p),
+                                      "discretisation": method})
+
+
+def pid_description(p: dict) -> dict:
+    """The PID's parameters as a record's or a controller file's ``controller`` metadata
+    names them.
+
+    Parameters
+    ----------
+    p : dict
+        A PID as :func:`reference_pid` returns it.
+
+    Returns
+    -------
+    dict
+        ``kp`` (A/m), ``ti``, ``td`` (s), ``eps`` (-) and, where it has any, ``filters``
+        (``[[controller.filter]]`` tables as dicts).
+    """
+    out = {k: p[k] for k in ("kp", "ti", "td", "eps")}
+    if p.get("filters"):
+        out["filters"] = [dict(f) for f in p["filters"]]
+    return out
 
 
 def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<data>"):
@@ -240,7 +336,8 @@ def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<
     description included.
 
     ``{"type": "pid", kp, ti, td, eps, "discretisation": "tustin"|"zoh"}`` (P5 Eq. 6 at the
-    record's sample rate) is discretised here; anything else is read by
+    record's sample rate), with ``filters`` (``[[controller.filter]]`` tables) where the PID
+    has any, is discretised here; anything else is read by
     :func:`ambseal.identify.fitting.stages.state_space_from_metadata`.
 
     Parameters
@@ -272,7 +369,15 @@ def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<
         if not (kp > 0 and ti > 0 and td >= 0 and eps > 0):
             raise ValueError("expected kp > 0, ti > 0, td >= 0, eps > 0")
         method = c.get("discretisation", "tustin")
-        ctrl = discrete_controller(pid_controller(kp, ti, td, eps, axes), 1.0 / fs, method)
+        filters = c.get("filters", [])
+        if not isinstance(filters, list):
+            raise ValueError("filters: expected a list of [[controller.filter]] tables")
+        filters = [PidFilter.model_validate(f) for f in filters]
+        ctrl = discrete_controller(pid_controller(kp, ti, td, eps, axes, filters), 1.0 / fs,
+                                   method)
+    except ValidationError as exc:
+        raise DataError(f"{source}: metadata.controller.filters: "
+                        f"{exc.errors()[0]['msg']}") from None
     except (KeyError, TypeError, ValueError) as exc:
         raise DataError(f"{source}: metadata.controller: {exc}") from None
     return check_controller(replace(ctrl, description=dict(c)), axes, fs, source)

@@ -15,6 +15,7 @@ import pytest
 from ambseal.config import default_rig_path, load_rig, parse_rig
 from ambseal.design import controller_from_metadata, design, reference_pid
 from ambseal.design.pid import filter_matrices, pid_controller, reference_controller
+from ambseal.design.pid_filters import flexible_mode_filters
 from ambseal.errors import ConfigError, DataError
 from ambseal.files import load_toml
 from ambseal.model import channel_names
@@ -139,3 +140,91 @@ def test_a_records_bad_filter_is_refused_naming_the_file():
             "sample_rate_hz": 10000.0}
     with pytest.raises(DataError, match=r"^rec\.json: metadata\.controller\.filters: .*width_hz"):
         controller_from_metadata(meta, ("A_zeta",), "rec.json")
+
+
+# The derived filters (ambseal.design.pid_filters) on a two-mode model of one axis: a rigid
+# mass m on the AMB's negative stiffness Ks and one bending mode (modal mass m_b, ζ 0.5 %)
+# seen at the sensor with the sign of its shape there, the PID of pid_from_rig's rule.
+M, KS, KI, MB, FS = 50.0, 1.0e6, 200.0, 20.0, 10000.0
+KP = 1.5 * KS / KI
+TD = 2 * np.sqrt(0.5 * KS * M) / (KI * KP)
+TI, EPS = 0.5, 1 / (2 * np.pi * FS / 10 * TD)
+FLOOR = 0.2 * 0.005
+RIGID_HZ = np.sqrt(0.5 * KS / M) / (2 * np.pi)
+
+
+def _two_mode(fb, shape_at_sensor):
+    """(A, B, C, D): y = x_r + φ_s q; m ẍ_r = Ks x_r + Ki i, q̈ + 2ζω q̇ + ω² q = φ_a Ki i."""
+    wb, phi = 2 * np.pi * fb, 1 / np.sqrt(MB)
+    A = np.array([[0, 1, 0, 0], [KS / M, 0, 0, 0], [0, 0, 0, 1],
+                  [0, 0, -wb**2, -2 * 0.005 * wb]])
+    B = np.array([[0.0], [KI / M], [0.0], [phi * KI]])
+    C = np.array([[1.0, 0.0, shape_at_sensor * phi, 0.0]])
+    return A, B, C, np.zeros((1, 1))
+
+
+def _pid_mats(filters):
+    K = pid_controller(KP, TI, TD, EPS, ("a",), filters)
+    return tuple(np.asarray(getattr(K, m), float) for m in "ABCD")
+
+
+def _as_it_runs(G, filters):
+    """python-control: the plant sampled by its hold, the PID by Tustin with one sample of
+    delay, closed u = −K y; its discrete poles."""
+    T = 1 / FS
+    Gd = control.sample_system(control.ss(*G), T, "zoh")
+    Kd = control.sample_system(control.ss(*_pid_mats(filters)), T, "tustin") \
+        * control.tf([1], [1, 0], T)
+    return control.feedback(Gd, Kd).poles()
+
+
+def _zeta(z):
+    r = np.log(np.abs(z))
+    return -r / np.hypot(r, np.angle(z))
+
+
+@pytest.mark.parametrize("fb, shape, kind", [(1200.0, 1.0, "lead"), (600.0, -1.0, "lag")],
+                         ids=["collocated", "non-collocated"])
+def test_a_bending_mode_the_pid_drives_gets_its_phase_put_right(fb, shape, kind):
+    """Reference: python-control's poles of the sampled loop. A collocated mode above the
+    PID's derivative corner, whose phase the hold and delay have taken (the plain PID
+    drives it, ζ < 0), gets phase lead; a non-collocated one (sensor and actuator on
+    opposite sides of a node), which the PID's lead drives, gets phase lag. With the
+    filter every pole lies inside the unit circle with ζ ≥ 0.2 of the structural damping."""
+    G = _two_mode(fb, shape)
+    plain = _as_it_runs(G, [])
+    assert _zeta(plain).min() < 0
+    fd = flexible_mode_filters([G], _pid_mats, FS, 1, FLOOR, RIGID_HZ)
+    assert fd.kept
+    (f,) = fd.filters
+    assert f["kind"] == kind and f["frequency_hz"] == pytest.approx(fb, rel=0.1)
+    assert fd.modes[0].collocated == (shape > 0)
+    poles = _as_it_runs(G, fd.filters)
+    assert np.abs(poles).max() < 1 and _zeta(poles).min() >= FLOOR
+    # the mode itself: from driven (ζ < 0) to damped beyond the floor
+    at = np.argmin(np.abs(np.abs(np.angle(plain)) * FS / (2 * np.pi) - fb))
+    assert _zeta(plain[at]) < 0
+
+
+def test_a_mode_with_a_node_at_the_sensor_needs_no_filter():
+    """A bending mode with a node at the sensor is not observed: the loop leaves it at its
+    structural damping (python-control's poles: ζ 0.005 at its frequency) and the rule adds
+    no filter for it, where the same mode seen at the sensor non-collocated needs one."""
+    seen = flexible_mode_filters([_two_mode(600.0, -1.0)], _pid_mats, FS, 1, FLOOR, RIGID_HZ)
+    assert seen.filters
+    G = _two_mode(600.0, 0.0)
+    fd = flexible_mode_filters([G], _pid_mats, FS, 1, FLOOR, RIGID_HZ)
+    assert fd.filters == () and fd.modes == () and fd.kept
+    poles = _as_it_runs(G, [])
+    at = np.argmin(np.abs(np.abs(np.angle(poles)) * FS / (2 * np.pi) - 600.0))
+    assert _zeta(poles[at]) == pytest.approx(0.005, rel=1e-3)
+
+
+def test_a_mode_no_filter_saves_is_named_with_why():
+    """A non-collocated mode inside the PID's bandwidth (300 Hz, 19× the rigid-body mode)
+    defeats every lead, lag and notch: the result is not kept and names the mode, that it
+    is non-collocated and the phase it needed."""
+    fd = flexible_mode_filters([_two_mode(300.0, -1.0)], _pid_mats, FS, 1, FLOOR, RIGID_HZ)
+    assert not fd.kept
+    text = fd.modes[-1].text()
+    assert "non-collocated" in text and "° of phase needed" in text

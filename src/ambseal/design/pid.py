@@ -9,7 +9,8 @@ import numpy as np
 from pydantic import ValidationError
 
 from ambseal.config import PidFilter
-from ambseal.design.conditions import judged_conditions
+from ambseal.design.conditions import judged_conditions, stability_speeds
+from ambseal.design.pid_filters import flexible_mode_filters
 from ambseal.errors import ConfigError, DataError
 from ambseal.identify import check_controller, sample_rate_of, state_space_from_metadata
 from ambseal.lti import feedback_matrices, picklable, zoh
@@ -174,7 +175,15 @@ def pid_from_rig(cfg) -> dict:
       keeps the floor there: ζ 0.0006 at 1.6 kHz), pump f_s/10, test rig f_s/14,
       turboexpander f_s/10; the phase lost at ω_n (1–2°) is
       stated in ``rule``. Raising Td to win that phase back was tried and made the test
-      rig's loop unstable at 2.04 bar (more gain at the bending mode).
+      rig's loop unstable at 2.04 bar (more gain at the bending mode);
+    * filters (``[[controller.filter]]`` left out of the rig file): where no corner keeps
+      that floor at every judged condition, a lead, lag or notch per flexible mode the
+      loop leaves under-damped as it runs, chosen from the mode's band over the judged
+      pressures at standstill, the judged speeds and the top speed, its collocation and
+      the phase it needs (:mod:`ambseal.design.pid_filters`); the modes, the filters and
+      a mode that defeats them all are stated in ``rule``. The test rig, the pump and the
+      turboexpander need none (their corner keeps the floor where the PID holds its
+      rigid-body modes).
 
     On the test rig (10 kHz, 1 sample): Kp 1.8e4 A/m, Td 3.3 ms, Ti 0.25 s (the thesis's
     hand tuning: 1.6e4, 3.5 ms, 0.2 s).
@@ -182,7 +191,8 @@ def pid_from_rig(cfg) -> dict:
     Returns
     -------
     dict
-        ``kp`` (A/m), ``ti``, ``td`` (s), ``eps`` (-), ``corner_hz`` (Hz) and ``rule``.
+        ``kp`` (A/m), ``ti``, ``td`` (s), ``eps`` (-), ``corner_hz`` (Hz), ``filters``
+        (``[[controller.filter]]`` dicts) and ``rule``.
     """
 
     key = cfg.model_dump_json()
@@ -202,7 +212,7 @@ def pid_from_rig(cfg) -> dict:
     td = float(2 * PID_ZETA * np.sqrt(k_eq * m_b) / (ki * kp))
     ti = float(TI_PER_OMEGA_N / w_n)
     fs = cfg.controller.sample_rate_hz
-    frac = _corner_for_target(cfg, kp, ti, td)
+    frac, kept = _corner_for_target(cfg, kp, ti, td)
     eps = float(1 / (2 * np.pi * frac * fs * td))
     lost = np.degrees((cfg.controller.delay_samples + 0.5) * w_n / fs)
     out = {"kp": float(kp), "ti": ti, "td": td, "eps": eps, "corner_hz": frac * fs,
@@ -213,8 +223,40 @@ def pid_from_rig(cfg) -> dict:
                    f"{', f_s/'.join(f'{1 / c:.3g}' for c in PID_CORNERS_PER_FS)} that "
                    f"keeps {KEEP_OF_STRUCTURAL:g} of the structural damping as it runs, "
                    f"else the best); sampling and delay cost {lost:.1f}° at ω_n"}
+    fd = None if kept else _filters_for_target(cfg, kp, ti, td, eps, w_n / (2 * np.pi))
+    out["filters"] = [dict(f) for f in fd.filters] if fd else []
+    if fd and fd.modes:
+        out["rule"] += "; flexible modes as it runs: " + "; ".join(m.text() for m in fd.modes)
+        if not fd.kept:
+            out["rule"] += (f" — as it runs the PID leaves a flexible mode below "
+                            f"{KEEP_OF_STRUCTURAL:g} of the structural damping (least ζ "
+                            f"{fd.least_zeta:.2g})")
     _DERIVED[key] = out
     return dict(out)
+
+
+def _filters_for_target(cfg, kp, ti, td, eps, rigid_hz: float):
+    """The derived PID's filters (:mod:`ambseal.design.pid_filters`) on the rig's full-order
+    plants at every judged pressure, at the judged speeds, at standstill and at the top
+    speed: the gyroscopic moments move each mode monotonically with speed, so these ends
+    bound the band it sweeps from standstill to the top speed."""
+    pressures, judged = judged_conditions(cfg)
+    speeds = sorted({0.0, *judged, max(stability_speeds(cfg)[0])})
+    fs = cfg.controller.sample_rate_hz
+    plants = []
+    for p in pressures:
+        for f in speeds:
+            pl = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * f)
+            cur = pl.current_inputs()
+            plants.append((pl.A, pl.B[:, cur], pl.C, pl.D[:, cur]))
+    axes = channel_names(cfg)
+
+    def matrices(filters):
+        K = pid_controller(kp, ti, td, eps, axes, filters)
+        return tuple(np.asarray(X, float) for X in (K.A, K.B, K.C, K.D))
+
+    return flexible_mode_filters(plants, matrices, fs, cfg.controller.delay_samples,
+                                 KEEP_OF_STRUCTURAL * cfg.rotor.modal_damping, rigid_hz)
 
 
 def _zeta_z(z: np.ndarray) -> np.ndarray:
@@ -224,7 +266,9 @@ def _zeta_z(z: np.ndarray) -> np.ndarray:
 
 
 def _corner_for_target(cfg, kp: float, ti: float, td: float) -> float:
-    """The derivative filter's corner (fraction of f_s) of :func:`pid_from_rig`."""
+    """The derivative filter's corner (fraction of f_s) of :func:`pid_from_rig`, and
+    whether it keeps the floor at every judged condition (the continuous loop stable at
+    each)."""
 
     pressures, speeds = judged_conditions(cfg)
     fs, delay = cfg.controller.sample_rate_hz, cfg.controller.delay_samples
@@ -241,17 +285,18 @@ def _corner_for_target(cfg, kp: float, ti: float, td: float) -> float:
         K = pid_controller(kp, ti, td, 1 / (2 * np.pi * frac * fs * td), channel_names(cfg))
         mats = tuple(np.asarray(X, float) for X in (K.A, K.B, K.C, K.D))
         Kd = with_delay(discretize_as(mats, 1 / fs, "tustin"), delay)
-        n_ok, zeta = 0, np.inf
+        n_ok, zeta, held = 0, np.inf, True
         for G, Gd in plants:
             if not is_stable(np.linalg.eigvals(feedback_matrices(G, mats)[0])):
+                held = False
                 continue  # unstable as designed: nothing to keep as it runs
             z = _zeta_z(np.linalg.eigvals(feedback_matrices(Gd, Kd)[0])).min()
             n_ok, zeta = n_ok + (z > 0), min(zeta, z)
         if zeta >= floor and zeta > 0:
-            return frac
+            return frac, held
         if best is None or (n_ok, zeta) > best[0]:
             best = ((n_ok, zeta), frac)
-    return best[1]
+    return best[1], False
 
 
 def reference_pid(cfg) -> dict:

@@ -353,7 +353,8 @@ def design(
         reduce_to, max_iter or sp.max_iter, sp.dk_order if dk_order is None else dk_order, dl,
         enlarge, steps, progress)
     if not check["stable"] and not allow_unstable:
-        raise SynthesisError(_unstable_message(method, check, n, steps, _top_mode_hz(cfg, p, n)))
+        raise SynthesisError(_unstable_message(method, check, n, steps, _top_mode_hz(cfg, p, n),
+                                               cfg.operating.speed_rpm / 60.0))
     return DesignResult(
         method, r.K, p, gamma=r.gamma, mu=r.mu, order=int(r.K.nstates),
         order_full=r.order_full, history=tuple(r.history), weights=w,
@@ -515,11 +516,19 @@ def _states_to_keep(cfg, p: float, mode_hz: float) -> int:
     return int(np.sum(np.abs(disk.poles) / (2 * np.pi) < 1.1 * mode_hz))
 
 
-def _unstable_message(method, check, n, steps, cut_hz) -> str:
+def _unstable_message(method, check, n, steps, cut_hz, design_speed_hz) -> str:
     tried = f" after {len(steps)} automatic enlargement(s)" if steps else ""
     head = (f"design({method}): the controller destabilises the full-order plant{tried}: the "
             f"mode at {check['mode_hz']:.4g} Hz has damping ζ = {check['damping']:.3g} at "
             f"{check['pressure_bar']:g} bar, {check['speed_hz']:g} Hz; ")
+    if check["mode_hz"] < cut_hz and abs(check["speed_hz"] - design_speed_hz) > 1e-9:
+        # the plant the design kept that mode of is the one at the design speed: the
+        # gyroscopic moments move the mode with speed, which no seal range covers
+        return head + (f"the design model keeps that mode as it is at the design speed "
+                       f"({design_speed_hz:.6g} Hz), and the gyroscopic moments move it at "
+                       f"{check['speed_hz']:g} Hz: a controller scheduled on speed holds it "
+                       "over the range (ambseal design --method lpv, with [operating] "
+                       "speed_range_hz; ambseal run adds it), or pass --allow-unstable")
     if check["mode_hz"] < cut_hz and method == "hinf":
         return head + (f"the design model keeps that mode; H∞ is designed on the nominal plant "
                        f"only ({check['pressure_bar']:g} bar is another plant): the μ design "

@@ -9,6 +9,7 @@ temporary name and a rename (:mod:`ambseal.files`).
 from __future__ import annotations
 
 import hashlib
+import logging
 import math
 import sys
 from dataclasses import asdict, dataclass, field, replace
@@ -372,7 +373,7 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
         # there)
         res = design(cfg, method, pressure_bar=pressure_bar, allow_unstable=allow_unstable,
                      spec=spec if pressure_bar is None else design_spec(cfg, pressure_bar),
-                     progress=lambda line: print(f"ambseal: {line}", file=sys.stderr))
+                     progress=logging.getLogger("ambseal").info)  # -q silences it
         K, summary = res.K, res.to_dict()
 
     points = operating_points(spec)

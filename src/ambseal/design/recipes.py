@@ -354,7 +354,7 @@ def design(
         enlarge, steps, progress)
     if not check["stable"] and not allow_unstable:
         raise SynthesisError(_unstable_message(method, check, n, steps, _top_mode_hz(cfg, p, n),
-                                               cfg.operating.speed_rpm / 60.0))
+                                               _lost_by(cfg, r.K, check, p)))
     return DesignResult(
         method, r.K, p, gamma=r.gamma, mu=r.mu, order=int(r.K.nstates),
         order_full=r.order_full, history=tuple(r.history), weights=w,
@@ -377,9 +377,6 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
                   for f in sorted({*sp.speeds_hz, *sp.stability_speeds_hz})]
     for attempt in range(enlarge + 1):
         r = _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl)
-        if progress:
-            progress(f"{method}: synthesised on {n} design-model states; closing it with the "
-                     f"full-order plant at {len(conditions)} conditions")
         check = full_order_check(cfg, r.K, conditions)
         if check["stable"] or attempt == enlarge or states is not None:
             break
@@ -516,19 +513,41 @@ def _states_to_keep(cfg, p: float, mode_hz: float) -> int:
     return int(np.sum(np.abs(disk.poles) / (2 * np.pi) < 1.1 * mode_hz))
 
 
-def _unstable_message(method, check, n, steps, cut_hz, design_speed_hz) -> str:
+def _lost_by(cfg, K, check, p: float) -> tuple[bool, bool, float]:
+    """Whether the pressure and whether the speed lost the loop at ``check``'s condition:
+    the loop, closed at the design pressure ``p`` and that speed, and at that pressure and
+    the design speed, is unstable there too (a full-order check each, where the condition
+    differs from the design point in both); and the design speed (Hz)."""
+    f0 = cfg.operating.speed_rpm / 60.0
+    other_p = abs(check["pressure_bar"] - p) > 1e-9
+    other_f = abs(check["speed_hz"] - f0) > 1e-9
+    if not (other_p and other_f):
+        return other_p, other_f, f0
+    lost = [not full_order_check(cfg, K, [c])["stable"]
+            for c in ((check["pressure_bar"], f0), (p, check["speed_hz"]))]
+    return lost[0] or not lost[1], lost[1], f0
+
+
+def _unstable_message(method, check, n, steps, cut_hz, lost=(True, False, 0.0)) -> str:
+    """The refusal's one line; ``lost`` = (by the pressure, by the speed, design speed Hz)
+    of :func:`_lost_by`."""
     tried = f" after {len(steps)} automatic enlargement(s)" if steps else ""
     head = (f"design({method}): the controller destabilises the full-order plant{tried}: the "
             f"mode at {check['mode_hz']:.4g} Hz has damping ζ = {check['damping']:.3g} at "
             f"{check['pressure_bar']:g} bar, {check['speed_hz']:g} Hz; ")
-    if check["mode_hz"] < cut_hz and abs(check["speed_hz"] - design_speed_hz) > 1e-9:
-        # the plant the design kept that mode of is the one at the design speed: the
-        # gyroscopic moments move the mode with speed, which no seal range covers
-        return head + (f"the design model keeps that mode as it is at the design speed "
-                       f"({design_speed_hz:.6g} Hz), and the gyroscopic moments move it at "
-                       f"{check['speed_hz']:g} Hz: a controller scheduled on speed holds it "
-                       "over the range (ambseal design --method lpv, with [operating] "
-                       "speed_range_hz; ambseal run adds it), or pass --allow-unstable")
+    by_pressure, by_speed, f0 = lost
+    if check["mode_hz"] < cut_hz and by_speed:
+        # the gyroscopic moments move the mode with speed, which no seal range covers
+        speed = (f"the design model keeps that mode as it is at the design speed "
+                 f"({f0:.6g} Hz), and the gyroscopic moments move it at "
+                 f"{check['speed_hz']:g} Hz: a controller scheduled on speed holds it over "
+                 "the range (ambseal design --method lpv, with [operating] speed_range_hz; "
+                 "ambseal run adds it)")
+        if not by_pressure:
+            return head + speed + ", or pass --allow-unstable"
+        return head + speed + (f"; the loop is lost at {check['pressure_bar']:g} bar at the "
+                               "design speed too: that pressure needs the μ design with it in "
+                               "[[design.uncertainty]]; or pass --allow-unstable")
     if check["mode_hz"] < cut_hz and method == "hinf":
         return head + (f"the design model keeps that mode; H∞ is designed on the nominal plant "
                        f"only ({check['pressure_bar']:g} bar is another plant): the μ design "

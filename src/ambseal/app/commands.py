@@ -38,6 +38,7 @@ from ambseal.identify import (
     MISMATCH,
     TrackingSettings,
     advice,
+    at_speed,
     check_excitation,
     check_record_metadata,
     design_rig,
@@ -48,6 +49,7 @@ from ambseal.identify import (
     impulse_checks,
     interval_check,
     load_measurement,
+    prepare_facility,
     record_spread,
     require_finite,
     thesis_procedure,
@@ -78,12 +80,19 @@ from ambseal.report import (
     target_difference,
     tracking_figure,
 )
-from ambseal.robust import check_rate, digital_controller, peak_difference, sampled_plants
+from ambseal.robust import (
+    check_rate,
+    digital_controller,
+    is_stable,
+    peak_difference,
+    sampled_plants,
+    unstable_poles,
+)
 
 __all__ = ["Designed", "Identified", "identification_stage", "facility_impulses", "design_files",
            "identify_files", "export_design", "show_defaults",
            "validate_summary", "track_files", "export_all", "digital_for", "choice_margins",
-           "judged_margins", "digitals_for", "target_pid"]
+           "judged_margins", "digitals_for", "target_pid", "facility_controller"]
 
 
 @dataclass(frozen=True)
@@ -201,6 +210,53 @@ def target_pid(cfg):
     return replace(dc.discrete, description={"type": "pid", **pid_description(reference_pid(cfg)),
                                              "discretisation": dc.method,
                                              "prewarp_hz": dc.prewarp_hz})
+
+
+def facility_controller(cfg, truth, pid):
+    """The controller that levitates the virtual facility while it is identified, and a
+    note when it is not the rig's reference PID.
+
+    A commissioning engineer levitates a new machine first at standstill without pressure
+    (where the identification's first records are taken, P2 §3, P4 §3.2) with a
+    controller that holds it there. The rig's reference PID as it runs (``pid``, from
+    ``[controller.pid]``) is that controller where it stabilises the facility's loop
+    there; where it does not and the rig file gives its own PID (or filters), the PID
+    derived from the rig with its flexible-mode filters
+    (:func:`ambseal.design.pid.pid_from_rig`) is tried, as it will run (:func:`target_pid`).
+    Where neither holds, ``pid`` is returned and the acquisition refuses it, naming the
+    pole.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig file.
+    truth : TruthSection
+        The facility's truth.
+    pid : DiscreteController
+        The reference PID as it runs on the target.
+
+    Returns
+    -------
+    (DiscreteController, str or None)
+    """
+    fs = cfg.controller.sample_rate_hz
+    fac = prepare_facility(at_speed(cfg, 0.0), truth, fs, pressure_bar=0.0)
+    z = fac.loop_poles(pid)
+    own = cfg.controller.pid is not None or cfg.controller.filter is not None
+    if is_stable(z, fac.T) or not own:
+        return pid, None
+    derived = cfg.model_copy(update={"controller": cfg.controller.model_copy(
+        update={"pid": None, "filter": None})})
+    alt = target_pid(derived)
+    if not is_stable(fac.loop_poles(alt), fac.T):
+        return pid, None
+    worst = complex(unstable_poles(z, fac.T)[0])
+    f_hz = abs(np.angle(worst)) * fs / (2 * np.pi)
+    return alt, (f"the rig file's PID does not hold the virtual facility at standstill, "
+                 f"0 bar (a sampled-loop pole |z| = {abs(worst):.5f} at {f_hz:.4g} Hz): the "
+                 "identification levitates it with the PID derived from the rig (kp "
+                 f"{alt.description['kp']:.3g} A/m, {len(alt.description.get('filters', []))}"
+                 " filter(s))")
 
 
 def _conditions(cfg, points) -> list[tuple[float, float]]:

@@ -36,6 +36,7 @@ from ambseal.app.commands import (
     Identified,
     digitals_for,
     export_all,
+    facility_controller,
     facility_impulses,
     identification_stage,
 )
@@ -380,8 +381,12 @@ def _design_stage(st: _RunState) -> None:
                               "PID during identification, and "
                               + st.cannot_run.get("pid", "the rig has none"))
         st.stages.begin("identification")
-        st.ident = identification_stage(cfg, st.truth_cfg, st.out, st.stages.step,
-                                        st.digitals["pid"].discrete)
+        levitating, note = facility_controller(cfg, st.truth_cfg, st.digitals["pid"].discrete)
+        if note:
+            st.say(note)
+        st.ident = identification_stage(cfg, st.truth_cfg, st.out, st.stages.step, levitating)
+        if note:
+            st.ident.summary["levitated_by"] = note
     if early:
         st.stages.begin("design (identified)", st.ident.summary["design"]["designed_on"])
         robust = _controllers(st.ident.design_cfg, spec, st.say, st.failed, synthesised)

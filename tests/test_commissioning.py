@@ -31,10 +31,10 @@ def _weak_pid_rig(tmp_path) -> Path:
 
 
 def test_a_pid_that_loses_the_facility_is_replaced_by_the_derived_one(tmp_path):
-    """Reference: the facility's own simulation. With the rig file's weak PID the rotor
-    leaves the gap (or the run is refused before it starts); with the controller chosen
-    the same excitation runs to the end with the rotor within a tenth of the gap, and the
-    note names the pole that lost it."""
+    """Reference: the facility's own simulation. The rig file's weak PID is refused before
+    the run, as losing the rig file's own model (not blamed on the truth's τ_e and
+    parameters); with the controller chosen the same excitation runs to the end with the
+    rotor within a tenth of the gap, and the note names the pole that lost it."""
     cfg = load_rig(_weak_pid_rig(tmp_path))
     truth = load_truth(default_truth_path())
     weak = target_pid(cfg)
@@ -44,7 +44,8 @@ def test_a_pid_that_loses_the_facility_is_replaced_by_the_derived_one(tmp_path):
         and "|z| = 1.0" in note
     fs = cfg.controller.sample_rate_hz
     e = 0.02 * np.random.default_rng(1).choice([-1.0, 1.0], size=(int(0.2 * fs), 4))
-    with pytest.raises(ModelError):
+    # refused before the run, the fault named: the rig file's own model is lost too
+    with pytest.raises(ModelError, match="loses the rig file's own model there too"):
         simulate_facility(cfg, truth, e, fs, weak, pressure_bar=0.0)
     rec = simulate_facility(cfg, truth, e, fs, chosen, pressure_bar=0.0)
     assert np.abs(rec.displacement_m).max() < 0.1 * machine(cfg).air_gap_m

@@ -488,6 +488,15 @@ def _refuse_unstable(fac: Facility, controller: DiscreteController, cfg: RigConf
     worst = unstable_poles(z, fac.T)[0]
     s = np.log(complex(worst)) / fac.T
     f_hz, zeta = abs(s.imag) / (2 * np.pi), -s.real / abs(s)
+    # a controller that loses the rig file's own model too is not the truth's to blame
+    own = prepare_facility(cfg, TruthSection(tau_e=cfg.actuator.eddy_time_constant),
+                           1.0 / fac.T, pressure_bar=pressure_bar)
+    if not is_stable(own.loop_poles(controller), own.T):
+        raise ModelError(
+            f"the controller does not stabilise the virtual facility at {pressure_bar:g} bar: "
+            f"its sampled loop has a pole |z| = {abs(worst):.5f} at {f_hz:.4g} Hz (ζ = "
+            f"{zeta:.2g}), and it loses the rig file's own model there too (the controller, "
+            "not the truth's departures from the rig file, is at fault)")
     seen = []
     if truth.tau_e != cfg.actuator.eddy_time_constant:
         seen.append(f"tau_e = {truth.tau_e * 1e3:.3g} ms (the rig file's actuator: "

@@ -432,6 +432,7 @@ def _judge_stage(st: _RunState) -> None:
             del st.failed[m]
             st.designs = [fixed.design if d.method == m else d for d in st.designs]
             st.digitals[m] = fixed.digital
+            st.cannot_run.pop(m, None)  # the redesign runs on the target: it has a digital
             new = iter(zip(fixed.jobs, fixed.judged))
             st.jobs, st.judged = map(list, zip(*[next(new) if j.name == m else (j, r)
                                                  for j, r in zip(st.jobs, st.judged)]))

@@ -187,7 +187,7 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "PidFilter.width_hz": ("Hz", "a notch's width between its −3 dB points"),
     "PidFilter.depth_db": ("dB", "a notch's attenuation at its centre"),
     "PidFilter.phase_deg": ("°", "phase a lead adds (a lag takes) at ``frequency_hz``; "
-                                 "gain 1 at standstill"),
+                                 "gain 1 at zero frequency"),
     "PidFilter.damping": ("", "a low-pass filter's damping ratio ζ"),
     # [operating]
     "Operating.speed_rpm": ("rpm", "operating speed"),

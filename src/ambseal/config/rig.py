@@ -390,10 +390,10 @@ class Pid(_Strict):
 class PidFilter(_Strict):
     """A filter in series with the reference PID on every axis (the commissioning
     engineer's gain or phase stabilisation of a flexible mode, Schweitzer & Maslen 2009
-    §8.4; :func:`ambseal.design.pid.pid_controller`): ``kind`` = ``"notch"``
+    on flexible rotors; :func:`ambseal.design.pid.pid_controller`): ``kind`` = ``"notch"``
     (``frequency_hz``, ``width_hz`` between the −3 dB points of a deep notch,
     ``depth_db``), ``"lead"`` or ``"lag"`` (``phase_deg``, the phase added, or taken, at
-    ``frequency_hz``, unity gain at standstill) or ``"lowpass"`` (second order,
+    ``frequency_hz``, unity gain at zero frequency) or ``"lowpass"`` (second order,
     ``frequency_hz``, ``damping``)."""
 
     kind: Literal["notch", "lead", "lag", "lowpass"]

@@ -38,14 +38,14 @@ def pid_controller(
     K_PID(s) = Kp (1 + 1/(Ti s) + Td s/(ε Td s + 1)) · Π F_k(s)   (thesis P5 Eq. 6)
 
     The filters are the commissioning engineer's (Schweitzer & Maslen, *Magnetic
-    Bearings*, 2009, §8.4), with ω_c = 2π ``frequency_hz``:
+    Bearings*, 2009, on flexible rotors), with ω_c = 2π ``frequency_hz``:
 
     * notch: F = (s² + 2ζ_z ω_c s + ω_c²)/(s² + 2ζ_p ω_c s + ω_c²), ζ_p = ``width_hz``/(2
       ``frequency_hz``) (the −3 dB width of a deep notch), ζ_z = ζ_p·10^(−depth_db/20): the
       gain at ω_c is 10^(−depth_db/20), 1 far from it;
     * lead, lag: F = (1 + s/ω_z)/(1 + s/ω_p), ω_z = ω_c/√α, ω_p = ω_c·√α, with
       α = (1 + sin φ)/(1 − sin φ) for a lead of φ = ``phase_deg`` (α → 1/α for a lag): the
-      largest phase change, ±φ, at ω_c; gain 1 at standstill, √α at ω_c (a lag: 1/√α);
+      largest phase change, ±φ, at ω_c; gain 1 at zero frequency, √α at ω_c (a lag: 1/√α);
     * lowpass: F = ω_c²/(s² + 2ζ ω_c s + ω_c²), ζ = ``damping``.
 
     Parameters

@@ -5,7 +5,7 @@ A decentralised PID (thesis P5 Eq. 6) is tuned on the rigid-body modes; on a fle
 its derivative action, the target's hold and computation delay and the actuator decide
 the phase the controller has at each bending mode, and the mode's shapes at the sensors
 and actuators decide which phase damps it (Schweitzer & Maslen, *Magnetic Bearings*, 2009,
-§8.4 and §12.3): a mode whose sensor and actuator move together (collocated) is damped by
+the control of flexible rotors): a mode whose sensor and actuator move together (collocated) is damped by
 phase lead, one whose sensor and actuator lie on opposite sides of a node (non-collocated)
 by phase lag, and a mode whose phase cannot be put right within a filter's reach is
 gain-stabilised by a notch. A mode with a node at the sensors or actuators is neither
@@ -42,7 +42,7 @@ the filter taken, or the mode that defeats every candidate and why.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -105,11 +105,6 @@ class FilterDesign:
     modes: tuple
     kept: bool
     least_zeta: float
-
-    def to_dict(self) -> dict:
-        return {"filters": [dict(f) for f in self.filters],
-                "modes": [asdict(m) for m in self.modes], "kept": self.kept,
-                "least_zeta": self.least_zeta}
 
 
 def _zeta_z(z: np.ndarray) -> np.ndarray:

@@ -60,8 +60,9 @@ def test_a_pid_that_holds_the_facility_is_kept(tmp_path):
 @pytest.mark.slow
 def test_run_identifies_a_rig_whose_own_pid_loses_the_facility(tmp_path, capsys):
     """`ambseal run` on the weak-PID rig with the test rig's truth: the identification
-    runs with the derived PID (said in metrics' identification block), every 95 % interval
-    holds the true value, and only the rig file's PID is reported failing."""
+    runs with the derived PID (said in metrics' identification block and first in the
+    report's identification section), every 95 % interval holds the true value, and only
+    the rig file's PID is reported failing."""
     out = tmp_path / "o"
     main(["--quiet", "run", str(_weak_pid_rig(tmp_path)), "--truth",
           str(default_truth_path()), "--out", str(out)])
@@ -71,3 +72,4 @@ def test_run_identifies_a_rig_whose_own_pid_loses_the_facility(tmp_path, capsys)
     assert ident["levitated_by"].startswith("the rig file's PID does not hold")
     assert ident["converged"] and not ident["interval_check"]["missed"]
     assert set(m["failed"]) == {"pid"}
+    assert "PID does not hold the virtual facility" in (out / "report.html").read_text()

@@ -351,11 +351,13 @@ class Identified:
     extra: dict = field(default_factory=dict)
 
 
-def identification_stage(cfg, truth, out: Path, say, controller) -> Identified:
+def identification_stage(cfg, truth, out: Path, say, controller,
+                         levitated_by: str | None = None) -> Identified:
     """The thesis's identification procedure on the virtual facility, its files, the FRF
     checks of the identified model, its figures and report section, and the rig to design
     on. ``controller`` is the exported, judged discrete reference PID (the facility runs
-    exactly that object)."""
+    exactly that object), or the one :func:`facility_controller` chose instead, with
+    ``levitated_by`` saying why."""
 
     res = thesis_procedure(cfg, truth, controller, progress=say)
     write_json(out / "identification.json", res.to_dict())
@@ -367,14 +369,15 @@ def identification_stage(cfg, truth, out: Path, say, controller) -> Identified:
     seal = cfg.seal[0].name if cfg.seal else None
     errors = truth_errors(res, seal)
     figs, sections = identification_report(out, res, errors, checks, truth, seal,
-                                           cfg.operating.pressure_bar)
+                                           cfg.operating.pressure_bar, levitated_by)
     a = res.amb
     design_cfg, note = design_rig(cfg, res)
     summary = {"parameters": errors, "converged": bool(a.converged),
                "model_check": a.model_check(), "interval_check": interval_check(errors),
                "nrmse_fit_pct": {k: (float(v) if math.isfinite(v) else None)
                                  for k, v in a.nrmse_fit_pct.items()},
-               "design": note, "judged_on": "virtual facility (truth file, full order)"}
+               "design": note, "judged_on": "virtual facility (truth file, full order)",
+               **({"levitated_by": levitated_by} if levitated_by else {})}
     return Identified(summary, figs, sections, res, design_cfg, truth_rig(cfg, truth))
 
 

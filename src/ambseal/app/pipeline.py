@@ -384,9 +384,8 @@ def _design_stage(st: _RunState) -> None:
         levitating, note = facility_controller(cfg, st.truth_cfg, st.digitals["pid"].discrete)
         if note:
             st.say(note)
-        st.ident = identification_stage(cfg, st.truth_cfg, st.out, st.stages.step, levitating)
-        if note:
-            st.ident.summary["levitated_by"] = note
+        st.ident = identification_stage(cfg, st.truth_cfg, st.out, st.stages.step, levitating,
+                                        note)
     if early:
         st.stages.begin("design (identified)", st.ident.summary["design"]["designed_on"])
         robust = _controllers(st.ident.design_cfg, spec, st.say, st.failed, synthesised)

@@ -190,7 +190,8 @@ def spinup_figures(out: Path, sims: list, sens: list, speeds_hz: tuple[float, fl
 
 
 def identification_report(out: Path, res, errors: dict, checks, truth, seal_name: str | None,
-                          nominal_bar: float) -> tuple[list, list]:
+                          nominal_bar: float, levitated_by: str | None = None
+                          ) -> tuple[list, list]:
     """Figures and the HTML section of the identification stage.
 
     Parameters
@@ -209,6 +210,9 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
         The seal whose coefficients are drawn against pressure; None for none.
     nominal_bar : float
         The rig's nominal pressure drop (bar), marked in the pressure figure.
+    levitated_by : str, optional
+        Why the facility was levitated by another controller than the rig file's PID
+        (:func:`ambseal.app.commands.facility_controller`), said first.
 
     Returns
     -------
@@ -266,7 +270,9 @@ def identification_report(out: Path, res, errors: dict, checks, truth, seal_name
         fits += f". Seal impulse at {p:g} bar skipped: {html.escape(why)}"
     section = {
         "title": "Identification on the virtual test facility",
-        "html": ("<p>Records from the virtual facility (nonlinear AMB force law, full FE rotor, "
+        "html": ((f"<p><b>{html.escape(levitated_by[0].upper() + levitated_by[1:])}.</b></p>"
+                  if levitated_by else "")
+                 + "<p>Records from the virtual facility (nonlinear AMB force law, full FE rotor, "
                  "noise, ADC), fitted by the output-error method of P2/P4. NRMSE fit of stage "
                  f"(a): {fits}. Identified rig: <code>identified_rig.toml</code>.</p>"
                  "<table><tr><th>parameter</th><th>identified</th><th>truth</th>"

@@ -244,8 +244,9 @@ def test_design_is_deterministic_and_validates(cfg, designs):
 
 
 def test_a_mode_lost_at_another_speed_is_blamed_on_the_speed_not_the_seal():
-    """The back-to-back compressor's H∞, designed at 183.3 Hz, loses its first bending mode
-    (kept in the design model) at standstill, 0 bar (measured: 254 Hz, ζ −0.04), and at
+    """The back-to-back compressor's H∞, designed at 183.3 Hz without a damping margin,
+    loses its first bending mode (kept in the design model) at standstill, 0 bar
+    (measured: 254 Hz, ζ −0.04), and at
     standstill at its design pressure too (ζ −0.03): the refusal names the speed and the
     controller scheduled on speed, not only a seal range that cannot cover a gyroscopic
     shift; where the pressure alone lost it (the manual's compressor: its piston's K gone

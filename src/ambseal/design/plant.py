@@ -55,7 +55,17 @@ from ambseal.model import Plant, build_plant
 from ambseal.robust import lft_lower, mussv
 
 __all__ = ["UncertainParameter", "GeneralizedPlant", "generalized_plant",
-           "physical_controller", "physical_matrices"]
+           "physical_controller", "physical_matrices", "less_damped"]
+
+#: Modes with damping ratio below this are the lightly damped (structural) ones a damping
+#: margin applies to; rigid-body modes on AMBs are real and unstable, the actuator's
+#: poles real: neither is touched.
+LIGHT_DAMPING = 0.2
+
+#: A margin applies to the design model's modes within this factor of its frequency: the
+#: lost closed-loop mode sits between the open-loop pair it came from (the forward and
+#: backward whirls, the ζ and η planes).
+MARGIN_BAND = 1.15
 
 
 @dataclass(frozen=True)
@@ -300,6 +310,7 @@ def generalized_plant(
     force_positions: tuple = (),
     actuator_delay: Any = None,
     gain_weight: Any = None,
+    damping_margins: tuple = (),
 ) -> GeneralizedPlant:
     """Build the generalised plant of P5 Figs. 8–9 from a rig or a plant.
 
@@ -349,6 +360,10 @@ def generalized_plant(
         W_K on every control channel, an extra performance output ``z_K = W_K u`` after
         ``z_u`` (μ's gain demand, :meth:`ambseal.design.weights.Weights.Wk`); its states
         join P last.
+    damping_margins : tuple of (float, float)
+        ``(f_hz, Δζ)`` pairs: every lightly damped mode of the design model within a
+        factor 1.15 of f_hz is made Δζ less damped (:func:`less_damped`), so the
+        controller must add that damping of its own.
 
     Returns
     -------
@@ -376,6 +391,8 @@ def generalized_plant(
             raise ConfigError(f"generalized_plant: {nm}={v!r} must be finite and > 0")
     full, cur, fcols = _source_plant(source, reduced, pressure_bar, states, force_positions,
                                      force_disturbance is not None)
+    if damping_margins:
+        full = less_damped(full, damping_margins)
     params = _ranges(full.select_inputs([full.input_names[i] for i in cur]), uncertainty or {})
     centre = full.with_values({q.name: q.centre for q in params}) if params else full
     parts = _parts(centre, params, cur, fcols, Wp, Wu, input_disturbance, output_disturbance,
@@ -405,6 +422,54 @@ class _Parts:
     labels_out: tuple
     state_names: tuple
     nd: int
+
+
+def less_damped(plant: Plant, margins) -> Plant:
+    """The plant with the damping of its lightly damped modes lowered: a design-model margin.
+
+    Each complex mode λ with 0 < ζ = −Re λ/|λ| < :data:`LIGHT_DAMPING` whose |λ|/2π lies
+    within a factor :data:`MARGIN_BAND` of a margin's frequency moves to
+    λ + Δζ·|λ| (its damping ratio drops by Δζ, to below zero when Δζ > ζ), the other
+    modes staying where they are: ``A + Re(V diag(δλ) W)`` with V, W the right and
+    (biorthonormal) left eigenvectors. A controller that holds this model adds at least
+    Δζ of damping of its own to those modes, the margin the truncated modes and the
+    sampling may take from the full-order loop: a floor on the closed-loop damping ratio
+    of those modes, as regional pole placement asks of every pole (Chilali & Gahinet,
+    IEEE TAC 41(3), 1996).
+
+    Parameters
+    ----------
+    plant : Plant
+        Design model (states n, small: a dense eigendecomposition).
+    margins : iterable of (float, float)
+        ``(f_hz, Δζ)``: mode frequency (Hz, > 0) and damping-ratio margin (> 0).
+
+    Returns
+    -------
+    Plant
+        The same channels and parameters; only A changes.
+
+    Raises
+    ------
+    ModelError
+        A margin with a non-positive frequency or Δζ.
+    """
+    margins = [(float(f), float(dz)) for f, dz in margins]
+    if any(not (f > 0 and dz > 0) for f, dz in margins):
+        raise ModelError(f"less_damped: margins {margins}: expected (f_hz > 0, Δζ > 0) pairs")
+    A = np.asarray(plant.A, float)
+    lam, V = np.linalg.eig(A)
+    W = np.linalg.inv(V)
+    mag = np.abs(lam)
+    zeta = -lam.real / np.maximum(mag, 1e-300)
+    light = (np.abs(lam.imag) > 1e-9 * mag) & (zeta > 0) & (zeta < LIGHT_DAMPING)
+    shift = np.zeros(lam.size)
+    for f, dz in margins:
+        near = light & (mag < MARGIN_BAND * 2 * np.pi * f) & (mag > 2 * np.pi * f / MARGIN_BAND)
+        shift = np.where(near, np.maximum(shift, dz * mag), shift)
+    if not shift.any():
+        return plant
+    return replace(plant, A=A + np.real((V * shift) @ W))
 
 
 def _sig(prefix: str, names) -> list[str]:

@@ -56,7 +56,12 @@ import numpy as np
 
 from ambseal.config import method_names
 from ambseal.design.pid import pid_controller, reference_pid
-from ambseal.design.plant import generalized_plant
+from ambseal.design.plant import (
+    LIGHT_DAMPING,
+    MARGIN_BAND,
+    generalized_plant,
+    less_damped,
+)
 from ambseal.design.specs import design_spec
 from ambseal.design.weights import Weights
 from ambseal.errors import ConfigError, SynthesisError
@@ -229,20 +234,33 @@ def full_order_check(cfg, K, conditions) -> dict:
         (damped frequency) and ``damping`` (ζ = −Re λ/|λ|, negative when unstable).
     """
 
+    return _worst(_checked(cfg, K, conditions))
+
+
+def _checked(cfg, K, conditions) -> list[dict]:
+    """:func:`full_order_check`'s dict for each condition alone."""
     L = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples).system
-    worst = None
+    rows = []
     for p, f in conditions:
         plant = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * f)
         judged = judged_loop(plant.to_statespace(), K, plant.current_inputs(), delay=L)
         lam = judged.loop.poles
         z = lam[int(np.argmax(lam.real))]
-        rank = (not judged.stable, z.real / np.abs(lam).max())
-        if worst is None or rank > worst[0]:
-            worst = (rank, p, f, z)
-    (unstable, _), p, f, z = worst
-    return {"stable": not unstable, "pressure_bar": float(p), "speed_hz": float(f),
-            "max_real_pole": float(z.real), "mode_hz": float(abs(z.imag) / (2 * np.pi)),
-            "damping": float(-z.real / max(abs(z), 1e-300))}
+        rows.append({"stable": bool(judged.stable), "pressure_bar": float(p),
+                     "speed_hz": float(f), "max_real_pole": float(z.real),
+                     "mode_hz": float(abs(z.imag) / (2 * np.pi)),
+                     "damping": float(-z.real / max(abs(z), 1e-300)),
+                     "rank": z.real / np.abs(lam).max()})
+    return rows
+
+
+def _worst(rows: list[dict]) -> dict:
+    """The least stable of :func:`_checked`'s rows (an unstable one first), ``stable``
+    true only if every row is."""
+    w = max(rows, key=lambda r: (not r["stable"], r["rank"]))
+    out = {k: v for k, v in w.items() if k != "rank"}
+    out["stable"] = all(r["stable"] for r in rows)
+    return out
 
 
 @with_numerics_threads
@@ -367,32 +385,74 @@ def design(
 
 def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max_iter,
                           dk_order, dl, enlarge, steps, progress):
-    """:func:`_synthesise` on the specification's design model, enlarged (at most
-    ``enlarge`` times, unless ``states`` fixes it) while the full-order loop is unstable
-    at a mode the model left out; each enlargement is appended to ``steps`` and reported
-    to ``progress``. Returns (synthesis, full-order check, design states)."""
+    """:func:`_synthesise` on the specification's design model, corrected (at most
+    ``enlarge`` times) while the full-order loop is unstable: enlarged (unless ``states``
+    fixes it) to keep a mode the model left out, or, where the model keeps the mode,
+    given a damping margin on it
+    (:func:`margin_for`); if no margin holds it, the last design without margins is
+    returned. Each correction is appended to ``steps`` and reported to ``progress``.
+    Returns (synthesis, full-order check, design states)."""
     n = int(states or sp.model_states)
     # held where it is judged and wherever the machine runs, standstill to the top speed
     conditions = [(q, f) for q in sp.pressures_bar
                   for f in sorted({*sp.speeds_hz, *sp.stability_speeds_hz})]
+    margins: dict[float, float] = {}
+    plain = None  # the last design without margins: delivered if no margin holds the loop
     for attempt in range(enlarge + 1):
-        r = _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl)
+        r = _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl,
+                        tuple(margins.items()))
         check = full_order_check(cfg, r.K, conditions)
-        if check["stable"] or attempt == enlarge or states is not None:
+        if not margins:
+            plain = (r, check, n)
+        if check["stable"] or attempt == enlarge:
             break
-        n_new = _states_to_keep(cfg, p, check["mode_hz"])
-        if n_new <= n:  # the mode is in the design model: enlarging it cannot help
-            break
-        steps.append(f"{method}: full-order loop unstable at {check['mode_hz']:.4g} Hz "
-                     f"(ζ = {check['damping']:.3g}, {check['pressure_bar']:g} bar); design "
-                     f"model enlarged from {n} to {n_new} states")
+        n_new = n if states is not None else _states_to_keep(cfg, p, check["mode_hz"])
+        if n_new > n:
+            steps.append(f"{method}: full-order loop unstable at {check['mode_hz']:.4g} Hz "
+                         f"(ζ = {check['damping']:.3g}, {check['pressure_bar']:g} bar); design "
+                         f"model enlarged from {n} to {n_new} states")
+            n = n_new
+            top = 1.5 * check["mode_hz"]
+            if om is None and top > sp.synthesis_band_hz[1]:
+                om = design_omega(sp.synthesis_band_hz[0], top)
+        else:
+            # a lightly damped mode the model keeps, barely damped by the design: a margin
+            # on it (a rigid-body mode the loop no longer holds is no such mode)
+            f, dz = margin_for(check, margins)
+            model = build_plant(cfg, pressure_bar=p, states=n)
+            if -check["damping"] >= LIGHT_DAMPING or less_damped(model, [(f, dz)]) is model:
+                break
+            margins[f] = dz
+            steps.append(f"{method}: full-order loop unstable at {check['mode_hz']:.4g} Hz "
+                         f"(ζ = {check['damping']:.3g}, {check['pressure_bar']:g} bar, "
+                         f"{check['speed_hz']:g} Hz), a mode the design model keeps: its "
+                         f"damping there lowered by {dz:.3g} (ζ) so the controller adds it")
         if progress:
             progress(steps[-1])
-        n = n_new
-        top = 1.5 * check["mode_hz"]
-        if om is None and top > sp.synthesis_band_hz[1]:
-            om = design_omega(sp.synthesis_band_hz[0], top)
+    if not check["stable"] and margins:
+        # the margins asked for damping this design could not give without losing the
+        # loop elsewhere: the design as the weights ask it, with the steps tried reported
+        steps.append(f"{method}: no damping margin held the full-order loop; the design "
+                     "without margins is delivered")
+        r, check, n = plain
     return r, check, n
+
+
+#: The damping-ratio margin a lost kept mode gets first (on top of twice the damping the
+#: full-order loop lacked), doubled on each further loss of the same mode: 0.5 %, the
+#: structural damping of a built-up rotor, so the controller at least doubles it.
+MARGIN_ZETA = 0.005
+
+
+def margin_for(check: dict, margins: dict) -> tuple[float, float]:
+    """The damping margin (f_hz, Δζ) for the mode a full-order check lost: Δζ =
+    :data:`MARGIN_ZETA` + 2·(−ζ) of the lost mode, or twice the margin already given to
+    a mode within :data:`ambseal.design.plant.MARGIN_BAND` of it (which it replaces)."""
+    f, zeta = check["mode_hz"], check["damping"]
+    for g, dz in margins.items():
+        if g / MARGIN_BAND < f < g * MARGIN_BAND:
+            return g, 2.0 * dz
+    return f, MARGIN_ZETA + 2.0 * max(-zeta, 0.0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -410,8 +470,10 @@ class _Synthesis:
     stopping: dict | None = None
 
 
-def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl):
-    """One synthesis on an n-state design model, reduced, as a physical controller."""
+def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl,
+                margins=()):
+    """One synthesis on an n-state design model (with ``margins``, see
+    :func:`ambseal.design.plant.less_damped`), reduced, as a physical controller."""
 
     robust = method in method_names(robust=True)  # against the uncertain parameters
     Wf = w.Wf()
@@ -420,7 +482,7 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
                            pressure_bar=p, states=n, input_disturbance=w.W1(),
                            force_disturbance=Wf, force_positions=fpos, d_e=w.d_e, d_u=w.d_u,
                            actuator_delay=dl.system,
-                           gain_weight=w.Wk())
+                           gain_weight=w.Wk(), damping_margins=margins)
     mu_omega = None
     if not robust:  # nominal H∞
         r = hinfsyn(gp.P_nominal, gp.nmeas, gp.ncon)
@@ -531,7 +593,7 @@ def _lost_by(cfg, K, check, p: float) -> tuple[bool, bool, float]:
 def _unstable_message(method, check, n, steps, cut_hz, lost=(True, False, 0.0)) -> str:
     """The refusal's one line; ``lost`` = (by the pressure, by the speed, design speed Hz)
     of :func:`_lost_by`."""
-    tried = f" after {len(steps)} automatic enlargement(s)" if steps else ""
+    tried = f" after {len(steps)} automatic design step(s)" if steps else ""
     head = (f"design({method}): the controller destabilises the full-order plant{tried}: the "
             f"mode at {check['mode_hz']:.4g} Hz has damping ζ = {check['damping']:.3g} at "
             f"{check['pressure_bar']:g} bar, {check['speed_hz']:g} Hz; ")

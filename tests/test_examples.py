@@ -205,12 +205,14 @@ def test_a_rig_with_one_amb_and_a_plain_bearing_runs_or_is_refused_plainly(tmp_p
 
 @pytest.mark.slow
 def test_the_manuals_compressor_is_judged_from_standstill_to_the_top_speed(tmp_path, capsys):
-    """The manual's compressor (docs/rigs/compressor.toml, 150 Hz, range 60–165 Hz): its H∞
-    controller holds at the operating speed but not below it (a 348 Hz mode loses its
-    damping at standstill and low speed, measured), so the run marks it failed with those
-    conditions and exits 1 — instead of calling it zone A at 150 Hz alone — and adds the
-    LPV on speed, which holds everywhere. Every controller is closed at each judged
-    pressure from 0 to 165 Hz in quarters."""
+    """The manual's compressor (docs/rigs/compressor.toml, 150 Hz, range 60–165 Hz): its μ,
+    robust to the seals' k but not to the piston's K, loses a rigid-body mode at 0 bar at
+    every speed (measured), so the run marks it failed with those conditions and exits 1 —
+    instead of calling it zone A at 30 and 60 bar alone. H∞, designed at 30 bar, loses the
+    rotor at 0 bar; redesigned there (the first remedy) with a damping margin on its 348 Hz
+    mode, which the plain design loses at standstill, it holds everywhere. The LPV on speed
+    holds everywhere. Every controller is closed at each judged pressure from 0 to 165 Hz
+    in quarters."""
     rig = Path(__file__).resolve().parents[1] / "docs" / "rigs" / "compressor.toml"
     code = main(["--quiet", "run", str(rig), "--no-identify", "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err
@@ -219,8 +221,12 @@ def test_the_manuals_compressor_is_judged_from_standstill_to_the_top_speed(tmp_p
     validate_metrics(m)
     speeds = {c["speed_hz"] for c in m["stability"]}
     assert speeds == {0.0, 41.25, 60.0, 82.5, 123.75, 165.0}
-    hinf_bad = [c for c in m["stability"] if c["controller"] == "hinf" and not c["stable"]]
-    assert any(c["speed_hz"] == 0.0 for c in hinf_bad)
-    assert all(c["label"] in m["failed"]["hinf"]["conditions"] for c in hinf_bad)
-    assert "0 Hz" in err and "H∞: not delivered" in err
+    mu_bad = [c for c in m["stability"] if c["controller"] == "mu" and not c["stable"]]
+    assert {c["speed_hz"] for c in mu_bad} == speeds and {c["pressure_bar"] for c in mu_bad} \
+        == {0.0}
+    assert all(c["label"] in m["failed"]["mu"]["conditions"] for c in mu_bad)
+    assert "μ: not delivered" in err and "hinf" not in m["failed"]
+    assert any("damping there lowered" in s for s in m["controllers"]["hinf"]["steps"])
+    assert all(c["stable"] and c["discrete"]["stable"] for c in m["stability"]
+               if c["controller"] == "hinf")
     _lpv_holds_everywhere(m)

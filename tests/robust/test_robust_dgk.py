@@ -93,9 +93,14 @@ def test_dgk_result_holds_by_a_parameter_sweep(complex_dk):
     P = gain_plant()
     w, blocks = W_GRID, BLOCKS
     dk = complex_dk(R, search=0)
-    r = musyn_dgk(P, blocks, 1, 1, w, max_iter=6)
+    lines: list[str] = []
+    r = musyn_dgk(P, blocks, 1, 1, w, max_iter=6, progress=lines.append)
     assert r.mu < 0.9 * dk.mu and r.mu <= complex_dk(R).mu
     assert "D-G-K" in {h["step"] for h in r.history} <= {"D-K", "D search", "D-G-K"}
+    # one progress line per K-step of each phase (a callable gets them, not the terminal)
+    for step in ("D-K", "D-G-K"):
+        done = sum(h["step"] == step for h in r.history)
+        assert sum(ln.startswith(f"{step} ") and "γ =" in ln for ln in lines) == done > 0
     # the reported μ: the peak over the grid it names (W_GRID and the points added at its
     # peaks), not below the grid's
     mu_check = mussv(lft_lower(P, r.K, 1, 1), blocks, r.check_omega).upper

@@ -400,7 +400,8 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
     plain = None  # the last design without margins: delivered if no margin holds the loop
     for attempt in range(enlarge + 1):
         r = _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl,
-                        tuple(margins.items()))
+                        tuple(margins.items()),
+                        progress and (lambda line: progress(f"{method}: {line}")))
         check = full_order_check(cfg, r.K, conditions)
         if not margins:
             plain = (r, check, n)
@@ -471,9 +472,10 @@ class _Synthesis:
 
 
 def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl,
-                margins=()):
+                margins=(), progress=None):
     """One synthesis on an n-state design model (with ``margins``, see
-    :func:`ambseal.design.plant.less_damped`), reduced, as a physical controller."""
+    :func:`ambseal.design.plant.less_damped`), reduced, as a physical controller;
+    ``progress(line)`` gets μ's iterations."""
 
     robust = method in method_names(robust=True)  # against the uncertain parameters
     Wf = w.Wf()
@@ -495,7 +497,8 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
         if om is None:
             om = design_omega(*sp.synthesis_band_hz)
         syn = musyn_dgk if sp.mu_iteration == "dgk" else musyn
-        r = syn(gp.P, gp.blocks, gp.nmeas, gp.ncon, om, order=dk_order, max_iter=max_iter)
+        r = syn(gp.P, gp.blocks, gp.nmeas, gp.ncon, om, order=dk_order, max_iter=max_iter,
+                progress=progress or False)
         K_P, gamma, mu, hist = r.K, float(r.gamma), float(r.mu), r.history
         stopping = r.stopping
         P_red, blocks, mu_omega = gp.P, gp.blocks, float(r.mu_omega)

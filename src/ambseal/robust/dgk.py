@@ -49,11 +49,10 @@ from __future__ import annotations
 
 import time
 from dataclasses import replace
-from typing import Sequence
+from typing import Any, Sequence
 
 import control as ct
 import numpy as np
-from rich.console import Console
 
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.lti.freqresp import freqresp
@@ -65,7 +64,14 @@ from ambseal.robust._dgscale import (
     relax_pointwise,
     scaled_plant_dg,
 )
-from ambseal.robust.dk import MusynResult, _check, default_omega, fit_dscale, musyn
+from ambseal.robust.dk import (
+    MusynResult,
+    _check,
+    default_omega,
+    fit_dscale,
+    musyn,
+    progress_printer,
+)
 from ambseal.robust.hinf import hinfsyn, lft_lower
 from ambseal.robust.mu import check_blocks, mussv
 from ambseal.threads import with_numerics_threads
@@ -188,7 +194,7 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
               order: int | str = "auto", max_iter: int = 8, rtol: float = 1e-2,
               patience: int = 2, backoff: float = 1.01, fit_tol: float = 0.05,
               search: int | str = "auto", search_backoff: float = 1.001,
-              progress: bool = False) -> MusynResult:
+              progress: Any = False) -> MusynResult:
     """μ-synthesis by D–G–K iteration for mixed real/complex structures (Young 1996).
 
     Complex D–K (:func:`~ambseal.robust.dk.musyn`) first, then D–G–K steps from its best
@@ -224,8 +230,8 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
         Relative magnitude tolerance of the automatic scaling fit orders.
     search, search_backoff : int or "auto", float
         The D search of the D–K phase, as in :func:`~ambseal.robust.dk.musyn`.
-    progress : bool
-        Print one line per iteration on stderr (rich).
+    progress : bool or callable
+        As in :func:`~ambseal.robust.dk.musyn`.
 
     Returns
     -------
@@ -258,10 +264,7 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
         return dk
     sblocks, real = _split(blks)
     history = [dict(h, step=h.get("step", "D-K")) for h in dk.history]
-    console = None
-    if progress:
-
-        console = Console(stderr=True)
+    console = progress_printer(progress)
     # iterates compared by their peak on the grid, as in complex D–K
     best = (dk.mu_grid, dk.best_iteration, dk.K, dk.gamma, np.asarray(dk.mu_curve), dk.scalings)
     K, stall, rule = dk.K, 0, f"max_iter={max_iter}"
@@ -269,6 +272,8 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
     for it in range(first, first + max_iter):
         mu_s = mussv(lft_lower(P, K, nmeas, ncon), sblocks, w, lower=False, peak=False)
         beta = float(np.max(mu_s.upper))
+        if console is not None:
+            console.print(f"D-G-K {it}: fitting the D and G scalings at β = {beta:.4g}")
         fits, jg_err, level = _dg_step_scalings(P, K, nmeas, ncon, mu_s, real, beta, w,
                                                 fit_tol)
         try:

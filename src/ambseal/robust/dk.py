@@ -369,12 +369,33 @@ def _check(P, K, blocks, nmeas, ncon, w, upper):
     return mu_peak(lft_lower(P, K, nmeas, ncon), blocks, w, upper)
 
 
+def progress_printer(progress) -> Any:
+    """Where the μ syntheses' iteration lines go: ``None`` (false), an object whose
+    ``print(line)`` calls ``progress(line)`` (a callable, e.g. the main job's logger), or
+    rich's stderr console (true)."""
+    if not progress:
+        return None
+    if callable(progress):
+        return _Lines(progress)
+    return Console(stderr=True)
+
+
+@dataclass(frozen=True)
+class _Lines:
+    """``print(line)`` → ``say(line)``."""
+
+    say: Any
+
+    def print(self, line: str) -> None:
+        self.say(line)
+
+
 @with_numerics_threads
 def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None, *,
           order: int | str = "auto", max_iter: int = 8, rtol: float = 1e-2,
           patience: int = 2, backoff: float = 1.01, fit_tol: float = 0.05,
           search: int | str = "auto", search_backoff: float = 1.001,
-          progress: bool = False) -> MusynResult:
+          progress: Any = False) -> MusynResult:
     """μ-synthesis by complex D–K iteration (Balas et al. 1993), then a
     direct search over the D scales.
 
@@ -435,8 +456,9 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
         much of the gain (Mackenroth's aircraft, ``benchmarks/bench_dk.py``: μ 0.985 at
         1.01·γ_opt, 0.978 at 1.001·γ_opt). :func:`~ambseal.robust.hinf.hinfsyn` raises it
         when the closed loop is not stable.
-    progress : bool
-        Print one line per iteration on stderr (rich).
+    progress : bool or callable
+        One line per iteration: printed on stderr (rich) if true, or passed to
+        ``progress(line)`` (:func:`progress_printer`).
 
     Returns
     -------
@@ -472,10 +494,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     if w.ndim != 1 or w.size < 2 or np.any(w <= 0) or not np.all(np.isfinite(w)):
         raise ConfigError("musyn: omega must be a 1-D grid of positive rad/s values")
     cblocks = _complexify(blks)
-    console = None
-    if progress:
-
-        console = Console(stderr=True)
+    console = progress_printer(progress)
 
     history, best = [], None
     fits: list = []

@@ -194,9 +194,15 @@ class Page:
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
             code = main(argv)
         got = out.getvalue() + err.getvalue()
+        status = re.fullmatch(r"\(exit status (\d+)\)", expected[-1].strip()) \
+            if expected else None
         if error:
             assert code == 2, f"{where}: expected the error, got exit {code}: {got}"
             assert _matches(expected, err.getvalue()), (
+                f"{where}: the page shows\n{chr(10).join(expected)}\nambseal said\n{got}")
+        elif status:  # a verdict the page shows with its exit status
+            assert code == int(status[1]), f"{where}: exit {code}: {got}"
+            assert _matches(expected[:-1], got), (
                 f"{where}: the page shows\n{chr(10).join(expected)}\nambseal said\n{got}")
         else:
             assert code == 0, f"{where}: exit {code}: {got}"

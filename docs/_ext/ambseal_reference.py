@@ -190,6 +190,18 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                                  "gain 1 at zero frequency"),
     "PidFilter.damping": ("", "a low-pass filter's damping ratio ζ"),
     # [operating]
+    "Stage.name": ("", "label in the sign-off's tables"),
+    "Stage.position": ("m", "axial position of the impeller or stage (or ``disk``)"),
+    "Stage.disk": ("", "the ``[[disk]]`` (by ``name``) the impeller or stage is (or "
+                       "``position``)"),
+    "Stage.power": ("W", "rated power of the stage (API 617's P; P/Ω its torque)"),
+    "Stage.impeller_diameter": ("m", "impeller diameter D_c"),
+    "Stage.discharge_width": ("m", "H_c: the smaller of the impeller's discharge width and "
+                                   "the diffuser's width"),
+    "Stage.suction_density": ("kg/m³", "gas density at the stage's suction ρ_s"),
+    "Stage.discharge_density": ("kg/m³", "gas density at the stage's discharge ρ_d"),
+    "Machine.kind": ("", "``compressor`` or ``turbine``: API 617's anticipated "
+                         "cross-coupling (B = 3 with the density ratio, or 1.5 without)"),
     "Operating.speed_rpm": ("rpm", "operating speed"),
     "Operating.pressure_bar": ("bar", "nominal pressure drop across the seals"),
     "Operating.speed_range_hz": ("Hz", "``[low, high]`` operating speed range: schedules "
@@ -432,6 +444,10 @@ def _sections() -> list[Section]:
                 "(affine in the pressure drop) or ``{ frequency_hz, value }`` (a table "
                 "against excitation frequency, evaluated at the synchronous frequency)."),
         Section("[[spring]]", r.Spring, "Couplings, plain bearings, supports."),
+        Section("[[stage]]", r.Stage, "One table per impeller or stage: what API 617's "
+                "Level I stability screening needs (``ambseal signoff``); ``position`` or "
+                "``disk``, one of them."),
+        Section("[machine]", r.Machine),
         Section("[controller]", r.Controllers),
         Section("[controller.pid]", r.Pid, "All four keys, or leave the table out."),
         Section("[[controller.filter]]", r.PidFilter, "A notch, lead, lag or low-pass "

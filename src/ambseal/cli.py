@@ -365,6 +365,20 @@ def _rotordynamics_parsers(sub) -> None:
     s.add_argument("--out", default="ambseal-sweep", help="output folder")
     _executor_args(s)
 
+    so = sub.add_parser("signoff", help="sign a machine off: API 617 Level I stability "
+                                        "screening with each controller as it runs")
+    so.add_argument("rig", help="rig file (TOML) with its [[stage]] tables")
+    sg = so.add_mutually_exclusive_group()
+    sg.add_argument("--method", default=None,
+                    help="pid, hinf, mu or none, comma separated: designed and discretised "
+                         "as ambseal design does (default pid, or none on a rig without "
+                         "AMBs)")
+    sg.add_argument("--controller", default=None,
+                    help="a controller file of ambseal design (.json, .npz, .mat)")
+    so.add_argument("--out", default="ambseal-signoff", help="output folder")
+    so.add_argument("--json", action="store_true",
+                    help="print one JSON object (per controller its level1 block)")
+
     r = sub.add_parser("import-ross", help="a ROSS rotor file (.toml/.json) as an ambseal rig")
     r.add_argument("file", help="ROSS rotor file saved by ross.Rotor.save")
     r.add_argument("--out", required=True, help="rig file to write (TOML)")

@@ -22,6 +22,8 @@ sampled with its delay) on the full-order plant:
   modes and log decrements (API 684; :func:`open_loop_modes`, :data:`OVERDAMPED_ZETA`), the
   Campbell diagram
   (:func:`ambseal.analysis.campbell.campbell` → :class:`Campbell`);
+* :func:`level1_screening` → :class:`Level1`, :func:`stage_cross_coupling` — API 617's Level I
+  stability screening with each controller as it runs;
 * :func:`stability_boundary`, :func:`refine_boundary` — on the rows of
   :func:`ambseal.analysis.sweep.sweep` (:func:`parse_range`, :func:`check_cases`);
   :func:`stability_case`, :func:`stability_points` → :class:`StabilityCase` (with a
@@ -59,6 +61,7 @@ _FROM = {
     "IsoAssessment": "iso", "ZONES": "iso", "ZONE_LIMITS": "iso", "frozen_at": "judge",
     "judge_case": "judge", "judge_jobs": "judge", "judge_settings": "judge",
     "judge_spinup": "judge", "operating_points": "judge", "points_for": "judge",
+    "level1_screening": "level1", "stage_cross_coupling": "level1", "Level1": "level1",
     "speed_scheduled": "judge", "unstable_open_loop_poles": "judge", "JudgeJob": "judge",
     "JudgeSettings": "judge", "JudgedCase": "judge", "LoopJudgement": "judge",
     "OperatingPoint": "judge", "compliance": "loops", "loop_responses": "loops",

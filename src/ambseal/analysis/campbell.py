@@ -45,7 +45,8 @@ from ambseal.robust import decay_rate, is_stable
 
 __all__ = ["API684_LOG_DEC", "OVERDAMPED_ZETA", "ClosedLoopModes", "Crossing", "Campbell",
            "log_decrement", "lowest_log_decrement", "whirl_of", "closed_loop_state_matrix",
-           "closed_loop_modes", "modes_of_state_matrix", "open_loop_modes", "campbell"]
+           "closed_loop_modes", "modes_of_state_matrix", "modes_of_sampled_loop", "track_modes",
+           "open_loop_modes", "campbell"]
 
 #: API 684 (2nd ed., 2005) level-I stability screening: log decrement of every mode ≥ 0.1.
 API684_LOG_DEC = 0.1
@@ -260,6 +261,41 @@ def modes_of_state_matrix(A: np.ndarray, mesh, *, speed_hz: float, pressure_bar:
                            w_max=float(np.abs(lam).max(initial=0.0)))
 
 
+def modes_of_sampled_loop(A_d: np.ndarray, dt: float, mesh, *, speed_hz: float,
+                          pressure_bar: float, max_hz: float) -> ClosedLoopModes:
+    """:class:`ClosedLoopModes` of a sampled loop's state matrix (the discrete controller
+    as it runs, its delay among its states) whose first ``mesh.n_dof`` states are the
+    rotor's node DOFs q at the sampling instants (a zero-order-hold sampled plant keeps
+    the continuous plant's coordinates).
+
+    Each pole z maps to λ = ln z / dt (the principal branch: |Im λ| < π/dt, so keep
+    ``max_hz`` below the Nyquist frequency); the delay's poles at z = 0 are no modes and
+    are left out. Stability is that of every pole: |z| < 1 ⇔ Re λ < 0.
+
+    Parameters
+    ----------
+    A_d : ndarray, shape (n, n)
+        The sampled closed loop's state matrix.
+    dt : float
+        Sample time (s), > 0.
+    mesh
+        The rotor's mesh (:func:`ambseal.model.build_mesh`).
+    speed_hz, pressure_bar, max_hz : float
+        As :func:`modes_of_state_matrix`.
+
+    Returns
+    -------
+    ClosedLoopModes
+    """
+
+    z, V = sla.eig(A_d)
+    keep = np.abs(z) > 1e-12
+    lam = np.log(z[keep].astype(complex)) / float(dt)
+    return _modes_of_pairs(lam, V[:mesh.n_dof, keep], mesh, speed_hz=speed_hz,
+                           pressure_bar=pressure_bar, max_hz=max_hz, verdict=lam,
+                           w_max=float(np.abs(lam).max(initial=0.0)))
+
+
 def open_loop_modes(sys, *, speed_hz: float, pressure_bar: float, max_hz: float,
                     judged_poles=None) -> ClosedLoopModes:
     """:class:`ClosedLoopModes` of a second-order system itself (rotor, AMBs without a
@@ -438,8 +474,21 @@ class Campbell:
                 "flagged": self.flagged(), "points": [p.to_dict() for p in self.points]}
 
 
-def _tracks(points: list[ClosedLoopModes]) -> np.ndarray:
-    """Follow modes from speed to speed by the assignment of least total |Δλ|."""
+def track_modes(points) -> np.ndarray:
+    """Follow modes from point to point (speeds, or any parameter) by the assignment of
+    least total |Δλ|.
+
+    Parameters
+    ----------
+    points : sequence of ClosedLoopModes
+        The modes at each point, in order.
+
+    Returns
+    -------
+    ndarray of int, shape (n_points, n_lines)
+        ``[i, j]`` the index into ``points[i].poles`` of line ``j``, −1 where the line has
+        no mode at that point.
+    """
     lines: list[list[int]] = [[k] for k in range(len(points[0].poles))]
     for i in range(1, len(points)):
         prev = [(j, ln[-1]) for j, ln in enumerate(lines) if ln[-1] >= 0]
@@ -521,7 +570,7 @@ def campbell(cfg, controller=None, speeds_hz=None, *, pressure_bar: float | None
                         workers=workers, scheduler=scheduler, progress=progress,
                         description="campbell", raise_errors=True)
     pts = list(results)
-    c = Campbell(s, tuple(pts), _tracks(pts), (), log_dec_limit)
+    c = Campbell(s, tuple(pts), track_modes(pts), (), log_dec_limit)
     crossings, overdamped = _crossings(c)
     return Campbell(s, c.points, c.tracks, crossings, log_dec_limit, overdamped)
 

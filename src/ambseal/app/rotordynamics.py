@@ -1,8 +1,11 @@
-"""The rotordynamicist's commands: ``modes``, ``campbell``, ``sweep`` and ``import-ross``.
+"""The rotordynamicist's commands: ``modes``, ``campbell``, ``sweep``, ``signoff`` and
+``import-ross``.
 
 Wiring only, like :mod:`ambseal.app.commands`: the numbers come from
-:mod:`ambseal.analysis.campbell`, :mod:`ambseal.analysis.sweep` and :mod:`ambseal.io.ross`,
-the figures from :mod:`ambseal.report.modal_figures`, and every file is written through a
+:mod:`ambseal.analysis.campbell`, :mod:`ambseal.analysis.sweep`,
+:mod:`ambseal.analysis.level1` and :mod:`ambseal.io.ross`, the figures from
+:mod:`ambseal.report.modal_figures` and :mod:`ambseal.report.signoff_figures`, and every
+file is written through a
 temporary name and a rename (:mod:`ambseal.files`). The CLI (:mod:`ambseal.cli`) parses these
 subcommands and runs them with :data:`HANDLERS`; ``modes`` lives in
 :mod:`ambseal.app.modes`, which the CLI loads alone.
@@ -14,6 +17,7 @@ import argparse
 import csv
 import io
 import json
+import logging
 import math
 import sys
 from pathlib import Path
@@ -22,6 +26,8 @@ from ambseal.analysis import (
     check_cases,
     dask_available,
     judge_settings,
+    level1_screening,
+    operating_points,
     parse_range,
     probe_scheduler,
     refine_boundary,
@@ -29,6 +35,7 @@ from ambseal.analysis import (
 )
 from ambseal.analysis.campbell import campbell
 from ambseal.analysis.sweep import sweep
+from ambseal.app.commands import digital_for
 from ambseal.app.controllers import controller_for
 from ambseal.app.modes import mode_positions, modes_command
 from ambseal.config import (
@@ -36,13 +43,21 @@ from ambseal.config import (
     MAX_PRESSURE_BAR,
     MAX_SPEED_HZ,
     load_rig,
+    method_names,
     rig_parameter_names,
 )
-from ambseal.design import design_spec
+from ambseal.design import design, design_spec
 from ambseal.errors import ConfigError
+from ambseal.export import load_controller
 from ambseal.files import OwnedFolder, atomic_write, write_json, write_text
 from ambseal.io import import_ross_file
-from ambseal.report import campbell_figure, mode_shapes_figure, stability_map_figure
+from ambseal.model import channel_names
+from ambseal.report import (
+    campbell_figure,
+    level1_figure,
+    mode_shapes_figure,
+    stability_map_figure,
+)
 
 __all__ = ["HANDLERS", "write_table"]
 
@@ -178,6 +193,62 @@ def _sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+def _signoff_controllers(cfg, args) -> list[tuple[str, object]]:
+    """(name, controller as it runs) of ``--controller FILE`` or each ``--method`` (default
+    the reference PID on a rig with AMBs, else ``none``): a method is designed and
+    discretised as ``ambseal design`` does (:func:`ambseal.app.commands.digital_for`)."""
+    if args.controller is not None:
+        K = load_controller(args.controller, channel_names(cfg))
+        if not hasattr(K, "delay_samples"):
+            raise ConfigError(f"--controller: {args.controller} holds a continuous "
+                              "controller; the sign-off judges the discrete one as it runs "
+                              "(export it with ambseal design or ambseal export)")
+        return [(Path(args.controller).stem, K)]
+    methods = (args.method or ("pid" if cfg.amb else "none")).split(",")
+    allowed = ("none", *method_names(fixed=True))
+    bad = [m for m in methods if m not in allowed]
+    if bad:
+        raise ConfigError(f"--method: {bad[0]!r}; expected {', '.join(allowed)} (comma "
+                          "separated), or --controller FILE")
+    out, spec = [], None
+    for m in methods:
+        if m == "none" or not cfg.amb:
+            out.append((m, None))
+            continue
+        spec = spec or design_spec(cfg)
+        res = design(cfg, m, spec=spec, progress=logging.getLogger("ambseal").info)
+        out.append((m, digital_for(cfg, m, res.K, res, operating_points(spec))))
+    return out
+
+
+@_owns_out
+def _signoff(args: argparse.Namespace) -> int:
+    cfg = load_rig(args.rig)
+    if not cfg.stage:  # before any design
+        level1_screening(cfg)  # raises the error that names the missing [[stage]]
+    say = logging.getLogger("ambseal").info
+    results = [level1_screening(cfg, K, name=name, progress=say)
+               for name, K in _signoff_controllers(cfg, args)]
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    doc = {"rig": str(args.rig), "machine": cfg.machine.kind,
+           "passed": all(r.passed for r in results),
+           "controllers": {r.controller: {"level1": r.to_dict()} for r in results}}
+    files = [write_json(out / "signoff.json", doc),
+             level1_figure(out / "level1.png", results,
+                           title=f"API 617 Level I — {cfg.rotor.name}")]
+    if args.json:
+        print(json.dumps({**doc, "files": [str(f) for f in files]}))
+    else:
+        for r in results:
+            q0 = f"{r.Q_0:.4g} N/m" if r.Q_0 is not None else f"above {r.Q[-1]:.4g} N/m"
+            print(f"{r.controller}: Level I {'passed' if r.passed else 'NOT passed'} — "
+                  f"Q_A = {r.Q_A:.4g} N/m, δ_A = {r.log_dec_A:.3g}, Q_0 = {q0}, "
+                  f"CSR = {r.csr:.3g}; {r.rule}")
+        print(f"files: {', '.join(str(f) for f in files)}")
+    return 0 if doc["passed"] else 1
+
+
 def _import_ross(args: argparse.Namespace) -> int:
     res = import_ross_file(args.file, args.out, speed_rpm=args.speed_rpm, force=args.force)
     for line in [f"not imported: {n}" for n in res["unmapped"]] + [
@@ -188,4 +259,4 @@ def _import_ross(args: argparse.Namespace) -> int:
 
 
 HANDLERS = {"modes": modes_command, "campbell": _campbell, "sweep": _sweep,
-            "import-ross": _import_ross}
+            "signoff": _signoff, "import-ross": _import_ross}

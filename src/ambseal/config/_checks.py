@@ -170,6 +170,14 @@ def cross_check(cfg, where: str) -> None:
     for kind in ("disk", "seal", "spring"):
         for i, comp in enumerate(getattr(cfg, kind)):
             on_shaft(f"{kind}[{i}].position", comp.position)
+    disks = {d.name for d in cfg.disk if d.name}
+    for i, st in enumerate(cfg.stage):
+        if st.position is not None:
+            on_shaft(f"stage[{i}].position", st.position)
+        elif st.disk not in disks:
+            known = ", ".join(sorted(disks)) or "no named disk"
+            raise ConfigError(f"{where}: stage[{i}].disk: unknown disk {st.disk!r} "
+                              f"(expected one of: {known})")
     n_elements = sum(s.elements for s in cfg.shaft)
     if n_elements > MAX_ELEMENTS:
         raise ConfigError(

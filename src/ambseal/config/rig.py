@@ -380,6 +380,40 @@ class Spring(_Strict):
     uncertainty: Uncertainty = None
 
 
+class Stage(_Strict):
+    """One impeller (compressor) or stage (turbine) as API 617 (8th ed., 2014) needs it
+    for the anticipated cross-coupling of its Level I stability screening: where it sits
+    (``position`` in m, or the ``disk`` it is), its rated ``power`` (W), the impeller
+    diameter D_c and the discharge width H_c (m, the smaller of the impeller's discharge
+    and the diffuser's width), and the gas densities at its suction and discharge
+    (kg/m³)."""
+
+    name: Label | None = None
+    position: float | None = Field(default=None, ge=0)
+    disk: Label | None = None
+    # a single stage of a large compressor train or turbine: up to 100 MW
+    power: float = Field(gt=0, le=1e8)
+    impeller_diameter: float = Field(gt=0, le=5.0)
+    discharge_width: float = Field(gt=0, le=1.0)
+    # from vacuum service to dense CO2 and liquids at the limit
+    suction_density: float = Field(gt=0, le=2000.0)
+    discharge_density: float = Field(gt=0, le=2000.0)
+
+    @model_validator(mode="after")
+    def _where(self) -> "Stage":
+        if (self.position is None) == (self.disk is None):
+            raise ValueError("expected exactly one of position (m) and disk (a [[disk]] "
+                             "name)")
+        return self
+
+
+class Machine(_Strict):
+    """What the machine is, for the standards' rules: ``kind`` = ``"compressor"`` or
+    ``"turbine"`` (API 617's anticipated cross-coupling differs)."""
+
+    kind: Literal["compressor", "turbine"] = "compressor"
+
+
 class Pid(_Strict):
     kp: float = Field(gt=0, le=1e9)
     ti: float = Field(gt=0, le=1e4)
@@ -474,6 +508,8 @@ class RigConfig(_Strict):
     actuator: Actuator = Actuator()
     seal: list[Seal] = Field(default=[], max_length=MAX_COMPONENTS)
     spring: list[Spring] = Field(default=[], max_length=MAX_COMPONENTS)
+    stage: list[Stage] = Field(default=[], max_length=MAX_COMPONENTS)
+    machine: Machine = Machine()
     controller: Controllers = Controllers()
     operating: Operating = Operating()
     reduction: Reduction = Reduction()

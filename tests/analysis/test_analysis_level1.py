@@ -1,0 +1,124 @@
+"""API 617 Level I screening (:mod:`ambseal.analysis.level1`) against hand calculations and
+the closed form of a rigid rotor on damped isotropic supports."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from ambseal.analysis.level1 import level1_screening, stage_cross_coupling
+from ambseal.config import parse_rig
+from ambseal.errors import ConfigError
+
+#: N/m per klbf/in: 1000 lbf (4448.2216 N) per inch (0.0254 m)
+KLBF_PER_IN = 4448.2216152605 / 0.0254
+HP = 745.69987158227  # W per mechanical horsepower
+INCH = 0.0254
+
+
+def test_anticipated_cross_coupling_by_hand_in_both_unit_systems():
+    """A 1 MW compressor impeller at 10 000 rpm, D_c = 400 mm, H_c = 20 mm, density ratio
+    1.5: by hand q_A = 3·(1e6/(2π·10000/60))·1.5/(0.4·0.02) = 5.3715e5 N/m; the US form
+    HP·B·C·(ρ_d/ρ_s)/(D_c·H_c·N) with C = 63 (klbf/in) gives it to the 0.04 % of 63 against
+    63 025/1000. A turbine stage (B = 1.5, no density ratio) is a third of it here."""
+    st = SimpleNamespace(power=1e6, impeller_diameter=0.4, discharge_width=0.02,
+                         suction_density=20.0, discharge_density=30.0)
+    w = 2 * math.pi * 10000 / 60
+    q = stage_cross_coupling(st, "compressor", w)
+    assert q == pytest.approx(3 * (1e6 / w) * 1.5 / (0.4 * 0.02), rel=1e-12)
+    assert q == pytest.approx(5.3715e5, rel=1e-4)
+    us = (1e6 / HP) * 3 * 63 * 1.5 / ((0.4 / INCH) * (0.02 / INCH) * 10000)  # klbf/in
+    assert q == pytest.approx(us * KLBF_PER_IN, rel=1e-3)
+    assert stage_cross_coupling(st, "turbine", w) == pytest.approx(q / 3, rel=1e-12)
+    with pytest.raises(ConfigError, match="speed"):
+        stage_cross_coupling(st, "compressor", 0.0)
+
+
+def _rigid_rotor(k: float, c: float, power: float) -> str:
+    """A short thick steel rotor (0.4 m × 200 mm, 98.6 kg; its first bending mode in the
+    kHz) on two isotropic springs with dampers, k/2 and c/2 each, one stage at mid-span."""
+    return f"""
+[rotor]
+name = "rigid rotor on damped springs"
+[materials.steel]
+E = 2.1e11
+rho = 7850.0
+nu = 0.3
+[[shaft]]
+length = 0.4
+outer_diameter = 0.2
+material = "steel"
+elements = 8
+[[spring]]
+name = "left"
+position = 0.0
+kxx = {k / 2}
+kyy = {k / 2}
+cxx = {c / 2}
+cyy = {c / 2}
+[[spring]]
+name = "right"
+position = 0.4
+kxx = {k / 2}
+kyy = {k / 2}
+cxx = {c / 2}
+cyy = {c / 2}
+[[stage]]
+position = 0.2
+power = {power}
+impeller_diameter = 0.3
+discharge_width = 0.02
+suction_density = 10.0
+discharge_density = 15.0
+[operating]
+speed_rpm = 3000.0
+"""
+
+
+def test_q0_of_a_rigid_rotor_on_damped_supports_is_the_closed_form():
+    """m z̈ + c ż + k z − jQ z = 0 (z = x + jy, the cross-coupling k_xy = Q, k_yx = −Q at
+    mid-span of a rotor symmetric about it): forward whirl at ω = √(k/m) loses its damping
+    at Q_0 = c·√(k/m). The screening's Q_0 (no AMB: the rig as it is) within 2 %, δ(0) of
+    the cylindrical mode 2πζ/√(1 − ζ²) with ζ = c/(2√(km)); a Q_A of about Q_0/6
+    (Q_0/Q_A between 2 and 10) requires Level II."""
+    import tomllib
+
+    k, c = 1e7, 2000.0
+    cfg = parse_rig(tomllib.loads(_rigid_rotor(k, c, 4.5e4)))
+    m = math.pi / 4 * 0.2**2 * 0.4 * 7850.0
+    r = level1_screening(cfg)
+    q0 = c * math.sqrt(k / m)
+    assert r.Q_0 == pytest.approx(q0, rel=0.02)
+    zeta = c / (2 * math.sqrt(k * m))
+    assert r.log_dec[0] == pytest.approx(2 * math.pi * zeta / math.sqrt(1 - zeta**2),
+                                         rel=0.02)
+    assert r.frequency_hz[0] == pytest.approx(math.sqrt(k / m) / (2 * math.pi), rel=0.02)
+    assert r.converged and 2 < r.ratio < 10 and not r.passed and "Level II" in r.rule
+    assert r.where_m == ((pytest.approx(0.2), 1.0),)
+    # δ falls with Q through the found zero
+    assert np.all(np.diff(r.log_dec) < 0)
+
+
+def test_screening_outcomes_by_their_rules():
+    """The same rotor with a stage about four times larger (Q_0/Q_A = 1.3, δ_A below 0.1)
+    fails; one about a sixth of it passes (Q_0 beyond 10·Q_A). Nothing passes without its
+    rule."""
+    import tomllib
+
+    k, c = 1e7, 2000.0
+    big = level1_screening(parse_rig(tomllib.loads(_rigid_rotor(k, c, 2.0e5))))
+    assert not big.passed and big.ratio < 2 and ("δ_A" in big.rule or "Q_0/Q_A" in big.rule)
+    small = level1_screening(parse_rig(tomllib.loads(_rigid_rotor(k, c, 8.0e3))))
+    assert small.passed and small.Q_0 is None and small.log_dec_A >= 0.1
+    assert "passed" in small.rule
+
+
+def test_a_rig_without_stages_is_refused_by_name():
+    import tomllib
+
+    text = _rigid_rotor(1e7, 2000.0, 1e5).split("[[stage]]")[0] + "[operating]\nspeed_rpm = 3000.0\n"
+    with pytest.raises(ConfigError, match=r"\[\[stage\]\]"):
+        level1_screening(parse_rig(tomllib.loads(text)))

@@ -564,3 +564,44 @@ def test_hollow_tapered_elements_with_loads_equal_ross(shear):
     assert all(s.inner_diameter_right is not None for s in cfg.shaft[:5])
     for rpm in (0.0, 6000.0):
         _assert_modes_equal_ross(cfg, rotor, rpm * np.pi / 30, 1000.0, 14)
+
+
+def test_level1_screening_equals_the_same_sweep_in_ross():
+    """API 617 Level I on ROSS's ``rotor_example`` on damped anisotropic bearings, imported:
+    the same cross-coupling element (``BearingElement(kxy=Q, kyx=−Q)`` at mid-span, node
+    3) added to ROSS's rotor and its eigenvalues at the same speed (ROSS 2.3's own modal
+    analysis, side by side). The screened mode's log decrement at Q_A equals ROSS's of
+    the same mode to 1 %, and Q_0, where ROSS's mode loses its damping (found here by
+    bisection on ROSS's eigenvalues), equals ambseal's to 1 %."""
+    from scipy.optimize import brentq
+
+    from ambseal.analysis.level1 import level1_screening
+
+    rotor = _bearing_rotor()
+    doc = tomllib.loads(dump_rig(from_ross(rotor).rig))
+    doc["stage"] = [{"position": 0.75, "power": 2.0e4, "impeller_diameter": 0.3,
+                     "discharge_width": 0.02, "suction_density": 10.0,
+                     "discharge_density": 12.0}]
+    doc["operating"] = {"speed_rpm": 4000.0}
+    r = level1_screening(parse_rig(doc))
+    w = 4000.0 * np.pi / 30
+
+    def ross_mode(Q: float, near: complex) -> complex:
+        b = [*rotor.bearing_elements, rs.BearingElement(3, kxx=0.0, cxx=0.0, kyy=0.0,
+                                                        kxy=Q, kyx=-Q, tag="Q")]
+        lam = _ross_eigenvalues(rs.Rotor(rotor.shaft_elements, rotor.disk_elements, b), w)
+        return lam[np.argmin(np.abs(lam - near))]
+
+    def ours(i: int) -> complex:  # the screened pole at grid point i, from (f_d, δ)
+        wd = 2 * np.pi * r.frequency_hz[i]
+        return complex(-r.log_dec[i] * wd / (2 * np.pi), wd)
+
+    iA = int(np.argmin(np.abs(r.Q - r.Q_A)))
+    lam_A = ross_mode(r.Q_A, ours(iA))
+    assert r.log_dec_A == pytest.approx(-2 * np.pi * lam_A.real / lam_A.imag, rel=0.01)
+    assert r.Q_0 is not None and r.converged
+    i0 = int(np.searchsorted(r.Q, r.Q_0))
+    a, b = float(r.Q[i0 - 1]), float(r.Q[i0])
+    q0_ross = brentq(lambda Q: ross_mode(Q, ours(i0 - 1 if Q - a < b - Q else i0)).real,
+                     a, b, xtol=1e-6 * r.Q_A)
+    assert r.Q_0 == pytest.approx(q0_ross, rel=0.01)

@@ -122,3 +122,47 @@ def test_a_rig_without_stages_is_refused_by_name():
     text = _rigid_rotor(1e7, 2000.0, 1e5).split("[[stage]]")[0] + "[operating]\nspeed_rpm = 3000.0\n"
     with pytest.raises(ConfigError, match=r"\[\[stage\]\]"):
         level1_screening(parse_rig(tomllib.loads(text)))
+
+
+def _rigid_rotor_on_ambs(ki: float, ks: float, pid: dict) -> str:
+    """The rotor of :func:`_rigid_rotor` (1 % modal damping) on two AMBs at its ends
+    (sensors collocated), with the PID of ``pid`` at 50 kHz and no computation delay."""
+    text = _rigid_rotor(1.0, 0.0, 4.5e4).split("[[spring]]")[0].replace(
+        'name = "rigid rotor on damped springs"', 'name = "rigid rotor on AMBs"\n'
+        "modal_damping = 0.01")  # the kHz bending modes, which the sampling reaches
+    for name, z in (("A", 0.0), ("B", 0.4)):
+        text += (f'[[amb]]\nname = "{name}"\nposition = {z}\nsensor_position = {z}\n'
+                 f"ki = {ki}\nks = {ks}\nbias_current = 5.0\ncurrent_limit = 10.0\n")
+    text += ("[controller]\nsample_rate_hz = 50000.0\ndelay_samples = 0\n"
+             "[controller.pid]\n" + "".join(f"{k} = {v}\n" for k, v in pid.items()))
+    return text + ("[[stage]]\nposition = 0.2\npower = 4.5e4\nimpeller_diameter = 0.3\n"
+                   "discharge_width = 0.02\nsuction_density = 10.0\n"
+                   "discharge_density = 15.0\n[operating]\nspeed_rpm = 3000.0\n")
+
+
+def test_q0_with_a_pd_acting_amb_is_the_closed_form_of_its_equivalent_support():
+    """Two AMBs under a PID that acts as a PD at the ~50 Hz whirl (T_i = 100 s, the
+    derivative filter at 7 kHz) on the same rigid rotor, the controller as it runs at
+    50 kHz: each AMB is a support of stiffness k_eq = K_i K_p − K_s and damping
+    c_eq = K_i K_p T_d, and the zero-order hold a lag of half a sample T/2, whose phase
+    ωT/2 takes k_eq·T/2 from the damping (the force −(k_eq + jωc_eq)e^{−jωT/2}): so
+    Q_0 = c·√(k/m) with k = 2 k_eq, c = 2 (c_eq − k_eq T/2), to 2 % (the PID's integral
+    and derivative filter are the difference; without the hold's term it is 4.6 % off)."""
+    import tomllib
+
+    from ambseal.analysis import operating_points
+    from ambseal.app.commands import digital_for
+    from ambseal.design import design, design_spec
+
+    ki, ks, kp, td = 100.0, 2.0e6, 7.0e4, 2.24e-4
+    cfg = parse_rig(tomllib.loads(_rigid_rotor_on_ambs(
+        ki, ks, {"kp": kp, "ti": 100.0, "td": td, "eps": 0.1})))
+    res = design(cfg, "pid")
+    digital = digital_for(cfg, "pid", res.K, res, operating_points(design_spec(cfg)))
+    r = level1_screening(cfg, digital, name="pid")
+    m = math.pi / 4 * 0.2**2 * 0.4 * 7850.0
+    T = 1.0 / 50000.0
+    k, c = 2 * (ki * kp - ks), 2 * (ki * kp * td - (ki * kp - ks) * T / 2)
+    assert r.Q_0 == pytest.approx(c * math.sqrt(k / m), rel=0.02)
+    assert r.converged and r.frequency_hz[0] == pytest.approx(
+        math.sqrt(k / m) / (2 * math.pi), rel=0.03)

@@ -53,3 +53,25 @@ def test_signoff_refuses_plainly(tmp_path, capsys, args, says):
     code = main(["signoff", str(rig), "--out", str(tmp_path / "so"), *args])
     err = capsys.readouterr().err
     assert code == 2 and says in err and "Traceback" not in err
+
+
+def test_the_reports_signoff_section_says_the_verdict_first(tmp_path):
+    """The run report's section: the overall verdict before the table, one row per
+    controller with its rule; the figure is written."""
+    import tomllib
+
+    from ambseal.analysis import level1_screening
+    from ambseal.config import parse_rig
+    from ambseal.report import signoff_report
+
+    ok = level1_screening(parse_rig(tomllib.loads(_rigid_rotor(1e7, 2000.0, 8.0e3))),
+                          name="a")
+    bad = level1_screening(parse_rig(tomllib.loads(_rigid_rotor(1e7, 2000.0, 2.0e5))),
+                           name="b")
+    figs, sections = signoff_report(tmp_path, [ok, bad], "rigid")
+    text = sections[0]["html"]
+    assert text.index("NOT passed") < text.index("<table>") and "b require" in text
+    assert text.count("<tr><td>") == 2 and "δ_A = 0.0497 &lt; 0.1: Level II required" in text
+    assert figs[0][1].is_file()
+    _, passed = signoff_report(tmp_path, [ok], "rigid")
+    assert "passed by every controller" in passed[0]["html"]

@@ -27,7 +27,7 @@ __all__ = ["SCHEMA_VERSION", "SCHEMA_PATH", "OpenLoop", "ControllerSummary", "Ru
            "metrics_schema", "schema_text"]
 
 #: Version of the ``metrics.json`` document (module docstring).
-SCHEMA_VERSION = "1.3.0"
+SCHEMA_VERSION = "1.4.0"
 #: The JSON Schema shipped with the package.
 SCHEMA_PATH = Path(__file__).resolve().parents[1] / "data" / "metrics.schema.json"
 
@@ -130,6 +130,10 @@ class RunMetrics:
     identification, spinup, ramp : dict, optional
         The identification on the virtual facility, the spin-up of a speed-scheduled rig,
         the pressure ramp of the tracked controller — when the run did them.
+    signoff : dict, optional
+        A rig with ``[[stage]]`` tables: API 617's Level I screening of each delivered
+        controller as it runs (``passed``, and ``level1`` per controller:
+        :meth:`ambseal.analysis.level1.Level1.to_dict`).
     """
 
     schema_version: str
@@ -146,6 +150,7 @@ class RunMetrics:
     identification: dict[str, Any] | None = None
     spinup: dict[str, Any] | None = None
     ramp: dict[str, Any] | None = None
+    signoff: dict[str, Any] | None = None
 
     def to_dict(self) -> dict:
         """The JSON document (sections the run did not do are left out)."""
@@ -159,7 +164,7 @@ class RunMetrics:
              "cannot_run": self.cannot_run, "cases": [c.to_dict() for c in self.cases],
              "stability": [c.to_dict() for c in self.stability],
              "failed": {m: asdict(f) for m, f in self.failed.items()}}
-        for key in ("identification", "spinup", "ramp"):
+        for key in ("identification", "spinup", "ramp", "signoff"):
             if getattr(self, key) is not None:
                 d[key] = getattr(self, key)
         return d

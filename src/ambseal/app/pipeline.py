@@ -22,6 +22,7 @@ from ambseal.analysis import (
     judge_jobs,
     judge_settings,
     judge_spinup,
+    level1_screening,
     loop_failure,
     operating_points,
     run_cases,
@@ -54,12 +55,14 @@ from ambseal.config import (
 from ambseal.design import DesignSpec, design, design_frozen, design_lpv, design_spec
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.files import RunFolder, write_json
+from ambseal.machine import SPEED
 from ambseal.model import build_plant
 from ambseal.report import (
     StageProgress,
     gains_figure,
     judged_on,
     rig_clearances_um,
+    signoff_report,
     spinup_figures,
     stamp,
     write_run_report,
@@ -305,7 +308,7 @@ def _stage_totals(cfg: RigConfig, points: list[OperatingPoint]) -> dict[str, int
     return {"model": 1, "design": n_designs, "judge": (n_designs + n_tr) * len(points),
             "identification": None,
             "design (identified)": len(method_names(synthesised=True)) + n_tr,
-            "speed-range": None, "spin-up": 1, "ramp": 1, "report": 1}
+            "speed-range": None, "spin-up": 1, "signoff": 1, "ramp": 1, "report": 1}
 
 
 @dataclass
@@ -472,6 +475,19 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
             cfg, {d.method: d.controller for d in st.designs if d.method in ("mu", "lpv")})
         figs += spinup_figures(out, sims, sens, cfg.operating.speed_range_hz)
         stages.step()
+    signoff = None
+    if cfg.stage:  # the machine's stages are given: API 617's Level I, as it runs
+        stages.begin("signoff", "API 617 Level I")
+        results = [level1_screening(cfg, g, name=m, progress=lambda s: st.say(s, 0))
+                   for m, g in st.digitals.items()
+                   if m not in held and m not in st.cannot_run
+                   and getattr(g, "parameter", SPEED) == SPEED]
+        if results:
+            signoff = {"passed": all(r.passed for r in results),
+                       "level1": {r.controller: r.to_dict() for r in results}}
+            more_figs, more_sections = signoff_report(out, results, cfg.rotor.name)
+            figs, sections = figs + more_figs, more_sections + sections
+        stages.step()
     if cfg.design.tracked and st.truth_cfg is not None:
         stages.begin("ramp", "0 → 3× nominal pressure on the virtual facility")
         ramp, fig = tracked_ramp(cfg, st.truth_cfg, st.designs, st.digitals, ident,
@@ -485,7 +501,7 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
         controllers={m: ControllerSummary.from_dict(s) for m, s in summaries.items()},
         cannot_run=st.cannot_run, cases=cases, stability=stability, failed=st.failed,
         identification=None if ident is None else ident.summary, spinup=spinup,
-        ramp=ramp).to_dict()
+        ramp=ramp, signoff=signoff).to_dict()
     stages.begin("report")
     write_json(out / "metrics.json", metrics)
     figs.append(gains_figure(out, [(d.method, frozen_at(d.controller, cfg.operating,

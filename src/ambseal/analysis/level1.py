@@ -306,7 +306,7 @@ def _rigid_critical_hz(cfg) -> float:
 
 
 def level1_screening(cfg, controller=None, *, name: str = "none", points: int = 21,
-           q_max_factor: float = RATIO_FREE, progress=None) -> Level1:
+                     q_max_factor: float = RATIO_FREE, progress=None) -> Level1:
     """API 617 Level I screening of a rig with one controller as it runs (module
     docstring).
 
@@ -368,7 +368,8 @@ def level1_screening(cfg, controller=None, *, name: str = "none", points: int = 
     d, f = D[:, j], F[:, j]
     log_dec_A = float(d[iA])
     unstable = [i for i, m in enumerate(pts) if not m.stable]
-    if lost is None and unstable:  # lost by a pole that is no forward mode: no Q_0 to refine
+    if unstable and (lost is None or unstable[0] < lost):
+        # lost first by a pole that is no forward mode: no Q_0 to refine
         Q_0, converged = float(grid[unstable[0]]), False
     elif lost is None:
         Q_0, converged = None, True

@@ -40,8 +40,9 @@ Design model versus judgement: the design model keeps every mode the controller 
 (the specification's rule; on the test rig the rigid-body modes and the first bending pair,
 12 states). After synthesis the controller is closed with the full-order plant at every
 judged condition (:func:`full_order_check`); an unstable loop enlarges the design model to
-keep the mode that went unstable and designs again, a bounded number of times, each step
-reported, and is refused as a :class:`~ambseal.errors.SynthesisError` naming the mode and
+keep the mode that went unstable, or, where the model keeps that mode, lowers its damping
+in the design model by a margin the controller must add (:func:`margin_for`), and designs
+again, a bounded number of times, each step reported, and is refused as a :class:`~ambseal.errors.SynthesisError` naming the mode and
 the key to set if it stays unstable (unless ``allow_unstable``).
 """
 
@@ -134,7 +135,7 @@ class DesignResult:
         The controller's hold + computation delay the design model carries
         (:meth:`ambseal.robust.delay.DesignDelay.to_dict`); None for the PID.
     steps : tuple of str
-        The automatic design-loop steps taken (model enlargements).
+        The automatic design-loop steps taken (model enlargements, damping margins).
     omega : ndarray or None
         The μ design's frequency grid (rad/s), on which its μ is stated (not serialised);
         None for H∞ and the PID.
@@ -234,33 +235,20 @@ def full_order_check(cfg, K, conditions) -> dict:
         (damped frequency) and ``damping`` (ζ = −Re λ/|λ|, negative when unstable).
     """
 
-    return _worst(_checked(cfg, K, conditions))
-
-
-def _checked(cfg, K, conditions) -> list[dict]:
-    """:func:`full_order_check`'s dict for each condition alone."""
     L = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples).system
-    rows = []
+    worst = None
     for p, f in conditions:
         plant = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * f)
         judged = judged_loop(plant.to_statespace(), K, plant.current_inputs(), delay=L)
         lam = judged.loop.poles
         z = lam[int(np.argmax(lam.real))]
-        rows.append({"stable": bool(judged.stable), "pressure_bar": float(p),
-                     "speed_hz": float(f), "max_real_pole": float(z.real),
-                     "mode_hz": float(abs(z.imag) / (2 * np.pi)),
-                     "damping": float(-z.real / max(abs(z), 1e-300)),
-                     "rank": z.real / np.abs(lam).max()})
-    return rows
-
-
-def _worst(rows: list[dict]) -> dict:
-    """The least stable of :func:`_checked`'s rows (an unstable one first), ``stable``
-    true only if every row is."""
-    w = max(rows, key=lambda r: (not r["stable"], r["rank"]))
-    out = {k: v for k, v in w.items() if k != "rank"}
-    out["stable"] = all(r["stable"] for r in rows)
-    return out
+        rank = (not judged.stable, z.real / np.abs(lam).max())
+        if worst is None or rank > worst[0]:
+            worst = (rank, p, f, z)
+    (unstable, _), p, f, z = worst
+    return {"stable": not unstable, "pressure_bar": float(p), "speed_hz": float(f),
+            "max_real_pole": float(z.real), "mode_hz": float(abs(z.imag) / (2 * np.pi)),
+            "damping": float(-z.real / max(abs(z), 1e-300))}
 
 
 @with_numerics_threads
@@ -321,8 +309,9 @@ def design(
     progress : callable, optional
         Called with one line per automatic design step.
     enlarge : int
-        Times the design model may be enlarged automatically when the full-order loop is
-        unstable at a mode the design model left out.
+        Automatic design steps when the full-order loop is unstable: the design model
+        enlarged to keep a mode it left out, or a damping margin on a lightly damped mode
+        it keeps (:func:`margin_for`, :func:`ambseal.design.plant.less_damped`).
 
     Returns
     -------
@@ -388,9 +377,8 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
     """:func:`_synthesise` on the specification's design model, corrected (at most
     ``enlarge`` times) while the full-order loop is unstable: enlarged (unless ``states``
     fixes it) to keep a mode the model left out, or, where the model keeps the mode,
-    given a damping margin on it
-    (:func:`margin_for`); if no margin holds it, the last design without margins is
-    returned. Each correction is appended to ``steps`` and reported to ``progress``.
+    given a damping margin on it (:func:`margin_for`); if no margin holds it, the last
+    design without margins is returned. Each correction is appended to ``steps`` and reported to ``progress``.
     Returns (synthesis, full-order check, design states)."""
     n = int(states or sp.model_states)
     # held where it is judged and wherever the machine runs, standstill to the top speed

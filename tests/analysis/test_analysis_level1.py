@@ -119,7 +119,8 @@ def test_screening_outcomes_by_their_rules():
 def test_a_rig_without_stages_is_refused_by_name():
     import tomllib
 
-    text = _rigid_rotor(1e7, 2000.0, 1e5).split("[[stage]]")[0] + "[operating]\nspeed_rpm = 3000.0\n"
+    text = (_rigid_rotor(1e7, 2000.0, 1e5).split("[[stage]]")[0]
+            + "[operating]\nspeed_rpm = 3000.0\n")
     with pytest.raises(ConfigError, match=r"\[\[stage\]\]"):
         level1_screening(parse_rig(tomllib.loads(text)))
 

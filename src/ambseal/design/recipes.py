@@ -42,8 +42,9 @@ Design model versus judgement: the design model keeps every mode the controller 
 judged condition (:func:`full_order_check`); an unstable loop enlarges the design model to
 keep the mode that went unstable, or, where the model keeps that mode, lowers its damping
 in the design model by a margin the controller must add (:func:`margin_for`), and designs
-again, a bounded number of times, each step reported, and is refused as a :class:`~ambseal.errors.SynthesisError` naming the mode and
-the key to set if it stays unstable (unless ``allow_unstable``).
+again, a bounded number of times, each step reported; it is refused as a
+:class:`~ambseal.errors.SynthesisError` naming the mode and the key to set if it stays
+unstable (unless ``allow_unstable``).
 """
 
 from __future__ import annotations
@@ -378,8 +379,8 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
     ``enlarge`` times) while the full-order loop is unstable: enlarged (unless ``states``
     fixes it) to keep a mode the model left out, or, where the model keeps the mode,
     given a damping margin on it (:func:`margin_for`); if no margin holds it, the last
-    design without margins is returned. Each correction is appended to ``steps`` and reported to ``progress``.
-    Returns (synthesis, full-order check, design states)."""
+    design without margins is returned. Each correction is appended to ``steps`` and
+    reported to ``progress``. Returns (synthesis, full-order check, design states)."""
     n = int(states or sp.model_states)
     # held where it is judged and wherever the machine runs, standstill to the top speed
     conditions = [(q, f) for q in sp.pressures_bar

@@ -11,7 +11,8 @@
 * :func:`fit_timeseries_figure`, :func:`correlation_figure`, :func:`residual_figure`,
   :func:`error_budget_figure` — an identification (:mod:`ambseal.report.identify_figures`);
 * :func:`tracking_figure`, :func:`ramp_figure` — on-line tracking and the pressure ramp;
-* :func:`level1_figure`, :func:`signoff_report` — API 617's Level I screening (:mod:`ambseal.report.signoff_figures`);
+* :func:`level1_figure`, :func:`signoff_report` — API 617's Level I screening
+  (:mod:`ambseal.report.signoff_figures`);
 * :func:`figure_is_ours` — whether a PNG is one ambseal wrote (:mod:`ambseal.report.figures`);
 * :class:`StageProgress` — a long job's progress, stage by stage.
 

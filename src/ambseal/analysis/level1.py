@@ -348,9 +348,9 @@ def level1_screening(cfg, controller=None, *, name: str = "none", points: int = 
          for st in cfg.stage]
     Q_A = float(sum(q))
     where = _applied_at(cfg, q)
-    max_hz = (0.45 * cfg.controller.sample_rate_hz if controller is not None and cfg.amb
-              else bending_limit_hz(cfg))
-    max_hz = min(max_hz, bending_limit_hz(cfg))
+    max_hz = bending_limit_hz(cfg)
+    if controller is not None and cfg.amb:  # the sampled loop's modes: below Nyquist
+        max_hz = min(max_hz, 0.45 * cfg.controller.sample_rate_hz)
 
     def modes(Q: float):
         m = _modes_at(_with_cross_coupling(cfg, where, Q), controller, speed_hz, max_hz)

@@ -14,11 +14,12 @@ from .analysis.test_analysis_level1 import _rigid_rotor
 
 
 def test_signoff_json_files_and_exit_status(tmp_path, capsys):
-    """A rotor on damped springs (no AMB: controller ``none``), Q_0/Q_A between 2 and 10:
-    Level II required, exit status 1; the JSON holds the level1 block with Q_A, Q_0
+    """A rotor on damped springs (no AMB: controller ``none``), Q_0/Q_A between 2 and 10
+    and its CSR above a boundary set low (Region B): Level II required, exit status 1; the JSON holds the level1 block with Q_A, Q_0
     (Q_0 = c√(k/m) within 2 %), δ_A, CSR and passed, and the files it names exist."""
     rig = tmp_path / "rigid.toml"
-    rig.write_text(_rigid_rotor(1e7, 2000.0, 4.5e4))
+    rig.write_text(_rigid_rotor(1e7, 2000.0, 4.5e4)
+                   + "[signoff]\ncsr_boundary = [[0.0, 0.001]]\n")
     code = main(["signoff", str(rig), "--json", "--out", str(tmp_path / "so")])
     out, err = capsys.readouterr()
     assert code == 1 and "Traceback" not in err

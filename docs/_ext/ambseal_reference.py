@@ -202,6 +202,26 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Stage.discharge_density": ("kg/m³", "gas density at the stage's discharge ρ_d"),
     "Machine.kind": ("", "``compressor`` or ``turbine``: API 617's anticipated "
                          "cross-coupling (B = 3 with the density ratio, or 1.5 without)"),
+    "Signoff.csr_boundary": ("kg/m³, −", "API 617 Level I's Region A/B boundary: points "
+                             "``[ρ_avg, CSR]``, linear between, flat beyond (ρ_avg: the "
+                             "first stage's suction and the last stage's discharge density, "
+                             "averaged; ROSS's report tool, API 684 §SP6.8.5)"),
+    "Signoff.log_dec_min": ("", "least log decrement: Level I's δ_A and Level II"),
+    "Signoff.unbalance_factor": ("", "the API 617 unbalance in units of U_r = 6350·W/N g·mm"),
+    "Signoff.analysis_top_ratio": ("", "the unbalance response is analysed from 0 to this "
+                                       "times the trip speed"),
+    "Signoff.vibration_limit_cap_um": ("µm", "cap of A_vl = 25.4 √(12000/N) µm p-p"),
+    "Signoff.scale_factor_limits": ("", "``[low, high]`` bounds of the scale factor "
+                                        "S_c = A_vl/A_probe"),
+    "Signoff.clearance_fraction": ("", "the scaled response's allowed fraction of each "
+                                       "close clearance (diametral)"),
+    "Signoff.iso14839_2_zones": ("", "ISO 14839-2 zone boundaries A/B, B/C, C/D as "
+                                     "fractions of the backup bearing's clearance"),
+    "Seal.clearance": ("m", "radial running clearance: a close clearance of the API 617 "
+                            "unbalance response"),
+    "Operating.trip_speed_hz": ("Hz", "trip speed (default 1.05 × the maximum continuous "
+                                      "speed, the top of ``speed_range_hz`` or the "
+                                      "operating speed)"),
     "Operating.speed_rpm": ("rpm", "operating speed"),
     "Operating.pressure_bar": ("bar", "nominal pressure drop across the seals"),
     "Operating.speed_range_hz": ("Hz", "``[low, high]`` operating speed range: schedules "
@@ -448,6 +468,8 @@ def _sections() -> list[Section]:
                 "Level I stability screening needs (``ambseal signoff``); ``position`` or "
                 "``disk``, one of them."),
         Section("[machine]", r.Machine),
+        Section("[signoff]", r.Signoff, "The sign-off's limits that the standards' public "
+                "text could not confirm; every key optional, its default shown."),
         Section("[controller]", r.Controllers),
         Section("[controller.pid]", r.Pid, "All four keys, or leave the table out."),
         Section("[[controller.filter]]", r.PidFilter, "A notch, lead, lag or low-pass "

@@ -82,8 +82,10 @@ def test_q0_of_a_rigid_rotor_on_damped_supports_is_the_closed_form():
     """m z̈ + c ż + k z − jQ z = 0 (z = x + jy, the cross-coupling k_xy = Q, k_yx = −Q at
     mid-span of a rotor symmetric about it): forward whirl at ω = √(k/m) loses its damping
     at Q_0 = c·√(k/m). The screening's Q_0 (no AMB: the rig as it is) within 2 %, δ(0) of
-    the cylindrical mode 2πζ/√(1 − ζ²) with ζ = c/(2√(km)); a Q_A of about Q_0/6
-    (Q_0/Q_A between 2 and 10) requires Level II."""
+    the cylindrical mode 2πζ/√(1 − ζ²) with ζ = c/(2√(km)); with a Q_A of about Q_0/6
+    (Q_0/Q_A between 2 and 10) the CSR region decides: this short stiff rotor's CSR lies
+    far below the default boundary (Region A, passed), and above a boundary set below it
+    (Region B, Level II required)."""
     import tomllib
 
     k, c = 1e7, 2000.0
@@ -96,7 +98,14 @@ def test_q0_of_a_rigid_rotor_on_damped_supports_is_the_closed_form():
     assert r.log_dec[0] == pytest.approx(2 * math.pi * zeta / math.sqrt(1 - zeta**2),
                                          rel=0.02)
     assert r.frequency_hz[0] == pytest.approx(math.sqrt(k / m) / (2 * math.pi), rel=0.02)
-    assert r.converged and 2 < r.ratio < 10 and not r.passed and "Level II" in r.rule
+    assert r.converged and 2 < r.ratio < 10
+    assert r.rho_avg == pytest.approx(0.5 * (10.0 + 15.0)) and r.csr_boundary == 2.5
+    assert r.region == "A" and r.passed and "Region A" in r.rule
+    low = parse_rig({**tomllib.loads(_rigid_rotor(k, c, 4.5e4)),
+                     "signoff": {"csr_boundary": [[0.0, r.csr / 2]]}})
+    b = level1_screening(low)
+    assert b.Q_0 == pytest.approx(r.Q_0) and b.csr_boundary == pytest.approx(r.csr / 2)
+    assert b.region == "B" and not b.passed and "Level II" in b.rule
     assert r.where_m == ((pytest.approx(0.2), 1.0),)
     # δ falls with Q through the found zero
     assert np.all(np.diff(r.log_dec) < 0)
@@ -167,3 +176,14 @@ def test_q0_with_a_pd_acting_amb_is_the_closed_form_of_its_equivalent_support():
     assert r.Q_0 == pytest.approx(c * math.sqrt(k / m), rel=0.02)
     assert r.converged and r.frequency_hz[0] == pytest.approx(
         math.sqrt(k / m) / (2 * math.pi), rel=0.03)
+
+
+def test_csr_boundary_is_linear_between_its_points_and_flat_beyond():
+    """The default boundary: 2.5 up to 16.53 kg/m³, 2.0 from 60 kg/m³, linear between
+    (2.5 − 0.5·(ρ − 16.53)/43.47)."""
+    from ambseal.analysis.level1 import csr_boundary
+    from ambseal.config.rig import Signoff
+
+    pts = Signoff().csr_boundary
+    assert csr_boundary(pts, 5.0) == 2.5 and csr_boundary(pts, 200.0) == 2.0
+    assert csr_boundary(pts, 30.0) == pytest.approx(2.5 - 0.5 * (30.0 - 16.53) / 43.47)

@@ -32,12 +32,18 @@ discrete controller with its computation delay on the plant sampled by a zero-or
 (:func:`ambseal.analysis.campbell.modes_of_sampled_loop`); a rig on springs alone is
 screened as it is (controller ``None``).
 
-The screening's outcome (the rule that decides, in this order): δ_A = δ(Q_A) < 0.1 →
-Level II required; Q_0/Q_A < 2 → Level II required; 2 ≤ Q_0/Q_A < 10 → the critical speed
-ratio's region decides, which this module does not yet evaluate, so Level II is required
-(stated as such); Q_0/Q_A ≥ 10 (or no Q_0 up to the sweep's end) → passed. The critical
-speed ratio CSR (maximum continuous speed over the first critical speed on rigid
-supports) is reported beside it.
+The screening's outcome (the rule that decides, in this order): δ_A = δ(Q_A) below
+``[signoff] log_dec_min`` (0.1) → Level II required; Q_0/Q_A < 2 → Level II required;
+2 ≤ Q_0/Q_A < 10 → the critical speed ratio decides: in Region A (CSR on or below the
+Region A/B boundary at the average gas density) passed, in Region B Level II required;
+Q_0/Q_A ≥ 10 (or no Q_0 up to the sweep's end) → passed. The critical speed ratio CSR is
+the maximum continuous speed over the first critical speed on rigid supports; the average
+gas density ρ_avg is the mean of the first stage's suction and the last stage's discharge
+density (the stages in the rig file's flow order). The boundary is ``[signoff]
+csr_boundary``, points (ρ_avg, CSR) joined linearly and held flat beyond; its default,
+CSR 2.5 up to 16.53 kg/m³ falling linearly to 2.0 at 60 kg/m³ and 2.0 beyond, is the one
+ROSS's API report tool draws (API 684 §SP6.8.5, as ROSS cites it; the standard's figure
+could not be confirmed from its public text, so it is a setting).
 """
 
 from __future__ import annotations
@@ -53,21 +59,21 @@ from ambseal.analysis.campbell import (
     modes_of_state_matrix,
     track_modes,
 )
+from ambseal.analysis.synchronous import controller_as_runs
 from ambseal.config import Spring
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
 from ambseal.model import bending_limit_hz, build_mesh, build_plant
 
-__all__ = ["B_COMPRESSOR", "B_TURBINE", "LOG_DEC_MIN", "RATIO_MIN", "RATIO_FREE",
-           "Level1", "stage_cross_coupling", "level1_screening"]
+__all__ = ["B_COMPRESSOR", "B_TURBINE", "RATIO_MIN", "RATIO_FREE",
+           "Level1", "stage_cross_coupling", "csr_boundary", "level1_screening"]
 
 #: API 617's factor B of the anticipated cross-coupling: compressors (with the density
 #: ratio) and turbines (without it).
 B_COMPRESSOR = 3.0
 B_TURBINE = 1.5
-#: The screening's limits: δ_A below 0.1, or Q_0/Q_A below 2, requires Level II; Q_0/Q_A of
-#: 10 or more passes whatever the critical speed ratio.
-LOG_DEC_MIN = 0.1
+#: The screening's limits: Q_0/Q_A below 2 requires Level II; Q_0/Q_A of 10 or more
+#: passes whatever the critical speed ratio (δ_A's limit: ``[signoff] log_dec_min``).
 RATIO_MIN = 2.0
 RATIO_FREE = 10.0
 #: Brent's method stops when Q_0 is known to this fraction of Q_A.
@@ -115,6 +121,10 @@ class Level1:
         No Level II analysis required.
     rule : str
         The rule that decided, in words.
+    rho_avg : float
+        Average gas density (kg/m³).
+    csr_boundary : float
+        The Region A/B boundary's CSR at ``rho_avg``.
     """
 
     controller: str
@@ -132,6 +142,13 @@ class Level1:
     rigid_critical_hz: float
     passed: bool
     rule: str
+    rho_avg: float = math.nan
+    csr_boundary: float = math.nan
+
+    @property
+    def region(self) -> str:
+        """``"A"`` (CSR on or below the boundary) or ``"B"``."""
+        return "A" if self.csr <= self.csr_boundary else "B"
 
     @property
     def ratio(self) -> float:
@@ -146,6 +163,8 @@ class Level1:
                 "Q_0_over_Q_A": json_float(self.ratio), "log_dec_A": json_float(self.log_dec_A),
                 "CSR": json_float(self.csr), "rigid_critical_hz": json_float(
                     self.rigid_critical_hz),
+                "rho_avg": json_float(self.rho_avg), "CSR_boundary": json_float(
+                    self.csr_boundary), "region": self.region,
                 "passed": self.passed, "rule": self.rule, "converged": self.converged,
                 "speed_hz": self.speed_hz, "stage_q_A": list(self.stage_q),
                 "applied_at": [{"position_m": z, "share": w} for z, w in self.where_m],
@@ -188,13 +207,6 @@ def stage_cross_coupling(stage, kind: str, speed_rad_s: float) -> float:
     raise ConfigError(f"machine.kind: expected 'compressor' or 'turbine', got {kind!r}")
 
 
-def _max_continuous_hz(cfg) -> float:
-    """The maximum continuous speed (Hz): the top of ``[operating] speed_range_hz``, else
-    the operating speed."""
-    r = cfg.operating.speed_range_hz
-    return float(r[1]) if r is not None else abs(cfg.operating.speed_rpm) / 60.0
-
-
 def _stage_position(cfg, st) -> float:
     if st.position is not None:
         return float(st.position)
@@ -225,18 +237,6 @@ def _with_cross_coupling(cfg, where, Q: float):
     return cfg.model_copy(update={"seal": [], "spring": [*cfg.spring, *springs]})
 
 
-def _discrete_at(controller, speed_rad_s: float):
-    """The controller as it runs: a discrete ``control.StateSpace`` with its computation
-    delay (a scheduled one at the speed)."""
-    if hasattr(controller, "statespace_at"):
-        return controller.statespace_at(speed_rad_s, delayed=True)
-    if hasattr(controller, "statespace") and hasattr(controller, "discrete"):
-        return controller.statespace(delayed=True)
-    raise ConfigError("API 617 Level I: the controller must be a digital one as it runs "
-                      "(a DigitalController or a scheduled table, e.g. an exported file of "
-                      "ambseal design); a continuous controller is not judged here")
-
-
 def _modes_at(cfg, controller, speed_hz: float, max_hz: float):
     """The loop's oscillating modes at ``speed_hz`` (:class:`ClosedLoopModes`): the
     discrete controller as it runs on the sampled plant, or the rig alone."""
@@ -249,7 +249,7 @@ def _modes_at(cfg, controller, speed_hz: float, max_hz: float):
 
     G = plant.select_inputs([plant.input_names[j] for j in plant.current_inputs()]
                             ).to_statespace()
-    Kd = _discrete_at(controller, 2 * math.pi * speed_hz)
+    Kd = controller_as_runs(controller, 2 * math.pi * speed_hz)
     A = np.asarray(judged_loop(G, Kd).loop.system.A)
     return modes_of_sampled_loop(A, float(Kd.dt), mesh, speed_hz=speed_hz,
                                  pressure_bar=0.0, max_hz=max_hz)
@@ -291,6 +291,13 @@ def _screened(D: np.ndarray, forward: np.ndarray, iA: int) -> tuple[int, int | N
     if np.any(np.isfinite(drop)):
         return int(np.nanargmax(drop)), None
     return int(np.argmin(np.where(forward & np.isfinite(D[iA]), D[iA], np.inf))), None
+
+
+def csr_boundary(points, rho_avg: float) -> float:
+    """The Region A/B boundary's CSR at the average gas density ``rho_avg`` (kg/m³):
+    ``points`` ``[(ρ, CSR), …]`` joined linearly, flat beyond (module docstring)."""
+    rho, csr = np.array(points, dtype=float).T
+    return float(np.interp(rho_avg, rho, csr))
 
 
 def _rigid_critical_hz(cfg) -> float:
@@ -343,7 +350,7 @@ def level1_screening(cfg, controller=None, *, name: str = "none", points: int = 
     if points < 3 or not q_max_factor >= RATIO_FREE:
         raise ConfigError(f"API 617 Level I: points={points} (≥ 3) and q_max_factor="
                           f"{q_max_factor:g} (≥ {RATIO_FREE:g}) expected")
-    speed_hz = _max_continuous_hz(cfg)
+    speed_hz = cfg.operating.continuous_hz[1]
     q = [stage_cross_coupling(st, cfg.machine.kind, 2 * math.pi * speed_hz)
          for st in cfg.stage]
     Q_A = float(sum(q))
@@ -379,27 +386,32 @@ def level1_screening(cfg, controller=None, *, name: str = "none", points: int = 
         Q_0, converged = _zero(grid, lost, pts[lost - 1].poles[idx[lost - 1, j]],
                                pts[lost].poles[idx[lost, j]], modes, Q_A)
     ratio = math.inf if Q_0 is None else Q_0 / Q_A
+    f_rigid = _rigid_critical_hz(cfg)
+    csr = speed_hz / f_rigid
+    rho_avg = 0.5 * (cfg.stage[0].suction_density + cfg.stage[-1].discharge_density)
+    edge = csr_boundary(cfg.signoff.csr_boundary, rho_avg)
+    d_min = cfg.signoff.log_dec_min
     if not converged:
         passed, rule = False, (f"the loop is lost at Q = {Q_0:.4g} N/m and Q_0 could not "
                                "be found to its tolerance: not passed")
-    elif not log_dec_A >= LOG_DEC_MIN:
-        passed, rule = False, (f"δ_A = {log_dec_A:.3g} < {LOG_DEC_MIN:g}: Level II "
-                               "required")
+    elif not log_dec_A >= d_min:
+        passed, rule = False, f"δ_A = {log_dec_A:.3g} < {d_min:g}: Level II required"
     elif ratio < RATIO_MIN:
         passed, rule = False, f"Q_0/Q_A = {ratio:.3g} < {RATIO_MIN:g}: Level II required"
     elif ratio < RATIO_FREE:
-        passed, rule = False, (f"{RATIO_MIN:g} ≤ Q_0/Q_A = {ratio:.3g} < {RATIO_FREE:g}: "
-                               "the CSR region decides, not evaluated here: Level II "
-                               "required")
+        region = (f"CSR = {csr:.3g} at ρ_avg = {rho_avg:.3g} kg/m³, boundary "
+                  f"{edge:.3g}")
+        passed = csr <= edge
+        rule = (f"{RATIO_MIN:g} ≤ Q_0/Q_A = {ratio:.3g} < {RATIO_FREE:g} and {region}: "
+                + ("Region A, passed" if passed else "Region B, Level II required"))
     else:
         above = "" if Q_0 is not None else f" (δ > 0 up to {grid[-1]:.4g} N/m)"
-        passed, rule = True, (f"δ_A = {log_dec_A:.3g} ≥ {LOG_DEC_MIN:g} and Q_0/Q_A ≥ "
+        passed, rule = True, (f"δ_A = {log_dec_A:.3g} ≥ {d_min:g} and Q_0/Q_A ≥ "
                               f"{RATIO_FREE:g}{above}: passed")
-    f_rigid = _rigid_critical_hz(cfg)
     return Level1(controller=name, speed_hz=speed_hz, stage_q=tuple(q), Q_A=Q_A,
                   where_m=where, Q=grid, log_dec=d, frequency_hz=f, log_dec_A=log_dec_A,
-                  Q_0=Q_0, converged=converged, csr=speed_hz / f_rigid,
-                  rigid_critical_hz=f_rigid, passed=passed, rule=rule)
+                  Q_0=Q_0, converged=converged, csr=csr, rigid_critical_hz=f_rigid,
+                  passed=passed, rule=rule, rho_avg=rho_avg, csr_boundary=edge)
 
 
 def _zero(grid, i: int, lam0: complex, lam1: complex, modes, Q_A: float

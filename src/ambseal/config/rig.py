@@ -357,6 +357,8 @@ class Seal(_Strict):
     C: SealCoefficient = 0.0
     c: SealCoefficient = 0.0
     M: SealCoefficient = 0.0
+    # radial running clearance: API 617's close clearances; a seal's is 10 µm to 10 mm
+    clearance: float | None = Field(default=None, ge=1e-6, le=0.1)
     uncertainty: Uncertainty = None
 
     @property
@@ -414,6 +416,46 @@ class Machine(_Strict):
     kind: Literal["compressor", "turbine"] = "compressor"
 
 
+class Signoff(_Strict):
+    """The sign-off's limits that the standards' public text does not confirm, as
+    settings with documented defaults (:mod:`ambseal.analysis.signoff`): API 617's CSR
+    Region A/B boundary ``csr_boundary`` (points ``[ρ_avg kg/m³, CSR]``, linear between,
+    flat beyond), the least log decrement ``log_dec_min`` (Level I's δ_A and Level II),
+    the unbalance ``unbalance_factor`` × U_r, the analysed speeds up to
+    ``analysis_top_ratio`` × the trip speed, the vibration limit's cap
+    ``vibration_limit_cap_um`` (µm p-p), the scale factor's ``scale_factor_limits`` and the
+    close clearances' allowed ``clearance_fraction``, and ISO 14839-2's zone boundaries
+    ``iso14839_2_zones`` (fractions of the backup bearing's clearance C_min)."""
+
+    csr_boundary: list[Annotated[list[float], Field(min_length=2, max_length=2)]] = Field(
+        default=[[16.53, 2.5], [60.0, 2.0]], min_length=1, max_length=100)
+    log_dec_min: float = Field(default=0.1, gt=0, le=10.0)
+    unbalance_factor: float = Field(default=2.0, gt=0, le=100.0)
+    analysis_top_ratio: float = Field(default=1.25, ge=1.0, le=5.0)
+    vibration_limit_cap_um: float = Field(default=25.4, gt=0, le=1e4)
+    scale_factor_limits: tuple[float, float] = Field(default=(0.5, 6.0), strict=False)
+    clearance_fraction: float = Field(default=0.75, gt=0, le=1.0)
+    iso14839_2_zones: tuple[float, float, float] = Field(default=(0.3, 0.4, 0.5),
+                                                         strict=False)
+
+    @model_validator(mode="after")
+    def _ordered(self) -> "Signoff":
+        rho = [r for r, _ in self.csr_boundary]
+        if any(b <= a for a, b in zip(rho, rho[1:])) or any(
+                not (0 <= r <= 2000 and 0 < c <= 100) for r, c in self.csr_boundary):
+            raise ValueError("csr_boundary: expected [density kg/m³, CSR] points with "
+                             "densities increasing within 0–2000 and CSR within (0, 100]")
+        lo, hi = self.scale_factor_limits
+        if not 0 < lo <= hi <= 100:
+            raise ValueError("scale_factor_limits: expected [low, high] with 0 < low <= "
+                             "high <= 100")
+        z = self.iso14839_2_zones
+        if not 0 < z[0] < z[1] < z[2] <= 1:
+            raise ValueError("iso14839_2_zones: expected A/B < B/C < C/D within (0, 1] "
+                             "(fractions of the backup clearance)")
+        return self
+
+
 class Pid(_Strict):
     kp: float = Field(gt=0, le=1e9)
     ti: float = Field(gt=0, le=1e4)
@@ -468,14 +510,39 @@ class Controllers(_Strict):
     delay_samples: int = Field(default=1, ge=0, le=MAX_DELAY_SAMPLES)
 
 
+#: The trip speed over the maximum continuous speed when ``trip_speed_hz`` is left out:
+#: API 617's value for a variable-speed motor or gas-turbine drive (105 %), the lowest
+#: of a turbine-driven machine's; not confirmed from the standard's public text.
+TRIP_RATIO = 1.05
+
+
 class Operating(_Strict):
     speed_rpm: float = Field(default=0.0, ge=-1e6, le=1e6)
     pressure_bar: float = Field(default=0.0, ge=0, le=1e4)
     speed_range_hz: tuple[float, float] | None = Field(default=None, strict=False)  # a list
+    trip_speed_hz: float | None = Field(default=None, gt=0, le=1e5)
+
+    @property
+    def continuous_hz(self) -> tuple[float, float]:
+        """(minimum, maximum) continuous speed (Hz): ``speed_range_hz``, else the operating
+        speed for both."""
+        r = self.speed_range_hz
+        f = abs(self.speed_rpm) / 60.0
+        return (float(r[0]), float(r[1])) if r is not None else (f, f)
+
+    @property
+    def trip_hz(self) -> float:
+        """The trip speed (Hz): ``trip_speed_hz``, else :data:`TRIP_RATIO` × the maximum
+        continuous speed."""
+        return (self.trip_speed_hz if self.trip_speed_hz is not None
+                else TRIP_RATIO * self.continuous_hz[1])
 
     @model_validator(mode="after")
     def _range(self) -> "Operating":
         r = self.speed_range_hz
+        if self.trip_speed_hz is not None and self.trip_speed_hz < self.continuous_hz[1]:
+            raise ValueError(f"trip_speed_hz: {self.trip_speed_hz:g} Hz lies below the "
+                             f"maximum continuous speed {self.continuous_hz[1]:g} Hz")
         if r is not None and not 0 < r[0] < r[1] <= 1e5:
             raise ValueError("speed_range_hz: expected [low, high] with 0 < low < high "
                              "<= 1e5 Hz")
@@ -510,6 +577,7 @@ class RigConfig(_Strict):
     spring: list[Spring] = Field(default=[], max_length=MAX_COMPONENTS)
     stage: list[Stage] = Field(default=[], max_length=MAX_COMPONENTS)
     machine: Machine = Machine()
+    signoff: Signoff = Signoff()
     controller: Controllers = Controllers()
     operating: Operating = Operating()
     reduction: Reduction = Reduction()

@@ -1,0 +1,191 @@
+"""Synchronous (unbalance) response of the rotor with its AMB loop as it runs.
+
+A rotating unbalance ``U = m·e`` (kg·m) at axial position z and phase φ is the force
+``F_x = U Ω² e^{jφ}``, ``F_y = −j U Ω² e^{jφ}`` (phasors of ``x = Re{X e^{jΩt}}``: a
+force turning with the shaft, forward). At each speed Ω the rotor's second-order model
+(:func:`ambseal.model.build_system`: gyroscopics ``ΩG``, the seals at the synchronous
+frequency, the AMBs' negative stiffness K_s and force factor K_i) is closed by the
+controller through the actuator's response ``H_a(jΩ)`` (the ``[actuator]`` model and the
+eddy-current lag):
+
+    (K − Ω²M + jΩ(C + ΩG) + B_i H_a(jΩ) K_r(Ω) C_s) q = F_u ,
+
+with ``q`` every node's ``x, y, α, β`` and ``C_s`` the sensors. The controller as it runs
+is the discrete one with its computation delay, whose fundamental harmonic through the
+sampler and the zero-order hold is ``K_r(Ω) = K_d(e^{jΩT}) · (1 − e^{−jΩT})/(jΩT)``
+(Franklin, Powell & Workman, *Digital Control of Dynamic Systems*, 3rd ed., §6.3: the
+ZOH's frequency response); the aliases at ``Ω ± 2πk/T`` are left out, a fraction
+``(ΩT/2π)²`` of the response at speeds far below the sample rate, as every AMB machine
+runs. A continuous controller is evaluated at ``jΩ``; ``None`` leaves the supports to
+the rig's springs.
+
+Every node's displacement amplitude is the orbit's semi-major axis
+``√((|X|² + |Y|² + |X² + Y²|)/2)`` — what a probe in the worst direction reads, half of
+its peak-to-peak value.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ambseal.errors import ConfigError, ModelError
+from ambseal.lti import freqresp_at
+from ambseal.model import build_system
+from ambseal.model.amb import actuator_matrices, eddy_lag_matrices
+from ambseal.model.seal import SealElement
+
+__all__ = ["Unbalance", "SynchronousResponse", "synchronous_response", "controller_as_runs",
+           "orbit_semi_major"]
+
+
+@dataclass(frozen=True)
+class Unbalance:
+    """One rotating unbalance: ``position`` (m), ``amount`` U = m·e (kg·m), ``phase_deg``."""
+
+    position: float
+    amount: float
+    phase_deg: float = 0.0
+
+
+@dataclass(frozen=True)
+class SynchronousResponse:
+    """Synchronous response amplitudes over speed, per unbalance case.
+
+    Attributes
+    ----------
+    speed_hz : ndarray, shape (n_s,)
+        Spin speeds (Hz).
+    positions_m : ndarray, shape (n_z,)
+        Where the amplitude is taken (m).
+    amplitude_m : ndarray, shape (n_c, n_s, n_z)
+        The orbit's semi-major axis (m, zero-to-peak) per case, speed and position.
+    """
+
+    speed_hz: np.ndarray
+    positions_m: np.ndarray
+    amplitude_m: np.ndarray
+
+
+def orbit_semi_major(X: np.ndarray, Y: np.ndarray) -> np.ndarray:
+    """Semi-major axis of the ellipse ``(Re{X e^{jθ}}, Re{Y e^{jθ}})`` (module docstring);
+    same shape as ``X`` and ``Y``."""
+    return np.sqrt(0.5 * (np.abs(X) ** 2 + np.abs(Y) ** 2 + np.abs(X ** 2 + Y ** 2)))
+
+
+def controller_as_runs(controller, speed_rad_s: float):
+    """The controller as it runs at ``speed_rad_s``: a discrete ``control.StateSpace`` with
+    its computation delay (a scheduled table at that speed).
+
+    Raises
+    ------
+    ConfigError
+        A controller that is not a digital one as it runs.
+    """
+    if hasattr(controller, "statespace_at"):
+        return controller.statespace_at(speed_rad_s, delayed=True)
+    if hasattr(controller, "statespace") and hasattr(controller, "discrete"):
+        return controller.statespace(delayed=True)
+    raise ConfigError("the sign-off judges a digital controller as it runs (a "
+                      "DigitalController or a scheduled table, e.g. an exported file of "
+                      "ambseal design); a continuous controller is not judged here")
+
+
+def _siso_at(mats, s: complex) -> complex:
+    A, B, C, D = mats
+    if A.size == 0:
+        return complex(D[0, 0])
+    return complex((C @ np.linalg.solve(s * np.eye(A.shape[0]) - A, B) + D)[0, 0])
+
+
+def _controller_at(controller, out_names, in_names, omega: float) -> np.ndarray:
+    """``K_r(Ω)`` (nu × ny, the plant's input × output order; module docstring)."""
+    K = controller_as_runs(controller, omega)
+    dt = float(K.dt)
+    Kw = freqresp_at(K, [np.exp(1j * omega * dt)])[0]
+    ins, outs = list(K.input_labels), list(K.output_labels)
+    if sorted(ins) != sorted(out_names) or sorted(outs) != sorted(in_names):
+        raise ModelError(f"the controller's signals ({', '.join(ins)} → {', '.join(outs)}) "
+                         f"are not the rig's ({', '.join(out_names)} → "
+                         f"{', '.join(in_names)})")
+    Kw = Kw[np.ix_([outs.index(n) for n in in_names], [ins.index(n) for n in out_names])]
+    hold = 1.0 if omega == 0 else (1 - np.exp(-1j * omega * dt)) / (1j * omega * dt)
+    return Kw * hold
+
+
+def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
+                         pressure_bar: float | None = None) -> SynchronousResponse:
+    """The loop's response to rotating unbalances over speed (module docstring).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+    controller : DigitalController, ScheduledDigital or None
+        The controller as it runs; None for a rig on springs alone.
+    speeds_hz : array_like, shape (n_s,)
+        Spin speeds (Hz), ≥ 0.
+    cases : sequence of sequence of Unbalance
+        The unbalance cases, ``n_c`` of them; the unbalances of one case act together.
+    positions_m : array_like, shape (n_z,)
+        Where the amplitude is read (m): each gets a node.
+    pressure_bar : float, optional
+        The seals' pressure drop (``[operating] pressure_bar`` if omitted).
+
+    Returns
+    -------
+    SynchronousResponse
+
+    Raises
+    ------
+    ModelError
+        A controller whose signals are not the rig's, or a singular dynamic stiffness (a
+        loop with an undamped mode exactly at a speed).
+    """
+    speeds = np.atleast_1d(np.asarray(speeds_hz, dtype=float))
+    zs = np.atleast_1d(np.asarray(positions_m, dtype=float))
+    where = tuple(sorted({*(u.position for c in cases for u in c), *map(float, zs)}))
+    act = (actuator_matrices(cfg.actuator), eddy_lag_matrices(cfg.actuator.eddy_time_constant))
+    p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
+    # the rotor, AMBs and springs once; the seals per speed where a table follows the
+    # synchronous frequency (P3 §4), else once
+    base = build_system(cfg, speed_rpm=0.0, include_seals=False, force_positions=where)
+    mesh, n = base.mesh, base.n_dof
+    follow = any(s.frequency_dependent for s in cfg.seal)
+
+    def seals(f_hz: float):
+        M, C, K = (np.zeros((n, n)) for _ in range(3))
+        for s in cfg.seal:
+            SealElement.from_config(s, mesh, p, f_hz).assemble(M, C, K)
+        return M, C, K
+
+    fixed = None if follow else seals(0.0)
+    F1 = np.zeros((n, len(cases)), dtype=complex)  # per unit Ω²
+    for c, case in enumerate(cases):
+        for u in case:
+            i = mesh.node_at(u.position)
+            Fu = u.amount * np.exp(1j * math.radians(u.phase_deg))
+            F1[4 * i, c] += Fu
+            F1[4 * i + 1, c] += -1j * Fu
+    nodes = [mesh.node_at(z) for z in zs]
+    rows_x, rows_y = [4 * i for i in nodes], [4 * i + 1 for i in nodes]
+    n_cur = len(base.output_names)
+    amp = np.empty((len(cases), speeds.size, zs.size))
+    for k, f in enumerate(speeds):
+        omega = 2 * math.pi * f
+        Ms, Cs, Ks = fixed if fixed is not None else seals(f)
+        Z = (base.K + Ks - omega ** 2 * (base.M + Ms)
+             + 1j * omega * (base.C + Cs + omega * base.G))
+        if controller is not None and n_cur:
+            Ha = _siso_at(act[0], 1j * omega) * _siso_at(act[1], 1j * omega)
+            Kr = _controller_at(controller, base.output_names, base.input_names[:n_cur],
+                                omega)
+            Z = Z + (base.B[:, :n_cur] * Ha) @ Kr @ base.Cq
+        try:
+            q = np.linalg.solve(Z, omega ** 2 * F1)
+        except np.linalg.LinAlgError:
+            raise ModelError(f"synchronous response: the dynamic stiffness is singular at "
+                             f"{f:g} Hz (an undamped mode at that speed)") from None
+        amp[:, k, :] = orbit_semi_major(q[rows_x], q[rows_y]).T
+    return SynchronousResponse(speed_hz=speeds, positions_m=zs, amplitude_m=amp)

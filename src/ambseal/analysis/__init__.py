@@ -24,6 +24,9 @@ sampled with its delay) on the full-order plant:
   (:func:`ambseal.analysis.campbell.campbell` → :class:`Campbell`);
 * :func:`level1_screening` → :class:`Level1`, :func:`stage_cross_coupling` — API 617's Level I
   stability screening with each controller as it runs;
+* :func:`api617_unbalance` → :class:`Api617Unbalance` — API 617's unbalance response,
+  separation margins and close clearances, on :func:`synchronous_response` (rotating
+  :class:`Unbalance` with the loop as it runs);
 * :func:`stability_boundary`, :func:`refine_boundary` — on the rows of
   :func:`ambseal.analysis.sweep.sweep` (:func:`parse_range`, :func:`check_cases`);
   :func:`stability_case`, :func:`stability_points` → :class:`StabilityCase` (with a
@@ -62,6 +65,8 @@ _FROM = {
     "judge_case": "judge", "judge_jobs": "judge", "judge_settings": "judge",
     "judge_spinup": "judge", "operating_points": "judge", "points_for": "judge",
     "level1_screening": "level1", "stage_cross_coupling": "level1", "Level1": "level1",
+    "api617_unbalance": "unbalance_api617", "Api617Unbalance": "unbalance_api617",
+    "synchronous_response": "synchronous", "Unbalance": "synchronous",
     "speed_scheduled": "judge", "unstable_open_loop_poles": "judge", "JudgeJob": "judge",
     "JudgeSettings": "judge", "JudgedCase": "judge", "LoopJudgement": "judge",
     "OperatingPoint": "judge", "compliance": "loops", "loop_responses": "loops",

@@ -41,11 +41,13 @@ from ambseal.model import (
     free_bending_hz,
     poles_near_zero,
 )
+from ambseal.analysis.synchronous import controller_as_runs
 from ambseal.robust import decay_rate, is_stable
 
 __all__ = ["API684_LOG_DEC", "OVERDAMPED_ZETA", "ClosedLoopModes", "Crossing", "Campbell",
            "log_decrement", "lowest_log_decrement", "whirl_of", "closed_loop_state_matrix",
-           "closed_loop_modes", "modes_of_state_matrix", "modes_of_sampled_loop", "track_modes",
+           "closed_loop_modes", "modes_as_run", "modes_of_state_matrix", "modes_of_sampled_loop",
+           "track_modes",
            "open_loop_modes", "campbell"]
 
 #: API 684 (2nd ed., 2005) level-I stability screening: log decrement of every mode ≥ 0.1.
@@ -238,6 +240,48 @@ def closed_loop_modes(cfg, controller=None, *, speed_hz: float = 0.0,
             cfg, controller, speed_hz=speed_hz, pressure_bar=p, delay=True)[0])
     return modes_of_state_matrix(A, mesh, speed_hz=speed_hz, pressure_bar=p, max_hz=f_max,
                                  judged_poles=judged)
+
+
+def modes_as_run(cfg, controller=None, *, speed_hz: float, max_hz: float,
+                 pressure_bar: float | None = None) -> ClosedLoopModes:
+    """The loop's oscillating modes with the controller as it runs: the discrete
+    controller with its computation delay on the plant sampled by a zero-order hold
+    (:func:`modes_of_sampled_loop`), or the rig alone (``controller`` None, or no AMB).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+    controller : DigitalController or ScheduledDigital, optional
+        As it runs (:func:`ambseal.analysis.synchronous.controller_as_runs`).
+    speed_hz, max_hz : float
+        Spin speed and highest damped frequency kept (Hz; below Nyquist for a sampled
+        loop).
+    pressure_bar : float, optional
+        The seals' pressure drop; default ``[operating] pressure_bar``.
+
+    Returns
+    -------
+    ClosedLoopModes
+
+    Raises
+    ------
+    ConfigError
+        A controller that is not a digital one as it runs.
+    """
+    p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
+    plant = build_plant(cfg, speed_rpm=60.0 * speed_hz, pressure_bar=p)
+    mesh = build_mesh(cfg)
+    if controller is None or not cfg.amb:
+        return modes_of_state_matrix(np.asarray(plant.A), mesh, speed_hz=speed_hz,
+                                     pressure_bar=p, max_hz=max_hz)
+    from ambseal.machine import judged_loop  # python-control: loaded when needed
+
+    G = plant.select_inputs([plant.input_names[j] for j in plant.current_inputs()]
+                            ).to_statespace()
+    Kd = controller_as_runs(controller, 2 * math.pi * speed_hz)
+    A = np.asarray(judged_loop(G, Kd).loop.system.A)
+    return modes_of_sampled_loop(A, float(Kd.dt), mesh, speed_hz=speed_hz, pressure_bar=p,
+                                 max_hz=max_hz)
 
 
 def modes_of_state_matrix(A: np.ndarray, mesh, *, speed_hz: float, pressure_bar: float,

@@ -54,16 +54,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from ambseal.analysis.campbell import (
-    modes_of_sampled_loop,
-    modes_of_state_matrix,
-    track_modes,
-)
-from ambseal.analysis.synchronous import controller_as_runs
+from ambseal.analysis.campbell import modes_as_run, track_modes
 from ambseal.config import Spring
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
-from ambseal.model import bending_limit_hz, build_mesh, build_plant
+from ambseal.model import bending_limit_hz, build_plant
 
 __all__ = ["B_COMPRESSOR", "B_TURBINE", "RATIO_MIN", "RATIO_FREE",
            "Level1", "stage_cross_coupling", "csr_boundary", "level1_screening"]
@@ -207,7 +202,8 @@ def stage_cross_coupling(stage, kind: str, speed_rad_s: float) -> float:
     raise ConfigError(f"machine.kind: expected 'compressor' or 'turbine', got {kind!r}")
 
 
-def _stage_position(cfg, st) -> float:
+def stage_position(cfg, st) -> float:
+    """Where a ``[[stage]]`` sits (m): its ``position``, or its ``disk``'s."""
     if st.position is not None:
         return float(st.position)
     return float(next(d.position for d in cfg.disk if d.name == st.disk))
@@ -221,7 +217,7 @@ def _applied_at(cfg, q: list[float]) -> tuple:
         raise ConfigError("API 617 Level I: the rig has no [[amb]] or [[spring]] to carry "
                           "the rotor")
     lo, hi = min(supports), max(supports)
-    zs = [_stage_position(cfg, st) for st in cfg.stage]
+    zs = [stage_position(cfg, st) for st in cfg.stage]
     over = [(z, qi) for z, qi in zip(zs, q) if z < lo - 1e-9 or z > hi + 1e-9]
     if not over:
         return ((0.5 * (lo + hi), 1.0),)
@@ -235,24 +231,6 @@ def _with_cross_coupling(cfg, where, Q: float):
     springs = [Spring(position=z, kxx=0.0, kyy=0.0, kxy=w * Q, kyx=-w * Q,
                       name=f"api617_Q{i}") for i, (z, w) in enumerate(where)]
     return cfg.model_copy(update={"seal": [], "spring": [*cfg.spring, *springs]})
-
-
-def _modes_at(cfg, controller, speed_hz: float, max_hz: float):
-    """The loop's oscillating modes at ``speed_hz`` (:class:`ClosedLoopModes`): the
-    discrete controller as it runs on the sampled plant, or the rig alone."""
-    plant = build_plant(cfg, speed_rpm=60.0 * speed_hz)
-    mesh = build_mesh(cfg)
-    if controller is None or not cfg.amb:
-        return modes_of_state_matrix(np.asarray(plant.A), mesh, speed_hz=speed_hz,
-                                     pressure_bar=0.0, max_hz=max_hz)
-    from ambseal.machine import judged_loop  # python-control: loaded when needed
-
-    G = plant.select_inputs([plant.input_names[j] for j in plant.current_inputs()]
-                            ).to_statespace()
-    Kd = controller_as_runs(controller, 2 * math.pi * speed_hz)
-    A = np.asarray(judged_loop(G, Kd).loop.system.A)
-    return modes_of_sampled_loop(A, float(Kd.dt), mesh, speed_hz=speed_hz,
-                                 pressure_bar=0.0, max_hz=max_hz)
 
 
 def _lines(points) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -360,7 +338,8 @@ def level1_screening(cfg, controller=None, *, name: str = "none", points: int = 
         max_hz = min(max_hz, 0.45 * cfg.controller.sample_rate_hz)
 
     def modes(Q: float):
-        m = _modes_at(_with_cross_coupling(cfg, where, Q), controller, speed_hz, max_hz)
+        m = modes_as_run(_with_cross_coupling(cfg, where, Q), controller,
+                         speed_hz=speed_hz, max_hz=max_hz, pressure_bar=0.0)
         if progress:
             progress(f"{name}: Q = {Q:.4g} N/m, {'stable' if m.stable else 'UNSTABLE'}")
         return m

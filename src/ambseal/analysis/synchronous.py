@@ -33,9 +33,7 @@ import numpy as np
 
 from ambseal.errors import ConfigError, ModelError
 from ambseal.lti import freqresp_at
-from ambseal.model import build_system
-from ambseal.model.amb import actuator_matrices, eddy_lag_matrices
-from ambseal.model.seal import SealElement
+from ambseal.model import SealElement, actuator_matrices, build_system, eddy_lag_matrices
 
 __all__ = ["Unbalance", "SynchronousResponse", "synchronous_response", "controller_as_runs",
            "orbit_semi_major"]
@@ -43,7 +41,17 @@ __all__ = ["Unbalance", "SynchronousResponse", "synchronous_response", "controll
 
 @dataclass(frozen=True)
 class Unbalance:
-    """One rotating unbalance: ``position`` (m), ``amount`` U = m·e (kg·m), ``phase_deg``."""
+    """One rotating unbalance.
+
+    Parameters
+    ----------
+    position : float
+        Axial position (m).
+    amount : float
+        U = m·e (kg·m).
+    phase_deg : float
+        Its angle on the rotor (°), against the other unbalances of a case.
+    """
 
     position: float
     amount: float
@@ -100,19 +108,27 @@ def _siso_at(mats, s: complex) -> complex:
     return complex((C @ np.linalg.solve(s * np.eye(A.shape[0]) - A, B) + D)[0, 0])
 
 
-def _controller_at(controller, out_names, in_names, omega: float) -> np.ndarray:
-    """``K_r(Ω)`` (nu × ny, the plant's input × output order; module docstring)."""
-    K = controller_as_runs(controller, omega)
-    dt = float(K.dt)
-    Kw = freqresp_at(K, [np.exp(1j * omega * dt)])[0]
-    ins, outs = list(K.input_labels), list(K.output_labels)
-    if sorted(ins) != sorted(out_names) or sorted(outs) != sorted(in_names):
-        raise ModelError(f"the controller's signals ({', '.join(ins)} → {', '.join(outs)}) "
-                         f"are not the rig's ({', '.join(out_names)} → "
-                         f"{', '.join(in_names)})")
-    Kw = Kw[np.ix_([outs.index(n) for n in in_names], [ins.index(n) for n in out_names])]
-    hold = 1.0 if omega == 0 else (1 - np.exp(-1j * omega * dt)) / (1j * omega * dt)
-    return Kw * hold
+def _controller_at(controller, out_names, in_names, omegas: np.ndarray) -> np.ndarray:
+    """``K_r(Ω)`` at each speed (n_s × nu × ny, the plant's input × output order; module
+    docstring); a scheduled table taken at each speed, any other controller once."""
+    def at(K, w):
+        dt = float(K.dt)
+        Kw = freqresp_at(K, np.exp(1j * w * dt))
+        ins, outs = list(K.input_labels), list(K.output_labels)
+        if sorted(ins) != sorted(out_names) or sorted(outs) != sorted(in_names):
+            raise ModelError(f"the controller's signals ({', '.join(ins)} → "
+                             f"{', '.join(outs)}) are not the rig's ({', '.join(out_names)} "
+                             f"→ {', '.join(in_names)})")
+        Kw = Kw[:, [outs.index(n) for n in in_names]][:, :, [ins.index(n) for n in out_names]]
+        wdt = w * dt
+        hold = np.where(wdt == 0, 1.0, (1 - np.exp(-1j * wdt)) / np.where(wdt == 0, 1.0,
+                                                                          1j * wdt))
+        return Kw * hold[:, None, None]
+
+    if hasattr(controller, "statespace_at"):
+        return np.concatenate([at(controller_as_runs(controller, w), np.array([w]))
+                               for w in omegas])
+    return at(controller_as_runs(controller, 0.0), omegas)
 
 
 def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
@@ -122,6 +138,7 @@ def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
     Parameters
     ----------
     cfg : RigConfig
+        The rig.
     controller : DigitalController, ScheduledDigital or None
         The controller as it runs; None for a rig on springs alone.
     speeds_hz : array_like, shape (n_s,)
@@ -171,17 +188,19 @@ def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
     nodes = [mesh.node_at(z) for z in zs]
     rows_x, rows_y = [4 * i for i in nodes], [4 * i + 1 for i in nodes]
     n_cur = len(base.output_names)
+    closed = controller is not None and n_cur > 0
+    if closed:
+        Krs = _controller_at(controller, base.output_names, base.input_names[:n_cur],
+                             2 * math.pi * speeds)
     amp = np.empty((len(cases), speeds.size, zs.size))
     for k, f in enumerate(speeds):
         omega = 2 * math.pi * f
         Ms, Cs, Ks = fixed if fixed is not None else seals(f)
         Z = (base.K + Ks - omega ** 2 * (base.M + Ms)
              + 1j * omega * (base.C + Cs + omega * base.G))
-        if controller is not None and n_cur:
+        if closed:
             Ha = _siso_at(act[0], 1j * omega) * _siso_at(act[1], 1j * omega)
-            Kr = _controller_at(controller, base.output_names, base.input_names[:n_cur],
-                                omega)
-            Z = Z + (base.B[:, :n_cur] * Ha) @ Kr @ base.Cq
+            Z = Z + (base.B[:, :n_cur] * Ha) @ Krs[k] @ base.Cq
         try:
             q = np.linalg.solve(Z, omega ** 2 * F1)
         except np.linalg.LinAlgError:

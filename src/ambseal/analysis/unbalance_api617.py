@@ -1,0 +1,531 @@
+"""API 617 unbalance response analysis with the AMB loop as it runs.
+
+API 617 (8th ed., 2014), Part 1, the lateral analysis's unbalance response (its rules
+as ROSS's API report tool implements them, after API 684 (2nd ed., 2005) §SP6.8; where
+the public text could not confirm a number it is a ``[signoff]`` setting, its default
+stated):
+
+* **The unbalance.** ``U = f_U · U_r`` with ``U_r = 6350 · W / N`` (g·mm; W the journal
+  static load in kg, N the maximum continuous speed in rpm) and ``f_U`` =
+  ``[signoff] unbalance_factor`` (2). The journal static loads are the reactions of the
+  rotor on rigid supports at every AMB and spring under gravity.
+* **Where, per mode.** The first and second rigid-body shapes always: one unbalance at
+  mid-span between the outermost supports (W the sum of the journal loads) and two at
+  those supports 180° apart (each W its journal's load), and one at each impeller
+  outboard of them (below); an AMB loop may damp every mode beyond resonance, and the
+  probes and clearances are judged on these. Then for each forward mode of the loop at the maximum continuous
+  speed whose frequency lies below the analysed top speed and that resonates (ζ below
+  1/√2, :data:`ambseal.analysis.campbell.OVERDAMPED_ZETA`), from its shape (the orbit's
+  semi-major axis along the rotor, signed by its phase against the largest between the
+  supports): a mode largest outboard of the supports on a side that carries an impeller
+  (a ``[[stage]]``; without stages a ``[[disk]]``) gets one unbalance at that impeller,
+  W the mass outboard of the nearest support (overhung); a mode whose shape between the
+  supports changes sign (a share below −:data:`SIGN_CHANGE` of the largest) gets two,
+  180° apart, at its largest positive and negative antinodes there, each W the load of
+  the support nearest it; any other mode one at its largest antinode between the
+  supports, W the sum of the journal loads. Cases with the same unbalances are analysed
+  once.
+* **The response** at the probes (the AMB sensors; the springs of a rig without AMBs),
+  from standstill to ``[signoff] analysis_top_ratio`` (1.25) × the trip speed
+  (:func:`ambseal.analysis.synchronous.synchronous_response`), as peak-to-peak
+  amplitude (twice the orbit's semi-major axis).
+* **Criticals and margins.** A peak of a probe's response that rises at least 3 dB
+  above its surroundings (its prominence ≥ 1 − 1/√2 of its height) is a critical speed
+  N_c; its amplification factor by the half-power method ``AF = N_c / (N_2 − N_1)``, the
+  speeds where the response is 1/√2 of the peak (interpolated linearly). AF < 2.5: no
+  separation margin is required. Else a critical below the minimum continuous speed
+  needs ``SM = min(16, 17 (1 − 1/(AF − 1.5)))`` %, one above the maximum continuous
+  speed ``SM = min(26, 10 + 17 (1 − 1/(AF − 1.5)))`` %; the actual margins are
+  ``100 (N_min − N_c)/N_min`` and ``100 (N_c − N_max)/N_max``, a critical inside the
+  range a negative one (its distance into the range, the nearer end's rule).
+* **Vibration limit.** ``A_vl = 25.4 √(12000/N)`` µm peak-to-peak, at most ``[signoff]
+  vibration_limit_cap_um`` (25.4 µm); the probes' largest amplitude from the minimum
+  continuous to the trip speed must not exceed it.
+* **Close clearances.** The scale factor ``S_c = A_vl / A_1`` (A_1 the probes' largest
+  amplitude from standstill to the trip speed), bounded to ``[signoff]
+  scale_factor_limits`` ([0.5, 6]); the response at every close clearance (a seal's
+  ``clearance``, a backup bearing's ``backup_clearance`` at its AMB), times S_c, from
+  standstill to the trip speed, must stay within ``[signoff] clearance_fraction`` (75 %)
+  of the diametral clearance.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.signal import find_peaks
+
+from ambseal.analysis.campbell import OVERDAMPED_ZETA, modes_as_run
+from ambseal.analysis.level1 import RIGID_SUPPORT, stage_position
+from ambseal.analysis.synchronous import Unbalance, orbit_semi_major, synchronous_response
+from ambseal.config import Spring
+from ambseal.errors import ConfigError
+from ambseal.lti import json_float
+from ambseal.model import bending_limit_hz, build_system
+
+__all__ = ["unbalance_ur", "vibration_limit_um", "amplification_factor",
+           "required_margin", "journal_loads", "Critical", "Clearance", "UnbalanceCase",
+           "Api617Unbalance", "api617_unbalance", "AF_NO_MARGIN", "SIGN_CHANGE"]
+
+#: API 617: an amplification factor below this needs no separation margin.
+AF_NO_MARGIN = 2.5
+#: A mode shape "changes sign" when its most negative share reaches this fraction of its
+#: largest amplitude (a node between the supports, not a rounding of a rigid mode).
+SIGN_CHANGE = 0.25
+#: Speeds of the coarse sweep; each critical is refined with :data:`REFINE` more.
+SPEEDS = 241
+REFINE = 41
+#: Standard gravity (m/s²), ISO 80000-3.
+GRAVITY = 9.80665
+
+
+def unbalance_ur(load_kg: float, speed_rpm: float) -> float:
+    """API 617's U_r = 6350·W/N (g·mm) as kg·m.
+
+    Parameters
+    ----------
+    load_kg : float
+        W, the journal static load (kg), > 0.
+    speed_rpm : float
+        N, the maximum continuous speed (rpm), > 0.
+
+    Returns
+    -------
+    float
+        U_r (kg·m); 6350 g·mm·rpm/kg = 6.35e-3 kg·m·rpm/kg.
+
+    Raises
+    ------
+    ConfigError
+        A load or speed that is not positive.
+    """
+    if not (load_kg > 0 and speed_rpm > 0):
+        raise ConfigError(f"API 617 U_r: the load ({load_kg:g} kg) and the maximum "
+                          f"continuous speed ({speed_rpm:g} rpm) must be > 0")
+    return 6350e-6 * load_kg / speed_rpm
+
+
+def vibration_limit_um(speed_rpm: float, cap_um: float = 25.4) -> float:
+    """API 617's A_vl = 25.4·√(12000/N) µm peak-to-peak, at most ``cap_um``."""
+    return min(25.4 * math.sqrt(12000.0 / speed_rpm), cap_um)
+
+
+def amplification_factor(speed_hz: np.ndarray, amp: np.ndarray, i: int
+                         ) -> tuple[float, float, float]:
+    """Half-power amplification factor of the peak ``amp[i]``: ``(AF, N_1, N_2)`` with
+    ``N_1 < speed_hz[i] < N_2`` where ``amp`` falls to ``amp[i]/√2`` (interpolated
+    linearly; NaN where it does not, on that side).
+
+    Parameters
+    ----------
+    speed_hz, amp : ndarray, shape (n,)
+        Speeds (ascending) and response amplitudes.
+    i : int
+        The peak's index.
+    """
+    half = amp[i] / math.sqrt(2.0)
+
+    def cross(idx):
+        for a, b in zip(idx[:-1], idx[1:]):
+            if amp[b] <= half:
+                t = (amp[a] - half) / (amp[a] - amp[b])
+                return float(speed_hz[a] + t * (speed_hz[b] - speed_hz[a]))
+        return math.nan
+
+    n1 = cross(list(range(i, -1, -1)))
+    n2 = cross(list(range(i, amp.size)))
+    return float(speed_hz[i] / (n2 - n1)), n1, n2
+
+
+def required_margin(af: float, below: bool) -> float:
+    """API 617's required separation margin (%) of a critical with amplification factor
+    ``af`` below the minimum (``below``) or above the maximum continuous speed: 0 for
+    AF < 2.5 (module docstring)."""
+    if not af >= AF_NO_MARGIN:
+        return 0.0
+    m = 17.0 * (1.0 - 1.0 / (af - 1.5))
+    return min(16.0, m) if below else min(26.0, 10.0 + m)
+
+
+def _supports(cfg) -> list[float]:
+    zs = sorted({a.position for a in cfg.amb} | {s.position for s in cfg.spring})
+    if not zs:
+        raise ConfigError("API 617 unbalance response: the rig has no [[amb]] or "
+                          "[[spring]] to carry the rotor")
+    return zs
+
+
+def _node_masses(cfg) -> np.ndarray:
+    """Each node's share of the rotor's mass (kg): the consistent mass matrix times a
+    rigid translation."""
+    sys = build_system(cfg, speed_rpm=0.0, include_amb=False, include_seals=False,
+                       include_springs=False)  # the rig's mesh, its modes' nodes
+    t = np.zeros(sys.n_dof)
+    t[1::4] = 1.0
+    return (sys.M @ t)[1::4]
+
+
+def journal_loads(cfg) -> tuple[tuple[float, float], ...]:
+    """The journal static loads: ``((position m, load kg), …)`` per support (AMBs and
+    springs), the reactions of the rotor pinned there under gravity.
+
+    Raises
+    ------
+    ConfigError
+        A rig without a support.
+    """
+    zs = _supports(cfg)
+    pins = [Spring(position=z, kxx=RIGID_SUPPORT, kyy=RIGID_SUPPORT, name=f"pin{i}")
+            for i, z in enumerate(zs)]
+    rig = cfg.model_copy(update={"seal": [], "amb": [], "spring": pins})
+    sys = build_system(rig, speed_rpm=0.0)
+    t = np.zeros(sys.n_dof)
+    t[1::4] = 1.0
+    q = np.linalg.solve(sys.K, GRAVITY * (sys.M @ t))
+    return tuple((z, float(RIGID_SUPPORT * q[4 * sys.mesh.node_at(z) + 1] / GRAVITY))
+                 for z in zs)
+
+
+@dataclass(frozen=True)
+class Critical:
+    """A critical speed found in a probe's response (module docstring)."""
+
+    speed_hz: float
+    probe_m: float
+    amplitude_um: float
+    af: float
+    required_margin_pct: float
+    actual_margin_pct: float
+
+    @property
+    def passed(self) -> bool:
+        """No margin required (AF < 2.5), or the actual one at least the required."""
+        return not self.af >= AF_NO_MARGIN or self.actual_margin_pct >= self.required_margin_pct
+
+    def to_dict(self) -> dict:
+        return {"speed_hz": self.speed_hz, "probe_m": self.probe_m,
+                "amplitude_um_pp": self.amplitude_um, "AF": json_float(self.af),
+                "required_margin_pct": self.required_margin_pct,
+                "actual_margin_pct": self.actual_margin_pct, "passed": self.passed}
+
+
+@dataclass(frozen=True)
+class Clearance:
+    """One close clearance against the scaled response."""
+
+    name: str
+    position_m: float
+    diametral_um: float
+    allowed_um: float
+    scaled_um: float
+
+    @property
+    def passed(self) -> bool:
+        return self.scaled_um <= self.allowed_um
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "position_m": self.position_m,
+                "diametral_clearance_um": self.diametral_um, "allowed_um_pp": self.allowed_um,
+                "scaled_response_um_pp": self.scaled_um, "passed": self.passed}
+
+
+@dataclass(frozen=True)
+class UnbalanceCase:
+    """One mode's unbalance and what its response shows.
+
+    Attributes
+    ----------
+    mode_hz : float
+        The damped frequency of the mode it excites (Hz, at the maximum continuous speed);
+        NaN for the rigid-body shapes placed whatever the modes.
+    placement : str
+        The rule that placed it, in words.
+    unbalances : tuple of Unbalance
+    speed_hz : ndarray, shape (n,)
+        The analysed speeds (Hz).
+    probe_m : tuple of float
+        Probe positions (m).
+    probe_um : ndarray, shape (n, n_probes)
+        Peak-to-peak amplitude at each probe (µm).
+    criticals : tuple of Critical
+    probe_max_um : float
+        The probes' largest amplitude from the minimum continuous to the trip speed (µm
+        p-p).
+    scale_factor : float
+        S_c.
+    clearances : tuple of Clearance
+    """
+
+    mode_hz: float
+    placement: str
+    unbalances: tuple
+    speed_hz: np.ndarray
+    probe_m: tuple
+    probe_um: np.ndarray
+    criticals: tuple
+    probe_max_um: float
+    scale_factor: float
+    clearances: tuple
+
+    def to_dict(self) -> dict:
+        return {"mode_hz": json_float(self.mode_hz), "placement": self.placement,
+                "unbalances": [{"position_m": u.position, "amount_kg_m": u.amount,
+                                "amount_g_mm": u.amount * 1e6, "phase_deg": u.phase_deg}
+                               for u in self.unbalances],
+                "criticals": [c.to_dict() for c in self.criticals],
+                "probe_max_um_pp": self.probe_max_um, "scale_factor": self.scale_factor,
+                "clearances": [c.to_dict() for c in self.clearances]}
+
+
+@dataclass(frozen=True)
+class Api617Unbalance:
+    """The API 617 unbalance response analysis of one controller (module docstring).
+
+    Attributes
+    ----------
+    controller : str
+    min_hz, max_hz, trip_hz, top_hz : float
+        Minimum and maximum continuous, trip and analysed top speed (Hz).
+    journal_loads : tuple of (float, float)
+        (position m, static load kg) per support.
+    vibration_limit_um : float
+        A_vl (µm p-p).
+    cases : tuple of UnbalanceCase
+    """
+
+    controller: str
+    min_hz: float
+    max_hz: float
+    trip_hz: float
+    top_hz: float
+    journal_loads: tuple
+    vibration_limit_um: float
+    cases: tuple
+
+    @property
+    def probe_max_um(self) -> float:
+        return max((c.probe_max_um for c in self.cases), default=0.0)
+
+    @property
+    def separation_passed(self) -> bool:
+        return all(k.passed for c in self.cases for k in c.criticals)
+
+    @property
+    def vibration_passed(self) -> bool:
+        return self.probe_max_um <= self.vibration_limit_um
+
+    @property
+    def clearance_passed(self) -> bool:
+        return all(k.passed for c in self.cases for k in c.clearances)
+
+    @property
+    def passed(self) -> bool:
+        return self.separation_passed and self.vibration_passed and self.clearance_passed
+
+    def to_dict(self) -> dict:
+        """The ``unbalance`` block: SI at the core, µm and % where the standard reads so."""
+        return {"min_continuous_hz": self.min_hz, "max_continuous_hz": self.max_hz,
+                "trip_hz": self.trip_hz, "analysed_to_hz": self.top_hz,
+                "journal_loads": [{"position_m": z, "load_kg": w}
+                                  for z, w in self.journal_loads],
+                "vibration_limit_um_pp": self.vibration_limit_um,
+                "probe_max_um_pp": self.probe_max_um,
+                "separation_passed": self.separation_passed,
+                "vibration_passed": self.vibration_passed,
+                "clearance_passed": self.clearance_passed, "passed": self.passed,
+                "cases": [c.to_dict() for c in self.cases]}
+
+
+def _placements(cfg, modes, loads, factor: float, n_rpm: float) -> list[tuple]:
+    """``(mode_hz, rule, unbalances)`` per forward mode (module docstring), distinct."""
+    zs = [z for z, _ in loads]
+    lo, hi = min(zs), max(zs)
+    node_mass = _node_masses(cfg)
+    z_nodes = modes.node_z_m
+    total = sum(w for _, w in loads)
+    # the impellers (the stages; without stages, the disks) outboard of the supports
+    heavy = ([stage_position(cfg, st) for st in cfg.stage] if cfg.stage
+             else [d.position for d in cfg.disk])
+    outboard = [z for z in heavy if z < lo - 1e-9 or z > hi + 1e-9]
+    inside = (z_nodes >= lo - 1e-9) & (z_nodes <= hi + 1e-9)
+    out, seen = [], set()
+
+    def add(f_hz, rule, unb):
+        key = tuple((round(u.position, 9), u.phase_deg) for u in unb)
+        if key not in seen:
+            seen.add(key)
+            out.append((f_hz, rule, unb))
+
+    # the first and second rigid-body shapes, whatever the loop's modes (an AMB loop may
+    # damp them all beyond resonance): the probes and clearances are judged on them
+    mid = float(z_nodes[int(np.argmin(np.abs(z_nodes - 0.5 * (lo + hi))))])
+    add(math.nan, f"first mode, at mid-span {mid:.3g} m, W = {total:.4g} kg (every "
+        "journal)", (Unbalance(mid, factor * unbalance_ur(total, n_rpm)),))
+    add(math.nan, f"second mode, at the journals {lo:.3g} m and {hi:.3g} m, 180° apart, "
+        "W each journal's load", tuple(
+            Unbalance(z, factor * unbalance_ur(dict(loads)[z], n_rpm), ph)
+            for z, ph in ((lo, 0.0), (hi, 180.0))))
+    for zu in outboard:
+        side = z_nodes < lo - 1e-9 if zu < lo else z_nodes > hi + 1e-9
+        edge = int(np.argmin(np.abs(z_nodes - (lo if zu < lo else hi))))
+        w = float(node_mass[side].sum()) + 0.5 * float(node_mass[edge])
+        add(math.nan, f"overhung: at {zu:.3g} m, W = {w:.4g} kg outboard of the support",
+            (Unbalance(zu, factor * unbalance_ur(w, n_rpm)),))
+    for k in range(modes.poles.size):
+        if modes.whirl[k] == "backward" or modes.damping_ratio[k] >= OVERDAMPED_ZETA:
+            continue
+        X, Y = modes.shapes[k, :, 0], modes.shapes[k, :, 1]
+        a = orbit_semi_major(X, Y)
+        z0 = float(z_nodes[int(np.argmax(a))])
+        over = [z for z in outboard if (z < lo) == (z0 < lo)] if not inside[
+            int(np.argmax(a))] else []
+        if over:
+            zu = min(over, key=lambda z: abs(z - z0))
+            side = z_nodes < lo - 1e-9 if zu < lo else z_nodes > hi + 1e-9
+            edge = int(np.argmin(np.abs(z_nodes - (lo if zu < lo else hi))))
+            w = float(node_mass[side].sum()) + 0.5 * float(node_mass[edge])
+            add(float(modes.frequency_hz[k]), f"overhung: at {zu:.3g} m, W = {w:.4g} kg "
+                "outboard of the support", (Unbalance(zu, factor * unbalance_ur(w, n_rpm)),))
+            continue
+        i0 = int(np.argmax(np.where(inside, a, -1.0)))
+        ref = X[i0] if abs(X[i0]) >= abs(Y[i0]) else Y[i0]
+        both = np.where(np.abs(X) >= np.abs(Y), X, Y)
+        r = np.where(inside, a * np.sign(np.real(both * np.conj(ref))), 0.0)
+        z0 = float(z_nodes[i0])
+        if r.min() < -SIGN_CHANGE * r.max():
+            ip, im = int(np.argmax(r)), int(np.argmin(r))
+            unb = tuple(Unbalance(float(z_nodes[i]), factor * unbalance_ur(
+                dict(loads)[min(zs, key=lambda s: abs(s - z_nodes[i]))], n_rpm), ph)
+                for i, ph in ((ip, 0.0), (im, 180.0)))
+            rule = (f"two antinodes, 180° apart: at {unb[0].position:.3g} m and "
+                    f"{unb[1].position:.3g} m, W the nearest journal's load")
+        else:
+            unb = (Unbalance(z0, factor * unbalance_ur(total, n_rpm)),)
+            rule = f"at its largest antinode {z0:.3g} m, W = {total:.4g} kg (every journal)"
+        add(float(modes.frequency_hz[k]), rule, unb)
+    return out
+
+
+def _close_clearances(cfg) -> list[tuple[str, float, float]]:
+    """(name, position m, radial clearance m) of each seal with a ``clearance`` and each
+    backup bearing (at its AMB)."""
+    out = [(s.name, s.position, s.clearance) for s in cfg.seal if s.clearance is not None]
+    out += [(f"backup bearing {a.name}", a.position, a.backup_clearance)
+            for a in cfg.amb if a.backup_clearance is not None]
+    return out
+
+
+def _criticals(speed, probe_um, probes, f_min, f_max) -> list[Critical]:
+    out = []
+    for p, z in enumerate(probes):
+        amp = probe_um[:, p]
+        if not np.any(amp > 0):
+            continue
+        idx, _ = find_peaks(amp, prominence=(1 - 1 / math.sqrt(2)) * amp)
+        for i in idx:
+            af, _, _ = amplification_factor(speed, amp, int(i))
+            nc = float(speed[i])
+            if nc < f_min:
+                req, act = required_margin(af, True), 100 * (f_min - nc) / f_min
+            elif nc > f_max:
+                req, act = required_margin(af, False), 100 * (nc - f_max) / f_max
+            else:
+                near_low = nc - f_min <= f_max - nc
+                req = required_margin(af, near_low)
+                act = -100 * min(nc - f_min, f_max - nc) / f_max
+            out.append(Critical(nc, float(z), float(amp[i]), af, req, act))
+    # one critical per speed: the probe that shows it largest
+    best: dict = {}
+    for c in out:
+        key = round(c.speed_hz, 6)
+        if key not in best or c.amplitude_um > best[key].amplitude_um:
+            best[key] = c
+    return sorted(best.values(), key=lambda c: c.speed_hz)
+
+
+def api617_unbalance(cfg, controller=None, *, name: str = "none",
+                     progress=None) -> Api617Unbalance:
+    """API 617's unbalance response analysis of a rig with one controller as it runs
+    (module docstring).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig; its speeds from ``[operating]`` (``speed_range_hz``, ``trip_speed_hz``),
+        its limits from ``[signoff]``.
+    controller : DigitalController or ScheduledDigital, optional
+        As it runs; None for a rig on springs alone.
+    name : str
+        The controller's name in the result.
+    progress : callable, optional
+        Called with one line per unbalance case.
+
+    Returns
+    -------
+    Api617Unbalance
+
+    Raises
+    ------
+    ConfigError
+        A rig without supports or a maximum continuous speed of 0.
+    """
+    so = cfg.signoff
+    f_min, f_max = cfg.operating.continuous_hz
+    if not f_max > 0:
+        raise ConfigError("API 617 unbalance response: the maximum continuous speed must be "
+                          "> 0 (set [operating] speed_rpm or speed_range_hz)")
+    trip = cfg.operating.trip_hz
+    top = so.analysis_top_ratio * trip
+    n_rpm = 60.0 * f_max
+    loads = journal_loads(cfg)
+    max_hz = min(top, bending_limit_hz(cfg))
+    if controller is not None and cfg.amb:
+        max_hz = min(max_hz, 0.45 * cfg.controller.sample_rate_hz)
+    modes = modes_as_run(cfg, controller, speed_hz=f_max, max_hz=max_hz)
+    cases = _placements(cfg, modes, loads, so.unbalance_factor, n_rpm)
+    probes = tuple(sorted({a.sensor_position for a in cfg.amb}) if cfg.amb
+                   else [z for z, _ in loads])
+    close = _close_clearances(cfg)
+    where = [*probes, *(z for _, z, _ in close)]
+    a_vl = vibration_limit_um(n_rpm, so.vibration_limit_cap_um)
+    # from standstill: the first speed a step above it (a controller's integrator has no
+    # response at zero frequency)
+    coarse = np.unique(np.concatenate([np.linspace(top / SPEEDS, top, SPEEDS),
+                                       [f_min, f_max, trip]]))
+
+    def response(speeds):
+        r = synchronous_response(cfg, controller, speeds, [u for _, _, u in cases], where)
+        return 2e6 * r.amplitude_m  # µm peak-to-peak
+
+    amp = response(coarse)
+    # each peak refined between its neighbours of the coarse sweep
+    extra = []
+    for c in range(len(cases)):
+        for p in range(len(probes)):
+            for i in find_peaks(amp[c, :, p])[0]:
+                extra.append(np.linspace(coarse[i - 1], coarse[i + 1], REFINE)[1:-1])
+    speed = coarse
+    if extra:
+        fine = np.setdiff1d(np.unique(np.concatenate(extra)), coarse)
+        speed = np.concatenate([coarse, fine])
+        order = np.argsort(speed)
+        speed, amp = speed[order], np.concatenate([amp, response(fine)], axis=1)[:, order]
+    lo_, hi_ = (speed >= f_min - 1e-9) & (speed <= trip + 1e-9), speed <= trip + 1e-9
+    s_lo, s_hi = so.scale_factor_limits
+    out = []
+    for c, (f_mode, rule, unb) in enumerate(cases):
+        pr = amp[c, :, :len(probes)]
+        crit = _criticals(speed, pr, probes, f_min, f_max)
+        a1 = float(pr[hi_].max())
+        sc = float(np.clip(a_vl / a1, s_lo, s_hi)) if a1 > 0 else s_hi
+        clear = tuple(Clearance(n, float(z), 2e6 * rc, so.clearance_fraction * 2e6 * rc,
+                                float(sc * amp[c, hi_, len(probes) + j].max()))
+                      for j, (n, z, rc) in enumerate(close))
+        out.append(UnbalanceCase(f_mode, rule, unb, speed, probes, pr, tuple(crit),
+                                 float(pr[lo_].max()), sc, clear))
+        if progress:
+            progress(f"{name}: unbalance {c + 1}/{len(cases)} ({rule}): "
+                     f"{len(crit)} critical(s), probes ≤ {out[-1].probe_max_um:.3g} µm p-p")
+    return Api617Unbalance(name, f_min, f_max, trip, top, loads, a_vl, tuple(out))

@@ -1,0 +1,87 @@
+"""API 617's unbalance response: U_r, A_vl and the separation margins against hand
+calculations, and a rigid rotor on damped springs against its single-degree-of-freedom
+closed form (AF = 1/(2ζ), the peak U·ω_n/c)."""
+
+from __future__ import annotations
+
+import math
+import tomllib
+
+import pytest
+
+from ambseal.analysis.unbalance_api617 import (
+    amplification_factor,
+    api617_unbalance,
+    journal_loads,
+    required_margin,
+    unbalance_ur,
+    vibration_limit_um,
+)
+from ambseal.config import parse_rig
+
+from .test_analysis_level1 import _rigid_rotor
+
+
+def test_unbalance_ur_by_hand():
+    """U_r = 6350·W/N g·mm: 100 kg at 10 000 rpm is 63.5 g·mm; in US units 4·W/N oz·in
+    (W in lb): 220.46 lb → 0.088 oz·in = 63.5 g·mm (1 oz·in = 720.08 g·mm)."""
+    assert unbalance_ur(100.0, 10000.0) == pytest.approx(63.5e-6)
+    assert unbalance_ur(100.0, 10000.0) * 1e6 == pytest.approx(
+        4 * 220.462 / 10000.0 * 720.078, rel=1e-3)
+
+
+@pytest.mark.parametrize("rpm, um", [(12000.0, 25.4), (3000.0, 25.4),
+                                     (20000.0, 25.4 * math.sqrt(0.6))])
+def test_vibration_limit_by_hand(rpm, um):
+    assert vibration_limit_um(rpm) == pytest.approx(um)
+
+
+@pytest.mark.parametrize("af, below, above", [
+    (2.4, 0.0, 0.0), (4.0, 10.2, 20.2), (30.0, 16.0, 26.0),
+])
+def test_required_separation_margins_by_hand(af, below, above):
+    """17(1 − 1/(AF − 1.5)) below the minimum speed (≤ 16 %), 10 more above the maximum
+    (≤ 26 %); none under AF 2.5."""
+    assert required_margin(af, True) == pytest.approx(below)
+    assert required_margin(af, False) == pytest.approx(above)
+
+
+def test_half_power_af_of_a_sampled_resonance():
+    """A single-degree-of-freedom amplitude 1/|1 − r² + 2jζr| sampled finely: AF = 1/(2ζ)
+    to the order ζ."""
+    import numpy as np
+
+    zeta = 0.02
+    r = np.linspace(0.5, 1.5, 20001)
+    amp = 1 / np.abs(1 - r**2 + 2j * zeta * r)
+    af, n1, n2 = amplification_factor(r, amp, int(np.argmax(amp)))
+    assert af == pytest.approx(1 / (2 * zeta), rel=2 * zeta) and n1 < 1 < n2
+
+
+def test_rigid_rotor_on_damped_springs_is_the_closed_form():
+    """The rotor of the Level I test (m ≈ 98.6 kg on k = 1e7 N/m, c = 2000 N·s/m, 3000 rpm
+    continuous): journal loads m/2; the mid-span case 2·U_r with W = m; its critical at
+    ω_n = √(k/m) with AF = 1/(2ζ) within 1 %, the peak 2·U·ω_n/c peak-to-peak within 1 %;
+    the separation margin 100·(N_c − N)/N against the required min(26, 10 + 17(1 −
+    1/(AF − 1.5))); the vibration limit exceeded (133 µm > 25.4 µm)."""
+    k, c = 1e7, 2000.0
+    cfg = parse_rig(tomllib.loads(_rigid_rotor(k, c, 4.5e4)))
+    m = math.pi / 4 * 0.2**2 * 0.4 * 7850.0
+    loads = journal_loads(cfg)
+    assert [w for _, w in loads] == pytest.approx([m / 2, m / 2], rel=1e-3)
+    r = api617_unbalance(cfg)
+    first = r.cases[0]
+    (u,) = first.unbalances
+    U = 2 * 6350e-6 * m / 3000.0
+    assert u.position == pytest.approx(0.2) and u.amount == pytest.approx(U, rel=1e-3)
+    (crit,) = first.criticals
+    wn = math.sqrt(k / m)
+    zeta = c / (2 * math.sqrt(k * m))
+    assert crit.speed_hz == pytest.approx(wn / (2 * math.pi), rel=0.01)
+    assert crit.af == pytest.approx(1 / (2 * zeta), rel=0.01)
+    assert crit.amplitude_um == pytest.approx(2e6 * U * wn / c, rel=0.01)
+    assert crit.actual_margin_pct == pytest.approx(100 * (crit.speed_hz - 50.0) / 50.0)
+    assert crit.required_margin_pct == pytest.approx(required_margin(crit.af, False))
+    assert not crit.passed and not r.separation_passed
+    assert r.vibration_limit_um == 25.4 and not r.vibration_passed and not r.passed
+    assert r.trip_hz == pytest.approx(1.05 * 50.0) and r.top_hz == pytest.approx(1.25 * 52.5)

@@ -26,20 +26,33 @@ def test_signoff_json_files_and_exit_status(tmp_path, capsys):
     doc = json.loads(out)
     lv = doc["controllers"]["none"]["level1"]
     assert set(lv) >= {"Q_A", "Q_0", "log_dec_A", "CSR", "passed", "rule"}
+    block = doc["controllers"]["none"]
+    assert set(block) >= {"passed", "criteria", "level2", "unbalance", "iso14839_2"}
+    assert doc["verdict"].startswith("Sign-off NOT passed") and not block["passed"]
+    names = [c["criterion"] for c in block["criteria"]]
+    assert names == ["stability, Level I", "stability, Level II", "separation margins",
+                     "vibration at the probes", "close clearances", "vibration zone"]
+    assert all(c["source"] for c in block["criteria"])
     m = math.pi / 4 * 0.2**2 * 0.4 * 7850.0
     assert lv["Q_0"] == pytest.approx(2000.0 * math.sqrt(1e7 / m), rel=0.02)
     assert lv["passed"] is False and doc["passed"] is False and "Level II" in lv["rule"]
-    assert all((tmp_path / "so" / n).is_file() for n in ("signoff.json", "level1.png"))
+    assert all((tmp_path / "so" / n).is_file()
+               for n in ("signoff.json", "level1.png", "unbalance.png"))
     assert json.loads((tmp_path / "so" / "signoff.json").read_text())["controllers"] == \
         doc["controllers"]
 
 
 def test_signoff_passes_with_exit_status_0(tmp_path, capsys):
+    """Supports ten times stiffer and damped at ζ ≈ 0.1: the critical far above the trip
+    speed, the response at the probes a micrometre, Q_0 beyond 10·Q_A: every criterion
+    passed, the verdict first."""
     rig = tmp_path / "rigid.toml"
-    rig.write_text(_rigid_rotor(1e7, 2000.0, 8.0e3))
+    rig.write_text(_rigid_rotor(1e8, 2.0e4, 8.0e3))
     code = main(["signoff", str(rig), "--out", str(tmp_path / "so")])
     out, _ = capsys.readouterr()
-    assert code == 0 and out.startswith("none: Level I passed")
+    lines = out.splitlines()
+    assert code == 0 and lines[0].startswith("Sign-off PASSED")
+    assert lines[1].startswith("none: stability, Level I: passed")
 
 
 @pytest.mark.parametrize("args, says", [
@@ -58,21 +71,21 @@ def test_signoff_refuses_plainly(tmp_path, capsys, args, says):
 
 def test_the_reports_signoff_section_says_the_verdict_first(tmp_path):
     """The run report's section: the overall verdict before the table, one row per
-    controller with its rule; the figure is written."""
+    controller and criterion with its source; the Level II table; both figures."""
     import tomllib
 
-    from ambseal.analysis import level1_screening
+    from ambseal.analysis import sign_off
     from ambseal.config import parse_rig
     from ambseal.report import signoff_report
 
-    ok = level1_screening(parse_rig(tomllib.loads(_rigid_rotor(1e7, 2000.0, 8.0e3))),
-                          name="a")
-    bad = level1_screening(parse_rig(tomllib.loads(_rigid_rotor(1e7, 2000.0, 2.0e5))),
-                           name="b")
+    ok = sign_off(parse_rig(tomllib.loads(_rigid_rotor(1e8, 2.0e4, 8.0e3))), name="a")
+    bad = sign_off(parse_rig(tomllib.loads(_rigid_rotor(1e7, 2000.0, 2.0e5))), name="b")
+    assert ok.passed and not bad.passed
     figs, sections = signoff_report(tmp_path, [ok, bad], "rigid")
     text = sections[0]["html"]
-    assert text.index("NOT passed") < text.index("<table>") and "b require" in text
-    assert text.count("<tr><td>") == 2 and "δ_A = 0.0497 &lt; 0.1: Level II required" in text
-    assert figs[0][1].is_file()
+    assert text.index("Sign-off NOT passed — b: ") < text.index("<table>")
+    assert text.count("<tr><td>") == 2 * 6 + 2 * 3  # criteria, then Level II rows
+    assert "API 617 (8th ed., 2014) Part 1 §4.8.2, A_vl" in text
+    assert all(png.is_file() for _, png in figs) and len(figs) == 2
     _, passed = signoff_report(tmp_path, [ok], "rigid")
-    assert "passed by every controller" in passed[0]["html"]
+    assert "Sign-off PASSED" in passed[0]["html"]

@@ -365,8 +365,9 @@ def _rotordynamics_parsers(sub) -> None:
     s.add_argument("--out", default="ambseal-sweep", help="output folder")
     _executor_args(s)
 
-    so = sub.add_parser("signoff", help="sign a machine off: API 617 Level I stability "
-                                        "screening with each controller as it runs")
+    so = sub.add_parser("signoff", help="sign a machine off: API 617 stability (Level I "
+                                        "and II) and unbalance response, ISO 14839-2 "
+                                        "zones, with each controller as it runs")
     so.add_argument("rig", help="rig file (TOML) with its [[stage]] tables")
     sg = so.add_mutually_exclusive_group()
     sg.add_argument("--method", default=None,
@@ -377,7 +378,8 @@ def _rotordynamics_parsers(sub) -> None:
                     help="a controller file of ambseal design (.json, .npz, .mat)")
     so.add_argument("--out", default="ambseal-signoff", help="output folder")
     so.add_argument("--json", action="store_true",
-                    help="print one JSON object (per controller its level1 block)")
+                    help="print one JSON object (per controller its criteria and the "
+                         "level1, level2, unbalance and iso14839_2 blocks)")
 
     r = sub.add_parser("import-ross", help="a ROSS rotor file (.toml/.json) as an ambseal rig")
     r.add_argument("file", help="ROSS rotor file saved by ross.Rotor.save")

@@ -24,6 +24,8 @@ sampled with its delay) on the full-order plant:
   (:func:`ambseal.analysis.campbell.campbell` → :class:`Campbell`);
 * :func:`level1_screening` → :class:`Level1`, :func:`stage_cross_coupling` — API 617's Level I
   stability screening with each controller as it runs;
+* :func:`sign_off` → :class:`SignOff`, :func:`verdict_line` — every criterion of API 617
+  and ISO 14839-2 per controller (:func:`iso14839_2_zones` → :class:`IsoVibration`);
 * :func:`level2_analysis` → :class:`Level2` — API 617's Level II table, component by
   component;
 * :func:`api617_unbalance` → :class:`Api617Unbalance` — API 617's unbalance response,
@@ -67,7 +69,9 @@ _FROM = {
     "judge_case": "judge", "judge_jobs": "judge", "judge_settings": "judge",
     "judge_spinup": "judge", "operating_points": "judge", "points_for": "judge",
     "level1_screening": "level1", "stage_cross_coupling": "level1", "Level1": "level1",
-    "level2_analysis": "level2", "Level2": "level2",
+    "level2_analysis": "level2", "Level2": "level2", "sign_off": "signoff",
+    "SignOff": "signoff", "verdict_line": "signoff", "iso14839_2_zones": "iso_vibration",
+    "IsoVibration": "iso_vibration",
     "api617_unbalance": "unbalance_api617", "Api617Unbalance": "unbalance_api617",
     "synchronous_response": "synchronous", "Unbalance": "synchronous",
     "speed_scheduled": "judge", "unstable_open_loop_poles": "judge", "JudgeJob": "judge",

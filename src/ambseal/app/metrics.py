@@ -27,7 +27,7 @@ __all__ = ["SCHEMA_VERSION", "SCHEMA_PATH", "OpenLoop", "ControllerSummary", "Ru
            "metrics_schema", "schema_text"]
 
 #: Version of the ``metrics.json`` document (module docstring).
-SCHEMA_VERSION = "1.4.0"
+SCHEMA_VERSION = "1.5.0"
 #: The JSON Schema shipped with the package.
 SCHEMA_PATH = Path(__file__).resolve().parents[1] / "data" / "metrics.schema.json"
 
@@ -101,6 +101,84 @@ class ControllerSummary:
 
 
 @dataclass(frozen=True)
+class SignoffCriterion:
+    """One criterion of a controller's sign-off.
+
+    Attributes
+    ----------
+    criterion : str
+        ``stability, Level I``, ``stability, Level II``, ``separation margins``,
+        ``vibration at the probes``, ``close clearances`` or ``vibration zone``.
+    value, limit : str
+        Its value and its limit, in words with their units.
+    source : str
+        The standard, edition and clause.
+    passed : bool
+    counts : bool
+        Whether it decides the verdict (the stability is Level I's where it passes, else
+        Level II's).
+    """
+
+    criterion: str
+    value: str
+    limit: str
+    source: str
+    passed: bool
+    counts: bool
+
+
+@dataclass(frozen=True)
+class SignoffController:
+    """One controller's sign-off (:class:`ambseal.analysis.signoff.SignOff`).
+
+    Attributes
+    ----------
+    passed : bool
+        Every criterion that counts passed.
+    criteria : list of SignoffCriterion
+    level1, level2, unbalance, iso14839_2 : dict
+        The analyses: :meth:`ambseal.analysis.level1.Level1.to_dict`,
+        :meth:`ambseal.analysis.level2.Level2.to_dict`,
+        :meth:`ambseal.analysis.unbalance_api617.Api617Unbalance.to_dict`,
+        :meth:`ambseal.analysis.iso_vibration.IsoVibration.to_dict`.
+    """
+
+    passed: bool
+    criteria: list[SignoffCriterion]
+    level1: dict[str, Any]
+    level2: dict[str, Any]
+    unbalance: dict[str, Any]
+    iso14839_2: dict[str, Any]
+
+
+@dataclass(frozen=True)
+class Signoff:
+    """The machine's sign-off: API 617 and ISO 14839-2 per delivered controller.
+
+    Attributes
+    ----------
+    passed : bool
+        Every controller passed.
+    verdict : str
+        The one line a manager reads first.
+    controllers : dict of str to SignoffController
+    """
+
+    passed: bool
+    verdict: str
+    controllers: dict[str, SignoffController]
+
+    @classmethod
+    def of(cls, results, verdict: str) -> "Signoff":
+        """From :class:`ambseal.analysis.signoff.SignOff` results and their verdict."""
+        return cls(all(r.passed for r in results), verdict, {
+            r.controller: SignoffController(
+                r.passed, [SignoffCriterion(**c.to_dict()) for c in r.criteria],
+                r.level1.to_dict(), r.level2.to_dict(), r.unbalance.to_dict(),
+                r.iso14839_2.to_dict()) for r in results})
+
+
+@dataclass(frozen=True)
 class RunMetrics:
     """The document ``ambseal run`` writes as ``metrics.json``.
 
@@ -130,10 +208,9 @@ class RunMetrics:
     identification, spinup, ramp : dict, optional
         The identification on the virtual facility, the spin-up of a speed-scheduled rig,
         the pressure ramp of the tracked controller — when the run did them.
-    signoff : dict, optional
-        A rig with ``[[stage]]`` tables: API 617's Level I screening of each delivered
-        controller as it runs (``passed``, and ``level1`` per controller:
-        :meth:`ambseal.analysis.level1.Level1.to_dict`).
+    signoff : Signoff, optional
+        A rig with ``[[stage]]`` tables: the sign-off of each delivered controller as it
+        runs (API 617 stability and unbalance response, ISO 14839-2).
     """
 
     schema_version: str
@@ -150,7 +227,7 @@ class RunMetrics:
     identification: dict[str, Any] | None = None
     spinup: dict[str, Any] | None = None
     ramp: dict[str, Any] | None = None
-    signoff: dict[str, Any] | None = None
+    signoff: Signoff | None = None
 
     def to_dict(self) -> dict:
         """The JSON document (sections the run did not do are left out)."""
@@ -164,9 +241,11 @@ class RunMetrics:
              "cannot_run": self.cannot_run, "cases": [c.to_dict() for c in self.cases],
              "stability": [c.to_dict() for c in self.stability],
              "failed": {m: asdict(f) for m, f in self.failed.items()}}
-        for key in ("identification", "spinup", "ramp", "signoff"):
+        for key in ("identification", "spinup", "ramp"):
             if getattr(self, key) is not None:
                 d[key] = getattr(self, key)
+        if self.signoff is not None:
+            d["signoff"] = asdict(self.signoff)
         return d
 
 

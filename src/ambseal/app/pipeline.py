@@ -22,15 +22,16 @@ from ambseal.analysis import (
     judge_jobs,
     judge_settings,
     judge_spinup,
-    level1_screening,
     loop_failure,
     operating_points,
     run_cases,
+    sign_off,
     speed_scheduled,
     stability_case,
     stability_points,
     synthesis_failure,
     unstable_open_loop_poles,
+    verdict_line,
 )
 from ambseal.app.commands import (
     Designed,
@@ -41,7 +42,13 @@ from ambseal.app.commands import (
     facility_impulses,
     identification_stage,
 )
-from ambseal.app.metrics import SCHEMA_VERSION, ControllerSummary, OpenLoop, RunMetrics
+from ambseal.app.metrics import (
+    SCHEMA_VERSION,
+    ControllerSummary,
+    OpenLoop,
+    RunMetrics,
+    Signoff,
+)
 from ambseal.app.remedies import remedy
 from ambseal.app.tracked import tracked_designs, tracked_ramp
 from ambseal.config import (
@@ -476,15 +483,14 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
         figs += spinup_figures(out, sims, sens, cfg.operating.speed_range_hz)
         stages.step()
     signoff = None
-    if cfg.stage:  # the machine's stages are given: API 617's Level I, as it runs
-        stages.begin("signoff", "API 617 Level I")
-        results = [level1_screening(cfg, g, name=m, progress=lambda s: st.say(s, 0))
+    if cfg.stage:  # the machine's stages are given: its sign-off, as it runs
+        stages.begin("signoff", "API 617 and ISO 14839-2")
+        results = [sign_off(cfg, g, name=m, progress=lambda s: st.say(s, 0))
                    for m, g in st.digitals.items()
                    if m not in held and m not in st.cannot_run
                    and getattr(g, "parameter", SPEED) == SPEED]
         if results:
-            signoff = {"passed": all(r.passed for r in results),
-                       "level1": {r.controller: r.to_dict() for r in results}}
+            signoff = Signoff.of(results, verdict_line(results))
             more_figs, more_sections = signoff_report(out, results, cfg.rotor.name)
             figs, sections = figs + more_figs, more_sections + sections
         stages.step()

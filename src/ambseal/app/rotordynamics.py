@@ -31,7 +31,9 @@ from ambseal.analysis import (
     parse_range,
     probe_scheduler,
     refine_boundary,
+    sign_off,
     stability_boundary,
+    verdict_line,
 )
 from ambseal.analysis.campbell import campbell
 from ambseal.analysis.sweep import sweep
@@ -57,6 +59,7 @@ from ambseal.report import (
     level1_figure,
     mode_shapes_figure,
     stability_map_figure,
+    unbalance_figure,
 )
 
 __all__ = ["HANDLERS", "write_table"]
@@ -227,24 +230,28 @@ def _signoff(args: argparse.Namespace) -> int:
     if not cfg.stage:  # before any design
         level1_screening(cfg)  # raises the error that names the missing [[stage]]
     say = logging.getLogger("ambseal").info
-    results = [level1_screening(cfg, K, name=name, progress=say)
+    results = [sign_off(cfg, K, name=name, progress=say)
                for name, K in _signoff_controllers(cfg, args)]
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     doc = {"rig": str(args.rig), "machine": cfg.machine.kind,
-           "passed": all(r.passed for r in results),
-           "controllers": {r.controller: {"level1": r.to_dict()} for r in results}}
+           "passed": all(r.passed for r in results), "verdict": verdict_line(results),
+           "controllers": {r.controller: r.to_dict() for r in results}}
     files = [write_json(out / "signoff.json", doc),
-             level1_figure(out / "level1.png", results,
-                           title=f"API 617 Level I — {cfg.rotor.name}")]
+             level1_figure(out / "level1.png", [r.level1 for r in results],
+                           title=f"API 617 Level I — {cfg.rotor.name}"),
+             unbalance_figure(out / "unbalance.png", [r.unbalance for r in results],
+                              title=f"API 617 unbalance response — {cfg.rotor.name}")]
     if args.json:
         print(json.dumps({**doc, "files": [str(f) for f in files]}))
     else:
+        print(doc["verdict"])
         for r in results:
-            q0 = f"{r.Q_0:.4g} N/m" if r.Q_0 is not None else f"above {r.Q[-1]:.4g} N/m"
-            print(f"{r.controller}: Level I {'passed' if r.passed else 'NOT passed'} — "
-                  f"Q_A = {r.Q_A:.4g} N/m, δ_A = {r.log_dec_A:.3g}, Q_0 = {q0}, "
-                  f"CSR = {r.csr:.3g}; {r.rule}")
+            for c in r.criteria:
+                state = ("passed" if c.passed else "FAILED") if c.counts else (
+                    "not counted")
+                print(f"{r.controller}: {c.name}: {state} — {c.value} (limit {c.limit}; "
+                      f"{c.source})")
         print(f"files: {', '.join(str(f) for f in files)}")
     return 0 if doc["passed"] else 1
 

@@ -1,5 +1,6 @@
-"""A machine's sign-off in the report: API 617's Level I screening as a figure (matplotlib,
-Agg canvas, written through :func:`ambseal.report.figures.save_figure`) and a section."""
+"""A machine's sign-off in the report: API 617's Level I screening and unbalance response
+as figures (matplotlib, Agg canvas, written through
+:func:`ambseal.report.figures.save_figure`) and a section that says the verdict first."""
 
 from __future__ import annotations
 
@@ -10,9 +11,10 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
+from ambseal.analysis import verdict_line
 from ambseal.report.figures import save_figure
 
-__all__ = ["level1_figure", "signoff_report"]
+__all__ = ["level1_figure", "unbalance_figure", "signoff_report"]
 
 
 def level1_figure(path: str | os.PathLike, results, *,
@@ -53,19 +55,66 @@ def level1_figure(path: str | os.PathLike, results, *,
     return save_figure(fig, path, tight=True)
 
 
+def unbalance_figure(path: str | os.PathLike, results, *,
+                     title: str = "API 617 unbalance response") -> Path:
+    """The probes' peak-to-peak response against speed: one panel per controller, one
+    line per unbalance case (the largest probe), with A_vl, the minimum and maximum
+    continuous and the trip speed, and each critical marked with its AF.
+
+    Parameters
+    ----------
+    path : path-like
+        The PNG to write.
+    results : sequence of ambseal.analysis.unbalance_api617.Api617Unbalance
+        One per controller.
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The PNG written.
+    """
+    n = len(results)
+    fig = Figure(figsize=(8, 2.6 + 2.2 * n))
+    axes = np.atleast_1d(fig.subplots(n, 1, squeeze=False)[:, 0])
+    for ax, r in zip(axes, results):
+        for i, c in enumerate(r.cases):
+            ax.semilogy(c.speed_hz * 60.0, c.probe_um.max(axis=1), lw=1.2,
+                        label=f"case {i + 1}: {c.placement}"[:70])
+            for k in c.criticals:
+                ax.plot(k.speed_hz * 60.0, k.amplitude_um, "kv", ms=5)
+                ax.annotate(f"AF {k.af:.3g}", (k.speed_hz * 60.0, k.amplitude_um),
+                            textcoords="offset points", xytext=(4, 4), fontsize=7)
+        ax.axhline(r.vibration_limit_um, color="r", ls="--", lw=1.0,
+                   label=f"A_vl = {r.vibration_limit_um:.3g} µm p-p")
+        ax.axvspan(60.0 * r.min_hz, 60.0 * r.max_hz, color="0.85", alpha=0.6,
+                   label="continuous speed range")
+        ax.axvline(60.0 * r.trip_hz, color="0.3", ls=":", lw=1.0, label="trip speed")
+        ax.set_ylabel("probe response (µm p-p)")
+        ax.set_title(f"{r.controller}: {'passed' if r.passed else 'NOT passed'}",
+                     fontsize=9)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7, loc="lower right")
+    axes[-1].set_xlabel("speed (rpm)")
+    fig.suptitle(title, fontsize=10)
+    return save_figure(fig, path, tight=True)
+
+
 def signoff_report(out: Path, results, rig_name: str) -> tuple[list, list]:
-    """The run report's sign-off: the Level I figure (``level1.png`` in ``out``) and a
-    section whose first line is the overall verdict, then per controller each criterion,
-    its value, its limit and the rule that decided.
+    """The run report's sign-off: the figures (``level1.png``, ``unbalance.png`` in
+    ``out``) and a section whose first line is the overall verdict, then per controller
+    every criterion, its value, its limit, its source and pass/fail, and the Level II
+    table.
 
     Parameters
     ----------
     out : Path
-        The run's folder.
-    results : sequence of ambseal.analysis.level1.Level1
-        One per delivered controller.
+        The folder the figures go to.
+    results : sequence of ambseal.analysis.signoff.SignOff
+        One per controller.
     rig_name : str
-        For the figure's title.
+        For the figures' titles.
 
     Returns
     -------
@@ -73,30 +122,40 @@ def signoff_report(out: Path, results, rig_name: str) -> tuple[list, list]:
         ``[(caption, png)]`` and ``[{"title", "html"}]`` for
         :func:`ambseal.report.run_report.write_run_report`.
     """
-    png = level1_figure(out / "level1.png", results, title=f"API 617 Level I — {rig_name}")
+    esc = html.escape
+    l1 = level1_figure(out / "level1.png", [r.level1 for r in results],
+                       title=f"API 617 Level I — {rig_name}")
+    unb = unbalance_figure(out / "unbalance.png", [r.unbalance for r in results],
+                           title=f"API 617 unbalance response — {rig_name}")
     ok = all(r.passed for r in results)
-    head = ("<p><b>API 617 Level I: passed by every controller</b> — no Level II analysis "
-            "required.</p>" if ok else
-            "<p><b>API 617 Level I: NOT passed</b> — " + html.escape(", ".join(
-                r.controller for r in results if not r.passed)) + " require(s) Level II.</p>")
+    head = f"<p><b>{esc(verdict_line(results))}</b></p>"
     rows = []
     for r in results:
-        q0 = f"{r.Q_0:.4g}" if r.Q_0 is not None else f"&gt; {r.Q[-1]:.4g}"
-        rows.append(
-            f"<tr><td>{html.escape(r.controller)}</td><td>{r.Q_A:.4g}</td>"
-            f"<td>{r.log_dec_A:.3g} (≥ 0.1)</td><td>{q0}</td>"
-            f"<td>{r.ratio:.3g} (≥ 2; ≥ 10 passes)</td><td>{r.csr:.3g}</td>"
-            f"<td>{'passed' if r.passed else 'Level II'}</td>"
-            f"<td class=\"text\">{html.escape(r.rule)}</td></tr>")
-    table = ("<table><tr><th>controller</th><th>Q_A (N/m)</th><th>δ_A</th>"
-             "<th>Q_0 (N/m)</th><th>Q_0/Q_A</th><th>CSR</th><th>outcome</th>"
-             "<th>rule</th></tr>" + "".join(rows) + "</table>")
-    note = ("<p>API 617 (8th ed., 2014) Level I: anticipated cross-coupling Q_A from the "
-            "rig's stages, applied cross-coupling swept to 10·Q_A at the maximum "
-            "continuous speed with the seals left out, each controller as it runs. The "
-            "critical speed ratio's Region A/B is not evaluated: 2 ≤ Q_0/Q_A &lt; 10 "
-            "requires Level II.</p>")
-    caption = ("API 617 Level I: log decrement of the screened forward mode against the "
-               "applied cross-coupling Q/Q_A, per controller")
-    return [(caption, png)], [{"title": "Sign-off: API 617 Level I stability",
-                               "html": head + note + table}]
+        for c in r.criteria:
+            state = ("passed" if c.passed else "FAILED") if c.counts else (
+                "passed" if c.passed else "not needed" if c.name.endswith("II")
+                else "Level II decides")
+            rows.append(f"<tr><td>{esc(r.controller)}</td><td>{esc(c.name)}</td>"
+                        f"<td class=\"text\">{esc(c.value)}</td><td class=\"text\">"
+                        f"{esc(c.limit)}</td><td class=\"text\">{esc(c.source)}</td>"
+                        f"<td>{state}</td></tr>")
+    table = ("<table><tr><th>controller</th><th>criterion</th><th>value</th><th>limit</th>"
+             "<th>source</th><th>outcome</th></tr>" + "".join(rows) + "</table>")
+    l2 = "".join(
+        f"<tr><td>{esc(r.controller)}</td><td>{esc(row.component)}</td>"
+        f"<td>{row.frequency_hz:.4g}</td><td>{row.log_dec:.3g}</td>"
+        f"<td>{'yes' if row.stable else 'NO'}</td></tr>"
+        for r in results for row in r.level2.rows)
+    level2 = ("<p>API 617 Level II at the maximum continuous speed, component by "
+              "component (first forward mode):</p><table><tr><th>controller</th>"
+              "<th>loop with</th><th>f (Hz)</th><th>δ</th><th>stable</th></tr>" + l2 +
+              "</table>")
+    note = ("<p>Each controller as it runs (the discrete controller with its delay). "
+            "Limits the standards' public text could not confirm are the rig file's "
+            "<code>[signoff]</code> settings.</p>")
+    figures = [("API 617 Level I: log decrement of the screened forward mode against the "
+                "applied cross-coupling Q/Q_A, per controller", l1),
+               ("API 617 unbalance response at the probes, per controller and case, with "
+                "A_vl and the speed range", unb)]
+    title = "Sign-off: API 617 and ISO 14839-2" + ("" if ok else " — NOT passed")
+    return figures, [{"title": title, "html": head + table + level2 + note}]

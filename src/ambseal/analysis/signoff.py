@@ -1,0 +1,206 @@
+"""A machine's sign-off: every criterion of API 617 and ISO 14839-2 per controller.
+
+Per controller as it runs (the discrete controller with its computation delay; ``None``
+for a rig on springs alone):
+
+============================  ==========================================  ==============
+criterion                     limit                                       source
+============================  ==========================================  ==============
+stability, Level I            δ_A ≥ 0.1, Q_0/Q_A ≥ 2; ≥ 10 or Region A    API 617 (8th ed., 2014) Part 1, Level I; API 684 (2nd ed.) SP6.8.5
+stability, Level II           δ ≥ 0.1 with every source                   API 617 (8th ed.) Part 1, Level II
+separation margins            each critical's SM ≥ the required           API 617 (8th ed.) Part 1 §4.8.2 (lateral analysis)
+vibration at the probes       ≤ A_vl from minimum to trip speed           API 617 (8th ed.) Part 1 §4.8.2
+close clearances              S_c·response ≤ 75 % of the clearance        API 617 (8th ed.) Part 1 §4.8.2.11 (S_c)
+vibration zone                zone A or B at every AMB sensor             ISO 14839-2:2004
+============================  ==========================================  ==============
+
+The stability holds when Level I passes or, where Level I asks for it, Level II passes;
+the machine passes when every controller meets every criterion. The clause numbers are
+those ROSS's API report tool cites; where a limit could not be confirmed from the
+standards' public text it is a ``[signoff]`` setting (:class:`ambseal.config.rig.Signoff`).
+The modules: :mod:`~ambseal.analysis.level1`, :mod:`~ambseal.analysis.level2`,
+:mod:`~ambseal.analysis.unbalance_api617`, :mod:`~ambseal.analysis.iso_vibration`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ambseal.analysis.iso_vibration import iso14839_2_zones
+from ambseal.analysis.level1 import RATIO_FREE, RATIO_MIN, level1_screening
+from ambseal.analysis.level2 import level2_analysis
+from ambseal.analysis.unbalance_api617 import AF_NO_MARGIN, api617_unbalance
+
+__all__ = ["Criterion", "SignOff", "sign_off", "verdict_line", "CLAUSES"]
+
+#: The source of each criterion (module docstring).
+CLAUSES = {
+    "level1": "API 617 (8th ed., 2014) Part 1, stability Level I; API 684 (2nd ed.) SP6.8.5",
+    "level2": "API 617 (8th ed., 2014) Part 1, stability Level II",
+    "separation": "API 617 (8th ed., 2014) Part 1 §4.8.2, unbalance response",
+    "vibration": "API 617 (8th ed., 2014) Part 1 §4.8.2, A_vl",
+    "clearance": "API 617 (8th ed., 2014) Part 1 §4.8.2.11, scale factor S_c",
+    "iso14839_2": "ISO 14839-2:2004, vibration zones",
+}
+
+
+@dataclass(frozen=True)
+class Criterion:
+    """One line of the sign-off: ``name``, its ``value`` and ``limit`` in words,
+    ``source`` (edition and clause), ``passed``, and whether it ``counts`` for the verdict
+    (the stability is Level I's where it passes, else Level II's)."""
+
+    name: str
+    value: str
+    limit: str
+    source: str
+    passed: bool
+    counts: bool = True
+
+    def to_dict(self) -> dict:
+        return {"criterion": self.name, "value": self.value, "limit": self.limit,
+                "source": self.source, "passed": self.passed, "counts": self.counts}
+
+
+@dataclass(frozen=True)
+class SignOff:
+    """Every sign-off analysis of one controller and its criteria (module docstring).
+
+    Attributes
+    ----------
+    controller : str
+    level1 : ambseal.analysis.level1.Level1
+    level2 : ambseal.analysis.level2.Level2
+    unbalance : ambseal.analysis.unbalance_api617.Api617Unbalance
+    iso14839_2 : ambseal.analysis.iso_vibration.IsoVibration
+    criteria : tuple of Criterion
+    """
+
+    controller: str
+    level1: object
+    level2: object
+    unbalance: object
+    iso14839_2: object
+    criteria: tuple
+
+    @property
+    def passed(self) -> bool:
+        return all(c.passed for c in self.criteria if c.counts)
+
+    @property
+    def failed(self) -> list[str]:
+        return [c.name for c in self.criteria if c.counts and not c.passed]
+
+    def to_dict(self) -> dict:
+        """The controller's sign-off block: ``passed``, ``criteria`` and each analysis."""
+        return {"passed": self.passed, "criteria": [c.to_dict() for c in self.criteria],
+                "level1": self.level1.to_dict(), "level2": self.level2.to_dict(),
+                "unbalance": self.unbalance.to_dict(),
+                "iso14839_2": self.iso14839_2.to_dict()}
+
+
+def _criteria(cfg, l1, l2, unb, iso) -> tuple:
+    d_min = cfg.signoff.log_dec_min
+    q0 = "none up to 10·Q_A" if l1.Q_0 is None else f"Q_0/Q_A = {l1.ratio:.3g}"
+    rows = [Criterion("stability, Level I",
+                      f"δ_A = {l1.log_dec_A:.3g}, {q0}, CSR {l1.csr:.3g} (Region "
+                      f"{l1.region})",
+                      f"δ_A ≥ {d_min:g}, Q_0/Q_A ≥ {RATIO_MIN:g}; ≥ {RATIO_FREE:g} or "
+                      "Region A", CLAUSES["level1"], l1.passed, counts=l1.passed)]
+    last = l2.rows[-1]
+    rows.append(Criterion("stability, Level II",
+                          f"δ = {last.log_dec:.3g} at {last.frequency_hz:.4g} Hz"
+                          + ("" if last.stable else ", loop UNSTABLE"),
+                          f"δ ≥ {d_min:g} with every source", CLAUSES["level2"], l2.passed,
+                          counts=not l1.passed))
+    crit = [k for c in unb.cases for k in c.criticals]
+    sharp = [k for k in crit if k.af >= AF_NO_MARGIN]
+    worst = min(sharp, key=lambda k: k.actual_margin_pct - k.required_margin_pct,
+                default=None)
+    if not crit:
+        value = f"no critical speed up to {unb.top_hz:.4g} Hz"
+    elif worst is None:
+        value = (f"{len(crit)} critical(s), none with AF ≥ {AF_NO_MARGIN:g} (largest AF "
+                 f"{max(k.af for k in crit):.3g}): no margin required")
+    else:
+        value = (f"{len(crit)} critical(s); tightest at {worst.speed_hz:.4g} Hz: AF "
+                 f"{worst.af:.3g}, SM {worst.actual_margin_pct:.3g} % (required "
+                 f"{worst.required_margin_pct:.3g} %)")
+    rows.append(Criterion(
+        "separation margins", value,
+        "SM ≥ required (none below AF 2.5)", CLAUSES["separation"], unb.separation_passed))
+    rows.append(Criterion("vibration at the probes",
+                          f"{unb.probe_max_um:.3g} µm p-p", f"≤ A_vl = "
+                          f"{unb.vibration_limit_um:.3g} µm p-p", CLAUSES["vibration"],
+                          unb.vibration_passed))
+    clear = [(k, c.scale_factor) for c in unb.cases for k in c.clearances]
+    if clear:
+        k, sc = max(clear, key=lambda t: t[0].scaled_um / t[0].allowed_um)
+        value = (f"{k.name}: {k.scaled_um:.3g} µm p-p (S_c = {sc:.3g}) of "
+                 f"{k.diametral_um:.3g} µm")
+    else:
+        value = "no close clearance given ([[seal]] clearance, [[amb]] backup_clearance)"
+    rows.append(Criterion("close clearances", value,
+                          f"≤ {100 * cfg.signoff.clearance_fraction:.3g} % of the diametral "
+                          "clearance", CLAUSES["clearance"], unb.clearance_passed))
+    if iso.graded:
+        s = max((s for s in iso.sensors if s.zone), key=lambda s: s.d_max_m / s.c_min_m)
+        value = (f"zone {iso.zone}: AMB {s.amb} {1e6 * s.d_max_m:.3g} µm 0-p = "
+                 f"{s.d_max_m / s.c_min_m:.3g}·C_min")
+    else:
+        value = "not graded: no [[amb]] backup_clearance"
+    rows.append(Criterion("vibration zone", value,
+                          f"zone A or B (A/B {iso.boundaries[0]:g}, B/C {iso.boundaries[1]:g}"
+                          f", C/D {iso.boundaries[2]:g}·C_min)", CLAUSES["iso14839_2"],
+                          iso.passed))
+    return tuple(rows)
+
+
+def sign_off(cfg, controller=None, *, name: str = "none", progress=None) -> SignOff:
+    """Every sign-off analysis of one controller as it runs (module docstring).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig with its ``[[stage]]`` tables, ``[operating]`` speeds and ``[signoff]``.
+    controller : DigitalController or ScheduledDigital, optional
+        As it runs; None for a rig on springs alone.
+    name : str
+        The controller's name.
+    progress : callable, optional
+        Called with one line per step.
+
+    Returns
+    -------
+    SignOff
+
+    Raises
+    ------
+    ConfigError
+        No ``[[stage]]``, no support, a maximum continuous speed of 0 or a continuous
+        controller.
+    """
+    l1 = level1_screening(cfg, controller, name=name, progress=progress)
+    l2 = level2_analysis(cfg, controller, name=name, progress=progress)
+    unb = api617_unbalance(cfg, controller, name=name, progress=progress)
+    iso = iso14839_2_zones(cfg, unb)
+    return SignOff(name, l1, l2, unb, iso, _criteria(cfg, l1, l2, unb, iso))
+
+
+def verdict_line(results) -> str:
+    """The one line a manager reads first: passed, or which controller failed what.
+
+    Parameters
+    ----------
+    results : sequence of SignOff
+
+    Returns
+    -------
+    str
+        ``Sign-off PASSED: …`` or ``Sign-off NOT passed — <controller>: <criteria>; …``.
+    """
+    if all(r.passed for r in results):
+        return ("Sign-off PASSED: every controller meets API 617 (stability, unbalance "
+                "response) and ISO 14839-2")
+    bad = "; ".join(f"{r.controller}: {', '.join(r.failed)}" for r in results if not r.passed)
+    return f"Sign-off NOT passed — {bad}"

@@ -15,11 +15,11 @@ setting).
 With AMBs the supports are the controller: each row's loop is the discrete controller
 with its computation delay on the sampled plant
 (:func:`ambseal.analysis.campbell.modes_as_run`); a rig on springs alone is analysed as
-it is. The screened mode of each row is its first forward mode: the lowest in frequency
-that whirls forward (not backward) and resonates (ζ below 1/√2,
-:data:`ambseal.analysis.campbell.OVERDAMPED_ZETA`; an AMB loop's overdamped rigid-body
-and controller poles are no modes the cross-coupling drives), below the bending limit and
-Nyquist.
+it is. The screened mode of each row is its least damped forward (not backward) mode
+below the bending limit and Nyquist: the first forward mode API 617 names where it is
+the least damped, and never a forward mode less damped than the one reported (an AMB
+loop's first forward mode by frequency is often an overdamped rigid-body or controller
+pole, while a bending mode above it is the one that fails).
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ambseal.analysis.campbell import OVERDAMPED_ZETA, modes_as_run
+from ambseal.analysis.campbell import modes_as_run
 from ambseal.analysis.level1 import stage_cross_coupling, stage_position
 from ambseal.config import Spring
 from ambseal.errors import ConfigError
@@ -47,7 +47,7 @@ class Level2Row:
         What the loop holds: ``"rotor and supports"``, ``"+ seal <name>"``,
         ``"+ Q_A at the stages"`` or ``"all sources"``.
     frequency_hz : float
-        Damped frequency of its first forward mode (Hz; NaN without one).
+        Damped frequency of its least damped forward mode (Hz; NaN without one).
     log_dec : float
         That mode's log decrement (NaN without one).
     stable : bool
@@ -104,11 +104,10 @@ class Level2:
 
 def _row(component, cfg, controller, speed_hz, max_hz, p) -> Level2Row:
     m = modes_as_run(cfg, controller, speed_hz=speed_hz, max_hz=max_hz, pressure_bar=p)
-    fwd = [k for k in range(m.poles.size)
-           if m.whirl[k] != "backward" and m.damping_ratio[k] < OVERDAMPED_ZETA]
+    fwd = [k for k in range(m.poles.size) if m.whirl[k] != "backward"]
     if not fwd:
         return Level2Row(component, math.nan, math.nan, m.stable)
-    k = min(fwd, key=lambda i: m.frequency_hz[i])
+    k = min(fwd, key=lambda i: m.log_decrement[i])
     return Level2Row(component, float(m.frequency_hz[k]), float(m.log_decrement[k]),
                      m.stable)
 

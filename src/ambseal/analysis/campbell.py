@@ -41,7 +41,6 @@ from ambseal.model import (
     free_bending_hz,
     poles_near_zero,
 )
-from ambseal.analysis.synchronous import controller_as_runs
 from ambseal.robust import decay_rate, is_stable
 
 __all__ = ["API684_LOG_DEC", "OVERDAMPED_ZETA", "ClosedLoopModes", "Crossing", "Campbell",
@@ -274,12 +273,20 @@ def modes_as_run(cfg, controller=None, *, speed_hz: float, max_hz: float,
     if controller is None or not cfg.amb:
         return modes_of_state_matrix(np.asarray(plant.A), mesh, speed_hz=speed_hz,
                                      pressure_bar=p, max_hz=max_hz)
-    from ambseal.machine import judged_loop  # python-control: loaded when needed
+    # the loop's python-control machinery: loaded when a controller is closed, not for
+    # the open loop's modes (``ambseal modes``)
+    from ambseal.analysis.synchronous import controller_as_runs
+    from ambseal.lti import feedback_matrices, ss_matrices, wired
+    from ambseal.machine import sampled_plant
 
     G = plant.select_inputs([plant.input_names[j] for j in plant.current_inputs()]
                             ).to_statespace()
     Kd = controller_as_runs(controller, 2 * math.pi * speed_hz)
-    A = np.asarray(judged_loop(G, Kd).loop.system.A)
+    # the sampled loop's state matrix alone: its eigenvectors give the modes and their
+    # eigenvalues the verdict, so the loop's poles are not computed apart
+    Gd = sampled_plant(G, float(Kd.dt))
+    A = feedback_matrices(ss_matrices(Gd, allow_discrete=True),
+                          ss_matrices(wired(Gd, Kd), allow_discrete=True))[0]
     return modes_of_sampled_loop(A, float(Kd.dt), mesh, speed_hz=speed_hz, pressure_bar=p,
                                  max_hz=max_hz)
 

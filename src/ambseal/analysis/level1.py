@@ -290,7 +290,7 @@ def _rigid_critical_hz(cfg) -> float:
     return float(f.min()) if f.size else math.nan
 
 
-def level1_screening(cfg, controller=None, *, name: str = "none", points: int = 21,
+def level1_screening(cfg, controller=None, *, name: str = "none", points: int = 11,
                      q_max_factor: float = RATIO_FREE, progress=None) -> Level1:
     """API 617 Level I screening of a rig with one controller as it runs (module
     docstring).

@@ -193,6 +193,7 @@ def verdict_line(results) -> str:
     Parameters
     ----------
     results : sequence of SignOff
+        One per controller.
 
     Returns
     -------

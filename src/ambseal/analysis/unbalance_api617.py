@@ -150,7 +150,9 @@ def required_margin(af: float, below: bool) -> float:
 
 
 def _supports(cfg) -> list[float]:
-    zs = sorted({a.position for a in cfg.amb} | {s.position for s in cfg.spring})
+    """The bearings' positions: the AMBs (springs beside them are couplings or seals), or
+    the springs of a rig without AMBs."""
+    zs = sorted({a.position for a in cfg.amb} or {s.position for s in cfg.spring})
     if not zs:
         raise ConfigError("API 617 unbalance response: the rig has no [[amb]] or "
                           "[[spring]] to carry the rotor")
@@ -168,24 +170,33 @@ def _node_masses(cfg) -> np.ndarray:
 
 
 def journal_loads(cfg) -> tuple[tuple[float, float], ...]:
-    """The journal static loads: ``((position m, load kg), …)`` per support (AMBs and
-    springs), the reactions of the rotor pinned there under gravity.
+    """The journal static loads: ``((position m, load kg), …)`` per bearing (the AMBs,
+    else the springs), the rotor's reactions under gravity with each AMB holding its
+    journal (a rigid pin: the controller keeps the set point) and every spring as stiff as
+    it is. A bearing that holds the rotor down carries the magnitude of its reaction.
 
     Raises
     ------
     ConfigError
-        A rig without a support.
+        A rig without a bearing, or whose bearings carry no load.
     """
     zs = _supports(cfg)
     pins = [Spring(position=z, kxx=RIGID_SUPPORT, kyy=RIGID_SUPPORT, name=f"pin{i}")
-            for i, z in enumerate(zs)]
-    rig = cfg.model_copy(update={"seal": [], "amb": [], "spring": pins})
+            for i, z in enumerate(zs)] if cfg.amb else []
+    rig = cfg.model_copy(update={"seal": [], "amb": [], "spring": [*cfg.spring, *pins]})
     sys = build_system(rig, speed_rpm=0.0)
     t = np.zeros(sys.n_dof)
     t[1::4] = 1.0
     q = np.linalg.solve(sys.K, GRAVITY * (sys.M @ t))
-    return tuple((z, float(RIGID_SUPPORT * q[4 * sys.mesh.node_at(z) + 1] / GRAVITY))
-                 for z in zs)
+    k_of = {z: RIGID_SUPPORT for z in zs} if cfg.amb else {}
+    for s in cfg.spring if not cfg.amb else []:
+        k_of[s.position] = k_of.get(s.position, 0.0) + s.kyy
+    loads = tuple((z, abs(float(k_of[z] * q[4 * sys.mesh.node_at(z) + 1] / GRAVITY)))
+                  for z in zs)
+    if not sum(w for _, w in loads) > 0:
+        raise ConfigError("API 617 unbalance response: the bearings carry no static load "
+                          "(a rotor without mass?)")
+    return loads
 
 
 @dataclass(frozen=True)
@@ -345,6 +356,8 @@ def _placements(cfg, modes, loads, factor: float, n_rpm: float) -> list[tuple]:
     node_mass = _node_masses(cfg)
     z_nodes = modes.node_z_m
     total = sum(w for _, w in loads)
+    # a journal that carries (almost) nothing gets the mean load: U_r needs W > 0
+    loads = tuple((z, w if w > 1e-6 * total else total / len(loads)) for z, w in loads)
     # the impellers (the stages; without stages, the disks) outboard of the supports
     heavy = ([stage_position(cfg, st) for st in cfg.stage] if cfg.stage
              else [d.position for d in cfg.disk])

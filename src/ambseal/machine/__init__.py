@@ -7,7 +7,8 @@ controller on a machine is: negative feedback ``u = −K y`` from its measuremen
 speed (:data:`SPEED`) or any other (:mod:`ambseal.machine.controller`); the one loop every
 verdict is taken on, with the target's hold and computation delay
 (:mod:`ambseal.machine.loop`; :func:`loop_matrices` and :func:`sample_time` check a
-plant and a controller before they are closed); and a scheduled controller's table as it runs on the target
+plant and a controller before they are closed, :func:`sampled_plant` samples a plant as
+the controller sees it); and a scheduled controller's table as it runs on the target
 (:mod:`ambseal.machine.scheduled_digital`).
 """
 
@@ -19,9 +20,10 @@ from ambseal.machine.loop import (
     judged_loop,
     loop_matrices,
     sample_time,
+    sampled_plant,
 )
 from ambseal.machine.scheduled_digital import ScheduledDigital, scheduled_digital
 
 __all__ = ["SPEED", "ScheduledController", "frozen", "matrices_at", "ClosedLoop",
            "JudgedLoop", "closed_loop", "judged_loop", "loop_matrices", "sample_time",
-           "ScheduledDigital", "scheduled_digital"]
+           "sampled_plant", "ScheduledDigital", "scheduled_digital"]

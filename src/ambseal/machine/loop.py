@@ -469,7 +469,22 @@ def sampled_plant(P, dt: float, inputs=None):
     signal names kept. ``inputs`` (indices; default all) are sampled together and give
     ``A_d``, the others apart: the controller's loop then has the state matrix of the
     plant sampled with its control inputs alone, as the discretisation chosen for it
-    (:func:`ambseal.robust.digital.sampled_plants`), and their poles are computed once."""
+    (:func:`ambseal.robust.digital.sampled_plants`), and their poles are computed once.
+
+    Parameters
+    ----------
+    P : control.StateSpace
+        The continuous plant.
+    dt : float
+        Sample time (s), > 0.
+    inputs : sequence of int, optional
+        The inputs sampled together (default all).
+
+    Returns
+    -------
+    control.StateSpace
+        Discrete, ``dt`` its sample time, the same states and signal names.
+    """
 
     A, B = np.asarray(P.A, float), np.asarray(P.B, float)
     cur = list(range(B.shape[1])) if inputs is None else list(inputs)

@@ -251,7 +251,7 @@ def modes_as_run(cfg, controller=None, *, speed_hz: float, max_hz: float,
     ----------
     cfg : RigConfig
     controller : DigitalController or ScheduledDigital, optional
-        As it runs (:func:`ambseal.analysis.synchronous.controller_as_runs`).
+        As it runs (:func:`ambseal.machine.controller_as_runs`).
     speed_hz, max_hz : float
         Spin speed and highest damped frequency kept (Hz; below Nyquist for a sampled
         loop).
@@ -273,20 +273,14 @@ def modes_as_run(cfg, controller=None, *, speed_hz: float, max_hz: float,
     if controller is None or not cfg.amb:
         return modes_of_state_matrix(np.asarray(plant.A), mesh, speed_hz=speed_hz,
                                      pressure_bar=p, max_hz=max_hz)
-    # the loop's python-control machinery: loaded when a controller is closed, not for
-    # the open loop's modes (``ambseal modes``)
-    from ambseal.analysis.synchronous import controller_as_runs
-    from ambseal.lti import feedback_matrices, ss_matrices, wired
-    from ambseal.machine import sampled_plant
+    # python-control: loaded when a controller is closed, not for the open loop's modes
+    from ambseal.machine import controller_as_runs, sampled_loop_matrix
 
     G = plant.select_inputs([plant.input_names[j] for j in plant.current_inputs()]
                             ).to_statespace()
     Kd = controller_as_runs(controller, 2 * math.pi * speed_hz)
-    # the sampled loop's state matrix alone: its eigenvectors give the modes and their
-    # eigenvalues the verdict, so the loop's poles are not computed apart
-    Gd = sampled_plant(G, float(Kd.dt))
-    A = feedback_matrices(ss_matrices(Gd, allow_discrete=True),
-                          ss_matrices(wired(Gd, Kd), allow_discrete=True))[0]
+    # the matrix alone: its eigenvectors give the modes and its eigenvalues the verdict
+    A = sampled_loop_matrix(G, Kd)
     return modes_of_sampled_loop(A, float(Kd.dt), mesh, speed_hz=speed_hz, pressure_bar=p,
                                  max_hz=max_hz)
 

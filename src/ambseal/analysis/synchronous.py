@@ -31,12 +31,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ambseal.errors import ConfigError, ModelError
+from ambseal.errors import ModelError
 from ambseal.lti import freqresp_at
+from ambseal.machine import controller_as_runs
 from ambseal.model import SealElement, actuator_matrices, build_system, eddy_lag_matrices
 
-__all__ = ["Unbalance", "SynchronousResponse", "synchronous_response", "controller_as_runs",
-           "orbit_semi_major"]
+__all__ = ["Unbalance", "SynchronousResponse", "synchronous_response", "orbit_semi_major"]
 
 
 @dataclass(frozen=True)
@@ -81,24 +81,6 @@ def orbit_semi_major(X: np.ndarray, Y: np.ndarray) -> np.ndarray:
     """Semi-major axis of the ellipse ``(Re{X e^{jθ}}, Re{Y e^{jθ}})`` (module docstring);
     same shape as ``X`` and ``Y``."""
     return np.sqrt(0.5 * (np.abs(X) ** 2 + np.abs(Y) ** 2 + np.abs(X ** 2 + Y ** 2)))
-
-
-def controller_as_runs(controller, speed_rad_s: float):
-    """The controller as it runs at ``speed_rad_s``: a discrete ``control.StateSpace`` with
-    its computation delay (a scheduled table at that speed).
-
-    Raises
-    ------
-    ConfigError
-        A controller that is not a digital one as it runs.
-    """
-    if hasattr(controller, "statespace_at"):
-        return controller.statespace_at(speed_rad_s, delayed=True)
-    if hasattr(controller, "statespace") and hasattr(controller, "discrete"):
-        return controller.statespace(delayed=True)
-    raise ConfigError("the sign-off judges a digital controller as it runs (a "
-                      "DigitalController or a scheduled table, e.g. an exported file of "
-                      "ambseal design); a continuous controller is not judged here")
 
 
 def _siso_at(mats, s: complex) -> complex:

@@ -12,7 +12,13 @@ the controller sees it); and a scheduled controller's table as it runs on the ta
 (:mod:`ambseal.machine.scheduled_digital`).
 """
 
-from ambseal.machine.controller import SPEED, ScheduledController, frozen, matrices_at
+from ambseal.machine.controller import (
+    SPEED,
+    ScheduledController,
+    controller_as_runs,
+    frozen,
+    matrices_at,
+)
 from ambseal.machine.loop import (
     ClosedLoop,
     JudgedLoop,
@@ -20,10 +26,12 @@ from ambseal.machine.loop import (
     judged_loop,
     loop_matrices,
     sample_time,
+    sampled_loop_matrix,
     sampled_plant,
 )
 from ambseal.machine.scheduled_digital import ScheduledDigital, scheduled_digital
 
-__all__ = ["SPEED", "ScheduledController", "frozen", "matrices_at", "ClosedLoop",
+__all__ = ["SPEED", "ScheduledController", "controller_as_runs", "frozen", "matrices_at",
+           "sampled_loop_matrix", "ClosedLoop",
            "JudgedLoop", "closed_loop", "judged_loop", "loop_matrices", "sample_time",
            "sampled_plant", "ScheduledDigital", "scheduled_digital"]

@@ -33,9 +33,9 @@ from typing import Mapping
 
 import numpy as np
 
-from ambseal.errors import ModelError
+from ambseal.errors import ConfigError, ModelError
 
-__all__ = ["ScheduledController", "frozen", "matrices_at", "SPEED"]
+__all__ = ["ScheduledController", "frozen", "matrices_at", "controller_as_runs", "SPEED"]
 
 #: The name of the rotor speed as a scheduling parameter (Ω, rad/s).
 SPEED = "speed"
@@ -134,3 +134,34 @@ def matrices_at(K, speed_rad_s: float | None = None,
     if isinstance(K, ScheduledController):
         return K.matrices_at(_value(K, speed_rad_s, values))
     return tuple(np.asarray(M, float) for M in (K.A, K.B, K.C, K.D))
+
+
+def controller_as_runs(controller, speed_rad_s: float):
+    """The controller as it runs at ``speed_rad_s``: a discrete ``control.StateSpace`` with
+    its computation delay (a scheduled table at that speed).
+
+    Parameters
+    ----------
+    controller : DigitalController or ScheduledDigital
+        A digital controller (``statespace(delayed=True)``) or a scheduled table
+        (``statespace_at``).
+    speed_rad_s : float
+        The speed a scheduled table is taken at (rad/s).
+
+    Returns
+    -------
+    control.StateSpace
+        Discrete, its delay among its states.
+
+    Raises
+    ------
+    ConfigError
+        A controller that is not a digital one as it runs.
+    """
+    if hasattr(controller, "statespace_at"):
+        return controller.statespace_at(speed_rad_s, delayed=True)
+    if hasattr(controller, "statespace") and hasattr(controller, "discrete"):
+        return controller.statespace(delayed=True)
+    raise ConfigError("the sign-off judges a digital controller as it runs (a "
+                      "DigitalController or a scheduled table, e.g. an exported file of "
+                      "ambseal design); a continuous controller is not judged here")

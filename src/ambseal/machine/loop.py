@@ -48,7 +48,7 @@ from ambseal.lti import (
 from ambseal.robust import decay_rate, is_stable
 
 __all__ = ["ClosedLoop", "JudgedLoop", "closed_loop", "judged_loop", "delayed_plant",
-           "sampled_plant", "loop_matrices", "sample_time"]
+           "sampled_plant", "sampled_loop_matrix", "loop_matrices", "sample_time"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -495,6 +495,36 @@ def sampled_plant(P, dt: float, inputs=None):
         Bd[:, rest] = zoh(A, B[:, rest], dt)[1]
     return shared_ss(Ad, Bd, np.asarray(P.C, float), np.asarray(P.D, float), dt,
                      inputs=list(P.input_labels), outputs=list(P.output_labels))
+
+
+def sampled_loop_matrix(P, K) -> np.ndarray:
+    """The state matrix of the discrete ``K`` closed on the continuous ``P`` sampled by a
+    zero-order hold at its sample time, ``u = −K y`` wired by signal names: states
+    ``[x; x_K]``, ``x`` the plant's own. Only the matrix (no poles, no system): what a
+    modal analysis of the loop as it runs needs.
+
+    Parameters
+    ----------
+    P : control.StateSpace
+        Continuous plant, every input driven by ``K``.
+    K : control.StateSpace
+        Discrete controller (``dt`` its sample time, its delay among its states).
+
+    Returns
+    -------
+    ndarray, shape (n + n_K, n + n_K)
+
+    Raises
+    ------
+    ModelError
+        A continuous ``K`` or channels that do not fit.
+    """
+    dt = sample_time(K)
+    if not dt:
+        raise ModelError("sampled_loop_matrix: the controller must be discrete")
+    Pd = sampled_plant(P, dt)
+    return feedback_matrices(ss_matrices(Pd, allow_discrete=True),
+                             ss_matrices(wired(Pd, K), name="K", allow_discrete=True))[0]
 
 
 def judged_loop(P, K, control_inputs=None, *, delay=None) -> JudgedLoop:

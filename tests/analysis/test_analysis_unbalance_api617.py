@@ -85,3 +85,27 @@ def test_rigid_rotor_on_damped_springs_is_the_closed_form():
     assert not crit.passed and not r.separation_passed
     assert r.vibration_limit_um == 25.4 and not r.vibration_passed and not r.passed
     assert r.trip_hz == pytest.approx(1.05 * 50.0) and r.top_hz == pytest.approx(1.25 * 52.5)
+
+
+def test_close_clearance_is_the_scaled_response_against_its_fraction():
+    """A seal of 0.3 mm radial clearance at mid-span of the same rotor: S_c = A_vl/A_1
+    bounded to [0.5, 6] (A_1 the probes' largest amplitude to the trip speed), the seal's
+    scaled response S_c × its own largest amplitude to the trip speed, allowed 75 % of
+    the 0.6 mm diametral clearance."""
+    import numpy as np
+
+    doc = tomllib.loads(_rigid_rotor(1e8, 2.0e4, 4.5e4))
+    doc["seal"] = [{"name": "eye", "position": 0.2, "clearance": 3e-4}]
+    r = api617_unbalance(parse_rig(doc))
+    c = r.cases[0]
+    upto = c.speed_hz <= r.trip_hz + 1e-9
+    a1 = c.probe_um[upto].max()
+    sc = min(max(r.vibration_limit_um / a1, 0.5), 6.0)
+    assert c.scale_factor == pytest.approx(sc)
+    (k,) = c.clearances
+    assert k.name == "eye" and k.diametral_um == pytest.approx(600.0)
+    assert k.allowed_um == pytest.approx(450.0) and k.passed
+    # at mid-span of the symmetric rotor the seal moves as much as the probes (rigid
+    # cylindrical whirl far below its critical): its scaled response is S_c·A_1
+    assert k.scaled_um == pytest.approx(sc * a1, rel=0.02)
+    assert np.all(np.diff(c.speed_hz) > 0)

@@ -30,10 +30,11 @@ __all__ = ["vibration_zone", "SensorZone", "IsoVibration", "iso14839_2_zones"]
 def vibration_zone(d_max: float, c_min: float, boundaries) -> str:
     """ISO 14839-2 zone of a displacement ``d_max`` (m, 0-p) against the clearance
     ``c_min`` (m): boundaries (A/B, B/C, C/D) as fractions of ``c_min``; a value on a
-    boundary belongs to the upper zone."""
+    boundary (to 1e-12 of ``c_min``, the rounding of the ratio) belongs to the upper
+    zone."""
     r = d_max / c_min
     for zone, edge in zip(ZONES, boundaries):
-        if r < edge:
+        if r < edge - 1e-12:
             return zone
     return ZONES[-1]
 

@@ -491,7 +491,8 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
                    and getattr(g, "parameter", SPEED) == SPEED]
         if results:
             signoff = Signoff.of(results, verdict_line(results))
-            more_figs, more_sections = signoff_report(out, results, cfg.rotor.name)
+            more_figs, more_sections = signoff_report(out, results, cfg.rotor.name,
+                                                      cfg.signoff.csr_boundary)
             figs, sections = figs + more_figs, more_sections + sections
         stages.step()
     if cfg.design.tracked and st.truth_cfg is not None:

@@ -239,7 +239,8 @@ def _signoff(args: argparse.Namespace) -> int:
            "controllers": {r.controller: r.to_dict() for r in results}}
     files = [write_json(out / "signoff.json", doc),
              level1_figure(out / "level1.png", [r.level1 for r in results],
-                           title=f"API 617 Level I — {cfg.rotor.name}"),
+                           title=f"API 617 Level I — {cfg.rotor.name}",
+                           boundary=cfg.signoff.csr_boundary),
              unbalance_figure(out / "unbalance.png", [r.unbalance for r in results],
                               title=f"API 617 unbalance response — {cfg.rotor.name}")]
     if args.json:

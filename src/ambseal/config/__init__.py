@@ -34,6 +34,7 @@ from ambseal.config.rig import (
                                     PidFilter,
                                     RigConfig,
                                     Seal,
+                                    Signoff,
                                     Spring,
                                     Stage,
                                     TruthSection,
@@ -52,7 +53,7 @@ __all__ = ["MAX_AMBS", "MAX_COEFFICIENT", "MAX_COMPONENTS", "MAX_CURRENT_A", "MA
            "MAX_FREQUENCY_HZ", "MAX_GAP_M", "MAX_PRESSURE_BAR", "MAX_SPEED_HZ", "METHODS",
            "Method", "method", "method_label", "method_names",
            "Actuator", "Affine", "Amb", "AxisPair", "Coefficient", "FrequencyTable",
-           "Machine", "Pid", "PidFilter", "RigConfig", "Seal", "Spring", "Stage",
+           "Machine", "Pid", "PidFilter", "RigConfig", "Seal", "Signoff", "Spring", "Stage",
            "TruthSection", "apply_overrides",
            "check_operating", "default_rig_path", "dump_rig", "load_rig", "load_truth",
            "parse_rig", "rig_parameter_names", "rig_with_values"]

@@ -12,15 +12,18 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ambseal.analysis import verdict_line
+from ambseal.config import Signoff
 from ambseal.report.figures import save_figure
 
 __all__ = ["level1_figure", "unbalance_figure", "signoff_report"]
 
 
 def level1_figure(path: str | os.PathLike, results, *,
-                  title: str = "API 617 Level I screening") -> Path:
+                  title: str = "API 617 Level I screening", boundary=None) -> Path:
     """Log decrement of the screened forward mode against the applied cross-coupling Q, one
-    line per controller, with Q_A, each Q_0 and the screening's δ = 0.1 and 0 lines.
+    line per controller, with Q_A, each Q_0 and the screening's δ = 0.1 and 0 lines; beside
+    it the critical speed ratio against the average gas density with the Region A/B
+    boundary (``boundary``: its points, ``[signoff] csr_boundary``).
 
     Parameters
     ----------
@@ -30,14 +33,16 @@ def level1_figure(path: str | os.PathLike, results, *,
         One per controller; Q in units of the common Q_A on the axis.
     title : str
         The figure's title.
+    boundary : sequence of (float, float), optional
+        The Region A/B boundary's points (kg/m³, CSR); default ``[signoff]``'s default.
 
     Returns
     -------
     Path
         The PNG written.
     """
-    fig = Figure(figsize=(8, 4.8))
-    ax = fig.subplots()
+    fig = Figure(figsize=(11, 4.8))
+    ax, ax2 = fig.subplots(1, 2, gridspec_kw={"width_ratios": [3, 2]})
     for r in results:
         d = np.where(np.isfinite(r.log_dec), r.log_dec, np.nan)
         line, = ax.plot(r.Q / r.Q_A, d, "o-", ms=3, lw=1.2,
@@ -52,6 +57,23 @@ def level1_figure(path: str | os.PathLike, results, *,
     ax.set_title(title, fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
+    pts = np.array(boundary if boundary is not None else Signoff().csr_boundary, float)
+    r0 = results[0]
+    top = max(200.0, 1.5 * float(pts[-1, 0]), 1.5 * r0.rho_avg)
+    rho = np.concatenate([[0.0], pts[:, 0], [top]])
+    ax2.plot(rho, np.interp(rho, pts[:, 0], pts[:, 1]), "k-", lw=1.2,
+             label="Region A/B boundary")
+    ax2.plot([r0.rho_avg], [r0.csr], "ro", ms=7,
+             label=f"machine: CSR {r0.csr:.3g}, Region {r0.region}")
+    ax2.set_xlim(0.0, top)
+    ax2.set_ylim(0.0, max(3.0, 1.2 * r0.csr))
+    ax2.text(0.05 * top, 0.3, "Region A", fontsize=9)
+    ax2.text(0.05 * top, max(3.0, 1.2 * r0.csr) * 0.9, "Region B", fontsize=9)
+    ax2.set_xlabel("average gas density ρ_avg (kg/m³)")
+    ax2.set_ylabel("critical speed ratio CSR (-)")
+    ax2.set_title("critical speed ratio", fontsize=10)
+    ax2.grid(True, alpha=0.3)
+    ax2.legend(fontsize=8, loc="lower right")
     return save_figure(fig, path, tight=True)
 
 
@@ -101,7 +123,7 @@ def unbalance_figure(path: str | os.PathLike, results, *,
     return save_figure(fig, path, tight=True)
 
 
-def signoff_report(out: Path, results, rig_name: str) -> tuple[list, list]:
+def signoff_report(out: Path, results, rig_name: str, boundary=None) -> tuple[list, list]:
     """The run report's sign-off: the figures (``level1.png``, ``unbalance.png`` in
     ``out``) and a section whose first line is the overall verdict, then per controller
     every criterion, its value, its limit, its source and pass/fail, and the Level II
@@ -115,6 +137,8 @@ def signoff_report(out: Path, results, rig_name: str) -> tuple[list, list]:
         One per controller.
     rig_name : str
         For the figures' titles.
+    boundary : sequence of (float, float), optional
+        The rig's ``[signoff] csr_boundary``.
 
     Returns
     -------
@@ -124,7 +148,7 @@ def signoff_report(out: Path, results, rig_name: str) -> tuple[list, list]:
     """
     esc = html.escape
     l1 = level1_figure(out / "level1.png", [r.level1 for r in results],
-                       title=f"API 617 Level I — {rig_name}")
+                       title=f"API 617 Level I — {rig_name}", boundary=boundary)
     unb = unbalance_figure(out / "unbalance.png", [r.unbalance for r in results],
                            title=f"API 617 unbalance response — {rig_name}")
     ok = all(r.passed for r in results)
@@ -154,7 +178,8 @@ def signoff_report(out: Path, results, rig_name: str) -> tuple[list, list]:
             "Limits the standards' public text could not confirm are the rig file's "
             "<code>[signoff]</code> settings.</p>")
     figures = [("API 617 Level I: log decrement of the screened forward mode against the "
-                "applied cross-coupling Q/Q_A, per controller", l1),
+                "applied cross-coupling Q/Q_A, per controller; the critical speed ratio "
+                "against the average gas density with the Region A/B boundary", l1),
                ("API 617 unbalance response at the probes, per controller and case, with "
                 "A_vl and the speed range", unb)]
     title = "Sign-off: API 617 and ISO 14839-2" + ("" if ok else " — NOT passed")

@@ -371,6 +371,14 @@ def _placements(cfg, modes, loads, factor: float, n_rpm: float) -> list[tuple]:
             seen.add(key)
             out.append((f_hz, rule, unb))
 
+    def overhung(f_hz, zu):
+        """One unbalance at the impeller ``zu``, W the mass outboard of its support."""
+        side = z_nodes < lo - 1e-9 if zu < lo else z_nodes > hi + 1e-9
+        edge = int(np.argmin(np.abs(z_nodes - (lo if zu < lo else hi))))
+        w = float(node_mass[side].sum()) + 0.5 * float(node_mass[edge])
+        add(f_hz, f"overhung: at {zu:.3g} m, W = {w:.4g} kg outboard of the support",
+            (Unbalance(zu, factor * unbalance_ur(w, n_rpm)),))
+
     # the first and second rigid-body shapes, whatever the loop's modes (an AMB loop may
     # damp them all beyond resonance): the probes and clearances are judged on them
     mid = float(z_nodes[int(np.argmin(np.abs(z_nodes - 0.5 * (lo + hi))))])
@@ -381,11 +389,7 @@ def _placements(cfg, modes, loads, factor: float, n_rpm: float) -> list[tuple]:
             Unbalance(z, factor * unbalance_ur(dict(loads)[z], n_rpm), ph)
             for z, ph in ((lo, 0.0), (hi, 180.0))))
     for zu in outboard:
-        side = z_nodes < lo - 1e-9 if zu < lo else z_nodes > hi + 1e-9
-        edge = int(np.argmin(np.abs(z_nodes - (lo if zu < lo else hi))))
-        w = float(node_mass[side].sum()) + 0.5 * float(node_mass[edge])
-        add(math.nan, f"overhung: at {zu:.3g} m, W = {w:.4g} kg outboard of the support",
-            (Unbalance(zu, factor * unbalance_ur(w, n_rpm)),))
+        overhung(math.nan, zu)
     for k in range(modes.poles.size):
         if modes.whirl[k] == "backward" or modes.damping_ratio[k] >= OVERDAMPED_ZETA:
             continue
@@ -395,12 +399,7 @@ def _placements(cfg, modes, loads, factor: float, n_rpm: float) -> list[tuple]:
         over = [z for z in outboard if (z < lo) == (z0 < lo)] if not inside[
             int(np.argmax(a))] else []
         if over:
-            zu = min(over, key=lambda z: abs(z - z0))
-            side = z_nodes < lo - 1e-9 if zu < lo else z_nodes > hi + 1e-9
-            edge = int(np.argmin(np.abs(z_nodes - (lo if zu < lo else hi))))
-            w = float(node_mass[side].sum()) + 0.5 * float(node_mass[edge])
-            add(float(modes.frequency_hz[k]), f"overhung: at {zu:.3g} m, W = {w:.4g} kg "
-                "outboard of the support", (Unbalance(zu, factor * unbalance_ur(w, n_rpm)),))
+            overhung(float(modes.frequency_hz[k]), min(over, key=lambda z: abs(z - z0)))
             continue
         i0 = int(np.argmax(np.where(inside, a, -1.0)))
         ref = X[i0] if abs(X[i0]) >= abs(Y[i0]) else Y[i0]

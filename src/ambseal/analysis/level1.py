@@ -61,7 +61,8 @@ from ambseal.lti import json_float
 from ambseal.model import bending_limit_hz, build_plant
 
 __all__ = ["B_COMPRESSOR", "B_TURBINE", "RATIO_MIN", "RATIO_FREE",
-           "Level1", "stage_cross_coupling", "csr_boundary", "level1_screening"]
+           "Level1", "stage_cross_coupling", "stage_position", "bearing_positions", "csr_boundary",
+           "level1_screening"]
 
 #: API 617's factor B of the anticipated cross-coupling: compressors (with the density
 #: ratio) and turbines (without it).
@@ -137,8 +138,8 @@ class Level1:
     rigid_critical_hz: float
     passed: bool
     rule: str
-    rho_avg: float = math.nan
-    csr_boundary: float = math.nan
+    rho_avg: float
+    csr_boundary: float
 
     @property
     def region(self) -> str:
@@ -209,13 +210,25 @@ def stage_position(cfg, st) -> float:
     return float(next(d.position for d in cfg.disk if d.name == st.disk))
 
 
+def bearing_positions(cfg) -> list[float]:
+    """The bearings' positions (m, ascending): the AMBs (a spring beside them is a coupling
+    or a seal), or the springs of a rig without AMBs.
+
+    Raises
+    ------
+    ConfigError
+        A rig with neither.
+    """
+    zs = sorted({a.position for a in cfg.amb} or {s.position for s in cfg.spring})
+    if not zs:
+        raise ConfigError("API 617: the rig has no [[amb]] or [[spring]] to carry the rotor")
+    return zs
+
+
 def _applied_at(cfg, q: list[float]) -> tuple:
-    """(position, share of Q) pairs: mid-span between the outermost supports, or the
+    """(position, share of Q) pairs: mid-span between the outermost bearings, or the
     overhung stages in proportion to their q_A."""
-    supports = [a.position for a in cfg.amb] + [s.position for s in cfg.spring]
-    if not supports:
-        raise ConfigError("API 617 Level I: the rig has no [[amb]] or [[spring]] to carry "
-                          "the rotor")
+    supports = bearing_positions(cfg)
     lo, hi = min(supports), max(supports)
     zs = [stage_position(cfg, st) for st in cfg.stage]
     over = [(z, qi) for z, qi in zip(zs, q) if z < lo - 1e-9 or z > hi + 1e-9]
@@ -280,10 +293,9 @@ def csr_boundary(points, rho_avg: float) -> float:
 
 def _rigid_critical_hz(cfg) -> float:
     """The first critical speed on rigid supports (Hz): the first bending mode of the
-    shaft and disks pinned at every AMB and spring, at standstill."""
+    shaft and disks pinned at every bearing (:func:`bearing_positions`), at standstill."""
     pins = [Spring(position=z, kxx=RIGID_SUPPORT, kyy=RIGID_SUPPORT, name=f"rigid{i}")
-            for i, z in enumerate(sorted({a.position for a in cfg.amb}
-                                         | {s.position for s in cfg.spring}))]
+            for i, z in enumerate(bearing_positions(cfg))]
     rig = cfg.model_copy(update={"seal": [], "amb": [], "spring": pins})
     lam = np.linalg.eigvals(np.asarray(build_plant(rig).A))
     f = lam.imag[lam.imag > 2 * np.pi * 0.1] / (2 * np.pi)

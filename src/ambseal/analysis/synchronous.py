@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ambseal.errors import ModelError
-from ambseal.lti import freqresp_at
+from ambseal.lti import freqresp_at, shared_ss, wired
 from ambseal.machine import controller_as_runs
 from ambseal.model import SealElement, actuator_matrices, build_system, eddy_lag_matrices
 
@@ -93,18 +93,17 @@ def _siso_at(mats, s: complex) -> complex:
 def _controller_at(controller, out_names, in_names, omegas: np.ndarray) -> np.ndarray:
     """``K_r(Ω)`` at each speed (n_s × nu × ny, the plant's input × output order; module
     docstring); a scheduled table taken at each speed, any other controller once."""
+    # the plant's channels by name, as every loop is wired (no states: names only)
+    names = shared_ss(np.zeros((0, 0)), np.zeros((0, len(in_names))),
+                      np.zeros((len(out_names), 0)), np.zeros((len(out_names), len(in_names))),
+                      inputs=list(in_names), outputs=list(out_names))
+
     def at(K, w):
+        K = wired(names, K)
         dt = float(K.dt)
         Kw = freqresp_at(K, np.exp(1j * w * dt))
-        ins, outs = list(K.input_labels), list(K.output_labels)
-        if sorted(ins) != sorted(out_names) or sorted(outs) != sorted(in_names):
-            raise ModelError(f"the controller's signals ({', '.join(ins)} → "
-                             f"{', '.join(outs)}) are not the rig's ({', '.join(out_names)} "
-                             f"→ {', '.join(in_names)})")
-        Kw = Kw[:, [outs.index(n) for n in in_names]][:, :, [ins.index(n) for n in out_names]]
-        wdt = w * dt
-        hold = np.where(wdt == 0, 1.0, (1 - np.exp(-1j * wdt)) / np.where(wdt == 0, 1.0,
-                                                                          1j * wdt))
+        # the ZOH's (1 − e^{−jΩT})/(jΩT) = e^{−jΩT/2} sinc(ΩT/2π), 1 at standstill
+        hold = np.exp(-0.5j * w * dt) * np.sinc(w * dt / (2 * math.pi))
         return Kw * hold[:, None, None]
 
     if hasattr(controller, "statespace_at"):
@@ -139,7 +138,8 @@ def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
     Raises
     ------
     ModelError
-        A controller whose signals are not the rig's, or a singular dynamic stiffness (a
+        A controller whose signals are not the rig's (:func:`ambseal.lti.wired`), or a
+        singular dynamic stiffness (a
         loop with an undamped mode exactly at a speed).
     """
     speeds = np.atleast_1d(np.asarray(speeds_hz, dtype=float))

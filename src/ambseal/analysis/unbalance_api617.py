@@ -58,7 +58,7 @@ import numpy as np
 from scipy.signal import find_peaks
 
 from ambseal.analysis.campbell import OVERDAMPED_ZETA, modes_as_run
-from ambseal.analysis.level1 import RIGID_SUPPORT, stage_position
+from ambseal.analysis.level1 import RIGID_SUPPORT, bearing_positions, stage_position
 from ambseal.analysis.synchronous import Unbalance, orbit_semi_major, synchronous_response
 from ambseal.config import Spring
 from ambseal.errors import ConfigError
@@ -149,16 +149,6 @@ def required_margin(af: float, below: bool) -> float:
     return min(16.0, m) if below else min(26.0, 10.0 + m)
 
 
-def _supports(cfg) -> list[float]:
-    """The bearings' positions: the AMBs (springs beside them are couplings or seals), or
-    the springs of a rig without AMBs."""
-    zs = sorted({a.position for a in cfg.amb} or {s.position for s in cfg.spring})
-    if not zs:
-        raise ConfigError("API 617 unbalance response: the rig has no [[amb]] or "
-                          "[[spring]] to carry the rotor")
-    return zs
-
-
 def _node_masses(cfg) -> np.ndarray:
     """Each node's share of the rotor's mass (kg): the consistent mass matrix times a
     rigid translation."""
@@ -180,7 +170,7 @@ def journal_loads(cfg) -> tuple[tuple[float, float], ...]:
     ConfigError
         A rig without a bearing, or whose bearings carry no load.
     """
-    zs = _supports(cfg)
+    zs = bearing_positions(cfg)
     pins = [Spring(position=z, kxx=RIGID_SUPPORT, kyy=RIGID_SUPPORT, name=f"pin{i}")
             for i, z in enumerate(zs)] if cfg.amb else []
     rig = cfg.model_copy(update={"seal": [], "amb": [], "spring": [*cfg.spring, *pins]})

@@ -37,7 +37,7 @@ def test_signoff_json_files_and_exit_status(tmp_path, capsys):
     assert lv["Q_0"] == pytest.approx(2000.0 * math.sqrt(1e7 / m), rel=0.02)
     assert lv["passed"] is False and doc["passed"] is False and "Level II" in lv["rule"]
     assert all((tmp_path / "so" / n).is_file()
-               for n in ("signoff.json", "level1.png", "unbalance.png"))
+               for n in ("signoff.json", "level1.png", "api617_unbalance.png"))
     assert json.loads((tmp_path / "so" / "signoff.json").read_text())["controllers"] == \
         doc["controllers"]
 
@@ -87,5 +87,7 @@ def test_the_reports_signoff_section_says_the_verdict_first(tmp_path):
     assert text.count("<tr><td>") == 2 * 6 + 2 * 3  # criteria, then Level II rows
     assert "API 617 (8th ed., 2014) Part 1 §4.8.2, A_vl" in text
     assert all(png.is_file() for _, png in figs) and len(figs) == 2
+    # beside, not over, the run's own figures (its worst-case unbalance.png)
+    assert {png.name for _, png in figs} == {"level1.png", "api617_unbalance.png"}
     _, passed = signoff_report(tmp_path, [ok], "rigid")
     assert "Sign-off PASSED" in passed[0]["html"]

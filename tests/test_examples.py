@@ -123,6 +123,8 @@ def test_every_example_runs_end_to_end(rig, tmp_path, capsys):
                    for v in so.values())
         assert metrics["signoff"]["passed"] == all(v["passed"] for v in so.values())
         assert metrics["signoff"]["verdict"].startswith("Sign-off ")
+        assert all((tmp_path / "out" / n).is_file()
+                   for n in ("unbalance.png", "level1.png", "api617_unbalance.png"))
     else:
         assert "signoff" not in metrics
     # μ: ISO 14839-3 zone A (σ̄(S_o) < 3 per axis) at every judged condition, and the

@@ -55,11 +55,11 @@ from ambseal.files import OwnedFolder, atomic_write, write_json, write_text
 from ambseal.io import import_ross_file
 from ambseal.model import channel_names
 from ambseal.report import (
+    api617_unbalance_figure,
     campbell_figure,
     level1_figure,
     mode_shapes_figure,
     stability_map_figure,
-    unbalance_figure,
 )
 
 __all__ = ["HANDLERS", "write_table"]
@@ -241,8 +241,9 @@ def _signoff(args: argparse.Namespace) -> int:
              level1_figure(out / "level1.png", [r.level1 for r in results],
                            title=f"API 617 Level I — {cfg.rotor.name}",
                            boundary=cfg.signoff.csr_boundary),
-             unbalance_figure(out / "unbalance.png", [r.unbalance for r in results],
-                              title=f"API 617 unbalance response — {cfg.rotor.name}")]
+             api617_unbalance_figure(out / "api617_unbalance.png",
+                                     [r.unbalance for r in results],
+                                     title=f"API 617 unbalance response — {cfg.rotor.name}")]
     if args.json:
         print(json.dumps({**doc, "files": [str(f) for f in files]}))
     else:

@@ -11,7 +11,7 @@
 * :func:`fit_timeseries_figure`, :func:`correlation_figure`, :func:`residual_figure`,
   :func:`error_budget_figure` — an identification (:mod:`ambseal.report.identify_figures`);
 * :func:`tracking_figure`, :func:`ramp_figure` — on-line tracking and the pressure ramp;
-* :func:`level1_figure`, :func:`unbalance_figure`, :func:`signoff_report` — API 617's
+* :func:`level1_figure`, :func:`api617_unbalance_figure`, :func:`signoff_report` — API 617's
   Level I screening, unbalance response
   (:mod:`ambseal.report.signoff_figures`);
 * :func:`figure_is_ours` — whether a PNG is one ambseal wrote (:mod:`ambseal.report.figures`);
@@ -32,7 +32,7 @@ _FROM = {
     "stability_map_figure": "modal_figures",
     "StageProgress": "progress",
     "level1_figure": "signoff_figures", "signoff_report": "signoff_figures",
-    "unbalance_figure": "signoff_figures",
+    "api617_unbalance_figure": "signoff_figures",
     "facility_impulse_report": "run_report", "gains_figure": "run_report",
     "identification_report": "run_report", "judged_on": "run_report",
     "rig_clearances_um": "run_report", "spinup_figures": "run_report",

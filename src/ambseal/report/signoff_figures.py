@@ -15,7 +15,7 @@ from ambseal.analysis import verdict_line
 from ambseal.config import Signoff
 from ambseal.report.figures import save_figure
 
-__all__ = ["level1_figure", "unbalance_figure", "signoff_report"]
+__all__ = ["level1_figure", "api617_unbalance_figure", "signoff_report"]
 
 
 def level1_figure(path: str | os.PathLike, results, *,
@@ -77,7 +77,7 @@ def level1_figure(path: str | os.PathLike, results, *,
     return save_figure(fig, path, tight=True)
 
 
-def unbalance_figure(path: str | os.PathLike, results, *,
+def api617_unbalance_figure(path: str | os.PathLike, results, *,
                      title: str = "API 617 unbalance response") -> Path:
     """The probes' peak-to-peak response against speed: one panel per controller, one
     line per unbalance case (the largest probe), with A_vl, the minimum and maximum
@@ -124,7 +124,7 @@ def unbalance_figure(path: str | os.PathLike, results, *,
 
 
 def signoff_report(out: Path, results, rig_name: str, boundary=None) -> tuple[list, list]:
-    """The run report's sign-off: the figures (``level1.png``, ``unbalance.png`` in
+    """The run report's sign-off: the figures (``level1.png``, ``api617_unbalance.png`` in
     ``out``) and a section whose first line is the overall verdict, then per controller
     every criterion, its value, its limit, its source and pass/fail, and the Level II
     table.
@@ -149,8 +149,10 @@ def signoff_report(out: Path, results, rig_name: str, boundary=None) -> tuple[li
     esc = html.escape
     l1 = level1_figure(out / "level1.png", [r.level1 for r in results],
                        title=f"API 617 Level I — {rig_name}", boundary=boundary)
-    unb = unbalance_figure(out / "unbalance.png", [r.unbalance for r in results],
-                           title=f"API 617 unbalance response — {rig_name}")
+    # not unbalance.png: the run's worst-case unbalance figure is written there
+    unb = api617_unbalance_figure(out / "api617_unbalance.png",
+                                  [r.unbalance for r in results],
+                                  title=f"API 617 unbalance response — {rig_name}")
     ok = all(r.passed for r in results)
     head = f"<p><b>{esc(verdict_line(results))}</b></p>"
     rows = []

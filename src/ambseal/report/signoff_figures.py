@@ -173,7 +173,8 @@ def signoff_report(out: Path, results, rig_name: str, boundary=None) -> tuple[li
         f"<td>{'yes' if row.stable else 'NO'}</td></tr>"
         for r in results for row in r.level2.rows)
     level2 = ("<p>API 617 Level II at the maximum continuous speed, component by "
-              "component (first forward mode):</p><table><tr><th>controller</th>"
+              "component (the forward mode the sources act on):</p><table>"
+              "<tr><th>controller</th>"
               "<th>loop with</th><th>f (Hz)</th><th>δ</th><th>stable</th></tr>" + l2 +
               "</table>")
     note = ("<p>Each controller as it runs (the discrete controller with its delay). "

@@ -48,6 +48,7 @@ from typing import Any, Mapping
 import control
 import numpy as np
 
+from ambseal.design.modal_bands import with_modal_frequencies
 from ambseal.design.weights import diagonal_weight
 from ambseal.errors import ConfigError, ModelError
 from ambseal.lti import picklable
@@ -311,6 +312,7 @@ def generalized_plant(
     actuator_delay: Any = None,
     gain_weight: Any = None,
     damping_margins: tuple = (),
+    modal_bands: tuple = (),
 ) -> GeneralizedPlant:
     """Build the generalised plant of P5 Figs. 8–9 from a rig or a plant.
 
@@ -364,6 +366,10 @@ def generalized_plant(
         ``(f_hz, Δζ)`` pairs: every lightly damped mode of the design model within a
         factor 1.15 of f_hz is made Δζ less damped (:func:`less_damped`), so the
         controller must add that damping of its own.
+    modal_bands : tuple of ModeBand
+        Modes whose damped frequency is uncertain over the band it sweeps with speed
+        (:func:`ambseal.design.modal_bands.with_modal_frequencies`): each a real scalar
+        block after those of ``uncertainty``.
 
     Returns
     -------
@@ -393,7 +399,11 @@ def generalized_plant(
                                      force_disturbance is not None)
     if damping_margins:
         full = less_damped(full, damping_margins)
-    params = _ranges(full.select_inputs([full.input_names[i] for i in cur]), uncertainty or {})
+    uncertainty = dict(uncertainty or {})
+    if modal_bands:
+        full, ranges = with_modal_frequencies(full, modal_bands)
+        uncertainty.update(ranges)
+    params = _ranges(full.select_inputs([full.input_names[i] for i in cur]), uncertainty)
     centre = full.with_values({q.name: q.centre for q in params}) if params else full
     parts = _parts(centre, params, cur, fcols, Wp, Wu, input_disturbance, output_disturbance,
                    force_disturbance, d_e, d_u, actuator_delay, gain_weight)

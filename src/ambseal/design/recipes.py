@@ -51,12 +51,14 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any, Mapping
 
 import control
 import numpy as np
 
 from ambseal.config import method_names
+from ambseal.design.modal_bands import bands_near, mode_bands
 from ambseal.design.pid import pid_controller, reference_pid
 from ambseal.design.plant import (
     LIGHT_DAMPING,
@@ -66,7 +68,7 @@ from ambseal.design.plant import (
 )
 from ambseal.design.specs import design_spec
 from ambseal.design.weights import Weights
-from ambseal.errors import ConfigError, SynthesisError
+from ambseal.errors import ConfigError, ModelError, SynthesisError
 from ambseal.lti import lft_lower
 from ambseal.lti.freqresp import freqresp
 from ambseal.machine import judged_loop
@@ -79,6 +81,7 @@ from ambseal.robust import (
     musyn,
     musyn_dgk,
     reduce_controller,
+    unstable_poles,
 )
 from ambseal.threads import with_numerics_threads
 
@@ -233,15 +236,19 @@ def full_order_check(cfg, K, conditions) -> dict:
         ``stable`` (bool: every judged loop stable by
         :func:`ambseal.robust.stability.is_stable`) and, for the least stable condition,
         ``pressure_bar``, ``speed_hz``, ``max_real_pole`` (1/s) and its mode: ``mode_hz``
-        (damped frequency) and ``damping`` (ζ = −Re λ/|λ|, negative when unstable).
+        (damped frequency) and ``damping`` (ζ = −Re λ/|λ|, negative when unstable);
+        ``unstable``: every pole in the right half-plane at every condition, as
+        ``{"mode_hz", "speed_hz", "pressure_bar"}`` (empty when stable).
     """
 
     L = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples).system
-    worst = None
+    worst, lost = None, []
     for p, f in conditions:
         plant = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * f)
         judged = judged_loop(plant.to_statespace(), K, plant.current_inputs(), delay=L)
         lam = judged.loop.poles
+        lost += [{"mode_hz": float(x.imag / (2 * np.pi)), "speed_hz": float(f),
+                  "pressure_bar": float(p)} for x in unstable_poles(lam) if x.imag >= 0]
         z = lam[int(np.argmax(lam.real))]
         rank = (not judged.stable, z.real / np.abs(lam).max())
         if worst is None or rank > worst[0]:
@@ -249,7 +256,7 @@ def full_order_check(cfg, K, conditions) -> dict:
     (unstable, _), p, f, z = worst
     return {"stable": not unstable, "pressure_bar": float(p), "speed_hz": float(f),
             "max_real_pole": float(z.real), "mode_hz": float(abs(z.imag) / (2 * np.pi)),
-            "damping": float(-z.real / max(abs(z), 1e-300))}
+            "damping": float(-z.real / max(abs(z), 1e-300)), "unstable": lost}
 
 
 @with_numerics_threads
@@ -386,17 +393,29 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
     conditions = [(q, f) for q in sp.pressures_bar
                   for f in sorted({*sp.speeds_hz, *sp.stability_speeds_hz})]
     margins: dict[float, float] = {}
+    bands: list = []  # modes whose frequency μ takes as uncertain over their speed band
+    swept = None      # (states, every band) of the design model, found when first needed
     plain = None  # the last design without margins: delivered if no margin holds the loop
     for attempt in range(enlarge + 1):
         r = _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl,
                         tuple(margins.items()),
-                        progress and (lambda line: progress(f"{method}: {line}")))
+                        progress and (lambda line: progress(f"{method}: {line}")), tuple(bands))
         check = full_order_check(cfg, r.K, conditions)
         if not margins:
             plain = (r, check, n)
         if check["stable"] or attempt == enlarge:
             break
         n_new = n if states is not None else _states_to_keep(cfg, p, check["mode_hz"])
+        new = []
+        if n_new <= n and method in method_names(robust=True):
+            # every mode lost away from the design speed, not only the least stable one:
+            # one design step for all the bands they call for
+            swept = _swept(cfg, conditions, n, swept)
+            away = {c["mode_hz"] for c in check["unstable"]
+                    if abs(c["speed_hz"] - swept[2]) > 1e-9}
+            new = sorted({b for f in away for b in bands_near(swept[1], f)} - set(bands),
+                         key=lambda b: b.f_hz)
+            new = new if abs(check["speed_hz"] - swept[2]) > 1e-9 else []
         if n_new > n:
             steps.append(f"{method}: full-order loop unstable at {check['mode_hz']:.4g} Hz "
                          f"(ζ = {check['damping']:.3g}, {check['pressure_bar']:g} bar); design "
@@ -405,6 +424,15 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
             top = 1.5 * check["mode_hz"]
             if om is None and top > sp.synthesis_band_hz[1]:
                 om = design_omega(sp.synthesis_band_hz[0], top)
+        elif new:
+            # the design speed's plant puts the mode elsewhere than the speed that lost it:
+            # μ holds the band the mode sweeps when its frequency is uncertain over it
+            bands += new
+            steps.append(f"{method}: full-order loop unstable at {check['mode_hz']:.4g} Hz "
+                         f"(ζ = {check['damping']:.3g}, {check['pressure_bar']:g} bar, "
+                         f"{check['speed_hz']:g} Hz), where the gyroscopic moments move a mode "
+                         "the design model keeps: its frequency made uncertain over the band it "
+                         "sweeps with speed, " + ", ".join(b.text() for b in new))
         else:
             # a lightly damped mode the model keeps, barely damped by the design: a margin
             # on it (a rigid-body mode the loop no longer holds is no such mode)
@@ -426,6 +454,20 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
                      "without margins is delivered")
         r, check, n = plain
     return r, check, n
+
+
+def _swept(cfg, conditions, n: int, swept):
+    """``(n, bands, design speed Hz)``: every mode band of the n-state design model over the
+    judged speeds (:func:`ambseal.design.modal_bands.mode_bands`), ``swept`` again if it is
+    for n states already; no bands where the LPV model cannot be made."""
+    f0 = cfg.operating.speed_rpm / 60.0
+    if swept is not None and swept[0] == n:
+        return swept
+    try:
+        bands = mode_bands(cfg, [f for _, f in conditions], design_speed_hz=f0, states=n)
+    except ModelError:
+        bands = ()
+    return n, bands, f0
 
 
 #: The damping-ratio margin a lost kept mode gets first (on top of twice the damping the
@@ -461,10 +503,11 @@ class _Synthesis:
 
 
 def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl,
-                margins=(), progress=None):
+                margins=(), progress=None, bands=()):
     """One synthesis on an n-state design model (with ``margins``, see
-    :func:`ambseal.design.plant.less_damped`), reduced, as a physical controller;
-    ``progress(line)`` gets μ's iterations."""
+    :func:`ambseal.design.plant.less_damped`; μ with ``bands`` of uncertain mode frequency,
+    :func:`ambseal.design.modal_bands.with_modal_frequencies`), reduced, as a physical
+    controller; ``progress(line)`` gets μ's iterations."""
 
     robust = method in method_names(robust=True)  # against the uncertain parameters
     Wf = w.Wf()
@@ -473,7 +516,8 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
                            pressure_bar=p, states=n, input_disturbance=w.W1(),
                            force_disturbance=Wf, force_positions=fpos, d_e=w.d_e, d_u=w.d_u,
                            actuator_delay=dl.system,
-                           gain_weight=w.Wk(), damping_margins=margins)
+                           gain_weight=w.Wk(), damping_margins=margins,
+                           modal_bands=bands if robust else ())
     mu_omega = None
     if not robust:  # nominal H∞
         r = hinfsyn(gp.P_nominal, gp.nmeas, gp.ncon)
@@ -485,7 +529,8 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
     else:
         if om is None:
             om = design_omega(*sp.synthesis_band_hz)
-        syn = musyn_dgk if sp.mu_iteration == "dgk" else musyn
+        # D–G–K only where complex D–K leaves robust performance unmet (μ > 1)
+        syn = (partial(musyn_dgk, target=1.0) if sp.mu_iteration == "dgk" else musyn)
         r = syn(gp.P, gp.blocks, gp.nmeas, gp.ncon, om, order=dk_order, max_iter=max_iter,
                 progress=progress or False)
         K_P, gamma, mu, hist = r.K, float(r.gamma), float(r.mu), r.history
@@ -596,7 +641,9 @@ def _unstable_message(method, check, n, steps, cut_hz, lost=(True, False, 0.0)) 
                  f"({f0:.6g} Hz), and the gyroscopic moments move it at "
                  f"{check['speed_hz']:g} Hz: a controller scheduled on speed holds it over "
                  "the range (ambseal design --method lpv, with [operating] speed_range_hz; "
-                 "ambseal run adds it)")
+                 "ambseal run adds it)" + (
+                     ", or μ, which takes the mode's frequency as uncertain over the band it "
+                     "sweeps (ambseal design --method mu)" if method == "hinf" else ""))
         if not by_pressure:
             return head + speed + ", or pass --allow-unstable"
         return head + speed + (f"; the loop is lost at {check['pressure_bar']:g} bar at the "

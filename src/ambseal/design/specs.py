@@ -228,7 +228,8 @@ class DesignSpec:
         ``{"hinf" | "mu" | "lpv": Weights}`` (read-only).
     max_iter, dk_order : int
     mu_iteration : {"dgk", "dk"}
-        μ synthesis: D–G–K (real parameters kept real, Young 1996) or complex D–K.
+        μ synthesis: D–G–K (real parameters kept real, Young 1996; its steps taken only
+        where complex D–K leaves μ above 1) or complex D–K.
     sources : Mapping
         ``{key: "set" | rule text}``: where each value came from (read-only).
     notes : tuple of str

@@ -1,0 +1,120 @@
+"""A flexible mode's natural frequency as an uncertain parameter of μ over the band the
+gyroscopic moments sweep it through (:mod:`ambseal.design.modal_bands`)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ambseal.config import load_rig
+from ambseal.design.modal_bands import (
+    ModeBand,
+    bands_near,
+    mode_bands,
+    with_modal_frequencies,
+)
+from ambseal.design.plant import generalized_plant
+from ambseal.design.weights import control_weight, performance_weight
+from ambseal.errors import ModelError
+from ambseal.model import build_system
+from ambseal.model.lft import Plant
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+def _mixed_oscillators(modes, seed=1) -> Plant:
+    """Oscillators (f_hz, ζ) and a real pole, seen through a random change of state
+    coordinates (so no eigenvector is a unit vector)."""
+    blocks = [np.array([[40.0]])]
+    for f, z in modes:
+        w = 2 * np.pi * f
+        blocks.append(np.array([[0.0, 1.0], [-w * w, -2 * z * w]]))
+    n = 1 + 2 * len(modes)
+    A = np.zeros((n, n))
+    i = 0
+    for b in blocks:
+        A[i:i + b.shape[0], i:i + b.shape[0]] = b
+        i += b.shape[0]
+    T = np.eye(n) + 0.3 * np.random.default_rng(seed).standard_normal((n, n))
+    A = T @ A @ np.linalg.inv(T)
+    return Plant(A, np.ones((n, 1)), np.ones((1, n)), np.zeros((1, 1)), ("i_A_x",),
+                 ("y_A_x",), tuple(f"x{k}" for k in range(n)))
+
+
+def test_the_parameter_moves_its_mode_to_the_square_root_and_nothing_else():
+    """Closed form: with θ the parameter, the mode's eigenvalues are σ ± j√θ (σ kept), every
+    other eigenvalue where it was; the range is the band's shifts applied to the plant's
+    own damped frequency, squared."""
+    plant = _mixed_oscillators([(100.0, 0.01), (400.0, 0.005)])
+    lam0 = np.linalg.eigvals(plant.A)
+    band = ModeBand(f_hz=400.0, lo_hz=380.0, hi_hz=410.0)
+    out, ranges = with_modal_frequencies(plant, [band])
+    assert np.array_equal(out.A, plant.A)
+    wd = 2 * np.pi * 400.0 * np.sqrt(1 - 0.005 ** 2)
+    lo, hi = ranges[band.name]
+    assert (lo, hi) == pytest.approx(((wd - 2 * np.pi * 20) ** 2, (wd + 2 * np.pi * 10) ** 2))
+    sigma = -0.005 * 2 * np.pi * 400.0
+    for theta in (lo, hi, 0.5 * (lo + hi)):
+        lam = np.linalg.eigvals(out.with_values({band.name: theta}).A)
+        moved = [sigma + 1j * np.sqrt(theta), sigma - 1j * np.sqrt(theta)]
+        kept = [x for x in lam0 if abs(abs(x.imag) - wd) > 1.0]
+        assert np.sort_complex(lam) == pytest.approx(np.sort_complex(np.r_[kept, moved]),
+                                                     rel=1e-8)
+
+
+def test_a_band_without_its_mode_is_refused():
+    plant = _mixed_oscillators([(100.0, 0.01)])
+    with pytest.raises(ModelError, match="no lightly damped mode near 300"):
+        with_modal_frequencies(plant, [ModeBand(300.0, 290.0, 310.0)])
+
+
+def test_the_bands_a_lost_mode_calls_for():
+    """The lost mode's own band (widened 5 %) and every band below it; none above."""
+    bands = [ModeBand(316.0, 315.0, 378.0), ModeBand(433.0, 378.0, 434.0),
+             ModeBand(647.0, 645.0, 756.0), ModeBand(885.0, 756.0, 887.0)]
+    assert bands_near(bands, 397.0) == bands[:2]
+    assert bands_near(bands, 797.5) == bands
+    assert bands_near(bands, 290.0) == []
+
+
+@pytest.fixture(scope="module")
+def overhung():
+    return load_rig(EXAMPLES / "overhung_compressor.toml")
+
+
+def test_bands_end_at_the_full_order_modes_at_standstill_and_top_speed(overhung):
+    """The overhung impeller's pair: followed on the 36-state design model over 0–305 Hz,
+    its backward whirl runs from the standstill frequency down to its top-speed one, the
+    forward whirl up from it; both ends are the full-order rotor's damped frequencies at
+    those speeds (its dense eigenvalues, no projection, no tracking) within 0.5 %."""
+    bands = mode_bands(overhung, [0.0, 150.0, 305.0], design_speed_hz=300.0, states=36)
+    pair = [b for b in bands if 250.0 < b.f_hz < 500.0]
+    assert len(pair) == 2
+
+    def damped_hz(speed_hz):
+        sys = build_system(overhung, speed_rpm=60.0 * speed_hz)
+        lam = sys.poles()
+        return np.sort(lam.imag[(lam.imag > 2 * np.pi * 250) & (lam.imag < 2 * np.pi * 500)]
+                       / (2 * np.pi))
+
+    f0, f_top, f_305 = damped_hz(0.0), damped_hz(300.0), damped_hz(305.0)
+    backward, forward = pair
+    assert backward.f_hz == pytest.approx(f_top[0], rel=5e-3)
+    assert forward.f_hz == pytest.approx(f_top[1], rel=5e-3)
+    assert backward.hi_hz == pytest.approx(f0[0], rel=5e-3)
+    assert forward.lo_hz == pytest.approx(f0[1], rel=5e-3)
+    assert backward.lo_hz == pytest.approx(f_305[0], rel=5e-3)
+    assert forward.hi_hz == pytest.approx(f_305[1], rel=5e-3)
+
+
+def test_mu_gets_one_real_scalar_per_band(overhung):
+    """In the generalised plant each band is one real scalar block after the seals', with
+    the range :func:`with_modal_frequencies` gives."""
+    bands = mode_bands(overhung, [0.0, 305.0], design_speed_hz=300.0, states=36)[:2]
+    gp = generalized_plant(overhung, performance_weight(2.5, 60.0), control_weight(1.0),
+                           states=36, uncertainty={}, modal_bands=bands)
+    assert gp.blocks[:-1] == ((-1, 0), (-1, 0))
+    assert [q.name for q in gp.parameters] == [b.name for b in bands]
+    assert all(q.low < q.nominal <= q.high * (1 + 1e-12) for q in gp.parameters)

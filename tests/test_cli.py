@@ -1,6 +1,7 @@
 """The CLI: one clear line and exit status 2 on every bad rig file, JSON from ``modes``."""
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -90,6 +91,37 @@ def test_cli_no_traceback_in_a_real_process(tmp_path):
                           capture_output=True, text=True)
     assert proc.returncode == 2
     assert "Traceback" not in proc.stderr and "shaft[0].length" in proc.stderr
+
+
+def test_the_console_ignores_the_environments_matplotlib_backend(tmp_path):
+    """ambseal draws on Agg canvases, never through pyplot: a backend matplotlib cannot
+    load (MPLBACKEND named by a shell, a notebook kernel or a typo) stopped its import with
+    a traceback; the figure is written all the same."""
+    rig = tmp_path / "rig.toml"
+    rig.write_text(GOOD)
+    env = dict(os.environ, MPLBACKEND="no_such_backend")
+    proc = subprocess.run([sys.executable, "-m", "ambseal.cli", "modes", str(rig), "--shapes"],
+                          capture_output=True, text=True, cwd=tmp_path, env=env)
+    assert proc.returncode == 0, proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert (tmp_path / "mode_shapes.png").stat().st_size > 0
+
+
+def test_the_console_runs_with_stdout_or_stderr_closed(tmp_path):
+    """A shell's ``2>&-`` or ``>&-``: Python starts with None for that stream, and the first
+    message (rich's isatty) ended in exit 1 and nothing said. The exit status is the
+    command's: 2 for a bad rig, 0 for a good one."""
+    bad, good = tmp_path / "bad.toml", tmp_path / "good.toml"
+    bad.write_text(GOOD.replace("length = 0.5", "length = -0.5"))
+    good.write_text(GOOD)
+    script = "import sys; from ambseal.cli import main; sys.exit(main())"
+    for fd in (1, 2):
+        for rig, code in ((bad, 2), (good, 0)):
+            proc = subprocess.run([sys.executable, "-c", script, "validate", str(rig)],
+                                  preexec_fn=lambda fd=fd: os.close(fd),
+                                  stdout=subprocess.DEVNULL if fd == 2 else None,
+                                  stderr=subprocess.DEVNULL if fd == 1 else None)
+            assert proc.returncode == code, (fd, rig.name)
 
 
 def test_modes_json_keys_and_unstable_poles(tmp_path, capsys):

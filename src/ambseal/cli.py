@@ -467,8 +467,19 @@ def main(argv: list[str] | None = None) -> int:
     Warnings raised on the way (numpy's, say) are shown after a successful command and
     dropped when the command ends in the one error line."""
 
+    # a shell may start us with stdout or stderr closed (`2>&-`): Python has None there and
+    # the first message (or rich's isatty) would fail with exit 1; they go nowhere instead,
+    # and the exit status is the command's
+    for stream in ("stdout", "stderr"):
+        if getattr(sys, stream) is None:
+            setattr(sys, stream, open(os.devnull, "w", encoding="utf-8"))
     parser = _parser()
     args = parser.parse_args(argv)
+    if argv is None:
+        # the console script's own process draws on Agg canvases and never through pyplot:
+        # the environment's MPLBACKEND (a Jupyter kernel's inline backend under `!ambseal`,
+        # or one that does not exist, which stops matplotlib's import) is not ours to load
+        os.environ.pop("MPLBACKEND", None)
     try:
         blas_threads(args.blas_threads)
     except AmbsealError as exc:

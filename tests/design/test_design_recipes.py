@@ -12,14 +12,20 @@ closed-loop pole: the first bending mode (≈ 557 Hz) has closed-loop damping ra
 the log grid but 5.8 at 556.8 Hz, 4.08 bar).
 """
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from ambseal.analysis.loops import compliance, loop_responses
 from ambseal.machine.loop import closed_loop
 from ambseal.analysis.unbalance import unbalance_from_compliance
-from ambseal.design.recipes import _unstable_message, design
+from ambseal.design.plant import UncertainParameter
+from ambseal.design.recipes import _outside, _unstable_message, design
 from ambseal.design.weights import Weights
+from ambseal.config import load_rig
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 OMEGA = 2 * np.pi * np.logspace(-1, np.log10(3000.0), 800)
 #: ISO 14839-3:2006 zone A/B boundary of the sensitivity peak (3, i.e. 9.5 dB; P5 §4.1).
@@ -258,3 +264,30 @@ def test_a_mode_lost_at_another_speed_is_blamed_on_the_speed_not_the_seal():
     assert "gyroscopic" in msg and "[[design.uncertainty]]" in msg
     msg = _unstable_message("hinf", check, 30, [], 1000.0, (True, False, 183.333))
     assert "[[design.uncertainty]]" in msg and "--method lpv" not in msg
+
+
+def test_a_mu_refusal_names_the_parameter_it_was_not_robust_to():
+    """The back-to-back compressor's μ robust to the division wall's k over 0–9.96 MN/m
+    (±100 % at 60 bar): at 120 bar its k is 8.3e4·120 = 9.96e6 N/m (the rig file's
+    affine law), on the range's edge, and its K (1.5e4·120 = 1.8e6 N/m) and C
+    (100 + 220·120 N·s/m) differ from the design's 60 bar values and are not uncertain; at
+    0 bar the eye labyrinths' k is 0 against 6e5 N/m. The refusal names each, the
+    parameter and its value there, never only "widen the uncertainty"; with nothing
+    outside, it names the bandwidth and the design-model states instead."""
+    cfg = load_rig(EXAMPLES / "b2b_compressor.toml")
+    f0 = cfg.operating.speed_rpm / 60.0
+    k = UncertainParameter("division_wall.k", 4.98e6, 0.0, 9.96e6, 2, "N/m")
+    out = _outside(cfg, (k,), {"pressure_bar": 120.0, "speed_hz": f0}, 60.0)
+    assert any(o.startswith("division_wall.K = 1.8e+06 N/m") and "9e+05" in o for o in out)
+    assert any(o.startswith("division_wall.C = 2.65e+04 N*s/m") for o in out)
+    assert not any(o.startswith("division_wall.k") for o in out)
+    narrow = UncertainParameter("division_wall.k", 4.98e6, 2e6, 8e6, 2, "N/m")
+    out = _outside(cfg, (narrow,), {"pressure_bar": 120.0, "speed_hz": f0}, 60.0)
+    assert "division_wall.k = 9.96e+06 N/m there, outside its range 2e+06–8e+06" in out
+    out = _outside(cfg, (k,), {"pressure_bar": 0.0, "speed_hz": f0}, 60.0)
+    assert any(o.startswith("eye_labyrinths.k = 0 N/m there against 6e+05") for o in out)
+    check = {"mode_hz": 6.5, "damping": -0.3, "pressure_bar": 0.0, "speed_hz": f0}
+    msg = _unstable_message("mu", check, 30, [], 1000.0, (True, False, f0), out)
+    assert "eye_labyrinths.k = 0 N/m" in msg and "[[design.uncertainty]]" in msg
+    msg = _unstable_message("mu", check, 30, [], 1000.0, (True, False, f0), [])
+    assert "omega_b_rad_s" in msg and "design.model_states" in msg

@@ -369,7 +369,8 @@ def design(
         enlarge, steps, progress)
     if not check["stable"] and not allow_unstable:
         raise SynthesisError(_unstable_message(method, check, n, steps, _top_mode_hz(cfg, p, n),
-                                               _lost_by(cfg, r.K, check, p)))
+                                               _lost_by(cfg, r.K, check, p),
+                                               _outside(cfg, r.gp.parameters, check, p)))
     return DesignResult(
         method, r.K, p, gamma=r.gamma, mu=r.mu, order=int(r.K.nstates),
         order_full=r.order_full, history=tuple(r.history), weights=w,
@@ -394,7 +395,7 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
                   for f in sorted({*sp.speeds_hz, *sp.stability_speeds_hz})]
     margins: dict[float, float] = {}
     bands: list = []  # modes whose frequency μ takes as uncertain over their speed band
-    swept = None      # (states, every band) of the design model, found when first needed
+    swept = None  # (states, every band) of the design model, found when first needed
     plain = None  # the last design without margins: delivered if no margin holds the loop
     for attempt in range(enlarge + 1):
         r = _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl,
@@ -406,16 +407,15 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
         if check["stable"] or attempt == enlarge:
             break
         n_new = n if states is not None else _states_to_keep(cfg, p, check["mode_hz"])
-        new = []
-        if n_new <= n and method in method_names(robust=True):
+        new, f0 = [], cfg.operating.speed_rpm / 60.0
+        if (n_new <= n and method in method_names(robust=True)
+                and abs(check["speed_hz"] - f0) > 1e-9):
             # every mode lost away from the design speed, not only the least stable one:
             # one design step for all the bands they call for
-            swept = _swept(cfg, conditions, n, swept)
-            away = {c["mode_hz"] for c in check["unstable"]
-                    if abs(c["speed_hz"] - swept[2]) > 1e-9}
+            swept = _swept(cfg, conditions, n, f0, swept)
+            away = {c["mode_hz"] for c in check["unstable"] if abs(c["speed_hz"] - f0) > 1e-9}
             new = sorted({b for f in away for b in bands_near(swept[1], f)} - set(bands),
                          key=lambda b: b.f_hz)
-            new = new if abs(check["speed_hz"] - swept[2]) > 1e-9 else []
         if n_new > n:
             steps.append(f"{method}: full-order loop unstable at {check['mode_hz']:.4g} Hz "
                          f"(ζ = {check['damping']:.3g}, {check['pressure_bar']:g} bar); design "
@@ -456,18 +456,17 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
     return r, check, n
 
 
-def _swept(cfg, conditions, n: int, swept):
-    """``(n, bands, design speed Hz)``: every mode band of the n-state design model over the
-    judged speeds (:func:`ambseal.design.modal_bands.mode_bands`), ``swept`` again if it is
-    for n states already; no bands where the LPV model cannot be made."""
-    f0 = cfg.operating.speed_rpm / 60.0
+def _swept(cfg, conditions, n: int, f0: float, swept):
+    """``(n, bands)``: every mode band of the n-state design model, designed at ``f0`` Hz,
+    over the judged speeds (:func:`ambseal.design.modal_bands.mode_bands`), ``swept`` again
+    if it is for n states already; no bands where the LPV model cannot be made."""
     if swept is not None and swept[0] == n:
         return swept
     try:
         bands = mode_bands(cfg, [f for _, f in conditions], design_speed_hz=f0, states=n)
     except ModelError:
         bands = ()
-    return n, bands, f0
+    return n, bands
 
 
 #: The damping-ratio margin a lost kept mode gets first (on top of twice the damping the
@@ -627,9 +626,32 @@ def _lost_by(cfg, K, check, p: float) -> tuple[bool, bool, float]:
     return lost[0] or not lost[1], lost[1], f0
 
 
-def _unstable_message(method, check, n, steps, cut_hz, lost=(True, False, 0.0)) -> str:
+def _outside(cfg, params, check, p: float) -> list[str]:
+    """What the design was not robust to at ``check``'s condition: each uncertain
+    parameter whose value there lies outside its range, and each parameter the design took
+    as fixed whose value there differs from the design point's (pressure ``p`` bar, the
+    design speed) by more than 1 %, one phrase each."""
+    there = build_plant(cfg, pressure_bar=check["pressure_bar"],
+                        speed_rpm=60.0 * check["speed_hz"]).parameters
+    design_point = build_plant(cfg, pressure_bar=p).parameters
+    ranges = {q.name: q for q in params}
+    out = []
+    for name, par in there.items():
+        v, q = par.nominal, ranges.get(name)
+        if q is not None and not q.low <= v <= q.high:
+            out.append(f"{name} = {v:.4g} {par.unit} there, outside its range "
+                       f"{q.low:.4g}–{q.high:.4g}")
+        elif q is None and name in design_point and abs(
+                v - (v0 := design_point[name].nominal)) > 0.01 * max(abs(v), abs(v0)):
+            out.append(f"{name} = {v:.4g} {par.unit} there against {v0:.4g} in the design, "
+                       "and not uncertain in it")
+    return out
+
+
+def _unstable_message(method, check, n, steps, cut_hz, lost=(True, False, 0.0),
+                      outside=()) -> str:
     """The refusal's one line; ``lost`` = (by the pressure, by the speed, design speed Hz)
-    of :func:`_lost_by`."""
+    of :func:`_lost_by`; ``outside``: :func:`_outside` of the design's parameters."""
     tried = f" after {len(steps)} automatic design step(s)" if steps else ""
     head = (f"design({method}): the controller destabilises the full-order plant{tried}: the "
             f"mode at {check['mode_hz']:.4g} Hz has damping ζ = {check['damping']:.3g} at "
@@ -654,10 +676,18 @@ def _unstable_message(method, check, n, steps, cut_hz, lost=(True, False, 0.0)) 
                        f"only ({check['pressure_bar']:g} bar is another plant): the μ design "
                        "with that condition in [[design.uncertainty]] is the robust one, or "
                        "pass --allow-unstable")
+    if check["mode_hz"] < cut_hz and outside:
+        return head + ("the design model keeps that mode, and the plant there is outside what "
+                       "the design was robust to: " + "; ".join(outside) + ": a range in "
+                       "[[design.uncertainty]] that covers it holds it, or pass "
+                       "--allow-unstable")
     if check["mode_hz"] < cut_hz:
-        return head + ("the design model keeps that mode, so the plant at that condition is "
-                       "outside what the design was robust to: widen [[design.uncertainty]] "
-                       "to cover it, or pass --allow-unstable")
+        # robust to every parameter there: what the design model leaves out lost it
+        return head + ("the design model keeps that mode and the plant there is within every "
+                       "uncertain range, so what the design model leaves out (the sampling, "
+                       "the modes it truncates) took its damping: a lower bandwidth holds it "
+                       f"(a smaller [design.{method}] omega_b_rad_s), or more design-model "
+                       "states (design.model_states); or pass --allow-unstable")
     return head + (f"the design model ({n} states) should keep it: set "
                    f"design.model_cutoff_hz above {check['mode_hz']:.4g} (or "
                    "design.model_states), or pass --allow-unstable")

@@ -153,54 +153,6 @@ def _osborne_init(M, blks, S, sweeps=8):
     return z.T
 
 
-#: A matrix whose balancing scalings span more than this factor is solved balanced; below
-#: it the Osborne start reaches the optimum (4×4 random stacks scaled by D·M·D⁻¹: at a
-#: span of 1e2 the unbalanced bound was within 4e-7, at 1e4 8 % high, at 1e6 21× high)
-#: and the solve is left as it was.
-BALANCE_SPAN = 10.0
-
-
-def _balancing(M, blks, S, sweeps=200, rtol=1e-3):
-    """T (F, N): per matrix, one positive scalar per block (so T commutes with the
-    structure) that balances the blocks' norms, ‖(T M T⁻¹)_jk‖ against ‖(T M T⁻¹)_kj‖
-    (:func:`osborne_scalings` of the block norms), repeated over each block's size."""
-    nb, offs = len(blks), S.offs
-    Bn = np.empty((M.shape[0], nb, nb))
-    for j in range(nb):
-        for k in range(nb):
-            Bn[:, j, k] = np.sum(np.abs(M[:, offs[j]:offs[j + 1], offs[k]:offs[k + 1]]) ** 2,
-                                 axis=(1, 2))
-    return np.repeat(osborne_scalings(Bn, sweeps, rtol), [b.size for b in blks], axis=1)
-
-
-def osborne_scalings(Bn, sweeps=200, rtol=1e-3):
-    """Balancing scalings t (F, nb) of block norms: ``Bn[f, j, k] = ‖M_jk‖²``, and t such
-    that in ``t_j M_jk / t_k`` every block row's norm equals its block column's (Osborne
-    1960, unclipped, to ``rtol``), geometric mean 1."""
-    F, nb = Bn.shape[:2]
-    Bn = np.array(Bn, float)
-    Bn[:, np.arange(nb), np.arange(nb)] = 0.0
-    # a zero block (block-triangular M) would send its scaling to 0 or ∞: zeros count as
-    # 1e-8 of the smallest block there is (a floor relative to the largest would swamp the
-    # small blocks of a stack in other units: squared norms span 50 decades when M's
-    # entries span 25)
-    off = ~np.eye(nb, dtype=bool)
-    small = np.where(Bn > 0, Bn, np.inf)[:, off].min(axis=1) if nb > 1 else np.ones(F)
-    small = np.where(np.isfinite(small), small, 1.0)
-    Bn = np.where(Bn > 0, Bn, 1e-8 * small[:, None, None])
-    d = np.ones((F, nb))  # d = t²
-    for _ in range(sweeps):
-        num = np.einsum("fkj,fk->fj", Bn, d)
-        den = np.einsum("fjk,fk->fj", Bn, 1.0 / d)
-        new = np.sqrt(d * np.sqrt(num / den))  # half steps: the full one can oscillate
-        new = new / np.exp(np.mean(np.log(new), axis=1, keepdims=True))
-        done = np.all(np.abs(new / d - 1.0) < rtol)
-        d = new
-        if done:
-            break
-    return np.sqrt(d)
-
-
 class _Problem:
     """The normalised stack M (F, N, N) and its affine scalings.
 
@@ -439,14 +391,6 @@ def upper_bound(Mp, blks, tol, max_iter, gmax, *, stride=0, t0_factor=1.2, warm_
     F = Mp.shape[0]
     peak_tol = 1e-3 * tol if peak_tol is None else peak_tol
     S = structure(blks)
-    # μ is invariant under T M T⁻¹ for T commuting with the structure, the solver is not:
-    # its D moves affinely from the Osborne start, and a stack in other units (D·M·D⁻¹
-    # with D spanning 12 decades) left it at bounds 3e4 times too high. It solves the
-    # balanced stack, and the certificate comes back as (T D T, T G T): the same
-    # generalised eigenvalue for M.
-    t = _balancing(Mp, blks, S)
-    t[t.max(axis=1) / t.min(axis=1) <= BALANCE_SPAN] = 1.0
-    Mp = t[:, :, None] * Mp / t[:, None, :]
     nrm = np.linalg.norm(Mp, ord=2, axis=(-2, -1))
     nrm = np.where(nrm > 0, nrm, 1.0)
     M = Mp / nrm[:, None, None]
@@ -470,8 +414,4 @@ def upper_bound(Mp, blks, tol, max_iter, gmax, *, stride=0, t0_factor=1.2, warm_
     upper = np.sqrt(np.maximum(_gevp(D, A), 0.0)) * nrm
     # the LMI is homogeneous in (D, G); M was divided by nrm, so G scales with nrm
     G = P.G(best_z) * nrm[:, None, None]
-    # back to M's units: Mᴴ(TDT)M + j(TGT·M − Mᴴ·TGT) ⪯ β² TDT, then tr D = N again
-    tt = t[:, :, None] * t[:, None, :]
-    D, G = D * tt, G * tt
-    c = S.N / np.real(np.trace(D, axis1=1, axis2=2))
-    return upper, _herm(D * c[:, None, None]), _herm(G * c[:, None, None]), S.offs
+    return upper, _herm(D), _herm(G), S.offs

@@ -280,11 +280,6 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
         (measured on a 108-state loop, 500 frequencies: peak within 3e-10 of a
         ``tol = 1e-6`` solve; refining only the largest, one at a time, had left it 2.6e-4
         above).
-        Channels in any units: a matrix whose block norms need scalings spanning more
-        than a factor 10 to balance (``T M T⁻¹``, T one positive scalar per block, Osborne
-        1960) is solved balanced and its certificate mapped back — μ does not depend on T,
-        and the solver's start and steps would (D·M·D⁻¹ with D = diag(1e6, 1e−6, 1e3, 1)
-        gave 93 065 for a μ of 3.25).
     max_iter : int
         Outer iterations of the upper-bound solver.
     lower_iter : int

@@ -118,6 +118,20 @@ def test_dgk_result_holds_by_a_parameter_sweep(complex_dk):
         assert np.max(perf) <= r.mu * (1 + 1e-6)
 
 
+def test_a_target_complex_dk_meets_skips_the_dgk_steps(complex_dk):
+    """``target``: complex D–K's result as it is (its controller and μ, no D–G–K step, the
+    rule saying why) when its μ is at or below the target; D–G–K steps when above."""
+    P, w = gain_plant(), W_GRID
+    dk = complex_dk(R)
+    kept = musyn_dgk(P, BLOCKS, 1, 1, w, max_iter=6, target=dk.mu * 1.01)
+    assert kept.mu == pytest.approx(dk.mu, rel=1e-12)
+    assert kept.K.nstates == dk.K.nstates and np.allclose(kept.K.A, dk.K.A)
+    assert {h["step"] for h in kept.history} <= {"D-K", "D search"}
+    assert kept.stopping["dgk"]["iterations"] == 0 and "target" in kept.stopping["dgk"]["rule"]
+    stepped = musyn_dgk(P, BLOCKS, 1, 1, w, max_iter=6, target=dk.mu * 0.5)
+    assert "D-G-K" in {h["step"] for h in stepped.history} and stepped.mu < dk.mu
+
+
 def test_design_mu_iteration_key_defaults_to_dgk():
     """[design.mu] iteration: "dgk" by default (the rig's real seal parameters), "dk" by
     --set; anything else refused naming the key."""

@@ -420,7 +420,7 @@ def _by_condition(fn, jobs, shared: dict, on_done) -> list:
     condition in turn, results in the jobs' order: the condition's full-order plant and its
     sampled form are then built once and found in their memos by the next controllers
     (:func:`ambseal.model.build_plant`, :func:`ambseal.lti.discrete.zoh`), instead of
-    once per controller (b2b compressor: 36 of 54 builds and samplings, ~3 s)."""
+    once per controller."""
     order = sorted(range(len(jobs)), key=lambda i: (jobs[i].point.pressure_bar,
                                                     jobs[i].point.speed_rpm))
     done = run_cases(fn, [jobs[i] for i in order], shared=shared, workers=1,

@@ -22,9 +22,10 @@ mode's frequency is one of the uncertain parameters, over the band it sweeps:
   mode's squared damped frequency, entering A affinely as the LFT of thesis P1 Eqs. 46–52
   asks. The real parameter is one scalar block (Young's D–G–K keeps it real).
 
-This is the "modal parameter uncertainty" of flexible-structure robust control (e.g.
-Balas & Doyle, IEEE TCST 2(3), 1994, natural frequencies of a flexible structure as real
-parametric uncertainty in μ-synthesis).
+This is the modal-parameter uncertainty of flexible-structure robust control (natural
+frequencies as real parametric uncertainty in μ-synthesis; e.g. Balas & Doyle,
+"Robustness and performance trade-offs in control design for flexible structures", IEEE
+Transactions on Control Systems Technology, 1994).
 """
 
 from __future__ import annotations
@@ -156,9 +157,21 @@ def bands_near(bands, f_hz: float) -> list[ModeBand]:
     """The bands a mode lost at ``f_hz`` calls for: those whose sweep starts below
     ``f_hz`` widened by :data:`BAND_MATCH` — the lost mode's own (the controller moves a
     closed-loop mode a little off its open-loop frequency) and every sweeping mode below
-    it, which the controller has to phase-stabilise as well and which, left frozen, is
-    the next one lost (the overhung compressor example: 885 Hz, then 388 Hz, then 758 Hz
-    one design after the other)."""
+    it, which the controller has to phase-stabilise as well and which, left frozen, would
+    be the next one lost.
+
+    Parameters
+    ----------
+    bands : iterable of ModeBand
+        The design model's bands (:func:`mode_bands`).
+    f_hz : float
+        Damped frequency of the lost closed-loop mode (Hz).
+
+    Returns
+    -------
+    list of ModeBand
+        In the order of ``bands``.
+    """
     return [b for b in bands if b.lo_hz / BAND_MATCH <= f_hz]
 
 

@@ -233,8 +233,7 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
     target : float, optional
         A μ level the design asks for (1: robust performance): when complex D–K's μ is at
         or below it, its result is returned without D–G–K steps, which would only lower a
-        bound already met (they cost ~25 s on the 110-state b2b compressor design, about
-        twice its D–K phase, and there lowered nothing). None: D–G–K always.
+        bound already met. None: D–G–K always.
     progress : bool or callable
         As in :func:`~ambseal.robust.dk.musyn`.
 
@@ -267,12 +266,12 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
     blks = check_blocks(P, blocks, nmeas, ncon)
     if not any(b.kind == "real" for b in blks):
         return dk
+    history = [dict(h, step=h.get("step", "D-K")) for h in dk.history]
     if target is not None and dk.mu <= target:
         stopping = dict(dk.stopping, dgk={"iterations": 0, "rule": f"complex D-K's μ "
                                           f"{dk.mu:.4g} ≤ target={target:g}"})
-        return replace(dk, stopping=stopping)
+        return replace(dk, history=tuple(history), stopping=stopping)
     sblocks, real = _split(blks)
-    history = [dict(h, step=h.get("step", "D-K")) for h in dk.history]
     console = progress_printer(progress)
     # iterates compared by their peak on the grid, as in complex D–K
     best = (dk.mu_grid, dk.best_iteration, dk.K, dk.gamma, np.asarray(dk.mu_curve), dk.scalings)

@@ -44,6 +44,11 @@ __all__ = ["ModeBand", "mode_bands", "with_modal_frequencies", "bands_near"]
 
 _TWO_PI = 2.0 * np.pi
 
+#: Modes with damping ratio below this are the lightly damped (structural) ones a damping
+#: margin or a mode band applies to; rigid-body modes on AMBs are real and unstable, the
+#: actuator's poles real: neither is touched.
+LIGHT_DAMPING = 0.2
+
 #: Speeds (evenly spaced over the judged range, plus the design speed) on which the modes
 #: are followed: the gyroscopic shift is smooth in Ω, and neighbouring speeds this close
 #: keep each mode nearest to itself (a step of 1/30 of the range).
@@ -87,7 +92,7 @@ def _light(lam: np.ndarray, light_damping: float) -> np.ndarray:
 
 
 def mode_bands(cfg, speeds_hz, *, design_speed_hz: float, states: int,
-               light_damping: float = 0.2) -> tuple[ModeBand, ...]:
+               light_damping: float = LIGHT_DAMPING) -> tuple[ModeBand, ...]:
     """The band each lightly damped mode of the design model sweeps over a speed range.
 
     Parameters
@@ -204,7 +209,7 @@ def with_modal_frequencies(plant: Plant, bands) -> tuple[Plant, dict]:
     A = np.asarray(plant.A, float)
     lam, V = np.linalg.eig(A)
     W = np.linalg.inv(V)
-    light = np.flatnonzero(_light(lam, 0.2))
+    light = np.flatnonzero(_light(lam, LIGHT_DAMPING))
     params, ranges = dict(plant.parameters), {}
     for band in bands:
         wb = _TWO_PI * band.f_hz

@@ -48,7 +48,7 @@ from typing import Any, Mapping
 import control
 import numpy as np
 
-from ambseal.design.modal_bands import with_modal_frequencies
+from ambseal.design.modal_bands import LIGHT_DAMPING, with_modal_frequencies
 from ambseal.design.weights import diagonal_weight
 from ambseal.errors import ConfigError, ModelError
 from ambseal.lti import picklable
@@ -57,11 +57,6 @@ from ambseal.robust import lft_lower, mussv
 
 __all__ = ["UncertainParameter", "GeneralizedPlant", "generalized_plant",
            "physical_controller", "physical_matrices", "less_damped"]
-
-#: Modes with damping ratio below this are the lightly damped (structural) ones a damping
-#: margin applies to; rigid-body modes on AMBs are real and unstable, the actuator's
-#: poles real: neither is touched.
-LIGHT_DAMPING = 0.2
 
 #: A margin applies to the design model's modes within this factor of its frequency: the
 #: lost closed-loop mode sits between the open-loop pair it came from (the forward and

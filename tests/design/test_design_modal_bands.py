@@ -118,3 +118,22 @@ def test_mu_gets_one_real_scalar_per_band(overhung):
     assert gp.blocks[:-1] == ((-1, 0), (-1, 0))
     assert [q.name for q in gp.parameters] == [b.name for b in bands]
     assert all(q.low < q.nominal <= q.high * (1 + 1e-12) for q in gp.parameters)
+
+
+def test_the_mu_verdict_says_which_mode_frequencies_it_was_robust_to():
+    """The design's verdict (and so the report's design bound, the text before its first
+    ';') names each band μ held; a design without bands says nothing of them."""
+    from ambseal.design.recipes import _Synthesis, _verdict
+
+    band = ModeBand(316.7, 315.7, 378.4)
+    stable = {"stable": True}
+    r = _Synthesis(K=None, gamma=1.0, mu=0.919, history=(), order_full=0, reduction=None,
+                   gp=None, bands=(band,))
+    head = _verdict("mu", r, stable).split(";")[0]
+    assert head == ("robust performance met: μ = 0.919 ≤ 1 on the design model, with the "
+                    "modes at 316.7 Hz (315.7–378.4 Hz) uncertain in frequency over the "
+                    "speed range")
+    plain = _Synthesis(K=None, gamma=1.0, mu=0.919, history=(), order_full=0, reduction=None,
+                       gp=None)
+    assert _verdict("mu", plain, stable).split(";")[0] == (
+        "robust performance met: μ = 0.919 ≤ 1 on the design model")

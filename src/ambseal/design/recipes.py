@@ -499,6 +499,7 @@ class _Synthesis:
     mu_omega: float | None = None
     omega: Any = None
     stopping: dict | None = None
+    bands: tuple = ()
 
 
 def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl,
@@ -552,7 +553,7 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
         order_full = red["order_full"]
     K = gp.physical_controller(K_P, name=f"K_{method}")
     return _Synthesis(K, gamma, mu, tuple(hist), order_full, red, gp, K_P, mu_omega,
-                      om if robust else None, stopping)
+                      om if robust else None, stopping, tuple(bands) if robust else ())
 
 
 def _reduce_best(P, cands, order: int, auto: bool, gp, blocks, omega):
@@ -700,12 +701,15 @@ def _verdict(method, r: _Synthesis, check) -> str:
             "bar (kept unstable: allow_unstable)")
     if method == "hinf":
         return f"H∞ γ = {r.gamma:.3g} on the nominal design model; {stab}"
+    # what the design model was robust to beyond [[design.uncertainty]]: the mode bands
+    swept = (f", with the modes at {', '.join(b.text() for b in r.bands)} uncertain in "
+             "frequency over the speed range" if r.bands else "")
     if r.mu is not None and r.mu <= 1:
-        return (f"robust performance met: μ = {bound_text(r.mu)} ≤ 1 on the design model; "
-                f"{stab}")
+        return (f"robust performance met: μ = {bound_text(r.mu)} ≤ 1 on the design model"
+                f"{swept}; {stab}")
     by = _dominant_weight(r)
     return (f"robust performance NOT met: μ = {bound_text(r.mu)} > 1: missed by "
-            f"{100 * (r.mu - 1):.2g} %{by}; {stab}")
+            f"{100 * (r.mu - 1):.2g} %{by}{swept}; {stab}")
 
 
 def bound_text(x: float) -> str:

@@ -137,3 +137,19 @@ def test_the_mu_verdict_says_which_mode_frequencies_it_was_robust_to():
                        gp=None)
     assert _verdict("mu", plain, stable).split(";")[0] == (
         "robust performance met: μ = 0.919 ≤ 1 on the design model")
+
+
+def test_two_bands_of_one_frequency_are_two_modes():
+    """The two whirls of an isotropic rotor coincide at standstill: two bands named at the
+    same frequency take the two modes there, each its own channel and name, and each
+    moves its own mode (the pair splits to √θ₁ and √θ₂; to 1e-6, the eigenvectors of a
+    repeated eigenvalue being known to about √ε of it)."""
+    plant = _mixed_oscillators([(200.0, 0.01), (200.0, 0.01), (500.0, 0.01)])
+    pair = [ModeBand(200.0, 190.0, 200.0), ModeBand(200.0, 200.0, 210.0)]
+    out, ranges = with_modal_frequencies(plant, pair)
+    assert list(ranges) == ["mode_200Hz.omega_sq", "mode_200Hz_2.omega_sq"]
+    w1, w2 = 2 * np.pi * 195.0, 2 * np.pi * 205.0
+    lam = np.linalg.eigvals(out.with_values({"mode_200Hz.omega_sq": w1 ** 2,
+                                             "mode_200Hz_2.omega_sq": w2 ** 2}).A)
+    up = np.sort(lam.imag[lam.imag > 0])
+    assert up[:2] == pytest.approx([w1, w2], rel=1e-6)

@@ -194,7 +194,8 @@ def with_modal_frequencies(plant: Plant, bands) -> tuple[Plant, dict]:
     Returns
     -------
     plant : Plant
-        The same A, B, C, D; a parameter ``band.name`` (rad²/s², nominal ω_d²) per band.
+        The same A, B, C, D; a parameter ``band.name`` (rad²/s², nominal ω_d²) per band
+        (``mode_<f>Hz_2.omega_sq`` and on for a second band of the same rounded frequency).
     ranges : dict
         ``{name: (low, high)}``: (ω_d + 2π(lo − f))², (ω_d + 2π(hi − f))² — the band's
         shifts applied to the plant's mode — for :func:`generalized_plant`'s uncertainty.
@@ -210,21 +211,30 @@ def with_modal_frequencies(plant: Plant, bands) -> tuple[Plant, dict]:
     lam, V = np.linalg.eig(A)
     W = np.linalg.inv(V)
     light = np.flatnonzero(_light(lam, LIGHT_DAMPING))
-    params, ranges = dict(plant.parameters), {}
+    params, ranges, used = dict(plant.parameters), {}, set()
     for band in bands:
         wb = _TWO_PI * band.f_hz
-        k = light[np.argmin(np.abs(lam[light].imag - wb))] if light.size else -1
+        # the nearest mode no other band took: a pair that coincides at the design speed
+        # (the two whirls of an isotropic rotor at standstill) is two modes, two channels
+        free = [k for k in light if k not in used]
+        k = free[int(np.argmin(np.abs(lam[free].imag - wb)))] if free else -1
         if k < 0 or not (wb / BAND_MATCH <= lam[k].imag <= wb * BAND_MATCH):
             raise ModelError(f"with_modal_frequencies: the design model has no lightly damped "
                              f"mode near {band.f_hz:.4g} Hz")
+        used.add(k)
+        name = band.name
+        for j in range(2, len(used) + 2):
+            if name not in params:
+                break
+            name = band.name.replace("Hz.", f"Hz_{j}.")
         wd = float(lam[k].imag)
         vi, wr = V[:, k].imag, W[k, :].real
         # ΔA = (θ − ω_d²) · (−v_i/ω_d)(2 w_r), the two factors balanced in norm
         b, c = -vi / wd, 2.0 * wr
         s = np.sqrt(np.linalg.norm(c) / max(np.linalg.norm(b), 1e-300))
-        params[band.name] = Parameter(
-            name=band.name, nominal=wd ** 2, unit="rad²/s²", B=(b * s)[:, None],
+        params[name] = Parameter(
+            name=name, nominal=wd ** 2, unit="rad²/s²", B=(b * s)[:, None],
             C=(c / s)[None, :], D=np.zeros((1, plant.B.shape[1])))
-        ranges[band.name] = tuple(sorted(((wd + _TWO_PI * (band.lo_hz - band.f_hz)) ** 2,
+        ranges[name] = tuple(sorted(((wd + _TWO_PI * (band.lo_hz - band.f_hz)) ** 2,
                                           (wd + _TWO_PI * (band.hi_hz - band.f_hz)) ** 2)))
     return replace(plant, parameters=params), ranges

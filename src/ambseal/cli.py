@@ -260,7 +260,8 @@ def _parser() -> argparse.ArgumentParser:
                    help="design this controller (or give --controller)")
     e.add_argument("--controller", default=None,
                    help="a controller file written by ambseal (.json/.npz/.mat) to export "
-                        "as C instead of designing one")
+                        "as C instead of designing one (a continuous one is discretised for "
+                        "the rig's target first, as design does)")
     e.add_argument("--pressure-bar", type=float, default=None,
                    help="design pressure drop (bar); default [operating] pressure_bar")
     e.add_argument("--out", default="ambseal-export", help="folder of the controller files")

@@ -40,6 +40,7 @@ from ambseal.model import (
     classify_poles,
     free_bending_hz,
     poles_near_zero,
+    seal_values,
 )
 from ambseal.robust import decay_rate, is_stable
 
@@ -182,10 +183,12 @@ def closed_loop_state_matrix(cfg, controller=None, *, speed_hz: float,
     continuous controller (no delay: the lag's own poles are no rotor modes).
 
     Without a controller (or a rig without AMBs) the open-loop plant's A; a scheduled
-    controller is frozen at the speed.
+    controller is frozen at the speed, or at its seal coefficient's value at the pressure
+    drop.
     """
 
-    plant = build_plant(cfg, pressure_bar=pressure_bar, speed_rpm=60.0 * speed_hz)
+    p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
+    plant = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * speed_hz)
     mesh = build_mesh(cfg)
     if controller is None or not cfg.amb:
         return plant.A, mesh
@@ -197,7 +200,7 @@ def closed_loop_state_matrix(cfg, controller=None, *, speed_hz: float,
     G = plant.select_inputs([plant.input_names[j] for j in plant.current_inputs()]
                             ).to_statespace()
     L = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples).system
-    K = frozen(controller, 2 * math.pi * speed_hz)
+    K = frozen(controller, 2 * math.pi * speed_hz, seal_values(cfg.seal, p))
     return np.asarray(judged_loop(G, K, delay=L if delay else None).loop.system.A), mesh
 
 
@@ -278,7 +281,7 @@ def modes_as_run(cfg, controller=None, *, speed_hz: float, max_hz: float,
 
     G = plant.select_inputs([plant.input_names[j] for j in plant.current_inputs()]
                             ).to_statespace()
-    Kd = controller_as_runs(controller, 2 * math.pi * speed_hz)
+    Kd = controller_as_runs(controller, 2 * math.pi * speed_hz, seal_values(cfg.seal, p))
     # the matrix alone: its eigenvectors give the modes and its eigenvalues the verdict
     A = sampled_loop_matrix(G, Kd)
     return modes_of_sampled_loop(A, float(Kd.dt), mesh, speed_hz=speed_hz, pressure_bar=p,

@@ -63,7 +63,7 @@ from ambseal.machine import (
     SPEED,
     JudgedLoop,
     ScheduledController,
-    ScheduledDigital,
+    controller_as_runs,
     frozen,
     judged_loop,
 )
@@ -635,11 +635,7 @@ def frozen_discrete(digital, point, design_cfg):
 
     if digital is None:
         return None
-    if isinstance(digital, ScheduledDigital):
-        w, values = condition_values(point, design_cfg)
-        return digital.statespace_at(w if digital.parameter == SPEED
-                                     else values[digital.parameter], delayed=True)
-    return digital.statespace(delayed=True)
+    return controller_as_runs(digital, *condition_values(point, design_cfg))
 
 
 def judge_case(case: JudgeJob, cfg, settings: JudgeSettings) -> tuple[JudgedCase, dict]:

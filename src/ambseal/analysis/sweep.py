@@ -11,7 +11,9 @@ The cases run on :func:`ambseal.analysis.cases.run_cases` (serial or Dask).
   the same bisected on the closed-loop poles to a stated tolerance.
 
 Inputs of a sweep case are plain and picklable: the rig as a dict (``RigConfig.model_dump``),
-each controller as its ``(A, B, C, D)`` arrays and signal names.
+each fixed controller as its ``(A, B, C, D)`` arrays and signal names, a scheduled one as its
+table (:class:`~ambseal.machine.ScheduledDigital`, frozen at each case's speed or seal
+coefficient).
 """
 
 from __future__ import annotations
@@ -24,10 +26,11 @@ import numpy as np
 
 from ambseal.analysis.campbell import closed_loop_state_matrix, lowest_log_decrement
 from ambseal.analysis.cases import CaseError, run_cases
-from ambseal.analysis.judge import JudgeSettings, OperatingPoint, judge
+from ambseal.analysis.judge import JudgeSettings, OperatingPoint, frozen_at, judge
 from ambseal.config import parse_rig, rig_with_values
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
+from ambseal.machine import ScheduledController
 from ambseal.model import bending_limit_hz
 from ambseal.robust import is_stable
 
@@ -98,7 +101,10 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
     controllers : dict
         ``{name: (A, B, C, D, inputs, outputs)}``, displacement (m) → current (A),
         ``i = −K y``, wired to the plant by its signal names; ``(A, B, C, D)`` alone is
-        taken in the plant's channel order.
+        taken in the plant's channel order; or ``{name: ScheduledController}`` (a controller
+        file's table, :class:`~ambseal.machine.ScheduledDigital`), frozen at the case's
+        speed or at the nominal rig's seal coefficient at the case's pressure
+        (:func:`ambseal.analysis.judge.frozen_at`, as ``run`` judges it).
     max_hz : float
         Highest frequency (Hz) of the modes the lowest log decrement is taken over.
     settings : JudgeSettings
@@ -112,9 +118,9 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
         ``iso_zone_<axis>``, ``unbalance_peak_um``.
     """
 
-    cfg = _case_rig(rig, case.get("params"))
-    K = _controller(controllers[case["controller"]])
+    nominal, cfg = _case_rig(rig, case.get("params"))
     point = OperatingPoint(case["pressure_bar"], 60.0 * case["speed_hz"], "")
+    K = _controller(controllers[case["controller"]], point, nominal)
     res, curves = judge(cfg, K, case["controller"], point, settings,
                         impulse=False)
     dec, dec_hz = lowest_log_decrement(curves["poles"], max_hz)
@@ -129,21 +135,27 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
 
 
 def _case_rig(rig: dict, params: dict | None):
+    """(the nominal rig, the case's rig with ``params``)."""
     cfg = parse_rig(rig, "<sweep rig>")
-    return rig_with_values(cfg, params) if params else cfg
+    return cfg, (rig_with_values(cfg, params) if params else cfg)
 
 
 def _shared(cfg, controllers: dict) -> dict:
     """The plain, picklable inputs every case of a sweep shares; each controller keeps its
-    signal names, so that the case wires it to the plant by name."""
+    signal names, so that the case wires it to the plant by name (a scheduled table is
+    plain already)."""
     return {"rig": cfg.model_dump(exclude_none=True),
-            "controllers": {n: (*(np.asarray(M, float) for M in (K.A, K.B, K.C, K.D)),
-                                list(K.input_labels), list(K.output_labels))
+            "controllers": {n: K if isinstance(K, ScheduledController) else
+                            (*(np.asarray(M, float) for M in (K.A, K.B, K.C, K.D)),
+                             list(K.input_labels), list(K.output_labels))
                             for n, K in controllers.items()}}
 
 
-def _controller(entry: tuple):
-    """A case's controller, ``(A, B, C, D[, inputs, outputs])``, as a StateSpace."""
+def _controller(entry, point: OperatingPoint, nominal):
+    """A case's controller at ``point`` as a StateSpace: ``(A, B, C, D[, inputs,
+    outputs])``, or a scheduled one frozen there on the ``nominal`` rig."""
+    if isinstance(entry, ScheduledController):
+        return frozen_at(entry, point, nominal)
     mats, names = entry[:4], entry[4:]
     return control.ss(*mats, **dict(zip(("inputs", "outputs"), names)))
 
@@ -177,7 +189,8 @@ def sweep(cfg, controllers: dict, pressures_bar, speeds_hz, params: dict | None 
     ----------
     cfg : RigConfig
     controllers : dict
-        ``{name: control.StateSpace}`` (fixed controllers).
+        ``{name: control.StateSpace}`` (fixed controllers) or ``{name:
+        ScheduledController}`` (frozen at each case as :func:`sweep_case` says).
     pressures_bar, speeds_hz : array_like
     params : dict, optional
         ``{name: values}`` of rig parameters (:func:`ambseal.config.rig_with_values` names).
@@ -263,13 +276,14 @@ def boundary_case(case: dict, rig: dict, controllers: dict, tol_bar: float) -> f
     first_unstable_bar}`` of the stability boundary to ``tol_bar`` (bar) on the max real
     part of the closed-loop poles (the loop of :func:`sweep_case`)."""
 
-    cfg = _case_rig(rig, case.get("params"))
-    K = _controller(controllers[case["controller"]])
+    nominal, cfg = _case_rig(rig, case.get("params"))
+    entry = controllers[case["controller"]]
     lo, hi = case["last_stable_bar"], case["first_unstable_bar"]
     while hi - lo > tol_bar:
         mid = 0.5 * (lo + hi)
         if not lo < mid < hi:  # the bracket is two adjacent floats: no narrower one exists
             break
+        K = _controller(entry, OperatingPoint(mid, 60.0 * case["speed_hz"], ""), nominal)
         A, _ = closed_loop_state_matrix(cfg, K, speed_hz=case["speed_hz"], pressure_bar=mid,
                                         delay=True)  # the loop judge() judges
         lo, hi = (mid, hi) if is_stable(np.linalg.eigvals(A)) else (lo, mid)
@@ -289,7 +303,7 @@ def refine_boundary(cfg, controllers: dict, edges: list[dict], *, tol_bar: float
     cfg : RigConfig
         The rig the sweep was made on.
     controllers : dict
-        ``{name: control.StateSpace}``, the sweep's fixed controllers.
+        The sweep's controllers (:func:`sweep`).
     edges : list of dict
         Rows of :func:`stability_boundary`.
     tol_bar : float

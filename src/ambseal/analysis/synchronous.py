@@ -34,7 +34,13 @@ import numpy as np
 from ambseal.errors import ModelError
 from ambseal.lti import freqresp_at, shared_ss, wired
 from ambseal.machine import controller_as_runs
-from ambseal.model import SealElement, actuator_matrices, build_system, eddy_lag_matrices
+from ambseal.model import (
+    SealElement,
+    actuator_matrices,
+    build_system,
+    eddy_lag_matrices,
+    seal_values,
+)
 
 __all__ = ["Unbalance", "SynchronousResponse", "synchronous_response", "orbit_semi_major"]
 
@@ -90,9 +96,11 @@ def _siso_at(mats, s: complex) -> complex:
     return complex((C @ np.linalg.solve(s * np.eye(A.shape[0]) - A, B) + D)[0, 0])
 
 
-def _controller_at(controller, out_names, in_names, omegas: np.ndarray) -> np.ndarray:
+def _controller_at(controller, out_names, in_names, omegas: np.ndarray,
+                   values: dict) -> np.ndarray:
     """``K_r(Ω)`` at each speed (n_s × nu × ny, the plant's input × output order; module
-    docstring); a scheduled table taken at each speed, any other controller once."""
+    docstring); a scheduled table taken at each speed (a table scheduled on a seal
+    coefficient at its value in ``values``), any other controller once."""
     # the plant's channels by name, as every loop is wired (no states: names only)
     names = shared_ss(np.zeros((0, 0)), np.zeros((0, len(in_names))),
                       np.zeros((len(out_names), 0)), np.zeros((len(out_names), len(in_names))),
@@ -107,7 +115,7 @@ def _controller_at(controller, out_names, in_names, omegas: np.ndarray) -> np.nd
         return Kw * hold[:, None, None]
 
     if hasattr(controller, "statespace_at"):
-        return np.concatenate([at(controller_as_runs(controller, w), np.array([w]))
+        return np.concatenate([at(controller_as_runs(controller, w, values), np.array([w]))
                                for w in omegas])
     return at(controller_as_runs(controller, 0.0), omegas)
 
@@ -173,7 +181,7 @@ def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
     closed = controller is not None and n_cur > 0
     if closed:
         Krs = _controller_at(controller, base.output_names, base.input_names[:n_cur],
-                             2 * math.pi * speeds)
+                             2 * math.pi * speeds, seal_values(cfg.seal, p))
     amp = np.empty((len(cases), speeds.size, zs.size))
     for k, f in enumerate(speeds):
         omega = 2 * math.pi * f

@@ -59,7 +59,7 @@ from ambseal.identify import (
     with_static_record,
 )
 from ambseal.lti import finite_or_none
-from ambseal.machine import SPEED, ScheduledController, scheduled_digital
+from ambseal.machine import SPEED, ScheduledController, ScheduledDigital, scheduled_digital
 from ambseal.model import (
     assemble_rotor,
     build_mesh,
@@ -386,7 +386,16 @@ def facility_impulses(cfg, truth, ident: Identified, digitals: dict, out: Path) 
     responses at 0 bar and the nominal pressure drop (P5 Figs. 15–16), into ``ident``'s
     summary, figures and report sections."""
 
-    ctrls = {m: d.discrete for m, d in digitals.items() if hasattr(d, "discrete")}
+    w = 2 * math.pi * cfg.operating.speed_rpm / 60.0
+
+    def as_runs(d):
+        """The discrete controller at a pressure drop: a scheduled table's entry at the
+        operating speed, or at the seal coefficient of that pressure drop."""
+        if not isinstance(d, ScheduledDigital):
+            return d.discrete
+        return lambda p: d.discrete_at(d.theta_at(w, seal_values(cfg.seal, p)))
+
+    ctrls = {m: as_runs(d) for m, d in digitals.items()}
     checks = impulse_checks(cfg, ident.result.identified, truth, ctrls,
                             sorted({0.0, cfg.operating.pressure_bar}))
     ident.summary["facility_impulse"] = [c.to_dict() for c in checks]

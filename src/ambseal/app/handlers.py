@@ -18,8 +18,10 @@ from pathlib import Path
 from rich.console import Console
 
 from ambseal.app import rotordynamics
+from ambseal.analysis import operating_points
 from ambseal.app.commands import (
     design_files,
+    digital_for,
     identify_files,
     show_defaults,
     target_pid,
@@ -28,6 +30,7 @@ from ambseal.app.commands import (
 )
 from ambseal.app.pipeline import run
 from ambseal.config import default_rig_path, load_rig, load_truth, method_names
+from ambseal.design import design_spec
 from ambseal.errors import AmbsealError, ConfigError, with_source
 from ambseal.export import c_identifier, load_controller, write_c
 from ambseal.files import OwnedFolder, claim_file, writable_folder
@@ -157,12 +160,22 @@ def _export(args: argparse.Namespace) -> int:
         raise ConfigError("export: give exactly one of --method and --controller")
     if args.controller is not None:
         # the rig is read first: the file must be this rig's controller, wired by name
-        ctrl = load_controller(args.controller, channel_names(load_rig(args.rig)))
+        cfg = load_rig(args.rig)
+        ctrl = load_controller(args.controller, channel_names(cfg))
+        done = {}
+        if not hasattr(ctrl, "discrete"):  # a continuous file: discretised as design does
+            try:
+                ctrl = digital_for(cfg, "file", ctrl, None, operating_points(design_spec(cfg)))
+            except ConfigError as exc:
+                raise ConfigError(f"{args.controller} holds a continuous controller, which "
+                                  f"export discretises for the rig's target: {exc}") from None
+            done["discretised"] = {"method": ctrl.method, "sample_rate_hz": ctrl.sample_rate_hz,
+                                   "delay_samples": ctrl.delay_samples}
         with _owned(None if args.c_dir else args.out, args.c_dir):
             files = write_c(ctrl, args.c_dir or Path(args.out) / "c",  # file name as C names
                             f"ambseal_{c_identifier(Path(args.controller).stem)}",
                             precision=args.precision)
-        print(json.dumps({"files": [str(f) for f in files]}))
+        print(json.dumps({"files": [str(f) for f in files], **done}))
         return 0
     with _owned(args.out, args.c_dir):
         summary = design_files(args.rig, args.method, args.out,

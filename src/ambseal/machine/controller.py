@@ -68,16 +68,23 @@ class ScheduledController(ABC):
         """The frozen controller at θ = ``value`` (SI): a ``control.StateSpace``, m → A,
         named signals, ``i = −K y``."""
 
+    def theta_at(self, speed_rad_s: float | None = None,
+                 values: Mapping[str, float] | None = None) -> float:
+        """θ at a condition: the speed Ω (rad/s) for a speed-scheduled controller, else
+        ``values[parameter]`` (SI; e.g. :func:`ambseal.model.seal.seal_values` at the
+        pressure drop).
 
-def _value(K: ScheduledController, speed_rad_s: float | None,
-           values: Mapping[str, float] | None) -> float:
-    """θ of ``K`` at the condition: the speed, or ``values[K.parameter]``."""
-    if K.parameter == SPEED and speed_rad_s is not None:
-        return float(speed_rad_s)
-    if values is not None and K.parameter in values:
-        return float(values[K.parameter])
-    raise ModelError(f"a controller scheduled on {K.parameter!r} needs its value to be "
-                     "frozen (values={...})")
+        Raises
+        ------
+        ModelError
+            The condition does not give the parameter's value.
+        """
+        if self.parameter == SPEED and speed_rad_s is not None:
+            return float(speed_rad_s)
+        if values is not None and self.parameter in values:
+            return float(values[self.parameter])
+        raise ModelError(f"a controller scheduled on {self.parameter!r} needs its value at "
+                         "the condition (values={...})")
 
 
 def frozen(K, speed_rad_s: float | None = None, values: Mapping[str, float] | None = None):
@@ -103,7 +110,7 @@ def frozen(K, speed_rad_s: float | None = None, values: Mapping[str, float] | No
         A scheduled controller whose parameter has no value given.
     """
     if isinstance(K, ScheduledController):
-        return K.at(_value(K, speed_rad_s, values))
+        return K.at(K.theta_at(speed_rad_s, values))
     return K
 
 
@@ -132,21 +139,26 @@ def matrices_at(K, speed_rad_s: float | None = None,
         A scheduled controller whose parameter has no value given.
     """
     if isinstance(K, ScheduledController):
-        return K.matrices_at(_value(K, speed_rad_s, values))
+        return K.matrices_at(K.theta_at(speed_rad_s, values))
     return tuple(np.asarray(M, float) for M in (K.A, K.B, K.C, K.D))
 
 
-def controller_as_runs(controller, speed_rad_s: float):
-    """The controller as it runs at ``speed_rad_s``: a discrete ``control.StateSpace`` with
-    its computation delay (a scheduled table at that speed).
+def controller_as_runs(controller, speed_rad_s: float,
+                       values: Mapping[str, float] | None = None):
+    """The controller as it runs at a condition: a discrete ``control.StateSpace`` with
+    its computation delay (a scheduled table at the condition's value of its parameter).
 
     Parameters
     ----------
     controller : DigitalController or ScheduledDigital
         A digital controller (``statespace(delayed=True)``) or a scheduled table
-        (``statespace_at``).
+        (``statespace_at``, on the speed or on ``controller.parameter``).
     speed_rad_s : float
-        The speed a scheduled table is taken at (rad/s).
+        The speed (rad/s): θ of a table scheduled on speed.
+    values : mapping, optional
+        ``{parameter: value}`` (SI) at the condition, e.g.
+        :func:`ambseal.model.seal.seal_values`: θ of a table scheduled on a seal
+        coefficient.
 
     Returns
     -------
@@ -157,9 +169,12 @@ def controller_as_runs(controller, speed_rad_s: float):
     ------
     ConfigError
         A controller that is not a digital one as it runs.
+    ModelError
+        A table scheduled on a parameter ``values`` does not give.
     """
     if hasattr(controller, "statespace_at"):
-        return controller.statespace_at(speed_rad_s, delayed=True)
+        return controller.statespace_at(controller.theta_at(speed_rad_s, values),
+                                        delayed=True)
     if hasattr(controller, "statespace") and hasattr(controller, "discrete"):
         return controller.statespace(delayed=True)
     raise ConfigError("the sign-off judges a digital controller as it runs (a "

@@ -194,8 +194,9 @@ def impulse_checks(cfg: RigConfig, identified: RigConfig, truth: TruthSection,
         The identified rig.
     truth : TruthSection
         The facility's truth.
-    controllers : dict of str to DiscreteController
-        The controllers checked, by name, at the rig's sample rate.
+    controllers : dict of str to DiscreteController or callable
+        The controllers checked, by name, at the rig's sample rate; a callable of the
+        pressure drop (bar) gives the one that runs there (a scheduled table's entry).
     pressures_bar : iterable of float
         The pressure drops (bar).
     seed : int, optional
@@ -218,8 +219,9 @@ def impulse_checks(cfg: RigConfig, identified: RigConfig, truth: TruthSection,
                  sample_rate_hz=fs, axes=axes,
                  excited={f"{ambs[0]}_zeta": 1.0, f"{ambs[-1]}_eta": 1.0})
     out = []
-    for name, Kd in controllers.items():
+    for name, K in controllers.items():
         for p in pressures_bar:
+            Kd = K(p) if callable(K) else K
             try:
                 rec = acquire(cfg, truth, ex, controller=Kd, pressure_bar=p, seed=seed)
             except ModelError as exc:

@@ -66,6 +66,11 @@ SPARSE_FILL = 0.1
 # vectors save restarts: measured fastest over the bench rotor, the test rig and the
 # turboexpander, free and supported).
 NCV_EXTRA = 20
+# Arnoldi restarts ARPACK may take before the dense eigenvalues are taken instead: at most
+# 3.2 on every example rig, free and supported (measured); a shift that cannot separate
+# the wanted eigenvalues (a mesh with µm elements, whose stiffness scale sets σ millions of
+# rad/s away from the low modes) took 643 restarts for 22 of them, then failed at 44.
+ARNOLDI_RESTARTS = 30
 
 
 @dataclass(frozen=True)
@@ -135,14 +140,27 @@ def modes(sys: SecondOrderSystem, n_modes: int | None = None) -> Modes:
         The mass matrix is not positive definite, ``n_modes`` < 1, or the model's
         conditioning makes the rigid-body modes or the stability doubtful.
     """
-    if n_modes is None:
-        lam = sys.poles()
-        return modes_from_poles(lam, float(np.abs(lam).max()))
-    if int(n_modes) != n_modes or n_modes < 1:
+    if n_modes is not None and (int(n_modes) != n_modes or n_modes < 1):
         raise ModelError(f"n_modes must be a positive integer, got {n_modes!r}")
-    n_modes = int(n_modes)
-    lam, w_ref = lowest_eigenvalues(sys, n_modes)
-    return modes_from_poles(lam, max(w_ref, float(np.abs(lam).max(initial=0.0))), n_modes)
+    try:
+        if n_modes is None:
+            lam = sys.poles()
+            return modes_from_poles(lam, float(np.abs(lam).max()))
+        lam, w_ref = lowest_eigenvalues(sys, int(n_modes))
+        return modes_from_poles(lam, max(w_ref, float(np.abs(lam).max(initial=0.0))),
+                                int(n_modes))
+    except ModelError as exc:
+        raise ModelError(f"{exc}{_shortest_element(sys)}") from None
+
+
+def _shortest_element(sys: SecondOrderSystem) -> str:
+    """Where the mesh's shortest beam element lies, for a message on the conditioning."""
+    z = getattr(getattr(sys, "mesh", None), "z", None)
+    if z is None or len(z) < 2:
+        return ""
+    e = int(np.argmin(np.diff(z)))
+    return (f"; the shortest beam element is {z[e + 1] - z[e]:.3g} m long, at z = "
+            f"{z[e]:.6g}–{z[e + 1]:.6g} m")
 
 
 def classify_poles(lam: np.ndarray, w_max: float | None = None,
@@ -292,7 +310,8 @@ def lowest_eigenvalues(sys: SecondOrderSystem, n_modes: int) -> tuple[np.ndarray
     Raises
     ------
     ModelError
-        The mass matrix is not positive definite, or ARPACK fails to converge.
+        The mass matrix is not positive definite, or ARPACK fails (not for want of
+        convergence: the dense eigenvalues are then taken).
     """
     sys.mass_factor()  # ModelError unless M is positive definite, as in the dense path
     w_ref = _w_ref(sys)
@@ -364,7 +383,8 @@ def poles_near_zero(sys: SecondOrderSystem, *, count: int = 0, radius_rad_s: flo
     Raises
     ------
     ModelError
-        The mass matrix is not positive definite, or ARPACK fails to converge.
+        The mass matrix is not positive definite, or ARPACK fails (not for want of
+        convergence: the dense eigenvalues are then taken).
     """
     if 2 * sys.n_dof > DENSE_STATES:
         sys.mass_factor()  # ModelError unless M is positive definite, as in the dense path
@@ -397,7 +417,8 @@ def _arnoldi_disk(sys: SecondOrderSystem, w_ref: float, k: int, enough, vectors:
     """``(lam, Q, radius)``: the eigenvalues inside the complete disk |λ| < radius of the
     k nearest σ = −``SHIFT_FRACTION``·ω_ref, sorted by |λ|, with the displacement parts Q
     of their eigenvectors (or None), k doubled until ``enough(lam, radius)``; None when k
-    would reach n_state − 1 (the caller goes dense)."""
+    would reach n_state − 1 or ARPACK does not converge in :data:`ARNOLDI_RESTARTS`
+    restarts (the caller goes dense)."""
     M, K = sys.M, sys.K
     D = sys.C + sys.speed * sys.G
     n = sys.n_dof
@@ -408,9 +429,12 @@ def _arnoldi_disk(sys: SecondOrderSystem, w_ref: float, k: int, enough, vectors:
             op = _shift_invert_operator(M, D, K, sigma)
         try:
             out = spla.eigs(op, k=k, which="LM", v0=np.ones(2 * n),
-                            ncv=min(2 * n, 2 * k + NCV_EXTRA), return_eigenvectors=vectors)
-        except spla.ArpackError as exc:  # includes ArpackNoConvergence
-            raise ModelError(f"ARPACK did not converge for the {k} eigenvalues nearest "
+                            ncv=min(2 * n, 2 * k + NCV_EXTRA), return_eigenvectors=vectors,
+                            maxiter=ARNOLDI_RESTARTS)
+        except spla.ArpackNoConvergence:
+            return None  # the dense eigenvalues: what the model's size costs
+        except spla.ArpackError as exc:
+            raise ModelError(f"ARPACK failed for the {k} eigenvalues nearest "
                              f"σ = {sigma:.3g} rad/s ({exc})") from None
         mu, X = out if vectors else (out, None)
         lam = sigma + 1.0 / mu

@@ -134,3 +134,32 @@ def test_amb_axes_rotated_45_degrees(rig):
     node = sys_.mesh.node_at(0.17)
     b = sys_.B[4 * node: 4 * node + 2, 0]
     np.testing.assert_allclose(b / np.linalg.norm(b), [math.sqrt(0.5)] * 2, rtol=1e-12)
+
+
+def test_reduction_keeps_a_defective_mode_by_its_invariant_subspace():
+    """Reference: the closed form of a plant built as S J S⁻¹ with J block diagonal — a
+    Jordan block at λ = −2 (defective: one eigenvector for a double eigenvalue), a
+    lightly damped pair at |λ| = 5, then faster modes. Keeping the four slowest states
+    (the Jordan block and the pair), the reduced plant is the kept blocks' transfer
+    C S_k (sI − J_k)⁻¹ (S⁻¹)_k B exactly (1e-9), T_L T_R = I, and its states are named
+    as the Schur basis they are."""
+    from ambseal.model.lft import Plant
+
+    rng = np.random.default_rng(5)
+    J = np.zeros((7, 7))
+    J[:2, :2] = [[-2.0, 1.0], [0.0, -2.0]]
+    J[2:4, 2:4] = [[-0.3, 4.99], [-4.99, -0.3]]
+    J[4:, 4:] = np.diag([-40.0, -60.0, -90.0])
+    S = np.eye(7) + 0.3 * rng.standard_normal((7, 7))
+    Si = np.linalg.inv(S)
+    B, C = rng.standard_normal((7, 2)), rng.standard_normal((3, 7))
+    plant = Plant(A=S @ J @ Si, B=B, C=C, D=np.zeros((3, 2)), input_names=("u0", "u1"),
+                  output_names=("y0", "y1", "y2"),
+                  state_names=tuple(f"x{i}" for i in range(7)))
+    red = modal_reduction(plant, states=4)
+    np.testing.assert_allclose(red.T_L @ red.T_R, np.eye(4), atol=1e-10)
+    assert red.plant.state_names == ("schur0", "schur1", "schur2", "schur3")
+    for s in (0.0, 1j, 3.0 + 2j, 20j):
+        want = C @ S[:, :4] @ np.linalg.solve(s * np.eye(4) - J[:4, :4], Si[:4] @ B)
+        got = red.plant.C @ np.linalg.solve(s * np.eye(4) - red.plant.A, red.plant.B)
+        np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-9 * np.abs(want).max())

@@ -13,6 +13,14 @@ so that T_L T_R = I. Both are built here directly:
 
 so A = T_L A_f T_R is block diagonal with the real 2×2 blocks [[σ, ω], [−ω, σ]] of P1
 Eq. 32 and has exactly the kept eigenvalues; B = T_L B_f, C = C_f T_R (Eqs. 43–45).
+
+Where the kept eigenvectors cannot be paired (Wᵀ T_R singular to working precision: a
+defective or nearly defective eigenvalue, whose eigenvectors are not a basis of its
+invariant subspace) the same invariant subspace is taken from the ordered real Schur form
+A_f = Q T Qᵀ, the kept eigenvalues first (Golub & Van Loan, Matrix Computations, 4th ed.,
+§7.6.2 and §7.6.3): T_R = Q₁ and T_L = Q₁ᵀ − Y Q₂ᵀ with T₁₁ Y − Y T₂₂ = −T₁₂, the spectral
+projector's block diagonalisation. T_L T_R = I again and A = T₁₁ (quasi-triangular, the
+kept eigenvalues on its diagonal blocks); the states are named ``schur<k>``.
 """
 
 from __future__ import annotations
@@ -20,6 +28,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg as sla
 
 from ambseal.errors import ModelError
 from ambseal.lti import lowest_eigenpairs
@@ -79,8 +88,8 @@ def modal_reduction(
     ------
     ModelError
         Neither or both of ``states`` and ``cutoff_hz``; a count that splits a complex pair
-        or a repeated eigenvalue; left and right eigenvectors that cannot be paired
-        (a defective eigenvalue, e.g. free–free rigid-body modes).
+        or a repeated eigenvalue; kept eigenvalues the ordered Schur form cannot separate
+        from the others.
     """
     if (states is None) == (cutoff_hz is None):
         raise ModelError("modal reduction expects exactly one of states or cutoff_hz")
@@ -124,11 +133,29 @@ def modal_reduction(
     T_R = np.column_stack(cols_r)
     Wr = np.column_stack(cols_l)
     P = Wr.T @ T_R
-    if np.linalg.cond(P) > 1e12:
-        raise ModelError(
-            "left and right eigenvectors of the kept modes cannot be paired "
-            "(defective eigenvalue, e.g. free–free rigid-body modes)"
-        )
-    T_L = np.linalg.solve(P, Wr.T)
+    if np.linalg.cond(P) > 1e12:  # no eigenvector basis: the invariant subspace itself
+        T_L, T_R = _schur_subspace(np.asarray(plant.A, float), n_keep)
+        names = [f"schur{k}" for k in range(n_keep)]
+    else:
+        T_L = np.linalg.solve(P, Wr.T)
     reduced = plant.transformed(T_L, T_R, tuple(names))
     return ModalReduction(plant=reduced, T_L=T_L, T_R=T_R, poles=kept)
+
+
+def _schur_subspace(A: np.ndarray, n_keep: int) -> tuple[np.ndarray, np.ndarray]:
+    """(T_L, T_R) of the invariant subspace of the ``n_keep`` eigenvalues of smallest |λ|
+    from the ordered real Schur form (module docstring)."""
+    n = A.shape[0]
+    if n_keep == n:
+        return np.eye(n), np.eye(n)
+    # the radius between the kept eigenvalues and the next: the Schur form's sort
+    size = np.sort(np.abs(np.linalg.eigvals(A)))
+    r = 0.5 * (size[n_keep - 1] + size[n_keep])
+    T, Q, sdim = sla.schur(A, output="real", sort=lambda re, im: np.hypot(re, im) < r)
+    if sdim != n_keep:
+        raise ModelError(f"the ordered Schur form keeps {sdim} eigenvalues below "
+                         f"|λ| = {r:.6g} rad/s where {n_keep} were asked for: keep one "
+                         "state more or less")
+    k = n_keep
+    Y = sla.solve_sylvester(T[:k, :k], -T[k:, k:], -T[:k, k:])
+    return Q[:, :k].T - Y @ Q[:, k:].T, Q[:, :k]

@@ -170,10 +170,10 @@ def feedback_matrices(G: Matrices, K: Matrices, Gf: tuple[np.ndarray, np.ndarray
 
 
 # the last closed-loop state matrices decomposed: a design's loops at every judged condition,
-# continuous and sampled, are closed again by the judgement and the speed-range check. Kept
-# for 256: a run checks each design at every pressure × speed (21 on a 3 × 7 grid) and its
-# rejected designs' loops come between a design's check and its judgement; eigenvalues
-# only, ~10 kB at 600 states, so 2.5 MB at most
+# continuous and sampled, are closed again by the judgement. Kept for 256: a design is
+# checked at a grid of conditions (21 on a 3 × 7 grid) and the checks of the designs it
+# rejected come between its check and its judgement; eigenvalues only, ~10 kB at 600
+# states, so 2.5 MB at most
 _POLES = ArrayMemo(keep=256)
 
 

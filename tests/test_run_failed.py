@@ -57,6 +57,8 @@ def test_loop_failure_names_the_least_stable_mode():
     assert loop_failure("mu", cases[:1], designed=True) is None
     pid = loop_failure("pid", cases[1:2], designed=False)
     assert pid.reason.startswith("PID (reference, given by the rig file)") and not pid.designed
+    derived = loop_failure("pid", cases[1:2], designed=False, derived=True)
+    assert derived.reason.startswith("PID (reference, derived from the rig): fails — ")
 
 
 def test_many_unstable_conditions_are_listed_with_the_least_stable_mode():

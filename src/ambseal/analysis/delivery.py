@@ -6,7 +6,8 @@ with the target's delay or the discrete loop as it runs) is unstable at a judged
 or that could not be designed at all, is *failed*. A designed controller that failed is not
 delivered (no controller files are written for it unless the user asks with
 ``--allow-unstable``); the reference PID, given by the rig file rather than designed, is
-marked the same way but is the user's own controller, judged for comparison.
+marked the same way but is the user's own controller (or the one derived for them from the
+rig), judged for comparison.
 
 The verdict is the judged cases' own (``stable`` of each case and of its ``discrete``
 block); the line names the least stable closed-loop mode of each failed condition by its
@@ -56,9 +57,10 @@ def _name(method: str) -> str:
     return method_label(method)
 
 
-def _head(method: str, designed: bool, kept: bool = False) -> str:
+def _head(method: str, designed: bool, kept: bool = False, derived: bool = False) -> str:
     if not designed:
-        return f"{_name(method)} (reference, given by the rig file): fails"
+        source = "derived from the rig" if derived else "given by the rig file"
+        return f"{_name(method)} (reference, {source}): fails"
     return (f"{_name(method)}: delivered as asked (allow_unstable) but fails" if kept else
             f"{_name(method)}: not delivered")
 
@@ -94,7 +96,7 @@ def _listed(found: list[tuple]) -> str:
 
 
 def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
-                 kept: bool = False) -> FailedController | None:
+                 kept: bool = False, derived: bool = False) -> FailedController | None:
     """The failure of one controller from its judged cases, or None when every judged
     loop (continuous and, where judged, discrete) is stable.
 
@@ -113,6 +115,9 @@ def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
         False for the reference PID of the rig file.
     kept : bool
         True when the run delivers it all the same (``allow_unstable``): said in the line.
+    derived : bool
+        The reference PID was derived from the rig (no ``[controller.pid]``), not given
+        by it: said in the line.
 
     Returns
     -------
@@ -138,7 +143,7 @@ def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
          f"{_listed(disc_parts)}"] if disc_parts else [])
     if not parts:
         return None
-    return FailedController(f"{_head(method, designed, kept)}{_SEP}" + "; ".join(parts),
+    return FailedController(f"{_head(method, designed, kept, derived)}{_SEP}" + "; ".join(parts),
                             designed, True, where)
 
 

@@ -119,7 +119,8 @@ def _speed_range(designs, digitals, spec, points, design_cfg, judge_cfg, stages,
                          lambda i, r: stages.step(f"{jobs[i].name} at {jobs[i].point.label}"))
     for d in designs:
         f = loop_failure(d.method, _judged_of(d.method, jobs, done),
-                         designed=d.method != "pid", kept=allow_unstable)
+                         designed=d.method != "pid", kept=allow_unstable,
+                         derived=design_cfg.controller.pid is None)
         if f is not None:
             failed[d.method] = also_failed(failed.get(d.method), f)
     return [case for case, _ in done]
@@ -439,7 +440,8 @@ def _judge_stage(st: _RunState) -> None:
     st.jobs, st.judged = _judge_designs(st, st.designs, st.digitals)
     for d in st.designs:
         f = loop_failure(d.method, _judged_of(d.method, st.jobs, st.judged),
-                         designed=d.method != "pid", kept=st.allow_unstable)
+                         designed=d.method != "pid", kept=st.allow_unstable,
+                         derived=st.cfg.controller.pid is None)
         if f is not None:
             st.failed[d.method] = f
     if speed_scheduled(st.cfg):

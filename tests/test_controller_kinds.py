@@ -294,3 +294,18 @@ def test_a_scheduled_table_runs_on_the_virtual_facility(kinds, tmp_path):
         if ref.discrete.D[0, 0] != d.D[0, 0]:  # not the first entry: not its response
             assert a["peak_model_um"] != pytest.approx(first[("pid", p)]["peak_model_um"],
                                                        rel=1e-3), (kind, p)
+
+
+def test_design_prints_the_verdict_its_file_holds(tmp_path, capsys):
+    """``design --method pid --allow-unstable`` on the embedded rig, whose reference PID
+    loses the full-order loop at 3× the nominal pressure drop: the JSON line on stdout
+    says ``kept_unstable`` and gives the full-order check exactly as
+    ``design_pid.json`` does."""
+    code, out, _ = _cli(capsys, ["design", RIG, "--method", "pid", "--allow-unstable",
+                                 "--out", tmp_path])
+    assert code == 0
+    printed = json.loads(out)
+    written = json.loads((tmp_path / "design_pid.json").read_text())
+    assert written["kept_unstable"] is True and not written["full_order"]["stable"]
+    assert printed["kept_unstable"] is True
+    assert printed["full_order"] == written["full_order"]

@@ -464,6 +464,9 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
     if c_dir is not None:
         files += write_c(digital, c_dir, f"ambseal_{method}", precision=precision)
     short = res.summary() if hasattr(res, "summary") else summary
+    # the verdict of a check made here, as design_<method>.json has it
+    short = {**short, **{k: summary[k] for k in ("full_order", "kept_unstable")
+                         if k in summary}}
     return {**short, "discretisation": digital.to_dict(),
             "files": [str(f) for f in files]}
 

@@ -146,6 +146,10 @@ RIG_CASES = [
      "design.impulse.duration_s", "controller samples"),
     ("unbalance grade", _set("design/unbalance/grade_mm_s", 1e300),
      "design.unbalance.grade_mm_s", "<= 4000"),
+    # 11 000 rpm is 183.3333… Hz: the message must not print it as the range's end
+    ("speed past a rounded range",
+     lambda d: d["operating"].update(speed_rpm=11000.0, speed_range_hz=[116.667, 183.333]),
+     "speed_rpm", "183.333333333 Hz lies outside speed_range_hz [116.667, 183.333]"),
 ]
 
 

@@ -547,9 +547,11 @@ class Operating(_Strict):
             raise ValueError("speed_range_hz: expected [low, high] with 0 < low < high "
                              "<= 1e5 Hz")
         if r is not None and not r[0] <= abs(self.speed_rpm) / 60 <= r[1]:
-            raise ValueError(f"speed_rpm: {self.speed_rpm:g} rpm = {abs(self.speed_rpm) / 60:g} "
-                             f"Hz lies outside speed_range_hz [{r[0]:g}, {r[1]:g}]: a "
-                             "controller scheduled over that range would be extrapolated")
+            # every digit: 11 000 rpm is 183.3333… Hz, outside a range written to 183.333
+            raise ValueError(f"speed_rpm: {self.speed_rpm:.12g} rpm = "
+                             f"{abs(self.speed_rpm) / 60:.12g} Hz lies outside speed_range_hz "
+                             f"[{r[0]:.12g}, {r[1]:.12g}]: a controller scheduled over that "
+                             "range would be extrapolated")
         return self
 
 

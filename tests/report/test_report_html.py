@@ -164,3 +164,24 @@ def test_orbit_against_the_rigs_clearances(tmp_path):
     assert rig_clearances_um(load_rig()) == pytest.approx({"air gap": 500.0}, rel=1e-3)
     v = verdicts(_metrics()[:1], clear)[0]
     assert v.orbit_text() == "7.9 µm (1.6 % of the air gap; 3.2 % of the backup bearing)"
+
+
+def test_on_the_target_names_only_what_metrics_records():
+    """Reference: metrics.json's ``discretisation`` blocks. A case run on the target whose
+    controller has its discretisation recorded is named with its method and delay; one
+    whose controller has none recorded (not exported) is named by its rate alone — no
+    "?" placeholders."""
+    from ambseal.report.run_report import _discrete_section
+
+    disc = {"stable": True, "max_abs_pole_z": 0.99, "sensitivity_peak": 2.0,
+            "iso_zone": "A", "sample_rate_hz": 10000.0}
+    case = {"pressure_bar": 0.0, "speed_hz": 50.0, "sensitivity_peak": 1.9, "discrete": disc}
+    metrics = {"cases": [{**case, "controller": "pid"}, {**case, "controller": "hinf"}],
+               "controllers": {"pid": {"discretisation": {"method": "tustin",
+                                                          "delay_samples": 1}},
+                               "hinf": {"discretisation": None}}}
+    text = _discrete_section(metrics)[0]["text"]
+    assert "?" not in text
+    assert "pid at 0 bar, 50 Hz: stable" in text and "tustin at 10000 Hz, 1 sample(s)" in text
+    assert "hinf at 0 bar, 50 Hz: stable (max |z| 0.99000), σ̄(S_o) 2.00 against 1.90 " \
+           "continuous, zone A; at 10000 Hz" in text

@@ -424,12 +424,16 @@ def _discrete_section(metrics: dict) -> list[dict]:
             continue
         disc = metrics["controllers"].get(c["controller"], {}).get("discretisation") or {}
         peak = lambda x: "–" if x is None else f"{x:.2f}"  # noqa: E731
+        # the discretisation as metrics.json records it; a controller without one there
+        # (not exported) is named by its rate alone, never by a placeholder
+        how = (f"{disc['method']} at {d['sample_rate_hz']:g} Hz, {disc['delay_samples']} "
+               "sample(s) delay" if {"method", "delay_samples"} <= disc.keys()
+               else f"at {d['sample_rate_hz']:g} Hz")
         lines.append(
             f"{c['controller']} at {c['pressure_bar']:g} bar, {c['speed_hz']:g} Hz: "
             f"{'stable' if d['stable'] else 'UNSTABLE'} (max |z| {d['max_abs_pole_z']:.5f}), "
             f"σ̄(S_o) {peak(d['sensitivity_peak'])} against {peak(c['sensitivity_peak'])} "
-            f"continuous, zone {d['iso_zone']}; {disc.get('method', '?')} at "
-            f"{d['sample_rate_hz']:g} Hz, {disc.get('delay_samples', '?')} sample(s) delay")
+            f"continuous, zone {d['iso_zone']}; {how}")
     if not lines:
         return []
     why = [f"{m}: {d['peak_difference']['explanation']}" for m, c in metrics["controllers"].items()

@@ -137,6 +137,10 @@ def test_the_mu_verdict_says_which_mode_frequencies_it_was_robust_to():
                        gp=None)
     assert _verdict("mu", plain, stable).split(";")[0] == (
         "robust performance met: μ = 0.919 ≤ 1 on the design model")
+    # an unstable loop is said so, and nothing of a flag the verdict does not know of
+    lost = {"stable": False, "mode_hz": 957.0, "pressure_bar": 120.0}
+    assert _verdict("mu", plain, lost).split("; ")[1] == (
+        "FULL-ORDER LOOP UNSTABLE at 957 Hz, 120 bar")
 
 
 def test_two_bands_of_one_frequency_are_two_modes():

@@ -183,7 +183,7 @@ def _stability_over_speed(check: dict | None) -> str:
     if check is None or check["stable"]:
         return "full-order loop stable at every judged condition"
     return (f"FULL-ORDER LOOP UNSTABLE at {check['mode_hz']:.4g} Hz, {check['speed_hz']:g} Hz "
-            "speed (kept unstable: allow_unstable)")
+            "speed")
 
 
 @dataclass(frozen=True, eq=False)

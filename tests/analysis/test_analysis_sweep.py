@@ -43,6 +43,11 @@ def test_pid_loses_the_embedded_rig_between_nominal_and_twice_nominal(testrig_cf
         assert r["max_real_pole"] == pytest.approx(ref, rel=1e-6, abs=1e-9)
     assert rows[0]["iso_zone_A_zeta"] in "ABCD" and rows[2]["unbalance_peak_um"] is None
     assert rows[2]["lowest_log_dec"] < 0 < rows[1]["lowest_log_dec"]  # δ < 0: growing
+    # the sign-off's limit on the log decrement, beside the zones: a row says whether its
+    # least damped mode meets it
+    limit = testrig_cfg.signoff.log_dec_min
+    assert [r["log_dec_ok"] for r in rows] == [r["lowest_log_dec"] >= limit for r in rows]
+    assert rows[2]["log_dec_ok"] is False
 
 
 #: the tiny rig's controller: 1 MHz, one sample of computation delay (τ = 1.5 µs)

@@ -114,8 +114,11 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
     -------
     dict
         The case, ``stable``, ``max_real_pole`` (1/s), ``lowest_log_dec`` and its
-        ``lowest_log_dec_hz``, ``sensitivity_peak`` (σ̄(S_o), -), ``iso_zone`` and
-        ``iso_zone_<axis>``, ``unbalance_peak_um``.
+        ``lowest_log_dec_hz``, ``log_dec_ok`` (no mode's log decrement below the rig's
+        ``[signoff] log_dec_min``, the sign-off's limit, 0.1 by default: a stable loop
+        with a zone A σ̄(S_o) may still have a mode too lightly damped to pass),
+        ``sensitivity_peak`` (σ̄(S_o), -), ``iso_zone`` and ``iso_zone_<axis>``,
+        ``unbalance_peak_um``.
     """
 
     nominal, cfg = _case_rig(rig, case.get("params"))
@@ -128,6 +131,7 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
            "speed_hz": case["speed_hz"], **(case.get("params") or {}),
            "stable": res.stable, "max_real_pole": json_float(res.max_real_pole),
            "lowest_log_dec": dec, "lowest_log_dec_hz": dec_hz,
+           "log_dec_ok": bool(not dec < cfg.signoff.log_dec_min),  # NaN: no mode
            "sensitivity_peak": res.sensitivity_peak, "iso_zone": res.iso_zone}
     row.update({f"iso_zone_{ax}": z for ax, z in res.iso_zone_per_axis.items()})
     row["unbalance_peak_um"] = res.unbalance_peak_um
@@ -349,7 +353,7 @@ def refine_boundary(cfg, controllers: dict, edges: list[dict], *, tol_bar: float
 
 
 _BRACKET = {"controller", "speed_hz", "last_stable_bar", "first_unstable_bar", "params"}
-_RESULTS = {"stable", "max_real_pole", "lowest_log_dec", "lowest_log_dec_hz",
+_RESULTS = {"stable", "max_real_pole", "lowest_log_dec", "lowest_log_dec_hz", "log_dec_ok",
             "sensitivity_peak", "iso_zone", "unbalance_peak_um", "error"}
 
 

@@ -192,6 +192,8 @@ def _sweep(args: argparse.Namespace) -> int:
                                           title=cfg.rotor.name))
     print(json.dumps({"cases": len(rows), "failed": sum(r.get("error") is not None
                                                          for r in rows),
+                      "log_dec_below_min": sum(r.get("log_dec_ok") is False for r in rows),
+                      "log_dec_min": cfg.signoff.log_dec_min,
                       "boundary": edge, "files": [str(f) for f in files]}))
     return 0
 

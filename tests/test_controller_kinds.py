@@ -62,11 +62,17 @@ def _fixed(K, t: float, path):
 
 @pytest.fixture(scope="module")
 def kinds(tmp_path_factory):
-    """The embedded rig's reference PID as ``ambseal design`` writes it, and from it a
-    continuous file and two tables: on the speed over 0–100 Hz and on the seal's k from
-    0 bar to 3× the nominal pressure drop."""
+    """The embedded rig's reference PID as ``ambseal design`` writes it (with the JSON line
+    it printed), and from it a continuous file and two tables: on the speed over 0–100 Hz
+    and on the seal's k from 0 bar to 3× the nominal pressure drop."""
+    import contextlib
+    import io
+
     out = tmp_path_factory.mktemp("kinds")
-    assert main(["design", RIG, "--method", "pid", "--out", str(out), "--allow-unstable"]) == 0
+    printed = io.StringIO()
+    with contextlib.redirect_stdout(printed):
+        assert main(["design", RIG, "--method", "pid", "--out", str(out),
+                     "--allow-unstable"]) == 0
     digital = out / "controller_pid.json"
     K = load_controller(digital)
     cfg = load_rig(RIG)
@@ -78,7 +84,7 @@ def kinds(tmp_path_factory):
     seal = export_controller(_table(K, k_ends, k_name), out / "table_seal.json")
     cont = _fixed(K, 0.0, out / "continuous.json")
     return {"K": K, "cfg": cfg, "p0": p0, "k_name": k_name, "k_ends": k_ends, "dir": out,
-            "files": {"digital": digital, "continuous": cont, "speed": speed, "seal": seal}}
+            "printed": json.loads(printed.getvalue()), "files": {"digital": digital, "continuous": cont, "speed": speed, "seal": seal}}
 
 
 def _cli(capsys, argv) -> tuple[int, str, list[str]]:
@@ -94,7 +100,7 @@ def test_every_kind_through_every_command(kinds, tmp_path, capsys):
     assert isinstance(load_controller(files["speed"]), ScheduledDigital)
     assert load_controller(files["seal"]).parameter == kinds["k_name"]
     for kind, path in files.items():
-        for cmd in (["sweep", RIG, "--pressure-bar", "1", "--speed-hz", "0:50:2",
+        for cmd in (["sweep", RIG, "--pressure-bar", "1", "--speed-hz", "50",
                      "--workers", "1", "--out", tmp_path / f"sw_{kind}"],
                     ["export", RIG, "--out", tmp_path / f"ex_{kind}"],
                     ["campbell", RIG, "--speed-hz", "0:50:2", "--out", tmp_path / f"cb_{kind}"],
@@ -296,16 +302,13 @@ def test_a_scheduled_table_runs_on_the_virtual_facility(kinds, tmp_path):
                                                        rel=1e-3), (kind, p)
 
 
-def test_design_prints_the_verdict_its_file_holds(tmp_path, capsys):
+def test_design_prints_the_verdict_its_file_holds(kinds):
     """``design --method pid --allow-unstable`` on the embedded rig, whose reference PID
     loses the full-order loop at 3× the nominal pressure drop: the JSON line on stdout
     says ``kept_unstable`` and gives the full-order check exactly as
     ``design_pid.json`` does."""
-    code, out, _ = _cli(capsys, ["design", RIG, "--method", "pid", "--allow-unstable",
-                                 "--out", tmp_path])
-    assert code == 0
-    printed = json.loads(out)
-    written = json.loads((tmp_path / "design_pid.json").read_text())
+    printed = kinds["printed"]
+    written = json.loads((kinds["dir"] / "design_pid.json").read_text())
     assert written["kept_unstable"] is True and not written["full_order"]["stable"]
     assert printed["kept_unstable"] is True
     assert printed["full_order"] == written["full_order"]

@@ -131,6 +131,38 @@ def test_every_example_runs_end_to_end(rig, tmp_path, capsys):
         assert max(c["sensitivity_peak_per_axis"].values()) < 3.0, c
     red = metrics["controllers"]["mu"]["reduction"]
     assert red is None or red["mu"] <= 1.1 * red["mu_full"]
+    _every_file_through_every_command(rig, tmp_path / "out", tmp_path, capsys)
+
+
+def _every_file_through_every_command(rig: Path, out: Path, tmp: Path, capsys) -> None:
+    """What one command wrote, fed to every command that reads it: each controller file
+    the run exported (every kind and format) through ``export``, and the JSON one through
+    ``modes``, ``campbell`` and ``sweep`` at the nominal point (and ``signoff`` for a rig
+    with stages, once): each exits 0 with a JSON line saying what it did, without a
+    traceback."""
+    cfg = load_rig(rig)
+    p, f = cfg.operating.pressure_bar, abs(cfg.operating.speed_rpm) / 60.0
+    files = sorted((out / "controllers").glob("controller_*.*"))
+    assert files
+    signed = False
+    for path in files:
+        runs = [["export", rig, "--out", tmp / f"ex_{path.name}"]]
+        if path.suffix == ".json":
+            runs += [["modes", rig, "--json", "--pressure-bar", p, "--speed-rpm", 60.0 * f],
+                     ["campbell", rig, "--pressure-bar", p, "--speed-hz", f"0:{f:g}:2",
+                      "--out", tmp / f"cb_{path.stem}"],
+                     ["sweep", rig, "--pressure-bar", p, "--speed-hz", f, "--workers", "1",
+                      "--out", tmp / f"sw_{path.stem}"]]
+            if cfg.stage and not signed:
+                runs.append(["signoff", rig, "--json", "--out", tmp / f"so_{path.stem}"])
+                signed = True
+        for argv in runs:
+            code = main(["--quiet", *map(str, argv), "--controller", str(path)])
+            cap = capsys.readouterr()
+            assert "Traceback" not in cap.err, (argv[0], path.name, cap.err)
+            assert code in ((0, 1) if argv[0] == "signoff" else (0,)), \
+                (argv[0], path.name, cap.err)
+            assert json.loads(cap.out), (argv[0], path.name)
 
 
 def _held_by_python_control(rig: Path, metrics: dict, out: Path) -> None:

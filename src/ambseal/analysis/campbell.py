@@ -179,8 +179,7 @@ def closed_loop_state_matrix(cfg, controller=None, *, speed_hz: float,
     ``[q; q̇; actuator; controller]``; with ``delay`` ``[q; q̇; actuator; delay;
     controller]``, the loop of :func:`ambseal.analysis.judge.judge` (the digital
     controller's hold + computation delay as a Padé lag,
-    :func:`ambseal.robust.delay.loop_delay`). The closed-loop modes are those of the
-    continuous controller (no delay: the lag's own poles are no rotor modes).
+    :func:`ambseal.robust.delay.loop_delay`).
 
     Without a controller (or a rig without AMBs) the open-loop plant's A; a scheduled
     controller is frozen at the speed, or at its seal coefficient's value at the pressure
@@ -206,8 +205,12 @@ def closed_loop_state_matrix(cfg, controller=None, *, speed_hz: float,
 
 def closed_loop_modes(cfg, controller=None, *, speed_hz: float = 0.0,
                       pressure_bar: float | None = None,
-                      max_hz: float | None = None) -> ClosedLoopModes:
-    """Damped frequencies, damping, log decrement, whirl and shapes of the closed loop.
+                      max_hz: float | None = None, delay: bool = True) -> ClosedLoopModes:
+    """Damped frequencies, damping, log decrement, whirl and shapes of the closed loop: by
+    default the loop the main job judges (:func:`closed_loop_state_matrix` with ``delay``:
+    the continuous controller behind the target's hold and computation delay), so that
+    every command reports the log decrements of one loop. The lag's own poles lie at the
+    Padé approximant's frequencies, well above the rotor's modes kept here.
 
     Parameters
     ----------
@@ -222,6 +225,9 @@ def closed_loop_modes(cfg, controller=None, *, speed_hz: float = 0.0,
     max_hz : float, optional
         Highest damped frequency kept (Hz); default
         :func:`ambseal.model.modes.bending_limit_hz` (a few bending modes).
+    delay : bool
+        With the target's hold and computation delay (default); False: the continuous
+        design's own loop (e.g. against a closed form).
 
     Returns
     -------
@@ -235,13 +241,11 @@ def closed_loop_modes(cfg, controller=None, *, speed_hz: float = 0.0,
 
     p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
     f_max = bending_limit_hz(cfg) if max_hz is None else float(max_hz)
-    A, mesh = closed_loop_state_matrix(cfg, controller, speed_hz=speed_hz, pressure_bar=p)
-    judged = None
-    if controller is not None and cfg.amb:  # the verdict is the judged loop's, with the delay
-        judged = np.linalg.eigvals(closed_loop_state_matrix(
-            cfg, controller, speed_hz=speed_hz, pressure_bar=p, delay=True)[0])
-    return modes_of_state_matrix(A, mesh, speed_hz=speed_hz, pressure_bar=p, max_hz=f_max,
-                                 judged_poles=judged)
+    # the loop the run judges, its delay included: the modes' log decrements are those of
+    # the loop that runs, not of a better-damped one without the target's lag
+    A, mesh = closed_loop_state_matrix(cfg, controller, speed_hz=speed_hz, pressure_bar=p,
+                                       delay=delay)
+    return modes_of_state_matrix(A, mesh, speed_hz=speed_hz, pressure_bar=p, max_hz=f_max)
 
 
 def modes_as_run(cfg, controller=None, *, speed_hz: float, max_hz: float,
@@ -580,7 +584,7 @@ def _crossings(c: Campbell) -> tuple[tuple[Crossing, ...], tuple[Crossing, ...]]
 def campbell(cfg, controller=None, speeds_hz=None, *, pressure_bar: float | None = None,
              max_hz: float | None = None, log_dec_limit: float = API684_LOG_DEC,
              workers: int | None = None, scheduler: str | None = None,
-             progress: bool = False) -> Campbell:
+             progress: bool = False, delay: bool = True) -> Campbell:
     """The closed-loop Campbell diagram: :func:`closed_loop_modes` at every speed.
 
     Parameters
@@ -594,6 +598,8 @@ def campbell(cfg, controller=None, speeds_hz=None, *, pressure_bar: float | None
         the first bending mode's 1× crossings on the plot).
     pressure_bar, max_hz : float, optional
         As in :func:`closed_loop_modes` (``max_hz`` is fixed once, at standstill).
+    delay : bool
+        As in :func:`closed_loop_modes`: the judged loop, with the target's delay.
     log_dec_limit : float
         Modes below it are flagged (API 684: 0.1).
     workers, scheduler, progress
@@ -614,7 +620,7 @@ def campbell(cfg, controller=None, speeds_hz=None, *, pressure_bar: float | None
     cases = [dict(speed_hz=float(v)) for v in s]
     results = run_cases(_modes_case, cases, shared=dict(cfg=cfg, controller=controller,
                                                         pressure_bar=pressure_bar,
-                                                        max_hz=f_max),
+                                                        max_hz=f_max, delay=delay),
                         workers=workers, scheduler=scheduler, progress=progress,
                         description="campbell", raise_errors=True)
     pts = list(results)
@@ -623,6 +629,6 @@ def campbell(cfg, controller=None, speeds_hz=None, *, pressure_bar: float | None
     return Campbell(s, c.points, c.tracks, crossings, log_dec_limit, overdamped)
 
 
-def _modes_case(case: dict, cfg, controller, pressure_bar, max_hz) -> ClosedLoopModes:
+def _modes_case(case: dict, cfg, controller, pressure_bar, max_hz, delay) -> ClosedLoopModes:
     return closed_loop_modes(cfg, controller, speed_hz=case["speed_hz"],
-                             pressure_bar=pressure_bar, max_hz=max_hz)
+                             pressure_bar=pressure_bar, max_hz=max_hz, delay=delay)

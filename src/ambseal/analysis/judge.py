@@ -17,8 +17,8 @@ will act; the case records it as ``delay`` (``delay_s``, ``pade_order``,
 ``phase_error_deg``, ``band_top_hz``). On the test rig the PID's continuous σ̄(S_o) peaks
 then equal the sampled loop's to 0.1 % (13.36 against 13.37 at 2.04 bar, 7.43 against 7.43
 at 0 bar; without the delay they were 9.36 and 4.94). The closed-loop modes of
-:mod:`ambseal.analysis.campbell` stay those of the continuous controller; their stability
-verdict is this loop's (:func:`ambseal.machine.loop.judged_loop`).
+:mod:`ambseal.analysis.campbell` (``modes``, ``campbell``) are this loop's too, their log
+decrements and stability verdict alike (:func:`ambseal.machine.loop.judged_loop`).
 
 **What runs is judged too**: given the discrete controller of the target (with its
 computation delay, :class:`ambseal.robust.digital.DigitalController`), the same numbers are

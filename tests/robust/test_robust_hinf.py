@@ -454,3 +454,42 @@ def test_hinfsyn_gamma_opt_is_a_gamma_the_closed_loop_reaches():
     at_peak = C @ np.linalg.solve(1j * r.omega_peak * np.eye(A.shape[0]) - A, B) + D
     assert np.linalg.norm(at_peak, 2) == pytest.approx(r.gamma, rel=1e-9)
     assert r.gamma <= 1.0001 * r.gamma_opt * (1 + 1e-6)
+
+
+def test_a_static_plant_is_solved_as_python_control_defines_it():
+    """Reference: the closed form. z = [w + u; u], y = w: u = −k y gives
+    ‖z‖ = √((1 − k)² + k²) |w|, least at k = ½: γ_opt = 1/√2 (SLICOT needs n > 0; the
+    plant has no state). The controller is that static gain."""
+    import control as ct
+
+    from ambseal.robust import hinfsyn
+
+    P = ct.ss(np.zeros((0, 0)), np.zeros((0, 2)), np.zeros((3, 0)),
+              [[1.0, 1.0], [0.0, 1.0], [1.0, 0.0]])
+    r = hinfsyn(P, 1, 1)
+    assert r.gamma_opt == pytest.approx(1 / np.sqrt(2), rel=1e-6)
+    assert r.gamma == pytest.approx(1 / np.sqrt(2), rel=1e-6)
+    assert np.asarray(r.K.D).item() == pytest.approx(-0.5, rel=1e-5)
+
+
+def test_hinfnorm_and_digital_controller_refuse_what_they_cannot_take():
+    """A NaN or infinite entry and a tolerance outside (0, 1) are refused by hinfnorm
+    naming them (they reached LAPACK's and SLICOT's own errors, or returned (nan, 0));
+    digital_controller without a plant is refused (it was an IndexError)."""
+    import control as ct
+
+    from ambseal.errors import ConfigError, ModelError
+    from ambseal.robust import hinfnorm
+    from ambseal.robust.digital import digital_controller
+
+    G = ct.ss([[-1.0]], [[1.0]], [[1.0]], [[0.0]])
+    for bad in (ct.ss([[np.nan]], [[1.0]], [[1.0]], [[0.0]]),
+                ct.ss([[-1.0]], [[1.0]], [[1.0]], [[np.inf]])):
+        with pytest.raises(ModelError, match="non-finite"):
+            hinfnorm(bad)
+    for rtol in (0.0, -1.0, 1.0, float("nan")):
+        with pytest.raises(ConfigError, match="rtol"):
+            hinfnorm(G, rtol=rtol)
+    assert hinfnorm(G)[0] == pytest.approx(1.0, rel=1e-9)
+    with pytest.raises(ModelError, match="plants is empty"):
+        digital_controller(ct.ss([[-10.0]], [[1.0]], [[1.0]], [[0.0]]), 1000.0, [])

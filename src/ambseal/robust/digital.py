@@ -53,7 +53,7 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.signal import cont2discrete
 
-from ambseal.errors import ConfigError, SynthesisError
+from ambseal.errors import ConfigError, ModelError, SynthesisError
 from ambseal.lti import (
     feedback_poles,
     finite_or_none_tree,
@@ -670,11 +670,16 @@ def digital_controller(K, sample_rate_hz: float, plants, *,
     ------
     ConfigError
         A bad sample rate or delay.
+    ModelError
+        No plant given.
     SynthesisError
         An unstable fast pole, or no candidate keeps the sampled loop stable where the
         continuous loop is: the reason names the rate and the controller's poles.
     """
     check_rate(K, sample_rate_hz, delay_samples, removable=rise is not None)
+    if not isinstance(plants, SampledPlants) and len(plants) == 0:
+        raise ModelError("digital_controller: plants is empty; expected the full-order plant "
+                         "at one condition at least, (A, B, C, D) each")
     fs, T = float(sample_rate_hz), 1.0 / float(sample_rate_hz)
     mats = tuple(np.asarray(X, float) for X in (K.A, K.B, K.C, K.D))
     reduced, Kr, fast, red = _remove_fast(K, mats, fs, rise)

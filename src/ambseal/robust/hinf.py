@@ -102,7 +102,9 @@ def hinfnorm(sys, rtol: float = 1e-10) -> tuple[float, float]:
     Raises
     ------
     ModelError
-        If ``sys`` is discrete-time.
+        If ``sys`` is discrete-time or has a NaN or infinite entry.
+    ConfigError
+        ``rtol`` not in (0, 1).
     SynthesisError
         If SLICOT AB13DD does not converge on ``sys`` or on its balanced realisation.
 
@@ -116,6 +118,10 @@ def hinfnorm(sys, rtol: float = 1e-10) -> tuple[float, float]:
     sys = ct.ss(sys)
     if sys.isdtime(strict=True):
         raise ModelError("hinfnorm: only continuous-time systems are supported")
+    if not all(np.all(np.isfinite(np.asarray(M, float))) for M in (sys.A, sys.B, sys.C, sys.D)):
+        raise ModelError("hinfnorm: sys has non-finite entries (NaN or inf)")
+    if not (isinstance(rtol, (int, float, np.floating)) and 0.0 < rtol < 1.0):
+        raise ConfigError(f"hinfnorm: rtol={rtol!r}, expected a relative accuracy in (0, 1)")
     A = np.asarray(sys.A, float)
     if sys.ninputs == 0 or sys.noutputs == 0:
         return 0.0, 0.0
@@ -412,7 +418,8 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
     python-control's ``hinfsyn`` starts SB10AD's bisection and scan at γ = 1e100 instead.
     Then it builds the controller at ``backoff·γ_opt`` and checks that the closed loop is
     stable and keeps that γ; the back-off grows (×1.01 … ×``max_backoff``) until it does.
-    The reported γ is the recomputed norm of ``F_l(P, K)``.
+    The reported γ is the recomputed norm of ``F_l(P, K)``. A static plant (no state) is
+    given one decoupled state at −1 rad/s for SB10AD, which needs one; γ is unchanged.
 
     Parameters
     ----------
@@ -470,6 +477,11 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
     check_plant(P, nmeas, ncon)
     if backoff < 1.0:
         raise ConfigError(f"backoff={backoff} must be ≥ 1")
+    if P.nstates == 0:
+        # SLICOT SB10AD needs a state: one decoupled at −1 rad/s changes neither γ nor any
+        # transfer function (stable, neither controllable nor observable)
+        P = ct.ss(-np.eye(1), np.zeros((1, P.ninputs)), np.zeros((P.noutputs, 1)), P.D,
+                  inputs=P.input_labels, outputs=P.output_labels)
     sb = _Sb10(P, nmeas, ncon)
     if gamma is None:
         gamma_opt, gamma_lower, tests = sb.gamma_opt(rtol, confirm=False)

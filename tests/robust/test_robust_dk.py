@@ -298,3 +298,31 @@ def test_musyn_defaults_reach_the_published_aircraft_result():
     check = _mu_ab13md(cl, 2 * np.pi * np.logspace(-2, 2, 301), (2, 8), pad_cols=1)
     assert check <= 0.9824
     assert r.mu == pytest.approx(check, rel=1e-2)
+
+
+def test_a_k_step_that_fails_on_dynamic_fits_is_redone_with_static_ones(monkeypatch):
+    """A D-step's dynamic fits can make the scaled plant one no controller is found for
+    (a back-to-back compressor's banded μ: '(A, B2) is not stabilisable' on the fitted
+    scalings; D–K then stopped at μ 1.69 and D–G–K took 180 s). Here every K-step on a
+    plant enlarged by dynamic scalings is made to fail: D–K goes on with constant
+    scalings (the scaled plant keeps P's states), still improves on plain H∞ and says
+    so, instead of stopping after its first iteration."""
+    import ambseal.robust.dk as dk
+    from ambseal.errors import SynthesisError
+
+    P = rp_plant()
+    real = dk.hinfsyn
+
+    def refusing(Ps, *a, **kw):
+        if Ps.nstates > P.nstates:
+            raise SynthesisError("(A, B2) is not stabilisable (injected)")
+        return real(Ps, *a, **kw)
+
+    monkeypatch.setattr(dk, "hinfsyn", refusing)
+    lines = []
+    r = musyn(P, [(1, 1), (1, 1)], 1, 1, order="auto", max_iter=3, search=0,
+              progress=lines.append)
+    assert len(r.history) == 3, r.stopping
+    assert not r.stopping["dk"]["rule"].startswith("K-step")
+    assert any("static scalings taken" in ln for ln in lines)
+    assert r.mu < 0.95 * r.history[0]["mu"]

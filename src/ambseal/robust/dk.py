@@ -403,7 +403,9 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     Robust Control Toolbox documentation): a K-step (H∞ synthesis on ``D P D⁻¹`` at
     ``backoff·γ_opt``), the μ upper bound of the closed loop on ``omega``, a D-step (the
     bound's scalings fitted by stable, minimum-phase functions of automatically chosen
-    order), until μ stops improving; the best iterate is kept, not the last. D–K then often
+    order), until μ stops improving; the best iterate is kept, not the last. A K-step that
+    fails on dynamic fits (a scaled plant no controller is found for) is redone once with
+    the same D-step's constant scalings before the iterations end. D–K then often
     stalls a few per cent above the μ-optimum: each D-step fits the D that is optimal for the
     *current* K, not the D whose K-step is best. So a direct search over the fitted
     scales' parameters for the smallest γ_opt of ``D P D⁻¹`` follows
@@ -499,6 +501,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     history, best = [], None
     fits: list = []
     stall, rule = 0, f"max_iter={max_iter}"
+    last = None  # the previous closed loop and its μ, for a D-step redone with static fits
     for it in range(max_iter):
         Ps = _scaled_plant(P, cblocks, fits, nmeas, ncon) if fits else P
         try:
@@ -506,8 +509,23 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
         except SynthesisError as exc:
             if it == 0:
                 raise
-            rule = f"K-step {it} failed ({exc})"
-            break
+            # a dynamic fit can make the scaled plant one no controller is found for (jω
+            # zeros, rank loss) where its static scalings are not: redo the D-step with
+            # constant fits before ending the iterations
+            static = (_d_step(last[0], blocks, cblocks, w, last[1], 0, fit_tol)
+                      if order != 0 else None)
+            try:
+                if static is None:
+                    raise exc
+                hr = hinfsyn(_scaled_plant(P, cblocks, static, nmeas, ncon), nmeas, ncon,
+                             backoff=backoff)
+            except SynthesisError as again:
+                rule = f"K-step {it} failed ({again})"
+                break
+            fits = static
+            if console is not None:
+                console.print(f"D-K {it}: the K-step failed on the fitted scalings ({exc}); "
+                              "static scalings taken")
         cl = lft_lower(P, hr.K, nmeas, ncon)
         mu_true = mussv(cl, blocks, w, lower=False, peak=False)
         peak = float(np.max(mu_true.upper))
@@ -523,6 +541,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
         if stall >= patience:
             rule = f"patience={patience}: {stall} iterations without a μ gain of rtol={rtol:g}"
             break
+        last = (cl, mu_true)
         fits = _d_step(cl, blocks, cblocks, w, mu_true, order, fit_tol)
     finalists = [_finalist(best)]
     n_scaled = _scaled_plant(P, cblocks, best[4], nmeas, ncon).nstates if best[4] else 0

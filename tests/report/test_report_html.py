@@ -113,12 +113,14 @@ def test_verdict_holds_only_where_the_machine_runs_up_too():
           dict(ok, label="2.04 bar, 50 Hz", discrete={"stable": False}),
           dict(ok, label="2.04 bar, 100 Hz")]
     v = verdicts([case], None, st)[0]
-    assert v.zone_axis == "D" and v.speed_checked == 3
+    # both zone cells of the row: a loop lost in the speed range is zone D for σ̄ too
+    assert v.zone_axis == "D" and v.zone_sigma == "D" and v.speed_checked == 3
     assert v.speed_unstable == ("2.04 bar, 0 Hz", "2.04 bar, 50 Hz")
     assert v.stable_range == "2.04 bar; unstable at 2 of 3 speed-range conditions"
     assert v.words() == ("Not acceptable: the loop is unstable at 2.04 bar, 0 Hz; "
                          "2.04 bar, 50 Hz (where the machine runs up).")
     good = verdicts([case], None, st[2:])[0]
+    assert good.zone_sigma == case["iso_zone"]
     assert good.zone_axis == "B" and good.stable_range == "2.04 bar, standstill to top speed"
     assert good.words().startswith("Zone B on its worst axis (B η at 2.04 bar) over 2.04 "
                                    "bar: fit for")

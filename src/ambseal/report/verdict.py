@@ -270,15 +270,17 @@ def _verdict(name: str, cs: list, by_speed: bool, sc: list,
 
     stable_zones = {z for c in ok for z in (c.get("iso_zone_per_axis") or {}).values()}
     speed_bad = tuple(c["label"] for c in sc if _unstable(c))
-    # an unstable loop, judged or at a speed of the range, is zone D
-    axis_zones = ([z for c in cs for z in (c.get("iso_zone_per_axis") or {}).values()]
-                  + ["D" for c in cs if not c.get("stable")] + (["D"] if speed_bad else []))
+    # an unstable loop, judged or at a speed of the range, is zone D: for σ̄(S_o) too, so
+    # that the two zone cells of one row never disagree on it
+    lost = ["D" for c in cs if not c.get("stable")] + (["D"] if speed_bad else [])
+    axis_zones = [z for c in cs for z in (c.get("iso_zone_per_axis") or {}).values()] + lost
     top = _worst_axis(label, cs)
     return Verdict(
         controller=name, conditions=tuple(label),
         stable_at=tuple(lb for lb, c in zip(label, cs) if c.get("stable")),
         unstable_at=tuple(lb for lb, c in zip(label, cs) if not c.get("stable")),
-        zone_axis=_worst(axis_zones), zone_sigma=_worst(c.get("iso_zone") for c in cs),
+        zone_axis=_worst(axis_zones),
+        zone_sigma=_worst([c.get("iso_zone") for c in cs] + lost),
         sigma_peak=peak("sensitivity_peak"), orbit_um=peak("unbalance_peak_um"),
         impulse_peak_um=peak("impulse_peak_um"),
         impulse_settling_s=peak("impulse_settling_s"),

@@ -70,9 +70,21 @@ class ScheduledController(ABC):
 
     def theta_at(self, speed_rad_s: float | None = None,
                  values: Mapping[str, float] | None = None) -> float:
-        """θ at a condition: the speed Ω (rad/s) for a speed-scheduled controller, else
-        ``values[parameter]`` (SI; e.g. :func:`ambseal.model.seal.seal_values` at the
-        pressure drop).
+        """θ at a condition: the speed Ω for a speed-scheduled controller, else the
+        condition's value of ``parameter``.
+
+        Parameters
+        ----------
+        speed_rad_s : float, optional
+            The rotor speed Ω (rad/s).
+        values : mapping of str to float, optional
+            ``{parameter: value}`` (SI) at the condition, e.g.
+            :func:`ambseal.model.seal.seal_values` at the pressure drop.
+
+        Returns
+        -------
+        float
+            θ (rad/s for the speed, else SI).
 
         Raises
         ------

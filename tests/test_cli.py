@@ -122,6 +122,13 @@ def test_the_console_runs_with_stdout_or_stderr_closed(tmp_path):
                                   stdout=subprocess.DEVNULL if fd == 2 else None,
                                   stderr=subprocess.DEVNULL if fd == 1 else None)
             assert proc.returncode == code, (fd, rig.name)
+    # a wrapper script (pyenv's shim) run with `2>&-` leaves its own file open for reading
+    # on descriptor 2 of the interpreter it starts: `python -m ambseal.cli` exited 1
+    with open(good, "rb") as read_only:
+        for rig, code in ((bad, 2), (good, 0)):
+            proc = subprocess.run([sys.executable, "-m", "ambseal.cli", "validate", str(rig)],
+                                  stdout=subprocess.DEVNULL, stderr=read_only)
+            assert proc.returncode == code, ("read-only stderr", rig.name)
 
 
 def test_modes_json_keys_and_unstable_poles(tmp_path, capsys):

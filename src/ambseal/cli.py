@@ -462,17 +462,43 @@ def _inputs(args: argparse.Namespace) -> tuple[list, str]:
     return files, str(rig)
 
 
+def _open_stream(stream) -> bool:
+    """False for a standard stream that is missing, or whose descriptor is closed or open
+    for reading only (a wrapper script run with `2>&-` leaves its own file on descriptor 2
+    for the interpreter it starts); an in-memory one (no descriptor: a test's capture) is
+    open."""
+    if stream is None:
+        return False
+    try:
+        fd = stream.fileno()
+    except (AttributeError, ValueError, OSError):  # io.UnsupportedOperation is an OSError
+        return True
+    try:
+        # POSIX only; elsewhere an open descriptor is taken as writable
+        import fcntl
+    except ImportError:
+        fcntl = None
+    try:
+        os.fstat(fd)
+        if fcntl is not None:
+            return fcntl.fcntl(fd, fcntl.F_GETFL) & os.O_ACCMODE != os.O_RDONLY
+    except OSError:
+        return False
+    return True
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``ambseal`` console script; returns the exit status.
 
     Warnings raised on the way (numpy's, say) are shown after a successful command and
     dropped when the command ends in the one error line."""
 
-    # a shell may start us with stdout or stderr closed (`2>&-`): Python has None there and
-    # the first message (or rich's isatty) would fail with exit 1; they go nowhere instead,
-    # and the exit status is the command's
+    # a shell may start us with stdout or stderr closed (`2>&-`): Python has None there (the
+    # console script) or a stream on the closed descriptor (`python -m`), and the first
+    # message (or rich's isatty) would fail with exit 1; they go nowhere instead, and the
+    # exit status is the command's
     for stream in ("stdout", "stderr"):
-        if getattr(sys, stream) is None:
+        if not _open_stream(getattr(sys, stream)):
             setattr(sys, stream, open(os.devnull, "w", encoding="utf-8"))
     parser = _parser()
     args = parser.parse_args(argv)

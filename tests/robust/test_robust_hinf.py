@@ -459,7 +459,8 @@ def test_hinfsyn_gamma_opt_is_a_gamma_the_closed_loop_reaches():
 def test_a_static_plant_is_solved_as_python_control_defines_it():
     """Reference: the closed form. z = [w + u; u], y = w: u = −k y gives
     ‖z‖ = √((1 − k)² + k²) |w|, least at k = ½: γ_opt = 1/√2 (SLICOT needs n > 0; the
-    plant has no state). The controller is that static gain."""
+    plant has no state). The controller is that static gain; with z = w + u alone,
+    k = 1 and γ_opt = 0."""
     import control as ct
 
     from ambseal.robust import hinfsyn
@@ -470,6 +471,12 @@ def test_a_static_plant_is_solved_as_python_control_defines_it():
     assert r.gamma_opt == pytest.approx(1 / np.sqrt(2), rel=1e-6)
     assert r.gamma == pytest.approx(1 / np.sqrt(2), rel=1e-6)
     assert np.asarray(r.K.D).item() == pytest.approx(-0.5, rel=1e-5)
+    # z = w + u, y = w: u = −y cancels w exactly, γ_opt = 0 (the compiled γ margin's pencil
+    # is singular there: it ended in numba's LinAlgError)
+    P0 = ct.ss(np.zeros((0, 0)), np.zeros((0, 2)), np.zeros((2, 0)), [[1.0, 1.0], [1.0, 0.0]])
+    r0 = hinfsyn(P0, 1, 1)
+    assert r0.gamma == pytest.approx(0.0, abs=1e-9)
+    assert np.asarray(r0.K.D).item() == pytest.approx(-1.0, rel=1e-6)
 
 
 def test_hinfnorm_and_digital_controller_refuse_what_they_cannot_take():

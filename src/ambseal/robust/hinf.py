@@ -688,9 +688,11 @@ class _Sb10:
         the plant is larger."""
         if self.A.shape[0] > _SMALL_STATES:
             return float("nan")
-
-        return float(small_margin(self.A, self.B, self.C, self.D, self.nw, self.nz,
-                                  float(g)))
+        try:
+            return float(small_margin(self.A, self.B, self.C, self.D, self.nw, self.nz,
+                                      float(g)))
+        except np.linalg.LinAlgError:  # a singular pencil (e.g. γ_opt = 0): not decided
+            return float("nan")
 
     def gamma_opt(self, rtol: float = 1e-6, confirm: bool = True
                   ) -> tuple[float, float, int]:

@@ -1,8 +1,10 @@
-"""The main job with identification (``run --truth``) on rigs of other layouts than the
-embedded one: no coupling spring (nothing to identify in stage (b)), the pump (another
-rotor, bearings and seals, its AMBs biased at 5 A) and three AMBs (a statically
-indeterminate rotor: the static loads must be applied at two places). The embedded rig runs in the default
-suite (tests/test_pipeline.py); these take a minute or more each."""
+"""Identification on rigs of other layouts than the embedded one: the main job with
+identification (``run --truth``) with no coupling spring (nothing to identify in stage
+(b)), on the pump (another rotor, bearings and seals, its AMBs biased at 5 A) and with
+three AMBs (a statically indeterminate rotor: the static loads must be applied at two
+places), a minute or more each; and a record of the virtual facility fitted on every
+example rig (``acquire`` then ``identify``, about ten seconds each). The embedded rig runs
+in the default suite (tests/test_pipeline.py)."""
 
 from __future__ import annotations
 
@@ -15,6 +17,7 @@ import pytest
 from ambseal.cli import main
 from ambseal.config import default_rig_path, load_rig
 from ambseal.identify.fitting.procedure import seal_test_pressures
+from ambseal.model.amb import amb_factors
 
 from .metrics_schema import validate_metrics
 
@@ -80,3 +83,53 @@ def test_run_with_truth_on_other_layouts(layout, tmp_path, capsys):
     if layout == "three_ambs":  # the third AMB's factors found (static loads at two places)
         for axis in ("zeta", "eta"):
             assert abs(ident["parameters"][f"C.Ki_{axis}"]["error_pct"]) < 2.0
+
+
+EXAMPLES = sorted((ROOT / "examples").glob("*.toml"))
+#: Truth factors a few per cent off the rig file's, different per axis, as P2 found its
+#: identified factors against the first-principles ones
+_OFF = {"Ki": (1.02, 0.985, 1.03, 0.975), "Ks": (1.025, 0.98, 1.015, 0.97)}
+
+
+def _truth_of(cfg) -> dict:
+    """Ki and Ks of every AMB axis ``_OFF`` the rig file's (given or from the geometry)."""
+    values = {}
+    for i, amb in enumerate(cfg.amb):
+        for name, pair in zip(("Ki", "Ks"), amb_factors(amb)):
+            for j, (axis, v) in enumerate(zip(("zeta", "eta"), pair)):
+                values[f"{amb.name}.{name}_{axis}"] = (v, v * _OFF[name][(2 * i + j) % 4])
+    return values
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("rig", [*EXAMPLES, "no_spring"],
+                         ids=lambda r: getattr(r, "stem", r))
+def test_identification_on_every_example(rig, tmp_path, capsys):
+    """A PRBS record of the virtual facility (truth: the AMB factors a few per cent off, an
+    eddy-current lag, 1 % sensor noise, a 16-bit ADC) and the closed-loop fit of every
+    AMB factor and τ_e on each example rig and on the embedded rig without its spring:
+    every estimate within 1.5 half-widths of its 95 % interval of the truth and nearer
+    to it than the rig file's value it starts from."""
+    if rig == "no_spring":
+        rig, _ = _without_spring(tmp_path)
+    values = _truth_of(load_rig(rig))
+    tau_e = 1.0e-4
+    truth = tmp_path / "truth.toml"
+    truth.write_text("[truth]\ntau_e = 1.0e-4\nnoise_fraction = 0.01\nadc_bits = 16\n\n"
+                     "[truth.parameters]\n"
+                     + "".join(f'"{k}" = {t!r}\n' for k, (_, t) in values.items()))
+    record, fit = tmp_path / "prbs0.csv", tmp_path / "fit"
+    assert main(["--quiet", "acquire", str(rig), "--truth", str(truth), "--excitation",
+                 "prbs", "--pressure-bar", "0", "--out", str(record)]) == 0
+    code = main(["--quiet", "identify", str(rig), str(record), "--out", str(fit),
+                 "--params", ",".join([*values, "tau_e"])])
+    err = capsys.readouterr().err
+    assert code == 0 and "Traceback" not in err, err
+    result = json.loads((fit / "fit.json").read_text())
+    assert result["converged"], result["message"]
+    values["tau_e"] = (0.0, tau_e)
+    for name, (start, true) in values.items():
+        p = result["parameters"][name]
+        lo, hi = p["ci95"]
+        assert abs(p["estimate"] - true) <= 1.5 * (hi - lo) / 2, (name, p, true)
+        assert abs(p["estimate"] - true) < abs(start - true), (name, p, true)

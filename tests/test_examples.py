@@ -25,6 +25,7 @@ from ambseal.config import load_rig
 from ambseal.model import build_plant
 
 from .metrics_schema import validate_metrics
+from .report_agreement import check_report_agrees
 
 EXAMPLES = sorted((Path(__file__).resolve().parents[1] / "examples").glob("*.toml"))
 TESTRIG = Path(__file__).resolve().parents[1] / "examples" / "testrig.toml"
@@ -72,6 +73,7 @@ def _run(rig: Path, out: Path, capsys, failing: set = frozenset()) -> tuple[dict
         assert all(c["stable"] for c in metrics["cases"] if c["controller"] == m)
     if failing:
         _lpv_holds_everywhere(metrics)
+    check_report_agrees(out)
     return metrics, err
 
 

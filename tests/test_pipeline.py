@@ -11,6 +11,7 @@ from ambseal.cli import main
 
 from .browser import chromium, probe
 from .metrics_schema import validate_metrics
+from .report_agreement import check_report_agrees
 
 #: ISO 14839-3:2006 zone A/B boundary of the sensitivity peak (3, i.e. 9.5 dB; P5 §4.1).
 ISO_ZONE_A_LIMIT = 3.0
@@ -71,6 +72,15 @@ def test_run_on_a_terminal_ends_with_the_verdict_and_the_report_path(terminal_ru
     assert f"report: {(out / 'report.html').resolve()}" in text.replace("\r", "")
     last = [ln for ln in text.replace("\r", "\n").splitlines() if ln.strip()][-1]
     assert json.loads(last)["report"] == str(out / "report.html")
+
+
+def test_every_report_verdict_agrees_with_metrics_json(metrics, turbo_run):
+    """Every verdict of report.html read back (the verdict and detail tables' zones and
+    words, the speed-range table) against metrics.json's numbers graded by ISO
+    14839-3:2006's limits: the embedded rig (its PID lost at 4.08 bar) and the
+    turboexpander (four controllers over 20–300 Hz)."""
+    for out in (metrics[0], turbo_run):
+        check_report_agrees(out)
 
 
 def test_run_writes_the_contract(metrics):

@@ -13,6 +13,7 @@ from ambseal.cli import main
 from ambseal.config import default_rig_path
 
 from .metrics_schema import validate_metrics
+from .report_agreement import check_report_agrees
 
 #: the embedded rig's seal cross-coupling slope (N/m per bar), as its rig file states it
 K_SLOPE = "k = { at_zero = 0.0, per_bar = 1.1e6 }"
@@ -136,6 +137,7 @@ def test_run_with_a_failing_controller_writes_the_report_and_exits_1(tmp_path, c
     html = (out / "report.html").read_text()
     assert "Failed controllers" in html and html.index("Failed controllers") < html.index(
         "Verdict") and "H∞: not delivered" in html
+    check_report_agrees(out)
 
 
 @pytest.mark.slow

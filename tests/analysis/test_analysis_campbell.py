@@ -180,3 +180,34 @@ def test_overdamped_lines_cross_apart():
     assert [(x.track, x.speed_hz) for x in crossings] == [(0, 50.0)]
     assert [(x.track, x.speed_hz) for x in over] == [(1, 50.0)]
     assert z2 >= OVERDAMPED_ZETA > z1
+
+
+def test_campbell_figure_draws_only_modes_with_a_resonance(tmp_path, monkeypatch):
+    """Three lines over 0–100 Hz: a lightly damped mode at 50 Hz (ζ = 0.05: AF = π/δ ≈ 10,
+    a critical speed by API 684), a well damped one at 70 Hz (ζ = 0.3: AF ≈ 1.6 < 2.5) and
+    a controller pole damped at ζ = 0.95 whose frequency rises from 20 to 80 Hz. The
+    frequency panel draws the first in full colour, the second faint, the third not at all
+    (ζ ≥ 1/√2: no resonance to meet the 1× line); the δ panel holds all three."""
+    from types import SimpleNamespace
+
+    import ambseal.report.modal_figures as mf
+    from ambseal.analysis.campbell import Campbell, _crossings
+
+    speeds = np.linspace(0.0, 100.0, 11)
+    zeta = np.array([0.05, 0.3, 0.95])
+    pts = tuple(SimpleNamespace(
+        speed_hz=s, max_hz=1e3, frequency_hz=np.array([50.0, 70.0, 20.0 + 0.6 * s]),
+        damping_ratio=zeta, log_decrement=2 * np.pi * zeta / np.sqrt(1 - zeta**2),
+        whirl=("forward",) * 3) for s in speeds)
+    c = Campbell(speeds, pts, np.tile([0, 1, 2], (11, 1)), ())
+    c = Campbell(speeds, pts, c.tracks, *_crossings(c)[:1])
+    figs = []
+    monkeypatch.setattr(mf, "save_figure", lambda fig, path, **kw: figs.append(fig) or path)
+    mf.campbell_figure(tmp_path / "c.png", c)
+    top, bottom = figs[0].axes[:2]
+    drawn = [(col.get_alpha(), {float(y) for y in col.get_offsets()[:, 1]})
+             for col in top.collections if len(col.get_offsets())]
+    assert (None, {50.0}) in drawn and (0.25, {70.0}) in drawn
+    assert not any(y < 50.0 or 70.0 < y for _, ys in drawn for y in ys)  # the pole left out
+    assert sum(len(col.get_offsets()) for col in bottom.collections) == 3 * len(speeds)
+    assert [(x.track, x.critical) for x in c.crossings] == [(0, True), (1, False)]

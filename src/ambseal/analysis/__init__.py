@@ -19,9 +19,9 @@ sampled with its delay) on the full-order plant:
 * :func:`impulse_response` → :class:`ImpulseResponse` — the current-impulse response
   (P5 §5.1);
 * :func:`closed_loop_modes` → :class:`ClosedLoopModes`, :func:`log_decrement` — closed-loop
-  modes and log decrements (API 684; :func:`open_loop_modes`, :data:`OVERDAMPED_ZETA`), the
-  Campbell diagram
-  (:func:`ambseal.analysis.campbell.campbell` → :class:`Campbell`);
+  modes and log decrements (API 684; :func:`open_loop_modes`, :data:`OVERDAMPED_ZETA`,
+  :data:`AF_CRITICAL`), the Campbell diagram (:func:`ambseal.analysis.campbell.campbell`
+  → :class:`Campbell`);
 * :func:`level1_screening` → :class:`Level1`, :func:`stage_cross_coupling` — API 617's Level I
   stability screening with each controller as it runs;
 * :func:`sign_off` → :class:`SignOff`, :func:`verdict_line` — every criterion of API 617
@@ -61,7 +61,7 @@ from ambseal.lazy import lazy_face
 _FROM = {
     "closed_loop_modes": "campbell", "log_decrement": "campbell",
     "open_loop_modes": "campbell", "Campbell": "campbell", "ClosedLoopModes": "campbell",
-    "OVERDAMPED_ZETA": "campbell", "dask_available": "cases", "probe_scheduler": "cases",
+    "OVERDAMPED_ZETA": "campbell", "AF_CRITICAL": "campbell", "dask_available": "cases", "probe_scheduler": "cases",
     "run_cases": "cases", "CaseError": "cases", "also_failed": "delivery",
     "loop_failure": "delivery", "synthesis_failure": "delivery",
     "FailedController": "delivery", "iso_assessment": "iso", "zone_limit_db": "iso",

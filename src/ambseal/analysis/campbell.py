@@ -44,7 +44,7 @@ from ambseal.model import (
 )
 from ambseal.robust import decay_rate, is_stable
 
-__all__ = ["API684_LOG_DEC", "OVERDAMPED_ZETA", "ClosedLoopModes", "Crossing", "Campbell",
+__all__ = ["AF_CRITICAL", "API684_LOG_DEC", "OVERDAMPED_ZETA", "ClosedLoopModes", "Crossing", "Campbell",
            "log_decrement", "lowest_log_decrement", "whirl_of", "closed_loop_state_matrix",
            "closed_loop_modes", "modes_as_run", "modes_of_state_matrix", "modes_of_sampled_loop",
            "track_modes",
@@ -55,6 +55,10 @@ API684_LOG_DEC = 0.1
 #: A mode damped at ζ ≥ 1/√2 has no resonance peak (its second-order response falls
 #: monotonically with frequency): its 1× crossing is no critical speed and is listed apart.
 OVERDAMPED_ZETA = 1.0 / math.sqrt(2.0)
+#: API 684 (2nd ed., 2005) counts a resonance as a critical speed when its amplification
+#: factor AF ≈ π/δ is at least 2.5 (δ ≤ 1.26); API 617 asks no separation margin of one
+#: below it.
+AF_CRITICAL = 2.5
 #: A node counts in the whirl classification when it moves more than this share of the
 #: largest node amplitude of the mode.
 _MOVING = 0.01
@@ -453,7 +457,7 @@ class Crossing:
 
     @property
     def critical(self) -> bool:
-        return self.amplification_factor >= 2.5
+        return self.amplification_factor >= AF_CRITICAL
 
     def to_dict(self) -> dict:
         return {"track": self.track, "speed_hz": self.speed_hz,

@@ -26,10 +26,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ambseal.analysis.campbell import AF_CRITICAL
 from ambseal.analysis.iso_vibration import iso14839_2_zones
 from ambseal.analysis.level1 import RATIO_FREE, RATIO_MIN, level1_screening
 from ambseal.analysis.level2 import level2_analysis
-from ambseal.analysis.unbalance_api617 import AF_NO_MARGIN, api617_unbalance
+from ambseal.analysis.unbalance_api617 import api617_unbalance
 
 __all__ = ["Criterion", "SignOff", "sign_off", "verdict_line", "CLAUSES"]
 
@@ -114,13 +115,13 @@ def _criteria(cfg, l1, l2, unb, iso) -> tuple:
                           f"δ ≥ {d_min:g} with every source", CLAUSES["level2"], l2.passed,
                           counts=not l1.passed))
     crit = [k for c in unb.cases for k in c.criticals]
-    sharp = [k for k in crit if k.af >= AF_NO_MARGIN]
+    sharp = [k for k in crit if k.af >= AF_CRITICAL]
     worst = min(sharp, key=lambda k: k.actual_margin_pct - k.required_margin_pct,
                 default=None)
     if not crit:
         value = f"no critical speed up to {unb.top_hz:.4g} Hz"
     elif worst is None:
-        value = (f"{len(crit)} critical(s), none with AF ≥ {AF_NO_MARGIN:g} (largest AF "
+        value = (f"{len(crit)} critical(s), none with AF ≥ {AF_CRITICAL:g} (largest AF "
                  f"{max(k.af for k in crit):.3g}): no margin required")
     else:
         value = (f"{len(crit)} critical(s); tightest at {worst.speed_hz:.4g} Hz: AF "

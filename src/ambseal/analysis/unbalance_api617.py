@@ -57,7 +57,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import find_peaks
 
-from ambseal.analysis.campbell import OVERDAMPED_ZETA, modes_as_run
+from ambseal.analysis.campbell import AF_CRITICAL, OVERDAMPED_ZETA, modes_as_run
 from ambseal.analysis.level1 import RIGID_SUPPORT, bearing_positions, stage_position
 from ambseal.analysis.synchronous import Unbalance, orbit_semi_major, synchronous_response
 from ambseal.config import Spring
@@ -67,10 +67,8 @@ from ambseal.model import bending_limit_hz, build_system
 
 __all__ = ["unbalance_ur", "vibration_limit_um", "amplification_factor",
            "required_margin", "journal_loads", "Critical", "Clearance", "UnbalanceCase",
-           "Api617Unbalance", "api617_unbalance", "AF_NO_MARGIN", "SIGN_CHANGE"]
+           "Api617Unbalance", "api617_unbalance", "SIGN_CHANGE"]
 
-#: API 617: an amplification factor below this needs no separation margin.
-AF_NO_MARGIN = 2.5
 #: A mode shape "changes sign" when its most negative share reaches this fraction of its
 #: largest amplitude (a node between the supports, not a rounding of a rigid mode).
 SIGN_CHANGE = 0.25
@@ -143,7 +141,7 @@ def required_margin(af: float, below: bool) -> float:
     """API 617's required separation margin (%) of a critical with amplification factor
     ``af`` below the minimum (``below``) or above the maximum continuous speed: 0 for
     AF < 2.5 (module docstring)."""
-    if not af >= AF_NO_MARGIN:
+    if not af >= AF_CRITICAL:
         return 0.0
     m = 17.0 * (1.0 - 1.0 / (af - 1.5))
     return min(16.0, m) if below else min(26.0, 10.0 + m)
@@ -203,7 +201,7 @@ class Critical:
     @property
     def passed(self) -> bool:
         """No margin required (AF < 2.5), or the actual one at least the required."""
-        return not self.af >= AF_NO_MARGIN or self.actual_margin_pct >= self.required_margin_pct
+        return not self.af >= AF_CRITICAL or self.actual_margin_pct >= self.required_margin_pct
 
     def to_dict(self) -> dict:
         return {"speed_hz": self.speed_hz, "probe_m": self.probe_m,

@@ -15,6 +15,7 @@ import numpy as np
 from matplotlib.colors import TwoSlopeNorm
 from matplotlib.figure import Figure
 
+from ambseal.analysis import AF_CRITICAL, OVERDAMPED_ZETA
 from ambseal.report.figures import save_figure
 
 __all__ = ["campbell_figure", "mode_shapes_figure", "stability_map_figure"]
@@ -27,9 +28,14 @@ def campbell_figure(path: str | os.PathLike, c, *, title: str = "Closed-loop Cam
                     ) -> Path:
     """Damped natural frequency and log decrement of every closed-loop mode against speed.
 
-    Top: frequencies (markers by whirl: ▲ forward, ▼ backward, ◆ mixed, ● planar; a filled
-    black ring on modes below the log-decrement limit), the mode lines, the 1× line and the
-    crossings (×, bold where API 684 counts them critical). Bottom: log decrements with the limit (API 684: 0.1).
+    Top: the frequencies of the modes with a resonance (ζ < 1/√2,
+    :data:`~ambseal.analysis.campbell.OVERDAMPED_ZETA`; markers by whirl: ▲ forward,
+    ▼ backward, ◆ mixed, ● planar, faint where the mode is too well damped to be a critical
+    speed, AF = π/δ < 2.5 as API 684 counts them; a black ring on modes below the
+    log-decrement limit), their lines, the 1× line and the crossings (×, bold where API 684
+    counts them critical). A controller's or an eddy-current pole damped at ζ ≥ 1/√2 has no
+    resonance to meet the 1× line and is left out there. Bottom: the log decrements of every
+    mode with the limit (API 684: 0.1).
 
     Parameters
     ----------
@@ -49,19 +55,32 @@ def campbell_figure(path: str | os.PathLike, c, *, title: str = "Closed-loop Cam
     ax, axd = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 2]})
     s = c.speeds_hz
     for j in range(c.tracks.shape[1]):
-        ax.plot(s, c.line(j), color="0.75", lw=0.8, zorder=1)
+        f = c.line(j)
+        ax.plot(s, np.where(c.line(j, "damping_ratio") < OVERDAMPED_ZETA, f, np.nan),
+                color="0.75", lw=0.8, zorder=1)
         d = c.line(j, "log_decrement")
         axd.plot(s, np.clip(d, -1.0, 10.0), color="0.75", lw=0.8, zorder=1)
+    sharp_delta = np.pi / AF_CRITICAL  # δ at AF = 2.5
     for whirl, (col, mk) in _WHIRL_STYLE.items():
-        xs, fs, ds = [], [], []
+        xs, fs, ds, zs = [], [], [], []
         for p in c.points:
             sel = [k for k, w in enumerate(p.whirl) if w == whirl]
             xs += [p.speed_hz] * len(sel)
             fs += list(p.frequency_hz[sel])
             ds += list(p.log_decrement[sel])
-        if xs:
-            ax.scatter(xs, fs, s=14, color=col, marker=mk, label=whirl, zorder=3)
-            axd.scatter(xs, np.clip(ds, -1.0, 10.0), s=14, color=col, marker=mk, zorder=3)
+            zs += list(p.damping_ratio[sel])
+        if not xs:
+            continue
+        xs, fs, ds, zs = map(np.asarray, (xs, fs, ds, zs))
+        sharp = ds <= sharp_delta
+        damped = ~sharp & (zs < OVERDAMPED_ZETA)
+        if np.any(sharp):
+            ax.scatter(xs[sharp], fs[sharp], s=14, color=col, marker=mk, label=whirl,
+                       zorder=3)
+        if np.any(damped):
+            ax.scatter(xs[damped], fs[damped], s=10, color=col, marker=mk, alpha=0.25,
+                       zorder=2, label=None if np.any(sharp) else whirl)
+        axd.scatter(xs, np.clip(ds, -1.0, 10.0), s=14, color=col, marker=mk, zorder=3)
     low = c.flagged()
     if low:
         ax.scatter([r["speed_hz"] for r in low], [r["frequency_hz"] for r in low], s=60,
@@ -71,8 +90,17 @@ def campbell_figure(path: str | os.PathLike, c, *, title: str = "Closed-loop Cam
     for x in c.crossings:  # API 684 critical (AF ≥ 2.5) bold, the others small
         ax.plot(x.speed_hz, x.speed_hz, "x", color="k" if x.critical else "0.5",
                 ms=9 if x.critical else 5, mew=2 if x.critical else 1, zorder=5)
-    # up to the first mode above the speed range (the modes that can meet 1× and the next)
-    f_all = np.concatenate([p.frequency_hz for p in c.points])
+    if c.crossings:
+        ax.plot([], [], "x", color="k", ms=7, mew=1.5,
+                label=f"1× crossing (bold: critical, AF ≥ {AF_CRITICAL:g})")
+    if any(np.any((p.log_decrement > sharp_delta) & (p.damping_ratio < OVERDAMPED_ZETA))
+           for p in c.points):
+        ax.scatter([], [], s=10, color="0.3", alpha=0.25,
+                   label=f"faint: AF < {AF_CRITICAL:g}, no critical speed")
+    # up to the first resonant mode above the speed range (the modes that can meet 1× and
+    # the next)
+    f_all = np.concatenate([p.frequency_hz[p.damping_ratio < OVERDAMPED_ZETA]
+                            for p in c.points])
     above = f_all[f_all > s.max()]
     top = max(float(s.max()), float(above.min()) if above.size else float(f_all.max(initial=1.0)))
     ax.set_ylim(0, 1.15 * top)

@@ -10,6 +10,7 @@ ambseal writes, the reference being the planted bytes: they must be there afterw
 
 from __future__ import annotations
 
+import json
 import os
 import random
 import signal
@@ -23,6 +24,7 @@ import pytest
 
 from ambseal.cli import main
 from ambseal.config import default_rig_path
+from ambseal.errors import AmbsealError
 from ambseal.files import FOLDER_LOCK, OwnedFolder, RunFolder, check_manifest
 
 from .conftest import ROOT
@@ -186,3 +188,94 @@ def test_a_link_planted_in_an_output_folder_is_refused_and_its_target_kept(tmp_p
     assert main(["campbell", RIG, "--speed-hz", "0:10:2", "--out", str(out)]) == 2
     _one_error(capsys, "campbell_pid.png")
     assert doc.read_bytes() == USER and (out / "campbell_pid.png").is_symlink()
+
+
+def test_a_file_saved_beside_a_command_stays_the_users(tmp_path):
+    """A file the user saves into a folder while a command writes there is not listed in
+    the folder's manifest (only what ambseal wrote, with the hash it wrote), so a later
+    run into the folder refuses it by name instead of replacing it with the former set."""
+    from ambseal.files import write_text
+
+    out = tmp_path / "cb"
+    with OwnedFolder(out) as folder:
+        write_text(folder / "campbell.json", "{}")
+        (out / "notes.txt").write_bytes(USER)
+        write_text(folder / "campbell.csv", "speed_hz\n")
+    listed = json.loads((out / "manifest.json").read_text())["files"]
+    assert set(listed) == {"campbell.json", "campbell.csv"}
+    with pytest.raises(AmbsealError, match="notes.txt"):
+        with RunFolder(out):
+            pass
+    assert (out / "notes.txt").read_bytes() == USER
+
+
+def test_a_killed_commands_folder_keeps_a_file_saved_meanwhile(tmp_path):
+    """A command killed (SIGTERM, its lock left) while the user saved a file into its
+    folder: the next command takes over the dead command's outputs — the files its journal
+    names with their hashes — but refuses the user's file by name and keeps it."""
+    out = tmp_path / "out"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    proc = subprocess.Popen([sys.executable, "-c", WRITER, str(out), "400"],
+                            stdout=subprocess.PIPE, env=env)
+    assert proc.stdout.readline().strip() == b"started"
+    (out / "mine.txt").write_bytes(USER)
+    time.sleep(0.1)
+    proc.send_signal(signal.SIGTERM)
+    proc.wait()
+    assert FOLDER_LOCK in {p.name for p in out.iterdir()}
+    rerun = subprocess.run([sys.executable, "-c", WRITER, str(out), "3"],
+                           capture_output=True, env=env, text=True)
+    assert rerun.returncode != 0 and "mine.txt" in rerun.stderr, rerun.stderr
+    assert (out / "mine.txt").read_bytes() == USER
+    (out / "mine.txt").unlink()
+    rerun = subprocess.run([sys.executable, "-c", WRITER, str(out), "3"],
+                           capture_output=True, env=env, text=True)
+    assert rerun.returncode == 0 and "taken as ambseal's" in rerun.stderr, rerun.stderr
+    check_manifest(out)
+
+
+def test_an_edited_file_of_an_export_folder_is_the_users(tmp_path, capsys):
+    """A re-export into a folder where the user edited one of ambseal's files (its hash no
+    longer the manifest's) is refused by name and the edit kept, as a single file is;
+    with --force the file is replaced."""
+    from .test_run_folder import _small_controller_file
+
+    K = _small_controller_file(tmp_path)
+    out = tmp_path / "export"
+    argv = ["export", RIG, "--controller", str(K), "--out", str(out)]
+    assert main(argv) == 0
+    source = out / "c" / "ambseal_K.c"
+    written = source.read_bytes()
+    source.write_bytes(written + b"/* tuned by hand */\n")
+    capsys.readouterr()
+    assert main(argv) == 2
+    _one_error(capsys, "c/ambseal_K.c", "changed since ambseal wrote", "--force")
+    assert source.read_bytes().endswith(b"/* tuned by hand */\n")
+    assert main([*argv, "--force"]) == 0
+    assert source.read_bytes() == written
+    check_manifest(out)
+
+
+def test_stale_folders_beside_a_run_are_removed_only_when_ambseals(tmp_path):
+    """Beside ``out``: a user's folders named like a killed run's staging and former
+    folders (no mark, no complete manifest) are kept; a killed run's own staging folder
+    (its mark inside) is removed — also when ``out``'s name holds glob characters."""
+    from ambseal.files import STAGING_MARK, write_text
+
+    for name in ("out", "res[1]"):
+        out = tmp_path / name
+        with RunFolder(out) as stage:
+            write_text(stage / "metrics.json", "{}")
+        users = [tmp_path / f".{name}.staging-77", tmp_path / f".{name}.old-78"]
+        for u in users:
+            u.mkdir()
+            (u / "mine.txt").write_bytes(USER)
+        killed = tmp_path / f".{name}.staging-79"
+        killed.mkdir()
+        (killed / STAGING_MARK).write_text("79\n")
+        write_text(killed / "metrics.json", "{}")
+        with RunFolder(out) as stage:
+            write_text(stage / "metrics.json", "{}")
+        assert not killed.exists()
+        assert all((u / "mine.txt").read_bytes() == USER for u in users)
+        check_manifest(out)

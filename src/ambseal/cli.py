@@ -70,6 +70,14 @@ class _Parser(argparse.ArgumentParser):
         sys.exit(2)
 
 
+def _folder_force(parser) -> None:
+    """``--force`` of a command writing an output folder (:mod:`ambseal.files`)."""
+    parser.add_argument("--force", action="store_true",
+                        help="replace files ambseal wrote into --out that were changed since "
+                             "(without it they are the user's and the folder is refused); "
+                             "files ambseal did not write are never replaced")
+
+
 def _finite(text: str) -> float:
     """A finite number of plausible size (|x| < 1e12: no argument of ambseal is larger in
     the units of its name)."""
@@ -185,6 +193,7 @@ def _parser() -> argparse.ArgumentParser:
                          "identification, report", description=_RUN_TEXT)
     run.add_argument("rig", nargs="?", help=_RIG_HELP)
     run.add_argument("--out", default="ambseal-out", help="output folder")
+    _folder_force(run)
     run.add_argument("--truth", default=None,
                      help="truth file of the virtual facility: adds the identification stage "
                           "(the embedded rig uses its packaged truth)")
@@ -253,6 +262,7 @@ def _parser() -> argparse.ArgumentParser:
     d.add_argument("--pressure-bar", type=_finite, default=None,
                    help="design pressure drop (bar); default [operating] pressure_bar")
     d.add_argument("--out", default="ambseal-design", help="output folder")
+    _folder_force(d)
 
     e = sub.add_parser("export", help="a controller for the real-time target: files and C code")
     e.add_argument("rig", help="rig file (TOML)")
@@ -265,6 +275,7 @@ def _parser() -> argparse.ArgumentParser:
     e.add_argument("--pressure-bar", type=float, default=None,
                    help="design pressure drop (bar); default [operating] pressure_bar")
     e.add_argument("--out", default="ambseal-export", help="folder of the controller files")
+    _folder_force(e)
     e.add_argument("--c", dest="c_dir", default=None, help="write the C99 module to this folder")
     e.add_argument("--precision", choices=["double", "float"], default="double",
                    help="floating-point type of the C module (default double)")
@@ -278,6 +289,7 @@ def _parser() -> argparse.ArgumentParser:
     i.add_argument("--params", required=True,
                    help="parameters, e.g. A.Ki_zeta,A.Ks_zeta,tau_e,coupling.kxx,seal.k")
     i.add_argument("--out", required=True, help="output folder")
+    _folder_force(i)
     i.add_argument("--current-weight", type=_nonnegative, default=0.0,
                    help="weight of the coil-current residuals (0: displacements only)")
     i.add_argument("--accept-unconverged", action="store_true",
@@ -297,6 +309,7 @@ def _parser() -> argparse.ArgumentParser:
     tr.add_argument("data", nargs="+", help="record files (.csv with sidecar, or .mat)")
     tr.add_argument("--params", required=True, help="LFT parameters, e.g. seal.k,seal.K")
     tr.add_argument("--out", default="ambseal-track", help="output folder")
+    _folder_force(tr)
     tr.add_argument("--rate-per-s", type=_positive, default=None,
                     help="expected drift per second as a fraction of each parameter's scale "
                          "(default 0.1)")
@@ -347,6 +360,7 @@ def _rotordynamics_parsers(sub) -> None:
     c.add_argument("--log-dec-limit", type=float, default=0.1,
                    help="flag modes below this log decrement (API 684: 0.1)")
     c.add_argument("--out", default="ambseal-campbell", help="output folder")
+    _folder_force(c)
     _executor_args(c)
 
     s = sub.add_parser("sweep", help="stability and performance map over pressure x speed")
@@ -364,6 +378,7 @@ def _rotordynamics_parsers(sub) -> None:
     s.add_argument("--tol-bar", type=_positive, default=0.01,
                    help="the stability boundary is bisected to this pressure (bar)")
     s.add_argument("--out", default="ambseal-sweep", help="output folder")
+    _folder_force(s)
     _executor_args(s)
 
     so = sub.add_parser("signoff", help="sign a machine off: API 617 stability (Level I "
@@ -378,6 +393,7 @@ def _rotordynamics_parsers(sub) -> None:
     sg.add_argument("--controller", default=None,
                     help="a controller file of ambseal design (.json, .npz, .mat)")
     so.add_argument("--out", default="ambseal-signoff", help="output folder")
+    _folder_force(so)
     so.add_argument("--json", action="store_true",
                     help="print one JSON object (per controller its criteria and the "
                          "level1, level2, unbalance and iso14839_2 blocks)")

@@ -25,6 +25,7 @@ import shutil
 import stat
 import sys
 import tempfile
+import threading
 import tomllib
 import uuid
 from pathlib import Path
@@ -34,7 +35,8 @@ from ambseal.errors import AmbsealError
 
 __all__ = ["atomic_write", "writable_folder", "input_file", "MAX_READ_BYTES", "read_text",
            "load_toml", "write_text", "write_json", "RunFolder", "check_manifest",
-           "write_manifest", "OwnedFolder", "foreign_entries", "claim_file", "stamp_text",
+           "write_manifest", "OwnedFolder", "foreign_entries", "changed_entries",
+           "claim_file", "stamp_text",
            "stamp_holds", "STAMP_KEY"]
 
 
@@ -60,6 +62,7 @@ def atomic_write(path: str | os.PathLike, write: Callable[[BinaryIO], Any]) -> P
         with os.fdopen(fd, "wb") as fh:
             write(fh)
         os.chmod(tmp, 0o644)
+        _journal(path, tmp)
         os.replace(tmp, path)
     except BaseException as exc:
         if os.path.exists(tmp):
@@ -68,6 +71,36 @@ def atomic_write(path: str | os.PathLike, write: Callable[[BinaryIO], Any]) -> P
             raise AmbsealError(f"{path}: cannot write ({exc.strerror or exc})") from None
         raise
     return path
+
+
+#: The folders whose writes are being recorded (:class:`OwnedFolder`, innermost last):
+#: what ambseal writes there is what their manifests list, with the hash it was written with
+_RECORDING: list = []
+_RECORDING_LOCK = threading.Lock()
+
+
+def _journal(path: Path, tmp: str) -> None:
+    """Record a file about to be renamed to ``path`` (its bytes in ``tmp``) in each
+    recording folder that holds it: in its lock file first (the journal a next command reads
+    when this one is killed), then in memory."""
+    with _RECORDING_LOCK:
+        if not _RECORDING:
+            return
+        real = Path(os.path.realpath(path.parent)) / path.name
+        owners = [(f, rel) for f in _RECORDING
+                  for rel in [_relative(real, f.out)] if rel is not None]
+        if owners:
+            digest = _file_hash(Path(tmp))
+            for folder, rel in owners:
+                folder.record(rel, digest)
+
+
+def _relative(path: Path, folder: Path) -> str | None:
+    """``path`` relative to ``folder`` (POSIX form), None when it is not inside it."""
+    try:
+        return path.relative_to(folder).as_posix()
+    except ValueError:
+        return None
 
 
 def writable_folder(folder: str | os.PathLike) -> Path:
@@ -251,6 +284,9 @@ MIN_FREE_BYTES = 50 * 2**20
 MANIFEST = "manifest.json"
 #: The lock of an :class:`OwnedFolder`, inside it (ambseal's, never listed or refused).
 FOLDER_LOCK = ".ambseal.lock"
+#: The mark of a :class:`RunFolder`'s staging folder while the run writes it: a stale
+#: ``.<out>.staging-<pid>`` is removed only when it holds the mark (or is a complete set).
+STAGING_MARK = ".ambseal-staging"
 _RENAME_EXCHANGE = 2  # linux/fs.h
 _AT_FDCWD = -100
 
@@ -339,7 +375,8 @@ def foreign_entries(folder: str | os.PathLike) -> list[str]:
         with os.scandir(path) as entries:
             for e in sorted(entries, key=lambda e: e.name):
                 r = rel + e.name
-                if (not rel and (e.name == FOLDER_LOCK or e.name == MANIFEST and man)) or \
+                if (not rel and (e.name in (FOLDER_LOCK, STAGING_MARK)
+                                 or e.name == MANIFEST and man)) or \
                         _TEMPORARY.fullmatch(e.name):
                     continue
                 if e.is_dir(follow_symlinks=False):
@@ -354,12 +391,51 @@ def foreign_entries(folder: str | os.PathLike) -> list[str]:
     return out
 
 
-def _not_ours(folder: Path, extra: list[str]) -> AmbsealError:
-    names = ", ".join(extra[:3]) + (f" and {len(extra) - 3} more" if len(extra) > 3 else "")
+def changed_entries(folder: str | os.PathLike, journal: dict | None = None) -> list[str]:
+    """The files of ``folder``'s manifest whose bytes are no longer those ambseal wrote
+    (SHA-256 against the manifest, or against ``journal``'s ``{path: sha256}`` of a killed
+    command's writes): edited since, and so the user's.
+
+    Parameters
+    ----------
+    folder : path
+        An existing folder.
+    journal : dict, optional
+        Hashes a killed command recorded for the files it wrote (they count as ambseal's).
+
+    Returns
+    -------
+    list of str
+        Paths relative to ``folder``, sorted.
+    """
+    folder = Path(folder)
+    man = _read_manifest(folder)
+    out = []
+    for rel, digest in sorted((man or {"files": {}})["files"].items()):
+        p = folder / rel
+        if not p.is_file() or p.is_symlink():
+            continue  # gone, or no longer a file: foreign_entries names what is there
+        try:
+            now = _file_hash(p)
+        except OSError:
+            now = None
+        if now not in (digest, (journal or {}).get(rel)):
+            out.append(rel)
+    return out
+
+
+def _not_ours(folder: Path, extra: list[str], changed: list[str] = ()) -> AmbsealError:
+    def names(xs):
+        return ", ".join(xs[:3]) + (f" and {len(xs) - 3} more" if len(xs) > 3 else "")
+    if not extra:
+        return AmbsealError(f"{folder}: {names(list(changed))}: changed since ambseal wrote "
+                            f"{'them' if len(changed) > 1 else 'it'}, so the user's; move "
+                            "them elsewhere, choose another --out, or pass --force to "
+                            "replace them")
     return AmbsealError(f"{folder}: not an ambseal output folder, or it holds files ambseal "
-                        f"did not write ({names}); ambseal replaces only the files its "
-                        f"{MANIFEST} lists: move those elsewhere or choose an empty or new "
-                        "--out")
+                        f"did not write ({names(extra)}); ambseal replaces only the files "
+                        f"its {MANIFEST} lists: move those elsewhere or choose an empty or "
+                        "new --out")
 
 
 def _file_hash(path: Path) -> str:
@@ -370,16 +446,24 @@ def _file_hash(path: Path) -> str:
     return h.hexdigest()
 
 
-def write_manifest(folder: Path, run_id: str, keep=None) -> Path:
+def write_manifest(folder: Path, run_id: str, files: dict | None = None,
+                   folders: list | None = None) -> Path:
     """Write ``manifest.json``: the run id, the SHA-256 of every file in ``folder`` and its
-    sub-folders, and the sub-folders (only the paths that ``keep(relative_path)`` accepts,
-    when given)."""
+    sub-folders, and the sub-folders; or exactly ``files`` (``{path: sha256}``, the hashes
+    the files were written with) and ``folders`` when given, those still there."""
 
-    paths = [p for p in sorted(folder.rglob("*")) if p.name not in (MANIFEST, FOLDER_LOCK)
-             and not _TEMPORARY.fullmatch(p.name) and not p.is_symlink()
-             and (keep is None or keep(p.relative_to(folder).as_posix()))]
-    files = {p.relative_to(folder).as_posix(): _file_hash(p) for p in paths if p.is_file()}
-    folders = [p.relative_to(folder).as_posix() for p in paths if p.is_dir()]
+    if files is None:
+        paths = [p for p in sorted(folder.rglob("*"))
+                 if p.name not in (MANIFEST, FOLDER_LOCK, STAGING_MARK)
+                 and not _TEMPORARY.fullmatch(p.name) and not p.is_symlink()]
+        files = {p.relative_to(folder).as_posix(): _file_hash(p) for p in paths
+                 if p.is_file()}
+        folders = [p.relative_to(folder).as_posix() for p in paths if p.is_dir()]
+    else:
+        files = {r: d for r, d in sorted(files.items())
+                 if (folder / r).is_file() and not (folder / r).is_symlink()}
+        folders = sorted(r for r in folders or ()
+                         if (folder / r).is_dir() and not (folder / r).is_symlink())
     stamp = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
     return write_json(folder / MANIFEST, {"run_id": run_id, "finished_utc": stamp,
                                           "files": files, "folders": folders})
@@ -410,6 +494,19 @@ def check_manifest(folder: str | os.PathLike) -> str:
     return str(man["run_id"])
 
 
+def _made_here(folder: Path) -> bool:
+    """A killed run's staging or former folder is ambseal's: it holds :data:`STAGING_MARK`
+    (a staging folder being written) or is a complete output (:func:`check_manifest`)."""
+    mark = folder / STAGING_MARK
+    if mark.is_file() and not mark.is_symlink():
+        return True
+    try:
+        check_manifest(folder)
+    except (AmbsealError, OSError):
+        return False
+    return True
+
+
 class RunFolder:
     """The output folder of one run, written as one unit.
 
@@ -421,17 +518,29 @@ class RunFolder:
     ``out`` by one atomic exchange of the two directories (Linux ``renameat2``; elsewhere
     two renames, and a run killed between them is repaired by the next); on error or kill
     ``out`` keeps the former run's complete set. ``out`` may be replaced only when it holds
-    nothing but the files of its manifest (a file that appears there during the run is
-    moved into the new set, not lost).
+    nothing but the files of its manifest as ambseal wrote them (a file that appears there
+    during the run is moved into the new set, not lost; a listed file edited since is the
+    user's: refused unless ``force``). A stale staging or former folder of a killed run
+    (``.<name>.staging-<pid>``, ``.<name>.old-<pid>``) is removed only when its mark
+    (:data:`STAGING_MARK`) or its complete manifest says ambseal made it.
+
+    Parameters
+    ----------
+    out : path
+        The output folder.
+    force : bool
+        Replace the listed files the user changed since ambseal wrote them.
 
     Raises
     ------
     AmbsealError
         The folder cannot be created or written, the disk is full, another run holds the
-        lock, or ``out`` holds files its manifest does not list.
+        lock, or ``out`` holds files its manifest does not list (or, without ``force``,
+        listed files changed since).
     """
 
-    def __init__(self, out: str | os.PathLike):
+    def __init__(self, out: str | os.PathLike, force: bool = False):
+        self.force = bool(force)
         self.out = Path(out).absolute()
         name = self.out.name
         self.parent = self.out.parent
@@ -440,7 +549,8 @@ class RunFolder:
         self.old = self.parent / f".{name}.old-{os.getpid()}"
         self._lock_fd: int | None = None
         self.stale_pid: int | None = None
-        self.stale_since = 0.0
+        self._previous = b""  # the lock file as a killed owner left it (its journal)
+        self._keep_journal = False  # leave the lock file: it holds a killed owner's journal
 
     def _fail(self, what: str, exc: OSError) -> AmbsealError:
         return AmbsealError(f"{self.out}: cannot {what} ({exc.strerror or exc})")
@@ -459,7 +569,8 @@ class RunFolder:
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except OSError:
-                owner = os.pread(fd, 32, 0).decode("ascii", "replace").strip() or "?"
+                owner = (os.pread(fd, 32, 0).decode("ascii", "replace").split()
+                         or ["?"])[0]
                 os.close(fd)
                 raise AmbsealError(f"{self.out}: another ambseal run (pid {owner}) is writing "
                                    "this folder; wait for it or choose another --out") from None
@@ -473,22 +584,30 @@ class RunFolder:
             os.close(fd)  # locked a file its owner had just removed: take the new one
         else:
             raise AmbsealError(f"{self.lock_path}: the lock keeps changing hands; try again")
-        previous = os.pread(fd, 32, 0).decode("ascii", "replace").split()
-        self.stale_since = os.fstat(fd).st_mtime  # when the former owner took it
+        self._previous = os.pread(fd, min(os.fstat(fd).st_size, MAX_READ_BYTES), 0)
+        previous = self._previous[:32].decode("ascii", "replace").split()
         self.stale_pid = int(previous[0]) if previous and previous[0].isdigit() \
             and int(previous[0]) != os.getpid() else None
         if self.stale_pid is not None:
             print(f"ambseal: note: {self.out}: took over the lock of pid {self.stale_pid}, "
                   "which is no longer running", file=sys.stderr)
         os.ftruncate(fd, 0)
-        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+        head = f"{os.getpid()}\n".encode()
+        os.pwrite(fd, head, 0)
+        self._journal_end = len(head)
         self._lock_fd = fd
 
     def _clean_stale(self) -> None:
+        """Remove the staging and former folders killed runs left beside ``out`` — only
+        those ambseal's mark or complete manifest proves its own (names compared as
+        strings: ``out`` may hold glob characters)."""
         prefix = f".{self.out.name}."
-        for p in self.parent.glob(prefix + "*"):
+        with os.scandir(self.parent) as entries:
+            stale = [Path(e.path) for e in entries if e.name.startswith(prefix)
+                     and e.is_dir(follow_symlinks=False)]
+        for p in stale:
             kind, _, pid = p.name[len(prefix):].partition("-")
-            if kind not in ("staging", "old") or not pid.isdigit() or not p.is_dir():
+            if kind not in ("staging", "old") or not pid.isdigit() or not _made_here(p):
                 continue
             if kind == "old" and not self.out.exists():
                 os.rename(p, self.out)  # killed between the two renames: keep the old set
@@ -502,6 +621,7 @@ class RunFolder:
             self._check_ours()
             try:
                 self.stage.mkdir()
+                (self.stage / STAGING_MARK).write_bytes(f"{os.getpid()}\n".encode())
                 (self.stage / ".probe").write_bytes(b"0" * 4096)
                 (self.stage / ".probe").unlink()
                 free = shutil.disk_usage(self.stage).free
@@ -525,6 +645,7 @@ class RunFolder:
             moved: list = []
             try:
                 write_manifest(self.stage, uuid.uuid4().hex)
+                (self.stage / STAGING_MARK).unlink()  # a complete set from here on
                 self._keep_foreign(moved)
                 if not self.out.exists():
                     os.rename(self.stage, self.out)
@@ -544,9 +665,11 @@ class RunFolder:
         finally:
             self._unlock()
 
-    def _check_ours(self, adopted: frozenset = frozenset()) -> None:
+    def _check_ours(self, adopted: frozenset = frozenset(), journal: dict | None = None
+                    ) -> None:
         """AmbsealError unless ``out`` is new, or a folder of nothing but its manifest's
-        (and the ``adopted`` entries)."""
+        files as ambseal wrote them (and the ``adopted`` entries; listed files changed
+        since pass with ``force``, or when ``journal`` has their hash)."""
         if not os.path.lexists(self.out):
             return
         if self.out.is_symlink() or not self.out.is_dir():
@@ -554,10 +677,11 @@ class RunFolder:
                                "new --out")
         try:
             extra = [e for e in foreign_entries(self.out) if e.rstrip("/") not in adopted]
+            changed = [] if self.force else changed_entries(self.out, journal)
         except OSError as exc:
             raise self._fail("read the output folder", exc) from None
-        if extra:
-            raise _not_ours(self.out, extra)
+        if extra or changed:
+            raise _not_ours(self.out, extra, changed)
 
     def _keep_foreign(self, moved: list) -> None:
         """Move what appeared in ``out`` during the run (not in its manifest) into the
@@ -565,8 +689,10 @@ class RunFolder:
         (source, destination) as it is moved."""
         if not self.out.is_dir():
             return
+        # and a listed file the user edited during the run: theirs now
+        edited = [] if self.force else changed_entries(self.out)
         moves = [(self.out / rel.rstrip("/"), self.stage / rel.rstrip("/"))
-                 for rel in foreign_entries(self.out)]
+                 for rel in [*foreign_entries(self.out), *edited]]
         for src, dst in moves:  # all checked before the first is moved
             if os.path.lexists(dst):
                 raise AmbsealError(f"{src}: appeared during the run and has the name of one "
@@ -581,7 +707,7 @@ class RunFolder:
         process locked): nothing is left beside or in the output."""
         if self._lock_fd is not None:
             try:
-                if os.fstat(self._lock_fd).st_ino == os.stat(
+                if not self._keep_journal and os.fstat(self._lock_fd).st_ino == os.stat(
                         self.lock_path, follow_symlinks=False).st_ino:
                     os.unlink(self.lock_path)
             except OSError:
@@ -595,27 +721,48 @@ class OwnedFolder(RunFolder):
     ``identify``, ``track``, ``campbell``, ``sweep``).
 
     ``with OwnedFolder(out) as folder:`` refuses a folder that holds anything its manifest
-    does not list, creates ``out`` if needed, takes the lock :data:`FOLDER_LOCK` inside it
-    (a second command into the same folder is refused) and checks that a file can be
-    written there, all before any work. On leaving (after an error too) the manifest lists
-    what it listed before and is still there, and every file made during the command;
-    nothing else in the folder is touched. A folder that was created and got nothing is
-    removed again.
+    does not list, or (without ``force``) a listed file changed since ambseal wrote it,
+    creates ``out`` if needed, takes the lock :data:`FOLDER_LOCK` inside it (a second
+    command into the same folder is refused) and checks that a file can be written there,
+    all before any work. While it is open, every file ambseal writes into it
+    (:func:`atomic_write`) is recorded with the SHA-256 of its bytes, first in the lock
+    file (a journal the next command reads if this one is killed) — so the manifest lists
+    what ambseal wrote, with the hash it wrote, and never a file that appeared beside it
+    meanwhile. On leaving (after an error too) the manifest lists what it listed before and
+    is still there, and every file written during the command; nothing else in the folder
+    is touched. A folder that was created and got nothing is removed again.
+
+    Parameters
+    ----------
+    out : path
+        The output folder.
+    force : bool
+        Replace listed files the user changed since ambseal wrote them.
 
     Raises
     ------
     AmbsealError
         The folder cannot be created or written, another command holds the lock, or the
-        folder holds files its manifest does not list.
+        folder holds files its manifest does not list (or, without ``force``, listed files
+        changed since).
     """
 
-    def __init__(self, out: str | os.PathLike):
-        super().__init__(out)
+    def __init__(self, out: str | os.PathLike, force: bool = False):
+        super().__init__(out, force)
         self.lock_path = self.out / FOLDER_LOCK
+        self._written: dict[str, str] = {}
 
     def _entries(self) -> set[str]:
         return {p.relative_to(self.out).as_posix() for p in self.out.rglob("*")} - {
             FOLDER_LOCK}
+
+    def record(self, rel: str, digest: str) -> None:
+        """Note a file written into the folder (its path relative to it, the SHA-256 of its
+        bytes): appended to the lock file's journal, then kept for the manifest."""
+        line = f"{digest} {json.dumps(rel)}\n".encode()
+        os.pwrite(self._lock_fd, line, self._journal_end)
+        self._journal_end += len(line)
+        self._written[rel] = digest
 
     def __enter__(self) -> Path:
         # with a lock left there, perhaps a killed command's (see below); a link is refused
@@ -627,40 +774,88 @@ class OwnedFolder(RunFolder):
         except OSError as exc:
             raise self._fail("create the output folder", exc) from None
         self._lock()
+        journal: dict[str, str] = {}
         try:
-            adopted = self._killed_outputs()
-            self._check_ours(adopted)  # again, under the lock
+            self.out = Path(os.path.realpath(self.out))  # as atomic_write's paths resolve
+            journal = self._killed_journal()
+            adopted = self._killed_outputs(journal)
+            self._check_ours(adopted, journal)  # again, under the lock
             writable_folder(self.out)
             self._before = self._entries()
-            self._listed = set().union(*_listed(_read_manifest(self.out))) | adopted
+            man = _read_manifest(self.out) or {"files": {}, "folders": []}
+            self._files = {**man["files"], **{r: d for r, d in journal.items()
+                                                if (self.out / r).is_file()}}
+            self._folders = set(man["folders"]) | {a for a in adopted
+                                                   if (self.out / a).is_dir()}
+            with _RECORDING_LOCK:
+                _RECORDING.append(self)
         except BaseException:
+            if journal:  # refused: the killed command's journal stays for the next one
+                os.ftruncate(self._lock_fd, 0)
+                os.pwrite(self._lock_fd, self._previous, 0)
+                self._keep_journal = True
             self._release()
             raise
         return self.out
 
-    def _killed_outputs(self) -> frozenset:
-        """The entries a command killed in this folder left (its lock, now taken over, was
-        still there): those not in the manifest that changed after it took the lock. They
-        are ambseal's partial outputs, replaced by this command (noted on stderr)."""
+    def _killed_journal(self) -> dict[str, str]:
+        """``{path: sha256}`` of the files a killed command recorded writing here (the
+        journal in its lock, now taken over; empty when there was none)."""
         if self.stale_pid is None:
+            return {}
+        journal = {}
+        for line in self._previous.decode("utf-8", "replace").splitlines()[1:]:
+            digest, _, name = line.partition(" ")
+            try:
+                rel = json.loads(name)
+            except ValueError:
+                continue  # a line cut by the kill
+            if isinstance(rel, str) and re.fullmatch(r"[0-9a-f]{64}", digest):
+                journal[rel] = digest
+        return journal
+
+    def _killed_outputs(self, journal: dict[str, str]) -> frozenset:
+        """The entries a killed command left here that its journal proves its own (files
+        with the hash it recorded; folders holding only such files). They are ambseal's
+        partial outputs, replaced by this command (noted on stderr); anything else not in
+        the manifest is the user's."""
+        if not journal:
             return frozenset()
+
+        def written(p: Path) -> bool:
+            rel = p.relative_to(self.out).as_posix()
+            return (p.is_file() and not p.is_symlink() and rel in journal
+                    and _file_hash(p) == journal[rel])
         try:
-            rel = [e.rstrip("/") for e in foreign_entries(self.out)]
-            out = frozenset(e for e in rel if os.lstat(self.out / e).st_mtime
-                            >= self.stale_since - 1.0)
+            out = set()
+            for e in foreign_entries(self.out):
+                p = self.out / e.rstrip("/")
+                if e.endswith("/"):
+                    inside = [q for q in p.rglob("*") if q.is_symlink() or not q.is_dir()]
+                    if inside and all(map(written, inside)):
+                        out.add(e.rstrip("/"))
+                elif written(p):
+                    out.add(e)
         except OSError:
             return frozenset()
         if out:
             print(f"ambseal: note: {self.out}: {', '.join(sorted(out))}: left by the killed "
                   f"command (pid {self.stale_pid}); taken as ambseal's", file=sys.stderr)
-        return out
+        return frozenset(out)
 
     def __exit__(self, kind, exc, tb) -> None:
-
+        with _RECORDING_LOCK:
+            if self in _RECORDING:
+                _RECORDING.remove(self)
         try:
-            mine = self._listed | (self._entries() - self._before)
+            files = {**self._files, **self._written}
+            # the folders this command made that hold nothing but what it wrote
+            new = {e for e in self._entries() - self._before if (self.out / e).is_dir()}
+            made = {d for d in new if all(
+                q.relative_to(self.out).as_posix() in files
+                for q in (self.out / d).rglob("*") if q.is_symlink() or not q.is_dir())}
             if not (self._created and not self._entries()):
-                write_manifest(self.out, uuid.uuid4().hex, keep=mine.__contains__)
+                write_manifest(self.out, uuid.uuid4().hex, files, sorted(self._folders | made))
         except OSError as exc:
             if kind is None:
                 raise self._fail("write its manifest", exc) from None

@@ -134,24 +134,24 @@ def _design(args: argparse.Namespace) -> int:
     if args.method is None:
         raise ConfigError(f"design: --method is required "
                           f"({', '.join(method_names(option=True))}) unless --show-defaults")
-    with _owned(args.out):
+    with _owned(args.out, force=args.force):
         summary = design_files(rig, args.method, args.out, pressure_bar=args.pressure_bar,
                                overrides=args.overrides, allow_unstable=args.allow_unstable)
     print(json.dumps(summary))
     return 0
 
 
-def _owned(out, c_dir=None):
+def _owned(out, c_dir=None, force=False):
     """The folders a command writes, each claimed (:class:`ambseal.files.OwnedFolder`:
-    refused if it holds files ambseal did not write, its manifest updated at the end);
-    ``c_dir`` only when it is not inside ``out`` (paths resolved first: ``out/../x`` is
-    not inside ``out``)."""
+    refused if it holds files ambseal did not write, or without ``force`` files it wrote
+    that were changed since; its manifest updated at the end); ``c_dir`` only when it is
+    not inside ``out`` (paths resolved first: ``out/../x`` is not inside ``out``)."""
     inside = None not in (out, c_dir) and Path(c_dir).resolve().is_relative_to(
         Path(out).resolve())
     with ExitStack() as claims:
         for folder in (out, None if inside else c_dir):
             if folder is not None:
-                claims.enter_context(OwnedFolder(folder))
+                claims.enter_context(OwnedFolder(folder, force))
         return claims.pop_all()  # open for the command's with block, which closes them
 
 
@@ -171,13 +171,13 @@ def _export(args: argparse.Namespace) -> int:
                                   f"export discretises for the rig's target: {exc}") from None
             done["discretised"] = {"method": ctrl.method, "sample_rate_hz": ctrl.sample_rate_hz,
                                    "delay_samples": ctrl.delay_samples}
-        with _owned(None if args.c_dir else args.out, args.c_dir):
+        with _owned(None if args.c_dir else args.out, args.c_dir, args.force):
             files = write_c(ctrl, args.c_dir or Path(args.out) / "c",  # file name as C names
                             f"ambseal_{c_identifier(Path(args.controller).stem)}",
                             precision=args.precision)
         print(json.dumps({"files": [str(f) for f in files], **done}))
         return 0
-    with _owned(args.out, args.c_dir):
+    with _owned(args.out, args.c_dir, args.force):
         summary = design_files(args.rig, args.method, args.out,
                                pressure_bar=args.pressure_bar,
                                c_dir=args.c_dir or Path(args.out) / "c",
@@ -187,7 +187,7 @@ def _export(args: argparse.Namespace) -> int:
 
 
 def _identify(args: argparse.Namespace) -> int:
-    with _owned(args.out):
+    with _owned(args.out, force=args.force):
         summary = identify_files(args.rig, args.data, args.params.split(","), args.out,
                                  current_weight=args.current_weight, refine=not args.no_refine,
                                  accept_unconverged=args.accept_unconverged,
@@ -198,7 +198,7 @@ def _identify(args: argparse.Namespace) -> int:
 
 
 def _track(args: argparse.Namespace) -> int:
-    with _owned(args.out):
+    with _owned(args.out, force=args.force):
         summary = track_files(args.rig, args.data, args.params.split(","), args.out,
                               rate_per_s=args.rate_per_s)
     print(json.dumps(summary))
@@ -208,7 +208,8 @@ def _track(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace) -> int:
     result = run(args.rig, args.out, truth=args.truth, identification=not args.no_identify,
                  overrides=tuple(args.overrides), allow_unstable=args.allow_unstable,
-                 command=args.command_line, progress=not (args.quiet or args.verbose))
+                 command=args.command_line, progress=not (args.quiet or args.verbose),
+                 force=args.force)
     for reason in result.metrics.get("cannot_run", {}).values():
         print(f"ambseal: {reason}", file=sys.stderr)
     if sys.stderr.isatty() and not args.quiet:

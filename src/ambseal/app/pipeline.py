@@ -226,7 +226,8 @@ def _lost_over_speed(cfg: RigConfig, designs: list[Designed]) -> list[str]:
 def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         progress: bool = True, truth: str | Path | None = None,
         identification: bool = True, overrides: tuple[str, ...] = (),
-        allow_unstable: bool = False, command: str | None = None) -> RunResult:
+        allow_unstable: bool = False, command: str | None = None,
+        force: bool = False) -> RunResult:
     """The main job: build and reduce the model, design, judge, identify, report.
 
     Parameters
@@ -260,6 +261,9 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         :data:`EXIT_FAILED`.
     command : str, optional
         The command line, for the report's stamp.
+    force : bool
+        Replace the former run's files in ``out_dir`` that were changed since ambseal wrote
+        them (without it they are the user's and the folder is refused).
 
     Returns
     -------
@@ -288,7 +292,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
     points = operating_points(spec)
     final = Path(out_dir)
     # one run = one folder: written into a staging folder that replaces out_dir at the end
-    with RunFolder(final) as out, \
+    with RunFolder(final, force) as out, \
             StageProgress(_stage_totals(cfg, points),
                           display=progress and sys.stderr.isatty()) as stages:
         (out / "controllers").mkdir()

@@ -107,7 +107,7 @@ def _owns_out(handler):
     """``handler`` with its ``--out`` folder claimed before any work
     (:class:`ambseal.files.OwnedFolder`)."""
     def run(args: argparse.Namespace) -> int:
-        with OwnedFolder(args.out):
+        with OwnedFolder(args.out, args.force):
             return handler(args)
     return run
 

@@ -416,7 +416,9 @@ def _executor_args(p) -> None:
     g.add_argument("--workers", type=_workers, default=None,
                    help="local Dask worker processes (1: serial; default: serial for small "
                         "runs, one per core for large ones)")
-    g.add_argument("--scheduler", default=None, help="address of a running Dask scheduler")
+    g.add_argument("--scheduler", default=None,
+                   help="address of a running Dask scheduler (trusted: whoever can reach it "
+                        "runs code in its workers)")
 
 
 def _checked_numbers(parser: argparse.ArgumentParser) -> None:

@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import json
+import os
 import pickle
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -221,3 +224,60 @@ def test_a_scheduler_that_never_answers_is_refused_in_time(silent_peer, tmp_path
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
                                   dashboard_address=None) as cluster:
         cases.probe_scheduler(cluster.scheduler_address)
+
+
+def _inside_a_worker(case: dict) -> dict:
+    """What a case sees of its cluster from inside a worker: the scheduler's protocol,
+    the scratch folder, every listening TCP port of the main process and of the worker,
+    and whether another client gets in — plain, or with TLS credentials of its own, as
+    another local user would make."""
+    import stat
+
+    import psutil
+    from distributed import Client, get_worker
+    from distributed.security import Security
+
+    w = get_worker()
+
+    def listening(p):
+        return sorted(c.laddr.port for c in p.net_connections("tcp")
+                      if c.status == psutil.CONN_LISTEN)
+    intruder = []
+    plain = "tcp://" + w.scheduler.address.split("://", 1)[1]
+    for address, security in ((plain, None), (w.scheduler.address, Security.temporary())):
+        try:
+            with Client(address, security=security, timeout="3s"):
+                intruder.append("connected")
+        except Exception as exc:  # whatever the refusal looks like
+            intruder.append(type(exc).__name__)
+    top = Path(w.local_directory)
+    while not top.name.startswith("ambseal-dask-") and top != top.parent:
+        top = top.parent
+    return {"scheduler": w.scheduler.address, "address": w.address, "scratch": str(top),
+            "mode": stat.S_IMODE(top.stat().st_mode),
+            "main": listening(psutil.Process(case["main"])),
+            "worker": listening(psutil.Process()), "intruder": intruder}
+
+
+def test_the_local_cluster_is_private():
+    """``workers=2``: the scheduler speaks TLS with credentials of its own (a client with
+    other credentials is refused), the workers' scratch is a fresh 0700 folder of
+    ambseal's, removed afterwards; the main process listens on the TLS comms of the
+    scheduler and of the two workers' nannies only, and each worker on its own comm: no HTTP
+    server (Dask starts one, on 8787 for the scheduler, even without a dashboard)."""
+    pytest.importorskip("distributed")
+    import cloudpickle
+
+    cloudpickle.register_pickle_by_value(sys.modules[__name__])
+    try:
+        seen = run_cases(_inside_a_worker, [{"main": os.getpid()}] * 2, workers=2)
+    finally:
+        cloudpickle.unregister_pickle_by_value(sys.modules[__name__])
+    for s in seen:
+        assert s["scheduler"].startswith("tls://"), s
+        assert "connected" not in s["intruder"], s
+        assert Path(s["scratch"]).name.startswith("ambseal-dask-") and s["mode"] == 0o700
+        assert not Path(s["scratch"]).exists()
+        port = int(s["scheduler"].rsplit(":", 1)[1])
+        assert port in s["main"] and len(s["main"]) == 1 + 2, s
+        assert s["worker"] == [int(s["address"].rsplit(":", 1)[1])], s

@@ -5,7 +5,15 @@ sweeps' grid points, the Campbell diagram's speeds, ``ambseal run``'s judged ope
 points), serially or on ``dask.distributed`` (a local cluster of processes with one BLAS
 thread each, or a running scheduler by address). ``shared`` is sent to each worker once
 (``Client.scatter``, broadcast) and the function is pickled by reference, so a worker
-imports ambseal once, not per case. Results come back in input order; a case that raises is
+imports ambseal once, not per case. The local cluster is private to the process that
+starts it: TLS with temporary credentials of its own (``LocalCluster(security=True)``: a
+client without them, another local user's included, cannot connect to run code in it),
+its workers' scratch folder a fresh 0700 one (``tempfile.mkdtemp``: a folder on a shared,
+predictable path such as ``$TMPDIR/dask-scratch-space`` could be created first by another
+user and planted with modules the workers import), no HTTP server left listening (no
+dashboard, metrics or proxy routes, the servers stopped once the cluster is up). A
+scheduler given by address is the user's and trusted: whoever can reach it runs code in
+its workers. Results come back in input order; a case that raises is
 recorded as a :class:`CaseError` with its message and the others go on. A progress bar
 (rich, on stderr) counts cases as they finish.
 """
@@ -15,7 +23,9 @@ from __future__ import annotations
 import asyncio
 import multiprocessing
 import os
+import shutil
 import sys
+import tempfile
 from dataclasses import dataclass
 from typing import Callable, Sequence
 
@@ -96,6 +106,8 @@ def run_cases(fn: Callable, cases: Sequence[dict], *, shared: dict | None = None
         per core.
     scheduler : str, optional
         Address of a running Dask scheduler (``tcp://host:8786``); wins over ``workers``.
+        Trusted: the cases run in its workers, and whoever can connect to it can run code
+        there (secure it as Dask's documentation says, e.g. TLS).
     progress : bool
         A progress bar over the cases on stderr.
     description : str
@@ -198,7 +210,7 @@ def _run_dask(fn, cases, shared, workers, scheduler, done) -> list:
     import dask  # optional: the [dask] extra
     from distributed import Client, LocalCluster, as_completed  # optional, as above
 
-    cluster = None
+    cluster = scratch = None
     try:
         if scheduler is not None:
             probe_scheduler(scheduler)
@@ -217,17 +229,24 @@ def _run_dask(fn, cases, shared, workers, scheduler, done) -> list:
             if method == "forkserver":
                 multiprocessing.get_context("forkserver").set_forkserver_preload(
                     ["ambseal.analysis.cases"])
-            with dask.config.set({"distributed.worker.multiprocessing-method": method}):
+            scratch = tempfile.mkdtemp(prefix="ambseal-dask-")  # 0700, a fresh name
+            with dask.config.set({"distributed.worker.multiprocessing-method": method,
+                                  "distributed.scheduler.http.routes": [],
+                                  "distributed.worker.http.routes": []}):
                 cluster = LocalCluster(
-                    n_workers=n, threads_per_worker=1, processes=True,
-                    dashboard_address=None,
+                    n_workers=n, threads_per_worker=1, processes=True, security=True,
+                    dashboard_address=None, local_directory=scratch,
+                    scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
                     env={v: "1" for v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
                                           "MKL_NUM_THREADS")})
+            cluster.scheduler.http_server.stop()  # Dask starts one even without a dashboard
             client = Client(cluster)
+            client.run(_stop_http)
     except OSError as exc:
         raise ConfigError(f"dask scheduler {scheduler!r}: cannot connect ({exc})") from None
     try:
-        shared_f = client.scatter(shared, broadcast=True)
+        # nothing to send: Dask's scatter of an empty dict fails
+        shared_f = client.scatter(shared, broadcast=True) if shared else {}
         futures = client.map(_call, cases, fn=fn, shared=shared_f, pure=False)
         index = {f.key: i for i, f in enumerate(futures)}
         for f in as_completed(futures):
@@ -237,3 +256,10 @@ def _run_dask(fn, cases, shared, workers, scheduler, done) -> list:
         client.close()
         if cluster is not None:
             cluster.close()
+        if scratch is not None:
+            shutil.rmtree(scratch, ignore_errors=True)
+
+
+def _stop_http(dask_worker) -> None:
+    """Stop a worker's HTTP server (it serves no routes: nothing to listen for)."""
+    dask_worker.http_server.stop()

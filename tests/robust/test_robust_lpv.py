@@ -476,7 +476,7 @@ def test_rate_dependent_controller_satisfies_the_lpv_bounded_real_lemma():
     plants = [wu1996_plant(t) for t in th]
     grid, As, dAs, B, C, D, nw, nz = _validate(plants, th, 2, 2, [_wu1996_dA(t) for t in th],
                                                (_trig_basis, _trig_basis), 5.0, 1.05, 1.1,
-                                               1e-4)
+                                               1e-4, 5, 1e-6)
     sc = scale_grid(As, dAs, B, C, D, grid, nw, nz, 2, 2, "riccati")
     blocks = lmi_blocks(sc, nw, nz, 2, 2)
     nu = 5.0 / sc.w0 * sc.dp_dtheta  # |dp/dt'| in the scaled time

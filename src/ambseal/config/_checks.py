@@ -10,6 +10,8 @@ from typing import Annotated
 from pydantic import Field
 
 from ambseal.errors import LABEL_PATTERN, NAME_PATTERN, ConfigError
+# the bound of the target's delay, where the robust layer checks it (a light module)
+from ambseal.robust import MAX_DELAY_SAMPLES
 
 __all__ = ["MIN_CURRENT_A", "MIN_TIME_CONSTANT_S", "MAX_ELEMENTS", "MAX_COMPONENTS", "MAX_AMBS", "MAX_LAYERS", "MAX_REDUCED_STATES", "MAX_COEFFICIENT",
            "MAX_FREQUENCY_HZ", "MAX_SPEED_HZ", "MAX_PRESSURE_BAR", "MAX_CURRENT_A", "MAX_GAP_M",
@@ -71,9 +73,6 @@ MIN_CURRENT_A = 1e-6
 MIN_TIME_CONSTANT_S = 1e-9
 #: A displacement inside a bearing (m): the bound of an AMB's ``air_gap``.
 MAX_GAP_M = 0.1
-#: A computation delay (controller samples): each sample adds a state per controller output
-#: to every sampled loop; real-time targets delay by one or two samples, so 100 is ample.
-MAX_DELAY_SAMPLES = 100
 #: filters in series with the PID: one or two per flexible mode within its reach
 MAX_PID_FILTERS = 16
 #: A relative uncertainty (1σ or ± range as a fraction of the value): beyond 10× the value

@@ -17,8 +17,9 @@ Analysis: :func:`mussv` — μ upper and lower bounds for mixed real/complex blo
 
 The controller that runs on a target: :func:`digital_controller` (fast poles removed, the
 discretisation chosen by the sampled loop), :class:`DiscreteController` and the
-sample-and-hold delay a synthesis model carries (:func:`design_delay`). Its steps, for a
-caller that discretises a family of controllers (a scheduled one): :func:`check_rate`,
+sample-and-hold delay a synthesis model carries (:func:`design_delay`; the timing's
+bounds: :func:`check_timing`, :data:`MAX_DELAY_SAMPLES`). Its steps, for a caller that
+discretises a family of controllers (a scheduled one): :func:`check_rate`,
 :func:`split_fast`, :func:`hold_keeps`, :func:`residualize`, :func:`discretize_as`,
 :func:`with_delay`, :func:`prewarp_frequency_hz`, :func:`sampled_plants`,
 :func:`choose_method`, :func:`chosen_error`, :func:`peak_difference` and their constants;
@@ -57,7 +58,7 @@ _FROM = {
     "lpvsyn": "lpv", "LpvController": "lpv", "LpvSynResult": "lpv", "mussv": "mu",
     "MuResult": "mu", "balred_controller": "order", "reduce_controller": "order",
     "ReductionResult": "order", "decay_rate": "stability", "is_stable": "stability",
-    "unstable_poles": "stability",
+    "unstable_poles": "stability", "MAX_DELAY_SAMPLES": "timing", "check_timing": "timing",
 }
 
 __all__ = sorted(_FROM)

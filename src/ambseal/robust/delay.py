@@ -36,8 +36,9 @@ import numpy as np
 
 from ambseal.errors import ConfigError
 from ambseal.lti.freqresp import freqresp
+from ambseal.robust.timing import check_timing
 
-__all__ = ["DesignDelay", "design_delay", "loop_delay", "check_timing", "PHASE_TOLERANCE_DEG",
+__all__ = ["DesignDelay", "design_delay", "loop_delay", "PHASE_TOLERANCE_DEG",
            "MAX_ORDER"]
 
 #: largest phase error (deg) of the Padé approximation allowed up to the design band's top
@@ -74,17 +75,6 @@ class DesignDelay:
         """JSON-ready description (no matrices)."""
         return {"delay_s": self.delay_s, "pade_order": self.order,
                 "phase_error_deg": self.phase_error_deg, "band_top_hz": self.band_top_hz}
-
-
-def check_timing(sample_rate_hz: float, delay_samples) -> None:
-    """A finite rate > 0 Hz and a whole delay ≥ 0 samples, else ``ConfigError`` naming the
-    setting."""
-    if not (math.isfinite(float(sample_rate_hz)) and sample_rate_hz > 0):
-        raise ConfigError(f"controller.sample_rate_hz: {sample_rate_hz!r}, expected a "
-                          "finite rate > 0 Hz")
-    if int(delay_samples) != delay_samples or delay_samples < 0:
-        raise ConfigError(f"controller.delay_samples: {delay_samples!r}, expected a whole "
-                          "number of samples >= 0")
 
 
 def loop_delay(sample_rate_hz: float, delay_samples: int) -> DesignDelay:

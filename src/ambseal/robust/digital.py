@@ -64,7 +64,8 @@ from ambseal.lti import (
 )
 from ambseal.robust._digital_choice import first_stable as _first_stable
 from ambseal.robust._digital_choice import so_peak as _so_peak
-from ambseal.robust.delay import check_timing, loop_delay
+from ambseal.robust.delay import loop_delay
+from ambseal.robust.timing import check_timing
 from ambseal.robust.digital_loop import DiscreteController
 from ambseal.robust.stability import is_stable
 

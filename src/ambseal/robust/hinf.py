@@ -28,6 +28,7 @@ Boyd, Balakrishnan & Kabamba (1989); Bruinsma & Steinbuch (1990).
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -173,6 +174,13 @@ def _pbh_fails(A, X, rows, eigs):
     return bad
 
 
+def _check_counts(nmeas, ncon) -> None:
+    """ModelError unless both channel counts are whole numbers (not bools)."""
+    for name, v in (("nmeas", nmeas), ("ncon", ncon)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
+            raise ModelError(f"{name}={v!r}: expected a whole number of channels")
+
+
 def check_plant(P, nmeas: int, ncon: int) -> None:
     """Check that ``P`` meets the assumptions of H∞ synthesis (Zhou et al. 1996, §17.1).
 
@@ -189,8 +197,7 @@ def check_plant(P, nmeas: int, ncon: int) -> None:
     if P.isdtime(strict=True):
         raise ModelError("P must be continuous-time (dt = 0)")
     nin, nout = P.ninputs, P.noutputs
-    if not (isinstance(nmeas, (int, np.integer)) and isinstance(ncon, (int, np.integer))):
-        raise ModelError("nmeas and ncon must be integers")
+    _check_counts(nmeas, ncon)
     if not (0 < ncon < nin):
         raise ModelError(f"ncon={ncon} must be between 1 and the number of inputs - 1 ({nin - 1})")
     if not (0 < nmeas < nout):
@@ -471,12 +478,13 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
     True
     """
     given, reg = P, None
+    _check_counts(nmeas, ncon)
     if regularise is not None and isinstance(P, ct.StateSpace) and 0 < ncon < P.ninputs \
             and 0 < nmeas < P.noutputs:
         P, reg = regularise_plant(P, nmeas, ncon, regularise)
     check_plant(P, nmeas, ncon)
-    if backoff < 1.0:
-        raise ConfigError(f"backoff={backoff} must be ≥ 1")
+    if not (math.isfinite(backoff) and backoff >= 1.0):
+        raise ConfigError(f"backoff={backoff} must be a finite number ≥ 1")
     if P.nstates == 0:
         # SLICOT SB10AD needs a state: one decoupled at −1 rad/s changes neither γ nor any
         # transfer function (stable, neither controllable nor observable)

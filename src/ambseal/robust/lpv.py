@@ -372,7 +372,10 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
         an unknown ``lyapunov`` or ``lyapunov_r`` (or a basis whose values are not two
         finite arrays of one length, or dependent over the grid), a rate bound with both
         constant (or none with a parameter-dependent S or R), an unknown key in
-        ``solver_options``, infeasible LMIs, a
+        ``solver_options``, a plant that is not a state-space system or has a NaN or
+        infinite entry, ``nmeas``, ``ncon`` or ``check_density`` not a whole number ≥ 1,
+        ``margin`` not finite and > 0, ``backoff`` not finite and ≥ 1, a basis not finite
+        somewhere on the controller's table, infeasible LMIs, a
         solver status other than ``optimal``, or a reconstructed frozen closed loop that is
         unstable.
 
@@ -388,7 +391,7 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
     t_start = time.perf_counter()
     grid, As, dAs, B, C, D, nw, nz = _validate(plants, theta, nmeas, ncon, dA,
                                                (lyapunov, lyapunov_r), rate_bound, backoff,
-                                               coupling_ratio, penalty)
+                                               coupling_ratio, penalty, check_density, margin)
     unknown = sorted(set(solver_options or {}) - set(SOLVER_KEYS))
     if unknown:
         raise SynthesisError(f"lpvsyn: solver_options {unknown} unknown; expected some of "
@@ -517,17 +520,38 @@ def _basis_name(kind) -> str:
 
 
 def _validate(plants, theta, nmeas, ncon, dA, bases, rate_bound, backoff,
-              coupling_ratio, penalty):
+              coupling_ratio, penalty, check_density, margin):
     """Checked grid and plant data of :func:`lpvsyn`: (grid, A stack, dA stack, B, C, D,
     n_w, n_z); raises SynthesisError as documented there."""
-    grid = np.asarray(theta, float).ravel()
+    for name, v in (("nmeas", nmeas), ("ncon", ncon), ("check_density", check_density)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
+            raise SynthesisError(f"lpvsyn: {name}={v!r}; expected a whole number ≥ 1")
+    if not (isinstance(margin, (int, float)) and np.isfinite(margin) and margin > 0):
+        raise SynthesisError(f"lpvsyn: margin={margin!r}; expected a finite number > 0")
+    try:
+        plants = list(plants)
+        grid = np.asarray(theta, float).ravel()
+    except (TypeError, ValueError) as exc:
+        raise SynthesisError(f"lpvsyn: plants and theta must be a sequence of systems and "
+                             f"an array of numbers ({exc})") from None
+    for k, P in enumerate(plants):
+        try:
+            parts = [np.asarray(getattr(P, m), float) for m in "ABCD"]
+        except (AttributeError, TypeError, ValueError):
+            raise SynthesisError(f"lpvsyn: plants[{k}] is a {type(P).__name__}, not a "
+                                 "state-space system (A, B, C, D)") from None
+        if not all(np.all(np.isfinite(X)) for X in parts):
+            raise SynthesisError(f"lpvsyn: plants[{k}] has a NaN or infinite entry")
     if grid.size < 2 or len(plants) != grid.size:
         raise SynthesisError(f"lpvsyn: the θ grid needs at least 2 points with one plant "
                              f"each; got {grid.size} values and {len(plants)} plants")
     if np.any(np.diff(grid) <= 0) or not np.all(np.isfinite(grid)):
         raise SynthesisError("lpvsyn: theta must be finite and strictly increasing")
+    # the basis is evaluated where the controller is: on the table between the grid points
+    table = np.concatenate([np.linspace(a, b, check_density + 1)[:-1]
+                            for a, b in zip(grid[:-1], grid[1:])] + [grid[-1:]])
     for name, kind in zip(("lyapunov", "lyapunov_r"), bases):
-        _validate_basis(name, kind, grid)
+        _validate_basis(name, kind, grid, table)
     _validate_settings(bases, rate_bound, backoff, coupling_ratio, penalty)
     As = np.array([np.asarray(P.A, float) for P in plants])
     B = np.asarray(plants[0].B, float)
@@ -555,9 +579,10 @@ def _validate(plants, theta, nmeas, ncon, dA, bases, rate_bound, backoff,
     return grid, As, dAs, B, C, D, nw, nz
 
 
-def _validate_basis(name: str, kind, grid: np.ndarray) -> None:
+def _validate_basis(name: str, kind, grid: np.ndarray, table: np.ndarray) -> None:
     """A Lyapunov basis of :func:`lpvsyn`: a name of ``BASES``, or a callable whose values
-    on the grid are two finite arrays of one length, linearly independent over the grid."""
+    on the controller's ``table`` are two finite arrays of one length, linearly
+    independent over the grid."""
     if isinstance(kind, str):
         if kind not in BASES:
             raise SynthesisError(f"lpvsyn: {name}={kind!r}; expected one of {sorted(BASES)} "
@@ -567,7 +592,7 @@ def _validate_basis(name: str, kind, grid: np.ndarray) -> None:
         raise SynthesisError(f"lpvsyn: {name}={kind!r}; expected one of {sorted(BASES)} or a "
                              "callable θ ↦ (f(θ), df/dθ(θ))")
     rows = []
-    for th in grid:
+    for th in table:
         try:
             f, df = (np.asarray(v, float).ravel() for v in kind(float(th)))
         except (TypeError, ValueError) as exc:
@@ -582,7 +607,7 @@ def _validate_basis(name: str, kind, grid: np.ndarray) -> None:
             raise SynthesisError(f"lpvsyn: {name} has {f.size} functions at θ = {th:g} and "
                                  f"{rows[0].size} at θ = {grid[0]:g}")
         rows.append(f)
-    F = np.array(rows)
+    F = np.array(rows)[np.isin(table, grid)]
     if np.linalg.matrix_rank(F) < F.shape[1]:
         raise SynthesisError(f"lpvsyn: {name}'s {F.shape[1]} functions are linearly dependent "
                              f"on the grid (rank {np.linalg.matrix_rank(F)}); the LMIs "
@@ -602,8 +627,8 @@ def _validate_settings(bases, rate_bound, backoff, coupling_ratio, penalty) -> N
                              f"(lyapunov={_basis_name(bases[0])!r}, "
                              f"lyapunov_r={_basis_name(bases[1])!r}) needs a finite "
                              f"rate_bound ≥ 0 (θ's unit per second), got {rate_bound!r}")
-    if backoff < 1.0:
-        raise SynthesisError(f"lpvsyn: backoff={backoff} must be ≥ 1")
+    if not (np.isfinite(backoff) and backoff >= 1.0):
+        raise SynthesisError(f"lpvsyn: backoff={backoff} must be a finite number ≥ 1")
     if not coupling_ratio > 1.0:
         raise SynthesisError(f"lpvsyn: coupling_ratio={coupling_ratio} must be > 1")
     if not penalty >= 0.0:

@@ -339,12 +339,19 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
             raise ModelError("mussv: a state-space M needs a frequency grid omega (rad/s)")
         if getattr(M, "dt", 0) not in (0, None):
             raise ModelError("mussv: only continuous-time systems (dt = 0) are supported")
-        w = np.atleast_1d(np.asarray(omega, float))
+        try:
+            w = np.atleast_1d(np.asarray(omega, float))
+        except (TypeError, ValueError):
+            w = np.zeros((0,))
         if w.ndim != 1 or w.size == 0 or not np.all(np.isfinite(w)):
             raise ModelError("mussv: omega must be a non-empty 1-D array of finite rad/s values")
         Marr = freqresp(M, w)
     else:
-        Marr = np.asarray(M, complex)
+        try:
+            Marr = np.asarray(M, complex)
+        except (TypeError, ValueError) as exc:
+            raise ModelError(f"mussv: M must be a complex matrix or stack of them ({exc})"
+                             ) from None
         if omega is not None:
             raise ModelError("mussv: omega is only used with a state-space M")
     if Marr.ndim < 2:

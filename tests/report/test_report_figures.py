@@ -64,3 +64,37 @@ def test_log_minor_grid_drawn_as_one_collection(tmp_path):
     np.testing.assert_allclose(xs, expected)
     assert isinstance(ax.xaxis.get_minor_locator(), NullLocator)
     assert isinstance(short.xaxis.get_minor_locator(), LogLocator)
+
+
+def test_user_names_are_drawn_as_written(tmp_path):
+    """A name with mathtext in it (``$\\alpha_{1}$ \\frac``) in a title, a legend and an
+    annotation is drawn as its characters: each text's width equals that of the same
+    string drawn with mathtext off, not with it on; the logarithmic axis's tick labels
+    keep their mathtext powers of ten."""
+    from matplotlib.figure import Figure
+    from matplotlib.text import Text
+
+    from ambseal.report.figures import save_figure
+
+    name = "rig $\\alpha_{1}$ \\frac"
+    fig = Figure()
+    ax = fig.subplots()
+    ax.set_yscale("log")
+    ax.plot([1, 2], [1, 100], label=name)
+    ax.set_title(name)
+    ax.annotate(name, (1.5, 10))
+    legend = ax.legend()
+    save_figure(fig, tmp_path / "f.png")
+    r = fig.canvas.get_renderer()
+
+    def width(t: Text, math: bool | None = None) -> float:
+        if math is not None:
+            t = Text(0, 0, t.get_text(), parse_math=math, figure=fig,
+                     fontproperties=t.get_fontproperties())
+        return t.get_window_extent(r).width
+
+    for t in (ax.title, legend.get_texts()[0], ax.texts[0]):
+        assert width(t) == pytest.approx(width(t, False))
+        assert width(t, True) < 0.9 * width(t, False)
+    powers = [t for t in ax.yaxis.get_ticklabels() if "$" in t.get_text()]
+    assert powers and all(t.get_parse_math() for t in powers)

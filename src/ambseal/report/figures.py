@@ -21,6 +21,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from matplotlib.image import imsave
+from matplotlib.text import Text
 from matplotlib.ticker import LogLocator, NullFormatter, NullLocator, ScalarFormatter
 from PIL import Image, UnidentifiedImageError
 
@@ -76,7 +77,10 @@ def save_figure(fig: Figure, path: str | os.PathLike, *, dpi: int = 120,
                 tight: bool = False) -> Path:
     """Write ``fig`` as PNG to ``path`` atomically (temporary file + ``os.replace``).
 
-    The minor ticks of logarithmic axes are replaced by their grid lines drawn as one line
+    Titles, axis labels, legends and annotations are drawn as written (matplotlib's
+    mathtext off: a rig, AMB or controller named ``$\\alpha$`` keeps its dollars and
+    backslash); tick labels keep mathtext (the powers of ten of logarithmic axes). The
+    minor ticks of logarithmic axes are replaced by their grid lines drawn as one line
     collection (:func:`_light_log_axes`) before the layout; ``tight=True`` then applies
     ``tight_layout`` (figures made with ``layout="constrained"`` lay out while drawing).
     The figure is drawn once at ``dpi`` and its canvas written as PNG the way
@@ -96,6 +100,7 @@ def save_figure(fig: Figure, path: str | os.PathLike, *, dpi: int = 120,
         raise AmbsealError(f"figure folder {str(path.parent)!r} does not exist")
     canvas = FigureCanvasAgg(fig)
     _light_log_axes(fig)
+    _literal_texts(fig)
     if tight:
         fig.tight_layout()
     fig.set_dpi(dpi)
@@ -105,6 +110,20 @@ def save_figure(fig: Figure, path: str | os.PathLike, *, dpi: int = 120,
     atomic_write(path, lambda fh: imsave(fh, rgba, format="png", origin="upper", dpi=dpi,
                                          metadata=mark, pil_kwargs={"compress_level": 3}))
     return path
+
+
+def _literal_texts(fig: Figure) -> None:
+    """Mathtext off in every text of ``fig`` but the axes' tick labels and offsets: the
+    texts that carry users' names (ambseal's own labels use Unicode, never mathtext)."""
+    ticks = set()
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            ticks.add(axis.offsetText)
+            for tick in (*axis.get_major_ticks(), *axis.get_minor_ticks()):
+                ticks.update(tick.findobj(Text))
+    for t in fig.findobj(Text):
+        if t not in ticks:
+            t.set_parse_math(False)
 
 
 #: The PNG text key of a figure ambseal drew (ambseal's file mark): the SHA-256 of its RGBA

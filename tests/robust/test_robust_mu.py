@@ -379,3 +379,30 @@ def test_sharp_real_mu_peak_is_found_between_the_grid_points():
     assert float(np.max(r.upper)) < 0.99 * lower
     assert r.peak is not None and r.peak_upper >= lower * (1 - 1e-3)
     assert abs(r.peak_omega - wd[k]) < 0.01
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_upper_near_peak_solves_the_band_only(seed):
+    """A stable 12-state system with three real scalars and a complex 2 × 2 block on a
+    60-point grid, its complexified bound as cover: the mixed bound is solved at part of
+    the frequencies (15 and 31 of the 60 here), its peak is that of mussv on the whole grid (1e-7: both
+    refined to tol·1e-3), every bound solved is mussv's to its tolerance, and every other
+    point keeps its cover, below PEAK_BAND of the peak (no local maximum mu_peak would
+    refine is left out)."""
+    from ambseal.robust.mu import PEAK_BAND, upper_near_peak
+
+    rng = np.random.default_rng(seed)
+    n = 12
+    A = rng.normal(size=(n, n))
+    A -= (np.abs(np.linalg.eigvals(A)).max() + 0.3) * np.eye(n)
+    M = ct.ss(A, rng.normal(size=(n, 5)), rng.normal(size=(5, n)), 0.2 * rng.normal(size=(5, 5)))
+    w = np.logspace(-1, 2, 60)
+    blocks = [(-1, 0), (-1, 0), (-1, 0), (2, 2)]
+    full = mussv(M, blocks, w, lower=False, peak=False).upper
+    cover = mussv(M, [(1, 0), (1, 0), (1, 0), (2, 2)], w, lower=False, peak=False).upper
+    near = upper_near_peak(M, blocks, w, cover)
+    solved = near != cover
+    assert 0 < solved.sum() < w.size * 0.6
+    assert near.max() == pytest.approx(full.max(), rel=1e-7)
+    assert near[solved] == pytest.approx(full[solved], rel=1e-3)
+    assert np.all(cover[~solved] < PEAK_BAND * near.max())

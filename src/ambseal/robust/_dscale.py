@@ -305,4 +305,4 @@ def _search_step(P, blocks, cblocks, nmeas, ncon, w, best, evals, backoff, histo
                     "order": hr.order, "step": "D search", "evaluations": n})
     if console is not None:
         console.print(f"D search ({n} γ evaluations): γ = {hr.gamma:.4g}, μ = {peak:.4g}")
-    return (peak, len(history) - 1, hr, mu, tuple(fits)), done
+    return (peak, len(history) - 1, hr, np.asarray(mu.upper, float), tuple(fits)), done

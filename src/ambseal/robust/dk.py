@@ -44,7 +44,7 @@ from ambseal.robust._dscale import (
     _theta_to_tf,
 )
 from ambseal.robust.hinf import check_plant, hinfsyn, lft_lower
-from ambseal.robust.mu import check_blocks, mu_peak, mussv
+from ambseal.robust.mu import check_blocks, mu_peak, mussv, upper_near_peak
 from ambseal.threads import with_numerics_threads
 
 __all__ = ["MusynResult", "musyn", "fit_magnitude", "fit_dscale", "default_omega",
@@ -512,8 +512,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
             # a dynamic fit can make the scaled plant one no controller is found for (jω
             # zeros, rank loss) where its static scalings are not: redo the D-step with
             # constant fits before ending the iterations
-            static = (_d_step(last[0], blocks, cblocks, w, last[1], 0, fit_tol)
-                      if order != 0 else None)
+            static = _d_step(w, last, 0, fit_tol) if order != 0 else None
             try:
                 if static is None:
                     raise exc
@@ -527,8 +526,8 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
                 console.print(f"D-K {it}: the K-step failed on the fitted scalings ({exc}); "
                               "static scalings taken")
         cl = lft_lower(P, hr.K, nmeas, ncon)
-        mu_true = mussv(cl, blocks, w, lower=False, peak=False)
-        peak = float(np.max(mu_true.upper))
+        mu_c, curve = _mu_step(cl, blocks, cblocks, w)
+        peak = float(np.max(curve))
         history.append({"iteration": it, "gamma": hr.gamma, "mu": peak, "order": hr.order})
         if console is not None:
             console.print(f"D-K {it}: γ = {hr.gamma:.4g}, μ = {peak:.4g}, order {hr.order}")
@@ -537,12 +536,12 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
         else:
             stall += 1
         if best is None or peak < best[0]:
-            best = (peak, it, hr, mu_true, tuple(fits))
+            best = (peak, it, hr, curve, tuple(fits))
         if stall >= patience:
             rule = f"patience={patience}: {stall} iterations without a μ gain of rtol={rtol:g}"
             break
-        last = (cl, mu_true)
-        fits = _d_step(cl, blocks, cblocks, w, mu_true, order, fit_tol)
+        last = mu_c
+        fits = _d_step(w, mu_c, order, fit_tol)
     finalists = [_finalist(best)]
     n_scaled = _scaled_plant(P, cblocks, best[4], nmeas, ncon).nstates if best[4] else 0
     evals, granted = _search_evals(search, best[4], n_scaled)
@@ -568,12 +567,20 @@ def _check_settings(order, search, search_backoff) -> None:
         raise ConfigError(f"search_backoff={search_backoff!r}: expected a number ≥ 1")
 
 
-def _d_step(cl, blocks, cblocks, w, mu_true, order, fit_tol) -> list:
-    """The D-step on the unscaled closed loop ``cl``, diagonal (complexified) structure:
-    the D scales' fits, one per block but the last (weighted by μ⁴ towards its peak with
+def _mu_step(cl, blocks, cblocks, w):
+    """The μ-step on the closed loop ``cl``: the complexified structure's bound (whose
+    scalings the D-step fits) and the upper bound of the structure as given on ``w``, the
+    mixed one solved where it can reach its peak (:func:`~ambseal.robust.mu.upper_near_peak`)."""
+    mu_c = mussv(cl, cblocks, w, lower=False, peak=False)
+    if cblocks == [tuple(b) for b in blocks]:
+        return mu_c, np.asarray(mu_c.upper, float)
+    return mu_c, upper_near_peak(cl, blocks, w, mu_c.upper)
+
+
+def _d_step(w, mu_c, order, fit_tol) -> list:
+    """The D-step from the complexified structure's bound ``mu_c`` on ``w``: the D scales'
+    fits, one per block but the last (weighted by μ⁴ towards its peak with
     ``order="auto"``)."""
-    mu_c = (mussv(cl, cblocks, w, lower=False, peak=False)
-            if cblocks != [tuple(b) for b in blocks] else mu_true)
     ds = np.asarray(mu_c.dscale)  # (F, nblocks), last block = 1
     if order == "auto":
         wgt = (mu_c.upper / np.max(mu_c.upper)) ** 4
@@ -583,9 +590,9 @@ def _d_step(cl, blocks, cblocks, w, mu_true, order, fit_tol) -> list:
 
 def _finalist(entry):
     """``(μ on the grid, index, K, γ, μ curve, fits)`` of a ``(μ, index, HinfResult,
-    MuResult, fits)`` iterate."""
-    peak, it, hr, mu, fits = entry
-    return (peak, it, hr.K, float(hr.gamma), np.asarray(mu.upper, float), fits)
+    μ curve, fits)`` iterate."""
+    peak, it, hr, curve, fits = entry
+    return (peak, it, hr.K, float(hr.gamma), curve, fits)
 
 
 def _result(P, blocks, nmeas, ncon, w, finalists, history, t0, alternatives=(),

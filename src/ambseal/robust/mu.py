@@ -46,7 +46,8 @@ from ambseal.robust._mu_lower import lower_bound as _lower_bound
 from ambseal.robust._mu_upper import upper_bound as _upper_bound
 from ambseal.threads import with_numerics_threads
 
-__all__ = ["MuResult", "MuPeak", "mussv", "mu_peak", "parse_blocks", "check_blocks"]
+__all__ = ["MuResult", "MuPeak", "mussv", "mu_peak", "upper_near_peak", "parse_blocks",
+           "check_blocks", "PEAK_BAND"]
 
 
 # --------------------------------------------------------------------------- blocks
@@ -254,6 +255,9 @@ def _worst_direction(Mp, D, G, cols):
 
 # --------------------------------------------------------------------------- public
 _STRIDE = 32  # cold solves on every 32nd frequency, warm starts in between
+#: The local maxima of a μ curve refined by :func:`mu_peak`: those within this share of its
+#: largest value.
+PEAK_BAND = 0.95
 
 
 @with_numerics_threads
@@ -398,6 +402,70 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
               and np.all(w > 0) else None))
 
 
+def upper_near_peak(M, blocks, omega, cover, *, tol: float = 1e-3, chunk: int = 8
+                    ) -> np.ndarray:
+    """The μ upper bound of a system on a frequency grid where it can reach
+    :data:`PEAK_BAND` of its peak, and ``cover`` — an upper bound of it at each frequency,
+    such as the bound of the complexified structure — elsewhere.
+
+    A mixed (real and complex) bound costs several times the complex one, and near a peak
+    only part of the grid matters. The bound is solved in chunks of ``chunk`` frequencies,
+    largest ``cover`` first, while ``cover`` still reaches ``PEAK_BAND`` of the largest
+    bound found: the frequencies left cannot hold the peak or a local maximum
+    :func:`mu_peak` refines. On a grid solved cold (at most twice the continuation stride,
+    e.g. the 60 points of a design grid) each bound is that of a :func:`mussv` call on the
+    whole grid: solved without :func:`mussv`'s peak refinement, then the bounds within
+    ``2·tol`` of the largest solved again in one call that refines them as the whole-grid
+    call would. On a longer grid every point is solved in one call.
+
+    Parameters
+    ----------
+    M : control.StateSpace
+        Continuous-time system, ``Σ c`` outputs × ``Σ r`` inputs of ``blocks``.
+    blocks : sequence of (int, int)
+        MATLAB ``mussv`` block structure.
+    omega : array_like, shape (F,)
+        Increasing frequencies (rad/s).
+    cover : array_like, shape (F,)
+        An upper bound of the structure's μ at each frequency (dimensionless).
+    tol : float
+        :func:`mussv`'s tolerance.
+    chunk : int
+        Frequencies solved per call while searching (≥ 1).
+
+    Returns
+    -------
+    ndarray, shape (F,)
+        Upper bounds: :func:`mussv`'s where solved, ``cover`` elsewhere.
+
+    Raises
+    ------
+    ModelError
+        As :func:`mussv`; ``cover`` not of the grid's length.
+    """
+    w = np.asarray(omega, float)
+    cover = np.asarray(cover, float)
+    if cover.shape != w.shape:
+        raise ModelError(f"upper_near_peak: cover has shape {cover.shape}, the grid "
+                         f"{w.shape}")
+    if w.size > 2 * _STRIDE:  # solved by continuation: every point, as mussv would
+        return np.asarray(mussv(M, blocks, w, tol=tol, lower=False, peak=False).upper, float)
+    out, solved, best = cover.copy(), np.zeros(w.size, bool), -np.inf
+    order = np.argsort(-cover, kind="stable")
+    for start in range(0, w.size, max(1, int(chunk))):
+        idx = np.sort([i for i in order[start:start + chunk] if cover[i] >= PEAK_BAND * best])
+        if not idx.size:
+            break
+        out[idx] = mussv(M, blocks, w[idx], tol=tol, lower=False, peak=False,
+                         peak_tol=tol).upper
+        solved[idx] = True
+        best = max(best, float(out[idx].max()))
+    # the refinement of a whole-grid call: the bounds within 2·tol (on μ²) of the largest
+    top = np.flatnonzero(solved & (out ** 2 >= (1.0 - 2.0 * tol) * best ** 2))
+    out[top] = mussv(M, blocks, w[top], tol=tol, lower=False, peak=False).upper
+    return out
+
+
 # --------------------------------------------------------------------------- peak
 @dataclass(frozen=True)
 class MuPeak:
@@ -439,7 +507,7 @@ class MuPeak:
                 f"{self.evaluated} frequencies; peak at {self.omega_peak:.5g} rad/s")
 
 
-def mu_peak(M, blocks, omega, upper=None, *, candidates: int = 2, band: float = 0.95,
+def mu_peak(M, blocks, omega, upper=None, *, candidates: int = 2, band: float = PEAK_BAND,
             points: int = 4, rounds: int = 6, xtol: float = 1e-4, ftol: float = 1e-4,
             resolve: int = 2, tol: float = 1e-3) -> MuPeak:
     """Peak of the μ upper bound of a system over frequency, refined around the grid's peaks.

@@ -222,3 +222,41 @@ def test_mussv_refuses_bad_matrices_and_structures(value, what):
     else:
         _refused(lambda: mussv(M, [(3, 3)]))
         _refused(lambda: mussv(M, [(1, 1), (1, 2)]))
+
+
+@SETTINGS
+@given(st.sampled_from(BAD), st.sampled_from(["A", "B", "C", "D"]))
+def test_controllers_and_plants_with_non_finite_entries_are_refused(value, entry):
+    """A NaN or infinite entry in a controller or a plant: order reduction, the rate check,
+    the discretisation and the sampled plants refuse it with ambseal's error."""
+    from ambseal.robust import (balred_controller, check_rate, discretize_as,
+                                sampled_plants)
+
+    K = _with(control.ss([[-1.0]], [[1.0]], [[1.0]], [[0.5]]), entry, value)
+    G = control.ss([[-1.0]], [[1.0]], [[1.0]], 0)
+    _refused(lambda: balred_controller(K, 1))
+    _refused(lambda: check_rate(K, 1e4))
+    _refused(lambda: digital_controller(K, 1e4, [G]))
+    _refused(lambda: discretize_as((K.A, K.B, K.C, K.D), 1e-4, "zoh"))
+    _refused(lambda: sampled_plants([_with(G, entry, value)], 1e4))
+    _refused(lambda: digital_controller(control.ss([], [], [], [[1.0]]), 1e4,
+                                        [_with(G, entry, value)]))
+
+
+@SETTINGS
+@given(st.sampled_from([0.0, -1e-3, 1.0, math.nan, "x"]), st.sampled_from([0, -3, 2.5]))
+def test_tolerances_and_counts_out_of_range_are_refused(tol, count):
+    """mussv's tolerance outside (0, 1) and iteration counts below 1; hinfsyn's rtol and a
+    non-finite γ; an LFT whose channel counts do not fit; a delay of a negative or
+    fractional number of samples; something that is no system."""
+    from ambseal.robust import lft_lower, with_delay
+
+    M = np.eye(2, dtype=complex)
+    _refused(lambda: mussv(M, [(1, 1), (1, 1)], tol=tol))
+    _refused(lambda: mussv(M, [(1, 1), (1, 1)], max_iter=count))
+    _refused(lambda: hinfsyn(P1, 1, 1, rtol=tol))
+    _refused(lambda: hinfsyn(P1, 1, 1, gamma=math.nan))
+    _refused(lambda: lft_lower(P1, control.ss([], [], [], [[1.0]]), 2, 1))
+    _refused(lambda: with_delay((np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)),
+                                 np.ones((1, 1))), count - 0.5 if count else -1))
+    _refused(lambda: hinfnorm("G"))

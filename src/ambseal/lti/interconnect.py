@@ -58,10 +58,18 @@ def lft_lower_matrices(P: Matrices, K: Matrices, nmeas: int, ncon: int) -> Matri
     Raises
     ------
     ModelError
-        If ``I − D22·D_K`` is singular (an ill-posed loop).
+        If ``I − D22·D_K`` is singular (an ill-posed loop), or the channel counts do not
+        fit ``P`` and ``K``.
     """
     A, B, C, D = P
     Ak, Bk, Ck, Dk = K
+    counts = [isinstance(v, (int, np.integer)) and not isinstance(v, bool) and v >= 0
+              for v in (nmeas, ncon)]
+    if not all(counts) or nmeas > C.shape[0] or ncon > B.shape[1] \
+            or np.shape(Dk) != (ncon, nmeas):
+        raise ModelError(f"F_l(P, K): nmeas={nmeas!r}, ncon={ncon!r} do not fit P "
+                         f"({C.shape[0]} outputs, {B.shape[1]} inputs) and K "
+                         f"({np.shape(Dk)[0]} outputs, {np.shape(Dk)[1]} inputs)")
     n, nk = A.shape[0], Ak.shape[0]
     nw, nz = B.shape[1] - ncon, C.shape[0] - nmeas
     B1, B2 = B[:, :nw], B[:, nw:]

@@ -48,8 +48,8 @@ def as_omega(omega: Any, *, name: str = "omega") -> np.ndarray:
     return w
 
 
-def ss_matrices(sys: Any, *, name: str = "sys",
-                allow_discrete: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def ss_matrices(sys: Any, *, name: str = "sys", allow_discrete: bool = False,
+                finite: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Return (A, B, C, D) as float arrays of an LTI system.
 
     Accepts a ``control.StateSpace`` (or anything python-control converts to one, e.g. a
@@ -63,6 +63,8 @@ def ss_matrices(sys: Any, *, name: str = "sys",
         What the error messages call the system.
     allow_discrete : bool, optional
         Accept a discrete-time system (its matrices are returned as they are).
+    finite : bool, optional
+        Refuse a NaN or infinite entry.
 
     Returns
     -------
@@ -72,16 +74,21 @@ def ss_matrices(sys: Any, *, name: str = "sys",
     Raises
     ------
     ModelError
-        If the system is discrete-time (unless ``allow_discrete``) or the shapes disagree.
+        If the system is discrete-time (unless ``allow_discrete``), the shapes disagree, it
+        is no system or (with ``finite``) an entry is NaN or infinite.
     """
     if isinstance(sys, tuple) and len(sys) == 4:
-        A, B, C, D = (np.atleast_2d(np.asarray(m, dtype=float)) for m in sys)
+        try:
+            A, B, C, D = (np.atleast_2d(np.asarray(m, dtype=float)) for m in sys)
+        except (TypeError, ValueError) as exc:
+            raise ModelError(f"{name}: (A, B, C, D) must be arrays of numbers ({exc})") from None
     else:
         if not isinstance(sys, control.StateSpace):
             try:
                 sys = control.ss(sys)
-            except Exception as exc:  # pragma: no cover - message only
-                raise ModelError(f"{name}: cannot convert {type(sys).__name__} to state space: {exc}") from exc
+            except Exception as exc:  # python-control's own errors: named here, one line
+                raise ModelError(f"{name}: cannot convert {type(sys).__name__} to state "
+                                 f"space: {exc}") from None
         if sys.dt not in (0, None) and not allow_discrete:
             raise ModelError(f"{name}: expected a continuous-time system (dt=0), got dt={sys.dt}")
         A, B, C, D = (np.asarray(m, dtype=float) for m in (sys.A, sys.B, sys.C, sys.D))
@@ -90,6 +97,8 @@ def ss_matrices(sys: Any, *, name: str = "sys",
         raise ModelError(
             f"{name}: inconsistent state-space shapes A{A.shape} B{B.shape} C{C.shape} D{D.shape}"
         )
+    if finite and not all(np.all(np.isfinite(X)) for X in (A, B, C, D)):
+        raise ModelError(f"{name}: a NaN or infinite entry in its matrices")
     return A, B, C, D
 
 

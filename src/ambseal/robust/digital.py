@@ -60,12 +60,13 @@ from ambseal.lti import (
     freqresp_at,
     sampled_response_at,
     series_inputs,
+    ss_matrices,
     zoh,
 )
 from ambseal.robust._digital_choice import first_stable as _first_stable
 from ambseal.robust._digital_choice import so_peak as _so_peak
 from ambseal.robust.delay import loop_delay
-from ambseal.robust.timing import check_timing
+from ambseal.robust.timing import MAX_DELAY_SAMPLES, check_timing
 from ambseal.robust.digital_loop import DiscreteController
 from ambseal.robust.stability import is_stable
 
@@ -254,9 +255,13 @@ def check_rate(K, sample_rate_hz: float, delay_samples: int = 0, removable: bool
     ------
     ConfigError
         A rate or delay the target cannot run, naming ``controller.sample_rate_hz``.
+    ModelError
+        ``K`` with a NaN or infinite entry.
     """
 
     check_timing(sample_rate_hz, delay_samples)
+    if K is not None and hasattr(K, "A"):
+        ss_matrices(K, name="controller", allow_discrete=True, finite=True)
     A = np.asarray(getattr(K, "A", np.zeros((0, 0))), float)
     if not removable and A.size:
         f_max = float(np.abs(np.linalg.eigvals(A)).max()) / (2 * np.pi)
@@ -381,9 +386,12 @@ def discretize_as(mats: Matrices, dt: float, method: str, prewarp_hz: float | No
     ------
     ConfigError
         Unknown method, or ``"tustin_prewarp"`` without a frequency below Nyquist.
+    ModelError
+        ``mats`` no system of consistent shapes, or with a NaN or infinite entry.
     """
 
-    A, B, C, D = mats
+    A, B, C, D = ss_matrices(mats if hasattr(mats, "A") else tuple(mats), name="controller",
+                             finite=True)
     if method == "zoh":
         Ad, Bd = zoh(A, B, dt)
         return Ad, Bd, C.copy(), D.copy()
@@ -417,7 +425,17 @@ def with_delay(mats: Matrices, n: int) -> Matrices:
     -------
     (A, B, C, D)
         The delayed system, ``n·nu`` states more.
+
+    Raises
+    ------
+    ConfigError
+        ``n`` not a whole number of samples from 0 to
+        :data:`~ambseal.robust.timing.MAX_DELAY_SAMPLES`.
     """
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) \
+            or not 0 <= n <= MAX_DELAY_SAMPLES:
+        raise ConfigError(f"with_delay: n={n!r}, expected a whole number of samples from 0 "
+                          f"to {MAX_DELAY_SAMPLES}")
     A, B, C, D = mats
     for _ in range(int(n)):
         nk, (nu, ny) = A.shape[0], D.shape
@@ -542,11 +560,21 @@ def sampled_plants(plants: Sequence[Matrices], fs: float, n_grid: int = 400, *,
     Returns
     -------
     SampledPlants
+
+    Raises
+    ------
+    ConfigError
+        A rate or delay out of range (:func:`~ambseal.robust.timing.check_timing`).
+    ModelError
+        A plant that is no ``(A, B, C, D)`` of consistent shapes, or has a NaN or infinite
+        entry.
     """
 
+    check_timing(fs, delay_samples)
     T = 1.0 / fs
     w = 2 * np.pi * np.logspace(0, np.log10(0.999 * fs / 2), n_grid)
-    plants = [tuple(np.asarray(X, float) for X in G) for G in plants]
+    plants = [ss_matrices(G if hasattr(G, "A") else tuple(G), name=f"plants[{k}]",
+                          finite=True) for k, G in enumerate(plants)]
     L = loop_delay(fs, delay_samples).system
     L = tuple(np.asarray(getattr(L, m), float) for m in ("A", "B", "C", "D"))
     # the lag is one SISO block before every input: the delayed plant's response is the

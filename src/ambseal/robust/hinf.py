@@ -39,7 +39,7 @@ from slycot import ab13dd
 from slycot.exceptions import SlycotArithmeticError
 
 from ambseal.errors import ConfigError, ModelError, SynthesisError
-from ambseal.lti import lft_lower, lft_lower_matrices
+from ambseal.lti import lft_lower, lft_lower_matrices, ss_matrices
 from ambseal.robust._hinf_gamma import backoff_ladder as _backoff_ladder
 from ambseal.robust._hinf_gamma import game_riccati as _game_riccati
 from ambseal.robust._hinf_gamma import gamma_search as _gamma_search
@@ -116,7 +116,8 @@ def hinfnorm(sys, rtol: float = 1e-10) -> tuple[float, float]:
     >>> round(g, 4), round(w, 4)
     (5.0252, 0.9899)
     """
-    sys = ct.ss(sys)
+    sys = ct.ss(*ss_matrices(sys, name="hinfnorm: sys", allow_discrete=True),
+                getattr(sys, "dt", 0) or 0)
     if sys.isdtime(strict=True):
         raise ModelError("hinfnorm: only continuous-time systems are supported")
     if not all(np.all(np.isfinite(np.asarray(M, float))) for M in (sys.A, sys.B, sys.C, sys.D)):
@@ -461,7 +462,9 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
     Raises
     ------
     ModelError, ConfigError
-        Wrong system type or channel counts (ModelError); backoff < 1 (ConfigError).
+        Wrong system type, a NaN or infinite entry or channel counts (ModelError); a
+        back-off that is not finite and ≥ 1, ``rtol`` outside (0, 1) or a ``gamma`` that is
+        not finite and > 0 (ConfigError).
     SynthesisError
         Plant not stabilisable/detectable, ``D12``/``D21`` rank deficient, jω-axis zeros,
         inadmissible ``gamma`` or no stabilising controller found. A verified norm far
@@ -485,6 +488,11 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
     check_plant(P, nmeas, ncon)
     if not (math.isfinite(backoff) and backoff >= 1.0):
         raise ConfigError(f"backoff={backoff} must be a finite number ≥ 1")
+    if not (isinstance(rtol, (int, float)) and 0.0 < rtol < 1.0):
+        raise ConfigError(f"hinfsyn: rtol={rtol!r}, expected a relative tolerance in (0, 1)")
+    if gamma is not None and not (isinstance(gamma, (int, float)) and math.isfinite(gamma)
+                                  and gamma > 0):
+        raise ConfigError(f"hinfsyn: gamma={gamma!r}, expected a finite γ > 0")
     if P.nstates == 0:
         # SLICOT SB10AD needs a state: one decoupled at −1 rad/s changes neither γ nor any
         # transfer function (stable, neither controllable nor observable)

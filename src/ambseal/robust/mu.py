@@ -319,7 +319,8 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
     Raises
     ------
     ModelError
-        Malformed blocks, dimensions that do not match ``M``, missing ``omega``, non-finite
+        Malformed blocks, ``tol`` outside (0, 1), ``max_iter`` or ``lower_iter`` not a whole
+        number ≥ 1, dimensions that do not match ``M``, missing ``omega``, non-finite
         entries.
 
     Notes
@@ -337,6 +338,11 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
     (5.0, 5.0)
     """
     blks = parse_blocks(blocks)
+    if not (isinstance(tol, (int, float)) and 0.0 < tol < 1.0):
+        raise ModelError(f"mussv: tol={tol!r}, expected a relative tolerance in (0, 1)")
+    for name, v in (("max_iter", max_iter), ("lower_iter", lower_iter)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
+            raise ModelError(f"mussv: {name}={v!r}, expected a whole number ≥ 1")
     w = None
     if hasattr(M, "A") and hasattr(M, "B"):
         if omega is None:

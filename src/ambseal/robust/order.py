@@ -17,7 +17,8 @@ import control as ct
 import numpy as np
 from slycot import ab09md
 
-from ambseal.errors import ConfigError
+from ambseal.errors import ConfigError, ModelError
+from ambseal.lti import ss_matrices
 from ambseal.robust.hinf import hinfnorm, lft_lower
 from ambseal.robust.mu import mussv
 
@@ -46,13 +47,18 @@ def balred_controller(K, order: int, alpha: float | None = None):
 
     Raises
     ------
+    ModelError
+        ``K`` is no continuous state-space system, or has a NaN or infinite entry.
     ConfigError
         ``order`` negative, above ``n`` or below the number of unstable poles.
     """
-    n = int(K.nstates)
+    if not isinstance(K, ct.StateSpace):
+        raise ModelError(f"balred_controller: K is a {type(K).__name__}, not a "
+                         "control.StateSpace")
+    A, B, C, D = ss_matrices(K, name="balred_controller: K", finite=True)
+    n = A.shape[0]
     if not isinstance(order, (int, np.integer)) or order < 0 or order > n:
         raise ConfigError(f"order={order!r}: must be an integer between 0 and {n}")
-    A, B, C, D = (np.asarray(X, float) for X in (K.A, K.B, K.C, K.D))
     lam = np.linalg.eigvals(A) if n else np.zeros(0)
     if alpha is None:
         # not a stability verdict (that is ambseal.robust.stability's): the split of the

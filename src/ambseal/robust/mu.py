@@ -419,10 +419,12 @@ def upper_near_peak(M, blocks, omega, cover, *, tol: float = 1e-3, chunk: int = 
     largest ``cover`` first, while ``cover`` still reaches ``PEAK_BAND`` of the largest
     bound found: the frequencies left cannot hold the peak or a local maximum
     :func:`mu_peak` refines. On a grid solved cold (at most twice the continuation stride,
-    e.g. the 60 points of a design grid) each bound is that of a :func:`mussv` call on the
-    whole grid: solved without :func:`mussv`'s peak refinement, then the bounds within
-    ``2·tol`` of the largest solved again in one call that refines them as the whole-grid
-    call would. On a longer grid every point is solved in one call.
+    e.g. the 60 points of a design grid) the chunks are solved without :func:`mussv`'s peak
+    refinement, then the bounds within ``2·tol`` of the largest again in one call that
+    refines them as a whole-grid call would: the peak is the whole grid's to about 1e-8,
+    each other bound to the solver's tolerance (the method of centres runs a stack
+    together, so a subset's bounds differ from the whole grid's by up to about 1e-4
+    relative). On a longer grid every point is solved in one call.
 
     Parameters
     ----------

@@ -120,6 +120,37 @@ def _scatter(vals, a, b, N, base=None):
     return out
 
 
+#: Osborne's D of a matrix whose entries span more than this is beyond the range a cold
+#: solve starts within (its start is clipped to 1e-4 … 1e4): its bound is solved balanced
+#: too, and the lower of the two kept.
+WIDE_SPREAD = 1e4
+
+
+def _balancing(M, blks, S, sweeps=8):
+    """Per-index scalings t (F, N) balancing M (Osborne 1960 on the norms of the groups one
+    real scalar may scale: each full block, and each row of a repeated scalar block — any T
+    commutes with δI), and which matrices need them (Osborne's D spanning more than
+    :data:`WIDE_SPREAD`)."""
+    cuts = [0]
+    for b, o in zip(blks, S.offs[:-1]):
+        cuts += list(range(o + 1, o + b.size + 1)) if b.kind != "full" else [o + b.size]
+    cuts = np.asarray(cuts)
+    F, ng = M.shape[0], len(cuts) - 1
+    Bn = np.empty((F, ng, ng))
+    for j in range(ng):
+        for k in range(ng):
+            Bn[:, j, k] = np.sum(np.abs(M[:, cuts[j]:cuts[j + 1], cuts[k]:cuts[k + 1]]) ** 2,
+                                 axis=(1, 2))
+    Bn[:, np.arange(ng), np.arange(ng)] = 0.0
+    Bn = Bn + 1e-300
+    d = np.ones((F, ng))
+    for _ in range(sweeps):
+        d = np.sqrt(np.einsum("fkj,fk->fj", Bn, d) / np.einsum("fjk,fk->fj", Bn, 1.0 / d))
+        d = d / np.exp(np.mean(np.log(d), axis=1, keepdims=True))
+    wide = d.max(axis=1) > WIDE_SPREAD * d.min(axis=1)
+    return np.repeat(np.sqrt(d), np.diff(cuts), axis=1), wide
+
+
 def _osborne_init(M, blks, S, sweeps=8):
     """Trace-free coordinates of a diagonal D from Osborne balancing of block norms.
 
@@ -355,7 +386,7 @@ def _refine_peak(P, best_z, nrm, tol, peak_tol, max_iter, batch=16, max_total=64
 
 
 def upper_bound(Mp, blks, tol, max_iter, gmax, *, stride=0, t0_factor=1.2, warm_factor=None,
-                peak_tol=None):
+                peak_tol=None, balance=True):
     """D–G upper bound on the padded stack Mp (F, N, N).
 
     Parameters
@@ -380,6 +411,9 @@ def upper_bound(Mp, blks, tol, max_iter, gmax, *, stride=0, t0_factor=1.2, warm_
     peak_tol : float, optional
         The bounds within ``2·tol`` of the largest one are refined further, to this
         tolerance (:func:`_refine_peak`); default ``tol·1e-3``.
+    balance : bool
+        Solve the matrices whose Osborne balancing spans more than :data:`WIDE_SPREAD`
+        balanced too, keeping the lower bound (:func:`_balancing`).
 
     Returns
     -------
@@ -414,4 +448,18 @@ def upper_bound(Mp, blks, tol, max_iter, gmax, *, stride=0, t0_factor=1.2, warm_
     upper = np.sqrt(np.maximum(_gevp(D, A), 0.0)) * nrm
     # the LMI is homogeneous in (D, G); M was divided by nrm, so G scales with nrm
     G = P.G(best_z) * nrm[:, None, None]
+    t, wide = _balancing(Mp, blks, S) if balance else (None, np.zeros(F, bool))
+    if np.any(wide):
+        # a matrix in other units: its bound solved balanced too (M_b = T M T⁻¹, the bound
+        # invariant, the solver's conditioning not) and the lower one kept — with its
+        # certificate mapped back, D = T D_b T, G = T G_b T, renormalised to tr D = N
+        idx = np.flatnonzero(wide)
+        Mb = t[idx, :, None] * Mp[idx] / t[idx, None, :]
+        ub, Db, Gb, _ = upper_bound(Mb, blks, tol, max_iter, gmax, peak_tol=peak_tol,
+                                    balance=False)
+        lower_ = ub < upper[idx] * (1.0 - tol)
+        for j, k in zip(np.flatnonzero(lower_), idx[lower_]):
+            Dk, Gk = (t[k][:, None] * X * t[k][None, :] for X in (Db[j], Gb[j]))
+            c = S.N / np.real(np.trace(Dk))
+            upper[k], D[k], G[k] = ub[j], Dk * c, Gk * c
     return upper, _herm(D), _herm(G), S.offs

@@ -120,9 +120,11 @@ def _scatter(vals, a, b, N, base=None):
     return out
 
 
-#: Osborne's D of a matrix whose entries span more than this is beyond the range a cold
-#: solve starts within (its start is clipped to 1e-4 … 1e4): its bound is solved balanced
-#: too, and the lower of the two kept.
+#: A matrix whose Osborne D spans more than this (a matrix in other units) is solved
+#: balanced too, and the lower bound kept: the cold solve starts from Osborne's D clipped
+#: to 1e-4 … 1e4 and moves an affine D, and from a start that far off its bound ended
+#: 9 % high where D spanned 1e10 (93 065 instead of 3.2468 at 1e24); up to 1e8 it stays
+#: within 2e-6, so 1e4 leaves the well-scaled matrices of typical μ designs as they were.
 WIDE_SPREAD = 1e4
 
 

@@ -61,7 +61,8 @@ from ambseal.lazy import lazy_face
 _FROM = {
     "closed_loop_modes": "campbell", "log_decrement": "campbell",
     "open_loop_modes": "campbell", "Campbell": "campbell", "ClosedLoopModes": "campbell",
-    "OVERDAMPED_ZETA": "campbell", "AF_CRITICAL": "campbell", "dask_available": "cases", "probe_scheduler": "cases",
+    "OVERDAMPED_ZETA": "campbell", "AF_CRITICAL": "campbell", "dask_available": "cases",
+    "probe_scheduler": "cases",
     "run_cases": "cases", "CaseError": "cases", "also_failed": "delivery",
     "loop_failure": "delivery", "synthesis_failure": "delivery",
     "FailedController": "delivery", "iso_assessment": "iso", "zone_limit_db": "iso",

@@ -44,11 +44,11 @@ from ambseal.model import (
 )
 from ambseal.robust import decay_rate, is_stable
 
-__all__ = ["AF_CRITICAL", "API684_LOG_DEC", "OVERDAMPED_ZETA", "ClosedLoopModes", "Crossing", "Campbell",
-           "log_decrement", "lowest_log_decrement", "whirl_of", "closed_loop_state_matrix",
-           "closed_loop_modes", "modes_as_run", "modes_of_state_matrix", "modes_of_sampled_loop",
-           "track_modes",
-           "open_loop_modes", "campbell"]
+__all__ = ["AF_CRITICAL", "API684_LOG_DEC", "OVERDAMPED_ZETA", "ClosedLoopModes", "Crossing",
+           "Campbell", "log_decrement", "lowest_log_decrement", "whirl_of",
+           "closed_loop_state_matrix", "closed_loop_modes", "modes_as_run",
+           "modes_of_state_matrix", "modes_of_sampled_loop", "track_modes", "open_loop_modes",
+           "campbell"]
 
 #: API 684 (2nd ed., 2005) level-I stability screening: log decrement of every mode ≥ 0.1.
 API684_LOG_DEC = 0.1

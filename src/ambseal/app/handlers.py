@@ -17,8 +17,8 @@ from pathlib import Path
 
 from rich.console import Console
 
-from ambseal.app import rotordynamics
 from ambseal.analysis import operating_points
+from ambseal.app import rotordynamics
 from ambseal.app.commands import (
     design_files,
     digital_for,

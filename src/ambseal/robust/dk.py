@@ -501,7 +501,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     history, best = [], None
     fits: list = []
     stall, rule = 0, f"max_iter={max_iter}"
-    last = None  # the previous closed loop and its μ, for a D-step redone with static fits
+    last = None  # the previous complexified μ, for a D-step redone with static fits
     for it in range(max_iter):
         Ps = _scaled_plant(P, cblocks, fits, nmeas, ncon) if fits else P
         try:
@@ -570,7 +570,8 @@ def _check_settings(order, search, search_backoff) -> None:
 def _mu_step(cl, blocks, cblocks, w):
     """The μ-step on the closed loop ``cl``: the complexified structure's bound (whose
     scalings the D-step fits) and the upper bound of the structure as given on ``w``, the
-    mixed one solved where it can reach its peak (:func:`~ambseal.robust.mu.upper_near_peak`)."""
+    mixed one solved where it can reach its peak
+    (:func:`~ambseal.robust.mu.upper_near_peak`)."""
     mu_c = mussv(cl, cblocks, w, lower=False, peak=False)
     if cblocks == [tuple(b) for b in blocks]:
         return mu_c, np.asarray(mu_c.upper, float)

@@ -41,6 +41,10 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Rotor.name": ("", "the machine's name, in every output and the report header"),
     "Rotor.modal_damping": ("", "damping ratio ζ given to every free–free bending mode of "
                                 "shaft and disks (structural damping)"),
+    "Rotor.rayleigh_alpha": ("1/s", "Rayleigh damping α·M of shaft and disks (a mode of ω "
+                                    "rad/s gets ζ = α/(2ω); ROSS 3's rotor ``alpha``)"),
+    "Rotor.rayleigh_beta": ("s", "Rayleigh damping β·K of shaft and disks (ζ = βω/2; ROSS "
+                                 "3's rotor ``beta``)"),
     # [materials.NAME]
     "Material.E": ("Pa", "Young's modulus"),
     "Material.rho": ("kg/m³", "density"),
@@ -75,6 +79,10 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "ShaftSection.inner_diameter_right": ("m", "bore at the right end; less than "
                                                "outer_diameter_right (default "
                                                "inner_diameter)"),
+    "ShaftSection.rayleigh_alpha": ("1/s", "the section's tube's own Rayleigh damping "
+                                           "α·M (ROSS's shaft element ``alpha``)"),
+    "ShaftSection.rayleigh_beta": ("s", "the section's tube's own Rayleigh damping β·K "
+                                        "(ROSS's shaft element ``beta``)"),
     "ShaftSection.layers": ("", "concentric tubes on the section's nodes, in parallel with "
                                 "its own (a sleeve, a hub; ROSS's layered elements)"),
     "ShaftLayer.outer_diameter": ("m", "outer diameter of the layer"),
@@ -91,6 +99,8 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                                              "(a tapered layer; default outer_diameter)"),
     "ShaftLayer.inner_diameter_right": ("m", "bore at the right end (default "
                                              "inner_diameter)"),
+    "ShaftLayer.rayleigh_alpha": ("1/s", "the layer's Rayleigh damping α·M"),
+    "ShaftLayer.rayleigh_beta": ("s", "the layer's Rayleigh damping β·K"),
     # [[disk]]
     "Disk.position": ("m", "axial position from the shaft's left end"),
     "Disk.mass": ("kg", "mass of the rigid disk (impeller, lamination stack, sleeve, hub)"),

@@ -28,6 +28,7 @@ with contextlib.redirect_stdout(sys.stderr), warnings.catch_warnings():
 from ambseal.analysis.campbell import closed_loop_modes  # noqa: E402
 from ambseal.config import dump_rig, parse_rig  # noqa: E402
 from ambseal.design.pid import pid_controller  # noqa: E402
+from ambseal.errors import ConfigError  # noqa: E402
 from ambseal.io.ross import _stdout_to_stderr, from_ross, load_ross  # noqa: E402
 from ambseal.model.amb import amb_factors, channel_names  # noqa: E402
 from ambseal.model.rig import build_system  # noqa: E402
@@ -98,6 +99,42 @@ def test_bearing_rotor_modes_equal_ross(speed_rpm):
         assert dec == pytest.approx(-2 * np.pi * ref[j].real / ref[j].imag, rel=1e-6)
 
 
+def _rotor_damping_in_ross() -> bool:
+    """Whether this ROSS's ``Rotor`` takes damping of its own (ROSS 3: ``alpha``, ``beta``,
+    ``modal_damping_ratio``)."""
+    import inspect
+    return "alpha" in inspect.signature(rs.Rotor.__init__).parameters
+
+
+@pytest.mark.skipif(not _rotor_damping_in_ross(),
+                    reason="ROSS < 3: a Rotor has no damping of its own (alpha, beta)")
+def test_rotor_rayleigh_damping_equals_ross(tmp_path):
+    """A ROSS 3 rotor with its own Rayleigh damping (``Rotor(alpha=3, beta=2e-5)``, of
+    shaft and disks), saved and imported: ``[rotor] rayleigh_alpha``, ``rayleigh_beta``, and
+    every lateral mode up to 500 Hz (damped frequency and log decrement) equal to one of
+    ROSS's eigenvalues to 1e-6 at 0 and 4000 rpm. With modal damping ratios instead, the
+    import is refused naming them."""
+    ex = _bearing_rotor()
+    rotor = _quiet(rs.Rotor, ex.shaft_elements, ex.disk_elements, ex.bearing_elements,
+                   alpha=3.0, beta=2e-5)
+    path = tmp_path / "damped.toml"
+    _quiet(rotor.save, path)
+    imp = from_ross(load_ross(path), where=str(path))
+    assert (imp.rig.rotor.rayleigh_alpha, imp.rig.rotor.rayleigh_beta) == (3.0, 2e-5)
+    for speed_rpm in (0.0, 4000.0):
+        ref = _ross_eigenvalues(rotor, speed_rpm * np.pi / 30)
+        m = closed_loop_modes(imp.rig, None, speed_hz=speed_rpm / 60, max_hz=500.0)
+        assert len(m.poles) == 12
+        for lam, dec in zip(m.poles, m.log_decrement):
+            j = np.argmin(np.abs(ref - lam))
+            assert abs(ref[j] - lam) <= 1e-6 * abs(lam)
+            assert dec == pytest.approx(-2 * np.pi * ref[j].real / ref[j].imag, rel=1e-6)
+    modal = _quiet(rs.Rotor, ex.shaft_elements, ex.disk_elements, ex.bearing_elements,
+                   modal_damping_ratio=[0.01, 0.02])
+    with pytest.raises(ConfigError, match="modal_damping_ratio=.*not supported"):
+        from_ross(modal, where="modal.toml")
+
+
 def test_rotor_example_file_modes_equal_ross(examples):
     """ROSS's ``rotor_example`` as saved (bearings tagged "Bearing 0", "Bearing 1", with a
     space): its 12 lateral modes up to 500 Hz at 0 and 3000 rpm equal ROSS's to 1e-6."""
@@ -156,8 +193,8 @@ def test_amb_example_equivalent_bearings_equal_ross(examples, tmp_path, ki_pid):
     bearing: the imported rig with each AMB replaced by Ki·K(jω) − Ks — K being the
     imported [controller.pid] when ROSS's PID has integral action (which must then equal
     ROSS's own C(s)·k_amp·k_sense at every frequency, 1e-12), ROSS's C(s) otherwise — has
-    ROSS's modes with that AMB model at ω = 1000 rad/s to 1e-6 (without ROSS's Rayleigh
-    shaft damping, which is reported as left out)."""
+    ROSS's modes with that AMB model at ω = 1000 rad/s to 1e-6, ROSS's Rayleigh damping of
+    the shaft elements (α = 2.5 1/s) imported with them."""
     if ki_pid:
         rotor = _amb_rotor(ki_pid)
         path = tmp_path / "amb.toml"
@@ -170,7 +207,8 @@ def test_amb_example_equivalent_bearings_equal_ross(examples, tmp_path, ki_pid):
         ki, ks = amb_factors(a)
         assert ki == pytest.approx((mb.ki, mb.ki), rel=1e-12)
         assert ks == pytest.approx((-mb.ks, -mb.ks), rel=1e-12) and ks[0] > 0
-    assert any("Rayleigh damping alpha=2.5" in n for n in imp.unmapped)
+    assert {(t.rayleigh_alpha, t.rayleigh_beta) for t in cfg.shaft} == {(2.5, 0.0)}
+    assert not any("Rayleigh" in n for n in imp.unmapped + imp.notes)
     ross_c = mbs[0].get_analog_controller() * float(mbs[0].k_amp * mbs[0].k_sense)
     if ki_pid:
         p = cfg.controller.pid
@@ -189,8 +227,6 @@ def test_amb_example_equivalent_bearings_equal_ross(examples, tmp_path, ki_pid):
     data["spring"] = [{"position": a.position, "kxx": k.real, "kyy": k.real,
                        "cxx": k.imag / w0, "cyy": k.imag / w0} for a, k in zip(cfg.amb, kc)]
     data.get("controller", {}).pop("pid", None)
-    shafts = [rs.ShaftElement(L=e.L, idl=e.idl, odl=e.odl, material=e.material, alpha=0.0)
-              for e in rotor.shaft_elements]
     ross_eq = [_quiet(rs.MagneticBearingElement, n=b.n, g0=float(b.g0), i0=float(b.i0),
                       ag=float(b.ag), nw=float(b.nw), alpha=float(b.alpha),
                       kp_pid=float(b.kp_pid), kd_pid=float(b.kd_pid),
@@ -199,24 +235,21 @@ def test_amb_example_equivalent_bearings_equal_ross(examples, tmp_path, ki_pid):
                       sensors_axis_rotation=float(b.sensors_axis_rotation),
                       frequency=np.array([w0, 2 * w0]))  # ROSS's formula at w0 exactly
                for b in mbs]
-    reference = _quiet(rs.Rotor, shafts, rotor.disk_elements, ross_eq)
+    reference = _quiet(rs.Rotor, rotor.shaft_elements, rotor.disk_elements, ross_eq)
     _assert_modes_equal_ross(parse_rig(data), reference, w0, 1500.0, 12)
 
 
 def test_amb_rotor_open_loop_unstable_poles_equal_ross():
     """ROSS's AMB test rig (``rotor_amb_example``, in memory): the open-loop unstable poles
     (the AMBs' negative stiffness alone) equal ROSS's frequency-domain AMB model with the
-    controller term at zero — ROSS bearings of stiffness ks — on the same rotor without
-    Rayleigh damping, to 1e-6."""
+    controller term at zero — ROSS bearings of stiffness ks — on the same rotor, its
+    shaft's Rayleigh damping included, to 1e-6."""
     amb = _quiet(rs.rotor_amb_example)
     imp = from_ross(amb)
     mbs = amb.bearing_elements
     assert sum("controller" in n for n in imp.unmapped) == 2  # the k(ω) model, the PID
-    shafts = [rs.ShaftElement(L=e.L, idl=e.idl, odl=e.odl, material=e.material, alpha=0.0,
-                              shear_effects=True, rotary_inertia=True, gyroscopic=True)
-              for e in amb.shaft_elements]
     springs = [rs.BearingElement(mb.n, kxx=mb.ks, kyy=mb.ks, cxx=0.0) for mb in mbs]
-    ref = _ross_eigenvalues(rs.Rotor(shafts, amb.disk_elements, springs), 0.0)
+    ref = _ross_eigenvalues(rs.Rotor(amb.shaft_elements, amb.disk_elements, springs), 0.0)
     ref = np.sort(ref[ref.real > 1e-6].real)
     lam = build_system(imp.rig, speed_rpm=0.0).poles()
     got = np.sort(lam[lam.real > 1e-6].real)

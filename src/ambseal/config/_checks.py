@@ -78,6 +78,11 @@ MAX_PID_FILTERS = 16
 #: A relative uncertainty (1σ or ± range as a fraction of the value): beyond 10× the value
 #: the range says nothing about it.
 MAX_RELATIVE = 10.0
+#: Rayleigh damping C = α·M + β·K of a shaft tube or the rotor: a mode of ω rad/s gets
+#: ζ = α/(2ω) + βω/2, so α = 1e4 1/s overdamps every mode below 800 Hz and β = 1 s every
+#: mode above 0.3 Hz: far beyond structural damping (ζ ~ 1e-3 … 1e-2).
+MAX_RAYLEIGH_ALPHA = 1e4
+MAX_RAYLEIGH_BETA = 1.0
 #: A coefficient of a table against frequency, bounded like a number or the affine form.
 BoundedCoefficient = Annotated[float, Field(ge=-MAX_COEFFICIENT, le=MAX_COEFFICIENT)]
 #: A frequency of a table (Hz); negative for backward whirl excitation.

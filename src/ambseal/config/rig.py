@@ -11,7 +11,9 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
 
 ``[rotor]``
     ``beam`` = ``"timoshenko"`` (default) or ``"euler-bernoulli"``; ``name`` (optional);
-    ``modal_damping`` (ζ of every free–free bending mode of shaft and disks, default 0).
+    ``modal_damping`` (ζ of every free–free bending mode of shaft and disks, default 0);
+    ``rayleigh_alpha`` (1/s), ``rayleigh_beta`` (s): Rayleigh damping α·M + β·K of shaft
+    and disks (default 0; ROSS 3's rotor ``alpha``, ``beta``).
 ``[materials.NAME]``
     ``E`` (Pa), ``rho`` (kg/m³) and either ``G`` (Pa) or ``nu`` (-).
 ``[[shaft]]`` (left to right)
@@ -23,7 +25,9 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     element's rotary-inertia and gyroscopic matrices, either may be left out),
     ``axial_force`` (N, tension positive) and ``torque`` (N·m): their geometric stiffness;
     ``outer_diameter_right``, ``inner_diameter_right`` (m, default: the left end's): a
-    tapered (conical) tube, its diameters linear along the section.
+    tapered (conical) tube, its diameters linear along the section; ``rayleigh_alpha``
+    (1/s), ``rayleigh_beta`` (s): the tube's own Rayleigh damping α·M + β·K (default 0;
+    ROSS's shaft element ``alpha``, ``beta``).
 ``[[disk]]``
     ``position`` (m), ``mass`` (kg), ``Ip``, ``Id`` (kg·m²), ``name`` (optional).
 ``[[amb]]``
@@ -98,6 +102,8 @@ from ambseal.config._checks import (
     MAX_GAP_M,
     MAX_LAYERS,
     MAX_PID_FILTERS,
+    MAX_RAYLEIGH_ALPHA,
+    MAX_RAYLEIGH_BETA,
     MAX_REDUCED_STATES,
     MAX_RELATIVE,
     MIN_CURRENT_A,
@@ -181,6 +187,8 @@ class Rotor(_Strict):
     beam: Literal["timoshenko", "euler-bernoulli"] = "timoshenko"
     name: Label = "rotor"
     modal_damping: float = Field(default=0.0, ge=0, lt=1)
+    rayleigh_alpha: float = Field(default=0.0, ge=0, le=MAX_RAYLEIGH_ALPHA)
+    rayleigh_beta: float = Field(default=0.0, ge=0, le=MAX_RAYLEIGH_BETA)
 
 
 class ShaftLayer(_Strict):
@@ -199,6 +207,8 @@ class ShaftLayer(_Strict):
     torque: float = Field(default=0.0, ge=-1e8, le=1e8)
     outer_diameter_right: float | None = Field(default=None, ge=1e-4, le=10.0)
     inner_diameter_right: float | None = Field(default=None, ge=0)
+    rayleigh_alpha: float = Field(default=0.0, ge=0, le=MAX_RAYLEIGH_ALPHA)
+    rayleigh_beta: float = Field(default=0.0, ge=0, le=MAX_RAYLEIGH_BETA)
 
     @model_validator(mode="after")
     def _bore(self) -> "ShaftLayer":
@@ -239,6 +249,8 @@ class ShaftSection(_Strict):
     torque: float = Field(default=0.0, ge=-1e8, le=1e8)
     outer_diameter_right: float | None = Field(default=None, ge=1e-4, le=10.0)
     inner_diameter_right: float | None = Field(default=None, ge=0)
+    rayleigh_alpha: float = Field(default=0.0, ge=0, le=MAX_RAYLEIGH_ALPHA)
+    rayleigh_beta: float = Field(default=0.0, ge=0, le=MAX_RAYLEIGH_BETA)
 
     @model_validator(mode="after")
     def _bore(self) -> "ShaftSection":
@@ -910,7 +922,7 @@ def _toml_table(name: str, val: dict, lines: list[str]) -> None:
 #: The options of a shaft tube (section or layer) and their defaults, which
 #: :func:`dump_rig` leaves out.
 _TUBE_DEFAULTS = {"rotary_inertia": True, "gyroscopic": True, "axial_force": 0.0,
-                  "torque": 0.0}  # the right end's diameters: None, left out as any None
+                  "torque": 0.0, "rayleigh_alpha": 0.0, "rayleigh_beta": 0.0}  # the right end's diameters: None, left out as any None
 
 
 def dump_rig(cfg: RigConfig, header: str = "") -> str:

@@ -18,8 +18,11 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
   a tapered element (``odr``, ``idr`` differ from ``odl``, ``idl``) → a section with
   ``outer_diameter_right``, ``inner_diameter_right``, whose element is Genta & Gugliotta's
   conical one as ROSS's (:class:`ambseal.model.fe.BeamElement`). Hutchinson's shear
-  coefficient has no equivalent: an error. ROSS's Rayleigh damping of shaft elements (``alpha``, ``beta``) has none either:
-  reported, left out. Several shafts (ROSS's ``CoAxialRotor``, its shafts linked by
+  coefficient has no equivalent: an error. ROSS's Rayleigh damping of a shaft element
+  (``alpha``, ``beta``: C = αM + βK) → the tube's ``rayleigh_alpha``, ``rayleigh_beta``;
+  a ROSS 3 rotor's own (``Rotor(alpha=..., beta=...)``, which ROSS takes in place of its
+  elements') → ``[rotor] rayleigh_alpha``, ``rayleigh_beta``; its modal damping ratios: an
+  error (ROSS sets them on modes a lateral model does not order alike). Several shafts (ROSS's ``CoAxialRotor``, its shafts linked by
   bearings): an error naming them (an ambseal rig has one shaft).
 * ``DiskElement`` → ``[[disk]]`` (m, Ip, Id); a ``PointMass`` on a shaft node → a disk
   without inertia.
@@ -152,9 +155,10 @@ def _check_element(el, where: str) -> None:
                           "supported (expected 'cowper')")
 
 
-def _shaft(rotor, where: str) -> tuple[list[dict], dict, str, list[str]]:
+def _shaft(rotor, where: str, elemental: bool = True) -> tuple[list[dict], dict, str]:
     """``[[shaft]]`` sections (one per node pair, layered elements as ``layers``), the
-    materials, the beam type and what was left out."""
+    materials and the beam type; ``elemental``: each element's Rayleigh
+    damping taken (ROSS ignores it where the rotor has its own)."""
     shafts = sorted(rotor.shaft_elements, key=lambda e: (e.n, e.idl))
     _one_shaft([int(el.n) for el in shafts], where)
     pairs: dict[int, list] = {}
@@ -182,22 +186,16 @@ def _shaft(rotor, where: str) -> tuple[list[dict], dict, str, list[str]]:
                   "material": key_of[id(e)], "rotary_inertia": bool(e.rotary_inertia),
                   "gyroscopic": bool(e.gyroscopic), "axial_force": float(e.axial_force),
                   "torque": float(e.torque)}
+                 | ({"rayleigh_alpha": float(e.alpha), "rayleigh_beta": float(e.beta)}
+                    if elemental and (e.alpha or e.beta) else {})
                  | ({"outer_diameter_right": float(e.odr), "inner_diameter_right": float(e.idr)}
                     if (e.odr, e.idr) != (e.odl, e.idl) else {}) for e in group]
         section = {"length": float(group[0].L), **tubes[0], "elements": 1}
         if len(tubes) > 1:
             section["layers"] = tubes[1:]
         out.append(section)
-    damped: dict[tuple[float, float], list] = {}
-    for el in shafts:
-        if el.alpha or el.beta:
-            damped.setdefault((float(el.alpha), float(el.beta)), []).append(str(el.tag))
-    notes = [f"Rayleigh damping alpha={a:g} 1/s, beta={b:g} s of {len(tags)} shaft "
-             f"element(s) ({tags[0]}{' ... ' + tags[-1] if len(tags) > 1 else ''}) left out "
-             "(no equivalent; [rotor] modal_damping is modal)"
-             for (a, b), tags in damped.items()]
     beam = "timoshenko" if shear == {True} else "euler-bernoulli"
-    return out, mats, beam, notes
+    return out, mats, beam
 
 
 def _isotropic_skew(c: dict[str, np.ndarray]) -> bool:
@@ -340,10 +338,12 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
         if kind not in known and not any(el is b for b in bearings):
             raise _bad(where, f"unsupported element {kind} ({getattr(el, 'tag', '')}) with "
                               "no ambseal equivalent")
-    shaft, mats, beam, unmapped = _shaft(rotor, where)
+    damping = _rotor_damping(rotor, where)
+    shaft, mats, beam = _shaft(rotor, where, elemental=not damping)
+    unmapped: list[str] = []
     nodes = np.concatenate([[0.0], np.cumsum([s["length"] for s in shaft])])
     rig: dict = {"rotor": {"beam": beam, "name": name or str(getattr(rotor, "tag", None)
-                                                            or "ROSS rotor")},
+                                                            or "ROSS rotor"), **damping},
                  "materials": mats, "shaft": shaft, "disk": [], "amb": [], "seal": [],
                  "spring": []}
     rig["disk"] = _masses(rotor, nodes, where)
@@ -376,6 +376,26 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
                         "closes the loop with the controller's dynamics")
         _controller(rig, pids, unmapped, notes)
     return RossImport(parse_rig(rig, where), tuple(unmapped), tuple(notes))
+
+
+def _rotor_damping(rotor, where: str) -> dict:
+    """``[rotor]`` keys of a ROSS 3 rotor's own damping: its Rayleigh ``alpha``, ``beta``
+    (of shaft, disks and point masses, as ROSS assembles them); ROSS 3 takes it in place
+    of its elements' own. Modal damping ratios are refused: ROSS puts them on the modes of
+    the supported rotor at standstill, its axial and torsional modes among them, which a
+    lateral model cannot order the same way."""
+    ratios = getattr(rotor, "modal_damping_ratio", None)
+    default = float(getattr(rotor, "default_damping_ratio", 0.0) or 0.0)
+    alpha = float(getattr(rotor, "alpha", 0.0) or 0.0)
+    beta = float(getattr(rotor, "beta", 0.0) or 0.0)
+    if (ratios is not None and np.any(np.asarray(ratios, float))) or default:
+        raise _bad(where, f"the rotor's modal damping (modal_damping_ratio={ratios!r}, "
+                          f"default_damping_ratio={default:g}) is not supported: ROSS sets "
+                          "it on the supported rotor's modes, axial and torsional ones "
+                          "among them; give the damping as Rayleigh alpha, beta (ROSS's "
+                          "Rotor(alpha=..., beta=...)) or set [rotor] modal_damping "
+                          "(free–free bending modes) in the rig after importing without it")
+    return {k: v for k, v in (("rayleigh_alpha", alpha), ("rayleigh_beta", beta)) if v}
 
 
 def _masses(rotor, nodes: np.ndarray, where: str) -> list[dict]:

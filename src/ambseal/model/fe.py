@@ -129,6 +129,10 @@ class BeamElement:
         couples the bending planes and is not symmetric (:meth:`_geometric`).
     outer_diameter_right, inner_diameter_right : float, optional
         Diameters (m) at the right end (node 2); None: the left end's (uniform).
+    rayleigh_alpha, rayleigh_beta : float
+        Rayleigh (proportional) damping of the element, :meth:`C` = α·M + β·K: α in 1/s,
+        β in s (ROSS's ``ShaftElement`` ``alpha``, ``beta``). A mode of a uniform free beam
+        damped this way has ζ = α/(2ω) + βω/2 (Rayleigh 1877; Craig & Kurdila 2006 §10.2).
     """
 
     length: float
@@ -144,6 +148,8 @@ class BeamElement:
     torque: float = 0.0
     outer_diameter_right: float | None = None
     inner_diameter_right: float | None = None
+    rayleigh_alpha: float = 0.0
+    rayleigh_beta: float = 0.0
 
     def _diameters(self, xi) -> tuple[np.ndarray, np.ndarray]:
         """Outer and inner diameter (m) at ξ = z/L: linear between the ends."""
@@ -342,6 +348,13 @@ class BeamElement:
         g[4:, :4] = -mr
         return _to_nodes(g, coupled=True)
 
+    def C(self) -> np.ndarray:
+        """Damping matrix (8, 8) in N·s/m, N·s, N·m·s: α·M + β·K (Rayleigh damping; K with
+        its geometric stiffness, as ROSS's ``ShaftElement.C``); zero without it."""
+        if not (self.rayleigh_alpha or self.rayleigh_beta):
+            return np.zeros((8, 8))
+        return self.rayleigh_alpha * self.M() + self.rayleigh_beta * self.K()
+
 
 @dataclass(frozen=True)
 class LayeredBeam:
@@ -379,6 +392,10 @@ class LayeredBeam:
     def G(self) -> np.ndarray:
         """Gyroscopic matrix (8, 8) per unit spin speed: the sum of the tubes'."""
         return sum(t.G() for t in self.tubes)
+
+    def C(self) -> np.ndarray:
+        """Damping matrix (8, 8): the sum of the tubes' Rayleigh damping."""
+        return sum(t.C() for t in self.tubes)
 
 
 @dataclass(frozen=True)

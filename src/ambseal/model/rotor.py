@@ -142,6 +142,8 @@ def build_mesh(cfg: RigConfig, extra_positions: tuple[float, ...] = ()) -> Mesh:
                     gyroscopic=t.gyroscopic,
                     axial_force=t.axial_force,
                     torque=t.torque,
+                    rayleigh_alpha=t.rayleigh_alpha,
+                    rayleigh_beta=t.rayleigh_beta,
                 )
                 for t in (sec, *sec.layers)
             )
@@ -175,8 +177,9 @@ class RotorMatrices:
     K : ndarray, shape (n_dof, n_dof)
         Stiffness matrix (N/m, N·m/rad); not symmetric where a section carries torque.
     C : ndarray, shape (n_dof, n_dof)
-        Structural (modal) damping (N·s/m): the rotor's ``modal_damping`` on every
-        free–free elastic mode.
+        Structural damping (N·s/m): the rotor's ``modal_damping`` on every free–free
+        elastic mode, plus the rotor's Rayleigh damping ``rayleigh_alpha``·M +
+        ``rayleigh_beta``·K and each shaft tube's own (:meth:`BeamElement.C`).
     G : ndarray, shape (n_dof, n_dof)
         Gyroscopic matrix per unit spin speed (multiplied by Ω in rad/s).
     """
@@ -221,11 +224,13 @@ def assemble_rotor(cfg: RigConfig, mesh: Mesh | None = None) -> RotorMatrices:
     M = np.zeros((n, n))
     K = np.zeros((n, n))
     G = np.zeros((n, n))
+    C_shaft = np.zeros((n, n))
     for e, el in enumerate(mesh.elements):
         s = slice(4 * e, 4 * e + 8)
         M[s, s] += el.M()
         K[s, s] += el.K()
         G[s, s] += el.G()
+        C_shaft[s, s] += el.C()
     for d in cfg.disk:
         de = DiskElement(d.mass, d.Ip, d.Id)
         s = slice(4 * mesh.node_at(d.position), 4 * mesh.node_at(d.position) + 4)
@@ -234,6 +239,10 @@ def assemble_rotor(cfg: RigConfig, mesh: Mesh | None = None) -> RotorMatrices:
     # a torque's stiffness has a circulatory (skew) part: the free–free modes that the
     # structural damping is set on are those of the conservative part
     C = modal_damping(M, (K + K.T) / 2, cfg.rotor.modal_damping)
+    alpha, beta = cfg.rotor.rayleigh_alpha, cfg.rotor.rayleigh_beta
+    if alpha or beta or np.any(C_shaft):
+        # the rotor's Rayleigh damping is of shaft and disks, as ROSS 3's Rotor(alpha, beta)
+        C = C + C_shaft + alpha * M + beta * K
     return RotorMatrices(mesh=mesh, M=M, K=K, C=C, G=G)
 
 

@@ -25,7 +25,9 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
   error (ROSS sets them on modes a lateral model does not order alike). Several shafts (ROSS's ``CoAxialRotor``, its shafts linked by
   bearings): an error naming them (an ambseal rig has one shaft).
 * ``DiskElement`` → ``[[disk]]`` (m, Ip, Id); a ``PointMass`` on a shaft node → a disk
-  without inertia.
+  without inertia; a gear of a single rotor (ROSS 3's ``GearElement``) → a disk (no gear
+  mesh acts on it). A ROSS 3 ``MultiRotor`` (rotors joined by a gear mesh): an error
+  naming its rotors.
 * ``BearingElement`` and its kinds (``SealElement``, fluid-film, ball, ...): coefficients of
   the isotropic, skew form (kxx = kyy, kxy = −kyx, cxx = cyy, cxy = −cyx, mxx = myy, no cross
   mass) → ``[[seal]]`` with K = kxx, k = kxy, C = cxx, c = cxy, M = mxx (Childs'
@@ -210,6 +212,10 @@ def _isotropic_skew(c: dict[str, np.ndarray]) -> bool:
 def _kind(el, where: str, i: int) -> tuple[str, bool]:
     """("seal" | "spring", whether its coefficients change with frequency) of a ROSS
     bearing or seal."""
+    if getattr(el, "speed", None) is not None and getattr(el, "frequency", None) is not None:
+        raise _bad(where, f"bearing {i} ({el.tag}, node {el.n}): coefficients tabulated "
+                          "against both speed and whirl frequency (a ROSS 3 2-D table) are "
+                          "not supported: give them against speed or against frequency")
     c = {n: _coef(el, n) for n in _COEFFS}
     varies = not all(np.allclose(v, v[0], rtol=1e-12, atol=0.0) for v in c.values())
     if _isotropic_skew(c):
@@ -220,6 +226,14 @@ def _kind(el, where: str, i: int) -> tuple[str, bool]:
                           "an isotropic mxx = myy have no ambseal equivalent ([[seal]] takes M "
                           "with the isotropic skew form, [[spring]] no mass)")
     return "spring", varies
+
+
+def _axis(el) -> np.ndarray:
+    """The table axis (rad/s) of a bearing's coefficients: ROSS 2.3's ``frequency``, or
+    ROSS 3's ``speed`` (its ``frequency`` is then the whirl frequency; a table over both
+    is refused by :func:`_kind`). Either is evaluated at the synchronous frequency."""
+    speed = getattr(el, "speed", None)
+    return np.atleast_1d(np.asarray(el.frequency if speed is None else speed, float))
 
 
 def _at(el, name: str, omega: float) -> float:
@@ -242,7 +256,7 @@ def _seal(el, z: float, i: int, varies: bool, omega: float) -> dict:
     entry = {"name": _name(el.tag, f"bearing{i}"), "position": z}
     if not varies:
         return entry | {k: float(_coef(el, v)[0]) for k, v in keys.items()}
-    w = sorted({float(x) for x in np.atleast_1d(el.frequency)})
+    w = sorted({float(x) for x in _axis(el)})
     if w[0] < omega < w[-1] and not any(math.isclose(omega, x) for x in w):
         w = sorted(w + [omega])  # exact at the operating speed, too
     return entry | {k: {"frequency_hz": [x / (2 * math.pi) for x in w],
@@ -331,7 +345,14 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
         An element with no ambseal equivalent (named by kind, index, tag and node), or a
         shaft element without a material.
     """
-    known = {"ShaftElement", "DiskElement", "PointMass"}
+    rotors = getattr(rotor, "rotors", None)
+    if isinstance(rotors, dict) and rotors:  # a ROSS 3 MultiRotor: rotors joined by gears
+        tags = ", ".join(f"{k} {getattr(r, 'tag', '')!s}" for k, r in rotors.items())
+        raise _bad(where, f"a ROSS MultiRotor ({tags}) has several shafts coupled by a "
+                          "gear mesh; an ambseal rig has one shaft and no gear mesh: import "
+                          "each rotor on its own (its gear becomes a disk)")
+    # a gear of a single rotor is a disk with teeth: its mass and inertias are imported
+    known = {"ShaftElement", "DiskElement", "PointMass", "GearElement", "GearElementTVMS"}
     bearings = list(getattr(rotor, "bearing_elements", []))
     for el in getattr(rotor, "elements", []):
         kind = type(el).__name__
@@ -349,7 +370,7 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
     rig["disk"] = _masses(rotor, nodes, where)
     pids, notes = [], []
     plan = _supports(bearings, nodes, where, rig, pids)
-    one_freq = [np.atleast_1d(b.frequency) for _, b, kind, varies in plan
+    one_freq = [_axis(b) for _, b, kind, varies in plan
                 if varies and kind == "spring"]
     omega, rpm, rule = _import_speed(one_freq, speed_rpm)
     for i, b, kind, varies in plan:
@@ -433,7 +454,7 @@ def _supports(bearings: list, nodes: np.ndarray, where: str, rig: dict,
 
 def _one_frequency_note(i: int, b, omega: float, rpm: float, rule: str) -> str:
     """What the import did with a bearing's frequency-dependent coefficients."""
-    f = np.atleast_1d(b.frequency) / (2 * math.pi)
+    f = _axis(b) / (2 * math.pi)
     out = "" if f.min() <= omega / (2 * math.pi) <= f.max() else (
         " (outside the table: ROSS's interpolant extrapolated)")
     return (f"bearing {i} ({b.tag}, node {b.n}): frequency-dependent "

@@ -920,9 +920,9 @@ def _toml_table(name: str, val: dict, lines: list[str]) -> None:
 
 
 #: The options of a shaft tube (section or layer) and their defaults, which
-#: :func:`dump_rig` leaves out.
+#: :func:`dump_rig` leaves out (the right end's diameters: None, left out as any None).
 _TUBE_DEFAULTS = {"rotary_inertia": True, "gyroscopic": True, "axial_force": 0.0,
-                  "torque": 0.0, "rayleigh_alpha": 0.0, "rayleigh_beta": 0.0}  # the right end's diameters: None, left out as any None
+                  "torque": 0.0, "rayleigh_alpha": 0.0, "rayleigh_beta": 0.0}
 
 
 def dump_rig(cfg: RigConfig, header: str = "") -> str:

@@ -1,7 +1,8 @@
 """ROSS rotors in: a ``ross.Rotor`` (or ROSS's saved .toml/.json rotor file) as an ambseal rig.
 
-Tested with ross-rotordynamics 2.3 (Python 3.11, ``plotly<7``; ROSS 3 needs Python ≥ 3.12) on
-ROSS's own ``rotor_example``, ``compressor_example`` and ``rotor_amb_example``. The mapping,
+Tested with ross-rotordynamics 2.3 (Python 3.11, ``plotly<7``) on ROSS's own
+``rotor_example``, ``compressor_example`` and ``rotor_amb_example``, and with ROSS 3.1
+(Python 3.13) on its ``rotor_example`` and ``compressor_example``. The mapping,
 element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keeps the lateral
 [x, y, α, β], so ROSS's axial and torsional modes have no counterpart):
 
@@ -22,8 +23,9 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
   (``alpha``, ``beta``: C = αM + βK) → the tube's ``rayleigh_alpha``, ``rayleigh_beta``;
   a ROSS 3 rotor's own (``Rotor(alpha=..., beta=...)``, which ROSS takes in place of its
   elements') → ``[rotor] rayleigh_alpha``, ``rayleigh_beta``; its modal damping ratios: an
-  error (ROSS sets them on modes a lateral model does not order alike). Several shafts (ROSS's ``CoAxialRotor``, its shafts linked by
-  bearings): an error naming them (an ambseal rig has one shaft).
+  error (ROSS sets them on modes a lateral model does not order alike). Several shafts
+  (ROSS's ``CoAxialRotor``, its shafts linked by bearings): an error naming them (an
+  ambseal rig has one shaft).
 * ``DiskElement`` → ``[[disk]]`` (m, Ip, Id); a ``PointMass`` on a shaft node → a disk
   without inertia; a gear of a single rotor (ROSS 3's ``GearElement``) → a disk (no gear
   mesh acts on it). A ROSS 3 ``MultiRotor`` (rotors joined by a gear mesh): an error
@@ -159,8 +161,8 @@ def _check_element(el, where: str) -> None:
 
 def _shaft(rotor, where: str, elemental: bool = True) -> tuple[list[dict], dict, str]:
     """``[[shaft]]`` sections (one per node pair, layered elements as ``layers``), the
-    materials and the beam type; ``elemental``: each element's Rayleigh
-    damping taken (ROSS ignores it where the rotor has its own)."""
+    materials and the beam type; ``elemental``: each element's Rayleigh damping taken
+    (ROSS ignores it where the rotor has its own)."""
     shafts = sorted(rotor.shaft_elements, key=lambda e: (e.n, e.idl))
     _one_shaft([int(el.n) for el in shafts], where)
     pairs: dict[int, list] = {}

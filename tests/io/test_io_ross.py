@@ -30,7 +30,8 @@ from ambseal.config import dump_rig, parse_rig  # noqa: E402
 from ambseal.design.pid import pid_controller  # noqa: E402
 from ambseal.errors import ConfigError  # noqa: E402
 from ambseal.io.ross import _stdout_to_stderr, from_ross, load_ross  # noqa: E402
-from ambseal.model.amb import amb_factors, channel_names  # noqa: E402
+from ambseal.model.amb import AmbElement, amb_factors, channel_names  # noqa: E402
+from ambseal.model.rotor import build_mesh  # noqa: E402
 from ambseal.model.rig import build_system  # noqa: E402
 
 
@@ -633,6 +634,49 @@ def test_conical_rotor_equals_ross_and_its_asserted_frequencies(tmp_path):
     one = closed_loop_modes(parse_rig(data), None, speed_hz=0.0, max_hz=5000.0)
     four = closed_loop_modes(cfg, None, speed_hz=0.0, max_hz=5000.0)
     assert one.poles == pytest.approx(four.poles, rel=1e-12)
+
+
+def test_ross_pinned_conical_rotor_is_imported_with_pins(tmp_path):
+    """ROSS's ``rotor_conical`` exactly as ROSS's tests build it, on 1e20 N/m bearings (its
+    way of pinning a node), saved and imported: the bearings become springs at the rig
+    file's stiffest support, 1e17 N/m, each with a note, and the rotor's natural frequencies
+    are those ROSS's ``test_rotor_conical_frequencies`` asserts (1630.75, 9899.54, 21074.45
+    rad/s) to 1e-6."""
+    rotor = _conical_rotor(1e20)
+    path = tmp_path / "pinned.toml"
+    _quiet(rotor.save, path)
+    imp = from_ross(load_ross(path), where=str(path))
+    assert [(sp.kxx, sp.kyy) for sp in imp.rig.spring] == [(1e17, 1e17)] * 2
+    assert sum("taken as a pin, 1e+17 N/m" in n for n in imp.notes) == 4
+    m = closed_loop_modes(imp.rig, None, speed_hz=0.0, max_hz=5000.0)
+    w = np.sort(np.abs(m.poles))
+    asserted = [1630.7509182, 1630.75091824, 9899.54379138, 9899.54396231,
+                21074.45440319, 21074.45440372]
+    assert w == pytest.approx(asserted, rel=1e-6)
+
+
+@pytest.mark.skipif(not hasattr(rs, "MultiRotor") or "sensor_node" not in __import__(
+    "inspect").signature(rs.MagneticBearingElement.__init__).parameters,
+    reason="ROSS < 3: an AMB's sensor is at the bearing (no sensor_node)")
+def test_amb_sensor_node_is_the_sensor_position():
+    """ROSS 3's AMB rotor (``rotor_example_amb_simple``: AMBs on nodes 1 and 9 of ten
+    0.1 m elements) with each sensor one node outboard (``sensor_node`` 0 and 10): the
+    imported AMBs keep their actuators at 0.1 and 0.9 m and put their sensors at 0 and
+    1.0 m: the model's sensor nodes are ROSS's sensor nodes."""
+    from ross.bearings.magnetic.amb_models import rotor_example_amb_simple
+
+    ex = _quiet(rotor_example_amb_simple)
+    keys = ("g0", "i0", "ag", "nw", "kp_pid", "kd_pid", "ki_pid", "k_amp", "k_sense")
+    mbs = [_quiet(rs.MagneticBearingElement, n=b.n, sensor_node=s, tag=b.tag,
+                  **{k: float(np.asarray(getattr(b, k))) for k in keys})
+           for b, s in zip(ex.bearing_elements, (0, 10))]
+    rotor = _quiet(rs.Rotor, ex.shaft_elements, ex.disk_elements, mbs)
+    cfg = from_ross(rotor).rig
+    got = [(a.position, a.sensor_position) for a in cfg.amb]
+    assert np.asarray(got) == pytest.approx(np.array([(0.1, 0.0), (0.9, 1.0)]), abs=1e-12)
+    mesh = build_mesh(cfg)
+    assert [(e.bearing_node, e.sensor_node) for e in
+            (AmbElement.from_config(a, mesh) for a in cfg.amb)] == [(1, 0), (9, 10)]
 
 
 @pytest.mark.parametrize("shear", [True, False])

@@ -20,6 +20,7 @@ from ambseal.config._checks import (
                                     MAX_GAP_M,
                                     MAX_PRESSURE_BAR,
                                     MAX_SPEED_HZ,
+                                    MAX_SUPPORT_STIFFNESS,
 )
 from ambseal.config.methods import METHODS, Method, method, method_label, method_names
 from ambseal.config.rig import (
@@ -50,7 +51,7 @@ from ambseal.config.rig import (
 )
 
 __all__ = ["MAX_AMBS", "MAX_COEFFICIENT", "MAX_COMPONENTS", "MAX_CURRENT_A", "MAX_DELAY_SAMPLES", "MAX_ELEMENTS",
-           "MAX_FREQUENCY_HZ", "MAX_GAP_M", "MAX_PRESSURE_BAR", "MAX_SPEED_HZ", "METHODS",
+           "MAX_FREQUENCY_HZ", "MAX_GAP_M", "MAX_PRESSURE_BAR", "MAX_SPEED_HZ", "MAX_SUPPORT_STIFFNESS", "METHODS",
            "Method", "method", "method_label", "method_names",
            "Actuator", "Affine", "Amb", "AxisPair", "Coefficient", "FrequencyTable",
            "Machine", "Pid", "PidFilter", "RigConfig", "Seal", "Signoff", "Spring", "Stage",

@@ -78,6 +78,10 @@ MAX_PID_FILTERS = 16
 #: A relative uncertainty (1σ or ± range as a fraction of the value): beyond 10× the value
 #: the range says nothing about it.
 MAX_RELATIVE = 10.0
+#: A support's stiffness (N/m), the bound of a ``[[spring]]``'s kxx, kyy, kxy, kyx: a pin. A
+#: node on two springs of 1e17 N/m has the natural frequencies of the pinned shaft to 1e-8
+#: (ROSS's conical test rotor), and the eigenvalues stay well conditioned.
+MAX_SUPPORT_STIFFNESS = 1e17
 #: Rayleigh damping C = α·M + β·K of a shaft tube or the rotor: a mode of ω rad/s gets
 #: ζ = α/(2ω) + βω/2, so α = 1e4 1/s overdamps every mode below 800 Hz and β = 1 s every
 #: mode above 0.3 Hz: far beyond structural damping (ζ ~ 1e-3 … 1e-2).

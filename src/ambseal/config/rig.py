@@ -106,6 +106,7 @@ from ambseal.config._checks import (
     MAX_RAYLEIGH_BETA,
     MAX_REDUCED_STATES,
     MAX_RELATIVE,
+    MAX_SUPPORT_STIFFNESS,
     MIN_CURRENT_A,
     MIN_TIME_CONSTANT_S,
     BoundedCoefficient,
@@ -381,10 +382,10 @@ class Seal(_Strict):
 
 class Spring(_Strict):
     position: float = Field(ge=0)
-    kxx: float = Field(ge=-1e17, le=1e17)  # up to a stiff pin
-    kyy: float = Field(ge=-1e17, le=1e17)
-    kxy: float = Field(default=0.0, ge=-1e17, le=1e17)
-    kyx: float = Field(default=0.0, ge=-1e17, le=1e17)
+    kxx: float = Field(ge=-MAX_SUPPORT_STIFFNESS, le=MAX_SUPPORT_STIFFNESS)  # up to a pin
+    kyy: float = Field(ge=-MAX_SUPPORT_STIFFNESS, le=MAX_SUPPORT_STIFFNESS)
+    kxy: float = Field(default=0.0, ge=-MAX_SUPPORT_STIFFNESS, le=MAX_SUPPORT_STIFFNESS)
+    kyx: float = Field(default=0.0, ge=-MAX_SUPPORT_STIFFNESS, le=MAX_SUPPORT_STIFFNESS)
     cxx: float = Field(default=0.0, ge=-1e12, le=1e12)
     cyy: float = Field(default=0.0, ge=-1e12, le=1e12)
     cxy: float = Field(default=0.0, ge=-1e12, le=1e12)

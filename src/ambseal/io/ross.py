@@ -41,12 +41,15 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
   against frequency, ROSS's interpolant at one frequency: the synchronous frequency of the
   import speed (``speed_rpm``; by default the lowest frequency that every such table of
   ROSS's covers), written as ``[operating] speed_rpm`` and reported, so that ambseal's
-  modes at that speed are ROSS's ``run_modal(speed)``. Mass terms that are not of the
-  seal's form, or a bearing on a support (``n_link``): an error.
+  modes at that speed are ROSS's ``run_modal(speed)``. A direct stiffness above the rig
+  file's stiffest support (:data:`~ambseal.config.MAX_SUPPORT_STIFFNESS`; ROSS pins a node
+  with 1e20 N/m) is taken at that bound, a pin, with a note. Mass terms that are not of
+  the seal's form, or a bearing on a support (``n_link``): an error.
 * ``MagneticBearingElement`` → ``[[amb]]`` with its geometry (turns, pole area, gap, bias,
   pole angle) and its factors: Ki = ROSS ``ki`` and Ks = −ROSS ``ks`` (ROSS stores the
   negative stiffness with its sign, ambseal the magnitude, P2 Eq. 1), actuator axes at
-  ROSS's ``sensors_axis_rotation``, sensor at the bearing (ROSS's AMB is collocated), no
+  ROSS's ``sensors_axis_rotation``, sensor at ROSS 3's ``sensor_node`` (at the bearing
+  where it has none: ROSS 2.3's AMB is collocated), no
   amplifier dynamics (``[actuator] model = "none"``). ROSS's PID C(s) = kp + ki/s +
   kd s/(1 + s/n_f), from sensor volts to amplifier volts, is the current per displacement
   k_amp k_sense C(s): → ``[controller.pid]`` (P5 Eq. 6) with Kp = k_amp k_sense kp,
@@ -76,7 +79,7 @@ from pathlib import Path
 import numpy as np
 from pydantic import ValidationError
 
-from ambseal.config import Pid, RigConfig, dump_rig, parse_rig
+from ambseal.config import MAX_SUPPORT_STIFFNESS, Pid, RigConfig, dump_rig, parse_rig
 from ambseal.errors import AmbsealError, ConfigError
 from ambseal.files import claim_file, read_text, stamp_text, write_text
 
@@ -247,9 +250,15 @@ def _at(el, name: str, omega: float) -> float:
     return float(np.asarray(f(omega), float))
 
 
-def _spring(el, z: float, i: int, varies: bool, omega: float) -> dict:
+def _spring(el, z: float, i: int, varies: bool, omega: float, notes: list) -> dict:
     names = ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy", "cxy", "cyx")
     vals = {n: (_at(el, n, omega) if varies else float(_coef(el, n)[0])) for n in names}
+    for n in ("kxx", "kyy"):
+        if vals[n] > MAX_SUPPORT_STIFFNESS:  # ROSS pins a node with a 1e20 N/m bearing
+            notes.append(f"bearing {i} ({el.tag}, node {el.n}): {n} = {vals[n]:.3g} N/m "
+                         f"taken as a pin, {MAX_SUPPORT_STIFFNESS:.0e} N/m (the rig file's "
+                         "stiffest support; the pinned shaft's frequencies to 1e-8)")
+            vals[n] = MAX_SUPPORT_STIFFNESS
     return {"name": _name(el.tag, f"bearing{i}"), "position": z, **vals}
 
 
@@ -292,13 +301,20 @@ def _pid(el) -> tuple[dict | None, str]:
     return pid, what
 
 
-def _amb(el, z: float, i: int) -> tuple[dict, dict | None, str]:
+def _amb(el, nodes: np.ndarray, i: int, where: str) -> tuple[dict, dict | None, str]:
     def pair(v):
         v = np.atleast_1d(np.asarray(v, float))
         return {"zeta": float(v[0]), "eta": float(v[-1])}
 
+    # ROSS 3's sensor_node: a sensor beside the actuator (ROSS 2.3's AMB is collocated)
+    sensor = getattr(el, "sensor_node", None)
+    sensor = el.n if sensor is None else int(sensor)
+    if not 0 <= sensor < len(nodes):
+        raise _bad(where, f"magnetic bearing {i} ({el.tag}): sensor_node {sensor} is off "
+                          f"the shaft (nodes 0–{len(nodes) - 1})")
     i0 = np.atleast_1d(np.asarray(el.i0, float))
-    entry = {"name": _name(el.tag, f"amb{i}"), "position": z, "sensor_position": z,
+    entry = {"name": _name(el.tag, f"amb{i}"), "position": float(nodes[el.n]),
+             "sensor_position": float(nodes[sensor]),
              "axes_angle_deg": math.degrees(float(el.sensors_axis_rotation)),
              "turns": int(round(float(el.nw))), "pole_area": float(el.ag),
              "air_gap": float(el.g0), "bias_current": float(i0.mean()),
@@ -380,7 +396,7 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
         if kind == "seal":
             rig["seal"].append(_seal(b, z, i, varies, omega))
             continue
-        rig["spring"].append(_spring(b, z, i, varies, omega))
+        rig["spring"].append(_spring(b, z, i, varies, omega, notes))
         if varies:
             notes.append(_one_frequency_note(i, b, omega, rpm, rule))
     tables = [s["name"] for s in rig["seal"] if isinstance(s["K"], dict)]
@@ -446,7 +462,7 @@ def _supports(bearings: list, nodes: np.ndarray, where: str, rig: dict,
         if b.n >= len(nodes):
             raise _bad(where, f"bearing {i} ({b.tag}) on node {b.n} off the shaft")
         if type(b).__name__ == "MagneticBearingElement":
-            entry, pid, what = _amb(b, float(nodes[b.n]), i)
+            entry, pid, what = _amb(b, nodes, i, where)
             rig["amb"].append(entry)
             pids.append((b.tag, pid, what))
         else:

@@ -93,6 +93,34 @@ def test_cli_no_traceback_in_a_real_process(tmp_path):
     assert "Traceback" not in proc.stderr and "shaft[0].length" in proc.stderr
 
 
+def test_a_dependencys_deprecation_notices_are_not_shown(tmp_path, monkeypatch):
+    """A command's warnings are shown after it, except a dependency's deprecation notices
+    (python-control's on NumPy 2.5 filled a plain ``ambseal run``'s stderr): those of
+    ambseal's own modules and any other warning still are."""
+    import warnings
+
+    import ambseal.app
+
+    def handler(args):
+        for module, category in (("control.statesp", DeprecationWarning),
+                                 ("numpy.linalg", FutureWarning),
+                                 ("ambseal.robust.hinf", DeprecationWarning)):
+            warnings.warn_explicit(f"{category.__name__} from {module}", category,
+                                   f"{module.replace('.', '/')}.py", 1, module=module)
+        warnings.warn("a RuntimeWarning of a solver", RuntimeWarning)
+        return 0
+
+    shown = []
+    monkeypatch.setitem(ambseal.app.HANDLERS, "validate", handler)
+    monkeypatch.setattr(warnings, "showwarning", lambda message, *a, **k: shown.append(
+        str(message)))  # (pytest records what reaches the real one)
+    rig = tmp_path / "rig.toml"
+    rig.write_text(GOOD)
+    assert main(["validate", str(rig)]) == 0
+    assert sorted(shown) == ["DeprecationWarning from ambseal.robust.hinf",
+                             "a RuntimeWarning of a solver"]
+
+
 def test_the_console_ignores_the_environments_matplotlib_backend(tmp_path):
     """ambseal draws on Agg canvases, never through pyplot: a backend matplotlib cannot
     load (MPLBACKEND named by a shell, a notebook kernel or a typo) stopped its import with

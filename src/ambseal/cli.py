@@ -546,6 +546,12 @@ def main(argv: list[str] | None = None) -> int:
         handler = HANDLERS[args.command]
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("default")
+        # a dependency's notice to its own users' code (python-control on NumPy 2.5: "Setting
+        # the shape on a NumPy array has been deprecated") is nothing a user of ambseal can
+        # act on; ambseal's own are shown
+        for category in (DeprecationWarning, PendingDeprecationWarning, FutureWarning):
+            warnings.filterwarnings("ignore", category=category)
+            warnings.filterwarnings("default", category=category, module=r"ambseal(\.|$)")
         try:
             _check_operating(args)
             with numerics_threads():

@@ -67,19 +67,21 @@ def examples(tmp_path_factory):
     folder = tmp_path_factory.mktemp("ross")
     out = {}
     for name in ("rotor_example", "compressor_example", "rotor_amb_example"):
-        if hasattr(rs, name):  # (ROSS 3 has no rotor_amb_example)
-            rotor = _quiet(getattr(rs, name))
-            _quiet(rotor.save, folder / f"{name}.toml")
-            out[name] = (rotor, folder / f"{name}.toml")
+        rotor = _quiet(_amb_example if name == "rotor_amb_example" else getattr(rs, name))
+        _quiet(rotor.save, folder / f"{name}.toml")
+        out[name] = (rotor, folder / f"{name}.toml")
     return out
 
 
-def _example(examples, name: str):
-    """ROSS's example ``name`` from :func:`examples`; the test is skipped, naming it, on
-    a ROSS without it."""
-    if name not in examples:
-        pytest.skip(f"ROSS {rs.__version__} has no {name}")
-    return examples[name]
+def _amb_example():
+    """ROSS's AMB test rig (Mendes 2015, doi.org/10.14393/ufu.di.2015.186): ROSS 2.3's
+    ``rotor_amb_example``, in ROSS 3 ``rotor_example_amb_general_controllers()`` of
+    ``ross.bearings.magnetic.amb_models`` (the same rotor, AMBs and PD controller)."""
+    if hasattr(rs, "rotor_amb_example"):
+        return rs.rotor_amb_example()
+    from ross.bearings.magnetic.amb_models import rotor_example_amb_general_controllers
+    return rotor_example_amb_general_controllers()
+
 
 
 def _bearing_rotor():
@@ -147,7 +149,7 @@ def test_rotor_rayleigh_damping_equals_ross(tmp_path):
 def test_rotor_example_file_modes_equal_ross(examples):
     """ROSS's ``rotor_example`` as saved (bearings tagged "Bearing 0", "Bearing 1", with a
     space): its 12 lateral modes up to 500 Hz at 0 and 3000 rpm equal ROSS's to 1e-6."""
-    rotor, path = _example(examples, "rotor_example")
+    rotor, path = examples["rotor_example"]
     imp = from_ross(load_ross(path), where=str(path))
     assert [s.name for s in imp.rig.spring] == ["Bearing_0", "Bearing_1"]
     for w in (0.0, 100 * np.pi):
@@ -163,7 +165,7 @@ def test_compressor_example_layers_and_frequency_dependent_bearings(examples):
     isotropic skew seals → seal tables. At 4000 rpm, and at 4500 rpm between the tables'
     points (springs then taken there), every lateral mode up to 2 kHz equals ROSS's to
     1e-6."""
-    rotor, path = _example(examples, "compressor_example")
+    rotor, path = examples["compressor_example"]
     loaded = load_ross(path)
     imp = from_ross(loaded, where=str(path))
     cfg = imp.rig
@@ -184,7 +186,7 @@ def test_compressor_example_layers_and_frequency_dependent_bearings(examples):
 def _amb_rotor(ki_pid: float):
     """ROSS's ``rotor_amb_example`` with the integral gain ``ki_pid`` in both AMBs' PID
     (ROSS's own has none)."""
-    ex = _quiet(rs.rotor_amb_example)
+    ex = _quiet(_amb_example)
     mbs = [_quiet(rs.MagneticBearingElement, n=b.n, g0=float(b.g0), i0=float(b.i0),
                   ag=float(b.ag), nw=float(b.nw), alpha=float(b.alpha),
                   kp_pid=float(b.kp_pid), kd_pid=float(b.kd_pid), ki_pid=ki_pid,
@@ -205,7 +207,7 @@ def test_amb_example_equivalent_bearings_equal_ross(examples, tmp_path, ki_pid):
     ROSS's own C(s)·k_amp·k_sense at every frequency, 1e-12), ROSS's C(s) otherwise — has
     ROSS's modes with that AMB model at ω = 1000 rad/s to 1e-6, ROSS's Rayleigh damping of
     the shaft elements (α = 2.5 1/s) imported with them."""
-    rotor, path = _example(examples, "rotor_amb_example")
+    rotor, path = examples["rotor_amb_example"]
     if ki_pid:
         rotor = _amb_rotor(ki_pid)
         path = tmp_path / "amb.toml"
@@ -248,14 +250,12 @@ def test_amb_example_equivalent_bearings_equal_ross(examples, tmp_path, ki_pid):
     _assert_modes_equal_ross(parse_rig(data), reference, w0, 1500.0, 12)
 
 
-@pytest.mark.skipif(not hasattr(rs, "rotor_amb_example"),
-                    reason="ROSS 3 has no rotor_amb_example")
 def test_amb_rotor_open_loop_unstable_poles_equal_ross():
     """ROSS's AMB test rig (``rotor_amb_example``, in memory): the open-loop unstable poles
     (the AMBs' negative stiffness alone) equal ROSS's frequency-domain AMB model with the
     controller term at zero — ROSS bearings of stiffness ks — on the same rotor, its
     shaft's Rayleigh damping included, to 1e-6."""
-    amb = _quiet(rs.rotor_amb_example)
+    amb = _quiet(_amb_example)
     imp = from_ross(amb)
     mbs = amb.bearing_elements
     assert sum("controller" in n for n in imp.unmapped) == 2  # the k(ω) model, the PID
@@ -344,7 +344,7 @@ def test_import_ross_stdout_is_the_json_only(examples, tmp_path):
     REFPROP banner from C on stdout), ``ambseal import-ross`` of the AMB example writes
     nothing but its JSON summary to stdout; the notes (what was left out, what was taken)
     go to stderr and into the rig file's header."""
-    _, path = _example(examples, "rotor_amb_example")
+    _, path = examples["rotor_amb_example"]
     out = tmp_path / "rig.toml"
     proc = subprocess.run([sys.executable, "-m", "ambseal.cli", "import-ross", str(path),
                            "--out", str(out)], capture_output=True, text=True,

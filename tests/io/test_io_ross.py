@@ -498,6 +498,44 @@ def test_multirotor_refused_and_a_gear_of_one_rotor_is_a_disk():
             assert abs(ref[j] - lam) <= 1e-6 * abs(lam)
 
 
+def test_elements_ambseal_cannot_take_are_each_named(tmp_path, capsys):
+    """ROSS's coupled rotor (its ``test_refine_keeps_couplings``: a flexible coupling
+    between two shaft elements), saved by ROSS:
+    ``import-ross`` exits 2 with no traceback, naming the coupling on a line of its own
+    (before: "2 shafts … a ROSS CoAxialRotor"); in memory the same. On ROSS 3, a rotor
+    with ROSS's induction motor (``motor_example``, which drives the torsional DOF only)
+    imports, the motor named once among what was left out."""
+    from ambseal.cli import main
+
+    steel = rs.materials.steel
+    coupling = rs.CouplingElement(m_l=10, m_r=10, Ip_l=0.1, Ip_r=0.1, kt_x=1e6, kr_x=1e6,
+                                  tag="C1")
+    shafts = [rs.ShaftElement(L=0.25, idl=0, odl=0.05, material=steel), coupling,
+              rs.ShaftElement(L=0.25, idl=0, odl=0.05, material=steel)]
+    bearings = [rs.BearingElement(n=n, kxx=1e6, cxx=1e3) for n in (0, 3)]
+    rotor = _quiet(rs.Rotor, shafts, bearing_elements=bearings)
+    src = tmp_path / "coupled.toml"
+    _quiet(rotor.save, src)
+    assert main(["import-ross", str(src), "--out", str(tmp_path / "rig.toml")]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and "CoAxialRotor" not in err
+    assert "1 element(s) ambseal cannot take" in err
+    assert [ln.strip() for ln in err.splitlines()[1:]] == [
+        "coupling C1 (nodes 1–2): a flexible coupling (stiffness kt, kr and masses lumped "
+        "on two nodes) has no ambseal equivalent"]
+    with pytest.raises(ConfigError, match="coupling C1 .nodes 1–2."):
+        from_ross(rotor)
+    if not hasattr(rs, "MotorElement"):
+        return
+    from ross.motors.motor_element import motor_example
+
+    plain = _bearing_rotor()
+    driven = _quiet(plain.add_elements, [_quiet(motor_example)])
+    imp = from_ross(driven)
+    assert sum(u.startswith("motor ") and "no lateral effect" in u for u in imp.unmapped) == 1
+    assert imp.rig == from_ross(plain).rig
+
+
 def _flags_rotor(shear: bool):
     """ROSS's ``rotor_example_6dof`` shaft (6 elements) with the rotary inertia and
     gyroscopic terms switched off element by element in every combination, two disks, on

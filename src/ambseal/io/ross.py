@@ -30,7 +30,10 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
 * ``DiskElement`` → ``[[disk]]`` (m, Ip, Id); a ``PointMass`` on a shaft node → a disk
   without inertia; a gear of a single rotor (ROSS 3's ``GearElement``) → a disk (no gear
   mesh acts on it). A ROSS 3 ``MultiRotor`` (rotors joined by a gear mesh): an error
-  naming its rotors.
+  naming its rotors. A ``CouplingElement`` (stiffness and masses lumped on two nodes) or
+  any other element without an equivalent: an error naming each, one line each; ROSS 3's
+  ``MotorElement`` (its induction-motor model drives the torsional DOF only): named among
+  what is left out.
 * ``BearingElement`` and its kinds (``SealElement``, fluid-film, ball, ...): coefficients of
   the isotropic, skew form (kxx = kyy, kxy = −kyx, cxx = cyy, cxy = −cyx, mxx = myy, no cross
   mass) → ``[[seal]]`` with K = kxx, k = kxy, C = cxx, c = cxy, M = mxx (Childs'
@@ -370,17 +373,13 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
         raise _bad(where, f"a ROSS MultiRotor ({tags}) has several shafts coupled by a "
                           "gear mesh; an ambseal rig has one shaft and no gear mesh: import "
                           "each rotor on its own (its gear becomes a disk)")
-    # a gear of a single rotor is a disk with teeth: its mass and inertias are imported
-    known = {"ShaftElement", "DiskElement", "PointMass", "GearElement", "GearElementTVMS"}
     bearings = list(getattr(rotor, "bearing_elements", []))
-    for el in getattr(rotor, "elements", []):
-        kind = type(el).__name__
-        if kind not in known and not any(el is b for b in bearings):
-            raise _bad(where, f"unsupported element {kind} ({getattr(el, 'tag', '')}) with "
-                              "no ambseal equivalent")
+    refused, unmapped = _elements(rotor, bearings)
+    if refused:
+        raise _bad(where, f"{len(refused)} element(s) ambseal cannot take (each would change "
+                          "the dynamics):\n" + "\n".join(f"  {r}" for r in refused))
     damping = _rotor_damping(rotor, where)
     shaft, mats, beam = _shaft(rotor, where, elemental=not damping)
-    unmapped: list[str] = []
     nodes = np.concatenate([[0.0], np.cumsum([s["length"] for s in shaft])])
     rig: dict = {"rotor": {"beam": beam, "name": name or str(getattr(rotor, "tag", None)
                                                             or "ROSS rotor"), **damping},
@@ -416,6 +415,35 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
                         "closes the loop with the controller's dynamics")
         _controller(rig, pids, unmapped, notes)
     return RossImport(parse_rig(rig, where), tuple(unmapped), tuple(notes))
+
+
+#: Element classes imported: a gear of a single rotor is a disk with teeth (its mass and
+#: inertias; no gear mesh acts on it).
+_IMPORTED = {"ShaftElement", "DiskElement", "PointMass", "GearElement", "GearElementTVMS"}
+
+
+def _elements(rotor, bearings: list) -> tuple[list[str], list[str]]:
+    """The rotor's elements that are neither imported nor bearings: those that would change
+    the lateral dynamics (refused, one line each) and those that do not (named, one line
+    each, in ``unmapped``)."""
+    refused, unmapped = [], []
+    for el in getattr(rotor, "elements", []):
+        kind, tag = type(el).__name__, getattr(el, "tag", "")
+        if kind in _IMPORTED or any(el is b for b in bearings):
+            continue
+        if kind == "MotorElement":  # ROSS 3: not a structural element (its docstring)
+            unmapped.append(f"motor {tag} (node {getattr(el, 'n', '?')}): ROSS's induction-"
+                            "motor model drives the torsional DOF only (no mass, stiffness "
+                            "or damping in the rotor's matrices): not imported, no lateral "
+                            "effect")
+        elif kind == "CouplingElement":
+            n = getattr(el, "n", None)
+            refused.append(f"coupling {tag} (nodes {n}–{n + 1 if n is not None else '?'}): "
+                           "a flexible coupling (stiffness kt, kr and masses lumped on two "
+                           "nodes) has no ambseal equivalent")
+        else:
+            refused.append(f"{kind} {tag}: no ambseal equivalent")
+    return refused, unmapped
 
 
 def _rotor_damping(rotor, where: str) -> dict:
@@ -632,7 +660,9 @@ def _check_file(path: Path, ross=None) -> dict:
         if kind == "ShaftElement" and not isinstance(val.get("material"), dict):
             raise ConfigError(f"{path}: {key}: missing material (expected a table "
                               f"[\"{key}\".material] with rho, E, G_s)")
-    pairs = [v.get("n") for k, v in data.items() if k.startswith("ShaftElement_")]
+    # a coupling sits between shaft elements on a node pair of its own: the shaft runs on
+    pairs = [v.get("n") for k, v in data.items()
+             if k.startswith(("ShaftElement_", "CouplingElement_"))]
     if pairs and all(isinstance(n, int) and not isinstance(n, bool) for n in pairs):
         _one_shaft(pairs, str(path))
     return data

@@ -83,6 +83,25 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                                            "α·M (ROSS's shaft element ``alpha``)"),
     "ShaftSection.rayleigh_beta": ("s", "the section's tube's own Rayleigh damping β·K "
                                         "(ROSS's shaft element ``beta``)"),
+    "ShaftSection.coupling": ("", "the section is a flexible coupling (ROSS's "
+                                  "``CouplingElement``), not a beam: its halves' inertia on its "
+                                  "end nodes, joined by the springs and dampers below; one "
+                                  "element, no layers, nothing placed inside it; its "
+                                  "diameter and material only draw it"),
+    "ShaftCoupling.m_left": ("kg", "mass of the coupling's left half, on the left node"),
+    "ShaftCoupling.m_right": ("kg", "mass of the right half, on the right node"),
+    "ShaftCoupling.Ip_left": ("kg·m²", "polar inertia of the left half (gyroscopics)"),
+    "ShaftCoupling.Ip_right": ("kg·m²", "polar inertia of the right half"),
+    "ShaftCoupling.Id_left": ("kg·m²", "diametral inertia of the left half"),
+    "ShaftCoupling.Id_right": ("kg·m²", "diametral inertia of the right half"),
+    "ShaftCoupling.kt_x": ("N/m", "translational stiffness between the halves, x"),
+    "ShaftCoupling.kt_y": ("N/m", "translational stiffness between the halves, y"),
+    "ShaftCoupling.kr_x": ("N·m/rad", "rotational (angular misalignment) stiffness about x"),
+    "ShaftCoupling.kr_y": ("N·m/rad", "rotational stiffness about y"),
+    "ShaftCoupling.ct_x": ("N·s/m", "translational damping between the halves, x"),
+    "ShaftCoupling.ct_y": ("N·s/m", "translational damping between the halves, y"),
+    "ShaftCoupling.cr_x": ("N·m·s/rad", "rotational damping about x"),
+    "ShaftCoupling.cr_y": ("N·m·s/rad", "rotational damping about y"),
     "ShaftSection.layers": ("", "concentric tubes on the section's nodes, in parallel with "
                                 "its own (a sleeve, a hub; ROSS's layered elements)"),
     "ShaftLayer.outer_diameter": ("m", "outer diameter of the layer"),
@@ -505,6 +524,10 @@ def _sections() -> list[Section]:
         Section("{ outer_diameter, inner_diameter, material }", r.ShaftLayer, "A layer of "
                 "a ``[[shaft]]`` section (``layers = [{ ... }, ...]``): a tube of its own "
                 "material and shear parameter whose beam matrices add to the section's."),
+        Section("{ m_left, m_right, kt_x, kr_x, ... }", r.ShaftCoupling, "The ``coupling`` "
+                "of a ``[[shaft]]`` section that is a flexible coupling (``coupling = "
+                "{ ... }``): each half's inertia on its end node, the halves joined by "
+                "springs and dampers."),
         Section("{ frequency_hz, value }", r.FrequencyTable, "A seal coefficient tabulated "
                 "against excitation frequency, of equal lengths."),
         Section("[truth]", r.TruthSection, "The truth file of the virtual test facility "

@@ -182,6 +182,38 @@ def test_rayleigh_damping_closed_form_and_per_tube(alpha, beta):
     np.testing.assert_allclose(real[1], real[0], rtol=1e-9, atol=1e-9 * np.abs(a).max())
 
 
+def test_coupling_element_two_body_frequencies_and_nothing_inside():
+    """A flexible coupling alone (two rigid halves m1, m2, Id1, Id2 joined by kt_x, kt_y,
+    kr_x, kr_y) has the two-body frequencies ω² = k(1/m1 + 1/m2) in x and y and
+    ω² = kr(1/Id1 + 1/Id2) about x and y, besides four rigid-body zeros; a rig with a disk
+    inside a coupling section is refused naming it, and a rig with a coupling reads back
+    from its dumped TOML unchanged."""
+    from ambseal.config import dump_rig
+    from ambseal.errors import ConfigError
+    from ambseal.model.fe import CouplingElement
+
+    c = CouplingElement(0.2, m_left=3.0, m_right=5.0, Id_left=0.02, Id_right=0.04,
+                        kt_x=1e6, kt_y=4e5, kr_x=3e4, kr_y=1e4)
+    w = np.sort(np.sqrt(np.clip(sla.eigh(c.K(), c.M(), eigvals_only=True), 0, None)))
+    ref = np.sort(np.concatenate([np.zeros(4), np.sqrt([
+        1e6 * (1 / 3 + 1 / 5), 4e5 * (1 / 3 + 1 / 5), 3e4 * (1 / 0.02 + 1 / 0.04),
+        1e4 * (1 / 0.02 + 1 / 0.04)])]))
+    np.testing.assert_allclose(w, ref, rtol=1e-10, atol=1e-4)  # (zeros to rounding)
+    coupling = {"m_left": 3.0, "m_right": 5.0, "Ip_left": 0.04, "kt_x": 1e6, "kt_y": 1e6,
+                "kr_x": 3e4, "kr_y": 3e4}
+    shaft = [{"length": 0.3, "outer_diameter": 0.05, "material": "steel", "elements": 3},
+             {"length": 0.2, "outer_diameter": 0.08, "material": "steel",
+              "coupling": coupling},
+             {"length": 0.3, "outer_diameter": 0.05, "material": "steel", "elements": 3}]
+    data = {"materials": {"steel": {"E": E, "rho": RHO, "nu": NU}}, "shaft": shaft}
+    cfg = parse_rig(data)
+    assert parse_rig(__import__("tomllib").loads(dump_rig(cfg))) == cfg
+    assert assemble_rotor(cfg).mass == pytest.approx(cfg.shaft[0].length * 2 * RHO * np.pi
+                                                     * 0.05 ** 2 / 4 + 8.0, rel=1e-12)
+    with pytest.raises(ConfigError, match=r"shaft\[1\]\.coupling: a component at z = 0.4 m"):
+        build_system(parse_rig({**data, "disk": [{"position": 0.4, "mass": 1.0}]}))
+
+
 def test_seal_cross_coupling_destabilises_forward_whirl():
     """Childs' convention (−f = [K k; −k K] q + ...): a positive k pushes the rotor round in
     the direction of rotation, so it takes damping from the forward-whirl mode and gives it

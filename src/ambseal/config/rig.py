@@ -27,7 +27,11 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     ``outer_diameter_right``, ``inner_diameter_right`` (m, default: the left end's): a
     tapered (conical) tube, its diameters linear along the section; ``rayleigh_alpha``
     (1/s), ``rayleigh_beta`` (s): the tube's own Rayleigh damping α·M + β·K (default 0;
-    ROSS's shaft element ``alpha``, ``beta``).
+    ROSS's shaft element ``alpha``, ``beta``); ``coupling`` (a table ``{ m_left, m_right,
+    Ip_left, Ip_right, Id_left, Id_right, kt_x, kt_y, kr_x, kr_y, ct_x, ct_y, cr_x, cr_y }``
+    in kg, kg·m², N/m, N·m/rad, N·s/m, N·m·s/rad): the section is a flexible coupling, its
+    halves' inertia on its end nodes joined by those springs and dampers, instead of a
+    beam (one element, no layers; its diameters and material only draw it).
 ``[[disk]]``
     ``position`` (m), ``mass`` (kg), ``Ip``, ``Id`` (kg·m²), ``name`` (optional).
 ``[[amb]]``
@@ -235,6 +239,28 @@ def _check_bore(tube) -> None:
                          f"outer_diameter_right ({do_r:g} m) (a tapered tube's right end)")
 
 
+class ShaftCoupling(_Strict):
+    """A flexible coupling in place of a section's beam (ROSS's ``CouplingElement``): a
+    rigid body of each half on the section's end nodes (mass, polar and diametral inertia)
+    joined by springs and dampers between the two nodes, translational in x and y and
+    rotational about x (α) and y (β)."""
+
+    m_left: float = Field(default=0.0, ge=0, le=1e6)
+    m_right: float = Field(default=0.0, ge=0, le=1e6)
+    Ip_left: float = Field(default=0.0, ge=0, le=1e6)
+    Ip_right: float = Field(default=0.0, ge=0, le=1e6)
+    Id_left: float = Field(default=0.0, ge=0, le=1e6)
+    Id_right: float = Field(default=0.0, ge=0, le=1e6)
+    kt_x: float = Field(default=0.0, ge=0, le=MAX_SUPPORT_STIFFNESS)
+    kt_y: float = Field(default=0.0, ge=0, le=MAX_SUPPORT_STIFFNESS)
+    kr_x: float = Field(default=0.0, ge=0, le=MAX_SUPPORT_STIFFNESS)
+    kr_y: float = Field(default=0.0, ge=0, le=MAX_SUPPORT_STIFFNESS)
+    ct_x: float = Field(default=0.0, ge=0, le=1e12)
+    ct_y: float = Field(default=0.0, ge=0, le=1e12)
+    cr_x: float = Field(default=0.0, ge=0, le=1e12)
+    cr_y: float = Field(default=0.0, ge=0, le=1e12)
+
+
 class ShaftSection(_Strict):
     length: float = Field(ge=1e-4, le=100.0)
     outer_diameter: float = Field(ge=1e-4, le=10.0)
@@ -252,10 +278,14 @@ class ShaftSection(_Strict):
     inner_diameter_right: float | None = Field(default=None, ge=0)
     rayleigh_alpha: float = Field(default=0.0, ge=0, le=MAX_RAYLEIGH_ALPHA)
     rayleigh_beta: float = Field(default=0.0, ge=0, le=MAX_RAYLEIGH_BETA)
+    coupling: ShaftCoupling | None = None
 
     @model_validator(mode="after")
     def _bore(self) -> "ShaftSection":
         _check_bore(self)
+        if self.coupling is not None and (self.elements != 1 or self.layers):
+            raise ValueError("coupling: a coupling section is one element without layers "
+                             f"(got elements = {self.elements}, {len(self.layers)} layers)")
         # the diameters run linearly from end to end: tubes apart at both ends are apart
         # everywhere between
         for end, ends in (("left", [(t.outer_diameter, t.inner_diameter)

@@ -30,8 +30,10 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
 * ``DiskElement`` → ``[[disk]]`` (m, Ip, Id); a ``PointMass`` on a shaft node → a disk
   without inertia; a gear of a single rotor (ROSS 3's ``GearElement``) → a disk (no gear
   mesh acts on it). A ROSS 3 ``MultiRotor`` (rotors joined by a gear mesh): an error
-  naming its rotors. A ``CouplingElement`` (stiffness and masses lumped on two nodes) or
-  any other element without an equivalent: an error naming each, one line each; ROSS 3's
+  naming its rotors. A ``CouplingElement`` → a ``[[shaft]]`` section of its length with a
+  ``coupling`` (its halves' mass and inertia, lateral springs and dampers; the axial and
+  torsional ones have no lateral effect). Any element without an equivalent: an error
+  naming each, one line each; ROSS 3's
   ``MotorElement`` (its induction-motor model drives the torsional DOF only): named among
   what is left out.
 * ``BearingElement`` and its kinds (``SealElement``, fluid-film, ball, ...): coefficients of
@@ -170,13 +172,21 @@ def _shaft(rotor, where: str, elemental: bool = True) -> tuple[list[dict], dict,
     """``[[shaft]]`` sections (one per node pair, layered elements as ``layers``), the
     materials and the beam type; ``elemental``: each element's Rayleigh damping taken
     (ROSS ignores it where the rotor has its own)."""
-    shafts = sorted(rotor.shaft_elements, key=lambda e: (e.n, e.idl))
-    _one_shaft([int(el.n) for el in shafts], where)
+    line = sorted(rotor.shaft_elements, key=lambda e: (e.n, getattr(e, "idl", 0.0)))
+    _one_shaft([int(el.n) for el in line], where)
+    couplings = {int(el.n): el for el in line if type(el).__name__ == "CouplingElement"}
+    crowded = [n for n in sorted(couplings) if sum(int(e.n) == n for e in line) > 1]
+    if crowded:
+        raise _bad(where, f"coupling {couplings[crowded[0]].tag}: it shares node pair "
+                          f"{crowded[0]} with another element (a coupling spans a node pair "
+                          "alone)")
+    shafts = [el for el in line if int(el.n) not in couplings]
     pairs: dict[int, list] = {}
     for el in shafts:
         _check_element(el, where)
         pairs.setdefault(int(el.n), []).append(el)
-    missing = sorted(set(range(max(pairs, default=-1) + 1)) - set(pairs))
+    on = set(pairs) | set(couplings)
+    missing = sorted(set(range(max(on, default=-1) + 1)) - on)
     if not pairs or missing:
         raise _bad(where, "shaft elements: expected elements on every node pair from node 0, "
                           f"left to right (none on node pair(s) {missing[:5]} or none at all)")
@@ -187,7 +197,10 @@ def _shaft(rotor, where: str, elemental: bool = True) -> tuple[list[dict], dict,
         raise _bad(where, "shaft elements mix shear_effects True and False (one beam type "
                           "per rig)")
     out = []
-    for n in sorted(pairs):
+    for n in sorted(on):
+        if n in couplings:
+            out.append(_coupling(couplings[n], keys[0]))
+            continue
         group = pairs[n]
         if not all(math.isclose(e.L, group[0].L, rel_tol=1e-9) for e in group):
             raise _bad(where, f"shaft elements on node pair {n} "
@@ -207,6 +220,18 @@ def _shaft(rotor, where: str, elemental: bool = True) -> tuple[list[dict], dict,
         out.append(section)
     beam = "timoshenko" if shear == {True} else "euler-bernoulli"
     return out, mats, beam
+
+
+def _coupling(el, material: str) -> dict:
+    """A ``[[shaft]]`` section of a ROSS ``CouplingElement``: its length and diameter draw
+    it (ROSS's ``L``, ``o_d``), its halves and lateral springs and dampers are the
+    ``coupling`` (ROSS's ``_l``/``_r`` as ``_left``/``_right``); its axial and torsional
+    ones (``kt_z``, ``kr_z``, ``ct_z``, ``cr_z``) have no lateral effect."""
+    keys = {f"{a}_{side}": f"{a}_{s}" for a in ("m", "Ip", "Id")
+            for s, side in (("l", "left"), ("r", "right"))}
+    keys |= {k: k for k in ("kt_x", "kt_y", "kr_x", "kr_y", "ct_x", "ct_y", "cr_x", "cr_y")}
+    return {"length": float(el.L), "outer_diameter": float(el.o_d), "material": material,
+            "elements": 1, "coupling": {k: float(getattr(el, v)) for k, v in keys.items()}}
 
 
 def _isotropic_skew(c: dict[str, np.ndarray]) -> bool:
@@ -419,7 +444,8 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
 
 #: Element classes imported: a gear of a single rotor is a disk with teeth (its mass and
 #: inertias; no gear mesh acts on it).
-_IMPORTED = {"ShaftElement", "DiskElement", "PointMass", "GearElement", "GearElementTVMS"}
+_IMPORTED = {"ShaftElement", "CouplingElement", "DiskElement", "PointMass", "GearElement",
+             "GearElementTVMS"}
 
 
 def _elements(rotor, bearings: list) -> tuple[list[str], list[str]]:
@@ -436,11 +462,6 @@ def _elements(rotor, bearings: list) -> tuple[list[str], list[str]]:
                             "motor model drives the torsional DOF only (no mass, stiffness "
                             "or damping in the rotor's matrices): not imported, no lateral "
                             "effect")
-        elif kind == "CouplingElement":
-            n = getattr(el, "n", None)
-            refused.append(f"coupling {tag} (nodes {n}–{n + 1 if n is not None else '?'}): "
-                           "a flexible coupling (stiffness kt, kr and masses lumped on two "
-                           "nodes) has no ambseal equivalent")
         else:
             refused.append(f"{kind} {tag}: no ambseal equivalent")
     return refused, unmapped

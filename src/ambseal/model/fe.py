@@ -9,7 +9,8 @@ Sources: Nelson, "A finite rotating shaft element using Timoshenko beam theory",
 Des. 102 (1980); Friswell, Penny, Garvey & Lees, *Dynamics of Rotating Machines*, CUP 2010,
 §5.4–5.5 (Timoshenko element matrices with the shear parameter Φ = 12EI/(κGAL²)); the
 shear coefficient of a hollow circular section from Hutchinson (2001).
-Every element owns its ``M()``, ``K()``, ``G()`` and DOF mapping; the rotor only assembles.
+Every element owns its ``M()``, ``K()``, ``G()``, ``C()`` and DOF mapping; the rotor only
+assembles.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["BeamElement", "LayeredBeam", "DiskElement", "shear_coefficient"]
+__all__ = ["BeamElement", "CouplingElement", "LayeredBeam", "DiskElement", "shear_coefficient"]
 
 # Node-DOF index of each plane coordinate: x-plane (x, β) and y-plane (y, −α).
 _X, _Y, _A, _B = 0, 1, 2, 3
@@ -396,6 +397,74 @@ class LayeredBeam:
     def C(self) -> np.ndarray:
         """Damping matrix (8, 8): the sum of the tubes' Rayleigh damping."""
         return sum(t.C() for t in self.tubes)
+
+
+@dataclass(frozen=True)
+class CouplingElement:
+    """A flexible coupling between two nodes (ROSS's ``CouplingElement``): each half a rigid
+    body on its node (mass, diametral and polar inertia, as :class:`DiskElement`), the two
+    nodes joined by springs and dampers, translational in x, y and rotational about x (α)
+    and y (β): K = [[k, −k], [−k, k]] with k = diag(kt_x, kt_y, kr_x, kr_y), C alike.
+
+    Parameters
+    ----------
+    length : float
+        Distance between its nodes (m); no stiffness depends on it.
+    m_left, m_right, Ip_left, Ip_right, Id_left, Id_right : float
+        Each half's mass (kg) and polar and diametral inertia (kg·m²).
+    kt_x, kt_y, kr_x, kr_y : float
+        Translational (N/m) and rotational (N·m/rad) stiffness between the nodes.
+    ct_x, ct_y, cr_x, cr_y : float
+        The same dampers (N·s/m, N·m·s/rad).
+    """
+
+    length: float
+    m_left: float = 0.0
+    m_right: float = 0.0
+    Ip_left: float = 0.0
+    Ip_right: float = 0.0
+    Id_left: float = 0.0
+    Id_right: float = 0.0
+    kt_x: float = 0.0
+    kt_y: float = 0.0
+    kr_x: float = 0.0
+    kr_y: float = 0.0
+    ct_x: float = 0.0
+    ct_y: float = 0.0
+    cr_x: float = 0.0
+    cr_y: float = 0.0
+
+    @property
+    def mass(self) -> float:
+        """Both halves' mass (kg)."""
+        return self.m_left + self.m_right
+
+    def _halves(self, f) -> np.ndarray:
+        out = np.zeros((8, 8))
+        out[:4, :4] = f(DiskElement(self.m_left, self.Ip_left, self.Id_left))
+        out[4:, 4:] = f(DiskElement(self.m_right, self.Ip_right, self.Id_right))
+        return out
+
+    @staticmethod
+    def _link(k) -> np.ndarray:
+        d = np.diag(k)
+        return np.block([[d, -d], [-d, d]])
+
+    def M(self) -> np.ndarray:
+        """Mass matrix (8, 8): the halves' on their nodes."""
+        return self._halves(DiskElement.M)
+
+    def G(self) -> np.ndarray:
+        """Gyroscopic matrix (8, 8) per unit spin speed: the halves' polar inertia."""
+        return self._halves(DiskElement.G)
+
+    def K(self) -> np.ndarray:
+        """Stiffness matrix (8, 8) between the nodes' x, y, α, β."""
+        return self._link([self.kt_x, self.kt_y, self.kr_x, self.kr_y])
+
+    def C(self) -> np.ndarray:
+        """Damping matrix (8, 8) between the nodes' x, y, α, β."""
+        return self._link([self.ct_x, self.ct_y, self.cr_x, self.cr_y])
 
 
 @dataclass(frozen=True)

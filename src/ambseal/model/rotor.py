@@ -24,7 +24,7 @@ import scipy.linalg as sla
 from ambseal.config import MAX_ELEMENTS, RigConfig
 from ambseal.errors import ConfigError, ModelError
 from ambseal.lti import ArrayMemo
-from ambseal.model.fe import BeamElement, DiskElement, LayeredBeam
+from ambseal.model.fe import BeamElement, CouplingElement, DiskElement, LayeredBeam
 
 __all__ = ["Mesh", "build_mesh", "RotorMatrices", "assemble_rotor", "dof"]
 
@@ -38,19 +38,19 @@ def dof(node: int, direction: int) -> int:
 
 @dataclass(frozen=True)
 class Mesh:
-    """Node positions and the beam elements between them.
+    """Node positions and the elements between them.
 
     Attributes
     ----------
     z : ndarray, shape (n_nodes,)
         Node positions (m) from the shaft's left end.
-    elements : tuple of BeamElement or LayeredBeam
+    elements : tuple of BeamElement, LayeredBeam or CouplingElement
         ``elements[e]`` joins nodes ``e`` and ``e + 1`` (a section with ``layers``: all its
-        tubes).
+        tubes; a ``coupling`` section: the coupling).
     """
 
     z: np.ndarray
-    elements: tuple[BeamElement | LayeredBeam, ...]
+    elements: tuple[BeamElement | LayeredBeam | CouplingElement, ...]
 
     @property
     def n_nodes(self) -> int:
@@ -120,12 +120,21 @@ def build_mesh(cfg: RigConfig, extra_positions: tuple[float, ...] = ()) -> Mesh:
     tol = _snap(length)
 
     z_nodes = [0.0]
-    elements: list[BeamElement | LayeredBeam] = []
+    elements: list[BeamElement | LayeredBeam | CouplingElement] = []
     z0 = 0.0
-    for sec in cfg.shaft:
+    for i, sec in enumerate(cfg.shaft):
         z1 = z0 + sec.length
         cuts = set(np.linspace(z0, z1, sec.elements + 1)[1:-1].tolist())
         cuts |= {p for p in positions if z0 + tol < p < z1 - tol}
+        if sec.coupling is not None:
+            if cuts:  # its two halves sit on its end nodes: nothing lies between them
+                raise ConfigError(f"shaft[{i}].coupling: a component at z = {min(cuts):g} m "
+                                  f"lies inside the coupling ({z0:g}–{z1:g} m); place it on "
+                                  "a shaft section")
+            elements.append(CouplingElement(length=sec.length, **sec.coupling.model_dump()))
+            z_nodes.append(z1)
+            z0 = z1
+            continue
         left = z0
         for p in sorted(cuts) + [z1]:
             if p - left < tol or (p < z1 and z1 - p < tol):

@@ -498,6 +498,37 @@ def test_multirotor_refused_and_a_gear_of_one_rotor_is_a_disk():
             assert abs(ref[j] - lam) <= 1e-6 * abs(lam)
 
 
+@pytest.mark.skipif("speed" not in __import__("inspect").signature(
+    rs.BearingElement.__init__).parameters,
+    reason="ROSS < 3: no coefficient tables over speed and frequency")
+def test_tables_over_speed_and_whirl_frequency_equal_ross():
+    """ROSS 3 tables over speed and whirl frequency (PCHIP on both axes): an isotropic skew
+    seal (K, k, C of both axes) and an anisotropic bearing on ROSS's ``rotor_example``.
+    The seal becomes a table at the points of both axes (ROSS's values with whirl frequency
+    = speed), the bearing a spring at the import speed; every lateral mode up to 500 Hz and
+    its log decrement equal ROSS's synchronous ones to 1e-6 at the import speed and, for
+    the seal, at a point of either axis."""
+    speed, freq = np.array([100.0, 300.0, 500.0]), np.array([150.0, 400.0])
+    grid = np.add.outer(speed, 2 * freq)  # a coefficient that varies along both axes
+    seal = rs.BearingElement(n=3, kxx=2e6 + 1e3 * grid, kyy=2e6 + 1e3 * grid,
+                             kxy=5e5 + 50 * grid, kyx=-(5e5 + 50 * grid), cxx=80 + 0.1 * grid,
+                             cyy=80 + 0.1 * grid, speed=speed, frequency=freq, tag="seal")
+    bearings = [rs.BearingElement(n=n, kxx=1e6 + 2e2 * grid, kyy=8e5 + 1e2 * grid,
+                                  cxx=150.0 + 0.05 * grid, cyy=90.0 + 0.05 * grid,
+                                  speed=speed, frequency=freq, tag=f"B{n}") for n in (0, 6)]
+    ex = rs.rotor_example()
+    rotor = _quiet(rs.Rotor, ex.shaft_elements, ex.disk_elements, [*bearings, seal])
+    imp = from_ross(rotor)
+    cfg = imp.rig
+    assert [s.name for s in cfg.seal] == ["seal"] and len(cfg.spring) == 2
+    assert cfg.seal[0].K.frequency_hz == pytest.approx(
+        list(np.unique(np.r_[speed, freq]) / (2 * np.pi)), rel=1e-12)
+    _assert_log_decrements_equal_ross(cfg, rotor, cfg.operating.speed_rpm)
+    for w in (300.0, 400.0):  # seal tables' points (the springs taken there too)
+        at = from_ross(rotor, speed_rpm=w * 30 / np.pi).rig
+        _assert_log_decrements_equal_ross(at, rotor, w * 30 / np.pi)
+
+
 def _coupled_rotor(**link):
     """ROSS's coupled rotor (its ``test_refine_keeps_couplings``: a flexible coupling
     between two shaft elements, on two damped bearings), the coupling's springs and dampers

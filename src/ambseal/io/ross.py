@@ -246,10 +246,6 @@ def _isotropic_skew(c: dict[str, np.ndarray]) -> bool:
 def _kind(el, where: str, i: int) -> tuple[str, bool]:
     """("seal" | "spring", whether its coefficients change with frequency) of a ROSS
     bearing or seal."""
-    if getattr(el, "speed", None) is not None and getattr(el, "frequency", None) is not None:
-        raise _bad(where, f"bearing {i} ({el.tag}, node {el.n}): coefficients tabulated "
-                          "against both speed and whirl frequency (a ROSS 3 2-D table) are "
-                          "not supported: give them against speed or against frequency")
     c = {n: _coef(el, n) for n in _COEFFS}
     varies = not all(np.allclose(v, v[0], rtol=1e-12, atol=0.0) for v in c.values())
     if _isotropic_skew(c):
@@ -263,16 +259,19 @@ def _kind(el, where: str, i: int) -> tuple[str, bool]:
 
 
 def _axis(el) -> np.ndarray:
-    """The table axis (rad/s) of a bearing's coefficients: ROSS 2.3's ``frequency``, or
-    ROSS 3's ``speed`` (its ``frequency`` is then the whirl frequency; a table over both
-    is refused by :func:`_kind`). Either is evaluated at the synchronous frequency."""
-    speed = getattr(el, "speed", None)
-    return np.atleast_1d(np.asarray(el.frequency if speed is None else speed, float))
+    """The points (rad/s) at which a bearing's coefficient table is taken: ROSS 2.3's
+    ``frequency``; ROSS 3's ``speed`` or ``frequency`` (whirl), or for a table over both
+    the points of both axes. ambseal evaluates every table at the synchronous frequency,
+    as ROSS's synchronous analyses do (whirl frequency = speed), so ROSS's interpolant
+    there is the table's value (:func:`_at`)."""
+    axes = [np.atleast_1d(np.asarray(a, float)) for a in
+            (getattr(el, "speed", None), getattr(el, "frequency", None)) if a is not None]
+    return np.unique(np.concatenate(axes))
 
 
 def _at(el, name: str, omega: float) -> float:
     """ROSS's own value of a coefficient at ``omega`` (rad/s): the interpolant its
-    ``run_modal`` evaluates."""
+    ``run_modal`` evaluates (ROSS 3: at speed and whirl frequency ``omega``)."""
     f = getattr(el, f"{name}_interpolated", None)
     if f is None:
         return float(_coef(el, name)[0])

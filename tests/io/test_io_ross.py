@@ -315,6 +315,28 @@ def test_import_ross_cli_round_trip_and_bad_files(tmp_path, capsys):
     assert err.startswith(f"ambseal: error: {src}: --speed-rpm") and "testrig" not in err
 
 
+def test_a_file_of_a_newer_ross_is_refused_naming_both_versions(examples, tmp_path, capsys):
+    """A rotor file written by a newer ROSS major than the one installed (here ROSS's own
+    ``rotor_example`` file with its ``ross_version`` one major up, as a ROSS 3.1 file is
+    to ROSS 2.3): ``import-ross`` exits 2 naming both versions and what to install,
+    instead of ROSS's own error on the newer keys ("not a ROSS rotor file (TypeError:
+    Rotor.__init__() got an unexpected keyword argument 'default_damping_ratio')")."""
+    from ambseal.cli import main
+
+    newer = f"{int(rs.__version__.split('.')[0]) + 1}.0.0"
+    text = examples["rotor_example"][1].read_text()
+    assert f'ross_version = "{rs.__version__}"' in text
+    src = tmp_path / "newer.toml"
+    src.write_text(text.replace(f'ross_version = "{rs.__version__}"',
+                                f'ross_version = "{newer}"'))
+    assert main(["import-ross", str(src), "--out", str(tmp_path / "rig.toml")]) == 2
+    err = capsys.readouterr().err
+    assert err == (f"ambseal: error: {src}: saved by ROSS {newer}, which the installed ROSS "
+                   f"{rs.__version__} cannot read: install ROSS {newer.split('.')[0]} (ROSS 3 needs "
+                   "Python 3.12 or newer; ambseal's 'ross' extra picks the ROSS of its "
+                   "Python) and import again\n")
+
+
 def test_import_chatter_goes_to_stderr(capfd):
     """What a library writes to stdout while ROSS is imported — from Python, at the file
     descriptor, or through C's buffered stdio as CoolProp's REFPROP banner does — ends up

@@ -670,6 +670,14 @@ def _check_file(path: Path, ross=None) -> dict:
         raise ConfigError(f"{path}: not a ROSS rotor file ({exc})") from None
     if not isinstance(data, dict) or not isinstance(data.get("parameters"), dict):
         raise ConfigError(f"{path}: not a ROSS rotor file (no 'parameters' table)")
+    saved, have = _major(data.get("ross_version")), _major(getattr(ross, "__version__", None))
+    if saved is not None and have is not None and saved > have:
+        # ROSS 3 changed the file (rotor-level damping, tables against speed): ROSS 2 fails
+        # on it with a TypeError or a shape error that names neither version
+        raise ConfigError(f"{path}: saved by ROSS {data['ross_version']}, which the installed "
+                          f"ROSS {ross.__version__} cannot read: install ROSS {saved} (ROSS 3 "
+                          "needs Python 3.12 or newer; ambseal's 'ross' extra picks the ROSS "
+                          "of its Python) and import again")
     for key, val in data.items():
         if key in ("parameters", "ross_version") or key.startswith("_"):
             continue
@@ -686,6 +694,12 @@ def _check_file(path: Path, ross=None) -> dict:
     if pairs and all(isinstance(n, int) and not isinstance(n, bool) for n in pairs):
         _one_shaft(pairs, str(path))
     return data
+
+
+def _major(version) -> int | None:
+    """The major number of a version string (``"3.1.0"`` → 3), None if it has none."""
+    head = str(version).split(".")[0] if version is not None else ""
+    return int(head) if head.isdigit() else None
 
 
 def _one_shaft(pairs, where: str) -> None:

@@ -92,8 +92,8 @@ from ambseal.files import claim_file, read_text, stamp_text, write_text
 __all__ = ["RossImport", "from_ross", "load_ross", "import_ross_file", "ROSS_TESTED",
            "ROSS_TIMEOUT_S"]
 
-#: The ROSS version the importer is tested with.
-ROSS_TESTED = "2.3"
+#: The ROSS versions the importer is tested with (2.3 on Python 3.11, 3.1 on 3.13).
+ROSS_TESTED = ("2.3", "3.1")
 #: The longest :func:`import_ross_file`'s child process may take (s): importing ROSS takes
 #: 10–20 s on a 2-core machine, loading and mapping a rotor of hundreds of elements a few
 #: seconds more.

@@ -146,6 +146,16 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                       "``{ zeta, eta }``; Ks ≥ 0"),
     "Amb.current_limit": ("A", "amplifier current limit (clipping check, orbit against "
                                "force capacity)"),
+    "Amb.supply_voltage": ("V", "the amplifier's supply: with the coil's inductance it "
+                                "bounds the force amplitude at high frequency, Ki·V/(Lω) "
+                                "(ambseal.model.capacity)"),
+    "Amb.inductance": ("H", "one magnet's coil inductance; default μ0 N² A/(2 s0) from the "
+                            "geometry"),
+    "Amb.resistance": ("Ω", "one magnet's coil resistance (R·i0 takes supply voltage; "
+                            "default 0)"),
+    "Amb.saturation_flux_density": ("T", "usable flux density of the iron: the static load "
+                                         "capacity B_sat² A cos α / μ0 (default 1.2, a "
+                                         "setting: no one published value)"),
     "Amb.backup_clearance": ("m", "radial clearance of the backup bearing beside the AMB; "
                                   "the report sets the unbalance orbit against it"),
     "Amb.uncertainty": ("", "``{ key = σ }``: relative 1σ uncertainty of a value the fit "

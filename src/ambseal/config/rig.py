@@ -43,7 +43,10 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     explicitly (also for one axis only) wins over the geometry's
     (:func:`ambseal.model.amb.amb_factors`). Also optional ``current_limit`` (A) and
     ``backup_clearance`` (m, radial clearance of the backup bearing beside the AMB); the
-    report sets the worst unbalance orbit against it and against ``air_gap``.
+    report sets the worst unbalance orbit against it and against ``air_gap``. The amplifier
+    and coil (:mod:`ambseal.model.capacity`): ``supply_voltage`` (V), ``inductance`` (H,
+    default from the geometry), ``resistance`` (Ω) and ``saturation_flux_density`` (T,
+    default 1.2).
 ``[actuator]``
     ``model`` = ``"none"`` | ``"first_order"`` (``cutoff_hz``) | ``"second_order"``
     (``natural_frequency`` in rad/s, ``damping_ratio``); ``eddy_time_constant`` τ_e (s,
@@ -336,6 +339,12 @@ class Amb(_Strict):
     ki: _Big | AxisPair | None = None
     ks: _Big | AxisPair | None = None
     current_limit: float | None = Field(default=None, ge=MIN_CURRENT_A, le=MAX_CURRENT_A)
+    # the amplifier and the coil (ambseal.model.capacity): plausible up to a 100 kV supply,
+    # a 10 H coil and 10 kΩ; saturation of soft magnetic iron lies below 2.5 T
+    supply_voltage: float | None = Field(default=None, gt=0, le=1e5)
+    inductance: float | None = Field(default=None, gt=0, le=10.0)
+    resistance: float | None = Field(default=None, ge=0, le=1e4)
+    saturation_flux_density: float = Field(default=1.2, gt=0, le=2.5)
     backup_clearance: float | None = Field(default=None, gt=0, le=1.0)
     uncertainty: Uncertainty = None
 

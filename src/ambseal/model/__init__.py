@@ -9,7 +9,9 @@ Each element owns its matrices and parameter channels; the rig only assembles th
   P5 Eq. 1) on actuator axes rotated from x, y (:func:`axes_rotation`), its factors
   (:func:`amb_factors`) and bias current (:func:`bias_current`, :func:`bias_currents`), the
   amplifier and the eddy-current lag (:func:`actuator_matrices`,
-  :func:`eddy_lag_matrices`);
+  :func:`eddy_lag_matrices`); what it can deliver: its coil's inductance, force capacity
+  against frequency and static load capacity (:func:`coil_inductance`,
+  :func:`force_capacity`, :func:`load_capacity`);
 * :class:`SealElement` — Childs' seal force (P4 Eq. 3), its coefficients against the
   pressure drop (:func:`seal_coefficients`, :func:`seal_values`,
   :func:`coefficient_value`, P5 §4.1), and the coefficients that follow a tracked one
@@ -43,7 +45,9 @@ from ambseal.lazy import lazy_face
 _FROM = {
     "AmbElement": "amb", "actuator_matrices": "amb", "amb_factors": "amb",
     "axes_rotation": "amb", "bias_current": "amb", "bias_currents": "amb",
-    "channel_names": "amb", "eddy_lag_matrices": "amb", "BeamElement": "fe",
+    "channel_names": "amb", "eddy_lag_matrices": "amb", "coil_inductance": "capacity",
+    "force_capacity": "capacity", "load_capacity": "capacity", "BeamElement": "fe",
+    "CouplingElement": "fe",
     "DiskElement": "fe", "Channel": "lft", "Parameter": "lft", "Plant": "lft",
     "Modes": "modes", "PoleDisk": "modes", "RIGID_BODY_RAD_S": "modes",
     "bending_limit_hz": "modes", "classify_poles": "modes", "free_bending_hz": "modes",

@@ -1,0 +1,100 @@
+"""What an AMB can deliver (model/capacity.py) against the force law it must agree with and
+closed forms of the amplifier's limits."""
+
+import math
+
+import numpy as np
+import pytest
+
+from ambseal.config import Amb
+from ambseal.errors import ConfigError
+from ambseal.model.amb import MU0, amb_factors
+from ambseal.model.capacity import coil_inductance, force_capacity, load_capacity
+
+GEOMETRY = {"name": "a", "position": 0.1, "sensor_position": 0.1, "turns": 160,
+            "pole_area": 6e-4, "air_gap": 4e-4, "bias_current": 2.5, "pole_angle_deg": 22.5}
+
+
+def test_inductance_gives_the_force_law_by_virtual_work():
+    """One magnet's force is ½ i² |dL/ds| cos α (virtual work on the coil's co-energy), L
+    the coil's inductance as a function of the gap: the differential pair's dF/di at the
+    bias is the force law's Ki, and its dF/dx at the centre its Ks, both to 1e-6
+    (amb_factors, Schweitzer & Maslen Eqs. 3.27–3.30)."""
+    amb = Amb(**GEOMETRY)
+    cos = math.cos(math.radians(amb.pole_angle_deg))
+
+    def dL_ds(s):
+        h = 1e-4 * s
+        at = [coil_inductance(Amb(**{**GEOMETRY, "air_gap": g})) for g in (s - h, s + h)]
+        return (at[1] - at[0]) / (2 * h)
+
+    def magnet(i, s):
+        return 0.5 * i ** 2 * abs(dL_ds(s)) * cos
+
+    i0, s0 = amb.bias_current, amb.air_gap
+    di, dx = 1e-4 * i0, 1e-4 * s0
+    ki = (magnet(i0 + di, s0) - magnet(i0 - di, s0) - magnet(i0 - di, s0)
+          + magnet(i0 + di, s0)) / (2 * di)
+    ks = (magnet(i0, s0 - dx) - magnet(i0, s0 + dx) - magnet(i0, s0 + dx)
+          + magnet(i0, s0 - dx)) / (2 * dx)
+    (ki_ref, _), (ks_ref, _) = amb_factors(amb)
+    assert ki == pytest.approx(ki_ref, rel=1e-6)
+    assert ks == pytest.approx(ks_ref, rel=1e-6)
+    assert coil_inductance(Amb(**GEOMETRY, inductance=0.02)) == 0.02
+
+
+def test_force_capacity_current_and_voltage_limits():
+    """Ki·min(i0, i_lim − i0, (V − R i0)/|R + jωL|) per axis: at standstill the current
+    bound, above the crossover ω_c = (V − R i0)/(L i_c) (R = 0) the slew-rate bound
+    Ki V/(L ω), each axis with its own Ki; without a supply voltage the current bound at
+    every frequency."""
+    amb = Amb(**GEOMETRY, ki={"zeta": 100.0, "eta": 80.0}, current_limit=4.0,
+              supply_voltage=150.0)
+    L = coil_inductance(amb)
+    ic = min(2.5, 4.0 - 2.5)
+    wc = 150.0 / (L * ic)
+    w = np.array([0.0, 0.5 * wc, wc, 4 * wc])
+    f = force_capacity(amb, w)
+    assert f.shape == (4, 2)
+    np.testing.assert_allclose(f[:3, 0], 100.0 * ic, rtol=1e-12)
+    np.testing.assert_allclose(f[3], [100.0 * 150.0 / (L * 4 * wc), 80.0 * 150.0 / (L * 4 * wc)],
+                               rtol=1e-12)
+    damped = Amb(**{**GEOMETRY, "resistance": 2.0}, current_limit=4.0, supply_voltage=150.0)
+    ki = amb_factors(damped)[0][0]
+    assert force_capacity(damped, [3 * wc])[0, 0] == pytest.approx(
+        ki * (150.0 - 2.0 * 2.5) / math.hypot(2.0, 3 * wc * L), rel=1e-12)
+    plain = Amb(**GEOMETRY, current_limit=4.0)
+    free = force_capacity(plain, [0.0, 1e6])
+    np.testing.assert_allclose(free[:, 0], amb_factors(plain)[0][0] * ic, rtol=1e-12)
+
+
+def test_load_capacity_is_the_force_law_at_saturation():
+    """B_sat² A cos α / μ0: one magnet at the current that saturates its gaps (B = μ0 N i
+    /(2 s0)), its opposite off — the force law f = k i²/s0², k = Ki s0²/(4 i0) of the
+    differential pair's Ki (amb_factors) — at the default 1.2 T and at 1.6 T."""
+    for b_sat in (None, 1.6):
+        amb = Amb(**GEOMETRY, **({} if b_sat is None else {"saturation_flux_density": b_sat}))
+        b = 1.2 if b_sat is None else b_sat
+        i_sat = 2 * amb.air_gap * b / (MU0 * amb.turns)
+        k = amb_factors(amb)[0][0] * amb.air_gap ** 2 / (4 * amb.bias_current)
+        assert load_capacity(amb) == pytest.approx(k * i_sat ** 2 / amb.air_gap ** 2,
+                                                   rel=1e-12)
+    assert load_capacity(Amb(name="a", position=0.1, sensor_position=0.1, ki=50.0,
+                             ks=1e5)) is None
+
+
+@pytest.mark.parametrize(("extra", "match"), [
+    ({"turns": None, "pole_area": None, "air_gap": None, "bias_current": None, "ki": 50.0,
+      "ks": 1e5}, "needs bias_current"),
+    ({"current_limit": 2.0}, "not above the bias current"),
+    ({"supply_voltage": 4.0, "resistance": 2.0}, "does not drive the bias current"),
+    ({"turns": None, "pole_area": None, "air_gap": None, "ki": 50.0, "ks": 1e5,
+      "supply_voltage": 100.0}, "needs the coil's inductance"),
+])
+def test_force_capacity_refuses_what_it_cannot_bound(extra, match):
+    """Each missing or impossible limit is named."""
+    amb = Amb(**{**GEOMETRY, **extra})
+    with pytest.raises(ConfigError, match=match):
+        force_capacity(amb, [0.0, 100.0])
+    with pytest.raises(ConfigError, match="frequencies ≥ 0"):
+        force_capacity(Amb(**GEOMETRY), [-1.0])

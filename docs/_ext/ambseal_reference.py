@@ -201,6 +201,11 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Spring.cyy": ("N·s/m", "direct damping"),
     "Spring.cxy": ("N·s/m", "cross-coupled damping (fixed: not a parameter to identify)"),
     "Spring.cyx": ("N·s/m", "cross-coupled damping (fixed: not a parameter to identify)"),
+    "Spring.mxx": ("kg", "added mass in the spring's x axis (a seal's fluid inertia; "
+                         "fixed)"),
+    "Spring.myy": ("kg", "added mass in the spring's y axis"),
+    "Spring.mxy": ("kg", "cross-coupled added mass"),
+    "Spring.myx": ("kg", "cross-coupled added mass"),
     "Spring.axes_angle_deg": ("°", "the axes the coefficients are given in, rotated from "
                                    "x, y"),
     "Spring.name": ("", "names its parameters (``coupling.kxx``); unnamed: ``spring<i>``"),

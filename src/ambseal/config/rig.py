@@ -60,7 +60,8 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     −f = [K k; −k K] q + [C c; −c C] q̇ + M q̈.
 ``[[spring]]``
     ``position``, ``kxx``, ``kyy`` and optional ``kxy``, ``kyx`` (N/m), ``cxx``, ``cyy``,
-    ``cxy``, ``cyx`` (N·s/m), ``axes_angle_deg`` (the axes the coefficients are given in,
+    ``cxy``, ``cyx`` (N·s/m), ``mxx``, ``myy``, ``mxy``, ``myx`` (kg: added mass, e.g. a
+    hole-pattern seal's), ``axes_angle_deg`` (the axes the coefficients are given in,
     default 0), ``name`` (optional).
 ``[controller.pid]``
     ``kp`` (A/m), ``ti`` (s), ``td`` (s), ``eps`` (-): thesis P5 Eq. 6, per actuator axis.
@@ -429,6 +430,11 @@ class Spring(_Strict):
     cyy: float = Field(default=0.0, ge=-1e12, le=1e12)
     cxy: float = Field(default=0.0, ge=-1e12, le=1e12)
     cyx: float = Field(default=0.0, ge=-1e12, le=1e12)
+    # added (fluid) mass of a seal or bearing, kg: far below any rotor's 1e6 kg bound
+    mxx: float = Field(default=0.0, ge=-1e6, le=1e6)
+    myy: float = Field(default=0.0, ge=-1e6, le=1e6)
+    mxy: float = Field(default=0.0, ge=-1e6, le=1e6)
+    myx: float = Field(default=0.0, ge=-1e6, le=1e6)
     axes_angle_deg: float = Field(default=0.0, ge=-360, le=360)
     name: Name | None = None
     uncertainty: Uncertainty = None

@@ -43,14 +43,15 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
   own interpolant gives at its frequencies (and at the operating frequency, when inside),
   evaluated by ambseal at the synchronous frequency as ROSS's ``run_modal`` does (ambseal
   interpolates linearly between the points, ROSS with a smoothing spline). Any other
-  coefficients without mass terms → ``[[spring]]`` (kxx, kyy, kxy, kyx, cxx, cyy, cxy, cyx);
+  coefficients → ``[[spring]]`` (kxx, kyy, kxy, kyx, cxx, cyy, cxy, cyx, and the mass terms
+  mxx, myy, mxy, myx);
   against frequency, ROSS's interpolant at one frequency: the synchronous frequency of the
   import speed (``speed_rpm``; by default the lowest frequency that every such table of
   ROSS's covers), written as ``[operating] speed_rpm`` and reported, so that ambseal's
   modes at that speed are ROSS's ``run_modal(speed)``. A direct stiffness above the rig
   file's stiffest support (:data:`~ambseal.config.MAX_SUPPORT_STIFFNESS`; ROSS pins a node
-  with 1e20 N/m) is taken at that bound, a pin, with a note. Mass terms that are not of
-  the seal's form, or a bearing on a support (``n_link``): an error.
+  with 1e20 N/m) is taken at that bound, a pin, with a note. A bearing on a support
+  (``n_link``): an error.
 * ``MagneticBearingElement`` → ``[[amb]]`` with its geometry (turns, pole area, gap, bias,
   pole angle) and its factors: Ki = ROSS ``ki`` and Ks = −ROSS ``ks`` (ROSS stores the
   negative stiffness with its sign, ambseal the magnitude, P2 Eq. 1), actuator axes at
@@ -251,10 +252,6 @@ def _kind(el, where: str, i: int) -> tuple[str, bool]:
     if _isotropic_skew(c):
         plain = not any(np.any(c[n]) for n in ("cxy", "cyx", "mxx", "myy"))
         return ("spring" if plain and not varies else "seal"), varies
-    if any(np.any(c[n]) for n in ("mxx", "myy", "mxy", "myx")):
-        raise _bad(where, f"bearing {i} ({el.tag}, node {el.n}): mass coefficients other than "
-                          "an isotropic mxx = myy have no ambseal equivalent ([[seal]] takes M "
-                          "with the isotropic skew form, [[spring]] no mass)")
     return "spring", varies
 
 
@@ -279,7 +276,8 @@ def _at(el, name: str, omega: float) -> float:
 
 
 def _spring(el, z: float, i: int, varies: bool, omega: float, notes: list) -> dict:
-    names = ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy", "cxy", "cyx")
+    names = ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy", "cxy", "cyx", "mxx", "myy", "mxy",
+             "myx")
     vals = {n: (_at(el, n, omega) if varies else float(_coef(el, n)[0])) for n in names}
     for n in ("kxx", "kyy"):
         if vals[n] > MAX_SUPPORT_STIFFNESS:  # ROSS pins a node with a 1e20 N/m bearing

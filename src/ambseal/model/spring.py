@@ -3,10 +3,11 @@
 Given in its own axes u, v, rotated by ``axes_angle_deg`` from x, y ([u, v]ᵀ = R [x, y]ᵀ,
 R of :func:`ambseal.model.amb.axes_rotation`), the spring force is
 
-    −f = Rᵀ [kxx kxy; kyx kyy] R q + Rᵀ [cxx cxy; cyx cyy] R q̇,   q = [x, y] of the node,
+    −f = Rᵀ [kxx kxy; kyx kyy] R q + Rᵀ [cxx cxy; cyx cyy] R q̇ + Rᵀ [mxx mxy; myx myy] R q̈,
 
-the change of basis of a 2×2 stiffness (damping) tensor given in rotated axes. The
-cross-coupled damping cxy, cyx (an imported plain bearing's) is fixed: not among the
+q = [x, y] of the node: the change of basis of a 2×2 stiffness (damping, added mass) tensor
+given in rotated axes. The cross-coupled damping cxy, cyx (an imported plain bearing's) and
+the added mass (a seal's fluid inertia, ROSS's bearing ``mxx`` …) are fixed: not among the
 spring's parameters (:data:`KEYS`).
 """
 
@@ -52,6 +53,8 @@ class SpringElement:
         [kxx kxy; kyx kyy] (N/m) in the spring's axes.
     c : ndarray, shape (2, 2)
         [cxx cxy; cyx cyy] (N·s/m) in the spring's axes.
+    m : ndarray, shape (2, 2)
+        [mxx mxy; myx myy] (kg) in the spring's axes.
     """
 
     label: str
@@ -59,6 +62,7 @@ class SpringElement:
     R: np.ndarray
     k: np.ndarray
     c: np.ndarray
+    m: np.ndarray
 
     @classmethod
     def from_config(cls, spring: Spring, mesh: Mesh, index: int) -> "SpringElement":
@@ -66,7 +70,8 @@ class SpringElement:
         return cls(spring_label(spring, index), mesh.node_at(spring.position),
                    axes_rotation(spring.axes_angle_deg),
                    np.array([[spring.kxx, spring.kxy], [spring.kyx, spring.kyy]]),
-                   np.array([[spring.cxx, spring.cxy], [spring.cyx, spring.cyy]]))
+                   np.array([[spring.cxx, spring.cxy], [spring.cyx, spring.cyy]]),
+                   np.array([[spring.mxx, spring.mxy], [spring.myx, spring.myy]]))
 
     def matrices(self) -> tuple[np.ndarray, np.ndarray]:
         """(K, C), each (2, 2) on [x, y] of the node: Rᵀ k R and Rᵀ c R."""
@@ -74,11 +79,12 @@ class SpringElement:
         return R.T @ self.k @ R, R.T @ self.c @ R
 
     def assemble(self, M: np.ndarray, C: np.ndarray, K: np.ndarray) -> None:
-        """Add the spring to the global K and C (n_dof, n_dof), in place (M unchanged)."""
+        """Add the spring to the global M, C and K (n_dof, n_dof), in place."""
         i = np.ix_(self._dofs(), self._dofs())
         Ke, Ce = self.matrices()
         K[i] += Ke
         C[i] += Ce
+        M[i] += self.R.T @ self.m @ self.R
 
     def channels(self, n_dof: int) -> list[Channel]:
         """One rank-1 channel per entry of :data:`KEYS`: Δ(kab) changes K by θ d_a d_bᵀ with

@@ -602,15 +602,19 @@ def _coupled_rotor(**link):
 
 def test_coupling_equals_ross(tmp_path):
     """ROSS's coupled rotor with an anisotropic, damped coupling (kt 1e6/8e5 N/m, kr
-    2e5/1e5 N·m/rad, ct 50 N·s/m, cr 2 N·m·s/rad), saved and imported: a ``coupling``
+    2e5/1e5 N·m/rad, ct 50 N·s/m, cr 2 N·m·s/rad, and a torsional stiffness, named as left
+    out), saved and imported: a ``coupling``
     section (halves 10 kg, Ip 0.1, Id = Ip/2 as ROSS defaults it), and every lateral mode
     up to 500 Hz with its log decrement equal to ROSS's at 0 and 4000 rpm to 1e-6 (before:
     refused as "2 shafts … a ROSS CoAxialRotor")."""
     rotor = _coupled_rotor(kt_x=1e6, kt_y=8e5, kr_x=2e5, kr_y=1e5, ct_x=50.0, ct_y=50.0,
-                           cr_x=2.0, cr_y=2.0)
+                           cr_x=2.0, cr_y=2.0, kr_z=3e6)
     src = tmp_path / "coupled.toml"
     _quiet(rotor.save, src)
-    cfg = from_ross(load_ross(src), where=str(src)).rig
+    imp = from_ross(load_ross(src), where=str(src))
+    assert imp.unmapped == ("coupling C1: its axial and torsional springs and dampers (kr_z "
+                            "= 3e+06) not imported: no lateral effect",)
+    cfg = imp.rig
     c = cfg.shaft[1].coupling
     assert (c.m_left, c.Ip_right, c.Id_left, c.kt_y, c.kr_x) == (10.0, 0.1, 0.05, 8e5, 2e5)
     assert cfg.shaft[0].coupling is None and cfg.shaft[1].length == pytest.approx(0.2)

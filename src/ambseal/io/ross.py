@@ -452,6 +452,11 @@ def _elements(rotor, bearings: list) -> tuple[list[str], list[str]]:
     refused, unmapped = [], []
     for el in getattr(rotor, "elements", []):
         kind, tag = type(el).__name__, getattr(el, "tag", "")
+        axial = {k: float(getattr(el, k, 0.0) or 0.0) for k in ("kt_z", "kr_z", "ct_z", "cr_z")}
+        if kind == "CouplingElement" and any(axial.values()):
+            unmapped.append(f"coupling {tag}: its axial and torsional springs and dampers ("
+                            + ", ".join(f"{k} = {v:g}" for k, v in axial.items() if v)
+                            + ") not imported: no lateral effect")
         if kind in _IMPORTED or any(el is b for b in bearings):
             continue
         if kind == "MotorElement":  # ROSS 3: not a structural element (its docstring)

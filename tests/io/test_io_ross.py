@@ -144,7 +144,7 @@ def test_rotor_rayleigh_damping_equals_ross(tmp_path):
         _assert_log_decrements_equal_ross(imp.rig, rotor, speed_rpm)
     modal = _quiet(rs.Rotor, ex.shaft_elements, ex.disk_elements, ex.bearing_elements,
                    modal_damping_ratio=[0.01, 0.02])
-    with pytest.raises(ConfigError, match="modal_damping_ratio=.*not supported"):
+    with pytest.raises(ConfigError, match="1 item.* cannot take.*\n.*modal_damping_ratio="):
         from_ross(modal, where="modal.toml")
 
 
@@ -628,7 +628,9 @@ def test_coupling_equals_ross(tmp_path):
 def test_elements_ambseal_cannot_take_are_each_named(tmp_path, capsys):
     """A rotor with two elements of a class ambseal does not know (a ROSS disk subclass,
     as a user's or a ROSS extension's element is): one error naming each on a line of its
-    own; saved by ROSS, ``import-ross`` exits 2 with one line and no traceback. On ROSS 3,
+    own; likewise a support structure (a bearing linked to a housing node, the housing's
+    bearing and point mass) beside such an element; saved by ROSS, ``import-ross`` exits
+    2 with one line and no traceback. On ROSS 3,
     a rotor with ROSS's induction motor (``motor_example``, which drives the torsional DOF
     only) imports, the motor named once among what was left out."""
     from ambseal.cli import main
@@ -641,9 +643,25 @@ def test_elements_ambseal_cannot_take_are_each_named(tmp_path, capsys):
     with pytest.raises(ConfigError) as info:
         from_ross(rotor, where="fly")
     lines = str(info.value).splitlines()
-    assert lines[0] == "fly: 2 element(s) ambseal cannot take (each would change the dynamics):"
+    assert lines[0] == "fly: 2 item(s) ambseal cannot take (each would change the dynamics):"
     assert [ln.strip() for ln in lines[1:]] == ["Flywheel F2: no ambseal equivalent",
                                                 "Flywheel F4: no ambseal equivalent"]
+    # a housing behind the right bearing (ROSS's support model: the bearing linked to a
+    # node with a point mass, on a bearing to ground) and a flywheel: three lines
+    housing = [rs.BearingElement(n=0, kxx=1e6, kyy=0.8e6, cxx=150.0, cyy=90.0, tag="B0"),
+               rs.BearingElement(n=6, n_link=7, kxx=1e6, cxx=150.0, tag="B6"),
+               rs.BearingElement(n=7, kxx=5e7, cxx=500.0, tag="H")]
+    supported = _quiet(rs.Rotor, ex.shaft_elements, [*ex.disk_elements, extra[0]], housing,
+                       point_mass_elements=[rs.PointMass(n=7, m=20.0, tag="P7")])
+    with pytest.raises(ConfigError) as info:
+        from_ross(supported, where="housing")
+    assert [ln.strip() for ln in str(info.value).splitlines()] == [
+        "housing: 4 item(s) ambseal cannot take (each would change the dynamics):",
+        "bearing 1 (B6): linked to node 7, a support structure behind the bearing: no "
+        "ambseal equivalent",
+        "bearing 2 (H): on node 7, off the shaft (nodes 0–6)",
+        "point mass P7: on node 7, off the shaft (a support mass; nodes 0–6)",
+        "Flywheel F2: no ambseal equivalent"]
     src = tmp_path / "fly.toml"
     _quiet(rotor.save, src)
     assert main(["import-ross", str(src), "--out", str(tmp_path / "rig.toml")]) == 2

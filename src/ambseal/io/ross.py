@@ -395,19 +395,21 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
         raise _bad(where, f"a ROSS MultiRotor ({tags}) has several shafts coupled by a "
                           "gear mesh; an ambseal rig has one shaft and no gear mesh: import "
                           "each rotor on its own (its gear becomes a disk)")
+    # several shafts first: their linking bearing would otherwise be named as a support
+    _one_shaft([int(el.n) for el in getattr(rotor, "shaft_elements", [])], where)
     bearings = list(getattr(rotor, "bearing_elements", []))
     refused, unmapped = _elements(rotor, bearings)
     if refused:
-        raise _bad(where, f"{len(refused)} element(s) ambseal cannot take (each would change "
+        raise _bad(where, f"{len(refused)} item(s) ambseal cannot take (each would change "
                           "the dynamics):\n" + "\n".join(f"  {r}" for r in refused))
-    damping = _rotor_damping(rotor, where)
+    damping = _rotor_damping(rotor)
     shaft, mats, beam = _shaft(rotor, where, elemental=not damping)
     nodes = np.concatenate([[0.0], np.cumsum([s["length"] for s in shaft])])
     rig: dict = {"rotor": {"beam": beam, "name": name or str(getattr(rotor, "tag", None)
                                                             or "ROSS rotor"), **damping},
                  "materials": mats, "shaft": shaft, "disk": [], "amb": [], "seal": [],
                  "spring": []}
-    rig["disk"] = _masses(rotor, nodes, where)
+    rig["disk"] = _masses(rotor, nodes)
     pids, notes = [], []
     plan = _supports(bearings, nodes, where, rig, pids)
     one_freq = [_axis(b) for _, b, kind, varies in plan
@@ -446,10 +448,32 @@ _IMPORTED = {"ShaftElement", "CouplingElement", "DiskElement", "PointMass", "Gea
 
 
 def _elements(rotor, bearings: list) -> tuple[list[str], list[str]]:
-    """The rotor's elements that are neither imported nor bearings: those that would change
-    the lateral dynamics (refused, one line each) and those that do not (named, one line
-    each, in ``unmapped``)."""
+    """What of the rotor ambseal cannot take: what would change the lateral dynamics
+    (refused, one line each: elements without an equivalent, modal damping ratios, a
+    support structure behind a bearing, anything on a node off the shaft) and what would
+    not (named, one line each, in ``unmapped``)."""
     refused, unmapped = [], []
+    ratios = getattr(rotor, "modal_damping_ratio", None)
+    default = float(getattr(rotor, "default_damping_ratio", 0.0) or 0.0)
+    if (ratios is not None and np.any(np.asarray(ratios, float))) or default:
+        refused.append(f"the rotor's modal damping (modal_damping_ratio={ratios!r}, "
+                       f"default_damping_ratio={default:g}): ROSS sets it on the supported "
+                       "rotor's modes, axial and torsional ones among them; give the damping "
+                       "as Rayleigh alpha, beta (ROSS's Rotor(alpha=..., beta=...)) or set "
+                       "[rotor] modal_damping (free–free bending modes) after importing "
+                       "without it")
+    last = max((int(e.n) + 1 for e in getattr(rotor, "shaft_elements", [])), default=0)
+    for i, b in enumerate(bearings):
+        if getattr(b, "n_link", None) is not None:
+            refused.append(f"bearing {i} ({b.tag}): linked to node {b.n_link}, a support "
+                           "structure behind the bearing: no ambseal equivalent")
+        elif b.n > last:
+            refused.append(f"bearing {i} ({b.tag}): on node {b.n}, off the shaft (nodes "
+                           f"0–{last})")
+    for p in getattr(rotor, "point_mass_elements", []):
+        if p.n > last:
+            refused.append(f"point mass {p.tag}: on node {p.n}, off the shaft (a support "
+                           f"mass; nodes 0–{last})")
     for el in getattr(rotor, "elements", []):
         kind, tag = type(el).__name__, getattr(el, "tag", "")
         axial = {k: float(getattr(el, k, 0.0) or 0.0) for k in ("kt_z", "kr_z", "ct_z", "cr_z")}
@@ -469,34 +493,20 @@ def _elements(rotor, bearings: list) -> tuple[list[str], list[str]]:
     return refused, unmapped
 
 
-def _rotor_damping(rotor, where: str) -> dict:
+def _rotor_damping(rotor) -> dict:
     """``[rotor]`` keys of a ROSS 3 rotor's own damping: its Rayleigh ``alpha``, ``beta``
     (of shaft, disks and point masses, as ROSS assembles them); ROSS 3 takes it in place
-    of its elements' own. Modal damping ratios are refused: ROSS puts them on the modes of
-    the supported rotor at standstill, its axial and torsional modes among them, which a
-    lateral model cannot order the same way."""
-    ratios = getattr(rotor, "modal_damping_ratio", None)
-    default = float(getattr(rotor, "default_damping_ratio", 0.0) or 0.0)
+    of its elements' own. (Its modal damping ratios are refused by :func:`_elements`.)"""
     alpha = float(getattr(rotor, "alpha", 0.0) or 0.0)
     beta = float(getattr(rotor, "beta", 0.0) or 0.0)
-    if (ratios is not None and np.any(np.asarray(ratios, float))) or default:
-        raise _bad(where, f"the rotor's modal damping (modal_damping_ratio={ratios!r}, "
-                          f"default_damping_ratio={default:g}) is not supported: ROSS sets "
-                          "it on the supported rotor's modes, axial and torsional ones "
-                          "among them; give the damping as Rayleigh alpha, beta (ROSS's "
-                          "Rotor(alpha=..., beta=...)) or set [rotor] modal_damping "
-                          "(free–free bending modes) in the rig after importing without it")
     return {k: v for k, v in (("rayleigh_alpha", alpha), ("rayleigh_beta", beta)) if v}
 
 
-def _masses(rotor, nodes: np.ndarray, where: str) -> list[dict]:
+def _masses(rotor, nodes: np.ndarray) -> list[dict]:
     """``[[disk]]`` entries of ROSS's disks and point masses on the shaft."""
     out = [{"name": str(d.tag), "position": float(nodes[d.n]), "mass": float(d.m),
             "Ip": float(d.Ip), "Id": float(d.Id)} for d in rotor.disk_elements]
-    for p in getattr(rotor, "point_mass_elements", []):
-        if p.n >= len(nodes):
-            raise _bad(where, f"point mass {p.tag} on node {p.n} off the shaft (a support "
-                              "mass) is not supported")
+    for p in getattr(rotor, "point_mass_elements", []):  # (on the shaft: _elements)
         out.append({"name": str(p.tag), "position": float(nodes[p.n]), "mass": float(p.m)})
     return out
 
@@ -507,12 +517,7 @@ def _supports(bearings: list, nodes: np.ndarray, where: str, rig: dict,
     other bearings and seals as (index, element, kind, frequency-dependent), to place once
     the import's speed is known."""
     plan = []
-    for i, b in enumerate(bearings):
-        if getattr(b, "n_link", None) is not None:
-            raise _bad(where, f"bearing {i} ({b.tag}) linked to node {b.n_link} (support "
-                              "structures are not supported)")
-        if b.n >= len(nodes):
-            raise _bad(where, f"bearing {i} ({b.tag}) on node {b.n} off the shaft")
+    for i, b in enumerate(bearings):  # (on the shaft, none linked: _elements)
         if type(b).__name__ == "MagneticBearingElement":
             entry, pid, what = _amb(b, nodes, i, where)
             rig["amb"].append(entry)

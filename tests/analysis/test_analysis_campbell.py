@@ -182,6 +182,34 @@ def test_overdamped_lines_cross_apart():
     assert z2 >= OVERDAMPED_ZETA > z1
 
 
+def test_campbell_rings_a_low_log_decrement_where_the_mode_is_drawn(tmp_path, monkeypatch):
+    """Over 0–100 Hz a mode at 150 Hz (ζ = 0.05) sets the frequency panel's range (to
+    1.15 × 150 Hz); a mode at 900 Hz with δ ≈ 0.03 < 0.1 lies above it. Its low log
+    decrement is ringed in the δ panel, with the legend there, and the frequency panel's
+    legend has no "log dec < 0.1" entry for a ring it does not draw."""
+    from types import SimpleNamespace
+
+    import ambseal.report.modal_figures as mf
+    from ambseal.analysis.campbell import Campbell
+
+    speeds = np.linspace(0.0, 100.0, 5)
+    zeta = np.array([0.05, 0.005])
+    pts = tuple(SimpleNamespace(
+        speed_hz=sp, max_hz=1e3, frequency_hz=np.array([150.0, 900.0]), damping_ratio=zeta,
+        log_decrement=2 * np.pi * zeta / np.sqrt(1 - zeta**2), whirl=("forward",) * 2)
+        for sp in speeds)
+    c = Campbell(speeds, pts, np.tile([0, 1], (5, 1)), ())
+    figs = []
+    monkeypatch.setattr(mf, "save_figure", lambda fig, path, **kw: figs.append(fig) or path)
+    mf.campbell_figure(tmp_path / "c.png", c)
+    top, bottom = figs[0].axes[:2]
+    assert top.get_ylim()[1] == pytest.approx(1.15 * 150.0)
+    assert not any("log dec" in t.get_text() for t in top.get_legend().get_texts())
+    assert [t.get_text() for t in bottom.get_legend().get_texts()] == ["log dec < 0.1"]
+    rings = [col for col in bottom.collections if col.get_label() == "log dec < 0.1"]
+    assert len(rings) == 1 and len(rings[0].get_offsets()) == len(speeds)
+
+
 def test_campbell_figure_draws_only_modes_with_a_resonance(tmp_path, monkeypatch):
     """Three lines over 0–100 Hz: a lightly damped mode at 50 Hz (ζ = 0.05: AF = π/δ ≈ 10,
     a critical speed by API 684), a well damped one at 70 Hz (ζ = 0.3: AF ≈ 1.6 < 2.5) and

@@ -35,7 +35,8 @@ def campbell_figure(path: str | os.PathLike, c, *, title: str = "Closed-loop Cam
     log-decrement limit), their lines, the 1× line and the crossings (×, bold where API 684
     counts them critical). A controller's or an eddy-current pole damped at ζ ≥ 1/√2 has no
     resonance to meet the 1× line and is left out there. Bottom: the log decrements of every
-    mode with the limit (API 684: 0.1).
+    mode with the limit (API 684: 0.1), a black ring on each below it (those above the
+    frequency panel's range are ringed here only).
 
     Parameters
     ----------
@@ -81,11 +82,22 @@ def campbell_figure(path: str | os.PathLike, c, *, title: str = "Closed-loop Cam
             ax.scatter(xs[damped], fs[damped], s=10, color=col, marker=mk, alpha=0.25,
                        zorder=2, label=None if np.any(sharp) else whirl)
         axd.scatter(xs, np.clip(ds, -1.0, 10.0), s=14, color=col, marker=mk, zorder=3)
+    # up to the first resonant mode above the speed range (the modes that can meet 1× and
+    # the next)
+    f_all = np.concatenate([p.frequency_hz[p.damping_ratio < OVERDAMPED_ZETA]
+                            for p in c.points])
+    above = f_all[f_all > s.max()]
+    top = max(float(s.max()), float(above.min()) if above.size else float(f_all.max(initial=1.0)))
     low = c.flagged()
+    ring = {"s": 60, "facecolors": "none", "edgecolors": "k", "lw": 1.0, "zorder": 4,
+            "label": f"log dec < {c.log_dec_limit:g}"}
+    shown = [r for r in low if r["frequency_hz"] <= 1.15 * top]
+    if shown:  # (a ring in the legend only where one is drawn in this panel)
+        ax.scatter([r["speed_hz"] for r in shown], [r["frequency_hz"] for r in shown], **ring)
     if low:
-        ax.scatter([r["speed_hz"] for r in low], [r["frequency_hz"] for r in low], s=60,
-                   facecolors="none", edgecolors="k", lw=1.0, zorder=4,
-                   label=f"log dec < {c.log_dec_limit:g}")
+        axd.scatter([r["speed_hz"] for r in low],
+                    np.clip([r["log_decrement"] for r in low], -1.0, 10.0), **ring)
+        axd.legend(fontsize=8, loc="upper left")
     ax.plot(s, s, "k--", lw=1.0, label="1× (synchronous)")
     for x in c.crossings:  # API 684 critical (AF ≥ 2.5) bold, the others small
         ax.plot(x.speed_hz, x.speed_hz, "x", color="k" if x.critical else "0.5",
@@ -97,12 +109,6 @@ def campbell_figure(path: str | os.PathLike, c, *, title: str = "Closed-loop Cam
            for p in c.points):
         ax.scatter([], [], s=10, color="0.3", alpha=0.25,
                    label=f"faint: AF < {AF_CRITICAL:g}, no critical speed")
-    # up to the first resonant mode above the speed range (the modes that can meet 1× and
-    # the next)
-    f_all = np.concatenate([p.frequency_hz[p.damping_ratio < OVERDAMPED_ZETA]
-                            for p in c.points])
-    above = f_all[f_all > s.max()]
-    top = max(float(s.max()), float(above.min()) if above.size else float(f_all.max(initial=1.0)))
     ax.set_ylim(0, 1.15 * top)
     if np.any(f_all > 1.15 * top):
         title += (f"\n(modes to {max(p.max_hz for p in c.points):.0f} Hz in the δ panel; "

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
+import inspect
 import json
 import os
 import subprocess
@@ -118,14 +119,12 @@ def _assert_log_decrements_equal_ross(rig, rotor, speed_rpm: float, max_hz: floa
         assert dec == pytest.approx(-2 * np.pi * ref[j].real / ref[j].imag, rel=1e-6)
 
 
-def _rotor_damping_in_ross() -> bool:
-    """Whether this ROSS's ``Rotor`` takes damping of its own (ROSS 3: ``alpha``, ``beta``,
-    ``modal_damping_ratio``)."""
-    import inspect
-    return "alpha" in inspect.signature(rs.Rotor.__init__).parameters
+def _takes(cls, argument: str) -> bool:
+    """Whether this ROSS's ``cls`` takes ``argument`` (ROSS 3 added some)."""
+    return argument in inspect.signature(cls.__init__).parameters
 
 
-@pytest.mark.skipif(not _rotor_damping_in_ross(),
+@pytest.mark.skipif(not _takes(rs.Rotor, "alpha"),
                     reason="ROSS < 3: a Rotor has no damping of its own (alpha, beta)")
 def test_rotor_rayleigh_damping_equals_ross(tmp_path):
     """A ROSS 3 rotor with its own Rayleigh damping (``Rotor(alpha=3, beta=2e-5)``, of
@@ -522,9 +521,8 @@ def test_multirotor_refused_and_a_gear_of_one_rotor_is_a_disk():
             assert abs(ref[j] - lam) <= 1e-6 * abs(lam)
 
 
-@pytest.mark.skipif("speed" not in __import__("inspect").signature(
-    rs.BearingElement.__init__).parameters,
-    reason="ROSS < 3: no coefficient tables over speed and frequency")
+@pytest.mark.skipif(not _takes(rs.BearingElement, "speed"),
+                    reason="ROSS < 3: no coefficient tables over speed and frequency")
 def test_tables_over_speed_and_whirl_frequency_equal_ross():
     """ROSS 3 tables over speed and whirl frequency (PCHIP on both axes): an isotropic skew
     seal (K, k, C of both axes) and an anisotropic bearing on ROSS's ``rotor_example``.
@@ -834,9 +832,8 @@ def test_ross_pinned_conical_rotor_is_imported_with_pins(tmp_path):
     assert w == pytest.approx(asserted, rel=1e-6)
 
 
-@pytest.mark.skipif(not hasattr(rs, "MultiRotor") or "sensor_node" not in __import__(
-    "inspect").signature(rs.MagneticBearingElement.__init__).parameters,
-    reason="ROSS < 3: an AMB's sensor is at the bearing (no sensor_node)")
+@pytest.mark.skipif(not _takes(rs.MagneticBearingElement, "sensor_node"),
+                    reason="ROSS < 3: an AMB's sensor is at the bearing (no sensor_node)")
 def test_amb_sensor_node_is_the_sensor_position():
     """ROSS 3's AMB rotor (``rotor_example_amb_simple``: AMBs on nodes 1 and 9 of ten
     0.1 m elements) with each sensor one node outboard (``sensor_node`` 0 and 10): the

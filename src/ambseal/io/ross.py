@@ -174,7 +174,6 @@ def _shaft(rotor, where: str, elemental: bool = True) -> tuple[list[dict], dict,
     materials and the beam type; ``elemental``: each element's Rayleigh damping taken
     (ROSS ignores it where the rotor has its own)."""
     line = sorted(rotor.shaft_elements, key=lambda e: (e.n, getattr(e, "idl", 0.0)))
-    _one_shaft([int(el.n) for el in line], where)
     couplings = {int(el.n): el for el in line if type(el).__name__ == "CouplingElement"}
     crowded = [n for n in sorted(couplings) if sum(int(e.n) == n for e in line) > 1]
     if crowded:

@@ -173,6 +173,85 @@ def _scaled_plant(P, cblocks, fits, nmeas, ncon):
     return ct.ss(Ps.A, Ps.B, Ps.C, Ps.D, inputs=names_in, outputs=names_out, name="P_scaled")
 
 
+def _balance_channels(P, cblocks, nmeas, ncon, w, evals=0):
+    """The uncertainty channels of ``P`` in balanced units: ``(P_b, b, evaluations)`` with
+    ``P_b = diag(b, I) · P · diag(b⁻¹, I)``, one constant ``b_j > 0`` per block of the
+    complexified structure but the last (performance) block.
+
+    μ is unchanged by such a D (Packard & Doyle 1993: μ(DMD⁻¹) = μ(M) for D commuting
+    with Δ), but D–K is not: its first K-step is H∞ at D = I, and a start in other units
+    ends elsewhere. Two steps, each the same in any units of the channels:
+
+    1. ``b_j² = c_j / r_j``, with ``r_j`` the RMS over ``w`` of the Frobenius norm of
+       block j's z_Δ rows of P(jω) into the non-Δ inputs ``[w, u]`` and ``c_j`` the same of
+       its w_Δ columns seen at the non-Δ outputs ``[z, y]`` (a block with no such path
+       keeps 1): channels in other units (z_Δ·a, w_Δ/a) scale r_j by a and c_j by 1/a.
+    2. From there, at most ``evals`` γ evaluations of Nelder–Mead over log b for the
+       smallest γ_opt of ``P_b`` (the best constant D of the H∞ problem; 0: none):
+       translation in log b, the change of units, leaves the search unchanged.
+    """
+    nzd = sum(c for _, c in cblocks[:-1])
+    nwd = sum(r for r, _ in cblocks[:-1])
+    H = np.moveaxis(ct.frequency_response(ct.ss(P.A, P.B, P.C, P.D), w,
+                                          squeeze=False).complex, 2, 0)
+    H = H[np.all(np.isfinite(H), axis=(1, 2))]
+
+    def rms(block):
+        return float(np.sqrt(np.mean(np.sum(np.abs(block) ** 2, axis=(1, 2))))) \
+            if block.size else 0.0
+
+    zs, ws, logb = [], [], []
+    zo = wo = 0
+    for r, c in cblocks[:-1]:
+        rj, cj = rms(H[:, zo:zo + c, nwd:]), rms(H[:, nzd:, wo:wo + r])
+        ok = rj > 0 and cj > 0 and np.isfinite(cj / rj)
+        logb.append(0.5 * np.log(cj / rj) if ok else 0.0)
+        zs.append(slice(zo, zo + c))
+        ws.append(slice(wo, wo + r))
+        zo, wo = zo + c, wo + r
+
+    def scaled(x):
+        left, right = np.ones(P.noutputs), np.ones(P.ninputs)
+        for z, v, xj in zip(zs, ws, x):
+            left[z], right[v] = np.exp(xj), np.exp(-xj)
+        return ct.ss(P.A, P.B * right, left[:, None] * P.C, left[:, None] * P.D * right,
+                     inputs=list(P.input_labels), outputs=list(P.output_labels),
+                     name=P.name)
+
+    x = np.array(logb, float)
+    near, count = [None], [0]
+
+    def gamma(y):
+        count[0] += 1
+        try:
+            g = hinf_gamma_opt(scaled(y), nmeas, ncon, rtol=1e-4, near=near[0])
+        except (SynthesisError, ModelError, ValueError, np.linalg.LinAlgError):
+            return np.inf
+        near[0] = g if near[0] is None else min(near[0], g)
+        return g
+
+    if evals > x.size + 1:
+
+        # first simplex: each log b moved by 1 (a factor e): the RMS balance is a start,
+        # not the optimum, which lies a decade or two away on plants with integrators
+        g0 = gamma(x)
+        res = minimize(gamma, x, method="Nelder-Mead",
+                       options={"maxfev": int(evals) - 1, "xatol": 1e-2, "fatol": 1e-4,
+                                "initial_simplex": np.vstack([x, x + np.eye(x.size)])})
+        if np.isfinite(res.fun) and res.fun < g0:
+            x = np.asarray(res.x, float)
+    return scaled(x), [float(np.exp(v)) for v in x], count[0]
+
+
+def _unbalanced_fit(fit, b):
+    """A D scale fitted on :func:`_balance_channels`' plant, in ``P``'s units: ``b·D``
+    (a transfer function, or the ``(D, D⁻¹)`` realisation pair of :func:`_realize`)."""
+    if not isinstance(fit, tuple):
+        return fit * b
+    (a, bb, c, d), (ai, bi, ci, di) = fit
+    return (a, bb, c * b, d * b), (ai, bi, ci / b, di / b)
+
+
 def _tf_to_theta(tf):
     """Section parameters (:func:`_logmag`) of a fitted D scale and its order: the inverse
     of :func:`_theta_to_tf` (complex root pairs first, then real roots paired by size)."""
@@ -191,19 +270,18 @@ def _tf_to_theta(tf):
 
 
 #: D search: Nelder–Mead evaluations per parameter of the fitted D scales. On Skogestad &
-#: Postlethwaite's distillation problem (18 parameters on their 61-point grid, 14 on
-#: ``default_omega``'s) 150 γ evaluations reached μ 0.984, 300 0.978 and 600 0.9736, the
-#: published optimum (benchmarks/bench_dk.py); 25 per parameter (350–450) is within 1 % of
-#: the optimum at half the cost of 50.
-SEARCH_EVALS_PER_PARAMETER = 25
+#: Postlethwaite's distillation problem (18 parameters, D–K started from the balanced
+#: channels) 450 γ evaluations reached μ 1.012, 700 0.998, 900 0.980 and 1200 0.970, below
+#: the published optimum 0.9737 (benchmarks/bench_dk.py): 50 per parameter is within 1 %.
+SEARCH_EVALS_PER_PARAMETER = 50
 #: The work ``search="auto"`` may spend, counted in γ evaluations × n³, n the states of the
 #: scaled plant: a γ evaluation (Riccati equations and Hamiltonian eigenvalues of the scaled
 #: plant) costs ∝ n³. A count, not a clock, so the same problem gets the same search on
-#: every machine, quiet or loaded. The distillation column's full search is 450 × 22³ ≈
-#: 4.8·10⁶; on a 92-state scaled plant (10 parameters) it would be
-#: 250 × 92³ ≈ 1.9·10⁸, at a K-step of 0.4 s a minute for a μ 0.1 % lower
+#: every machine, quiet or loaded. The distillation column's full search is 900 × 22³ ≈
+#: 9.6·10⁶; on a 92-state scaled plant (10 parameters) it would be
+#: 500 × 92³ ≈ 3.9·10⁸, at a K-step of 0.4 s minutes for a μ 0.1 % lower
 #: (benchmarks/README.md, bench_dk): the limit lies between.
-SEARCH_WORK = 5e7
+SEARCH_WORK = 1e8
 
 
 def _search_dscales(P, cblocks, fits, nmeas, ncon, evals, restarts=2):
@@ -282,6 +360,21 @@ def _search_evals(search, fits, n_states: int) -> tuple[int, str]:
         return full, f"auto: {SEARCH_EVALS_PER_PARAMETER} per parameter of {n}"
     return 0, (f"auto: not started, {full} evaluations on a {n_states}-state plant exceed "
                f"the work limit ({work:.2g} > {SEARCH_WORK:.0e} evaluations × states³)")
+
+
+#: The best-constant-D start: Nelder–Mead evaluations per scale (a search in one to a few
+#: dimensions from the RMS balance, converged to 1 % in log D within about 20).
+START_EVALS_PER_SCALE = 20
+
+
+def _start_evals(search, cblocks, n_states: int) -> int:
+    """γ evaluations granted to :func:`_balance_channels`' search for the best constant D
+    (0: none): ``SEARCH_EVALS_PER_PARAMETER`` per scale when ``search`` is not 0 and their
+    work, evaluations × ``n_states``³, is within ``SEARCH_WORK`` (the D search's rule)."""
+    evals = START_EVALS_PER_SCALE * (len(cblocks) - 1)
+    if search == 0 or evals * float(n_states) ** 3 > SEARCH_WORK:
+        return 0
+    return evals if search == "auto" else min(evals, int(search))
 
 
 def _search_step(P, blocks, cblocks, nmeas, ncon, w, best, evals, backoff, history,

@@ -153,18 +153,35 @@ def test_musyn_gives_the_same_mu_and_controller_in_any_units():
     1993), so a change of units of the uncertainty channels (w_Δ × a, z_Δ ÷ a) must leave
     musyn's μ, and the μ of its controller on the plant in the first units, unchanged (to
     1 %) over 12 decades of a — checked by SLICOT AB13MD on python-control's F_l. (Started
-    from D = I in the user's units, D–K gave μ 0.772 in plain units and 99.99 with
+    from D = I in the user's units, D–K gave μ 0.782 in plain units and 99.99 with
     a = 1e-6.) The start's scale follows the units exactly."""
     P = rp_plant()
-    w = np.logspace(-3, 2, 60)
-    plain = musyn(P, [(1, 1), (1, 1)], 1, 1, w)
-    for a in (1e6, 1e-6):
-        r = musyn(in_units(P, a), [(1, 1), (1, 1)], 1, 1, w)
+    kw = {"max_iter": 3, "search": 30}  # 30 γ evaluations: the start's 20 and the D search
+    plain = musyn(P, [(1, 1), (1, 1)], 1, 1, **kw)
+    assert plain.stopping["start"]["evaluations"] > 0
+    for a in (1e-6, 1e6):
+        r = musyn(in_units(P, a), [(1, 1), (1, 1)], 1, 1, **kw)
         assert r.mu == pytest.approx(plain.mu, rel=1e-2)
         assert _mu_ab13md(P.lft(r.K, 1, 1), r.check_omega) == pytest.approx(plain.mu,
                                                                              rel=1e-2)
         assert r.stopping["start"]["scales"][0] == pytest.approx(
             a * plain.stopping["start"]["scales"][0], rel=1e-6)
+
+
+def test_start_search_work_rule_is_a_count():
+    """Reference: the rule itself (``START_WORK`` in γ evaluations × states³). Two scales
+    on the largest plant within the limit get ``START_EVALS_PER_SCALE`` evaluations each,
+    one state more gets none (the RMS balance alone), as does ``search=0``; an explicit
+    search count caps the start's too."""
+    from ambseal.robust._dscale import START_EVALS_PER_SCALE, START_WORK, _start_evals
+
+    cb = [(1, 1), (1, 1), (2, 2)]
+    full = 2 * START_EVALS_PER_SCALE
+    edge = int((START_WORK / full) ** (1 / 3))
+    assert full * edge ** 3 <= START_WORK < full * (edge + 1) ** 3
+    assert _start_evals("auto", cb, edge) == full
+    assert _start_evals("auto", cb, edge + 1) == 0
+    assert _start_evals(0, cb, 4) == 0 and _start_evals(7, cb, 4) == 7
 
 
 def test_search_work_rule_is_a_count():

@@ -412,7 +412,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     D of :func:`~ambseal.robust._dscale._balance_channels` — an RMS balance of each
     block's rows and columns, then Nelder–Mead for the D of the smallest γ_opt
     (``START_EVALS_PER_SCALE`` γ evaluations per scale when their work is within
-    ``SEARCH_WORK``; none with ``search=0``) — the same plant in any units of the
+    ``START_WORK``; none with ``search=0``) — the same plant in any units of the
     channels, so μ and the controller are too (to rounding; tests: 12 decades).
 
     The steps, after Balas et al. (1993) and MATLAB's ``musyn`` (D-K Iteration Process,

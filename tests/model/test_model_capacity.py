@@ -9,7 +9,8 @@ import pytest
 from ambseal.config import Amb
 from ambseal.errors import ConfigError
 from ambseal.model.amb import MU0, amb_factors
-from ambseal.model.capacity import coil_inductance, force_capacity, load_capacity
+from ambseal.model.capacity import (amplifier_use, coil_inductance, force_capacity,
+                                     load_capacity)
 
 GEOMETRY = {"name": "a", "position": 0.1, "sensor_position": 0.1, "turns": 160,
             "pole_area": 6e-4, "air_gap": 4e-4, "bias_current": 2.5, "pole_angle_deg": 22.5}
@@ -44,14 +45,15 @@ def test_inductance_gives_the_force_law_by_virtual_work():
 
 
 def test_force_capacity_current_and_voltage_limits():
-    """Ki·min(i0, i_lim − i0, (V − R i0)/|R + jωL|) per axis: at standstill the current
-    bound, above the crossover ω_c = (V − R i0)/(L i_c) (R = 0) the slew-rate bound
-    Ki V/(L ω), each axis with its own Ki; without a supply voltage the current bound at
-    every frequency."""
-    amb = Amb(**GEOMETRY, ki={"zeta": 100.0, "eta": 80.0}, current_limit=4.0,
+    """Ki·min(i0, i_lim, (V − R i0)/|R + jωL|) per axis, i_lim the amplifier's limit on
+    the control current: at standstill the current bound, above the crossover
+    ω_c = (V − R i0)/(L i_c) (R = 0) the slew-rate bound Ki V/(L ω), each axis with its
+    own Ki; without a supply voltage the current bound at every frequency; a limit above
+    the bias leaves the linear range i0 as the bound."""
+    amb = Amb(**GEOMETRY, ki={"zeta": 100.0, "eta": 80.0}, current_limit=1.5,
               supply_voltage=150.0)
     L = coil_inductance(amb)
-    ic = min(2.5, 4.0 - 2.5)
+    ic = min(2.5, 1.5)
     wc = 150.0 / (L * ic)
     w = np.array([0.0, 0.5 * wc, wc, 4 * wc])
     f = force_capacity(amb, w)
@@ -59,13 +61,39 @@ def test_force_capacity_current_and_voltage_limits():
     np.testing.assert_allclose(f[:3, 0], 100.0 * ic, rtol=1e-12)
     np.testing.assert_allclose(f[3], [100.0 * 150.0 / (L * 4 * wc), 80.0 * 150.0 / (L * 4 * wc)],
                                rtol=1e-12)
-    damped = Amb(**{**GEOMETRY, "resistance": 2.0}, current_limit=4.0, supply_voltage=150.0)
+    damped = Amb(**{**GEOMETRY, "resistance": 2.0}, current_limit=1.5, supply_voltage=150.0)
     ki = amb_factors(damped)[0][0]
     assert force_capacity(damped, [3 * wc])[0, 0] == pytest.approx(
         ki * (150.0 - 2.0 * 2.5) / math.hypot(2.0, 3 * wc * L), rel=1e-12)
-    plain = Amb(**GEOMETRY, current_limit=4.0)
+    plain = Amb(**GEOMETRY, current_limit=1.5)
     free = force_capacity(plain, [0.0, 1e6])
     np.testing.assert_allclose(free[:, 0], amb_factors(plain)[0][0] * ic, rtol=1e-12)
+    wide = Amb(**GEOMETRY, current_limit=6.0)
+    assert force_capacity(wide, [0.0])[0, 0] == pytest.approx(amb_factors(wide)[0][0] * 2.5,
+                                                               rel=1e-12)
+
+
+def test_amplifier_use_is_the_current_and_voltage_against_their_limits():
+    """Closed forms: a control current of amplitude i_c at ω uses i_c/i0 of the linear
+    range, i_c/i_lim of the current limit and (R i0 + |R + jωL| i_c)/V of the supply; at
+    the force capacity's current (:func:`force_capacity` / Ki) the binding limit is used
+    exactly (1) and the others less; limits the rig file does not give are None."""
+    amb = Amb(**{**GEOMETRY, "resistance": 2.0}, current_limit=1.5, supply_voltage=150.0)
+    L, ki = coil_inductance(amb), amb_factors(amb)[0][0]
+    w = np.array([0.0, 100.0, 2e3, 2e4])
+    ic = force_capacity(amb, w)[:, 0] / ki
+    use = amplifier_use(amb, w, ic)
+    np.testing.assert_allclose(use["bias_used"], ic / 2.5, rtol=1e-12)
+    np.testing.assert_allclose(use["current_used"], ic / 1.5, rtol=1e-12)
+    np.testing.assert_allclose(use["voltage_used"],
+                               (2.0 * 2.5 + np.hypot(2.0, w * L) * ic) / 150.0, rtol=1e-12)
+    binding = np.maximum.reduce([use["bias_used"], use["current_used"], use["voltage_used"]])
+    np.testing.assert_allclose(binding, 1.0, rtol=1e-12)
+    assert use["current_used"][-1] < 1 and use["voltage_used"][0] < 1
+    bare = amplifier_use(Amb(**GEOMETRY), [10.0], [1.0])
+    assert bare["current_used"] is None and bare["voltage_used"] is None
+    with pytest.raises(ConfigError, match="2 current amplitudes for 1"):
+        amplifier_use(amb, [10.0], [1.0, 2.0])
 
 
 def test_load_capacity_is_the_force_law_at_saturation():
@@ -86,7 +114,6 @@ def test_load_capacity_is_the_force_law_at_saturation():
 @pytest.mark.parametrize(("extra", "match"), [
     ({"turns": None, "pole_area": None, "air_gap": None, "bias_current": None, "ki": 50.0,
       "ks": 1e5}, "needs bias_current"),
-    ({"current_limit": 2.0}, "not above the bias current"),
     ({"supply_voltage": 4.0, "resistance": 2.0}, "does not drive the bias current"),
     ({"turns": None, "pole_area": None, "air_gap": None, "ki": 50.0, "ks": 1e5,
       "supply_voltage": 100.0}, "needs the coil's inductance"),

@@ -127,6 +127,30 @@ def test_verdict_holds_only_where_the_machine_runs_up_too():
     assert "stable from standstill to the top speed" in good.words()
 
 
+def test_verdict_says_what_the_unbalance_asks_of_the_amplifier():
+    """The design summary's ``capacity`` block in words: the larger of the voltage and
+    current fractions, with the axis, the speed in rpm and the condition; above 1 the
+    amplifier saturates and the sentence says by how much; no limits, no words."""
+    from ambseal.report.verdict import verdicts
+
+    case = _metrics()[0]
+    where = {"condition": "2.04 bar", "speed_hz": 183.3, "axis": "A_zeta"}
+    cap = {"current_used": 0.31, "voltage_used": 0.64, "bias_used": 0.31, "current_a": 1.9,
+           "worst": {"current_used": dict(where, axis="B_eta"), "voltage_used": where}}
+    v = verdicts([case], None, (), {case["controller"]: {"capacity": cap}})[0]
+    assert v.amplifier_text() == ("holding the unbalance it uses 64 % of the supply voltage "
+                                  "(A ζ at 10 998 rpm, 2.04 bar)")
+    assert "; holding the unbalance it uses 64 %" in v.words()
+    hot = dict(cap, current_used=1.5)
+    v = verdicts([case], None, (), {case["controller"]: {"capacity": hot}})[0]
+    assert v.amplifier_text() == ("the amplifier saturates holding the unbalance: it needs "
+                                  "1.5× the current limit (B η at 10 998 rpm, 2.04 bar)")
+    bare = dict(cap, current_used=None, voltage_used=None)
+    assert verdicts([case], None, (), {case["controller"]: {"capacity": bare}}
+                    )[0].amplifier_text() == ""
+    assert verdicts([case])[0].amplifier_text() == ""
+
+
 def test_bad_inputs_raise(tmp_path):
     """Reference: interface contract — a non-PNG figure or an empty section raises AmbsealError."""
     bad = tmp_path / "x.png"

@@ -55,6 +55,7 @@ from ambseal.analysis.loops import (
 )
 from ambseal.analysis.response import impulse_response_of
 from ambseal.analysis.spinup import frozen_sensitivity, spinup
+from ambseal.analysis.amplifier import unbalance_currents
 from ambseal.analysis.unbalance import unbalance_from_compliance
 from ambseal.design import RIGID_STATES, vertex_grid_hz
 from ambseal.design.lpv_plant import lpv_plant
@@ -443,7 +444,9 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
         its loop's numbers in ``case.discrete`` (plus ``max_abs_pole_z`` and
         ``sample_rate_hz``). ``case.to_dict()`` is the ``metrics.json`` form.
     curves : dict
-        ``So``, ``compliance``, ``unbalance`` (frequency Hz, values) and ``impulse``
+        ``So``, ``compliance``, ``unbalance`` (frequency Hz, values),
+        ``unbalance_current`` (speeds Hz, the current references per axis in A,
+        :func:`~ambseal.analysis.amplifier.unbalance_currents`, the axes' names) and ``impulse``
         (:class:`~ambseal.analysis.response.ImpulseResponse`) for the figures, and
         ``poles`` (the closed-loop poles, rad/s); the discrete loop's under
         ``curves["discrete"]`` (its ``poles`` are z).
@@ -516,6 +519,10 @@ def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, im
                                     grade_mm_s=s.unbalance_grade_mm_s, law=s.unbalance_law,
                                     max_speed_rad_s=2 * math.pi * s.unbalance_max_speed_hz)
     curves["unbalance"] = (unb.speed_hz, unb.response_um)
+    # the current references that hold it, per axis (ambseal.analysis.amplifier)
+    curves["unbalance_current"] = (unb.speed_hz,
+                                   unbalance_currents(Kw[w.size:], cu.H_m_per_n, unb.force_n),
+                                   tuple(nu_names))
     case.update(compliance_peak_m_per_n=c.peak.value, unbalance_peak_um=unb.peak_um)
     if not impulse or s.impulse_a is None:
         case.update(impulse_peak_um=None, impulse_settling_s=None)

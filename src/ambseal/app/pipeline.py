@@ -17,6 +17,7 @@ from ambseal.analysis import (
     JudgeSettings,
     OperatingPoint,
     also_failed,
+    capacity_block,
     frozen_at,
     judge_case,
     judge_jobs,
@@ -479,6 +480,16 @@ def _note_speed_lpv(st: _RunState) -> None:
                                                      "range")
 
 
+def _unbalance_currents(method: str, jobs, judged):
+    """The unbalance's current references of ``method``'s stable judged loops, as it runs
+    where it runs sampled: ``(condition, speeds Hz, currents, axes)`` for
+    :func:`~ambseal.analysis.amplifier.capacity_block`."""
+    for job, (case, curves) in zip(jobs, judged):
+        c = curves.get("discrete", curves)
+        if job.name == method and "unbalance_current" in c:
+            yield (case.label, *c["unbalance_current"])
+
+
 def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path: Path,
                         truth, command: str | None) -> dict:
     """Export the delivered controllers, run the speed-scheduled and tracked extras, write
@@ -492,6 +503,8 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
     held = {m for m, f in st.failed.items() if f.designed and not st.allow_unstable}
     summaries = export_all(st.designs, {m: g for m, g in st.digitals.items() if m not in held},
                            case_dicts, out / "controllers")
+    for m, summary in summaries.items():
+        summary["capacity"] = capacity_block(cfg, _unbalance_currents(m, st.jobs, st.judged))
     ident = st.ident
     figs, sections = ([], []) if ident is None else (ident.figs, ident.sections)
     spinup = ramp = None

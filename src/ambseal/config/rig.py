@@ -41,7 +41,8 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     poles of a pole pair of an 8-pole heteropolar bearing) or ``ki`` (N/A) and ``ks`` (N/m),
     each a number or ``{ zeta = ..., eta = ... }``; with the geometry, a factor given
     explicitly (also for one axis only) wins over the geometry's
-    (:func:`ambseal.model.amb.amb_factors`). Also optional ``current_limit`` (A) and
+    (:func:`ambseal.model.amb.amb_factors`). Also optional ``current_limit`` (A, the
+    amplifier's limit on the control current) and
     ``backup_clearance`` (m, radial clearance of the backup bearing beside the AMB); the
     report sets the worst unbalance orbit against it and against ``air_gap``. The amplifier
     and coil (:mod:`ambseal.model.capacity`): ``supply_voltage`` (V), ``inductance`` (H,

@@ -11,7 +11,8 @@ Each element owns its matrices and parameter channels; the rig only assembles th
   amplifier and the eddy-current lag (:func:`actuator_matrices`,
   :func:`eddy_lag_matrices`); what it can deliver: its coil's inductance, force capacity
   against frequency and static load capacity (:func:`coil_inductance`,
-  :func:`force_capacity`, :func:`load_capacity`);
+  :func:`force_capacity`, :func:`load_capacity`) and the fractions of its limits a
+  control current uses (:func:`amplifier_use`);
 * :class:`SealElement` — Childs' seal force (P4 Eq. 3), its coefficients against the
   pressure drop (:func:`seal_coefficients`, :func:`seal_values`,
   :func:`coefficient_value`, P5 §4.1), and the coefficients that follow a tracked one
@@ -46,7 +47,8 @@ _FROM = {
     "AmbElement": "amb", "actuator_matrices": "amb", "amb_factors": "amb",
     "axes_rotation": "amb", "bias_current": "amb", "bias_currents": "amb",
     "channel_names": "amb", "eddy_lag_matrices": "amb", "coil_inductance": "capacity",
-    "force_capacity": "capacity", "load_capacity": "capacity", "BeamElement": "fe",
+    "force_capacity": "capacity", "load_capacity": "capacity", "amplifier_use": "capacity",
+    "AXES": "amb", "BeamElement": "fe",
     "CouplingElement": "fe",
     "DiskElement": "fe", "Channel": "lft", "Parameter": "lft", "Plant": "lft",
     "Modes": "modes", "PoleDisk": "modes", "RIGID_BODY_RAD_S": "modes",

@@ -13,8 +13,10 @@ cos α = μ0 N² A i² cos α / (4 s²), the k of :func:`ambseal.model.amb.amb_f
 
 The force amplitude an axis can hold at a frequency ω (rad/s) is Ki times the largest
 control-current amplitude i_c its amplifier can drive there: the linear range of the
-differential pair (i_c ≤ i0: neither coil's current below zero), the current limit
-(i0 + i_c ≤ ``current_limit``) and the voltage, R i0 + |R + jωL| i_c ≤ ``supply_voltage``
+differential pair (i_c ≤ i0: neither coil's current below zero), the amplifier's limit on
+the control current (i_c ≤ ``current_limit``, the limit the virtual facility clips the
+current reference at, :mod:`ambseal.identify.facility`) and the voltage,
+R i0 + |R + jωL| i_c ≤ ``supply_voltage``
 — at high frequency i_c ≤ V/(ωL), the amplifier's slew rate di/dt ≤ V/L, so the force
 capacity falls as Ki V/(L ω) (Maslen's force slew-rate limit; Schweitzer & Maslen 2009).
 A limit the rig file does not give does not bound it.
@@ -35,7 +37,7 @@ from ambseal.config import Amb
 from ambseal.errors import ConfigError
 from ambseal.model.amb import MU0, amb_factors
 
-__all__ = ["coil_inductance", "force_capacity", "load_capacity"]
+__all__ = ["coil_inductance", "force_capacity", "load_capacity", "amplifier_use"]
 
 
 def coil_inductance(amb: Amb) -> float | None:
@@ -73,43 +75,99 @@ def force_capacity(amb: Amb, omega) -> np.ndarray:
     Returns
     -------
     numpy.ndarray, shape (F, 2)
-        Per frequency, (ζ, η): Ki·min(i0, current_limit − i0, (V − R i0)/|R + jωL|), the
+        Per frequency, (ζ, η): Ki·min(i0, current_limit, (V − R i0)/|R + jωL|), the
         limits the rig file does not give left out.
 
     Raises
     ------
     ConfigError
-        No bias current, a Ki that is not known, a negative frequency, a current limit at
-        or below the bias or a supply voltage at or below R·i0 (the amplifier cannot hold
-        the bias), or a supply voltage without an inductance to take it through.
+        No bias current, a Ki that is not known, a negative frequency, a supply voltage at
+        or below R·i0 (the amplifier cannot hold the bias), or a supply voltage without an
+        inductance to take it through.
     """
-    w = np.atleast_1d(np.asarray(omega, float))
-    where = f"amb {amb.name}"
-    if w.ndim != 1 or not np.all(np.isfinite(w)) or np.any(w < 0):
-        raise ConfigError(f"{where}: force capacity: expected frequencies ≥ 0 rad/s")
+    w = _frequencies(amb, omega)
     ki = amb_factors(amb)[0]
-    if amb.bias_current is None or None in ki:
-        raise ConfigError(f"{where}: the force capacity needs bias_current (A) and Ki (or "
-                          "the geometry)")
-    i0 = float(amb.bias_current)
+    if None in ki:
+        raise ConfigError(f"amb {amb.name}: the force capacity needs bias_current (A) and "
+                          "Ki (or the geometry)")
+    i0, limit, coil = _amplifier(amb)
     bound = np.full(w.shape, i0)
-    if amb.current_limit is not None:
-        if amb.current_limit <= i0:
-            raise ConfigError(f"{where}: current_limit = {amb.current_limit:g} A is not above "
-                              f"the bias current {i0:g} A")
-        bound = np.minimum(bound, amb.current_limit - i0)
-    if amb.supply_voltage is not None:
-        L, R = coil_inductance(amb), float(amb.resistance or 0.0)
-        if L is None:
-            raise ConfigError(f"{where}: supply_voltage needs the coil's inductance (H) or "
-                              "the geometry (turns, pole_area, air_gap) to derive it")
-        headroom = amb.supply_voltage - R * i0
-        if headroom <= 0:
-            raise ConfigError(f"{where}: supply_voltage = {amb.supply_voltage:g} V does not "
-                              f"drive the bias current through R = {R:g} Ω")
+    if limit is not None:
+        bound = np.minimum(bound, limit)
+    if coil is not None:
+        L, R, headroom = coil
         with np.errstate(divide="ignore"):  # R = 0 at ω = 0: no voltage bound (inf)
             bound = np.minimum(bound, headroom / np.hypot(R, w * L))
     return bound[:, None] * np.asarray(ki, float)[None, :]
+
+
+def amplifier_use(amb: Amb, omega, current_a) -> dict:
+    """The fractions of an AMB axis's limits a sinusoidal control current uses (module
+    docstring): 1 is the limit, above it the amplifier saturates or a coil's current
+    would go below zero.
+
+    Parameters
+    ----------
+    amb : Amb
+        One ``[[amb]]`` of the rig file, with its ``bias_current``.
+    omega : array_like, shape (F,)
+        Frequencies (rad/s), ≥ 0.
+    current_a : array_like, shape (F,)
+        The control current's amplitude (A, zero-to-peak) at each frequency.
+
+    Returns
+    -------
+    dict
+        Arrays of shape (F,): ``bias_used`` i_c/i0 (the differential pair's linear range),
+        ``current_used`` i_c/``current_limit`` and ``voltage_used``
+        (R i0 + |R + jωL| i_c)/``supply_voltage``; the last two None where the rig file
+        gives no such limit.
+
+    Raises
+    ------
+    ConfigError
+        As :func:`force_capacity`.
+    """
+    w = _frequencies(amb, omega)
+    ic = np.abs(np.asarray(current_a, float))
+    if ic.shape != w.shape:
+        raise ConfigError(f"amb {amb.name}: amplifier use: {ic.shape[0] if ic.ndim else 1} "
+                          f"current amplitudes for {w.size} frequencies")
+    i0, limit, coil = _amplifier(amb)
+    voltage = None
+    if coil is not None:
+        L, R, _ = coil
+        voltage = (R * i0 + np.hypot(R, w * L) * ic) / amb.supply_voltage
+    return {"bias_used": ic / i0, "current_used": None if limit is None else ic / limit,
+            "voltage_used": voltage}
+
+
+def _frequencies(amb: Amb, omega) -> np.ndarray:
+    w = np.atleast_1d(np.asarray(omega, float))
+    if w.ndim != 1 or not np.all(np.isfinite(w)) or np.any(w < 0):
+        raise ConfigError(f"amb {amb.name}: force capacity: expected frequencies ≥ 0 rad/s")
+    return w
+
+
+def _amplifier(amb: Amb) -> tuple:
+    """``(i0, current_limit or None, (L, R, V − R i0) or None)`` of an AMB; ConfigError as
+    :func:`force_capacity`."""
+    where = f"amb {amb.name}"
+    if amb.bias_current is None:
+        raise ConfigError(f"{where}: the force capacity needs bias_current (A) and Ki (or "
+                          "the geometry)")
+    i0 = float(amb.bias_current)
+    if amb.supply_voltage is None:
+        return i0, amb.current_limit, None
+    L, R = coil_inductance(amb), float(amb.resistance or 0.0)
+    if L is None:
+        raise ConfigError(f"{where}: supply_voltage needs the coil's inductance (H) or "
+                          "the geometry (turns, pole_area, air_gap) to derive it")
+    headroom = amb.supply_voltage - R * i0
+    if headroom <= 0:
+        raise ConfigError(f"{where}: supply_voltage = {amb.supply_voltage:g} V does not "
+                          f"drive the bias current through R = {R:g} Ω")
+    return i0, amb.current_limit, (L, R, headroom)
 
 
 def load_capacity(amb: Amb) -> float | None:

@@ -116,6 +116,9 @@ class Verdict:
         conditions, e.g. ``"A ζ at 4.08 bar"``; None without per-axis peaks.
     axes_alike : bool
         Every axis is in the same zone at every stable condition.
+    capacity : dict or None
+        The amplifier's limits the unbalance uses (the design summary's ``capacity``,
+        :func:`ambseal.analysis.amplifier.capacity_block`); None without one.
     """
 
     controller: str
@@ -135,6 +138,7 @@ class Verdict:
     design_bound: str | None = None
     worst_axis: str | None = None
     axes_alike: bool = True
+    capacity: dict | None = None
 
     @property
     def judged_range(self) -> str:
@@ -168,6 +172,23 @@ class Verdict:
                         for n, c in self.clearances_um.items() if c)
         return f"{sig(self.orbit_um)} µm" + (f" ({rel})" if rel else "")
 
+    def amplifier_text(self) -> str:
+        """``"the unbalance uses 64 % of the supply voltage (A ζ at 11 000 rpm, 0 bar)"``,
+        or that it saturates the amplifier; ``""`` without limits to set it against."""
+        c = self.capacity or {}
+        used = [(c[q], what, c["worst"][q]) for q, what in
+                (("voltage_used", "the supply voltage"), ("current_used", "the current limit"))
+                if c.get(q) is not None]
+        if not used:
+            return ""
+        over = [u for u in used if u[0] > 1]
+        v, what, w = max(over or used, key=lambda u: u[0])
+        rpm = f"{60 * w['speed_hz']:,.0f}".replace(",", " ")
+        at = f"{axis_label(w['axis'])} at {rpm} rpm, {w['condition']}"
+        if over:
+            return f"the amplifier saturates holding the unbalance: it needs {sig(v)}× {what} ({at})"
+        return f"holding the unbalance it uses {100 * v:.0f} % of {what} ({at})"
+
     def words(self) -> str:
         """The verdict in one sentence."""
         if self.unstable_at or self.speed_unstable:
@@ -195,6 +216,9 @@ class Verdict:
         if self.orbit_um is not None and gap and self.orbit_um > 0.5 * min(gap):
             text += "; the unbalance orbit uses over half of the clearance"
 
+        amp = self.amplifier_text()
+        if amp:
+            text += f"; {amp}"
         if self.target_difference is not None and self.target_difference > PEAK_TOLERANCE:
             text += (f"; as it runs on the target its σ̄(S_o) peak differs from the continuous "
                      f"one by {100 * self.target_difference:.0f} % (see “On the target”)")
@@ -288,7 +312,7 @@ def _verdict(name: str, cs: list, by_speed: bool, sc: list,
         speed_checked=len(sc), speed_unstable=speed_bad,
         design_bound=(design.get("verdict") or "").split(";")[0] or None,
         worst_axis=None if top is None else f"{axis_label(top[1])} at {top[2]}",
-        axes_alike=len(stable_zones) <= 1)
+        axes_alike=len(stable_zones) <= 1, capacity=design.get("capacity"))
 
 
 def _worst_axis(labels: list[str], cs: list) -> tuple | None:

@@ -1,0 +1,104 @@
+"""What the judged unbalance response asks of each AMB's amplifier.
+
+The judgement bounds the synchronous orbit by σ̄(S_o G_f(jΩ))·F_u(Ω) over every
+distribution of an unbalance force of amplitude F_u over the bearing planes
+(:mod:`ambseal.analysis.unbalance`). The control current the loop commands for that force is
+i = −K S_o G_f f, so the current reference of axis a, over the same forces, is at most
+
+    i_ref,a(Ω) = ‖(K S_o G_f)(jΩ)_a,:‖₂ · F_u(Ω)
+
+(the row's Euclidean norm: the worst distribution for that axis), and its coil current
+i_c = |H_a(jΩ)|·i_ref with H_a the amplifier's current loop (``[actuator]``,
+:func:`ambseal.model.amb.actuator_matrices`). Set against the bearing's limits
+(:func:`ambseal.model.capacity.amplifier_use`: the linear range i0, ``current_limit``,
+``supply_voltage`` through R and L) this is the fraction of each limit the controller uses to
+hold the unbalance; above 1 the amplifier saturates (Schweitzer & Maslen, *Magnetic
+Bearings*, 2009, ch. 5 and 15). A discrete loop's current is taken at its samples (the
+held value's fundamental is sinc(ΩT/2π) ≤ 1 of it: the fractions err on the safe side).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ambseal.model import AXES, actuator_matrices, amplifier_use
+
+__all__ = ["unbalance_currents", "capacity_block"]
+
+#: The fractions of :func:`ambseal.model.capacity.amplifier_use`, as metrics.json names them.
+QUANTITIES = ("current_used", "voltage_used", "bias_used")
+
+
+def unbalance_currents(Kw: np.ndarray, H: np.ndarray, force_n: np.ndarray) -> np.ndarray:
+    """The current reference (A, amplitude) each axis commands against the worst-case
+    unbalance (module docstring).
+
+    Parameters
+    ----------
+    Kw : ndarray of complex, shape (F, nu, ny)
+        The controller at each speed (``jΩ`` or ``e^{jΩT}``).
+    H : ndarray of complex, shape (F, ny, nf)
+        ``S_o G_f`` at the same points (the compliance, m/N).
+    force_n : ndarray, shape (F,)
+        The unbalance force amplitude F_u (N) at each speed.
+
+    Returns
+    -------
+    ndarray, shape (F, nu)
+    """
+    return np.linalg.norm(Kw @ H, axis=2) * np.asarray(force_n, float)[:, None]
+
+
+def capacity_block(cfg, entries) -> dict | None:
+    """The largest fraction of each amplifier limit a controller uses over its judged
+    conditions (module docstring), as ``metrics.json`` writes it.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig: its ``[[amb]]`` limits and ``[actuator]``.
+    entries : iterable of (str, ndarray, ndarray, sequence of str)
+        Per judged condition of the controller: its label, the speeds Ω/2π (Hz, shape
+        (F,)), the current references (A, shape (F, nu), :func:`unbalance_currents`) and
+        the axes' input names (``i_<amb>_<axis>``).
+
+    Returns
+    -------
+    dict or None
+        ``current_used``, ``voltage_used``, ``bias_used`` (the largest fraction, None where
+        no AMB gives the limit), ``current_a`` (the largest coil current amplitude, A) and
+        ``worst`` (per quantity: ``condition``, ``speed_hz``, ``axis``); None when no
+        condition was judged stable or the rig's AMBs give no bias current.
+    """
+    by_axis = {f"i_{amb.name}_{ax}": amb for amb in cfg.amb for ax in AXES}
+    if not cfg.amb or any(a.bias_current is None for a in cfg.amb):
+        return None
+    A, B, C, D = actuator_matrices(cfg.actuator)
+    best: dict = {q: (None, None) for q in (*QUANTITIES, "current_a")}
+    for label, speed_hz, i_ref, names in entries:
+        w = 2 * np.pi * np.asarray(speed_hz, float)
+        gain = np.abs(_siso(A, B, C, D, 1j * w))
+        for a, name in enumerate(names):
+            ic = gain * i_ref[:, a]
+            use = amplifier_use(by_axis[name], w, ic)
+            use["current_a"] = ic
+            for q, v in use.items():
+                if v is None:
+                    continue
+                k = int(np.argmax(v))
+                if best[q][0] is None or v[k] > best[q][0]:
+                    best[q] = (float(v[k]), {"condition": label,
+                                             "speed_hz": float(speed_hz[k]),
+                                             "axis": name.removeprefix("i_")})
+    if best["current_a"][0] is None:
+        return None
+    return {**{q: best[q][0] for q in (*QUANTITIES, "current_a")},
+            "worst": {q: best[q][1] for q in QUANTITIES if best[q][1] is not None}}
+
+
+def _siso(A, B, C, D, s: np.ndarray) -> np.ndarray:
+    """C (sI − A)⁻¹ B + D of a SISO state space at each point of ``s``."""
+    if A.size == 0:
+        return np.full(s.shape, complex(D[0, 0]))
+    n = A.shape[0]
+    return np.array([(C @ np.linalg.solve(x * np.eye(n) - A, B) + D)[0, 0] for x in s])

@@ -1,0 +1,89 @@
+"""What the judged unbalance asks of the amplifiers (analysis/amplifier.py), against
+python-control's frequency responses of the same loop and the closed forms of the limits."""
+
+import math
+
+import control as ct
+import numpy as np
+import pytest
+
+from ambseal.analysis.amplifier import capacity_block
+from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
+from ambseal.analysis.unbalance import unbalance_force
+from ambseal.design.specs import design_spec
+from ambseal.model.rig import build_plant
+
+
+@pytest.fixture(scope="module")
+def judged(testrig_cfg, testrig_designs):
+    """The embedded rig's H∞ controller judged at 0 bar (continuous, with its delay)."""
+    s = judge_settings(design_spec(testrig_cfg))
+    K = testrig_designs["hinf"].K
+    case, curves = judge(testrig_cfg, K, "hinf", OperatingPoint(0.0, 0.0, "0 bar"), s,
+                         impulse=False)
+    return s, K, case, curves
+
+
+def test_unbalance_current_is_the_controller_on_the_compliance(testrig_cfg, judged):
+    """Reference: python-control's responses of the same loop at the axis's worst speed —
+    the plant from the currents and from the forces at the bearings, the controller with
+    its hold and computation delay as e^{−jΩτ} (τ = (n_d + ½)/f_s, exact, where the judge
+    takes its Padé system) — i = K (I + G K)⁻¹ G_f f over every force of amplitude F_u
+    (ISO 21940-11 at that speed): its largest value on an axis is the row's Euclidean norm
+    times F_u. To 1 %."""
+    s, K, case, curves = judged
+    speeds, current, names = curves["unbalance_current"]
+    assert current.shape == (speeds.size, 4) and names[0].startswith("i_")
+    pl = build_plant(testrig_cfg, pressure_bar=0.0, force_positions=tuple(s.force_positions_m))
+    P = pl.to_statespace()
+    cur = [j for j, n in enumerate(P.input_labels) if n.startswith("i_")]
+    frc = [j for j in range(P.ninputs) if j not in cur]
+    tau = (testrig_cfg.controller.delay_samples + 0.5) / testrig_cfg.controller.sample_rate_hz
+    for a in (0, 3):
+        k = int(np.argmax(current[:, a]))
+        w = 2 * math.pi * speeds[k]
+        H = ct.frequency_response(P, [w], squeeze=False).complex[:, :, 0]
+        Kf = ct.frequency_response(K, [w], squeeze=False).complex[:, :, 0]
+        # the controller's channels in the plant's order, by name
+        Kw = Kf[[list(K.output_labels).index(P.input_labels[j]) for j in cur]][
+            :, [list(K.input_labels).index(n) for n in P.output_labels]] * np.exp(-1j * w * tau)
+        G, Gf = H[:, cur], H[:, frc]
+        T = Kw @ np.linalg.solve(np.eye(G.shape[0]) + G @ Kw, Gf)
+        F = unbalance_force(s.unbalance_mass_kg, s.unbalance_grade_mm_s, [w],
+                            max_speed_rad_s=2 * math.pi * s.unbalance_max_speed_hz,
+                            law=s.unbalance_law)[0]
+        assert P.input_labels[cur[a]] == names[a]
+        assert current[k, a] == pytest.approx(np.linalg.norm(T[a]) * F, rel=1e-2)
+
+
+def test_capacity_block_names_the_limit_and_where(testrig_cfg, judged):
+    """Reference: the closed forms of the limits on the judged currents. The rig's
+    ``current_limit`` (6 A, the bias) used as i_c/6 at the worst axis and speed; a supply
+    voltage set to half of what the worst point needs (R = 0, L given: |jΩL|·|H_a|·i over
+    the speeds, H_a the rig's second-order amplifier) is used 2× — reported above 1 with the
+    speed and the axis where it happens; a rig without voltage or inductance gets None."""
+    _, _, case, curves = judged
+    speeds, current, names = curves["unbalance_current"]
+    entries = [("0 bar", speeds, current, names)]
+    block = capacity_block(testrig_cfg, entries)
+    wn, zeta = testrig_cfg.actuator.natural_frequency, testrig_cfg.actuator.damping_ratio
+    sw = 2j * math.pi * speeds
+    ha = np.abs(wn ** 2 / (sw ** 2 + 2 * zeta * wn * sw + wn ** 2))
+    coil = ha[:, None] * current
+    assert block["current_a"] == pytest.approx(coil.max(), rel=1e-9)
+    assert block["current_used"] == pytest.approx(coil.max() / 6.0, rel=1e-9)
+    assert block["voltage_used"] is None
+    k, a = np.unravel_index(np.argmax(coil), coil.shape)
+    assert block["worst"]["current_used"] == {"condition": "0 bar",
+                                              "speed_hz": pytest.approx(speeds[k]),
+                                              "axis": names[a].removeprefix("i_")}
+    L = 0.01
+    need = 2 * math.pi * speeds[:, None] * L * coil
+    v = float(need.max()) / 2
+    ambs = [a.model_copy(update={"supply_voltage": v, "inductance": L})
+            for a in testrig_cfg.amb]
+    low = capacity_block(testrig_cfg.model_copy(update={"amb": ambs}), entries)
+    assert low["voltage_used"] == pytest.approx(2.0, rel=1e-9)
+    k, a = np.unravel_index(np.argmax(need), need.shape)
+    assert low["worst"]["voltage_used"]["speed_hz"] == pytest.approx(speeds[k])
+    assert low["worst"]["voltage_used"]["axis"] == names[a].removeprefix("i_")

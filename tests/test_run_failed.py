@@ -198,3 +198,34 @@ def test_run_on_a_stronger_seal_reports_every_controller(example, tmp_path, caps
         if bad:
             assert len(m["failed"][name]["conditions"]) == len(bad)
             assert f"ambseal: {m['failed'][name]['reason']}" in err
+
+
+def test_a_controller_whose_amplifier_saturates_is_not_delivered(tmp_path, capsys):
+    """The embedded rig with a 1 V supply and 10 mH coils (R = 0): holding the judged
+    unbalance needs about 2.7 V (|jΩL|·i near the top of the unbalance band), so H∞ and μ,
+    stable everywhere, fail on their amplifiers: marked with the condition, the speed and
+    the axis, not exported, exit 1; the fraction in metrics.json is the one the reason
+    names."""
+    text = default_rig_path().read_text()
+    assert text.count("current_limit = 6.0\n") == 2
+    rig = tmp_path / "weak_amplifier.toml"
+    rig.write_text(text.replace("current_limit = 6.0\n", "current_limit = 6.0\n"
+                                "supply_voltage = 1.0\ninductance = 0.01\n"))
+    out = tmp_path / "run"
+    code = main(["run", str(rig), "--no-identify", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 1, err
+    m = json.loads((out / "metrics.json").read_text())
+    validate_metrics(m)
+    for name in ("hinf", "mu"):
+        cap = m["controllers"][name]["capacity"]
+        assert cap["voltage_used"] > 1 and cap["current_used"] < 1
+        w = cap["worst"]["voltage_used"]
+        f = m["failed"][name]
+        assert f["designed"] and f["judged"] and f["conditions"] == [w["condition"]]
+        assert (f"the amplifier saturates holding the unbalance: it needs "
+                f"{cap['voltage_used']:.3g}× the supply voltage") in f["reason"]
+        assert f"{60 * w['speed_hz']:,.0f} rpm".replace(",", " ") in f["reason"]
+        assert f"ambseal: {f['reason']}" in err
+    assert not any("hinf" in p.name or "mu" in p.name for p in (out / "controllers").iterdir())
+    check_report_agrees(out)

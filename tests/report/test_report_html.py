@@ -130,7 +130,8 @@ def test_verdict_holds_only_where_the_machine_runs_up_too():
 def test_verdict_says_what_the_unbalance_asks_of_the_amplifier():
     """The design summary's ``capacity`` block in words: the larger of the voltage and
     current fractions, with the axis, the speed in rpm and the condition; above 1 the
-    amplifier saturates and the sentence says by how much; no limits, no words."""
+    amplifier saturates, the controller is not acceptable and the sentence says by how
+    much; no limits, no words."""
     from ambseal.report.verdict import verdicts
 
     case = _metrics()[0]
@@ -145,6 +146,7 @@ def test_verdict_says_what_the_unbalance_asks_of_the_amplifier():
     v = verdicts([case], None, (), {case["controller"]: {"capacity": hot}})[0]
     assert v.amplifier_text() == ("the amplifier saturates holding the unbalance: it needs "
                                   "1.5× the current limit (B η at 10 998 rpm, 2.04 bar)")
+    assert v.words() == f"Not acceptable: {v.amplifier_text()}."
     bare = dict(cap, current_used=None, voltage_used=None)
     assert verdicts([case], None, (), {case["controller"]: {"capacity": bare}}
                     )[0].amplifier_text() == ""

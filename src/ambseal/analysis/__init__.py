@@ -59,13 +59,15 @@ from ambseal.lazy import lazy_face
 
 #: Each public name (``__all__``) and the module that defines it.
 _FROM = {
-    "capacity_block": "amplifier", "unbalance_currents": "amplifier",
+    "capacity_block": "amplifier", "capacity_words": "amplifier",
+    "saturates": "amplifier", "unbalance_currents": "amplifier",
     "closed_loop_modes": "campbell", "log_decrement": "campbell",
     "open_loop_modes": "campbell", "Campbell": "campbell", "ClosedLoopModes": "campbell",
     "OVERDAMPED_ZETA": "campbell", "AF_CRITICAL": "campbell", "dask_available": "cases",
     "probe_scheduler": "cases",
     "run_cases": "cases", "CaseError": "cases", "also_failed": "delivery",
-    "loop_failure": "delivery", "synthesis_failure": "delivery",
+    "loop_failure": "delivery", "saturation_failure": "delivery",
+    "synthesis_failure": "delivery",
     "FailedController": "delivery", "iso_assessment": "iso", "zone_limit_db": "iso",
     "IsoAssessment": "iso", "ZONES": "iso", "ZONE_LIMITS": "iso", "frozen_at": "judge",
     "judge_case": "judge", "judge_jobs": "judge", "judge_settings": "judge",

@@ -21,12 +21,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from ambseal.model import AXES, actuator_matrices, amplifier_use
+from ambseal.model import AXES, actuator_matrices, amplifier_use, axis_label
 
-__all__ = ["unbalance_currents", "capacity_block"]
+__all__ = ["unbalance_currents", "capacity_block", "capacity_words", "saturates"]
 
-#: The fractions of :func:`ambseal.model.capacity.amplifier_use`, as metrics.json names them.
+#: The fractions of :func:`ambseal.model.capacity.amplifier_use`, as metrics.json names them,
+#: and what each is a fraction of, in words.
 QUANTITIES = ("current_used", "voltage_used", "bias_used")
+_LIMITS = {"voltage_used": "the supply voltage", "current_used": "the current limit",
+           "bias_used": "the bias current's linear range"}
 
 
 def unbalance_currents(Kw: np.ndarray, H: np.ndarray, force_n: np.ndarray) -> np.ndarray:
@@ -94,6 +97,52 @@ def capacity_block(cfg, entries) -> dict | None:
         return None
     return {**{q: best[q][0] for q in (*QUANTITIES, "current_a")},
             "worst": {q: best[q][1] for q in QUANTITIES if best[q][1] is not None}}
+
+
+def saturates(block: dict | None) -> bool:
+    """A :func:`capacity_block` with a fraction above 1: the amplifier cannot deliver the
+    current the loop commands to hold the unbalance (or a coil's current would go below
+    zero, out of the linear force law the loop was designed on).
+
+    Parameters
+    ----------
+    block : dict or None
+        A :func:`capacity_block`.
+
+    Returns
+    -------
+    bool
+    """
+    return any((block or {}).get(q) is not None and block[q] > 1 for q in QUANTITIES)
+
+
+def capacity_words(block: dict | None) -> str:
+    """A :func:`capacity_block` in words: ``"holding the unbalance it uses 64 % of the
+    supply voltage (A ζ at 11 000 rpm, 0 bar)"``, the largest of the voltage and current
+    fractions; when a fraction is above 1, ``"the amplifier saturates holding the unbalance:
+    it needs 1.5× the current limit (…)"``; ``""`` without a limit to set it against.
+
+    Parameters
+    ----------
+    block : dict or None
+        A :func:`capacity_block`.
+
+    Returns
+    -------
+    str
+    """
+    c = block or {}
+    used = [(c[q], _LIMITS[q], c["worst"][q]) for q in QUANTITIES
+            if c.get(q) is not None and (q != "bias_used" or c[q] > 1)]
+    if not used:
+        return ""
+    over = [u for u in used if u[0] > 1]
+    v, what, w = max(over or used, key=lambda u: u[0])
+    rpm = f"{60 * w['speed_hz']:,.0f}".replace(",", " ")
+    at = f"{axis_label(w['axis'])} at {rpm} rpm, {w['condition']}"
+    if over:
+        return f"the amplifier saturates holding the unbalance: it needs {v:.3g}× {what} ({at})"
+    return f"holding the unbalance it uses {100 * v:.0f} % of {what} ({at})"
 
 
 def _siso(A, B, C, D, s: np.ndarray) -> np.ndarray:

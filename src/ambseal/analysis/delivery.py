@@ -21,9 +21,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ambseal.analysis.amplifier import capacity_words, saturates
 from ambseal.config import method_label
 
-__all__ = ["FailedController", "loop_failure", "synthesis_failure", "also_failed"]
+__all__ = ["FailedController", "loop_failure", "saturation_failure", "synthesis_failure",
+           "also_failed"]
 
 #: Between a failure's head (the controller, delivered or not) and why.
 _SEP = " — "
@@ -145,6 +147,33 @@ def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
         return None
     return FailedController(f"{_head(method, designed, kept, derived)}{_SEP}" + "; ".join(parts),
                             designed, True, where)
+
+
+def saturation_failure(method: str, capacity: dict | None, designed: bool,
+                       kept: bool = False, derived: bool = False) -> FailedController | None:
+    """The failure of a controller whose amplifiers saturate holding the judged unbalance
+    (:func:`ambseal.analysis.amplifier.saturates`), or None.
+
+    Parameters
+    ----------
+    method : str
+        The controller's method.
+    capacity : dict or None
+        Its :func:`~ambseal.analysis.amplifier.capacity_block`.
+    designed, kept, derived : bool
+        As :func:`loop_failure`.
+
+    Returns
+    -------
+    FailedController or None
+        Judged; its condition the one where the largest fraction is used.
+    """
+    if not saturates(capacity):
+        return None
+    worst = max(capacity["worst"], key=lambda q: capacity[q])
+    where = capacity["worst"][worst]["condition"]
+    return FailedController(f"{_head(method, designed, kept, derived)}{_SEP}"
+                            f"{capacity_words(capacity)}", designed, True, [where])
 
 
 def synthesis_failure(method: str, why: str) -> FailedController:

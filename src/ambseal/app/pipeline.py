@@ -26,6 +26,7 @@ from ambseal.analysis import (
     loop_failure,
     operating_points,
     run_cases,
+    saturation_failure,
     sign_off,
     speed_scheduled,
     stability_case,
@@ -499,12 +500,19 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
     case_dicts = [case.to_dict() for case in cases]
     curves = [(j.name, j.point, case, c)
               for j, case, (_, c) in zip(st.jobs, case_dicts, st.judged)]
+    capacity = {d.method: capacity_block(cfg, _unbalance_currents(d.method, st.jobs, st.judged))
+                for d in st.designs}
+    for m, block in capacity.items():  # an amplifier that saturates fails its controller
+        f = saturation_failure(m, block, designed=m != "pid", kept=st.allow_unstable,
+                               derived=cfg.controller.pid is None)
+        if f is not None:
+            st.failed[m] = also_failed(st.failed.get(m), f)
     # a failed design is judged and reported, not delivered (unless asked for)
     held = {m for m, f in st.failed.items() if f.designed and not st.allow_unstable}
     summaries = export_all(st.designs, {m: g for m, g in st.digitals.items() if m not in held},
                            case_dicts, out / "controllers")
     for m, summary in summaries.items():
-        summary["capacity"] = capacity_block(cfg, _unbalance_currents(m, st.jobs, st.judged))
+        summary["capacity"] = capacity.get(m)
     ident = st.ident
     figs, sections = ([], []) if ident is None else (ident.figs, ident.sections)
     spinup = ramp = None

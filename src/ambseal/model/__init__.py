@@ -48,7 +48,7 @@ _FROM = {
     "axes_rotation": "amb", "bias_current": "amb", "bias_currents": "amb",
     "channel_names": "amb", "eddy_lag_matrices": "amb", "coil_inductance": "capacity",
     "force_capacity": "capacity", "load_capacity": "capacity", "amplifier_use": "capacity",
-    "AXES": "amb", "BeamElement": "fe",
+    "AXES": "amb", "axis_label": "amb", "BeamElement": "fe",
     "CouplingElement": "fe",
     "DiskElement": "fe", "Channel": "lft", "Parameter": "lft", "Plant": "lft",
     "Modes": "modes", "PoleDisk": "modes", "RIGID_BODY_RAD_S": "modes",

@@ -22,7 +22,7 @@ from ambseal.config import Actuator, Amb, AxisPair, RigConfig
 from ambseal.model.lft import Channel
 from ambseal.model.rotor import Mesh, X, Y
 
-__all__ = ["AXES", "MU0", "axes_rotation", "channel_names", "bias_currents", "bias_current",
+__all__ = ["AXES", "MU0", "axes_rotation", "axis_label", "channel_names", "bias_currents", "bias_current",
            "amb_factors_from_geometry",
            "amb_factors", "AmbElement", "actuator_matrices", "eddy_lag_matrices"]
 
@@ -48,6 +48,21 @@ def axes_rotation(angle_deg: float) -> np.ndarray:
     """
     c, s = math.cos(math.radians(angle_deg)), math.sin(math.radians(angle_deg))
     return np.array([[c, s], [-s, c]])
+
+
+def axis_label(axis: str) -> str:
+    """An actuator axis as people write it: ``"A_zeta"`` → ``"A ζ"``.
+
+    Parameters
+    ----------
+    axis : str
+        ``{amb}_zeta`` or ``{amb}_eta`` (:func:`channel_names`).
+
+    Returns
+    -------
+    str
+    """
+    return axis.replace("_zeta", " ζ").replace("_eta", " η")
 
 
 def channel_names(cfg: RigConfig) -> tuple[str, ...]:

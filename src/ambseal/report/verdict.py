@@ -24,6 +24,8 @@ from rich.console import Group
 from rich.table import Table
 from rich.text import Text
 
+from ambseal.analysis import capacity_words, saturates
+from ambseal.model import axis_label
 from ambseal.robust import PEAK_TOLERANCE
 
 __all__ = ["ZONE_COLOURS", "ZONE_WORDS", "Verdict", "verdicts", "condition_label",
@@ -61,11 +63,6 @@ def sig(v: Any, digits: int = 3) -> str:
             return f"{m}·10^{int(e)}"
         return text
     return str(v)
-
-
-def axis_label(axis: str) -> str:
-    """``"A_zeta"`` → ``"A ζ"``."""
-    return axis.replace("_zeta", " ζ").replace("_eta", " η")
 
 
 def _speed_varies(cases: Sequence[Mapping]) -> bool:
@@ -173,21 +170,9 @@ class Verdict:
         return f"{sig(self.orbit_um)} µm" + (f" ({rel})" if rel else "")
 
     def amplifier_text(self) -> str:
-        """``"the unbalance uses 64 % of the supply voltage (A ζ at 11 000 rpm, 0 bar)"``,
-        or that it saturates the amplifier; ``""`` without limits to set it against."""
-        c = self.capacity or {}
-        used = [(c[q], what, c["worst"][q]) for q, what in
-                (("voltage_used", "the supply voltage"), ("current_used", "the current limit"))
-                if c.get(q) is not None]
-        if not used:
-            return ""
-        over = [u for u in used if u[0] > 1]
-        v, what, w = max(over or used, key=lambda u: u[0])
-        rpm = f"{60 * w['speed_hz']:,.0f}".replace(",", " ")
-        at = f"{axis_label(w['axis'])} at {rpm} rpm, {w['condition']}"
-        if over:
-            return f"the amplifier saturates holding the unbalance: it needs {sig(v)}× {what} ({at})"
-        return f"holding the unbalance it uses {100 * v:.0f} % of {what} ({at})"
+        """What holding the unbalance asks of the amplifier, in words
+        (:func:`ambseal.analysis.amplifier.capacity_words`); ``""`` without limits."""
+        return capacity_words(self.capacity)
 
     def words(self) -> str:
         """The verdict in one sentence."""
@@ -199,6 +184,8 @@ class Verdict:
                     and self.unstable_at else "")
             run = " (where the machine runs up)" if self.speed_unstable else ""
             return f"Not acceptable: the loop is unstable at {where}{run}{tail}."
+        if saturates(self.capacity):
+            return f"Not acceptable: {self.amplifier_text()}."
         z = self.zone_axis or "?"
         where = ("on every axis" if self.axes_alike or self.worst_axis is None else
                  f"on its worst axis ({self.worst_axis})")

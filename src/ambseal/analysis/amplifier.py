@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ambseal.lti import freqresp_at
 from ambseal.model import AXES, actuator_matrices, amplifier_use, axis_label
 
 __all__ = ["unbalance_currents", "capacity_block", "capacity_words", "saturates"]
@@ -76,11 +77,11 @@ def capacity_block(cfg, entries) -> dict | None:
     by_axis = {f"i_{amb.name}_{ax}": amb for amb in cfg.amb for ax in AXES}
     if not cfg.amb or any(a.bias_current is None for a in cfg.amb):
         return None
-    A, B, C, D = actuator_matrices(cfg.actuator)
+    act = actuator_matrices(cfg.actuator)
     best: dict = {q: (None, None) for q in (*QUANTITIES, "current_a")}
     for label, speed_hz, i_ref, names in entries:
         w = 2 * np.pi * np.asarray(speed_hz, float)
-        gain = np.abs(_siso(A, B, C, D, 1j * w))
+        gain = np.abs(freqresp_at(act, 1j * w)[:, 0, 0])
         for a, name in enumerate(names):
             ic = gain * i_ref[:, a]
             use = amplifier_use(by_axis[name], w, ic)
@@ -144,10 +145,3 @@ def capacity_words(block: dict | None) -> str:
         return f"the amplifier saturates holding the unbalance: it needs {v:.3g}× {what} ({at})"
     return f"holding the unbalance it uses {100 * v:.0f} % of {what} ({at})"
 
-
-def _siso(A, B, C, D, s: np.ndarray) -> np.ndarray:
-    """C (sI − A)⁻¹ B + D of a SISO state space at each point of ``s``."""
-    if A.size == 0:
-        return np.full(s.shape, complex(D[0, 0]))
-    n = A.shape[0]
-    return np.array([(C @ np.linalg.solve(x * np.eye(n) - A, B) + D)[0, 0] for x in s])

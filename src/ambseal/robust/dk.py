@@ -526,10 +526,12 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     fits: list = []
     stall, rule = 0, f"max_iter={max_iter}"
     last = None  # the previous complexified μ, for a D-step redone with static fits
+    near = None  # the last K-step's γ_opt
     for it in range(max_iter):
         Ps = _scaled_plant(P, cblocks, fits, nmeas, ncon) if fits else P
         try:
-            hr = hinfsyn(Ps, nmeas, ncon, backoff=backoff)
+            # the last K-step's γ_opt starts the search: a D-step moves it by a few %
+            hr = hinfsyn(Ps, nmeas, ncon, backoff=backoff, near=near)
         except SynthesisError as exc:
             if it == 0:
                 raise
@@ -549,6 +551,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
             if console is not None:
                 console.print(f"D-K {it}: the K-step failed on the fitted scalings ({exc}); "
                               "static scalings taken")
+        near = hr.gamma_opt
         cl = lft_lower(P, hr.K, nmeas, ncon)
         mu_c, curve = _mu_step(cl, blocks, cblocks, w)
         peak = float(np.max(curve))

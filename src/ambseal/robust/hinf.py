@@ -57,6 +57,11 @@ __all__ = ["HinfResult", "hinfsyn", "hinf_gamma_opt", "hinfnorm", "lft_lower", "
 #: for the Schur form in Python and 0.2 ms for SB10AD's test).
 _SMALL_STATES = 6
 
+#: The ladder's factor of a γ search started near γ_opt (``near``): D–K's K-steps move γ
+#: by a few % (b2b compressor: 4–15 %), so the bracket closes in one to three steps where
+#: a factor of 4 from γ = 1 leaves Brent's method a bracket of 4 to close.
+NEAR_FACTOR = 1.05
+
 _SB10AD_INFO = {
     1: "[A - jωI, B2; C1, D12] loses column rank on the imaginary axis (P12 has a jω zero)",
     2: "[A - jωI, B1; C2, D21] loses row rank on the imaginary axis (P21 has a jω zero)",
@@ -413,7 +418,8 @@ def _scale(A, B, C, D, nw, nz):
 @with_numerics_threads
 def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | None = None,
             max_backoff: float = 4.0, rtol: float = 1e-6,
-            regularise: float | None = REGULARISE_REL) -> HinfResult:
+            regularise: float | None = REGULARISE_REL, near: float | None = None
+            ) -> HinfResult:
     """H∞ controller for a generalised plant (Glover & Doyle 1988; Zhou, Doyle & Glover
     1996, ch. 14).
 
@@ -450,6 +456,10 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
         A ``D12`` or ``D21`` without full rank is made full rank by ε-channels of this
         relative size (:func:`regularise_plant`; stated in ``HinfResult.regularisation``);
         None refuses such a plant instead.
+    near : float, optional
+        A γ expected within a few % of γ_opt (a D–K iteration's previous γ_opt): the
+        search starts there (:meth:`_Sb10.gamma_opt`); the same γ_opt to ``rtol``, fewer
+        γ tests.
 
     Returns
     -------
@@ -500,7 +510,7 @@ def hinfsyn(P, nmeas: int, ncon: int, *, backoff: float = 1.01, gamma: float | N
                   inputs=P.input_labels, outputs=P.output_labels)
     sb = _Sb10(P, nmeas, ncon)
     if gamma is None:
-        gamma_opt, gamma_lower, tests = sb.gamma_opt(rtol, confirm=False)
+        gamma_opt, gamma_lower, tests = sb.gamma_opt(rtol, confirm=False, near=near)
         base_g, factors = gamma_opt, _backoff_ladder(backoff, max_backoff)
     else:
         gamma_opt, gamma_lower, tests = float("nan"), float("nan"), 0
@@ -559,14 +569,14 @@ def hinf_gamma_opt(P, nmeas: int, ncon: int, *, rtol: float = 1e-6,
     measurements, ``ncon`` controls) to relative tolerance ``rtol``, without a controller:
     the γ search of :func:`hinfsyn` alone, for callers that compare many plants (the D-scale
     search of :func:`ambseal.robust.dk.musyn`). ``near``: a γ expected within a few % of
-    γ_opt; the search then starts there with steps of 5 % and uses the Riccati margin alone
-    (no SB10AD cross-check). Raises as :func:`hinfsyn` (ModelError, SynthesisError)."""
+    γ_opt; the search then starts there with steps of :data:`NEAR_FACTOR` and uses the
+    Riccati margin alone (no SB10AD cross-check). Raises as :func:`hinfsyn` (ModelError, SynthesisError)."""
     check_plant(P, nmeas, ncon)
     sb = _Sb10(P, nmeas, ncon)
     if near is None:
         return float(sb.gamma_opt(rtol)[0])
     return float(_search_gamma(sb.riccati_margin, sb.parrott_bound, rtol, start=near,
-                               factor=1.05)[0])
+                               factor=NEAR_FACTOR)[0])
 
 
 @dataclass(frozen=True)
@@ -710,8 +720,8 @@ class _Sb10:
         except np.linalg.LinAlgError:  # a singular pencil (e.g. γ_opt = 0): not decided
             return float("nan")
 
-    def gamma_opt(self, rtol: float = 1e-6, confirm: bool = True
-                  ) -> tuple[float, float, int]:
+    def gamma_opt(self, rtol: float = 1e-6, confirm: bool = True,
+                  near: float | None = None) -> tuple[float, float, int]:
         """γ_opt by a search between cheap bounds (:func:`_search_gamma`).
 
         The γ test is the Riccati margin (:meth:`riccati_margin`, a number, so the search
@@ -734,7 +744,11 @@ class _Sb10:
 
         ``confirm=False`` leaves out SB10AD's confirmation at the end, for a caller that
         builds a controller near the result and checks its closed loop itself
-        (:func:`hinfsyn`).
+        (:func:`hinfsyn`). ``near``: a γ expected within a few % of γ_opt (the previous
+        D–K step's); on plants above ``_SMALL_STATES`` states the margin's search starts
+        there with steps of :data:`NEAR_FACTOR` instead of the ladder of 4 from γ = 1,
+        without SB10AD's test of that first γ (the checks at the search's lower end and
+        the confirmation stay): the same γ_opt to ``rtol`` in a third of the margins.
 
         Returns ``(hi, lo, tests)``: the smallest admissible γ found, the largest
         inadmissible one (a lower bound of γ_opt; the Parrott bound if none was tried) and
@@ -742,20 +756,25 @@ class _Sb10:
         """
         lo0 = self.parrott_bound
         g0 = max(1.5 * lo0, 1.0)
-        ric0, tests, sb0 = self._small_margin(g0), 1, None  # (g0 is above the Parrott bound)
-        if np.isnan(ric0):
-            if self.A.shape[0] <= _SMALL_STATES:
-                return self._ladder_job1(lo0, g0, None, rtol, tests)
-            ric0 = self.riccati_margin(g0)
-        if ric0 >= 0:
-            sb0, tests = (-1.0 if self.admissible(g0) else 1.0), tests + 1
-            if sb0 < 0:
-                tests += 1
-                if self._keeps_gamma(g0):
-                    return self._ladder_job1(lo0, g0, sb0, rtol, tests)
-                sb0 = 1.0
-        hi, lo, more = _search_gamma(self.riccati_margin, lo0, rtol, {g0: ric0})
-        tests += more
+        if near is not None and self.A.shape[0] > _SMALL_STATES:
+            sb0 = None
+            hi, lo, tests = _search_gamma(self.riccati_margin, lo0, rtol, start=near,
+                                          factor=NEAR_FACTOR)
+        else:
+            ric0, tests, sb0 = self._small_margin(g0), 1, None  # (g0 > the Parrott bound)
+            if np.isnan(ric0):
+                if self.A.shape[0] <= _SMALL_STATES:
+                    return self._ladder_job1(lo0, g0, None, rtol, tests)
+                ric0 = self.riccati_margin(g0)
+            if ric0 >= 0:
+                sb0, tests = (-1.0 if self.admissible(g0) else 1.0), tests + 1
+                if sb0 < 0:
+                    tests += 1
+                    if self._keeps_gamma(g0):
+                        return self._ladder_job1(lo0, g0, sb0, rtol, tests)
+                    sb0 = 1.0
+            hi, lo, more = _search_gamma(self.riccati_margin, lo0, rtol, {g0: ric0})
+            tests += more
         if lo > lo0 * (1.0 + 1e-9) and self.riccati_margin(lo) >= 1.0:
             # the margin refused lo for want of a stabilising X∞ ⪰ 0 or Y∞ ⪰ 0 — which a
             # Hamiltonian with eigenvalues near the imaginary axis (a weight's pole near zero) also

@@ -100,3 +100,28 @@ def test_a_plants_state_matrix_is_frozen():
     with pytest.raises(ValueError):
         p.A[0, 0] = 1.0
     assert not A.flags.writeable and np.shares_memory(p.to_statespace().A, A)
+
+
+def test_memo_keeps_more_than_its_count_within_its_byte_budget():
+    """A sweep of 5 inputs repeated (a Level I sweep per controller): with ``keep=2`` alone
+    every lookup of the second pass computes again (least recently used goes first); with
+    a byte budget for 5 results, none does; a budget for 3 keeps the count's 2 at least
+    and no more than 3."""
+    from ambseal.lti.memo import ArrayMemo
+
+    inputs = [np.full((64, 64), float(k)) for k in range(5)]  # 32 kB each
+
+    def sweep(memo, calls):
+        for A in inputs:
+            memo.get((A,), None, lambda A=A: calls.append(1) or A * 2.0)
+
+    for budget, second_pass in ((0, 5), (5 * inputs[0].nbytes, 0)):
+        memo, calls = ArrayMemo(keep=2, keep_bytes=budget), []
+        sweep(memo, calls)
+        assert len(calls) == 5
+        sweep(memo, calls)
+        assert len(calls) == 5 + second_pass
+    memo, calls = ArrayMemo(keep=2, keep_bytes=3 * inputs[0].nbytes), []
+    sweep(memo, calls)
+    assert len(memo._kept) == 3
+    np.testing.assert_array_equal(memo.get((inputs[4],), None, lambda: None), inputs[4] * 2)

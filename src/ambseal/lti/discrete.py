@@ -29,7 +29,10 @@ from ambseal.lti.memo import ArrayMemo
 __all__ = ["zoh", "discretize", "simulate_lti", "simulate_modal_loop"]
 
 _METHODS = ("tustin", "zoh")
-_ZOH = ArrayMemo()  # the last large (A, B, dt) sampled
+#: The last large (A, B, dt) sampled: at least 8, and as many as 64 MB hold — the API 617
+#: Level I sweep samples one plant per cross-coupling (11 and more) and repeats the sweep
+#: for each controller (a 392-state plant's e^{AT} is 1.2 MB, a 1 888-state one's 28 MB).
+_ZOH = ArrayMemo(keep_bytes=64 * 2**20)
 
 
 def zoh(A: np.ndarray, B: np.ndarray, dt: float, *, keep: bool = True

@@ -13,6 +13,7 @@ that only computes modes loads nothing of the control numerics.
 from __future__ import annotations
 
 import hashlib
+import math
 import weakref
 from collections import OrderedDict
 from typing import Any, Callable
@@ -94,6 +95,16 @@ def array_digest(arrays: tuple) -> bytes:
     return h.digest()
 
 
+def _nbytes(value) -> float:
+    """The bytes of a result's arrays: an array's, or the sum over a tuple or list of
+    arrays; infinite for anything else (its size unknown, it never exceeds ``keep``)."""
+    if isinstance(value, np.ndarray):
+        return float(value.nbytes)
+    if isinstance(value, (tuple, list)):
+        return float(sum(_nbytes(v) for v in value))
+    return math.inf
+
+
 class ArrayMemo:
     """Results of ``compute()`` kept for the last ``keep`` distinct inputs, keyed by a digest
     (:func:`array_digest`) of the input arrays plus ``extra``.
@@ -110,11 +121,18 @@ class ArrayMemo:
         How many distinct inputs' results are kept (the least recently used goes first).
     min_states : int
         Inputs whose first array has fewer rows are computed every time, not kept.
+    keep_bytes : int
+        More than ``keep`` results are kept while the arrays of all of them (a result that
+        is an array or a tuple or list of arrays; any other counts as unbounded) hold at
+        most this many bytes: a sweep over more inputs than ``keep``, repeated for each
+        controller, finds its results on a small model, where on a large one the ``keep``
+        bound holds.
     """
 
-    def __init__(self, keep: int = 8, min_states: int = 64):
-        self.keep, self.min_states = keep, min_states
+    def __init__(self, keep: int = 8, min_states: int = 64, keep_bytes: int = 0):
+        self.keep, self.min_states, self.keep_bytes = keep, min_states, keep_bytes
         self._kept: OrderedDict = OrderedDict()
+        self._bytes: dict = {}
 
     def get(self, arrays: tuple, extra: Any, compute: Callable[[], Any]) -> Any:
         """``compute()``, or its kept result for the same ``arrays`` and ``extra``."""
@@ -133,8 +151,9 @@ class ArrayMemo:
             self._kept.move_to_end(key)
             return self._kept[key]
         value = self._kept[key] = compute()
-        if len(self._kept) > self.keep:
-            self._kept.popitem(last=False)
+        self._bytes[key] = _nbytes(value)
+        while len(self._kept) > self.keep and sum(self._bytes.values()) > self.keep_bytes:
+            self._bytes.pop(self._kept.popitem(last=False)[0])
         return value
 
     def digest(self, arrays: tuple) -> bytes | None:

@@ -78,3 +78,27 @@ def test_the_lpv_on_speed_holds_the_blower_where_a_frozen_design_does_not():
                      allow_unstable=True, spec=sp)
     assert lpv.full_order["stable"]
     assert all(_max_real_pole(cfg, lpv.controller_at(f), p, f) < 0 for p, f in conds)
+
+
+def test_a_check_for_a_correction_stops_at_the_farthest_speed_that_loses_a_mode(
+        turbo_cfg, turbo_frozen):
+    """Reference: python-control's feedback poles. The frozen controller with its sign
+    flipped loses the loop everywhere: ``first_loss`` checks the speed farthest from the
+    design speed (300 Hz from 140 Hz, not standstill) at every pressure and stops there,
+    with the same lost modes there as the whole check; the stable controller is checked
+    at every condition either way, with the same result."""
+    from ambseal.design.recipes import full_order_check
+
+    sp = design_spec(turbo_cfg)
+    conds = [(p, f) for p in sp.pressures_bar
+             for f in sorted({*sp.speeds_hz, *sp.stability_speeds_hz})]
+    flipped = -1.0 * turbo_frozen.K
+    whole = full_order_check(turbo_cfg, flipped, conds)
+    first = full_order_check(turbo_cfg, flipped, conds, first_loss=True)
+    assert whole["checked"] == len(conds) and first["checked"] == len(sp.pressures_bar)
+    assert not first["stable"] and first["speed_hz"] == 300.0
+    assert all(_max_real_pole(turbo_cfg, flipped, p, 300.0) > 0 for p in sp.pressures_bar)
+    assert first["unstable"] == [c for c in whole["unstable"] if c["speed_hz"] == 300.0]
+    held = full_order_check(turbo_cfg, turbo_frozen.K, conds, first_loss=True)
+    assert held == full_order_check(turbo_cfg, turbo_frozen.K, conds)
+    assert held["stable"] and held["checked"] == len(conds)

@@ -96,13 +96,13 @@ def array_digest(arrays: tuple) -> bytes:
 
 
 def _nbytes(value) -> float:
-    """The bytes of a result's arrays: an array's, or the sum over a tuple or list of
-    arrays; infinite for anything else (its size unknown, it never exceeds ``keep``)."""
-    if isinstance(value, np.ndarray):
-        return float(value.nbytes)
+    """The bytes of a result's arrays: an array's or an object's ``nbytes``, or the sum over
+    a tuple or list of them; infinite for anything else (its size unknown, it never
+    exceeds ``keep``)."""
     if isinstance(value, (tuple, list)):
         return float(sum(_nbytes(v) for v in value))
-    return math.inf
+    size = getattr(value, "nbytes", None)
+    return float(size) if isinstance(size, (int, np.integer)) else math.inf
 
 
 class ArrayMemo:
@@ -123,8 +123,8 @@ class ArrayMemo:
         Inputs whose first array has fewer rows are computed every time, not kept.
     keep_bytes : int
         More than ``keep`` results are kept while the arrays of all of them (a result that
-        is an array or a tuple or list of arrays; any other counts as unbounded) hold at
-        most this many bytes: a sweep over more inputs than ``keep``, repeated for each
+        is an array, has ``nbytes``, or is a tuple or list of such; any other counts as
+        unbounded) hold at most this many bytes: a sweep over more inputs than ``keep``, repeated for each
         controller, finds its results on a small model, where on a large one the ``keep``
         bound holds.
     """

@@ -159,6 +159,11 @@ class Plant:
         return self.A.shape[0]
 
     @property
+    def nbytes(self) -> int:
+        """Bytes of the state-space arrays (what a memo of plants weighs)."""
+        return int(sum(X.nbytes for X in (self.A, self.B, self.C, self.D)))
+
+    @property
     def axes(self) -> tuple[str, ...]:
         """The actuator axes ``<axis>`` that have both a current input ``i_<axis>`` and a
         sensor output ``y_<axis>``, in input order."""

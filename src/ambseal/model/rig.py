@@ -287,8 +287,10 @@ def build_plant(
 #: The last plants built, by rig and arguments: a run asks for the same few plants (its
 #: judged pressures, with and without force inputs) in every design's check, digital
 #: choice and judgement — 22 builds of 8 plants on the test facility, 0.2 s each at 1 888
-#: states. A plant is immutable (its arrays are frozen), so one is handed to every caller.
-_PLANTS = ArrayMemo(keep=4)
+#: states — and the API 617 sweeps one plant per cross-coupling for every controller: at
+#: least 4, and as many as 64 MB hold. A plant is immutable (its arrays are frozen), so one
+#: is handed to every caller.
+_PLANTS = ArrayMemo(keep=4, keep_bytes=64 * 2**20)
 
 
 def _build_plant(cfg, reduced, pressure_bar, speed_rpm, force_positions, states, cutoff_hz):

@@ -27,6 +27,7 @@ below :data:`PHASE_TOLERANCE_DEG` up to the top of the design band (150 µs up t
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -77,6 +78,7 @@ class DesignDelay:
                 "phase_error_deg": self.phase_error_deg, "band_top_hz": self.band_top_hz}
 
 
+@functools.lru_cache(maxsize=8)  # asked for at every judged loop (0.01 s each), immutable
 def loop_delay(sample_rate_hz: float, delay_samples: int) -> DesignDelay:
     """The delay the continuous analyses put in every loop: :func:`design_delay` checked
     up to 0.999 of the Nyquist frequency (Hz).

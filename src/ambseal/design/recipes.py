@@ -470,8 +470,9 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
         steps.append(f"{method}: no damping margin held the full-order loop; the design "
                      "without margins is delivered")
         r, check, n = plain
-        if check["checked"] < len(conditions):
-            check = full_order_check(cfg, r.K, conditions)
+    if check["checked"] < len(conditions):
+        # the design delivered, or refused, is judged at every condition
+        check = full_order_check(cfg, r.K, conditions)
     return r, check, n
 
 

@@ -61,7 +61,9 @@ def test_capacity_block_names_the_limit_and_where(testrig_cfg, judged):
     ``current_limit`` (6 A, the bias) used as i_c/6 at the worst axis and speed; a supply
     voltage set to half of what the worst point needs (R = 0, L given: |jΩL|·|H_a|·i over
     the speeds, H_a the rig's second-order amplifier) is used 2× — reported above 1 with the
-    speed and the axis where it happens; a rig without voltage or inductance gets None."""
+    speed and the axis where it happens; a rig without voltage or inductance gets None. The
+    sizing per AMB is the largest current and ωL·i_c of its axes, and an amplifier of that
+    size is used exactly to its limits."""
     _, _, case, curves = judged
     speeds, current, names = curves["unbalance_current"]
     entries = [("0 bar", speeds, current, names)]
@@ -87,3 +89,17 @@ def test_capacity_block_names_the_limit_and_where(testrig_cfg, judged):
     k, a = np.unravel_index(np.argmax(need), need.shape)
     assert low["worst"]["voltage_used"]["speed_hz"] == pytest.approx(speeds[k])
     assert low["worst"]["voltage_used"]["axis"] == names[a].removeprefix("i_")
+    # sizing: per AMB the largest coil current of its axes and the largest ωL·i_c (R = 0);
+    # an amplifier of exactly that size is used to 1 of its current and its voltage
+    for amb in testrig_cfg.amb:
+        own = [j for j, n in enumerate(names) if n.startswith(f"i_{amb.name}_")]
+        assert low["sizing"][amb.name]["current_limit_a"] == \
+            pytest.approx(coil[:, own].max(), rel=1e-12)
+        assert low["sizing"][amb.name]["supply_voltage_v"] == \
+            pytest.approx(need[:, own].max(), rel=1e-12)
+    sized = [a.model_copy(update={"current_limit": low["sizing"][a.name]["current_limit_a"],
+                                  "supply_voltage": low["sizing"][a.name]["supply_voltage_v"]})
+             for a in ambs]
+    fit = capacity_block(testrig_cfg.model_copy(update={"amb": sized}), entries)
+    assert fit["current_used"] == pytest.approx(1.0, rel=1e-12)
+    assert fit["voltage_used"] == pytest.approx(1.0, rel=1e-12)

@@ -9,8 +9,8 @@ import pytest
 from ambseal.config import Amb
 from ambseal.errors import ConfigError
 from ambseal.model.amb import MU0, amb_factors
-from ambseal.model.capacity import (amplifier_use, coil_inductance, force_capacity,
-                                     load_capacity)
+from ambseal.model.capacity import (amplifier_needs, amplifier_use, coil_inductance,
+                                    force_capacity, load_capacity)
 
 GEOMETRY = {"name": "a", "position": 0.1, "sensor_position": 0.1, "turns": 160,
             "pole_area": 6e-4, "air_gap": 4e-4, "bias_current": 2.5, "pole_angle_deg": 22.5}
@@ -94,6 +94,14 @@ def test_amplifier_use_is_the_current_and_voltage_against_their_limits():
     assert bare["current_used"] is None and bare["voltage_used"] is None
     with pytest.raises(ConfigError, match="2 current amplitudes for 1"):
         amplifier_use(amb, [10.0], [1.0, 2.0])
+    # what the amplifier must deliver, whatever its limits: i_c and R i0 + |R + jωL| i_c —
+    # the supply voltage and current limit used to exactly 1 at the force capacity's
+    need = amplifier_needs(amb, w, ic)
+    np.testing.assert_allclose(need["current_a"], ic, rtol=1e-12)
+    np.testing.assert_allclose(need["voltage_v"], use["voltage_used"] * 150.0, rtol=1e-12)
+    bare = Amb(name="a", position=0.1, sensor_position=0.1, ki=100.0, ks=1e5,
+               bias_current=2.5)  # no inductance, no geometry to derive it
+    assert amplifier_needs(bare, [10.0], [1.0])["voltage_v"] is None
 
 
 def test_load_capacity_is_the_force_law_at_saturation():

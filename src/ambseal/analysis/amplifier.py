@@ -13,7 +13,9 @@ i_c = |H_a(jΩ)|·i_ref with H_a the amplifier's current loop (``[actuator]``,
 (:func:`ambseal.model.capacity.amplifier_use`: the linear range i0, ``current_limit``,
 ``supply_voltage`` through R and L) this is the fraction of each limit the controller uses to
 hold the unbalance; above 1 the amplifier saturates (Schweitzer & Maslen, *Magnetic
-Bearings*, 2009, ch. 5 and 15). A discrete loop's current is taken at its samples (the
+Bearings*, 2009, ch. 5 and 15). The largest current and voltage over the judged conditions
+(:func:`ambseal.model.capacity.amplifier_needs`) are the smallest amplifier that holds it,
+per AMB: its sizing. A discrete loop's current is taken at its samples (the
 held value's fundamental is sinc(ΩT/2π) ≤ 1 of it: the fractions err on the safe side).
 """
 
@@ -22,7 +24,8 @@ from __future__ import annotations
 import numpy as np
 
 from ambseal.lti import freqresp_at
-from ambseal.model import AXES, actuator_matrices, amplifier_use, axis_label
+from ambseal.model import (AXES, actuator_matrices, amplifier_needs, amplifier_use,
+                           axis_label)
 
 __all__ = ["unbalance_currents", "capacity_block", "capacity_words", "saturates"]
 
@@ -70,8 +73,12 @@ def capacity_block(cfg, entries) -> dict | None:
     -------
     dict or None
         ``current_used``, ``voltage_used``, ``bias_used`` (the largest fraction, None where
-        no AMB gives the limit), ``current_a`` (the largest coil current amplitude, A) and
-        ``worst`` (per quantity: ``condition``, ``speed_hz``, ``axis``); None when no
+        no AMB gives the limit), ``current_a`` (the largest coil current amplitude, A),
+        ``worst`` (per quantity: ``condition``, ``speed_hz``, ``axis``) and ``sizing``:
+        per AMB the smallest amplifier that holds every judged condition,
+        ``current_limit_a`` (the largest control current amplitude of its axes, A) and
+        ``supply_voltage_v`` (the largest R i0 + |R + jωL| i_c, V; None without the coil's
+        inductance), :func:`ambseal.model.capacity.amplifier_needs`; None when no
         condition was judged stable or the rig's AMBs give no bias current.
     """
     by_axis = {f"i_{amb.name}_{ax}": amb for amb in cfg.amb for ax in AXES}
@@ -79,12 +86,20 @@ def capacity_block(cfg, entries) -> dict | None:
         return None
     act = actuator_matrices(cfg.actuator)
     best: dict = {q: (None, None) for q in (*QUANTITIES, "current_a")}
+    sizing: dict = {}
     for label, speed_hz, i_ref, names in entries:
         w = 2 * np.pi * np.asarray(speed_hz, float)
         gain = np.abs(freqresp_at(act, 1j * w)[:, 0, 0])
         for a, name in enumerate(names):
-            ic = gain * i_ref[:, a]
-            use = amplifier_use(by_axis[name], w, ic)
+            amb, ic = by_axis[name], gain * i_ref[:, a]
+            need = amplifier_needs(amb, w, ic)
+            row = sizing.setdefault(amb.name, {"current_limit_a": 0.0,
+                                               "supply_voltage_v": None})
+            row["current_limit_a"] = max(row["current_limit_a"], float(ic.max(initial=0.0)))
+            if need["voltage_v"] is not None:
+                row["supply_voltage_v"] = max(row["supply_voltage_v"] or 0.0,
+                                              float(need["voltage_v"].max(initial=0.0)))
+            use = amplifier_use(amb, w, ic)
             use["current_a"] = ic
             for q, v in use.items():
                 if v is None:
@@ -97,7 +112,8 @@ def capacity_block(cfg, entries) -> dict | None:
     if best["current_a"][0] is None:
         return None
     return {**{q: best[q][0] for q in (*QUANTITIES, "current_a")},
-            "worst": {q: best[q][1] for q in QUANTITIES if best[q][1] is not None}}
+            "worst": {q: best[q][1] for q in QUANTITIES if best[q][1] is not None},
+            "sizing": sizing}
 
 
 def saturates(block: dict | None) -> bool:

@@ -37,7 +37,8 @@ from ambseal.config import Amb
 from ambseal.errors import ConfigError
 from ambseal.model.amb import MU0, amb_factors
 
-__all__ = ["coil_inductance", "force_capacity", "load_capacity", "amplifier_use"]
+__all__ = ["coil_inductance", "force_capacity", "load_capacity", "amplifier_needs",
+           "amplifier_use"]
 
 
 def coil_inductance(amb: Amb) -> float | None:
@@ -101,6 +102,46 @@ def force_capacity(amb: Amb, omega) -> np.ndarray:
     return bound[:, None] * np.asarray(ki, float)[None, :]
 
 
+def amplifier_needs(amb: Amb, omega, current_a) -> dict:
+    """What the amplifier of an AMB axis must deliver to drive a sinusoidal control current
+    (module docstring): the current and the voltage, whatever its limits — the size of the
+    smallest amplifier that does.
+
+    Parameters
+    ----------
+    amb : Amb
+        One ``[[amb]]`` of the rig file, with its ``bias_current``.
+    omega : array_like, shape (F,)
+        Frequencies (rad/s), ≥ 0.
+    current_a : array_like, shape (F,)
+        The control current's amplitude (A, zero-to-peak) at each frequency.
+
+    Returns
+    -------
+    dict
+        Arrays of shape (F,): ``current_a`` i_c (A; the smallest ``current_limit``) and
+        ``voltage_v`` R i0 + |R + jωL| i_c (V; the smallest ``supply_voltage``), None where
+        the rig file gives neither ``inductance`` nor the geometry to derive it
+        (``resistance`` defaults to 0).
+
+    Raises
+    ------
+    ConfigError
+        No bias current, a negative frequency, or as many amplitudes as frequencies not
+        given.
+    """
+    w = _frequencies(amb, omega)
+    ic = np.abs(np.asarray(current_a, float))
+    if ic.shape != w.shape:
+        raise ConfigError(f"amb {amb.name}: amplifier: {ic.shape[0] if ic.ndim else 1} "
+                          f"current amplitudes for {w.size} frequencies")
+    if amb.bias_current is None:
+        raise ConfigError(f"amb {amb.name}: the amplifier's voltage needs bias_current (A)")
+    L, R = coil_inductance(amb), float(amb.resistance or 0.0)
+    voltage = None if L is None else R * float(amb.bias_current) + np.hypot(R, w * L) * ic
+    return {"current_a": ic, "voltage_v": voltage}
+
+
 def amplifier_use(amb: Amb, omega, current_a) -> dict:
     """The fractions of an AMB axis's limits a sinusoidal control current uses (module
     docstring): 1 is the limit, above it the amplifier saturates or a coil's current
@@ -128,16 +169,10 @@ def amplifier_use(amb: Amb, omega, current_a) -> dict:
     ConfigError
         As :func:`force_capacity`.
     """
-    w = _frequencies(amb, omega)
-    ic = np.abs(np.asarray(current_a, float))
-    if ic.shape != w.shape:
-        raise ConfigError(f"amb {amb.name}: amplifier use: {ic.shape[0] if ic.ndim else 1} "
-                          f"current amplitudes for {w.size} frequencies")
+    need = amplifier_needs(amb, omega, current_a)
     i0, limit, coil = _amplifier(amb)
-    voltage = None
-    if coil is not None:
-        L, R, _ = coil
-        voltage = (R * i0 + np.hypot(R, w * L) * ic) / amb.supply_voltage
+    ic = need["current_a"]
+    voltage = None if coil is None else need["voltage_v"] / amb.supply_voltage
     return {"bias_used": ic / i0, "current_used": None if limit is None else ic / limit,
             "voltage_used": voltage}
 

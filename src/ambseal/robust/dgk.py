@@ -200,8 +200,8 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
     Complex D–K (:func:`~ambseal.robust.dk.musyn`) first, then D–G–K steps from its best
     controller (each: the D–G scalings of the closed loop on the scalar structure, relaxed,
     fitted and refined, and an H∞ K-step on the scaled plant, module docstring) until μ
-    stops improving or reaches ``target``. The best controller over both phases is returned, so its μ is never
-    above complex D–K's.
+    stops improving or reaches ``target``. The best controller over both phases is
+    returned, so its μ is never above complex D–K's.
 
     Parameters
     ----------

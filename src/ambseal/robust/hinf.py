@@ -570,7 +570,8 @@ def hinf_gamma_opt(P, nmeas: int, ncon: int, *, rtol: float = 1e-6,
     the γ search of :func:`hinfsyn` alone, for callers that compare many plants (the D-scale
     search of :func:`ambseal.robust.dk.musyn`). ``near``: a γ expected within a few % of
     γ_opt; the search then starts there with steps of :data:`NEAR_FACTOR` and uses the
-    Riccati margin alone (no SB10AD cross-check). Raises as :func:`hinfsyn` (ModelError, SynthesisError)."""
+    Riccati margin alone (no SB10AD cross-check). Raises as :func:`hinfsyn` (ModelError,
+    SynthesisError)."""
     check_plant(P, nmeas, ncon)
     sb = _Sb10(P, nmeas, ncon)
     if near is None:

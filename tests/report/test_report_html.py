@@ -213,3 +213,25 @@ def test_on_the_target_names_only_what_metrics_records():
     assert "pid at 0 bar, 50 Hz: stable" in text and "tustin at 10000 Hz, 1 sample(s)" in text
     assert "hinf at 0 bar, 50 Hz: stable (max |z| 0.99000), σ̄(S_o) 2.00 against 1.90 " \
            "continuous, zone A; at 10000 Hz" in text
+
+
+def test_amplifier_sizing_is_tabled_per_controller_and_amb():
+    """Reference: metrics.json's ``capacity.sizing`` blocks. A row per delivered controller
+    with sizing, a column per AMB, the current limit and supply voltage at three
+    significant digits ("—" where no voltage could be derived); a failed controller and
+    one without a capacity block get no row; none at all, no section."""
+    from ambseal.report.run_report import _sizing_section
+
+    sized = {"A": {"current_limit_a": 0.48291, "supply_voltage_v": None},
+             "B": {"current_limit_a": 1.2345, "supply_voltage_v": 36.24}}
+    metrics = {"controllers": {"pid": {"capacity": {"sizing": sized}},
+                               "hinf": {"capacity": {"sizing": sized}},
+                               "mu": {"capacity": None}},
+               "failed": {"hinf": "unstable at 0 bar, 0 Hz"}}
+    (sec,) = _sizing_section(metrics)
+    assert sec["title"] == "Amplifier sizing"
+    table = sec["html"]
+    assert table.count("<tr>") == 2 and "<th>AMB A</th><th>AMB B</th>" in table
+    assert "<td>0.483 A, — V</td><td>1.23 A, 36.2 V</td>" in table
+    assert "H∞" not in table and "μ" not in table
+    assert _sizing_section({"controllers": {"mu": {"capacity": None}}}) == []

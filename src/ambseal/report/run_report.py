@@ -579,6 +579,38 @@ def _impulse_figure(out: Path, imp: list, styles: dict) -> list:
             styles=styles))]
 
 
+def _sizing_section(metrics: dict) -> list[dict]:
+    """A table of each delivered controller's ``capacity.sizing``
+    (:func:`ambseal.analysis.amplifier.capacity_block`): per AMB the smallest current limit
+    and supply voltage of an amplifier that holds every judged condition's unbalance."""
+    rows = {m: s["capacity"]["sizing"] for m, s in metrics["controllers"].items()
+            if m not in (metrics.get("failed") or {})
+            and (s.get("capacity") or {}).get("sizing")}
+    if not rows:
+        return []
+    ambs = list(dict.fromkeys(a for sizing in rows.values() for a in sizing))
+
+    def cell(need: dict | None) -> str:
+        if need is None:
+            return "<td>—</td>"
+        volts = need.get("supply_voltage_v")
+        return (f"<td>{sig(need['current_limit_a'])} A, "
+                + (f"{sig(volts)} V" if volts is not None else "— V") + "</td>")
+
+    body = "".join(f"<tr><td>{html.escape(method_label(m))}</td>"
+                   + "".join(cell(sizing.get(a)) for a in ambs) + "</tr>"
+                   for m, sizing in rows.items())
+    head = "".join(f"<th>AMB {html.escape(a)}</th>" for a in ambs)
+    table = (f'<div class="scroll"><table><tr><th>Controller</th>{head}</tr>{body}'
+             "</table></div>")
+    text = ("The smallest amplifier that holds the judged worst-case unbalance at every "
+            "judged condition, as each controller runs: its control-current limit "
+            "(zero-to-peak) and supply voltage (R·i0 + |R + jωL| times that current; — "
+            "where the rig file gives neither the coil's inductance nor its geometry), per "
+            "AMB, for both of its axes.")
+    return [{"title": "Amplifier sizing", "text": text, "html": table}]
+
+
 def _run_sections(metrics: dict) -> list[dict]:
     """The main job's text sections: the speed range, redesigns, what cannot run on the
     target, the open loop and the discretisations."""
@@ -593,4 +625,5 @@ def _run_sections(metrics: dict) -> list[dict]:
     sections = [{"title": f"{method_label(m)}: redesigned", "text": (
         f"{s['remedy']}; the new design holds at every judged condition.")}
         for m, s in metrics["controllers"].items() if s.get("remedy")] + sections
-    return _speed_range_section(metrics) + sections + _discrete_section(metrics)
+    return (_speed_range_section(metrics) + sections + _discrete_section(metrics)
+            + _sizing_section(metrics))

@@ -234,8 +234,7 @@ def full_order_check(cfg, K, conditions, *, first_loss: bool = False) -> dict:
         and stop after the first speed with an unstable loop, every pressure at it
         checked: for a design about to be corrected, whose lost modes matter and not
         every condition's verdict. The gyroscopic moments move a frozen design's modes
-        the more the farther the speed (on the flexible example rigs every corrected
-        design lost, at the farthest speed, a mode of each band it was corrected for).
+        the more the farther the speed, so the farthest speed loses the modes first.
 
     Returns
     -------

@@ -78,7 +78,7 @@ class DesignDelay:
                 "phase_error_deg": self.phase_error_deg, "band_top_hz": self.band_top_hz}
 
 
-@functools.lru_cache(maxsize=8)  # asked for at every judged loop (0.01 s each), immutable
+@functools.lru_cache(maxsize=8)  # asked for at every judged loop; the result is immutable
 def loop_delay(sample_rate_hz: float, delay_samples: int) -> DesignDelay:
     """The delay the continuous analyses put in every loop: :func:`design_delay` checked
     up to 0.999 of the Nyquist frequency (Hz).

@@ -57,9 +57,9 @@ __all__ = ["HinfResult", "hinfsyn", "hinf_gamma_opt", "hinfnorm", "lft_lower", "
 #: for the Schur form in Python and 0.2 ms for SB10AD's test).
 _SMALL_STATES = 6
 
-#: The ladder's factor of a γ search started near γ_opt (``near``): D–K's K-steps move γ
-#: by a few % (b2b compressor: 4–15 %), so the bracket closes in one to three steps where
-#: a factor of 4 from γ = 1 leaves Brent's method a bracket of 4 to close.
+#: The ladder's factor of a γ search started near γ_opt (``near``): a D–K step moves γ by a
+#: few %, so the bracket closes in a few steps where a factor of 4 from γ = 1 leaves
+#: Brent's method a bracket of 4 to close (benchmarks/README.md).
 NEAR_FACTOR = 1.05
 
 _SB10AD_INFO = {
@@ -749,7 +749,7 @@ class _Sb10:
         D–K step's); on plants above ``_SMALL_STATES`` states the margin's search starts
         there with steps of :data:`NEAR_FACTOR` instead of the ladder of 4 from γ = 1,
         without SB10AD's test of that first γ (the checks at the search's lower end and
-        the confirmation stay): the same γ_opt to ``rtol`` in a third of the margins.
+        the confirmation stay): the same γ_opt to ``rtol`` in fewer margins.
 
         Returns ``(hi, lo, tests)``: the smallest admissible γ found, the largest
         inadmissible one (a lower bound of γ_opt; the Parrott bound if none was tried) and

@@ -28,6 +28,17 @@ def _strong_seal_rig(tmp_path, factor: float):
     return rig
 
 
+def _run_failing(rig, out, capsys) -> tuple[dict, str]:
+    """``ambseal run RIG --no-identify`` that must exit 1: its checked metrics.json and
+    stderr."""
+    code = main(["run", str(rig), "--no-identify", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 1, err
+    m = json.loads((out / "metrics.json").read_text())
+    validate_metrics(m)
+    return m, err
+
+
 def _case(p_bar, stable, label="", max_real_pole=None, discrete=None):
     """A judged condition's stability (the cases the main job's judgements make)."""
     return StabilityCase("hinf", label, p_bar, 0.0, stable,
@@ -107,11 +118,7 @@ def test_run_with_a_failing_controller_writes_the_report_and_exits_1(tmp_path, c
     judged condition and delivered."""
     rig = _strong_seal_rig(tmp_path, 3.0)
     out = tmp_path / "run"
-    code = main(["run", str(rig), "--no-identify", "--out", str(out)])
-    err = capsys.readouterr().err
-    assert code == 1, err
-    m = json.loads((out / "metrics.json").read_text())
-    validate_metrics(m)
+    m, err = _run_failing(rig, out, capsys)
     by = {}
     for c in m["cases"]:
         by.setdefault(c["controller"], []).append(c)
@@ -212,11 +219,7 @@ def test_a_controller_whose_amplifier_saturates_is_not_delivered(tmp_path, capsy
     rig.write_text(text.replace("current_limit = 6.0\n", "current_limit = 6.0\n"
                                 "supply_voltage = 1.0\ninductance = 0.01\n"))
     out = tmp_path / "run"
-    code = main(["run", str(rig), "--no-identify", "--out", str(out)])
-    err = capsys.readouterr().err
-    assert code == 1, err
-    m = json.loads((out / "metrics.json").read_text())
-    validate_metrics(m)
+    m, err = _run_failing(rig, out, capsys)
     for name in ("hinf", "mu"):
         cap = m["controllers"][name]["capacity"]
         assert cap["voltage_used"] > 1 and cap["current_used"] < 1

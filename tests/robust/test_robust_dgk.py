@@ -120,8 +120,7 @@ def test_dgk_result_holds_by_a_parameter_sweep(complex_dk):
 
 def test_a_target_complex_dk_meets_skips_the_dgk_steps(complex_dk):
     """``target``: complex D–K's result as it is (its controller and μ, no D–G–K step, the
-    rule saying why) when its μ is at or below the target; D–G–K steps when above, until
-    the first that reaches it."""
+    rule saying why) when its μ is at or below the target; D–G–K steps when above."""
     P, w = gain_plant(), W_GRID
     dk = complex_dk(R)
     kept = musyn_dgk(P, BLOCKS, 1, 1, w, max_iter=6, target=dk.mu * 1.01)
@@ -131,15 +130,6 @@ def test_a_target_complex_dk_meets_skips_the_dgk_steps(complex_dk):
     assert kept.stopping["dgk"]["iterations"] == 0 and "target" in kept.stopping["dgk"]["rule"]
     stepped = musyn_dgk(P, BLOCKS, 1, 1, w, max_iter=6, target=dk.mu * 0.5)
     assert "D-G-K" in {h["step"] for h in stepped.history} and stepped.mu < dk.mu
-    # the steps stop at the first that reaches the target: with the target just above the
-    # first D–G–K step's μ, that step is the only one, where without it more follow
-    free = musyn_dgk(P, BLOCKS, 1, 1, w, max_iter=6)
-    steps = [h for h in free.history if h["step"] == "D-G-K"]
-    assert len(steps) > 1 and steps[0]["mu"] < dk.mu
-    met = musyn_dgk(P, BLOCKS, 1, 1, w, max_iter=6, target=steps[0]["mu"] * 1.001)
-    assert [h["mu"] for h in met.history if h["step"] == "D-G-K"] == \
-        pytest.approx([steps[0]["mu"]], rel=1e-9)
-    assert "target" in met.stopping["dgk"]["rule"] and met.mu <= steps[0]["mu"] * 1.001
 
 
 def test_design_mu_iteration_key_defaults_to_dgk():

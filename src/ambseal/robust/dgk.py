@@ -200,8 +200,8 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
     Complex D–K (:func:`~ambseal.robust.dk.musyn`) first, then D–G–K steps from its best
     controller (each: the D–G scalings of the closed loop on the scalar structure, relaxed,
     fitted and refined, and an H∞ K-step on the scaled plant, module docstring) until μ
-    stops improving or reaches ``target``. The best controller over both phases is
-    returned, so its μ is never above complex D–K's.
+    stops improving. The best controller over both phases is returned, so its μ is never
+    above complex D–K's.
 
     Parameters
     ----------
@@ -231,11 +231,9 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
     search, search_backoff : int or "auto", float
         The D search of the D–K phase, as in :func:`~ambseal.robust.dk.musyn`.
     target : float, optional
-        A μ level the design asks for (1: robust performance; MATLAB ``musyn``'s
-        ``TargetPerf``): when complex D–K's μ is at or below it, its result is returned
-        without D–G–K steps, which would only lower a bound already met, and the D–G–K
-        steps stop at the first that reaches it (each costs a mixed μ bound and an H∞
-        synthesis on a plant of a few hundred states). None: D–G–K until μ stalls.
+        A μ level the design asks for (1: robust performance): when complex D–K's μ is at
+        or below it, its result is returned without D–G–K steps, which would only lower a
+        bound already met. None: D–G–K always.
     progress : bool or callable
         As in :func:`~ambseal.robust.dk.musyn`.
 
@@ -304,9 +302,6 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
         stall = 0 if peak < best[0] * (1 - rtol) else stall + 1
         if peak < best[0]:
             best = (peak, it, hr.K, hr.gamma, np.asarray(mu_true.upper), tuple(fits))
-        if target is not None and peak <= target:
-            rule = f"μ {peak:.4g} ≤ target={target:g}"
-            break
         if stall >= patience:
             rule = f"patience={patience}: {stall} iterations without a μ gain of rtol={rtol:g}"
             break

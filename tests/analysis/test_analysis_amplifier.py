@@ -7,10 +7,11 @@ import control as ct
 import numpy as np
 import pytest
 
-from ambseal.analysis.amplifier import capacity_block
+from ambseal.analysis.amplifier import capacity_block, capacity_words, force_demand
 from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
 from ambseal.analysis.unbalance import unbalance_force
 from ambseal.design.specs import design_spec
+from ambseal.model import amb_factors
 from ambseal.model.rig import build_plant
 
 
@@ -19,8 +20,7 @@ def judged(testrig_cfg, testrig_designs):
     """The embedded rig's H∞ controller judged at 0 bar (continuous, with its delay)."""
     s = judge_settings(design_spec(testrig_cfg))
     K = testrig_designs["hinf"].K
-    case, curves = judge(testrig_cfg, K, "hinf", OperatingPoint(0.0, 0.0, "0 bar"), s,
-                         impulse=False)
+    case, curves = judge(testrig_cfg, K, "hinf", OperatingPoint(0.0, 0.0, "0 bar"), s)
     return s, K, case, curves
 
 
@@ -78,7 +78,8 @@ def test_capacity_block_names_the_limit_and_where(testrig_cfg, judged):
     k, a = np.unravel_index(np.argmax(coil), coil.shape)
     assert block["worst"]["current_used"] == {"condition": "0 bar",
                                               "speed_hz": pytest.approx(speeds[k]),
-                                              "axis": names[a].removeprefix("i_")}
+                                              "axis": names[a].removeprefix("i_"),
+                                              "response": "unbalance"}
     L = 0.01
     need = 2 * math.pi * speeds[:, None] * L * coil
     v = float(need.max()) / 2
@@ -103,3 +104,69 @@ def test_capacity_block_names_the_limit_and_where(testrig_cfg, judged):
     fit = capacity_block(testrig_cfg.model_copy(update={"amb": sized}), entries)
     assert fit["current_used"] == pytest.approx(1.0, rel=1e-12)
     assert fit["voltage_used"] == pytest.approx(1.0, rel=1e-12)
+
+
+def test_impulse_voltage_is_the_coil_driven_through_the_amplifier(testrig_cfg, judged):
+    """Reference: python-control's zero-order-hold discretisation of the rig's amplifier
+    H_a (second order) and of s·H_a, driven by the judged impulse response's current
+    reference (−K y plus the injected impulse) held over each step, give the coil current
+    and its rate; the coils need R i0 + |R i + L di/dt|. A supply voltage of half the
+    largest need is used 2× in the impulse, named with its axis and "in the current
+    impulse"; the current limit is used as max |i| / limit."""
+    _, _, case, curves = judged
+    imp = curves["impulse"]
+    wn, zeta = testrig_cfg.actuator.natural_frequency, testrig_cfg.actuator.damping_ratio
+    den = [1.0, 2 * zeta * wn, wn ** 2]
+    ref = imp.current_a + imp.disturbance_a
+    t = np.arange(ref.shape[0]) * imp.dt_s
+    i, di = (np.array([ct.forced_response(ct.c2d(ct.tf(num, den), imp.dt_s, "zoh"), t,
+                                          ref[:, j]).outputs for j in range(ref.shape[1])])
+             for num in ([wn ** 2], [wn ** 2, 0.0]))
+    R, L, i0 = 0.2, 0.05, testrig_cfg.amb[0].bias_current
+    need = R * i0 + np.abs(R * i + L * di)  # (axes, time)
+    v = float(need.max()) / 2
+    ambs = [a.model_copy(update={"supply_voltage": v, "inductance": L, "resistance": R})
+            for a in testrig_cfg.amb]
+    block = capacity_block(testrig_cfg.model_copy(update={"amb": ambs}), [],
+                           [("0 bar", 0.0, imp)])
+    assert block["voltage_used"] == pytest.approx(2.0, rel=1e-6)
+    a = int(np.unravel_index(np.argmax(need), need.shape)[0])
+    assert block["worst"]["voltage_used"] == {"condition": "0 bar", "speed_hz": 0.0,
+                                              "axis": imp.input_names[a].removeprefix("i_"),
+                                              "response": "impulse"}
+    assert block["current_used"] == pytest.approx(np.abs(i).max() / 6.0, rel=1e-6)
+    assert capacity_words(block).startswith("the amplifier saturates in the current "
+                                            "impulse: it needs 2× the supply voltage")
+    for amb in testrig_cfg.amb:
+        own = [j for j, n in enumerate(imp.input_names) if n.startswith(f"i_{amb.name}_")]
+        assert block["sizing"][amb.name]["supply_voltage_v"] == \
+            pytest.approx(need[own].max(), rel=1e-6)
+
+
+def test_force_demand_is_ki_times_the_coil_current(testrig_cfg, judged):
+    """Reference: the closed form Ki·|H_a(jΩ)|·i_ref per axis (H_a the rig's second-order
+    amplifier, Ki each AMB's from the geometry), the largest of the AMB's axes; a second
+    condition asking twice the current on a coarser grid of speeds raises the envelope to
+    twice the first, interpolated linearly on the union of the grids."""
+    _, _, case, curves = judged
+    speeds, current, names = curves["unbalance_current"]
+    wn, zeta = testrig_cfg.actuator.natural_frequency, testrig_cfg.actuator.damping_ratio
+    sw = 2j * math.pi * speeds
+    ha = np.abs(wn ** 2 / (sw ** 2 + 2 * zeta * wn * sw + wn ** 2))
+    one = force_demand(testrig_cfg, [("0 bar", speeds, current, names)])
+    assert set(one) == {a.name for a in testrig_cfg.amb}
+    for amb in testrig_cfg.amb:
+        ki = amb_factors(amb)[0]
+        own = [(j, ki[("zeta", "eta").index(n.rsplit("_", 1)[1])])
+               for j, n in enumerate(names) if n.startswith(f"i_{amb.name}_")]
+        ref = np.max([k * ha * current[:, j] for j, k in own], axis=0)
+        f, force = one[amb.name]
+        np.testing.assert_allclose(f, speeds)
+        np.testing.assert_allclose(force, ref, rtol=1e-12)
+    coarse = speeds[::7]
+    two = force_demand(testrig_cfg, [("0 bar", speeds, current, names),
+                                     ("hi", coarse, 2 * current[::7], names)])
+    f, force = two[testrig_cfg.amb[0].name]
+    np.testing.assert_allclose(f, np.union1d(speeds, coarse))
+    np.testing.assert_allclose(force[np.isin(f, coarse)],
+                               2 * one[testrig_cfg.amb[0].name][1][::7], rtol=1e-12)

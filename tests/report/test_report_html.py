@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from ambseal.errors import AmbsealError
-from ambseal.report import figures, html
+from ambseal.report import capacity_figure, figures, html
 
 
 def _metrics():
@@ -235,3 +235,19 @@ def test_amplifier_sizing_is_tabled_per_controller_and_amb():
     assert "<td>0.483 A, — V</td><td>1.23 A, 36.2 V</td>" in table
     assert "H∞" not in table and "μ" not in table
     assert _sizing_section({"controllers": {"mu": {"capacity": None}}}) == []
+
+
+def test_capacity_figure_draws_each_amb_or_nothing(tmp_path, testrig_cfg):
+    """A PNG with a panel per AMB from the judged unbalance currents; nothing for a rig
+    whose AMBs give no bias current (no capacity to draw) or no stable loop (no demand)."""
+    f = np.linspace(10.0, 100.0, 30)
+    names = [f"i_{a.name}_{ax}" for a in testrig_cfg.amb for ax in ("zeta", "eta")]
+    entries = [("0 bar", f, np.full((f.size, len(names)), 0.5), names)]
+    (caption, png), = capacity_figure(tmp_path, testrig_cfg, {"pid": entries, "hinf": entries})
+    assert png == tmp_path / "force_capacity.png" and png.read_bytes()[:4] == b"\x89PNG"
+    assert "slew rate" in caption
+    assert capacity_figure(tmp_path, testrig_cfg, {"pid": []}) == []
+    bare = [a.model_copy(update={"bias_current": None, "ki": 50.0, "ks": 1e5})
+            for a in testrig_cfg.amb]
+    assert capacity_figure(tmp_path, testrig_cfg.model_copy(update={"amb": bare}),
+                           {"pid": entries}) == []

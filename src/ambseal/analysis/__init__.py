@@ -59,7 +59,7 @@ from ambseal.lazy import lazy_face
 
 #: Each public name (``__all__``) and the module that defines it.
 _FROM = {
-    "capacity_block": "amplifier", "capacity_words": "amplifier",
+    "capacity_block": "amplifier", "capacity_words": "amplifier", "force_demand": "amplifier",
     "saturates": "amplifier", "unbalance_currents": "amplifier",
     "closed_loop_modes": "campbell", "log_decrement": "campbell",
     "open_loop_modes": "campbell", "Campbell": "campbell", "ClosedLoopModes": "campbell",

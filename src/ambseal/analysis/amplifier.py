@@ -17,23 +17,34 @@ Bearings*, 2009, ch. 5 and 15). The largest current and voltage over the judged 
 (:func:`ambseal.model.capacity.amplifier_needs`) are the smallest amplifier that holds it,
 per AMB: its sizing. A discrete loop's current is taken at its samples (the
 held value's fundamental is sinc(ΩT/2π) ≤ 1 of it: the fractions err on the safe side).
+
+The judged current-impulse response (P5 §5.1) is held to the same limits: the amplifier
+drives the current reference −K y plus the injected impulse, held over each step of the
+response; its coil current i and rate di/dt follow from the current loop H_a integrated
+exactly over each step (at a step's start, where a held input makes |di/dt| largest), and
+the coils need R i0 + |R i + L di/dt| (:func:`ambseal.model.capacity.transient_needs`). An
+ideal current loop (``[actuator] model = "none"``) steps the current instantly: the
+impulse's current is judged, its voltage not.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ambseal.lti import freqresp_at
-from ambseal.model import (AXES, actuator_matrices, amplifier_needs, amplifier_use,
-                           axis_label)
+from ambseal.lti import freqresp_at, zoh
+from ambseal.model import (AXES, actuator_matrices, amb_factors, amplifier_needs,
+                           axis_label, limits_used, transient_needs)
 
-__all__ = ["unbalance_currents", "capacity_block", "capacity_words", "saturates"]
+__all__ = ["unbalance_currents", "impulse_coil_currents", "force_demand", "capacity_block",
+           "capacity_words", "saturates"]
 
 #: The fractions of :func:`ambseal.model.capacity.amplifier_use`, as metrics.json names them,
 #: and what each is a fraction of, in words.
 QUANTITIES = ("current_used", "voltage_used", "bias_used")
 _LIMITS = {"voltage_used": "the supply voltage", "current_used": "the current limit",
            "bias_used": "the bias current's linear range"}
+#: What the controller holds in each judged response :func:`capacity_block` takes, in words.
+_HOLDING = {"unbalance": "holding the unbalance", "impulse": "in the current impulse"}
 
 
 def unbalance_currents(Kw: np.ndarray, H: np.ndarray, force_n: np.ndarray) -> np.ndarray:
@@ -56,7 +67,77 @@ def unbalance_currents(Kw: np.ndarray, H: np.ndarray, force_n: np.ndarray) -> np
     return np.linalg.norm(Kw @ H, axis=2) * np.asarray(force_n, float)[:, None]
 
 
-def capacity_block(cfg, entries) -> dict | None:
+def impulse_coil_currents(act, impulse) -> tuple[np.ndarray, np.ndarray | None]:
+    """The coil currents and their rates through the amplifier's current loop in a judged
+    current-impulse response (module docstring).
+
+    Parameters
+    ----------
+    act : Actuator
+        The rig's ``[actuator]`` (:func:`ambseal.model.amb.actuator_matrices`).
+    impulse : ImpulseResponse
+        The judged response (:func:`ambseal.analysis.response.impulse_response_of`): its
+        current reference ``current_a + disturbance_a`` held over each ``dt_s``.
+
+    Returns
+    -------
+    current : ndarray, shape (n_t, nu)
+        The control current i of each coil pair (A), at each step's start.
+    rate : ndarray, shape (n_t, nu) or None
+        di/dt there (A/s), the input of that step applied; None for an ideal current loop.
+    """
+    ref = np.asarray(impulse.current_a + impulse.disturbance_a, float)
+    A, B, C, D = actuator_matrices(act)
+    if A.shape[0] == 0:
+        return ref * float(D[0, 0]), None
+    Ad, Bd = zoh(A, B, float(impulse.dt_s), keep=False)
+    x = np.zeros((A.shape[0], ref.shape[1]))  # each axis's amplifier at rest
+    current, rate = np.empty_like(ref), np.empty_like(ref)
+    for k, r in enumerate(ref):
+        current[k] = (C @ x)[0] + D[0, 0] * r
+        rate[k] = (C @ (A @ x + B * r))[0]
+        x = Ad @ x + Bd * r
+    return current, rate
+
+
+def force_demand(cfg, entries) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """The force amplitude (N) each AMB delivers to hold the judged unbalance, Ki·|H_a(jΩ)|·
+    i_ref per axis (module docstring): the largest over the AMB's axes and a controller's
+    judged conditions, to set against :func:`ambseal.model.capacity.force_capacity`.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig: its ``[[amb]]`` (Ki) and ``[actuator]``.
+    entries : iterable of (str, ndarray, ndarray, sequence of str)
+        As :func:`capacity_block`'s.
+
+    Returns
+    -------
+    dict
+        Per AMB name, ``(speed_hz, force_n)``: arrays of shape (S,) on the union of the
+        conditions' speeds (each condition's curve linearly interpolated there); an AMB
+        without Ki is left out.
+    """
+    act = actuator_matrices(cfg.actuator)
+    ki = {f"i_{amb.name}_{ax}": (amb.name, k)
+          for amb in cfg.amb for ax, k in zip(AXES, amb_factors(amb)[0]) if k is not None}
+    curves: dict = {}
+    for _, speed_hz, i_ref, names in entries:
+        f = np.asarray(speed_hz, float)
+        gain = np.abs(freqresp_at(act, 2j * np.pi * f)[:, 0, 0])
+        for a, name in enumerate(names):
+            if name in ki:
+                amb, k = ki[name]
+                curves.setdefault(amb, []).append((f, k * gain * i_ref[:, a]))
+    out = {}
+    for amb, cs in curves.items():
+        grid = np.unique(np.concatenate([f for f, _ in cs]))
+        out[amb] = (grid, np.max([np.interp(grid, f, y) for f, y in cs], axis=0))
+    return out
+
+
+def capacity_block(cfg, entries, impulses=()) -> dict | None:
     """The largest fraction of each amplifier limit a controller uses over its judged
     conditions (module docstring), as ``metrics.json`` writes it.
 
@@ -68,18 +149,23 @@ def capacity_block(cfg, entries) -> dict | None:
         Per judged condition of the controller: its label, the speeds Ω/2π (Hz, shape
         (F,)), the current references (A, shape (F, nu), :func:`unbalance_currents`) and
         the axes' input names (``i_<amb>_<axis>``).
+    impulses : iterable of (str, float, ImpulseResponse)
+        Per judged condition: its label, its speed (Hz) and the judged current-impulse
+        response (:func:`impulse_coil_currents`).
 
     Returns
     -------
     dict or None
         ``current_used``, ``voltage_used``, ``bias_used`` (the largest fraction, None where
         no AMB gives the limit), ``current_a`` (the largest coil current amplitude, A),
-        ``worst`` (per quantity: ``condition``, ``speed_hz``, ``axis``) and ``sizing``:
-        per AMB the smallest amplifier that holds every judged condition,
-        ``current_limit_a`` (the largest control current amplitude of its axes, A) and
-        ``supply_voltage_v`` (the largest R i0 + |R + jωL| i_c, V; None without the coil's
-        inductance), :func:`ambseal.model.capacity.amplifier_needs`; None when no
-        condition was judged stable or the rig's AMBs give no bias current.
+        ``worst`` (per quantity: ``condition``, ``speed_hz``, ``axis`` and ``response``,
+        ``"unbalance"`` or ``"impulse"``) and ``sizing``: per AMB the smallest amplifier
+        that holds every judged condition, ``current_limit_a`` (the largest control
+        current of its axes, A) and ``supply_voltage_v`` (the largest voltage its coils
+        need, V; None without the coil's inductance),
+        :func:`ambseal.model.capacity.amplifier_needs` and
+        :func:`~ambseal.model.capacity.transient_needs`; None when no condition was judged
+        stable or the rig's AMBs give no bias current.
     """
     by_axis = {f"i_{amb.name}_{ax}": amb for amb in cfg.amb for ax in AXES}
     if not cfg.amb or any(a.bias_current is None for a in cfg.amb):
@@ -87,28 +173,39 @@ def capacity_block(cfg, entries) -> dict | None:
     act = actuator_matrices(cfg.actuator)
     best: dict = {q: (None, None) for q in (*QUANTITIES, "current_a")}
     sizing: dict = {}
+
+    def account(label, speed_hz, name, need, response):
+        amb = by_axis[name]
+        row = sizing.setdefault(amb.name, {"current_limit_a": 0.0, "supply_voltage_v": None})
+        row["current_limit_a"] = max(row["current_limit_a"],
+                                     float(need["current_a"].max(initial=0.0)))
+        if need["voltage_v"] is not None:
+            row["supply_voltage_v"] = max(row["supply_voltage_v"] or 0.0,
+                                          float(need["voltage_v"].max(initial=0.0)))
+        use = limits_used(amb, need)
+        use["current_a"] = need["current_a"]
+        for q, v in use.items():
+            if v is None or not v.size:
+                continue
+            k = int(np.argmax(v))
+            if best[q][0] is None or v[k] > best[q][0]:
+                best[q] = (float(v[k]), {"condition": label, "speed_hz": float(speed_hz[k]),
+                                         "axis": name.removeprefix("i_"),
+                                         "response": response})
+
     for label, speed_hz, i_ref, names in entries:
         w = 2 * np.pi * np.asarray(speed_hz, float)
         gain = np.abs(freqresp_at(act, 1j * w)[:, 0, 0])
         for a, name in enumerate(names):
-            amb, ic = by_axis[name], gain * i_ref[:, a]
-            need = amplifier_needs(amb, w, ic)
-            row = sizing.setdefault(amb.name, {"current_limit_a": 0.0,
-                                               "supply_voltage_v": None})
-            row["current_limit_a"] = max(row["current_limit_a"], float(ic.max(initial=0.0)))
-            if need["voltage_v"] is not None:
-                row["supply_voltage_v"] = max(row["supply_voltage_v"] or 0.0,
-                                              float(need["voltage_v"].max(initial=0.0)))
-            use = amplifier_use(amb, w, ic)
-            use["current_a"] = ic
-            for q, v in use.items():
-                if v is None:
-                    continue
-                k = int(np.argmax(v))
-                if best[q][0] is None or v[k] > best[q][0]:
-                    best[q] = (float(v[k]), {"condition": label,
-                                             "speed_hz": float(speed_hz[k]),
-                                             "axis": name.removeprefix("i_")})
+            account(label, speed_hz, name, amplifier_needs(by_axis[name], w, gain * i_ref[:, a]),
+                    "unbalance")
+    for label, speed_hz, imp in impulses:
+        current, rate = impulse_coil_currents(cfg.actuator, imp)
+        at = np.full(current.shape[0], float(speed_hz))
+        for a, name in enumerate(imp.input_names):
+            need = transient_needs(by_axis[name], current[:, a],
+                                   None if rate is None else rate[:, a])
+            account(label, at, name, need, "impulse")
     if best["current_a"][0] is None:
         return None
     return {**{q: best[q][0] for q in (*QUANTITIES, "current_a")},
@@ -135,9 +232,10 @@ def saturates(block: dict | None) -> bool:
 
 def capacity_words(block: dict | None) -> str:
     """A :func:`capacity_block` in words: ``"holding the unbalance it uses 64 % of the
-    supply voltage (A ζ at 11 000 rpm, 0 bar)"``, the largest of the voltage and current
-    fractions; when a fraction is above 1, ``"the amplifier saturates holding the unbalance:
-    it needs 1.5× the current limit (…)"``; ``""`` without a limit to set it against.
+    supply voltage (A ζ at 11 000 rpm, 0 bar)"`` (``"in the current impulse"`` where the
+    impulse response uses more), the largest of the voltage and current fractions; when a
+    fraction is above 1, ``"the amplifier saturates holding the unbalance: it needs 1.5×
+    the current limit (…)"``; ``""`` without a limit to set it against.
 
     Parameters
     ----------
@@ -157,7 +255,8 @@ def capacity_words(block: dict | None) -> str:
     v, what, w = max(over or used, key=lambda u: u[0])
     rpm = f"{60 * w['speed_hz']:,.0f}".replace(",", " ")
     at = f"{axis_label(w['axis'])} at {rpm} rpm, {w['condition']}"
+    holding = _HOLDING[w.get("response", "unbalance")]
     if over:
-        return f"the amplifier saturates holding the unbalance: it needs {v:.3g}× {what} ({at})"
-    return f"holding the unbalance it uses {100 * v:.0f} % of {what} ({at})"
+        return f"the amplifier saturates {holding}: it needs {v:.3g}× {what} ({at})"
+    return f"{holding} it uses {100 * v:.0f} % of {what} ({at})"
 

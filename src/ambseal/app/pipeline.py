@@ -68,6 +68,7 @@ from ambseal.machine import SPEED
 from ambseal.model import build_plant
 from ambseal.report import (
     StageProgress,
+    capacity_figure,
     gains_figure,
     judged_on,
     rig_clearances_um,
@@ -491,6 +492,16 @@ def _unbalance_currents(method: str, jobs, judged):
             yield (case.label, *c["unbalance_current"])
 
 
+def _impulses(method: str, jobs, judged):
+    """The current-impulse responses of ``method``'s stable judged loops, as it runs
+    where it runs sampled: ``(condition, speed Hz, response)`` for
+    :func:`~ambseal.analysis.amplifier.capacity_block`."""
+    for job, (case, curves) in zip(jobs, judged):
+        c = curves.get("discrete", curves)
+        if job.name == method and c.get("impulse") is not None:
+            yield case.label, case.speed_hz, c["impulse"]
+
+
 def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path: Path,
                         truth, command: str | None) -> dict:
     """Export the delivered controllers, run the speed-scheduled and tracked extras, write
@@ -500,8 +511,10 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
     case_dicts = [case.to_dict() for case in cases]
     curves = [(j.name, j.point, case, c)
               for j, case, (_, c) in zip(st.jobs, case_dicts, st.judged)]
-    capacity = {d.method: capacity_block(cfg, _unbalance_currents(d.method, st.jobs, st.judged))
+    currents = {d.method: list(_unbalance_currents(d.method, st.jobs, st.judged))
                 for d in st.designs}
+    capacity = {m: capacity_block(cfg, entries, _impulses(m, st.jobs, st.judged))
+                for m, entries in currents.items()}
     for m, block in capacity.items():  # an amplifier that saturates fails its controller
         f = saturation_failure(m, block, designed=m != "pid", kept=st.allow_unstable,
                                derived=cfg.controller.pid is None)
@@ -553,6 +566,7 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
     write_json(out / "metrics.json", metrics)
     figs.append(gains_figure(out, [(d.method, frozen_at(d.controller, cfg.operating,
                                                         st.design_cfg)) for d in st.designs]))
+    figs += capacity_figure(out, cfg, currents)
     write_run_report(out, f"ambseal — {cfg.rotor.name}", stamp(rig_path, command),
                      metrics, curves, figs, sections, rig_clearances_um(cfg),
                      judged_on(cfg, st.truth_cfg if ident is not None else None, truth))

@@ -12,8 +12,9 @@ Each element owns its matrices and parameter channels; the rig only assembles th
   :func:`eddy_lag_matrices`); what it can deliver: its coil's inductance, force capacity
   against frequency and static load capacity (:func:`coil_inductance`,
   :func:`force_capacity`, :func:`load_capacity`), the current and voltage a control
-  current needs (:func:`amplifier_needs`) and the fractions of its limits it uses
-  (:func:`amplifier_use`);
+  current needs (:func:`amplifier_needs`), what a transient needs
+  (:func:`transient_needs`) and the fractions of its limits they use
+  (:func:`amplifier_use`, :func:`limits_used`);
 * :class:`SealElement` — Childs' seal force (P4 Eq. 3), its coefficients against the
   pressure drop (:func:`seal_coefficients`, :func:`seal_values`,
   :func:`coefficient_value`, P5 §4.1), and the coefficients that follow a tracked one
@@ -49,7 +50,7 @@ _FROM = {
     "axes_rotation": "amb", "bias_current": "amb", "bias_currents": "amb",
     "channel_names": "amb", "eddy_lag_matrices": "amb", "coil_inductance": "capacity",
     "force_capacity": "capacity", "load_capacity": "capacity", "amplifier_use": "capacity",
-    "amplifier_needs": "capacity",
+    "amplifier_needs": "capacity", "transient_needs": "capacity", "limits_used": "capacity",
     "AXES": "amb", "axis_label": "amb", "BeamElement": "fe",
     "CouplingElement": "fe",
     "DiskElement": "fe", "Channel": "lft", "Parameter": "lft", "Plant": "lft",

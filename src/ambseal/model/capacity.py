@@ -38,7 +38,7 @@ from ambseal.errors import ConfigError
 from ambseal.model.amb import MU0, amb_factors
 
 __all__ = ["coil_inductance", "force_capacity", "load_capacity", "amplifier_needs",
-           "amplifier_use"]
+           "transient_needs", "limits_used", "amplifier_use"]
 
 
 def coil_inductance(amb: Amb) -> float | None:
@@ -142,10 +142,80 @@ def amplifier_needs(amb: Amb, omega, current_a) -> dict:
     return {"current_a": ic, "voltage_v": voltage}
 
 
+def transient_needs(amb: Amb, current_a, rate_a_per_s) -> dict:
+    """What the amplifier of an AMB axis must deliver to drive a control current i(t) (a
+    transient: an impulse or step response): the coils carry i0 ± i, so their voltages are
+    R(i0 ± i) ± L di/dt, the larger in size R i0 + |R i + L di/dt| (module docstring).
+
+    Parameters
+    ----------
+    amb : Amb
+        One ``[[amb]]`` of the rig file, with its ``bias_current``.
+    current_a : array_like, shape (N,)
+        The control current i (A) at N instants.
+    rate_a_per_s : array_like, shape (N,) or None
+        Its rate di/dt (A/s) there; None when the amplifier's current loop is ideal (an
+        instantaneous step has no finite voltage): the voltage is then not judged.
+
+    Returns
+    -------
+    dict
+        Arrays of shape (N,): ``current_a`` |i| (A) and ``voltage_v`` (V; None without a
+        rate or without the coil's inductance, as in :func:`amplifier_needs`).
+
+    Raises
+    ------
+    ConfigError
+        No bias current, or a rate not of the current's shape.
+    """
+    i = np.atleast_1d(np.asarray(current_a, float))
+    if amb.bias_current is None:
+        raise ConfigError(f"amb {amb.name}: the amplifier's voltage needs bias_current (A)")
+    L, R = coil_inductance(amb), float(amb.resistance or 0.0)
+    if rate_a_per_s is None or L is None:
+        return {"current_a": np.abs(i), "voltage_v": None}
+    rate = np.atleast_1d(np.asarray(rate_a_per_s, float))
+    if rate.shape != i.shape:
+        raise ConfigError(f"amb {amb.name}: amplifier: {rate.size} current rates for "
+                          f"{i.size} currents")
+    return {"current_a": np.abs(i),
+            "voltage_v": R * float(amb.bias_current) + np.abs(R * i + L * rate)}
+
+
+def limits_used(amb: Amb, need: dict) -> dict:
+    """The fractions of an AMB axis's limits that what its amplifier must deliver uses
+    (:func:`amplifier_needs`, :func:`transient_needs`): 1 is the limit, above it the
+    amplifier saturates or a coil's current would go below zero.
+
+    Parameters
+    ----------
+    amb : Amb
+        One ``[[amb]]`` of the rig file, with its ``bias_current``.
+    need : dict
+        ``current_a`` and ``voltage_v`` (arrays of one shape; ``voltage_v`` may be None).
+
+    Returns
+    -------
+    dict
+        Arrays of ``need``'s shape: ``bias_used`` |i_c|/i0 (the differential pair's linear
+        range), ``current_used`` |i_c|/``current_limit`` and ``voltage_used``
+        (the voltage)/``supply_voltage``; the last two None where the rig file gives no
+        such limit (or ``need`` no voltage).
+
+    Raises
+    ------
+    ConfigError
+        As :func:`force_capacity`.
+    """
+    i0, limit, coil = _amplifier(amb)
+    ic, v = need["current_a"], need["voltage_v"]
+    return {"bias_used": ic / i0, "current_used": None if limit is None else ic / limit,
+            "voltage_used": None if coil is None or v is None else v / amb.supply_voltage}
+
+
 def amplifier_use(amb: Amb, omega, current_a) -> dict:
-    """The fractions of an AMB axis's limits a sinusoidal control current uses (module
-    docstring): 1 is the limit, above it the amplifier saturates or a coil's current
-    would go below zero.
+    """The fractions of an AMB axis's limits a sinusoidal control current uses
+    (:func:`limits_used` of :func:`amplifier_needs`).
 
     Parameters
     ----------
@@ -159,22 +229,16 @@ def amplifier_use(amb: Amb, omega, current_a) -> dict:
     Returns
     -------
     dict
-        Arrays of shape (F,): ``bias_used`` i_c/i0 (the differential pair's linear range),
-        ``current_used`` i_c/``current_limit`` and ``voltage_used``
-        (R i0 + |R + jωL| i_c)/``supply_voltage``; the last two None where the rig file
-        gives no such limit.
+        Arrays of shape (F,): ``bias_used`` i_c/i0, ``current_used`` i_c/``current_limit``
+        and ``voltage_used`` (R i0 + |R + jωL| i_c)/``supply_voltage``; the last two None
+        where the rig file gives no such limit.
 
     Raises
     ------
     ConfigError
         As :func:`force_capacity`.
     """
-    need = amplifier_needs(amb, omega, current_a)
-    i0, limit, coil = _amplifier(amb)
-    ic = need["current_a"]
-    voltage = None if coil is None else need["voltage_v"] / amb.supply_voltage
-    return {"bias_used": ic / i0, "current_used": None if limit is None else ic / limit,
-            "voltage_used": voltage}
+    return limits_used(amb, amplifier_needs(amb, omega, current_a))
 
 
 def _frequencies(amb: Amb, omega) -> np.ndarray:

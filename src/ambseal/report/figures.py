@@ -37,6 +37,7 @@ __all__ = [
     "compliance_figure",
     "unbalance_figure",
     "impulse_figure",
+    "force_capacity_figure",
     "save_figure",
     "CONDITION_STYLES",
     "controller_colours",
@@ -385,6 +386,62 @@ def impulse_figure(
                 ax.set_xlabel("Time (ms)")
     if cases:
         axes[0, 0].legend(fontsize=7)
+    fig.suptitle(title)
+    return save_figure(fig, path, tight=True)
+
+
+def force_capacity_figure(
+    path: str | os.PathLike,
+    bearings: Sequence[tuple[str, Sequence[float], np.ndarray]],
+    demands: Mapping[str, Sequence[Curve]],
+    *,
+    static_n: Mapping[str, float | None] | None = None,
+    title: str = "Force capacity and the force the controllers ask for",
+    styles: Mapping[str, dict] | None = None,
+) -> Path:
+    """Per AMB, the largest force amplitude it can deliver against frequency (the current
+    limit, then the amplifier's slew rate K_i V/(L ω)) with the force each controller asks
+    of it to hold the unbalance; one panel per AMB, log axes.
+
+    Parameters
+    ----------
+    path : path-like
+    bearings : sequence of (name, frequency_hz, capacity_n)
+        Per AMB, frequencies (Hz, shape (F,)) and the force capacity of its axes (N, shape
+        (F,) or (F, 2): ζ and η, drawn apart where they differ).
+    demands : mapping of str → sequence of (label, speed_hz, force_n)
+        Per AMB name, each controller's force amplitude (N) against speed (Hz).
+    static_n : mapping of str → float or None, optional
+        Per AMB name, its static load capacity (N), a dashed line.
+    title : str
+    styles : mapping of label → matplotlib keywords, optional
+        Style of each controller's curve (:func:`case_style`).
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    n = max(len(bearings), 1)
+    fig = Figure(figsize=(4.6 * n, 4.2))
+    axes = fig.subplots(1, n, squeeze=False, sharey=True)[0]
+    for ax, (name, f, cap) in zip(axes, bearings):
+        f, cap = np.asarray(f, float), np.asarray(cap, float).reshape(len(f), -1)
+        same = np.allclose(cap, cap[:, :1], rtol=1e-9)
+        for j in range(1 if same else cap.shape[1]):
+            ax.loglog(f, cap[:, j], color="k", lw=2, ls="-" if j == 0 else ":",
+                      label="capacity" if same else f"capacity {('ζ', 'η')[j]}")
+        if (static_n or {}).get(name):
+            ax.axhline(static_n[name], color="0.45", ls="--", lw=1,
+                       label="static load capacity")
+        for label, x, y in _curves(demands.get(name, ())):
+            ax.loglog(x, y, label=label, **{"lw": 1.2, **(styles or {}).get(label, {})})
+        ax.set_title(f"AMB {name}")
+        ax.xaxis.set_major_formatter(ScalarFormatter())
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.set_xlabel("Frequency, speed (Hz)")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    axes[0].set_ylabel("Force amplitude (N)")
     fig.suptitle(title)
     return save_figure(fig, path, tight=True)
 

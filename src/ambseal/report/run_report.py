@@ -16,10 +16,12 @@ from pathlib import Path
 import numpy as np
 
 from ambseal import __version__
+from ambseal.analysis import force_demand
 from ambseal.config import method_label
 from ambseal.design import machine
 from ambseal.identify import MIN_FIT_PCT, fit_reliability, interval_check, true_line
 from ambseal.lti.freqresp import freqresp
+from ambseal.model import amb_factors, force_capacity, load_capacity
 from ambseal.report import figures
 from ambseal.report.figures import case_style, controller_colours, controller_gains_figure
 from ambseal.report.html import write_report
@@ -35,8 +37,8 @@ from ambseal.report.identify_figures import (
 from ambseal.report.lpv_figures import frozen_sensitivity_figure, spinup_figure
 from ambseal.report.verdict import axis_label, sig
 
-__all__ = ["gains_figure", "spinup_figures", "identification_report", "write_run_report",
-           "stamp", "rig_clearances_um"]
+__all__ = ["gains_figure", "capacity_figure", "spinup_figures", "identification_report",
+           "write_run_report", "stamp", "rig_clearances_um"]
 
 
 def stamp(rig_path: str | Path, command: str | None = None) -> str:
@@ -158,6 +160,49 @@ def gains_figure(out: Path, controllers: list[tuple[str, object]]) -> tuple[str,
     return ("Direct and cross gains of the controllers (P5 Fig. 10)",
             controller_gains_figure(out / "controller_gains.png", rows, names,
                                     styles={m: case_style(c) for m, c in colours.items()}))
+
+
+def capacity_figure(out: Path, cfg, currents: dict[str, list]) -> list[tuple[str, Path]]:
+    """The force each AMB can deliver against frequency and the force each controller asks
+    of it to hold the judged unbalance (:func:`ambseal.model.capacity.force_capacity`,
+    :func:`ambseal.analysis.amplifier.force_demand`), one panel per AMB.
+
+    Parameters
+    ----------
+    out : Path
+        Folder of the figure (``force_capacity.png``).
+    cfg : RigConfig
+        The rig (its ``[[amb]]`` limits and ``[actuator]``).
+    currents : dict
+        Method → its judged conditions' unbalance currents, the entries of
+        :func:`ambseal.analysis.amplifier.capacity_block`.
+
+    Returns
+    -------
+    list of (str, Path)
+        The caption and PNG; empty when no AMB gives its bias current and Ki or no loop
+        was judged stable.
+    """
+    ambs = [a for a in cfg.amb if a.bias_current is not None and None not in amb_factors(a)[0]]
+    demands = {m: force_demand(cfg, entries) for m, entries in currents.items()}
+    speeds = np.concatenate([f for d in demands.values() for f, _ in d.values()] or [[]])
+    speeds = speeds[speeds > 0]
+    if not ambs or not speeds.size:
+        return []
+    # the judged speeds and an octave either side: where the slew rate starts to bind shows
+    f = np.logspace(math.log10(speeds.min() / 2), math.log10(2 * speeds.max()), 300)
+    bearings = [(a.name, f, force_capacity(a, 2 * np.pi * f)) for a in ambs]
+    by_amb = {a.name: [(method_label(m), *d[a.name]) for m, d in demands.items()
+                       if a.name in d] for a in ambs}
+    colours = controller_colours(list(demands))
+    return [("Force capacity of each AMB (Ki times the control current its bias, current "
+             "limit and supply voltage allow: the amplifier's slew rate Ki·V/(Lω) at high "
+             "frequency) and the force each controller asks of it to hold the worst-case "
+             "unbalance, the largest over its judged conditions",
+             figures.force_capacity_figure(
+                 out / "force_capacity.png", bearings, by_amb,
+                 static_n={a.name: load_capacity(a) for a in ambs},
+                 styles={method_label(m): case_style(c) for m, c in colours.items()}))]
 
 
 def spinup_figures(out: Path, sims: list, sens: list, speeds_hz: tuple[float, float]

@@ -16,7 +16,9 @@
 * :func:`design_lpv`, :func:`design_frozen` — controllers scheduled on the speed (P3 §4),
   on the gridded plant of :func:`ambseal.design.lpv_plant.lpv_plant` (not re-exported: it
   shares its module's name) at the speeds of :func:`vertex_grid_hz`;
-  :func:`design_seal_scheduled` — scheduled on the tracked seal coefficient (Ch. 7).
+  :func:`design_seal_scheduled` — scheduled on the tracked seal coefficient (Ch. 7);
+* :func:`design_rejection` → :class:`SynchronousRejection` — a controller's unbalance
+  force rejection, a generalised notch filter scheduled on speed (Herzog et al. 1996).
 
 The synthesis itself is :mod:`ambseal.robust`'s, which knows nothing of rotors.
 """
@@ -35,10 +37,12 @@ from ambseal.design.recipes import DesignResult, design, full_order_check
 from ambseal.design.result import Design
 from ambseal.design.seal_schedule import design_seal_scheduled
 from ambseal.design.specs import RIGID_STATES, DesignSpec, Machine, design_spec, machine
+from ambseal.design.synchronous_rejection import SynchronousRejection, design_rejection
 from ambseal.design.weights import Weights, default_weights
 
 __all__ = ["RIGID_STATES", "Design", "DesignResult", "DesignSpec", "Machine", "Weights",
            "controller_from_metadata", "default_weights", "design", "design_frozen",
            "design_lpv", "design_rise", "design_seal_scheduled", "design_spec",
            "full_order_check", "generalized_plant", "machine",
-           "physical_controller", "pid_controller", "pid_description", "reference_pid", "vertex_grid_hz"]
+           "physical_controller", "pid_controller", "pid_description", "reference_pid",
+           "vertex_grid_hz", "SynchronousRejection", "design_rejection"]

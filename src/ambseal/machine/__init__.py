@@ -9,7 +9,9 @@ verdict is taken on, with the target's hold and computation delay
 (:mod:`ambseal.machine.loop`; :func:`loop_matrices` and :func:`sample_time` check a
 plant and a controller before they are closed, :func:`sampled_plant` samples a plant as
 the controller sees it); and a scheduled controller's table as it runs on the target
-(:mod:`ambseal.machine.scheduled_digital`).
+(:mod:`ambseal.machine.scheduled_digital`); and the generalised notch filter that rejects
+the synchronous force, scheduled on speed, around any of them
+(:mod:`ambseal.machine.synchronous_notch`).
 """
 
 from ambseal.machine.controller import (
@@ -30,8 +32,10 @@ from ambseal.machine.loop import (
     sampled_plant,
 )
 from ambseal.machine.scheduled_digital import ScheduledDigital, scheduled_digital
+from ambseal.machine.synchronous_notch import NotchedController, NotchedDigital, SynchronousNotch
 
 __all__ = ["SPEED", "ScheduledController", "controller_as_runs", "frozen", "matrices_at",
            "sampled_loop_matrix", "ClosedLoop",
            "JudgedLoop", "closed_loop", "judged_loop", "loop_matrices", "sample_time",
-           "sampled_plant", "ScheduledDigital", "scheduled_digital"]
+           "sampled_plant", "ScheduledDigital", "scheduled_digital", "SynchronousNotch",
+           "NotchedController", "NotchedDigital"]

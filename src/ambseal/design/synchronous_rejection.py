@@ -1,0 +1,174 @@
+"""The unbalance force rejection of a controller: its generalised notch's gain table over
+the speed range, on the full-order plant (Herzog et al., IEEE TCST 4(5), 1996;
+:mod:`ambseal.machine.synchronous_notch`).
+
+At each speed Ω of a grid over the rig's continuous speed range the gain is the inverse of
+the output sensitivity, ``T(Ω) = S_o⁻¹ = I + G K``, of the loop the controller runs in:
+
+- continuous: ``G(jΩ)`` the full-order plant at that speed (gyroscopics, seals at the
+  rig's operating pressure) with the hold-and-computation-delay lag the judgement puts in
+  every continuous loop (:func:`ambseal.robust.delay.loop_delay`), ``K(jΩ)`` the designed
+  controller (frozen at Ω when it is scheduled);
+- as it runs: ``G_d(e^{jΩT_s})`` the plant sampled by a zero-order hold, ``K_d(e^{jΩT_s})``
+  the discrete controller with its computation delay.
+
+Rules, each a parameter:
+
+- the speeds: ``[operating] speed_range_hz`` (the minimum to the maximum continuous
+  speed), else the operating speed alone; :data:`GRID_POINTS` evenly spaced speeds over a
+  range (the table is interpolated linearly between them; the first-order poles stay in
+  the left half-plane while the interpolated gain's phase error stays below 90°, and the
+  judgement checks every condition);
+- on from the lowest of them: below the minimum continuous speed the rotor passes its
+  critical speeds on the feedback alone, and at standstill a notch at 0 Hz would take the
+  controller's static stiffness;
+- ε = :data:`RATE_FRACTION` × Ω: a narrow notch, its poles ε/2 from the imaginary axis,
+  settling (time constant 2/ε) in 1/(π·0.05) ≈ 6 revolutions at every speed — slow
+  against the rotation it tracks, as the first-order placement needs.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ambseal.errors import ConfigError
+from ambseal.lti import freqresp_at, sampled_response_at
+from ambseal.machine import (
+    NotchedController,
+    NotchedDigital,
+    SynchronousNotch,
+    controller_as_runs,
+    frozen,
+)
+from ambseal.model import build_plant
+from ambseal.robust import loop_delay
+
+__all__ = ["SynchronousRejection", "design_rejection", "GRID_POINTS", "RATE_FRACTION"]
+
+#: Speeds of the gain table over a speed range (module docstring).
+GRID_POINTS = 16
+#: ε as a fraction of the speed Ω, both in rad/s (module docstring).
+RATE_FRACTION = 0.05
+
+
+@dataclass(frozen=True, eq=False)
+class SynchronousRejection:
+    """A controller with its unbalance force rejection (module docstring).
+
+    Attributes
+    ----------
+    controller : NotchedController
+        The designed controller with its continuous notch.
+    digital : NotchedDigital or None
+        The digital controller with its discrete notch, as it runs; None when no digital
+        controller was given.
+    speeds_hz : ndarray, shape (S,)
+        The speeds of the gain table (Hz).
+    pressure_bar : float
+        The pressure drop the table was made at.
+    """
+
+    controller: NotchedController
+    digital: NotchedDigital | None
+    speeds_hz: np.ndarray
+    pressure_bar: float
+
+    def to_dict(self) -> dict:
+        """JSON-ready description: the table's speeds (Hz), ε/Ω, the speed it is on from
+        (Hz) and the pressure drop (bar)."""
+        n = self.controller.notch
+        return {"table_speeds_hz": [float(f) for f in self.speeds_hz],
+                "rate_fraction": float(n.rate_fraction),
+                "on_from_hz": float(n.on_rad_s / (2 * math.pi)),
+                "pressure_bar": float(self.pressure_bar)}
+
+
+def design_rejection(cfg, controller, digital=None, *, pressure_bar: float | None = None,
+                     speeds_hz: tuple[float, float] | None = None,
+                     points: int = GRID_POINTS,
+                     rate_fraction: float = RATE_FRACTION) -> SynchronousRejection:
+    """A controller's unbalance force rejection over the speed range (module docstring).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig.
+    controller : control.StateSpace or ScheduledController
+        The designed controller, ``i = −K y`` (scheduled on speed, or fixed).
+    digital : DigitalController or ScheduledDigital, optional
+        The controller as it runs; its notch is designed on the sampled loop.
+    pressure_bar : float, optional
+        The seals' pressure drop (default ``[operating] pressure_bar``).
+    speeds_hz : (float, float), optional
+        The speed range (Hz), default ``[operating]``'s continuous speeds.
+    points : int
+        Speeds of the table over a range (≥ 2).
+    rate_fraction : float
+        ε/Ω, in (0, 0.5).
+
+    Returns
+    -------
+    SynchronousRejection
+
+    Raises
+    ------
+    ConfigError
+        A rig that does not rotate (lowest speed 0), fewer than 2 points, or a fraction
+        outside (0, 0.5).
+    """
+    lo, hi = (cfg.operating.continuous_hz if speeds_hz is None
+              else (float(speeds_hz[0]), float(speeds_hz[1])))
+    if not lo > 0 or hi < lo:
+        raise ConfigError("synchronous rejection: the rotor must turn — [operating] "
+                          f"speed_rpm or speed_range_hz above 0 Hz (got {lo:g}–{hi:g} Hz)")
+    if int(points) < 2 or not 0 < rate_fraction < 0.5:
+        raise ConfigError("synchronous rejection: expected points ≥ 2 and a rate fraction "
+                          "in (0, 0.5)")
+    grid = np.linspace(lo, hi, int(points)) if hi > lo else np.array([lo])
+    p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
+    fs, nd = cfg.controller.sample_rate_hz, cfg.controller.delay_samples
+    lag = loop_delay(fs, nd).system
+    gains: dict = {"c": [], "d": []}
+    names: dict = {}
+    for f in grid:
+        w = 2 * math.pi * float(f)
+        plant = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * float(f))
+        P = plant.to_statespace()
+        cur = plant.current_inputs()
+        rest = [j for j in range(P.ninputs) if j not in cur]
+        K = frozen(controller, w)
+        loops = [("c", K, 1j * w, freqresp_at(P, np.array([1j * w]))[0]
+                  * _lag_on(lag, 1j * w, P.ninputs, cur))]
+        if digital is not None:
+            Kd = controller_as_runs(digital, w)
+            loops.append(("d", Kd, np.exp(1j * w / fs),
+                          sampled_response_at(P, 1.0 / fs, np.array([w]),
+                                              groups=(cur, rest))[0]))
+        for key, Kx, point, H in loops:
+            rows = [list(P.output_labels).index(n) for n in Kx.input_labels]
+            cols = [list(P.input_labels).index(n) for n in Kx.output_labels]
+            G = H[np.ix_(rows, cols)]
+            gains[key].append(np.eye(len(rows)) + G @ freqresp_at(Kx, np.array([point]))[0])
+            names[key] = tuple(Kx.input_labels), float(Kx.dt or 0.0)
+    w_grid = 2 * math.pi * grid
+
+    def notch(key):
+        T = np.array(gains[key])
+        inputs, dt = names[key]
+        return SynchronousNotch(w_grid, T.real, T.imag, rate_fraction, w_grid[0], inputs, dt)
+
+    return SynchronousRejection(
+        controller=NotchedController(controller, notch("c")),
+        digital=None if digital is None else NotchedDigital(digital, notch("d")),
+        speeds_hz=grid, pressure_bar=p)
+
+
+def _lag_on(lag: Any, s: complex, n_inputs: int, cur) -> np.ndarray:
+    """A row of ones with the delay lag's ``lag(s)`` on the control inputs ``cur``."""
+    row = np.ones(n_inputs, dtype=complex)
+    row[list(cur)] = freqresp_at(lag, np.array([s]))[0, 0, 0]
+    return row

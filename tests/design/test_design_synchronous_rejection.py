@@ -1,0 +1,111 @@
+"""The unbalance force rejection (design/synchronous_rejection.py) on the turboexpander's
+full-order plant, judged by python-control: its own sampling of the plant (c2d, ZOH), its
+own interconnection of the loop, its poles and frequency responses."""
+
+import math
+
+import control as ct
+import numpy as np
+import pytest
+
+from ambseal.design.synchronous_rejection import design_rejection
+from ambseal.errors import ConfigError
+from ambseal.model import build_plant
+from ambseal.robust import loop_delay
+
+
+@pytest.fixture(scope="module")
+def rejection(turbo_cfg, turbo_frozen, turbo_digital):
+    return design_rejection(turbo_cfg, turbo_frozen.K, turbo_digital["hinf"])
+
+
+def _loop(P, K, cur, delay=None):
+    """python-control's loop: K on P's current inputs (``i = −K y``, by name), the other
+    inputs (forces at the bearings, N) external, the currents out; ``delay`` a SISO lag in
+    front of each current input."""
+    G = ct.ss(P.A, P.B, P.C, P.D, P.dt, inputs=list(P.input_labels),
+              outputs=list(P.output_labels), name="G")
+    Kc = ct.ss(K.A, K.B, K.C, K.D, K.dt, inputs=list(K.input_labels),
+               outputs=list(K.output_labels), name="K")
+    frc = [n for j, n in enumerate(P.input_labels) if j not in cur]
+    blocks, conn = [G, Kc], []
+    for n in Kc.output_labels:
+        if delay is None:
+            conn.append([f"G.{n}", f"-K.{n}"])
+        else:
+            lag = ct.ss(delay.A, delay.B, delay.C, delay.D, inputs=["u"], outputs=["v"],
+                        name=f"lag_{n}")
+            blocks.append(lag)
+            conn += [[f"lag_{n}.u", f"-K.{n}"], [f"G.{n}", f"lag_{n}.v"]]
+    conn += [[f"K.{n}", f"G.{n}"] for n in Kc.input_labels]
+    return ct.interconnect(blocks, connections=conn, inplist=[f"G.{n}" for n in frc],
+                           inputs=frc, outlist=[f"K.{n}" for n in Kc.output_labels],
+                           outputs=list(Kc.output_labels))
+
+
+def test_rejection_takes_the_synchronous_current_out_at_every_speed(
+        turbo_cfg, turbo_frozen, turbo_digital, rejection):
+    """At constant speeds over the range — table speeds and between them — the loop as it
+    runs (the plant sampled by python-control's ZOH, the discrete controller with its
+    delay and notch) and the continuous loop (the judgement's delay lag) are stable, their
+    current at the rotational frequency from forces at the bearings is below 1 % of the
+    feedback-only loop's."""
+    cfg = turbo_cfg
+    fs = cfg.controller.sample_rate_hz
+    lag = loop_delay(fs, cfg.controller.delay_samples).system
+    table = rejection.speeds_hz
+    for f in (table[0], 0.5 * (table[4] + table[5]), table[-1]):
+        w = 2 * math.pi * f
+        pl = build_plant(cfg, pressure_bar=cfg.operating.pressure_bar, speed_rpm=60 * f,
+                         force_positions=tuple(a.position for a in cfg.amb))
+        P, cur = pl.to_statespace(), pl.current_inputs()
+        Pd = ct.c2d(ct.ss(P.A, P.B, P.C, P.D), 1 / fs, "zoh")
+        Pd = ct.ss(Pd.A, Pd.B, Pd.C, Pd.D, 1 / fs, inputs=list(P.input_labels),
+                   outputs=list(P.output_labels))
+        z = np.exp(1j * w / fs)
+        runs = {k: _loop(Pd, K, cur) for k, K in (
+            ("off", turbo_digital["hinf"].statespace(delayed=True)),
+            ("on", rejection.digital.statespace_at(w, delayed=True)))}
+        assert np.abs(runs["on"].poles()).max() < 1
+        assert np.abs(runs["on"](z)).max() < 1e-2 * np.abs(runs["off"](z)).max()
+        cont = {k: _loop(P, K, cur, lag) for k, K in (
+            ("off", turbo_frozen.K), ("on", rejection.controller.at(w)))}
+        assert cont["on"].poles().real.max() < 0
+        assert np.abs(cont["on"](1j * w)).max() < 1e-2 * np.abs(cont["off"](1j * w)).max()
+
+
+def test_notch_poles_sit_where_the_inverse_sensitivity_puts_them(turbo_cfg, turbo_frozen,
+                                                                turbo_digital):
+    """Herzog et al.'s first-order placement: with T = S_o⁻¹ the notch's poles lie at
+    e^{jΩT_s}(1 − εT_s/2), one per channel, whatever the plant — exact as ε → 0: at
+    ε = 0.005 Ω within 1 % of their distance from the unit circle (python-control's poles
+    of the sampled loop at a table speed and at the range's ends)."""
+    cfg = turbo_cfg
+    fs = cfg.controller.sample_rate_hz
+    narrow = design_rejection(cfg, turbo_frozen.K, turbo_digital["hinf"],
+                              rate_fraction=0.005)
+    for f in narrow.speeds_hz[[0, 7, -1]]:
+        w = 2 * math.pi * f
+        pl = build_plant(cfg, pressure_bar=cfg.operating.pressure_bar, speed_rpm=60 * f)
+        P, cur = pl.to_statespace(), pl.current_inputs()
+        Pd = ct.c2d(ct.ss(P.A, P.B, P.C, P.D), 1 / fs, "zoh")
+        Pd = ct.ss(Pd.A, Pd.B, Pd.C, Pd.D, 1 / fs, inputs=list(P.input_labels),
+                   outputs=list(P.output_labels))
+        A = _loop(Pd, narrow.digital.statespace_at(w, delayed=True), cur).A
+        shift = 0.5 * 0.005 * w / fs
+        predicted = np.exp(1j * w / fs) * (1 - shift)
+        near = np.sort(np.abs(np.linalg.eigvals(A) - predicted))[:4]  # one per channel
+        assert near.max() < 0.01 * shift
+
+
+def test_rejection_is_off_below_the_speed_range_and_needs_a_turning_rotor(
+        turbo_cfg, turbo_frozen, testrig_cfg, testrig_designs, rejection):
+    """Below the minimum continuous speed the controller runs without the notch; a rig at
+    standstill has nothing to reject: refused with the keys that would give it a speed."""
+    lo = turbo_cfg.operating.continuous_hz[0]
+    assert rejection.to_dict()["on_from_hz"] == pytest.approx(lo)
+    K = rejection.controller.at(2 * math.pi * 0.9 * lo)
+    assert K.nstates == turbo_frozen.K.nstates
+    assert rejection.controller.at(2 * math.pi * lo).nstates == turbo_frozen.K.nstates + 8
+    with pytest.raises(ConfigError, match="speed_range_hz"):
+        design_rejection(testrig_cfg, testrig_designs["hinf"].K)

@@ -133,6 +133,17 @@ def test_every_example_runs_end_to_end(rig, tmp_path, capsys):
         assert max(c["sensitivity_peak_per_axis"].values()) < 3.0, c
     red = metrics["controllers"]["mu"]["reduction"]
     assert red is None or red["mu"] <= 1.1 * red["mu_full"]
+    # the unbalance force rejection, where the rig asks for it: every delivered controller
+    # gets one, its loops hold at every condition judged where it is on, and its
+    # synchronous coil current is below 1 % of the controller's alone over the range
+    if load_rig(rig).design.rejection.enabled:
+        delivered = set(metrics["controllers"]) - set(metrics["failed"]) \
+            - set(metrics["cannot_run"])
+        for m in delivered:
+            r = metrics["controllers"][m]["rejection"]
+            assert r["stable"] and r["conditions"], (m, r["conditions"])
+            assert r["current_ratio"] < 1e-2, (m, r["current_ratio"])
+        assert (tmp_path / "out" / "rejection.png").is_file()
     _every_file_through_every_command(rig, tmp_path / "out", tmp_path, capsys)
 
 

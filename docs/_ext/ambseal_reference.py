@@ -301,6 +301,14 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Design.hinf": ("", "H∞ weights (table below)"),
     "Design.mu": ("", "μ weights and D–K settings (table below)"),
     "Design.lpv": ("", "LPV weights (table below)"),
+    "Design.rejection": ("", "the unbalance force rejection (table below)"),
+    "RejectionSpec.enabled": ("", "``ambseal run`` adds to every delivered controller a "
+                                  "generalised notch at the rotational frequency, scheduled "
+                                  "on speed over ``speed_range_hz``, judged and shown"),
+    "RejectionSpec.rate_fraction": ("", "ε/Ω of the notch (default 0.05: it settles in "
+                                        "≈ 6 revolutions)"),
+    "RejectionSpec.points": ("", "speeds of its gain table over the speed range (default "
+                                 "16)"),
     "Design.tracked": ("", "``ambseal run`` adds the controller scheduled on the tracked "
                            "seal k (LMI synthesis: minutes)"),
     "UnbalanceSpec.grade_mm_s": ("mm/s", "ISO 21940-11 balance grade G"),
@@ -532,6 +540,9 @@ def _sections() -> list[Section]:
         Section("[design.hinf]", d.MethodSpec, "The same keys in ``[design.lpv]``, and in "
                 "``[design.mu]`` with the μ keys below."),
         Section("[design.mu]", d.MuSpec, "Every key of ``[design.hinf]``, and:"),
+        Section("[design.rejection]", d.RejectionSpec, "The unbalance force rejection "
+                "(Herzog et al., IEEE TCST 1996): a generalised notch filter in each "
+                "controller's input, on from the minimum continuous speed."),
         Section("{ zeta, eta }", r.AxisPair, "A value per actuator axis (``ki``, ``ks``); "
                 "with the geometry one axis may be left out."),
         Section("{ at_zero, per_bar }", r.Affine, "A coefficient affine in the pressure "

@@ -159,3 +159,61 @@ def test_synchronous_response_with_the_loop_as_it_runs_is_the_judged_sampled_loo
     a = f"y_{cfg.amb[0].name}"
     yz, ye = y[names.index(f"{a}_zeta")], y[names.index(f"{a}_eta")]
     assert ours == pytest.approx(float(orbit_semi_major(yz, ye)), rel=5e-3)
+    # the coil currents i = H_a(jΩ)·(−K_r S_o G_f F) of the same path, per axis
+    from ambseal.model import actuator_matrices
+    hold = np.exp(-0.5j * w * float(Kd.dt)) * np.sinc(w * float(Kd.dt) / (2 * math.pi))
+    r = synchronous_response(cfg, K, [f], [[Unbalance(z, U)]], [z])
+    ha = freqresp_at(actuator_matrices(cfg.actuator), [1j * w])[0, 0, 0]
+    coil = -ha * hold * (Kw @ y)
+    np.testing.assert_allclose(r.current_a[0, 0], np.abs(coil), rtol=5e-3)
+    assert r.axes == tuple(P.input_labels[j] for j in cur)
+
+
+def test_synchronous_force_is_the_force_law_at_the_actuator():
+    """With each sensor at its actuator (the same node and axes), the force an AMB axis
+    transmits is the force law K_i·H_e·i + K_s·x with x the sensor's reading: from the
+    response's own currents and the orbit's phasors read through python-control's
+    frequency response of the loop (the judged path), to 0.5 %."""
+    import math
+
+    import numpy as np
+
+    from ambseal.analysis.judge import operating_points
+    from ambseal.analysis.synchronous import Unbalance, synchronous_response
+    from ambseal.app.commands import digital_for
+    from ambseal.config import load_rig
+    from ambseal.design import design, design_spec
+    from ambseal.lti import freqresp_at, shared_ss, wired
+    from ambseal.machine import controller_as_runs, judged_loop
+    from ambseal.model import actuator_matrices, amb_factors, build_plant, eddy_lag_matrices
+
+    cfg = load_rig("examples/overhung_compressor.toml")
+    cfg = cfg.model_copy(update={"amb": [a.model_copy(update={"sensor_position": a.position})
+                                         for a in cfg.amb]})
+    spec = design_spec(cfg)
+    res = design(cfg, "pid", spec=spec)
+    K = digital_for(cfg, "pid", res.K, res, operating_points(spec))
+    f, U, z = 100.0, 1e-4, 0.82
+    w = 2 * math.pi * f
+    r = synchronous_response(cfg, K, [f], [[Unbalance(z, U)]], [z])
+    plant = build_plant(cfg, speed_rpm=60 * f, force_positions=(z,))
+    P = plant.to_statespace()
+    cur = list(plant.current_inputs())
+    Kd = controller_as_runs(K, w)
+    Pw = judged_loop(P, Kd, cur).plant_response(np.array([w]))[0]
+    G, Gf = Pw[:, cur], Pw[:, [j for j in range(P.ninputs) if j not in cur]]
+    named = shared_ss(np.zeros((0, 0)), np.zeros((0, len(cur))),
+                      np.zeros((P.noutputs, 0)), np.zeros((P.noutputs, len(cur))),
+                      inputs=[P.input_labels[j] for j in cur], outputs=list(P.output_labels))
+    Kw = freqresp_at(wired(named, Kd), [np.exp(1j * w * float(Kd.dt))])[0]
+    y = np.linalg.solve(np.eye(G.shape[0]) + G @ Kw, Gf @ (U * w**2 * np.array([1.0, -1j])))
+    hold = np.exp(-0.5j * w * float(Kd.dt)) * np.sinc(w * float(Kd.dt) / (2 * math.pi))
+    ha, he = (freqresp_at(m, [1j * w])[0, 0, 0] for m in (
+        actuator_matrices(cfg.actuator), eddy_lag_matrices(cfg.actuator.eddy_time_constant)))
+    coil = -ha * hold * (Kw @ y)
+    for a, name in enumerate(r.axes):
+        amb, ax = name.removeprefix("i_").rsplit("_", 1)
+        (ki, ks) = (v[("zeta", "eta").index(ax)]
+                    for v in amb_factors(next(b for b in cfg.amb if b.name == amb)))
+        x = y[list(P.output_labels).index(f"y_{amb}_{ax}")]
+        assert r.force_n[0, 0, a] == pytest.approx(abs(ki * he * coil[a] + ks * x), rel=5e-3)

@@ -61,6 +61,7 @@ from ambseal.lazy import lazy_face
 _FROM = {
     "capacity_block": "amplifier", "capacity_words": "amplifier", "force_demand": "amplifier",
     "saturates": "amplifier", "unbalance_currents": "amplifier",
+    "rejection_effect": "rejection", "rejection_stability": "rejection",
     "closed_loop_modes": "campbell", "log_decrement": "campbell",
     "open_loop_modes": "campbell", "Campbell": "campbell", "ClosedLoopModes": "campbell",
     "OVERDAMPED_ZETA": "campbell", "AF_CRITICAL": "campbell", "dask_available": "cases",

@@ -21,7 +21,11 @@ the rig's springs.
 
 Every node's displacement amplitude is the orbit's semi-major axis
 ``√((|X|² + |Y|² + |X² + Y²|)/2)`` — what a probe in the worst direction reads, half of
-its peak-to-peak value.
+its peak-to-peak value. With a controller, each AMB axis's coil current
+``i = H_a(jΩ) i_ref``, ``i_ref = −K_r(Ω) C_s q``, and the force it transmits,
+``f = K_i H_e(jΩ) i + K_s x`` (``H_e`` the eddy-current lag, ``x`` the shaft's
+displacement along the axis at the actuator: the force law f = K_i i + K_s x), are
+amplitudes of one sinusoid each.
 """
 
 from __future__ import annotations
@@ -35,8 +39,10 @@ from ambseal.errors import ModelError
 from ambseal.lti import freqresp_at, shared_ss, wired
 from ambseal.machine import controller_as_runs
 from ambseal.model import (
+    AXES,
     SealElement,
     actuator_matrices,
+    amb_factors,
     build_system,
     eddy_lag_matrices,
     seal_values,
@@ -76,11 +82,19 @@ class SynchronousResponse:
         Where the amplitude is taken (m).
     amplitude_m : ndarray, shape (n_c, n_s, n_z)
         The orbit's semi-major axis (m, zero-to-peak) per case, speed and position.
+    current_a, force_n : ndarray, shape (n_c, n_s, nu), or None
+        Per AMB axis the coil current (A) and the force it transmits (N), amplitudes
+        (module docstring); None without a controller.
+    axes : tuple of str
+        The AMB axes of ``current_a`` and ``force_n`` (``i_<amb>_<axis>``).
     """
 
     speed_hz: np.ndarray
     positions_m: np.ndarray
     amplitude_m: np.ndarray
+    current_a: np.ndarray | None = None
+    force_n: np.ndarray | None = None
+    axes: tuple = ()
 
 
 def orbit_semi_major(X: np.ndarray, Y: np.ndarray) -> np.ndarray:
@@ -182,6 +196,11 @@ def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
     if closed:
         Krs = _controller_at(controller, base.output_names, base.input_names[:n_cur],
                              2 * math.pi * speeds, seal_values(cfg.seal, p))
+        Bi = base.B[:, :n_cur]
+        ki = np.linalg.norm(Bi, axis=0)  # each column is Ki along the axis at its node
+        ks = np.array([_ks(cfg, name) for name in base.input_names[:n_cur]])
+        current = np.empty((len(cases), speeds.size, n_cur))
+        force = np.empty_like(current)
     amp = np.empty((len(cases), speeds.size, zs.size))
     for k, f in enumerate(speeds):
         omega = 2 * math.pi * f
@@ -189,12 +208,30 @@ def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
         Z = (base.K + Ks - omega ** 2 * (base.M + Ms)
              + 1j * omega * (base.C + Cs + omega * base.G))
         if closed:
-            Ha = _siso_at(act[0], 1j * omega) * _siso_at(act[1], 1j * omega)
-            Z = Z + (base.B[:, :n_cur] * Ha) @ Krs[k] @ base.Cq
+            h_amp, h_eddy = (_siso_at(m, 1j * omega) for m in act)
+            Z = Z + (Bi * (h_amp * h_eddy)) @ Krs[k] @ base.Cq
         try:
             q = np.linalg.solve(Z, omega ** 2 * F1)
         except np.linalg.LinAlgError:
             raise ModelError(f"synchronous response: the dynamic stiffness is singular at "
                              f"{f:g} Hz (an undamped mode at that speed)") from None
         amp[:, k, :] = orbit_semi_major(q[rows_x], q[rows_y]).T
-    return SynchronousResponse(speed_hz=speeds, positions_m=zs, amplitude_m=amp)
+        if closed:
+            coil = -h_amp * (Krs[k] @ (base.Cq @ q))  # (nu, n_c)
+            x = (Bi / ki).T @ q
+            current[:, k, :] = np.abs(coil).T
+            force[:, k, :] = np.abs(ki[:, None] * h_eddy * coil + ks[:, None] * x).T
+    if not closed:
+        return SynchronousResponse(speed_hz=speeds, positions_m=zs, amplitude_m=amp)
+    return SynchronousResponse(speed_hz=speeds, positions_m=zs, amplitude_m=amp,
+                               current_a=current, force_n=force,
+                               axes=tuple(base.input_names[:n_cur]))
+
+
+def _ks(cfg, input_name: str) -> float:
+    """K_s (N/m) of the AMB axis ``i_<amb>_<axis>``."""
+    for amb in cfg.amb:
+        for ax, ks in zip(AXES, amb_factors(amb)[1]):
+            if input_name == f"i_{amb.name}_{ax}":
+                return float(ks)
+    raise ModelError(f"synchronous response: no AMB axis {input_name!r}")

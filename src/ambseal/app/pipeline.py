@@ -12,6 +12,8 @@ import sys
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+import numpy as np
+
 from ambseal.analysis import (
     FailedController,
     JudgeSettings,
@@ -24,6 +26,8 @@ from ambseal.analysis import (
     judge_settings,
     judge_spinup,
     loop_failure,
+    rejection_effect,
+    rejection_stability,
     operating_points,
     run_cases,
     saturation_failure,
@@ -61,7 +65,14 @@ from ambseal.config import (
     load_truth,
     method_names,
 )
-from ambseal.design import DesignSpec, design, design_frozen, design_lpv, design_spec
+from ambseal.design import (
+    DesignSpec,
+    design,
+    design_frozen,
+    design_lpv,
+    design_rejection,
+    design_spec,
+)
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.files import RunFolder, write_json
 from ambseal.machine import SPEED
@@ -70,6 +81,7 @@ from ambseal.report import (
     StageProgress,
     capacity_figure,
     gains_figure,
+    rejection_figure,
     judged_on,
     rig_clearances_um,
     signoff_report,
@@ -502,6 +514,44 @@ def _impulses(method: str, jobs, judged):
             yield case.label, case.speed_hz, c["impulse"]
 
 
+def _rejections(st: _RunState, summaries: dict) -> dict:
+    """Each delivered controller's unbalance force rejection
+    (:func:`~ambseal.design.synchronous_rejection.design_rejection` on the design rig),
+    judged at its judged conditions and shown against the controller alone on the judged
+    rig (:mod:`ambseal.analysis.rejection`): its ``rejection`` block in ``summaries``, and
+    method → the effect's curves for the figure. A notch that loses a loop is said so on
+    stderr and in the block (``stable`` false); the controller alone is delivered still."""
+    st.stages.begin("rejection", "unbalance force rejection")
+    r = st.cfg.design.rejection
+    kw = {k: v for k, v in (("rate_fraction", r.rate_fraction), ("points", r.points))
+          if v is not None}
+    effects = {}
+    speeds = stability_points(st.spec.pressures_bar, st.spec.stability_speeds_hz, st.points)
+    for d in st.designs:
+        g = st.digitals.get(d.method)
+        if d.method not in summaries or g is None or getattr(g, "parameter", SPEED) != SPEED:
+            continue
+        rej = design_rejection(st.design_cfg, d.controller, g, **kw)
+        # every condition the run judges it at: in full, and over the speed range
+        rows = rejection_stability(st.judge_cfg, rej, [j.point for j in st.jobs
+                                                       if j.name == d.method] + speeds)
+        lost = [x["condition"] for x in rows
+                if not x["stable"] or x["stable_as_runs"] is False]
+        effects[d.method] = rejection_effect(st.judge_cfg, g, rej, st.settings)
+        e = effects[d.method]
+        summaries[d.method]["rejection"] = {
+            **rej.to_dict(), "stable": not lost, "conditions": rows,
+            **{q: {k: float(np.max(v)) for k, v in e[q].items()}
+               for q in ("current_a", "force_n", "orbit_um")},
+            "current_ratio": float(np.max(e["current_a"]["with"]
+                                          / np.maximum(e["current_a"]["without"], 1e-300)))}
+        if lost:
+            st.say(f"{d.method}: its unbalance force rejection loses the loop at "
+                   f"{', '.join(lost)}")
+        st.stages.step()
+    return effects
+
+
 def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path: Path,
                         truth, command: str | None) -> dict:
     """Export the delivered controllers, run the speed-scheduled and tracked extras, write
@@ -526,6 +576,7 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
                            case_dicts, out / "controllers")
     for m, summary in summaries.items():
         summary["capacity"] = capacity.get(m)
+    effects = _rejections(st, summaries) if cfg.design.rejection.enabled else {}
     ident = st.ident
     figs, sections = ([], []) if ident is None else (ident.figs, ident.sections)
     spinup = ramp = None
@@ -567,6 +618,7 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
     figs.append(gains_figure(out, [(d.method, frozen_at(d.controller, cfg.operating,
                                                         st.design_cfg)) for d in st.designs]))
     figs += capacity_figure(out, cfg, currents)
+    figs += rejection_figure(out, effects)
     write_run_report(out, f"ambseal — {cfg.rotor.name}", stamp(rig_path, command),
                      metrics, curves, figs, sections, rig_clearances_um(cfg),
                      judged_on(cfg, st.truth_cfg if ident is not None else None, truth))

@@ -52,6 +52,13 @@ and bounded (the bounds beside each key in the code, with their reasons).
     ``[design.mu]`` also ``max_iter`` and ``dk_order`` (D–K iterations, D-scale fit order)
     and ``iteration``: ``"dgk"`` (default: D–G–K, the real parameters kept real in the
     synthesis, Young 1996) or ``"dk"`` (complex D–K, every block treated as complex).
+``[design.rejection]``
+    The unbalance force rejection (:mod:`ambseal.design.synchronous_rejection`): ``enabled``
+    (bool, default false) adds to every delivered controller a generalised notch filter at
+    the rotational frequency, scheduled on speed over ``[operating] speed_range_hz`` and on
+    from its minimum, judged at every condition with it and shown against the controller
+    alone; ``rate_fraction`` (ε/Ω, default 0.05: the notch settles in ≈ 6 revolutions) and
+    ``points`` (speeds of its gain table, default 16).
 ``[design] tracked`` (bool, default false)
     ``ambseal run`` adds the ``tracked`` controller: scheduled on the first
     seal's k as tracked on line (:mod:`ambseal.design.seal_schedule`), judged at the
@@ -205,6 +212,12 @@ class ImpulseSpec(_Strict):
     duration_s: float | None = Field(default=None, gt=0)  # bound: check_design_names
 
 
+class RejectionSpec(_Strict):
+    enabled: bool = False
+    rate_fraction: float | None = Field(default=None, gt=0, lt=0.5)  # own poles: < 2/π
+    points: int | None = Field(default=None, ge=2, le=MAX_CONDITIONS)
+
+
 class Design(_Strict):
     """The ``[design]`` part (module docstring); every key optional."""
 
@@ -227,6 +240,7 @@ class Design(_Strict):
     hinf: MethodSpec = MethodSpec()
     mu: MuSpec = MuSpec()
     lpv: MethodSpec = MethodSpec()
+    rejection: RejectionSpec = RejectionSpec()
     tracked: bool = False
 
     @model_validator(mode="after")

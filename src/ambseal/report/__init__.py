@@ -2,7 +2,8 @@
 
 * :func:`write_run_report`, :func:`stamp`, :func:`judged_on`, :func:`rig_clearances_um` —
   the main job's ``report.html`` (:mod:`ambseal.report.run_report`), its figures
-  (:func:`gains_figure`, :func:`capacity_figure`, :func:`spinup_figures`) and sections
+  (:func:`gains_figure`, :func:`capacity_figure`, :func:`rejection_figure`,
+  :func:`spinup_figures`) and sections
   (:func:`identification_report`, :func:`facility_impulse_report`);
 * :func:`verdicts`, :func:`verdict_table_rich`, :func:`target_difference` — the verdict
   per controller (:mod:`ambseal.report.verdict`);
@@ -34,7 +35,7 @@ _FROM = {
     "level1_figure": "signoff_figures", "signoff_report": "signoff_figures",
     "api617_unbalance_figure": "signoff_figures",
     "facility_impulse_report": "run_report", "gains_figure": "run_report",
-    "capacity_figure": "run_report",
+    "capacity_figure": "run_report", "rejection_figure": "run_report",
     "identification_report": "run_report", "judged_on": "run_report",
     "rig_clearances_um": "run_report", "spinup_figures": "run_report",
     "stamp": "run_report", "write_run_report": "run_report",

@@ -38,6 +38,7 @@ __all__ = [
     "unbalance_figure",
     "impulse_figure",
     "force_capacity_figure",
+    "panels_figure",
     "save_figure",
     "CONDITION_STYLES",
     "controller_colours",
@@ -442,6 +443,47 @@ def force_capacity_figure(
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
     axes[0].set_ylabel("Force amplitude (N)")
+    fig.suptitle(title)
+    return save_figure(fig, path, tight=True)
+
+
+def panels_figure(
+    path: str | os.PathLike,
+    panels: Sequence[tuple[str, str]],
+    curves: Mapping[str, Sequence[Curve]],
+    *,
+    xlabel: str,
+    title: str = "",
+    styles: Mapping[str, dict] | None = None,
+) -> Path:
+    """Panels side by side sharing the x axis, each its own quantity against one
+    variable (linear axes, from 0).
+
+    Parameters
+    ----------
+    path : path-like
+    panels : sequence of (key, ylabel)
+        One panel per key of ``curves``, left to right.
+    curves : mapping of str → sequence of (label, x, y)
+        Each panel's curves; the legend is the first panel's.
+    xlabel, title : str
+    styles : mapping of label → matplotlib keywords, optional
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    fig = Figure(figsize=(4.2 * max(len(panels), 1), 4.0))
+    axes = fig.subplots(1, max(len(panels), 1), squeeze=False)[0]
+    for ax, (key, ylabel) in zip(axes, panels):
+        for label, x, y in _curves(curves.get(key, ())):
+            ax.plot(x, y, label=label, **{"lw": 1.2, **(styles or {}).get(label, {})})
+        ax.set_ylim(bottom=0)
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+        ax.grid(True, alpha=0.3)
+    if panels and curves.get(panels[0][0]):
+        axes[0].legend(fontsize=7)
     fig.suptitle(title)
     return save_figure(fig, path, tight=True)
 

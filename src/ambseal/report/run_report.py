@@ -37,8 +37,8 @@ from ambseal.report.identify_figures import (
 from ambseal.report.lpv_figures import frozen_sensitivity_figure, spinup_figure
 from ambseal.report.verdict import axis_label, sig
 
-__all__ = ["gains_figure", "capacity_figure", "spinup_figures", "identification_report",
-           "write_run_report", "stamp", "rig_clearances_um"]
+__all__ = ["gains_figure", "capacity_figure", "rejection_figure", "spinup_figures",
+           "identification_report", "write_run_report", "stamp", "rig_clearances_um"]
 
 
 def stamp(rig_path: str | Path, command: str | None = None) -> str:
@@ -195,14 +195,50 @@ def capacity_figure(out: Path, cfg, currents: dict[str, list]) -> list[tuple[str
     by_amb = {a.name: [(method_label(m), *d[a.name]) for m, d in demands.items()
                        if a.name in d] for a in ambs}
     colours = controller_colours(list(demands))
-    return [("Force capacity of each AMB (Ki times the control current its bias, current "
-             "limit and supply voltage allow: the amplifier's slew rate Ki·V/(Lω) at high "
-             "frequency) and the force each controller asks of it to hold the worst-case "
-             "unbalance, the largest over its judged conditions",
+    return [("Force capacity of each AMB (current limit, bias, the supply voltage's slew rate "
+             "Ki·V/(Lω)) and the force each controller asks of it for the unbalance",
              figures.force_capacity_figure(
                  out / "force_capacity.png", bearings, by_amb,
                  static_n={a.name: load_capacity(a) for a in ambs},
                  styles={method_label(m): case_style(c) for m, c in colours.items()}))]
+
+
+def rejection_figure(out: Path, effects: dict) -> list[tuple[str, Path]]:
+    """The synchronous coil current, transmitted force and orbit over the speed range with
+    each controller alone (dashed) and with its unbalance force rejection (solid)
+    (:func:`ambseal.analysis.rejection.rejection_effect`).
+
+    Parameters
+    ----------
+    out : Path
+        Folder of the figure (``rejection.png``).
+    effects : dict
+        Method → :func:`~ambseal.analysis.rejection.rejection_effect`.
+
+    Returns
+    -------
+    list of (str, Path)
+        The caption and PNG; empty without any effect.
+    """
+    if not effects:
+        return []
+    colours = controller_colours(list(effects))
+    panels = [("current_a", "Coil current (A)"), ("force_n", "Transmitted force (N)"),
+              ("orbit_um", "Orbit at the sensors (µm)")]
+    curves = {q: [] for q, _ in panels}
+    styles = {}
+    for m, e in effects.items():
+        for key, ls in (("without", "--"), ("with", "-")):
+            label = f"{method_label(m)}, {key} rejection"
+            styles[label] = {**case_style(colours[m]), "ls": ls}
+            for q, _ in panels:
+                curves[q].append((label, e["speed_hz"], e[q][key]))
+    return [("Unbalance force rejection (Herzog et al. 1996): synchronous coil current, "
+             "transmitted force and orbit, each controller alone (dashed) and with it "
+             "(solid)",
+             figures.panels_figure(out / "rejection.png", panels, curves,
+                                   xlabel="Speed (Hz)", styles=styles,
+                                   title="Unbalance force rejection"))]
 
 
 def spinup_figures(out: Path, sims: list, sens: list, speeds_hz: tuple[float, float]
@@ -648,12 +684,51 @@ def _sizing_section(metrics: dict) -> list[dict]:
     head = "".join(f"<th>AMB {html.escape(a)}</th>" for a in ambs)
     table = (f'<div class="scroll"><table><tr><th>Controller</th>{head}</tr>{body}'
              "</table></div>")
-    text = ("The smallest amplifier that holds the judged worst-case unbalance at every "
-            "judged condition, as each controller runs: its control-current limit "
-            "(zero-to-peak) and supply voltage (R·i0 + |R + jωL| times that current; — "
+    text = ("The smallest amplifier that holds the judged worst-case unbalance and the "
+            "current impulse at every judged condition, as each controller runs: its "
+            "control-current limit (zero-to-peak) and supply voltage (R·i0 + |R + jωL| "
+            "times the unbalance's current, R·i0 + |R i + L di/dt| in the impulse; — "
             "where the rig file gives neither the coil's inductance nor its geometry), per "
             "AMB, for both of its axes.")
     return [{"title": "Amplifier sizing", "text": text, "html": table}]
+
+
+def _rejection_section(metrics: dict) -> list[dict]:
+    """A table of each controller's unbalance force rejection (its ``rejection`` block,
+    :mod:`ambseal.analysis.rejection`): where it is on, whether its loops hold at the
+    judged conditions, and the synchronous current, force and orbit without and with it."""
+    rows = {m: s["rejection"] for m, s in metrics["controllers"].items() if s.get("rejection")}
+    if not rows:
+        return []
+
+    def pair(r: dict, q: str, unit: str) -> str:
+        return f"<td>{sig(r[q]['without'])} → {sig(r[q]['with'])} {unit}</td>"
+
+    def held(r: dict) -> str:
+        if r["stable"]:
+            return f"yes, at {len(r['conditions'])} conditions"
+        lost = [c["condition"] for c in r["conditions"]
+                if not c["stable"] or c["stable_as_runs"] is False]
+        return "<b>no</b>: loses the loop at " + html.escape(", ".join(lost))
+
+    body = "".join(
+        f"<tr><td>{html.escape(method_label(m))}</td><td>{sig(r['on_from_hz'])} Hz</td>"
+        f"<td>{sig(r['rate_fraction'])}</td><td>{held(r)}</td>"
+        + pair(r, "current_a", "A") + pair(r, "force_n", "N") + pair(r, "orbit_um", "µm")
+        + "</tr>" for m, r in rows.items())
+    table = ('<div class="scroll"><table><tr><th>Controller</th><th>On from</th>'
+             "<th>ε/Ω</th><th>Loops hold (continuous and as it runs)</th>"
+             "<th>Coil current</th><th>Transmitted force</th><th>Orbit</th></tr>"
+             f"{body}</table></div>")
+    text = ("A generalised notch filter at the rotational frequency in each controller's "
+            "input (Herzog et al., IEEE TCST 1996), scheduled on speed: the controller "
+            "commands no synchronous current, so the rotor turns about its axis of inertia "
+            "and each bearing transmits its negative stiffness's force alone. The largest "
+            "synchronous amplitudes over the speed range (of the AMB axes, and of the "
+            "orbit at the sensors; the ISO 21940-11 residual unbalance of the judged grade "
+            "at the bearings, in phase and in opposite phase), without → with it. Not yet "
+            "in the exported controller files.")
+    return [{"title": "Unbalance force rejection", "text": text, "html": table}]
 
 
 def _run_sections(metrics: dict) -> list[dict]:
@@ -671,4 +746,4 @@ def _run_sections(metrics: dict) -> list[dict]:
         f"{s['remedy']}; the new design holds at every judged condition.")}
         for m, s in metrics["controllers"].items() if s.get("remedy")] + sections
     return (_speed_range_section(metrics) + sections + _discrete_section(metrics)
-            + _sizing_section(metrics))
+            + _sizing_section(metrics) + _rejection_section(metrics))

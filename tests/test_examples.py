@@ -22,6 +22,7 @@ import pytest
 
 from ambseal.cli import main
 from ambseal.config import load_rig
+from ambseal.export import load_notch
 from ambseal.model import build_plant
 
 from .metrics_schema import validate_metrics
@@ -144,6 +145,7 @@ def test_every_example_runs_end_to_end(rig, tmp_path, capsys):
             assert r["stable"] and r["conditions"], (m, r["conditions"])
             assert r["current_ratio"] < 1e-2, (m, r["current_ratio"])
         assert (tmp_path / "out" / "rejection.png").is_file()
+        _rejection_held_by_python_control(rig, metrics, tmp_path / "out")
     _every_file_through_every_command(rig, tmp_path / "out", tmp_path, capsys)
 
 
@@ -205,6 +207,50 @@ def _held_by_python_control(rig: Path, metrics: dict, out: Path) -> None:
             G = control.ss(plant.A, plant.B[:, cur], plant.C, plant.D[:, cur])
             z = control.feedback(control.sample_system(G, Ts, "zoh"), K).poles()
             assert np.abs(z).max() < 1, (rig.stem, m, p, hz, np.abs(z).max())
+
+
+def _rejection_held_by_python_control(rig: Path, metrics: dict, out: Path) -> None:
+    """The exported unbalance force rejection checked as :func:`_held_by_python_control`
+    checks the controllers: each delivered controller's file with its notch read back
+    from ``rejection_<m>.json`` — the controller after python-control's loop
+    ``q = y − N q`` (``control.feedback``), then its delay — closed on the full-order plant
+    sampled by python-control at every condition the run judged where the notch is on:
+    every pole inside the unit circle, and the current from forces at the bearings at
+    the rotational frequency below 1 % of the controller's alone."""
+    cfg = load_rig(rig)
+    delivered = set(metrics["controllers"]) - set(metrics["failed"]) - set(metrics["cannot_run"])
+    conditions = {(c["pressure_bar"], c["speed_hz"]) for c in metrics["stability"]} | {
+        (c["pressure_bar"], c["speed_hz"]) for c in metrics["cases"]}
+    for m in sorted(delivered):
+        notch = load_notch(out / "controllers" / f"rejection_{m}.json")
+        f = np.load(out / "controllers" / f"controller_{m}.npz", allow_pickle=False)
+        Ts, d = float(f["Ts"]), int(f["delay_samples"])
+        assert Ts == notch.dt
+        K = control.ss(*[np.asarray(f[k], float) for k in "ABCD"], Ts)
+        delay = control.tf([1], [1] + [0] * d, Ts)
+        for p, hz in sorted(c for c in conditions if notch.is_on(2 * np.pi * c[1])):
+            w = 2 * np.pi * hz
+            A, B, C = notch.matrices_at(w)
+            N = control.ss(A, B, C, np.zeros((C.shape[0], C.shape[0])), Ts)
+            Kn = K * control.feedback(control.ss([], [], [], np.eye(C.shape[0]), Ts), N)
+            plant = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * hz,
+                                force_positions=tuple(a.position for a in cfg.amb))
+            cur = plant.current_inputs()
+            frc = [j for j in range(plant.B.shape[1]) if j not in cur]
+            G = control.sample_system(control.ss(plant.A, plant.B, plant.C, plant.D), Ts,
+                                      "zoh")
+            z = np.exp(1j * w * Ts)
+            gains = []
+            for Kx in (K * delay, Kn * delay):
+                Gi = control.ss(G.A, G.B[:, cur], G.C, G.D[:, cur], Ts)
+                Gf = control.ss(G.A, G.B[:, frc], G.C, G.D[:, frc], Ts)
+                loop = control.feedback(Gi, Kx)
+                assert np.abs(loop.poles()).max() < 1, (rig.stem, m, p, hz)
+                # current from the forces: i = −K (I + G K)⁻¹ G_f, at z
+                Gz, Gfz, Kz = Gi(z), Gf(z), Kx(z)
+                gains.append(np.abs(Kz @ np.linalg.solve(np.eye(Gz.shape[0]) + Gz @ Kz,
+                                                         Gfz)).max())
+            assert gains[1] < 1e-2 * gains[0], (rig.stem, m, p, hz, gains)
 
 
 def _testrig_without(kind: str) -> str:

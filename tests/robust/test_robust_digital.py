@@ -310,7 +310,7 @@ def _python_run(d, y):
     return out
 
 
-def _compile_and_run(tmp_path, files, prefix, y, ctype, speeds=None):
+def _compile_and_run(tmp_path, files, prefix, y, ctype, speeds=None, outputs="NU"):
     cc = shutil.which("cc") or shutil.which("gcc")
     if cc is None:
         pytest.skip("no C compiler (cc/gcc) on this machine: the generated C is not compiled")
@@ -322,7 +322,7 @@ def _compile_and_run(tmp_path, files, prefix, y, ctype, speeds=None):
     main.write_text(f"""#include <stdio.h>
 #include "{prefix}.h"
 int main(void) {{
-    {prefix}_state s; {ctype} y[{P}_NY], i[{P}_NU]; double v, sp = 0.0; int k, n;
+    {prefix}_state s; {ctype} y[{P}_NY], i[{P}_{outputs}]; double v, sp = 0.0; int k, n;
     {prefix}_reset(&s);
     (void)sp;
     if (scanf("%d", &n) != 1) return 1;
@@ -331,7 +331,7 @@ int main(void) {{
         {read_speed}
         for (c = 0; c < {P}_NY; ++c) {{ if (scanf("%lf", &v) != 1) return 1; y[c] = ({ctype})v; }}
         {call}
-        for (c = 0; c < {P}_NU; ++c) printf("%.17g ", (double)i[c]);
+        for (c = 0; c < {P}_{outputs}; ++c) printf("%.17g ", (double)i[c]);
         printf("\\n");
     }}
     return 0;

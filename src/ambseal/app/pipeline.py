@@ -74,6 +74,7 @@ from ambseal.design import (
     design_spec,
 )
 from ambseal.errors import ConfigError, SynthesisError
+from ambseal.export import export_notch, write_notch_c
 from ambseal.files import RunFolder, write_json
 from ambseal.machine import SPEED
 from ambseal.model import build_plant
@@ -545,9 +546,16 @@ def _rejections(st: _RunState, summaries: dict) -> dict:
                for q in ("current_a", "force_n", "orbit_um")},
             "current_ratio": float(np.max(e["current_a"]["with"]
                                           / np.maximum(e["current_a"]["without"], 1e-300)))}
-        if lost:
+        if lost:  # said, not delivered
             st.say(f"{d.method}: its unbalance force rejection loses the loop at "
                    f"{', '.join(lost)}")
+        else:  # beside the controller's files: its notch as a file and as C
+            folder = st.out / "controllers"
+            files = [export_notch(rej.digital.notch, folder / f"rejection_{d.method}.json",
+                                  d.method),
+                     *write_notch_c(rej.digital.notch, folder, f"ambseal_{d.method}_rejection")]
+            summaries[d.method]["rejection"]["files"] = [
+                f.relative_to(st.out).as_posix() for f in files]
         st.stages.step()
     return effects
 

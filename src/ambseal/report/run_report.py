@@ -726,8 +726,11 @@ def _rejection_section(metrics: dict) -> list[dict]:
             "and each bearing transmits its negative stiffness's force alone. The largest "
             "synchronous amplitudes over the speed range (of the AMB axes, and of the "
             "orbit at the sensors; the ISO 21940-11 residual unbalance of the judged grade "
-            "at the bearings, in phase and in opposite phase), without → with it. Not yet "
-            "in the exported controller files.")
+            "at the bearings, in phase and in opposite phase), without → with it. Each "
+            "notch whose loops hold is exported beside its controller: "
+            "controllers/rejection_<controller>.json and the C module "
+            "ambseal_<controller>_rejection, whose output the controller reads in "
+            "place of the displacements.")
     return [{"title": "Unbalance force rejection", "text": text, "html": table}]
 
 

@@ -25,6 +25,7 @@ from ambseal.config import load_rig
 from ambseal.export import load_notch
 from ambseal.model import build_plant
 
+from .freq_at import at
 from .metrics_schema import validate_metrics
 from .report_agreement import check_report_agrees
 
@@ -144,6 +145,7 @@ def test_every_example_runs_end_to_end(rig, tmp_path, capsys):
             r = metrics["controllers"][m]["rejection"]
             assert r["stable"] and r["conditions"], (m, r["conditions"])
             assert r["current_ratio"] < 1e-2, (m, r["current_ratio"])
+            assert r["facility"]["after_a"] < 1e-2 * r["facility"]["before_a"], m
         assert (tmp_path / "out" / "rejection.png").is_file()
         _rejection_held_by_python_control(rig, metrics, tmp_path / "out")
     _every_file_through_every_command(rig, tmp_path / "out", tmp_path, capsys)
@@ -247,7 +249,7 @@ def _rejection_held_by_python_control(rig: Path, metrics: dict, out: Path) -> No
                 loop = control.feedback(Gi, Kx)
                 assert np.abs(loop.poles()).max() < 1, (rig.stem, m, p, hz)
                 # current from the forces: i = −K (I + G K)⁻¹ G_f, at z
-                Gz, Gfz, Kz = Gi(z), Gf(z), Kx(z)
+                Gz, Gfz, Kz = at(Gi, z), at(Gf, z), at(Kx, z)
                 gains.append(np.abs(Kz @ np.linalg.solve(np.eye(Gz.shape[0]) + Gz @ Kz,
                                                          Gfz)).max())
             assert gains[1] < 1e-2 * gains[0], (rig.stem, m, p, hz, gains)

@@ -1,6 +1,7 @@
 """The unbalance force rejection (design/synchronous_rejection.py) on the turboexpander's
 full-order plant, judged by python-control: its own sampling of the plant (c2d, ZOH), its
-own interconnection of the loop, its poles and frequency responses."""
+own interconnection of the loop and its poles; responses by dense solves
+(:mod:`tests.freq_at`)."""
 
 import math
 
@@ -12,6 +13,8 @@ from ambseal.design.synchronous_rejection import design_rejection
 from ambseal.errors import ConfigError
 from ambseal.model import build_plant
 from ambseal.robust import loop_delay
+
+from ..freq_at import at
 
 
 @pytest.fixture(scope="module")
@@ -67,11 +70,12 @@ def test_rejection_takes_the_synchronous_current_out_at_every_speed(
             ("off", turbo_digital["hinf"].statespace(delayed=True)),
             ("on", rejection.digital.statespace_at(w, delayed=True)))}
         assert np.abs(runs["on"].poles()).max() < 1
-        assert np.abs(runs["on"](z)).max() < 1e-2 * np.abs(runs["off"](z)).max()
+        assert np.abs(at(runs["on"], z)).max() < 1e-2 * np.abs(at(runs["off"], z)).max()
         cont = {k: _loop(P, K, cur, lag) for k, K in (
             ("off", turbo_frozen.K), ("on", rejection.controller.at(w)))}
         assert cont["on"].poles().real.max() < 0
-        assert np.abs(cont["on"](1j * w)).max() < 1e-2 * np.abs(cont["off"](1j * w)).max()
+        assert np.abs(at(cont["on"], 1j * w)).max() < 1e-2 * np.abs(
+            at(cont["off"], 1j * w)).max()
 
 
 def test_notch_poles_sit_where_the_inverse_sensitivity_puts_them(turbo_cfg, turbo_frozen,

@@ -15,23 +15,48 @@ does to the synchronous response over the speed range
   the judgement's force planes (the bearings by default) — in phase (static) and in
   alternating phase (couple) — of the ISO 21940-11 permissible residual unbalance
   U = m·G/Ω_max of the judged grade.
+- **On the virtual facility** (:func:`facility_rejection`): the time simulation of
+  :mod:`ambseal.identify.facility` (nonlinear force law, amplifier limits, the controller
+  as it runs) at a constant speed with a synchronous sensor runout — each sensor reading
+  r·cos(Ωt) (ζ) or r·sin(Ωt) (η) more than the shaft's position, a runout track turning
+  with the shaft — first with the controller alone until its loop has settled, then with
+  the notch switched on: the coil currents' synchronous part (its amplitude over each
+  revolution, a least-squares fit of a sinusoid at Ω and an offset) before and after. The runout is
+  :data:`RUNOUT_FRACTION` of the smallest air gap (a clearance the rig file gives; else
+  :data:`RUNOUT_M`): the check is linear in it while the currents stay within the
+  amplifier's limits.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from ambseal.analysis.synchronous import Unbalance, synchronous_response
-from ambseal.machine import judged_loop
+from ambseal.config import TruthSection
+from ambseal.errors import ModelError
+from ambseal.identify import at_speed, prepare_facility
+from ambseal.machine import controller_as_runs, judged_loop
 from ambseal.model import build_plant
-from ambseal.robust import loop_delay
+from ambseal.robust import DiscreteController, loop_delay
 
-__all__ = ["rejection_stability", "rejection_effect", "EFFECT_SPEEDS"]
+__all__ = ["rejection_stability", "rejection_effect", "facility_rejection",
+           "FacilityRejection", "EFFECT_SPEEDS", "RUNOUT_FRACTION", "RUNOUT_M"]
 
 #: Speeds of the synchronous response over the speed range.
 EFFECT_SPEEDS = 61
+#: The facility's runout as a fraction of the smallest air gap (module docstring).
+RUNOUT_FRACTION = 0.01
+#: The runout (m) of a rig file without an air gap or backup clearance.
+RUNOUT_M = 5e-6
+#: Time constants of a loop (its slowest pole's) or of the notch (2/ε) a phase lasts: its
+#: transient down to e^{-7} < 1e-3 of its start.
+SETTLE_TIME_CONSTANTS = 7.0
+#: The longest a phase lasts (s): a loop with a mode that decays slower than this does not
+#: hold the synchronous part's estimate back (the mode is not at Ω).
+MAX_PHASE_S = 5.0
 
 
 def rejection_stability(cfg, rejection, points) -> list[dict]:
@@ -121,3 +146,123 @@ def rejection_effect(cfg, digital, rejection, settings, *, pressure_bar=None) ->
         out["force_n"][key] = r.force_n.max(axis=(0, 2))
         out["orbit_um"][key] = 1e6 * r.amplitude_m.max(axis=(0, 2))
     return out
+
+
+@dataclass(frozen=True)
+class FacilityRejection:
+    """The notch switched on under a synchronous sensor runout on the virtual facility
+    (:func:`facility_rejection`).
+
+    Attributes
+    ----------
+    speed_hz : float
+        The constant speed (Hz).
+    runout_m : float
+        The runout's amplitude (m).
+    on_s : float
+        When the notch was switched on (s).
+    time_s : ndarray, shape (R,)
+        The end of each revolution-long window (s).
+    current_a : ndarray, shape (R,)
+        The largest synchronous coil-current amplitude of the AMB axes over each window
+        (A).
+    before_a, after_a : float
+        That amplitude over the last window before the switch and the last of the run.
+    """
+
+    speed_hz: float
+    runout_m: float
+    on_s: float
+    time_s: np.ndarray
+    current_a: np.ndarray
+    before_a: float
+    after_a: float
+
+    def to_dict(self) -> dict:
+        """JSON-ready: speed (Hz), runout (µm), switch time (s), the amplitudes before and
+        after (A) and their ratio."""
+        return {"speed_hz": self.speed_hz, "runout_um": 1e6 * self.runout_m,
+                "on_s": self.on_s, "before_a": self.before_a, "after_a": self.after_a,
+                "ratio": self.after_a / self.before_a if self.before_a > 0 else None}
+
+
+def facility_rejection(cfg, digital, rejection, speed_hz: float, *,
+                       runout_m: float | None = None) -> FacilityRejection:
+    """The notch switched on under a synchronous sensor runout on the virtual facility
+    (module docstring).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig; the facility is its own model (no noise, no quantisation, its
+        ``[actuator]`` eddy lag), at the pressure the notch was made at.
+    digital : DigitalController or ScheduledDigital
+        The controller as it runs, alone.
+    rejection : SynchronousRejection
+        The same with its notch.
+    speed_hz : float
+        The constant speed (Hz), where the notch is on.
+    runout_m : float, optional
+        The runout's amplitude (m); default: module docstring.
+
+    Returns
+    -------
+    FacilityRejection
+
+    Raises
+    ------
+    ModelError
+        The notch is off at that speed, or the rotor left the air gap.
+    """
+    w = 2 * math.pi * float(speed_hz)
+    notch = rejection.digital.notch
+    if not notch.is_on(w):
+        raise ModelError(f"facility rejection: the notch is off at {speed_hz:g} Hz (on from "
+                         f"{notch.on_rad_s / (2 * math.pi):g} Hz)")
+    fs = cfg.controller.sample_rate_hz
+    truth = TruthSection(tau_e=cfg.actuator.eddy_time_constant)
+    fac = prepare_facility(at_speed(cfg, float(speed_hz)), truth, fs,
+                           pressure_bar=rejection.pressure_bar)
+    K0, Kn = (DiscreteController(np.asarray(K.A, float), np.asarray(K.B, float),
+                                 np.asarray(K.C, float), np.asarray(K.D, float), 1.0 / fs)
+              for K in (controller_as_runs(digital, w),
+                        rejection.digital.statespace_at(w, delayed=True)))
+    if runout_m is None:
+        gaps = [g for a in cfg.amb for g in (a.air_gap, a.backup_clearance) if g]
+        runout_m = RUNOUT_FRACTION * min(gaps) if gaps else RUNOUT_M
+    # phase lengths: the controller's loop settles, then the notch's (time constant 2/ε)
+    decay = -math.log(float(np.abs(fac.loop_poles(K0)).max())) * fs
+    rev = max(1, int(round(fs / float(speed_hz))))  # samples of a revolution
+    n1 = _whole(SETTLE_TIME_CONSTANTS / decay * fs, rev, fs)
+    n2 = _whole(SETTLE_TIME_CONSTANTS * 2.0 / (notch.rate_fraction * w) * fs, rev, fs)
+    k = len(fac.axes)
+    t = np.arange(n1 + n2) / fs
+    runout = np.column_stack([runout_m * (np.cos(w * t) if ax.endswith("zeta")
+                                          else np.sin(w * t)) for ax in fac.axes])
+    zero = np.zeros((n1 + n2, k))
+    xc = np.zeros(K0.A.shape[0])
+    _, i1, _ = fac.run(K0, xc, zero[:n1], runout[:n1], zero[:n1])
+    xn = np.concatenate([xc, np.zeros(Kn.A.shape[0] - xc.size)])
+    _, i2, _ = fac.run(Kn, xn, zero[n1:], runout[n1:], zero[n1:])
+    coil = np.vstack([i1, i2])
+    # amplitude at Ω over each revolution-long window
+    ends = np.arange(rev, n1 + n2 + 1, rev)
+    amp = np.array([_synchronous(coil[e - rev:e], t[e - rev:e], w) for e in ends])
+    before = amp[ends <= n1][-1]
+    return FacilityRejection(float(speed_hz), float(runout_m), n1 / fs, t[ends - 1], amp,
+                             float(before), float(amp[-1]))
+
+
+def _whole(samples: float, rev: int, fs: float) -> int:
+    """``samples`` rounded up to whole revolutions of ``rev`` samples, at least two and at
+    most :data:`MAX_PHASE_S`."""
+    return rev * max(2, int(math.ceil(min(samples, MAX_PHASE_S * fs) / rev)))
+
+
+def _synchronous(x: np.ndarray, t: np.ndarray, w: float) -> float:
+    """The largest amplitude at ``w`` (rad/s) of the columns of ``x`` over the window
+    ``t``: each column fitted by least squares with a cos ωt + b sin ωt + c (exact for a
+    sinusoid whatever the window's length in periods), amplitude √(a² + b²)."""
+    basis = np.column_stack([np.cos(w * t), np.sin(w * t), np.ones_like(t)])
+    coef = np.linalg.lstsq(basis, x, rcond=None)[0]
+    return float(np.hypot(coef[0], coef[1]).max())

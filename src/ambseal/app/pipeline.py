@@ -20,15 +20,16 @@ from ambseal.analysis import (
     OperatingPoint,
     also_failed,
     capacity_block,
+    facility_rejection,
     frozen_at,
     judge_case,
     judge_jobs,
     judge_settings,
     judge_spinup,
     loop_failure,
+    operating_points,
     rejection_effect,
     rejection_stability,
-    operating_points,
     run_cases,
     saturation_failure,
     sign_off,
@@ -519,14 +520,16 @@ def _rejections(st: _RunState, summaries: dict) -> dict:
     """Each delivered controller's unbalance force rejection
     (:func:`~ambseal.design.synchronous_rejection.design_rejection` on the design rig),
     judged at its judged conditions and shown against the controller alone on the judged
-    rig (:mod:`ambseal.analysis.rejection`): its ``rejection`` block in ``summaries``, and
-    method → the effect's curves for the figure. A notch that loses a loop is said so on
-    stderr and in the block (``stable`` false); the controller alone is delivered still."""
+    rig, and switched on under a sensor runout on the virtual facility
+    (:mod:`ambseal.analysis.rejection`): its ``rejection`` block in ``summaries``, and for
+    the figures ``{"effects": method → the effect's curves, "facility": method →
+    FacilityRejection}``. A notch that loses a loop is said so on stderr and in the block
+    (``stable`` false), not exported; the controller alone is delivered still."""
     st.stages.begin("rejection", "unbalance force rejection")
     r = st.cfg.design.rejection
     kw = {k: v for k, v in (("rate_fraction", r.rate_fraction), ("points", r.points))
           if v is not None}
-    effects = {}
+    effects, facility = {}, {}
     speeds = stability_points(st.spec.pressures_bar, st.spec.stability_speeds_hz, st.points)
     for d in st.designs:
         g = st.digitals.get(d.method)
@@ -549,7 +552,15 @@ def _rejections(st: _RunState, summaries: dict) -> dict:
         if lost:  # said, not delivered
             st.say(f"{d.method}: its unbalance force rejection loses the loop at "
                    f"{', '.join(lost)}")
-        else:  # beside the controller's files: its notch as a file and as C
+        else:  # on the facility at the top speed (the most synchronous current), then
+            # beside the controller's files: its notch as a file and as C
+            top = float(rej.speeds_hz[-1])
+            fac = facility_rejection(st.design_cfg, g, rej, top)
+            summaries[d.method]["rejection"]["facility"] = fac.to_dict()
+            facility[d.method] = fac
+            if not fac.after_a < 1e-2 * fac.before_a:
+                st.say(f"{d.method}: on the virtual facility at {top:g} Hz its notch leaves "
+                       f"{fac.after_a:.3g} A of synchronous current of {fac.before_a:.3g} A")
             folder = st.out / "controllers"
             files = [export_notch(rej.digital.notch, folder / f"rejection_{d.method}.json",
                                   d.method),
@@ -557,7 +568,7 @@ def _rejections(st: _RunState, summaries: dict) -> dict:
             summaries[d.method]["rejection"]["files"] = [
                 f.relative_to(st.out).as_posix() for f in files]
         st.stages.step()
-    return effects
+    return {"effects": effects, "facility": facility}
 
 
 def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path: Path,
@@ -584,7 +595,7 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
                            case_dicts, out / "controllers")
     for m, summary in summaries.items():
         summary["capacity"] = capacity.get(m)
-    effects = _rejections(st, summaries) if cfg.design.rejection.enabled else {}
+    rejections = _rejections(st, summaries) if cfg.design.rejection.enabled else {}
     ident = st.ident
     figs, sections = ([], []) if ident is None else (ident.figs, ident.sections)
     spinup = ramp = None
@@ -626,7 +637,7 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
     figs.append(gains_figure(out, [(d.method, frozen_at(d.controller, cfg.operating,
                                                         st.design_cfg)) for d in st.designs]))
     figs += capacity_figure(out, cfg, currents)
-    figs += rejection_figure(out, effects)
+    figs += rejection_figure(out, rejections)
     write_run_report(out, f"ambseal — {cfg.rotor.name}", stamp(rig_path, command),
                      metrics, curves, figs, sections, rig_clearances_um(cfg),
                      judged_on(cfg, st.truth_cfg if ident is not None else None, truth))

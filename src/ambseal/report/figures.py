@@ -39,6 +39,7 @@ __all__ = [
     "impulse_figure",
     "force_capacity_figure",
     "panels_figure",
+    "decay_figure",
     "save_figure",
     "CONDITION_STYLES",
     "controller_colours",
@@ -486,6 +487,42 @@ def panels_figure(
         axes[0].legend(fontsize=7)
     fig.suptitle(title)
     return save_figure(fig, path, tight=True)
+
+
+def decay_figure(
+    path: str | os.PathLike,
+    curves: Sequence[Curve],
+    *,
+    ylabel: str,
+    title: str = "",
+    marks: Mapping[str, float] | None = None,
+    styles: Mapping[str, dict] | None = None,
+) -> Path:
+    """Amplitudes against time on a log axis (a decay), with labelled vertical marks.
+
+    Parameters
+    ----------
+    path : path-like
+    curves : sequence of (label, time_s, amplitude)
+        Time (s) and a positive amplitude (zeros are not drawn).
+    ylabel, title : str
+    marks : mapping of str → float, optional
+        Vertical dashed lines at these times (s), labelled.
+    styles : mapping of label → matplotlib keywords, optional
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    def decorate(ax, cs):
+        for label, t in (marks or {}).items():
+            ax.axvline(t, color="0.4", ls=":", lw=1)
+            ax.text(t, 0.98, f" {label}", transform=ax.get_xaxis_transform(), va="top",
+                    fontsize=8, color="0.25")
+
+    positive = [(lb, x, np.where(np.asarray(y, float) > 0, y, np.nan)) for lb, x, y in curves]
+    return _curve_figure(path, positive, "semilogy", "Time (s)", ylabel, title,
+                         decorate=decorate, styles=styles)
 
 
 def controller_gains_figure(

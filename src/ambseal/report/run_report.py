@@ -203,23 +203,26 @@ def capacity_figure(out: Path, cfg, currents: dict[str, list]) -> list[tuple[str
                  styles={method_label(m): case_style(c) for m, c in colours.items()}))]
 
 
-def rejection_figure(out: Path, effects: dict) -> list[tuple[str, Path]]:
-    """The synchronous coil current, transmitted force and orbit over the speed range with
-    each controller alone (dashed) and with its unbalance force rejection (solid)
-    (:func:`ambseal.analysis.rejection.rejection_effect`).
+def rejection_figure(out: Path, rejections: dict) -> list[tuple[str, Path]]:
+    """The unbalance force rejection's figures (:mod:`ambseal.analysis.rejection`): the
+    synchronous coil current, transmitted force and orbit over the speed range with each
+    controller alone (dashed) and with its rejection (solid); and the synchronous coil
+    current on the virtual facility under a sensor runout, the notch switched on.
 
     Parameters
     ----------
     out : Path
-        Folder of the figure (``rejection.png``).
-    effects : dict
-        Method → :func:`~ambseal.analysis.rejection.rejection_effect`.
+        Folder of the figures (``rejection.png``, ``rejection_facility.png``).
+    rejections : dict
+        ``effects`` (method → :func:`~ambseal.analysis.rejection.rejection_effect`) and
+        ``facility`` (method → :class:`~ambseal.analysis.rejection.FacilityRejection`).
 
     Returns
     -------
     list of (str, Path)
-        The caption and PNG; empty without any effect.
+        Captions and PNGs; empty without any rejection.
     """
+    effects, facility = (rejections or {}).get("effects"), (rejections or {}).get("facility")
     if not effects:
         return []
     colours = controller_colours(list(effects))
@@ -233,12 +236,26 @@ def rejection_figure(out: Path, effects: dict) -> list[tuple[str, Path]]:
             styles[label] = {**case_style(colours[m]), "ls": ls}
             for q, _ in panels:
                 curves[q].append((label, e["speed_hz"], e[q][key]))
-    return [("Unbalance force rejection (Herzog et al. 1996): synchronous coil current, "
+    figs = [("Unbalance force rejection (Herzog et al. 1996): synchronous coil current, "
              "transmitted force and orbit, each controller alone (dashed) and with it "
              "(solid)",
              figures.panels_figure(out / "rejection.png", panels, curves,
                                    xlabel="Speed (Hz)", styles=styles,
                                    title="Unbalance force rejection"))]
+    if facility:
+        first = next(iter(facility.values()))
+        figs.append((
+            f"Virtual facility at {first.speed_hz:g} Hz, a sensor runout of "
+            f"{first.runout_m * 1e6:.3g} µm: synchronous coil current, each controller "
+            "alone until its loop has settled, then with its notch switched on (time 0)",
+            figures.decay_figure(
+                out / "rejection_facility.png",
+                [(method_label(m), r.time_s - r.on_s, r.current_a)
+                 for m, r in facility.items()],
+                ylabel="Synchronous coil current (A)", marks={"notch on": 0.0},
+                styles={method_label(m): case_style(colours[m]) for m in facility},
+                title="Runout rejection on the virtual facility")))
+    return figs
 
 
 def spinup_figures(out: Path, sims: list, sens: list, speeds_hz: tuple[float, float]

@@ -12,9 +12,9 @@ from ambseal.design import design_rejection, design_spec
 from ..freq_at import at
 
 
-@pytest.fixture(scope="module")
-def rejection(turbo_cfg, turbo_frozen, turbo_digital):
-    return design_rejection(turbo_cfg, turbo_frozen.K, turbo_digital["hinf"])
+@pytest.fixture
+def rejection(turbo_rejection):
+    return turbo_rejection
 
 
 def test_rejection_stability_judges_where_the_notch_is_on(turbo_cfg, rejection):

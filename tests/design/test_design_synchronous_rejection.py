@@ -17,9 +17,9 @@ from ambseal.robust import loop_delay
 from ..freq_at import at
 
 
-@pytest.fixture(scope="module")
-def rejection(turbo_cfg, turbo_frozen, turbo_digital):
-    return design_rejection(turbo_cfg, turbo_frozen.K, turbo_digital["hinf"])
+@pytest.fixture
+def rejection(turbo_rejection):
+    return turbo_rejection
 
 
 def _loop(P, K, cur, delay=None):

@@ -263,6 +263,10 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                                      "fractions of the backup bearing's clearance"),
     "Seal.clearance": ("m", "radial running clearance: a close clearance of the API 617 "
                             "unbalance response"),
+    "Seal.static_eccentricity": ("m", "the rotor's static offset in the seal (its "
+                                      "misalignment): the seal's static load, −[K k; −k K] "
+                                      "times it, that the AMBs carry in every judged "
+                                      "condition"),
     "Operating.trip_speed_hz": ("Hz", "trip speed (default 1.05 × the maximum continuous "
                                       "speed, the top of ``speed_range_hz`` or the "
                                       "operating speed)"),

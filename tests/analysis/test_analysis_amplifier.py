@@ -66,7 +66,7 @@ def test_capacity_block_names_the_limit_and_where(testrig_cfg, judged):
     size is used exactly to its limits."""
     _, _, case, curves = judged
     speeds, current, names = curves["unbalance_current"]
-    entries = [("0 bar", speeds, current, names)]
+    entries = [("0 bar", speeds, current, names, None)]
     block = capacity_block(testrig_cfg, entries)
     wn, zeta = testrig_cfg.actuator.natural_frequency, testrig_cfg.actuator.damping_ratio
     sw = 2j * math.pi * speeds
@@ -128,7 +128,7 @@ def test_impulse_voltage_is_the_coil_driven_through_the_amplifier(testrig_cfg, j
     ambs = [a.model_copy(update={"supply_voltage": v, "inductance": L, "resistance": R})
             for a in testrig_cfg.amb]
     block = capacity_block(testrig_cfg.model_copy(update={"amb": ambs}), [],
-                           [("0 bar", 0.0, imp)])
+                           [("0 bar", 0.0, imp, None)])
     assert block["voltage_used"] == pytest.approx(2.0, rel=1e-6)
     a = int(np.unravel_index(np.argmax(need), need.shape)[0])
     assert block["worst"]["voltage_used"] == {"condition": "0 bar", "speed_hz": 0.0,
@@ -170,3 +170,62 @@ def test_force_demand_is_ki_times_the_coil_current(testrig_cfg, judged):
     np.testing.assert_allclose(f, np.union1d(speeds, coarse))
     np.testing.assert_allclose(force[np.isin(f, coarse)],
                                2 * one[testrig_cfg.amb[0].name][1][::7], rtol=1e-12)
+
+
+def test_static_current_holds_the_seal_offset_at_every_direction(testrig_cfg, testrig_designs):
+    """Reference: python-control's interconnection of the embedded rig's full-order plant
+    (a force input at the seal), its delay lag and its PID, the closed loop's static gain
+    from the seal force to the current references by a dense solve at s = 0 (the PID
+    integrates: its gain is infinite there, the loop's is not); the seal's force
+    −[K k; −k K] e at 2.04 bar for an offset e = 50 µm turned through 3600 directions:
+    the largest current of each axis is the judgement's static current to 1e-6. And the
+    amplifier carries it: the capacity block with it uses (|i_s| + i_c)/i0 of the bias."""
+    import control as ct
+
+    from ambseal.analysis.judge import seal_static_load
+    from ambseal.robust import loop_delay
+
+    from ..freq_at import at
+
+    seal = testrig_cfg.seal[0]
+    cfg = testrig_cfg.model_copy(update={"seal": [seal.model_copy(
+        update={"static_eccentricity": 5e-5})]})
+    s = judge_settings(design_spec(cfg))
+    K = testrig_designs["pid"].K
+    p = 2.04
+    _, curves = judge(cfg, K, "pid", OperatingPoint(p, 0.0, "2.04 bar"), s, impulse=False)
+    i_s, names = curves["static_current"]
+    pl = build_plant(cfg, pressure_bar=p, force_positions=(seal.position,))
+    P = pl.to_statespace()
+    cur = list(pl.current_inputs())
+    G = ct.ss(P.A, P.B, P.C, P.D, inputs=list(P.input_labels),
+              outputs=list(P.output_labels), name="G")
+    lag = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples).system
+    blocks, conn = [G, ct.ss(K, name="K")], []
+    for n in K.output_labels:
+        blocks.append(ct.ss(lag.A, lag.B, lag.C, lag.D, inputs=["u"], outputs=["v"],
+                            name=f"lag_{n}"))
+        conn += [[f"lag_{n}.u", f"-K.{n}"], [f"G.{n}", f"lag_{n}.v"]]
+    conn += [[f"K.{n}", f"G.{n}"] for n in K.input_labels]
+    frc = [n for j, n in enumerate(P.input_labels) if j not in cur]
+    loop = ct.interconnect(blocks, connections=conn, inplist=[f"G.{n}" for n in frc],
+                           inputs=frc, outlist=[f"K.{n}" for n in K.output_labels],
+                           outputs=list(K.output_labels))
+    M = -at(loop, 0.0).real  # current references i = −K y per unit seal force (x, y)
+    F, e = seal_static_load(cfg.seal[0], p)
+    theta = np.linspace(0, 2 * math.pi, 3600, endpoint=False)
+    currents = M @ F @ (e * np.vstack([np.cos(theta), np.sin(theta)]))
+    worst = np.abs(currents).max(axis=1)
+    order = [list(K.output_labels).index(n) for n in names]
+    np.testing.assert_allclose(i_s, worst[order], rtol=1e-6)
+    assert i_s.max() > 0
+    speeds, current, unames = curves["unbalance_current"]
+    block = capacity_block(cfg, [("2.04 bar", speeds, current, unames,
+                                  dict(zip(names, i_s)))])
+    wn, zeta = cfg.actuator.natural_frequency, cfg.actuator.damping_ratio
+    sw = 2j * math.pi * speeds
+    ha = np.abs(wn ** 2 / (sw ** 2 + 2 * zeta * wn * sw + wn ** 2))
+    ref = max((i_s[names.index(n)] + ha * current[:, a]).max() for a, n in enumerate(unames))
+    assert block["bias_used"] == pytest.approx(ref / cfg.amb[0].bias_current, rel=1e-9)
+    assert block["static_a"] == pytest.approx(i_s.max())
+    assert "and the seals' static load" in capacity_words(block)

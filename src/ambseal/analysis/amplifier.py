@@ -25,6 +25,13 @@ exactly over each step (at a step's start, where a held input makes |di/dt| larg
 the coils need R i0 + |R i + L di/dt| (:func:`ambseal.model.capacity.transient_needs`). An
 ideal current loop (``[actuator] model = "none"``) steps the current instantly: the
 impulse's current is judged, its voltage not.
+
+A seal the rotor runs offset in (``static_eccentricity``) loads the bearings statically:
+the loop holds it with a static control current i_s per axis
+(:func:`ambseal.analysis.judge.static_currents`, the worst over the offset's direction),
+on which the unbalance's and the impulse's currents ride: the amplifier drives
+|i_s| + i_c and its coils need R (i0 + |i_s|) plus the dynamic voltage — the static load
+takes its share of the bias's linear range, the current limit and the supply.
 """
 
 from __future__ import annotations
@@ -123,7 +130,7 @@ def force_demand(cfg, entries) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     ki = {f"i_{amb.name}_{ax}": (amb.name, k)
           for amb in cfg.amb for ax, k in zip(AXES, amb_factors(amb)[0]) if k is not None}
     curves: dict = {}
-    for _, speed_hz, i_ref, names in entries:
+    for _, speed_hz, i_ref, names, *_ in entries:
         f = np.asarray(speed_hz, float)
         gain = np.abs(freqresp_at(act, 2j * np.pi * f)[:, 0, 0])
         for a, name in enumerate(names):
@@ -145,21 +152,24 @@ def capacity_block(cfg, entries, impulses=()) -> dict | None:
     ----------
     cfg : RigConfig
         The rig: its ``[[amb]]`` limits and ``[actuator]``.
-    entries : iterable of (str, ndarray, ndarray, sequence of str)
+    entries : iterable of (str, ndarray, ndarray, sequence of str, dict or None)
         Per judged condition of the controller: its label, the speeds Ω/2π (Hz, shape
-        (F,)), the current references (A, shape (F, nu), :func:`unbalance_currents`) and
-        the axes' input names (``i_<amb>_<axis>``).
-    impulses : iterable of (str, float, ImpulseResponse)
-        Per judged condition: its label, its speed (Hz) and the judged current-impulse
-        response (:func:`impulse_coil_currents`).
+        (F,)), the current references (A, shape (F, nu), :func:`unbalance_currents`), the
+        axes' input names (``i_<amb>_<axis>``) and the static currents (A) by axis name
+        (module docstring; None without a static load).
+    impulses : iterable of (str, float, ImpulseResponse, dict or None)
+        Per judged condition: its label, its speed (Hz), the judged current-impulse
+        response (:func:`impulse_coil_currents`) and the static currents by axis.
 
     Returns
     -------
     dict or None
         ``current_used``, ``voltage_used``, ``bias_used`` (the largest fraction, None where
-        no AMB gives the limit), ``current_a`` (the largest coil current amplitude, A),
+        no AMB gives the limit), ``current_a`` (the largest coil current, static and
+        amplitude, A),
         ``worst`` (per quantity: ``condition``, ``speed_hz``, ``axis`` and ``response``,
-        ``"unbalance"`` or ``"impulse"``) and ``sizing``: per AMB the smallest amplifier
+        ``"unbalance"`` or ``"impulse"``), ``static_a`` (the largest static current, A;
+        None without a static load) and ``sizing``: per AMB the smallest amplifier
         that holds every judged condition, ``current_limit_a`` (the largest control
         current of its axes, A) and ``supply_voltage_v`` (the largest voltage its coils
         need, V; None without the coil's inductance),
@@ -193,24 +203,29 @@ def capacity_block(cfg, entries, impulses=()) -> dict | None:
                                          "axis": name.removeprefix("i_"),
                                          "response": response})
 
-    for label, speed_hz, i_ref, names in entries:
+    statics = []
+    for label, speed_hz, i_ref, names, static in entries:
         w = 2 * np.pi * np.asarray(speed_hz, float)
         gain = np.abs(freqresp_at(act, 1j * w)[:, 0, 0])
         for a, name in enumerate(names):
-            account(label, speed_hz, name, amplifier_needs(by_axis[name], w, gain * i_ref[:, a]),
+            i_s = (static or {}).get(name, 0.0)
+            statics.append(i_s)
+            account(label, speed_hz, name,
+                    amplifier_needs(by_axis[name], w, gain * i_ref[:, a], static_a=i_s),
                     "unbalance")
-    for label, speed_hz, imp in impulses:
+    for label, speed_hz, imp, static in impulses:
         current, rate = impulse_coil_currents(cfg.actuator, imp)
         at = np.full(current.shape[0], float(speed_hz))
         for a, name in enumerate(imp.input_names):
             need = transient_needs(by_axis[name], current[:, a],
-                                   None if rate is None else rate[:, a])
+                                   None if rate is None else rate[:, a],
+                                   static_a=(static or {}).get(name, 0.0))
             account(label, at, name, need, "impulse")
     if best["current_a"][0] is None:
         return None
     return {**{q: best[q][0] for q in (*QUANTITIES, "current_a")},
             "worst": {q: best[q][1] for q in QUANTITIES if best[q][1] is not None},
-            "sizing": sizing}
+            "static_a": float(max(statics)) if any(statics) else None, "sizing": sizing}
 
 
 def saturates(block: dict | None) -> bool:
@@ -256,6 +271,8 @@ def capacity_words(block: dict | None) -> str:
     rpm = f"{60 * w['speed_hz']:,.0f}".replace(",", " ")
     at = f"{axis_label(w['axis'])} at {rpm} rpm, {w['condition']}"
     holding = _HOLDING[w.get("response", "unbalance")]
+    if c.get("static_a"):
+        holding += " and the seals' static load"
     if over:
         return f"the amplifier saturates {holding}: it needs {v:.3g}× {what} ({at})"
     return f"{holding} it uses {100 * v:.0f} % of {what} ({at})"

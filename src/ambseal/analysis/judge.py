@@ -68,13 +68,19 @@ from ambseal.machine import (
     frozen,
     judged_loop,
 )
-from ambseal.model import build_plant, classify_poles, pressure_for_k, seal_values
+from ambseal.model import (build_plant, classify_poles, coefficient_value, pressure_for_k,
+                           seal_values)
 from ambseal.robust import loop_delay
 
 __all__ = ["JudgeSettings", "OperatingPoint", "LoopJudgement", "JudgedCase", "JudgeJob", "judge", "judge_case", "judge_spinup",
            "operating_points", "speed_scheduled",
            "judge_settings", "unstable_open_loop_poles", "condition_values", "frozen_at",
            "frozen_discrete", "judge_jobs", "points_for"]
+
+#: Where a loop's static response is taken (rad/s): far below any AMB loop's dynamics (the
+#: plant there equals its static response to ~1e-8), and not zero, where an integrating
+#: controller's gain is infinite — the loop's response is finite and exact to that order.
+STATIC_RAD_S = 1e-4
 
 
 @dataclass(frozen=True)
@@ -453,28 +459,36 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
     """
 
     s = settings
+    # the seals the rotor is offset in carry a static load: a force input at each, after
+    # the judgement's own
+    offset = [sl for sl in cfg.seal if sl.static_eccentricity > 0]
     plant = build_plant(cfg, pressure_bar=point.pressure_bar, speed_rpm=point.speed_rpm,
-                        force_positions=tuple(s.force_positions_m))
+                        force_positions=tuple(s.force_positions_m)
+                        + tuple(sl.position for sl in offset))
     cur = plant.current_inputs()
-    force = [j for j in range(len(plant.input_names)) if j not in cur]
+    rest = [j for j in range(len(plant.input_names)) if j not in cur]
+    force = rest[:2 * len(s.force_positions_m)]
+    static = (rest[len(force):], [seal_static_load(sl, point.pressure_bar) for sl in offset])
     P = plant.to_statespace()
     dl = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples)
     body, curves = _judge_loop(judged_loop(P, controller, cur, delay=dl.system), cur, force,
-                               controller, s, impulse)
+                               controller, s, impulse, static)
     disc = None
     if discrete is not None:
         disc, curves["discrete"] = _judge_loop(judged_loop(P, discrete, cur), cur, force,
-                                               discrete, s, impulse)
+                                               discrete, s, impulse, static)
     case = JudgedCase(**vars(body), controller=name, pressure_bar=point.pressure_bar,
                       speed_hz=point.speed_rpm / 60.0, label=point.label, delay=dl.to_dict(),
                       discrete=disc)
     return case, curves
 
 
-def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, impulse: bool
-                ) -> tuple[LoopJudgement, dict]:
+def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, impulse: bool,
+                static=((), ())) -> tuple[LoopJudgement, dict]:
     """The case's numbers for one judged loop, continuous or discrete: its plant with
-    current inputs ``cur`` and force inputs ``force``."""
+    current inputs ``cur``, force inputs ``force`` and the seals' static loads ``static``
+    (their x/y force inputs, and per seal the 2 × 2 force per unit offset and the offset,
+    :func:`seal_static_load`)."""
 
     # signal names from the continuous plant: a sampled one is not formed (its modal
     # form serves the responses, the poles and the impulse response)
@@ -524,6 +538,8 @@ def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, im
                                    unbalance_currents(Kw[w.size:], cu.H_m_per_n, unb.force_n),
                                    tuple(nu_names))
     case.update(compliance_peak_m_per_n=c.peak.value, unbalance_peak_um=unb.peak_um)
+    if static[0]:
+        curves["static_current"] = static_currents(judged, controller, cur, *static)
     if not impulse or s.impulse_a is None:
         case.update(impulse_peak_um=None, impulse_settling_s=None)
         return LoopJudgement(**case), curves
@@ -540,6 +556,63 @@ def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, im
         impulse_settling_s=finite_or_none(imp.settling_time_s),
     )
     return LoopJudgement(**case), curves
+
+
+def seal_static_load(seal, pressure_bar: float) -> tuple[np.ndarray, float]:
+    """A seal's static load on the rotor per unit offset and the offset: the force
+    ``f = −[[K, k], [−k, K]] e`` (N, x/y) of its direct and cross-coupled stiffness at
+    zero frequency at the pressure drop, and its ``static_eccentricity`` |e| (m).
+
+    Parameters
+    ----------
+    seal : Seal
+        A ``[[seal]]`` of the rig file.
+    pressure_bar : float
+        Pressure drop (bar).
+
+    Returns
+    -------
+    (ndarray, float)
+        The 2 × 2 matrix (N/m) and |e| (m).
+    """
+    K, k = (coefficient_value(getattr(seal, n), pressure_bar, 0.0) for n in ("K", "k"))
+    return -np.array([[K, k], [-k, K]]), float(seal.static_eccentricity)
+
+
+def static_currents(judged: JudgedLoop, controller, cur, inputs, loads) -> tuple:
+    """The static control current of each axis that holds the seals' static loads, the
+    worst over each seal's offset direction (module docstring of
+    :mod:`ambseal.analysis.amplifier`): the loop's response at :data:`STATIC_RAD_S`,
+    ``i = −K (I + G K)⁻¹ G_s f``, and per axis Σ_seals |e| ‖(M F)_a,:‖₂ (M the current per
+    unit seal force, F the seal's force per unit offset).
+
+    Parameters
+    ----------
+    judged : JudgedLoop
+        The judged loop (its plant with the seals' force inputs).
+    controller : control.StateSpace
+        Its controller, wired in the plant's order.
+    cur : sequence of int
+        The plant's current inputs.
+    inputs : sequence of int
+        The seals' force inputs, x and y per seal.
+    loads : sequence of (ndarray, float)
+        Per seal :func:`seal_static_load`.
+
+    Returns
+    -------
+    (ndarray, tuple of str)
+        The static currents (A, shape (nu,)) and the axes' input names.
+    """
+    w = np.array([STATIC_RAD_S])
+    pts, _ = response_points(w, judged.loop.dt)
+    H = judged.plant_response(w)[0]
+    G = _signals(judged.source, cur)
+    Kw = freqresp_at(wired(G, controller), pts)[0]
+    M = -Kw @ np.linalg.solve(np.eye(H.shape[0]) + H[:, cur] @ Kw, H[:, list(inputs)])
+    i_s = sum(e * np.linalg.norm((M[:, 2 * j:2 * j + 2] @ F).real, axis=1)
+              for j, (F, e) in enumerate(loads))
+    return np.asarray(i_s, float), tuple(G.input_labels)
 
 
 def _signals(P, idx):

@@ -498,22 +498,27 @@ def _note_speed_lpv(st: _RunState) -> None:
 
 def _unbalance_currents(method: str, jobs, judged):
     """The unbalance's current references of ``method``'s stable judged loops, as it runs
-    where it runs sampled: ``(condition, speeds Hz, currents, axes)`` for
-    :func:`~ambseal.analysis.amplifier.capacity_block`."""
+    where it runs sampled: ``(condition, speeds Hz, currents, axes, static currents by
+    axis or None)`` for :func:`~ambseal.analysis.amplifier.capacity_block`."""
     for job, (case, curves) in zip(jobs, judged):
         c = curves.get("discrete", curves)
         if job.name == method and "unbalance_current" in c:
-            yield (case.label, *c["unbalance_current"])
+            static = c.get("static_current")
+            yield (case.label, *c["unbalance_current"],
+                   None if static is None else dict(zip(static[1], static[0])))
 
 
 def _impulses(method: str, jobs, judged):
     """The current-impulse responses of ``method``'s stable judged loops, as it runs
-    where it runs sampled: ``(condition, speed Hz, response)`` for
+    where it runs sampled: ``(condition, speed Hz, response, static currents by axis or
+    None)`` for
     :func:`~ambseal.analysis.amplifier.capacity_block`."""
     for job, (case, curves) in zip(jobs, judged):
         c = curves.get("discrete", curves)
         if job.name == method and c.get("impulse") is not None:
-            yield case.label, case.speed_hz, c["impulse"]
+            static = c.get("static_current")
+            yield (case.label, case.speed_hz, c["impulse"],
+                   None if static is None else dict(zip(static[1], static[0])))
 
 
 def _rejections(st: _RunState, summaries: dict) -> dict:

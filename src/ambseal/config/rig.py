@@ -413,12 +413,22 @@ class Seal(_Strict):
     M: SealCoefficient = 0.0
     # radial running clearance: API 617's close clearances; a seal's is 10 µm to 10 mm
     clearance: float | None = Field(default=None, ge=1e-6, le=0.1)
+    # the rotor's static offset in the seal (its misalignment against the bearings' axis):
+    # within any clearance
+    static_eccentricity: float = Field(default=0.0, ge=0, le=0.1)
     uncertainty: Uncertainty = None
 
     @property
     def frequency_dependent(self) -> bool:
         """Whether any coefficient is tabulated against frequency."""
         return any(isinstance(getattr(self, n), FrequencyTable) for n in "KkCcM")
+
+    @model_validator(mode="after")
+    def _offset(self) -> "Seal":
+        if self.clearance is not None and self.static_eccentricity >= self.clearance:
+            raise ValueError(f"static_eccentricity: expected less than the clearance "
+                             f"{self.clearance:g} m, got {self.static_eccentricity:g} m")
+        return self
 
 
 class Spring(_Strict):

@@ -102,7 +102,7 @@ def force_capacity(amb: Amb, omega) -> np.ndarray:
     return bound[:, None] * np.asarray(ki, float)[None, :]
 
 
-def amplifier_needs(amb: Amb, omega, current_a) -> dict:
+def amplifier_needs(amb: Amb, omega, current_a, static_a: float = 0.0) -> dict:
     """What the amplifier of an AMB axis must deliver to drive a sinusoidal control current
     (module docstring): the current and the voltage, whatever its limits — the size of the
     smallest amplifier that does.
@@ -115,14 +115,16 @@ def amplifier_needs(amb: Amb, omega, current_a) -> dict:
         Frequencies (rad/s), ≥ 0.
     current_a : array_like, shape (F,)
         The control current's amplitude (A, zero-to-peak) at each frequency.
+    static_a : float
+        A static control current (A) the sinusoid rides on (a static load's).
 
     Returns
     -------
     dict
-        Arrays of shape (F,): ``current_a`` i_c (A; the smallest ``current_limit``) and
-        ``voltage_v`` R i0 + |R + jωL| i_c (V; the smallest ``supply_voltage``), None where
-        the rig file gives neither ``inductance`` nor the geometry to derive it
-        (``resistance`` defaults to 0).
+        Arrays of shape (F,): ``current_a`` |i_s| + i_c (A; the smallest
+        ``current_limit``) and ``voltage_v`` R (i0 + |i_s|) + |R + jωL| i_c (V; the
+        smallest ``supply_voltage``), None where the rig file gives neither ``inductance``
+        nor the geometry to derive it (``resistance`` defaults to 0).
 
     Raises
     ------
@@ -138,11 +140,13 @@ def amplifier_needs(amb: Amb, omega, current_a) -> dict:
     if amb.bias_current is None:
         raise ConfigError(f"amb {amb.name}: the amplifier's voltage needs bias_current (A)")
     L, R = coil_inductance(amb), float(amb.resistance or 0.0)
-    voltage = None if L is None else R * float(amb.bias_current) + np.hypot(R, w * L) * ic
-    return {"current_a": ic, "voltage_v": voltage}
+    i_s = abs(float(static_a))
+    voltage = (None if L is None
+               else R * (float(amb.bias_current) + i_s) + np.hypot(R, w * L) * ic)
+    return {"current_a": i_s + ic, "voltage_v": voltage}
 
 
-def transient_needs(amb: Amb, current_a, rate_a_per_s) -> dict:
+def transient_needs(amb: Amb, current_a, rate_a_per_s, static_a: float = 0.0) -> dict:
     """What the amplifier of an AMB axis must deliver to drive a control current i(t) (a
     transient: an impulse or step response): the coils carry i0 ± i, so their voltages are
     R(i0 ± i) ± L di/dt, the larger in size R i0 + |R i + L di/dt| (module docstring).
@@ -156,12 +160,15 @@ def transient_needs(amb: Amb, current_a, rate_a_per_s) -> dict:
     rate_a_per_s : array_like, shape (N,) or None
         Its rate di/dt (A/s) there; None when the amplifier's current loop is ideal (an
         instantaneous step has no finite voltage): the voltage is then not judged.
+    static_a : float
+        A static control current (A) under it, of either sign: counted as |i_s| + |i|
+        and R (i0 + |i_s|) + |R i + L di/dt|.
 
     Returns
     -------
     dict
-        Arrays of shape (N,): ``current_a`` |i| (A) and ``voltage_v`` (V; None without a
-        rate or without the coil's inductance, as in :func:`amplifier_needs`).
+        Arrays of shape (N,): ``current_a`` |i_s| + |i| (A) and ``voltage_v`` (V; None
+        without a rate or without the coil's inductance, as in :func:`amplifier_needs`).
 
     Raises
     ------
@@ -172,14 +179,15 @@ def transient_needs(amb: Amb, current_a, rate_a_per_s) -> dict:
     if amb.bias_current is None:
         raise ConfigError(f"amb {amb.name}: the amplifier's voltage needs bias_current (A)")
     L, R = coil_inductance(amb), float(amb.resistance or 0.0)
+    i_s = abs(float(static_a))
     if rate_a_per_s is None or L is None:
-        return {"current_a": np.abs(i), "voltage_v": None}
+        return {"current_a": i_s + np.abs(i), "voltage_v": None}
     rate = np.atleast_1d(np.asarray(rate_a_per_s, float))
     if rate.shape != i.shape:
         raise ConfigError(f"amb {amb.name}: amplifier: {rate.size} current rates for "
                           f"{i.size} currents")
-    return {"current_a": np.abs(i),
-            "voltage_v": R * float(amb.bias_current) + np.abs(R * i + L * rate)}
+    return {"current_a": i_s + np.abs(i),
+            "voltage_v": R * (float(amb.bias_current) + i_s) + np.abs(R * i + L * rate)}
 
 
 def limits_used(amb: Amb, need: dict) -> dict:

@@ -704,7 +704,9 @@ def _sizing_section(metrics: dict) -> list[dict]:
     text = ("The smallest amplifier that holds the judged worst-case unbalance and the "
             "current impulse at every judged condition, as each controller runs: its "
             "control-current limit (zero-to-peak) and supply voltage (R·i0 + |R + jωL| "
-            "times the unbalance's current, R·i0 + |R i + L di/dt| in the impulse; — "
+            "times the unbalance's current, R·i0 + |R i + L di/dt| in the impulse, each "
+            "on the static current of the seals' static load where the rig file gives "
+            "one; — "
             "where the rig file gives neither the coil's inductance nor its geometry), per "
             "AMB, for both of its axes.")
     return [{"title": "Amplifier sizing", "text": text, "html": table}]

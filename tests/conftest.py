@@ -10,8 +10,9 @@ same controllers:
 * ``turbo_lpv`` — the constant-Lyapunov LPV design of the turboexpander over its
   ``[operating] speed_range_hz`` with the frozen γ's (P3 §4), about half a minute;
 * ``turbo_frozen`` — the H∞ controller at the operating speed (140 Hz, P3 Fig. 11);
-* ``testrig_digital``, ``turbo_digital`` — the digital controllers of those designs as
-  ``ambseal run`` chooses them (:func:`ambseal.app.commands.digital_for`);
+* ``testrig_digital``, ``turbo_digital`` (``turbo_hinf_digital`` its H∞ alone) — the
+  digital controllers of those designs as ``ambseal run`` chooses them
+  (:func:`ambseal.app.commands.digital_for`);
 * ``turbo_rejection`` — the turboexpander's H∞ with its unbalance force rejection.
 
 ``design_cache_for`` lets a test run the main job (``ambseal run``) on these designs instead
@@ -110,18 +111,24 @@ def testrig_digital(testrig_cfg, testrig_designs):
 
 
 @pytest.fixture(scope="session")
-def turbo_digital(turbo_cfg, turbo_frozen, turbo_lpv):
-    """{"hinf", "lpv"} → DigitalController / ScheduledDigital of the turboexpander."""
-    return _digital(turbo_cfg, {"hinf": turbo_frozen, "lpv": turbo_lpv})
+def turbo_hinf_digital(turbo_cfg, turbo_frozen):
+    """The DigitalController of the turboexpander's H∞ (without its LPV's design)."""
+    return _digital(turbo_cfg, {"hinf": turbo_frozen})["hinf"]
 
 
 @pytest.fixture(scope="session")
-def turbo_rejection(turbo_cfg, turbo_frozen, turbo_digital):
+def turbo_digital(turbo_cfg, turbo_hinf_digital, turbo_lpv):
+    """{"hinf", "lpv"} → DigitalController / ScheduledDigital of the turboexpander."""
+    return {"hinf": turbo_hinf_digital, **_digital(turbo_cfg, {"lpv": turbo_lpv})}
+
+
+@pytest.fixture(scope="session")
+def turbo_rejection(turbo_cfg, turbo_frozen, turbo_hinf_digital):
     """The turboexpander's H∞ with its unbalance force rejection over its speed range
     (:func:`ambseal.design.design_rejection`, every default)."""
     from ambseal.design import design_rejection
 
-    return design_rejection(turbo_cfg, turbo_frozen.K, turbo_digital["hinf"])
+    return design_rejection(turbo_cfg, turbo_frozen.K, turbo_hinf_digital)
 
 
 class DesignCache:

@@ -30,14 +30,14 @@ def test_rejection_stability_judges_where_the_notch_is_on(turbo_cfg, rejection):
         assert r["max_real_pole"] < 0
 
 
-def test_rejection_effect_takes_out_the_synchronous_current(turbo_cfg, turbo_digital,
+def test_rejection_effect_takes_out_the_synchronous_current(turbo_cfg, turbo_hinf_digital,
                                                             rejection):
     """Over the speed range (its ends the notch's table's) the largest synchronous coil
     current with the notch is below 1 % of the controller's alone at every speed, while
     the bearings still transmit a force (their negative stiffness's) and the rotor
     still has an orbit."""
     s = judge_settings(design_spec(turbo_cfg))
-    e = rejection_effect(turbo_cfg, turbo_digital["hinf"], rejection, s)
+    e = rejection_effect(turbo_cfg, turbo_hinf_digital, rejection, s)
     lo, hi = turbo_cfg.operating.continuous_hz
     assert e["speed_hz"][0] == pytest.approx(lo) and e["speed_hz"][-1] == pytest.approx(hi)
     assert np.all(e["current_a"]["with"] < 1e-2 * e["current_a"]["without"])
@@ -46,7 +46,7 @@ def test_rejection_effect_takes_out_the_synchronous_current(turbo_cfg, turbo_dig
 
 
 def test_facility_runout_current_is_the_sampled_loop_s_and_the_notch_removes_it(
-        turbo_cfg, turbo_digital, rejection):
+        turbo_cfg, turbo_hinf_digital, rejection):
     """Reference: the full-order plant and the amplifier sampled by python-control's
     zero-order hold (c2d) and the controller with its delay, at e^{jΩT_s} (dense solves,
     :mod:`tests.freq_at`): a sensor runout r (ζ: r cos Ωt, η: r sin Ωt) asks the current
@@ -60,13 +60,13 @@ def test_facility_runout_current_is_the_sampled_loop_s_and_the_notch_removes_it(
 
     cfg = turbo_cfg
     f = float(rejection.speeds_hz[-1])
-    r = facility_rejection(cfg, turbo_digital["hinf"], rejection, f)
+    r = facility_rejection(cfg, turbo_hinf_digital, rejection, f)
     fs = cfg.controller.sample_rate_hz
     w, T = 2 * np.pi * f, 1.0 / fs
     pl = build_plant(cfg, pressure_bar=rejection.pressure_bar, speed_rpm=60 * f)
     P, cur = pl.to_statespace(), pl.current_inputs()
     G = ct.c2d(ct.ss(P.A, P.B[:, cur], P.C, P.D[:, cur]), T, "zoh")
-    K = turbo_digital["hinf"].statespace(delayed=True)
+    K = turbo_hinf_digital.statespace(delayed=True)
     rows = [list(P.output_labels).index(n) for n in K.input_labels]
     cols = [[P.input_labels[j] for j in cur].index(n) for n in K.output_labels]
     z = np.exp(1j * w * T)

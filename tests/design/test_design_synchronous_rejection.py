@@ -47,7 +47,7 @@ def _loop(P, K, cur, delay=None):
 
 
 def test_rejection_takes_the_synchronous_current_out_at_every_speed(
-        turbo_cfg, turbo_frozen, turbo_digital, rejection):
+        turbo_cfg, turbo_frozen, turbo_hinf_digital, rejection):
     """At constant speeds over the range — table speeds and between them — the loop as it
     runs (the plant sampled by python-control's ZOH, the discrete controller with its
     delay and notch) and the continuous loop (the judgement's delay lag) are stable, their
@@ -67,7 +67,7 @@ def test_rejection_takes_the_synchronous_current_out_at_every_speed(
                    outputs=list(P.output_labels))
         z = np.exp(1j * w / fs)
         runs = {k: _loop(Pd, K, cur) for k, K in (
-            ("off", turbo_digital["hinf"].statespace(delayed=True)),
+            ("off", turbo_hinf_digital.statespace(delayed=True)),
             ("on", rejection.digital.statespace_at(w, delayed=True)))}
         assert np.abs(runs["on"].poles()).max() < 1
         assert np.abs(at(runs["on"], z)).max() < 1e-2 * np.abs(at(runs["off"], z)).max()
@@ -79,14 +79,14 @@ def test_rejection_takes_the_synchronous_current_out_at_every_speed(
 
 
 def test_notch_poles_sit_where_the_inverse_sensitivity_puts_them(turbo_cfg, turbo_frozen,
-                                                                turbo_digital):
+                                                                turbo_hinf_digital):
     """Herzog et al.'s first-order placement: with T = S_o⁻¹ the notch's poles lie at
     e^{jΩT_s}(1 − εT_s/2), one per channel, whatever the plant — exact as ε → 0: at
     ε = 0.005 Ω within 1 % of their distance from the unit circle (python-control's poles
     of the sampled loop at a table speed and at the range's ends)."""
     cfg = turbo_cfg
     fs = cfg.controller.sample_rate_hz
-    narrow = design_rejection(cfg, turbo_frozen.K, turbo_digital["hinf"],
+    narrow = design_rejection(cfg, turbo_frozen.K, turbo_hinf_digital,
                               rate_fraction=0.005)
     for f in narrow.speeds_hz[[0, 7, -1]]:
         w = 2 * math.pi * f

@@ -243,6 +243,7 @@ def test_the_manual_has_code_blocks_of_known_kinds():
     assert {b.kind for b in found} <= KINDS, {b.kind for b in found} - KINDS
 
 
+@pytest.mark.xdist_group("terminal_run")  # the manual's `ambseal run` reads it
 @pytest.mark.parametrize("path", WITH_CODE, ids=_ids(WITH_CODE))
 def test_page_runs(path, tmp_path, monkeypatch, request):
     page = _run_page(path, tmp_path, monkeypatch, request, slow=False)

@@ -52,6 +52,7 @@ def test_the_recipes_design_the_fixed_methods_and_refuse_the_others(testrig_cfg)
             design(testrig_cfg, name)
 
 
+@pytest.mark.xdist_group("terminal_run")
 def test_the_main_job_designs_judges_exports_and_reports_every_fixed_method(terminal_run):
     out, m, _ = terminal_run
     fixed = method_names(fixed=True)

@@ -13,6 +13,9 @@ from .browser import chromium, probe
 from .metrics_schema import validate_metrics
 from .report_agreement import check_report_agrees
 
+# with every other reader of the session's embedded run (conftest.terminal_run): one worker
+pytestmark = pytest.mark.xdist_group("terminal_run")
+
 #: ISO 14839-3:2006 zone A/B boundary of the sensitivity peak (3, i.e. 9.5 dB; P5 §4.1).
 ISO_ZONE_A_LIMIT = 3.0
 #: Thesis demand on the worst-case G2.5 unbalance orbit up to 200 Hz (P5 §4.4.1): 8 µm.

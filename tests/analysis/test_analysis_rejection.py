@@ -78,3 +78,20 @@ def test_facility_runout_current_is_the_sampled_loop_s_and_the_notch_removes_it(
     coil = np.abs(complex(np.squeeze(Ha)) * iref).max()
     assert r.before_a == pytest.approx(coil, rel=2e-2)
     assert r.after_a < 1e-2 * r.before_a
+
+
+def test_facility_speed_step_keeps_the_synchronous_current_out(turbo_cfg, turbo_hinf_digital,
+                                                              rejection):
+    """A step from 270 to 300 Hz on the facility under the runout: with the notch the
+    synchronous coil current and the orbit stay below 1 % of the controller's alone after
+    the step, at every revolution; the controller alone settles at the new speed to what
+    the facility built at that speed gives at constant speed (facility_rejection's
+    ``before_a``) to 1 %."""
+    from ambseal.analysis.rejection import facility_rejection, facility_speed_step
+
+    step = facility_speed_step(turbo_cfg, turbo_hinf_digital, rejection, 270.0, 300.0)
+    after = step.time_s > step.step_s
+    for q in (step.current_a, step.orbit_m):
+        assert np.all(q["with"][after] < 1e-2 * q["without"][after])
+    const = facility_rejection(turbo_cfg, turbo_hinf_digital, rejection, 300.0)
+    assert step.current_a["without"][-1] == pytest.approx(const.before_a, rel=1e-2)

@@ -24,7 +24,11 @@ does to the synchronous response over the speed range
   revolution, a least-squares fit of a sinusoid at Ω and an offset) before and after. The runout is
   :data:`RUNOUT_FRACTION` of the smallest air gap (a clearance the rig file gives; else
   :data:`RUNOUT_M`): the check is linear in it while the currents stay within the
-  amplifier's limits.
+  amplifier's limits. And a speed step (:func:`facility_speed_step`): the facility's
+  plant steps from one speed to another (its speed schedule), the runout's frequency with
+  it, each controller alone and with its notch (rescheduled at the step): the synchronous
+  coil current and orbit — the shaft's displacement at the sensors, the reading less the
+  runout — settling at the new speed.
 """
 
 from __future__ import annotations
@@ -43,7 +47,8 @@ from ambseal.model import build_plant
 from ambseal.robust import DiscreteController, loop_delay
 
 __all__ = ["rejection_stability", "rejection_effect", "facility_rejection",
-           "FacilityRejection", "EFFECT_SPEEDS", "RUNOUT_FRACTION", "RUNOUT_M"]
+           "FacilityRejection", "facility_speed_step", "SpeedStep", "EFFECT_SPEEDS",
+           "RUNOUT_FRACTION", "RUNOUT_M"]
 
 #: Speeds of the synchronous response over the speed range.
 EFFECT_SPEEDS = 61
@@ -227,9 +232,7 @@ def facility_rejection(cfg, digital, rejection, speed_hz: float, *,
                                  np.asarray(K.C, float), np.asarray(K.D, float), 1.0 / fs)
               for K in (controller_as_runs(digital, w),
                         rejection.digital.statespace_at(w, delayed=True)))
-    if runout_m is None:
-        gaps = [g for a in cfg.amb for g in (a.air_gap, a.backup_clearance) if g]
-        runout_m = RUNOUT_FRACTION * min(gaps) if gaps else RUNOUT_M
+    runout_m = _runout(cfg) if runout_m is None else runout_m
     # phase lengths: the controller's loop settles, then the notch's (time constant 2/ε)
     decay = -math.log(float(np.abs(fac.loop_poles(K0)).max())) * fs
     rev = max(1, int(round(fs / float(speed_hz))))  # samples of a revolution
@@ -251,6 +254,128 @@ def facility_rejection(cfg, digital, rejection, speed_hz: float, *,
     before = amp[ends <= n1][-1]
     return FacilityRejection(float(speed_hz), float(runout_m), n1 / fs, t[ends - 1], amp,
                              float(before), float(amp[-1]))
+
+
+@dataclass(frozen=True)
+class SpeedStep:
+    """A speed step on the virtual facility under a sensor runout, each controller alone
+    and with its notch (:func:`facility_speed_step`).
+
+    Attributes
+    ----------
+    from_hz, to_hz : float
+        The speeds before and after the step (Hz).
+    step_s : float
+        When the speed steps (s).
+    runout_m : float
+        The runout's amplitude (m).
+    time_s : ndarray, shape (R,)
+        The end of each revolution-long window (s).
+    current_a, orbit_m : dict
+        ``{"without", "with"}``: arrays of shape (R,), the largest synchronous coil
+        current (A) and orbit (m, the shaft at the sensors) of the axes over each window,
+        at the speed of the window.
+    """
+
+    from_hz: float
+    to_hz: float
+    step_s: float
+    runout_m: float
+    time_s: np.ndarray
+    current_a: dict
+    orbit_m: dict
+
+    def to_dict(self) -> dict:
+        """JSON-ready: the speeds (Hz), the step time (s), and per quantity (``current_a``
+        in A, ``orbit_um`` in µm) ``without`` and ``with`` the notch: the largest after
+        the step and the last."""
+        def ends(d, scale=1.0):
+            after = self.time_s > self.step_s
+            return {k: {"largest_after_step": scale * float(v[after].max()),
+                        "last": scale * float(v[-1])} for k, v in d.items()}
+        return {"from_hz": self.from_hz, "to_hz": self.to_hz, "step_s": self.step_s,
+                "runout_um": 1e6 * self.runout_m, "current_a": ends(self.current_a),
+                "orbit_um": ends(self.orbit_m, 1e6)}
+
+
+def facility_speed_step(cfg, digital, rejection, from_hz: float, to_hz: float, *,
+                        runout_m: float | None = None) -> SpeedStep:
+    """A speed step on the virtual facility under a synchronous sensor runout (module
+    docstring): the loop settles at ``from_hz`` (the notch too, from rest), then the
+    plant, the runout and the controller step to ``to_hz``.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig; the facility as in :func:`facility_rejection`.
+    digital : DigitalController or ScheduledDigital
+        The controller as it runs, alone.
+    rejection : SynchronousRejection
+        The same with its notch.
+    from_hz, to_hz : float
+        The speeds (Hz) before and after the step; the notch on at both.
+    runout_m : float, optional
+        The runout's amplitude (m); default as :func:`facility_rejection`.
+
+    Returns
+    -------
+    SpeedStep
+
+    Raises
+    ------
+    ModelError
+        The notch is off at either speed, or the rotor left the air gap.
+    """
+    notch = rejection.digital.notch
+    w1, w2 = 2 * math.pi * float(from_hz), 2 * math.pi * float(to_hz)
+    if not (notch.is_on(w1) and notch.is_on(w2)):
+        raise ModelError(f"facility speed step: the notch is off at {from_hz:g} or "
+                         f"{to_hz:g} Hz (on from {notch.on_rad_s / (2 * math.pi):g} Hz)")
+    fs = cfg.controller.sample_rate_hz
+    truth = TruthSection(tau_e=cfg.actuator.eddy_time_constant)
+    runout_m = _runout(cfg) if runout_m is None else runout_m
+    base = at_speed(cfg, float(from_hz))
+    probe = prepare_facility(base, truth, fs, pressure_bar=rejection.pressure_bar)
+    K = {(key, w): DiscreteController(*(np.asarray(getattr(S, m), float) for m in "ABCD"),
+                                      1.0 / fs)
+         for w in (w1, w2) for key, S in (
+             ("without", controller_as_runs(digital, w)),
+             ("with", rejection.digital.statespace_at(w, delayed=True)))}
+    decay = -math.log(float(np.abs(probe.loop_poles(K["with", w1])).max())) * fs
+    revs = [max(1, int(round(fs / f))) for f in (from_hz, to_hz)]
+    n1, n2 = (_whole(max(SETTLE_TIME_CONSTANTS / decay,
+                         SETTLE_TIME_CONSTANTS * 2.0 / (notch.rate_fraction * w)) * fs, r, fs)
+              for w, r in ((w1, revs[0]), (w2, revs[1])))
+    t = np.arange(n1 + n2) / fs
+    angle = np.where(t < n1 / fs, w1 * t, w1 * n1 / fs + w2 * (t - n1 / fs))
+    k = len(probe.axes)
+    runout = np.column_stack([runout_m * (np.cos(angle) if ax.endswith("zeta")
+                                          else np.sin(angle)) for ax in probe.axes])
+    zero = np.zeros((n1 + n2, k))
+    ends = np.concatenate([np.arange(revs[0], n1 + 1, revs[0]),
+                           n1 + np.arange(revs[1], n2 + 1, revs[1])])
+    current, orbit = {}, {}
+    for key in ("without", "with"):
+        fac = prepare_facility(base, truth, fs, pressure_bar=rejection.pressure_bar,
+                               speed_schedule=[(n1 / fs, float(to_hz))])
+        xc = np.zeros(K[key, w1].A.shape[0])
+        rec = [fac.run(K[key, w], xc, zero[a:b], runout[a:b], zero[a:b])
+               for w, a, b in ((w1, 0, n1), (w2, n1, n1 + n2))]
+        y, i = (np.vstack([r[j] for r in rec]) for j in (0, 1))
+        shaft = y - runout
+
+        def amplitudes(x):
+            return np.array([_synchronous(x[e - r:e], t[e - r:e], w) for e, r, w in zip(
+                ends, np.where(ends <= n1, revs[0], revs[1]), np.where(ends <= n1, w1, w2))])
+        current[key], orbit[key] = amplitudes(i), amplitudes(shaft)
+    return SpeedStep(float(from_hz), float(to_hz), n1 / fs, float(runout_m), t[ends - 1],
+                     current, orbit)
+
+
+def _runout(cfg) -> float:
+    """The facility's runout amplitude (m; module docstring)."""
+    gaps = [g for a in cfg.amb for g in (a.air_gap, a.backup_clearance) if g]
+    return RUNOUT_FRACTION * min(gaps) if gaps else RUNOUT_M
 
 
 def _whole(samples: float, rev: int, fs: float) -> int:

@@ -21,6 +21,7 @@ from ambseal.analysis import (
     also_failed,
     capacity_block,
     facility_rejection,
+    facility_speed_step,
     frozen_at,
     judge_case,
     judge_jobs,
@@ -525,16 +526,17 @@ def _rejections(st: _RunState, summaries: dict) -> dict:
     """Each delivered controller's unbalance force rejection
     (:func:`~ambseal.design.synchronous_rejection.design_rejection` on the design rig),
     judged at its judged conditions and shown against the controller alone on the judged
-    rig, and switched on under a sensor runout on the virtual facility
-    (:mod:`ambseal.analysis.rejection`): its ``rejection`` block in ``summaries``, and for
-    the figures ``{"effects": method → the effect's curves, "facility": method →
-    FacilityRejection}``. A notch that loses a loop is said so on stderr and in the block
-    (``stable`` false), not exported; the controller alone is delivered still."""
+    rig, and switched on, then through a speed step, under a sensor runout on the virtual
+    facility (:mod:`ambseal.analysis.rejection`): its ``rejection`` block in
+    ``summaries``, and for the figures ``{"effects": method → the effect's curves,
+    "facility": method → FacilityRejection, "speed_step": method → SpeedStep}``. A notch
+    that loses a loop is said so on stderr and in the block (``stable`` false), not
+    exported; the controller alone is delivered still."""
     st.stages.begin("rejection", "unbalance force rejection")
     r = st.cfg.design.rejection
     kw = {k: v for k, v in (("rate_fraction", r.rate_fraction), ("points", r.points))
           if v is not None}
-    effects, facility = {}, {}
+    effects, facility, steps = {}, {}, {}
     speeds = stability_points(st.spec.pressures_bar, st.spec.stability_speeds_hz, st.points)
     for d in st.designs:
         g = st.digitals.get(d.method)
@@ -559,10 +561,14 @@ def _rejections(st: _RunState, summaries: dict) -> dict:
                    f"{', '.join(lost)}")
         else:  # on the facility at the top speed (the most synchronous current), then
             # beside the controller's files: its notch as a file and as C
-            top = float(rej.speeds_hz[-1])
+            lo, top = float(rej.speeds_hz[0]), float(rej.speeds_hz[-1])
             fac = facility_rejection(st.design_cfg, g, rej, top)
-            summaries[d.method]["rejection"]["facility"] = fac.to_dict()
+            # and a speed step to the top from 10 % below it (within the range)
+            step = facility_speed_step(st.design_cfg, g, rej, max(lo, 0.9 * top), top)
+            summaries[d.method]["rejection"]["facility"] = {**fac.to_dict(),
+                                                            "speed_step": step.to_dict()}
             facility[d.method] = fac
+            steps[d.method] = step
             if not fac.after_a < 1e-2 * fac.before_a:
                 st.say(f"{d.method}: on the virtual facility at {top:g} Hz its notch leaves "
                        f"{fac.after_a:.3g} A of synchronous current of {fac.before_a:.3g} A")
@@ -573,7 +579,7 @@ def _rejections(st: _RunState, summaries: dict) -> dict:
             summaries[d.method]["rejection"]["files"] = [
                 f.relative_to(st.out).as_posix() for f in files]
         st.stages.step()
-    return {"effects": effects, "facility": facility}
+    return {"effects": effects, "facility": facility, "speed_step": steps}
 
 
 def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path: Path,

@@ -212,10 +212,12 @@ def rejection_figure(out: Path, rejections: dict) -> list[tuple[str, Path]]:
     Parameters
     ----------
     out : Path
-        Folder of the figures (``rejection.png``, ``rejection_facility.png``).
+        Folder of the figures (``rejection.png``, ``rejection_facility.png``,
+        ``rejection_speed_step.png``).
     rejections : dict
         ``effects`` (method → :func:`~ambseal.analysis.rejection.rejection_effect`) and
-        ``facility`` (method → :class:`~ambseal.analysis.rejection.FacilityRejection`).
+        ``facility`` (method → :class:`~ambseal.analysis.rejection.FacilityRejection`)
+        and ``speed_step`` (method → :class:`~ambseal.analysis.rejection.SpeedStep`).
 
     Returns
     -------
@@ -255,6 +257,28 @@ def rejection_figure(out: Path, rejections: dict) -> list[tuple[str, Path]]:
                 ylabel="Synchronous coil current (A)", marks={"notch on": 0.0},
                 styles={method_label(m): case_style(colours[m]) for m in facility},
                 title="Runout rejection on the virtual facility")))
+    steps = (rejections or {}).get("speed_step")
+    if steps:
+        first = next(iter(steps.values()))
+        curves = {"current_a": [], "orbit_um": []}
+        styles = {}
+        for m, r in steps.items():
+            for key, ls in (("without", "--"), ("with", "-")):
+                label = f"{method_label(m)}, {key} rejection"
+                styles[label] = {**case_style(colours[m]), "ls": ls}
+                curves["current_a"].append((label, r.time_s - r.step_s, r.current_a[key]))
+                curves["orbit_um"].append((label, r.time_s - r.step_s, 1e6 * r.orbit_m[key]))
+        figs.append((
+            f"Virtual facility, a speed step {first.from_hz:g} → {first.to_hz:g} Hz at time "
+            f"0 under the sensor runout: synchronous coil current and orbit (the shaft at "
+            "the sensors) per revolution, each controller alone (dashed) and with its "
+            "notch (solid)",
+            figures.panels_figure(
+                out / "rejection_speed_step.png",
+                [("current_a", "Synchronous coil current (A)"),
+                 ("orbit_um", "Synchronous orbit (µm)")], curves,
+                xlabel="Time from the speed step (s)", styles=styles,
+                title="Speed step on the virtual facility")))
     return figs
 
 

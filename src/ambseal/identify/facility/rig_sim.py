@@ -198,6 +198,17 @@ def reduced_plant(cfg: RigConfig, pressure_bar: float, speed_rpm: float | None,
     ModelError
         A value names a parameter the rig has no channel for; no mode below the cut-off.
     """
+    return _reduction(cfg, pressure_bar, speed_rpm, values, cutoff_hz).plant
+
+
+def _full_plant(cfg: RigConfig, pressure_bar: float, speed_rpm: float, values: dict):
+    full = mechanical_plant(build_system(cfg, pressure_bar=pressure_bar, speed_rpm=speed_rpm))
+    return full.with_values(values) if values else full
+
+
+def _reduction(cfg: RigConfig, pressure_bar: float, speed_rpm: float | None, values: dict,
+               cutoff_hz: float):
+    """:func:`reduced_plant`'s modal reduction (its plant and transformation), kept."""
     if speed_rpm is None:  # the rig's speed, as build_system takes it: one key for both
         speed_rpm = cfg.operating.speed_rpm
     key = (cfg.model_dump_json(), pressure_bar, speed_rpm, tuple(sorted(values.items())),
@@ -205,13 +216,11 @@ def reduced_plant(cfg: RigConfig, pressure_bar: float, speed_rpm: float | None,
     if key in _PLANTS:
         _PLANTS.move_to_end(key)
         return _PLANTS[key]
-    full = mechanical_plant(build_system(cfg, pressure_bar=pressure_bar, speed_rpm=speed_rpm))
-    if values:
-        full = full.with_values(values)
-    plant = _PLANTS[key] = modal_reduction(full, cutoff_hz=cutoff_hz).plant
+    red = _PLANTS[key] = modal_reduction(_full_plant(cfg, pressure_bar, speed_rpm, values),
+                                         cutoff_hz=cutoff_hz)
     if len(_PLANTS) > _PLANTS_KEPT:
         _PLANTS.popitem(last=False)
-    return plant
+    return red
 
 
 def pressure_values(cfg: RigConfig, truth: TruthSection, plant, pressure_bar: float) -> dict:
@@ -315,7 +324,8 @@ class Facility:
 
 def prepare_facility(cfg: RigConfig, truth: TruthSection, sample_rate_hz: float, *,
                      pressure_bar: float,
-                     pressure_schedule: list[tuple[float, float]] | None = None) -> Facility:
+                     pressure_schedule: list[tuple[float, float]] | None = None,
+                     speed_schedule: list[tuple[float, float]] | None = None) -> Facility:
     """The virtual facility at rest, ready to run.
 
     Parameters
@@ -331,6 +341,12 @@ def prepare_facility(cfg: RigConfig, truth: TruthSection, sample_rate_hz: float,
     pressure_schedule : list of (start_s, pressure_bar), optional
         A piecewise-constant pressure drop (bar) from each start time (s) on, as in
         :func:`simulate_facility`.
+    speed_schedule : list of (start_s, speed_hz), optional
+        A piecewise-constant rotor speed (Hz) from each start time (s) on (the rig's
+        operating speed before the first): each segment's plant is the full-order plant
+        at its speed (gyroscopics, seals) projected on the modal basis of the first
+        (a Galerkin projection on the modes below ``max_mode_hz``), so that the state
+        carries over a speed step. Not with a pressure schedule.
 
     Returns
     -------
@@ -344,14 +360,22 @@ def prepare_facility(cfg: RigConfig, truth: TruthSection, sample_rate_hz: float,
         Unknown truth parameters, a force law without Ki, Ks > 0.
     """
     T = 1.0 / sample_rate_hz
+    if pressure_schedule and speed_schedule:
+        raise ModelError("the virtual facility takes a pressure schedule or a speed "
+                         "schedule, not both")
     values = {k: coefficient_value(v, pressure_bar) for k, v in truth.parameters.items()}
     # raises ModelError naming an unknown parameter
     cfg_t = true_rig(cfg, truth)
-    plant = reduced_plant(cfg_t, pressure_bar, None, values, truth.max_mode_hz)
+    red = _reduction(cfg_t, pressure_bar, None, values, truth.max_mode_hz)
+    plant = red.plant
     segments = [(0, plant.A)]
     for start_s, p_bar in sorted(pressure_schedule or []):
         segments.append((int(round(start_s * sample_rate_hz)),
                          plant.with_values(pressure_values(cfg_t, truth, plant, p_bar)).A))
+    for start_s, f_hz in sorted(speed_schedule or []):
+        full = _full_plant(cfg_t, pressure_bar, 60.0 * f_hz, values)
+        segments.append((int(round(start_s * sample_rate_hz)),
+                         red.T_L @ np.asarray(full.A, float) @ red.T_R))
     axes = plant.axes
     k = len(axes)
     names = [a.rsplit("_", 1) for a in axes]

@@ -84,8 +84,8 @@ from ambseal.report import (
     StageProgress,
     capacity_figure,
     gains_figure,
-    rejection_figure,
     judged_on,
+    rejection_figure,
     rig_clearances_um,
     signoff_report,
     spinup_figures,
@@ -504,22 +504,23 @@ def _unbalance_currents(method: str, jobs, judged):
     for job, (case, curves) in zip(jobs, judged):
         c = curves.get("discrete", curves)
         if job.name == method and "unbalance_current" in c:
-            static = c.get("static_current")
-            yield (case.label, *c["unbalance_current"],
-                   None if static is None else dict(zip(static[1], static[0])))
+            yield (case.label, *c["unbalance_current"], _static(c))
 
 
 def _impulses(method: str, jobs, judged):
     """The current-impulse responses of ``method``'s stable judged loops, as it runs
     where it runs sampled: ``(condition, speed Hz, response, static currents by axis or
-    None)`` for
-    :func:`~ambseal.analysis.amplifier.capacity_block`."""
+    None)`` for :func:`~ambseal.analysis.amplifier.capacity_block`."""
     for job, (case, curves) in zip(jobs, judged):
         c = curves.get("discrete", curves)
         if job.name == method and c.get("impulse") is not None:
-            static = c.get("static_current")
-            yield (case.label, case.speed_hz, c["impulse"],
-                   None if static is None else dict(zip(static[1], static[0])))
+            yield case.label, case.speed_hz, c["impulse"], _static(c)
+
+
+def _static(curves: dict) -> dict | None:
+    """A judged loop's static currents by axis (its seals' static load), or None."""
+    static = curves.get("static_current")
+    return None if static is None else dict(zip(static[1], static[0]))
 
 
 def _rejections(st: _RunState, summaries: dict) -> dict:
@@ -562,9 +563,9 @@ def _rejections(st: _RunState, summaries: dict) -> dict:
         else:  # on the facility at the top speed (the most synchronous current), then
             # beside the controller's files: its notch as a file and as C
             lo, top = float(rej.speeds_hz[0]), float(rej.speeds_hz[-1])
-            fac = facility_rejection(st.design_cfg, g, rej, top)
+            fac = facility_rejection(st.judge_cfg, g, rej, top)
             # and a speed step to the top from 10 % below it (within the range)
-            step = facility_speed_step(st.design_cfg, g, rej, max(lo, 0.9 * top), top)
+            step = facility_speed_step(st.judge_cfg, g, rej, max(lo, 0.9 * top), top)
             summaries[d.method]["rejection"]["facility"] = {**fac.to_dict(),
                                                             "speed_step": step.to_dict()}
             facility[d.method] = fac

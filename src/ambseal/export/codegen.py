@@ -190,12 +190,7 @@ def write_c(ctrl, out_dir, prefix: str = "ambseal_controller", precision: str = 
     ConfigError
         Unknown precision or a prefix that is not a C identifier.
     """
-    if precision not in _PRECISION:
-        raise ConfigError(f"precision={precision!r}: expected 'double' or 'float'")
-    if not isinstance(prefix, str) or not _IDENTIFIER.fullmatch(prefix):
-        raise ConfigError(f"prefix={prefix!r}: expected a C identifier "
-                          "([A-Za-z_][A-Za-z0-9_]*)")
-    ctype, suf = _PRECISION[precision]
+    ctype, suf = _c_names(prefix, precision)
     p, P = prefix, prefix.upper()
     scheduled = isinstance(ctrl, ScheduledDigital)
     if scheduled:
@@ -236,6 +231,17 @@ def write_c(ctrl, out_dir, prefix: str = "ambseal_controller", precision: str = 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     return [write_text(out / f"{p}.h", h), write_text(out / f"{p}.c", "".join(src))]
+
+
+def _c_names(prefix: str, precision: str) -> tuple[str, str]:
+    """``(C type, literal suffix)`` of ``precision``, the prefix checked as a C
+    identifier; ConfigError naming either."""
+    if precision not in _PRECISION:
+        raise ConfigError(f"precision={precision!r}: expected 'double' or 'float'")
+    if not isinstance(prefix, str) or not _IDENTIFIER.fullmatch(prefix):
+        raise ConfigError(f"prefix={prefix!r}: expected a C identifier "
+                          "([A-Za-z_][A-Za-z0-9_]*)")
+    return _PRECISION[precision]
 
 
 def _scheduled_step(p: str, P: str, ctype: str, suf: str, nt: int, var: str) -> str:
@@ -297,14 +303,9 @@ def write_notch_c(notch, out_dir, prefix: str = "ambseal_rejection",
     ConfigError
         Unknown precision, a prefix that is not a C identifier, or a continuous notch.
     """
-    if precision not in _PRECISION:
-        raise ConfigError(f"precision={precision!r}: expected 'double' or 'float'")
-    if not isinstance(prefix, str) or not _IDENTIFIER.fullmatch(prefix):
-        raise ConfigError(f"prefix={prefix!r}: expected a C identifier "
-                          "([A-Za-z_][A-Za-z0-9_]*)")
+    ctype, suf = _c_names(prefix, precision)
     if not notch.dt > 0:
         raise ConfigError("a continuous notch does not run on a target (dt = 0)")
-    ctype, suf = _PRECISION[precision]
     p, P = prefix, prefix.upper()
     W = np.asarray(notch.speeds_rad_s, float)
     ny, nt = len(notch.inputs), W.size

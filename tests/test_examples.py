@@ -146,6 +146,8 @@ def test_every_example_runs_end_to_end(rig, tmp_path, capsys):
             assert r["stable"] and r["conditions"], (m, r["conditions"])
             assert r["current_ratio"] < 1e-2, (m, r["current_ratio"])
             assert r["facility"]["after_a"] < 1e-2 * r["facility"]["before_a"], m
+            given = load_rig(rig).design.rejection.runout_um
+            assert given is None or r["facility"]["runout_um"] == pytest.approx(given)
         assert (tmp_path / "out" / "rejection.png").is_file()
         _rejection_held_by_python_control(rig, metrics, tmp_path / "out")
     _every_file_through_every_command(rig, tmp_path / "out", tmp_path, capsys)

@@ -313,6 +313,9 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                                         "≈ 6 revolutions)"),
     "RejectionSpec.points": ("", "speeds of its gain table over the speed range (default "
                                  "16)"),
+    "RejectionSpec.runout_um": ("µm", "the synchronous sensor runout of its check on the "
+                                      "virtual facility (default 1 % of the smallest air "
+                                      "gap or backup clearance, else 5 µm)"),
     "Design.tracked": ("", "``ambseal run`` adds the controller scheduled on the tracked "
                            "seal k (LMI synthesis: minutes)"),
     "UnbalanceSpec.grade_mm_s": ("mm/s", "ISO 21940-11 balance grade G"),

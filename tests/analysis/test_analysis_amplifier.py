@@ -76,6 +76,10 @@ def test_capacity_block_names_the_limit_and_where(testrig_cfg, judged):
     assert block["current_used"] == pytest.approx(coil.max() / 6.0, rel=1e-9)
     assert block["voltage_used"] is None
     k, a = np.unravel_index(np.argmax(coil), coil.shape)
+    for amb in testrig_cfg.amb:  # each bearing's margin: the largest of its own axes
+        own = [j for j, n in enumerate(names) if n.startswith(f"i_{amb.name}_")]
+        assert block["per_amb"][amb.name]["current_used"] == pytest.approx(
+            coil[:, own].max() / 6.0, rel=1e-9)
     assert block["worst"]["current_used"] == {"condition": "0 bar",
                                               "speed_hz": pytest.approx(speeds[k]),
                                               "axis": names[a].removeprefix("i_"),

@@ -169,7 +169,8 @@ def capacity_block(cfg, entries, impulses=()) -> dict | None:
         amplitude, A),
         ``worst`` (per quantity: ``condition``, ``speed_hz``, ``axis`` and ``response``,
         ``"unbalance"`` or ``"impulse"``), ``static_a`` (the largest static current, A;
-        None without a static load) and ``sizing``: per AMB the smallest amplifier
+        None without a static load), ``per_amb`` (per AMB the same three fractions over
+        its axes: each bearing's margin) and ``sizing``: per AMB the smallest amplifier
         that holds every judged condition, ``current_limit_a`` (the largest control
         current of its axes, A) and ``supply_voltage_v`` (the largest voltage its coils
         need, V; None without the coil's inductance),
@@ -183,6 +184,7 @@ def capacity_block(cfg, entries, impulses=()) -> dict | None:
     act = actuator_matrices(cfg.actuator)
     best: dict = {q: (None, None) for q in (*QUANTITIES, "current_a")}
     sizing: dict = {}
+    per_amb: dict = {}
 
     def account(label, speed_hz, name, need, response):
         amb = by_axis[name]
@@ -194,9 +196,12 @@ def capacity_block(cfg, entries, impulses=()) -> dict | None:
                                           float(need["voltage_v"].max(initial=0.0)))
         use = limits_used(amb, need)
         use["current_a"] = need["current_a"]
+        margins = per_amb.setdefault(amb.name, dict.fromkeys(QUANTITIES))
         for q, v in use.items():
             if v is None or not v.size:
                 continue
+            if q in margins:
+                margins[q] = max(margins[q] or 0.0, float(v.max()))
             k = int(np.argmax(v))
             if best[q][0] is None or v[k] > best[q][0]:
                 best[q] = (float(v[k]), {"condition": label, "speed_hz": float(speed_hz[k]),
@@ -225,7 +230,8 @@ def capacity_block(cfg, entries, impulses=()) -> dict | None:
         return None
     return {**{q: best[q][0] for q in (*QUANTITIES, "current_a")},
             "worst": {q: best[q][1] for q in QUANTITIES if best[q][1] is not None},
-            "static_a": float(max(statics)) if any(statics) else None, "sizing": sizing}
+            "static_a": float(max(statics)) if any(statics) else None, "per_amb": per_amb,
+            "sizing": sizing}
 
 
 def saturates(block: dict | None) -> bool:

@@ -563,9 +563,11 @@ def _rejections(st: _RunState, summaries: dict) -> dict:
         else:  # on the facility at the top speed (the most synchronous current), then
             # beside the controller's files: its notch as a file and as C
             lo, top = float(rej.speeds_hz[0]), float(rej.speeds_hz[-1])
-            fac = facility_rejection(st.judge_cfg, g, rej, top)
+            runout = None if r.runout_um is None else 1e-6 * r.runout_um
+            fac = facility_rejection(st.judge_cfg, g, rej, top, runout_m=runout)
             # and a speed step to the top from 10 % below it (within the range)
-            step = facility_speed_step(st.judge_cfg, g, rej, max(lo, 0.9 * top), top)
+            step = facility_speed_step(st.judge_cfg, g, rej, max(lo, 0.9 * top), top,
+                                       runout_m=runout)
             summaries[d.method]["rejection"]["facility"] = {**fac.to_dict(),
                                                             "speed_step": step.to_dict()}
             facility[d.method] = fac

@@ -57,8 +57,10 @@ and bounded (the bounds beside each key in the code, with their reasons).
     (bool, default false) adds to every delivered controller a generalised notch filter at
     the rotational frequency, scheduled on speed over ``[operating] speed_range_hz`` and on
     from its minimum, judged at every condition with it and shown against the controller
-    alone; ``rate_fraction`` (ε/Ω, default 0.05: the notch settles in ≈ 6 revolutions) and
-    ``points`` (speeds of its gain table, default 16).
+    alone; ``rate_fraction`` (ε/Ω, default 0.05: the notch settles in ≈ 6 revolutions),
+    ``points`` (speeds of its gain table, default 16) and ``runout_um`` (the synchronous
+    sensor runout of its check on the virtual facility, µm; default 1 % of the smallest
+    air gap or backup clearance, else 5 µm).
 ``[design] tracked`` (bool, default false)
     ``ambseal run`` adds the ``tracked`` controller: scheduled on the first
     seal's k as tracked on line (:mod:`ambseal.design.seal_schedule`), judged at the
@@ -216,6 +218,7 @@ class RejectionSpec(_Strict):
     enabled: bool = False
     rate_fraction: float | None = Field(default=None, gt=0, lt=0.5)  # own poles: < 2/π
     points: int | None = Field(default=None, ge=2, le=MAX_CONDITIONS)
+    runout_um: float | None = Field(default=None, gt=0, le=MAX_GAP_M * 1e6)  # within a gap
 
 
 class Design(_Strict):

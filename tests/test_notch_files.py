@@ -4,7 +4,6 @@ module computes what the notch's own matrices compute, sample by sample, over a 
 ramp through its on speed and its whole table; bad files are refused naming the key."""
 
 import json
-import math
 
 import numpy as np
 import pytest
@@ -13,7 +12,7 @@ from ambseal.errors import DataError
 from ambseal.export.codegen import write_notch_c
 from ambseal.export.notch_files import export_notch, load_notch
 from ambseal.machine import SynchronousNotch
-from tests.robust.test_robust_digital import _compile_and_run
+from .robust.test_robust_digital import _compile_and_run
 
 RNG = np.random.default_rng(11)
 P = 4
@@ -72,4 +71,3 @@ def test_notch_c_runs_like_its_matrices(tmp_path):
     got = _compile_and_run(tmp_path, files, "amb_notch", y, "double", speeds=speeds,
                            outputs="NY")
     assert np.max(np.abs(got - ref)) < 1e-9 * np.max(np.abs(ref))
-    assert math.isclose(speeds[0], 0.5 * SPEEDS[0])

@@ -7,7 +7,7 @@ import pytest
 
 from ambseal.analysis.judge import OperatingPoint, judge_settings
 from ambseal.analysis.rejection import rejection_effect, rejection_stability
-from ambseal.design import design_rejection, design_spec
+from ambseal.design import design_spec
 
 from ..freq_at import at
 

@@ -275,12 +275,12 @@ def write_notch_c(notch, out_dir, prefix: str = "ambseal_rejection",
                   precision: str = "double") -> list[Path]:
     """Write ``<prefix>.h`` and ``<prefix>.c`` implementing a discrete synchronous notch
     (:class:`~ambseal.machine.synchronous_notch.SynchronousNotch`; the convention of
-    :mod:`ambseal.export.notch_files`): every sample, with the measured speed,
-    ``<prefix>_step(&s, speed_rad_s, y, q)`` gives the displacements ``q`` (m) the
-    controller reads in place of ``y``::
+    :mod:`ambseal.export.notch_files`).
 
-        ambseal_mu_rejection_step(&n, speed_rad_s, y, q);
-        ambseal_mu_step(&s, q, i);
+    Every sample, with the measured speed, ``<prefix>_step(&s, speed_rad_s, y, q)`` gives
+    the displacements ``q`` (m) the controller reads in place of ``y``:
+    ``ambseal_mu_rejection_step(&n, speed_rad_s, y, q);`` then
+    ``ambseal_mu_step(&s, q, i);``.
 
     Parameters
     ----------

@@ -228,21 +228,16 @@ def facility_rejection(cfg, digital, rejection, speed_hz: float, *,
     truth = TruthSection(tau_e=cfg.actuator.eddy_time_constant)
     fac = prepare_facility(at_speed(cfg, float(speed_hz)), truth, fs,
                            pressure_bar=rejection.pressure_bar)
-    K0, Kn = (DiscreteController(np.asarray(K.A, float), np.asarray(K.B, float),
-                                 np.asarray(K.C, float), np.asarray(K.D, float), 1.0 / fs)
-              for K in (controller_as_runs(digital, w),
-                        rejection.digital.statespace_at(w, delayed=True)))
+    K0, Kn = (_as_run(K, fs) for K in (controller_as_runs(digital, w),
+                                       rejection.digital.statespace_at(w, delayed=True)))
     runout_m = _runout(cfg) if runout_m is None else runout_m
-    # phase lengths: the controller's loop settles, then the notch's (time constant 2/ε)
-    decay = -math.log(float(np.abs(fac.loop_poles(K0)).max())) * fs
+    # phase lengths: the controller's loop settles, then the notch's
     rev = max(1, int(round(fs / float(speed_hz))))  # samples of a revolution
-    n1 = _whole(SETTLE_TIME_CONSTANTS / decay * fs, rev, fs)
-    n2 = _whole(SETTLE_TIME_CONSTANTS * 2.0 / (notch.rate_fraction * w) * fs, rev, fs)
-    k = len(fac.axes)
+    n1 = _whole(_loop_settle_s(fac, K0) * fs, rev, fs)
+    n2 = _whole(_notch_settle_s(notch, w) * fs, rev, fs)
     t = np.arange(n1 + n2) / fs
-    runout = np.column_stack([runout_m * (np.cos(w * t) if ax.endswith("zeta")
-                                          else np.sin(w * t)) for ax in fac.axes])
-    zero = np.zeros((n1 + n2, k))
+    runout = _runout_signal(fac.axes, runout_m, w * t)
+    zero = np.zeros_like(runout)
     xc = np.zeros(K0.A.shape[0])
     _, i1, _ = fac.run(K0, xc, zero[:n1], runout[:n1], zero[:n1])
     xn = np.concatenate([xc, np.zeros(Kn.A.shape[0] - xc.size)])
@@ -336,22 +331,17 @@ def facility_speed_step(cfg, digital, rejection, from_hz: float, to_hz: float, *
     runout_m = _runout(cfg) if runout_m is None else runout_m
     base = at_speed(cfg, float(from_hz))
     probe = prepare_facility(base, truth, fs, pressure_bar=rejection.pressure_bar)
-    K = {(key, w): DiscreteController(*(np.asarray(getattr(S, m), float) for m in "ABCD"),
-                                      1.0 / fs)
-         for w in (w1, w2) for key, S in (
-             ("without", controller_as_runs(digital, w)),
-             ("with", rejection.digital.statespace_at(w, delayed=True)))}
-    decay = -math.log(float(np.abs(probe.loop_poles(K["with", w1])).max())) * fs
+    K = {(key, w): _as_run(S, fs) for w in (w1, w2) for key, S in (
+        ("without", controller_as_runs(digital, w)),
+        ("with", rejection.digital.statespace_at(w, delayed=True)))}
+    loop_s = _loop_settle_s(probe, K["with", w1])
     revs = [max(1, int(round(fs / f))) for f in (from_hz, to_hz)]
-    n1, n2 = (_whole(max(SETTLE_TIME_CONSTANTS / decay,
-                         SETTLE_TIME_CONSTANTS * 2.0 / (notch.rate_fraction * w)) * fs, r, fs)
+    n1, n2 = (_whole(max(loop_s, _notch_settle_s(notch, w)) * fs, r, fs)
               for w, r in ((w1, revs[0]), (w2, revs[1])))
     t = np.arange(n1 + n2) / fs
     angle = np.where(t < n1 / fs, w1 * t, w1 * n1 / fs + w2 * (t - n1 / fs))
-    k = len(probe.axes)
-    runout = np.column_stack([runout_m * (np.cos(angle) if ax.endswith("zeta")
-                                          else np.sin(angle)) for ax in probe.axes])
-    zero = np.zeros((n1 + n2, k))
+    runout = _runout_signal(probe.axes, runout_m, angle)
+    zero = np.zeros_like(runout)
     ends = np.concatenate([np.arange(revs[0], n1 + 1, revs[0]),
                            n1 + np.arange(revs[1], n2 + 1, revs[1])])
     current, orbit = {}, {}
@@ -376,6 +366,29 @@ def _runout(cfg) -> float:
     """The facility's runout amplitude (m; module docstring)."""
     gaps = [g for a in cfg.amb for g in (a.air_gap, a.backup_clearance) if g]
     return RUNOUT_FRACTION * min(gaps) if gaps else RUNOUT_M
+
+
+def _as_run(K, fs: float) -> DiscreteController:
+    """A discrete ``control.StateSpace`` as the facility runs it."""
+    return DiscreteController(*(np.asarray(getattr(K, m), float) for m in "ABCD"), 1.0 / fs)
+
+
+def _loop_settle_s(fac, K: DiscreteController) -> float:
+    """:data:`SETTLE_TIME_CONSTANTS` of the facility's loop with ``K`` (its slowest pole's),
+    at most :data:`MAX_PHASE_S`."""
+    decay = -math.log(float(np.abs(fac.loop_poles(K)).max())) / fac.T
+    return min(SETTLE_TIME_CONSTANTS / decay, MAX_PHASE_S) if decay > 0 else MAX_PHASE_S
+
+
+def _notch_settle_s(notch, w: float) -> float:
+    """:data:`SETTLE_TIME_CONSTANTS` of the notch at Ω = ``w`` (its time constant 2/ε)."""
+    return SETTLE_TIME_CONSTANTS * 2.0 / (notch.rate_fraction * w)
+
+
+def _runout_signal(axes, runout_m: float, angle: np.ndarray) -> np.ndarray:
+    """The runout at each sample (m, shape (N, k)): r cos θ on the ζ axes, r sin θ on η."""
+    return np.column_stack([runout_m * (np.cos(angle) if ax.endswith("zeta")
+                                        else np.sin(angle)) for ax in axes])
 
 
 def _whole(samples: float, rev: int, fs: float) -> int:

@@ -66,16 +66,18 @@ class SynchronousRejection:
     digital : NotchedDigital or None
         The digital controller with its discrete notch, as it runs; None when no digital
         controller was given.
-    speeds_hz : ndarray, shape (S,)
-        The speeds of the gain table (Hz).
     pressure_bar : float
         The pressure drop the table was made at.
     """
 
     controller: NotchedController
     digital: NotchedDigital | None
-    speeds_hz: np.ndarray
     pressure_bar: float
+
+    @property
+    def speeds_hz(self) -> np.ndarray:
+        """The speeds of the gain table (Hz), shape (S,)."""
+        return self.controller.notch.speeds_rad_s / (2 * math.pi)
 
     def to_dict(self) -> dict:
         """JSON-ready description: the table's speeds (Hz), ε/Ω, the speed it is on from
@@ -164,7 +166,7 @@ def design_rejection(cfg, controller, digital=None, *, pressure_bar: float | Non
     return SynchronousRejection(
         controller=NotchedController(controller, notch("c")),
         digital=None if digital is None else NotchedDigital(digital, notch("d")),
-        speeds_hz=grid, pressure_bar=p)
+        pressure_bar=p)
 
 
 def _lag_on(lag: Any, s: complex, n_inputs: int, cur) -> np.ndarray:

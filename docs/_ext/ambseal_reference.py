@@ -41,6 +41,18 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Rotor.name": ("", "the machine's name, in every output and the report header"),
     "Rotor.modal_damping": ("", "damping ratio ζ given to every free–free bending mode of "
                                 "shaft and disks (structural damping)"),
+    "Rotor.supported_modal_damping": ("", "damping ratios of the modes of the rotor on "
+                                          "its supports, instead of modal_damping (ROSS "
+                                          "3's modal damping): a table below"),
+    "SupportedModalDamping.ratios": ("", "ζ of the lowest modes of the rotor on its "
+                                         "springs and seals (their stiffness and mass at 0 "
+                                         "Hz and the [operating] pressure; AMBs left out: "
+                                         "theirs is the loop's) at standstill, in ascending "
+                                         "frequency, each plane's mode counted; modes below "
+                                         "1 rpm (rigid-body) get none and are not counted "
+                                         "(ROSS 3's modal_damping_ratio)"),
+    "SupportedModalDamping.others": ("", "ζ of every mode above those of ratios (ROSS 3's "
+                                         "default_damping_ratio)"),
     "Rotor.rayleigh_alpha": ("1/s", "Rayleigh damping α·M of shaft and disks (a mode of ω "
                                     "rad/s gets ζ = α/(2ω); ROSS 3's rotor ``alpha``)"),
     "Rotor.rayleigh_beta": ("s", "Rayleigh damping β·K of shaft and disks (ζ = βω/2; ROSS "
@@ -561,6 +573,10 @@ def _sections() -> list[Section]:
                 "of a ``[[shaft]]`` section that is a flexible coupling (``coupling = "
                 "{ ... }``): each half's inertia on its end node, the halves joined by "
                 "springs and dampers."),
+        Section("[rotor.supported_modal_damping]", r.SupportedModalDamping, "Modal "
+                "damping on the modes of the rotor on its supports, C = M Φ diag(2ζω) Φᵀ M "
+                "with Φ those mass-normalised modes (Craig & Kurdila 2006, §10.2), as ROSS "
+                "3's ``Rotor(modal_damping_ratio=..., default_damping_ratio=...)``."),
         Section("{ frequency_hz, value }", r.FrequencyTable, "A seal coefficient tabulated "
                 "against excitation frequency, of equal lengths."),
         Section("[truth]", r.TruthSection, "The truth file of the virtual test facility "

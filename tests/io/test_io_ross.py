@@ -130,8 +130,7 @@ def test_rotor_rayleigh_damping_equals_ross(tmp_path):
     """A ROSS 3 rotor with its own Rayleigh damping (``Rotor(alpha=3, beta=2e-5)``, of
     shaft and disks), saved and imported: ``[rotor] rayleigh_alpha``, ``rayleigh_beta``, and
     every lateral mode up to 500 Hz (damped frequency and log decrement) equal to one of
-    ROSS's eigenvalues to 1e-6 at 0 and 4000 rpm. With modal damping ratios instead, the
-    import is refused naming them."""
+    ROSS's eigenvalues to 1e-6 at 0 and 4000 rpm."""
     ex = _bearing_rotor()
     rotor = _quiet(rs.Rotor, ex.shaft_elements, ex.disk_elements, ex.bearing_elements,
                    alpha=3.0, beta=2e-5)
@@ -141,10 +140,62 @@ def test_rotor_rayleigh_damping_equals_ross(tmp_path):
     assert (imp.rig.rotor.rayleigh_alpha, imp.rig.rotor.rayleigh_beta) == (3.0, 2e-5)
     for speed_rpm in (0.0, 4000.0):
         _assert_log_decrements_equal_ross(imp.rig, rotor, speed_rpm)
-    modal = _quiet(rs.Rotor, ex.shaft_elements, ex.disk_elements, ex.bearing_elements,
-                   modal_damping_ratio=[0.01, 0.02])
-    with pytest.raises(ConfigError, match="1 item.* cannot take.*\n.*modal_damping_ratio="):
-        from_ross(modal, where="modal.toml")
+
+
+def _modal_damping_rotor(stiffness_y=0.8e6, **damping):
+    """ROSS 3.1's ``test_modal_damping`` rotor: six Timoshenko elements, two disks, plain
+    bearings of 1e6 N/m in x and ``stiffness_y`` in y without damping."""
+    shaft = [rs.ShaftElement(0.25, 0, 0.05, material=rs.materials.steel, shear_effects=True,
+                             rotary_inertia=True, gyroscopic=True) for _ in range(6)]
+    disks = [rs.DiskElement.from_geometry(2, rs.materials.steel, 0.07, 0.05, 0.28),
+             rs.DiskElement.from_geometry(4, rs.materials.steel, 0.07, 0.05, 0.35)]
+    bearings = [rs.BearingElement(n, kxx=1e6, kyy=stiffness_y, cxx=0) for n in (0, 6)]
+    return _quiet(rs.Rotor, shaft, disks, bearings, **damping)
+
+
+@pytest.mark.skipif(not _takes(rs.Rotor, "modal_damping_ratio"),
+                    reason="ROSS < 3: a Rotor has no modal damping ratios")
+def test_rotor_modal_damping_equals_ross(tmp_path):
+    """ROSS 3.1's ``test_modal_damping`` rotor (``modal_damping_ratio=[0.001, 0.001]``,
+    ``default_damping_ratio=0.01``), saved and imported: ``[rotor.supported_modal_damping]``
+    with ROSS's ratios on the two lowest lateral modes (ROSS's axial and torsional modes
+    lie above them), every lateral mode up to 500 Hz (damped frequency and log decrement)
+    equal to one of ROSS's eigenvalues to 1e-6 at 0 and 4000 rpm, and the receptance at
+    the first disk equal to the values ROSS's test asserts (rtol 1e-6 there; 1e-5 here).
+    Ratios that differ within an isotropic rotor's repeated x/y mode are refused, and so
+    are ratios beside ROSS's rotor Rayleigh damping named as ROSS drops them."""
+    rotor = _modal_damping_rotor(modal_damping_ratio=[0.001, 0.001],
+                                 default_damping_ratio=0.01)
+    path = tmp_path / "modal.toml"
+    _quiet(rotor.save, path)
+    imp = from_ross(load_ross(path), where=str(path))
+    spec = imp.rig.rotor.supported_modal_damping
+    assert (spec.ratios, spec.others) == ([0.001, 0.001], 0.01) and imp.unmapped == ()
+    for speed_rpm in (0.0, 4000.0):
+        _assert_log_decrements_equal_ross(imp.rig, rotor, speed_rpm)
+    # ROSS's test: run_freq_response(speed_range=0, 200, ..., 1400 rpm) at x of node 2
+    # driven at x of node 2 (ROSS's DOF 12), its amplitude and phase asserted
+    amp = [1.495079e-06, 1.803400e-06, 2.819422e-06, 1.914051e-05, 2.548842e-06,
+           9.418038e-07, 4.558292e-07]
+    phase = [-6.188289e-04, -1.423301e-03, -3.157592e-03, -3.001839e-02, -3.135327e00,
+             -3.135999e00, -3.131778e00]
+    z = float(build_mesh(imp.rig).z[2])
+    for k, (a, ph) in enumerate(zip(amp, phase), start=1):
+        w = k * 200 * np.pi / 30
+        sys2 = build_system(imp.rig, speed_rpm=k * 200.0, force_positions=(z,))
+        f = sys2.B[:, sys2.input_names.index("F0_x")]
+        x = np.linalg.solve(sys2.K - w**2 * sys2.M + 1j * w * (sys2.C + w * sys2.G), f)
+        assert abs(x @ f) == pytest.approx(a, rel=1e-5)
+        assert np.angle(x @ f) == pytest.approx(ph, rel=1e-5)
+    split = _modal_damping_rotor(stiffness_y=1e6, modal_damping_ratio=[0.01, 0.02])
+    with pytest.raises(ConfigError, match="differ within a repeated mode"):
+        from_ross(split, where="split.toml")
+    both = _modal_damping_rotor(modal_damping_ratio=[0.01], alpha=3.0)
+    imp = from_ross(both)
+    assert imp.rig.rotor.supported_modal_damping is None
+    assert imp.rig.rotor.rayleigh_alpha == 3.0
+    assert any("modal_damping_ratio=[0.01]" in u and "alpha, beta win" in u
+               for u in imp.unmapped)
 
 
 def test_rotor_example_file_modes_equal_ross(examples):
@@ -621,6 +672,16 @@ def test_coupling_equals_ross(tmp_path):
     assert n >= 6
     for speed_rpm in (0.0, 4000.0):
         _assert_log_decrements_equal_ross(cfg, rotor, speed_rpm, 500.0, n)
+    if not _takes(rs.Rotor, "alpha"):
+        return
+    # ROSS 3: the rotor's own Rayleigh damping wins over the coupling's dampers, which
+    # ROSS then drops: named, not imported, the modes ROSS's
+    damped = _quiet(rs.Rotor, rotor.shaft_elements, bearing_elements=rotor.bearing_elements,
+                    alpha=3.0)
+    imp = from_ross(damped)
+    assert imp.rig.shaft[1].coupling.ct_x == 0.0 and imp.rig.rotor.rayleigh_alpha == 3.0
+    assert any(u.startswith("the elements' own damping") for u in imp.unmapped)
+    _assert_log_decrements_equal_ross(imp.rig, damped, 4000.0, 500.0, n)
 
 
 def test_elements_ambseal_cannot_take_are_each_named(tmp_path, capsys):

@@ -1,5 +1,7 @@
 """FE rotor against closed forms."""
 
+import tomllib
+
 import numpy as np
 import pytest
 import scipy.linalg as sla
@@ -145,6 +147,42 @@ def test_modal_damping_sets_bending_mode_damping():
     cfg = beam_rig("timoshenko", d=0.05, n=10, rotor={"modal_damping": 0.02})
     res = modes(build_system(cfg))
     np.testing.assert_allclose(res.damping_ratios[:6], 0.02, rtol=1e-6)
+
+
+def test_supported_modal_damping_sets_each_supported_mode():
+    """[rotor.supported_modal_damping] gives the modes of the rotor on its springs and
+    seals (stiffness and mass at 0 Hz, the [operating] pressure) the listed ζ in ascending
+    order and ``others`` above, to 1e-8 at standstill (classical damping: each undamped
+    mode keeps its shape, Craig & Kurdila 2006 §10.2); the matrix is the same at another
+    pressure; it reads back from the dumped TOML; with modal_damping as well, an error."""
+    from ambseal.config import dump_rig
+    from ambseal.errors import ConfigError
+
+    ratios, others = [0.01, 0.03, 0.05, 0.002], 0.02
+    seal = {"name": "S", "position": 0.6, "K": {"at_zero": 2e5, "per_bar": 4e4},
+            "k": 0.0, "C": 0.0, "c": 0.0, "M": 0.5}
+    springs = [{"name": f"B{i}", "position": z, "kxx": 1e6, "kyy": 6e5}
+               for i, z in enumerate((0.0, 1.0))]
+    extra = dict(disk=[{"position": 0.3, "mass": 4.0, "Ip": 0.02, "Id": 0.01}],
+                 spring=springs, seal=[seal], operating={"pressure_bar": 5.0})
+    cfg = beam_rig("timoshenko", d=0.05, n=10, rotor={"supported_modal_damping": {
+        "ratios": ratios, "others": others}}, **extra)
+    bare = build_system(beam_rig("timoshenko", d=0.05, n=10, **extra), speed_rpm=0.0)
+    w = np.sort(2 * np.pi * undamped_hz(bare.K, bare.M))
+    lam = build_system(cfg, speed_rpm=0.0).poles()
+    lam = lam[lam.imag > 0]
+    zeta = np.array(ratios + [others] * (len(w) - len(ratios)))
+    for wr, z in zip(w[:8], zeta[:8]):
+        j = np.argmin(np.abs(np.abs(lam) - wr))
+        assert abs(lam[j]) == pytest.approx(wr, rel=1e-8)
+        assert -lam[j].real / abs(lam[j]) == pytest.approx(z, rel=1e-8)
+    other_p = build_system(cfg, speed_rpm=0.0, pressure_bar=20.0)
+    np.testing.assert_allclose(other_p.C, build_system(cfg, speed_rpm=0.0).C, rtol=0,
+                               atol=1e-12 * np.abs(other_p.C).max())
+    assert parse_rig(tomllib.loads(dump_rig(cfg))) == cfg
+    with pytest.raises(ConfigError, match="modal_damping .*supported_modal_damping"):
+        beam_rig("timoshenko", rotor={"modal_damping": 0.01, "supported_modal_damping": {
+            "ratios": [0.01]}})
 
 
 @pytest.mark.parametrize(("alpha", "beta"), [(3.0, 0.0), (0.0, 2e-5), (3.0, 2e-5)])

@@ -11,7 +11,10 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
 
 ``[rotor]``
     ``beam`` = ``"timoshenko"`` (default) or ``"euler-bernoulli"``; ``name`` (optional);
-    ``modal_damping`` (ζ of every free–free bending mode of shaft and disks, default 0);
+    ``modal_damping`` (ζ of every free–free bending mode of shaft and disks, default 0) or
+    ``[rotor.supported_modal_damping]`` ``ratios`` (ζ of the lowest modes of the rotor on
+    its springs and seals at standstill, ascending) and ``others`` (ζ of the modes above,
+    default 0): ROSS 3's modal damping;
     ``rayleigh_alpha`` (1/s), ``rayleigh_beta`` (s): Rayleigh damping α·M + β·K of shaft
     and disks (default 0; ROSS 3's rotor ``alpha``, ``beta``).
 ``[materials.NAME]``
@@ -193,12 +196,30 @@ class Material(_Strict):
         return self.nu if self.nu is not None else self.E / (2.0 * self.G) - 1.0
 
 
+class SupportedModalDamping(_Strict):
+    """Damping ratios of the rotor's modes on its supports (ROSS 3's ``modal_damping_ratio``
+    and ``default_damping_ratio``): ``ratios`` of the lowest modes in ascending frequency,
+    ``others`` of every mode above them."""
+
+    # a mode per plane: 4 DOFs per node of at most 400 elements
+    ratios: list[Annotated[float, Field(ge=0, lt=1)]] = Field(min_length=1, max_length=1604)
+    others: float = Field(default=0.0, ge=0, lt=1)
+
+
 class Rotor(_Strict):
     beam: Literal["timoshenko", "euler-bernoulli"] = "timoshenko"
     name: Label = "rotor"
     modal_damping: float = Field(default=0.0, ge=0, lt=1)
+    supported_modal_damping: SupportedModalDamping | None = None
     rayleigh_alpha: float = Field(default=0.0, ge=0, le=MAX_RAYLEIGH_ALPHA)
     rayleigh_beta: float = Field(default=0.0, ge=0, le=MAX_RAYLEIGH_BETA)
+
+    @model_validator(mode="after")
+    def _one_modal_basis(self) -> "Rotor":
+        if self.modal_damping and self.supported_modal_damping is not None:
+            raise ValueError("modal_damping (free–free modes) and supported_modal_damping "
+                             "(modes on the supports) both given: expected one of them")
+        return self
 
 
 class ShaftLayer(_Strict):

@@ -23,8 +23,13 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
   coefficient has no equivalent: an error. ROSS's Rayleigh damping of a shaft element
   (``alpha``, ``beta``: C = αM + βK) → the tube's ``rayleigh_alpha``, ``rayleigh_beta``;
   a ROSS 3 rotor's own (``Rotor(alpha=..., beta=...)``, which ROSS takes in place of its
-  elements') → ``[rotor] rayleigh_alpha``, ``rayleigh_beta``; its modal damping ratios: an
-  error (ROSS sets them on modes a lateral model does not order alike). Several shafts
+  elements') → ``[rotor] rayleigh_alpha``, ``rayleigh_beta``; its modal damping ratios
+  (``modal_damping_ratio``, ``default_damping_ratio``) → ``[rotor.supported_modal_damping]``
+  with the ratio of each lateral mode read off ROSS's damping matrix (ROSS counts its
+  axial and torsional modes among them; an error on a rotor with AMBs, whose modes ROSS
+  takes with the AMBs' equivalent stiffness). Whichever damping ROSS drops by its rule
+  (the rotor's α, β win; ratios beside elements' damping: neither) is named, not
+  imported. Several shafts
   (ROSS's ``CoAxialRotor``, its shafts linked by bearings): an error naming them (an
   ambseal rig has one shaft).
 * ``DiskElement`` → ``[[disk]]`` (m, Ip, Id); a ``PointMass`` on a shaft node → a disk
@@ -84,11 +89,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import scipy.linalg
 from pydantic import ValidationError
 
 from ambseal.config import MAX_SUPPORT_STIFFNESS, Pid, RigConfig, dump_rig, parse_rig
 from ambseal.errors import AmbsealError, ConfigError
 from ambseal.files import claim_file, read_text, stamp_text, write_text
+from ambseal.model.rotor import RIGID_BELOW_RAD_S
 
 __all__ = ["RossImport", "from_ross", "load_ross", "import_ross_file", "ROSS_TESTED",
            "ROSS_TIMEOUT_S"]
@@ -199,7 +206,7 @@ def _shaft(rotor, where: str, elemental: bool = True) -> tuple[list[dict], dict,
     out = []
     for n in sorted(on):
         if n in couplings:
-            out.append(_coupling(couplings[n], keys[0]))
+            out.append(_coupling(couplings[n], keys[0], elemental))
             continue
         group = pairs[n]
         if not all(math.isclose(e.L, group[0].L, rel_tol=1e-9) for e in group):
@@ -222,14 +229,16 @@ def _shaft(rotor, where: str, elemental: bool = True) -> tuple[list[dict], dict,
     return out, mats, beam
 
 
-def _coupling(el, material: str) -> dict:
+def _coupling(el, material: str, elemental: bool = True) -> dict:
     """A ``[[shaft]]`` section of a ROSS ``CouplingElement``: its length and diameter draw
     it (ROSS's ``L``, ``o_d``), its halves and lateral springs and dampers are the
-    ``coupling`` (ROSS's ``_l``/``_r`` as ``_left``/``_right``); its axial and torsional
-    ones (``kt_z``, ``kr_z``, ``ct_z``, ``cr_z``) have no lateral effect."""
+    ``coupling`` (ROSS's ``_l``/``_r`` as ``_left``/``_right``; the dampers where ROSS
+    applies the elements' damping, ``elemental``); its axial and torsional ones (``kt_z``,
+    ``kr_z``, ``ct_z``, ``cr_z``) have no lateral effect."""
     keys = {f"{a}_{side}": f"{a}_{s}" for a in ("m", "Ip", "Id")
             for s, side in (("l", "left"), ("r", "right"))}
-    keys |= {k: k for k in ("kt_x", "kt_y", "kr_x", "kr_y", "ct_x", "ct_y", "cr_x", "cr_y")}
+    keys |= {k: k for k in ("kt_x", "kt_y", "kr_x", "kr_y")}
+    keys |= {k: k for k in ("ct_x", "ct_y", "cr_x", "cr_y") if elemental}
     return {"length": float(el.L), "outer_diameter": float(el.o_d), "material": material,
             "elements": 1, "coupling": {k: float(getattr(el, v)) for k, v in keys.items()}}
 
@@ -401,8 +410,8 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
     if refused:
         raise _bad(where, f"{len(refused)} item(s) ambseal cannot take (each would change "
                           "the dynamics):\n" + "\n".join(f"  {r}" for r in refused))
-    damping = _rotor_damping(rotor)
-    shaft, mats, beam = _shaft(rotor, where, elemental=not damping)
+    damping = _rotor_damping(rotor, where, unmapped)
+    shaft, mats, beam = _shaft(rotor, where, elemental=_damping_kind(rotor) == "elements")
     nodes = np.concatenate([[0.0], np.cumsum([s["length"] for s in shaft])])
     rig: dict = {"rotor": {"beam": beam, "name": name or str(getattr(rotor, "tag", None)
                                                             or "ROSS rotor"), **damping},
@@ -452,15 +461,11 @@ def _elements(rotor, bearings: list) -> tuple[list[str], list[str]]:
     support structure behind a bearing, anything on a node off the shaft) and what would
     not (named, one line each, in ``unmapped``)."""
     refused, unmapped = [], []
-    ratios = getattr(rotor, "modal_damping_ratio", None)
-    default = float(getattr(rotor, "default_damping_ratio", 0.0) or 0.0)
-    if (ratios is not None and np.any(np.asarray(ratios, float))) or default:
-        refused.append(f"the rotor's modal damping (modal_damping_ratio={ratios!r}, "
-                       f"default_damping_ratio={default:g}): ROSS sets it on the supported "
-                       "rotor's modes, axial and torsional ones among them; give the damping "
-                       "as Rayleigh alpha, beta (ROSS's Rotor(alpha=..., beta=...)) or set "
-                       "[rotor] modal_damping (free–free bending modes) after importing "
-                       "without it")
+    if _damping_kind(rotor) == "modal" and any(type(b).__name__ == "MagneticBearingElement"
+                                               for b in bearings):
+        refused.append("the rotor's modal damping ratios on a rotor with magnetic bearings: "
+                       "ROSS sets them on the modes with its AMBs' equivalent stiffness at "
+                       "0 Hz, ambseal on the modes without the AMBs (theirs is the loop's)")
     last = max((int(e.n) + 1 for e in getattr(rotor, "shaft_elements", [])), default=0)
     for i, b in enumerate(bearings):
         if getattr(b, "n_link", None) is not None:
@@ -492,13 +497,80 @@ def _elements(rotor, bearings: list) -> tuple[list[str], list[str]]:
     return refused, unmapped
 
 
-def _rotor_damping(rotor) -> dict:
-    """``[rotor]`` keys of a ROSS 3 rotor's own damping: its Rayleigh ``alpha``, ``beta``
-    (of shaft, disks and point masses, as ROSS assembles them); ROSS 3 takes it in place
-    of its elements' own. (Its modal damping ratios are refused by :func:`_elements`.)"""
-    alpha = float(getattr(rotor, "alpha", 0.0) or 0.0)
-    beta = float(getattr(rotor, "beta", 0.0) or 0.0)
-    return {k: v for k, v in (("rayleigh_alpha", alpha), ("rayleigh_beta", beta)) if v}
+def _damping_kind(rotor) -> str:
+    """The rotor damping ROSS 3 assembles (``Rotor._build_base_matrices``): ``"rayleigh"``
+    (the rotor's α, β, which win over the others), ``"modal"`` (its modal damping ratios,
+    on a rotor without elements' damping), ``"none"`` (ratios and elements' damping both
+    given: ROSS drops both) or ``"elements"`` (each element's own, if any)."""
+    if float(getattr(rotor, "alpha", 0.0) or 0.0) or float(getattr(rotor, "beta", 0.0) or 0.0):
+        return "rayleigh"
+    if getattr(rotor, "modal_damping_ratio", None) is None:
+        return "elements"
+    bearings = list(getattr(rotor, "bearing_elements", []))
+    own = any(np.any(e.C()) for e in getattr(rotor, "elements", [])
+              if not any(e is b for b in bearings))
+    return "none" if own else "modal"
+
+
+def _rotor_damping(rotor, where: str, unmapped: list) -> dict:
+    """``[rotor]`` keys of a ROSS 3 rotor's own damping, the kind ROSS assembles
+    (:func:`_damping_kind`): its Rayleigh ``alpha``, ``beta`` (of shaft, disks and point
+    masses, as ROSS assembles them), or its modal damping ratios
+    (:func:`_supported_modal_damping`); what ROSS itself drops named in ``unmapped``."""
+    kind = _damping_kind(rotor)
+    ratios = getattr(rotor, "modal_damping_ratio", None)
+    default = float(getattr(rotor, "default_damping_ratio", 0.0) or 0.0)
+    if kind != "modal" and (ratios is not None or default):
+        why = ("its Rayleigh alpha, beta win" if kind == "rayleigh" else "ratios without "
+               "modal_damping_ratio are unused" if ratios is None else "with its shaft "
+               "elements' own damping ROSS uses neither")
+        unmapped.append(f"the rotor's modal damping (modal_damping_ratio={ratios!r}, "
+                        f"default_damping_ratio={default:g}): not imported, ROSS does not "
+                        f"apply it ({why})")
+    if kind in ("none", "rayleigh") and any(np.any(e.C()) for e in rotor.shaft_elements):
+        unmapped.append("the elements' own damping (shaft elements' alpha, beta, couplings' "
+                        "dampers): not imported, ROSS does not apply it beside the rotor's "
+                        + ("modal damping ratios" if kind == "none" else "alpha, beta"))
+    if kind == "modal":
+        return {"supported_modal_damping": _supported_modal_damping(rotor, where)}
+    if kind != "rayleigh":
+        return {}
+    return {"rayleigh_alpha": float(rotor.alpha), "rayleigh_beta": float(rotor.beta)}
+
+
+#: ROSS 3's DOFs per node are [x, y, z, α, β, θ]: the lateral ones ambseal holds.
+_LATERAL = (0, 1, 3, 4)
+
+
+def _supported_modal_damping(rotor, where: str) -> dict:
+    """``[rotor.supported_modal_damping]`` of a ROSS 3 rotor's modal damping: the ratio of
+    each lateral mode read off ROSS's own damping matrix (ζ_r = φ_rᵀ C₀ φ_r / 2ω_r on the
+    mass-normalised modes of ROSS's M(0), K(0)) — ROSS orders its ratios over all its modes,
+    the axial and torsional ones among them, which the lateral ones skip."""
+    per = int(getattr(rotor, "number_dof", 6))
+    lat = [i for i in range(rotor.ndof) if i % per in _LATERAL]
+    sub = np.ix_(lat, lat)
+    M = np.asarray(rotor.M(0), float)[sub]
+    K = np.asarray(rotor.K(0), float)[sub]
+    C0 = np.real(np.asarray(rotor.C0))[sub]  # complex (ROSS's eig), real to round-off
+    w2, phi = scipy.linalg.eigh((K + K.T) / 2, M)
+    keep = np.flatnonzero(w2 >= RIGID_BELOW_RAD_S ** 2)
+    w, phi = np.sqrt(w2[keep]), phi[:, keep]
+    modal = phi.T @ C0 @ phi / (2 * w)  # diag: ζ; off it, what one ζ per mode cannot hold
+    zeta = np.diag(modal).copy()
+    if np.abs(modal - np.diag(zeta)).max(initial=0.0) > 1e-6 * max(zeta.max(initial=0), 1e-9):
+        raise _bad(where, "the rotor's modal damping ratios differ within a repeated mode "
+                          "(the x and y modes of an isotropic rotor): ROSS's damping then "
+                          "depends on the eigenvectors its solver returns; give the pair one "
+                          "ratio")
+    given = [float(z) for z in np.atleast_1d(rotor.modal_damping_ratio)]
+    others = float(rotor.default_damping_ratio or 0.0)
+    for j, z in enumerate(zeta):  # ROSS's exact values, not their round-off
+        near = [g for g in given + [others, 0.0] if math.isclose(z, g, rel_tol=1e-6,
+                                                                  abs_tol=1e-12)]
+        zeta[j] = near[0] if near else z
+    last = max((j for j, z in enumerate(zeta) if z != others), default=0)
+    return {"ratios": [float(z) for z in zeta[:last + 1]], "others": others}
 
 
 def _masses(rotor, nodes: np.ndarray) -> list[dict]:

@@ -27,7 +27,8 @@ from ambseal.lti import ArrayMemo
 from ambseal.model.amb import AXES, AmbElement, actuator_matrices, eddy_lag_matrices
 from ambseal.model.lft import Channel, Parameter, Plant
 from ambseal.model.reduction import modal_reduction
-from ambseal.model.rotor import Mesh, X, Y, assemble_rotor, build_mesh
+from ambseal.model.rotor import (Mesh, X, Y, assemble_rotor, build_mesh,
+                                  supported_modal_damping)
 from ambseal.model.seal import SealElement
 from ambseal.model.spring import SpringElement
 
@@ -164,6 +165,8 @@ def build_system(
     for el in others:
         el.assemble(M, C, K)
         changes += el.channels(n)
+    if cfg.rotor.supported_modal_damping is not None:
+        C += _supported_damping(cfg, mesh, rot)
     out_names = tuple(f"y_{a[2:]}" for a in names)
     for k_i, z in enumerate(force_positions):
         i = mesh.node_at(z)
@@ -177,6 +180,21 @@ def build_system(
         mesh=mesh, M=M, C=C, G=rot.G, K=K, B=B, Cq=Cq, speed=speed,
         input_names=tuple(names), output_names=out_names, changes=tuple(changes),
     )
+
+
+def _supported_damping(cfg: RigConfig, mesh: Mesh, rot) -> np.ndarray:
+    """``[rotor.supported_modal_damping]`` as a damping matrix: on the modes of the rotor
+    on its springs and seals at standstill — their stiffness and mass at 0 Hz and the
+    [operating] pressure, so that the rotor's damping is one matrix at every speed and
+    pressure, as ROSS 3's (its bearings at frequency 0); the AMBs are left out, their
+    stiffness being the loop's."""
+    M, K, C = rot.M.copy(), rot.K.copy(), np.zeros_like(rot.M)
+    for s in cfg.seal:
+        SealElement.from_config(s, mesh, cfg.operating.pressure_bar, 0.0).assemble(M, C, K)
+    for i, s in enumerate(cfg.spring):
+        SpringElement.from_config(s, mesh, i).assemble(M, C, K)
+    spec = cfg.rotor.supported_modal_damping
+    return supported_modal_damping(M, K, spec.ratios, spec.others)
 
 
 def mechanical_plant(sys: SecondOrderSystem) -> Plant:

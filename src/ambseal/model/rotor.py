@@ -293,6 +293,54 @@ def _modal_damping(M: np.ndarray, K: np.ndarray, zeta: float) -> np.ndarray:
     return _read_only((Mphi * (2 * zeta * w)) @ Mphi.T)
 
 
+#: Modes below this (rad/s, 1 rpm) are rigid-body modes of the supported rotor: ROSS 3's
+#: rule (``Rotor._compute_modal_damping``), which :func:`supported_modal_damping` follows.
+RIGID_BELOW_RAD_S = 2 * np.pi / 60
+
+
+def supported_modal_damping(M: np.ndarray, K: np.ndarray, ratios, others: float = 0.0
+                            ) -> np.ndarray:
+    """Damping matrix giving the modes of (K, M) — a rotor on its supports — the damping
+    ratios ``ratios`` in ascending frequency and ``others`` above them.
+
+    C = M Φ diag(2ζ_r ω_r) Φᵀ M with Φ the mass-normalised modes (Craig & Kurdila,
+    *Fundamentals of Structural Dynamics*, 2006, §10.2), as ROSS 3's
+    ``Rotor(modal_damping_ratio=ratios, default_damping_ratio=others)``: modes below
+    :data:`RIGID_BELOW_RAD_S` (rigid-body) and modes of negative stiffness get none and are
+    not counted; a stiffness with a circulatory part (torque) sets the modes of its
+    symmetric part.
+
+    Parameters
+    ----------
+    M, K : numpy.ndarray, shape (n, n)
+        Mass (symmetric, positive definite) and stiffness matrices of the supported rotor.
+    ratios : sequence of float
+        ζ of the lowest modes that are not rigid-body modes, ascending.
+    others : float
+        ζ of every mode above them.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n, n)
+        Read-only (kept for the last rotors: copy it to change it).
+    """
+    zeta = tuple(float(z) for z in ratios)
+    return _DAMPING.get((M, K), ("supported", zeta, float(others)),
+                        lambda: _supported(M, (K + K.T) / 2, zeta, float(others)))
+
+
+def _supported(M: np.ndarray, K: np.ndarray, ratios: tuple, others: float) -> np.ndarray:
+    w2, phi = sla.eigh(K, M)  # ascending, M-normalised
+    w = np.sqrt(np.clip(w2, 0.0, None))
+    flexible = np.flatnonzero(w2 >= RIGID_BELOW_RAD_S ** 2)
+    zeta = np.zeros(len(w))
+    zeta[flexible] = others
+    first = flexible[:len(ratios)]
+    zeta[first] = ratios[:len(first)]
+    Mphi = M @ phi
+    return _read_only((Mphi * (2 * zeta * w)) @ Mphi.T)
+
+
 def _read_only(a: np.ndarray) -> np.ndarray:
     a.setflags(write=False)
     return a

@@ -367,13 +367,14 @@ def test_import_ross_cli_round_trip_and_bad_files(tmp_path, capsys):
 
 def test_a_file_of_a_newer_ross_is_refused_naming_both_versions(examples, tmp_path, capsys):
     """A rotor file written by a newer ROSS major than the one installed (here ROSS's own
-    ``rotor_example`` file with its ``ross_version`` one major up, as a ROSS 3.1 file is
-    to ROSS 2.3): ``import-ross`` exits 2 naming both versions and what to install,
+    ``rotor_example`` file with its ``ross_version`` a major up, and past 3, which
+    ambseal reads without ROSS): ``import-ross`` exits 2 naming both versions and what to install,
     instead of ROSS's own error on the newer keys ("not a ROSS rotor file (TypeError:
     Rotor.__init__() got an unexpected keyword argument 'default_damping_ratio')")."""
     from ambseal.cli import main
 
-    newer = f"{int(rs.__version__.split('.')[0]) + 1}.0.0"
+    # one major up, and past ROSS 3, whose files ambseal also reads without ROSS
+    newer = f"{max(int(rs.__version__.split('.')[0]) + 1, 4)}.0.0"
     text = examples["rotor_example"][1].read_text()
     assert f'ross_version = "{rs.__version__}"' in text
     src = tmp_path / "newer.toml"
@@ -976,3 +977,50 @@ def test_level1_screening_equals_the_same_sweep_in_ross():
     q0_ross = brentq(lambda Q: ross_mode(Q, ours(i0 - 1 if Q - a < b - Q else i0)).real,
                      a, b, xtol=1e-6 * r.Q_A)
     assert r.Q_0 == pytest.approx(q0_ross, rel=0.01)
+
+
+@pytest.mark.skipif(not _takes(rs.BearingElement, "speed"),
+                    reason="ROSS < 3: no ROSS 3 file to read")
+def test_ross3_file_read_without_ross_equals_the_ross_import(examples, tmp_path):
+    """Every ROSS 3 rotor the importer is checked on against ROSS's modes, saved by ROSS 3
+    and read by ambseal's reader of the format (no ROSS: what Python 3.11 with ROSS 2.3
+    does), gives the same rig, the same items left out and the same notes as the import
+    through ROSS — tables over speed and whirl frequency (pchip, linear, extrapolated), a
+    magnetic bearing with a non-collocated sensor, a coupling and a point mass, layered and
+    tapered elements with loads, 1e20 N/m pins, a rotor's Rayleigh damping; a rotor with
+    modal damping ratios is refused saying it needs ROSS 3."""
+    from ambseal.io.ross_file import read_ross3_file
+
+    speed, freq = np.array([100.0, 300.0, 500.0]), np.array([150.0, 400.0])
+    grid = np.add.outer(speed, 2 * freq)
+    seal = rs.BearingElement(n=3, kxx=2e6 + 1e3 * grid, kyy=2e6 + 1e3 * grid,
+                             kxy=5e5 + 50 * grid, kyx=-(5e5 + 50 * grid), cxx=80 + 0.1 * grid,
+                             cyy=80 + 0.1 * grid, speed=speed, frequency=freq, tag="seal")
+    ex = rs.rotor_example()
+    lin = [rs.BearingElement(n=n, kxx=[1e6, 3e6, 4e6], kyy=[8e5, 1e6, 2e6], cxx=150.0,
+                             speed=[50.0, 200.0, 900.0], interpolation=kind, tag=f"B{n}")
+           for n, kind in ((0, "linear"), (6, "pchip"))]
+    rotors = {
+        "tables": _quiet(rs.Rotor, ex.shaft_elements, ex.disk_elements, [*lin, seal]),
+        "rayleigh": _quiet(rs.Rotor, ex.shaft_elements, ex.disk_elements,
+                           _bearing_rotor().bearing_elements, alpha=3.0, beta=2e-5),
+        "coupling": _coupled_rotor(kt_x=1e6, kt_y=8e5, kr_x=2e5, kr_y=1e5, ct_x=50.0,
+                                   ct_y=50.0, cr_x=2.0, cr_y=2.0, kr_z=3e6),
+        "pinned": _conical_rotor(1e20),
+        "compressor": examples["compressor_example"][0],
+        "amb": examples["rotor_amb_example"][0],
+    }
+    for name, rotor in rotors.items():
+        path = tmp_path / f"{name}.toml"
+        _quiet(rotor.save, path)
+        data = tomllib.loads(path.read_text())
+        for speed_rpm in (None, 2500.0):
+            ross = from_ross(load_ross(path), where=str(path), speed_rpm=speed_rpm)
+            own = from_ross(read_ross3_file(path, data), where=str(path), speed_rpm=speed_rpm)
+            assert own.rig == ross.rig, name
+            assert (own.unmapped, own.notes) == (ross.unmapped, ross.notes), name
+    modal = _modal_damping_rotor(modal_damping_ratio=[0.01])
+    path = tmp_path / "modal.toml"
+    _quiet(modal.save, path)
+    with pytest.raises(ConfigError, match="modal damping ratios .* need ROSS 3"):
+        read_ross3_file(path, tomllib.loads(path.read_text()))

@@ -77,6 +77,7 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
+import importlib.metadata
 import json
 import math
 import os
@@ -95,7 +96,8 @@ from pydantic import ValidationError
 from ambseal.config import MAX_SUPPORT_STIFFNESS, Pid, RigConfig, dump_rig, parse_rig
 from ambseal.errors import AmbsealError, ConfigError
 from ambseal.files import claim_file, read_text, stamp_text, write_text
-from ambseal.model.rotor import RIGID_BELOW_RAD_S
+from ambseal.io.ross_file import _AMB_KEYS, _COEFFS, read_ross3_file
+from ambseal.model import RIGID_BELOW_RAD_S
 
 __all__ = ["RossImport", "from_ross", "load_ross", "import_ross_file", "ROSS_TESTED",
            "ROSS_TIMEOUT_S"]
@@ -107,9 +109,6 @@ ROSS_TESTED = ("2.3", "3.1")
 #: seconds more.
 ROSS_TIMEOUT_S = 300.0
 
-_COEFFS = ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy", "cxy", "cyx", "mxx", "myy", "mxy", "myx")
-#: The keys of a saved ROSS AMB beyond a bearing's (ROSS 2.3 ``MagneticBearingElement``).
-_AMB_KEYS = ("g0", "i0", "ag", "nw")
 
 
 @dataclass(frozen=True)
@@ -506,10 +505,16 @@ def _damping_kind(rotor) -> str:
         return "rayleigh"
     if getattr(rotor, "modal_damping_ratio", None) is None:
         return "elements"
-    bearings = list(getattr(rotor, "bearing_elements", []))
-    own = any(np.any(e.C()) for e in getattr(rotor, "elements", [])
-              if not any(e is b for b in bearings))
+    own = any(_own_damping(e) for e in getattr(rotor, "shaft_elements", []))
     return "none" if own else "modal"
+
+
+def _own_damping(el) -> bool:
+    """Whether a shaft element carries damping of its own (ROSS's ``C()`` not zero): its
+    Rayleigh α, β, or a coupling's dampers (disks and point masses have none)."""
+    keys = (("ct_x", "ct_y", "ct_z", "cr_x", "cr_y", "cr_z")
+            if type(el).__name__ == "CouplingElement" else ("alpha", "beta"))
+    return any(float(getattr(el, k, 0.0) or 0.0) for k in keys)
 
 
 def _rotor_damping(rotor, where: str, unmapped: list) -> dict:
@@ -527,7 +532,7 @@ def _rotor_damping(rotor, where: str, unmapped: list) -> dict:
         unmapped.append(f"the rotor's modal damping (modal_damping_ratio={ratios!r}, "
                         f"default_damping_ratio={default:g}): not imported, ROSS does not "
                         f"apply it ({why})")
-    if kind in ("none", "rayleigh") and any(np.any(e.C()) for e in rotor.shaft_elements):
+    if kind in ("none", "rayleigh") and any(_own_damping(e) for e in rotor.shaft_elements):
         unmapped.append("the elements' own damping (shaft elements' alpha, beta, couplings' "
                         "dampers): not imported, ROSS does not apply it beside the rotor's "
                         + ("modal damping ratios" if kind == "none" else "alpha, beta"))
@@ -536,6 +541,23 @@ def _rotor_damping(rotor, where: str, unmapped: list) -> dict:
     if kind != "rayleigh":
         return {}
     return {"rayleigh_alpha": float(rotor.alpha), "rayleigh_beta": float(rotor.beta)}
+
+
+def _split_repeated(rotor) -> bool:
+    """Whether ROSS's rule gives a repeated mode (an isotropic rotor's x and y) two
+    ratios: ROSS's modes at standstill ascending, those below 1 rpm none, then
+    ``modal_damping_ratio``, then ``default_damping_ratio`` — which of the two gets which
+    then depends on the vectors ROSS's eigensolver returns in their plane."""
+    M, K = np.asarray(rotor.M(0), float), np.asarray(rotor.K(0), float)
+    w2 = scipy.linalg.eigh((K + K.T) / 2, M, eigvals_only=True)
+    w = np.sqrt(w2[w2 >= 0])
+    given = list(np.atleast_1d(np.asarray(rotor.modal_damping_ratio, float)))
+    rigid = int(np.sum(w < RIGID_BELOW_RAD_S))
+    zeta = np.full(len(w), float(rotor.default_damping_ratio or 0.0))
+    zeta[:rigid] = 0.0
+    zeta[rigid:rigid + len(given)] = given[:max(len(w) - rigid, 0)]
+    same = np.diff(w) <= 1e-6 * np.maximum(w[1:], RIGID_BELOW_RAD_S)
+    return bool(np.any(same & (np.diff(zeta) != 0)))
 
 
 #: ROSS 3's DOFs per node are [x, y, z, α, β, θ]: the lateral ones ambseal holds.
@@ -558,7 +580,8 @@ def _supported_modal_damping(rotor, where: str) -> dict:
     w, phi = np.sqrt(w2[keep]), phi[:, keep]
     modal = phi.T @ C0 @ phi / (2 * w)  # diag: ζ; off it, what one ζ per mode cannot hold
     zeta = np.diag(modal).copy()
-    if np.abs(modal - np.diag(zeta)).max(initial=0.0) > 1e-6 * max(zeta.max(initial=0), 1e-9):
+    if _split_repeated(rotor) or np.abs(modal - np.diag(zeta)).max(initial=0.0) > 1e-6 * max(
+            zeta.max(initial=0), 1e-9):
         raise _bad(where, "the rotor's modal damping ratios differ within a repeated mode "
                           "(the x and y modes of an isotropic rotor): ROSS's damping then "
                           "depends on the eigenvectors its solver returns; give the pair one "
@@ -775,6 +798,14 @@ def _check_file(path: Path, ross=None) -> dict:
     return data
 
 
+def _installed_ross() -> str | None:
+    """The installed ROSS's version, read from its package metadata (no import), or None."""
+    try:
+        return importlib.metadata.version("ross-rotordynamics")
+    except importlib.metadata.PackageNotFoundError:
+        return None
+
+
 def _major(version) -> int | None:
     """The major number of a version string (``"3.1.0"`` → 3), None if it has none."""
     head = str(version).split(".")[0] if version is not None else ""
@@ -890,12 +921,21 @@ def import_ross_file(path: str | Path, out: str | Path, *,
         raise ConfigError(f"{path}: no such ROSS rotor file")
     if path.suffix.lower() not in (".toml", ".json"):
         raise ConfigError(f"{path}: expected a ROSS rotor file (.toml or .json)")
-    _check_file(path)  # before ROSS's import: a file that is no rotor, a missing material
-    doc = _in_clean_process(path, speed_rpm)
+    data = _check_file(path)  # before ROSS's import: no rotor file, a missing material
+    saved, have = _major(data.get("ross_version")), _major(_installed_ross())
+    if saved == 3 and (have is None or have < saved):
+        # a ROSS 3 file where ROSS 3 is not installed (Python 3.11: ROSS 2.3): read the
+        # format itself, no ROSS imported
+        imp = from_ross(read_ross3_file(path, data), where=str(path), speed_rpm=speed_rpm)
+        doc = {"rig": imp.rig.model_dump(exclude_none=True), "unmapped": list(imp.unmapped),
+               "notes": list(imp.notes)}
+        source = f"ROSS {data['ross_version']}'s file, read without ROSS"
+    else:
+        doc = _in_clean_process(path, speed_rpm)
+        source = f"ROSS {doc['ross_version']}"
     res = RossImport(parse_rig(doc["rig"], str(path)), tuple(doc["unmapped"]),
                      tuple(doc["notes"]))
-    header = (f"Imported by ambseal from the ROSS rotor file {path} "
-              f"(ROSS {doc['ross_version']})"
+    header = (f"Imported by ambseal from the ROSS rotor file {path} ({source})"
               + "".join(f"\nnot imported: {n}" for n in res.unmapped)
               + "".join(f"\ntaken: {n}" for n in res.notes))
     write_text(out, stamp_text(dump_rig(res.rig, header)))

@@ -5,6 +5,8 @@ Each element owns its matrices and parameter channels; the rig only assembles th
 * :class:`BeamElement`, :class:`DiskElement` — Timoshenko shaft elements and rigid disks
   (Nelson 1980; Friswell et al., *Dynamics of Rotating Machines*, 2010, §5.4–5.5);
   :func:`build_mesh`, :func:`assemble_rotor` — the rotor's mesh and matrices;
+  :func:`supported_modal_damping` — damping ratios on the modes of the rotor on its
+  supports (ROSS 3's modal damping);
 * :class:`AmbElement` — the linearised AMB force ``f = Ki·i + Ks·s`` (thesis P2 Eq. 1,
   P5 Eq. 1) on actuator axes rotated from x, y (:func:`axes_rotation`), its factors
   (:func:`amb_factors`) and bias current (:func:`bias_current`, :func:`bias_currents`), the
@@ -60,6 +62,7 @@ _FROM = {
     "modal_reduction": "reduction", "SecondOrderSystem": "rig", "build_plant": "rig",
     "build_system": "rig", "mechanical_plant": "rig", "Mesh": "rotor",
     "RotorMatrices": "rotor", "assemble_rotor": "rotor", "build_mesh": "rotor",
+    "RIGID_BELOW_RAD_S": "rotor", "supported_modal_damping": "rotor",
     "SealElement": "seal", "coefficient_value": "seal", "pressure_for_k": "seal",
     "seal_coefficients": "seal", "seal_values": "seal", "values_following": "seal",
     "values_following_k": "seal", "SpringElement": "spring",

@@ -26,7 +26,8 @@ from ambseal.errors import ConfigError, ModelError
 from ambseal.lti import ArrayMemo
 from ambseal.model.fe import BeamElement, CouplingElement, DiskElement, LayeredBeam
 
-__all__ = ["Mesh", "build_mesh", "RotorMatrices", "assemble_rotor", "dof"]
+__all__ = ["Mesh", "build_mesh", "RotorMatrices", "assemble_rotor", "dof",
+           "supported_modal_damping", "RIGID_BELOW_RAD_S"]
 
 X, Y, ALPHA, BETA = 0, 1, 2, 3
 

@@ -1,0 +1,215 @@
+"""ROSS 3's rotor file read without ROSS: a ROSS 3 rotor where no ROSS 3 is installed.
+
+ROSS 3 (Python 3.12 or newer) writes a rotor (``Rotor.save``) as a TOML or JSON document:
+``ross_version``, a ``parameters`` table (the rotor's ``alpha``, ``beta``,
+``modal_damping_ratio``, ``default_damping_ratio``) and one table per element, keyed
+``<Class>_<tag>``, holding the element's constructor arguments (a shaft element's material
+as a sub-table). ROSS 2.3, the ROSS of Python 3.11, cannot read it (rotor-level damping
+and tables against speed are new in ROSS 3). This module reads the document itself and
+hands :func:`ambseal.io.ross.from_ross` the rotor as plain objects with the attributes
+it reads from ROSS's — so one mapping serves both paths, and ROSS 3's file is read on any
+Python (the design: the format is documented by ROSS's own ``save``/``read_toml_data``,
+a reader of it needs no ROSS at all).
+
+What the objects reproduce of ROSS 3.1:
+
+* the coefficient tables (``BearingCoefficient``): constant, over ``speed`` or over
+  ``frequency`` (whirl) — a shape-preserving piecewise cubic Hermite interpolant
+  (``interpolation = "pchip"``, linear with two points) or linear, extrapolated linearly
+  with the end slopes — and a 2-D table over both, interpolated along speed first, then
+  along frequency;
+* a magnetic bearing (a bearing table with ``g0``, ``i0``, ``ag``, ``nw``) with ROSS's
+  factors from its geometry, Ki = μ0 N² A i0 cos α / g0² and Ks = −μ0 N² A i0² cos α / g0³
+  (μ0 = 4π·10⁻⁷ H/m)
+  (Schweitzer & Maslen, *Magnetic Bearings*, 2009, p. 343, as ROSS), and its PID.
+
+A ROSS 3 rotor with modal damping ratios needs ROSS 3 (its ratios are set over ROSS's
+axial and torsional modes too, which only ROSS's six-DOF model gives): refused, saying so.
+An element class this reader does not know is refused naming it.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+from scipy import interpolate
+
+from ambseal.errors import ConfigError
+
+__all__ = ["read_ross3_file"]
+
+_COEFFS = ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy", "cxy", "cyx", "mxx", "myy", "mxy", "myx")
+_AMB_KEYS = ("g0", "i0", "ag", "nw")
+
+
+class _Element:
+    """An element of the file: its table's keys as attributes."""
+
+    def __init__(self, table: dict):
+        self.__dict__.update(table)
+        self.tag = table.get("tag")
+
+
+def _kind(name: str) -> type:
+    # from_ross dispatches on the class name, as it does on ROSS's own classes
+    return type(name, (_Element,), {})
+
+
+ShaftElement, CouplingElement, DiskElement, PointMass, BearingElement, \
+    MagneticBearingElement = (_kind(n) for n in (
+        "ShaftElement", "CouplingElement", "DiskElement", "PointMass", "BearingElement",
+        "MagneticBearingElement"))
+
+
+class _Material:
+    def __init__(self, table: dict):
+        self.name = table.get("name")
+        self.rho, self.E, self.G_s = (float(table[k]) for k in ("rho", "E", "G_s"))
+
+
+class _Axis:
+    """ROSS 3.1's interpolation along a table's first axis: pchip (two points: linear) or
+    linear, extrapolated linearly with the end slopes."""
+
+    def __init__(self, axis, values, method: str):
+        self.axis = np.asarray(axis, float)
+        self.values = np.asarray(values, float)
+        if len(self.axis) == 1:
+            self.f = None
+        elif len(self.axis) == 2 or method == "linear":
+            self.f = interpolate.interp1d(self.axis, self.values, axis=0, kind="linear",
+                                          fill_value="extrapolate")
+            self.slopes = None
+        else:
+            self.f = interpolate.PchipInterpolator(self.axis, self.values, axis=0)
+            d = self.f.derivative()
+            self.slopes = (d(self.axis[0]), d(self.axis[-1]))
+
+    def __call__(self, x: float):
+        if self.f is None:
+            return self.values[0]
+        if self.slopes is None:
+            return self.f(x)
+        lo, hi = self.axis[0], self.axis[-1]
+        clipped = min(max(x, lo), hi)
+        slope = self.slopes[0] if x < lo else self.slopes[1]
+        return self.f(clipped) + (x - clipped) * slope
+
+
+def _interpolant(values, speed, frequency, method: str):
+    """A coefficient at (frequency, speed) (rad/s, speed defaulting to the frequency)."""
+    values = np.asarray(values, float)
+    if speed is not None and frequency is not None:
+        rows = _Axis(speed, values, method)
+        return lambda w, s=None: float(_Axis(frequency, rows(w if s is None else s),
+                                             method)(w))
+    axis = speed if speed is not None else frequency
+    if axis is None:
+        return lambda w, s=None: float(values.ravel()[0])
+    along = _Axis(axis, values, method)
+    if speed is not None:
+        return lambda w, s=None: float(along(w if s is None else s))
+    return lambda w, s=None: float(along(w))
+
+
+def _bearing(table: dict, where: str) -> _Element:
+    amb = all(k in table for k in _AMB_KEYS)
+    el = (MagneticBearingElement if amb else BearingElement)(table)
+    el.n_link = table.get("n_link")
+    speed, freq = table.get("speed"), table.get("frequency")
+    method = table.get("interpolation", "pchip")
+    if method not in ("pchip", "linear"):
+        raise ConfigError(f"{where}: bearing {el.tag}: interpolation {method!r} (expected "
+                          "'pchip' or 'linear')")
+    for name in _COEFFS:
+        v = table.get(name, [0.0])
+        setattr(el, name, np.asarray(v, float))
+        setattr(el, f"{name}_interpolated", _interpolant(v, speed, freq, method))
+    if amb:
+        # in ROSS's order of operations: the same factors to the last bit
+        i0, g0, cos = np.asarray(el.i0, float), float(el.g0), math.cos(float(el.alpha))
+        nw2, ag = float(el.nw) ** 2.0, float(el.ag)
+        el.ki = 4.0 * i0 * cos * 4.0 * math.pi * 1e-7 * nw2 * ag / (4.0 * g0**2)
+        el.ks = -4.0 * i0**2.0 * cos * 4.0 * math.pi * 1e-7 * nw2 * ag / (4.0 * g0**3)
+        el.sensor_node = table.get("sensor_node", el.n)
+        el.controller_transfer_function_num = table.get("controller_transfer_function_num")
+        for key, default in (("k_amp", 1.0), ("k_sense", 1.0), ("kp_pid", 0.0),
+                             ("ki_pid", 0.0), ("kd_pid", 0.0), ("n_f", 10000.0),
+                             ("sensors_axis_rotation", 0.0)):
+            setattr(el, key, table.get(key, default))
+    return el
+
+
+class _Rotor:
+    """The rotor of the file with the attributes :func:`~ambseal.io.ross.from_ross` reads."""
+
+    def __init__(self, data: dict, where: str):
+        par = data["parameters"]
+        self.tag = par.get("tag") or "Rotor 0"  # ROSS's name of a rotor without a tag
+        self.alpha, self.beta = (float(par.get(k, 0.0) or 0.0) for k in ("alpha", "beta"))
+        self.modal_damping_ratio = par.get("modal_damping_ratio")
+        self.default_damping_ratio = float(par.get("default_damping_ratio", 0.0) or 0.0)
+        self.shaft_elements, self.disk_elements, self.point_mass_elements = [], [], []
+        self.bearing_elements, unknown = [], []
+        for key, table in data.items():
+            kind = key.split("_")[0]
+            if key in ("parameters", "ross_version") or not isinstance(table, dict):
+                continue
+            if kind == "ShaftElement":
+                el = ShaftElement(table)
+                el.material = _Material(table["material"])
+                for k, d in (("axial_force", 0.0), ("torque", 0.0), ("alpha", 0.0),
+                             ("beta", 0.0), ("shear_method_calc", "cowper")):
+                    setattr(el, k, table.get(k, d))
+                self.shaft_elements.append(el)
+            elif kind == "CouplingElement":
+                self.shaft_elements.append(CouplingElement(table))
+            elif kind == "DiskElement":
+                self.disk_elements.append(DiskElement(table))
+            elif kind == "PointMass":
+                self.point_mass_elements.append(PointMass(table))
+            elif kind in ("BearingElement", "SealElement"):
+                self.bearing_elements.append(_bearing(table, where))
+            else:
+                unknown.append(f"{kind} {table.get('tag', key)}")
+        if unknown:
+            raise ConfigError(f"{where}: element(s) this reader of ROSS 3 files does not "
+                              f"know: {', '.join(unknown)} (install ROSS 3, on Python 3.12 "
+                              "or newer, and import again)")
+        if self.modal_damping_ratio is not None:
+            raise ConfigError(f"{where}: the rotor's modal damping ratios "
+                              f"(modal_damping_ratio={self.modal_damping_ratio!r}) need ROSS "
+                              "3 to read (ROSS sets them over its axial and torsional modes "
+                              "too): install ROSS 3, on Python 3.12 or newer, and import "
+                              "again")
+        self.elements = [*self.shaft_elements, *self.disk_elements,
+                         *self.point_mass_elements, *self.bearing_elements]
+
+
+def read_ross3_file(path: str | Path, data: dict):
+    """The rotor of a ROSS 3 file as plain objects for :func:`ambseal.io.ross.from_ross`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file (for messages).
+    data : dict
+        Its tables, as read (TOML or JSON).
+
+    Returns
+    -------
+    object
+        With ``tag``, ``alpha``, ``beta``, ``modal_damping_ratio``,
+        ``default_damping_ratio``, ``shaft_elements`` (couplings among them),
+        ``disk_elements``, ``point_mass_elements``, ``bearing_elements`` and ``elements``,
+        each element with the attributes of ROSS 3.1's of the same class.
+
+    Raises
+    ------
+    ConfigError
+        An element class the reader does not know, a table interpolation other than
+        ROSS's, or modal damping ratios (they need ROSS 3).
+    """
+    return _Rotor(data, str(path))

@@ -1,0 +1,55 @@
+"""Write the ROSS 3.1 rotor file and ROSS 3.1's eigenvalues beside it, with which the tests
+check ambseal's reader of ROSS 3 files on a Python without ROSS 3 (Python 3.11: ROSS 2.3).
+
+Run with ROSS 3.1 installed (Python 3.13): ``python tests/data/ross3/make.py``. The rotor:
+ROSS's ``rotor_example`` on two bearings tabulated over speed (linear and pchip, a
+stiffness and a damping beyond the table: ROSS extrapolates) and a seal tabulated over
+speed and whirl frequency, with the rotor's own Rayleigh damping; its eigenvalues those of
+ROSS's ``Rotor._eigen(speed, sparse=False)`` (the |λ| of ``run_modal(speed).wn``) at 150,
+300 and 400 rad/s, points of the seal's table, where ambseal's table of ROSS's values is
+exact.
+"""
+
+import contextlib
+import json
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+with contextlib.redirect_stdout(sys.stderr), warnings.catch_warnings():
+    warnings.simplefilter("ignore")
+    import ross as rs
+
+HERE = Path(__file__).parent
+SPEEDS_RAD_S = (150.0, 300.0, 400.0)
+
+
+def rotor():
+    speed, freq = np.array([100.0, 300.0, 500.0]), np.array([150.0, 400.0])
+    grid = np.add.outer(speed, 2 * freq)
+    seal = rs.BearingElement(n=3, kxx=2e6 + 1e3 * grid, kyy=2e6 + 1e3 * grid,
+                             kxy=5e5 + 50 * grid, kyx=-(5e5 + 50 * grid),
+                             cxx=80 + 0.1 * grid, cyy=80 + 0.1 * grid, speed=speed,
+                             frequency=freq, tag="seal")
+    bearings = [rs.BearingElement(n=n, kxx=[1e6, 3e6, 4e6], kyy=[8e5, 1e6, 2e6],
+                                  cxx=[150.0, 120.0, 200.0], cyy=90.0,
+                                  speed=[50.0, 200.0, 900.0], interpolation=kind,
+                                  tag=f"B{n}") for n, kind in ((0, "linear"), (6, "pchip"))]
+    ex = rs.rotor_example()
+    return rs.Rotor(ex.shaft_elements, ex.disk_elements, [*bearings, seal], alpha=2.0,
+                    beta=1e-5)
+
+
+if __name__ == "__main__":
+    with contextlib.redirect_stdout(sys.stderr), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = rotor()
+        r.save(HERE / "tables.toml")
+        out = {"ross_version": rs.__version__}
+        for w in SPEEDS_RAD_S:
+            lam, _ = r._eigen(w, sparse=False)
+            out[f"{w:g}"] = [[float(x.real), float(x.imag)] for x in np.asarray(lam)]
+    rows = ",\n".join(f"{json.dumps(k)}: {json.dumps(v)}" for k, v in out.items())
+    (HERE / "tables_eigenvalues.json").write_text("{\n" + rows + "\n}\n")

@@ -1,0 +1,59 @@
+"""A ROSS 3.1 rotor file imported on any Python: through ROSS where ROSS 3 is installed,
+else by ambseal's reader of the format (io/ross_file.py; Python 3.11 has ROSS 2.3, which
+cannot read it). The file and ROSS 3.1's eigenvalues beside it are written by
+``tests/data/ross3/make.py`` with ROSS 3.1."""
+
+from __future__ import annotations
+
+import importlib.metadata
+import json
+import shutil
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ambseal.analysis.campbell import closed_loop_modes
+from ambseal.cli import main
+from ambseal.config import load_rig
+
+DATA = Path(__file__).resolve().parents[1] / "data" / "ross3"
+
+
+def _ross_major() -> int | None:
+    try:
+        return int(importlib.metadata.version("ross-rotordynamics").split(".")[0])
+    except importlib.metadata.PackageNotFoundError:
+        return None
+
+
+@pytest.mark.parametrize("speed_rad_s", [150.0, 300.0, 400.0])
+def test_ross3_file_modes_equal_ross_31(tmp_path, capsys, speed_rad_s):
+    """ROSS 3.1's file of ``rotor_example`` on bearings tabulated over speed (linear and
+    pchip, extrapolated) and a seal over speed and whirl frequency, with the rotor's
+    Rayleigh damping, imported by ``ambseal import-ross --speed-rpm``: every lateral mode
+    up to 500 Hz (damped frequency and log decrement) equals one of ROSS 3.1's eigenvalues
+    at that speed to 1e-6; where no ROSS 3 is installed the rig file says it was read
+    without ROSS."""
+    src = tmp_path / "tables.toml"
+    shutil.copy(DATA / "tables.toml", src)
+    out = tmp_path / "rig.toml"
+    rpm = speed_rad_s * 30 / np.pi
+    assert main(["import-ross", str(src), "--out", str(out), "--speed-rpm", f"{rpm!r}"]) == 0
+    capsys.readouterr()
+    header = out.read_text().splitlines()[1]
+    major = _ross_major()
+    assert ("read without ROSS" in header) == (major is None or major < 3)
+    rig = load_rig(out)
+    assert (rig.rotor.rayleigh_alpha, rig.rotor.rayleigh_beta) == (2.0, 1e-5)
+    ref = json.loads((DATA / "tables_eigenvalues.json").read_text())
+    assert tomllib.loads(src.read_text())["ross_version"] == ref["ross_version"]
+    lam_ross = np.array([complex(*x) for x in ref[f"{speed_rad_s:g}"]])
+    m = closed_loop_modes(rig, None, speed_hz=speed_rad_s / (2 * np.pi), max_hz=500.0)
+    assert len(m.poles) >= 8
+    for lam, dec in zip(m.poles, m.log_decrement):
+        j = np.argmin(np.abs(lam_ross - lam))
+        assert abs(lam_ross[j] - lam) <= 1e-6 * abs(lam)
+        ref_dec = -2 * np.pi * lam_ross[j].real / lam_ross[j].imag
+        assert dec == pytest.approx(ref_dec, rel=1e-6, abs=1e-9)

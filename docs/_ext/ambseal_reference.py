@@ -220,6 +220,17 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Spring.myx": ("kg", "cross-coupled added mass"),
     "Spring.axes_angle_deg": ("°", "the axes the coefficients are given in, rotated from "
                                    "x, y"),
+    "Spring.housing": ("", "a housing behind the spring (a table below): the spring joins "
+                           "the shaft to the housing's mass instead of to ground"),
+    "SpringHousing.mass": ("kg", "the housing's mass, in x and y (its own DOFs)"),
+    "SpringHousing.kxx": ("N/m", "the housing's support stiffness to ground, x"),
+    "SpringHousing.kyy": ("N/m", "the housing's support stiffness to ground, y"),
+    "SpringHousing.kxy": ("N/m", "cross-coupled support stiffness"),
+    "SpringHousing.kyx": ("N/m", "cross-coupled support stiffness"),
+    "SpringHousing.cxx": ("N·s/m", "the housing's support damping, x"),
+    "SpringHousing.cyy": ("N·s/m", "the housing's support damping, y"),
+    "SpringHousing.cxy": ("N·s/m", "cross-coupled support damping"),
+    "SpringHousing.cyx": ("N·s/m", "cross-coupled support damping"),
     "Spring.name": ("", "names its parameters (``coupling.kxx``); unnamed: ``spring<i>``"),
     "Spring.uncertainty": ("", "``{ key = σ }``: relative 1σ uncertainty of a value the fit "
                                "holds fixed"),
@@ -573,6 +584,11 @@ def _sections() -> list[Section]:
                 "of a ``[[shaft]]`` section that is a flexible coupling (``coupling = "
                 "{ ... }``): each half's inertia on its end node, the halves joined by "
                 "springs and dampers."),
+        Section("{ mass, kxx, kyy, cxx, ... }", r.SpringHousing, "The ``housing`` of a "
+                "``[[spring]]`` (``housing = { ... }``): a mass of two DOFs, x and y, between "
+                "the spring and ground (ROSS's bearing linked to a housing node, ``n_link``, "
+                "with its point mass and supports). Its coefficients are in x, y; the "
+                "spring's own act on the shaft's motion relative to the housing."),
         Section("[rotor.supported_modal_damping]", r.SupportedModalDamping, "Modal "
                 "damping on the modes of the rotor on its supports, C = M Φ diag(2ζω) Φᵀ M "
                 "with Φ those mass-normalised modes (Craig & Kurdila 2006, §10.2), as ROSS "

@@ -706,21 +706,23 @@ def test_elements_ambseal_cannot_take_are_each_named(tmp_path, capsys):
     assert lines[0] == "fly: 2 item(s) ambseal cannot take (each would change the dynamics):"
     assert [ln.strip() for ln in lines[1:]] == ["Flywheel F2: no ambseal equivalent",
                                                 "Flywheel F4: no ambseal equivalent"]
-    # a housing behind the right bearing (ROSS's support model: the bearing linked to a
-    # node with a point mass, on a bearing to ground) and a flywheel: three lines
-    housing = [rs.BearingElement(n=0, kxx=1e6, kyy=0.8e6, cxx=150.0, cyy=90.0, tag="B0"),
+    # one housing behind both bearings (ROSS's support model: a bearing linked to a node
+    # with a point mass, on a bearing to ground), a bearing linked to a shaft node and a
+    # flywheel: a line each
+    housing = [rs.BearingElement(n=0, n_link=7, kxx=1e6, kyy=0.8e6, cxx=150.0, tag="B0"),
                rs.BearingElement(n=6, n_link=7, kxx=1e6, cxx=150.0, tag="B6"),
-               rs.BearingElement(n=7, kxx=5e7, cxx=500.0, tag="H")]
+               rs.BearingElement(n=7, kxx=5e7, cxx=500.0, tag="H"),
+               rs.BearingElement(n=2, n_link=4, kxx=1e5, cxx=0.0, tag="L")]
     supported = _quiet(rs.Rotor, ex.shaft_elements, [*ex.disk_elements, extra[0]], housing,
                        point_mass_elements=[rs.PointMass(n=7, m=20.0, tag="P7")])
     with pytest.raises(ConfigError) as info:
         from_ross(supported, where="housing")
     assert [ln.strip() for ln in str(info.value).splitlines()] == [
-        "housing: 4 item(s) ambseal cannot take (each would change the dynamics):",
-        "bearing 1 (B6): linked to node 7, a support structure behind the bearing: no "
-        "ambseal equivalent",
-        "bearing 2 (H): on node 7, off the shaft (nodes 0–6)",
-        "point mass P7: on node 7, off the shaft (a support mass; nodes 0–6)",
+        "housing: 3 item(s) ambseal cannot take (each would change the dynamics):",
+        "bearing 1 (L): linked to node 4, a shaft node: a bearing between two shaft nodes "
+        "has no ambseal equivalent",
+        "housing node 7: bearings 0 (B0), 2 (B6) share it; an ambseal housing carries one "
+        "bearing",
         "Flywheel F2: no ambseal equivalent"]
     src = tmp_path / "fly.toml"
     _quiet(rotor.save, src)
@@ -735,6 +737,44 @@ def test_elements_ambseal_cannot_take_are_each_named(tmp_path, capsys):
     imp = from_ross(driven)
     assert sum(u.startswith("motor ") and "no lateral effect" in u for u in imp.unmapped) == 1
     assert imp.rig == from_ross(ex).rig
+
+
+def _tapered_housing_rotor():
+    """ROSS 3.1's ``rotor_tapered_housing`` as its tests build it: a cone 0.1 → 0.2 m with
+    its own Rayleigh damping and three cylinders; the left bearing linked to housing node
+    5, a 5 kg point mass on a 1e7 N/m support, the right bearing to ground."""
+    steel = rs.materials.steel
+    shaft = [rs.ShaftElement(L=0.25, idl=0, odl=0.1, idr=0, odr=0.2, material=steel,
+                             alpha=1e-4, beta=1e-5)]
+    shaft += [rs.ShaftElement(L=0.25, idl=0, odl=0.2, material=steel) for _ in range(3)]
+    bearings = [rs.BearingElement(n=0, n_link=5, kxx=1e6, cxx=1e3),
+                rs.BearingElement(n=4, kxx=1e6, cxx=1e3),
+                rs.BearingElement(n=5, kxx=1e7, cxx=1e3)]
+    return _quiet(rs.Rotor, shaft, bearing_elements=bearings,
+                  point_mass_elements=[rs.PointMass(n=5, m=5.0)])
+
+
+def test_tapered_housing_rotor_equals_ross(tmp_path):
+    """ROSS's rotor with a housing (``rotor_tapered_housing`` of ROSS 3.1's tests; its
+    bearing linked to a housing node, ``n_link``, on ROSS 2.3 as well), saved and
+    imported: a ``[[spring]]`` with a ``housing`` of 5 kg on 1e7 N/m, 1e3 N·s/m, the cone's
+    Rayleigh damping on its tube, and every lateral mode up to 1 kHz (below the first
+    torsional one of ROSS's six-DOF model) with its log decrement equal to one of ROSS's
+    eigenvalues to 1e-6 at 0 and 4000 rpm, the housing's modes among them."""
+    rotor = _tapered_housing_rotor()
+    src = tmp_path / "housing.toml"
+    _quiet(rotor.save, src)
+    imp = from_ross(load_ross(src), where=str(src))
+    cfg = imp.rig
+    linked = [s for s in cfg.spring if s.housing is not None]
+    assert len(cfg.spring) == 2 and len(linked) == 1 and cfg.disk == []
+    h = linked[0].housing
+    assert (h.mass, h.kxx, h.kyy, h.cxx, h.cyy) == (5.0, 1e7, 1e7, 1e3, 1e3)
+    assert cfg.shaft[0].rayleigh_beta == 1e-5
+    ref = _ross_eigenvalues(rotor, 0.0)
+    n = int(np.sum((ref.imag > 1.0) & (ref.imag < 2 * np.pi * 1000.0)))
+    for speed_rpm in (0.0, 4000.0):
+        _assert_log_decrements_equal_ross(cfg, rotor, speed_rpm, 1000.0, n)
 
 
 def _flags_rotor(shear: bool):
@@ -987,8 +1027,8 @@ def test_ross3_file_read_without_ross_equals_the_ross_import(examples, tmp_path)
     does), gives the same rig, the same items left out and the same notes as the import
     through ROSS — tables over speed and whirl frequency (pchip, linear, extrapolated), a
     magnetic bearing with a non-collocated sensor, a coupling and a point mass, layered and
-    tapered elements with loads, 1e20 N/m pins, a rotor's Rayleigh damping; a rotor with
-    modal damping ratios is refused saying it needs ROSS 3."""
+    tapered elements with loads, 1e20 N/m pins, a housing, a rotor's Rayleigh damping; a
+    rotor with modal damping ratios is refused saying it needs ROSS 3."""
     from ambseal.io.ross_file import read_ross3_file
 
     speed, freq = np.array([100.0, 300.0, 500.0]), np.array([150.0, 400.0])
@@ -1007,6 +1047,7 @@ def test_ross3_file_read_without_ross_equals_the_ross_import(examples, tmp_path)
         "coupling": _coupled_rotor(kt_x=1e6, kt_y=8e5, kr_x=2e5, kr_y=1e5, ct_x=50.0,
                                    ct_y=50.0, cr_x=2.0, cr_y=2.0, kr_z=3e6),
         "pinned": _conical_rotor(1e20),
+        "housing": _tapered_housing_rotor(),
         "compressor": examples["compressor_example"][0],
         "amb": examples["rotor_amb_example"][0],
     }

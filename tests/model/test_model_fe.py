@@ -430,3 +430,54 @@ def test_bad_tube_options_are_refused_naming_the_key(extra, words):
         beam_rig("timoshenko", shaft=[{"length": 1.0, "outer_diameter": 0.05,
                                        "material": "steel", **extra}])
     assert words in str(info.value) and "\n" not in str(info.value)
+
+
+def test_spring_housing_two_mass_closed_form():
+    """A near-rigid rotor (E = 1e15 Pa) on two springs k1, each to a housing of mass m_h
+    held by k2 to ground (``[[spring]] housing``): its bouncing modes in x are those of
+    two masses, m_r and 2 m_h, joined by 2 k1 with 2 k2 to ground (closed form of the 2×2
+    problem) to 1e-5 (the shaft's flexibility, (ω/ω_bending)², and the eigensolver's
+    rounding, ε·λ_max/λ, together about 1e-6 there), and y's likewise with the y
+    stiffnesses;
+    without the housings, each spring to ground, the rig's modes are those of the rotor on
+    k1 alone; each journal carries half the rotor's weight; the housing's DOFs follow
+    the shaft's in the plant's states; a rig with a housing reads back from its TOML."""
+    from ambseal.analysis.unbalance_api617 import journal_loads
+    from ambseal.config import dump_rig
+    from ambseal.model.rig import mechanical_plant
+
+    k1 = {"x": 2e6, "y": 1.2e6}
+    k2 = {"x": 5e6, "y": 3e6}
+    m_h = 7.0
+    house = {"mass": m_h, "kxx": k2["x"], "kyy": k2["y"], "cxx": 0.0}
+    data = {
+        "rotor": {"beam": "timoshenko"},
+        "materials": {"rigid": {"E": 1e15, "rho": RHO, "nu": NU}},
+        "shaft": [{"length": 0.6, "outer_diameter": 0.08, "material": "rigid", "elements": 6}],
+        "spring": [{"name": f"B{i}", "position": z, "kxx": k1["x"], "kyy": k1["y"],
+                    "housing": house} for i, z in enumerate((0.0, 0.6))],
+    }
+    cfg = parse_rig(data)
+    sys_ = build_system(cfg, speed_rpm=0.0)
+    m_r = assemble_rotor(cfg).mass
+    assert sys_.n_dof == sys_.mesh.n_dof + 4
+    w = 2 * np.pi * undamped_hz(sys_.K, sys_.M)
+    for axis in ("x", "y"):
+        a, b = 2 * k1[axis], 2 * k2[axis]
+        two = sla.eigh(np.array([[a, -a], [-a, a + b]]), np.diag([m_r, 2 * m_h]),
+                       eigvals_only=True)
+        for w_ref in np.sqrt(two):
+            assert np.min(np.abs(w - w_ref)) <= 1e-5 * w_ref
+    bare = parse_rig({**data, "spring": [{k: v for k, v in s.items() if k != "housing"}
+                                         for s in data["spring"]]})
+    sys_bare = build_system(bare, speed_rpm=0.0)
+    w = 2 * np.pi * undamped_hz(sys_bare.K, sys_bare.M)
+    for axis in ("x", "y"):
+        w_ref = np.sqrt(2 * k1[axis] / m_r)
+        assert np.min(np.abs(w - w_ref)) <= 1e-5 * w_ref
+    # statics: each journal carries half the rotor's weight, the housings' their own
+    assert [w for _, w in journal_loads(cfg)] == pytest.approx([m_r / 2] * 2, rel=1e-6)
+    states = mechanical_plant(sys_).state_names
+    assert states[sys_.mesh.n_dof:sys_.n_dof] == (
+        "B0_housing_x", "B0_housing_y", "B1_housing_x", "B1_housing_y")
+    assert parse_rig(tomllib.loads(dump_rig(cfg))) == cfg

@@ -63,7 +63,7 @@ from ambseal.analysis.synchronous import Unbalance, orbit_semi_major, synchronou
 from ambseal.config import Spring
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
-from ambseal.model import bending_limit_hz, build_system
+from ambseal.model import bending_limit_hz, build_system, spring_label
 
 __all__ = ["unbalance_ur", "vibration_limit_um", "amplification_factor",
            "required_margin", "journal_loads", "Critical", "Clearance", "UnbalanceCase",
@@ -174,13 +174,23 @@ def journal_loads(cfg) -> tuple[tuple[float, float], ...]:
     rig = cfg.model_copy(update={"seal": [], "amb": [], "spring": [*cfg.spring, *pins]})
     sys = build_system(rig, speed_rpm=0.0)
     t = np.zeros(sys.n_dof)
-    t[1::4] = 1.0
+    t[1:sys.mesh.n_dof:4] = 1.0  # the rotor's weight (a housing's goes to its supports)
     q = np.linalg.solve(sys.K, GRAVITY * (sys.M @ t))
-    k_of = {z: RIGID_SUPPORT for z in zs} if cfg.amb else {}
-    for s in cfg.spring if not cfg.amb else []:
-        k_of[s.position] = k_of.get(s.position, 0.0) + s.kyy
-    loads = tuple((z, abs(float(k_of[z] * q[4 * sys.mesh.node_at(z) + 1] / GRAVITY)))
-                  for z in zs)
+
+    def stretch(s: Spring, index: int) -> float:
+        """The spring's deflection in y: the journal's, less its housing's."""
+        y = q[4 * sys.mesh.node_at(s.position) + 1]
+        if s.housing is None:
+            return float(y)
+        return float(y - q[sys.mesh.n_dof + sys.housing_names.index(
+            f"{spring_label(s, index)}_housing_y")])
+
+    force = {z: 0.0 for z in zs}
+    # with AMBs, their pins (appended after the rig's springs) carry the journals
+    for i, s in list(enumerate(rig.spring))[len(cfg.spring) if cfg.amb else 0:]:
+        if s.position in force:
+            force[s.position] += s.kyy * stretch(s, i)
+    loads = tuple((z, abs(force[z] / GRAVITY)) for z in zs)
     if not sum(w for _, w in loads) > 0:
         raise ConfigError("API 617 unbalance response: the bearings carry no static load "
                           "(a rotor without mass?)")

@@ -66,7 +66,9 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     ``position``, ``kxx``, ``kyy`` and optional ``kxy``, ``kyx`` (N/m), ``cxx``, ``cyy``,
     ``cxy``, ``cyx`` (N·s/m), ``mxx``, ``myy``, ``mxy``, ``myx`` (kg: added mass, e.g. a
     hole-pattern seal's), ``axes_angle_deg`` (the axes the coefficients are given in,
-    default 0), ``name`` (optional).
+    default 0), ``housing`` (optional ``{ mass, kxx, kyy, kxy, kyx, cxx, cyy, cxy, cyx }``
+    in kg, N/m, N·s/m: the spring joins the shaft to this mass, which its own springs and
+    dampers hold to ground in x, y), ``name`` (optional).
 ``[controller.pid]``
     ``kp`` (A/m), ``ti`` (s), ``td`` (s), ``eps`` (-): thesis P5 Eq. 6, per actuator axis.
 ``[[controller.filter]]``
@@ -452,6 +454,22 @@ class Seal(_Strict):
         return self
 
 
+class SpringHousing(_Strict):
+    """The housing behind a ``[[spring]]`` (ROSS's bearing linked to a housing node that
+    carries a point mass and its own supports): a mass on the spring's far end, held to
+    ground by its own springs and dampers in x, y."""
+
+    mass: float = Field(gt=0, le=1e6)
+    kxx: float = Field(ge=-MAX_SUPPORT_STIFFNESS, le=MAX_SUPPORT_STIFFNESS)
+    kyy: float = Field(ge=-MAX_SUPPORT_STIFFNESS, le=MAX_SUPPORT_STIFFNESS)
+    kxy: float = Field(default=0.0, ge=-MAX_SUPPORT_STIFFNESS, le=MAX_SUPPORT_STIFFNESS)
+    kyx: float = Field(default=0.0, ge=-MAX_SUPPORT_STIFFNESS, le=MAX_SUPPORT_STIFFNESS)
+    cxx: float = Field(default=0.0, ge=-1e12, le=1e12)
+    cyy: float = Field(default=0.0, ge=-1e12, le=1e12)
+    cxy: float = Field(default=0.0, ge=-1e12, le=1e12)
+    cyx: float = Field(default=0.0, ge=-1e12, le=1e12)
+
+
 class Spring(_Strict):
     position: float = Field(ge=0)
     kxx: float = Field(ge=-MAX_SUPPORT_STIFFNESS, le=MAX_SUPPORT_STIFFNESS)  # up to a pin
@@ -468,6 +486,7 @@ class Spring(_Strict):
     mxy: float = Field(default=0.0, ge=-1e6, le=1e6)
     myx: float = Field(default=0.0, ge=-1e6, le=1e6)
     axes_angle_deg: float = Field(default=0.0, ge=-360, le=360)
+    housing: SpringHousing | None = None
     name: Name | None = None
     uncertainty: Uncertainty = None
 

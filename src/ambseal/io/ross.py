@@ -55,8 +55,11 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
   ROSS's covers), written as ``[operating] speed_rpm`` and reported, so that ambseal's
   modes at that speed are ROSS's ``run_modal(speed)``. A direct stiffness above the rig
   file's stiffest support (:data:`~ambseal.config.MAX_SUPPORT_STIFFNESS`; ROSS pins a node
-  with 1e20 N/m) is taken at that bound, a pin, with a note. A bearing on a support
-  (``n_link``): an error.
+  with 1e20 N/m) is taken at that bound, a pin, with a note. A bearing linked to a
+  housing node (``n_link``; the node off the shaft, with its point mass and the bearings
+  that hold it to ground) → a ``[[spring]]`` with a ``housing`` (their mass and summed
+  constant coefficients); a link between shaft nodes, a housing shared by two bearings,
+  without mass, of anisotropic mass or on tabulated supports: an error.
 * ``MagneticBearingElement`` → ``[[amb]]`` with its geometry (turns, pole area, gap, bias,
   pole angle) and its factors: Ki = ROSS ``ki`` and Ks = −ROSS ``ks`` (ROSS stores the
   negative stiffness with its sign, ambseal the magnitude, P2 Eq. 1), actuator axes at
@@ -416,18 +419,23 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
                                                             or "ROSS rotor"), **damping},
                  "materials": mats, "shaft": shaft, "disk": [], "amb": [], "seal": [],
                  "spring": []}
-    rig["disk"] = _masses(rotor, nodes)
+    last = len(nodes) - 1
+    housings = _housing_nodes(bearings, last)
+    rig["disk"] = _masses(rotor, nodes, set(housings))
     pids, notes = [], []
+    linked = {id(b): h for h, b in housings.items()}
     plan = _supports(bearings, nodes, where, rig, pids)
     one_freq = [_axis(b) for _, b, kind, varies in plan
                 if varies and kind == "spring"]
     omega, rpm, rule = _import_speed(one_freq, speed_rpm)
     for i, b, kind, varies in plan:
         z = float(nodes[b.n])
-        if kind == "seal":
+        if kind == "seal" and id(b) not in linked:
             rig["seal"].append(_seal(b, z, i, varies, omega))
             continue
         rig["spring"].append(_spring(b, z, i, varies, omega, notes))
+        if id(b) in linked:
+            rig["spring"][-1]["housing"] = _housing(rotor, bearings, linked[id(b)])
         if varies:
             notes.append(_one_frequency_note(i, b, omega, rpm, rule))
     tables = [s["name"] for s in rig["seal"] if isinstance(s["K"], dict)]
@@ -466,15 +474,14 @@ def _elements(rotor, bearings: list) -> tuple[list[str], list[str]]:
                        "ROSS sets them on the modes with its AMBs' equivalent stiffness at "
                        "0 Hz, ambseal on the modes without the AMBs (theirs is the loop's)")
     last = max((int(e.n) + 1 for e in getattr(rotor, "shaft_elements", [])), default=0)
+    refused += _housing_refusals(rotor, bearings, last)
+    housings = _housing_nodes(bearings, last)
     for i, b in enumerate(bearings):
-        if getattr(b, "n_link", None) is not None:
-            refused.append(f"bearing {i} ({b.tag}): linked to node {b.n_link}, a support "
-                           "structure behind the bearing: no ambseal equivalent")
-        elif b.n > last:
+        if b.n > last and b.n not in housings:
             refused.append(f"bearing {i} ({b.tag}): on node {b.n}, off the shaft (nodes "
                            f"0–{last})")
     for p in getattr(rotor, "point_mass_elements", []):
-        if p.n > last:
+        if p.n > last and p.n not in housings:
             refused.append(f"point mass {p.tag}: on node {p.n}, off the shaft (a support "
                            f"mass; nodes 0–{last})")
     for el in getattr(rotor, "elements", []):
@@ -494,6 +501,71 @@ def _elements(rotor, bearings: list) -> tuple[list[str], list[str]]:
         else:
             refused.append(f"{kind} {tag}: no ambseal equivalent")
     return refused, unmapped
+
+
+def _housing_nodes(bearings: list, last: int) -> dict[int, object]:
+    """The housing nodes (off the shaft) and the bearing linked to each: ROSS's support
+    model, a bearing from a shaft node to a node with a point mass on supports of its own
+    (``n_link``)."""
+    return {int(b.n_link): b for b in bearings
+            if getattr(b, "n_link", None) is not None and int(b.n_link) > last}
+
+
+def _housing_refusals(rotor, bearings: list, last: int) -> list[str]:
+    """What of ROSS's support structures ``[[spring]] housing`` cannot hold, one line each:
+    a link between shaft nodes, a housing shared or linked on, without mass or with an
+    anisotropic one, supported by tabulated coefficients, behind an AMB or a seal."""
+    out, linked = [], {}
+    for i, b in enumerate(bearings):
+        h = getattr(b, "n_link", None)
+        if h is None:
+            continue
+        where = f"bearing {i} ({b.tag}): linked to node {h}"
+        linked.setdefault(int(h), []).append(i)
+        if int(h) <= last:
+            out.append(f"{where}, a shaft node: a bearing between two shaft nodes has no "
+                       "ambseal equivalent")
+        elif b.n > last:
+            out.append(f"{where} from node {b.n}, itself off the shaft: a chain of "
+                       "housings has no ambseal equivalent (one housing per bearing)")
+        elif type(b).__name__ == "MagneticBearingElement":
+            out.append(f"{where}: an AMB on a housing has no ambseal equivalent (its "
+                       "actuator and sensor act on the ground)")
+    for h, ids in linked.items():
+        if h <= last:
+            continue
+        if len(ids) > 1:
+            names = ", ".join(f"{j} ({bearings[j].tag})" for j in ids)
+            out.append(f"housing node {h}: bearings {names} share it; an ambseal housing "
+                       "carries one bearing")
+        masses = [p for p in getattr(rotor, "point_mass_elements", []) if p.n == h]
+        mx = [float(getattr(p, "mx", p.m) or 0.0) for p in masses]
+        my = [float(getattr(p, "my", p.m) or 0.0) for p in masses]
+        if not sum(mx) > 0:
+            out.append(f"housing node {h}: no point mass (a housing has a mass)")
+        elif not math.isclose(sum(mx), sum(my), rel_tol=1e-12):
+            out.append(f"housing node {h}: point mass mx = {sum(mx):g} kg, my = {sum(my):g} "
+                       "kg (an ambseal housing's mass is the same in x and y)")
+        for j, s in enumerate(bearings):
+            if s.n == h and getattr(s, "n_link", None) is None and _kind(s, "", j)[1]:
+                out.append(f"bearing {j} ({s.tag}): supports housing node {h} with "
+                           "coefficients that change with frequency (a housing's support "
+                           "holds constants)")
+    return out
+
+
+def _housing(rotor, bearings: list, h: int) -> dict:
+    """``[[spring]] housing`` of housing node ``h``: its point masses and the bearings
+    that hold it to ground, summed."""
+    mass = sum(float(p.m) for p in getattr(rotor, "point_mass_elements", []) if p.n == h)
+    out = {"mass": mass} | {k: 0.0 for k in ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy",
+                                             "cxy", "cyx")}
+    for s in bearings:
+        if s.n == h and getattr(s, "n_link", None) is None:
+            for k in out:
+                if k != "mass":
+                    out[k] += float(_coef(s, k)[0])
+    return out
 
 
 def _damping_kind(rotor) -> str:
@@ -596,12 +668,15 @@ def _supported_modal_damping(rotor, where: str) -> dict:
     return {"ratios": [float(z) for z in zeta[:last + 1]], "others": others}
 
 
-def _masses(rotor, nodes: np.ndarray) -> list[dict]:
-    """``[[disk]]`` entries of ROSS's disks and point masses on the shaft."""
+def _masses(rotor, nodes: np.ndarray, housings: set) -> list[dict]:
+    """``[[disk]]`` entries of ROSS's disks and point masses on the shaft (those on
+    ``housings`` are their housings')."""
     out = [{"name": str(d.tag), "position": float(nodes[d.n]), "mass": float(d.m),
             "Ip": float(d.Ip), "Id": float(d.Id)} for d in rotor.disk_elements]
     for p in getattr(rotor, "point_mass_elements", []):  # (on the shaft: _elements)
-        out.append({"name": str(p.tag), "position": float(nodes[p.n]), "mass": float(p.m)})
+        if p.n not in housings:
+            out.append({"name": str(p.tag), "position": float(nodes[p.n]),
+                        "mass": float(p.m)})
     return out
 
 
@@ -611,7 +686,10 @@ def _supports(bearings: list, nodes: np.ndarray, where: str, rig: dict,
     other bearings and seals as (index, element, kind, frequency-dependent), to place once
     the import's speed is known."""
     plan = []
-    for i, b in enumerate(bearings):  # (on the shaft, none linked: _elements)
+    last = len(nodes) - 1
+    for i, b in enumerate(bearings):  # (on the shaft or holding a housing: _elements)
+        if b.n > last:  # a housing's support: part of its housing (_housing)
+            continue
         if type(b).__name__ == "MagneticBearingElement":
             entry, pid, what = _amb(b, nodes, i, where)
             rig["amb"].append(entry)

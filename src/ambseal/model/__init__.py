@@ -66,6 +66,7 @@ _FROM = {
     "SealElement": "seal", "coefficient_value": "seal", "pressure_for_k": "seal",
     "seal_coefficients": "seal", "seal_values": "seal", "values_following": "seal",
     "values_following_k": "seal", "SpringElement": "spring",
+    "spring_label": "spring",
 }
 
 __all__ = sorted(_FROM)

@@ -58,6 +58,9 @@ class SecondOrderSystem:
     changes : tuple of Channel
         Every named physical parameter as a low-rank change of K, C or B (thesis P1
         Eqs. 48–50), from the AMBs, seals and springs.
+    housing_names : tuple of str
+        ``<spring>_housing_<x|y>``: the DOFs after the shaft's (``mesh.n_dof`` on), those
+        of the springs' housings.
     """
 
     mesh: Mesh
@@ -71,6 +74,7 @@ class SecondOrderSystem:
     input_names: tuple[str, ...]
     output_names: tuple[str, ...]
     changes: tuple[Channel, ...] = field(default=())
+    housing_names: tuple[str, ...] = field(default=())
 
     @property
     def n_dof(self) -> int:
@@ -145,13 +149,14 @@ def build_system(
     f_seal = seal_frequency_hz if seal_frequency_hz is not None else speed / (2 * np.pi)
     mesh = build_mesh(cfg, tuple(force_positions))
     rot = assemble_rotor(cfg, mesh)
-    n = mesh.n_dof
-    M, C, K = rot.M.copy(), rot.C.copy(), rot.K.copy()
+    springs = _springs(cfg, mesh) if include_springs else []
+    # the housings' DOFs (x, y each) after the shaft's
+    n = mesh.n_dof + 2 * sum(s.housing is not None for s in springs)
+    M, C, K, G = (_padded(X, n) for X in (rot.M, rot.C, rot.K, rot.G))
     ambs = [AmbElement.from_config(a, mesh) for a in cfg.amb] if include_amb else []
     others = [SealElement.from_config(s, mesh, p, f_seal)
               for s in (cfg.seal if include_seals else [])]
-    others += [SpringElement.from_config(s, mesh, i)
-               for i, s in enumerate(cfg.spring if include_springs else [])]
+    others += springs
     names: list[str] = []
     b_cols: list[np.ndarray] = []
     c_rows: list[np.ndarray] = []
@@ -166,7 +171,7 @@ def build_system(
         el.assemble(M, C, K)
         changes += el.channels(n)
     if cfg.rotor.supported_modal_damping is not None:
-        C += _supported_damping(cfg, mesh, rot)
+        C += _supported_damping(cfg, mesh, rot)[:n, :n]  # (springs left out: no housings)
     out_names = tuple(f"y_{a[2:]}" for a in names)
     for k_i, z in enumerate(force_positions):
         i = mesh.node_at(z)
@@ -176,10 +181,30 @@ def build_system(
             b_cols[-1][4 * i + d] = 1.0
     B = np.column_stack(b_cols) if b_cols else np.zeros((n, 0))
     Cq = np.vstack(c_rows) if c_rows else np.zeros((0, n))
+    housings = tuple(f"{s.label}_housing_{a}" for s in springs if s.housing is not None
+                     for a in ("x", "y"))
     return SecondOrderSystem(
-        mesh=mesh, M=M, C=C, G=rot.G, K=K, B=B, Cq=Cq, speed=speed,
+        mesh=mesh, M=M, C=C, G=G, K=K, B=B, Cq=Cq, speed=speed,
         input_names=tuple(names), output_names=out_names, changes=tuple(changes),
+        housing_names=housings,
     )
+
+
+def _springs(cfg: RigConfig, mesh: Mesh) -> list[SpringElement]:
+    """The rig's springs, each housing given its two DOFs after the shaft's in order."""
+    out, next_dof = [], mesh.n_dof
+    for i, s in enumerate(cfg.spring):
+        out.append(SpringElement.from_config(s, mesh, i, None if s.housing is None
+                                             else next_dof))
+        next_dof += 0 if s.housing is None else 2
+    return out
+
+
+def _padded(X: np.ndarray, n: int) -> np.ndarray:
+    """X (the shaft's DOFs) in an n × n matrix whose further DOFs are the housings'."""
+    out = np.zeros((n, n))
+    out[:X.shape[0], :X.shape[1]] = X
+    return out
 
 
 def _supported_damping(cfg: RigConfig, mesh: Mesh, rot) -> np.ndarray:
@@ -188,11 +213,13 @@ def _supported_damping(cfg: RigConfig, mesh: Mesh, rot) -> np.ndarray:
     [operating] pressure, so that the rotor's damping is one matrix at every speed and
     pressure, as ROSS 3's (its bearings at frequency 0); the AMBs are left out, their
     stiffness being the loop's."""
-    M, K, C = rot.M.copy(), rot.K.copy(), np.zeros_like(rot.M)
+    springs = _springs(cfg, mesh)
+    n = mesh.n_dof + 2 * sum(s.housing is not None for s in springs)
+    M, K, C = _padded(rot.M, n), _padded(rot.K, n), np.zeros((n, n))
     for s in cfg.seal:
         SealElement.from_config(s, mesh, cfg.operating.pressure_bar, 0.0).assemble(M, C, K)
-    for i, s in enumerate(cfg.spring):
-        SpringElement.from_config(s, mesh, i).assemble(M, C, K)
+    for el in springs:
+        el.assemble(M, C, K)
     spec = cfg.rotor.supported_modal_damping
     return supported_modal_damping(M, K, spec.ratios, spec.others)
 
@@ -234,7 +261,7 @@ def mechanical_plant(sys: SecondOrderSystem) -> Plant:
             Dt = np.zeros((r, m))
         params[ch.name] = Parameter(ch.name, float(ch.nominal), ch.unit, Bt, Ct, Dt)
     dofs = ("x", "y", "alpha", "beta")
-    qn = [f"{d}{k}" for k in range(sys.mesh.n_nodes) for d in dofs]
+    qn = [f"{d}{k}" for k in range(sys.mesh.n_nodes) for d in dofs] + list(sys.housing_names)
     states = tuple(qn + [f"d{s}" for s in qn])
     return Plant(
         A=A, B=B, C=C, D=np.zeros((C.shape[0], m)),

@@ -50,6 +50,19 @@ def _ross_eigenvalues(rotor, speed_rad_s: float) -> np.ndarray:
     return np.asarray(lam)
 
 
+def _ross_lateral_count(rotor, speed_rad_s: float, max_hz: float) -> int:
+    """How many of ROSS's eigenvalues at ``speed_rad_s`` with 1 rad/s < Im λ < ``max_hz``
+    are lateral modes: most of their eigenvector's position part in x, y, α, β (ROSS's six
+    DOFs per node add axial and torsional modes, which ambseal does not model)."""
+    lam, V = _quiet(rotor._eigen, speed_rad_s, sparse=False)
+    lam, V = np.asarray(lam), np.asarray(V)
+    per = int(getattr(rotor, "number_dof", 4))
+    q = np.abs(V[:rotor.ndof]) ** 2
+    lateral = q[[i for i in range(rotor.ndof) if i % per in (0, 1, 3, 4)]].sum(axis=0)
+    band = (lam.imag > 1.0) & (lam.imag < 2 * np.pi * max_hz)
+    return int(np.sum(band & (lateral > 0.5 * q.sum(axis=0))))
+
+
 def _assert_modes_equal_ross(rig, rotor, speed_rad_s: float, max_hz: float, n: int) -> None:
     """Every lateral mode of ``rig`` up to ``max_hz`` equals one of ROSS's eigenvalues of
     ``rotor`` at the same speed, and its |λ| (ROSS's ``wn``), to 1e-6 relative."""
@@ -603,6 +616,42 @@ def test_tables_over_speed_and_whirl_frequency_equal_ross():
         _assert_log_decrements_equal_ross(at, rotor, w * 30 / np.pi)
 
 
+def _rotor8():
+    """ROSS's ``rotor8`` as its tests build it: ``rotor_example``'s shaft and disks on two
+    bearings whose kxx = kyy and cxx = cyy run linearly from 50 to 5000 rad/s (ROSS 3.1:
+    a table over ``speed``; ROSS 2.3: over ``frequency``)."""
+    i_d, o_d = 0, 0.05
+    shaft = [rs.ShaftElement(0.25, i_d, o_d, material=rs.materials.steel, shear_effects=True,
+                             rotary_inertia=True, gyroscopic=True) for _ in range(6)]
+    disks = [rs.DiskElement.from_geometry(2, rs.materials.steel, 0.07, 0.05, 0.28),
+             rs.DiskElement.from_geometry(4, rs.materials.steel, 0.07, 0.05, 0.35)]
+    axis = "speed" if _takes(rs.BearingElement, "speed") else "frequency"
+    bearings = [rs.BearingElement(n, kxx=[1e7, 1.5e7], kyy=[1e7, 1.5e7], cxx=[1e3, 1.5e3],
+                                  cyy=[1e3, 1.5e3], **{axis: [50, 5000]}) for n in (0, 6)]
+    return _quiet(rs.Rotor, shaft, disks, bearings)
+
+
+@pytest.mark.parametrize("suffix", [".toml", ".json"])
+def test_rotor8_equals_ross(tmp_path, suffix):
+    """ROSS's ``rotor8`` (its tables over speed in ROSS 3, over frequency in ROSS 2.3),
+    saved as TOML and as JSON (ROSS's ``test_save_load``, ``test_save_load_json``) and
+    imported at 1000 and 3000 rad/s: two ``[[seal]]`` tables (isotropic bearings) holding
+    ROSS's linear values at those speeds, every lateral mode up to 1 kHz with its log
+    decrement equal to one of ROSS's eigenvalues there to 1e-6."""
+    rotor = _rotor8()
+    src = tmp_path / f"rotor8{suffix}"
+    _quiet(rotor.save, src)
+    for w in (1000.0, 3000.0):
+        cfg = from_ross(load_ross(src), where=str(src), speed_rpm=w * 30 / np.pi).rig
+        assert len(cfg.seal) == 2 and cfg.spring == []
+        for seal in cfg.seal:  # isotropic skew: seals, tabulated, exact at the speed
+            table = dict(zip(seal.K.frequency_hz, seal.K.value))
+            f = min(table, key=lambda x: abs(x - w / (2 * np.pi)))
+            assert table[f] == pytest.approx(1e7 + 5e6 * (w - 50) / 4950, rel=1e-12)
+        n = _ross_lateral_count(rotor, w, 1000.0)
+        _assert_log_decrements_equal_ross(cfg, rotor, w * 30 / np.pi, 1000.0, n)
+
+
 def test_ross_test_data_rotor_equals_ross():
     """ROSS's own saved test rotor (``ross/tests/data/rotor.toml``, its ``rotor9``: 55
     layered and plain elements, 7 disks, 14 seals and bearings with coefficient tables,
@@ -758,9 +807,9 @@ def test_tapered_housing_rotor_equals_ross(tmp_path):
     """ROSS's rotor with a housing (``rotor_tapered_housing`` of ROSS 3.1's tests; its
     bearing linked to a housing node, ``n_link``, on ROSS 2.3 as well), saved and
     imported: a ``[[spring]]`` with a ``housing`` of 5 kg on 1e7 N/m, 1e3 N·s/m, the cone's
-    Rayleigh damping on its tube, and every lateral mode up to 1 kHz (below the first
-    torsional one of ROSS's six-DOF model) with its log decrement equal to one of ROSS's
-    eigenvalues to 1e-6 at 0 and 4000 rpm, the housing's modes among them."""
+    Rayleigh damping on its tube, and every lateral mode up to 1 kHz with its log
+    decrement equal to one of ROSS's eigenvalues to 1e-6 at 0 and 4000 rpm, as many as
+    ROSS's lateral ones, the housing's modes among them."""
     rotor = _tapered_housing_rotor()
     src = tmp_path / "housing.toml"
     _quiet(rotor.save, src)
@@ -771,9 +820,8 @@ def test_tapered_housing_rotor_equals_ross(tmp_path):
     h = linked[0].housing
     assert (h.mass, h.kxx, h.kyy, h.cxx, h.cyy) == (5.0, 1e7, 1e7, 1e3, 1e3)
     assert cfg.shaft[0].rayleigh_beta == 1e-5
-    ref = _ross_eigenvalues(rotor, 0.0)
-    n = int(np.sum((ref.imag > 1.0) & (ref.imag < 2 * np.pi * 1000.0)))
     for speed_rpm in (0.0, 4000.0):
+        n = _ross_lateral_count(rotor, speed_rpm * np.pi / 30, 1000.0)
         _assert_log_decrements_equal_ross(cfg, rotor, speed_rpm, 1000.0, n)
 
 

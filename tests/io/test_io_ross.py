@@ -166,6 +166,37 @@ def _modal_damping_rotor(stiffness_y=0.8e6, **damping):
     return _quiet(rs.Rotor, shaft, disks, bearings, **damping)
 
 
+def _assert_receptance_equals(rig, amp, phase) -> None:
+    """The receptance x/F_x at node 2 (ROSS's DOF 12 of ``test_modal_damping``'s rotor)
+    at 200, 400, ... rpm, the frequency following the speed as in ROSS's
+    ``run_freq_response(speed_range=...)``, equal to ROSS's asserted amplitude (rtol 1e-5;
+    ROSS's test 1e-6, on its values printed to 7 digits) and phase (atol 1e-5)."""
+    z = float(build_mesh(rig).z[2])
+    for k, (a, ph) in enumerate(zip(amp, phase), start=1):
+        w = k * 200 * np.pi / 30
+        sys2 = build_system(rig, speed_rpm=k * 200.0, force_positions=(z,))
+        f = sys2.B[:, sys2.input_names.index("F0_x")]
+        x = np.linalg.solve(sys2.K - w**2 * sys2.M + 1j * w * (sys2.C + w * sys2.G), f)
+        assert abs(x @ f) == pytest.approx(a, rel=1e-5)
+        assert np.angle(x @ f) == pytest.approx(ph, rel=1e-5, abs=1e-5)
+
+
+@pytest.mark.skipif(not _takes(rs.Rotor, "alpha"),
+                    reason="ROSS < 3: a Rotor has no damping of its own (alpha, beta)")
+def test_ross_proportional_damping_rotor_receptance(tmp_path):
+    """ROSS 3.1's ``test_proportional_damping`` rotor (``Rotor(alpha=1.6, beta=1.7e-7)``),
+    saved and imported: its receptance equals the values ROSS's test asserts."""
+    rotor = _modal_damping_rotor(alpha=1.6, beta=1.7e-7)
+    path = tmp_path / "rayleigh.toml"
+    _quiet(rotor.save, path)
+    imp = from_ross(load_ross(path), where=str(path))
+    assert (imp.rig.rotor.rayleigh_alpha, imp.rig.rotor.rayleigh_beta) == (1.6, 1.7e-7)
+    _assert_receptance_equals(
+        imp.rig, [1.495063e-06, 1.803282e-06, 2.818322e-06, 1.854149e-05, 2.545901e-06,
+                  9.415274e-07, 4.557404e-07],
+        [-0.004284, -0.010686, -0.026649, -0.268325, -3.089441, -3.111475, -3.114635])
+
+
 @pytest.mark.skipif(not _takes(rs.Rotor, "modal_damping_ratio"),
                     reason="ROSS < 3: a Rotor has no modal damping ratios")
 def test_rotor_modal_damping_equals_ross(tmp_path):
@@ -186,20 +217,11 @@ def test_rotor_modal_damping_equals_ross(tmp_path):
     assert (spec.ratios, spec.others) == ([0.001, 0.001], 0.01) and imp.unmapped == ()
     for speed_rpm in (0.0, 4000.0):
         _assert_log_decrements_equal_ross(imp.rig, rotor, speed_rpm)
-    # ROSS's test: run_freq_response(speed_range=0, 200, ..., 1400 rpm) at x of node 2
-    # driven at x of node 2 (ROSS's DOF 12), its amplitude and phase asserted
-    amp = [1.495079e-06, 1.803400e-06, 2.819422e-06, 1.914051e-05, 2.548842e-06,
-           9.418038e-07, 4.558292e-07]
-    phase = [-6.188289e-04, -1.423301e-03, -3.157592e-03, -3.001839e-02, -3.135327e00,
-             -3.135999e00, -3.131778e00]
-    z = float(build_mesh(imp.rig).z[2])
-    for k, (a, ph) in enumerate(zip(amp, phase), start=1):
-        w = k * 200 * np.pi / 30
-        sys2 = build_system(imp.rig, speed_rpm=k * 200.0, force_positions=(z,))
-        f = sys2.B[:, sys2.input_names.index("F0_x")]
-        x = np.linalg.solve(sys2.K - w**2 * sys2.M + 1j * w * (sys2.C + w * sys2.G), f)
-        assert abs(x @ f) == pytest.approx(a, rel=1e-5)
-        assert np.angle(x @ f) == pytest.approx(ph, rel=1e-5)
+    _assert_receptance_equals(
+        imp.rig, [1.495079e-06, 1.803400e-06, 2.819422e-06, 1.914051e-05, 2.548842e-06,
+                  9.418038e-07, 4.558292e-07],
+        [-6.188289e-04, -1.423301e-03, -3.157592e-03, -3.001839e-02, -3.135327e00,
+         -3.135999e00, -3.131778e00])
     split = _modal_damping_rotor(stiffness_y=1e6, modal_damping_ratio=[0.01, 0.02])
     with pytest.raises(ConfigError, match="differ within a repeated mode"):
         from_ross(split, where="split.toml")

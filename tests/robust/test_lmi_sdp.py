@@ -147,3 +147,33 @@ def test_infeasible_lmis_are_reported():
             sdp.Lmi(np.zeros((n, n)), None, (sdp.LmiTerm(0, np.eye(n), 0.5 * np.eye(n)),))]
     sol = sdp.solve_lmis(lmis, n, 1, None, [1.0], {})
     assert sol.status == "infeasible"
+
+
+def test_a_point_where_the_lmis_hold_certifies_without_the_solvers_optimal():
+    """An LMI holds where its smallest eigenvalue is at least −margin/2 (the strict LMI it
+    stands for keeps half its margin) or, without a margin, −1e-9 of its largest; on the
+    Lyapunov inequality with its solver stopped one iteration short of "optimal" (CVXOPT:
+    "unknown", as its 3.12 build ends on the LPV SDPs), with lpvsyn's margin, the point
+    returned satisfies the LMI and the status is "feasible", its X within 1e-3 of the
+    optimum's."""
+    lay = sdp._Layout(2, 1, False)
+    x = np.zeros(lay.size)  # X = 0: each LMI is its constant
+    for margin, low, ok in ((1e-6, -0.4e-6, True), (1e-6, -0.6e-6, False),
+                            (0.0, -0.5e-9, True), (0.0, -2e-9, False)):
+        lmi = sdp.Lmi(np.diag([1.0, low]), None, (sdp.LmiTerm(0, np.eye(2), np.eye(2)),),
+                      margin)
+        assert sdp.holds([lmi], lay, x) is ok
+    rng = np.random.default_rng(1)
+    n = 6
+    A = _stable(n, rng)
+    M = rng.standard_normal((n, n))
+    margin = 1e-6  # lpvsyn's default
+    lmi = sdp.Lmi(-(M @ M.T + np.eye(n)) - margin * np.eye(n), None,
+                  (sdp.LmiTerm(0, A.T, -np.eye(n)),), margin)
+    opts = {"reltol": 1e-8, "abstol": 1e-9}
+    best = sdp.solve_lmis([lmi], n, 1, None, [1.0], opts)
+    assert best.status == "optimal" and best.iterations > 2
+    short = sdp.solve_lmis([lmi], n, 1, None, [1.0], opts | {"maxiters": best.iterations - 1})
+    assert short.status == "feasible" and short.iterations == best.iterations - 1
+    np.testing.assert_allclose(short.X[0], best.X[0], rtol=1e-3,
+                               atol=1e-3 * np.abs(best.X[0]).max())

@@ -55,11 +55,13 @@ class LmiTerm:
 
 @dataclass(frozen=True)
 class Lmi:
-    """``const + γ·gamma + Σ terms ⪰ 0`` (``gamma`` None: γ does not enter)."""
+    """``const + γ·gamma + Σ terms ⪰ 0`` (``gamma`` None: γ does not enter); ``margin``: the
+    strictness margin ``const`` carries (−margin·I, the LMI being a strict one ≻ 0)."""
 
     const: np.ndarray
     gamma: np.ndarray | None
     terms: tuple[LmiTerm, ...]
+    margin: float = 0.0
 
     @property
     def size(self) -> int:
@@ -70,7 +72,8 @@ class Lmi:
 class SdpSolution:
     """What :func:`solve_lmis` found: ``gamma`` (None without γ), the matrices ``X``, CVXOPT's
     ``status`` (``"optimal"`` or ``"unknown"``, and ``"infeasible"`` for a primal
-    infeasibility certificate) and ``iterations``."""
+    infeasibility certificate; ``"feasible"`` where CVXOPT stopped short of its tolerances,
+    "unknown", on a point at which every LMI holds: :func:`holds`) and ``iterations``."""
 
     gamma: float | None
     X: list
@@ -133,6 +136,33 @@ def _lin_adjoint(lmi: Lmi, lay: _Layout, Y: np.ndarray, out: np.ndarray) -> None
         PYQ = t.P.T @ Y @ t.Q
         o = lay.off[t.var]
         out[o:o + lay.m] += lay.adjoint(PYQ + PYQ.T)
+
+
+#: An LMI without a margin holds at x where its smallest eigenvalue is at least
+#: −HOLD_RTOL times its largest magnitude: in the LPV synthesis those are the coupling
+#: LMIs [[R, αI], [αI, S]] ⪰ 0, whose strictness is α > 1 (S R ⪰ α² I where the
+#: reconstruction needs I − S R invertible: α² − 1 = 0.21 at the default 1.1), far above
+#: this; the reconstruction's own check (its loss, RECONSTRUCTION_LOSS) follows.
+HOLD_RTOL = 1e-9
+
+
+def holds(lmis, lay: _Layout, x: np.ndarray) -> bool:
+    """Whether every LMI holds at x, by its eigenvalues: the strict LMI it stands for with
+    at least half its ``margin`` (smallest eigenvalue ≥ −margin/2), one without a margin
+    to :data:`HOLD_RTOL`. Where CVXOPT stops short of its tolerances — on the same LMIs,
+    by its BLAS's rounding, one build of CVXOPT ends "optimal" and another "unknown" after
+    its iterations — the point it returns may still satisfy them, and then certifies as
+    an optimal one does (less tightly: not the optimum)."""
+    if not np.all(np.isfinite(x)):
+        return False
+    for lmi in lmis:
+        S = lmi.const + _lin(lmi, lay, x)
+        w = np.linalg.eigvalsh((S + S.T) / 2)
+        floor = 0.5 * lmi.margin if lmi.margin > 0 else HOLD_RTOL * max(np.abs(w).max(),
+                                                                         1e-300)
+        if w[0] < -floor:
+            return False
+    return True
 
 
 def _scaled(lmi: Lmi, rti: np.ndarray) -> Lmi:
@@ -258,6 +288,8 @@ def solve_lmis(lmis, n: int, n_vars: int, cost_gamma: float | None, cost_trace,
                          kktsolver=kktsolver, options=opts)
     status = {"primal infeasible": "infeasible"}.get(res["status"], res["status"])
     x = np.asarray(res["x"])[:, 0] if res["x"] is not None else np.full(lay.size, np.nan)
+    if status == "unknown" and holds(lmis, lay, x):
+        status = "feasible"
     X = [lay.unpack(x, v) for v in range(n_vars)]
     return SdpSolution(float(x[0]) if lay.with_gamma else None, X, status,
                        int(res.get("iterations", 0) or 0))

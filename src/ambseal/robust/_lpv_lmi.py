@@ -361,10 +361,10 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
     def build(gamma_fixed: float | None, alpha: float):
         lmis = []
 
-        def add(const, gam, terms):
+        def add(const, gam, terms, strict=0.0):
             if gamma_fixed is not None and gam is not None:
                 const, gam = const + gamma_fixed * gam, None
-            lmis.append(_sdp.Lmi(const, gam, tuple(terms)))
+            lmis.append(_sdp.Lmi(const, gam, tuple(terms), strict))
 
         for k in range(grid.size):
             A = sc.A[k]
@@ -372,11 +372,11 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
             (fR, dfR), (fS, dfS) = at[k]
             UR = NR.T @ np.vstack([A, C1, Z((nw, N))])
             for terms in projected(JR, UR, fR, dfR, 0, r_const, r_const and inner and a_affine):
-                add(-margin * np.eye(JR.shape[0]) - cR, gR, terms)
+                add(-margin * np.eye(JR.shape[0]) - cR, gR, terms, margin)
             US = NS.T @ np.vstack([A.T, B1.T, Z((nz, N))])
             for terms in projected(JS, US, fS, dfS, nbR, s_const,
                                    s_const and inner and a_affine):
-                add(-margin * np.eye(JS.shape[0]) - cS, gS, terms)
+                add(-margin * np.eye(JS.shape[0]) - cS, gS, terms, margin)
             if k == 0 or not (r_const and s_const) and not (coupling_convex and inner):
                 terms = [_sdp.LmiTerm(j, E1, 0.5 * fR[j] * E1) for j in range(nbR) if fR[j]]
                 terms += [_sdp.LmiTerm(nbR + i, E2, 0.5 * fS[i] * E2) for i in range(nbS)
@@ -465,7 +465,7 @@ def _solve_sdp(lmis, N, n_vars, cost_gamma, cost_trace, options, stage, reports)
             f"lpvsyn ({stage}): the LMIs are infeasible (CVXOPT: primal infeasibility "
             "certificate): no controller with this Lyapunov structure exists for the plant "
             "and weights; relax the weights, the rate bound or the grid range")
-    if sol.status != "optimal":
+    if sol.status not in ("optimal", "feasible"):
         raise SynthesisError(
             f"lpvsyn ({stage}): solver status {sol.status!r} after {sol.iterations} "
             "iterations — the solution is not accurate enough to build a controller from; "

@@ -1,8 +1,8 @@
 """ROSS rotors in: a ``ross.Rotor`` (or ROSS's saved .toml/.json rotor file) as an ambseal rig.
 
 Tested with ross-rotordynamics 2.3 (Python 3.11, ``plotly<7``) on ROSS's own
-``rotor_example``, ``compressor_example`` and ``rotor_amb_example``, and with ROSS 3.1
-(Python 3.13) on the same rotors (its AMB rig: ``ross.bearings.magnetic.amb_models.
+``rotor_example``, ``compressor_example`` and ``rotor_amb_example``, and with ROSS 3.0
+(Python 3.12) and 3.1 (Python 3.13) on the same rotors (its AMB rig: ``ross.bearings.magnetic.amb_models.
 rotor_example_amb_general_controllers``). The mapping,
 element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keeps the lateral
 [x, y, α, β], so ROSS's axial and torsional modes have no counterpart):
@@ -105,8 +105,9 @@ from ambseal.model import RIGID_BELOW_RAD_S
 __all__ = ["RossImport", "from_ross", "load_ross", "import_ross_file", "ROSS_TESTED",
            "ROSS_TIMEOUT_S"]
 
-#: The ROSS versions the importer is tested with (2.3 on Python 3.11, 3.1 on 3.13).
-ROSS_TESTED = ("2.3", "3.1")
+#: The ROSS versions the importer is tested with (2.3 on Python 3.11, 3.0 on 3.12, 3.1 on
+#: 3.13).
+ROSS_TESTED = ("2.3", "3.0", "3.1")
 #: The longest :func:`import_ross_file`'s child process may take (s): importing ROSS takes
 #: 10–20 s on a 2-core machine, loading and mapping a rotor of hundreds of elements a few
 #: seconds more.

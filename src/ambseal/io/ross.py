@@ -2,8 +2,8 @@
 
 Tested with ross-rotordynamics 2.3 (Python 3.11, ``plotly<7``) on ROSS's own
 ``rotor_example``, ``compressor_example`` and ``rotor_amb_example``, and with ROSS 3.0
-(Python 3.12) and 3.1 (Python 3.13) on the same rotors (its AMB rig: ``ross.bearings.magnetic.amb_models.
-rotor_example_amb_general_controllers``). The mapping,
+(Python 3.12) and 3.1 (Python 3.13) on the same rotors (its AMB rig:
+``ross.bearings.magnetic.amb_models.rotor_example_amb_general_controllers``). The mapping,
 element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keeps the lateral
 [x, y, α, β], so ROSS's axial and torsional modes have no counterpart):
 

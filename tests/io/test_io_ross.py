@@ -1097,8 +1097,10 @@ def test_ross3_file_read_without_ross_equals_the_ross_import(examples, tmp_path)
     does), gives the same rig, the same items left out and the same notes as the import
     through ROSS — tables over speed and whirl frequency (pchip, linear, extrapolated), a
     magnetic bearing with a non-collocated sensor, a coupling and a point mass, layered and
-    tapered elements with loads, 1e20 N/m pins, a housing, a rotor's Rayleigh damping; a
-    rotor with modal damping ratios is refused saying it needs ROSS 3."""
+    tapered elements with loads, 1e20 N/m pins, a housing, a rotor's Rayleigh damping and
+    modal damping ratios — ROSS counts them over its axial and torsional modes too, which
+    the reader takes from ROSS's six-DOF model: on a rotor whose first torsional mode lies
+    among the modes given a ratio, the lateral ones skip the ratio it took."""
     from ambseal.io.ross_file import read_ross3_file
 
     speed, freq = np.array([100.0, 300.0, 500.0]), np.array([150.0, 400.0])
@@ -1118,6 +1120,12 @@ def test_ross3_file_read_without_ross_equals_the_ross_import(examples, tmp_path)
                                    ct_y=50.0, cr_x=2.0, cr_y=2.0, kr_z=3e6),
         "pinned": _conical_rotor(1e20),
         "housing": _tapered_housing_rotor(),
+        "modal": _modal_damping_rotor(modal_damping_ratio=[0.001, 0.001],
+                                      default_damping_ratio=0.01),
+        # ratios past ROSS's first torsional mode (650 rad/s), which they count too
+        "modal_torsion": _modal_damping_rotor(
+            modal_damping_ratio=[0.001 * (k + 1) for k in range(14)],
+            default_damping_ratio=0.03),
         "compressor": examples["compressor_example"][0],
         "amb": examples["rotor_amb_example"][0],
     }
@@ -1130,8 +1138,6 @@ def test_ross3_file_read_without_ross_equals_the_ross_import(examples, tmp_path)
             own = from_ross(read_ross3_file(path, data), where=str(path), speed_rpm=speed_rpm)
             assert own.rig == ross.rig, name
             assert (own.unmapped, own.notes) == (ross.unmapped, ross.notes), name
-    modal = _modal_damping_rotor(modal_damping_ratio=[0.01])
-    path = tmp_path / "modal.toml"
-    _quiet(modal.save, path)
-    with pytest.raises(ConfigError, match="modal damping ratios .* need ROSS 3"):
-        read_ross3_file(path, tomllib.loads(path.read_text()))
+        if name == "modal_torsion":  # ROSS's 5th and 14th flexible modes are not lateral
+            assert own.rig.rotor.supported_modal_damping.ratios == [
+                0.001 * (k + 1) for k in range(14) if k + 1 not in (5, 14)]

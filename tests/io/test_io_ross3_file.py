@@ -1,6 +1,6 @@
-"""A ROSS 3.1 rotor file imported on any Python: through ROSS where ROSS 3 is installed,
+"""ROSS 3.1 rotor files imported on any Python: through ROSS where ROSS 3 is installed,
 else by ambseal's reader of the format (io/ross_file.py; Python 3.11 has ROSS 2.3, which
-cannot read it). The file and ROSS 3.1's eigenvalues beside it are written by
+cannot read them). The files and ROSS 3.1's eigenvalues beside them are written by
 ``tests/data/ross3/make.py`` with ROSS 3.1."""
 
 from __future__ import annotations
@@ -29,15 +29,18 @@ def _ross_major() -> int | None:
 
 
 @pytest.mark.parametrize("speed_rad_s", [150.0, 300.0, 400.0])
-def test_ross3_file_modes_equal_ross_31(tmp_path, capsys, speed_rad_s):
-    """ROSS 3.1's file of ``rotor_example`` on bearings tabulated over speed (linear and
-    pchip, extrapolated) and a seal over speed and whirl frequency, with the rotor's
-    Rayleigh damping, imported by ``ambseal import-ross --speed-rpm``: every lateral mode
-    up to 500 Hz (damped frequency and log decrement) equals one of ROSS 3.1's eigenvalues
-    at that speed to 1e-6; where no ROSS 3 is installed the rig file says it was read
-    without ROSS."""
-    src = tmp_path / "tables.toml"
-    shutil.copy(DATA / "tables.toml", src)
+@pytest.mark.parametrize("name", ["tables", "modal"])
+def test_ross3_file_modes_equal_ross_31(tmp_path, capsys, name, speed_rad_s):
+    """ROSS 3.1's files, imported by ``ambseal import-ross --speed-rpm``: ``tables``,
+    ``rotor_example`` on bearings tabulated over speed (linear and pchip, extrapolated) and
+    a seal over speed and whirl frequency, with the rotor's Rayleigh damping; ``modal``,
+    ROSS's ``test_modal_damping`` rotor with 14 modal damping ratios, which ROSS counts
+    over its torsional and axial modes too (its 5th and 14th flexible ones: the lateral
+    modes skip those ratios). Every lateral mode up to 500 Hz (damped frequency and log
+    decrement) equals one of ROSS 3.1's eigenvalues at that speed to 1e-6; where no ROSS 3
+    is installed the rig file says it was read without ROSS."""
+    src = tmp_path / f"{name}.toml"
+    shutil.copy(DATA / f"{name}.toml", src)
     out = tmp_path / "rig.toml"
     rpm = speed_rad_s * 30 / np.pi
     assert main(["import-ross", str(src), "--out", str(out), "--speed-rpm", f"{rpm!r}"]) == 0
@@ -46,8 +49,12 @@ def test_ross3_file_modes_equal_ross_31(tmp_path, capsys, speed_rad_s):
     major = _ross_major()
     assert ("read without ROSS" in header) == (major is None or major < 3)
     rig = load_rig(out)
-    assert (rig.rotor.rayleigh_alpha, rig.rotor.rayleigh_beta) == (2.0, 1e-5)
-    ref = json.loads((DATA / "tables_eigenvalues.json").read_text())
+    if name == "tables":
+        assert (rig.rotor.rayleigh_alpha, rig.rotor.rayleigh_beta) == (2.0, 1e-5)
+    else:
+        assert rig.rotor.supported_modal_damping.ratios == [
+            0.001 * (k + 1) for k in range(14) if k + 1 not in (5, 14)]
+    ref = json.loads((DATA / f"{name}_eigenvalues.json").read_text())
     assert tomllib.loads(src.read_text())["ross_version"] == ref["ross_version"]
     lam_ross = np.array([complex(*x) for x in ref[f"{speed_rad_s:g}"]])
     m = closed_loop_modes(rig, None, speed_hz=speed_rad_s / (2 * np.pi), max_hz=500.0)

@@ -100,7 +100,7 @@ from ambseal.config import MAX_SUPPORT_STIFFNESS, Pid, RigConfig, dump_rig, pars
 from ambseal.errors import AmbsealError, ConfigError
 from ambseal.files import claim_file, read_text, stamp_text, write_text
 from ambseal.io.ross_file import _AMB_KEYS, _COEFFS, read_ross3_file
-from ambseal.model import RIGID_BELOW_RAD_S
+from ambseal.model import RIGID_BELOW_RAD_S, build_system
 
 __all__ = ["RossImport", "from_ross", "load_ross", "import_ross_file", "ROSS_TESTED",
            "ROSS_TIMEOUT_S"]
@@ -448,6 +448,8 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
                      + (" and at the [operating] speed" if rpm else ""))
     if rpm:
         rig["operating"] = {"speed_rpm": rpm}
+    if _damping_kind(rotor) == "modal" and not hasattr(rotor, "C0"):
+        rig["rotor"]["supported_modal_damping"] = _modal_damping_by_order(rotor, rig, where)
     if rig["amb"]:
         rig["actuator"] = {"model": "none"}
         unmapped.append("magnetic bearings: ROSS's equivalent-bearing coefficients k(ω), c(ω) "
@@ -609,8 +611,9 @@ def _rotor_damping(rotor, where: str, unmapped: list) -> dict:
         unmapped.append("the elements' own damping (shaft elements' alpha, beta, couplings' "
                         "dampers): not imported, ROSS does not apply it beside the rotor's "
                         + ("modal damping ratios" if kind == "none" else "alpha, beta"))
-    if kind == "modal":
-        return {"supported_modal_damping": _supported_modal_damping(rotor, where)}
+    if kind == "modal":  # a rotor read without ROSS: by the modes' order (from_ross)
+        return ({"supported_modal_damping": _supported_modal_damping(rotor, where)}
+                if hasattr(rotor, "C0") else {})
     if kind != "rayleigh":
         return {}
     return {"rayleigh_alpha": float(rotor.alpha), "rayleigh_beta": float(rotor.beta)}
@@ -667,6 +670,34 @@ def _supported_modal_damping(rotor, where: str) -> dict:
         zeta[j] = near[0] if near else z
     last = max((j for j, z in enumerate(zeta) if z != others), default=0)
     return {"ratios": [float(z) for z in zeta[:last + 1]], "others": others}
+
+
+def _modal_damping_by_order(rotor, rig: dict, where: str) -> dict:
+    """``[rotor.supported_modal_damping]`` of modal damping ratios read without ROSS (the
+    rotor of :func:`~ambseal.io.ross_file.read_ross3_file`): ROSS's rule over the modes
+    of its rotor at standstill in ascending order — rigid-body ones none, then
+    ``modal_damping_ratio``, then ``default_damping_ratio`` — with the lateral modes those
+    of the rig's basis (:func:`~ambseal.model.supported_modal_damping`: the rotor on its
+    springs and seals at 0 Hz, ROSS's lateral ones) and the axial and torsional ones of
+    ROSS's six-DOF model (``rotor.axial_torsional_rad_s()``) among them."""
+    sys = build_system(parse_rig(rig, where), speed_rpm=0.0, include_amb=False)
+    w2 = scipy.linalg.eigh((sys.K + sys.K.T) / 2, sys.M, eigvals_only=True)
+    lateral = np.sqrt(w2[w2 >= RIGID_BELOW_RAD_S ** 2])
+    other = rotor.axial_torsional_rad_s()
+    other = other[other >= RIGID_BELOW_RAD_S]
+    given = [float(z) for z in np.atleast_1d(rotor.modal_damping_ratio)]
+    others = float(rotor.default_damping_ratio or 0.0)
+    merged = sorted([(w, True) for w in lateral] + [(w, False) for w in other])
+    zeta = [given[k] if k < len(given) else others
+            for k, (_, is_lateral) in enumerate(merged) if is_lateral]
+    if any(b - a <= 1e-6 * b and za != zb
+           for a, b, za, zb in zip(lateral, lateral[1:], zeta, zeta[1:])):
+        raise _bad(where, "the rotor's modal damping ratios differ within a repeated mode "
+                          "(the x and y modes of an isotropic rotor): ROSS's damping then "
+                          "depends on the eigenvectors its solver returns; give the pair one "
+                          "ratio")
+    last = max((j for j, z in enumerate(zeta) if z != others), default=0)
+    return {"ratios": zeta[:last + 1] or [others], "others": others}
 
 
 def _masses(rotor, nodes: np.ndarray, housings: set) -> list[dict]:

@@ -23,8 +23,13 @@ What the objects reproduce of ROSS 3.1:
   (μ0 = 4π·10⁻⁷ H/m)
   (Schweitzer & Maslen, *Magnetic Bearings*, 2009, p. 343, as ROSS), and its PID.
 
-A ROSS 3 rotor with modal damping ratios needs ROSS 3 (its ratios are set over ROSS's
-axial and torsional modes too, which only ROSS's six-DOF model gives): refused, saying so.
+* ROSS's axial and torsional modes at standstill (:meth:`_Rotor.axial_torsional_rad_s`),
+  over which ROSS counts its modal damping ratios as over the lateral ones: its six-DOF
+  elements' z and θ parts — a shaft element's bar and torsion matrices on its mean area
+  and second moment (E·A/L, ρAL/6·[2 1; 1 2]; G_s·J/L, ρJL/6·[2 1; 1 2], J = I_l + I_r),
+  disks' and couplings' masses and polar inertias, a coupling's ``kt_z``, ``kr_z``, point
+  masses' ``mz``, bearings' ``kzz``, ``mzz`` at 0 Hz.
+
 An element class this reader does not know is refused naming it.
 """
 
@@ -34,6 +39,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import scipy.linalg
 from scipy import interpolate
 
 from ambseal.errors import ConfigError
@@ -123,7 +129,7 @@ def _bearing(table: dict, where: str) -> _Element:
     if method not in ("pchip", "linear"):
         raise ConfigError(f"{where}: bearing {el.tag}: interpolation {method!r} (expected "
                           "'pchip' or 'linear')")
-    for name in _COEFFS:
+    for name in _COEFFS + ("kzz", "mzz"):
         v = table.get(name, [0.0])
         setattr(el, name, np.asarray(v, float))
         setattr(el, f"{name}_interpolated", _interpolant(v, speed, freq, method))
@@ -178,14 +184,53 @@ class _Rotor:
             raise ConfigError(f"{where}: element(s) this reader of ROSS 3 files does not "
                               f"know: {', '.join(unknown)} (install ROSS 3, on Python 3.12 "
                               "or newer, and import again)")
-        if self.modal_damping_ratio is not None:
-            raise ConfigError(f"{where}: the rotor's modal damping ratios "
-                              f"(modal_damping_ratio={self.modal_damping_ratio!r}) need ROSS "
-                              "3 to read (ROSS sets them over its axial and torsional modes "
-                              "too): install ROSS 3, on Python 3.12 or newer, and import "
-                              "again")
         self.elements = [*self.shaft_elements, *self.disk_elements,
                          *self.point_mass_elements, *self.bearing_elements]
+
+    def axial_torsional_rad_s(self) -> np.ndarray:
+        """ROSS's axial and torsional natural frequencies (rad/s) at standstill, ascending:
+        the z and θ DOFs of its six per node, which its lateral ones do not couple to
+        (module docstring); DOFs without inertia or stiffness (a housing's θ) left out."""
+        nodes = 1 + max(int(n) for el in self.elements
+                        for n in (el.n, getattr(el, "n_link", None) or 0))
+        M, K = np.zeros((2 * nodes, 2 * nodes)), np.zeros((2 * nodes, 2 * nodes))
+
+        def pair(dof, n, m, k):  # [m, m/2; m/2, m]-style pair across nodes n, n + 1
+            i = [2 * n + dof, 2 * (n + 1) + dof]
+            M[np.ix_(i, i)] += m
+            K[np.ix_(i, i)] += k * np.array([[1.0, -1.0], [-1.0, 1.0]])
+
+        for el in self.shaft_elements:
+            n = int(el.n)
+            if type(el).__name__ == "CouplingElement":
+                for dof, (a, b) in enumerate((("m_l", "m_r"), ("Ip_l", "Ip_r"))):
+                    M[2 * n + dof, 2 * n + dof] += float(getattr(el, a, 0.0))
+                    M[2 * n + 2 + dof, 2 * n + 2 + dof] += float(getattr(el, b, 0.0))
+                pair(0, n, 0.0, float(getattr(el, "kt_z", 0.0)))
+                pair(1, n, 0.0, float(getattr(el, "kr_z", 0.0)))
+                continue
+            mat, L = el.material, float(el.L)
+            area = np.pi * ((el.odl**2 - el.idl**2) + (el.odr**2 - el.idr**2)) / 8
+            polar = np.pi * ((el.odl**4 - el.idl**4) + (el.odr**4 - el.idr**4)) / 64
+            consistent = np.array([[2.0, 1.0], [1.0, 2.0]]) / 6
+            pair(0, n, mat.rho * area * L * consistent, mat.E * area / L)
+            pair(1, n, mat.rho * polar * L * consistent, mat.G_s * polar / L)
+        for d in self.disk_elements:
+            M[2 * d.n, 2 * d.n] += float(d.m)
+            M[2 * d.n + 1, 2 * d.n + 1] += float(d.Ip)
+        for p in self.point_mass_elements:
+            M[2 * p.n, 2 * p.n] += float(getattr(p, "mz", p.m))
+        for b in self.bearing_elements:
+            k, m = b.kzz_interpolated(0.0), b.mzz_interpolated(0.0)
+            i = [2 * b.n] + ([] if b.n_link is None else [2 * int(b.n_link)])
+            rel = np.array([[1.0]]) if b.n_link is None else np.array([[1.0, -1.0],
+                                                                      [-1.0, 1.0]])
+            K[np.ix_(i, i)] += k * rel
+            M[np.ix_(i, i)] += m * rel
+        keep = np.flatnonzero((np.abs(M).sum(axis=1) > 0) | (np.abs(K).sum(axis=1) > 0))
+        M, K = M[np.ix_(keep, keep)], K[np.ix_(keep, keep)]
+        w2 = scipy.linalg.eigh(K, M, eigvals_only=True)
+        return np.sqrt(w2[w2 >= 0])
 
 
 def read_ross3_file(path: str | Path, data: dict):
@@ -209,7 +254,7 @@ def read_ross3_file(path: str | Path, data: dict):
     Raises
     ------
     ConfigError
-        An element class the reader does not know, a table interpolation other than
-        ROSS's, or modal damping ratios (they need ROSS 3).
+        An element class the reader does not know, or a table interpolation other than
+        ROSS's.
     """
     return _Rotor(data, str(path))

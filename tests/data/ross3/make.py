@@ -1,4 +1,4 @@
-"""Write the ROSS 3.1 rotor file and ROSS 3.1's eigenvalues beside it, with which the tests
+"""Write ROSS 3.1 rotor files and ROSS 3.1's eigenvalues beside them, with which the tests
 check ambseal's reader of ROSS 3 files on a Python without ROSS 3 (Python 3.11: ROSS 2.3).
 
 Run with ROSS 3.1 installed (Python 3.13): ``python tests/data/ross3/make.py``. The rotor:
@@ -26,6 +26,19 @@ HERE = Path(__file__).parent
 SPEEDS_RAD_S = (150.0, 300.0, 400.0)
 
 
+def modal_rotor():
+    """ROSS 3.1's ``test_modal_damping`` rotor with 14 modal damping ratios, which ROSS
+    counts over its torsional and axial modes too (its 5th flexible mode is torsional)."""
+    shaft = [rs.ShaftElement(0.25, 0, 0.05, material=rs.materials.steel, shear_effects=True,
+                             rotary_inertia=True, gyroscopic=True) for _ in range(6)]
+    disks = [rs.DiskElement.from_geometry(2, rs.materials.steel, 0.07, 0.05, 0.28),
+             rs.DiskElement.from_geometry(4, rs.materials.steel, 0.07, 0.05, 0.35)]
+    bearings = [rs.BearingElement(n, kxx=1e6, kyy=0.8e6, cxx=0) for n in (0, 6)]
+    return rs.Rotor(shaft, disks, bearings,
+                    modal_damping_ratio=[0.001 * (k + 1) for k in range(14)],
+                    default_damping_ratio=0.03)
+
+
 def rotor():
     speed, freq = np.array([100.0, 300.0, 500.0]), np.array([150.0, 400.0])
     grid = np.add.outer(speed, 2 * freq)
@@ -45,11 +58,11 @@ def rotor():
 if __name__ == "__main__":
     with contextlib.redirect_stdout(sys.stderr), warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        r = rotor()
-        r.save(HERE / "tables.toml")
-        out = {"ross_version": rs.__version__}
-        for w in SPEEDS_RAD_S:
-            lam, _ = r._eigen(w, sparse=False)
-            out[f"{w:g}"] = [[float(x.real), float(x.imag)] for x in np.asarray(lam)]
-    rows = ",\n".join(f"{json.dumps(k)}: {json.dumps(v)}" for k, v in out.items())
-    (HERE / "tables_eigenvalues.json").write_text("{\n" + rows + "\n}\n")
+        for name, r in (("tables", rotor()), ("modal", modal_rotor())):
+            r.save(HERE / f"{name}.toml")
+            out = {"ross_version": rs.__version__}
+            for w in SPEEDS_RAD_S:
+                lam, _ = r._eigen(w, sparse=False)
+                out[f"{w:g}"] = [[float(x.real), float(x.imag)] for x in np.asarray(lam)]
+            rows = ",\n".join(f"{json.dumps(k)}: {json.dumps(v)}" for k, v in out.items())
+            (HERE / f"{name}_eigenvalues.json").write_text("{\n" + rows + "\n}\n")

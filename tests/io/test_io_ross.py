@@ -1126,6 +1126,12 @@ def test_ross3_file_read_without_ross_equals_the_ross_import(examples, tmp_path)
         "modal_torsion": _modal_damping_rotor(
             modal_damping_ratio=[0.001 * (k + 1) for k in range(14)],
             default_damping_ratio=0.03),
+        # overhung: no element on the shaft's last node but the shaft's
+        "modal_overhung": _quiet(rs.Rotor, ex.shaft_elements, ex.disk_elements,
+                                 [rs.BearingElement(n, kxx=1e6, kyy=0.8e6, cxx=0)
+                                  for n in (0, 3)],
+                                 modal_damping_ratio=[0.01, 0.02, 0.03, 0.04, 0.05, 0.06],
+                                 default_damping_ratio=0.02),
         "compressor": examples["compressor_example"][0],
         "amb": examples["rotor_amb_example"][0],
     }

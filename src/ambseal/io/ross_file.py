@@ -191,8 +191,9 @@ class _Rotor:
         """ROSS's axial and torsional natural frequencies (rad/s) at standstill, ascending:
         the z and θ DOFs of its six per node, which its lateral ones do not couple to
         (module docstring); DOFs without inertia or stiffness (a housing's θ) left out."""
-        nodes = 1 + max(int(n) for el in self.elements
-                        for n in (el.n, getattr(el, "n_link", None) or 0))
+        nodes = 1 + max([int(el.n) + 1 for el in self.shaft_elements]
+                        + [int(n) for el in self.elements
+                           for n in (el.n, getattr(el, "n_link", None) or 0)])
         M, K = np.zeros((2 * nodes, 2 * nodes)), np.zeros((2 * nodes, 2 * nodes))
 
         def pair(dof, n, m, k):  # [m, m/2; m/2, m]-style pair across nodes n, n + 1

@@ -1089,6 +1089,18 @@ def test_level1_screening_equals_the_same_sweep_in_ross():
     assert r.Q_0 == pytest.approx(q0_ross, rel=0.01)
 
 
+def _gear_motor_rotor():
+    """ROSS 3's ``rotor_example`` with a gear on node 3 (a disk with teeth) and its
+    induction motor (no matrices: named, left out), modal damping ratios on it."""
+    from ross.motors.motor_element import motor_example
+
+    ex = rs.rotor_example()
+    gear = rs.GearElement(n=3, m=8.0, Id=0.03, Ip=0.06, n_teeth=40, pitch_diameter=0.2)
+    geared = _quiet(rs.Rotor, ex.shaft_elements, [*ex.disk_elements, gear],
+                    ex.bearing_elements, modal_damping_ratio=[0.01, 0.02, 0.03, 0.04, 0.05])
+    return _quiet(geared.add_elements, [_quiet(motor_example)])
+
+
 @pytest.mark.skipif(not _takes(rs.BearingElement, "speed"),
                     reason="ROSS < 3: no ROSS 3 file to read")
 def test_ross3_file_read_without_ross_equals_the_ross_import(examples, tmp_path):
@@ -1133,6 +1145,7 @@ def test_ross3_file_read_without_ross_equals_the_ross_import(examples, tmp_path)
                                  modal_damping_ratio=[0.01, 0.02, 0.03, 0.04, 0.05, 0.06],
                                  default_damping_ratio=0.02),
         "compressor": examples["compressor_example"][0],
+        "gear_motor": _gear_motor_rotor(),
         "amb": examples["rotor_amb_example"][0],
     }
     for name, rotor in rotors.items():

@@ -64,9 +64,11 @@ def _kind(name: str) -> type:
 
 
 ShaftElement, CouplingElement, DiskElement, PointMass, BearingElement, \
-    MagneticBearingElement = (_kind(n) for n in (
+    MagneticBearingElement, MotorElement = (_kind(n) for n in (
         "ShaftElement", "CouplingElement", "DiskElement", "PointMass", "BearingElement",
-        "MagneticBearingElement"))
+        "MagneticBearingElement", "MotorElement"))
+#: A gear of a single rotor is a disk with teeth (its mass and inertias in ROSS's matrices)
+_DISKS = {name: _kind(name) for name in ("DiskElement", "GearElement", "GearElementTVMS")}
 
 
 class _Material:
@@ -158,7 +160,7 @@ class _Rotor:
         self.modal_damping_ratio = par.get("modal_damping_ratio")
         self.default_damping_ratio = float(par.get("default_damping_ratio", 0.0) or 0.0)
         self.shaft_elements, self.disk_elements, self.point_mass_elements = [], [], []
-        self.bearing_elements, unknown = [], []
+        self.bearing_elements, unknown, motors = [], [], []
         for key, table in data.items():
             kind = key.split("_")[0]
             if key in ("parameters", "ross_version") or not isinstance(table, dict):
@@ -172,8 +174,10 @@ class _Rotor:
                 self.shaft_elements.append(el)
             elif kind == "CouplingElement":
                 self.shaft_elements.append(CouplingElement(table))
-            elif kind == "DiskElement":
-                self.disk_elements.append(DiskElement(table))
+            elif kind in _DISKS:
+                self.disk_elements.append(_DISKS[kind](table))
+            elif kind == "MotorElement":  # no matrices in ROSS's rotor: named, left out
+                motors.append(MotorElement(table))
             elif kind == "PointMass":
                 self.point_mass_elements.append(PointMass(table))
             elif kind in ("BearingElement", "SealElement"):
@@ -185,7 +189,7 @@ class _Rotor:
                               f"know: {', '.join(unknown)} (install ROSS 3, on Python 3.12 "
                               "or newer, and import again)")
         self.elements = [*self.shaft_elements, *self.disk_elements,
-                         *self.point_mass_elements, *self.bearing_elements]
+                         *self.point_mass_elements, *self.bearing_elements, *motors]
 
     def axial_torsional_rad_s(self) -> np.ndarray:
         """ROSS's axial and torsional natural frequencies (rad/s) at standstill, ascending:

@@ -200,7 +200,8 @@ class _Rotor:
                            for n in (el.n, getattr(el, "n_link", None) or 0)])
         M, K = np.zeros((2 * nodes, 2 * nodes)), np.zeros((2 * nodes, 2 * nodes))
 
-        def pair(dof, n, m, k):  # [m, m/2; m/2, m]-style pair across nodes n, n + 1
+        def pair(dof, n, m, k):  # an element on DOF z (0) or θ (1) of nodes n and n + 1:
+            # mass m (its 2×2 matrix, or 0), stiffness k [1 −1; −1 1]
             i = [2 * n + dof, 2 * (n + 1) + dof]
             M[np.ix_(i, i)] += m
             K[np.ix_(i, i)] += k * np.array([[1.0, -1.0], [-1.0, 1.0]])

@@ -726,13 +726,12 @@ def _sizing_section(metrics: dict) -> list[dict]:
     table = (f'<div class="scroll"><table><tr><th>Controller</th>{head}</tr>{body}'
              "</table></div>")
     text = ("The smallest amplifier that holds the judged worst-case unbalance and the "
-            "current impulse at every judged condition, as each controller runs: its "
-            "control-current limit (zero-to-peak) and supply voltage (R·i0 + |R + jωL| "
-            "times the unbalance's current, R·i0 + |R i + L di/dt| in the impulse, each "
-            "on the static current of the seals' static load where the rig file gives "
-            "one; — "
-            "where the rig file gives neither the coil's inductance nor its geometry), per "
-            "AMB, for both of its axes.")
+            "current impulse at every judged condition, as each controller runs, per AMB "
+            "and for both of its axes: its control-current limit (zero-to-peak) and supply "
+            "voltage — R·i0 + |R + jωL| times the unbalance's current, R·i0 + "
+            "|R i + L di/dt| in the impulse, each on top of the static current that holds "
+            "the seals' static load where the rig file gives one. A dash for the voltage: "
+            "the rig file gives neither the coil's inductance nor its geometry.")
     return [{"title": "Amplifier sizing", "text": text, "html": table}]
 
 

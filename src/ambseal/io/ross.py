@@ -467,9 +467,9 @@ _IMPORTED = {"ShaftElement", "CouplingElement", "DiskElement", "PointMass", "Gea
 
 def _elements(rotor, bearings: list) -> tuple[list[str], list[str]]:
     """What of the rotor ambseal cannot take: what would change the lateral dynamics
-    (refused, one line each: elements without an equivalent, modal damping ratios, a
-    support structure behind a bearing, anything on a node off the shaft) and what would
-    not (named, one line each, in ``unmapped``)."""
+    (refused, one line each: elements without an equivalent, modal damping ratios on a
+    rotor with AMBs, a support structure a housing cannot hold, anything else on a node off
+    the shaft) and what would not (named, one line each, in ``unmapped``)."""
     refused, unmapped = [], []
     if _damping_kind(rotor) == "modal" and any(type(b).__name__ == "MagneticBearingElement"
                                                for b in bearings):

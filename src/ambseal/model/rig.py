@@ -171,7 +171,8 @@ def build_system(
         el.assemble(M, C, K)
         changes += el.channels(n)
     if cfg.rotor.supported_modal_damping is not None:
-        C += _supported_damping(cfg, mesh, rot)[:n, :n]  # (springs left out: no housings)
+        # the shaft's block where the springs, and so their housings, are left out
+        C += _supported_damping(cfg, mesh, rot)[:n, :n]
     out_names = tuple(f"y_{a[2:]}" for a in names)
     for k_i, z in enumerate(force_positions):
         i = mesh.node_at(z)

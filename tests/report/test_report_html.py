@@ -109,9 +109,9 @@ def test_verdict_holds_only_where_the_machine_runs_up_too():
     case = _metrics()[0]
     ok = {"controller": case["controller"], "stable": True,
           "discrete": {"stable": True}}
-    st = [dict(ok, label="2.04 bar, 0 Hz", stable=False),
-          dict(ok, label="2.04 bar, 50 Hz", discrete={"stable": False}),
-          dict(ok, label="2.04 bar, 100 Hz")]
+    st = [dict(ok, label="2.04 bar, 0 Hz", speed_hz=0.0, stable=False),
+          dict(ok, label="2.04 bar, 50 Hz", speed_hz=50.0, discrete={"stable": False}),
+          dict(ok, label="2.04 bar, 100 Hz", speed_hz=100.0)]
     v = verdicts([case], None, st)[0]
     # both zone cells of the row: a loop lost in the speed range is zone D for σ̄ too
     assert v.zone_axis == "D" and v.zone_sigma == "D" and v.speed_checked == 3
@@ -121,10 +121,62 @@ def test_verdict_holds_only_where_the_machine_runs_up_too():
                          "2.04 bar, 50 Hz (where the machine runs up).")
     good = verdicts([case], None, st[2:])[0]
     assert good.zone_sigma == case["iso_zone"]
-    assert good.zone_axis == "B" and good.stable_range == "2.04 bar, standstill to top speed"
+    assert good.zone_axis == "B" and good.stable_range == "2.04 bar, standstill to 100 Hz"
     assert good.words().startswith("Zone B on its worst axis (B η at 2.04 bar) over 2.04 "
                                    "bar: fit for")
-    assert "stable from standstill to the top speed" in good.words()
+    assert "stable from standstill to 100 Hz" in good.words()
+
+
+def test_verdict_claims_standstill_only_where_it_was_judged():
+    """Reference: what was judged — a controller stable at every stability speed given as
+    333.33–1000 Hz (``[design] stability_speeds_hz`` without 0) and at its judged condition
+    (0 Hz in the test data, left out here by moving it to 500 Hz) was not judged at
+    standstill: neither the range nor the sentence may say "standstill"; with 0 Hz among
+    the speeds they say "standstill to 1000 Hz"."""
+    from ambseal.report.verdict import verdicts
+
+    case = dict(_metrics()[0], speed_hz=500.0)
+    ok = {"controller": case["controller"], "stable": True, "discrete": {"stable": True}}
+    st = [dict(ok, label=f"2.04 bar, {f:g} Hz", speed_hz=f)
+          for f in (333.33, 666.667, 750.0, 1000.0)]
+    v = verdicts([case], None, st)[0]
+    assert "standstill" not in v.words().replace("standstill not judged", "")
+    assert v.stable_range == "2.04 bar, 333.33–1000 Hz (standstill not judged)"
+    assert "stable at every judged speed, 333.33–1000 Hz (standstill not judged)" in v.words()
+    st0 = [dict(ok, label="2.04 bar, 0 Hz", speed_hz=0.0), *st]
+    v0 = verdicts([case], None, st0)[0]
+    assert v0.stable_range == "2.04 bar, standstill to 1000 Hz"
+    assert "stable from standstill to 1000 Hz" in v0.words()
+
+
+def test_an_orbit_beyond_the_backup_clearance_fails():
+    """Reference: the rig's clearances — a worst unbalance orbit of 1800 µm (3.6× a 500 µm
+    air gap) with 250 µm backup bearings runs the rotor on them: not acceptable, in numbers,
+    and the controller fails (:func:`ambseal.analysis.delivery.clearance_failure`), its
+    discrete loop's orbit counted too; 200 µm passes and says which share of the backup
+    clearance it uses (80 %); an orbit below half of it says nothing."""
+    from ambseal.analysis import clearance_failure
+    from ambseal.report.verdict import verdicts
+
+    clear = {"air gap": 500.0, "backup bearing": 250.0}
+    base = dict(_metrics()[0], label="2.04 bar")
+    big = dict(base, unbalance_peak_um=120.0, discrete={"stable": True, "unbalance_peak_um": 1800.0})
+    v = verdicts([big], clear)[0]
+    assert v.orbit_um == 1800.0
+    assert v.words() == ("Not acceptable: the worst unbalance orbit, 1.8·10^3 µm, exceeds the "
+                         "backup bearing's clearance (250 µm).")
+    f = clearance_failure("hinf", [big], clear, designed=True)
+    assert f is not None and f.conditions == ["2.04 bar"]
+    assert f.reason == ("H∞: not delivered — the worst unbalance orbit, 1.8e+03 µm, exceeds "
+                        "the backup bearing's clearance (250 µm)")
+    # no backup bearing given: the air gap is the clearance
+    assert "exceeds the air gap (500 µm)" in verdicts([big], {"air gap": 500.0})[0].words()
+    mid = dict(base, unbalance_peak_um=200.0)
+    assert clearance_failure("hinf", [mid], clear, designed=True) is None
+    words = verdicts([mid], clear)[0].words()
+    assert words.startswith("Zone B") and ("the unbalance orbit, 200 µm, uses 80 % of the "
+                                           "backup bearing's clearance (250 µm)") in words
+    assert "orbit" not in verdicts([dict(base, unbalance_peak_um=100.0)], clear)[0].words()
 
 
 def test_verdict_says_what_the_unbalance_asks_of_the_amplifier():
@@ -181,7 +233,7 @@ def test_orbit_against_the_rigs_clearances(tmp_path):
     backup-bearing clearance given in the rig file; the orbit is set against the smaller of
     each kind, in per cent (7.9 µm of 500 µm is 1.58 %)."""
     from ambseal.config import default_rig_path, load_rig
-    from ambseal.report.run_report import rig_clearances_um
+    from ambseal.analysis.delivery import rig_clearances_um
     from ambseal.report.verdict import verdicts
 
     text = default_rig_path().read_text().replace(

@@ -9,7 +9,8 @@ sampled with its delay) on the full-order plant:
   job's cases (:func:`judge_jobs`, :func:`points_for`, :func:`frozen_at`,
   :func:`speed_scheduled`, :func:`judge_spinup`, :func:`unstable_open_loop_poles`) and its
   verdict on a controller that failed (:class:`FailedController`,
-  :func:`synthesis_failure`, :func:`loop_failure`, :func:`also_failed`);
+  :func:`synthesis_failure`, :func:`loop_failure`, :func:`also_failed`; an unbalance orbit
+  beyond the rig's clearances, :func:`clearance_failure` on :func:`rig_clearances_um`);
 * :func:`loop_responses`, :func:`sensitivity_peaks`, :func:`compliance` — S_o, S_i, T_o,
   K S_o and the compliance;
 * :func:`iso_assessment` → :class:`IsoAssessment` — ISO 14839-3 zones from the sensitivity
@@ -70,7 +71,9 @@ _FROM = {
     "probe_scheduler": "cases",
     "run_cases": "cases", "CaseError": "cases", "also_failed": "delivery",
     "loop_failure": "delivery", "saturation_failure": "delivery",
-    "synthesis_failure": "delivery",
+    "synthesis_failure": "delivery", "rig_clearances_um": "delivery",
+    "worst_orbit_um": "delivery", "clearance_exceeded": "delivery",
+    "clearance_failure": "delivery", "CLEARANCE_WORDS": "delivery",
     "FailedController": "delivery", "iso_assessment": "iso", "zone_limit_db": "iso",
     "IsoAssessment": "iso", "ZONES": "iso", "ZONE_LIMITS": "iso", "frozen_at": "judge",
     "judge_case": "judge", "judge_jobs": "judge", "judge_settings": "judge",

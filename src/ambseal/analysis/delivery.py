@@ -23,9 +23,14 @@ import numpy as np
 
 from ambseal.analysis.amplifier import capacity_words, saturates
 from ambseal.config import method_label
+from ambseal.design import machine
 
 __all__ = ["FailedController", "loop_failure", "saturation_failure", "synthesis_failure",
-           "also_failed"]
+           "also_failed", "rig_clearances_um", "worst_orbit_um", "clearance_exceeded",
+           "clearance_failure", "CLEARANCE_WORDS"]
+
+#: How a sentence names each clearance of :func:`rig_clearances_um`.
+CLEARANCE_WORDS = {"air gap": "the air gap", "backup bearing": "the backup bearing's clearance"}
 
 #: Between a failure's head (the controller, delivered or not) and why.
 _SEP = " — "
@@ -174,6 +179,110 @@ def saturation_failure(method: str, capacity: dict | None, designed: bool,
     where = capacity["worst"][worst]["condition"]
     return FailedController(f"{_head(method, designed, kept, derived)}{_SEP}"
                             f"{capacity_words(capacity)}", designed, True, [where])
+
+
+def rig_clearances_um(cfg) -> dict[str, float]:
+    """Clearances (µm) the unbalance orbit is judged against: the nominal AMB air gap
+    (:func:`ambseal.design.specs.machine`: ``air_gap``, or Ki·i0/Ks) and the smallest
+    backup-bearing clearance (``[[amb]] backup_clearance``), those the rig gives.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig.
+
+    Returns
+    -------
+    dict of str to float
+        ``"air gap"`` and ``"backup bearing"`` (µm), those the rig gives.
+    """
+
+    out = {}
+    gap = machine(cfg).air_gap_m if cfg.amb else None
+    if gap:
+        out["air gap"] = gap * 1e6
+    backup = [a.backup_clearance for a in cfg.amb if a.backup_clearance]
+    if backup:
+        out["backup bearing"] = min(backup) * 1e6
+    return out
+
+
+def worst_orbit_um(cases) -> float | None:
+    """The largest worst-case unbalance orbit of a controller's judged cases.
+
+    Parameters
+    ----------
+    cases : sequence of mapping
+        Its judged cases, ``metrics.json`` form: each stable loop's ``unbalance_peak_um``
+        and its ``discrete`` block's (the loop as it runs) count.
+
+    Returns
+    -------
+    float or None
+        The orbit (µm); None where no case has one.
+    """
+    vals = [v for c in cases for v in (c.get("unbalance_peak_um") if c.get("stable") else None,
+                                       (c.get("discrete") or {}).get("unbalance_peak_um"))
+            if v is not None]
+    return max(vals) if vals else None
+
+
+def clearance_exceeded(orbit_um: float | None,
+                       clearances_um: dict | None) -> tuple[str, float] | None:
+    """The smallest clearance the unbalance orbit exceeds: an orbit larger than the backup
+    bearing's clearance runs the rotor on its backup bearings, one larger than the air gap
+    into the stator.
+
+    Parameters
+    ----------
+    orbit_um : float or None
+        The worst unbalance orbit (µm, zero-to-peak), :func:`worst_orbit_um`.
+    clearances_um : mapping of str to float or None
+        :func:`rig_clearances_um` of the rig (µm).
+
+    Returns
+    -------
+    (str, float) or None
+        The clearance's name and size (µm); None where the orbit exceeds none.
+    """
+    over = [(c, n) for n, c in (clearances_um or {}).items()
+            if c and orbit_um is not None and orbit_um > c]
+    if not over:
+        return None
+    c, n = min(over)
+    return n, c
+
+
+def clearance_failure(method: str, cases, clearances_um: dict | None, designed: bool,
+                      kept: bool = False, derived: bool = False) -> FailedController | None:
+    """The failure of a controller whose worst unbalance orbit (:func:`worst_orbit_um`)
+    exceeds a clearance of the rig (:func:`clearance_exceeded`), or None.
+
+    Parameters
+    ----------
+    method : str
+        The controller's method.
+    cases : sequence of dict
+        Its judged cases, ``metrics.json`` form.
+    clearances_um : dict or None
+        :func:`rig_clearances_um` of the rig.
+    designed, kept, derived : bool
+        As :func:`loop_failure`.
+
+    Returns
+    -------
+    FailedController or None
+        Judged; its conditions those whose orbit exceeds the clearance.
+    """
+    orbit = worst_orbit_um(cases)
+    over = clearance_exceeded(orbit, clearances_um)
+    if over is None:
+        return None
+    name, c = over
+    where = [c_["label"] for c_ in cases if (worst_orbit_um([c_]) or 0.0) > c]
+    return FailedController(f"{_head(method, designed, kept, derived)}{_SEP}the worst unbalance "
+                            f"orbit, {orbit:.3g} µm, exceeds {CLEARANCE_WORDS.get(name, name)} "
+                            f"({c:.3g} µm)", designed, True, where)
 
 
 def synthesis_failure(method: str, why: str) -> FailedController:

@@ -17,7 +17,7 @@ from pathlib import Path
 
 from rich.console import Console
 
-from ambseal.analysis import operating_points
+from ambseal.analysis import operating_points, rig_clearances_um
 from ambseal.app import rotordynamics
 from ambseal.app.commands import (
     design_files,
@@ -49,7 +49,7 @@ from ambseal.identify import (
     virtual_static_load,
 )
 from ambseal.model import channel_names
-from ambseal.report import rig_clearances_um, verdict_table_rich, verdicts
+from ambseal.report import verdict_table_rich, verdicts
 
 __all__ = ["HANDLERS"]
 

@@ -20,6 +20,7 @@ from ambseal.analysis import (
     OperatingPoint,
     also_failed,
     capacity_block,
+    clearance_failure,
     facility_rejection,
     facility_speed_step,
     frozen_at,
@@ -30,6 +31,7 @@ from ambseal.analysis import (
     loop_failure,
     operating_points,
     rejection_effect,
+    rig_clearances_um,
     rejection_stability,
     run_cases,
     saturation_failure,
@@ -86,7 +88,6 @@ from ambseal.report import (
     gains_figure,
     judged_on,
     rejection_figure,
-    rig_clearances_um,
     signoff_report,
     spinup_figures,
     stamp,
@@ -603,6 +604,13 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
                                derived=cfg.controller.pid is None)
         if f is not None:
             st.failed[m] = also_failed(st.failed.get(m), f)
+    clearances = rig_clearances_um(cfg)
+    for m in capacity:  # an orbit beyond a clearance runs the rotor on its backup bearings
+        f = clearance_failure(m, [c for j, c in zip(st.jobs, case_dicts) if j.name == m],
+                              clearances, designed=m != "pid", kept=st.allow_unstable,
+                              derived=cfg.controller.pid is None)
+        if f is not None:
+            st.failed[m] = also_failed(st.failed.get(m), f)
     # a failed design is judged and reported, not delivered (unless asked for)
     held = {m for m, f in st.failed.items() if f.designed and not st.allow_unstable}
     summaries = export_all(st.designs, {m: g for m, g in st.digitals.items() if m not in held},
@@ -653,7 +661,7 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
     figs += capacity_figure(out, cfg, currents)
     figs += rejection_figure(out, rejections)
     write_run_report(out, f"ambseal — {cfg.rotor.name}", stamp(rig_path, command),
-                     metrics, curves, figs, sections, rig_clearances_um(cfg),
+                     metrics, curves, figs, sections, clearances,
                      judged_on(cfg, st.truth_cfg if ident is not None else None, truth))
     stages.step()
     return metrics

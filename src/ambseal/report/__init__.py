@@ -1,6 +1,6 @@
 """ambseal.report: figures (matplotlib, Agg) and the self-contained HTML report.
 
-* :func:`write_run_report`, :func:`stamp`, :func:`judged_on`, :func:`rig_clearances_um` —
+* :func:`write_run_report`, :func:`stamp`, :func:`judged_on` —
   the main job's ``report.html`` (:mod:`ambseal.report.run_report`), its figures
   (:func:`gains_figure`, :func:`capacity_figure`, :func:`rejection_figure`,
   :func:`spinup_figures`) and sections
@@ -37,7 +37,7 @@ _FROM = {
     "facility_impulse_report": "run_report", "gains_figure": "run_report",
     "capacity_figure": "run_report", "rejection_figure": "run_report",
     "identification_report": "run_report", "judged_on": "run_report",
-    "rig_clearances_um": "run_report", "spinup_figures": "run_report",
+    "spinup_figures": "run_report",
     "stamp": "run_report", "write_run_report": "run_report",
     "ramp_figure": "tracking_figures", "tracking_figure": "tracking_figures",
     "target_difference": "verdict", "verdict_table_rich": "verdict", "verdicts": "verdict",

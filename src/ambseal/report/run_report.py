@@ -18,7 +18,6 @@ import numpy as np
 from ambseal import __version__
 from ambseal.analysis import force_demand
 from ambseal.config import method_label
-from ambseal.design import machine
 from ambseal.identify import MIN_FIT_PCT, fit_reliability, interval_check, true_line
 from ambseal.lti.freqresp import freqresp
 from ambseal.model import amb_factors, force_capacity, load_capacity
@@ -38,7 +37,7 @@ from ambseal.report.lpv_figures import frozen_sensitivity_figure, spinup_figure
 from ambseal.report.verdict import axis_label, sig
 
 __all__ = ["gains_figure", "capacity_figure", "rejection_figure", "spinup_figures",
-           "identification_report", "write_run_report", "stamp", "rig_clearances_um"]
+           "identification_report", "write_run_report", "stamp"]
 
 
 def stamp(rig_path: str | Path, command: str | None = None) -> str:
@@ -108,32 +107,6 @@ def judged_on(cfg, truth=None, truth_path: str | Path | None = None) -> tuple[st
     name = Path(truth_path).name if truth_path is not None else "its truth file"
     return (f"the virtual facility's truth ({name}, full order), not the rig file; it "
             f"differs from the rig file in: {', '.join(diff) or 'nothing'}", href)
-
-
-def rig_clearances_um(cfg) -> dict[str, float]:
-    """Clearances (µm) the unbalance orbit is judged against: the nominal AMB air gap
-    (:func:`ambseal.design.specs.machine`: ``air_gap``, or Ki·i0/Ks) and the smallest
-    backup-bearing clearance (``[[amb]] backup_clearance``), those the rig gives.
-
-    Parameters
-    ----------
-    cfg : RigConfig
-        The rig.
-
-    Returns
-    -------
-    dict of str to float
-        ``"air gap"`` and ``"backup bearing"`` (µm), those the rig gives.
-    """
-
-    out = {}
-    gap = machine(cfg).air_gap_m if cfg.amb else None
-    if gap:
-        out["air gap"] = gap * 1e6
-    backup = [a.backup_clearance for a in cfg.amb if a.backup_clearance]
-    if backup:
-        out["backup bearing"] = min(backup) * 1e6
-    return out
 
 
 def gains_figure(out: Path, controllers: list[tuple[str, object]]) -> tuple[str, Path]:
@@ -627,7 +600,7 @@ def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: li
     extra_sections : list of dict
         ``{"title", "html"}`` of each further section.
     clearances_um : dict, optional
-        :func:`rig_clearances_um` of the rig, for the unbalance orbit.
+        :func:`ambseal.analysis.delivery.rig_clearances_um` of the rig, for the unbalance orbit.
     judged_on : (str, str), optional
         :func:`judged_on`'s line and link.
 

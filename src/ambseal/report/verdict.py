@@ -24,7 +24,8 @@ from rich.console import Group
 from rich.table import Table
 from rich.text import Text
 
-from ambseal.analysis import capacity_words, saturates
+from ambseal.analysis import (CLEARANCE_WORDS, capacity_words, clearance_exceeded, saturates,
+                               worst_orbit_um)
 from ambseal.model import axis_label
 from ambseal.robust import PEAK_TOLERANCE
 
@@ -116,6 +117,9 @@ class Verdict:
     capacity : dict or None
         The amplifier's limits the unbalance uses (the design summary's ``capacity``,
         :func:`ambseal.analysis.amplifier.capacity_block`); None without one.
+    speeds_hz : tuple of float
+        Every speed (Hz) the loop was judged at, in full or for stability only, sorted:
+        what the verdict may claim of the speed range (standstill only if 0 is among them).
     """
 
     controller: str
@@ -136,6 +140,17 @@ class Verdict:
     worst_axis: str | None = None
     axes_alike: bool = True
     capacity: dict | None = None
+    speeds_hz: tuple[float, ...] = ()
+
+    def speed_span(self) -> str:
+        """The judged speeds in words: ``"standstill to 1000 Hz"``, or ``"333–1000 Hz
+        (standstill not judged)"`` when 0 Hz was not among them."""
+        if not self.speeds_hz:
+            return "the judged speeds"
+        lo, hi = self.speeds_hz[0], self.speeds_hz[-1]
+        if lo == 0:
+            return f"standstill to {hi:g} Hz"
+        return f"{lo:g}–{hi:g} Hz (standstill not judged)"
 
     @property
     def judged_range(self) -> str:
@@ -158,7 +173,7 @@ class Verdict:
             text += (f"; unstable at {len(self.speed_unstable)} of {self.speed_checked} "
                      f"speed-range conditions")
         elif self.speed_checked:
-            text += ", standstill to top speed"
+            text += f", {self.speed_span()}"
         return text
 
     def orbit_text(self) -> str:
@@ -186,6 +201,10 @@ class Verdict:
             return f"Not acceptable: the loop is unstable at {where}{run}{tail}."
         if saturates(self.capacity):
             return f"Not acceptable: {self.amplifier_text()}."
+        over = clearance_exceeded(self.orbit_um, self.clearances_um)
+        if over is not None:
+            return (f"Not acceptable: the worst unbalance orbit, {sig(self.orbit_um)} µm, "
+                    f"exceeds {CLEARANCE_WORDS.get(over[0], over[0])} ({sig(over[1])} µm).")
         z = self.zone_axis or "?"
         where = ("on every axis" if self.axes_alike or self.worst_axis is None else
                  f"on its worst axis ({self.worst_axis})")
@@ -198,10 +217,15 @@ class Verdict:
                      f"{sig(self.sigma_peak)})")
         text += f": {ZONE_WORDS.get(worse or z, 'not graded')}"
         if self.speed_checked:
-            text += "; stable from standstill to the top speed"
-        gap = [c for c in self.clearances_um.values() if c]
-        if self.orbit_um is not None and gap and self.orbit_um > 0.5 * min(gap):
-            text += "; the unbalance orbit uses over half of the clearance"
+            span = self.speed_span()
+            text += (f"; stable from {span}" if span.startswith("standstill")
+                     else f"; stable at every judged speed, {span}")
+        gap = [(c, n) for n, c in self.clearances_um.items() if c]
+        if self.orbit_um is not None and gap and self.orbit_um > 0.5 * min(gap)[0]:
+            c, n = min(gap)
+            text += (f"; the unbalance orbit, {sig(self.orbit_um)} µm, uses "
+                     f"{100 * self.orbit_um / c:.0f} % of {CLEARANCE_WORDS.get(n, n)} "
+                     f"({sig(c)} µm)")
 
         amp = self.amplifier_text()
         if amp:
@@ -292,14 +316,16 @@ def _verdict(name: str, cs: list, by_speed: bool, sc: list,
         unstable_at=tuple(lb for lb, c in zip(label, cs) if not c.get("stable")),
         zone_axis=_worst(axis_zones),
         zone_sigma=_worst([c.get("iso_zone") for c in cs] + lost),
-        sigma_peak=peak("sensitivity_peak"), orbit_um=peak("unbalance_peak_um"),
+        sigma_peak=peak("sensitivity_peak"), orbit_um=worst_orbit_um(cs),
         impulse_peak_um=peak("impulse_peak_um"),
         impulse_settling_s=peak("impulse_settling_s"),
         clearances_um=dict(clearances_um or {}), target_difference=target_difference(cs),
         speed_checked=len(sc), speed_unstable=speed_bad,
         design_bound=(design.get("verdict") or "").split(";")[0] or None,
         worst_axis=None if top is None else f"{axis_label(top[1])} at {top[2]}",
-        axes_alike=len(stable_zones) <= 1, capacity=design.get("capacity"))
+        axes_alike=len(stable_zones) <= 1, capacity=design.get("capacity"),
+        speeds_hz=tuple(sorted({float(c["speed_hz"]) for c in [*cs, *sc]
+                                if c.get("speed_hz") is not None})))
 
 
 def _worst_axis(labels: list[str], cs: list) -> tuple | None:

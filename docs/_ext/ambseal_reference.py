@@ -351,6 +351,10 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "UnbalanceSpec.force_at": ("", "seal, disk, AMB or spring where the force acts and the "
                                    "compliance is taken"),
     "UnbalanceSpec.range_hz": ("Hz", "``[low, high]`` speeds of the unbalance response"),
+    "UnbalanceSpec.plant": ("", "``running`` (default): at each speed the plant built at "
+                                "that speed, forward-turning forces; ``frozen``: the plant "
+                                "at the judged condition, the forcing swept (the thesis's "
+                                "simplification, P5 §4.4.1)"),
     "ImpulseSpec.amplitude_a": ("A", "current impulse amplitude (P5 §5.1); also the "
                                      "amplitude of every identification excitation"),
     "ImpulseSpec.duration_s": ("s", "current impulse duration (judgement and identification)"),

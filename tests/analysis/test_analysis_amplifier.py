@@ -9,7 +9,7 @@ import pytest
 
 from ambseal.analysis.amplifier import capacity_block, capacity_words, force_demand
 from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
-from ambseal.analysis.unbalance import unbalance_force
+from ambseal.analysis.unbalance import forward_forces, unbalance_force
 from ambseal.design.specs import design_spec
 from ambseal.model import amb_factors
 from ambseal.model.rig import build_plant
@@ -26,28 +26,29 @@ def judged(testrig_cfg, testrig_designs):
 
 def test_unbalance_current_is_the_controller_on_the_compliance(testrig_cfg, judged):
     """Reference: python-control's responses of the same loop at the axis's worst speed —
-    the plant from the currents and from the forces at the bearings, the controller with
-    its hold and computation delay as e^{−jΩτ} (τ = (n_d + ½)/f_s, exact, where the judge
-    takes its Padé system) — i = K (I + G K)⁻¹ G_f f over every force of amplitude F_u
-    (ISO 21940-11 at that speed): its largest value on an axis is the row's Euclidean norm
+    the plant built at that speed from the currents and from the forces at the bearings,
+    the controller with its hold and computation delay as e^{−jΩτ} (τ = (n_d + ½)/f_s,
+    exact, where the judge takes its Padé system) — i = K (I + G K)⁻¹ G_f T c over every
+    forward-turning force of amplitude F_u (T the bearing planes' forward forces, ISO
+    21940-11 at that speed): its largest value on an axis is the row's Euclidean norm
     times F_u. To 1 %."""
     s, K, case, curves = judged
     speeds, current, names = curves["unbalance_current"]
     assert current.shape == (speeds.size, 4) and names[0].startswith("i_")
-    pl = build_plant(testrig_cfg, pressure_bar=0.0, force_positions=tuple(s.force_positions_m))
-    P = pl.to_statespace()
-    cur = [j for j, n in enumerate(P.input_labels) if n.startswith("i_")]
-    frc = [j for j in range(P.ninputs) if j not in cur]
     tau = (testrig_cfg.controller.delay_samples + 0.5) / testrig_cfg.controller.sample_rate_hz
     for a in (0, 3):
         k = int(np.argmax(current[:, a]))
+        P = build_plant(testrig_cfg, pressure_bar=0.0, speed_rpm=60.0 * speeds[k],
+                        force_positions=tuple(s.force_positions_m)).to_statespace()
+        cur = [j for j, n in enumerate(P.input_labels) if n.startswith("i_")]
+        frc = [j for j in range(P.ninputs) if j not in cur]
         w = 2 * math.pi * speeds[k]
         H = ct.frequency_response(P, [w], squeeze=False).complex[:, :, 0]
         Kf = ct.frequency_response(K, [w], squeeze=False).complex[:, :, 0]
         # the controller's channels in the plant's order, by name
         Kw = Kf[[list(K.output_labels).index(P.input_labels[j]) for j in cur]][
             :, [list(K.input_labels).index(n) for n in P.output_labels]] * np.exp(-1j * w * tau)
-        G, Gf = H[:, cur], H[:, frc]
+        G, Gf = H[:, cur], H[:, frc] @ forward_forces([P.input_labels[j] for j in frc])
         T = Kw @ np.linalg.solve(np.eye(G.shape[0]) + G @ Kw, Gf)
         F = unbalance_force(s.unbalance_mass_kg, s.unbalance_grade_mm_s, [w],
                             max_speed_rad_s=2 * math.pi * s.unbalance_max_speed_hz,

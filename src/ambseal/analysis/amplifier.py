@@ -1,11 +1,12 @@
 """What the judged unbalance response asks of each AMB's amplifier.
 
-The judgement bounds the synchronous orbit by σ̄(S_o G_f(jΩ))·F_u(Ω) over every
-distribution of an unbalance force of amplitude F_u over the bearing planes
-(:mod:`ambseal.analysis.unbalance`). The control current the loop commands for that force is
+The judgement bounds the synchronous orbit over every distribution of an unbalance force
+of amplitude F_u over the bearing planes (:mod:`ambseal.analysis.unbalance`): by default
+forward-turning forces f = T c on the loop at the running speed Ω, else (the thesis's
+frozen plant) every force f. The control current the loop commands for that force is
 i = −K S_o G_f f, so the current reference of axis a, over the same forces, is at most
 
-    i_ref,a(Ω) = ‖(K S_o G_f)(jΩ)_a,:‖₂ · F_u(Ω)
+    i_ref,a(Ω) = ‖(K S_o G_f T)(jΩ)_a,:‖₂ · F_u(Ω)      (T = I for every force)
 
 (the row's Euclidean norm: the worst distribution for that axis), and its coil current
 i_c = |H_a(jΩ)|·i_ref with H_a the amplifier's current loop (``[actuator]``,

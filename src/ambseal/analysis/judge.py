@@ -56,7 +56,8 @@ from ambseal.analysis.loops import (
 from ambseal.analysis.response import impulse_response_of
 from ambseal.analysis.spinup import frozen_sensitivity, spinup
 from ambseal.analysis.amplifier import unbalance_currents
-from ambseal.analysis.unbalance import unbalance_from_compliance
+from ambseal.analysis.synchronous import hold_fundamental, running_plant
+from ambseal.analysis.unbalance import running_unbalance, unbalance_from_compliance
 from ambseal.design import RIGID_STATES, vertex_grid_hz
 from ambseal.design.lpv_plant import lpv_plant
 from ambseal.lti import eigenvalues, finite_or_none, freqresp_at, json_float, wired
@@ -112,6 +113,10 @@ class JudgeSettings:
     impulse_start_s, impulse_end_s, impulse_dt_s : float
         Start of the impulse, end of the simulated window and sample time of the response
         (s).
+    unbalance_plant : {"running", "frozen"}
+        The unbalance response's plant (:mod:`ambseal.analysis.unbalance`): at each speed
+        the one built at that speed (with the controller as it acts there), or frozen at
+        the judged condition (the thesis's simplification).
     """
 
     freq_hz: tuple[float, float, int]
@@ -126,12 +131,13 @@ class JudgeSettings:
     impulse_start_s: float
     impulse_end_s: float
     impulse_dt_s: float
+    unbalance_plant: str = "running"
 
     def unbalance_dict(self) -> dict:
         """The unbalance settings as ``metrics.json`` states them (grade, law, Ω_max/2π, speeds)."""
         return {"grade_mm_s": self.unbalance_grade_mm_s, "law": self.unbalance_law,
                 "max_speed_hz": self.unbalance_max_speed_hz,
-                "range_hz": list(self.unbalance_range_hz)}
+                "range_hz": list(self.unbalance_range_hz), "plant": self.unbalance_plant}
 
 
 #: points of the judgement's log grid (before the refinement around lightly damped poles)
@@ -257,7 +263,7 @@ def judge_settings(spec) -> JudgeSettings:
         unbalance_mass_kg=sp.unbalance_mass_kg, unbalance_law=sp.unbalance_law,
         unbalance_max_speed_hz=sp.unbalance_max_speed_hz, force_positions_m=sp.force_positions_m,
         impulse_a=sp.impulse_a, impulse_s=t, impulse_start_s=5 * t, impulse_end_s=35 * t,
-        impulse_dt_s=0.5 / sp.machine.sample_rate_hz)
+        impulse_dt_s=0.5 / sp.machine.sample_rate_hz, unbalance_plant=sp.unbalance_plant)
 
 
 @dataclass(frozen=True)
@@ -420,7 +426,7 @@ def unstable_open_loop_poles(A: np.ndarray, C: np.ndarray | None = None) -> np.n
 
 def judge(cfg, controller, name: str, point: OperatingPoint,
           settings: JudgeSettings, *, impulse: bool = True,
-          discrete=None) -> tuple[JudgedCase, dict]:
+          discrete=None, schedule=None, schedule_discrete=None) -> tuple[JudgedCase, dict]:
     """Judge one physical controller on the full-order plant at one operating point.
 
     Parameters
@@ -442,6 +448,10 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
         computation delay included
         (:meth:`ambseal.robust.digital.DigitalController.statespace` ``(delayed=True)``):
         judged the same way on the plant sampled at ``dt`` (module docstring).
+    schedule, schedule_discrete : ScheduledController, ScheduledDigital, optional
+        A controller scheduled on speed, continuous and as it runs, of which ``controller``
+        and ``discrete`` are the frozen ones at ``point``: the unbalance response at the
+        running speed (``settings.unbalance_plant``) takes it at each speed.
 
     Returns
     -------
@@ -471,24 +481,69 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
     static = (rest[len(force):], [seal_static_load(sl, point.pressure_bar) for sl in offset])
     P = plant.to_statespace()
     dl = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples)
+
+    def running(sched):
+        """The unbalance response with the plant at each speed, for one loop: the controller
+        as the loop has it (wired, continuous or discrete) or scheduled on speed."""
+        if s.unbalance_plant != "running":
+            return None
+        positions = tuple(s.force_positions_m)
+
+        def plant_at(speeds):
+            return running_plant(cfg, speeds, positions, pressure_bar=point.pressure_bar)
+
+        return lambda G, K: running_unbalance(
+            plant_at, _controller_at_speed(G, K, sched, dl.system), s.unbalance_range_hz,
+            mass_kg=s.unbalance_mass_kg, grade_mm_s=s.unbalance_grade_mm_s,
+            law=s.unbalance_law, max_speed_rad_s=2 * math.pi * s.unbalance_max_speed_hz)
+
     body, curves = _judge_loop(judged_loop(P, controller, cur, delay=dl.system), cur, force,
-                               controller, s, impulse, static)
+                               controller, s, impulse, static, running(schedule))
     disc = None
     if discrete is not None:
         disc, curves["discrete"] = _judge_loop(judged_loop(P, discrete, cur), cur, force,
-                                               discrete, s, impulse, static)
+                                               discrete, s, impulse, static,
+                                               running(schedule_discrete))
     case = JudgedCase(**vars(body), controller=name, pressure_bar=point.pressure_bar,
                       speed_hz=point.speed_rpm / 60.0, label=point.label, delay=dl.to_dict(),
                       discrete=disc)
     return case, curves
 
 
+def _controller_at_speed(G, K, schedule, delay):
+    """``controller_at(Ω)`` of :func:`ambseal.analysis.unbalance.running_unbalance` for the
+    controller ``K`` wired to ``G``: continuous, ``K(jΩ)`` behind the judged loop's delay
+    lag (its current reference the same, |lag| = 1); discrete, ``K_d(e^{jΩT})`` times the
+    hold's fundamental in the loop and at the samples for the current. A controller
+    ``schedule``\ d on speed is taken at each speed Ω."""
+    dt = float(K.dt or 0.0)
+
+    def at(Kx, w):
+        if dt:
+            Kw = freqresp_at(Kx, np.exp(1j * w * dt))
+            return Kw * hold_fundamental(w, dt)[:, None, None], Kw
+        Kw = freqresp_at(Kx, 1j * w)
+        if delay is not None:
+            Kw = Kw * freqresp_at(delay, 1j * w)[:, :1, :1]
+        return Kw, Kw
+
+    if schedule is None:
+        return lambda w: at(K, w)
+
+    def scheduled(w):
+        parts = [at(wired(G, frozen(schedule, x) if not dt else
+                          controller_as_runs(schedule, x)), np.array([x])) for x in w]
+        return tuple(np.concatenate([p[i] for p in parts]) for i in (0, 1))
+    return scheduled
+
+
 def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, impulse: bool,
-                static=((), ())) -> tuple[LoopJudgement, dict]:
+                static=((), ()), running=None) -> tuple[LoopJudgement, dict]:
     """The case's numbers for one judged loop, continuous or discrete: its plant with
     current inputs ``cur``, force inputs ``force`` and the seals' static loads ``static``
     (their x/y force inputs, and per seal the 2 × 2 force per unit offset and the offset,
-    :func:`seal_static_load`)."""
+    :func:`seal_static_load`). ``running(G, K)`` gives the unbalance response at the
+    running speed; None takes it from the plant frozen at the condition."""
 
     # signal names from the continuous plant: a sampled one is not formed (its modal
     # form serves the responses, the poles and the impulse response)
@@ -502,7 +557,9 @@ def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, im
     f_hi = 0.999 * 0.5 / dt if dt else s.freq_hz[1]  # discrete: up to Nyquist
     w = 2 * np.pi * np.logspace(math.log10(s.freq_hz[0]), math.log10(f_hi), s.freq_hz[2])
     w = resolved_grid(w, loop.s_poles)  # a 0.5 %-damped bending mode must not slip through
-    wu = resolved_grid(2 * np.pi * np.linspace(*s.unbalance_range_hz, 400), loop.s_poles)
+    # the frozen plant's unbalance grid (the running plant's is its own)
+    wu = (resolved_grid(2 * np.pi * np.linspace(*s.unbalance_range_hz, 400), loop.s_poles)
+          if running is None else np.empty(0))
     # the plant (currents and force share its A) and the controller evaluated once, on both
     # grids: from the continuous plant's modal form, shared by every controller judged there
     ww = np.concatenate([w, wu])
@@ -526,17 +583,19 @@ def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, im
         case.update(compliance_peak_m_per_n=None, unbalance_peak_um=None,
                     impulse_peak_um=None, impulse_settling_s=None)
         return LoopJudgement(**case), curves
-    c, cu = (compliance_from(Gw[sl], Kw[sl], Gfw[sl], grid, ny_names, f_names)
-             for sl, grid in ((slice(0, w.size), w), (slice(w.size, None), wu)))
+    c = compliance_from(Gw[:w.size], Kw[:w.size], Gfw[:w.size], w, ny_names, f_names)
     curves["compliance"] = (w / (2 * np.pi), c.sigma_max_m_per_n)
-    unb = unbalance_from_compliance(cu, mass_kg=s.unbalance_mass_kg,
-                                    grade_mm_s=s.unbalance_grade_mm_s, law=s.unbalance_law,
-                                    max_speed_rad_s=2 * math.pi * s.unbalance_max_speed_hz)
+    if running is None:
+        cu = compliance_from(Gw[w.size:], Kw[w.size:], Gfw[w.size:], wu, ny_names, f_names)
+        unb = unbalance_from_compliance(cu, mass_kg=s.unbalance_mass_kg,
+                                        grade_mm_s=s.unbalance_grade_mm_s, law=s.unbalance_law,
+                                        max_speed_rad_s=2 * math.pi * s.unbalance_max_speed_hz)
+        # the current references that hold it, per axis (ambseal.analysis.amplifier)
+        held = unbalance_currents(Kw[w.size:], cu.H_m_per_n, unb.force_n), tuple(nu_names)
+    else:
+        unb, *held = running(G, controller)
     curves["unbalance"] = (unb.speed_hz, unb.response_um)
-    # the current references that hold it, per axis (ambseal.analysis.amplifier)
-    curves["unbalance_current"] = (unb.speed_hz,
-                                   unbalance_currents(Kw[w.size:], cu.H_m_per_n, unb.force_n),
-                                   tuple(nu_names))
+    curves["unbalance_current"] = (unb.speed_hz, *held)
     case.update(compliance_peak_m_per_n=c.peak.value, unbalance_peak_um=unb.peak_um)
     if static[0]:
         curves["static_current"] = static_currents(judged, controller, cur, *static)
@@ -680,8 +739,17 @@ def judge_jobs(designs, digitals: dict, points, design_cfg) -> list[dict]:
         One job per design and point.
     """
     return [JudgeJob(d.method, p, frozen_at(d.controller, p, design_cfg),
-                     frozen_discrete(digitals.get(d.method), p, design_cfg))
+                     frozen_discrete(digitals.get(d.method), p, design_cfg),
+                     *_on_speed(d.controller, digitals.get(d.method)))
             for d in designs for p in points_for(d.controller, points, design_cfg)]
+
+
+def _on_speed(K, digital) -> tuple:
+    """(continuous, as it runs) of a controller scheduled on speed, for the unbalance
+    response at the running speed; (None, None) for any other."""
+    if not (isinstance(K, ScheduledController) and K.parameter == SPEED):
+        return None, None
+    return K, (digital if getattr(digital, "parameter", None) == SPEED else None)
 
 
 @dataclass(frozen=True)
@@ -700,12 +768,17 @@ class JudgeJob:
     discrete : control.StateSpace or None
         The delayed discrete controller that runs there (its sample time ``dt``); None for
         a controller that cannot run on the target.
+    schedule, schedule_discrete : ScheduledController, ScheduledDigital or None
+        A controller scheduled on speed, continuous and as it runs (the unbalance response
+        takes it at each speed, :func:`judge`); None for any other.
     """
 
     name: str
     point: OperatingPoint
     controller: Any
     discrete: Any = None
+    schedule: Any = None
+    schedule_discrete: Any = None
 
 
 def frozen_discrete(digital, point, design_cfg):
@@ -739,7 +812,8 @@ def judge_case(case: JudgeJob, cfg, settings: JudgeSettings) -> tuple[JudgedCase
         The curves for the figures (:func:`judge`).
     """
     return judge(cfg, case.controller, case.name, case.point, settings,
-                 discrete=case.discrete)
+                 discrete=case.discrete, schedule=case.schedule,
+                 schedule_discrete=case.schedule_discrete)
 
 
 def judge_spinup(cfg, controllers: dict) -> tuple[dict, list, list]:

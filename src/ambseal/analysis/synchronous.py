@@ -30,13 +30,14 @@ amplitudes of one sinusoid each.
 
 from __future__ import annotations
 
+import hashlib
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ambseal.errors import ModelError
-from ambseal.lti import freqresp_at, shared_ss, wired
+from ambseal.lti import ArrayMemo, freqresp_at, shared_ss, wired
 from ambseal.machine import controller_as_runs
 from ambseal.model import (
     AXES,
@@ -48,7 +49,8 @@ from ambseal.model import (
     seal_values,
 )
 
-__all__ = ["Unbalance", "SynchronousResponse", "synchronous_response", "orbit_semi_major"]
+__all__ = ["Unbalance", "SynchronousResponse", "synchronous_response", "orbit_semi_major",
+           "RunningPlant", "running_plant", "hold_fundamental"]
 
 
 @dataclass(frozen=True)
@@ -110,6 +112,13 @@ def _siso_at(mats, s: complex) -> complex:
     return complex((C @ np.linalg.solve(s * np.eye(A.shape[0]) - A, B) + D)[0, 0])
 
 
+def hold_fundamental(w: np.ndarray, dt: float) -> np.ndarray:
+    """The zero-order hold's fundamental ``(1 − e^{−jΩT})/(jΩT) = e^{−jΩT/2} sinc(ΩT/2π)``
+    (module docstring; 1 at standstill), shape of ``w`` (rad/s); ``dt`` the sample time (s)."""
+    w = np.asarray(w, float)
+    return np.exp(-0.5j * w * dt) * np.sinc(w * dt / (2 * math.pi))
+
+
 def _controller_at(controller, out_names, in_names, omegas: np.ndarray,
                    values: dict) -> np.ndarray:
     """``K_r(Ω)`` at each speed (n_s × nu × ny, the plant's input × output order; module
@@ -124,9 +133,7 @@ def _controller_at(controller, out_names, in_names, omegas: np.ndarray,
         K = wired(names, K)
         dt = float(K.dt)
         Kw = freqresp_at(K, np.exp(1j * w * dt))
-        # the ZOH's (1 − e^{−jΩT})/(jΩT) = e^{−jΩT/2} sinc(ΩT/2π), 1 at standstill
-        hold = np.exp(-0.5j * w * dt) * np.sinc(w * dt / (2 * math.pi))
-        return Kw * hold[:, None, None]
+        return Kw * hold_fundamental(w, dt)[:, None, None]
 
     if hasattr(controller, "statespace_at"):
         return np.concatenate([at(controller_as_runs(controller, w, values), np.array([w]))
@@ -169,19 +176,8 @@ def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
     where = tuple(sorted({*(u.position for c in cases for u in c), *map(float, zs)}))
     act = (actuator_matrices(cfg.actuator), eddy_lag_matrices(cfg.actuator.eddy_time_constant))
     p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
-    # the rotor, AMBs and springs once; the seals per speed where a table follows the
-    # synchronous frequency (P3 §4), else once
-    base = build_system(cfg, speed_rpm=0.0, include_seals=False, force_positions=where)
+    base, stiffness = _running_system(cfg, where, p)
     mesh, n = base.mesh, base.n_dof
-    follow = any(s.frequency_dependent for s in cfg.seal)
-
-    def seals(f_hz: float):
-        M, C, K = (np.zeros((n, n)) for _ in range(3))
-        for s in cfg.seal:
-            SealElement.from_config(s, mesh, p, f_hz).assemble(M, C, K)
-        return M, C, K
-
-    fixed = None if follow else seals(0.0)
     F1 = np.zeros((n, len(cases)), dtype=complex)  # per unit Ω²
     for c, case in enumerate(cases):
         for u in case:
@@ -204,9 +200,7 @@ def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
     amp = np.empty((len(cases), speeds.size, zs.size))
     for k, f in enumerate(speeds):
         omega = 2 * math.pi * f
-        Ms, Cs, Ks = fixed if fixed is not None else seals(f)
-        Z = (base.K + Ks - omega ** 2 * (base.M + Ms)
-             + 1j * omega * (base.C + Cs + omega * base.G))
+        Z = stiffness(f)
         if closed:
             h_amp, h_eddy = (_siso_at(m, 1j * omega) for m in act)
             Z = Z + (Bi * (h_amp * h_eddy)) @ Krs[k] @ base.Cq
@@ -226,6 +220,130 @@ def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
     return SynchronousResponse(speed_hz=speeds, positions_m=zs, amplitude_m=amp,
                                current_a=current, force_n=force,
                                axes=tuple(base.input_names[:n_cur]))
+
+
+def _running_system(cfg, where: tuple, p: float):
+    """The rotor, AMBs and springs with force inputs at ``where`` (m), and the dynamic
+    stiffness at a speed ``f`` (Hz) for whirl at that speed: ``K − Ω²M + jΩ(C + ΩG)`` with
+    the seals at pressure drop ``p`` (bar) at the synchronous frequency (P3 §4), assembled
+    once where no seal table follows the frequency."""
+    # the rotor, AMBs and springs once; the seals per speed where a table follows the
+    # synchronous frequency (P3 §4), else once
+    base = build_system(cfg, speed_rpm=0.0, include_seals=False, force_positions=where)
+    mesh, n = base.mesh, base.n_dof
+    follow = any(s.frequency_dependent for s in cfg.seal)
+
+    def seals(f_hz: float):
+        M, C, K = (np.zeros((n, n)) for _ in range(3))
+        for s in cfg.seal:
+            SealElement.from_config(s, mesh, p, f_hz).assemble(M, C, K)
+        return M, C, K
+
+    fixed = None if follow else seals(0.0)
+
+    def stiffness(f_hz: float) -> np.ndarray:
+        omega = 2 * math.pi * f_hz
+        Ms, Cs, Ks = fixed if fixed is not None else seals(f_hz)
+        return (base.K + Ks - omega ** 2 * (base.M + Ms)
+                + 1j * omega * (base.C + Cs + omega * base.G))
+
+    return base, stiffness
+
+
+@dataclass(frozen=True)
+class RunningPlant:
+    """The open loop at the running speed: at each speed Ω the plant built at Ω (its
+    gyroscopics, its seals at the synchronous frequency) evaluated at ``jΩ``.
+
+    Attributes
+    ----------
+    speed_hz : ndarray, shape (n_s,)
+        The speeds (Hz), each the forcing frequency too.
+    Gu : ndarray of complex, shape (n_s, ny, nu)
+        Sensors (m) per current reference (A), through the amplifier's current loop and the
+        eddy-current lag (``[actuator]``): the plant ``build_plant`` makes, at ``jΩ`` and Ω.
+    Gf : ndarray of complex, shape (n_s, ny, nf)
+        Sensors (m) per force (N) at each force position, x then y.
+    inputs, outputs, forces : tuple of str
+        The current inputs ``i_<amb>_<axis>``, sensors ``y_<amb>_<axis>`` and forces
+        ``F<k>_<x|y>``, in the order of the arrays' axes.
+    """
+
+    speed_hz: np.ndarray
+    Gu: np.ndarray
+    Gf: np.ndarray
+    inputs: tuple
+    outputs: tuple
+    forces: tuple
+
+    @property
+    def nbytes(self) -> int:
+        """The arrays' bytes (for :class:`ambseal.lti.ArrayMemo`'s budget)."""
+        return int(self.speed_hz.nbytes + self.Gu.nbytes + self.Gf.nbytes)
+
+
+def running_plant(cfg, speeds_hz, force_positions, *, pressure_bar: float | None = None
+                  ) -> RunningPlant:
+    """The plant at each speed for forcing at that speed (:class:`RunningPlant`): every
+    response to a synchronous force takes the plant at its speed, not the plant frozen at
+    one speed with the forcing frequency swept.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig (with AMBs).
+    speeds_hz : array_like, shape (n_s,)
+        Speeds (Hz), > 0 (each is the forcing frequency).
+    force_positions : sequence of float
+        Where the forces act (m).
+    pressure_bar : float, optional
+        The seals' pressure drop (``[operating] pressure_bar`` if omitted).
+
+    Returns
+    -------
+    RunningPlant
+        Kept for the last few rigs, pressures and grids (the controllers judged at one
+        condition close the same open loop).
+
+    Raises
+    ------
+    ModelError
+        A singular dynamic stiffness (an undamped open-loop mode exactly at a speed), or a
+        rig without AMBs.
+    """
+    speeds = np.array(np.atleast_1d(np.asarray(speeds_hz, dtype=float)))
+    where = tuple(float(z) for z in force_positions)
+    p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
+    rig = hashlib.sha256(cfg.model_dump_json().encode()).digest()
+    key = hashlib.sha256(rig + speeds.tobytes()).digest()
+    return _RUNNING.get_digested(key, (p, where), lambda: _running_plant(cfg, speeds, where, p))
+
+
+#: The open loops at the running speed of the last conditions: each judged condition's
+#: controllers (continuous and as they run) close the same one.
+_RUNNING = ArrayMemo(keep=8, keep_bytes=16 * 2**20)
+
+
+def _running_plant(cfg, speeds: np.ndarray, where: tuple, p: float) -> RunningPlant:
+    base, stiffness = _running_system(cfg, where, p)
+    n_cur = len(base.output_names)
+    if n_cur == 0:
+        raise ModelError("the running plant needs AMBs: the rig has none")
+    act = (actuator_matrices(cfg.actuator), eddy_lag_matrices(cfg.actuator.eddy_time_constant))
+    Bi, Bf = base.B[:, :n_cur], base.B[:, n_cur:]
+    Gu = np.empty((speeds.size, n_cur, n_cur), complex)
+    Gf = np.empty((speeds.size, n_cur, Bf.shape[1]), complex)
+    for k, f in enumerate(speeds):
+        h_amp, h_eddy = (_siso_at(m, 2j * math.pi * f) for m in act)
+        try:
+            X = np.linalg.solve(stiffness(f), np.hstack([Bi * (h_amp * h_eddy), Bf]))
+        except np.linalg.LinAlgError:
+            raise ModelError(f"running plant: the dynamic stiffness is singular at {f:g} Hz "
+                             "(an undamped mode at that speed)") from None
+        Y = base.Cq @ X
+        Gu[k], Gf[k] = Y[:, :n_cur], Y[:, n_cur:]
+    return RunningPlant(speeds, Gu, Gf, tuple(base.input_names[:n_cur]),
+                        tuple(base.output_names), tuple(base.input_names[n_cur:]))
 
 
 def _ks(cfg, input_name: str) -> float:

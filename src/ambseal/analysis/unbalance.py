@@ -25,8 +25,28 @@ over the bearing planes. It also reproduces the thesis's finding that the H∞ a
 controllers, not the PID, keep the orbit below 8 µm (P5 §4.4.1; on the embedded rig over
 0–4.08 bar: H∞ 5.1, μ 4.6, the PID 10 µm; a force at the seal would put every controller,
 the PID too, below 5 µm). ``[design.unbalance] force_at`` puts it at a named component
-instead. Gyroscopic effects (speed dependence of the plant) are neglected, as in the
-thesis.
+instead.
+
+**The plant at the running speed** (:func:`running_unbalance`, the default,
+``[design.unbalance] plant = "running"``): an unbalance forces the rotor at the speed it
+turns at, so at each speed Ω the plant is the one built at Ω — its gyroscopic coupling ΩG
+and its seals at the synchronous frequency (:func:`ambseal.analysis.synchronous.
+running_plant`) — closed by the controller as it acts at Ω (scheduled on speed where it
+is). And an unbalance's force turns forward with the shaft: at bearing plane k it is
+``F_x = c_k``, ``F_y = −j c_k`` (phasors of ``Re{F e^{jΩt}}``), so the bound is taken over
+those forces alone, ``Σ|c_k|² = F_u²``: the largest semi-major axis of the orbit at any
+sensor plane, ``max_k √λ_max(Re(M_k M_kᴴ))`` with ``M_k`` the plane's two sensors' rows of
+``S_o G_f T`` (T the forward forces; the semi-major axis is ``max_d ‖dᵀ M_k c‖`` over real
+unit directions d) — a backward-whirling mode, which a forward force on an axisymmetric
+rotor does not excite, does not count as it would in σ̄ over every force. On a rotor
+without gyroscopics, on isotropic supports, both bounds are ``|g|·F_u``. Gyroscopic
+rotors — flywheels, overhung wheels — meet their 1× crossings only this way: with the
+plant frozen at one speed their orbit and coil current can be off many times over.
+
+**The thesis's simplification** (``plant = "frozen"``, :func:`unbalance_from_compliance`):
+the plant frozen at the judged condition's speed with the forcing frequency swept and the
+bound σ̄ over every force distribution, as P5 §4.4.1 and its Fig. 12 take it (harmless
+on its near-rigid rig); kept to reproduce the thesis's figures.
 """
 
 from __future__ import annotations
@@ -36,15 +56,26 @@ from typing import Any
 
 import numpy as np
 
+from scipy.signal import find_peaks
+
 from ambseal.analysis.loops import ComplianceResponse, Peak, compliance, peak_of
 from ambseal.errors import ModelError
 from ambseal.lti import as_omega, json_float, json_list
 
 __all__ = ["unbalance_force", "UnbalanceResponse", "unbalance_response", "unbalance_from_compliance",
-           "UNBALANCE_LAWS"]
+           "UNBALANCE_LAWS", "UNBALANCE_PLANTS", "forward_forces", "worst_orbit",
+           "running_unbalance"]
 
 #: The force laws of :func:`unbalance_force` (module docstring).
 UNBALANCE_LAWS = ("iso21940", "constant_velocity")
+#: The plants of the judged unbalance response (module docstring): at the running speed, or
+#: frozen at the judged condition (the thesis's simplification).
+UNBALANCE_PLANTS = ("running", "frozen")
+#: Speeds of the running unbalance response's first sweep, evenly over its range; each
+#: local maximum is then refined :data:`REFINE_ROUNDS` times by :data:`REFINE` speeds
+#: between its neighbours (every round narrows the bracket of a peak 4-fold).
+SPEED_POINTS = 400
+REFINE, REFINE_ROUNDS = 9, 3
 
 
 def unbalance_force(
@@ -238,3 +269,152 @@ def unbalance_response(
         compliance(G, K, Gf, as_omega(omega)), mass_kg=mass_kg, grade_mm_s=grade_mm_s,
         max_speed_rad_s=max_speed_rad_s, law=law,
     )
+
+
+def forward_forces(forces) -> np.ndarray:
+    """The forces of a rotating unbalance at each force position (module docstring).
+
+    Parameters
+    ----------
+    forces : sequence of str
+        The force inputs, ``F<k>_x`` then ``F<k>_y`` per position (as
+        :func:`ambseal.model.build_system` names them).
+
+    Returns
+    -------
+    ndarray of complex, shape (nf, nf // 2)
+        T: column k puts ``F_x = 1``, ``F_y = −j`` at position k.
+
+    Raises
+    ------
+    ModelError
+        Forces not in x, y pairs.
+    """
+    names = list(forces)
+    if len(names) % 2 or any(not (a.endswith("_x") and b.endswith("_y") and a[:-2] == b[:-2])
+                             for a, b in zip(names[::2], names[1::2])):
+        raise ModelError(f"forward_forces: expected x, y pairs of force inputs, got {names}")
+    T = np.zeros((len(names), len(names) // 2), complex)
+    for k in range(len(names) // 2):
+        T[2 * k, k], T[2 * k + 1, k] = 1.0, -1j
+    return T
+
+
+def worst_orbit(H: np.ndarray, outputs) -> np.ndarray:
+    """The largest semi-major axis of the orbit at any sensor plane per unit force
+    amplitude, over every distribution of the forces (module docstring).
+
+    Parameters
+    ----------
+    H : ndarray of complex, shape (n_w, ny, n_c)
+        Sensors (m) per unit force amplitude of each force pattern (e.g. ``S_o G_f T``).
+    outputs : sequence of str
+        The sensors, ``y_<amb>_<axis>``: the two axes of one AMB (orthogonal) make a plane;
+        a sensor without its pair counts alone (its amplitude).
+
+    Returns
+    -------
+    ndarray, shape (n_w,)
+        ``max_k √λ_max(Re(M_k M_kᴴ))`` (m/N).
+    """
+    planes: dict = {}
+    for i, name in enumerate(outputs):
+        planes.setdefault(name.rsplit("_", 1)[0], []).append(i)
+    out = np.zeros(H.shape[0])
+    for rows in planes.values():
+        M = H[:, rows, :]
+        R = np.einsum("wic,wjc->wij", M, M.conj()).real
+        out = np.maximum(out, np.sqrt(np.maximum(np.linalg.eigvalsh(R)[:, -1], 0.0)))
+    return out
+
+
+def running_unbalance(plant_at, controller_at, range_hz, *, mass_kg: float, grade_mm_s: float,
+                      max_speed_rad_s: float | None = None, law: str = "iso21940"
+                      ) -> tuple[UnbalanceResponse, np.ndarray, tuple]:
+    """The worst-case unbalance orbit over a speed range with the plant at the running
+    speed (module docstring), and the current references that hold it.
+
+    The speeds: :data:`SPEED_POINTS` evenly over the range, then around each local maximum
+    of the orbit :data:`REFINE` more between its neighbours, :data:`REFINE_ROUNDS` times.
+
+    Parameters
+    ----------
+    plant_at : callable
+        ``plant_at(speeds_hz)`` → :class:`ambseal.analysis.synchronous.RunningPlant`.
+    controller_at : callable
+        ``controller_at(omega)`` (rad/s, shape (n_w,)) → ``(K_loop, K_current)``, each of
+        shape (n_w, nu, ny) in the plant's order: the controller as the loop sees it at each
+        speed (continuous: with the delay's lag; as it runs: ``K_d(e^{jΩT})`` times the
+        hold's fundamental), and the map from the sensors to the current reference the
+        amplifier is given (as it runs: at the samples, ``K_d(e^{jΩT})``).
+    range_hz : (float, float)
+        The speeds (Hz), ``0 < low < high``.
+    mass_kg : float
+        Mass m (kg) of the force law, as in :func:`unbalance_force`.
+    grade_mm_s : float
+        Balance grade G (mm/s).
+    max_speed_rad_s : float, optional
+        Ω_max (rad/s) of the ``"iso21940"`` law.
+    law : {"iso21940", "constant_velocity"}
+        The force law of :func:`unbalance_force`.
+
+    Returns
+    -------
+    response : UnbalanceResponse
+        The orbit bound (m) over speed and its peak.
+    current_a : ndarray, shape (n_w, nu)
+        Per AMB axis, the largest current reference (A, amplitude) over the same forces.
+    axes : tuple of str
+        The current inputs of ``current_a``.
+
+    Raises
+    ------
+    ModelError
+        A range not ``0 < low < high``, a singular loop at a speed, or as
+        :func:`unbalance_force`.
+    """
+    lo, hi = (float(x) for x in range_hz)
+    if not 0 < lo < hi:
+        raise ModelError(f"running_unbalance: expected 0 < low < high (Hz), got {range_hz}")
+    axes: tuple = ()
+
+    def evaluate(speeds):
+        nonlocal axes
+        rp = plant_at(speeds)
+        axes = rp.inputs
+        Kl, Kc = controller_at(2 * np.pi * speeds)
+        GfT = rp.Gf @ forward_forces(rp.forces)
+        try:
+            H = np.linalg.solve(np.eye(rp.Gu.shape[1]) + rp.Gu @ Kl, GfT)
+        except np.linalg.LinAlgError:
+            raise ModelError("running unbalance: the loop is singular at a speed of "
+                             f"{lo:g}–{hi:g} Hz") from None
+        return worst_orbit(H, rp.outputs), np.linalg.norm(Kc @ H, axis=2)
+
+    def force(speeds):
+        return unbalance_force(mass_kg, grade_mm_s, 2 * np.pi * speeds,
+                               max_speed_rad_s=max_speed_rad_s, law=law)
+
+    speeds = np.linspace(lo, hi, SPEED_POINTS)
+    orbit, current = evaluate(speeds)
+    for _ in range(REFINE_ROUNDS):
+        peaks = find_peaks(orbit * force(speeds))[0]
+        if not peaks.size:
+            break
+        extra = np.setdiff1d(np.concatenate([np.linspace(speeds[i - 1], speeds[i + 1],
+                                                         REFINE + 2)[1:-1] for i in peaks]),
+                             speeds)
+        if not extra.size:
+            break
+        o2, c2 = evaluate(extra)
+        order = np.argsort(np.concatenate([speeds, extra]), kind="stable")
+        speeds = np.concatenate([speeds, extra])[order]
+        orbit, current = np.concatenate([orbit, o2])[order], np.concatenate([current, c2])[order]
+    F = force(speeds)
+    w = 2 * np.pi * speeds
+    resp = orbit * F
+    pk = peak_of(resp, w)
+    wmax = float(max_speed_rad_s) if law == "iso21940" else None
+    return (UnbalanceResponse(w, F, resp, pk.value * 1e6, pk.frequency_hz, float(mass_kg),
+                              float(grade_mm_s), law, wmax),
+            current * F[:, None], tuple(axes))

@@ -27,7 +27,10 @@ and bounded (the bounds beside each key in the code, with their reasons).
     ``max_speed_hz`` (the maximum service speed Ω_max/2π at which the grade holds, Hz),
     ``force_at`` (the name of the seal, disk, AMB or spring where the unbalance force and
     the compliance are taken; by default the bearings), ``range_hz`` = ``[low, high]`` (the
-    speeds of the unbalance response, Hz).
+    speeds of the unbalance response, Hz), ``plant`` (``"running"``, the default: at each
+    speed the plant built at that speed, gyroscopics and seals, under forward-turning
+    forces; ``"frozen"``: the plant frozen at the judged condition with the forcing
+    swept, the thesis's simplification, P5 §4.4.1; :mod:`ambseal.analysis.unbalance`).
 ``[design.impulse]``
     ``amplitude_a`` (A) and ``duration_s`` (s) of the current impulse of the time-domain
     judgement (P5 §5.1) and of the identification on the virtual facility (P5 §3.3), whose
@@ -202,6 +205,7 @@ class UnbalanceSpec(_Strict):
     max_speed_hz: float | None = Field(default=None, gt=0, le=MAX_SPEED_HZ)
     force_at: str | None = Field(default=None, min_length=1)
     range_hz: tuple[float, float] | None = Field(default=None, strict=False)  # a list
+    plant: Literal["running", "frozen"] | None = None
 
     @model_validator(mode="after")
     def _r(self) -> "UnbalanceSpec":

@@ -29,7 +29,8 @@ the value the thesis used on its test facility, P5, where it names one):
   ``[operating] speed_range_hz``, else the operating speed, else the top of the unbalance
   range (test rig: ``max_speed_hz = 500`` set, "balanced according to the G2.5 norm at
   500 Hz", P5 §4.4.1); the force at the bearings, where P5 §4.4.1 takes the compliance
-  (the reason is in :mod:`ambseal.analysis.unbalance`).
+  (the reason is in :mod:`ambseal.analysis.unbalance`); at each speed the plant built at
+  that speed (``plant = "running"``; ``"frozen"`` is the thesis's simplification).
 * **H∞ and μ weights** (P5 Eq. 7, §4.1 objective 1, §4.3): ω_B = 1/T_i of the reference
   PID (:func:`ambseal.design.pid.reference_pid`), so the
   integral time is the PID's ("tuned to achieve an integral time close to the reference
@@ -230,6 +231,10 @@ class DesignSpec:
     mu_iteration : {"dgk", "dk"}
         μ synthesis: D–G–K (real parameters kept real, Young 1996; its steps taken only
         where complex D–K leaves μ above 1) or complex D–K.
+    unbalance_plant : {"running", "frozen"}
+        The plant of the judged unbalance response (:mod:`ambseal.analysis.unbalance`): at
+        each speed the one built at that speed, or frozen at the judged condition (the
+        thesis's simplification).
     sources : Mapping
         ``{key: "set" | rule text}``: where each value came from (read-only).
     notes : tuple of str
@@ -262,6 +267,7 @@ class DesignSpec:
     max_iter: int = 6
     dk_order: int = 2
     mu_iteration: str = "dgk"
+    unbalance_plant: str = "running"
     sources: Mapping = field(default_factory=dict, repr=False)
     notes: tuple = ()
 
@@ -315,6 +321,7 @@ class DesignSpec:
                   if self.force_at else ["# force_at: none (the bearings, P5 §4.4.1)"]),
                 line("range_hz", f"[{fmt(self.unbalance_range_hz[0])}, "
                      f"{fmt(self.unbalance_range_hz[1])}]", "unbalance.range_hz"),
+                line("plant", f'"{self.unbalance_plant}"', "unbalance.plant"),
                 "", "[design.impulse]",
                 *([line("amplitude_a", fmt(self.impulse_a), "impulse")] if self.impulse_a
                   else ["# amplitude_a: no bias current, none"]),
@@ -446,6 +453,8 @@ def _unbalance(cfg, d, mach: Machine, rules: dict, notes: list):
     rules["unbalance.force_at"] = "set" if at else "the bearings (P5 §4.4.1), else mid-span"
     law = u.law or "iso21940"
     rules["unbalance.law"] = "set" if u.law else "ISO 21940-11: F = m G Ω²/Ω_max"
+    rules["unbalance.plant"] = ("set" if u.plant else "at each speed the plant built at that "
+                                "speed (gyroscopics, seals), forward-turning forces")
     if u.max_speed_hz is not None:
         top, rules["unbalance.max_speed_hz"] = float(u.max_speed_hz), "set"
     elif cfg.operating.speed_range_hz is not None:
@@ -590,4 +599,5 @@ def design_spec(cfg, pressure_bar: float | None = None) -> DesignSpec:
         weights=MappingProxyType(weights),
         max_iter=mu.max_iter or 6, dk_order=mu.dk_order if mu.dk_order is not None else 2,
         mu_iteration=mu.iteration or "dgk",
+        unbalance_plant=d.unbalance.plant or "running",
         sources=MappingProxyType(rules), notes=tuple(notes))

@@ -27,6 +27,17 @@ from ambseal.errors import ModelError, SynthesisError
 from ambseal.robust.hinf import hinf_gamma_opt, hinfsyn, lft_lower
 from ambseal.robust.mu import mussv
 
+#: Relative tolerance of each γ_opt a Nelder–Mead search over D scales evaluates
+#: (:func:`_balance_channels`, :func:`_search_dscales`). The γ search returns the top of a
+#: bracket of this relative width, so the value jumps by up to the tolerance where rounding
+#: moves one of its steps across it: at 1e-4 such jumps exceed the differences the simplex
+#: ranks its vertices by (``fatol`` 1e-5), and the search's path — its D and the μ reached
+#: — depended on the BLAS kernels (distillation column: μ 0.9810 with OpenBLAS's SkylakeX
+#: kernels, 0.9839 with Haswell's). At 1e-8 the γ values of different kernels agree to
+#: rounding (1e-8), the same path is taken and the same μ reached (to 1e-6), at about 10 %
+#: more time (Brent's method converges superlinearly: one or two more margins per γ).
+SEARCH_GAMMA_RTOL = 1e-8
+
 
 def _logmag(theta, w, order):
     """log|W(jω)| for W = k Π(num sections)/Π(den sections), all roots in the LHP."""
@@ -224,7 +235,8 @@ def _balance_channels(P, cblocks, nmeas, ncon, w, evals=0):
     def gamma(y):
         count[0] += 1
         try:
-            g = hinf_gamma_opt(scaled(y), nmeas, ncon, rtol=1e-4, near=near[0])
+            g = hinf_gamma_opt(scaled(y), nmeas, ncon, rtol=SEARCH_GAMMA_RTOL,
+                               near=near[0])
         except (SynthesisError, ModelError, ValueError, np.linalg.LinAlgError):
             return np.inf
         near[0] = g if near[0] is None else min(near[0], g)
@@ -271,9 +283,16 @@ def _tf_to_theta(tf):
 
 #: D search: Nelder–Mead evaluations per parameter of the fitted D scales. On Skogestad &
 #: Postlethwaite's distillation problem (18 parameters, D–K started from the balanced
-#: channels) 450 γ evaluations reached μ 1.012, 700 0.998, 900 0.980 and 1200 0.970, below
-#: the published optimum 0.9737 (benchmarks/bench_dk.py): 50 per parameter is within 1 %.
+#: channels; ``musyn(search=N)``) 450 γ evaluations reached μ 1.002, 700 0.986, 900 0.970
+#: and 1200 0.962, below the published optimum 0.9737: 50 per parameter is within 1 %.
 SEARCH_EVALS_PER_PARAMETER = 50
+#: D search: the first simplex moves each parameter (a logarithm) by this much, a factor e,
+#: as the best-constant-D start moves its log D (:func:`_balance_channels`): a D–K stall
+#: leaves the best D's sections a fair way from the fitted ones, and a small simplex spends
+#: the evaluations crawling towards them. On the distillation problem, 900 evaluations
+#: from a first simplex of 0.3 reached μ 0.985, of 0.6 0.986, of 0.8 … 1.2 0.979 … 0.962,
+#: of 1.5 0.999 and of 2 0.984.
+SEARCH_SIMPLEX_STEP = 1.0
 #: The work ``search="auto"`` may spend, counted in γ evaluations × n³, n the states of the
 #: scaled plant: a γ evaluation (Riccati equations and Hamiltonian eigenvalues of the scaled
 #: plant) costs ∝ n³. A count, not a clock, so the same problem gets the same search on
@@ -286,7 +305,8 @@ SEARCH_WORK = 1e8
 
 def _search_dscales(P, cblocks, fits, nmeas, ncon, evals, restarts=2):
     """Direct search (Nelder–Mead, at most ``evals`` γ evaluations) over the section
-    parameters of the fitted D scales for the smallest γ_opt of ``D P D⁻¹`` (γ to 1e-4).
+    parameters of the fitted D scales for the smallest γ_opt of ``D P D⁻¹`` (γ to
+    ``SEARCH_GAMMA_RTOL``).
 
     D–K stalls above the μ-optimum because each D-step fits the pointwise-optimal D of the
     *current* K; this searches the same rational D's for the best K-step directly. Every
@@ -310,7 +330,7 @@ def _search_dscales(P, cblocks, fits, nmeas, ncon, evals, restarts=2):
         best["n"] += 1
         try:
             Ps = _scaled_plant(P, cblocks, [_realize(*t) for t in sections(x)], nmeas, ncon)
-            g = hinf_gamma_opt(Ps, nmeas, ncon, rtol=1e-4, near=near[0])
+            g = hinf_gamma_opt(Ps, nmeas, ncon, rtol=SEARCH_GAMMA_RTOL, near=near[0])
         except (SynthesisError, ModelError, ValueError, np.linalg.LinAlgError):
             return np.inf
         near[0] = g if near[0] is None else min(near[0], g)
@@ -328,8 +348,7 @@ def _search_dscales(P, cblocks, fits, nmeas, ncon, evals, restarts=2):
         if left <= x.size + 1:
             rule = "evaluations spent"
             break
-        # first simplex: each parameter (a logarithm) moved by 0.3, i.e. by a factor 1.35
-        simplex = np.vstack([x, x + 0.3 * np.eye(x.size)])
+        simplex = np.vstack([x, x + SEARCH_SIMPLEX_STEP * np.eye(x.size)])
         g_start = best["g"]
         minimize(gamma, x, method="Nelder-Mead",
                  options={"maxfev": left, "adaptive": True, "xatol": 1e-3,

@@ -207,3 +207,43 @@ def test_a_speed_scheduled_controller_is_taken_at_each_speed(overhung):
     fixed = _controller_at_speed(G, K, None, None)(w)[0]
     sched = _controller_at_speed(G, K, Scaled(), None)(w)[0]
     np.testing.assert_allclose(sched, fixed * (1 + w / 1000.0)[:, None, None], rtol=1e-12)
+
+
+@pytest.mark.parametrize("f_range, zeta, where", [
+    ((90.0, 110.0), 0.05, "inside"),   # AF 10 inside the range
+    ((50.0, 85.0), 0.05, "above"),     # 17 % above, 10 + 17(1 − 1/8.5) = 25 % required
+    ((50.0, 75.0), 0.05, None),        # 33 % above: separated
+    ((115.0, 150.0), 0.05, "below"),   # 13 % below, min(16, 17(1 − 1/8.5)) = 15 % required
+    ((120.0, 150.0), 0.05, None),      # 17 % below: separated
+    ((90.0, 110.0), 0.3, None),        # AF 1.7: no critical speed
+])
+def test_critical_speeds_are_the_api_617_separation_check(f_range, zeta, where):
+    """Reference: a single-degree-of-freedom resonance 1/|1 − r² + 2jζr| at 100 Hz (its
+    peak at N = 100 √(1 − 2ζ²) Hz, AF = 1/(2ζ) by half power to the order ζ) against API
+    617's separation margins by hand: 100 (N − f_max)/f_max above the continuous range
+    against 10 + 17(1 − 1/(AF − 1.5)) % (at most 26), 100 (f_min − N)/f_min below it
+    against 17(1 − 1/(AF − 1.5)) % (at most 16), 0 inside it; a critical speed separated
+    by its margin is not named, nor is a resonance with AF < 2.5."""
+    from ambseal.analysis.judge import critical_speeds
+    from ambseal.analysis.unbalance import UnbalanceResponse
+
+    f = np.linspace(40.0, 160.0, 24001)
+    r = f / 100.0
+    amp = 1e-5 / np.abs(1 - r**2 + 2j * zeta * r)
+    unb = UnbalanceResponse(2 * np.pi * f, np.ones_like(f), amp, 0.0, 0.0, 1.0, 1.0)
+    got = critical_speeds(unb, *f_range)
+    if where is None:
+        assert got == []
+        return
+    (c,) = got
+    n = 100.0 * math.sqrt(1 - 2 * zeta**2)
+    af = 1 / (2 * zeta)
+    m = 17 * (1 - 1 / (af - 1.5))
+    lo, hi = f_range
+    margin, need = {"inside": (0.0, min(26.0, 10 + m)), "above": (100 * (n - hi) / hi,
+                                                                 min(26.0, 10 + m)),
+                    "below": (100 * (lo - n) / lo, min(16.0, m))}[where]
+    assert c["speed_hz"] == pytest.approx(n, rel=1e-4)
+    assert c["af"] == pytest.approx(af, rel=2 * zeta)
+    assert c["margin_pct"] == pytest.approx(margin, rel=1e-3, abs=1e-9)
+    assert c["required_pct"] == pytest.approx(need, rel=0.01)

@@ -179,6 +179,25 @@ def test_an_orbit_beyond_the_backup_clearance_fails():
     assert "orbit" not in verdicts([dict(base, unbalance_peak_um=100.0)], clear)[0].words()
 
 
+def test_verdict_names_the_critical_speeds_near_the_running_range():
+    """A case whose loop, as it runs, has the nutation mode's 1× crossing at 1007 Hz with
+    AF 4.1, 0.7 % above a continuous range whose margin for that AF is 20.2 %, and one at
+    950 Hz inside it (continuous loop, AF 12; the same speed as it runs to 3 digits, AF 11:
+    once, the larger AF): the sentence names both, by speed."""
+    from ambseal.report.verdict import verdicts
+
+    crit = [{"speed_hz": 950.2, "af": 12.0, "margin_pct": 0.0, "required_pct": 25.0}]
+    case = dict(_metrics()[0], critical_speeds=crit,
+                discrete={"stable": True, "critical_speeds": [
+                    {"speed_hz": 1007.0, "af": 4.1, "margin_pct": 0.7, "required_pct": 20.2},
+                    {"speed_hz": 950.4, "af": 11.0, "margin_pct": 0.0, "required_pct": 24.0}]})
+    words = verdicts([case])[0].words()
+    assert ("but critical speeds (1× crossing, AF ≥ 2.5) at 950.2 Hz (AF 12) inside the "
+            "continuous speed range; 1007 Hz (AF 4.1) 0.7 % from the continuous speed "
+            "range where API 617 requires 20 %") in words
+    assert "critical" not in verdicts([_metrics()[0]])[0].words()
+
+
 def test_verdict_says_what_the_unbalance_asks_of_the_amplifier():
     """The design summary's ``capacity`` block in words: the larger of the voltage and
     current fractions, with the axis, the speed in rpm and the condition; above 1 the

@@ -45,6 +45,9 @@ from typing import Any
 import control
 import numpy as np
 
+from scipy.signal import find_peaks
+
+from ambseal.analysis.campbell import AF_CRITICAL
 from ambseal.analysis.iso import iso_assessment
 from ambseal.analysis.loops import (
     compliance_from,
@@ -57,7 +60,9 @@ from ambseal.analysis.response import impulse_response_of
 from ambseal.analysis.spinup import frozen_sensitivity, spinup
 from ambseal.analysis.amplifier import unbalance_currents
 from ambseal.analysis.synchronous import hold_fundamental, running_plant
-from ambseal.analysis.unbalance import running_unbalance, unbalance_from_compliance
+from ambseal.analysis.unbalance import (UnbalanceResponse, running_unbalance,
+                                        unbalance_from_compliance)
+from ambseal.analysis.unbalance_api617 import amplification_factor, required_margin
 from ambseal.design import RIGID_STATES, vertex_grid_hz
 from ambseal.design.lpv_plant import lpv_plant
 from ambseal.lti import eigenvalues, finite_or_none, freqresp_at, json_float, wired
@@ -173,6 +178,13 @@ class LoopJudgement:
         The current-impulse response's peak displacement (µm) and settling time (s).
     max_abs_pole_z, sample_rate_hz : float or None
         Of a discrete loop only: its largest ``|z|`` and sample rate (Hz).
+    critical_speeds : list of dict or None
+        The loop's critical speeds (1× crossings of the unbalance orbit at the running
+        speed with AF ≥ 2.5) inside the continuous speed range or within the separation
+        margin API 617 (8th ed., §2.6.2.10; API 684 §2.8) requires of them: ``speed_hz``,
+        ``af``, ``margin_pct`` (the separation from the continuous range, % of its nearer
+        end; 0 inside it) and ``required_pct``; None where not judged (the frozen plant, an
+        unstable loop, a rig without a running speed).
     """
 
     stable: bool
@@ -187,6 +199,7 @@ class LoopJudgement:
     impulse_settling_s: float | None
     max_abs_pole_z: float | None = None
     sample_rate_hz: float | None = None
+    critical_speeds: list[dict[str, JsonFloat]] | None = None
 
     def to_dict(self) -> dict:
         """The ``metrics.json`` form (a discrete loop's two extra keys only when set)."""
@@ -492,10 +505,21 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
         def plant_at(speeds):
             return running_plant(cfg, speeds, positions, pressure_bar=point.pressure_bar)
 
-        return lambda G, K: running_unbalance(
-            plant_at, _controller_at_speed(G, K, sched, dl.system), s.unbalance_range_hz,
-            mass_kg=s.unbalance_mass_kg, grade_mm_s=s.unbalance_grade_mm_s,
-            law=s.unbalance_law, max_speed_rad_s=2 * math.pi * s.unbalance_max_speed_hz)
+        lo, hi = s.unbalance_range_hz
+        f_min, f_max = cfg.operating.continuous_hz
+        # the sweep reaches past the top of the continuous range by the largest separation
+        # margin API 617 can require, so that a critical just above it is seen
+        top = max(hi, (1 + MAX_MARGIN_ABOVE) * f_max)
+
+        def judged(G, K):
+            unb, current, axes = running_unbalance(
+                plant_at, _controller_at_speed(G, K, sched, dl.system), (lo, top),
+                mass_kg=s.unbalance_mass_kg, grade_mm_s=s.unbalance_grade_mm_s,
+                law=s.unbalance_law, max_speed_rad_s=2 * math.pi * s.unbalance_max_speed_hz)
+            crit = critical_speeds(unb, f_min, f_max) if f_max > 0 else None
+            keep = unb.speed_hz <= hi * (1 + 1e-12)
+            return _within(unb, keep), current[keep], axes, crit
+        return judged
 
     body, curves = _judge_loop(judged_loop(P, controller, cur, delay=dl.system), cur, force,
                                controller, s, impulse, static, running(schedule))
@@ -508,6 +532,67 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
                       speed_hz=point.speed_rpm / 60.0, label=point.label, delay=dl.to_dict(),
                       discrete=disc)
     return case, curves
+
+
+#: API 617's largest separation margin above the maximum continuous speed (26 %) and below
+#: the minimum (16 %), as fractions (:func:`ambseal.analysis.unbalance_api617.required_margin`)
+MAX_MARGIN_ABOVE, MAX_MARGIN_BELOW = 0.26, 0.16
+
+
+def critical_speeds(unb: UnbalanceResponse, f_min: float, f_max: float) -> list[dict]:
+    """The critical speeds of an unbalance response at the running speed that lie inside
+    the continuous speed range or within the separation margin API 617 requires of them.
+
+    A critical speed is a local maximum of the orbit over speed (a closed-loop mode's 1×
+    crossing) with a half-power amplification factor AF ≥ 2.5 (API 684 §2.8; where the
+    sweep ends before the orbit falls to half power on one side, the other side's
+    half-width is taken for both; on neither, it counts as critical: not shown to be
+    damped); its separation margin from the continuous range [f_min, f_max] is
+    ``100 (f_min − N)/f_min`` below it and ``100 (N − f_max)/f_max`` above it, and API 617
+    (8th ed., §2.6.2.10) requires ``min(16, 17(1 − 1/(AF − 1.5)))`` % below and
+    ``min(26, 10 + 17(1 − 1/(AF − 1.5)))`` % above
+    (:func:`ambseal.analysis.unbalance_api617.required_margin`).
+
+    Parameters
+    ----------
+    unb : UnbalanceResponse
+        The orbit over speed (:func:`ambseal.analysis.unbalance.running_unbalance`).
+    f_min, f_max : float
+        The continuous speed range (Hz).
+
+    Returns
+    -------
+    list of dict
+        ``speed_hz``, ``af``, ``margin_pct`` (0 inside the range) and ``required_pct`` of
+        each, by speed.
+    """
+    f, a = unb.speed_hz, unb.response_m
+    out = []
+    for i in find_peaks(a)[0]:
+        af, n1, n2 = amplification_factor(f, a, int(i))
+        n = float(f[i])
+        if np.isnan(af):  # one side (or none) within the sweep
+            half = np.nanmax([n - n1, n2 - n]) if np.isfinite([n1, n2]).any() else 0.0
+            af = n / (2 * half) if half > 0 else math.inf
+        if af < AF_CRITICAL:
+            continue
+        below = n < f_min
+        margin = (100 * (f_min - n) / f_min if below else
+                  100 * (n - f_max) / f_max if n > f_max else 0.0)
+        need = required_margin(af, below)
+        if margin < need:
+            out.append({"speed_hz": n, "af": json_float(af), "margin_pct": margin,
+                        "required_pct": need})
+    return out
+
+
+def _within(unb: UnbalanceResponse, keep: np.ndarray) -> UnbalanceResponse:
+    """``unb`` on the speeds ``keep`` selects, its peak taken there."""
+    w, resp = unb.omega_rad_s[keep], unb.response_m[keep]
+    k = int(np.argmax(resp))
+    return UnbalanceResponse(w, unb.force_n[keep], resp, float(resp[k] * 1e6),
+                             float(w[k] / (2 * math.pi)), unb.mass_kg, unb.grade_mm_s,
+                             unb.law, unb.max_speed_rad_s)
 
 
 def _controller_at_speed(G, K, schedule, delay):
@@ -593,7 +678,7 @@ def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, im
         # the current references that hold it, per axis (ambseal.analysis.amplifier)
         held = unbalance_currents(Kw[w.size:], cu.H_m_per_n, unb.force_n), tuple(nu_names)
     else:
-        unb, *held = running(G, controller)
+        unb, *held, case["critical_speeds"] = running(G, controller)
     curves["unbalance"] = (unb.speed_hz, unb.response_um)
     curves["unbalance_current"] = (unb.speed_hz, *held)
     case.update(compliance_peak_m_per_n=c.peak.value, unbalance_peak_um=unb.peak_um)

@@ -120,6 +120,10 @@ class Verdict:
     speeds_hz : tuple of float
         Every speed (Hz) the loop was judged at, in full or for stability only, sorted:
         what the verdict may claim of the speed range (standstill only if 0 is among them).
+    criticals : tuple of dict
+        The loop's critical speeds inside the continuous speed range or within API 617's
+        separation margin (the cases' ``critical_speeds``, continuous and as it runs, one
+        per speed to 3 digits, the largest AF kept), by speed.
     """
 
     controller: str
@@ -141,6 +145,25 @@ class Verdict:
     axes_alike: bool = True
     capacity: dict | None = None
     speeds_hz: tuple[float, ...] = ()
+    criticals: tuple = ()
+
+    def critical_text(self) -> str:
+        """The critical speeds in words, ``""`` without any: ``"a critical speed (1×
+        crossing, AF ≥ 2.5) at 950 Hz (AF 12) inside the continuous speed range"``."""
+        parts = []
+        for c in self.criticals:
+            af = c.get("af")
+            af = math.inf if af is None or isinstance(af, str) else af  # "inf" in JSON
+            head = f"{c['speed_hz']:.4g} Hz (AF {sig(af, 2)})"
+            if not c["margin_pct"]:
+                parts.append(f"{head} inside the continuous speed range")
+            else:
+                parts.append(f"{head} {sig(c['margin_pct'], 2)} % from the continuous speed "
+                             f"range where API 617 requires {sig(c['required_pct'], 2)} %")
+        if not parts:
+            return ""
+        what = "a critical speed" if len(parts) == 1 else "critical speeds"
+        return f"{what} (1× crossing, AF ≥ 2.5) at " + "; ".join(parts)
 
     def speed_span(self) -> str:
         """The judged speeds in words: ``"standstill to 1000 Hz"``, or ``"333–1000 Hz
@@ -227,6 +250,9 @@ class Verdict:
                      f"{100 * self.orbit_um / c:.0f} % of {CLEARANCE_WORDS.get(n, n)} "
                      f"({sig(c)} µm)")
 
+        crit = self.critical_text()
+        if crit:
+            text += f"; but {crit}"
         amp = self.amplifier_text()
         if amp:
             text += f"; {amp}"
@@ -325,7 +351,26 @@ def _verdict(name: str, cs: list, by_speed: bool, sc: list,
         worst_axis=None if top is None else f"{axis_label(top[1])} at {top[2]}",
         axes_alike=len(stable_zones) <= 1, capacity=design.get("capacity"),
         speeds_hz=tuple(sorted({float(c["speed_hz"]) for c in [*cs, *sc]
-                                if c.get("speed_hz") is not None})))
+                                if c.get("speed_hz") is not None})),
+        criticals=_criticals(cs))
+
+
+def _criticals(cs: list) -> tuple:
+    """The critical speeds of a controller's judged cases (continuous and as it runs), one
+    per speed to 3 significant digits (the largest AF), by speed."""
+    found: dict = {}
+    for c in cs:
+        for block in (c, c.get("discrete") or {}):
+            if not block.get("stable"):
+                continue
+            for k in block.get("critical_speeds") or ():
+                key = float(f"{k['speed_hz']:.3g}")
+                af = k.get("af")
+                af = math.inf if af is None or isinstance(af, str) else af
+                old = found.get(key)
+                if old is None or af > old[0]:
+                    found[key] = (af, k)
+    return tuple(found[key][1] for key in sorted(found))
 
 
 def _worst_axis(labels: list[str], cs: list) -> tuple | None:

@@ -84,9 +84,12 @@ def check_report_agrees(out: Path) -> None:
         speed = [c for c in m.get("stability") or [] if c["controller"] == name]
         lost = any(not c["stable"] for c in cases) or any(_unstable(c) for c in speed)
         row = rows[name]
-        sigma = "D" if lost else worst(zone_of(c["sensitivity_peak"]) for c in cases)
-        axis = "D" if lost else worst(zone_of(v) for c in cases
-                                      for v in c["sensitivity_peak_per_axis"].values())
+        # every loop graded: judged and speed-range conditions, continuous and as it runs
+        loops = [b for c in [*cases, *speed] for b in (c, c.get("discrete") or {})
+                 if b.get("stable") and b.get("sensitivity_peak") is not None]
+        sigma = "D" if lost else worst(zone_of(b["sensitivity_peak"]) for b in loops)
+        axis = "D" if lost else worst(zone_of(v) for b in loops
+                                      for v in b["sensitivity_peak_per_axis"].values())
         assert row[head[2]] == axis and row[head[3]] == sigma, (name, row)
         assert axis <= sigma  # σ̄(S_o) bounds every axis's peak
         words = row[head[-1]]
@@ -101,7 +104,7 @@ def check_report_agrees(out: Path) -> None:
             assert words.startswith(f"Zone {axis}"), (name, words)
         else:
             assert name in m["failed"], (name, m["failed"])
-        peaks = [c["sensitivity_peak"] for c in cases if c["stable"]]
+        peaks = [b["sensitivity_peak"] for b in loops]
         assert row[head[4]] == (f"{max(peaks):.3g}" if peaks else "—"), (name, row)
         bad = sum(_unstable(c) for c in speed)
         over = row[head[1]]
@@ -132,8 +135,12 @@ def check_report_agrees(out: Path) -> None:
             for f, cell in zip(speeds, row[1:]):
                 at = [c for c in m["stability"] if c["controller"] == row[0]
                       and c["speed_hz"] == f]
-                assert (cell == "stable") == (bool(at) and not any(map(_unstable, at))), \
-                    (row[0], f, cell)
+                ok = bool(at) and not any(map(_unstable, at))
+                zones = [z for c in at for b in (c, c.get("discrete") or {})
+                         for z in (b.get("iso_zone_per_axis") or {}).values()]
+                want = ("stable" + (f", zone {worst(zones)}" if zones else "")) if ok else None
+                assert (cell == want if ok else cell.startswith("unstable") if at
+                        else cell == "—"), (row[0], f, cell)
 
     if m.get("signoff"):
         s = m["signoff"]

@@ -69,3 +69,30 @@ def test_stability_case_is_python_controls_closed_loop(speed_hz):
     assert case.max_real_pole == pytest.approx(ref.real.max(), rel=1e-6, abs=1e-6)
     assert curves["poles"].size == ref.size and case.discrete is None
     assert case.speed_hz == speed_hz and case.pressure_bar == 30.0
+
+
+def test_speed_range_loops_are_graded_as_the_judged_ones(testrig_cfg):
+    """Reference: the judgement at the same condition — a speed-range loop graded
+    (:func:`stability_case` with the judgement's settings) has the σ̄(S_o) peak, per-axis
+    peaks and zones :func:`judge` gives there, continuous and as it runs (the discrete
+    controller with its delay on the sampled plant): the one rule, to 1e-9."""
+    from ambseal.analysis.judge import judge, judge_settings
+    from ambseal.app.commands import digital_for
+    from ambseal.design import design_spec
+
+    cfg, res = testrig_cfg, design(testrig_cfg, "pid")
+    K = res.K
+    spec = design_spec(cfg)
+    s = judge_settings(spec)
+    point = OperatingPoint(cfg.operating.pressure_bar, 60.0 * 50.0, "x")
+    digital = digital_for(cfg, "pid", K, res, [point])
+    Kd = digital.statespace(delayed=True)
+    case, _ = stability_case(JudgeJob("pid", point, K, Kd), cfg, s)
+    ref, _ = judge(cfg, K, "pid", point, s, impulse=False, discrete=Kd)
+    for got, want in ((case.to_dict(), ref.to_dict()),
+                      (case.to_dict()["discrete"], ref.to_dict()["discrete"])):
+        assert got["iso_zone"] == want["iso_zone"] and got["iso_zone"] in "ABCD"
+        assert got["iso_zone_per_axis"] == want["iso_zone_per_axis"]
+        assert got["sensitivity_peak"] == pytest.approx(want["sensitivity_peak"], rel=1e-9)
+        for ax, pk in want["sensitivity_peak_per_axis"].items():
+            assert got["sensitivity_peak_per_axis"][ax] == pytest.approx(pk, rel=1e-9)

@@ -127,6 +127,28 @@ def test_verdict_holds_only_where_the_machine_runs_up_too():
     assert "stable from standstill to 100 Hz" in good.words()
 
 
+def test_verdict_grades_every_speed_as_it_runs_and_names_the_worst():
+    """A controller zone B at its judged condition whose loop as it runs at 500 Hz, a
+    speed-range condition, reaches zone C on B η (peak 3.8): the row's zone is C and the
+    sentence names that axis, speed and loop; σ̄(S_o) follows the worst graded loop too."""
+    from ambseal.report.verdict import verdicts
+
+    case = _metrics()[0]
+    axes = ("A_zeta", "B_eta")
+    ok = {"controller": case["controller"], "stable": True, "label": "2.04 bar, 500 Hz",
+          "speed_hz": 500.0, "sensitivity_peak": 3.2, "iso_zone": "B",
+          "sensitivity_peak_per_axis": dict(zip(axes, (2.9, 3.0))),
+          "iso_zone_per_axis": dict(zip(axes, "AB")),
+          "discrete": {"stable": True, "sensitivity_peak": 3.9, "iso_zone": "C",
+                       "sensitivity_peak_per_axis": dict(zip(axes, (2.9, 3.8))),
+                       "iso_zone_per_axis": dict(zip(axes, "AC"))}}
+    v = verdicts([case], None, [ok])[0]
+    assert v.zone_axis == "C" and v.zone_sigma == "C" and v.sigma_peak == 3.9
+    assert v.worst_axis == "B η at 2.04 bar, 500 Hz, as it runs"
+    assert v.words().startswith("Zone C on its worst axis (B η at 2.04 bar, 500 Hz, as it "
+                                "runs)")
+
+
 def test_verdict_claims_standstill_only_where_it_was_judged():
     """Reference: what was judged — a controller stable at every stability speed given as
     333.33–1000 Hz (``[design] stability_speeds_hz`` without 0) and at its judged condition

@@ -81,7 +81,8 @@ from ambseal.robust import loop_delay
 __all__ = ["JudgeSettings", "OperatingPoint", "LoopJudgement", "JudgedCase", "JudgeJob", "judge", "judge_case", "judge_spinup",
            "operating_points", "speed_scheduled",
            "judge_settings", "unstable_open_loop_poles", "condition_values", "frozen_at",
-           "frozen_discrete", "judge_jobs", "points_for"]
+           "frozen_discrete", "judge_jobs", "points_for", "sensitivity_grades",
+           "critical_speeds"]
 
 #: Where a loop's static response is taken (rad/s): far below any AMB loop's dynamics (the
 #: plant there equals its static response to ~1e-8), and not zero, where an integrating
@@ -622,6 +623,59 @@ def _controller_at_speed(G, K, schedule, delay):
     return scheduled
 
 
+def _sensitivity_grid(loop, freq_hz) -> np.ndarray:
+    """The judged loop's grid (rad/s): ``freq_hz``'s log grid, up to Nyquist for a
+    discrete loop, refined around its lightly damped poles."""
+    dt = loop.dt
+    f_hi = 0.999 * 0.5 / dt if dt else freq_hz[1]  # discrete: up to Nyquist
+    w = 2 * np.pi * np.logspace(math.log10(freq_hz[0]), math.log10(f_hi), freq_hz[2])
+    return resolved_grid(w, loop.s_poles)  # a 0.5 %-damped bending mode must not slip through
+
+
+def _grades(resp, ny_names, stable: bool) -> tuple[dict, np.ndarray]:
+    """The ISO 14839-3 grades of one loop's responses (σ̄(S_o) and per axis) as a case
+    states them, and σ̄(S_o) on the grid."""
+    so = sigma_max(resp.So)  # once, for the peaks, the zone and the figure
+    so_peaks = resp.peaks("So", sigma=so)
+    iso = iso_assessment(so_peaks, stable=stable)
+    return {"sensitivity_peak": finite_or_none(iso.sigma_max_peak),
+            "sensitivity_peak_per_axis": {ax.removeprefix("y_"): (p.value if stable else None)
+                                          for ax, p in zip(ny_names, so_peaks.diagonal)},
+            "iso_zone": iso.zone_sigma_max,
+            "iso_zone_per_axis": {ax.removeprefix("y_"): z for ax, z in iso.zones_per_axis}}, so
+
+
+def sensitivity_grades(judged: JudgedLoop, controller, cur, freq_hz) -> dict:
+    """ISO 14839-3's grades of a judged loop, continuous or as it runs, as :func:`judge`
+    takes them: σ̄(S_o) and each axis's |S_o| peak on the judgement's grid.
+
+    Parameters
+    ----------
+    judged : JudgedLoop
+        The loop (:func:`ambseal.machine.loop.judged_loop`).
+    controller : control.StateSpace
+        Its controller (continuous or discrete), wired by signal names.
+    cur : sequence of int
+        The plant's current inputs.
+    freq_hz : (float, float, int)
+        :attr:`JudgeSettings.freq_hz`.
+
+    Returns
+    -------
+    dict
+        ``sensitivity_peak`` (None where unstable), ``sensitivity_peak_per_axis``,
+        ``iso_zone``, ``iso_zone_per_axis`` (an unstable loop is zone D).
+    """
+    loop = judged.loop
+    G = _signals(judged.source, cur)
+    w = _sensitivity_grid(loop, freq_hz)
+    pts, _ = response_points(w, loop.dt)
+    Gw = judged.plant_response(w)[:, :, list(cur)]
+    Kw = freqresp_at(wired(G, controller), pts)
+    resp = loop_responses_from(Gw, Kw, w, G.output_labels, G.input_labels)
+    return _grades(resp, G.output_labels, loop.stable)[0]
+
+
 def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, impulse: bool,
                 static=((), ()), running=None) -> tuple[LoopJudgement, dict]:
     """The case's numbers for one judged loop, continuous or discrete: its plant with
@@ -639,9 +693,7 @@ def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, im
     case = {"stable": loop.stable, "max_real_pole": loop.max_real_pole}
     if dt:
         case.update(max_abs_pole_z=loop.max_abs_pole, sample_rate_hz=1.0 / dt)
-    f_hi = 0.999 * 0.5 / dt if dt else s.freq_hz[1]  # discrete: up to Nyquist
-    w = 2 * np.pi * np.logspace(math.log10(s.freq_hz[0]), math.log10(f_hi), s.freq_hz[2])
-    w = resolved_grid(w, loop.s_poles)  # a 0.5 %-damped bending mode must not slip through
+    w = _sensitivity_grid(loop, s.freq_hz)
     # the frozen plant's unbalance grid (the running plant's is its own)
     wu = (resolved_grid(2 * np.pi * np.linspace(*s.unbalance_range_hz, 400), loop.s_poles)
           if running is None else np.empty(0))
@@ -653,17 +705,9 @@ def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, im
     Gw, Gfw = Pw[:, :, cur], Pw[:, :, force]
     ny_names, nu_names, f_names = G.output_labels, G.input_labels, Gf.input_labels
     resp = loop_responses_from(Gw[:w.size], Kw[:w.size], w, ny_names, nu_names)
-    so = sigma_max(resp.So)  # once, for the peaks, the zone and the figure
-    so_peaks = resp.peaks("So", sigma=so)
-    iso = iso_assessment(so_peaks, stable=loop.stable)
+    grade, so = _grades(resp, ny_names, loop.stable)
     curves: dict = {"So": (w / (2 * np.pi), so), "poles": loop.poles}
-    case.update(
-        sensitivity_peak=finite_or_none(iso.sigma_max_peak),
-        sensitivity_peak_per_axis={ax.removeprefix("y_"): (p.value if loop.stable else None)
-                                   for ax, p in zip(ny_names, so_peaks.diagonal)},
-        iso_zone=iso.zone_sigma_max,
-        iso_zone_per_axis={ax.removeprefix("y_"): z for ax, z in iso.zones_per_axis},
-    )
+    case.update(grade)
     if not loop.stable:
         case.update(compliance_peak_m_per_n=None, unbalance_peak_um=None,
                     impulse_peak_um=None, impulse_settling_s=None)

@@ -9,21 +9,28 @@ each of the specification's stability speeds (:func:`ambseal.design.conditions.s
 standstill to the top speed) that is not already a judged condition, in the same loop as the
 judgement (:func:`ambseal.machine.loop.judged_loop`): continuous with the target's hold and
 computation delay, and the discrete controller as it runs on the plant sampled at its rate.
-Only stability is asked there; an unstable loop at any of those conditions fails the
-controller like one at a judged condition (:func:`ambseal.analysis.delivery.loop_failure`).
+An unstable loop at any of those conditions fails the controller like one at a judged
+condition (:func:`ambseal.analysis.delivery.loop_failure`); a stable one is graded by ISO
+14839-3 as at a judged condition (σ̄(S_o) and each axis's peak,
+:func:`ambseal.analysis.judge.sensitivity_grades`), continuous and as it runs, so that the
+verdict's zone is the worst from standstill to the top speed and names where.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ambseal.analysis.judge import JudgeJob, OperatingPoint
+from ambseal.analysis.judge import JudgeJob, JudgeSettings, OperatingPoint, sensitivity_grades
 from ambseal.lti import json_float
 from ambseal.machine import judged_loop
 from ambseal.model import build_plant
 from ambseal.robust import loop_delay
 
 __all__ = ["SampledStability", "StabilityCase", "stability_points", "stability_case"]
+
+#: The ISO 14839-3 grades a speed-range loop carries (:func:`ambseal.analysis.judge.
+#: sensitivity_grades`), as a judged case names them.
+GRADES = ("sensitivity_peak", "sensitivity_peak_per_axis", "iso_zone", "iso_zone_per_axis")
 
 
 @dataclass(frozen=True)
@@ -45,6 +52,10 @@ class StabilityCase:
     discrete : SampledStability or None
         The loop of the discrete controller as it runs; None for a controller that cannot
         run on the target.
+    sensitivity_peak, sensitivity_peak_per_axis, iso_zone, iso_zone_per_axis
+        ISO 14839-3's grades of the continuous loop
+        (:func:`ambseal.analysis.judge.sensitivity_grades`: σ̄(S_o)'s peak (-) and zone,
+        each axis's peak and zone); None where not graded.
     """
 
     controller: str
@@ -54,12 +65,17 @@ class StabilityCase:
     stable: bool
     max_real_pole: float | None
     discrete: SampledStability | None = None
+    sensitivity_peak: float | None = None
+    sensitivity_peak_per_axis: dict[str, float | None] | None = None
+    iso_zone: str | None = None
+    iso_zone_per_axis: dict[str, str] | None = None
 
     def to_dict(self) -> dict:
         """The ``metrics.json`` form."""
         return {"controller": self.controller, "label": self.label,
                 "pressure_bar": self.pressure_bar, "speed_hz": self.speed_hz,
                 "stable": self.stable, "max_real_pole": self.max_real_pole,
+                **{k: getattr(self, k) for k in GRADES},
                 "discrete": None if self.discrete is None else self.discrete.to_dict()}
 
 
@@ -75,16 +91,23 @@ class SampledStability:
         The largest pole modulus |z|.
     sample_rate_hz : float
         The controller's sample rate (Hz).
+    sensitivity_peak, sensitivity_peak_per_axis, iso_zone, iso_zone_per_axis
+        ISO 14839-3's grades of the loop as it runs (as :class:`StabilityCase`'s).
     """
 
     stable: bool
     max_abs_pole_z: float
     sample_rate_hz: float
+    sensitivity_peak: float | None = None
+    sensitivity_peak_per_axis: dict[str, float | None] | None = None
+    iso_zone: str | None = None
+    iso_zone_per_axis: dict[str, str] | None = None
 
     def to_dict(self) -> dict:
         """The ``metrics.json`` form."""
         return {"stable": self.stable, "max_abs_pole_z": self.max_abs_pole_z,
-                "sample_rate_hz": self.sample_rate_hz}
+                "sample_rate_hz": self.sample_rate_hz,
+                **{k: getattr(self, k) for k in GRADES}}
 
 
 def stability_points(pressures_bar, speeds_hz, judged) -> list[OperatingPoint]:
@@ -112,7 +135,8 @@ def stability_points(pressures_bar, speeds_hz, judged) -> list[OperatingPoint]:
             if (round(q, 12), round(f, 9)) not in done]
 
 
-def stability_case(case: JudgeJob, cfg) -> tuple[StabilityCase, dict]:
+def stability_case(case: JudgeJob, cfg, settings: JudgeSettings | None = None
+                   ) -> tuple[StabilityCase, dict]:
     """Close one controller on the full-order plant at one condition, continuous with the
     target's delay and, when it runs there, discrete as it runs; stability only.
 
@@ -123,6 +147,9 @@ def stability_case(case: JudgeJob, cfg) -> tuple[StabilityCase, dict]:
         point, and the discrete controller that runs (or None).
     cfg : RigConfig
         The rig judged on.
+    settings : JudgeSettings, optional
+        The judgement's grid (:func:`ambseal.analysis.judge.judge_settings`): with it,
+        each loop is graded by ISO 14839-3 too.
 
     Returns
     -------
@@ -135,13 +162,21 @@ def stability_case(case: JudgeJob, cfg) -> tuple[StabilityCase, dict]:
     plant = build_plant(cfg, pressure_bar=point.pressure_bar, speed_rpm=point.speed_rpm)
     P, cur = plant.to_statespace(), plant.current_inputs()
     dl = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples)
-    loop = judged_loop(P, case.controller, cur, delay=dl.system).loop
+    judged = judged_loop(P, case.controller, cur, delay=dl.system)
+    loop = judged.loop
+
+    def grades(j, K) -> dict:
+        return {} if settings is None else sensitivity_grades(j, K, cur, settings.freq_hz)
+
     curves: dict = {"poles": loop.poles}
     disc = None
     if case.discrete is not None:
-        dloop = judged_loop(P, case.discrete, cur).loop
-        disc = SampledStability(bool(dloop.stable), float(dloop.max_abs_pole), 1.0 / dloop.dt)
+        djudged = judged_loop(P, case.discrete, cur)
+        dloop = djudged.loop
+        disc = SampledStability(bool(dloop.stable), float(dloop.max_abs_pole), 1.0 / dloop.dt,
+                                **grades(djudged, case.discrete))
         curves["discrete"] = {"poles": dloop.poles}
     return StabilityCase(case.name, point.label, float(point.pressure_bar),
                          float(point.speed_rpm) / 60.0, bool(loop.stable),
-                         json_float(loop.max_real_pole), disc), curves
+                         json_float(loop.max_real_pole), disc,
+                         **grades(judged, case.controller)), curves

@@ -134,7 +134,8 @@ def _speed_range(designs, digitals, spec, points, design_cfg, judge_cfg, stages,
     stages.begin("speed-range", f"stability from standstill to "
                  f"{max(spec.stability_speeds_hz):g} Hz")
     jobs = judge_jobs(designs, digitals, spoints, design_cfg)
-    done = _by_condition(stability_case, jobs, {"cfg": judge_cfg},
+    done = _by_condition(stability_case, jobs, {"cfg": judge_cfg,
+                                                "settings": judge_settings(spec)},
                          lambda i, r: stages.step(f"{jobs[i].name} at {jobs[i].point.label}"))
     for d in designs:
         f = loop_failure(d.method, _judged_of(d.method, jobs, done),

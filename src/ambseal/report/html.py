@@ -176,7 +176,8 @@ def write_report(
         above the verdict, under "Failed controllers".
     stability : sequence of mapping
         ``metrics.json`` ``stability``: every controller's loop from standstill to the top
-        speed (stability only); an unstable one makes its verdict "not acceptable".
+        speed (stability and ISO 14839-3 zones, which the verdict counts); an unstable
+        one makes its verdict "not acceptable".
     designs : mapping, optional
         ``metrics.json`` ``controllers``: each design's bound (γ, μ and whether robust
         performance is met) beside its verdict.

@@ -541,8 +541,9 @@ def _discrete_section(metrics: dict) -> list[dict]:
 
 def _speed_range_section(metrics: dict) -> list[dict]:
     """A table of ``metrics["stability"]``: a row per controller, a column per speed; a cell
-    says "stable" when the loop (continuous and as it runs) is stable at every judged
-    pressure there, else the pressures where it is not."""
+    says "stable" and the worst ISO 14839-3 zone of any axis (continuous and as it runs,
+    every judged pressure) when the loop is stable at every judged pressure there, else the
+    pressures where it is not."""
     cases = metrics.get("stability") or []
     if not cases:
         return []
@@ -555,7 +556,11 @@ def _speed_range_section(metrics: dict) -> list[dict]:
             at = [c for c in cases if c["controller"] == n and c["speed_hz"] == f]
             bad = [c["pressure_bar"] for c in at if not c["stable"]
                    or not (c.get("discrete") or {}).get("stable", True)]
-            cells.append('<td>—</td>' if not at else '<td>stable</td>' if not bad else
+            zones = [z for c in at for b in (c, c.get("discrete") or {})
+                     for z in (b.get("iso_zone_per_axis") or {}).values()]
+            zone = max(zones, key="ABCD".index) if zones else None
+            ok = "stable" + (f", zone {zone}" if zone else "")
+            cells.append('<td>—</td>' if not at else f'<td>{ok}</td>' if not bad else
                          '<td class="unstable">unstable at '
                          + html.escape(", ".join(f"{q:g}" for q in bad)) + " bar</td>")
         rows.append(f"<tr><td>{html.escape(n)}</td>{''.join(cells)}</tr>")
@@ -564,7 +569,8 @@ def _speed_range_section(metrics: dict) -> list[dict]:
              f"{''.join(rows)}</table></div>")
     text = ("Every controller closed on the full-order plant at each judged pressure and "
             "each speed from standstill to the top speed that is not a judged condition, "
-            "continuous with the target's delay and as it runs (sampled): stability only.")
+            "continuous with the target's delay and as it runs (sampled): its stability and "
+            "the worst ISO 14839-3 zone of any axis there (the verdict counts it).")
     return [{"title": "From standstill to the top speed", "text": text, "html": table}]
 
 

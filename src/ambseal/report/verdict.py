@@ -76,7 +76,7 @@ def condition_label(case: Mapping, by_speed: bool) -> str:
 
 
 def _worst(zones) -> str | None:
-    zs = [z for z in zones if z in _ORDER]
+    zs = [z for z in zones if z and z in _ORDER]
     return max(zs, key=_ORDER.index) if zs else None
 
 
@@ -90,9 +90,11 @@ class Verdict:
     conditions, stable_at, unstable_at : tuple of str
         Judged conditions (``"2.04 bar"`` or ``"140 Hz"``), those with a stable loop, the rest.
     zone_axis, zone_sigma : str or None
-        Worst per-axis ISO 14839-3 zone (unstable → D), and the zone of σ̄(S_o).
+        Worst per-axis ISO 14839-3 zone (unstable → D), and the zone of σ̄(S_o), over
+        every graded loop: the judged conditions, continuous and as it runs, and the
+        speed range's (standstill to the top speed) where they are graded.
     sigma_peak : float or None
-        Largest σ̄(S_o) peak over the stable conditions (-).
+        Largest σ̄(S_o) peak over those loops where stable (-).
     orbit_um, impulse_peak_um, impulse_settling_s : float or None
         Worst unbalance orbit (µm), impulse peak (µm) and 2 % settling time (s).
     clearances_um : dict
@@ -110,8 +112,9 @@ class Verdict:
         ``"robust performance met: μ = <μ> ≤ 1 on the design model"`` (its summary's
         verdict, up to the full-order check); None for the PID.
     worst_axis : str or None
-        The axis and condition of the largest per-axis sensitivity peak over the stable
-        conditions, e.g. ``"A ζ at 4.08 bar"``; None without per-axis peaks.
+        The axis and condition of the largest per-axis sensitivity peak over those loops,
+        e.g. ``"A ζ at 4.08 bar"`` or ``"B η at 2.04 bar, 500 Hz, as it runs"``; None
+        without per-axis peaks.
     axes_alike : bool
         Every axis is in the same zone at every stable condition.
     capacity : dict or None
@@ -325,24 +328,34 @@ def _verdict(name: str, cs: list, by_speed: bool, sc: list,
     label = [condition_label(c, by_speed) for c in cs]
     ok = [c for c in cs if c.get("stable")]
 
-    def peak(key):
-        vals = [c[key] for c in ok if c.get(key) is not None]
+    def peak(key, among=ok):
+        vals = [c[key] for c in among if c.get(key) is not None]
         return max(vals) if vals else None
 
-    stable_zones = {z for c in ok for z in (c.get("iso_zone_per_axis") or {}).values()}
+    # every stable loop graded: the judged ones, continuous and as they run, and those of
+    # the speed range (standstill to the top speed), each by its condition
+    graded = [(lb, c) for lb, c in zip(label, ok)] + [
+        (f"{lb}, as it runs", c["discrete"]) for lb, c in zip(label, cs)
+        if (c.get("discrete") or {}).get("stable") and c["discrete"].get("iso_zone")] + [
+        (c["label"], c) for c in sc if c.get("stable") and c.get("iso_zone")] + [
+        (f"{c['label']}, as it runs", c["discrete"]) for c in sc
+        if (c.get("discrete") or {}).get("stable") and c["discrete"].get("iso_zone")]
+    loops = [g for _, g in graded]
+    stable_zones = {z for g in loops for z in (g.get("iso_zone_per_axis") or {}).values()}
     speed_bad = tuple(c["label"] for c in sc if _unstable(c))
     # an unstable loop, judged or at a speed of the range, is zone D: for σ̄(S_o) too, so
     # that the two zone cells of one row never disagree on it
     lost = ["D" for c in cs if not c.get("stable")] + (["D"] if speed_bad else [])
-    axis_zones = [z for c in cs for z in (c.get("iso_zone_per_axis") or {}).values()] + lost
-    top = _worst_axis(label, cs)
+    axis_zones = [z for c in [*cs, *loops[len(ok):]]
+                  for z in (c.get("iso_zone_per_axis") or {}).values()] + lost
+    top = _worst_axis([lb for lb, _ in graded], loops)
     return Verdict(
         controller=name, conditions=tuple(label),
         stable_at=tuple(lb for lb, c in zip(label, cs) if c.get("stable")),
         unstable_at=tuple(lb for lb, c in zip(label, cs) if not c.get("stable")),
         zone_axis=_worst(axis_zones),
-        zone_sigma=_worst([c.get("iso_zone") for c in cs] + lost),
-        sigma_peak=peak("sensitivity_peak"), orbit_um=worst_orbit_um(cs),
+        zone_sigma=_worst([c.get("iso_zone") for c in [*cs, *loops[len(ok):]]] + lost),
+        sigma_peak=peak("sensitivity_peak", loops), orbit_um=worst_orbit_um(cs),
         impulse_peak_um=peak("impulse_peak_um"),
         impulse_settling_s=peak("impulse_settling_s"),
         clearances_um=dict(clearances_um or {}), target_difference=target_difference(cs),

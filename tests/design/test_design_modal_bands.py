@@ -70,6 +70,24 @@ def test_a_band_without_its_mode_is_refused():
         with_modal_frequencies(plant, [ModeBand(300.0, 290.0, 310.0)])
 
 
+def test_a_mode_a_damping_margin_took_below_zero_is_still_its_bands_mode():
+    """Reference: the plant's own eigenvalues — a design model given both remedies for one
+    mode, a damping margin larger than its damping (:func:`less_damped`: ζ 0.005 − 0.02,
+    growing) and a band of uncertain frequency, makes that mode uncertain (σ ± j√θ, σ > 0
+    kept) rather than refusing the band as if the model had no such mode."""
+    from ambseal.design.plant import less_damped
+
+    plant = less_damped(_mixed_oscillators([(100.0, 0.01), (400.0, 0.005)]), [(400.0, 0.02)])
+    lam0 = np.linalg.eigvals(plant.A)
+    mode = lam0[np.argmin(np.abs(lam0.imag - 2 * np.pi * 400.0))]
+    assert mode.real > 0  # the margin made it grow
+    band = ModeBand(f_hz=400.0, lo_hz=380.0, hi_hz=410.0)
+    out, ranges = with_modal_frequencies(plant, [band])
+    theta = ranges[band.name][0]
+    lam = np.linalg.eigvals(out.with_values({band.name: theta}).A)
+    assert np.min(np.abs(lam - (mode.real + 1j * np.sqrt(theta)))) < 1e-6 * abs(mode)
+
+
 def test_the_bands_a_lost_mode_calls_for():
     """The lost mode's own band (widened 5 %) and every band below it; none above."""
     bands = [ModeBand(316.0, 315.0, 378.0), ModeBand(433.0, 378.0, 434.0),

@@ -216,6 +216,7 @@ def test_a_speed_scheduled_controller_is_taken_at_each_speed(overhung):
     ((115.0, 150.0), 0.05, "below"),   # 13 % below, min(16, 17(1 − 1/8.5)) = 15 % required
     ((120.0, 150.0), 0.05, None),      # 17 % below: separated
     ((90.0, 110.0), 0.3, None),        # AF 1.7: no critical speed
+    ((90.0, 110.0), "ripple", None),   # never falls to half power: no resonance
 ])
 def test_critical_speeds_are_the_api_617_separation_check(f_range, zeta, where):
     """Reference: a single-degree-of-freedom resonance 1/|1 − r² + 2jζr| at 100 Hz (its
@@ -229,7 +230,10 @@ def test_critical_speeds_are_the_api_617_separation_check(f_range, zeta, where):
 
     f = np.linspace(40.0, 160.0, 24001)
     r = f / 100.0
-    amp = 1e-5 / np.abs(1 - r**2 + 2j * zeta * r)
+    if zeta == "ripple":  # a broad response with a 1 % ripple
+        amp = 1e-5 * (1 + 0.01 * np.sin(2 * np.pi * f / 7.0))
+    else:
+        amp = 1e-5 / np.abs(1 - r**2 + 2j * zeta * r)
     unb = UnbalanceResponse(2 * np.pi * f, np.ones_like(f), amp, 0.0, 0.0, 1.0, 1.0)
     got = critical_speeds(unb, *f_range)
     if where is None:

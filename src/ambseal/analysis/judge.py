@@ -547,8 +547,9 @@ def critical_speeds(unb: UnbalanceResponse, f_min: float, f_max: float) -> list[
     A critical speed is a local maximum of the orbit over speed (a closed-loop mode's 1×
     crossing) with a half-power amplification factor AF ≥ 2.5 (API 684 §2.8; where the
     sweep ends before the orbit falls to half power on one side, the other side's
-    half-width is taken for both; on neither, it counts as critical: not shown to be
-    damped); its separation margin from the continuous range [f_min, f_max] is
+    half-width is taken for both; a peak that falls to half power on neither side within
+    the sweep is no resonance — a ripple of a broad response — and is left out); its
+    separation margin from the continuous range [f_min, f_max] is
     ``100 (f_min − N)/f_min`` below it and ``100 (N − f_max)/f_max`` above it, and API 617
     (8th ed., §2.6.2.10) requires ``min(16, 17(1 − 1/(AF − 1.5)))`` % below and
     ``min(26, 10 + 17(1 − 1/(AF − 1.5)))`` % above
@@ -573,8 +574,9 @@ def critical_speeds(unb: UnbalanceResponse, f_min: float, f_max: float) -> list[
         af, n1, n2 = amplification_factor(f, a, int(i))
         n = float(f[i])
         if np.isnan(af):  # one side (or none) within the sweep
-            half = np.nanmax([n - n1, n2 - n]) if np.isfinite([n1, n2]).any() else 0.0
-            af = n / (2 * half) if half > 0 else math.inf
+            if not np.isfinite([n1, n2]).any():
+                continue
+            af = n / (2 * np.nanmax([n - n1, n2 - n]))
         if af < AF_CRITICAL:
             continue
         below = n < f_min

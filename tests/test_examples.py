@@ -148,6 +148,13 @@ def test_every_example_runs_end_to_end(rig, tmp_path, capsys):
             assert r["facility"]["after_a"] < 1e-2 * r["facility"]["before_a"], m
             given = load_rig(rig).design.rejection.runout_um
             assert given is None or r["facility"]["runout_um"] == pytest.approx(given)
+        # notch files only beside a delivered controller whose notched orbit fits the rig
+        for m, summary in metrics["controllers"].items():
+            r = summary.get("rejection") or {}
+            if r.get("files"):
+                assert m in delivered and r["beyond"] is None, (m, r.get("beyond"))
+        assert not [f for f in (tmp_path / "out" / "controllers").glob("rejection_*")
+                    if f.name.split(".")[0].removeprefix("rejection_") not in delivered]
         assert (tmp_path / "out" / "rejection.png").is_file()
         _rejection_held_by_python_control(rig, metrics, tmp_path / "out")
     _every_file_through_every_command(rig, tmp_path / "out", tmp_path, capsys)

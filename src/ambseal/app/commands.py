@@ -28,6 +28,7 @@ from ambseal.design import (
     design_rise,
     design_spec,
     full_order_check,
+    lpv_schedule,
     pid_description,
     reference_pid,
 )
@@ -421,7 +422,7 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
     Raises
     ------
     ConfigError
-        A bad rig, a bad sample rate or delay, or ``lpv`` without a speed range.
+        A bad rig, a bad sample rate or delay, or ``lpv`` on a rig at standstill.
     SynthesisError
         No discretisation keeps the sampled loop stable (the reason named).
     """
@@ -429,11 +430,12 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
     cfg = load_rig(rig, overrides)
     out = writable_folder(out_dir)  # before the design, not after it
     spec = design_spec(cfg)  # judged at the rig's conditions, whatever the design pressure
-    if method == "lpv":
-        if cfg.operating.speed_range_hz is None:
-            raise ConfigError(f"{rig}: operating.speed_range_hz: an LPV design needs the "
-                              "speed range it is scheduled over, e.g. [20.0, 300.0]")
-        res = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz,
+    if method == "lpv":  # what ambseal run designs (the one rule)
+        try:
+            speeds, states, _ = lpv_schedule(cfg, spec)
+        except ConfigError as exc:
+            raise ConfigError(f"{rig}: {exc}") from None
+        res = design_lpv(cfg, speeds_hz=speeds, states=states,
                          allow_unstable=allow_unstable, spec=spec)
         K, summary = res, res.to_dict()
     else:

@@ -19,7 +19,9 @@ from ambseal.analysis import (
     JudgeSettings,
     OperatingPoint,
     also_failed,
+    CLEARANCE_WORDS,
     capacity_block,
+    clearance_exceeded,
     clearance_failure,
     facility_rejection,
     facility_speed_step,
@@ -76,6 +78,7 @@ from ambseal.design import (
     design_lpv,
     design_rejection,
     design_spec,
+    lpv_schedule,
 )
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.export import export_notch, write_notch_c
@@ -196,7 +199,8 @@ def _controllers(cfg: RigConfig, spec, say, failed: dict,
             return Designed(fz)
 
         def lpv() -> Designed:
-            d = design_lpv(cfg, speeds_hz=cfg.operating.speed_range_hz, allow_unstable=True,
+            speeds, states, _ = lpv_schedule(cfg, spec)
+            d = design_lpv(cfg, speeds_hz=speeds, states=states, allow_unstable=True,
                            spec=spec)
             return Designed(d)
 
@@ -210,13 +214,14 @@ def _controllers(cfg: RigConfig, spec, say, failed: dict,
             say(f"{m} designed", 1)
     lost = _lost_over_speed(cfg, out)
     if lost:
-        top = max(spec.stability_speeds_hz)
+        speeds, states, _ = lpv_schedule(cfg, spec)
         say(f"{' and '.join(lost)} designed at {cfg.operating.speed_rpm / 60.0:g} Hz lose the "
-            f"rotor at other speeds: designing the LPV on speed, 0–{top:g} Hz", 0)
+            f"rotor at other speeds: designing the LPV on speed, {speeds[0]:g}–{speeds[1]:g} "
+            "Hz", 0)
 
         def speed_lpv() -> Designed:
-            d = design_lpv(cfg, speeds_hz=(0.0, top), states=spec.model_states,
-                           allow_unstable=True, spec=spec)
+            d = design_lpv(cfg, speeds_hz=speeds, states=states, allow_unstable=True,
+                           spec=spec)
             return Designed(d)
 
         out += guarded("lpv", speed_lpv)
@@ -533,8 +538,10 @@ def _rejections(st: _RunState, summaries: dict) -> dict:
     facility (:mod:`ambseal.analysis.rejection`): its ``rejection`` block in
     ``summaries``, and for the figures ``{"effects": method → the effect's curves,
     "facility": method → FacilityRejection, "speed_step": method → SpeedStep}``. A notch
-    that loses a loop is said so on stderr and in the block (``stable`` false), not
-    exported; the controller alone is delivered still."""
+    that loses a loop, or whose orbit exceeds a clearance of the rig
+    (:func:`ambseal.analysis.delivery.clearance_exceeded`: ``beyond`` in the block), is
+    said so on stderr and in the block, not exported; the controller alone is delivered
+    still. A controller not delivered gets no notch files."""
     st.stages.begin("rejection", "unbalance force rejection")
     r = st.cfg.design.rejection
     kw = {k: v for k, v in (("rate_fraction", r.rate_fraction), ("points", r.points))
@@ -559,10 +566,20 @@ def _rejections(st: _RunState, summaries: dict) -> dict:
                for q in ("current_a", "force_n", "orbit_um")},
             "current_ratio": float(np.max(e["current_a"]["with"]
                                           / np.maximum(e["current_a"]["without"], 1e-300)))}
+        orbit = summaries[d.method]["rejection"]["orbit_um"]["with"]
+        beyond = clearance_exceeded(orbit, rig_clearances_um(st.cfg))
+        summaries[d.method]["rejection"]["beyond"] = (
+            None if beyond is None else {"clearance": beyond[0], "clearance_um": beyond[1],
+                                         "orbit_um": orbit})
+        delivered = summaries[d.method].get("discretisation") is not None
         if lost:  # said, not delivered
             st.say(f"{d.method}: its unbalance force rejection loses the loop at "
                    f"{', '.join(lost)}")
-        else:  # on the facility at the top speed (the most synchronous current), then
+        elif beyond is not None:
+            st.say(f"{d.method}: with its unbalance force rejection the orbit, {orbit:.3g} µm, "
+                   f"exceeds {CLEARANCE_WORDS.get(beyond[0], beyond[0])} ({beyond[1]:.3g} µm):"
+                   " not exported")
+        elif delivered:  # on the facility at the top speed (the most synchronous current), then
             # beside the controller's files: its notch as a file and as C
             lo, top = float(rej.speeds_hz[0]), float(rej.speeds_hz[-1])
             runout = None if r.runout_um is None else 1e-6 * r.runout_um

@@ -14,6 +14,7 @@
 * :class:`Design` — what every design result offers (:class:`DesignResult` and the
   scheduled designs below alike);
 * :func:`design_lpv`, :func:`design_frozen` — controllers scheduled on the speed (P3 §4),
+  over the speeds :func:`lpv_schedule` gives,
   on the gridded plant of :func:`ambseal.design.lpv_plant.lpv_plant` (not re-exported: it
   shares its module's name) at the speeds of :func:`vertex_grid_hz`;
   :func:`design_seal_scheduled` — scheduled on the tracked seal coefficient (Ch. 7);
@@ -24,7 +25,7 @@ The synthesis itself is :mod:`ambseal.robust`'s, which knows nothing of rotors.
 """
 
 from ambseal.design.fast_poles import design_rise
-from ambseal.design.lpv_design import design_frozen, design_lpv
+from ambseal.design.lpv_design import design_frozen, design_lpv, lpv_schedule
 from ambseal.design.lpv_plant import vertex_grid_hz
 from ambseal.design.pid import (
     controller_from_metadata,
@@ -42,7 +43,7 @@ from ambseal.design.weights import Weights, default_weights
 
 __all__ = ["RIGID_STATES", "Design", "DesignResult", "DesignSpec", "Machine", "Weights",
            "controller_from_metadata", "default_weights", "design", "design_frozen",
-           "design_lpv", "design_rise", "design_seal_scheduled", "design_spec",
+           "design_lpv", "lpv_schedule", "design_rise", "design_seal_scheduled", "design_spec",
            "full_order_check", "generalized_plant", "machine",
            "physical_controller", "pid_controller", "pid_description", "reference_pid",
            "vertex_grid_hz", "SynchronousRejection", "design_rejection"]

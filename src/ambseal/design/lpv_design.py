@@ -51,7 +51,51 @@ from ambseal.machine import SPEED, ScheduledController
 from ambseal.robust import design_omega, hinfsyn, lpvsyn, musyn
 
 __all__ = ["LpvDesign", "FrozenDesign", "design_lpv", "design_frozen",
-           "lpv_generalized_plants", "check_full_order"]
+           "lpv_generalized_plants", "check_full_order", "lpv_schedule"]
+
+#: Mechanical states of the design model of an LPV controller on a rig whose seals follow
+#: the speed (P3 §4: the rigid-body modes and their actuators)
+LPV_SEAL_STATES = 8
+
+
+def lpv_schedule(cfg, spec) -> tuple[tuple[float, float], int, str]:
+    """The speeds an LPV controller of the rig is scheduled over and the states of its
+    design model — the one rule of ``ambseal run`` and ``ambseal design --method lpv``.
+
+    A rig whose seals follow the speed over ``[operating] speed_range_hz`` (P3 §4): that
+    range, on :data:`LPV_SEAL_STATES` states. Any other: standstill to the top speed (the
+    largest of the specification's stability speeds), on the specification's
+    ``model_states`` — where the gyroscopic moments move the modes out of what one frozen
+    design holds.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig.
+    spec : DesignSpec
+        Its design specification (:func:`ambseal.design.specs.design_spec`).
+
+    Returns
+    -------
+    speeds_hz : (float, float)
+    states : int
+    rule : str
+        The rule in words.
+
+    Raises
+    ------
+    ConfigError
+        A rig with no speed above standstill to schedule on.
+    """
+    rng = cfg.operating.speed_range_hz
+    if rng is not None and any(s.frequency_dependent for s in cfg.seal):
+        return ((float(rng[0]), float(rng[1])), LPV_SEAL_STATES,
+                "[operating] speed_range_hz, which the seals follow (P3 §4)")
+    top = max(spec.stability_speeds_hz)
+    if not top > 0:
+        raise ConfigError("an LPV controller is scheduled on speed, and the rig runs at "
+                          "standstill: set [operating] speed_rpm or speed_range_hz")
+    return (0.0, float(top)), int(spec.model_states), "standstill to the top speed"
 
 _TWO_PI = 2.0 * np.pi
 

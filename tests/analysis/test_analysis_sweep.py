@@ -281,3 +281,39 @@ def test_the_local_cluster_is_private():
         port = int(s["scheduler"].rsplit(":", 1)[1])
         assert port in s["main"] and len(s["main"]) == 1 + 2, s
         assert s["worker"] == [int(s["address"].rsplit(":", 1)[1])], s
+
+
+def test_a_controller_that_runs_on_a_target_is_swept_as_it_runs(testrig_cfg):
+    """Reference: the judgement of ``ambseal run`` at the same condition — a controller
+    file's digital controller (the PID as ``ambseal design`` exports it) in a sweep gives,
+    beside the continuous columns, the loop as it runs (discrete controller with its delay
+    on the sampled plant): stable, max |z|, σ̄(S_o) peak and zones, unbalance peak, equal
+    to :func:`~ambseal.analysis.judge.judge`'s ``discrete`` block there (1e-9); a
+    controller without one gets no such column."""
+    from ambseal.analysis.judge import OperatingPoint, judge
+    from ambseal.app.commands import digital_for
+    from ambseal.design import design
+
+    cfg = testrig_cfg
+    res = design(cfg, "pid")
+    s = judge_settings(design_spec(cfg))
+    p = cfg.operating.pressure_bar
+    point = OperatingPoint(p, 0.0, "")
+    digital = digital_for(cfg, "pid", res.K, res, [point])
+    rows = sweep(cfg, {"pid": res.K, "plain": res.K}, [p], [0.0], settings=s, workers=1,
+                 digitals={"pid": digital})
+    ref = judge(cfg, res.K, "pid", point, s, impulse=False,
+                discrete=digital.statespace(delayed=True))[0].discrete
+    row, plain = rows
+    assert row["stable_as_runs"] is ref.stable is True
+    assert row["max_abs_pole_z"] == pytest.approx(ref.max_abs_pole_z, rel=1e-9)
+    assert row["sensitivity_peak_as_runs"] == pytest.approx(ref.sensitivity_peak, rel=1e-9)
+    assert row["iso_zone_as_runs"] == ref.iso_zone
+    assert {k: v for k, v in row.items() if k.startswith("iso_zone_") and k.endswith(
+        "_as_runs") and k != "iso_zone_as_runs"} == {
+        f"iso_zone_{ax}_as_runs": z for ax, z in ref.iso_zone_per_axis.items()}
+    assert row["unbalance_peak_um_as_runs"] == pytest.approx(ref.unbalance_peak_um, rel=1e-9)
+    assert not any(k.endswith("_as_runs") for k in plain)
+    # the loop as it runs is a result, not a parameter of the map's boundary
+    (edge,) = [b for b in stability_boundary(rows) if b["controller"] == "pid"]
+    assert not any(k.endswith("_as_runs") or k == "max_abs_pole_z" for k in edge)

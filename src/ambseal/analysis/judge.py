@@ -603,7 +603,7 @@ def _controller_at_speed(G, K, schedule, delay):
     controller ``K`` wired to ``G``: continuous, ``K(jΩ)`` behind the judged loop's delay
     lag (its current reference the same, |lag| = 1); discrete, ``K_d(e^{jΩT})`` times the
     hold's fundamental in the loop and at the samples for the current. A controller
-    ``schedule``\ d on speed is taken at each speed Ω."""
+    scheduled on speed (``schedule``) is taken at each speed Ω."""
     dt = float(K.dt or 0.0)
 
     def at(Kx, w):

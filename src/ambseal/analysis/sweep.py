@@ -14,6 +14,12 @@ Inputs of a sweep case are plain and picklable: the rig as a dict (``RigConfig.m
 each fixed controller as its ``(A, B, C, D)`` arrays and signal names, a scheduled one as its
 table (:class:`~ambseal.machine.ScheduledDigital`, frozen at each case's speed or seal
 coefficient).
+
+A controller that runs on a target (a controller file of ``ambseal design``: its
+:class:`~ambseal.robust.DigitalController` or table) is judged as it runs too, the discrete
+controller with its computation delay on the plant sampled at its rate, as ``ambseal run``
+judges it: the row's ``*_as_runs`` columns (``stable_as_runs``, ``max_abs_pole_z``,
+``sensitivity_peak_as_runs``, ``iso_zone_as_runs`` and per axis, ``unbalance_peak_um_as_runs``).
 """
 
 from __future__ import annotations
@@ -26,11 +32,12 @@ import numpy as np
 
 from ambseal.analysis.campbell import closed_loop_state_matrix, lowest_log_decrement
 from ambseal.analysis.cases import CaseError, run_cases
-from ambseal.analysis.judge import JudgeSettings, OperatingPoint, frozen_at, judge
+from ambseal.analysis.judge import (JudgeSettings, OperatingPoint, frozen_at, frozen_discrete,
+                                   judge)
 from ambseal.config import parse_rig, rig_with_values
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
-from ambseal.machine import ScheduledController
+from ambseal.machine import SPEED, ScheduledController
 from ambseal.model import bending_limit_hz
 from ambseal.robust import is_stable
 
@@ -88,7 +95,7 @@ def parse_range(text: str, name: str) -> np.ndarray:
 
 
 def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
-               settings: JudgeSettings) -> dict:
+               settings: JudgeSettings, digitals: dict | None = None) -> dict:
     """One map point: the judgement without impulse and the lowest log decrement.
 
     Parameters
@@ -109,6 +116,9 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
         Highest frequency (Hz) of the modes the lowest log decrement is taken over.
     settings : JudgeSettings
         The nominal rig's :func:`~ambseal.analysis.judge.judge_settings`.
+    digitals : dict, optional
+        ``{name: DigitalController or ScheduledDigital}``: the controllers that run on a
+        target, judged as they run too (module docstring).
 
     Returns
     -------
@@ -118,14 +128,20 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
         ``[signoff] log_dec_min``, the sign-off's limit, 0.1 by default: a stable loop
         with a zone A σ̄(S_o) may still have a mode too lightly damped to pass),
         ``sensitivity_peak`` (σ̄(S_o), -), ``iso_zone`` and ``iso_zone_<axis>``,
-        ``unbalance_peak_um``.
+        ``unbalance_peak_um``; for a controller of ``digitals`` the same as it runs
+        (module docstring).
     """
 
     nominal, cfg = _case_rig(rig, case.get("params"))
     point = OperatingPoint(case["pressure_bar"], 60.0 * case["speed_hz"], "")
-    K = _controller(controllers[case["controller"]], point, nominal)
-    res, curves = judge(cfg, K, case["controller"], point, settings,
-                        impulse=False)
+    entry = controllers[case["controller"]]
+    K = _controller(entry, point, nominal)
+    g = (digitals or {}).get(case["controller"])
+    on_speed = getattr(g, "parameter", None) == SPEED  # the running unbalance at each speed
+    res, curves = judge(cfg, K, case["controller"], point, settings, impulse=False,
+                        discrete=frozen_discrete(g, point, nominal),
+                        schedule=entry if on_speed else None,
+                        schedule_discrete=g if on_speed else None)
     dec, dec_hz = lowest_log_decrement(curves["poles"], max_hz)
     row = {"controller": case["controller"], "pressure_bar": case["pressure_bar"],
            "speed_hz": case["speed_hz"], **(case.get("params") or {}),
@@ -135,6 +151,13 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
            "sensitivity_peak": res.sensitivity_peak, "iso_zone": res.iso_zone}
     row.update({f"iso_zone_{ax}": z for ax, z in res.iso_zone_per_axis.items()})
     row["unbalance_peak_um"] = res.unbalance_peak_um
+    d = res.discrete
+    if d is not None:
+        row.update({"stable_as_runs": d.stable, "max_abs_pole_z": d.max_abs_pole_z,
+                    "sensitivity_peak_as_runs": d.sensitivity_peak,
+                    "iso_zone_as_runs": d.iso_zone,
+                    **{f"iso_zone_{ax}_as_runs": z for ax, z in d.iso_zone_per_axis.items()},
+                    "unbalance_peak_um_as_runs": d.unbalance_peak_um})
     return row
 
 
@@ -186,7 +209,8 @@ def check_cases(n: int, what: str) -> None:
 
 def sweep(cfg, controllers: dict, pressures_bar, speeds_hz, params: dict | None = None, *,
           settings: JudgeSettings, max_hz: float | None = None, workers: int | None = None,
-          scheduler: str | None = None, progress: bool = False) -> list[dict]:
+          scheduler: str | None = None, progress: bool = False,
+          digitals: dict | None = None) -> list[dict]:
     """The map over every (controller, pressure, speed, parameter values) combination.
 
     Parameters
@@ -206,6 +230,9 @@ def sweep(cfg, controllers: dict, pressures_bar, speeds_hz, params: dict | None 
         :func:`ambseal.model.modes.bending_limit_hz`.
     workers, scheduler, progress
         As in :func:`run_cases`.
+    digitals : dict, optional
+        ``{name: DigitalController or ScheduledDigital}``: those of ``controllers`` that
+        run on a target, judged as they run too (:func:`sweep_case`).
 
     Returns
     -------
@@ -224,7 +251,8 @@ def sweep(cfg, controllers: dict, pressures_bar, speeds_hz, params: dict | None 
              for vals in itertools.product(*(params[n] for n in names))]
 
     shared = {**_shared(cfg, controllers), "settings": settings,
-              "max_hz": bending_limit_hz(cfg) if max_hz is None else float(max_hz)}
+              "max_hz": bending_limit_hz(cfg) if max_hz is None else float(max_hz),
+              "digitals": dict(digitals or {})}
     out = run_cases(sweep_case, cases, shared=shared, workers=workers, scheduler=scheduler,
                     progress=progress, description="sweep")
     return [{**{k: v for k, v in r.case.items() if k != "params"}, **r.case["params"],
@@ -358,4 +386,6 @@ _RESULTS = {"stable", "max_real_pole", "lowest_log_dec", "lowest_log_dec_hz", "l
 
 
 def _is_result(key: str) -> bool:
-    return key in _RESULTS or key.startswith("iso_zone_")
+    # the loop as it runs (*_as_runs, max |z|) is a result too, not a parameter of the map
+    return (key in _RESULTS or key.startswith("iso_zone_") or key.endswith("_as_runs")
+            or key == "max_abs_pole_z")

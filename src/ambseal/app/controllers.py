@@ -12,7 +12,7 @@ from ambseal.export import load_controller
 from ambseal.model import channel_names
 from ambseal.robust import DigitalController
 
-__all__ = ["controller_for"]
+__all__ = ["controller_for", "runs_as"]
 
 
 def controller_for(cfg, spec: str | None, pressure_bar: float | None = None):
@@ -33,3 +33,15 @@ def controller_for(cfg, spec: str | None, pressure_bar: float | None = None):
 
     K = load_controller(spec, channel_names(cfg))  # a judged digital one: its continuous design
     return K.continuous if isinstance(K, DigitalController) else K
+
+
+def runs_as(cfg, spec: str | None):
+    """The controller as it runs on the target that ``spec`` names, where it names one: a
+    controller file of ``ambseal design`` holding a digital controller or a scheduled
+    table (:class:`~ambseal.robust.DigitalController`, ``ScheduledDigital``); None for a
+    method designed here (its discretisation is ``ambseal design``'s to choose), a
+    continuous file, or the open loop."""
+    if spec is None or spec == "none" or spec in method_names(fixed=True):
+        return None
+    K = load_controller(spec, channel_names(cfg))
+    return K if hasattr(K, "statespace_at") or isinstance(K, DigitalController) else None

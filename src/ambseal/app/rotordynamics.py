@@ -38,7 +38,7 @@ from ambseal.analysis import (
 from ambseal.analysis.campbell import campbell
 from ambseal.analysis.sweep import sweep
 from ambseal.app.commands import digital_for
-from ambseal.app.controllers import controller_for
+from ambseal.app.controllers import controller_for, runs_as
 from ambseal.app.modes import mode_positions, modes_command
 from ambseal.config import (
     MAX_COEFFICIENT,
@@ -179,8 +179,11 @@ def _sweep(args: argparse.Namespace) -> int:
         print("ambseal: note: dask is not installed; the sweep runs serially",
               file=sys.stderr)
         workers = 1
+    # a controller file runs on a target: judged as it runs too (the *_as_runs columns)
+    digitals = {Path(s).stem: g for s in specs if (g := runs_as(cfg, s)) is not None}
     rows = sweep(cfg, ctrl, pressures, speeds, params, settings=judge_settings(spec),
-                 max_hz=args.max_hz, workers=workers, scheduler=args.scheduler, progress=True)
+                 max_hz=args.max_hz, workers=workers, scheduler=args.scheduler, progress=True,
+                 digitals=digitals)
     edge = refine_boundary(cfg, ctrl, stability_boundary(rows), tol_bar=args.tol_bar,
                            workers=workers, scheduler=args.scheduler, progress=True)
     out = Path(args.out)

@@ -185,8 +185,10 @@ class DesignCache:
 
         def design_lpv(cfg, **kw):
             tc = got.get("turbo_cfg")
+            # the session's design is the default one: over the speed range, 8 states
             if (tc is not None and _same(cfg, tc)
-                    and set(kw) - {"allow_unstable", "spec"} == {"speeds_hz"}
+                    and set(kw) - {"allow_unstable", "spec", "states"} == {"speeds_hz"}
+                    and kw.get("states", 8) == 8
                     and tuple(kw["speeds_hz"]) == tuple(tc.operating.speed_range_hz)):
                 self.hits.append("design_lpv")
                 return got["turbo_lpv"]

@@ -245,6 +245,10 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Pid.ti": ("s", "integral time T_i"),
     "Pid.td": ("s", "derivative time T_d"),
     "Pid.eps": ("", "derivative filter ε: the filter's time constant is ε T_d"),
+    "Pid.cross_kp": ("A/m", "cross-axis proportional gain between the two axes of a "
+                            "bearing (default 0)"),
+    "Pid.cross_kd": ("A·s/m", "cross-axis derivative gain, through the derivative's filter "
+                              "(default 0)"),
     "Controllers.filter": ("", "filters in series with the PID on every axis; left out, "
                                "a derived PID carries its derived filters and a given PID "
                                "none (``filter = []``: none)"),

@@ -70,7 +70,11 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     in kg, N/m, N·s/m: the spring joins the shaft to this mass, which its own springs and
     dampers hold to ground in x, y), ``name`` (optional).
 ``[controller.pid]``
-    ``kp`` (A/m), ``ti`` (s), ``td`` (s), ``eps`` (-): thesis P5 Eq. 6, per actuator axis.
+    ``kp`` (A/m), ``ti`` (s), ``td`` (s), ``eps`` (-): thesis P5 Eq. 6, per actuator axis;
+    ``cross_kp`` (A/m) and ``cross_kd`` (A·s/m), default 0: cross-axis gains between the
+    two axes of each bearing, i_ζ = −(K y_ζ + K_c y_η), i_η = −(K y_η − K_c y_ζ) with
+    K_c = cross_kp + cross_kd·s/(ε T_d s + 1) — the cross feedback that damps a gyroscopic
+    rotor's whirl (:func:`ambseal.design.pid.pid_controller`).
 ``[[controller.filter]]``
     Filters in series with the PID on every axis (:class:`PidFilter`): ``kind`` =
     ``"notch"`` (``frequency_hz``, ``width_hz``, ``depth_db`` default 20), ``"lead"`` or
@@ -570,6 +574,17 @@ class Pid(_Strict):
     ti: float = Field(gt=0, le=1e4)
     td: float = Field(ge=0, le=100.0)
     eps: float = Field(gt=0, le=1e3)
+    # cross-axis gains between the two axes of one bearing: either sign (the sense of
+    # whirl they act on), bounded as kp and kp·td are
+    cross_kp: float = Field(default=0.0, ge=-1e9, le=1e9)
+    cross_kd: float = Field(default=0.0, ge=-1e11, le=1e11)
+
+    @model_validator(mode="after")
+    def _cross(self) -> "Pid":
+        if self.cross_kd != 0 and self.td == 0:
+            raise ValueError("cross_kd: a cross-axis derivative takes the derivative's "
+                             "filter, and td = 0 has none; set td > 0 or cross_kd = 0")
+        return self
 
 
 class PidFilter(_Strict):

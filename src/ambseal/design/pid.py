@@ -18,7 +18,7 @@ from ambseal.model import amb_factors, assemble_rotor, build_plant, channel_name
 from ambseal.robust import discrete_controller, discretize_as, is_stable, with_delay
 
 __all__ = ["pid_controller", "pid_from_rig", "reference_pid", "reference_controller",
-           "controller_from_metadata", "filter_matrices", "pid_description",
+           "controller_from_metadata", "filter_matrices", "pid_description", "pid_of",
            "PID_CORNERS_PER_FS"]
 
 #: the derived PID (no [controller.pid]): k_eq = K_EQ_PER_KS·Ks, ζ on the rigid-body modes,
@@ -31,11 +31,20 @@ KEEP_OF_STRUCTURAL = 0.2
 
 def pid_controller(
     kp: float, ti: float, td: float, eps: float, channels: list[str] | tuple[str, ...],
-    filters=(),
+    filters=(), cross_kp: float = 0.0, cross_kd: float = 0.0,
 ):
-    """Decentralised PID, the same on every actuator axis, with filters in series.
+    """Decentralised PID, the same on every actuator axis, with filters in series, and
+    cross-axis gains between the two axes of each bearing.
 
     K_PID(s) = Kp (1 + 1/(Ti s) + Td s/(ε Td s + 1)) · Π F_k(s)   (thesis P5 Eq. 6)
+
+    Cross feedback (Schweitzer & Maslen, *Magnetic Bearings*, 2009, on gyroscopic rotors;
+    Brown et al., NASA/TM-2006-214027): on the two axes ζ, η of one AMB,
+    i_ζ = −(K y_ζ + K_c y_η), i_η = −(K y_η − K_c y_ζ), with
+    K_c(s) = (cross_kp + cross_kd s/(ε Td s + 1)) · Π F_k(s): in the complex coordinate
+    r = ζ + jη, i = −(K − jK_c) r, a force that turns with the whirl (forward for
+    K_c > 0 acting as a negative cross stiffness, −j K_i cross_kp) — what damps or
+    stiffens a gyroscopic rotor's nutation and precession differently.
 
     The filters are the commissioning engineer's (Schweitzer & Maslen, *Magnetic
     Bearings*, 2009, on flexible rotors), with ω_c = 2π ``frequency_hz``:
@@ -62,13 +71,23 @@ def pid_controller(
     filters : sequence of PidFilter or dict, optional
         ``[[controller.filter]]`` entries (:class:`ambseal.config.rig.PidFilter`, or dicts
         of its keys), applied in order.
+    cross_kp, cross_kd : float, optional
+        Cross-axis gains (A/m, A·s/m) between the ``<amb>_zeta`` and ``<amb>_eta``
+        channels of each AMB; the derivative through the derivative's filter (needs
+        ``td > 0``).
 
     Returns
     -------
     control.StateSpace
-        Diagonal controller with 2 states per axis (integrator, derivative filter) plus
-        the filters' (2 per notch or lowpass, 1 per lead or lag), used in negative
-        feedback u = −K y.
+        Controller with 2 states per axis (integrator, derivative filter) plus the
+        filters' (2 per notch or lowpass, 1 per lead or lag), used in negative feedback
+        u = −K y; diagonal without cross gains.
+
+    Raises
+    ------
+    ConfigError
+        ``cross_kd`` without a derivative (``td = 0``), or cross gains on channels that
+        are not ζ/η pairs.
     """
 
     picklable()
@@ -82,18 +101,58 @@ def pid_controller(
     else:
         a, b = np.zeros((1, 1)), np.ones((1, 1))
         c, d = np.array([[kp / ti]]), np.array([[kp]])
+    n_core = a.shape[0]
+    # the filters alone, driven by the PID's output u: where a cross term enters
+    fb, fd = np.zeros((0, 1)), np.ones((1, 1))
     for f in filters:
         a, b, c, d = _series((a, b, c, d), filter_matrices(f))
+        _, fbk, _, fdk = filter_matrices(f)
+        fb, fd = np.vstack([fb, fbk @ fd]), fdk @ fd
     n = len(channels)
     eye = np.eye(n)
     A, B, C, D = (np.kron(eye, m) for m in (a, b, c, d))
     ns = a.shape[0]
+    if cross_kp or cross_kd:
+        _add_cross(A, B, C, D, channels, ns, n_core, fb, fd, float(cross_kp),
+                   float(cross_kd), eps * td)
     return control.ss(
         A, B, C, D,
         inputs=[f"y_{c}" for c in channels],
         outputs=[f"i_{c}" for c in channels],
         states=[f"pid_{c}_{k}" for c in channels for k in range(ns)], name="K_pid",
     )
+
+
+def _add_cross(A, B, C, D, channels, ns: int, n_core: int, fb, fd, kcp: float, kcd: float,
+               tau: float) -> None:
+    """Add the cross-axis terms of :func:`pid_controller` in place: to the PID output u of
+    axis ζ, Δu = K_c y_η (η: −K_c y_ζ), K_c y = kcp y + kcd s y/(τ s + 1) = (kcp + kcd/τ) y
+    − (kcd/τ²) x_d with x_d = y/(s + 1/τ) the derivative filter's state of that axis
+    (state 1 of its PID core); Δu enters the axis's filter states through ``fb`` and its
+    output through ``fd`` (the filters' input column and feedthrough)."""
+    if kcd and not tau > 0:
+        raise ConfigError("controller.pid.cross_kd: a cross-axis derivative needs td > 0")
+    index = {c: i for i, c in enumerate(channels)}
+    for c in channels:
+        if not c.endswith("_zeta"):
+            continue
+        j_eta = index.get(c[:-5] + "_eta")
+        if j_eta is None:
+            raise ConfigError(f"controller.pid.cross_kp/cross_kd: AMB axis {c!r} has no "
+                              "η axis to cross with")
+        for out, src, sign in ((index[c], j_eta, 1.0), (j_eta, index[c], -1.0)):
+            dd = sign * (kcp + (kcd / tau if kcd else 0.0))  # per unit y of the source axis
+            dc = -sign * kcd / tau**2 if kcd else 0.0  # per unit of its derivative state
+            rows = slice(out * ns + n_core, (out + 1) * ns)  # the output axis's filters
+            B[rows, src] += fb[:, 0] * dd
+            D[out, src] += fd[0, 0] * dd
+            if dc:
+                col = src * ns + 1
+                A[rows, col] += fb[:, 0] * dc
+                C[out, col] += fd[0, 0] * dc
+    if sum(c.endswith("_zeta") for c in channels) * 2 != len(channels):
+        raise ConfigError("controller.pid.cross_kp/cross_kd: cross-axis gains need each "
+                          f"AMB's ζ and η axes, got channels {list(channels)}")
 
 
 def filter_matrices(f) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -314,14 +373,16 @@ def reference_pid(cfg) -> dict:
     dict
         ``kp`` (A/m), ``ti``, ``td`` (s), ``eps`` (-), ``filters`` (the
         ``[[controller.filter]]`` entries as dicts, in series with the PID; left out of the
-        rig file, none for a given PID); derived ones also carry the ``rule`` of
-        :func:`pid_from_rig`.
+        rig file, none for a given PID), ``cross_kp`` (A/m) and ``cross_kd`` (A·s/m), the
+        cross-axis gains (0 where the rig file gives none, and for a derived PID);
+        derived ones also carry the ``rule`` of :func:`pid_from_rig`.
     """
     ctrl = getattr(cfg, "controller", None)
     pid = getattr(ctrl, "pid", None)
     given = getattr(ctrl, "filter", None)
     if pid is not None:
-        out = {"kp": pid.kp, "ti": pid.ti, "td": pid.td, "eps": pid.eps, "filters": []}
+        out = {"kp": pid.kp, "ti": pid.ti, "td": pid.td, "eps": pid.eps, "filters": [],
+               "cross_kp": pid.cross_kp, "cross_kd": pid.cross_kd}
     else:
         out = pid_from_rig(cfg)
         out.setdefault("filters", [])
@@ -349,7 +410,7 @@ def reference_controller(cfg, method: str = "tustin"):
     """
 
     p = reference_pid(cfg)
-    K = pid_controller(p["kp"], p["ti"], p["td"], p["eps"], channel_names(cfg), p["filters"])
+    K = pid_of(p, channel_names(cfg))
     ctrl = discrete_controller(K, 1.0 / cfg.controller.sample_rate_hz, method)
     return replace(ctrl, description={"type": "pid", **pid_description(p),
                                       "discretisation": method})
@@ -368,12 +429,38 @@ def pid_description(p: dict) -> dict:
     -------
     dict
         ``kp`` (A/m), ``ti``, ``td`` (s), ``eps`` (-) and, where it has any, ``filters``
-        (``[[controller.filter]]`` tables as dicts).
+        (``[[controller.filter]]`` tables as dicts) and cross-axis gains (``cross_kp``,
+        ``cross_kd``).
     """
     out = {k: p[k] for k in ("kp", "ti", "td", "eps")}
     if p.get("filters"):
         out["filters"] = [dict(f) for f in p["filters"]]
+    out.update({k: p[k] for k in CROSS if p.get(k)})
     return out
+
+
+#: The cross-axis gains of a PID description (:func:`pid_controller`), 0 when left out.
+CROSS = ("cross_kp", "cross_kd")
+
+
+def pid_of(p: dict, channels) -> control.StateSpace:
+    """:func:`pid_controller` of a PID description (:func:`reference_pid`,
+    :func:`pid_description`) on the rig's ``channels``.
+
+    Parameters
+    ----------
+    p : dict
+        ``kp``, ``ti``, ``td``, ``eps``, and optionally ``filters``, ``cross_kp`` and
+        ``cross_kd``.
+    channels : sequence of str
+        The AMB channels (:func:`ambseal.model.amb.channel_names`).
+
+    Returns
+    -------
+    control.StateSpace
+    """
+    return pid_controller(p["kp"], p["ti"], p["td"], p["eps"], channels, p.get("filters", ()),
+                          *(float(p.get(k) or 0.0) for k in CROSS))
 
 
 def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<data>"):
@@ -418,8 +505,11 @@ def controller_from_metadata(meta: dict, axes: tuple[str, ...], source: str = "<
         if not isinstance(filters, list):
             raise ValueError("filters: expected a list of [[controller.filter]] tables")
         filters = [PidFilter.model_validate(f) for f in filters]
-        ctrl = discrete_controller(pid_controller(kp, ti, td, eps, axes, filters), 1.0 / fs,
-                                   method)
+        cross = [float(c.get(k, 0.0)) for k in CROSS]
+        if not all(np.isfinite(cross)):
+            raise ValueError("cross_kp, cross_kd: expected finite numbers")
+        ctrl = discrete_controller(pid_controller(kp, ti, td, eps, axes, filters, *cross),
+                                   1.0 / fs, method)
     except ValidationError as exc:
         raise DataError(f"{source}: metadata.controller.filters: "
                         f"{exc.errors()[0]['msg']}") from None

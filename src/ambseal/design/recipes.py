@@ -59,7 +59,7 @@ import numpy as np
 
 from ambseal.config import method_names
 from ambseal.design.modal_bands import bands_near, mode_bands
-from ambseal.design.pid import pid_controller, reference_pid
+from ambseal.design.pid import pid_of, reference_pid
 from ambseal.design.plant import (
     LIGHT_DAMPING,
     MARGIN_BAND,
@@ -211,7 +211,7 @@ def _pid(cfg, p):
     d = reference_pid(cfg)
     notes = (f"PID designed from the rig (no [controller.pid]): {d['rule']}",) \
         if "rule" in d else ()
-    K = pid_controller(d["kp"], d["ti"], d["td"], d["eps"], channel_names(cfg), d["filters"])
+    K = pid_of(d, channel_names(cfg))
     return DesignResult("pid", K, p, order=int(K.nstates), order_full=int(K.nstates),
                         notes=notes)
 

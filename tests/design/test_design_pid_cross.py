@@ -1,0 +1,165 @@
+"""Cross-axis gains of the reference PID (ambseal.design.pid.pid_controller) on a rigid
+gyroscopic rotor.
+
+Reference: Routh–Hurwitz for polynomials with complex coefficients (Frank 1946; e.g.
+Bodson, *IEEE TAC* 1996): s² + (α₁ + jβ₁)s + (α₀ + jβ₀) has both roots in the left half
+plane iff α₁ > 0 and α₁²α₀ + α₁β₁β₀ − β₀² > 0. A rigid symmetric rotor (mass m,
+transverse and polar inertia I_t, I_p, spinning at Ω) on two identical AMBs at ±a from its
+centre, sensors collocated, under the PD i_ζ = −(k_p y_ζ + k_d ẏ_ζ) − (k_cp y_η + k_cd ẏ_η),
+i_η = −(k_p y_η + k_d ẏ_η) + (k_cp y_ζ + k_cd ẏ_ζ) — i = −(K − jK_c) r in r = ζ + jη — has,
+with f = K_i i + K_s r, the modes (Genta, *Dynamics of Rotating Systems*, 2005, §4.4)
+
+    cylindrical:  m s² + 2K_i(k_d − jk_cd) s + 2(K_i k_p − K_s) − 2jK_i k_cp = 0,
+    conical:      I_t s² + (2a²K_i k_d − j(I_pΩ + 2a²K_i k_cd)) s
+                  + 2a²(K_i k_p − K_s) − 2ja²K_i k_cp = 0,
+
+so the loop holds while c²k + c(g + c_c)k_c − M k_c² > 0 for each (c the direct damping,
+k the stiffness, g = I_pΩ on the conical mode, c_c and k_c the cross terms, M = m or I_t):
+a band of the cross gain k_cp whose ends move with the speed.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+
+import numpy as np
+import pytest
+
+from ambseal.config import parse_rig
+from ambseal.design.pid import pid_controller
+from ambseal.errors import ConfigError
+from ambseal.lti import feedback_matrices
+from ambseal.model import channel_names
+from ambseal.model.rig import build_plant
+
+L, D = 0.4, 0.1
+DISK_M, DISK_IP, DISK_ID = 20.0, 0.9, 3.0
+KI, KS = 100.0, 2.0e5
+KP, KD, KCD = 4.0e3, 6.0, 1.5
+
+
+def _rotor() -> str:
+    text = f"""
+[rotor]
+name = "rigid gyroscopic rotor on AMBs"
+[materials.rigid]
+E = 2.1e15
+rho = 7850.0
+nu = 0.3
+[[shaft]]
+length = {L}
+outer_diameter = {D}
+material = "rigid"
+elements = 4
+[[disk]]
+position = {L / 2}
+mass = {DISK_M}
+Ip = {DISK_IP}
+Id = {DISK_ID}
+[controller]
+sample_rate_hz = 20000.0
+delay_samples = 0
+[controller.pid]
+kp = {KP}
+ti = 1.0
+td = 1e-3
+eps = 0.1
+[operating]
+speed_rpm = 0.0
+"""
+    for name, z in (("A", 0.0), ("B", L)):
+        text += (f'[[amb]]\nname = "{name}"\nposition = {z}\nsensor_position = {z}\n'
+                 f"ki = {KI}\nks = {KS}\nbias_current = 5.0\ncurrent_limit = 10.0\n")
+    return text
+
+
+def _stable(cfg, speed_hz: float, kcp: float) -> bool:
+    """The continuous loop (no delay) of the full plant at ``speed_hz`` with a PD — the
+    PID's integral and derivative filter pushed out of the band (T_i 1e4 s, ε T_d 1e-8 s)."""
+    P = build_plant(cfg, speed_rpm=60.0 * speed_hz).to_statespace()
+    K = pid_controller(KP, 1e4, KD / KP, 1e-8 / (KD / KP), channel_names(cfg),
+                       cross_kp=kcp, cross_kd=KCD)
+    mats = [tuple(np.asarray(getattr(S, m), float) for m in "ABCD") for S in (P, K)]
+    lam = np.linalg.eigvals(feedback_matrices(*mats)[0])
+    return bool(lam.real.max() < 0)
+
+
+def _band(M: float, c: float, k: float, g: float, cc: float) -> tuple[float, float]:
+    """The cross stiffness k_c of c²k + c(g + c_c)k_c − M k_c² > 0 (module docstring)."""
+    b = c * (g + cc)
+    r = math.sqrt(b * b + 4 * M * c * c * k)
+    return (b - r) / (2 * M), (b + r) / (2 * M)
+
+
+@pytest.mark.parametrize("speed_hz", [0.0, 150.0, 400.0])
+def test_the_cross_gain_band_is_routh_hurwitz(speed_hz):
+    """Both ends of the stable band of k_cp, found by bisection on the loop's eigenvalues,
+    equal the intersection of the cylindrical and conical modes' Routh–Hurwitz bands to
+    2e-3 (the PID's integral and filter and the shaft's flexibility are the difference):
+    at standstill the conical mode decides both ends; spinning, the gyroscopic moment
+    widens its band upwards and narrows it below (−404 A/m at standstill, −101 at 150 Hz,
+    −40 at 400 Hz: a cross gain of that sign soon loses the rotor)."""
+    cfg = parse_rig(tomllib.loads(_rotor()))
+    ms = 7850.0 * math.pi / 4 * D**2 * L
+    m = ms + DISK_M
+    it = ms * (3 * (D / 2) ** 2 + L**2) / 12 + DISK_ID
+    ip = ms * (D / 2) ** 2 / 2 + DISK_IP
+    a = L / 2
+    g = ip * 2 * math.pi * speed_hz
+    cyl = [x / (2 * KI) for x in _band(m, 2 * KI * KD, 2 * (KI * KP - KS), 0.0, 2 * KI * KCD)]
+    con = [x / (2 * a * a * KI) for x in _band(it, 2 * a * a * KI * KD,
+                                               2 * a * a * (KI * KP - KS), g,
+                                               2 * a * a * KI * KCD)]
+    want = (max(cyl[0], con[0]), min(cyl[1], con[1]))
+    assert want[0] == con[0]  # the conical mode, where the gyroscopic moment acts
+    for edge, outside in zip(want, (2 * want[0], 2 * want[1])):
+        inside, out = 0.0, outside
+        assert _stable(cfg, speed_hz, inside) and not _stable(cfg, speed_hz, out)
+        for _ in range(40):
+            mid = 0.5 * (inside + out)
+            inside, out = (mid, out) if _stable(cfg, speed_hz, mid) else (inside, mid)
+        assert inside == pytest.approx(edge, rel=2e-3), (speed_hz, edge)
+
+
+def test_no_cross_gain_is_the_diagonal_pid_and_refusals():
+    """Zero cross gains give the thesis's diagonal PID to the bit; a cross derivative
+    without a derivative (td = 0) and channels without an η axis are refused."""
+    ch = ("A_zeta", "A_eta", "B_zeta", "B_eta")
+    K0 = pid_controller(1e4, 0.2, 3e-3, 0.1, ch)
+    K1 = pid_controller(1e4, 0.2, 3e-3, 0.1, ch, cross_kp=0.0, cross_kd=0.0)
+    for m in "ABCD":
+        assert np.array_equal(getattr(K0, m), getattr(K1, m))
+    Kc = pid_controller(1e4, 0.2, 3e-3, 0.1, ch, cross_kp=500.0)
+    # the cross terms at zero frequency-free feedthrough: K_ζη = +k_cp, K_ηζ = −k_cp
+    assert Kc.D[0, 1] - K0.D[0, 1] == pytest.approx(500.0)
+    assert Kc.D[1, 0] - K0.D[1, 0] == pytest.approx(-500.0)
+    with pytest.raises(ConfigError, match="td > 0"):
+        pid_controller(1e4, 0.2, 0.0, 0.1, ch, cross_kd=1.0)
+    with pytest.raises(ConfigError, match="η axis"):
+        pid_controller(1e4, 0.2, 3e-3, 0.1, ("A_zeta", "B_zeta"), cross_kp=1.0)
+
+
+def test_the_rig_files_cross_gains_reach_the_pid_and_its_record():
+    """``[controller.pid] cross_kp``, ``cross_kd`` are the reference PID's (its K_ζη, K_ηζ
+    feedthrough ±(cross_kp + cross_kd/(ε T_d))), its description carries them, and a
+    record's PID metadata rebuilds the same discrete controller; a cross derivative with
+    ``td = 0`` is refused by the rig file, naming the key."""
+    from ambseal.design import design
+    from ambseal.design.pid import controller_from_metadata, pid_description, reference_pid
+    from ambseal.robust import discrete_controller
+
+    text = _rotor().replace("eps = 0.1\n", "eps = 0.1\ncross_kp = 300.0\ncross_kd = 0.2\n")
+    cfg = parse_rig(tomllib.loads(text))
+    K = design(cfg, "pid").K
+    assert K.D[0, 1] == pytest.approx(300.0 + 0.2 / (0.1 * 1e-3))
+    assert K.D[1, 0] == pytest.approx(-(300.0 + 0.2 / (0.1 * 1e-3)))
+    desc = pid_description(reference_pid(cfg))
+    assert (desc["cross_kp"], desc["cross_kd"]) == (300.0, 0.2)
+    meta = {"sample_rate_hz": 20000.0, "controller": {"type": "pid", **desc}}
+    got = controller_from_metadata(meta, channel_names(cfg))
+    want = discrete_controller(K, 1 / 20000.0, "tustin")
+    for m in "ABCD":
+        np.testing.assert_allclose(getattr(got, m), getattr(want, m), rtol=1e-12, atol=1e-12)
+    with pytest.raises(ConfigError, match="cross_kd"):
+        parse_rig(tomllib.loads(text.replace("td = 1e-3", "td = 0.0")))

@@ -28,6 +28,8 @@ from ambseal.design import design, design_spec
 from ambseal.model.rig import build_plant
 from ambseal.robust import loop_delay
 
+from ..rigid_rotor import L, inertia, rotor_text
+
 
 def _at(sys, s: complex) -> np.ndarray:
     """``C (sI − A)⁻¹ B + D`` of a python-control system by a dense solve."""
@@ -36,32 +38,13 @@ def _at(sys, s: complex) -> np.ndarray:
         return D.astype(complex)
     return C @ np.linalg.solve(s * np.eye(A.shape[0]) - A, B) + D
 
-#: a shaft 1e4 times stiffer than steel: its bending, under the springs' forces and the
-#: inertia's up to 1.6× the critical, adds below 1e-6 of the response
-E_RIGID = 2.1e15
-L, D = 0.4, 0.1
+
 K_SIDE, C_SIDE = 2.0e5, 40.0
 DISK_M, DISK_IP, DISK_ID = 20.0, 0.5, 0.3
 
 
 def _rigid_rotor() -> str:
-    return f"""
-[rotor]
-name = "rigid gyroscopic rotor"
-[materials.rigid]
-E = {E_RIGID}
-rho = 7850.0
-nu = 0.3
-[[shaft]]
-length = {L}
-outer_diameter = {D}
-material = "rigid"
-elements = 8
-[[disk]]
-position = {L / 2}
-mass = {DISK_M}
-Ip = {DISK_IP}
-Id = {DISK_ID}
+    return rotor_text("rigid gyroscopic rotor", DISK_M, DISK_IP, DISK_ID, 8) + f"""
 [[spring]]
 name = "left"
 position = 0.0
@@ -87,10 +70,7 @@ def test_rigid_gyroscopic_rotor_on_isotropic_springs_is_the_closed_form():
     I_t = m(3r² + L²)/12 + I_d and I_p = m r²/2 + I_p,disk of the shaft and disk — to 1e-6
     at speeds below, near and above the forward conical critical √(2ka²/(I_t − I_p))."""
     cfg = parse_rig(tomllib.loads(_rigid_rotor()))
-    ms = 7850.0 * math.pi / 4 * D**2 * L
-    m = ms + DISK_M
-    it = ms * (3 * (D / 2) ** 2 + L**2) / 12 + DISK_ID
-    ip = ms * (D / 2) ** 2 / 2 + DISK_IP
+    m, it, ip = inertia(DISK_M, DISK_IP, DISK_ID)
     a, k, c = L / 2, K_SIDE, C_SIDE
     assert it > ip  # a forward conical critical exists
     w_con = math.sqrt(2 * k * a**2 / (it - ip))

@@ -33,30 +33,15 @@ from ambseal.lti import feedback_matrices
 from ambseal.model import channel_names
 from ambseal.model.rig import build_plant
 
-L, D = 0.4, 0.1
+from ..rigid_rotor import L, inertia, rotor_text
+
 DISK_M, DISK_IP, DISK_ID = 20.0, 0.9, 3.0
 KI, KS = 100.0, 2.0e5
 KP, KD, KCD = 4.0e3, 6.0, 1.5
 
 
 def _rotor() -> str:
-    text = f"""
-[rotor]
-name = "rigid gyroscopic rotor on AMBs"
-[materials.rigid]
-E = 2.1e15
-rho = 7850.0
-nu = 0.3
-[[shaft]]
-length = {L}
-outer_diameter = {D}
-material = "rigid"
-elements = 4
-[[disk]]
-position = {L / 2}
-mass = {DISK_M}
-Ip = {DISK_IP}
-Id = {DISK_ID}
+    text = rotor_text("rigid gyroscopic rotor on AMBs", DISK_M, DISK_IP, DISK_ID, 4) + f"""
 [controller]
 sample_rate_hz = 20000.0
 delay_samples = 0
@@ -101,10 +86,7 @@ def test_the_cross_gain_band_is_routh_hurwitz(speed_hz):
     widens its band upwards and narrows it below (−404 A/m at standstill, −101 at 150 Hz,
     −40 at 400 Hz: a cross gain of that sign soon loses the rotor)."""
     cfg = parse_rig(tomllib.loads(_rotor()))
-    ms = 7850.0 * math.pi / 4 * D**2 * L
-    m = ms + DISK_M
-    it = ms * (3 * (D / 2) ** 2 + L**2) / 12 + DISK_ID
-    ip = ms * (D / 2) ** 2 / 2 + DISK_IP
+    m, it, ip = inertia(DISK_M, DISK_IP, DISK_ID)
     a = L / 2
     g = ip * 2 * math.pi * speed_hz
     cyl = [x / (2 * KI) for x in _band(m, 2 * KI * KD, 2 * (KI * KP - KS), 0.0, 2 * KI * KCD)]

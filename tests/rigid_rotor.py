@@ -1,0 +1,43 @@
+"""A rigid symmetric rotor with a disk at mid-span, as a rig file's text, and its mass and
+inertias by hand (tests of gyroscopic closed forms)."""
+
+from __future__ import annotations
+
+import math
+
+#: a shaft 1e4 times stiffer than steel: its bending, under support forces and inertia up
+#: to a few hundred hertz, adds below 1e-6 of the rigid rotor's response
+E_RIGID = 2.1e15
+RHO = 7850.0
+L, D = 0.4, 0.1
+
+
+def rotor_text(name: str, disk_m: float, disk_ip: float, disk_id: float,
+               elements: int) -> str:
+    """``[rotor]``, the material, the shaft (L × D) in ``elements`` and the disk at
+    mid-span; the supports are the caller's."""
+    return f"""
+[rotor]
+name = "{name}"
+[materials.rigid]
+E = {E_RIGID}
+rho = {RHO}
+nu = 0.3
+[[shaft]]
+length = {L}
+outer_diameter = {D}
+material = "rigid"
+elements = {elements}
+[[disk]]
+position = {L / 2}
+mass = {disk_m}
+Ip = {disk_ip}
+Id = {disk_id}
+"""
+
+
+def inertia(disk_m: float, disk_ip: float, disk_id: float) -> tuple[float, float, float]:
+    """(m, I_t about the centre, I_p) of the shaft (a solid cylinder) and the disk."""
+    ms = RHO * math.pi / 4 * D**2 * L
+    return (ms + disk_m, ms * (3 * (D / 2) ** 2 + L**2) / 12 + disk_id,
+            ms * (D / 2) ** 2 / 2 + disk_ip)

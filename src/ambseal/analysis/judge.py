@@ -44,7 +44,6 @@ from typing import Any
 
 import control
 import numpy as np
-
 from scipy.signal import find_peaks
 
 from ambseal.analysis.campbell import AF_CRITICAL
@@ -508,17 +507,18 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
 
         lo, hi = s.unbalance_range_hz
         f_min, f_max = cfg.operating.continuous_hz
-        # the sweep reaches past the top of the continuous range by the largest separation
-        # margin API 617 can require, so that a critical just above it is seen
+        # the sweep reaches past the continuous range by the largest separation margins API
+        # 617 can require, so that a critical just outside it is seen
         top = max(hi, (1 + MAX_MARGIN_ABOVE) * f_max)
+        bottom = min(lo, (1 - MAX_MARGIN_BELOW) * f_min) if f_min > 0 else lo
 
         def judged(G, K):
             unb, current, axes = running_unbalance(
-                plant_at, _controller_at_speed(G, K, sched, dl.system), (lo, top),
+                plant_at, _controller_at_speed(G, K, sched, dl.system), (bottom, top),
                 mass_kg=s.unbalance_mass_kg, grade_mm_s=s.unbalance_grade_mm_s,
                 law=s.unbalance_law, max_speed_rad_s=2 * math.pi * s.unbalance_max_speed_hz)
             crit = critical_speeds(unb, f_min, f_max) if f_max > 0 else None
-            keep = unb.speed_hz <= hi * (1 + 1e-12)
+            keep = (unb.speed_hz >= lo * (1 - 1e-12)) & (unb.speed_hz <= hi * (1 + 1e-12))
             return _within(unb, keep), current[keep], axes, crit
         return judged
 
@@ -544,7 +544,8 @@ def critical_speeds(unb: UnbalanceResponse, f_min: float, f_max: float) -> list[
     """The critical speeds of an unbalance response at the running speed that lie inside
     the continuous speed range or within the separation margin API 617 requires of them.
 
-    A critical speed is a local maximum of the orbit over speed (a closed-loop mode's 1×
+    The running sweep reaches 16 % below the minimum and 26 % above the maximum continuous
+    speed for it. A critical speed is a local maximum of the orbit over speed (a closed-loop mode's 1×
     crossing) with a half-power amplification factor AF ≥ 2.5 (API 684 §2.8; where the
     sweep ends before the orbit falls to half power on one side, the other side's
     half-width is taken for both; a peak that falls to half power on neither side within

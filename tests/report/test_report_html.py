@@ -146,7 +146,8 @@ def test_verdict_grades_every_speed_as_it_runs_and_names_the_worst():
     assert v.zone_axis == "C" and v.zone_sigma == "C" and v.sigma_peak == 3.9
     assert v.worst_axis == "B η at 2.04 bar, 500 Hz, as it runs"
     assert v.words().startswith("Zone C on its worst axis (B η at 2.04 bar, 500 Hz, as it "
-                                "runs)")
+                                "runs) over 2.04 bar and standstill to 500 Hz: fit for "
+                                "limited-term operation only")
 
 
 def test_verdict_claims_standstill_only_where_it_was_judged():

@@ -127,6 +127,9 @@ class Verdict:
         The loop's critical speeds inside the continuous speed range or within API 617's
         separation margin (the cases' ``critical_speeds``, continuous and as it runs, one
         per speed to 3 digits, the largest AF kept), by speed.
+    speed_graded : bool
+        The speed range's loops were graded by ISO 14839-3 too (not stability alone): the
+        zone is then over the judged conditions and the speed range.
     """
 
     controller: str
@@ -149,6 +152,7 @@ class Verdict:
     capacity: dict | None = None
     speeds_hz: tuple[float, ...] = ()
     criticals: tuple = ()
+    speed_graded: bool = False
 
     def critical_text(self) -> str:
         """The critical speeds in words, ``""`` without any: ``"a critical speed (1×
@@ -234,7 +238,10 @@ class Verdict:
         z = self.zone_axis or "?"
         where = ("on every axis" if self.axes_alike or self.worst_axis is None else
                  f"on its worst axis ({self.worst_axis})")
-        text = f"Zone {z} {where} over {self.judged_range}"
+        over = self.judged_range
+        if self.speed_checked and self.speed_graded:  # the zone covers the speed range
+            over += f" and {self.speed_span()}"
+        text = f"Zone {z} {where} over {over}"
         # σ̄(S_o) bounds every axis's peak from above, so its zone is never the better one;
         # where it is worse, the words follow it: the loop is judged as the MIMO loop it is
         worse = self.zone_sigma if self.zone_sigma and self.zone_sigma != z else None
@@ -242,7 +249,7 @@ class Verdict:
             text += (f", but σ̄(S_o) over all axes reaches zone {worse} (peak "
                      f"{sig(self.sigma_peak)})")
         text += f": {ZONE_WORDS.get(worse or z, 'not graded')}"
-        if self.speed_checked:
+        if self.speed_checked and not self.speed_graded:
             span = self.speed_span()
             text += (f"; stable from {span}" if span.startswith("standstill")
                      else f"; stable at every judged speed, {span}")
@@ -365,7 +372,7 @@ def _verdict(name: str, cs: list, by_speed: bool, sc: list,
         axes_alike=len(stable_zones) <= 1, capacity=design.get("capacity"),
         speeds_hz=tuple(sorted({float(c["speed_hz"]) for c in [*cs, *sc]
                                 if c.get("speed_hz") is not None})),
-        criticals=_criticals(cs))
+        criticals=_criticals(cs), speed_graded=any(c.get("iso_zone") for c in sc))
 
 
 def _criticals(cs: list) -> tuple:

@@ -104,18 +104,36 @@ def test_the_cross_gain_band_is_routh_hurwitz(speed_hz):
         assert inside == pytest.approx(edge, rel=2e-3), (speed_hz, edge)
 
 
-def test_no_cross_gain_is_the_diagonal_pid_and_refusals():
-    """Zero cross gains give the thesis's diagonal PID to the bit; a cross derivative
-    without a derivative (td = 0) and channels without an η axis are refused."""
+def test_cross_terms_pass_the_filters_and_refusals():
+    """Reference: the transfer functions written out — with a lead and a notch in series
+    (the commissioning engineer's filters), each entry of K(jω) at 1, 80 and 900 Hz is
+    F(jω)·K_PID(jω) on the diagonal, +F(jω)·K_c(jω) at (ζ, η) and −F(jω)·K_c(jω) at
+    (η, ζ), 0 between bearings, with K_c = k_cp + k_cd jω/(ε T_d jω + 1) and F the filters'
+    formulas (:func:`pid_controller`), to 1e-9; a cross derivative without a derivative
+    (td = 0) and channels without an η axis are refused."""
     ch = ("A_zeta", "A_eta", "B_zeta", "B_eta")
-    K0 = pid_controller(1e4, 0.2, 3e-3, 0.1, ch)
-    K1 = pid_controller(1e4, 0.2, 3e-3, 0.1, ch, cross_kp=0.0, cross_kd=0.0)
-    for m in "ABCD":
-        assert np.array_equal(getattr(K0, m), getattr(K1, m))
-    Kc = pid_controller(1e4, 0.2, 3e-3, 0.1, ch, cross_kp=500.0)
-    # the cross terms at zero frequency-free feedthrough: K_ζη = +k_cp, K_ηζ = −k_cp
-    assert Kc.D[0, 1] - K0.D[0, 1] == pytest.approx(500.0)
-    assert Kc.D[1, 0] - K0.D[1, 0] == pytest.approx(-500.0)
+    kp, ti, td, eps, kcp, kcd = 1e4, 0.2, 3e-3, 0.1, 500.0, 0.7
+    lead = {"kind": "lead", "frequency_hz": 300.0, "phase_deg": 30.0}
+    notch = {"kind": "notch", "frequency_hz": 900.0, "width_hz": 100.0, "depth_db": 20.0}
+    K = pid_controller(kp, ti, td, eps, ch, [lead, notch], cross_kp=kcp, cross_kd=kcd)
+    A, B, C, Dm = (np.asarray(getattr(K, m), float) for m in "ABCD")
+    for f in (1.0, 80.0, 900.0):
+        s = 2j * math.pi * f
+        Kw = C @ np.linalg.solve(s * np.eye(A.shape[0]) - A, B) + Dm
+        sn = math.sin(math.radians(30.0))
+        al = (1 + sn) / (1 - sn)
+        wc = 2 * math.pi * 300.0
+        wz, wp = wc / math.sqrt(al), wc * math.sqrt(al)
+        F_lead = (wp / wz) * (s + wz) / (s + wp)  # (1 + s/ω_z)/(1 + s/ω_p)
+        wn = 2 * math.pi * 900.0
+        zp = 100.0 / (2 * 900.0)
+        zz = zp * 10 ** (-20.0 / 20)
+        F = F_lead * (s * s + 2 * zz * wn * s + wn * wn) / (s * s + 2 * zp * wn * s + wn * wn)
+        direct = kp * (1 + 1 / (ti * s) + td * s / (eps * td * s + 1)) * F
+        cross = (kcp + kcd * s / (eps * td * s + 1)) * F
+        want = np.array([[direct, cross, 0, 0], [-cross, direct, 0, 0],
+                         [0, 0, direct, cross], [0, 0, -cross, direct]])
+        np.testing.assert_allclose(Kw, want, rtol=1e-9, atol=1e-9 * abs(direct))
     with pytest.raises(ConfigError, match="td > 0"):
         pid_controller(1e4, 0.2, 0.0, 0.1, ch, cross_kd=1.0)
     with pytest.raises(ConfigError, match="η axis"):

@@ -17,7 +17,7 @@ sampled with its delay) on the full-order plant:
   peaks (thesis P5 §4.4.1; :data:`ZONES`, :data:`ZONE_LIMITS`, :func:`zone_limit_db`);
 * :func:`unbalance_force`, :func:`unbalance_response` — ISO 21940-11 unbalance and its
   response bound; :func:`running_unbalance` on :func:`running_plant` (→ :class:`RunningPlant`)
-  — the bound with the plant at the running speed (:data:`UNBALANCE_PLANTS`);
+  — the bound with the plant at the running speed;
 * :func:`impulse_response` → :class:`ImpulseResponse` — the current-impulse response
   (P5 §5.1);
 * :func:`closed_loop_modes` → :class:`ClosedLoopModes`, :func:`log_decrement` — closed-loop
@@ -97,7 +97,7 @@ _FROM = {
     "check_cases": "sweep", "parse_range": "sweep", "refine_boundary": "sweep",
     "stability_boundary": "sweep", "unbalance_force": "unbalance",
     "unbalance_response": "unbalance", "UnbalanceResponse": "unbalance",
-    "running_unbalance": "unbalance", "UNBALANCE_PLANTS": "unbalance",
+    "running_unbalance": "unbalance",
     "running_plant": "synchronous", "RunningPlant": "synchronous",
 }
 

@@ -63,14 +63,10 @@ from ambseal.errors import ModelError
 from ambseal.lti import as_omega, json_float, json_list
 
 __all__ = ["unbalance_force", "UnbalanceResponse", "unbalance_response", "unbalance_from_compliance",
-           "UNBALANCE_LAWS", "UNBALANCE_PLANTS", "forward_forces", "worst_orbit",
-           "running_unbalance"]
+           "UNBALANCE_LAWS", "forward_forces", "worst_orbit", "running_unbalance"]
 
 #: The force laws of :func:`unbalance_force` (module docstring).
 UNBALANCE_LAWS = ("iso21940", "constant_velocity")
-#: The plants of the judged unbalance response (module docstring): at the running speed, or
-#: frozen at the judged condition (the thesis's simplification).
-UNBALANCE_PLANTS = ("running", "frozen")
 #: Speeds of the running unbalance response's first sweep, evenly over its range; each
 #: local maximum is then refined :data:`REFINE_ROUNDS` times by :data:`REFINE` speeds
 #: between its neighbours (every round narrows the bracket of a peak 4-fold).

@@ -132,6 +132,10 @@ def _add_cross(A, B, C, D, channels, ns: int, n_core: int, fb, fd, kcp: float, k
     output through ``fd`` (the filters' input column and feedthrough)."""
     if kcd and not tau > 0:
         raise ConfigError("controller.pid.cross_kd: a cross-axis derivative needs td > 0")
+    if sum(c.endswith("_zeta") for c in channels) * 2 != len(channels):
+        raise ConfigError("controller.pid.cross_kp/cross_kd: cross-axis gains need each "
+                          f"AMB's ζ and η axes (no η axis to cross with), got channels "
+                          f"{list(channels)}")
     index = {c: i for i, c in enumerate(channels)}
     for c in channels:
         if not c.endswith("_zeta"):
@@ -150,9 +154,6 @@ def _add_cross(A, B, C, D, channels, ns: int, n_core: int, fb, fd, kcp: float, k
                 col = src * ns + 1
                 A[rows, col] += fb[:, 0] * dc
                 C[out, col] += fd[0, 0] * dc
-    if sum(c.endswith("_zeta") for c in channels) * 2 != len(channels):
-        raise ConfigError("controller.pid.cross_kp/cross_kd: cross-axis gains need each "
-                          f"AMB's ζ and η axes, got channels {list(channels)}")
 
 
 def filter_matrices(f) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

@@ -113,7 +113,7 @@ class Verdict:
         verdict, up to the full-order check); None for the PID.
     worst_axis : str or None
         The axis and condition of the largest per-axis sensitivity peak over those loops,
-        e.g. ``"A ζ at 4.08 bar"`` or ``"B η at 2.04 bar, 500 Hz, as it runs"``; None
+        e.g. ``"A ζ at 4.08 bar"`` or ``"B η at 40 bar, 500 Hz, as it runs"``; None
         without per-axis peaks.
     axes_alike : bool
         Every axis is in the same zone at every stable condition.

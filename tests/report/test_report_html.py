@@ -150,6 +150,21 @@ def test_verdict_grades_every_speed_as_it_runs_and_names_the_worst():
                                 "limited-term operation only")
 
 
+def test_a_rig_judged_at_speeds_names_its_graded_span_once():
+    """A rig judged at speeds (20–300 Hz) whose speed range from standstill was graded:
+    the zone is over "standstill to 300 Hz", not "20–300 Hz and standstill to 300 Hz"."""
+    from ambseal.report.verdict import verdicts
+
+    base = _metrics()[0]
+    cases = [dict(base, speed_hz=f, label=f"{f:g} Hz") for f in (20.0, 140.0, 300.0)]
+    st = [{"controller": base["controller"], "stable": True, "label": "2.04 bar, 0 Hz",
+           "speed_hz": 0.0, "sensitivity_peak": 2.0, "iso_zone": "A",
+           "sensitivity_peak_per_axis": {"A_zeta": 1.5}, "iso_zone_per_axis": {"A_zeta": "A"},
+           "discrete": {"stable": True}}]
+    words = verdicts(cases, None, st)[0].words()
+    assert " over standstill to 300 Hz:" in words and "20–300 Hz and" not in words
+
+
 def test_verdict_claims_standstill_only_where_it_was_judged():
     """Reference: what was judged — a controller stable at every stability speed given as
     333.33–1000 Hz (``[design] stability_speeds_hz`` without 0) and at its judged condition

@@ -240,7 +240,9 @@ class Verdict:
                  f"on its worst axis ({self.worst_axis})")
         over = self.judged_range
         if self.speed_checked and self.speed_graded:  # the zone covers the speed range
-            over += f" and {self.speed_span()}"
+            # judged at speeds already, the span says it all ("standstill to 300 Hz")
+            over = (self.speed_span() if over.endswith(" Hz")
+                    else f"{over} and {self.speed_span()}")
         text = f"Zone {z} {where} over {over}"
         # σ̄(S_o) bounds every axis's peak from above, so its zone is never the better one;
         # where it is worse, the words follow it: the loop is judged as the MIMO loop it is

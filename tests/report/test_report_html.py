@@ -119,6 +119,9 @@ def test_verdict_holds_only_where_the_machine_runs_up_too():
     assert v.stable_range == "2.04 bar; unstable at 2 of 3 speed-range conditions"
     assert v.words() == ("Not acceptable: the loop is unstable at 2.04 bar, 0 Hz; "
                          "2.04 bar, 50 Hz (where the machine runs up).")
+    # lost at its judged condition too: "none" of those, and the speed range still counted
+    lost = verdicts([dict(case, stable=False)], None, st)[0]
+    assert lost.stable_range == "none; unstable at 2 of 3 speed-range conditions"
     good = verdicts([case], None, st[2:])[0]
     assert good.zone_sigma == case["iso_zone"]
     assert good.zone_axis == "B" and good.stable_range == "2.04 bar, standstill to 100 Hz"

@@ -195,9 +195,10 @@ class Verdict:
     @property
     def stable_range(self) -> str:
         """:attr:`judged_range`, with the speed range: ``"…, standstill to top speed"``, or
-        how many of its conditions the loop is unstable at."""
+        how many of its conditions the loop is unstable at (also after ``"none"``: a loop
+        lost at every judged condition may still hold some of the speed range)."""
         text = self.judged_range
-        if text == "none":
+        if text == "none" and not self.speed_unstable:
             return text
         if self.speed_unstable:
             text += (f"; unstable at {len(self.speed_unstable)} of {self.speed_checked} "

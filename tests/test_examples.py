@@ -39,7 +39,15 @@ TESTRIG = Path(__file__).resolve().parents[1] / "examples" / "testrig.toml"
 #: margin holds it. μ holds it with the modes' frequencies uncertain over their bands. The
 #: run then adds the LPV on speed. (The blower's H∞, designed at 600 Hz, holds its ~930 Hz
 #: bending mode with the damping margin the mode lost at standstill asks for.)
-FAIL_BELOW_TOP = {"overhung_compressor": {"hinf"}}
+FAIL_BELOW_TOP = {"overhung_compressor": {"hinf"}, "flywheel": {"hinf", "mu"}}
+
+#: Rigs whose reference PID, derived from the rig, loses the rotor at the nominal
+#: condition, measured: the flywheel's nutation mode (1.02 kHz at the top speed, ζ −0.025;
+#: 0.44–0.83 kHz from 333 Hz up) outruns the decentralised PID's phase lead through the
+#: 2 kHz amplifier and the 75 µs hold + delay, and cross-axis gains on each bearing
+#: (proportional or derivative, scheduled on speed) do not hold it (benchmarks/README.md).
+#: Reported, not counted in the exit status; the LPV on speed holds it.
+PID_LOSES = {"flywheel"}
 
 
 def _lpv_holds_everywhere(metrics: dict) -> None:
@@ -53,6 +61,7 @@ def _lpv_holds_everywhere(metrics: dict) -> None:
 
 
 def _run(rig: Path, out: Path, capsys, failing: set = frozenset()) -> tuple[dict, str]:
+    pid_loses = rig.stem in PID_LOSES
     code = main(["--quiet", "run", str(rig), "--no-identify", "--out", str(out)])
     err = capsys.readouterr().err
     assert code == (1 if failing else 0), err
@@ -64,7 +73,7 @@ def _run(rig: Path, out: Path, capsys, failing: set = frozenset()) -> tuple[dict
     # the thesis's does (P5 Fig. 13): reported, not counted in the exit status
     nominal = metrics["controllers"].get("pid", {}).get("pressure_bar", 0.0)
     for m, f in failed.items():
-        if not f["designed"]:
+        if not f["designed"] and not pid_loses:
             assert all(c["pressure_bar"] > nominal + 1e-9 for c in metrics["cases"]
                        if c["controller"] == m and not c["stable"]), f
     speeds = [c["speed_hz"] for c in [*metrics["cases"], *metrics["stability"]]]
@@ -79,7 +88,7 @@ def _run(rig: Path, out: Path, capsys, failing: set = frozenset()) -> tuple[dict
     return metrics, err
 
 
-def _check_stable_or_stated(metrics: dict, err: str) -> None:
+def _check_stable_or_stated(metrics: dict, err: str, pid_loses: bool = False) -> None:
     """H∞/μ/LPV: stable at every judged condition, continuous and as it runs; the PID at
     every condition up to the nominal pressure (above it the thesis's own finding is that
     the PID goes unstable, P5 Fig. 13, and the verdict says so). A controller that cannot
@@ -91,7 +100,7 @@ def _check_stable_or_stated(metrics: dict, err: str) -> None:
     nominal = metrics["controllers"].get("pid", {}).get("pressure_bar", 0.0)
     for c in metrics["cases"]:
         name = c["controller"]
-        if name == "pid" and c["pressure_bar"] > nominal + 1e-9:
+        if name == "pid" and (pid_loses or c["pressure_bar"] > nominal + 1e-9):
             continue
         assert c["stable"], (name, c["pressure_bar"], c["speed_hz"])
         if name in cannot:
@@ -112,7 +121,7 @@ def test_every_example_runs_end_to_end(rig, tmp_path, capsys):
     judged condition by python-control (:func:`_held_by_python_control`)."""
     metrics, err = _run(rig, tmp_path / "out", capsys, FAIL_BELOW_TOP.get(rig.stem, set()))
     validate_metrics(metrics)
-    _check_stable_or_stated(metrics, err)
+    _check_stable_or_stated(metrics, err, rig.stem in PID_LOSES)
     _held_by_python_control(rig, metrics, tmp_path / "out")
     assert {c["controller"] for c in metrics["cases"]} >= {"pid", "hinf", "mu"}
     # a rig with its stages is signed off (API 617, ISO 14839-2) with every delivered

@@ -128,21 +128,27 @@ def test_hinf_and_mu_weights_from_the_reference_pid(specs):
 
 def test_lpv_weights_from_the_rig(specs, turbo_cfg):
     """P3 Eq. 11, §3.3 made a rule: the scalings of H∞ and μ; W_u's low-frequency gain μ's
-    constant W_u with 2.5× the PID's peak (μ's 3×), rising tenfold above the actuator
-    bandwidth f_a — the turboexpander's
-    1.5 kHz first-order cut-off (P3 §3.3 puts the crossover at 1.4 kHz) and the beam's F_A;
-    on the turboexpander by hand D_u/(2.5 D_e Kp (1 + 1/ε)) with Kp = 1.5 Ks/Ki = 7500 A/m
+    constant W_u with 2.5× the PID's peak (μ's 3×), rising tenfold above its corner: the
+    actuator bandwidth f_a, or 1/(8τ) rounded down to two digits where the controller's
+    hold + computation delay τ = (n_d + ½)/f_s lags 45° below f_a. By hand: the beam's
+    F_A (127 Hz, below 1/(8·150 µs) = 833 Hz); the turboexpander's 1.5 kHz cut-off (P3
+    §3.3 puts the crossover at 1.4 kHz) above 833 Hz at 10 kHz with one sample: 830 Hz;
+    the flywheel's 2 kHz above 1/(8·75 µs) = 1667 Hz at 20 kHz: 1600 Hz. On the
+    turboexpander by hand D_u/(2.5 D_e Kp (1 + 1/ε)) with Kp = 1.5 Ks/Ki = 7500 A/m
     and D_u = 0.42 A. The LPV designs take these weights, and ``[design.lpv]`` keys over
     them."""
     from ambseal.design.pid import pid_from_rig
 
-    for name, f_a in (("turbo", 1500.0), ("beam", F_A)):
+    flywheel = design_spec(load_rig(Path(__file__).resolve().parents[2] / "examples"
+                                    / "flywheel.toml"))
+    assert flywheel.weights["lpv"].wu_corner_hz == pytest.approx(1600.0)
+    for name, corner in (("turbo", 830.0), ("beam", F_A)):
         sp = specs[name]
         w = sp.weights["lpv"]
         assert (w.d_e, w.d_u) == (sp.d_e, sp.d_u)
         assert w.wu_gain == pytest.approx(sp.weights["mu"].wu_gain * 3 / 2.5, rel=0.06)
         assert w.wu_hf_gain == pytest.approx(10 * w.wu_gain)
-        assert w.wu_corner_hz == pytest.approx(f_a)
+        assert w.wu_corner_hz == pytest.approx(corner)
     eps = pid_from_rig(turbo_cfg)["eps"]
     hand = 0.42 / (2.5 * 20e-6 * 7500.0 * (1 + 1 / eps))
     assert specs["turbo"].weights["lpv"].wu_gain == pytest.approx(hand, rel=0.03)

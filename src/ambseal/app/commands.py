@@ -60,7 +60,13 @@ from ambseal.identify import (
     with_static_record,
 )
 from ambseal.lti import finite_or_none
-from ambseal.machine import SPEED, ScheduledController, ScheduledDigital, scheduled_digital
+from ambseal.machine import (
+    SPEED,
+    ScheduledController,
+    ScheduledDigital,
+    scheduled_digital,
+    table_grid,
+)
 from ambseal.model import (
     assemble_rotor,
     build_mesh,
@@ -149,7 +155,7 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
         return digital_controller(controller, fs, cache["plants"],
                                   delay_samples=delay, rise=rise)
 
-    W = np.asarray(controller.K.theta, float)  # the LPV table's θ (speeds or SI)
+    W = table_grid(controller.K.theta)  # the LPV table's θ (speeds or SI), made denser
     # between table entries at 1/8, 3/8, 5/8, 7/8 of the table: the interpolation judged
     mids = [(W[j] + W[j + 1]) / 2 for j in (np.arange(1, 8, 2) * (W.size - 1)) // 8]
     if controller.parameter == SPEED:

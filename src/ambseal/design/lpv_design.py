@@ -9,7 +9,12 @@
 
 Design model (P3 §2.2): the rigid-body modes in one common modal basis (8 mechanical
 states) with the first-order actuator in series (P3 Eq. 2): 12 states, plus one W_p and
-one W_u state per channel: 20 states in the LMIs. The first bending pair (~1 kHz) is left
+one W_u state per channel: 20 states in the LMIs, and the controller's hold + computation
+delay τ = (``[controller] delay_samples`` + ½)/``sample_rate_hz`` as a first-order Padé lag
+on every control channel (:func:`ambseal.robust.delay.design_delay`, as the H∞ and μ
+designs carry it), so that the controller is designed for the loop it will run in:
+without it the flywheel's (``examples/flywheel.toml``) loses its nutation mode as it runs
+at 20 kHz (benchmarks/README.md, "Where the design defaults come from"). The first bending pair (~1 kHz) is left
 out of the design model, as in the thesis: the controller built without it, rolled off by
 the high-pass W_u, keeps every full-order frozen loop stable with σ̄(S_o) ≤ 3 over
 20–300 Hz (checked in ``tests/control/test_control_lpv.py``).
@@ -48,7 +53,7 @@ from ambseal.design.weights import Weights, default_weights
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.lti import json_float
 from ambseal.machine import SPEED, ScheduledController
-from ambseal.robust import design_omega, hinfsyn, lpvsyn, musyn
+from ambseal.robust import design_delay, design_omega, hinfsyn, lpvsyn, musyn
 
 __all__ = ["LpvDesign", "FrozenDesign", "design_lpv", "design_frozen",
            "lpv_generalized_plants", "check_full_order", "lpv_schedule"]
@@ -133,6 +138,9 @@ class LpvDesign(ScheduledController):
         The design model (not serialised).
     full_order : dict or None
         :func:`check_full_order` of the controller at the judged conditions.
+    delay : DesignDelay or None
+        The controller's hold + computation delay the design model carries
+        (:func:`ambseal.robust.delay.design_delay`; serialised by its ``to_dict``).
     kind : str
         What :func:`lpvsyn` delivered: ``"lpv"`` (the LMIs' scheduled controller) or
         ``"frozen"`` (the best frozen-point design, better at every frozen speed).
@@ -157,6 +165,7 @@ class LpvDesign(ScheduledController):
     elapsed_s: float = 0.0
     plant: Any = field(default=None, repr=False)
     full_order: dict | None = None
+    delay: Any = None
     kind: str = "lpv"
     frozen_best_gamma: float = float("nan")
 
@@ -209,6 +218,7 @@ class LpvDesign(ScheduledController):
                 "reports": [r.to_dict() for r in self.reports],
                 "synthesis_s": round(self.synthesis_s, 3),
                 "elapsed_s": round(self.elapsed_s, 3), "full_order": self.full_order,
+                "delay": None if self.delay is None else self.delay.to_dict(),
                 "kind": self.kind, "frozen_best_gamma": json_float(self.frozen_best_gamma),
                 "verdict": self.verdict}
 
@@ -318,17 +328,27 @@ def check_full_order(cfg, spec, controller_at, name: str, allow_unstable: bool =
     return worst
 
 
-def lpv_generalized_plants(L, weights: Weights, speeds_rad_s=None):
+def lpv_generalized_plants(L, weights: Weights, speeds_rad_s=None, delay=None):
     """Generalised plants (P5 Figs. 8–9, nominal: inputs [d_i, d_o, u], outputs
-    [z_p, z_u, y]) of the LPV plant ``L`` at its grid speeds (or ``speeds_rad_s``).
+    [z_p, z_u, y]) of the LPV plant ``L`` at its grid speeds (or ``speeds_rad_s``), with
+    the controller's ``delay`` (a :class:`~ambseal.robust.delay.DesignDelay`, e.g. an
+    :class:`LpvDesign`'s) on every control channel when given.
 
     Returns a list of :class:`ambseal.design.plant.GeneralizedPlant` in one state basis.
     """
 
     Wp, Wu = weights.Wp(), weights.Wu()
     W = L.speeds_rad_s if speeds_rad_s is None else np.asarray(speeds_rad_s, float)
-    return [generalized_plant(L.plant_at(w), Wp, Wu, d_e=weights.d_e, d_u=weights.d_u)
+    lag = None if delay is None else delay.system
+    return [generalized_plant(L.plant_at(w), Wp, Wu, d_e=weights.d_e, d_u=weights.d_u,
+                              actuator_delay=lag)
             for w in W]
+
+
+def _delay(cfg, spec: DesignSpec):
+    """The controller's delay as the design models carry it (the H∞ recipe's call)."""
+    return design_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples,
+                        spec.synthesis_band_hz[1], max_order=1)
 
 
 def design_lpv(cfg, *, speeds_hz=None, n_grid: int | None = None,
@@ -423,7 +443,8 @@ def design_lpv(cfg, *, speeds_hz=None, n_grid: int | None = None,
         grid = np.linspace(lo, hi, n_grid)
     nu = None if rate_bound_hz_per_s is None else _TWO_PI * float(rate_bound_hz_per_s)
     L = lpv_plant(cfg, grid, states=states)
-    gps = lpv_generalized_plants(L, w)
+    dl = _delay(cfg, sp)
+    gps = lpv_generalized_plants(L, w, delay=dl)
     P = [g.P_nominal for g in gps]
     nmeas, ncon = gps[0].nmeas, gps[0].ncon
     # dA/dΩ of the generalised plant: the weights do not depend on Ω
@@ -440,7 +461,7 @@ def design_lpv(cfg, *, speeds_hz=None, n_grid: int | None = None,
                   check_speeds_hz=r.check_grid / _TWO_PI, lyapunov=lyapunov,
                   rate_bound_hz_per_s=None if nu is None else float(rate_bound_hz_per_s),
                   weights=w, reports=r.reports, synthesis_s=r.time_s, plant=L,
-                  kind=r.kind, frozen_best_gamma=r.frozen_best_gamma)
+                  delay=dl, kind=r.kind, frozen_best_gamma=r.frozen_best_gamma)
     check = check_full_order(cfg, sp, d.controller_at, "lpv", allow_unstable)
     return replace(d, full_order=check, elapsed_s=time.perf_counter() - t0)
 
@@ -501,7 +522,7 @@ def design_frozen(cfg, speed_hz: float | None = None, *, method: str = "hinf",
     f = float(cfg.operating.speed_rpm / 60.0 if speed_hz is None else speed_hz)
     if method == "hinf":
         L = lpv_plant(cfg, [f, f + 1.0], states=states, reference_speed_hz=f)
-        gp = lpv_generalized_plants(L, w, [_TWO_PI * f])[0]
+        gp = lpv_generalized_plants(L, w, [_TWO_PI * f], delay=_delay(cfg, sp))[0]
         r = hinfsyn(gp.P_nominal, gp.nmeas, gp.ncon)
         K_P, gamma = r.K, float(r.gamma)
     else:
@@ -513,7 +534,7 @@ def design_frozen(cfg, speed_hz: float | None = None, *, method: str = "hinf",
             "operating": cfg.operating.model_copy(update={"speed_rpm": 60.0 * f})})
         gp = generalized_plant(cfg_f, w.Wp(), w.Wu(), states=states,
                                uncertainty={f"{cfg.seal[0].name}.k": seal_k_uncertainty},
-                               d_e=w.d_e, d_u=w.d_u)
+                               d_e=w.d_e, d_u=w.d_u, actuator_delay=_delay(cfg, sp).system)
         om = kw.pop("omega", None)
         if om is None:  # the specification's synthesis band: modes at the operating speed
             om = design_omega(*sp.synthesis_band_hz)

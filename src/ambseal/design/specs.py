@@ -53,7 +53,11 @@ the value the thesis used on its test facility, P5, where it names one):
   3×: the LPV designs have no W_K) and which rises tenfold above its corner
   at the actuator bandwidth f_a, rolling the controller off at the bending modes the
   rigid-body LPV design model leaves out (turboexpander: D_u 0.42 A, W_u 0.037 → 0.37 at
-  1.5 kHz, where P3 §3.3 puts the crossover at 1.4 kHz). M = 2, ω_B = 2π·50 rad/s and
+  1.5 kHz, where P3 §3.3 puts the crossover at 1.4 kHz) — or lower, at 1/(8τ), where the
+  controller's hold + computation delay τ = (n_d + ½)/f_s lags by 45° as the actuator
+  does at f_a: beyond it the sampled controller no longer acts as the continuous one it
+  was designed as (the flywheel's, 20 kHz with one sample: 1.6 kHz, not f_a = 2 kHz;
+  benchmarks/README.md). M = 2, ω_B = 2π·50 rad/s and
   A = 1e-2 stay the method's tuning (P3's 20 ms settling; :mod:`ambseal.design.lpv_design`).
 * **Uncertainty** (μ): the cross-coupled stiffness k ± 100 % of every seal, by its own
   name (P5 §4.1); a seal with k = 0 at the design pressure, or a rig without a seal, has
@@ -113,8 +117,9 @@ WU_PID_PEAKS, MU_WU_PID_PEAKS = 2.5, 3.0
 GAIN_FACTOR, GAIN_BAND = 2.0, (0.75, 1.1)
 #: μ's orbit demand in multiples of D_e (module docstring)
 ORBIT_PER_DE = 0.5
-#: the LPV design's W_u: high-frequency over low-frequency gain (module docstring)
-LPV_WU_RISE = 10.0
+#: the LPV design's W_u: high-frequency over low-frequency gain, and its corner's delay
+#: bound 1/(8τ), where the delay τ lags by 45° (module docstring)
+LPV_WU_RISE, LPV_WU_DELAY_PER_TAU = 10.0, 8.0
 
 
 def round_125(x: float) -> float:
@@ -125,6 +130,14 @@ def round_125(x: float) -> float:
 
 def _sig2(x: float) -> float:
     return float(f"{x:.2g}")
+
+
+def _floor2(x: float) -> float:
+    """``x`` > 0 rounded down to two significant digits (a bound stays a bound)."""
+    if not math.isfinite(x):
+        return x
+    e = math.floor(math.log10(x)) - 1
+    return math.floor(x / 10.0**e * (1 + 1e-12)) * 10.0**e
 
 
 @dataclass(frozen=True)
@@ -140,6 +153,8 @@ class Machine:
     bias_current_a, air_gap_m : float or None
         None when the rig gives neither (then D_e, D_u and the impulse need keys).
     sample_rate_hz : float
+    delay_s : float
+        The digital controller's hold + computation delay τ = (n_d + ½)/f_s (s).
     """
 
     mass_kg: float
@@ -148,6 +163,7 @@ class Machine:
     bias_current_a: float | None
     air_gap_m: float | None
     sample_rate_hz: float
+    delay_s: float = 0.0
 
 
 def machine(cfg) -> Machine:
@@ -183,7 +199,7 @@ def machine(cfg) -> Machine:
             gaps += [k_i * b / k_s for k_i, k_s in zip(*amb_factors(a)) if k_i * b <= MAX_GAP_M * k_s]
     s0 = min(gaps) if gaps and len(gaps) >= len(cfg.amb) else None
     return Machine(float(assemble_rotor(cfg).mass), fb[0] if fb else None, float(fa), i0,
-                   s0, float(fs))
+                   s0, float(fs), (cfg.controller.delay_samples + 0.5) / float(fs))
 
 
 @dataclass(frozen=True)
@@ -510,9 +526,14 @@ def _weights(d, method: str, mach: Machine, d_e: float, d_u: float, band_hi: flo
         rules[f"{method}.wu_gain"] = (f"D_u/({peaks:g} D_e Kp (1 + 1/ε)): |K| ≤ {peaks:g}× "
                                       "the reference PID's peak where S_o ≈ 1")
     if method == "lpv":
-        w = replace(w, wu_hf_gain=LPV_WU_RISE * w.wu_gain, wu_corner_hz=mach.actuator_hz)
+        f_tau = 1.0 / (LPV_WU_DELAY_PER_TAU * mach.delay_s) if mach.delay_s > 0 else math.inf
+        w = replace(w, wu_hf_gain=LPV_WU_RISE * w.wu_gain,
+                    wu_corner_hz=min(mach.actuator_hz, _floor2(f_tau)))
         rules["lpv.wu_hf_gain"] = f"{LPV_WU_RISE:g}× wu_gain (P3 §3.3: a high-pass W_u)"
-        rules["lpv.wu_corner_hz"] = "the actuator bandwidth f_a (P3 §3.3: 1.4 kHz, f_a 1.5 kHz)"
+        rules["lpv.wu_corner_hz"] = (
+            "the lower of the actuator bandwidth f_a (P3 §3.3: 1.4 kHz, f_a 1.5 kHz) and "
+            f"1/({LPV_WU_DELAY_PER_TAU:g} τ) rounded down to 2 digits, where the controller's hold + computation "
+            "delay τ lags 45° as the actuator does at f_a")
     else:
         w = replace(w, omega_b=OMEGA_B_TIMES_TI / pid["ti"])
         rules[f"{method}.omega_b_rad_s"] = (f"{OMEGA_B_TIMES_TI:g}/T_i of the reference PID "

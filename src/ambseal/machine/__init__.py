@@ -31,11 +31,11 @@ from ambseal.machine.loop import (
     sampled_loop_matrix,
     sampled_plant,
 )
-from ambseal.machine.scheduled_digital import ScheduledDigital, scheduled_digital
+from ambseal.machine.scheduled_digital import ScheduledDigital, scheduled_digital, table_grid
 from ambseal.machine.synchronous_notch import NotchedController, NotchedDigital, SynchronousNotch
 
 __all__ = ["SPEED", "ScheduledController", "controller_as_runs", "frozen", "matrices_at",
            "sampled_loop_matrix", "ClosedLoop",
            "JudgedLoop", "closed_loop", "judged_loop", "loop_matrices", "sample_time",
-           "sampled_plant", "ScheduledDigital", "scheduled_digital", "SynchronousNotch",
+           "sampled_plant", "ScheduledDigital", "scheduled_digital", "table_grid", "SynchronousNotch",
            "NotchedController", "NotchedDigital"]

@@ -19,6 +19,14 @@ table 3.10–3.11 as it runs), kept under the triangle hold 2.93.
 The interpolation is judged between the grid points: the caller passes plants at values
 between table entries, and the chosen method keeps every one of those sampled loops
 stable (``candidates``).
+
+The discrete table is at least as dense as the continuous one and has at least
+:data:`MIN_TABLE_INTERVALS` intervals (:func:`table_grid`): between two entries of the
+continuous table the controller is the interpolated one, exact for the vertex-grid LPV
+design, but its sampled matrices (a matrix exponential of them, after a residualisation)
+are not linear in Ω: the flywheel's LPV (``examples/flywheel.toml``), tabulated at
+standstill and the top speed alone, lost its nutation mode half way with every method,
+where the same controller sampled there held it (benchmarks/README.md).
 """
 
 from __future__ import annotations
@@ -52,7 +60,32 @@ from ambseal.robust import (
     with_delay,
 )
 
-__all__ = ["ScheduledDigital", "scheduled_digital", "INTERPOLATION", "interpolation_law"]
+__all__ = ["ScheduledDigital", "scheduled_digital", "INTERPOLATION", "interpolation_law",
+           "table_grid", "MIN_TABLE_INTERVALS"]
+
+#: Fewest intervals of a discrete table (module docstring)
+MIN_TABLE_INTERVALS = 8
+
+
+def table_grid(theta) -> np.ndarray:
+    """The θ of a scheduled controller's discrete table: every entry of its continuous
+    table ``theta`` (increasing), each interval split evenly so that there are at least
+    :data:`MIN_TABLE_INTERVALS` (module docstring).
+
+    Parameters
+    ----------
+    theta : array_like, shape (n_t,)
+        The continuous table's θ, increasing, n_t ≥ 2.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        n ≥ max(n_t, MIN_TABLE_INTERVALS + 1); the entries of ``theta`` among them.
+    """
+    W = np.asarray(theta, float)
+    split = -(-MIN_TABLE_INTERVALS // max(W.size - 1, 1))
+    pieces = [np.linspace(a, b, split + 1)[:-1] for a, b in zip(W[:-1], W[1:])]
+    return np.concatenate(pieces + [W[-1:]])
 
 
 def interpolation_law(parameter: str = SPEED) -> str:

@@ -10,6 +10,7 @@ each speed, not by ambseal's own judgement."""
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import control
@@ -97,3 +98,19 @@ def test_the_lpv_runs_on_the_flywheel_from_standstill_to_the_top_speed(flywheel_
     for r in (r for r in metrics["cases"] if r["controller"] == "lpv"):
         assert r["discrete"]["unbalance_peak_um"] < backup_um, r["discrete"]
 
+
+def test_the_failures_name_the_mode_by_its_kind_and_a_remedy_that_holds(flywheel_run):
+    """The derived PID loses the nutation (rigid conical, forward whirl) at the top speed,
+    H∞ and μ designed at the top speed lose a rigid conical mode at standstill: their
+    lines say so (the kind from the mode's shape, tests/analysis/test_mode_naming.py), and
+    the remedy they name — the LPV on speed — is delivered and holds (above)."""
+    code, metrics, _ = flywheel_run
+    assert code == 1  # H∞ and μ not delivered
+    failed = metrics["failed"]
+    assert "(mode at 1023 Hz, ζ = −0.025, rigid conical, forward whirl: the nutation)" \
+        in failed["pid"]["reason"]
+    for m in ("hinf", "mu"):
+        assert re.search(r"0 bar, 0 Hz \(mode at [\d.]+ Hz, ζ = −[\d.]+, rigid conical\)",
+                         failed[m]["reason"]), failed[m]["reason"]
+        assert "the LPV on speed holds the rotor over the speed range" in failed[m]["reason"]
+    assert "lpv" not in failed

@@ -10,7 +10,9 @@ sampled with its delay) on the full-order plant:
   :func:`speed_scheduled`, :func:`judge_spinup`, :func:`unstable_open_loop_poles`) and its
   verdict on a controller that failed (:class:`FailedController`,
   :func:`synthesis_failure`, :func:`loop_failure`, :func:`also_failed`; an unbalance orbit
-  beyond the rig's clearances, :func:`clearance_failure` on :func:`rig_clearances_um`);
+  beyond the rig's clearances, :func:`clearance_failure` on :func:`rig_clearances_um`;
+  the failing mode named by its kind, :func:`failing_mode_kind`, :func:`mode_kind` on
+  :func:`support_span_m`);
 * :func:`loop_responses`, :func:`sensitivity_peaks`, :func:`compliance` — S_o, S_i, T_o,
   K S_o and the compliance;
 * :func:`iso_assessment` → :class:`IsoAssessment` — ISO 14839-3 zones from the sensitivity
@@ -99,6 +101,8 @@ _FROM = {
     "unbalance_response": "unbalance", "UnbalanceResponse": "unbalance",
     "running_unbalance": "unbalance",
     "running_plant": "synchronous", "RunningPlant": "synchronous",
+    "mode_kind": "mode_naming", "failing_mode_kind": "mode_naming",
+    "support_span_m": "mode_naming",
 }
 
 __all__ = sorted(_FROM)

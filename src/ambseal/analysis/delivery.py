@@ -11,7 +11,9 @@ rig), judged for comparison.
 
 The verdict is the judged cases' own (``stable`` of each case and of its ``discrete``
 block); the line names the least stable closed-loop mode of each failed condition by its
-damped frequency and damping ratio ζ = −Re λ/|λ| (negative: growing).
+damped frequency and damping ratio ζ = −Re λ/|λ| (negative: growing), and, given the
+means to (``kind_of``), by its kind: rigid cylindrical or conical, bending, its whirl
+(:mod:`ambseal.analysis.mode_naming`).
 """
 
 from __future__ import annotations
@@ -72,15 +74,19 @@ def _head(method: str, designed: bool, kept: bool = False, derived: bool = False
             f"{_name(method)}: not delivered")
 
 
-def _mode_text(poles, discrete_dt: float | None = None) -> str:
-    """The least stable mode of closed-loop poles: 's' poles (rad/s), or 'z' poles of a
-    loop sampled at ``discrete_dt`` (s), mapped to s by λ = ln z / dt."""
+def _least_stable(poles, discrete_dt: float | None = None) -> complex | None:
+    """The least stable of closed-loop poles as a rate (rad/s): 's' poles, or 'z' poles
+    of a loop sampled at ``discrete_dt`` (s), mapped to s by λ = ln z / dt."""
     lam = np.asarray(poles, complex).ravel()
-    if lam.size == 0:
-        return ""
     if discrete_dt:
         lam = np.log(lam[np.abs(lam) > 0]) / discrete_dt
-    z = lam[int(np.argmax(lam.real))]
+    return complex(lam[int(np.argmax(lam.real))]) if lam.size else None
+
+
+def _mode_text(z: complex | None) -> str:
+    """``"mode at f Hz, ζ = …"`` of a pole (rad/s)."""
+    if z is None:
+        return ""
     zeta = -z.real / max(abs(z), 1e-300)
     return f"mode at {abs(z.imag) / (2 * math.pi):.4g} Hz, ζ = {zeta:.2g}".replace("-", "−")
 
@@ -90,20 +96,26 @@ def _mode_text(poles, discrete_dt: float | None = None) -> str:
 _NAMED = 4
 
 
-def _listed(found: list[tuple]) -> str:
-    """``(label, mode text, rank)`` of each unstable condition as one phrase: each with its
-    mode, or, beyond :data:`_NAMED`, the labels and the mode of the highest rank (the
-    rightmost pole's real part, or max |z|)."""
+def _listed(found: list[tuple], kind=None) -> str:
+    """``(label, mode text, rank, case, pole)`` of each unstable condition as one phrase:
+    each with its mode, or, beyond :data:`_NAMED`, the labels and the mode of the highest
+    rank (the rightmost pole's real part, or max |z|); each named mode with its kind when
+    ``kind(case, pole)`` gives one."""
+    def mode(f):
+        k = kind(f[3], f[4]) if kind is not None and f[4] is not None else None
+        return f"{f[1]}, {k}" if k else f[1]
+
     if len(found) <= _NAMED:
-        return " and ".join(f"{lb} ({mode})" for lb, mode, _ in found)
+        return " and ".join(f"{f[0]} ({mode(f)})" for f in found)
     worst = max(found, key=lambda f: -math.inf if f[2] is None or isinstance(f[2], str)
                 else f[2])
-    return (f"{len(found)} conditions: {'; '.join(lb for lb, _, _ in found)} "
-            f"(the least stable {worst[0]}: {worst[1]})")
+    return (f"{len(found)} conditions: {'; '.join(f[0] for f in found)} "
+            f"(the least stable {worst[0]}: {mode(worst)})")
 
 
 def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
-                 kept: bool = False, derived: bool = False) -> FailedController | None:
+                 kept: bool = False, derived: bool = False,
+                 kind_of=None) -> FailedController | None:
     """The failure of one controller from its judged cases, or None when every judged
     loop (continuous and, where judged, discrete) is stable.
 
@@ -125,6 +137,10 @@ def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
     derived : bool
         The reference PID was derived from the rig (no ``[controller.pid]``), not given
         by it: said in the line.
+    kind_of : callable, optional
+        ``kind_of(case, pole) → str or None``: the kind of the mode of ``pole`` (rad/s) at
+        that case's condition (:func:`ambseal.analysis.mode_naming.failing_mode_kind`),
+        asked only for the modes the line names.
 
     Returns
     -------
@@ -135,19 +151,20 @@ def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
     for case, curves in judged:
         label = case.label or f"{case.pressure_bar:g} bar"
         if not case.stable:
-            cont.append((label, _mode_text(curves.get('poles', ())), case.max_real_pole))
+            z = _least_stable(curves.get('poles', ()))
+            cont.append((label, _mode_text(z), case.max_real_pole, case, z))
             where.append(label)
             continue
         disc = case.discrete
         if disc is not None and not disc.stable:
-            mode = _mode_text((curves.get("discrete") or {}).get("poles", ()),
+            z = _least_stable((curves.get("discrete") or {}).get("poles", ()),
                               1.0 / disc.sample_rate_hz)
-            disc_parts.append((label, f"{mode}, max |z| = {disc.max_abs_pole_z:.5f}",
-                               disc.max_abs_pole_z))
+            disc_parts.append((label, f"{_mode_text(z)}, max |z| = {disc.max_abs_pole_z:.5f}",
+                               disc.max_abs_pole_z, case, z))
             where.append(label)
-    parts = ([f"the full-order loop is unstable at {_listed(cont)}"] if cont else []) + (
-        [f"as it runs on the target (sampled, delayed) the loop is unstable at "
-         f"{_listed(disc_parts)}"] if disc_parts else [])
+    parts = ([f"the full-order loop is unstable at {_listed(cont, kind_of)}"] if cont else []
+             ) + ([f"as it runs on the target (sampled, delayed) the loop is unstable at "
+                   f"{_listed(disc_parts, kind_of)}"] if disc_parts else [])
     if not parts:
         return None
     return FailedController(f"{_head(method, designed, kept, derived)}{_SEP}" + "; ".join(parts),

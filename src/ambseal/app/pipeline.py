@@ -25,6 +25,7 @@ from ambseal.analysis import (
     clearance_failure,
     facility_rejection,
     facility_speed_step,
+    failing_mode_kind,
     frozen_at,
     judge_case,
     judge_jobs,
@@ -80,7 +81,7 @@ from ambseal.design import (
     design_spec,
     lpv_schedule,
 )
-from ambseal.errors import ConfigError, SynthesisError
+from ambseal.errors import ConfigError, ModelError, SynthesisError
 from ambseal.export import export_notch, write_notch_c
 from ambseal.files import RunFolder, write_json
 from ambseal.machine import SPEED
@@ -120,6 +121,19 @@ class RunResult:
     exit_status: int = 0
 
 
+def kind_of(cfg, controller):
+    """``kind_of`` of :func:`~ambseal.analysis.loop_failure` for one controller on the rig:
+    the failing mode's kind (:func:`~ambseal.analysis.failing_mode_kind`) at the case's
+    condition, or None where its shape cannot be taken (named in the line without it)."""
+    def kind(case, pole):
+        try:
+            return failing_mode_kind(cfg, controller, pressure_bar=case.pressure_bar,
+                                     speed_hz=case.speed_hz, pole=pole)
+        except (ModelError, ValueError, np.linalg.LinAlgError):
+            return None
+    return kind
+
+
 def _judged_of(method: str, jobs: list, judged: list) -> list[tuple]:
     """``method``'s judged cases with their curves."""
     return [done for j, done in zip(jobs, judged) if j.name == method]
@@ -143,7 +157,8 @@ def _speed_range(designs, digitals, spec, points, design_cfg, judge_cfg, stages,
     for d in designs:
         f = loop_failure(d.method, _judged_of(d.method, jobs, done),
                          designed=d.method != "pid", kept=allow_unstable,
-                         derived=design_cfg.controller.pid is None)
+                         derived=design_cfg.controller.pid is None,
+                         kind_of=kind_of(judge_cfg, d.controller))
         if f is not None:
             failed[d.method] = also_failed(failed.get(d.method), f)
     return [case for case, _ in done]
@@ -470,7 +485,8 @@ def _judge_stage(st: _RunState) -> None:
     for d in st.designs:
         f = loop_failure(d.method, _judged_of(d.method, st.jobs, st.judged),
                          designed=d.method != "pid", kept=st.allow_unstable,
-                         derived=st.cfg.controller.pid is None)
+                         derived=st.cfg.controller.pid is None,
+                         kind_of=kind_of(st.cfg, d.controller))
         if f is not None:
             st.failed[d.method] = f
     if speed_scheduled(st.cfg):

@@ -187,3 +187,21 @@ def test_csr_boundary_is_linear_between_its_points_and_flat_beyond():
     pts = Signoff().csr_boundary
     assert csr_boundary(pts, 5.0) == 2.5 and csr_boundary(pts, 200.0) == 2.0
     assert csr_boundary(pts, 30.0) == pytest.approx(2.5 - 0.5 * (30.0 - 16.53) / 43.47)
+
+
+def test_the_csr_takes_the_rigid_support_critical_at_standstill():
+    """API 617's critical speed ratio divides the maximum continuous speed by the first
+    critical speed on rigid supports, a standstill property of the rotor. The overhung
+    compressor pinned at its bearings: 329.5 Hz in ROSS 3.1 at standstill (its
+    ``run_critical_speed``, measured beside ambseal and stored here), CSR 305/329.5 = 0.93;
+    built at the operating speed the gyroscopic moments of the impeller pull the backward
+    whirl down to 269.7 Hz (CSR 1.13)."""
+    from pathlib import Path
+
+    from ambseal.config import load_rig
+
+    cfg = load_rig(Path(__file__).resolve().parents[2] / "examples" / "overhung_compressor.toml")
+    r = level1_screening(cfg, None, points=3)
+    assert r.rigid_critical_hz == pytest.approx(329.5, abs=0.05)
+    assert r.csr == pytest.approx(r.speed_hz / r.rigid_critical_hz, rel=1e-12)
+    assert r.csr == pytest.approx(0.93, abs=0.005)

@@ -297,7 +297,7 @@ def _rigid_critical_hz(cfg) -> float:
     pins = [Spring(position=z, kxx=RIGID_SUPPORT, kyy=RIGID_SUPPORT, name=f"rigid{i}")
             for i, z in enumerate(bearing_positions(cfg))]
     rig = cfg.model_copy(update={"seal": [], "amb": [], "spring": pins})
-    lam = np.linalg.eigvals(np.asarray(build_plant(rig).A))
+    lam = np.linalg.eigvals(np.asarray(build_plant(rig, speed_rpm=0.0).A))
     f = lam.imag[lam.imag > 2 * np.pi * 0.1] / (2 * np.pi)
     return float(f.min()) if f.size else math.nan
 

@@ -145,15 +145,19 @@ def check_report_agrees(out: Path) -> None:
     if m.get("signoff"):
         s = m["signoff"]
         outcome = _table(tables, lambda a, r: r and r[0][:2] == ["controller", "criterion"])
-        expected = [(name, c["criterion"], c["passed"], c["counts"])
+        expected = [(name, c["criterion"], c["passed"], c["counts"], c["graded"],
+                     c["outcome"])
                     for name, per in s["controllers"].items() for c in per["criteria"]]
         assert len(outcome) - 1 == len(expected)
-        for row, (name, criterion, passed, counts) in zip(outcome[1:], expected):
-            assert row[:2] == [name, criterion]
-            assert (row[-1] == "passed") == passed, (row, passed)
-            if counts:
+        for row, (name, criterion, passed, counts, graded, said) in zip(outcome[1:],
+                                                                       expected):
+            assert row[:2] == [name, criterion] and row[-1] == said, (row, said)
+            assert (row[-1] == "passed") == (passed and counts and graded), (row, passed)
+            if not graded:
+                assert row[-1] == "not graded" and not passed, row
+            elif counts:
                 assert row[-1] == ("passed" if passed else "FAILED"), row
         page = (out / "report.html").read_text(encoding="utf-8")
         assert ("Sign-off PASSED" in page) == s["passed"]
         assert s["passed"] == all(c["passed"] for per in s["controllers"].values()
-                                  for c in per["criteria"] if c["counts"])
+                                  for c in per["criteria"] if c["counts"] and c["graded"])

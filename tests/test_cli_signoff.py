@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 
+import numpy as np
 import pytest
 
 from ambseal.cli import main
@@ -53,6 +54,49 @@ def test_signoff_passes_with_exit_status_0(tmp_path, capsys):
     lines = out.splitlines()
     assert code == 0 and lines[0].startswith("Sign-off PASSED")
     assert lines[1].startswith("none: stability, Level I: passed")
+
+
+def test_a_rotor_its_own_seal_makes_unstable_is_not_signed_off(tmp_path, capsys):
+    """The passing rotor above with a seal at mid-span whose cross-coupled stiffness
+    k = 5e7 N/m drives its forward cylindrical mode: closed form of the rigid rotor,
+    m s² + c s + K − j k = 0 (z = x + jy; Childs' sign convention), a root at
+    Re s = +144 rad/s. Level I leaves the seals out and passes; Level II with every source
+    finds the loop unstable and now counts, so the machine is not signed off (exit 1),
+    and the unbalance criteria, which have no steady response on an unstable loop, are
+    not graded — none is called passed."""
+    m = math.pi / 4 * 0.2**2 * 0.4 * 7850.0
+    s = np.roots([m, 2.0e4, 1e8 - 1j * 5e7])
+    assert s.real.max() == pytest.approx(144.3, abs=0.1)
+    rig = tmp_path / "sealed.toml"
+    rig.write_text(_rigid_rotor(1e8, 2.0e4, 8.0e3) + "[[seal]]\nname = \"piston\"\n"
+                   "position = 0.2\nk = { at_zero = 5e7, per_bar = 0.0 }\n")
+    code = main(["signoff", str(rig), "--json", "--out", str(tmp_path / "so")])
+    out, err = capsys.readouterr()
+    assert code == 1 and "Traceback" not in err
+    doc = json.loads(out)
+    assert doc["verdict"] == "Sign-off NOT passed — none: stability, Level II"
+    crit = {c["criterion"]: c for c in doc["controllers"]["none"]["criteria"]}
+    assert crit["stability, Level I"]["outcome"] == "passed"
+    lv2 = crit["stability, Level II"]
+    assert lv2["outcome"] == "FAILED" and lv2["counts"] and "UNSTABLE" in lv2["value"]
+    for name in ("separation margins", "vibration at the probes", "close clearances",
+                 "vibration zone"):
+        c = crit[name]
+        assert (c["outcome"], c["passed"], c["graded"]) == ("not graded", False, False)
+        assert "unstable" in c["value"]
+
+
+def test_criteria_not_evaluated_are_not_graded_and_the_verdict_says_so(tmp_path, capsys):
+    """A rotor on springs (no AMB, no seal clearance): its close clearances and ISO 14839-2
+    zone cannot be graded; they say so instead of "passed", and the verdict line names
+    them."""
+    rig = tmp_path / "rigid.toml"
+    rig.write_text(_rigid_rotor(1e8, 2.0e4, 8.0e3))
+    assert main(["signoff", str(rig), "--out", str(tmp_path / "so")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].endswith("(not graded: close clearances, vibration zone)")
+    assert "none: close clearances: not graded — no close clearance given" in lines[5]
+    assert "none: vibration zone: not graded — no [[amb]] backup_clearance given" in lines[6]
 
 
 @pytest.mark.parametrize("args, says", [

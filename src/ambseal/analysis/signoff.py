@@ -14,8 +14,14 @@ close clearances              S_c·response ≤ 75 % of the clearance        API
 vibration zone                zone A or B at every AMB sensor             ISO 14839-2:2004
 ============================  ==========================================  ==============
 
-The stability holds when Level I passes or, where Level I asks for it, Level II passes;
-the machine passes when every controller meets every criterion. The clause numbers are
+The stability holds when Level I passes and the loop with every source is stable, or,
+where Level I asks for it, Level II passes: a machine whose loop with every source is
+unstable at the maximum continuous speed is never signed off, whichever level found it
+(Level I leaves the seals out). Each criterion is passed, failed or not graded (with
+why: no close clearance or backup clearance given; the unbalance criteria on a loop
+that is unstable, where no steady response exists), one :attr:`Criterion.outcome` for
+the command line and the report alike; the machine passes when every controller meets
+every criterion that counts and is graded. The clause numbers are
 those ROSS's API report tool cites; where a limit could not be confirmed from the
 standards' public text it is a ``[signoff]`` setting (:class:`ambseal.config.rig.Signoff`).
 The modules: :mod:`~ambseal.analysis.level1`, :mod:`~ambseal.analysis.level2`,
@@ -48,8 +54,10 @@ CLAUSES = {
 @dataclass(frozen=True)
 class Criterion:
     """One line of the sign-off: ``name``, its ``value`` and ``limit`` in words,
-    ``source`` (edition and clause), ``passed``, and whether it ``counts`` for the verdict
-    (the stability is Level I's where it passes, else Level II's)."""
+    ``source`` (edition and clause), ``passed``, whether it ``counts`` for the verdict
+    (the stability is Level I's where it passes and the loop with every source is stable,
+    else Level II's), and whether it was ``graded`` at all (``value`` then says why not;
+    ``passed`` is False)."""
 
     name: str
     value: str
@@ -57,10 +65,23 @@ class Criterion:
     source: str
     passed: bool
     counts: bool = True
+    graded: bool = True
+
+    @property
+    def outcome(self) -> str:
+        """``"passed"``, ``"FAILED"`` or ``"not graded"``; a stability level that does not
+        count: ``"not needed"`` (Level II where Level I decides) or ``"Level II
+        decides"`` (a Level I that asks for it)."""
+        if not self.graded:
+            return "not graded"
+        if self.counts:
+            return "passed" if self.passed else "FAILED"
+        return "not needed" if self.name.endswith("II") else "Level II decides"
 
     def to_dict(self) -> dict:
         return {"criterion": self.name, "value": self.value, "limit": self.limit,
-                "source": self.source, "passed": self.passed, "counts": self.counts}
+                "source": self.source, "passed": self.passed, "counts": self.counts,
+                "graded": self.graded, "outcome": self.outcome}
 
 
 @dataclass(frozen=True)
@@ -86,11 +107,11 @@ class SignOff:
 
     @property
     def passed(self) -> bool:
-        return all(c.passed for c in self.criteria if c.counts)
+        return all(c.passed for c in self.criteria if c.counts and c.graded)
 
     @property
     def failed(self) -> list[str]:
-        return [c.name for c in self.criteria if c.counts and not c.passed]
+        return [c.name for c in self.criteria if c.counts and c.graded and not c.passed]
 
     def to_dict(self) -> dict:
         """The controller's sign-off block: ``passed``, ``criteria`` and each analysis."""
@@ -113,7 +134,18 @@ def _criteria(cfg, l1, l2, unb, iso) -> tuple:
                           f"δ = {last.log_dec:.3g} at {last.frequency_hz:.4g} Hz"
                           + ("" if last.stable else ", loop UNSTABLE"),
                           f"δ ≥ {d_min:g} with every source", CLAUSES["level2"], l2.passed,
-                          counts=not l1.passed))
+                          counts=not (l1.passed and last.stable)))
+    if not unb.loop_stable:  # no steady unbalance response on an unstable loop
+        why = (f"the loop with the seals at {cfg.operating.pressure_bar:g} bar is unstable "
+               f"at {unb.max_hz:.4g} Hz: no steady unbalance response")
+        limits = (("separation margins", "SM ≥ required (none below AF 2.5)", "separation"),
+                  ("vibration at the probes", f"≤ A_vl = {unb.vibration_limit_um:.3g} µm "
+                   "p-p", "vibration"),
+                  ("close clearances", f"≤ {100 * cfg.signoff.clearance_fraction:.3g} % of "
+                   "the diametral clearance", "clearance"),
+                  ("vibration zone", "zone A or B", "iso14839_2"))
+        return tuple(rows) + tuple(Criterion(n, why, lim, CLAUSES[k], False, graded=False)
+                                   for n, lim, k in limits)
     crit = [k for c in unb.cases for k in c.criticals]
     sharp = [k for k in crit if k.af >= AF_CRITICAL]
     worst = min(sharp, key=lambda k: k.actual_margin_pct - k.required_margin_pct,
@@ -143,17 +175,18 @@ def _criteria(cfg, l1, l2, unb, iso) -> tuple:
         value = "no close clearance given ([[seal]] clearance, [[amb]] backup_clearance)"
     rows.append(Criterion("close clearances", value,
                           f"≤ {100 * cfg.signoff.clearance_fraction:.3g} % of the diametral "
-                          "clearance", CLAUSES["clearance"], unb.clearance_passed))
+                          "clearance", CLAUSES["clearance"], bool(clear) and unb.clearance_passed,
+                          graded=bool(clear)))
     if iso.graded:
         s = max((s for s in iso.sensors if s.zone), key=lambda s: s.d_max_m / s.c_min_m)
         value = (f"zone {iso.zone}: AMB {s.amb} {1e6 * s.d_max_m:.3g} µm 0-p = "
                  f"{s.d_max_m / s.c_min_m:.3g}·C_min")
     else:
-        value = "not graded: no [[amb]] backup_clearance"
+        value = "no [[amb]] backup_clearance given"
     rows.append(Criterion("vibration zone", value,
                           f"zone A or B (A/B {iso.boundaries[0]:g}, B/C {iso.boundaries[1]:g}"
                           f", C/D {iso.boundaries[2]:g}·C_min)", CLAUSES["iso14839_2"],
-                          iso.passed))
+                          iso.graded and iso.passed, graded=iso.graded))
     return tuple(rows)
 
 
@@ -199,10 +232,13 @@ def verdict_line(results) -> str:
     Returns
     -------
     str
-        ``Sign-off PASSED: …`` or ``Sign-off NOT passed — <controller>: <criteria>; …``.
+        ``Sign-off PASSED: …`` (naming the criteria not graded) or ``Sign-off NOT passed —
+        <controller>: <criteria>; …``.
     """
     if all(r.passed for r in results):
+        left = sorted({c.name for r in results for c in r.criteria if not c.graded})
         return ("Sign-off PASSED: every controller meets API 617 (stability, unbalance "
-                "response) and ISO 14839-2")
+                "response) and ISO 14839-2" + (f" (not graded: {', '.join(left)})"
+                                               if left else ""))
     bad = "; ".join(f"{r.controller}: {', '.join(r.failed)}" for r in results if not r.passed)
     return f"Sign-off NOT passed — {bad}"

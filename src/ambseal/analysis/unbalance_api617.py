@@ -302,6 +302,11 @@ class Api617Unbalance:
     vibration_limit_um : float
         A_vl (µm p-p).
     cases : tuple of UnbalanceCase
+    loop_stable : bool
+        The loop the responses are taken on (the rig, its seals at ``[operating]
+        pressure_bar``, the controller as it runs) is stable at the maximum continuous
+        speed: where it is not, a steady unbalance response does not exist and none of
+        these criteria is graded (:mod:`ambseal.analysis.signoff`).
     """
 
     controller: str
@@ -312,6 +317,7 @@ class Api617Unbalance:
     journal_loads: tuple
     vibration_limit_um: float
     cases: tuple
+    loop_stable: bool = True
 
     @property
     def probe_max_um(self) -> float:
@@ -344,6 +350,7 @@ class Api617Unbalance:
                 "separation_passed": self.separation_passed,
                 "vibration_passed": self.vibration_passed,
                 "clearance_passed": self.clearance_passed, "passed": self.passed,
+                "loop_stable": self.loop_stable,
                 "cases": [c.to_dict() for c in self.cases]}
 
 
@@ -538,4 +545,5 @@ def api617_unbalance(cfg, controller=None, *, name: str = "none",
         if progress:
             progress(f"{name}: unbalance {c + 1}/{len(cases)} ({rule}): "
                      f"{len(crit)} critical(s), probes ≤ {out[-1].probe_max_um:.3g} µm p-p")
-    return Api617Unbalance(name, f_min, f_max, trip, top, loads, a_vl, tuple(out))
+    return Api617Unbalance(name, f_min, f_max, trip, top, loads, a_vl, tuple(out),
+                           bool(modes.stable))

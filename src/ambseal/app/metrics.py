@@ -115,8 +115,13 @@ class SignoffCriterion:
         The standard, edition and clause.
     passed : bool
     counts : bool
-        Whether it decides the verdict (the stability is Level I's where it passes, else
-        Level II's).
+        Whether it decides the verdict (the stability is Level I's where it passes and
+        the loop with every source is stable, else Level II's).
+    graded : bool
+        Whether it was graded at all (``value`` says why not; ``passed`` is then false).
+    outcome : str
+        ``passed``, ``FAILED``, ``not graded``, ``not needed`` or ``Level II decides``:
+        what the command line and the report print.
     """
 
     criterion: str
@@ -125,6 +130,8 @@ class SignoffCriterion:
     source: str
     passed: bool
     counts: bool
+    graded: bool
+    outcome: str
 
 
 @dataclass(frozen=True)

@@ -255,9 +255,7 @@ def _signoff(args: argparse.Namespace) -> int:
         print(doc["verdict"])
         for r in results:
             for c in r.criteria:
-                state = ("passed" if c.passed else "FAILED") if c.counts else (
-                    "not counted")
-                print(f"{r.controller}: {c.name}: {state} — {c.value} (limit {c.limit}; "
+                print(f"{r.controller}: {c.name}: {c.outcome} — {c.value} (limit {c.limit}; "
                       f"{c.source})")
         print(f"files: {', '.join(str(f) for f in files)}")
     return 0 if doc["passed"] else 1

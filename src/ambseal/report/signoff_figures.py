@@ -158,9 +158,7 @@ def signoff_report(out: Path, results, rig_name: str, boundary=None) -> tuple[li
     rows = []
     for r in results:
         for c in r.criteria:
-            state = ("passed" if c.passed else "FAILED") if c.counts else (
-                "passed" if c.passed else "not needed" if c.name.endswith("II")
-                else "Level II decides")
+            state = c.outcome
             rows.append(f"<tr><td>{esc(r.controller)}</td><td>{esc(c.name)}</td>"
                         f"<td class=\"text\">{esc(c.value)}</td><td class=\"text\">"
                         f"{esc(c.limit)}</td><td class=\"text\">{esc(c.source)}</td>"

@@ -205,3 +205,33 @@ def test_the_csr_takes_the_rigid_support_critical_at_standstill():
     assert r.rigid_critical_hz == pytest.approx(329.5, abs=0.05)
     assert r.csr == pytest.approx(r.speed_hz / r.rigid_critical_hz, rel=1e-12)
     assert r.csr == pytest.approx(0.93, abs=0.005)
+
+
+def test_level1_screens_the_first_forward_mode_not_the_mesh_modes(tmp_path):
+    """ROSS's own ``compressor_example`` (saved by ROSS 2.3, ``tests/data``; no structural
+    damping) with six stages: its FE mesh modes far above the model's bending band (21–106
+    kHz) are lossless, so the loop without cross-coupling is not asymptotically stable by
+    ambseal's rule — the screening was "lost at Q = 0". API 617 screens the first forward
+    mode the cross-coupling acts on: the mesh modes are reported apart, the screened
+    mode at Q = 0 is the rotor's 162.48 Hz mode with δ 0.86129 — ROSS 3.1's ``run_modal``
+    of the same rotor without its labyrinth seals at 4 000 rpm gives 162.480869 Hz and
+    δ 0.861292 (measured beside ambseal, stored here) — and Q_0 lies beyond Q_A."""
+    from pathlib import Path
+
+    from ambseal.config import load_rig
+    from ambseal.io import import_ross_file
+
+    src = Path(__file__).resolve().parents[1] / "data" / "ross_compressor_example.toml"
+    rig = tmp_path / "compressor.toml"
+    import_ross_file(src, rig)
+    rig.write_text(rig.read_text().replace("\n[machine]", "".join(
+        f'\n[[stage]]\ndisk = "Disk {i}"\npower = 1.0e6\nimpeller_diameter = 0.35\n'
+        f"discharge_width = 0.012\nsuction_density = {10.0 + 2 * i}\n"
+        f"discharge_density = {12.0 + 2 * i}\n" for i in range(1, 7)) + "\n[machine]", 1))
+    r = level1_screening(load_rig(rig), None)
+    assert r.frequency_hz[0] == pytest.approx(162.480869, rel=1e-5)
+    assert r.log_dec[0] == pytest.approx(0.861292, rel=1e-4)
+    assert r.Q_0 is not None and r.Q_0 > r.Q_A and r.converged
+    for mesh_hz in (62.79e3, 105.7e3):  # two of the lossless mesh modes
+        assert any(abs(f / mesh_hz - 1) < 2e-3 for f in r.apart_hz), r.apart_hz
+    assert "not screened" in r.rule

@@ -24,7 +24,7 @@ that moves (amplitude above 1 % of the largest) turns that way, *planar* when no
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg as sla
@@ -42,7 +42,7 @@ from ambseal.model import (
     poles_near_zero,
     seal_values,
 )
-from ambseal.robust import decay_rate, is_stable
+from ambseal.robust import decay_rate, is_stable, unstable_poles
 
 __all__ = ["AF_CRITICAL", "API684_LOG_DEC", "OVERDAMPED_ZETA", "ClosedLoopModes", "Crossing",
            "Campbell", "log_decrement", "lowest_log_decrement", "whirl_of",
@@ -151,6 +151,8 @@ class ClosedLoopModes:
         delay included), the loop whose modes these are without a controller.
     stable : bool
         The judged loop's verdict (:func:`ambseal.robust.stability.is_stable`).
+    unstable : ndarray of complex
+        The judged loop's poles that break that rule (rad/s), whatever their frequency.
     """
 
     speed_hz: float
@@ -166,6 +168,25 @@ class ClosedLoopModes:
     node_z_m: np.ndarray
     max_real_pole: float
     stable: bool
+    unstable: np.ndarray = field(default_factory=lambda: np.zeros(0, complex))
+
+    def deciding(self) -> np.ndarray:
+        """The poles of :attr:`unstable` that decide a stability screening (API 617 Level
+        I and II): those within the modes' band, |Im λ| ≤ 2π ``max_hz`` (the real ones
+        included), where the model and the screening read the rotor's modes. A lossless
+        mesh mode far above it — ROSS's ``compressor_example``, without structural
+        damping, has them at 21–105 kHz — breaks the rule at Q = 0 because nothing damps
+        it, and any cross-coupling at a stage drives it; it is no mode API 617 screens
+        (the first forward mode, the one the stage cross-coupling destabilises), and a
+        screening reports it apart.
+
+        Returns
+        -------
+        ndarray of complex
+            The deciding poles (rad/s).
+        """
+        u = np.asarray(self.unstable, complex)
+        return u[np.abs(u.imag) <= 2 * np.pi * self.max_hz]
 
     def to_dict(self) -> dict:
         return {"speed_hz": self.speed_hz, "pressure_bar": self.pressure_bar,
@@ -435,7 +456,8 @@ def _modes_of_pairs(lam, Q, mesh, *, speed_hz, pressure_bar, max_hz, verdict,
         poles=z, frequency_hz=z.imag / (2 * np.pi), damping_ratio=-z.real / np.abs(z),
         log_decrement=log_decrement(z), whirl=tuple(w for w, _ in whirls),
         kappa=np.array([k for _, k in whirls]), shapes=shapes, node_z_m=np.asarray(mesh.z),
-        max_real_pole=decay_rate(verdict), stable=is_stable(verdict))
+        max_real_pole=decay_rate(verdict), stable=is_stable(verdict),
+        unstable=unstable_poles(verdict))
 
 
 @dataclass(frozen=True)

@@ -22,7 +22,11 @@ a small imaginary part that Q hardly moves, and the lowest log decrement of all 
 an undamped bending mode Q does not touch. So the forward (not backward) modes are
 followed over the sweep by nearest eigenvalue (:func:`~ambseal.analysis.campbell.
 track_modes`), and the screened mode is the one that loses its damping first; if none
-does, the one Q takes the most damping from. Q_0, where its pole crosses the imaginary
+does, the one Q takes the most damping from. The loop counts as lost where a pole within the
+screened band breaks the stability rule (:meth:`~ambseal.analysis.campbell.
+ClosedLoopModes.deciding`); a lossless mesh mode far above the band, which nothing damps
+(ROSS's ``compressor_example`` has them at 21–105 kHz, no structural damping) and any Q
+then drives, is reported apart and decides nothing. Q_0, where its pole crosses the imaginary
 axis (δ = 0), is found by Brent's method on the bracketing interval to a tolerance, not
 read off the grid; a loop lost by a pole that is no forward mode has no Q_0 to refine
 and does not pass.
@@ -121,6 +125,10 @@ class Level1:
         Average gas density (kg/m³).
     csr_boundary : float
         The Region A/B boundary's CSR at ``rho_avg``.
+    apart_hz : tuple of float
+        Damped frequencies (Hz) of poles above the screened band that break the
+        stability rule somewhere in the sweep (a lossless mesh mode nothing damps):
+        reported, not deciding (module docstring).
     """
 
     controller: str
@@ -140,6 +148,7 @@ class Level1:
     rule: str
     rho_avg: float
     csr_boundary: float
+    apart_hz: tuple = ()
 
     @property
     def region(self) -> str:
@@ -162,6 +171,7 @@ class Level1:
                 "rho_avg": json_float(self.rho_avg), "CSR_boundary": json_float(
                     self.csr_boundary), "region": self.region,
                 "passed": self.passed, "rule": self.rule, "converged": self.converged,
+                "unstable_apart_hz": [float(f) for f in self.apart_hz],
                 "speed_hz": self.speed_hz, "stage_q_A": list(self.stage_q),
                 "applied_at": [{"position_m": z, "share": w} for z, w in self.where_m],
                 "sweep": {"Q": [float(q) for q in self.Q],
@@ -353,7 +363,9 @@ def level1_screening(cfg, controller=None, *, name: str = "none", points: int = 
         m = modes_as_run(_with_cross_coupling(cfg, where, Q), controller,
                          speed_hz=speed_hz, max_hz=max_hz, pressure_bar=0.0)
         if progress:
-            progress(f"{name}: Q = {Q:.4g} N/m, {'stable' if m.stable else 'UNSTABLE'}")
+            state = ("stable" if m.stable else "UNSTABLE" if m.deciding().size
+                     else "stable in the screened band")
+            progress(f"{name}: Q = {Q:.4g} N/m, {state}")
         return m
 
     # Q_A is a point of the grid: 0, Q_A/2·k, … (points − 1 intervals to q_max_factor·Q_A)
@@ -365,7 +377,12 @@ def level1_screening(cfg, controller=None, *, name: str = "none", points: int = 
     j, lost = _screened(D, forward, iA)
     d, f = D[:, j], F[:, j]
     log_dec_A = float(d[iA])
-    unstable = [i for i, m in enumerate(pts) if not m.stable]
+    # lost where a pole within the screened band breaks the rule, not a lossless mesh
+    # mode above it (reported apart)
+    unstable = [i for i, m in enumerate(pts) if m.deciding().size]
+    band = 2 * math.pi * max_hz
+    apart = tuple(sorted({round(abs(p.imag) / (2 * math.pi), 1) for m in pts
+                          for p in m.unstable if abs(p.imag) > band}))
     if unstable and (lost is None or unstable[0] < lost):
         # lost first by a pole that is no forward mode: no Q_0 to refine
         Q_0, converged = float(grid[unstable[0]]), False
@@ -399,10 +416,15 @@ def level1_screening(cfg, controller=None, *, name: str = "none", points: int = 
         above = "" if Q_0 is not None else f" (δ > 0 up to {grid[-1]:.4g} N/m)"
         passed, rule = True, (f"δ_A = {log_dec_A:.3g} ≥ {d_min:g} and Q_0/Q_A ≥ "
                               f"{RATIO_FREE:g}{above}: passed")
+    if apart:
+        rule += (f"; modes above the screened band ({max_hz:.4g} Hz) at "
+                 f"{', '.join(f'{x:.4g}' for x in apart[:4])}{' …' if len(apart) > 4 else ''}"
+                 " Hz are not asymptotically stable (nothing damps them): not screened")
     return Level1(controller=name, speed_hz=speed_hz, stage_q=tuple(q), Q_A=Q_A,
                   where_m=where, Q=grid, log_dec=d, frequency_hz=f, log_dec_A=log_dec_A,
                   Q_0=Q_0, converged=converged, csr=csr, rigid_critical_hz=f_rigid,
-                  passed=passed, rule=rule, rho_avg=rho_avg, csr_boundary=edge)
+                  passed=passed, rule=rule, rho_avg=rho_avg, csr_boundary=edge,
+                  apart_hz=apart)
 
 
 def _zero(grid, i: int, lam0: complex, lam1: complex, modes, Q_A: float

@@ -23,7 +23,9 @@ with every source among those the sources take damping from (more than
 :data:`LOST_SHARE` of their δ), or the least damped of all if they take none. Each row
 reports that mode, followed from the loop without sources. A bending mode the sources
 leave alone, with a structural δ of a few hundredths, is not what Level II judges; a
-mode they leave at δ 0.06 is.
+mode they leave at δ 0.06 is. A row's loop is unstable where a pole within the band of
+modes it reads breaks the stability rule; a lossless mesh mode far above, which nothing
+damps, does not decide it (:meth:`ambseal.analysis.campbell.ClosedLoopModes.deciding`).
 """
 
 from __future__ import annotations
@@ -129,16 +131,19 @@ def _screened(base, last) -> int | None:
 
 
 def _row(component, m, base, k0) -> Level2Row:
-    """The row of the loop ``m``: the mode followed from ``base``'s mode ``k0``."""
+    """The row of the loop ``m``: the mode followed from ``base``'s mode ``k0``; stable
+    unless a pole within the band of modes it reads breaks the rule
+    (:meth:`~ambseal.analysis.campbell.ClosedLoopModes.deciding`)."""
+    stable = not m.deciding().size
     if k0 is None:
-        return Level2Row(component, math.nan, math.nan, m.stable)
+        return Level2Row(component, math.nan, math.nan, stable)
     tr = track_modes([base, m])
     j = next((j for j in range(tr.shape[1]) if tr[0, j] == k0), None)
     k = None if j is None else int(tr[1, j])
     if k is None or k < 0:
-        return Level2Row(component, math.nan, math.nan, m.stable)
+        return Level2Row(component, math.nan, math.nan, stable)
     return Level2Row(component, float(m.frequency_hz[k]), float(m.log_decrement[k]),
-                     m.stable)
+                     stable)
 
 
 def level2_analysis(cfg, controller=None, *, name: str = "none",

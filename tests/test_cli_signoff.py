@@ -135,3 +135,16 @@ def test_the_reports_signoff_section_says_the_verdict_first(tmp_path):
     assert {png.name for _, png in figs} == {"level1.png", "api617_unbalance.png"}
     _, passed = signoff_report(tmp_path, [ok], "rigid")
     assert "Sign-off PASSED" in passed[0]["html"]
+
+
+def test_a_critical_seen_at_two_probes_and_two_placements_is_counted_once():
+    """The peaks every probe and unbalance case found are grouped by speed (within 1 %):
+    four sightings of a 100 Hz resonance and two of one at 250 Hz are two critical
+    speeds, where the line said "6 critical(s)"."""
+    from types import SimpleNamespace
+
+    from ambseal.analysis import critical_speeds_hz
+
+    seen = [SimpleNamespace(speed_hz=f) for f in (250.0, 100.0, 100.4, 251.0, 100.2, 99.8)]
+    assert critical_speeds_hz(seen) == pytest.approx([100.1, 250.5])
+    assert critical_speeds_hz([]) == []

@@ -83,7 +83,7 @@ _FROM = {
     "judge_spinup": "judge", "operating_points": "judge", "points_for": "judge",
     "level1_screening": "level1", "stage_cross_coupling": "level1", "Level1": "level1",
     "level2_analysis": "level2", "Level2": "level2", "sign_off": "signoff",
-    "SignOff": "signoff", "verdict_line": "signoff", "iso14839_2_zones": "iso_vibration",
+    "SignOff": "signoff", "verdict_line": "signoff", "critical_speeds_hz": "signoff", "iso14839_2_zones": "iso_vibration",
     "IsoVibration": "iso_vibration",
     "api617_unbalance": "unbalance_api617", "Api617Unbalance": "unbalance_api617",
     "synchronous_response": "synchronous", "Unbalance": "synchronous",

@@ -38,7 +38,8 @@ from ambseal.analysis.level1 import RATIO_FREE, RATIO_MIN, level1_screening
 from ambseal.analysis.level2 import level2_analysis
 from ambseal.analysis.unbalance_api617 import api617_unbalance
 
-__all__ = ["Criterion", "SignOff", "sign_off", "verdict_line", "CLAUSES"]
+__all__ = ["Criterion", "SignOff", "sign_off", "verdict_line", "critical_speeds_hz", "CLAUSES",
+           "CRITICAL_SAME"]
 
 #: The source of each criterion (module docstring).
 CLAUSES = {
@@ -121,6 +122,35 @@ class SignOff:
                 "iso14839_2": self.iso14839_2.to_dict()}
 
 
+#: Peaks of the probes' responses within this relative distance are one critical speed
+CRITICAL_SAME = 0.01
+
+
+def critical_speeds_hz(criticals) -> list[float]:
+    """The distinct critical speeds (Hz) among the peaks every probe and unbalance case
+    found: the same resonance seen at two probes or under two placements is one critical
+    speed (peaks within :data:`CRITICAL_SAME` of each other, relative), the mean of each
+    group.
+
+    Parameters
+    ----------
+    criticals : sequence of Critical
+        :class:`ambseal.analysis.unbalance_api617.Critical` of every case and probe.
+
+    Returns
+    -------
+    list of float
+        Increasing.
+    """
+    groups: list[list[float]] = []
+    for f in sorted(k.speed_hz for k in criticals):
+        if groups and f <= groups[-1][0] * (1 + CRITICAL_SAME):
+            groups[-1].append(f)
+        else:
+            groups.append([f])
+    return [sum(g) / len(g) for g in groups]
+
+
 def _criteria(cfg, l1, l2, unb, iso) -> tuple:
     d_min = cfg.signoff.log_dec_min
     q0 = "none up to 10·Q_A" if l1.Q_0 is None else f"Q_0/Q_A = {l1.ratio:.3g}"
@@ -150,13 +180,16 @@ def _criteria(cfg, l1, l2, unb, iso) -> tuple:
     sharp = [k for k in crit if k.af >= AF_CRITICAL]
     worst = min(sharp, key=lambda k: k.actual_margin_pct - k.required_margin_pct,
                 default=None)
+    speeds = critical_speeds_hz(crit)
+    found = (f"{len(speeds)} critical speed{'s' if len(speeds) > 1 else ''} ("
+             f"{', '.join(f'{f:.4g}' for f in speeds)} Hz)")
     if not crit:
         value = f"no critical speed up to {unb.top_hz:.4g} Hz"
     elif worst is None:
-        value = (f"{len(crit)} critical(s), none with AF ≥ {AF_CRITICAL:g} (largest AF "
+        value = (f"{found}, none with AF ≥ {AF_CRITICAL:g} (largest AF "
                  f"{max(k.af for k in crit):.3g}): no margin required")
     else:
-        value = (f"{len(crit)} critical(s); tightest at {worst.speed_hz:.4g} Hz: AF "
+        value = (f"{found}; tightest at {worst.speed_hz:.4g} Hz: AF "
                  f"{worst.af:.3g}, SM {worst.actual_margin_pct:.3g} % (required "
                  f"{worst.required_margin_pct:.3g} %)")
     rows.append(Criterion(

@@ -113,6 +113,50 @@ def test_signoff_refuses_plainly(tmp_path, capsys, args, says):
     assert code == 2 and says in err and "Traceback" not in err
 
 
+def _edit(text: str, *pairs) -> str:
+    for old, new in pairs:
+        assert old in text
+        text = text.replace(old, new)
+    return text
+
+
+@pytest.mark.parametrize("edits, says", [
+    # a wheel and a passage of 1e-300 m: q_A divided by zero
+    ((("impeller_diameter = 0.3", "impeller_diameter = 1e-300"),
+      ("discharge_width = 0.02", "discharge_width = 1e-300")),
+     "stage[0].impeller_diameter: expected a value >= 0.01"),
+    # within every key's bounds, a q_A whose sweep no support can be given
+    ((("impeller_diameter = 0.3", "impeller_diameter = 0.01"),
+      ("discharge_width = 0.02", "discharge_width = 1e-4"), ("power = 8000.0", "power = 1e8"),
+      ("suction_density = 10.0", "suction_density = 1e-6"),
+      ("discharge_density = 15.0", "discharge_density = 2000.0")),
+     "stage at 0.2 m: q_A = 1.91e+21 N/m"),
+    # a compressor stage whose densities are swapped: Q_A 0.44× the right way round
+    ((("suction_density = 10.0", "suction_density = 20.0"),),
+     "stage[0]: discharge_density 15 kg/m³ below suction_density 20 kg/m³"),
+    # the stage on a disk name two disks carry
+    ((("[[stage]]\nposition = 0.2", "[[disk]]\nname = \"wheel\"\nposition = 0.1\nmass = 1.0\n"
+       "Ip = 0.01\nId = 0.005\n[[disk]]\nname = \"wheel\"\nposition = 0.3\nmass = 1.0\n"
+       "Ip = 0.01\nId = 0.005\n[[stage]]\ndisk = \"wheel\""),),
+     "stage[0].disk: 'wheel' names 2 disks"),
+    # a rotor on one support: its journal load was a singular solve's
+    ((("[[spring]]\nname = \"right\"", "[[seal]]\nname = \"right\""),
+      ("kxx = 50000000.0\nkyy = 50000000.0\ncxx = 10000.0\ncyy = 10000.0\n[[stage]]",
+       "K = { at_zero = 0.0, per_bar = 0.0 }\n[[stage]]")),
+     "need the rotor held at two bearings at least"),
+])
+def test_signoffs_held_out_probes_are_refused_by_name(tmp_path, capsys, edits, says):
+    """Inputs a new user tried, each answered with exit status 2 and one line naming the
+    key or what is missing, where they gave a ZeroDivisionError or a pydantic traceback
+    or a silently wrong Q_A or journal load."""
+    rig = tmp_path / "probe.toml"
+    rig.write_text(_edit(_rigid_rotor(1e8, 2.0e4, 8.0e3), *edits))
+    code = main(["--quiet", "signoff", str(rig), "--out", str(tmp_path / "so")])
+    err = capsys.readouterr().err
+    assert code == 2 and says in err and "Traceback" not in err, err
+    assert len(err.strip().splitlines()) == 1, err
+
+
 def test_the_reports_signoff_section_says_the_verdict_first(tmp_path):
     """The run report's section: the overall verdict before the table, one row per
     controller and criterion with its source; the Level II table; both figures."""

@@ -59,7 +59,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ambseal.analysis.campbell import modes_as_run, track_modes
-from ambseal.config import Spring
+from ambseal.config import MAX_SUPPORT_STIFFNESS, Spring
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
 from ambseal.model import bending_limit_hz, build_plant
@@ -205,12 +205,28 @@ def stage_cross_coupling(stage, kind: str, speed_rad_s: float) -> float:
         raise ConfigError(f"API 617 Level I: the maximum continuous speed must be > 0, got "
                           f"{speed_rad_s:g} rad/s")
     torque = stage.power / speed_rad_s
-    area = stage.impeller_diameter * stage.discharge_width
     if kind == "compressor":
-        return B_COMPRESSOR * torque * (stage.discharge_density / stage.suction_density) / area
-    if kind == "turbine":
-        return B_TURBINE * torque / area
-    raise ConfigError(f"machine.kind: expected 'compressor' or 'turbine', got {kind!r}")
+        q = (B_COMPRESSOR * torque * (stage.discharge_density / stage.suction_density)
+             / stage.impeller_diameter / stage.discharge_width)
+    elif kind == "turbine":
+        q = B_TURBINE * torque / stage.impeller_diameter / stage.discharge_width
+    else:
+        raise ConfigError(f"machine.kind: expected 'compressor' or 'turbine', got {kind!r}")
+    # the screening sweeps to RATIO_FREE·Q_A and applies it as a support's k_xy
+    if not (math.isfinite(q) and RATIO_FREE * q <= MAX_SUPPORT_STIFFNESS):
+        raise ConfigError(
+            f"stage {_stage_label(stage)}: q_A = {q:.4g} N/m from "
+            f"power {stage.power:g} W at {speed_rad_s:g} rad/s, impeller_diameter "
+            f"{stage.impeller_diameter:g} m, discharge_width {stage.discharge_width:g} m "
+            f"and the densities; API 617 Level I sweeps to {RATIO_FREE:g}·Q_A, which must "
+            f"stay below {MAX_SUPPORT_STIFFNESS:g} N/m: check these keys")
+    return q
+
+
+def _stage_label(st) -> str:
+    """A stage in words: its name, its disk, or where it sits."""
+    return (repr(st.name) if st.name else f"on disk {st.disk!r}" if st.disk
+            else f"at {st.position:g} m")
 
 
 def stage_position(cfg, st) -> float:
@@ -354,6 +370,11 @@ def level1_screening(cfg, controller=None, *, name: str = "none", points: int = 
     q = [stage_cross_coupling(st, cfg.machine.kind, 2 * math.pi * speed_hz)
          for st in cfg.stage]
     Q_A = float(sum(q))
+    if not q_max_factor * Q_A <= MAX_SUPPORT_STIFFNESS:
+        raise ConfigError(f"API 617 Level I: Q_A = {Q_A:.4g} N/m over the stages; the sweep "
+                          f"to {q_max_factor:g}·Q_A must stay below {MAX_SUPPORT_STIFFNESS:g}"
+                          " N/m: check the stages' power, impeller_diameter, discharge_width "
+                          "and densities")
     where = _applied_at(cfg, q)
     max_hz = bending_limit_hz(cfg)
     if controller is not None and cfg.amb:  # the sampled loop's modes: below Nyquist

@@ -36,7 +36,7 @@ from ambseal.analysis.campbell import AF_CRITICAL
 from ambseal.analysis.iso_vibration import iso14839_2_zones
 from ambseal.analysis.level1 import RATIO_FREE, RATIO_MIN, level1_screening
 from ambseal.analysis.level2 import level2_analysis
-from ambseal.analysis.unbalance_api617 import api617_unbalance
+from ambseal.analysis.unbalance_api617 import api617_unbalance, journal_loads
 
 __all__ = ["Criterion", "SignOff", "sign_off", "verdict_line", "critical_speeds_hz", "CLAUSES",
            "CRITICAL_SAME"]
@@ -244,9 +244,11 @@ def sign_off(cfg, controller=None, *, name: str = "none", progress=None) -> Sign
     Raises
     ------
     ConfigError
-        No ``[[stage]]``, no support, a maximum continuous speed of 0 or a continuous
-        controller.
+        No ``[[stage]]``, fewer than two supports or supports that do not hold the rotor,
+        a maximum continuous speed of 0, a stage whose q_A no support can carry, or a
+        continuous controller.
     """
+    journal_loads(cfg)  # a rotor its supports cannot hold is refused before the analyses
     l1 = level1_screening(cfg, controller, name=name, progress=progress)
     l2 = level2_analysis(cfg, controller, name=name, progress=progress)
     unb = api617_unbalance(cfg, controller, name=name, progress=progress)

@@ -166,9 +166,15 @@ def journal_loads(cfg) -> tuple[tuple[float, float], ...]:
     Raises
     ------
     ConfigError
-        A rig without a bearing, or whose bearings carry no load.
+        A rig without a bearing, or whose bearings carry no load, or do not hold the
+        rotor's weight (one support: nothing takes its moment).
     """
     zs = bearing_positions(cfg)
+    if len(set(zs)) < 2:
+        raise ConfigError(f"API 617 unbalance response: the journal static loads need the "
+                          f"rotor held at two bearings at least, got {len(set(zs))} "
+                          "([[amb]] or [[spring]] positions): on one, nothing takes the "
+                          "weight's moment")
     pins = [Spring(position=z, kxx=RIGID_SUPPORT, kyy=RIGID_SUPPORT, name=f"pin{i}")
             for i, z in enumerate(zs)] if cfg.amb else []
     rig = cfg.model_copy(update={"seal": [], "amb": [], "spring": [*cfg.spring, *pins]})
@@ -194,6 +200,12 @@ def journal_loads(cfg) -> tuple[tuple[float, float], ...]:
     if not sum(w for _, w in loads) > 0:
         raise ConfigError("API 617 unbalance response: the bearings carry no static load "
                           "(a rotor without mass?)")
+    mass = float(t @ sys.M @ t)
+    held = sum(force.values()) / GRAVITY
+    if not abs(held - mass) <= 1e-3 * mass:
+        raise ConfigError(f"API 617 unbalance response: the bearings hold {held:.4g} kg of "
+                          f"the rotor's {mass:.4g} kg: its supports do not carry it "
+                          "statically (check the [[spring]] stiffnesses and positions)")
     return loads
 
 

@@ -186,6 +186,17 @@ def cross_check(cfg, where: str) -> None:
             known = ", ".join(sorted(disks)) or "no named disk"
             raise ConfigError(f"{where}: stage[{i}].disk: unknown disk {st.disk!r} "
                               f"(expected one of: {known})")
+        elif sum(d.name == st.disk for d in cfg.disk) > 1:
+            raise ConfigError(f"{where}: stage[{i}].disk: {st.disk!r} names "
+                              f"{sum(d.name == st.disk for d in cfg.disk)} disks; give "
+                              "them distinct names, or the stage its position (m)")
+        # a compressor raises the gas density; API 617's q_A takes the ratio
+        if cfg.machine.kind == "compressor" and st.discharge_density < st.suction_density:
+            raise ConfigError(f"{where}: stage[{i}]: discharge_density "
+                              f"{st.discharge_density:g} kg/m³ below suction_density "
+                              f"{st.suction_density:g} kg/m³: a compressor stage raises the "
+                              "density (swapped? for an expander set [machine] kind = "
+                              "\"turbine\")")
     n_elements = sum(s.elements for s in cfg.shaft)
     if n_elements > MAX_ELEMENTS:
         raise ConfigError(

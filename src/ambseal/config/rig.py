@@ -506,13 +506,14 @@ class Stage(_Strict):
     name: Label | None = None
     position: float | None = Field(default=None, ge=0)
     disk: Label | None = None
-    # a single stage of a large compressor train or turbine: up to 100 MW
+    # a single stage of a large compressor train or turbine: up to 100 MW; a micro-turbine's
+    # 10 mm wheel with a 0.1 mm passage at the small end
     power: float = Field(gt=0, le=1e8)
-    impeller_diameter: float = Field(gt=0, le=5.0)
-    discharge_width: float = Field(gt=0, le=1.0)
-    # from vacuum service to dense CO2 and liquids at the limit
-    suction_density: float = Field(gt=0, le=2000.0)
-    discharge_density: float = Field(gt=0, le=2000.0)
+    impeller_diameter: float = Field(ge=1e-2, le=5.0)
+    discharge_width: float = Field(ge=1e-4, le=1.0)
+    # from vacuum service (1e-6 kg/m³) to dense CO2 and liquids at the limit
+    suction_density: float = Field(ge=1e-6, le=2000.0)
+    discharge_density: float = Field(ge=1e-6, le=2000.0)
 
     @model_validator(mode="after")
     def _where(self) -> "Stage":

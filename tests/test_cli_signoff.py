@@ -99,18 +99,42 @@ def test_criteria_not_evaluated_are_not_graded_and_the_verdict_says_so(tmp_path,
     assert "none: vibration zone: not graded — no [[amb]] backup_clearance given" in lines[6]
 
 
-@pytest.mark.parametrize("args, says", [
-    ([], "[[stage]]"), (["--method", "lqr"], "--method"),
-])
-def test_signoff_refuses_plainly(tmp_path, capsys, args, says):
+def test_signoff_refuses_plainly(tmp_path, capsys):
     rig = tmp_path / "rigid.toml"
-    text = _rigid_rotor(1e7, 2000.0, 8.0e3)
-    if not args:
-        text = text.split("[[stage]]")[0] + "[operating]\nspeed_rpm = 3000.0\n"
-    rig.write_text(text)
-    code = main(["signoff", str(rig), "--out", str(tmp_path / "so"), *args])
+    rig.write_text(_rigid_rotor(1e7, 2000.0, 8.0e3))
+    code = main(["signoff", str(rig), "--out", str(tmp_path / "so"), "--method", "lqr"])
     err = capsys.readouterr().err
-    assert code == 2 and says in err and "Traceback" not in err
+    assert code == 2 and "--method" in err and "Traceback" not in err
+
+
+def test_a_machine_without_stages_is_signed_off_on_its_own_sources(tmp_path, capsys):
+    """A rotor without [[stage]] (a flywheel, a motor, a pump) was refused; API 617's
+    Level I (an impeller's anticipated cross-coupling) does not apply, and says so, not
+    graded; Level II, on the rig's own sources (none here: the rotor on its supports),
+    decides; the unbalance response is judged. The rotor on stiff damped supports passes:
+    its forward mode's δ by hand, m s² + c s + k = 0, δ = 2π ζ/√(1 − ζ²) with
+    ζ = c/(2√(k m)), within 2 %; no level1.png is written."""
+    rig = tmp_path / "nostage.toml"
+    rig.write_text(_rigid_rotor(1e8, 2.0e4, 8.0e3).split("[[stage]]")[0]
+                   + "[operating]\nspeed_rpm = 3000.0\n")
+    code = main(["signoff", str(rig), "--json", "--out", str(tmp_path / "so")])
+    out, err = capsys.readouterr()
+    assert code == 0 and "Traceback" not in err
+    doc = json.loads(out)
+    block = doc["controllers"]["none"]
+    assert block["level1"] is None
+    crit = {c["criterion"]: c for c in block["criteria"]}
+    assert crit["stability, Level I"]["outcome"] == "not graded"
+    assert crit["stability, Level I"]["value"].startswith("not applicable: no [[stage]]")
+    assert crit["stability, Level II"]["outcome"] == "passed"
+    assert [r["component"] for r in block["level2"]["table"]] == ["rotor and supports",
+                                                                  "all sources"]
+    m = math.pi / 4 * 0.2**2 * 0.4 * 7850.0
+    zeta = 2.0e4 / (2 * math.sqrt(1e8 * m))
+    assert block["level2"]["log_dec"] == pytest.approx(
+        2 * math.pi * zeta / math.sqrt(1 - zeta**2), rel=0.02)
+    assert crit["vibration at the probes"]["outcome"] == "passed"
+    assert not (tmp_path / "so" / "level1.png").exists()
 
 
 def _edit(text: str, *pairs) -> str:

@@ -20,7 +20,8 @@ mode the sources act on. The forward modes of the loop without sources are follo
 the loop with every source (by nearest eigenvalue,
 :func:`ambseal.analysis.campbell.track_modes`); the screened one is the least damped
 with every source among those the sources take damping from (more than
-:data:`LOST_SHARE` of their δ), or the least damped of all if they take none. Each row
+:data:`LOST_SHARE` of their δ), or, if they take none (a machine without sources), the
+lowest forward mode. Each row
 reports that mode, followed from the loop without sources. A bending mode the sources
 leave alone, with a structural δ of a few hundredths, is not what Level II judges; a
 mode they leave at δ 0.06 is. A row's loop is unstable where a pole within the band of
@@ -114,8 +115,8 @@ class Level2:
 def _screened(base, last) -> int | None:
     """The mode of ``base`` (the rotor on its supports) the sources act on: of the forward
     modes followed from ``base`` to ``last`` (every source), the least damped in ``last``
-    among those the sources take damping from; if they take none, the least damped in
-    ``last``. None without a forward mode."""
+    among those the sources take damping from; if they take none (or there are none),
+    the lowest forward mode, API 617's first. None without a forward mode."""
     tr = track_modes([base, last])
     # forward with every source: without them an isotropic rotor's forward and backward
     # whirl coincide, and their shapes there say nothing
@@ -126,7 +127,10 @@ def _screened(base, last) -> int | None:
     d0 = {j: base.log_decrement[tr[0, j]] for j in lines}
     d1 = {j: last.log_decrement[tr[1, j]] for j in lines}
     hit = [j for j in lines if d1[j] < d0[j] - LOST_SHARE * abs(d0[j])]
-    j = min(hit or lines, key=lambda i: d1[i])
+    if hit:
+        j = min(hit, key=lambda i: d1[i])
+    else:  # no source acts (none, or none takes damping): API 617's first forward mode
+        j = min(lines, key=lambda i: last.frequency_hz[tr[1, i]])
     return int(tr[0, j])
 
 
@@ -153,7 +157,8 @@ def level2_analysis(cfg, controller=None, *, name: str = "none",
     Parameters
     ----------
     cfg : RigConfig
-        The rig with its ``[[stage]]`` tables (and seals).
+        The rig with its ``[[stage]]`` tables (and seals); without stages (a flywheel, a
+        motor, a pump) the rows leave out Q_A, the seals are every source.
     controller : DigitalController or ScheduledDigital, optional
         As it runs; None for a rig on springs alone.
     name : str
@@ -170,11 +175,8 @@ def level2_analysis(cfg, controller=None, *, name: str = "none",
     Raises
     ------
     ConfigError
-        No ``[[stage]]`` or a maximum continuous speed of 0.
+        A maximum continuous speed of 0.
     """
-    if not cfg.stage:
-        raise ConfigError("API 617 Level II needs the machine's stages: add a [[stage]] per "
-                          "impeller")
     speed_hz = cfg.operating.continuous_hz[1]
     if not speed_hz > 0:
         raise ConfigError("API 617 Level II: the maximum continuous speed must be > 0")
@@ -189,7 +191,8 @@ def level2_analysis(cfg, controller=None, *, name: str = "none",
                 (st, stage_cross_coupling(st, cfg.machine.kind, omega)) for st in cfg.stage)]
     variants = [("rotor and supports", {"seal": []})]
     variants += [(f"+ seal {s.name}", {"seal": [s]}) for s in cfg.seal]
-    variants += [("+ Q_A at the stages", {"seal": [], "spring": [*cfg.spring, *aero]})]
+    if aero:  # a machine without stages (a flywheel, a motor, a pump) has no Q_A
+        variants += [("+ Q_A at the stages", {"seal": [], "spring": [*cfg.spring, *aero]})]
     variants += [("all sources", {"spring": [*cfg.spring, *aero]})]
     loops = [modes_as_run(cfg.model_copy(update=update), controller, speed_hz=speed_hz,
                           max_hz=max_hz, pressure_bar=p) for _, update in variants]

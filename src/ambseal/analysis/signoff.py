@@ -14,6 +14,9 @@ close clearances              S_c·response ≤ 75 % of the clearance        API
 vibration zone                zone A or B at every AMB sensor             ISO 14839-2:2004
 ============================  ==========================================  ==============
 
+A machine without ``[[stage]]`` (a flywheel, a motor, a pump without an aerodynamic
+cross-coupling of its own) has no Level I; its Level II, on the rig's own sources (its
+seals), decides, and the unbalance response and ISO 14839-2 are judged as for any other.
 The stability holds when Level I passes and the loop with every source is stable, or,
 where Level I asks for it, Level II passes: a machine whose loop with every source is
 unstable at the maximum continuous speed is never signed off, whichever level found it
@@ -92,7 +95,8 @@ class SignOff:
     Attributes
     ----------
     controller : str
-    level1 : ambseal.analysis.level1.Level1
+    level1 : ambseal.analysis.level1.Level1 or None
+        None for a machine without ``[[stage]]`` (Level I does not apply).
     level2 : ambseal.analysis.level2.Level2
     unbalance : ambseal.analysis.unbalance_api617.Api617Unbalance
     iso14839_2 : ambseal.analysis.iso_vibration.IsoVibration
@@ -117,7 +121,8 @@ class SignOff:
     def to_dict(self) -> dict:
         """The controller's sign-off block: ``passed``, ``criteria`` and each analysis."""
         return {"passed": self.passed, "criteria": [c.to_dict() for c in self.criteria],
-                "level1": self.level1.to_dict(), "level2": self.level2.to_dict(),
+                "level1": None if self.level1 is None else self.level1.to_dict(),
+                "level2": self.level2.to_dict(),
                 "unbalance": self.unbalance.to_dict(),
                 "iso14839_2": self.iso14839_2.to_dict()}
 
@@ -153,18 +158,25 @@ def critical_speeds_hz(criticals) -> list[float]:
 
 def _criteria(cfg, l1, l2, unb, iso) -> tuple:
     d_min = cfg.signoff.log_dec_min
-    q0 = "none up to 10·Q_A" if l1.Q_0 is None else f"Q_0/Q_A = {l1.ratio:.3g}"
-    rows = [Criterion("stability, Level I",
-                      f"δ_A = {l1.log_dec_A:.3g}, {q0}, CSR {l1.csr:.3g} (Region "
-                      f"{l1.region})",
-                      f"δ_A ≥ {d_min:g}, Q_0/Q_A ≥ {RATIO_MIN:g}; ≥ {RATIO_FREE:g} or "
-                      "Region A", CLAUSES["level1"], l1.passed, counts=l1.passed)]
+    limit1 = f"δ_A ≥ {d_min:g}, Q_0/Q_A ≥ {RATIO_MIN:g}; ≥ {RATIO_FREE:g} or Region A"
+    if l1 is None:  # API 617's anticipated cross-coupling is an impeller's or a stage's
+        rows = [Criterion("stability, Level I", "not applicable: no [[stage]] (no "
+                          "impeller or stage whose anticipated cross-coupling to screen); "
+                          "Level II decides with the rig's own sources", limit1,
+                          CLAUSES["level1"], False, counts=False, graded=False)]
+    else:
+        q0 = "none up to 10·Q_A" if l1.Q_0 is None else f"Q_0/Q_A = {l1.ratio:.3g}"
+        rows = [Criterion("stability, Level I",
+                          f"δ_A = {l1.log_dec_A:.3g}, {q0}, CSR {l1.csr:.3g} (Region "
+                          f"{l1.region})", limit1, CLAUSES["level1"], l1.passed,
+                          counts=l1.passed)]
+    passed1 = l1 is not None and l1.passed
     last = l2.rows[-1]
     rows.append(Criterion("stability, Level II",
                           f"δ = {last.log_dec:.3g} at {last.frequency_hz:.4g} Hz"
                           + ("" if last.stable else ", loop UNSTABLE"),
                           f"δ ≥ {d_min:g} with every source", CLAUSES["level2"], l2.passed,
-                          counts=not (l1.passed and last.stable)))
+                          counts=not (passed1 and last.stable)))
     if not unb.loop_stable:  # no steady unbalance response on an unstable loop
         why = (f"the loop with the seals at {cfg.operating.pressure_bar:g} bar is unstable "
                f"at {unb.max_hz:.4g} Hz: no steady unbalance response")
@@ -229,7 +241,9 @@ def sign_off(cfg, controller=None, *, name: str = "none", progress=None) -> Sign
     Parameters
     ----------
     cfg : RigConfig
-        The rig with its ``[[stage]]`` tables, ``[operating]`` speeds and ``[signoff]``.
+        The rig with its ``[[stage]]`` tables (without them Level I is not applicable and
+        Level II decides on the rig's own sources), ``[operating]`` speeds and
+        ``[signoff]``.
     controller : DigitalController or ScheduledDigital, optional
         As it runs; None for a rig on springs alone.
     name : str
@@ -244,12 +258,13 @@ def sign_off(cfg, controller=None, *, name: str = "none", progress=None) -> Sign
     Raises
     ------
     ConfigError
-        No ``[[stage]]``, fewer than two supports or supports that do not hold the rotor,
+        Fewer than two supports or supports that do not hold the rotor,
         a maximum continuous speed of 0, a stage whose q_A no support can carry, or a
         continuous controller.
     """
     journal_loads(cfg)  # a rotor its supports cannot hold is refused before the analyses
-    l1 = level1_screening(cfg, controller, name=name, progress=progress)
+    l1 = (level1_screening(cfg, controller, name=name, progress=progress) if cfg.stage
+          else None)
     l2 = level2_analysis(cfg, controller, name=name, progress=progress)
     unb = api617_unbalance(cfg, controller, name=name, progress=progress)
     iso = iso14839_2_zones(cfg, unb)
@@ -271,7 +286,8 @@ def verdict_line(results) -> str:
         <controller>: <criteria>; …``.
     """
     if all(r.passed for r in results):
-        left = sorted({c.name for r in results for c in r.criteria if not c.graded})
+        left = list(dict.fromkeys(c.name for r in results for c in r.criteria
+                                  if not c.graded))
         return ("Sign-off PASSED: every controller meets API 617 (stability, unbalance "
                 "response) and ISO 14839-2" + (f" (not graded: {', '.join(left)})"
                                                if left else ""))

@@ -216,3 +216,24 @@ def test_a_critical_seen_at_two_probes_and_two_placements_is_counted_once():
     seen = [SimpleNamespace(speed_hz=f) for f in (250.0, 100.0, 100.4, 251.0, 100.2, 99.8)]
     assert critical_speeds_hz(seen) == pytest.approx([100.1, 250.5])
     assert critical_speeds_hz([]) == []
+
+
+def test_signoff_into_a_runs_folder_is_refused(terminal_run, tmp_path, capsys):
+    """`ambseal run R --out D` then `ambseal signoff R --out D` replaced the run's
+    level1.png and api617_unbalance.png by the sign-off's while metrics.json and
+    report.html still described the run's: refused, by name, with nothing changed."""
+    import hashlib
+    import shutil
+
+    from ambseal.config import default_rig_path
+
+    run = tmp_path / "run"
+    shutil.copytree(terminal_run[0], run)
+    before = {p.name: hashlib.sha256(p.read_bytes()).hexdigest()
+              for p in run.iterdir() if p.is_file()}
+    code = main(["--quiet", "signoff", str(default_rig_path()), "--out", str(run)])
+    err = capsys.readouterr().err
+    assert code == 2 and "holds the results of `ambseal run`" in err, err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert before == {p.name: hashlib.sha256(p.read_bytes()).hexdigest()
+                      for p in run.iterdir() if p.is_file()}

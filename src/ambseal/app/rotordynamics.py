@@ -228,8 +228,19 @@ def _signoff_controllers(cfg, args) -> list[tuple[str, object]]:
     return out
 
 
-@_owns_out
 def _signoff(args: argparse.Namespace) -> int:
+    if (Path(args.out) / "metrics.json").is_file():  # before the folder is claimed
+        # the run's report and metrics describe its own level1.png and api617_unbalance.png
+        raise ConfigError(f"--out {args.out}: holds the results of `ambseal run` "
+                          "(metrics.json), whose report describes the level1.png and "
+                          "api617_unbalance.png a sign-off would replace; sign off into "
+                          "another folder (the run signs its delivered controllers off "
+                          "itself)")
+    return _signoff_into(args)
+
+
+@_owns_out
+def _signoff_into(args: argparse.Namespace) -> int:
     cfg = load_rig(args.rig)
     say = logging.getLogger("ambseal").info
     results = [sign_off(cfg, K, name=name, progress=say)

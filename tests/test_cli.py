@@ -6,6 +6,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from ambseal.cli import main
@@ -345,3 +346,26 @@ def test_tracked_without_a_pressure_driven_seal_k_exits_2_with_one_line(capsys):
                  "design.tracked=true"]) == 2
     err = capsys.readouterr().err.strip()
     assert "design.tracked" in err and "per_bar" in err and "\n" not in err
+
+
+def test_validate_takes_a_rotor_on_plain_bearings(tmp_path, capsys):
+    """ROSS's ``rotor_example`` as ``import-ross`` writes it (two plain bearings, no AMB):
+    ``validate`` exited 2 ("controller.pid: cannot be derived") where ``modes`` and
+    ``signoff`` work on it. Its modes, with no controller to design or judge: no judged
+    condition, no judgement; the same first natural frequencies as ``modes`` lists."""
+    from ambseal.io import import_ross_file
+
+    src = Path(__file__).resolve().parent / "data" / "ross_rotor_example.toml"
+    rig = tmp_path / "plain.toml"
+    import_ross_file(src, rig)
+    assert main(["validate", str(rig), "--json"]) == 0
+    v = json.loads(capsys.readouterr().out)
+    assert v["axes"] == [] and v["defaults"]["judged_conditions"] == []
+    assert v["defaults"]["judgement"] is None and v["defaults"]["pid"] is None
+    assert main(["modes", str(rig), "--json"]) == 0
+    m = json.loads(capsys.readouterr().out)
+    first = [f for f, _ in v["modes"]][:2]
+    np.testing.assert_allclose(first, m["natural_frequencies_hz"][:2], rtol=1e-9)
+    assert main(["validate", str(rig)]) == 0
+    out = capsys.readouterr().out
+    assert "AMB axes none" in out and "judged_conditions: none (no AMB" in out

@@ -618,7 +618,8 @@ def validate_summary(rig: str | Path | None = None) -> dict:
     of the full model at the nominal condition below the controller's Nyquist frequency
     (``modes_below_hz``, ``modes`` as [f_Hz, ζ]); ``unstable_poles`` ([Re, Im] rad/s); and
     ``defaults``: the reduced model's order, the judged conditions, the controller's sample
-    rate, the reference PID and the judgement's grids and disturbances.
+    rate, the reference PID and the judgement's grids and disturbances (on a rig without
+    AMBs none: no controller to design or judge).
 
     Raises
     ------
@@ -627,7 +628,9 @@ def validate_summary(rig: str | Path | None = None) -> dict:
     """
 
     cfg = load_rig(rig)
-    spec = design_spec(cfg)
+    # a rig without AMBs (a rotor on plain bearings, as import-ross writes it) has no
+    # controller to design or judge: its modes, model and sign-off still are
+    spec = design_spec(cfg) if cfg.amb else None
     limit = cfg.controller.sample_rate_hz / 2
     res = modes(build_system(cfg))
     rows = [[f, z] for f, z in zip(res.natural_frequencies_hz, res.damping_ratios) if f < limit]
@@ -640,12 +643,12 @@ def validate_summary(rig: str | Path | None = None) -> dict:
         "unstable_poles": [list(p) for p in res.unstable_poles],
         "defaults": {
             "reduced_states": build_plant(cfg, reduced=True).n_states,
-            "judged_conditions": [p.label for p in operating_points(spec)],
+            "judged_conditions": [p.label for p in operating_points(spec)] if spec else [],
             "nominal_pressure_bar": cfg.operating.pressure_bar,
             "nominal_speed_rpm": cfg.operating.speed_rpm,
             "controller_sample_rate_hz": cfg.controller.sample_rate_hz,
             "pid": None if pid is None else pid.model_dump(),
-            "judgement": asdict(judge_settings(spec)),
+            "judgement": asdict(judge_settings(spec)) if spec else None,
         },
     }
 

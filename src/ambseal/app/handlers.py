@@ -243,7 +243,7 @@ def _validate(args: argparse.Namespace) -> int:
         return 0
     print(f"{v['rig']}: valid — {v['name']}")
     print(f"  rotor mass {v['mass_kg']:.4g} kg, {v['nodes']} nodes, AMB axes "
-          f"{', '.join(v['axes'])}")
+          f"{', '.join(v['axes']) or 'none'}")
     print(f"  modes below {v['modes_below_hz']:g} Hz (controller Nyquist): "
           + ", ".join(f"{f:.4g} Hz (ζ {z:.3g})" for f, z in v["modes"]))
     poles = v["unstable_poles"]
@@ -251,6 +251,8 @@ def _validate(args: argparse.Namespace) -> int:
           + (": " + ", ".join(f"{re:.4g}{im:+.4g}j rad/s" for re, im in poles) if poles else ""))
     print("  defaults a run takes:")
     for key, val in v["defaults"].items():
+        if key == "judged_conditions" and not val:
+            val = "none (no AMB: no controller to design or judge)"
         print(f"    {key}: {_plain(val)}")
     return 0
 

@@ -232,6 +232,9 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "SpringHousing.cxy": ("N·s/m", "cross-coupled support damping"),
     "SpringHousing.cyx": ("N·s/m", "cross-coupled support damping"),
     "Spring.name": ("", "names its parameters (``coupling.kxx``); unnamed: ``spring<i>``"),
+    "Spring.kind": ("", "``bearing`` (default) or ``seal``: a seal whose coefficients have "
+                        "no Childs form (kxy = kyx); the sign-off treats it as a seal — a "
+                        "source, left out of Level I, no bearing, no journal load, no probe"),
     "Spring.uncertainty": ("", "``{ key = σ }``: relative 1σ uncertainty of a value the fit "
                                "holds fixed"),
     # [controller], [controller.pid]

@@ -213,9 +213,11 @@ def test_level1_screens_the_first_forward_mode_not_the_mesh_modes(tmp_path):
     kHz) are lossless, so the loop without cross-coupling is not asymptotically stable by
     ambseal's rule — the screening was "lost at Q = 0". API 617 screens the first forward
     mode the cross-coupling acts on: the mesh modes are reported apart, the screened
-    mode at Q = 0 is the rotor's 162.48 Hz mode with δ 0.86129 — ROSS 3.1's ``run_modal``
-    of the same rotor without its labyrinth seals at 4 000 rpm gives 162.480869 Hz and
-    δ 0.861292 (measured beside ambseal, stored here) — and Q_0 lies beyond Q_A."""
+    mode at Q = 0 is the rotor's 103.43 Hz mode on its two bearings (its seals left out,
+    the balance piston among them) — ROSS 3.1's ``run_modal`` of the same rotor on
+    Bearing 0 and Bearing 13 alone at 4 000 rpm gives 103.429084 Hz and δ 0.464951
+    (measured beside ambseal, stored here) — and Q_0, where that mode loses its damping,
+    is found (0.64·Q_A with these stages)."""
     from pathlib import Path
 
     from ambseal.config import load_rig
@@ -229,9 +231,42 @@ def test_level1_screens_the_first_forward_mode_not_the_mesh_modes(tmp_path):
         f"discharge_width = 0.012\nsuction_density = {10.0 + 2 * i}\n"
         f"discharge_density = {12.0 + 2 * i}\n" for i in range(1, 7)) + "\n[machine]", 1))
     r = level1_screening(load_rig(rig), None)
-    assert r.frequency_hz[0] == pytest.approx(162.480869, rel=1e-5)
-    assert r.log_dec[0] == pytest.approx(0.861292, rel=1e-4)
-    assert r.Q_0 is not None and r.Q_0 > r.Q_A and r.converged
+    assert r.frequency_hz[0] == pytest.approx(103.429084, rel=1e-5)
+    assert r.log_dec[0] == pytest.approx(0.464951, rel=1e-4)
+    assert r.Q_0 is not None and r.Q_0 > 0 and r.converged  # not lost at Q = 0
     for mesh_hz in (62.79e3, 105.7e3):  # two of the lossless mesh modes
         assert any(abs(f / mesh_hz - 1) < 2e-3 for f in r.apart_hz), r.apart_hz
     assert "not screened" in r.rule
+
+
+def test_a_seal_given_as_a_spring_is_no_bearing(tmp_path):
+    """ROSS's ``compressor_example`` has a balance-piston seal (``SealElement`` "Seal 1",
+    kxy = kyx: no Childs form) that ``import-ross`` writes as a ``[[spring]]``; it was
+    pinned for the CSR, given a journal load and made a probe. As ``kind = "seal"`` it is
+    none of those: the journal loads are the two-support statics of ROSS 2.3's own mass
+    and centre of mass (246.870 kg at 0.82764 m; bearings at 0.2355 and 1.4255 m),
+    W_A = m (z_B − z_G)/(z_B − z_A), to 1e-4, and Level II lists the seal as a source."""
+    from pathlib import Path
+
+    from ambseal.analysis.level1 import bearing_positions
+    from ambseal.analysis.level2 import level2_analysis
+    from ambseal.analysis.unbalance_api617 import journal_loads
+    from ambseal.config import load_rig
+    from ambseal.io import import_ross_file
+
+    src = Path(__file__).resolve().parents[1] / "data" / "ross_compressor_example.toml"
+    rig = tmp_path / "compressor.toml"
+    import_ross_file(src, rig)
+    cfg = load_rig(rig)
+    seals = [s for s in cfg.spring if s.kind == "seal"]
+    assert len(seals) == 1 and seals[0].kxy == pytest.approx(seals[0].kyx)
+    assert bearing_positions(cfg) == pytest.approx([0.2355, 1.4255])
+    m, zg, (za, zb) = 246.87036435603625, 0.8276413453580715, (0.2355, 1.4255)
+    loads = journal_loads(cfg)
+    assert [z for z, _ in loads] == pytest.approx([za, zb])
+    np.testing.assert_allclose([w for _, w in loads],
+                               [m * (zb - zg) / (zb - za), m * (zg - za) / (zb - za)],
+                               rtol=1e-4)
+    rows = [r.component for r in level2_analysis(cfg.model_copy(update={"stage": []}),
+                                                 None).rows]
+    assert f"+ seal {seals[0].name}" in rows and rows[0] == "rotor and supports"

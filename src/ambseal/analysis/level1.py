@@ -238,17 +238,26 @@ def stage_position(cfg, st) -> float:
 
 def bearing_positions(cfg) -> list[float]:
     """The bearings' positions (m, ascending): the AMBs (a spring beside them is a coupling
-    or a seal), or the springs of a rig without AMBs.
+    or a seal), or the springs of a rig without AMBs, but those of ``kind = "seal"``.
 
     Raises
     ------
     ConfigError
         A rig with neither.
     """
-    zs = sorted({a.position for a in cfg.amb} or {s.position for s in cfg.spring})
+    zs = sorted({a.position for a in cfg.amb}
+                or {s.position for s in cfg.spring if s.kind != "seal"})
     if not zs:
-        raise ConfigError("API 617: the rig has no [[amb]] or [[spring]] to carry the rotor")
+        raise ConfigError("API 617: the rig has no [[amb]] or [[spring]] (of kind "
+                          "\"bearing\") to carry the rotor")
     return zs
+
+
+def without_seals(cfg):
+    """The rig without its seals: its ``[[seal]]`` and its springs of ``kind = "seal"``
+    (API 617 Level I screens the rotor on its bearings alone)."""
+    return cfg.model_copy(update={"seal": [], "spring": [s for s in cfg.spring
+                                                         if s.kind != "seal"]})
 
 
 def _applied_at(cfg, q: list[float]) -> tuple:
@@ -269,7 +278,8 @@ def _with_cross_coupling(cfg, where, Q: float):
     ``k_yx = −wQ``."""
     springs = [Spring(position=z, kxx=0.0, kyy=0.0, kxy=w * Q, kyx=-w * Q,
                       name=f"api617_Q{i}") for i, (z, w) in enumerate(where)]
-    return cfg.model_copy(update={"seal": [], "spring": [*cfg.spring, *springs]})
+    bare = without_seals(cfg)
+    return bare.model_copy(update={"spring": [*bare.spring, *springs]})
 
 
 def _lines(points) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

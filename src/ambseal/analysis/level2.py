@@ -189,10 +189,13 @@ def level2_analysis(cfg, controller=None, *, name: str = "none",
                    name=f"api617_qA{i}")
             for i, (st, q) in enumerate(
                 (st, stage_cross_coupling(st, cfg.machine.kind, omega)) for st in cfg.stage)]
-    variants = [("rotor and supports", {"seal": []})]
-    variants += [(f"+ seal {s.name}", {"seal": [s]}) for s in cfg.seal]
+    bearings = [s for s in cfg.spring if s.kind != "seal"]  # a spring may be a seal
+    variants = [("rotor and supports", {"seal": [], "spring": bearings})]
+    variants += [(f"+ seal {s.name}", {"seal": [s], "spring": bearings}) for s in cfg.seal]
+    variants += [(f"+ seal {s.name or f'spring{i}'}", {"seal": [], "spring": [*bearings, s]})
+                 for i, s in enumerate(cfg.spring) if s.kind == "seal"]
     if aero:  # a machine without stages (a flywheel, a motor, a pump) has no Q_A
-        variants += [("+ Q_A at the stages", {"seal": [], "spring": [*cfg.spring, *aero]})]
+        variants += [("+ Q_A at the stages", {"seal": [], "spring": [*bearings, *aero]})]
     variants += [("all sources", {"spring": [*cfg.spring, *aero]})]
     loops = [modes_as_run(cfg.model_copy(update=update), controller, speed_hz=speed_hz,
                           max_hz=max_hz, pressure_bar=p) for _, update in variants]

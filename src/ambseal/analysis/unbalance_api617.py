@@ -177,7 +177,9 @@ def journal_loads(cfg) -> tuple[tuple[float, float], ...]:
                           "weight's moment")
     pins = [Spring(position=z, kxx=RIGID_SUPPORT, kyy=RIGID_SUPPORT, name=f"pin{i}")
             for i, z in enumerate(zs)] if cfg.amb else []
-    rig = cfg.model_copy(update={"seal": [], "amb": [], "spring": [*cfg.spring, *pins]})
+    # the bearings carry the weight: a seal (also one given as a spring) takes none
+    kept = [s for s in cfg.spring if s.kind != "seal"]
+    rig = cfg.model_copy(update={"seal": [], "amb": [], "spring": [*kept, *pins]})
     sys = build_system(rig, speed_rpm=0.0)
     t = np.zeros(sys.n_dof)
     t[1:sys.mesh.n_dof:4] = 1.0  # the rotor's weight (a housing's goes to its supports)
@@ -193,7 +195,7 @@ def journal_loads(cfg) -> tuple[tuple[float, float], ...]:
 
     force = {z: 0.0 for z in zs}
     # with AMBs, their pins (appended after the rig's springs) carry the journals
-    for i, s in list(enumerate(rig.spring))[len(cfg.spring) if cfg.amb else 0:]:
+    for i, s in list(enumerate(rig.spring))[len(kept) if cfg.amb else 0:]:
         if s.position in force:
             force[s.position] += s.kyy * stretch(s, i)
     loads = tuple((z, abs(force[z] / GRAVITY)) for z in zs)

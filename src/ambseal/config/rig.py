@@ -68,7 +68,9 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     hole-pattern seal's), ``axes_angle_deg`` (the axes the coefficients are given in,
     default 0), ``housing`` (optional ``{ mass, kxx, kyy, kxy, kyx, cxx, cyy, cxy, cyx }``
     in kg, N/m, N·s/m: the spring joins the shaft to this mass, which its own springs and
-    dampers hold to ground in x, y), ``name`` (optional).
+    dampers hold to ground in x, y), ``name`` (optional), ``kind`` (``"bearing"``, the
+    default, or ``"seal"``: a seal whose coefficients have no Childs form — the sign-off
+    then treats it as a seal, a source, never a bearing).
 ``[controller.pid]``
     ``kp`` (A/m), ``ti`` (s), ``td`` (s), ``eps`` (-): thesis P5 Eq. 6, per actuator axis;
     ``cross_kp`` (A/m) and ``cross_kd`` (A·s/m), default 0: cross-axis gains between the
@@ -493,6 +495,9 @@ class Spring(_Strict):
     housing: SpringHousing | None = None
     name: Name | None = None
     uncertainty: Uncertainty = None
+    # a seal whose coefficients have no Childs form (kxy = kyx, a balance piston's): the
+    # sign-off must not take it for a bearing
+    kind: Literal["bearing", "seal"] = "bearing"
 
 
 class Stage(_Strict):

@@ -49,7 +49,8 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
   evaluated by ambseal at the synchronous frequency as ROSS's ``run_modal`` does (ambseal
   interpolates linearly between the points, ROSS with a smoothing spline). Any other
   coefficients → ``[[spring]]`` (kxx, kyy, kxy, kyx, cxx, cyy, cxy, cyx, and the mass terms
-  mxx, myy, mxy, myx);
+  mxx, myy, mxy, myx), of ``kind = "seal"`` for ROSS's seals (``SealElement`` and its
+  kinds: the sign-off must not take a balance piston for a bearing);
   against frequency, ROSS's interpolant at one frequency: the synchronous frequency of the
   import speed (``speed_rpm``; by default the lowest frequency that every such table of
   ROSS's covers), written as ``[operating] speed_rpm`` and reported, so that ambseal's
@@ -435,6 +436,11 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
             rig["seal"].append(_seal(b, z, i, varies, omega))
             continue
         rig["spring"].append(_spring(b, z, i, varies, omega, notes))
+        if "Seal" in type(b).__name__:  # ROSS's SealElement and its kinds: a seal
+            rig["spring"][-1]["kind"] = "seal"
+            notes.append(f"bearing {i} ({b.tag}, node {b.n}): a seal ({type(b).__name__}) "
+                         "whose coefficients have no Childs form (kxx = kyy, kxy = −kyx): "
+                         "a [[spring]] of kind = \"seal\", never a bearing in the sign-off")
         if id(b) in linked:
             rig["spring"][-1]["housing"] = _housing(rotor, bearings, linked[id(b)])
         if varies:

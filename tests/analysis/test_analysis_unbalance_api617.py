@@ -219,3 +219,61 @@ def test_synchronous_force_is_the_force_law_at_the_actuator():
                     for v in amb_factors(next(b for b in cfg.amb if b.name == amb)))
         x = y[list(P.output_labels).index(f"y_{amb}_{ax}")]
         assert r.force_n[0, 0, a] == pytest.approx(abs(ki * he * coil[a] + ks * x), rel=5e-3)
+
+
+def test_exact_half_power_of_a_closed_form_resonance():
+    """A rotating unbalance on a single degree of freedom, X(r) = r²/|1 − r² + 2jζr|
+    (ζ = 0.5 %), swept at 241 points from standstill to 1.5× its natural frequency: the
+    peak and half-power points solved on X itself (scipy's root finders on the closed form
+    here) to 1e-6 — read off the sweep, AF was more than 1 % off."""
+    import numpy as np
+    from scipy.optimize import brentq, minimize_scalar
+
+    from ambseal.analysis.unbalance_api617 import exact_half_power
+
+    zeta = 0.005
+
+    def x(r):
+        return r**2 / abs(1 - r**2 + 2j * zeta * r)
+
+    r = np.linspace(0.0, 1.5, 241)
+    amp = np.array([x(v) for v in r])
+    i = int(np.argmax(amp))
+    pk = minimize_scalar(lambda v: -x(v), bounds=(0.9, 1.1), method="bounded",
+                         options={"xatol": 1e-12})
+    rc, xc = float(pk.x), -float(pk.fun)
+    n1 = brentq(lambda v: x(v) - xc / np.sqrt(2), 0.9, rc, xtol=1e-14)
+    n2 = brentq(lambda v: x(v) - xc / np.sqrt(2), rc, 1.1, xtol=1e-14)
+    nc, ac, af, m1, m2 = exact_half_power(x, r, amp, i)
+    np.testing.assert_allclose([nc, ac, af, m1, m2], [rc, xc, rc / (n2 - n1), n1, n2],
+                               rtol=1e-6)
+    sampled, _, _ = amplification_factor(r, amp, i)
+    assert abs(sampled / af - 1) > 1e-2
+
+
+def test_the_criticals_are_the_responses_own_peaks():
+    """The rigid rotor on lightly damped springs (c = 200 N·s/m, ζ 0.3 %): each critical
+    of the sign-off is the peak of the synchronous response solved on that response
+    (scipy's bounded Brent on the same case and probe, here), its amplitude and AF to
+    1e-6, not the sweep's sample."""
+    import numpy as np
+    from scipy.optimize import brentq, minimize_scalar
+
+    from ambseal.analysis import synchronous_response
+
+    cfg = parse_rig(tomllib.loads(_rigid_rotor(1e7, 200.0, 4.5e4)))
+    case = api617_unbalance(cfg).cases[0]
+    (crit,) = case.criticals
+
+    def x(f):
+        r = synchronous_response(cfg, None, [f], [case.unbalances], [crit.probe_m])
+        return 2e6 * float(r.amplitude_m[0, 0, 0])
+
+    f0 = crit.speed_hz
+    pk = minimize_scalar(lambda f: -x(f), bounds=(0.98 * f0, 1.02 * f0), method="bounded",
+                         options={"xatol": 1e-9 * f0})
+    fc, xc = float(pk.x), -float(pk.fun)
+    n1 = brentq(lambda f: x(f) - xc / np.sqrt(2), 0.9 * fc, fc, xtol=1e-10 * fc)
+    n2 = brentq(lambda f: x(f) - xc / np.sqrt(2), fc, 1.1 * fc, xtol=1e-10 * fc)
+    np.testing.assert_allclose([crit.speed_hz, crit.amplitude_um, crit.af],
+                               [fc, xc, fc / (n2 - n1)], rtol=1e-6)

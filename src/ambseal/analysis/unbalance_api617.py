@@ -32,7 +32,10 @@ stated):
 * **Criticals and margins.** A peak of a probe's response that rises at least 3 dB
   above its surroundings (its prominence ≥ 1 − 1/√2 of its height) is a critical speed
   N_c; its amplification factor by the half-power method ``AF = N_c / (N_2 − N_1)``, the
-  speeds where the response is 1/√2 of the peak (interpolated linearly). AF < 2.5: no
+  speeds where the response is 1/√2 of the peak. The peak and those speeds are solved on
+  the response itself, not read off the sweep (:func:`exact_half_power`: the peak by
+  Brent's method between its neighbours of the sweep, N_1 and N_2 by Brent's root finder
+  between the sweep's points that bracket them, each to 1e-9 of the speed). AF < 2.5: no
   separation margin is required. Else a critical below the minimum continuous speed
   needs ``SM = min(16, 17 (1 − 1/(AF − 1.5)))`` %, one above the maximum continuous
   speed ``SM = min(26, 10 + 17 (1 − 1/(AF − 1.5)))`` %; the actual margins are
@@ -55,6 +58,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import brentq, minimize_scalar
 from scipy.signal import find_peaks
 
 from ambseal.analysis.campbell import AF_CRITICAL, OVERDAMPED_ZETA, modes_as_run
@@ -65,7 +69,7 @@ from ambseal.errors import ConfigError
 from ambseal.lti import json_float
 from ambseal.model import bending_limit_hz, build_system, spring_label
 
-__all__ = ["unbalance_ur", "vibration_limit_um", "amplification_factor",
+__all__ = ["unbalance_ur", "vibration_limit_um", "amplification_factor", "exact_half_power",
            "required_margin", "journal_loads", "Critical", "Clearance", "UnbalanceCase",
            "Api617Unbalance", "api617_unbalance", "SIGN_CHANGE"]
 
@@ -135,6 +139,49 @@ def amplification_factor(speed_hz: np.ndarray, amp: np.ndarray, i: int
     n1 = cross(list(range(i, -1, -1)))
     n2 = cross(list(range(i, amp.size)))
     return float(speed_hz[i] / (n2 - n1)), n1, n2
+
+
+def exact_half_power(response, speed_hz: np.ndarray, amp: np.ndarray, i: int
+                     ) -> tuple[float, float, float, float, float]:
+    """The peak near ``amp[i]`` and its half-power points solved on ``response`` itself:
+    ``(N_c, A_c, AF, N_1, N_2)``.
+
+    Parameters
+    ----------
+    response : callable
+        ``response(speed_hz) → amplitude`` (a float), the function sampled as ``amp``.
+    speed_hz, amp : ndarray, shape (n,)
+        The sweep (ascending) and its samples.
+    i : int
+        The sampled peak's index (0 < i < n − 1).
+
+    Returns
+    -------
+    tuple of float
+        The peak's speed and amplitude, ``AF = N_c/(N_2 − N_1)`` and the half-power speeds
+        (NaN on a side where the response does not fall to A_c/√2 within the sweep).
+    """
+    lo, hi = float(speed_hz[max(i - 1, 0)]), float(speed_hz[min(i + 1, amp.size - 1)])
+    tol = 1e-9 * float(speed_hz[i])
+    best = minimize_scalar(lambda s: -response(s), bounds=(lo, hi), method="bounded",
+                           options={"xatol": tol, "maxiter": 200})
+    n_c, a_c = float(best.x), float(-best.fun)
+    if a_c < amp[i]:  # the sampled point is the better peak
+        n_c, a_c = float(speed_hz[i]), float(amp[i])
+    half = a_c / math.sqrt(2.0)
+
+    def side(idx):
+        for a, b in zip(idx[:-1], idx[1:]):
+            if amp[b] <= half:
+                x0, x1 = sorted((float(speed_hz[a]), float(speed_hz[b])))
+                if a == i:  # the bracket's inner end is the peak itself
+                    x0, x1 = (n_c, x1) if x1 > n_c else (x0, n_c)
+                return float(brentq(lambda s: response(s) - half, x0, x1, xtol=tol))
+        return math.nan
+
+    n1 = side(list(range(i, -1, -1)))
+    n2 = side(list(range(i, amp.size)))
+    return n_c, a_c, n_c / (n2 - n1), n1, n2
 
 
 def required_margin(af: float, below: bool) -> float:
@@ -448,7 +495,10 @@ def _close_clearances(cfg) -> list[tuple[str, float, float]]:
     return out
 
 
-def _criticals(speed, probe_um, probes, f_min, f_max) -> list[Critical]:
+def _criticals(speed, probe_um, probes, f_min, f_max, response=None) -> list[Critical]:
+    """The criticals of one case (module docstring); ``response(speed_hz, p)``, the
+    probe ``p``'s amplitude at any speed, solves each peak and its half-power points
+    (:func:`exact_half_power`), else they are read off the sweep."""
     out = []
     for p, z in enumerate(probes):
         amp = probe_um[:, p]
@@ -456,8 +506,12 @@ def _criticals(speed, probe_um, probes, f_min, f_max) -> list[Critical]:
             continue
         idx, _ = find_peaks(amp, prominence=(1 - 1 / math.sqrt(2)) * amp)
         for i in idx:
-            af, _, _ = amplification_factor(speed, amp, int(i))
-            nc = float(speed[i])
+            if response is None:
+                af, _, _ = amplification_factor(speed, amp, int(i))
+                nc, a_c = float(speed[i]), float(amp[i])
+            else:
+                nc, a_c, af, _, _ = exact_half_power(lambda s, p=p: response(s, p), speed,
+                                                     amp, int(i))
             if nc < f_min:
                 req, act = required_margin(af, True), 100 * (f_min - nc) / f_min
             elif nc > f_max:
@@ -466,14 +520,17 @@ def _criticals(speed, probe_um, probes, f_min, f_max) -> list[Critical]:
                 near_low = nc - f_min <= f_max - nc
                 req = required_margin(af, near_low)
                 act = -100 * min(nc - f_min, f_max - nc) / f_max
-            out.append(Critical(nc, float(z), float(amp[i]), af, req, act))
-    # one critical per speed: the probe that shows it largest
-    best: dict = {}
-    for c in out:
-        key = round(c.speed_hz, 6)
-        if key not in best or c.amplitude_um > best[key].amplitude_um:
-            best[key] = c
-    return sorted(best.values(), key=lambda c: c.speed_hz)
+            out.append(Critical(nc, float(z), a_c, af, req, act))
+    # one critical per speed (the solved peaks of two probes agree to the solver's
+    # tolerance): the probe that shows it largest
+    best: list[Critical] = []
+    for c in sorted(out, key=lambda c: c.speed_hz):
+        if best and c.speed_hz - best[-1].speed_hz <= 1e-6 * c.speed_hz:
+            if c.amplitude_um > best[-1].amplitude_um:
+                best[-1] = c
+        else:
+            best.append(c)
+    return best
 
 
 def api617_unbalance(cfg, controller=None, *, name: str = "none",
@@ -548,7 +605,12 @@ def api617_unbalance(cfg, controller=None, *, name: str = "none",
     out = []
     for c, (f_mode, rule, unb) in enumerate(cases):
         pr = amp[c, :, :len(probes)]
-        crit = _criticals(speed, pr, probes, f_min, f_max)
+
+        def at(s, p, c=c):  # this case's probe p at one speed
+            r = synchronous_response(cfg, controller, [s], [cases[c][2]], [probes[p]])
+            return 2e6 * float(r.amplitude_m[0, 0, 0])
+
+        crit = _criticals(speed, pr, probes, f_min, f_max, at)
         a1 = float(pr[hi_].max())
         sc = float(np.clip(a_vl / a1, s_lo, s_hi)) if a1 > 0 else s_hi
         clear = tuple(Clearance(n, float(z), 2e6 * rc, so.clearance_fraction * 2e6 * rc,

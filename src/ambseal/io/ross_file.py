@@ -63,10 +63,10 @@ def _kind(name: str) -> type:
     return type(name, (_Element,), {})
 
 
-ShaftElement, CouplingElement, DiskElement, PointMass, BearingElement, \
+ShaftElement, CouplingElement, DiskElement, PointMass, BearingElement, SealElement, \
     MagneticBearingElement, MotorElement = (_kind(n) for n in (
         "ShaftElement", "CouplingElement", "DiskElement", "PointMass", "BearingElement",
-        "MagneticBearingElement", "MotorElement"))
+        "SealElement", "MagneticBearingElement", "MotorElement"))
 #: A gear of a single rotor is a disk with teeth (its mass and inertias in ROSS's matrices)
 _DISKS = {name: _kind(name) for name in ("DiskElement", "GearElement", "GearElementTVMS")}
 
@@ -122,9 +122,9 @@ def _interpolant(values, speed, frequency, method: str):
     return lambda w, s=None: float(along(w))
 
 
-def _bearing(table: dict, where: str) -> _Element:
+def _bearing(table: dict, where: str, seal: bool = False) -> _Element:
     amb = all(k in table for k in _AMB_KEYS)
-    el = (MagneticBearingElement if amb else BearingElement)(table)
+    el = (MagneticBearingElement if amb else SealElement if seal else BearingElement)(table)
     el.n_link = table.get("n_link")
     speed, freq = table.get("speed"), table.get("frequency")
     method = table.get("interpolation", "pchip")
@@ -181,7 +181,7 @@ class _Rotor:
             elif kind == "PointMass":
                 self.point_mass_elements.append(PointMass(table))
             elif kind in ("BearingElement", "SealElement"):
-                self.bearing_elements.append(_bearing(table, where))
+                self.bearing_elements.append(_bearing(table, where, kind == "SealElement"))
             else:
                 unknown.append(f"{kind} {table.get('tag', key)}")
         if unknown:

@@ -58,7 +58,7 @@ def test_a_free_free_beams_first_bending_mode_is_bending():
 def test_the_flywheels_nutation_lies_above_the_rigid_rotors_bound():
     """The flywheel's derived PID at 500 Hz: the mode named the nutation lies above
     Ω·Ip/It of the whole rotor (a rigid rotor's forward conical mode on positive tilt
-    stiffness, It ω² − Ip Ω ω − k = 0: ω > Ω Ip/It; Genta 2005 §4.6) — Ip and It by hand
+    stiffness, It ω² − Ip Ω ω − k = 0: ω > Ω Ip/It; Genta 2005 §4.6) — Ip, It by hand
     from the rig file's disks and its hollow shaft about the centre of mass — and the one
     named the precession well below Ω."""
     rig = Path(__file__).resolve().parents[2] / "examples" / "flywheel.toml"

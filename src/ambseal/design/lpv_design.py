@@ -14,10 +14,10 @@ delay τ = (``[controller] delay_samples`` + ½)/``sample_rate_hz`` as a first-o
 on every control channel (:func:`ambseal.robust.delay.design_delay`, as the H∞ and μ
 designs carry it), so that the controller is designed for the loop it will run in:
 without it the flywheel's (``examples/flywheel.toml``) loses its nutation mode as it runs
-at 20 kHz (benchmarks/README.md, "Where the design defaults come from"). The first bending pair (~1 kHz) is left
-out of the design model, as in the thesis: the controller built without it, rolled off by
-the high-pass W_u, keeps every full-order frozen loop stable with σ̄(S_o) ≤ 3 over
-20–300 Hz (checked in ``tests/control/test_control_lpv.py``).
+at 20 kHz (benchmarks/README.md, "Where the design defaults come from"). The first bending
+pair (~1 kHz) is left out of the design model, as in the thesis: the controller built
+without it, rolled off by the high-pass W_u, keeps every full-order frozen loop stable
+with σ̄(S_o) ≤ 3 over 20–300 Hz (checked in ``tests/control/test_control_lpv.py``).
 
 Weights (P3 Eq. 11): W_p = (s/M + ω_B)/(s + ω_B A) with M = 2 (σ̄(S_o) ≤ Mγ ≈ 2 < 3, the
 ISO 14839-3 zone-A limit), ω_B = 2π·50 rad/s (2 % settling of every spin-up step in

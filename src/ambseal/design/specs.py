@@ -532,8 +532,8 @@ def _weights(d, method: str, mach: Machine, d_e: float, d_u: float, band_hi: flo
         rules["lpv.wu_hf_gain"] = f"{LPV_WU_RISE:g}× wu_gain (P3 §3.3: a high-pass W_u)"
         rules["lpv.wu_corner_hz"] = (
             "the lower of the actuator bandwidth f_a (P3 §3.3: 1.4 kHz, f_a 1.5 kHz) and "
-            f"1/({LPV_WU_DELAY_PER_TAU:g} τ) rounded down to 2 digits, where the controller's hold + computation "
-            "delay τ lags 45° as the actuator does at f_a")
+            f"1/({LPV_WU_DELAY_PER_TAU:g} τ) rounded down to 2 digits, where the controller's "
+            "hold + computation delay τ lags 45° as the actuator does at f_a")
     else:
         w = replace(w, omega_b=OMEGA_B_TIMES_TI / pid["ti"])
         rules[f"{method}.omega_b_rad_s"] = (f"{OMEGA_B_TIMES_TI:g}/T_i of the reference PID "

@@ -37,5 +37,5 @@ from ambseal.machine.synchronous_notch import NotchedController, NotchedDigital,
 __all__ = ["SPEED", "ScheduledController", "controller_as_runs", "frozen", "matrices_at",
            "sampled_loop_matrix", "ClosedLoop",
            "JudgedLoop", "closed_loop", "judged_loop", "loop_matrices", "sample_time",
-           "sampled_plant", "ScheduledDigital", "scheduled_digital", "table_grid", "SynchronousNotch",
-           "NotchedController", "NotchedDigital"]
+           "sampled_plant", "ScheduledDigital", "scheduled_digital", "table_grid",
+           "SynchronousNotch", "NotchedController", "NotchedDigital"]

@@ -35,7 +35,7 @@ import math
 from dataclasses import dataclass
 
 from ambseal.analysis.campbell import modes_as_run, track_modes
-from ambseal.analysis.level1 import stage_cross_coupling, stage_position
+from ambseal.analysis.level1 import stage_cross_coupling, stage_position, without_seals
 from ambseal.config import Spring
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
@@ -189,7 +189,7 @@ def level2_analysis(cfg, controller=None, *, name: str = "none",
                    name=f"api617_qA{i}")
             for i, (st, q) in enumerate(
                 (st, stage_cross_coupling(st, cfg.machine.kind, omega)) for st in cfg.stage)]
-    bearings = [s for s in cfg.spring if s.kind != "seal"]  # a spring may be a seal
+    bearings = without_seals(cfg).spring  # a spring may be a seal
     variants = [("rotor and supports", {"seal": [], "spring": bearings})]
     variants += [(f"+ seal {s.name}", {"seal": [s], "spring": bearings}) for s in cfg.seal]
     variants += [(f"+ seal {s.name or f'spring{i}'}", {"seal": [], "spring": [*bearings, s]})

@@ -62,7 +62,12 @@ from scipy.optimize import brentq, minimize_scalar
 from scipy.signal import find_peaks
 
 from ambseal.analysis.campbell import AF_CRITICAL, OVERDAMPED_ZETA, modes_as_run
-from ambseal.analysis.level1 import RIGID_SUPPORT, bearing_positions, stage_position
+from ambseal.analysis.level1 import (
+    RIGID_SUPPORT,
+    bearing_positions,
+    stage_position,
+    without_seals,
+)
 from ambseal.analysis.synchronous import Unbalance, orbit_semi_major, synchronous_response
 from ambseal.config import Spring
 from ambseal.errors import ConfigError
@@ -225,7 +230,7 @@ def journal_loads(cfg) -> tuple[tuple[float, float], ...]:
     pins = [Spring(position=z, kxx=RIGID_SUPPORT, kyy=RIGID_SUPPORT, name=f"pin{i}")
             for i, z in enumerate(zs)] if cfg.amb else []
     # the bearings carry the weight: a seal (also one given as a spring) takes none
-    kept = [s for s in cfg.spring if s.kind != "seal"]
+    kept = without_seals(cfg).spring
     rig = cfg.model_copy(update={"seal": [], "amb": [], "spring": [*kept, *pins]})
     sys = build_system(rig, speed_rpm=0.0)
     t = np.zeros(sys.n_dof)

@@ -24,7 +24,7 @@ that moves (amplitude above 1 % of the largest) turns that way, *planar* when no
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
@@ -168,7 +168,7 @@ class ClosedLoopModes:
     node_z_m: np.ndarray
     max_real_pole: float
     stable: bool
-    unstable: np.ndarray = field(default_factory=lambda: np.zeros(0, complex))
+    unstable: np.ndarray
 
     def deciding(self) -> np.ndarray:
         """The poles of :attr:`unstable` that decide a stability screening (API 617 Level

@@ -33,7 +33,7 @@ The modules: :mod:`~ambseal.analysis.level1`, :mod:`~ambseal.analysis.level2`,
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ambseal.analysis.campbell import AF_CRITICAL
 from ambseal.analysis.iso_vibration import iso14839_2_zones
@@ -177,17 +177,6 @@ def _criteria(cfg, l1, l2, unb, iso) -> tuple:
                           + ("" if last.stable else ", loop UNSTABLE"),
                           f"δ ≥ {d_min:g} with every source", CLAUSES["level2"], l2.passed,
                           counts=not (passed1 and last.stable)))
-    if not unb.loop_stable:  # no steady unbalance response on an unstable loop
-        why = (f"the loop with the seals at {cfg.operating.pressure_bar:g} bar is unstable "
-               f"at {unb.max_hz:.4g} Hz: no steady unbalance response")
-        limits = (("separation margins", "SM ≥ required (none below AF 2.5)", "separation"),
-                  ("vibration at the probes", f"≤ A_vl = {unb.vibration_limit_um:.3g} µm "
-                   "p-p", "vibration"),
-                  ("close clearances", f"≤ {100 * cfg.signoff.clearance_fraction:.3g} % of "
-                   "the diametral clearance", "clearance"),
-                  ("vibration zone", "zone A or B", "iso14839_2"))
-        return tuple(rows) + tuple(Criterion(n, why, lim, CLAUSES[k], False, graded=False)
-                                   for n, lim, k in limits)
     crit = [k for c in unb.cases for k in c.criticals]
     sharp = [k for k in crit if k.af >= AF_CRITICAL]
     worst = min(sharp, key=lambda k: k.actual_margin_pct - k.required_margin_pct,
@@ -232,6 +221,10 @@ def _criteria(cfg, l1, l2, unb, iso) -> tuple:
                           f"zone A or B (A/B {iso.boundaries[0]:g}, B/C {iso.boundaries[1]:g}"
                           f", C/D {iso.boundaries[2]:g}·C_min)", CLAUSES["iso14839_2"],
                           iso.graded and iso.passed, graded=iso.graded))
+    if not unb.loop_stable:  # no steady unbalance response on an unstable loop
+        why = (f"the loop with the seals at {cfg.operating.pressure_bar:g} bar is unstable "
+               f"at {unb.max_hz:.4g} Hz: no steady unbalance response")
+        rows[2:] = [replace(c, value=why, passed=False, graded=False) for c in rows[2:]]
     return tuple(rows)
 
 

@@ -178,9 +178,10 @@ def exact_half_power(response, speed_hz: np.ndarray, amp: np.ndarray, i: int
     def side(idx):
         for a, b in zip(idx[:-1], idx[1:]):
             if amp[b] <= half:
-                x0, x1 = sorted((float(speed_hz[a]), float(speed_hz[b])))
-                if a == i:  # the bracket's inner end is the peak itself
-                    x0, x1 = (n_c, x1) if x1 > n_c else (x0, n_c)
+                # beside the peak the bracket's inner end is the solved peak (above half
+                # wherever it lies; the sampled one may fall below it)
+                inner = n_c if a == i else float(speed_hz[a])
+                x0, x1 = sorted((inner, float(speed_hz[b])))
                 return float(brentq(lambda s: response(s) - half, x0, x1, xtol=tol))
         return math.nan
 

@@ -134,8 +134,6 @@ def _sig2(x: float) -> float:
 
 def _floor2(x: float) -> float:
     """``x`` > 0 rounded down to two significant digits (a bound stays a bound)."""
-    if not math.isfinite(x):
-        return x
     e = math.floor(math.log10(x)) - 1
     return math.floor(x / 10.0**e * (1 + 1e-12)) * 10.0**e
 
@@ -163,7 +161,7 @@ class Machine:
     bias_current_a: float | None
     air_gap_m: float | None
     sample_rate_hz: float
-    delay_s: float = 0.0
+    delay_s: float
 
 
 def machine(cfg) -> Machine:
@@ -526,7 +524,7 @@ def _weights(d, method: str, mach: Machine, d_e: float, d_u: float, band_hi: flo
         rules[f"{method}.wu_gain"] = (f"D_u/({peaks:g} D_e Kp (1 + 1/ε)): |K| ≤ {peaks:g}× "
                                       "the reference PID's peak where S_o ≈ 1")
     if method == "lpv":
-        f_tau = 1.0 / (LPV_WU_DELAY_PER_TAU * mach.delay_s) if mach.delay_s > 0 else math.inf
+        f_tau = 1.0 / (LPV_WU_DELAY_PER_TAU * mach.delay_s)  # τ ≥ half a sample
         w = replace(w, wu_hf_gain=LPV_WU_RISE * w.wu_gain,
                     wu_corner_hz=min(mach.actuator_hz, _floor2(f_tau)))
         rules["lpv.wu_hf_gain"] = f"{LPV_WU_RISE:g}× wu_gain (P3 §3.3: a high-pass W_u)"

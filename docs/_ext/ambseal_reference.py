@@ -252,6 +252,9 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                             "bearing (default 0)"),
     "Pid.cross_kd": ("A·s/m", "cross-axis derivative gain, through the derivative's filter "
                               "(default 0)"),
+    "Pid.cross_speed_rpm": ("rpm", "the speed the cross gains are given at: with it they "
+                                   "scale with the speed (K_c Ω/Ω_ref, the PID scheduled "
+                                   "on speed); left out, constant"),
     "Controllers.filter": ("", "filters in series with the PID on every axis; left out, "
                                "a derived PID carries its derived filters and a given PID "
                                "none (``filter = []``: none)"),

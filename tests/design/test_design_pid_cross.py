@@ -33,7 +33,7 @@ from ambseal.lti import feedback_matrices
 from ambseal.model import channel_names
 from ambseal.model.rig import build_plant
 
-from ..rigid_rotor import L, inertia, rotor_text
+from ..rigid_rotor import E_RIGID, L, inertia, rotor_text
 
 DISK_M, DISK_IP, DISK_ID = 20.0, 0.9, 3.0
 KI, KS = 100.0, 2.0e5
@@ -163,3 +163,108 @@ def test_the_rig_files_cross_gains_reach_the_pid_and_its_record():
         np.testing.assert_allclose(getattr(got, m), getattr(want, m), rtol=1e-12, atol=1e-12)
     with pytest.raises(ConfigError, match="cross_kd"):
         parse_rig(tomllib.loads(text.replace("td = 1e-3", "td = 0.0")))
+
+
+def _pd_band_top(speed_hz: float, kd: float, disk_id: float) -> float:
+    """The upper end of the stable band of k_cp (no cross derivative) at ``speed_hz``: the
+    conical and cylindrical modes' Routh–Hurwitz bands intersected (module docstring)."""
+    m, it, ip = inertia(DISK_M, DISK_IP, disk_id)
+    a = L / 2
+    cyl = _band(m, 2 * KI * kd, 2 * (KI * KP - KS), 0.0, 0.0)[1] / (2 * KI)
+    con = _band(it, 2 * a * a * KI * kd, 2 * a * a * (KI * KP - KS),
+                ip * 2 * math.pi * speed_hz, 0.0)[1] / (2 * a * a * KI)
+    return min(cyl, con)
+
+
+def test_cross_gains_scheduled_on_speed_hold_where_constant_ones_do_not():
+    """``cross_speed_rpm``: the cross gain given at 400 Hz (0.8 of the band's top there) and
+    scaled ∝ Ω stays inside the Routh–Hurwitz band at every speed, so the PID frozen at
+    0, 150 and 400 Hz holds the rotor; the same gain held constant is above the band's top
+    at standstill (by the closed form) and loses it there. The scheduled PID at Ω is
+    :func:`pid_controller` with the scaled gain, and between its two table entries (0 and
+    the top speed) linear interpolation is that PID exactly."""
+    from ambseal.design import design
+    from ambseal.design.pid import ScheduledPid, reference_pid
+
+    kd, disk_id = KP * 1e-3, 6.0  # the rig file's PID: kp·td; a long rotor: I_t ≫ m a²
+    k_ref = 0.8 * _pd_band_top(400.0, kd, disk_id)
+    assert k_ref > 1.25 * _pd_band_top(0.0, kd, disk_id)  # constant: above the band at rest
+    text = _rotor().replace(f"Id = {DISK_ID}", f"Id = {disk_id}").replace(
+        "eps = 0.1\n", f"eps = 0.1\ncross_kp = {k_ref}\n"
+                            "cross_speed_rpm = 24000.0\n").replace(
+        "[operating]\nspeed_rpm = 0.0", "[operating]\nspeed_rpm = 9000.0\n"
+                                         "speed_range_hz = [100.0, 400.0]").replace(
+        "ti = 1.0", "ti = 1e4")  # no integral: the precession would meet it (2.6 Hz)
+    cfg = parse_rig(tomllib.loads(text))
+    res = design(cfg, "pid")
+    K = res.controller
+    assert isinstance(K, ScheduledPid) and K.schedule == (0.0, 2 * math.pi * 400.0)
+    assert reference_pid(cfg)["cross_kp"] == pytest.approx(k_ref * 150.0 / 400.0)
+    ch = channel_names(cfg)
+
+    def loop_stable(Kss, speed_hz):
+        """The loop's modes below 50 kHz in the left half-plane (the 1e4-times-stiffer
+        shaft's lossless bending modes, above 0.6 MHz, are not the rotor's)."""
+        P = build_plant(cfg, speed_rpm=60.0 * speed_hz).to_statespace()
+        mats = [tuple(np.asarray(getattr(S, m), float) for m in "ABCD") for S in (P, Kss)]
+        lam = np.linalg.eigvals(feedback_matrices(*mats)[0])
+        return bool(lam[np.abs(lam) < 2 * math.pi * 5e4].real.max() < 0)
+
+    for f in (0.0, 150.0, 400.0):
+        want = pid_controller(KP, 1e4, 1e-3, 0.1, ch, cross_kp=k_ref * f / 400.0)
+        got = K.at(2 * math.pi * f)
+        for m in "ABCD":
+            np.testing.assert_allclose(getattr(got, m), getattr(want, m), rtol=1e-12,
+                                       atol=1e-9)
+        assert loop_stable(got, f), f
+    assert not loop_stable(pid_controller(KP, 1e4, 1e-3, 0.1, ch, cross_kp=k_ref), 0.0)
+    mid = K.matrices_at(2 * math.pi * 130.0)
+    ends = [K.matrices_at(w) for w in K.table_theta]
+    t = 130.0 / 400.0
+    for x, a, b in zip(mid, *ends):
+        np.testing.assert_allclose(x, (1 - t) * a + t * b, rtol=1e-12, atol=1e-9)
+    with pytest.raises(ConfigError, match="cross_speed_rpm"):
+        parse_rig(tomllib.loads(_rotor().replace("eps = 0.1\n",
+                                                 "eps = 0.1\ncross_speed_rpm = 1000.0\n")))
+
+
+def test_the_scheduled_pid_runs_as_a_table():
+    """A PID with cross gains ∝ speed, on the rotor with a steel shaft (bending at a few
+    kilohertz), runs as a discrete table on speed from standstill to the top speed
+    (``ambseal.app.commands.digital_for``): each entry is python-control's
+    ``sample_system`` of the frozen PID at that speed by the chosen method, and the loop
+    of the table interpolated at speeds on and between its entries with the plant sampled
+    by SciPy (ZOH) is stable, checked by python-control's poles."""
+    import control
+    from scipy.signal import cont2discrete
+
+    from ambseal.analysis.judge import operating_points
+    from ambseal.app.commands import digital_for
+    from ambseal.design import design
+    from ambseal.design.specs import design_spec
+    from ambseal.machine import ScheduledDigital
+
+    text = _rotor().replace(f"E = {E_RIGID}", "E = 2.1e11").replace(
+        'rotor on AMBs"', 'rotor on AMBs"\nmodal_damping = 0.01').replace(
+        "eps = 0.1\n", "eps = 0.1\ncross_kp = 150.0\ncross_kd = 0.05\n"
+        "cross_speed_rpm = 24000.0\n").replace(
+        "[operating]\nspeed_rpm = 0.0", "[operating]\nspeed_rpm = 9000.0\n"
+                                         "speed_range_hz = [100.0, 400.0]").replace(
+        "ti = 1.0", "ti = 1e4")  # no integral: the precession would meet it (2.6 Hz)
+    cfg = parse_rig(tomllib.loads(text))
+    res = design(cfg, "pid")
+    dig = digital_for(cfg, "pid", res.controller, res, operating_points(design_spec(cfg)))
+    assert isinstance(dig, ScheduledDigital)
+    np.testing.assert_allclose(dig.grid / (2 * math.pi), np.linspace(0.0, 400.0, 9))
+    T = dig.Ts
+    method = {"tustin": "tustin", "zoh": "zoh", "foh": "foh"}[dig.method]
+    for j, w in enumerate(dig.grid):
+        want = control.sample_system(res.controller.at(w), T, method)
+        for m, X in zip("ABCD", dig.discrete):
+            np.testing.assert_allclose(X[j], getattr(want, m), rtol=1e-9, atol=1e-9)
+    for f in (0.0, 75.0, 150.0, 275.0, 400.0):
+        P = build_plant(cfg, speed_rpm=60.0 * f).to_statespace()
+        Gd = control.ss(*cont2discrete((P.A, P.B, P.C, P.D), T, method="zoh")[:4], T)
+        Kd = dig.statespace_at(2 * math.pi * f, delayed=True)
+        loop = control.feedback(Gd, Kd)  # i = −K y
+        assert np.abs(loop.poles()).max() < 1.0, f

@@ -155,7 +155,7 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
         return digital_controller(controller, fs, cache["plants"],
                                   delay_samples=delay, rise=rise)
 
-    W = table_grid(controller.K.theta)  # the LPV table's θ (speeds or SI), made denser
+    W = table_grid(controller.table_theta)  # the table's θ (speeds or SI), made denser
     # between table entries at 1/8, 3/8, 5/8, 7/8 of the table: the interpolation judged
     mids = [(W[j] + W[j + 1]) / 2 for j in (np.arange(1, 8, 2) * (W.size - 1)) // 8]
     if controller.parameter == SPEED:

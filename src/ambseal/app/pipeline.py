@@ -84,7 +84,7 @@ from ambseal.design import (
 from ambseal.errors import ConfigError, ModelError, SynthesisError
 from ambseal.export import export_notch, write_notch_c
 from ambseal.files import RunFolder, write_json
-from ambseal.machine import SPEED
+from ambseal.machine import SPEED, ScheduledDigital
 from ambseal.model import build_plant
 from ambseal.report import (
     StageProgress,
@@ -434,7 +434,10 @@ def _design_stage(st: _RunState) -> None:
                               "PID during identification, and "
                               + st.cannot_run.get("pid", "the rig has none"))
         st.stages.begin("identification")
-        levitating, note = facility_controller(cfg, st.truth_cfg, st.digitals["pid"].discrete)
+        pid = st.digitals["pid"]  # a PID scheduled on speed: as it runs at the records' speed
+        pid = (pid.discrete_at(2 * np.pi * cfg.operating.speed_rpm / 60.0)
+               if isinstance(pid, ScheduledDigital) else pid.discrete)
+        levitating, note = facility_controller(cfg, st.truth_cfg, pid)
         if note:
             st.say(note)
         st.ident = identification_stage(cfg, st.truth_cfg, st.out, st.stages.step, levitating,

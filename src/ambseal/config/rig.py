@@ -76,7 +76,10 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     ``cross_kp`` (A/m) and ``cross_kd`` (A·s/m), default 0: cross-axis gains between the
     two axes of each bearing, i_ζ = −(K y_ζ + K_c y_η), i_η = −(K y_η − K_c y_ζ) with
     K_c = cross_kp + cross_kd·s/(ε T_d s + 1) — the cross feedback that damps a gyroscopic
-    rotor's whirl (:func:`ambseal.design.pid.pid_controller`).
+    rotor's whirl (:func:`ambseal.design.pid.pid_controller`); ``cross_speed_rpm``
+    (optional): the speed those gains are given at, and with it they scale with the speed,
+    K_c(Ω) = K_c·Ω/Ω_ref, as the gyroscopic moments do (the PID is then scheduled on
+    speed, :class:`ambseal.design.pid.ScheduledPid`); without it they are constant.
 ``[[controller.filter]]``
     Filters in series with the PID on every axis (:class:`PidFilter`): ``kind`` =
     ``"notch"`` (``frequency_hz``, ``width_hz``, ``depth_db`` default 20), ``"lead"`` or
@@ -584,12 +587,18 @@ class Pid(_Strict):
     # whirl they act on), bounded as kp and kp·td are
     cross_kp: float = Field(default=0.0, ge=-1e9, le=1e9)
     cross_kd: float = Field(default=0.0, ge=-1e11, le=1e11)
+    # the speed the cross gains are given at: with it they scale with the speed, as the
+    # gyroscopic moments do; without it they are constant
+    cross_speed_rpm: float | None = Field(default=None, gt=0, le=1e7)
 
     @model_validator(mode="after")
     def _cross(self) -> "Pid":
         if self.cross_kd != 0 and self.td == 0:
             raise ValueError("cross_kd: a cross-axis derivative takes the derivative's "
                              "filter, and td = 0 has none; set td > 0 or cross_kd = 0")
+        if self.cross_speed_rpm is not None and not (self.cross_kp or self.cross_kd):
+            raise ValueError("cross_speed_rpm: schedules the cross-axis gains on speed, and "
+                             "cross_kp = cross_kd = 0; set a cross gain or leave it out")
         return self
 
 

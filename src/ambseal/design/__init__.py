@@ -8,7 +8,8 @@
 * :func:`generalized_plant`, :func:`physical_controller` — the generalised plant of the
   robust designs (P5 §4.3, Figs. 8–9);
 * :func:`design` — the recipes: the reference PID (P5 Eq. 6; :func:`reference_pid`,
-  :func:`controller_from_metadata` for the one a record names), nominal H∞ and robust μ;
+  :func:`controller_from_metadata` for the one a record names; :class:`ScheduledPid` where
+  its cross gains are scheduled on speed), nominal H∞ and robust μ;
   :func:`full_order_check` — a design closed with the full-order plant;
   :func:`design_rise` — what the removal of fast poles costs a design;
 * :class:`Design` — what every design result offers (:class:`DesignResult` and the
@@ -28,6 +29,7 @@ from ambseal.design.fast_poles import design_rise
 from ambseal.design.lpv_design import design_frozen, design_lpv, lpv_schedule
 from ambseal.design.lpv_plant import vertex_grid_hz
 from ambseal.design.pid import (
+    ScheduledPid,
     controller_from_metadata,
     pid_controller,
     pid_description,
@@ -42,6 +44,7 @@ from ambseal.design.synchronous_rejection import SynchronousRejection, design_re
 from ambseal.design.weights import Weights, default_weights
 
 __all__ = ["RIGID_STATES", "Design", "DesignResult", "DesignSpec", "Machine", "Weights",
+           "ScheduledPid",
            "controller_from_metadata", "default_weights", "design", "design_frozen",
            "design_lpv", "lpv_schedule", "design_rise", "design_seal_scheduled", "design_spec",
            "full_order_check", "generalized_plant", "machine",

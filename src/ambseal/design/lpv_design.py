@@ -174,6 +174,11 @@ class LpvDesign(ScheduledController):
         return self.K.order
 
     @property
+    def table_theta(self) -> np.ndarray:
+        """θ of the controller's table, where it is exact (SI; rad/s for the speed)."""
+        return np.asarray(self.K.theta, float)
+
+    @property
     def schedule(self) -> tuple[float, float]:
         """(Ω_min, Ω_max) of the table (rad/s)."""
         return (_TWO_PI * float(self.speeds_hz[0]), _TWO_PI * float(self.speeds_hz[-1]))

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
+from typing import ClassVar
 
 import control
 import numpy as np
@@ -14,17 +15,21 @@ from ambseal.design.pid_filters import flexible_mode_filters
 from ambseal.errors import ConfigError, DataError
 from ambseal.identify import check_controller, sample_rate_of, state_space_from_metadata
 from ambseal.lti import feedback_matrices, picklable, zoh
+from ambseal.machine import SPEED, ScheduledController
 from ambseal.model import amb_factors, assemble_rotor, build_plant, channel_names
 from ambseal.robust import discrete_controller, discretize_as, is_stable, with_delay
 
 __all__ = ["pid_controller", "pid_from_rig", "reference_pid", "reference_controller",
+           "ScheduledPid", "scheduled_pid",
            "controller_from_metadata", "filter_matrices", "pid_description", "pid_of",
-           "PID_CORNERS_PER_FS"]
+           "PID_CORNERS_PER_FS", "precession_rad_s"]
 
 #: the derived PID (no [controller.pid]): k_eq = K_EQ_PER_KS·Ks, ζ on the rigid-body modes,
-#: Ti in rigid-body time constants (P5 Eq. 6, §4.2), and the derivative filter's corner as
-#: a fraction of the sample rate, chosen among PID_CORNERS_PER_FS (:func:`pid_from_rig`)
-K_EQ_PER_KS, PID_ZETA, TI_PER_OMEGA_N = 0.5, 1.0, 50.0
+#: Ti in rigid-body time constants (P5 Eq. 6, §4.2), set on the precession instead where
+#: the gyroscopic moments take it below PRECESSION_DROP·ω_n, and the derivative filter's
+#: corner as a fraction of the sample rate, chosen among PID_CORNERS_PER_FS
+#: (:func:`pid_from_rig`)
+K_EQ_PER_KS, PID_ZETA, TI_PER_OMEGA_N, PRECESSION_DROP = 0.5, 1.0, 50.0, 0.25
 PID_CORNERS_PER_FS = (0.1, 0.07, 0.05, 0.035, 0.14, 0.2)
 KEEP_OF_STRUCTURAL = 0.2
 
@@ -215,7 +220,15 @@ def pid_from_rig(cfg) -> dict:
       destabilised the test rig's rigid-body mode;
     * damping: the rigid-body mode ω_n = √(k_eq/m_b) gets the damping ratio PID_ZETA
       (Ki·Kp·Td = 2ζ√(k_eq m_b)); ζ ≤ 0.5 left the test rig unstable at 2.04 bar;
-    * integral: Ti = TI_PER_OMEGA_N/ω_n, well below the rigid-body mode;
+    * integral: Ti = TI_PER_OMEGA_N/ω_n, well below the rigid-body mode; on a gyroscopic
+      rotor the backward conical mode (the precession) falls with speed, towards
+      k_eq·l²/(Ω I_p), and an integral corner it reaches gives it negative damping (the
+      flywheel of ``examples/flywheel.toml``, Ti = 50/ω_n: lost at 333 Hz, where
+      1/Ti is ω_p/4.7). So where the precession ω_p of the rigid rotor on k_eq at the
+      AMBs at the top speed (:func:`precession_rad_s`) is below PRECESSION_DROP·ω_n,
+      Ti = TI_PER_OMEGA_N/ω_p: the same factor below the lowest rigid-body mode at every
+      speed; elsewhere that factor stays above TI_PER_OMEGA_N·PRECESSION_DROP = 12.5, and
+      Ti is as P5 (the turboexpander's precession, 0.49 ω_n at 300 Hz, keeps it);
     * derivative filter (the roll-off) for the target: its corner f_d = 1/(2π ε Td) at a
       fraction of the sample rate f_s, at most f_s/5 (two fifths of Nyquist, where Tustin
       warps it by 13 %); the loop as it runs loses (delay_samples + ½)·360°·f/f_s to the
@@ -226,8 +239,8 @@ def pid_from_rig(cfg) -> dict:
       (ZOH) with the controller by Tustin and its delay; the first kept that leaves the
       least-damped pole as it runs at least KEEP_OF_STRUCTURAL of the rotor's structural
       damping ``rotor.modal_damping`` at every condition where the continuous loop is
-      stable, else the one stable as it runs at the most conditions and then the best
-      damped. The order favours the higher corner: a low corner costs phase at the
+      stable, else the one stable as it runs at the most conditions, then holding the
+      continuous loop at the most, then the best damped. The order favours the higher corner: a low corner costs phase at the
       rigid-body modes and raises σ̄(S_o) (test rig: 5.9 at f_s/10, 16 at f_s/20). P5's
       ε = 0.1 puts the corner at 10/(2π Td) whatever the rate: on
       the blower (20 kHz) and the pump (10 kHz) that corner (0.50 and 0.43 kHz) left the
@@ -270,14 +283,20 @@ def pid_from_rig(cfg) -> dict:
     kp = (1 + K_EQ_PER_KS) * ks_over_ki
     w_n = np.sqrt(k_eq / m_b)
     td = float(2 * PID_ZETA * np.sqrt(k_eq * m_b) / (ki * kp))
-    ti = float(TI_PER_OMEGA_N / w_n)
+    top_hz = max(stability_speeds(cfg)[0])
+    w_p = precession_rad_s(cfg, k_eq, 2 * np.pi * top_hz)
+    slow = w_p < PRECESSION_DROP * w_n
+    ti = float(TI_PER_OMEGA_N / (w_p if slow else w_n))
     fs = cfg.controller.sample_rate_hz
     frac, kept = _corner_for_target(cfg, kp, ti, td)
     eps = float(1 / (2 * np.pi * frac * fs * td))
     lost = np.degrees((cfg.controller.delay_samples + 0.5) * w_n / fs)
     out = {"kp": float(kp), "ti": ti, "td": td, "eps": eps, "corner_hz": frac * fs,
            "rule": f"k_eq = {K_EQ_PER_KS:g} Ks, ζ = {PID_ZETA:g} on the rigid-body modes "
-                   f"({w_n / (2 * np.pi):.3g} Hz), Ti = {TI_PER_OMEGA_N:g}/ω_n, derivative "
+                   f"({w_n / (2 * np.pi):.3g} Hz), Ti = {TI_PER_OMEGA_N:g}/"
+                   + (f"ω_p (the precession, {w_p / (2 * np.pi):.3g} Hz at "
+                      f"{top_hz:.4g} Hz, below {PRECESSION_DROP:g} ω_n)" if slow else "ω_n")
+                   + f", derivative "
                    f"filter at f_s/{1 / frac:.3g} = {frac * fs:.4g} Hz (ε = {eps:.2g}; the "
                    f"first of f_s/"
                    f"{', f_s/'.join(f'{1 / c:.3g}' for c in PID_CORNERS_PER_FS)} that "
@@ -293,6 +312,38 @@ def pid_from_rig(cfg) -> dict:
                             f"{fd.least_zeta:.2g})")
     _DERIVED[key] = out
     return dict(out)
+
+
+def precession_rad_s(cfg, k_eq: float, speed_rad_s: float) -> float:
+    """The lowest natural frequency of the rotor as a rigid body
+    (:meth:`~ambseal.model.rotor.RotorMatrices.rigid`) on an isotropic spring ``k_eq`` at
+    each AMB's actuator, spinning at Ω: on a gyroscopic rotor at speed, the backward
+    conical mode, the precession (Genta, *Dynamics of Rotating Systems*, 2005, §4.6).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+    k_eq : float
+        Each AMB's stiffness per axis (N/m), > 0.
+    speed_rad_s : float
+        Ω (rad/s).
+
+    Returns
+    -------
+    float
+        The undamped natural frequency (rad/s), > 0.
+    """
+    rotor = assemble_rotor(cfg)
+    M, G, _ = rotor.rigid()
+    K = np.zeros((4, 4))
+    for a in cfg.amb:
+        z = float(rotor.mesh.z[rotor.mesh.node_at(a.position)])
+        for e in (np.array([1.0, 0.0, z, 0.0]), np.array([0.0, 1.0, 0.0, z])):
+            K += k_eq * np.outer(e, e)
+    A = np.block([[np.zeros((4, 4)), np.eye(4)],
+                  [-np.linalg.solve(M, K), -speed_rad_s * np.linalg.solve(M, G)]])
+    w = np.abs(np.linalg.eigvals(A).imag)
+    return float(w[w > 0].min())
 
 
 def _filters_for_target(cfg, kp, ti, td, eps, rigid_hz: float):
@@ -345,29 +396,35 @@ def _corner_for_target(cfg, kp: float, ti: float, td: float) -> float:
         K = pid_controller(kp, ti, td, 1 / (2 * np.pi * frac * fs * td), channel_names(cfg))
         mats = tuple(np.asarray(X, float) for X in (K.A, K.B, K.C, K.D))
         Kd = with_delay(discretize_as(mats, 1 / fs, "tustin"), delay)
-        n_ok, zeta, held = 0, np.inf, True
+        n_ok, n_held, zeta = 0, 0, np.inf
         for G, Gd in plants:
             if not is_stable(np.linalg.eigvals(feedback_matrices(G, mats)[0])):
-                held = False
                 continue  # unstable as designed: nothing to keep as it runs
             z = _zeta_z(np.linalg.eigvals(feedback_matrices(Gd, Kd)[0])).min()
-            n_ok, zeta = n_ok + (z > 0), min(zeta, z)
-        if zeta >= floor and zeta > 0:
+            n_ok, n_held, zeta = n_ok + (z > 0), n_held + 1, min(zeta, z)
+        held = n_held == len(plants)
+        if n_held and zeta >= floor and zeta > 0:
             return frac, held
-        if best is None or (n_ok, zeta) > best[0]:
-            best = ((n_ok, zeta), frac)
+        # a corner whose loop is unstable as designed counts nothing as it runs: it ranks
+        # below one that holds it (the flywheel: f_s/14 lost its bending modes designed)
+        if best is None or (n_ok, n_held, zeta) > best[0]:
+            best = ((n_ok, n_held, zeta), frac)
     return best[1], False
 
 
-def reference_pid(cfg) -> dict:
-    """The rig's reference PID (P5 Eq. 6): ``[controller.pid]`` as given, else derived from
-    the rig by :func:`pid_from_rig` — the one rule by which the PID design, the weights of
-    the design specification and the acquisition's controller find it.
+def reference_pid(cfg, speed_rpm: float | None = None) -> dict:
+    """The rig's reference PID (P5 Eq. 6) as it acts at one speed: ``[controller.pid]`` as
+    given, else derived from the rig by :func:`pid_from_rig` — the one rule by which the
+    PID design, the weights of the design specification and the acquisition's controller
+    find it.
 
     Parameters
     ----------
     cfg : RigConfig
         The rig (its ``[controller.pid]``, else what :func:`pid_from_rig` derives from).
+    speed_rpm : float, optional
+        The speed (rpm) of a PID whose cross gains are scheduled on speed
+        (``cross_speed_rpm``, :class:`ScheduledPid`); ``[operating] speed_rpm`` if omitted.
 
     Returns
     -------
@@ -375,21 +432,109 @@ def reference_pid(cfg) -> dict:
         ``kp`` (A/m), ``ti``, ``td`` (s), ``eps`` (-), ``filters`` (the
         ``[[controller.filter]]`` entries as dicts, in series with the PID; left out of the
         rig file, none for a given PID), ``cross_kp`` (A/m) and ``cross_kd`` (A·s/m), the
-        cross-axis gains (0 where the rig file gives none, and for a derived PID);
-        derived ones also carry the ``rule`` of :func:`pid_from_rig`.
+        cross-axis gains at that speed (0 where the rig file gives none, and for a derived
+        PID); derived ones also carry the ``rule`` of :func:`pid_from_rig`.
     """
     ctrl = getattr(cfg, "controller", None)
     pid = getattr(ctrl, "pid", None)
     given = getattr(ctrl, "filter", None)
     if pid is not None:
+        scale = 1.0
+        if pid.cross_speed_rpm is not None:
+            at = cfg.operating.speed_rpm if speed_rpm is None else float(speed_rpm)
+            scale = at / pid.cross_speed_rpm
         out = {"kp": pid.kp, "ti": pid.ti, "td": pid.td, "eps": pid.eps, "filters": [],
-               "cross_kp": pid.cross_kp, "cross_kd": pid.cross_kd}
+               "cross_kp": pid.cross_kp * scale, "cross_kd": pid.cross_kd * scale}
     else:
         out = pid_from_rig(cfg)
         out.setdefault("filters", [])
     if given is not None:
         out["filters"] = [f.model_dump(exclude_none=True) for f in given]
     return out
+
+
+@dataclass(frozen=True, eq=False)
+class ScheduledPid(ScheduledController):
+    """The reference PID with cross-axis gains scheduled on speed,
+    K_c(Ω) = K_c,ref·Ω/Ω_ref (``[controller.pid] cross_speed_rpm``), ``i = −K(Ω) y``: the
+    gyroscopic moments grow with Ω, and so does the cross feedback that answers them
+    (Ahrens, Kučera & Larsonneur, IEEE Trans. Control Syst. Technol. 4(5), 1996;
+    Schweitzer & Maslen, *Magnetic Bearings*, 2009, on gyroscopic rotors). Every matrix of
+    :func:`pid_controller` is affine in the cross gains, so the table at standstill and
+    the top speed, interpolated linearly, is this PID exactly at every speed between.
+
+    Attributes
+    ----------
+    gains : dict
+        A PID description (:func:`pid_description`) with the cross gains at ``speed_ref``.
+    channels : tuple of str
+        The AMB channels.
+    speed_ref : float
+        Ω_ref (rad/s), > 0.
+    top : float
+        The top of the schedule (rad/s): held above it.
+    name : str
+    """
+
+    parameter: ClassVar[str] = SPEED
+    gains: dict = field(repr=False)
+    channels: tuple
+    speed_ref: float
+    top: float
+    name: str = "K_pid"
+
+    @property
+    def schedule(self) -> tuple[float, float]:
+        """(0, Ω_top) (rad/s)."""
+        return (0.0, float(self.top))
+
+    @property
+    def table_theta(self) -> np.ndarray:
+        """The speeds (rad/s) of an exact table: standstill and the top speed."""
+        return np.array([0.0, float(self.top)])
+
+    def gains_at(self, speed_rad_s: float) -> dict:
+        """The PID description at Ω (rad/s), held at the schedule's ends outside it."""
+        w = min(max(float(speed_rad_s), 0.0), float(self.top))
+        g = dict(self.gains)
+        for k in CROSS:
+            g[k] = float(g.get(k) or 0.0) * w / self.speed_ref
+        return g
+
+    def at(self, speed_rad_s: float, name: str | None = None):
+        """The frozen PID at Ω (rad/s): a ``control.StateSpace``, m → A, ``i = −K y``."""
+        K = pid_of(self.gains_at(speed_rad_s), self.channels)
+        return control.ss(K.A, K.B, K.C, K.D, inputs=K.input_labels,
+                          outputs=K.output_labels, states=K.state_labels,
+                          name=name or self.name)
+
+    def matrices_at(self, speed_rad_s: float) -> tuple[np.ndarray, ...]:
+        """Physical ``(A_K, B_K, C_K, D_K)`` at Ω (rad/s)."""
+        K = pid_of(self.gains_at(speed_rad_s), self.channels)
+        return tuple(np.asarray(X, float) for X in (K.A, K.B, K.C, K.D))
+
+
+def scheduled_pid(cfg) -> ScheduledPid | None:
+    """The rig's reference PID scheduled on speed, where its cross gains are
+    (``[controller.pid] cross_speed_rpm``); None where it is one fixed controller.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+
+    Returns
+    -------
+    ScheduledPid or None
+        Scheduled from standstill to the top of the stability speeds
+        (:func:`ambseal.design.conditions.stability_speeds`).
+    """
+    pid = getattr(getattr(cfg, "controller", None), "pid", None)
+    if pid is None or pid.cross_speed_rpm is None:
+        return None
+    p = reference_pid(cfg, speed_rpm=pid.cross_speed_rpm)
+    top = 2 * np.pi * max(max(stability_speeds(cfg)[0]), pid.cross_speed_rpm / 60.0)
+    return ScheduledPid(gains=p, channels=tuple(channel_names(cfg)),
+                        speed_ref=2 * np.pi * pid.cross_speed_rpm / 60.0, top=top)
 
 
 def reference_controller(cfg, method: str = "tustin"):

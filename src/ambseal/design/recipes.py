@@ -59,7 +59,7 @@ import numpy as np
 
 from ambseal.config import method_names
 from ambseal.design.modal_bands import bands_near, mode_bands
-from ambseal.design.pid import pid_of, reference_pid
+from ambseal.design.pid import pid_of, reference_pid, scheduled_pid
 from ambseal.design.plant import (
     LIGHT_DAMPING,
     MARGIN_BAND,
@@ -131,6 +131,9 @@ class DesignResult:
         Mechanical states of the design model the controller was made on.
     full_order : dict or None
         :func:`full_order_check` of the delivered controller.
+    scheduled : ScheduledPid or None
+        The PID scheduled on speed (its cross gains ∝ Ω), of which ``K`` is the one at
+        ``[operating] speed_rpm``; None for a fixed controller (not serialised).
     kept_unstable : bool
         True when the design's own full-order loop is unstable and it was returned all
         the same because the caller passed ``allow_unstable`` (the main job does, so that
@@ -176,11 +179,14 @@ class DesignResult:
     verdict: str = ""
     omega: Any = field(default=None, repr=False)
     stopping: dict | None = None
+    scheduled: Any = field(default=None, repr=False)
 
     @property
-    def controller(self) -> control.StateSpace:
-        """``K`` (:class:`~ambseal.design.Design`)."""
-        return self.K
+    def controller(self):
+        """The controller that runs (:class:`~ambseal.design.Design`): ``scheduled`` where
+        the design is scheduled on speed (a PID's cross gains, :class:`ScheduledPid`),
+        else ``K``."""
+        return self.K if self.scheduled is None else self.scheduled
 
     def summary(self) -> dict:
         """Short JSON-ready summary (no matrices)."""
@@ -212,8 +218,14 @@ def _pid(cfg, p):
     notes = (f"PID designed from the rig (no [controller.pid]): {d['rule']}",) \
         if "rule" in d else ()
     K = pid_of(d, channel_names(cfg))
+    sched = scheduled_pid(cfg)
+    if sched is not None:
+        notes += (f"cross-axis gains scheduled on speed, ∝ Ω from standstill to "
+                  f"{sched.top / (2 * np.pi):.4g} Hz (cross_kp {sched.gains['cross_kp']:.4g} "
+                  f"A/m, cross_kd {sched.gains['cross_kd']:.4g} A·s/m at "
+                  f"{cfg.controller.pid.cross_speed_rpm:.6g} rpm)",)
     return DesignResult("pid", K, p, order=int(K.nstates), order_full=int(K.nstates),
-                        notes=notes)
+                        notes=notes, scheduled=sched)
 
 
 def full_order_check(cfg, K, conditions, *, first_loss: bool = False) -> dict:

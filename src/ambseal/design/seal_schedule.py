@@ -145,6 +145,11 @@ class SealScheduledDesign(ScheduledController):
     delay: dict = field(default_factory=dict)
 
     @property
+    def table_theta(self) -> np.ndarray:
+        """θ of the controller's table, where it is exact (SI; rad/s for the speed)."""
+        return np.asarray(self.K.theta, float)
+
+    @property
     def schedule(self) -> tuple[float, float]:
         """(θ_min, θ_max) of the table (SI)."""
         return (float(self.grid[0]), float(self.grid[-1]))

@@ -62,7 +62,7 @@ _FROM = {
     "modal_reduction": "reduction", "SecondOrderSystem": "rig", "build_plant": "rig",
     "build_system": "rig", "mechanical_plant": "rig", "Mesh": "rotor",
     "RotorMatrices": "rotor", "assemble_rotor": "rotor", "build_mesh": "rotor",
-    "RIGID_BELOW_RAD_S": "rotor", "supported_modal_damping": "rotor",
+    "RIGID_BELOW_RAD_S": "rotor", "supported_modal_damping": "rotor", "rigid_basis": "rotor",
     "SealElement": "seal", "coefficient_value": "seal", "pressure_for_k": "seal",
     "seal_coefficients": "seal", "seal_values": "seal", "values_following": "seal",
     "values_following_k": "seal", "SpringElement": "spring",

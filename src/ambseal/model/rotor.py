@@ -27,7 +27,7 @@ from ambseal.lti import ArrayMemo
 from ambseal.model.fe import BeamElement, CouplingElement, DiskElement, LayeredBeam
 
 __all__ = ["Mesh", "build_mesh", "RotorMatrices", "assemble_rotor", "dof",
-           "supported_modal_damping", "RIGID_BELOW_RAD_S"]
+           "supported_modal_damping", "RIGID_BELOW_RAD_S", "rigid_basis"]
 
 X, Y, ALPHA, BETA = 0, 1, 2, 3
 
@@ -171,6 +171,30 @@ def build_mesh(cfg: RigConfig, extra_positions: tuple[float, ...] = ()) -> Mesh:
     return Mesh(z=np.asarray(z_nodes), elements=tuple(elements))
 
 
+def rigid_basis(mesh: Mesh) -> np.ndarray:
+    """The rigid-body motions of the rotor in its DOFs: x and y translations, and tilts
+    about the shaft's left end (x = z·t with β = t; y = z·t with α = −t, the slopes of this
+    DOF map).
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The rotor's nodes (their positions z, m).
+
+    Returns
+    -------
+    ndarray, shape (n_dof, 4)
+        Columns: x translation, y translation, tilt in the x–z plane, tilt in the y–z
+        plane; the free–free stiffness maps each to zero.
+    """
+    phi = np.zeros((mesh.n_dof, 4))
+    phi[X::4, 0] = 1.0
+    phi[Y::4, 1] = 1.0
+    phi[X::4, 2], phi[BETA::4, 2] = mesh.z, 1.0
+    phi[Y::4, 3], phi[ALPHA::4, 3] = mesh.z, -1.0
+    return phi
+
+
 @dataclass(frozen=True)
 class RotorMatrices:
     """Assembled shaft-and-disk matrices, each (n_dof, n_dof).
@@ -199,6 +223,19 @@ class RotorMatrices:
     K: np.ndarray
     C: np.ndarray
     G: np.ndarray
+
+    def rigid(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The rotor as a rigid body: its mass and gyroscopic matrices on
+        :func:`rigid_basis` (Friswell et al. 2010, §3.5: m, m, I_t and I_p about the
+        centre of mass after a change of origin).
+
+        Returns
+        -------
+        (M_r, G_r, Phi) : ndarray
+            Shapes (4, 4), (4, 4) (per unit spin speed, rad/s) and (n_dof, 4).
+        """
+        phi = rigid_basis(self.mesh)
+        return phi.T @ self.M @ phi, phi.T @ self.G @ phi, phi
 
     @property
     def mass(self) -> float:

@@ -200,9 +200,12 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Affine.per_bar": ("as the key, per bar", "rise per bar of pressure drop"),
     # { frequency_hz, value }
     "FrequencyTable.frequency_hz": ("Hz", "excitation frequencies, strictly increasing"),
-    "FrequencyTable.value": ("as the key", "the coefficient at each frequency; linear "
-                                           "between, held outside; evaluated at the "
-                                           "synchronous frequency"),
+    "FrequencyTable.value": ("as the key", "the coefficient at each frequency; "
+                                           "evaluated at the synchronous frequency"),
+    "FrequencyTable.interpolation": ("", "``linear`` (default) or ``pchip`` (shape-"
+                                         "preserving cubic, ROSS 3.1's) between points"),
+    "FrequencyTable.extrapolation": ("", "``hold`` (default: the end value) or ``linear`` "
+                                         "(the end slope, ROSS 3.1's) outside"),
     # [[spring]]
     "Spring.position": ("m", "axial position (coupling, plain bearing, support)"),
     "Spring.kxx": ("N/m", "direct stiffness in the spring's x axis"),

@@ -28,17 +28,23 @@ def _ross_major() -> int | None:
         return None
 
 
-@pytest.mark.parametrize("speed_rad_s", [150.0, 300.0, 400.0])
-@pytest.mark.parametrize("name", ["tables", "modal"])
+@pytest.mark.parametrize("name, speed_rad_s", [
+    *((n, w) for n in ("tables", "modal") for w in (150.0, 300.0, 400.0)),
+    *(("seals", w) for w in (300.0, 523.6, 700.0, 900.0))])
 def test_ross3_file_modes_equal_ross_31(tmp_path, capsys, name, speed_rad_s):
     """ROSS 3.1's files, imported by ``ambseal import-ross --speed-rpm``: ``tables``,
     ``rotor_example`` on bearings tabulated over speed (linear and pchip, extrapolated) and
     a seal over speed and whirl frequency, with the rotor's Rayleigh damping; ``modal``,
     ROSS's ``test_modal_damping`` rotor with 14 modal damping ratios, which ROSS counts
     over its torsional and axial modes too (its 5th and 14th flexible ones: the lateral
-    modes skip those ratios). Every lateral mode up to 500 Hz (damped frequency and log
-    decrement) equals one of ROSS 3.1's eigenvalues at that speed to 1e-6; where no ROSS 3
-    is installed the rig file says it was read without ROSS."""
+    modes skip those ratios); ``seals``, ROSS's own ROSS 2 test rotor with a labyrinth seal
+    tabulated at 523.6 and 837.8 rad/s and a hole-pattern seal, converted by ROSS 3.1's
+    ``ross_2to3``: below, on, between and beyond the labyrinth's points, where ROSS
+    continues the table with its end slopes (a table held at its ends put the mode at
+    124 Hz at δ 0.009 at 300 rad/s where ROSS has 0.867). Every lateral mode up to 500 Hz
+    (damped frequency and log decrement) equals one of ROSS 3.1's eigenvalues at that
+    speed to 1e-6; where no ROSS 3 is installed the rig file says it was read without
+    ROSS."""
     src = tmp_path / f"{name}.toml"
     shutil.copy(DATA / f"{name}.toml", src)
     out = tmp_path / "rig.toml"
@@ -51,6 +57,9 @@ def test_ross3_file_modes_equal_ross_31(tmp_path, capsys, name, speed_rad_s):
     rig = load_rig(out)
     if name == "tables":
         assert (rig.rotor.rayleigh_alpha, rig.rotor.rayleigh_beta) == (2.0, 1e-5)
+    elif name == "seals":
+        law = rig.seal[0].K
+        assert (law.interpolation, law.extrapolation) == ("pchip", "linear")
     else:
         assert rig.rotor.supported_modal_damping.ratios == [
             0.001 * (k + 1) for k in range(14) if k + 1 not in (5, 14)]

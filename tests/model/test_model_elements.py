@@ -99,6 +99,58 @@ def test_frequency_table_interpolation_by_hand():
                                    rtol=1e-15)
 
 
+def test_frequency_table_pchip_and_end_slopes_as_scipy_and_ross_31():
+    """Reference: SciPy's ``PchipInterpolator`` (Fritsch–Carlson) inside the table and its
+    end derivative continued linearly outside (ROSS 3.1's ``_AxisInterpolator``); with
+    ``interpolation = "linear"`` and ``extrapolation = "linear"`` the end segments'
+    slopes by hand: (7.5 − 6)/30 MN/m per Hz below, (10 − 7.5)/50 above."""
+    from scipy.interpolate import PchipInterpolator
+
+    cfg = _rig(seal=[{"name": "s", "position": 0.2,
+                      "K": {**TABLE, "interpolation": "pchip", "extrapolation": "linear"},
+                      "C": {**TABLE, "extrapolation": "linear"}}])
+    K, C = cfg.seal[0].K, cfg.seal[0].C
+    p = PchipInterpolator(TABLE["frequency_hz"], TABLE["value"])
+    for f in (20.0, 27.0, 50.0, 64.0, 99.0):
+        assert coefficient_value(K, 0.0, f) == pytest.approx(float(p(f)), rel=1e-14)
+    d = p.derivative()
+    for f, end in ((5.0, 20.0), (180.0, 100.0)):
+        want = float(p(end)) + (f - end) * float(d(end))
+        assert coefficient_value(K, 0.0, f) == pytest.approx(want, rel=1e-14)
+    assert coefficient_value(C, 0.0, 5.0) == pytest.approx(6.0e6 - 15 * 1.5e6 / 30, rel=1e-14)
+    assert coefficient_value(C, 0.0, 180.0) == pytest.approx(10.0e6 + 80 * 2.5e6 / 50,
+                                                             rel=1e-14)
+    with pytest.raises(ConfigError, match="interpolation"):
+        _rig(seal=[{"name": "s", "position": 0.2, "K": {**TABLE, "interpolation": "cubic"}}])
+
+
+def test_a_cross_added_mass_is_solved_as_it_is():
+    """A spring's cross added mass (mxy = −myx, as ROSS's hole-pattern seals carry) makes
+    M non-symmetric: the poles are the generalised eigenvalues of the pencil
+    [[0, I], [−K, −D]] x = λ diag(I, M) x (SciPy's QZ, Tisseur & Meerbergen 2001), and both
+    of ambseal's solvers agree with them (a Cholesky factor of M had read one triangle)."""
+    import scipy.linalg as sla
+
+    from ambseal.model.modes import modes
+
+    cfg = _rig(spring=[{"position": 0.0, "kxx": 1e6, "kyy": 1e6},
+                       {"position": 0.5, "kxx": 1e6, "kyy": 1e6, "cxx": 200.0, "cyy": 200.0,
+                        "mxx": 0.5, "myy": 0.5, "mxy": 0.8, "myx": -0.8}])
+    sys = build_system(cfg, speed_rpm=3000.0)
+    assert not np.array_equal(sys.M, sys.M.T)
+    n = sys.n_dof
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-sys.K, -(sys.C + sys.speed * sys.G)]])
+    B = sla.block_diag(np.eye(n), sys.M)
+    want = sla.eig(A, B, right=False)
+    want = want[np.isfinite(want)]
+    got = sys.poles()
+    for lam in got:
+        assert np.min(np.abs(want - lam)) <= 1e-6 * max(abs(lam), 1.0)
+    low = modes(sys, 4).poles
+    for lam in low:
+        assert np.min(np.abs(want - lam)) <= 1e-6 * max(abs(lam), 1.0)
+
+
 def test_affine_and_plain_coefficients_and_missing_frequency():
     """Reference: the rig format — ``at_zero + per_bar · pressure_bar`` (by hand:
     100 + 50·4.08 = 304), a plain number as is; a table without a frequency is refused."""

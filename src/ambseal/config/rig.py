@@ -59,7 +59,8 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     ``name``, ``position``, ``K``, ``k`` (N/m), ``C``, ``c`` (N·s/m), ``M`` (kg), each a number,
     ``{ at_zero = ..., per_bar = ... }`` (affine in the pressure drop) or
     ``{ frequency_hz = [...], value = [...] }`` (a table against excitation frequency,
-    evaluated at the synchronous frequency, thesis P3 §4; see
+    evaluated at the synchronous frequency, thesis P3 §4; optional ``interpolation`` =
+    ``"linear"`` | ``"pchip"`` and ``extrapolation`` = ``"hold"`` | ``"linear"``, see
     :func:`ambseal.model.seal.coefficient_value`); Childs' convention
     −f = [K k; −k K] q + [C c; −c C] q̇ + M q̈.
 ``[[spring]]``
@@ -415,11 +416,18 @@ class Affine(_Strict):
 
 
 class FrequencyTable(_Strict):
-    """A coefficient tabulated against excitation frequency (Hz), interpolated linearly and
-    held constant outside the table: ``{ frequency_hz = [...], value = [...] }``."""
+    """A coefficient tabulated against excitation frequency (Hz):
+    ``{ frequency_hz = [...], value = [...] }``, interpolated by ``interpolation`` —
+    ``"linear"`` (the default) or ``"pchip"`` (a shape-preserving piecewise cubic, Fritsch
+    & Carlson 1980; linear between two points) — and beyond its ends by ``extrapolation``:
+    ``"hold"`` (the default: the end value) or ``"linear"`` (the end slope). ROSS 3.1
+    evaluates its bearing and seal tables as ``pchip``/``linear``
+    (:func:`ambseal.model.seal.table_value`)."""
 
     frequency_hz: list[BoundedFrequency] = Field(min_length=1, max_length=10000)
     value: list[_Big] = Field(min_length=1, max_length=10000)
+    interpolation: Literal["linear", "pchip"] = "linear"
+    extrapolation: Literal["hold", "linear"] = "hold"
 
     @model_validator(mode="after")
     def _table(self) -> "FrequencyTable":

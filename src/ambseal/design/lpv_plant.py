@@ -29,7 +29,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-import scipy.linalg as sla
 
 from ambseal.config import FrequencyTable
 from ambseal.errors import ModelError
@@ -228,7 +227,7 @@ def lpv_plant(cfg, speeds_hz, *, reference_speed_hz: float | None = None,
     T_L, T_R, mech = red.T_L, red.T_R, red.plant
     # gyroscopic part of A_f per rad/s: [[0, 0], [0, −M⁻¹G]], projected once
     nd = sys_ref.n_dof
-    MiG = sla.cho_solve(sla.cho_factor(sys_ref.M), sys_ref.G)
+    MiG = sys_ref.mass_solve(sys_ref.G)
     A_gyro = -T_L[:, nd:] @ MiG @ T_R[nd:, :]
     # seal coefficients through their (projected) LFT channels: A += Δθ B_θ C_θ
     p_bar = cfg.operating.pressure_bar

@@ -44,10 +44,13 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
 * ``BearingElement`` and its kinds (``SealElement``, fluid-film, ball, ...): coefficients of
   the isotropic, skew form (kxx = kyy, kxy = −kyx, cxx = cyy, cxy = −cyx, mxx = myy, no cross
   mass) → ``[[seal]]`` with K = kxx, k = kxy, C = cxx, c = cxy, M = mxx (Childs'
-  convention); against frequency, a table in Hz (ROSS's rad/s / 2π) of the values ROSS's
-  own interpolant gives at its frequencies (and at the operating frequency, when inside),
-  evaluated by ambseal at the synchronous frequency as ROSS's ``run_modal`` does (ambseal
-  interpolates linearly between the points, ROSS with a smoothing spline). Any other
+  convention); against speed or frequency, a table in Hz (ROSS's rad/s / 2π) evaluated by
+  ambseal at the synchronous frequency as ROSS's ``run_modal`` does: ROSS 3's table along
+  one axis as it is, with ROSS 3.1's law (``pchip`` or ``linear``, continued with the end
+  slopes: the same coefficient at every speed); ROSS 2.3's (a smoothing spline) and ROSS
+  3's over speed and frequency both as the values ROSS's interpolant gives at its points
+  (and at the operating frequency, when inside), linear between them, held outside. Any
+  other
   coefficients → ``[[spring]]`` (kxx, kyy, kxy, kyx, cxx, cyy, cxy, cyx, and the mass terms
   mxx, myy, mxy, myx), of ``kind = "seal"`` for ROSS's seals (``SealElement`` and its
   kinds: the sign-off must not take a balance piston for a bearing);
@@ -300,12 +303,26 @@ def _spring(el, z: float, i: int, varies: bool, omega: float, notes: list) -> di
     return {"name": _name(el.tag, f"bearing{i}"), "position": z, **vals}
 
 
+def _ross3_law(el) -> str | None:
+    """ROSS 3's interpolation of a table along one axis (``"pchip"`` or ``"linear"``, both
+    continued with the end slope), which a rig's table reproduces; None for ROSS 2.3's
+    smoothing spline and for ROSS 3's tables over speed and frequency both."""
+    law = getattr(el, "interpolation", None)
+    one_axis = (getattr(el, "speed", None) is None) != (getattr(el, "frequency", None) is None)
+    return law if law in ("pchip", "linear") and one_axis else None
+
+
 def _seal(el, z: float, i: int, varies: bool, omega: float) -> dict:
     keys = {"K": "kxx", "k": "kxy", "C": "cxx", "c": "cxy", "M": "mxx"}
     entry = {"name": _name(el.tag, f"bearing{i}"), "position": z}
     if not varies:
         return entry | {k: float(_coef(el, v)[0]) for k, v in keys.items()}
     w = sorted({float(x) for x in _axis(el)})
+    law = _ross3_law(el)
+    if law is not None:  # ROSS 3.1's own interpolant, between and beyond the points
+        return entry | {k: {"frequency_hz": [x / (2 * math.pi) for x in w],
+                            "value": [_at(el, v, x) for x in w], "interpolation": law,
+                            "extrapolation": "linear"} for k, v in keys.items()}
     if w[0] < omega < w[-1] and not any(math.isclose(omega, x) for x in w):
         w = sorted(w + [omega])  # exact at the operating speed, too
     return entry | {k: {"frequency_hz": [x / (2 * math.pi) for x in w],
@@ -445,7 +462,8 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
             rig["spring"][-1]["housing"] = _housing(rotor, bearings, linked[id(b)])
         if varies:
             notes.append(_one_frequency_note(i, b, omega, rpm, rule))
-    tables = [s["name"] for s in rig["seal"] if isinstance(s["K"], dict)]
+    tables = [s["name"] for s in rig["seal"] if isinstance(s["K"], dict)
+              and "interpolation" not in s["K"]]
     if tables:
         notes.append(f"seal(s) {', '.join(tables)}: frequency tables of ROSS's values at its "
                      "frequencies; ambseal interpolates linearly between them and holds the "

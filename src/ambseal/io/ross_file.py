@@ -122,15 +122,19 @@ def _interpolant(values, speed, frequency, method: str):
     return lambda w, s=None: float(along(w))
 
 
-def _bearing(table: dict, where: str, seal: bool = False) -> _Element:
+def _bearing(table: dict, where: str, seal: str | None = None) -> _Element:
+    """A bearing, or a seal of ROSS's class ``seal`` (its saved coefficient tables)."""
     amb = all(k in table for k in _AMB_KEYS)
-    el = (MagneticBearingElement if amb else SealElement if seal else BearingElement)(table)
+    kind = (MagneticBearingElement if amb else BearingElement if seal is None
+            else SealElement if seal == "SealElement" else _kind(seal))
+    el = kind(table)
     el.n_link = table.get("n_link")
     speed, freq = table.get("speed"), table.get("frequency")
     method = table.get("interpolation", "pchip")
     if method not in ("pchip", "linear"):
         raise ConfigError(f"{where}: bearing {el.tag}: interpolation {method!r} (expected "
                           "'pchip' or 'linear')")
+    el.interpolation = method  # ROSS 3.1's default where the file names none
     for name in _COEFFS + ("kzz", "mzz"):
         v = table.get(name, [0.0])
         setattr(el, name, np.asarray(v, float))
@@ -165,6 +169,8 @@ class _Rotor:
             kind = key.split("_")[0]
             if key in ("parameters", "ross_version") or not isinstance(table, dict):
                 continue
+            if "tag" not in table and "_" in key:  # ROSS's own tag: the key's second part
+                table = {**table, "tag": key.split("_", 1)[1]}
             if kind == "ShaftElement":
                 el = ShaftElement(table)
                 el.material = _Material(table["material"])
@@ -180,8 +186,15 @@ class _Rotor:
                 motors.append(MotorElement(table))
             elif kind == "PointMass":
                 self.point_mass_elements.append(PointMass(table))
-            elif kind in ("BearingElement", "SealElement"):
-                self.bearing_elements.append(_bearing(table, where, kind == "SealElement"))
+            elif kind == "BearingElement":
+                self.bearing_elements.append(_bearing(table, where))
+            elif kind.endswith("Seal") or kind == "SealElement":
+                # a seal of any of ROSS's models (labyrinth, hole-pattern, ...): ROSS 3
+                # loads its saved coefficient tables as they are, without its model
+                if "kxx" not in table:
+                    unknown.append(f"{kind} {table.get('tag', key)} (no coefficients)")
+                    continue
+                self.bearing_elements.append(_bearing(table, where, kind))
             else:
                 unknown.append(f"{kind} {table.get('tag', key)}")
         if unknown:

@@ -81,21 +81,32 @@ class SecondOrderSystem:
         return self.M.shape[0]
 
     def mass_factor(self):
-        """Cholesky factor of M; ModelError if M is not positive definite (e.g. a negative
-        seal mass coefficient)."""
+        """A factor of M for :meth:`mass_solve`: Cholesky where M is symmetric, else LU (a
+        spring's cross added mass, mxy ≠ myx, as ROSS's hole-pattern seals carry);
+        ModelError if M's symmetric part is not positive definite (e.g. a negative seal
+        mass coefficient)."""
+        sym = (self.M + self.M.T) / 2
         try:
-            return sla.cho_factor(self.M)
+            chol = sla.cho_factor(sym)
         except np.linalg.LinAlgError:
             raise ModelError("the mass matrix is not positive definite (check disk masses "
                              "and the seals' M coefficients)") from None
+        if np.array_equal(sym, self.M):
+            return "cholesky", chol
+        return "lu", sla.lu_factor(self.M)
+
+    def mass_solve(self, X: np.ndarray, factor=None) -> np.ndarray:
+        """M⁻¹ X, by :meth:`mass_factor` (or the ``factor`` it returned)."""
+        kind, f = factor if factor is not None else self.mass_factor()
+        return sla.cho_solve(f, X) if kind == "cholesky" else sla.lu_solve(f, X)
 
     def state_matrices(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(A, B, C) of the first-order form x = [q; q̇]."""
         n = self.n_dof
         lu = self.mass_factor()
-        MiK = sla.cho_solve(lu, self.K)
-        MiD = sla.cho_solve(lu, self.C + self.speed * self.G)
-        MiB = sla.cho_solve(lu, self.B)
+        MiK = self.mass_solve(self.K, lu)
+        MiD = self.mass_solve(self.C + self.speed * self.G, lu)
+        MiB = self.mass_solve(self.B, lu)
         A = np.block([[np.zeros((n, n)), np.eye(n)], [-MiK, -MiD]])
         B = np.vstack([np.zeros_like(self.B), MiB])
         C = np.hstack([self.Cq, np.zeros_like(self.Cq)])
@@ -248,7 +259,7 @@ def mechanical_plant(sys: SecondOrderSystem) -> Plant:
     lu = sys.mass_factor()
     params: dict[str, Parameter] = {}
     for ch in sys.changes:
-        MiU = sla.cho_solve(lu, ch.U)
+        MiU = sys.mass_solve(ch.U, lu)
         r = ch.U.shape[1]
         zero = np.zeros((n, r))
         if ch.kind == "B":

@@ -7,8 +7,9 @@ Rotordynamics*, 1993, §3.2; thesis P4 Eq. 3):
 
 positive K restores, positive k drives forward whirl. Each coefficient is a number, affine
 in the pressure drop (``at_zero + per_bar · pressure_bar``, thesis P5 §4.1) or a table
-against excitation frequency, interpolated linearly and held constant outside the table
-(thesis P3 §4, taken at the synchronous frequency Ω/2π unless told otherwise).
+against excitation frequency (thesis P3 §4, taken at the synchronous frequency Ω/2π unless
+told otherwise), interpolated linearly (or by pchip) and held constant (or continued with
+its end slope) outside the table (:func:`table_value`).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.interpolate import PchipInterpolator
 
 from ambseal.config import Affine, FrequencyTable, Seal
 from ambseal.errors import ModelError
@@ -23,7 +25,7 @@ from ambseal.lti import interp_table
 from ambseal.model.lft import Channel
 from ambseal.model.rotor import Mesh, X, Y
 
-__all__ = ["COEFFICIENTS", "coefficient_value", "seal_coefficients",
+__all__ = ["COEFFICIENTS", "coefficient_value", "table_value", "seal_coefficients",
            "seal_values", "pressure_for_k", "values_following_k", "SealElement"]
 
 COEFFICIENTS = ("K", "k", "C", "c", "M")
@@ -50,8 +52,8 @@ def coefficient_value(c: float | Affine | FrequencyTable, pressure_bar: float,
     Returns
     -------
     float
-        ``c``, ``at_zero + per_bar · pressure_bar``, or the table interpolated linearly
-        at ``frequency_hz`` and held at its end values outside (:func:`interp_table`).
+        ``c``, ``at_zero + per_bar · pressure_bar``, or the table at ``frequency_hz``
+        (:func:`table_value`).
 
     Raises
     ------
@@ -65,8 +67,49 @@ def coefficient_value(c: float | Affine | FrequencyTable, pressure_bar: float,
             raise ModelError("a frequency-dependent seal coefficient needs a frequency "
                              "(by default the synchronous one; at standstill the table's "
                              "first value holds)")
-        return interp_table(frequency_hz, c.frequency_hz, c.value)
+        return table_value(c, frequency_hz)
     return float(c)
+
+
+def table_value(table: FrequencyTable, frequency_hz: float) -> float:
+    """A frequency table's value (:class:`~ambseal.config.FrequencyTable`): interpolated
+    linearly or by a shape-preserving piecewise cubic Hermite interpolant (``pchip``,
+    Fritsch & Carlson, *SIAM J. Numer. Anal.* 17, 1980; SciPy's ``PchipInterpolator``;
+    linear between two points), and outside the table held at the end value or continued
+    with the end slope (``extrapolation = "linear"``) — ROSS 3.1's
+    ``BearingCoefficient`` along one axis is ``pchip`` or ``linear`` with the end slope.
+
+    Parameters
+    ----------
+    table : FrequencyTable
+        The points (Hz), the values, and the laws between and beyond them.
+    frequency_hz : float
+        The excitation frequency (Hz).
+
+    Returns
+    -------
+    float
+    """
+    x = np.asarray(table.frequency_hz, float)
+    y = np.asarray(table.value, float)
+    if x.size == 1:
+        return float(y[0])
+    f = float(frequency_hz)
+    inside = min(max(f, x[0]), x[-1])
+    if table.interpolation == "pchip" and x.size > 2:
+        p = PchipInterpolator(x, y)
+        value, slope = float(p(inside)), p.derivative()
+    else:
+        value, slope = interp_table(inside, x, y), None
+    if table.extrapolation == "hold" or f == inside:
+        return value
+    end = 0 if f < inside else -1
+    if slope is not None:
+        d = float(slope(x[end]))
+    else:
+        d = float((y[1] - y[0]) / (x[1] - x[0]) if end == 0 else
+                  (y[-1] - y[-2]) / (x[-1] - x[-2]))
+    return value + (f - inside) * d
 
 
 def seal_coefficients(seal: Seal, pressure_bar: float,

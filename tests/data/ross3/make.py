@@ -24,6 +24,26 @@ with contextlib.redirect_stdout(sys.stderr), warnings.catch_warnings():
 
 HERE = Path(__file__).parent
 SPEEDS_RAD_S = (150.0, 300.0, 400.0)
+#: rotor_seals' labyrinth is tabulated at 523.6 and 837.8 rad/s: below, on, between and
+#: beyond its points (ROSS continues it with its end slopes)
+SEALS_SPEEDS_RAD_S = (300.0, 523.6, 700.0, 900.0)
+
+
+def seals_rotor():
+    """ROSS's own ROSS 2 test rotor with seals (``tests/data/v2/rotor_seals.toml``: a
+    labyrinth seal tabulated at two speeds, a hole-pattern seal with cross mass), as
+    ROSS 3.1's ``ross_2to3`` converts it."""
+    from ross.ross_2to3 import Report, convert_model_text
+
+    src = Path(rs.__file__).parent / "tests" / "data" / "v2" / "rotor_seals.toml"
+    text = convert_model_text(src.read_text(), ".toml", Report(), path=src,
+                              version=rs.__version__)
+    tmp = HERE / "_seals_converted.toml"
+    tmp.write_text(text)
+    try:
+        return rs.Rotor.load(tmp)
+    finally:
+        tmp.unlink()
 
 
 def modal_rotor():
@@ -58,10 +78,12 @@ def rotor():
 if __name__ == "__main__":
     with contextlib.redirect_stdout(sys.stderr), warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        for name, r in (("tables", rotor()), ("modal", modal_rotor())):
+        for name, r, speeds in (("tables", rotor(), SPEEDS_RAD_S),
+                                ("modal", modal_rotor(), SPEEDS_RAD_S),
+                                ("seals", seals_rotor(), SEALS_SPEEDS_RAD_S)):
             r.save(HERE / f"{name}.toml")
             out = {"ross_version": rs.__version__}
-            for w in SPEEDS_RAD_S:
+            for w in speeds:
                 lam, _ = r._eigen(w, sparse=False)
                 out[f"{w:g}"] = [[float(x.real), float(x.imag)] for x in np.asarray(lam)]
             rows = ",\n".join(f"{json.dumps(k)}: {json.dumps(v)}" for k, v in out.items())

@@ -73,3 +73,31 @@ def test_ross3_file_modes_equal_ross_31(tmp_path, capsys, name, speed_rad_s):
         assert abs(lam_ross[j] - lam) <= 1e-6 * abs(lam)
         ref_dec = -2 * np.pi * lam_ross[j].real / lam_ross[j].imag
         assert dec == pytest.approx(ref_dec, rel=1e-6, abs=1e-9)
+
+
+def test_a_ross2_file_is_read_by_the_installed_ross(tmp_path, capsys):
+    """ROSS's own ROSS 2.3 test rotor with seals (``tests/data/ross2_rotor_seals.toml``,
+    ROSS's ``tests/data/v2/rotor_seals.toml``). Where ROSS 3 is installed it is converted
+    by ROSS 3's own ``ross_2to3`` (said in the rig file) and imported — it had been refused
+    as "not a ROSS rotor file (TypeError: LabyrinthSeal…)" — and its modes at 523.6
+    rad/s, a point of the labyrinth's table, equal ROSS 3.1's eigenvalues of the converted
+    rotor (``seals_eigenvalues.json``) to 1e-6. ROSS 2.3 cannot load its labyrinth
+    without the ``rossxl`` package: the refusal says so (exit 2)."""
+    src = tmp_path / "rotor_seals.toml"
+    shutil.copy(DATA.parent / "ross2_rotor_seals.toml", src)
+    out = tmp_path / "rig.toml"
+    major = _ross_major()
+    code = main(["import-ross", str(src), "--out", str(out), "--speed-rpm", "5000"])
+    err = capsys.readouterr().err
+    if major is None or major < 3:
+        assert code == 2 and "rossxl" in err and "ROSS 3" in err and "Traceback" not in err
+        return
+    assert code == 0
+    assert "converted by ROSS 3" in out.read_text().split("\n[", 1)[0]
+    rig = load_rig(out)
+    ref = json.loads((DATA / "seals_eigenvalues.json").read_text())
+    lam_ross = np.array([complex(*x) for x in ref["523.6"]])
+    m = closed_loop_modes(rig, None, speed_hz=523.6 / (2 * np.pi), max_hz=500.0)
+    assert len(m.poles) >= 8
+    for lam in m.poles:
+        assert np.min(np.abs(lam_ross - lam)) <= 1e-6 * abs(lam)

@@ -85,6 +85,7 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import importlib.metadata
+import importlib.util
 import json
 import math
 import os
@@ -863,16 +864,49 @@ def load_ross(path: str | Path):
         raise ConfigError(f"{path}: expected a ROSS rotor file (.toml or .json)")
     ross = _ross()
     data = _check_file(path, ross)
-    with _stdout_to_stderr(), warnings.catch_warnings():
+    with _stdout_to_stderr(), warnings.catch_warnings(), \
+            tempfile.TemporaryDirectory(prefix="ambseal-ross2-") as tmp:
         warnings.simplefilter("ignore")
         try:
-            rotor = ross.Rotor.load(path)
+            src = path
+            if _older_file(data, ross):
+                src, data = _converted(path, data, ross, Path(tmp))
+            rotor = ross.Rotor.load(src)
             _restore_ambs(rotor, data, ross)
+        except ModuleNotFoundError as exc:  # ROSS 2.3's seal models need rossxl
+            raise ConfigError(f"{path}: a ROSS {data.get('ross_version', '')} rotor file that "
+                              f"the installed ROSS {ross.__version__} cannot load: it needs "
+                              f"the package {exc.name!r}, which is not installed (ROSS 3, on "
+                              "Python 3.12 or newer, converts and loads it)") from None
         except Exception as exc:  # ROSS raises anything from KeyError to TOML errors
             msg = str(exc).splitlines()[0] if str(exc) else ""
             raise ConfigError(f"{path}: not a ROSS rotor file ({type(exc).__name__}: "
                               f"{msg})") from None
     return rotor
+
+
+def _older_file(data: dict, ross) -> bool:
+    """Whether a rotor file (its tables ``data``) was saved by a ROSS major before the
+    installed one, which ships ``ross_2to3`` to convert it (ROSS 3: a ROSS 2 file's seals
+    and tables over frequency do not load as they are)."""
+    saved, have = _major(data.get("ross_version")), _major(getattr(ross, "__version__", None))
+    return (saved is not None and have is not None and saved < have
+            and importlib.util.find_spec("ross.ross_2to3") is not None)
+
+
+def _converted(path: Path, data: dict, ross, folder: Path) -> tuple[Path, dict]:
+    """The ROSS 2 file converted by the installed ROSS's own ``ross_2to3`` (written into
+    ``folder``, a temporary one) and its tables."""
+    from ross.ross_2to3 import Report, convert_model_text
+
+    text = convert_model_text(read_text(path, "ROSS rotor file"), path.suffix.lower(),
+                              Report(), path=path, version=ross.__version__)
+    if text is None:
+        raise ConfigError(f"{path}: a ROSS {data.get('ross_version')} file that ROSS "
+                          f"{ross.__version__}'s ross_2to3 does not take for a model")
+    out = folder / f"converted{path.suffix.lower()}"
+    out.write_text(text, encoding="utf-8")
+    return out, (json.loads(text) if path.suffix.lower() == ".json" else tomllib.loads(text))
 
 
 def _restore_ambs(rotor, data: dict, ross) -> None:
@@ -971,8 +1005,14 @@ def _child() -> None:
     try:
         rotor = load_ross(path)
         res = from_ross(rotor, where=where, speed_rpm=json.loads(sys.argv[3]))
+        ross = _ross()
+        data = _check_file(path, ross)
+        notes = list(res.notes)
+        if _older_file(data, ross):
+            notes.insert(0, f"ROSS {data['ross_version']}'s file, converted by ROSS "
+                            f"{ross.__version__}'s own ross_2to3 before it was loaded")
         doc = {"rig": res.rig.model_dump(exclude_none=True), "unmapped": list(res.unmapped),
-               "notes": list(res.notes), "ross_version": str(_ross().__version__)}
+               "notes": notes, "ross_version": str(ross.__version__)}
     except AmbsealError as exc:  # the user's name of the file, not the absolute one
         doc = {"error": str(exc).replace(str(path), where, 1)}
     out.write_text(json.dumps(doc, allow_nan=False), encoding="utf-8")

@@ -235,6 +235,8 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "SpringHousing.cxy": ("N·s/m", "cross-coupled support damping"),
     "SpringHousing.cyx": ("N·s/m", "cross-coupled support damping"),
     "Spring.name": ("", "names its parameters (``coupling.kxx``); unnamed: ``spring<i>``"),
+    "Spring.clearance": ("m", "radial running clearance of the bearing or seal: a close "
+                              "clearance of the API 617 unbalance response"),
     "Spring.kind": ("", "``bearing`` (default) or ``seal``: a seal whose coefficients have "
                         "no Childs form (kxy = kyx); the sign-off treats it as a seal — a "
                         "source, left out of Level I, no bearing, no journal load, no probe"),
@@ -292,7 +294,11 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                                        "times the trip speed"),
     "Signoff.vibration_limit_cap_um": ("µm", "cap of A_vl = 25.4 √(12000/N) µm p-p"),
     "Signoff.scale_factor_limits": ("", "``[low, high]`` bounds of the scale factor "
-                                        "S_c = A_vl/A_probe"),
+                                        "S_c = A_vl/A_probe (default [0.5, 6], API 617 "
+                                        "8th ed. Part 1 §4.8.2.11; ROSS 3.1: [0, 6])"),
+    "Signoff.scale_factor_speeds": ("", "where A_probe is taken: ``to_trip`` (default, "
+                                        "standstill to the trip speed) or ``continuous`` "
+                                        "(minimum to maximum continuous, ROSS 3.1's)"),
     "Signoff.clearance_fraction": ("", "the scaled response's allowed fraction of each "
                                        "close clearance (diametral)"),
     "Signoff.iso14839_2_zones": ("", "ISO 14839-2 zone boundaries A/B, B/C, C/D as "

@@ -111,6 +111,43 @@ def test_close_clearance_is_the_scaled_response_against_its_fraction():
     assert np.all(np.diff(c.speed_hz) > 0)
 
 
+def test_scale_factor_over_the_continuous_range_without_a_floor_as_ross():
+    """``[signoff] scale_factor_speeds = "continuous"`` and ``scale_factor_limits = [0,
+    6]`` (ROSS 3.1's ``run_clearance_analysis``: A_1 from the minimum to the maximum
+    continuous speed, no lower bound): on the rotor whose critical sits at its 3000 rpm
+    (133 µm against A_vl 25.4 µm) S_c = A_vl/A_1 = 0.19, where the default (standstill to
+    trip, at least 0.5) gives 0.5."""
+    doc = tomllib.loads(_rigid_rotor(1e7, 2000.0, 4.5e4))
+    doc["seal"] = [{"name": "eye", "position": 0.2, "clearance": 3e-4}]
+    r = api617_unbalance(parse_rig(doc))
+    assert r.cases[0].scale_factor == 0.5
+    doc["signoff"] = {"scale_factor_speeds": "continuous", "scale_factor_limits": [0.0, 6.0]}
+    r = api617_unbalance(parse_rig(doc))
+    c = r.cases[0]
+    cont = (c.speed_hz >= r.min_hz - 1e-9) & (c.speed_hz <= r.max_hz + 1e-9)
+    want = r.vibration_limit_um / c.probe_um[cont].max()
+    assert c.scale_factor == pytest.approx(want, rel=1e-12) and want < 0.25
+
+
+def test_a_plain_bearings_clearance_is_a_close_clearance_too():
+    """The same rotor's two supports as springs with a 0.15 mm radial clearance each (a
+    plain bearing's, ``[[spring]] clearance``): each is judged as the seal is above, S_c
+    times its own largest response to the trip speed against 75 % of its 0.3 mm diametral
+    clearance; at the supports of the rigid rotor the response is the probes' (they are
+    the probes), so the scaled response is S_c·A_1."""
+    doc = tomllib.loads(_rigid_rotor(1e8, 2.0e4, 4.5e4))
+    for sp in doc["spring"]:
+        sp["clearance"] = 1.5e-4
+    r = api617_unbalance(parse_rig(doc))
+    c = r.cases[0]
+    upto = c.speed_hz <= r.trip_hz + 1e-9
+    a1 = c.probe_um[upto].max()
+    assert len(c.clearances) == 2
+    for k in c.clearances:
+        assert k.diametral_um == pytest.approx(300.0) and k.allowed_um == pytest.approx(225.0)
+        assert k.scaled_um == pytest.approx(c.scale_factor * a1, rel=1e-6)
+
+
 def test_synchronous_response_with_the_loop_as_it_runs_is_the_judged_sampled_loop():
     """The overhung compressor's PID as it runs, a rotating unbalance at the impeller at
     100 Hz: the orbit at AMB A's sensor from the dynamic stiffness closed by

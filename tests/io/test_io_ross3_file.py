@@ -39,7 +39,8 @@ def test_ross3_file_modes_equal_ross_31(tmp_path, capsys, name, speed_rad_s):
     over its torsional and axial modes too (its 5th and 14th flexible ones: the lateral
     modes skip those ratios); ``seals``, ROSS's own ROSS 2 test rotor with a labyrinth seal
     tabulated at 523.6 and 837.8 rad/s and a hole-pattern seal, converted by ROSS 3.1's
-    ``ross_2to3``: below, on, between and beyond the labyrinth's points, where ROSS
+    ``ross_2to3`` (their radial clearances imported): below, on, between and beyond the
+    labyrinth's points, where ROSS
     continues the table with its end slopes (a table held at its ends put the mode at
     124 Hz at δ 0.009 at 300 rad/s where ROSS has 0.867). Every lateral mode up to 500 Hz
     (damped frequency and log decrement) equals one of ROSS 3.1's eigenvalues at that
@@ -60,6 +61,9 @@ def test_ross3_file_modes_equal_ross_31(tmp_path, capsys, name, speed_rad_s):
     elif name == "seals":
         law = rig.seal[0].K
         assert (law.interpolation, law.extrapolation) == ("pchip", "linear")
+        # ROSS's radial_clearance of both seals (0.3 mm), the hole-pattern one a spring
+        assert rig.seal[0].clearance == 3e-4
+        assert [s.clearance for s in rig.spring if s.kind == "seal"] == [3e-4]
     else:
         assert rig.rotor.supported_modal_damping.ratios == [
             0.001 * (k + 1) for k in range(14) if k + 1 not in (5, 14)]

@@ -45,11 +45,15 @@ stated):
   vibration_limit_cap_um`` (25.4 µm); the probes' largest amplitude from the minimum
   continuous to the trip speed must not exceed it.
 * **Close clearances.** The scale factor ``S_c = A_vl / A_1`` (A_1 the probes' largest
-  amplitude from standstill to the trip speed), bounded to ``[signoff]
-  scale_factor_limits`` ([0.5, 6]); the response at every close clearance (a seal's
-  ``clearance``, a backup bearing's ``backup_clearance`` at its AMB), times S_c, from
-  standstill to the trip speed, must stay within ``[signoff] clearance_fraction`` (75 %)
-  of the diametral clearance.
+  amplitude over ``[signoff] scale_factor_speeds``: ``"to_trip"``, standstill to the
+  trip speed, by default; ``"continuous"``, the minimum to the maximum continuous speed,
+  as ROSS 3.1's ``run_clearance_analysis`` takes it), bounded to ``[signoff]
+  scale_factor_limits`` ([0.5, 6]; ROSS 3.1 has no lower bound: ``[0, 6]``). API 617
+  (8th ed., 2014) Part 1 §4.8.2.11 defines S_c and its bounds; the speed range of A_1
+  is not in the public text, and both readings are settings. The response at every
+  close clearance (a seal's or a spring's ``clearance``, a backup bearing's
+  ``backup_clearance`` at its AMB), times S_c, from standstill to the trip speed, must
+  stay within ``[signoff] clearance_fraction`` (75 %) of the diametral clearance.
 """
 
 from __future__ import annotations
@@ -493,9 +497,11 @@ def _placements(cfg, modes, loads, factor: float, n_rpm: float) -> list[tuple]:
 
 
 def _close_clearances(cfg) -> list[tuple[str, float, float]]:
-    """(name, position m, radial clearance m) of each seal with a ``clearance`` and each
-    backup bearing (at its AMB)."""
+    """(name, position m, radial clearance m) of each seal and spring (a plain bearing, a
+    seal without Childs form) with a ``clearance`` and each backup bearing (at its AMB)."""
     out = [(s.name, s.position, s.clearance) for s in cfg.seal if s.clearance is not None]
+    out += [(s.name or f"spring{i}", s.position, s.clearance)
+            for i, s in enumerate(cfg.spring) if s.clearance is not None]
     out += [(f"backup bearing {a.name}", a.position, a.backup_clearance)
             for a in cfg.amb if a.backup_clearance is not None]
     return out
@@ -608,6 +614,8 @@ def api617_unbalance(cfg, controller=None, *, name: str = "none",
         speed, amp = speed[order], np.concatenate([amp, response(fine)], axis=1)[:, order]
     lo_, hi_ = (speed >= f_min - 1e-9) & (speed <= trip + 1e-9), speed <= trip + 1e-9
     s_lo, s_hi = so.scale_factor_limits
+    a1_speeds = (((speed >= f_min - 1e-9) & (speed <= f_max + 1e-9))
+                 if so.scale_factor_speeds == "continuous" else hi_)
     out = []
     for c, (f_mode, rule, unb) in enumerate(cases):
         pr = amp[c, :, :len(probes)]
@@ -617,7 +625,7 @@ def api617_unbalance(cfg, controller=None, *, name: str = "none",
             return 2e6 * float(r.amplitude_m[0, 0, 0])
 
         crit = _criticals(speed, pr, probes, f_min, f_max, at)
-        a1 = float(pr[hi_].max())
+        a1 = float(pr[a1_speeds].max())
         sc = float(np.clip(a_vl / a1, s_lo, s_hi)) if a1 > 0 else s_hi
         clear = tuple(Clearance(n, float(z), 2e6 * rc, so.clearance_fraction * 2e6 * rc,
                                 float(sc * amp[c, hi_, len(probes) + j].max()))

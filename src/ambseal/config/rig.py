@@ -71,7 +71,9 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     in kg, N/m, N·s/m: the spring joins the shaft to this mass, which its own springs and
     dampers hold to ground in x, y), ``name`` (optional), ``kind`` (``"bearing"``, the
     default, or ``"seal"``: a seal whose coefficients have no Childs form — the sign-off
-    then treats it as a seal, a source, never a bearing).
+    then treats it as a seal, a source, never a bearing), ``clearance`` (m, optional: the
+    radial running clearance of the bearing or seal, a close clearance of the API 617
+    unbalance response, as a ``[[seal]]``'s).
 ``[controller.pid]``
     ``kp`` (A/m), ``ti`` (s), ``td`` (s), ``eps`` (-): thesis P5 Eq. 6, per actuator axis;
     ``cross_kp`` (A/m) and ``cross_kd`` (A·s/m), default 0: cross-axis gains between the
@@ -509,6 +511,9 @@ class Spring(_Strict):
     # a seal whose coefficients have no Childs form (kxy = kyx, a balance piston's): the
     # sign-off must not take it for a bearing
     kind: Literal["bearing", "seal"] = "bearing"
+    # radial running clearance of a plain bearing or seal: API 617's close clearances, as
+    # a [[seal]]'s
+    clearance: float | None = Field(default=None, ge=1e-6, le=0.1)
 
 
 class Stage(_Strict):
@@ -553,7 +558,8 @@ class Signoff(_Strict):
     flat beyond), the least log decrement ``log_dec_min`` (Level I's δ_A and Level II),
     the unbalance ``unbalance_factor`` × U_r, the analysed speeds up to
     ``analysis_top_ratio`` × the trip speed, the vibration limit's cap
-    ``vibration_limit_cap_um`` (µm p-p), the scale factor's ``scale_factor_limits`` and the
+    ``vibration_limit_cap_um`` (µm p-p), the scale factor's ``scale_factor_limits`` and
+    ``scale_factor_speeds`` (``"to_trip"`` or ``"continuous"``), the
     close clearances' allowed ``clearance_fraction``, and ISO 14839-2's zone boundaries
     ``iso14839_2_zones`` (fractions of the backup bearing's clearance C_min)."""
 
@@ -564,6 +570,9 @@ class Signoff(_Strict):
     analysis_top_ratio: float = Field(default=1.25, ge=1.0, le=5.0)
     vibration_limit_cap_um: float = Field(default=25.4, gt=0, le=1e4)
     scale_factor_limits: tuple[float, float] = Field(default=(0.5, 6.0), strict=False)
+    # the speeds over which A_1 of S_c = A_vl/A_1 is taken (API 617 8th ed. Part 1
+    # §4.8.2.11 as read: standstill to trip; ROSS 3.1: minimum to maximum continuous)
+    scale_factor_speeds: Literal["to_trip", "continuous"] = "to_trip"
     clearance_fraction: float = Field(default=0.75, gt=0, le=1.0)
     iso14839_2_zones: tuple[float, float, float] = Field(default=(0.3, 0.4, 0.5),
                                                          strict=False)
@@ -576,9 +585,9 @@ class Signoff(_Strict):
             raise ValueError("csr_boundary: expected [density kg/m³, CSR] points with "
                              "densities increasing within 0–2000 and CSR within (0, 100]")
         lo, hi = self.scale_factor_limits
-        if not 0 < lo <= hi <= 100:
-            raise ValueError("scale_factor_limits: expected [low, high] with 0 < low <= "
-                             "high <= 100")
+        if not 0 <= lo <= hi <= 100 or hi == 0:
+            raise ValueError("scale_factor_limits: expected [low, high] with 0 <= low <= "
+                             "high <= 100, high > 0 (low 0: no lower bound)")
         z = self.iso14839_2_zones
         if not 0 < z[0] < z[1] < z[2] <= 1:
             raise ValueError("iso14839_2_zones: expected A/B < B/C < C/D within (0, 1] "

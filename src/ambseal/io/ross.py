@@ -53,7 +53,9 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
   other
   coefficients → ``[[spring]]`` (kxx, kyy, kxy, kyx, cxx, cyy, cxy, cyx, and the mass terms
   mxx, myy, mxy, myx), of ``kind = "seal"`` for ROSS's seals (``SealElement`` and its
-  kinds: the sign-off must not take a balance piston for a bearing);
+  kinds: the sign-off must not take a balance piston for a bearing); ROSS's
+  ``radial_clearance`` (the least of a table, as its ``run_clearance_analysis``) →
+  ``clearance`` of either, a close clearance of the sign-off;
   against frequency, ROSS's interpolant at one frequency: the synchronous frequency of the
   import speed (``speed_rpm``; by default the lowest frequency that every such table of
   ROSS's covers), written as ``[operating] speed_rpm`` and reported, so that ambseal's
@@ -84,6 +86,7 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
+import importlib
 import importlib.metadata
 import importlib.util
 import json
@@ -301,7 +304,7 @@ def _spring(el, z: float, i: int, varies: bool, omega: float, notes: list) -> di
                          f"taken as a pin, {MAX_SUPPORT_STIFFNESS:.0e} N/m (the rig file's "
                          "stiffest support; the pinned shaft's frequencies to 1e-8)")
             vals[n] = MAX_SUPPORT_STIFFNESS
-    return {"name": _name(el.tag, f"bearing{i}"), "position": z, **vals}
+    return {"name": _name(el.tag, f"bearing{i}"), "position": z, **vals, **_clearance(el)}
 
 
 def _ross3_law(el) -> str | None:
@@ -313,9 +316,19 @@ def _ross3_law(el) -> str | None:
     return law if law in ("pchip", "linear") and one_axis else None
 
 
+def _clearance(el) -> dict:
+    """``{"clearance": c}`` of a bearing or seal with ROSS's ``radial_clearance`` (m; the
+    least of a table, as ROSS's ``run_clearance_analysis`` takes it), else empty."""
+    rc = getattr(el, "radial_clearance", None)
+    if rc is None:
+        return {}
+    c = float(np.min(np.atleast_1d(np.asarray(getattr(rc, "magnitude", rc), float))))
+    return {"clearance": c}
+
+
 def _seal(el, z: float, i: int, varies: bool, omega: float) -> dict:
     keys = {"K": "kxx", "k": "kxy", "C": "cxx", "c": "cxy", "M": "mxx"}
-    entry = {"name": _name(el.tag, f"bearing{i}"), "position": z}
+    entry = {"name": _name(el.tag, f"bearing{i}"), "position": z, **_clearance(el)}
     if not varies:
         return entry | {k: float(_coef(el, v)[0]) for k, v in keys.items()}
     w = sorted({float(x) for x in _axis(el)})
@@ -897,10 +910,9 @@ def _older_file(data: dict, ross) -> bool:
 def _converted(path: Path, data: dict, ross, folder: Path) -> tuple[Path, dict]:
     """The ROSS 2 file converted by the installed ROSS's own ``ross_2to3`` (written into
     ``folder``, a temporary one) and its tables."""
-    from ross.ross_2to3 import Report, convert_model_text
-
-    text = convert_model_text(read_text(path, "ROSS rotor file"), path.suffix.lower(),
-                              Report(), path=path, version=ross.__version__)
+    conv = importlib.import_module("ross.ross_2to3")  # the installed ROSS's, as ross
+    text = conv.convert_model_text(read_text(path, "ROSS rotor file"), path.suffix.lower(),
+                                   conv.Report(), path=path, version=ross.__version__)
     if text is None:
         raise ConfigError(f"{path}: a ROSS {data.get('ross_version')} file that ROSS "
                           f"{ross.__version__}'s ross_2to3 does not take for a model")

@@ -208,7 +208,9 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                                          "(the end slope, ROSS 3.1's) outside"),
     # [[spring]]
     "Spring.position": ("m", "axial position (coupling, plain bearing, support)"),
-    "Spring.kxx": ("N/m", "direct stiffness in the spring's x axis"),
+    "Spring.kxx": ("N/m", "direct stiffness in the spring's x axis; this and every "
+                          "coefficient below a number or a frequency table (below), taken "
+                          "at the synchronous frequency"),
     "Spring.kyy": ("N/m", "direct stiffness in the spring's y axis"),
     "Spring.kxy": ("N/m", "cross-coupled stiffness"),
     "Spring.kyx": ("N/m", "cross-coupled stiffness"),

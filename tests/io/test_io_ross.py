@@ -247,11 +247,12 @@ def test_compressor_example_layers_and_frequency_dependent_bearings(examples):
     """ROSS's ``compressor_example``: 91 shaft elements on 55 node pairs (36 of them a
     shaft and a sleeve of E = 1 psi in parallel) → 55 sections with 36 layers; its two
     tilting-pad bearings and the anisotropic ``Seal 1`` (coefficients against frequency,
-    with cross-coupled damping) → springs at one frequency, the lowest their tables cover
-    (418.9 rad/s = 4000 rpm, ROSS's first table point), stated in the notes; the 11
-    isotropic skew seals → seal tables. At 4000 rpm, and at 4500 rpm between the tables'
-    points (springs then taken there), every lateral mode up to 2 kHz equals ROSS's to
-    1e-6."""
+    with cross-coupled damping) → springs with tables over the synchronous frequency; the
+    11 isotropic skew seals → seal tables; the operating speed the lowest their tables
+    cover (418.9 rad/s = 4000 rpm, ROSS's first table point). At 4000 rpm, at another
+    point of the springs' tables from the same rig (the springs taken there: a rig frozen
+    at 4000 rpm would not be), and at 4500 rpm between the tables' points (imported there)
+    every lateral mode up to 2 kHz equals ROSS's to 1e-6."""
     rotor, path = examples["compressor_example"]
     loaded = load_ross(path)
     imp = from_ross(loaded, where=str(path))
@@ -263,11 +264,60 @@ def test_compressor_example_layers_and_frequency_dependent_bearings(examples):
                       if b.tag in ("Bearing 0", "Bearing 13", "Seal 1"))
     assert cfg.operating.speed_rpm == pytest.approx(table_start * 30 / np.pi, rel=1e-12)
     assert cfg.operating.speed_rpm == pytest.approx(4000.0, rel=1e-9)
-    assert sum("taken at one frequency, 66.6667 Hz = 4000 rpm" in n for n in imp.notes) == 3
+    tabulated = [sp for sp in cfg.spring if sp.tabulated]
+    assert len(tabulated) == 3
     _assert_modes_equal_ross(cfg, rotor, cfg.speed, 2000.0, 12)
+    common = set.intersection(*(set(sp.kxx.frequency_hz) for sp in tabulated))
+    other = min(f for f in common if f > 70.0)  # a point of every table above 4000 rpm
+    w = 2 * np.pi * other
+    _assert_modes_equal_ross(cfg, rotor, w, 2000.0, _ross_lateral_count(rotor, w, 2000.0))
     at = from_ross(loaded, where=str(path), speed_rpm=4500.0).rig
     assert at.operating.speed_rpm == 4500.0
     _assert_modes_equal_ross(at, rotor, at.speed, 2000.0, 12)
+
+
+def test_compressor_unbalance_response_with_its_bearing_tables_equals_ross(examples):
+    """ROSS's ``compressor_example`` imported once, an unbalance of 2.6e-4 kg·m at its
+    mid-span node 31: ambseal's synchronous response (its bearings' and seals' tables
+    taken at each speed) against ROSS's ``run_unbalance_response`` — the orbit's
+    semi-major axis there (ROSS's x and y amplitudes, the largest of the ellipse by
+    brute force over a turn) equal to 1e-6 at the points of every bearing's table
+    (418.9–1047.2 rad/s), where ROSS 2.3's smoothing spline and 3's pchip agree with the
+    points; with ROSS 3 (its pchip reproduced) also on a fine grid across the first
+    critical, whose speed and half-power amplification factor then agree within 0.5 %
+    (sampled alike). Taken at one frequency (the rig frozen at 4000 rpm) the bearings
+    gave AF 188 where ROSS has 29."""
+    from ambseal.analysis.synchronous import Unbalance, synchronous_response
+    from ambseal.analysis.unbalance_api617 import amplification_factor
+
+    rotor, path = examples["compressor_example"]
+    cfg = from_ross(load_ross(path), where=str(path)).rig
+    node, amount = 31, 2.6e-4
+    z = float(rotor.nodes_pos[node])
+
+    def ross(w):
+        r = _quiet(rotor.run_unbalance_response, [node], [amount], [0.0], np.asarray(w))
+        x = np.asarray(r.forced_resp)[rotor.number_dof * node]
+        y = np.asarray(r.forced_resp)[rotor.number_dof * node + 1]
+        t = np.linspace(0, 2 * np.pi, 3601)[:, None]
+        return np.hypot((x * np.exp(1j * t)).real, (y * np.exp(1j * t)).real).max(axis=0)
+
+    def ours(w):
+        r = synchronous_response(cfg, None, np.asarray(w) / (2 * np.pi),
+                                 [[Unbalance(z, amount, 0.0)]], [z])
+        return r.amplitude_m[0, :, 0]
+
+    points = np.array([4000.0, 6000.0, 8000.0, 10000.0]) * np.pi / 30  # rad/s
+    np.testing.assert_allclose(ours(points), ross(points), rtol=1e-6)
+    if int(rs.__version__.split(".")[0]) < 3:
+        return
+    w = np.linspace(900.0, 1300.0, 801)
+    a, b = ours(w), ross(w)
+    np.testing.assert_allclose(a, b, rtol=1e-6)
+    i, j = int(np.argmax(a)), int(np.argmax(b))
+    assert w[i] == pytest.approx(w[j], rel=5e-3)
+    assert amplification_factor(w, a, i)[0] == pytest.approx(
+        amplification_factor(w, b, j)[0], rel=5e-3)
 
 
 def _amb_rotor(ki_pid: float):

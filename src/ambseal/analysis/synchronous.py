@@ -42,6 +42,7 @@ from ambseal.machine import controller_as_runs
 from ambseal.model import (
     AXES,
     SealElement,
+    SpringElement,
     actuator_matrices,
     amb_factors,
     build_system,
@@ -225,18 +226,27 @@ def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
 def _running_system(cfg, where: tuple, p: float):
     """The rotor, AMBs and springs with force inputs at ``where`` (m), and the dynamic
     stiffness at a speed ``f`` (Hz) for whirl at that speed: ``K − Ω²M + jΩ(C + ΩG)`` with
-    the seals at pressure drop ``p`` (bar) at the synchronous frequency (P3 §4), assembled
-    once where no seal table follows the frequency."""
-    # the rotor, AMBs and springs once; the seals per speed where a table follows the
-    # synchronous frequency (P3 §4), else once
+    the seals at pressure drop ``p`` (bar) and the springs' tables at the synchronous
+    frequency (P3 §4; a bearing's coefficients over speed), assembled once where no table
+    follows the frequency."""
+    # the rotor, AMBs and springs once; the seals and the tabulated springs per speed where
+    # a table follows the synchronous frequency (P3 §4), else once
     base = build_system(cfg, speed_rpm=0.0, include_seals=False, force_positions=where)
     mesh, n = base.mesh, base.n_dof
-    follow = any(s.frequency_dependent for s in cfg.seal)
+    tables = [(i, s) for i, s in enumerate(cfg.spring) if s.tabulated]
+    follow = any(s.frequency_dependent for s in cfg.seal) or bool(tables)
 
     def seals(f_hz: float):
+        """The seals at ``f_hz``, and the tabulated springs' change from their values at 0
+        Hz, which ``base`` holds (a spring with a table has no housing)."""
         M, C, K = (np.zeros((n, n)) for _ in range(3))
         for s in cfg.seal:
             SealElement.from_config(s, mesh, p, f_hz).assemble(M, C, K)
+        for i, s in tables:
+            SpringElement.from_config(s, mesh, i, None, f_hz).assemble(M, C, K)
+            Mz, Cz, Kz = (np.zeros((n, n)) for _ in range(3))
+            SpringElement.from_config(s, mesh, i, None, 0.0).assemble(Mz, Cz, Kz)
+            M, C, K = M - Mz, C - Cz, K - Kz
         return M, C, K
 
     fixed = None if follow else seals(0.0)

@@ -76,7 +76,7 @@ from ambseal.analysis.synchronous import Unbalance, orbit_semi_major, synchronou
 from ambseal.config import Spring
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
-from ambseal.model import bending_limit_hz, build_system, spring_label
+from ambseal.model import bending_limit_hz, build_system, spring_at, spring_label
 
 __all__ = ["unbalance_ur", "vibration_limit_um", "amplification_factor", "exact_half_power",
            "required_margin", "journal_loads", "Critical", "Clearance", "UnbalanceCase",
@@ -235,7 +235,7 @@ def journal_loads(cfg) -> tuple[tuple[float, float], ...]:
     pins = [Spring(position=z, kxx=RIGID_SUPPORT, kyy=RIGID_SUPPORT, name=f"pin{i}")
             for i, z in enumerate(zs)] if cfg.amb else []
     # the bearings carry the weight: a seal (also one given as a spring) takes none
-    kept = without_seals(cfg).spring
+    kept = [spring_at(s, 0.0) for s in without_seals(cfg).spring]  # statics: at rest
     rig = cfg.model_copy(update={"seal": [], "amb": [], "spring": [*kept, *pins]})
     sys = build_system(rig, speed_rpm=0.0)
     t = np.zeros(sys.n_dof)

@@ -33,6 +33,7 @@ from ambseal.config.rig import (
                                     Machine,
                                     Pid,
                                     PidFilter,
+                                    SPRING_BOUNDS,
                                     RigConfig,
                                     Seal,
                                     Signoff,
@@ -52,6 +53,7 @@ from ambseal.config.rig import (
 
 __all__ = ["MAX_AMBS", "MAX_COEFFICIENT", "MAX_COMPONENTS", "MAX_CURRENT_A", "MAX_DELAY_SAMPLES", "MAX_ELEMENTS",
            "MAX_FREQUENCY_HZ", "MAX_GAP_M", "MAX_PRESSURE_BAR", "MAX_SPEED_HZ", "MAX_SUPPORT_STIFFNESS", "METHODS",
+           "SPRING_BOUNDS",
            "Method", "method", "method_label", "method_names",
            "Actuator", "Affine", "Amb", "AxisPair", "Coefficient", "FrequencyTable",
            "Machine", "Pid", "PidFilter", "RigConfig", "Seal", "Signoff", "Spring", "Stage",

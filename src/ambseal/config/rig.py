@@ -66,7 +66,9 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
 ``[[spring]]``
     ``position``, ``kxx``, ``kyy`` and optional ``kxy``, ``kyx`` (N/m), ``cxx``, ``cyy``,
     ``cxy``, ``cyx`` (N·s/m), ``mxx``, ``myy``, ``mxy``, ``myx`` (kg: added mass, e.g. a
-    hole-pattern seal's), ``axes_angle_deg`` (the axes the coefficients are given in,
+    hole-pattern seal's), each a number or a table ``{ frequency_hz = [...], value = [...]
+    }`` taken at the synchronous frequency at each speed (a bearing's coefficients over
+    speed; as a seal's table, without a housing), ``axes_angle_deg`` (the axes the coefficients are given in,
     default 0), ``housing`` (optional ``{ mass, kxx, kyy, kxy, kyx, cxx, cyy, cxy, cyx }``
     in kg, N/m, N·s/m: the spring joins the shaft to this mass, which its own springs and
     dampers hold to ground in x, y), ``name`` (optional), ``kind`` (``"bearing"``, the
@@ -157,6 +159,7 @@ __all__ = [
     "Coefficient",
     "Affine",
     "FrequencyTable",
+    "SPRING_BOUNDS",
     "TruthSection",
     "load_truth",
     "rig_with_values",
@@ -489,21 +492,32 @@ class SpringHousing(_Strict):
     cyx: float = Field(default=0.0, ge=-1e12, le=1e12)
 
 
+_SupportK = Annotated[float, Field(ge=-MAX_SUPPORT_STIFFNESS, le=MAX_SUPPORT_STIFFNESS)]
+_SupportC = Annotated[float, Field(ge=-1e12, le=1e12)]
+# added (fluid) mass of a seal or bearing, kg: far below any rotor's 1e6 kg bound
+_SupportM = Annotated[float, Field(ge=-1e6, le=1e6)]
+#: a spring coefficient's bounds, whether a number or a table's values
+SPRING_BOUNDS = {**{k: MAX_SUPPORT_STIFFNESS for k in ("kxx", "kyy", "kxy", "kyx")},
+                 **{k: 1e12 for k in ("cxx", "cyy", "cxy", "cyx")},
+                 **{k: 1e6 for k in ("mxx", "myy", "mxy", "myx")}}
+
+
 class Spring(_Strict):
     position: float = Field(ge=0)
-    kxx: float = Field(ge=-MAX_SUPPORT_STIFFNESS, le=MAX_SUPPORT_STIFFNESS)  # up to a pin
-    kyy: float = Field(ge=-MAX_SUPPORT_STIFFNESS, le=MAX_SUPPORT_STIFFNESS)
-    kxy: float = Field(default=0.0, ge=-MAX_SUPPORT_STIFFNESS, le=MAX_SUPPORT_STIFFNESS)
-    kyx: float = Field(default=0.0, ge=-MAX_SUPPORT_STIFFNESS, le=MAX_SUPPORT_STIFFNESS)
-    cxx: float = Field(default=0.0, ge=-1e12, le=1e12)
-    cyy: float = Field(default=0.0, ge=-1e12, le=1e12)
-    cxy: float = Field(default=0.0, ge=-1e12, le=1e12)
-    cyx: float = Field(default=0.0, ge=-1e12, le=1e12)
-    # added (fluid) mass of a seal or bearing, kg: far below any rotor's 1e6 kg bound
-    mxx: float = Field(default=0.0, ge=-1e6, le=1e6)
-    myy: float = Field(default=0.0, ge=-1e6, le=1e6)
-    mxy: float = Field(default=0.0, ge=-1e6, le=1e6)
-    myx: float = Field(default=0.0, ge=-1e6, le=1e6)
+    # each a number or a table over the synchronous frequency (a bearing's coefficients
+    # that change with speed)
+    kxx: _SupportK | FrequencyTable  # up to a pin
+    kyy: _SupportK | FrequencyTable
+    kxy: _SupportK | FrequencyTable = 0.0
+    kyx: _SupportK | FrequencyTable = 0.0
+    cxx: _SupportC | FrequencyTable = 0.0
+    cyy: _SupportC | FrequencyTable = 0.0
+    cxy: _SupportC | FrequencyTable = 0.0
+    cyx: _SupportC | FrequencyTable = 0.0
+    mxx: _SupportM | FrequencyTable = 0.0
+    myy: _SupportM | FrequencyTable = 0.0
+    mxy: _SupportM | FrequencyTable = 0.0
+    myx: _SupportM | FrequencyTable = 0.0
     axes_angle_deg: float = Field(default=0.0, ge=-360, le=360)
     housing: SpringHousing | None = None
     name: Name | None = None
@@ -514,6 +528,22 @@ class Spring(_Strict):
     # radial running clearance of a plain bearing or seal: API 617's close clearances, as
     # a [[seal]]'s
     clearance: float | None = Field(default=None, ge=1e-6, le=0.1)
+
+    @model_validator(mode="after")
+    def _tables(self) -> "Spring":
+        for key, bound in SPRING_BOUNDS.items():
+            v = getattr(self, key)
+            if isinstance(v, FrequencyTable) and max(abs(x) for x in v.value) > bound:
+                raise ValueError(f"{key}: expected table values within ±{bound:g}")
+        if self.housing is not None and self.tabulated:
+            raise ValueError("housing: a spring with a housing takes constant coefficients "
+                             "(no frequency table)")
+        return self
+
+    @property
+    def tabulated(self) -> bool:
+        """Whether a coefficient is a frequency table."""
+        return any(isinstance(getattr(self, k), FrequencyTable) for k in SPRING_BOUNDS)
 
 
 class Stage(_Strict):

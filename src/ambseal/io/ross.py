@@ -56,10 +56,11 @@ element by element (ROSS's DOFs per node are [x, y, z, α, β, θ]; ambseal keep
   kinds: the sign-off must not take a balance piston for a bearing); ROSS's
   ``radial_clearance`` (the least of a table, as its ``run_clearance_analysis``) →
   ``clearance`` of either, a close clearance of the sign-off;
-  against frequency, ROSS's interpolant at one frequency: the synchronous frequency of the
-  import speed (``speed_rpm``; by default the lowest frequency that every such table of
-  ROSS's covers), written as ``[operating] speed_rpm`` and reported, so that ambseal's
-  modes at that speed are ROSS's ``run_modal(speed)``. A direct stiffness above the rig
+  against speed or frequency, each coefficient that changes a table as a seal's (above),
+  evaluated at the synchronous frequency at every speed as ROSS's ``run_modal`` and
+  unbalance response do. The rig's ``[operating] speed_rpm``: the import speed
+  (``speed_rpm``; by default the lowest frequency that every bearing table of ROSS's
+  covers). A direct stiffness above the rig
   file's stiffest support (:data:`~ambseal.config.MAX_SUPPORT_STIFFNESS`; ROSS pins a node
   with 1e20 N/m) is taken at that bound, a pin, with a note. A bearing linked to a
   housing node (``n_link``; the node off the shaft, with its point mass and the bearings
@@ -294,16 +295,37 @@ def _at(el, name: str, omega: float) -> float:
     return float(np.asarray(f(omega), float))
 
 
+def _table(el, name: str, omega: float) -> dict:
+    """A coefficient of a ROSS bearing or seal whose coefficients change with speed or
+    frequency, as a rig file's table over the synchronous frequency (Hz): ROSS 3's table
+    along one axis with its own points and law; otherwise (ROSS 2.3's smoothing spline,
+    ROSS 3's table over speed and frequency) ROSS's values at its points and at the
+    operating frequency ``omega`` (rad/s) when inside, linear between them, held
+    outside."""
+    w = sorted({float(x) for x in _axis(el)})
+    law = _ross3_law(el)
+    if law is None and w[0] < omega < w[-1] and not any(math.isclose(omega, x) for x in w):
+        w = sorted(w + [omega])  # exact at the operating speed, too
+    out = {"frequency_hz": [x / (2 * math.pi) for x in w],
+           "value": [_at(el, name, x) for x in w]}
+    return out | ({"interpolation": law, "extrapolation": "linear"} if law else {})
+
+
 def _spring(el, z: float, i: int, varies: bool, omega: float, notes: list) -> dict:
     names = ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy", "cxy", "cyx", "mxx", "myy", "mxy",
              "myx")
-    vals = {n: (_at(el, n, omega) if varies else float(_coef(el, n)[0])) for n in names}
+    vals = {n: float(_coef(el, n)[0]) for n in names}
+    if varies:
+        vals |= {n: t for n in names if len(set((t := _table(el, n, omega))["value"])) > 1}
     for n in ("kxx", "kyy"):
-        if vals[n] > MAX_SUPPORT_STIFFNESS:  # ROSS pins a node with a 1e20 N/m bearing
-            notes.append(f"bearing {i} ({el.tag}, node {el.n}): {n} = {vals[n]:.3g} N/m "
+        v = vals[n]
+        top = max(v["value"]) if isinstance(v, dict) else v
+        if top > MAX_SUPPORT_STIFFNESS:  # ROSS pins a node with a 1e20 N/m bearing
+            notes.append(f"bearing {i} ({el.tag}, node {el.n}): {n} = {top:.3g} N/m "
                          f"taken as a pin, {MAX_SUPPORT_STIFFNESS:.0e} N/m (the rig file's "
                          "stiffest support; the pinned shaft's frequencies to 1e-8)")
-            vals[n] = MAX_SUPPORT_STIFFNESS
+            vals[n] = (v | {"value": [min(x, MAX_SUPPORT_STIFFNESS) for x in v["value"]]}
+                       if isinstance(v, dict) else MAX_SUPPORT_STIFFNESS)
     return {"name": _name(el.tag, f"bearing{i}"), "position": z, **vals, **_clearance(el)}
 
 
@@ -331,16 +353,7 @@ def _seal(el, z: float, i: int, varies: bool, omega: float) -> dict:
     entry = {"name": _name(el.tag, f"bearing{i}"), "position": z, **_clearance(el)}
     if not varies:
         return entry | {k: float(_coef(el, v)[0]) for k, v in keys.items()}
-    w = sorted({float(x) for x in _axis(el)})
-    law = _ross3_law(el)
-    if law is not None:  # ROSS 3.1's own interpolant, between and beyond the points
-        return entry | {k: {"frequency_hz": [x / (2 * math.pi) for x in w],
-                            "value": [_at(el, v, x) for x in w], "interpolation": law,
-                            "extrapolation": "linear"} for k, v in keys.items()}
-    if w[0] < omega < w[-1] and not any(math.isclose(omega, x) for x in w):
-        w = sorted(w + [omega])  # exact at the operating speed, too
-    return entry | {k: {"frequency_hz": [x / (2 * math.pi) for x in w],
-                        "value": [_at(el, v, x) for x in w]} for k, v in keys.items()}
+    return entry | {k: _table(el, v, omega) for k, v in keys.items()}
 
 
 def _pid(el) -> tuple[dict | None, str]:
@@ -394,8 +407,9 @@ def _amb(el, nodes: np.ndarray, i: int, where: str) -> tuple[dict, dict | None, 
 
 
 def _import_speed(freq_tables: list, speed_rpm: float | None) -> tuple[float, float, str]:
-    """The frequency (rad/s) at which coefficients ambseal holds as constants are taken, the
-    speed (rpm) it is the synchronous frequency of, and the rule that chose it."""
+    """The rig's operating speed: its synchronous frequency (rad/s), the speed (rpm) and
+    the rule that chose it — a point every table of ROSS's covers, where a table written
+    as ROSS's values at its points (ROSS 2.3's) is exact."""
     if speed_rpm is not None:
         return abs(speed_rpm) * math.pi / 30, speed_rpm, "the import speed, --speed-rpm"
     if not freq_tables:
@@ -474,16 +488,14 @@ def from_ross(rotor, *, name: str | None = None, where: str = "<ross rotor>",
                          "a [[spring]] of kind = \"seal\", never a bearing in the sign-off")
         if id(b) in linked:
             rig["spring"][-1]["housing"] = _housing(rotor, bearings, linked[id(b)])
-        if varies:
-            notes.append(_one_frequency_note(i, b, omega, rpm, rule))
-    tables = [s["name"] for s in rig["seal"] if isinstance(s["K"], dict)
-              and "interpolation" not in s["K"]]
+    tables = [e["name"] for e in (*rig["seal"], *rig["spring"]) for v in e.values()
+              if isinstance(v, dict) and "value" in v and "interpolation" not in v]
     if tables:
-        notes.append(f"seal(s) {', '.join(tables)}: frequency tables of ROSS's values at its "
-                     "frequencies; ambseal interpolates linearly between them and holds the "
-                     "end values outside, ROSS's spline runs between them and extrapolates: "
-                     "the modes agree at the tables' frequencies"
-                     + (" and at the [operating] speed" if rpm else ""))
+        notes.append(f"seal(s) and bearing(s) {', '.join(dict.fromkeys(tables))}: tables "
+                     "of ROSS's values at its frequencies; ambseal interpolates linearly "
+                     "between them and holds the end values outside, ROSS's spline runs "
+                     "between them and extrapolates: the modes agree at the tables' "
+                     "frequencies" + (" and at the [operating] speed" if rpm else ""))
     if rpm:
         rig["operating"] = {"speed_rpm": rpm}
     if _damping_kind(rotor) == "modal" and not hasattr(rotor, "C0"):
@@ -767,19 +779,6 @@ def _supports(bearings: list, nodes: np.ndarray, where: str, rig: dict,
         else:
             plan.append((i, b, *_kind(b, where, i)))
     return plan
-
-
-def _one_frequency_note(i: int, b, omega: float, rpm: float, rule: str) -> str:
-    """What the import did with a bearing's frequency-dependent coefficients."""
-    f = _axis(b) / (2 * math.pi)
-    out = "" if f.min() <= omega / (2 * math.pi) <= f.max() else (
-        " (outside the table: ROSS's interpolant extrapolated)")
-    return (f"bearing {i} ({b.tag}, node {b.n}): frequency-dependent "
-            f"coefficients (ROSS's table {f.min():.4g}–{f.max():.4g} Hz) taken "
-            f"at one frequency, {omega / (2 * math.pi):.6g} Hz = "
-            f"{abs(rpm):.6g} rpm ({rule}){out}: ambseal's modes at "
-            "that [operating] speed are ROSS's run_modal there, at other speeds "
-            "the coefficients stay")
 
 
 def _controller(rig: dict, pids: list, unmapped: list, notes: list) -> None:

@@ -66,7 +66,7 @@ _FROM = {
     "SealElement": "seal", "coefficient_value": "seal", "table_value": "seal",
     "pressure_for_k": "seal",
     "seal_coefficients": "seal", "seal_values": "seal", "values_following": "seal",
-    "values_following_k": "seal", "SpringElement": "spring",
+    "values_following_k": "seal", "SpringElement": "spring", "spring_at": "spring",
     "spring_label": "spring",
 }
 

@@ -160,7 +160,7 @@ def build_system(
     f_seal = seal_frequency_hz if seal_frequency_hz is not None else speed / (2 * np.pi)
     mesh = build_mesh(cfg, tuple(force_positions))
     rot = assemble_rotor(cfg, mesh)
-    springs = _springs(cfg, mesh) if include_springs else []
+    springs = _springs(cfg, mesh, speed / (2 * np.pi)) if include_springs else []
     # the housings' DOFs (x, y each) after the shaft's
     n = mesh.n_dof + 2 * sum(s.housing is not None for s in springs)
     M, C, K, G = (_padded(X, n) for X in (rot.M, rot.C, rot.K, rot.G))
@@ -202,12 +202,13 @@ def build_system(
     )
 
 
-def _springs(cfg: RigConfig, mesh: Mesh) -> list[SpringElement]:
-    """The rig's springs, each housing given its two DOFs after the shaft's in order."""
+def _springs(cfg: RigConfig, mesh: Mesh, frequency_hz: float) -> list[SpringElement]:
+    """The rig's springs, each housing given its two DOFs after the shaft's in order, their
+    tabulated coefficients at the synchronous frequency ``frequency_hz`` (Hz)."""
     out, next_dof = [], mesh.n_dof
     for i, s in enumerate(cfg.spring):
         out.append(SpringElement.from_config(s, mesh, i, None if s.housing is None
-                                             else next_dof))
+                                             else next_dof, frequency_hz))
         next_dof += 0 if s.housing is None else 2
     return out
 
@@ -225,7 +226,7 @@ def _supported_damping(cfg: RigConfig, mesh: Mesh, rot) -> np.ndarray:
     [operating] pressure, so that the rotor's damping is one matrix at every speed and
     pressure, as ROSS 3's (its bearings at frequency 0); the AMBs are left out, their
     stiffness being the loop's."""
-    springs = _springs(cfg, mesh)
+    springs = _springs(cfg, mesh, 0.0)
     n = mesh.n_dof + 2 * sum(s.housing is not None for s in springs)
     M, K, C = _padded(rot.M, n), _padded(rot.K, n), np.zeros((n, n))
     for s in cfg.seal:

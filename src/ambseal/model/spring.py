@@ -23,12 +23,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ambseal.config import Spring
+from ambseal.config import SPRING_BOUNDS, FrequencyTable, Spring
 from ambseal.model.amb import axes_rotation
 from ambseal.model.lft import Channel
 from ambseal.model.rotor import Mesh, X, Y
+from ambseal.model.seal import table_value
 
-__all__ = ["KEYS", "spring_label", "SpringElement"]
+__all__ = ["KEYS", "spring_label", "spring_at", "SpringElement"]
 
 KEYS = ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy")
 """The spring's parameters in the order of its channels."""
@@ -54,6 +55,30 @@ def spring_label(spring: Spring, index: int) -> str:
     str
     """
     return spring.name or f"spring{index}"
+
+
+def spring_at(spring: Spring, frequency_hz: float) -> Spring:
+    """The spring with each tabulated coefficient taken at a frequency (a bearing's
+    coefficients over speed, at the synchronous frequency as ROSS's ``run_modal`` and
+    unbalance response take them; :func:`ambseal.model.seal.table_value`).
+
+    Parameters
+    ----------
+    spring : Spring
+        The rig file's ``[[spring]]``.
+    frequency_hz : float
+        The frequency (Hz).
+
+    Returns
+    -------
+    Spring
+        ``spring`` itself where nothing is tabulated, else a copy with numbers.
+    """
+    if not spring.tabulated:
+        return spring
+    return spring.model_copy(update={
+        k: table_value(v, frequency_hz) for k in SPRING_BOUNDS
+        if isinstance(v := getattr(spring, k), FrequencyTable)})
 
 
 @dataclass(frozen=True)
@@ -90,9 +115,12 @@ class SpringElement:
 
     @classmethod
     def from_config(cls, spring: Spring, mesh: Mesh, index: int,
-                    housing_dof: int | None = None) -> "SpringElement":
+                    housing_dof: int | None = None, frequency_hz: float = 0.0
+                    ) -> "SpringElement":
         """The element of the rig's ``[[spring]]`` number ``index``; ``housing_dof``: the
-        first of its housing's two DOFs (a spring with a ``housing``)."""
+        first of its housing's two DOFs (a spring with a ``housing``); ``frequency_hz``:
+        where its tabulated coefficients are taken (:func:`spring_at`)."""
+        spring = spring_at(spring, frequency_hz)
         h = spring.housing
         if (h is None) != (housing_dof is None):
             raise ValueError(f"spring {index}: a housing needs its DOFs and only a housing "

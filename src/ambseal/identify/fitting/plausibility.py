@@ -54,7 +54,8 @@ def _rig_value(cfg, name: str) -> float | None:
             return float((ki if key[:2] == "Ki" else ks)[_AXES.index(key[3:])])
     for i, s in enumerate(cfg.spring):
         if (s.name or f"spring{i}") == owner and key in _DIRECT:
-            return float(getattr(s, key))
+            v = getattr(s, key)  # a table over speed has no one scale
+            return float(v) if isinstance(v, (int, float)) else None
     return None
 
 

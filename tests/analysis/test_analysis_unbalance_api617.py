@@ -28,6 +28,9 @@ def test_unbalance_ur_by_hand():
     assert unbalance_ur(100.0, 10000.0) == pytest.approx(63.5e-6)
     assert unbalance_ur(100.0, 10000.0) * 1e6 == pytest.approx(
         4 * 220.462 / 10000.0 * 720.078, rel=1e-3)
+    # from 25 000 rpm on, W/3.937 g·mm (API 617 9th ed. 6.8.2.7, as ROSS 3.1)
+    for rpm in (25000.0, 60000.0):
+        assert unbalance_ur(100.0, rpm) == pytest.approx(100.0 / 3.937 * 1e-6, rel=1e-4)
 
 
 @pytest.mark.parametrize("rpm, um", [(12000.0, 25.4), (3000.0, 25.4),

@@ -6,25 +6,29 @@ the public text could not confirm a number it is a ``[signoff]`` setting, its de
 stated):
 
 * **The unbalance.** ``U = f_U · U_r`` with ``U_r = 6350 · W / N`` (g·mm; W the journal
-  static load in kg, N the maximum continuous speed in rpm) and ``f_U`` =
-  ``[signoff] unbalance_factor`` (2). The journal static loads are the reactions of the
-  rotor on rigid supports at every AMB and spring under gravity.
+  static load in kg, N the maximum continuous speed in rpm; from 25 000 rpm on
+  ``U_r = W / 3.937``, the value at 25 000 rpm, API 617 9th ed. 6.8.2.7 as ROSS 3.1
+  takes it) and ``f_U`` = ``[signoff] unbalance_factor`` (2). The journal static loads
+  are the reactions of the rotor on rigid supports at every AMB and spring under
+  gravity.
 * **Where, per mode.** The first and second rigid-body shapes always: one unbalance at
   mid-span between the outermost supports (W the sum of the journal loads) and two at
   those supports 180° apart (each W its journal's load), and one at each impeller
   outboard of them (below); an AMB loop may damp every mode beyond resonance, and the
-  probes and clearances are judged on these. Then for each forward mode of the loop at the maximum continuous
-  speed whose frequency lies below the analysed top speed and that resonates (ζ below
-  1/√2, :data:`ambseal.analysis.campbell.OVERDAMPED_ZETA`), from its shape (the orbit's
-  semi-major axis along the rotor, signed by its phase against the largest between the
-  supports): a mode largest outboard of the supports on a side that carries an impeller
-  (a ``[[stage]]``; without stages a ``[[disk]]``) gets one unbalance at that impeller,
-  W the mass outboard of the nearest support (overhung); a mode whose shape between the
-  supports changes sign (a share below −:data:`SIGN_CHANGE` of the largest) gets two,
-  180° apart, at its largest positive and negative antinodes there, each W the load of
-  the support nearest it; any other mode one at its largest antinode between the
-  supports, W the sum of the journal loads. Cases with the same unbalances are analysed
-  once.
+  probes and clearances are judged on these. Then for each forward mode of the loop at
+  the maximum continuous speed whose frequency lies below the analysed top speed and
+  that resonates (ζ below 1/√2, :data:`ambseal.analysis.campbell.OVERDAMPED_ZETA`), at
+  the antinodes of its shape as API 617 (9th ed., 6.8.2.7 and Fig. 2) places them and
+  ROSS 3.1's ``api617_unbalance`` reads it, for any mode shape: the shape's amplitude
+  along the rotor (the orbit's semi-major axis) signed by the phase of its projection on
+  the largest orbit's major axis; lobes of one sign (nodes below :data:`LOBE_FLOOR` of
+  the largest not splitting them), an antinode at each lobe's largest amplitude; taken
+  between the outermost supports when at least :data:`INBOARD_SHARE` of the largest,
+  outboard when the largest or at least :data:`OUTBOARD_SHARE` of it; the phase 0° or
+  180° by the lobe's sign against the largest; W the sum of the journal loads for a
+  single antinode between the supports, the nearest journal's load for one of several,
+  and the rotor's mass outboard of the adjacent support (its shaft elements and disks
+  beyond it) for one outboard. Cases with the same unbalances are analysed once.
 * **The response** at the probes (the AMB sensors; the springs of a rig without AMBs),
   from standstill to ``[signoff] analysis_top_ratio`` (1.25) × the trip speed
   (:func:`ambseal.analysis.synchronous.synchronous_response`), as peak-to-peak
@@ -76,15 +80,16 @@ from ambseal.analysis.synchronous import Unbalance, orbit_semi_major, synchronou
 from ambseal.config import Spring
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
-from ambseal.model import bending_limit_hz, build_system, spring_at, spring_label
+from ambseal.model import bending_limit_hz, build_mesh, build_system, spring_at, spring_label
 
 __all__ = ["unbalance_ur", "vibration_limit_um", "amplification_factor", "exact_half_power",
            "required_margin", "journal_loads", "Critical", "Clearance", "UnbalanceCase",
-           "Api617Unbalance", "api617_unbalance", "SIGN_CHANGE"]
+           "Api617Unbalance", "api617_unbalance", "antinode_unbalances"]
 
-#: A mode shape "changes sign" when its most negative share reaches this fraction of its
-#: largest amplitude (a node between the supports, not a rounding of a rigid mode).
-SIGN_CHANGE = 0.25
+#: API 617 placement (module docstring; ROSS 3.1's ``api617_unbalance``): nodes below
+#: LOBE_FLOOR of the largest amplitude do not split a lobe; an antinode between the
+#: supports counts from INBOARD_SHARE of the largest, one outboard from OUTBOARD_SHARE
+LOBE_FLOOR, INBOARD_SHARE, OUTBOARD_SHARE = 0.02, 0.1, 0.5
 #: Speeds of the coarse sweep; each critical is refined with :data:`REFINE` more.
 SPEEDS = 241
 REFINE = 41
@@ -93,7 +98,8 @@ GRAVITY = 9.80665
 
 
 def unbalance_ur(load_kg: float, speed_rpm: float) -> float:
-    """API 617's U_r = 6350·W/N (g·mm) as kg·m.
+    """API 617's U_r = 6350·W/N (g·mm) as kg·m, N at most 25 000 rpm (above it W/3.937,
+    API 617 9th ed. 6.8.2.7, as ROSS 3.1).
 
     Parameters
     ----------
@@ -115,7 +121,7 @@ def unbalance_ur(load_kg: float, speed_rpm: float) -> float:
     if not (load_kg > 0 and speed_rpm > 0):
         raise ConfigError(f"API 617 U_r: the load ({load_kg:g} kg) and the maximum "
                           f"continuous speed ({speed_rpm:g} rpm) must be > 0")
-    return 6350e-6 * load_kg / speed_rpm
+    return 6350e-6 * load_kg / min(speed_rpm, 25000.0)
 
 
 def vibration_limit_um(speed_rpm: float, cap_um: float = 25.4) -> float:
@@ -202,16 +208,6 @@ def required_margin(af: float, below: bool) -> float:
         return 0.0
     m = 17.0 * (1.0 - 1.0 / (af - 1.5))
     return min(16.0, m) if below else min(26.0, 10.0 + m)
-
-
-def _node_masses(cfg) -> np.ndarray:
-    """Each node's share of the rotor's mass (kg): the consistent mass matrix times a
-    rigid translation."""
-    sys = build_system(cfg, speed_rpm=0.0, include_amb=False, include_seals=False,
-                       include_springs=False)  # the rig's mesh, its modes' nodes
-    t = np.zeros(sys.n_dof)
-    t[1::4] = 1.0
-    return (sys.M @ t)[1::4]
 
 
 def journal_loads(cfg) -> tuple[tuple[float, float], ...]:
@@ -429,8 +425,9 @@ def _placements(cfg, modes, loads, factor: float, n_rpm: float) -> list[tuple]:
     """``(mode_hz, rule, unbalances)`` per forward mode (module docstring), distinct."""
     zs = [z for z, _ in loads]
     lo, hi = min(zs), max(zs)
-    node_mass = _node_masses(cfg)
     z_nodes = modes.node_z_m
+    outboard_mass = {side: _outboard_mass(cfg, z, side) for side, z in (("left", lo),
+                                                                        ("right", hi))}
     total = sum(w for _, w in loads)
     # a journal that carries (almost) nothing gets the mean load: U_r needs W > 0
     loads = tuple((z, w if w > 1e-6 * total else total / len(loads)) for z, w in loads)
@@ -438,7 +435,6 @@ def _placements(cfg, modes, loads, factor: float, n_rpm: float) -> list[tuple]:
     heavy = ([stage_position(cfg, st) for st in cfg.stage] if cfg.stage
              else [d.position for d in cfg.disk])
     outboard = [z for z in heavy if z < lo - 1e-9 or z > hi + 1e-9]
-    inside = (z_nodes >= lo - 1e-9) & (z_nodes <= hi + 1e-9)
     out, seen = [], set()
 
     def add(f_hz, rule, unb):
@@ -449,9 +445,7 @@ def _placements(cfg, modes, loads, factor: float, n_rpm: float) -> list[tuple]:
 
     def overhung(f_hz, zu):
         """One unbalance at the impeller ``zu``, W the mass outboard of its support."""
-        side = z_nodes < lo - 1e-9 if zu < lo else z_nodes > hi + 1e-9
-        edge = int(np.argmin(np.abs(z_nodes - (lo if zu < lo else hi))))
-        w = float(node_mass[side].sum()) + 0.5 * float(node_mass[edge])
+        w = outboard_mass["left" if zu < lo else "right"]
         add(f_hz, f"overhung: at {zu:.3g} m, W = {w:.4g} kg outboard of the support",
             (Unbalance(zu, factor * unbalance_ur(w, n_rpm)),))
 
@@ -469,31 +463,103 @@ def _placements(cfg, modes, loads, factor: float, n_rpm: float) -> list[tuple]:
     for k in range(modes.poles.size):
         if modes.whirl[k] == "backward" or modes.damping_ratio[k] >= OVERDAMPED_ZETA:
             continue
-        X, Y = modes.shapes[k, :, 0], modes.shapes[k, :, 1]
-        a = orbit_semi_major(X, Y)
-        z0 = float(z_nodes[int(np.argmax(a))])
-        over = [z for z in outboard if (z < lo) == (z0 < lo)] if not inside[
-            int(np.argmax(a))] else []
-        if over:
-            overhung(float(modes.frequency_hz[k]), min(over, key=lambda z: abs(z - z0)))
-            continue
-        i0 = int(np.argmax(np.where(inside, a, -1.0)))
-        ref = X[i0] if abs(X[i0]) >= abs(Y[i0]) else Y[i0]
-        both = np.where(np.abs(X) >= np.abs(Y), X, Y)
-        r = np.where(inside, a * np.sign(np.real(both * np.conj(ref))), 0.0)
-        z0 = float(z_nodes[i0])
-        if r.min() < -SIGN_CHANGE * r.max():
-            ip, im = int(np.argmax(r)), int(np.argmin(r))
-            unb = tuple(Unbalance(float(z_nodes[i]), factor * unbalance_ur(
-                dict(loads)[min(zs, key=lambda s: abs(s - z_nodes[i]))], n_rpm), ph)
-                for i, ph in ((ip, 0.0), (im, 180.0)))
-            rule = (f"two antinodes, 180° apart: at {unb[0].position:.3g} m and "
-                    f"{unb[1].position:.3g} m, W the nearest journal's load")
-        else:
-            unb = (Unbalance(z0, factor * unbalance_ur(total, n_rpm)),)
-            rule = f"at its largest antinode {z0:.3g} m, W = {total:.4g} kg (every journal)"
+        rule, unb = antinode_unbalances(modes.shapes[k, :, 0], modes.shapes[k, :, 1],
+                                        z_nodes, loads, outboard_mass, factor, n_rpm)
         add(float(modes.frequency_hz[k]), rule, unb)
     return out
+
+
+def _outboard_mass(cfg, z_b: float, side: str) -> float:
+    """The rotor's mass outboard of a support at ``z_b`` (m) on ``side`` ("left" or
+    "right"): its shaft elements wholly beyond it and its disks strictly beyond it, as
+    ROSS 3.1's ``_overhung_mass``."""
+    mesh = build_mesh(cfg)
+    t = np.zeros(8)
+    t[[0, 4]] = 1.0  # a rigid translation of an element's two nodes
+    beyond = (lambda a, b: b <= z_b + 1e-12) if side == "left" else (
+        lambda a, b: a >= z_b - 1e-12)
+    shaft = sum(float(t @ el.M() @ t) for e, el in enumerate(mesh.elements)
+                if beyond(mesh.z[e], mesh.z[e + 1]))
+    disks = sum(d.mass for d in cfg.disk
+                if (d.position < z_b - 1e-12 if side == "left" else d.position > z_b + 1e-12))
+    return float(shaft + disks)
+
+
+def antinode_unbalances(X, Y, z_nodes, loads, outboard_mass, factor: float,
+                        n_rpm: float) -> tuple[str, tuple]:
+    """API 617's unbalances for one mode shape (module docstring; API 617 9th ed. 6.8.2.7
+    and Fig. 2 as ROSS 3.1's ``api617_unbalance`` reads them).
+
+    Parameters
+    ----------
+    X, Y : ndarray of complex, shape (n,)
+        The mode's x and y displacements at the nodes.
+    z_nodes : ndarray, shape (n,)
+        The nodes' positions (m), increasing.
+    loads : sequence of (float, float)
+        ``(z, W)``: each journal's position (m) and static load (kg).
+    outboard_mass : dict
+        ``{"left": kg, "right": kg}``: the rotor's mass outboard of the outermost supports.
+    factor : float
+        ``[signoff] unbalance_factor`` (U = factor · U_r).
+    n_rpm : float
+        The maximum continuous speed (rpm).
+
+    Returns
+    -------
+    (str, tuple of Unbalance)
+        The rule in words, and the unbalances.
+    """
+    X, Y = np.asarray(X, complex), np.asarray(Y, complex)
+    z_nodes = np.asarray(z_nodes, float)
+    a = orbit_semi_major(X, Y)
+    ref = int(np.argmax(a))
+    # the largest orbit's major axis: r(t) = Re([X, Y] e^{jt}) longest at
+    # t = −arg(X² + Y²)/2
+    t = -0.5 * np.angle(X[ref] ** 2 + Y[ref] ** 2)
+    d = np.real(np.array([X[ref], Y[ref]]) * np.exp(1j * t))
+    theta = math.atan2(d[1], d[0])
+    proj = X * math.cos(theta) + Y * math.sin(theta)
+    sign = np.sign(np.real(proj * np.conj(proj[ref])))
+    sign[sign == 0] = 1.0
+    lobes, current, cur = [], [], None
+    for i in range(a.size):
+        s_i = sign[i] if a[i] >= LOBE_FLOOR * a.max() else None
+        if cur is not None and s_i is not None and s_i != cur:
+            lobes.append(current)
+            current = []
+        current.append(i)
+        if s_i is not None:
+            cur = s_i
+    lobes.append(current)
+    zs = [z for z, _ in loads]
+    lo, hi = min(zs), max(zs)
+    picks = []
+    for lobe in lobes:
+        i = lobe[int(np.argmax(a[lobe]))]
+        inboard = lo - 1e-9 <= z_nodes[i] <= hi + 1e-9
+        if (a[i] >= INBOARD_SHARE * a[ref]) if inboard else (
+                i == ref or a[i] >= OUTBOARD_SHARE * a[ref]):
+            picks.append((i, inboard))
+    n_in = sum(inb for _, inb in picks)
+    total = sum(w for _, w in loads)
+    unb, words = [], []
+    for i, inboard in picks:
+        z = float(z_nodes[i])
+        if inboard and n_in == 1:
+            w, why = total, "every journal"
+        elif inboard:
+            zj, w = min(loads, key=lambda zw: abs(zw[0] - z))
+            why = f"the journal at {zj:.3g} m"
+        else:
+            w = outboard_mass["left" if z < lo else "right"]
+            why = "outboard of the support"
+        ph = 0.0 if sign[i] == sign[ref] else 180.0
+        unb.append(Unbalance(z, factor * unbalance_ur(w, n_rpm), ph))
+        words.append(f"{z:.3g} m at {ph:.0f}° (W = {w:.4g} kg, {why})")
+    rule = (f"{len(unb)} antinode(s): " if len(unb) > 1 else "its antinode: ") + "; ".join(
+        words)
+    return rule, tuple(unb)
 
 
 def _close_clearances(cfg) -> list[tuple[str, float, float]]:

@@ -75,6 +75,30 @@ def rotor():
                     beta=1e-5)
 
 
+#: ROSS 3.1's API 617 unbalance placement: its examples at their maximum continuous
+#: speed (rpm), the first three forward modes
+API617 = {"rotor_example": 9000.0, "compressor_example": 12000.0}
+
+
+def api617_placements() -> dict:
+    """ROSS 3.1's ``api617_unbalance`` of its own examples: per mode the damped frequency
+    (rad/s), the unbalances' axial positions (m), magnitudes (kg·m), phases (rad) and the
+    loads W (kg)."""
+    out = {"ross_version": rs.__version__}
+    for name, rpm in API617.items():
+        rotor = getattr(rs, name)()
+        rows = []
+        for mode in range(3):
+            u = rotor.api617_unbalance(mode, rpm * np.pi / 30, num_modes=24)
+            rows.append({"mode_frequency": u["mode_frequency"],
+                         "position": [float(rotor.nodes_pos[n]) for n in u["node"]],
+                         "magnitude": [float(x) for x in u["unbalance_magnitude"]],
+                         "phase": [float(x) for x in u["unbalance_phase"]],
+                         "static_load": [float(x) for x in u["static_load"]]})
+        out[name] = rows
+    return out
+
+
 if __name__ == "__main__":
     with contextlib.redirect_stdout(sys.stderr), warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -88,3 +112,5 @@ if __name__ == "__main__":
                 out[f"{w:g}"] = [[float(x.real), float(x.imag)] for x in np.asarray(lam)]
             rows = ",\n".join(f"{json.dumps(k)}: {json.dumps(v)}" for k, v in out.items())
             (HERE / f"{name}_eigenvalues.json").write_text("{\n" + rows + "\n}\n")
+        (HERE / "api617_unbalance.json").write_text(
+            json.dumps(api617_placements(), indent=1) + "\n")

@@ -298,6 +298,11 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Signoff.scale_factor_limits": ("", "``[low, high]`` bounds of the scale factor "
                                         "S_c = A_vl/A_probe (default [0.5, 6], API 617 "
                                         "8th ed. Part 1 §4.8.2.11; ROSS 3.1: [0, 6])"),
+    "Signoff.probes": ("", "the unbalance response's probes, ``[{ position, angle_deg "
+                           "}]``, each reading x cos θ + y sin θ; left out, the orbit's "
+                           "semi-major axis at the AMB sensors (the springs without AMBs)"),
+    "Probe.position": ("m", "the probe's axial position (a node of the rotor)"),
+    "Probe.angle_deg": ("°", "the direction it reads, from x towards y (default 0)"),
     "Signoff.scale_factor_speeds": ("", "where A_probe is taken: ``to_trip`` (default, "
                                         "standstill to the trip speed) or ``continuous`` "
                                         "(minimum to maximum continuous, ROSS 3.1's)"),
@@ -577,6 +582,8 @@ def _sections() -> list[Section]:
         Section("[machine]", r.Machine),
         Section("[signoff]", r.Signoff, "The sign-off's limits that the standards' public "
                 "text could not confirm; every key optional, its default shown."),
+        Section("[[signoff.probes]]", r.Probe, "The unbalance response's probes, "
+                "directional, at any node (optional)."),
         Section("[controller]", r.Controllers),
         Section("[controller.pid]", r.Pid, "All four keys, or leave the table out."),
         Section("[[controller.filter]]", r.PidFilter, "A notch, lead, lag or low-pass "

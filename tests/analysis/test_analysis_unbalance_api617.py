@@ -132,6 +132,32 @@ def test_scale_factor_over_the_continuous_range_without_a_floor_as_ross():
     assert c.scale_factor == pytest.approx(want, rel=1e-12) and want < 0.25
 
 
+def test_directional_probes_read_the_closed_form_of_anisotropic_supports():
+    """The symmetric rigid rotor on two springs of k_x = 5e6, k_y = 1e7 N/m and c = 1000
+    N·s/m each, its unbalance U at mid-span: the translation only is excited, x =
+    U ω²/(2k_x − mω² + 2jωc), y = −j U ω²/(2k_y − mω² + 2jωc) (the force U ω² e^{jωt}
+    turning forward). ``[signoff] probes`` at mid-span read at 0°, 90° and 45° give 2|x|,
+    2|y| and 2|x + y|/√2 peak to peak at every speed of the sweep, to 1e-5."""
+    import numpy as np
+
+    # the shaft 1e4 times stiffer than steel: its bending adds below 1e-6 at mid-span
+    doc = tomllib.loads(_rigid_rotor(1e7, 2000.0, 4.5e4).replace("E = 2.1e11", "E = 2.1e15"))
+    for sp in doc["spring"]:
+        sp["kyy"] = 1e7
+    doc["signoff"] = {"probes": [{"position": 0.2, "angle_deg": a} for a in (0.0, 90.0,
+                                                                             45.0)]}
+    r = api617_unbalance(parse_rig(doc))
+    c = r.cases[0]  # one unbalance at mid-span
+    (u,) = c.unbalances
+    assert u.position == pytest.approx(0.2)
+    m = math.pi / 4 * 0.2**2 * 0.4 * 7850.0
+    w = 2 * np.pi * c.speed_hz
+    x = u.amount * w**2 / (1e7 - m * w**2 + 2j * w * 1000.0)
+    y = -1j * u.amount * w**2 / (2e7 - m * w**2 + 2j * w * 1000.0)
+    want = 2e6 * np.column_stack([np.abs(x), np.abs(y), np.abs(x + y) / math.sqrt(2)])
+    np.testing.assert_allclose(c.probe_um, want, rtol=1e-5)
+
+
 def test_a_plain_bearings_clearance_is_a_close_clearance_too():
     """The same rotor's two supports as springs with a 0.15 mm radial clearance each (a
     plain bearing's, ``[[spring]] clearance``): each is judged as the seal is above, S_c

@@ -84,7 +84,8 @@ class SynchronousResponse:
     positions_m : ndarray, shape (n_z,)
         Where the amplitude is taken (m).
     amplitude_m : ndarray, shape (n_c, n_s, n_z)
-        The orbit's semi-major axis (m, zero-to-peak) per case, speed and position.
+        The orbit's semi-major axis (m, zero-to-peak) per case, speed and position; where
+        a probe's direction θ was given, |x cos θ + y sin θ|.
     current_a, force_n : ndarray, shape (n_c, n_s, nu), or None
         Per AMB axis the coil current (A) and the force it transmits (N), amplitudes
         (module docstring); None without a controller.
@@ -143,7 +144,8 @@ def _controller_at(controller, out_names, in_names, omegas: np.ndarray,
 
 
 def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
-                         pressure_bar: float | None = None) -> SynchronousResponse:
+                         pressure_bar: float | None = None,
+                         angles_deg=None) -> SynchronousResponse:
     """The loop's response to rotating unbalances over speed (module docstring).
 
     Parameters
@@ -160,6 +162,10 @@ def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
         Where the amplitude is read (m): each gets a node.
     pressure_bar : float, optional
         The seals' pressure drop (``[operating] pressure_bar`` if omitted).
+    angles_deg : sequence of (float or None), optional
+        Per position, the direction a probe reads there (° from x towards y): the
+        amplitude is then |x cos θ + y sin θ| (a proximity probe), else (None, or the
+        argument left out) the orbit's semi-major axis.
 
     Returns
     -------
@@ -188,6 +194,11 @@ def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
             F1[4 * i + 1, c] += -1j * Fu
     nodes = [mesh.node_at(z) for z in zs]
     rows_x, rows_y = [4 * i for i in nodes], [4 * i + 1 for i in nodes]
+    angles = [None] * zs.size if angles_deg is None else list(angles_deg)
+    if len(angles) != zs.size:
+        raise ModelError(f"synchronous response: {len(angles)} probe angles for "
+                         f"{zs.size} positions")
+    directional = [j for j, a in enumerate(angles) if a is not None]
     n_cur = len(base.output_names)
     closed = controller is not None and n_cur > 0
     if closed:
@@ -211,6 +222,9 @@ def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
             raise ModelError(f"synchronous response: the dynamic stiffness is singular at "
                              f"{f:g} Hz (an undamped mode at that speed)") from None
         amp[:, k, :] = orbit_semi_major(q[rows_x], q[rows_y]).T
+        for j in directional:
+            th = math.radians(angles[j])
+            amp[:, k, j] = np.abs(q[rows_x[j]] * math.cos(th) + q[rows_y[j]] * math.sin(th))
         if closed:
             coil = -h_amp * (Krs[k] @ (base.Cq @ q))  # (nu, n_c)
             x = (Bi / ki).T @ q

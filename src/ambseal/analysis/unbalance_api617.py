@@ -29,7 +29,9 @@ stated):
   single antinode between the supports, the nearest journal's load for one of several,
   and the rotor's mass outboard of the adjacent support (its shaft elements and disks
   beyond it) for one outboard. Cases with the same unbalances are analysed once.
-* **The response** at the probes (the AMB sensors; the springs of a rig without AMBs),
+* **The response** at the probes (``[signoff] probes``, each reading x cos θ + y sin θ
+  at its position; left out, the orbit's semi-major axis at the AMB sensors, or at the
+  springs of a rig without AMBs),
   from standstill to ``[signoff] analysis_top_ratio`` (1.25) × the trip speed
   (:func:`ambseal.analysis.synchronous.synchronous_response`), as peak-to-peak
   amplitude (twice the orbit's semi-major axis).
@@ -90,6 +92,8 @@ __all__ = ["unbalance_ur", "vibration_limit_um", "amplification_factor", "exact_
 #: LOBE_FLOOR of the largest amplitude do not split a lobe; an antinode between the
 #: supports counts from INBOARD_SHARE of the largest, one outboard from OUTBOARD_SHARE
 LOBE_FLOOR, INBOARD_SHARE, OUTBOARD_SHARE = 0.02, 0.1, 0.5
+#: a probe's amplitude below this share of the analysis's largest is rounding
+NOISE_SHARE = 1e-9
 #: Speeds of the coarse sweep; each critical is refined with :data:`REFINE` more.
 SPEEDS = 241
 REFINE = 41
@@ -573,16 +577,19 @@ def _close_clearances(cfg) -> list[tuple[str, float, float]]:
     return out
 
 
-def _criticals(speed, probe_um, probes, f_min, f_max, response=None) -> list[Critical]:
+def _criticals(speed, probe_um, probes, f_min, f_max, response=None, floor: float = 0.0
+               ) -> list[Critical]:
     """The criticals of one case (module docstring); ``response(speed_hz, p)``, the
     probe ``p``'s amplitude at any speed, solves each peak and its half-power points
-    (:func:`exact_half_power`), else they are read off the sweep."""
+    (:func:`exact_half_power`), else they are read off the sweep; peaks below ``floor``
+    (µm) are rounding (a probe on a node of the excited shape: the case's wiggles there are
+    no critical)."""
     out = []
     for p, z in enumerate(probes):
         amp = probe_um[:, p]
-        if not np.any(amp > 0):
+        if not np.any(amp > floor):
             continue
-        idx, _ = find_peaks(amp, prominence=(1 - 1 / math.sqrt(2)) * amp)
+        idx, _ = find_peaks(amp, prominence=(1 - 1 / math.sqrt(2)) * amp, height=floor)
         for i in idx:
             if response is None:
                 af, _, _ = amplification_factor(speed, amp, int(i))
@@ -651,10 +658,16 @@ def api617_unbalance(cfg, controller=None, *, name: str = "none",
         max_hz = min(max_hz, 0.45 * cfg.controller.sample_rate_hz)
     modes = modes_as_run(cfg, controller, speed_hz=f_max, max_hz=max_hz)
     cases = _placements(cfg, modes, loads, so.unbalance_factor, n_rpm)
-    probes = tuple(sorted({a.sensor_position for a in cfg.amb}) if cfg.amb
-                   else [z for z, _ in loads])
+    if so.probes:  # directional probes where the rig file puts them
+        probes = tuple(float(pr.position) for pr in so.probes)
+        angles = [float(pr.angle_deg) for pr in so.probes]
+    else:
+        probes = tuple(sorted({a.sensor_position for a in cfg.amb}) if cfg.amb
+                       else [z for z, _ in loads])
+        angles = [None] * len(probes)
     close = _close_clearances(cfg)
     where = [*probes, *(z for _, z, _ in close)]
+    where_angles = [*angles, *(None for _ in close)]
     a_vl = vibration_limit_um(n_rpm, so.vibration_limit_cap_um)
     # from standstill: the first speed a step above it (a controller's integrator has no
     # response at zero frequency)
@@ -662,7 +675,8 @@ def api617_unbalance(cfg, controller=None, *, name: str = "none",
                                        [f_min, f_max, trip]]))
 
     def response(speeds):
-        r = synchronous_response(cfg, controller, speeds, [u for _, _, u in cases], where)
+        r = synchronous_response(cfg, controller, speeds, [u for _, _, u in cases], where,
+                                 angles_deg=where_angles)
         return 2e6 * r.amplitude_m  # µm peak-to-peak
 
     amp = response(coarse)
@@ -679,6 +693,7 @@ def api617_unbalance(cfg, controller=None, *, name: str = "none",
         order = np.argsort(speed)
         speed, amp = speed[order], np.concatenate([amp, response(fine)], axis=1)[:, order]
     lo_, hi_ = (speed >= f_min - 1e-9) & (speed <= trip + 1e-9), speed <= trip + 1e-9
+    floor = NOISE_SHARE * float(amp[:, :, :len(probes)].max(initial=0.0))
     s_lo, s_hi = so.scale_factor_limits
     a1_speeds = (((speed >= f_min - 1e-9) & (speed <= f_max + 1e-9))
                  if so.scale_factor_speeds == "continuous" else hi_)
@@ -687,10 +702,11 @@ def api617_unbalance(cfg, controller=None, *, name: str = "none",
         pr = amp[c, :, :len(probes)]
 
         def at(s, p, c=c):  # this case's probe p at one speed
-            r = synchronous_response(cfg, controller, [s], [cases[c][2]], [probes[p]])
+            r = synchronous_response(cfg, controller, [s], [cases[c][2]], [probes[p]],
+                                     angles_deg=[angles[p]])
             return 2e6 * float(r.amplitude_m[0, 0, 0])
 
-        crit = _criticals(speed, pr, probes, f_min, f_max, at)
+        crit = _criticals(speed, pr, probes, f_min, f_max, at, floor)
         a1 = float(pr[a1_speeds].max())
         sc = float(np.clip(a_vl / a1, s_lo, s_hi)) if a1 > 0 else s_hi
         clear = tuple(Clearance(n, float(z), 2e6 * rc, so.clearance_fraction * 2e6 * rc,

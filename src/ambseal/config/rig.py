@@ -581,6 +581,14 @@ class Machine(_Strict):
     kind: Literal["compressor", "turbine"] = "compressor"
 
 
+class Probe(_Strict):
+    """A displacement probe of the sign-off: its axial ``position`` (m) and the direction
+    it reads, ``angle_deg`` from x towards y (a proximity probe reads x cos θ + y sin θ)."""
+
+    position: float = Field(ge=0)
+    angle_deg: float = Field(default=0.0, ge=-360, le=360)
+
+
 class Signoff(_Strict):
     """The sign-off's limits that the standards' public text does not confirm, as
     settings with documented defaults (:mod:`ambseal.analysis.signoff`): API 617's CSR
@@ -591,7 +599,9 @@ class Signoff(_Strict):
     ``vibration_limit_cap_um`` (µm p-p), the scale factor's ``scale_factor_limits`` and
     ``scale_factor_speeds`` (``"to_trip"`` or ``"continuous"``), the
     close clearances' allowed ``clearance_fraction``, and ISO 14839-2's zone boundaries
-    ``iso14839_2_zones`` (fractions of the backup bearing's clearance C_min)."""
+    ``iso14839_2_zones`` (fractions of the backup bearing's clearance C_min); and the
+    unbalance response's ``probes`` (``[{ position, angle_deg }]``, directional; left out,
+    the orbit at the AMB sensors or the springs)."""
 
     csr_boundary: list[Annotated[list[float], Field(min_length=2, max_length=2)]] = Field(
         default=[[16.53, 2.5], [60.0, 2.0]], min_length=1, max_length=100)
@@ -606,6 +616,9 @@ class Signoff(_Strict):
     clearance_fraction: float = Field(default=0.75, gt=0, le=1.0)
     iso14839_2_zones: tuple[float, float, float] = Field(default=(0.3, 0.4, 0.5),
                                                          strict=False)
+    # the API 617 unbalance response's probes: directional, at any node; left out, the
+    # orbit's semi-major axis at the AMB sensors (the springs of a rig without AMBs)
+    probes: list[Probe] | None = Field(default=None, min_length=1, max_length=100)
 
     @model_validator(mode="after")
     def _ordered(self) -> "Signoff":

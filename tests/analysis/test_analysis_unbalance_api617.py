@@ -90,6 +90,41 @@ def test_rigid_rotor_on_damped_springs_is_the_closed_form():
     assert r.trip_hz == pytest.approx(1.05 * 50.0) and r.top_hz == pytest.approx(1.25 * 52.5)
 
 
+@pytest.mark.parametrize("c", [2000.0, 500.0])
+def test_the_critical_of_a_rigid_rotor_is_its_exact_closed_form(c):
+    """The rotor of the test above with a shaft 1e4 times stiffer than steel (a rigid
+    body to 1e-6): its mid-span unbalance U excites one degree of freedom, x = U ω²/(k −
+    mω² + jωc). The critical's speed, its peak-to-peak amplitude and its half-power AF
+    equal that closed form's, solved by SciPy (``minimize_scalar`` for the peak,
+    ``brentq`` for the half-power speeds), to 1e-5; and AF = 1/(2ζ), the closed form's
+    light-damping limit, within 0.1 % at ζ = 0.008 (c = 500 N·s/m; 0.4 % at ζ = 0.032,
+    where the mass-excited peak moves by order ζ²)."""
+    from scipy.optimize import brentq, minimize_scalar
+
+    k = 1e7
+    cfg = parse_rig(tomllib.loads(_rigid_rotor(k, c, 4.5e4).replace("E = 2.1e11",
+                                                                     "E = 2.1e15")))
+    r = api617_unbalance(cfg)
+    (u,) = r.cases[0].unbalances
+    m = math.pi / 4 * 0.2**2 * 0.4 * 7850.0
+    wn, zeta = math.sqrt(k / m), c / (2 * math.sqrt(k * m))
+    (crit,) = r.cases[0].criticals
+
+    def amp(w):
+        return abs(u.amount * w * w / (k - m * w * w + 1j * w * c))
+
+    best = minimize_scalar(lambda w: -amp(w), bounds=(0.5 * wn, 1.5 * wn), method="bounded",
+                           options={"xatol": 1e-10})
+    wp, ap = best.x, amp(best.x)
+    w1 = brentq(lambda w: amp(w) - ap / math.sqrt(2), 0.5 * wn, wp, xtol=1e-12)
+    w2 = brentq(lambda w: amp(w) - ap / math.sqrt(2), wp, 2 * wn, xtol=1e-12)
+    assert crit.speed_hz == pytest.approx(wp / (2 * math.pi), rel=1e-5)
+    assert crit.amplitude_um == pytest.approx(2e6 * ap, rel=1e-5)
+    assert crit.af == pytest.approx(wp / (w2 - w1), rel=1e-5)
+    if zeta < 0.01:
+        assert crit.af == pytest.approx(1 / (2 * zeta), rel=1e-3)
+
+
 def test_close_clearance_is_the_scaled_response_against_its_fraction():
     """A seal of 0.3 mm radial clearance at mid-span of the same rotor: S_c = A_vl/A_1
     bounded to [0.5, 6] (A_1 the probes' largest amplitude to the trip speed), the seal's

@@ -92,6 +92,8 @@ __all__ = ["unbalance_ur", "vibration_limit_um", "amplification_factor", "exact_
 #: LOBE_FLOOR of the largest amplitude do not split a lobe; an antinode between the
 #: supports counts from INBOARD_SHARE of the largest, one outboard from OUTBOARD_SHARE
 LOBE_FLOOR, INBOARD_SHARE, OUTBOARD_SHARE = 0.02, 0.1, 0.5
+#: two probes' peaks this close (relative) are one critical speed
+SAME_CRITICAL = 1e-4
 #: a probe's amplitude below this share of the analysis's largest is rounding
 NOISE_SHARE = 1e-9
 #: Speeds of the coarse sweep; each critical is refined with :data:`REFINE` more.
@@ -606,11 +608,12 @@ def _criticals(speed, probe_um, probes, f_min, f_max, response=None, floor: floa
                 req = required_margin(af, near_low)
                 act = -100 * min(nc - f_min, f_max - nc) / f_max
             out.append(Critical(nc, float(z), a_c, af, req, act))
-    # one critical per speed (the solved peaks of two probes agree to the solver's
-    # tolerance): the probe that shows it largest
+    # one critical per speed: the solved peaks of two probes agree to the flat top's
+    # conditioning (a rigid rotor's two supports: 2.6e-6 apart), the probe that shows it
+    # largest
     best: list[Critical] = []
     for c in sorted(out, key=lambda c: c.speed_hz):
-        if best and c.speed_hz - best[-1].speed_hz <= 1e-6 * c.speed_hz:
+        if best and c.speed_hz - best[-1].speed_hz <= SAME_CRITICAL * c.speed_hz:
             if c.amplitude_um > best[-1].amplitude_um:
                 best[-1] = c
         else:

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import importlib.metadata
 import json
+import re
 import shutil
 import tomllib
 from pathlib import Path
@@ -17,6 +18,7 @@ import pytest
 from ambseal.analysis.campbell import closed_loop_modes
 from ambseal.cli import main
 from ambseal.config import load_rig
+from ambseal.errors import ConfigError
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "ross3"
 
@@ -105,3 +107,76 @@ def test_a_ross2_file_is_read_by_the_installed_ross(tmp_path, capsys):
     assert len(m.poles) >= 8
     for lam in m.poles:
         assert np.min(np.abs(lam_ross - lam)) <= 1e-6 * abs(lam)
+
+
+def _mutated(change) -> dict:
+    """``tables.toml``'s tables with ``change(data)`` applied."""
+    data = tomllib.loads((DATA / "tables.toml").read_text())
+    change(data)
+    return data
+
+
+def _set(key_prefix: str, field: str, value, index: int = 0):
+    def change(data):
+        key = [k for k in data if k.startswith(key_prefix)][index]
+        if value is _DROP:
+            del data[key][field]
+        else:
+            data[key][field] = value
+    return change
+
+
+_DROP = object()
+
+
+@pytest.mark.parametrize("change, message", [
+    (_set("BearingElement", "cxx", [150.0, float("nan"), 200.0], 1), "expected finite"),
+    (_set("BearingElement", "speed", [900.0, 50.0, 200.0], 1), "strictly increasing"),
+    (_set("BearingElement", "speed", [50.0, 50.0, 900.0], 1), "strictly increasing"),
+    (_set("BearingElement", "kxx", [1e6, 2e6], 1), "values for the table"),
+    (_set("BearingElement", "kxx", "stiff", 1), "expected finite"),
+    (_set("DiskElement", "n", -1), "integer ≥ 0"),
+    (_set("DiskElement", "n", 2.5), "integer ≥ 0"),
+    (_set("DiskElement", "n", 99), "not on the shaft"),
+    (_set("DiskElement", "m", _DROP), "missing 'm'"),
+    (_set("ShaftElement", "L", _DROP), "missing 'L'"),
+    (_set("BearingElement", "n", _DROP), "missing 'n'"),
+    (lambda d: d[[k for k in d if k.startswith("ShaftElement")][0]]["material"].pop("E"),
+     "material E"),
+    (lambda d: d["parameters"].update(alpha="two"), "alpha = 'two'"),
+])
+def test_the_ross3_reader_refuses_damaged_tables_by_name(change, message):
+    """ROSS 3 files damaged as a user's may be: each refused with ambseal's error naming
+    the element and the key (ROSS's interpolants had raised SciPy's ValueError, a missing
+    key a KeyError, a disk on node −1 went silently to the last node)."""
+    from ambseal.io.ross import from_ross
+    from ambseal.io.ross_file import read_ross3_file
+
+    data = _mutated(change)
+    with pytest.raises(ConfigError, match=re.escape(message)):
+        from_ross(read_ross3_file("damaged.toml", data), where="damaged.toml")
+
+
+def test_the_ross3_reader_names_what_it_leaves_out_and_refuses_unreadable_json(tmp_path,
+                                                                               capsys):
+    """A bearing's axial kzz, czz is named among what is not imported (it had been dropped
+    with ``unmapped`` empty); a JSON file with one element key twice (JSON keeps the last:
+    a disk lost) and one nested 100 000 deep (a RecursionError traceback) are refused,
+    exit 2, before ROSS is imported."""
+    from ambseal.io.ross import from_ross
+    from ambseal.io.ross_file import read_ross3_file
+
+    data = _mutated(lambda d: d[[k for k in d if k.startswith("BearingElement")][0]].update(
+        kzz=[1e8], czz=[500.0]))
+    imp = from_ross(read_ross3_file("axial.toml", data), where="axial.toml")
+    assert any("kzz = 1e+08, czz = 500" in u and "not imported" in u for u in imp.unmapped)
+    disk = [k for k in data if k.startswith("DiskElement")][0]
+    text = json.dumps(data)
+    cases = {"repeat.json": text[:-1] + f", {json.dumps(disk)}: {json.dumps(data[disk])}}}",
+             "deep.json": '{"parameters": {}, "x": ' + "[" * 100000 + "]" * 100000 + "}"}
+    for name, body in cases.items():
+        src = tmp_path / name
+        src.write_text(body)
+        assert main(["import-ross", str(src), "--out", str(tmp_path / "o.toml")]) == 2
+        err = capsys.readouterr().err
+        assert "Traceback" not in err and ("twice" in err or "nested too deeply" in err)

@@ -533,6 +533,13 @@ def _elements(rotor, bearings: list) -> tuple[list[str], list[str]]:
         if b.n > last and b.n not in housings:
             refused.append(f"bearing {i} ({b.tag}): on node {b.n}, off the shaft (nodes "
                            f"0–{last})")
+        ax = {k: np.atleast_1d(np.asarray(_coef(b, k) if hasattr(b, k) else 0.0, float))
+              for k in ("kzz", "czz")}
+        if any(np.any(v) for v in ax.values()):
+            unmapped.append(f"bearing {i} ({b.tag}): its axial terms ("
+                            + ", ".join(f"{k} = {float(np.max(np.abs(v))):g}"
+                                        for k, v in ax.items() if np.any(v))
+                            + ") not imported: no lateral effect")
     for p in getattr(rotor, "point_mass_elements", []):
         if p.n > last and p.n not in housings:
             refused.append(f"point mass {p.tag}: on node {p.n}, off the shaft (a support "
@@ -944,9 +951,13 @@ def _check_file(path: Path, ross=None) -> dict:
 
     try:
         text = read_text(path, "ROSS rotor file")
-        data = json.loads(text) if path.suffix.lower() == ".json" else tomllib.loads(text)
+        data = (json.loads(text, object_pairs_hook=_no_repeats)
+                if path.suffix.lower() == ".json" else tomllib.loads(text))
     except AmbsealError as exc:
         raise ConfigError(str(exc)) from None
+    except RecursionError:
+        raise ConfigError(f"{path}: not a ROSS rotor file (nested too deeply to read)"
+                          ) from None
     except (OSError, ValueError) as exc:
         raise ConfigError(f"{path}: not a ROSS rotor file ({exc})") from None
     if not isinstance(data, dict) or not isinstance(data.get("parameters"), dict):
@@ -975,6 +986,17 @@ def _check_file(path: Path, ross=None) -> dict:
     if pairs and all(isinstance(n, int) and not isinstance(n, bool) for n in pairs):
         _one_shaft(pairs, str(path))
     return data
+
+
+def _no_repeats(pairs: list) -> dict:
+    """A JSON object without a repeated key (JSON's own readers keep the last silently:
+    two elements under one key would lose one)."""
+    out: dict = {}
+    for k, v in pairs:
+        if k in out:
+            raise ValueError(f"the key {k!r} appears twice")
+        out[k] = v
+    return out
 
 
 def _installed_ross() -> str | None:

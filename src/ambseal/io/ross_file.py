@@ -122,6 +122,62 @@ def _interpolant(values, speed, frequency, method: str):
     return lambda w, s=None: float(along(w))
 
 
+#: the keys each element class needs, numbers all (ROSS 3.1's constructors' arguments)
+_NEEDS = {"ShaftElement": ("L", "idl", "odl", "idr", "odr", "n"),
+          "DiskElement": ("n", "m", "Id", "Ip"), "GearElement": ("n", "m", "Id", "Ip"),
+          "GearElementTVMS": ("n", "m", "Id", "Ip"), "PointMass": ("n",),
+          "CouplingElement": ("n", "L"), "MotorElement": ("n",), "bearing": ("n",)}
+_MATERIAL = ("rho", "E", "G_s")
+
+
+def _number(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _check(key: str, kind: str, table: dict, where: str) -> None:
+    """Refuse an element table without the keys its class needs, or with one that is not
+    a finite number, naming the element and the key."""
+    for name in _NEEDS.get(kind, ()):
+        if name not in table:
+            raise ConfigError(f"{where}: {key}: missing {name!r} (a {kind} needs "
+                              f"{', '.join(_NEEDS[kind])})")
+        if not _number(table[name]):
+            raise ConfigError(f"{where}: {key}: {name} = {table[name]!r} (expected a finite "
+                              "number)")
+    if kind == "ShaftElement":
+        mat = table.get("material")
+        for name in _MATERIAL:
+            if not isinstance(mat, dict) or not _number(mat.get(name)):
+                raise ConfigError(f"{where}: {key}: material {name} = "
+                                  f"{(mat or {}).get(name)!r} (expected a finite number)")
+
+
+def _check_table(key: str, table: dict, where: str) -> None:
+    """A bearing's coefficients: finite numbers, one per point of its axis (or one), the
+    axis strictly increasing (ROSS's interpolants need it)."""
+    axes = [(a, table[a]) for a in ("speed", "frequency") if table.get(a) is not None]
+    for a, ax in axes:
+        ax = list(np.atleast_1d(ax)) if not isinstance(ax, list) else ax
+        if not ax or not all(_number(x) for x in ax):
+            raise ConfigError(f"{where}: {key}: {a} = {ax!r} (expected finite numbers)")
+        if any(b <= c for c, b in zip(ax, ax[1:])):
+            raise ConfigError(f"{where}: {key}: {a} = {ax!r} (expected strictly "
+                              "increasing values)")
+    shape = tuple(len(np.atleast_1d(ax)) for _, ax in axes)
+    for name in _COEFFS + ("kzz", "czz", "mzz"):
+        if name not in table:
+            continue
+        v = np.asarray(table[name], dtype=object)
+        flat = list(v.ravel())
+        if not flat or not all(_number(x) for x in flat):
+            raise ConfigError(f"{where}: {key}: {name} = {table[name]!r} (expected finite "
+                              "numbers)")
+        if len(flat) > 1 and v.shape != shape:
+            raise ConfigError(f"{where}: {key}: {name} has {v.shape} values for the table's "
+                              f"{' × '.join(a for a, _ in axes) or 'no axis'} of "
+                              f"{shape} points")
+
+
 def _bearing(table: dict, where: str, seal: str | None = None) -> _Element:
     """A bearing, or a seal of ROSS's class ``seal`` (its saved coefficient tables)."""
     amb = all(k in table for k in _AMB_KEYS)
@@ -135,9 +191,12 @@ def _bearing(table: dict, where: str, seal: str | None = None) -> _Element:
         raise ConfigError(f"{where}: bearing {el.tag}: interpolation {method!r} (expected "
                           "'pchip' or 'linear')")
     el.interpolation = method  # ROSS 3.1's default where the file names none
+    shape = tuple(len(np.atleast_1d(a)) for a in (speed, freq) if a is not None)
     for name in _COEFFS + ("kzz", "mzz"):
-        v = table.get(name, [0.0])
-        setattr(el, name, np.asarray(v, float))
+        v = np.asarray(table.get(name, [0.0]), float)
+        if v.size == 1 and shape:  # one value beside a table's axes: a constant
+            v = np.full(shape, float(v.ravel()[0]))
+        setattr(el, name, v)
         setattr(el, f"{name}_interpolated", _interpolant(v, speed, freq, method))
     if amb:
         # in ROSS's order of operations: the same factors to the last bit
@@ -159,6 +218,15 @@ class _Rotor:
 
     def __init__(self, data: dict, where: str):
         par = data["parameters"]
+        for k in ("alpha", "beta", "default_damping_ratio"):
+            if par.get(k) is not None and not _number(par[k]):
+                raise ConfigError(f"{where}: parameters: {k} = {par[k]!r} (expected a finite "
+                                  "number)")
+        ratios = par.get("modal_damping_ratio")
+        if ratios is not None and not all(_number(x) for x in np.atleast_1d(
+                np.asarray(ratios, dtype=object))):
+            raise ConfigError(f"{where}: parameters: modal_damping_ratio = {ratios!r} "
+                              "(expected finite numbers)")
         self.tag = par.get("tag") or "Rotor 0"  # ROSS's name of a rotor without a tag
         self.alpha, self.beta = (float(par.get(k, 0.0) or 0.0) for k in ("alpha", "beta"))
         self.modal_damping_ratio = par.get("modal_damping_ratio")
@@ -171,6 +239,10 @@ class _Rotor:
                 continue
             if "tag" not in table and "_" in key:  # ROSS's own tag: the key's second part
                 table = {**table, "tag": key.split("_", 1)[1]}
+            bearing = kind == "BearingElement" or kind.endswith("Seal")
+            _check(key, "bearing" if bearing else kind, table, where)
+            if bearing:
+                _check_table(key, table, where)
             if kind == "ShaftElement":
                 el = ShaftElement(table)
                 el.material = _Material(table["material"])
@@ -203,6 +275,17 @@ class _Rotor:
                               "or newer, and import again)")
         self.elements = [*self.shaft_elements, *self.disk_elements,
                          *self.point_mass_elements, *self.bearing_elements, *motors]
+        for el in self.elements:
+            for attr in ("n", "n_link"):
+                n = getattr(el, attr, None)
+                if n is not None and not (_number(n) and n == int(n) and n >= 0):
+                    raise ConfigError(f"{where}: {type(el).__name__} {el.tag}: {attr} = "
+                                      f"{n!r} (expected a node number, an integer ≥ 0)")
+        last = max([int(el.n) + 1 for el in self.shaft_elements], default=0)
+        for el in self.disk_elements:  # a disk sits on the shaft (housings hold masses)
+            if int(el.n) > last:
+                raise ConfigError(f"{where}: {type(el).__name__} {el.tag}: node {el.n} is "
+                                  f"not on the shaft (nodes 0–{last})")
 
     def axial_torsional_rad_s(self) -> np.ndarray:
         """ROSS's axial and torsional natural frequencies (rad/s) at standstill, ascending:

@@ -271,6 +271,23 @@ def test_design_show_defaults_prints_a_design_part_that_reads_back(capsys):
     assert cfg.design.mu.wf_rolloff_hz == 260
 
 
+def test_show_defaults_writes_names_with_quotes_and_backslashes_as_toml(tmp_path, capsys):
+    """A disk named ``Impeller "A" C:\\stage`` as ``force_at``: ``--show-defaults`` writes
+    it as a TOML string that reads back to the same name (it had printed the quotes and
+    the backslash bare, which does not parse)."""
+    import tomllib
+
+    name = 'Impeller "A" C:\\stage'
+    text = (Path(__file__).resolve().parents[1] / "examples" / "overhung_compressor.toml"
+            ).read_text().replace('name = "impeller"', f"name = {json.dumps(name)}").replace(
+        'disk = "impeller"', f"disk = {json.dumps(name)}")
+    rig = tmp_path / "rig.toml"
+    rig.write_text(text + f"\n[design.unbalance]\nforce_at = {json.dumps(name)}\n")
+    assert main(["design", str(rig), "--show-defaults"]) == 0
+    shown = tomllib.loads(capsys.readouterr().out)["design"]
+    assert shown["unbalance"]["force_at"] == name
+
+
 @pytest.mark.parametrize("args, words", [
     (["--show-defaults", "--set", "design.mu.orbit_um=-1"], "design.mu.orbit_um"),
     (["--show-defaults", "--set", "orbit_um=8"], "design.<key>=<value>"),

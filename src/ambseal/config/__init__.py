@@ -49,6 +49,7 @@ from ambseal.config.rig import (
                                     parse_rig,
                                     rig_parameter_names,
                                     rig_with_values,
+                                    toml_string,
 )
 
 __all__ = ["MAX_AMBS", "MAX_COEFFICIENT", "MAX_COMPONENTS", "MAX_CURRENT_A", "MAX_DELAY_SAMPLES", "MAX_ELEMENTS",
@@ -59,4 +60,4 @@ __all__ = ["MAX_AMBS", "MAX_COEFFICIENT", "MAX_COMPONENTS", "MAX_CURRENT_A", "MA
            "Machine", "Pid", "PidFilter", "RigConfig", "Seal", "Signoff", "Spring", "Stage",
            "TruthSection", "apply_overrides",
            "check_operating", "default_rig_path", "dump_rig", "load_rig", "load_truth",
-           "parse_rig", "rig_parameter_names", "rig_with_values"]
+           "parse_rig", "rig_parameter_names", "rig_with_values", "toml_string"]

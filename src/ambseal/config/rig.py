@@ -165,6 +165,7 @@ __all__ = [
     "rig_with_values",
     "rig_parameter_names",
     "dump_rig",
+    "toml_string",
 ]
 
 
@@ -1075,13 +1076,37 @@ def rig_with_values(cfg: RigConfig, values: dict[str, Coefficient]) -> RigConfig
     return parse_rig(data, "<identified rig>")
 
 
+def toml_string(text: str) -> str:
+    """``text`` as a TOML basic string: quoted, its backslashes, quotes and control
+    characters escaped (TOML 1.0, §String).
+
+    Parameters
+    ----------
+    text : str
+
+    Returns
+    -------
+    str
+        E.g. ``'"Impeller \\"A\\" C:\\\\stage"'`` for ``Impeller "A" C:\\stage``.
+    """
+    out = []
+    for ch in text:
+        if ch in ('"', "\\"):
+            out.append("\\" + ch)
+        elif ord(ch) < 0x20 or ord(ch) == 0x7F:
+            out.append(f"\\u{ord(ch):04X}")
+        else:
+            out.append(ch)
+    return '"' + "".join(out) + '"'
+
+
 def _toml_value(v) -> str:
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, (int, float)):
         return repr(v) if isinstance(v, int) or math.isfinite(v) else "nan"
     if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        return toml_string(v)
     if isinstance(v, dict):
         return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
     if isinstance(v, (list, tuple)):

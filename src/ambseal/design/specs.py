@@ -82,7 +82,7 @@ from types import MappingProxyType
 
 import numpy as np
 
-from ambseal.config import MAX_GAP_M
+from ambseal.config import MAX_GAP_M, toml_string
 from ambseal.design.conditions import judged_conditions, stability_speeds
 from ambseal.design.pid import reference_pid
 from ambseal.design.weights import default_weights
@@ -329,13 +329,13 @@ class DesignSpec:
                 "", "[design.unbalance]",
                 f"grade_mm_s = {fmt(self.unbalance_grade_mm_s)}",
                 f"mass_kg = {fmt(self.unbalance_mass_kg)}  # assembled rotor mass",
-                line("law", f'"{self.unbalance_law}"', "unbalance.law"),
+                line("law", toml_string(self.unbalance_law), "unbalance.law"),
                 line("max_speed_hz", fmt(self.unbalance_max_speed_hz), "unbalance.max_speed_hz"),
-                *([line("force_at", f'"{self.force_at}"', "unbalance.force_at")]
+                *([line("force_at", toml_string(self.force_at), "unbalance.force_at")]
                   if self.force_at else ["# force_at: none (the bearings, P5 §4.4.1)"]),
                 line("range_hz", f"[{fmt(self.unbalance_range_hz[0])}, "
                      f"{fmt(self.unbalance_range_hz[1])}]", "unbalance.range_hz"),
-                line("plant", f'"{self.unbalance_plant}"', "unbalance.plant"),
+                line("plant", toml_string(self.unbalance_plant), "unbalance.plant"),
                 "", "[design.impulse]",
                 *([line("amplitude_a", fmt(self.impulse_a), "impulse")] if self.impulse_a
                   else ["# amplitude_a: no bias current, none"]),
@@ -344,12 +344,12 @@ class DesignSpec:
             r = f"relative = {fmt(rng)}" if np.isscalar(rng) else \
                 f"low = {fmt(rng[0])}\nhigh = {fmt(rng[1])}"
             out += ["", "[[design.uncertainty]]  # " + src.get("uncertainty", ""),
-                    f'parameter = "{name}"', r]
+                    f"parameter = {toml_string(name)}", r]
         for method, w in self.weights.items():
             out += ["", f"[design.{method}]"] + _weight_lines(method, w, src)
             if method == "mu":
                 out += [f"max_iter = {self.max_iter}", f"dk_order = {self.dk_order}",
-                        f'iteration = "{self.mu_iteration}"']
+                        f"iteration = {toml_string(self.mu_iteration)}"]
         return "\n".join(out) + "\n"
 
 

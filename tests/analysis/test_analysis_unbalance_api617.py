@@ -61,6 +61,19 @@ def test_half_power_af_of_a_sampled_resonance():
     assert af == pytest.approx(1 / (2 * zeta), rel=2 * zeta) and n1 < 1 < n2
 
 
+def test_journal_loads_with_cross_coupled_supports_are_the_statics():
+    """Two supports with cross-coupled stiffness (kxy = kyx = 0.4 kyy, a tilting-pad
+    bearing's) under the symmetric rotor: the weight sags it in x too, and each journal
+    carries m/2 — the vertical force kyx·x + kyy·y (reading kyy·y alone had taken part of
+    it for the x sag's)."""
+    doc = tomllib.loads(_rigid_rotor(1e7, 2000.0, 4.5e4))
+    for sp in doc["spring"]:
+        sp["kxy"] = sp["kyx"] = 0.4 * sp["kyy"]
+    m = math.pi / 4 * 0.2**2 * 0.4 * 7850.0
+    assert [w for _, w in journal_loads(parse_rig(doc))] == pytest.approx([m / 2, m / 2],
+                                                                          rel=1e-3)
+
+
 def test_rigid_rotor_on_damped_springs_is_the_closed_form():
     """The rotor of the Level I test (m ≈ 98.6 kg on k = 1e7 N/m, c = 2000 N·s/m, 3000 rpm
     continuous): journal loads m/2; the mid-span case 2·U_r with W = m; its critical at

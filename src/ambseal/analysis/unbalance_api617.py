@@ -82,7 +82,14 @@ from ambseal.analysis.synchronous import Unbalance, orbit_semi_major, synchronou
 from ambseal.config import Spring
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
-from ambseal.model import bending_limit_hz, build_mesh, build_system, spring_at, spring_label
+from ambseal.model import (
+    SpringElement,
+    bending_limit_hz,
+    build_mesh,
+    build_system,
+    spring_at,
+    spring_label,
+)
 
 __all__ = ["unbalance_ur", "vibration_limit_um", "amplification_factor", "exact_half_power",
            "required_margin", "journal_loads", "Critical", "Clearance", "UnbalanceCase",
@@ -237,26 +244,32 @@ def journal_loads(cfg) -> tuple[tuple[float, float], ...]:
     pins = [Spring(position=z, kxx=RIGID_SUPPORT, kyy=RIGID_SUPPORT, name=f"pin{i}")
             for i, z in enumerate(zs)] if cfg.amb else []
     # the bearings carry the weight: a seal (also one given as a spring) takes none
-    kept = [spring_at(s, 0.0) for s in without_seals(cfg).spring]  # statics: at rest
+    # a bearing's table at the running speed (a fluid film's has no standstill value)
+    f_run = cfg.operating.speed_rpm / 60.0
+    kept = [spring_at(s, f_run) for s in without_seals(cfg).spring]
     rig = cfg.model_copy(update={"seal": [], "amb": [], "spring": [*kept, *pins]})
     sys = build_system(rig, speed_rpm=0.0)
     t = np.zeros(sys.n_dof)
     t[1:sys.mesh.n_dof:4] = 1.0  # the rotor's weight (a housing's goes to its supports)
     q = np.linalg.solve(sys.K, GRAVITY * (sys.M @ t))
 
-    def stretch(s: Spring, index: int) -> float:
-        """The spring's deflection in y: the journal's, less its housing's."""
-        y = q[4 * sys.mesh.node_at(s.position) + 1]
-        if s.housing is None:
-            return float(y)
-        return float(y - q[sys.mesh.n_dof + sys.housing_names.index(
-            f"{spring_label(s, index)}_housing_y")])
+    def vertical(s: Spring, index: int) -> float:
+        """The spring's vertical force: its stiffness (cross terms and axes included) on
+        the journal's deflection, less its housing's."""
+        node = sys.mesh.node_at(s.position)
+        d = np.array([q[4 * node], q[4 * node + 1]])
+        if s.housing is not None:
+            h = sys.mesh.n_dof + sys.housing_names.index(f"{spring_label(s, index)}_housing_x")
+            d = d - q[h:h + 2]
+        K2 = SpringElement.from_config(s.model_copy(update={"housing": None}), sys.mesh,
+                                       index).matrices()[0]
+        return float((K2 @ d)[1])
 
     force = {z: 0.0 for z in zs}
     # with AMBs, their pins (appended after the rig's springs) carry the journals
     for i, s in list(enumerate(rig.spring))[len(kept) if cfg.amb else 0:]:
         if s.position in force:
-            force[s.position] += s.kyy * stretch(s, i)
+            force[s.position] += vertical(s, i)
     loads = tuple((z, abs(force[z] / GRAVITY)) for z in zs)
     if not sum(w for _, w in loads) > 0:
         raise ConfigError("API 617 unbalance response: the bearings carry no static load "

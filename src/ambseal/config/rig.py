@@ -1083,6 +1083,7 @@ def toml_string(text: str) -> str:
     Parameters
     ----------
     text : str
+        Any text (a name from the rig file).
 
     Returns
     -------

@@ -314,7 +314,7 @@ def _table(el, name: str, omega: float) -> dict:
 def _spring(el, z: float, i: int, varies: bool, omega: float, notes: list) -> dict:
     names = ("kxx", "kyy", "kxy", "kyx", "cxx", "cyy", "cxy", "cyx", "mxx", "myy", "mxy",
              "myx")
-    vals = {n: float(_coef(el, n)[0]) for n in names}
+    vals = {n: float(_coef(el, n).ravel()[0]) for n in names}  # constant ones
     if varies:
         vals |= {n: t for n in names if len(set((t := _table(el, n, omega))["value"])) > 1}
     for n in ("kxx", "kyy"):

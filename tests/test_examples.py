@@ -42,11 +42,12 @@ TESTRIG = Path(__file__).resolve().parents[1] / "examples" / "testrig.toml"
 FAIL_BELOW_TOP = {"overhung_compressor": {"hinf"}, "flywheel": {"hinf", "mu"}}
 
 #: Rigs whose reference PID, derived from the rig, loses the rotor at the nominal
-#: condition, measured: the flywheel's nutation mode (1.02 kHz at the top speed, ζ −0.025;
-#: 0.44–0.83 kHz from 333 Hz up) outruns the decentralised PID's phase lead through the
-#: 2 kHz amplifier and the 75 µs hold + delay, and cross-axis gains on each bearing
-#: (proportional or derivative, scheduled on speed) do not hold it (benchmarks/README.md).
-#: Reported, not counted in the exit status; the LPV on speed holds it.
+#: condition, measured: on the flywheel, with its integral below the precession, no
+#: corner, lead, lag or notch keeps the first bending modes near 2.2 kHz damped through the
+#: 2 kHz amplifier and the 75 µs hold + delay at every speed, and the notches that do at
+#: standstill cost the nutation (0.44–1.02 kHz) its phase lead; cross-axis gains on each
+#: bearing do not hold it (benchmarks/README.md). Reported, not counted in the exit
+#: status; the LPV on speed holds it.
 PID_LOSES = {"flywheel"}
 
 

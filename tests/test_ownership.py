@@ -279,3 +279,21 @@ def test_stale_folders_beside_a_run_are_removed_only_when_ambseals(tmp_path):
         assert not killed.exists()
         assert all((u / "mine.txt").read_bytes() == USER for u in users)
         check_manifest(out)
+
+
+@pytest.mark.parametrize("umask, mode", [(0o077, 0o600), (0o022, 0o644), (0o002, 0o664)])
+def test_written_files_take_the_users_umask(tmp_path, umask, mode):
+    """``ambseal modes --shapes`` (a figure) and any result file ambseal writes get the mode
+    the user's umask gives a new file (created 0666 less the umask), as any program's:
+    they had been forced to 0644 whatever the umask (a 077 user's results readable by
+    all)."""
+    import stat
+
+    old = os.umask(umask)
+    try:
+        out = tmp_path / "shapes.png"
+        assert main(["modes", str(ROOT / "examples" / "pump.toml"), "--shapes",
+                     str(out)]) == 0
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE(out.stat().st_mode) == mode

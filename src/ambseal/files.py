@@ -21,6 +21,7 @@ import hashlib
 import json
 import os
 import re
+import secrets
 import shutil
 import stat
 import sys
@@ -43,7 +44,9 @@ __all__ = ["atomic_write", "writable_folder", "input_file", "MAX_READ_BYTES", "r
 def atomic_write(path: str | os.PathLike, write: Callable[[BinaryIO], Any]) -> Path:
     """Call ``write(fh)`` on a temporary binary file beside ``path``, then rename it.
 
-    The file gets mode 0644 (results are meant to be shared).
+    The file gets the mode the user's umask gives a new file (0644 under the usual 022):
+    it is created with 0666 and the kernel applies the umask, as for any file a program
+    writes.
 
     Raises
     ------
@@ -55,13 +58,12 @@ def atomic_write(path: str | os.PathLike, write: Callable[[BinaryIO], Any]) -> P
     if not path.parent.is_dir():
         raise AmbsealError(f"{path}: folder {str(path.parent)!r} does not exist")
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        fd, tmp = _new_file(path)
     except OSError as exc:
         raise AmbsealError(f"{path}: cannot write ({exc.strerror or exc})") from None
     try:
         with os.fdopen(fd, "wb") as fh:
             write(fh)
-        os.chmod(tmp, 0o644)
         _journal(path, tmp)
         os.replace(tmp, path)
     except BaseException as exc:
@@ -71,6 +73,19 @@ def atomic_write(path: str | os.PathLike, write: Callable[[BinaryIO], Any]) -> P
             raise AmbsealError(f"{path}: cannot write ({exc.strerror or exc})") from None
         raise
     return path
+
+
+def _new_file(path: Path) -> tuple[int, str]:
+    """A new file beside ``path`` under a random name, opened for writing: created with
+    0666 so that the user's umask sets its mode (``tempfile.mkstemp`` creates 0600)."""
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC | os.O_NOFOLLOW
+    for _ in range(100):
+        tmp = str(path.parent / f".{path.name}.{secrets.token_hex(4)}.tmp")
+        try:
+            return os.open(tmp, flags, 0o666), tmp
+        except FileExistsError:
+            continue
+    raise FileExistsError(f"no free temporary name beside {path}")
 
 
 #: The folders whose writes are being recorded (:class:`OwnedFolder`, innermost last):
@@ -297,7 +312,7 @@ def _open_lock(path: Path, fail) -> int:
     flags = os.O_RDWR | os.O_CLOEXEC | os.O_NOFOLLOW
     try:
         try:
-            return os.open(path, flags | os.O_CREAT | os.O_EXCL, 0o644)
+            return os.open(path, flags | os.O_CREAT | os.O_EXCL, 0o666)  # the umask sets it
         except FileExistsError:
             return os.open(path, flags)
     except OSError as exc:
@@ -319,7 +334,7 @@ def _exchange(a: Path, b: Path) -> bool:
     return fn(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE) == 0
 
 
-#: The temporary name of :func:`atomic_write` (``tempfile.mkstemp``'s 8 random characters):
+#: The temporary name of :func:`atomic_write` (8 random characters, as ``tempfile``'s):
 #: a write killed half-way leaves one; it is ambseal's, not a user's file.
 _TEMPORARY = re.compile(r"\..+\.[a-z0-9_]{8}\.tmp")
 

@@ -68,10 +68,11 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     ``cxy``, ``cyx`` (N·s/m), ``mxx``, ``myy``, ``mxy``, ``myx`` (kg: added mass, e.g. a
     hole-pattern seal's), each a number or a table ``{ frequency_hz = [...], value = [...]
     }`` taken at the synchronous frequency at each speed (a bearing's coefficients over
-    speed; as a seal's table, without a housing), ``axes_angle_deg`` (the axes the coefficients are given in,
-    default 0), ``housing`` (optional ``{ mass, kxx, kyy, kxy, kyx, cxx, cyy, cxy, cyx }``
-    in kg, N/m, N·s/m: the spring joins the shaft to this mass, which its own springs and
-    dampers hold to ground in x, y), ``name`` (optional), ``kind`` (``"bearing"``, the
+    speed; as a seal's table, without a housing), ``axes_angle_deg`` (the axes the
+    coefficients are given in, default 0), ``housing`` (optional
+    ``{ mass, kxx, kyy, kxy, kyx, cxx, cyy, cxy, cyx }`` in kg, N/m, N·s/m: the spring
+    joins the shaft to this mass, which its own springs and dampers hold to ground in x,
+    y), ``name`` (optional), ``kind`` (``"bearing"``, the
     default, or ``"seal"``: a seal whose coefficients have no Childs form — the sign-off
     then treats it as a seal, a source, never a bearing), ``clearance`` (m, optional: the
     radial running clearance of the bearing or seal, a close clearance of the API 617

@@ -240,9 +240,10 @@ def pid_from_rig(cfg) -> dict:
       least-damped pole as it runs at least KEEP_OF_STRUCTURAL of the rotor's structural
       damping ``rotor.modal_damping`` at every condition where the continuous loop is
       stable, else the one stable as it runs at the most conditions, then holding the
-      continuous loop at the most, then the best damped. The order favours the higher corner: a low corner costs phase at the
-      rigid-body modes and raises σ̄(S_o) (test rig: 5.9 at f_s/10, 16 at f_s/20). P5's
-      ε = 0.1 puts the corner at 10/(2π Td) whatever the rate: on
+      continuous loop at the most, then the best damped. The order favours the higher
+      corner: a low corner costs phase at the rigid-body modes and raises σ̄(S_o) (test
+      rig: 5.9 at f_s/10, 16 at f_s/20). P5's ε = 0.1 puts the corner at 10/(2π Td)
+      whatever the rate: on
       the blower (20 kHz) and the pump (10 kHz) that corner (0.50 and 0.43 kHz) left the
       sampled loop unstable at their bending modes. Chosen: blower f_s/20 (none
       keeps the floor there: ζ 0.0006 at 1.6 kHz), pump f_s/10, test rig f_s/14,
@@ -323,6 +324,7 @@ def precession_rad_s(cfg, k_eq: float, speed_rad_s: float) -> float:
     Parameters
     ----------
     cfg : RigConfig
+        The rig (its rotor and AMB positions).
     k_eq : float
         Each AMB's stiffness per axis (N/m), > 0.
     speed_rad_s : float

@@ -176,6 +176,17 @@ def _pd_band_top(speed_hz: float, kd: float, disk_id: float) -> float:
     return min(cyl, con)
 
 
+def _scheduled(text: str, cross: str) -> str:
+    """The rig ``text`` with the cross gains ``cross`` given at 400 Hz (24 000 rpm), run
+    at 150 Hz over 100–400 Hz, and no integral (T_i 1e4 s: the precession, 2.6 Hz at
+    150 Hz, would meet it)."""
+    return text.replace("eps = 0.1\n", f"eps = 0.1\n{cross}cross_speed_rpm = 24000.0\n"
+                        ).replace("[operating]\nspeed_rpm = 0.0",
+                                  "[operating]\nspeed_rpm = 9000.0\n"
+                                  "speed_range_hz = [100.0, 400.0]").replace(
+        "ti = 1.0", "ti = 1e4")
+
+
 def test_cross_gains_scheduled_on_speed_hold_where_constant_ones_do_not():
     """``cross_speed_rpm``: the cross gain given at 400 Hz (0.8 of the band's top there) and
     scaled ∝ Ω stays inside the Routh–Hurwitz band at every speed, so the PID frozen at
@@ -189,13 +200,8 @@ def test_cross_gains_scheduled_on_speed_hold_where_constant_ones_do_not():
     kd, disk_id = KP * 1e-3, 6.0  # the rig file's PID: kp·td; a long rotor: I_t ≫ m a²
     k_ref = 0.8 * _pd_band_top(400.0, kd, disk_id)
     assert k_ref > 1.25 * _pd_band_top(0.0, kd, disk_id)  # constant: above the band at rest
-    text = _rotor().replace(f"Id = {DISK_ID}", f"Id = {disk_id}").replace(
-        "eps = 0.1\n", f"eps = 0.1\ncross_kp = {k_ref}\n"
-                            "cross_speed_rpm = 24000.0\n").replace(
-        "[operating]\nspeed_rpm = 0.0", "[operating]\nspeed_rpm = 9000.0\n"
-                                         "speed_range_hz = [100.0, 400.0]").replace(
-        "ti = 1.0", "ti = 1e4")  # no integral: the precession would meet it (2.6 Hz)
-    cfg = parse_rig(tomllib.loads(text))
+    cfg = parse_rig(tomllib.loads(_scheduled(
+        _rotor().replace(f"Id = {DISK_ID}", f"Id = {disk_id}"), f"cross_kp = {k_ref}\n")))
     res = design(cfg, "pid")
     K = res.controller
     assert isinstance(K, ScheduledPid) and K.schedule == (0.0, 2 * math.pi * 400.0)
@@ -244,14 +250,10 @@ def test_the_scheduled_pid_runs_as_a_table():
     from ambseal.design.specs import design_spec
     from ambseal.machine import ScheduledDigital
 
-    text = _rotor().replace(f"E = {E_RIGID}", "E = 2.1e11").replace(
-        'rotor on AMBs"', 'rotor on AMBs"\nmodal_damping = 0.01').replace(
-        "eps = 0.1\n", "eps = 0.1\ncross_kp = 150.0\ncross_kd = 0.05\n"
-        "cross_speed_rpm = 24000.0\n").replace(
-        "[operating]\nspeed_rpm = 0.0", "[operating]\nspeed_rpm = 9000.0\n"
-                                         "speed_range_hz = [100.0, 400.0]").replace(
-        "ti = 1.0", "ti = 1e4")  # no integral: the precession would meet it (2.6 Hz)
-    cfg = parse_rig(tomllib.loads(text))
+    cfg = parse_rig(tomllib.loads(_scheduled(
+        _rotor().replace(f"E = {E_RIGID}", "E = 2.1e11").replace(
+            'rotor on AMBs"', 'rotor on AMBs"\nmodal_damping = 0.01'),
+        "cross_kp = 150.0\ncross_kd = 0.05\n")))
     res = design(cfg, "pid")
     dig = digital_for(cfg, "pid", res.controller, res, operating_points(design_spec(cfg)))
     assert isinstance(dig, ScheduledDigital)

@@ -250,17 +250,19 @@ def _running_system(cfg, where: tuple, p: float):
     tables = [(i, s) for i, s in enumerate(cfg.spring) if s.tabulated]
     follow = any(s.frequency_dependent for s in cfg.seal) or bool(tables)
 
+    # the tabulated springs as ``base`` holds them (at 0 Hz): what each speed replaces
+    at_rest = [np.zeros((n, n)) for _ in range(3)]
+    for i, s in tables:
+        SpringElement.from_config(s, mesh, i, None, 0.0).assemble(*at_rest)
+
     def seals(f_hz: float):
         """The seals at ``f_hz``, and the tabulated springs' change from their values at 0
         Hz, which ``base`` holds (a spring with a table has no housing)."""
-        M, C, K = (np.zeros((n, n)) for _ in range(3))
+        M, C, K = (-X for X in at_rest)
         for s in cfg.seal:
             SealElement.from_config(s, mesh, p, f_hz).assemble(M, C, K)
         for i, s in tables:
             SpringElement.from_config(s, mesh, i, None, f_hz).assemble(M, C, K)
-            Mz, Cz, Kz = (np.zeros((n, n)) for _ in range(3))
-            SpringElement.from_config(s, mesh, i, None, 0.0).assemble(Mz, Cz, Kz)
-            M, C, K = M - Mz, C - Cz, K - Kz
         return M, C, K
 
     fixed = None if follow else seals(0.0)

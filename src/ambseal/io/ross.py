@@ -882,7 +882,11 @@ def load_ross(path: str | Path):
     if path.suffix.lower() not in (".toml", ".json"):
         raise ConfigError(f"{path}: expected a ROSS rotor file (.toml or .json)")
     ross = _ross()
-    data = _check_file(path, ross)
+    return _load(path, ross, _check_file(path, ross))
+
+
+def _load(path: Path, ross, data: dict):
+    """:func:`load_ross` of a file whose tables ``data`` :func:`_check_file` read."""
     with _stdout_to_stderr(), warnings.catch_warnings(), \
             tempfile.TemporaryDirectory(prefix="ambseal-ross2-") as tmp:
         warnings.simplefilter("ignore")
@@ -1036,10 +1040,10 @@ def _child() -> None:
     the file (absolute), its name for messages, the speed (JSON) and the result file."""
     path, where, out = Path(sys.argv[1]), sys.argv[2], Path(sys.argv[4])
     try:
-        rotor = load_ross(path)
-        res = from_ross(rotor, where=where, speed_rpm=json.loads(sys.argv[3]))
         ross = _ross()
         data = _check_file(path, ross)
+        rotor = _load(path, ross, data)
+        res = from_ross(rotor, where=where, speed_rpm=json.loads(sys.argv[3]))
         notes = list(res.notes)
         if _older_file(data, ross):
             notes.insert(0, f"ROSS {data['ross_version']}'s file, converted by ROSS "

@@ -233,6 +233,41 @@ def test_design_cache_is_data_never_code(testrig_cfg, tmp_path, monkeypatch):
     assert len(calls) == 6 and not marker.exists()
 
 
+def test_a_cache_that_cannot_be_written_is_skipped(testrig_cfg, tmp_path, monkeypatch):
+    """A cache folder the user cannot write (read-only, or a file in its place) is skipped
+    with a warning naming it: the design is still returned, the same as without a cache.
+    Reference: the design the synthesis returns."""
+    import os
+
+    import ambseal.design.seal_schedule as ss
+
+    monkeypatch.setattr(ss, "_synthesise", lambda *a: _two_entry_design())
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    os.chmod(ro, 0o500)
+    blocked = tmp_path / "file"
+    blocked.write_text("not a folder")
+    # an entry's name taken by a folder: the rename fails as in a read-only folder, also
+    # for root (who writes anywhere)
+    taken = tmp_path / "taken"
+    design_seal_scheduled(testrig_cfg, cache_dir=taken)
+    (entry,) = taken.iterdir()
+    entry.unlink()
+    entry.mkdir()
+    try:
+        for folder in (ro, blocked / "sub", taken):
+            if folder == ro and os.access(ro, os.W_OK):  # root writes anywhere
+                continue
+            monkeypatch.setenv(ss.CACHE_ENV, str(folder))
+            with pytest.warns(UserWarning, match="cache.*not kept") as rec:
+                d = design_seal_scheduled(testrig_cfg)
+            assert str(folder) in str(rec[0].message)
+            assert d.schedule == _two_entry_design().schedule
+    finally:
+        os.chmod(ro, 0o700)
+    assert list(ro.iterdir()) == [] and list(taken.iterdir()) == [entry]
+
+
 def test_no_deserialisation_of_code_in_the_package():
     """Nothing ambseal reads from disk is unpickled: no pickle load, no
     ``allow_pickle=True`` and no ``eval`` in the source."""

@@ -111,11 +111,11 @@ def test_bad_inputs():
     """One grid point, a rate bound with a constant Lyapunov function, no rate bound with
     a parameter-dependent one, an infeasible problem and an inaccurate solve are refused."""
     P = _toy(0.0)
-    with pytest.raises(SynthesisError, match="at least 2 points"):
+    with pytest.raises(ModelError, match="at least 2 points"):
         lpvsyn([P], [0.0], 2, 2)
-    with pytest.raises(SynthesisError, match="rate bound needs a parameter-dependent"):
+    with pytest.raises(ModelError, match="rate bound needs a parameter-dependent"):
         lpvsyn([P, _toy(1.0)], [0.0, 1.0], 2, 2, rate_bound=5.0)
-    with pytest.raises(SynthesisError, match="needs a finite rate_bound"):
+    with pytest.raises(ModelError, match="needs a finite rate_bound"):
         lpvsyn([P, _toy(1.0)], [0.0, 1.0], 2, 2, lyapunov="affine")
     # unstable and unreachable from u: no stabilising controller, the LMIs are infeasible
     bad = ct.ss([[1.0]], [[1.0, 0.0]], [[1.0], [1.0]], [[0.0, 1.0], [1.0, 0.0]])
@@ -123,6 +123,38 @@ def test_bad_inputs():
         lpvsyn([bad, bad], [0.0, 1.0], 1, 1)
     with pytest.raises(SynthesisError, match="status"):
         lpvsyn([P, _toy(1.0)], [0.0, 1.0], 2, 2, solver_options={"maxiters": 2})
+
+
+def test_bad_plants_and_settings_are_refused_as_hinfsyn_refuses_them():
+    """The inputs hinfsyn and musyn refuse with ModelError are refused so by lpvsyn, each
+    naming what is wrong, before any SDP: plants of two sizes in one family, a NaN or an
+    infinite entry, arrays for plants, and settings that are not finite numbers."""
+    from ambseal.robust.hinf import hinfsyn
+
+    P = [_toy(0.0), _toy(1.0)]
+    big = ct.ss(np.eye(3), np.ones((3, P[0].ninputs)), np.ones((P[0].noutputs, 3)), P[0].D)
+    nan = ct.ss(np.where(np.eye(P[0].nstates) > 0, np.nan, 0.0), P[0].B, P[0].C, P[0].D)
+    B_inf = np.array(P[0].B, float)
+    B_inf[0, 0] = np.inf
+    inf = ct.ss(P[0].A, B_inf, P[0].C, P[0].D)
+    with pytest.raises(ModelError):  # the reference: hinfsyn on the same NaN plant
+        hinfsyn(nan, 2, 2)
+    for plants, match in (([P[0], big], "number of states"), ([P[0], nan], "NaN"),
+                          ([inf, P[1]], "infinite"), ([np.eye(2), np.eye(2)], "not a state"),
+                          (np.array([1.0, 2.0]), "not a state"), ("ab", "not a state")):
+        with pytest.raises(ModelError, match=match):
+            lpvsyn(plants, [0.0, 1.0], 2, 2)
+    for kw, match in (({"backoff": float("nan")}, "backoff"), ({"backoff": "x"}, "backoff"),
+                      ({"backoff": True}, "backoff"), ({"coupling_ratio": np.inf}, "coupling"),
+                      ({"penalty": -1.0}, "penalty"), ({"margin": "x"}, "margin"),
+                      ({"lyapunov": "affine", "rate_bound": "x"}, "rate_bound"),
+                      ({"scaling": "none"}, "scaling"),
+                      ({"solver_options": {"maxiter": 5}}, "solver_options")):
+        with pytest.raises(ModelError, match=match):
+            lpvsyn(P, [0.0, 1.0], 2, 2, **kw)
+    for theta in ([0.0, np.nan], [1.0, 0.0], [0.0]):
+        with pytest.raises(ModelError, match="theta|grid"):
+            lpvsyn(P, theta, 2, 2)
 
 
 def test_lpv_plant_common_basis_matches_reduction(turbo_cfg):
@@ -530,13 +562,13 @@ def test_user_basis_and_rate_dependent_controller_interface():
     θ̇ and the controller's θ̇ = 0 matrices are those of ``at``."""
     P = [_toy(t) for t in (0.0, 20.0, 40.0)]
     grid = [0.0, 20.0, 40.0]
-    with pytest.raises(SynthesisError, match="lyapunov_r.*two finite arrays"):
+    with pytest.raises(ModelError, match="lyapunov_r.*two finite arrays"):
         lpvsyn(P, grid, 2, 2, lyapunov_r=lambda t: ([1.0, t], [0.0]), rate_bound=1.0)
-    with pytest.raises(SynthesisError, match="linearly dependent"):
+    with pytest.raises(ModelError, match="linearly dependent"):
         lpvsyn(P, grid, 2, 2, lyapunov=lambda t: ([1.0, 2.0], [0.0, 0.0]), rate_bound=1.0)
-    with pytest.raises(SynthesisError, match="expected one of"):
+    with pytest.raises(ModelError, match="expected one of"):
         lpvsyn(P, grid, 2, 2, lyapunov_r="cubic", rate_bound=1.0)
-    with pytest.raises(SynthesisError, match="needs a finite rate_bound"):
+    with pytest.raises(ModelError, match="needs a finite rate_bound"):
         lpvsyn(P, grid, 2, 2, lyapunov_r="affine")
     r = lpvsyn(P, grid, 2, 2, lyapunov_r="affine", rate_bound=10.0)
     assert r.K.takes_rate and r.check_stable

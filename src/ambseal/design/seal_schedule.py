@@ -65,6 +65,7 @@ import json
 import math
 import os
 import time
+import warnings
 from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any, ClassVar
@@ -76,7 +77,7 @@ from ambseal.design.plant import generalized_plant, physical_controller, physica
 from ambseal.design.recipes import bound_text
 from ambseal.design.specs import DesignSpec, design_spec
 from ambseal.design.weights import Weights
-from ambseal.errors import ModelError, SynthesisError
+from ambseal.errors import AmbsealError, ModelError, SynthesisError
 from ambseal.files import write_json
 from ambseal.machine import ScheduledController
 from ambseal.model import build_plant, values_following_k
@@ -302,7 +303,8 @@ _TABLE = ("AK", "BK", "CK", "DK")
 
 def _write_cache(path: Path, key: str, d: SealScheduledDesign) -> None:
     """Keep ``d`` as JSON at ``path`` (the key and version inside); a design with a
-    non-finite number is not kept (strict JSON has none)."""
+    non-finite number is not kept (strict JSON has none), nor one the folder cannot take
+    (a warning names it)."""
     K = d.K
     doc = {"key": key, "ambseal_version": __version__, "parameter": d.parameter,
            "gamma": d.gamma, "gamma_design": d.gamma_design, "rate_bound": d.rate_bound,
@@ -316,8 +318,11 @@ def _write_cache(path: Path, key: str, d: SealScheduledDesign) -> None:
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         write_json(path, doc)
-    except (OSError, ValueError):  # a read-only cache or a NaN: the design is still returned
+    except ValueError:  # a NaN, which strict JSON cannot hold: the design is still returned
         pass
+    except (OSError, AmbsealError) as exc:  # a read-only cache: the run goes on without it
+        warnings.warn(f"design cache {str(path.parent)!r}: the design is not kept "
+                      f"({exc})", stacklevel=3)
 
 
 def _floats(x, ndim: int) -> np.ndarray:

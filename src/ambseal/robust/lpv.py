@@ -52,7 +52,7 @@ import control
 import control as ct
 import numpy as np
 
-from ambseal.errors import SynthesisError
+from ambseal.errors import ModelError, SynthesisError
 from ambseal.lti import interp_table, json_float, lft_lower_matrices
 from ambseal.robust._lpv_lmi import (
     BASES,
@@ -367,17 +367,20 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
 
     Raises
     ------
+    ModelError
+        Bad input, refused before any synthesis (as :func:`hinfsyn` and :func:`musyn`
+        refuse theirs): one grid point, a grid not finite or not increasing, plants that
+        are not state-space systems, have a NaN or infinite entry, differ in size or in B,
+        C or D, D22 ≠ 0, an unknown ``lyapunov``, ``lyapunov_r``, ``scaling`` or key in
+        ``solver_options`` (or a basis whose values are not two finite arrays of one length
+        or are dependent over the grid or not finite somewhere on the controller's table),
+        a rate bound with both constant (or none with a parameter-dependent S or R),
+        ``nmeas``, ``ncon`` or ``check_density`` not a whole number ≥ 1, ``margin`` not a
+        finite number > 0, ``backoff`` not a finite number ≥ 1, ``coupling_ratio`` not a
+        number > 1 or ``penalty`` not a number ≥ 0.
     SynthesisError
-        One grid point, a grid not increasing, plants that differ in B, C or D, D22 ≠ 0,
-        an unknown ``lyapunov`` or ``lyapunov_r`` (or a basis whose values are not two
-        finite arrays of one length, or dependent over the grid), a rate bound with both
-        constant (or none with a parameter-dependent S or R), an unknown key in
-        ``solver_options``, a plant that is not a state-space system or has a NaN or
-        infinite entry, ``nmeas``, ``ncon`` or ``check_density`` not a whole number ≥ 1,
-        ``margin`` not finite and > 0, ``backoff`` not finite and ≥ 1, a basis not finite
-        somewhere on the controller's table, infeasible LMIs, a
-        solver status other than ``optimal``, or a reconstructed frozen closed loop that is
-        unstable.
+        Infeasible LMIs, a solver status other than ``optimal``, or a reconstructed frozen
+        closed loop that is unstable.
 
     Examples
     --------
@@ -394,10 +397,10 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
                                                coupling_ratio, penalty, check_density, margin)
     unknown = sorted(set(solver_options or {}) - set(SOLVER_KEYS))
     if unknown:
-        raise SynthesisError(f"lpvsyn: solver_options {unknown} unknown; expected some of "
+        raise ModelError(f"lpvsyn: solver_options {unknown} unknown; expected some of "
                              f"{', '.join(SOLVER_KEYS)} (CVXOPT's options)")
     if scaling not in ("auto", "riccati", "diagonal"):
-        raise SynthesisError(f"lpvsyn: scaling={scaling!r}; expected 'auto', 'riccati' or "
+        raise ModelError(f"lpvsyn: scaling={scaling!r}; expected 'auto', 'riccati' or "
                              "'diagonal'")
     solver_options = {**DEFAULT_TOL, **(solver_options or {})}
     data = (plants, grid, As, dAs, B, C, D, nw, nz, nmeas, ncon)
@@ -522,37 +525,41 @@ def _basis_name(kind) -> str:
 def _validate(plants, theta, nmeas, ncon, dA, bases, rate_bound, backoff,
               coupling_ratio, penalty, check_density, margin):
     """Checked grid and plant data of :func:`lpvsyn`: (grid, A stack, dA stack, B, C, D,
-    n_w, n_z); raises SynthesisError as documented there."""
+    n_w, n_z); raises ModelError as documented there."""
     for name, v in (("nmeas", nmeas), ("ncon", ncon), ("check_density", check_density)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
-            raise SynthesisError(f"lpvsyn: {name}={v!r}; expected a whole number ≥ 1")
+            raise ModelError(f"lpvsyn: {name}={v!r}; expected a whole number ≥ 1")
     if not (isinstance(margin, (int, float)) and np.isfinite(margin) and margin > 0):
-        raise SynthesisError(f"lpvsyn: margin={margin!r}; expected a finite number > 0")
+        raise ModelError(f"lpvsyn: margin={margin!r}; expected a finite number > 0")
     try:
         plants = list(plants)
         grid = np.asarray(theta, float).ravel()
     except (TypeError, ValueError) as exc:
-        raise SynthesisError(f"lpvsyn: plants and theta must be a sequence of systems and "
+        raise ModelError(f"lpvsyn: plants and theta must be a sequence of systems and "
                              f"an array of numbers ({exc})") from None
     for k, P in enumerate(plants):
         try:
             parts = [np.asarray(getattr(P, m), float) for m in "ABCD"]
         except (AttributeError, TypeError, ValueError):
-            raise SynthesisError(f"lpvsyn: plants[{k}] is a {type(P).__name__}, not a "
+            raise ModelError(f"lpvsyn: plants[{k}] is a {type(P).__name__}, not a "
                                  "state-space system (A, B, C, D)") from None
         if not all(np.all(np.isfinite(X)) for X in parts):
-            raise SynthesisError(f"lpvsyn: plants[{k}] has a NaN or infinite entry")
+            raise ModelError(f"lpvsyn: plants[{k}] has a NaN or infinite entry")
     if grid.size < 2 or len(plants) != grid.size:
-        raise SynthesisError(f"lpvsyn: the θ grid needs at least 2 points with one plant "
+        raise ModelError(f"lpvsyn: the θ grid needs at least 2 points with one plant "
                              f"each; got {grid.size} values and {len(plants)} plants")
     if np.any(np.diff(grid) <= 0) or not np.all(np.isfinite(grid)):
-        raise SynthesisError("lpvsyn: theta must be finite and strictly increasing")
+        raise ModelError("lpvsyn: theta must be finite and strictly increasing")
     # the basis is evaluated where the controller is: on the table between the grid points
     table = np.concatenate([np.linspace(a, b, check_density + 1)[:-1]
                             for a, b in zip(grid[:-1], grid[1:])] + [grid[-1:]])
     for name, kind in zip(("lyapunov", "lyapunov_r"), bases):
         _validate_basis(name, kind, grid, table)
     _validate_settings(bases, rate_bound, backoff, coupling_ratio, penalty)
+    sizes = {np.shape(P.A) for P in plants}
+    if len(sizes) > 1:
+        raise ModelError(f"lpvsyn: the plants differ in their number of states "
+                         f"({sorted(s[0] for s in sizes)}); one family has one state basis")
     As = np.array([np.asarray(P.A, float) for P in plants])
     B = np.asarray(plants[0].B, float)
     C = np.asarray(plants[0].C, float)
@@ -562,20 +569,20 @@ def _validate(plants, theta, nmeas, ncon, dA, bases, rate_bound, backoff,
             atol = 1e-12 * max(1.0, np.abs(X).max())
             if np.shape(Y) != X.shape or not np.allclose(np.asarray(Y, float), X, rtol=1e-9,
                                                          atol=atol):
-                raise SynthesisError(f"lpvsyn: plant {k} differs from plant 0 in {nm}; only A "
+                raise ModelError(f"lpvsyn: plant {k} differs from plant 0 in {nm}; only A "
                                      "may depend on θ (one state basis)")
     nw, nz = B.shape[1] - ncon, C.shape[0] - nmeas
     if nw <= 0 or nz <= 0 or ncon <= 0 or nmeas <= 0:
-        raise SynthesisError(f"lpvsyn: bad channel counts (nw={nw}, nz={nz}, ncon={ncon}, "
+        raise ModelError(f"lpvsyn: bad channel counts (nw={nw}, nz={nz}, ncon={ncon}, "
                              f"nmeas={nmeas})")
     if np.any(D[nz:, nw:] != 0):
-        raise SynthesisError("lpvsyn: D22 must be zero")
+        raise ModelError("lpvsyn: D22 must be zero")
     if dA is None:
         dAs = np.gradient(As, grid, axis=0)
     else:
         dAs = np.array([np.asarray(X, float) for X in dA])
         if dAs.shape != As.shape:
-            raise SynthesisError(f"lpvsyn: dA has shape {dAs.shape}, expected {As.shape}")
+            raise ModelError(f"lpvsyn: dA has shape {dAs.shape}, expected {As.shape}")
     return grid, As, dAs, B, C, D, nw, nz
 
 
@@ -585,54 +592,59 @@ def _validate_basis(name: str, kind, grid: np.ndarray, table: np.ndarray) -> Non
     independent over the grid."""
     if isinstance(kind, str):
         if kind not in BASES:
-            raise SynthesisError(f"lpvsyn: {name}={kind!r}; expected one of {sorted(BASES)} "
+            raise ModelError(f"lpvsyn: {name}={kind!r}; expected one of {sorted(BASES)} "
                                  "or a callable θ ↦ (f(θ), df/dθ(θ))")
         return
     if not callable(kind):
-        raise SynthesisError(f"lpvsyn: {name}={kind!r}; expected one of {sorted(BASES)} or a "
+        raise ModelError(f"lpvsyn: {name}={kind!r}; expected one of {sorted(BASES)} or a "
                              "callable θ ↦ (f(θ), df/dθ(θ))")
     rows = []
     for th in table:
         try:
             f, df = (np.asarray(v, float).ravel() for v in kind(float(th)))
         except (TypeError, ValueError) as exc:
-            raise SynthesisError(f"lpvsyn: {name} at θ = {th:g} did not return two arrays "
+            raise ModelError(f"lpvsyn: {name} at θ = {th:g} did not return two arrays "
                                  f"(f, df/dθ): {exc}") from None
         if f.size == 0 or f.shape != df.shape or not np.all(np.isfinite(f)) \
                 or not np.all(np.isfinite(df)):
-            raise SynthesisError(f"lpvsyn: {name} at θ = {th:g} gave f of shape {f.shape} "
+            raise ModelError(f"lpvsyn: {name} at θ = {th:g} gave f of shape {f.shape} "
                                  f"and df/dθ of shape {df.shape}; expected two finite arrays "
                                  "of one length")
         if rows and f.size != rows[0].size:
-            raise SynthesisError(f"lpvsyn: {name} has {f.size} functions at θ = {th:g} and "
+            raise ModelError(f"lpvsyn: {name} has {f.size} functions at θ = {th:g} and "
                                  f"{rows[0].size} at θ = {grid[0]:g}")
         rows.append(f)
     F = np.array(rows)[np.isin(table, grid)]
     if np.linalg.matrix_rank(F) < F.shape[1]:
-        raise SynthesisError(f"lpvsyn: {name}'s {F.shape[1]} functions are linearly dependent "
+        raise ModelError(f"lpvsyn: {name}'s {F.shape[1]} functions are linearly dependent "
                              f"on the grid (rank {np.linalg.matrix_rank(F)}); the LMIs "
                              "would not determine their matrices")
 
 
 def _validate_settings(bases, rate_bound, backoff, coupling_ratio, penalty) -> None:
-    """:func:`lpvsyn`'s settings; raises SynthesisError as documented there."""
+    """:func:`lpvsyn`'s settings; raises ModelError as documented there."""
     dependent = not all(is_constant(kind) for kind in bases)
     if not dependent and rate_bound is not None:
-        raise SynthesisError(
+        raise ModelError(
             "lpvsyn: a rate bound needs a parameter-dependent Lyapunov function "
             "(lyapunov or lyapunov_r 'affine', 'quadratic' or a basis); constant ones "
             "already allow arbitrarily fast parameter changes")
-    if dependent and (rate_bound is None or not np.isfinite(rate_bound) or rate_bound < 0):
-        raise SynthesisError(f"lpvsyn: a parameter-dependent Lyapunov function "
+    rate_ok = isinstance(rate_bound, (int, float, np.integer, np.floating)) \
+        and not isinstance(rate_bound, bool) and bool(np.isfinite(rate_bound)) \
+        and rate_bound >= 0
+    if dependent and not rate_ok:
+        raise ModelError(f"lpvsyn: a parameter-dependent Lyapunov function "
                              f"(lyapunov={_basis_name(bases[0])!r}, "
                              f"lyapunov_r={_basis_name(bases[1])!r}) needs a finite "
                              f"rate_bound ≥ 0 (θ's unit per second), got {rate_bound!r}")
-    if not (np.isfinite(backoff) and backoff >= 1.0):
-        raise SynthesisError(f"lpvsyn: backoff={backoff} must be a finite number ≥ 1")
-    if not coupling_ratio > 1.0:
-        raise SynthesisError(f"lpvsyn: coupling_ratio={coupling_ratio} must be > 1")
-    if not penalty >= 0.0:
-        raise SynthesisError(f"lpvsyn: penalty={penalty} must be ≥ 0")
+    for name, v, low, strict in (("backoff", backoff, 1.0, False),
+                                 ("coupling_ratio", coupling_ratio, 1.0, True),
+                                 ("penalty", penalty, 0.0, False)):
+        number = isinstance(v, (int, float, np.integer, np.floating)) \
+            and not isinstance(v, bool) and bool(np.isfinite(v))
+        if not number or (v <= low if strict else v < low):
+            raise ModelError(f"lpvsyn: {name}={v!r}; expected a finite number "
+                             f"{'>' if strict else '≥'} {low:g}")
 
 
 def _check_table(K: LpvController, A_of, B, C, D, nmeas: int, ncon: int) -> np.ndarray:

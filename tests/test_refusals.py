@@ -146,6 +146,18 @@ RIG_CASES = [
      "design.impulse.duration_s", "controller samples"),
     ("unbalance grade", _set("design/unbalance/grade_mm_s", 1e300),
      "design.unbalance.grade_mm_s", "<= 4000"),
+    # what run refuses after its designs, validate refuses before them: a supply that
+    # cannot drive the bias current through R, a supply without the coil's inductance, a
+    # synchronous rejection on a rotor that does not turn
+    ("supply below R i0",
+     lambda d: d["amb"][0].update(supply_voltage=2.0, resistance=0.5, inductance=0.02),
+     "amb[0]", "does not drive the bias current 6 A through R = 0.5 Ω"),
+    ("supply without inductance", _set("amb/1/supply_voltage", 48.0), "amb[1]",
+     "supply_voltage needs the coil's inductance"),
+    ("rejection at standstill",
+     lambda d: (d["operating"].update(speed_rpm=0.0),
+                d.setdefault("design", {}).update(rejection={"enabled": True})),
+     "design.rejection.enabled", "the rotor must turn"),
     # 11 000 rpm is 183.3333… Hz: the message must not print it as the range's end
     ("speed past a rounded range",
      lambda d: d["operating"].update(speed_rpm=11000.0, speed_range_hz=[116.667, 183.333]),

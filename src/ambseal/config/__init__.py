@@ -21,6 +21,7 @@ from ambseal.config._checks import (
                                     MAX_PRESSURE_BAR,
                                     MAX_SPEED_HZ,
                                     MAX_SUPPORT_STIFFNESS,
+                                    check_coil,
 )
 from ambseal.config.methods import METHODS, Method, method, method_label, method_names
 from ambseal.config.rig import (
@@ -59,5 +60,5 @@ __all__ = ["MAX_AMBS", "MAX_COEFFICIENT", "MAX_COMPONENTS", "MAX_CURRENT_A", "MA
            "Actuator", "Affine", "Amb", "AxisPair", "Coefficient", "FrequencyTable",
            "Machine", "Pid", "PidFilter", "RigConfig", "Seal", "Signoff", "Spring", "Stage",
            "TruthSection", "apply_overrides",
-           "check_operating", "default_rig_path", "dump_rig", "load_rig", "load_truth",
+           "check_coil", "check_operating", "default_rig_path", "dump_rig", "load_rig", "load_truth",
            "parse_rig", "rig_parameter_names", "rig_with_values", "toml_string"]

@@ -114,7 +114,7 @@ def check_amb(self):  # noqa: N805 (the Amb being validated)
                 "air_gap": self.air_gap, "bias_current": self.bias_current}
     given = [k for k, v in geometry.items() if v is not None]
     if len(given) == len(geometry):
-        return self
+        return check_coil(self)
     if given and not (set(given) <= {"air_gap", "bias_current"}
                       and None not in (self.ki, self.ks)):
         # with ki and ks, air_gap and bias_current alone are read by the design defaults
@@ -132,7 +132,43 @@ def check_amb(self):  # noqa: N805 (the Amb being validated)
         if hasattr(v, "zeta") and None in (v.zeta, v.eta):
             raise ValueError(f"{key}: expected both zeta and eta (or the geometry: "
                              "turns, pole_area, air_gap, bias_current)")
-    return self
+    return check_coil(self)
+
+
+def check_coil(amb):
+    """Check an AMB's amplifier supply against its coil (R i0 + |R + jωL| i_c ≤ V,
+    :mod:`ambseal.model.capacity`; Schweitzer & Maslen 2009, ch. 3): a supply needs the
+    coil's inductance or the geometry that gives it, and must drive the bias current
+    through R. Checked when the rig file is read, so that no run ends on it after its
+    designs.
+
+    Parameters
+    ----------
+    amb : Amb
+        One ``[[amb]]`` of the rig file (or a copy made without validation).
+
+    Returns
+    -------
+    Amb
+        ``amb``, unchanged.
+
+    Raises
+    ------
+    ValueError
+        ``supply_voltage`` without ``inductance`` or ``turns``, ``pole_area`` and
+        ``air_gap``; or R·i0 ≥ ``supply_voltage``.
+    """
+    if amb.supply_voltage is None:
+        return amb
+    if amb.inductance is None and None in (amb.turns, amb.pole_area, amb.air_gap):
+        raise ValueError("supply_voltage needs the coil's inductance (H) or the geometry "
+                         "(turns, pole_area, air_gap) to derive it")
+    drop = (amb.resistance or 0.0) * (amb.bias_current or 0.0)
+    if amb.bias_current is not None and drop >= amb.supply_voltage:
+        raise ValueError(f"supply_voltage = {amb.supply_voltage:g} V does not drive the bias "
+                         f"current {amb.bias_current:g} A through R = {amb.resistance:g} Ω "
+                         f"(R i0 = {drop:g} V)")
+    return amb
 
 
 def check_actuator(self):  # noqa: N805
@@ -197,6 +233,10 @@ def cross_check(cfg, where: str) -> None:
                               f"{st.suction_density:g} kg/m³: a compressor stage raises the "
                               "density (swapped? for an expander set [machine] kind = "
                               "\"turbine\")")
+    if cfg.design.rejection.enabled and cfg.operating.continuous_hz[0] <= 0:
+        raise ConfigError(f"{where}: design.rejection.enabled: a synchronous rejection "
+                          "follows the running speed, and the rotor must turn: set "
+                          "[operating] speed_rpm or speed_range_hz above 0 Hz")
     n_elements = sum(s.elements for s in cfg.shaft)
     if n_elements > MAX_ELEMENTS:
         raise ConfigError(

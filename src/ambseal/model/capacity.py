@@ -33,7 +33,7 @@ import math
 
 import numpy as np
 
-from ambseal.config import Amb
+from ambseal.config import Amb, check_coil
 from ambseal.errors import ConfigError
 from ambseal.model.amb import MU0, amb_factors
 
@@ -266,15 +266,12 @@ def _amplifier(amb: Amb) -> tuple:
     i0 = float(amb.bias_current)
     if amb.supply_voltage is None:
         return i0, amb.current_limit, None
+    try:  # the rig file's own rule, for an AMB copied without validation
+        check_coil(amb)
+    except ValueError as exc:
+        raise ConfigError(f"{where}: {exc}") from None
     L, R = coil_inductance(amb), float(amb.resistance or 0.0)
-    if L is None:
-        raise ConfigError(f"{where}: supply_voltage needs the coil's inductance (H) or "
-                          "the geometry (turns, pole_area, air_gap) to derive it")
-    headroom = amb.supply_voltage - R * i0
-    if headroom <= 0:
-        raise ConfigError(f"{where}: supply_voltage = {amb.supply_voltage:g} V does not "
-                          f"drive the bias current through R = {R:g} Ω")
-    return i0, amb.current_limit, (L, R, headroom)
+    return i0, amb.current_limit, (L, R, amb.supply_voltage - R * i0)
 
 
 def load_capacity(amb: Amb) -> float | None:

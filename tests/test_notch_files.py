@@ -19,7 +19,8 @@ P = 4
 SPEEDS = 2 * np.pi * np.array([20.0, 60.0, 110.0])
 T = RNG.normal(size=(3, P, P)) + 1j * RNG.normal(size=(3, P, P))
 NAMES = tuple(f"y_{a}_{x}" for a in "AB" for x in ("zeta", "eta"))
-NOTCH = SynchronousNotch(SPEEDS, T.real, T.imag, 0.05, SPEEDS[0], NAMES, 1e-4)
+# NumPy scalars as a design gives them: the C must print them as numbers
+NOTCH = SynchronousNotch(SPEEDS, T.real, T.imag, np.float64(0.05), SPEEDS[0], NAMES, 1e-4)
 
 
 def test_notch_file_round_trip(tmp_path):
@@ -39,6 +40,12 @@ def test_notch_file_round_trip(tmp_path):
     ({"rate_fraction": "fast"}, "rate_fraction"),
     ({"gain_re": [[1.0]]}, "gain_re"),
     ({"speeds_rad_s": [3.0, 2.0, 1.0]}, "increase"),
+    # a typo for 1e-4: the table's speeds far above Nyquist, ε·Ts ≈ 3.5e5, and the state
+    # would reach 1e307 within 60 samples
+    ({"Ts": 1e4}, "Ts.*Nyquist"),
+    ({"gain_re": np.vectorize(str)(T.real).tolist()}, "gain_re.*numbers"),
+    ({"gain_im": (T.imag > 0).tolist()}, "gain_im.*numbers"),
+    ({"speeds_rad_s": ["125.6", 377.0, 691.1]}, "speeds_rad_s.*numbers"),
 ])
 def test_bad_notch_files_are_refused_naming_the_key(tmp_path, edit, match):
     path = export_notch(NOTCH, tmp_path / "n.json")
@@ -68,6 +75,7 @@ def test_notch_c_runs_like_its_matrices(tmp_path):
         ref[k] = y[k] - C @ x
         x = A @ x + B @ ref[k]
     files = write_notch_c(NOTCH, tmp_path / "c", "amb_notch")
+    assert "np." not in files[0].read_text() + files[1].read_text()  # plain C numbers
     got = _compile_and_run(tmp_path, files, "amb_notch", y, "double", speeds=speeds,
                            outputs="NY")
     assert np.max(np.abs(got - ref)) < 1e-9 * np.max(np.abs(ref))

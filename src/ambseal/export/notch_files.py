@@ -124,10 +124,11 @@ def load_notch(path) -> SynchronousNotch:
         return float(v)
 
     def array(key, shape):
-        try:
-            a = np.asarray(doc.get(key), dtype=float)
-        except (TypeError, ValueError):
-            raise DataError(f"{path}: {key}: expected an array of numbers") from None
+        v = doc.get(key)
+        if not _numbers(v):  # NumPy would read "1.5" and true as numbers
+            raise DataError(f"{path}: {key}: expected an array of numbers (not strings or "
+                            "true/false)")
+        a = np.asarray(v, dtype=float)
         if a.shape != shape or not np.all(np.isfinite(a)):
             raise DataError(f"{path}: {key}: expected finite numbers of shape {shape}, got "
                             f"shape {a.shape}")
@@ -144,3 +145,10 @@ def load_notch(path) -> SynchronousNotch:
                                 number("Ts"))
     except ModelError as exc:
         raise DataError(f"{path}: {exc}") from None
+
+
+def _numbers(v, depth: int = 0) -> bool:
+    """Whether ``v`` is a number (not a bool) or nested lists of them (3 levels at most)."""
+    if isinstance(v, list):
+        return depth < 3 and all(_numbers(x, depth + 1) for x in v)
+    return isinstance(v, (int, float)) and not isinstance(v, bool)

@@ -42,6 +42,7 @@ Realisation (``z = a + jb``, p channels, 2p states)::
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -74,7 +75,15 @@ class SynchronousNotch:
     inputs : tuple of str
         The controller's measurement names (``y_<channel>``) the notch acts on, in order.
     dt : float
-        0 for a continuous notch, else the sample time (s) of the discrete one.
+        0 for a continuous notch, else the sample time (s) of the discrete one, with the
+        table's top speed at most the Nyquist frequency (Ω_max·dt ≤ π).
+
+    Raises
+    ------
+    ModelError
+        On construction: speeds not increasing from above 0, gains of another shape,
+        ``rate_fraction`` outside (0, 0.5), ``on_rad_s`` ≤ 0, ``dt`` < 0, or a table's top
+        speed above the discrete notch's Nyquist frequency.
     """
 
     speeds_rad_s: np.ndarray
@@ -99,7 +108,12 @@ class SynchronousNotch:
                              "on_rad_s > 0 and dt ≥ 0")
         # ε T_s < 2 keeps the notch's own poles inside the unit circle up to Nyquist (Ω T_s
         # ≤ π): rate_fraction < 2/π; the narrow notch the first-order placement needs is
-        # far below it
+        # far below it. Beyond Nyquist neither holds (a sample time in the wrong unit)
+        if self.dt and w[-1] * self.dt > math.pi:
+            raise ModelError(f"synchronous notch: Ts = {self.dt:g} s puts the table's top "
+                             f"speed {w[-1]:g} rad/s above the Nyquist frequency π/Ts = "
+                             f"{math.pi / self.dt:g} rad/s: the notch cannot follow it "
+                             "(the sample time in seconds?)")
 
     @property
     def schedule(self) -> tuple[float, float]:

@@ -137,8 +137,8 @@ def test_controller_file_with_an_injected_name_is_refused(tmp_path, capsys):
     from ambseal.export.controller_files import export_controller
 
     good = export_controller(_small_digital("K_small"), tmp_path / "K-1 v2.json")
-    assert main(["export", RIG, "--controller", str(good), "--c",
-                 str(tmp_path / "ok")]) == 0
+    assert main(["export", RIG, "--controller", str(good), "--c",  # it levitates nothing
+                 str(tmp_path / "ok"), "--allow-unstable"]) == 0
     files = json.loads(capsys.readouterr().out)["files"]
     assert [Path(f).name for f in files] == ["ambseal_K_1_v2.h", "ambseal_K_1_v2.c"]
     for key, value in (("name", INJECTED), ("inputs", ['y_A"; system("x"); /*'])):
@@ -165,4 +165,52 @@ def test_an_unstable_pid_is_not_exported_quietly(tmp_path, capsys):
     assert "warning" in capsys.readouterr().err
     design = json.loads((out / "design_pid.json").read_text())
     assert design["full_order"]["stable"] is False and design["kept_unstable"] is True
-    assert (out / "controller_pid.json").exists()
+    # every file says so: the controller's JSON, NumPy and MATLAB documents and the C
+    _says_it_does_not_hold(out / "controller_pid", "4.08 bar")
+    header = (out / "c" / "ambseal_pid.h").read_text()
+    assert "AMBSEAL_PID_JUDGED_HOLDS 0" in header and "--allow-unstable" in header
+    assert "4.08 bar" in header
+
+    # the same file handed to export: judged on the rig before its C is written
+    path = str(out / "controller_pid.json")
+    _one_line_exit_2(capsys, ["export", rig, "--controller", path, "--c",
+                              str(tmp_path / "c1")], path, "4.08 bar", "--allow-unstable")
+    assert not (tmp_path / "c1").exists()
+    assert main(["export", rig, "--controller", path, "--c", str(tmp_path / "c2"),
+                 "--allow-unstable"]) == 0
+    captured = capsys.readouterr()
+    assert "warning" in captured.err and "4.08 bar" in captured.err
+    loop = json.loads(captured.out)["loop"]
+    assert loop["loop_holds"] is False and loop["allow_unstable"] is True
+    header = (tmp_path / "c2" / "ambseal_controller_pid.h").read_text()
+    assert "_JUDGED_HOLDS 0" in header and "4.08 bar" in header
+
+
+def _says_it_does_not_hold(stem: Path, where: str) -> None:
+    """The exported documents of a controller whose loop does not hold say so, and where."""
+    import numpy as np
+    from scipy.io import loadmat
+
+    doc = json.loads(stem.with_suffix(".json").read_text())
+    with np.load(stem.with_suffix(".npz"), allow_pickle=False) as z:
+        npz = {k: str(z[k]) for k in ("loop_holds", "allow_unstable", "verdict")}
+    mat = {k: str(np.ravel(v)[0]) for k, v in loadmat(stem.with_suffix(".mat")).items()
+           if k in ("loop_holds", "allow_unstable", "verdict")}
+    for d in (doc, npz, mat):
+        assert d["loop_holds"] == "no" and d["allow_unstable"] == "yes", d
+        assert "does NOT hold" in d["verdict"] and where in d["verdict"], d
+
+
+def test_a_controller_file_that_holds_says_so(tmp_path, capsys, testrig_digital):
+    """Reference: the μ controller holds the test rig at every judged condition (its own
+    judgement, ``testrig_designs``); exported from its file, the C header says where it
+    was judged and defines its verdict 1."""
+    from ambseal.export.controller_files import export_controller
+
+    path = export_controller(testrig_digital["mu"], tmp_path / "K_mu.json")
+    assert main(["export", RIG, "--controller", str(path), "--c", str(tmp_path / "c")]) == 0
+    loop = json.loads(capsys.readouterr().out)["loop"]
+    assert loop["loop_holds"] is True and loop["allow_unstable"] is False
+    assert "4.08 bar" in loop["verdict"] and "0 Hz" in loop["verdict"]
+    header = (tmp_path / "c" / "ambseal_K_mu.h").read_text()
+    assert "AMBSEAL_K_MU_JUDGED_HOLDS 1" in header and "holds as it runs" in header

@@ -144,6 +144,14 @@ def test_run_with_a_failing_controller_writes_the_report_and_exits_1(tmp_path, c
     assert not m["failed"]["pid"]["designed"]
     files = {p.name for p in (out / "controllers").iterdir()}
     assert "controller_mu.json" in files and not any("hinf" in n for n in files)
+    # the files say which loop holds: the failed reference with the run's reason
+    pid = json.loads((out / "controllers" / "controller_pid.json").read_text())
+    assert pid["loop_holds"] == "no" and pid["allow_unstable"] == "no"
+    assert pid["verdict"] == "does NOT hold: " + m["failed"]["pid"]["reason"]
+    assert "AMBSEAL_PID_JUDGED_HOLDS 0" in (out / "controllers" / "ambseal_pid.h").read_text()
+    mu = json.loads((out / "controllers" / "controller_mu.json").read_text())
+    assert mu["loop_holds"] == "yes" and mu["verdict"].startswith("holds as it runs at every")
+    assert "AMBSEAL_MU_JUDGED_HOLDS 1" in (out / "controllers" / "ambseal_mu.h").read_text()
     html = (out / "report.html").read_text()
     assert "Failed controllers" in html and html.index("Failed controllers") < html.index(
         "Verdict") and "H∞: not delivered" in html
@@ -159,7 +167,8 @@ def test_run_allow_unstable_delivers_the_failed_controller_marked(tmp_path, caps
     assert main(["run", str(rig), "--no-identify", "--allow-unstable", "--out", str(out)]) == 0
     m = json.loads((out / "metrics.json").read_text())
     assert m["failed"]["hinf"]["designed"]
-    assert (out / "controllers" / "controller_hinf.json").is_file()
+    hinf = json.loads((out / "controllers" / "controller_hinf.json").read_text())
+    assert hinf["loop_holds"] == "no" and hinf["allow_unstable"] == "yes"
     assert "H∞: delivered as asked (allow_unstable) but fails" in capsys.readouterr().err
 
 

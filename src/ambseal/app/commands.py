@@ -19,6 +19,7 @@ import control
 import numpy as np
 
 from ambseal.analysis import judge_settings, operating_points
+from ambseal.analysis.campbell import modes_as_run
 from ambseal.config import default_rig_path, dump_rig, load_rig, method_names, rig_with_values
 from ambseal.design import (
     Design,
@@ -33,7 +34,7 @@ from ambseal.design import (
     reference_pid,
 )
 from ambseal.errors import ConfigError, DataError, IdentificationError, SynthesisError
-from ambseal.export import export_controller, write_c
+from ambseal.export import export_controller, loop_verdict, write_c
 from ambseal.files import writable_folder, write_json, write_text
 from ambseal.identify import (
     MISMATCH,
@@ -292,13 +293,38 @@ def choice_margins(cfg, points, digital) -> list[dict]:
                                        c["sensitivity_peak_continuous"])]
 
 
-def export_design(method: str, digital, summary_dict: dict, out: Path, judged=None
-                  ) -> list[Path]:
-    """Write a designed controller as it runs (``controller_<method>.json/.npz/.mat``,
-    :func:`ambseal.export.controller_files.export_controller`) with the judged discrete margins,
-    and its design summary with the discretisation (``design_<method>.json``)."""
+def judged_as_runs(cfg, ctrl) -> list[dict]:
+    """The loop of a discrete controller as it runs (the sampled full-order plant, its
+    delay; :func:`ambseal.analysis.campbell.modes_as_run`) at the conditions a run judges:
+    the judged points and the stability speeds from standstill to the top speed at the
+    nominal pressure. Per condition ``pressure_bar``, ``speed_hz`` and ``stable``."""
+    spec = design_spec(cfg)
+    conditions = sorted({(p, rpm / 60.0) for p, rpm in _conditions(cfg, operating_points(spec))}
+                        | {(cfg.operating.pressure_bar, float(f))
+                           for f in spec.stability_speeds_hz})
+    top = 0.99 * 0.5 * float(ctrl.sample_rate_hz)  # the modes below Nyquist
+    return [{"pressure_bar": p, "speed_hz": f,
+             "stable": bool(modes_as_run(cfg, ctrl, speed_hz=f, max_hz=top,
+                                         pressure_bar=p).stable)}
+            for p, f in conditions]
 
-    files = [export_controller(digital, out / f"controller_{method}{ext}", judged)
+
+def warn_unheld(name: str, verdict: dict) -> None:
+    """One line on stderr for an exported controller whose judged loop does not hold."""
+    if verdict["loop_holds"] is False:
+        print(f"ambseal: warning: {name}: the judged loop {verdict['verdict']}",
+              file=sys.stderr)
+
+
+def export_design(method: str, digital, summary_dict: dict, out: Path, judged=None,
+                  verdict: dict | None = None) -> list[Path]:
+    """Write a designed controller as it runs (``controller_<method>.json/.npz/.mat``,
+    :func:`ambseal.export.controller_files.export_controller`) with the judged discrete
+    margins and the verdict on its loop (:func:`~ambseal.export.controller_files.
+    loop_verdict`), and its design summary with the discretisation
+    (``design_<method>.json``)."""
+
+    files = [export_controller(digital, out / f"controller_{method}{ext}", judged, verdict)
              for ext in (".json", ".npz", ".mat")]
     files.append(write_json(out / f"design_{method}.json",
                             {**summary_dict, "discretisation": digital.to_dict()}))
@@ -313,11 +339,13 @@ def show_defaults(rig: str | Path, overrides=()) -> str:
     return f"# {cfg.rotor.name}: resolved design specification\n" + design_spec(cfg).to_toml()
 
 
-def export_all(designs, digitals: dict, cases: list[dict], out: Path) -> dict:
+def export_all(designs, digitals: dict, cases: list[dict], out: Path,
+               failed: dict | None = None, allow_unstable: bool = False) -> dict:
     """``ambseal run``'s controllers: each as it runs (:func:`export_design` with its judged
-    discrete margins) and as C (:func:`ambseal.export.codegen.write_c`); returns the
-    design summaries with their ``discretisation`` for ``metrics.json`` (``None`` for a
-    controller without a digital one in ``digitals``: nothing of it is exported)."""
+    discrete margins and the run's verdict: ``failed``'s reason, by method) and as C
+    (:func:`ambseal.export.codegen.write_c`); returns the design summaries with their
+    ``discretisation`` for ``metrics.json`` (``None`` for a controller without a digital
+    one in ``digitals``: nothing of it is exported)."""
 
     summaries = {}
     for d in designs:
@@ -325,9 +353,12 @@ def export_all(designs, digitals: dict, cases: list[dict], out: Path) -> dict:
         if digital is None:  # cannot run on the target (metrics' "cannot_run"): no export
             summaries[d.method] = {**d.summary, "discretisation": None}
             continue
-        export_design(d.method, digital, d.result.to_dict(), out,
-                      judged_margins(cases, d.method))
-        write_c(digital, out, f"ambseal_{d.method}")
+        judged = judged_margins(cases, d.method)
+        failure = (failed or {}).get(d.method)
+        verdict = loop_verdict(judged, None if failure is None else failure.reason,
+                               allow_unstable)
+        export_design(d.method, digital, d.result.to_dict(), out, judged, verdict)
+        write_c(digital, out, f"ambseal_{d.method}", verdict=verdict)
         disc = digital.to_dict()  # the difference as judged (grids refined at the peaks)
         disc["peak_difference"] = peak_difference(
             target_difference([c for c in cases if c["controller"] == d.method]),
@@ -458,22 +489,25 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
         # the reference PID is given, not designed: judged here before it is handed over
         check = full_order_check(cfg, K, [(q.pressure_bar, q.speed_rpm / 60.0) for q in points])
         summary.update(full_order=check, kept_unstable=not check["stable"])
-        if not check["stable"]:
-            what = (f"{method}: the full-order loop is unstable at {check['pressure_bar']:g} "
-                    f"bar, {check['speed_hz']:g} Hz (the mode at {check['mode_hz']:.4g} Hz "
-                    f"has ζ = {check['damping']:.3g})")
-            if not allow_unstable:
-                raise SynthesisError(f"{what}; nothing exported. Pass --allow-unstable to "
-                                     f"export it anyway (marked in design_{method}.json)")
-            print(f"ambseal: warning: {what}; exported as asked (--allow-unstable), marked "
-                  f"in design_{method}.json", file=sys.stderr)
+    check = summary.get("full_order")
+    failure = None if check is None or check["stable"] else (
+        f"the full-order loop is unstable at {check['pressure_bar']:g} bar, "
+        f"{check['speed_hz']:g} Hz (the mode at {check['mode_hz']:.4g} Hz has ζ = "
+        f"{check['damping']:.3g})")
+    if failure is not None and not allow_unstable:
+        raise SynthesisError(f"{method}: {failure}; nothing exported. Pass --allow-unstable "
+                             "to export it anyway (marked in every file)")
     judged = choice_margins(cfg, points, digital)
-    files = export_design(method, digital, summary, out, judged)
+    verdict = loop_verdict(judged, failure, allow_unstable)
+    summary["loop"] = verdict
+    warn_unheld(method, verdict)
+    files = export_design(method, digital, summary, out, judged, verdict)
     if c_dir is not None:
-        files += write_c(digital, c_dir, f"ambseal_{method}", precision=precision)
+        files += write_c(digital, c_dir, f"ambseal_{method}", precision=precision,
+                         verdict=verdict)
     short = res.summary() if hasattr(res, "summary") else summary
     # the verdict of a check made here, as design_<method>.json has it
-    short = {**short, **{k: summary[k] for k in ("full_order", "kept_unstable")
+    short = {**short, **{k: summary[k] for k in ("full_order", "kept_unstable", "loop")
                          if k in summary}}
     return {**short, "discretisation": digital.to_dict(),
             "files": [str(f) for f in files]}

@@ -23,16 +23,18 @@ from ambseal.app.commands import (
     design_files,
     digital_for,
     identify_files,
+    judged_as_runs,
     show_defaults,
     target_pid,
     track_files,
     validate_summary,
+    warn_unheld,
 )
 from ambseal.app.pipeline import run
 from ambseal.config import default_rig_path, load_rig, load_truth, method_names
 from ambseal.design import design_spec
-from ambseal.errors import AmbsealError, ConfigError, with_source
-from ambseal.export import c_identifier, load_controller, write_c
+from ambseal.errors import AmbsealError, ConfigError, SynthesisError, with_source
+from ambseal.export import c_identifier, load_controller, loop_verdict, write_c
 from ambseal.files import OwnedFolder, claim_file, writable_folder
 from ambseal.identify import (
     IMPULSE_LEAD,
@@ -171,11 +173,19 @@ def _export(args: argparse.Namespace) -> int:
                                   f"export discretises for the rig's target: {exc}") from None
             done["discretised"] = {"method": ctrl.method, "sample_rate_hz": ctrl.sample_rate_hz,
                                    "delay_samples": ctrl.delay_samples}
+        # judged on this rig as it runs before it is handed over, as design judges its own
+        verdict = loop_verdict(judged_as_runs(cfg, ctrl), None, args.allow_unstable)
+        if verdict["loop_holds"] is False and not args.allow_unstable:
+            raise SynthesisError(f"{args.controller}: on {args.rig}, the judged loop "
+                                 f"{verdict['verdict']}; nothing exported. Pass "
+                                 "--allow-unstable to export it anyway (marked in the C "
+                                 "header)")
+        warn_unheld(Path(args.controller).name, verdict)
         with _owned(None if args.c_dir else args.out, args.c_dir, args.force):
             files = write_c(ctrl, args.c_dir or Path(args.out) / "c",  # file name as C names
                             f"ambseal_{c_identifier(Path(args.controller).stem)}",
-                            precision=args.precision)
-        print(json.dumps({"files": [str(f) for f in files], **done}))
+                            precision=args.precision, verdict=verdict)
+        print(json.dumps({"files": [str(f) for f in files], "loop": verdict, **done}))
         return 0
     with _owned(args.out, args.c_dir, args.force):
         summary = design_files(args.rig, args.method, args.out,

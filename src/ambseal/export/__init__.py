@@ -11,8 +11,8 @@
 """
 
 from ambseal.export.codegen import c_identifier, write_c, write_notch_c
-from ambseal.export.controller_files import export_controller, load_controller
+from ambseal.export.controller_files import export_controller, load_controller, loop_verdict
 from ambseal.export.notch_files import export_notch, load_notch
 
-__all__ = ["c_identifier", "export_controller", "load_controller", "write_c",
+__all__ = ["c_identifier", "export_controller", "load_controller", "loop_verdict", "write_c",
            "export_notch", "load_notch", "write_notch_c"]

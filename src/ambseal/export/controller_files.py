@@ -12,7 +12,10 @@ Every file holds the same document (:func:`controller_document`):
 * ``A_c … D_c`` — the continuous design, ``A_r … D_r`` the continuous controller that was
   discretised (fast poles removed);
 * ``discretisation_json`` — the choice (candidates, their ``|z|``, the rise of γ/μ) and
-  ``judged_json`` — the judged discrete margins per condition, as JSON text.
+  ``judged_json`` — the judged discrete margins per condition, as JSON text;
+* ``loop_holds`` (``"yes"``, ``"no"``, ``"not judged"``), ``allow_unstable`` (``"yes"`` or
+  ``"no"``: whether ``--allow-unstable`` was given) and ``verdict`` — whether the judged
+  loop holds, where, and why not (:func:`loop_verdict`); the C header says the same.
 
 A continuous controller alone (a ``control.StateSpace``, e.g. for ``ambseal campbell`` or
 ``sweep --controller FILE``) is written with ``kind = "continuous"``, ``A … D`` continuous
@@ -55,8 +58,8 @@ from ambseal.identify import read_matlab
 from ambseal.machine import SPEED, ScheduledDigital
 from ambseal.robust import DigitalController, DiscreteController, discretize_as
 
-__all__ = ["export_controller", "load_controller", "controller_document", "CONVENTION",
-           "MATLAB_LINE", "LABEL"]
+__all__ = ["export_controller", "load_controller", "controller_document", "loop_verdict",
+           "CONVENTION", "MATLAB_LINE", "LABEL"]
 
 _FORMATS = (".npz", ".mat", ".json")
 CONVENTION = ("i = -K y: u[k] = C x[k] + D y[k], x[k+1] = A x[k] + B y[k]; inputs y are "
@@ -106,7 +109,45 @@ def _continuous_document(K) -> dict:
             **{k: np.asarray(getattr(K, k), float) for k in "ABCD"}}
 
 
-def controller_document(ctrl, judged=None) -> dict:
+def loop_verdict(judged=None, failure: str | None = None, allow_unstable: bool = False
+                 ) -> dict:
+    """What the files of an exported controller say of its judged loop: whether it holds,
+    where it was judged, and whether ``--allow-unstable`` kept it.
+
+    Parameters
+    ----------
+    judged : list of dict, optional
+        The judged discrete loops, each with ``pressure_bar``, ``speed_hz`` and ``stable``
+        (bool; None where not judged), as :func:`controller_document` stores them.
+    failure : str, optional
+        Why the controller failed its judgement elsewhere (the run's verdict, e.g. over the
+        speed range); it then does not hold, whatever ``judged`` says.
+    allow_unstable : bool
+        Whether ``--allow-unstable`` was given.
+
+    Returns
+    -------
+    dict
+        ``loop_holds`` (True, False, or None when nothing was judged), ``allow_unstable``
+        and ``verdict``: one line of text naming the conditions (bar, Hz).
+    """
+    rows = list(judged or [])
+    where = [f"{float(r['pressure_bar']):g} bar, {float(r['speed_hz']):g} Hz" for r in rows]
+    lost = [w for w, r in zip(where, rows) if r.get("stable") is False]
+    if failure is not None or lost:
+        text = "does NOT hold: " + (failure if failure is not None
+                                    else "the loop as it runs is unstable at " + "; ".join(lost))
+        holds = False
+        text += "; exported as asked (--allow-unstable)" if allow_unstable else ""
+    elif rows and all(r.get("stable") for r in rows):
+        holds, text = True, (f"holds as it runs at every judged condition ({len(rows)}: "
+                             + "; ".join(where) + ")")
+    else:
+        holds, text = None, "not judged"
+    return {"loop_holds": holds, "allow_unstable": bool(allow_unstable), "verdict": text}
+
+
+def controller_document(ctrl, judged=None, verdict: dict | None = None) -> dict:
     """The content of every export format: arrays and plain values (module docstring).
 
     Parameters
@@ -115,16 +156,25 @@ def controller_document(ctrl, judged=None) -> dict:
     judged : list of dict, optional
         The judged discrete margins (``metrics.json`` cases' ``discrete`` blocks with the
         condition), stored as ``judged_json``.
+    verdict : dict, optional
+        :func:`loop_verdict` (default: of ``judged`` alone), stored as ``loop_holds``
+        (``"yes"``, ``"no"`` or ``"not judged"``), ``allow_unstable`` (``"yes"`` or
+        ``"no"``) and ``verdict``.
     """
     if not isinstance(ctrl, (DigitalController, ScheduledDigital)):
         return _continuous_document(ctrl)
+    v = verdict or loop_verdict(judged)
     doc: dict = {"convention": CONVENTION, "input_unit": "m", "output_unit": "A",
                  "Ts": ctrl.Ts, "sample_rate_hz": ctrl.sample_rate_hz,
                  "delay_samples": int(ctrl.delay_samples), "method": ctrl.method,
                  "prewarp_hz": _nan(ctrl.prewarp_hz),
                  "removed_poles_hz": np.asarray(ctrl.removed_poles_hz, float),
                  "discretisation_json": json.dumps(ctrl.to_dict(), allow_nan=False),
-                 "judged_json": json.dumps(judged or [], allow_nan=False)}
+                 "judged_json": json.dumps(judged or [], allow_nan=False),
+                 # text, the same in JSON, NumPy and MATLAB files (MATLAB has no null)
+                 "loop_holds": {True: "yes", False: "no", None: "not judged"}[v["loop_holds"]],
+                 "allow_unstable": "yes" if v["allow_unstable"] else "no",
+                 "verdict": v["verdict"]}
     if isinstance(ctrl, ScheduledDigital):
         doc.update(kind="scheduled", name=ctrl.name, inputs=list(ctrl.inputs),
                    outputs=list(ctrl.outputs), parameter=ctrl.parameter,
@@ -143,7 +193,7 @@ def controller_document(ctrl, judged=None) -> dict:
     return doc
 
 
-def export_controller(ctrl, path, judged=None) -> Path:
+def export_controller(ctrl, path, judged=None, verdict: dict | None = None) -> Path:
     """Write a digital controller to ``path`` (``.json``, ``.npz`` or ``.mat``).
 
     Parameters
@@ -156,6 +206,8 @@ def export_controller(ctrl, path, judged=None) -> Path:
         Destination; the suffix picks the format.
     judged : list of dict, optional
         The judged discrete margins written with it.
+    verdict : dict, optional
+        :func:`loop_verdict`, written with it (default: of ``judged`` alone).
 
     Returns
     -------
@@ -174,7 +226,7 @@ def export_controller(ctrl, path, judged=None) -> Path:
         raise DataError(f"{path}: unknown controller format {suffix!r}, expected one of "
                         f"{_FORMATS}")
     try:
-        doc = controller_document(ctrl, judged)
+        doc = controller_document(ctrl, judged, verdict)
     except ValueError:  # json.dumps of the choice or the margins, allow_nan=False
         raise DataError(f"{path}: the controller's discretisation or judged margins hold NaN "
                         "or inf; nothing was written") from None

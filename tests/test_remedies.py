@@ -54,3 +54,35 @@ def test_a_design_that_holds_after_the_first_remedy_replaces_the_failed_one():
     assert top.label in fixed.design.summary["remedy"].split("lost the loop at ")[1]
     assert len(fixed.jobs) == len(points) and lines[-1].endswith("holds at every judged "
                                                                   "condition")
+
+
+def test_a_remedy_at_zero_pressure_keeps_the_seal_uncertainty_it_was_given(monkeypatch):
+    """The test rig's seal has k = 1.1 MN/m per bar from 0 (rig file), so at 0 bar the
+    specification's default, k ± 100 % (P5 §4.1), has no width. The μ remedy designed at
+    a failing 0 bar condition is given the range that default spans at the nominal
+    2.04 bar instead, [0, 2 × 1.1e6 × 2.04] N/m, and the design's own check of it
+    (``generalized_plant``'s) passes, where it had refused the remedy's own default."""
+    import ambseal.app.remedies as rem
+    from ambseal.design.plant import _ranges
+    from ambseal.model import build_plant
+
+    cfg = load_rig()
+    spec = design_spec(cfg)
+    points = operating_points(spec)
+    zero = min(points, key=lambda p: p.pressure_bar)
+    assert zero.pressure_bar == 0.0 and dict(spec.uncertainty) == {"seal.k": 1.0}
+    given = []
+
+    def fake_design(cfg_, method, *, pressure_bar, uncertainty=None, spec=None, **kw):
+        given.append(uncertainty if uncertainty is not None else spec.uncertainty)
+        _ranges(build_plant(cfg_, pressure_bar=pressure_bar), given[-1])  # the check
+        raise rem.SynthesisError("stop here")
+
+    monkeypatch.setattr(rem, "design", fake_design)
+    failure = FailedController("μ: not delivered — ...", True, True, [zero.label])
+    cases = [_case(p.pressure_bar, p is not zero, 1.0 if p is zero else -5.0, label=p.label)
+             for p in points]
+    _, f = remedy("mu", failure, cases, cfg, spec, points, None, lambda line: None)
+    assert len(given) == 2 and "zero width" not in f.reason
+    assert given[0]["seal.k"] == pytest.approx((0.0, 2 * 1.1e6 * 2.04), rel=1e-12)
+    assert f.reason.count("the design failed: stop here") == 2

@@ -28,7 +28,7 @@ from dataclasses import dataclass, replace
 from ambseal.analysis import FailedController, JudgedCase, loop_failure
 from ambseal.app.commands import Designed, digitals_for
 from ambseal.config import method_label, method_names
-from ambseal.design import design
+from ambseal.design import design, uncertainty_at
 from ambseal.errors import ConfigError, SynthesisError
 
 __all__ = ["Remedied", "remedy", "worst_case"]
@@ -123,14 +123,18 @@ def remedy(method: str, failure: FailedController, cases: list[JudgedCase], desi
                 (f"designed there with ω_B × {OMEGA_B_FACTOR:g} ({wider.omega_b:.3g} rad/s)",
                  wider)]
     tried = []
+    # the specification's uncertainty, a relative range of a coefficient that is 0 there (a
+    # seal at 0 bar) kept at the width it has where the specification was made
+    try:
+        ranges = uncertainty_at(design_cfg, spec.uncertainty, p, spec.nominal_pressure_bar)
+    except ConfigError as exc:
+        return None, replace(failure, reason=f"{failure.reason}. Not tried: {exc}")
     for label, w in attempts:
         say(f"{method}: remedy — {label}")
         try:
             res = design(design_cfg, method, pressure_bar=p, weights=w, spec=spec,
-                         allow_unstable=True)
+                         uncertainty=ranges, allow_unstable=True)
         except (SynthesisError, ConfigError) as exc:
-            # ConfigError: the specification does not hold there (a relative uncertainty
-            # of a coefficient that is 0 at that pressure): that remedy cannot be tried
             tried.append(f"{label} (the design failed: {exc})")
             continue
         d = Designed(res, {**res.summary(), "remedy": (

@@ -35,7 +35,7 @@ from ambseal.design.pid import (
     pid_description,
     reference_pid,
 )
-from ambseal.design.plant import generalized_plant, physical_controller
+from ambseal.design.plant import generalized_plant, physical_controller, uncertainty_at
 from ambseal.design.recipes import DesignResult, design, full_order_check
 from ambseal.design.result import Design
 from ambseal.design.seal_schedule import design_seal_scheduled
@@ -47,6 +47,6 @@ __all__ = ["RIGID_STATES", "Design", "DesignResult", "DesignSpec", "Machine", "W
            "ScheduledPid",
            "controller_from_metadata", "default_weights", "design", "design_frozen",
            "design_lpv", "lpv_schedule", "design_rise", "design_seal_scheduled", "design_spec",
-           "full_order_check", "generalized_plant", "machine",
+           "full_order_check", "generalized_plant", "machine", "uncertainty_at",
            "physical_controller", "pid_controller", "pid_description", "reference_pid",
            "vertex_grid_hz", "SynchronousRejection", "design_rejection"]

@@ -260,6 +260,42 @@ def physical_controller(K_P, d_e: float, d_u: float, channels, name: str = "K"):
                       states=[f"xK{i}" for i in range(A.shape[0])], name=name)
 
 
+def uncertainty_at(cfg, uncertainty: Mapping[str, Any], pressure_bar: float,
+                   made_at_bar: float) -> dict:
+    """An uncertainty specification for a design at another pressure than the one it was
+    made at: a relative range of a parameter whose nominal value is 0 at ``pressure_bar``
+    (a seal's k at 0 bar, where ± a fraction has no width) becomes the absolute range it
+    spans at ``made_at_bar``; every other entry is kept as given.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig designed on.
+    uncertainty : mapping
+        ``{parameter: fraction or (low, high)}`` (SI), as :func:`generalized_plant` takes
+        it.
+    pressure_bar, made_at_bar : float
+        The design's pressure drop and the one the specification was made at (bar).
+
+    Returns
+    -------
+    dict
+        The specification for the design at ``pressure_bar``.
+
+    Raises
+    ------
+    ConfigError, ModelError
+        As :func:`generalized_plant`: a bad range or an unknown parameter.
+    """
+    out = dict(uncertainty)
+    at = build_plant(cfg, pressure_bar=pressure_bar)
+    zero = {n: r for n, r in out.items() if np.isscalar(r) and at.parameter(n).nominal == 0}
+    if zero:
+        made = _ranges(build_plant(cfg, pressure_bar=made_at_bar), zero)
+        out.update({q.name: (q.low, q.high) for q in made})
+    return out
+
+
 def _ranges(plant, uncertainty: Mapping[str, Any]) -> tuple[UncertainParameter, ...]:
     out = []
     for name, spec in uncertainty.items():

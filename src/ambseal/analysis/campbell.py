@@ -282,6 +282,7 @@ def modes_as_run(cfg, controller=None, *, speed_hz: float, max_hz: float,
     Parameters
     ----------
     cfg : RigConfig
+        The rig, its plant built at ``speed_hz`` and ``pressure_bar``.
     controller : DigitalController or ScheduledDigital, optional
         As it runs (:func:`ambseal.machine.controller_as_runs`).
     speed_hz, max_hz : float

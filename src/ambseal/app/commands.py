@@ -18,8 +18,7 @@ from pathlib import Path
 import control
 import numpy as np
 
-from ambseal.analysis import judge_settings, operating_points
-from ambseal.analysis.campbell import modes_as_run
+from ambseal.analysis import judge_settings, modes_as_run, operating_points
 from ambseal.config import default_rig_path, dump_rig, load_rig, method_names, rig_with_values
 from ambseal.design import (
     Design,

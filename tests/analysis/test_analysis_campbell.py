@@ -81,6 +81,26 @@ def test_rigid_rotor_modes_match_the_closed_form(rigid, speed_hz):
     assert m.stable
 
 
+def test_repeated_pairs_at_standstill_whirl_backward_then_forward(rigid):
+    """At standstill the isotropic rotor's x and y modes are one repeated eigenvalue, whose
+    eigenvectors are any basis of its plane; each pair is read in the circular basis, the
+    limit of the split pair as the speed rises from 0 (the closed form at 0⁺: the lower
+    conical mode backward, κ = −1, the upper forward, κ = +1), the same at every call. A
+    pair split by anisotropic supports keeps its own (planar) shapes."""
+    cfg, Kp = rigid
+    for _ in range(3):
+        m = closed_loop_modes(cfg, Kp, speed_hz=0.0, max_hz=1e4, delay=False)
+        assert m.whirl[:4] == ("backward", "forward") * 2
+        assert m.kappa[:4] == pytest.approx([-1.0, 1.0] * 2, abs=1e-9)
+    from ambseal.config import parse_rig
+
+    rig = _rig()
+    for sp in rig["spring"]:
+        sp["kyy"] = 1e5  # y stiffer than x: two planar modes per pair
+    m = closed_loop_modes(parse_rig(rig), Kp, speed_hz=0.0, max_hz=1e4, delay=False)
+    assert m.whirl[:4] == ("planar",) * 4
+
+
 def test_campbell_crossings_match_the_closed_form(rigid):
     """The 1× crossings of the tracked lines: the translation at its (speed-independent)
     damped frequency, the conical modes where the closed-form frequency equals the speed

@@ -113,7 +113,10 @@ def modes(sys: SecondOrderSystem, n_modes: int | None = None) -> Modes:
     a mode oscillates at Im λ/2π Hz with damping ratio −Re λ/|λ|. Rigid-body modes and
     unstable poles by :func:`classify_poles` (absolute thresholds in rad/s, a model too
     badly conditioned to tell is refused); its ω_max is the largest |λ| in the dense path
-    and ω_ref of :func:`lowest_eigenvalues` in the ``n_modes`` path.
+    and ω_ref of :func:`lowest_eigenvalues` in the ``n_modes`` path. In the dense path a
+    marginal pole (0 < Re λ < :data:`MARGINAL`·|λ|) whose real part lies within its own
+    rounding error (:func:`_real_part_rounding`: an ill-conditioned gyroscopic pole of a
+    conservative rotor) is neutral: its real part is taken as 0.
 
     Parameters
     ----------
@@ -145,12 +148,58 @@ def modes(sys: SecondOrderSystem, n_modes: int | None = None) -> Modes:
     try:
         if n_modes is None:
             lam = sys.poles()
-            return modes_from_poles(lam, float(np.abs(lam).max()))
+            w_max = float(np.abs(lam).max())
+            unstable = classify_poles(lam, w_max)[1]
+            marginal = unstable & (lam.real < MARGINAL * np.abs(lam))
+            if np.any(marginal):  # a neutral pole's rounding may lie above the floor
+                neutral = np.zeros(lam.shape, bool)
+                neutral[marginal] = lam.real[marginal] <= _real_part_rounding(
+                    sys.state_matrices()[0], lam[marginal])
+                lam = np.where(neutral, 1j * lam.imag, lam)
+            return modes_from_poles(lam, w_max)
         lam, w_ref = lowest_eigenvalues(sys, int(n_modes))
         return modes_from_poles(lam, max(w_ref, float(np.abs(lam).max(initial=0.0))),
                                 int(n_modes))
     except ModelError as exc:
         raise ModelError(f"{exc}{_shortest_element(sys)}") from None
+
+
+#: A pole is marginal when 0 < Re λ < MARGINAL·|λ| (a negative damping ratio below 1e-4,
+#: an e-folding over 1 600 periods): only there is its rounding error weighed.
+MARGINAL = 1e-4
+#: Margin of :func:`real_part_rounding` over the first-order bound.
+ROUNDING_MARGIN = 10.0
+
+
+def _real_part_rounding(A: np.ndarray, lam: np.ndarray) -> np.ndarray:
+    """How far rounding may have moved each computed eigenvalue ``lam`` of ``A``:
+    ``ROUNDING_MARGIN``·ε·‖B‖_F·κ(λ), B the balanced A (as LAPACK's ``dgeev`` balances
+    it) and κ(λ) = ‖x‖‖y‖/|yᴴx| its condition number from the right and left eigenvectors
+    (first-order perturbation bound, Wilkinson 1965; Golub & Van Loan 2013, §7.2.2).
+
+    A conservative rotor at speed has its poles on the imaginary axis; near a double zero
+    (a free–free rotor's rigid-body modes) its slow gyroscopic poles are ill conditioned
+    (κ ~ 3e5 measured) and are computed with real parts of 1e-6 rad/s either sign: a real
+    part within this bound is neutral, not a growth.
+
+    Parameters
+    ----------
+    A : ndarray, shape (n, n)
+        The state matrix.
+    lam : ndarray of complex
+        Eigenvalues of ``A`` (rad/s), as computed.
+
+    Returns
+    -------
+    ndarray of float
+        The bound per eigenvalue (rad/s).
+    """
+    B = sla.matrix_balance(A, permute=True)[0]
+    w, left, right = sla.eig(B, left=True, right=True)
+    kappa = (np.linalg.norm(left, axis=0) * np.linalg.norm(right, axis=0)
+             / np.maximum(np.abs(np.sum(left.conj() * right, axis=0)), np.finfo(float).tiny))
+    nearest = np.argmin(np.abs(np.asarray(lam)[:, None] - w[None, :]), axis=1)
+    return ROUNDING_MARGIN * np.finfo(float).eps * np.linalg.norm(B) * kappa[nearest]
 
 
 def _shortest_element(sys: SecondOrderSystem) -> str:

@@ -117,8 +117,9 @@ def loop_verdict(judged=None, failure: str | None = None, allow_unstable: bool =
     Parameters
     ----------
     judged : list of dict, optional
-        The judged discrete loops, each with ``pressure_bar``, ``speed_hz`` and ``stable``
-        (bool; None where not judged), as :func:`controller_document` stores them.
+        The judged discrete loops, each with ``stable`` (bool; None where not judged) and
+        its condition (``pressure_bar``, ``speed_hz``), as :func:`controller_document`
+        stores them.
     failure : str, optional
         Why the controller failed its judgement elsewhere (the run's verdict, e.g. over the
         speed range); it then does not hold, whatever ``judged`` says.
@@ -132,7 +133,9 @@ def loop_verdict(judged=None, failure: str | None = None, allow_unstable: bool =
         and ``verdict``: one line of text naming the conditions (bar, Hz).
     """
     rows = list(judged or [])
-    where = [f"{float(r['pressure_bar']):g} bar, {float(r['speed_hz']):g} Hz" for r in rows]
+    where = [", ".join(f"{float(r[k]):g} {unit}" for k, unit in (("pressure_bar", "bar"),
+                                                                  ("speed_hz", "Hz"))
+                       if k in r) or "a judged condition" for r in rows]
     lost = [w for w, r in zip(where, rows) if r.get("stable") is False]
     if failure is not None or lost:
         text = "does NOT hold: " + (failure if failure is not None

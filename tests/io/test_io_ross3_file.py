@@ -5,15 +5,19 @@ cannot read them). The files and ROSS 3.1's eigenvalues beside them are written 
 
 from __future__ import annotations
 
+import copy
 import importlib.metadata
 import json
 import re
 import shutil
+import tempfile
 import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from ambseal.analysis.campbell import closed_loop_modes
 from ambseal.cli import main
@@ -180,3 +184,77 @@ def test_the_ross3_reader_names_what_it_leaves_out_and_refuses_unreadable_json(t
         assert main(["import-ross", str(src), "--out", str(tmp_path / "o.toml")]) == 2
         err = capsys.readouterr().err
         assert "Traceback" not in err and ("twice" in err or "nested too deeply" in err)
+
+
+#: Values a damaged ROSS 3 file may hold where a number, a table or a node was meant.
+_ODD = [True, "1.5", "", None, {}, [], [1.0, "a"], [[1.0]], float("nan"), float("inf"),
+        -1.0, 0, 0.0, 1e308, 1e-308, 2.5, 10**30, [1.0, 2.0], [2.0, 1.0], [5.0, 5.0],
+        {"a": 1.0}]
+
+
+@st.composite
+def _damaged(draw):
+    """One of ROSS 3.1's own files (``tables``: bearings over speed and a seal over speed
+    and whirl; ``seals``: ROSS's labyrinth and hole-pattern seals) with 1–3 changes over
+    its documented layout: a key of an element or of ``parameters`` deleted or given an
+    odd value, a table's entry changed, an element copied under a new key, an element's
+    class renamed, or a value nested deeper."""
+    data = json.loads(json.dumps(tomllib.loads((DATA / f"{draw(_SEEDS)}.toml").read_text())))
+    for _ in range(draw(st.integers(1, 3))):
+        tables = [k for k, v in data.items() if isinstance(v, dict)]
+        key = draw(st.sampled_from(tables))
+        table = data[key]
+        op = draw(st.sampled_from(["delete", "odd", "entry", "copy", "rename", "nest"]))
+        fields = [f for f in table if not isinstance(table[f], dict)]
+        if op == "copy":
+            data[f"{key.split('_')[0]}_copy{len(data)}"] = json.loads(json.dumps(table))
+        elif op == "rename" and key != "parameters":
+            data[f"{draw(st.sampled_from(['Bearing', 'DiskElementX', 'PointMass']))}_"
+                 f"{key.split('_', 1)[-1]}"] = data.pop(key)
+        elif fields:
+            field = draw(st.sampled_from(fields))
+            if op == "delete":
+                del table[field]
+            elif op == "entry" and isinstance(table[field], list) and table[field]:
+                i = draw(st.integers(0, len(table[field]) - 1))
+                table[field][i] = copy.deepcopy(draw(st.sampled_from(_ODD)))
+            elif op == "nest":
+                table[field] = [table[field]]
+            else:
+                table[field] = copy.deepcopy(draw(st.sampled_from(_ODD)))
+    return data
+
+
+_SEEDS = st.sampled_from(["tables", "seals"])
+
+
+@settings(max_examples=150, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow])
+@given(_damaged())
+def test_the_ross3_reader_refuses_or_accounts_for_every_element(data):
+    """Property (hypothesis) over ROSS 3's documented layout: a damaged file is either
+    refused with ambseal's own error (ConfigError, naming the file), or imported with every
+    element accounted for — each shaft element a shaft section, each disk a disk, each
+    bearing or seal a spring, seal or AMB, and nothing else — never a traceback of
+    another kind."""
+    from ambseal.io.ross import _check_file, from_ross
+    from ambseal.io.ross_file import read_ross3_file
+
+    src = Path(tempfile.mkdtemp()) / "damaged.json"
+    src.write_text(json.dumps(data))
+    try:
+        rotor = read_ross3_file(src, _check_file(src))
+        imp = from_ross(rotor, where=str(src))
+    except ConfigError as exc:
+        assert str(src) in str(exc) or "damaged" in str(exc), exc
+        return
+    elements = [k for k, v in data.items() if k != "parameters" and isinstance(v, dict)]
+    kinds = [k.split("_")[0] for k in elements]
+    rig = imp.rig
+    masses = kinds.count("PointMass")  # a disk on the shaft, or a housing's mass
+    assert len(rig.shaft) == kinds.count("ShaftElement")
+    assert kinds.count("DiskElement") <= len(rig.disk) <= kinds.count("DiskElement") + masses
+    supports = sum(k == "BearingElement" or k.endswith("Seal") for k in kinds)
+    assert len(rig.spring) + len(rig.seal) + len(rig.amb) == supports
+    assert len(elements) == (kinds.count("ShaftElement") + kinds.count("DiskElement")
+                             + masses + supports)

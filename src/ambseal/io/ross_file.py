@@ -128,6 +128,17 @@ _NEEDS = {"ShaftElement": ("L", "idl", "odl", "idr", "odr", "n"),
           "GearElementTVMS": ("n", "m", "Id", "Ip"), "PointMass": ("n",),
           "CouplingElement": ("n", "L"), "MotorElement": ("n",), "bearing": ("n",)}
 _MATERIAL = ("rho", "E", "G_s")
+#: keys each class may hold that must then be finite numbers (ROSS 3.1's constructors'
+#: keyword arguments), and those that must be true or false
+_MAY = {"ShaftElement": ("axial_force", "torque", "alpha", "beta"),
+        "PointMass": ("m", "mx", "my", "mz"),
+        "CouplingElement": ("o_d", "m_l", "m_r", "Ip_l", "Ip_r", "Id_l", "Id_r", "kt_x",
+                            "kt_y", "kt_z", "kr_x", "kr_y", "kr_z", "ct_x", "ct_y", "ct_z",
+                            "cr_x", "cr_y", "cr_z"),
+        "bearing": ("scale_factor", "g0", "i0", "ag", "nw", "alpha", "k_amp", "k_sense",
+                    "kp_pid", "ki_pid", "kd_pid", "n_f", "sensors_axis_rotation",
+                    "radial_clearance")}
+_FLAGS = ("shear_effects", "rotary_inertia", "gyroscopic")
 
 
 def _number(v) -> bool:
@@ -144,6 +155,18 @@ def _check(key: str, kind: str, table: dict, where: str) -> None:
         if not _number(table[name]):
             raise ConfigError(f"{where}: {key}: {name} = {table[name]!r} (expected a finite "
                               "number)")
+    for name in _MAY.get(kind, ()):
+        if table.get(name) is not None and not _number(table[name]):
+            raise ConfigError(f"{where}: {key}: {name} = {table[name]!r} (expected a finite "
+                              "number)")
+    if kind == "PointMass" and table.get("m") is None and (
+            table.get("mx") is None or table.get("mx") != table.get("my")):
+        raise ConfigError(f"{where}: {key}: missing 'm' (a PointMass needs its mass m, or "
+                          "mx and my equal: ambseal's masses are the same in x and y)")
+    for name in _FLAGS:
+        if name in table and not isinstance(table[name], bool):
+            raise ConfigError(f"{where}: {key}: {name} = {table[name]!r} (expected true or "
+                              "false)")
     if kind == "ShaftElement":
         mat = table.get("material")
         for name in _MATERIAL:
@@ -247,8 +270,10 @@ class _Rotor:
                 el = ShaftElement(table)
                 el.material = _Material(table["material"])
                 for k, d in (("axial_force", 0.0), ("torque", 0.0), ("alpha", 0.0),
-                             ("beta", 0.0), ("shear_method_calc", "cowper")):
-                    setattr(el, k, table.get(k, d))
+                             ("beta", 0.0), ("shear_method_calc", "cowper"),
+                             ("shear_effects", True), ("rotary_inertia", True),
+                             ("gyroscopic", True)):  # ROSS 3.1's defaults
+                    setattr(el, k, d if table.get(k) is None else table[k])
                 self.shaft_elements.append(el)
             elif kind == "CouplingElement":
                 self.shaft_elements.append(CouplingElement(table))
@@ -256,8 +281,9 @@ class _Rotor:
                 self.disk_elements.append(_DISKS[kind](table))
             elif kind == "MotorElement":  # no matrices in ROSS's rotor: named, left out
                 motors.append(MotorElement(table))
-            elif kind == "PointMass":
-                self.point_mass_elements.append(PointMass(table))
+            elif kind == "PointMass":  # ROSS saves m = None where mx and my were given
+                self.point_mass_elements.append(PointMass(
+                    {**table, "m": table["mx"] if table.get("m") is None else table["m"]}))
             elif kind == "BearingElement":
                 self.bearing_elements.append(_bearing(table, where))
             elif kind.endswith("Seal") or kind == "SealElement":
@@ -281,6 +307,8 @@ class _Rotor:
                 if n is not None and not (_number(n) and n == int(n) and n >= 0):
                     raise ConfigError(f"{where}: {type(el).__name__} {el.tag}: {attr} = "
                                       f"{n!r} (expected a node number, an integer ≥ 0)")
+                if n is not None:
+                    setattr(el, attr, int(n))  # 2.0 is node 2
         last = max([int(el.n) + 1 for el in self.shaft_elements], default=0)
         for el in self.disk_elements:  # a disk sits on the shaft (housings hold masses)
             if int(el.n) > last:

@@ -174,6 +174,22 @@ def test_rig_value_refused(tmp_path, capsys, label, edit, key, expect):
     refused(capsys, ["modes", rig, "--n-modes", 1], str(rig), key, expect)
 
 
+def test_validate_refuses_what_run_refuses_before_its_designs(tmp_path, capsys):
+    """A sample rate below twice the reference PID's highest pole (its derivative filter at
+    454.7 Hz, P5 Eq. 6): ``run`` refuses it before any stage (it had designed for 27 s
+    first), and ``validate`` with the same line, where it had said "valid"."""
+    data = copy.deepcopy(BASE)
+    data.setdefault("controller", {})["sample_rate_hz"] = 800.0
+    rig = tmp_path / "rig.toml"
+    rig.write_text(dump(data))
+    expect = ("controller.sample_rate_hz = 800 Hz is below twice the highest pole of K_pid "
+              "(454.7 Hz)")
+    line = refused(capsys, ["validate", rig], str(rig), expect)
+    ran = refused(capsys, ["run", rig, "--no-identify", "--out", tmp_path / "out"], str(rig),
+                  expect)  # one line: before any stage
+    assert ran == line
+
+
 def test_duplicate_seal_and_spring_names(tmp_path, capsys):
     """Their parameter names would collide (seal.k, spring0.kxx)."""
     for kind, extra in (("seal", {}), ("spring", {})):

@@ -644,6 +644,23 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
             "warnings": warnings + reasons}
 
 
+def check_reference_rate(cfg, where) -> None:
+    """Refuse, before any design, a target that cannot run the rig's reference PID
+    (:func:`ambseal.robust.digital.check_rate` on it, as :func:`digital_for` checks it
+    after the designs): ``validate`` and ``run`` refuse the same rig with the same line.
+
+    Raises
+    ------
+    ConfigError
+        ``where: controller.sample_rate_hz …``."""
+    K = design(cfg, "pid").K
+    try:
+        check_rate(K, cfg.controller.sample_rate_hz, cfg.controller.delay_samples,
+                   removable=isinstance(K, ScheduledController))
+    except ConfigError as exc:
+        raise ConfigError(f"{where}: {exc}") from None
+
+
 def validate_summary(rig: str | Path | None = None) -> dict:
     """``ambseal validate``: parse and check a rig file; its model and the defaults a run takes.
 
@@ -664,6 +681,8 @@ def validate_summary(rig: str | Path | None = None) -> dict:
     # a rig without AMBs (a rotor on plain bearings, as import-ross writes it) has no
     # controller to design or judge: its modes, model and sign-off still are
     spec = design_spec(cfg) if cfg.amb else None
+    if cfg.amb:
+        check_reference_rate(cfg, rig if rig is not None else default_rig_path())
     limit = cfg.controller.sample_rate_hz / 2
     res = modes(build_system(cfg))
     rows = [[f, z] for f, z in zip(res.natural_frequencies_hz, res.damping_ratios) if f < limit]

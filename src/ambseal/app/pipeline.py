@@ -49,6 +49,7 @@ from ambseal.analysis import (
 from ambseal.app.commands import (
     Designed,
     Identified,
+    check_reference_rate,
     digitals_for,
     export_all,
     facility_controller,
@@ -329,6 +330,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
     # the truth file is refused before any work
     truth_cfg = load_truth(truth) if identification and truth is not None else None
     spec = design_spec(cfg)
+    check_reference_rate(cfg, rig_path)  # before any design, as validate refuses it
     points = operating_points(spec)
     final = Path(out_dir)
     # one run = one folder: written into a staging folder that replaces out_dir at the end

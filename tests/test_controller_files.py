@@ -229,4 +229,5 @@ def test_a_controller_file_whose_kind_its_matrices_contradict_is_refused(files, 
         _one_line(capsys, ["export", RIG, "--controller", path, "--c", c_dir], str(path),
                   *words)
     assert not c_dir.exists()
-    assert main(["export", RIG, "--controller", str(files["json"]), "--c", str(c_dir)]) == 0
+    assert main(["export", RIG, "--controller", str(files["json"]), "--c", str(c_dir),
+                 "--allow-unstable"]) == 0  # the test rig's PID loses 4.08 bar

@@ -102,7 +102,8 @@ def test_every_kind_through_every_command(kinds, tmp_path, capsys):
     for kind, path in files.items():
         for cmd in (["sweep", RIG, "--pressure-bar", "1", "--speed-hz", "50",
                      "--workers", "1", "--out", tmp_path / f"sw_{kind}"],
-                    ["export", RIG, "--out", tmp_path / f"ex_{kind}"],
+                    # the test rig's PID family loses 4.08 bar: exported as asked
+                    ["export", RIG, "--out", tmp_path / f"ex_{kind}", "--allow-unstable"],
                     ["campbell", RIG, "--speed-hz", "50", "--out", tmp_path / f"cb_{kind}"],
                     ["modes", RIG, "--json"]):
             code, out, errors = _cli(capsys, cmd + ["--controller", path])
@@ -198,8 +199,9 @@ def test_export_discretises_a_continuous_file_as_python_control_does(kinds, tmp_
     ``sample_system`` with that method at the rig's rate (Tustin or ZOH), within 1e-9 of
     its peak."""
     K = kinds["K"]
-    code, out, errors = _cli(capsys, ["export", RIG, "--controller",
-                                      kinds["files"]["continuous"], "--out", tmp_path])
+    code, out, errors = _cli(capsys, ["export", RIG, "--controller",  # loses 4.08 bar
+                                      kinds["files"]["continuous"], "--out", tmp_path,
+                                      "--allow-unstable"])
     assert code == 0, errors
     done = json.loads(out)["discretised"]
     fs = done["sample_rate_hz"]

@@ -248,7 +248,8 @@ def test_folder_commands_write_only_beside_their_own_files(tmp_path, capsys):
     removed, the rerun works again."""
     K = _small_controller_file(tmp_path)
     out = tmp_path / "export"
-    argv = ["export", str(default_rig_path()), "--controller", str(K), "--out", str(out)]
+    argv = ["export", str(default_rig_path()), "--controller", str(K), "--out", str(out),
+            "--allow-unstable"]  # a small controller that levitates nothing
     assert main(argv) == 0 and main(argv) == 0
     assert {"c/ambseal_K.h", "c/ambseal_K.c"} <= set(
         json.loads((out / "manifest.json").read_text())["files"])

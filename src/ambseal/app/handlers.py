@@ -173,15 +173,16 @@ def _export(args: argparse.Namespace) -> int:
                                   f"export discretises for the rig's target: {exc}") from None
             done["discretised"] = {"method": ctrl.method, "sample_rate_hz": ctrl.sample_rate_hz,
                                    "delay_samples": ctrl.delay_samples}
-        # judged on this rig as it runs before it is handed over, as design judges its own
-        verdict = loop_verdict(judged_as_runs(cfg, ctrl), None, args.allow_unstable)
-        if verdict["loop_holds"] is False and not args.allow_unstable:
-            raise SynthesisError(f"{args.controller}: on {args.rig}, the judged loop "
-                                 f"{verdict['verdict']}; nothing exported. Pass "
-                                 "--allow-unstable to export it anyway (marked in the C "
-                                 "header)")
-        warn_unheld(Path(args.controller).name, verdict)
         with _owned(None if args.c_dir else args.out, args.c_dir, args.force):
+            # judged on this rig as it runs before it is handed over, as design judges its
+            # own (the output folder checked first)
+            verdict = loop_verdict(judged_as_runs(cfg, ctrl), None, args.allow_unstable)
+            if verdict["loop_holds"] is False and not args.allow_unstable:
+                raise SynthesisError(f"{args.controller}: on {args.rig}, the judged loop "
+                                     f"{verdict['verdict']}; nothing exported. Pass "
+                                     "--allow-unstable to export it anyway (marked in the "
+                                     "C header)")
+            warn_unheld(Path(args.controller).name, verdict)
             files = write_c(ctrl, args.c_dir or Path(args.out) / "c",  # file name as C names
                             f"ambseal_{c_identifier(Path(args.controller).stem)}",
                             precision=args.precision, verdict=verdict)

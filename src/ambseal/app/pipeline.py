@@ -330,7 +330,6 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
     # the truth file is refused before any work
     truth_cfg = load_truth(truth) if identification and truth is not None else None
     spec = design_spec(cfg)
-    check_reference_rate(cfg, rig_path)  # before any design, as validate refuses it
     points = operating_points(spec)
     final = Path(out_dir)
     # one run = one folder: written into a staging folder that replaces out_dir at the end
@@ -338,6 +337,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
             StageProgress(_stage_totals(cfg, points),
                           display=progress and sys.stderr.isatty()) as stages:
         (out / "controllers").mkdir()
+        check_reference_rate(cfg, rig_path)  # before any stage, as validate refuses it
         st = _RunState(cfg, spec, points, judge_settings(spec), out, stages, allow_unstable,
                        truth_cfg)
         model = _model_stage(st)

@@ -291,10 +291,16 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                              "first stage's suction and the last stage's discharge density, "
                              "averaged; ROSS's report tool, API 684 §SP6.8.5)"),
     "Signoff.log_dec_min": ("", "least log decrement: Level I's δ_A and Level II"),
-    "Signoff.unbalance_factor": ("", "the API 617 unbalance in units of U_r = 6350·W/N g·mm"),
+    "Signoff.unbalance_factor": ("", "the API 617 unbalance in units of U_r = 6350·W/N g·mm "
+                                     "(default 2: API 617 9th ed. 6.8.2.7, U = 2 U_r, as "
+                                     "ROSS 3.1's ``api617_unbalance``; another edition's "
+                                     "factor, e.g. 4, here)"),
     "Signoff.analysis_top_ratio": ("", "the unbalance response is analysed from 0 to this "
                                        "times the trip speed"),
-    "Signoff.vibration_limit_cap_um": ("µm", "cap of A_vl = 25.4 √(12000/N) µm p-p"),
+    "Signoff.vibration_limit_cap_um": ("µm", "cap of A_vl = 25.4 √(12000/N) µm p-p "
+                                            "(default 25.4: API 617 9th ed. 6.8.2.10, "
+                                            "A_vl = min(25.4, 25.4 √(12000/N)), as ROSS "
+                                            "3.1's ``run_clearance_analysis``)"),
     "Signoff.scale_factor_limits": ("", "``[low, high]`` bounds of the scale factor "
                                         "S_c = A_vl/A_probe (default [0.5, 6], API 617 "
                                         "8th ed. Part 1 §4.8.2.11; ROSS 3.1: [0, 6])"),

@@ -8,7 +8,9 @@ stated):
 * **The unbalance.** ``U = f_U · U_r`` with ``U_r = 6350 · W / N`` (g·mm; W the journal
   static load in kg, N the maximum continuous speed in rpm; from 25 000 rpm on
   ``U_r = W / 3.937``, the value at 25 000 rpm, API 617 9th ed. 6.8.2.7 as ROSS 3.1
-  takes it) and ``f_U`` = ``[signoff] unbalance_factor`` (2). The journal static loads
+  takes it) and ``f_U`` = ``[signoff] unbalance_factor`` (2: API 617 9th ed. 6.8.2.7,
+  ``U = 2 U_r``, as ROSS 3.1's ``api617_unbalance``; an edition that asks for another
+  multiple sets it there; 6350·W/N g·mm is 4·W/N oz·in). The journal static loads
   are the reactions of the rotor on rigid supports at every AMB and spring under
   gravity.
 * **Where, per mode.** The first and second rigid-body shapes always: one unbalance at
@@ -48,8 +50,10 @@ stated):
   ``100 (N_min − N_c)/N_min`` and ``100 (N_c − N_max)/N_max``, a critical inside the
   range a negative one (its distance into the range, the nearer end's rule).
 * **Vibration limit.** ``A_vl = 25.4 √(12000/N)`` µm peak-to-peak, at most ``[signoff]
-  vibration_limit_cap_um`` (25.4 µm); the probes' largest amplitude from the minimum
-  continuous to the trip speed must not exceed it.
+  vibration_limit_cap_um`` (25.4 µm: API 617 9th ed. 6.8.2.10,
+  ``A_vl = min(25.4, 25.4 √(12000/N))``, as ROSS 3.1's ``run_clearance_analysis``); the
+  probes' largest amplitude from the minimum continuous to the trip speed must not
+  exceed it.
 * **Close clearances.** The scale factor ``S_c = A_vl / A_1`` (A_1 the probes' largest
   amplitude over ``[signoff] scale_factor_speeds``: ``"to_trip"``, standstill to the
   trip speed, by default; ``"continuous"``, the minimum to the maximum continuous speed,

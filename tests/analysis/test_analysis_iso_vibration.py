@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from ambseal.analysis.iso_vibration import vibration_zone
+from ambseal.analysis.signoff.iso_vibration import vibration_zone
 
 
 @pytest.mark.parametrize("d_um, zone", [(0.0, "A"), (29.9, "A"), (30.0, "B"), (39.0, "B"),

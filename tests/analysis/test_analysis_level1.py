@@ -1,4 +1,4 @@
-"""API 617 Level I screening (:mod:`ambseal.analysis.level1`) against hand calculations and
+"""API 617 Level I screening (:mod:`ambseal.analysis.signoff.level1`) against hand calculations and
 the closed form of a rigid rotor on damped isotropic supports."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from ambseal.analysis.level1 import level1_screening, stage_cross_coupling
+from ambseal.analysis.signoff.level1 import level1_screening, stage_cross_coupling
 from ambseal.config import parse_rig
 from ambseal.errors import ConfigError
 
@@ -181,7 +181,7 @@ def test_q0_with_a_pd_acting_amb_is_the_closed_form_of_its_equivalent_support():
 def test_csr_boundary_is_linear_between_its_points_and_flat_beyond():
     """The default boundary: 2.5 up to 16.53 kg/m³, 2.0 from 60 kg/m³, linear between
     (2.5 − 0.5·(ρ − 16.53)/43.47)."""
-    from ambseal.analysis.level1 import csr_boundary
+    from ambseal.analysis.signoff.level1 import csr_boundary
     from ambseal.config.rig import Signoff
 
     pts = Signoff().csr_boundary
@@ -248,9 +248,9 @@ def test_a_seal_given_as_a_spring_is_no_bearing(tmp_path):
     W_A = m (z_B − z_G)/(z_B − z_A), to 1e-4, and Level II lists the seal as a source."""
     from pathlib import Path
 
-    from ambseal.analysis.level1 import bearing_positions
-    from ambseal.analysis.level2 import level2_analysis
-    from ambseal.analysis.unbalance_api617 import journal_loads
+    from ambseal.analysis.signoff.level1 import bearing_positions
+    from ambseal.analysis.signoff.level2 import level2_analysis
+    from ambseal.analysis.signoff.unbalance_api617 import journal_loads
     from ambseal.config import load_rig
     from ambseal.io import import_ross_file
 

@@ -9,8 +9,8 @@ import tomllib
 import numpy as np
 import pytest
 
-from ambseal.analysis.level1 import stage_cross_coupling
-from ambseal.analysis.level2 import level2_analysis
+from ambseal.analysis.signoff.level1 import stage_cross_coupling
+from ambseal.analysis.signoff.level2 import level2_analysis
 from ambseal.config import parse_rig
 
 from .test_analysis_level1 import _rigid_rotor

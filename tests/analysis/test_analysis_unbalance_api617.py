@@ -9,7 +9,7 @@ import tomllib
 
 import pytest
 
-from ambseal.analysis.unbalance_api617 import (
+from ambseal.analysis.signoff.unbalance_api617 import (
     amplification_factor,
     api617_unbalance,
     journal_loads,
@@ -346,7 +346,7 @@ def test_exact_half_power_of_a_closed_form_resonance(offset):
     import numpy as np
     from scipy.optimize import brentq, minimize_scalar
 
-    from ambseal.analysis.unbalance_api617 import exact_half_power
+    from ambseal.analysis.signoff.unbalance_api617 import exact_half_power
 
     zeta = 0.005
 

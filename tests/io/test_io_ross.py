@@ -288,7 +288,7 @@ def test_compressor_unbalance_response_with_its_bearing_tables_equals_ross(examp
     (sampled alike). Taken at one frequency (the rig frozen at 4000 rpm) the bearings
     gave AF 188 where ROSS has 29."""
     from ambseal.analysis.synchronous import Unbalance, synchronous_response
-    from ambseal.analysis.unbalance_api617 import amplification_factor
+    from ambseal.analysis.signoff.unbalance_api617 import amplification_factor
 
     rotor, path = examples["compressor_example"]
     cfg = from_ross(load_ross(path), where=str(path)).rig
@@ -338,7 +338,7 @@ def test_api617_unbalance_placement_is_ross_31s(name):
     from pathlib import Path
 
     from ambseal.analysis.campbell import modes_as_run
-    from ambseal.analysis.unbalance_api617 import (
+    from ambseal.analysis.signoff.unbalance_api617 import (
         _outboard_mass,
         antinode_unbalances,
         journal_loads,
@@ -1158,7 +1158,7 @@ def test_level1_screening_equals_the_same_sweep_in_ross():
     bisection on ROSS's eigenvalues), equals ambseal's to 1 %."""
     from scipy.optimize import brentq
 
-    from ambseal.analysis.level1 import level1_screening
+    from ambseal.analysis.signoff.level1 import level1_screening
 
     rotor = _bearing_rotor()
     doc = tomllib.loads(dump_rig(from_ross(rotor).rig))

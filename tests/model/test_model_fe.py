@@ -442,7 +442,7 @@ def test_spring_housing_two_mass_closed_form():
     without the housings, each spring to ground, the rig's modes are those of the rotor on
     k1 alone; each journal carries half the rotor's weight; the housing's DOFs follow
     the shaft's in the plant's states; a rig with a housing reads back from its TOML."""
-    from ambseal.analysis.unbalance_api617 import journal_loads
+    from ambseal.analysis.signoff.unbalance_api617 import journal_loads
     from ambseal.config import dump_rig
     from ambseal.model.rig import mechanical_plant
 

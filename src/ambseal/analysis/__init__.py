@@ -26,15 +26,15 @@ sampled with its delay) on the full-order plant:
   modes and log decrements (API 684; :func:`open_loop_modes`, :data:`OVERDAMPED_ZETA`,
   :data:`AF_CRITICAL`), the Campbell diagram (:func:`ambseal.analysis.campbell.campbell`
   → :class:`Campbell`);
-* :func:`level1_screening` → :class:`Level1`, :func:`stage_cross_coupling` — API 617's Level I
-  stability screening with each controller as it runs;
-* :func:`sign_off` → :class:`SignOff`, :func:`verdict_line` — every criterion of API 617
-  and ISO 14839-2 per controller (:func:`iso14839_2_zones` → :class:`IsoVibration`);
-* :func:`level2_analysis` → :class:`Level2` — API 617's Level II table, component by
-  component;
-* :func:`api617_unbalance` → :class:`Api617Unbalance` — API 617's unbalance response,
-  separation margins and close clearances, on :func:`synchronous_response` (rotating
-  :class:`Unbalance` with the loop as it runs);
+* the sign-off, in one subpackage read in the order a rig goes through it
+  (:mod:`ambseal.analysis.signoff`): :func:`sign_off` → :class:`SignOff`,
+  :func:`verdict_line` — every criterion of API 617 and ISO 14839-2 per controller as it
+  runs; :func:`level1_screening` → :class:`Level1`, :func:`stage_cross_coupling` — API
+  617's Level I; :func:`level2_analysis` → :class:`Level2` — Level II, source by source;
+  :func:`api617_unbalance` → :class:`Api617Unbalance` — the unbalance response, separation
+  margins and close clearances, on :func:`synchronous_response` (rotating
+  :class:`Unbalance` with the loop as it runs); :func:`iso14839_2_zones` →
+  :class:`IsoVibration`;
 * :func:`stability_boundary`, :func:`refine_boundary` — on the rows of
   :func:`ambseal.analysis.sweep.sweep` (:func:`parse_range`, :func:`check_cases`);
   :func:`stability_case`, :func:`stability_points` → :class:`StabilityCase` (with a
@@ -81,12 +81,14 @@ _FROM = {
     "IsoAssessment": "iso", "ZONES": "iso", "ZONE_LIMITS": "iso", "frozen_at": "judge",
     "judge_case": "judge", "judge_jobs": "judge", "judge_settings": "judge",
     "judge_spinup": "judge", "operating_points": "judge", "points_for": "judge",
-    "level1_screening": "level1", "stage_cross_coupling": "level1", "Level1": "level1",
-    "level2_analysis": "level2", "Level2": "level2", "sign_off": "signoff",
-    "SignOff": "signoff", "verdict_line": "signoff", "critical_speeds_hz": "signoff",
-    "iso14839_2_zones": "iso_vibration",
-    "IsoVibration": "iso_vibration",
-    "api617_unbalance": "unbalance_api617", "Api617Unbalance": "unbalance_api617",
+    "level1_screening": "signoff.level1", "stage_cross_coupling": "signoff.level1",
+    "Level1": "signoff.level1", "level2_analysis": "signoff.level2",
+    "Level2": "signoff.level2", "sign_off": "signoff.verdict",
+    "SignOff": "signoff.verdict", "verdict_line": "signoff.verdict",
+    "critical_speeds_hz": "signoff.verdict", "iso14839_2_zones": "signoff.iso_vibration",
+    "IsoVibration": "signoff.iso_vibration",
+    "api617_unbalance": "signoff.unbalance_api617",
+    "Api617Unbalance": "signoff.unbalance_api617",
     "synchronous_response": "synchronous", "Unbalance": "synchronous",
     "speed_scheduled": "judge", "unstable_open_loop_poles": "judge", "JudgeJob": "judge",
     "JudgeSettings": "judge", "JudgedCase": "judge", "LoopJudgement": "judge",

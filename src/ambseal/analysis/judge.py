@@ -61,7 +61,7 @@ from ambseal.analysis.amplifier import unbalance_currents
 from ambseal.analysis.synchronous import hold_fundamental, running_plant
 from ambseal.analysis.unbalance import (UnbalanceResponse, running_unbalance,
                                         unbalance_from_compliance)
-from ambseal.analysis.unbalance_api617 import amplification_factor, required_margin
+from ambseal.analysis.signoff.unbalance_api617 import amplification_factor, required_margin
 from ambseal.design import RIGID_STATES, vertex_grid_hz
 from ambseal.design.lpv_plant import lpv_plant
 from ambseal.lti import eigenvalues, finite_or_none, freqresp_at, json_float, wired
@@ -536,7 +536,7 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
 
 
 #: API 617's largest separation margin above the maximum continuous speed (26 %) and below
-#: the minimum (16 %), as fractions (:func:`ambseal.analysis.unbalance_api617.required_margin`)
+#: the minimum (16 %), as fractions (:func:`ambseal.analysis.signoff.unbalance_api617.required_margin`)
 MAX_MARGIN_ABOVE, MAX_MARGIN_BELOW = 0.26, 0.16
 
 
@@ -554,7 +554,7 @@ def critical_speeds(unb: UnbalanceResponse, f_min: float, f_max: float) -> list[
     ``100 (f_min − N)/f_min`` below it and ``100 (N − f_max)/f_max`` above it, and API 617
     (8th ed., §2.6.2.10) requires ``min(16, 17(1 − 1/(AF − 1.5)))`` % below and
     ``min(26, 10 + 17(1 − 1/(AF − 1.5)))`` % above
-    (:func:`ambseal.analysis.unbalance_api617.required_margin`).
+    (:func:`ambseal.analysis.signoff.unbalance_api617.required_margin`).
 
     Parameters
     ----------

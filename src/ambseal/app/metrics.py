@@ -144,10 +144,10 @@ class SignoffController:
         Every criterion that counts passed.
     criteria : list of SignoffCriterion
     level1, level2, unbalance, iso14839_2 : dict
-        The analyses: :meth:`ambseal.analysis.level1.Level1.to_dict`,
-        :meth:`ambseal.analysis.level2.Level2.to_dict`,
-        :meth:`ambseal.analysis.unbalance_api617.Api617Unbalance.to_dict`,
-        :meth:`ambseal.analysis.iso_vibration.IsoVibration.to_dict`.
+        The analyses: :meth:`ambseal.analysis.signoff.level1.Level1.to_dict`,
+        :meth:`ambseal.analysis.signoff.level2.Level2.to_dict`,
+        :meth:`ambseal.analysis.signoff.unbalance_api617.Api617Unbalance.to_dict`,
+        :meth:`ambseal.analysis.signoff.iso_vibration.IsoVibration.to_dict`.
     """
 
     passed: bool

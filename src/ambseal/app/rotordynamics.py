@@ -3,7 +3,7 @@
 
 Wiring only, like :mod:`ambseal.app.commands`: the numbers come from
 :mod:`ambseal.analysis.campbell`, :mod:`ambseal.analysis.sweep`,
-:mod:`ambseal.analysis.level1` and :mod:`ambseal.io.ross`, the figures from
+:mod:`ambseal.analysis.signoff.level1` and :mod:`ambseal.io.ross`, the figures from
 :mod:`ambseal.report.modal_figures` and :mod:`ambseal.report.signoff_figures`, and every
 file is written through a
 temporary name and a rename (:mod:`ambseal.files`). The CLI (:mod:`ambseal.cli`) parses these

@@ -29,7 +29,7 @@ def level1_figure(path: str | os.PathLike, results, *,
     ----------
     path : path-like
         The PNG to write.
-    results : sequence of ambseal.analysis.level1.Level1
+    results : sequence of ambseal.analysis.signoff.level1.Level1
         One per controller; Q in units of the common Q_A on the axis.
     title : str
         The figure's title.
@@ -87,7 +87,7 @@ def api617_unbalance_figure(path: str | os.PathLike, results, *,
     ----------
     path : path-like
         The PNG to write.
-    results : sequence of ambseal.analysis.unbalance_api617.Api617Unbalance
+    results : sequence of ambseal.analysis.signoff.unbalance_api617.Api617Unbalance
         One per controller.
     title : str
         The figure's title.

@@ -5,7 +5,7 @@ at the maximum continuous speed with every modelled destabilising source, tabula
 component by component — the rotor on its supports alone, each seal added alone (its
 coefficients at the operating pressure drop, ``[operating] pressure_bar``, and the
 synchronous frequency), the anticipated aerodynamic cross-coupling added alone (each
-stage's q_A of :func:`ambseal.analysis.level1.stage_cross_coupling` as k_xy = q_A,
+stage's q_A of :func:`ambseal.analysis.signoff.level1.stage_cross_coupling` as k_xy = q_A,
 k_yx = −q_A at the stage), and all of them together. The machine passes when the loop
 with every source is stable and its least damped forward mode keeps δ ≥ ``[signoff]
 log_dec_min`` (0.1; API 684 (2nd ed., 2005) §2.8's limit, as ROSS's API report tool
@@ -35,7 +35,7 @@ import math
 from dataclasses import dataclass
 
 from ambseal.analysis.campbell import modes_as_run, track_modes
-from ambseal.analysis.level1 import stage_cross_coupling, stage_position, without_seals
+from ambseal.analysis.signoff.level1 import stage_cross_coupling, stage_position, without_seals
 from ambseal.config import Spring
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float

@@ -27,8 +27,8 @@ the command line and the report alike; the machine passes when every controller 
 every criterion that counts and is graded. The clause numbers are
 those ROSS's API report tool cites; where a limit could not be confirmed from the
 standards' public text it is a ``[signoff]`` setting (:class:`ambseal.config.rig.Signoff`).
-The modules: :mod:`~ambseal.analysis.level1`, :mod:`~ambseal.analysis.level2`,
-:mod:`~ambseal.analysis.unbalance_api617`, :mod:`~ambseal.analysis.iso_vibration`.
+The modules: :mod:`~ambseal.analysis.signoff.level1`, :mod:`~ambseal.analysis.signoff.level2`,
+:mod:`~ambseal.analysis.signoff.unbalance_api617`, :mod:`~ambseal.analysis.signoff.iso_vibration`.
 """
 
 from __future__ import annotations
@@ -36,10 +36,10 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from ambseal.analysis.campbell import AF_CRITICAL
-from ambseal.analysis.iso_vibration import iso14839_2_zones
-from ambseal.analysis.level1 import RATIO_FREE, RATIO_MIN, level1_screening
-from ambseal.analysis.level2 import level2_analysis
-from ambseal.analysis.unbalance_api617 import api617_unbalance, journal_loads
+from ambseal.analysis.signoff.iso_vibration import iso14839_2_zones
+from ambseal.analysis.signoff.level1 import RATIO_FREE, RATIO_MIN, level1_screening
+from ambseal.analysis.signoff.level2 import level2_analysis
+from ambseal.analysis.signoff.unbalance_api617 import api617_unbalance, journal_loads
 
 __all__ = ["Criterion", "SignOff", "sign_off", "verdict_line", "critical_speeds_hz", "CLAUSES",
            "CRITICAL_SAME"]
@@ -95,11 +95,11 @@ class SignOff:
     Attributes
     ----------
     controller : str
-    level1 : ambseal.analysis.level1.Level1 or None
+    level1 : ambseal.analysis.signoff.level1.Level1 or None
         None for a machine without ``[[stage]]`` (Level I does not apply).
-    level2 : ambseal.analysis.level2.Level2
-    unbalance : ambseal.analysis.unbalance_api617.Api617Unbalance
-    iso14839_2 : ambseal.analysis.iso_vibration.IsoVibration
+    level2 : ambseal.analysis.signoff.level2.Level2
+    unbalance : ambseal.analysis.signoff.unbalance_api617.Api617Unbalance
+    iso14839_2 : ambseal.analysis.signoff.iso_vibration.IsoVibration
     criteria : tuple of Criterion
     """
 
@@ -140,7 +140,7 @@ def critical_speeds_hz(criticals) -> list[float]:
     Parameters
     ----------
     criticals : sequence of Critical
-        :class:`ambseal.analysis.unbalance_api617.Critical` of every case and probe.
+        :class:`ambseal.analysis.signoff.unbalance_api617.Critical` of every case and probe.
 
     Returns
     -------

@@ -76,7 +76,7 @@ from scipy.optimize import brentq, minimize_scalar
 from scipy.signal import find_peaks
 
 from ambseal.analysis.campbell import AF_CRITICAL, OVERDAMPED_ZETA, modes_as_run
-from ambseal.analysis.level1 import (
+from ambseal.analysis.signoff.level1 import (
     RIGID_SUPPORT,
     bearing_positions,
     stage_position,

@@ -10,7 +10,7 @@ confirm them, so they are a setting); zones A and B pass (unrestricted long-term
 operation), as ISO 14839-3 grades the sensitivity (:mod:`ambseal.analysis.iso`).
 
 The displacement graded is the API 617 unbalance response's at the sensors
-(:mod:`ambseal.analysis.unbalance_api617`), the largest over its cases, from the minimum
+(:mod:`ambseal.analysis.signoff.unbalance_api617`), the largest over its cases, from the minimum
 to the maximum continuous speed: the rotor carrying the specification's unbalance. An
 AMB without ``backup_clearance`` is not graded, and says so.
 """
@@ -101,7 +101,7 @@ def iso14839_2_zones(cfg, unbalance) -> IsoVibration:
     ----------
     cfg : RigConfig
         The rig (its ``[[amb]]`` ``backup_clearance`` and ``[signoff]``).
-    unbalance : ambseal.analysis.unbalance_api617.Api617Unbalance
+    unbalance : ambseal.analysis.signoff.unbalance_api617.Api617Unbalance
         Its responses at the probes.
 
     Returns

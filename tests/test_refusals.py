@@ -188,6 +188,11 @@ def test_validate_refuses_what_run_refuses_before_its_designs(tmp_path, capsys):
     ran = refused(capsys, ["run", rig, "--no-identify", "--out", tmp_path / "out"], str(rig),
                   expect)  # one line: before any stage
     assert ran == line
+    # a [design] override run takes, validate takes and refuses alike
+    band = ["--set", "design.band_hz=[2000.0, 1.0]"]
+    line = refused(capsys, ["validate", RIG, *band], str(RIG), "band_hz", "low < high")
+    assert refused(capsys, ["run", RIG, "--no-identify", "--out", tmp_path / "o2", *band],
+                   str(RIG), "band_hz") == line
 
 
 def test_duplicate_seal_and_spring_names(tmp_path, capsys):

@@ -7,7 +7,7 @@ Commands
 ``ambseal run [RIG] [--out DIR]``
     The main job on a rig (default: the embedded thesis test facility). Exit status 1: the
     report is written but a designed controller failed (named on stderr).
-``ambseal validate [RIG] [--json]``
+``ambseal validate [RIG] [--json] [--set design.KEY=VALUE ...]``
     Parse and check a rig file; print its model summary and the defaults a run takes.
 ``ambseal modes [RIG] [--speed-rpm N] [--pressure-bar P] [--json] [--n-modes N] [--max-hz F]
 [--controller C] [--shapes [PNG]] [--free | --no-amb]``
@@ -204,6 +204,10 @@ def _parser() -> argparse.ArgumentParser:
                        "a run takes")
     v.add_argument("rig", nargs="?", help=_RIG_HELP)
     v.add_argument("--json", action="store_true", help="print JSON instead of text")
+    v.add_argument("--set", action="append", default=[], metavar="design.KEY=VALUE",
+                   dest="overrides",
+                   help="check the rig with a [design] key overridden, as run and design "
+                        "take it (a TOML value); repeatable")
 
     a = sub.add_parser("acquire", help="record a run of the virtual test facility")
     a.add_argument("rig", help="rig file (TOML)")

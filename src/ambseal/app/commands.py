@@ -661,7 +661,7 @@ def check_reference_rate(cfg, where) -> None:
         raise ConfigError(f"{where}: {exc}") from None
 
 
-def validate_summary(rig: str | Path | None = None) -> dict:
+def validate_summary(rig: str | Path | None = None, overrides=()) -> dict:
     """``ambseal validate``: parse and check a rig file; its model and the defaults a run takes.
 
     Returns a JSON-ready dict: ``rig``, ``name``, ``mass_kg``, ``nodes``, ``axes``; the modes
@@ -669,15 +669,17 @@ def validate_summary(rig: str | Path | None = None) -> dict:
     (``modes_below_hz``, ``modes`` as [f_Hz, ζ]); ``unstable_poles`` ([Re, Im] rad/s); and
     ``defaults``: the reduced model's order, the judged conditions, the controller's sample
     rate, the reference PID and the judgement's grids and disturbances (on a rig without
-    AMBs none: no controller to design or judge).
+    AMBs none: no controller to design or judge). ``overrides`` are ``design.KEY=VALUE``
+    settings, as ``run`` takes them (:func:`ambseal.config.apply_overrides`).
 
     Raises
     ------
     ConfigError
-        The rig file does not parse or check.
+        The rig file does not parse or check, or holds what ``run`` would refuse before
+        its designs (a target that cannot run the reference PID).
     """
 
-    cfg = load_rig(rig)
+    cfg = load_rig(rig, overrides)
     # a rig without AMBs (a rotor on plain bearings, as import-ross writes it) has no
     # controller to design or judge: its modes, model and sign-off still are
     spec = design_spec(cfg) if cfg.amb else None

@@ -248,7 +248,7 @@ def _plain(x) -> str:
 
 
 def _validate(args: argparse.Namespace) -> int:
-    v = validate_summary(args.rig)
+    v = validate_summary(args.rig, tuple(args.overrides))
     if args.json:
         print(json.dumps(v, indent=2))
         return 0

@@ -377,18 +377,21 @@ def turbo_run(tmp_path_factory, request, design_cache_for):
 
 
 def test_run_not_on_a_terminal_logs_one_line_per_stage(turbo_run):
-    """`ambseal run 2>log`: one plain line per stage with its time and the elapsed time,
-    in the order of the job, no terminal control characters."""
+    """`ambseal run 2>log`: one plain line per stage with its time, its CPU time and the
+    elapsed time, in the order of the job, no terminal control characters; the stages'
+    wall times add up to the elapsed time."""
     import re
 
     lines = (turbo_run / "stderr.log").read_text().splitlines()
-    stages = [re.match(r"ambseal: ([a-z-]+): done in [0-9.]+ s, elapsed ([0-9.]+) s$", ln)
-              for ln in lines]
+    stages = [re.match(r"ambseal: ([a-z-]+): done in ([0-9.]+) s \(([0-9.]+) s CPU\), "
+                       r"elapsed ([0-9.]+) s$", ln) for ln in lines]
     assert all(stages), lines
     assert [m.group(1) for m in stages] == ["model", "design", "judge", "speed-range", "spin-up",
                                            "report"]
-    elapsed = [float(m.group(2)) for m in stages]
+    elapsed = [float(m.group(4)) for m in stages]
     assert elapsed == sorted(elapsed)
+    walls = [float(m.group(2)) for m in stages]
+    assert sum(walls) == pytest.approx(elapsed[-1], abs=0.05 * len(walls) + 0.5)
     assert "\x1b" not in "".join(lines)
 
 

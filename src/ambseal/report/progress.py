@@ -1,8 +1,10 @@
 """Progress of a long job, stage by stage: bars on a terminal, plain log lines elsewhere.
 
 Python's :mod:`logging` is underneath, on the ``"ambseal"`` logger, so a library user
-routes it like any other: each finished stage is one INFO record (``"judge: 9 steps in
-41.2 s, elapsed 75.3 s"``) and each step within a stage one DEBUG record. With
+routes it like any other: each finished stage is one INFO record (``"judge: done in
+41.2 s (40.9 s CPU), elapsed 75.3 s"``: wall and this process's CPU time, which
+``benchmarks/bench_rigs.py`` reads per stage) and each step within a stage one DEBUG
+record. With
 ``display=True`` (the CLI on a terminal) rich shows one bar per stage as it starts, each with
 its own clock; a bar only fills, and a stage's bar is full when the next one starts.
 """
@@ -42,6 +44,7 @@ class StageProgress:
         self._name: str | None = None
         self._steps = 0
         self._t0 = self._t_stage = time.perf_counter()
+        self._cpu_stage = time.process_time()
 
     def __enter__(self) -> "StageProgress":
         if self._display:
@@ -63,7 +66,7 @@ class StageProgress:
         """End the current stage (its bar full) and start ``name``."""
         self._end_stage()
         self._name, self._steps = name, 0
-        self._t_stage = time.perf_counter()
+        self._t_stage, self._cpu_stage = time.perf_counter(), time.process_time()
         total = self._totals.get(name)
         if self._progress is not None:
             self._task = self._progress.add_task(name, total=total, detail=detail)
@@ -85,11 +88,11 @@ class StageProgress:
     def _end_stage(self) -> None:
         if self._name is None:
             return
-        now = time.perf_counter()
+        now, cpu = time.perf_counter(), time.process_time()
         if self._progress is not None and self._task is not None:
             total = self._totals.get(self._name) or max(self._steps, 1)
             self._progress.update(self._task, total=total, completed=total, detail="")
             self._progress.stop_task(self._task)
-        LOGGER.info("%s: done in %.1f s, elapsed %.1f s", self._name, now - self._t_stage,
-                    now - self._t0)
+        LOGGER.info("%s: done in %.1f s (%.1f s CPU), elapsed %.1f s", self._name,
+                    now - self._t_stage, cpu - self._cpu_stage, now - self._t0)
         self._name, self._task = None, None

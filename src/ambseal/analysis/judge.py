@@ -536,7 +536,8 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
 
 
 #: API 617's largest separation margin above the maximum continuous speed (26 %) and below
-#: the minimum (16 %), as fractions (:func:`ambseal.analysis.signoff.unbalance_api617.required_margin`)
+#: the minimum (16 %), as fractions
+#: (:func:`ambseal.analysis.signoff.unbalance_api617.required_margin`)
 MAX_MARGIN_ABOVE, MAX_MARGIN_BELOW = 0.26, 0.16
 
 

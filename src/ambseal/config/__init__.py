@@ -60,5 +60,6 @@ __all__ = ["MAX_AMBS", "MAX_COEFFICIENT", "MAX_COMPONENTS", "MAX_CURRENT_A", "MA
            "Actuator", "Affine", "Amb", "AxisPair", "Coefficient", "FrequencyTable",
            "Machine", "Pid", "PidFilter", "RigConfig", "Seal", "Signoff", "Spring", "Stage",
            "TruthSection", "apply_overrides",
-           "check_coil", "check_operating", "default_rig_path", "dump_rig", "load_rig", "load_truth",
+           "check_coil", "check_operating", "default_rig_path", "dump_rig", "load_rig",
+           "load_truth",
            "parse_rig", "rig_parameter_names", "rig_with_values", "toml_string"]

@@ -128,6 +128,13 @@ def _marked_discrete(folder: Path) -> Path:
     return path
 
 
+def _json_list(folder):
+    """A JSON file holding a list where an identification's fit (an object) belongs."""
+    path = folder / "list.json"
+    path.write_text("[1, 2]")
+    return path
+
+
 def _fifo(folder: Path) -> Path:
     path = folder / "rig.toml"
     os.mkfifo(path)  # reading it would block until a writer comes: never
@@ -164,6 +171,10 @@ REFUSED = [
         "design", _rig(f, lambda d: d.setdefault("design", {}).update(
             uncertainty_from_identification="/dev/zero")), "--show-defaults"],
      ("uncertainty_from_identification", "/dev/zero", "not a regular file")),
+    ("a JSON list as identification", lambda f: [
+        "design", _rig(f, lambda d: d.setdefault("design", {}).update(
+            uncertainty_from_identification=str(_json_list(f)))), "--show-defaults"],
+     ("uncertainty_from_identification", "list.json", "expected the table")),
     ("/dev/zero as controller", lambda f: ["export", RIG, "--controller",
                                            _device_controller(f), "--c", f / "c"],
      ("K.json", "not a regular file")),

@@ -258,3 +258,31 @@ def test_the_ross3_reader_refuses_or_accounts_for_every_element(data):
     assert len(rig.spring) + len(rig.seal) + len(rig.amb) == supports
     assert len(elements) == (kinds.count("ShaftElement") + kinds.count("DiskElement")
                              + masses + supports)
+
+
+def test_level1_q0_equals_ross_31(tmp_path, capsys):
+    """API 617 Level I against ROSS 3.1's ``run_level1`` (``tests/data/ross3/level1.json``,
+    written by ``make.py``): ROSS's ``rotor_example`` on two damped bearings, imported,
+    with one stage on its first disk. Between the bearings API 617 applies Q at mid-span
+    (ROSS's node 3, where the reference puts it); the screened mode's log decrement at
+    Q = 0 (ROSS's first mode that does not whirl backward, 15.4 Hz) and Q_0, where it
+    crosses zero (Brent's method on ROSS's own evaluation), agree within 1e-4 and 1e-3."""
+    from ambseal.analysis import level1_screening
+
+    ref = json.loads((DATA / "level1.json").read_text())
+    src = tmp_path / "level1.toml"
+    shutil.copy(DATA / "level1.toml", src)
+    out = tmp_path / "rig.toml"
+    rpm = ref["speed_rad_s"] * 30 / np.pi
+    assert main(["import-ross", str(src), "--out", str(out), "--speed-rpm", f"{rpm!r}"]) == 0
+    capsys.readouterr()
+    out.write_text(out.read_text() + '\n[[stage]]\ndisk = "Disk 0"\npower = 1.0e5\n'
+                   "impeller_diameter = 0.28\ndischarge_width = 0.01\n"
+                   "suction_density = 1.2\ndischarge_density = 2.4\n")
+    res = level1_screening(load_rig(out))
+    assert res.where_m == ((0.75, 1.0),)  # mid-span of 1.5 m between the bearings
+    sweep = res.to_dict()["sweep"]
+    assert sweep["Q"][0] == 0.0
+    assert sweep["log_dec"][0] == pytest.approx(ref["log_dec_at_0"], rel=1e-4)
+    assert 2 * np.pi * sweep["frequency_hz"][0] == pytest.approx(ref["wd_at_0"], rel=1e-4)
+    assert res.Q_0 == pytest.approx(ref["Q_0"], rel=1e-3)

@@ -99,6 +99,43 @@ def api617_placements() -> dict:
     return out
 
 
+#: The Level I screening's rotor: ``rotor_example`` on two damped bearings, screened at
+#: 600 rad/s with the cross-coupling at mid-span (node 3), where API 617 applies it for a
+#: rotor between bearings
+LEVEL1_SPEED_RAD_S, LEVEL1_NODE = 600.0, 3
+
+
+def level1_rotor():
+    ex = rs.rotor_example()
+    bearings = [rs.BearingElement(n=n, kxx=1e6, kyy=0.8e6, cxx=500.0, cyy=500.0,
+                                  tag=f"B{n}") for n in (0, 6)]
+    return rs.Rotor(ex.shaft_elements, ex.disk_elements, bearings)
+
+
+def level1_reference(rotor) -> dict:
+    """ROSS 3.1's ``run_level1`` on ``rotor``: the log decrement of the first mode that
+    does not whirl backward with Q (``k_xy = Q``, ``k_yx = −Q``) at node ``LEVEL1_NODE``,
+    at Q = 0 and its zero Q_0 (Brent's method on ROSS's own evaluation, as
+    ``run_level1`` builds each rotor)."""
+    from copy import copy
+
+    from scipy.optimize import brentq
+
+    def first(Q):
+        bearings = [copy(b) for b in rotor.bearing_elements]
+        bearings.append(rs.BearingElement(n=LEVEL1_NODE, kxx=0, cxx=0, kxy=Q, kyx=-Q))
+        r = rotor.__class__(rotor.shaft_elements, rotor.disk_elements, bearings,
+                            rotor.point_mass_elements)
+        m = r.run_modal(speed=LEVEL1_SPEED_RAD_S)
+        non_backward = m.whirl_direction() != "Backward"
+        return float(m.log_dec[non_backward][0]), float(m.wd[non_backward][0])
+
+    q0 = brentq(lambda q: first(q)[0], 0.0, 1e5, xtol=1e-6, rtol=1e-12)
+    return {"ross_version": rs.__version__, "speed_rad_s": LEVEL1_SPEED_RAD_S,
+            "node": LEVEL1_NODE, "log_dec_at_0": first(0.0)[0], "wd_at_0": first(0.0)[1],
+            "Q_0": q0}
+
+
 if __name__ == "__main__":
     with contextlib.redirect_stdout(sys.stderr), warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -114,3 +151,6 @@ if __name__ == "__main__":
             (HERE / f"{name}_eigenvalues.json").write_text("{\n" + rows + "\n}\n")
         (HERE / "api617_unbalance.json").write_text(
             json.dumps(api617_placements(), indent=1) + "\n")
+        r = level1_rotor()
+        r.save(HERE / "level1.toml")
+        (HERE / "level1.json").write_text(json.dumps(level1_reference(r), indent=1) + "\n")

@@ -81,7 +81,9 @@ speed_rpm = 3000.0
 def test_q0_of_a_rigid_rotor_on_damped_supports_is_the_closed_form():
     """m z̈ + c ż + k z − jQ z = 0 (z = x + jy, the cross-coupling k_xy = Q, k_yx = −Q at
     mid-span of a rotor symmetric about it): forward whirl at ω = √(k/m) loses its damping
-    at Q_0 = c·√(k/m). The screening's Q_0 (no AMB: the rig as it is) within 2 %, δ(0) of
+    at Q_0 = c·√(k/m). The screening's Q_0 (no AMB: the rig as it is) within 1 % (API 617's
+    check of the screening on a closed form; the shaft's own flexibility and mass move it by
+    0.2 %), δ(0) of
     the cylindrical mode 2πζ/√(1 − ζ²) with ζ = c/(2√(km)); with a Q_A of about Q_0/6
     (Q_0/Q_A between 2 and 10) the CSR region decides: this short stiff rotor's CSR lies
     far below the default boundary (Region A, passed), and above a boundary set below it
@@ -93,7 +95,7 @@ def test_q0_of_a_rigid_rotor_on_damped_supports_is_the_closed_form():
     m = math.pi / 4 * 0.2**2 * 0.4 * 7850.0
     r = level1_screening(cfg)
     q0 = c * math.sqrt(k / m)
-    assert r.Q_0 == pytest.approx(q0, rel=0.02)
+    assert r.Q_0 == pytest.approx(q0, rel=0.01)
     zeta = c / (2 * math.sqrt(k * m))
     assert r.log_dec[0] == pytest.approx(2 * math.pi * zeta / math.sqrt(1 - zeta**2),
                                          rel=0.02)

@@ -265,8 +265,9 @@ def test_level1_q0_equals_ross_31(tmp_path, capsys):
     written by ``make.py``): ROSS's ``rotor_example`` on two damped bearings, imported,
     with one stage on its first disk. Between the bearings API 617 applies Q at mid-span
     (ROSS's node 3, where the reference puts it); the screened mode's log decrement at
-    Q = 0 (ROSS's first mode that does not whirl backward, 15.4 Hz) and Q_0, where it
-    crosses zero (Brent's method on ROSS's own evaluation), agree within 1e-4 and 1e-3."""
+    Q = 0 (ROSS's first mode that does not whirl backward, 15.4 Hz) and at Q_A (δ_A), and
+    Q_0, where it crosses zero (Brent's method on ROSS's own evaluation), agree within 1e-4,
+    1e-4 and 1e-3."""
     from ambseal.analysis import level1_screening
 
     ref = json.loads((DATA / "level1.json").read_text())
@@ -276,10 +277,13 @@ def test_level1_q0_equals_ross_31(tmp_path, capsys):
     rpm = ref["speed_rad_s"] * 30 / np.pi
     assert main(["import-ross", str(src), "--out", str(out), "--speed-rpm", f"{rpm!r}"]) == 0
     capsys.readouterr()
-    out.write_text(out.read_text() + '\n[[stage]]\ndisk = "Disk 0"\npower = 1.0e5\n'
+    # q_A = 3·(P/Ω)·(ρ_d/ρ_s)/(D_c·H_c) = 3·(2800/600)·2/(0.28·0.01) = 1e4 N/m (API 617)
+    out.write_text(out.read_text() + '\n[[stage]]\ndisk = "Disk 0"\npower = 2800.0\n'
                    "impeller_diameter = 0.28\ndischarge_width = 0.01\n"
                    "suction_density = 1.2\ndischarge_density = 2.4\n")
     res = level1_screening(load_rig(out))
+    assert res.Q_A == pytest.approx(ref["Q_A"], rel=1e-12)
+    assert res.log_dec_A == pytest.approx(ref["log_dec_A"], rel=1e-4)
     assert res.where_m == ((0.75, 1.0),)  # mid-span of 1.5 m between the bearings
     sweep = res.to_dict()["sweep"]
     assert sweep["Q"][0] == 0.0

@@ -103,6 +103,8 @@ def api617_placements() -> dict:
 #: 600 rad/s with the cross-coupling at mid-span (node 3), where API 617 applies it for a
 #: rotor between bearings
 LEVEL1_SPEED_RAD_S, LEVEL1_NODE = 600.0, 3
+#: The anticipated cross-coupling δ_A is read at (N/m): the test's stage gives it
+LEVEL1_Q_A = 1e4
 
 
 def level1_rotor():
@@ -133,7 +135,7 @@ def level1_reference(rotor) -> dict:
     q0 = brentq(lambda q: first(q)[0], 0.0, 1e5, xtol=1e-6, rtol=1e-12)
     return {"ross_version": rs.__version__, "speed_rad_s": LEVEL1_SPEED_RAD_S,
             "node": LEVEL1_NODE, "log_dec_at_0": first(0.0)[0], "wd_at_0": first(0.0)[1],
-            "Q_0": q0}
+            "Q_A": LEVEL1_Q_A, "log_dec_A": first(LEVEL1_Q_A)[0], "Q_0": q0}
 
 
 if __name__ == "__main__":

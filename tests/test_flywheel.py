@@ -72,6 +72,9 @@ def test_the_lpv_runs_on_the_flywheel_from_standstill_to_the_top_speed(flywheel_
     rows = [r for r in [*metrics["cases"], *metrics["stability"]] if r["controller"] == "lpv"]
     judged = sorted({r["speed_hz"] for r in rows})
     assert judged[0] == 0.0 and judged[-1] == pytest.approx(1000.0)
+    # its files say where it was judged: the design speed and the speed range
+    assert str(f["loop_holds"]) == "yes"
+    assert f"{len(rows)}: 0 bar, 0–1000 Hz" in str(f["verdict"])
     w = np.pi / Ts * np.logspace(-4, 0, 2000)[:-1]
     z = np.exp(1j * w * Ts)
     for hz in sorted({*np.linspace(0.0, 1000.0, 17), *judged}):

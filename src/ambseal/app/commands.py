@@ -339,9 +339,11 @@ def show_defaults(rig: str | Path, overrides=()) -> str:
 
 
 def export_all(designs, digitals: dict, cases: list[dict], out: Path,
-               failed: dict | None = None, allow_unstable: bool = False) -> dict:
+               failed: dict | None = None, allow_unstable: bool = False,
+               speed_range: list[dict] = ()) -> dict:
     """``ambseal run``'s controllers: each as it runs (:func:`export_design` with its judged
-    discrete margins and the run's verdict: ``failed``'s reason, by method) and as C
+    discrete margins and the run's verdict: ``failed``'s reason, by method, and where its
+    loop was judged, the ``speed_range`` cases included) and as C
     (:func:`ambseal.export.codegen.write_c`); returns the design summaries with their
     ``discretisation`` for ``metrics.json`` (``None`` for a controller without a digital
     one in ``digitals``: nothing of it is exported)."""
@@ -354,8 +356,8 @@ def export_all(designs, digitals: dict, cases: list[dict], out: Path,
             continue
         judged = judged_margins(cases, d.method)
         failure = (failed or {}).get(d.method)
-        verdict = loop_verdict(judged, None if failure is None else failure.reason,
-                               allow_unstable)
+        verdict = loop_verdict(judged + judged_margins(list(speed_range), d.method),
+                               None if failure is None else failure.reason, allow_unstable)
         export_design(d.method, digital, d.result.to_dict(), out, judged, verdict)
         write_c(digital, out, f"ambseal_{d.method}", verdict=verdict)
         disc = digital.to_dict()  # the difference as judged (grids refined at the peaks)
@@ -369,7 +371,7 @@ def export_all(designs, digitals: dict, cases: list[dict], out: Path,
 def judged_margins(cases: list[dict], method: str) -> list[dict]:
     """The discrete blocks of one controller's cases, with their conditions."""
     return [{"pressure_bar": c["pressure_bar"], "speed_hz": c["speed_hz"], **c["discrete"]}
-            for c in cases if c["controller"] == method and "discrete" in c]
+            for c in cases if c["controller"] == method and c.get("discrete")]
 
 
 @dataclass

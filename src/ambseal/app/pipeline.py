@@ -653,7 +653,8 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
     # a failed design is judged and reported, not delivered (unless asked for)
     held = {m for m, f in st.failed.items() if f.designed and not st.allow_unstable}
     summaries = export_all(st.designs, {m: g for m, g in st.digitals.items() if m not in held},
-                           case_dicts, out / "controllers", st.failed, st.allow_unstable)
+                           case_dicts, out / "controllers", st.failed, st.allow_unstable,
+                           [s.to_dict() for s in stability])
     for m, summary in summaries.items():
         summary["capacity"] = capacity.get(m)
     rejections = _rejections(st, summaries) if cfg.design.rejection.enabled else {}

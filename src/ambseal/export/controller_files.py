@@ -144,10 +144,22 @@ def loop_verdict(judged=None, failure: str | None = None, allow_unstable: bool =
         text += "; exported as asked (--allow-unstable)" if allow_unstable else ""
     elif rows and all(r.get("stable") for r in rows):
         holds, text = True, (f"holds as it runs at every judged condition ({len(rows)}: "
-                             + "; ".join(where) + ")")
+                             + _span(rows) + ")")
     else:
         holds, text = None, "not judged"
     return {"loop_holds": holds, "allow_unstable": bool(allow_unstable), "verdict": text}
+
+
+def _span(rows) -> str:
+    """The judged conditions in few words: per pressure, the speed or the speeds' span."""
+    by: dict = {}
+    for r in rows:
+        if "pressure_bar" in r and "speed_hz" in r:
+            by.setdefault(float(r["pressure_bar"]), []).append(float(r["speed_hz"]))
+    if not by:
+        return "the judged conditions"
+    return "; ".join(f"{p:g} bar, {min(f):g} Hz" if min(f) == max(f) else
+                     f"{p:g} bar, {min(f):g}–{max(f):g} Hz" for p, f in by.items())
 
 
 def controller_document(ctrl, judged=None, verdict: dict | None = None) -> dict:

@@ -156,9 +156,12 @@ def _check(key: str, kind: str, table: dict, where: str) -> None:
             raise ConfigError(f"{where}: {key}: {name} = {table[name]!r} (expected a finite "
                               "number)")
     for name in _MAY.get(kind, ()):
-        if table.get(name) is not None and not _number(table[name]):
-            raise ConfigError(f"{where}: {key}: {name} = {table[name]!r} (expected a finite "
-                              "number)")
+        v = table.get(name)
+        # a bearing's AMB setting may be tabulated like its coefficients (a list)
+        flat = np.asarray(v, dtype=object).ravel() if kind == "bearing" and isinstance(
+            v, list) else [v]
+        if v is not None and not (len(flat) and all(_number(x) for x in flat)):
+            raise ConfigError(f"{where}: {key}: {name} = {v!r} (expected a finite number)")
     if kind == "PointMass" and table.get("m") is None and (
             table.get("mx") is None or table.get("mx") != table.get("my")):
         raise ConfigError(f"{where}: {key}: missing 'm' (a PointMass needs its mass m, or "

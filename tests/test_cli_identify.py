@@ -36,6 +36,38 @@ def test_acquire_writes_csv_and_sidecar(record):
     assert header[0] == "time_s" and len(header) == 1 + 4 * 4
 
 
+def test_acquire_levitates_with_a_controller_file(tmp_path, capsys, testrig_digital):
+    """``acquire --controller FILE``: the facility runs the file's controller as it runs
+    (its discrete matrices, in the record's metadata bit for bit, and the fit reads them
+    back from there) instead of the reference PID; a file of another rig's channels is
+    refused naming the file, before any simulation."""
+    from ambseal.export.controller_files import export_controller
+    from ambseal.design import controller_from_metadata
+    from ambseal.identify import load_measurement
+
+    path = export_controller(testrig_digital["mu"], tmp_path / "K_mu.json")
+    out = tmp_path / "rec.csv"
+    assert main(["--quiet", "acquire", RIG, "--truth", TRUTH, "--excitation", "prbs",
+                 "--duration-s", "0.2", "--pressure-bar", "0", "--out", str(out),
+                 "--controller", str(path)]) == 0
+    meas = load_measurement(out)
+    assert meas.metadata["controller"]["type"] != "pid"
+    K = controller_from_metadata(dict(meas.metadata), meas.axes, str(out))
+    d = testrig_digital["mu"].discrete
+    for X, Y in zip((K.A, K.B, K.C, K.D), (d.A, d.B, d.C, d.D)):
+        np.testing.assert_array_equal(np.asarray(X), np.asarray(Y))
+    doc = json.loads(path.read_text())
+    doc["inputs"] = ["y_A_zeta", "y_A_eta", "y_C_zeta", "y_C_eta"]
+    other = tmp_path / "K_other.json"
+    other.write_text(json.dumps(doc))
+    capsys.readouterr()
+    code = main(["acquire", RIG, "--truth", TRUTH, "--excitation", "prbs", "--pressure-bar",
+                 "0", "--out", str(tmp_path / "rec2.csv"), "--controller", str(other)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and str(other) in err and "\n" not in err
+    assert not (tmp_path / "rec2.csv").exists()
+
+
 def test_identify_writes_fit_and_a_rig_the_other_commands_accept(record, tmp_path, capsys):
     """`identify` fits named parameters, writes fit.json and an identified rig file that
     `load_rig` reads; the estimate is near the truth file's value (205 N/A)."""

@@ -176,14 +176,24 @@ def _every_file_through_every_command(rig: Path, out: Path, tmp: Path, capsys) -
     the run exported (every kind and format) through ``export``, and the JSON one through
     ``modes``, ``campbell`` and ``sweep`` at the nominal point (and ``signoff`` for a rig
     with stages, once): each exits 0 with a JSON line saying what it did, without a
-    traceback."""
+    traceback. A controller whose files say its judged loop does not hold (the test rig's
+    reference PID, lost at 4.08 bar) is refused by ``export`` in one line, and exported
+    with ``--allow-unstable``."""
     cfg = load_rig(rig)
     p, f = cfg.operating.pressure_bar, abs(cfg.operating.speed_rpm) / 60.0
     files = sorted((out / "controllers").glob("controller_*.*"))
     assert files
     signed = False
     for path in files:
-        runs = [["export", rig, "--out", tmp / f"ex_{path.name}"]]
+        doc = json.loads(path.with_suffix(".json").read_text())
+        holds = doc["loop_holds"]
+        if holds == "no" and "unstable" in doc["verdict"]:  # export judges the loop alone
+            code = main(["--quiet", "export", str(rig), "--out", str(tmp / "refused"),
+                         "--controller", str(path)])
+            err = capsys.readouterr().err.strip()
+            assert code == 2 and "\n" not in err and "--allow-unstable" in err, err
+        runs = [["export", rig, "--out", tmp / f"ex_{path.name}",
+                 *(["--allow-unstable"] if holds == "no" else [])]]
         if path.suffix == ".json":
             runs += [["modes", rig, "--json", "--pressure-bar", p, "--speed-rpm", 60.0 * f],
                      ["campbell", rig, "--pressure-bar", p, "--speed-hz", f"0:{f:g}:2",
@@ -331,27 +341,29 @@ def test_a_rig_with_one_amb_and_a_plain_bearing_runs_or_is_refused_plainly(tmp_p
 @pytest.mark.slow
 def test_the_manuals_compressor_is_judged_from_standstill_to_the_top_speed(tmp_path, capsys):
     """The manual's compressor (docs/rigs/compressor.toml, 150 Hz, range 60–165 Hz): its μ,
-    robust to the seals' k but not to the piston's K, loses a rigid-body mode at 0 bar at
-    every speed (measured), so the run marks it failed with those conditions and exits 1 —
-    instead of calling it zone A at 30 and 60 bar alone. H∞, designed at 30 bar, loses the
-    rotor at 0 bar; redesigned there (the first remedy) with a damping margin on its 348 Hz
-    mode, which the plain design loses at standstill, it holds everywhere. The LPV on speed
-    holds everywhere. Every controller is closed at each judged pressure from 0 to 165 Hz
-    in quarters."""
+    designed at the nominal pressure, robust to the seals' k but not to the piston's K,
+    loses a rigid-body mode at 0 bar; the run's first remedy designs it at 0 bar, keeping
+    the seal uncertainty at the width it spans at the nominal pressure (where k is 0, ±100 %
+    of it has none: that retry had failed on the default it chose), and that μ holds at
+    every judged pressure and speed, so nothing is failed and the run exits 0. H∞, designed
+    at 30 bar, loses the rotor at 0 bar; redesigned there (the first remedy) with a damping
+    margin on its 348 Hz mode, which the plain design loses at standstill, it holds
+    everywhere. The LPV on speed holds everywhere. Every controller is closed at each judged
+    pressure from 0 to 165 Hz in quarters."""
     rig = Path(__file__).resolve().parents[1] / "docs" / "rigs" / "compressor.toml"
     code = main(["--quiet", "run", str(rig), "--no-identify", "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err
-    assert code == 1 and "Traceback" not in err
+    assert code == 0 and "Traceback" not in err
     m = json.loads((tmp_path / "o" / "metrics.json").read_text())
     validate_metrics(m)
     speeds = {c["speed_hz"] for c in m["stability"]}
     assert speeds == {0.0, 41.25, 60.0, 82.5, 123.75, 165.0}
-    mu_bad = [c for c in m["stability"] if c["controller"] == "mu" and not c["stable"]]
-    assert {c["speed_hz"] for c in mu_bad} == speeds and {c["pressure_bar"] for c in mu_bad} \
-        == {0.0}
-    assert all(c["label"] in m["failed"]["mu"]["conditions"] for c in mu_bad)
-    assert "μ: not delivered" in err and "hinf" not in m["failed"]
+    assert m["failed"] == {}
+    mu = m["controllers"]["mu"]
+    assert mu["pressure_bar"] == 0.0 and mu["remedy"].startswith("designed at 0 bar: ")
+    assert "lost the loop at 0 bar" in mu["remedy"]
     assert any("damping there lowered" in s for s in m["controllers"]["hinf"]["steps"])
-    assert all(c["stable"] and c["discrete"]["stable"] for c in m["stability"]
-               if c["controller"] == "hinf")
+    for method in ("mu", "hinf"):
+        assert all(c["stable"] and c["discrete"]["stable"] for c in m["stability"]
+                   if c["controller"] == method)
     _lpv_holds_everywhere(m)

@@ -101,10 +101,11 @@ def _truth_of(cfg) -> dict:
     return values
 
 
-#: Rigs identified at standstill, as they are commissioned: their reference PID loses the
-#: rotor at the operating speed (the flywheel's nutation mode, tests/test_examples.py's
-#: PID_LOSES), so the record is taken where it levitates it.
-AT_STANDSTILL = {"flywheel"}
+#: Rigs identified at standstill, as they are commissioned, levitated by the controller the
+#: run delivers: their reference PID cannot run on the target (the flywheel's loses its
+#: bending modes as it runs at every speed, tests/test_examples.py's PID_LOSES), so the
+#: record is taken with the run's LPV (``acquire --controller``) where it holds the rotor.
+AT_STANDSTILL = {"flywheel": "lpv"}
 
 
 @pytest.mark.slow
@@ -125,7 +126,12 @@ def test_identification_on_every_example(rig, tmp_path, capsys):
                      "[truth.parameters]\n"
                      + "".join(f'"{k}" = {t!r}\n' for k, (_, t) in values.items()))
     record, fit = tmp_path / "prbs0.csv", tmp_path / "fit"
-    still = ["--speed-hz", "0"] if getattr(rig, "stem", "") in AT_STANDSTILL else []
+    still = []
+    method = AT_STANDSTILL.get(getattr(rig, "stem", ""))
+    if method is not None:  # the controller the run delivers, as it runs at standstill
+        main(["--quiet", "run", str(rig), "--no-identify", "--out", str(tmp_path / "run")])
+        ctrl = tmp_path / "run" / "controllers" / f"controller_{method}.json"
+        still = ["--speed-hz", "0", "--controller", str(ctrl)]
     assert main(["--quiet", "acquire", str(rig), "--truth", str(truth), "--excitation",
                  "prbs", "--pressure-bar", "0", "--out", str(record), *still]) == 0
     code = main(["--quiet", "identify", str(rig), str(record), "--out", str(fit),

@@ -20,7 +20,8 @@ Commands
     Stability and performance map; serial or on Dask.
 ``ambseal import-ross FILE --out RIG [--speed-rpm N]``
     A ROSS rotor file as an ambseal rig file.
-``ambseal acquire RIG --truth TRUTH --excitation prbs|sine|chirp|impulse --pressure-bar P --out FILE``
+``ambseal acquire RIG --truth TRUTH --excitation prbs|sine|chirp|impulse --pressure-bar P --out FILE
+[--controller C]``
     A record from the virtual test facility (CSV + JSON sidecar, or .mat).
 ``ambseal design [RIG] --method pid|hinf|mu|lpv [--out DIR] [--set design.KEY=VALUE ...]``
     Design a controller on the rig's reduced model; write it (continuous, Tustin and ZOH at
@@ -230,6 +231,10 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("--axes", default=None, help="excited axes, e.g. A_zeta,B_zeta (default all)")
     a.add_argument("--clock-period-s", type=_positive, default=None,
                    help="PRBS clock period (s; default 10 controller samples)")
+    a.add_argument("--controller", default=None,
+                   help="levitate the facility with this controller file (written by "
+                        "ambseal; as it runs at the record's speed and pressure) instead of "
+                        "the rig's reference PID, e.g. where that PID cannot run")
     a.add_argument("--speed-hz", type=_finite, default=None,
                    help="spin speed of the run (Hz; default the rig's operating speed; "
                         "standstill up to the top of [operating] speed_range_hz)")

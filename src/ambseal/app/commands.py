@@ -33,7 +33,7 @@ from ambseal.design import (
     reference_pid,
 )
 from ambseal.errors import ConfigError, DataError, IdentificationError, SynthesisError
-from ambseal.export import export_controller, loop_verdict, write_c
+from ambseal.export import export_controller, load_controller, loop_verdict, write_c
 from ambseal.files import writable_folder, write_json, write_text
 from ambseal.identify import (
     MISMATCH,
@@ -420,6 +420,38 @@ def identification_stage(cfg, truth, out: Path, say, controller,
     return Identified(summary, figs, sections, res, design_cfg, truth_rig(cfg, truth))
 
 
+def discrete_as_runs(cfg, digital, speed_rad_s: float, pressure_bar: float):
+    """The discrete controller a digital one runs as at a speed and pressure drop: a fixed
+    one's own, a scheduled table's entry at the speed or at the seal coefficient of that
+    pressure drop (:meth:`~ambseal.machine.ScheduledDigital.discrete_at`)."""
+    if not isinstance(digital, ScheduledDigital):
+        return digital.discrete
+    return digital.discrete_at(digital.theta_at(speed_rad_s,
+                                                seal_values(cfg.seal, pressure_bar)))
+
+
+def levitating_controller(cfg, path, speed_hz: float | None, pressure_bar: float):
+    """The controller of a file ambseal wrote (:func:`ambseal.export.load_controller`) as
+    it runs on the virtual facility at a speed (Hz; default the operating speed) and
+    pressure drop (bar): ``acquire --controller`` levitates a rig with it where the
+    reference PID cannot (a continuous file is discretised for the rig's target first, as
+    ``design`` does).
+
+    Raises
+    ------
+    DataError, ConfigError
+        A file that is not this rig's controller, or one the target cannot run."""
+    ctrl = load_controller(path, channel_names(cfg))
+    if not hasattr(ctrl, "discrete"):
+        try:
+            ctrl = digital_for(cfg, "file", ctrl, None, operating_points(design_spec(cfg)))
+        except ConfigError as exc:
+            raise ConfigError(f"{path} holds a continuous controller, which acquire "
+                              f"discretises for the rig's target: {exc}") from None
+    f = abs(cfg.operating.speed_rpm) / 60.0 if speed_hz is None else float(speed_hz)
+    return discrete_as_runs(cfg, ctrl, 2 * math.pi * f, pressure_bar)
+
+
 def facility_impulses(cfg, truth, ident: Identified, digitals: dict, out: Path) -> None:
     """Each digital controller on the virtual facility and on the identified model: impulse
     responses at 0 bar and the nominal pressure drop (P5 Figs. 15–16), into ``ident``'s
@@ -428,11 +460,10 @@ def facility_impulses(cfg, truth, ident: Identified, digitals: dict, out: Path) 
     w = 2 * math.pi * cfg.operating.speed_rpm / 60.0
 
     def as_runs(d):
-        """The discrete controller at a pressure drop: a scheduled table's entry at the
-        operating speed, or at the seal coefficient of that pressure drop."""
+        """The discrete controller at a pressure drop (:func:`discrete_as_runs`)."""
         if not isinstance(d, ScheduledDigital):
             return d.discrete
-        return lambda p: d.discrete_at(d.theta_at(w, seal_values(cfg.seal, p)))
+        return lambda p: discrete_as_runs(cfg, d, w, p)
 
     ctrls = {m: as_runs(d) for m, d in digitals.items()}
     checks = impulse_checks(cfg, ident.result.identified, truth, ctrls,

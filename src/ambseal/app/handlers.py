@@ -24,6 +24,7 @@ from ambseal.app.commands import (
     digital_for,
     identify_files,
     judged_as_runs,
+    levitating_controller,
     show_defaults,
     target_pid,
     track_files,
@@ -115,8 +116,11 @@ def _acquire_cmd(args: argparse.Namespace) -> int:
                          duration_s=duration, **common)
     except ValueError as exc:
         raise ConfigError(f"acquire: {exc}") from None
+    # a controller file's errors name the file; the reference PID's, the truth file's run
+    levitating = None if args.controller is None else levitating_controller(
+        cfg, args.controller, args.speed_hz, args.pressure_bar)
     try:
-        meas = acquire(cfg, truth, ex, controller=target_pid(cfg),
+        meas = acquire(cfg, truth, ex, controller=levitating or target_pid(cfg),
                        pressure_bar=args.pressure_bar, seed=args.seed,
                        speed_hz=args.speed_hz)
     except AmbsealError as exc:  # the simulation runs on the truth file's values

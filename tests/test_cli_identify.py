@@ -68,6 +68,31 @@ def test_acquire_levitates_with_a_controller_file(tmp_path, capsys, testrig_digi
     assert not (tmp_path / "rec2.csv").exists()
 
 
+def test_a_record_whose_controller_cannot_hold_its_rotor_is_refused_by_name(tmp_path, capsys):
+    """A short record's controller metadata with one state coupled by −1e12 (two cases the
+    long fuzz of records found): the closed-loop model's residuals overflow, and the
+    optimiser's Jacobian, or the error budget's score test, is not finite. ``identify``
+    ends in one line naming the record, exit 2; it had ended in SciPy's ValueError
+    traceback, or in a line naming no file."""
+    rec = tmp_path / "prbs.csv"
+    assert main(["--quiet", "acquire", RIG, "--truth", TRUTH, "--excitation", "prbs",
+                 "--duration-s", "0.03", "--pressure-bar", "0", "--out", str(rec),
+                 "--seed", "2"]) == 0
+    meta = json.loads(rec.with_name(rec.name + ".json").read_text())
+    for col in (4, 2):
+        bad = tmp_path / f"r{col}.csv"
+        bad.write_text(rec.read_text())
+        doc = json.loads(json.dumps(meta))
+        doc["controller"]["state_space"]["A"][0][col] = -1e12
+        bad.with_name(bad.name + ".json").write_text(json.dumps(doc))
+        capsys.readouterr()
+        code = main(["identify", RIG, str(bad), "--params", "A.Ki_zeta", "--no-refine",
+                     "--out", str(tmp_path / f"o{col}")])
+        err = capsys.readouterr().err.strip()
+        assert code == 2 and "\n" not in err and "Traceback" not in err, err
+        assert str(bad) in err or str(tmp_path / f"o{col}") in err, err
+
+
 def test_identify_writes_fit_and_a_rig_the_other_commands_accept(record, tmp_path, capsys):
     """`identify` fits named parameters, writes fit.json and an identified rig file that
     `load_rig` reads; the estimate is near the truth file's value (205 N/A)."""

@@ -32,7 +32,8 @@ from ambseal.design import (
     pid_description,
     reference_pid,
 )
-from ambseal.errors import ConfigError, DataError, IdentificationError, SynthesisError
+from ambseal.errors import (ConfigError, DataError, IdentificationError, SynthesisError,
+                            with_source)
 from ambseal.export import export_controller, load_controller, loop_verdict, write_c
 from ambseal.files import writable_folder, write_json, write_text
 from ambseal.identify import (
@@ -618,6 +619,18 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
         records.append(meas)
         controllers.append(controller_from_metadata(dict(meas.metadata), axes, str(path)))
     _check_records(records, data)
+    sources = [str(d) for d in data]
+    try:  # the fit's errors name the records it was made from
+        return _identify_and_write(cfg, records, controllers, names, data, out,
+                                   current_weight, refine, accept_unconverged, static_load,
+                                   accept_implausible)
+    except IdentificationError as exc:
+        raise with_source(exc, [*sources, out], ", ".join(sources)) from None
+
+
+def _identify_and_write(cfg, records, controllers, names, data, out, current_weight,
+                        refine, accept_unconverged, static_load, accept_implausible) -> dict:
+    """The fit of :func:`identify_files` and its files."""
     sources = [str(d) for d in data]
     res = identify(cfg, records, names, current_weight=current_weight, refine=refine,
                    controllers=controllers, budget=True, sources=sources)

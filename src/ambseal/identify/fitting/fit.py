@@ -462,8 +462,14 @@ def _solve(residuals, x0, r0, bounds, max_nfev: int):
         return residuals(x) if r is None else r.copy()
 
     # scipy's default tolerances: 1e-10 took 35 % more evaluations, moved estimates < 1e-3 SE
-    return least_squares(cost, x0, bounds=bounds, method="trf", x_scale=1.0,
-                         max_nfev=max_nfev, xtol=1e-8, ftol=1e-8, gtol=1e-8)
+    try:
+        return least_squares(cost, x0, bounds=bounds, method="trf", x_scale=1.0,
+                             max_nfev=max_nfev, xtol=1e-8, ftol=1e-8, gtol=1e-8)
+    except ValueError as exc:  # residuals so large that their differences overflow
+        raise IdentificationError(
+            f"fit: the residuals' Jacobian is not finite ({exc}): the records' closed-loop "
+            "model cannot follow them (a record whose controller does not hold its rotor, "
+            "or implausible values)") from None
 
 
 def _blocks_at(sol, residual_blocks, shapes) -> list:

@@ -59,6 +59,7 @@ Conventions: rad/s inside, Hz at the edges (``*_hz``); results are frozen datacl
 ``to_dict()`` (JSON-safe, ``inf`` → ``"inf"``, ``NaN`` → ``None``).
 """
 
+from ambseal.analysis.signoff import _FROM as _SIGNOFF
 from ambseal.lazy import lazy_face
 
 #: Each public name (``__all__``) and the module that defines it.
@@ -81,14 +82,8 @@ _FROM = {
     "IsoAssessment": "iso", "ZONES": "iso", "ZONE_LIMITS": "iso", "frozen_at": "judge",
     "judge_case": "judge", "judge_jobs": "judge", "judge_settings": "judge",
     "judge_spinup": "judge", "operating_points": "judge", "points_for": "judge",
-    "level1_screening": "signoff.level1", "stage_cross_coupling": "signoff.level1",
-    "Level1": "signoff.level1", "level2_analysis": "signoff.level2",
-    "Level2": "signoff.level2", "sign_off": "signoff.verdict",
-    "SignOff": "signoff.verdict", "verdict_line": "signoff.verdict",
-    "critical_speeds_hz": "signoff.verdict", "iso14839_2_zones": "signoff.iso_vibration",
-    "IsoVibration": "signoff.iso_vibration",
-    "api617_unbalance": "signoff.unbalance_api617",
-    "Api617Unbalance": "signoff.unbalance_api617",
+    # the sign-off's names, as its own face lists them
+    **{name: f"signoff.{module}" for name, module in _SIGNOFF.items()},
     "synchronous_response": "synchronous", "Unbalance": "synchronous",
     "speed_scheduled": "judge", "unstable_open_loop_poles": "judge", "JudgeJob": "judge",
     "JudgeSettings": "judge", "JudgedCase": "judge", "LoopJudgement": "judge",

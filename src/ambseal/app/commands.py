@@ -621,17 +621,16 @@ def identify_files(rig: str | Path, data: list[str], names: list[str], out_dir: 
     _check_records(records, data)
     sources = [str(d) for d in data]
     try:  # the fit's errors name the records it was made from
-        return _identify_and_write(cfg, records, controllers, names, data, out,
+        return _identify_and_write(cfg, records, controllers, names, sources, out,
                                    current_weight, refine, accept_unconverged, static_load,
                                    accept_implausible)
     except IdentificationError as exc:
         raise with_source(exc, [*sources, out], ", ".join(sources)) from None
 
 
-def _identify_and_write(cfg, records, controllers, names, data, out, current_weight,
+def _identify_and_write(cfg, records, controllers, names, sources, out, current_weight,
                         refine, accept_unconverged, static_load, accept_implausible) -> dict:
-    """The fit of :func:`identify_files` and its files."""
-    sources = [str(d) for d in data]
+    """The fit of :func:`identify_files` and its files (``sources``: the records' paths)."""
     res = identify(cfg, records, names, current_weight=current_weight, refine=refine,
                    controllers=controllers, budget=True, sources=sources)
     spread = record_spread(cfg, records, names, res, controllers=controllers,
@@ -670,7 +669,7 @@ def _identify_and_write(cfg, records, controllers, names, data, out, current_wei
     est = dict(zip(res.names, res.estimate))
     lag = est.pop("tau_s", None)  # the sensors' lag: no rig-file value, told in the header
     identified = rig_with_values(cfg, est)
-    header = (f"Identified by ambseal from {', '.join(str(d) for d in data)}\n"
+    header = (f"Identified by ambseal from {', '.join(sources)}\n"
               f"parameters: {', '.join(res.names)}; converged: {res.converged}\n"
               + (f"sensor lag tau_s = {lag:.4g} s (fitted; the rig file has no key for it: "
                  "the model the controllers are designed on leaves it out)\n"

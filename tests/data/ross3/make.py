@@ -83,10 +83,13 @@ API617 = {"rotor_example": 9000.0, "compressor_example": 12000.0}
 def api617_placements() -> dict:
     """ROSS 3.1's ``api617_unbalance`` of its own examples: per mode the damped frequency
     (rad/s), the unbalances' axial positions (m), magnitudes (kg·m), phases (rad) and the
-    loads W (kg)."""
-    out = {"ross_version": rs.__version__}
+    loads W (kg); under ``journal_loads`` each example's journal static loads ``[[z m, kg],
+    …]`` as ``run_static`` gives them (its bearings' reactions over g)."""
+    out = {"ross_version": rs.__version__, "journal_loads": {}}
     for name, rpm in API617.items():
         rotor = getattr(rs, name)()
+        out["journal_loads"][name] = [[float(rotor.nodes_pos[n]), w] for n, w in
+                                      sorted(rotor._journal_bearing_loads().items())]
         rows = []
         for mode in range(3):
             u = rotor.api617_unbalance(mode, rpm * np.pi / 30, num_modes=24)

@@ -109,11 +109,18 @@ def check_report_agrees(out: Path) -> None:
         bad = sum(_unstable(c) for c in speed)
         over = row[head[1]]
         if speed and not bad:
-            # what was judged, no more: standstill only where 0 Hz was among the speeds
-            hz = sorted({c["speed_hz"] for c in [*cases, *speed]})
+            # what was judged, no more: standstill only where 0 Hz was among the speeds;
+            # lost at the judged conditions, only the speed range's speeds hold
+            lost_judged = all(not c["stable"] for c in cases)
+            hz = sorted({c["speed_hz"] for c in [*([] if lost_judged else cases), *speed]})
             span = (f"standstill to {hz[-1]:g} Hz" if hz[0] == 0 else
                     f"{hz[0]:g}–{hz[-1]:g} Hz (standstill not judged)")
-            assert over.endswith(span), (over, span)
+            if lost_judged:
+                n = len(speed)
+                assert over == (f"none; stable at {'its' if n > 1 else 'the'} {n} speed-range "
+                                f"condition{'s' if n > 1 else ''} ({span})"), (over, span)
+            else:
+                assert over.endswith(span), (over, span)
         elif bad:
             assert f"unstable at {bad} of {len(speed)} speed-range conditions" in over, over
 

@@ -122,6 +122,14 @@ def test_verdict_holds_only_where_the_machine_runs_up_too():
     # lost at its judged condition too: "none" of those, and the speed range still counted
     lost = verdicts([dict(case, stable=False)], None, st)[0]
     assert lost.stable_range == "none; unstable at 2 of 3 speed-range conditions"
+    # lost at its judged condition only: not "none" alone, the range that holds named
+    held = verdicts([dict(case, stable=False)], None, st[2:])[0]
+    assert held.stable_range == ("none; stable at the 1 speed-range condition "
+                                 "(100–100 Hz (standstill not judged))")
+    fine = [dict(s, stable=True, discrete={"stable": True}) for s in st]
+    both = verdicts([dict(case, stable=False)], None, fine)[0]
+    assert both.stable_range == ("none; stable at its 3 speed-range conditions "
+                                 "(standstill to 100 Hz)")
     good = verdicts([case], None, st[2:])[0]
     assert good.zone_sigma == case["iso_zone"]
     assert good.zone_axis == "B" and good.stable_range == "2.04 bar, standstill to 100 Hz"

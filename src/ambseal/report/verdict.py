@@ -123,6 +123,9 @@ class Verdict:
     speeds_hz : tuple of float
         Every speed (Hz) the loop was judged at, in full or for stability only, sorted:
         what the verdict may claim of the speed range (standstill only if 0 is among them).
+    range_hz : tuple of float
+        The speeds (Hz) of the speed-range conditions alone (``metrics["stability"]``),
+        sorted.
     criticals : tuple of dict
         The loop's critical speeds inside the continuous speed range or within API 617's
         separation margin (the cases' ``critical_speeds``, continuous and as it runs, one
@@ -151,6 +154,7 @@ class Verdict:
     axes_alike: bool = True
     capacity: dict | None = None
     speeds_hz: tuple[float, ...] = ()
+    range_hz: tuple[float, ...] = ()
     criticals: tuple = ()
     speed_graded: bool = False
 
@@ -172,12 +176,13 @@ class Verdict:
         what = "a critical speed" if len(parts) == 1 else "critical speeds"
         return f"{what} (1× crossing, AF ≥ 2.5) at " + "; ".join(parts)
 
-    def speed_span(self) -> str:
-        """The judged speeds in words: ``"standstill to 1000 Hz"``, or ``"333–1000 Hz
-        (standstill not judged)"`` when 0 Hz was not among them."""
-        if not self.speeds_hz:
+    def speed_span(self, speeds_hz: tuple[float, ...] | None = None) -> str:
+        """The judged speeds (or ``speeds_hz``) in words: ``"standstill to 1000 Hz"``, or
+        ``"333–1000 Hz (standstill not judged)"`` when 0 Hz was not among them."""
+        speeds_hz = self.speeds_hz if speeds_hz is None else speeds_hz
+        if not speeds_hz:
             return "the judged speeds"
-        lo, hi = self.speeds_hz[0], self.speeds_hz[-1]
+        lo, hi = speeds_hz[0], speeds_hz[-1]
         if lo == 0:
             return f"standstill to {hi:g} Hz"
         return f"{lo:g}–{hi:g} Hz (standstill not judged)"
@@ -196,10 +201,15 @@ class Verdict:
     def stable_range(self) -> str:
         """:attr:`judged_range`, with the speed range: ``"…, standstill to top speed"``, or
         how many of its conditions the loop is unstable at (also after ``"none"``: a loop
-        lost at every judged condition may still hold some of the speed range)."""
+        lost at every judged condition may still hold some of the speed range, and says
+        where: ``"none; stable at its 5 speed-range conditions (standstill to 394 Hz)"``)."""
         text = self.judged_range
         if text == "none" and not self.speed_unstable:
-            return text
+            if not self.speed_checked:
+                return text
+            n = self.speed_checked
+            return (f"{text}; stable at {'its' if n > 1 else 'the'} {n} speed-range "
+                    f"condition{'s' if n > 1 else ''} ({self.speed_span(self.range_hz)})")
         if self.speed_unstable:
             text += (f"; unstable at {len(self.speed_unstable)} of {self.speed_checked} "
                      f"speed-range conditions")
@@ -375,6 +385,8 @@ def _verdict(name: str, cs: list, by_speed: bool, sc: list,
         axes_alike=len(stable_zones) <= 1, capacity=design.get("capacity"),
         speeds_hz=tuple(sorted({float(c["speed_hz"]) for c in [*cs, *sc]
                                 if c.get("speed_hz") is not None})),
+        range_hz=tuple(sorted({float(c["speed_hz"]) for c in sc
+                               if c.get("speed_hz") is not None})),
         criticals=_criticals(cs), speed_graded=any(c.get("iso_zone") for c in sc))
 
 

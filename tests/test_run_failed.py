@@ -76,6 +76,29 @@ def test_loop_failure_names_the_least_stable_mode():
     assert derived.reason.startswith("PID (reference, derived from the rig): fails — ")
 
 
+def test_a_loop_lost_only_to_the_delays_pade_approximation_says_so():
+    """A condition whose continuous loop (the delay as its Padé approximation) loses a mode
+    that the loop as it runs keeps is still a failure, worded as what was found: the Padé
+    loop unstable there, the sampled one holding — not "the full-order loop is unstable",
+    which ``export --controller`` (judging the file as it runs) would then contradict."""
+    w = 2 * math.pi * 1323.0
+    bad = np.array([0.3 + 1j * w, 0.3 - 1j * w])
+    held = SampledStability(True, 0.9994, 1e4)
+    f = loop_failure("pid", [(_case(0.0, False, "0 bar", discrete=held), {"poles": bad})],
+                     designed=False, derived=True)
+    zeta = f"{-0.3 / abs(bad[0]):.2g}".replace("-", "−")
+    assert f.reason == ("PID (reference, derived from the rig): fails — the full-order loop "
+                        "with the delay as its Padé approximation is unstable at 0 bar (mode "
+                        f"at 1323 Hz, ζ = {zeta}), though as it runs on the target (sampled, "
+                        "delayed) it holds there")
+    assert f.conditions == ["0 bar"]
+    # lost as it runs too: the full-order loop is unstable
+    lost = SampledStability(False, 1.0003, 1e4)
+    g = loop_failure("pid", [(_case(0.0, False, "0 bar", discrete=lost), {"poles": bad})],
+                     designed=False, derived=True)
+    assert "fails — the full-order loop is unstable at 0 bar (mode at 1323 Hz" in g.reason
+
+
 def test_many_unstable_conditions_are_listed_with_the_least_stable_mode():
     """Beyond four unstable conditions the line lists them and names the mode of the one
     with the rightmost pole (σ = 2 of 0.1–2 here: a 50 Hz pair, ζ = −2/|λ|, closed form)."""

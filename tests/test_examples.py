@@ -38,8 +38,11 @@ TESTRIG = Path(__file__).resolve().parents[1] / "examples" / "testrig.toml"
 #: standstill, ζ down to −0.02): H∞ is designed on the one nominal plant and no damping
 #: margin holds it. μ holds it with the modes' frequencies uncertain over their bands. The
 #: run then adds the LPV on speed. (The blower's H∞, designed at 600 Hz, holds its ~930 Hz
-#: bending mode with the damping margin the mode lost at standstill asks for.)
-FAIL_BELOW_TOP = {"overhung_compressor": {"hinf"}, "flywheel": {"hinf", "mu"}}
+#: bending mode with the damping margin the mode lost at standstill asks for.) On the
+#: turboexpander-generator, μ designed at 525 Hz loses a rigid conical mode at and near
+#: standstill (~15 Hz, ζ −0.18) where H∞'s nominal design holds it.
+FAIL_BELOW_TOP = {"overhung_compressor": {"hinf"}, "flywheel": {"hinf", "mu"},
+                  "expander_generator": {"mu"}}
 
 #: Rigs whose reference PID, derived from the rig, loses the rotor at the nominal
 #: condition, measured: on the flywheel, with its integral below the precession, no
@@ -47,8 +50,9 @@ FAIL_BELOW_TOP = {"overhung_compressor": {"hinf"}, "flywheel": {"hinf", "mu"}}
 #: 2 kHz amplifier and the 75 µs hold + delay at every speed, and the notches that do at
 #: standstill cost the nutation (0.44–1.02 kHz) its phase lead; cross-axis gains on each
 #: bearing do not hold it (benchmarks/README.md). Reported, not counted in the exit
-#: status; the LPV on speed holds it.
-PID_LOSES = {"flywheel"}
+#: status; the LPV on speed holds it. On the turboexpander-generator the derived PID
+#: loses the wheel's backward bending mode (~1.3 kHz at the top speed) to the target's lag.
+PID_LOSES = {"flywheel", "expander_generator"}
 
 
 def _lpv_holds_everywhere(metrics: dict) -> None:
@@ -187,7 +191,10 @@ def _every_file_through_every_command(rig: Path, out: Path, tmp: Path, capsys) -
     for path in files:
         doc = json.loads(path.with_suffix(".json").read_text())
         holds = doc["loop_holds"]
-        if holds == "no" and "unstable" in doc["verdict"]:  # export judges the loop alone
+        # export judges the file's loop alone, as it runs: refused where that loop is lost
+        v = doc["verdict"]
+        if holds == "no" and ("full-order loop is unstable" in v or "the loop is unstable" in v
+                              or "unstable at" in v and "Padé" not in v):
             code = main(["--quiet", "export", str(rig), "--out", str(tmp / "refused"),
                          "--controller", str(path)])
             err = capsys.readouterr().err.strip()

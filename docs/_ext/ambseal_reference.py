@@ -307,6 +307,11 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Signoff.probes": ("", "the unbalance response's probes, ``[{ position, angle_deg "
                            "}]``, each reading x cos θ + y sin θ; left out, the orbit's "
                            "semi-major axis at the AMB sensors (the springs without AMBs)"),
+    "Signoff.level1_position_m": ("m", "where Level I applies the whole cross-coupling Q; "
+                                       "left out, mid-span between the outermost bearings "
+                                       "or the overhung stages in proportion to their q_A "
+                                       "(API 617); ROSS 3.1's ``run_level1`` takes the "
+                                       "node nearest mid-span"),
     "Probe.position": ("m", "the probe's axial position (a node of the rotor)"),
     "Probe.angle_deg": ("°", "the direction it reads, from x towards y (default 0)"),
     "Signoff.scale_factor_speeds": ("", "where A_probe is taken: ``to_trip`` (default, "

@@ -113,6 +113,23 @@ def test_q0_of_a_rigid_rotor_on_damped_supports_is_the_closed_form():
     assert np.all(np.diff(r.log_dec) < 0)
 
 
+def test_q_applied_off_mid_span_where_the_rig_file_says():
+    """``[signoff] level1_position_m`` moves the whole Q: on the rigid rotor of the test
+    above the cylindrical mode moves every station alike, so Q a quarter-length from
+    mid-span still loses it at Q_0 = c·√(k/m) (within 1 %, the closed form), now from
+    there; off the rotor the key is refused by name."""
+    import tomllib
+
+    k, c = 1e7, 2000.0
+    doc = tomllib.loads(_rigid_rotor(k, c, 4.5e4))
+    m = math.pi / 4 * 0.2**2 * 0.4 * 7850.0
+    at = level1_screening(parse_rig({**doc, "signoff": {"level1_position_m": 0.1}}))
+    assert at.where_m == ((0.1, 1.0),)
+    assert at.Q_0 == pytest.approx(c * math.sqrt(k / m), rel=0.01)
+    with pytest.raises(ConfigError, match=r"level1_position_m: 9 m is off the rotor"):
+        level1_screening(parse_rig({**doc, "signoff": {"level1_position_m": 9.0}}))
+
+
 def test_screening_outcomes_by_their_rules():
     """The same rotor with a stage about four times larger (Q_0/Q_A = 1.3, δ_A below 0.1)
     fails; one about a sixth of it passes (Q_0 beyond 10·Q_A). Nothing passes without its

@@ -260,31 +260,55 @@ def test_the_ross3_reader_refuses_or_accounts_for_every_element(data):
                              + masses + supports)
 
 
-def test_level1_q0_equals_ross_31(tmp_path, capsys):
-    """API 617 Level I against ROSS 3.1's ``run_level1`` (``tests/data/ross3/level1.json``,
-    written by ``make.py``): ROSS's ``rotor_example`` on two damped bearings, imported,
-    with one stage on its first disk. Between the bearings API 617 applies Q at mid-span
-    (ROSS's node 3, where the reference puts it); the screened mode's log decrement at
-    Q = 0 (ROSS's first mode that does not whirl backward, 15.4 Hz) and at Q_A (δ_A), and
-    Q_0, where it crosses zero (Brent's method on ROSS's own evaluation), agree within 1e-4,
-    1e-4 and 1e-3."""
+#: Level I's references (``make.py``): the test's stage giving ROSS's Q_A, and where Q
+#: is applied — API 617's mid-span on ``rotor_example`` (ROSS's node 3), ROSS's node 27 on
+#: ``compressor_example`` (2.45 cm from mid-span: ``[signoff] level1_position_m``)
+LEVEL1_CASES = {
+    # q_A = 3·(P/Ω)·(ρ_d/ρ_s)/(D_c·H_c) = 3·(2800/600)·2/(0.28·0.01) = 1e4 N/m
+    "level1": ('[[stage]]\ndisk = "Disk 0"\npower = 2800.0\nimpeller_diameter = 0.28\n'
+               "discharge_width = 0.01\nsuction_density = 1.2\ndischarge_density = 2.4\n",
+               ((0.75, 1.0),)),
+    # 3·(400 000π/400π)·2/(0.3·0.02) = 1e6 N/m at 12 000 rpm
+    "level1_compressor": ("[[stage]]\ndisk = \"{disk}\"\npower = 1256637.0614359172\n"
+                          "impeller_diameter = 0.3\ndischarge_width = 0.02\n"
+                          "suction_density = 1.2\ndischarge_density = 2.4\n",
+                          ((0.806, 1.0),)),
+}
+
+
+@pytest.mark.parametrize("name", sorted(LEVEL1_CASES))
+def test_level1_q0_equals_ross_31(name, tmp_path, capsys):
+    """API 617 Level I against ROSS 3.1's ``run_level1`` (``tests/data/ross3/<name>.json``,
+    written by ``make.py``), the ROSS 3 file imported by ambseal's own reader with one
+    stage: ``rotor_example`` on two damped bearings, Q at mid-span where API 617 applies
+    it between bearings (ROSS's node 3); ``compressor_example`` at 12 000 rpm on its
+    bearing tables, its twelve seals left out (Level I; ROSS's ``run_level1`` keeps them,
+    so its reference is ROSS's rule on the rotor without them), Q at ROSS's node 27. The
+    screened mode's log decrement at Q = 0 (ROSS's first mode that does not whirl
+    backward: 15.4 Hz and 106.5 Hz) and at Q_A (δ_A), and Q_0, where it crosses zero
+    (Brent's method on ROSS's own evaluation), agree within 1e-4, 1e-4 and 1e-3."""
     from ambseal.analysis import level1_screening
 
-    ref = json.loads((DATA / "level1.json").read_text())
-    src = tmp_path / "level1.toml"
-    shutil.copy(DATA / "level1.toml", src)
+    ref = json.loads((DATA / f"{name}.json").read_text())
+    assert ref["seals"] is (name == "level1")
+    src = tmp_path / f"{name}.toml"
+    shutil.copy(DATA / f"{name}.toml", src)
     out = tmp_path / "rig.toml"
     rpm = ref["speed_rad_s"] * 30 / np.pi
     assert main(["import-ross", str(src), "--out", str(out), "--speed-rpm", f"{rpm!r}"]) == 0
     capsys.readouterr()
-    # q_A = 3·(P/Ω)·(ρ_d/ρ_s)/(D_c·H_c) = 3·(2800/600)·2/(0.28·0.01) = 1e4 N/m (API 617)
-    out.write_text(out.read_text() + '\n[[stage]]\ndisk = "Disk 0"\npower = 2800.0\n'
-                   "impeller_diameter = 0.28\ndischarge_width = 0.01\n"
-                   "suction_density = 1.2\ndischarge_density = 2.4\n")
+    stage, where = LEVEL1_CASES[name]
+    disk = load_rig(out).disk[0].name
+    text = out.read_text() + "\n" + stage.replace("{disk}", disk)
+    if name == "level1_compressor":  # into the [signoff] table import-ross writes
+        assert text.count("\n[signoff]\n") == 1
+        text = text.replace("\n[signoff]\n", "\n[signoff]\nlevel1_position_m = 0.806\n")
+    out.write_text(text)
     res = level1_screening(load_rig(out))
     assert res.Q_A == pytest.approx(ref["Q_A"], rel=1e-12)
+    assert [w for p in res.where_m for w in p] == pytest.approx([w for p in where for w in p])
+    assert where[0][0] == pytest.approx(ref["position_m"], abs=1e-12)
     assert res.log_dec_A == pytest.approx(ref["log_dec_A"], rel=1e-4)
-    assert res.where_m == ((0.75, 1.0),)  # mid-span of 1.5 m between the bearings
     sweep = res.to_dict()["sweep"]
     assert sweep["Q"][0] == 0.0
     assert sweep["log_dec"][0] == pytest.approx(ref["log_dec_at_0"], rel=1e-4)

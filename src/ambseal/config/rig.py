@@ -603,7 +603,8 @@ class Signoff(_Strict):
     close clearances' allowed ``clearance_fraction``, and ISO 14839-2's zone boundaries
     ``iso14839_2_zones`` (fractions of the backup bearing's clearance C_min); and the
     unbalance response's ``probes`` (``[{ position, angle_deg }]``, directional; left out,
-    the orbit at the AMB sensors or the springs)."""
+    the orbit at the AMB sensors or the springs); and where Level I applies its
+    cross-coupling, ``level1_position_m`` (left out, API 617's place)."""
 
     csr_boundary: list[Annotated[list[float], Field(min_length=2, max_length=2)]] = Field(
         default=[[16.53, 2.5], [60.0, 2.0]], min_length=1, max_length=100)
@@ -621,6 +622,10 @@ class Signoff(_Strict):
     # the API 617 unbalance response's probes: directional, at any node; left out, the
     # orbit's semi-major axis at the AMB sensors (the springs of a rig without AMBs)
     probes: list[Probe] | None = Field(default=None, min_length=1, max_length=100)
+    # where Level I applies the whole cross-coupling Q (m); left out, mid-span between
+    # the outermost bearings, or the overhung stages (API 617); ROSS's run_level1 takes
+    # the node nearest mid-span
+    level1_position_m: float | None = Field(default=None, ge=0, le=1e3)
 
     @model_validator(mode="after")
     def _ordered(self) -> "Signoff":

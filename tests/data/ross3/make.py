@@ -102,12 +102,15 @@ def api617_placements() -> dict:
     return out
 
 
-#: The Level I screening's rotor: ``rotor_example`` on two damped bearings, screened at
-#: 600 rad/s with the cross-coupling at mid-span (node 3), where API 617 applies it for a
-#: rotor between bearings
-LEVEL1_SPEED_RAD_S, LEVEL1_NODE = 600.0, 3
-#: The anticipated cross-coupling δ_A is read at (N/m): the test's stage gives it
-LEVEL1_Q_A = 1e4
+#: The Level I screenings: ``rotor_example`` on two damped bearings, screened at 600 rad/s
+#: with the cross-coupling at mid-span (node 3), where API 617 applies it for a rotor
+#: between bearings; ROSS's ``compressor_example`` at its maximum continuous speed,
+#: 12 000 rpm, with its twelve seals left out as API 617 Level I leaves them (ROSS's
+#: ``run_level1`` keeps them), the cross-coupling at node 27 (0.806 m), the node nearest
+#: mid-span that ROSS takes. Per rotor: (speed rad/s, node, the anticipated Q_A N/m the
+#: test's stage gives, the top of Brent's bracket N/m)
+LEVEL1 = {"level1": (600.0, 3, 1e4, 1e5),
+          "level1_compressor": (400.0 * np.pi, 27, 1e6, 1e7)}
 
 
 def level1_rotor():
@@ -117,28 +120,32 @@ def level1_rotor():
     return rs.Rotor(ex.shaft_elements, ex.disk_elements, bearings)
 
 
-def level1_reference(rotor) -> dict:
-    """ROSS 3.1's ``run_level1`` on ``rotor``: the log decrement of the first mode that
-    does not whirl backward with Q (``k_xy = Q``, ``k_yx = −Q``) at node ``LEVEL1_NODE``,
-    at Q = 0 and its zero Q_0 (Brent's method on ROSS's own evaluation, as
-    ``run_level1`` builds each rotor)."""
+def level1_reference(rotor, speed_rad_s, node, q_a, q_hi, seals=True) -> dict:
+    """ROSS 3.1's ``run_level1`` on ``rotor`` (without its ``SealElement``s unless
+    ``seals``): the log decrement of the first mode that does not whirl backward with Q
+    (``k_xy = Q``, ``k_yx = −Q``) at ``node``, at Q = 0, at ``q_a`` and its zero Q_0
+    (Brent's method on ROSS's own evaluation within [0, ``q_hi``], as ``run_level1``
+    builds each rotor)."""
     from copy import copy
 
     from scipy.optimize import brentq
 
+    kept = [b for b in rotor.bearing_elements if seals or not isinstance(b, rs.SealElement)]
+
     def first(Q):
-        bearings = [copy(b) for b in rotor.bearing_elements]
-        bearings.append(rs.BearingElement(n=LEVEL1_NODE, kxx=0, cxx=0, kxy=Q, kyx=-Q))
+        bearings = [copy(b) for b in kept]
+        bearings.append(rs.BearingElement(n=node, kxx=0, cxx=0, kxy=Q, kyx=-Q))
         r = rotor.__class__(rotor.shaft_elements, rotor.disk_elements, bearings,
                             rotor.point_mass_elements)
-        m = r.run_modal(speed=LEVEL1_SPEED_RAD_S)
+        m = r.run_modal(speed=speed_rad_s)
         non_backward = m.whirl_direction() != "Backward"
         return float(m.log_dec[non_backward][0]), float(m.wd[non_backward][0])
 
-    q0 = brentq(lambda q: first(q)[0], 0.0, 1e5, xtol=1e-6, rtol=1e-12)
-    return {"ross_version": rs.__version__, "speed_rad_s": LEVEL1_SPEED_RAD_S,
-            "node": LEVEL1_NODE, "log_dec_at_0": first(0.0)[0], "wd_at_0": first(0.0)[1],
-            "Q_A": LEVEL1_Q_A, "log_dec_A": first(LEVEL1_Q_A)[0], "Q_0": q0}
+    q0 = brentq(lambda q: first(q)[0], 0.0, q_hi, xtol=1e-6, rtol=1e-12)
+    return {"ross_version": rs.__version__, "speed_rad_s": speed_rad_s, "node": node,
+            "position_m": float(rotor.nodes_pos[node]), "seals": seals,
+            "log_dec_at_0": first(0.0)[0], "wd_at_0": first(0.0)[1],
+            "Q_A": q_a, "log_dec_A": first(q_a)[0], "Q_0": q0}
 
 
 if __name__ == "__main__":
@@ -156,6 +163,8 @@ if __name__ == "__main__":
             (HERE / f"{name}_eigenvalues.json").write_text("{\n" + rows + "\n}\n")
         (HERE / "api617_unbalance.json").write_text(
             json.dumps(api617_placements(), indent=1) + "\n")
-        r = level1_rotor()
-        r.save(HERE / "level1.toml")
-        (HERE / "level1.json").write_text(json.dumps(level1_reference(r), indent=1) + "\n")
+        for name, r, seals in (("level1", level1_rotor(), True),
+                               ("level1_compressor", rs.compressor_example(), False)):
+            r.save(HERE / f"{name}.toml")
+            (HERE / f"{name}.json").write_text(
+                json.dumps(level1_reference(r, *LEVEL1[name], seals=seals), indent=1) + "\n")

@@ -14,8 +14,9 @@ C = 63, HP in hp, D_c and H_c in inches and N in rpm, is the same number in klbf
 
 A cross-coupled stiffness Q (k_xy = Q, k_yx = −Q, destabilising forward whirl) is applied
 at mid-span of a between-bearings rotor, or at each overhung stage in proportion to its
-q_A, at the maximum continuous speed, with the seals left out; Q runs from 0 to 10·Q_A
-(at least). The log decrement δ of the forward mode Q destabilises is taken at each Q.
+q_A (or wholly where ``[signoff] level1_position_m`` puts it: ROSS's ``run_level1``
+takes the node nearest mid-span), at the maximum continuous speed, with the seals left
+out; Q runs from 0 to 10·Q_A (at least). The log decrement δ of the forward mode Q destabilises is taken at each Q.
 ROSS's ``Rotor.run_level1`` takes the lowest-frequency mode that is not backward; under an
 AMB controller that mode is often an overdamped rigid-body mode, or a controller pole with
 a small imaginary part that Q hardly moves, and the lowest log decrement of all would be
@@ -261,9 +262,23 @@ def without_seals(cfg):
 
 
 def _applied_at(cfg, q: list[float]) -> tuple:
-    """(position, share of Q) pairs: mid-span between the outermost bearings, or the
-    overhung stages in proportion to their q_A."""
+    """(position, share of Q) pairs: ``[signoff] level1_position_m`` where given, else
+    mid-span between the outermost bearings, or the overhung stages in proportion to
+    their q_A.
+
+    Raises
+    ------
+    ConfigError
+        A ``level1_position_m`` off the rotor.
+    """
     supports = bearing_positions(cfg)
+    at = cfg.signoff.level1_position_m
+    if at is not None:
+        length = sum(s.length for s in cfg.shaft)
+        if not at <= length:
+            raise ConfigError(f"signoff.level1_position_m: {at:g} m is off the rotor "
+                              f"(0–{length:g} m)")
+        return ((float(at), 1.0),)
     lo, hi = min(supports), max(supports)
     zs = [stage_position(cfg, st) for st in cfg.stage]
     over = [(z, qi) for z, qi in zip(zs, q) if z < lo - 1e-9 or z > hi + 1e-9]

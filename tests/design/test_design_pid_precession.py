@@ -15,6 +15,7 @@ from ambseal.config import load_rig, parse_rig
 from ambseal.design.pid import (
     K_EQ_PER_KS,
     TI_PER_OMEGA_N,
+    gyroscopic_cancellation,
     pid_from_rig,
     pid_of,
     precession_rad_s,
@@ -52,6 +53,40 @@ def test_precession_is_the_rigid_rotors_closed_form(speed_hz):
     assert got == pytest.approx(want, rel=1e-9)
 
 
+def _oscillating_poles(cfg, p: dict, speed_hz: float) -> np.ndarray:
+    """The continuous loop's (no delay) poles with 1 < ω < 2π·500 rad/s, upper half."""
+    pl = build_plant(cfg, speed_rpm=60.0 * speed_hz)
+    cur = pl.current_inputs()
+    K = pid_of(p, channel_names(cfg))
+    mats = ((pl.A, pl.B[:, cur], pl.C, pl.D[:, cur]),
+            tuple(np.asarray(X, float) for X in (K.A, K.B, K.C, K.D)))
+    lam = np.linalg.eigvals(feedback_matrices(*mats)[0])
+    return np.sort_complex(lam[(lam.imag > 1) & (np.abs(lam) < 2 * math.pi * 500)])
+
+
+def test_the_gyroscopic_cancellation_removes_the_conical_split():
+    """I_p/(K_i Σ l²) of the symmetric rigid rotor (AMBs at ±L/2 from its centre of mass)
+    by hand to 1e-9; and a PD with that cross-axis derivative times −Ω on each bearing
+    cancels the gyroscopic moments of the tilt (Brown et al., NASA/TM-2006-214027): at
+    200 Hz the conical pair is back at its standstill frequency (97.09 rad/s) within 1e-4
+    — the derivative filter's lag is the rest — where without it the rotor's gyroscopics
+    split it by an order of magnitude."""
+    cfg = _rigid_rig()
+    _, _, ip = inertia(DISK_M, DISK_IP, DISK_ID)
+    g = gyroscopic_cancellation(cfg)
+    assert g == pytest.approx(ip / (100.0 * 2 * (L / 2) ** 2), rel=1e-9)
+    pd = {"kp": 3000.0, "ti": 1e6, "td": 5e-4, "eps": 1e-3}
+    still = _oscillating_poles(cfg, pd, 0.0)
+    assert still.size == 4  # the cylindrical and the conical pair, x and y alike
+    W = 2 * math.pi * 200.0
+    cancelled = _oscillating_poles(cfg, dict(pd, cross_kd=-g * W), 200.0)
+    conical = cancelled[np.abs(cancelled.imag - still.imag.max()) < 1.0]
+    assert conical.size == 2
+    np.testing.assert_allclose(conical.imag, still.imag.max(), rtol=1e-4)
+    free = _oscillating_poles(cfg, pd, 200.0)
+    assert not np.any(np.abs(free.imag - still.imag.max()) < 1.0)
+
+
 @pytest.fixture(scope="module")
 def flywheel():
     cfg = load_rig(EXAMPLES / "flywheel.toml")
@@ -79,6 +114,11 @@ def test_the_flywheels_integral_keeps_its_precession(flywheel):
     w_p = precession_rad_s(cfg, K_EQ_PER_KS * ks, 2 * math.pi * 1000.0)
     assert p["ti"] == pytest.approx(TI_PER_OMEGA_N / w_p, rel=1e-12)
     assert "the precession" in p["rule"]
+    # no cross gains derived; the rule names the cancellation's scale at the top speed
+    assert not p.get("cross_kd") and not p.get("cross_kp")
+    full = 2 * math.pi * 1000.0 * gyroscopic_cancellation(cfg)
+    assert f"no cross-axis gains (the gyroscopic cancellation Ω I_p/(K_i Σ l²) is {full:.4g}" \
+        in p["rule"]
     assert _low_poles(cfg, p, 333.33).real.max() < 0
     m_b = sum(d.mass for d in cfg.disk) / 2  # a lower bound of half the rotor's mass
     w_n = math.sqrt(K_EQ_PER_KS * ks / m_b)

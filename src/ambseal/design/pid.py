@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+
 from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
@@ -22,7 +24,7 @@ from ambseal.robust import discrete_controller, discretize_as, is_stable, with_d
 __all__ = ["pid_controller", "pid_from_rig", "reference_pid", "reference_controller",
            "ScheduledPid", "scheduled_pid",
            "controller_from_metadata", "filter_matrices", "pid_description", "pid_of",
-           "PID_CORNERS_PER_FS", "precession_rad_s"]
+           "PID_CORNERS_PER_FS", "precession_rad_s", "gyroscopic_cancellation"]
 
 #: the derived PID (no [controller.pid]): k_eq = K_EQ_PER_KS·Ks, ζ on the rigid-body modes,
 #: Ti in rigid-body time constants (P5 Eq. 6, §4.2), set on the precession instead where
@@ -229,6 +231,18 @@ def pid_from_rig(cfg) -> dict:
       Ti = TI_PER_OMEGA_N/ω_p: the same factor below the lowest rigid-body mode at every
       speed; elsewhere that factor stays above TI_PER_OMEGA_N·PRECESSION_DROP = 12.5, and
       Ti is as P5 (the turboexpander's precession, 0.49 ω_n at 300 Hz, keeps it);
+    * cross-axis gains: none derived, on any rotor. The field's cross feedback on a
+      gyroscopic rotor (Brown, Kascak, Jansen, Dever & Duffy, NASA/TM-2006-214027; Ahrens
+      et al. 1996), a cross-axis derivative on each bearing scheduled ∝ Ω at a fraction of
+      the gyroscopic cancellation Ω I_p/(K_i Σ l²) (:func:`gyroscopic_cancellation`),
+      damps the nutation as it runs, but through the derivative filter it shares with the
+      PID it takes the first bending modes' damping: on the flywheel of
+      ``examples/flywheel.toml`` a tenth of it takes the 1.7 kHz pair at 1 000 Hz from
+      ζ −0.017 to −0.055 as it runs, on a stiff-shaft variant the 3.5 kHz pair from
+      +0.0027 to +0.0011, and with this PID the nutation is not the mode that limits it
+      (benchmarks/README.md). Where the precession falls below PRECESSION_DROP·ω_n the
+      rule states the full cancellation at the top speed, the scale of the
+      ``[controller.pid]`` keys ``cross_kd`` and ``cross_speed_rpm`` that give them;
     * derivative filter (the roll-off) for the target: its corner f_d = 1/(2π ε Td) at a
       fraction of the sample rate f_s, at most f_s/5 (two fifths of Nyquist, where Tustin
       warps it by 13 %); the loop as it runs loses (delay_samples + ½)·360°·f/f_s to the
@@ -303,6 +317,11 @@ def pid_from_rig(cfg) -> dict:
                    f"{', f_s/'.join(f'{1 / c:.3g}' for c in PID_CORNERS_PER_FS)} that "
                    f"keeps {KEEP_OF_STRUCTURAL:g} of the structural damping as it runs, "
                    f"else the best); sampling and delay cost {lost:.1f}° at ω_n"}
+    with contextlib.suppress(ConfigError):  # a note only: no lever arm, no note
+        full = 2 * np.pi * top_hz * gyroscopic_cancellation(cfg) if slow else None
+        out["rule"] += "" if full is None else (f"; no cross-axis gains (the gyroscopic cancellation Ω I_p/(K_i Σ "
+                        f"l²) is {full:.4g} A·s/m at {top_hz:.4g} Hz: the scale of "
+                        f"[controller.pid] cross_kd with cross_speed_rpm)")
     fd = None if kept else _filters_for_target(cfg, kp, ti, td, eps, w_n / (2 * np.pi))
     out["filters"] = [dict(f) for f in fd.filters] if fd else []
     if fd and fd.modes:
@@ -313,6 +332,40 @@ def pid_from_rig(cfg) -> dict:
                             f"{fd.least_zeta:.2g})")
     _DERIVED[key] = out
     return dict(out)
+
+
+def gyroscopic_cancellation(cfg) -> float:
+    """The cross-axis derivative gain per unit speed that would cancel a rigid rotor's
+    gyroscopic moments of tilt, decentralised on its AMBs: I_p/(K_i Σ l²), with I_p the
+    rotor's polar moment of inertia, K_i the AMBs' mean current stiffness and l each AMB's
+    distance from the centre of mass (Brown et al., NASA/TM-2006-214027: the bearing
+    pair's cross forces k_c·Ω·(l_A² + l_B²)·θ̇ against the moment Ω I_p θ̇).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig (its rotor and AMBs).
+
+    Returns
+    -------
+    float
+        A·s/m per rad/s of speed, ≥ 0.
+
+    Raises
+    ------
+    ConfigError
+        A rig whose AMBs all sit at the centre of mass (no lever arm).
+    """
+    rotor = assemble_rotor(cfg)
+    M, G, _ = rotor.rigid()
+    z_g = float(M[0, 2] / M[0, 0])  # tilts about the left end: M_r[0, 2] = m z_G
+    l2 = sum((float(rotor.mesh.z[rotor.mesh.node_at(a.position)]) - z_g) ** 2
+             for a in cfg.amb)
+    ki = float(np.mean([k for a in cfg.amb for k in amb_factors(a)[0]]))
+    if not l2 > 0 or not ki > 0:
+        raise ConfigError("controller.pid: the cross-axis gains' rule needs AMBs away from "
+                          "the centre of mass with Ki > 0")
+    return float(abs(G[2, 3]) / (ki * l2))
 
 
 def precession_rad_s(cfg, k_eq: float, speed_rad_s: float) -> float:
@@ -435,7 +488,7 @@ def reference_pid(cfg, speed_rpm: float | None = None) -> dict:
         ``[[controller.filter]]`` entries as dicts, in series with the PID; left out of the
         rig file, none for a given PID), ``cross_kp`` (A/m) and ``cross_kd`` (A·s/m), the
         cross-axis gains at that speed (0 where the rig file gives none, and for a derived
-        PID); derived ones also carry the ``rule`` of :func:`pid_from_rig`.
+        PID: :func:`pid_from_rig`); derived ones also carry its ``rule``.
     """
     ctrl = getattr(cfg, "controller", None)
     pid = getattr(ctrl, "pid", None)

@@ -312,6 +312,42 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                                        "or the overhung stages in proportion to their q_A "
                                        "(API 617); ROSS 3.1's ``run_level1`` takes the "
                                        "node nearest mid-span"),
+    "Touchdown.name": ("", "the touchdown bearing's name"),
+    "Touchdown.position": ("m", "axial position of its plane"),
+    "Touchdown.radial_clearance": ("m", "radial clearance between the journal and the "
+                                        "ring (ISO 14839-5's C_min is the smallest)"),
+    "Touchdown.axial_clearance": ("m", "axial clearance, where the bearing also takes "
+                                       "thrust (left out: radial only)"),
+    "Touchdown.kind": ("", "``deep_groove``, ``angular_contact_pair``, "
+                           "``full_complement`` (rolling) or ``sleeve``"),
+    "Touchdown.contact": ("", "``point`` (Hertz, n = 3/2) or ``line`` (Palmgren, "
+                              "n = 10/9): F = K·δ^n"),
+    "Touchdown.contact_stiffness": ("N/m^n", "K of F = K·δ^n; left out, from the geometry "
+                                             "(``contact_radius`` or ``contact_length``)"),
+    "Touchdown.contact_radius": ("m", "a point contact's effective radius R* "
+                                      "(1/R* = Σ curvatures): K = (4/3)·E*·√R*"),
+    "Touchdown.contact_length": ("m", "a line contact's length: Palmgren's "
+                                      "K = (l^0.8/3.84e-5)^(10/9) in N, mm, bearing steel"),
+    "Touchdown.E": ("Pa", "Young's modulus of both contacting bodies (default: AISI 52100 "
+                          "bearing steel, Harris & Kotzalas 2007)"),
+    "Touchdown.nu": ("", "Poisson's ratio of both bodies (default: 52100 steel)"),
+    "Touchdown.damping_law": ("", "contact damping F = K·δ^n·(1 + D·δ̇): "
+                                  "``hunt_crossley`` D = 3(1 − e)/(2v₀), "
+                                  "``lankarani_nikravesh`` 3(1 − e²)/(4v₀), ``flores`` "
+                                  "8(1 − e)/(5e·v₀) (default: valid over the whole range "
+                                  "of e), v₀ the impact's normal speed"),
+    "Touchdown.restitution": ("", "coefficient of restitution e of the contact (required)"),
+    "Touchdown.friction": ("", "Coulomb friction coefficient μ of the journal on the ring "
+                               "(required)"),
+    "Touchdown.friction_velocity": ("m/s", "slip speed of the regularised Coulomb law "
+                                           "μN·tanh(v/v_r)"),
+    "Touchdown.race_inertia": ("kg·m²", "the ring's (inner race's) polar inertia; left "
+                                        "out, the ring does not turn (a sleeve)"),
+    "Touchdown.race_drag_torque": ("N·m", "the drag torque resisting the ring's spin"),
+    "Touchdown.support_stiffness": ("N/m", "the bearing's support stiffness (left out: "
+                                           "rigid)"),
+    "Touchdown.support_damping": ("N·s/m", "the support's damping"),
+    "Touchdown.support_mass": ("kg", "the support's moving mass (needs a stiffness)"),
     "Probe.position": ("m", "the probe's axial position (a node of the rotor)"),
     "Probe.angle_deg": ("°", "the direction it reads, from x towards y (default 0)"),
     "Signoff.scale_factor_speeds": ("", "where A_probe is taken: ``to_trip`` (default, "
@@ -590,6 +626,9 @@ def _sections() -> list[Section]:
         Section("[[stage]]", r.Stage, "One table per impeller or stage: what API 617's "
                 "Level I stability screening needs (``ambseal signoff``); ``position`` or "
                 "``disk``, one of them."),
+        Section("[[touchdown]]", r.Touchdown, "One table per touchdown (backup) bearing "
+                "plane: its clearance, contact law and damping, friction, ring and support "
+                "(``ambseal.model.contact``)."),
         Section("[machine]", r.Machine),
         Section("[signoff]", r.Signoff, "The sign-off's limits that the standards' public "
                 "text could not confirm; every key optional, its default shown."),

@@ -126,8 +126,9 @@ def test_q_applied_off_mid_span_where_the_rig_file_says():
     at = level1_screening(parse_rig({**doc, "signoff": {"level1_position_m": 0.1}}))
     assert at.where_m == ((0.1, 1.0),)
     assert at.Q_0 == pytest.approx(c * math.sqrt(k / m), rel=0.01)
-    with pytest.raises(ConfigError, match=r"level1_position_m: 9 m is off the rotor"):
-        level1_screening(parse_rig({**doc, "signoff": {"level1_position_m": 9.0}}))
+    with pytest.raises(ConfigError, match=r"signoff.level1_position_m: position 9.0 m lies "
+                                          r"outside the shaft"):
+        parse_rig({**doc, "signoff": {"level1_position_m": 9.0}})
 
 
 def test_screening_outcomes_by_their_rules():

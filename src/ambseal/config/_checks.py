@@ -211,9 +211,11 @@ def cross_check(cfg, where: str) -> None:
                 f"(expected 0 <= position <= {length:g} m)"
             )
 
-    for kind in ("disk", "seal", "spring"):
+    for kind in ("disk", "seal", "spring", "touchdown"):
         for i, comp in enumerate(getattr(cfg, kind)):
             on_shaft(f"{kind}[{i}].position", comp.position)
+    if cfg.signoff.level1_position_m is not None:
+        on_shaft("signoff.level1_position_m", cfg.signoff.level1_position_m)
     disks = {d.name for d in cfg.disk if d.name}
     for i, st in enumerate(cfg.stage):
         if st.position is not None:

@@ -478,6 +478,66 @@ class Seal(_Strict):
         return self
 
 
+class Touchdown(_Strict):
+    """A touchdown (backup, auxiliary) bearing in one plane: the ring the rotor lands on
+    when the AMBs let it go (ISO 14839-5:2022's touch-down bearing). ``radial_clearance``
+    (m) between the journal and the ring; ``kind`` of bearing; the contact law
+    F = K·δ^n (:mod:`ambseal.model.contact`): ``contact`` ``"point"`` (n = 3/2, Hertz)
+    or ``"line"`` (n = 10/9, Palmgren), K as ``contact_stiffness`` (N/m^n) or from the
+    geometry — a point contact's effective radius ``contact_radius`` (m) with ``E`` and
+    ``nu`` of both bodies, a line contact's ``contact_length`` (m; Palmgren's relation,
+    bearing steel); the contact damping by ``damping_law`` at the coefficient of
+    ``restitution``; regularised Coulomb ``friction`` with ``friction_velocity`` (m/s);
+    the ring's ``race_inertia`` (kg·m²) and ``race_drag_torque`` (N·m); the support's
+    ``support_stiffness`` (N/m; left out, rigid), ``support_damping`` (N·s/m) and
+    ``support_mass`` (kg). ``restitution`` and ``friction`` have no default: no public
+    source gives one for every pair of surfaces."""
+
+    name: Name
+    position: float = Field(ge=0)
+    radial_clearance: float = Field(gt=0, le=0.1)
+    axial_clearance: float | None = Field(default=None, gt=0, le=0.1)
+    kind: Literal["deep_groove", "angular_contact_pair", "full_complement",
+                  "sleeve"] = "deep_groove"
+    contact: Literal["point", "line"] = "line"
+    contact_stiffness: float | None = Field(default=None, gt=0, le=1e16)
+    contact_radius: float | None = Field(default=None, gt=0, le=10.0)
+    contact_length: float | None = Field(default=None, gt=0, le=10.0)
+    # AISI 52100 bearing steel (Harris & Kotzalas, Rolling Bearing Analysis, 5th ed., 2007)
+    E: float = Field(default=2.075e11, gt=1e8, le=1e13)
+    nu: float = Field(default=0.3, ge=0, lt=0.5)
+    # Flores et al. (2011): the one law valid from plastic-like to elastic impacts
+    damping_law: Literal["hunt_crossley", "lankarani_nikravesh", "flores"] = "flores"
+    restitution: float = Field(gt=0, le=1.0)
+    friction: float = Field(ge=0, le=2.0)
+    # the slip speed below which friction grows in proportion to it (the regularisation):
+    # small against a landing rotor's surface speed, tens of m/s
+    friction_velocity: float = Field(default=1e-3, gt=0, le=10.0)
+    race_inertia: float | None = Field(default=None, gt=0, le=1e3)
+    race_drag_torque: float = Field(default=0.0, ge=0, le=1e5)
+    support_stiffness: float | None = Field(default=None, gt=0, le=1e13)
+    support_damping: float = Field(default=0.0, ge=0, le=1e9)
+    support_mass: float = Field(default=0.0, ge=0, le=1e5)
+
+    @model_validator(mode="after")
+    def _stiffness(self) -> "Touchdown":
+        if self.contact_stiffness is None:
+            if self.contact == "point" and self.contact_radius is None:
+                raise ValueError("contact_radius: a point contact without "
+                                 "contact_stiffness takes K from its effective radius (m)")
+            if self.contact == "line" and self.contact_length is None:
+                raise ValueError("contact_length: a line contact without "
+                                 "contact_stiffness takes K from its length (m)")
+            if self.contact == "line" and (self.E, self.nu) != (2.075e11, 0.3):
+                raise ValueError("contact_stiffness: a line contact's K from its length is "
+                                 "Palmgren's relation for bearing steel; for another E or "
+                                 "nu give contact_stiffness (N/m^(10/9))")
+        if self.support_mass > 0 and self.support_stiffness is None:
+            raise ValueError("support_mass: a rigid support (no support_stiffness) moves "
+                             "no mass; give support_stiffness or leave support_mass out")
+        return self
+
+
 class SpringHousing(_Strict):
     """The housing behind a ``[[spring]]`` (ROSS's bearing linked to a housing node that
     carries a point mass and its own supports): a mass on the spring's far end, held to
@@ -784,6 +844,7 @@ class RigConfig(_Strict):
     seal: list[Seal] = Field(default=[], max_length=MAX_COMPONENTS)
     spring: list[Spring] = Field(default=[], max_length=MAX_COMPONENTS)
     stage: list[Stage] = Field(default=[], max_length=MAX_COMPONENTS)
+    touchdown: list[Touchdown] = Field(default=[], max_length=MAX_COMPONENTS)
     machine: Machine = Machine()
     signoff: Signoff = Signoff()
     controller: Controllers = Controllers()

@@ -262,22 +262,12 @@ def without_seals(cfg):
 
 
 def _applied_at(cfg, q: list[float]) -> tuple:
-    """(position, share of Q) pairs: ``[signoff] level1_position_m`` where given, else
-    mid-span between the outermost bearings, or the overhung stages in proportion to
-    their q_A.
-
-    Raises
-    ------
-    ConfigError
-        A ``level1_position_m`` off the rotor.
-    """
+    """(position, share of Q) pairs: ``[signoff] level1_position_m`` where given (on the
+    shaft: the rig's reading checks it), else mid-span between the outermost bearings,
+    or the overhung stages in proportion to their q_A."""
     supports = bearing_positions(cfg)
     at = cfg.signoff.level1_position_m
     if at is not None:
-        length = sum(s.length for s in cfg.shaft)
-        if not at <= length:
-            raise ConfigError(f"signoff.level1_position_m: {at:g} m is off the rotor "
-                              f"(0–{length:g} m)")
         return ((float(at), 1.0),)
     lo, hi = min(supports), max(supports)
     zs = [stage_position(cfg, st) for st in cfg.stage]

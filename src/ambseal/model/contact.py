@@ -1,0 +1,250 @@
+"""The contact of a landing rotor with a touchdown bearing: the normal force of the journal
+on the ring, its damping, and the friction between them.
+
+The normal force on a penetration δ > 0 (m) at the rate δ̇ (m/s) is Hertz's power law with
+a damping that vanishes with δ (Hunt & Crossley 1975):
+
+    F = K·δ^n·(1 + D·δ̇),        F = 0 where δ ≤ 0 or where the bracket turns negative,
+
+n = 3/2 for a point contact (Hertz; K = (4/3)·E*·√R*, Johnson, *Contact Mechanics*,
+1985, §4.2) and n = 10/9 for a line contact (Palmgren's relation for bearing steel,
+δ = 3.84·10⁻⁵·Q^0.9/l^0.8 in mm and N; Harris & Kotzalas, *Rolling Bearing Analysis*,
+5th ed., 2007). D (s/m) sets the coefficient of restitution e at the impact's normal
+speed v₀, by one of three published laws:
+
+* Hunt & Crossley (1975): D = 3(1 − e)/(2v₀), derived for e near 1;
+* Lankarani & Nikravesh (1990): D = 3(1 − e²)/(4v₀), the same limit;
+* Flores, Machado, Silva & Martins (2011): D = 8(1 − e)/(5e·v₀), close to e over its
+  whole range.
+
+Integrated through one impact, the three give different restitutions for the same e
+away from 1 (at e = 0.5 about 0.66, 0.73 and 0.47), and agree near it. The tangential
+force is Coulomb's, regularised so that a slip speed v below ``v_r`` is not a
+discontinuity: F_t = μ·N·tanh(v/v_r).
+
+Without damping an impact of a mass m at v₀ ends where the kinetic energy is stored,
+(½)m v₀² = K δ_max^{n+1}/(n+1), and lasts t_c = 2(δ_max/v₀)·∫₀¹(1 − u^{n+1})^{-½}du
+(for n = 3/2, t_c = 2.943 δ_max/v₀; Goldsmith, *Impact*, 1960): :func:`hertz_impact`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["N_POINT", "N_LINE", "PALMGREN_MM", "DAMPING_LAWS", "effective_modulus",
+           "point_stiffness", "line_stiffness", "damping_coefficient", "normal_force",
+           "friction_force", "hertz_impact", "ContactLaw"]
+
+#: Hertz's exponent of a point contact and Palmgren's of a line contact
+N_POINT, N_LINE = 1.5, 10.0 / 9.0
+#: Palmgren's line contact of bearing steel: δ = PALMGREN_MM·Q^0.9/l^0.8 (mm, N, mm)
+PALMGREN_MM = 3.84e-5
+#: the damping laws, by their rig-file names: D·v₀ as a function of e
+DAMPING_LAWS = {
+    "hunt_crossley": lambda e: 1.5 * (1.0 - e),
+    "lankarani_nikravesh": lambda e: 0.75 * (1.0 - e * e),
+    "flores": lambda e: 1.6 * (1.0 - e) / e,
+}
+
+
+def effective_modulus(E: float, nu: float) -> float:
+    """E* of two bodies of one material: 1/E* = 2(1 − ν²)/E (Johnson 1985, Eq. 4.22).
+
+    Parameters
+    ----------
+    E : float
+        Young's modulus (Pa), > 0.
+    nu : float
+        Poisson's ratio, in [0, 0.5).
+
+    Returns
+    -------
+    float
+        E* (Pa).
+    """
+    return E / (2.0 * (1.0 - nu * nu))
+
+
+def point_stiffness(E: float, nu: float, radius: float) -> float:
+    """Hertz's point contact, F = K·δ^{3/2}: K = (4/3)·E*·√R* (Johnson 1985, Eq. 4.23).
+
+    Parameters
+    ----------
+    E, nu : float
+        Both bodies' Young's modulus (Pa) and Poisson's ratio.
+    radius : float
+        The effective radius R* (m), 1/R* the sum of the principal curvatures (a
+        conformal one negative), > 0.
+
+    Returns
+    -------
+    float
+        K (N/m^1.5).
+    """
+    return 4.0 / 3.0 * effective_modulus(E, nu) * math.sqrt(radius)
+
+
+def line_stiffness(length: float) -> float:
+    """Palmgren's line contact of bearing steel, F = K·δ^{10/9}, from
+    δ = 3.84·10⁻⁵·Q^0.9/l^0.8 (δ and l in mm, Q in N; Harris & Kotzalas 2007).
+
+    Parameters
+    ----------
+    length : float
+        The contact's length l (m), > 0.
+
+    Returns
+    -------
+    float
+        K (N/m^{10/9}).
+    """
+    # Q = (δ_mm · l_mm^0.8 / 3.84e-5)^(1/0.9), δ_mm = 1e3·δ
+    return (1e3 * (1e3 * length) ** 0.8 / PALMGREN_MM) ** (1.0 / 0.9)
+
+
+def damping_coefficient(law: str, restitution: float, impact_speed: float) -> float:
+    """D of F = K·δ^n·(1 + D·δ̇) for an impact at ``impact_speed`` (module docstring).
+
+    Parameters
+    ----------
+    law : {"hunt_crossley", "lankarani_nikravesh", "flores"}
+    restitution : float
+        The coefficient of restitution e, in (0, 1].
+    impact_speed : float
+        The normal speed v₀ at the start of the impact (m/s), > 0.
+
+    Returns
+    -------
+    float
+        D (s/m).
+
+    Raises
+    ------
+    ValueError
+        An unknown law, e outside (0, 1], or v₀ ≤ 0.
+    """
+    if law not in DAMPING_LAWS:
+        raise ValueError(f"damping_law: expected one of {', '.join(DAMPING_LAWS)}, got "
+                         f"{law!r}")
+    if not 0.0 < restitution <= 1.0:
+        raise ValueError(f"restitution: expected 0 < e <= 1, got {restitution!r}")
+    if not impact_speed > 0.0:
+        raise ValueError(f"impact speed: expected > 0 m/s, got {impact_speed!r}")
+    return DAMPING_LAWS[law](restitution) / impact_speed
+
+
+def normal_force(delta, delta_rate, stiffness: float, exponent: float, damping: float):
+    """F = K·δ^n·(1 + D·δ̇) where δ > 0 and the bracket is positive, else 0 (N).
+
+    Parameters
+    ----------
+    delta, delta_rate : float or ndarray
+        Penetration (m) and its rate (m/s).
+    stiffness, exponent, damping : float
+        K (N/m^n), n and D (s/m).
+
+    Returns
+    -------
+    float or ndarray
+    """
+    d = np.maximum(np.asarray(delta, float), 0.0)
+    f = stiffness * d ** exponent * (1.0 + damping * np.asarray(delta_rate, float))
+    return np.where(np.asarray(delta) > 0.0, np.maximum(f, 0.0), 0.0)
+
+
+def friction_force(mu: float, normal, slip_speed, velocity: float):
+    """The regularised Coulomb force μ·N·tanh(v/v_r) (N), along the slip.
+
+    Parameters
+    ----------
+    mu : float
+        Friction coefficient, ≥ 0.
+    normal : float or ndarray
+        Normal force N (N), ≥ 0.
+    slip_speed : float or ndarray
+        Slip speed v of the journal's surface against the ring's (m/s).
+    velocity : float
+        v_r (m/s), > 0.
+
+    Returns
+    -------
+    float or ndarray
+    """
+    return mu * np.asarray(normal, float) * np.tanh(np.asarray(slip_speed, float) / velocity)
+
+
+def hertz_impact(mass: float, speed: float, stiffness: float,
+                 exponent: float = N_POINT) -> tuple[float, float]:
+    """An undamped impact of ``mass`` at ``speed`` on F = K·δ^n: the largest penetration
+    and the contact time (module docstring; Goldsmith 1960).
+
+    Parameters
+    ----------
+    mass : float
+        kg, > 0.
+    speed : float
+        Normal speed at contact (m/s), > 0.
+    stiffness : float
+        K (N/m^n).
+    exponent : float, optional
+        n (3/2: Hertz).
+
+    Returns
+    -------
+    (float, float)
+        δ_max (m) and t_c (s).
+    """
+    p = exponent + 1.0
+    d_max = (p * mass * speed ** 2 / (2.0 * stiffness)) ** (1.0 / p)
+    # ∫₀¹ (1 − u^p)^(−1/2) du = B(1/p, 1/2)/p
+    integral = math.gamma(1.0 / p) * math.sqrt(math.pi) / (p * math.gamma(1.0 / p + 0.5))
+    return d_max, 2.0 * integral * d_max / speed
+
+
+@dataclass(frozen=True)
+class ContactLaw:
+    """One touchdown bearing's contact (module docstring).
+
+    Attributes
+    ----------
+    stiffness : float
+        K (N/m^n).
+    exponent : float
+        n.
+    law : str
+        The damping law (:data:`DAMPING_LAWS`).
+    restitution : float
+        e.
+    friction : float
+        μ.
+    friction_velocity : float
+        v_r (m/s).
+    """
+
+    stiffness: float
+    exponent: float
+    law: str
+    restitution: float
+    friction: float
+    friction_velocity: float
+
+    @classmethod
+    def of(cls, touchdown) -> "ContactLaw":
+        """The law of a ``[[touchdown]]`` table (:class:`ambseal.config.Touchdown`): K as
+        given, or from its contact radius (point) or length (line)."""
+        n = N_POINT if touchdown.contact == "point" else N_LINE
+        k = touchdown.contact_stiffness
+        if k is None:
+            k = (point_stiffness(touchdown.E, touchdown.nu, touchdown.contact_radius)
+                 if touchdown.contact == "point" else line_stiffness(touchdown.contact_length))
+        return cls(float(k), n, touchdown.damping_law, touchdown.restitution,
+                   touchdown.friction, touchdown.friction_velocity)
+
+    def force(self, delta, delta_rate, impact_speed: float):
+        """The normal force (N) at penetration ``delta`` (m) and its rate (m/s), in an
+        impact that began at ``impact_speed`` (m/s)."""
+        return normal_force(delta, delta_rate, self.stiffness, self.exponent,
+                            damping_coefficient(self.law, self.restitution, impact_speed))

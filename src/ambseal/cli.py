@@ -407,6 +407,22 @@ def _rotordynamics_parsers(sub) -> None:
                     help="print one JSON object (per controller its criteria and the "
                          "level1, level2, unbalance and iso14839_2 blocks)")
 
+    dr = sub.add_parser("drop", help="drop the rotor onto its touchdown bearings: every "
+                                     "AMB lets go at the operating speed")
+    dr.add_argument("rig", help="rig file (TOML) with its [[touchdown]] tables")
+    dg = dr.add_mutually_exclusive_group()
+    dg.add_argument("--speed-rpm", type=_finite, default=None,
+                    help="spin speed (rpm), held; default [operating] speed_rpm")
+    dg.add_argument("--speed-hz", type=_finite, default=None, help="spin speed (Hz), held")
+    dr.add_argument("--duration-s", type=_positive, default=0.5,
+                    help="time simulated after the AMBs let go (s; default 0.5)")
+    dr.add_argument("--modes-hz", type=_positive, default=None,
+                    help="keep the free rotor's modes below this (Hz); default twice the "
+                         "contact's own frequency")
+    dr.add_argument("--out", default="ambseal-drop", help="output folder")
+    _folder_force(dr)
+    dr.add_argument("--json", action="store_true", help="print one JSON object")
+
     r = sub.add_parser("import-ross", help="a ROSS rotor file (.toml/.json) as an ambseal rig")
     r.add_argument("file", help="ROSS rotor file saved by ross.Rotor.save")
     r.add_argument("--out", required=True, help="rig file to write (TOML)")

@@ -31,6 +31,7 @@ from ambseal.analysis import (
     probe_scheduler,
     refine_boundary,
     sign_off,
+    simulate_drop,
     stability_boundary,
     verdict_line,
 )
@@ -56,6 +57,7 @@ from ambseal.model import channel_names
 from ambseal.report import (
     api617_unbalance_figure,
     campbell_figure,
+    drop_figure,
     level1_figure,
     mode_shapes_figure,
     stability_map_figure,
@@ -269,6 +271,41 @@ def _signoff_into(args: argparse.Namespace) -> int:
     return 0 if doc["passed"] else 1
 
 
+@_owns_out
+def _drop(args: argparse.Namespace) -> int:
+    cfg = load_rig(args.rig)
+    rpm = (60.0 * args.speed_hz if args.speed_hz is not None else
+           args.speed_rpm if args.speed_rpm is not None else cfg.operating.speed_rpm)
+    if not 0 <= rpm <= 60.0 * MAX_SPEED_HZ:
+        raise ConfigError(f"--speed-rpm: expected 0 to {60.0 * MAX_SPEED_HZ:g} rpm, got "
+                          f"{rpm:g}")
+    say = logging.getLogger("ambseal").info
+    shown = [0]
+
+    def progress(t: float) -> None:  # a line per tenth of the drop, not per contact
+        tenth = int(10 * t / args.duration_s)
+        if tenth > shown[0]:
+            shown[0] = tenth
+            say(f"drop: {1e3 * t:.4g} ms of {1e3 * args.duration_s:.4g} ms")
+
+    res = simulate_drop(cfg, speed_rpm=rpm, duration_s=args.duration_s,
+                        modes_hz=args.modes_hz, progress=progress)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    doc = {"rig": str(args.rig), "speed_rpm": rpm, **res.to_dict()}
+    files = [write_json(out / "drop.json", doc),
+             drop_figure(out / "drop.png", res, [t.radial_clearance for t in cfg.touchdown],
+                         title=f"Rotor drop — {cfg.rotor.name}")]
+    if args.json:
+        print(json.dumps({**doc, "files": [str(f) for f in files]}))
+    else:
+        for p in doc["planes"]:
+            print(f"{p['name']}: peak force {p['peak_force_n']:.4g} N, penetration "
+                  f"{1e6 * p['max_penetration_m']:.3g} µm, {p['regime']}")
+        print(f"files: {', '.join(str(f) for f in files)}")
+    return 0
+
+
 def _import_ross(args: argparse.Namespace) -> int:
     res = import_ross_file(args.file, args.out, speed_rpm=args.speed_rpm, force=args.force)
     for line in [f"not imported: {n}" for n in res["unmapped"]] + [
@@ -279,4 +316,4 @@ def _import_ross(args: argparse.Namespace) -> int:
 
 
 HANDLERS = {"modes": modes_command, "campbell": _campbell, "sweep": _sweep,
-            "signoff": _signoff, "import-ross": _import_ross}
+            "signoff": _signoff, "import-ross": _import_ross, "drop": _drop}

@@ -532,6 +532,9 @@ class Touchdown(_Strict):
                 raise ValueError("contact_stiffness: a line contact's K from its length is "
                                  "Palmgren's relation for bearing steel; for another E or "
                                  "nu give contact_stiffness (N/m^(10/9))")
+        if self.kind == "sleeve" and self.race_inertia is not None:
+            raise ValueError("race_inertia: a sleeve does not turn; leave it out, or give "
+                             "the rolling bearing's kind")
         if self.support_mass > 0 and self.support_stiffness is None:
             raise ValueError("support_mass: a rigid support (no support_stiffness) moves "
                              "no mass; give support_stiffness or leave support_mass out")

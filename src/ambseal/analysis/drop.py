@@ -1,0 +1,500 @@
+"""The rotor drop: the FE rotor released by its AMBs onto its touchdown bearings.
+
+ISO 14839-5:2022 asks for the analysis of the events that land a rotor on its touch-down
+bearings. Here the event is the loss of every AMB: from the levitated equilibrium at the
+operating speed, each AMB's static force (the share of the rotor's weight it carries)
+decays through its coil, e^{−t R/L} (instant where the rig gives no ``inductance`` and
+``resistance``; its negative stiffness goes with its bias), and the rotor falls through
+the clearance onto the rings. Radial contact only: ``axial_clearance`` is not simulated.
+
+The rotor: the free FE rotor of the rig (:func:`ambseal.model.assemble_rotor`, a node at
+every touchdown plane) in the mass-normalised real modes of its free–free
+non-rotating form up to ``modes_hz`` (rigid-body modes included), M q̈ + (C + ΩG) q̇ + K q
+= f at the spin speed Ω, held constant. The default ``modes_hz`` is twice the contact's
+own frequency 1/t_c (:func:`ambseal.model.hertz_impact`) for a fall through the smallest
+clearance onto the stiffest contact with the rotor's mass shared among the touchdown
+planes: the impulse's spectrum lies below it.
+
+Each touchdown plane (:class:`ambseal.config.Touchdown`; :class:`ambseal.model.
+ContactLaw`): the journal's centre r relative to the ring's (the ring on its support
+where ``support_mass`` is given), penetration δ = |r| − c, normal n = r/|r|, tangent
+t = ẑ × n. The normal force N on δ and δ̇ with the damping of the impact's normal speed
+v₀ at the contact's onset (floored at 1 % of the free-fall speed over the clearance: a
+grazing contact is damped as that impact would be); friction μN·tanh(v_s/v_r) against
+the slip v_s = t·ṙ + Ω R_j − ω_r R_r of the journal's surface on the ring's (R_j the
+shaft's outer radius there, R_r = R_j + c); a ring with ``race_inertia`` J spins up,
+J ω̇_r = F_t R_r − T_d·tanh(ω_r/ω_d), ω_d = v_r/R_r; without it the ring stands still.
+
+Integration: scipy's ``solve_ivp`` from event to event (each plane's contact onset and
+end are events that end a segment: the onset sets v₀), to relative tolerance ``rtol``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.linalg import eigh
+
+from ambseal.errors import ConfigError
+from ambseal.lti import json_float
+from ambseal.model import ContactLaw, assemble_rotor, build_mesh, hertz_impact
+
+__all__ = ["GRAVITY", "DropModel", "DropResult", "drop_model", "simulate_drop",
+           "journal_radius"]
+
+#: standard gravity (m/s²)
+GRAVITY = 9.80665
+#: the grazing impact's speed: this fraction of the free fall over the clearance
+V0_FLOOR = 0.01
+#: regimes: the share of the last half of the drop in contact below which it bounces
+BOUNCING_BELOW = 0.5
+#: integration segments (one per contact onset or end) after which a drop is refused:
+#: a contact chattering at the integrator's resolution
+MAX_SEGMENTS = 100_000
+
+
+def journal_radius(cfg, z: float) -> float:
+    """The shaft's outer radius (m) at ``z`` (m): the larger of two sections meeting there,
+    a tapered section's radius interpolated, a layer (sleeve) over it included."""
+    r, z0 = 0.0, 0.0
+    tol = 1e-9 * max(cfg.length, 1.0)
+    for s in cfg.shaft:
+        z1 = z0 + s.length
+        if z0 - tol <= z <= z1 + tol:
+            right = s.outer_diameter_right or s.outer_diameter
+            f = min(max((z - z0) / s.length, 0.0), 1.0)
+            r = max(r, 0.5 * ((1 - f) * s.outer_diameter + f * right),
+                    *(0.5 * layer.outer_diameter for layer in s.layers))
+        z0 = z1
+    return r
+
+
+@dataclass(frozen=True)
+class DropModel:
+    """The drop's equations (module docstring): the modal rotor and its contacts.
+
+    Attributes
+    ----------
+    phi : ndarray, shape (n_dof, m)
+        Mass-normalised free–free modes kept.
+    frequency_hz : ndarray, shape (m,)
+        Their natural frequencies (rigid-body modes 0).
+    K, C, G : ndarray, shape (m, m)
+        Φᵀ K Φ, Φᵀ C Φ, Φᵀ G Φ.
+    gravity : ndarray, shape (m,)
+        Φᵀ of the rotor's weight (−y).
+    planes : tuple of ndarray, shape (2, m)
+        Each touchdown plane's x, y rows of Φ.
+    laws : tuple of ContactLaw
+    clearance, journal, race_inertia, drag : ndarray, shape (p,)
+        Per plane: radial clearance c (m), journal radius R_j (m), ring inertia (kg·m²,
+        0: it stands still), drag torque (N·m).
+    support : tuple of (float, float, float) or None
+        Per plane: the support's mass, stiffness and damping, None where rigid.
+    amb_rows : ndarray, shape (a, m)
+        Each AMB's y row of Φ.
+    amb_force, amb_tau : ndarray, shape (a,)
+        Each AMB's static force (N, +y) at the drop and its decay time L/R (s; 0 instant).
+    q0 : ndarray, shape (m,)
+        The levitated equilibrium (the bending under gravity and the AMBs' forces).
+    mass : float
+        The rotor's mass (kg).
+    names : tuple of str
+        The touchdown planes' names.
+    modes_hz : float
+        The modes kept are those below this (Hz).
+    """
+
+    phi: np.ndarray
+    frequency_hz: np.ndarray
+    K: np.ndarray
+    C: np.ndarray
+    G: np.ndarray
+    gravity: np.ndarray
+    planes: tuple
+    laws: tuple
+    clearance: np.ndarray
+    journal: np.ndarray
+    race_inertia: np.ndarray
+    drag: np.ndarray
+    support: tuple
+    amb_rows: np.ndarray
+    amb_force: np.ndarray
+    amb_tau: np.ndarray
+    q0: np.ndarray
+    mass: float
+    names: tuple
+    modes_hz: float
+    node_rows: dict = field(default_factory=dict, repr=False)
+
+
+def _amb_static_forces(cfg, mass: float, z_g: float) -> np.ndarray:
+    """The AMBs' upward forces (N) that hold the rotor's weight: net force and moment
+    (the least-norm split beyond two AMBs)."""
+    z = np.array([a.position for a in cfg.amb], float)
+    A = np.vstack([np.ones_like(z), z])
+    b = mass * GRAVITY * np.array([1.0, z_g])
+    f, *_ = np.linalg.lstsq(A, b, rcond=None)
+    if not np.allclose(A @ f, b, rtol=1e-9, atol=1e-9 * abs(b).max()):
+        raise ConfigError("drop: the AMBs cannot hold the rotor's weight (one AMB away "
+                          "from the centre of mass)")
+    return f
+
+
+def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
+    """The drop's modal rotor and contacts of a rig (module docstring).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        With ``[[amb]]`` and ``[[touchdown]]`` tables.
+    modes_hz : float, optional
+        Keep the free–free modes below this (Hz); default: the module docstring's rule.
+
+    Returns
+    -------
+    DropModel
+
+    Raises
+    ------
+    ConfigError
+        A rig without AMBs or touchdown bearings, a flexible support without mass.
+    """
+    if not cfg.touchdown:
+        raise ConfigError("drop: the rig has no [[touchdown]] bearing to land on")
+    if not cfg.amb:
+        raise ConfigError("drop: the rig has no [[amb]]: nothing lets the rotor go")
+    for i, td in enumerate(cfg.touchdown):
+        if td.support_stiffness is not None and td.support_mass == 0:
+            raise ConfigError(f"touchdown[{i}].support_mass: a flexible support needs its "
+                              "moving mass (kg) in the drop")
+    mesh = build_mesh(cfg, extra_positions=tuple(t.position for t in cfg.touchdown))
+    rotor = assemble_rotor(cfg, mesh)
+    Mr, _, _ = rotor.rigid()
+    mass, z_g = float(Mr[0, 0]), float(Mr[0, 2] / Mr[0, 0])
+    laws = tuple(ContactLaw.of(t) for t in cfg.touchdown)
+    c = np.array([t.radial_clearance for t in cfg.touchdown])
+    if modes_hz is None:
+        share = mass / len(cfg.touchdown)
+        v0 = math.sqrt(2 * GRAVITY * c.min())
+        t_c = min(hertz_impact(share, v0, law.stiffness, law.exponent)[1] for law in laws)
+        modes_hz = 2.0 / t_c
+    w2, vec = eigh(0.5 * (rotor.K + rotor.K.T), rotor.M)
+    f = np.sqrt(np.clip(w2, 0.0, None)) / (2 * np.pi)
+    keep = f <= modes_hz
+    keep[:4] = True  # the rigid-body modes, whatever the rounding
+    phi = vec[:, keep]
+    f = np.where(np.arange(f.size)[keep] < 4, 0.0, f[keep])
+    rows = {}
+
+    def xy(z: float) -> np.ndarray:
+        n = mesh.node_at(z)
+        return phi[[4 * n, 4 * n + 1], :]
+
+    t_y = np.zeros(mesh.n_dof)
+    t_y[1::4] = 1.0
+    gravity = -GRAVITY * phi.T @ (rotor.M @ t_y)
+    amb_rows = np.array([xy(a.position)[1] for a in cfg.amb])
+    amb_force = _amb_static_forces(cfg, mass, z_g)
+    tau = np.array([(a.inductance / a.resistance) if (a.inductance and a.resistance)
+                    else 0.0 for a in cfg.amb])
+    Km = phi.T @ rotor.K @ phi
+    # levitated: the flexible modes bent by gravity and the AMBs (the rigid ones balanced)
+    load = gravity + amb_rows.T @ amb_force
+    q0 = np.zeros(phi.shape[1])
+    flex = f > 0
+    q0[flex] = np.linalg.solve(Km[np.ix_(flex, flex)], load[flex])
+    rows.update({f"amb:{a.name}": xy(a.position) for a in cfg.amb})
+    rows.update({f"seal:{s.name}": xy(s.position) for s in cfg.seal})
+    return DropModel(
+        phi=phi, frequency_hz=f, K=Km, C=phi.T @ rotor.C @ phi, G=phi.T @ rotor.G @ phi,
+        gravity=gravity, planes=tuple(xy(t.position) for t in cfg.touchdown), laws=laws,
+        clearance=c, journal=np.array([journal_radius(cfg, t.position)
+                                       for t in cfg.touchdown]),
+        race_inertia=np.array([t.race_inertia or 0.0 for t in cfg.touchdown]),
+        drag=np.array([t.race_drag_torque for t in cfg.touchdown]),
+        support=tuple((t.support_mass, t.support_stiffness, t.support_damping)
+                      if t.support_mass > 0 else None for t in cfg.touchdown),
+        amb_rows=amb_rows, amb_force=amb_force, amb_tau=tau, q0=q0, mass=mass,
+        names=tuple(t.name for t in cfg.touchdown), modes_hz=float(modes_hz),
+        node_rows=rows)
+
+
+@dataclass(frozen=True)
+class DropResult:
+    """A simulated drop (module docstring).
+
+    Attributes
+    ----------
+    t : ndarray, shape (k,)
+        Sample times (s).
+    orbit : ndarray, shape (p, k, 2)
+        Each touchdown plane's journal centre relative to its ring (m).
+    force : ndarray, shape (p, k)
+        Normal contact force (N).
+    penetration : ndarray, shape (p, k)
+        δ (m; negative out of contact).
+    race_speed : ndarray, shape (p, k)
+        Ring speed (rad/s).
+    energy : ndarray, shape (k,)
+        The rotor's mechanical energy with the contacts' stored energy (J; the weight's
+        potential from the levitated position).
+    watched : dict
+        ``{name: ndarray (k, 2)}``: the rotor's centre at each AMB and seal plane (m).
+    impacts : int
+        Contact onsets counted.
+    names : tuple of str
+    speed_rad_s : float
+    modes_hz : float
+    n_modes : int
+    """
+
+    t: np.ndarray
+    orbit: np.ndarray
+    force: np.ndarray
+    penetration: np.ndarray
+    race_speed: np.ndarray
+    energy: np.ndarray
+    watched: dict
+    impacts: int
+    names: tuple
+    speed_rad_s: float
+    modes_hz: float
+    n_modes: int
+
+    def regime(self, p: int) -> tuple[str, float]:
+        """The plane's regime over the last half of the drop: ``"bouncing"`` (in contact
+        less than half that time), else ``"forward whirl"`` or ``"backward whirl"`` by
+        the orbit's mean angular speed against the spin; and that whirl frequency (Hz)."""
+        half = self.t >= 0.5 * self.t[-1]
+        contact = float(np.mean(self.force[p, half] > 0))
+        x, y = self.orbit[p, half, 0], self.orbit[p, half, 1]
+        ang = np.unwrap(np.arctan2(y, x))
+        span = self.t[half][-1] - self.t[half][0]
+        w = float((ang[-1] - ang[0]) / span) if span > 0 else 0.0
+        if contact < BOUNCING_BELOW:
+            return "bouncing", abs(w) / (2 * np.pi)
+        forward = w * (self.speed_rad_s or 1.0) >= 0
+        return ("forward whirl" if forward else "backward whirl"), abs(w) / (2 * np.pi)
+
+    def to_dict(self) -> dict:
+        """The summary an engineer judges, JSON-safe: per plane the peak force, the
+        deepest penetration, the largest orbit, the regime and whirl frequency, the ring's
+        final speed; the largest excursion at each watched plane."""
+        planes = []
+        for p, name in enumerate(self.names):
+            regime, hz = self.regime(p)
+            planes.append({
+                "name": name, "peak_force_n": json_float(float(self.force[p].max())),
+                "max_penetration_m": json_float(float(max(self.penetration[p].max(), 0.0))),
+                "max_orbit_m": json_float(float(np.hypot(*self.orbit[p].T).max())),
+                "regime": regime, "whirl_hz": json_float(hz),
+                "final_race_speed_rad_s": json_float(float(self.race_speed[p, -1]))})
+        return {"duration_s": json_float(float(self.t[-1])),
+                "speed_rad_s": json_float(self.speed_rad_s), "modes_hz": self.modes_hz,
+                "n_modes": self.n_modes, "impacts": self.impacts, "planes": planes,
+                "watched_max_m": {k: json_float(float(np.hypot(*v.T).max()))
+                                  for k, v in self.watched.items()},
+                # the contacts' damping, friction, drag and structural damping took it,
+                # less the work of the AMBs' decaying forces
+                "energy_lost_j": json_float(float(self.energy[0] - self.energy[-1]))}
+
+
+def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
+                  samples: int = 4001, modes_hz: float | None = None, rtol: float = 1e-8,
+                  method: str = "DOP853", model: DropModel | None = None,
+                  progress=None) -> DropResult:
+    """Drop the rotor of ``cfg`` onto its touchdown bearings (module docstring).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        With ``[[amb]]`` and ``[[touchdown]]`` tables.
+    speed_rpm : float, optional
+        Spin speed, held constant (rpm).
+    duration_s : float, optional
+        Simulated time after the AMBs let go (s), > 0.
+    samples : int, optional
+        Output samples, evenly spaced over the drop.
+    modes_hz : float, optional
+        Modes kept (:func:`drop_model`).
+    rtol : float, optional
+        ``solve_ivp``'s relative tolerance (its absolute one: ``rtol`` times the smallest
+        clearance, and that over 1 ms for the speeds).
+    method : str, optional
+        ``solve_ivp``'s method.
+    model : DropModel, optional
+        Built by :func:`drop_model` if omitted.
+    progress : callable, optional
+        ``progress(t_s)`` after each segment.
+
+    Returns
+    -------
+    DropResult
+
+    Raises
+    ------
+    ConfigError
+        As :func:`drop_model`; a duration or sample count out of range.
+    """
+    if not (duration_s > 0 and math.isfinite(duration_s)):
+        raise ConfigError(f"drop: duration: expected > 0 s, got {duration_s!r}")
+    if not samples >= 2:
+        raise ConfigError(f"drop: samples: expected at least 2, got {samples!r}")
+    dm = model or drop_model(cfg, modes_hz)
+    m, P = dm.phi.shape[1], len(dm.laws)
+    W = 2 * np.pi * speed_rpm / 60.0
+    D_matrix = dm.C + W * dm.G
+    races = np.flatnonzero(dm.race_inertia > 0)
+    sup = [p for p in range(P) if dm.support[p] is not None]
+    n_y = 2 * m + races.size + 4 * len(sup)
+    floor = V0_FLOOR * np.sqrt(2 * GRAVITY * dm.clearance)
+    v0 = floor.copy()
+    ring = dm.journal + dm.clearance
+
+    def unpack(y):
+        eta, deta = y[:m], y[m:2 * m]
+        wr = np.zeros(P)
+        wr[races] = y[2 * m:2 * m + races.size]
+        s = np.zeros((P, 2))
+        ds = np.zeros((P, 2))
+        base = 2 * m + races.size
+        for k, p in enumerate(sup):
+            s[p] = y[base + 4 * k:base + 4 * k + 2]
+            ds[p] = y[base + 4 * k + 2:base + 4 * k + 4]
+        return eta, deta, wr, s, ds
+
+    def contacts(t, y):
+        """Per plane: relative position, δ, normal force, friction, n, t."""
+        eta, deta, wr, s, ds = unpack(y)
+        out = []
+        for p in range(P):
+            r = dm.planes[p] @ eta - s[p]
+            v = dm.planes[p] @ deta - ds[p]
+            d = math.hypot(r[0], r[1])
+            delta = d - dm.clearance[p]
+            if delta <= 0.0 or d == 0.0:
+                out.append((r, delta, 0.0, 0.0, None, None))
+                continue
+            n = r / d
+            tang = np.array([-n[1], n[0]])
+            N = float(dm.laws[p].force(delta, float(n @ v), v0[p]))
+            slip = float(tang @ v) + W * dm.journal[p] - wr[p] * ring[p]
+            law = dm.laws[p]
+            Ft = law.friction * N * math.tanh(slip / law.friction_velocity)
+            out.append((r, delta, N, Ft, n, tang))
+        return out
+
+    def rhs(t, y):
+        eta, deta, wr, s, ds = unpack(y)
+        f = dm.gravity.copy()
+        if dm.amb_force.size:
+            decay = np.where(dm.amb_tau > 0, np.exp(-t / np.where(dm.amb_tau > 0,
+                                                                   dm.amb_tau, 1.0)), 0.0)
+            f += dm.amb_rows.T @ (dm.amb_force * decay)
+        dy = np.empty_like(y)
+        dwr = np.zeros(P)
+        dsup = {}
+        for p, (r, delta, N, Ft, n, tang) in enumerate(contacts(t, y)):
+            F = np.zeros(2) if n is None else -N * n - Ft * tang
+            f += dm.planes[p].T @ F
+            if dm.race_inertia[p] > 0:
+                w_d = dm.laws[p].friction_velocity / ring[p]
+                dwr[p] = (Ft * ring[p] - dm.drag[p] * math.tanh(wr[p] / w_d)) \
+                    / dm.race_inertia[p]
+            if dm.support[p] is not None:
+                ms, ks, cs = dm.support[p]
+                dsup[p] = (-F - ks * s[p] - cs * ds[p]) / ms
+        dy[:m] = deta
+        dy[m:2 * m] = f - D_matrix @ deta - dm.K @ eta
+        dy[2 * m:2 * m + races.size] = dwr[races]
+        base = 2 * m + races.size
+        for k, p in enumerate(sup):
+            dy[base + 4 * k:base + 4 * k + 2] = ds[p]
+            dy[base + 4 * k + 2:base + 4 * k + 4] = dsup[p]
+        return dy
+
+    def events(touching):
+        evs = []
+        for p in range(P):
+            def g(t, y, p=p):
+                eta, _, _, s, _ = unpack(y)
+                r = dm.planes[p] @ eta - s[p]
+                return math.hypot(r[0], r[1]) - dm.clearance[p]
+            g.terminal = True
+            g.direction = -1.0 if touching[p] else 1.0
+            evs.append(g)
+        return evs
+
+    y = np.zeros(n_y)
+    y[:m] = dm.q0
+    grid = np.linspace(0.0, duration_s, samples)
+    # absolute tolerances by the state's scale: positions the clearance, speeds that
+    # over 1 ms, ring speeds the journal's surface speed over the ring's radius
+    c_min = dm.clearance.min()
+    atol = np.full(n_y, rtol * c_min / 1e-3)
+    atol[:m] = rtol * c_min
+    atol[2 * m:2 * m + races.size] = rtol * (abs(W) * dm.journal[races] / ring[races] + 1.0)
+    for k in range(len(sup)):
+        atol[2 * m + races.size + 4 * k:2 * m + races.size + 4 * k + 2] = rtol * c_min
+    touching = [False] * P
+    ts, ys = [0.0], [y.copy()]
+    t0, impacts, segments = 0.0, 0, 0
+    while t0 < duration_s:
+        segments += 1
+        if segments > MAX_SEGMENTS:
+            raise ConfigError(f"drop: more than {MAX_SEGMENTS} contact onsets and ends by "
+                              f"t = {t0:.6g} s (a contact chattering); lower rtol")
+        sel = grid[(grid > t0) & (grid <= duration_s)]
+        r = solve_ivp(rhs, (t0, duration_s), y, method=method, t_eval=sel,
+                      events=events(touching), rtol=rtol, atol=atol)
+        if not r.success:
+            raise ConfigError(f"drop: the integration failed at t = {r.t[-1]:.6g} s "
+                              f"({r.message}); lower rtol or modes_hz")
+        ts.extend(np.asarray(r.t, float).tolist())
+        ys.extend(np.asarray(r.y, float).reshape(n_y, -1).T)
+        hit = [k for k, te in enumerate(r.t_events) if te.size]
+        if not hit:
+            break
+        k = min(hit, key=lambda k: r.t_events[k][0])
+        t0 = float(r.t_events[k][0])
+        y = r.y_events[k][0].copy()
+        touching[k] = not touching[k]
+        if touching[k]:
+            impacts += 1
+            eta, deta, _, s, ds = unpack(y)
+            rel = dm.planes[k] @ eta - s[k]
+            n = rel / max(math.hypot(*rel), 1e-300)
+            v0[k] = max(float(n @ (dm.planes[k] @ deta - ds[k])), floor[k])
+        if progress is not None:
+            progress(t0)
+    t = np.array(ts)
+    Y = np.array(ys)
+    keep = np.concatenate([[True], np.diff(t) > 0])
+    t, Y = t[keep], Y[keep]
+    orbit = np.zeros((P, t.size, 2))
+    force = np.zeros((P, t.size))
+    pen = np.zeros((P, t.size))
+    race = np.zeros((P, t.size))
+    energy = np.zeros(t.size)
+    for j, yj in enumerate(Y):
+        eta, deta, wr, s, ds = unpack(yj)
+        e = 0.5 * deta @ deta + 0.5 * eta @ dm.K @ eta - dm.gravity @ eta
+        for p, (rel, delta, N, _, _, _) in enumerate(contacts(t[j], yj)):
+            orbit[p, j], pen[p, j], force[p, j], race[p, j] = rel, delta, N, wr[p]
+            law = dm.laws[p]
+            if delta > 0:
+                e += law.stiffness * delta ** (law.exponent + 1) / (law.exponent + 1)
+            if dm.support[p] is not None:
+                ms, ks, _ = dm.support[p]
+                e += 0.5 * ms * ds[p] @ ds[p] + 0.5 * ks * s[p] @ s[p]
+            if dm.race_inertia[p] > 0:
+                e += 0.5 * dm.race_inertia[p] * wr[p] ** 2
+        energy[j] = e
+    watched = {k: np.einsum("ij,kj->ki", rows, Y[:, :m]) for k, rows in dm.node_rows.items()}
+    return DropResult(t=t, orbit=orbit, force=force, penetration=pen, race_speed=race,
+                      energy=energy, watched=watched, impacts=impacts, names=dm.names,
+                      speed_rad_s=W, modes_hz=dm.modes_hz, n_modes=m)

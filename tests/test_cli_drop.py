@@ -1,0 +1,59 @@
+"""``ambseal drop``: the rotor released onto its touchdown bearings from the command line,
+its JSON and figure; a rig it cannot drop refused in one line (exit 2)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+from ambseal.cli import main
+
+from .rigid_rotor import L, rotor_text
+
+
+def _rig_text(touchdown: bool = True) -> str:
+    text = rotor_text("rigid rotor on touchdown bearings", 20.0, 0.05, 0.1, 4)
+    for name, z in (("A", 0.1), ("B", L - 0.1)):
+        text += (f'[[amb]]\nname = "{name}"\nposition = {z}\nsensor_position = {z}\n'
+                 "ki = 100.0\nks = 2.0e5\nbias_current = 5.0\ncurrent_limit = 10.0\n"
+                 "air_gap = 5.0e-4\n")
+    if touchdown:
+        for name, z in (("TA", 0.0), ("TB", L)):
+            text += (f'[[touchdown]]\nname = "{name}"\nposition = {z}\n'
+                     "radial_clearance = 2.0e-4\ncontact_length = 0.01\n"
+                     "restitution = 0.5\nfriction = 0.1\nrace_inertia = 1.0e-4\n")
+    return text + "[operating]\nspeed_rpm = 3000.0\n"
+
+
+def test_drop_writes_its_summary_and_figure(tmp_path, capsys):
+    """At the rig's speed: one JSON object with each plane's peak force, penetration and
+    regime (the first impact's penetration below the clearance, the journal's orbit at
+    least the clearance), the drop.json and drop.png it names; the same numbers in the
+    file."""
+    rig = tmp_path / "rig.toml"
+    rig.write_text(_rig_text())
+    out = tmp_path / "drop"
+    code = main(["--quiet", "drop", str(rig), "--duration-s", "0.03", "--out", str(out),
+                 "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert code == 0
+    assert doc["speed_rpm"] == 3000.0 and doc["speed_rad_s"] == pytest.approx(100 * math.pi)
+    assert [p["name"] for p in doc["planes"]] == ["TA", "TB"]
+    for p in doc["planes"]:
+        assert p["peak_force_n"] > 0 and 0 < p["max_penetration_m"] < 2e-4
+        assert p["max_orbit_m"] >= 2e-4
+        assert p["regime"] in ("bouncing", "forward whirl", "backward whirl")
+    assert set(doc["watched_max_m"]) == {"amb:A", "amb:B"}
+    assert json.loads((out / "drop.json").read_text())["planes"] == doc["planes"]
+    assert (out / "drop.png").stat().st_size > 0
+
+
+def test_a_rig_without_touchdown_bearings_is_refused(tmp_path, capsys):
+    rig = tmp_path / "rig.toml"
+    rig.write_text(_rig_text(touchdown=False))
+    code = main(["drop", str(rig), "--out", str(tmp_path / "d")])
+    err = capsys.readouterr().err
+    assert code == 2 and "[[touchdown]]" in err and "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1

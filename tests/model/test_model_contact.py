@@ -130,8 +130,8 @@ def _rig_with(touchdown: str) -> dict:
 def test_the_touchdown_table_is_read_and_refused_by_key():
     """A ``[[touchdown]]`` table gives its law (K from the length: Palmgren); a table
     without the restitution or the friction, off the shaft, a point contact without a
-    radius, a line contact of another material without a stiffness, or a support mass
-    on a rigid support are refused naming the key."""
+    radius, a line contact of another material without a stiffness, a support mass on a
+    rigid support, or a turning sleeve are refused naming the key."""
     good = ('name = "A"\nposition = 0.05\nradial_clearance = 2.5e-4\n'
             "contact_length = 0.015\nrestitution = 0.5\nfriction = 0.1\n")
     cfg = parse_rig(_rig_with(good))
@@ -145,6 +145,7 @@ def test_the_touchdown_table_is_read_and_refused_by_key():
         (good.replace("contact_length = 0.015\n", 'contact = "point"\n'), "contact_radius"),
         (good + "E = 7.0e10\n", "contact_stiffness"),
         (good + "support_mass = 1.0\n", "support_mass"),
+        (good + 'kind = "sleeve"\nrace_inertia = 1.0e-4\n', "race_inertia"),
     ]:
         with pytest.raises(ConfigError, match=key):
             parse_rig(_rig_with(text))

@@ -348,6 +348,10 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                                            "rigid)"),
     "Touchdown.support_damping": ("N·s/m", "the support's damping"),
     "Touchdown.support_mass": ("kg", "the support's moving mass (needs a stiffness)"),
+    "Touchdown.static_rating": ("N", "the bearing's basic static load rating C₀ (ISO 76); "
+                                     "left out, the drop's peak force is not graded"),
+    "DropLimits.force_ratio": ("", "largest peak contact force over C₀ that passes "
+                                   "(default 1: ISO 76's static rating)"),
     "Probe.position": ("m", "the probe's axial position (a node of the rotor)"),
     "Probe.angle_deg": ("°", "the direction it reads, from x towards y (default 0)"),
     "Signoff.scale_factor_speeds": ("", "where A_probe is taken: ``to_trip`` (default, "
@@ -629,6 +633,8 @@ def _sections() -> list[Section]:
         Section("[[touchdown]]", r.Touchdown, "One table per touchdown (backup) bearing "
                 "plane: its clearance, contact law and damping, friction, ring and support "
                 "(``ambseal.model.contact``)."),
+        Section("[drop]", r.DropLimits, "The rotor drop's pass criteria (``ambseal "
+                "drop``)."),
         Section("[machine]", r.Machine),
         Section("[signoff]", r.Signoff, "The sign-off's limits that the standards' public "
                 "text could not confirm; every key optional, its default shown."),

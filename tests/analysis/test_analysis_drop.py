@@ -10,7 +10,13 @@ import tomllib
 import numpy as np
 import pytest
 
-from ambseal.analysis.drop import GRAVITY, drop_model, journal_radius, simulate_drop
+from ambseal.analysis.drop import (
+    GRAVITY,
+    drop_model,
+    drop_verdict,
+    journal_radius,
+    simulate_drop,
+)
 from ambseal.config import parse_rig
 from ambseal.errors import ConfigError
 from ambseal.model import hertz_impact
@@ -129,6 +135,31 @@ def test_a_ring_spun_up_by_friction():
         first = r.t[np.argmax(r.force[p] > 0)]
         assert t99 - first == pytest.approx(0.99 * t_spin, rel=0.02)
         assert w[-1] == pytest.approx(target, rel=0.01)
+
+
+def test_the_verdict_grades_what_the_rig_gives():
+    """The rotor falls through the rings' 0.2 mm at its AMBs too: an AMB air gap of
+    0.15 mm is touched (FAILED), 0.5 mm is not; the peak force against C₀ passes or fails
+    by ``[drop] force_ratio``; without a C₀ or a gap the criterion is not graded and the
+    verdict says so; bouncing is no backward whirl."""
+    plain = _rig()
+    fall = math.sqrt(2 * C_TD / GRAVITY)
+    r = simulate_drop(plain, duration_s=2 * fall, samples=4001)
+    v = drop_verdict(plain, r)
+    assert v["passed"] and v["verdict"].startswith("Drop PASSED on what was graded")
+    assert {c["outcome"] for c in v["criteria"]} == {"passed", "not graded"}
+    peak = r.force.max()
+    for gap, c0, ratio, ok in ((5e-4, 2 * peak, 1.0, True), (1.5e-4, 2 * peak, 1.0, False),
+                               (5e-4, 0.9 * peak, 1.0, False), (5e-4, 0.9 * peak, 1.2, True)):
+        cfg = plain.model_copy(update={
+            "amb": [a.model_copy(update={"air_gap": gap}) for a in plain.amb],
+            "touchdown": [t.model_copy(update={"static_rating": c0})
+                          for t in plain.touchdown],
+            "drop": plain.drop.model_copy(update={"force_ratio": ratio})})
+        v = drop_verdict(cfg, r)
+        assert v["passed"] is ok, v
+        assert v["verdict"] == "Drop PASSED" if ok else v["verdict"].startswith("Drop FAILED")
+        assert all(c["outcome"] != "not graded" for c in v["criteria"])
 
 
 def test_the_drop_needs_its_bearings():

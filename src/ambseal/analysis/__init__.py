@@ -45,7 +45,8 @@ sampled with its delay) on the full-order plant:
 * :func:`pressure_ramp`, :func:`ramp_simulation` → :class:`RampResult` — a seal pressure
   ramp;
 * :func:`simulate_drop` → :class:`DropResult` — the rotor dropped onto its touchdown
-  bearings when its AMBs let go (:func:`drop_model`; :mod:`ambseal.analysis.drop`);
+  bearings when its AMBs let go (:func:`drop_model`; :mod:`ambseal.analysis.drop`), and
+  :func:`drop_verdict`, its pass criteria;
 * :func:`run_cases` — every multi-case analysis, serial or on Dask (:func:`dask_available`,
   :func:`probe_scheduler`).
 
@@ -67,6 +68,7 @@ from ambseal.lazy import lazy_face
 #: Each public name (``__all__``) and the module that defines it.
 _FROM = {
     "DropResult": "drop", "simulate_drop": "drop", "drop_model": "drop",
+    "drop_verdict": "drop",
     "capacity_block": "amplifier", "capacity_words": "amplifier", "force_demand": "amplifier",
     "saturates": "amplifier", "unbalance_currents": "amplifier",
     "rejection_effect": "rejection", "rejection_stability": "rejection",

@@ -43,7 +43,7 @@ from ambseal.lti import json_float
 from ambseal.model import ContactLaw, assemble_rotor, build_mesh, hertz_impact
 
 __all__ = ["GRAVITY", "DropModel", "DropResult", "drop_model", "simulate_drop",
-           "journal_radius"]
+           "journal_radius", "drop_verdict"]
 
 #: standard gravity (m/s²)
 GRAVITY = 9.80665
@@ -498,3 +498,58 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     return DropResult(t=t, orbit=orbit, force=force, penetration=pen, race_speed=race,
                       energy=energy, watched=watched, impacts=impacts, names=dm.names,
                       speed_rad_s=W, modes_hz=dm.modes_hz, n_modes=m)
+
+
+def drop_verdict(cfg, result: DropResult) -> dict:
+    """The drop judged, verdict first: each criterion passed, FAILED, or not graded (with
+    why) — no contact outside the touchdown bearings (the largest excursion at each AMB
+    against its ``air_gap``, at each seal against its ``clearance``), each touchdown
+    bearing's peak force against ``[drop] force_ratio`` × its ``static_rating`` C₀, and
+    no backward whirl sustained over the last half of the drop.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig dropped.
+    result : DropResult
+        Its drop.
+
+    Returns
+    -------
+    dict
+        ``passed`` (bool: nothing failed), ``verdict`` (one line) and ``criteria``
+        (``name``, ``outcome`` — ``"passed"``, ``"FAILED"`` or ``"not graded"`` —,
+        ``value``, ``limit``).
+    """
+    rows = []
+
+    def row(name, ok, value, limit):
+        rows.append({"name": name, "outcome": ("not graded" if ok is None else
+                                               "passed" if ok else "FAILED"),
+                     "value": value, "limit": limit})
+
+    gaps = {f"amb:{a.name}": a.air_gap for a in cfg.amb}
+    gaps.update({f"seal:{s.name}": s.clearance for s in cfg.seal})
+    for key, gap in gaps.items():
+        worst = float(np.hypot(*result.watched[key].T).max())
+        what = "air gap" if key.startswith("amb:") else "clearance"
+        row(f"no contact at {key.split(':', 1)[1]} ({what})",
+            None if gap is None else worst < gap, f"{1e6 * worst:.4g} µm",
+            f"{1e6 * gap:.4g} µm" if gap else f"no {what} given")
+    ratio = cfg.drop.force_ratio
+    for p, td in enumerate(cfg.touchdown):
+        peak = float(result.force[p].max())
+        c0 = td.static_rating
+        row(f"peak force at {td.name}", None if c0 is None else peak <= ratio * c0,
+            f"{peak:.4g} N" + (f" ({peak / c0:.3g} C₀)" if c0 else ""),
+            f"{ratio:g} C₀ = {ratio * c0:.4g} N" if c0 else "no static_rating given")
+        regime, hz = result.regime(p)
+        row(f"no backward whirl at {td.name}", regime != "backward whirl",
+            f"{regime}" + (f" at {hz:.3g} Hz" if regime != "bouncing" else ""),
+            "no sustained backward whirl")
+    failed = [r["name"] for r in rows if r["outcome"] == "FAILED"]
+    skipped = [r["name"] for r in rows if r["outcome"] == "not graded"]
+    line = (f"Drop FAILED: {'; '.join(failed)}" if failed else
+            "Drop PASSED" + (f" on what was graded (not graded: {'; '.join(skipped)})"
+                             if skipped else ""))
+    return {"passed": not failed, "verdict": line, "criteria": rows}

@@ -25,6 +25,7 @@ from pathlib import Path
 from ambseal.analysis import (
     check_cases,
     dask_available,
+    drop_verdict,
     judge_settings,
     operating_points,
     parse_range,
@@ -292,18 +293,19 @@ def _drop(args: argparse.Namespace) -> int:
                         modes_hz=args.modes_hz, progress=progress)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    doc = {"rig": str(args.rig), "speed_rpm": rpm, **res.to_dict()}
+    judged = drop_verdict(cfg, res)
+    doc = {"rig": str(args.rig), "speed_rpm": rpm, **judged, **res.to_dict()}
     files = [write_json(out / "drop.json", doc),
              drop_figure(out / "drop.png", res, [t.radial_clearance for t in cfg.touchdown],
                          title=f"Rotor drop — {cfg.rotor.name}")]
     if args.json:
         print(json.dumps({**doc, "files": [str(f) for f in files]}))
     else:
-        for p in doc["planes"]:
-            print(f"{p['name']}: peak force {p['peak_force_n']:.4g} N, penetration "
-                  f"{1e6 * p['max_penetration_m']:.3g} µm, {p['regime']}")
+        print(doc["verdict"])
+        for c in doc["criteria"]:
+            print(f"{c['name']}: {c['outcome']} — {c['value']} (limit {c['limit']})")
         print(f"files: {', '.join(str(f) for f in files)}")
-    return 0
+    return 0 if doc["passed"] else 1
 
 
 def _import_ross(args: argparse.Namespace) -> int:

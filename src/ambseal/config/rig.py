@@ -490,8 +490,9 @@ class Touchdown(_Strict):
     ``restitution``; regularised Coulomb ``friction`` with ``friction_velocity`` (m/s);
     the ring's ``race_inertia`` (kg·m²) and ``race_drag_torque`` (N·m); the support's
     ``support_stiffness`` (N/m; left out, rigid), ``support_damping`` (N·s/m) and
-    ``support_mass`` (kg). ``restitution`` and ``friction`` have no default: no public
-    source gives one for every pair of surfaces."""
+    ``support_mass`` (kg); the bearing's basic ``static_rating`` C₀ (N, ISO 76) the drop's
+    peak force is graded against. ``restitution`` and ``friction`` have no default: no
+    public source gives one for every pair of surfaces."""
 
     name: Name
     position: float = Field(ge=0)
@@ -518,6 +519,8 @@ class Touchdown(_Strict):
     support_stiffness: float | None = Field(default=None, gt=0, le=1e13)
     support_damping: float = Field(default=0.0, ge=0, le=1e9)
     support_mass: float = Field(default=0.0, ge=0, le=1e5)
+    # the basic static load rating C0 (ISO 76) the drop's peak force is graded against
+    static_rating: float | None = Field(default=None, gt=0, le=1e9)
 
     @model_validator(mode="after")
     def _stiffness(self) -> "Touchdown":
@@ -652,6 +655,15 @@ class Probe(_Strict):
 
     position: float = Field(ge=0)
     angle_deg: float = Field(default=0.0, ge=-360, le=360)
+
+
+class DropLimits(_Strict):
+    """The rotor drop's pass criteria that no public text fixes, as settings
+    (:func:`ambseal.analysis.drop.drop_verdict`): the largest ``force_ratio`` of a
+    touchdown bearing's peak force to its ``static_rating`` C₀ (default 1: C₀ is the load
+    ISO 76 lets a rolling bearing carry at rest without harmful permanent deformation)."""
+
+    force_ratio: float = Field(default=1.0, gt=0, le=100.0)
 
 
 class Signoff(_Strict):
@@ -850,6 +862,7 @@ class RigConfig(_Strict):
     touchdown: list[Touchdown] = Field(default=[], max_length=MAX_COMPONENTS)
     machine: Machine = Machine()
     signoff: Signoff = Signoff()
+    drop: DropLimits = DropLimits()
     controller: Controllers = Controllers()
     operating: Operating = Operating()
     reduction: Reduction = Reduction()

@@ -162,6 +162,21 @@ def test_the_verdict_grades_what_the_rig_gives():
         assert all(c["outcome"] != "not graded" for c in v["criteria"])
 
 
+def test_a_rotor_settled_on_its_rings_is_resting_not_whirling():
+    """A damped drop (e = 0.3, friction 0.1) at standstill settles at the bottom of the
+    rings: over the last half its regime is resting, not a whirl, and it stays in
+    contact with the plane's weight share."""
+    base = _rig()
+    cfg = base.model_copy(update={"touchdown": [
+        t.model_copy(update={"restitution": 0.3, "friction": 0.1, "contact_stiffness": 5e8})
+        for t in base.touchdown]})
+    r = simulate_drop(cfg, duration_s=0.1, samples=2001)
+    m = inertia(*DISK)[0]
+    for p in range(2):
+        assert r.regime(p) == ("resting", 0.0)
+        assert r.force[p, -1] == pytest.approx(0.5 * m * GRAVITY, rel=0.02)
+
+
 def test_the_drop_needs_its_bearings():
     """No touchdown bearing, no AMB, or a flexible support without its mass: refused by
     name; the journal radius is the shaft's."""

@@ -267,8 +267,10 @@ class DropResult:
 
     def regime(self, p: int) -> tuple[str, float]:
         """The plane's regime over the last half of the drop: ``"bouncing"`` (in contact
-        less than half that time), else ``"forward whirl"`` or ``"backward whirl"`` by
-        the orbit's mean angular speed against the spin; and that whirl frequency (Hz)."""
+        less than half that time), ``"resting"`` (in contact, its orbit going less than
+        once round the ring: settled or sliding to and fro at the bottom), else
+        ``"forward whirl"`` or ``"backward whirl"`` by the orbit's mean angular speed
+        against the spin; and that whirl frequency (Hz)."""
         half = self.t >= 0.5 * self.t[-1]
         contact = float(np.mean(self.force[p, half] > 0))
         x, y = self.orbit[p, half, 0], self.orbit[p, half, 1]
@@ -277,6 +279,8 @@ class DropResult:
         w = float((ang[-1] - ang[0]) / span) if span > 0 else 0.0
         if contact < BOUNCING_BELOW:
             return "bouncing", abs(w) / (2 * np.pi)
+        if abs(ang[-1] - ang[0]) < 2 * np.pi:
+            return "resting", 0.0
         forward = w * (self.speed_rad_s or 1.0) >= 0
         return ("forward whirl" if forward else "backward whirl"), abs(w) / (2 * np.pi)
 
@@ -545,7 +549,7 @@ def drop_verdict(cfg, result: DropResult) -> dict:
             f"{ratio:g} C₀ = {ratio * c0:.4g} N" if c0 else "no static_rating given")
         regime, hz = result.regime(p)
         row(f"no backward whirl at {td.name}", regime != "backward whirl",
-            f"{regime}" + (f" at {hz:.3g} Hz" if regime != "bouncing" else ""),
+            f"{regime}" + (f" at {hz:.3g} Hz" if regime.endswith("whirl") else ""),
             "no sustained backward whirl")
     failed = [r["name"] for r in rows if r["outcome"] == "FAILED"]
     skipped = [r["name"] for r in rows if r["outcome"] == "not graded"]

@@ -46,7 +46,7 @@ def drop_figure(path: str | os.PathLike, result, clearances_m, *,
         ax.plot(1e6 * result.orbit[p, :, 0], 1e6 * result.orbit[p, :, 1], lw=0.7,
                 label="journal centre")
         regime, hz = result.regime(p)
-        ax.set_title(f"{name}: {regime}" + (f", {hz:.3g} Hz" if regime != "bouncing"
+        ax.set_title(f"{name}: {regime}" + (f", {hz:.3g} Hz" if regime.endswith("whirl")
                                             else ""), fontsize=9)
         ax.set_aspect("equal")
         lim = 1.2 * max(c, 1e6 * np.hypot(*result.orbit[p].T).max())

@@ -28,8 +28,9 @@ Each element owns its matrices and parameter channels; the rig only assembles th
   displacements, physical parameters as LFT channels (:class:`Parameter`,
   :class:`Channel`; P1 Eqs. 46–52);
 * :class:`ContactLaw` — a touchdown bearing's contact: Hertz/Palmgren force, its damping
-  by a named law, regularised Coulomb friction (:mod:`ambseal.model.contact`), and
-  :func:`hertz_impact`, the undamped impact's closed form;
+  by a named law, regularised Coulomb friction (:mod:`ambseal.model.contact`;
+  :func:`normal_force`, :func:`damping_coefficient`), and :func:`hertz_impact`, the
+  undamped impact's closed form;
 * :func:`modal_reduction` → :class:`ModalReduction` — the small real model (P1 §III.4–6);
 * :class:`Modes`, :func:`modes_from_poles`, :func:`classify_poles`, :func:`free_bending_hz`,
   :func:`bending_limit_hz` — damped natural frequencies, damping, unstable poles;
@@ -57,7 +58,8 @@ _FROM = {
     "force_capacity": "capacity", "load_capacity": "capacity", "amplifier_use": "capacity",
     "amplifier_needs": "capacity", "transient_needs": "capacity", "limits_used": "capacity",
     "AXES": "amb", "axis_label": "amb", "BeamElement": "fe",
-    "ContactLaw": "contact", "hertz_impact": "contact",
+    "ContactLaw": "contact", "hertz_impact": "contact", "normal_force": "contact",
+    "damping_coefficient": "contact",
     "CouplingElement": "fe",
     "DiskElement": "fe", "Channel": "lft", "Parameter": "lft", "Plant": "lft",
     "Modes": "modes", "PoleDisk": "modes", "RIGID_BODY_RAD_S": "modes",

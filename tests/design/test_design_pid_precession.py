@@ -53,14 +53,20 @@ def test_precession_is_the_rigid_rotors_closed_form(speed_hz):
     assert got == pytest.approx(want, rel=1e-9)
 
 
-def _oscillating_poles(cfg, p: dict, speed_hz: float) -> np.ndarray:
-    """The continuous loop's (no delay) poles with 1 < ω < 2π·500 rad/s, upper half."""
+def _loop_poles(cfg, p: dict, speed_hz: float) -> np.ndarray:
+    """The poles of the continuous loop (no delay) of the full-order plant at
+    ``speed_hz`` with the PID ``p``."""
     pl = build_plant(cfg, speed_rpm=60.0 * speed_hz)
     cur = pl.current_inputs()
     K = pid_of(p, channel_names(cfg))
     mats = ((pl.A, pl.B[:, cur], pl.C, pl.D[:, cur]),
             tuple(np.asarray(X, float) for X in (K.A, K.B, K.C, K.D)))
-    lam = np.linalg.eigvals(feedback_matrices(*mats)[0])
+    return np.linalg.eigvals(feedback_matrices(*mats)[0])
+
+
+def _oscillating_poles(cfg, p: dict, speed_hz: float) -> np.ndarray:
+    """The loop's poles with 1 < ω < 2π·500 rad/s, upper half."""
+    lam = _loop_poles(cfg, p, speed_hz)
     return np.sort_complex(lam[(lam.imag > 1) & (np.abs(lam) < 2 * math.pi * 500)])
 
 
@@ -94,14 +100,8 @@ def flywheel():
 
 
 def _low_poles(cfg, p: dict, speed_hz: float) -> np.ndarray:
-    """Poles below 20 Hz of the continuous loop (no delay) of the full-order plant at
-    ``speed_hz`` with the PID ``p``."""
-    pl = build_plant(cfg, speed_rpm=60.0 * speed_hz)
-    cur = pl.current_inputs()
-    K = pid_of(p, channel_names(cfg))
-    mats = ((pl.A, pl.B[:, cur], pl.C, pl.D[:, cur]),
-            tuple(np.asarray(X, float) for X in (K.A, K.B, K.C, K.D)))
-    lam = np.linalg.eigvals(feedback_matrices(*mats)[0])
+    """The loop's poles below 20 Hz."""
+    lam = _loop_poles(cfg, p, speed_hz)
     return lam[np.abs(lam) < 2 * math.pi * 20.0]
 
 
@@ -134,9 +134,4 @@ def test_the_flywheels_corner_holds_its_loop_as_designed(flywheel):
     cfg, p = flywheel
     assert p["corner_hz"] == pytest.approx(2000.0)
     for f in (0.0, 1000.0):
-        pl = build_plant(cfg, speed_rpm=60.0 * f)
-        cur = pl.current_inputs()
-        K = pid_of(p, channel_names(cfg))
-        mats = ((pl.A, pl.B[:, cur], pl.C, pl.D[:, cur]),
-                tuple(np.asarray(X, float) for X in (K.A, K.B, K.C, K.D)))
-        assert np.linalg.eigvals(feedback_matrices(*mats)[0]).real.max() < 0, f
+        assert _loop_poles(cfg, p, f).real.max() < 0, f

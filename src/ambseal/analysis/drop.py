@@ -119,6 +119,9 @@ class DropModel:
         The touchdown planes' names.
     modes_hz : float
         The modes kept are those below this (Hz).
+    node_rows : dict
+        ``{"amb:NAME" or "seal:NAME": ndarray (2, m)}``: the x, y rows of Φ at each AMB
+        and seal, whose excursions the verdict sets against their gaps.
     """
 
     phi: np.ndarray

@@ -57,3 +57,17 @@ def test_a_rig_without_touchdown_bearings_is_refused(tmp_path, capsys):
     err = capsys.readouterr().err
     assert code == 2 and "[[touchdown]]" in err and "Traceback" not in err
     assert len(err.strip().splitlines()) == 1
+
+
+def test_drop_coasting_down(tmp_path, capsys):
+    """``--coast-down --drag-torque 2``: the spin the JSON ends with is below the start;
+    a drag torque without the coast-down is refused by name (exit 2)."""
+    rig = tmp_path / "rig.toml"
+    rig.write_text(_rig_text())
+    code = main(["--quiet", "drop", str(rig), "--duration-s", "0.02", "--out",
+                 str(tmp_path / "d"), "--json", "--coast-down", "--drag-torque", "2"])
+    doc = json.loads(capsys.readouterr().out)
+    assert code == 0 and doc["final_speed_rad_s"] < doc["speed_rad_s"]
+    code = main(["drop", str(rig), "--out", str(tmp_path / "e"), "--drag-torque", "2"])
+    err = capsys.readouterr().err
+    assert code == 2 and "--drag-torque" in err and "Traceback" not in err

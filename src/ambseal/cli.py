@@ -416,6 +416,12 @@ def _rotordynamics_parsers(sub) -> None:
     dg.add_argument("--speed-hz", type=_finite, default=None, help="spin speed (Hz), held")
     dr.add_argument("--duration-s", type=_positive, default=0.5,
                     help="time simulated after the AMBs let go (s; default 0.5)")
+    dr.add_argument("--coast-down", action="store_true",
+                    help="the drive lets go too: the spin slows under the rings' friction "
+                         "and --drag-torque (default: the speed is held)")
+    dr.add_argument("--drag-torque", type=_finite, default=0.0,
+                    help="process and windage torque against the spin (N·m; with "
+                         "--coast-down)")
     dr.add_argument("--modes-hz", type=_positive, default=None,
                     help="keep the free rotor's modes below this (Hz); default twice the "
                          "contact's own frequency")

@@ -205,6 +205,29 @@ def test_peaks_are_read_between_the_samples_and_slow_onsets_are_not_overdamped()
     assert np.all(r.peak_force < 2 * elastic), (r.peak_force, elastic)
 
 
+def test_a_coasting_rotor_slows_under_the_rings_friction():
+    """The drive lets go too: resting on fixed rings (1 µm clearance, e = 0.3), the journal
+    slides at both planes with μN, N = (m/2)·g·cos(atan μ), and the spin slows at
+    2 μ N R_j/I_p, less a drag torque T_d/I_p: the slope within 2 %; with no friction and
+    no drag the spin is kept (1e-9)."""
+    mu, drag = 0.2, 0.5
+    base = _rig()
+    cfg = base.model_copy(update={"touchdown": [
+        t.model_copy(update={"radial_clearance": 1e-6, "restitution": 0.3, "friction": mu,
+                             "contact_stiffness": 5e8}) for t in base.touchdown]})
+    m, _, ip = inertia(*DISK)
+    R_j = journal_radius(cfg, 0.0)
+    N = 0.5 * m * GRAVITY * math.cos(math.atan(mu))
+    r = simulate_drop(cfg, speed_rpm=3000.0, duration_s=0.2, samples=401, coast_down=True,
+                      drag_torque=drag)
+    late = r.t >= 0.05
+    slope = np.polyfit(r.t[late], r.spin[late], 1)[0]
+    assert slope == pytest.approx(-(2 * mu * N * R_j + drag) / ip, rel=0.02)
+    free = simulate_drop(_rig(), speed_rpm=3000.0, duration_s=0.02, samples=101,
+                         coast_down=True)
+    assert free.spin == pytest.approx(100 * math.pi, rel=1e-9)
+
+
 def test_the_drop_needs_its_bearings():
     """No touchdown bearing, no AMB, or a flexible support without its mass: refused by
     name; the journal radius is the shaft's."""

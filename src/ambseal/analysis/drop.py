@@ -10,7 +10,8 @@ the clearance onto the rings. Radial contact only: ``axial_clearance`` is not si
 The rotor: the free FE rotor of the rig (:func:`ambseal.model.assemble_rotor`, a node at
 every touchdown plane) in the mass-normalised real modes of its free–free
 non-rotating form up to ``modes_hz`` (rigid-body modes included), M q̈ + (C + ΩG) q̇ + K q
-= f at the spin speed Ω, held constant. The default ``modes_hz`` is twice the contact's
+= f at the spin speed Ω, held by the drive or coasting down under the rings' friction
+and a drag torque (``coast_down``), the gyroscopic moments at the instantaneous speed. The default ``modes_hz`` is twice the contact's
 own frequency 1/t_c (:func:`ambseal.model.hertz_impact`) for a fall through the smallest
 clearance onto the stiffest contact with the rotor's mass shared among the touchdown
 planes: the impulse's spectrum lies below it.
@@ -115,6 +116,8 @@ class DropModel:
         The levitated equilibrium (the bending under gravity and the AMBs' forces).
     mass : float
         The rotor's mass (kg).
+    polar_inertia : float
+        The rotor's polar moment of inertia I_p (kg·m²).
     names : tuple of str
         The touchdown planes' names.
     modes_hz : float
@@ -142,6 +145,7 @@ class DropModel:
     amb_tau: np.ndarray
     q0: np.ndarray
     mass: float
+    polar_inertia: float
     names: tuple
     modes_hz: float
     node_rows: dict = field(default_factory=dict, repr=False)
@@ -189,7 +193,7 @@ def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
                               "moving mass (kg) in the drop")
     mesh = build_mesh(cfg, extra_positions=tuple(t.position for t in cfg.touchdown))
     rotor = assemble_rotor(cfg, mesh)
-    Mr, _, _ = rotor.rigid()
+    Mr, Gr, _ = rotor.rigid()
     mass, z_g = float(Mr[0, 0]), float(Mr[0, 2] / Mr[0, 0])
     laws = tuple(ContactLaw.of(t) for t in cfg.touchdown)
     c = np.array([t.radial_clearance for t in cfg.touchdown])
@@ -235,6 +239,7 @@ def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
         support=tuple((t.support_mass, t.support_stiffness, t.support_damping)
                       if t.support_mass > 0 else None for t in cfg.touchdown),
         amb_rows=amb_rows, amb_force=amb_force, amb_tau=tau, q0=q0, mass=mass,
+        polar_inertia=float(abs(Gr[2, 3])),
         names=tuple(t.name for t in cfg.touchdown), modes_hz=float(modes_hz),
         node_rows=rows)
 
@@ -269,6 +274,8 @@ class DropResult:
     peak_force, peak_penetration : ndarray, shape (p,)
         Each plane's largest normal force (N) and penetration (m), over the output's
         samples and the integrator's own steps.
+    spin : ndarray, shape (k,)
+        The rotor's spin speed (rad/s): ``speed_rad_s`` throughout unless it coasts down.
     """
 
     t: np.ndarray
@@ -285,6 +292,7 @@ class DropResult:
     n_modes: int
     peak_force: np.ndarray
     peak_penetration: np.ndarray
+    spin: np.ndarray
 
     def regime(self, p: int) -> tuple[str, float]:
         """The plane's regime over the last half of the drop: ``"bouncing"`` (in contact
@@ -325,12 +333,14 @@ class DropResult:
                                   for k, v in self.watched.items()},
                 # the contacts' damping, friction, drag and structural damping took it,
                 # less the work of the AMBs' decaying forces
-                "energy_lost_j": json_float(float(self.energy[0] - self.energy[-1]))}
+                "energy_lost_j": json_float(float(self.energy[0] - self.energy[-1])),
+                "final_speed_rad_s": json_float(float(self.spin[-1]))}
 
 
 def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                   samples: int = 4001, modes_hz: float | None = None, rtol: float = 1e-8,
                   method: str = "DOP853", model: DropModel | None = None,
+                  coast_down: bool = False, drag_torque: float = 0.0,
                   progress=None) -> DropResult:
     """Drop the rotor of ``cfg`` onto its touchdown bearings (module docstring).
 
@@ -339,7 +349,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     cfg : RigConfig
         With ``[[amb]]`` and ``[[touchdown]]`` tables.
     speed_rpm : float, optional
-        Spin speed, held constant (rpm).
+        Spin speed (rpm) at the drop: held by the drive, or the start of a coast-down.
     duration_s : float, optional
         Simulated time after the AMBs let go (s), > 0.
     samples : int, optional
@@ -353,6 +363,12 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         ``solve_ivp``'s method.
     model : DropModel, optional
         Built by :func:`drop_model` if omitted.
+    coast_down : bool, optional
+        The drive lets go too: the spin slows under the rings' friction at the journal
+        radii and ``drag_torque``, I_p Ω̇ = −Σ F_t R_j − T_d·tanh(Ω/ω_d) (ω_d = 0.1 rad/s),
+        the gyroscopic moments at the instantaneous speed.
+    drag_torque : float, optional
+        The process and windage torque T_d against the spin (N·m), ≥ 0.
     progress : callable, optional
         ``progress(t_s)`` after each segment.
 
@@ -369,13 +385,14 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         raise ConfigError(f"drop: duration: expected > 0 s, got {duration_s!r}")
     if not samples >= 2:
         raise ConfigError(f"drop: samples: expected at least 2, got {samples!r}")
+    if not (drag_torque >= 0 and math.isfinite(drag_torque)):
+        raise ConfigError(f"drop: drag torque: expected >= 0 N·m, got {drag_torque!r}")
     dm = model or drop_model(cfg, modes_hz)
     m, P = dm.phi.shape[1], len(dm.laws)
-    W = 2 * np.pi * speed_rpm / 60.0
-    D_matrix = dm.C + W * dm.G
+    W0 = 2 * np.pi * speed_rpm / 60.0
     races = np.flatnonzero(dm.race_inertia > 0)
     sup = [p for p in range(P) if dm.support[p] is not None]
-    n_y = 2 * m + races.size + 4 * len(sup)
+    n_y = 2 * m + races.size + 4 * len(sup) + (1 if coast_down else 0)
     floor = V0_FLOOR * np.sqrt(2 * GRAVITY * dm.clearance)
     v0 = floor.copy()
     ring = dm.journal + dm.clearance
@@ -392,6 +409,9 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             ds[p] = y[base + 4 * k + 2:base + 4 * k + 4]
         return eta, deta, wr, s, ds
 
+    def spin(y) -> float:
+        return float(y[-1]) if coast_down else W0
+
     def contacts(t, y):
         """Per plane: relative position, δ, normal force, friction, n, t."""
         eta, deta, wr, s, ds = unpack(y)
@@ -407,7 +427,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             n = r / d
             tang = np.array([-n[1], n[0]])
             N = float(dm.laws[p].force(delta, float(n @ v), v0[p]))
-            slip = float(tang @ v) + W * dm.journal[p] - wr[p] * ring[p]
+            slip = float(tang @ v) + spin(y) * dm.journal[p] - wr[p] * ring[p]
             law = dm.laws[p]
             Ft = law.friction * N * math.tanh(slip / law.friction_velocity)
             out.append((r, delta, N, Ft, n, tang))
@@ -423,9 +443,11 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         dy = np.empty_like(y)
         dwr = np.zeros(P)
         dsup = {}
+        torque = 0.0
         for p, (r, delta, N, Ft, n, tang) in enumerate(contacts(t, y)):
             F = np.zeros(2) if n is None else -N * n - Ft * tang
             f += dm.planes[p].T @ F
+            torque -= Ft * dm.journal[p]
             if dm.race_inertia[p] > 0:
                 w_d = dm.laws[p].friction_velocity / ring[p]
                 dwr[p] = (Ft * ring[p] - dm.drag[p] * math.tanh(wr[p] / w_d)) \
@@ -433,8 +455,11 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             if dm.support[p] is not None:
                 ms, ks, cs = dm.support[p]
                 dsup[p] = (-F - ks * s[p] - cs * ds[p]) / ms
+        W = spin(y)
         dy[:m] = deta
-        dy[m:2 * m] = f - D_matrix @ deta - dm.K @ eta
+        dy[m:2 * m] = f - (dm.C + W * dm.G) @ deta - dm.K @ eta
+        if coast_down:
+            dy[-1] = (torque - drag_torque * math.tanh(W / 0.1)) / dm.polar_inertia
         dy[2 * m:2 * m + races.size] = dwr[races]
         base = 2 * m + races.size
         for k, p in enumerate(sup):
@@ -456,13 +481,17 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
 
     y = np.zeros(n_y)
     y[:m] = dm.q0
+    if coast_down:
+        y[-1] = W0
     grid = np.linspace(0.0, duration_s, samples)
     # absolute tolerances by the state's scale: positions the clearance, speeds that
     # over 1 ms, ring speeds the journal's surface speed over the ring's radius
     c_min = dm.clearance.min()
     atol = np.full(n_y, rtol * c_min / 1e-3)
     atol[:m] = rtol * c_min
-    atol[2 * m:2 * m + races.size] = rtol * (abs(W) * dm.journal[races] / ring[races] + 1.0)
+    atol[2 * m:2 * m + races.size] = rtol * (abs(W0) * dm.journal[races] / ring[races] + 1.0)
+    if coast_down:
+        atol[-1] = rtol * (abs(W0) + 1.0)
     for k in range(len(sup)):
         atol[2 * m + races.size + 4 * k:2 * m + races.size + 4 * k + 2] = rtol * c_min
     touching = [False] * P
@@ -541,11 +570,14 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                 e += 0.5 * ms * ds[p] @ ds[p] + 0.5 * ks * s[p] @ s[p]
             if dm.race_inertia[p] > 0:
                 e += 0.5 * dm.race_inertia[p] * wr[p] ** 2
+        if coast_down:  # the spin's energy, which the drive no longer holds
+            e += 0.5 * dm.polar_inertia * spin(yj) ** 2
         energy[j] = e
     watched = {k: np.einsum("ij,kj->ki", rows, Y[:, :m]) for k, rows in dm.node_rows.items()}
     return DropResult(t=t, orbit=orbit, force=force, penetration=pen, race_speed=race,
                       energy=energy, watched=watched, impacts=impacts, names=dm.names,
-                      speed_rad_s=W, modes_hz=dm.modes_hz, n_modes=m,
+                      speed_rad_s=W0, modes_hz=dm.modes_hz, n_modes=m,
+                      spin=np.array([spin(yj) for yj in Y]),
                       peak_force=np.maximum(peak_force, force.max(axis=1)),
                       peak_penetration=np.maximum(peak_delta, pen.max(axis=1).clip(0)))
 

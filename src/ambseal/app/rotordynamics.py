@@ -289,8 +289,12 @@ def _drop(args: argparse.Namespace) -> int:
             shown[0] = tenth
             say(f"drop: {1e3 * t:.4g} ms of {1e3 * args.duration_s:.4g} ms")
 
+    if args.drag_torque and not args.coast_down:
+        raise ConfigError("--drag-torque: slows a coasting rotor; add --coast-down (the "
+                          "drive holds the speed otherwise)")
     res = simulate_drop(cfg, speed_rpm=rpm, duration_s=args.duration_s,
-                        modes_hz=args.modes_hz, progress=progress)
+                        modes_hz=args.modes_hz, coast_down=args.coast_down,
+                        drag_torque=args.drag_torque, progress=progress)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     judged = drop_verdict(cfg, res)

@@ -11,10 +11,11 @@ The rotor: the free FE rotor of the rig (:func:`ambseal.model.assemble_rotor`, a
 every touchdown plane) in the mass-normalised real modes of its free–free
 non-rotating form up to ``modes_hz`` (rigid-body modes included), M q̈ + (C + ΩG) q̇ + K q
 = f at the spin speed Ω, held by the drive or coasting down under the rings' friction
-and a drag torque (``coast_down``), the gyroscopic moments at the instantaneous speed. The default ``modes_hz`` is twice the contact's
-own frequency 1/t_c (:func:`ambseal.model.hertz_impact`) for a fall through the smallest
-clearance onto the stiffest contact with the rotor's mass shared among the touchdown
-planes: the impulse's spectrum lies below it.
+and a drag torque (``coast_down``), the gyroscopic moments at the instantaneous speed.
+The default ``modes_hz`` is twice the contact's own frequency 1/t_c
+(:func:`ambseal.model.hertz_impact`) for a fall through the smallest clearance onto the
+stiffest contact with the rotor's mass shared among the touchdown planes: the impulse's
+spectrum lies below it.
 
 Each touchdown plane (:class:`ambseal.config.Touchdown`; :class:`ambseal.model.
 ContactLaw`): the journal's centre r relative to the ring's (the ring on its support
@@ -39,6 +40,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.constants import g as GRAVITY
 from scipy.integrate import solve_ivp
 from scipy.linalg import eigh
 
@@ -49,6 +51,7 @@ from ambseal.model import (
     assemble_rotor,
     build_mesh,
     damping_coefficient,
+    friction_force,
     hertz_impact,
     normal_force,
 )
@@ -56,11 +59,6 @@ from ambseal.model import (
 __all__ = ["GRAVITY", "DropModel", "DropResult", "drop_model", "simulate_drop",
            "journal_radius", "drop_verdict"]
 
-#: standard gravity (m/s²)
-GRAVITY = 9.80665
-#: the slowest impact the damping law is set by: this fraction of the free fall over the
-#: clearance (module docstring)
-V0_FLOOR = 1.0
 #: regimes: the share of the last half of the drop in contact below which it bounces
 BOUNCING_BELOW = 0.5
 #: integration segments (one per contact onset or end) after which a drop is refused:
@@ -393,7 +391,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     races = np.flatnonzero(dm.race_inertia > 0)
     sup = [p for p in range(P) if dm.support[p] is not None]
     n_y = 2 * m + races.size + 4 * len(sup) + (1 if coast_down else 0)
-    floor = V0_FLOOR * np.sqrt(2 * GRAVITY * dm.clearance)
+    floor = np.sqrt(2 * GRAVITY * dm.clearance)  # the slowest impact the damping takes
     v0 = floor.copy()
     ring = dm.journal + dm.clearance
 
@@ -429,7 +427,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             N = float(dm.laws[p].force(delta, float(n @ v), v0[p]))
             slip = float(tang @ v) + spin(y) * dm.journal[p] - wr[p] * ring[p]
             law = dm.laws[p]
-            Ft = law.friction * N * math.tanh(slip / law.friction_velocity)
+            Ft = float(friction_force(law.friction, N, slip, law.friction_velocity))
             out.append((r, delta, N, Ft, n, tang))
         return out
 

@@ -531,7 +531,8 @@ class Touchdown(_Strict):
             if self.contact == "line" and self.contact_length is None:
                 raise ValueError("contact_length: a line contact without "
                                  "contact_stiffness takes K from its length (m)")
-            if self.contact == "line" and (self.E, self.nu) != (2.075e11, 0.3):
+            steel = tuple(type(self).model_fields[k].default for k in ("E", "nu"))
+            if self.contact == "line" and (self.E, self.nu) != steel:
                 raise ValueError("contact_stiffness: a line contact's K from its length is "
                                  "Palmgren's relation for bearing steel; for another E or "
                                  "nu give contact_stiffness (N/m^(10/9))")

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import contextlib
-
 from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
@@ -317,11 +316,12 @@ def pid_from_rig(cfg) -> dict:
                    f"{', f_s/'.join(f'{1 / c:.3g}' for c in PID_CORNERS_PER_FS)} that "
                    f"keeps {KEEP_OF_STRUCTURAL:g} of the structural damping as it runs, "
                    f"else the best); sampling and delay cost {lost:.1f}° at ω_n"}
-    with contextlib.suppress(ConfigError):  # a note only: no lever arm, no note
-        full = 2 * np.pi * top_hz * gyroscopic_cancellation(cfg) if slow else None
-        out["rule"] += "" if full is None else (f"; no cross-axis gains (the gyroscopic cancellation Ω I_p/(K_i Σ "
-                        f"l²) is {full:.4g} A·s/m at {top_hz:.4g} Hz: the scale of "
-                        f"[controller.pid] cross_kd with cross_speed_rpm)")
+    if slow:
+        with contextlib.suppress(ConfigError):  # a note only: no lever arm, no note
+            full = 2 * np.pi * top_hz * gyroscopic_cancellation(cfg)
+            out["rule"] += (f"; no cross-axis gains (the gyroscopic cancellation Ω I_p/"
+                            f"(K_i Σ l²) is {full:.4g} A·s/m at {top_hz:.4g} Hz: the scale "
+                            f"of [controller.pid] cross_kd with cross_speed_rpm)")
     fd = None if kept else _filters_for_target(cfg, kp, ti, td, eps, w_n / (2 * np.pi))
     out["filters"] = [dict(f) for f in fd.filters] if fd else []
     if fd and fd.modes:

@@ -29,8 +29,8 @@ Each element owns its matrices and parameter channels; the rig only assembles th
   :class:`Channel`; P1 Eqs. 46–52);
 * :class:`ContactLaw` — a touchdown bearing's contact: Hertz/Palmgren force, its damping
   by a named law, regularised Coulomb friction (:mod:`ambseal.model.contact`;
-  :func:`normal_force`, :func:`damping_coefficient`), and :func:`hertz_impact`, the
-  undamped impact's closed form;
+  :func:`normal_force`, :func:`damping_coefficient`, :func:`friction_force`), and
+  :func:`hertz_impact`, the undamped impact's closed form;
 * :func:`modal_reduction` → :class:`ModalReduction` — the small real model (P1 §III.4–6);
 * :class:`Modes`, :func:`modes_from_poles`, :func:`classify_poles`, :func:`free_bending_hz`,
   :func:`bending_limit_hz` — damped natural frequencies, damping, unstable poles;
@@ -59,7 +59,7 @@ _FROM = {
     "amplifier_needs": "capacity", "transient_needs": "capacity", "limits_used": "capacity",
     "AXES": "amb", "axis_label": "amb", "BeamElement": "fe",
     "ContactLaw": "contact", "hertz_impact": "contact", "normal_force": "contact",
-    "damping_coefficient": "contact",
+    "damping_coefficient": "contact", "friction_force": "contact",
     "CouplingElement": "fe",
     "DiskElement": "fe", "Channel": "lft", "Parameter": "lft", "Plant": "lft",
     "Modes": "modes", "PoleDisk": "modes", "RIGID_BODY_RAD_S": "modes",

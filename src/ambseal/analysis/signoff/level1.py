@@ -14,23 +14,23 @@ C = 63, HP in hp, D_c and H_c in inches and N in rpm, is the same number in klbf
 
 A cross-coupled stiffness Q (k_xy = Q, k_yx = −Q, destabilising forward whirl) is applied
 at mid-span of a between-bearings rotor, or at each overhung stage in proportion to its
-q_A (or wholly where ``[signoff] level1_position_m`` puts it: ROSS's ``run_level1``
-takes the node nearest mid-span), at the maximum continuous speed, with the seals left
-out; Q runs from 0 to 10·Q_A (at least). The log decrement δ of the forward mode Q destabilises is taken at each Q.
-ROSS's ``Rotor.run_level1`` takes the lowest-frequency mode that is not backward; under an
-AMB controller that mode is often an overdamped rigid-body mode, or a controller pole with
-a small imaginary part that Q hardly moves, and the lowest log decrement of all would be
-an undamped bending mode Q does not touch. So the forward (not backward) modes are
-followed over the sweep by nearest eigenvalue (:func:`~ambseal.analysis.campbell.
-track_modes`), and the screened mode is the one that loses its damping first; if none
-does, the one Q takes the most damping from. The loop counts as lost where a pole within the
-screened band breaks the stability rule (:meth:`~ambseal.analysis.campbell.
-ClosedLoopModes.deciding`); a lossless mesh mode far above the band, which nothing damps
-(ROSS's ``compressor_example`` has them at 21–105 kHz, no structural damping) and any Q
-then drives, is reported apart and decides nothing. Q_0, where its pole crosses the imaginary
-axis (δ = 0), is found by Brent's method on the bracketing interval to a tolerance, not
-read off the grid; a loop lost by a pole that is no forward mode has no Q_0 to refine
-and does not pass.
+q_A (or wholly where ``[signoff] level1_position_m`` puts it: ROSS's ``run_level1`` takes
+the node nearest mid-span), at the maximum continuous speed, with the seals left out; Q
+runs from 0 to 10·Q_A (at least). The log decrement δ of the forward mode Q destabilises
+is taken at each Q. ROSS's ``Rotor.run_level1`` takes the lowest-frequency mode that is
+not backward; under an AMB controller that mode is often an overdamped rigid-body mode,
+or a controller pole with a small imaginary part that Q hardly moves, and the lowest log
+decrement of all would be an undamped bending mode Q does not touch. So the forward (not
+backward) modes are followed over the sweep by nearest eigenvalue
+(:func:`~ambseal.analysis.campbell.track_modes`), and the screened mode is the one that
+loses its damping first; if none does, the one Q takes the most damping from. The loop
+counts as lost where a pole within the screened band breaks the stability rule
+(:meth:`~ambseal.analysis.campbell.ClosedLoopModes.deciding`); a lossless mesh mode far
+above the band, which nothing damps (ROSS's ``compressor_example`` has them at 21–105
+kHz, no structural damping) and any Q then drives, is reported apart and decides nothing.
+Q_0, where its pole crosses the imaginary axis (δ = 0), is found by Brent's method on the
+bracketing interval to a tolerance, not read off the grid; a loop lost by a pole that is
+no forward mode has no Q_0 to refine and does not pass.
 
 With AMBs the supports are the controller: each controller is closed as it runs, the
 discrete controller with its computation delay on the plant sampled by a zero-order hold

@@ -72,6 +72,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.constants import g as GRAVITY  # standard gravity (m/s²), ISO 80000-3
 from scipy.optimize import brentq, minimize_scalar
 from scipy.signal import find_peaks
 
@@ -110,8 +111,6 @@ NOISE_SHARE = 1e-9
 #: Speeds of the coarse sweep; each critical is refined with :data:`REFINE` more.
 SPEEDS = 241
 REFINE = 41
-#: Standard gravity (m/s²), ISO 80000-3.
-GRAVITY = 9.80665
 
 
 def unbalance_ur(load_kg: float, speed_rpm: float) -> float:

@@ -96,7 +96,8 @@ def test_criteria_not_evaluated_are_not_graded_and_the_verdict_says_so(tmp_path,
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].endswith("(not graded: close clearances, vibration zone)")
     assert "none: close clearances: not graded — no close clearance given" in lines[5]
-    assert "none: vibration zone: not graded — no [[amb]] backup_clearance given" in lines[6]
+    assert ("none: vibration zone: not graded — no backup clearance given ([[touchdown]] "
+            "radial_clearance)") in lines[6]
 
 
 def test_signoff_refuses_plainly(tmp_path, capsys):

@@ -169,7 +169,9 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                                          "capacity B_sat² A cos α / μ0 (default 1.2, a "
                                          "setting: no one published value)"),
     "Amb.backup_clearance": ("m", "radial clearance of the backup bearing beside the AMB; "
-                                  "the report sets the unbalance orbit against it"),
+                                  "the report sets the unbalance orbit against it. On a "
+                                  "rig with ``[[touchdown]]`` bearings it is refused: "
+                                  "the nearest one's ``radial_clearance`` is the gap"),
     "Amb.uncertainty": ("", "``{ key = σ }``: relative 1σ uncertainty of a value the fit "
                             "holds fixed (e.g. ``ki = 0.02``)"),
     # { zeta, eta }

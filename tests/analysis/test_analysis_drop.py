@@ -148,6 +148,14 @@ def test_the_verdict_grades_what_the_rig_gives():
     v = drop_verdict(plain, r)
     assert v["passed"] and v["verdict"].startswith("Drop PASSED on what was graded")
     assert {c["outcome"] for c in v["criteria"]} == {"passed", "not graded"}
+    # no air_gap given: the AMB's is its linearisation's Ki·i0/Ks = 100·5/2e5 = 2.5 mm, and
+    # a Ks that puts it at 0.15 mm, inside the fall through the rings, is touched
+    gap = {c["name"]: c for c in v["criteria"]}["no contact at A (air gap)"]
+    assert gap["outcome"] == "passed" and gap["limit"] == "2500 µm"
+    stiff = plain.model_copy(update={"amb": [a.model_copy(update={"ks": 100.0 * 5.0 / 1.5e-4})
+                                             for a in plain.amb]})
+    gap = {c["name"]: c for c in drop_verdict(stiff, r)["criteria"]}["no contact at A (air gap)"]
+    assert gap["outcome"] == "FAILED" and gap["limit"] == "150 µm"
     peak = r.force.max()
     for gap, c0, ratio, ok in ((5e-4, 2 * peak, 1.0, True), (1.5e-4, 2 * peak, 1.0, False),
                                (5e-4, 0.9 * peak, 1.0, False), (5e-4, 0.9 * peak, 1.2, True)):
@@ -241,3 +249,4 @@ def test_the_drop_needs_its_bearings():
         cfg.touchdown[0].model_copy(update={"support_stiffness": 1e7}), cfg.touchdown[1]]})
     with pytest.raises(ConfigError, match="support_mass"):
         drop_model(soft)
+

@@ -35,9 +35,10 @@ def test_an_amb_rig_is_graded_at_its_sensors(tmp_path):
         d = max(0.5e-6 * c.probe_um[(c.speed_hz >= unb.min_hz) & (c.speed_hz <= unb.max_hz),
                                     list(c.probe_m).index(a.sensor_position)].max()
                 for c in unb.cases)
-        assert s.d_max_m == pytest.approx(d) and s.c_min_m == a.backup_clearance
-        assert s.zone == vibration_zone(d, a.backup_clearance, (0.3, 0.4, 0.5))
-    bare = cfg.model_copy(update={"amb": [a.model_copy(update={"backup_clearance": None})
-                                          for a in cfg.amb]})
+        # C_min: the touchdown bearing beside the AMB (the rig's TA, TB)
+        td = min(cfg.touchdown, key=lambda t: abs(t.position - a.position))
+        assert s.d_max_m == pytest.approx(d) and s.c_min_m == td.radial_clearance
+        assert s.zone == vibration_zone(d, td.radial_clearance, (0.3, 0.4, 0.5))
+    bare = cfg.model_copy(update={"touchdown": []})
     none = iso14839_2_zones(bare, unb)
     assert not none.graded and none.zone is None and none.passed

@@ -153,3 +153,23 @@ def test_the_touchdown_table_is_read_and_refused_by_key():
                                              'contact = "point"\ncontact_radius = 0.004\n')))
     assert ContactLaw.of(point.touchdown[0]).stiffness == pytest.approx(
         point_stiffness(2.075e11, 0.3, 0.004))
+
+
+def test_the_backup_clearance_is_the_nearest_touchdown_bearings_and_given_once():
+    """The gap an AMB's backup bearing leaves is the ``radial_clearance`` of the
+    ``[[touchdown]]`` bearing nearest the AMB; a rig without them keeps ``[[amb]]
+    backup_clearance``; a rig giving both is refused, naming the AMB's key."""
+    near = ('name = "TB"\nposition = 0.75\nradial_clearance = 3.0e-4\n'
+            "contact_length = 0.015\nrestitution = 0.5\nfriction = 0.1\n")
+    doc = _rig_with(near)
+    doc["touchdown"].insert(0, tomllib.loads(near.replace('"TB"', '"TA"').replace(
+        "0.75", "0.01").replace("3.0e-4", "2.0e-4")))
+    cfg = parse_rig(doc)
+    # AMB A at 0.17 m lies nearer TA (0.01 m), AMB B at 0.69 m nearer TB (0.75 m)
+    assert [cfg.backup_clearance(a) for a in cfg.amb] == [2.0e-4, 3.0e-4]
+    doc["amb"][1]["backup_clearance"] = 3.0e-4
+    with pytest.raises(ConfigError, match=r"amb\[1\]\.backup_clearance.*\[\[touchdown\]\]"):
+        parse_rig(doc)
+    del doc["touchdown"]
+    bare = parse_rig(doc)
+    assert [bare.backup_clearance(a) for a in bare.amb] == [None, 3.0e-4]

@@ -296,20 +296,23 @@ def test_the_command_line_starts_light():
     subprocess.run([sys.executable, "-c", code], check=True)
 
 
-def test_orbit_against_the_rigs_clearances(tmp_path):
-    """Reference: the thesis rig's nominal radial air gap, 0.5 mm (P2 Table 1), and a
-    backup-bearing clearance given in the rig file; the orbit is set against the smaller of
-    each kind, in per cent (7.9 µm of 500 µm is 1.58 %)."""
-    from ambseal.config import default_rig_path, load_rig
+def test_orbit_against_the_rigs_clearances():
+    """Reference: the thesis rig's nominal radial air gap, 0.5 mm (P2 Table 1), and the
+    backup-bearing clearance its touchdown bearings give (0.25 mm, the rig file's
+    choice); the orbit is set against the smaller of each kind, in per cent (7.9 µm of
+    500 µm is 1.58 %). Without touchdown bearings, an ``[[amb]] backup_clearance``."""
+    from ambseal.config import load_rig
     from ambseal.analysis.delivery import rig_clearances_um
     from ambseal.report.verdict import verdicts
 
-    text = default_rig_path().read_text().replace(
-        "current_limit = 6.0\n", "current_limit = 6.0\nbackup_clearance = 0.25e-3\n")
-    (tmp_path / "rig.toml").write_text(text)
-    clear = rig_clearances_um(load_rig(tmp_path / "rig.toml"))
+    cfg = load_rig()
+    clear = rig_clearances_um(cfg)
     assert clear == pytest.approx({"air gap": 500.0, "backup bearing": 250.0}, rel=1e-3)
-    assert rig_clearances_um(load_rig()) == pytest.approx({"air gap": 500.0}, rel=1e-3)
+    bare = cfg.model_copy(update={"touchdown": []})
+    assert rig_clearances_um(bare) == pytest.approx({"air gap": 500.0}, rel=1e-3)
+    given = bare.model_copy(update={"amb": [a.model_copy(update={"backup_clearance": 3e-4})
+                                            for a in bare.amb]})
+    assert rig_clearances_um(given)["backup bearing"] == pytest.approx(300.0)
     v = verdicts(_metrics()[:1], clear)[0]
     assert v.orbit_text() == "7.9 µm (1.6 % of the air gap; 3.2 % of the backup bearing)"
 

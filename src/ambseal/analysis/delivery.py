@@ -208,7 +208,8 @@ def saturation_failure(method: str, capacity: dict | None, designed: bool,
 def rig_clearances_um(cfg) -> dict[str, float]:
     """Clearances (µm) the unbalance orbit is judged against: the nominal AMB air gap
     (:func:`ambseal.design.specs.machine`: ``air_gap``, or Ki·i0/Ks) and the smallest
-    backup-bearing clearance (``[[amb]] backup_clearance``), those the rig gives.
+    backup-bearing clearance (:meth:`~ambseal.config.RigConfig.backup_clearance`), those
+    the rig gives.
 
     Parameters
     ----------
@@ -225,7 +226,7 @@ def rig_clearances_um(cfg) -> dict[str, float]:
     gap = machine(cfg).air_gap_m if cfg.amb else None
     if gap:
         out["air gap"] = gap * 1e6
-    backup = [a.backup_clearance for a in cfg.amb if a.backup_clearance]
+    backup = [g for g in map(cfg.backup_clearance, cfg.amb) if g]
     if backup:
         out["backup bearing"] = min(backup) * 1e6
     return out

@@ -44,6 +44,7 @@ from scipy.constants import g as GRAVITY
 from scipy.integrate import solve_ivp
 from scipy.linalg import eigh
 
+from ambseal.design import air_gaps
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
 from ambseal.model import (
@@ -583,7 +584,8 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
 def drop_verdict(cfg, result: DropResult) -> dict:
     """The drop judged, verdict first: each criterion passed, FAILED, or not graded (with
     why) — no contact outside the touchdown bearings (the largest excursion at each AMB
-    against its ``air_gap``, at each seal against its ``clearance``), each touchdown
+    against its air gap, :func:`ambseal.design.air_gaps`, at each seal against its
+    ``clearance``), each touchdown
     bearing's peak force against ``[drop] force_ratio`` × its ``static_rating`` C₀, and
     no backward whirl sustained over the last half of the drop.
 
@@ -608,7 +610,7 @@ def drop_verdict(cfg, result: DropResult) -> dict:
                                                "passed" if ok else "FAILED"),
                      "value": value, "limit": limit})
 
-    gaps = {f"amb:{a.name}": a.air_gap for a in cfg.amb}
+    gaps = {f"amb:{a.name}": s0 for a, s0 in zip(cfg.amb, air_gaps(cfg))}
     gaps.update({f"seal:{s.name}": s.clearance for s in cfg.seal})
     for key, gap in gaps.items():
         worst = float(np.hypot(*result.watched[key].T).max())

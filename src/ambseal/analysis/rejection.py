@@ -364,7 +364,7 @@ def facility_speed_step(cfg, digital, rejection, from_hz: float, to_hz: float, *
 
 def _runout(cfg) -> float:
     """The facility's runout amplitude (m; module docstring)."""
-    gaps = [g for a in cfg.amb for g in (a.air_gap, a.backup_clearance) if g]
+    gaps = [g for a in cfg.amb for g in (a.air_gap, cfg.backup_clearance(a)) if g]
     return RUNOUT_FRACTION * min(gaps) if gaps else RUNOUT_M
 
 

@@ -261,4 +261,9 @@ def cross_check(cfg, where: str) -> None:
         on_shaft(f"amb[{i}].sensor_position", a.sensor_position)
         if a.name in names:
             raise ConfigError(f"{where}: amb[{i}].name: duplicate AMB name {a.name!r}")
+        # one gap, one number: the touchdown bearing's is the one the drop lands on
+        if cfg.touchdown and a.backup_clearance is not None:
+            raise ConfigError(f"{where}: amb[{i}].backup_clearance: the rig's [[touchdown]] "
+                              "bearings give the backup clearance (their radial_clearance); "
+                              "give it there only")
         names.add(a.name)

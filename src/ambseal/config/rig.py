@@ -46,8 +46,10 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
     explicitly (also for one axis only) wins over the geometry's
     (:func:`ambseal.model.amb.amb_factors`). Also optional ``current_limit`` (A, the
     amplifier's limit on the control current) and
-    ``backup_clearance`` (m, radial clearance of the backup bearing beside the AMB); the
-    report sets the worst unbalance orbit against it and against ``air_gap``. The amplifier
+    ``backup_clearance`` (m, radial clearance of the backup bearing beside the AMB, on a
+    rig without ``[[touchdown]]`` bearings, whose clearances replace it:
+    :meth:`RigConfig.backup_clearance`); the report sets the worst unbalance orbit
+    against it and against ``air_gap``. The amplifier
     and coil (:mod:`ambseal.model.capacity`): ``supply_voltage`` (V), ``inductance`` (H,
     default from the geometry), ``resistance`` (Ω) and ``saturation_flux_density`` (T,
     default 1.2).
@@ -878,6 +880,17 @@ class RigConfig(_Strict):
     def speed(self) -> float:
         """Rotational speed Ω (rad/s)."""
         return self.operating.speed_rpm * 2.0 * math.pi / 60.0
+
+    def backup_clearance(self, amb: Amb) -> float | None:
+        """The radial clearance (m) of the backup bearing beside an AMB: on a rig with
+        ``[[touchdown]]`` bearings, the ``radial_clearance`` of the one nearest the AMB
+        along the shaft (the first of two equally near); else the AMB's own
+        ``backup_clearance``, None where neither is given. A rig gives the gap in one of
+        the two places (:func:`~ambseal.config.parse_rig` refuses both)."""
+        if self.touchdown:
+            return min(self.touchdown, key=lambda t: abs(t.position - amb.position)
+                       ).radial_clearance
+        return amb.backup_clearance
 
 
 def _union_tags() -> set[str]:

@@ -39,12 +39,19 @@ from ambseal.design.plant import generalized_plant, physical_controller, uncerta
 from ambseal.design.recipes import DesignResult, design, full_order_check
 from ambseal.design.result import Design
 from ambseal.design.seal_schedule import design_seal_scheduled
-from ambseal.design.specs import RIGID_STATES, DesignSpec, Machine, design_spec, machine
+from ambseal.design.specs import (
+    RIGID_STATES,
+    DesignSpec,
+    Machine,
+    air_gaps,
+    design_spec,
+    machine,
+)
 from ambseal.design.synchronous_rejection import SynchronousRejection, design_rejection
 from ambseal.design.weights import Weights, default_weights
 
 __all__ = ["RIGID_STATES", "Design", "DesignResult", "DesignSpec", "Machine", "Weights",
-           "ScheduledPid",
+           "ScheduledPid", "air_gaps",
            "controller_from_metadata", "default_weights", "design", "design_frozen",
            "design_lpv", "lpv_schedule", "design_rise", "design_seal_scheduled", "design_spec",
            "full_order_check", "generalized_plant", "machine", "uncertainty_at",

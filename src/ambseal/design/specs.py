@@ -105,7 +105,7 @@ from ambseal.model import (
     poles_near_zero,
 )
 
-__all__ = ["Machine", "DesignSpec", "machine", "design_spec", "round_125", "judged_conditions"]
+__all__ = ["Machine", "DesignSpec", "air_gaps", "machine", "design_spec", "round_125", "judged_conditions"]
 
 RIGID_STATES = 8  # 2 translations and 2 tilts of a rigid rotor, 2 states each
 #: ω_B·T_i of the H∞ and μ performance weights (module docstring, "H∞ and μ weights")
@@ -164,6 +164,31 @@ class Machine:
     delay_s: float
 
 
+def air_gaps(cfg, biases=None) -> list[float | None]:
+    """Each AMB's nominal radial air gap s0 (m): its ``air_gap``, else the smallest over its
+    axes of the linearisation's own ratio Ki·i0/Ks (Schweitzer & Maslen 2009); None where
+    neither is known (no bias current, Ks = 0, or a ratio beyond an ``air_gap``'s bound).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig, with its ``[[amb]]`` tables.
+    biases : list of float or None, optional
+        Each AMB's bias current (A), as :func:`ambseal.model.bias_currents` gives them.
+
+    Returns
+    -------
+    list of float or None
+        One per ``[[amb]]``, in their order.
+    """
+    out = []
+    for a, b in zip(cfg.amb, bias_currents(cfg) if biases is None else biases):
+        ratios = [] if b is None else [k_i * b / k_s for k_i, k_s in zip(*amb_factors(a))
+                                       if k_i * b <= MAX_GAP_M * k_s]
+        out.append(a.air_gap if a.air_gap is not None else min(ratios) if ratios else None)
+    return out
+
+
 def machine(cfg) -> Machine:
     """The machine facts of a rig (module docstring, "Machine facts").
 
@@ -189,13 +214,8 @@ def machine(cfg) -> Machine:
         fa = min(fa, 1 / (2 * math.pi * act.eddy_time_constant))
     biases = bias_currents(cfg)
     i0 = bias_current(cfg)
-    gaps = []
-    for a, b in zip(cfg.amb, biases):
-        if a.air_gap is not None:
-            gaps.append(a.air_gap)
-        elif b is not None:  # none where Ks = 0 or Ki·i0/Ks exceeds an air_gap's bound
-            gaps += [k_i * b / k_s for k_i, k_s in zip(*amb_factors(a)) if k_i * b <= MAX_GAP_M * k_s]
-    s0 = min(gaps) if gaps and len(gaps) >= len(cfg.amb) else None
+    gaps = [g for g in air_gaps(cfg, biases) if g is not None]
+    s0 = min(gaps) if gaps else None
     return Machine(float(assemble_rotor(cfg).mass), fb[0] if fb else None, float(fa), i0,
                    s0, float(fs), (cfg.controller.delay_samples + 0.5) / float(fs))
 

@@ -12,7 +12,8 @@ operation), as ISO 14839-3 grades the sensitivity (:mod:`ambseal.analysis.iso`).
 The displacement graded is the API 617 unbalance response's at the sensors
 (:mod:`ambseal.analysis.signoff.unbalance_api617`), the largest over its cases, from the minimum
 to the maximum continuous speed: the rotor carrying the specification's unbalance. An
-AMB without ``backup_clearance`` is not graded, and says so.
+AMB without a backup clearance (:meth:`~ambseal.config.RigConfig.backup_clearance`) is
+not graded, and says so.
 """
 
 from __future__ import annotations
@@ -100,7 +101,7 @@ def iso14839_2_zones(cfg, unbalance) -> IsoVibration:
     Parameters
     ----------
     cfg : RigConfig
-        The rig (its ``[[amb]]`` ``backup_clearance`` and ``[signoff]``).
+        The rig (its backup clearances and ``[signoff]``).
     unbalance : ambseal.analysis.signoff.unbalance_api617.Api617Unbalance
         Its responses at the probes.
 
@@ -119,7 +120,7 @@ def iso14839_2_zones(cfg, unbalance) -> IsoVibration:
             p = int(np.argmin(np.abs(np.asarray(c.probe_m) - a.sensor_position)))
             if band.any():
                 d = max(d, 0.5e-6 * float(c.probe_um[band, p].max()))
-        cm = a.backup_clearance
+        cm = cfg.backup_clearance(a)
         out.append(SensorZone(a.name, a.sensor_position, cm, d,
                               None if cm is None else vibration_zone(d, cm, bounds)))
     return IsoVibration(unbalance.controller, bounds, tuple(out))

@@ -62,7 +62,7 @@ stated):
   (8th ed., 2014) Part 1 §4.8.2.11 defines S_c and its bounds; the speed range of A_1
   is not in the public text, and both readings are settings. The response at every
   close clearance (a seal's or a spring's ``clearance``, a backup bearing's
-  ``backup_clearance`` at its AMB), times S_c, from standstill to the trip speed, must
+  clearance at its AMB, :meth:`~ambseal.config.RigConfig.backup_clearance`), times S_c, from standstill to the trip speed, must
   stay within ``[signoff] clearance_fraction`` (75 %) of the diametral clearance.
 """
 
@@ -590,8 +590,8 @@ def _close_clearances(cfg) -> list[tuple[str, float, float]]:
     out = [(s.name, s.position, s.clearance) for s in cfg.seal if s.clearance is not None]
     out += [(s.name or f"spring{i}", s.position, s.clearance)
             for i, s in enumerate(cfg.spring) if s.clearance is not None]
-    out += [(f"backup bearing {a.name}", a.position, a.backup_clearance)
-            for a in cfg.amb if a.backup_clearance is not None]
+    out += [(f"backup bearing {a.name}", a.position, cfg.backup_clearance(a))
+            for a in cfg.amb if cfg.backup_clearance(a) is not None]
     return out
 
 

@@ -206,7 +206,8 @@ def _criteria(cfg, l1, l2, unb, iso) -> tuple:
         value = (f"{k.name}: {k.scaled_um:.3g} µm p-p (S_c = {sc:.3g}) of "
                  f"{k.diametral_um:.3g} µm")
     else:
-        value = "no close clearance given ([[seal]] clearance, [[amb]] backup_clearance)"
+        value = ("no close clearance given ([[seal]] clearance, [[touchdown]] "
+                 "radial_clearance)")
     rows.append(Criterion("close clearances", value,
                           f"≤ {100 * cfg.signoff.clearance_fraction:.3g} % of the diametral "
                           "clearance", CLAUSES["clearance"], bool(clear) and unb.clearance_passed,
@@ -216,7 +217,7 @@ def _criteria(cfg, l1, l2, unb, iso) -> tuple:
         value = (f"zone {iso.zone}: AMB {s.amb} {1e6 * s.d_max_m:.3g} µm 0-p = "
                  f"{s.d_max_m / s.c_min_m:.3g}·C_min")
     else:
-        value = "no [[amb]] backup_clearance given"
+        value = "no backup clearance given ([[touchdown]] radial_clearance)"
     rows.append(Criterion("vibration zone", value,
                           f"zone A or B (A/B {iso.boundaries[0]:g}, B/C {iso.boundaries[1]:g}"
                           f", C/D {iso.boundaries[2]:g}·C_min)", CLAUSES["iso14839_2"],

@@ -250,3 +250,43 @@ def test_the_drop_needs_its_bearings():
     with pytest.raises(ConfigError, match="support_mass"):
         drop_model(soft)
 
+
+def test_a_whirl_in_rolling_contact_meets_the_no_slip_kinematics():
+    """The rotor started whirling forward at ω₀ = 2000 rad/s round its rings (1 mm
+    clearance, stiff point contacts), spinning at Ω = 3000 rpm, the free rings at rest:
+    friction at the slip Ω R_j + r ω − ω_r R_r turns the rings and brakes the whirl until
+    the journal rolls on each ring: r ω + Ω R_j = ω_r R_r (within 2 %). Friction is
+    internal to the rotor and its rings, so the whirl's angular momentum about the ring's
+    centre with the rings' (carried to the contact's radius) is kept:
+    (m/2) r² ω + J ω_r r/R_r is the same at the end (within 2 %)."""
+    c, J, W, w0 = 1e-3, 1e-3, 100 * math.pi, 2000.0
+    base = _rig()
+    cfg = base.model_copy(update={"touchdown": [
+        t.model_copy(update={"radial_clearance": c, "restitution": 0.5, "friction": 0.2,
+                             "friction_velocity": 0.1, "race_inertia": J,
+                             "contact_stiffness": 1e12})
+        for t in base.touchdown]})
+    dm = drop_model(cfg)
+    m = inertia(*DISK)[0]
+    # the start: each plane's half of the centripetal force m ω₀² r carried by its contact
+    r0 = c
+    for _ in range(50):
+        r0 = c + (0.5 * m * w0 ** 2 * r0 / 1e12) ** (2 / 3)
+    u, v = np.zeros(4 * dm.z.size), np.zeros(4 * dm.z.size)
+    u[0::4], v[1::4] = r0, w0 * r0
+    r = simulate_drop(cfg, speed_rpm=3000.0, duration_s=0.004, samples=4001, model=dm,
+                      initial=(u, v))
+    R_j = journal_radius(cfg, 0.0)
+    R_r = R_j + c
+    late = r.t >= 0.75 * r.t[-1]
+    for p in range(2):
+        x, y = r.orbit[p, late].T
+        radius = float(np.hypot(x, y).mean())
+        ang = np.unwrap(np.arctan2(y, x))
+        w = float(np.polyfit(r.t[late], ang, 1)[0])
+        w_r = float(r.race_speed[p, -1])
+        assert abs(w_r) > 100.0 and w < 0.9 * w0  # the rings turned, the whirl braked
+        assert radius * w + W * R_j == pytest.approx(w_r * R_r, rel=0.02)
+        start = 0.5 * m * r0 ** 2 * w0
+        end = 0.5 * m * radius ** 2 * w + J * w_r * radius / R_r
+        assert end == pytest.approx(start, rel=0.02)

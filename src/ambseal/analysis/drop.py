@@ -124,6 +124,11 @@ class DropModel:
     node_rows : dict
         ``{"amb:NAME" or "seal:NAME": ndarray (2, m)}``: the x, y rows of Φ at each AMB
         and seal, whose excursions the verdict sets against their gaps.
+    z : ndarray, shape (n_nodes,)
+        The FE nodes' positions (m); node k's DOFs are x, y, θx, θy at 4k … 4k + 3.
+    projector : ndarray, shape (m, n_dof)
+        ΦᵀM: the modal coordinates of a nodal displacement or velocity (exact within the
+        modes kept, their mass-weighted least squares otherwise).
     """
 
     phi: np.ndarray
@@ -148,6 +153,8 @@ class DropModel:
     names: tuple
     modes_hz: float
     node_rows: dict = field(default_factory=dict, repr=False)
+    z: np.ndarray = field(default=None, repr=False)
+    projector: np.ndarray = field(default=None, repr=False)
 
 
 def _amb_static_forces(cfg, mass: float, z_g: float) -> np.ndarray:
@@ -240,7 +247,7 @@ def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
         amb_rows=amb_rows, amb_force=amb_force, amb_tau=tau, q0=q0, mass=mass,
         polar_inertia=float(abs(Gr[2, 3])),
         names=tuple(t.name for t in cfg.touchdown), modes_hz=float(modes_hz),
-        node_rows=rows)
+        node_rows=rows, z=np.asarray(mesh.z, float), projector=phi.T @ rotor.M)
 
 
 @dataclass(frozen=True)
@@ -340,6 +347,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                   samples: int = 4001, modes_hz: float | None = None, rtol: float = 1e-8,
                   method: str = "DOP853", model: DropModel | None = None,
                   coast_down: bool = False, drag_torque: float = 0.0,
+                  initial: tuple | None = None,
                   progress=None) -> DropResult:
     """Drop the rotor of ``cfg`` onto its touchdown bearings (module docstring).
 
@@ -368,6 +376,10 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         the gyroscopic moments at the instantaneous speed.
     drag_torque : float, optional
         The process and windage torque T_d against the spin (N·m), ≥ 0.
+    initial : tuple of two ndarray, shape (n_dof,), optional
+        The rotor's nodal displacement (m, rad) and velocity (m/s, rad/s) in the drop
+        model's DOFs (:attr:`DropModel.z`) when the AMBs let go, projected on the modes
+        kept (:attr:`DropModel.projector`); default the levitated equilibrium at rest.
     progress : callable, optional
         ``progress(t_s)`` after each segment.
 
@@ -378,7 +390,8 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     Raises
     ------
     ConfigError
-        As :func:`drop_model`; a duration or sample count out of range.
+        As :func:`drop_model`; a duration or sample count out of range; an ``initial``
+        state of the wrong shape or not finite.
     """
     if not (duration_s > 0 and math.isfinite(duration_s)):
         raise ConfigError(f"drop: duration: expected > 0 s, got {duration_s!r}")
@@ -480,6 +493,14 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
 
     y = np.zeros(n_y)
     y[:m] = dm.q0
+    if initial is not None:
+        u0, du0 = (np.asarray(a, float) for a in initial)
+        n_dof = dm.projector.shape[1]
+        if u0.shape != (n_dof,) or du0.shape != (n_dof,) or not (
+                np.isfinite(u0).all() and np.isfinite(du0).all()):
+            raise ConfigError(f"drop: initial: expected a finite displacement and velocity "
+                              f"of {n_dof} DOFs each, got shapes {u0.shape}, {du0.shape}")
+        y[:m], y[m:2 * m] = dm.projector @ u0, dm.projector @ du0
     if coast_down:
         y[-1] = W0
     grid = np.linspace(0.0, duration_s, samples)
@@ -493,7 +514,8 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         atol[-1] = rtol * (abs(W0) + 1.0)
     for k in range(len(sup)):
         atol[2 * m + races.size + 4 * k:2 * m + races.size + 4 * k + 2] = rtol * c_min
-    touching = [False] * P
+    # a start in contact (an ``initial`` state on a ring) waits for the contact's end
+    touching = [c[1] > 0 for c in contacts(0.0, y)]
     ts, ys = [0.0], [y.copy()]
     peak_force, peak_delta = np.zeros(P), np.zeros(P)
     t0, impacts, segments = 0.0, 0, 0

@@ -49,7 +49,17 @@ def test_drop_writes_its_summary_and_figure(tmp_path, capsys):
         assert p["regime"] in ("bouncing", "resting", "forward whirl", "backward whirl")
     assert set(doc["watched_max_m"]) == {"amb:A", "amb:B"}
     assert json.loads((out / "drop.json").read_text())["planes"] == doc["planes"]
-    assert (out / "drop.png").stat().st_size > 0
+    assert doc["files"] == [str(out / f) for f in ("drop.json", "drop.png",
+                                                    "drop_whirl.png", "drop.html")]
+    assert (out / "drop.png").stat().st_size > 0 and (out / "drop_whirl.png").stat().st_size
+    # the page: the verdict first, then each bearing's row with its numbers, the figures
+    # embedded
+    page = (out / "drop.html").read_text()
+    assert page.index("<h2>Verdict</h2>") < page.index("<h2>Touchdown bearings</h2>")
+    assert doc["verdict"] in page and page.count("data:image/png;base64,") == 2
+    for p in doc["planes"]:
+        assert f"{p['peak_force_n']:.4g}" in page
+        assert f"{1e6 * p['max_orbit_m']:.4g} ({p['max_orbit_m'] / 2e-4:.3g} c)" in page
 
 
 def test_a_rig_without_touchdown_bearings_is_refused(tmp_path, capsys):

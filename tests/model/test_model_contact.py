@@ -173,3 +173,31 @@ def test_the_backup_clearance_is_the_nearest_touchdown_bearings_and_given_once()
     del doc["touchdown"]
     bare = parse_rig(doc)
     assert [bare.backup_clearance(a) for a in bare.amb] == [None, 3.0e-4]
+
+
+def test_the_rated_contact_stress_is_iso76s_at_c0_and_hertzs_power_below():
+    """ISO 76:2006 §3.1: C₀ gives 4 200 MPa in a ball bearing, 4 000 MPa in a roller
+    bearing. Below it the stress follows the element's load as Hertz's closed forms do
+    (Johnson 1985): a ball's p₀ = (6 Q E*²/(π³ R²))^{1/3}, a roller's
+    p₀ = (Q E*/(π l R))^{1/2}, here evaluated at two loads for their ratio."""
+    from ambseal.model import rated_contact_stress
+
+    c0 = 2.0e4
+    assert rated_contact_stress(c0, c0) == pytest.approx(4.2e9)
+    assert rated_contact_stress(c0, c0, "roller") == pytest.approx(4.0e9)
+    E = effective_modulus(2.075e11, 0.3)
+
+    def ball(q):
+        return (6 * q * E ** 2 / (np.pi ** 3 * 0.004 ** 2)) ** (1 / 3)
+
+    def roller(q):
+        return (q * E / (np.pi * 0.01 * 0.004)) ** 0.5
+
+    for f in (0.01, 0.3, 0.77):
+        assert rated_contact_stress(f * c0, c0) / 4.2e9 == pytest.approx(
+            ball(f) / ball(1.0), rel=1e-12)
+        assert rated_contact_stress(f * c0, c0, "roller") / 4.0e9 == pytest.approx(
+            roller(f) / roller(1.0), rel=1e-12)
+    for bad in ({"elements": "needle"}, {"static_rating": 0.0}):
+        with pytest.raises(ValueError, match=next(iter(bad))):
+            rated_contact_stress(1.0, **{"static_rating": c0, **bad})

@@ -59,9 +59,12 @@ from ambseal.report import (
     api617_unbalance_figure,
     campbell_figure,
     drop_figure,
+    drop_whirl_figure,
     level1_figure,
     mode_shapes_figure,
     stability_map_figure,
+    stamp,
+    write_drop_report,
 )
 
 __all__ = ["HANDLERS", "write_table"]
@@ -299,15 +302,29 @@ def _drop(args: argparse.Namespace) -> int:
     out.mkdir(parents=True, exist_ok=True)
     judged = drop_verdict(cfg, res)
     doc = {"rig": str(args.rig), "speed_rpm": rpm, **judged, **res.to_dict()}
-    files = [write_json(out / "drop.json", doc),
-             drop_figure(out / "drop.png", res, [t.radial_clearance for t in cfg.touchdown],
-                         title=f"Rotor drop — {cfg.rotor.name}")]
+    for plane, td in zip(doc["planes"], cfg.touchdown):
+        plane["radial_clearance_m"] = td.radial_clearance
+    title = f"Rotor drop — {cfg.rotor.name}"
+    figures = [("Orbits in the clearance and contact forces",
+                drop_figure(out / "drop.png", res, [t.radial_clearance for t in cfg.touchdown],
+                            title=title)),
+               ("Whirl waterfall and speeds", drop_whirl_figure(out / "drop_whirl.png", res,
+                                                                title=title))]
+    files = [write_json(out / "drop.json", doc), *(png for _, png in figures),
+             write_drop_report(out / "drop.html", doc, figures, title=title,
+                               meta=stamp(args.rig, args.command_line))]
     if args.json:
         print(json.dumps({**doc, "files": [str(f) for f in files]}))
     else:
         print(doc["verdict"])
         for c in doc["criteria"]:
             print(f"{c['name']}: {c['outcome']} — {c['value']} (limit {c['limit']})")
+        for p in doc["planes"]:
+            onset, spin_up = p["whirl_onset_s"], p["race_spin_up_s"]
+            print(f"{p['name']}: {p['regime']}"
+                  + (f" at {p['whirl_hz']:.4g} Hz from {1e3 * onset:.4g} ms"
+                     if onset is not None else "")
+                  + (f"; ring spun up in {1e3 * spin_up:.4g} ms" if spin_up else ""))
         print(f"files: {', '.join(str(f) for f in files)}")
     return 0 if doc["passed"] else 1
 

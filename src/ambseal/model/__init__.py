@@ -30,7 +30,8 @@ Each element owns its matrices and parameter channels; the rig only assembles th
 * :class:`ContactLaw` — a touchdown bearing's contact: Hertz/Palmgren force, its damping
   by a named law, regularised Coulomb friction (:mod:`ambseal.model.contact`;
   :func:`normal_force`, :func:`damping_coefficient`, :func:`friction_force`), and
-  :func:`hertz_impact`, the undamped impact's closed form;
+  :func:`hertz_impact`, the undamped impact's closed form; :func:`rated_contact_stress`,
+  a rolling bearing's element stress from its C₀ (ISO 76);
 * :func:`modal_reduction` → :class:`ModalReduction` — the small real model (P1 §III.4–6);
 * :class:`Modes`, :func:`modes_from_poles`, :func:`classify_poles`, :func:`free_bending_hz`,
   :func:`bending_limit_hz` — damped natural frequencies, damping, unstable poles;
@@ -60,6 +61,7 @@ _FROM = {
     "AXES": "amb", "axis_label": "amb", "BeamElement": "fe",
     "ContactLaw": "contact", "hertz_impact": "contact", "normal_force": "contact",
     "damping_coefficient": "contact", "friction_force": "contact",
+    "rated_contact_stress": "contact",
     "CouplingElement": "fe",
     "DiskElement": "fe", "Channel": "lft", "Parameter": "lft", "Plant": "lft",
     "Modes": "modes", "PoleDisk": "modes", "RIGID_BODY_RAD_S": "modes",

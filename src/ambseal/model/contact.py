@@ -25,6 +25,14 @@ discontinuity: F_t = μ·N·tanh(v/v_r).
 Without damping an impact of a mass m at v₀ ends where the kinetic energy is stored,
 (½)m v₀² = K δ_max^{n+1}/(n+1), and lasts t_c = 2(δ_max/v₀)·∫₀¹(1 − u^{n+1})^{-½}du
 (for n = 3/2, t_c = 2.943 δ_max/v₀; Goldsmith, *Impact*, 1960): :func:`hertz_impact`.
+
+The stress inside a rolling touchdown bearing is read from its basic static load rating
+C₀ (:func:`rated_contact_stress`): ISO 76:2006 §3.1 defines C₀ as the radial load that
+gives 4 200 MPa at the centre of the most heavily loaded ball–raceway contact (4 000 MPa
+for rollers); that element's share of the bearing's load is fixed by the bearing's
+geometry, and Hertz's contact stress grows with the element's load as Q^{1/3} (point) or
+Q^{1/2} (line; Johnson 1985, Eqs. 4.23, 4.45), so a load F gives σ_C₀·(F/C₀)^{1/3}
+in a ball bearing and σ_C₀·(F/C₀)^{1/2} in a roller bearing.
 """
 
 from __future__ import annotations
@@ -36,12 +44,16 @@ import numpy as np
 
 __all__ = ["N_POINT", "N_LINE", "PALMGREN_MM", "DAMPING_LAWS", "effective_modulus",
            "point_stiffness", "line_stiffness", "damping_coefficient", "normal_force",
-           "friction_force", "hertz_impact", "ContactLaw"]
+           "friction_force", "hertz_impact", "rated_contact_stress", "ISO76_STRESS_PA",
+           "ContactLaw"]
 
 #: Hertz's exponent of a point contact and Palmgren's of a line contact
 N_POINT, N_LINE = 1.5, 10.0 / 9.0
 #: Palmgren's line contact of bearing steel: δ = PALMGREN_MM·Q^0.9/l^0.8 (mm, N, mm)
 PALMGREN_MM = 3.84e-5
+#: ISO 76:2006 §3.1: the contact stress (Pa) at C₀ in a ball and in a roller bearing
+#: (4 600 MPa for self-aligning ball bearings, not a touchdown bearing's kind)
+ISO76_STRESS_PA = {"ball": 4.2e9, "roller": 4.0e9}
 #: the damping laws, by their rig-file names: D·v₀ as a function of e
 DAMPING_LAWS = {
     "hunt_crossley": lambda e: 1.5 * (1.0 - e),
@@ -202,6 +214,39 @@ def hertz_impact(mass: float, speed: float, stiffness: float,
     # ∫₀¹ (1 − u^p)^(−1/2) du = B(1/p, 1/2)/p
     integral = math.gamma(1.0 / p) * math.sqrt(math.pi) / (p * math.gamma(1.0 / p + 0.5))
     return d_max, 2.0 * integral * d_max / speed
+
+
+def rated_contact_stress(force, static_rating: float, elements: str = "ball"):
+    """The largest rolling-element contact stress (Pa) in a rolling bearing carrying a
+    radial ``force`` (N), from its basic static load rating (module docstring).
+
+    Parameters
+    ----------
+    force : float or ndarray
+        The bearing's radial load (N), ≥ 0.
+    static_rating : float
+        C₀ (N, ISO 76), > 0.
+    elements : {"ball", "roller"}
+        The rolling elements: Hertz's point contact (stress ∝ load^{1/3}) or line contact
+        (∝ load^{1/2}).
+
+    Returns
+    -------
+    float or ndarray
+        σ (Pa): ISO76_STRESS_PA[elements] at ``force`` = C₀.
+
+    Raises
+    ------
+    ValueError
+        An unknown ``elements``, or C₀ not positive.
+    """
+    if elements not in ISO76_STRESS_PA:
+        raise ValueError(f"elements: expected one of {sorted(ISO76_STRESS_PA)}, got "
+                         f"{elements!r}")
+    if not static_rating > 0:
+        raise ValueError(f"static_rating: expected > 0 N, got {static_rating!r}")
+    power = 1.0 / 3.0 if elements == "ball" else 0.5
+    return ISO76_STRESS_PA[elements] * (np.asarray(force, float) / static_rating) ** power
 
 
 @dataclass(frozen=True)

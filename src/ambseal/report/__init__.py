@@ -15,8 +15,11 @@
 * :func:`level1_figure`, :func:`api617_unbalance_figure`, :func:`signoff_report` — API 617's
   Level I screening, unbalance response
   (:mod:`ambseal.report.signoff_figures`);
-* :func:`drop_figure` — the rotor drop: orbits in the clearance, contact forces
-  (:mod:`ambseal.report.drop_figures`);
+* :func:`drop_figure`, :func:`drop_whirl_figure` — the rotor drop: orbits in the
+  clearance, contact forces, the whirl's waterfall (:func:`whirl_waterfall`), the rings'
+  speeds
+  (:mod:`ambseal.report.drop_figures`); :func:`write_drop_report`, its page
+  (:mod:`ambseal.report.drop_report`);
 * :func:`figure_is_ours` — whether a PNG is one ambseal wrote (:mod:`ambseal.report.figures`);
 * :class:`StageProgress` — a long job's progress, stage by stage.
 
@@ -35,7 +38,9 @@ _FROM = {
     "stability_map_figure": "modal_figures",
     "StageProgress": "progress",
     "level1_figure": "signoff_figures", "signoff_report": "signoff_figures",
-    "drop_figure": "drop_figures",
+    "drop_figure": "drop_figures", "drop_whirl_figure": "drop_figures",
+    "whirl_waterfall": "drop_figures",
+    "write_drop_report": "drop_report",
     "api617_unbalance_figure": "signoff_figures",
     "facility_impulse_report": "run_report", "gains_figure": "run_report",
     "capacity_figure": "run_report", "rejection_figure": "run_report",

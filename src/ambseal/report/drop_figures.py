@@ -1,6 +1,8 @@
 """The rotor drop as an engineer reads it: at each touchdown plane the journal's orbit in
-its clearance circle, and the contact force against time (matplotlib, Agg canvas, written
-through :func:`ambseal.report.figures.save_figure`)."""
+its clearance circle, and the contact force against time (:func:`drop_figure`); the
+whirl's full spectrum against time at each plane — its waterfall, forward whirl above
+zero, backward below — and the rings' and the rotor's speeds (:func:`drop_whirl_figure`).
+Matplotlib, Agg canvas, written through :func:`ambseal.report.figures.save_figure`."""
 
 from __future__ import annotations
 
@@ -9,10 +11,14 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
+from scipy.signal import spectrogram
 
 from ambseal.report.figures import save_figure
 
-__all__ = ["drop_figure"]
+__all__ = ["drop_figure", "drop_whirl_figure", "whirl_waterfall"]
+
+#: the share of the waterfall's energy inside the frequency band shown
+SHOWN_ENERGY = 0.995
 
 
 def drop_figure(path: str | os.PathLike, result, clearances_m, *,
@@ -64,4 +70,95 @@ def drop_figure(path: str | os.PathLike, result, clearances_m, *,
     ax.legend(fontsize=8)
     fig.suptitle(f"{title} at {60 * result.speed_rad_s / (2 * np.pi):.6g} rpm "
                  f"({result.n_modes} modes up to {result.modes_hz:.4g} Hz)", fontsize=10)
+    return save_figure(fig, path)
+
+
+def whirl_waterfall(t, orbit) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The full spectrum of an orbit against time: the magnitude of the spectrogram of
+    x + j·y (Hann windows of an eighth of the record, 3/4 overlapping, each window's mean
+    taken out, :func:`scipy.signal.spectrogram`), forward whirl at positive frequencies.
+
+    Parameters
+    ----------
+    t : ndarray, shape (k,)
+        Evenly spaced times (s).
+    orbit : ndarray, shape (k, 2)
+        x, y (m).
+
+    Returns
+    -------
+    times : ndarray, shape (w,)
+        The windows' centres (s).
+    frequency_hz : ndarray, shape (f,)
+        Ascending, negative (backward whirl) to positive (forward).
+    amplitude_um : ndarray, shape (f, w)
+        The whirl's amplitude (µm) at each frequency and time.
+    """
+    t = np.asarray(t, float)
+    fs = (t.size - 1) / (t[-1] - t[0])
+    seg = max(16, t.size // 8)
+    z = orbit[:, 0] + 1j * orbit[:, 1]
+    f, tw, S = spectrogram(z, fs=fs, window="hann", nperseg=seg, noverlap=3 * seg // 4,
+                           detrend="constant", return_onesided=False, scaling="spectrum",
+                           mode="magnitude")
+    order = np.argsort(f)
+    return tw + t[0], f[order], 1e6 * S[order]
+
+
+def drop_whirl_figure(path: str | os.PathLike, result, *,
+                      title: str = "Rotor drop: whirl") -> Path:
+    """Per touchdown plane the full spectrum of its orbit against time
+    (:func:`whirl_waterfall`), forward whirl at positive frequencies, backward at negative,
+    the spin's frequency dashed; the band shown holds :data:`SHOWN_ENERGY` of it, at least
+    ±1.5 × the spin. Beside them the rings' and the rotor's speeds (rpm) against time.
+
+    Parameters
+    ----------
+    path : path-like
+        The PNG to write.
+    result : ambseal.analysis.drop.DropResult
+        The simulated drop (evenly sampled).
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The PNG written.
+    """
+    n = len(result.names)
+    fig = Figure(figsize=(4.6 * n + 5, 4.6), layout="constrained")
+    axes = fig.subplots(1, n + 1, gridspec_kw={"width_ratios": [1] * n + [1.3]})
+    spin_hz = float(np.abs(result.spin).max()) / (2 * np.pi)
+    for p, (ax, name) in enumerate(zip(axes[:-1], result.names)):
+        t, f, S = whirl_waterfall(result.t, result.orbit[p])
+        energy = (S ** 2).sum(axis=1)
+        # the band round zero holding SHOWN_ENERGY of the energy, at least 1.5 × the spin
+        span = np.abs(f)
+        cum = np.array([energy[span <= a].sum() for a in np.unique(span)])
+        inside = np.unique(span)[np.searchsorted(cum, SHOWN_ENERGY * energy.sum())
+                                 .clip(max=cum.size - 1)]
+        lim = max(float(inside), 1.5 * spin_hz, 10.0)
+        mesh = ax.pcolormesh(1e3 * t, f, S, shading="nearest", cmap="viridis")
+        fig.colorbar(mesh, ax=ax, label="orbit amplitude (µm)", fraction=0.06, pad=0.02)
+        if spin_hz > 0:
+            ax.axhline(spin_hz, color="w", ls="--", lw=0.8)
+        ax.axhline(0.0, color="w", lw=0.4)
+        ax.set_ylim(-lim, lim)
+        regime, hz = result.regime(p)
+        ax.set_title(f"{name}: {regime}" + (f", {hz:.3g} Hz" if regime.endswith("whirl")
+                                            else ""), fontsize=9)
+        ax.set_xlabel("time after the AMBs let go (ms)")
+        ax.set_ylabel("whirl frequency (Hz; backward < 0)")
+    ax = axes[-1]
+    rpm = 60.0 / (2 * np.pi)
+    ax.plot(1e3 * result.t, rpm * result.spin, "k-", lw=1.0, label="rotor")
+    for p, name in enumerate(result.names):
+        if result.turning[p]:
+            ax.plot(1e3 * result.t, rpm * result.race_speed[p], lw=0.8, label=f"ring {name}")
+    ax.set_xlabel("time after the AMBs let go (ms)")
+    ax.set_ylabel("speed (rpm)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.suptitle(f"{title} at {rpm * result.speed_rad_s:.6g} rpm", fontsize=10)
     return save_figure(fig, path)

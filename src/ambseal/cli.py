@@ -423,8 +423,8 @@ def _rotordynamics_parsers(sub) -> None:
                     help="process and windage torque against the spin (N·m; with "
                          "--coast-down)")
     dr.add_argument("--modes-hz", type=_positive, default=None,
-                    help="keep the free rotor's modes below this (Hz); default twice the "
-                         "contact's own frequency")
+                    help="keep the free rotor's modes below this (Hz); default four times "
+                         "the contact's own frequency")
     dr.add_argument("--out", default="ambseal-drop", help="output folder")
     _folder_force(dr)
     dr.add_argument("--json", action="store_true", help="print one JSON object")

@@ -12,10 +12,14 @@ every touchdown plane) in the mass-normalised real modes of its free–free
 non-rotating form up to ``modes_hz`` (rigid-body modes included), M q̈ + (C + ΩG) q̇ + K q
 = f at the spin speed Ω, held by the drive or coasting down under the rings' friction
 and a drag torque (``coast_down``), the gyroscopic moments at the instantaneous speed.
-The default ``modes_hz`` is twice the contact's own frequency 1/t_c
-(:func:`ambseal.model.hertz_impact`) for a fall through the smallest clearance onto the
-stiffest contact with the rotor's mass shared among the touchdown planes: the impulse's
-spectrum lies below it.
+The default ``modes_hz`` is :data:`MODES_PER_CONTACT` (4) times the contact's own
+frequency 1/t_c (:func:`ambseal.model.hertz_impact`) for a fall through the smallest
+clearance, the shortest over the planes, each an impact of the rotor's mass shared among
+the touchdown planes on the ring's support mass where it has one (their reduced mass: a
+light ring on a soft mount makes the contact far shorter than the rotor's share does).
+Twice as many hertz moves the first impact's peak force by under 2 % on the example rigs
+(benchmarks/README.md); the later impacts of a drop depend on its whole history, and
+their peaks do not converge as the first does.
 
 Each touchdown plane (:class:`ambseal.config.Touchdown`; :class:`ambseal.model.
 ContactLaw`): the journal's centre r relative to the ring's (the ring on its support
@@ -61,6 +65,8 @@ from ambseal.model import (
 __all__ = ["GRAVITY", "DropModel", "DropResult", "drop_model", "simulate_drop",
            "journal_radius", "drop_verdict"]
 
+#: the modes kept reach this many times the contact's own frequency 1/t_c
+MODES_PER_CONTACT = 4.0
 #: regimes: the share of the last half of the drop in contact below which it bounces
 BOUNCING_BELOW = 0.5
 #: integration segments (one per contact onset or end) after which a drop is refused:
@@ -207,8 +213,12 @@ def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
     if modes_hz is None:
         share = mass / len(cfg.touchdown)
         v0 = math.sqrt(2 * GRAVITY * c.min())
-        t_c = min(hertz_impact(share, v0, law.stiffness, law.exponent)[1] for law in laws)
-        modes_hz = 2.0 / t_c
+        # the impact's two bodies: the rotor's share and the ring's support mass, if any
+        masses = [share * t.support_mass / (share + t.support_mass) if t.support_mass > 0
+                  else share for t in cfg.touchdown]
+        t_c = min(hertz_impact(mm, v0, law.stiffness, law.exponent)[1]
+                  for mm, law in zip(masses, laws))
+        modes_hz = MODES_PER_CONTACT / t_c
     w2, vec = eigh(0.5 * (rotor.K + rotor.K.T), rotor.M)
     f = np.sqrt(np.clip(w2, 0.0, None)) / (2 * np.pi)
     keep = f <= modes_hz
@@ -287,6 +297,10 @@ class DropResult:
     peak_force, peak_penetration : ndarray, shape (p,)
         Each plane's largest normal force (N) and penetration (m), over the output's
         samples and the integrator's own steps.
+    first_peak_force : ndarray, shape (p,)
+        Each plane's largest normal force in its first contact (N; 0 where it never
+        touched): the impact of the fall itself, before the history of the bounces that
+        follow (which a drop's later, larger impacts depend on).
     spin : ndarray, shape (k,)
         The rotor's spin speed (rad/s): ``speed_rad_s`` throughout unless it coasts down.
     journal, clearance : ndarray, shape (p,)
@@ -310,6 +324,7 @@ class DropResult:
     n_modes: int
     peak_force: np.ndarray
     peak_penetration: np.ndarray
+    first_peak_force: np.ndarray
     spin: np.ndarray
     journal: np.ndarray
     clearance: np.ndarray
@@ -393,6 +408,7 @@ class DropResult:
             regime, hz = self.regime(p)
             planes.append({
                 "name": name, "peak_force_n": json_float(float(self.peak_force[p])),
+                "first_impact_peak_n": json_float(float(self.first_peak_force[p])),
                 "max_penetration_m": json_float(float(self.peak_penetration[p])),
                 "max_orbit_m": json_float(float(np.hypot(*self.orbit[p].T).max())),
                 "regime": regime, "whirl_hz": json_float(hz),
@@ -596,7 +612,8 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     # a start in contact (an ``initial`` state on a ring) waits for the contact's end
     touching = [c[1] > 0 for c in contacts(0.0, y)]
     ts, ys = [0.0], [y.copy()]
-    peak_force, peak_delta = np.zeros(P), np.zeros(P)
+    peak_force, peak_delta, first_peak = np.zeros(P), np.zeros(P), np.zeros(P)
+    first_over = [False] * P  # each plane's first contact ended
     t0, impacts, segments = 0.0, 0, 0
     while t0 < duration_s:
         segments += 1
@@ -635,6 +652,8 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             N = normal_force(delta, rate, law.stiffness, law.exponent,
                              damping_coefficient(law.law, law.restitution, v0[p]))
             peak_force[p] = max(peak_force[p], float(N.max()))
+            if touching[p] and not first_over[p]:
+                first_peak[p] = max(first_peak[p], float(N.max()))
             peak_delta[p] = max(peak_delta[p], float(delta.max()))
         hit = [k for k, te in enumerate(r.t_events) if te.size]
         if not hit:
@@ -643,6 +662,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         t0 = float(r.t_events[k][0])
         y = r.y_events[k][0].copy()
         touching[k] = not touching[k]
+        first_over[k] = first_over[k] or not touching[k]
         if touching[k]:
             impacts += 1
             eta, deta, _, s, ds = unpack(y)
@@ -684,6 +704,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                       spin=np.array([spin(yj) for yj in Y]),
                       peak_force=np.maximum(peak_force, force.max(axis=1)),
                       peak_penetration=np.maximum(peak_delta, pen.max(axis=1).clip(0)),
+                      first_peak_force=first_peak,
                       journal=dm.journal.copy(), clearance=dm.clearance.copy(),
                       turning=dm.race_inertia > 0)
 

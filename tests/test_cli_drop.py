@@ -105,3 +105,45 @@ def test_every_example_rig_lands_on_its_own_touchdown_bearings(rig, tmp_path, ca
         assert p["name"] == td.name and p["peak_force_n"] > 0
         assert 0 < p["max_penetration_m"] < 0.2 * td.radial_clearance
         assert p["max_orbit_m"] >= td.radial_clearance
+
+
+def test_monte_carlo_drops_from_the_command_line(tmp_path, capsys):
+    """``--runs 3 --seed 5 --friction 0.1:0.2 --unbalance-kgm 0:1e-4``: the JSON's counts,
+    the CSV of the three runs with their draws, the same numbers again for the same seed;
+    a spread without ``--runs``, or an unbalance range for one drop, refused by name."""
+    rig = tmp_path / "rig.toml"
+    rig.write_text(_rig_text())
+    args = ["--quiet", "drop", str(rig), "--duration-s", "0.02", "--runs", "3", "--seed",
+            "5", "--friction", "0.1:0.2", "--unbalance-kgm", "0:1e-4", "--workers", "1",
+            "--json"]
+    code = main([*args, "--out", str(tmp_path / "a")])
+    doc = json.loads(capsys.readouterr().out)
+    assert code in (0, 1) and (code == 1) == (doc["failed"]["count"] > 0)
+    assert doc["n"] == 3 and doc["seed"] == 5 and "runs" not in doc
+    lines = (tmp_path / "a" / "drop_scatter.csv").read_text().splitlines()
+    assert len(lines) == 4 and "TA_friction" in lines[0]
+    main([*args, "--out", str(tmp_path / "b")])
+    capsys.readouterr()
+    assert (tmp_path / "b" / "drop_scatter.csv").read_text() == "\n".join(lines) + "\n"
+    for extra, key in ((["--friction", "0.1:0.2"], "--friction"),
+                       (["--unbalance-kgm", "0:1e-4"], "--unbalance-kgm")):
+        code = main(["drop", str(rig), "--out", str(tmp_path / "c"), *extra])
+        err = capsys.readouterr().err
+        assert code == 2 and key in err and "Traceback" not in err
+    with pytest.raises(SystemExit) as stop:  # argparse's own refusal
+        main(["drop", str(rig), "--runs", "2", "--friction", "0.3:0.1"])
+    assert stop.value.code == 2 and "--friction" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("at, rpm", [("standstill", 0.0), ("max-continuous", 3000.0),
+                                     ("trip", 3150.0)])
+def test_the_drop_at_a_named_speed(at, rpm, tmp_path, capsys):
+    """``--at``: standstill, the maximum continuous speed (the rig's 3 000 rpm, no range
+    given) and the trip speed (API 617's 105 % where the rig gives none)."""
+    rig = tmp_path / "rig.toml"
+    rig.write_text(_rig_text())
+    code = main(["--quiet", "drop", str(rig), "--at", at, "--duration-s", "0.01",
+                 "--out", str(tmp_path / "d"), "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert code in (0, 1) and doc["speed_rpm"] == pytest.approx(rpm)
+    assert doc["speed_rad_s"] == pytest.approx(rpm * math.pi / 30)

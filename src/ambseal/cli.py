@@ -91,6 +91,17 @@ def _finite(text: str) -> float:
     return x
 
 
+def _span(text: str) -> tuple[float, float]:
+    """``X`` or ``LO:HI``, finite, 0 ≤ LO ≤ HI: a value, or a range to draw from."""
+    parts = text.split(":")
+    if len(parts) > 2:
+        raise argparse.ArgumentTypeError(f"expected X or LO:HI, got {text!r}")
+    lo, hi = (_finite(p) for p in (parts * 2)[:2])
+    if not 0 <= lo <= hi:
+        raise argparse.ArgumentTypeError(f"expected 0 <= LO <= HI, got {text!r}")
+    return lo, hi
+
+
 def _positive(text: str) -> float:
     """A finite number above 0 (a tolerance, a frequency limit, a duration)."""
     x = _finite(text)
@@ -414,6 +425,9 @@ def _rotordynamics_parsers(sub) -> None:
     dg.add_argument("--speed-rpm", type=_finite, default=None,
                     help="spin speed (rpm), held; default [operating] speed_rpm")
     dg.add_argument("--speed-hz", type=_finite, default=None, help="spin speed (Hz), held")
+    dg.add_argument("--at", choices=("standstill", "max-continuous", "trip"), default=None,
+                    help="the spin speed by name: 0, the top of [operating] speed_range_hz "
+                         "(else speed_rpm), or trip_speed_hz (else 1.05 × that)")
     dr.add_argument("--duration-s", type=_positive, default=0.5,
                     help="time simulated after the AMBs let go (s; default 0.5)")
     dr.add_argument("--coast-down", action="store_true",
@@ -425,6 +439,21 @@ def _rotordynamics_parsers(sub) -> None:
     dr.add_argument("--modes-hz", type=_positive, default=None,
                     help="keep the free rotor's modes below this (Hz); default four times "
                          "the contact's own frequency")
+    dr.add_argument("--unbalance-kgm", type=_span, default=None,
+                    help="static unbalance at the centre of mass (kg·m): X, or LO:HI drawn "
+                         "per run with --runs")
+    dr.add_argument("--runs", type=int, default=None,
+                    help="Monte-Carlo drops over the scatter below (drop_scatter.csv, "
+                         ".json: the probability of backward whirl and of a failed verdict; "
+                         "exit 1 if any run fails)")
+    dr.add_argument("--seed", type=int, default=1, help="the Monte-Carlo draws' seed")
+    dr.add_argument("--friction", type=_span, default=None,
+                    help="LO:HI: each touchdown bearing's friction drawn per run")
+    dr.add_argument("--clearance-tol-um", type=_positive, default=None,
+                    help="each touchdown bearing's radial clearance drawn within ± this (µm)")
+    dr.add_argument("--support-damping", type=_span, default=None,
+                    help="LO:HI: a factor on each support's damping, drawn per run")
+    _executor_args(dr)
     dr.add_argument("--out", default="ambseal-drop", help="output folder")
     _folder_force(dr)
     dr.add_argument("--json", action="store_true", help="print one JSON object")

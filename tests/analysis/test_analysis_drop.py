@@ -342,3 +342,51 @@ def test_the_default_modes_hold_the_first_impact_to_two_per_cent(name):
     assert runs[1].n_modes > runs[0].n_modes
     assert np.all(runs[0].first_peak_force > 0)
     np.testing.assert_allclose(runs[0].first_peak_force, runs[1].first_peak_force, rtol=0.02)
+
+
+def test_an_unbalance_fifty_times_the_weight_whirls_the_rotor_round_its_rings():
+    """A static unbalance U with U·Ω² = 50 m·g at the centre of a rigid symmetric rotor on
+    frictionless rings (1e11 N/m^1.5): it lands into synchronous forward whirl pressed on
+    both rings, which carry U·Ω² and the centripetal force m·Ω²·r of the whirl of radius
+    r (−m Ω² r = U Ω² − N), half each: the penetration
+    δ = (N/K)^(2/3) over the last half within 2 % (the weight's ±2 % ripple in N averages
+    out), the whirl at the spin's frequency within 1 %."""
+    base = _rig()
+    k = 1e11
+    cfg = base.model_copy(update={"touchdown": [
+        t.model_copy(update={"restitution": 0.5, "contact_stiffness": k})
+        for t in base.touchdown]})
+    m = inertia(*DISK)[0]
+    W = 100 * math.pi
+    U = 50 * m * GRAVITY / W ** 2
+    r = simulate_drop(cfg, speed_rpm=3000.0, duration_s=0.2, samples=8001, unbalance_kgm=U)
+    late = r.t >= 0.1
+    for p in range(2):
+        radius = float(np.hypot(*r.orbit[p, late].T).mean())
+        N = 0.5 * (U + m * radius) * W ** 2
+        assert float(r.penetration[p, late].mean()) == pytest.approx((N / k) ** (2 / 3),
+                                                                     rel=0.02)
+        regime, hz = r.regime(p)
+        assert regime == "forward whirl" and hz == pytest.approx(50.0, rel=0.01)
+
+
+def test_a_ring_rolling_without_slip_hands_the_drop_to_the_stiff_method():
+    """Light rings (J = 1e-6 kg·m²) spun up by μ = 0.3 at the default regularisation
+    v_r = 1 mm/s: once a ring rolls on the journal the friction's slope μN/v_r on its
+    inertia is a time constant of nanoseconds, and DOP853 hands over to LSODA, counted in
+    evaluations; the drop then equals LSODA's from the start (rings' final speed 1e-6,
+    peak forces 1e-3). A drop without friction stays with DOP853 to its end."""
+    base = _rig()
+    cfg = base.model_copy(update={"touchdown": [
+        t.model_copy(update={"radial_clearance": 1e-6, "restitution": 0.3, "friction": 0.3,
+                             "race_inertia": 1e-6, "contact_stiffness": 5e8})
+        for t in base.touchdown]})
+    fast = simulate_drop(cfg, speed_rpm=3000.0, duration_s=0.05, samples=501)
+    assert fast.integrator.startswith("DOP853 → LSODA from ")
+    stiff = simulate_drop(cfg, speed_rpm=3000.0, duration_s=0.05, samples=501,
+                          method="LSODA")
+    assert stiff.integrator == "LSODA"
+    np.testing.assert_allclose(fast.race_speed[:, -1], stiff.race_speed[:, -1], rtol=1e-6)
+    np.testing.assert_allclose(fast.peak_force, stiff.peak_force, rtol=1e-3)
+    plain = simulate_drop(_rig(), speed_rpm=3000.0, duration_s=0.02, samples=201)
+    assert plain.integrator == "DOP853"

@@ -46,7 +46,9 @@ sampled with its delay) on the full-order plant:
   ramp;
 * :func:`simulate_drop` → :class:`DropResult` — the rotor dropped onto its touchdown
   bearings when its AMBs let go (:func:`drop_model`; :mod:`ambseal.analysis.drop`), and
-  :func:`drop_verdict`, its pass criteria;
+  :func:`drop_verdict`, its pass criteria; :func:`drop_scatter`, Monte-Carlo drops over
+  friction, clearance, support damping and unbalance, serial or on Dask
+  (:mod:`ambseal.analysis.drop_monte_carlo`, :func:`wilson_interval`);
 * :func:`run_cases` — every multi-case analysis, serial or on Dask (:func:`dask_available`,
   :func:`probe_scheduler`).
 
@@ -68,7 +70,8 @@ from ambseal.lazy import lazy_face
 #: Each public name (``__all__``) and the module that defines it.
 _FROM = {
     "DropResult": "drop", "simulate_drop": "drop", "drop_model": "drop",
-    "drop_verdict": "drop",
+    "drop_verdict": "drop", "drop_scatter": "drop_monte_carlo",
+    "wilson_interval": "drop_monte_carlo",
     "capacity_block": "amplifier", "capacity_words": "amplifier", "force_demand": "amplifier",
     "saturates": "amplifier", "unbalance_currents": "amplifier",
     "rejection_effect": "rejection", "rejection_stability": "rejection",

@@ -35,7 +35,17 @@ shaft's outer radius there, R_r = R_j + c); a ring with ``race_inertia`` J spins
 J ω̇_r = F_t R_r − T_d·tanh(ω_r/ω_d), ω_d = v_r/R_r; without it the ring stands still.
 
 Integration: scipy's ``solve_ivp`` from event to event (each plane's contact onset and
-end are events that end a segment: the onset sets v₀), to relative tolerance ``rtol``.
+end are events that end a segment: the onset sets v₀), to relative tolerance ``rtol``,
+by DOP853 (explicit: an impact's and the flexible modes' oscillations at the least cost)
+until it crawls: a ring rolling on the journal without slip meets the friction's
+regularised slope μN/v_r on the ring's small inertia, a time constant of nanoseconds, and
+where a segment advances less than one period of the highest mode kept per
+:data:`CYCLE_EVALUATIONS` evaluations (judged past :data:`CRAWL_EVALUATIONS`) the drop
+goes on with LSODA, which switches to its stiff method there. On the expander-generator
+example DOP853 takes a 1 s drop in 40 s and LSODA in 190 s; on the flywheel rolling
+on its rings DOP853 does not finish 0.1 s in ten minutes and LSODA takes 11 s
+(benchmarks/README.md). The switch counts evaluations, not time: the same drop switches
+at the same point on every machine.
 """
 
 from __future__ import annotations
@@ -62,6 +72,10 @@ from ambseal.model import (
     rated_contact_stress,
 )
 
+class _Crawling(Exception):
+    """An explicit integration step size collapsed (the friction's stick is stiff)."""
+
+
 __all__ = ["GRAVITY", "DropModel", "DropResult", "drop_model", "simulate_drop",
            "journal_radius", "drop_verdict"]
 
@@ -72,6 +86,13 @@ BOUNCING_BELOW = 0.5
 #: integration segments (one per contact onset or end) after which a drop is refused:
 #: a contact chattering at the integrator's resolution
 MAX_SEGMENTS = 100_000
+#: an explicit method gives way to STIFF_METHOD for the rest of the drop when a segment,
+#: past CRAWL_EVALUATIONS right-hand sides, advances less than one period of the highest
+#: mode kept per CYCLE_EVALUATIONS of them (module docstring)
+EXPLICIT = ("RK23", "RK45", "DOP853")
+STIFF_METHOD = "LSODA"
+CRAWL_EVALUATIONS = 20_000
+CYCLE_EVALUATIONS = 1000
 #: the points in each integrator step at which the peak force and penetration are read
 PEAK_POINTS = 8
 
@@ -136,6 +157,9 @@ class DropModel:
     projector : ndarray, shape (m, n_dof)
         ΦᵀM: the modal coordinates of a nodal displacement or velocity (exact within the
         modes kept, their mass-weighted least squares otherwise).
+    cg_rows : ndarray, shape (2, m)
+        The x, y rows of Φ at the node nearest the rotor's centre of mass, where an
+        unbalance acts.
     """
 
     phi: np.ndarray
@@ -162,6 +186,7 @@ class DropModel:
     node_rows: dict = field(default_factory=dict, repr=False)
     z: np.ndarray = field(default=None, repr=False)
     projector: np.ndarray = field(default=None, repr=False)
+    cg_rows: np.ndarray = field(default=None, repr=False)
 
 
 def _amb_static_forces(cfg, mass: float, z_g: float) -> np.ndarray:
@@ -244,6 +269,7 @@ def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
     q0 = np.zeros(phi.shape[1])
     flex = f > 0
     q0[flex] = np.linalg.solve(Km[np.ix_(flex, flex)], load[flex])
+    g_node = int(np.argmin(np.abs(mesh.z - z_g)))
     rows.update({f"amb:{a.name}": xy(a.position) for a in cfg.amb})
     rows.update({f"seal:{s.name}": xy(s.position) for s in cfg.seal})
     return DropModel(
@@ -258,7 +284,8 @@ def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
         amb_rows=amb_rows, amb_force=amb_force, amb_tau=tau, q0=q0, mass=mass,
         polar_inertia=float(abs(Gr[2, 3])),
         names=tuple(t.name for t in cfg.touchdown), modes_hz=float(modes_hz),
-        node_rows=rows, z=np.asarray(mesh.z, float), projector=phi.T @ rotor.M)
+        node_rows=rows, z=np.asarray(mesh.z, float), projector=phi.T @ rotor.M,
+        cg_rows=phi[[4 * g_node, 4 * g_node + 1], :])
 
 
 @dataclass(frozen=True)
@@ -307,6 +334,9 @@ class DropResult:
         Each plane's journal radius R_j and radial clearance c (m).
     turning : ndarray of bool, shape (p,)
         The planes whose ring turns (a ``race_inertia``).
+    integrator : str
+        The ``solve_ivp`` method, and where it gave way to the stiff one
+        (``"DOP853 → LSODA from 0.0123 s"``).
     """
 
     t: np.ndarray
@@ -329,6 +359,7 @@ class DropResult:
     journal: np.ndarray
     clearance: np.ndarray
     turning: np.ndarray
+    integrator: str = ""
 
     def regime(self, p: int) -> tuple[str, float]:
         """The plane's regime over the last half of the drop: ``"bouncing"`` (in contact
@@ -418,6 +449,7 @@ class DropResult:
         return {"duration_s": json_float(float(self.t[-1])),
                 "speed_rad_s": json_float(self.speed_rad_s), "modes_hz": self.modes_hz,
                 "n_modes": self.n_modes, "impacts": self.impacts, "planes": planes,
+                "integrator": self.integrator,
                 "watched_max_m": {k: json_float(float(np.hypot(*v.T).max()))
                                   for k, v in self.watched.items()},
                 "energy_dissipated_j": json_float(float(self.energy[0] + self.work[-1]
@@ -432,7 +464,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                   samples: int = 4001, modes_hz: float | None = None, rtol: float = 1e-8,
                   method: str = "DOP853", model: DropModel | None = None,
                   coast_down: bool = False, drag_torque: float = 0.0,
-                  initial: tuple | None = None,
+                  initial: tuple | None = None, unbalance_kgm: float = 0.0,
                   progress=None) -> DropResult:
     """Drop the rotor of ``cfg`` onto its touchdown bearings (module docstring).
 
@@ -465,6 +497,11 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         The rotor's nodal displacement (m, rad) and velocity (m/s, rad/s) in the drop
         model's DOFs (:attr:`DropModel.z`) when the AMBs let go, projected on the modes
         kept (:attr:`DropModel.projector`); default the levitated equilibrium at rest.
+    unbalance_kgm : float, optional
+        A static unbalance U (kg·m, ≥ 0) at the node nearest the centre of mass
+        (:attr:`DropModel.cg_rows`): the force U·Ω²·(cos θ, sin θ) turning with the spin's
+        angle θ (θ = Ω t held; ∫Ω dt coasting, the spin's own slowing by it left out). Its
+        work is counted as work from outside (:attr:`DropResult.work`).
     progress : callable, optional
         ``progress(t_s)`` after each segment.
 
@@ -476,7 +513,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     ------
     ConfigError
         As :func:`drop_model`; a duration or sample count out of range; an ``initial``
-        state of the wrong shape or not finite.
+        state of the wrong shape or not finite; a negative or non-finite unbalance.
     """
     if not (duration_s > 0 and math.isfinite(duration_s)):
         raise ConfigError(f"drop: duration: expected > 0 s, got {duration_s!r}")
@@ -484,16 +521,19 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         raise ConfigError(f"drop: samples: expected at least 2, got {samples!r}")
     if not (drag_torque >= 0 and math.isfinite(drag_torque)):
         raise ConfigError(f"drop: drag torque: expected >= 0 N·m, got {drag_torque!r}")
+    if not (unbalance_kgm >= 0 and math.isfinite(unbalance_kgm)):
+        raise ConfigError(f"drop: unbalance: expected >= 0 kg·m, got {unbalance_kgm!r}")
     dm = model or drop_model(cfg, modes_hz)
     m, P = dm.phi.shape[1], len(dm.laws)
     W0 = 2 * np.pi * speed_rpm / 60.0
     races = np.flatnonzero(dm.race_inertia > 0)
     sup = [p for p in range(P) if dm.support[p] is not None]
-    # the states: modes and their rates, the turning rings, the supports, the spin when it
-    # coasts, and last the work done on the rotor from outside (J): by the drive holding
-    # the spin against the rings' friction, and by the AMBs' decaying forces
+    # the states: modes and their rates, the turning rings, the supports, the spin and its
+    # angle when it coasts, and last the work done on the rotor from outside (J): by the
+    # drive holding the spin against the rings' friction, the AMBs' decaying forces and
+    # the unbalance
     i_spin = 2 * m + races.size + 4 * len(sup)
-    n_y = i_spin + (1 if coast_down else 0) + 1
+    n_y = i_spin + (2 if coast_down else 0) + 1
     floor = np.sqrt(2 * GRAVITY * dm.clearance)  # the slowest impact the damping takes
     v0 = floor.copy()
     ring = dm.journal + dm.clearance
@@ -512,6 +552,9 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
 
     def spin(y) -> float:
         return float(y[i_spin]) if coast_down else W0
+
+    def angle(t, y) -> float:
+        return float(y[i_spin + 1]) if coast_down else W0 * t
 
     def contacts(t, y):
         """Per plane: relative position, δ, normal force, friction, n, t."""
@@ -543,6 +586,11 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                                                                    dm.amb_tau, 1.0)), 0.0)
             f += dm.amb_rows.T @ (dm.amb_force * decay)
             power += float((dm.amb_force * decay) @ (dm.amb_rows @ deta))
+        if unbalance_kgm:
+            W, th = spin(y), angle(t, y)
+            fu = unbalance_kgm * W * W * np.array([math.cos(th), math.sin(th)])
+            f += dm.cg_rows.T @ fu
+            power += float(fu @ (dm.cg_rows @ deta))
         dy = np.empty_like(y)
         dwr = np.zeros(P)
         dsup = {}
@@ -563,6 +611,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         dy[m:2 * m] = f - (dm.C + W * dm.G) @ deta - dm.K @ eta
         if coast_down:
             dy[i_spin] = (torque - drag_torque * math.tanh(W / 0.1)) / dm.polar_inertia
+            dy[i_spin + 1] = W
         else:  # the drive supplies the friction's torque
             power -= torque * W
         dy[-1] = power
@@ -572,6 +621,20 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             dy[base + 4 * k:base + 4 * k + 2] = ds[p]
             dy[base + 4 * k + 2:base + 4 * k + 4] = dsup[p]
         return dy
+
+    pace = 1.0 / (CYCLE_EVALUATIONS * dm.modes_hz)  # the slowest progress per evaluation
+
+    def paced(fn, start: float):
+        """``fn``, counting its evaluations: past CRAWL_EVALUATIONS, a segment advancing
+        less than ``pace`` per evaluation raises _Crawling."""
+        count = [0]
+
+        def f(t, y):
+            count[0] += 1
+            if count[0] > CRAWL_EVALUATIONS and t - start < pace * count[0]:
+                raise _Crawling
+            return fn(t, y)
+        return f
 
     def events(touching):
         evs = []
@@ -606,6 +669,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     atol[2 * m:2 * m + races.size] = rtol * (abs(W0) * dm.journal[races] / ring[races] + 1.0)
     if coast_down:
         atol[i_spin] = rtol * (abs(W0) + 1.0)
+        atol[i_spin + 1] = rtol
     atol[-1] = rtol * dm.mass * GRAVITY * c_min  # the work: the energy of the fall
     for k in range(len(sup)):
         atol[2 * m + races.size + 4 * k:2 * m + races.size + 4 * k + 2] = rtol * c_min
@@ -615,6 +679,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     peak_force, peak_delta, first_peak = np.zeros(P), np.zeros(P), np.zeros(P)
     first_over = [False] * P  # each plane's first contact ended
     t0, impacts, segments = 0.0, 0, 0
+    integrator = method
     while t0 < duration_s:
         segments += 1
         if segments > MAX_SEGMENTS:
@@ -623,8 +688,15 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         # a trial step far too long may overflow in the contact's power law; the
         # integrator rejects it (its error estimate is not finite) and halves the step
         with np.errstate(over="ignore", invalid="ignore"):
-            r = solve_ivp(rhs, (t0, duration_s), y, method=method, dense_output=True,
-                          events=events(touching), rtol=rtol, atol=atol)
+            try:
+                r = solve_ivp(paced(rhs, t0) if method in EXPLICIT else rhs,
+                              (t0, duration_s), y, method=method, dense_output=True,
+                              events=events(touching), rtol=rtol, atol=atol)
+            except _Crawling:  # stiff: from here on, the stiff method (module docstring)
+                method = STIFF_METHOD
+                integrator += f" → {method} from {t0:.6g} s"
+                r = solve_ivp(rhs, (t0, duration_s), y, method=method, dense_output=True,
+                              events=events(touching), rtol=rtol, atol=atol)
         if not r.success or not np.isfinite(r.y).all():
             raise ConfigError(f"drop: the integration failed at t = {r.t[-1]:.6g} s "
                               f"({r.message}); lower rtol or modes_hz")
@@ -704,7 +776,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                       spin=np.array([spin(yj) for yj in Y]),
                       peak_force=np.maximum(peak_force, force.max(axis=1)),
                       peak_penetration=np.maximum(peak_delta, pen.max(axis=1).clip(0)),
-                      first_peak_force=first_peak,
+                      first_peak_force=first_peak, integrator=integrator,
                       journal=dm.journal.copy(), clearance=dm.clearance.copy(),
                       turning=dm.race_inertia > 0)
 

@@ -25,6 +25,7 @@ from pathlib import Path
 from ambseal.analysis import (
     check_cases,
     dask_available,
+    drop_scatter,
     drop_verdict,
     judge_settings,
     operating_points,
@@ -278,8 +279,11 @@ def _signoff_into(args: argparse.Namespace) -> int:
 @_owns_out
 def _drop(args: argparse.Namespace) -> int:
     cfg = load_rig(args.rig)
+    named = {"standstill": 0.0, "max-continuous": 60.0 * cfg.operating.continuous_hz[1],
+             "trip": 60.0 * cfg.operating.trip_hz}
     rpm = (60.0 * args.speed_hz if args.speed_hz is not None else
-           args.speed_rpm if args.speed_rpm is not None else cfg.operating.speed_rpm)
+           args.speed_rpm if args.speed_rpm is not None else
+           named[args.at] if args.at is not None else cfg.operating.speed_rpm)
     if not 0 <= rpm <= 60.0 * MAX_SPEED_HZ:
         raise ConfigError(f"--speed-rpm: expected 0 to {60.0 * MAX_SPEED_HZ:g} rpm, got "
                           f"{rpm:g}")
@@ -295,13 +299,25 @@ def _drop(args: argparse.Namespace) -> int:
     if args.drag_torque and not args.coast_down:
         raise ConfigError("--drag-torque: slows a coasting rotor; add --coast-down (the "
                           "drive holds the speed otherwise)")
+    if args.runs is not None:
+        return _drop_scatter(args, cfg, rpm)
+    for name in ("friction", "clearance_tol_um", "support_damping", "workers", "scheduler"):
+        if getattr(args, name) is not None:
+            raise ConfigError(f"--{name.replace('_', '-')}: draws or spreads Monte-Carlo "
+                              "drops; add --runs N")
+    unbalance = args.unbalance_kgm or (0.0, 0.0)
+    if unbalance[0] != unbalance[1]:
+        raise ConfigError("--unbalance-kgm: a range LO:HI is drawn per run; add --runs N, "
+                          "or give one value")
     res = simulate_drop(cfg, speed_rpm=rpm, duration_s=args.duration_s,
                         modes_hz=args.modes_hz, coast_down=args.coast_down,
-                        drag_torque=args.drag_torque, progress=progress)
+                        drag_torque=args.drag_torque, unbalance_kgm=unbalance[0],
+                        progress=progress)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     judged = drop_verdict(cfg, res)
-    doc = {"rig": str(args.rig), "speed_rpm": rpm, **judged, **res.to_dict()}
+    doc = {"rig": str(args.rig), "speed_rpm": rpm, "unbalance_kgm": unbalance[0], **judged,
+           **res.to_dict()}
     for plane, td in zip(doc["planes"], cfg.touchdown):
         plane["radial_clearance_m"] = td.radial_clearance
     title = f"Rotor drop — {cfg.rotor.name}"
@@ -327,6 +343,37 @@ def _drop(args: argparse.Namespace) -> int:
                   + (f"; ring spun up in {1e3 * spin_up:.4g} ms" if spin_up else ""))
         print(f"files: {', '.join(str(f) for f in files)}")
     return 0 if doc["passed"] else 1
+
+
+def _drop_scatter(args: argparse.Namespace, cfg, rpm: float) -> int:
+    """``ambseal drop --runs N``: Monte-Carlo drops (:func:`drop_scatter`)."""
+    if args.scheduler is not None:
+        probe_scheduler(args.scheduler)
+    tol = None if args.clearance_tol_um is None else 1e-6 * args.clearance_tol_um
+    doc = drop_scatter(cfg, args.runs, seed=args.seed, friction=args.friction,
+                       clearance_tol_m=tol, support_damping=args.support_damping,
+                       unbalance_kgm=args.unbalance_kgm, speed_rpm=rpm,
+                       duration_s=args.duration_s, modes_hz=args.modes_hz,
+                       coast_down=args.coast_down, drag_torque=args.drag_torque,
+                       workers=args.workers, scheduler=args.scheduler, progress=True)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    doc = {"rig": str(args.rig), "speed_rpm": rpm, **doc}
+    files = [*write_table(out / "drop_scatter.csv", doc["runs"]),
+             write_json(out / "drop_scatter.json", doc)]
+    failed = doc["failed"]["count"]
+    if args.json:
+        print(json.dumps({**{k: v for k, v in doc.items() if k != "runs"},
+                          "files": [str(f) for f in files]}))
+    else:
+        for key, what in (("backward_whirl", "backward whirl"), ("failed", "failed verdict")):
+            s = doc[key]
+            lo, hi = s["interval"]
+            print(f"{what}: {s['count']} of {doc['n']} drops, p = {s['probability']:.3g} "
+                  f"(95 % interval {lo:.3g}–{hi:.3g})")
+        print(f"largest peak force: {doc['peak_force_n']:.4g} N")
+        print(f"files: {', '.join(str(f) for f in files)}")
+    return 1 if failed else 0
 
 
 def _import_ross(args: argparse.Namespace) -> int:

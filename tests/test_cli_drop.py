@@ -147,3 +147,19 @@ def test_the_drop_at_a_named_speed(at, rpm, tmp_path, capsys):
     doc = json.loads(capsys.readouterr().out)
     assert code in (0, 1) and doc["speed_rpm"] == pytest.approx(rpm)
     assert doc["speed_rad_s"] == pytest.approx(rpm * math.pi / 30)
+
+
+def test_an_unbalanced_drop_starts_from_its_levitated_orbit_or_at_rest(tmp_path, capsys):
+    """``--unbalance-kgm``: by default the drop starts in the reference PID loop's
+    unbalance orbit, with ``--start rest`` from the levitated equilibrium at rest; the
+    JSON says which, and the two drops differ."""
+    rig = tmp_path / "rig.toml"
+    rig.write_text(_rig_text())
+    docs = {}
+    for start in ("levitated", "rest"):
+        code = main(["--quiet", "drop", str(rig), "--duration-s", "0.02", "--unbalance-kgm",
+                     "2e-3", "--start", start, "--out", str(tmp_path / start), "--json"])
+        docs[start] = json.loads(capsys.readouterr().out)
+        assert code in (0, 1) and docs[start]["start"] == start
+        assert docs[start]["unbalance_kgm"] == 2e-3
+    assert docs["levitated"]["planes"] != docs["rest"]["planes"]

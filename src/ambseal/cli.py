@@ -442,6 +442,10 @@ def _rotordynamics_parsers(sub) -> None:
     dr.add_argument("--unbalance-kgm", type=_span, default=None,
                     help="static unbalance at the centre of mass (kg·m): X, or LO:HI drawn "
                          "per run with --runs")
+    dr.add_argument("--start", choices=("levitated", "rest"), default="levitated",
+                    help="the state the AMBs let go of: levitated, the unbalance orbit of "
+                         "the reference PID's loop at the speed (default), or at rest in "
+                         "the levitated equilibrium")
     dr.add_argument("--runs", type=int, default=None,
                     help="Monte-Carlo drops over the scatter below (drop_scatter.csv, "
                          ".json: the probability of backward whirl and of a failed verdict; "

@@ -390,3 +390,34 @@ def test_a_ring_rolling_without_slip_hands_the_drop_to_the_stiff_method():
     np.testing.assert_allclose(fast.peak_force, stiff.peak_force, rtol=1e-3)
     plain = simulate_drop(_rig(), speed_rpm=3000.0, duration_s=0.02, samples=201)
     assert plain.integrator == "DOP853"
+
+
+def test_the_levitated_start_is_the_pid_loops_unbalance_orbit():
+    """The rigid symmetric rotor held by a PID on two collocated AMBs (no amplifier lag),
+    spinning at 3000 rpm with U = 1e-4 kg·m at its centre: its cylindrical whirl is the
+    closed form X = U Ω²/(2(Ki·K(jΩ) − Ks) − m Ω²), K(jΩ) = Kp(1 + 1/(jΩ Ti) +
+    jΩ Td/(jΩ ε Td + 1)) (P5 Eq. 6); at t = 0 the centre sits at (Re X, Im X) moving at
+    Ω (−Im X, Re X): within 1e-6. A PID of the wrong sign is refused, naming the pole."""
+    from ambseal.analysis.drop_levitated import levitated_start
+    from ambseal.design import pid_controller
+    from ambseal.model import channel_names
+
+    cfg = _rig()
+    dm = drop_model(cfg)
+    m = inertia(*DISK)[0]
+    kp, ti, td, eps = 1e4, 0.2, 3e-3, 0.1
+    K = pid_controller(kp, ti, td, eps, channel_names(cfg))
+    W, U = 100 * math.pi, 1e-4
+    u, v = levitated_start(cfg, dm, 3000.0, U, controller=K)
+    s = 1j * W
+    Kc = kp * (1 + 1 / (s * ti) + s * td / (s * eps * td + 1))
+    X = U * W ** 2 / (2 * (100.0 * Kc - 2e5) - m * W ** 2)
+    g = int(np.argmin(np.abs(dm.z - L / 2)))
+    sag = dm.phi @ dm.q0
+    np.testing.assert_allclose(u[4 * g:4 * g + 2] - sag[4 * g:4 * g + 2],
+                               [X.real, X.imag], rtol=1e-6, atol=1e-6 * abs(X))
+    np.testing.assert_allclose(v[4 * g:4 * g + 2], [-W * X.imag, W * X.real], rtol=1e-6,
+                               atol=1e-6 * W * abs(X))
+    with pytest.raises(ConfigError, match=r"unstable at 3000 rpm \(a pole at"):
+        levitated_start(cfg, dm, 3000.0, U,
+                        controller=pid_controller(-kp, ti, td, eps, channel_names(cfg)))

@@ -49,6 +49,8 @@ sampled with its delay) on the full-order plant:
   :func:`drop_verdict`, its pass criteria; :func:`drop_scatter`, Monte-Carlo drops over
   friction, clearance, support damping and unbalance, serial or on Dask
   (:mod:`ambseal.analysis.drop_monte_carlo`, :func:`wilson_interval`);
+  :func:`levitated_start`, the AMB loop's unbalance orbit a drop starts from
+  (:mod:`ambseal.analysis.drop_levitated`);
 * :func:`run_cases` — every multi-case analysis, serial or on Dask (:func:`dask_available`,
   :func:`probe_scheduler`).
 
@@ -71,7 +73,7 @@ from ambseal.lazy import lazy_face
 _FROM = {
     "DropResult": "drop", "simulate_drop": "drop", "drop_model": "drop",
     "drop_verdict": "drop", "drop_scatter": "drop_monte_carlo",
-    "wilson_interval": "drop_monte_carlo",
+    "wilson_interval": "drop_monte_carlo", "levitated_start": "drop_levitated",
     "capacity_block": "amplifier", "capacity_words": "amplifier", "force_demand": "amplifier",
     "saturates": "amplifier", "unbalance_currents": "amplifier",
     "rejection_effect": "rejection", "rejection_stability": "rejection",

@@ -310,7 +310,8 @@ class DropResult:
         the spin's.
     work : ndarray, shape (k,)
         The work done on it from outside since the drop (J): by the drive holding the
-        spin against the rings' friction and by the AMBs' decaying forces. What the
+        spin against the rings' friction, by the AMBs' decaying forces and by the
+        unbalance. What the
         contacts' damping and friction, the drag and the structural damping took is
         ``energy[0] + work − energy``.
     watched : dict

@@ -25,6 +25,7 @@ import numpy as np
 
 from ambseal.analysis.cases import CaseError, run_cases
 from ambseal.analysis.drop import drop_model, drop_verdict, simulate_drop
+from ambseal.analysis.drop_levitated import levitated_start
 from ambseal.config import parse_rig
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
@@ -75,7 +76,7 @@ def _range(name: str, value) -> tuple[float, float] | None:
 
 
 def drop_run(case: dict, rig: dict, speed_rpm: float, duration_s: float, modes_hz: float,
-             coast_down: bool, drag_torque: float) -> dict:
+             coast_down: bool, drag_torque: float, start: str = "levitated") -> dict:
     """One Monte-Carlo drop (module docstring): the rig with the case's friction,
     clearance and support damping per touchdown bearing, dropped with its unbalance.
 
@@ -88,6 +89,9 @@ def drop_run(case: dict, rig: dict, speed_rpm: float, duration_s: float, modes_h
         The rig (``RigConfig.model_dump()``).
     speed_rpm, duration_s, modes_hz, coast_down, drag_torque
         As :func:`~ambseal.analysis.drop.simulate_drop`.
+    start : {"levitated", "rest"}
+        With an unbalance, the drop starts from the reference PID loop's unbalance orbit
+        (:func:`~ambseal.analysis.drop_levitated.levitated_start`) or at rest.
 
     Returns
     -------
@@ -102,9 +106,12 @@ def drop_run(case: dict, rig: dict, speed_rpm: float, duration_s: float, modes_h
            for t, mu, c, d in zip(cfg.touchdown, case["friction"], case["clearance_m"],
                                   case["support_damping"])]
     cfg = cfg.model_copy(update={"touchdown": tds})
+    dm = drop_model(cfg, modes_hz)
+    u = case["unbalance_kgm"]
+    initial = levitated_start(cfg, dm, speed_rpm, u) if start == "levitated" and u else None
     res = simulate_drop(cfg, speed_rpm=speed_rpm, duration_s=duration_s, samples=2001,
-                        model=drop_model(cfg, modes_hz), coast_down=coast_down,
-                        drag_torque=drag_torque, unbalance_kgm=case["unbalance_kgm"])
+                        model=dm, coast_down=coast_down, drag_torque=drag_torque,
+                        unbalance_kgm=u, initial=initial)
     judged = drop_verdict(cfg, res)
     row = {"run": case["run"], "passed": judged["passed"],
            "failed": "; ".join(c["name"] for c in judged["criteria"]
@@ -129,7 +136,7 @@ def drop_scatter(cfg, runs: int, *, seed: int, friction=None, clearance_tol_m=No
                  support_damping=None, unbalance_kgm=None, speed_rpm: float = 0.0,
                  duration_s: float = 0.5, modes_hz: float | None = None,
                  coast_down: bool = False, drag_torque: float = 0.0,
-                 workers: int | None = None, scheduler: str | None = None,
+                 start: str = "levitated", workers: int | None = None, scheduler: str | None = None,
                  progress: bool = False) -> dict:
     """Monte-Carlo drops of a rig (module docstring).
 
@@ -160,6 +167,8 @@ def drop_scatter(cfg, runs: int, *, seed: int, friction=None, clearance_tol_m=No
         The drive lets go too (:func:`~ambseal.analysis.drop.simulate_drop`).
     drag_torque : float, optional
         The torque against the spin when it coasts (N·m).
+    start : {"levitated", "rest"}, optional
+        As :func:`drop_run`.
     workers : int, optional
         Local Dask worker processes (:func:`ambseal.analysis.cases.run_cases`).
     scheduler : str, optional
@@ -209,7 +218,8 @@ def drop_scatter(cfg, runs: int, *, seed: int, friction=None, clearance_tol_m=No
                       "unbalance_kgm": float(rng.uniform(*unb)) if unb else 0.0})
     shared = {"rig": cfg.model_dump(), "speed_rpm": float(speed_rpm),
               "duration_s": float(duration_s), "modes_hz": base.modes_hz,
-              "coast_down": bool(coast_down), "drag_torque": float(drag_torque)}
+              "coast_down": bool(coast_down), "drag_torque": float(drag_torque),
+              "start": start}
     out = run_cases(drop_run, cases, shared=shared, workers=workers, scheduler=scheduler,
                     progress=progress, description="drops")
     rows = [{"run": r.case["run"], "error": r.error} if isinstance(r, CaseError) else r

@@ -25,9 +25,11 @@ from pathlib import Path
 from ambseal.analysis import (
     check_cases,
     dask_available,
+    drop_model,
     drop_scatter,
     drop_verdict,
     judge_settings,
+    levitated_start,
     operating_points,
     parse_range,
     probe_scheduler,
@@ -309,15 +311,17 @@ def _drop(args: argparse.Namespace) -> int:
     if unbalance[0] != unbalance[1]:
         raise ConfigError("--unbalance-kgm: a range LO:HI is drawn per run; add --runs N, "
                           "or give one value")
-    res = simulate_drop(cfg, speed_rpm=rpm, duration_s=args.duration_s,
-                        modes_hz=args.modes_hz, coast_down=args.coast_down,
-                        drag_torque=args.drag_torque, unbalance_kgm=unbalance[0],
-                        progress=progress)
+    dm = drop_model(cfg, args.modes_hz)
+    start = (levitated_start(cfg, dm, rpm, unbalance[0])
+             if args.start == "levitated" and unbalance[0] > 0 else None)
+    res = simulate_drop(cfg, speed_rpm=rpm, duration_s=args.duration_s, model=dm,
+                        coast_down=args.coast_down, drag_torque=args.drag_torque,
+                        unbalance_kgm=unbalance[0], initial=start, progress=progress)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     judged = drop_verdict(cfg, res)
-    doc = {"rig": str(args.rig), "speed_rpm": rpm, "unbalance_kgm": unbalance[0], **judged,
-           **res.to_dict()}
+    doc = {"rig": str(args.rig), "speed_rpm": rpm, "unbalance_kgm": unbalance[0],
+           "start": args.start, **judged, **res.to_dict()}
     for plane, td in zip(doc["planes"], cfg.touchdown):
         plane["radial_clearance_m"] = td.radial_clearance
     title = f"Rotor drop — {cfg.rotor.name}"
@@ -355,7 +359,8 @@ def _drop_scatter(args: argparse.Namespace, cfg, rpm: float) -> int:
                        unbalance_kgm=args.unbalance_kgm, speed_rpm=rpm,
                        duration_s=args.duration_s, modes_hz=args.modes_hz,
                        coast_down=args.coast_down, drag_torque=args.drag_torque,
-                       workers=args.workers, scheduler=args.scheduler, progress=True)
+                       start=args.start, workers=args.workers, scheduler=args.scheduler,
+                       progress=True)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     doc = {"rig": str(args.rig), "speed_rpm": rpm, **doc}

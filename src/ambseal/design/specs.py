@@ -105,7 +105,8 @@ from ambseal.model import (
     poles_near_zero,
 )
 
-__all__ = ["Machine", "DesignSpec", "air_gaps", "machine", "design_spec", "round_125", "judged_conditions"]
+__all__ = ["Machine", "DesignSpec", "air_gaps", "machine", "design_spec", "round_125",
+           "judged_conditions"]
 
 RIGID_STATES = 8  # 2 translations and 2 tilts of a rigid rotor, 2 states each
 #: ω_B·T_i of the H∞ and μ performance weights (module docstring, "H∞ and μ weights")

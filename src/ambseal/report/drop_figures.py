@@ -21,6 +21,13 @@ __all__ = ["drop_figure", "drop_whirl_figure", "whirl_waterfall"]
 SHOWN_ENERGY = 0.995
 
 
+def _plane_title(result, p: int) -> str:
+    """A plane's name, regime and whirl frequency."""
+    regime, hz = result.regime(p)
+    return f"{result.names[p]}: {regime}" + (f", {hz:.3g} Hz" if regime.endswith("whirl")
+                                              else "")
+
+
 def drop_figure(path: str | os.PathLike, result, clearances_m, *,
                 title: str = "Rotor drop") -> Path:
     """Per touchdown plane its orbit (µm) inside the clearance circle, and the normal
@@ -46,14 +53,12 @@ def drop_figure(path: str | os.PathLike, result, clearances_m, *,
     fig = Figure(figsize=(4 * n + 5, 4.4))
     axes = fig.subplots(1, n + 1, gridspec_kw={"width_ratios": [1] * n + [1.6]})
     ring = np.linspace(0, 2 * np.pi, 361)
-    for p, (ax, name) in enumerate(zip(axes[:-1], result.names)):
+    for p, ax in enumerate(axes[:-1]):
         c = 1e6 * clearances_m[p]
         ax.plot(c * np.cos(ring), c * np.sin(ring), "k-", lw=1.0, label="clearance")
         ax.plot(1e6 * result.orbit[p, :, 0], 1e6 * result.orbit[p, :, 1], lw=0.7,
                 label="journal centre")
-        regime, hz = result.regime(p)
-        ax.set_title(f"{name}: {regime}" + (f", {hz:.3g} Hz" if regime.endswith("whirl")
-                                            else ""), fontsize=9)
+        ax.set_title(_plane_title(result, p), fontsize=9)
         ax.set_aspect("equal")
         lim = 1.2 * max(c, 1e6 * np.hypot(*result.orbit[p].T).max())
         ax.set_xlim(-lim, lim)
@@ -130,7 +135,7 @@ def drop_whirl_figure(path: str | os.PathLike, result, *,
     fig = Figure(figsize=(4.6 * n + 5, 4.6), layout="constrained")
     axes = fig.subplots(1, n + 1, gridspec_kw={"width_ratios": [1] * n + [1.3]})
     spin_hz = float(np.abs(result.spin).max()) / (2 * np.pi)
-    for p, (ax, name) in enumerate(zip(axes[:-1], result.names)):
+    for p, ax in enumerate(axes[:-1]):
         t, f, S = whirl_waterfall(result.t, result.orbit[p])
         energy = (S ** 2).sum(axis=1)
         # the band round zero holding SHOWN_ENERGY of the energy, at least 1.5 × the spin
@@ -145,9 +150,7 @@ def drop_whirl_figure(path: str | os.PathLike, result, *,
             ax.axhline(spin_hz, color="w", ls="--", lw=0.8)
         ax.axhline(0.0, color="w", lw=0.4)
         ax.set_ylim(-lim, lim)
-        regime, hz = result.regime(p)
-        ax.set_title(f"{name}: {regime}" + (f", {hz:.3g} Hz" if regime.endswith("whirl")
-                                            else ""), fontsize=9)
+        ax.set_title(_plane_title(result, p), fontsize=9)
         ax.set_xlabel("time after the AMBs let go (ms)")
         ax.set_ylabel("whirl frequency (Hz; backward < 0)")
     ax = axes[-1]

@@ -62,8 +62,9 @@ stated):
   (8th ed., 2014) Part 1 §4.8.2.11 defines S_c and its bounds; the speed range of A_1
   is not in the public text, and both readings are settings. The response at every
   close clearance (a seal's or a spring's ``clearance``, a backup bearing's
-  clearance at its AMB, :meth:`~ambseal.config.RigConfig.backup_clearance`), times S_c, from standstill to the trip speed, must
-  stay within ``[signoff] clearance_fraction`` (75 %) of the diametral clearance.
+  clearance at its AMB, :meth:`~ambseal.config.RigConfig.backup_clearance`), times
+  S_c, from standstill to the trip speed, must stay within ``[signoff]
+  clearance_fraction`` (75 %) of the diametral clearance.
 """
 
 from __future__ import annotations

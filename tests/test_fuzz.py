@@ -327,7 +327,8 @@ def _range_case(tmp_path_factory, data):
 #: sees at 100 Hz (the rotor, its supports, the AMBs with their actuator and sensors, the
 #: seals at the operating pressure, the reference PID; spinning, so that the polar inertia
 #: acts): changing one must change the modes or be refused. Keys outside it (names,
-#: [design], [reduction], bounds such as current_limit) are not physics of that loop.
+#: [design], [reduction], bounds such as current_limit, the touchdown bearings, out of
+#: contact while the rotor levitates) are not physics of that loop.
 PHYSICS = {"modal_damping", "E", "rho", "nu", "length", "outer_diameter", "inner_diameter",
            "mass", "Ip", "Id", "position", "sensor_position", "axes_angle_deg", "ki", "ks",
            "natural_frequency", "damping_ratio", "K", "k", "C", "c", "M", "at_zero",
@@ -344,7 +345,7 @@ def _physics_paths(doc: dict) -> list[tuple]:
     # the pressure drop reaches the model only through coefficients affine in it
     pressure_driven = "per_bar" in json.dumps(doc.get("seal", []))
     for p in _paths(doc):
-        if p[0] in ("design", "reduction") or "frequency_hz" in p:
+        if p[0] in ("design", "reduction", "touchdown") or "frequency_hz" in p:
             continue
         if p == ("operating", "pressure_bar") and not pressure_driven:
             continue

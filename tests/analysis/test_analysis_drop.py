@@ -392,10 +392,12 @@ def test_a_ring_rolling_without_slip_hands_the_drop_to_the_stiff_method():
     assert plain.integrator == "DOP853"
 
 
-def test_the_levitated_start_is_the_pid_loops_unbalance_orbit():
-    """The rigid symmetric rotor held by a PID on two collocated AMBs (no amplifier lag),
-    spinning at 3000 rpm with U = 1e-4 kg·m at its centre: its cylindrical whirl is the
-    closed form X = U Ω²/(2(Ki·K(jΩ) − Ks) − m Ω²), K(jΩ) = Kp(1 + 1/(jΩ Ti) +
+@pytest.mark.parametrize("cutoff_hz", [None, 200.0])
+def test_the_levitated_start_is_the_pid_loops_unbalance_orbit(cutoff_hz):
+    """The rigid symmetric rotor held by a PID on two collocated AMBs, without and with a
+    first-order amplifier G_a = ω_c/(s + ω_c), spinning at 3000 rpm with U = 1e-4 kg·m at
+    its centre: its cylindrical whirl is the closed form
+    X = U Ω²/(2(Ki·G_a(jΩ)·K(jΩ) − Ks) − m Ω²), K(jΩ) = Kp(1 + 1/(jΩ Ti) +
     jΩ Td/(jΩ ε Td + 1)) (P5 Eq. 6); at t = 0 the centre sits at (Re X, Im X) moving at
     Ω (−Im X, Re X): within 1e-6. A PID of the wrong sign is refused, naming the pole."""
     from ambseal.analysis.drop_levitated import levitated_start
@@ -403,6 +405,9 @@ def test_the_levitated_start_is_the_pid_loops_unbalance_orbit():
     from ambseal.model import channel_names
 
     cfg = _rig()
+    if cutoff_hz:
+        cfg = cfg.model_copy(update={"actuator": cfg.actuator.model_copy(update={
+            "model": "first_order", "cutoff_hz": cutoff_hz})})
     dm = drop_model(cfg)
     m = inertia(*DISK)[0]
     kp, ti, td, eps = 1e4, 0.2, 3e-3, 0.1
@@ -411,7 +416,8 @@ def test_the_levitated_start_is_the_pid_loops_unbalance_orbit():
     u, v = levitated_start(cfg, dm, 3000.0, U, controller=K)
     s = 1j * W
     Kc = kp * (1 + 1 / (s * ti) + s * td / (s * eps * td + 1))
-    X = U * W ** 2 / (2 * (100.0 * Kc - 2e5) - m * W ** 2)
+    Ga = 1.0 if not cutoff_hz else 2 * math.pi * cutoff_hz / (s + 2 * math.pi * cutoff_hz)
+    X = U * W ** 2 / (2 * (100.0 * Ga * Kc - 2e5) - m * W ** 2)
     g = int(np.argmin(np.abs(dm.z - L / 2)))
     sag = dm.phi @ dm.q0
     np.testing.assert_allclose(u[4 * g:4 * g + 2] - sag[4 * g:4 * g + 2],

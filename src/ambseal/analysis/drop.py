@@ -360,7 +360,7 @@ class DropResult:
     journal: np.ndarray
     clearance: np.ndarray
     turning: np.ndarray
-    integrator: str = ""
+    integrator: str
 
     def regime(self, p: int) -> tuple[str, float]:
         """The plane's regime over the last half of the drop: ``"bouncing"`` (in contact

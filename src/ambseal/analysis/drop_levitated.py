@@ -22,12 +22,12 @@ it is refused, naming its least damped pole.
 
 from __future__ import annotations
 
-import control
 import numpy as np
-from scipy.linalg import block_diag, eigvals
+from scipy.linalg import eigvals
 
 from ambseal.design import pid_controller, reference_pid
 from ambseal.errors import ConfigError
+from ambseal.lti import feedback_matrices, series_inputs
 from ambseal.model import (
     AmbElement,
     actuator_matrices,
@@ -37,19 +37,6 @@ from ambseal.model import (
 )
 
 __all__ = ["levitated_loop", "levitated_start"]
-
-
-def _axis_lags(cfg, n_axes: int):
-    """(A, B, C, D) of the amplifier and the eddy-current lag in series, one per axis:
-    current reference (A) → the current that makes the force (A)."""
-    Aa, Ba, Ca, Da = actuator_matrices(cfg.actuator)
-    Ae, Be, Ce, De = eddy_lag_matrices(cfg.actuator.eddy_time_constant)
-    A = np.block([[Aa, np.zeros((Aa.shape[0], Ae.shape[0]))], [Be @ Ca, Ae]])
-    B = np.vstack([Ba, Be @ Da])
-    C = np.hstack([De @ Ca, Ce])
-    D = De @ Da
-    return (block_diag(*[A] * n_axes), block_diag(*[B] * n_axes),
-            block_diag(*[C] * n_axes), block_diag(*[D] * n_axes))
 
 
 def levitated_loop(cfg, dm, speed_rpm: float, controller=None):
@@ -97,16 +84,18 @@ def levitated_loop(cfg, dm, speed_rpm: float, controller=None):
         controller = pid_controller(g["kp"], g["ti"], g["td"], g["eps"], channel_names(cfg),
                                     g.get("filters", ()), g.get("cross_kp", 0.0),
                                     g.get("cross_kd", 0.0))
-    Ak, Bk, Ck, Dk = (np.asarray(x, float) for x in (controller.A, controller.B,
-                                                   controller.C, controller.D))
-    Al, Bl, Cl, Dl = _axis_lags(cfg, 2 * len(els))
-    nr, nl, nk = A_r.shape[0], Al.shape[0], Ak.shape[0]
-    # u = −(Ck x_k + Dk y), y = C_r x_r; the force per Ki is Cl x_l + Dl u
-    A = np.block([
-        [A_r - B_ri @ Dl @ Dk @ C_r, B_ri @ Cl, -B_ri @ Dl @ Ck],
-        [-Bl @ Dk @ C_r, Al, -Bl @ Ck],
-        [Bk @ C_r, np.zeros((nk, nl)), Ak]])
-    return A, np.vstack([B_rf, np.zeros((nl + nk, 2))])
+    G = (A_r, B_ri, C_r, np.zeros((C_r.shape[0], B_ri.shape[1])))
+    # the eddy-current lag next to the rotor, the amplifier before it (as build_plant)
+    act = cfg.actuator
+    for on, block in ((act.eddy_time_constant > 0, eddy_lag_matrices(act.eddy_time_constant)),
+                      (act.model != "none", actuator_matrices(act))):
+        if on:
+            G = series_inputs(G, block)[:4]
+    Bf = np.vstack([B_rf, np.zeros((G[0].shape[0] - B_rf.shape[0], 2))])
+    K = tuple(np.asarray(x, float) for x in (controller.A, controller.B, controller.C,
+                                             controller.D))
+    A, B, _, _ = feedback_matrices(G, K, (Bf, np.zeros((G[2].shape[0], 2))))
+    return A, B[:, -2:]  # the inputs [d, f]: the force last
 
 
 def levitated_start(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=None):

@@ -46,17 +46,18 @@ def test_drop_writes_its_summary_and_figure(tmp_path, capsys):
     for p in doc["planes"]:
         assert p["peak_force_n"] > 0 and 0 < p["max_penetration_m"] < 2e-4
         assert p["max_orbit_m"] >= 2e-4
-        assert p["regime"] in ("bouncing", "resting", "forward whirl", "backward whirl")
+        assert p["regime"] in ("bouncing", "resting", "forward whirl", "backward whirl",
+                               "no contact")
     assert set(doc["watched_max_m"]) == {"amb:A", "amb:B"}
     assert json.loads((out / "drop.json").read_text())["planes"] == doc["planes"]
-    assert doc["files"] == [str(out / f) for f in ("drop.json", "drop.png",
-                                                    "drop_whirl.png", "drop.html")]
+    assert doc["files"] == [str(out / f) for f in ("drop.json", "drop.png", "drop_whirl.png",
+                                                    "drop_currents.png", "drop.html")]
     assert (out / "drop.png").stat().st_size > 0 and (out / "drop_whirl.png").stat().st_size
     # the page: the verdict first, then each bearing's row with its numbers, the figures
     # embedded
     page = (out / "drop.html").read_text()
     assert page.index("<h2>Verdict</h2>") < page.index("<h2>Touchdown bearings</h2>")
-    assert doc["verdict"] in page and page.count("data:image/png;base64,") == 2
+    assert doc["verdict"] in page and page.count("data:image/png;base64,") == 3
     for p in doc["planes"]:
         assert f"{p['peak_force_n']:.4g}" in page
         assert f"{1e6 * p['max_orbit_m']:.4g} ({p['max_orbit_m'] / 2e-4:.3g} c)" in page
@@ -163,3 +164,70 @@ def test_an_unbalanced_drop_starts_from_its_levitated_orbit_or_at_rest(tmp_path,
         assert code in (0, 1) and docs[start]["start"] == start
         assert docs[start]["unbalance_kgm"] == 2e-3
     assert docs["levitated"]["planes"] != docs["rest"]["planes"]
+
+
+def test_the_events_from_the_command_line(tmp_path, capsys):
+    """``--event one-axis`` loses the most loaded axis by default (a vertical one; here
+    both AMBs alike, the first), lands its end, the other AMB taking up more of the
+    weight; ``--event overload`` beyond the AMBs' capacity (each holds
+    Ki·i_max = 500 N) lands both ends and says the currents saturated, one within it
+    does not land (5 N on the reference PID's 1e5 N/m); arguments of another event, and
+    events with --runs, are refused."""
+    rig = tmp_path / "rig.toml"
+    rig.write_text(_rig_text())
+
+    def drop(*extra):
+        code = main(["--quiet", "drop", str(rig), "--duration-s", "0.1", "--start", "rest",
+                     "--speed-rpm", "0", "--out", str(tmp_path / "d"), "--force", "--json",
+                     *extra])
+        return code, json.loads(capsys.readouterr().out)
+
+    code, doc = drop("--event", "one-axis")
+    assert code == 0 and doc["event"] == "one-axis"
+    assert [a["channel"] for a in doc["amb"] if a["failed"]] == ["A_eta"]
+    # A's end lands; B's axis takes up more than its static share, m g/(2 Ki)
+    assert doc["planes"][0]["peak_force_n"] > 0
+    static = (20.0 + 7850.0 * math.pi / 4 * 0.1 ** 2 * L) * 9.80665 / 2 / 100.0
+    assert doc["amb"][3]["peak_current_a"] > 1.2 * static
+    code, doc = drop("--event", "overload", "--overload-n", "1500")
+    assert [p["peak_force_n"] > 0 for p in doc["planes"]] == [True, True]
+    assert [a["saturated"] for a in doc["amb"]] == [False, True, False, True]
+    assert "1500 N downward at centre of mass" in doc["event_summary"]
+    code, doc = drop("--event", "overload", "--overload-n", "5", "--overload-at", "A")
+    assert [p["regime"] for p in doc["planes"]] == ["no contact", "no contact"]
+    for bad, why in ((["--axis", "A_eta"], "--axis: names the axis of --event one-axis"),
+                     (["--event", "one-axis", "--axis", "C_eta"], "--axis: expected one of"),
+                     (["--event", "overload"], "--overload-n: expected the step force"),
+                     (["--event", "overload", "--overload-n", "1", "--overload-at", "X"],
+                      "--overload-at: expected a seal, AMB"),
+                     (["--event", "one-axis", "--runs", "2"], "--runs: Monte-Carlo drops")):
+        assert main(["--quiet", "drop", str(rig), "--out", str(tmp_path / "x"), *bad]) == 2
+        err = capsys.readouterr().err
+        assert why in err and "Traceback" not in err
+
+
+def test_the_drop_from_a_designed_controllers_orbit(tmp_path, capsys):
+    """``--controller FILE``: the loop a drop starts from and runs on is the file's
+    controller: a PID twice as stiff as the rig's reference PID holds an unbalance to a
+    smaller orbit at the instant of the drop (the levitated start, as its closed form in
+    test_analysis_drop), named in drop.json."""
+    from ambseal.design import pid_controller, reference_pid
+    from ambseal.export import export_controller
+    from ambseal.model import channel_names
+
+    rig = tmp_path / "rig.toml"
+    rig.write_text(_rig_text())
+    cfg = load_rig(rig)
+    g = reference_pid(cfg)
+    stiff = export_controller(pid_controller(2 * g["kp"], g["ti"], g["td"], g["eps"],
+                                             channel_names(cfg)), tmp_path / "stiff.json")
+    orbits = []
+    for extra in ([], ["--controller", str(stiff)]):
+        code = main(["--quiet", "drop", str(rig), "--duration-s", "0.002", "--event",
+                     "one-axis", "--unbalance-kgm", "1e-3", "--out",
+                     str(tmp_path / "d"), "--force", "--json", *extra])
+        doc = json.loads(capsys.readouterr().out)
+        assert code in (0, 1)
+        orbits.append(doc["watched_max_m"]["amb:B"])
+    assert doc["controller"] == str(stiff)
+    assert orbits[1] < orbits[0]

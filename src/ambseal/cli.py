@@ -428,6 +428,22 @@ def _rotordynamics_parsers(sub) -> None:
     dg.add_argument("--at", choices=("standstill", "max-continuous", "trip"), default=None,
                     help="the spin speed by name: 0, the top of [operating] speed_range_hz "
                          "(else speed_rpm), or trip_speed_hz (else 1.05 × that)")
+    dr.add_argument("--event", choices=("loss", "one-axis", "overload"), default="loss",
+                    help="what lands the rotor: every AMB loses power (default), one axis "
+                         "does (--axis) while the others run on, or a step force "
+                         "(--overload-n) beyond what the AMBs hold")
+    dr.add_argument("--axis", default=None,
+                    help="--event one-axis: the axis lost, AMB_zeta or AMB_eta (default "
+                         "the one carrying the most static load)")
+    dr.add_argument("--overload-n", type=_positive, default=None,
+                    help="--event overload: the step force (N), downward")
+    dr.add_argument("--overload-at", default=None,
+                    help="--event overload: a seal, AMB, touchdown bearing or named disk "
+                         "where it acts (default the centre of mass)")
+    dr.add_argument("--controller", default=None,
+                    help="the AMB loop's controller: pid, hinf, mu (designed here) or a "
+                         "controller file (its continuous design); default the rig's "
+                         "reference PID")
     dr.add_argument("--duration-s", type=_positive, default=0.5,
                     help="time simulated after the AMBs let go (s; default 0.5)")
     dr.add_argument("--coast-down", action="store_true",

@@ -1,11 +1,13 @@
 """The rotor drop: the FE rotor released by its AMBs onto its touchdown bearings.
 
 ISO 14839-5:2022 asks for the analysis of the events that land a rotor on its touch-down
-bearings. Here the event is the loss of every AMB: from the levitated equilibrium at the
-operating speed, each AMB's static force (the share of the rotor's weight it carries)
-decays through its coil, e^{−t R/L} (instant where the rig gives no ``inductance`` and
-``resistance``; its negative stiffness goes with its bias), and the rotor falls through
-the clearance onto the rings. Radial contact only: ``axial_clearance`` is not simulated.
+bearings. Here the events are the loss of AMB axes — every one, or some while the loop
+runs the others — and a step force, from the levitated state at the operating speed: the
+AMB loop runs inside the drop (:mod:`ambseal.analysis.drop_loop`: each axis's force
+linearised about the levitated equilibrium, its current reference clipped at its limit,
+a lost axis's force decaying with the square of its coil's current, e^{−2t R/L}), and the
+rotor falls through the clearance onto the rings. Radial contact only:
+``axial_clearance`` is not simulated.
 
 The rotor: the free FE rotor of the rig (:func:`ambseal.model.assemble_rotor`, a node at
 every touchdown plane) in the mass-normalised real modes of its free–free
@@ -58,6 +60,7 @@ from scipy.constants import g as GRAVITY
 from scipy.integrate import solve_ivp
 from scipy.linalg import eigh
 
+from ambseal.analysis.drop_loop import AmbLoop, amb_loop
 from ambseal.design import air_gaps
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
@@ -135,10 +138,8 @@ class DropModel:
         0: it stands still), drag torque (N·m).
     support : tuple of (float, float, float) or None
         Per plane: the support's mass, stiffness and damping, None where rigid.
-    amb_rows : ndarray, shape (a, m)
-        Each AMB's y row of Φ.
-    amb_force, amb_tau : ndarray, shape (a,)
-        Each AMB's static force (N, +y) at the drop and its decay time L/R (s; 0 instant).
+    amb_force : ndarray, shape (a,)
+        Each AMB's static force (N, +y) in the levitated equilibrium.
     q0 : ndarray, shape (m,)
         The levitated equilibrium (the bending under gravity and the AMBs' forces).
     mass : float
@@ -160,6 +161,8 @@ class DropModel:
     cg_rows : ndarray, shape (2, m)
         The x, y rows of Φ at the node nearest the rotor's centre of mass, where an
         unbalance acts.
+    z_cg : float
+        The rotor's centre of mass (m).
     """
 
     phi: np.ndarray
@@ -175,9 +178,7 @@ class DropModel:
     race_inertia: np.ndarray
     drag: np.ndarray
     support: tuple
-    amb_rows: np.ndarray
     amb_force: np.ndarray
-    amb_tau: np.ndarray
     q0: np.ndarray
     mass: float
     polar_inertia: float
@@ -187,6 +188,7 @@ class DropModel:
     z: np.ndarray = field(default=None, repr=False)
     projector: np.ndarray = field(default=None, repr=False)
     cg_rows: np.ndarray = field(default=None, repr=False)
+    z_cg: float = 0.0
 
 
 def _amb_static_forces(cfg, mass: float, z_g: float) -> np.ndarray:
@@ -261,8 +263,6 @@ def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
     gravity = -GRAVITY * phi.T @ (rotor.M @ t_y)
     amb_rows = np.array([xy(a.position)[1] for a in cfg.amb])
     amb_force = _amb_static_forces(cfg, mass, z_g)
-    tau = np.array([(a.inductance / a.resistance) if (a.inductance and a.resistance)
-                    else 0.0 for a in cfg.amb])
     Km = phi.T @ rotor.K @ phi
     # levitated: the flexible modes bent by gravity and the AMBs (the rigid ones balanced)
     load = gravity + amb_rows.T @ amb_force
@@ -281,11 +281,11 @@ def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
         drag=np.array([t.race_drag_torque for t in cfg.touchdown]),
         support=tuple((t.support_mass, t.support_stiffness, t.support_damping)
                       if t.support_mass > 0 else None for t in cfg.touchdown),
-        amb_rows=amb_rows, amb_force=amb_force, amb_tau=tau, q0=q0, mass=mass,
+        amb_force=amb_force, q0=q0, mass=mass,
         polar_inertia=float(abs(Gr[2, 3])),
         names=tuple(t.name for t in cfg.touchdown), modes_hz=float(modes_hz),
         node_rows=rows, z=np.asarray(mesh.z, float), projector=phi.T @ rotor.M,
-        cg_rows=phi[[4 * g_node, 4 * g_node + 1], :])
+        cg_rows=phi[[4 * g_node, 4 * g_node + 1], :], z_cg=z_g)
 
 
 @dataclass(frozen=True)
@@ -338,6 +338,18 @@ class DropResult:
     integrator : str
         The ``solve_ivp`` method, and where it gave way to the stiff one
         (``"DOP853 → LSODA from 0.0123 s"``).
+    channels : tuple of str
+        The AMB axes (:attr:`AmbLoop.names`).
+    failed : tuple of str
+        Those that lost power at t = 0.
+    amb_current : ndarray, shape (c, k)
+        Each axis's coil current i_s + i (A): driven by the loop, or decaying once its
+        power is lost (:mod:`ambseal.analysis.drop_loop`).
+    current_limit : ndarray, shape (c,)
+        Each axis's largest current i_max (A; inf: unbounded).
+    saturated : ndarray of bool, shape (c,)
+        The axes that ran on whose current reference was clipped at i_max at an output
+        sample.
     """
 
     t: np.ndarray
@@ -361,10 +373,15 @@ class DropResult:
     clearance: np.ndarray
     turning: np.ndarray
     integrator: str
+    channels: tuple = ()
+    failed: tuple = ()
+    amb_current: np.ndarray = field(default=None, repr=False)
+    current_limit: np.ndarray = field(default=None, repr=False)
+    saturated: np.ndarray = field(default=None, repr=False)
 
     def regime(self, p: int) -> tuple[str, float]:
-        """The plane's regime over the last half of the drop: ``"bouncing"`` (in contact
-        less than half that time), ``"resting"`` (in contact, its orbit going less than
+        """The plane's regime over the last half of the drop: ``"no contact"`` (never
+        touched), ``"bouncing"`` (in contact less than half that time), ``"resting"`` (in contact, its orbit going less than
         once round the ring: settled or sliding to and fro at the bottom), else
         ``"forward whirl"`` or ``"backward whirl"`` by the orbit's mean angular speed
         against the spin; and the whirl frequency (Hz) at the end, the orbit's mean
@@ -377,6 +394,8 @@ class DropResult:
             span = self.t[keep][-1] - self.t[keep][0]
             return float(ang[-1] - ang[0]), float(span)
 
+        if not (self.force[p] > 0).any():
+            return "no contact", 0.0
         half = self.t >= 0.5 * self.t[-1]
         contact = float(np.mean(self.force[p, half] > 0))
         angle, _ = turned(0.5)
@@ -457,6 +476,12 @@ class DropResult:
                                                         - self.energy[-1])),
                 "external_work_j": json_float(float(self.work[-1])),
                 "final_speed_rad_s": json_float(float(self.spin[-1])),
+                "amb": [{"channel": name, "failed": name in self.failed,
+                         "peak_current_a": json_float(float(np.abs(i).max())),
+                         "current_limit_a": json_float(float(lim)),
+                         "saturated": bool(sat)}
+                        for name, i, lim, sat in zip(self.channels, self.amb_current,
+                                                     self.current_limit, self.saturated)],
                 "coast_down_s": None if stop is None else json_float(stop),
                 "coast_down_extrapolated": extrapolated}
 
@@ -466,7 +491,8 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                   method: str = "DOP853", model: DropModel | None = None,
                   coast_down: bool = False, drag_torque: float = 0.0,
                   initial: tuple | None = None, unbalance_kgm: float = 0.0,
-                  progress=None) -> DropResult:
+                  loop: AmbLoop | None = None, loop_state=None, failed=None,
+                  overload: tuple | None = None, progress=None) -> DropResult:
     """Drop the rotor of ``cfg`` onto its touchdown bearings (module docstring).
 
     Parameters
@@ -503,6 +529,18 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         (:attr:`DropModel.cg_rows`): the force U·Ω²·(cos θ, sin θ) turning with the spin's
         angle θ (θ = Ω t held; ∫Ω dt coasting, the spin's own slowing by it left out). Its
         work is counted as work from outside (:attr:`DropResult.work`).
+    loop : AmbLoop, optional
+        The AMB loop (:func:`ambseal.analysis.drop_loop.amb_loop`); default one without a
+        controller where every axis fails, else the reference PID's at ``speed_rpm``.
+    loop_state : ndarray, shape (loop.n_states,), optional
+        The loop's states at t = 0 (:func:`ambseal.analysis.drop_levitated.
+        levitated_state`); default zero, the loop at rest in the levitated equilibrium.
+    failed : sequence of str, optional
+        The channels (``loop.names``) whose power is lost at t = 0; default every one
+        (the AMBs let go). The others run on under the loop's controller.
+    overload : tuple (float, array_like of 2 float), optional
+        A step force from t = 0: its position z (m; at the nearest node) and its x, y
+        components (N). Its work is counted as work from outside.
     progress : callable, optional
         ``progress(t_s)`` after each segment.
 
@@ -514,7 +552,9 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     ------
     ConfigError
         As :func:`drop_model`; a duration or sample count out of range; an ``initial``
-        state of the wrong shape or not finite; a negative or non-finite unbalance.
+        or ``loop_state`` of the wrong shape or not finite; a negative or non-finite
+        unbalance; a ``failed`` channel the rig does not have, or axes left running
+        without a controller; an overload off the rotor or not finite.
     """
     if not (duration_s > 0 and math.isfinite(duration_s)):
         raise ConfigError(f"drop: duration: expected > 0 s, got {duration_s!r}")
@@ -527,13 +567,41 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     dm = model or drop_model(cfg, modes_hz)
     m, P = dm.phi.shape[1], len(dm.laws)
     W0 = 2 * np.pi * speed_rpm / 60.0
+    if loop is None:
+        loop = amb_loop(cfg, dm, speed_rpm, None if failed is not None else "none")
+    names = loop.names
+    failed = names if failed is None else tuple(failed)
+    unknown = [n for n in failed if n not in names]
+    if unknown:
+        raise ConfigError(f"drop: failed: {', '.join(unknown)}: expected AMB channels of "
+                          f"the rig ({', '.join(names)})")
+    down = np.array([n in failed for n in names])
+    if not down.all() and not loop.has_controller:
+        raise ConfigError("drop: the AMB axes that run on need a controller (the loop "
+                          "has none)")
+    f_over = np.zeros(m)
+    if overload is not None:
+        z_o, F_o = float(overload[0]), np.asarray(overload[1], float)
+        if F_o.shape != (2,) or not np.isfinite(F_o).all() or not (
+                dm.z[0] <= z_o <= dm.z[-1]):
+            raise ConfigError(f"drop: overload: expected a position on the rotor "
+                              f"({dm.z[0]:g} to {dm.z[-1]:g} m) and a finite force (x, y) "
+                              f"in N, got {overload!r}")
+        n_o = int(np.argmin(np.abs(dm.z - z_o)))
+        over_rows = dm.phi[[4 * n_o, 4 * n_o + 1], :]
+        f_over = over_rows.T @ F_o
+    Aa, Ba, Ca, Da = loop.coil
+    Ak, Bk, Ck, Dk = loop.controller
+    na, n_loop = Aa.shape[0], loop.n_states
+    i_s = loop.static / loop.ki
     races = np.flatnonzero(dm.race_inertia > 0)
     sup = [p for p in range(P) if dm.support[p] is not None]
-    # the states: modes and their rates, the turning rings, the supports, the spin and its
-    # angle when it coasts, and last the work done on the rotor from outside (J): by the
-    # drive holding the spin against the rings' friction, the AMBs' decaying forces and
-    # the unbalance
-    i_spin = 2 * m + races.size + 4 * len(sup)
+    # the states: modes and their rates, the turning rings, the supports, the AMB loop's
+    # (the coil's, the controller's), the spin and its angle when it coasts, and last the
+    # work done on the rotor from outside (J): by the drive holding the spin against the
+    # rings' friction, the AMBs' forces, the unbalance and the overload
+    i_loop = 2 * m + races.size + 4 * len(sup)
+    i_spin = i_loop + n_loop
     n_y = i_spin + (2 if coast_down else 0) + 1
     floor = np.sqrt(2 * GRAVITY * dm.clearance)  # the slowest impact the damping takes
     v0 = floor.copy()
@@ -578,15 +646,34 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             out.append((r, delta, N, Ft, n, tang))
         return out
 
+    def fade(t):
+        """Each failed axis's force's share left at t (module docstring of
+        :mod:`ambseal.analysis.drop_loop`): e^{−2t R/L}, 0 at once."""
+        tau = np.where(loop.tau > 0, loop.tau, 1.0)
+        return np.where(loop.tau > 0, np.exp(-2.0 * t / tau), 0.0)
+
+    def amb(t, y):
+        """The axes' forces (N), the loop's state derivative, the currents (A) and where
+        the loop's reference was clipped."""
+        dev = y[:m] - dm.q0
+        x_a, x_k = y[i_loop:i_loop + na], y[i_loop + na:i_spin]
+        sensed = loop.sensor @ dev
+        i_ref, clipped = loop.reference(sensed, x_k)
+        i_e = Ca @ x_a + Da @ i_ref
+        pull = loop.ks * (loop.axis @ dev)
+        fch = loop.static + loop.ki * i_e + pull
+        b2 = fade(t)
+        fch[down] = (b2 * (loop.static + loop.ki * i_fail + pull))[down]
+        current = np.where(down, np.sqrt(b2) * (i_s + i_fail), i_s + i_e)
+        return (fch, np.concatenate([Aa @ x_a + Ba @ i_ref, Ak @ x_k + Bk @ sensed]),
+                current, clipped & ~down)
+
     def rhs(t, y):
         eta, deta, wr, s, ds = unpack(y)
-        f = dm.gravity.copy()
-        power = 0.0
-        if dm.amb_force.size:
-            decay = np.where(dm.amb_tau > 0, np.exp(-t / np.where(dm.amb_tau > 0,
-                                                                   dm.amb_tau, 1.0)), 0.0)
-            f += dm.amb_rows.T @ (dm.amb_force * decay)
-            power += float((dm.amb_force * decay) @ (dm.amb_rows @ deta))
+        f = dm.gravity + f_over
+        fch, dloop, _, _ = amb(t, y)
+        f += loop.axis.T @ fch
+        power = float(fch @ (loop.axis @ deta) + f_over @ deta)
         if unbalance_kgm:
             W, th = spin(y), angle(t, y)
             fu = unbalance_kgm * W * W * np.array([math.cos(th), math.sin(th)])
@@ -616,6 +703,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         else:  # the drive supplies the friction's torque
             power -= torque * W
         dy[-1] = power
+        dy[i_loop:i_spin] = dloop
         dy[2 * m:2 * m + races.size] = dwr[races]
         base = 2 * m + races.size
         for k, p in enumerate(sup):
@@ -659,6 +747,16 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             raise ConfigError(f"drop: initial: expected a finite displacement and velocity "
                               f"of {n_dof} DOFs each, got shapes {u0.shape}, {du0.shape}")
         y[:m], y[m:2 * m] = dm.projector @ u0, dm.projector @ du0
+    if loop_state is not None:
+        x0 = np.asarray(loop_state, float)
+        if x0.shape != (n_loop,) or not np.isfinite(x0).all():
+            raise ConfigError(f"drop: loop_state: expected {n_loop} finite states, got "
+                              f"shape {x0.shape}")
+        y[i_loop:i_spin] = x0
+    # what the failed axes' coils carry at the instant they lose power
+    x_k0 = y[i_loop + na:i_spin]
+    i_fail = Ca @ y[i_loop:i_loop + na] + Da @ loop.reference(
+        loop.sensor @ (y[:m] - dm.q0), x_k0)[0]
     if coast_down:
         y[i_spin] = W0
     grid = np.linspace(0.0, duration_s, samples)
@@ -672,6 +770,13 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         atol[i_spin] = rtol * (abs(W0) + 1.0)
         atol[i_spin + 1] = rtol
     atol[-1] = rtol * dm.mass * GRAVITY * c_min  # the work: the energy of the fall
+    # the loop's states by what they add to a current: of the order of the static
+    # currents, the limit or 1 mA, whichever is largest
+    i_scale = max(float(np.abs(i_s).max(initial=0.0)),
+                  float(loop.limit[np.isfinite(loop.limit)].min(initial=0.0)), 1e-3)
+    gain = np.abs(np.hstack([Ca, Ck])).max(axis=0, initial=0.0)
+    for j in range(n_loop):
+        atol[i_loop + j] = rtol * i_scale / (gain[j] if gain[j] > 0 else 1.0)
     for k in range(len(sup)):
         atol[2 * m + races.size + 4 * k:2 * m + races.size + 4 * k + 2] = rtol * c_min
     # a start in contact (an ``initial`` state on a ring) waits for the contact's end
@@ -770,6 +875,8 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             e += 0.5 * dm.polar_inertia * spin(yj) ** 2
         energy[j] = e
     watched = {k: np.einsum("ij,kj->ki", rows, Y[:, :m]) for k, rows in dm.node_rows.items()}
+    at = [amb(tj, yj) for tj, yj in zip(t, Y)]
+    currents = np.array([a[2] for a in at]).T
     return DropResult(t=t, orbit=orbit, force=force, penetration=pen, race_speed=race,
                       energy=energy, work=Y[:, -1].copy(), watched=watched,
                       impacts=impacts, names=dm.names,
@@ -779,7 +886,9 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                       peak_penetration=np.maximum(peak_delta, pen.max(axis=1).clip(0)),
                       first_peak_force=first_peak, integrator=integrator,
                       journal=dm.journal.copy(), clearance=dm.clearance.copy(),
-                      turning=dm.race_inertia > 0)
+                      turning=dm.race_inertia > 0, channels=names, failed=failed,
+                      amb_current=currents, current_limit=loop.limit.copy(),
+                      saturated=np.array([a[3] for a in at]).any(axis=0))
 
 
 def drop_verdict(cfg, result: DropResult) -> dict:

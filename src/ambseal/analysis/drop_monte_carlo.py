@@ -25,7 +25,8 @@ import numpy as np
 
 from ambseal.analysis.cases import CaseError, run_cases
 from ambseal.analysis.drop import drop_model, drop_verdict, simulate_drop
-from ambseal.analysis.drop_levitated import levitated_start
+from ambseal.analysis.drop_levitated import levitated_state
+from ambseal.analysis.drop_loop import amb_loop
 from ambseal.config import parse_rig
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
@@ -91,7 +92,7 @@ def drop_run(case: dict, rig: dict, speed_rpm: float, duration_s: float, modes_h
         As :func:`~ambseal.analysis.drop.simulate_drop`.
     start : {"levitated", "rest"}
         With an unbalance, the drop starts from the reference PID loop's unbalance orbit
-        (:func:`~ambseal.analysis.drop_levitated.levitated_start`) or at rest.
+        (:func:`~ambseal.analysis.drop_levitated.levitated_state`) or at rest.
 
     Returns
     -------
@@ -108,10 +109,14 @@ def drop_run(case: dict, rig: dict, speed_rpm: float, duration_s: float, modes_h
     cfg = cfg.model_copy(update={"touchdown": tds})
     dm = drop_model(cfg, modes_hz)
     u = case["unbalance_kgm"]
-    initial = levitated_start(cfg, dm, speed_rpm, u) if start == "levitated" and u else None
+    initial = loop = x0 = None
+    if start == "levitated" and u:  # the orbit and the currents the coils carry at the drop
+        loop = amb_loop(cfg, dm, speed_rpm)
+        eta, deta, x0 = levitated_state(cfg, dm, speed_rpm, u, loop=loop)
+        initial = (dm.phi @ eta, dm.phi @ deta)
     res = simulate_drop(cfg, speed_rpm=speed_rpm, duration_s=duration_s, samples=2001,
                         model=dm, coast_down=coast_down, drag_torque=drag_torque,
-                        unbalance_kgm=u, initial=initial)
+                        unbalance_kgm=u, initial=initial, loop=loop, loop_state=x0)
     judged = drop_verdict(cfg, res)
     row = {"run": case["run"], "passed": judged["passed"],
            "failed": "; ".join(c["name"] for c in judged["criteria"]

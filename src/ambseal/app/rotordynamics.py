@@ -23,13 +23,15 @@ import sys
 from pathlib import Path
 
 from ambseal.analysis import (
+    amb_loop,
     check_cases,
     dask_available,
+    drop_event,
     drop_model,
     drop_scatter,
     drop_verdict,
     judge_settings,
-    levitated_start,
+    levitated_state,
     operating_points,
     parse_range,
     probe_scheduler,
@@ -61,6 +63,7 @@ from ambseal.model import channel_names
 from ambseal.report import (
     api617_unbalance_figure,
     campbell_figure,
+    drop_current_figure,
     drop_figure,
     drop_whirl_figure,
     level1_figure,
@@ -302,6 +305,13 @@ def _drop(args: argparse.Namespace) -> int:
         raise ConfigError("--drag-torque: slows a coasting rotor; add --coast-down (the "
                           "drive holds the speed otherwise)")
     if args.runs is not None:
+        given = [f"--{n.replace('_', '-')}" for n in ("axis", "overload_n", "overload_at",
+                                                       "controller")
+                 if getattr(args, n) is not None]
+        if args.event != "loss" or given:
+            raise ConfigError(f"--runs: Monte-Carlo drops are of --event loss from the "
+                              f"reference PID's orbit; drop without --runs for "
+                              f"{', '.join(given) or '--event ' + args.event}")
         return _drop_scatter(args, cfg, rpm)
     for name in ("friction", "clearance_tol_um", "support_damping", "workers", "scheduler"):
         if getattr(args, name) is not None:
@@ -312,16 +322,26 @@ def _drop(args: argparse.Namespace) -> int:
         raise ConfigError("--unbalance-kgm: a range LO:HI is drawn per run; add --runs N, "
                           "or give one value")
     dm = drop_model(cfg, args.modes_hz)
-    start = (levitated_start(cfg, dm, rpm, unbalance[0])
-             if args.start == "levitated" and unbalance[0] > 0 else None)
+    controller = controller_for(cfg, args.controller) if args.controller else None
+    loop = amb_loop(cfg, dm, rpm, controller)
+    event = drop_event(cfg, dm, loop, args.event, args.axis, args.overload_n,
+                       args.overload_at)
+    start = x0 = None
+    # a loop that runs on is checked for stability at the speed, as the orbit needs it
+    if args.start == "levitated" and (unbalance[0] > 0 or event["failed"] != loop.names):
+        eta, deta, x0 = levitated_state(cfg, dm, rpm, unbalance[0], loop=loop)
+        start = (dm.phi @ eta, dm.phi @ deta)
     res = simulate_drop(cfg, speed_rpm=rpm, duration_s=args.duration_s, model=dm,
                         coast_down=args.coast_down, drag_torque=args.drag_torque,
-                        unbalance_kgm=unbalance[0], initial=start, progress=progress)
+                        unbalance_kgm=unbalance[0], initial=start, loop=loop,
+                        loop_state=x0, failed=event["failed"], overload=event["overload"],
+                        progress=progress)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     judged = drop_verdict(cfg, res)
     doc = {"rig": str(args.rig), "speed_rpm": rpm, "unbalance_kgm": unbalance[0],
-           "start": args.start, **judged, **res.to_dict()}
+           "start": args.start, "event": args.event, "event_summary": event["summary"],
+           "controller": args.controller or "reference PID", **judged, **res.to_dict()}
     for plane, td in zip(doc["planes"], cfg.touchdown):
         plane["radial_clearance_m"] = td.radial_clearance
     title = f"Rotor drop — {cfg.rotor.name}"
@@ -329,7 +349,9 @@ def _drop(args: argparse.Namespace) -> int:
                 drop_figure(out / "drop.png", res, [t.radial_clearance for t in cfg.touchdown],
                             title=title)),
                ("Whirl waterfall and speeds", drop_whirl_figure(out / "drop_whirl.png", res,
-                                                                title=title))]
+                                                                title=title)),
+               ("AMB coil currents", drop_current_figure(out / "drop_currents.png", res,
+                                                         title=title))]
     files = [write_json(out / "drop.json", doc), *(png for _, png in figures),
              write_drop_report(out / "drop.html", doc, figures, title=title,
                                meta=stamp(args.rig, args.command_line))]
@@ -345,6 +367,9 @@ def _drop(args: argparse.Namespace) -> int:
                   + (f" at {p['whirl_hz']:.4g} Hz from {1e3 * onset:.4g} ms"
                      if onset is not None else "")
                   + (f"; ring spun up in {1e3 * spin_up:.4g} ms" if spin_up else ""))
+        for a in doc["amb"]:
+            if a["saturated"]:
+                print(f"{a['channel']}: current saturated at {a['current_limit_a']:.4g} A")
         print(f"files: {', '.join(str(f) for f in files)}")
     return 0 if doc["passed"] else 1
 

@@ -15,7 +15,8 @@
 * :func:`level1_figure`, :func:`api617_unbalance_figure`, :func:`signoff_report` — API 617's
   Level I screening, unbalance response
   (:mod:`ambseal.report.signoff_figures`);
-* :func:`drop_figure`, :func:`drop_whirl_figure` — the rotor drop: orbits in the
+* :func:`drop_figure`, :func:`drop_whirl_figure`, :func:`drop_current_figure` — the
+  rotor drop: the AMB axes' currents, orbits in the
   clearance, contact forces, the whirl's waterfall (:func:`whirl_waterfall`), the rings'
   speeds
   (:mod:`ambseal.report.drop_figures`); :func:`write_drop_report`, its page
@@ -39,7 +40,7 @@ _FROM = {
     "StageProgress": "progress",
     "level1_figure": "signoff_figures", "signoff_report": "signoff_figures",
     "drop_figure": "drop_figures", "drop_whirl_figure": "drop_figures",
-    "whirl_waterfall": "drop_figures",
+    "whirl_waterfall": "drop_figures", "drop_current_figure": "drop_figures",
     "write_drop_report": "drop_report",
     "api617_unbalance_figure": "signoff_figures",
     "facility_impulse_report": "run_report", "gains_figure": "run_report",

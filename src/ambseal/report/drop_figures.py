@@ -15,7 +15,7 @@ from scipy.signal import spectrogram
 
 from ambseal.report.figures import save_figure
 
-__all__ = ["drop_figure", "drop_whirl_figure", "whirl_waterfall"]
+__all__ = ["drop_figure", "drop_whirl_figure", "whirl_waterfall", "drop_current_figure"]
 
 #: the share of the waterfall's energy inside the frequency band shown
 SHOWN_ENERGY = 0.995
@@ -69,7 +69,7 @@ def drop_figure(path: str | os.PathLike, result, clearances_m, *,
     ax = axes[-1]
     for p, name in enumerate(result.names):
         ax.plot(1e3 * result.t, 1e-3 * result.force[p], lw=0.8, label=name)
-    ax.set_xlabel("time after the AMBs let go (ms)")
+    ax.set_xlabel("time after the event (ms)")
     ax.set_ylabel("contact force (kN)")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
@@ -151,7 +151,7 @@ def drop_whirl_figure(path: str | os.PathLike, result, *,
         ax.axhline(0.0, color="w", lw=0.4)
         ax.set_ylim(-lim, lim)
         ax.set_title(_plane_title(result, p), fontsize=9)
-        ax.set_xlabel("time after the AMBs let go (ms)")
+        ax.set_xlabel("time after the event (ms)")
         ax.set_ylabel("whirl frequency (Hz; backward < 0)")
     ax = axes[-1]
     rpm = 60.0 / (2 * np.pi)
@@ -159,9 +159,48 @@ def drop_whirl_figure(path: str | os.PathLike, result, *,
     for p, name in enumerate(result.names):
         if result.turning[p]:
             ax.plot(1e3 * result.t, rpm * result.race_speed[p], lw=0.8, label=f"ring {name}")
-    ax.set_xlabel("time after the AMBs let go (ms)")
+    ax.set_xlabel("time after the event (ms)")
     ax.set_ylabel("speed (rpm)")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.suptitle(f"{title} at {rpm * result.speed_rad_s:.6g} rpm", fontsize=10)
+    return save_figure(fig, path)
+
+
+def drop_current_figure(path: str | os.PathLike, result, *,
+                        title: str = "Rotor drop: AMB currents") -> Path:
+    """Each AMB axis's coil current (A) against time: driven by its loop (solid) or
+    decaying once its power was lost (dotted), each limit ±i_max dashed.
+
+    Parameters
+    ----------
+    path : path-like
+        The PNG to write.
+    result : ambseal.analysis.drop.DropResult
+        The simulated drop, with its ``channels`` and ``amb_current``.
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The PNG written.
+    """
+    fig = Figure(figsize=(8, 4.2), layout="constrained")
+    ax = fig.subplots()
+    limits = set()
+    for name, i, lim in zip(result.channels, result.amb_current, result.current_limit):
+        lost = name in result.failed
+        ax.plot(1e3 * result.t, i, ls=":" if lost else "-", lw=1.0,
+                label=f"{name} (lost)" if lost else name)
+        if np.isfinite(lim):
+            limits.add(float(lim))
+    for lim in sorted(limits):
+        for sign in (1, -1):
+            ax.axhline(sign * lim, color="k", ls="--", lw=0.7)
+    ax.set_xlabel("time after the event (ms)")
+    ax.set_ylabel("coil current i_s + i (A)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, ncol=2)
+    ax.set_title(title, fontsize=10)
     return save_figure(fig, path)

@@ -1,5 +1,7 @@
 """The rotor drop's report page: the verdict first (each criterion passed, FAILED or not
-graded, with its value and limit), then per touchdown bearing what the engineer judges —
+graded, with its value and limit), the event and each AMB axis (lost or running on, its
+peak current against its limit, saturated or not), then per touchdown bearing what the
+engineer judges —
 peak force, deepest penetration, largest orbit against the clearance, regime, whirl
 frequency and onset, the ring's spin-up and final speed —, the largest excursion at each
 AMB and seal, the energy the drop took, the coast-down, and the figures
@@ -83,9 +85,19 @@ def write_drop_report(path: str | os.PathLike, doc: dict, figures, *, title: str
                  == doc["speed_rad_s"] else "not slowing" if stop is None else
                  f"{stop:.4g} s" + (" (extrapolated from the drop's last half)"
                                     if doc.get("coast_down_extrapolated") else ""))
+    ambs = [f'<tr><td class="text">{html.escape(a["channel"])}</td>'
+            + _cell("lost" if a["failed"] else "runs on", text=True)
+            + _cell(_num(a["peak_current_a"])) + _cell(_num(a["current_limit_a"]))
+            + _cell("yes" if a["saturated"] else "no", text=True) + "</tr>"
+            for a in doc.get("amb", [])]
+    event = (f"<p>{html.escape(doc['event_summary'])}; the loop's controller: "
+             f"{html.escape(str(doc.get('controller', 'reference PID')))}.</p>"
+             if "event_summary" in doc else "")
     sections = [
         {"title": "Verdict", "html": f"<p><b>{html.escape(doc['verdict'])}</b></p>"
          + _table(["criterion", "outcome", "value", "limit"], crit)},
+        {"title": "The event and the AMB axes", "html": event + _table(
+            ["axis", "power", "peak current (A)", "limit (A)", "saturated"], ambs)},
         {"title": "Touchdown bearings", "html": _table(
             ["plane", "peak force (N)", "max penetration (µm)", "max orbit (µm)",
              "regime", "whirl (Hz)", "whirl onset (ms)", "ring spin-up (ms)",
@@ -95,7 +107,8 @@ def write_drop_report(path: str | os.PathLike, doc: dict, figures, *, title: str
         {"title": "Energy and speed",
          "text": f"{doc['impacts']} contact onsets in {doc['duration_s']:.4g} s; the "
                  f"contacts, drag and structure dissipated {doc['energy_dissipated_j']:.4g} J "
-                 f"(the drive and the AMBs did {doc['external_work_j']:.4g} J of work on "
+                 f"(the drive, the AMBs, the unbalance and any overload did "
+                 f"{doc['external_work_j']:.4g} J of work on "
                  f"the rotor); the rotor's spin from "
                  f"{doc['speed_rad_s'] * 60 / (2 * math.pi):.6g} rpm, "
                  f"standstill: {stop_text}; {doc['n_modes']} free–free modes up to "

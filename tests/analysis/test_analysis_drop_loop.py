@@ -1,0 +1,152 @@
+"""The AMB loop inside the drop (ambseal.analysis.drop_loop) on the rigid symmetric rotor of
+test_analysis_drop: a lost axis against the one-degree-of-freedom fall under its decaying
+magnets, the running loop against its linear unbalance orbit, and the statics of one
+axis lost and of an overload within and beyond the AMBs' capacity."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
+
+from ambseal.analysis.drop import GRAVITY, drop_model, simulate_drop
+from ambseal.analysis.drop_levitated import levitated_state
+from ambseal.analysis.drop_loop import amb_loop
+from ambseal.design import pid_controller
+from ambseal.errors import ConfigError
+from ambseal.model import channel_names
+
+from ..rigid_rotor import L, inertia
+from .test_analysis_drop import C_TD, DISK, K_TD, _rig
+
+KI, KS, I_MAX = 100.0, 2.0e5, 5.0  # the rig's Ki, Ks and its bias current (< its limit)
+Z_AMB = (0.1, L - 0.1)
+
+
+def _damped():
+    """The rig with contacts that settle (Flores, e = 0.5) rather than bounce for ever."""
+    base = _rig()
+    return base.model_copy(update={"touchdown": [
+        t.model_copy(update={"restitution": 0.5}) for t in base.touchdown]})
+
+
+def _pid(cfg, ti: float = 0.2):
+    return pid_controller(1e4, ti, 3e-3, 0.1, channel_names(cfg))
+
+
+def test_a_lost_amb_lets_go_with_the_square_of_its_decaying_current():
+    """Both AMBs lose power at rest, their coils' L/R = 2 ms: the rotor falls straight,
+    m ÿ = −m g + e^{−2t/τ}(m g + 2 Ks y) (the force ∝ i², Ks with the bias), integrated
+    apart as one degree of freedom — the drop's centre within 1e-6 of the clearance of
+    it until the first contact."""
+    base = _rig()
+    cfg = base.model_copy(update={"amb": [a.model_copy(update={"inductance": 0.02,
+                                                                "resistance": 10.0})
+                                          for a in base.amb]})
+    m, tau = inertia(*DISK)[0], 0.002
+
+    def fall(t, s):
+        return [s[1], -GRAVITY + math.exp(-2 * t / tau) * (GRAVITY + 2 * KS * s[0] / m)]
+
+    r = simulate_drop(cfg, duration_s=0.012, samples=1201, rtol=1e-10)
+    first = np.flatnonzero(r.force.max(axis=0) > 0)[0]
+    ref = solve_ivp(fall, (0, r.t[first]), [0.0, 0.0], method="DOP853", rtol=1e-11,
+                    atol=1e-15, dense_output=True)
+    y = 0.5 * (r.watched["amb:A"][:first, 1] + r.watched["amb:B"][:first, 1])
+    y = y - y[0]
+    np.testing.assert_allclose(y, ref.sol(r.t[:first])[0], rtol=0, atol=1e-6 * C_TD)
+    assert ref.sol(r.t[first])[0] < -C_TD < ref.sol(r.t[first - 1])[0]
+    assert r.failed == ("A_zeta", "A_eta", "B_zeta", "B_eta")
+
+
+def test_the_running_loop_holds_its_levitated_unbalance_orbit():
+    """No axis lost, U = 1e-4 kg·m at 3000 rpm: the nonlinear drop with the PID loop
+    inside runs on in the linear loop's steady orbit (test_analysis_drop's closed form
+    X = U Ω²/(2(Ki K(jΩ) − Ks) − m Ω²)) within 1e-6 of |X|, never touching, the currents
+    the static one and the PID's, −K(jΩ) X, within 1e-6 of its amplitude."""
+    cfg = _rig()
+    dm = drop_model(cfg)
+    K = _pid(cfg)
+    loop = amb_loop(cfg, dm, controller=K)
+    m = inertia(*DISK)[0]
+    W, U = 100 * math.pi, 1e-4
+    eta, deta, x0 = levitated_state(cfg, dm, 3000.0, U, loop=loop)
+    r = simulate_drop(cfg, speed_rpm=3000.0, duration_s=0.04, samples=401, model=dm,
+                      loop=loop, loop_state=x0, failed=(), unbalance_kgm=U, rtol=1e-10,
+                      initial=(dm.phi @ eta, dm.phi @ deta))
+    s = 1j * W
+    Kc = 1e4 * (1 + 1 / (s * 0.2) + s * 3e-3 / (s * 0.1 * 3e-3 + 1))
+    X = U * W ** 2 / (2 * (KI * Kc - KS) - m * W ** 2)
+    orbit = X * np.exp(1j * W * r.t)
+    sag = r.watched["amb:A"][0] - np.array([X.real, X.imag])
+    got = r.watched["amb:A"] - sag
+    np.testing.assert_allclose(got[:, 0] + 1j * got[:, 1], orbit, rtol=0, atol=1e-6 * abs(X))
+    assert r.impacts == 0 and r.force.max() == 0
+    i_s = m * GRAVITY / 2 / KI
+    np.testing.assert_allclose(r.amb_current[1], i_s - (Kc * orbit).imag, rtol=0,
+                               atol=1e-6 * abs(Kc * X))
+
+
+def test_one_axis_lost_lands_that_end_and_the_other_amb_holds_the_rest():
+    """At rest the vertical axis of AMB A fails at once: the rotor tips onto the ring at
+    A's end (z = 0) about B, whose loop holds it; statics: the ring carries
+    N = m g (z_B − L/2)/z_B and B's coil, its sensor brought back by the integral action,
+    carries (m g − N)/Ki — both within 1 % once settled. The other end's ring is not
+    touched."""
+    cfg = _damped()
+    dm = drop_model(cfg)
+    loop = amb_loop(cfg, dm, controller=_pid(cfg, ti=0.02))
+    m = inertia(*DISK)[0]
+    r = simulate_drop(cfg, duration_s=0.6, samples=601, model=dm, loop=loop,
+                      failed=("A_eta",))
+    N = m * GRAVITY * (Z_AMB[1] - L / 2) / Z_AMB[1]
+    assert r.force[0, -1] == pytest.approx(N, rel=0.01)
+    assert r.force[1].max() == 0
+    assert r.amb_current[3, -1] == pytest.approx((m * GRAVITY - N) / KI, rel=0.01)
+    assert r.amb_current[1, -1] == 0  # A's lost axis: at once, without L and R
+
+
+@pytest.mark.parametrize("overload_n", [200.0, 1000.0])
+def test_an_overload_within_the_capacity_is_held_and_beyond_it_lands(overload_n):
+    """A step force F down at the centre from rest. Within the AMBs' capacity (F = 200 N:
+    each coil's current i_s + F/(2 Ki) below its bias, the linear range) the loop holds
+    it: no contact, the currents that much up within 1e-3. Beyond it (F = 1000 N) the
+    currents clip at the bias and the rotor lands on both rings: each carries
+    N = (m g + F)/2 − Ki i_max + Ks (c + δ), δ = (N/K)^{2/3} (the magnets pulling it
+    down), within 1 %, and the drop says they saturated."""
+    cfg = _damped()
+    dm = drop_model(cfg)
+    loop = amb_loop(cfg, dm, controller=_pid(cfg, ti=0.02))
+    m = inertia(*DISK)[0]
+    r = simulate_drop(cfg, duration_s=0.4, samples=401, model=dm, loop=loop, failed=(),
+                      overload=(L / 2, (0.0, -overload_n)))
+    per = (m * GRAVITY + overload_n) / 2
+    amb = r.to_dict()["amb"]
+    if per < KI * I_MAX:
+        assert r.force.max() == 0
+        np.testing.assert_allclose(r.amb_current[[1, 3], -1], per / KI, rtol=1e-3)
+        assert not any(a["saturated"] for a in amb)
+        return
+    N = brentq(lambda n: n - (per - KI * I_MAX + KS * (C_TD + (n / K_TD) ** (2 / 3))),
+               0.0, 10 * per)
+    np.testing.assert_allclose(r.force[:, -1], N, rtol=0.01)
+    np.testing.assert_allclose(r.amb_current[[1, 3], -1], I_MAX, rtol=1e-9)
+    assert [a["saturated"] for a in amb] == [False, True, False, True]
+
+
+def test_the_loop_refuses_what_it_cannot_run():
+    """A channel the rig has not, axes left running without a controller and an overload
+    off the rotor are refused, each naming what was expected."""
+    cfg = _rig()
+    dm = drop_model(cfg)
+    with pytest.raises(ConfigError, match=r"failed: C_eta: expected AMB channels"):
+        simulate_drop(cfg, duration_s=0.01, model=dm, failed=("C_eta",),
+                      loop=amb_loop(cfg, dm, controller=_pid(cfg)))
+    with pytest.raises(ConfigError, match="run on need a controller"):
+        simulate_drop(cfg, duration_s=0.01, model=dm, failed=("A_eta",),
+                      loop=amb_loop(cfg, dm, controller="none"))
+    with pytest.raises(ConfigError, match="overload: expected a position on the rotor"):
+        simulate_drop(cfg, duration_s=0.01, model=dm, overload=(2 * L, (0.0, -1.0)))

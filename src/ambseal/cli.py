@@ -444,6 +444,9 @@ def _rotordynamics_parsers(sub) -> None:
                     help="the AMB loop's controller: pid, hinf, mu (designed here) or a "
                          "controller file (its continuous design); default the rig's "
                          "reference PID")
+    dr.add_argument("--pressure-bar", type=_finite, default=None,
+                    help="the seals' pressure drop (bar) through the drop; default "
+                         "[operating] pressure_bar")
     dr.add_argument("--duration-s", type=_positive, default=0.5,
                     help="time simulated after the AMBs let go (s; default 0.5)")
     dr.add_argument("--coast-down", action="store_true",

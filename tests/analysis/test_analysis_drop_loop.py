@@ -62,12 +62,24 @@ def test_a_lost_amb_lets_go_with_the_square_of_its_decaying_current():
     assert r.failed == ("A_zeta", "A_eta", "B_zeta", "B_eta")
 
 
-def test_the_running_loop_holds_its_levitated_unbalance_orbit():
+SEAL = {"K": 2e5, "k": 1.5e5, "C": 300.0, "c": 80.0, "M": 3.0}  # at mid-span
+
+
+@pytest.mark.parametrize("sealed", [False, True])
+def test_the_running_loop_holds_its_levitated_unbalance_orbit(sealed):
     """No axis lost, U = 1e-4 kg·m at 3000 rpm: the nonlinear drop with the PID loop
-    inside runs on in the linear loop's steady orbit (test_analysis_drop's closed form
-    X = U Ω²/(2(Ki K(jΩ) − Ks) − m Ω²)) within 1e-6 of |X|, never touching, the currents
-    the static one and the PID's, −K(jΩ) X, within 1e-6 of its amplitude."""
+    inside runs on in the linear loop's steady orbit — the forward whirl
+    X = U Ω²/(2(Ki K(jΩ) − Ks) + (K − jk) + jΩ(C − jc) − (m + M)Ω²), with a seal of
+    Childs' K, k, C, c, M at mid-span (thesis P4 Eq. 3; its force on x + jy is
+    −(K − jk) z − (C − jc) ż − M z̈) or without — at the start (the levitated state) and
+    throughout, within 1e-6 of |X|, never touching, the currents the static one and the
+    PID's, −K(jΩ) X, within 1e-6 of its amplitude."""
+    from ambseal.config import Seal
+
     cfg = _rig()
+    if sealed:
+        cfg = cfg.model_copy(update={"seal": [Seal(name="mid", position=L / 2, **SEAL)]})
+    seal = SEAL if sealed else dict.fromkeys(SEAL, 0.0)
     dm = drop_model(cfg)
     K = _pid(cfg)
     loop = amb_loop(cfg, dm, controller=K)
@@ -79,9 +91,11 @@ def test_the_running_loop_holds_its_levitated_unbalance_orbit():
                       initial=(dm.phi @ eta, dm.phi @ deta))
     s = 1j * W
     Kc = 1e4 * (1 + 1 / (s * 0.2) + s * 3e-3 / (s * 0.1 * 3e-3 + 1))
-    X = U * W ** 2 / (2 * (KI * Kc - KS) - m * W ** 2)
+    X = U * W ** 2 / (2 * (KI * Kc - KS) + seal["K"] - 1j * seal["k"]
+                      + 1j * W * (seal["C"] - 1j * seal["c"]) - (m + seal["M"]) * W ** 2)
     orbit = X * np.exp(1j * W * r.t)
-    sag = r.watched["amb:A"][0] - np.array([X.real, X.imag])
+    a = int(np.argmin(np.abs(dm.z - Z_AMB[0])))
+    sag = (dm.phi @ dm.q0)[[4 * a, 4 * a + 1]]  # the levitated equilibrium at A's node
     got = r.watched["amb:A"] - sag
     np.testing.assert_allclose(got[:, 0] + 1j * got[:, 1], orbit, rtol=0, atol=1e-6 * abs(X))
     assert r.impacts == 0 and r.force.max() == 0

@@ -13,7 +13,8 @@ The rotor: the free FE rotor of the rig (:func:`ambseal.model.assemble_rotor`, a
 every touchdown plane) in the mass-normalised real modes of its free–free
 non-rotating form up to ``modes_hz`` (rigid-body modes included), M q̈ + (C + ΩG) q̇ + K q
 = f at the spin speed Ω, held by the drive or coasting down under the rings' friction
-and a drag torque (``coast_down``), the gyroscopic moments at the instantaneous speed.
+and a drag torque (``coast_down``), the gyroscopic moments at the instantaneous speed;
+the seals' forces (:func:`seal_matrices`) at the drop's speed and pressure drop.
 The default ``modes_hz`` is :data:`MODES_PER_CONTACT` (4) times the contact's own
 frequency 1/t_c (:func:`ambseal.model.hertz_impact`) for a fall through the smallest
 clearance, the shortest over the planes, each an impact of the rotor's mass shared among
@@ -66,6 +67,7 @@ from ambseal.errors import ConfigError
 from ambseal.lti import json_float
 from ambseal.model import (
     ContactLaw,
+    SealElement,
     assemble_rotor,
     build_mesh,
     damping_coefficient,
@@ -80,7 +82,7 @@ class _Crawling(Exception):
 
 
 __all__ = ["GRAVITY", "DropModel", "DropResult", "drop_model", "simulate_drop",
-           "journal_radius", "drop_verdict"]
+           "journal_radius", "drop_verdict", "seal_matrices"]
 
 #: the modes kept reach this many times the contact's own frequency 1/t_c
 MODES_PER_CONTACT = 4.0
@@ -288,6 +290,41 @@ def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
         cg_rows=phi[[4 * g_node, 4 * g_node + 1], :], z_cg=z_g)
 
 
+def seal_matrices(cfg, dm: DropModel, speed_rpm: float, pressure_bar: float | None = None
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The rig's seals on the drop's modes: Childs' force −[K k; −k K] s − [C c; −c C] ṡ
+    − M s̈ on each seal's displacement s from the levitated equilibrium (thesis P4 Eq. 3),
+    at the pressure drop and, for tabulated coefficients, the synchronous frequency of
+    ``speed_rpm`` (as :func:`ambseal.model.build_plant` takes them), held through the drop.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig and its ``[[seal]]`` tables.
+    dm : DropModel
+        Its drop model.
+    speed_rpm : float
+        The spin speed (rpm) at the drop.
+    pressure_bar : float, optional
+        The pressure drop across the seals (bar); ``[operating] pressure_bar`` if omitted.
+
+    Returns
+    -------
+    K, C, M : ndarray, shape (m, m)
+        Φᵀ K_s Φ, Φᵀ C_s Φ, Φᵀ M_s Φ (zero without seals).
+    """
+    p = cfg.operating.pressure_bar if pressure_bar is None else pressure_bar
+    m = dm.phi.shape[1]
+    out = [np.zeros((m, m)) for _ in range(3)]
+    mesh = build_mesh(cfg, extra_positions=tuple(t.position for t in cfg.touchdown))
+    for seal in cfg.seal:
+        el = SealElement.from_config(seal, mesh, p, abs(speed_rpm) / 60.0)
+        rows = dm.phi[[4 * el.node, 4 * el.node + 1], :]
+        for X, e in zip(out, el.matrices()):
+            X += rows.T @ e @ rows
+    return tuple(out)
+
+
 @dataclass(frozen=True)
 class DropResult:
     """A simulated drop (module docstring).
@@ -310,10 +347,9 @@ class DropResult:
         the spin's.
     work : ndarray, shape (k,)
         The work done on it from outside since the drop (J): by the drive holding the
-        spin against the rings' friction, by the AMBs' decaying forces and by the
-        unbalance. What the
-        contacts' damping and friction, the drag and the structural damping took is
-        ``energy[0] + work − energy``.
+        spin against the rings' friction, by the AMBs' forces, the seals', the unbalance
+        and the overload. What the contacts' damping and friction, the drag and the
+        structural damping took is ``energy[0] + work − energy``.
     watched : dict
         ``{name: ndarray (k, 2)}``: the rotor's centre at each AMB and seal plane (m).
     impacts : int
@@ -492,7 +528,8 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                   coast_down: bool = False, drag_torque: float = 0.0,
                   initial: tuple | None = None, unbalance_kgm: float = 0.0,
                   loop: AmbLoop | None = None, loop_state=None, failed=None,
-                  overload: tuple | None = None, progress=None) -> DropResult:
+                  overload: tuple | None = None, seals: bool = True,
+                  pressure_bar: float | None = None, progress=None) -> DropResult:
     """Drop the rotor of ``cfg`` onto its touchdown bearings (module docstring).
 
     Parameters
@@ -541,6 +578,11 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     overload : tuple (float, array_like of 2 float), optional
         A step force from t = 0: its position z (m; at the nearest node) and its x, y
         components (N). Its work is counted as work from outside.
+    seals : bool, optional
+        The seals' forces on the rotor (:func:`seal_matrices`: at the drop's speed and
+        pressure, held through it); their work is counted as work from outside.
+    pressure_bar : float, optional
+        The pressure drop across the seals (bar); ``[operating] pressure_bar`` if omitted.
     progress : callable, optional
         ``progress(t_s)`` after each segment.
 
@@ -594,12 +636,16 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     Ak, Bk, Ck, Dk = loop.controller
     na, n_loop = Aa.shape[0], loop.n_states
     i_s = loop.static / loop.ki
+    sealed = bool(seals and cfg.seal)
+    if sealed:
+        K_s, C_s, M_s = seal_matrices(cfg, dm, speed_rpm, pressure_bar)
+        M_inv = np.linalg.inv(np.eye(m) + M_s)
     races = np.flatnonzero(dm.race_inertia > 0)
     sup = [p for p in range(P) if dm.support[p] is not None]
     # the states: modes and their rates, the turning rings, the supports, the AMB loop's
     # (the coil's, the controller's), the spin and its angle when it coasts, and last the
     # work done on the rotor from outside (J): by the drive holding the spin against the
-    # rings' friction, the AMBs' forces, the unbalance and the overload
+    # rings' friction, the AMBs' and the seals' forces, the unbalance and the overload
     i_loop = 2 * m + races.size + 4 * len(sup)
     i_spin = i_loop + n_loop
     n_y = i_spin + (2 if coast_down else 0) + 1
@@ -696,7 +742,12 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                 dsup[p] = (-F - ks * s[p] - cs * ds[p]) / ms
         W = spin(y)
         dy[:m] = deta
-        dy[m:2 * m] = f - (dm.C + W * dm.G) @ deta - dm.K @ eta
+        acc = f - (dm.C + W * dm.G) @ deta - dm.K @ eta
+        if sealed:  # (I + M_s) η̈ = the rest − K_s Δη − C_s η̇: the seals' force as work
+            pushed = -K_s @ (eta - dm.q0) - C_s @ deta
+            acc = M_inv @ (acc + pushed)
+            power += float((pushed - M_s @ acc) @ deta)
+        dy[m:2 * m] = acc
         if coast_down:
             dy[i_spin] = (torque - drag_torque * math.tanh(W / 0.1)) / dm.polar_inertia
             dy[i_spin + 1] = W

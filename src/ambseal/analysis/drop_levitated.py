@@ -6,8 +6,8 @@ FE rotor in its modes kept, gyroscopics at the spin Ω) held by the AMB loop of
 :mod:`ambseal.analysis.drop_loop` (each axis's −Ks and Ki·i, the sensors, the amplifiers
 and eddy-current lags, the controller in negative feedback i = −K y: the rig's reference
 PID at that speed, :func:`ambseal.design.reference_pid`, P5 Eq. 6, unless one is given,
-in continuous time), linear: the orbit's currents are not clipped. The seals are not in
-the drop's rotor, nor in this loop.
+in continuous time), linear: the orbit's currents are not clipped, and the seals at the
+speed and pressure drop (:func:`ambseal.analysis.drop.seal_matrices`), as in the drop.
 
 The unbalance U (kg·m) at the node nearest the centre of mass is the force
 U Ω² (cos Ωt, sin Ωt) = Re(U Ω² (1, −j) e^{jΩt}) that :func:`~ambseal.analysis.drop.
@@ -23,6 +23,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg import eigvals
 
+from ambseal.analysis.drop import seal_matrices
 from ambseal.analysis.drop_loop import amb_loop
 from ambseal.errors import ConfigError
 from ambseal.lti import feedback_matrices
@@ -30,7 +31,8 @@ from ambseal.lti import feedback_matrices
 __all__ = ["levitated_loop", "levitated_start", "levitated_state"]
 
 
-def levitated_loop(cfg, dm, speed_rpm: float, controller=None, loop=None):
+def levitated_loop(cfg, dm, speed_rpm: float, controller=None, loop=None, seals=True,
+                   pressure_bar: float | None = None):
     """The closed AMB loop of the drop's rotor (module docstring) in state space, linear
     (no current clipped), the states the modes, their rates, the amplifiers' and lags'
     and the controller's.
@@ -50,6 +52,10 @@ def levitated_loop(cfg, dm, speed_rpm: float, controller=None, loop=None):
     loop : AmbLoop, optional
         The loop's pieces (:func:`ambseal.analysis.drop_loop.amb_loop`), built from
         ``controller`` if omitted.
+    seals : bool, optional
+        The seals' forces on the rotor (:func:`ambseal.analysis.drop.seal_matrices`).
+    pressure_bar : float, optional
+        Their pressure drop (bar); ``[operating] pressure_bar`` if omitted.
 
     Returns
     -------
@@ -63,22 +69,26 @@ def levitated_loop(cfg, dm, speed_rpm: float, controller=None, loop=None):
     W = 2 * np.pi * speed_rpm / 60.0
     L = loop or amb_loop(cfg, dm, speed_rpm, controller)
     m = dm.phi.shape[1]
+    K_s, C_s, M_s = (seal_matrices(cfg, dm, speed_rpm, pressure_bar) if seals
+                     else (np.zeros((m, m)),) * 3)
+    M_inv = np.linalg.inv(np.eye(m) + M_s)
     A_r = np.block([[np.zeros((m, m)), np.eye(m)],
-                    [-(dm.K - L.axis.T @ (L.ks[:, None] * L.axis)), -(dm.C + W * dm.G)]])
-    B_r = np.vstack([np.zeros((m, L.ki.size)), L.axis.T * L.ki])
+                    [-M_inv @ (dm.K + K_s - L.axis.T @ (L.ks[:, None] * L.axis)),
+                     -M_inv @ (dm.C + W * dm.G + C_s)]])
+    B_r = np.vstack([np.zeros((m, L.ki.size)), M_inv @ (L.axis.T * L.ki)])
     Aa, Ba, Ca, Da = L.coil
     na = Aa.shape[0]
     # the coil in front of the rotor's current inputs: its states after the rotor's
     A = np.block([[A_r, B_r @ Ca], [np.zeros((na, 2 * m)), Aa]])
     G = (A, np.vstack([B_r @ Da, Ba]),
          np.hstack([L.sensor, np.zeros((L.ki.size, m + na))]), np.zeros((L.ki.size,) * 2))
-    Bf = np.vstack([np.zeros((m, 2)), dm.cg_rows.T, np.zeros((na, 2))])
+    Bf = np.vstack([np.zeros((m, 2)), M_inv @ dm.cg_rows.T, np.zeros((na, 2))])
     A_cl, B_cl, _, _ = feedback_matrices(G, L.controller, (Bf, np.zeros((L.ki.size, 2))))
     return A_cl, B_cl[:, -2:]  # the inputs [d, f]: the force last
 
 
 def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=None,
-                    loop=None):
+                    loop=None, seals=True, pressure_bar: float | None = None):
     """The modal state at the drop (module docstring), the loop's states with it.
 
     Parameters
@@ -94,6 +104,10 @@ def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=
     controller : control.StateSpace, optional
         As :func:`levitated_loop`.
     loop : AmbLoop, optional
+        As :func:`levitated_loop`.
+    seals : bool, optional
+        As :func:`levitated_loop`.
+    pressure_bar : float, optional
         As :func:`levitated_loop`.
 
     Returns
@@ -111,7 +125,7 @@ def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=
     """
     if not cfg.amb:
         raise ConfigError("drop: levitated start: the rig has no [[amb]] to levitate it")
-    A, B_u = levitated_loop(cfg, dm, speed_rpm, controller, loop)
+    A, B_u = levitated_loop(cfg, dm, speed_rpm, controller, loop, seals, pressure_bar)
     poles = eigvals(A)
     worst = poles[np.argmax(poles.real)]
     if worst.real >= 0:

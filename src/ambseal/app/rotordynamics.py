@@ -301,6 +301,10 @@ def _drop(args: argparse.Namespace) -> int:
             shown[0] = tenth
             say(f"drop: {1e3 * t:.4g} ms of {1e3 * args.duration_s:.4g} ms")
 
+    if args.pressure_bar is not None:  # checked as the rig file's key is, before here
+        # the seals' pressure through the drop, the Monte-Carlo runs' too
+        cfg = cfg.model_copy(update={"operating": cfg.operating.model_copy(
+            update={"pressure_bar": float(args.pressure_bar)})})
     if args.drag_torque and not args.coast_down:
         raise ConfigError("--drag-torque: slows a coasting rotor; add --coast-down (the "
                           "drive holds the speed otherwise)")
@@ -341,6 +345,7 @@ def _drop(args: argparse.Namespace) -> int:
     judged = drop_verdict(cfg, res)
     doc = {"rig": str(args.rig), "speed_rpm": rpm, "unbalance_kgm": unbalance[0],
            "start": args.start, "event": args.event, "event_summary": event["summary"],
+           "pressure_bar": cfg.operating.pressure_bar,
            "controller": args.controller or "reference PID", **judged, **res.to_dict()}
     for plane, td in zip(doc["planes"], cfg.touchdown):
         plane["radial_clearance_m"] = td.radial_clearance

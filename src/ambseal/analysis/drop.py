@@ -417,8 +417,9 @@ class DropResult:
 
     def regime(self, p: int) -> tuple[str, float]:
         """The plane's regime over the last half of the drop: ``"no contact"`` (never
-        touched), ``"bouncing"`` (in contact less than half that time), ``"resting"`` (in contact, its orbit going less than
-        once round the ring: settled or sliding to and fro at the bottom), else
+        touched), ``"bouncing"`` (in contact less than half that time), ``"resting"`` (in
+        contact, its orbit going less than once round the ring: settled or sliding to and
+        fro at the bottom), else
         ``"forward whirl"`` or ``"backward whirl"`` by the orbit's mean angular speed
         against the spin; and the whirl frequency (Hz) at the end, the orbit's mean
         angular speed over the last quarter (a whirl that grew in the last half is not

@@ -314,3 +314,24 @@ def test_design_prints_the_verdict_its_file_holds(kinds):
     assert written["kept_unstable"] is True and not written["full_order"]["stable"]
     assert printed["kept_unstable"] is True
     assert printed["full_order"] == written["full_order"]
+
+
+def test_the_drop_runs_a_digital_controller_as_it_runs(kinds, tmp_path, capsys):
+    """``ambseal drop --controller FILE`` with ``ambseal design``'s digital PID runs it
+    sampled, with its delay (drop.json's ``controller_runs``), and its continuous design
+    (the continuous file of the same PID) gives another orbit after the same overload."""
+    docs = {}
+    for kind in ("digital", "continuous"):
+        code, out, errors = _cli(capsys, [
+            "--quiet", "drop", RIG, "--controller", kinds["files"][kind], "--event",
+            "overload", "--overload-n", "200", "--start", "rest", "--duration-s", "0.01",
+            "--out", tmp_path / kind, "--json"])
+        assert code in (0, 1) and not errors
+        docs[kind] = json.loads(out)
+    K = kinds["K"]
+    assert docs["digital"]["controller_runs"] == (
+        f"digital at {K.sample_rate_hz:g} Hz, {K.delay_samples} sample(s) of computation "
+        "delay")
+    assert docs["continuous"]["controller_runs"] == "continuous"
+    a, b = (docs[k]["watched_max_m"]["amb:A"] for k in ("digital", "continuous"))
+    assert abs(a - b) > 1e-3 * b

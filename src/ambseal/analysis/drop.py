@@ -569,8 +569,10 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         work is counted as work from outside (:attr:`DropResult.work`).
     loop : AmbLoop, optional
         The AMB loop (:func:`ambseal.analysis.drop_loop.amb_loop`); default one without a
-        controller where every axis fails, else the reference PID's at ``speed_rpm``.
-    loop_state : ndarray, shape (loop.n_states,), optional
+        controller where every axis fails, else the reference PID's at ``speed_rpm``. A
+        digital controller (``loop.sampled``) is updated at t = 0, T_s, 2 T_s, … (each
+        sample ends an integration segment) and its output held between.
+    loop_state : ndarray, shape (loop.n_states + loop.n_sampled,), optional
         The loop's states at t = 0 (:func:`ambseal.analysis.drop_levitated.
         levitated_state`); default zero, the loop at rest in the levitated equilibrium.
     failed : sequence of str, optional
@@ -699,13 +701,17 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         tau = np.where(loop.tau > 0, loop.tau, 1.0)
         return np.where(loop.tau > 0, np.exp(-2.0 * t / tau), 0.0)
 
-    def amb(t, y):
+    def amb(t, y, hold=None):
         """The axes' forces (N), the loop's state derivative, the currents (A) and where
-        the loop's reference was clipped."""
+        the loop's reference was clipped; a digital controller's reference is the one
+        held (``hold``: (i_ref, clipped), default the last update's)."""
         dev = y[:m] - dm.q0
         x_a, x_k = y[i_loop:i_loop + na], y[i_loop + na:i_spin]
         sensed = loop.sensor @ dev
-        i_ref, clipped = loop.reference(sensed, x_k)
+        if digital:
+            i_ref, clipped = held[-1][1:] if hold is None else hold
+        else:
+            i_ref, clipped = loop.reference(sensed, x_k)
         i_e = Ca @ x_a + Da @ i_ref
         pull = loop.ks * (loop.axis @ dev)
         fch = loop.static + loop.ki * i_e + pull
@@ -714,6 +720,19 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         current = np.where(down, np.sqrt(b2) * (i_s + i_fail), i_s + i_e)
         return (fch, np.concatenate([Aa @ x_a + Ba @ i_ref, Ak @ x_k + Bk @ sensed]),
                 current, clipped & ~down)
+
+    digital = loop.sampled is not None
+    held = []  # a digital controller's updates: (t, i_ref, clipped)
+
+    def sample(t, y):
+        """The digital controller's update at the sample instant t (module docstring of
+        :mod:`ambseal.analysis.drop_loop`): its output held from t."""
+        nonlocal x_d
+        A_d, B_d, C_d, D_d, _ = loop.sampled
+        y_k = loop.sensor @ (y[:m] - dm.q0)
+        u = C_d @ x_d + D_d @ y_k
+        x_d = A_d @ x_d + B_d @ y_k
+        held.append((t, *loop.clip(-u)))
 
     def rhs(t, y):
         eta, deta, wr, s, ds = unpack(y)
@@ -799,16 +818,21 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             raise ConfigError(f"drop: initial: expected a finite displacement and velocity "
                               f"of {n_dof} DOFs each, got shapes {u0.shape}, {du0.shape}")
         y[:m], y[m:2 * m] = dm.projector @ u0, dm.projector @ du0
+    n_d = loop.n_sampled
+    x_d = np.zeros(n_d)  # a digital controller's state, before its update at t = 0
     if loop_state is not None:
         x0 = np.asarray(loop_state, float)
-        if x0.shape != (n_loop,) or not np.isfinite(x0).all():
-            raise ConfigError(f"drop: loop_state: expected {n_loop} finite states, got "
-                              f"shape {x0.shape}")
-        y[i_loop:i_spin] = x0
+        if x0.shape != (n_loop + n_d,) or not np.isfinite(x0).all():
+            raise ConfigError(f"drop: loop_state: expected {n_loop + n_d} finite states, "
+                              f"got shape {x0.shape}")
+        y[i_loop:i_spin], x_d = x0[:n_loop], x0[n_loop:].copy()
+    if digital:
+        sample(0.0, y)
     # what the failed axes' coils carry at the instant they lose power
     x_k0 = y[i_loop + na:i_spin]
-    i_fail = Ca @ y[i_loop:i_loop + na] + Da @ loop.reference(
-        loop.sensor @ (y[:m] - dm.q0), x_k0)[0]
+    i_ref0 = held[-1][1] if digital else loop.reference(loop.sensor @ (y[:m] - dm.q0),
+                                                        x_k0)[0]
+    i_fail = Ca @ y[i_loop:i_loop + na] + Da @ i_ref0
     if coast_down:
         y[i_spin] = W0
     grid = np.linspace(0.0, duration_s, samples)
@@ -838,22 +862,24 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     first_over = [False] * P  # each plane's first contact ended
     t0, impacts, segments = 0.0, 0, 0
     integrator = method
+    n_sample = 1  # the next sample of a digital controller
     while t0 < duration_s:
-        segments += 1
         if segments > MAX_SEGMENTS:
             raise ConfigError(f"drop: more than {MAX_SEGMENTS} contact onsets and ends by "
                               f"t = {t0:.6g} s (a contact chattering); lower rtol")
+        # a digital controller's segments end at its samples
+        t_end = min(duration_s, n_sample * loop.sampled[4]) if digital else duration_s
         # a trial step far too long may overflow in the contact's power law; the
         # integrator rejects it (its error estimate is not finite) and halves the step
         with np.errstate(over="ignore", invalid="ignore"):
             try:
                 r = solve_ivp(paced(rhs, t0) if method in EXPLICIT else rhs,
-                              (t0, duration_s), y, method=method, dense_output=True,
+                              (t0, t_end), y, method=method, dense_output=True,
                               events=events(touching), rtol=rtol, atol=atol)
             except _Crawling:  # stiff: from here on, the stiff method (module docstring)
                 method = STIFF_METHOD
                 integrator += f" → {method} from {t0:.6g} s"
-                r = solve_ivp(rhs, (t0, duration_s), y, method=method, dense_output=True,
+                r = solve_ivp(rhs, (t0, t_end), y, method=method, dense_output=True,
                               events=events(touching), rtol=rtol, atol=atol)
         if not r.success or not np.isfinite(r.y).all():
             raise ConfigError(f"drop: the integration failed at t = {r.t[-1]:.6g} s "
@@ -887,7 +913,13 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             peak_delta[p] = max(peak_delta[p], float(delta.max()))
         hit = [k for k, te in enumerate(r.t_events) if te.size]
         if not hit:
-            break
+            if t_end >= duration_s:
+                break
+            t0, y = t_end, r.y[:, -1].copy()  # a sample instant
+            sample(t0, y)
+            n_sample += 1
+            continue
+        segments += 1
         k = min(hit, key=lambda k: r.t_events[k][0])
         t0 = float(r.t_events[k][0])
         y = r.y_events[k][0].copy()
@@ -927,7 +959,11 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             e += 0.5 * dm.polar_inertia * spin(yj) ** 2
         energy[j] = e
     watched = {k: np.einsum("ij,kj->ki", rows, Y[:, :m]) for k, rows in dm.node_rows.items()}
-    at = [amb(tj, yj) for tj, yj in zip(t, Y)]
+    if digital:  # the reference each output sample saw: the last update's at or before it
+        last = np.searchsorted([h[0] for h in held], t, side="right") - 1
+        at = [amb(tj, yj, held[j][1:]) for tj, yj, j in zip(t, Y, last)]
+    else:
+        at = [amb(tj, yj) for tj, yj in zip(t, Y)]
     currents = np.array([a[2] for a in at]).T
     return DropResult(t=t, orbit=orbit, force=force, penetration=pen, race_speed=race,
                       energy=energy, work=Y[:, -1].copy(), watched=watched,

@@ -21,7 +21,7 @@ it is refused, naming its least damped pole.
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg import eigvals
+from scipy.linalg import eigvals, expm
 
 from ambseal.analysis.drop import seal_matrices
 from ambseal.analysis.drop_loop import amb_loop
@@ -66,8 +66,17 @@ def levitated_loop(cfg, dm, speed_rpm: float, controller=None, loop=None, seals=
     B_u : ndarray, shape (n, 2)
         The input of a force (N) at the node nearest the centre of mass, x and y.
     """
-    W = 2 * np.pi * speed_rpm / 60.0
     L = loop or amb_loop(cfg, dm, speed_rpm, controller)
+    G, Bf = _open_loop(cfg, dm, speed_rpm, L, seals, pressure_bar)
+    A_cl, B_cl, _, _ = feedback_matrices(G, L.controller, (Bf, np.zeros((L.ki.size, 2))))
+    return A_cl, B_cl[:, -2:]  # the inputs [d, f]: the force last
+
+
+def _open_loop(cfg, dm, speed_rpm: float, L, seals: bool, pressure_bar):
+    """The rotor with its seals, −Ks and the coil, current references → sensors: (A, B,
+    C, D), the states the modes' deviation from the levitated equilibrium, their rates and
+    the coil's; and the input of a force (N) at the centre of mass."""
+    W = 2 * np.pi * speed_rpm / 60.0
     m = dm.phi.shape[1]
     K_s, C_s, M_s = (seal_matrices(cfg, dm, speed_rpm, pressure_bar) if seals
                      else (np.zeros((m, m)),) * 3)
@@ -82,9 +91,32 @@ def levitated_loop(cfg, dm, speed_rpm: float, controller=None, loop=None, seals=
     A = np.block([[A_r, B_r @ Ca], [np.zeros((na, 2 * m)), Aa]])
     G = (A, np.vstack([B_r @ Da, Ba]),
          np.hstack([L.sensor, np.zeros((L.ki.size, m + na))]), np.zeros((L.ki.size,) * 2))
-    Bf = np.vstack([np.zeros((m, 2)), M_inv @ dm.cg_rows.T, np.zeros((na, 2))])
-    A_cl, B_cl, _, _ = feedback_matrices(G, L.controller, (Bf, np.zeros((L.ki.size, 2))))
-    return A_cl, B_cl[:, -2:]  # the inputs [d, f]: the force last
+    return G, np.vstack([np.zeros((m, 2)), M_inv @ dm.cg_rows.T, np.zeros((na, 2))])
+
+
+def _sampled_orbit(G, Bf, sampled, W: float, force: np.ndarray):
+    """The steady orbit of the rotor under a digital controller (:mod:`ambseal.analysis.
+    drop_loop`) and the force Re(F e^{jΩt}), at the sample instant t = 0: the plant
+    sampled exactly, x_{k+1} = Φ x_k + Γ i_k + (z I − Φ)(jΩ I − A)⁻¹ B_f F z^k with
+    z = e^{jΩT_s} (the force's own response between the samples, Franklin, Powell &
+    Workman §4.3), closed with x_{d,k+1} = A_d x_d + B_d y_k, i_k = −(C_d x_d + D_d y_k):
+    the orbit X z^k, X_d z^k solves the loop's equations at z. Returns (X, X_d) and the
+    lifted loop's largest eigenvalue."""
+    A, B, C, _ = G
+    A_d, B_d, C_d, D_d, Ts = sampled
+    n, nu, nd = A.shape[0], B.shape[1], A_d.shape[0]
+    aug = np.zeros((n + nu, n + nu))
+    aug[:n, :n], aug[:n, n:] = A * Ts, B * Ts
+    E = expm(aug)
+    Phi, Gam = E[:n, :n], E[:n, n:]
+    lifted = np.block([[Phi - Gam @ D_d @ C, -Gam @ C_d], [B_d @ C, A_d]])
+    z = np.exp(1j * W * Ts)
+    rhs = np.zeros(n + nd, complex)
+    if np.any(force):
+        rhs[:n] = (z * np.eye(n) - Phi) @ np.linalg.solve(1j * W * np.eye(n) - A, Bf @ force)
+    X = np.linalg.solve(z * np.eye(n + nd) - lifted, rhs)
+    poles = eigvals(lifted)
+    return X[:n], X[n:], poles[np.argmax(np.abs(poles))]
 
 
 def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=None,
@@ -116,7 +148,10 @@ def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=
         The modal coordinates and their rates: the levitated equilibrium ``dm.q0`` and
         the unbalance orbit at t = 0.
     x_loop : ndarray, shape (n_loop,)
-        The loop's states (:attr:`AmbLoop.n_states`) at t = 0.
+        The loop's states at t = 0: the coil's and a continuous controller's
+        (:attr:`AmbLoop.n_states`), or the coil's and a digital controller's before its
+        update at t = 0 (:attr:`AmbLoop.n_sampled`), the orbit then the sampled loop's
+        (:func:`_sampled_orbit`).
 
     Raises
     ------
@@ -125,7 +160,21 @@ def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=
     """
     if not cfg.amb:
         raise ConfigError("drop: levitated start: the rig has no [[amb]] to levitate it")
-    A, B_u = levitated_loop(cfg, dm, speed_rpm, controller, loop, seals, pressure_bar)
+    W = 2 * np.pi * speed_rpm / 60.0
+    m = dm.phi.shape[1]
+    force = unbalance_kgm * W * W * np.array([1.0, -1.0j])
+    L = loop or amb_loop(cfg, dm, speed_rpm, controller)
+    if L.sampled is not None:
+        X, X_d, worst = _sampled_orbit(*_open_loop(cfg, dm, speed_rpm, L, seals,
+                                                   pressure_bar), L.sampled, W, force)
+        if abs(worst) >= 1:
+            raise ConfigError(
+                f"drop: levitated start: the AMB loop with the digital controller as it "
+                f"runs is unstable at {speed_rpm:g} rpm (a pole at |z| = {abs(worst):.6g}): "
+                "the rotor has no levitated orbit there; start the drop at rest")
+        return (dm.q0 + X[:m].real, X[m:2 * m].real,
+                np.concatenate([X[2 * m:].real, X_d.real]))
+    A, B_u = levitated_loop(cfg, dm, speed_rpm, controller, L, seals, pressure_bar)
     poles = eigvals(A)
     worst = poles[np.argmax(poles.real)]
     if worst.real >= 0:
@@ -134,9 +183,6 @@ def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=
             f"{'reference PID' if controller is None else 'controller'} is unstable at "
             f"{speed_rpm:g} rpm (a pole at {worst.real:.4g} ± {abs(worst.imag):.4g}j "
             "rad/s): the rotor has no levitated orbit there; start the drop at rest")
-    W = 2 * np.pi * speed_rpm / 60.0
-    m = dm.phi.shape[1]
-    force = unbalance_kgm * W * W * np.array([1.0, -1.0j])
     X = np.linalg.solve(1j * W * np.eye(A.shape[0]) - A, B_u @ force)
     return dm.q0 + X[:m].real, (1j * W * X[:m]).real, X[2 * m:].real
 

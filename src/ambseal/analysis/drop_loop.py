@@ -29,6 +29,12 @@ the force, quadratic in the currents (f ∝ i², Schweitzer & Maslen, *Magnetic 
     f_j(t) = e^{−2t R/L} (F_j + Ki_j i_j(0) + Ks_j s_j(t)),
 
 its negative stiffness Ks ∝ i0² going with its bias. The loop's other axes run on.
+
+A digital controller runs as it does on the target: sampled every T_s from t = 0, its
+discrete state x_{k+1} = A x_k + B y_k updated and its output u_k = C x_k + D y_k (the
+computation delay among its states) held by the DAC, i_ref = −u_k clipped, until the next
+sample (zero-order hold; Franklin, Powell & Workman, *Digital Control of Dynamic
+Systems*, 3rd ed., §4.3); the amplifier and the rotor run on in continuous time between.
 """
 
 from __future__ import annotations
@@ -84,6 +90,11 @@ class AmbLoop:
         (A_a, B_a, C_a, D_a): the amplifiers and eddy-current lags, i_ref → i, c × c.
     has_controller : bool
         Whether a controller runs the loop.
+    sampled : tuple or None
+        (A, B, C, D, T_s) of a digital controller as it runs (module docstring; the
+        computation delay among its states), y_k → u_k, i_ref = −u_k held; then
+        ``controller`` has no states and no gain. None: the controller runs in continuous
+        time.
     """
 
     names: tuple
@@ -97,20 +108,31 @@ class AmbLoop:
     controller: tuple
     coil: tuple
     has_controller: bool
+    sampled: tuple | None = None
 
     @property
     def n_states(self) -> int:
-        """The loop's states: the coil's then the controller's."""
+        """The loop's states in continuous time: the coil's then the controller's."""
         return self.coil[0].shape[0] + self.controller[0].shape[0]
+
+    @property
+    def n_sampled(self) -> int:
+        """The digital controller's states (0 for a continuous one)."""
+        return 0 if self.sampled is None else self.sampled[0].shape[0]
+
+    def clip(self, i_ref: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``i_ref`` (A, shape (c,)) clipped so the coil's total current stays within
+        ±i_max (module docstring), and the axes it was clipped on."""
+        total = self.static / self.ki + i_ref
+        return (np.clip(total, -self.limit, self.limit) - self.static / self.ki,
+                np.abs(total) > self.limit)
 
     def reference(self, y: np.ndarray, x_k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The current reference (A), shape (c,), clipped (module docstring), for the
         sensors' readings ``y`` (m, shape (c,)) and the controller's states ``x_k``; and
         which axes it was clipped on (bool, shape (c,))."""
         Ak, Bk, Ck, Dk = self.controller
-        total = self.static / self.ki - (Ck @ x_k + Dk @ y)
-        clipped = np.abs(total) > self.limit
-        return np.clip(total, -self.limit, self.limit) - self.static / self.ki, clipped
+        return self.clip(-(Ck @ x_k + Dk @ y))
 
 
 def _coil(cfg, c: int) -> tuple:
@@ -138,10 +160,12 @@ def amb_loop(cfg, dm, speed_rpm: float | None = None, controller=None) -> AmbLoo
         The speed (rpm) at which the reference PID acts (its cross gains may be scheduled
         on it); ``[operating] speed_rpm`` if omitted.
     controller : control.StateSpace or "none", optional
-        Continuous, the rig's sensor displacements (m) → current references (A) in
-        :func:`ambseal.model.channel_names`'s order, i = −K y; default the reference PID
-        (:func:`ambseal.design.reference_pid`, P5 Eq. 6); ``"none"`` for a loop no
-        controller runs (every axis loses power at once).
+        The rig's sensor displacements (m) → current references (A) in
+        :func:`ambseal.model.channel_names`'s order, i = −K y: continuous, or discrete
+        (``dt`` > 0, the computation delay among its states) for a digital controller as
+        it runs (module docstring); default the reference PID
+        (:func:`ambseal.design.reference_pid`, P5 Eq. 6) in continuous time; ``"none"``
+        for a loop no controller runs (every axis loses power at once).
 
     Returns
     -------
@@ -150,7 +174,7 @@ def amb_loop(cfg, dm, speed_rpm: float | None = None, controller=None) -> AmbLoo
     Raises
     ------
     ConfigError
-        A rig without AMBs; a controller of the wrong size or not continuous.
+        A rig without AMBs; a controller of the wrong size.
     """
     if not cfg.amb:
         raise ConfigError("drop: the rig has no [[amb]]: no AMB loop")
@@ -171,26 +195,29 @@ def amb_loop(cfg, dm, speed_rpm: float | None = None, controller=None) -> AmbLoo
         limit += [min(given) if given else np.inf] * 2
     tau = np.repeat([(a.inductance / a.resistance) if (a.inductance and a.resistance)
                      else 0.0 for a in cfg.amb], 2)
+    none = (np.zeros((0, 0)), np.zeros((0, c)), np.zeros((c, 0)), np.zeros((c, c)))
+    sampled = None
     if isinstance(controller, str) and controller == "none":
-        K = (np.zeros((0, 0)), np.zeros((0, c)), np.zeros((c, 0)), np.zeros((c, c)))
+        K = none
     else:
         if controller is None:
             g = reference_pid(cfg, speed_rpm)
             controller = pid_controller(g["kp"], g["ti"], g["td"], g["eps"], names,
                                         g.get("filters", ()), g.get("cross_kp", 0.0),
                                         g.get("cross_kd", 0.0))
-        if getattr(controller, "dt", 0):
-            raise ConfigError("drop: the controller must be continuous (the drop runs the "
-                              "continuous design of a digital one)")
         K = tuple(np.asarray(x, float) for x in (controller.A, controller.B, controller.C,
                                                  controller.D))
         if K[3].shape != (c, c):
             raise ConfigError(f"drop: the controller maps {K[3].shape[1]} sensors to "
                               f"{K[3].shape[0]} currents; the rig has {c} channels "
                               f"({', '.join(names)})")
+        dt = getattr(controller, "dt", 0)
+        if dt and dt is not True:  # a digital controller as it runs
+            sampled, K = (*K, float(dt)), none
     return AmbLoop(names=names, sensor=sensor @ phi, axis=axis @ phi, ki=ki, ks=ks,
                    static=static, limit=np.array(limit, float), tau=tau, controller=K,
-                   coil=_coil(cfg, c), has_controller=K[0].shape[0] > 0 or bool(K[3].any()))
+                   coil=_coil(cfg, c), sampled=sampled,
+                   has_controller=sampled is not None or K[0].shape[0] > 0 or bool(K[3].any()))
 
 
 def drop_event(cfg, dm, loop: AmbLoop, event: str = "loss", axis: str | None = None,

@@ -22,6 +22,8 @@ import math
 import sys
 from pathlib import Path
 
+import control
+
 from ambseal.analysis import (
     amb_loop,
     check_cases,
@@ -43,7 +45,7 @@ from ambseal.analysis import (
 )
 from ambseal.analysis.campbell import campbell
 from ambseal.analysis.sweep import sweep
-from ambseal.app.commands import digital_for
+from ambseal.app.commands import digital_for, discrete_as_runs
 from ambseal.app.controllers import controller_for, runs_as
 from ambseal.app.modes import mode_positions, modes_command
 from ambseal.config import (
@@ -72,6 +74,7 @@ from ambseal.report import (
     stamp,
     write_drop_report,
 )
+from ambseal.robust import with_delay
 
 __all__ = ["HANDLERS", "write_table"]
 
@@ -327,6 +330,12 @@ def _drop(args: argparse.Namespace) -> int:
                           "or give one value")
     dm = drop_model(cfg, args.modes_hz)
     controller = controller_for(cfg, args.controller) if args.controller else None
+    digital = runs_as(cfg, args.controller) if args.controller else None
+    if digital is not None:  # a digital controller's file: as it runs on the target
+        d = discrete_as_runs(cfg, digital, 2 * math.pi * rpm / 60.0,
+                             cfg.operating.pressure_bar)
+        controller = control.ss(*with_delay((d.A, d.B, d.C, d.D), digital.delay_samples),
+                                d.dt)
     loop = amb_loop(cfg, dm, rpm, controller)
     event = drop_event(cfg, dm, loop, args.event, args.axis, args.overload_n,
                        args.overload_at)
@@ -346,7 +355,11 @@ def _drop(args: argparse.Namespace) -> int:
     doc = {"rig": str(args.rig), "speed_rpm": rpm, "unbalance_kgm": unbalance[0],
            "start": args.start, "event": args.event, "event_summary": event["summary"],
            "pressure_bar": cfg.operating.pressure_bar,
-           "controller": args.controller or "reference PID", **judged, **res.to_dict()}
+           "controller": args.controller or "reference PID",
+           "controller_runs": ("continuous" if digital is None else
+                               f"digital at {1 / loop.sampled[4]:g} Hz, "
+                               f"{digital.delay_samples} sample(s) of computation delay"),
+           **judged, **res.to_dict()}
     for plane, td in zip(doc["planes"], cfg.touchdown):
         plane["radial_clearance_m"] = td.radial_clearance
     title = f"Rotor drop — {cfg.rotor.name}"

@@ -12,7 +12,7 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from ambseal.analysis.drop import GRAVITY, drop_model, simulate_drop
+from ambseal.analysis.drop import GRAVITY, drop_model, drop_verdict, simulate_drop
 from ambseal.analysis.drop_levitated import levitated_state
 from ambseal.analysis.drop_loop import amb_loop
 from ambseal.design import pid_controller
@@ -234,3 +234,34 @@ def test_the_digital_loops_levitated_orbit_is_its_sampled_steady_state():
     wrong = control.ss(-K.A, K.B, K.C, -K.D, Ts)  # an unstable, mis-signed controller
     with pytest.raises(ConfigError, match=r"digital controller as it runs is unstable"):
         levitated_state(cfg, dm, 3000.0, U, loop=amb_loop(cfg, dm, controller=wrong))
+
+
+def test_a_coupling_holds_its_end_of_the_falling_rotor():
+    """A coupling spring k (P4 Eq. 4) at z = 0, where ring A also sits, ring B at L,
+    every AMB lost: the rotor settles on both rings, the coupling's force on its node's
+    deflection from the levitated equilibrium. Statics, within 1 %: moments about z = 0
+    give ring B m g/2, and ring A with the coupling, k (c + δ_A), carry the other half.
+    Without the coupling each ring carries m g/2. A coupling with a clearance (0.1 mm,
+    under the rings' 0.2 mm) fails the verdict against it; a spring on a housing is
+    refused."""
+    from ambseal.config import Spring
+    from ambseal.config.rig import SpringHousing
+
+    base = _damped()
+    m = inertia(*DISK)[0]
+    k = 0.25 * m * GRAVITY / C_TD  # alone it would hold its half 2 c down: ring A lands
+    coupled = base.model_copy(update={"spring": [Spring(name="coupling", position=0.0,
+                                                       kxx=k, kyy=k, clearance=1e-4)]})
+    r = simulate_drop(coupled, duration_s=0.3, samples=301)
+    N = r.force[:, -1]
+    delta = (N / K_TD) ** (2 / 3)
+    assert N.sum() + k * (C_TD + delta[0]) == pytest.approx(m * GRAVITY, rel=0.01)
+    assert N[1] * L == pytest.approx(m * GRAVITY * L / 2, rel=0.01)
+    judged = {c["name"]: c for c in drop_verdict(coupled, r)["criteria"]}
+    assert judged["no contact at coupling (clearance)"]["outcome"] == "FAILED"
+    free = simulate_drop(base, duration_s=0.3, samples=301)
+    np.testing.assert_allclose(free.force[:, -1], m * GRAVITY / 2, rtol=0.01)
+    housed = coupled.model_copy(update={"spring": [coupled.spring[0].model_copy(
+        update={"housing": SpringHousing(mass=1.0, kxx=1e6, kyy=1e6)})]})
+    with pytest.raises(ConfigError, match=r"spring\[0\].housing: the drop holds"):
+        simulate_drop(housed, duration_s=0.01)

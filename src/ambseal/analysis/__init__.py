@@ -46,7 +46,7 @@ sampled with its delay) on the full-order plant:
   ramp;
 * :func:`simulate_drop` → :class:`DropResult` — the rotor dropped onto its touchdown
   bearings when its AMBs let go (:func:`drop_model`; :mod:`ambseal.analysis.drop`), and
-  :func:`drop_verdict`, its pass criteria; :func:`seal_matrices`, the seals in it;
+  :func:`drop_verdict`, its pass criteria; :func:`support_matrices`, the seals and springs in it;
   :func:`drop_scatter`, Monte-Carlo drops over friction, clearance, support damping and
   unbalance, serial or on Dask
   (:mod:`ambseal.analysis.drop_monte_carlo`, :func:`wilson_interval`);
@@ -75,7 +75,7 @@ from ambseal.lazy import lazy_face
 #: Each public name (``__all__``) and the module that defines it.
 _FROM = {
     "DropResult": "drop", "simulate_drop": "drop", "drop_model": "drop",
-    "drop_verdict": "drop", "seal_matrices": "drop", "drop_scatter": "drop_monte_carlo",
+    "drop_verdict": "drop", "support_matrices": "drop", "drop_scatter": "drop_monte_carlo",
     "wilson_interval": "drop_monte_carlo", "levitated_start": "drop_levitated",
     "levitated_state": "drop_levitated", "AmbLoop": "drop_loop", "amb_loop": "drop_loop",
     "drop_event": "drop_loop",

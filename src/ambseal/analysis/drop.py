@@ -14,7 +14,8 @@ every touchdown plane) in the mass-normalised real modes of its free–free
 non-rotating form up to ``modes_hz`` (rigid-body modes included), M q̈ + (C + ΩG) q̇ + K q
 = f at the spin speed Ω, held by the drive or coasting down under the rings' friction
 and a drag torque (``coast_down``), the gyroscopic moments at the instantaneous speed;
-the seals' forces (:func:`seal_matrices`) at the drop's speed and pressure drop.
+the seals' and springs' forces (:func:`support_matrices`) at the drop's speed and pressure
+drop.
 The default ``modes_hz`` is :data:`MODES_PER_CONTACT` (4) times the contact's own
 frequency 1/t_c (:func:`ambseal.model.hertz_impact`) for a fall through the smallest
 clearance, the shortest over the planes, each an impact of the rotor's mass shared among
@@ -68,6 +69,7 @@ from ambseal.lti import json_float
 from ambseal.model import (
     ContactLaw,
     SealElement,
+    SpringElement,
     assemble_rotor,
     build_mesh,
     damping_coefficient,
@@ -75,6 +77,7 @@ from ambseal.model import (
     hertz_impact,
     normal_force,
     rated_contact_stress,
+    spring_label,
 )
 
 class _Crawling(Exception):
@@ -82,7 +85,7 @@ class _Crawling(Exception):
 
 
 __all__ = ["GRAVITY", "DropModel", "DropResult", "drop_model", "simulate_drop",
-           "journal_radius", "drop_verdict", "seal_matrices"]
+           "journal_radius", "drop_verdict", "support_matrices"]
 
 #: the modes kept reach this many times the contact's own frequency 1/t_c
 MODES_PER_CONTACT = 4.0
@@ -153,8 +156,9 @@ class DropModel:
     modes_hz : float
         The modes kept are those below this (Hz).
     node_rows : dict
-        ``{"amb:NAME" or "seal:NAME": ndarray (2, m)}``: the x, y rows of Φ at each AMB
-        and seal, whose excursions the verdict sets against their gaps.
+        ``{"amb:NAME", "seal:NAME" or "spring:NAME": ndarray (2, m)}``: the x, y rows of Φ
+        at each AMB, seal and ``[[spring]]`` with a ``clearance``, whose excursions the
+        verdict sets against their gaps.
     z : ndarray, shape (n_nodes,)
         The FE nodes' positions (m); node k's DOFs are x, y, θx, θy at 4k … 4k + 3.
     projector : ndarray, shape (m, n_dof)
@@ -274,6 +278,8 @@ def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
     g_node = int(np.argmin(np.abs(mesh.z - z_g)))
     rows.update({f"amb:{a.name}": xy(a.position) for a in cfg.amb})
     rows.update({f"seal:{s.name}": xy(s.position) for s in cfg.seal})
+    rows.update({f"spring:{spring_label(s, i)}": xy(s.position)
+                 for i, s in enumerate(cfg.spring) if s.clearance is not None})
     return DropModel(
         phi=phi, frequency_hz=f, K=Km, C=phi.T @ rotor.C @ phi, G=phi.T @ rotor.G @ phi,
         gravity=gravity, planes=tuple(xy(t.position) for t in cfg.touchdown), laws=laws,
@@ -290,17 +296,20 @@ def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
         cg_rows=phi[[4 * g_node, 4 * g_node + 1], :], z_cg=z_g)
 
 
-def seal_matrices(cfg, dm: DropModel, speed_rpm: float, pressure_bar: float | None = None
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The rig's seals on the drop's modes: Childs' force −[K k; −k K] s − [C c; −c C] ṡ
-    − M s̈ on each seal's displacement s from the levitated equilibrium (thesis P4 Eq. 3),
-    at the pressure drop and, for tabulated coefficients, the synchronous frequency of
-    ``speed_rpm`` (as :func:`ambseal.model.build_plant` takes them), held through the drop.
+def support_matrices(cfg, dm: DropModel, speed_rpm: float,
+                     pressure_bar: float | None = None
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """What holds the rotor besides its AMBs, on the drop's modes: each seal's Childs force
+    −[K k; −k K] s − [C c; −c C] ṡ − M s̈ (thesis P4 Eq. 3) and each ``[[spring]]``'s
+    (a coupling, P4 Eq. 4; a plain bearing, a balance piston) on the node's displacement s
+    from the levitated equilibrium, at the pressure drop and, for tabulated coefficients,
+    the synchronous frequency of ``speed_rpm`` (as :func:`ambseal.model.build_plant`
+    takes them), held through the drop.
 
     Parameters
     ----------
     cfg : RigConfig
-        The rig and its ``[[seal]]`` tables.
+        The rig and its ``[[seal]]`` and ``[[spring]]`` tables.
     dm : DropModel
         Its drop model.
     speed_rpm : float
@@ -311,18 +320,27 @@ def seal_matrices(cfg, dm: DropModel, speed_rpm: float, pressure_bar: float | No
     Returns
     -------
     K, C, M : ndarray, shape (m, m)
-        Φᵀ K_s Φ, Φᵀ C_s Φ, Φᵀ M_s Φ (zero without seals).
+        Φᵀ K Φ, Φᵀ C Φ, Φᵀ M Φ of the seals and springs (zero without them).
+
+    Raises
+    ------
+    ConfigError
+        A spring on a housing (its own degrees of freedom are not in the drop's modes).
     """
     p = cfg.operating.pressure_bar if pressure_bar is None else pressure_bar
-    m = dm.phi.shape[1]
-    out = [np.zeros((m, m)) for _ in range(3)]
+    f = abs(speed_rpm) / 60.0
     mesh = build_mesh(cfg, extra_positions=tuple(t.position for t in cfg.touchdown))
+    n = mesh.n_dof
+    K, C, M = (np.zeros((n, n)) for _ in range(3))
     for seal in cfg.seal:
-        el = SealElement.from_config(seal, mesh, p, abs(speed_rpm) / 60.0)
-        rows = dm.phi[[4 * el.node, 4 * el.node + 1], :]
-        for X, e in zip(out, el.matrices()):
-            X += rows.T @ e @ rows
-    return tuple(out)
+        SealElement.from_config(seal, mesh, p, f).assemble(M, C, K)
+    for i, spring in enumerate(cfg.spring):
+        if spring.housing is not None:
+            raise ConfigError(f"spring[{i}].housing: the drop holds a spring to ground; "
+                              "one on a housing is not simulated")
+        SpringElement.from_config(spring, mesh, i, None, f).assemble(M, C, K)
+    phi = dm.phi
+    return phi.T @ K @ phi, phi.T @ C @ phi, phi.T @ M @ phi
 
 
 @dataclass(frozen=True)
@@ -582,8 +600,9 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         A step force from t = 0: its position z (m; at the nearest node) and its x, y
         components (N). Its work is counted as work from outside.
     seals : bool, optional
-        The seals' forces on the rotor (:func:`seal_matrices`: at the drop's speed and
-        pressure, held through it); their work is counted as work from outside.
+        The seals' and springs' forces on the rotor (:func:`support_matrices`: at the
+        drop's speed and pressure, held through it); their work is counted as work from
+        outside.
     pressure_bar : float, optional
         The pressure drop across the seals (bar); ``[operating] pressure_bar`` if omitted.
     progress : callable, optional
@@ -639,9 +658,9 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     Ak, Bk, Ck, Dk = loop.controller
     na, n_loop = Aa.shape[0], loop.n_states
     i_s = loop.static / loop.ki
-    sealed = bool(seals and cfg.seal)
+    sealed = bool(seals and (cfg.seal or cfg.spring))
     if sealed:
-        K_s, C_s, M_s = seal_matrices(cfg, dm, speed_rpm, pressure_bar)
+        K_s, C_s, M_s = support_matrices(cfg, dm, speed_rpm, pressure_bar)
         M_inv = np.linalg.inv(np.eye(m) + M_s)
     races = np.flatnonzero(dm.race_inertia > 0)
     sup = [p for p in range(P) if dm.support[p] is not None]
@@ -982,8 +1001,8 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
 def drop_verdict(cfg, result: DropResult) -> dict:
     """The drop judged, verdict first: each criterion passed, FAILED, or not graded (with
     why) — no contact outside the touchdown bearings (the largest excursion at each AMB
-    against its air gap, :func:`ambseal.design.air_gaps`, at each seal against its
-    ``clearance``), each touchdown
+    against its air gap, :func:`ambseal.design.air_gaps`, at each seal and each
+    ``[[spring]]`` with a ``clearance`` against it), each touchdown
     bearing's peak force against ``[drop] force_ratio`` × its ``static_rating`` C₀ (with
     the most loaded ball's contact stress that force gives in a rolling bearing,
     :func:`ambseal.model.rated_contact_stress`: the rig's kinds are ball bearings), and
@@ -1012,6 +1031,8 @@ def drop_verdict(cfg, result: DropResult) -> dict:
 
     gaps = {f"amb:{a.name}": s0 for a, s0 in zip(cfg.amb, air_gaps(cfg))}
     gaps.update({f"seal:{s.name}": s.clearance for s in cfg.seal})
+    gaps.update({f"spring:{spring_label(s, i)}": s.clearance
+                 for i, s in enumerate(cfg.spring) if s.clearance is not None})
     for key, gap in gaps.items():
         worst = float(np.hypot(*result.watched[key].T).max())
         what = "air gap" if key.startswith("amb:") else "clearance"

@@ -7,7 +7,8 @@ FE rotor in its modes kept, gyroscopics at the spin Ω) held by the AMB loop of
 and eddy-current lags, the controller in negative feedback i = −K y: the rig's reference
 PID at that speed, :func:`ambseal.design.reference_pid`, P5 Eq. 6, unless one is given,
 in continuous time), linear: the orbit's currents are not clipped, and the seals at the
-speed and pressure drop (:func:`ambseal.analysis.drop.seal_matrices`), as in the drop.
+speed and pressure drop, and the springs (:func:`ambseal.analysis.drop.support_matrices`),
+as in the drop.
 
 The unbalance U (kg·m) at the node nearest the centre of mass is the force
 U Ω² (cos Ωt, sin Ωt) = Re(U Ω² (1, −j) e^{jΩt}) that :func:`~ambseal.analysis.drop.
@@ -23,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg import eigvals, expm
 
-from ambseal.analysis.drop import seal_matrices
+from ambseal.analysis.drop import support_matrices
 from ambseal.analysis.drop_loop import amb_loop
 from ambseal.errors import ConfigError
 from ambseal.lti import feedback_matrices
@@ -53,7 +54,8 @@ def levitated_loop(cfg, dm, speed_rpm: float, controller=None, loop=None, seals=
         The loop's pieces (:func:`ambseal.analysis.drop_loop.amb_loop`), built from
         ``controller`` if omitted.
     seals : bool, optional
-        The seals' forces on the rotor (:func:`ambseal.analysis.drop.seal_matrices`).
+        The seals' and springs' forces on the rotor
+        (:func:`ambseal.analysis.drop.support_matrices`).
     pressure_bar : float, optional
         Their pressure drop (bar); ``[operating] pressure_bar`` if omitted.
 
@@ -73,12 +75,12 @@ def levitated_loop(cfg, dm, speed_rpm: float, controller=None, loop=None, seals=
 
 
 def _open_loop(cfg, dm, speed_rpm: float, L, seals: bool, pressure_bar):
-    """The rotor with its seals, −Ks and the coil, current references → sensors: (A, B,
-    C, D), the states the modes' deviation from the levitated equilibrium, their rates and
-    the coil's; and the input of a force (N) at the centre of mass."""
+    """The rotor with its seals and springs, −Ks and the coil, current references →
+    sensors: (A, B, C, D), the states the modes' deviation from the levitated equilibrium,
+    their rates and the coil's; and the input of a force (N) at the centre of mass."""
     W = 2 * np.pi * speed_rpm / 60.0
     m = dm.phi.shape[1]
-    K_s, C_s, M_s = (seal_matrices(cfg, dm, speed_rpm, pressure_bar) if seals
+    K_s, C_s, M_s = (support_matrices(cfg, dm, speed_rpm, pressure_bar) if seals
                      else (np.zeros((m, m)),) * 3)
     M_inv = np.linalg.inv(np.eye(m) + M_s)
     A_r = np.block([[np.zeros((m, m)), np.eye(m)],

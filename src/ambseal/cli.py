@@ -440,6 +440,9 @@ def _rotordynamics_parsers(sub) -> None:
     dr.add_argument("--overload-at", default=None,
                     help="--event overload: a seal, AMB, touchdown bearing or named disk "
                          "where it acts (default the centre of mass)")
+    dr.add_argument("--surge-bar", type=_finite, default=None,
+                    help="--event overload: a seal surge, the seals' pressure drop stepping "
+                         "to this (bar) at the event")
     dr.add_argument("--controller", default=None,
                     help="the AMB loop's controller: pid, hinf, mu (designed here) or a "
                          "controller file (its continuous design); default the rig's "

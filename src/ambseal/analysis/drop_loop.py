@@ -221,7 +221,8 @@ def amb_loop(cfg, dm, speed_rpm: float | None = None, controller=None) -> AmbLoo
 
 
 def drop_event(cfg, dm, loop: AmbLoop, event: str = "loss", axis: str | None = None,
-               overload_n: float | None = None, overload_at: str | None = None) -> dict:
+               overload_n: float | None = None, overload_at: str | None = None,
+               surge_bar: float | None = None) -> dict:
     """What :func:`~ambseal.analysis.drop.simulate_drop` is given for an event.
 
     - ``loss``: every axis loses power.
@@ -229,7 +230,9 @@ def drop_event(cfg, dm, loop: AmbLoop, event: str = "loss", axis: str | None = N
       force (the weight's share: its loss drops the most), the first of equals.
     - ``overload``: a step force of ``overload_n`` downward, the way the weight acts, at
       ``overload_at`` (a seal, AMB or touchdown bearing by name, or a disk's position
-      given as its name; default the centre of mass); every axis runs on.
+      given as its name; default the centre of mass), or a seal surge: the seals' pressure
+      drop stepping from the operating one to ``surge_bar`` (their coefficients with it,
+      :func:`ambseal.analysis.drop.support_matrices`), or both; every axis runs on.
 
     Parameters
     ----------
@@ -247,38 +250,52 @@ def drop_event(cfg, dm, loop: AmbLoop, event: str = "loss", axis: str | None = N
         ``overload``: the force (N), > 0; required there.
     overload_at : str, optional
         ``overload``: where it acts.
+    surge_bar : float, optional
+        ``overload``: the seals' pressure drop (bar) from t = 0, ≥ 0.
 
     Returns
     -------
     dict
-        ``failed`` (tuple of channel names), ``overload`` (None or (z m, (F_x, F_y) N))
-        and ``summary`` (one line for the report).
+        ``failed`` (tuple of channel names), ``overload`` (None or (z m, (F_x, F_y) N)),
+        ``pressure_bar`` (the seals' through the drop; None: the operating one) and
+        ``summary`` (one line for the report).
 
     Raises
     ------
     ConfigError
-        An unknown event, axis or place; an axis or force given to an event that takes
-        none; an overload without its force.
+        An unknown event, axis or place; an axis, force or surge given to an event that
+        takes none; an overload without a force or a surge, or with a negative surge.
     """
     if event not in EVENTS:
         raise ConfigError(f"drop: event: expected one of {', '.join(EVENTS)}, got {event!r}")
     if axis is not None and event != "one-axis":
         raise ConfigError("--axis: names the axis of --event one-axis")
-    if (overload_n is not None or overload_at is not None) and event != "overload":
-        raise ConfigError("--overload-n, --overload-at: the force of --event overload")
+    if (overload_n is not None or overload_at is not None or surge_bar is not None) \
+            and event != "overload":
+        raise ConfigError("--overload-n, --overload-at, --surge-bar: the overload of "
+                          "--event overload")
     if event == "loss":
-        return {"failed": loop.names, "overload": None,
+        return {"failed": loop.names, "overload": None, "pressure_bar": None,
                 "summary": "every AMB loses power"}
     if event == "one-axis":
         if axis is None:
             axis = loop.names[int(np.argmax(np.abs(loop.static)))]
         if axis not in loop.names:
             raise ConfigError(f"--axis: expected one of {', '.join(loop.names)}, got {axis!r}")
-        return {"failed": (axis,), "overload": None,
+        return {"failed": (axis,), "overload": None, "pressure_bar": None,
                 "summary": f"AMB axis {axis} loses power, the others run on"}
+    if surge_bar is not None and not (surge_bar >= 0 and np.isfinite(surge_bar)):
+        raise ConfigError(f"--surge-bar: expected a pressure drop (bar, >= 0), got "
+                          f"{surge_bar!r}")
+    surge = ("" if surge_bar is None else
+             f"the seals' pressure drop surging from {cfg.operating.pressure_bar:g} to "
+             f"{surge_bar:g} bar")
+    if overload_n is None and surge_bar is not None and overload_at is None:
+        return {"failed": (), "overload": None, "pressure_bar": surge_bar,
+                "summary": surge}
     if overload_n is None or not (overload_n > 0 and np.isfinite(overload_n)):
         raise ConfigError(f"--overload-n: expected the step force (N, > 0) of --event "
-                          f"overload, got {overload_n!r}")
+                          f"overload (or --surge-bar alone), got {overload_n!r}")
     places = {"centre of mass": dm.z_cg}
     for kind in (cfg.seal, cfg.amb, cfg.touchdown, cfg.disk):
         places.update({x.name: x.position for x in kind if getattr(x, "name", None)})
@@ -287,5 +304,6 @@ def drop_event(cfg, dm, loop: AmbLoop, event: str = "loss", axis: str | None = N
         raise ConfigError(f"--overload-at: expected a seal, AMB, touchdown bearing or disk "
                           f"of the rig ({', '.join(sorted(places))}), got {at!r}")
     return {"failed": (), "overload": (places[at], (0.0, -float(overload_n))),
+            "pressure_bar": surge_bar,
             "summary": f"a step force of {overload_n:g} N downward at {at} "
-                       f"(z = {places[at]:.4g} m)"}
+                       f"(z = {places[at]:.4g} m)" + (f" and {surge}" if surge else "")}

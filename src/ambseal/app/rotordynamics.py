@@ -313,7 +313,7 @@ def _drop(args: argparse.Namespace) -> int:
                           "drive holds the speed otherwise)")
     if args.runs is not None:
         given = [f"--{n.replace('_', '-')}" for n in ("axis", "overload_n", "overload_at",
-                                                       "controller")
+                                                       "surge_bar", "controller")
                  if getattr(args, n) is not None]
         if args.event != "loss" or given:
             raise ConfigError(f"--runs: Monte-Carlo drops are of --event loss from the "
@@ -338,7 +338,7 @@ def _drop(args: argparse.Namespace) -> int:
                                 d.dt)
     loop = amb_loop(cfg, dm, rpm, controller)
     event = drop_event(cfg, dm, loop, args.event, args.axis, args.overload_n,
-                       args.overload_at)
+                       args.overload_at, args.surge_bar)
     start = x0 = None
     # a loop that runs on is checked for stability at the speed, as the orbit needs it
     if args.start == "levitated" and (unbalance[0] > 0 or event["failed"] != loop.names):
@@ -348,7 +348,7 @@ def _drop(args: argparse.Namespace) -> int:
                         coast_down=args.coast_down, drag_torque=args.drag_torque,
                         unbalance_kgm=unbalance[0], initial=start, loop=loop,
                         loop_state=x0, failed=event["failed"], overload=event["overload"],
-                        progress=progress)
+                        pressure_bar=event["pressure_bar"], progress=progress)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     judged = drop_verdict(cfg, res)

@@ -369,7 +369,8 @@ class DropResult:
         and the overload. What the contacts' damping and friction, the drag and the
         structural damping took is ``energy[0] + work − energy``.
     watched : dict
-        ``{name: ndarray (k, 2)}``: the rotor's centre at each AMB and seal plane (m).
+        ``{name: ndarray (k, 2)}``: the rotor's centre at each plane of
+        :attr:`DropModel.node_rows` (m).
     impacts : int
         Contact onsets counted.
     names : tuple of str
@@ -547,7 +548,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                   coast_down: bool = False, drag_torque: float = 0.0,
                   initial: tuple | None = None, unbalance_kgm: float = 0.0,
                   loop: AmbLoop | None = None, loop_state=None, failed=None,
-                  overload: tuple | None = None, seals: bool = True,
+                  overload: tuple | None = None, supports: bool = True,
                   pressure_bar: float | None = None, progress=None) -> DropResult:
     """Drop the rotor of ``cfg`` onto its touchdown bearings (module docstring).
 
@@ -599,7 +600,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     overload : tuple (float, array_like of 2 float), optional
         A step force from t = 0: its position z (m; at the nearest node) and its x, y
         components (N). Its work is counted as work from outside.
-    seals : bool, optional
+    supports : bool, optional
         The seals' and springs' forces on the rotor (:func:`support_matrices`: at the
         drop's speed and pressure, held through it); their work is counted as work from
         outside.
@@ -658,7 +659,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     Ak, Bk, Ck, Dk = loop.controller
     na, n_loop = Aa.shape[0], loop.n_states
     i_s = loop.static / loop.ki
-    sealed = bool(seals and (cfg.seal or cfg.spring))
+    sealed = bool(supports and (cfg.seal or cfg.spring))
     if sealed:
         K_s, C_s, M_s = support_matrices(cfg, dm, speed_rpm, pressure_bar)
         M_inv = np.linalg.inv(np.eye(m) + M_s)

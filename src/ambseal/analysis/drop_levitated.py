@@ -32,7 +32,7 @@ from ambseal.lti import feedback_matrices
 __all__ = ["levitated_loop", "levitated_start", "levitated_state"]
 
 
-def levitated_loop(cfg, dm, speed_rpm: float, controller=None, loop=None, seals=True,
+def levitated_loop(cfg, dm, speed_rpm: float, controller=None, loop=None, supports=True,
                    pressure_bar: float | None = None):
     """The closed AMB loop of the drop's rotor (module docstring) in state space, linear
     (no current clipped), the states the modes, their rates, the amplifiers' and lags'
@@ -53,7 +53,7 @@ def levitated_loop(cfg, dm, speed_rpm: float, controller=None, loop=None, seals=
     loop : AmbLoop, optional
         The loop's pieces (:func:`ambseal.analysis.drop_loop.amb_loop`), built from
         ``controller`` if omitted.
-    seals : bool, optional
+    supports : bool, optional
         The seals' and springs' forces on the rotor
         (:func:`ambseal.analysis.drop.support_matrices`).
     pressure_bar : float, optional
@@ -69,18 +69,18 @@ def levitated_loop(cfg, dm, speed_rpm: float, controller=None, loop=None, seals=
         The input of a force (N) at the node nearest the centre of mass, x and y.
     """
     L = loop or amb_loop(cfg, dm, speed_rpm, controller)
-    G, Bf = _open_loop(cfg, dm, speed_rpm, L, seals, pressure_bar)
+    G, Bf = _open_loop(cfg, dm, speed_rpm, L, supports, pressure_bar)
     A_cl, B_cl, _, _ = feedback_matrices(G, L.controller, (Bf, np.zeros((L.ki.size, 2))))
     return A_cl, B_cl[:, -2:]  # the inputs [d, f]: the force last
 
 
-def _open_loop(cfg, dm, speed_rpm: float, L, seals: bool, pressure_bar):
+def _open_loop(cfg, dm, speed_rpm: float, L, supports: bool, pressure_bar):
     """The rotor with its seals and springs, −Ks and the coil, current references →
     sensors: (A, B, C, D), the states the modes' deviation from the levitated equilibrium,
     their rates and the coil's; and the input of a force (N) at the centre of mass."""
     W = 2 * np.pi * speed_rpm / 60.0
     m = dm.phi.shape[1]
-    K_s, C_s, M_s = (support_matrices(cfg, dm, speed_rpm, pressure_bar) if seals
+    K_s, C_s, M_s = (support_matrices(cfg, dm, speed_rpm, pressure_bar) if supports
                      else (np.zeros((m, m)),) * 3)
     M_inv = np.linalg.inv(np.eye(m) + M_s)
     A_r = np.block([[np.zeros((m, m)), np.eye(m)],
@@ -122,7 +122,7 @@ def _sampled_orbit(G, Bf, sampled, W: float, force: np.ndarray):
 
 
 def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=None,
-                    loop=None, seals=True, pressure_bar: float | None = None):
+                    loop=None, supports=True, pressure_bar: float | None = None):
     """The modal state at the drop (module docstring), the loop's states with it.
 
     Parameters
@@ -139,7 +139,7 @@ def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=
         As :func:`levitated_loop`.
     loop : AmbLoop, optional
         As :func:`levitated_loop`.
-    seals : bool, optional
+    supports : bool, optional
         As :func:`levitated_loop`.
     pressure_bar : float, optional
         As :func:`levitated_loop`.
@@ -167,7 +167,7 @@ def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=
     force = unbalance_kgm * W * W * np.array([1.0, -1.0j])
     L = loop or amb_loop(cfg, dm, speed_rpm, controller)
     if L.sampled is not None:
-        X, X_d, worst = _sampled_orbit(*_open_loop(cfg, dm, speed_rpm, L, seals,
+        X, X_d, worst = _sampled_orbit(*_open_loop(cfg, dm, speed_rpm, L, supports,
                                                    pressure_bar), L.sampled, W, force)
         if abs(worst) >= 1:
             raise ConfigError(
@@ -176,7 +176,7 @@ def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=
                 "the rotor has no levitated orbit there; start the drop at rest")
         return (dm.q0 + X[:m].real, X[m:2 * m].real,
                 np.concatenate([X[2 * m:].real, X_d.real]))
-    A, B_u = levitated_loop(cfg, dm, speed_rpm, controller, L, seals, pressure_bar)
+    A, B_u = levitated_loop(cfg, dm, speed_rpm, controller, L, supports, pressure_bar)
     poles = eigvals(A)
     worst = poles[np.argmax(poles.real)]
     if worst.real >= 0:

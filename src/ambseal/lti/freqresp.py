@@ -77,7 +77,11 @@ _BALANCED = ArrayMemo()  # the same of the balanced system (:func:`_arbitrated`)
 #: (:func:`sampled_modal_form`) — a dense eigenvalue problem or ``expm`` of a 500-state
 #: matrix costs 0.1 s, of a 1 888-state one 2–3.5 s (benchmarks/README.md).
 STRUCTURED_STATES = 500
-_EIG = ArrayMemo(keep=6, min_states=STRUCTURED_STATES)
+#: More than six while they fit in 128 MB: a design's full-order check closes its loops on
+#: the plants of every judged condition (21 on a 3 × 7 grid), and the judgement and the
+#: speed range close theirs on the same plants again; at 540 states an entry is 4.7 MB, so
+#: all of them are kept, at 1 888 states (114 MB) six
+_EIG = ArrayMemo(keep=6, min_states=STRUCTURED_STATES, keep_bytes=128 * 2**20)
 _SAMPLED = ArrayMemo(keep=8, min_states=STRUCTURED_STATES)  # sampled_modal_form's results
 _PROBED = ArrayMemo(keep=64)  # C (sI − A)⁻¹ B + D at single probes s of large (A, B, C)
 #: Spread (largest over smallest) of the diagonal balancing of ``A`` above which

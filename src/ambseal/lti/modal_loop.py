@@ -71,10 +71,15 @@ __all__ = ["WEAK", "modal_loop_poles", "modal_loop_response"]
 #: far below rounding, and the small-gain bound is met with a wide margin.
 WEAK = 1e-6
 _EPS = float(np.finfo(float).eps)
-#: The strong part is solved densely: above this fraction of the loop's order (its dense
-#: problem then costs an eighth of the loop's, plus the iterations) the structured path
-#: is not taken.
-_MAX_STRONG_FRACTION = 0.5
+#: The strong part is solved densely and refined cluster by cluster, a factorisation of
+#: its order S per cluster and iteration (measured: ≈ 8.3e-9·S^3.2 s against the dense
+#: eigenvalues' ≈ 3.9e-10·N³ s of the whole loop, one thread): above this fraction of the
+#: loop's order N the structured path is not taken. The fraction is where the two meet,
+#: 0.27 N at 600 states, 0.24 N at 900, 0.19 N at 1 900 (benchmarks/README.md, "The
+#: 540-state back-to-back compressor"); it picked the cheaper path on each of 215 loops
+#: of three rigs of 540, 840 and 1 888 states. At 0.5 the 540-state compressor's loops,
+#: strong parts of 190–290, took the structured path at 2–3 times the dense cost.
+_MAX_STRONG_FRACTION = 0.25
 _MAX_ITER = 30
 #: The split of the last loops (:class:`_Solved`, no n × n array: 0.6 MB at 1 888
 #: states): a loop's poles and its time response share one, also when the design's check

@@ -78,8 +78,8 @@ _BALANCED = ArrayMemo()  # the same of the balanced system (:func:`_arbitrated`)
 #: matrix costs 0.1 s, of a 1 888-state one 2–3.5 s (benchmarks/README.md).
 STRUCTURED_STATES = 500
 #: More than six while they fit in 128 MB: a design's full-order check closes its loops on
-#: the plants of every judged condition (21 on a 3 × 7 grid), and the judgement and the
-#: speed range close theirs on the same plants again; at 540 states an entry is 4.7 MB, so
+#: the plants of every judged condition (21 on a 3 × 7 grid), and the later checks close
+#: theirs on the same plants again; at 540 states an entry is 4.7 MB, so
 #: all of them are kept, at 1 888 states (114 MB) six
 _EIG = ArrayMemo(keep=6, min_states=STRUCTURED_STATES, keep_bytes=128 * 2**20)
 _SAMPLED = ArrayMemo(keep=8, min_states=STRUCTURED_STATES)  # sampled_modal_form's results

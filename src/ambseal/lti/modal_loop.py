@@ -77,7 +77,7 @@ _EPS = float(np.finfo(float).eps)
 #: loop's order N the structured path is not taken. The fraction is where the two meet,
 #: 0.27 N at 600 states, 0.24 N at 900, 0.19 N at 1 900 (benchmarks/README.md, "The
 #: 540-state back-to-back compressor"); it picked the cheaper path on each of 215 loops
-#: of three rigs of 540, 840 and 1 888 states. At 0.5 the 540-state compressor's loops,
+#: on three plants of 540, 840 and 1 888 states. At 0.5 the 540-state plant's loops,
 #: strong parts of 190–290, took the structured path at 2–3 times the dense cost.
 _MAX_STRONG_FRACTION = 0.25
 _MAX_ITER = 30

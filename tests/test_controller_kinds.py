@@ -318,8 +318,9 @@ def test_design_prints_the_verdict_its_file_holds(kinds):
 
 def test_the_drop_runs_a_digital_controller_as_it_runs(kinds, tmp_path, capsys):
     """``ambseal drop --controller FILE`` with ``ambseal design``'s digital PID runs it
-    sampled, with its delay (drop.json's ``controller_runs``), and its continuous design
-    (the continuous file of the same PID) gives another orbit after the same overload."""
+    sampled, with its delay (drop.json's ``controller_runs``, and the page), and its
+    continuous design (the continuous file of the same PID) gives another orbit after
+    the same overload."""
     docs = {}
     for kind in ("digital", "continuous"):
         code, out, errors = _cli(capsys, [
@@ -333,5 +334,6 @@ def test_the_drop_runs_a_digital_controller_as_it_runs(kinds, tmp_path, capsys):
         f"digital at {K.sample_rate_hz:g} Hz, {K.delay_samples} sample(s) of computation "
         "delay")
     assert docs["continuous"]["controller_runs"] == "continuous"
+    assert docs["digital"]["controller_runs"] in (tmp_path / "digital" / "drop.html").read_text()
     a, b = (docs[k]["watched_max_m"]["amb:A"] for k in ("digital", "continuous"))
     assert abs(a - b) > 1e-3 * b

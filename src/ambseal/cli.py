@@ -430,8 +430,8 @@ def _rotordynamics_parsers(sub) -> None:
                          "(else speed_rpm), or trip_speed_hz (else 1.05 × that)")
     dr.add_argument("--event", choices=("loss", "one-axis", "overload"), default="loss",
                     help="what lands the rotor: every AMB loses power (default), one axis "
-                         "does (--axis) while the others run on, or a step force "
-                         "(--overload-n) beyond what the AMBs hold")
+                         "does (--axis) while the others run on, or an overload: a step "
+                         "force (--overload-n), a seal surge (--surge-bar) or both")
     dr.add_argument("--axis", default=None,
                     help="--event one-axis: the axis lost, AMB_zeta or AMB_eta (default "
                          "the one carrying the most static load)")
@@ -444,8 +444,9 @@ def _rotordynamics_parsers(sub) -> None:
                     help="--event overload: a seal surge, the seals' pressure drop stepping "
                          "to this (bar) at the event")
     dr.add_argument("--controller", default=None,
-                    help="the AMB loop's controller: pid, hinf, mu (designed here) or a "
-                         "controller file (its continuous design); default the rig's "
+                    help="the AMB loop's controller: pid, hinf, mu (designed here, run in "
+                         "continuous time) or a controller file (a digital one runs as on "
+                         "the target: sampled, with its delay); default the rig's "
                          "reference PID")
     dr.add_argument("--pressure-bar", type=_finite, default=None,
                     help="the seals' pressure drop (bar) through the drop; default "

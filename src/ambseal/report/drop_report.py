@@ -90,8 +90,10 @@ def write_drop_report(path: str | os.PathLike, doc: dict, figures, *, title: str
             + _cell(_num(a["peak_current_a"])) + _cell(_num(a["current_limit_a"]))
             + _cell("yes" if a["saturated"] else "no", text=True) + "</tr>"
             for a in doc.get("amb", [])]
+    runs = doc.get("controller_runs")
     event = (f"<p>{html.escape(doc['event_summary'])}; the loop's controller: "
-             f"{html.escape(str(doc.get('controller', 'reference PID')))}.</p>"
+             f"{html.escape(str(doc.get('controller', 'reference PID')))}"
+             + (f" ({html.escape(runs)})" if runs else "") + ".</p>"
              if "event_summary" in doc else "")
     sections = [
         {"title": "Verdict", "html": f"<p><b>{html.escape(doc['verdict'])}</b></p>"
@@ -107,7 +109,8 @@ def write_drop_report(path: str | os.PathLike, doc: dict, figures, *, title: str
         {"title": "Energy and speed",
          "text": f"{doc['impacts']} contact onsets in {doc['duration_s']:.4g} s; the "
                  f"contacts, drag and structure dissipated {doc['energy_dissipated_j']:.4g} J "
-                 f"(the drive, the AMBs, the unbalance and any overload did "
+                 f"(the drive, the AMBs, the seals and springs, the unbalance and any "
+                 f"overload did "
                  f"{doc['external_work_j']:.4g} J of work on "
                  f"the rotor); the rotor's spin from "
                  f"{doc['speed_rad_s'] * 60 / (2 * math.pi):.6g} rpm, "

@@ -264,22 +264,22 @@ def test_the_seals_drop_with_the_rotor_at_their_pressure(tmp_path, capsys):
 
 def test_a_seal_surge_lands_a_rotor_its_loop_held(tmp_path, capsys):
     """``--event overload --surge-bar P``: the seal's pressure drop steps from the
-    operating 0 bar to 1000 bar at the event, its cross-coupled stiffness (2e3 N/m per
-    bar) with it to 2e6 N/m, five times what the reference PID's damping holds at the
-    rigid forward whirl (its loop's pole then grows at 88/s): the loop that held the
+    operating 0 bar to 3000 bar at the event, its cross-coupled stiffness (2e3 N/m per
+    bar) with it to 6e6 N/m, fifteen times what the reference PID's damping holds at the
+    rigid forward whirl (its loop's pole then grows at 204/s): the loop that held the
     rotor in its orbit no longer does, and the rotor lands; at 0 bar, with a 1 N step
     only, it stays clear. A negative surge is refused (exit 2)."""
     rig = tmp_path / "rig.toml"
     rig.write_text(_rig_text() + f'[[seal]]\nname = "mid"\nposition = {L / 2}\n'
                    "clearance = 3.0e-4\nk = { per_bar = 2.0e3 }\n")
     peaks = {}
-    for extra in (["--surge-bar", "1000"], ["--overload-n", "1"]):
-        assert main(["--quiet", "drop", str(rig), "--duration-s", "0.3", "--event",
+    for extra in (["--surge-bar", "3000"], ["--overload-n", "1"]):
+        assert main(["--quiet", "drop", str(rig), "--duration-s", "0.06", "--event",
                      "overload", "--unbalance-kgm", "1e-4", "--out", str(tmp_path / "d"),
                      "--force", "--json", *extra]) in (0, 1)
         doc = json.loads(capsys.readouterr().out)
         peaks[extra[0]] = max(p["peak_force_n"] for p in doc["planes"])
-        assert ("surging from 0 to 1000 bar" in doc["event_summary"]) == (
+        assert ("surging from 0 to 3000 bar" in doc["event_summary"]) == (
             extra[0] == "--surge-bar")
     assert peaks["--surge-bar"] > 0 and peaks["--overload-n"] == 0
     assert main(["--quiet", "drop", str(rig), "--event", "overload", "--surge-bar", "-1",

@@ -184,7 +184,7 @@ def test_the_events_from_the_command_line(tmp_path, capsys):
     rig.write_text(_rig_text())
 
     def drop(*extra):
-        code = main(["--quiet", "drop", str(rig), "--duration-s", "0.1", "--start", "rest",
+        code = main(["--quiet", "drop", str(rig), "--duration-s", "0.05", "--start", "rest",
                      "--speed-rpm", "0", "--out", str(tmp_path / "d"), "--force", "--json",
                      *extra])
         return code, json.loads(capsys.readouterr().out)

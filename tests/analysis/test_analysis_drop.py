@@ -401,7 +401,7 @@ def test_the_levitated_start_is_the_pid_loops_unbalance_orbit(cutoff_hz):
     X = U Ω²/(2(Ki·G_a(jΩ)·K(jΩ) − Ks) − m Ω²), K(jΩ) = Kp(1 + 1/(jΩ Ti) +
     jΩ Td/(jΩ ε Td + 1)) (P5 Eq. 6); at t = 0 the centre sits at (Re X, Im X) moving at
     Ω (−Im X, Re X): within 1e-6. A PID of the wrong sign is refused, naming the pole."""
-    from ambseal.analysis.drop_levitated import levitated_start
+    from ambseal.analysis.drop_levitated import levitated_state
     from ambseal.design import pid_controller
     from ambseal.model import channel_names
 
@@ -414,7 +414,8 @@ def test_the_levitated_start_is_the_pid_loops_unbalance_orbit(cutoff_hz):
     kp, ti, td, eps = 1e4, 0.2, 3e-3, 0.1
     K = pid_controller(kp, ti, td, eps, channel_names(cfg))
     W, U = 100 * math.pi, 1e-4
-    u, v = levitated_start(cfg, dm, 3000.0, U, controller=K)
+    eta, deta, _ = levitated_state(cfg, dm, 3000.0, U, controller=K)
+    u, v = dm.phi @ eta, dm.phi @ deta
     s = 1j * W
     Kc = kp * (1 + 1 / (s * ti) + s * td / (s * eps * td + 1))
     Ga = 1.0 if not cutoff_hz else 2 * math.pi * cutoff_hz / (s + 2 * math.pi * cutoff_hz)
@@ -426,5 +427,5 @@ def test_the_levitated_start_is_the_pid_loops_unbalance_orbit(cutoff_hz):
     np.testing.assert_allclose(v[4 * g:4 * g + 2], [-W * X.imag, W * X.real], rtol=1e-6,
                                atol=1e-6 * W * abs(X))
     with pytest.raises(ConfigError, match=r"unstable at 3000 rpm \(a pole at"):
-        levitated_start(cfg, dm, 3000.0, U,
+        levitated_state(cfg, dm, 3000.0, U,
                         controller=pid_controller(-kp, ti, td, eps, channel_names(cfg)))

@@ -50,10 +50,10 @@ sampled with its delay) on the full-order plant:
   :func:`drop_scatter`, Monte-Carlo drops over friction, clearance, support damping and
   unbalance, serial or on Dask
   (:mod:`ambseal.analysis.drop_monte_carlo`, :func:`wilson_interval`);
-  :func:`levitated_start` and :func:`levitated_state`, the AMB loop's unbalance orbit a
-  drop starts from (:mod:`ambseal.analysis.drop_levitated`); :func:`amb_loop` →
-  :class:`AmbLoop`, the AMB loop that runs inside the drop, and :func:`drop_event`, the
-  event that lands the rotor (:mod:`ambseal.analysis.drop_loop`);
+  :func:`levitated_state`, the AMB loop's unbalance orbit a drop starts from
+  (:mod:`ambseal.analysis.drop_levitated`); :func:`amb_loop` → :class:`AmbLoop`, the AMB
+  loop that runs inside the drop, and :func:`drop_event`, the event that lands the rotor
+  (:mod:`ambseal.analysis.drop_loop`);
 * :func:`run_cases` — every multi-case analysis, serial or on Dask (:func:`dask_available`,
   :func:`probe_scheduler`).
 
@@ -76,9 +76,8 @@ from ambseal.lazy import lazy_face
 _FROM = {
     "DropResult": "drop", "simulate_drop": "drop", "drop_model": "drop",
     "drop_verdict": "drop", "support_matrices": "drop", "drop_scatter": "drop_monte_carlo",
-    "wilson_interval": "drop_monte_carlo", "levitated_start": "drop_levitated",
-    "levitated_state": "drop_levitated", "AmbLoop": "drop_loop", "amb_loop": "drop_loop",
-    "drop_event": "drop_loop",
+    "wilson_interval": "drop_monte_carlo", "levitated_state": "drop_levitated",
+    "AmbLoop": "drop_loop", "amb_loop": "drop_loop", "drop_event": "drop_loop",
     "capacity_block": "amplifier", "capacity_words": "amplifier", "force_demand": "amplifier",
     "saturates": "amplifier", "unbalance_currents": "amplifier",
     "rejection_effect": "rejection", "rejection_stability": "rejection",

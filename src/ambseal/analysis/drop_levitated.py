@@ -29,7 +29,7 @@ from ambseal.analysis.drop_loop import amb_loop
 from ambseal.errors import ConfigError
 from ambseal.lti import feedback_matrices
 
-__all__ = ["levitated_loop", "levitated_start", "levitated_state"]
+__all__ = ["levitated_loop", "levitated_state"]
 
 
 def levitated_loop(cfg, dm, speed_rpm: float, controller=None, loop=None, supports=True,
@@ -188,34 +188,3 @@ def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=
     X = np.linalg.solve(1j * W * np.eye(A.shape[0]) - A, B_u @ force)
     return dm.q0 + X[:m].real, (1j * W * X[:m]).real, X[2 * m:].real
 
-
-def levitated_start(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=None):
-    """The nodal state at the drop (module docstring): for
-    :func:`~ambseal.analysis.drop.simulate_drop`'s ``initial``.
-
-    Parameters
-    ----------
-    cfg : RigConfig
-        The rig.
-    dm : DropModel
-        Its drop model.
-    speed_rpm : float
-        The spin speed (rpm).
-    unbalance_kgm : float
-        The static unbalance U (kg·m) at the centre of mass, ≥ 0.
-    controller : control.StateSpace, optional
-        As :func:`levitated_loop`.
-
-    Returns
-    -------
-    u, v : ndarray, shape (n_dof,)
-        Nodal displacement (m, rad) and velocity (m/s, rad/s): the static sag and the
-        unbalance orbit at t = 0.
-
-    Raises
-    ------
-    ConfigError
-        A rig without AMBs, or a loop that is not stable at that speed.
-    """
-    eta, deta, _ = levitated_state(cfg, dm, speed_rpm, unbalance_kgm, controller)
-    return dm.phi @ eta, dm.phi @ deta

@@ -88,8 +88,6 @@ class AmbLoop:
         no states and D_K = 0 for a loop without a controller (every axis then fails).
     coil : tuple of ndarray
         (A_a, B_a, C_a, D_a): the amplifiers and eddy-current lags, i_ref → i, c × c.
-    has_controller : bool
-        Whether a controller runs the loop.
     sampled : tuple or None
         (A, B, C, D, T_s) of a digital controller as it runs (module docstring; the
         computation delay among its states), y_k → u_k, i_ref = −u_k held; then
@@ -107,8 +105,13 @@ class AmbLoop:
     tau: np.ndarray
     controller: tuple
     coil: tuple
-    has_controller: bool
     sampled: tuple | None = None
+
+    @property
+    def has_controller(self) -> bool:
+        """Whether a controller runs the loop (digital, or with states or a gain)."""
+        K = self.controller
+        return self.sampled is not None or K[0].shape[0] > 0 or bool(K[3].any())
 
     @property
     def n_states(self) -> int:
@@ -216,8 +219,7 @@ def amb_loop(cfg, dm, speed_rpm: float | None = None, controller=None) -> AmbLoo
             sampled, K = (*K, float(dt)), none
     return AmbLoop(names=names, sensor=sensor @ phi, axis=axis @ phi, ki=ki, ks=ks,
                    static=static, limit=np.array(limit, float), tau=tau, controller=K,
-                   coil=_coil(cfg, c), sampled=sampled,
-                   has_controller=sampled is not None or K[0].shape[0] > 0 or bool(K[3].any()))
+                   coil=_coil(cfg, c), sampled=sampled)
 
 
 def drop_event(cfg, dm, loop: AmbLoop, event: str = "loss", axis: str | None = None,

@@ -285,3 +285,35 @@ def test_a_seal_surge_lands_a_rotor_its_loop_held(tmp_path, capsys):
     assert main(["--quiet", "drop", str(rig), "--event", "overload", "--surge-bar", "-1",
                  "--out", str(tmp_path / "x")]) == 2
     assert "--surge-bar: expected a pressure drop" in capsys.readouterr().err
+
+
+def test_the_thrust_drives_the_rotor_onto_its_axial_stop(tmp_path, capsys):
+    """``--axial-thrust-n`` overrides ``[drop] axial_thrust``: the rotor, let go by every
+    axis, moves axially onto the plane with an ``axial_clearance`` and the JSON and the
+    page give its axial force, excursion and friction heat; with the thrust reversed the
+    rotor leaves its stop the other way, by the same clearance; with an event that keeps
+    the thrust bearing the flag is refused in one line (exit 2)."""
+    text = _rig_text().replace('name = "TB"\n', 'name = "TB"\naxial_clearance = 1.0e-4\n'
+                                                'race_mass = 0.05\n')
+    rig = tmp_path / "rig.toml"
+    rig.write_text(text)
+    docs = []
+    for thrust in ("2000", "-2000"):
+        out = tmp_path / f"drop{thrust}"
+        code = main(["--quiet", "drop", str(rig), "--duration-s", "0.01", "--out", str(out),
+                     "--json", "--axial-thrust-n", thrust])
+        docs.append(json.loads(capsys.readouterr().out))
+        assert code == 0
+    for doc, sign in zip(docs, (1, -1)):
+        assert doc["axial_thrust_n"] == sign * 2000.0
+        ta, tb = doc["planes"]
+        assert ta["peak_axial_force_n"] == 0 and tb["peak_axial_force_n"] > 2000.0
+        assert 1e-4 < doc["max_axial_m"] < 1.5e-4
+        assert tb["friction_heat_j"] > 0
+    page = (tmp_path / "drop2000" / "drop.html").read_text()
+    assert "peak axial force (N)" in page and "the thrust bearing let go" in page
+    assert "ring temperature rise at TB" in page
+    code = main(["--quiet", "drop", str(rig), "--event", "one-axis", "--duration-s", "0.01",
+                 "--out", str(tmp_path / "x"), "--axial-thrust-n", "100"])
+    err = capsys.readouterr().err
+    assert code == 2 and "--axial-thrust-n" in err and "Traceback" not in err

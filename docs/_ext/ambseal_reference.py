@@ -352,8 +352,23 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Touchdown.support_mass": ("kg", "the support's moving mass (needs a stiffness)"),
     "Touchdown.static_rating": ("N", "the bearing's basic static load rating C₀ (ISO 76); "
                                      "left out, the drop's peak force is not graded"),
+    "Touchdown.axial_contact_stiffness": ("N/m^n", "K of the axial contact (left out: "
+                                                   "the radial law's); needs "
+                                                   "``axial_clearance``"),
+    "Touchdown.static_factors": ("", "ISO 76's [X₀, Y₀]: P₀ = max(F_r, X₀F_r + Y₀F_a) "
+                                     "graded against C₀ (left out: 0.6, 0.5 deep groove; "
+                                     "1, 0.52 a 40° angular-contact pair)"),
+    "Touchdown.race_mass": ("kg", "the ring's mass: the drop's friction heat reported as "
+                                  "its temperature rise (left out: heat in J only)"),
+    "Touchdown.race_specific_heat": ("J/(kg·K)", "the ring's specific heat (default 475: "
+                                                 "through-hardened bearing steel)"),
     "DropLimits.force_ratio": ("", "largest peak contact force over C₀ that passes "
                                    "(default 1: ISO 76's static rating)"),
+    "DropLimits.axial_thrust": ("N", "the residual thrust on the rotor (+z towards its far "
+                                     "end) when the thrust bearing lets go (default 0)"),
+    "DropLimits.race_temperature_rise": ("K", "largest temperature rise of a ring with a "
+                                              "``race_mass`` that passes (left out: not "
+                                              "graded)"),
     "Probe.position": ("m", "the probe's axial position (a node of the rotor)"),
     "Probe.angle_deg": ("°", "the direction it reads, from x towards y (default 0)"),
     "Signoff.scale_factor_speeds": ("", "where A_probe is taken: ``to_trip`` (default, "

@@ -451,6 +451,10 @@ def _rotordynamics_parsers(sub) -> None:
     dr.add_argument("--pressure-bar", type=_finite, default=None,
                     help="the seals' pressure drop (bar) through the drop; default "
                          "[operating] pressure_bar")
+    dr.add_argument("--axial-thrust-n", type=_finite, default=None,
+                    help="--event loss: the residual thrust on the rotor (N, +z towards "
+                         "its far end) when the thrust bearing lets go with the AMBs; "
+                         "default [drop] axial_thrust")
     dr.add_argument("--duration-s", type=_positive, default=0.5,
                     help="time simulated after the AMBs let go (s; default 0.5)")
     dr.add_argument("--coast-down", action="store_true",

@@ -6,8 +6,15 @@ runs the others — and a step force, from the levitated state at the operating 
 AMB loop runs inside the drop (:mod:`ambseal.analysis.drop_loop`: each axis's force
 linearised about the levitated equilibrium, its current reference clipped at its limit,
 a lost axis's force decaying with the square of its coil's current, e^{−2t R/L}), and the
-rotor falls through the clearance onto the rings. Radial contact only:
-``axial_clearance`` is not simulated.
+rotor falls through the clearance onto the rings. Where every axis is lost the thrust
+bearing lets go too: the rotor, rigid along its axis (its axial modes lie far above the
+drop's), moves under the residual thrust (``[drop] axial_thrust``) onto the planes with an
+``axial_clearance``, m z̈ = F_a − Σ sign(z)·N_a(|z| − c_a), N_a the plane's contact law
+(its own K with ``axial_contact_stiffness``) damped as the radial one by the onset's
+axial speed, at least that of a fall through c_a under the thrust or the weight; its
+friction μN_a·tanh(v_s/v_r) at the ring's bore radius R_r against the slip
+(Ω − ω_r)·R_r brakes the spin and spins the ring up. Each plane's friction heat
+∫F_t v_s dt, radial and axial, is kept.
 
 The rotor: the free FE rotor of the rig (:func:`ambseal.model.assemble_rotor`, a node at
 every touchdown plane) in the mass-normalised real modes of its free–free
@@ -55,7 +62,7 @@ at the same point on every machine.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.constants import g as GRAVITY
@@ -169,6 +176,12 @@ class DropModel:
         unbalance acts.
     z_cg : float
         The rotor's centre of mass (m).
+    axial_clearance : ndarray, shape (p,)
+        Per plane: the axial clearance (m) at which it stops the rotor axially, inf where
+        it does not.
+    axial_laws : tuple of ContactLaw or None
+        Per plane: the axial contact's law (the radial one with
+        ``axial_contact_stiffness``), None where it does not stop the rotor axially.
     """
 
     phi: np.ndarray
@@ -195,6 +208,8 @@ class DropModel:
     projector: np.ndarray = field(default=None, repr=False)
     cg_rows: np.ndarray = field(default=None, repr=False)
     z_cg: float = 0.0
+    axial_clearance: np.ndarray = field(default=None, repr=False)
+    axial_laws: tuple = ()
 
 
 def _amb_static_forces(cfg, mass: float, z_g: float) -> np.ndarray:
@@ -293,7 +308,13 @@ def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
         polar_inertia=float(abs(Gr[2, 3])),
         names=tuple(t.name for t in cfg.touchdown), modes_hz=float(modes_hz),
         node_rows=rows, z=np.asarray(mesh.z, float), projector=phi.T @ rotor.M,
-        cg_rows=phi[[4 * g_node, 4 * g_node + 1], :], z_cg=z_g)
+        cg_rows=phi[[4 * g_node, 4 * g_node + 1], :], z_cg=z_g,
+        axial_clearance=np.array([np.inf if t.axial_clearance is None else t.axial_clearance
+                                  for t in cfg.touchdown]),
+        axial_laws=tuple(None if t.axial_clearance is None else
+                         law if t.axial_contact_stiffness is None else
+                         replace(law, stiffness=float(t.axial_contact_stiffness))
+                         for t, law in zip(cfg.touchdown, laws)))
 
 
 def support_matrices(cfg, dm: DropModel, speed_rpm: float,
@@ -405,6 +426,20 @@ class DropResult:
     saturated : ndarray of bool, shape (c,)
         The axes that ran on whose current reference was clipped at i_max at an output
         sample.
+    axial_position : ndarray, shape (k,), or None
+        The rotor's axial displacement (m, +z) where the thrust bearing let go and a plane
+        stops it axially; None where it held.
+    axial_force : ndarray, shape (p, k)
+        Each plane's axial contact force (N).
+    peak_axial_force, peak_axial_penetration : ndarray, shape (p,)
+        Each plane's largest axial force (N) and penetration (m), read as the radial ones.
+    axial_thrust : float
+        The thrust (N) on the rotor once the thrust bearing let go.
+    axial_clearance : ndarray, shape (p,)
+        Each plane's axial clearance (m; nan where it stops nothing axially).
+    friction_heat : ndarray, shape (p, k)
+        The heat (J) each plane's friction made since the drop, radial and axial:
+        ∫ F_t·v_s dt.
     """
 
     t: np.ndarray
@@ -433,6 +468,13 @@ class DropResult:
     amb_current: np.ndarray = field(default=None, repr=False)
     current_limit: np.ndarray = field(default=None, repr=False)
     saturated: np.ndarray = field(default=None, repr=False)
+    axial_position: np.ndarray | None = field(default=None, repr=False)
+    axial_force: np.ndarray = field(default=None, repr=False)
+    peak_axial_force: np.ndarray = field(default=None, repr=False)
+    peak_axial_penetration: np.ndarray = field(default=None, repr=False)
+    axial_thrust: float = 0.0
+    axial_clearance: np.ndarray = field(default=None, repr=False)
+    friction_heat: np.ndarray = field(default=None, repr=False)
 
     def regime(self, p: int) -> tuple[str, float]:
         """The plane's regime over the last half of the drop: ``"no contact"`` (never
@@ -508,13 +550,19 @@ class DropResult:
         deepest penetration, the largest orbit, the regime, whirl frequency and onset
         (:meth:`onset_s`), the ring's spin-up time (:meth:`spin_up_s`) and final speed;
         the largest excursion at each watched plane, the energy the drop dissipated and
-        the work done on the rotor from outside (:attr:`work`), and the coast-down time
-        (:meth:`coast_down_s`)."""
+        the work done on the rotor from outside (:attr:`work`), the coast-down time
+        (:meth:`coast_down_s`); per plane the peak axial force and penetration and the
+        friction heat, and the rotor's largest axial excursion (None where the thrust
+        bearing held)."""
         planes = []
         for p, name in enumerate(self.names):
             regime, hz = self.regime(p)
             planes.append({
                 "name": name, "peak_force_n": json_float(float(self.peak_force[p])),
+                "peak_axial_force_n": json_float(float(self.peak_axial_force[p])),
+                "max_axial_penetration_m": json_float(
+                    float(max(self.peak_axial_penetration[p], 0.0))),
+                "friction_heat_j": json_float(float(self.friction_heat[p, -1])),
                 "first_impact_peak_n": json_float(float(self.first_peak_force[p])),
                 "max_penetration_m": json_float(float(self.peak_penetration[p])),
                 "max_orbit_m": json_float(float(np.hypot(*self.orbit[p].T).max())),
@@ -539,7 +587,10 @@ class DropResult:
                         for name, i, lim, sat in zip(self.channels, self.amb_current,
                                                      self.current_limit, self.saturated)],
                 "coast_down_s": None if stop is None else json_float(stop),
-                "coast_down_extrapolated": extrapolated}
+                "coast_down_extrapolated": extrapolated,
+                "axial_thrust_n": json_float(self.axial_thrust),
+                "max_axial_m": (None if self.axial_position is None else
+                                json_float(float(np.abs(self.axial_position).max())))}
 
 
 def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
@@ -549,7 +600,8 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                   initial: tuple | None = None, unbalance_kgm: float = 0.0,
                   loop: AmbLoop | None = None, loop_state=None, failed=None,
                   overload: tuple | None = None, supports: bool = True,
-                  pressure_bar: float | None = None, progress=None) -> DropResult:
+                  pressure_bar: float | None = None, axial_thrust: float | None = None,
+                  progress=None) -> DropResult:
     """Drop the rotor of ``cfg`` onto its touchdown bearings (module docstring).
 
     Parameters
@@ -606,6 +658,12 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         outside.
     pressure_bar : float, optional
         The pressure drop across the seals (bar); ``[operating] pressure_bar`` if omitted.
+    axial_thrust : float, optional
+        The residual thrust (N, +z towards the rotor's far end) on the rotor once the
+        thrust bearing lets go, with every AMB axis (``failed`` all of them); default
+        ``[drop] axial_thrust``. The rotor then moves axially as a rigid body onto the
+        planes with an ``axial_clearance`` (module docstring); otherwise the thrust bearing
+        holds it.
     progress : callable, optional
         ``progress(t_s)`` after each segment.
 
@@ -619,7 +677,8 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         As :func:`drop_model`; a duration or sample count out of range; an ``initial``
         or ``loop_state`` of the wrong shape or not finite; a negative or non-finite
         unbalance; a ``failed`` channel the rig does not have, or axes left running
-        without a controller; an overload off the rotor or not finite.
+        without a controller; an overload off the rotor or not finite; a thrust not
+        finite.
     """
     if not (duration_s > 0 and math.isfinite(duration_s)):
         raise ConfigError(f"drop: duration: expected > 0 s, got {duration_s!r}")
@@ -641,6 +700,13 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         raise ConfigError(f"drop: failed: {', '.join(unknown)}: expected AMB channels of "
                           f"the rig ({', '.join(names)})")
     down = np.array([n in failed for n in names])
+    thrust = float(cfg.drop.axial_thrust if axial_thrust is None else axial_thrust)
+    if not math.isfinite(thrust):
+        raise ConfigError(f"drop: axial thrust: expected a finite force in N, got "
+                          f"{axial_thrust!r}")
+    stops = [p for p, law in enumerate(dm.axial_laws) if law is not None]
+    # the thrust bearing lets go with the radial axes: the rotor then moves axially
+    axial = bool(stops) and bool(down.all())
     if not down.all() and not loop.has_controller:
         raise ConfigError("drop: the AMB axes that run on need a controller (the loop "
                           "has none)")
@@ -669,11 +735,21 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     # (the coil's, the controller's), the spin and its angle when it coasts, and last the
     # work done on the rotor from outside (J): by the drive holding the spin against the
     # rings' friction, the AMBs' and the seals' forces, the unbalance and the overload
+    # the rotor's axial position and speed where it moves axially, each plane's friction
+    # heat (J)
     i_loop = 2 * m + races.size + 4 * len(sup)
     i_spin = i_loop + n_loop
-    n_y = i_spin + (2 if coast_down else 0) + 1
+    i_ax = i_spin + (2 if coast_down else 0)
+    i_heat = i_ax + (2 if axial else 0)
+    n_y = i_heat + P + 1
     floor = np.sqrt(2 * GRAVITY * dm.clearance)  # the slowest impact the damping takes
     v0 = floor.copy()
+    # axially, a fall through the axial clearance under the thrust (or the weight's
+    # acceleration, if larger)
+    c_ax = dm.axial_clearance if stops else np.full(P, np.inf)
+    floor_ax = np.sqrt(2 * max(abs(thrust) / dm.mass, GRAVITY)
+                       * np.where(np.isfinite(c_ax), c_ax, 0.0))
+    v0_ax = floor_ax.copy()
     ring = dm.journal + dm.clearance
 
     def unpack(y):
@@ -695,7 +771,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         return float(y[i_spin + 1]) if coast_down else W0 * t
 
     def contacts(t, y):
-        """Per plane: relative position, δ, normal force, friction, n, t."""
+        """Per plane: relative position, δ, normal force, friction, n, t, slip speed."""
         eta, deta, wr, s, ds = unpack(y)
         out = []
         for p in range(P):
@@ -704,7 +780,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             d = math.hypot(r[0], r[1])
             delta = d - dm.clearance[p]
             if delta <= 0.0 or d == 0.0:
-                out.append((r, delta, 0.0, 0.0, None, None))
+                out.append((r, delta, 0.0, 0.0, None, None, 0.0))
                 continue
             n = r / d
             tang = np.array([-n[1], n[0]])
@@ -712,7 +788,26 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             slip = float(tang @ v) + spin(y) * dm.journal[p] - wr[p] * ring[p]
             law = dm.laws[p]
             Ft = float(friction_force(law.friction, N, slip, law.friction_velocity))
-            out.append((r, delta, N, Ft, n, tang))
+            out.append((r, delta, N, Ft, n, tang, slip))
+        return out
+
+    def axial_contacts(y, wr):
+        """Per plane in axial contact: (plane, δ_a, normal force, friction, slip speed) of
+        the rotor's shoulder on the ring's face at the ring's bore radius, the slip that
+        of the spin against the ring's."""
+        if not axial:
+            return []
+        z, vz = float(y[i_ax]), float(y[i_ax + 1])
+        out = []
+        for p in stops:
+            delta = abs(z) - c_ax[p]
+            if delta <= 0.0:
+                continue
+            law = dm.axial_laws[p]
+            N = float(law.force(delta, vz if z >= 0 else -vz, v0_ax[p]))  # δ̇ = sign(z)·ż
+            slip = (spin(y) - wr[p]) * ring[p]
+            Ft = float(friction_force(law.friction, N, slip, law.friction_velocity))
+            out.append((p, delta, N, Ft, slip))
         return out
 
     def fade(t):
@@ -768,11 +863,13 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         dy = np.empty_like(y)
         dwr = np.zeros(P)
         dsup = {}
+        heat = np.zeros(P)  # each plane's friction power (W)
         torque = 0.0
-        for p, (r, delta, N, Ft, n, tang) in enumerate(contacts(t, y)):
+        for p, (r, delta, N, Ft, n, tang, slip) in enumerate(contacts(t, y)):
             F = np.zeros(2) if n is None else -N * n - Ft * tang
             f += dm.planes[p].T @ F
             torque -= Ft * dm.journal[p]
+            heat[p] = Ft * slip
             if dm.race_inertia[p] > 0:
                 w_d = dm.laws[p].friction_velocity / ring[p]
                 dwr[p] = (Ft * ring[p] - dm.drag[p] * math.tanh(wr[p] / w_d)) \
@@ -780,6 +877,17 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             if dm.support[p] is not None:
                 ms, ks, cs = dm.support[p]
                 dsup[p] = (-F - ks * s[p] - cs * ds[p]) / ms
+        if axial:  # the rotor as a rigid body along its axis, on the thrust and the faces
+            f_ax = thrust
+            for p, _, N, Ft, slip in axial_contacts(y, wr):
+                f_ax -= math.copysign(N, y[i_ax])
+                torque -= Ft * ring[p]
+                heat[p] += Ft * slip
+                if dm.race_inertia[p] > 0:
+                    dwr[p] += Ft * ring[p] / dm.race_inertia[p]
+            dy[i_ax], dy[i_ax + 1] = y[i_ax + 1], f_ax / dm.mass
+            power += thrust * float(y[i_ax + 1])
+        dy[i_heat:i_heat + P] = heat
         W = spin(y)
         dy[:m] = deta
         acc = f - (dm.C + W * dm.G) @ deta - dm.K @ eta
@@ -817,6 +925,8 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         return f
 
     def events(touching):
+        """Each plane's radial contact onset or end, then each axial stop's (touching:
+        the radial planes' flags, then the stops')."""
         evs = []
         for p in range(P):
             def g(t, y, p=p):
@@ -825,6 +935,12 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                 return math.hypot(r[0], r[1]) - dm.clearance[p]
             g.terminal = True
             g.direction = -1.0 if touching[p] else 1.0
+            evs.append(g)
+        for k, p in enumerate(stops if axial else ()):
+            def g(t, y, p=p):
+                return abs(y[i_ax]) - c_ax[p]
+            g.terminal = True
+            g.direction = -1.0 if touching[P + k] else 1.0
             evs.append(g)
         return evs
 
@@ -866,6 +982,9 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         atol[i_spin] = rtol * (abs(W0) + 1.0)
         atol[i_spin + 1] = rtol
     atol[-1] = rtol * dm.mass * GRAVITY * c_min  # the work: the energy of the fall
+    atol[i_heat:i_heat + P] = atol[-1]
+    if axial:
+        atol[i_ax] = rtol * float(c_ax[stops].min())
     # the loop's states by what they add to a current: of the order of the static
     # currents, the limit or 1 mA, whichever is largest
     i_scale = max(float(np.abs(i_s).max(initial=0.0)),
@@ -876,9 +995,10 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     for k in range(len(sup)):
         atol[2 * m + races.size + 4 * k:2 * m + races.size + 4 * k + 2] = rtol * c_min
     # a start in contact (an ``initial`` state on a ring) waits for the contact's end
-    touching = [c[1] > 0 for c in contacts(0.0, y)]
+    touching = [c[1] > 0 for c in contacts(0.0, y)] + [False] * (len(stops) if axial else 0)
     ts, ys = [0.0], [y.copy()]
     peak_force, peak_delta, first_peak = np.zeros(P), np.zeros(P), np.zeros(P)
+    peak_ax_force, peak_ax_delta = np.zeros(P), np.zeros(P)
     first_over = [False] * P  # each plane's first contact ended
     t0, impacts, segments = 0.0, 0, 0
     integrator = method
@@ -931,6 +1051,14 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             if touching[p] and not first_over[p]:
                 first_peak[p] = max(first_peak[p], float(N.max()))
             peak_delta[p] = max(peak_delta[p], float(delta.max()))
+        for p in stops if axial else ():
+            d_ax = np.abs(Yf[i_ax]) - c_ax[p]
+            law = dm.axial_laws[p]
+            N = normal_force(d_ax, np.sign(Yf[i_ax]) * Yf[i_ax + 1], law.stiffness,
+                             law.exponent, damping_coefficient(law.law, law.restitution,
+                                                               v0_ax[p]))
+            peak_ax_force[p] = max(peak_ax_force[p], float(N.max()))
+            peak_ax_delta[p] = max(peak_ax_delta[p], float(d_ax.max()))
         hit = [k for k, te in enumerate(r.t_events) if te.size]
         if not hit:
             if t_end >= duration_s:
@@ -944,6 +1072,13 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         t0 = float(r.t_events[k][0])
         y = r.y_events[k][0].copy()
         touching[k] = not touching[k]
+        if k >= P:  # an axial stop
+            if touching[k]:
+                impacts += 1
+                v0_ax[stops[k - P]] = max(abs(float(y[i_ax + 1])), floor_ax[stops[k - P]])
+            if progress is not None:
+                progress(t0)
+            continue
         first_over[k] = first_over[k] or not touching[k]
         if touching[k]:
             impacts += 1
@@ -962,10 +1097,11 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     pen = np.zeros((P, t.size))
     race = np.zeros((P, t.size))
     energy = np.zeros(t.size)
+    axial_force = np.zeros((P, t.size))
     for j, yj in enumerate(Y):
         eta, deta, wr, s, ds = unpack(yj)
         e = 0.5 * deta @ deta + 0.5 * eta @ dm.K @ eta - dm.gravity @ eta
-        for p, (rel, delta, N, _, _, _) in enumerate(contacts(t[j], yj)):
+        for p, (rel, delta, N, _, _, _, _) in enumerate(contacts(t[j], yj)):
             orbit[p, j], pen[p, j], force[p, j], race[p, j] = rel, delta, N, wr[p]
             law = dm.laws[p]
             if delta > 0:
@@ -977,6 +1113,12 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                 e += 0.5 * dm.race_inertia[p] * wr[p] ** 2
         if coast_down:  # the spin's energy, which the drive no longer holds
             e += 0.5 * dm.polar_inertia * spin(yj) ** 2
+        if axial:
+            e += 0.5 * dm.mass * yj[i_ax + 1] ** 2
+            for p, delta, N, _, _ in axial_contacts(yj, wr):
+                law = dm.axial_laws[p]
+                e += law.stiffness * delta ** (law.exponent + 1) / (law.exponent + 1)
+                axial_force[p, j] = N
         energy[j] = e
     watched = {k: np.einsum("ij,kj->ki", rows, Y[:, :m]) for k, rows in dm.node_rows.items()}
     if digital:  # the reference each output sample saw: the last update's at or before it
@@ -996,7 +1138,13 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                       journal=dm.journal.copy(), clearance=dm.clearance.copy(),
                       turning=dm.race_inertia > 0, channels=names, failed=failed,
                       amb_current=currents, current_limit=loop.limit.copy(),
-                      saturated=np.array([a[3] for a in at]).any(axis=0))
+                      saturated=np.array([a[3] for a in at]).any(axis=0),
+                      axial_position=Y[:, i_ax].copy() if axial else None,
+                      axial_force=axial_force,
+                      peak_axial_force=np.maximum(peak_ax_force, axial_force.max(axis=1)),
+                      peak_axial_penetration=peak_ax_delta, axial_thrust=thrust,
+                      axial_clearance=np.where(np.isfinite(c_ax), c_ax, np.nan),
+                      friction_heat=Y[:, i_heat:i_heat + P].T.copy())
 
 
 def drop_verdict(cfg, result: DropResult) -> dict:
@@ -1006,8 +1154,14 @@ def drop_verdict(cfg, result: DropResult) -> dict:
     ``[[spring]]`` with a ``clearance`` against it), each touchdown
     bearing's peak force against ``[drop] force_ratio`` × its ``static_rating`` C₀ (with
     the most loaded ball's contact stress that force gives in a rolling bearing,
-    :func:`ambseal.model.rated_contact_stress`: the rig's kinds are ball bearings), and
-    no backward whirl sustained over the last half of the drop.
+    :func:`ambseal.model.rated_contact_stress`: the rig's kinds are ball bearings) — where
+    it also stopped the rotor axially, ISO 76's static equivalent load of the peak radial
+    and axial forces, P₀ = max(F_r, X₀F_r + Y₀F_a) (:attr:`ambseal.config.Touchdown.
+    iso76_factors`; the two peaks combined whether or not they coincide, an upper bound),
+    not graded without X₀, Y₀ —, each ring's temperature rise from the friction heat,
+    all of it taken into the ring (an upper bound: none into the journal, none conducted
+    away), against ``[drop] race_temperature_rise`` where the ring's ``race_mass`` is
+    given, and no backward whirl sustained over the last half of the drop.
 
     Parameters
     ----------
@@ -1040,17 +1194,36 @@ def drop_verdict(cfg, result: DropResult) -> dict:
         row(f"no contact at {key.split(':', 1)[1]} ({what})",
             None if gap is None else worst < gap, f"{1e6 * worst:.4g} µm",
             f"{1e6 * gap:.4g} µm" if gap else f"no {what} given")
-    ratio = cfg.drop.force_ratio
+    ratio, rise_limit = cfg.drop.force_ratio, cfg.drop.race_temperature_rise
     for p, td in enumerate(cfg.touchdown):
-        peak = float(result.peak_force[p])
-        c0 = td.static_rating
+        peak = f_r = float(result.peak_force[p])
+        f_a = float(result.peak_axial_force[p])
+        c0, factors = td.static_rating, td.iso76_factors
+        text = f"{f_r:.4g} N"
+        if f_a > 0:
+            text = f"radial {f_r:.4g} N, axial {f_a:.4g} N"
+            if factors is not None:
+                peak = max(f_r, factors[0] * f_r + factors[1] * f_a)
+                text += f": P₀ = {peak:.4g} N (X₀ {factors[0]:g}, Y₀ {factors[1]:g})"
+        axial_open = f_a > 0 and factors is None
         stress = ""
-        if c0 and td.kind != "sleeve":
+        if c0 and td.kind != "sleeve" and not axial_open:
             stress = (f", {1e-6 * float(rated_contact_stress(peak, c0, 'ball')):.4g} MPa "
                       "at the most loaded ball")
-        row(f"peak force at {td.name}", None if c0 is None else peak <= ratio * c0,
-            f"{peak:.4g} N" + (f" ({peak / c0:.3g} C₀{stress})" if c0 else ""),
-            f"{ratio:g} C₀ = {ratio * c0:.4g} N" if c0 else "no static_rating given")
+        row(f"peak force at {td.name}",
+            None if c0 is None or axial_open else peak <= ratio * c0,
+            text + (f" ({peak / c0:.3g} C₀{stress})" if c0 and not axial_open else ""),
+            (f"no static_factors (X₀, Y₀) for a {td.kind} bearing's axial force"
+             if c0 and axial_open else
+             f"{ratio:g} C₀ = {ratio * c0:.4g} N" if c0 else "no static_rating given"))
+        if td.race_mass is not None:
+            rise = float(result.friction_heat[p, -1]) / (td.race_mass * td.race_specific_heat)
+            row(f"ring temperature rise at {td.name}",
+                None if rise_limit is None else rise <= rise_limit,
+                f"{rise:.3g} K ({float(result.friction_heat[p, -1]):.4g} J of friction heat, "
+                "all into the ring)",
+                f"{rise_limit:g} K" if rise_limit is not None
+                else "no [drop] race_temperature_rise given")
         regime, hz = result.regime(p)
         row(f"no backward whirl at {td.name}", regime != "backward whirl",
             f"{regime}" + (f" at {hz:.3g} Hz" if regime.endswith("whirl") else ""),

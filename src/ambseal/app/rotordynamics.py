@@ -308,6 +308,15 @@ def _drop(args: argparse.Namespace) -> int:
         # the seals' pressure through the drop, the Monte-Carlo runs' too
         cfg = cfg.model_copy(update={"operating": cfg.operating.model_copy(
             update={"pressure_bar": float(args.pressure_bar)})})
+    if args.axial_thrust_n is not None:  # the Monte-Carlo runs' too
+        if args.event != "loss":
+            raise ConfigError(f"--axial-thrust-n: the thrust bearing lets go with every AMB "
+                              f"axis (--event loss); with --event {args.event} it holds")
+        if not abs(args.axial_thrust_n) <= 1e8:
+            raise ConfigError(f"--axial-thrust-n: expected -1e8 to 1e8 N, got "
+                              f"{args.axial_thrust_n:g}")
+        cfg = cfg.model_copy(update={"drop": cfg.drop.model_copy(
+            update={"axial_thrust": float(args.axial_thrust_n)})})
     if args.drag_torque and not args.coast_down:
         raise ConfigError("--drag-torque: slows a coasting rotor; add --coast-down (the "
                           "drive holds the speed otherwise)")

@@ -480,6 +480,14 @@ class Seal(_Strict):
         return self
 
 
+#: ISO 76:2006's static equivalent radial load of a radial ball bearing, P₀ = X₀F_r + Y₀F_a
+#: and not less than F_r (§3.4 defines it), by kind: a single-row deep-groove bearing
+#: (0.6, 0.5), a pair of 40° angular-contact bearings (1, 0.52), as the bearing makers'
+#: catalogues (SKF) state them. A full-complement bearing or a sleeve gives its own
+#: (``static_factors``), or its axial force is not graded.
+STATIC_FACTORS = {"deep_groove": (0.6, 0.5), "angular_contact_pair": (1.0, 0.52)}
+
+
 class Touchdown(_Strict):
     """A touchdown (backup, auxiliary) bearing in one plane: the ring the rotor lands on
     when the AMBs let it go (ISO 14839-5:2022's touch-down bearing). ``radial_clearance``
@@ -493,7 +501,12 @@ class Touchdown(_Strict):
     the ring's ``race_inertia`` (kg·m²) and ``race_drag_torque`` (N·m); the support's
     ``support_stiffness`` (N/m; left out, rigid), ``support_damping`` (N·s/m) and
     ``support_mass`` (kg); the bearing's basic ``static_rating`` C₀ (N, ISO 76) the drop's
-    peak force is graded against. ``restitution`` and ``friction`` have no default: no
+    peak force is graded against, as the static equivalent load of the peak radial and
+    axial forces with ``static_factors`` (X₀, Y₀; ``STATIC_FACTORS``). Where an
+    ``axial_clearance`` (m) is given the bearing also stops the rotor axially, with the
+    radial law's K or ``axial_contact_stiffness``. With ``race_mass`` (kg) the friction
+    heat of the drop is reported as the ring's temperature rise at
+    ``race_specific_heat``. ``restitution`` and ``friction`` have no default: no
     public source gives one for every pair of surfaces."""
 
     name: Name
@@ -523,6 +536,16 @@ class Touchdown(_Strict):
     support_mass: float = Field(default=0.0, ge=0, le=1e5)
     # the basic static load rating C0 (ISO 76) the drop's peak force is graded against
     static_rating: float | None = Field(default=None, gt=0, le=1e9)
+    # the axial contact's K (N/m^n) where an axial_clearance is given; left out, the
+    # radial law's: the same rolling elements carry the axial load
+    axial_contact_stiffness: float | None = Field(default=None, gt=0, le=1e16)
+    # ISO 76's X0, Y0 of the static equivalent load P0 = max(Fr, X0 Fr + Y0 Fa); left
+    # out, by kind (STATIC_FACTORS)
+    static_factors: tuple[float, float] | None = Field(default=None, strict=False)
+    # the ring's mass (kg) and specific heat (J/(kg K)): the drop's friction heat as its
+    # temperature rise; 475 J/(kg K) is through-hardened bearing steel's
+    race_mass: float | None = Field(default=None, gt=0, le=1e4)
+    race_specific_heat: float = Field(default=475.0, gt=0, le=1e5)
 
     @model_validator(mode="after")
     def _stiffness(self) -> "Touchdown":
@@ -544,7 +567,20 @@ class Touchdown(_Strict):
         if self.support_mass > 0 and self.support_stiffness is None:
             raise ValueError("support_mass: a rigid support (no support_stiffness) moves "
                              "no mass; give support_stiffness or leave support_mass out")
+        if self.axial_contact_stiffness is not None and self.axial_clearance is None:
+            raise ValueError("axial_contact_stiffness: the axial contact needs the "
+                             "axial_clearance (m) at which it closes")
+        if self.static_factors is not None and not all(
+                0 <= f <= 10 for f in self.static_factors):
+            raise ValueError("static_factors: expected [X0, Y0] of ISO 76, each 0 to 10")
         return self
+
+    @property
+    def iso76_factors(self) -> tuple[float, float] | None:
+        """ISO 76's (X₀, Y₀): ``static_factors``, else ``STATIC_FACTORS`` by
+        ``kind``; None where neither gives them."""
+        given = self.static_factors
+        return tuple(given) if given is not None else STATIC_FACTORS.get(self.kind)
 
 
 class SpringHousing(_Strict):
@@ -664,9 +700,17 @@ class DropLimits(_Strict):
     """The rotor drop's pass criteria that no public text fixes, as settings
     (:func:`ambseal.analysis.drop.drop_verdict`): the largest ``force_ratio`` of a
     touchdown bearing's peak force to its ``static_rating`` C₀ (default 1: C₀ is the load
-    ISO 76 lets a rolling bearing carry at rest without harmful permanent deformation)."""
+    ISO 76 lets a rolling bearing carry at rest without harmful permanent deformation);
+    the largest ``race_temperature_rise`` (K) of a ring with a ``race_mass`` (no default:
+    the ring's steel and its ambient decide it; not graded without it); and the
+    ``axial_thrust`` (N) the thrust bearing carries until the AMBs let go (default 0)."""
 
     force_ratio: float = Field(default=1.0, gt=0, le=100.0)
+    # the residual thrust (N, +z towards the rotor's far end) the thrust bearing carries
+    # at the drop: on the rotor when it lets go
+    axial_thrust: float = Field(default=0.0, ge=-1e8, le=1e8)
+    # the largest temperature rise (K) of a touchdown ring from the drop's friction heat
+    race_temperature_rise: float | None = Field(default=None, gt=0, le=1e4)
 
 
 class Signoff(_Strict):

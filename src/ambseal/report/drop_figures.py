@@ -31,7 +31,8 @@ def _plane_title(result, p: int) -> str:
 def drop_figure(path: str | os.PathLike, result, clearances_m, *,
                 title: str = "Rotor drop") -> Path:
     """Per touchdown plane its orbit (µm) inside the clearance circle, and the normal
-    contact force (kN) of every plane against time (ms).
+    contact force (kN) of every plane against time (ms), its axial force dashed where it
+    stopped the rotor axially.
 
     Parameters
     ----------
@@ -68,7 +69,10 @@ def drop_figure(path: str | os.PathLike, result, clearances_m, *,
         ax.grid(alpha=0.3)
     ax = axes[-1]
     for p, name in enumerate(result.names):
-        ax.plot(1e3 * result.t, 1e-3 * result.force[p], lw=0.8, label=name)
+        line, = ax.plot(1e3 * result.t, 1e-3 * result.force[p], lw=0.8, label=name)
+        if result.axial_position is not None and result.axial_force[p].any():
+            ax.plot(1e3 * result.t, 1e-3 * result.axial_force[p], lw=0.8, ls="--",
+                    color=line.get_color(), label=f"{name} axial")
     ax.set_xlabel("time after the event (ms)")
     ax.set_ylabel("contact force (kN)")
     ax.grid(alpha=0.3)

@@ -65,6 +65,7 @@ def write_drop_report(path: str | os.PathLike, doc: dict, figures, *, title: str
             f'<td style="background:{colour[c["outcome"]]};text-align:center">'
             f'{html.escape(c["outcome"])}</td>{_cell(c["value"])}{_cell(c["limit"])}</tr>'
             for c in doc["criteria"]]
+    axial = doc.get("max_axial_m") is not None  # the thrust bearing let go
     planes = []
     for p in doc["planes"]:
         c = p.get("radial_clearance_m")
@@ -77,7 +78,9 @@ def write_drop_report(path: str | os.PathLike, doc: dict, figures, *, title: str
             + _cell(orbit) + _cell(p["regime"], text=True) + _cell(_num(p["whirl_hz"]))
             + _cell(_num(p["whirl_onset_s"], 1e3)) + _cell(_num(p["race_spin_up_s"], 1e3))
             + _cell(_num(p["final_race_speed_rad_s"], 60 / (2 * math.pi), ".5g"))
-            + "</tr>")
+            + (_cell(_num(p["peak_axial_force_n"]))
+               + _cell(_num(p["max_axial_penetration_m"], 1e6)) if axial else "")
+            + _cell(_num(p["friction_heat_j"])) + "</tr>")
     watched = [f'<tr><td class="text">{html.escape(k)}</td>{_cell(_num(v, 1e6))}</tr>'
                for k, v in doc["watched_max_m"].items()]
     stop = doc.get("coast_down_s")
@@ -103,7 +106,9 @@ def write_drop_report(path: str | os.PathLike, doc: dict, figures, *, title: str
         {"title": "Touchdown bearings", "html": _table(
             ["plane", "peak force (N)", "max penetration (µm)", "max orbit (µm)",
              "regime", "whirl (Hz)", "whirl onset (ms)", "ring spin-up (ms)",
-             "ring speed at the end (rpm)"], planes)},
+             "ring speed at the end (rpm)",
+             *(("peak axial force (N)", "max axial penetration (µm)") if axial else ()),
+             "friction heat (J)"], planes)},
         {"title": "Largest excursion at the AMBs and seals",
          "html": _table(["plane", "excursion (µm)"], watched)},
         {"title": "Energy and speed",
@@ -115,7 +120,10 @@ def write_drop_report(path: str | os.PathLike, doc: dict, figures, *, title: str
                  f"the rotor); the rotor's spin from "
                  f"{doc['speed_rad_s'] * 60 / (2 * math.pi):.6g} rpm, "
                  f"standstill: {stop_text}; {doc['n_modes']} free–free modes up to "
-                 f"{doc['modes_hz']:.4g} Hz."},
+                 f"{doc['modes_hz']:.4g} Hz"
+                 + (f"; the thrust bearing let go under {doc['axial_thrust_n']:.4g} N of "
+                    f"thrust, the rotor moving up to {1e6 * doc['max_axial_m']:.4g} µm "
+                    "axially" if axial else "") + "."},
         *({"title": caption, "figure": png} for caption, png in figures),
     ]
     return write_report(path, title=title, meta=meta, sections=sections)

@@ -178,8 +178,8 @@ def test_the_events_from_the_command_line(tmp_path, capsys):
     both AMBs alike, the first), lands its end, the other AMB taking up more of the
     weight; ``--event overload`` beyond the AMBs' capacity (each holds
     Ki·i_max = 500 N) lands both ends and says the currents saturated, one within it
-    does not land (5 N on the reference PID's 1e5 N/m); arguments of another event, and
-    events with --runs, are refused."""
+    does not land (5 N on the reference PID's 1e5 N/m); arguments of another event, a
+    controller for Monte-Carlo drops and a bad event with --runs are refused."""
     rig = tmp_path / "rig.toml"
     rig.write_text(_rig_text())
 
@@ -207,7 +207,10 @@ def test_the_events_from_the_command_line(tmp_path, capsys):
                      (["--event", "overload"], "--overload-n: expected the step force"),
                      (["--event", "overload", "--overload-n", "1", "--overload-at", "X"],
                       "--overload-at: expected a seal, AMB"),
-                     (["--event", "one-axis", "--runs", "2"], "--runs: Monte-Carlo drops")):
+                     (["--runs", "2", "--controller", "pid"],
+                      "--controller: Monte-Carlo drops run the reference PID"),
+                     (["--event", "overload", "--runs", "2"],
+                      "--overload-n: expected the step force")):
         assert main(["--quiet", "drop", str(rig), "--out", str(tmp_path / "x"), *bad]) == 2
         err = capsys.readouterr().err
         assert why in err and "Traceback" not in err
@@ -317,3 +320,26 @@ def test_the_thrust_drives_the_rotor_onto_its_axial_stop(tmp_path, capsys):
                  "--out", str(tmp_path / "x"), "--axial-thrust-n", "100"])
     err = capsys.readouterr().err
     assert code == 2 and "--axial-thrust-n" in err and "Traceback" not in err
+
+
+def test_monte_carlo_drops_of_an_event(tmp_path, capsys):
+    """``--runs`` with ``--event overload``: every run is the overload beyond the AMBs'
+    capacity from the reference PID's orbit (both ends land in each, whatever its
+    friction), one within it lands neither, ``--event one-axis`` lands A's end (B's end, the rotor tilting about B's
+    running axis, may touch its ring too); the JSON names the event."""
+    rig = tmp_path / "rig.toml"
+    rig.write_text(_rig_text())
+    for k, (extra, landed) in enumerate((
+            (["--event", "overload", "--overload-n", "1500"], {"TA": True, "TB": True}),
+            (["--event", "overload", "--overload-n", "5"], {"TA": False, "TB": False}),
+            (["--event", "one-axis"], {"TA": True}))):
+        code = main(["--quiet", "drop", str(rig), "--duration-s", "0.03", "--speed-rpm", "0",
+                     "--runs", "2", "--seed", "3", "--friction", "0.05:0.3", "--workers",
+                     "1", "--json", "--out", str(tmp_path / str(k)), *extra])
+        doc = json.loads(capsys.readouterr().out)
+        assert code in (0, 1) and doc["event"] == extra[1] and doc["n"] == 2
+        rows = (tmp_path / str(k) / "drop_scatter.csv").read_text().splitlines()
+        head = rows[0].split(",")
+        for row in rows[1:]:
+            cells = dict(zip(head, row.split(",")))
+            assert {p: float(cells[f"{p}_peak_force_n"]) > 0 for p in landed} == landed

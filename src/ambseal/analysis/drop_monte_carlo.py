@@ -26,7 +26,7 @@ import numpy as np
 from ambseal.analysis.cases import CaseError, run_cases
 from ambseal.analysis.drop import drop_model, drop_verdict, simulate_drop
 from ambseal.analysis.drop_levitated import levitated_state
-from ambseal.analysis.drop_loop import amb_loop
+from ambseal.analysis.drop_loop import amb_loop, drop_event
 from ambseal.config import parse_rig
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
@@ -77,9 +77,11 @@ def _range(name: str, value) -> tuple[float, float] | None:
 
 
 def drop_run(case: dict, rig: dict, speed_rpm: float, duration_s: float, modes_hz: float,
-             coast_down: bool, drag_torque: float, start: str = "levitated") -> dict:
+             coast_down: bool, drag_torque: float, start: str = "levitated",
+             event: dict | None = None) -> dict:
     """One Monte-Carlo drop (module docstring): the rig with the case's friction,
-    clearance and support damping per touchdown bearing, dropped with its unbalance.
+    clearance and support damping per touchdown bearing, dropped with its unbalance by
+    the event.
 
     Parameters
     ----------
@@ -91,8 +93,13 @@ def drop_run(case: dict, rig: dict, speed_rpm: float, duration_s: float, modes_h
     speed_rpm, duration_s, modes_hz, coast_down, drag_torque
         As :func:`~ambseal.analysis.drop.simulate_drop`.
     start : {"levitated", "rest"}
-        With an unbalance, the drop starts from the reference PID loop's unbalance orbit
+        With an unbalance, or an event that leaves the loop running, the drop starts from
+        the reference PID loop's orbit
         (:func:`~ambseal.analysis.drop_levitated.levitated_state`) or at rest.
+    event : dict, optional
+        The keywords of :func:`~ambseal.analysis.drop_loop.drop_event` (``event``,
+        ``axis``, ``overload_n``, ``overload_at``, ``surge_bar``); default every axis
+        lost. The axes that run on run the reference PID.
 
     Returns
     -------
@@ -109,14 +116,21 @@ def drop_run(case: dict, rig: dict, speed_rpm: float, duration_s: float, modes_h
     cfg = cfg.model_copy(update={"touchdown": tds})
     dm = drop_model(cfg, modes_hz)
     u = case["unbalance_kgm"]
-    initial = loop = x0 = None
-    if start == "levitated" and u:  # the orbit and the currents the coils carry at the drop
-        loop = amb_loop(cfg, dm, speed_rpm)
+    initial = x0 = None
+    loop = amb_loop(cfg, dm, speed_rpm)
+    what = drop_event(cfg, dm, loop, **(event or {}))
+    running = what["failed"] != loop.names
+    # the orbit and the currents the coils carry at the drop, as ``ambseal drop`` starts
+    if start == "levitated" and (u or running):
         eta, deta, x0 = levitated_state(cfg, dm, speed_rpm, u, loop=loop)
         initial = (dm.phi @ eta, dm.phi @ deta)
+    # every axis lost from rest: the loop without a controller, as simulate_drop takes it
+    keep = initial is not None or running
     res = simulate_drop(cfg, speed_rpm=speed_rpm, duration_s=duration_s, samples=2001,
                         model=dm, coast_down=coast_down, drag_torque=drag_torque,
-                        unbalance_kgm=u, initial=initial, loop=loop, loop_state=x0)
+                        unbalance_kgm=u, initial=initial, loop=loop if keep else None,
+                        loop_state=x0, failed=what["failed"] if running else None,
+                        overload=what["overload"], pressure_bar=what["pressure_bar"])
     judged = drop_verdict(cfg, res)
     row = {"run": case["run"], "passed": judged["passed"],
            "failed": "; ".join(c["name"] for c in judged["criteria"]
@@ -141,7 +155,8 @@ def drop_scatter(cfg, runs: int, *, seed: int, friction=None, clearance_tol_m=No
                  support_damping=None, unbalance_kgm=None, speed_rpm: float = 0.0,
                  duration_s: float = 0.5, modes_hz: float | None = None,
                  coast_down: bool = False, drag_torque: float = 0.0,
-                 start: str = "levitated", workers: int | None = None, scheduler: str | None = None,
+                 start: str = "levitated", event: dict | None = None,
+                 workers: int | None = None, scheduler: str | None = None,
                  progress: bool = False) -> dict:
     """Monte-Carlo drops of a rig (module docstring).
 
@@ -174,6 +189,8 @@ def drop_scatter(cfg, runs: int, *, seed: int, friction=None, clearance_tol_m=No
         The torque against the spin when it coasts (N·m).
     start : {"levitated", "rest"}, optional
         As :func:`drop_run`.
+    event : dict, optional
+        As :func:`drop_run`: the event of every run, checked on the nominal rig first.
     workers : int, optional
         Local Dask worker processes (:func:`ambseal.analysis.cases.run_cases`).
     scheduler : str, optional
@@ -205,6 +222,8 @@ def drop_scatter(cfg, runs: int, *, seed: int, friction=None, clearance_tol_m=No
                                                ("support damping", support_damping),
                                                ("unbalance", unbalance_kgm)))
     base = drop_model(cfg, modes_hz)
+    # a bad event is refused once, here, not in every run
+    drop_event(cfg, base, amb_loop(cfg, base, speed_rpm), **(event or {}))
     c0 = np.array([t.radial_clearance for t in cfg.touchdown])
     tol = 0.0 if clearance_tol_m is None else float(clearance_tol_m)
     if not (math.isfinite(tol) and 0 <= tol < c0.min()):
@@ -224,7 +243,7 @@ def drop_scatter(cfg, runs: int, *, seed: int, friction=None, clearance_tol_m=No
     shared = {"rig": cfg.model_dump(), "speed_rpm": float(speed_rpm),
               "duration_s": float(duration_s), "modes_hz": base.modes_hz,
               "coast_down": bool(coast_down), "drag_torque": float(drag_torque),
-              "start": start}
+              "start": start, "event": dict(event or {})}
     out = run_cases(drop_run, cases, shared=shared, workers=workers, scheduler=scheduler,
                     progress=progress, description="drops")
     rows = [{"run": r.case["run"], "error": r.error} if isinstance(r, CaseError) else r

@@ -321,13 +321,9 @@ def _drop(args: argparse.Namespace) -> int:
         raise ConfigError("--drag-torque: slows a coasting rotor; add --coast-down (the "
                           "drive holds the speed otherwise)")
     if args.runs is not None:
-        given = [f"--{n.replace('_', '-')}" for n in ("axis", "overload_n", "overload_at",
-                                                       "surge_bar", "controller")
-                 if getattr(args, n) is not None]
-        if args.event != "loss" or given:
-            raise ConfigError(f"--runs: Monte-Carlo drops are of --event loss from the "
-                              f"reference PID's orbit; drop without --runs for "
-                              f"{', '.join(given) or '--event ' + args.event}")
+        if args.controller is not None:
+            raise ConfigError("--controller: Monte-Carlo drops run the reference PID; drop "
+                              "without --runs for another controller")
         return _drop_scatter(args, cfg, rpm)
     for name in ("friction", "clearance_tol_um", "support_damping", "workers", "scheduler"):
         if getattr(args, name) is not None:
@@ -412,10 +408,13 @@ def _drop_scatter(args: argparse.Namespace, cfg, rpm: float) -> int:
                        duration_s=args.duration_s, modes_hz=args.modes_hz,
                        coast_down=args.coast_down, drag_torque=args.drag_torque,
                        start=args.start, workers=args.workers, scheduler=args.scheduler,
+                       event={"event": args.event, "axis": args.axis,
+                              "overload_n": args.overload_n,
+                              "overload_at": args.overload_at, "surge_bar": args.surge_bar},
                        progress=True)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    doc = {"rig": str(args.rig), "speed_rpm": rpm, **doc}
+    doc = {"rig": str(args.rig), "speed_rpm": rpm, "event": args.event, **doc}
     files = [*write_table(out / "drop_scatter.csv", doc["runs"]),
              write_json(out / "drop_scatter.json", doc)]
     failed = doc["failed"]["count"]

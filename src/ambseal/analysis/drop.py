@@ -70,6 +70,7 @@ from scipy.integrate import solve_ivp
 from scipy.linalg import eigh
 
 from ambseal.analysis.drop_loop import AmbLoop, amb_loop
+from ambseal.analysis.judge import seal_static_load
 from ambseal.design import air_gaps
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
@@ -92,7 +93,8 @@ class _Crawling(Exception):
 
 
 __all__ = ["GRAVITY", "DropModel", "DropResult", "drop_model", "simulate_drop",
-           "journal_radius", "drop_verdict", "support_matrices"]
+           "journal_radius", "drop_verdict", "support_matrices", "seal_offset",
+           "seal_offset_forces"]
 
 #: the modes kept reach this many times the contact's own frequency 1/t_c
 MODES_PER_CONTACT = 4.0
@@ -150,8 +152,10 @@ class DropModel:
         0: it stands still), drag torque (N·m).
     support : tuple of (float, float, float) or None
         Per plane: the support's mass, stiffness and damping, None where rigid.
-    amb_force : ndarray, shape (a,)
-        Each AMB's static force (N, +y) in the levitated equilibrium.
+    amb_force : ndarray, shape (a, 2)
+        Each AMB's static force (N, x and y) in the levitated equilibrium: the weight and
+        the offset seals' static loads at the operating pressure drop
+        (:func:`seal_offset_forces`).
     q0 : ndarray, shape (m,)
         The levitated equilibrium (the bending under gravity and the AMBs' forces).
     mass : float
@@ -212,17 +216,39 @@ class DropModel:
     axial_laws: tuple = ()
 
 
-def _amb_static_forces(cfg, mass: float, z_g: float) -> np.ndarray:
-    """The AMBs' upward forces (N) that hold the rotor's weight: net force and moment
-    (the least-norm split beyond two AMBs)."""
+def seal_offset(seal) -> np.ndarray:
+    """The rotor's static offset (m, x/y) from a seal's centre in the drop: its
+    ``static_eccentricity`` taken downward, the rotor low in the seal — the direction
+    in which the rotor falls closest to the seal's wall (the judgement's static currents
+    take the worst direction instead, :func:`ambseal.analysis.judge.static_currents`)."""
+    return np.array([0.0, -float(seal.static_eccentricity)])
+
+
+def seal_offset_forces(cfg, pressure_bar: float) -> list[tuple[float, np.ndarray]]:
+    """Each offset seal's position (m) and static force on the rotor (N, x/y) at the
+    pressure drop: −[[K, k], [−k, K]]·e at zero frequency
+    (:func:`ambseal.analysis.judge.seal_static_load`), e its :func:`seal_offset`."""
+    return [(s.position, seal_static_load(s, pressure_bar)[0] @ seal_offset(s))
+            for s in cfg.seal if s.static_eccentricity > 0]
+
+
+def _amb_static_forces(cfg, mass: float, z_g: float, loads=()) -> np.ndarray:
+    """The AMBs' forces (N, shape (a, 2): x, y) that hold the rotor's weight and the
+    static ``loads`` ((z, F_xy) pairs): net force and moment in each direction (the
+    least-norm split beyond two AMBs)."""
     z = np.array([a.position for a in cfg.amb], float)
     A = np.vstack([np.ones_like(z), z])
-    b = mass * GRAVITY * np.array([1.0, z_g])
-    f, *_ = np.linalg.lstsq(A, b, rcond=None)
-    if not np.allclose(A @ f, b, rtol=1e-9, atol=1e-9 * abs(b).max()):
-        raise ConfigError("drop: the AMBs cannot hold the rotor's weight (one AMB away "
-                          "from the centre of mass)")
-    return f
+    out = np.zeros((z.size, 2))
+    for j in range(2):
+        b = np.array([mass * GRAVITY * (j == 1), mass * GRAVITY * z_g * (j == 1)])
+        for zs, F in loads:
+            b -= F[j] * np.array([1.0, zs])
+        f, *_ = np.linalg.lstsq(A, b, rcond=None)
+        if not np.allclose(A @ f, b, rtol=1e-9, atol=1e-9 * max(abs(b).max(), 1e-300)):
+            raise ConfigError("drop: the AMBs cannot hold the rotor's weight and the seals' "
+                              "static loads (one AMB away from the centre of mass)")
+        out[:, j] = f
+    return out
 
 
 def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
@@ -282,11 +308,14 @@ def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
     t_y = np.zeros(mesh.n_dof)
     t_y[1::4] = 1.0
     gravity = -GRAVITY * phi.T @ (rotor.M @ t_y)
-    amb_rows = np.array([xy(a.position)[1] for a in cfg.amb])
-    amb_force = _amb_static_forces(cfg, mass, z_g)
+    offsets = seal_offset_forces(cfg, cfg.operating.pressure_bar)
+    amb_force = _amb_static_forces(cfg, mass, z_g, offsets)
     Km = phi.T @ rotor.K @ phi
-    # levitated: the flexible modes bent by gravity and the AMBs (the rigid ones balanced)
-    load = gravity + amb_rows.T @ amb_force
+    # levitated: the flexible modes bent by gravity, the AMBs and the offset seals (the
+    # rigid ones balanced)
+    load = gravity + sum((xy(a.position).T @ f for a, f in zip(cfg.amb, amb_force)),
+                         np.zeros(phi.shape[1]))
+    load = load + sum((xy(zs).T @ F for zs, F in offsets), np.zeros(phi.shape[1]))
     q0 = np.zeros(phi.shape[1])
     flex = f > 0
     q0[flex] = np.linalg.solve(Km[np.ix_(flex, flex)], load[flex])
@@ -729,6 +758,12 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     if sealed:
         K_s, C_s, M_s = support_matrices(cfg, dm, speed_rpm, pressure_bar)
         M_inv = np.linalg.inv(np.eye(m) + M_s)
+        # the offset seals' static loads at the drop's pressure (the AMBs held them at the
+        # operating one): on the rotor as the overload is, their work from outside
+        for zs, F in seal_offset_forces(cfg, cfg.operating.pressure_bar
+                                        if pressure_bar is None else pressure_bar):
+            n_s = int(np.argmin(np.abs(dm.z - zs)))
+            f_over = f_over + dm.phi[[4 * n_s, 4 * n_s + 1], :].T @ F
     races = np.flatnonzero(dm.race_inertia > 0)
     sup = [p for p in range(P) if dm.support[p] is not None]
     # the states: modes and their rates, the turning rings, the supports, the AMB loop's
@@ -1120,7 +1155,10 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                 e += law.stiffness * delta ** (law.exponent + 1) / (law.exponent + 1)
                 axial_force[p, j] = N
         energy[j] = e
-    watched = {k: np.einsum("ij,kj->ki", rows, Y[:, :m]) for k, rows in dm.node_rows.items()}
+    # a seal's excursion from its own centre: the rotor sits its offset from it
+    centre = {f"seal:{s.name}": seal_offset(s) for s in cfg.seal}
+    watched = {k: np.einsum("ij,kj->ki", rows, Y[:, :m]) + centre.get(k, 0.0)
+               for k, rows in dm.node_rows.items()}
     if digital:  # the reference each output sample saw: the last update's at or before it
         last = np.searchsorted([h[0] for h in held], t, side="right") - 1
         at = [amb(tj, yj, held[j][1:]) for tj, yj, j in zip(t, Y, last)]

@@ -190,8 +190,8 @@ def amb_loop(cfg, dm, speed_rpm: float | None = None, controller=None) -> AmbLoo
     ks = np.array([k for el in els for k in el.ks], float)
     axis = np.vstack([col / k for el in els for col, k in zip(el.input_columns(n_dof), el.ki)])
     sensor = np.vstack([r for el in els for r in el.sensor_rows(n_dof)])
-    # the static force of AMB a is +y: along axis r_j its component r_j·ŷ
-    static = np.array([el.R[j, 1] * f for el, f in zip(els, dm.amb_force) for j in range(2)])
+    # the static force of AMB a (x, y): along axis r_j its component r_j·f
+    static = np.array([el.R[j] @ f for el, f in zip(els, dm.amb_force) for j in range(2)])
     limit = []
     for a, i0 in zip(cfg.amb, bias_currents(cfg)):
         given = [x for x in (a.current_limit, i0) if x]

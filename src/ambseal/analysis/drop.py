@@ -94,7 +94,7 @@ class _Crawling(Exception):
 
 __all__ = ["GRAVITY", "DropModel", "DropResult", "drop_model", "simulate_drop",
            "journal_radius", "drop_verdict", "support_matrices", "seal_offset",
-           "seal_offset_forces"]
+           "seal_offset_forces", "housings"]
 
 #: the modes kept reach this many times the contact's own frequency 1/t_c
 MODES_PER_CONTACT = 4.0
@@ -354,7 +354,10 @@ def support_matrices(cfg, dm: DropModel, speed_rpm: float,
     (a coupling, P4 Eq. 4; a plain bearing, a balance piston) on the node's displacement s
     from the levitated equilibrium, at the pressure drop and, for tabulated coefficients,
     the synchronous frequency of ``speed_rpm`` (as :func:`ambseal.model.build_plant`
-    takes them), held through the drop.
+    takes them), held through the drop. A spring on a ``housing`` joins its node to the
+    housing's mass, held to ground by its own springs and dampers (ROSS's bearing on a
+    pedestal): the housings' x, y follow the modes, in the rig's order, as further
+    coordinates of these matrices (their mass in M).
 
     Parameters
     ----------
@@ -369,28 +372,34 @@ def support_matrices(cfg, dm: DropModel, speed_rpm: float,
 
     Returns
     -------
-    K, C, M : ndarray, shape (m, m)
-        Φᵀ K Φ, Φᵀ C Φ, Φᵀ M Φ of the seals and springs (zero without them).
-
-    Raises
-    ------
-    ConfigError
-        A spring on a housing (its own degrees of freedom are not in the drop's modes).
+    K, C, M : ndarray, shape (m + 2h, m + 2h)
+        Tᵀ K T, Tᵀ C T, Tᵀ M T of the seals and springs (zero without them) on the modes
+        and the h housings' x, y, T = diag(Φ, I).
     """
     p = cfg.operating.pressure_bar if pressure_bar is None else pressure_bar
     f = abs(speed_rpm) / 60.0
     mesh = build_mesh(cfg, extra_positions=tuple(t.position for t in cfg.touchdown))
-    n = mesh.n_dof
+    nh = 2 * housings(cfg)
+    n = mesh.n_dof + nh
     K, C, M = (np.zeros((n, n)) for _ in range(3))
     for seal in cfg.seal:
         SealElement.from_config(seal, mesh, p, f).assemble(M, C, K)
+    dof = mesh.n_dof  # each housing's x, y after the shaft's, in order
     for i, spring in enumerate(cfg.spring):
-        if spring.housing is not None:
-            raise ConfigError(f"spring[{i}].housing: the drop holds a spring to ground; "
-                              "one on a housing is not simulated")
-        SpringElement.from_config(spring, mesh, i, None, f).assemble(M, C, K)
-    phi = dm.phi
-    return phi.T @ K @ phi, phi.T @ C @ phi, phi.T @ M @ phi
+        SpringElement.from_config(spring, mesh, i, None if spring.housing is None else dof,
+                                  f).assemble(M, C, K)
+        dof += 0 if spring.housing is None else 2
+    m = dm.phi.shape[1]
+    T = np.zeros((n, m + nh))
+    T[:mesh.n_dof, :m] = dm.phi
+    T[mesh.n_dof:, m:] = np.eye(nh)
+    return T.T @ K @ T, T.T @ C @ T, T.T @ M @ T
+
+
+def housings(cfg) -> int:
+    """The ``[[spring]]`` housings of a rig: each two coordinates (x, y) of the drop after
+    the modes (:func:`support_matrices`)."""
+    return sum(s.housing is not None for s in cfg.spring)
 
 
 @dataclass(frozen=True)
@@ -755,9 +764,11 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     na, n_loop = Aa.shape[0], loop.n_states
     i_s = loop.static / loop.ki
     sealed = bool(supports and (cfg.seal or cfg.spring))
+    nh = 2 * housings(cfg) if sealed else 0
     if sealed:
         K_s, C_s, M_s = support_matrices(cfg, dm, speed_rpm, pressure_bar)
-        M_inv = np.linalg.inv(np.eye(m) + M_s)
+        # the modes' unit mass and the housings' own (in M_s)
+        M_inv = np.linalg.inv(np.diag(np.r_[np.ones(m), np.zeros(nh)]) + M_s)
         # the offset seals' static loads at the drop's pressure (the AMBs held them at the
         # operating one): on the rotor as the overload is, their work from outside
         for zs, F in seal_offset_forces(cfg, cfg.operating.pressure_bar
@@ -776,7 +787,8 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     i_spin = i_loop + n_loop
     i_ax = i_spin + (2 if coast_down else 0)
     i_heat = i_ax + (2 if axial else 0)
-    n_y = i_heat + P + 1
+    i_house = i_heat + P  # the housings' x, y, then their rates
+    n_y = i_house + 2 * nh + 1
     floor = np.sqrt(2 * GRAVITY * dm.clearance)  # the slowest impact the damping takes
     v0 = floor.copy()
     # axially, a fall through the axial clearance under the thrust (or the weight's
@@ -927,9 +939,12 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         dy[:m] = deta
         acc = f - (dm.C + W * dm.G) @ deta - dm.K @ eta
         if sealed:  # (I + M_s) η̈ = the rest − K_s Δη − C_s η̇: the seals' force as work
-            pushed = -K_s @ (eta - dm.q0) - C_s @ deta
-            acc = M_inv @ (acc + pushed)
-            power += float((pushed - M_s @ acc) @ deta)
+            h, dh = y[i_house:i_house + nh], y[i_house + nh:i_house + 2 * nh]
+            pushed = -K_s @ np.r_[eta - dm.q0, h] - C_s @ np.r_[deta, dh]
+            both = M_inv @ (np.r_[acc, np.zeros(nh)] + pushed)
+            acc = both[:m]
+            power += float((pushed[:m] - M_s[:m] @ both) @ deta)
+            dy[i_house:i_house + nh], dy[i_house + nh:i_house + 2 * nh] = dh, both[m:]
         dy[m:2 * m] = acc
         if coast_down:
             dy[i_spin] = (torque - drag_torque * math.tanh(W / 0.1)) / dm.polar_inertia
@@ -1018,6 +1033,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         atol[i_spin + 1] = rtol
     atol[-1] = rtol * dm.mass * GRAVITY * c_min  # the work: the energy of the fall
     atol[i_heat:i_heat + P] = atol[-1]
+    atol[i_house:i_house + nh] = rtol * c_min
     if axial:
         atol[i_ax] = rtol * float(c_ax[stops].min())
     # the loop's states by what they add to a current: of the order of the static
@@ -1159,6 +1175,13 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     centre = {f"seal:{s.name}": seal_offset(s) for s in cfg.seal}
     watched = {k: np.einsum("ij,kj->ki", rows, Y[:, :m]) + centre.get(k, 0.0)
                for k, rows in dm.node_rows.items()}
+    j = 0  # a spring on a housing: its clearance is to the housing, which moves
+    for i, spr in enumerate(cfg.spring if nh else ()):
+        if spr.housing is not None:
+            key = f"spring:{spring_label(spr, i)}"
+            if key in watched:
+                watched[key] = watched[key] - Y[:, i_house + j:i_house + j + 2]
+            j += 2
     if digital:  # the reference each output sample saw: the last update's at or before it
         last = np.searchsorted([h[0] for h in held], t, side="right") - 1
         at = [amb(tj, yj, held[j][1:]) for tj, yj, j in zip(t, Y, last)]

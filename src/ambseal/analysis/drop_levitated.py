@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg import eigvals, expm
 
-from ambseal.analysis.drop import support_matrices
+from ambseal.analysis.drop import housings, support_matrices
 from ambseal.analysis.drop_loop import amb_loop
 from ambseal.errors import ConfigError
 from ambseal.lti import feedback_matrices
@@ -63,8 +63,8 @@ def levitated_loop(cfg, dm, speed_rpm: float, controller=None, loop=None, suppor
     -------
     A : ndarray, shape (n, n)
         The closed loop's state matrix; its first 2m states are the modes and their
-        rates, the rest the loop's (:attr:`AmbLoop.n_states`: the coil's, the
-        controller's).
+        rates, then the springs' housings' x, y and their rates (2·2h), the rest the
+        loop's (:attr:`AmbLoop.n_states`: the coil's, the controller's).
     B_u : ndarray, shape (n, 2)
         The input of a force (N) at the node nearest the centre of mass, x and y.
     """
@@ -77,23 +77,38 @@ def levitated_loop(cfg, dm, speed_rpm: float, controller=None, loop=None, suppor
 def _open_loop(cfg, dm, speed_rpm: float, L, supports: bool, pressure_bar):
     """The rotor with its seals and springs, −Ks and the coil, current references →
     sensors: (A, B, C, D), the states the modes' deviation from the levitated equilibrium,
-    their rates and the coil's; and the input of a force (N) at the centre of mass."""
+    their rates, the springs' housings' x, y and their rates
+    (:func:`ambseal.analysis.drop.support_matrices`) and the coil's; and the input of a
+    force (N) at the centre of mass."""
     W = 2 * np.pi * speed_rpm / 60.0
     m = dm.phi.shape[1]
+    nh = 2 * housings(cfg) if supports else 0
+    n = m + nh
     K_s, C_s, M_s = (support_matrices(cfg, dm, speed_rpm, pressure_bar) if supports
                      else (np.zeros((m, m)),) * 3)
-    M_inv = np.linalg.inv(np.eye(m) + M_s)
-    A_r = np.block([[np.zeros((m, m)), np.eye(m)],
-                    [-M_inv @ (dm.K + K_s - L.axis.T @ (L.ks[:, None] * L.axis)),
-                     -M_inv @ (dm.C + W * dm.G + C_s)]])
-    B_r = np.vstack([np.zeros((m, L.ki.size)), M_inv @ (L.axis.T * L.ki)])
+    M_inv = np.linalg.inv(np.diag(np.r_[np.ones(m), np.zeros(nh)]) + M_s)
+    K_r = np.zeros((n, n))
+    K_r[:m, :m] = dm.K - L.axis.T @ (L.ks[:, None] * L.axis)
+    C_r = np.zeros((n, n))
+    C_r[:m, :m] = dm.C + W * dm.G
+    A_r = np.block([[np.zeros((n, n)), np.eye(n)],
+                    [-M_inv @ (K_r + K_s), -M_inv @ (C_r + C_s)]])
+    B_r = np.vstack([np.zeros((n, L.ki.size)),
+                     M_inv @ np.vstack([L.axis.T * L.ki, np.zeros((nh, L.ki.size))])])
     Aa, Ba, Ca, Da = L.coil
     na = Aa.shape[0]
     # the coil in front of the rotor's current inputs: its states after the rotor's
-    A = np.block([[A_r, B_r @ Ca], [np.zeros((na, 2 * m)), Aa]])
+    A = np.block([[A_r, B_r @ Ca], [np.zeros((na, 2 * n)), Aa]])
     G = (A, np.vstack([B_r @ Da, Ba]),
-         np.hstack([L.sensor, np.zeros((L.ki.size, m + na))]), np.zeros((L.ki.size,) * 2))
-    return G, np.vstack([np.zeros((m, 2)), M_inv @ dm.cg_rows.T, np.zeros((na, 2))])
+         np.hstack([L.sensor, np.zeros((L.ki.size, nh + n + na))]),
+         np.zeros((L.ki.size,) * 2))
+    # the states [Δη, h, η̇, ḣ, coil] put as [Δη, η̇, h, ḣ, coil]: the modes first
+    order = np.r_[np.arange(m), n + np.arange(m), m + np.arange(nh), n + m + np.arange(nh),
+                  2 * n + np.arange(na)]
+    A, B, C, D = G
+    Bf = np.vstack([np.zeros((n, 2)), M_inv @ np.vstack([dm.cg_rows.T, np.zeros((nh, 2))]),
+                    np.zeros((na, 2))])
+    return (A[np.ix_(order, order)], B[order], C[:, order], D), Bf[order]
 
 
 def _sampled_orbit(G, Bf, sampled, W: float, force: np.ndarray):
@@ -148,7 +163,8 @@ def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=
     -------
     eta, deta : ndarray, shape (m,)
         The modal coordinates and their rates: the levitated equilibrium ``dm.q0`` and
-        the unbalance orbit at t = 0.
+        the unbalance orbit at t = 0 (a spring's housing moves in the orbit too; the drop
+        starts it at rest in its equilibrium).
     x_loop : ndarray, shape (n_loop,)
         The loop's states at t = 0: the coil's and a continuous controller's
         (:attr:`AmbLoop.n_states`), or the coil's and a digital controller's before its
@@ -164,6 +180,7 @@ def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=
         raise ConfigError("drop: levitated start: the rig has no [[amb]] to levitate it")
     W = 2 * np.pi * speed_rpm / 60.0
     m = dm.phi.shape[1]
+    nh = 2 * housings(cfg) if supports else 0  # the housings' x, y and rates: not a start
     force = unbalance_kgm * W * W * np.array([1.0, -1.0j])
     L = loop or amb_loop(cfg, dm, speed_rpm, controller)
     if L.sampled is not None:
@@ -175,7 +192,7 @@ def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=
                 f"runs is unstable at {speed_rpm:g} rpm (a pole at |z| = {abs(worst):.6g}): "
                 "the rotor has no levitated orbit there; start the drop at rest")
         return (dm.q0 + X[:m].real, X[m:2 * m].real,
-                np.concatenate([X[2 * m:].real, X_d.real]))
+                np.concatenate([X[2 * (m + nh):].real, X_d.real]))
     A, B_u = levitated_loop(cfg, dm, speed_rpm, controller, L, supports, pressure_bar)
     poles = eigvals(A)
     worst = poles[np.argmax(poles.real)]
@@ -186,5 +203,5 @@ def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=
             f"{speed_rpm:g} rpm (a pole at {worst.real:.4g} ± {abs(worst.imag):.4g}j "
             "rad/s): the rotor has no levitated orbit there; start the drop at rest")
     X = np.linalg.solve(1j * W * np.eye(A.shape[0]) - A, B_u @ force)
-    return dm.q0 + X[:m].real, (1j * W * X[:m]).real, X[2 * m:].real
+    return dm.q0 + X[:m].real, (1j * W * X[:m]).real, X[2 * (m + nh):].real
 

@@ -138,6 +138,9 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Disk.Ip": ("kg·m²", "polar moment of inertia (gyroscopics)"),
     "Disk.Id": ("kg·m²", "diametral (transverse) moment of inertia"),
     "Disk.name": ("", "a name for outputs and for ``[design.unbalance] force_at``"),
+    "Disk.clearance": ("m", "the disk's radial clearance to its casing (an impeller's "
+                            "shroud or tip), judged by ``ambseal drop`` (left out: not "
+                            "judged)"),
     # [[amb]]
     "Amb.name": ("", "the bearing's name: it names the channels (``A_zeta``) and the "
                      "parameters (``A.Ki_zeta``); no '.', ',' or spaces"),
@@ -172,6 +175,8 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                                   "the report sets the unbalance orbit against it. On a "
                                   "rig with ``[[touchdown]]`` bearings it is refused: "
                                   "the nearest one's ``radial_clearance`` is the gap"),
+    "Amb.sensor_gap": ("m", "the displacement probe's radial gap to its target, judged "
+                            "by ``ambseal drop`` (left out: not judged)"),
     "Amb.uncertainty": ("", "``{ key = σ }``: relative 1σ uncertainty of a value the fit "
                             "holds fixed (e.g. ``ki = 0.02``)"),
     # { zeta, eta }

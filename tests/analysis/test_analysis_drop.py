@@ -429,3 +429,28 @@ def test_the_levitated_start_is_the_pid_loops_unbalance_orbit(cutoff_hz):
     with pytest.raises(ConfigError, match=r"unstable at 3000 rpm \(a pole at"):
         levitated_state(cfg, dm, 3000.0, U,
                         controller=pid_controller(-kp, ti, td, eps, channel_names(cfg)))
+
+
+def test_the_sensor_gaps_and_the_disks_clearance_are_judged():
+    """The rotor falls through the rings' 0.2 mm: at standstill the disk (mid-span) and
+    the sensors (at the AMBs) move about as much; a sensor gap or a disk clearance of
+    0.15 mm is closed (FAILED), 0.5 mm is not, each row named for its gap; without the
+    keys there is no such row."""
+    plain = _rig()
+    r = simulate_drop(plain, duration_s=0.02, samples=401)
+    names = {c["name"] for c in drop_verdict(plain, r)["criteria"]}
+    assert not any("sensor gap" in n or "disk" in n for n in names)
+    for gap, outcome in ((1.5e-4, "FAILED"), (5e-4, "passed")):
+        cfg = plain.model_copy(update={
+            "amb": [a.model_copy(update={"sensor_gap": gap}) for a in plain.amb],
+            "disk": [d.model_copy(update={"clearance": gap, "name": "wheel"})
+                     for d in plain.disk]})
+        r = simulate_drop(cfg, duration_s=0.02, samples=401)
+        rows = {c["name"]: c for c in drop_verdict(cfg, r)["criteria"]}
+        for name in ("no contact at A (sensor gap)", "no contact at B (sensor gap)",
+                     "no contact at wheel (clearance)"):
+            assert rows[name]["outcome"] == outcome and rows[name]["limit"] == \
+                f"{1e6 * gap:.4g} µm"
+        # the disk's excursion is the rotor's at mid-span: its fall through the rings
+        assert np.hypot(*r.watched["disk:wheel"].T).max() == pytest.approx(
+            C_TD + r.peak_penetration.max(), rel=0.05)

@@ -167,9 +167,10 @@ class DropModel:
     modes_hz : float
         The modes kept are those below this (Hz).
     node_rows : dict
-        ``{"amb:NAME", "seal:NAME" or "spring:NAME": ndarray (2, m)}``: the x, y rows of Φ
-        at each AMB, seal and ``[[spring]]`` with a ``clearance``, whose excursions the
-        verdict sets against their gaps.
+        ``{"amb:NAME", "seal:NAME", "spring:NAME", "sensor:NAME" or "disk:NAME": ndarray
+        (2, m)}``: the x, y rows of Φ at each AMB, seal, ``[[spring]]`` with a
+        ``clearance``, AMB sensor with a ``sensor_gap`` and disk with a ``clearance``,
+        whose excursions the verdict sets against their gaps.
     z : ndarray, shape (n_nodes,)
         The FE nodes' positions (m); node k's DOFs are x, y, θx, θy at 4k … 4k + 3.
     projector : ndarray, shape (m, n_dof)
@@ -214,6 +215,11 @@ class DropModel:
     z_cg: float = 0.0
     axial_clearance: np.ndarray = field(default=None, repr=False)
     axial_laws: tuple = ()
+
+
+def disk_label(disk, i: int) -> str:
+    """A disk's name in the drop's outputs: its ``name``, else ``disk[i]``."""
+    return disk.name or f"disk[{i}]"
 
 
 def seal_offset(seal) -> np.ndarray:
@@ -324,6 +330,10 @@ def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
     rows.update({f"seal:{s.name}": xy(s.position) for s in cfg.seal})
     rows.update({f"spring:{spring_label(s, i)}": xy(s.position)
                  for i, s in enumerate(cfg.spring) if s.clearance is not None})
+    rows.update({f"sensor:{a.name}": xy(a.sensor_position) for a in cfg.amb
+                 if a.sensor_gap is not None})
+    rows.update({f"disk:{disk_label(d, i)}": xy(d.position) for i, d in enumerate(cfg.disk)
+                 if d.clearance is not None})
     return DropModel(
         phi=phi, frequency_hz=f, K=Km, C=phi.T @ rotor.C @ phi, G=phi.T @ rotor.G @ phi,
         gravity=gravity, planes=tuple(xy(t.position) for t in cfg.touchdown), laws=laws,
@@ -1211,8 +1221,9 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
 def drop_verdict(cfg, result: DropResult) -> dict:
     """The drop judged, verdict first: each criterion passed, FAILED, or not graded (with
     why) — no contact outside the touchdown bearings (the largest excursion at each AMB
-    against its air gap, :func:`ambseal.design.air_gaps`, at each seal and each
-    ``[[spring]]`` with a ``clearance`` against it), each touchdown
+    against its air gap, :func:`ambseal.design.air_gaps`, at each seal, each
+    ``[[spring]]`` and each disk with a ``clearance`` against it, at each AMB's sensor
+    with a ``sensor_gap`` against it), each touchdown
     bearing's peak force against ``[drop] force_ratio`` × its ``static_rating`` C₀ (with
     the most loaded ball's contact stress that force gives in a rolling bearing,
     :func:`ambseal.model.rated_contact_stress`: the rig's kinds are ball bearings) — where
@@ -1249,9 +1260,14 @@ def drop_verdict(cfg, result: DropResult) -> dict:
     gaps.update({f"seal:{s.name}": s.clearance for s in cfg.seal})
     gaps.update({f"spring:{spring_label(s, i)}": s.clearance
                  for i, s in enumerate(cfg.spring) if s.clearance is not None})
+    gaps.update({f"sensor:{a.name}": a.sensor_gap for a in cfg.amb
+                 if a.sensor_gap is not None})
+    gaps.update({f"disk:{disk_label(d, i)}": d.clearance for i, d in enumerate(cfg.disk)
+                 if d.clearance is not None})
     for key, gap in gaps.items():
         worst = float(np.hypot(*result.watched[key].T).max())
-        what = "air gap" if key.startswith("amb:") else "clearance"
+        what = {"amb": "air gap", "sensor": "sensor gap"}.get(key.split(":")[0],
+                                                             "clearance")
         row(f"no contact at {key.split(':', 1)[1]} ({what})",
             None if gap is None else worst < gap, f"{1e6 * worst:.4g} µm",
             f"{1e6 * gap:.4g} µm" if gap else f"no {what} given")

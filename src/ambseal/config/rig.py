@@ -354,6 +354,9 @@ class Disk(_Strict):
     Ip: float = Field(default=0.0, ge=0, le=1e6)
     Id: float = Field(default=0.0, ge=0, le=1e6)
     name: Label | None = None
+    # radial clearance of the disk (an impeller's shroud or tip, a wheel's) to its casing:
+    # what a landing rotor must not close (ambseal drop)
+    clearance: float | None = Field(default=None, ge=1e-6, le=0.1)
 
 
 class AxisPair(_Strict):
@@ -390,6 +393,9 @@ class Amb(_Strict):
     resistance: float | None = Field(default=None, ge=0, le=1e4)
     saturation_flux_density: float = Field(default=1.2, gt=0, le=2.5)
     backup_clearance: float | None = Field(default=None, gt=0, le=1.0)
+    # the displacement probe's radial gap to its target: what a landing rotor must not
+    # close (ambseal drop)
+    sensor_gap: float | None = Field(default=None, ge=1e-6, le=0.1)
     uncertainty: Uncertainty = None
 
     @model_validator(mode="after")

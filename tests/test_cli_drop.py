@@ -171,6 +171,11 @@ def test_an_unbalanced_drop_starts_from_its_levitated_orbit_or_at_rest(tmp_path,
         assert code in (0, 1) and docs[start]["start"] == start
         assert docs[start]["unbalance_kgm"] == 2e-3
     assert docs["levitated"]["planes"] != docs["rest"]["planes"]
+    # from its orbit the reference PID held the rotor; from rest, every axis lost, no
+    # controller acts on the drop and none is derived
+    assert docs["levitated"]["controller"] == "reference PID"
+    assert docs["rest"]["controller"] == "none: every axis lost at rest"
+    assert docs["rest"]["controller_runs"] is None
 
 
 def test_the_events_from_the_command_line(tmp_path, capsys):

@@ -827,9 +827,10 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     def angle(t, y) -> float:
         return float(y[i_spin + 1]) if coast_down else W0 * t
 
-    def contacts(t, y):
-        """Per plane: relative position, δ, normal force, friction, n, t, slip speed."""
-        eta, deta, wr, s, ds = unpack(y)
+    def contacts(t, y, parts=None):
+        """Per plane: relative position, δ, normal force, friction, n, t, slip speed
+        (``parts``: ``unpack(y)`` where the caller has it)."""
+        eta, deta, wr, s, ds = unpack(y) if parts is None else parts
         out = []
         for p in range(P):
             r = dm.planes[p] @ eta - s[p]
@@ -876,7 +877,16 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     def amb(t, y, hold=None):
         """The axes' forces (N), the loop's state derivative, the currents (A) and where
         the loop's reference was clipped; a digital controller's reference is the one
-        held (``hold``: (i_ref, clipped), default the last update's)."""
+        held (``hold``: (i_ref, clipped), default the last update's). With every axis
+        lost the loop drives nothing: its states are held, and the forces are the fading
+        ones alone (none where every coil lets go at once)."""
+        if all_down:
+            if not fading:
+                return no_force, no_loop, no_force, no_clip
+            b2 = fade(t)
+            pull = loop.ks * (loop.axis @ (y[:m] - dm.q0))
+            return (b2 * (loop.static + loop.ki * i_fail + pull), no_loop,
+                    np.sqrt(b2) * (i_s + i_fail), no_clip)
         dev = y[:m] - dm.q0
         x_a, x_k = y[i_loop:i_loop + na], y[i_loop + na:i_spin]
         sensed = loop.sensor @ dev
@@ -895,6 +905,9 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
 
     digital = loop.sampled is not None
     held = []  # a digital controller's updates: (t, i_ref, clipped)
+    all_down, fading = bool(down.all()), bool((loop.tau > 0).any())
+    no_force, no_loop = np.zeros(len(names)), np.zeros(n_loop)
+    no_clip = np.zeros(len(names), bool)
 
     def sample(t, y):
         """The digital controller's update at the sample instant t (module docstring of
@@ -907,11 +920,14 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         held.append((t, *loop.clip(-u)))
 
     def rhs(t, y):
-        eta, deta, wr, s, ds = unpack(y)
+        parts = unpack(y)
+        eta, deta, wr, s, ds = parts
         f = dm.gravity + f_over
+        power = float(f_over @ deta)
         fch, dloop, _, _ = amb(t, y)
-        f += loop.axis.T @ fch
-        power = float(fch @ (loop.axis @ deta) + f_over @ deta)
+        if fch is not no_force:
+            f += loop.axis.T @ fch
+            power += float(fch @ (loop.axis @ deta))
         if unbalance_kgm:
             W, th = spin(y), angle(t, y)
             fu = unbalance_kgm * W * W * np.array([math.cos(th), math.sin(th)])
@@ -922,9 +938,10 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         dsup = {}
         heat = np.zeros(P)  # each plane's friction power (W)
         torque = 0.0
-        for p, (r, delta, N, Ft, n, tang, slip) in enumerate(contacts(t, y)):
+        for p, (r, delta, N, Ft, n, tang, slip) in enumerate(contacts(t, y, parts)):
             F = np.zeros(2) if n is None else -N * n - Ft * tang
-            f += dm.planes[p].T @ F
+            if n is not None:
+                f += dm.planes[p].T @ F
             torque -= Ft * dm.journal[p]
             heat[p] = Ft * slip
             if dm.race_inertia[p] > 0:
@@ -947,7 +964,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         dy[i_heat:i_heat + P] = heat
         W = spin(y)
         dy[:m] = deta
-        acc = f - (dm.C + W * dm.G) @ deta - dm.K @ eta
+        acc = f - (C_held if not coast_down else dm.C + W * dm.G) @ deta - dm.K @ eta
         if sealed:  # (I + M_s) η̈ = the rest − K_s Δη − C_s η̇: the seals' force as work
             h, dh = y[i_house:i_house + nh], y[i_house + nh:i_house + 2 * nh]
             pushed = -K_s @ np.r_[eta - dm.q0, h] - C_s @ np.r_[deta, dh]
@@ -970,6 +987,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             dy[base + 4 * k + 2:base + 4 * k + 4] = dsup[p]
         return dy
 
+    C_held = dm.C + W0 * dm.G  # the damping and gyroscopics at a held speed
     pace = 1.0 / (CYCLE_EVALUATIONS * dm.modes_hz)  # the slowest progress per evaluation
 
     def paced(fn, start: float):

@@ -341,7 +341,11 @@ def _drop(args: argparse.Namespace) -> int:
                              cfg.operating.pressure_bar)
         controller = control.ss(*with_delay((d.A, d.B, d.C, d.D), digital.delay_samples),
                                 d.dt)
-    loop = amb_loop(cfg, dm, rpm, controller)
+    # every axis lost from the levitated equilibrium at rest: no controller acts on the
+    # drop (the coils carry their static currents alone), none is derived
+    idle = (args.event == "loss" and args.controller is None
+            and (args.start == "rest" or not unbalance[0]))
+    loop = amb_loop(cfg, dm, rpm, "none" if idle else controller)
     event = drop_event(cfg, dm, loop, args.event, args.axis, args.overload_n,
                        args.overload_at, args.surge_bar)
     start = x0 = None
@@ -360,8 +364,9 @@ def _drop(args: argparse.Namespace) -> int:
     doc = {"rig": str(args.rig), "speed_rpm": rpm, "unbalance_kgm": unbalance[0],
            "start": args.start, "event": args.event, "event_summary": event["summary"],
            "pressure_bar": cfg.operating.pressure_bar,
-           "controller": args.controller or "reference PID",
-           "controller_runs": ("continuous" if digital is None else
+           "controller": args.controller or ("none: every axis lost at rest" if idle
+                                             else "reference PID"),
+           "controller_runs": (None if idle else "continuous" if digital is None else
                                f"digital at {1 / loop.sampled[4]:g} Hz, "
                                f"{digital.delay_samples} sample(s) of computation delay"),
            **judged, **res.to_dict()}

@@ -162,6 +162,10 @@ def normal_force(delta, delta_rate, stiffness: float, exponent: float, damping: 
     -------
     float or ndarray
     """
+    if isinstance(delta, float) and isinstance(delta_rate, float):  # one contact (the drop's rhs)
+        if not delta > 0.0:
+            return 0.0
+        return max(stiffness * delta ** exponent * (1.0 + damping * delta_rate), 0.0)
     d = np.maximum(np.asarray(delta, float), 0.0)
     f = stiffness * d ** exponent * (1.0 + damping * np.asarray(delta_rate, float))
     return np.where(np.asarray(delta) > 0.0, np.maximum(f, 0.0), 0.0)
@@ -185,6 +189,8 @@ def friction_force(mu: float, normal, slip_speed, velocity: float):
     -------
     float or ndarray
     """
+    if isinstance(normal, float) and isinstance(slip_speed, float):  # one contact (the drop's rhs)
+        return mu * normal * math.tanh(slip_speed / velocity)
     return mu * np.asarray(normal, float) * np.tanh(np.asarray(slip_speed, float) / velocity)
 
 

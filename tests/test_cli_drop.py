@@ -58,6 +58,10 @@ def test_drop_writes_its_summary_and_figure(tmp_path, capsys):
     page = (out / "drop.html").read_text()
     assert page.index("<h2>Verdict</h2>") < page.index("<h2>Touchdown bearings</h2>")
     assert doc["verdict"] in page and page.count("data:image/png;base64,") == 3
+    # each watched plane's gap beside its excursion, and their ratio
+    assert doc["gaps_m"] == {"amb:A": 5e-4, "amb:B": 5e-4}
+    ratio = doc["watched_max_m"]["amb:A"] / 5e-4
+    assert "excursion / gap" in page and f"<td>{ratio:.3g}</td>" in page
     for p in doc["planes"]:
         assert f"{p['peak_force_n']:.4g}" in page
         assert f"{1e6 * p['max_orbit_m']:.4g} ({p['max_orbit_m'] / 2e-4:.3g} c)" in page

@@ -1263,9 +1263,10 @@ def drop_verdict(cfg, result: DropResult) -> dict:
     Returns
     -------
     dict
-        ``passed`` (bool: nothing failed), ``verdict`` (one line) and ``criteria``
+        ``passed`` (bool: nothing failed), ``verdict`` (one line), ``criteria``
         (``name``, ``outcome`` — ``"passed"``, ``"FAILED"`` or ``"not graded"`` —,
-        ``value``, ``limit``).
+        ``value``, ``limit``) and ``gaps_m`` (each watched plane's gap, m, as
+        :attr:`DropResult.watched` names it; None where none is given).
     """
     rows = []
 
@@ -1328,4 +1329,5 @@ def drop_verdict(cfg, result: DropResult) -> dict:
     line = (f"Drop FAILED: {'; '.join(failed)}" if failed else
             "Drop PASSED" + (f" on what was graded (not graded: {'; '.join(skipped)})"
                              if skipped else ""))
-    return {"passed": not failed, "verdict": line, "criteria": rows}
+    return {"passed": not failed, "verdict": line, "criteria": rows,
+            "gaps_m": {k: json_float(g) if g is not None else None for k, g in gaps.items()}}

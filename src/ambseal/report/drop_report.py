@@ -81,8 +81,14 @@ def write_drop_report(path: str | os.PathLike, doc: dict, figures, *, title: str
             + (_cell(_num(p["peak_axial_force_n"]))
                + _cell(_num(p["max_axial_penetration_m"], 1e6)) if axial else "")
             + _cell(_num(p["friction_heat_j"])) + "</tr>")
-    watched = [f'<tr><td class="text">{html.escape(k)}</td>{_cell(_num(v, 1e6))}</tr>'
-               for k, v in doc["watched_max_m"].items()]
+    gaps = doc.get("gaps_m", {})
+    watched = []
+    for k, v in doc["watched_max_m"].items():
+        gap = gaps.get(k)
+        watched.append(f'<tr><td class="text">{html.escape(k)}</td>{_cell(_num(v, 1e6))}'
+                       + _cell(_num(gap, 1e6))
+                       + _cell(f"{v / gap:.3g}" if gap and v is not None else "—")
+                       + "</tr>")
     stop = doc.get("coast_down_s")
     stop_text = ("held by the drive" if stop is None and doc["final_speed_rad_s"]
                  == doc["speed_rad_s"] else "not slowing" if stop is None else
@@ -109,8 +115,9 @@ def write_drop_report(path: str | os.PathLike, doc: dict, figures, *, title: str
              "ring speed at the end (rpm)",
              *(("peak axial force (N)", "max axial penetration (µm)") if axial else ()),
              "friction heat (J)"], planes)},
-        {"title": "Largest excursion at the AMBs and seals",
-         "html": _table(["plane", "excursion (µm)"], watched)},
+        {"title": "Largest excursion at the AMBs, sensors, seals and disks",
+         "html": _table(["plane", "excursion (µm)", "gap (µm)", "excursion / gap"],
+                        watched)},
         {"title": "Energy and speed",
          "text": f"{doc['impacts']} contact onsets in {doc['duration_s']:.4g} s; the "
                  f"contacts, drag and structure dissipated {doc['energy_dissipated_j']:.4g} J "

@@ -93,8 +93,7 @@ class _Crawling(Exception):
 
 
 __all__ = ["GRAVITY", "DropModel", "DropResult", "drop_model", "simulate_drop",
-           "journal_radius", "drop_verdict", "support_matrices", "seal_offset",
-           "seal_offset_forces", "housings"]
+           "journal_radius", "drop_verdict", "support_matrices"]
 
 #: the modes kept reach this many times the contact's own frequency 1/t_c
 MODES_PER_CONTACT = 4.0
@@ -154,8 +153,8 @@ class DropModel:
         Per plane: the support's mass, stiffness and damping, None where rigid.
     amb_force : ndarray, shape (a, 2)
         Each AMB's static force (N, x and y) in the levitated equilibrium: the weight and
-        the offset seals' static loads at the operating pressure drop
-        (:func:`seal_offset_forces`).
+        the static loads of the seals the rotor runs offset in, at the operating pressure
+        drop (a seal's ``static_eccentricity`` taken downward: the rotor low in it).
     q0 : ndarray, shape (m,)
         The levitated equilibrium (the bending under gravity and the AMBs' forces).
     mass : float
@@ -217,12 +216,12 @@ class DropModel:
     axial_laws: tuple = ()
 
 
-def disk_label(disk, i: int) -> str:
+def _disk_label(disk, i: int) -> str:
     """A disk's name in the drop's outputs: its ``name``, else ``disk[i]``."""
     return disk.name or f"disk[{i}]"
 
 
-def seal_offset(seal) -> np.ndarray:
+def _seal_offset(seal) -> np.ndarray:
     """The rotor's static offset (m, x/y) from a seal's centre in the drop: its
     ``static_eccentricity`` taken downward, the rotor low in the seal — the direction
     in which the rotor falls closest to the seal's wall (the judgement's static currents
@@ -230,11 +229,11 @@ def seal_offset(seal) -> np.ndarray:
     return np.array([0.0, -float(seal.static_eccentricity)])
 
 
-def seal_offset_forces(cfg, pressure_bar: float) -> list[tuple[float, np.ndarray]]:
+def _seal_offset_forces(cfg, pressure_bar: float) -> list[tuple[float, np.ndarray]]:
     """Each offset seal's position (m) and static force on the rotor (N, x/y) at the
     pressure drop: −[[K, k], [−k, K]]·e at zero frequency
-    (:func:`ambseal.analysis.judge.seal_static_load`), e its :func:`seal_offset`."""
-    return [(s.position, seal_static_load(s, pressure_bar)[0] @ seal_offset(s))
+    (:func:`ambseal.analysis.judge.seal_static_load`), e its ``_seal_offset``."""
+    return [(s.position, seal_static_load(s, pressure_bar)[0] @ _seal_offset(s))
             for s in cfg.seal if s.static_eccentricity > 0]
 
 
@@ -314,7 +313,7 @@ def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
     t_y = np.zeros(mesh.n_dof)
     t_y[1::4] = 1.0
     gravity = -GRAVITY * phi.T @ (rotor.M @ t_y)
-    offsets = seal_offset_forces(cfg, cfg.operating.pressure_bar)
+    offsets = _seal_offset_forces(cfg, cfg.operating.pressure_bar)
     amb_force = _amb_static_forces(cfg, mass, z_g, offsets)
     Km = phi.T @ rotor.K @ phi
     # levitated: the flexible modes bent by gravity, the AMBs and the offset seals (the
@@ -332,7 +331,7 @@ def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
                  for i, s in enumerate(cfg.spring) if s.clearance is not None})
     rows.update({f"sensor:{a.name}": xy(a.sensor_position) for a in cfg.amb
                  if a.sensor_gap is not None})
-    rows.update({f"disk:{disk_label(d, i)}": xy(d.position) for i, d in enumerate(cfg.disk)
+    rows.update({f"disk:{_disk_label(d, i)}": xy(d.position) for i, d in enumerate(cfg.disk)
                  if d.clearance is not None})
     return DropModel(
         phi=phi, frequency_hz=f, K=Km, C=phi.T @ rotor.C @ phi, G=phi.T @ rotor.G @ phi,
@@ -389,7 +388,7 @@ def support_matrices(cfg, dm: DropModel, speed_rpm: float,
     p = cfg.operating.pressure_bar if pressure_bar is None else pressure_bar
     f = abs(speed_rpm) / 60.0
     mesh = build_mesh(cfg, extra_positions=tuple(t.position for t in cfg.touchdown))
-    nh = 2 * housings(cfg)
+    nh = 2 * _housings(cfg)
     n = mesh.n_dof + nh
     K, C, M = (np.zeros((n, n)) for _ in range(3))
     for seal in cfg.seal:
@@ -406,7 +405,7 @@ def support_matrices(cfg, dm: DropModel, speed_rpm: float,
     return T.T @ K @ T, T.T @ C @ T, T.T @ M @ T
 
 
-def housings(cfg) -> int:
+def _housings(cfg) -> int:
     """The ``[[spring]]`` housings of a rig: each two coordinates (x, y) of the drop after
     the modes (:func:`support_matrices`)."""
     return sum(s.housing is not None for s in cfg.spring)
@@ -483,8 +482,6 @@ class DropResult:
         Each plane's largest axial force (N) and penetration (m), read as the radial ones.
     axial_thrust : float
         The thrust (N) on the rotor once the thrust bearing let go.
-    axial_clearance : ndarray, shape (p,)
-        Each plane's axial clearance (m; nan where it stops nothing axially).
     friction_heat : ndarray, shape (p, k)
         The heat (J) each plane's friction made since the drop, radial and axial:
         ∫ F_t·v_s dt.
@@ -521,7 +518,6 @@ class DropResult:
     peak_axial_force: np.ndarray = field(default=None, repr=False)
     peak_axial_penetration: np.ndarray = field(default=None, repr=False)
     axial_thrust: float = 0.0
-    axial_clearance: np.ndarray = field(default=None, repr=False)
     friction_heat: np.ndarray = field(default=None, repr=False)
 
     def regime(self, p: int) -> tuple[str, float]:
@@ -774,25 +770,25 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     na, n_loop = Aa.shape[0], loop.n_states
     i_s = loop.static / loop.ki
     sealed = bool(supports and (cfg.seal or cfg.spring))
-    nh = 2 * housings(cfg) if sealed else 0
+    nh = 2 * _housings(cfg) if sealed else 0
     if sealed:
         K_s, C_s, M_s = support_matrices(cfg, dm, speed_rpm, pressure_bar)
         # the modes' unit mass and the housings' own (in M_s)
         M_inv = np.linalg.inv(np.diag(np.r_[np.ones(m), np.zeros(nh)]) + M_s)
         # the offset seals' static loads at the drop's pressure (the AMBs held them at the
         # operating one): on the rotor as the overload is, their work from outside
-        for zs, F in seal_offset_forces(cfg, cfg.operating.pressure_bar
+        for zs, F in _seal_offset_forces(cfg, cfg.operating.pressure_bar
                                         if pressure_bar is None else pressure_bar):
             n_s = int(np.argmin(np.abs(dm.z - zs)))
             f_over = f_over + dm.phi[[4 * n_s, 4 * n_s + 1], :].T @ F
     races = np.flatnonzero(dm.race_inertia > 0)
     sup = [p for p in range(P) if dm.support[p] is not None]
     # the states: modes and their rates, the turning rings, the supports, the AMB loop's
-    # (the coil's, the controller's), the spin and its angle when it coasts, and last the
-    # work done on the rotor from outside (J): by the drive holding the spin against the
-    # rings' friction, the AMBs' and the seals' forces, the unbalance and the overload
-    # the rotor's axial position and speed where it moves axially, each plane's friction
-    # heat (J)
+    # (the coil's, the controller's), the spin and its angle when it coasts, the rotor's
+    # axial position and speed where it moves axially, each plane's friction heat (J),
+    # the housings' x, y and rates, and last the work done on the rotor from outside (J):
+    # by the drive holding the spin against the rings' friction, the AMBs' and the
+    # seals' forces, the thrust, the unbalance and the overload
     i_loop = 2 * m + races.size + 4 * len(sup)
     i_spin = i_loop + n_loop
     i_ax = i_spin + (2 if coast_down else 0)
@@ -1200,7 +1196,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                 axial_force[p, j] = N
         energy[j] = e
     # a seal's excursion from its own centre: the rotor sits its offset from it
-    centre = {f"seal:{s.name}": seal_offset(s) for s in cfg.seal}
+    centre = {f"seal:{s.name}": _seal_offset(s) for s in cfg.seal}
     watched = {k: np.einsum("ij,kj->ki", rows, Y[:, :m]) + centre.get(k, 0.0)
                for k, rows in dm.node_rows.items()}
     j = 0  # a spring on a housing: its clearance is to the housing, which moves
@@ -1232,7 +1228,6 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
                       axial_force=axial_force,
                       peak_axial_force=np.maximum(peak_ax_force, axial_force.max(axis=1)),
                       peak_axial_penetration=peak_ax_delta, axial_thrust=thrust,
-                      axial_clearance=np.where(np.isfinite(c_ax), c_ax, np.nan),
                       friction_heat=Y[:, i_heat:i_heat + P].T.copy())
 
 
@@ -1281,7 +1276,7 @@ def drop_verdict(cfg, result: DropResult) -> dict:
                  for i, s in enumerate(cfg.spring) if s.clearance is not None})
     gaps.update({f"sensor:{a.name}": a.sensor_gap for a in cfg.amb
                  if a.sensor_gap is not None})
-    gaps.update({f"disk:{disk_label(d, i)}": d.clearance for i, d in enumerate(cfg.disk)
+    gaps.update({f"disk:{_disk_label(d, i)}": d.clearance for i, d in enumerate(cfg.disk)
                  if d.clearance is not None})
     for key, gap in gaps.items():
         worst = float(np.hypot(*result.watched[key].T).max())

@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg import eigvals, expm
 
-from ambseal.analysis.drop import housings, support_matrices
+from ambseal.analysis.drop import support_matrices
 from ambseal.analysis.drop_loop import amb_loop
 from ambseal.errors import ConfigError
 from ambseal.lti import feedback_matrices
@@ -82,10 +82,10 @@ def _open_loop(cfg, dm, speed_rpm: float, L, supports: bool, pressure_bar):
     force (N) at the centre of mass."""
     W = 2 * np.pi * speed_rpm / 60.0
     m = dm.phi.shape[1]
-    nh = 2 * housings(cfg) if supports else 0
-    n = m + nh
     K_s, C_s, M_s = (support_matrices(cfg, dm, speed_rpm, pressure_bar) if supports
                      else (np.zeros((m, m)),) * 3)
+    n = K_s.shape[0]
+    nh = n - m  # the housings' x, y
     M_inv = np.linalg.inv(np.diag(np.r_[np.ones(m), np.zeros(nh)]) + M_s)
     K_r = np.zeros((n, n))
     K_r[:m, :m] = dm.K - L.axis.T @ (L.ks[:, None] * L.axis)
@@ -180,7 +180,6 @@ def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=
         raise ConfigError("drop: levitated start: the rig has no [[amb]] to levitate it")
     W = 2 * np.pi * speed_rpm / 60.0
     m = dm.phi.shape[1]
-    nh = 2 * housings(cfg) if supports else 0  # the housings' x, y and rates: not a start
     force = unbalance_kgm * W * W * np.array([1.0, -1.0j])
     L = loop or amb_loop(cfg, dm, speed_rpm, controller)
     if L.sampled is not None:
@@ -192,7 +191,7 @@ def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=
                 f"runs is unstable at {speed_rpm:g} rpm (a pole at |z| = {abs(worst):.6g}): "
                 "the rotor has no levitated orbit there; start the drop at rest")
         return (dm.q0 + X[:m].real, X[m:2 * m].real,
-                np.concatenate([X[2 * (m + nh):].real, X_d.real]))
+                np.concatenate([X[X.size - L.coil[0].shape[0]:].real, X_d.real]))
     A, B_u = levitated_loop(cfg, dm, speed_rpm, controller, L, supports, pressure_bar)
     poles = eigvals(A)
     worst = poles[np.argmax(poles.real)]
@@ -203,5 +202,6 @@ def levitated_state(cfg, dm, speed_rpm: float, unbalance_kgm: float, controller=
             f"{speed_rpm:g} rpm (a pole at {worst.real:.4g} ± {abs(worst.imag):.4g}j "
             "rad/s): the rotor has no levitated orbit there; start the drop at rest")
     X = np.linalg.solve(1j * W * np.eye(A.shape[0]) - A, B_u @ force)
-    return dm.q0 + X[:m].real, (1j * W * X[:m]).real, X[2 * (m + nh):].real
+    # the loop's states last (the housings' before them are not a start)
+    return dm.q0 + X[:m].real, (1j * W * X[:m]).real, X[X.size - L.n_states:].real
 

@@ -334,8 +334,9 @@ def test_the_thrust_drives_the_rotor_onto_its_axial_stop(tmp_path, capsys):
 def test_monte_carlo_drops_of_an_event(tmp_path, capsys):
     """``--runs`` with ``--event overload``: every run is the overload beyond the AMBs'
     capacity from the reference PID's orbit (both ends land in each, whatever its
-    friction), one within it lands neither, ``--event one-axis`` lands A's end (B's end, the rotor tilting about B's
-    running axis, may touch its ring too); the JSON names the event."""
+    friction), one within it lands neither, ``--event one-axis`` lands A's end (B's end,
+    the rotor tilting about B's running axis, may touch its ring too); the JSON names the
+    event."""
     rig = tmp_path / "rig.toml"
     rig.write_text(_rig_text())
     for k, (extra, landed) in enumerate((

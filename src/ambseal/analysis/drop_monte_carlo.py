@@ -117,20 +117,21 @@ def drop_run(case: dict, rig: dict, speed_rpm: float, duration_s: float, modes_h
     dm = drop_model(cfg, modes_hz)
     u = case["unbalance_kgm"]
     initial = x0 = None
-    loop = amb_loop(cfg, dm, speed_rpm)
-    what = drop_event(cfg, dm, loop, **(event or {}))
-    running = what["failed"] != loop.names
+    ev = event or {}
+    # every axis lost from rest, as ``ambseal drop`` takes it: no controller acts on the
+    # drop, none is derived
+    idle = ev.get("event", "loss") == "loss" and not (start == "levitated" and u)
+    loop = amb_loop(cfg, dm, speed_rpm, "none" if idle else None)
+    what = drop_event(cfg, dm, loop, **ev)
     # the orbit and the currents the coils carry at the drop, as ``ambseal drop`` starts
-    if start == "levitated" and (u or running):
+    if start == "levitated" and (u or what["failed"] != loop.names):
         eta, deta, x0 = levitated_state(cfg, dm, speed_rpm, u, loop=loop)
         initial = (dm.phi @ eta, dm.phi @ deta)
-    # every axis lost from rest: the loop without a controller, as simulate_drop takes it
-    keep = initial is not None or running
     res = simulate_drop(cfg, speed_rpm=speed_rpm, duration_s=duration_s, samples=2001,
                         model=dm, coast_down=coast_down, drag_torque=drag_torque,
-                        unbalance_kgm=u, initial=initial, loop=loop if keep else None,
-                        loop_state=x0, failed=what["failed"] if running else None,
-                        overload=what["overload"], pressure_bar=what["pressure_bar"])
+                        unbalance_kgm=u, initial=initial, loop=loop, loop_state=x0,
+                        failed=what["failed"], overload=what["overload"],
+                        pressure_bar=what["pressure_bar"])
     judged = drop_verdict(cfg, res)
     row = {"run": case["run"], "passed": judged["passed"],
            "failed": "; ".join(c["name"] for c in judged["criteria"]
@@ -223,7 +224,7 @@ def drop_scatter(cfg, runs: int, *, seed: int, friction=None, clearance_tol_m=No
                                                ("unbalance", unbalance_kgm)))
     base = drop_model(cfg, modes_hz)
     # a bad event is refused once, here, not in every run
-    drop_event(cfg, base, amb_loop(cfg, base, speed_rpm), **(event or {}))
+    drop_event(cfg, base, amb_loop(cfg, base, speed_rpm, "none"), **(event or {}))
     c0 = np.array([t.radial_clearance for t in cfg.touchdown])
     tol = 0.0 if clearance_tol_m is None else float(clearance_tol_m)
     if not (math.isfinite(tol) and 0 <= tol < c0.min()):

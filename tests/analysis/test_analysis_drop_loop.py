@@ -65,6 +65,26 @@ def test_a_lost_amb_lets_go_with_the_square_of_its_decaying_current():
 SEAL = {"K": 2e5, "k": 1.5e5, "C": 300.0, "c": 80.0, "M": 3.0}  # at mid-span
 
 
+W_RUN, U_RUN = 100 * math.pi, 1e-4  # the running loops' 3000 rpm and unbalance (kg·m)
+
+
+def _running(cfg, ti: float, duration_s: float):
+    """No axis lost, U_RUN at 3000 rpm from the PID loop's levitated orbit: the drop, the
+    orbit at A's node less its levitated sag (x + jy), and the PID's K(jΩ)."""
+    dm = drop_model(cfg)
+    loop = amb_loop(cfg, dm, controller=_pid(cfg, ti=ti))
+    eta, deta, x0 = levitated_state(cfg, dm, 3000.0, U_RUN, loop=loop)
+    r = simulate_drop(cfg, speed_rpm=3000.0, duration_s=duration_s,
+                      samples=int(round(1e4 * duration_s)) + 1, model=dm, loop=loop,
+                      loop_state=x0, failed=(), unbalance_kgm=U_RUN, rtol=1e-10,
+                      initial=(dm.phi @ eta, dm.phi @ deta))
+    a = int(np.argmin(np.abs(dm.z - Z_AMB[0])))
+    got = r.watched["amb:A"] - (dm.phi @ dm.q0)[[4 * a, 4 * a + 1]]
+    s = 1j * W_RUN
+    return r, got[:, 0] + 1j * got[:, 1], 1e4 * (1 + 1 / (s * ti)
+                                                  + s * 3e-3 / (s * 0.1 * 3e-3 + 1))
+
+
 def test_a_spring_on_a_housing_runs_in_the_loops_orbit():
     """A plain bearing k_b = 2e5 N/m at mid-span on a housing (m_h = 2 kg, k_h = 1e5 N/m,
     c_h = 2000 N·s/m to ground), no axis lost, U = 1e-4 kg·m at 3000 rpm, a PD loop (the
@@ -75,29 +95,18 @@ def test_a_spring_on_a_housing_runs_in_the_loops_orbit():
     from ambseal.config import Spring
     from ambseal.config.rig import SpringHousing
 
-    kb, mh, kh, ch, ti = 2e5, 2.0, 1e5, 2000.0, 100.0
+    kb, mh, kh, ch = 2e5, 2.0, 1e5, 2000.0
     cfg = _rig().model_copy(update={"spring": [Spring(
         name="pedestal", position=L / 2, kxx=kb, kyy=kb,
         housing=SpringHousing(mass=mh, kxx=kh, kyy=kh, cxx=ch, cyy=ch))]})
-    dm = drop_model(cfg)
-    loop = amb_loop(cfg, dm, controller=_pid(cfg, ti=ti))
-    m = inertia(*DISK)[0]
-    W, U = 100 * math.pi, 1e-4
-    eta, deta, x0 = levitated_state(cfg, dm, 3000.0, U, loop=loop)
-    r = simulate_drop(cfg, speed_rpm=3000.0, duration_s=0.1, samples=1001, model=dm,
-                      loop=loop, loop_state=x0, failed=(), unbalance_kgm=U, rtol=1e-10,
-                      initial=(dm.phi @ eta, dm.phi @ deta))
-    s = 1j * W
-    Kc = 1e4 * (1 + 1 / (s * ti) + s * 3e-3 / (s * 0.1 * 3e-3 + 1))
-    ground = kh + s * ch - mh * W ** 2
+    r, got, Kc = _running(cfg, ti=100.0, duration_s=0.1)
+    W, m = W_RUN, inertia(*DISK)[0]
+    ground = kh + 1j * W * ch - mh * W ** 2
     Z = kb * ground / (kb + ground)
-    X = U * W ** 2 / (2 * (KI * Kc - KS) + Z - m * W ** 2)
-    a = int(np.argmin(np.abs(dm.z - Z_AMB[0])))
-    sag = (dm.phi @ dm.q0)[[4 * a, 4 * a + 1]]
-    got = r.watched["amb:A"] - sag
+    X = U_RUN * W ** 2 / (2 * (KI * Kc - KS) + Z - m * W ** 2)
     late = r.t >= 0.08
-    np.testing.assert_allclose((got[:, 0] + 1j * got[:, 1])[late],
-                               (X * np.exp(1j * W * r.t))[late], rtol=0, atol=1e-4 * abs(X))
+    np.testing.assert_allclose(got[late], (X * np.exp(1j * W * r.t))[late], rtol=0,
+                               atol=1e-4 * abs(X))
 
 
 @pytest.mark.parametrize("sealed", [False, True])
@@ -115,24 +124,12 @@ def test_the_running_loop_holds_its_levitated_unbalance_orbit(sealed):
     if sealed:
         cfg = cfg.model_copy(update={"seal": [Seal(name="mid", position=L / 2, **SEAL)]})
     seal = SEAL if sealed else dict.fromkeys(SEAL, 0.0)
-    dm = drop_model(cfg)
-    K = _pid(cfg)
-    loop = amb_loop(cfg, dm, controller=K)
-    m = inertia(*DISK)[0]
-    W, U = 100 * math.pi, 1e-4
-    eta, deta, x0 = levitated_state(cfg, dm, 3000.0, U, loop=loop)
-    r = simulate_drop(cfg, speed_rpm=3000.0, duration_s=0.04, samples=401, model=dm,
-                      loop=loop, loop_state=x0, failed=(), unbalance_kgm=U, rtol=1e-10,
-                      initial=(dm.phi @ eta, dm.phi @ deta))
-    s = 1j * W
-    Kc = 1e4 * (1 + 1 / (s * 0.2) + s * 3e-3 / (s * 0.1 * 3e-3 + 1))
+    r, got, Kc = _running(cfg, ti=0.2, duration_s=0.04)
+    W, U, m = W_RUN, U_RUN, inertia(*DISK)[0]
     X = U * W ** 2 / (2 * (KI * Kc - KS) + seal["K"] - 1j * seal["k"]
                       + 1j * W * (seal["C"] - 1j * seal["c"]) - (m + seal["M"]) * W ** 2)
     orbit = X * np.exp(1j * W * r.t)
-    a = int(np.argmin(np.abs(dm.z - Z_AMB[0])))
-    sag = (dm.phi @ dm.q0)[[4 * a, 4 * a + 1]]  # the levitated equilibrium at A's node
-    got = r.watched["amb:A"] - sag
-    np.testing.assert_allclose(got[:, 0] + 1j * got[:, 1], orbit, rtol=0, atol=1e-6 * abs(X))
+    np.testing.assert_allclose(got, orbit, rtol=0, atol=1e-6 * abs(X))
     assert r.impacts == 0 and r.force.max() == 0
     i_s = m * GRAVITY / 2 / KI
     np.testing.assert_allclose(r.amb_current[1], i_s - (Kc * orbit).imag, rtol=0,

@@ -116,9 +116,13 @@ def test_same_optimum_as_cvxopts_dense_solver():
         np.testing.assert_allclose(sol.X[v], Xr, rtol=1e-5, atol=1e-5 * np.abs(Xr).max())
 
 
-def test_schur_complement_is_its_definition():
+@pytest.mark.parametrize("rows", [64, 3])
+def test_schur_complement_is_its_definition(monkeypatch, rows):
     """H = Σ_j 𝒜_jᵀ 𝒜_j (scaled LMIs, Z = I) entry by entry from unit vectors: terms on
-    three variables in any order, one variable twice in an LMI, LMIs with and without γ."""
+    three variables in any order, one variable twice in an LMI, LMIs with and without γ;
+    its vech rows formed all at once or a few at a time. H is Fortran-ordered: LAPACK
+    factorises it where it lies."""
+    monkeypatch.setattr(sdp, "_SCHUR_ROWS", rows)
     rng = np.random.default_rng(4)
     n = 4
 
@@ -136,8 +140,9 @@ def test_schur_complement_is_its_definition():
     E = np.eye(lay.size)
     ref = np.array([[sum(np.sum(sdp._lin(lmi, lay, E[i]) * sdp._lin(lmi, lay, E[k]))
                          for lmi in lmis) for k in range(lay.size)] for i in range(lay.size)])
-    np.testing.assert_allclose(sdp._schur(lmis, lay), ref, rtol=1e-12,
-                               atol=1e-12 * np.abs(ref).max())
+    H = sdp._schur(lmis, lay)
+    np.testing.assert_allclose(H, ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max())
+    assert H.flags.f_contiguous
 
 
 def test_infeasible_lmis_are_reported():

@@ -520,3 +520,50 @@ def test_hinfnorm_and_digital_controller_refuse_what_they_cannot_take():
     assert hinfnorm(G)[0] == pytest.approx(1.0, rel=1e-9)
     with pytest.raises(ModelError, match="plants is empty"):
         digital_controller(ct.ss([[-10.0]], [[1.0]], [[1.0]], [[0.0]]), 1000.0, [])
+
+
+def test_the_gamma_search_asks_sb10ad_and_the_margin_once_per_gamma(monkeypatch):
+    """SB10AD's γ test is followed by the controller at the same γ, and a margin the
+    search computed is checked again: each is computed once (SB10AD and the two game
+    Riccati equations of a margin are the γ search's cost). Reference: python-control's
+    hinfsyn run side by side gives the same γ_opt (2e-3), from the ladder and started
+    near γ_opt, on the mixed-sensitivity plants of this module."""
+    import ambseal.robust.hinf as hinf_mod
+
+    sb_calls, riccati_x = [], []
+    real_sb10ad, real_riccati = hinf_mod._sb10ad, hinf_mod._game_riccati
+
+    def counting_sb10ad(*args):
+        sb_calls.append((args[0].ctypes.data,) + tuple(float(a) for a in args[-3:]))
+        return real_sb10ad(*args)
+
+    def counting_riccati(A, B, C1, D1, nw, g):
+        if A.flags.c_contiguous:  # X∞'s equation (Y∞'s takes Aᵀ)
+            riccati_x.append((A.ctypes.data, float(g)))
+        return real_riccati(A, B, C1, D1, nw, g)
+
+    monkeypatch.setattr(hinf_mod, "_sb10ad", counting_sb10ad)
+    monkeypatch.setattr(hinf_mod, "_game_riccati", counting_riccati)
+    s = ct.tf("s")
+    G3 = ct.ss(ct.tf([1], [1, 0.6, 1]) + ct.tf([0.3], [1 / 400, 0.002, 1])
+               + ct.tf([0.1], [1 / 3600, 0.001, 1]))
+    (G1, w1, w2), (G2, w1b, w2b) = _mixsyn_cases()
+    cases = [(mixed_sensitivity(ct.ss(G1), w1, w2), 1),
+             (mixed_sensitivity(ct.ss(G2), w1b, w2b), 2),
+             (mixed_sensitivity(G3, (s / 2 + 1) / (s + 1e-3), ct.tf([0.1], [1])), 1)]
+    for P, n in cases:
+        _, _, gam_pc, _ = ct.hinfsyn(P, n, n)
+        for near in (None, 1.03 * gam_pc):
+            sb_calls.clear()
+            riccati_x.clear()
+            r = hinfsyn(P, n, n, near=near)
+            assert r.gamma_opt == pytest.approx(gam_pc, rel=2e-3)
+            job4 = [c for c in sb_calls if c[2] == 4.0]
+            assert job4 and all(a != b for a, b in zip(job4, job4[1:]))
+            assert len(riccati_x) == len(set(riccati_x))
+        # a γ SB10AD admits, then its controller (the search's _keeps_gamma)
+        sb = hinf_mod._Sb10(P, n, n)
+        sb_calls.clear()
+        assert sb.admissible(1.5 * r.gamma_opt)
+        assert sb.controller(1.5 * r.gamma_opt).gamma <= 1.5 * r.gamma_opt
+        assert len(sb_calls) == 1

@@ -609,6 +609,11 @@ class _Sb10:
         self.A, self.B, self.C, self.D = (np.ascontiguousarray(M) for M in (A, B, C, D))
         #: smallest γ not refused by SB10AD's lower-bound check so far (:meth:`sb10ad`)
         self._bound_above = np.inf
+        # the γ search tests a γ (SB10AD job 4) whose controller it then builds, and checks
+        # a margin it has computed: both kept, SB10AD's last job-4 call alone (a
+        # controller of the full order)
+        self._last_job4: tuple | None = None
+        self._margins: dict = {}
 
     def sb10ad(self, g: float, job: int, gtol: float = 1e-6):
         """SLICOT SB10AD on the scaled plant at γ = g (job 4: test and controller at g; job
@@ -628,6 +633,16 @@ class _Sb10:
         refused leaves it above g, and g is refused) or on below g to ``gtol`` (job 1).
         python-control's ``hinfsyn`` gets past the bound the same way, from γ = 1e100.
         """
+        key = (float(g), int(job), float(gtol))
+        if self._last_job4 is not None and self._last_job4[0] == key:
+            return self._last_job4[1]
+        result = self._sb10ad_past_bound(g, job, gtol)
+        if job == 4:
+            self._last_job4 = (key, result)
+        return result
+
+    def _sb10ad_past_bound(self, g: float, job: int, gtol: float):
+        """:meth:`sb10ad` computed (its docstring)."""
         args = (self.A, self.B, self.C, self.D, self.ncon, self.nmeas)
         out, info = _sb10ad(*args, g, job, gtol)
         if info != 6:
@@ -696,6 +711,13 @@ class _Sb10:
         D22 does not matter), else +1 (also at or below the Parrott bound). Two Hamiltonian
         Schur forms instead of SB10AD's controller; on plants of at most ``_SMALL_STATES``
         states their compiled eigenvector form (:mod:`ambseal.robust._hinf_small`)."""
+        g = float(g)
+        if g not in self._margins:
+            self._margins[g] = self._riccati_margin(g)
+        return self._margins[g]
+
+    def _riccati_margin(self, g: float) -> float:
+        """:meth:`riccati_margin` computed."""
         nz, nw, A, B, C, D = self.nz, self.nw, self.A, self.B, self.C, self.D
         if g <= self.parrott_bound * (1 + 1e-9):
             return 1.0

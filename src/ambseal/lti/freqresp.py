@@ -69,8 +69,11 @@ _SVD_COND_STATES = 1000
 _BALANCED = ArrayMemo()  # the same of the balanced system (:func:`_arbitrated`)
 #: (λ, cond V, LU of V, CV, balancing) of the last large (A, C), balanced or not: one
 #: eigendecomposition per plant whatever its inputs (the LU of V is n² complex numbers,
-#: 57 MB at 1 888 states; a loop is judged with a few plants at once). Smaller systems
-#: are kept by (A, B, C) in _MODAL and _BALANCED only.
+#: 57 MB at 1 888 states; a loop is judged with a few plants at once). Systems of fewer
+#: than _EIG_STATES states (a design's loops, rebuilt at every iteration) are kept by
+#: (A, B, C) in _MODAL and _BALANCED only; from there up, a plant's current and force
+#: inputs share its eigendecomposition (16 repeated ones on a 468-state rig's run).
+_EIG_STATES = 128
 #: States from which a plant's eigendecomposition is kept per (A, C) and serves every use of
 #: that plant: its responses, the poles of the loops closed on it
 #: (:func:`ambseal.lti.interconnect.feedback_poles`) and its sampled form
@@ -81,7 +84,7 @@ STRUCTURED_STATES = 500
 #: the plants of every judged condition (21 on a 3 × 7 grid), and the later checks close
 #: theirs on the same plants again; at 540 states an entry is 4.7 MB, so
 #: all of them are kept, at 1 888 states (114 MB) six
-_EIG = ArrayMemo(keep=6, min_states=STRUCTURED_STATES, keep_bytes=128 * 2**20)
+_EIG = ArrayMemo(keep=6, min_states=_EIG_STATES, keep_bytes=128 * 2**20)
 _SAMPLED = ArrayMemo(keep=8, min_states=STRUCTURED_STATES)  # sampled_modal_form's results
 _PROBED = ArrayMemo(keep=64)  # C (sI − A)⁻¹ B + D at single probes s of large (A, B, C)
 #: Spread (largest over smallest) of the diagonal balancing of ``A`` above which

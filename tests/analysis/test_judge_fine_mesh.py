@@ -10,6 +10,7 @@ refined to 100 beam elements (848 states), and to 230 (1 888 states) behind ``-m
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
 
@@ -70,3 +71,51 @@ def test_judged_case_at_100_elements_equals_the_dense_path(tmp_path, testrig_des
 def test_judged_case_at_230_elements_equals_the_dense_path(tmp_path, testrig_designs,
                                                             testrig_digital, monkeypatch):
     _judged_both_ways(230, tmp_path, testrig_designs, testrig_digital, monkeypatch)
+
+
+@pytest.mark.parametrize("rig", ["pump", "b2b_compressor"])
+def test_an_example_rigs_judged_case_from_its_modal_form_equals_the_dense_path(rig,
+                                                                              monkeypatch):
+    """Two example rigs (356 and 468 states, below the size where the structured paths
+    start) judged with their derived PID from the plant's modal form — every loop's poles
+    certified from the modal split (:func:`ambseal.lti.modal_loop.modal_loop_poles`, its
+    strong part allowed up to the whole loop), the sampled plant from its modal form —
+    against the dense path: the same verdicts and zones, σ̄(S_o) and every other number
+    within 1e-6 relative."""
+    import ambseal.lti.modal_loop as mloop
+    from ambseal.design.recipes import design
+
+    from ..conftest import _digital
+
+    cfg = load_rig(Path(__file__).resolve().parents[2] / "examples" / f"{rig}.toml")
+    pid = design(cfg, "pid")
+    digital = _digital(cfg, {"pid": pid})["pid"]
+    point = OperatingPoint(cfg.operating.pressure_bar, cfg.operating.speed_rpm, "operating",
+                           "nominal")
+
+    def judged() -> dict:
+        case, _ = judge(cfg, pid.K, "pid", point, judge_settings(design_spec(cfg)),
+                        discrete=digital.statespace(delayed=True))
+        return case.to_dict()
+
+    certified, modal_poles = [], ic._modal_poles
+
+    def spy(*args):
+        poles = modal_poles(*args)
+        certified.append(poles is not None)
+        return poles
+
+    with monkeypatch.context() as m:
+        for module in (fr, ic, ml):
+            m.setattr(module, "STRUCTURED_STATES", 100)
+        m.setattr(mloop, "_MAX_STRONG_FRACTION", 1.0)
+        m.setattr(ic, "_modal_poles", spy)
+        fast = judged()
+    with monkeypatch.context() as m:
+        for module in (fr, ic, ml):
+            m.setattr(module, "STRUCTURED_STATES", 10**9)
+        dense = judged()
+    assert certified and all(certified)
+    assert fast["stable"] and fast["discrete"]["stable"]
+    assert fast["sensitivity_peak"] is not None
+    assert _compare(fast, dense) >= 20

@@ -71,8 +71,9 @@ _BALANCED = ArrayMemo()  # the same of the balanced system (:func:`_arbitrated`)
 #: eigendecomposition per plant whatever its inputs (the LU of V is n² complex numbers,
 #: 57 MB at 1 888 states; a loop is judged with a few plants at once). Systems of fewer
 #: than _EIG_STATES states (a design's loops, rebuilt at every iteration) are kept by
-#: (A, B, C) in _MODAL and _BALANCED only; from there up, a plant's current and force
-#: inputs share its eigendecomposition (16 repeated ones on a 468-state rig's run).
+#: (A, B, C) in _MODAL and _BALANCED only; from there up, the inputs of a plant answered
+#: for one group of them and then another share its eigendecomposition (16 repeated
+#: ones in a run on a 468-state plant).
 _EIG_STATES = 128
 #: States from which a plant's eigendecomposition is kept per (A, C) and serves every use of
 #: that plant: its responses, the poles of the loops closed on it

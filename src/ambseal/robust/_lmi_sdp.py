@@ -184,7 +184,7 @@ def _schur(scaled, lay: _Layout) -> np.ndarray:
     module docstring to the block (v, w), and its entries in the vech coordinates are
 
         [Dᵀ Op D]_pq = w_p (M_p[I_q, J_q] + [I_q ≠ J_q] M_p[J_q, I_q]),
-        M_p[k, l] = Σ_k L_k[I_p, k] R_k[l, J_p],
+        M_p[a, b] = Σ_k L_k[I_p, a] R_k[b, J_p],
 
     the n × n matrix M_p of row p being one product of the rows I_p of the L_k by the
     columns J_p of the R_k, summed over every LMI and pair of terms of the block. The

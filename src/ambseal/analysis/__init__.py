@@ -52,8 +52,8 @@ sampled with its delay) on the full-order plant:
   (:mod:`ambseal.analysis.drop_monte_carlo`, :func:`wilson_interval`);
   :func:`levitated_state`, the AMB loop's unbalance orbit a drop starts from
   (:mod:`ambseal.analysis.drop_levitated`); :func:`amb_loop` → :class:`AmbLoop`, the AMB
-  loop that runs inside the drop, and :func:`drop_event`, the event that lands the rotor
-  (:mod:`ambseal.analysis.drop_loop`);
+  loop that runs inside the drop, :func:`drop_event`, the event that lands the rotor, and
+  :func:`lost_at_rest`, whether a controller acts on it (:mod:`ambseal.analysis.drop_loop`);
 * :func:`run_cases` — every multi-case analysis, serial or on Dask (:func:`dask_available`,
   :func:`probe_scheduler`).
 
@@ -78,6 +78,7 @@ _FROM = {
     "drop_verdict": "drop", "support_matrices": "drop", "drop_scatter": "drop_monte_carlo",
     "wilson_interval": "drop_monte_carlo", "levitated_state": "drop_levitated",
     "AmbLoop": "drop_loop", "amb_loop": "drop_loop", "drop_event": "drop_loop",
+    "lost_at_rest": "drop_loop",
     "capacity_block": "amplifier", "capacity_words": "amplifier", "force_demand": "amplifier",
     "saturates": "amplifier", "unbalance_currents": "amplifier",
     "rejection_effect": "rejection", "rejection_stability": "rejection",

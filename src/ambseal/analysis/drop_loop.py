@@ -55,7 +55,7 @@ from ambseal.model import (
     eddy_lag_matrices,
 )
 
-__all__ = ["AmbLoop", "amb_loop", "drop_event", "EVENTS"]
+__all__ = ["AmbLoop", "amb_loop", "drop_event", "lost_at_rest", "EVENTS"]
 
 #: the events that land a rotor (ISO 14839-4's causes of contact): every AMB's power
 #: lost, one axis's, or a step force beyond what the loop holds
@@ -220,6 +220,28 @@ def amb_loop(cfg, dm, speed_rpm: float | None = None, controller=None) -> AmbLoo
     return AmbLoop(names=names, sensor=sensor @ phi, axis=axis @ phi, ki=ki, ks=ks,
                    static=static, limit=np.array(limit, float), tau=tau, controller=K,
                    coil=_coil(cfg, c), sampled=sampled)
+
+
+def lost_at_rest(event: str, start: str, unbalance_kgm: float) -> bool:
+    """Whether no controller acts on a drop: every AMB loses power (``event`` "loss") with
+    the rotor at its levitated equilibrium — started from rest, or levitated without an
+    unbalance (no orbit to start from). The coils then carry their static currents alone
+    as they decay, and no controller need be derived (:func:`amb_loop` with ``"none"``).
+
+    Parameters
+    ----------
+    event : str
+        One of :data:`EVENTS`.
+    start : str
+        ``"rest"`` or ``"levitated"``.
+    unbalance_kgm : float
+        The rotor's unbalance (kg·m).
+
+    Returns
+    -------
+    bool
+    """
+    return event == "loss" and (start == "rest" or not unbalance_kgm)
 
 
 def drop_event(cfg, dm, loop: AmbLoop, event: str = "loss", axis: str | None = None,

@@ -26,7 +26,7 @@ import numpy as np
 from ambseal.analysis.cases import CaseError, run_cases
 from ambseal.analysis.drop import drop_model, drop_verdict, simulate_drop
 from ambseal.analysis.drop_levitated import levitated_state
-from ambseal.analysis.drop_loop import amb_loop, drop_event
+from ambseal.analysis.drop_loop import amb_loop, drop_event, lost_at_rest
 from ambseal.config import parse_rig
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
@@ -118,9 +118,7 @@ def drop_run(case: dict, rig: dict, speed_rpm: float, duration_s: float, modes_h
     u = case["unbalance_kgm"]
     initial = x0 = None
     ev = event or {}
-    # every axis lost from rest, as ``ambseal drop`` takes it: no controller acts on the
-    # drop, none is derived
-    idle = ev.get("event", "loss") == "loss" and not (start == "levitated" and u)
+    idle = lost_at_rest(ev.get("event", "loss"), start, u)
     loop = amb_loop(cfg, dm, speed_rpm, "none" if idle else None)
     what = drop_event(cfg, dm, loop, **ev)
     # the orbit and the currents the coils carry at the drop, as ``ambseal drop`` starts

@@ -34,6 +34,7 @@ from ambseal.analysis import (
     drop_verdict,
     judge_settings,
     levitated_state,
+    lost_at_rest,
     operating_points,
     parse_range,
     probe_scheduler,
@@ -341,10 +342,8 @@ def _drop(args: argparse.Namespace) -> int:
                              cfg.operating.pressure_bar)
         controller = control.ss(*with_delay((d.A, d.B, d.C, d.D), digital.delay_samples),
                                 d.dt)
-    # every axis lost from the levitated equilibrium at rest: no controller acts on the
-    # drop (the coils carry their static currents alone), none is derived
-    idle = (args.event == "loss" and args.controller is None
-            and (args.start == "rest" or not unbalance[0]))
+    # a controller the user names runs on whatever the drop
+    idle = args.controller is None and lost_at_rest(args.event, args.start, unbalance[0])
     loop = amb_loop(cfg, dm, rpm, "none" if idle else controller)
     event = drop_event(cfg, dm, loop, args.event, args.axis, args.overload_n,
                        args.overload_at, args.surge_bar)

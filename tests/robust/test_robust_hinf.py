@@ -349,6 +349,26 @@ def test_stabilisability_test_does_not_depend_on_the_state_scaling():
     assert r.gamma_opt == pytest.approx(ref.gamma_opt, rel=1e-5)
 
 
+@pytest.mark.parametrize("dual", [False, True], ids=["stabilisable", "detectable"])
+def test_a_weakly_reached_unstable_mode_beside_a_fast_one_is_synthesised(dual):
+    """Reference: python-control's ``hinfsyn`` (SLICOT SB10AD without a PBH pre-check),
+    γ of the plant and of its dual (Aᵀ, Cᵀ, Bᵀ, Dᵀ: the same H∞ problem). The unstable
+    mode at 1 rad/s is reached by u (seen by y) through 1e-4 beside a mode at −1e6 rad/s:
+    the PBH matrix's σ_min/σ_max is 1e-10, balanced or not, but the mode's eigenvector
+    has a cosine of 1e-4 with B2 (C2), and SB10AD stabilises the loop. The rank test
+    alone refused it as not stabilisable (not detectable), as it refused a blower's
+    D–G-scaled plant, which stopped its μ-synthesis early."""
+    A = np.diag([1.0, -1e6])
+    B = np.array([[1e-2, 1e-4], [1.0, 1.0]])
+    C = np.array([[1.0, 1e-3], [1.0, 1e-3]])
+    D = np.array([[0.0, 1.0], [1.0, 0.0]])
+    P = ct.ss(A.T, C.T, B.T, D.T) if dual else ct.ss(A, B, C, D)
+    gamma_ref = ct.hinfsyn(P, 1, 1)[2]
+    r = hinfsyn(P, 1, 1)
+    assert r.gamma_opt == pytest.approx(gamma_ref, rel=1e-5)
+    assert np.all(np.linalg.eigvals(np.asarray(r.closed_loop.A)).real < 0)
+
+
 def test_hinfsyn_rejects_undetectable_plant():
     """Reference: PBH test — an unstable mode not seen by C2 cannot be detected."""
     A = np.diag([1.0, -2.0])

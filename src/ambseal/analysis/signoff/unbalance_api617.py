@@ -112,6 +112,8 @@ NOISE_SHARE = 1e-9
 #: Speeds of the coarse sweep; each critical is refined with :data:`REFINE` more.
 SPEEDS = 241
 REFINE = 41
+#: Speeds of the sweep closer than this (relative) are one speed: rounding apart.
+TWIN = 1e-12
 
 
 def unbalance_ur(load_kg: float, speed_rpm: float) -> float:
@@ -708,7 +710,12 @@ def api617_unbalance(cfg, controller=None, *, name: str = "none",
                 extra.append(np.linspace(coarse[i - 1], coarse[i + 1], REFINE)[1:-1])
     speed = coarse
     if extra:
-        fine = np.setdiff1d(np.unique(np.concatenate(extra)), coarse)
+        # the refinements of neighbouring peaks, and each one's midpoint and the coarse
+        # point it refines, coincide up to rounding: one speed of each (a twin beside the
+        # sampled peak leaves the bracket of its exact peak empty on that side)
+        fine = np.unique(np.concatenate(extra))
+        fine = fine[np.concatenate([[True], np.diff(fine) > TWIN * fine[1:]])]
+        fine = fine[np.min(np.abs(fine[:, None] - coarse[None, :]), axis=1) > TWIN * fine]
         speed = np.concatenate([coarse, fine])
         order = np.argsort(speed)
         speed, amp = speed[order], np.concatenate([amp, response(fine)], axis=1)[:, order]

@@ -175,10 +175,10 @@ PBH_RTOL = 1e-9
 def _pbh_fails(A, X, rows, eigs):
     """The eigenvalues ``eigs`` of A that are not stable (:func:`~ambseal.robust.stability.
     unstable_poles`) at which [A - λI, X] (or its dual) loses rank and which the mode's
-    eigenvector confirms (:func:`_modal_cosine`): the rank test alone, relative to
-    σ_max of the PBH matrix, took a mode reached by the inputs with a cosine of 2e-5 for
-    lost where the scalings' fast poles (to −1.9e5 rad/s) set σ_max (a D–G-scaled plant
-    that SB10AD stabilises)."""
+    eigenvector confirms (:func:`_modal_cosine`): the rank test alone is relative to the
+    PBH matrix's σ_max, which fast stable modes (a D–G scaling's poles) set, so a mode the
+    inputs reach with a small cosine falls below it, and SB10AD stabilises it all the
+    same."""
     n = A.shape[0]
     bad = []
     for lam in unstable_poles(eigs):

@@ -7,7 +7,8 @@ import control as ct
 import numpy as np
 import pytest
 
-from ambseal.analysis.amplifier import capacity_block, capacity_words, force_demand
+from ambseal.analysis.amplifier import (capacity_block, capacity_words, force_demand,
+                                        notched_currents)
 from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
 from ambseal.analysis.unbalance import forward_forces, unbalance_force
 from ambseal.design.specs import design_spec
@@ -109,6 +110,34 @@ def test_capacity_block_names_the_limit_and_where(testrig_cfg, judged):
     fit = capacity_block(testrig_cfg.model_copy(update={"amb": sized}), entries)
     assert fit["current_used"] == pytest.approx(1.0, rel=1e-12)
     assert fit["voltage_used"] == pytest.approx(1.0, rel=1e-12)
+
+
+def test_a_notch_that_holds_leaves_the_amplifier_what_it_leaves(testrig_cfg, judged):
+    """With an unbalance force rejection on from the middle of the judged speeds, the
+    amplifier holds the unbalance with the current the notch leaves there and the
+    controller's alone below it: the block is the closed form of the controller alone
+    restricted to the speeds below the notch (its left current far below), and its words
+    say the rejection is on and what the controller alone would take."""
+    _, _, _, curves = judged
+    speeds, current, names = curves["unbalance_current"]
+    on = float(speeds[speeds.size // 2])
+    entries = [("0 bar", speeds, current, names, None)]
+    notched = list(notched_currents(entries, on, 1e-12))
+    assert np.array_equal(notched[0][2][speeds < on], current[speeds < on])
+    assert np.all(notched[0][2][speeds >= on] == 1e-12)
+    assert np.array_equal(entries[0][2], current)  # the controller alone's are kept
+    below = capacity_block(testrig_cfg, [("0 bar", speeds[speeds < on], current[speeds < on],
+                                          names, None)])
+    block = capacity_block(testrig_cfg, notched)
+    alone = capacity_block(testrig_cfg, entries)
+    assert block["current_used"] == pytest.approx(below["current_used"], rel=1e-12)
+    assert block["current_used"] < alone["current_used"]
+    assert block["worst"]["current_used"]["speed_hz"] < on
+    block["without_rejection"] = {q: v for q, v in alone.items() if q.endswith("_used")}
+    words = capacity_words(block)
+    assert words.startswith("holding the unbalance (its unbalance force rejection on) it uses")
+    assert words.endswith(f"; without its unbalance force rejection, holding the unbalance "
+                          f"would take {alone['current_used']:.3g}× the current limit")
 
 
 def test_impulse_voltage_is_the_coil_driven_through_the_amplifier(testrig_cfg, judged):

@@ -80,7 +80,7 @@ _FROM = {
     "AmbLoop": "drop_loop", "amb_loop": "drop_loop", "drop_event": "drop_loop",
     "lost_at_rest": "drop_loop",
     "capacity_block": "amplifier", "capacity_words": "amplifier", "force_demand": "amplifier",
-    "saturates": "amplifier", "unbalance_currents": "amplifier",
+    "saturates": "amplifier", "unbalance_currents": "amplifier", "notched_currents": "amplifier",
     "rejection_effect": "rejection", "rejection_stability": "rejection",
     "facility_rejection": "rejection", "FacilityRejection": "rejection",
     "facility_speed_step": "rejection", "SpeedStep": "rejection",

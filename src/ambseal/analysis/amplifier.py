@@ -33,6 +33,14 @@ the loop holds it with a static control current i_s per axis
 on which the unbalance's and the impulse's currents ride: the amplifier drives
 |i_s| + i_c and its coils need R (i0 + |i_s|) plus the dynamic voltage — the static load
 takes its share of the bias's linear range, the current limit and the supply.
+
+A controller that runs with its unbalance force rejection (``[design.rejection]``,
+:mod:`ambseal.design.synchronous_rejection`) holds the unbalance with the synchronous
+current its notch leaves wherever the notch is on (:func:`notched_currents`): the notch
+removes the synchronous component from the control current, the rotor then turns about its
+axis of inertia (Herzog et al., IEEE TCST 4(5), 1996; Schweitzer & Maslen 2009, ch. 15),
+and the run's effect of the notch (:func:`ambseal.analysis.rejection.rejection_effect`)
+gives what is left. Below the notch's speed the controller alone holds it.
 """
 
 from __future__ import annotations
@@ -43,8 +51,8 @@ from ambseal.lti import freqresp_at, zoh
 from ambseal.model import (AXES, actuator_matrices, amb_factors, amplifier_needs,
                            axis_label, limits_used, transient_needs)
 
-__all__ = ["unbalance_currents", "impulse_coil_currents", "force_demand", "capacity_block",
-           "capacity_words", "saturates"]
+__all__ = ["unbalance_currents", "notched_currents", "impulse_coil_currents", "force_demand",
+           "capacity_block", "capacity_words", "saturates"]
 
 #: The fractions of :func:`ambseal.model.capacity.amplifier_use`, as metrics.json names them,
 #: and what each is a fraction of, in words.
@@ -73,6 +81,33 @@ def unbalance_currents(Kw: np.ndarray, H: np.ndarray, force_n: np.ndarray) -> np
     ndarray, shape (F, nu)
     """
     return np.linalg.norm(Kw @ H, axis=2) * np.asarray(force_n, float)[:, None]
+
+
+def notched_currents(entries, on_hz: float, left_a: float):
+    """The unbalance's current references of :func:`capacity_block`'s ``entries`` with an
+    unbalance force rejection on from ``on_hz`` up (module docstring): at those speeds every
+    axis's reference is ``left_a``, below them the controller's alone.
+
+    Parameters
+    ----------
+    entries : iterable of (str, ndarray, ndarray, sequence of str, dict or None)
+        As :func:`capacity_block`'s, the controller alone.
+    on_hz : float
+        The speed (Hz) the notch is on from.
+    left_a : float
+        The synchronous current (A, amplitude) the notch leaves, the largest over the
+        speeds it is on at (:func:`ambseal.analysis.rejection.rejection_effect`'s
+        ``current_a["with"]``), ≥ 0.
+
+    Yields
+    ------
+    tuple
+        Each entry with its current references replaced where the notch is on.
+    """
+    for label, speed_hz, i_ref, names, static in entries:
+        i_ref = np.array(i_ref, float)
+        i_ref[np.asarray(speed_hz, float) >= on_hz] = float(left_a)
+        yield label, speed_hz, i_ref, names, static
 
 
 def impulse_coil_currents(act, impulse) -> tuple[np.ndarray, np.ndarray | None]:
@@ -257,12 +292,16 @@ def capacity_words(block: dict | None) -> str:
     supply voltage (A ζ at 11 000 rpm, 0 bar)"`` (``"in the current impulse"`` where the
     impulse response uses more), the largest of the voltage and current fractions; when a
     fraction is above 1, ``"the amplifier saturates holding the unbalance: it needs 1.5×
-    the current limit (…)"``; ``""`` without a limit to set it against.
+    the current limit (…)"``; ``""`` without a limit to set it against. A block of a
+    controller that runs with its unbalance force rejection (``without_rejection``: the
+    fractions of the controller alone, :func:`notched_currents`) says so, and what the
+    controller alone would need: ``"…; without its unbalance force rejection, holding the
+    unbalance would take 1.09× the bias current's linear range"``.
 
     Parameters
     ----------
     block : dict or None
-        A :func:`capacity_block`.
+        A :func:`capacity_block`, with ``without_rejection`` where the notch holds it.
 
     Returns
     -------
@@ -280,7 +319,15 @@ def capacity_words(block: dict | None) -> str:
     holding = _HOLDING[w.get("response", "unbalance")]
     if c.get("static_a"):
         holding += " and the seals' static load"
-    if over:
-        return f"the amplifier saturates {holding}: it needs {v:.3g}× {what} ({at})"
-    return f"{holding} it uses {100 * v:.0f} % of {what} ({at})"
+    alone = c.get("without_rejection")
+    if alone is not None and w.get("response", "unbalance") == "unbalance":
+        holding += " (its unbalance force rejection on)"
+    text = (f"the amplifier saturates {holding}: it needs {v:.3g}× {what} ({at})" if over
+            else f"{holding} it uses {100 * v:.0f} % of {what} ({at})")
+    known = [q for q in QUANTITIES if (alone or {}).get(q) is not None]
+    if known:
+        q = max(known, key=alone.get)
+        text += (f"; without its unbalance force rejection, holding the unbalance would take "
+                 f"{alone[q]:.3g}× {_LIMITS[q]}")
+    return text
 

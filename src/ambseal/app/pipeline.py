@@ -32,6 +32,7 @@ from ambseal.analysis import (
     judge_settings,
     judge_spinup,
     loop_failure,
+    notched_currents,
     operating_points,
     rejection_effect,
     rig_clearances_um,
@@ -551,53 +552,88 @@ def _static(curves: dict) -> dict | None:
     return None if static is None else dict(zip(static[1], static[0]))
 
 
-def _rejections(st: _RunState, summaries: dict) -> dict:
-    """Each delivered controller's unbalance force rejection
-    (:func:`~ambseal.design.synchronous_rejection.design_rejection` on the design rig),
-    judged at its judged conditions and shown against the controller alone on the judged
-    rig, and switched on, then through a speed step, under a sensor runout on the virtual
-    facility (:mod:`ambseal.analysis.rejection`): its ``rejection`` block in
-    ``summaries``, and for the figures ``{"effects": method → the effect's curves,
-    "facility": method → FacilityRejection, "speed_step": method → SpeedStep}``. A notch
-    that loses a loop, or whose orbit exceeds a clearance of the rig
-    (:func:`ambseal.analysis.delivery.clearance_exceeded`: ``beyond`` in the block), is
-    said so on stderr and in the block, not exported; the controller alone is delivered
-    still. A controller not delivered gets no notch files."""
+@dataclass(frozen=True)
+class _Notch:
+    """A controller's unbalance force rejection, judged: the notch
+    (:class:`~ambseal.design.synchronous_rejection.SynchronousRejection`), its loops at
+    every condition judged where it is on (:func:`~ambseal.analysis.rejection.
+    rejection_stability`), the conditions where one is lost, its effect over the speed
+    range (:func:`~ambseal.analysis.rejection.rejection_effect`) and the clearance its
+    orbit exceeds (``(name, µm)``, or None)."""
+
+    rejection: object
+    rows: list
+    lost: list
+    effect: dict
+    beyond: tuple | None
+
+    @property
+    def holds(self) -> bool:
+        """Every loop with the notch holds and its orbit fits the rig's clearances."""
+        return not self.lost and self.beyond is None
+
+
+def _notches(st: _RunState) -> dict[str, _Notch]:
+    """Each controller's unbalance force rejection
+    (:func:`~ambseal.design.synchronous_rejection.design_rejection` on the design rig) but
+    those that cannot run on the target or are scheduled on another parameter, judged at
+    every condition the run judges its controller at, in full and over the speed range,
+    and shown against the controller alone on the judged rig: method → :class:`_Notch`."""
     st.stages.begin("rejection", "unbalance force rejection")
     r = st.cfg.design.rejection
     kw = {k: v for k, v in (("rate_fraction", r.rate_fraction), ("points", r.points))
           if v is not None}
-    effects, facility, steps = {}, {}, {}
     speeds = stability_points(st.spec.pressures_bar, st.spec.stability_speeds_hz, st.points)
+    clearances = rig_clearances_um(st.cfg)
+    out = {}
     for d in st.designs:
         g = st.digitals.get(d.method)
-        if d.method not in summaries or g is None or getattr(g, "parameter", SPEED) != SPEED:
+        if g is None or getattr(g, "parameter", SPEED) != SPEED:
             continue
         rej = design_rejection(st.design_cfg, d.controller, g, **kw)
-        # every condition the run judges it at: in full, and over the speed range
         rows = rejection_stability(st.judge_cfg, rej, [j.point for j in st.jobs
                                                        if j.name == d.method] + speeds)
         lost = [x["condition"] for x in rows
                 if not x["stable"] or x["stable_as_runs"] is False]
-        effects[d.method] = rejection_effect(st.judge_cfg, g, rej, st.settings)
-        e = effects[d.method]
-        summaries[d.method]["rejection"] = {
-            **rej.to_dict(), "stable": not lost, "conditions": rows,
+        effect = rejection_effect(st.judge_cfg, g, rej, st.settings)
+        beyond = clearance_exceeded(float(np.max(effect["orbit_um"]["with"])), clearances)
+        out[d.method] = _Notch(rej, rows, lost, effect, beyond)
+        st.stages.step()
+    return out
+
+
+def _rejections(st: _RunState, summaries: dict, notches: dict[str, _Notch]) -> dict:
+    """Each delivered controller's unbalance force rejection (:func:`_notches`), switched
+    on, then through a speed step, under a sensor runout on the virtual facility
+    (:mod:`ambseal.analysis.rejection`): its ``rejection`` block in ``summaries``, and for
+    the figures ``{"effects": method → the effect's curves, "facility": method →
+    FacilityRejection, "speed_step": method → SpeedStep}``. A notch that loses a loop, or
+    whose orbit exceeds a clearance of the rig
+    (:func:`ambseal.analysis.delivery.clearance_exceeded`: ``beyond`` in the block), is
+    said so on stderr and in the block, not exported; the controller alone is delivered
+    still. A controller not delivered gets no notch files."""
+    r = st.cfg.design.rejection
+    effects, facility, steps = {}, {}, {}
+    for m, n in notches.items():
+        if m not in summaries:
+            continue
+        rej, e, lost, beyond, g = n.rejection, n.effect, n.lost, n.beyond, st.digitals[m]
+        effects[m] = e
+        orbit = float(np.max(e["orbit_um"]["with"]))
+        summaries[m]["rejection"] = {
+            **rej.to_dict(), "stable": not lost, "conditions": n.rows,
             **{q: {k: float(np.max(v)) for k, v in e[q].items()}
                for q in ("current_a", "force_n", "orbit_um")},
             "current_ratio": float(np.max(e["current_a"]["with"]
-                                          / np.maximum(e["current_a"]["without"], 1e-300)))}
-        orbit = summaries[d.method]["rejection"]["orbit_um"]["with"]
-        beyond = clearance_exceeded(orbit, rig_clearances_um(st.cfg))
-        summaries[d.method]["rejection"]["beyond"] = (
-            None if beyond is None else {"clearance": beyond[0], "clearance_um": beyond[1],
-                                         "orbit_um": orbit})
-        delivered = summaries[d.method].get("discretisation") is not None
+                                          / np.maximum(e["current_a"]["without"], 1e-300))),
+            "beyond": None if beyond is None else {"clearance": beyond[0],
+                                                   "clearance_um": beyond[1],
+                                                   "orbit_um": orbit}}
+        delivered = summaries[m].get("discretisation") is not None
         if lost:  # said, not delivered
-            st.say(f"{d.method}: its unbalance force rejection loses the loop at "
-                   f"{', '.join(lost)}")
+            st.say(f"{m}: its unbalance force rejection loses the loop at {', '.join(lost)}")
         elif beyond is not None:
-            st.say(f"{d.method}: with its unbalance force rejection the orbit, {orbit:.3g} µm, "
+            st.say(f"{m}: with its unbalance force rejection the orbit, {orbit:.3g} µm, "
                    f"exceeds {CLEARANCE_WORDS.get(beyond[0], beyond[0])} ({beyond[1]:.3g} µm):"
                    " not exported")
         elif delivered:  # on the facility at the top speed (the most synchronous current), then
@@ -608,20 +644,18 @@ def _rejections(st: _RunState, summaries: dict) -> dict:
             # and a speed step to the top from 10 % below it (within the range)
             step = facility_speed_step(st.judge_cfg, g, rej, max(lo, 0.9 * top), top,
                                        runout_m=runout)
-            summaries[d.method]["rejection"]["facility"] = {**fac.to_dict(),
-                                                            "speed_step": step.to_dict()}
-            facility[d.method] = fac
-            steps[d.method] = step
+            summaries[m]["rejection"]["facility"] = {**fac.to_dict(),
+                                                     "speed_step": step.to_dict()}
+            facility[m] = fac
+            steps[m] = step
             if not fac.after_a < 1e-2 * fac.before_a:
-                st.say(f"{d.method}: on the virtual facility at {top:g} Hz its notch leaves "
+                st.say(f"{m}: on the virtual facility at {top:g} Hz its notch leaves "
                        f"{fac.after_a:.3g} A of synchronous current of {fac.before_a:.3g} A")
             folder = st.out / "controllers"
-            files = [export_notch(rej.digital.notch, folder / f"rejection_{d.method}.json",
-                                  d.method),
-                     *write_notch_c(rej.digital.notch, folder, f"ambseal_{d.method}_rejection")]
-            summaries[d.method]["rejection"]["files"] = [
+            files = [export_notch(rej.digital.notch, folder / f"rejection_{m}.json", m),
+                     *write_notch_c(rej.digital.notch, folder, f"ambseal_{m}_rejection")]
+            summaries[m]["rejection"]["files"] = [
                 f.relative_to(st.out).as_posix() for f in files]
-        st.stages.step()
     return {"effects": effects, "facility": facility, "speed_step": steps}
 
 
@@ -636,8 +670,20 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
               for j, case, (_, c) in zip(st.jobs, case_dicts, st.judged)]
     currents = {d.method: list(_unbalance_currents(d.method, st.jobs, st.judged))
                 for d in st.designs}
+    notches = _notches(st) if cfg.design.rejection.enabled else {}
+    alone = {}
+    for m, n in notches.items():  # a notch that holds runs with its controller
+        if n.holds and m in currents:
+            alone[m] = capacity_block(cfg, currents[m], _impulses(m, st.jobs, st.judged))
+            currents[m] = list(notched_currents(
+                currents[m], n.rejection.controller.notch.on_rad_s / (2 * np.pi),
+                float(np.max(n.effect["current_a"]["with"]))))
     capacity = {m: capacity_block(cfg, entries, _impulses(m, st.jobs, st.judged))
                 for m, entries in currents.items()}
+    for m, block in alone.items():
+        if block is not None and capacity[m] is not None:
+            capacity[m]["without_rejection"] = {q: v for q, v in block.items()
+                                                if q.endswith("_used")}
     for m, block in capacity.items():  # an amplifier that saturates fails its controller
         f = saturation_failure(m, block, designed=m != "pid", kept=st.allow_unstable,
                                derived=cfg.controller.pid is None)
@@ -657,7 +703,7 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
                            [s.to_dict() for s in stability])
     for m, summary in summaries.items():
         summary["capacity"] = capacity.get(m)
-    rejections = _rejections(st, summaries) if cfg.design.rejection.enabled else {}
+    rejections = _rejections(st, summaries, notches) if notches else {}
     ident = st.ident
     figs, sections = ([], []) if ident is None else (ident.figs, ident.sections)
     spinup = ramp = None

@@ -219,6 +219,18 @@ def _every_file_through_every_command(rig: Path, out: Path, tmp: Path, capsys) -
             assert json.loads(cap.out), (argv[0], path.name)
 
 
+def _file_at(f, hz: float) -> list[np.ndarray]:
+    """An exported controller file's A, B, C, D at ``hz``: a scheduled one's table linear
+    between its speeds (rad/s) as the file says, held at its ends."""
+    mats = [np.asarray(f[k], float) for k in "ABCD"]
+    if mats[0].ndim == 3:
+        w = np.clip(2 * np.pi * hz, f["grid"][0], f["grid"][-1])
+        j = min(int(np.searchsorted(f["grid"], w, side="right")) - 1, len(f["grid"]) - 2)
+        t = (w - f["grid"][j]) / (f["grid"][j + 1] - f["grid"][j])
+        mats = [(1 - t) * M[j] + t * M[j + 1] for M in mats]
+    return mats
+
+
 def _held_by_python_control(rig: Path, metrics: dict, out: Path) -> None:
     """The independent check of what the run delivers: each delivered controller's
     exported discrete file (``controllers/controller_<m>.npz``, a scheduled one
@@ -234,13 +246,7 @@ def _held_by_python_control(rig: Path, metrics: dict, out: Path) -> None:
         f = np.load(out / "controllers" / f"controller_{m}.npz", allow_pickle=False)
         Ts, d = float(f["Ts"]), int(f["delay_samples"])
         for p, hz in sorted(conditions):
-            mats = [np.asarray(f[k], float) for k in "ABCD"]
-            if mats[0].ndim == 3:  # scheduled on speed: linear between the table's speeds
-                w = np.clip(2 * np.pi * hz, f["grid"][0], f["grid"][-1])
-                j = min(int(np.searchsorted(f["grid"], w, side="right")) - 1, len(f["grid"]) - 2)
-                t = (w - f["grid"][j]) / (f["grid"][j + 1] - f["grid"][j])
-                mats = [(1 - t) * M[j] + t * M[j + 1] for M in mats]
-            K = control.ss(*mats, Ts) * control.tf([1], [1] + [0] * d, Ts)
+            K = control.ss(*_file_at(f, hz), Ts) * control.tf([1], [1] + [0] * d, Ts)
             plant = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * hz)
             cur = plant.current_inputs()
             G = control.ss(plant.A, plant.B[:, cur], plant.C, plant.D[:, cur])
@@ -250,7 +256,8 @@ def _held_by_python_control(rig: Path, metrics: dict, out: Path) -> None:
 
 def _rejection_held_by_python_control(rig: Path, metrics: dict, out: Path) -> None:
     """The exported unbalance force rejection checked as :func:`_held_by_python_control`
-    checks the controllers: each delivered controller's file with its notch read back
+    checks the controllers: each delivered controller's file (a scheduled one at the
+    condition's speed) with its notch read back
     from ``rejection_<m>.json`` — the controller after python-control's loop
     ``q = y − N q`` (``control.feedback``), then its delay — closed on the full-order plant
     sampled by python-control at every condition the run judged where the notch is on:
@@ -265,10 +272,10 @@ def _rejection_held_by_python_control(rig: Path, metrics: dict, out: Path) -> No
         f = np.load(out / "controllers" / f"controller_{m}.npz", allow_pickle=False)
         Ts, d = float(f["Ts"]), int(f["delay_samples"])
         assert Ts == notch.dt
-        K = control.ss(*[np.asarray(f[k], float) for k in "ABCD"], Ts)
         delay = control.tf([1], [1] + [0] * d, Ts)
         for p, hz in sorted(c for c in conditions if notch.is_on(2 * np.pi * c[1])):
             w = 2 * np.pi * hz
+            K = control.ss(*_file_at(f, hz), Ts)
             A, B, C = notch.matrices_at(w)
             N = control.ss(A, B, C, np.zeros((C.shape[0], C.shape[0])), Ts)
             Kn = K * control.feedback(control.ss([], [], [], np.eye(C.shape[0]), Ts), N)

@@ -22,10 +22,9 @@ import pytest
 
 from ambseal.cli import main
 from ambseal.config import load_rig
-from ambseal.export import load_notch
 from ambseal.model import build_plant
 
-from .freq_at import at
+from .exported_files import file_at, rejection_held_by_python_control
 from .metrics_schema import validate_metrics
 from .report_agreement import check_report_agrees
 
@@ -171,7 +170,7 @@ def test_every_example_runs_end_to_end(rig, tmp_path, capsys):
         assert not [f for f in (tmp_path / "out" / "controllers").glob("rejection_*")
                     if f.name.split(".")[0].removeprefix("rejection_") not in delivered]
         assert (tmp_path / "out" / "rejection.png").is_file()
-        _rejection_held_by_python_control(rig, metrics, tmp_path / "out")
+        rejection_held_by_python_control(rig, metrics, tmp_path / "out")
     _every_file_through_every_command(rig, tmp_path / "out", tmp_path, capsys)
 
 
@@ -219,18 +218,6 @@ def _every_file_through_every_command(rig: Path, out: Path, tmp: Path, capsys) -
             assert json.loads(cap.out), (argv[0], path.name)
 
 
-def _file_at(f, hz: float) -> list[np.ndarray]:
-    """An exported controller file's A, B, C, D at ``hz``: a scheduled one's table linear
-    between its speeds (rad/s) as the file says, held at its ends."""
-    mats = [np.asarray(f[k], float) for k in "ABCD"]
-    if mats[0].ndim == 3:
-        w = np.clip(2 * np.pi * hz, f["grid"][0], f["grid"][-1])
-        j = min(int(np.searchsorted(f["grid"], w, side="right")) - 1, len(f["grid"]) - 2)
-        t = (w - f["grid"][j]) / (f["grid"][j + 1] - f["grid"][j])
-        mats = [(1 - t) * M[j] + t * M[j + 1] for M in mats]
-    return mats
-
-
 def _held_by_python_control(rig: Path, metrics: dict, out: Path) -> None:
     """The independent check of what the run delivers: each delivered controller's
     exported discrete file (``controllers/controller_<m>.npz``, a scheduled one
@@ -246,57 +233,12 @@ def _held_by_python_control(rig: Path, metrics: dict, out: Path) -> None:
         f = np.load(out / "controllers" / f"controller_{m}.npz", allow_pickle=False)
         Ts, d = float(f["Ts"]), int(f["delay_samples"])
         for p, hz in sorted(conditions):
-            K = control.ss(*_file_at(f, hz), Ts) * control.tf([1], [1] + [0] * d, Ts)
+            K = control.ss(*file_at(f, hz), Ts) * control.tf([1], [1] + [0] * d, Ts)
             plant = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * hz)
             cur = plant.current_inputs()
             G = control.ss(plant.A, plant.B[:, cur], plant.C, plant.D[:, cur])
             z = control.feedback(control.sample_system(G, Ts, "zoh"), K).poles()
             assert np.abs(z).max() < 1, (rig.stem, m, p, hz, np.abs(z).max())
-
-
-def _rejection_held_by_python_control(rig: Path, metrics: dict, out: Path) -> None:
-    """The exported unbalance force rejection checked as :func:`_held_by_python_control`
-    checks the controllers: each delivered controller's file (a scheduled one at the
-    condition's speed) with its notch read back
-    from ``rejection_<m>.json`` — the controller after python-control's loop
-    ``q = y − N q`` (``control.feedback``), then its delay — closed on the full-order plant
-    sampled by python-control at every condition the run judged where the notch is on:
-    every pole inside the unit circle, and the current from forces at the bearings at
-    the rotational frequency below 1 % of the controller's alone."""
-    cfg = load_rig(rig)
-    delivered = set(metrics["controllers"]) - set(metrics["failed"]) - set(metrics["cannot_run"])
-    conditions = {(c["pressure_bar"], c["speed_hz"]) for c in metrics["stability"]} | {
-        (c["pressure_bar"], c["speed_hz"]) for c in metrics["cases"]}
-    for m in sorted(delivered):
-        notch = load_notch(out / "controllers" / f"rejection_{m}.json")
-        f = np.load(out / "controllers" / f"controller_{m}.npz", allow_pickle=False)
-        Ts, d = float(f["Ts"]), int(f["delay_samples"])
-        assert Ts == notch.dt
-        delay = control.tf([1], [1] + [0] * d, Ts)
-        for p, hz in sorted(c for c in conditions if notch.is_on(2 * np.pi * c[1])):
-            w = 2 * np.pi * hz
-            K = control.ss(*_file_at(f, hz), Ts)
-            A, B, C = notch.matrices_at(w)
-            N = control.ss(A, B, C, np.zeros((C.shape[0], C.shape[0])), Ts)
-            Kn = K * control.feedback(control.ss([], [], [], np.eye(C.shape[0]), Ts), N)
-            plant = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * hz,
-                                force_positions=tuple(a.position for a in cfg.amb))
-            cur = plant.current_inputs()
-            frc = [j for j in range(plant.B.shape[1]) if j not in cur]
-            G = control.sample_system(control.ss(plant.A, plant.B, plant.C, plant.D), Ts,
-                                      "zoh")
-            z = np.exp(1j * w * Ts)
-            gains = []
-            for Kx in (K * delay, Kn * delay):
-                Gi = control.ss(G.A, G.B[:, cur], G.C, G.D[:, cur], Ts)
-                Gf = control.ss(G.A, G.B[:, frc], G.C, G.D[:, frc], Ts)
-                loop = control.feedback(Gi, Kx)
-                assert np.abs(loop.poles()).max() < 1, (rig.stem, m, p, hz)
-                # current from the forces: i = −K (I + G K)⁻¹ G_f, at z
-                Gz, Gfz, Kz = at(Gi, z), at(Gf, z), at(Kx, z)
-                gains.append(np.abs(Kz @ np.linalg.solve(np.eye(Gz.shape[0]) + Gz @ Kz,
-                                                         Gfz)).max())
-            assert gains[1] < 1e-2 * gains[0], (rig.stem, m, p, hz, gains)
 
 
 def _testrig_without(kind: str) -> str:

@@ -22,8 +22,9 @@ import pytest
 
 from ambseal.cli import main
 from ambseal.config import load_rig
-from ambseal.export import load_notch
 from ambseal.model import build_plant
+
+from .exported_files import file_at, rejection_held_by_python_control
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 RIG = EXAMPLES / "flywheel.toml"
@@ -50,17 +51,6 @@ def gyroscopic_run(request, tmp_path_factory):
     if request.param == "flywheel":
         return rig, *request.getfixturevalue("flywheel_run")
     return rig, *_run(rig, tmp_path_factory)
-
-
-def _interpolated(f, speed_hz: float) -> list[np.ndarray]:
-    """The exported table's matrices at ``speed_hz``, linear between its speeds (rad/s)
-    as the file says, held at the ends."""
-    mats = [np.asarray(f[k], float) for k in "ABCD"]
-    g = np.asarray(f["grid"], float)
-    w = np.clip(2 * np.pi * speed_hz, g[0], g[-1])
-    j = min(int(np.searchsorted(g, w, side="right")) - 1, g.size - 2)
-    t = (w - g[j]) / (g[j + 1] - g[j])
-    return [(1 - t) * M[j] + t * M[j + 1] for M in mats]
 
 
 def _frf(A, B, C, D, z: np.ndarray) -> np.ndarray:
@@ -97,7 +87,7 @@ def test_the_lpv_runs_from_standstill_to_the_top_speed(gyroscopic_run):
     w = np.pi / Ts * np.logspace(-4, 0, 2000)[:-1]
     z = np.exp(1j * w * Ts)
     for hz in sorted({*np.linspace(0.0, top_hz, 17), *judged}):
-        K = control.ss(*_interpolated(f, hz), Ts) * control.tf([1], [1] + [0] * d, Ts)
+        K = control.ss(*file_at(f, hz), Ts) * control.tf([1], [1] + [0] * d, Ts)
         plant = build_plant(cfg, speed_rpm=60.0 * hz)
         cur = plant.current_inputs()
         G = control.sample_system(control.ss(plant.A, plant.B[:, cur], plant.C,
@@ -107,7 +97,7 @@ def test_the_lpv_runs_from_standstill_to_the_top_speed(gyroscopic_run):
         if hz not in judged:
             continue
         Gz = _frf(*(np.asarray(X, float) for X in (G.A, G.B, G.C, G.D)), z)
-        Kz = _frf(*_interpolated(f, hz), z) * (z ** -d)[:, None, None]
+        Kz = _frf(*file_at(f, hz), z) * (z ** -d)[:, None, None]
         eye = np.eye(Gz.shape[1])
         S = np.linalg.solve(eye + Gz @ Kz, np.broadcast_to(eye, Gz.shape))
         per_axis = np.abs(np.diagonal(S, axis1=1, axis2=2)).max(axis=0)
@@ -125,14 +115,13 @@ def test_the_flywheel_holds_its_unbalance_with_its_notch_on(flywheel_run):
     """Near the top speed the G2.5 residual unbalance whirls the flywheel in its forward
     conical mode whatever the controller, and the LPV alone would ask its amplifier for
     about the whole bias current to hold it; the example runs it with its unbalance force
-    rejection. Checked by python-control on the exported files: the LPV's table at each
-    judged speed where the notch is on, with the notch read back from
-    ``rejection_lpv.json`` (the controller after the loop q = y − N q, then its delay),
-    holds the full-order plant sampled by python-control, and the coil-current reference
-    from forces at the bearings at the rotational frequency is below 1 % of the LPV's
-    alone. So the run judges the amplifier with the notch on: every fraction below the
-    controller's alone (``without_rejection``) and below 1, the notched orbit inside the
-    backup clearance."""
+    rejection. Checked by python-control on the exported files
+    (:func:`tests.exported_files.rejection_held_by_python_control`): the LPV's table at
+    each judged speed where the notch is on, with its exported notch, holds the full-order
+    plant sampled by python-control, and the current from forces at the bearings at the
+    rotational frequency is below 1 % of the LPV's alone, up to the top speed. So the run
+    judges the amplifier with the notch on: every fraction below the controller's alone
+    (``without_rejection``) and below 1, the notched orbit inside the backup clearance."""
     code, metrics, out = flywheel_run
     cfg = load_rig(RIG)
     s = metrics["controllers"]["lpv"]
@@ -142,36 +131,9 @@ def test_the_flywheel_holds_its_unbalance_with_its_notch_on(flywheel_run):
     assert s["rejection"]["stable"] and s["rejection"]["beyond"] is None
     backup_um = min(map(cfg.backup_clearance, cfg.amb)) * 1e6
     assert s["rejection"]["orbit_um"]["with"] < backup_um
-    notch = load_notch(out / "controllers" / "rejection_lpv.json")
-    f = np.load(out / "controllers" / "controller_lpv.npz", allow_pickle=False)
-    Ts, d = float(f["Ts"]), int(f["delay_samples"])
-    assert Ts == notch.dt
-    delay = control.tf([1], [1] + [0] * d, Ts)
-    rows = [r for r in [*metrics["cases"], *metrics["stability"]] if r["controller"] == "lpv"]
-    judged = sorted({r["speed_hz"] for r in rows if notch.is_on(2 * np.pi * r["speed_hz"])})
-    assert judged and judged[-1] == pytest.approx(cfg.operating.speed_range_hz[1])
-    for hz in judged:
-        w = 2 * np.pi * hz
-        K = control.ss(*_interpolated(f, hz), Ts)
-        A, B, C = notch.matrices_at(w)
-        N = control.ss(A, B, C, np.zeros((C.shape[0], C.shape[0])), Ts)
-        Kn = K * control.feedback(control.ss([], [], [], np.eye(C.shape[0]), Ts), N)
-        plant = build_plant(cfg, speed_rpm=60.0 * hz,
-                            force_positions=tuple(a.position for a in cfg.amb))
-        cur = plant.current_inputs()
-        frc = [j for j in range(plant.B.shape[1]) if j not in cur]
-        G = control.sample_system(control.ss(plant.A, plant.B, plant.C, plant.D), Ts, "zoh")
-        Gi = control.ss(G.A, G.B[:, cur], G.C, G.D[:, cur], Ts)
-        Gf = control.ss(G.A, G.B[:, frc], G.C, G.D[:, frc], Ts)
-        z = np.exp(1j * w * Ts)
-        gains = []
-        for Kx in (K * delay, Kn * delay):
-            assert np.abs(control.feedback(Gi, Kx).poles()).max() < 1, hz
-            Gz, Gfz, Kz = (_frf(*(np.asarray(X, float) for X in (S.A, S.B, S.C, S.D)),
-                                np.array([z]))[0] for S in (Gi, Gf, Kx))
-            gains.append(np.abs(Kz @ np.linalg.solve(np.eye(Gz.shape[0]) + Gz @ Kz,
-                                                     Gfz)).max())
-        assert gains[1] < 1e-2 * gains[0], (hz, gains)
+    on = [r["speed_hz"] for r in s["rejection"]["conditions"]]
+    assert max(on) == pytest.approx(cfg.operating.speed_range_hz[1])
+    rejection_held_by_python_control(RIG, metrics, out)
 
 
 def test_the_failures_name_the_mode_by_its_kind_and_a_remedy_that_holds(flywheel_run):

@@ -673,7 +673,7 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
     notches = _notches(st) if cfg.design.rejection.enabled else {}
     alone = {}
     for m, n in notches.items():  # a notch that holds runs with its controller
-        if n.holds and m in currents:
+        if n.holds:
             alone[m] = capacity_block(cfg, currents[m], _impulses(m, st.jobs, st.judged))
             currents[m] = list(notched_currents(
                 currents[m], n.rejection.controller.notch.on_rad_s / (2 * np.pi),

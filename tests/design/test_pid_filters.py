@@ -228,3 +228,24 @@ def test_a_mode_no_filter_saves_is_named_with_why():
     assert not fd.kept
     text = fd.modes[-1].text()
     assert "non-collocated" in text and "° of phase needed" in text
+
+
+def test_a_lead_above_nyquist_is_left_out_and_named():
+    """A collocated mode at 0.15 f_s that the hold and delay drive (ζ < 0 as it runs): the
+    rule's leads of 60° and 75° would put their pole at f_c·√α = 3.7 and 7.6 f_c, above
+    the Nyquist frequency, where the target cannot run them. Every filter taken has its
+    poles (python-control's, of the filter's transfer function) below Nyquist, the mode's
+    text names the leads left out and why, and the loop as it runs (python-control's
+    poles) keeps the floor."""
+    G = _two_mode(1500.0, 1.0)
+    assert _zeta(_as_it_runs(G, [])).min() < 0
+    fd = flexible_mode_filters([G], _pid_mats, FS, 1, FLOOR, RIGID_HZ)
+    assert fd.filters and fd.kept
+    for f in fd.filters:
+        poles = control.ss(*filter_matrices(f)).poles()
+        assert np.abs(poles).max() / (2 * np.pi) <= FS / 2
+    text = fd.modes[0].text()
+    assert "(left out: lead 75°" in text and "lead 60° at" in text and "lead 45°" not in text
+    assert f"above the Nyquist frequency {FS / 2:.4g} Hz" in text
+    poles = _as_it_runs(G, fd.filters)
+    assert np.abs(poles).max() < 1 and _zeta(poles).min() >= FLOOR

@@ -149,7 +149,15 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
         cache = {} if cache is None else cache
         rise = ((lambda Kr: design_rise(result, Kr, getattr(result, "omega", None), fs / 2))
                 if method in method_names(synthesised=True) else None)
-        check_rate(controller, fs, delay, removable=rise is not None)  # before the plants
+        try:  # before the plants
+            check_rate(controller, fs, delay, removable=rise is not None)
+        except ConfigError as exc:
+            if method != "pid" or written_pid(cfg):
+                raise
+            # ambseal's own PID: the user's rig is not wrong, the derived controller fails
+            raise SynthesisError(f"the PID derived from the rig cannot run at the target's "
+                                 f"rate ({exc}); set [controller.pid] or "
+                                 "[[controller.filter]]") from None
         if "plants" not in cache:
             cache["plants"] = sampled_plants([plant(*c) for c in conds], fs,
                                              delay_samples=delay)
@@ -689,15 +697,27 @@ def _identify_and_write(cfg, records, controllers, names, sources, out, current_
             "warnings": warnings + reasons}
 
 
+def written_pid(cfg) -> bool:
+    """Whether the rig file writes any part of its reference PID (``[controller.pid]`` or
+    ``[[controller.filter]]``); otherwise ambseal derives it
+    (:func:`ambseal.design.pid.pid_from_rig`)."""
+    return cfg.controller.pid is not None or cfg.controller.filter is not None
+
+
 def check_reference_rate(cfg, where) -> None:
-    """Refuse, before any design, a target that cannot run the rig's reference PID
-    (:func:`ambseal.robust.digital.check_rate` on it, as :func:`digital_for` checks it
-    after the designs): ``validate`` and ``run`` refuse the same rig with the same line.
+    """Refuse, before any design, a target that cannot run the reference PID the rig file
+    writes (:func:`ambseal.robust.digital.check_rate` on it, as :func:`digital_for` checks
+    it after the designs): ``validate`` and ``run`` refuse the same rig with the same line.
+    A PID that ambseal derives is not the user's input: it is never refused here (its rule
+    fits its filters to the rate, and one that still cannot run is a failed controller of
+    the run, :func:`digital_for`).
 
     Raises
     ------
     ConfigError
         ``where: controller.sample_rate_hz …``."""
+    if not written_pid(cfg):
+        return
     K = design(cfg, "pid").K
     try:
         check_rate(K, cfg.controller.sample_rate_hz, cfg.controller.delay_samples,
@@ -713,7 +733,9 @@ def validate_summary(rig: str | Path | None = None, overrides=()) -> dict:
     of the full model at the nominal condition below the controller's Nyquist frequency
     (``modes_below_hz``, ``modes`` as [f_Hz, ζ]); ``unstable_poles`` ([Re, Im] rad/s); and
     ``defaults``: the reduced model's order, the judged conditions, the controller's sample
-    rate, the reference PID and the judgement's grids and disturbances (on a rig without
+    rate, the reference PID (the file's ``[controller.pid]``, else the one a run derives,
+    with ``derived`` true, its ``filters`` and its ``rule``) and the judgement's grids and
+    disturbances (on a rig without
     AMBs none: no controller to design or judge). ``overrides`` are ``design.KEY=VALUE``
     settings, as ``run`` takes them (:func:`ambseal.config.apply_overrides`).
 
@@ -721,7 +743,7 @@ def validate_summary(rig: str | Path | None = None, overrides=()) -> dict:
     ------
     ConfigError
         The rig file does not parse or check, or holds what ``run`` would refuse before
-        its designs (a target that cannot run the reference PID).
+        its designs (a target that cannot run the reference PID the file writes).
     """
 
     cfg = load_rig(rig, overrides)
@@ -746,7 +768,9 @@ def validate_summary(rig: str | Path | None = None, overrides=()) -> dict:
             "nominal_pressure_bar": cfg.operating.pressure_bar,
             "nominal_speed_rpm": cfg.operating.speed_rpm,
             "controller_sample_rate_hz": cfg.controller.sample_rate_hz,
-            "pid": None if pid is None else pid.model_dump(),
+            # the PID a run designs: the file's, else the derived one with its rule
+            "pid": (None if not cfg.amb else pid.model_dump() if pid is not None
+                    else {"derived": True, **reference_pid(cfg)}),
             "judgement": asdict(judge_settings(spec)) if spec else None,
         },
     }

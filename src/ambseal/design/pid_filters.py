@@ -15,9 +15,10 @@ The rule (:func:`flexible_mode_filters`), on the plants of every judged conditio
 (pressures × speeds from standstill to the top speed), each closed with the PID discretised
 as it runs (Tustin, the target's delay, the plant sampled by its hold):
 
-1. Conditions where the PID loses a rigid-body pole (ζ ≤ 0 below twice the rigid-body
-   frequency) are left out: no filter of a flexible mode saves them, and the judgement
-   says so. The least-damped pole below the floor ζ ≥ ``floor`` above twice the rigid-body
+1. Where the PID loses a rigid-body pole (ζ ≤ 0 below twice the rigid-body frequency)
+   no filter of a flexible mode saves it, and the judgement says so; that condition's
+   flexible poles still count (no filter is chosen at all where every condition loses
+   one). The least-damped pole below the floor ζ ≥ ``floor`` above twice the rigid-body
    frequency is the mode to treat; its band is the spread of the under-damped poles within
    a factor :data:`BAND_FACTOR` of its frequency over the conditions (the gyroscopic split
    with speed, the seals' shift with pressure).
@@ -27,7 +28,10 @@ as it runs (Tustin, the target's delay, the plant sampled by its hold):
    the mode needs is −arg(k r) (Re(j r) > 0: collocated).
 3. Candidates, in this order: a lead or lag (the sign of the needed phase) of each of
    :data:`PHASE_STEPS_DEG` at the band's centre, the smallest that covers the need first;
-   then notches of :data:`NOTCH_DEPTHS_DB` over the band. Each is judged on every
+   then notches of :data:`NOTCH_DEPTHS_DB` over the band. A candidate with a pole above
+   the Nyquist frequency f_s/2 is left out, and the mode's text says so: the target
+   cannot run it (a lead's pole lies at f_c·√α, 2.4× its centre at 45°; a lag's and a
+   notch's at or below their centre, which is below Nyquist). Each is judged on every
    condition; the first that keeps the floor at every condition is taken, else the one
    with the most conditions kept and then the largest least damping, if it betters the
    loop without it.
@@ -49,7 +53,7 @@ import numpy as np
 from ambseal.lti import feedback_matrices, zoh
 from ambseal.robust import discretize_as, with_delay
 
-__all__ = ["ModeFilter", "FilterDesign", "flexible_mode_filters", "MAX_FILTERS",
+__all__ = ["ModeFilter", "FilterDesign", "flexible_mode_filters", "pole_hz", "MAX_FILTERS",
            "PHASE_STEPS_DEG", "NOTCH_DEPTHS_DB", "BAND_FACTOR"]
 
 #: filters at most: one per treated mode
@@ -83,17 +87,43 @@ class ModeFilter:
     collocated: bool
     needed_phase_deg: float
     filter: dict | None
+    #: the candidates left out because a pole lies above the Nyquist frequency, and it (Hz)
+    left_out: tuple = ()
+    nyquist_hz: float = float("inf")
 
     def text(self) -> str:
         where = "collocated" if self.collocated else "non-collocated"
         head = (f"{self.frequency_hz:.4g} Hz mode ({where}, ζ {self.zeta_before:.2g}, "
                 f"{self.needed_phase_deg:+.0f}° of phase needed)")
         if self.filter is None:
-            return head + ": no lead, lag or notch keeps it damped"
-        f = self.filter
-        what = (f"notch {f['depth_db']:g} dB, {f['width_hz']:.3g} Hz wide" if f["kind"] == "notch"
-                else f"{f['kind']} {f['phase_deg']:g}°")
-        return f"{head}: {what} at {f['frequency_hz']:.4g} Hz → ζ {self.zeta_after:.2g}"
+            text = head + ": no lead, lag or notch keeps it damped"
+        else:
+            f = self.filter
+            text = f"{head}: {_name(f)} at {f['frequency_hz']:.4g} Hz → ζ {self.zeta_after:.2g}"
+        if self.left_out:
+            text += (" (left out: " + ", ".join(
+                f"{_name(c)} at {c['frequency_hz']:.4g} Hz, its pole at {pole_hz(c):.4g} Hz"
+                for c in self.left_out)
+                + f" above the Nyquist frequency {self.nyquist_hz:.4g} Hz, which the "
+                  "target cannot run)")
+        return text
+
+
+def _name(f: dict) -> str:
+    return (f"notch {f['depth_db']:g} dB, {f['width_hz']:.3g} Hz wide" if f["kind"] == "notch"
+            else f"{f['kind']} {f['phase_deg']:g}°")
+
+
+def pole_hz(f: dict) -> float:
+    """The highest pole (Hz) of a lead, lag or notch of :func:`_candidates` (the formulas
+    of :func:`ambseal.design.pid.filter_matrices`): a lead's at f_c·√α, a lag's at
+    f_c/√α, a notch's at f_c (its width is below twice its centre: complex poles of
+    modulus ω_c)."""
+    if f["kind"] in ("lead", "lag"):
+        s = np.sin(np.radians(f["phase_deg"]))
+        root = np.sqrt((1 + s) / (1 - s))
+        return float(f["frequency_hz"] * (root if f["kind"] == "lead" else 1 / root))
+    return float(f["frequency_hz"])
 
 
 @dataclass(frozen=True)
@@ -177,11 +207,14 @@ def flexible_mode_filters(plants, pid_matrices, fs: float, delay: int, floor: fl
         band = [f for z, f, _ in bad if f0 / BAND_FACTOR <= f <= f0 * BAND_FACTOR]
         lo, hi = min(band), max(band)
         need, collocated = _needed_phase(sampled[k0][1], pid_matrices(filters), f0, fs, delay)
-        judged = [(c, judge(filters + [c]))
-                  for c in _candidates(float(np.sqrt(lo * hi)), lo, hi, need)]
+        cands = _candidates(float(np.sqrt(lo * hi)), lo, hi, need)
+        # a filter the target cannot run is no candidate: the PID must run at f_s
+        runs = [c for c in cands if pole_hz(c) <= fs / 2]
+        judged = [(c, judge(filters + [c])) for c in runs]
         # a filter for a flexible mode must not take the rigid-body modes' damping
         judged = [(c, r) for c, r in judged if rigid(r) >= rigid(rows) - RIGID_COST]
-        return ModeFilter(f0, (lo, hi), z0, z0, collocated, need, None), judged
+        left = tuple(c for c in cands if pole_hz(c) > fs / 2)
+        return ModeFilter(f0, (lo, hi), z0, z0, collocated, need, None, left, fs / 2), judged
 
     def mode_after(m, c, r):
         lo, hi = m.band_hz
@@ -193,11 +226,10 @@ def flexible_mode_filters(plants, pid_matrices, fs: float, delay: int, floor: fl
     modes: list[ModeFilter] = []
     rows = judge(filters)
     # where the PID loses a rigid-body mode no filter of a flexible mode saves the loop
-    # (the judgement says so): those conditions are left out of the choice
-    held = [r[2] > 0 for r in rows]
-    sampled = [s for s, h in zip(sampled, held) if h]
-    rows = [r for r, h in zip(rows, held) if h]
-    if not rows:
+    # (the judgement says so); its flexible modes still count, since a filter chosen
+    # without them may drive them (a lead taken at standstill drove a bending mode at
+    # the top speed, where a precession was lost without it and held with it)
+    if not any(r[2] > 0 for r in rows):
         return FilterDesign((), (), False, float("nan"))
     while len(filters) < MAX_FILTERS:
         found = treat(filters, rows)

@@ -31,12 +31,18 @@ def rejection_held_by_python_control(rig: Path, metrics: dict, out: Path) -> Non
     ``_held_by_python_control`` checks the controllers: each delivered controller's file
     (a scheduled one at the condition's speed) with its notch read back from
     ``rejection_<m>.json`` — the controller after python-control's loop ``q = y − N q``
-    (``control.feedback``), then its delay — closed on the full-order plant sampled by
+    (``control.feedback``), then its delay, for each delivered controller that runs with
+    one — closed on the full-order plant sampled by
     python-control at every condition the run judged where the notch is on:
     every pole inside the unit circle, and the current from forces at the bearings at
     the rotational frequency below 1 % of the controller's alone."""
     cfg = load_rig(rig)
     delivered = set(metrics["controllers"]) - set(metrics["failed"]) - set(metrics["cannot_run"])
+    # those that run with a notch: every one where the rig asks for it, else those whose
+    # amplifier the run found saturated alone
+    delivered = {m for m in delivered
+                 if (metrics["controllers"][m].get("rejection") or {}).get("files")}
+    assert delivered, "no delivered controller runs with an unbalance force rejection"
     conditions = {(c["pressure_bar"], c["speed_hz"]) for c in metrics["stability"]} | {
         (c["pressure_bar"], c["speed_hz"]) for c in metrics["cases"]}
     for m in sorted(delivered):

@@ -138,6 +138,11 @@ def test_a_notch_that_holds_leaves_the_amplifier_what_it_leaves(testrig_cfg, jud
     assert words.startswith("holding the unbalance (its unbalance force rejection on) it uses")
     assert words.endswith(f"; without its unbalance force rejection, holding the unbalance "
                           f"would take {alone['current_used']:.3g}× the current limit")
+    # switched on by the run where the file leaves it off: the words say why
+    block["rejection_automatic"] = True
+    assert capacity_words(block).startswith(
+        "holding the unbalance (its unbalance force rejection on, switched on by the run: "
+        "the controller alone saturates the amplifier) it uses")
 
 
 def test_impulse_voltage_is_the_coil_driven_through_the_amplifier(testrig_cfg, judged):

@@ -296,7 +296,9 @@ def capacity_words(block: dict | None) -> str:
     controller that runs with its unbalance force rejection (``without_rejection``: the
     fractions of the controller alone, :func:`notched_currents`) says so, and what the
     controller alone would need: ``"…; without its unbalance force rejection, holding the
-    unbalance would take 1.09× the bias current's linear range"``.
+    unbalance would take 1.09× the bias current's linear range"``; one whose rejection the
+    run switched on by itself (``rejection_automatic``: the controller alone saturates the
+    amplifier and the rig file leaves ``[design.rejection]`` off) says that too.
 
     Parameters
     ----------
@@ -321,7 +323,9 @@ def capacity_words(block: dict | None) -> str:
         holding += " and the seals' static load"
     alone = c.get("without_rejection")
     if alone is not None and w.get("response", "unbalance") == "unbalance":
-        holding += " (its unbalance force rejection on)"
+        holding += (" (its unbalance force rejection on, switched on by the run: the "
+                    "controller alone saturates the amplifier)" if c.get("rejection_automatic")
+                    else " (its unbalance force rejection on)")
     text = (f"the amplifier saturates {holding}: it needs {v:.3g}× {what} ({at})" if over
             else f"{holding} it uses {100 * v:.0f} % of {what} ({at})")
     known = [q for q in QUANTITIES if (alone or {}).get(q) is not None]

@@ -38,6 +38,7 @@ from ambseal.analysis import (
     rig_clearances_um,
     rejection_stability,
     run_cases,
+    saturates,
     saturation_failure,
     sign_off,
     speed_scheduled,
@@ -573,12 +574,13 @@ class _Notch:
         return not self.lost and self.beyond is None
 
 
-def _notches(st: _RunState) -> dict[str, _Notch]:
+def _notches(st: _RunState, methods=None) -> dict[str, _Notch]:
     """Each controller's unbalance force rejection
     (:func:`~ambseal.design.synchronous_rejection.design_rejection` on the design rig) but
     those that cannot run on the target or are scheduled on another parameter, judged at
     every condition the run judges its controller at, in full and over the speed range,
-    and shown against the controller alone on the judged rig: method → :class:`_Notch`."""
+    and shown against the controller alone on the judged rig: method → :class:`_Notch`.
+    ``methods`` limits it to those controllers (all if None)."""
     st.stages.begin("rejection", "unbalance force rejection")
     r = st.cfg.design.rejection
     kw = {k: v for k, v in (("rate_fraction", r.rate_fraction), ("points", r.points))
@@ -588,7 +590,8 @@ def _notches(st: _RunState) -> dict[str, _Notch]:
     out = {}
     for d in st.designs:
         g = st.digitals.get(d.method)
-        if g is None or getattr(g, "parameter", SPEED) != SPEED:
+        if g is None or getattr(g, "parameter", SPEED) != SPEED \
+                or (methods is not None and d.method not in methods):
             continue
         rej = design_rejection(st.design_cfg, d.controller, g, **kw)
         rows = rejection_stability(st.judge_cfg, rej, [j.point for j in st.jobs
@@ -670,7 +673,21 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
               for j, case, (_, c) in zip(st.jobs, case_dicts, st.judged)]
     currents = {d.method: list(_unbalance_currents(d.method, st.jobs, st.judged))
                 for d in st.designs}
-    notches = _notches(st) if cfg.design.rejection.enabled else {}
+    automatic: set[str] = set()
+    if cfg.design.rejection.enabled:
+        notches = _notches(st)
+    else:
+        # the amplifier's limit is part of the design: a controller whose loops hold but
+        # which alone cannot hold the unbalance (a fraction above 1 in the unbalance
+        # response, the impulse left out: no notch helps it) runs with its unbalance force
+        # rejection, switched on by the run (Herzog, Bühler, Gähler & Larsonneur 1996)
+        # and said so in its verdict
+        automatic = {m for m, entries in currents.items()
+                     if m not in st.failed and saturates(capacity_block(cfg, entries))}
+        notches = _notches(st, automatic) if automatic else {}
+        for m in sorted(automatic):
+            st.say(f"{m}: the amplifier cannot hold the unbalance with the controller alone; "
+                   "its unbalance force rejection is switched on")
     alone = {}
     for m, n in notches.items():  # a notch that holds runs with its controller
         if n.holds:
@@ -684,6 +701,7 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
         if block is not None and capacity[m] is not None:
             capacity[m]["without_rejection"] = {q: v for q, v in block.items()
                                                 if q.endswith("_used")}
+            capacity[m]["rejection_automatic"] = m in automatic
     for m, block in capacity.items():  # an amplifier that saturates fails its controller
         f = saturation_failure(m, block, designed=m != "pid", kept=st.allow_unstable,
                                derived=cfg.controller.pid is None)

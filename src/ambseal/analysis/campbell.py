@@ -45,7 +45,8 @@ from ambseal.model import (
 from ambseal.robust import decay_rate, is_stable, unstable_poles
 
 __all__ = ["AF_CRITICAL", "API684_LOG_DEC", "OVERDAMPED_ZETA", "ClosedLoopModes", "Crossing",
-           "Campbell", "log_decrement", "lowest_log_decrement", "whirl_of",
+           "Campbell", "log_decrement", "amplification_factor", "resonant",
+           "lowest_log_decrement", "whirl_of",
            "closed_loop_state_matrix", "closed_loop_modes", "modes_as_run",
            "modes_of_state_matrix", "modes_of_sampled_loop", "track_modes", "open_loop_modes",
            "campbell"]
@@ -81,6 +82,47 @@ def log_decrement(poles: np.ndarray) -> np.ndarray:
     """
     p = np.asarray(poles, complex)
     return -2 * np.pi * p.real / p.imag
+
+
+def amplification_factor(log_dec) -> np.ndarray:
+    """API 684's amplification factor of a mode from its log decrement, AF ≈ π/δ (API 684
+    §1.3.3: AF = N_c/(N_2 − N_1), the half-power bandwidth, ≈ 1/(2ζ) ≈ π/δ at light
+    damping); inf for δ ≤ 0.
+
+    Parameters
+    ----------
+    log_dec : array_like of float
+        Log decrements δ (-), any shape.
+
+    Returns
+    -------
+    ndarray of float
+        AF, the shape of ``log_dec``.
+    """
+    d = np.asarray(log_dec, float)
+    with np.errstate(divide="ignore"):
+        return np.where(d > 0, np.pi / np.where(d > 0, d, 1.0), np.inf)
+
+
+def resonant(log_dec) -> np.ndarray:
+    """Whether a mode is a resonance in API 684's sense: its amplification factor
+    (:func:`amplification_factor`, π/δ) is at least :data:`AF_CRITICAL` (2.5), the factor
+    from which API 684 and API 617 count a resonance as a critical speed. That is
+    δ ≤ π/2.5 = 1.257, ζ ≤ 0.196 (ζ ≤ 0.2 by the half-power AF = 1/(2ζ)); a mode damped
+    more — an AMB controller's overdamped rigid-body pole with a small imaginary part, at
+    ζ ≈ 1 — has no resonance to speak of. A mode with δ ≤ 0 is resonant.
+
+    Parameters
+    ----------
+    log_dec : array_like of float
+        Log decrements δ (-), any shape; NaN is not resonant.
+
+    Returns
+    -------
+    ndarray of bool
+        The shape of ``log_dec``.
+    """
+    return amplification_factor(log_dec) >= AF_CRITICAL
 
 
 def lowest_log_decrement(poles: np.ndarray, max_hz: float) -> tuple[float, float]:
@@ -505,11 +547,11 @@ class Crossing:
 
     @property
     def amplification_factor(self) -> float:
-        return math.pi / self.log_decrement if self.log_decrement > 0 else math.inf
+        return float(amplification_factor(self.log_decrement))
 
     @property
     def critical(self) -> bool:
-        return self.amplification_factor >= AF_CRITICAL
+        return bool(resonant(self.log_decrement))
 
     def to_dict(self) -> dict:
         return {"track": self.track, "speed_hz": self.speed_hz,

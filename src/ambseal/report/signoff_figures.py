@@ -167,14 +167,14 @@ def signoff_report(out: Path, results, rig_name: str, boundary=None) -> tuple[li
              "<th>source</th><th>outcome</th></tr>" + "".join(rows) + "</table>")
     l2 = "".join(
         f"<tr><td>{esc(r.controller)}</td><td>{esc(row.component)}</td>"
-        f"<td>{row.frequency_hz:.4g}</td><td>{row.log_dec:.3g}</td>"
-        f"<td>{'yes' if row.stable else 'NO'}</td></tr>"
+        f"<td>{row.frequency_hz:.4g}</td><td class=\"text\">{esc(row.kind)}</td>"
+        f"<td>{row.log_dec:.3g}</td><td>{'yes' if row.stable else 'NO'}</td></tr>"
         for r in results for row in r.level2.rows)
     level2 = ("<p>API 617 Level II at the maximum continuous speed, component by "
-              "component (the forward mode the sources act on):</p><table>"
-              "<tr><th>controller</th>"
-              "<th>loop with</th><th>f (Hz)</th><th>δ</th><th>stable</th></tr>" + l2 +
-              "</table>")
+              "component: the first forward resonant mode (AF ≥ 2.5), or the one the "
+              "sources act on:</p><table><tr><th>controller</th>"
+              "<th>loop with</th><th>f (Hz)</th><th>mode</th><th>δ</th><th>stable</th>"
+              "</tr>" + l2 + "</table>")
     note = ("<p>Each controller as it runs (the discrete controller with its delay). "
             "Limits the standards' public text could not confirm are the rig file's "
             "<code>[signoff]</code> settings.</p>")

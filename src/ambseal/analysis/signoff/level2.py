@@ -7,7 +7,7 @@ coefficients at the operating pressure drop, ``[operating] pressure_bar``, and t
 synchronous frequency), the anticipated aerodynamic cross-coupling added alone (each
 stage's q_A of :func:`ambseal.analysis.signoff.level1.stage_cross_coupling` as k_xy = q_A,
 k_yx = −q_A at the stage), and all of them together. The machine passes when the loop
-with every source is stable and its least damped forward mode keeps δ ≥ ``[signoff]
+with every source is stable and the graded mode (below) keeps δ ≥ ``[signoff]
 log_dec_min`` (0.1; API 684 (2nd ed., 2005) §2.8's limit, as ROSS's API report tool
 tabulates it — the standard's public text could not confirm the clause, so it is a
 setting).
@@ -15,16 +15,30 @@ setting).
 With AMBs the supports are the controller: each row's loop is the discrete controller
 with its computation delay on the sampled plant
 (:func:`ambseal.analysis.campbell.modes_as_run`); a rig on springs alone is analysed as
-it is. The screened mode is API 617's first forward mode in the sense that matters: the
-mode the sources act on. The forward modes of the loop without sources are followed to
-the loop with every source (by nearest eigenvalue,
-:func:`ambseal.analysis.campbell.track_modes`); the screened one is the least damped
-with every source among those the sources take damping from (more than
-:data:`LOST_SHARE` of their δ), or, if they take none (a machine without sources), the
-lowest forward mode. Each row
-reports that mode, followed from the loop without sources. A bending mode the sources
-leave alone, with a structural δ of a few hundredths, is not what Level II judges; a
-mode they leave at δ 0.06 is. A row's loop is unstable where a pole within the band of
+it is. The graded mode is API 617's first forward mode, a *resonant* one: a mode whose
+amplification factor AF ≈ π/δ is at least 2.5, the factor from which API 684 (2nd ed.,
+2005, §1.3.3) and API 617 count a resonance as a critical speed — δ ≤ π/2.5 = 1.257,
+ζ ≤ 0.2 (:func:`ambseal.analysis.campbell.resonant`). An AMB controller damps the rigid-
+body modes near ζ = 1: such an overdamped pole, whose small imaginary part makes it the
+lowest "mode" by frequency, has no resonance and is never graded (its δ of tens would
+pass any limit while a lightly damped nutation above it went ungraded). The forward
+modes of the loop without sources are followed to the loop with every source (by nearest
+eigenvalue, :func:`ambseal.analysis.campbell.track_modes`); of those forward and
+resonant with every source, the graded one is, in this order:
+
+1. the least damped with every source among those the sources take damping from (more
+   than :data:`LOST_SHARE` of their δ): the mode the sources act on, as Level I screens
+   the mode the cross-coupling destabilises;
+2. if the sources take none (a machine without sources: a pump, a flywheel), the lowest
+   in frequency: API 617's first forward resonant mode at the maximum continuous speed;
+3. if the loop has no forward resonant mode up to the band's top, the least damped
+   forward mode (δ > 1.257, far above any limit), reported as not resonant.
+
+Each row reports that mode, followed from the loop without sources, with its kind
+(:func:`ambseal.analysis.mode_naming.mode_kind`: rigid cylindrical or conical, or
+bending, with its whirl). A bending mode the sources leave alone, with a structural δ of
+a few hundredths, is not what Level II judges where the sources act on another; a mode
+they leave at δ 0.06 is. A row's loop is unstable where a pole within the band of
 modes it reads breaks the stability rule; a lossless mesh mode far above, which nothing
 damps, does not decide it (:meth:`ambseal.analysis.campbell.ClosedLoopModes.deciding`).
 """
@@ -34,7 +48,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ambseal.analysis.campbell import modes_as_run, track_modes
+from ambseal.analysis.campbell import modes_as_run, resonant, track_modes
+from ambseal.analysis.mode_naming import mode_kind, support_span_m
 from ambseal.analysis.signoff.level1 import stage_cross_coupling, stage_position, without_seals
 from ambseal.config import Spring
 from ambseal.errors import ConfigError
@@ -62,16 +77,22 @@ class Level2Row:
         That mode's log decrement (NaN without one).
     stable : bool
         The loop's verdict (every pole, not the forward modes alone).
+    kind : str
+        The mode's kind and whirl (:func:`ambseal.analysis.mode_naming.mode_kind`, e.g.
+        ``"rigid conical, forward whirl: the nutation"``), with ``", not resonant"`` where
+        the loop has no forward resonant mode; ``""`` where it is not followed.
     """
 
     component: str
     frequency_hz: float
     log_dec: float
     stable: bool
+    kind: str = ""
 
     def to_dict(self) -> dict:
         return {"component": self.component, "frequency_hz": json_float(self.frequency_hz),
-                "log_dec": json_float(self.log_dec), "stable": self.stable}
+                "log_dec": json_float(self.log_dec), "stable": self.stable,
+                "kind": self.kind}
 
 
 @dataclass(frozen=True)
@@ -101,6 +122,11 @@ class Level2:
         return self.rows[-1].log_dec
 
     @property
+    def kind(self) -> str:
+        """The graded mode's kind with every source (the last row)."""
+        return self.rows[-1].kind
+
+    @property
     def passed(self) -> bool:
         last = self.rows[-1]
         return bool(last.stable and last.log_dec >= self.limit)
@@ -109,34 +135,41 @@ class Level2:
         """The ``level2`` block."""
         return {"speed_hz": self.speed_hz, "pressure_bar": self.pressure_bar,
                 "log_dec": json_float(self.log_dec), "limit": self.limit,
-                "passed": self.passed, "table": [r.to_dict() for r in self.rows]}
+                "passed": self.passed, "mode": self.kind,
+                "table": [r.to_dict() for r in self.rows]}
 
 
-def _screened(base, last) -> int | None:
-    """The mode of ``base`` (the rotor on its supports) the sources act on: of the forward
-    modes followed from ``base`` to ``last`` (every source), the least damped in ``last``
-    among those the sources take damping from; if they take none (or there are none),
-    the lowest forward mode, API 617's first. None without a forward mode."""
+def _screened(base, last) -> tuple[int | None, bool]:
+    """(the mode of ``base``, the rotor on its supports, that Level II grades; whether it
+    is resonant): of the forward modes followed from ``base`` to ``last`` (every source),
+    those resonant in ``last``; of them the least damped in ``last`` among those the
+    sources take damping from, else the lowest in frequency, API 617's first; without a
+    resonant one the least damped forward mode (module docstring). None without a
+    forward mode."""
     tr = track_modes([base, last])
     # forward with every source: without them an isotropic rotor's forward and backward
     # whirl coincide, and their shapes there say nothing
     lines = [j for j in range(tr.shape[1]) if tr[0, j] >= 0 and tr[1, j] >= 0
              and last.whirl[tr[1, j]] != "backward"]
     if not lines:
-        return None
+        return None, False
     d0 = {j: base.log_decrement[tr[0, j]] for j in lines}
     d1 = {j: last.log_decrement[tr[1, j]] for j in lines}
-    hit = [j for j in lines if d1[j] < d0[j] - LOST_SHARE * abs(d0[j])]
+    sharp = [j for j in lines if resonant(d1[j])]
+    hit = [j for j in sharp if d1[j] < d0[j] - LOST_SHARE * abs(d0[j])]
     if hit:
         j = min(hit, key=lambda i: d1[i])
-    else:  # no source acts (none, or none takes damping): API 617's first forward mode
-        j = min(lines, key=lambda i: last.frequency_hz[tr[1, i]])
-    return int(tr[0, j])
+    elif sharp:  # no source acts (none, or none takes damping): API 617's first
+        j = min(sharp, key=lambda i: last.frequency_hz[tr[1, i]])
+    else:  # no resonance to grade: the least damped, δ above any limit
+        j = min(lines, key=lambda i: d1[i])
+    return int(tr[0, j]), bool(sharp)
 
 
-def _row(component, m, base, k0) -> Level2Row:
-    """The row of the loop ``m``: the mode followed from ``base``'s mode ``k0``; stable
-    unless a pole within the band of modes it reads breaks the rule
+def _row(component, m, base, k0, span, sharp: bool) -> Level2Row:
+    """The row of the loop ``m``: the mode followed from ``base``'s mode ``k0``, named
+    by its shape over the bearing ``span`` (``", not resonant"`` unless ``sharp``);
+    stable unless a pole within the band of modes it reads breaks the rule
     (:meth:`~ambseal.analysis.campbell.ClosedLoopModes.deciding`)."""
     stable = not m.deciding().size
     if k0 is None:
@@ -146,8 +179,9 @@ def _row(component, m, base, k0) -> Level2Row:
     k = None if j is None else int(tr[1, j])
     if k is None or k < 0:
         return Level2Row(component, math.nan, math.nan, stable)
+    kind = mode_kind(m.shapes[k], m.node_z_m, span, m.whirl[k], m.speed_hz)
     return Level2Row(component, float(m.frequency_hz[k]), float(m.log_decrement[k]),
-                     stable)
+                     stable, kind if sharp else f"{kind}, not resonant")
 
 
 def level2_analysis(cfg, controller=None, *, name: str = "none",
@@ -199,12 +233,13 @@ def level2_analysis(cfg, controller=None, *, name: str = "none",
     variants += [("all sources", {"spring": [*cfg.spring, *aero]})]
     loops = [modes_as_run(cfg.model_copy(update=update), controller, speed_hz=speed_hz,
                           max_hz=max_hz, pressure_bar=p) for _, update in variants]
-    k0 = _screened(loops[0], loops[-1])
+    k0, sharp = _screened(loops[0], loops[-1])
+    span = support_span_m(cfg)
     rows = []
     for (component, _), m in zip(variants, loops):
-        rows.append(_row(component, m, loops[0], k0))
+        rows.append(_row(component, m, loops[0], k0, span, sharp))
         if progress:
             r = rows[-1]
             progress(f"{name}: Level II {component}: δ = {r.log_dec:.3g} at "
-                     f"{r.frequency_hz:.4g} Hz{'' if r.stable else ', UNSTABLE'}")
+                     f"{r.frequency_hz:.4g} Hz ({r.kind}){'' if r.stable else ', UNSTABLE'}")
     return Level2(name, speed_hz, p, tuple(rows), cfg.signoff.log_dec_min)

@@ -174,6 +174,7 @@ def _criteria(cfg, l1, l2, unb, iso) -> tuple:
     last = l2.rows[-1]
     rows.append(Criterion("stability, Level II",
                           f"δ = {last.log_dec:.3g} at {last.frequency_hz:.4g} Hz"
+                          + (f" ({last.kind})" if last.kind else "")
                           + ("" if last.stable else ", loop UNSTABLE"),
                           f"δ ≥ {d_min:g} with every source", CLAUSES["level2"], l2.passed,
                           counts=not (passed1 and last.stable)))

@@ -1276,3 +1276,61 @@ def test_ross3_file_read_without_ross_equals_the_ross_import(examples, tmp_path)
         if name == "modal_torsion":  # ROSS's 5th and 14th flexible modes are not lateral
             assert own.rig.rotor.supported_modal_damping.ratios == [
                 0.001 * (k + 1) for k in range(14) if k + 1 not in (5, 14)]
+
+
+
+def _ross_ucs_wn(rotor, k: float) -> np.ndarray:
+    """ROSS's ``run_ucs`` at one stiffness, its own loop body (ROSS 2.3 to 3.1: the shaft's
+    proportional damping set to zero, every bearing but the seals and the links
+    ``BearingElement(n, kxx=k, cxx=0)``, ``convert_6dof_to_4dof``, the modes at speed 0,
+    each pair of |λ| once) with the dense eigen-solve that ``run_modal`` reports, without
+    its post-processing (15 s for ``compressor_example`` on ROSS 2.3): its 4 lowest
+    (rad/s)."""
+    import copy
+
+    from ross.utils import convert_6dof_to_4dof
+
+    shafts = copy.deepcopy(rotor.shaft_elements)
+    for sh in shafts:
+        sh.alpha = sh.beta = 0
+    springs = [rs.BearingElement(b.n, kxx=k, cxx=0) for b in rotor.bearing_elements
+               if not isinstance(b, rs.SealElement) and b.n not in rotor.link_nodes]
+    r = _quiet(convert_6dof_to_4dof, _quiet(rotor.__class__, shaft_elements=shafts,
+                                            disk_elements=rotor.disk_elements,
+                                            bearing_elements=springs))
+    lam = _ross_eigenvalues(r, 0.0)
+    return np.sort(np.abs(lam[lam.imag > 0]))[::2][:4]
+
+
+def test_undamped_critical_speed_map_equals_ross(examples):
+    """API 684's undamped critical speed map of ROSS's ``rotor_example`` and
+    ``compressor_example`` (layered shaft, seals, bearing tables), imported, equals ROSS's
+    ``run_ucs`` loop on the same rotors (:func:`_ross_ucs_wn`, side by side, ROSS 2.3 or
+    3.1; ``run_ucs`` itself in the slow test below). The same definition — every bearing
+    but the seals an isotropic spring k, undamped, at standstill, each plane's
+    frequencies once, the 4 lowest — at 1e5 to 1e10 N/m, to 1e-6."""
+    from ambseal.analysis.signoff.ucs_map import ucs_map
+
+    k = np.logspace(5, 10, 4)
+    for name in ("rotor_example", "compressor_example"):
+        rotor = examples[name][0]
+        ours = ucs_map(from_ross(rotor).rig, stiffness=k)
+        ross = np.column_stack([_ross_ucs_wn(rotor, kj) for kj in k])
+        np.testing.assert_allclose(ours.critical_hz, ross / (2 * np.pi), rtol=1e-6)
+
+
+@pytest.mark.slow
+def test_undamped_critical_speed_map_equals_ross_run_ucs(examples):
+    """As above, against ROSS's ``Rotor.run_ucs`` itself (25 s on ROSS 2.3: its modal
+    post-processing compiles with numba, and ``compressor_example`` takes 15 s)."""
+    from ambseal.analysis.signoff.ucs_map import ucs_map
+
+    k = np.logspace(5, 10, 6)
+    for name in ("rotor_example", "compressor_example"):
+        rotor = examples[name][0]
+        ross = _quiet(rotor.run_ucs, stiffness_range=(5, 10), num=6)
+        ours = ucs_map(from_ross(rotor).rig, stiffness=k)
+        np.testing.assert_allclose(ours.stiffness, np.asarray(ross.stiffness_log),
+                                   rtol=1e-12)
+        np.testing.assert_allclose(ours.critical_hz, np.asarray(ross.wn) / (2 * np.pi),
+                                   rtol=1e-6)

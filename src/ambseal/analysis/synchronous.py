@@ -51,7 +51,7 @@ from ambseal.model import (
 )
 
 __all__ = ["Unbalance", "SynchronousResponse", "synchronous_response", "orbit_semi_major",
-           "RunningPlant", "running_plant", "hold_fundamental"]
+           "RunningPlant", "running_plant", "hold_fundamental", "amb_dynamic_stiffness"]
 
 
 @dataclass(frozen=True)
@@ -141,6 +141,63 @@ def _controller_at(controller, out_names, in_names, omegas: np.ndarray,
         return np.concatenate([at(controller_as_runs(controller, w, values), np.array([w]))
                                for w in omegas])
     return at(controller_as_runs(controller, 0.0), omegas)
+
+
+def amb_dynamic_stiffness(cfg, controller, speeds_hz, *, pressure_bar: float | None = None
+                          ) -> tuple[tuple[str, ...], np.ndarray]:
+    """Each AMB axis's dynamic stiffness at 1× with the controller as it runs: the force
+    per displacement it transmits to a synchronous whirl of its own sensor's reading,
+
+        D(Ω) = K_i H_a(jΩ) H_e(jΩ) K_r,jj(Ω) − K_s ,
+
+    ``K_r`` the controller's fundamental through the sampler and the hold (module
+    docstring: the discrete controller with its computation delay), ``jj`` its direct
+    term (the axis's current per the axis's own sensor), ``H_a`` the amplifier and ``H_e``
+    the eddy-current lag (``[actuator]``); the equivalent stiffness is Re D, the
+    equivalent damping Im D/Ω (Schweitzer & Maslen, *Magnetic Bearings*, 2009, §7.2:
+    k_eq = K_i Re K − K_s). For a decentralised controller (a PID) this is the AMB's own
+    support; a centralised one (H∞, μ) couples the axes, and the direct term is the part
+    a support map can draw. A sensor away from its actuator reads another displacement:
+    D then relates the force to the sensor's reading.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig, with ``[[amb]]``.
+    controller : DigitalController or ScheduledDigital
+        As it runs (a scheduled table at each speed).
+    speeds_hz : array_like, shape (n_s,)
+        Speeds (Hz), ≥ 0.
+    pressure_bar : float, optional
+        The seals' pressure drop, for a table scheduled on a seal coefficient (default
+        ``[operating] pressure_bar``).
+
+    Returns
+    -------
+    axes : tuple of str
+        ``<amb>_<axis>`` per column (:func:`ambseal.model.channel_names`' order).
+    D : ndarray of complex, shape (n_s, n_axes)
+        N/m.
+
+    Raises
+    ------
+    ModelError
+        A controller whose signals are not the rig's AMB axes.
+    """
+    speeds = np.atleast_1d(np.asarray(speeds_hz, dtype=float))
+    p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
+    names = [(amb, ax, ki, ks) for amb in cfg.amb
+             for ax, ki, ks in zip(AXES, *amb_factors(amb))]
+    axes = tuple(f"{a.name}_{ax}" for a, ax, _, _ in names)
+    Kr = _controller_at(controller, [f"y_{n}" for n in axes], [f"i_{n}" for n in axes],
+                        2 * math.pi * speeds, seal_values(cfg.seal, p))
+    act = (actuator_matrices(cfg.actuator), eddy_lag_matrices(cfg.actuator.eddy_time_constant))
+    h = np.array([_siso_at(act[0], 1j * w) * _siso_at(act[1], 1j * w)
+                  for w in 2 * math.pi * speeds])
+    ki = np.array([k for _, _, k, _ in names])
+    ks = np.array([k for _, _, _, k in names])
+    direct = np.diagonal(Kr, axis1=1, axis2=2)  # (n_s, n_axes): current per own reading
+    return axes, ki[None, :] * h[:, None] * direct - ks[None, :]
 
 
 def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,

@@ -19,6 +19,9 @@ Read it in the order a rig goes through it:
    (:func:`api617_unbalance`).
 5. :mod:`~ambseal.analysis.signoff.iso_vibration` — ISO 14839-2's zones at the AMB
    sensors against the backup clearance (:func:`iso14839_2_zones`).
+6. :mod:`~ambseal.analysis.signoff.ucs_map` — API 684's undamped critical speed map,
+   each controller's AMB stiffness at 1× on it (:func:`ucs_map`; the command's
+   ``ucs_map.png``, informative: no criterion).
 
 The closed-loop modes, log decrements and criticals they read are
 :mod:`ambseal.analysis.campbell`'s, the synchronous response
@@ -39,6 +42,7 @@ _FROM = {
     "level2_analysis": "level2", "Level2": "level2",
     "api617_unbalance": "unbalance_api617", "Api617Unbalance": "unbalance_api617",
     "iso14839_2_zones": "iso_vibration", "IsoVibration": "iso_vibration",
+    "ucs_map": "ucs_map", "UcsMap": "ucs_map", "undamped_criticals_hz": "ucs_map",
 }
 
 __all__ = sorted(_FROM)

@@ -17,7 +17,8 @@ from .analysis.test_analysis_level1 import _rigid_rotor
 def test_signoff_json_files_and_exit_status(tmp_path, capsys):
     """A rotor on damped springs (no AMB: controller ``none``), Q_0/Q_A between 2 and 10
     and its CSR above a boundary set low (Region B): Level II required, exit status 1; the JSON holds the level1 block with Q_A, Q_0
-    (Q_0 = c√(k/m) within 2 %), δ_A, CSR and passed, and the files it names exist."""
+    (Q_0 = c√(k/m) within 2 %), δ_A, CSR and passed, and the files it names exist; the
+    undamped critical speed map, its first critical on soft springs √(2k/m)."""
     rig = tmp_path / "rigid.toml"
     rig.write_text(_rigid_rotor(1e7, 2000.0, 4.5e4)
                    + "[signoff]\ncsr_boundary = [[0.0, 0.001]]\n")
@@ -38,9 +39,17 @@ def test_signoff_json_files_and_exit_status(tmp_path, capsys):
     assert lv["Q_0"] == pytest.approx(2000.0 * math.sqrt(1e7 / m), rel=0.02)
     assert lv["passed"] is False and doc["passed"] is False and "Level II" in lv["rule"]
     assert all((tmp_path / "so" / n).is_file()
-               for n in ("signoff.json", "level1.png", "api617_unbalance.png"))
+               for n in ("signoff.json", "level1.png", "api617_unbalance.png", "ucs_map.png"))
     assert json.loads((tmp_path / "so" / "signoff.json").read_text())["controllers"] == \
         doc["controllers"]
+    # API 684's map: ±3 decades around the springs' 5e6 N/m; on the softest the rotor
+    # moves as a rigid body, its cylindrical critical √(2k/m) (its shaft bends by 1e-7)
+    ucs = doc["ucs_map"]
+    k0 = ucs["stiffness_n_per_m"][0]
+    assert k0 == pytest.approx(1e3) and ucs["stiffness_n_per_m"][-1] == pytest.approx(1e9)
+    assert ucs["critical_speeds_hz"][0][0] == pytest.approx(
+        math.sqrt(2 * k0 / m) / (2 * math.pi), rel=1e-6)
+    assert ucs["controllers"] == []  # on springs alone: no AMB to draw
 
 
 def test_signoff_passes_with_exit_status_0(tmp_path, capsys):

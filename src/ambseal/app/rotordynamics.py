@@ -42,6 +42,7 @@ from ambseal.analysis import (
     sign_off,
     simulate_drop,
     stability_boundary,
+    ucs_map,
     verdict_line,
 )
 from ambseal.analysis.campbell import campbell
@@ -73,6 +74,7 @@ from ambseal.report import (
     mode_shapes_figure,
     stability_map_figure,
     stamp,
+    ucs_map_figure,
     write_drop_report,
 )
 from ambseal.robust import with_delay
@@ -259,20 +261,25 @@ def _signoff(args: argparse.Namespace) -> int:
 def _signoff_into(args: argparse.Namespace) -> int:
     cfg = load_rig(args.rig)
     say = logging.getLogger("ambseal").info
-    results = [sign_off(cfg, K, name=name, progress=say)
-               for name, K in _signoff_controllers(cfg, args)]
+    controllers = _signoff_controllers(cfg, args)
+    results = [sign_off(cfg, K, name=name, progress=say) for name, K in controllers]
+    ucs = ucs_map(cfg, controllers)  # API 684's map: informative, no criterion
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     doc = {"rig": str(args.rig), "machine": cfg.machine.kind,
            "passed": all(r.passed for r in results), "verdict": verdict_line(results),
-           "controllers": {r.controller: r.to_dict() for r in results}}
+           "controllers": {r.controller: r.to_dict() for r in results},
+           "ucs_map": ucs.to_dict()}
     files = [write_json(out / "signoff.json", doc),
              *([level1_figure(out / "level1.png", [r.level1 for r in results],
                               title=f"API 617 Level I — {cfg.rotor.name}",
                               boundary=cfg.signoff.csr_boundary)] if cfg.stage else []),
              api617_unbalance_figure(out / "api617_unbalance.png",
                                      [r.unbalance for r in results],
-                                     title=f"API 617 unbalance response — {cfg.rotor.name}")]
+                                     title=f"API 617 unbalance response — {cfg.rotor.name}"),
+             ucs_map_figure(out / "ucs_map.png", ucs, speeds_hz=(*cfg.operating.continuous_hz,
+                                                                 cfg.operating.trip_hz),
+                            title=f"API 684 undamped critical speed map — {cfg.rotor.name}")]
     if args.json:
         print(json.dumps({**doc, "files": [str(f) for f in files]}))
     else:

@@ -12,9 +12,9 @@
 * :func:`fit_timeseries_figure`, :func:`correlation_figure`, :func:`residual_figure`,
   :func:`error_budget_figure` — an identification (:mod:`ambseal.report.identify_figures`);
 * :func:`tracking_figure`, :func:`ramp_figure` — on-line tracking and the pressure ramp;
-* :func:`level1_figure`, :func:`api617_unbalance_figure`, :func:`signoff_report` — API 617's
-  Level I screening, unbalance response
-  (:mod:`ambseal.report.signoff_figures`);
+* :func:`level1_figure`, :func:`api617_unbalance_figure`, :func:`ucs_map_figure`,
+  :func:`signoff_report` — API 617's Level I screening, unbalance response, API 684's
+  undamped critical speed map (:mod:`ambseal.report.signoff_figures`);
 * :func:`drop_figure`, :func:`drop_whirl_figure`, :func:`drop_current_figure` — the
   rotor drop: the AMB axes' currents, orbits in the
   clearance, contact forces, the whirl's waterfall (:func:`whirl_waterfall`), the rings'
@@ -42,7 +42,7 @@ _FROM = {
     "drop_figure": "drop_figures", "drop_whirl_figure": "drop_figures",
     "whirl_waterfall": "drop_figures", "drop_current_figure": "drop_figures",
     "write_drop_report": "drop_report",
-    "api617_unbalance_figure": "signoff_figures",
+    "api617_unbalance_figure": "signoff_figures", "ucs_map_figure": "signoff_figures",
     "facility_impulse_report": "run_report", "gains_figure": "run_report",
     "capacity_figure": "run_report", "rejection_figure": "run_report",
     "identification_report": "run_report", "judged_on": "run_report",

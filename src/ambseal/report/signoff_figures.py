@@ -15,7 +15,7 @@ from ambseal.analysis import verdict_line
 from ambseal.config import Signoff
 from ambseal.report.figures import save_figure
 
-__all__ = ["level1_figure", "api617_unbalance_figure", "signoff_report"]
+__all__ = ["level1_figure", "api617_unbalance_figure", "ucs_map_figure", "signoff_report"]
 
 
 def level1_figure(path: str | os.PathLike, results, *,
@@ -120,6 +120,58 @@ def api617_unbalance_figure(path: str | os.PathLike, results, *,
         ax.legend(fontsize=7, loc="lower right")
     axes[-1].set_xlabel("speed (rpm)")
     fig.suptitle(title, fontsize=10)
+    return save_figure(fig, path, tight=True)
+
+
+def ucs_map_figure(path: str | os.PathLike, ucs, *, speeds_hz=None,
+                   title: str = "Undamped critical speed map") -> Path:
+    """API 684's undamped critical speed map: the rotor's critical speeds against the
+    support stiffness (log–log), each controller's AMBs as curves k_eq(Ω) at 1× (a
+    stiffness that is not positive leaves the axis), their undamped criticals marked, and
+    the speed range shaded.
+
+    Parameters
+    ----------
+    path : path-like
+        The PNG to write.
+    ucs : ambseal.analysis.signoff.ucs_map.UcsMap
+        The map.
+    speeds_hz : (float, float, float), optional
+        (minimum continuous, maximum continuous, trip) speed (Hz), drawn when given.
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    Path
+        The PNG written.
+    """
+    fig = Figure(figsize=(8, 5.6))
+    ax = fig.subplots()
+    for j, row in enumerate(ucs.critical_hz):
+        ax.loglog(ucs.stiffness, 60.0 * row, "k-", lw=1.4 if j == 0 else 1.0,
+                  label="rotor's critical speeds" if j == 0 else None)
+    styles = ["-", "--", ":", "-."]
+    for c, color in zip(ucs.curves, ["C0", "C1", "C2", "C3", "C4", "C5"] * 4):
+        for i, (amb, k) in enumerate(zip(c.ambs, c.k_eq)):
+            ax.loglog(np.where(k > 0, k, np.nan), 60.0 * ucs.speeds_hz, color=color,
+                      ls=styles[i % len(styles)], lw=1.2, label=f"{c.controller}: AMB {amb} "
+                      "k_eq at 1×")
+        for f in c.criticals_hz:
+            ax.axhline(60.0 * f, color=color, lw=0.6, alpha=0.5)
+            ax.annotate(f"{60.0 * f:.4g} rpm", (ucs.stiffness[0], 60.0 * f), fontsize=7,
+                        color=color, textcoords="offset points", xytext=(2, 2))
+    if speeds_hz is not None:
+        lo, hi, trip = speeds_hz
+        ax.axhspan(60.0 * lo, 60.0 * hi, color="0.85", alpha=0.6,
+                   label="continuous speed range")
+        ax.axhline(60.0 * trip, color="0.3", ls=":", lw=1.0, label="trip speed")
+    ax.set_xlim(ucs.stiffness[0], ucs.stiffness[-1])
+    ax.set_xlabel("support stiffness (N/m)")
+    ax.set_ylabel("critical speed (rpm)")
+    ax.set_title(title, fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, loc="upper left")
     return save_figure(fig, path, tight=True)
 
 

@@ -290,3 +290,45 @@ def test_a_seal_given_as_a_spring_is_no_bearing(tmp_path):
     rows = [r.component for r in level2_analysis(cfg.model_copy(update={"stage": []}),
                                                  None).rows]
     assert f"+ seal {seals[0].name}" in rows and rows[0] == "rotor and supports"
+
+
+def test_level1_screens_a_resonance_not_an_overdamped_pole():
+    """The gyroscopic rigid rotor on its PID of the Level II test (cylindrical mode at
+    ζ = 0.95, the nutation resonant at 200 Hz), a small stage at mid-span: up to 10·Q_A
+    no mode loses its damping, and Q, at mid-span of a symmetric rotor, takes damping
+    from the cylindrical whirl (δ 21 → 16) and moves the overdamped poles of the rigid
+    shaft's bending, aliased by the sampling (δ in the thousands): their δ falls by more
+    than the nutation's whole δ. Level I screens the mode that is a resonance (AF =
+    π/δ ≥ 2.5, API 684's critical speed) — the nutation, which Q leaves alone — and its
+    δ_A and frequency at Q_A are those of the lowest forward resonant eigenvalue of an
+    independent eigen-analysis of the same sampled loop with jQ_A r at mid-span in
+    complex coordinates (to 1e-3 and 1e-4); the cylindrical whirl stays overdamped
+    there (ζ > 0.5)."""
+    from ..rigid_rotor import L
+    from .test_analysis_level2 import (
+        FS,
+        _complex_sampled_loop,
+        _gyroscopic_rig_and_pid,
+    )
+    from ambseal.design.pid import pid_controller
+    from ambseal.model import channel_names
+    from ambseal.robust import discrete_controller
+    from ambseal.robust.digital import DigitalController
+
+    stage = (f"[[stage]]\nposition = {L / 2}\npower = 3000.0\nimpeller_diameter = 0.3\n"
+             "discharge_width = 0.02\nsuction_density = 10.0\ndischarge_density = 15.0\n")
+    cfg, p = _gyroscopic_rig_and_pid(stage)
+    K = pid_controller(*p, channel_names(cfg))
+    dc = DigitalController(K, K, discrete_controller(K, 1 / FS, "tustin"), "tustin", None,
+                           FS, 1)
+    r = level1_screening(cfg, dc)
+    assert r.Q_0 is None and r.passed
+    lam = _complex_sampled_loop(*p, q=r.Q_A)
+    fwd = lam[lam.imag > 2 * math.pi * 0.1]
+    fwd = fwd[np.argsort(fwd.imag)]
+    delta = -2 * math.pi * fwd.real / fwd.imag
+    sharp = np.flatnonzero(math.pi / delta >= 2.5)
+    assert sharp[0] > 0 and -fwd[0].real / abs(fwd[0]) > 0.5  # the cylindrical, below
+    iA = int(np.argmin(np.abs(r.Q - r.Q_A)))
+    assert r.log_dec_A == pytest.approx(delta[sharp[0]], rel=1e-3)
+    assert r.frequency_hz[iA] == pytest.approx(fwd[sharp[0]].imag / (2 * math.pi), rel=1e-4)

@@ -75,17 +75,18 @@ DISK = (20.0, 0.9, 0.5)
 KS, KI, FS, SPEED_HZ = 2.0e5, 100.0, 1.0e4, 200.0
 
 
-def _gyroscopic_rig_and_pid():
+def _gyroscopic_rig_and_pid(stage: str = ""):
     """The rigid rotor of :mod:`tests.rigid_rotor` on AMBs at 0 and L (sensors there too),
     its bending modes damped (ζ 0.05: they lie near 1 MHz and alias into the sampled
-    loop's band), and the PID (kp, ti, td, eps) at 10 kHz with one sample of delay."""
+    loop's band), and the PID (kp, ti, td, eps) at 10 kHz with one sample of delay;
+    ``stage`` is more of the rig file (a ``[[stage]]``)."""
     text = rotor_text("disc-like rigid rotor", *DISK, 4).replace(
         'name = "disc-like rigid rotor"', 'name = "disc-like rigid rotor"\nmodal_damping = 0.05')
     for name, z in (("A", 0.0), ("B", L)):
         text += (f'[[amb]]\nname = "{name}"\nposition = {z}\nsensor_position = {z}\n'
                  f"ki = {KI}\nks = {KS}\nbias_current = 5.0\ncurrent_limit = 10.0\n")
     text += (f"[controller]\nsample_rate_hz = {FS}\ndelay_samples = 1\n"
-             f"[operating]\nspeed_rpm = {60 * SPEED_HZ}\n")
+             f"[operating]\nspeed_rpm = {60 * SPEED_HZ}\n" + stage)
     m = inertia(*DISK)[0]
     k_eq = KS / 2
     kp = (KS + k_eq) / KI
@@ -94,20 +95,23 @@ def _gyroscopic_rig_and_pid():
     return parse_rig(tomllib.loads(text)), (kp, 1e6, td, eps)
 
 
-def _complex_sampled_loop(kp, ti, td, eps):
+def _complex_sampled_loop(kp, ti, td, eps, q: float = 0.0):
     """Every eigenvalue λ = ln z/T (rad/s) of the sampled loop in complex coordinates
     r = x + jy, φ = θ_y − jθ_x of the rigid rotor (Genta, *Dynamics of Rotating Systems*,
-    2005, §4.6): m r̈ = ΣF_b, I_t φ̈ − j I_p Ω φ̇ = Σ z_b F_b, F_b = Ks r_b + Ki i_b at
-    r_b = r + z_b φ, the plant sampled by a zero-order hold, the PID by Tustin, i[k] the
-    command of sample k − 1. In these coordinates Im λ > 0 is a forward whirl, Im λ < 0
-    a backward one: the gyroscopic term stiffens the positive frequencies."""
+    2005, §4.6): m r̈ = ΣF_b + jq r, I_t φ̈ − j I_p Ω φ̇ = Σ z_b F_b, F_b = Ks r_b + Ki i_b
+    at r_b = r + z_b φ, the plant sampled by a zero-order hold, the PID by Tustin, i[k]
+    the command of sample k − 1; ``q`` a cross-coupled stiffness k_xy = q, k_yx = −q at
+    mid-span (f_x = −q y, f_y = q x: f = jq r). In these coordinates Im λ > 0 is a
+    forward whirl, Im λ < 0 a backward one: the gyroscopic term stiffens the positive
+    frequencies."""
     m, it, ip = inertia(*DISK)
     zb = np.array([-L / 2, L / 2])
     T = np.column_stack([np.ones(2), zb])  # r_b = T [r, φ]
     Minv = np.diag([1 / m, 1 / it])
     W = 2 * math.pi * SPEED_HZ
     A = np.block([[np.zeros((2, 2)), np.eye(2)],
-                  [Minv @ (KS * T.T @ T), Minv @ np.diag([0.0, 1j * ip * W])]])
+                  [Minv @ (KS * T.T @ T + np.diag([1j * q, 0.0])),
+                   Minv @ np.diag([0.0, 1j * ip * W])]])
     B = np.vstack([np.zeros((2, 2)), Minv @ (KI * T.T)])
     C = np.hstack([T, np.zeros((2, 2))])
     dt = 1 / FS

@@ -23,7 +23,11 @@ or a controller pole with a small imaginary part that Q hardly moves, and the lo
 decrement of all would be an undamped bending mode Q does not touch. So the forward (not
 backward) modes are followed over the sweep by nearest eigenvalue
 (:func:`~ambseal.analysis.campbell.track_modes`), and the screened mode is the one that
-loses its damping first; if none does, the one Q takes the most damping from. The loop
+loses its damping first; if none does, the one Q takes the most damping from among those
+that are a resonance somewhere in the sweep (amplification factor π/δ ≥ 2.5, API 684's
+critical speed, :func:`~ambseal.analysis.campbell.resonant`): an overdamped pole's δ of
+tens falls by more than a resonance's whole δ while it stays without resonance, and is
+no mode API 617 screens (Level II grades the same kind of mode). The loop
 counts as lost where a pole within the screened band breaks the stability rule
 (:meth:`~ambseal.analysis.campbell.ClosedLoopModes.deciding`); a lossless mesh mode far
 above the band, which nothing damps (ROSS's ``compressor_example`` has them at 21–105
@@ -59,7 +63,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from ambseal.analysis.campbell import modes_as_run, track_modes
+from ambseal.analysis.campbell import modes_as_run, resonant, track_modes
 from ambseal.config import MAX_SUPPORT_STIFFNESS, Spring
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
@@ -308,8 +312,10 @@ def _lines(points) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
 
 def _screened(D: np.ndarray, forward: np.ndarray, iA: int) -> tuple[int, int | None]:
     """(line, first grid index where it has lost its damping or None): the forward line
-    that loses its damping first; else the one Q takes the most damping from (the mode
-    the cross-coupling acts on); else the least damped at Q_A."""
+    that loses its damping first; else, of the forward lines that are a resonance
+    somewhere in the sweep (:func:`~ambseal.analysis.campbell.resonant`, AF ≥ 2.5), the
+    one Q takes the most damping from (the mode the cross-coupling acts on); else the
+    least damped at Q_A."""
     first = None
     for j in np.flatnonzero(forward):
         d = D[:, j]
@@ -319,7 +325,10 @@ def _screened(D: np.ndarray, forward: np.ndarray, iA: int) -> tuple[int, int | N
             first = (int(j), int(down[0]))
     if first is not None:
         return first
-    drop = np.where(forward, D[0] - D[-1], np.nan)
+    # an overdamped pole's δ of tens moves by more than any resonance's whole δ: only a
+    # line that is a resonance somewhere in the sweep is screened by its loss
+    sharp = resonant(np.where(np.isfinite(D), D, np.inf)).any(axis=0)
+    drop = np.where(forward & sharp, D[0] - D[-1], np.nan)
     if np.any(np.isfinite(drop)):
         return int(np.nanargmax(drop)), None
     return int(np.argmin(np.where(forward & np.isfinite(D[iA]), D[iA], np.inf))), None

@@ -159,7 +159,7 @@ def ucs_map_figure(path: str | os.PathLike, ucs, *, speeds_hz=None,
                       "k_eq at 1×")
         for f in c.criticals_hz:
             ax.axhline(60.0 * f, color=color, lw=0.6, alpha=0.5)
-            ax.annotate(f"{60.0 * f:.4g} rpm", (ucs.stiffness[0], 60.0 * f), fontsize=7,
+            ax.annotate(f"{60.0 * f:.0f} rpm", (ucs.stiffness[0], 60.0 * f), fontsize=7,
                         color=color, textcoords="offset points", xytext=(2, 2))
     if speeds_hz is not None:
         lo, hi, trip = speeds_hz

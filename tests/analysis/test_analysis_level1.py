@@ -11,7 +11,13 @@ import pytest
 
 from ambseal.analysis.signoff.level1 import level1_screening, stage_cross_coupling
 from ambseal.config import parse_rig
+from ambseal.design.pid import pid_controller
 from ambseal.errors import ConfigError
+from ambseal.model import channel_names
+from ambseal.robust import discrete_controller
+from ambseal.robust.digital import DigitalController
+
+from ..rigid_rotor import L
 
 #: N/m per klbf/in: 1000 lbf (4448.2216 N) per inch (0.0254 m)
 KLBF_PER_IN = 4448.2216152605 / 0.0254
@@ -304,16 +310,8 @@ def test_level1_screens_a_resonance_not_an_overdamped_pole():
     independent eigen-analysis of the same sampled loop with jQ_A r at mid-span in
     complex coordinates (to 1e-3 and 1e-4); the cylindrical whirl stays overdamped
     there (ζ > 0.5)."""
-    from ..rigid_rotor import L
-    from .test_analysis_level2 import (
-        FS,
-        _complex_sampled_loop,
-        _gyroscopic_rig_and_pid,
-    )
-    from ambseal.design.pid import pid_controller
-    from ambseal.model import channel_names
-    from ambseal.robust import discrete_controller
-    from ambseal.robust.digital import DigitalController
+    # here, not at the top: test_analysis_level2 imports this module
+    from .test_analysis_level2 import FS, _complex_sampled_loop, _gyroscopic_rig_and_pid
 
     stage = (f"[[stage]]\nposition = {L / 2}\npower = 3000.0\nimpeller_diameter = 0.3\n"
              "discharge_width = 0.02\nsuction_density = 10.0\ndischarge_density = 15.0\n")

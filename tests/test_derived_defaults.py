@@ -77,3 +77,30 @@ def test_a_written_pid_the_target_cannot_run_is_still_refused(slim_rig, tmp_path
     assert main(["validate", str(rig)]) == 2
     err = capsys.readouterr().err
     assert "controller.sample_rate_hz = 20000 Hz is below twice the highest pole" in err
+
+
+@pytest.mark.slow
+def test_the_run_reports_the_pid_and_the_notch_it_tried(slim_rig, tmp_path):
+    """``ambseal run --no-identify`` on the same rig (2 min of CPU): the run is not refused;
+    the derived PID's notes in ``metrics.json`` name the lead left out; the derived PID,
+    which as it runs leaves a bending mode unstable at the top speed, is reported unable
+    to run on the target with the reason, and the run goes on with the other controllers.
+    The LPV alone would need more than the bias current's linear range to hold the G2.5
+    unbalance: the run switched its unbalance force rejection on by itself, and with it the
+    rotor whirls about its axis of inertia by more than the backup clearance, which the
+    failure says, with the clearance checked against the rig file."""
+    out = tmp_path / "out"
+    code = main(["--quiet", "run", str(slim_rig), "--no-identify", "--out", str(out)])
+    assert code in (0, 1)
+    m = json.loads((out / "metrics.json").read_text())
+    assert any("(left out: lead" in n for n in m["controllers"]["pid"]["notes"])
+    assert "pid cannot run on the target" in m["cannot_run"]["pid"]
+    lpv = m["controllers"]["lpv"]
+    assert lpv["capacity"]["bias_used"] > 1 and "rejection" in lpv
+    backup_um = 1e6 * min(map(load_rig(slim_rig).backup_clearance, load_rig(slim_rig).amb))
+    beyond = lpv["rejection"]["beyond"]
+    assert beyond["clearance_um"] == pytest.approx(backup_um)
+    assert beyond["orbit_um"] > backup_um
+    assert ("its unbalance force rejection, switched on by the run, whirls the rotor about "
+            f"its axis of inertia by {beyond['orbit_um']:.3g} µm, beyond the backup "
+            f"bearing's clearance ({backup_um:.3g} µm)") in m["failed"]["lpv"]["reason"]

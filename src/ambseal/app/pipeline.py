@@ -574,6 +574,18 @@ class _Notch:
         return not self.lost and self.beyond is None
 
 
+def _why_not_notched(n: _Notch) -> str:
+    """Why a controller's unbalance force rejection, switched on by the run, does not
+    hold it: the conditions where a loop is lost, or the clearance its orbit exceeds."""
+    head = "its unbalance force rejection, switched on by the run, "
+    if n.lost:
+        return head + f"loses the loop at {', '.join(n.lost)}"
+    name, clearance_um = n.beyond
+    orbit = float(np.max(n.effect["orbit_um"]["with"]))
+    return (head + f"whirls the rotor about its axis of inertia by {orbit:.3g} µm, beyond "
+            f"{CLEARANCE_WORDS.get(name, name)} ({clearance_um:.3g} µm)")
+
+
 def _notches(st: _RunState, methods=None) -> dict[str, _Notch]:
     """Each controller's unbalance force rejection
     (:func:`~ambseal.design.synchronous_rejection.design_rejection` on the design rig) but
@@ -705,6 +717,8 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
     for m, block in capacity.items():  # an amplifier that saturates fails its controller
         f = saturation_failure(m, block, designed=m != "pid", kept=st.allow_unstable,
                                derived=cfg.controller.pid is None)
+        if f is not None and m in automatic and m in notches:
+            f = replace(f, reason=f"{f.reason}; {_why_not_notched(notches[m])}")
         if f is not None:
             st.failed[m] = also_failed(st.failed.get(m), f)
     clearances = rig_clearances_um(cfg)

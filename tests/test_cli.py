@@ -94,7 +94,7 @@ def test_cli_no_traceback_in_a_real_process(tmp_path):
     assert "Traceback" not in proc.stderr and "shaft[0].length" in proc.stderr
 
 
-def test_a_dependencys_deprecation_notices_are_not_shown(tmp_path, monkeypatch):
+def test_a_dependencys_deprecation_notices_are_not_shown(tmp_path, capsys, monkeypatch):
     """A command's warnings are shown after it, except a dependency's deprecation notices
     (python-control's on NumPy 2.5 filled a plain ``ambseal run``'s stderr): those of
     ambseal's own modules and any other warning still are."""
@@ -111,15 +111,54 @@ def test_a_dependencys_deprecation_notices_are_not_shown(tmp_path, monkeypatch):
         warnings.warn("a RuntimeWarning of a solver", RuntimeWarning)
         return 0
 
-    shown = []
     monkeypatch.setitem(ambseal.app.HANDLERS, "validate", handler)
-    monkeypatch.setattr(warnings, "showwarning", lambda message, *a, **k: shown.append(
-        str(message)))  # (pytest records what reaches the real one)
     rig = tmp_path / "rig.toml"
     rig.write_text(GOOD)
     assert main(["validate", str(rig)]) == 0
-    assert sorted(shown) == ["DeprecationWarning from ambseal.robust.hinf",
-                             "a RuntimeWarning of a solver"]
+    assert sorted(capsys.readouterr().err.splitlines()) == [
+        "ambseal: warning: DeprecationWarning from ambseal.robust.hinf (DeprecationWarning)",
+        "ambseal: warning: a RuntimeWarning of a solver (RuntimeWarning)"]
+
+
+def _keep_design(folder: str) -> None:
+    """A library function that warns as the design cache does when it cannot keep a design
+    (ambseal.design.seal_schedule): a UserWarning naming the folder, pointing at its
+    caller's line."""
+    import warnings
+
+    warnings.warn(f"design cache {folder!r}: the design is not kept ([Errno 30] Read-only "
+                  f"file system: {folder + '/x.json'!r})", stacklevel=2)
+
+
+def test_a_warning_reaches_the_user_as_one_line(tmp_path, capsys, monkeypatch):
+    """Reference: the command line's promise (ambseal.cli) — a warning reaches the user of
+    the command as one line, ``ambseal: warning: <message>``, without Python's file, line
+    and source line (``…/app/tracked.py:66: UserWarning: …`` and the line of code); a
+    message of several lines becomes one; a category other than UserWarning is named.
+    A library user keeps Python's warnings: ``warnings.showwarning`` is Python's again
+    after the command, and the library function still warns as Python does."""
+    import warnings
+
+    import ambseal.app
+
+    def handler(args):
+        _keep_design(str(tmp_path / "ro_cache"))
+        warnings.warn("a solver's notice\n  over two lines", RuntimeWarning)
+        return 0
+
+    shown = warnings.showwarning
+    monkeypatch.setitem(ambseal.app.HANDLERS, "validate", handler)
+    rig = tmp_path / "rig.toml"
+    rig.write_text(GOOD)
+    assert main(["validate", str(rig)]) == 0
+    cache = tmp_path / "ro_cache"
+    assert capsys.readouterr().err.splitlines() == [
+        f"ambseal: warning: design cache '{cache}': the design is not kept ([Errno 30] "
+        f"Read-only file system: '{cache}/x.json')",
+        "ambseal: warning: a solver's notice over two lines (RuntimeWarning)"]
+    assert warnings.showwarning is shown
+    with pytest.warns(UserWarning, match="the design is not kept"):
+        _keep_design(str(cache))
 
 
 def test_the_console_ignores_the_environments_matplotlib_backend(tmp_path):

@@ -599,8 +599,10 @@ def _open_stream(stream) -> bool:
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``ambseal`` console script; returns the exit status.
 
-    Warnings raised on the way (numpy's, say) are shown after a successful command and
-    dropped when the command ends in the one error line."""
+    Warnings raised on the way (ambseal's own, numpy's) are shown after a successful
+    command, one line each (``ambseal: warning: …``, :func:`_warning_line`), and dropped
+    when the command ends in the one error line. A library user keeps Python's own
+    warnings: only the command line formats them."""
 
     # a shell may start us with stdout or stderr closed (`2>&-`): Python has None there (the
     # console script) or a stream on the closed descriptor (`python -m`), and the first
@@ -661,8 +663,17 @@ def main(argv: list[str] | None = None) -> int:
             sys.stdout = open(os.devnull, "w")
             return 0
     for w in caught:
-        warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+        print(_warning_line(w.message, w.category), file=sys.stderr)
     return code
+
+
+def _warning_line(message: Warning | str, category: type[Warning]) -> str:
+    """A warning as the command line shows it: ``ambseal: warning: <message>`` on one line
+    (Python's form names our source file and line, of no use to a user of the command;
+    the category is named unless it is the plain UserWarning, as ambseal's own are)."""
+    text = " ".join(str(message).split())
+    kind = "" if category is UserWarning else f" ({category.__name__})"
+    return f"ambseal: warning: {text}{kind}"
 
 
 if __name__ == "__main__":  # pragma: no cover

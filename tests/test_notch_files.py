@@ -46,6 +46,15 @@ def test_notch_file_round_trip(tmp_path):
     ({"gain_re": np.vectorize(str)(T.real).tolist()}, "gain_re.*numbers"),
     ({"gain_im": (T.imag > 0).tolist()}, "gain_im.*numbers"),
     ({"speeds_rad_s": ["125.6", 377.0, 691.1]}, "speeds_rad_s.*numbers"),
+    # hand-edited tables with rows of unequal length (NumPy's ValueError "setting an array
+    # element with a sequence"): the row named
+    ({"gain_re": [T.real[0].tolist(), T.real[1].tolist(),
+                  [T.real[2, 0].tolist(), T.real[2, 1, :3].tolist(), *T.real[2, 2:].tolist()]]},
+     r"n.json: gain_re\[2\]\[1\]: expected 4 numbers, got 3"),
+    ({"gain_im": [T.imag[0].tolist(), T.imag[1].tolist(), [1.0, *T.imag[2, 1:].tolist()]]},
+     r"n.json: gain_im\[2\]\[0\]: expected a list of 4, got a number"),
+    ({"speeds_rad_s": [125.6, [377.0], 691.1]},
+     r"n.json: speeds_rad_s\[1\]: expected a number, got a list"),
 ])
 def test_bad_notch_files_are_refused_naming_the_key(tmp_path, edit, match):
     path = export_notch(NOTCH, tmp_path / "n.json")

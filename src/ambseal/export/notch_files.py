@@ -98,7 +98,8 @@ def load_notch(path) -> SynchronousNotch:
     ------
     DataError
         A file that is not such a document: the key that is missing or wrong named, with
-        what was expected.
+        what was expected (a table whose rows differ in length: the first such row, e.g.
+        ``gain_re[2][1]``).
     """
     path = Path(path)
     try:
@@ -128,10 +129,13 @@ def load_notch(path) -> SynchronousNotch:
         if not _numbers(v):  # NumPy would read "1.5" and true as numbers
             raise DataError(f"{path}: {key}: expected an array of numbers (not strings or "
                             "true/false)")
+        uneven = _uneven(v, shape)  # NumPy refuses ragged rows with its own ValueError
+        if uneven is not None:
+            raise DataError(f"{path}: {key}{uneven}")
         a = np.asarray(v, dtype=float)
-        if a.shape != shape or not np.all(np.isfinite(a)):
+        if not np.all(np.isfinite(a)):
             raise DataError(f"{path}: {key}: expected finite numbers of shape {shape}, got "
-                            f"shape {a.shape}")
+                            "NaN or inf")
         return a
 
     speeds = doc.get("speeds_rad_s")
@@ -145,6 +149,26 @@ def load_notch(path) -> SynchronousNotch:
                                 number("Ts"))
     except ModelError as exc:
         raise DataError(f"{path}: {exc}") from None
+
+
+def _uneven(v, shape: tuple, at: str = "") -> str | None:
+    """Where nested lists ``v`` depart from ``shape`` — ``"[0][1]: expected 4 numbers, got
+    3"`` (a row of another length: a ragged table), or ``": expected an array of shape (3,
+    4, 4), got 2 rows"`` at the top — else None."""
+    if not shape:
+        return None if not isinstance(v, list) else f"{at}: expected a number, got a list"
+    where = at or ""
+    if not isinstance(v, list):
+        return f"{where}: expected a list of {shape[0]}, got a number"
+    if len(v) != shape[0]:
+        what = "numbers" if len(shape) == 1 else "rows"
+        whole = "" if at else f" (shape {shape})"
+        return f"{where}: expected {shape[0]} {what}{whole}, got {len(v)}"
+    for i, x in enumerate(v):
+        found = _uneven(x, shape[1:], f"{at}[{i}]")
+        if found is not None:
+            return found
+    return None
 
 
 def _numbers(v, depth: int = 0) -> bool:

@@ -15,7 +15,7 @@ Commands
     the full model (or of the closed loop), and the mode shapes.
 ``ambseal campbell RIG [--controller pid|hinf|mu|FILE] [--speed-hz a:b:n] [--pressure-bar P]``
     Closed-loop Campbell diagram with log decrements (API 684 limit flagged): PNG, JSON, CSV.
-``ambseal sweep RIG --pressure-bar a:b:n [--speed-hz a:b:n] [--controller ...]
+``ambseal sweep RIG [--pressure-bar a:b:n] [--speed-hz a:b:n] [--controller ...]
 [--param NAME=a:b:n] [--scheduler ADDRESS | --workers N]``
     Stability and performance map; serial or on Dask.
 ``ambseal import-ross FILE --out RIG [--speed-rpm N]``
@@ -385,7 +385,9 @@ def _rotordynamics_parsers(sub) -> None:
 
     s = sub.add_parser("sweep", help="stability and performance map over pressure x speed")
     s.add_argument("rig", help="rig file (TOML)")
-    s.add_argument("--pressure-bar", required=True, help="pressure drops a:b:n (bar)")
+    s.add_argument("--pressure-bar", default=None,
+                   help="pressure drops a:b:n (bar); default the rig's [operating] "
+                        "pressure_bar, the one pressure")
     s.add_argument("--speed-hz", default=None,
                    help="speeds a:b:n (Hz); default the rig's [design] stability_speeds_hz "
                         "(standstill to the top speed, as `run` checks)")

@@ -196,6 +196,44 @@ def test_cli_sweep_writes_table_boundary_and_map_and_keeps_failed_cases(tmp_path
     assert len(err) == 1 and "unknown parameter 'nope.k'" in err[0] and "s.k" in err[0]
 
 
+def test_cli_sweep_takes_the_rigs_pressure_without_pressure_bar(tmp_path, capsys):
+    """``ambseal sweep RIG --speed-hz ...`` without ``--pressure-bar``: the sweep runs at
+    the rig's own ``[operating] pressure_bar`` (a rig without seals has no other), as
+    ``--help`` says. Reference: the Jeffcott threshold k = c·ω_n (Childs 1993, §1.5) of the
+    rigid rotor, k = 10⁵ N/m per bar crossing at 3.2 bar: stable at the rig's 2 bar,
+    unstable at its 4 bar, at every speed of the range."""
+    import csv
+
+    import control
+
+    from ambseal.cli import main
+    from ambseal.config import dump_rig, parse_rig
+    from ambseal.export.controller_files import export_controller
+    from ambseal.model.amb import channel_names
+
+    kfile = None
+    for p_bar, stable in ((2.0, "True"), (4.0, "False")):
+        cfg = parse_rig({**_tiny_rig(), "operating": {"pressure_bar": p_bar}})
+        rig = tmp_path / f"rig{p_bar:g}.toml"
+        rig.write_text(dump_rig(cfg))
+        if kfile is None:
+            ch = channel_names(cfg)
+            kfile = export_controller(
+                control.ss([], [], [], 1.1e4 * np.eye(4), inputs=[f"y_{c}" for c in ch],
+                           outputs=[f"i_{c}" for c in ch]), tmp_path / "P.json")
+        out = tmp_path / f"sw{p_bar:g}"
+        assert main(["sweep", str(rig), "--speed-hz", "0:20:3", "--controller", str(kfile),
+                     "--out", str(out), "--workers", "1"]) == 0, capsys.readouterr().err
+        assert json.loads(capsys.readouterr().out)["cases"] == 3
+        rows = list(csv.DictReader((out / "sweep.csv").open()))
+        assert [float(r["pressure_bar"]) for r in rows] == [p_bar] * 3
+        assert [r["stable"] for r in rows] == [stable] * 3
+    with pytest.raises(SystemExit):
+        main(["sweep", "--help"])
+    assert "default the rig's [operating] pressure_bar" in " ".join(
+        capsys.readouterr().out.split())
+
+
 def test_a_scheduler_that_never_answers_is_refused_in_time(silent_peer, tmp_path, capsys,
                                                            monkeypatch):
     """A Dask scheduler address whose peer accepts and stays silent: ``run_cases`` and

@@ -167,7 +167,8 @@ def _campbell(args: argparse.Namespace) -> int:
 @_owns_out
 def _sweep(args: argparse.Namespace) -> int:
     cfg = load_rig(args.rig)
-    pressures = _range(args.pressure_bar, "--pressure-bar", *_PRESSURES)
+    pressures = (_range(args.pressure_bar, "--pressure-bar", *_PRESSURES)
+                 if args.pressure_bar is not None else [cfg.operating.pressure_bar])
     spec = design_spec(cfg)
     speeds = (_range(args.speed_hz, "--speed-hz", *_SPEEDS) if args.speed_hz is not None
               else list(spec.stability_speeds_hz))

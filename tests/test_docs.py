@@ -243,15 +243,60 @@ def test_the_manual_has_code_blocks_of_known_kinds():
     assert {b.kind for b in found} <= KINDS, {b.kind for b in found} - KINDS
 
 
+#: C modules the manual names that no page exports: the LPV controller on speed and the
+#: one tracked on the seal's k take minutes of synthesis (``ambseal_<method>``, as the
+#: PID's module the deployment page writes and checks)
+NOT_EXPORTED = ("ambseal_lpv", "ambseal_tracked")
+_C_NAME = re.compile(r"\b(?:ambseal_\w+(?:\.[ch]\b)?|AMBSEAL_\w+)")
+
+
+def _check_c_names(page: Page, path: Path) -> None:
+    """Every C file, function, type and macro name the page quotes (prose, tables and its
+    blocks) is one its own commands wrote: a ``.h``/``.c`` name is a file written in the
+    page's folder, an identifier is declared in the header of the longest module name it
+    starts with. Names of :data:`NOT_EXPORTED` modules are left out; placeholders
+    (``ambseal_<m>``) are no names."""
+    written = {f.name: f for f in page.folder.rglob("ambseal_*.[ch]")
+               if "examples" not in f.relative_to(page.folder).parts[:1]}
+    modules = sorted({f.stem for f in written.values()}, key=len, reverse=True)
+    text = path.read_text(encoding="utf-8")
+    for name in sorted(set(_C_NAME.findall(text))):
+        prefixes = [*modules, *NOT_EXPORTED]
+        if name.isupper():  # a macro; other upper-case names are not C (environment variables)
+            module = next((m for m in prefixes if name.startswith(m.upper() + "_")), None)
+        elif name.endswith((".h", ".c")):
+            module = name[:-2] if name in written else next(
+                (m for m in NOT_EXPORTED if name[:-2] == m), "")
+        else:
+            module = next((m for m in prefixes if name == m or name.startswith(m + "_")), "")
+        if module is None or module in NOT_EXPORTED:
+            continue
+        assert module, (f"{path.name} quotes {name}: no C module the page's commands wrote "
+                        f"({', '.join(modules) or 'none'}) has it")
+        if not name.endswith((".h", ".c")) and name != module:
+            header = written[f"{module}.h"].read_text(encoding="utf-8")
+            assert re.search(rf"\b{name}\b", header), (
+                f"{path.name} quotes {name}, which {module}.h does not declare")
+
+
 @pytest.mark.xdist_group("terminal_run")  # the manual's `ambseal run` reads it
 @pytest.mark.parametrize("path", WITH_CODE, ids=_ids(WITH_CODE))
 def test_page_runs(path, tmp_path, monkeypatch, request):
+    """The page's blocks run (module docstring), and the C names it quotes are those its
+    commands wrote (:func:`_check_c_names`)."""
     page = _run_page(path, tmp_path, monkeypatch, request, slow=False)
     if path.name == "own-machine.md":
         # the page's rig, written from the page alone, validates and runs modes and design
         for command in ("ambseal validate compressor.toml", "ambseal modes compressor.toml",
                         "ambseal design compressor.toml --method pid"):
             assert any(c.startswith(command) for c in page.ran), command
+    if path.name == "deploying.md":
+        # export names its C module after the method or after the controller file: both
+        # ways are shown, so that the names the page quotes for each are checked
+        for way in ("--method", "--controller"):
+            assert any(c.startswith("ambseal export") and way in c.split()
+                       for c in page.ran), way
+    _check_c_names(page, path)
 
 
 @pytest.mark.slow

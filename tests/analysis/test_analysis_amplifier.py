@@ -112,6 +112,53 @@ def test_capacity_block_names_the_limit_and_where(testrig_cfg, judged):
     assert fit["voltage_used"] == pytest.approx(1.0, rel=1e-12)
 
 
+def test_a_dash_for_the_voltage_says_why_and_only_where_there_is_one(testrig_cfg, judged):
+    """Reference: the coil's inductance L = μ0 N² A/(2 s0) (Schweitzer & Maslen 2009, Eqs.
+    3.27–3.30) and the voltage of the unbalance's current, |R + jΩL|·i_c + R i0. A rig
+    that gives the coil — its inductance, its geometry, or both — is sized with that
+    voltage, and the report's sizing text has no dash to explain; one that gives neither
+    has no voltage, and the text says that for its AMBs; one whose only judged response is
+    the impulse on an ideal current loop has none either, and says that instead."""
+    from ambseal.analysis.amplifier import IDEAL_LOOP, NO_COIL
+    from ambseal.model.amb import MU0
+    from ambseal.report.run_report import _sizing_section
+
+    _, _, case, curves = judged
+    speeds, current, names = curves["unbalance_current"]
+    entries = [("0 bar", speeds, current, names, None)]
+    wn, zeta = testrig_cfg.actuator.natural_frequency, testrig_cfg.actuator.damping_ratio
+    sw = 2j * math.pi * speeds
+    coil = np.abs(wn ** 2 / (sw ** 2 + 2 * zeta * wn * sw + wn ** 2))[:, None] * current
+    N, A, s0, R, i0 = 36, 5.5e-3, 5e-4, 0.3, 6.0
+    L = MU0 * N ** 2 * A / (2 * s0)
+    need = R * i0 + np.hypot(R, 2 * math.pi * speeds[:, None] * L) * coil
+
+    def text(cfg):
+        block = capacity_block(cfg, entries)
+        sec = _sizing_section({"controllers": {"hinf": {"capacity": block}}, "failed": {}})
+        return block["sizing"], sec[0]["text"]
+
+    geometry = {"turns": N, "pole_area": A, "air_gap": s0, "resistance": R}
+    for coil_keys in ({"inductance": L, "resistance": R}, geometry, {**geometry, "inductance": L}):
+        ambs = [a.model_copy(update=coil_keys) for a in testrig_cfg.amb]
+        sizing, words = text(testrig_cfg.model_copy(update={"amb": ambs}))
+        for amb in testrig_cfg.amb:
+            own = [j for j, n in enumerate(names) if n.startswith(f"i_{amb.name}_")]
+            assert sizing[amb.name]["supply_voltage_v"] == pytest.approx(
+                need[:, own].max(), rel=1e-9)
+            assert "supply_voltage_note" not in sizing[amb.name]
+        assert "dash" not in words and "inductance" not in words, words
+    sizing, words = text(testrig_cfg)  # the embedded rig gives no coil
+    assert {n: r["supply_voltage_v"] for n, r in sizing.items()} == {"A": None, "B": None}
+    assert words.endswith(f" A dash for the voltage of AMB A, B: {NO_COIL}.")
+    # an ideal current loop's impulse alone: the coil is known, its step has no voltage
+    ideal = testrig_cfg.model_copy(update={
+        "amb": [a.model_copy(update={"inductance": L}) for a in testrig_cfg.amb],
+        "actuator": testrig_cfg.actuator.model_copy(update={"model": "none"})})
+    block = capacity_block(ideal, [], [("0 bar", 0.0, curves["impulse"], None)])
+    assert {r["supply_voltage_note"] for r in block["sizing"].values()} == {IDEAL_LOOP}
+
+
 def test_a_notch_that_holds_leaves_the_amplifier_what_it_leaves(testrig_cfg, judged):
     """With an unbalance force rejection on from the middle of the judged speeds, the
     amplifier holds the unbalance with the current the notch leaves there and the

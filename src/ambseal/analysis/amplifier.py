@@ -49,11 +49,16 @@ import numpy as np
 
 from ambseal.lti import freqresp_at, zoh
 from ambseal.model import (AXES, actuator_matrices, amb_factors, amplifier_needs,
-                           axis_label, limits_used, transient_needs)
+                           axis_label, coil_inductance, limits_used, transient_needs)
 
 __all__ = ["unbalance_currents", "notched_currents", "impulse_coil_currents", "force_demand",
            "capacity_block", "capacity_words", "saturates"]
 
+#: Why a sizing has no supply voltage (``supply_voltage_note``, :func:`capacity_block`).
+NO_COIL = ("the rig file gives neither the coil's inductance nor its geometry (turns, "
+           "pole_area, air_gap)")
+IDEAL_LOOP = ("only the current impulse was judged, on an ideal current loop ([actuator] "
+              "model = \"none\"), whose step no finite voltage drives")
 #: The fractions of :func:`ambseal.model.capacity.amplifier_use`, as metrics.json names them,
 #: and what each is a fraction of, in words.
 QUANTITIES = ("current_used", "voltage_used", "bias_used")
@@ -209,7 +214,9 @@ def capacity_block(cfg, entries, impulses=()) -> dict | None:
         its axes: each bearing's margin) and ``sizing``: per AMB the smallest amplifier
         that holds every judged condition, ``current_limit_a`` (the largest control
         current of its axes, A) and ``supply_voltage_v`` (the largest voltage its coils
-        need, V; None without the coil's inductance),
+        need, V; None where none was computed, and then ``supply_voltage_note`` says why:
+        the rig file gives neither the coil's inductance nor its geometry, or only an
+        ideal current loop's impulse was judged, whose step no finite voltage drives),
         :func:`ambseal.model.capacity.amplifier_needs` and
         :func:`~ambseal.model.capacity.transient_needs`; None when no condition was judged
         stable or the rig's AMBs give no bias current.
@@ -221,6 +228,7 @@ def capacity_block(cfg, entries, impulses=()) -> dict | None:
     best: dict = {q: (None, None) for q in (*QUANTITIES, "current_a")}
     sizing: dict = {}
     per_amb: dict = {}
+    unknown: dict = {}  # AMB → why a need's voltage was not computed
 
     def account(label, speed_hz, name, need, response):
         amb = by_axis[name]
@@ -230,6 +238,9 @@ def capacity_block(cfg, entries, impulses=()) -> dict | None:
         if need["voltage_v"] is not None:
             row["supply_voltage_v"] = max(row["supply_voltage_v"] or 0.0,
                                           float(need["voltage_v"].max(initial=0.0)))
+        else:
+            unknown.setdefault(amb.name, set()).add(
+                NO_COIL if coil_inductance(amb) is None else IDEAL_LOOP)
         use = limits_used(amb, need)
         use["current_a"] = need["current_a"]
         margins = per_amb.setdefault(amb.name, dict.fromkeys(QUANTITIES))
@@ -264,6 +275,10 @@ def capacity_block(cfg, entries, impulses=()) -> dict | None:
             account(label, at, name, need, "impulse")
     if best["current_a"][0] is None:
         return None
+    for name, row in sizing.items():
+        if row["supply_voltage_v"] is None:  # the coil's reason first: it holds for all
+            row["supply_voltage_note"] = (NO_COIL if NO_COIL in unknown[name]
+                                          else IDEAL_LOOP)
     return {**{q: best[q][0] for q in (*QUANTITIES, "current_a")},
             "worst": {q: best[q][1] for q in QUANTITIES if best[q][1] is not None},
             "static_a": float(max(statics)) if any(statics) else None, "per_amb": per_amb,

@@ -709,9 +709,22 @@ def _sizing_section(metrics: dict) -> list[dict]:
             "and for both of its axes: its control-current limit (zero-to-peak) and supply "
             "voltage — R·i0 + |R + jωL| times the unbalance's current, R·i0 + "
             "|R i + L di/dt| in the impulse, each on top of the static current that holds "
-            "the seals' static load where the rig file gives one. A dash for the voltage: "
-            "the rig file gives neither the coil's inductance nor its geometry.")
+            "the seals' static load where the rig file gives one." + _dash_reasons(rows))
     return [{"title": "Amplifier sizing", "text": text, "html": table}]
+
+
+def _dash_reasons(rows: dict) -> str:
+    """`` A dash for the voltage of AMB A: <why>.`` for the AMBs whose sizing has no supply
+    voltage, each reason once with its AMBs (the sizing's ``supply_voltage_note``); ``""``
+    where every voltage was computed."""
+    why: dict = {}
+    for sizing in rows.values():
+        for amb, need in sizing.items():
+            if need is not None and need.get("supply_voltage_v") is None:
+                note = need.get("supply_voltage_note") or "no voltage was computed"
+                why.setdefault(note, []).append(amb)
+    return "".join(f" A dash for the voltage of AMB {', '.join(dict.fromkeys(ambs))}: {note}."
+                   for note, ambs in why.items())
 
 
 def _rejection_section(metrics: dict) -> list[dict]:

@@ -42,6 +42,72 @@ def test_first_order_peak_and_settling_closed_form(t_imp):
     np.testing.assert_allclose(r.current_a[:, 0], -r.displacement_m[:, 0])  # i = −kp y, kp = 1
 
 
+@pytest.mark.parametrize(("kp", "t_end_s", "beyond"), [(0.105, 0.05, True),
+                                                        (1.0, 0.012, False)])
+def test_a_response_that_does_not_settle_says_why(kp, t_end_s, beyond):
+    """Reference: the closed form of the first-order loop above — its one pole at
+    −p = a − b kp, the 2 % settling time T + ln(50)/p after a pulse of length T. Where that
+    lies beyond the simulated window the settling time is inf, and the note names the
+    window and the pole with its own 2 % decay time ln(50)/p, "beyond that window" when
+    that alone exceeds the window (p = 5 rad/s: 782 ms in 50 ms; p = 900 rad/s: 4.35 ms
+    after a 10 ms pulse, in 12 ms); a response that settles has no note."""
+    G, K, p = _first_order(kp=kp)
+    r = response.impulse_response(G, K, channels=["A_zeta"], amplitude_a=0.05, duration_s=0.01,
+                                  t_impulse_s=0.0, t_end_s=t_end_s)
+    assert 0.01 + math.log(50.0) / p > t_end_s  # the closed form settles after the window
+    assert r.stable and not r.settled and r.settling_time_s == math.inf
+    decay = math.log(50.0) / p
+    pole = (f"its slowest pole, at −{p:.3g} rad/s, decays to 2 % in "
+            f"{decay * 1e3:.3g} ms")
+    window = f"not settled within the {t_end_s * 1e3:.3g} ms simulated after the impulse"
+    assert r.settling_note == (f"{window}: {pole}, beyond that window" if beyond
+                               else f"{window} ({pole})")
+    longer = response.impulse_response(G, K, channels=["A_zeta"], amplitude_a=0.05,
+                                       duration_s=0.01, t_impulse_s=0.0, t_end_s=1.0)
+    assert longer.settling_time_s == pytest.approx(0.01 + decay, abs=1e-7)
+    assert longer.settling_note is None
+
+
+def test_the_judged_case_says_why_its_response_did_not_settle():
+    """Reference: python-control's closed loop of the rig's full-order plant (at the
+    judged condition) with the PID and the target's delay lag — its slowest pole is the
+    one the case's note names. A PID with T_i = 0.3 s on the coil rig, judged with a 1 ms
+    impulse (the window 30 impulse lengths: 30 ms after it): its response has not settled
+    when the window ends; metrics.json's case keeps no settling time and says why."""
+    import tomllib
+
+    from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
+    from ambseal.config import parse_rig
+    from ambseal.design import design, design_spec
+    from ambseal.model.rig import build_plant
+    from ambseal.robust import loop_delay
+
+    from ..coil_rig import COIL_RIG
+
+    doc = tomllib.loads(COIL_RIG)
+    doc["controller"] = {"pid": {"kp": 9000.0, "ti": 0.3, "td": 0.0039, "eps": 0.115},
+                         "filter": [{"kind": "notch", "frequency_hz": 1266.44,
+                                     "width_hz": 126.644, "depth_db": 20.0}]}
+    doc["design"] = {"impulse": {"duration_s": 1e-3}}
+    cfg = parse_rig(doc)
+    K = design(cfg, "pid").controller
+    case, curves = judge(cfg, K, "pid", OperatingPoint(0.0, 30000.0, "0 bar"),
+                         judge_settings(design_spec(cfg)))
+    P = build_plant(cfg, speed_rpm=30000.0).to_statespace()
+    cur = [n for n in P.input_labels if n.startswith("i_")]
+    lag = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples).system
+    G = P[list(P.output_labels), cur]
+    L = control.append(*[lag] * len(cur)) * K[cur, list(P.output_labels)]
+    sigma = control.feedback(G, L).poles().real.max()
+    assert case.stable and case.impulse_settling_s is None
+    decay = math.log(50.0) / -sigma
+    assert case.impulse_settling_note == (
+        f"not settled within the 30 ms simulated after the impulse: its slowest pole, at "
+        f"−{-sigma:.3g} rad/s, decays to 2 % in {decay * 1e3:.3g} ms, beyond that window")
+    assert case.to_dict()["impulse_settling_note"] == case.impulse_settling_note
+    assert curves["impulse"].settling_note == case.impulse_settling_note
+
+
 def test_1dof_pd_matches_python_control_forced_response():
     """Reference: control.forced_response run side by side on control.feedback(G, K) with the
     same pulse (P5 §5.1: 0.05 A, 10 ms); python-control interpolates the input linearly between

@@ -247,6 +247,32 @@ def test_verdict_names_the_critical_speeds_near_the_running_range():
     assert "critical" not in verdicts([_metrics()[0]])[0].words()
 
 
+def test_a_response_that_does_not_settle_shows_why_not_a_bare_dash():
+    """Reference: the cases' own ``impulse_settling_note`` (metrics.json). A stable case
+    whose impulse response did not settle within the simulated window has no settling
+    time: the verdict takes it as the worst (not the other condition's 30 ms), says why in
+    its sentence, and the tables show "not settled" with the reason under the detail
+    table; a case that settled shows its time, and the verdict no note."""
+    from ambseal.report.verdict import detail_table_html, verdict_table_html, verdicts
+
+    note = ("not settled within the 350 ms simulated after the impulse: its slowest pole, "
+            "at −0.19 rad/s, decays to 2 % in 20.6 s, beyond that window")
+    settled = dict(_metrics()[0], controller="pid")
+    slow = dict(settled, pressure_bar=4.08, impulse_settling_s=None,
+                impulse_settling_note=note)
+    v = verdicts([settled, slow])[0]
+    assert v.impulse_settling_s is None
+    assert v.impulse_settling_note == f"{note} (at 4.08 bar)"
+    assert f"; its impulse response is {note} (at 4.08 bar)" in v.words()
+    assert ">not settled</td>" in verdict_table_html([v])
+    detail = detail_table_html([settled, slow])
+    assert "<td>30</td>" in detail and "<td>not settled</td>" in detail
+    assert f"<p>pid at 4.08 bar: the impulse response is {note}.</p>" in detail
+    alone = verdicts([settled])[0]
+    assert alone.impulse_settling_s == 0.03 and alone.impulse_settling_note is None
+    assert "impulse" not in alone.words()
+
+
 def test_verdict_says_what_the_unbalance_asks_of_the_amplifier():
     """The design summary's ``capacity`` block in words: the larger of the voltage and
     current fractions, with the axis, the speed in rpm and the condition; above 1 the

@@ -185,6 +185,11 @@ class LoopJudgement:
         ``af``, ``margin_pct`` (the separation from the continuous range, % of its nearer
         end; 0 inside it) and ``required_pct``; None where not judged (the frozen plant, an
         unstable loop, a rig without a running speed).
+    impulse_settling_note : str or None
+        Why a judged impulse response has no settling time, in words
+        (:attr:`ambseal.analysis.response.ImpulseResponse.settling_note`: not settled
+        within the simulated window, with the window and the loop's slowest pole); None
+        where it settled or no impulse was judged.
     """
 
     stable: bool
@@ -200,6 +205,7 @@ class LoopJudgement:
     max_abs_pole_z: float | None = None
     sample_rate_hz: float | None = None
     critical_speeds: list[dict[str, JsonFloat]] | None = None
+    impulse_settling_note: str | None = None
 
     def to_dict(self) -> dict:
         """The ``metrics.json`` form (a discrete loop's two extra keys only when set)."""
@@ -746,6 +752,7 @@ def _judge_loop(judged: JudgedLoop, cur, force, controller, s: JudgeSettings, im
     case.update(
         impulse_peak_um=imp.peak_displacement_um,
         impulse_settling_s=finite_or_none(imp.settling_time_s),
+        impulse_settling_note=imp.settling_note,
     )
     return LoopJudgement(**case), curves
 

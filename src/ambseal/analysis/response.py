@@ -15,11 +15,14 @@ its final value 0, so the settling time is the last time any displacement leaves
 ``|y| ≤ 0.02 · peak`` (``peak`` = largest displacement over all channels and times), measured
 from the impulse start; the crossing is linearly interpolated between samples. It is ``inf``
 (and ``settled`` is False) if the response is outside the band at the end of the window, and
-``inf`` for an unstable loop (flagged by ``stable``; no error is raised).
+``inf`` for an unstable loop (flagged by ``stable``; no error is raised);
+:attr:`ImpulseResponse.settling_note` then says which, with the window and the loop's slowest
+pole.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, Sequence
 
@@ -98,6 +101,26 @@ class ImpulseResponse:
     def displacement_um(self) -> np.ndarray:
         """Displacements (µm), shape (n_t, ny)."""
         return self.displacement_m * 1e6
+
+    @property
+    def settling_note(self) -> str | None:
+        """Why ``settling_time_s`` is not finite, in words (None where it is): a stable
+        loop's response still outside the 2 % band at the end of the simulated window,
+        with the window and the loop's slowest pole σ, which decays to 2 % in ln 50/|σ| —
+        beyond the window when that is longer than it; or an unstable loop."""
+        if self.settled:
+            return None
+        if not self.stable:
+            return "no settling: the loop is unstable"
+        window = float(self.time_s[-1]) - self.t_impulse_s
+        text = f"not settled within the {_duration(window)} simulated after the impulse"
+        sigma = float(self.max_real_pole)
+        if not sigma < 0:
+            return text
+        decay = math.log(50.0) / -sigma  # e^{σ t} = 2 %
+        pole = (f"its slowest pole, at {sigma:.3g} rad/s".replace("-", "−")
+                + f", decays to 2 % in {_duration(decay)}")
+        return f"{text}: {pole}, beyond that window" if decay > window else f"{text} ({pole})"
 
     def to_dict(self) -> dict:
         """JSON-safe scalars (no time series); ``inf`` settling is the string ``"inf"``."""
@@ -190,6 +213,11 @@ def impulse_response(G: Any, K: Any, **kwargs) -> ImpulseResponse:
         As :func:`impulse_response_of`, or if ``G`` and ``K`` do not fit together.
     """
     return impulse_response_of(closed_loop(G, K), **kwargs)
+
+
+def _duration(t_s: float) -> str:
+    """A duration for people: ``"30 ms"``, ``"21 s"``."""
+    return f"{t_s * 1e3:.3g} ms" if t_s < 1.0 else f"{t_s:.3g} s"
 
 
 def _steps(x: float, dt: float, what: str) -> int:

@@ -28,6 +28,7 @@ from ambseal.design import (
     design_rise,
     design_spec,
     full_order_check,
+    full_order_words,
     lpv_schedule,
     pid_description,
     reference_pid,
@@ -527,9 +528,11 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
     points = operating_points(spec)
     digital = digital_for(cfg, method, K, res, points)
     if summary.get("full_order") is None and not isinstance(K, ScheduledController):
-        # the reference PID is given, not designed: judged here before it is handed over
+        # the reference PID is given, not designed: judged here before it is handed over,
+        # and its verdict says so as a design's does
         check = full_order_check(cfg, K, [(q.pressure_bar, q.speed_rpm / 60.0) for q in points])
-        summary.update(full_order=check, kept_unstable=not check["stable"])
+        summary.update(full_order=check, kept_unstable=not check["stable"],
+                       verdict=f"{summary['verdict']}; {full_order_words(check)}")
     check = summary.get("full_order")
     failure = None if check is None or check["stable"] else (
         f"the full-order loop is unstable at {check['pressure_bar']:g} bar, "
@@ -548,8 +551,8 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
                          verdict=verdict)
     short = res.summary() if hasattr(res, "summary") else summary
     # the verdict of a check made here, as design_<method>.json has it
-    short = {**short, **{k: summary[k] for k in ("full_order", "kept_unstable", "loop")
-                         if k in summary}}
+    short = {**short, **{k: summary[k] for k in ("full_order", "kept_unstable", "loop",
+                                                 "verdict") if k in summary}}
     return {**short, "discretisation": digital.to_dict(),
             "files": [str(f) for f in files]}
 

@@ -27,7 +27,7 @@ __all__ = ["SCHEMA_VERSION", "SCHEMA_PATH", "OpenLoop", "ControllerSummary", "Ru
            "metrics_schema", "schema_text"]
 
 #: Version of the ``metrics.json`` document (module docstring).
-SCHEMA_VERSION = "1.5.0"
+SCHEMA_VERSION = "1.6.0"
 #: The JSON Schema shipped with the package.
 SCHEMA_PATH = Path(__file__).resolve().parents[1] / "data" / "metrics.schema.json"
 

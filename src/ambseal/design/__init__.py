@@ -10,7 +10,8 @@
 * :func:`design` — the recipes: the reference PID (P5 Eq. 6; :func:`reference_pid`,
   :func:`controller_from_metadata` for the one a record names; :class:`ScheduledPid` where
   its cross gains are scheduled on speed), nominal H∞ and robust μ;
-  :func:`full_order_check` — a design closed with the full-order plant;
+  :func:`full_order_check` — a design closed with the full-order plant, and
+  :func:`full_order_words` — its result in a verdict's words;
   :func:`design_rise` — what the removal of fast poles costs a design;
 * :class:`Design` — what every design result offers (:class:`DesignResult` and the
   scheduled designs below alike);
@@ -36,7 +37,12 @@ from ambseal.design.pid import (
     reference_pid,
 )
 from ambseal.design.plant import generalized_plant, physical_controller, uncertainty_at
-from ambseal.design.recipes import DesignResult, design, full_order_check
+from ambseal.design.recipes import (
+    DesignResult,
+    design,
+    full_order_check,
+    full_order_words,
+)
 from ambseal.design.result import Design
 from ambseal.design.seal_schedule import design_seal_scheduled
 from ambseal.design.specs import (
@@ -54,6 +60,7 @@ __all__ = ["RIGID_STATES", "Design", "DesignResult", "DesignSpec", "Machine", "W
            "ScheduledPid", "air_gaps",
            "controller_from_metadata", "default_weights", "design", "design_frozen",
            "design_lpv", "lpv_schedule", "design_rise", "design_seal_scheduled", "design_spec",
-           "full_order_check", "generalized_plant", "machine", "uncertainty_at",
+           "full_order_check", "full_order_words", "generalized_plant", "machine",
+           "uncertainty_at",
            "physical_controller", "pid_controller", "pid_description", "reference_pid",
            "vertex_grid_hz", "SynchronousRejection", "design_rejection"]

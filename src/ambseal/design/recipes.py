@@ -85,7 +85,7 @@ from ambseal.robust import (
 )
 from ambseal.threads import with_numerics_threads
 
-__all__ = ["DesignResult", "design", "full_order_check", "bound_text"]
+__all__ = ["DesignResult", "design", "full_order_check", "full_order_words", "bound_text"]
 
 #: the automatic controller order keeps μ (H∞: γ) of the design loop within this fraction
 #: of the full-order controller's (:func:`design`, ``reduce_to="auto"``)
@@ -154,7 +154,9 @@ class DesignResult:
         H∞, ``hinf``: SB10AD calls and the tolerance; None for the PID.
     verdict : str
         One plain line: robust performance met or not (H∞: γ), and the full-order
-        stability.
+        stability; the PID's says it has no design bound (it is given, not synthesised),
+        the full-order stability added where it is checked
+        (:func:`ambseal.app.commands.design_files`).
     """
 
     method: str
@@ -225,7 +227,7 @@ def _pid(cfg, p):
                   f"A/m, cross_kd {sched.gains['cross_kd']:.4g} A·s/m at "
                   f"{cfg.controller.pid.cross_speed_rpm:.6g} rpm)",)
     return DesignResult("pid", K, p, order=int(K.nstates), order_full=int(K.nstates),
-                        notes=notes, scheduled=sched)
+                        notes=notes, scheduled=sched, verdict=_pid_verdict(d))
 
 
 def full_order_check(cfg, K, conditions, *, first_loss: bool = False) -> dict:
@@ -725,11 +727,38 @@ def _unstable_message(method, check, n, steps, cut_hz, lost=(True, False, 0.0),
                    "design.model_states), or pass --allow-unstable")
 
 
+def full_order_words(check: Mapping) -> str:
+    """The full-order check of a controller (:func:`full_order_check`) in the words of a
+    design's verdict.
+
+    Parameters
+    ----------
+    check : mapping
+        :func:`full_order_check`'s result: ``stable``, and the least stable condition's
+        ``mode_hz`` and ``pressure_bar``.
+
+    Returns
+    -------
+    str
+        ``"full-order loop stable at every judged condition"``, or ``"FULL-ORDER LOOP
+        UNSTABLE at <f> Hz, <p> bar"``.
+    """
+    return ("full-order loop stable at every judged condition" if check["stable"] else
+            f"FULL-ORDER LOOP UNSTABLE at {check['mode_hz']:.4g} Hz, "
+            f"{check['pressure_bar']:g} bar")
+
+
+def _pid_verdict(d: Mapping) -> str:
+    """The reference PID's verdict: it is given (or derived by a rule), not synthesised
+    against a bound, so it has none; its loop is judged as every controller's is."""
+    what = ("a PID derived from the rig by its rule (no [controller.pid])" if "rule" in d
+            else "the rig's reference PID ([controller.pid], P5 Eq. 6), given")
+    return f"no design bound (γ, μ): {what}, not synthesised against one"
+
+
 def _verdict(method, r: _Synthesis, check) -> str:
     """One plain line: robust performance met or not, and the full-order stability."""
-    stab = ("full-order loop stable at every judged condition" if check["stable"] else
-            f"FULL-ORDER LOOP UNSTABLE at {check['mode_hz']:.4g} Hz, {check['pressure_bar']:g} "
-            "bar")
+    stab = full_order_words(check)
     if method == "hinf":
         return f"H∞ γ = {r.gamma:.3g} on the nominal design model; {stab}"
     # what the design model was robust to beyond [[design.uncertainty]]: the mode bands

@@ -96,7 +96,8 @@ class Verdict:
     sigma_peak : float or None
         Largest σ̄(S_o) peak over those loops where stable (-).
     orbit_um, impulse_peak_um, impulse_settling_s : float or None
-        Worst unbalance orbit (µm), impulse peak (µm) and 2 % settling time (s).
+        Worst unbalance orbit (µm), impulse peak (µm) and 2 % settling time (s; None where
+        a judged response did not settle: ``impulse_settling_note`` says why).
     clearances_um : dict
         Clearances the orbit is set against, e.g. ``{"air gap": 500.0}`` (µm).
     target_difference : float or None
@@ -133,6 +134,10 @@ class Verdict:
     speed_graded : bool
         The speed range's loops were graded by ISO 14839-3 too (not stability alone): the
         zone is then over the judged conditions and the speed range.
+    impulse_settling_note : str or None
+        Why the impulse response of a stable judged loop has no settling time (the
+        case's ``impulse_settling_note``, with its condition when several were judged);
+        None where every one settled.
     """
 
     controller: str
@@ -157,6 +162,7 @@ class Verdict:
     range_hz: tuple[float, ...] = ()
     criticals: tuple = ()
     speed_graded: bool = False
+    impulse_settling_note: str | None = None
 
     def critical_text(self) -> str:
         """The critical speeds in words, ``""`` without any: ``"a critical speed (1×
@@ -279,6 +285,8 @@ class Verdict:
         amp = self.amplifier_text()
         if amp:
             text += f"; {amp}"
+        if self.impulse_settling_note:
+            text += f"; its impulse response is {self.impulse_settling_note}"
         if self.target_difference is not None and self.target_difference > PEAK_TOLERANCE:
             text += (f"; as it runs on the target its σ̄(S_o) peak differs from the continuous "
                      f"one by {100 * self.target_difference:.0f} % (see “On the target”)")
@@ -369,6 +377,11 @@ def _verdict(name: str, cs: list, by_speed: bool, sc: list,
     axis_zones = [z for c in [*cs, *loops[len(ok):]]
                   for z in (c.get("iso_zone_per_axis") or {}).values()] + lost
     top = _worst_axis([lb for lb, _ in graded], loops)
+    # a response that did not settle is the worst settling: no time, and why
+    unsettled = [(lb, c["impulse_settling_note"]) for lb, c in zip(label, cs)
+                 if c.get("stable") and c.get("impulse_settling_note")]
+    note = None if not unsettled else unsettled[0][1] + (
+        f" (at {unsettled[0][0]})" if len(cs) > 1 else "")
     return Verdict(
         controller=name, conditions=tuple(label),
         stable_at=tuple(lb for lb, c in zip(label, cs) if c.get("stable")),
@@ -377,7 +390,8 @@ def _verdict(name: str, cs: list, by_speed: bool, sc: list,
         zone_sigma=_worst([c.get("iso_zone") for c in [*cs, *loops[len(ok):]]] + lost),
         sigma_peak=peak("sensitivity_peak", loops), orbit_um=worst_orbit_um(cs),
         impulse_peak_um=peak("impulse_peak_um"),
-        impulse_settling_s=peak("impulse_settling_s"),
+        impulse_settling_s=None if unsettled else peak("impulse_settling_s"),
+        impulse_settling_note=note,
         clearances_um=dict(clearances_um or {}), target_difference=target_difference(cs),
         speed_checked=len(sc), speed_unstable=speed_bad,
         design_bound=(design.get("verdict") or "").split(";")[0] or None,
@@ -416,6 +430,15 @@ def _worst_axis(labels: list[str], cs: list) -> tuple | None:
                 if pk is not None), default=None)
 
 
+def _settling_text(settling_s: float | None, note: str | None) -> str:
+    """A settling time in ms for a table cell; ``"not settled"`` where a note says why
+    there is none (the verdict and the notes under the detail table give the reason),
+    ``—`` where none was judged."""
+    if settling_s is None and note:
+        return "not settled"
+    return sig(None if settling_s is None else settling_s * 1e3)
+
+
 def _esc(s: Any) -> str:
     return _html.escape(str(s), quote=True)
 
@@ -448,7 +471,7 @@ def verdict_table_html(vs: Sequence[Verdict]) -> str:
                  f"{_esc(v.orbit_text())}</td>",
                  f'<td data-label="Impulse peak (µm)">{sig(v.impulse_peak_um)}</td>',
                  f'<td data-label="Settling 2 % (ms)">'
-                 f"{sig(None if st is None else st * 1e3)}</td>",
+                 f"{_settling_text(st, v.impulse_settling_note)}</td>",
                  f'<td class="text" data-label="Design bound">'
                  f'{_esc(v.design_bound or "—")}</td>',
                  f'<td class="text verdict" data-label="Verdict">{_esc(v.words())}</td>']
@@ -460,7 +483,8 @@ def verdict_table_html(vs: Sequence[Verdict]) -> str:
 
 def detail_table_html(cases: Sequence[Mapping]) -> str:
     """Every judged case: units in the headers, 3–4 significant figures, per-axis values
-    as sub-columns; unstable rows shaded, their missing values shown as ``—``."""
+    as sub-columns; unstable rows shaded, their missing values shown as ``—``; an impulse
+    response that did not settle is ``not settled``, the reason in a line under the table."""
     if not cases:
         return "<p>No cases.</p>"
     by_speed = _speed_varies(cases)
@@ -492,11 +516,14 @@ def detail_table_html(cases: Sequence[Mapping]) -> str:
                  + [f"<td>{sig(None if comp is None else comp * 1e6)}</td>",
                     f"<td>{sig(c.get('unbalance_peak_um'))}</td>",
                     f"<td>{sig(c.get('impulse_peak_um'))}</td>",
-                    f"<td>{sig(None if st is None else st * 1e3)}</td>"])
+                    f"<td>{_settling_text(st, c.get('impulse_settling_note'))}</td>"])
         cls = "" if c.get("stable") else ' class="unstable"'
         rows.append(f"<tr{cls}>{''.join(cells)}</tr>")
+    notes = "".join(f"<p>{_esc(c['controller'])} at {_esc(condition_label(c, by_speed))}: "
+                    f"the impulse response is {_esc(c['impulse_settling_note'])}.</p>"
+                    for c in cases if c.get("stable") and c.get("impulse_settling_note"))
     return (f'<table class="detail"><thead>{head1}{head2}</thead>'
-            f"<tbody>{''.join(rows)}</tbody></table>")
+            f"<tbody>{''.join(rows)}</tbody></table>{notes}")
 
 
 def verdict_table_rich(vs: Sequence[Verdict]):
@@ -535,7 +562,7 @@ def verdict_table_rich(vs: Sequence[Verdict]):
             orb += f" ({sig(100 * v.orbit_um / gap[1], 2)} %)"
         t.add_row(v.controller, v.stable_range, f"{zone(v.zone_axis)}/{zone(v.zone_sigma)}",
                   sig(v.sigma_peak), orb, sig(v.impulse_peak_um),
-                  sig(None if st is None else st * 1e3),
+                  _settling_text(st, v.impulse_settling_note),
                   style="red" if v.unstable_at else None)
     lines = [Text.assemble((f"{v.controller}: ", "bold"), v.words()
                            + (f" Design: {v.design_bound}." if v.design_bound else ""))

@@ -391,7 +391,8 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                                       "condition"),
     "Operating.trip_speed_hz": ("Hz", "trip speed (default 1.05 × the maximum continuous "
                                       "speed, the top of ``speed_range_hz`` or the "
-                                      "operating speed)"),
+                                      "operating speed): the worst unbalance orbit is "
+                                      "judged up to it from standstill"),
     "Operating.speed_rpm": ("rpm", "operating speed"),
     "Operating.pressure_bar": ("bar", "nominal pressure drop across the seals"),
     "Operating.speed_range_hz": ("Hz", "``[low, high]`` operating speed range: schedules "
@@ -449,7 +450,9 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                                          "grade holds"),
     "UnbalanceSpec.force_at": ("", "seal, disk, AMB or spring where the force acts and the "
                                    "compliance is taken"),
-    "UnbalanceSpec.range_hz": ("Hz", "``[low, high]`` speeds of the unbalance response"),
+    "UnbalanceSpec.range_hz": ("Hz", "``[low, high]`` speeds of the unbalance response "
+                                     "(on a machine that runs, judged from standstill to "
+                                     "the trip speed as well)"),
     "UnbalanceSpec.plant": ("", "``running`` (default): at each speed the plant built at "
                                 "that speed, forward-turning forces; ``frozen``: the plant "
                                 "at the judged condition, the forcing swept (the thesis's "

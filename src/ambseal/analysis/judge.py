@@ -39,7 +39,7 @@ impulse are derived from the machine by the rules written there.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 from typing import Any
 
 import control
@@ -81,7 +81,7 @@ __all__ = ["JudgeSettings", "OperatingPoint", "LoopJudgement", "JudgedCase", "Ju
            "operating_points", "speed_scheduled",
            "judge_settings", "unstable_open_loop_poles", "condition_values", "frozen_at",
            "frozen_discrete", "judge_jobs", "points_for", "sensitivity_grades",
-           "critical_speeds"]
+           "critical_speeds", "unbalance_speeds_hz"]
 
 #: Where a loop's static response is taken (rad/s): far below any AMB loop's dynamics (the
 #: plant there equals its static response to ~1e-8), and not zero, where an integrating
@@ -253,7 +253,7 @@ class JudgedCase(LoopJudgement):
         return d
 
 
-def judge_settings(spec) -> JudgeSettings:
+def judge_settings(spec, cfg=None) -> JudgeSettings:
     """The judgement's grids and disturbances from the rig's design specification.
 
     The band, unbalance and impulse of :func:`ambseal.design.specs.design_spec`; the
@@ -267,6 +267,10 @@ def judge_settings(spec) -> JudgeSettings:
         The rig's design specification (:func:`~ambseal.design.specs.design_spec`, built
         once per rig by the caller); its machine's sample rate sets the impulse response's
         sampling.
+    cfg : RigConfig, optional
+        The rig: with it ``unbalance_range_hz`` are the speeds :func:`judge` takes the
+        worst orbit over (:func:`unbalance_speeds_hz`), as ``metrics.json`` states them;
+        without it the unbalance band (:func:`judge` widens it the same way).
 
     Returns
     -------
@@ -278,7 +282,9 @@ def judge_settings(spec) -> JudgeSettings:
     t = sp.impulse_s
     return JudgeSettings(
         freq_hz=(sp.band_hz[0], sp.band_hz[1], GRID_POINTS),
-        unbalance_grade_mm_s=sp.unbalance_grade_mm_s, unbalance_range_hz=sp.unbalance_range_hz,
+        unbalance_grade_mm_s=sp.unbalance_grade_mm_s,
+        unbalance_range_hz=(sp.unbalance_range_hz if cfg is None
+                            else unbalance_speeds_hz(cfg, sp.unbalance_range_hz)),
         unbalance_mass_kg=sp.unbalance_mass_kg, unbalance_law=sp.unbalance_law,
         unbalance_max_speed_hz=sp.unbalance_max_speed_hz, force_positions_m=sp.force_positions_m,
         impulse_a=sp.impulse_a, impulse_s=t, impulse_start_s=5 * t, impulse_end_s=35 * t,
@@ -487,7 +493,9 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
         ``curves["discrete"]`` (its ``poles`` are z).
     """
 
-    s = settings
+    # the worst orbit over every speed the machine passes, not the band alone
+    s = replace(settings, unbalance_range_hz=unbalance_speeds_hz(
+        cfg, settings.unbalance_range_hz))
     # the seals the rotor is offset in carry a static load: a force input at each, after
     # the judgement's own
     offset = [sl for sl in cfg.seal if sl.static_eccentricity > 0]
@@ -539,6 +547,38 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
                       speed_hz=point.speed_rpm / 60.0, label=point.label, delay=dl.to_dict(),
                       discrete=disc)
     return case, curves
+
+
+def unbalance_speeds_hz(cfg, band_hz) -> tuple[float, float]:
+    """The speeds (Hz) over which the worst-case unbalance orbit is judged: the unbalance
+    band (``[design.unbalance] range_hz``, or its rule), widened on a machine that runs to
+    every speed it passes, from standstill to its trip speed (``[operating]
+    trip_speed_hz``, :attr:`~ambseal.config.Operating.trip_hz`) — the speeds over which API
+    617 holds the response at the close clearances (8th ed., Part 1 §4.8.2.11; as
+    :mod:`ambseal.analysis.signoff.unbalance_api617` takes them), and the orbit is set
+    against the air gap and the backup clearance. The rotor passes a critical speed below
+    its minimum continuous speed on every run-up. Standstill is taken as 1 % of the
+    maximum continuous speed: the plant at the running speed needs one, and the unbalance
+    force there is 1e-4 of its top (ISO 21940-11 law; 1e-2 at a constant velocity).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig: its ``[operating]`` speeds.
+    band_hz : (float, float)
+        The unbalance band (Hz), ``0 < low < high``.
+
+    Returns
+    -------
+    (float, float)
+        ``(low, high)`` (Hz): the band, and on a rig with a running speed at most 1 % of the
+        maximum continuous speed to at least the trip speed. Applied twice, the same.
+    """
+    lo, hi = (float(x) for x in band_hz)
+    f_max = cfg.operating.continuous_hz[1]
+    if not f_max > 0:  # a rig at standstill: its band as set or derived
+        return lo, hi
+    return min(lo, f_max / 100.0), max(hi, float(cfg.operating.trip_hz))
 
 
 #: API 617's largest separation margin above the maximum continuous speed (26 %) and below

@@ -774,7 +774,7 @@ def validate_summary(rig: str | Path | None = None, overrides=()) -> dict:
             # the PID a run designs: the file's, else the derived one with its rule
             "pid": (None if not cfg.amb else pid.model_dump() if pid is not None
                     else {"derived": True, **reference_pid(cfg)}),
-            "judgement": asdict(judge_settings(spec)) if spec else None,
+            "judgement": asdict(judge_settings(spec, cfg)) if spec else None,
         },
     }
 

@@ -155,7 +155,7 @@ def _speed_range(designs, digitals, spec, points, design_cfg, judge_cfg, stages,
                  f"{max(spec.stability_speeds_hz):g} Hz")
     jobs = judge_jobs(designs, digitals, spoints, design_cfg)
     done = _by_condition(stability_case, jobs, {"cfg": judge_cfg,
-                                                "settings": judge_settings(spec)},
+                                                "settings": judge_settings(spec, judge_cfg)},
                          lambda i, r: stages.step(f"{jobs[i].name} at {jobs[i].point.label}"))
     for d in designs:
         f = loop_failure(d.method, _judged_of(d.method, jobs, done),
@@ -340,7 +340,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                           display=progress and sys.stderr.isatty()) as stages:
         (out / "controllers").mkdir()
         check_reference_rate(cfg, rig_path)  # before any stage, as validate refuses it
-        st = _RunState(cfg, spec, points, judge_settings(spec), out, stages, allow_unstable,
+        st = _RunState(cfg, spec, points, judge_settings(spec, cfg), out, stages, allow_unstable,
                        truth_cfg)
         model = _model_stage(st)
         _design_stage(st)

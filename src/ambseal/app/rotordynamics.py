@@ -199,7 +199,7 @@ def _sweep(args: argparse.Namespace) -> int:
         workers = 1
     # a controller file runs on a target: judged as it runs too (the *_as_runs columns)
     digitals = {Path(s).stem: g for s in specs if (g := runs_as(cfg, s)) is not None}
-    rows = sweep(cfg, ctrl, pressures, speeds, params, settings=judge_settings(spec),
+    rows = sweep(cfg, ctrl, pressures, speeds, params, settings=judge_settings(spec, cfg),
                  max_hz=args.max_hz, workers=workers, scheduler=args.scheduler, progress=True,
                  digitals=digitals)
     edge = refine_boundary(cfg, ctrl, stability_boundary(rows), tol_bar=args.tol_bar,

@@ -27,10 +27,13 @@ and bounded (the bounds beside each key in the code, with their reasons).
     ``max_speed_hz`` (the maximum service speed Ω_max/2π at which the grade holds, Hz),
     ``force_at`` (the name of the seal, disk, AMB or spring where the unbalance force and
     the compliance are taken; by default the bearings), ``range_hz`` = ``[low, high]`` (the
-    speeds of the unbalance response, Hz), ``plant`` (``"running"``, the default: at each
-    speed the plant built at that speed, gyroscopics and seals, under forward-turning
-    forces; ``"frozen"``: the plant frozen at the judged condition with the forcing
-    swept, the thesis's simplification, P5 §4.4.1; :mod:`ambseal.analysis.unbalance`).
+    speeds of the unbalance response, Hz; on a machine that runs, the worst orbit is judged
+    from standstill to the trip speed as well:
+    :func:`ambseal.analysis.judge.unbalance_speeds_hz`), ``plant`` (``"running"``, the
+    default: at each speed the plant built at that speed, gyroscopics and seals, under
+    forward-turning forces; ``"frozen"``: the plant frozen at the judged condition with
+    the forcing swept, the thesis's simplification, P5 §4.4.1;
+    :mod:`ambseal.analysis.unbalance`).
 ``[design.impulse]``
     ``amplitude_a`` (A) and ``duration_s`` (s) of the current impulse of the time-domain
     judgement (P5 §5.1) and of the identification on the virtual facility (P5 §3.3), whose

@@ -24,8 +24,10 @@ the value the thesis used on its test facility, P5, where it names one):
   1 Hz–2 kHz).
 * **Unbalance**: the speeds of ``[operating] speed_range_hz``, else up to 1.2× the
   operating speed (over-speed margin), else (a rig at standstill with no range) up to
-  f_b/2 with a note; grade G2.5 (ISO 21940-11, precision machines); mass m; the ISO
-  21940-11 law F_u = m·G·Ω²/Ω_max with the maximum service speed Ω_max the top of
+  f_b/2 with a note (the band of the μ design's W_f; the judged worst orbit covers
+  standstill to the trip speed too, :func:`ambseal.analysis.judge.unbalance_speeds_hz`);
+  grade G2.5 (ISO 21940-11, precision machines); mass m; the ISO 21940-11 law
+  F_u = m·G·Ω²/Ω_max with the maximum service speed Ω_max the top of
   ``[operating] speed_range_hz``, else the operating speed, else the top of the unbalance
   range (test rig: ``max_speed_hz = 500`` set, "balanced according to the G2.5 norm at
   500 Hz", P5 §4.4.1); the force at the bearings, where P5 §4.4.1 takes the compliance

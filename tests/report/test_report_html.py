@@ -400,3 +400,31 @@ def test_capacity_figure_draws_each_amb_or_nothing(tmp_path, testrig_cfg):
             for a in testrig_cfg.amb]
     assert capacity_figure(tmp_path, testrig_cfg.model_copy(update={"amb": bare}),
                            {"pid": entries}) == []
+
+
+def test_the_worst_axis_of_a_tie_is_the_first_in_the_rigs_channel_order():
+    """Reference: by symmetry the ζ and η axes of an isotropic bearing have one sensitivity
+    peak; two machines' rounding makes either larger by ~1e-12 (measured up to 8e-11 on
+    b2b_compressor's PID). The worst axis the verdict names must be the same whether the
+    tie is exact or η is larger by 1e-12 relative (as one machine gives it) — the first
+    in the rig's channel order — while a difference that is one (1e-6) still names the
+    larger axis."""
+    from ambseal.report.verdict import verdicts
+
+    base = _metrics()[0]
+
+    def worst(order, peaks):
+        case = dict(base, sensitivity_peak_per_axis=dict(zip(order, peaks)),
+                    iso_zone_per_axis=dict(zip(order, "BBAA")))
+        return verdicts([case])[0].worst_axis
+
+    axes = ("A_zeta", "A_eta", "B_zeta", "B_eta")
+    p = 3.4631249311503693
+    assert worst(axes, (p, p, 1.7, 1.7)) == "A ζ at 2.04 bar"
+    assert worst(axes, (p, p * (1 + 1e-12), 1.7, 1.7)) == "A ζ at 2.04 bar"
+    assert worst(axes, (p * (1 + 1e-12), p, 1.7, 1.7)) == "A ζ at 2.04 bar"
+    assert worst(axes, (p, p * (1 + 1e-6), 1.7, 1.7)) == "A η at 2.04 bar"
+    # the order decides, not the name: a rig listing η first names η
+    flipped = ("A_eta", "A_zeta", "B_eta", "B_zeta")
+    assert worst(flipped, (p, p, 1.7, 1.7)) == "A η at 2.04 bar"
+    assert worst(flipped, (p, p * (1 + 1e-12), 1.7, 1.7)) == "A η at 2.04 bar"

@@ -17,6 +17,8 @@ sampled with its delay) on the full-order plant:
   K S_o and the compliance;
 * :func:`iso_assessment` → :class:`IsoAssessment` — ISO 14839-3 zones from the sensitivity
   peaks (thesis P5 §4.4.1; :data:`ZONES`, :data:`ZONE_LIMITS`, :func:`zone_limit_db`);
+* :func:`first_largest`, :func:`beyond` — what rounding may not decide: ties broken by the
+  order given (:data:`TIE_RTOL`; :mod:`ambseal.analysis.tolerance`);
 * :func:`unbalance_force`, :func:`unbalance_response` — ISO 21940-11 unbalance and its
   response bound; :func:`running_unbalance` on :func:`running_plant` (→ :class:`RunningPlant`)
   — the bound with the plant at the running speed;
@@ -94,7 +96,9 @@ _FROM = {
     "worst_orbit_um": "delivery", "clearance_exceeded": "delivery",
     "clearance_failure": "delivery", "CLEARANCE_WORDS": "delivery",
     "FailedController": "delivery", "iso_assessment": "iso", "zone_limit_db": "iso",
-    "IsoAssessment": "iso", "ZONES": "iso", "ZONE_LIMITS": "iso", "frozen_at": "judge",
+    "IsoAssessment": "iso", "ZONES": "iso", "ZONE_LIMITS": "iso", "first_largest": "tolerance",
+    "beyond": "tolerance", "TIE_RTOL": "tolerance",
+    "frozen_at": "judge",
     "judge_case": "judge", "judge_jobs": "judge", "judge_settings": "judge",
     "judge_spinup": "judge", "operating_points": "judge", "points_for": "judge",
     # the sign-off's names, as its own face lists them

@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ambseal.analysis.tolerance import beyond
 from ambseal.lti import freqresp_at, zoh
 from ambseal.model import (AXES, actuator_matrices, amb_factors, amplifier_needs,
                            axis_label, coil_inductance, limits_used, transient_needs)
@@ -250,7 +251,9 @@ def capacity_block(cfg, entries, impulses=()) -> dict | None:
             if q in margins:
                 margins[q] = max(margins[q] or 0.0, float(v.max()))
             k = int(np.argmax(v))
-            if best[q][0] is None or v[k] > best[q][0]:
+            # the axes of a symmetric bearing need the same, but for rounding: the first
+            # of them in the rig's channel order is named on every machine
+            if best[q][0] is None or beyond(float(v[k]), best[q][0]):
                 best[q] = (float(v[k]), {"condition": label, "speed_hz": float(speed_hz[k]),
                                          "axis": name.removeprefix("i_"),
                                          "response": response})

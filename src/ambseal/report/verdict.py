@@ -24,8 +24,8 @@ from rich.console import Group
 from rich.table import Table
 from rich.text import Text
 
-from ambseal.analysis import (CLEARANCE_WORDS, capacity_words, clearance_exceeded, saturates,
-                               worst_orbit_um)
+from ambseal.analysis import (CLEARANCE_WORDS, capacity_words, clearance_exceeded,
+                               first_largest, saturates, worst_orbit_um)
 from ambseal.model import axis_label
 from ambseal.robust import PEAK_TOLERANCE
 
@@ -424,10 +424,14 @@ def _criticals(cs: list) -> tuple:
 
 def _worst_axis(labels: list[str], cs: list) -> tuple | None:
     """(σ̄ peak, axis, condition label) of the highest per-axis σ̄(S_o) peak among the
-    stable cases, or None."""
-    return max(((pk, a, lb) for lb, c in zip(labels, cs) if c.get("stable")
-                for a, pk in (c.get("sensitivity_peak_per_axis") or {}).items()
-                if pk is not None), default=None)
+    stable cases, or None. Peaks within :data:`ambseal.analysis.TIE_RTOL` of the highest are
+    the same peak (the ζ and η axes of a symmetric bearing, equal but for rounding): the
+    first of them wins, in the order of the cases and, within a case, the rig's channel
+    order, so that the name does not follow the machine's rounding
+    (:func:`ambseal.analysis.first_largest`)."""
+    return first_largest(((pk, a, lb) for lb, c in zip(labels, cs) if c.get("stable")
+                          for a, pk in (c.get("sensitivity_peak_per_axis") or {}).items()
+                          if pk is not None), key=lambda t: t[0])
 
 
 def _settling_text(settling_s: float | None, note: str | None) -> str:

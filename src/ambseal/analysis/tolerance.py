@@ -1,0 +1,81 @@
+"""Comparisons that rounding may not decide.
+
+A number ambseal computes differs between machines in its last digits (the BLAS kernels a
+machine runs, its thread count) and is known only to the accuracy of the method that
+computes it. Where a report turns such numbers into words — which axis is the worst — the
+words must be the same on every machine:
+
+* **ties**: values within :data:`TIE_RTOL` of the largest count as equal, and among equals
+  the first in the order given wins (:func:`first_largest`; the rig's channel order for
+  axes). The ζ and η axes of a symmetric bearing have the same sensitivity peak by
+  symmetry, equal to rounding, and the worst axis is then the ζ one on every machine.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable, Iterable, TypeVar
+
+__all__ = ["TIE_RTOL", "first_largest", "beyond"]
+
+T = TypeVar("T")
+
+#: Relative tolerance within which two values are the same value (:func:`first_largest`).
+#: Values equal by symmetry (the ζ and η axes of one bearing) differ by rounding, and one
+#: loop's values between BLAS kernels by rounding carried through its synthesis, both far
+#: below it; values that differ in fact (two bearings) differ by far more. The
+#: measurements are in benchmarks/README.md ("What rounding may not decide").
+TIE_RTOL = 1e-8
+
+
+def first_largest(items: Iterable[T], key: Callable[[T], float],
+                  rtol: float = TIE_RTOL) -> T | None:
+    """The first item whose value is within ``rtol`` of the largest.
+
+    Parameters
+    ----------
+    items : iterable
+        The candidates, in the order that breaks ties (for axes: the rig's channel order).
+    key : callable
+        ``key(item) → float``, the value compared (no NaN).
+    rtol : float
+        Relative tolerance (-) within which values count as equal: :data:`TIE_RTOL` by
+        default.
+
+    Returns
+    -------
+    item or None
+        The first of the items tied with the largest; None without items.
+
+    Examples
+    --------
+    >>> first_largest([("A_zeta", 1.7347937050777), ("A_eta", 1.7347937050780)],
+    ...               key=lambda x: x[1])[0]
+    'A_zeta'
+    """
+    pairs = [(item, float(key(item))) for item in items]
+    if not pairs:
+        return None
+    top = max(v for _, v in pairs)
+    floor = top - rtol * abs(top) if math.isfinite(top) else top
+    return next(item for item, v in pairs if v >= floor)
+
+
+def beyond(value: float, than: float, rtol: float = TIE_RTOL) -> bool:
+    """Whether ``value`` is larger than ``than`` by more than a tie: the test by which a
+    running maximum is replaced only by a larger value, never by an equal one that
+    rounding made larger (:func:`first_largest`, one value at a time).
+
+    Parameters
+    ----------
+    value, than : float
+        The candidate and the largest so far.
+    rtol : float
+        Relative tolerance (-) within which they count as equal: :data:`TIE_RTOL` by
+        default.
+
+    Returns
+    -------
+    bool
+    """
+    return value > than + rtol * abs(than)

@@ -2,7 +2,8 @@
 
 The reference is metrics.json's numbers, graded here on their own: ISO 14839-3:2006's zone
 limits on the sensitivity peaks (3, 4, 5: 9.5, 12 and 14 dB, a peak on a limit in the
-upper zone), an unstable loop — judged, or anywhere in the speed range, continuous or as
+upper zone; within 0.1 % of a limit, the grid's resolution of a peak, on the boundary of
+the two zones, "A/B"), an unstable loop — judged, or anywhere in the speed range, continuous or as
 it runs — zone D and "not acceptable", the sign-off's outcome per criterion. Each table
 of the page is parsed from its HTML: a row says what its cells say, not what the code
 meant them to say.
@@ -16,17 +17,26 @@ from pathlib import Path
 
 #: ISO 14839-3:2006 upper limits of zones A, B and C on the sensitivity peak
 ISO_LIMITS = ((3.0, "A"), (4.0, "B"), (5.0, "C"))
+#: The relative band around a limit that the report grades on the boundary of two zones
+BAND = 1e-3
 
 
 def zone_of(peak: float | None) -> str:
-    """The zone of a sensitivity peak; None (an unstable loop's) is D."""
+    """The zone of a sensitivity peak, ``"A/B"`` within :data:`BAND` of the limit between
+    A and B; None (an unstable loop's) is D."""
     if peak is None:
         return "D"
+    for (limit, z), upper in zip(ISO_LIMITS, "BCD"):
+        if abs(peak - limit) <= BAND * limit:
+            return f"{z}/{upper}"
     return next((z for limit, z in ISO_LIMITS if peak < limit), "D")
 
 
 def worst(zones) -> str:
-    return max(zones, default="A")
+    """The worst zone, a boundary between its two (``"A/B"`` is worse than A, better than
+    B)."""
+    return max(zones, key=lambda z: sum(map("ABCD".index, z.split("/"))) / len(z.split("/")),
+               default="A")
 
 
 class _Tables(HTMLParser):

@@ -274,3 +274,41 @@ def test_critical_speeds_are_the_api_617_separation_check(f_range, zeta, where):
     assert c["af"] == pytest.approx(af, rel=2 * zeta)
     assert c["margin_pct"] == pytest.approx(margin, rel=1e-3, abs=1e-9)
     assert c["required_pct"] == pytest.approx(need, rel=0.01)
+
+
+def test_a_separation_margin_on_its_requirement_is_named_on_the_boundary():
+    """Reference: a single-degree-of-freedom resonance 1/|1 − r² + 2jζr| at 100 Hz, ζ 0.05
+    (AF = 1/(2ζ) = 10 to the order ζ), against API 617's margin above the continuous range
+    by hand, 10 + 17(1 − 1/(AF − 1.5)) % = 25 %. With the range's top set so that the
+    critical's margin is the requirement ×(1 ± 5e-4) — within the 0.1 % to which the
+    judgement resolves the two — it is named, and the verdict says it lies on the
+    boundary, met or not; ×(1 + 2e-3) it is separated and not named, ×(1 − 2e-3) it is
+    short and named as short."""
+    from ambseal.analysis.judge import critical_speeds
+    from ambseal.analysis.unbalance import UnbalanceResponse
+    from ambseal.report.verdict import verdicts
+
+    f = np.linspace(40.0, 160.0, 24001)
+    r = f / 100.0
+    amp = 1e-5 / np.abs(1 - r**2 + 2j * 0.05 * r)
+    unb = UnbalanceResponse(2 * np.pi * f, np.ones_like(f), amp, 0.0, 0.0, 1.0, 1.0)
+    (inside,) = critical_speeds(unb, 90.0, 110.0)
+    need, n = inside["required_pct"], inside["speed_hz"]
+    assert need == pytest.approx(10 + 17 * (1 - 1 / (10 - 1.5)), rel=0.01)
+
+    def at(factor):
+        return critical_speeds(unb, 50.0, n / (1 + need * factor / 100))
+
+    assert at(1 + 2e-3) == []
+    base = {"controller": "LPV", "pressure_bar": 0.0, "speed_hz": 60.0, "stable": True,
+            "sensitivity_peak": 2.0, "sensitivity_peak_per_axis": {"A_zeta": 2.0},
+            "iso_zone": "A", "iso_zone_per_axis": {"A_zeta": "A"}}
+    for factor in (1 + 5e-4, 1 - 5e-4):
+        (c,) = at(factor)
+        assert c["margin_pct"] == pytest.approx(need * factor, rel=1e-9)
+        words = verdicts([dict(base, critical_speeds=[c])])[0].words()
+        assert (f"{c['margin_pct']:.4g} % from the continuous speed range, on the boundary "
+                f"of the {need:.4g} % API 617 requires") in words, words
+    (short,) = at(1 - 2e-3)
+    words = verdicts([dict(base, critical_speeds=[short])])[0].words()
+    assert "where API 617 requires 25 %" in words and "boundary" not in words

@@ -428,3 +428,46 @@ def test_the_worst_axis_of_a_tie_is_the_first_in_the_rigs_channel_order():
     flipped = ("A_eta", "A_zeta", "B_eta", "B_zeta")
     assert worst(flipped, (p, p, 1.7, 1.7)) == "A η at 2.04 bar"
     assert worst(flipped, (p, p * (1 + 1e-12), 1.7, 1.7)) == "A η at 2.04 bar"
+
+
+def _graded_case(sigma: float, axes: tuple[float, float]) -> dict:
+    """A stable judged case whose zones are graded from its peaks by
+    :func:`ambseal.analysis.iso.iso_assessment`, as the judgement grades them."""
+    from ambseal.analysis.iso import iso_assessment
+    from ambseal.analysis.loops import Peak, SensitivityPeaks
+
+    names = ("A_zeta", "B_eta")
+    a = iso_assessment(SensitivityPeaks(Peak(sigma, 80.0), tuple(
+        Peak(v, 80.0, n) for n, v in zip(names, axes))))
+    return dict(_metrics()[0], sensitivity_peak=sigma, iso_zone=a.zone_sigma_max,
+                sensitivity_peak_per_axis=dict(zip(names, axes)),
+                iso_zone_per_axis=dict(a.zones_per_axis))
+
+
+def test_a_zone_on_its_limit_names_both_sides_in_the_verdict():
+    """Reference: ISO 14839-3:2006's A/B limit 3 on σ̄(S_o) and on each axis's peak, known to
+    0.1 %. Just below (2.99) the verdict says zone A, just above (3.01) zone B; on the
+    limit (3.0004 on the worst axis, or the σ̄ peak 2.9997 over axes in A) it names both
+    zones and the number and the limit, whichever side of 3 rounding put the number —
+    so a machine that rounds 3.0004 to 2.9996 says the same words."""
+    from ambseal.report.verdict import verdicts
+
+    def words(sigma, axes):
+        return verdicts([_graded_case(sigma, axes)])[0].words()
+
+    assert words(2.99, (2.95, 2.99)).startswith(
+        "Zone A on every axis over 2.04 bar: as good as newly commissioned")
+    assert words(3.01, (2.95, 3.01)).startswith(
+        "Zone B on its worst axis (B η at 2.04 bar) over 2.04 bar: fit for unrestricted")
+    on = ("Zone A/B (on the boundary: |S_o| 3.0004 against 3.0) on its worst axis (B η at "
+          "2.04 bar) over 2.04 bar: on the boundary of A (as good as newly commissioned) "
+          "and B (fit for unrestricted long-term operation)")
+    assert words(3.0004, (2.95, 3.0004)).startswith(on)
+    assert words(2.9996, (2.95, 2.9996)).startswith(on.replace("3.0004", "2.9996"))
+    v = verdicts([_graded_case(2.9997, (2.5, 2.6))])[0]
+    assert (v.zone_axis, v.zone_sigma) == ("A", "A/B")
+    assert ("Zone A on every axis over 2.04 bar, but σ̄(S_o) over all axes reaches zone A/B "
+            "(on the boundary: σ̄ 2.9997 against 3.0): on the boundary of A") in v.words()
+    # the cells of the table carry both zones' colours
+    table = html.verdict_table_html([verdicts([_graded_case(3.0004, (2.95, 3.0004))])[0]])
+    assert "linear-gradient(90deg,#1a9850 50%,#91cf60 50%)" in table and ">A/B<" in table

@@ -62,6 +62,7 @@ from ambseal.analysis.synchronous import hold_fundamental, running_plant
 from ambseal.analysis.unbalance import (UnbalanceResponse, running_unbalance,
                                         unbalance_from_compliance)
 from ambseal.analysis.signoff.unbalance_api617 import amplification_factor, required_margin
+from ambseal.analysis.tolerance import ABOVE, SEPARATION_RTOL, side_of
 from ambseal.design import RIGID_STATES, vertex_grid_hz
 from ambseal.design.lpv_plant import lpv_plant
 from ambseal.lti import eigenvalues, finite_or_none, freqresp_at, json_float, wired
@@ -168,8 +169,11 @@ class LoopJudgement:
     sensitivity_peak_per_axis : dict of str to float or None
         Peak of each diagonal element of S_o, by AMB axis (ISO 14839-3 grades these).
     iso_zone : str
-        ISO 14839-3 zone of σ̄(S_o) (``"A"``–``"D"``).
+        ISO 14839-3 zone of σ̄(S_o): ``"A"``–``"D"``, or ``"A/B"``, ``"B/C"``, ``"C/D"`` for
+        a peak on the boundary of two zones (within 0.1 % of their limit,
+        :func:`ambseal.analysis.iso.graded_zone`).
     iso_zone_per_axis : dict of str to str
+        Each axis's zone from its |S_o| peak, graded the same way.
     compliance_peak_m_per_n : float or None
         Peak of σ̄ of the compliance at the unbalance force positions (m/N).
     unbalance_peak_um : float or None
@@ -181,9 +185,10 @@ class LoopJudgement:
     critical_speeds : list of dict or None
         The loop's critical speeds (1× crossings of the unbalance orbit at the running
         speed with AF ≥ 2.5) inside the continuous speed range or within the separation
-        margin API 617 (8th ed., §2.6.2.10; API 684 §2.8) requires of them: ``speed_hz``,
-        ``af``, ``margin_pct`` (the separation from the continuous range, % of its nearer
-        end; 0 inside it) and ``required_pct``; None where not judged (the frozen plant, an
+        margin API 617 (8th ed., §2.6.2.10; API 684 §2.8) requires of them, or on its
+        boundary (:func:`critical_speeds`): ``speed_hz``, ``af``, ``margin_pct`` (the
+        separation from the continuous range, % of its nearer end; 0 inside it) and
+        ``required_pct``; None where not judged (the frozen plant, an
         unstable loop, a rig without a running speed).
     impulse_settling_note : str or None
         Why a judged impulse response has no settling time, in words
@@ -589,7 +594,10 @@ MAX_MARGIN_ABOVE, MAX_MARGIN_BELOW = 0.26, 0.16
 
 def critical_speeds(unb: UnbalanceResponse, f_min: float, f_max: float) -> list[dict]:
     """The critical speeds of an unbalance response at the running speed that lie inside
-    the continuous speed range or within the separation margin API 617 requires of them.
+    the continuous speed range or within the separation margin API 617 requires of them, or
+    on its boundary: a margin within :data:`ambseal.analysis.tolerance.SEPARATION_RTOL` of
+    the requirement is not known to meet it or not (:func:`ambseal.analysis.tolerance.
+    side_of`), and is listed for the words to say so.
 
     The running sweep reaches 16 % below the minimum and 26 % above the maximum continuous
     speed for it. A critical speed is a local maximum of the orbit over speed (a closed-loop mode's 1×
@@ -631,7 +639,7 @@ def critical_speeds(unb: UnbalanceResponse, f_min: float, f_max: float) -> list[
         margin = (100 * (f_min - n) / f_min if below else
                   100 * (n - f_max) / f_max if n > f_max else 0.0)
         need = required_margin(af, below)
-        if margin < need:
+        if side_of(margin, need, SEPARATION_RTOL) != ABOVE:
             out.append({"speed_hz": n, "af": json_float(af), "margin_pct": margin,
                         "required_pct": need})
     return out

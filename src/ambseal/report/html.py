@@ -18,6 +18,7 @@ import os
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
+from ambseal.analysis import ZONE_RTOL
 from ambseal.errors import AmbsealError
 from ambseal.files import write_text
 from ambseal.report.verdict import (
@@ -71,9 +72,10 @@ def _figure_html(path: str | os.PathLike, caption: str | None, alt: str) -> str:
 
 
 def _zone_legend() -> str:
-    return ('<p class="legend">ISO 14839-3 zones: ' + " ".join(
-        f'<span style="background:{c}">{z}</span>{_esc(ZONE_WORDS[z])}'
-        for z, c in ZONE_COLOURS.items()) + "</p>")
+    zones = " ".join(f'<span style="background:{c}">{z}</span>{_esc(ZONE_WORDS[z])}'
+                     for z, c in ZONE_COLOURS.items())
+    return (f'<p class="legend">ISO 14839-3 zones: {zones}; A/B, B/C, C/D: a peak within '
+            f"{100 * ZONE_RTOL:g} % of the limit between two zones, on their boundary</p>")
 
 
 def render_report(

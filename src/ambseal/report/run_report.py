@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ambseal import __version__
-from ambseal.analysis import force_demand
+from ambseal.analysis import force_demand, worst_zone
 from ambseal.config import method_label
 from ambseal.identify import MIN_FIT_PCT, fit_reliability, interval_check, true_line
 from ambseal.lti.freqresp import freqresp
@@ -558,7 +558,7 @@ def _speed_range_section(metrics: dict) -> list[dict]:
                    or not (c.get("discrete") or {}).get("stable", True)]
             zones = [z for c in at for b in (c, c.get("discrete") or {})
                      for z in (b.get("iso_zone_per_axis") or {}).values()]
-            zone = max(zones, key="ABCD".index) if zones else None
+            zone = worst_zone(zones)
             ok = "stable" + (f", zone {zone}" if zone else "")
             cells.append('<td>—</td>' if not at else f'<td>{ok}</td>' if not bad else
                          '<td class="unstable">unstable at '

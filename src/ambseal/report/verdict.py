@@ -24,8 +24,9 @@ from rich.console import Group
 from rich.table import Table
 from rich.text import Text
 
-from ambseal.analysis import (CLEARANCE_WORDS, capacity_words, clearance_exceeded,
-                               first_largest, saturates, worst_orbit_um)
+from ambseal.analysis import (CLEARANCE_WORDS, SEPARATION_RTOL, ZONE_SCALE, boundary_note,
+                               capacity_words, clearance_exceeded, first_largest, saturates,
+                               side_of, worst_orbit_um, worst_zone, zone_sides, zone_words)
 from ambseal.model import axis_label
 from ambseal.robust import PEAK_TOLERANCE
 
@@ -36,11 +37,7 @@ __all__ = ["ZONE_COLOURS", "ZONE_WORDS", "Verdict", "verdicts", "condition_label
 #: Zone colours (green → red) of every table and figure.
 ZONE_COLOURS = {"A": "#1a9850", "B": "#91cf60", "C": "#fc8d59", "D": "#d73027"}
 #: What each ISO 14839-3 zone means for the machine, in words.
-ZONE_WORDS = {"A": "as good as newly commissioned",
-              "B": "fit for unrestricted long-term operation",
-              "C": "fit for limited-term operation only",
-              "D": "not acceptable (damage likely)"}
-_ORDER = "ABCD"
+ZONE_WORDS = {z: zone_words(z) for z in "ABCD"}
 _TERMINAL_ZONE = {"A": "green", "B": "bright_green", "C": "yellow", "D": "red"}
 #: Unstable conditions a verdict sentence names before it counts the rest.
 _NAMED = 4
@@ -75,11 +72,6 @@ def condition_label(case: Mapping, by_speed: bool) -> str:
     return f"{case['speed_hz']:g} Hz" if by_speed else f"{case['pressure_bar']:.4g} bar"
 
 
-def _worst(zones) -> str | None:
-    zs = [z for z in zones if z and z in _ORDER]
-    return max(zs, key=_ORDER.index) if zs else None
-
-
 @dataclass(frozen=True)
 class Verdict:
     """One controller over all judged conditions (the report's first screen).
@@ -92,7 +84,9 @@ class Verdict:
     zone_axis, zone_sigma : str or None
         Worst per-axis ISO 14839-3 zone (unstable → D), and the zone of σ̄(S_o), over
         every graded loop: the judged conditions, continuous and as it runs, and the
-        speed range's (standstill to the top speed) where they are graded.
+        speed range's (standstill to the top speed) where they are graded. A zone or the
+        boundary of two (``"A/B"``, :func:`ambseal.analysis.iso.graded_zone`), the worst
+        on :data:`ambseal.analysis.iso.ZONE_SCALE`.
     sigma_peak : float or None
         Largest σ̄(S_o) peak over those loops where stable (-).
     orbit_um, impulse_peak_um, impulse_settling_s : float or None
@@ -116,6 +110,8 @@ class Verdict:
         The axis and condition of the largest per-axis sensitivity peak over those loops,
         e.g. ``"A ζ at 4.08 bar"`` or ``"B η at 40 bar, 500 Hz, as it runs"``; None
         without per-axis peaks.
+    worst_axis_peak : float or None
+        That peak (-), which :attr:`zone_axis` is graded from.
     axes_alike : bool
         Every axis is in the same zone at every stable condition.
     capacity : dict or None
@@ -163,6 +159,7 @@ class Verdict:
     criticals: tuple = ()
     speed_graded: bool = False
     impulse_settling_note: str | None = None
+    worst_axis_peak: float | None = None
 
     def critical_text(self) -> str:
         """The critical speeds in words, ``""`` without any: ``"a critical speed (1×
@@ -174,6 +171,11 @@ class Verdict:
             head = f"{c['speed_hz']:.4g} Hz (AF {sig(af, 2)})"
             if not c["margin_pct"]:
                 parts.append(f"{head} inside the continuous speed range")
+            elif side_of(c["margin_pct"], c["required_pct"], SEPARATION_RTOL) == "on":
+                # the margin is not known to meet the requirement or not: both sides said
+                parts.append(f"{head} {c['margin_pct']:.4g} % from the continuous speed "
+                             f"range, on the boundary of the {c['required_pct']:.4g} % API "
+                             "617 requires (met or not met within the judgement's accuracy)")
             else:
                 parts.append(f"{head} {sig(c['margin_pct'], 2)} % from the continuous speed "
                              f"range where API 617 requires {sig(c['required_pct'], 2)} %")
@@ -255,6 +257,8 @@ class Verdict:
         z = self.zone_axis or "?"
         where = ("on every axis" if self.axes_alike or self.worst_axis is None else
                  f"on its worst axis ({self.worst_axis})")
+        # a zone on the boundary of two says the peak and the limit it lies on
+        z += boundary_note(self.zone_axis, self.worst_axis_peak, "|S_o|")
         over = self.judged_range
         if self.speed_checked and self.speed_graded:  # the zone covers the speed range
             # judged at speeds already, the span says it all ("standstill to 300 Hz")
@@ -263,11 +267,15 @@ class Verdict:
         text = f"Zone {z} {where} over {over}"
         # σ̄(S_o) bounds every axis's peak from above, so its zone is never the better one;
         # where it is worse, the words follow it: the loop is judged as the MIMO loop it is
-        worse = self.zone_sigma if self.zone_sigma and self.zone_sigma != z else None
+        worse = (self.zone_sigma if self.zone_sigma in ZONE_SCALE
+                 and ZONE_SCALE.index(self.zone_sigma)
+                 > ZONE_SCALE.index(self.zone_axis if self.zone_axis in ZONE_SCALE else "A")
+                 else None)
         if worse is not None:
-            text += (f", but σ̄(S_o) over all axes reaches zone {worse} (peak "
-                     f"{sig(self.sigma_peak)})")
-        text += f": {ZONE_WORDS.get(worse or z, 'not graded')}"
+            text += (f", but σ̄(S_o) over all axes reaches zone {worse}"
+                     + (boundary_note(worse, self.sigma_peak) or
+                        f" (peak {sig(self.sigma_peak)})"))
+        text += f": {zone_words(worse or self.zone_axis)}"
         if self.speed_checked and not self.speed_graded:
             span = self.speed_span()
             text += (f"; stable from {span}" if span.startswith("standstill")
@@ -386,8 +394,8 @@ def _verdict(name: str, cs: list, by_speed: bool, sc: list,
         controller=name, conditions=tuple(label),
         stable_at=tuple(lb for lb, c in zip(label, cs) if c.get("stable")),
         unstable_at=tuple(lb for lb, c in zip(label, cs) if not c.get("stable")),
-        zone_axis=_worst(axis_zones),
-        zone_sigma=_worst([c.get("iso_zone") for c in [*cs, *loops[len(ok):]]] + lost),
+        zone_axis=worst_zone(axis_zones),
+        zone_sigma=worst_zone([c.get("iso_zone") for c in [*cs, *loops[len(ok):]]] + lost),
         sigma_peak=peak("sensitivity_peak", loops), orbit_um=worst_orbit_um(cs),
         impulse_peak_um=peak("impulse_peak_um"),
         impulse_settling_s=None if unsettled else peak("impulse_settling_s"),
@@ -396,6 +404,7 @@ def _verdict(name: str, cs: list, by_speed: bool, sc: list,
         speed_checked=len(sc), speed_unstable=speed_bad,
         design_bound=(design.get("verdict") or "").split(";")[0] or None,
         worst_axis=None if top is None else f"{axis_label(top[1])} at {top[2]}",
+        worst_axis_peak=None if top is None else top[0],
         axes_alike=len(stable_zones) <= 1, capacity=design.get("capacity"),
         speeds_hz=tuple(sorted({float(c["speed_hz"]) for c in [*cs, *sc]
                                 if c.get("speed_hz") is not None})),
@@ -447,11 +456,19 @@ def _esc(s: Any) -> str:
     return _html.escape(str(s), quote=True)
 
 
+def _zone_background(z: str) -> str:
+    """A zone's colour; the boundary of two, both colours side by side."""
+    sides = [ZONE_COLOURS.get(s, "#eee") for s in zone_sides(z)]
+    if len(sides) == 1:
+        return sides[0]
+    return f"linear-gradient(90deg,{sides[0]} 50%,{sides[1]} 50%)"
+
+
 def _zone_cell(z: str | None, extra: str = "", label: str = "") -> str:
     lab = f' data-label="{_esc(label)}"' if label else ""
     if z is None:
         return f"<td{lab}>—</td>"
-    return (f'<td class="zone"{lab} style="background:{ZONE_COLOURS.get(z, "#eee")}">'
+    return (f'<td class="zone"{lab} style="background:{_zone_background(z)}">'
             f"{_esc(z)}{extra}</td>")
 
 
@@ -556,8 +573,10 @@ def verdict_table_rich(vs: Sequence[Verdict]):
         t.add_column(col, justify="left" if col in ("controller", "stable over") else "right",
                      no_wrap=col in ("controller", "zone", orbit))
 
-    def zone(z):  # named colours: also right on a 16-colour terminal
-        return "—" if z is None else f"[bold black on {_TERMINAL_ZONE.get(z, 'white')}] {z} [/]"
+    def zone(z):  # named colours: also right on a 16-colour terminal; a boundary, the worse's
+        if z is None:
+            return "—"
+        return f"[bold black on {_TERMINAL_ZONE.get(zone_sides(z)[-1], 'white')}] {z} [/]"
 
     for v in vs:
         st = v.impulse_settling_s

@@ -320,10 +320,10 @@ def test_static_current_holds_the_seal_offset_at_every_direction(testrig_cfg, te
 def test_the_axis_named_of_a_tie_is_the_first_in_the_rigs_channel_order(testrig_cfg):
     """Reference: the rig's limits in closed form (the coil current through the
     second-order amplifier, over the 6 A current limit). The two axes of a symmetric
-    bearing need one current by symmetry; whether the tie is exact or rounding (1e-12
-    relative, as another machine's BLAS kernels give it) makes η's larger, the axis
-    named is the first in the rig's channel order, A ζ; a real difference (1e-6) names
-    the larger."""
+    bearing need one current by symmetry; whether the tie is exact or rounding (1e-12 or
+    2e-8 relative, as another machine's BLAS kernels give it through the synthesis) makes
+    η's larger, the axis named is the first in the rig's channel order, A ζ; a real
+    difference (1e-4) names the larger."""
     speeds = np.linspace(20.0, 200.0, 37)
     names = ["i_A_zeta", "i_A_eta", "i_B_zeta", "i_B_eta"]
     shape = 0.5 + 0.3 * np.sin(speeds / 40.0)
@@ -340,4 +340,5 @@ def test_the_axis_named_of_a_tie_is_the_first_in_the_rigs_channel_order(testrig_
     assert used == pytest.approx(coil.max() / 6.0, rel=1e-9)
     assert exact == "A_zeta"
     assert named(1 + 1e-12)[0] == "A_zeta"
-    assert named(1 + 1e-6)[0] == "A_eta"
+    assert named(1 + 2e-8)[0] == "A_zeta"
+    assert named(1 + 1e-4)[0] == "A_eta"

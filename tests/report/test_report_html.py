@@ -472,3 +472,54 @@ def test_a_zone_on_its_limit_names_both_sides_in_the_verdict():
     # the cells of the table carry both zones' colours
     table = html.verdict_table_html([verdicts([_graded_case(3.0004, (2.95, 3.0004))])[0]])
     assert "linear-gradient(90deg,#1a9850 50%,#91cf60 50%)" in table and ">A/B<" in table
+
+
+def test_an_lpv_design_whose_sdp_stopped_at_its_cap_is_marked_where_it_is_delivered():
+    """Reference: CVXOPT's iteration count and cap (``maxiters`` 8 on a toy whose γ SDP
+    converges in 11; tests/robust/test_robust_lpv.py). The LPV design built from that
+    synthesis names the stage that stopped short of optimal in its summary (``sdp_status``,
+    ``sdp_shortfall``) and in its bound's words; the run's verdict on it, its design-bound
+    cell and the report's section on the syntheses say NOT SOLVED TO OPTIMALITY. The same
+    synthesis without the cap ends "optimal", and none of them says so."""
+    import dataclasses
+
+    from ambseal.design.lpv_design import LpvDesign
+    from ambseal.report.run_report import _synthesis_section
+    from ambseal.report.verdict import verdicts
+    from ambseal.robust import lpvsyn
+    from tests.robust.test_robust_lpv import _toy
+
+    grid = np.linspace(0.0, 40.0, 5)
+    plants = [_toy(p) for p in grid]
+
+    def delivered(options):
+        r = lpvsyn(plants, grid, 2, 2, frozen_check=False, solver_options=options)
+        d = LpvDesign(K=r.K, gamma=r.gamma, gamma_design=r.gamma_design,
+                      frozen_gamma=np.full(grid.size, np.nan), check_gamma=r.check_gamma,
+                      speeds_hz=grid / (2 * np.pi), check_speeds_hz=r.check_grid / (2 * np.pi),
+                      reports=r.reports, kind=r.kind)
+        summary = d.to_dict()
+        case = dict(_metrics()[0], controller="lpv")
+        v = verdicts([case], None, (), {"lpv": summary})[0]
+        text = " ".join(sec["text"] for sec in _synthesis_section({"controllers": {
+            "lpv": summary}}))
+        return d, summary, v, text
+
+    d, summary, v, text = delivered({"maxiters": 8})
+    assert summary["sdp_status"] == {"gamma": "feasible"}
+    short = ("the γ stage's SDP ended “feasible” at CVXOPT's iteration cap (8 iterations), "
+             "not optimal")
+    assert summary["sdp_shortfall"] == short
+    assert f"NOT SOLVED TO OPTIMALITY: {short}" in d.verdict
+    assert f"NOT SOLVED TO OPTIMALITY: {short}" in v.design_bound
+    assert v.words().endswith(f"; NOT SOLVED TO OPTIMALITY ({short}): this controller and "
+                              "its numbers are where the solver stopped, and may differ on "
+                              "another machine.")
+    assert "NOT SOLVED TO OPTIMALITY" in text and "γ stage feasible after 8 of at most 8 " \
+        "interior-point iterations (stopped by the cap)" in text
+    # the frozen-point design delivered in its place is not built from the SDPs
+    assert dataclasses.replace(d, kind="frozen").sdp_shortfall == ""
+    d, summary, v, text = delivered(None)
+    assert summary["sdp_status"] == {"gamma": "optimal"} and summary["sdp_shortfall"] == ""
+    assert "OPTIMALITY" not in d.verdict + v.words() + text
+    assert "γ stage optimal after 11 of at most 100 interior-point iterations" in text

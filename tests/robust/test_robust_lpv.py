@@ -578,3 +578,30 @@ def test_user_basis_and_rate_dependent_controller_interface():
     np.testing.assert_allclose(A2 - A1, A1 - A0, rtol=1e-12, atol=1e-12 * np.abs(A0).max())
     assert np.abs(A1 - A0).max() > 0
     np.testing.assert_array_equal(r.K.at(13.0).A, A0)
+
+
+def test_an_sdp_stopped_at_its_iteration_cap_says_so():
+    """Reference: CVXOPT's own iteration count and cap, and the bounded-real lemma on the
+    frozen loops (python-control's H∞ norms of F_l(P(θ), K(θ))). The toy's γ SDP converges
+    in 11 interior-point iterations ("optimal"); capped at 8 (``maxiters``), CVXOPT stops
+    short of its tolerances on a point where every LMI holds: the synthesis still delivers
+    (γ a bound the LMIs certify, at least the optimum), but its result reports that its γ
+    stage ended "feasible" at the cap, in its ``sdp_status``, its report and in words;
+    the run without a cap reports "optimal" and no shortfall."""
+    grid = np.linspace(0.0, 40.0, 5)
+    plants = [_toy(p) for p in grid]
+    full = lpvsyn(plants, grid, 2, 2, frozen_check=False)
+    assert full.sdp_status == {"gamma": "optimal"} and full.sdp_shortfall == ""
+    assert full.to_dict()["sdp_status"] == {"gamma": "optimal"}
+    capped = lpvsyn(plants, grid, 2, 2, frozen_check=False, solver_options={"maxiters": 8})
+    assert capped.sdp_status == {"gamma": "feasible"}
+    (gamma,) = [r for r in capped.reports if r.stage == "gamma"]
+    assert (gamma.iterations, gamma.max_iterations, gamma.capped) == (8, 8, True)
+    assert gamma.to_dict()["capped"] and gamma.to_dict()["used"]
+    assert capped.sdp_shortfall == ("the γ stage's SDP ended “feasible” at CVXOPT's "
+                                    "iteration cap (8 iterations), not optimal")
+    assert capped.gamma >= full.gamma * (1 - 1e-9)
+    for p in capped.check_grid:  # the controller is reconstructed 2 % above γ_design
+        cl = _frozen_loop(_toy(p), capped.K.at(p))
+        assert cl.poles().real.max() < 0
+        assert ct.norm(cl, "inf") <= 1.02 * capped.gamma_design * (1 + 1e-3)

@@ -53,7 +53,8 @@ from ambseal.design.weights import Weights, default_weights
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.lti import json_float
 from ambseal.machine import SPEED, ScheduledController
-from ambseal.robust import design_delay, design_omega, hinfsyn, lpvsyn, musyn
+from ambseal.robust import (design_delay, design_omega, hinfsyn, lpvsyn, musyn, sdp_shortfall,
+                            sdp_status)
 
 __all__ = ["LpvDesign", "FrozenDesign", "design_lpv", "design_frozen",
            "lpv_generalized_plants", "check_full_order", "lpv_schedule"]
@@ -130,6 +131,9 @@ class LpvDesign(ScheduledController):
         |Ω̇|/2π bound (Hz/s).
     weights : Weights
     reports : tuple of SolverReport
+        Every SDP solve and the reconstruction (:class:`ambseal.robust.lpv.SolverReport`);
+        :attr:`sdp_status` the status each stage ended on, :attr:`sdp_shortfall` those short
+        of optimal in words.
     synthesis_s : float
         Wall time of :func:`lpvsyn` (s).
     elapsed_s : float
@@ -201,6 +205,20 @@ class LpvDesign(ScheduledController):
                                  self.weights.d_u)
 
     @property
+    def sdp_status(self) -> dict:
+        """The status each SDP stage of the synthesis ended on, ``{"gamma": "optimal",
+        …}`` (:func:`ambseal.robust.sdp_status`)."""
+        return sdp_status(self.reports)
+
+    @property
+    def sdp_shortfall(self) -> str:
+        """The SDP stages the delivered controller was built from that ended short of
+        optimal (at CVXOPT's iteration cap or stalled, their LMIs holding), in words;
+        ``""`` where none did or where the delivered controller is the frozen-point design
+        (``kind == "frozen"``, not built from them)."""
+        return sdp_shortfall(self.reports) if self.kind == "lpv" else ""
+
+    @property
     def controller(self) -> LpvDesign:
         """The design itself: it is the scheduled controller
         (:class:`~ambseal.design.Design`)."""
@@ -225,15 +243,24 @@ class LpvDesign(ScheduledController):
                 "elapsed_s": round(self.elapsed_s, 3), "full_order": self.full_order,
                 "delay": None if self.delay is None else self.delay.to_dict(),
                 "kind": self.kind, "frozen_best_gamma": json_float(self.frozen_best_gamma),
+                "sdp_status": self.sdp_status, "sdp_shortfall": self.sdp_shortfall,
                 "verdict": self.verdict}
 
     @property
     def verdict(self) -> str:
-        """One plain line: the LMI bound over the scheduled range, the frozen loops, and
-        the full-order stability."""
+        """One plain line: the LMI bound over the scheduled range (and, where an SDP it
+        rests on ended short of optimal, that it is a certified bound, not the optimum,
+        of a controller that depends on the machine's rounding), the frozen loops, and the
+        full-order stability."""
         lo, hi = float(self.speeds_hz.min()), float(self.speeds_hz.max())
+        short = self.sdp_shortfall
+        # no ";" inside: the run's verdict takes the bound as the line's first clause
+        note = (f" — NOT SOLVED TO OPTIMALITY: {short}, so γ is a bound its LMIs certify "
+                "and the controller is where the solver stopped, which another machine's "
+                "rounding moves" if short else "")
         return (f"LPV γ = {bound_text(self.gamma)} over {lo:g}–{hi:g} Hz ({self.lyapunov} "
-                f"Lyapunov function), frozen loops γ ≤ {float(np.max(self.check_gamma)):.3g}"
+                f"Lyapunov function{note}), frozen loops γ ≤ "
+                f"{float(np.max(self.check_gamma)):.3g}"
                 f"; {_stability_over_speed(self.full_order)}")
 
 

@@ -768,9 +768,44 @@ def _rejection_section(metrics: dict) -> list[dict]:
     return [{"title": "Unbalance force rejection", "text": text, "html": table}]
 
 
+#: How :func:`_synthesis_section` names the stages of an SDP synthesis.
+_STAGES = {"gamma": "γ stage", "centre": "centring", "reconstruct": "reconstruction"}
+
+
+def _synthesis_section(metrics: dict) -> list[dict]:
+    """How each synthesis by SDPs ended (a design summary's ``reports``, the LPV's): per
+    stage the status of the solve its controller was built from, its iterations against
+    CVXOPT's cap, and the solves the synthesis went past; a design whose SDP ended short of
+    optimal says so first."""
+    lines = []
+    for m, summary in metrics["controllers"].items():
+        reports = summary.get("reports") or []
+        if not any(r.get("solver") == "CVXOPT" for r in reports):
+            continue
+        used = [r for r in reports if r.get("used", True)]
+        stages = "; ".join(
+            f"{_STAGES.get(r['stage'], r['stage'])} {r['status']}"
+            + (f" after {r['iterations']} of at most {r['max_iterations']} interior-point "
+               "iterations" + (" (stopped by the cap)" if r.get("capped") else "")
+               if r.get("max_iterations") else f" ({r['solver']})")
+            for r in used)
+        past = len(reports) - len(used)
+        head = (f"NOT SOLVED TO OPTIMALITY: {summary['sdp_shortfall']}; γ is a bound its "
+                "LMIs certify, and the controller is where the solver stopped, which "
+                "another machine's rounding moves. " if summary.get("sdp_shortfall") else "")
+        lines.append(f"{method_label(m)}: {head}Built from: {stages}"
+                     + (f"; {past} further solve{'s' if past > 1 else ''} the synthesis "
+                        "went past (continuation steps not kept, a scaling it replaced)"
+                        if past else "") + ".")
+    if not lines:
+        return []
+    return [{"title": "How the LMI syntheses ended", "text": " ".join(lines)}]
+
+
 def _run_sections(metrics: dict) -> list[dict]:
     """The main job's text sections: the speed range, redesigns, what cannot run on the
-    target, the open loop and the discretisations."""
+    target, the open loop, the discretisations, the amplifiers, the unbalance rejection
+    and how the LMI syntheses ended."""
     ol = metrics["open_loop"]
     sections = [{"title": "Open loop",
                  "text": (f"{len(ol['unstable_poles'])} unstable poles (rad/s): "
@@ -783,4 +818,5 @@ def _run_sections(metrics: dict) -> list[dict]:
         f"{s['remedy']}; the new design holds at every judged condition.")}
         for m, s in metrics["controllers"].items() if s.get("remedy")] + sections
     return (_speed_range_section(metrics) + sections + _discrete_section(metrics)
-            + _sizing_section(metrics) + _rejection_section(metrics))
+            + _sizing_section(metrics) + _rejection_section(metrics)
+            + _synthesis_section(metrics))

@@ -112,6 +112,10 @@ class Verdict:
         without per-axis peaks.
     worst_axis_peak : float or None
         That peak (-), which :attr:`zone_axis` is graded from.
+    synthesis_shortfall : str
+        Where the design's synthesis stopped short of its optimum (an LPV design whose SDP
+        ended "feasible" at CVXOPT's iteration cap or stalled: the design summary's
+        ``sdp_shortfall``), in words; ``""`` where it did not.
     axes_alike : bool
         Every axis is in the same zone at every stable condition.
     capacity : dict or None
@@ -160,6 +164,7 @@ class Verdict:
     speed_graded: bool = False
     impulse_settling_note: str | None = None
     worst_axis_peak: float | None = None
+    synthesis_shortfall: str = ""
 
     def critical_text(self) -> str:
         """The critical speeds in words, ``""`` without any: ``"a critical speed (1×
@@ -239,7 +244,18 @@ class Verdict:
         return capacity_words(self.capacity)
 
     def words(self) -> str:
-        """The verdict in one sentence."""
+        """The verdict in one sentence; a design whose synthesis stopped short of its
+        optimum says so at its end, whatever the verdict: its numbers are where the solver
+        stopped, and another machine's rounding stops it elsewhere."""
+        text = self._judged_words()
+        if self.synthesis_shortfall:
+            text = (f"{text[:-1]}; NOT SOLVED TO OPTIMALITY ({self.synthesis_shortfall}): "
+                    "this controller and its numbers are where the solver stopped, and may "
+                    "differ on another machine.")
+        return text
+
+    def _judged_words(self) -> str:
+        """The verdict on the judged loops, in one sentence."""
         if self.unstable_at or self.speed_unstable:
             bad = [*self.unstable_at, *self.speed_unstable]
             where = "; ".join(bad[:_NAMED]) + (f" and {len(bad) - _NAMED} more"
@@ -410,7 +426,8 @@ def _verdict(name: str, cs: list, by_speed: bool, sc: list,
                                 if c.get("speed_hz") is not None})),
         range_hz=tuple(sorted({float(c["speed_hz"]) for c in sc
                                if c.get("speed_hz") is not None})),
-        criticals=_criticals(cs), speed_graded=any(c.get("iso_zone") for c in sc))
+        criticals=_criticals(cs), speed_graded=any(c.get("iso_zone") for c in sc),
+        synthesis_shortfall=design.get("sdp_shortfall") or "")
 
 
 def _criticals(cs: list) -> tuple:

@@ -10,7 +10,9 @@ Synthesis (each returns the controller, the closed loop, the bound and a result 
   :func:`hinfnorm` the H∞ norm;
 * :func:`musyn` — μ-synthesis by complex D–K iteration; :func:`musyn_dgk` — by D–G–K
   iteration for mixed real/complex uncertainty;
-* :func:`lpvsyn` — gridded H∞ LPV synthesis by LMIs (CVXOPT, structured);
+* :func:`lpvsyn` — gridded H∞ LPV synthesis by LMIs (CVXOPT, structured); the status each
+  of its SDP stages ended on, :func:`sdp_status`, and any short of optimal in words,
+  :func:`sdp_shortfall`;
 * :func:`reduce_controller`, :func:`balred_controller` — order reduction with its cost.
 
 Analysis: :func:`mussv` — μ upper and lower bounds for mixed real/complex block structures.
@@ -55,7 +57,8 @@ _FROM = {
     "discrete_controller": "digital_loop", "DiscreteController": "digital_loop",
     "design_omega": "dk", "fit_magnitude": "dk", "musyn": "dk", "MusynResult": "dk",
     "hinfnorm": "hinf", "hinfsyn": "hinf", "lft_lower": "hinf", "HinfResult": "hinf",
-    "lpvsyn": "lpv", "LpvController": "lpv", "LpvSynResult": "lpv", "mussv": "mu",
+    "lpvsyn": "lpv", "LpvController": "lpv", "LpvSynResult": "lpv", "sdp_status": "lpv",
+    "sdp_shortfall": "lpv", "mussv": "mu",
     "MuResult": "mu", "balred_controller": "order", "reduce_controller": "order",
     "ReductionResult": "order", "decay_rate": "stability", "is_stable": "stability",
     "unstable_poles": "stability", "MAX_DELAY_SAMPLES": "timing", "check_timing": "timing",

@@ -68,17 +68,25 @@ class Lmi:
         return self.const.shape[0]
 
 
+#: CVXOPT's own cap on the interior-point iterations (its ``maxiters``) where the options
+#: do not set one.
+CVXOPT_MAXITERS = 100
+
+
 @dataclass(frozen=True)
 class SdpSolution:
     """What :func:`solve_lmis` found: ``gamma`` (None without γ), the matrices ``X``, CVXOPT's
     ``status`` (``"optimal"`` or ``"unknown"``, and ``"infeasible"`` for a primal
     infeasibility certificate; ``"feasible"`` where CVXOPT stopped short of its tolerances,
-    "unknown", on a point at which every LMI holds: :func:`holds`) and ``iterations``."""
+    "unknown", on a point at which every LMI holds: :func:`holds`), ``iterations`` and
+    ``max_iterations``, the cap it ran under (``iterations`` reaching it: stopped by the
+    cap; short of it and not optimal: stalled)."""
 
     gamma: float | None
     X: list
     status: str
     iterations: int
+    max_iterations: int = CVXOPT_MAXITERS
 
 
 class _Layout:
@@ -300,6 +308,7 @@ def solve_lmis(lmis, n: int, n_vars: int, cost_gamma: float | None, cost_trace,
         return f
 
     opts = {"show_progress": False, **options}
+    cap = int(opts.get("maxiters", solvers.options.get("maxiters", CVXOPT_MAXITERS)))
     res = solvers.conelp(cvxopt.matrix(c), G, cvxopt.matrix(h), dims,
                          kktsolver=kktsolver, options=opts)
     status = {"primal infeasible": "infeasible"}.get(res["status"], res["status"])
@@ -308,4 +317,4 @@ def solve_lmis(lmis, n: int, n_vars: int, cost_gamma: float | None, cost_trace,
         status = "feasible"
     X = [lay.unpack(x, v) for v in range(n_vars)]
     return SdpSolution(float(x[0]) if lay.with_gamma else None, X, status,
-                       int(res.get("iterations", 0) or 0))
+                       int(res.get("iterations", 0) or 0), cap)

@@ -6,8 +6,13 @@ projected LMIs of Gahinet & Apkarian (1994) on every grid point, with a constant
 parameter-dependent Lyapunov function (Apkarian & Adams 1998; Wu et al. 1996). The
 equations are in :mod:`ambseal.robust.lpv`. The SDPs are solved by CVXOPT with a KKT solver
 that forms their Schur complement from the LMIs' Kronecker structure
-(:mod:`ambseal.robust._lmi_sdp`); a status other than ``optimal`` raises
-:class:`~ambseal.errors.SynthesisError`.
+(:mod:`ambseal.robust._lmi_sdp`); a status other than ``optimal`` or ``feasible`` (CVXOPT
+stopped short of its tolerances, at its iteration cap or stalled, on a point where every
+LMI holds) raises :class:`~ambseal.errors.SynthesisError`. Each solve is reported
+(:class:`SolverReport`), those the controller was built from marked ``used``: the status
+each stage ended on (:func:`sdp_status`) and, where it is not ``optimal``, in words
+(:func:`sdp_shortfall`) — γ is then a bound the LMIs certify, not the optimum, and the
+controller is the one where the solver stopped, which another machine's rounding moves.
 """
 
 from __future__ import annotations
@@ -23,7 +28,8 @@ from ambseal.errors import SynthesisError
 from ambseal.robust import _lmi_sdp as _sdp
 
 __all__ = ["LmiInfeasible", "SolverReport", "Scaled", "scale_grid", "lmi_blocks", "solve_lmis",
-           "basis", "basis_at", "is_constant", "rebalanced", "BASES"]
+           "basis", "basis_at", "is_constant", "rebalanced", "BASES", "sdp_status",
+           "sdp_shortfall"]
 
 BASES = {"constant": 1, "affine": 2, "quadratic": 3}
 #: The largest share of stage 1's cost the trace term may take before its weight is
@@ -59,14 +65,23 @@ class SolverReport:
         ``"gamma"`` (minimise γ), ``"centre"`` (re-solve at the backed-off γ for a
         well-conditioned R, S) or ``"reconstruct"`` (all controller reconstructions).
     status : str
-        The SDP's status (``"optimal"`` is the only one accepted); for the reconstruction,
-        ``"optimal"`` or at how many table points θ its LMIs hold.
+        The SDP's status: ``"optimal"``, or ``"feasible"`` where CVXOPT stopped short of
+        its tolerances on a point where every LMI holds (:class:`~ambseal.robust._lmi_sdp.
+        SdpSolution`); for the reconstruction, ``"optimal"`` or at how many table points θ
+        its LMIs hold.
     iterations : int
         Interior-point iterations (0 for the closed-form reconstruction).
     time_s : float
         Wall time of setup and solve (s).
     solver : str
         ``"CVXOPT"`` or ``"closed form"``.
+    max_iterations : int or None
+        CVXOPT's cap on the iterations (``maxiters``) the solve ran under; None for the
+        closed form.
+    used : bool
+        The controller was built from this solve (False for a solve the synthesis went
+        past: a step of the trace weight's continuation it did not keep, the first scaling
+        where the rebalanced one was better).
     """
 
     stage: str
@@ -74,10 +89,68 @@ class SolverReport:
     iterations: int
     time_s: float
     solver: str = "CVXOPT"
+    max_iterations: int | None = None
+    used: bool = True
+
+    @property
+    def capped(self) -> bool:
+        """The SDP stopped at CVXOPT's iteration cap, not optimal."""
+        return (self.status != "optimal" and self.max_iterations is not None
+                and self.iterations >= self.max_iterations)
 
     def to_dict(self) -> dict:
         return {"stage": self.stage, "status": self.status, "iterations": self.iterations,
-                "time_s": self.time_s, "solver": self.solver}
+                "time_s": self.time_s, "solver": self.solver,
+                "max_iterations": self.max_iterations, "capped": self.capped,
+                "used": self.used}
+
+
+#: How :func:`sdp_shortfall` names each SDP stage.
+_STAGE_WORDS = {"gamma": "the γ stage's SDP", "centre": "the centring SDP"}
+
+
+def sdp_status(reports) -> dict:
+    """The status each SDP stage ended on: that of the solve the controller was built from.
+
+    Parameters
+    ----------
+    reports : sequence of SolverReport
+        The synthesis's reports, in order.
+
+    Returns
+    -------
+    dict of str to str
+        Stage (``"gamma"``, ``"centre"``) → status (``"optimal"``, ``"feasible"``), the
+        CVXOPT solves marked ``used``.
+    """
+    return {r.stage: r.status for r in reports if r.used and r.solver == "CVXOPT"}
+
+
+def sdp_shortfall(reports) -> str:
+    """The SDP stages that ended short of ``optimal``, in words; ``""`` where every one the
+    controller was built from is optimal.
+
+    Parameters
+    ----------
+    reports : sequence of SolverReport
+        The synthesis's reports.
+
+    Returns
+    -------
+    str
+        E.g. ``"the γ stage's SDP ended “feasible” at CVXOPT's iteration cap (100
+        iterations), not optimal"``, or ``"… after CVXOPT stalled at 57 of its 100
+        iterations …"``; stages joined by ``" and "``.
+    """
+    parts = []
+    for r in reports:
+        if not r.used or r.solver != "CVXOPT" or r.status == "optimal":
+            continue
+        how = (f"at CVXOPT's iteration cap ({r.iterations} iterations)" if r.capped else
+               f"after CVXOPT stalled at {r.iterations} of its {r.max_iterations} iterations")
+        parts.append(f"{_STAGE_WORDS.get(r.stage, r.stage)} ended “{r.status}” {how}, not "
+                     "optimal")
+    return " and ".join(parts)
 
 
 def _null(M: np.ndarray, tol: float = 1e-10) -> np.ndarray:
@@ -309,6 +382,7 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
     R, S : list of ndarray, shape (N, N)
         Coefficients R_j, S_i of R(θ) = Σ g_j(θ) R_j and S(θ) = Σ f_i(θ) S_i.
     reports : list of SolverReport
+        Every solve, those the result was not built from ``used=False``.
     penalty_share : float
         The trace term's share of stage 1's cost at its last solve (relative to γ).
 
@@ -391,6 +465,7 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
     n_vars = nbR + nbS
     lmis, tr = build(None, float(coupling_ratio) if not centre else 1.0)
     sol = _solve_sdp(lmis, N, n_vars, 1.0, penalty * tr, solver_options, "gamma", reports)
+    kept = len(reports) - 1  # the γ solve the controller is built from
     # The trace term keeps R and S bounded, but where they must grow large it also buys a
     # smaller trace with a larger γ: while its share of the cost exceeds PENALTY_SHARE the
     # weight is lowered to half that share and the SDP solved again (at most
@@ -414,8 +489,10 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
         if not float(lower.gamma) < float(sol.gamma) or \
                 _reconstruction_loss(lower.X[:nbR], lower.X[nbR:], at) > RECONSTRUCTION_LOSS:
             break
-        sol, weight = lower, lower_weight
+        sol, weight, kept = lower, lower_weight, len(reports) - 1
         share = share_of(sol, weight)
+    reports[:] = [r if r.stage != "gamma" or k == kept else replace(r, used=False)
+                  for k, r in enumerate(reports)]
     gamma = float(sol.gamma)
     gamma_d = backoff * gamma
     if centre:
@@ -459,7 +536,8 @@ def _solve_sdp(lmis, N, n_vars, cost_gamma, cost_trace, options, stage, reports)
         raise SynthesisError(
             f"lpvsyn ({stage}): CVXOPT stopped on a singular system ({exc!r}): the LMIs are "
             "badly conditioned; check the scaling of the plant and weights") from exc
-    rep = SolverReport(stage, sol.status, sol.iterations, time.perf_counter() - t0, "CVXOPT")
+    rep = SolverReport(stage, sol.status, sol.iterations, time.perf_counter() - t0, "CVXOPT",
+                       sol.max_iterations)
     if sol.status == "infeasible":
         raise LmiInfeasible(
             f"lpvsyn ({stage}): the LMIs are infeasible (CVXOPT: primal infeasibility "

@@ -39,8 +39,13 @@ Numerics: the plants are balanced with one diagonal state scaling for the whole 
 is scaled by ω₀ (norm-preserving), and controls/measurements are normalised, before the
 SDPs are solved by CVXOPT with a Schur complement formed from the LMIs' Kronecker structure
 (:mod:`ambseal.robust._lmi_sdp`). A solver status other than ``optimal`` raises
-:class:`~ambseal.errors.SynthesisError`: badly scaled LMIs fail silently, and a controller
-from an inaccurate solution is refused.
+:class:`~ambseal.errors.SynthesisError` (badly scaled LMIs fail silently, and a controller
+from an inaccurate solution is refused), but for ``feasible``: CVXOPT stopped short of its
+tolerances, at its iteration cap or stalled, on a point where every LMI holds. γ is then a
+bound those LMIs certify, not the optimum, and the controller is the one where the solver
+stopped — another machine's rounding stops it elsewhere. The result says so:
+:attr:`LpvSynResult.sdp_status`, the status each stage ended on, and
+:attr:`LpvSynResult.sdp_shortfall` in words.
 """
 from __future__ import annotations
 
@@ -65,6 +70,8 @@ from ambseal.robust._lpv_lmi import (
     lmi_blocks,
     rebalanced,
     scale_grid,
+    sdp_shortfall,
+    sdp_status,
     solve_lmis,
 )
 from ambseal.robust._lpv_frozen import frozen_reference, quadratic_gamma
@@ -73,7 +80,8 @@ from ambseal.robust.hinf import hinfnorm
 from ambseal.robust.stability import is_stable
 from ambseal.threads import with_numerics_threads
 
-__all__ = ["FrozenClosedLoop", "LpvController", "LpvSynResult", "lpvsyn", "SolverReport"]
+__all__ = ["FrozenClosedLoop", "LpvController", "LpvSynResult", "lpvsyn", "SolverReport",
+           "sdp_status", "sdp_shortfall"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -251,6 +259,18 @@ class LpvSynResult:
         """Interior-point iterations of the γ stage (all its solves)."""
         return sum(r.iterations for r in self.reports if r.stage == "gamma")
 
+    @property
+    def sdp_status(self) -> dict:
+        """The status each SDP stage ended on, ``{"gamma": "optimal", …}``: that of the
+        solve the controller was built from (:func:`sdp_status`)."""
+        return sdp_status(self.reports)
+
+    @property
+    def sdp_shortfall(self) -> str:
+        """The stages that ended short of ``optimal`` in words, ``""`` where none did
+        (:func:`sdp_shortfall`)."""
+        return sdp_shortfall(self.reports)
+
     def to_dict(self) -> dict:
         return {"gamma": self.gamma, "gamma_design": self.gamma_design,
                 "lyapunov": _basis_name(self.lyapunov),
@@ -264,7 +284,7 @@ class LpvSynResult:
                 "scaling": self.scaling, "kind": self.kind,
                 "frozen_best_gamma": json_float(self.frozen_best_gamma),
                 "frozen_best_theta": json_float(self.frozen_best_theta),
-                "penalty_share": self.penalty_share,
+                "penalty_share": self.penalty_share, "sdp_status": self.sdp_status,
                 "reports": [r.to_dict() for r in self.reports], "time_s": self.time_s}
 
 
@@ -488,7 +508,7 @@ def _synthesise(data, scaling: str, *, lyapunov, lyapunov_r, rate_bound, backoff
         if again is not None and again[0] < gamma:
             sc, blocks = sc2, blocks2
             gamma, gamma_d, R, S, more, share = again
-            reports = reports + more
+            reports = [replace(r, used=False) for r in reports] + more
 
     # controller table on the check grid
     dens = max(int(check_density), 1)

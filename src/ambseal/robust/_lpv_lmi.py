@@ -128,7 +128,9 @@ def sdp_status(reports) -> dict:
 
 def sdp_shortfall(reports) -> str:
     """The SDP stages that ended short of ``optimal``, in words; ``""`` where every one the
-    controller was built from is optimal.
+    controller was built from is optimal. The words do not say how many iterations it took
+    or whether the cap or a stall stopped it (the reports do): those follow the machine's
+    rounding, the shortfall not.
 
     Parameters
     ----------
@@ -138,18 +140,12 @@ def sdp_shortfall(reports) -> str:
     Returns
     -------
     str
-        E.g. ``"the γ stage's SDP ended “feasible” at CVXOPT's iteration cap (100
-        iterations), not optimal"``, or ``"… after CVXOPT stalled at 57 of its 100
-        iterations …"``; stages joined by ``" and "``.
+        E.g. ``"the γ stage's SDP ended “feasible”, not optimal (CVXOPT stopped short of
+        its tolerances)"``; stages joined by ``" and "``.
     """
-    parts = []
-    for r in reports:
-        if not r.used or r.solver != "CVXOPT" or r.status == "optimal":
-            continue
-        how = (f"at CVXOPT's iteration cap ({r.iterations} iterations)" if r.capped else
-               f"after CVXOPT stalled at {r.iterations} of its {r.max_iterations} iterations")
-        parts.append(f"{_STAGE_WORDS.get(r.stage, r.stage)} ended “{r.status}” {how}, not "
-                     "optimal")
+    parts = [f"{_STAGE_WORDS.get(r.stage, r.stage)} ended “{r.status}”, not optimal (CVXOPT "
+             "stopped short of its tolerances)"
+             for r in reports if r.used and r.solver == "CVXOPT" and r.status != "optimal"]
     return " and ".join(parts)
 
 

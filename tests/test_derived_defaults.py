@@ -5,10 +5,10 @@ cannot run on the target is a failed controller of the run, not a refused rig.
 
 The rig: the G2-class flywheel of ``examples/flywheel.toml`` as a user might write a
 variant of it, with a slimmer shaft (45/30 mm), sensors collocated with the actuators, no
-``[design.rejection]``, at the example's 20 kHz. The derived PID's rule wanted a 75° lead
-at the 1.85 kHz collocated bending mode, whose pole lies at f_c·√α = 7.6 f_c = 14 kHz,
-above the 10 kHz Nyquist frequency; ``validate`` then refused the rig by the PID's own
-rate check."""
+``[design.rejection]``, at the example's 20 kHz. Its 1.85 kHz collocated bending mode
+needs +135° of phase: a rule free to take any lead would take a 75° one, whose pole lies
+at f_c·√α = 7.6 f_c = 14 kHz, above the 10 kHz Nyquist frequency, and the PID's rate check
+would then refuse the rig."""
 
 from __future__ import annotations
 
@@ -67,7 +67,7 @@ def test_a_derived_lead_above_nyquist_leaves_the_rig_valid(slim_rig, capsys):
 
 
 def test_a_written_pid_the_target_cannot_run_is_still_refused(slim_rig, tmp_path, capsys):
-    """What the user writes is checked as before: the same rig with a 75° lead at 1.85 kHz
+    """What the user writes is still checked: the same rig with a 75° lead at 1.85 kHz
     written in ``[[controller.filter]]`` is refused by ``validate`` (exit 2) naming the
     sample rate and the PID's highest pole."""
     text = slim_rig.read_text(encoding="utf-8") + (
@@ -104,3 +104,4 @@ def test_the_run_reports_the_pid_and_the_notch_it_tried(slim_rig, tmp_path):
     assert ("its unbalance force rejection, switched on by the run, whirls the rotor about "
             f"its axis of inertia by {beyond['orbit_um']:.3g} µm, beyond the backup "
             f"bearing's clearance ({backup_um:.3g} µm)") in m["failed"]["lpv"]["reason"]
+

@@ -135,7 +135,7 @@ def test_the_flywheel_holds_its_unbalance_with_its_notch_on(flywheel_run):
         assert cap["bias_used"] < 1 and cap["current_used"] < 1 and "rejection" not in s
         return
     alone = cap["without_rejection"]
-    assert cap["rejection_automatic"] and max(alone.values()) > 1, cap
+    assert cap["rejection_automatic"] and max(v for v in alone.values() if v) > 1, cap
     assert 0 < cap["bias_used"] < alone["bias_used"] and cap["bias_used"] < 1, cap
     assert cap["current_used"] < alone["current_used"], cap
     assert s["rejection"]["stable"] and s["rejection"]["beyond"] is None

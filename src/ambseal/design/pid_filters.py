@@ -53,7 +53,7 @@ import numpy as np
 from ambseal.lti import feedback_matrices, zoh
 from ambseal.robust import discretize_as, with_delay
 
-__all__ = ["ModeFilter", "FilterDesign", "flexible_mode_filters", "pole_hz", "MAX_FILTERS",
+__all__ = ["ModeFilter", "FilterDesign", "flexible_mode_filters", "MAX_FILTERS",
            "PHASE_STEPS_DEG", "NOTCH_DEPTHS_DB", "BAND_FACTOR"]
 
 #: filters at most: one per treated mode
@@ -102,7 +102,7 @@ class ModeFilter:
             text = f"{head}: {_name(f)} at {f['frequency_hz']:.4g} Hz → ζ {self.zeta_after:.2g}"
         if self.left_out:
             text += (" (left out: " + ", ".join(
-                f"{_name(c)} at {c['frequency_hz']:.4g} Hz, its pole at {pole_hz(c):.4g} Hz"
+                f"{_name(c)} at {c['frequency_hz']:.4g} Hz, its pole at {_pole_hz(c):.4g} Hz"
                 for c in self.left_out)
                 + f" above the Nyquist frequency {self.nyquist_hz:.4g} Hz, which the "
                   "target cannot run)")
@@ -114,7 +114,7 @@ def _name(f: dict) -> str:
             else f"{f['kind']} {f['phase_deg']:g}°")
 
 
-def pole_hz(f: dict) -> float:
+def _pole_hz(f: dict) -> float:
     """The highest pole (Hz) of a lead, lag or notch of :func:`_candidates` (the formulas
     of :func:`ambseal.design.pid.filter_matrices`): a lead's at f_c·√α, a lag's at
     f_c/√α, a notch's at f_c (its width is below twice its centre: complex poles of
@@ -209,11 +209,11 @@ def flexible_mode_filters(plants, pid_matrices, fs: float, delay: int, floor: fl
         need, collocated = _needed_phase(sampled[k0][1], pid_matrices(filters), f0, fs, delay)
         cands = _candidates(float(np.sqrt(lo * hi)), lo, hi, need)
         # a filter the target cannot run is no candidate: the PID must run at f_s
-        runs = [c for c in cands if pole_hz(c) <= fs / 2]
+        runs = [c for c in cands if _pole_hz(c) <= fs / 2]
         judged = [(c, judge(filters + [c])) for c in runs]
         # a filter for a flexible mode must not take the rigid-body modes' damping
         judged = [(c, r) for c, r in judged if rigid(r) >= rigid(rows) - RIGID_COST]
-        left = tuple(c for c in cands if pole_hz(c) > fs / 2)
+        left = tuple(c for c in cands if _pole_hz(c) > fs / 2)
         return ModeFilter(f0, (lo, hi), z0, z0, collocated, need, None, left, fs / 2), judged
 
     def mode_after(m, c, r):

@@ -274,10 +274,10 @@ def main(argv=None) -> int:
         return 0
     cases = [{"text": t, "draw": d} for t, d in rigs]
     log(f"{len(cases)} rigs")
-    rows = run_cases(run_rig, cases, {"timeout": args.timeout}, workers=args.workers,
+    rows = run_cases(run_rig, cases, shared={"timeout": args.timeout}, workers=args.workers,
                      scheduler=args.scheduler, progress=False,
                      on_done=lambda i, r: print(json.dumps(r), flush=True))
-    rows = [r if isinstance(r, dict) else {"seed": cases[i]["draw"]["seed"], "error": str(r)}
+    rows = [r if isinstance(r, dict) else {"seed": cases[i]["draw"]["seed"], "error": r.error}
             for i, r in enumerate(rows)]
     print(json.dumps(summary(rows)), flush=True)
     return 0

@@ -67,6 +67,11 @@ and bounded (the bounds beside each key in the code, with their reasons).
     ``points`` (speeds of its gain table, default 16) and ``runout_um`` (the synchronous
     sensor runout of its check on the virtual facility, µm; default 1 % of the smallest
     air gap or backup clearance, else 5 µm).
+``[design] one_speed`` (bool, default false)
+    H∞ and μ designed at ``[operating] speed_rpm`` only. By default, on a rig with a speed
+    range, a design whose full-order loop loses the rotor at another judged speed is
+    designed again at each stability speed from standstill up, and the first that holds
+    every judged condition is kept (:func:`ambseal.design.recipes.design`).
 ``[design] tracked`` (bool, default false)
     ``ambseal run`` adds the ``tracked`` controller: scheduled on the first
     seal's k as tracked on line (:mod:`ambseal.design.seal_schedule`), judged at the
@@ -251,6 +256,7 @@ class Design(_Strict):
     mu: MuSpec = MuSpec()
     lpv: MethodSpec = MethodSpec()
     rejection: RejectionSpec = RejectionSpec()
+    one_speed: bool = False
     tracked: bool = False
 
     @model_validator(mode="after")

@@ -392,10 +392,17 @@ def design(
                       sp.synthesis_band_hz[1], max_order=1)
     steps: list[str] = []
     t0 = time.perf_counter()
-    r, check, n = _synthesise_enlarging(
-        cfg, method, p, w, unc, sp, states, None if omega is None else np.asarray(omega, float),
-        reduce_to, max_iter or sp.max_iter, sp.dk_order if dk_order is None else dk_order, dl,
-        enlarge, steps, progress)
+
+    def synthesise(c, into: list, m: str = method):
+        return _synthesise_enlarging(
+            c, m, p, w if m == method else sp.weights[m], unc, sp, states,
+            None if omega is None else np.asarray(omega, float), reduce_to,
+            max_iter or sp.max_iter, sp.dk_order if dk_order is None else dk_order, dl,
+            enlarge, into, progress)
+
+    r, check, n = synthesise(cfg, steps)
+    if not cfg.design.one_speed:
+        r, check, n = _over_speed(cfg, method, sp, (r, check, n), synthesise, steps, progress)
     if not check["stable"] and not allow_unstable:
         raise SynthesisError(_unstable_message(method, check, n, steps, _top_mode_hz(cfg, p, n),
                                                _lost_by(cfg, r.K, check, p),
@@ -487,6 +494,58 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
         # the design delivered, or refused, is judged at every condition
         check = full_order_check(cfg, r.K, conditions)
     return r, check, n
+
+
+def _over_speed(cfg, method: str, sp, first, synthesise, steps: list, progress):
+    """The design over the speed range: where ``first`` (synthesis, full-order check,
+    states), designed at the operating speed, loses the rotor at another judged speed, the
+    design at another of the specification's stability speeds; the first whose full-order
+    loop holds at every judged condition is kept and ``steps`` names its speed, else
+    ``first``. H∞ tries each stability speed in turn from standstill up (the gyroscopic
+    moments change the plant monotonically with speed, so the loss moves with the design
+    speed); μ, whose D–K steps cost a hundred H∞ designs, is designed once more, at the
+    speed that search finds for H∞ (``synthesise(cfg, steps, "hinf")``), where there is
+    one. Measured on the seeded gyroscopic family (benchmarks/README.md, bench_family.py):
+    a design at the top speed leans on the gyroscopic stiffening of the conical mode and
+    loses it at standstill, one at standstill can lose the nutation or a bending mode at
+    the top speed, and one between may hold both. ``[design] one_speed`` turns it off."""
+    r, check, n = first
+    f0 = cfg.operating.speed_rpm / 60.0
+    if check["stable"] or cfg.operating.speed_range_hz is None \
+            or abs(check["speed_hz"] - f0) <= 1e-9 * max(f0, 1.0):
+        return first
+    speeds = [f for f in sorted(set(sp.stability_speeds_hz))
+              if abs(f - f0) > 1e-9 * max(f0, 1.0)]
+    if method != "hinf":
+        found = _first_held(cfg, speeds, lambda c: synthesise(c, [], "hinf"))
+        speeds = [] if found is None else [found[0]]
+    found = _first_held(cfg, speeds, lambda c: synthesise(c, []))
+    if found is None:
+        return first
+    f, out = found
+    steps.append(f"{method}: designed at {f:g} Hz, the first stability speed from standstill "
+                 f"whose {'H∞ ' if method != 'hinf' else ''}design holds every judged "
+                 f"condition; the design at the operating speed ({f0:g} Hz) lost the rotor "
+                 f"at {check['speed_hz']:g} Hz (mode at {check['mode_hz']:.4g} Hz, ζ = "
+                 f"{check['damping']:.3g})")
+    if progress:
+        progress(steps[-1])
+    return out
+
+
+def _first_held(cfg, speeds, synthesise):
+    """``(f, synthesise(rig at f Hz))`` for the first speed in ``speeds`` whose design's
+    full-order loop holds at every judged condition, or None."""
+    for f in speeds:
+        at = cfg.model_copy(update={"operating": cfg.operating.model_copy(
+            update={"speed_rpm": 60.0 * f})})
+        try:
+            out = synthesise(at)
+        except (SynthesisError, ModelError):  # no design at that speed: the next one
+            continue
+        if out[1]["stable"]:
+            return f, out
+    return None
 
 
 def _swept(cfg, conditions, n: int, f0: float, swept):

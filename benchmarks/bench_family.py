@@ -8,10 +8,13 @@ as a rig file from the manual's keys alone:
 * **the rotor**: a hollow steel shaft (bore 0.6 of its outside diameter) of length L, a
   wheel at 0.45 L carrying 60 % of the rotor's mass, a motor rotor at 0.7 L (10 %), and
   the two AMBs' laminations at 0.12 L and 0.88 L (5 % each); mass m from 5 to 30 kg,
-  L from 0.25 to 0.6 m, the wheel's radius of gyration about its axis 0.12–0.3 L;
+  L from 0.25 to 0.6 m;
 * **Ip/It** of the whole rotor about its centre of mass drawn from 0.5 to 1.5: the wheel's
   diametral inertia is solved for it (what the shaft, motor and laminations add is
-  subtracted), refused below a thin disc's Ip/2 (the draw is repeated);
+  subtracted), at least a thin disc's Ip/2. So the wheel's polar radius of gyration is
+  drawn from 1 to 1.5 times the least that reaches the drawn ratio with a thin disc
+  (what the rest of the rotor adds to I_t estimated as point masses), at least 0.1 L;
+  the draw is repeated where the shaft the bending frequency asks for adds more;
 * **the top speed** from 20 000 to 100 000 rpm, run from a third of it up
   (``speed_range_hz``); **the first free–free bending mode** from 1.2 to 3× the top
   speed: the shaft's outside diameter is bisected on ambseal's own free–free model
@@ -134,8 +137,13 @@ def family_rig(seed: int) -> tuple[str, dict]:
              "rate_hz": float(rng.choice(RATES_HZ)),
              "collocated": bool(rng.integers(2)),
              "air_gap_m": 5e-4, "bias_a": 2.5}
-        p["r_wheel_m"] = float(rng.uniform(0.12, 0.3)) * p["length_m"]
-        p["ip_wheel"] = 0.6 * p["mass_kg"] * p["r_wheel_m"] ** 2
+        # I_t of the motor and laminations about the wheel (point masses): what the wheel's
+        # Ip must outweigh, with Id = Ip/2, for Ip/It = q: Ip ≥ q·It_rest/(1 − q/2)
+        m, L, q = p["mass_kg"], p["length_m"], p["ip_over_it"]
+        rest = m * L**2 * (0.10 * 0.25**2 + 0.05 * (0.33**2 + 0.43**2))
+        least = math.sqrt(q * rest / (1 - q / 2) / (0.6 * m))
+        p["r_wheel_m"] = max(float(rng.uniform(1.0, 1.5)) * least, 0.1 * L)
+        p["ip_wheel"] = 0.6 * m * p["r_wheel_m"] ** 2
         omega = 2 * math.pi * p["top_rpm"] / 60
         share = p["mass_kg"] / 2 * (GRAVITY + GRADE_M_S * omega)
         p["ki"] = 3 * share / p["bias_a"]

@@ -1,5 +1,6 @@
-"""H∞ over the speed range on a gyroscopic rotor nobody tuned (seed 0 of
-``benchmarks/bench_family.py``'s family, ``tests/data/gyro_family_seed0.toml``): designed at
+"""H∞ over the speed range on a gyroscopic rotor nobody tuned, of the class
+``benchmarks/bench_family.py`` generates (``tests/data/gyro_wheel_rig.toml``, Ip/It
+0.54): designed at
 the top speed it leans on the gyroscopic stiffening of its conical mode and loses it at
 standstill; the rule (:func:`ambseal.design.recipes.design`) designs it again from
 standstill up and keeps the first design that holds every judged speed."""
@@ -16,7 +17,7 @@ from ambseal.config import load_rig
 from ambseal.design import design, design_spec
 from ambseal.model import build_plant
 
-FAMILY_RIG = Path(__file__).resolve().parents[1] / "data" / "gyro_family_seed0.toml"
+FAMILY_RIG = Path(__file__).resolve().parents[1] / "data" / "gyro_wheel_rig.toml"
 
 
 def _held_as_it_runs(cfg, K, speeds_hz) -> list[bool]:

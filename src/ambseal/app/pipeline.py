@@ -695,7 +695,7 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
         # rejection, switched on by the run (Herzog, Bühler, Gähler & Larsonneur 1996)
         # and said so in its verdict
         # (a notch at the rotational frequency needs a rotor that turns)
-        turns = max(cfg.operating.speed_rpm / 60.0, *(cfg.operating.speed_range_hz or ())) > 0
+        turns = max((cfg.operating.speed_rpm / 60.0, *(cfg.operating.speed_range_hz or ()))) > 0
         automatic = {m for m, entries in currents.items() if turns
                      and m not in st.failed and saturates(capacity_block(cfg, entries))}
         notches = _notches(st, automatic) if automatic else {}

@@ -174,7 +174,8 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Amb.backup_clearance": ("m", "radial clearance of the backup bearing beside the AMB; "
                                   "the report sets the unbalance orbit against it. On a "
                                   "rig with ``[[touchdown]]`` bearings it is refused: "
-                                  "the nearest one's ``radial_clearance`` is the gap"),
+                                  "the nearest one's ``radial_clearance`` is the gap. "
+                                  "Below every AMB's ``air_gap`` and ``sensor_gap``"),
     "Amb.sensor_gap": ("m", "the displacement probe's radial gap to its target, judged "
                             "by ``ambseal drop`` (left out: not judged)"),
     "Amb.uncertainty": ("", "``{ key = σ }``: relative 1σ uncertainty of a value the fit "
@@ -319,10 +320,13 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                                        "or the overhung stages in proportion to their q_A "
                                        "(API 617); ROSS 3.1's ``run_level1`` takes the "
                                        "node nearest mid-span"),
-    "Touchdown.name": ("", "the touchdown bearing's name"),
-    "Touchdown.position": ("m", "axial position of its plane"),
+    "Touchdown.name": ("", "the touchdown bearing's name, its own (it names the bearing's "
+                           "results)"),
+    "Touchdown.position": ("m", "axial position of its plane, each bearing's its own"),
     "Touchdown.radial_clearance": ("m", "radial clearance between the journal and the "
-                                        "ring (ISO 14839-5's C_min is the smallest)"),
+                                        "ring (ISO 14839-5's C_min is the smallest); "
+                                        "below every AMB's ``air_gap`` and "
+                                        "``sensor_gap``"),
     "Touchdown.axial_clearance": ("m", "axial clearance, where the bearing also takes "
                                        "thrust (left out: radial only)"),
     "Touchdown.kind": ("", "``deep_groove``, ``angular_contact_pair``, "
@@ -347,12 +351,15 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Touchdown.friction": ("", "Coulomb friction coefficient μ of the journal on the ring "
                                "(required)"),
     "Touchdown.friction_velocity": ("m/s", "slip speed of the regularised Coulomb law "
-                                           "μN·tanh(v/v_r)"),
+                                           "μN·tanh(v/v_r); at least 1e-4, the slip the "
+                                           "drop's stiff integrator resolves (its "
+                                           "finite-difference Jacobian steps √ε of a "
+                                           "surface speed)"),
     "Touchdown.race_inertia": ("kg·m²", "the ring's (inner race's) polar inertia; left "
                                         "out, the ring does not turn (a sleeve)"),
     "Touchdown.race_drag_torque": ("N·m", "the drag torque resisting the ring's spin"),
     "Touchdown.support_stiffness": ("N/m", "the bearing's support stiffness (left out: "
-                                           "rigid)"),
+                                           "rigid); needs ``support_mass``"),
     "Touchdown.support_damping": ("N·s/m", "the support's damping"),
     "Touchdown.support_mass": ("kg", "the support's moving mass (needs a stiffness)"),
     "Touchdown.static_rating": ("N", "the bearing's basic static load rating C₀ (ISO 76); "
@@ -393,7 +400,8 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                                       "speed, the top of ``speed_range_hz`` or the "
                                       "operating speed): the worst unbalance orbit is "
                                       "judged up to it from standstill"),
-    "Operating.speed_rpm": ("rpm", "operating speed"),
+    "Operating.speed_rpm": ("rpm", "operating speed; negative, the rotor turns the other "
+                                   "way (about −z)"),
     "Operating.pressure_bar": ("bar", "nominal pressure drop across the seals"),
     "Operating.speed_range_hz": ("Hz", "``[low, high]`` operating speed range: schedules "
                                        "the LPV controller and sets the unbalance band; it "
@@ -439,6 +447,11 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "RejectionSpec.runout_um": ("µm", "the synchronous sensor runout of its check on the "
                                       "virtual facility (default 1 % of the smallest air "
                                       "gap or backup clearance, else 5 µm)"),
+    "Design.one_speed": ("", "H∞ and μ designed at the operating speed alone (default "
+                             "false: on a rig with a speed range, a design that loses the "
+                             "rotor at another judged speed is designed again from "
+                             "standstill up, the first that holds every judged condition "
+                             "kept)"),
     "Design.tracked": ("", "``ambseal run`` adds the controller scheduled on the tracked "
                            "seal k (LMI synthesis: minutes)"),
     "UnbalanceSpec.grade_mm_s": ("mm/s", "ISO 21940-11 balance grade G"),

@@ -21,7 +21,9 @@ from ambseal.config._checks import (
                                     MAX_PRESSURE_BAR,
                                     MAX_SPEED_HZ,
                                     MAX_SUPPORT_STIFFNESS,
+                                    MIN_FRICTION_VELOCITY,
                                     check_coil,
+                                    node_tolerance,
 )
 from ambseal.config.methods import METHODS, Method, method, method_label, method_names
 from ambseal.config.rig import (
@@ -62,6 +64,7 @@ __all__ = ["MAX_AMBS", "MAX_COEFFICIENT", "MAX_COMPONENTS", "MAX_CURRENT_A", "MA
            "Machine", "Pid", "PidFilter", "RigConfig", "Seal", "Signoff", "Spring", "Stage",
            "Touchdown",
            "TruthSection", "apply_overrides",
-           "check_coil", "check_operating", "default_rig_path", "dump_rig", "load_rig",
+           "MIN_FRICTION_VELOCITY", "check_coil", "check_operating", "node_tolerance",
+           "default_rig_path", "dump_rig", "load_rig",
            "load_truth",
            "parse_rig", "rig_parameter_names", "rig_with_values", "toml_string"]

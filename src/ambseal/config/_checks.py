@@ -16,7 +16,8 @@ from ambseal.robust import MAX_DELAY_SAMPLES
 __all__ = ["MIN_CURRENT_A", "MIN_TIME_CONSTANT_S", "MAX_ELEMENTS", "MAX_COMPONENTS", "MAX_AMBS", "MAX_LAYERS", "MAX_REDUCED_STATES", "MAX_COEFFICIENT",
            "MAX_FREQUENCY_HZ", "MAX_SPEED_HZ", "MAX_PRESSURE_BAR", "MAX_CURRENT_A", "MAX_GAP_M",
            "MAX_DELAY_SAMPLES", "MAX_PID_FILTERS", "MAX_RELATIVE", "BoundedCoefficient",
-           "BoundedFrequency", "check_amb", "check_actuator", "cross_check", "Name", "Label"]
+           "BoundedFrequency", "check_amb", "check_actuator", "cross_check", "Name", "Label",
+           "MIN_FRICTION_VELOCITY", "node_tolerance"]
 
 #: Names of AMBs, seals, springs and materials make parameter, signal and C names
 #: (``A.Ki_zeta``, ``y_A_zeta``; :data:`ambseal.errors.NAME_PATTERN`), checked once here.
@@ -87,10 +88,41 @@ MAX_SUPPORT_STIFFNESS = 1e17
 #: mode above 0.3 Hz: far beyond structural damping (ζ ~ 1e-3 … 1e-2).
 MAX_RAYLEIGH_ALPHA = 1e4
 MAX_RAYLEIGH_BETA = 1.0
+#: The least regularisation speed v_r (m/s) of a touchdown bearing's friction μN·tanh(v/v_r)
+#: the drop can integrate. Where the journal sticks to a ring, the friction's slope μN/v_r
+#: sets the stiff part of the drop, which its stiff integrator (LSODA) follows by a
+#: Jacobian of finite differences, each a step of √ε ≈ 1.5e-8 of the speed it perturbs:
+#: of a journal's surface speed, up to some hundred m/s (DN 3e6 mm·rpm, a rolling
+#: bearing's limit, is 157 m/s), 1e-6 to 1e-5 m/s of slip, which must stay well below v_r
+#: for the Jacobian to see the slope. Measured, a 0.1 s drop of examples/flywheel.toml
+#: (173 m/s) rolling on its rings: v_r = 1e-3 m/s (the default) 8–23 s, 1e-4 11 s, 1e-5
+#: 19 s, 1e-6 not done in eight minutes; the test rig's 20 ms drop at standstill fails at
+#: 1e-10. 1e-4 m/s keeps ten times √ε of a 600 m/s surface, and loses nothing of Coulomb's
+#: law: a slip below 0.1 mm/s moves the surfaces 0.1 mm in a second.
+MIN_FRICTION_VELOCITY = 1e-4
 #: A coefficient of a table against frequency, bounded like a number or the affine form.
 BoundedCoefficient = Annotated[float, Field(ge=-MAX_COEFFICIENT, le=MAX_COEFFICIENT)]
 #: A frequency of a table (Hz); negative for backward whirl excitation.
 BoundedFrequency = Annotated[float, Field(ge=-MAX_FREQUENCY_HZ, le=MAX_FREQUENCY_HZ)]
+
+
+def node_tolerance(length: float) -> float:
+    """The distance within which two positions on a shaft share one node of its mesh.
+
+    :func:`ambseal.model.build_mesh` puts a component this close to a node on it, and the
+    rig file refuses two touchdown planes this close (one ring per node).
+
+    Parameters
+    ----------
+    length : float
+        The shaft's length (m).
+
+    Returns
+    -------
+    float
+        1e-6 of the length, at least 1e-6 m.
+    """
+    return 1e-6 * max(length, 1.0)
 
 
 def check_amb(self):  # noqa: N805 (the Amb being validated)
@@ -267,3 +299,43 @@ def cross_check(cfg, where: str) -> None:
                               "bearings give the backup clearance (their radial_clearance); "
                               "give it there only")
         names.add(a.name)
+    _check_touchdowns(cfg, where)
+
+
+def _check_touchdowns(cfg, where: str) -> None:
+    """The touchdown bearings among themselves and against the AMBs (ConfigError naming the
+    keys): distinct names (each names its bearing's results, ``TA_peak_force_n``),
+    distinct planes (two rings on one node would share its motion, and the drop one
+    contact onset between them), and every backup clearance — a ``[[touchdown]]``
+    ``radial_clearance``, an ``[[amb]]`` ``backup_clearance`` — below every AMB's
+    ``air_gap`` and ``sensor_gap``: the backup bearing must catch the rotor before its
+    stator or a probe does. (A seal's, a spring's or a disk's clearance is judged by the
+    drop, at the rotor's excursion there: a labyrinth may be rubbed on purpose.)"""
+    tol = node_tolerance(cfg.length)
+    for i, td in enumerate(cfg.touchdown):
+        for j, other in enumerate(cfg.touchdown[:i]):
+            if td.name == other.name:
+                raise ConfigError(f"{where}: touchdown[{i}].name: duplicate touchdown name "
+                                  f"{td.name!r}, the name of touchdown[{j}] (each names its "
+                                  f"bearing's results, e.g. {td.name}_peak_force_n)")
+            if abs(td.position - other.position) <= tol:
+                raise ConfigError(
+                    f"{where}: touchdown[{i}].position: {td.position:g} m, the plane of "
+                    f"touchdown[{j}] ({other.name!r}): two rings at one axial position "
+                    f"(expected positions more than {tol:g} m apart; a double-row bearing "
+                    "is one [[touchdown]] whose contact_length or contact_stiffness holds "
+                    "both rows)")
+    backups = [(f"touchdown[{i}].radial_clearance", td.radial_clearance)
+               for i, td in enumerate(cfg.touchdown)]
+    backups += [(f"amb[{k}].backup_clearance", a.backup_clearance)
+                for k, a in enumerate(cfg.amb) if a.backup_clearance is not None]
+    gaps = [(f"amb[{k}].{key}", getattr(a, key), what) for k, a in enumerate(cfg.amb)
+            for key, what in (("air_gap", "AMB's stator"), ("sensor_gap", "probe"))
+            if getattr(a, key) is not None]
+    for key, c in backups:
+        for gap_key, gap, what in gaps:
+            if c >= gap:
+                raise ConfigError(
+                    f"{where}: {key}: {c:g} m, not below {gap_key} {gap:g} m: a falling "
+                    f"rotor would touch the {what} before its backup bearing (expected "
+                    "every backup clearance below every AMB's air_gap and sensor_gap)")

@@ -139,6 +139,7 @@ from ambseal.config._checks import (
     MAX_RELATIVE,
     MAX_SUPPORT_STIFFNESS,
     MIN_CURRENT_A,
+    MIN_FRICTION_VELOCITY,
     MIN_TIME_CONSTANT_S,
     BoundedCoefficient,
     BoundedFrequency,
@@ -503,17 +504,22 @@ class Touchdown(_Strict):
     geometry — a point contact's effective radius ``contact_radius`` (m) with ``E`` and
     ``nu`` of both bodies, a line contact's ``contact_length`` (m; Palmgren's relation,
     bearing steel); the contact damping by ``damping_law`` at the coefficient of
-    ``restitution``; regularised Coulomb ``friction`` with ``friction_velocity`` (m/s);
-    the ring's ``race_inertia`` (kg·m²) and ``race_drag_torque`` (N·m); the support's
-    ``support_stiffness`` (N/m; left out, rigid), ``support_damping`` (N·s/m) and
-    ``support_mass`` (kg); the bearing's basic ``static_rating`` C₀ (N, ISO 76) the drop's
+    ``restitution``; regularised Coulomb ``friction`` with ``friction_velocity`` (m/s, at
+    least :data:`~ambseal.config._checks.MIN_FRICTION_VELOCITY`: the slip the drop's
+    stiff integrator resolves); the ring's ``race_inertia`` (kg·m²) and
+    ``race_drag_torque`` (N·m); the support's ``support_stiffness`` (N/m; left out,
+    rigid) with its ``support_mass`` (kg, required with it) and ``support_damping``
+    (N·s/m); the bearing's basic ``static_rating`` C₀ (N, ISO 76) the drop's
     peak force is graded against, as the static equivalent load of the peak radial and
     axial forces with ``static_factors`` (X₀, Y₀; ``STATIC_FACTORS``). Where an
     ``axial_clearance`` (m) is given the bearing also stops the rotor axially, with the
     radial law's K or ``axial_contact_stiffness``. With ``race_mass`` (kg) the friction
     heat of the drop is reported as the ring's temperature rise at
     ``race_specific_heat``. ``restitution`` and ``friction`` have no default: no
-    public source gives one for every pair of surfaces."""
+    public source gives one for every pair of surfaces. Across the rig
+    (:func:`~ambseal.config._checks.cross_check`): each bearing's ``name`` its own, each
+    its own plane, and every ``radial_clearance`` below every AMB's ``air_gap`` and
+    ``sensor_gap``."""
 
     name: Name
     position: float = Field(ge=0)
@@ -533,8 +539,9 @@ class Touchdown(_Strict):
     restitution: float = Field(gt=0, le=1.0)
     friction: float = Field(ge=0, le=2.0)
     # the slip speed below which friction grows in proportion to it (the regularisation):
-    # small against a landing rotor's surface speed, tens of m/s
-    friction_velocity: float = Field(default=1e-3, gt=0, le=10.0)
+    # small against a landing rotor's surface speed, tens of m/s; at least what the drop's
+    # stiff integrator resolves (MIN_FRICTION_VELOCITY, with its measurements)
+    friction_velocity: float = Field(default=1e-3, ge=MIN_FRICTION_VELOCITY, le=10.0)
     race_inertia: float | None = Field(default=None, gt=0, le=1e3)
     race_drag_torque: float = Field(default=0.0, ge=0, le=1e5)
     support_stiffness: float | None = Field(default=None, gt=0, le=1e13)
@@ -573,6 +580,12 @@ class Touchdown(_Strict):
         if self.support_mass > 0 and self.support_stiffness is None:
             raise ValueError("support_mass: a rigid support (no support_stiffness) moves "
                              "no mass; give support_stiffness or leave support_mass out")
+        if self.support_stiffness is not None and self.support_mass == 0:
+            # the ring on its spring is a body of its own in the drop: without a mass its
+            # motion would have no inertia to integrate
+            raise ValueError("support_stiffness: a flexible support needs its moving mass: "
+                             "give support_mass (kg), or leave support_stiffness out for a "
+                             "rigid support")
         if self.axial_contact_stiffness is not None and self.axial_clearance is None:
             raise ValueError("axial_contact_stiffness: the axial contact needs the "
                              "axial_clearance (m) at which it closes")

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
-from ambseal.config import MAX_ELEMENTS, RigConfig
+from ambseal.config import MAX_ELEMENTS, RigConfig, node_tolerance
 from ambseal.errors import ConfigError, ModelError
 from ambseal.lti import ArrayMemo
 from ambseal.model.fe import BeamElement, CouplingElement, DiskElement, LayeredBeam
@@ -70,8 +70,10 @@ class Mesh:
 
 
 def _snap(length: float) -> float:
-    """Tolerance (m) within which a component is put on an existing node."""
-    return 1e-6 * max(length, 1.0)
+    """Tolerance (m) within which a component is put on an existing node (the rig file's
+    rule, :func:`ambseal.config.node_tolerance`, by which two touchdown planes on one node
+    are refused)."""
+    return node_tolerance(length)
 
 
 def _piece(tube, a: float, b: float) -> dict:

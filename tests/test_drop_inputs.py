@@ -1,0 +1,128 @@
+"""Every input of ``ambseal drop`` answered: the ``[[touchdown]]`` tables, the speed, the
+seal surge and the Monte-Carlo ranges are refused in one line naming what the user wrote
+(exit 2), by the one rule of their rig-file key, or dropped to the right result.
+
+The rig is the rigid rotor of test_cli_drop (two AMBs with a 0.5 mm air gap, rings with a
+0.2 mm clearance at both ends of a 100 mm shaft, 20 mm line contacts)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+from ambseal.analysis.drop_monte_carlo import drop_run
+from ambseal.cli import main
+from ambseal.config import load_rig
+from ambseal.errors import ConfigError
+
+from .test_cli_drop import _rig_text
+from .test_fuzz import _deadline
+
+
+def _rig(tmp_path, text: str, name: str = "rig.toml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def _refused(capsys, args, *expect: str) -> str:
+    """``main(args)`` (quiet: no progress lines) exits 2 with one line on stderr holding
+    each of ``expect``."""
+    capsys.readouterr()
+    try:
+        code = main(["--quiet", *map(str, args)])
+    except SystemExit as exc:  # argparse
+        code = exc.code
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(lines) == 1, lines
+    for part in expect:
+        assert part in lines[0], lines[0]
+    return lines[0]
+
+
+def _drop(capsys, rig, *extra) -> dict:
+    capsys.readouterr()
+    code = main(["--quiet", "drop", str(rig), "--json", "--force", *map(str, extra)])
+    out = capsys.readouterr().out
+    assert code in (0, 1), out
+    return json.loads(out)
+
+
+def test_duplicate_touchdown_names_are_refused_when_the_rig_is_read(tmp_path, capsys):
+    """Two bearings named TA: each bearing's results are keyed by its name (the drop's
+    planes, drop_scatter.csv's TA_* columns, the largest peak force over them), so
+    ``validate``, a drop and Monte-Carlo drops refuse the rig, naming the key and the
+    name."""
+    rig = _rig(tmp_path, _rig_text().replace('name = "TB"', 'name = "TA"'))
+    for args in (["validate", rig], ["drop", rig, "--out", tmp_path / "d"],
+                 ["drop", rig, "--runs", "1", "--out", tmp_path / "d"]):
+        _refused(capsys, args, str(rig), "touchdown[1].name", "duplicate touchdown name 'TA'")
+
+
+def _sealed(per_bar: float) -> str:
+    """The rig with a seal at mid-span whose cross-coupled stiffness grows ``per_bar``
+    (N/m per bar) with the pressure drop, lightly damped."""
+    return _rig_text() + ('[[seal]]\nname = "mid"\nposition = 0.2\nclearance = 3.0e-4\n'
+                          f"k = {{ per_bar = {per_bar} }}\n"
+                          "C = { at_zero = 100.0, per_bar = 50.0 }\n")
+
+
+def test_a_friction_velocity_below_what_the_drop_resolves_is_refused(tmp_path, capsys):
+    """``friction_velocity = 1e-15`` m/s lies below the slip the drop's stiff integrator
+    resolves (1e-4 m/s, its rule in the key's description): refused when the rig is read,
+    naming the key and the bound; 1e-4 is read."""
+    text = _rig_text().replace("friction = 0.1\n", "friction = 0.1\nfriction_velocity = {}\n",
+                               1)
+    rig = _rig(tmp_path, text.format("1.0e-15"))
+    _refused(capsys, ["validate", rig], "touchdown[0].friction_velocity",
+             "expected a value >= 0.0001, got 1e-15")
+    assert load_rig(_rig(tmp_path, text.format("1.0e-4"), "ok.toml")).touchdown[
+        0].friction_velocity == 1e-4
+
+
+def test_two_rings_at_one_axial_position_are_refused(tmp_path, capsys):
+    """Two planes at z = 0 share one node: the drop took one contact onset for both and
+    read one plane's first impact as 0 N beside its 931 N peak. Refused when the rig is
+    read, naming the second plane's position and the first's name."""
+    rig = _rig(tmp_path, _rig_text().replace("position = 0.4\nradial", "position = 0.0\n"
+                                                                       "radial"))
+    for args in (["validate", rig], ["drop", rig, "--out", tmp_path / "d"]):
+        _refused(capsys, args, "touchdown[1].position", "the plane of touchdown[0] ('TA')",
+                 "two rings at one axial position")
+
+
+def test_a_flexible_support_without_its_mass_is_refused_when_the_rig_is_read(tmp_path,
+                                                                             capsys):
+    """``support_stiffness`` without ``support_mass``: ``validate`` called it valid and
+    the drop refused it; now one rule refuses it when the rig is read, for every
+    command."""
+    rig = _rig(tmp_path, _rig_text().replace("race_inertia = 1.0e-4\n",
+                                             "race_inertia = 1.0e-4\nsupport_stiffness = "
+                                             "1.0e7\n", 1))
+    for args in (["validate", rig], ["drop", rig, "--out", tmp_path / "d"]):
+        _refused(capsys, args, "touchdown[0]", "support_stiffness", "give support_mass")
+
+
+def test_the_backup_clearance_lies_inside_the_air_gap_and_the_probe_gap(tmp_path, capsys):
+    """A ring 0.6 mm from the journal beside a 0.5 mm air gap lets the rotor hit the
+    stator first: refused when the rig is read, naming both keys; a probe gap of 0.15 mm
+    inside the rings' 0.2 mm alike; and an AMB's own ``backup_clearance`` on a rig
+    without rings. 0.2 mm inside 0.5 mm is read."""
+    cases = [(_rig_text().replace("radial_clearance = 2.0e-4", "radial_clearance = 6.0e-4"),
+              "touchdown[0].radial_clearance: 0.0006 m, not below amb[0].air_gap 0.0005 m",
+              "AMB's stator"),
+             (_rig_text().replace("air_gap = 5.0e-4", "air_gap = 5.0e-4\nsensor_gap = 1.5e-4"),
+              "touchdown[0].radial_clearance: 0.0002 m, not below amb[0].sensor_gap "
+              "0.00015 m", "probe"),
+             (_rig_text(touchdown=False).replace("air_gap = 5.0e-4",
+                                                 "air_gap = 5.0e-4\nbackup_clearance = "
+                                                 "5.0e-4"),
+              "amb[0].backup_clearance: 0.0005 m, not below amb[0].air_gap 0.0005 m",
+              "AMB's stator")]
+    for k, (text, key, what) in enumerate(cases):
+        rig = _rig(tmp_path, text, f"rig{k}.toml")
+        _refused(capsys, ["validate", rig], str(rig), key, what)
+    assert load_rig(_rig(tmp_path, _rig_text(), "ok.toml")).touchdown[0].radial_clearance \
+        == 2e-4

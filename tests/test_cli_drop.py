@@ -280,7 +280,8 @@ def test_a_seal_surge_lands_a_rotor_its_loop_held(tmp_path, capsys):
     bar) with it to 6e6 N/m, fifteen times what the reference PID's damping holds at the
     rigid forward whirl (its loop's pole then grows at 204/s): the loop that held the
     rotor in its orbit no longer does, and the rotor lands; at 0 bar, with a 1 N step
-    only, it stays clear. A negative surge is refused (exit 2)."""
+    only, it stays clear. A negative surge is refused by the rule of ``[operating]
+    pressure_bar`` (exit 2)."""
     rig = tmp_path / "rig.toml"
     rig.write_text(_rig_text() + f'[[seal]]\nname = "mid"\nposition = {L / 2}\n'
                    "clearance = 3.0e-4\nk = { per_bar = 2.0e3 }\n")
@@ -296,7 +297,8 @@ def test_a_seal_surge_lands_a_rotor_its_loop_held(tmp_path, capsys):
     assert peaks["--surge-bar"] > 0 and peaks["--overload-n"] == 0
     assert main(["--quiet", "drop", str(rig), "--event", "overload", "--surge-bar", "-1",
                  "--out", str(tmp_path / "x")]) == 2
-    assert "--surge-bar: expected a pressure drop" in capsys.readouterr().err
+    assert ("--surge-bar: expected a value >= 0.0, got -1.0 (the rule of [operating] "
+            "pressure_bar") in capsys.readouterr().err
 
 
 def test_the_thrust_drives_the_rotor_onto_its_axial_stop(tmp_path, capsys):

@@ -69,6 +69,30 @@ def _sealed(per_bar: float) -> str:
                           "C = { at_zero = 100.0, per_bar = 50.0 }\n")
 
 
+def test_a_seal_surge_is_bounded_as_the_pressure_and_ends_where_the_rings_crush(
+        tmp_path, capsys):
+    """``--surge-bar`` is a pressure drop of the seals: 1e5 bar is refused by the rule of
+    ``[operating] pressure_bar`` (<= 1e4), naming ``--surge-bar``, as ``--pressure-bar
+    1e5`` is. Within it, a seal surging to 1e4 bar (k = 1e10 N/m) drives a whirl into
+    the rings that would crush them: the drop ends in seconds where a ring is pressed 1 %
+    of the journal's 50 mm radius deep, under the force of Palmgren's line contact there
+    (δ = 3.84e-5 Q^0.9 / l^0.8 in mm and N: Q for δ = 0.5 mm on l = 10 mm); it had
+    crawled through the contact for minutes."""
+    rig = _rig(tmp_path, _sealed(1.0e6))
+    for flag in ("--surge-bar", "--pressure-bar"):
+        extra = ["--event", "overload", flag, "1e5"] if flag == "--surge-bar" else [
+            flag, "1e5"]
+        _refused(capsys, ["drop", rig, "--duration-s", "0.01", "--out", tmp_path / "d",
+                          *extra], flag, "expected a value <= 10000.0, got 100000.0",
+                 "[operating] pressure_bar")
+    force = (0.5 * 10.0 ** 0.8 / 3.84e-5) ** (1 / 0.9)
+    with _deadline(60.0):
+        _refused(capsys, ["drop", rig, "--event", "overload", "--surge-bar", "1e4",
+                          "--duration-s", "0.05", "--out", tmp_path / "d"],
+                 "pressed 500 µm into the ring of T", "(1 % of its 50 mm radius)",
+                 f"under {force:.3g} N")
+
+
 def test_a_friction_velocity_below_what_the_drop_resolves_is_refused(tmp_path, capsys):
     """``friction_velocity = 1e-15`` m/s lies below the slip the drop's stiff integrator
     resolves (1e-4 m/s, its rule in the key's description): refused when the rig is read,

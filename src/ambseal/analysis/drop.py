@@ -52,7 +52,14 @@ until it crawls: a ring rolling on the journal without slip meets the friction's
 regularised slope μN/v_r on the ring's small inertia, a time constant of nanoseconds, and
 where a segment advances less than one period of the highest mode kept per
 :data:`CYCLE_EVALUATIONS` evaluations (judged past :data:`CRAWL_EVALUATIONS`) the drop
-goes on with LSODA, which switches to its stiff method there. On the expander-generator
+goes on with LSODA, which switches to its stiff method there. A plane pressed deeper
+than :data:`CRUSHED` (1 %) of its journal's radius (radially, or axially on a stop) ends
+the drop with a refusal: the contact laws are those of a contact small against the
+bodies (a drop presses a few micrometres), and a load that crushes the rings — a seal
+surge of thousands of bar, say, whose cross-coupled stiffness drives a whirl growing at
+thousands per second into the rings with meganewtons — has no answer in them (and such a
+contact's friction makes the drop crawl even with LSODA: the test rig's seal surging to
+1e4 bar had not dropped 10 ms in 200 s). On the expander-generator
 example DOP853 takes a 1 s drop in 40 s and LSODA in 190 s; on the flywheel rolling
 on its rings DOP853 does not finish 0.1 s in ten minutes and LSODA takes 11 s
 (benchmarks/README.md). The switch counts evaluations, not time: the same drop switches
@@ -111,6 +118,12 @@ CRAWL_EVALUATIONS = 20_000
 CYCLE_EVALUATIONS = 1000
 #: the points in each integrator step at which the peak force and penetration are read
 PEAK_POINTS = 8
+#: the penetration, as a fraction of the journal's radius, that ends a drop with a
+#: refusal (module docstring): Hertz's and Palmgren's laws are those of a contact small
+#: against the bodies' radii (Johnson, Contact Mechanics, 1985, §4.2: the half-space
+#: premise), and a penetration δ = a²/R of 1 % of the radius is a contact a tenth as wide
+#: as the radius, where the premise ends (steel yields far earlier: ISO 76's C₀)
+CRUSHED = 0.01
 
 
 def journal_radius(cfg, z: float) -> float:
@@ -718,7 +731,8 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         or ``loop_state`` of the wrong shape or not finite; a negative or non-finite
         unbalance; a ``failed`` channel the rig does not have, or axes left running
         without a controller; an overload off the rotor or not finite; a thrust not
-        finite.
+        finite; a plane pressed deeper than :data:`CRUSHED` of its journal's radius
+        (module docstring).
     """
     if not (duration_s > 0 and math.isfinite(duration_s)):
         raise ConfigError(f"drop: duration: expected > 0 s, got {duration_s!r}")
@@ -996,23 +1010,40 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
 
     def events(touching):
         """Each plane's radial contact onset or end, then each axial stop's (touching:
-        the radial planes' flags, then the stops')."""
+        the radial planes' flags, then the stops'), then each plane's and stop's
+        penetration reaching CRUSHED of its journal's radius (the drop's end)."""
         evs = []
-        for p in range(P):
-            def g(t, y, p=p):
-                eta, _, _, s, _ = unpack(y)
-                r = dm.planes[p] @ eta - s[p]
-                return math.hypot(r[0], r[1]) - dm.clearance[p]
-            g.terminal = True
-            g.direction = -1.0 if touching[p] else 1.0
-            evs.append(g)
-        for k, p in enumerate(stops if axial else ()):
-            def g(t, y, p=p):
-                return abs(y[i_ax]) - c_ax[p]
-            g.terminal = True
-            g.direction = -1.0 if touching[P + k] else 1.0
-            evs.append(g)
+        for deep in (0.0, CRUSHED):
+            for p in range(P):
+                def g(t, y, p=p, deep=deep):
+                    eta, _, _, s, _ = unpack(y)
+                    r = dm.planes[p] @ eta - s[p]
+                    return math.hypot(r[0], r[1]) - dm.clearance[p] - deep * dm.journal[p]
+                g.terminal = True
+                g.direction = -1.0 if not deep and touching[p] else 1.0
+                evs.append(g)
+            for k, p in enumerate(stops if axial else ()):
+                def g(t, y, p=p, deep=deep):
+                    return abs(y[i_ax]) - c_ax[p] - deep * dm.journal[p]
+                g.terminal = True
+                g.direction = -1.0 if not deep and touching[P + k] else 1.0
+                evs.append(g)
         return evs
+
+    def crushed(t: float, k: int) -> ConfigError:
+        """The refusal of a drop whose plane (radial k < P, else the k − P-th axial stop)
+        was pressed :data:`CRUSHED` × its journal's radius deep at t."""
+        p, law, how = ((k, dm.laws[k], "") if k < P else
+                       (stops[k - P], dm.axial_laws[stops[k - P]], "axial "))
+        delta = CRUSHED * dm.journal[p]
+        return ConfigError(
+            f"drop: at t = {1e3 * t:.4g} ms the journal is pressed {1e6 * delta:.4g} µm "
+            f"into the {how}ring of {dm.names[p]} ({100 * CRUSHED:g} % of its "
+            f"{1e3 * dm.journal[p]:.4g} mm radius) under "
+            f"{law.stiffness * delta ** law.exponent:.3g} N, where the elastic contact "
+            "law ends (a contact a tenth as wide as the radius) and long after steel "
+            "yields: loads that crush the rings — a seal surge, an overload, the thrust — "
+            "leave no drop to simulate")
 
     y = np.zeros(n_y)
     y[:m] = dm.q0
@@ -1067,6 +1098,9 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         atol[2 * m + races.size + 4 * k:2 * m + races.size + 4 * k + 2] = rtol * c_min
     # a start in contact (an ``initial`` state on a ring) waits for the contact's end
     touching = [c[1] > 0 for c in contacts(0.0, y)] + [False] * (len(stops) if axial else 0)
+    for p, c in enumerate(contacts(0.0, y)):
+        if c[1] >= CRUSHED * dm.journal[p]:
+            raise crushed(0.0, p)
     ts, ys = [0.0], [y.copy()]
     peak_force, peak_delta, first_peak = np.zeros(P), np.zeros(P), np.zeros(P)
     peak_ax_force, peak_ax_delta = np.zeros(P), np.zeros(P)
@@ -1141,6 +1175,8 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
         segments += 1
         k = min(hit, key=lambda k: r.t_events[k][0])
         t0 = float(r.t_events[k][0])
+        if k >= len(touching):
+            raise crushed(t0, k - len(touching))
         y = r.y_events[k][0].copy()
         touching[k] = not touching[k]
         if k >= P:  # an axial stop

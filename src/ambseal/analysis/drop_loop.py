@@ -43,6 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ambseal.config import check_operating
 from ambseal.design import pid_controller, reference_pid
 from ambseal.errors import ConfigError
 from ambseal.lti import series_inputs
@@ -275,7 +276,8 @@ def drop_event(cfg, dm, loop: AmbLoop, event: str = "loss", axis: str | None = N
     overload_at : str, optional
         ``overload``: where it acts.
     surge_bar : float, optional
-        ``overload``: the seals' pressure drop (bar) from t = 0, ≥ 0.
+        ``overload``: the seals' pressure drop (bar) from t = 0, by the rule of
+        ``[operating] pressure_bar`` (:func:`ambseal.config.check_operating`).
 
     Returns
     -------
@@ -288,7 +290,8 @@ def drop_event(cfg, dm, loop: AmbLoop, event: str = "loss", axis: str | None = N
     ------
     ConfigError
         An unknown event, axis or place; an axis, force or surge given to an event that
-        takes none; an overload without a force or a surge, or with a negative surge.
+        takes none; an overload without a force or a surge, or with a surge the rule of
+        ``[operating] pressure_bar`` refuses.
     """
     if event not in EVENTS:
         raise ConfigError(f"drop: event: expected one of {', '.join(EVENTS)}, got {event!r}")
@@ -308,9 +311,8 @@ def drop_event(cfg, dm, loop: AmbLoop, event: str = "loss", axis: str | None = N
             raise ConfigError(f"--axis: expected one of {', '.join(loop.names)}, got {axis!r}")
         return {"failed": (axis,), "overload": None, "pressure_bar": None,
                 "summary": f"AMB axis {axis} loses power, the others run on"}
-    if surge_bar is not None and not (surge_bar >= 0 and np.isfinite(surge_bar)):
-        raise ConfigError(f"--surge-bar: expected a pressure drop (bar, >= 0), got "
-                          f"{surge_bar!r}")
+    if surge_bar is not None:  # a pressure drop of the seals: the rig file's rule of one
+        check_operating({"pressure_bar": surge_bar}, {"pressure_bar": "--surge-bar"})
     surge = ("" if surge_bar is None else
              f"the seals' pressure drop surging from {cfg.operating.pressure_bar:g} to "
              f"{surge_bar:g} bar")

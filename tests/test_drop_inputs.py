@@ -129,6 +129,53 @@ def test_a_flexible_support_without_its_mass_is_refused_when_the_rig_is_read(tmp
         _refused(capsys, args, "touchdown[0]", "support_stiffness", "give support_mass")
 
 
+def test_a_rotor_turning_the_other_way_drops_as_the_mirror_image(tmp_path, capsys):
+    """``[operating] speed_rpm = -3000`` turns the rotor about −z, as the rig file allows:
+    the drop is the mirror image (x → −x) of the drop at +3000 rpm — of a rig symmetric
+    under it: the same peak forces, regimes and whirl frequencies, the same coast-down
+    time, the rings' and the rotor's final speeds opposite (the mirror's reference is the
+    +3000 rpm drop itself). ``--at trip`` keeps the rig's sense (−3150 rpm); before, the
+    drop refused the rig naming ``--speed-rpm``, which the user never gave."""
+    docs = []
+    for rpm in ("3000.0", "-3000.0"):
+        rig = _rig(tmp_path, _rig_text().replace("speed_rpm = 3000.0", f"speed_rpm = {rpm}"),
+                   f"rig{rpm}.toml")
+        docs.append(_drop(capsys, rig, "--duration-s", "0.02", "--coast-down",
+                          "--drag-torque", "1", "--out", tmp_path / "d"))
+    fwd, rev = docs
+    assert rev["speed_rpm"] == -3000.0
+    for a, b in zip(fwd["planes"], rev["planes"]):
+        assert b["peak_force_n"] == pytest.approx(a["peak_force_n"], rel=1e-4)
+        assert b["regime"] == a["regime"]
+        assert b["whirl_hz"] == pytest.approx(a["whirl_hz"], rel=1e-4)
+        assert b["final_race_speed_rad_s"] == pytest.approx(-a["final_race_speed_rad_s"],
+                                                            rel=1e-4)
+    assert rev["final_speed_rad_s"] == pytest.approx(-fwd["final_speed_rad_s"], rel=1e-9)
+    assert fwd["coast_down_s"] > 0
+    assert rev["coast_down_s"] == pytest.approx(fwd["coast_down_s"], rel=1e-4)
+    trip = _drop(capsys, tmp_path / "rig-3000.0.toml", "--at", "trip", "--duration-s",
+                 "0.002", "--out", tmp_path / "d")
+    assert trip["speed_rpm"] == pytest.approx(-3150.0)
+
+
+def test_the_speed_in_hz_is_bounded_as_the_speed_in_rpm(tmp_path, capsys):
+    """``--speed-hz`` is ``[operating] speed_rpm``'s speed in other units: 50 000 Hz
+    (3e6 rpm) is refused as ``--speed-rpm 3000000`` is, and 200 000 Hz, each naming the
+    option given; −500 Hz turns the rotor the other way at 30 000 rpm."""
+    rig = _rig(tmp_path, _rig_text())
+    out = ["--out", tmp_path / "d", "--duration-s", "0.002"]
+    _refused(capsys, ["drop", rig, "--speed-rpm", "3000000", *out], "--speed-rpm",
+             "expected a value <= 1000000.0", "[operating] speed_rpm")
+    for hz, rpm in (("50000", "3e+06"), ("200000", "1.2e+07")):
+        line = _refused(capsys, ["drop", rig, "--speed-hz", hz, *out],
+                        f"--speed-hz {hz} (= {rpm} rpm)", "expected a value <= 1000000.0",
+                        "[operating] speed_rpm")
+        assert "--speed-rpm" not in line
+    doc = _drop(capsys, rig, "--speed-hz", "-500", *out)
+    assert doc["speed_rpm"] == -30000.0
+    assert doc["speed_rad_s"] == pytest.approx(-1000 * math.pi)
+
+
 def test_the_backup_clearance_lies_inside_the_air_gap_and_the_probe_gap(tmp_path, capsys):
     """A ring 0.6 mm from the journal beside a 0.5 mm air gap lets the rotor hit the
     stator first: refused when the rig is read, naming both keys; a probe gap of 0.15 mm

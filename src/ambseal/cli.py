@@ -425,11 +425,14 @@ def _rotordynamics_parsers(sub) -> None:
     dr.add_argument("rig", help="rig file (TOML) with its [[touchdown]] tables")
     dg = dr.add_mutually_exclusive_group()
     dg.add_argument("--speed-rpm", type=_finite, default=None,
-                    help="spin speed (rpm), held; default [operating] speed_rpm")
-    dg.add_argument("--speed-hz", type=_finite, default=None, help="spin speed (Hz), held")
+                    help="spin speed (rpm), held, negative turning the other way (as "
+                         "[operating] speed_rpm, its default)")
+    dg.add_argument("--speed-hz", type=_finite, default=None,
+                    help="spin speed (Hz), held; the rule of --speed-rpm")
     dg.add_argument("--at", choices=("standstill", "max-continuous", "trip"), default=None,
                     help="the spin speed by name: 0, the top of [operating] speed_range_hz "
-                         "(else speed_rpm), or trip_speed_hz (else 1.05 × that)")
+                         "(else speed_rpm), or trip_speed_hz (else 1.05 × that), in the "
+                         "sense of rotation of speed_rpm")
     dr.add_argument("--event", choices=("loss", "one-axis", "overload"), default="loss",
                     help="what lands the rotor: every AMB loses power (default), one axis "
                          "does (--axis) while the others run on, or an overload: a step "

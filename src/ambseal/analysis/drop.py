@@ -587,16 +587,20 @@ class DropResult:
         """The time (s) from the drop to standstill and whether it is extrapolated: when
         the spin reached zero in the drop, else the spin at the end over the mean
         deceleration of the drop's last half; (None, False) for a spin held by the
-        drive or not slowing."""
-        stopped = np.flatnonzero(self.spin <= 0)
-        if stopped.size and self.speed_rad_s > 0:
+        drive, not slowing, or a drop at standstill. A rotor turning the other way
+        (negative speed) slows towards zero from below alike."""
+        if self.speed_rad_s == 0:
+            return None, False
+        spin = np.sign(self.speed_rad_s) * self.spin  # in the sense the rotor turned
+        stopped = np.flatnonzero(spin <= 0)
+        if stopped.size:
             return float(self.t[stopped[0]]), False
         half = self.t >= 0.5 * self.t[-1]
         span = self.t[half][-1] - self.t[half][0]
-        rate = (self.spin[half][0] - self.spin[half][-1]) / span if span > 0 else 0.0
+        rate = (spin[half][0] - spin[half][-1]) / span if span > 0 else 0.0
         if rate <= 0:
             return None, False
-        return float(self.t[-1] + self.spin[-1] / rate), True
+        return float(self.t[-1] + spin[-1] / rate), True
 
     def to_dict(self) -> dict:
         """The summary an engineer judges, JSON-safe: per plane the peak force, the
@@ -662,7 +666,8 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
     cfg : RigConfig
         With ``[[amb]]`` and ``[[touchdown]]`` tables.
     speed_rpm : float, optional
-        Spin speed (rpm) at the drop: held by the drive, or the start of a coast-down.
+        Spin speed (rpm) at the drop: held by the drive, or the start of a coast-down;
+        negative, the rotor turns the other way (about −z), as ``[operating] speed_rpm``.
     duration_s : float, optional
         Simulated time after the AMBs let go (s), > 0.
     samples : int, optional

@@ -54,6 +54,7 @@ from ambseal.config import (
     MAX_COEFFICIENT,
     MAX_PRESSURE_BAR,
     MAX_SPEED_HZ,
+    check_operating,
     load_rig,
     method_names,
     rig_parameter_names,
@@ -296,14 +297,20 @@ def _signoff_into(args: argparse.Namespace) -> int:
 @_owns_out
 def _drop(args: argparse.Namespace) -> int:
     cfg = load_rig(args.rig)
-    named = {"standstill": 0.0, "max-continuous": 60.0 * cfg.operating.continuous_hz[1],
-             "trip": 60.0 * cfg.operating.trip_hz}
+    if args.speed_hz is not None:  # it stands for [operating] speed_rpm, as --speed-rpm
+        check_operating({"speed_rpm": 60.0 * args.speed_hz},
+                        {"speed_rpm": f"--speed-hz {args.speed_hz:g} "
+                                      f"(= {60.0 * args.speed_hz:g} rpm)"})
+    # a negative speed turns the rotor the other way (about −z), as everywhere in the rig
+    # file: the named speeds keep the rig's sense of rotation (--speed-rpm was checked by
+    # the rule of [operating] speed_rpm, ambseal.cli)
+    sense = -1.0 if cfg.operating.speed_rpm < 0 else 1.0
+    named = {"standstill": 0.0,
+             "max-continuous": sense * 60.0 * cfg.operating.continuous_hz[1],
+             "trip": sense * 60.0 * cfg.operating.trip_hz}
     rpm = (60.0 * args.speed_hz if args.speed_hz is not None else
            args.speed_rpm if args.speed_rpm is not None else
            named[args.at] if args.at is not None else cfg.operating.speed_rpm)
-    if not 0 <= rpm <= 60.0 * MAX_SPEED_HZ:
-        raise ConfigError(f"--speed-rpm: expected 0 to {60.0 * MAX_SPEED_HZ:g} rpm, got "
-                          f"{rpm:g}")
     say = logging.getLogger("ambseal").info
     shown = [0]
 

@@ -61,6 +61,29 @@ def test_duplicate_touchdown_names_are_refused_when_the_rig_is_read(tmp_path, ca
         _refused(capsys, args, str(rig), "touchdown[1].name", "duplicate touchdown name 'TA'")
 
 
+def test_the_monte_carlo_draws_follow_the_rig_files_rules(tmp_path, capsys):
+    """A friction drawn in 3:5 lies beyond ``[[touchdown]] friction``'s bound (μ <= 2),
+    and a clearance drawn ±150 µm about 0.2 mm reaches a 0.3 mm air gap: each range is
+    refused before any run, naming the option and the key whose rule it breaks; a run
+    whose draw breaks the rule (one built by hand) is refused by the same rule."""
+    rig = _rig(tmp_path, _rig_text())
+    _refused(capsys, ["drop", rig, "--runs", "1", "--friction", "3:5", "--out",
+                      tmp_path / "d"], "--friction 3:5", "touchdown[0].friction",
+             "expected a value <= 2.0, got 3.0")
+    assert not (tmp_path / "d").exists()
+    tight = _rig(tmp_path, _rig_text().replace("air_gap = 5.0e-4", "air_gap = 3.0e-4"),
+                 "tight.toml")
+    _refused(capsys, ["drop", tight, "--runs", "1", "--clearance-tol-um", "150", "--out",
+                      tmp_path / "d"], "--clearance-tol-um 150",
+             "touchdown[0].radial_clearance: 0.00035 m, not below amb[0].air_gap 0.0003 m")
+    cfg = load_rig(rig)
+    case = {"run": 7, "friction": [0.1, 3.0], "clearance_m": [2e-4, 2e-4],
+            "support_damping": [0.0, 0.0], "unbalance_kgm": 0.0}
+    with pytest.raises(ConfigError, match=r"drop scatter run 7: touchdown\[1\]\.friction: "
+                                          r"expected a value <= 2\.0, got 3\.0"):
+        drop_run(case, cfg.model_dump(), 0.0, 0.01, 1e4, False, 0.0)
+
+
 def _sealed(per_bar: float) -> str:
     """The rig with a seal at mid-span whose cross-coupled stiffness grows ``per_bar``
     (N/m per bar) with the pressure drop, lightly damped."""

@@ -4,11 +4,13 @@ tolerance, their supports' damping and the rotor's unbalance drawn at random, an
 probability of what an engineer fears from a drop — a backward whirl, a failed verdict.
 
 Each run is :func:`ambseal.analysis.drop.simulate_drop` of the rig with that run's draw,
-on the nominal rig's modal basis (its ``modes_hz``, so that every run keeps the same
-modes), judged by :func:`~ambseal.analysis.drop.drop_verdict`. The draws are uniform,
-independent per bearing, and made before any run from ``numpy.random.default_rng(seed)``
-in a fixed order (run, then friction, clearance, support damping per bearing, then the
-unbalance): the same seed gives the same runs serially or on Dask
+validated as a rig file is (:func:`ambseal.config.parse_rig`; the ends of each range
+are, before any run), on the nominal rig's modal basis (its ``modes_hz``, so that every
+run keeps the same modes), judged by :func:`~ambseal.analysis.drop.drop_verdict`. The
+draws are uniform, independent per bearing, and made before any run from
+``numpy.random.default_rng(seed)`` in a fixed order (run, then friction, clearance,
+support damping per bearing, then the unbalance): the same seed gives the same runs
+serially or on Dask
 (:func:`ambseal.analysis.cases.run_cases`), one BLAS thread per worker.
 
 The probability p of an outcome seen in k of n runs is reported with its Wilson score
@@ -19,6 +21,7 @@ keeps its coverage near 0 and 1 where the normal approximation's interval does n
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -76,6 +79,27 @@ def _range(name: str, value) -> tuple[float, float] | None:
     return lo, hi
 
 
+def _drawn(rig: dict, friction, clearance_m, support_damping) -> dict:
+    """The rig (a ``RigConfig.model_dump()``) with each touchdown bearing's friction,
+    radial clearance and support damping as drawn (lists in the rig's order), as a rig
+    file's document: :func:`~ambseal.config.parse_rig` validates it by the file's rules."""
+    doc = copy.deepcopy(rig)
+    for td, mu, c, d in zip(doc["touchdown"], friction, clearance_m, support_damping):
+        td.update({"friction": mu, "radial_clearance": c, "support_damping": d})
+    return doc
+
+
+def _check_ends(cfg, ranges: dict) -> None:
+    """Refuse a range whose draws the rig file would refuse, before any run: the rig with
+    every bearing at each end of each range (``{option text: (friction, clearance_m,
+    support_damping) per end}``) is validated by its rules (the bounds are intervals, so
+    a draw between two valid ends is valid; each run validates its own draw again)."""
+    rig = cfg.model_dump()
+    for option, ends in ranges.items():
+        for end in ends:
+            parse_rig(_drawn(rig, *end), option)
+
+
 def drop_run(case: dict, rig: dict, speed_rpm: float, duration_s: float, modes_hz: float,
              coast_down: bool, drag_torque: float, start: str = "levitated",
              event: dict | None = None) -> dict:
@@ -108,12 +132,8 @@ def drop_run(case: dict, rig: dict, speed_rpm: float, duration_s: float, modes_h
         ``backward_whirl`` (any bearing), and per bearing NAME ``NAME_regime``,
         ``NAME_whirl_hz``, ``NAME_peak_force_n``, ``NAME_first_impact_peak_n``.
     """
-    cfg = parse_rig(rig, "<drop scatter>")
-    tds = [t.model_copy(update={"friction": mu, "radial_clearance": c,
-                                "support_damping": d})
-           for t, mu, c, d in zip(cfg.touchdown, case["friction"], case["clearance_m"],
-                                  case["support_damping"])]
-    cfg = cfg.model_copy(update={"touchdown": tds})
+    cfg = parse_rig(_drawn(rig, case["friction"], case["clearance_m"],
+                           case["support_damping"]), f"drop scatter run {case['run']}")
     dm = drop_model(cfg, modes_hz)
     u = case["unbalance_kgm"]
     initial = x0 = None
@@ -210,6 +230,8 @@ def drop_scatter(cfg, runs: int, *, seed: int, friction=None, clearance_tol_m=No
     ------
     ConfigError
         Runs or a range out of bounds, a clearance tolerance as large as a clearance, a
+        range whose ends the rig file's rules refuse (a friction beyond ``[[touchdown]]
+        friction``'s bound, a clearance not below an air gap: named by its option), a
         rig the drop refuses (:func:`~ambseal.analysis.drop.drop_model`), or no run that
         finished.
     """
@@ -228,6 +250,19 @@ def drop_scatter(cfg, runs: int, *, seed: int, friction=None, clearance_tol_m=No
     if not (math.isfinite(tol) and 0 <= tol < c0.min()):
         raise ConfigError(f"drop scatter: clearance tolerance: expected 0 <= tol < the "
                           f"smallest clearance {c0.min():g} m, got {clearance_tol_m!r}")
+    nominal = [[t.friction for t in cfg.touchdown], c0.tolist(),
+               [t.support_damping for t in cfg.touchdown]]
+    ranges = {}
+    if mu:
+        ranges[f"--friction {mu[0]:g}:{mu[1]:g}"] = [
+            [[x] * len(c0), *nominal[1:]] for x in mu]
+    if tol:
+        ranges[f"--clearance-tol-um {1e6 * tol:g}"] = [
+            [nominal[0], (c0 + x).tolist(), nominal[2]] for x in (-tol, tol)]
+    if damp:
+        ranges[f"--support-damping {damp[0]:g}:{damp[1]:g}"] = [
+            [*nominal[:2], [x * t.support_damping for t in cfg.touchdown]] for x in damp]
+    _check_ends(cfg, ranges)
     rng = np.random.default_rng(seed)
     cases = []
     for run in range(runs):

@@ -26,12 +26,13 @@ def paths(node, prefix=()):
 
 
 @st.composite
-def mutated(draw, doc: dict):
+def mutated(draw, doc: dict, under: tuple = ()):
     """``doc`` with 1–3 mutations: a key deleted, a value replaced by an odd one, a number
-    scaled by a wild factor, or a table duplicated."""
+    scaled by a wild factor, or a table duplicated; only inside the tables ``under``
+    names, where it names any."""
     doc = copy.deepcopy(doc)
     for _ in range(draw(st.integers(1, 3))):
-        where = paths(doc)
+        where = [p for p in paths(doc) if not under or (p[0] in under and len(p) > 1)]
         if not where:
             break
         path = draw(st.sampled_from(where))

@@ -12,6 +12,7 @@ ones each time (the default set is derandomized, the same in every CI run).
 
 import contextlib
 import copy
+import csv
 import io
 import json
 import math
@@ -24,13 +25,15 @@ import numpy as np
 import scipy.io
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from ambseal.cli import main
+from ambseal.config import parse_rig
 
 from .conftest import ROOT
 from .mutations import mutated, paths
+from .test_cli_drop import _rig_text
 from .toml_text import dump
 
 RIGS = {name: tomllib.loads((ROOT / "examples" / name).read_text())
@@ -346,6 +349,123 @@ def _physics_case(tmp_path_factory, data):
         assert any(new.get(k) != base.get(k) for k in keys), (path, factor)
 
 
+#: The drop's rig: the rigid rotor on two rings of test_cli_drop, a seal at mid-span whose
+#: cross-coupled stiffness grows with its pressure drop as the test rig's does (a surge of
+#: thousands of bar drives a whirl into the rings).
+DROP_RIG = tomllib.loads(_rig_text() + '[[seal]]\nname = "mid"\nposition = 0.2\n'
+                         "clearance = 3.0e-4\nk = { per_bar = 1.0e6 }\n"
+                         "C = { at_zero = 100.0, per_bar = 50.0 }\n"
+                         "[drop]\naxial_thrust = 0.0\n")
+#: Keys a [[touchdown]] or [drop] table may add, with values inside, at and beyond their
+#: bounds and their rules (a support stiffness without its mass, a friction velocity below
+#: what the drop resolves).
+_ADDED = {"touchdown": {"support_stiffness": [1e7, 1e13, 1e-3], "support_mass": [0.5, 0.0],
+                        "support_damping": [2e3, 1e9], "friction_velocity": [1e-15, 1e-4,
+                                                                              10.0],
+                        "axial_clearance": [1e-4, 0.1], "race_mass": [0.05],
+                        "static_rating": [1e4, 1.0], "race_drag_torque": [1e5]},
+          "drop": {"axial_thrust": [2e3, -1e8, 1e8], "force_ratio": [1e-9, 100.0],
+                   "race_temperature_rise": [1e-3]}}
+#: Values of the drop's options: plausible, at the bounds of their keys and beyond.
+_SPEEDS = [["--speed-rpm", v] for v in ("0", "-3000", "3000", "6e4", "1e6", "3e6")] + [
+    ["--speed-hz", v] for v in ("-500", "50", "5e4", "2e5")] + [
+    ["--at", v] for v in ("standstill", "max-continuous", "trip")] + [[]]
+_EVENTS = [[], ["--event", "one-axis"], ["--event", "one-axis", "--axis", "B_zeta"],
+           ["--event", "overload", "--overload-n", "1500"],
+           ["--event", "overload", "--overload-n", "1e8"],
+           ["--event", "overload", "--surge-bar", "3000", "--unbalance-kgm", "1e-4"],
+           ["--event", "overload", "--surge-bar", "1e4"],
+           ["--event", "overload", "--surge-bar", "1e5"],
+           ["--event", "overload", "--surge-bar", "-1"], ["--axial-thrust-n", "2000"],
+           ["--axial-thrust-n", "1e9"], ["--coast-down", "--drag-torque", "2"],
+           ["--unbalance-kgm", "2e-3", "--start", "rest"], ["--pressure-bar", "1e5"]]
+_SCATTER = [["--friction", "3:5"], ["--friction", "0:2"], ["--friction", "0.1:0.3"],
+            ["--clearance-tol-um", "150"], ["--clearance-tol-um", "500"],
+            ["--support-damping", "0.5:2"], ["--support-damping", "1:1e12"],
+            ["--unbalance-kgm", "0:1e-4"]]
+
+
+@st.composite
+def _drop_args(draw) -> list:
+    """Options of ``ambseal drop``: a speed, an event, and sometimes Monte-Carlo ranges
+    with ``--runs 1`` (short drops: 2 to 10 ms)."""
+    args = [*draw(st.sampled_from(_SPEEDS)), *draw(st.sampled_from(_EVENTS)),
+            "--duration-s", draw(st.sampled_from(["0.002", "0.005", "0.01"]))]
+    if draw(st.booleans()):
+        args += ["--runs", "1", "--workers", "1", *draw(st.sampled_from(_SCATTER))]
+    return args
+
+
+@st.composite
+def _drop_rigs(draw) -> dict:
+    """:data:`DROP_RIG` with its ``[[touchdown]]`` and ``[drop]`` tables mutated (keys
+    deleted, odd values, numbers scaled, a bearing duplicated) and keys of
+    :data:`_ADDED` added."""
+    doc = copy.deepcopy(DROP_RIG)
+    if draw(st.booleans()):
+        doc = draw(mutated(doc, under=("touchdown", "drop")))
+    for _ in range(draw(st.integers(0, 2))):
+        table = draw(st.sampled_from(sorted(_ADDED)))
+        key = draw(st.sampled_from(sorted(_ADDED[table])))
+        value = draw(st.sampled_from(_ADDED[table][key]))
+        tables = {"drop": [doc.get("drop")], "touchdown": doc.get("touchdown")}[table]
+        tables = [t for t in tables if isinstance(t, dict)] if isinstance(
+            tables, list) else []
+        if tables:
+            draw(st.sampled_from(tables))[key] = value
+    return doc
+
+
+def _drop_case(tmp_path_factory, doc: dict, args: list):
+    """``ambseal drop`` of a rig ``doc`` (:func:`_drop_rigs`) with the options ``args``
+    (:func:`_drop_args`): refused in one line naming the rig or an option, or dropped
+    within the deadline to finite results — one plane per bearing, at a speed and
+    pressure the rig file accepts, each Monte-Carlo draw a rig the rig file accepts — in
+    which the energy the drop dissipated is never negative: what the rotor's energy
+    gained came from the work done on it (the drive, the AMBs, the seals, a force), as
+    the drop accounts it (:attr:`ambseal.analysis.drop.DropResult.work`)."""
+    d = tmp_path_factory.mktemp("fuzz")
+    rig = d / "rig.toml"
+    rig.write_text(dump(doc))
+    code, out, err = _sandboxed(d, ["--quiet", "drop", rig, *args, "--out", d / "o",
+                                    "--json"], [d / "o"], seconds=60.0)
+    options = [a for a in args if a.startswith("--")]
+    _check(code if code != 1 else 0, out, err, [str(rig), str(d / "o"), *options])
+    if code == 2:
+        return
+    if "--runs" in args:
+        _check_draws(doc, d / "o" / "drop_scatter.csv")
+        return
+    result = json.loads(out)
+    names = [t["name"] for t in doc["touchdown"]]
+    assert [p["name"] for p in result["planes"]] == names, names
+    # the speed and the pressure it dropped at are ones the rig file accepts
+    parse_rig({**doc, "operating": {**doc.get("operating", {}),
+                                    "speed_rpm": result["speed_rpm"],
+                                    "pressure_bar": result["pressure_bar"]}}, "as dropped")
+    scale = max(abs(result["external_work_j"]), 1e-3)
+    assert result["energy_dissipated_j"] >= -1e-4 * scale, (
+        args, result["energy_dissipated_j"], result["external_work_j"])
+
+
+def _check_draws(doc: dict, table: Path) -> None:
+    """Each Monte-Carlo run of the rig ``doc`` keeps a column set per bearing, and its
+    draws make a rig the rig file accepts."""
+    with open(table, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    names = [t["name"] for t in doc["touchdown"]]
+    assert sum(k.endswith("_peak_force_n") for k in rows[0]) == len(names), rows[0]
+    for row in rows:
+        if row.get("error"):
+            continue
+        drawn = copy.deepcopy(doc)
+        for td in drawn["touchdown"]:
+            td.update({k: float(row[f"{td['name']}_{c}"]) for k, c in (
+                ("friction", "friction"), ("radial_clearance", "clearance_m"),
+                ("support_damping", "support_damping"))})
+        parse_rig(drawn, f"run {row['run']}")
+
+
 @fuzz(150)
 @given(data=st.data())
 def test_fuzz_rig_files(tmp_path_factory, data):
@@ -380,6 +500,24 @@ def test_fuzz_ranges(tmp_path_factory, data):
 @given(data=st.data())
 def test_fuzz_physics_changes_show(tmp_path_factory, data):
     _physics_case(tmp_path_factory, data)
+
+
+#: Inputs the drop once answered wrongly, tried on every run: two bearings of one name
+#: (one set of columns in the Monte-Carlo table), a friction drawn beyond its key's bound,
+#: a speed in Hz beyond the bound of one in rpm, a seal surge that crawled for minutes.
+_TWINS = tomllib.loads(dump(DROP_RIG).replace('name = "TB"', 'name = "TA"'))
+_SHORT = ["--duration-s", "0.005"]
+
+
+@fuzz(8)
+@given(doc=_drop_rigs(), args=_drop_args())
+@example(doc=_TWINS, args=["--runs", "1", "--workers", "1", *_SHORT])
+@example(doc=DROP_RIG, args=["--runs", "1", "--workers", "1", "--friction", "3:5", *_SHORT])
+@example(doc=DROP_RIG, args=["--speed-hz", "5e4", *_SHORT])
+@example(doc=DROP_RIG, args=["--event", "overload", "--surge-bar", "1e4", "--duration-s",
+                             "0.05"])
+def test_fuzz_drops(tmp_path_factory, doc, args):
+    _drop_case(tmp_path_factory, doc, args)
 
 
 def test_the_fuzz_harness_sees_a_hang_and_a_stray_file(tmp_path):
@@ -438,3 +576,10 @@ def test_fuzz_physics_changes_show_long(tmp_path_factory, data):
 @given(data=st.data())
 def test_fuzz_ranges_long(tmp_path_factory, data):
     _range_case(tmp_path_factory, data)
+
+
+@pytest.mark.slow
+@fuzz(8, slow=True)
+@given(doc=_drop_rigs(), args=_drop_args())
+def test_fuzz_drops_long(tmp_path_factory, doc, args):
+    _drop_case(tmp_path_factory, doc, args)

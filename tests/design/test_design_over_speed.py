@@ -52,4 +52,5 @@ def test_hinf_designed_over_the_speed_range_holds_from_standstill_to_the_top_spe
     cfg = load_rig(FAMILY_RIG)
     held = design(cfg, "hinf")
     assert all(_held_as_it_runs(cfg, held.K, speeds))
-    assert any(s.startswith("hinf: designed at ") for s in held.steps)
+    assert frozen.design_speed_hz is None and held.design_speed_hz in speeds[:-1]
+    assert f"hinf: designed at {held.design_speed_hz:g} Hz" in held.steps[-1]

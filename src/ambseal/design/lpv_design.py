@@ -255,9 +255,8 @@ class LpvDesign(ScheduledController):
         lo, hi = float(self.speeds_hz.min()), float(self.speeds_hz.max())
         short = self.sdp_shortfall
         # no ";" inside: the run's verdict takes the bound as the line's first clause
-        note = (f" — NOT SOLVED TO OPTIMALITY: {short}, so γ is a bound its LMIs certify "
-                "and the controller is where the solver stopped, which another machine's "
-                "rounding moves" if short else "")
+        # short: the report's section on the syntheses says what it means
+        note = f" — NOT SOLVED TO OPTIMALITY: {short}" if short else ""
         return (f"LPV γ = {bound_text(self.gamma)} over {lo:g}–{hi:g} Hz ({self.lyapunov} "
                 f"Lyapunov function{note}), frozen loops γ ≤ "
                 f"{float(np.max(self.check_gamma)):.3g}"

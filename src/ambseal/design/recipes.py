@@ -148,6 +148,10 @@ class DesignResult:
         None for H∞ and the PID.
     notes : tuple of str
         The specification's notes (no seal, ...).
+    design_speed_hz : float or None
+        The speed (Hz) an H∞ or μ design over the speed range was designed at, where the
+        design at ``[operating] speed_rpm`` lost the rotor at another judged speed
+        (:func:`design`); None for a design at the operating speed.
     stopping : dict or None
         Why the synthesis stopped: μ, the rule that ended each phase, its iterations and
         the D search's γ evaluations (:attr:`ambseal.robust.dk.MusynResult.stopping`);
@@ -182,6 +186,7 @@ class DesignResult:
     omega: Any = field(default=None, repr=False)
     stopping: dict | None = None
     scheduled: Any = field(default=None, repr=False)
+    design_speed_hz: float | None = None
 
     @property
     def controller(self):
@@ -401,8 +406,10 @@ def design(
             enlarge, into, progress)
 
     r, check, n = synthesise(cfg, steps)
+    moved = None
     if not cfg.design.one_speed:
-        r, check, n = _over_speed(cfg, method, sp, (r, check, n), synthesise, steps, progress)
+        (r, check, n), moved = _over_speed(cfg, method, sp, (r, check, n), synthesise, steps,
+                                           progress)
     if not check["stable"] and not allow_unstable:
         raise SynthesisError(_unstable_message(method, check, n, steps, _top_mode_hz(cfg, p, n),
                                                _lost_by(cfg, r.K, check, p),
@@ -414,7 +421,8 @@ def design(
         elapsed_s=time.perf_counter() - t0, reduction=r.reduction, plant=r.gp,
         design_states=n, full_order=check, kept_unstable=not check["stable"],
         delay=dl.to_dict(), steps=tuple(steps), notes=tuple(sp.notes),
-        verdict=_verdict(method, r, check), omega=r.omega, stopping=r.stopping)
+        verdict=_verdict(method, r, check), omega=r.omega, stopping=r.stopping,
+        design_speed_hz=moved)
 
 
 def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max_iter,
@@ -501,7 +509,7 @@ def _over_speed(cfg, method: str, sp, first, synthesise, steps: list, progress):
     states), designed at the operating speed, loses the rotor at another judged speed, the
     design at another of the specification's stability speeds; the first whose full-order
     loop holds at every judged condition is kept and ``steps`` names its speed, else
-    ``first``. H∞ tries each stability speed in turn from standstill up (the gyroscopic
+    ``first``. Returns (the design, its speed in Hz or None for ``first``). H∞ tries each stability speed in turn from standstill up (the gyroscopic
     moments change the plant monotonically with speed, so the loss moves with the design
     speed); μ, whose D–K steps cost a hundred H∞ designs, is designed once more, at the
     speed that search finds for H∞ (``synthesise(cfg, steps, "hinf")``), where there is
@@ -513,7 +521,7 @@ def _over_speed(cfg, method: str, sp, first, synthesise, steps: list, progress):
     f0 = cfg.operating.speed_rpm / 60.0
     if check["stable"] or cfg.operating.speed_range_hz is None \
             or abs(check["speed_hz"] - f0) <= 1e-9 * max(f0, 1.0):
-        return first
+        return first, None
     speeds = [f for f in sorted(set(sp.stability_speeds_hz))
               if abs(f - f0) > 1e-9 * max(f0, 1.0)]
     if method != "hinf":
@@ -521,7 +529,7 @@ def _over_speed(cfg, method: str, sp, first, synthesise, steps: list, progress):
         speeds = [] if found is None else [found[0]]
     found = _first_held(cfg, speeds, lambda c: synthesise(c, []))
     if found is None:
-        return first
+        return first, None
     f, out = found
     steps.append(f"{method}: designed at {f:g} Hz, the first stability speed from standstill "
                  f"whose {'H∞ ' if method != 'hinf' else ''}design holds every judged "
@@ -530,7 +538,7 @@ def _over_speed(cfg, method: str, sp, first, synthesise, steps: list, progress):
                  f"{check['damping']:.3g})")
     if progress:
         progress(steps[-1])
-    return out
+    return out, f
 
 
 def _first_held(cfg, speeds, synthesise):

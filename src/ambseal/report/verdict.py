@@ -249,9 +249,9 @@ class Verdict:
         stopped, and another machine's rounding stops it elsewhere."""
         text = self._judged_words()
         if self.synthesis_shortfall:
-            text = (f"{text[:-1]}; NOT SOLVED TO OPTIMALITY ({self.synthesis_shortfall}): "
-                    "this controller and its numbers are where the solver stopped, and may "
-                    "differ on another machine.")
+            # what stopped short is in the design bound's cell and the syntheses' section
+            text = (f"{text[:-1]}; NOT SOLVED TO OPTIMALITY: its numbers may differ on "
+                    "another machine.")
         return text
 
     def _judged_words(self) -> str:

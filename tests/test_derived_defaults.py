@@ -95,6 +95,9 @@ def test_the_run_reports_the_pid_and_the_notch_it_tried(slim_rig, tmp_path):
     m = json.loads((out / "metrics.json").read_text())
     assert any("(left out: lead" in n for n in m["controllers"]["pid"]["notes"])
     assert "pid cannot run on the target" in m["cannot_run"]["pid"]
+    assert m["cannot_run"]["pid"].endswith("this PID is the one ambseal derives from the "
+                                           "rig: set [controller.pid] (and "
+                                           "[[controller.filter]]) to run your own")
     lpv = m["controllers"]["lpv"]
     assert lpv["capacity"]["bias_used"] > 1 and "rejection" in lpv
     backup_um = 1e6 * min(map(load_rig(slim_rig).backup_clearance, load_rig(slim_rig).amb))

@@ -162,8 +162,16 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
         if "plants" not in cache:
             cache["plants"] = sampled_plants([plant(*c) for c in conds], fs,
                                              delay_samples=delay)
-        return digital_controller(controller, fs, cache["plants"],
-                                  delay_samples=delay, rise=rise)
+        try:
+            return digital_controller(controller, fs, cache["plants"],
+                                      delay_samples=delay, rise=rise)
+        except SynthesisError as exc:
+            if method != "pid" or written_pid(cfg):
+                raise
+            # the user's remedy for ambseal's own PID is their own, not another rate
+            raise SynthesisError(f"{exc}; this PID is the one ambseal derives from the rig: "
+                                 "set [controller.pid] (and [[controller.filter]]) to run "
+                                 "your own") from None
 
     W = table_grid(controller.table_theta)  # the table's θ (speeds or SI), made denser
     # between table entries at 1/8, 3/8, 5/8, 7/8 of the table: the interpolation judged

@@ -29,7 +29,8 @@ Systems*, 3rd ed., ch. 6):
    controller (poles mapped as ``z = e^{sT}``, Franklin et al. §6.3.2).
 3. **Choice.** Each candidate, delayed by ``delay_samples`` samples of computation, is
    closed with the full-order plant sampled exactly (ZOH) at each given condition; the
-   candidate kept is stable wherever the continuous loop is, and among those the one
+   candidate kept is stable wherever the continuous loop is (with the delay, or without
+   it for a design that ignores the delay), and among those the one
    whose σ̄(S_o) peaks (log grid up to Nyquist) are closest to the continuous loop's
    (the largest relative difference over the conditions where the continuous loop is
    stable). The continuous loop here is the plant with the hold + computation delay as
@@ -635,11 +636,15 @@ def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int,
     """
     fs, T, w = sp.fs, 1.0 / sp.fs, sp.omega_rad_s
 
-    # the sampled loop must be stable wherever the design is (its continuous loop without
-    # the delay); the peaks are compared where the continuous loop with the delay is too
-    cont_stable = [is_stable(feedback_poles(G, Kc, dt=0.0)) for G, Kc in zip(sp.ideal, cont)]
-    judged = [j for j, Kc in enumerate(cont) if cont_stable[j]
-              and is_stable(sp.delayed_poles(j, Kc))]
+    # the sampled loop must be stable wherever the continuous loop is, without the delay
+    # (a design that ignores it) or with it (a design that carries it, as the H∞, μ and
+    # LPV designs do: without the delay their loop may be unstable, and a rule on the
+    # undelayed loop alone then asked nothing of the sampled one); the peaks are compared
+    # where both are stable
+    ideal_stable = [is_stable(feedback_poles(G, Kc, dt=0.0)) for G, Kc in zip(sp.ideal, cont)]
+    delayed_stable = [is_stable(sp.delayed_poles(j, Kc)) for j, Kc in enumerate(cont)]
+    cont_stable = [a or b for a, b in zip(ideal_stable, delayed_stable)]
+    judged = [j for j in range(len(cont)) if ideal_stable[j] and delayed_stable[j]]
     peak_c = {j: _so_peak(sp.continuous_response[j], freqresp_at(cont[j], 1j * w))
               for j in judged}
     n = len(sp.ideal)

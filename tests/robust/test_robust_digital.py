@@ -113,6 +113,29 @@ def test_choice_closes_candidates_by_rank_until_one_is_stable():
     assert "not_checked" not in a and "not_checked" not in b
 
 
+def test_when_no_candidate_holds_the_refusal_names_the_closest_and_a_remedy():
+    """The same one-state sampled plant (pole 0.5 − k by hand) under two static gains that
+    both lose it: k = 2 (|z| = 1.5) and k = −0.8 (|z| = 1.3). The refusal names the closest
+    candidate and its |z|, how many conditions it loses, and a remedy on the target's
+    rate; not the controller's highest pole, which is no reason here (a static gain has
+    none, and a rate above twice it still lost the flywheel's loop at 20 kHz)."""
+    from ambseal.robust._digital_choice import first_stable
+    from ambseal.robust.digital import _none_holds
+
+    rate = np.log(0.5)
+    G = (np.array([[rate]]), np.array([[-2.0 * rate]]), np.array([[1.0]]), np.zeros((1, 1)))
+    gain = lambda k: (np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), np.array([[k]]))
+    ks = {"tustin": 2.0, "zoh": -0.8}
+    cands = [{"method": m, "max_abs_z": [None, None], "sensitivity_peak": [1.1, 1.2],
+              "sensitivity_peak_continuous": [1.0, 1.0], "sensitivity_peak_error": 0.1,
+              "stable": None} for m in ks]
+    Kd = {m: (None, [gain(k)] * 2) for m, k in ks.items()}
+    assert first_stable(cands, Kd, [G, G], 1.0, [True, True]) is None
+    why = _none_holds(cands, [True, True], 1.0, 1, "K", list(ks))
+    assert "the closest, zoh," in why and "|z| = 1.3 " in why and "unstable at 2" in why
+    assert "controller.sample_rate_hz" in why and "twice" not in why
+
+
 def test_residualisation_keeps_the_static_gain_and_the_slow_poles():
     """Reference: singular perturbation (Skogestad & Postlethwaite Eq. 11.26) keeps
     K(0) exactly and the slow poles of a block-diagonal system exactly; a random stable

@@ -663,14 +663,33 @@ def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int,
                       "sensitivity_peak_error": err, "stable": None})
     best = _first_stable(cands, Kd, sp.ideal, T, cont_stable)
     if best is None:
-        poles = max((np.abs(np.linalg.eigvals(K[0])).max() / (2 * np.pi) if K[0].size else 0.0)
-                    for K in cont)
-        raise SynthesisError(
-            f"controller.sample_rate_hz = {fs:g} Hz (delay {delay} samples): no "
-            f"discretisation of {name} ({', '.join(methods)}) keeps the sampled loop "
-            f"stable where the continuous loop is (highest controller pole {poles:.4g} Hz; "
-            "a sample rate below twice it cannot run it): raise the sample rate or redesign")
+        raise SynthesisError(_none_holds(cands, cont_stable, fs, delay, name, methods))
     return best["method"], Kd[best["method"]][0], tuple(cands)
+
+
+def _none_holds(cands: list, cont_stable: list, fs: float, delay: int, name: str,
+                methods) -> str:
+    """Why no candidate of :func:`choose_method` runs: the candidate whose sampled loop
+    comes closest to stable (the smallest largest |z| where the continuous loop is stable)
+    and where. The controller's own poles are not the reason (those above half of Nyquist
+    were removed or kept by a hold that aliases nothing); the gap is between the sampled
+    loop and the continuous one the design foresaw, which narrows as the rate rises."""
+    def worst(c):
+        zs = [(z, j) for j, (z, ok) in enumerate(zip(c["max_abs_z"], cont_stable))
+              if ok and z is not None]
+        return max(zs) if zs else (float("inf"), -1)
+
+    closest = min(cands, key=lambda c: worst(c)[0])
+    z, j = worst(closest)
+    n_bad = sum(1 for zj, ok in zip(closest["max_abs_z"], cont_stable)
+                if ok and zj is not None and zj >= 1)
+    return (f"controller.sample_rate_hz = {fs:g} Hz (delay {delay} samples): no "
+            f"discretisation of {name} ({', '.join(methods)}) keeps the sampled loop stable "
+            f"where the continuous loop is; the closest, {closest['method']}, leaves a "
+            f"sampled-loop pole at |z| = {z:.6g} (condition {j + 1} of {len(cont_stable)}; "
+            f"unstable at {n_bad}): the loop as it runs differs from the continuous one "
+            "its design foresaw, a gap that narrows as the rate rises: raise "
+            "controller.sample_rate_hz or lower controller.delay_samples")
 
 
 def digital_controller(K, sample_rate_hz: float, plants, *,

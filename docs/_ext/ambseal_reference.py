@@ -294,6 +294,14 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Stage.discharge_density": ("kg/m³", "gas density at the stage's discharge ρ_d"),
     "Machine.kind": ("", "``compressor`` or ``turbine``: API 617's anticipated "
                          "cross-coupling (B = 3 with the density ratio, or 1.5 without)"),
+    "Machine.orientation": ("", "how the machine stands, where gravity acts: "
+                                "``horizontal`` (default; along −y), ``vertical`` (along "
+                                "−z: the end positions start from at the bottom; the radial "
+                                "AMBs carry no weight, a thrust bearing carries it) or "
+                                "``inclined`` (with inclination_deg)"),
+    "Machine.inclination_deg": ("deg", "with orientation = ``inclined`` only: the rotor "
+                                       "axis's angle above the horizontal, +z rising (−90 to "
+                                       "90; gravity g·(0, −cos θ, −sin θ))"),
     "Signoff.csr_boundary": ("kg/m³, −", "API 617 Level I's Region A/B boundary: points "
                              "``[ρ_avg, CSR]``, linear between, flat beyond (ρ_avg: the "
                              "first stage's suction and the last stage's discharge density, "
@@ -386,6 +394,14 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Signoff.scale_factor_speeds": ("", "where A_probe is taken: ``to_trip`` (default, "
                                         "standstill to the trip speed) or ``continuous`` "
                                         "(minimum to maximum continuous, ROSS 3.1's)"),
+    "Signoff.journal_load": ("", "API 617's journal static load W (U_r = 6350·W/N) on a "
+                                 "machine that does not lie horizontal: ``as_horizontal`` "
+                                 "(default: the rotor's weight apportioned to its bearings "
+                                 "by static equilibrium as if it lay horizontal, API 684 2nd "
+                                 "ed.'s reading for vertical machines, not confirmed in the "
+                                 "public text) or ``as_acting`` (the lateral part of gravity "
+                                 "as the machine stands; refused on a vertical rotor, whose "
+                                 "journals carry none); the same on a horizontal one"),
     "Signoff.clearance_fraction": ("", "the scaled response's allowed fraction of each "
                                        "close clearance (diametral)"),
     "Signoff.iso14839_2_zones": ("", "ISO 14839-2 zone boundaries A/B, B/C, C/D as "

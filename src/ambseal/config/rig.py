@@ -702,9 +702,24 @@ class Stage(_Strict):
 
 class Machine(_Strict):
     """What the machine is, for the standards' rules: ``kind`` = ``"compressor"`` or
-    ``"turbine"`` (API 617's anticipated cross-coupling differs)."""
+    ``"turbine"`` (API 617's anticipated cross-coupling differs); and how it stands, which
+    sets where gravity acts (:mod:`ambseal.model.gravity`): ``orientation`` =
+    ``"horizontal"`` (gravity along −y), ``"vertical"`` (along −z: the rotor's left end,
+    where positions start, at the bottom) or ``"inclined"`` with ``inclination_deg``, the
+    rotor axis's angle above the horizontal (+z rising; −90 to 90, the y axis in the
+    vertical plane through the rotor axis)."""
 
     kind: Literal["compressor", "turbine"] = "compressor"
+    orientation: Literal["horizontal", "vertical", "inclined"] = "horizontal"
+    inclination_deg: float | None = Field(default=None, ge=-90, le=90)
+
+    @model_validator(mode="after")
+    def _inclination(self) -> "Machine":
+        if (self.orientation == "inclined") != (self.inclination_deg is not None):
+            raise ValueError("inclination_deg: expected the rotor axis's angle above the "
+                             "horizontal (deg, -90 to 90) with orientation = \"inclined\", "
+                             "and only then (\"horizontal\" is 0, \"vertical\" 90)")
+        return self
 
 
 class Probe(_Strict):
@@ -740,7 +755,9 @@ class Signoff(_Strict):
     the unbalance ``unbalance_factor`` × U_r, the analysed speeds up to
     ``analysis_top_ratio`` × the trip speed, the vibration limit's cap
     ``vibration_limit_cap_um`` (µm p-p), the scale factor's ``scale_factor_limits`` and
-    ``scale_factor_speeds`` (``"to_trip"`` or ``"continuous"``), the
+    ``scale_factor_speeds`` (``"to_trip"`` or ``"continuous"``), the journal static
+    load W of a machine that does not lie horizontal ``journal_load``
+    (``"as_horizontal"`` or ``"as_acting"``), the
     close clearances' allowed ``clearance_fraction``, and ISO 14839-2's zone boundaries
     ``iso14839_2_zones`` (fractions of the backup bearing's clearance C_min); and the
     unbalance response's ``probes`` (``[{ position, angle_deg }]``, directional; left out,
@@ -757,6 +774,10 @@ class Signoff(_Strict):
     # the speeds over which A_1 of S_c = A_vl/A_1 is taken (API 617 8th ed. Part 1
     # §4.8.2.11 as read: standstill to trip; ROSS 3.1: minimum to maximum continuous)
     scale_factor_speeds: Literal["to_trip", "continuous"] = "to_trip"
+    # API 617's journal static load W on a machine that does not lie horizontal: its
+    # weight apportioned to the bearings as if it did (API 684 2nd ed.'s reading for
+    # vertical machines; the public text could not confirm it), or gravity's lateral part
+    journal_load: Literal["as_horizontal", "as_acting"] = "as_horizontal"
     clearance_fraction: float = Field(default=0.75, gt=0, le=1.0)
     iso14839_2_zones: tuple[float, float, float] = Field(default=(0.3, 0.4, 0.5),
                                                          strict=False)

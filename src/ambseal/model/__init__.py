@@ -32,6 +32,9 @@ Each element owns its matrices and parameter channels; the rig only assembles th
   :func:`normal_force`, :func:`damping_coefficient`, :func:`friction_force`), and
   :func:`hertz_impact`, the undamped impact's closed form; :func:`rated_contact_stress`,
   a rolling bearing's element stress from its C₀ (ISO 76);
+* :func:`gravity_vector`, :func:`gravity_load`, :func:`axial_weight`,
+  :func:`inclination` — where gravity acts on the machine as it stands (``[machine]
+  orientation``) and its load on the lateral model (:data:`STANDARD_GRAVITY`);
 * :func:`modal_reduction` → :class:`ModalReduction` — the small real model (P1 §III.4–6);
 * :class:`Modes`, :func:`modes_from_poles`, :func:`classify_poles`, :func:`free_bending_hz`,
   :func:`bending_limit_hz` — damped natural frequencies, damping, unstable poles;
@@ -75,7 +78,8 @@ _FROM = {
     "pressure_for_k": "seal",
     "seal_coefficients": "seal", "seal_values": "seal", "values_following": "seal",
     "values_following_k": "seal", "SpringElement": "spring", "spring_at": "spring",
-    "spring_label": "spring",
+    "spring_label": "spring", "STANDARD_GRAVITY": "gravity", "inclination": "gravity",
+    "gravity_vector": "gravity", "gravity_load": "gravity", "axial_weight": "gravity",
 }
 
 __all__ = sorted(_FROM)

@@ -12,7 +12,14 @@ stated):
   ``U = 2 U_r``, as ROSS 3.1's ``api617_unbalance``; an edition that asks for another
   multiple sets it there; 6350·W/N g·mm is 4·W/N oz·in). The journal static loads
   are the reactions of the rotor on rigid supports at every AMB and spring under
-  gravity.
+  gravity (:func:`ambseal.analysis.statics.support_forces`). A machine that does not
+  lie horizontal (``[machine] orientation``) takes, by ``[signoff] journal_load``
+  (:func:`journal_gravity`), its weight apportioned to its bearings by static
+  equilibrium as if it lay horizontal (``"as_horizontal"``, the default: a vertical
+  rotor's journals carry no gravity load, yet its unbalance still scales with the mass
+  each bearing holds; API 684 2nd ed.'s reading for vertical machines as we have it,
+  which the public text could not confirm), or the lateral part of gravity as it acts
+  (``"as_acting"``: an inclined rotor's cos θ of it; refused on a vertical rotor).
 * **Where, per mode.** The first and second rigid-body shapes always: one unbalance at
   mid-span between the outermost supports (W the sum of the journal loads) and two at
   those supports 180° apart (each W its journal's load), and one at each impeller
@@ -79,26 +86,23 @@ from scipy.signal import find_peaks
 
 from ambseal.analysis.campbell import AF_CRITICAL, OVERDAMPED_ZETA, modes_as_run
 from ambseal.analysis.signoff.level1 import (
-    RIGID_SUPPORT,
     bearing_positions,
     stage_position,
     without_seals,
 )
+from ambseal.analysis.statics import support_forces
 from ambseal.analysis.synchronous import Unbalance, orbit_semi_major, synchronous_response
-from ambseal.config import Spring
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
 from ambseal.model import (
-    SpringElement,
     bending_limit_hz,
     build_mesh,
-    build_system,
-    spring_at,
-    spring_label,
+    gravity_vector,
+    inclination,
 )
 
 __all__ = ["unbalance_ur", "vibration_limit_um", "amplification_factor", "exact_half_power",
-           "required_margin", "journal_loads", "Critical", "Clearance", "UnbalanceCase",
+           "required_margin", "journal_loads", "journal_gravity", "journal_load_rule", "Critical", "Clearance", "UnbalanceCase",
            "Api617Unbalance", "api617_unbalance", "antinode_unbalances"]
 
 #: API 617 placement (module docstring; ROSS 3.1's ``api617_unbalance``): nodes below
@@ -231,15 +235,19 @@ def required_margin(af: float, below: bool) -> float:
 
 def journal_loads(cfg) -> tuple[tuple[float, float], ...]:
     """The journal static loads: ``((position m, load kg), …)`` per bearing (the AMBs,
-    else the springs), the rotor's reactions under gravity with each AMB holding its
-    journal (a rigid pin: the controller keeps the set point) and every spring as stiff as
-    it is. A bearing that holds the rotor down carries the magnitude of its reaction.
+    else the springs), the rotor's reactions under the sign-off's gravity
+    (:func:`journal_gravity`) with each AMB holding its journal (a rigid pin: the
+    controller keeps the set point) and every spring as stiff as it is
+    (:func:`ambseal.analysis.statics.support_forces`). A bearing that holds the rotor down
+    carries the magnitude of its reaction; a load is in kg as API 617's W (the force over
+    standard gravity).
 
     Raises
     ------
     ConfigError
         A rig without a bearing, or whose bearings carry no load, or do not hold the
-        rotor's weight (one support: nothing takes its moment).
+        rotor's weight (one support: nothing takes its moment), or a vertical rotor whose
+        ``[signoff] journal_load`` asks for the gravity as it acts (none is lateral).
     """
     zs = bearing_positions(cfg)
     if len(set(zs)) < 2:
@@ -247,46 +255,55 @@ def journal_loads(cfg) -> tuple[tuple[float, float], ...]:
                           f"rotor held at two bearings at least, got {len(set(zs))} "
                           "([[amb]] or [[spring]] positions): on one, nothing takes the "
                           "weight's moment")
-    pins = [Spring(position=z, kxx=RIGID_SUPPORT, kyy=RIGID_SUPPORT, name=f"pin{i}")
-            for i, z in enumerate(zs)] if cfg.amb else []
+    g = journal_gravity(cfg)
     # the bearings carry the weight: a seal (also one given as a spring) takes none
-    # a bearing's table at the running speed (a fluid film's has no standstill value)
-    f_run = cfg.operating.speed_rpm / 60.0
-    kept = [spring_at(s, f_run) for s in without_seals(cfg).spring]
-    rig = cfg.model_copy(update={"seal": [], "amb": [], "spring": [*kept, *pins]})
-    sys = build_system(rig, speed_rpm=0.0)
-    t = np.zeros(sys.n_dof)
-    t[1:sys.mesh.n_dof:4] = 1.0  # the rotor's weight (a housing's goes to its supports)
-    q = np.linalg.solve(sys.K, GRAVITY * (sys.M @ t))
-
-    def vertical(s: Spring, index: int) -> float:
-        """The spring's vertical force: its stiffness (cross terms and axes included) on
-        the journal's deflection, less its housing's."""
-        node = sys.mesh.node_at(s.position)
-        d = np.array([q[4 * node], q[4 * node + 1]])
-        if s.housing is not None:
-            h = sys.mesh.n_dof + sys.housing_names.index(f"{spring_label(s, index)}_housing_x")
-            d = d - q[h:h + 2]
-        K2 = SpringElement.from_config(s.model_copy(update={"housing": None}), sys.mesh,
-                                       index).matrices()[0]
-        return float((K2 @ d)[1])
-
-    force = {z: 0.0 for z in zs}
-    # with AMBs, their pins (appended after the rig's springs) carry the journals
-    for i, s in list(enumerate(rig.spring))[len(kept) if cfg.amb else 0:]:
-        if s.position in force:
-            force[s.position] += vertical(s, i)
-    loads = tuple((z, abs(force[z] / GRAVITY)) for z in zs)
+    force, applied = support_forces(without_seals(cfg), g)
+    loads = tuple((z, abs(float(force[z][1]) / GRAVITY)) for z in zs)
     if not sum(w for _, w in loads) > 0:
         raise ConfigError("API 617 unbalance response: the bearings carry no static load "
                           "(a rotor without mass?)")
-    mass = float(t @ sys.M @ t)
-    held = sum(force.values()) / GRAVITY
+    mass = float(applied[1] / g[1])
+    held = sum(float(f[1]) for f in force.values()) / g[1]
     if not abs(held - mass) <= 1e-3 * mass:
         raise ConfigError(f"API 617 unbalance response: the bearings hold {held:.4g} kg of "
                           f"the rotor's {mass:.4g} kg: its supports do not carry it "
                           "statically (check the [[spring]] stiffnesses and positions)")
     return loads
+
+
+def journal_gravity(cfg) -> np.ndarray:
+    """The gravity (m/s², x y z in the rotor's frame) the journal static loads take, by
+    ``[signoff] journal_load`` (module docstring): ``"as_horizontal"``, −y whatever the
+    machine's orientation; ``"as_acting"``, the lateral part of the machine's own
+    (:func:`ambseal.model.gravity_vector`).
+
+    Raises
+    ------
+    ConfigError
+        ``"as_acting"`` on a vertical rotor: its journals carry no gravity load.
+    """
+    if cfg.signoff.journal_load == "as_horizontal":
+        return np.array([0.0, -GRAVITY, 0.0])
+    g = gravity_vector(cfg.machine)
+    if not abs(g[1]) > 1e-9 * GRAVITY:
+        raise ConfigError("[signoff] journal_load = \"as_acting\": a vertical rotor's "
+                          "journals carry no gravity load, and API 617's U_r = 6350·W/N "
+                          "needs W > 0; expected \"as_horizontal\" (the rotor's weight "
+                          "apportioned to its bearings as if it lay horizontal)")
+    return np.array([0.0, g[1], 0.0])
+
+
+def journal_load_rule(cfg) -> str:
+    """The rule the journal static loads W follow, in words (for the report)."""
+    if cfg.machine.orientation == "horizontal":
+        return "the rotor's weight on its bearings (static equilibrium)"
+    if cfg.signoff.journal_load == "as_horizontal":
+        return (f"{cfg.machine.orientation} machine: the rotor's weight apportioned to its "
+                "bearings by static equilibrium as if it lay horizontal ([signoff] "
+                "journal_load = \"as_horizontal\"; API 684 2nd ed. on vertical machines, "
+                "not confirmed in the public text)")
+    return (f"inclined machine ({inclination(cfg.machine):g}°): the lateral part of its "
+            "weight on its bearings ([signoff] journal_load = \"as_acting\")")
 
 
 @dataclass(frozen=True)

@@ -4,15 +4,18 @@ reactions by the moment about each support; the current from f = Ki·i + Ks·s a
 
 from __future__ import annotations
 
+import json
 import math
 import tomllib
 
 import pytest
 
+from ambseal.analysis import rotor_at_rest
 from ambseal.analysis.signoff.unbalance_api617 import journal_load_rule, journal_loads
-from ambseal.analysis.statics import statics
-from ambseal.config import parse_rig
+from ambseal.cli import main
+from ambseal.config import dump_rig, parse_rig
 from ambseal.errors import ConfigError
+from ambseal.report import statics_section
 
 G0 = 9.80665  # standard gravity, m/s² (ISO 80000-3)
 L, D, RHO = 0.4, 0.1, 7850.0
@@ -81,7 +84,7 @@ def test_horizontal_rotor_on_two_ambs_is_the_hand_statics():
     it, i_ζ = i_η = R_A sin 45°/Ki_A; B's η axis (vertical) alone, i_η = R_B/Ki_B. The
     journal loads W are R/g₀ (kg); nothing axial."""
     m, ra, rb = _hand()
-    st = statics(parse_rig(_rig()))
+    st = rotor_at_rest(parse_rig(_rig()))
     a, b = st.ambs
     assert a.force_n == pytest.approx((0.0, ra), abs=1e-9 * m * G0)
     assert b.force_n == pytest.approx((0.0, rb), abs=1e-9 * m * G0)
@@ -101,7 +104,7 @@ def test_vertical_rotor_radial_ambs_carry_no_weight():
     as the horizontal rotor — and the report says so."""
     m, ra, rb = _hand()
     cfg = parse_rig(_rig('orientation = "vertical"'))
-    st = statics(cfg)
+    st = rotor_at_rest(cfg)
     for amb in st.ambs:
         assert amb.force_n == (0.0, 0.0) and amb.current_a == (0.0, 0.0)
     assert st.axial_weight_n == pytest.approx(-m * G0, rel=1e-12)
@@ -121,7 +124,7 @@ def test_inclined_rotor_splits_its_weight():
     m, ra, rb = _hand()
     c = math.cos(math.radians(30.0))
     machine = 'orientation = "inclined"\ninclination_deg = 30.0'
-    st = statics(parse_rig(_rig(machine)))
+    st = rotor_at_rest(parse_rig(_rig(machine)))
     assert st.ambs[1].current_a[1] == pytest.approx(c * rb / KI_B, rel=1e-9)
     assert st.ambs[0].current_a[0] == pytest.approx(c * ra * math.sqrt(0.5) / KI_A,
                                                     rel=1e-9)
@@ -139,3 +142,22 @@ def test_orientation_refusals_name_the_key(machine):
     orientation: one error naming the key."""
     with pytest.raises(ConfigError, match="orientation|inclination_deg"):
         parse_rig(_rig(machine))
+
+
+def test_validate_and_the_report_show_the_orientation(tmp_path, capsys):
+    """``ambseal validate`` and the run report's statics section state the orientation,
+    the AMBs' static currents (0 A on a vertical rotor) and the thrust bearing outside
+    the model that carries the weight m·g₀."""
+    m, _, _ = _hand()
+    rig = tmp_path / "vertical.toml"
+    rig.write_text(dump_rig(parse_rig(_rig('orientation = "vertical"'))))
+    assert main(["validate", str(rig)]) == 0
+    text = capsys.readouterr().out
+    assert "vertical machine: gravity (0, 0, -9.807) m/s²" in text
+    assert "AMB A holds the rotor at rest with zeta 0 A, eta 0 A" in text
+    assert f"axis, {m * G0:.4g} N, is carried by an axial (thrust) bearing" in text
+    assert main(["validate", str(rig), "--json"]) == 0
+    st = json.loads(capsys.readouterr().out)["statics"]
+    assert st["axial_weight_n"] == pytest.approx(-m * G0, rel=1e-12)
+    section = statics_section(st)
+    assert "A vertical machine" in section["html"] and "thrust" in section["html"]

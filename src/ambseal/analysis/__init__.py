@@ -37,9 +37,9 @@ sampled with its delay) on the full-order plant:
   margins and close clearances, on :func:`synchronous_response` (rotating
   :class:`Unbalance` with the loop as it runs); :func:`iso14839_2_zones` →
   :class:`IsoVibration`;
-* :class:`Statics`, :class:`AmbStatic`, :func:`support_forces` — the rotor held at rest
-  under gravity as the machine stands: each bearing's load, each AMB's static currents,
-  the axial weight (:func:`ambseal.analysis.statics.statics`);
+* :func:`rotor_at_rest` → :class:`Statics` (:class:`AmbStatic`), :func:`support_forces` —
+  the rotor held at rest under gravity as the machine stands: each bearing's load, each
+  AMB's static currents, the axial weight;
 * :func:`stability_boundary`, :func:`refine_boundary` — on the rows of
   :func:`ambseal.analysis.sweep.sweep` (:func:`parse_range`, :func:`check_cases`);
   :func:`stability_case`, :func:`stability_points` → :class:`StabilityCase` (with a
@@ -127,6 +127,7 @@ _FROM = {
     "mode_kind": "mode_naming", "failing_mode_kind": "mode_naming",
     "support_span_m": "mode_naming",
     "Statics": "statics", "AmbStatic": "statics", "support_forces": "statics",
+    "rotor_at_rest": "statics",
 }
 
 __all__ = sorted(_FROM)

@@ -38,7 +38,7 @@ from ambseal.model import (
     spring_label,
 )
 
-__all__ = ["RIGID_SUPPORT", "support_forces", "AmbStatic", "Statics", "statics"]
+__all__ = ["RIGID_SUPPORT", "support_forces", "AmbStatic", "Statics", "rotor_at_rest"]
 
 #: A rigid support's stiffness (N/m): the AMBs' pins of the statics and the sign-off's
 #: rigid supports, stiff against any rotor's bending (a 1 m steel shaft's is ~1e8 N/m).
@@ -177,7 +177,7 @@ class Statics:
                 "ambs": [a.to_dict() for a in self.ambs]}
 
 
-def statics(cfg) -> Statics:
+def rotor_at_rest(cfg) -> Statics:
     """The rotor of a rig held at rest under gravity as the machine stands (module
     docstring).
 
@@ -198,7 +198,7 @@ def statics(cfg) -> Statics:
     ambs = []
     for a in cfg.amb:
         share = [b for b in cfg.amb if b.position == a.position]
-        f = -loads[a.position] / len(share)  # the AMB's force on the rotor
+        f = -loads[a.position] / len(share) + 0.0  # on the rotor (+0.0: no signed zero)
         ki, _ = amb_factors(a)
         fa = axes_rotation(a.axes_angle_deg) @ f
         ambs.append(AmbStatic(a.name, float(a.position), (float(f[0]), float(f[1])),

@@ -18,7 +18,7 @@ from pathlib import Path
 import control
 import numpy as np
 
-from ambseal.analysis import judge_settings, modes_as_run, operating_points
+from ambseal.analysis import judge_settings, modes_as_run, operating_points, rotor_at_rest
 from ambseal.config import default_rig_path, dump_rig, load_rig, method_names, rig_with_values
 from ambseal.design import (
     Design,
@@ -740,7 +740,9 @@ def check_reference_rate(cfg, where) -> None:
 def validate_summary(rig: str | Path | None = None, overrides=()) -> dict:
     """``ambseal validate``: parse and check a rig file; its model and the defaults a run takes.
 
-    Returns a JSON-ready dict: ``rig``, ``name``, ``mass_kg``, ``nodes``, ``axes``; the modes
+    Returns a JSON-ready dict: ``rig``, ``name``, ``mass_kg``, ``nodes``, ``axes``;
+    ``statics``, the rotor held at rest as the machine stands (``[machine] orientation``:
+    :meth:`ambseal.analysis.statics.Statics.to_dict`, each AMB's static currents); the modes
     of the full model at the nominal condition below the controller's Nyquist frequency
     (``modes_below_hz``, ``modes`` as [f_Hz, ζ]); ``unstable_poles`` ([Re, Im] rad/s); and
     ``defaults``: the reduced model's order, the judged conditions, the controller's sample
@@ -773,6 +775,7 @@ def validate_summary(rig: str | Path | None = None, overrides=()) -> dict:
         "nodes": build_mesh(cfg).n_nodes, "axes": list(channel_names(cfg)),
         "modes_below_hz": limit, "modes": rows,
         "unstable_poles": [list(p) for p in res.unstable_poles],
+        "statics": rotor_at_rest(cfg).to_dict(),
         "defaults": {
             "reduced_states": build_plant(cfg, reduced=True).n_states,
             "judged_conditions": [p.label for p in operating_points(spec)] if spec else [],

@@ -251,6 +251,23 @@ def _plain(x) -> str:
     return "none" if x is None else f"{x:g}" if isinstance(x, float) else str(x)
 
 
+def _statics_lines(st: dict) -> list[str]:
+    """``validate``'s statics (:meth:`ambseal.analysis.statics.Statics.to_dict`) as text:
+    the orientation, each AMB's static currents, who carries the axial weight."""
+    tilt = (f" ({st['inclination_deg']:g}° above the horizontal)"
+            if st["orientation"] == "inclined" else "")
+    out = [f"{st['orientation']} machine{tilt}: gravity "
+           + "(" + ", ".join(f"{g:.4g}" for g in st["gravity_m_s2"]) + ") m/s² on x, y, z"]
+    for a in st["ambs"]:
+        cur = ", ".join(f"{axis} {'?' if i is None else f'{i:.4g}'} A"
+                        for axis, i in a["current_a"].items())
+        out.append(f"AMB {a['name']} holds the rotor at rest with {cur} "
+                   f"(force {a['force_n'][0]:.4g}, {a['force_n'][1]:.4g} N on x, y)")
+    if st["axial_note"]:
+        out.append(st["axial_note"])
+    return out
+
+
 def _validate(args: argparse.Namespace) -> int:
     v = validate_summary(args.rig, tuple(args.overrides))
     if args.json:
@@ -264,6 +281,8 @@ def _validate(args: argparse.Namespace) -> int:
     poles = v["unstable_poles"]
     print(f"  {len(poles)} unstable open-loop poles"
           + (": " + ", ".join(f"{re:.4g}{im:+.4g}j rad/s" for re, im in poles) if poles else ""))
+    for line in _statics_lines(v["statics"]):
+        print("  " + line)
     print("  defaults a run takes:")
     for key, val in v["defaults"].items():
         if key == "judged_conditions" and not val:

@@ -47,6 +47,7 @@ from ambseal.analysis import (
     synthesis_failure,
     unstable_open_loop_poles,
     verdict_line,
+    rotor_at_rest,
 )
 from ambseal.app.commands import (
     Designed,
@@ -98,6 +99,7 @@ from ambseal.report import (
     signoff_report,
     spinup_figures,
     stamp,
+    statics_section,
     write_run_report,
 )
 from ambseal.threads import with_numerics_threads
@@ -785,6 +787,7 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
                                                         st.design_cfg)) for d in st.designs]))
     figs += capacity_figure(out, cfg, currents)
     figs += rejection_figure(out, rejections)
+    sections.append(statics_section(rotor_at_rest(cfg).to_dict()))
     write_run_report(out, f"ambseal — {cfg.rotor.name}", stamp(rig_path, command),
                      metrics, curves, figs, sections, clearances,
                      judged_on(cfg, st.truth_cfg if ident is not None else None, truth))

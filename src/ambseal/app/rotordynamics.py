@@ -64,7 +64,7 @@ from ambseal.errors import ConfigError
 from ambseal.export import load_controller
 from ambseal.files import OwnedFolder, atomic_write, write_json, write_text
 from ambseal.io import import_ross_file
-from ambseal.model import channel_names
+from ambseal.model import channel_names, inclination
 from ambseal.report import (
     api617_unbalance_figure,
     campbell_figure,
@@ -269,6 +269,8 @@ def _signoff_into(args: argparse.Namespace) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     doc = {"rig": str(args.rig), "machine": cfg.machine.kind,
+           "orientation": cfg.machine.orientation,
+           "inclination_deg": inclination(cfg.machine),
            "passed": all(r.passed for r in results), "verdict": verdict_line(results),
            "controllers": {r.controller: r.to_dict() for r in results},
            "ucs_map": ucs.to_dict()}
@@ -286,6 +288,8 @@ def _signoff_into(args: argparse.Namespace) -> int:
         print(json.dumps({**doc, "files": [str(f) for f in files]}))
     else:
         print(doc["verdict"])
+        if results:  # what the unbalance's W stands on: the machine as it stands
+            print(f"journal static loads W: {results[0].unbalance.journal_load_rule}")
         for r in results:
             for c in r.criteria:
                 print(f"{r.controller}: {c.name}: {c.outcome} — {c.value} (limit {c.limit}; "

@@ -1,6 +1,6 @@
 """ambseal.report: figures (matplotlib, Agg) and the self-contained HTML report.
 
-* :func:`write_run_report`, :func:`stamp`, :func:`judged_on` —
+* :func:`write_run_report`, :func:`stamp`, :func:`judged_on`, :func:`statics_section` —
   the main job's ``report.html`` (:mod:`ambseal.report.run_report`), its figures
   (:func:`gains_figure`, :func:`capacity_figure`, :func:`rejection_figure`,
   :func:`spinup_figures`) and sections
@@ -48,6 +48,7 @@ _FROM = {
     "identification_report": "run_report", "judged_on": "run_report",
     "spinup_figures": "run_report",
     "stamp": "run_report", "write_run_report": "run_report",
+    "statics_section": "run_report",
     "ramp_figure": "tracking_figures", "tracking_figure": "tracking_figures",
     "target_difference": "verdict", "verdict_table_rich": "verdict", "verdicts": "verdict",
 }

@@ -36,7 +36,7 @@ from ambseal.report.identify_figures import (
 from ambseal.report.lpv_figures import frozen_sensitivity_figure, spinup_figure
 from ambseal.report.verdict import axis_label, sig
 
-__all__ = ["gains_figure", "capacity_figure", "rejection_figure", "spinup_figures",
+__all__ = ["statics_section", "gains_figure", "capacity_figure", "rejection_figure", "spinup_figures",
            "identification_report", "write_run_report", "stamp"]
 
 
@@ -572,6 +572,42 @@ def _speed_range_section(metrics: dict) -> list[dict]:
             "continuous with the target's delay and as it runs (sampled): its stability and "
             "the worst ISO 14839-3 zone of any axis there (the verdict counts it).")
     return [{"title": "From standstill to the top speed", "text": text, "html": table}]
+
+
+def statics_section(st: dict) -> dict:
+    """The report's section on the rotor held at rest as the machine stands: its
+    orientation and gravity, each bearing's load, each AMB's static current per axis and
+    who carries the axial weight.
+
+    Parameters
+    ----------
+    st : dict
+        :meth:`ambseal.analysis.statics.Statics.to_dict`.
+
+    Returns
+    -------
+    dict
+        ``{"title", "html"}`` for :func:`write_run_report`.
+    """
+    esc = html.escape
+    tilt = (f", the rotor axis {sig(st['inclination_deg'])}° above the horizontal"
+            if st["orientation"] == "inclined" else "")
+    g = ", ".join(sig(x) for x in st["gravity_m_s2"])
+    head = (f"<p>A {esc(st['orientation'])} machine{tilt}: gravity ({g}) m/s² on x, y, z "
+            f"(<code>[machine] orientation</code>); rotor mass {sig(st['mass_kg'])} kg. "
+            "Each AMB holds its journal at the set point: its static current is its "
+            "force over Ki (f = Ki·i + Ks·s at s = 0).</p>")
+    rows = "".join(
+        f"<tr><td>{esc(a['name'])}</td><td>{sig(a['position_m'])}</td>"
+        f"<td>{sig(a['force_n'][0])}</td><td>{sig(a['force_n'][1])}</td>"
+        + "".join(f"<td>{'—' if i is None else sig(i)}</td>"
+                  for i in a["current_a"].values()) + "</tr>"
+        for a in st["ambs"])
+    table = ("<table><tr><th>AMB</th><th>z (m)</th><th>F_x (N)</th><th>F_y (N)</th>"
+             "<th>i_ζ (A)</th><th>i_η (A)</th></tr>" + rows + "</table>") if rows else ""
+    axial = f"<p>{esc(st['axial_note'])}.</p>" if st["axial_note"] else ""
+    return {"title": "Statics: the rotor at rest as the machine stands",
+            "html": head + table + axial}
 
 
 def write_run_report(out: Path, title: str, meta: str, metrics: dict, curves: list,

@@ -227,9 +227,12 @@ def signoff_report(out: Path, results, rig_name: str, boundary=None) -> tuple[li
               "sources act on:</p><table><tr><th>controller</th>"
               "<th>loop with</th><th>f (Hz)</th><th>mode</th><th>δ</th><th>stable</th>"
               "</tr>" + l2 + "</table>")
+    rule = results[0].unbalance.journal_load_rule if results else ""
     note = ("<p>Each controller as it runs (the discrete controller with its delay). "
             "Limits the standards' public text could not confirm are the rig file's "
-            "<code>[signoff]</code> settings.</p>")
+            "<code>[signoff]</code> settings."
+            + (f" The journal static loads W of U_r = 6350·W/N: {esc(rule)}." if rule
+               else "") + "</p>")
     figures = [("API 617 Level I: log decrement of the screened forward mode against the "
                 "applied cross-coupling Q/Q_A, per controller; the critical speed ratio "
                 "against the average gas density with the Region A/B boundary", l1),

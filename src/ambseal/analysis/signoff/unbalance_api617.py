@@ -416,6 +416,9 @@ class Api617Unbalance:
         pressure_bar``, the controller as it runs) is stable at the maximum continuous
         speed: where it is not, a steady unbalance response does not exist and none of
         these criteria is graded (:mod:`ambseal.analysis.signoff`).
+    journal_load_rule : str
+        The rule the journal loads follow, in words (:func:`journal_load_rule`: the
+        machine's orientation and ``[signoff] journal_load``).
     """
 
     controller: str
@@ -427,6 +430,7 @@ class Api617Unbalance:
     vibration_limit_um: float
     cases: tuple
     loop_stable: bool = True
+    journal_load_rule: str = ""
 
     @property
     def probe_max_um(self) -> float:
@@ -454,6 +458,7 @@ class Api617Unbalance:
                 "trip_hz": self.trip_hz, "analysed_to_hz": self.top_hz,
                 "journal_loads": [{"position_m": z, "load_kg": w}
                                   for z, w in self.journal_loads],
+                "journal_load_rule": self.journal_load_rule,
                 "vibration_limit_um_pp": self.vibration_limit_um,
                 "probe_max_um_pp": self.probe_max_um,
                 "separation_passed": self.separation_passed,
@@ -468,8 +473,11 @@ def _placements(cfg, modes, loads, factor: float, n_rpm: float) -> list[tuple]:
     zs = [z for z, _ in loads]
     lo, hi = min(zs), max(zs)
     z_nodes = modes.node_z_m
-    outboard_mass = {side: _outboard_mass(cfg, z, side) for side, z in (("left", lo),
-                                                                        ("right", hi))}
+    # an outboard W is its mass's load under the journal loads' gravity (as_acting: the
+    # lateral part only)
+    share = abs(float(journal_gravity(cfg)[1])) / GRAVITY
+    outboard_mass = {side: share * _outboard_mass(cfg, z, side)
+                     for side, z in (("left", lo), ("right", hi))}
     total = sum(w for _, w in loads)
     # a journal that carries (almost) nothing gets the mean load: U_r needs W > 0
     loads = tuple((z, w if w > 1e-6 * total else total / len(loads)) for z, w in loads)
@@ -762,4 +770,4 @@ def api617_unbalance(cfg, controller=None, *, name: str = "none",
             progress(f"{name}: unbalance {c + 1}/{len(cases)} ({rule}): "
                      f"{len(crit)} critical(s), probes ≤ {out[-1].probe_max_um:.3g} µm p-p")
     return Api617Unbalance(name, f_min, f_max, trip, top, loads, a_vl, tuple(out),
-                           bool(modes.stable))
+                           bool(modes.stable), journal_load_rule(cfg))

@@ -355,3 +355,17 @@ def test_monte_carlo_drops_of_an_event(tmp_path, capsys):
         for row in rows[1:]:
             cells = dict(zip(head, row.split(",")))
             assert {p: float(cells[f"{p}_peak_force_n"]) > 0 for p in landed} == landed
+
+
+def test_a_standing_rotors_drop_says_it_is_taken_lying(tmp_path, capsys):
+    """A rig whose ``[machine] orientation`` is vertical: the drop still takes gravity
+    across the axis, and says so on stderr (a standing rotor's axial landing is not
+    modelled); a horizontal rig's drop says nothing of it."""
+    for orientation, said in (("vertical", True), ("horizontal", False)):
+        rig = tmp_path / f"{orientation}.toml"
+        rig.write_text(_rig_text() + f'[machine]\norientation = "{orientation}"\n')
+        code = main(["--quiet", "drop", str(rig), "--duration-s", "0.002", "--out",
+                     str(tmp_path / orientation), "--json"])
+        err = capsys.readouterr().err
+        assert code in (0, 1)
+        assert ('orientation = "vertical"' in err and "not modelled yet" in err) == said

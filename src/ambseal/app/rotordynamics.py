@@ -301,6 +301,13 @@ def _signoff_into(args: argparse.Namespace) -> int:
 @_owns_out
 def _drop(args: argparse.Namespace) -> int:
     cfg = load_rig(args.rig)
+    if cfg.machine.orientation != "horizontal":
+        # the drop's gravity is across the axis: said, so that its verdict is not read as
+        # that of a standing rotor's axial landing
+        logging.getLogger("ambseal").warning(
+            "drop: [machine] orientation = \"%s\", yet the drop takes gravity along −y (a "
+            "rotor lying horizontal, falling onto its radial rings): a standing rotor's "
+            "landing on its axial face is not modelled yet", cfg.machine.orientation)
     if args.speed_hz is not None:  # it stands for [operating] speed_rpm, as --speed-rpm
         check_operating({"speed_rpm": 60.0 * args.speed_hz},
                         {"speed_rpm": f"--speed-hz {args.speed_hz:g} "

@@ -19,6 +19,7 @@ from ambseal.analysis.signoff.unbalance_api617 import (
     vibration_limit_um,
 )
 from ambseal.config import parse_rig
+from ambseal.errors import ConfigError
 
 from .test_analysis_level1 import _rigid_rotor
 
@@ -399,3 +400,29 @@ def test_the_criticals_are_the_responses_own_peaks():
     n2 = brentq(lambda f: x(f) - xc / np.sqrt(2), fc, 1.1 * fc, xtol=1e-10 * fc)
     np.testing.assert_allclose([crit.speed_hz, crit.amplitude_um, crit.af],
                                [fc, xc, fc / (n2 - n1)], rtol=1e-6)
+
+
+def test_a_vertical_rotors_unbalance_is_apportioned_as_if_horizontal(tmp_path):
+    """The rotor of the closed-form test stood on end: its journals carry no gravity
+    load, yet by ``[signoff] journal_load = "as_horizontal"`` (the default) its journal
+    loads and the mid-span unbalance are the horizontal rotor's by hand, W = m/2 each and
+    2·6350·m/N at mid-span; the report's sign-off section states the rule. Asked for
+    gravity as it acts, the sign-off refuses the vertical rotor by the key's name."""
+    from ambseal.analysis import sign_off
+    from ambseal.report import signoff_report
+
+    m = math.pi / 4 * 0.2**2 * 0.4 * 7850.0
+    doc = tomllib.loads(_rigid_rotor(1e7, 2000.0, 4.5e4))
+    doc["machine"] = {"orientation": "vertical"}
+    cfg = parse_rig(doc)
+    assert [w for _, w in journal_loads(cfg)] == pytest.approx([m / 2, m / 2], rel=1e-3)
+    r = api617_unbalance(cfg)
+    (u,) = r.cases[0].unbalances
+    assert u.amount == pytest.approx(2 * 6350e-6 * m / 3000.0, rel=1e-3)
+    assert "as if it lay horizontal" in r.to_dict()["journal_load_rule"]
+    _, sections = signoff_report(tmp_path, [sign_off(cfg, name="none")], "vertical")
+    rule = "weight apportioned to its bearings by static equilibrium as if it lay horizontal"
+    assert rule in sections[0]["html"]
+    doc["signoff"] = {"journal_load": "as_acting"}
+    with pytest.raises(ConfigError, match="journal_load"):
+        sign_off(parse_rig(doc), name="none")

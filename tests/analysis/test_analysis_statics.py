@@ -134,6 +134,17 @@ def test_inclined_rotor_splits_its_weight():
         [Z_A, c * ra / G0, Z_B, c * rb / G0], rel=1e-9)
 
 
+def test_a_rotor_on_one_bearing_plane_is_not_held_statically():
+    """One AMB alone (or two at one position) leaves the weight's moment free: no static
+    position, so no loads and no currents, said as such (not a singular solve's noise)."""
+    one = _rig()
+    one["amb"] = one["amb"][:1]
+    st = rotor_at_rest(parse_rig(one))
+    assert not st.held and st.ambs == () and st.bearing_loads_n == ()
+    both = rotor_at_rest(parse_rig(_rig()))
+    assert both.held and len(both.bearing_loads_n) == 2
+
+
 @pytest.mark.parametrize("machine", ['orientation = "inclined"',
                                      'orientation = "vertical"\ninclination_deg = 90.0',
                                      'orientation = "sideways"'])

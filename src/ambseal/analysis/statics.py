@@ -148,6 +148,9 @@ class Statics:
         rotor's load on it.
     ambs : tuple of AmbStatic
         Each AMB's force and static currents.
+    held : bool
+        The bearings hold the rotor statically (False: none, or one bearing plane, which
+        leaves the weight's moment free; then no loads and no AMB currents).
     """
 
     orientation: str
@@ -157,6 +160,7 @@ class Statics:
     axial_weight_n: float
     bearing_loads_n: tuple[tuple[float, float, float], ...]
     ambs: tuple[AmbStatic, ...]
+    held: bool = True
 
     @property
     def axial_note(self) -> str | None:
@@ -174,7 +178,7 @@ class Statics:
                 "axial_weight_n": self.axial_weight_n, "axial_note": self.axial_note,
                 "bearing_loads_n": [{"position_m": z, "x": fx, "y": fy}
                                     for z, fx, fy in self.bearing_loads_n],
-                "ambs": [a.to_dict() for a in self.ambs]}
+                "ambs": [a.to_dict() for a in self.ambs], "held": self.held}
 
 
 def rotor_at_rest(cfg) -> Statics:
@@ -189,14 +193,16 @@ def rotor_at_rest(cfg) -> Statics:
     Returns
     -------
     Statics
-        On a rig with neither AMBs nor bearing springs, no bearing loads.
+        On a rig with neither AMBs nor bearing springs, or whose bearings do not hold
+        the rotor statically (one bearing plane: nothing takes the weight's moment), no
+        bearing loads and no AMB currents.
     """
     g = gravity_vector(cfg.machine)
     mass = assemble_rotor(cfg).mass
     has_bearing = cfg.amb or any(s.kind != "seal" for s in cfg.spring)
-    loads = support_forces(cfg, g)[0] if has_bearing else {}
+    loads = _held(cfg, g) if has_bearing else {}
     ambs = []
-    for a in cfg.amb:
+    for a in cfg.amb if loads else ():
         share = [b for b in cfg.amb if b.position == a.position]
         f = -loads[a.position] / len(share) + 0.0  # on the rotor (+0.0: no signed zero)
         ki, _ = amb_factors(a)
@@ -207,4 +213,16 @@ def rotor_at_rest(cfg) -> Statics:
     return Statics(cfg.machine.orientation, inclination(cfg.machine),
                    tuple(float(x) for x in g), float(mass), axial_weight(mass, g),
                    tuple((float(z), float(F[0]), float(F[1])) for z, F in loads.items()),
-                   tuple(ambs))
+                   tuple(ambs), bool(loads))
+
+
+def _held(cfg, g) -> dict:
+    """:func:`support_forces`' loads where the bearings hold the rotor (their loads sum to
+    the weight's lateral part within 1e-6 of it), else none."""
+    try:
+        loads, applied = support_forces(cfg, g)
+    except np.linalg.LinAlgError:  # a rotor free to tilt or slide: no static position
+        return {}
+    total = sum(loads.values(), np.zeros(2))
+    scale = max(float(np.abs(applied).max()), 1.0)
+    return loads if float(np.abs(total - applied).max()) <= 1e-6 * scale else {}

@@ -263,6 +263,9 @@ def _statics_lines(st: dict) -> list[str]:
                         for axis, i in a["current_a"].items())
         out.append(f"AMB {a['name']} holds the rotor at rest with {cur} "
                    f"(force {a['force_n'][0]:.4g}, {a['force_n'][1]:.4g} N on x, y)")
+    if not st["held"]:
+        out.append("the bearings do not hold the rotor statically (one bearing plane: "
+                   "nothing takes the weight's moment): no static currents")
     if st["axial_note"]:
         out.append(st["axial_note"])
     return out

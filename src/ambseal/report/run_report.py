@@ -606,6 +606,9 @@ def statics_section(st: dict) -> dict:
     table = ("<table><tr><th>AMB</th><th>z (m)</th><th>F_x (N)</th><th>F_y (N)</th>"
              "<th>i_ζ (A)</th><th>i_η (A)</th></tr>" + rows + "</table>") if rows else ""
     axial = f"<p>{esc(st['axial_note'])}.</p>" if st["axial_note"] else ""
+    if not st["held"]:
+        axial = ("<p>The bearings do not hold the rotor statically (one bearing plane: "
+                 "nothing takes the weight's moment): no static currents.</p>" + axial)
     return {"title": "Statics: the rotor at rest as the machine stands",
             "html": head + table + axial}
 

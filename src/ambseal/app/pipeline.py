@@ -37,6 +37,7 @@ from ambseal.analysis import (
     rejection_effect,
     rig_clearances_um,
     rejection_stability,
+    rotor_at_rest,
     run_cases,
     saturates,
     saturation_failure,
@@ -47,7 +48,6 @@ from ambseal.analysis import (
     synthesis_failure,
     unstable_open_loop_poles,
     verdict_line,
-    rotor_at_rest,
 )
 from ambseal.app.commands import (
     Designed,

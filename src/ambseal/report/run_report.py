@@ -36,8 +36,8 @@ from ambseal.report.identify_figures import (
 from ambseal.report.lpv_figures import frozen_sensitivity_figure, spinup_figure
 from ambseal.report.verdict import axis_label, sig
 
-__all__ = ["statics_section", "gains_figure", "capacity_figure", "rejection_figure", "spinup_figures",
-           "identification_report", "write_run_report", "stamp"]
+__all__ = ["gains_figure", "capacity_figure", "rejection_figure", "spinup_figures",
+           "identification_report", "write_run_report", "stamp", "statics_section"]
 
 
 def stamp(rig_path: str | Path, command: str | None = None) -> str:

@@ -102,7 +102,8 @@ from ambseal.model import (
 )
 
 __all__ = ["unbalance_ur", "vibration_limit_um", "amplification_factor", "exact_half_power",
-           "required_margin", "journal_loads", "journal_gravity", "journal_load_rule", "Critical", "Clearance", "UnbalanceCase",
+           "required_margin", "journal_loads", "journal_gravity", "journal_load_rule",
+           "Critical", "Clearance", "UnbalanceCase",
            "Api617Unbalance", "api617_unbalance", "antinode_unbalances"]
 
 #: API 617 placement (module docstring; ROSS 3.1's ``api617_unbalance``): nodes below

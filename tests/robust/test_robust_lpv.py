@@ -8,6 +8,8 @@ reduced model), P3 §4 (speed as scheduling parameter, synchronous seal coeffici
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -606,3 +608,39 @@ def test_an_sdp_stopped_at_its_iteration_cap_says_so():
         cl = _frozen_loop(_toy(p), capped.K.at(p))
         assert cl.poles().real.max() < 0
         assert ct.norm(cl, "inf") <= 1.02 * capped.gamma_design * (1 + 1e-3)
+
+
+def test_a_solve_that_stopped_short_is_not_kept_before_an_optimal_one(monkeypatch):
+    """Reference: lpvsyn's own reports, and the same synthesis without the trace weight's
+    continuation. With a trace weight of 10 the LTI family's γ SDP takes the continuation
+    (the weight lowered while γ falls). Where every solve after the first stops short of
+    its tolerances (CVXOPT's ``"unknown"`` on a point where the LMIs hold, reported
+    ``"feasible"``: here made so by keeping its solution and changing its status only),
+    the lower γ it reached is where the solver stopped, which another machine's rounding
+    moves: the synthesis keeps the first, optimal solve — the controller and γ of the
+    synthesis without the continuation — and says it ended optimal."""
+    import ambseal.robust._lmi_sdp as sdp
+
+    P = _lti_family_plant()
+    real_solve, calls = sdp.solve_lmis, []
+
+    def first_optimal(*a, **k):
+        sol = real_solve(*a, **k)
+        calls.append(sol.status)
+        return sol if len(calls) == 1 else dataclasses.replace(sol, status="feasible")
+
+    kw = dict(penalty=10.0, frozen_check=False, scaling="diagonal")
+    monkeypatch.setattr("ambseal.robust.lpv.PENALTY_SHARE", np.inf)  # one scaling only
+    free = lpvsyn([P] * 3, [1.0, 2.0, 3.0], 1, 1, **kw)
+    assert sum(r.stage == "gamma" for r in free.reports) > 1  # the continuation ran
+    monkeypatch.setattr(sdp, "solve_lmis", first_optimal)
+    r = lpvsyn([P] * 3, [1.0, 2.0, 3.0], 1, 1, **kw)
+    monkeypatch.setattr(sdp, "solve_lmis", real_solve)
+    monkeypatch.setattr("ambseal.robust._lpv_lmi.PENALTY_STEPS", 0)
+    first = lpvsyn([P] * 3, [1.0, 2.0, 3.0], 1, 1, **kw)
+    assert len(calls) > 1 and r.sdp_status == {"gamma": "optimal"}
+    assert r.sdp_shortfall == ""
+    assert r.gamma == first.gamma > free.gamma
+    np.testing.assert_array_equal(r.K.at(2.0).A, first.K.at(2.0).A)
+    used = [x for x in r.reports if x.stage == "gamma" and x.used]
+    assert len(used) == 1 and used[0].status == "optimal"

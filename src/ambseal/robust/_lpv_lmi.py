@@ -465,8 +465,10 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
     # The trace term keeps R and S bounded, but where they must grow large it also buys a
     # smaller trace with a larger γ: while its share of the cost exceeds PENALTY_SHARE the
     # weight is lowered to half that share and the SDP solved again (at most
-    # PENALTY_STEPS times; a solve that fails, does not lower γ or leaves R and S too
-    # large for the controller's reconstruction, RECONSTRUCTION_LOSS, ends the continuation).
+    # PENALTY_STEPS times; a solve that fails, stops short of optimal (its solution is
+    # where CVXOPT stopped, which the machine's rounding moves; the optimum it left is
+    # not), does not lower γ or leaves R and S too large for the controller's
+    # reconstruction, RECONSTRUCTION_LOSS, ends the continuation).
     def share_of(sol, weight):
         return weight * float(tr @ [np.trace(X) for X in sol.X]) / max(float(sol.gamma),
                                                                        1e-300)
@@ -482,7 +484,7 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
                                "gamma", reports)
         except SynthesisError:
             break
-        if not float(lower.gamma) < float(sol.gamma) or \
+        if lower.status != "optimal" or not float(lower.gamma) < float(sol.gamma) or \
                 _reconstruction_loss(lower.X[:nbR], lower.X[nbR:], at) > RECONSTRUCTION_LOSS:
             break
         sol, weight, kept = lower, lower_weight, len(reports) - 1

@@ -43,9 +43,11 @@ SDPs are solved by CVXOPT with a Schur complement formed from the LMIs' Kronecke
 from an inaccurate solution is refused), but for ``feasible``: CVXOPT stopped short of its
 tolerances, at its iteration cap or stalled, on a point where every LMI holds. γ is then a
 bound those LMIs certify, not the optimum, and the controller is the one where the solver
-stopped — another machine's rounding stops it elsewhere. The result says so:
-:attr:`LpvSynResult.sdp_status`, the status each stage ended on, and
-:attr:`LpvSynResult.sdp_shortfall` in words.
+stopped — another machine's rounding stops it elsewhere. So the synthesis keeps a solve
+that ended ``optimal`` before one with a lower γ that did not: between the trace term's
+continuation steps, the rebalanced scaling and the Riccati or diagonal scaling. Where
+none ended optimal the result says so: :attr:`LpvSynResult.sdp_status`, the status each
+stage ended on, and :attr:`LpvSynResult.sdp_shortfall` in words.
 """
 from __future__ import annotations
 
@@ -309,8 +311,8 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
        or S would otherwise grow without limit (a hard cap on R, S sits on the cap and
        stalls the interior point). Where that term takes more than 1 % of the cost (R, S
        must be large: then it would raise γ), its weight is lowered to half that share and
-       the SDP solved again, up to three times while γ falls (``penalty_share`` says where
-       it ended).
+       the SDP solved again, up to three times while γ falls and the solve ends
+       ``optimal`` (``penalty_share`` says where it ended).
     2. ``"centre"`` (only with ``centre=True``): stage 1 with α = 1, then at
        γ_d = backoff·γ minimise tr R + mean_k tr S(θ_k) with α = ``coupling_ratio``
        (lowered towards 1 if infeasible). Gives the least conservative γ, but with a
@@ -434,10 +436,12 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
     else:
         try:
             r = _synthesise(data, "riccati", **settings)
-            if r.penalty_share > PENALTY_SHARE:  # γ held up by the trace term: try the other
+            # γ held up by the trace term, or an SDP that stopped short of optimal: try the
+            # other scaling, and keep an optimal solve before a lower γ
+            if r.penalty_share > PENALTY_SHARE or not _optimal(r):
                 try:
                     alt = _synthesise(data, "diagonal", **settings)
-                    if alt.gamma < r.gamma:
+                    if (not _optimal(alt), alt.gamma) < (not _optimal(r), r.gamma):
                         r = alt
                 except SynthesisError:
                     pass
@@ -451,6 +455,18 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
     if frozen_check:
         r = _against_frozen(r, data, solver_options, margin)
     return replace(r, time_s=time.perf_counter() - t_start)
+
+
+def _optimal(r: LpvSynResult) -> bool:
+    """Whether every SDP stage the controller was built from ended ``optimal``."""
+    return not _short(r.reports)
+
+
+def _short(reports) -> bool:
+    """Whether an SDP stage the controller would be built from stopped short of
+    ``optimal``: a solution where CVXOPT stopped follows the machine's rounding, an optimum
+    does not, so between two solves an optimal one is kept before a lower γ."""
+    return any(v != "optimal" for v in sdp_status(reports).values())
 
 
 #: Relative margin by which the best frozen-point design must beat the scheduled
@@ -505,7 +521,7 @@ def _synthesise(data, scaling: str, *, lyapunov, lyapunov_r, rate_bound, backoff
             again = solve_lmis(sc2, blocks2, grid, lyapunov, nu_s, **lmi_kw)
         except SynthesisError:
             again = None
-        if again is not None and again[0] < gamma:
+        if again is not None and (_short(again[4]), again[0]) < (_short(reports), gamma):
             sc, blocks = sc2, blocks2
             gamma, gamma_d, R, S, more, share = again
             reports = [replace(r, used=False) for r in reports] + more

@@ -350,12 +350,22 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "Touchdown.E": ("Pa", "Young's modulus of both contacting bodies (default: AISI 52100 "
                           "bearing steel, Harris & Kotzalas 2007)"),
     "Touchdown.nu": ("", "Poisson's ratio of both bodies (default: 52100 steel)"),
-    "Touchdown.damping_law": ("", "contact damping F = K·δ^n·(1 + D·δ̇): "
-                                  "``hunt_crossley`` D = 3(1 − e)/(2v₀), "
-                                  "``lankarani_nikravesh`` 3(1 − e²)/(4v₀), ``flores`` "
-                                  "8(1 − e)/(5e·v₀) (default: valid over the whole range "
-                                  "of e), v₀ the impact's normal speed"),
-    "Touchdown.restitution": ("", "coefficient of restitution e of the contact (required)"),
+    "Touchdown.damping_law": ("", "the published law ``law_restitution`` is read by, "
+                                  "F = K·δ^n·(1 + D·δ̇): ``hunt_crossley`` "
+                                  "D = 3(1 − e)/(2v₀), ``lankarani_nikravesh`` "
+                                  "3(1 − e²)/(4v₀), ``flores`` 8(1 − e)/(5e·v₀) (default), "
+                                  "v₀ the impact's normal speed; only with "
+                                  "``law_restitution``"),
+    "Touchdown.restitution": ("", "the measured coefficient of restitution e of one impact "
+                                  "(rebound over approach normal speed); the damping "
+                                  "D = ζ/v₀ is solved for it exactly, "
+                                  "ζ(1 + e) = ln((1 + ζ)/(1 − eζ)) (Carvalho & Martins "
+                                  "2019); this or ``law_restitution`` is required"),
+    "Touchdown.law_restitution": ("", "the e of ``damping_law``'s own formula, as its "
+                                      "paper uses it (an impact rebounds at it only near "
+                                      "1: Hunt–Crossley's e = 0.6 at 0.71, "
+                                      "Lankarani–Nikravesh's at 0.76); instead of "
+                                      "``restitution``"),
     "Touchdown.friction": ("", "Coulomb friction coefficient μ of the journal on the ring "
                                "(required)"),
     "Touchdown.friction_velocity": ("m/s", "slip speed of the regularised Coulomb law "

@@ -87,7 +87,6 @@ from ambseal.model import (
     SpringElement,
     assemble_rotor,
     build_mesh,
-    damping_coefficient,
     friction_force,
     hertz_impact,
     normal_force,
@@ -1155,8 +1154,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             delta = d - dm.clearance[p]
             rate = np.einsum("ij,ij->j", rel, vel) / np.where(d > 0, d, 1.0)
             law = dm.laws[p]
-            N = normal_force(delta, rate, law.stiffness, law.exponent,
-                             damping_coefficient(law.law, law.restitution, v0[p]))
+            N = normal_force(delta, rate, law.stiffness, law.exponent, law.damping(v0[p]))
             peak_force[p] = max(peak_force[p], float(N.max()))
             if touching[p] and not first_over[p]:
                 first_peak[p] = max(first_peak[p], float(N.max()))
@@ -1165,8 +1163,7 @@ def simulate_drop(cfg, *, speed_rpm: float = 0.0, duration_s: float = 0.5,
             d_ax = np.abs(Yf[i_ax]) - c_ax[p]
             law = dm.axial_laws[p]
             N = normal_force(d_ax, np.sign(Yf[i_ax]) * Yf[i_ax + 1], law.stiffness,
-                             law.exponent, damping_coefficient(law.law, law.restitution,
-                                                               v0_ax[p]))
+                             law.exponent, law.damping(v0_ax[p]))
             peak_ax_force[p] = max(peak_ax_force[p], float(N.max()))
             peak_ax_delta[p] = max(peak_ax_delta[p], float(d_ax.max()))
         hit = [k for k, te in enumerate(r.t_events) if te.size]

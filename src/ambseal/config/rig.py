@@ -503,8 +503,9 @@ class Touchdown(_Strict):
     or ``"line"`` (n = 10/9, Palmgren), K as ``contact_stiffness`` (N/m^n) or from the
     geometry — a point contact's effective radius ``contact_radius`` (m) with ``E`` and
     ``nu`` of both bodies, a line contact's ``contact_length`` (m; Palmgren's relation,
-    bearing steel); the contact damping by ``damping_law`` at the coefficient of
-    ``restitution``; regularised Coulomb ``friction`` with ``friction_velocity`` (m/s, at
+    bearing steel); the contact damping solved for the measured coefficient of
+    ``restitution`` e (rebound over approach speed of one impact), or a published
+    ``damping_law`` at its own ``law_restitution`` (one of the two); regularised Coulomb ``friction`` with ``friction_velocity`` (m/s, at
     least :data:`~ambseal.config._checks.MIN_FRICTION_VELOCITY`: the slip the drop's
     stiff integrator resolves); the ring's ``race_inertia`` (kg·m²) and
     ``race_drag_torque`` (N·m); the support's ``support_stiffness`` (N/m; left out,
@@ -515,7 +516,7 @@ class Touchdown(_Strict):
     ``axial_clearance`` (m) is given the bearing also stops the rotor axially, with the
     radial law's K or ``axial_contact_stiffness``. With ``race_mass`` (kg) the friction
     heat of the drop is reported as the ring's temperature rise at
-    ``race_specific_heat``. ``restitution`` and ``friction`` have no default: no
+    ``race_specific_heat``. The restitution and ``friction`` have no default: no
     public source gives one for every pair of surfaces. Across the rig
     (:func:`~ambseal.config._checks.cross_check`): each bearing's ``name`` its own, each
     its own plane, and every ``radial_clearance`` below every AMB's ``air_gap`` and
@@ -536,7 +537,12 @@ class Touchdown(_Strict):
     nu: float = Field(default=0.3, ge=0, lt=0.5)
     # Flores et al. (2011): the one law valid from plastic-like to elastic impacts
     damping_law: Literal["hunt_crossley", "lankarani_nikravesh", "flores"] = "flores"
-    restitution: float = Field(gt=0, le=1.0)
+    # the coefficient of restitution of one impact, as measured: the damping is solved
+    # for it exactly (ambseal.model.contact.damping_factor), whichever damping_law
+    restitution: float | None = Field(default=None, gt=0, le=1.0)
+    # the e of damping_law's own formula, as its paper gives it: an impact then rebounds
+    # at that e only near 1 (kept to reproduce a published model)
+    law_restitution: float | None = Field(default=None, gt=0, le=1.0)
     friction: float = Field(ge=0, le=2.0)
     # the slip speed below which friction grows in proportion to it (the regularisation):
     # small against a landing rotor's surface speed, tens of m/s; at least what the drop's
@@ -562,6 +568,16 @@ class Touchdown(_Strict):
 
     @model_validator(mode="after")
     def _stiffness(self) -> "Touchdown":
+        if (self.restitution is None) == (self.law_restitution is None):
+            raise ValueError("restitution: give the measured coefficient of restitution e "
+                             "(restitution) or damping_law's own e (law_restitution), "
+                             "one of the two" + (", not both" if self.restitution else ""))
+        # a default written back by dump_rig is no key of the user's
+        if (self.law_restitution is None
+                and self.damping_law != type(self).model_fields["damping_law"].default):
+            raise ValueError("damping_law: it reads law_restitution; with the measured "
+                             "restitution the damping is solved for it, whatever the law "
+                             "- leave damping_law out or give law_restitution")
         if self.contact_stiffness is None:
             if self.contact == "point" and self.contact_radius is None:
                 raise ValueError("contact_radius: a point contact without "

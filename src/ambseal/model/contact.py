@@ -9,18 +9,34 @@ a damping that vanishes with δ (Hunt & Crossley 1975):
 n = 3/2 for a point contact (Hertz; K = (4/3)·E*·√R*, Johnson, *Contact Mechanics*,
 1985, §4.2) and n = 10/9 for a line contact (Palmgren's relation for bearing steel,
 δ = 3.84·10⁻⁵·Q^0.9/l^0.8 in mm and N; Harris & Kotzalas, *Rolling Bearing Analysis*,
-5th ed., 2007). D (s/m) sets the coefficient of restitution e at the impact's normal
-speed v₀, by one of three published laws:
+5th ed., 2007). D (s/m) is the damping factor ζ over the impact's normal speed v₀,
+D = ζ/v₀, so that every impact of the law rebounds at the same fraction of its speed.
 
-* Hunt & Crossley (1975): D = 3(1 − e)/(2v₀), derived for e near 1;
-* Lankarani & Nikravesh (1990): D = 3(1 − e²)/(4v₀), the same limit;
-* Flores, Machado, Silva & Martins (2011): D = 8(1 − e)/(5e·v₀), close to e over its
-  whole range.
+**The measured restitution.** A mass m striking the law at v₀ obeys m·v·dv/dδ =
+−K·δ^n·(1 + D·v), whose variables separate; integrated in and out again
+(v₀ → 0 → −e·v₀ while δ goes 0 → δ_max → 0) the two halves store the same
+K·δ_max^{n+1}/(n+1), so the coefficient of restitution e of one impact and ζ = D·v₀ are
+tied, whatever K, m, v₀ and n, by
+
+    ζ·(1 + e) = ln((1 + ζ)/(1 − e·ζ)),    e = (1 + W₀(−(1 + ζ)·e^{−(1+ζ)}))/ζ,
+
+W₀ Lambert's function (Carvalho & Martins, "Exact restitution and generalizations for
+the Hunt–Crossley contact model", *Mech. Mach. Theory* 139, 2019): a measured e gives ζ
+(:func:`damping_factor`), and ζ gives the impact's e (:func:`impact_restitution`). Its
+rebound stays below 1/D, so the bracket never turns negative in one impact.
+
+**The published laws** approximate that relation by ζ = f(e), their "e" (here
+``law_restitution``) then the impact's restitution only near 1 (:data:`DAMPING_LAWS`):
+
+* Hunt & Crossley (1975): ζ = 3(1 − e)/2, derived for e near 1;
+* Lankarani & Nikravesh (1990): ζ = 3(1 − e²)/4, the same limit;
+* Flores, Machado, Silva & Martins (2011): ζ = 8(1 − e)/(5e).
 
 Integrated through one impact, the three give different restitutions for the same e
-away from 1 (at e = 0.5 about 0.66, 0.73 and 0.47), and agree near it. The tangential
-force is Coulomb's, regularised so that a slip speed v below ``v_r`` is not a
-discontinuity: F_t = μ·N·tanh(v/v_r).
+away from 1 (at e = 0.5 about 0.66, 0.73 and 0.47; at 0.6, 0.71, 0.76 and 0.58), and
+agree near it; :func:`law_restitution` is the e a law needs for a measured one. The
+tangential force is Coulomb's, regularised so that a slip speed v below ``v_r`` is not
+a discontinuity: F_t = μ·N·tanh(v/v_r).
 
 Without damping an impact of a mass m at v₀ ends where the kinetic energy is stored,
 (½)m v₀² = K δ_max^{n+1}/(n+1), and lasts t_c = 2(δ_max/v₀)·∫₀¹(1 − u^{n+1})^{-½}du
@@ -41,10 +57,13 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import brentq
+from scipy.special import lambertw
 
 __all__ = ["N_POINT", "N_LINE", "PALMGREN_MM", "DAMPING_LAWS", "effective_modulus",
            "point_stiffness", "line_stiffness", "damping_coefficient", "normal_force",
-           "friction_force", "hertz_impact", "rated_contact_stress", "ISO76_STRESS_PA",
+           "friction_force", "hertz_impact", "damping_factor", "impact_restitution",
+           "law_restitution", "rated_contact_stress", "ISO76_STRESS_PA",
            "ContactLaw"]
 
 #: Hertz's exponent of a point contact and Palmgren's of a line contact
@@ -54,7 +73,7 @@ PALMGREN_MM = 3.84e-5
 #: ISO 76:2006 §3.1: the contact stress (Pa) at C₀ in a ball and in a roller bearing
 #: (4 600 MPa for self-aligning ball bearings, not a touchdown bearing's kind)
 ISO76_STRESS_PA = {"ball": 4.2e9, "roller": 4.0e9}
-#: the damping laws, by their rig-file names: D·v₀ as a function of e
+#: the published damping laws, by their rig-file names: ζ = D·v₀ as a function of their e
 DAMPING_LAWS = {
     "hunt_crossley": lambda e: 1.5 * (1.0 - e),
     "lankarani_nikravesh": lambda e: 0.75 * (1.0 - e * e),
@@ -118,13 +137,15 @@ def line_stiffness(length: float) -> float:
 
 
 def damping_coefficient(law: str, restitution: float, impact_speed: float) -> float:
-    """D of F = K·δ^n·(1 + D·δ̇) for an impact at ``impact_speed`` (module docstring).
+    """D of F = K·δ^n·(1 + D·δ̇) by a published ``law`` at its own e, for an impact at
+    ``impact_speed`` (module docstring): the impact's restitution is that e only near 1
+    (:func:`damping_factor` gives the D of a measured one).
 
     Parameters
     ----------
     law : {"hunt_crossley", "lankarani_nikravesh", "flores"}
     restitution : float
-        The coefficient of restitution e, in (0, 1].
+        The law's e (``law_restitution``), in (0, 1].
     impact_speed : float
         The normal speed v₀ at the start of the impact (m/s), > 0.
 
@@ -146,6 +167,89 @@ def damping_coefficient(law: str, restitution: float, impact_speed: float) -> fl
     if not impact_speed > 0.0:
         raise ValueError(f"impact speed: expected > 0 m/s, got {impact_speed!r}")
     return DAMPING_LAWS[law](restitution) / impact_speed
+
+
+def impact_restitution(factor: float) -> float:
+    """The coefficient of restitution of one impact on F = K·δ^n·(1 + D·δ̇) at
+    D·v₀ = ``factor`` (module docstring; Carvalho & Martins 2019), for any K, m, v₀, n.
+
+    Parameters
+    ----------
+    factor : float
+        ζ = D·v₀, ≥ 0.
+
+    Returns
+    -------
+    float
+        e, in (0, 1]; 1 at ζ = 0.
+    """
+    if factor <= 0.0:
+        return 1.0
+    if factor < 1e-6:  # W₀ near its branch point loses the digits; HC's limit holds
+        return 1.0 - 2.0 * factor / 3.0
+    x = 1.0 + factor
+    return float((1.0 + lambertw(-x * math.exp(-x), 0).real) / factor)
+
+
+def _excess(factor: float, e: float) -> float:
+    """[ζ(1 + e) − ln((1 + ζ)/(1 − eζ))]/ζ², positive below the root, −∞ at ζ = 1/e;
+    its series Σ_{k≥2} −((−1)^{k+1} + e^k)·ζ^{k−2}/k where the closed form cancels."""
+    if factor < 0.25:
+        k = np.arange(2, 60)
+        return float(-np.sum(((-1.0) ** (k + 1) + e ** k) * factor ** (k - 2) / k))
+    return (factor * (1.0 + e) - math.log1p(factor) + math.log1p(-e * factor)) / factor ** 2
+
+
+def damping_factor(restitution: float) -> float:
+    """ζ = D·v₀ of F = K·δ^n·(1 + D·δ̇) whose impacts rebound at ``restitution`` times
+    their speed: the root of ζ(1 + e) = ln((1 + ζ)/(1 − eζ)) in (0, 1/e) (module
+    docstring), the same for every K, mass, speed and exponent.
+
+    Parameters
+    ----------
+    restitution : float
+        The measured coefficient of restitution e, in (0, 1].
+
+    Returns
+    -------
+    float
+        ζ ≥ 0 (0 at e = 1; about 1/e as e → 0).
+
+    Raises
+    ------
+    ValueError
+        e outside (0, 1].
+    """
+    e = restitution
+    if not 0.0 < e <= 1.0:
+        raise ValueError(f"restitution: expected 0 < e <= 1, got {restitution!r}")
+    if e == 1.0:
+        return 0.0
+    top = (1.0 - 1e-15) / e
+    return float(brentq(_excess, 1e-300, top, args=(e,), xtol=1e-15, rtol=1e-13))
+
+
+def law_restitution(law: str, restitution: float) -> float | None:
+    """The e a published ``law`` must be given for its impacts to rebound at the measured
+    ``restitution``: its ζ = f(e) solved for :func:`damping_factor` (closed forms).
+
+    Parameters
+    ----------
+    law : {"hunt_crossley", "lankarani_nikravesh", "flores"}
+    restitution : float
+        The measured e, in (0, 1].
+
+    Returns
+    -------
+    float or None
+        The law's e, in (0, 1]; None where no e of the law reaches that damping
+        (Hunt–Crossley's ζ ≤ 3/2, Lankarani–Nikravesh's ζ ≤ 3/4).
+    """
+    z = damping_factor(restitution)
+    e = {"hunt_crossley": lambda: 1.0 - z / 1.5,
+         "lankarani_nikravesh": lambda: math.sqrt(max(1.0 - z / 0.75, 0.0)),
+         "flores": lambda: 1.6 / (z + 1.6)}[law]()
+    return e if 0.0 < e <= 1.0 else None
 
 
 def normal_force(delta, delta_rate, stiffness: float, exponent: float, damping: float):
@@ -265,10 +369,9 @@ class ContactLaw:
         K (N/m^n).
     exponent : float
         n.
-    law : str
-        The damping law (:data:`DAMPING_LAWS`).
-    restitution : float
-        e.
+    factor : float
+        ζ = D·v₀ (:func:`damping_factor` of the measured e, or a published law's
+        ζ of its own e).
     friction : float
         μ.
     friction_velocity : float
@@ -277,25 +380,37 @@ class ContactLaw:
 
     stiffness: float
     exponent: float
-    law: str
-    restitution: float
+    factor: float
     friction: float
     friction_velocity: float
 
     @classmethod
     def of(cls, touchdown) -> "ContactLaw":
         """The law of a ``[[touchdown]]`` table (:class:`ambseal.config.Touchdown`): K as
-        given, or from its contact radius (point) or length (line)."""
+        given, or from its contact radius (point) or length (line); ζ from the measured
+        ``restitution``, else ``damping_law`` at its ``law_restitution``."""
         n = N_POINT if touchdown.contact == "point" else N_LINE
         k = touchdown.contact_stiffness
         if k is None:
             k = (point_stiffness(touchdown.E, touchdown.nu, touchdown.contact_radius)
                  if touchdown.contact == "point" else line_stiffness(touchdown.contact_length))
-        return cls(float(k), n, touchdown.damping_law, touchdown.restitution,
-                   touchdown.friction, touchdown.friction_velocity)
+        if touchdown.restitution is not None:
+            factor = damping_factor(touchdown.restitution)
+        else:
+            factor = DAMPING_LAWS[touchdown.damping_law](touchdown.law_restitution)
+        return cls(float(k), n, factor, touchdown.friction, touchdown.friction_velocity)
+
+    @property
+    def restitution(self) -> float:
+        """The coefficient of restitution of one impact on this law."""
+        return impact_restitution(self.factor)
+
+    def damping(self, impact_speed: float) -> float:
+        """D = ζ/v₀ (s/m) of an impact that began at ``impact_speed`` (m/s), > 0."""
+        return self.factor / impact_speed
 
     def force(self, delta, delta_rate, impact_speed: float):
         """The normal force (N) at penetration ``delta`` (m) and its rate (m/s), in an
         impact that began at ``impact_speed`` (m/s)."""
         return normal_force(delta, delta_rate, self.stiffness, self.exponent,
-                            damping_coefficient(self.law, self.restitution, impact_speed))
+                            self.damping(impact_speed))

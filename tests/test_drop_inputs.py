@@ -184,7 +184,7 @@ def test_a_rotor_turning_the_other_way_drops_as_the_mirror_image(tmp_path, capsy
 def test_the_speed_in_hz_is_bounded_as_the_speed_in_rpm(tmp_path, capsys):
     """``--speed-hz`` is ``[operating] speed_rpm``'s speed in other units: 50 000 Hz
     (3e6 rpm) is refused as ``--speed-rpm 3000000`` is, and 200 000 Hz, each naming the
-    option given; −500 Hz turns the rotor the other way at 30 000 rpm."""
+    option given; −50 Hz turns the rotor the other way at 3000 rpm."""
     rig = _rig(tmp_path, _rig_text())
     out = ["--out", tmp_path / "d", "--duration-s", "0.002"]
     _refused(capsys, ["drop", rig, "--speed-rpm", "3000000", *out], "--speed-rpm",
@@ -194,9 +194,9 @@ def test_the_speed_in_hz_is_bounded_as_the_speed_in_rpm(tmp_path, capsys):
                         f"--speed-hz {hz} (= {rpm} rpm)", "expected a value <= 1000000.0",
                         "[operating] speed_rpm")
         assert "--speed-rpm" not in line
-    doc = _drop(capsys, rig, "--speed-hz", "-500", *out)
-    assert doc["speed_rpm"] == -30000.0
-    assert doc["speed_rad_s"] == pytest.approx(-1000 * math.pi)
+    doc = _drop(capsys, rig, "--speed-hz", "-50", *out)
+    assert doc["speed_rpm"] == -3000.0
+    assert doc["speed_rad_s"] == pytest.approx(-100 * math.pi)
 
 
 def test_the_backup_clearance_lies_inside_the_air_gap_and_the_probe_gap(tmp_path, capsys):
@@ -220,3 +220,23 @@ def test_the_backup_clearance_lies_inside_the_air_gap_and_the_probe_gap(tmp_path
         _refused(capsys, ["validate", rig], str(rig), key, what)
     assert load_rig(_rig(tmp_path, _rig_text(), "ok.toml")).touchdown[0].radial_clearance \
         == 2e-4
+
+
+def test_a_drop_above_the_trip_speed_is_refused_naming_the_option(tmp_path, capsys):
+    """The rig runs at 3000 rpm with no trip speed given: its trip speed is API 617's
+    105 % of it, 52.5 Hz (3150 rpm). ``--speed-hz 2000`` and ``--speed-rpm 3200`` are
+    refused, each naming the option as given and the trip speed, single or Monte-Carlo;
+    with ``trip_speed_hz = 60`` the drop runs at 60 Hz and 61 Hz is refused naming the
+    key."""
+    rig = _rig(tmp_path, _rig_text())
+    out = ["--out", tmp_path / "d", "--duration-s", "0.002"]
+    for given, text in ((["--speed-hz", "2000"], "--speed-hz 2000: 2000 Hz"),
+                        (["--speed-rpm", "3200"], "--speed-rpm 3200: 53.3333 Hz")):
+        for runs in ([], ["--runs", "2"]):
+            line = _refused(capsys, ["drop", rig, *given, *runs, *out], text,
+                            "trip speed 52.5 Hz = 3150 rpm", "1.05 × the maximum")
+            assert "[operating] trip_speed_hz" not in line
+    tripped = _rig(tmp_path, _rig_text() + "trip_speed_hz = 60.0\n", "tripped.toml")
+    _refused(capsys, ["drop", tripped, "--speed-hz", "-61", *out], "--speed-hz -61",
+             "trip speed 60 Hz", "[operating] trip_speed_hz")
+    assert _drop(capsys, tripped, "--speed-hz", "60", *out)["speed_rpm"] == 3600.0

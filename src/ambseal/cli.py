@@ -426,7 +426,7 @@ def _rotordynamics_parsers(sub) -> None:
     dg = dr.add_mutually_exclusive_group()
     dg.add_argument("--speed-rpm", type=_finite, default=None,
                     help="spin speed (rpm), held, negative turning the other way (as "
-                         "[operating] speed_rpm, its default)")
+                         "[operating] speed_rpm, its default), up to the trip speed")
     dg.add_argument("--speed-hz", type=_finite, default=None,
                     help="spin speed (Hz), held; the rule of --speed-rpm")
     dg.add_argument("--at", choices=("standstill", "max-continuous", "trip"), default=None,

@@ -54,6 +54,7 @@ from ambseal.config import (
     MAX_COEFFICIENT,
     MAX_PRESSURE_BAR,
     MAX_SPEED_HZ,
+    check_below_trip,
     check_operating,
     load_rig,
     method_names,
@@ -322,6 +323,9 @@ def _drop(args: argparse.Namespace) -> int:
     rpm = (60.0 * args.speed_hz if args.speed_hz is not None else
            args.speed_rpm if args.speed_rpm is not None else
            named[args.at] if args.at is not None else cfg.operating.speed_rpm)
+    if args.speed_hz is not None or args.speed_rpm is not None:  # the rig's own: ≤ trip
+        check_below_trip(cfg.operating, rpm, f"--speed-hz {args.speed_hz:g}"
+                         if args.speed_hz is not None else f"--speed-rpm {args.speed_rpm:g}")
     say = logging.getLogger("ambseal").info
     shown = [0]
 

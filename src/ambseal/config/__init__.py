@@ -45,6 +45,7 @@ from ambseal.config.rig import (
                                     Touchdown,
                                     TruthSection,
                                     apply_overrides,
+                                    check_below_trip,
                                     check_operating,
                                     default_rig_path,
                                     dump_rig,
@@ -64,7 +65,7 @@ __all__ = ["MAX_AMBS", "MAX_COEFFICIENT", "MAX_COMPONENTS", "MAX_CURRENT_A", "MA
            "Machine", "Pid", "PidFilter", "RigConfig", "Seal", "Signoff", "Spring", "Stage",
            "Touchdown",
            "TruthSection", "apply_overrides",
-           "MIN_FRICTION_VELOCITY", "check_coil", "check_operating", "node_tolerance",
+           "MIN_FRICTION_VELOCITY", "check_below_trip", "check_coil", "check_operating", "node_tolerance",
            "default_rig_path", "dump_rig", "load_rig",
            "load_truth",
            "parse_rig", "rig_parameter_names", "rig_with_values", "toml_string"]

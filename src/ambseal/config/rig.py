@@ -1066,6 +1066,37 @@ def check_operating(values: dict, arg_names: dict[str, str]) -> None:
                               f"{key} in a rig file)") from None
 
 
+def check_below_trip(operating: Operating, speed_rpm: float, arg_name: str) -> None:
+    """Refuse a speed above the rig's trip speed (:attr:`Operating.trip_hz`): the machine
+    trips before it, so nothing run there (a drop) describes it. A rig that states no
+    speed at all (``speed_rpm`` 0, no ``speed_range_hz``, no ``trip_speed_hz``) has no
+    trip speed and bounds nothing.
+
+    Parameters
+    ----------
+    operating : Operating
+        The rig's ``[operating]`` table.
+    speed_rpm : float
+        The speed asked for (rpm; its sign the sense of rotation).
+    arg_name : str
+        What the user wrote, named in the error (``"--speed-hz 2000"``).
+
+    Raises
+    ------
+    ConfigError
+        ``<arg_name>: ... above the rig's trip speed ...``.
+    """
+    trip = operating.trip_hz
+    f = abs(speed_rpm) / 60.0
+    if trip > 0 and f > trip * (1.0 + 1e-12):
+        given = ("[operating] trip_speed_hz" if operating.trip_speed_hz is not None else
+                 f"{TRIP_RATIO:g} × the maximum continuous speed, no trip_speed_hz given")
+        raise ConfigError(f"{arg_name}: {f:.6g} Hz lies above the rig's trip speed "
+                          f"{trip:.6g} Hz = {60.0 * trip:.6g} rpm ({given}); the machine "
+                          "trips before it: give a speed up to the trip speed (--at trip), "
+                          "or the rig's trip_speed_hz")
+
+
 def load_rig(path: str | Path | None = None, overrides=()) -> RigConfig:
     """Read and validate a rig file (TOML).
 

@@ -240,3 +240,24 @@ def test_a_drop_above_the_trip_speed_is_refused_naming_the_option(tmp_path, caps
     _refused(capsys, ["drop", tripped, "--speed-hz", "-61", *out], "--speed-hz -61",
              "trip speed 60 Hz", "[operating] trip_speed_hz")
     assert _drop(capsys, tripped, "--speed-hz", "60", *out)["speed_rpm"] == 3600.0
+
+
+def test_the_penetration_ratio_is_set_from_the_command_line_by_its_keys_rule(tmp_path,
+                                                                            capsys):
+    """``--penetration-ratio`` stands for ``[drop] penetration_ratio``: 0 is refused by
+    the key's rule, naming the option; a share below the drop's deepest penetration
+    over the clearance makes the verdict fail on the contact law's range (exit 1), one
+    above it does not, for the same drop."""
+    rig = _rig(tmp_path, _rig_text())
+    out = ["--out", tmp_path / "d", "--duration-s", "0.01"]
+    _refused(capsys, ["drop", rig, "--penetration-ratio", "0", *out],
+             "--penetration-ratio 0", "[drop] penetration_ratio")
+    doc = _drop(capsys, rig, *out)
+    deep = max(p["max_penetration_m"] for p in doc["planes"]) / 2.0e-4
+    assert doc["beyond_range"] == [] and 0 < deep < 0.5
+    low = _drop(capsys, rig, "--penetration-ratio", f"{0.9 * deep:.6g}", *out)
+    assert not low["passed"] and low["verdict"].startswith(
+        "Drop FAILED, beyond the drop model's range")
+    assert {r.split("'s ring")[0] for r in low["beyond_range"]} <= {"TA", "TB"}
+    high = _drop(capsys, rig, "--penetration-ratio", f"{1.1 * deep:.6g}", *out)
+    assert high["beyond_range"] == []

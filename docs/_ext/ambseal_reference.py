@@ -396,6 +396,12 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                                    "(default 1: ISO 76's static rating)"),
     "DropLimits.axial_thrust": ("N", "the residual thrust on the rotor (+z towards its far "
                                      "end) when the thrust bearing lets go (default 0)"),
+    "DropLimits.penetration_ratio": ("", "the deepest penetration of a touchdown ring over "
+                                         "its clearance (radial, or axial) within which the "
+                                         "contact law is taken to hold; beyond it the "
+                                         "verdict says the drop left its model's range, "
+                                         "where and from when, and fails (default 0.5; "
+                                         "``--penetration-ratio``)"),
     "DropLimits.race_temperature_rise": ("K", "largest temperature rise of a ring with a "
                                               "``race_mass`` that passes (left out: not "
                                               "graded)"),

@@ -460,6 +460,10 @@ def _rotordynamics_parsers(sub) -> None:
                     help="--event loss: the residual thrust on the rotor (N, +z towards "
                          "its far end) when the thrust bearing lets go with the AMBs; "
                          "default [drop] axial_thrust")
+    dr.add_argument("--penetration-ratio", type=_finite, default=None,
+                    help="the deepest penetration of a ring, over its clearance, within "
+                         "which the contact law holds; beyond it the verdict says the "
+                         "drop left its model's range (default [drop] penetration_ratio)")
     dr.add_argument("--duration-s", type=_positive, default=0.5,
                     help="time simulated after the AMBs let go (s; default 0.5)")
     dr.add_argument("--coast-down", action="store_true",

@@ -450,3 +450,47 @@ def test_the_sensor_gaps_and_the_disks_clearance_are_judged():
         # the disk's excursion is the rotor's at mid-span: its fall through the rings
         assert np.hypot(*r.watched["disk:wheel"].T).max() == pytest.approx(
             C_TD + r.peak_penetration.max(), rel=0.05)
+
+
+def test_a_drop_beyond_the_contact_laws_range_says_so_where_and_when():
+    """Dry whip: at 6000 rpm on rings that do not turn, with friction 0.5, the journal
+    rolls round its ring backwards and the whirl's centripetal force presses it in far
+    past an elastic contact (0.86 × the 0.2 mm clearance within 23 ms, short of the 1 %
+    of the radius that ends a drop). The verdict does not pass: it says first that each
+    ring left the contact law's range, how deep (the drop's deepest penetration) and from
+    when (the first output sample past ``[drop] penetration_ratio`` × the clearance, 0.5
+    by default); with the share raised above the depth it says nothing of the range. An
+    AMB air gap of 0.15 mm, inside the fall through the rings' 0.2 mm, is a gap the rotor
+    goes through, no earlier than a free fall through it."""
+    base = _rig()
+    cfg = base.model_copy(update={"touchdown": [
+        t.model_copy(update={"restitution": 0.5, "friction": 0.5}) for t in base.touchdown]})
+    assert cfg.drop.penetration_ratio == 0.5
+    r = simulate_drop(cfg, speed_rpm=6000.0, duration_s=0.023, samples=2001)
+    assert r.regime(0)[0] == "backward whirl"
+    deep = r.peak_penetration / C_TD
+    assert (deep > 0.6).all()
+    v = drop_verdict(cfg, r)
+    assert not v["passed"] and "PASSED" not in v["verdict"]
+    assert v["verdict"].startswith("Drop FAILED, beyond the drop model's range: TA's ring")
+    rows = {c["name"]: c for c in v["criteria"]}
+    for p, name in enumerate(("TA", "TB")):
+        row = rows[f"penetration within the contact law's range at {name}"]
+        when = 1e3 * r.t[np.argmax(r.penetration[p] > 0.5 * C_TD)]
+        text = (f"{name}'s ring pressed {1e6 * r.peak_penetration[p]:.4g} µm deep "
+                f"({deep[p]:.3g} × its 200 µm clearance) from t = {when:.4g} ms")
+        assert row["outcome"] == "FAILED" and row["limit"].startswith("0.5 × the clearance")
+        assert any(b.startswith(text) for b in v["beyond_range"]) and text in v["verdict"]
+    loose = cfg.model_copy(update={"drop": cfg.drop.model_copy(
+        update={"penetration_ratio": 1.01 * deep.max()})})
+    v = drop_verdict(loose, r)
+    assert v["beyond_range"] == [] and "range" not in v["verdict"]
+    assert v["verdict"].startswith("Drop FAILED: no backward whirl")
+    tight = cfg.model_copy(update={"amb": [a.model_copy(update={"air_gap": 1.5e-4})
+                                          for a in cfg.amb]})
+    v = drop_verdict(tight, r)
+    through = [b for b in v["beyond_range"] if "air gap at A" in b]
+    t_gap = float(through[0].split("from t = ")[1].split(" ms")[0])
+    assert t_gap >= 1e3 * math.sqrt(2 * 1.5e-4 / GRAVITY)
+    assert "through the gap from t =" in {c["name"]: c for c in v["criteria"]}[
+        "no contact at A (air gap)"]["value"]

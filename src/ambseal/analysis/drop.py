@@ -1280,7 +1280,11 @@ def drop_verdict(cfg, result: DropResult) -> dict:
     not graded without X₀, Y₀ —, each ring's temperature rise from the friction heat,
     all of it taken into the ring (an upper bound: none into the journal, none conducted
     away), against ``[drop] race_temperature_rise`` where the ring's ``race_mass`` is
-    given, and no backward whirl sustained over the last half of the drop.
+    given, each ring's deepest penetration (radial, and axial where it stopped the rotor)
+    within ``[drop] penetration_ratio`` × its clearance, and no backward whirl sustained
+    over the last half of the drop. A penetration beyond that share, or the rotor through
+    a gap where the drop has no contact, leaves the drop model's range: the verdict says
+    so first, with where and from when (the first output sample past it), and fails.
 
     Parameters
     ----------
@@ -1292,7 +1296,8 @@ def drop_verdict(cfg, result: DropResult) -> dict:
     Returns
     -------
     dict
-        ``passed`` (bool: nothing failed), ``verdict`` (one line), ``criteria``
+        ``passed`` (bool: nothing failed), ``verdict`` (one line), ``beyond_range``
+        (where and when the drop left its model's range, one line each), ``criteria``
         (``name``, ``outcome`` — ``"passed"``, ``"FAILED"`` or ``"not graded"`` —,
         ``value``, ``limit``) and ``gaps_m`` (each watched plane's gap, m, as
         :attr:`DropResult.watched` names it; None where none is given).
@@ -1312,13 +1317,43 @@ def drop_verdict(cfg, result: DropResult) -> dict:
                  if a.sensor_gap is not None})
     gaps.update({f"disk:{_disk_label(d, i)}": d.clearance for i, d in enumerate(cfg.disk)
                  if d.clearance is not None})
+    beyond = []  # where and when the drop left its model's range
     for key, gap in gaps.items():
-        worst = float(np.hypot(*result.watched[key].T).max())
+        radius = np.hypot(*result.watched[key].T)
+        worst = float(radius.max())
         what = {"amb": "air gap", "sensor": "sensor gap"}.get(key.split(":")[0],
                                                              "clearance")
-        row(f"no contact at {key.split(':', 1)[1]} ({what})",
-            None if gap is None else worst < gap, f"{1e6 * worst:.4g} µm",
+        where = key.split(":", 1)[1]
+        value = f"{1e6 * worst:.4g} µm"
+        if gap is not None and worst >= gap:
+            when = _first_time(result.t, radius >= gap)
+            value += f", through the gap from {when}"
+            beyond.append(f"the rotor through the {what} at {where} from {when}, where "
+                          "the drop has no contact")
+        row(f"no contact at {where} ({what})",
+            None if gap is None else worst < gap, value,
             f"{1e6 * gap:.4g} µm" if gap else f"no {what} given")
+    share = cfg.drop.penetration_ratio
+    for p, td in enumerate(cfg.touchdown):
+        for how, c, deepest, depth in (
+                ("", td.radial_clearance, float(result.peak_penetration[p]),
+                 result.penetration[p]),
+                ("axial ", td.axial_clearance, float(result.peak_axial_penetration[p]),
+                 None if result.axial_position is None else
+                 np.abs(result.axial_position) - (td.axial_clearance or 0.0))):
+            if c is None or (how and not deepest > 0):
+                continue
+            ok = deepest <= share * c
+            value = f"{1e6 * deepest:.4g} µm ({deepest / c:.3g} × the clearance)"
+            if not ok:
+                when = _first_time(result.t, np.asarray(depth) > share * c)
+                value += f", beyond from {when}"
+                beyond.append(f"{td.name}'s {how}ring pressed {1e6 * deepest:.4g} µm deep "
+                              f"({deepest / c:.3g} × its {1e6 * c:.4g} µm {how}clearance) "
+                              f"from {when}, where the Hertz contact law no longer holds")
+            row(f"{how}penetration within the contact law's range at {td.name}", ok, value,
+                f"{share:g} × the {how}clearance = {1e6 * share * c:.4g} µm "
+                "([drop] penetration_ratio)")
     ratio, rise_limit = cfg.drop.force_ratio, cfg.drop.race_temperature_rise
     for p, td in enumerate(cfg.touchdown):
         peak = f_r = float(result.peak_force[p])
@@ -1358,5 +1393,15 @@ def drop_verdict(cfg, result: DropResult) -> dict:
     line = (f"Drop FAILED: {'; '.join(failed)}" if failed else
             "Drop PASSED" + (f" on what was graded (not graded: {'; '.join(skipped)})"
                              if skipped else ""))
-    return {"passed": not failed, "verdict": line, "criteria": rows,
+    if beyond:  # its forces past that point are not the machine's: said first
+        line = (f"Drop FAILED, beyond the drop model's range: {'; '.join(beyond)} — its "
+                f"results from then on do not describe the machine ({line})")
+    return {"passed": not failed, "verdict": line, "criteria": rows, "beyond_range": beyond,
             "gaps_m": {k: json_float(g) if g is not None else None for k, g in gaps.items()}}
+
+
+def _first_time(t: np.ndarray, over: np.ndarray) -> str:
+    """``"t = 12.3 ms"``: the first output sample where ``over`` holds, or where none does
+    (a peak read between the samples), ``"between the output samples"``."""
+    k = np.flatnonzero(over)
+    return f"t = {1e3 * float(t[k[0]]):.4g} ms" if k.size else "between the output samples"

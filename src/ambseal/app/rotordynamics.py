@@ -56,6 +56,7 @@ from ambseal.config import (
     MAX_SPEED_HZ,
     check_below_trip,
     check_operating,
+    drop_limits_with,
     load_rig,
     method_names,
     rig_parameter_names,
@@ -348,6 +349,10 @@ def _drop(args: argparse.Namespace) -> int:
                               f"{args.axial_thrust_n:g}")
         cfg = cfg.model_copy(update={"drop": cfg.drop.model_copy(
             update={"axial_thrust": float(args.axial_thrust_n)})})
+    if args.penetration_ratio is not None:  # the Monte-Carlo runs' too
+        cfg = cfg.model_copy(update={"drop": drop_limits_with(
+            cfg.drop, "penetration_ratio", args.penetration_ratio,
+            f"--penetration-ratio {args.penetration_ratio:g}")})
     if args.drag_torque and not args.coast_down:
         raise ConfigError("--drag-torque: slows a coasting rotor; add --coast-down (the "
                           "drive holds the speed otherwise)")

@@ -48,6 +48,7 @@ from ambseal.config.rig import (
                                     check_below_trip,
                                     check_operating,
                                     default_rig_path,
+                                    drop_limits_with,
                                     dump_rig,
                                     load_rig,
                                     load_truth,
@@ -66,6 +67,6 @@ __all__ = ["MAX_AMBS", "MAX_COEFFICIENT", "MAX_COMPONENTS", "MAX_CURRENT_A", "MA
            "Touchdown",
            "TruthSection", "apply_overrides",
            "MIN_FRICTION_VELOCITY", "check_below_trip", "check_coil", "check_operating", "node_tolerance",
-           "default_rig_path", "dump_rig", "load_rig",
+           "default_rig_path", "drop_limits_with", "dump_rig", "load_rig",
            "load_truth",
            "parse_rig", "rig_parameter_names", "rig_with_values", "toml_string"]

@@ -746,13 +746,24 @@ class Probe(_Strict):
     angle_deg: float = Field(default=0.0, ge=-360, le=360)
 
 
+#: The default largest penetration of a touchdown ring over its clearance: Hertz's and
+#: Palmgren's laws are elastic ones, and a bearing at its static rating C₀ deforms a few
+#: micrometres (ISO 76: a permanent 1e-4 of the rolling element's diameter), a small part
+#: of a touchdown clearance of tenths of a millimetre; half the clearance is far past
+#: that, where the journal digs into the ring. A setting, not a standard's number.
+PENETRATION_RATIO = 0.5
+
+
 class DropLimits(_Strict):
     """The rotor drop's pass criteria that no public text fixes, as settings
     (:func:`ambseal.analysis.drop.drop_verdict`): the largest ``force_ratio`` of a
     touchdown bearing's peak force to its ``static_rating`` C₀ (default 1: C₀ is the load
     ISO 76 lets a rolling bearing carry at rest without harmful permanent deformation);
     the largest ``race_temperature_rise`` (K) of a ring with a ``race_mass`` (no default:
-    the ring's steel and its ambient decide it; not graded without it); and the
+    the ring's steel and its ambient decide it; not graded without it); the
+    ``penetration_ratio``, the deepest penetration of a ring over its clearance within
+    which the contact law is taken to hold (default :data:`PENETRATION_RATIO`, 0.5;
+    beyond it the verdict says the drop left its model's range); and the
     ``axial_thrust`` (N) the thrust bearing carries until the AMBs let go (default 0)."""
 
     force_ratio: float = Field(default=1.0, gt=0, le=100.0)
@@ -761,6 +772,9 @@ class DropLimits(_Strict):
     axial_thrust: float = Field(default=0.0, ge=-1e8, le=1e8)
     # the largest temperature rise (K) of a touchdown ring from the drop's friction heat
     race_temperature_rise: float | None = Field(default=None, gt=0, le=1e4)
+    # the deepest penetration, over the ring's clearance, within which the elastic contact
+    # law is taken to hold (PENETRATION_RATIO)
+    penetration_ratio: float = Field(default=PENETRATION_RATIO, gt=0, le=10.0)
 
 
 class Signoff(_Strict):
@@ -1095,6 +1109,37 @@ def check_below_trip(operating: Operating, speed_rpm: float, arg_name: str) -> N
                           f"{trip:.6g} Hz = {60.0 * trip:.6g} rpm ({given}); the machine "
                           "trips before it: give a speed up to the trip speed (--at trip), "
                           "or the rig's trip_speed_hz")
+
+
+def drop_limits_with(drop: DropLimits, key: str, value, arg_name: str) -> DropLimits:
+    """``[drop]`` with one key set from the command line, by the rig file's own rule.
+
+    Parameters
+    ----------
+    drop : DropLimits
+        The rig's ``[drop]`` table.
+    key : str
+        A key of it (``"penetration_ratio"``).
+    value
+        Its value.
+    arg_name : str
+        The command-line option, named in the error.
+
+    Returns
+    -------
+    DropLimits
+
+    Raises
+    ------
+    ConfigError
+        ``<arg_name>: ...`` with what the rig format expects.
+    """
+    try:
+        return DropLimits.model_validate({**drop.model_dump(), key: value})
+    except ValidationError as exc:
+        msg = _describe(exc).split(": ", 1)[1]
+        raise ConfigError(f"{arg_name}: {msg} (the rule of [drop] {key} in a rig file)"
+                          ) from None
 
 
 def load_rig(path: str | Path | None = None, overrides=()) -> RigConfig:

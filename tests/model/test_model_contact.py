@@ -1,6 +1,6 @@
 """The touchdown bearing's contact law (ambseal.model.contact) against Hertz's impact, the
-measured restitution and the published one of each damping law, Palmgren's line contact in its own units, and
-the ``[[touchdown]]`` table's refusals."""
+measured restitution and the published one of each damping law, Palmgren's line contact
+in its own units, and the ``[[touchdown]]`` table's refusals."""
 
 from __future__ import annotations
 

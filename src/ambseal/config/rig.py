@@ -505,9 +505,10 @@ class Touchdown(_Strict):
     ``nu`` of both bodies, a line contact's ``contact_length`` (m; Palmgren's relation,
     bearing steel); the contact damping solved for the measured coefficient of
     ``restitution`` e (rebound over approach speed of one impact), or a published
-    ``damping_law`` at its own ``law_restitution`` (one of the two); regularised Coulomb ``friction`` with ``friction_velocity`` (m/s, at
-    least :data:`~ambseal.config._checks.MIN_FRICTION_VELOCITY`: the slip the drop's
-    stiff integrator resolves); the ring's ``race_inertia`` (kg·m²) and
+    ``damping_law`` at its own ``law_restitution`` (one of the two); regularised
+    Coulomb ``friction`` with ``friction_velocity`` (m/s, at least
+    :data:`~ambseal.config._checks.MIN_FRICTION_VELOCITY`: the slip the drop's stiff
+    integrator resolves); the ring's ``race_inertia`` (kg·m²) and
     ``race_drag_torque`` (N·m); the support's ``support_stiffness`` (N/m; left out,
     rigid) with its ``support_mass`` (kg, required with it) and ``support_damping``
     (N·s/m); the bearing's basic ``static_rating`` C₀ (N, ISO 76) the drop's

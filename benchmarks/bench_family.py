@@ -25,7 +25,9 @@ as a rig file from the manual's keys alone:
   Ks = Ki·i0/s0 (Schweitzer & Maslen 2009, §3.3); first-order amplifiers at f_s/10;
 * **sensors** collocated with the actuators or 0.08 L outboard (non-collocated), drawn;
 * **the target**: 10, 20 or 40 kHz (drawn), one sample of delay;
-* horizontal rotors (gravity −y): ambseal has no vertical machine yet.
+* **the orientation**, horizontal or vertical (``[machine] orientation``), drawn last: a
+  vertical rotor's radial AMBs carry no weight, so its Ki is sized on the unbalance
+  force alone.
 
 To these the family adds the example flywheel (``examples/flywheel.toml``, as its file
 says: no ``[design.rejection]``) at 10, 20 and 40 kHz.
@@ -101,6 +103,7 @@ def _rig_text(p: dict, d_o: float, id_wheel: float) -> str:
             for n, z, s in zip("AB", amb, sens)]
     out.append(f'[actuator]\nmodel = "first_order"\ncutoff_hz = {p["rate_hz"] / 10!r}\n')
     out.append(f'[controller]\nsample_rate_hz = {p["rate_hz"]!r}\ndelay_samples = 1\n')
+    out.append(f'[machine]\norientation = "{p["orientation"]}"\n')
     out.append(f'[operating]\nspeed_rpm = {p["top_rpm"]!r}\npressure_bar = 0.0\n'
                f'speed_range_hz = [{top_hz / 3!r}, {top_hz!r}]\n')
     return "\n".join(out)
@@ -144,8 +147,10 @@ def family_rig(seed: int) -> tuple[str, dict]:
         least = math.sqrt(q * rest / (1 - q / 2) / (0.6 * m))
         p["r_wheel_m"] = max(float(rng.uniform(1.0, 1.5)) * least, 0.1 * L)
         p["ip_wheel"] = 0.6 * m * p["r_wheel_m"] ** 2
+        p["orientation"] = str(rng.choice(["horizontal", "vertical"]))
         omega = 2 * math.pi * p["top_rpm"] / 60
-        share = p["mass_kg"] / 2 * (GRAVITY + GRADE_M_S * omega)
+        weight = GRAVITY if p["orientation"] == "horizontal" else 0.0
+        share = p["mass_kg"] / 2 * (weight + GRADE_M_S * omega)
         p["ki"] = 3 * share / p["bias_a"]
         built = _solve(p, parse_rig, free_bending_hz)
         if built is not None:

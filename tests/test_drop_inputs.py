@@ -61,6 +61,26 @@ def test_duplicate_touchdown_names_are_refused_when_the_rig_is_read(tmp_path, ca
         _refused(capsys, args, str(rig), "touchdown[1].name", "duplicate touchdown name 'TA'")
 
 
+def test_a_name_shared_by_a_seal_and_a_touchdown_bearing_is_refused(tmp_path, capsys):
+    """A seal named TA beside the touchdown bearing TA: ``--overload-at TA`` would load
+    one of the two planes (0.2 m or 0 m) without a word. ``validate``, ``drop``,
+    Monte-Carlo drops, ``signoff`` and ``run`` refuse the rig when it is read, naming both
+    tables; a seal named "mid" is read."""
+    seal = ('[[seal]]\nname = "{}"\nposition = 0.2\nclearance = 3.0e-4\n'
+            "k = {{ per_bar = 1.0e6 }}\n")
+    rig = _rig(tmp_path, _rig_text() + seal.format("TA"))
+    out = ["--out", tmp_path / "d"]
+    for args in (["validate", rig], ["drop", rig, *out],
+                 ["drop", rig, "--runs", "1", *out],
+                 ["drop", rig, "--event", "overload", "--overload-n", "100", "--overload-at",
+                  "TA", *out], ["signoff", rig, *out], ["run", rig, *out]):
+        _refused(capsys, args, str(rig), "touchdown[0].name: 'TA' is also the name of "
+                 "seal[0]")
+        assert not (tmp_path / "d").exists()
+    assert [s.name for s in load_rig(_rig(tmp_path, _rig_text() + seal.format("mid"),
+                                          "ok.toml")).seal] == ["mid"]
+
+
 def test_the_monte_carlo_draws_follow_the_rig_files_rules(tmp_path, capsys):
     """A friction drawn in 3:5 lies beyond ``[[touchdown]] friction``'s bound (μ <= 2),
     and a clearance drawn ±150 µm about 0.2 mm reaches a 0.3 mm air gap: each range is

@@ -300,6 +300,32 @@ def cross_check(cfg, where: str) -> None:
                               "give it there only")
         names.add(a.name)
     _check_touchdowns(cfg, where)
+    _check_place_names(cfg, where)
+
+
+#: The tables whose ``name`` ``ambseal drop --overload-at NAME`` and the drop's results
+#: (``TA_peak_force_n``, a plane's or a seal's row) read, in that order.
+_PLACE_TABLES = ("seal", "amb", "touchdown", "disk")
+
+
+def _check_place_names(cfg, where: str) -> None:
+    """One name, one place: a name given in two of :data:`_PLACE_TABLES` would make
+    ``--overload-at NAME`` pick one of them silently (ConfigError naming both tables).
+    Repeats within one table are each table's own rule."""
+    first: dict[str, str] = {}
+    for kind in _PLACE_TABLES:
+        here: dict[str, str] = {}
+        for i, comp in enumerate(getattr(cfg, kind)):
+            name = getattr(comp, "name", None)
+            if not name:
+                continue
+            if name in first:
+                raise ConfigError(f"{where}: {kind}[{i}].name: {name!r} is also the name of "
+                                  f"{first[name]}: a component is named by its name "
+                                  "(--overload-at NAME, the drop's results); expected "
+                                  f"distinct names over [[{']], [['.join(_PLACE_TABLES)}]]")
+            here.setdefault(name, f"{kind}[{i}]")
+        first.update(here)
 
 
 def _check_touchdowns(cfg, where: str) -> None:

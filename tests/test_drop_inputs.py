@@ -81,6 +81,29 @@ def test_a_name_shared_by_a_seal_and_a_touchdown_bearing_is_refused(tmp_path, ca
                                           "ok.toml")).seal] == ["mid"]
 
 
+def test_a_refused_drop_says_one_line_on_a_pipe(tmp_path, capsys):
+    """Without --quiet, stderr a pipe (capsys): a step force of 1e8 N, which crushes the
+    ring TA 0.025 ms into the drop, ends a drop and Monte-Carlo drops in exit 2 and the
+    one error line, with no progress line or blank line before it; bad options alike.
+    The drop's steps stay available with --verbose."""
+    rig = _rig(tmp_path, _rig_text())
+    crush = ["--event", "overload", "--overload-n", "1e8", "--duration-s", "0.0001",
+             "--out", tmp_path / "d"]
+    for args, expect in ((["drop", rig, *crush], "pressed 500 µm into the ring of TA"),
+                         (["drop", rig, "--runs", "2", *crush], "no drop finished"),
+                         (["drop", rig, *crush, "--overload-at", "nowhere"],
+                          "--overload-at"),
+                         (["drop", rig, "--runs", "2", *crush, "--friction", "3:5"],
+                          "--friction 3:5")):
+        capsys.readouterr()
+        code = main([*map(str, args)])
+        lines = capsys.readouterr().err.splitlines()
+        assert code == 2 and len(lines) == 1, lines
+        assert lines[0].startswith("ambseal: error:") and expect in lines[0], lines
+    code = main(["--verbose", *map(str, ["drop", rig, *crush])])
+    assert code == 2 and "ms of 0.1 ms" in capsys.readouterr().err
+
+
 def test_the_monte_carlo_draws_follow_the_rig_files_rules(tmp_path, capsys):
     """A friction drawn in 3:5 lies beyond ``[[touchdown]] friction``'s bound (μ <= 2),
     and a clearance drawn ±150 µm about 0.2 mm reaches a 0.3 mm air gap: each range is

@@ -138,7 +138,10 @@ def run_cases(fn: Callable, cases: Sequence[dict], *, shared: dict | None = None
     if distributed and not dask_available():
         raise ConfigError("dask.distributed is not installed (pip install 'ambseal[dask]'); "
                           "leave out --scheduler/--workers to run serially")
-    with Progress(console=Console(stderr=True), disable=not progress, transient=True) as bar:
+    console = Console(stderr=True)
+    # a bar is for a terminal: elsewhere rich leaves a blank line before the next message
+    with Progress(console=console, disable=not (progress and console.is_terminal),
+                  transient=True) as bar:
         task = bar.add_task(description, total=len(cases))
 
         def done(i: int, r) -> None:

@@ -327,14 +327,16 @@ def _drop(args: argparse.Namespace) -> int:
     if args.speed_hz is not None or args.speed_rpm is not None:  # the rig's own: ≤ trip
         check_below_trip(cfg.operating, rpm, f"--speed-hz {args.speed_hz:g}"
                          if args.speed_hz is not None else f"--speed-rpm {args.speed_rpm:g}")
-    say = logging.getLogger("ambseal").info
+    # steps within the drop are DEBUG records, as a stage's steps are (StageProgress):
+    # shown with --verbose, so that a drop the contact ends (crushed rings) says one line
+    step = logging.getLogger("ambseal").debug
     shown = [0]
 
     def progress(t: float) -> None:  # a line per tenth of the drop, not per contact
         tenth = int(10 * t / args.duration_s)
         if tenth > shown[0]:
             shown[0] = tenth
-            say(f"drop: {1e3 * t:.4g} ms of {1e3 * args.duration_s:.4g} ms")
+            step(f"drop: {1e3 * t:.4g} ms of {1e3 * args.duration_s:.4g} ms")
 
     if args.pressure_bar is not None:  # checked as the rig file's key is, before here
         # the seals' pressure through the drop, the Monte-Carlo runs' too

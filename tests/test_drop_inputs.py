@@ -14,7 +14,7 @@ import pytest
 
 from ambseal.analysis.drop_monte_carlo import drop_run
 from ambseal.cli import main
-from ambseal.config import load_rig
+from ambseal.config import MAX_SPEED_HZ, load_rig
 from ambseal.errors import ConfigError
 
 from .test_cli_drop import _rig_text
@@ -230,16 +230,52 @@ def test_the_speed_in_hz_is_bounded_as_the_speed_in_rpm(tmp_path, capsys):
     option given; −50 Hz turns the rotor the other way at 3000 rpm."""
     rig = _rig(tmp_path, _rig_text())
     out = ["--out", tmp_path / "d", "--duration-s", "0.002"]
-    _refused(capsys, ["drop", rig, "--speed-rpm", "3000000", *out], "--speed-rpm",
-             "expected a value <= 1000000.0", "[operating] speed_rpm")
+    bound = f"expected a value <= {60 * MAX_SPEED_HZ!r}"
+    _refused(capsys, ["drop", rig, "--speed-rpm", "3000000", *out], "--speed-rpm", bound,
+             "[operating] speed_rpm")
     for hz, rpm in (("50000", "3e+06"), ("200000", "1.2e+07")):
         line = _refused(capsys, ["drop", rig, "--speed-hz", hz, *out],
-                        f"--speed-hz {hz} (= {rpm} rpm)", "expected a value <= 1000000.0",
-                        "[operating] speed_rpm")
+                        f"--speed-hz {hz} (= {rpm} rpm)", bound, "[operating] speed_rpm")
         assert "--speed-rpm" not in line
     doc = _drop(capsys, rig, "--speed-hz", "-50", *out)
     assert doc["speed_rpm"] == -3000.0
     assert doc["speed_rad_s"] == pytest.approx(-100 * math.pi)
+
+
+def test_every_speed_has_one_bound_in_rpm_and_hz(tmp_path, capsys):
+    """One bound, :data:`~ambseal.config.MAX_SPEED_HZ` (× 60 in rpm), for every speed
+    however it is given: 5 % below it a rig's ``speed_rpm``,
+    ``speed_range_hz`` and ``trip_speed_hz`` are read; 5 % above it each rig key, and
+    ``--speed-rpm`` of ``drop`` and ``modes`` and ``--speed-hz`` of ``drop``, ``sweep``
+    and ``campbell``, are refused naming the key or option written (exit 2)."""
+    below, above = 0.95 * MAX_SPEED_HZ, 1.05 * MAX_SPEED_HZ
+    base = _rig_text().replace("speed_rpm = 3000.0\n", "")
+
+    def rig(name, text):
+        return _rig(tmp_path, base + text, name)
+
+    fast = load_rig(rig("fast.toml", f"speed_rpm = {60 * below!r}\nspeed_range_hz = "
+                                     f"[1.0, {below!r}]\ntrip_speed_hz = {below!r}\n"))
+    assert fast.operating.trip_hz == fast.operating.continuous_hz[1] == below
+    for k, (key, text) in enumerate((
+            ("speed_rpm", f"speed_rpm = {60 * above!r}\n"),
+            ("speed_rpm", f"speed_rpm = {-60 * above!r}\n"),
+            ("speed_range_hz", f"speed_range_hz = [1.0, {above!r}]\n"),
+            ("trip_speed_hz", f"trip_speed_hz = {above!r}\n"))):
+        path = rig(f"over{k}.toml", text)
+        _refused(capsys, ["validate", path], str(path), "operating", key)
+    ok = rig("ok.toml", "speed_rpm = 3000.0\n")
+    out = ["--out", tmp_path / "d"]
+    for args, option in ((["drop", ok, "--speed-rpm", 60 * above, *out], "--speed-rpm"),
+                         (["modes", ok, "--speed-rpm", 60 * above], "--speed-rpm"),
+                         (["drop", ok, "--speed-hz", above, *out], "--speed-hz"),
+                         (["sweep", ok, "--speed-hz", f"0:{above!r}:2", *out], "--speed-hz"),
+                         (["campbell", ok, "--speed-hz", f"0:{above!r}:2", *out],
+                          "--speed-hz")):
+        line = _refused(capsys, args, option)
+        rpm = 60 * MAX_SPEED_HZ
+        assert repr(rpm) in line or f"{rpm:g} rpm" in line, line
+        assert not (tmp_path / "d").exists()
 
 
 def test_the_backup_clearance_lies_inside_the_air_gap_and_the_probe_gap(tmp_path, capsys):

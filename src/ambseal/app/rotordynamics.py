@@ -54,6 +54,7 @@ from ambseal.config import (
     MAX_COEFFICIENT,
     MAX_PRESSURE_BAR,
     MAX_SPEED_HZ,
+    MAX_SPEED_RPM,
     check_below_trip,
     check_operating,
     drop_limits_with,
@@ -119,7 +120,8 @@ def _range(text: str | None, name: str, low: float, high: float, rule: str):
 
 
 #: The bounds of the ranges, by the rig file's rules (ambseal.config._checks).
-_SPEEDS = (-MAX_SPEED_HZ, MAX_SPEED_HZ, "the bound of [operating] speed_range_hz")
+_SPEEDS = (-MAX_SPEED_HZ, MAX_SPEED_HZ,
+           f"{MAX_SPEED_RPM:g} rpm, the bound of [operating] speed_rpm and speed_range_hz")
 _PRESSURES = (0.0, MAX_PRESSURE_BAR, "the rule of [operating] pressure_bar")
 
 

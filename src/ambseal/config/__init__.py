@@ -20,6 +20,7 @@ from ambseal.config._checks import (
                                     MAX_GAP_M,
                                     MAX_PRESSURE_BAR,
                                     MAX_SPEED_HZ,
+                                    MAX_SPEED_RPM,
                                     MAX_SUPPORT_STIFFNESS,
                                     MIN_FRICTION_VELOCITY,
                                     check_coil,
@@ -59,7 +60,7 @@ from ambseal.config.rig import (
 )
 
 __all__ = ["MAX_AMBS", "MAX_COEFFICIENT", "MAX_COMPONENTS", "MAX_CURRENT_A", "MAX_DELAY_SAMPLES", "MAX_ELEMENTS",
-           "MAX_FREQUENCY_HZ", "MAX_GAP_M", "MAX_PRESSURE_BAR", "MAX_SPEED_HZ", "MAX_SUPPORT_STIFFNESS", "METHODS",
+           "MAX_FREQUENCY_HZ", "MAX_GAP_M", "MAX_PRESSURE_BAR", "MAX_SPEED_HZ", "MAX_SPEED_RPM", "MAX_SUPPORT_STIFFNESS", "METHODS",
            "SPRING_BOUNDS",
            "Method", "method", "method_label", "method_names",
            "Actuator", "Affine", "Amb", "AxisPair", "Coefficient", "FrequencyTable",

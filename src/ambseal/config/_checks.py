@@ -14,7 +14,7 @@ from ambseal.errors import LABEL_PATTERN, NAME_PATTERN, ConfigError
 from ambseal.robust import MAX_DELAY_SAMPLES
 
 __all__ = ["MIN_CURRENT_A", "MIN_TIME_CONSTANT_S", "MAX_ELEMENTS", "MAX_COMPONENTS", "MAX_AMBS", "MAX_LAYERS", "MAX_REDUCED_STATES", "MAX_COEFFICIENT",
-           "MAX_FREQUENCY_HZ", "MAX_SPEED_HZ", "MAX_PRESSURE_BAR", "MAX_CURRENT_A", "MAX_GAP_M",
+           "MAX_FREQUENCY_HZ", "MAX_SPEED_HZ", "MAX_SPEED_RPM", "MAX_PRESSURE_BAR", "MAX_CURRENT_A", "MAX_GAP_M",
            "MAX_DELAY_SAMPLES", "MAX_PID_FILTERS", "MAX_RELATIVE", "BoundedCoefficient",
            "BoundedFrequency", "check_amb", "check_actuator", "cross_check", "Name", "Label",
            "MIN_FRICTION_VELOCITY", "node_tolerance"]
@@ -60,8 +60,13 @@ MAX_COEFFICIENT = 1e12
 #: A frequency (Hz): ten times the fastest controller sample rate the rig file accepts
 #: (``[controller] sample_rate_hz`` ≤ 1 MHz), so any band a controller acts in fits.
 MAX_FREQUENCY_HZ = 1e7
-#: A rotational speed (Hz): the bound of ``[operating] speed_range_hz``.
-MAX_SPEED_HZ = 1e5
+#: A rotational speed (Hz), either sense: the one bound of every speed a rig file or a
+#: command line gives (``[operating] speed_rpm``, ``speed_range_hz``, ``trip_speed_hz``,
+#: the ``[design]`` speeds; ``--speed-rpm``, ``--speed-hz``). 20 kHz is 1.2e6 rpm, beyond
+#: the fastest rotors on AMBs (about 1e6 rpm).
+MAX_SPEED_HZ = 2e4
+#: :data:`MAX_SPEED_HZ` in rpm, the bound of a speed given in rpm.
+MAX_SPEED_RPM = 60.0 * MAX_SPEED_HZ
 #: A pressure drop (bar): the bound of ``[operating] pressure_bar`` (1 GPa).
 MAX_PRESSURE_BAR = 1e4
 #: A current (A): the bound of an AMB's ``bias_current`` and ``current_limit``.

@@ -136,7 +136,10 @@ from ambseal.config._checks import (
     MAX_RAYLEIGH_ALPHA,
     MAX_RAYLEIGH_BETA,
     MAX_REDUCED_STATES,
+    MAX_PRESSURE_BAR,
     MAX_RELATIVE,
+    MAX_SPEED_HZ,
+    MAX_SPEED_RPM,
     MAX_SUPPORT_STIFFNESS,
     MIN_CURRENT_A,
     MIN_FRICTION_VELOCITY,
@@ -916,10 +919,11 @@ TRIP_RATIO = 1.05
 
 
 class Operating(_Strict):
-    speed_rpm: float = Field(default=0.0, ge=-1e6, le=1e6)
-    pressure_bar: float = Field(default=0.0, ge=0, le=1e4)
+    # one bound for every speed, in rpm or Hz (MAX_SPEED_HZ)
+    speed_rpm: float = Field(default=0.0, ge=-MAX_SPEED_RPM, le=MAX_SPEED_RPM)
+    pressure_bar: float = Field(default=0.0, ge=0, le=MAX_PRESSURE_BAR)
     speed_range_hz: tuple[float, float] | None = Field(default=None, strict=False)  # a list
-    trip_speed_hz: float | None = Field(default=None, gt=0, le=1e5)
+    trip_speed_hz: float | None = Field(default=None, gt=0, le=MAX_SPEED_HZ)
 
     @property
     def continuous_hz(self) -> tuple[float, float]:
@@ -942,9 +946,10 @@ class Operating(_Strict):
         if self.trip_speed_hz is not None and self.trip_speed_hz < self.continuous_hz[1]:
             raise ValueError(f"trip_speed_hz: {self.trip_speed_hz:g} Hz lies below the "
                              f"maximum continuous speed {self.continuous_hz[1]:g} Hz")
-        if r is not None and not 0 < r[0] < r[1] <= 1e5:
-            raise ValueError("speed_range_hz: expected [low, high] with 0 < low < high "
-                             "<= 1e5 Hz")
+        if r is not None and not 0 < r[0] < r[1] <= MAX_SPEED_HZ:
+            raise ValueError(f"speed_range_hz: expected [low, high] with 0 < low < high "
+                             f"<= {MAX_SPEED_HZ:g} Hz ({MAX_SPEED_RPM:g} rpm, the bound of "
+                             "speed_rpm)")
         if r is not None and not r[0] <= abs(self.speed_rpm) / 60 <= r[1]:
             # every digit: 11 000 rpm is 183.3333… Hz, outside a range written to 183.333
             raise ValueError(f"speed_rpm: {self.speed_rpm:.12g} rpm = "

@@ -18,6 +18,12 @@ would type them:
   compiles it); ``matlab`` — run by ``octave-cli`` when installed;
 * ``json`` — parsed; ``text`` — output shown, not run.
 
+After its blocks ran, every output file name a page quotes (``report.html``,
+``campbell_<controller>.png/.json``) is one its commands, or the session's ``ambseal
+run``, wrote, and every file its commands wrote (their manifests) is named on the page
+(:func:`check_file_names`); the README and the pages that run nothing are held to the
+session's run.
+
 A block after a line ``% test: slow`` runs only with ``pytest -m slow`` (minutes of
 synthesis); nothing later on its page may depend on it. ``ambseal run`` on the embedded
 rig is not run again: the folder of the session's run (``terminal_run`` in
@@ -29,6 +35,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import os
 import re
 import shlex
 import shutil
@@ -131,6 +138,7 @@ class Page:
         self.folder, self.request = folder, request
         self.namespace: dict = {"__name__": "__manual__"}
         self.ran: list[str] = []
+        self.inputs: set[str] = set()  # files the page's own toml and C blocks wrote
 
     def run(self, block: Block) -> None:
         where = f"{block.page}:{block.line}"
@@ -147,12 +155,14 @@ class Page:
         first = body.splitlines()[0] if body.strip() else ""
         if first.startswith("# file: "):
             (self.folder / first[len("# file: "):].strip()).write_text(body, encoding="utf-8")
+            self.inputs.add(first[len("# file: "):].strip())
 
     def _c(self, body, where):
         first = body.splitlines()[0]
         m = re.match(r"/\* file: (\S+) \*/", first)
         assert m, f"{where}: a C block starts with /* file: NAME */"
         (self.folder / m[1]).write_text(body, encoding="utf-8")
+        self.inputs.add(m[1])
 
     def _json(self, body, where):
         json.loads(body)
@@ -279,11 +289,117 @@ def _check_c_names(page: Page, path: Path) -> None:
                 f"{path.name} quotes {name}, which {module}.h does not declare")
 
 
+#: Extensions of the files ambseal's commands write.
+_OUTPUT_EXT = ("json", "html", "png", "csv", "parquet", "mat", "npz", "toml", "h", "c")
+_SPAN = re.compile(r"(?<!`)`([^`]+)`(?!`)|``([^`]+)``")  # may break a line; RST's too
+_FILE = re.compile(r"(?:[\w.<>*{},-]+/)*[\w<>*{},-][\w.<>*{},-]*\.(?:" + "|".join(_OUTPUT_EXT)
+                   + r")(?:/\.\w+)*")
+_TREE = re.compile(r"^[│├└─ ]*[├└]── (\S+)", re.M)
+
+#: Output names a page quotes that its commands (and the session's ``ambseal run``) do
+#: not write here, each with the reason.
+NOT_WRITTEN = {
+    "getting-started.md": {
+        "controllers/rejection_<m>.json": "a synchronous rejection's; the embedded rig runs "
+                                          "none (tests/exported_files.py reads them)",
+        "ambseal_<m>_rejection.h": "as controllers/rejection_<m>.json",
+        "ambseal_<m>_rejection.c": "as controllers/rejection_<m>.json"},
+    "identification.md": {"run.csv": "a user's record, read", "run.csv.json": "its sidecar",
+                          "STEPS.csv": "a user's static load steps, read"},
+    "own-machine.md": {"campbell_pid.png": "its `ambseal campbell` runs with -m slow"},
+}
+#: Files every output folder holds, named once in the manual (getting-started.md).
+EVERY_FOLDER = ("manifest.json",)
+
+
+def _expand(name: str) -> list[str]:
+    """``a_<m>.json/.npz`` → both names; ``a.{h,c}`` → both names."""
+    base, *more = name.split("/.")
+    names = [base] + [base.rsplit(".", 1)[0] + "." + ext for ext in more]
+    out = []
+    for n in names:
+        m = re.search(r"\{([^}]*)\}", n)
+        out += ([n[:m.start()] + alt + n[m.end():] for alt in m[1].split(",")] if m else [n])
+    return out
+
+
+def quoted_outputs(text: str) -> set[str]:
+    """The file names a page quotes as code in its prose and tables, or lists in a folder
+    tree (``├── report.html``), with their ``<placeholder>`` and ``*`` parts; names in
+    its code blocks are inputs or commands, not quotes (a figure's caption is prose)."""
+    prose = _FENCE.sub(lambda m: m["body"] if m["info"].strip().startswith("{figure}")
+                       else "", text)  # a figure's caption is prose
+    trees = "".join(m["body"] for m in _FENCE.finditer(text)
+                    if m["info"].strip().split()[:1] == ["text"])
+    found = set()
+    for chunk in [*("".join(m) for m in _SPAN.findall(prose)), *_TREE.findall(trees)]:
+        for token in chunk.split():
+            found.update(n for n in _expand(token.strip(",;:()")) if _FILE.fullmatch(n))
+    return found
+
+
+def _pattern(name: str) -> re.Pattern:
+    """A quoted name as a pattern over written paths: ``<m>`` one path part, ``*`` any."""
+    parts = re.split(r"(<[^>]+>|\*)", name)
+    rx = "".join("[^/]+" if p.startswith("<") else "[^/]*" if p == "*" else re.escape(p)
+                 for p in parts)
+    return re.compile(r"(?:.*/)?" + rx)
+
+
+def _written(folder: Path) -> list[str]:
+    """Every file under ``folder`` (links to the repository's folders not followed), as a
+    POSIX path relative to it."""
+    out = []
+    for here, dirs, files in os.walk(folder):
+        dirs[:] = [d for d in dirs if not (Path(here) / d).is_symlink()]
+        out += [(Path(here) / f).relative_to(folder).as_posix() for f in files]
+    return out
+
+
+def _inputs(page: Page | None) -> set[str]:
+    """Names of files the commands read: the repository's rigs and data, the page's own
+    files."""
+    repo = {f.name for d in (ROOT / "examples", ROOT / "src" / "ambseal" / "data",
+                             DOCS / "rigs") for f in d.iterdir()}
+    return repo | {"pyproject.toml"} | (page.inputs if page else set())
+
+
+def check_file_names(text: str, where: str, written: list[str], request,
+                     not_written: dict[str, str], manifests: list[Path]) -> None:
+    """Each output file name the page quotes (:func:`quoted_outputs`) is a file its
+    commands wrote (``written``), or one ``ambseal run`` writes (the session's run,
+    ``terminal_run``, looked at only when needed); and each file a command of the page
+    wrote (each ``manifest.json`` of ``manifests``) is one the page names (``*.png``
+    alone names none)."""
+    quoted = {n for n in quoted_outputs(text) if n not in not_written
+              and Path(n).name not in _inputs(None) | set(not_written)}
+    run: list[str] | None = None
+    for name in sorted(quoted):
+        pat = _pattern(name)
+        if any(pat.fullmatch(w) for w in written):
+            continue
+        if run is None:
+            run = _written(request.getfixturevalue("terminal_run")[0])
+        assert any(pat.fullmatch(w) for w in run), (
+            f"{where} names {name}: no command of the page, nor `ambseal run`, writes it")
+    # a bare `*.png` names no file: each must be named by a name of its own
+    patterns = [_pattern(n) for n in quoted_outputs(text)
+                if re.sub(r"<[^>]+>|\*", "", Path(n).stem)]
+    for manifest in manifests:
+        for f in json.loads(manifest.read_text(encoding="utf-8"))["files"]:
+            if Path(f).name in EVERY_FOLDER:
+                continue
+            assert any(p.fullmatch(f) for p in patterns), (
+                f"{where}: {manifest.parent.name}/{f} is written by a command of the page, "
+                "which does not name it")
+
+
 @pytest.mark.xdist_group("terminal_run")  # the manual's `ambseal run` reads it
 @pytest.mark.parametrize("path", WITH_CODE, ids=_ids(WITH_CODE))
 def test_page_runs(path, tmp_path, monkeypatch, request):
-    """The page's blocks run (module docstring), and the C names it quotes are those its
-    commands wrote (:func:`_check_c_names`)."""
+    """The page's blocks run (module docstring), the C names it quotes are those its
+    commands wrote (:func:`_check_c_names`), and so are the file names it quotes, each
+    file written named (:func:`check_file_names`)."""
     page = _run_page(path, tmp_path, monkeypatch, request, slow=False)
     if path.name == "own-machine.md":
         # the page's rig, written from the page alone, validates and runs modes and design
@@ -297,6 +413,67 @@ def test_page_runs(path, tmp_path, monkeypatch, request):
             assert any(c.startswith("ambseal export") and way in c.split()
                        for c in page.ran), way
     _check_c_names(page, path)
+    rel = str(path.relative_to(DOCS))
+    written = [w for w in _written(page.folder) if w not in page.inputs
+               and not w.startswith(tuple(f.name for f in (DOCS / "rigs").iterdir()))]
+    check_file_names(path.read_text(encoding="utf-8"), rel, written, request,
+                     NOT_WRITTEN.get(rel, {}),
+                     [page.folder / w for w in written if Path(w).name == "manifest.json"])
+
+
+def test_the_file_name_check_catches_a_wrong_name_and_an_unnamed_file(tmp_path):
+    """:func:`check_file_names` on a made-up page: the name ``export --controller``
+    writes (``ambseal_controller_pid.h``) passes and the one the manual once showed
+    (``ambseal_pid.h``) fails, as does a written file the page leaves unnamed; placeholders,
+    ``/.ext`` and ``{h,c}`` alternatives expand; the session's run folder is asked only
+    for a name the page's commands did not write."""
+    out = tmp_path / "again"
+    written = ["again/c/ambseal_controller_pid.h", "again/c/ambseal_controller_pid.c",
+               "again/manifest.json"]
+    for w in written:
+        (tmp_path / w).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / w).write_text("{}")
+    (out / "manifest.json").write_text(json.dumps({"files": {
+        "c/ambseal_controller_pid.h": "", "c/ambseal_controller_pid.c": "",
+        "manifest.json": ""}}))
+    run = tmp_path / "run"
+    (run / "controllers").mkdir(parents=True)
+    (run / "controllers" / "controller_mu.npz").write_text("")
+
+    class Request:
+        asked = 0
+
+        def getfixturevalue(self, name):
+            assert name == "terminal_run"
+            self.asked += 1
+            return run, {}, ""
+
+    def check(text):
+        request = Request()
+        check_file_names(text, "page.md", written, request, {}, [out / "manifest.json"])
+        return request.asked
+
+    assert check("It writes `ambseal_controller_<m>.{h,c}`.") == 0
+    assert check("`ambseal_controller_pid.h/.c`; a run's `controller_<m>.npz`.") == 1
+    with pytest.raises(AssertionError, match="names ambseal_pid.h"):
+        check("Its header is `ambseal_pid.h` (`ambseal_controller_pid.c`).")
+    for text in ("Its header is `ambseal_controller_pid.h`.",
+                 "`ambseal_controller_pid.h` and `*.c`"):  # a bare glob names no file
+        with pytest.raises(AssertionError, match="c/ambseal_controller_pid.c is written"):
+            check(text)
+
+
+WITHOUT_CODE = [ROOT / "README.md", *(p for p in PAGES if p not in WITH_CODE)]
+
+
+@pytest.mark.xdist_group("terminal_run")  # the names are those `ambseal run` writes
+@pytest.mark.parametrize("path", WITHOUT_CODE,
+                         ids=["README.md", *_ids(WITHOUT_CODE[1:])])
+def test_page_without_commands_names_files_a_run_writes(path, request):
+    """The README and the pages that run nothing quote output files of ``ambseal run``
+    (the session's run, ``terminal_run``): each is one it writes
+    (:func:`check_file_names`)."""
+    check_file_names(path.read_text(encoding="utf-8"), path.name, [], request, {}, [])
 
 
 @pytest.mark.slow

@@ -244,9 +244,9 @@ def test_the_speed_in_hz_is_bounded_as_the_speed_in_rpm(tmp_path, capsys):
 
 def test_every_speed_has_one_bound_in_rpm_and_hz(tmp_path, capsys):
     """One bound, :data:`~ambseal.config.MAX_SPEED_HZ` (× 60 in rpm), for every speed
-    however it is given: 5 % below it a rig's ``speed_rpm``,
-    ``speed_range_hz`` and ``trip_speed_hz`` are read; 5 % above it each rig key, and
-    ``--speed-rpm`` of ``drop`` and ``modes`` and ``--speed-hz`` of ``drop``, ``sweep``
+    however it is given: 5 % below it a rig's ``speed_rpm``, ``speed_range_hz``,
+    ``trip_speed_hz`` and ``[controller.pid] cross_speed_rpm`` are read; 5 % above it
+    each rig key, and ``--speed-rpm`` of ``drop`` and ``modes`` and ``--speed-hz`` of ``drop``, ``sweep``
     and ``campbell``, are refused naming the key or option written (exit 2)."""
     below, above = 0.95 * MAX_SPEED_HZ, 1.05 * MAX_SPEED_HZ
     base = _rig_text().replace("speed_rpm = 3000.0\n", "")
@@ -254,16 +254,21 @@ def test_every_speed_has_one_bound_in_rpm_and_hz(tmp_path, capsys):
     def rig(name, text):
         return _rig(tmp_path, base + text, name)
 
+    pid = "[controller.pid]\nkp = 1.0e4\nti = 0.1\ntd = 1.0e-3\neps = 0.1\ncross_kp = 100.0\n"
     fast = load_rig(rig("fast.toml", f"speed_rpm = {60 * below!r}\nspeed_range_hz = "
-                                     f"[1.0, {below!r}]\ntrip_speed_hz = {below!r}\n"))
+                                     f"[1.0, {below!r}]\ntrip_speed_hz = {below!r}\n"
+                                     f"{pid}cross_speed_rpm = {60 * below!r}\n"))
     assert fast.operating.trip_hz == fast.operating.continuous_hz[1] == below
+    assert fast.controller.pid.cross_speed_rpm == 60 * below
     for k, (key, text) in enumerate((
             ("speed_rpm", f"speed_rpm = {60 * above!r}\n"),
             ("speed_rpm", f"speed_rpm = {-60 * above!r}\n"),
             ("speed_range_hz", f"speed_range_hz = [1.0, {above!r}]\n"),
-            ("trip_speed_hz", f"trip_speed_hz = {above!r}\n"))):
+            ("trip_speed_hz", f"trip_speed_hz = {above!r}\n"),
+            ("cross_speed_rpm", f"{pid}cross_speed_rpm = {60 * above!r}\n"))):
         path = rig(f"over{k}.toml", text)
-        _refused(capsys, ["validate", path], str(path), "operating", key)
+        _refused(capsys, ["validate", path], str(path),
+                 "controller.pid" if key == "cross_speed_rpm" else "operating", key)
     ok = rig("ok.toml", "speed_rpm = 3000.0\n")
     out = ["--out", tmp_path / "d"]
     for args, option in ((["drop", ok, "--speed-rpm", 60 * above, *out], "--speed-rpm"),

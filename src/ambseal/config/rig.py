@@ -852,7 +852,7 @@ class Pid(_Strict):
     cross_kd: float = Field(default=0.0, ge=-1e11, le=1e11)
     # the speed the cross gains are given at: with it they scale with the speed, as the
     # gyroscopic moments do; without it they are constant
-    cross_speed_rpm: float | None = Field(default=None, gt=0, le=1e7)
+    cross_speed_rpm: float | None = Field(default=None, gt=0, le=MAX_SPEED_RPM)
 
     @model_validator(mode="after")
     def _cross(self) -> "Pid":

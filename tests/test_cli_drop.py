@@ -100,7 +100,9 @@ def test_every_example_rig_lands_on_its_own_touchdown_bearings(rig, tmp_path, ca
     small fraction of the clearance, and the journal at least the clearance off centre
     at each plane it lands on — every plane but where a stiff seal holds the rotor up
     (the turboexpander's hole-pattern seal, 12 MN/m at its speed, holds the end near
-    it off its ring: that plane is "no contact")."""
+    it off its ring: that plane is "no contact"). A standing example (the flywheel)
+    lands on its lower plane's axial face, within its axial clearance, and, balanced,
+    touches no ring radially."""
     cfg = load_rig(rig)
     assert len(cfg.touchdown) == 2
     code = main(["--quiet", "drop", str(rig), "--duration-s", "0.04", "--out",
@@ -108,6 +110,13 @@ def test_every_example_rig_lands_on_its_own_touchdown_bearings(rig, tmp_path, ca
     doc = json.loads(capsys.readouterr().out)
     assert code in (0, 1) and doc["verdict"].startswith("Drop ")
     assert doc["speed_rpm"] == cfg.operating.speed_rpm and doc["impacts"] >= 2
+    if cfg.machine.orientation == "vertical":
+        stops = [p for p, td in zip(doc["planes"], cfg.touchdown) if td.axial_clearance]
+        assert stops and all(p["peak_axial_force_n"] > 0 for p in stops)
+        assert all(0 < p["max_axial_penetration_m"] < 0.2 * td.axial_clearance
+                   for p, td in zip(doc["planes"], cfg.touchdown) if td.axial_clearance)
+        assert all(p["peak_force_n"] == 0 for p in doc["planes"])
+        return
     held = {"turboexpander": {"TA"}}.get(rig.stem, set())
     for p, td in zip(doc["planes"], cfg.touchdown):
         assert p["name"] == td.name
@@ -357,15 +366,35 @@ def test_monte_carlo_drops_of_an_event(tmp_path, capsys):
             assert {p: float(cells[f"{p}_peak_force_n"]) > 0 for p in landed} == landed
 
 
-def test_a_standing_rotors_drop_says_it_is_taken_lying(tmp_path, capsys):
-    """A rig whose ``[machine] orientation`` is vertical: the drop still takes gravity
-    across the axis, and says so on stderr (a standing rotor's axial landing is not
-    modelled); a horizontal rig's drop says nothing of it."""
-    for orientation, said in (("vertical", True), ("horizontal", False)):
-        rig = tmp_path / f"{orientation}.toml"
-        rig.write_text(_rig_text() + f'[machine]\norientation = "{orientation}"\n')
-        code = main(["--quiet", "drop", str(rig), "--duration-s", "0.002", "--out",
-                     str(tmp_path / orientation), "--json"])
-        err = capsys.readouterr().err
+def test_a_standing_rotors_drop_lands_it_axially_and_says_so(tmp_path, capsys):
+    """A vertical rig whose touchdown planes have no ``axial_clearance``: the drop warns
+    on stderr that the weight along the axis stays on the thrust bearing (its axial
+    landing not modelled); with an axial clearance on the lower plane it says nothing
+    of it and the rotor lands on that face, its JSON and text output naming the
+    orientation; a horizontal rig's drop warns of nothing and lands on its rings."""
+    axial = "axial_clearance = 1.0e-4\n"
+    for name, orientation, stop, said in (("bare", "vertical", "", True),
+                                          ("stop", "vertical", axial, False),
+                                          ("lying", "horizontal", "", False)):
+        text = _rig_text().replace("position = 0.0\n", "position = 0.0\n" + stop, 1)
+        rig = tmp_path / f"{name}.toml"
+        rig.write_text(text + f'[drop]\naxial_thrust = 0.0\n[machine]\norientation = '
+                       f'"{orientation}"\n')
+        code = main(["--quiet", "drop", str(rig), "--duration-s", "0.01", "--speed-rpm",
+                     "0", "--out", str(tmp_path / name), "--json"])
+        captured = capsys.readouterr()
+        doc = json.loads(captured.out)
         assert code in (0, 1)
-        assert ('orientation = "vertical"' in err and "not modelled yet" in err) == said
+        assert ('orientation = "vertical"' in captured.err
+                and "axial_clearance" in captured.err) == said
+        assert doc["orientation"] == orientation
+        assert doc["orientation_note"].startswith(f"{orientation} machine")
+        ta = doc["planes"][0]
+        if name == "stop":  # on its face, nowhere near its rings
+            assert ta["peak_axial_force_n"] > 0
+            assert all(p["peak_force_n"] == 0 for p in doc["planes"])
+        if name == "lying":
+            assert ta["peak_force_n"] > 0 and ta["peak_axial_force_n"] == 0
+    main(["--quiet", "drop", str(tmp_path / "stop.toml"), "--duration-s", "0.001",
+          "--speed-rpm", "0", "--out", str(tmp_path / "text")])
+    assert "vertical machine: its weight along the axis" in capsys.readouterr().out

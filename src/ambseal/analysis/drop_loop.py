@@ -306,7 +306,9 @@ def drop_event(cfg, dm, loop: AmbLoop, event: str = "loss", axis: str | None = N
                 "summary": "every AMB loses power"}
     if event == "one-axis":
         if axis is None:
-            axis = loop.names[int(np.argmax(np.abs(loop.static)))]
+            # the first of the most loaded: AMBs loaded alike within rounding tie
+            load = np.abs(loop.static)
+            axis = loop.names[int(np.flatnonzero(load >= (1 - 1e-9) * load.max())[0])]
         if axis not in loop.names:
             raise ConfigError(f"--axis: expected one of {', '.join(loop.names)}, got {axis!r}")
         return {"failed": (axis,), "overload": None, "pressure_bar": None,

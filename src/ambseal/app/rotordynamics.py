@@ -305,13 +305,15 @@ def _signoff_into(args: argparse.Namespace) -> int:
 @_owns_out
 def _drop(args: argparse.Namespace) -> int:
     cfg = load_rig(args.rig)
-    if cfg.machine.orientation != "horizontal":
-        # the drop's gravity is across the axis: said, so that its verdict is not read as
-        # that of a standing rotor's axial landing
+    if cfg.machine.orientation != "horizontal" and all(
+            t.axial_clearance is None for t in cfg.touchdown):
+        # the weight along the axis has nowhere to land: said, so that the verdict is not
+        # read as that of the rotor's axial landing
         logging.getLogger("ambseal").warning(
-            "drop: [machine] orientation = \"%s\", yet the drop takes gravity along −y (a "
-            "rotor lying horizontal, falling onto its radial rings): a standing rotor's "
-            "landing on its axial face is not modelled yet", cfg.machine.orientation)
+            "drop: [machine] orientation = \"%s\", yet no [[touchdown]] has an "
+            "axial_clearance: the rotor's weight along its axis stays on the thrust "
+            "bearing, and its landing on an axial face is not modelled",
+            cfg.machine.orientation)
     if args.speed_hz is not None:  # it stands for [operating] speed_rpm, as --speed-rpm
         check_operating({"speed_rpm": 60.0 * args.speed_hz},
                         {"speed_rpm": f"--speed-hz {args.speed_hz:g} "
@@ -425,6 +427,7 @@ def _drop(args: argparse.Namespace) -> int:
         print(json.dumps({**doc, "files": [str(f) for f in files]}))
     else:
         print(doc["verdict"])
+        print(doc["orientation_note"])
         for c in doc["criteria"]:
             print(f"{c['name']}: {c['outcome']} — {c['value']} (limit {c['limit']})")
         for p in doc["planes"]:

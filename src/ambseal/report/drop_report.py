@@ -106,6 +106,8 @@ def write_drop_report(path: str | os.PathLike, doc: dict, figures, *, title: str
              if "event_summary" in doc else "")
     sections = [
         {"title": "Verdict", "html": f"<p><b>{html.escape(doc['verdict'])}</b></p>"
+         + (f"<p>{html.escape(doc['orientation_note'])}.</p>"
+            if "orientation_note" in doc else "")
          + _table(["criterion", "outcome", "value", "limit"], crit)},
         {"title": "The event and the AMB axes", "html": event + _table(
             ["axis", "power", "peak current (A)", "limit (A)", "saturated"], ambs)},

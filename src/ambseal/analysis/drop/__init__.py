@@ -6,12 +6,20 @@ runs the others — and a step force, from the levitated state at the operating 
 AMB loop runs inside the drop (:mod:`ambseal.analysis.drop_loop`: each axis's force
 linearised about the levitated equilibrium, its current reference clipped at its limit,
 a lost axis's force decaying with the square of its coil's current, e^{−2t R/L}), and the
-rotor falls through the clearance onto the rings. Where every axis is lost the thrust
+rotor falls through the clearance onto the rings. Gravity acts as the machine stands
+(``[machine] orientation``, :func:`ambseal.model.gravity_vector`): its part across the
+axis loads the rotor's modes (:func:`ambseal.model.gravity_load`; none for a vertical
+rotor), held in the levitated state by the AMBs as the statics share it
+(:func:`ambseal.analysis.statics.support_forces`), and its part along the axis, the axial
+weight m·g_z, falls the rotor axially once the thrust bearing lets go. So a standing
+rotor lands on its axial touchdown face, and only its unbalance, its whirl and the face's
+friction bring it to its radial rings. Where every axis is lost the thrust
 bearing lets go too: the rotor, rigid along its axis (its axial modes lie far above the
-drop's), moves under the residual thrust (``[drop] axial_thrust``) onto the planes with an
-``axial_clearance``, m z̈ = F_a − Σ sign(z)·N_a(|z| − c_a), N_a the plane's contact law
-(its own K with ``axial_contact_stiffness``) damped as the radial one by the onset's
-axial speed, at least that of a fall through c_a under the thrust or the weight; its
+drop's), moves under the residual thrust (``[drop] axial_thrust``) and its axial weight
+onto the planes with an ``axial_clearance``, m z̈ = F_a + m·g_z − Σ sign(z)·N_a(|z| − c_a),
+N_a the plane's contact law (its own K with ``axial_contact_stiffness``; a plane stops the
+rotor either way) damped as the radial one by the onset's axial speed, at least that of a
+fall through c_a under F_a + m·g_z or standard gravity, whichever is larger; its
 friction μN_a·tanh(v_s/v_r) at the ring's bore radius R_r against the slip
 (Ω − ω_r)·R_r brakes the spin and spins the ring up. Each plane's friction heat
 ∫F_t v_s dt, radial and axial, is kept.
@@ -36,7 +44,9 @@ Each touchdown plane (:class:`ambseal.config.Touchdown`; :class:`ambseal.model.
 ContactLaw`): the journal's centre r relative to the ring's (the ring on its support
 where ``support_mass`` is given), penetration δ = |r| − c, normal n = r/|r|, tangent
 t = ẑ × n. The normal force N on δ and δ̇ with the damping of the impact's normal speed
-v₀ at the contact's onset, at least the free-fall speed over the clearance √(2 g c): a
+v₀ at the contact's onset, at least the free-fall speed over the clearance √(2 g c) under
+standard gravity g, however the machine stands (a floor on v₀, not the rotor's own fall:
+a standing rotor does not fall radially, yet touches its rings through its whirl): a
 slower onset — a grazing contact, or the ring's support meeting the journal — is damped
 as a fall through the clearance would be, not by the D ∝ 1/v₀ a near-zero v₀ would give
 (which would put a damping force many times the elastic one into a slow contact);

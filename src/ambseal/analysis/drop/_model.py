@@ -11,6 +11,7 @@ from scipy.constants import g as GRAVITY
 from scipy.linalg import eigh
 
 from ambseal.analysis.judge import seal_static_load
+from ambseal.analysis.statics import support_forces
 from ambseal.errors import ConfigError
 from ambseal.model import (
     ContactLaw,
@@ -18,6 +19,8 @@ from ambseal.model import (
     SpringElement,
     assemble_rotor,
     build_mesh,
+    gravity_load,
+    gravity_vector,
     hertz_impact,
     spring_label,
 )
@@ -55,7 +58,8 @@ class DropModel:
     K, C, G : ndarray, shape (m, m)
         Φᵀ K Φ, Φᵀ C Φ, Φᵀ G Φ.
     gravity : ndarray, shape (m,)
-        Φᵀ of the rotor's weight (−y).
+        Φᵀ of the lateral part of the rotor's weight as the machine stands
+        (:func:`ambseal.model.gravity_load`; zero for a vertical rotor).
     planes : tuple of ndarray, shape (2, m)
         Each touchdown plane's x, y rows of Φ.
     laws : tuple of ContactLaw
@@ -65,9 +69,12 @@ class DropModel:
     support : tuple of (float, float, float) or None
         Per plane: the support's mass, stiffness and damping, None where rigid.
     amb_force : ndarray, shape (a, 2)
-        Each AMB's static force (N, x and y) in the levitated equilibrium: the weight and
-        the static loads of the seals the rotor runs offset in, at the operating pressure
-        drop (a seal's ``static_eccentricity`` taken downward: the rotor low in it).
+        Each AMB's static force (N, x and y) in the levitated equilibrium: the lateral
+        part of the weight, as the statics share it among the AMBs
+        (:func:`ambseal.analysis.statics.support_forces`, the AMBs alone holding the
+        rotor), and the static loads of the seals the rotor runs offset in, at the
+        operating pressure drop (a seal's ``static_eccentricity`` taken downward: the
+        rotor low in it).
     q0 : ndarray, shape (m,)
         The levitated equilibrium (the bending under gravity and the AMBs' forces).
     mass : float
@@ -99,6 +106,12 @@ class DropModel:
     axial_laws : tuple of ContactLaw or None
         Per plane: the axial contact's law (the radial one with
         ``axial_contact_stiffness``), None where it does not stop the rotor axially.
+    g_xyz : ndarray, shape (3,)
+        Gravity in the rotor's frame (m/s², :func:`ambseal.model.gravity_vector`): its
+        x, y part in ``gravity``, its z part the axial weight m·g_z on the rotor once the
+        thrust bearing lets go.
+    orientation : str
+        ``[machine] orientation``.
     """
 
     phi: np.ndarray
@@ -127,6 +140,21 @@ class DropModel:
     z_cg: float = 0.0
     axial_clearance: np.ndarray = field(default=None, repr=False)
     axial_laws: tuple = ()
+    g_xyz: np.ndarray = field(default_factory=lambda: np.array([0.0, -GRAVITY, 0.0]),
+                              repr=False)
+    orientation: str = "horizontal"
+
+    @property
+    def axial_weight(self) -> float:
+        """The rotor's weight along its axis, m·g_z (N, +z positive; 0 lying
+        horizontal)."""
+        return float(self.mass * self.g_xyz[2])
+
+    @property
+    def lateral_gravity(self) -> float:
+        """The magnitude of gravity across the axis, √(g_x² + g_y²) (m/s²; 0 standing
+        vertical)."""
+        return float(math.hypot(self.g_xyz[0], self.g_xyz[1]))
 
 
 def _disk_label(disk, i: int) -> str:
@@ -150,22 +178,42 @@ def _seal_offset_forces(cfg, pressure_bar: float) -> list[tuple[float, np.ndarra
             for s in cfg.seal if s.static_eccentricity > 0]
 
 
-def _amb_static_forces(cfg, mass: float, z_g: float, loads=()) -> np.ndarray:
-    """The AMBs' forces (N, shape (a, 2): x, y) that hold the rotor's weight and the
-    static ``loads`` ((z, F_xy) pairs): net force and moment in each direction (the
-    least-norm split beyond two AMBs)."""
+def _amb_static_forces(cfg, g_xyz, loads=()) -> np.ndarray:
+    """The AMBs' forces (N, shape (a, 2): x, y) that hold the lateral part of the rotor's
+    weight and the static ``loads`` ((z, F_xy) pairs).
+
+    The weight's share is the statics' (:func:`ambseal.analysis.statics.support_forces`
+    on the rig without its springs: in the drop the AMBs hold the levitated rotor alone,
+    the springs acting on its excursions from there), split evenly among AMBs at one
+    position; the loads' is the net force and moment in each direction (the least-norm
+    split beyond two AMB positions).
+    """
     z = np.array([a.position for a in cfg.amb], float)
-    A = np.vstack([np.ones_like(z), z])
     out = np.zeros((z.size, 2))
+    if np.any(np.asarray(g_xyz[:2]) != 0.0):
+        try:
+            held, applied = support_forces(cfg.model_copy(update={"spring": []}), g_xyz)
+            total = sum(held.values(), np.zeros(2))
+            ok = np.abs(total - applied).max() <= 1e-6 * np.abs(applied).max()
+        except np.linalg.LinAlgError:  # one AMB plane: nothing holds the weight's moment
+            ok = False
+        if not ok:
+            raise ConfigError("drop: the AMBs cannot hold the rotor's weight (one AMB "
+                              "plane: nothing holds the weight's moment)")
+        for k, a in enumerate(cfg.amb):
+            out[k] = -held[a.position] / int(np.sum(z == a.position))
+    A = np.vstack([np.ones_like(z), z])
     for j in range(2):
-        b = np.array([mass * GRAVITY * (j == 1), mass * GRAVITY * z_g * (j == 1)])
+        b = np.zeros(2)
         for zs, F in loads:
             b -= F[j] * np.array([1.0, zs])
+        if not b.any():
+            continue
         f, *_ = np.linalg.lstsq(A, b, rcond=None)
         if not np.allclose(A @ f, b, rtol=1e-9, atol=1e-9 * max(abs(b).max(), 1e-300)):
             raise ConfigError("drop: the AMBs cannot hold the rotor's weight and the seals' "
                               "static loads (one AMB away from the centre of mass)")
-        out[:, j] = f
+        out[:, j] += f
     return out
 
 
@@ -219,19 +267,23 @@ def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
         n = mesh.node_at(z)
         return phi[[4 * n, 4 * n + 1], :]
 
-    t_y = np.zeros(mesh.n_dof)
-    t_y[1::4] = 1.0
-    gravity = -GRAVITY * phi.T @ (rotor.M @ t_y)
+    g_xyz = gravity_vector(cfg.machine)
+    gravity = phi.T @ gravity_load(rotor.M, mesh.n_dof, g_xyz)
     offsets = _seal_offset_forces(cfg, cfg.operating.pressure_bar)
-    amb_force = _amb_static_forces(cfg, mass, z_g, offsets)
+    amb_force = _amb_static_forces(cfg, g_xyz, offsets)
     Km = phi.T @ rotor.K @ phi
     # levitated: the flexible modes bent by gravity, the AMBs and the offset seals (the
     # rigid ones balanced)
     load = gravity + sum((xy(a.position).T @ f for a, f in zip(cfg.amb, amb_force)),
                          np.zeros(phi.shape[1]))
     load = load + sum((xy(zs).T @ F for zs, F in offsets), np.zeros(phi.shape[1]))
-    q0 = np.zeros(phi.shape[1])
     flex = f > 0
+    scale = float(np.abs(gravity).max(initial=0.0)) + sum(
+        float(np.abs(F).max()) for _, F in offsets)
+    if np.abs(load[~flex]).max(initial=0.0) > 1e-6 * max(scale, 1e-300):
+        raise ConfigError("drop: the AMBs cannot hold the rotor's weight and the seals' "
+                          "static loads (one AMB away from the centre of mass)")
+    q0 = np.zeros(phi.shape[1])
     q0[flex] = np.linalg.solve(Km[np.ix_(flex, flex)], load[flex])
     g_node = int(np.argmin(np.abs(mesh.z - z_g)))
     rows.update({f"amb:{a.name}": xy(a.position) for a in cfg.amb})
@@ -261,7 +313,8 @@ def drop_model(cfg, modes_hz: float | None = None) -> DropModel:
         axial_laws=tuple(None if t.axial_clearance is None else
                          law if t.axial_contact_stiffness is None else
                          replace(law, stiffness=float(t.axial_contact_stiffness))
-                         for t, law in zip(cfg.touchdown, laws)))
+                         for t, law in zip(cfg.touchdown, laws)),
+        g_xyz=g_xyz, orientation=cfg.machine.orientation)
 
 
 def support_matrices(cfg, dm: DropModel, speed_rpm: float,

@@ -89,6 +89,11 @@ class DropResult:
     friction_heat : ndarray, shape (p, k)
         The heat (J) each plane's friction made since the drop, radial and axial:
         ∫ F_t·v_s dt.
+    orientation : str
+        ``[machine] orientation``: how gravity acted in the drop.
+    axial_weight : float
+        The rotor's weight along its axis, m·g_z (N, +z positive), on it with the thrust
+        once the thrust bearing let go.
     """
 
     t: np.ndarray
@@ -123,6 +128,8 @@ class DropResult:
     peak_axial_penetration: np.ndarray = field(default=None, repr=False)
     axial_thrust: float = 0.0
     friction_heat: np.ndarray = field(default=None, repr=False)
+    orientation: str = "horizontal"
+    axial_weight: float = 0.0
 
     def regime(self, p: int) -> tuple[str, float]:
         """The plane's regime over the last half of the drop: ``"no contact"`` (never
@@ -205,7 +212,7 @@ class DropResult:
         the work done on the rotor from outside (:attr:`work`), the coast-down time
         (:meth:`coast_down_s`); per plane the peak axial force and penetration and the
         friction heat, and the rotor's largest axial excursion (None where the thrust
-        bearing held)."""
+        bearing held); the machine's orientation and the rotor's axial weight."""
         planes = []
         for p, name in enumerate(self.names):
             regime, hz = self.regime(p)
@@ -241,6 +248,8 @@ class DropResult:
                 "coast_down_s": None if stop is None else json_float(stop),
                 "coast_down_extrapolated": extrapolated,
                 "axial_thrust_n": json_float(self.axial_thrust),
+                "orientation": self.orientation,
+                "axial_weight_n": json_float(self.axial_weight),
                 "max_axial_m": (None if self.axial_position is None else
                                 json_float(float(np.abs(self.axial_position).max())))}
 
@@ -279,7 +288,8 @@ def collect(cfg, dyn, run) -> DropResult:
         if dyn.event.coast_down:  # the spin's energy, which the drive no longer holds
             e += 0.5 * dm.polar_inertia * dyn.spin(yj) ** 2
         if dyn.axial:
-            e += 0.5 * dm.mass * yj[L.i_ax + 1] ** 2
+            # and the axial weight's potential, as the lateral weight's above
+            e += 0.5 * dm.mass * yj[L.i_ax + 1] ** 2 - dm.axial_weight * yj[L.i_ax]
             for p, delta, N, _, _ in dyn.axial_contacts(yj, wr):
                 law = dm.axial_laws[p]
                 e += law.stiffness * delta ** (law.exponent + 1) / (law.exponent + 1)
@@ -321,5 +331,6 @@ def collect(cfg, dyn, run) -> DropResult:
                       peak_axial_force=np.maximum(run.peak_ax_force,
                                                   axial_force.max(axis=1)),
                       peak_axial_penetration=run.peak_ax_delta,
-                      axial_thrust=dyn.thrust,
+                      axial_thrust=dyn.thrust, orientation=dm.orientation,
+                      axial_weight=dm.axial_weight,
                       friction_heat=Y[:, L.i_heat:L.i_heat + P].T.copy())

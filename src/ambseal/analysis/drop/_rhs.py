@@ -88,12 +88,19 @@ class DropDynamics:
                 self.f_over = self.f_over + dm.phi[[4 * n_s, 4 * n_s + 1], :].T @ F
         self.layout = StateLayout.of(m, dm.race_inertia, dm.support, loop.n_states,
                                      event.coast_down, self.axial, nh)
-        self.floor = np.sqrt(2 * GRAVITY * dm.clearance)  # the slowest impact damped
+        # the slowest impact damped: a fall through the clearance under standard gravity,
+        # whatever the rotor's orientation — a floor on v₀ against the D = ζ/v₀ of a
+        # grazing onset, not the rotor's own fall (a standing rotor has none radially, yet
+        # touches its rings through its whirl)
+        self.floor = np.sqrt(2 * GRAVITY * dm.clearance)
         self.v0 = self.floor.copy()
-        # axially, a fall through the axial clearance under the thrust (or the weight's
-        # acceleration, if larger)
+        # the rotor's axial force once the thrust bearing lets go: the residual thrust
+        # and the weight along the axis (a standing rotor's whole weight)
+        self.f_axial = self.thrust + dm.axial_weight
+        # axially, a fall through the axial clearance under that force (or standard
+        # gravity's acceleration, if larger)
         self.c_ax = dm.axial_clearance if self.stops else np.full(P, np.inf)
-        self.floor_ax = np.sqrt(2 * max(abs(self.thrust) / dm.mass, GRAVITY)
+        self.floor_ax = np.sqrt(2 * max(abs(self.f_axial) / dm.mass, GRAVITY)
                                 * np.where(np.isfinite(self.c_ax), self.c_ax, 0.0))
         self.v0_ax = self.floor_ax.copy()
         self.ring = dm.journal + dm.clearance
@@ -332,11 +339,12 @@ class DropDynamics:
         return torque, heat, dwr, dsup
 
     def _axial(self, y, wr, dy, torque, heat, dwr):
-        """The rotor as a rigid body along its axis, on the thrust and the faces: its
-        derivatives into ``dy``; the faces' friction added to ``torque``, ``heat`` and
-        the rings' spin-up; the thrust's power."""
+        """The rotor as a rigid body along its axis, on the thrust, its axial weight and
+        the faces: its derivatives into ``dy``; the faces' friction added to ``torque``,
+        ``heat`` and the rings' spin-up; the thrust's power (the weight's is in the
+        energy, as its potential)."""
         i_ax, dm = self.layout.i_ax, self.dm
-        f_ax = self.thrust
+        f_ax = self.f_axial
         for p, _, N, Ft, slip in self.axial_contacts(y, wr):
             f_ax -= math.copysign(N, y[i_ax])
             torque -= Ft * self.ring[p]

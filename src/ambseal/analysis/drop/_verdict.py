@@ -46,8 +46,9 @@ def drop_verdict(cfg, result: DropResult) -> dict:
         ``passed`` (bool: nothing failed), ``verdict`` (one line), ``beyond_range``
         (where and when the drop left its model's range, one line each), ``criteria``
         (``name``, ``outcome`` — ``"passed"``, ``"FAILED"`` or ``"not graded"`` —,
-        ``value``, ``limit``) and ``gaps_m`` (each watched plane's gap, m, as
-        :attr:`DropResult.watched` names it; None where none is given).
+        ``value``, ``limit``), ``gaps_m`` (each watched plane's gap, m, as
+        :attr:`DropResult.watched` names it; None where none is given) and
+        ``orientation_note`` (:func:`drop_orientation`).
     """
     rows = []
 
@@ -144,7 +145,45 @@ def drop_verdict(cfg, result: DropResult) -> dict:
         line = (f"Drop FAILED, beyond the drop model's range: {'; '.join(beyond)} — its "
                 f"results from then on do not describe the machine ({line})")
     return {"passed": not failed, "verdict": line, "criteria": rows, "beyond_range": beyond,
-            "gaps_m": {k: json_float(g) if g is not None else None for k, g in gaps.items()}}
+            "gaps_m": {k: json_float(g) if g is not None else None for k, g in gaps.items()},
+            "orientation_note": drop_orientation(cfg, result)}
+
+
+def drop_orientation(cfg, result: DropResult) -> str:
+    """How the machine stands in the drop, one line: where its weight takes the rotor —
+    across its axis onto its radial rings, along it onto its axial touchdown faces (once
+    the thrust bearing lets go), or both (inclined) — and, for a standing rotor, what is
+    left to bring it to its rings radially.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig dropped (its ``[machine]``).
+    result : DropResult
+        Its drop.
+
+    Returns
+    -------
+    str
+    """
+    machine = cfg.machine
+    head = (f"{machine.orientation} machine"
+            + (f" ({machine.inclination_deg:g}° above the horizontal)"
+               if machine.orientation == "inclined" else ""))
+    w = abs(result.axial_weight)
+    if w == 0.0:
+        return f"{head}: its weight takes the rotor across its axis onto its radial rings"
+    if result.axial_position is not None:
+        axial = (f"its weight along the axis, {w:.4g} N, takes the rotor onto its axial "
+                 "touchdown face once the thrust bearing lets go")
+    else:
+        axial = (f"its weight along the axis, {w:.4g} N, stays on the thrust bearing "
+                 "(it holds in this event, or no touchdown plane has an "
+                 "axial_clearance)")
+    radial = ("across the axis nothing pulls the rotor to its rings: only the unbalance, "
+              "the whirl and the axial face's friction do" if machine.orientation ==
+              "vertical" else "the rest of it across the axis, onto its radial rings")
+    return f"{head}: {axial}; {radial}"
 
 
 def _first_time(t: np.ndarray, over: np.ndarray) -> str:

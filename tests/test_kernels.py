@@ -1,0 +1,141 @@
+"""The same delivered answer under two sets of BLAS kernels.
+
+A run's numbers differ between machines in their last digits: OpenBLAS picks its kernels
+by the processor (Haswell's AVX2, SkylakeX's AVX-512, …), and each sums in its own order.
+A synthesis that follows its path by rounding then delivers another controller on another
+machine. ``OPENBLAS_CORETYPE`` makes one machine run either set, so the blower example
+(``examples/blower.toml``: PID, H∞ and μ, the μ by D–G–K on a mixed structure) is run
+twice, in two processes at once, with two kernel sets the processor has, and the two
+``metrics.json`` compared as :mod:`tests.kernel_compare` states: the delivered set, every
+ISO 14839-3 zone and every verdict's words the same, each number within its stated
+tolerance (μ and γ 2 %, σ̄(S_o) peaks 5 %, orbits and currents 5 %).
+
+The reference is the run itself under the other kernels: any difference beyond the
+tolerances is rounding carried into a design's path. The whole run is used, not
+``ambseal design --method mu`` alone: the μ design is ~85 % of its ~80 s of CPU, and the
+zones and verdicts a user reads come from the judgement that follows it.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests.kernel_compare import delivered, differences
+
+ROOT = Path(__file__).resolve().parents[1]
+BLAS_VARS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS",
+             "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS",
+             "OPENBLAS_CORETYPE", "OPENBLAS_VERBOSE", "AMBSEAL_BLAS_THREADS")
+_MAIN = "import sys; from ambseal.cli import main; sys.exit(main())"
+_ARCH = ("import json, numpy, scipy.linalg, threadpoolctl; print(json.dumps(sorted("
+         "{i.get('architecture') or '' for i in threadpoolctl.threadpool_info() "
+         "if i.get('internal_api') == 'openblas'})))")
+
+
+def _env(coretype: str) -> dict:
+    """This environment without BLAS variables, then one kernel set and one thread."""
+    env = {k: v for k, v in os.environ.items() if k not in BLAS_VARS}
+    env.update(OPENBLAS_CORETYPE=coretype, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
+               MPLBACKEND="Agg")
+    env["PYTHONPATH"] = os.pathsep.join([str(ROOT / "src"), env.get("PYTHONPATH", "")])
+    return env
+
+
+def _cpu_flags() -> set[str]:
+    try:
+        text = Path("/proc/cpuinfo").read_text()
+    except OSError:
+        return set()
+    for line in text.splitlines():
+        if line.startswith("flags"):
+            return set(line.split(":", 1)[1].split())
+    return set()
+
+
+def _kernel_pair() -> tuple[str, str] | None:
+    """Two OpenBLAS kernel sets this processor runs: the AVX-512 one against AVX2's where
+    it has AVX-512, else AVX2's against AVX's; None where it has neither."""
+    flags = _cpu_flags()
+    if "avx512f" in flags:
+        return "Haswell", "SkylakeX"
+    if "avx2" in flags:
+        return "Sandybridge", "Haswell"
+    return None
+
+
+def _architecture(coretype: str) -> list[str]:
+    """The kernel sets NumPy's and SciPy's OpenBLAS report under ``coretype``."""
+    out = subprocess.run([sys.executable, "-c", _ARCH], env=_env(coretype), cwd=ROOT,
+                         capture_output=True, text=True, timeout=120)
+    return json.loads(out.stdout) if out.returncode == 0 else []
+
+
+def test_blower_delivers_the_same_answer_under_two_kernel_sets(tmp_path):
+    pair = _kernel_pair()
+    if pair is None:
+        pytest.skip("no two OpenBLAS kernel sets on this processor (neither AVX2 nor AVX-512)")
+    arch = [_architecture(c) for c in pair]
+    if not all(arch) or arch[0] == arch[1] or [pair[0].lower()] != [a.lower() for a in arch[0]] \
+            or [pair[1].lower()] != [a.lower() for a in arch[1]]:
+        pytest.skip(f"OPENBLAS_CORETYPE does not select the kernels here: {pair} gave {arch}")
+    procs = []
+    for coretype in pair:
+        out = tmp_path / coretype
+        argv = [sys.executable, "-c", _MAIN, "-q", "run", str(ROOT / "examples" / "blower.toml"),
+                "--no-identify", "--out", str(out)]
+        procs.append((coretype, out, subprocess.Popen(
+            argv, env=_env(coretype), cwd=tmp_path, stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE, text=True)))
+    metrics = []
+    for coretype, out, proc in procs:
+        stdout, stderr = proc.communicate(timeout=1200)
+        assert proc.returncode == 0, f"{coretype}: exit {proc.returncode}\n{stderr[-3000:]}"
+        metrics.append(json.loads((out / "metrics.json").read_text()))
+    assert delivered(metrics[0]) == delivered(metrics[1])
+    assert "mu" in delivered(metrics[0]), "the blower's μ design is what the test exercises"
+    diff = differences(*metrics)
+    assert not diff, f"{pair[0]} against {pair[1]}:\n" + "\n".join(diff)
+
+
+def _metrics(mu=0.60, zone="A", peak=2.5, verdict="robust performance met: μ = 0.600 ≤ 1"):
+    """A run's metrics.json, the parts the comparison reads."""
+    return {"controllers": {"pid": {"verdict": "no design bound", "gamma": None},
+                            "mu": {"mu": mu, "gamma": 1.0, "verdict": verdict,
+                                   "steps": [], "capacity": {"current_used": 0.03},
+                                   "reduction": {"mu_full": 2 * mu}}},
+            "failed": {}, "cannot_run": {},
+            "cases": [{"controller": "mu", "label": "0 bar", "sensitivity_peak": peak,
+                       "sensitivity_peak_per_axis": {"A_zeta": peak, "A_eta": peak},
+                       "iso_zone": zone, "iso_zone_per_axis": {"A_zeta": zone, "A_eta": zone},
+                       "max_real_pole": -10.0}],
+            "stability": []}
+
+
+def test_comparison_holds_words_and_zones_exactly_and_numbers_to_their_tolerance():
+    """The rules of tests/kernel_compare.py on hand-made runs: μ 2 %, σ̄(S_o) 5 %, zones
+    and words exact with their numbers masked, a design's path (reduction, poles) free."""
+    base = _metrics()
+    assert differences(base, _metrics(mu=0.61, verdict="robust performance met: "
+                                                        "μ = 0.610 ≤ 1")) == []
+    assert differences(base, _metrics(peak=2.5 * 1.04)) == []
+    d = differences(base, _metrics(mu=0.62))
+    assert len(d) == 1 and d[0].startswith("/controllers/mu/mu:")
+    d = differences(base, _metrics(peak=2.5 * 1.06))
+    assert {x.split(":")[0] for x in d} == {
+        "/cases[0]/sensitivity_peak", "/cases[0]/sensitivity_peak_per_axis/A_eta",
+        "/cases[0]/sensitivity_peak_per_axis/A_zeta"}
+    d = differences(base, _metrics(zone="B"))
+    assert {x.split(":")[0] for x in d} == {"/cases[0]/iso_zone",
+                                            "/cases[0]/iso_zone_per_axis"}
+    d = differences(base, _metrics(verdict="robust performance NOT met: μ = 0.600 > 1"))
+    assert len(d) == 1 and d[0].startswith("/controllers/mu/verdict")
+    failed = _metrics()
+    failed["failed"] = {"mu": {"reason": "μ: not delivered — unstable at 0 bar"}}
+    assert delivered(failed) == ["pid"]
+    assert differences(base, failed)[0] == "delivered: ['mu', 'pid'] against ['pid']"

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import control as ct
 import numpy as np
 import pytest
@@ -303,3 +305,41 @@ def test_musyn_dgk_defaults_reach_the_published_mixed_mu_spring_mass_result():
     assert check < 1.0 and r.mu == pytest.approx(check, rel=1e-2)
     worst, stable = _worst_gain(cl, w)
     assert stable and worst <= r.mu * (1 + 1e-3)
+
+
+
+def test_dgk_keeps_the_iterate_of_the_lowest_rechecked_mu(monkeypatch):
+    """Each D–G–K iterate is judged by its μ re-checked around its peaks, the number the
+    result reports, not by its grid's peak: a K-step can put a narrow peak between the
+    grid's points. Fault injection: the re-check of the last iterate (the lowest on the
+    6-point grid, 1.5426 against 1.5451 before it) is made to find such a peak, twice
+    its grid's; the controller kept is then the one before it, and its μ is its own
+    re-checked bound (reference: :func:`mussv` of the kept loop on 2 000 points)."""
+    import ambseal.robust.dgk as dgk
+
+    P, w, max_iter = gain_plant(), np.logspace(-2, 3, 6), 4
+    made, real_check, real_k_step = [], dgk._check, dgk._k_step
+
+    def k_step(*args):
+        hr = real_k_step(*args)
+        made.append(hr.K)
+        return hr
+
+    def check(P_, K, *args):
+        pk = real_check(P_, K, *args)
+        if len(made) == max_iter and K is made[-1]:
+            return replace(pk, peak=2 * pk.peak)
+        return pk
+
+    monkeypatch.setattr(dgk, "_k_step", k_step)
+    monkeypatch.setattr(dgk, "_check", check)
+    r = musyn_dgk(P, BLOCKS, 1, 1, w, max_iter=max_iter, search=0)
+    steps = [h for h in r.history if h["step"] == "D-G-K"]
+    assert len(steps) == max_iter and all(h["mu"] >= h["mu_grid"] * (1 - 1e-9)
+                                          for h in steps[:-1])
+    assert steps[-1]["mu_grid"] == min(h["mu_grid"] for h in steps)
+    assert steps[-1]["mu"] > 1.9 * steps[-1]["mu_grid"]
+    kept = min(steps[:-1], key=lambda h: h["mu"])
+    assert r.best_iteration == kept["iteration"] and r.K is made[steps.index(kept)]
+    true = float(np.max(mussv(P.lft(r.K, nu=1, ny=1), BLOCKS, np.logspace(-2, 3, 2000)).upper))
+    assert r.mu == kept["mu"] and r.mu == pytest.approx(true, rel=1e-3)

@@ -12,8 +12,12 @@ tolerance (μ and γ 2 %, σ̄(S_o) peaks 5 %, orbits and currents 5 %).
 
 The reference is the run itself under the other kernels: any difference beyond the
 tolerances is rounding carried into a design's path. The whole run is used, not
-``ambseal design --method mu`` alone: the μ design is ~85 % of its ~80 s of CPU, and the
-zones and verdicts a user reads come from the judgement that follows it.
+``ambseal design --method mu`` alone: the μ design is ~85 % of the run's ~78 s of CPU
+(65 s of it), so a cheaper command saves little, and the zones and verdicts a user reads
+come from the judgement that follows it. Cost: two runs of ~78 s of CPU each, at once on
+two cores (~86 s wall on an idle 2-core machine), about 80 s more per Python in CI.
+Skipped where the processor offers no two kernel sets or ``OPENBLAS_CORETYPE`` does not
+select them (another BLAS).
 """
 
 from __future__ import annotations
@@ -76,13 +80,18 @@ def _architecture(coretype: str) -> list[str]:
     return json.loads(out.stdout) if out.returncode == 0 else []
 
 
+@pytest.mark.xfail(strict=True, raises=AssertionError, reason=(
+    "D–G–K follows rounding: its first step's SLSQP refinement of the scalings ends at "
+    "another minimiser under each kernel set (peak 1.0045402 against 1.0045363), the K-step "
+    "near γ_opt turns that into μ 0.7439 against 0.7447, and six steps later the blower's "
+    "delivered μ is 0.587 against 0.621, its σ̄(S_o) peaks 7–12 % and its currents 9–11 % "
+    "apart"))
 def test_blower_delivers_the_same_answer_under_two_kernel_sets(tmp_path):
     pair = _kernel_pair()
     if pair is None:
         pytest.skip("no two OpenBLAS kernel sets on this processor (neither AVX2 nor AVX-512)")
     arch = [_architecture(c) for c in pair]
-    if not all(arch) or arch[0] == arch[1] or [pair[0].lower()] != [a.lower() for a in arch[0]] \
-            or [pair[1].lower()] != [a.lower() for a in arch[1]]:
+    if [[c.lower()] for c in pair] != [[a.lower() for a in x] for x in arch]:
         pytest.skip(f"OPENBLAS_CORETYPE does not select the kernels here: {pair} gave {arch}")
     procs = []
     for coretype in pair:
@@ -93,12 +102,19 @@ def test_blower_delivers_the_same_answer_under_two_kernel_sets(tmp_path):
             argv, env=_env(coretype), cwd=tmp_path, stdout=subprocess.PIPE,
             stderr=subprocess.PIPE, text=True)))
     metrics = []
-    for coretype, out, proc in procs:
-        stdout, stderr = proc.communicate(timeout=1200)
-        assert proc.returncode == 0, f"{coretype}: exit {proc.returncode}\n{stderr[-3000:]}"
-        metrics.append(json.loads((out / "metrics.json").read_text()))
-    assert delivered(metrics[0]) == delivered(metrics[1])
-    assert "mu" in delivered(metrics[0]), "the blower's μ design is what the test exercises"
+    try:
+        for coretype, out, proc in procs:
+            _, stderr = proc.communicate(timeout=1200)
+            if proc.returncode != 0:  # not the comparison: a failure even while it is known
+                pytest.fail(f"{coretype}: exit {proc.returncode}\n{stderr[-3000:]}")
+            metrics.append(json.loads((out / "metrics.json").read_text()))
+    finally:
+        for _, _, proc in procs:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
+    if "mu" not in delivered(metrics[0]):
+        pytest.fail("the blower's μ design, what the test exercises, was not delivered")
     diff = differences(*metrics)
     assert not diff, f"{pair[0]} against {pair[1]}:\n" + "\n".join(diff)
 

@@ -80,16 +80,25 @@ def _architecture(coretype: str) -> list[str]:
     return json.loads(out.stdout) if out.returncode == 0 else []
 
 
-@pytest.mark.xfail(strict=True, raises=AssertionError, reason=(
-    "D–G–K follows rounding: its first step's SLSQP refinement of the scalings ends at "
-    "another minimiser under each kernel set (peak 1.0045402 against 1.0045363), the K-step "
-    "near γ_opt turns that into μ 0.7439 against 0.7447, and six steps later the blower's "
-    "delivered μ is 0.587 against 0.621, its σ̄(S_o) peaks 7–12 % and its currents 9–11 % "
-    "apart"))
-def test_blower_delivers_the_same_answer_under_two_kernel_sets(tmp_path):
+#: Why the comparison fails today, measured with Haswell against SkylakeX kernels
+KNOWN = ("D–G–K follows rounding: its first step's SLSQP refinement of the scalings ends at "
+         "another minimiser under each kernel set (peak 1.0045402 against 1.0045363), the "
+         "K-step near γ_opt turns that into μ 0.7439 against 0.7447, and six steps later the "
+         "blower's delivered μ is 0.587 against 0.621, its σ̄(S_o) peaks 7–12 % and its "
+         "currents 9–11 % apart")
+
+
+def test_blower_delivers_the_same_answer_under_two_kernel_sets(tmp_path, request):
+    """Expected to fail on the comparison (``KNOWN``), strictly where that was measured:
+    with Haswell against SkylakeX kernels it must fail until D–G–K ends where rounding
+    cannot move it, and then the marker comes off. With another pair (Sandybridge against
+    Haswell, not measured) the comparison may hold and the test passes; a run that
+    crashes fails everywhere."""
     pair = _kernel_pair()
     if pair is None:
         pytest.skip("no two OpenBLAS kernel sets on this processor (neither AVX2 nor AVX-512)")
+    request.node.add_marker(pytest.mark.xfail(strict=pair == ("Haswell", "SkylakeX"),
+                                              raises=AssertionError, reason=KNOWN))
     arch = [_architecture(c) for c in pair]
     if [[c.lower()] for c in pair] != [[a.lower() for a in x] for x in arch]:
         pytest.skip(f"OPENBLAS_CORETYPE does not select the kernels here: {pair} gave {arch}")

@@ -62,7 +62,9 @@ def test_signoff_passes_with_exit_status_0(tmp_path, capsys):
     out, _ = capsys.readouterr()
     lines = out.splitlines()
     assert code == 0 and lines[0].startswith("Sign-off PASSED")
-    assert lines[1].startswith("none: stability, Level I: passed")
+    # the rule the journal loads W follow, then the criteria
+    assert lines[1].startswith("journal static loads W: the rotor's weight on its bearings")
+    assert lines[2].startswith("none: stability, Level I: passed")
 
 
 def test_a_rotor_its_own_seal_makes_unstable_is_not_signed_off(tmp_path, capsys):
@@ -104,9 +106,9 @@ def test_criteria_not_evaluated_are_not_graded_and_the_verdict_says_so(tmp_path,
     assert main(["signoff", str(rig), "--out", str(tmp_path / "so")]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].endswith("(not graded: close clearances, vibration zone)")
-    assert "none: close clearances: not graded — no close clearance given" in lines[5]
+    assert "none: close clearances: not graded — no close clearance given" in lines[6]
     assert ("none: vibration zone: not graded — no backup clearance given ([[touchdown]] "
-            "radial_clearance)") in lines[6]
+            "radial_clearance)") in lines[7]
 
 
 def test_signoff_refuses_plainly(tmp_path, capsys):

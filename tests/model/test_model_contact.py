@@ -105,7 +105,7 @@ def test_the_measured_restitution_is_the_impacts_for_every_law(e):
     the same; where it finds none, even the law's strongest damping (its e → 0)
     rebounds faster than e (Hunt–Crossley and Lankarani–Nikravesh cannot damp that
     much)."""
-    good = ('name = "A"\nposition = 0.05\nradial_clearance = 2.5e-4\n'
+    good = ('name = "TA"\nposition = 0.05\nradial_clearance = 2.5e-4\n'
             f"contact_length = 0.015\nrestitution = {e}\nfriction = 0.1\n")
     for text in (good, good.replace("contact_length = 0.015",
                                     'contact = "point"\ncontact_radius = 0.004')):
@@ -171,7 +171,7 @@ def test_the_touchdown_table_is_read_and_refused_by_key():
     radius, a line contact of another material without a stiffness, a support mass on a
     rigid support, a turning sleeve, both restitutions, or a damping law beside the
     measured restitution (which it would not read) are refused naming the key."""
-    good = ('name = "A"\nposition = 0.05\nradial_clearance = 2.5e-4\n'
+    good = ('name = "TA"\nposition = 0.05\nradial_clearance = 2.5e-4\n'
             "contact_length = 0.015\nrestitution = 0.5\nfriction = 0.1\n")
     cfg = parse_rig(_rig_with(good))
     law = ContactLaw.of(cfg.touchdown[0])

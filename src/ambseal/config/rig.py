@@ -1126,7 +1126,7 @@ def drop_limits_with(drop: DropLimits, key: str, value, arg_name: str) -> DropLi
         The rig's ``[drop]`` table.
     key : str
         A key of it (``"penetration_ratio"``).
-    value
+    value : object
         Its value.
     arg_name : str
         The command-line option, named in the error.

@@ -17,7 +17,8 @@ from ambseal.errors import DataError
 from ambseal.export.controller_files import export_controller, load_controller
 from ambseal.lti.discrete import zoh
 from ambseal.lti.interconnect import feedback_matrices
-from ambseal.robust.digital import discretize_as, residualize, split_fast, with_delay
+from ambseal.robust.digital import (choose_method, discretize_as, residualize, sampled_plants,
+                                    split_fast, with_delay)
 
 from ..octave import octave_cli
 
@@ -111,6 +112,38 @@ def test_choice_closes_candidates_by_rank_until_one_is_stable():
         assert x["stable"] is None and x["max_abs_z"] == [None, None]
         assert "cannot be chosen" in x["not_checked"]
     assert "not_checked" not in a and "not_checked" not in b
+
+
+def test_a_design_for_the_delayed_loop_is_held_where_that_loop_is_stable():
+    """Reference: python-control's closed loops (the plant sampled by a zero-order hold,
+    the discrete controller delayed by one sample) and a hand-made design that counts on
+    the delay. A mode at 333 Hz (ζ = 0.02) under velocity feedback of the wrong sign
+    (g = 4e-5 s, filtered at 20 kHz) is unstable without a delay (the damping
+    2ζω₀ − g ω₀² < 0); at 1 kHz with one sample of delay, 1.5 samples turn the feedback's
+    phase by 180° at ω₀ and the delayed loop is stable, as a design made with its delay
+    (H∞, μ, the LPV) is only with it. Of the candidates ZOH (sampled loop unstable) and
+    the triangle hold (stable), the choice must keep the triangle hold: the sampled loop
+    must be stable where the delayed continuous loop is. A rule on the undelayed loop alone
+    asks nothing here and keeps the first candidate, ZOH."""
+    fs, T, w0, zeta, g, wf = 1000.0, 1e-3, 2 * np.pi * 333.0, 0.02, 4e-5, 2 * np.pi * 2e4
+    G = ct.ss(ct.tf([w0**2], [1, 2 * zeta * w0, w0**2]))
+    K = ct.ss(ct.tf([-g * wf, 0.0], [1.0, wf]))  # u = −K y = +g s y (filtered)
+    assert ct.feedback(G, K).poles().real.max() > 0  # unstable without the delay
+    sp = sampled_plants([_mats(G)], fs, delay_samples=1)
+    assert sp.delayed_poles(0, _mats(K)).real.max() < 0  # stable with it
+    Gd = ct.sample_system(G, T, "zoh")
+
+    def z_max(method):
+        Kd = ct.ss(*with_delay(discretize_as(_mats(K), T, method), 1), T)
+        return np.abs(ct.feedback(Gd, Kd).poles()).max()
+
+    assert z_max("zoh") > 1 > z_max("foh")
+    method, _, cands = choose_method(sp, [_mats(K)], lambda m: [discretize_as(_mats(K), T, m)],
+                                     1, ("zoh", "foh"), None, "K")
+    assert method == "foh"
+    zoh, foh = cands
+    assert zoh["stable"] is False and zoh["max_abs_z"][0] == pytest.approx(z_max("zoh"))
+    assert foh["stable"] and foh["max_abs_z"][0] == pytest.approx(z_max("foh"))
 
 
 def test_when_no_candidate_holds_the_refusal_names_the_closest_and_a_remedy():

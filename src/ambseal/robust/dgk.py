@@ -204,8 +204,9 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
     re-checked around the peaks (:func:`~ambseal.robust.mu.mu_peak`), not by the grid's
     peak: a K-step can put a narrow peak between the grid's points (a 168-state
     controller of a lightly damped plant with two uncertain mode frequencies: 0.580 on a
-    60-point grid, 0.665 re-checked, where the iterate before it had 0.582 on both). The best controller over both phases is returned, so its μ is never above
-    complex D–K's.
+    60-point grid, 0.665 re-checked, where the iterate before it had 0.582 on both). The
+    best controller over both phases is returned, so its μ is never above complex
+    D–K's.
 
     Parameters
     ----------
@@ -251,7 +252,8 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
         ``beta``, the level of its scalings, ``jg_fit_error``, the ψ error of the G fit,
         ``fit_level``, the H∞ norm of the previous controller's loop on the scaled plant:
         1 when the fits certify it at β, and ``mu_grid``, its μ peak on ``omega`` alone,
-        its ``mu`` being re-checked around the peaks as the result's); ``scalings`` holds the fits of the best iteration
+        its ``mu`` being re-checked around the peaks as the result's); ``scalings`` holds
+        the fits of the best iteration
         (D–G–K: ``(d, f, h)`` per block); ``alternatives`` the best complex D–K controller
         when D–G–K's is better at full order. Without real blocks, complex D–K's result.
 

@@ -13,9 +13,9 @@ L, D = 0.4, 0.1
 
 
 def rotor_text(name: str, disk_m: float, disk_ip: float, disk_id: float,
-               elements: int) -> str:
+               elements: int, disk_z: float = L / 2) -> str:
     """``[rotor]``, the material, the shaft (L × D) in ``elements`` and the disk at
-    mid-span; the supports are the caller's."""
+    ``disk_z`` (m; mid-span by default); the supports are the caller's."""
     return f"""
 [rotor]
 name = "{name}"
@@ -29,7 +29,7 @@ outer_diameter = {D}
 material = "rigid"
 elements = {elements}
 [[disk]]
-position = {L / 2}
+position = {disk_z}
 mass = {disk_m}
 Ip = {disk_ip}
 Id = {disk_id}

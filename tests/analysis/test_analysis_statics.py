@@ -17,8 +17,9 @@ from ambseal.config import dump_rig, parse_rig
 from ambseal.errors import ConfigError
 from ambseal.report import statics_section
 
+from ..rigid_rotor import D, L, RHO, rotor_text
+
 G0 = 9.80665  # standard gravity, m/s² (ISO 80000-3)
-L, D, RHO = 0.4, 0.1, 7850.0
 Z_DISK, M_DISK = 0.3, 20.0
 Z_A, Z_B = 0.05, 0.35
 KI_A, KI_B = 100.0, 150.0
@@ -27,23 +28,7 @@ KI_A, KI_B = 100.0, 150.0
 def _rig(machine: str = "", signoff: str = "") -> dict:
     """A stiff uniform shaft (L × D) with a 20 kg disk off centre, on AMB A (axes turned
     45°, Ki 100 N/A) and AMB B (Ki 150 N/A), neither at the centre of mass."""
-    text = f"""
-[rotor]
-name = "rigid rotor on two AMBs"
-[materials.rigid]
-E = 2.1e15
-rho = {RHO}
-nu = 0.3
-[[shaft]]
-length = {L}
-outer_diameter = {D}
-material = "rigid"
-elements = 8
-[[disk]]
-position = {Z_DISK}
-mass = {M_DISK}
-Ip = 0.1
-Id = 0.05
+    text = rotor_text("rigid rotor on two AMBs", M_DISK, 0.1, 0.05, 8, Z_DISK) + f"""
 [[amb]]
 name = "A"
 position = {Z_A}

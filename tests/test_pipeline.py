@@ -5,6 +5,7 @@ import json
 import re
 
 import jsonschema
+import numpy as np
 import pytest
 
 from ambseal.cli import main
@@ -492,3 +493,24 @@ def test_report_in_a_real_browser(which, request, tmp_path):
     assert got["doc_width"] <= got["view_width"] == 1280
     assert got["verdict"] and got["verdict_bottom"] <= got["view_height"]
     assert png.read_bytes().startswith(b"\x89PNG")
+
+
+def test_a_notch_that_holds_but_leaves_the_amplifier_saturated_says_so():
+    """The supercritical example passes its bending critical (~106 Hz) below its speed
+    range (from 120 Hz), where the run's automatic unbalance force rejection is off: the
+    notch holds every loop and its orbit, yet the amplifier saturates there with it on as
+    well. The failure's words say that (they had ended the run in a TypeError, reading a
+    clearance the notch did not exceed), with the speed the notch is on from."""
+    from types import SimpleNamespace
+
+    from ambseal.app.pipeline import _Notch, _why_not_notched
+
+    notch = SimpleNamespace(on_rad_s=2 * np.pi * 120.0)
+    n = _Notch(SimpleNamespace(controller=SimpleNamespace(notch=notch)), [], [], {}, None)
+    assert n.holds
+    assert _why_not_notched(n) == (
+        "its unbalance force rejection, switched on by the run, holds, but the amplifier "
+        "saturates with it on as well: below 120 Hz, where it is off, or in the impulse "
+        "response")
+    lost = _Notch(n.rejection, [], ["0 bar, 191 Hz"], {}, None)
+    assert _why_not_notched(lost).endswith("loses the loop at 0 bar, 191 Hz")

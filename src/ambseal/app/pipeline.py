@@ -583,10 +583,17 @@ class _Notch:
 
 def _why_not_notched(n: _Notch) -> str:
     """Why a controller's unbalance force rejection, switched on by the run, does not
-    hold it: the conditions where a loop is lost, or the clearance its orbit exceeds."""
+    hold it: the conditions where a loop is lost, the clearance its orbit exceeds, or,
+    where it holds, that the amplifier saturates with it on as well (below the speed it
+    is on from, as through a critical speed under the speed range, or in the impulse
+    response, neither of which a notch at the rotational frequency reaches)."""
     head = "its unbalance force rejection, switched on by the run, "
     if n.lost:
         return head + f"loses the loop at {', '.join(n.lost)}"
+    if n.beyond is None:
+        on_hz = n.rejection.controller.notch.on_rad_s / (2 * np.pi)
+        return (head + "holds, but the amplifier saturates with it on as well: below "
+                f"{on_hz:.4g} Hz, where it is off, or in the impulse response")
     name, clearance_um = n.beyond
     orbit = float(np.max(n.effect["orbit_um"]["with"]))
     return (head + f"whirls the rotor about its axis of inertia by {orbit:.3g} µm, beyond "

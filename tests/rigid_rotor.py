@@ -13,13 +13,16 @@ L, D = 0.4, 0.1
 
 
 def rotor_text(name: str, disk_m: float, disk_ip: float, disk_id: float,
-               elements: int, disk_z: float = L / 2) -> str:
+               elements: int, disk_z: float = L / 2, modal_damping: float = 0.0) -> str:
     """``[rotor]``, the material, the shaft (L × D) in ``elements`` and the disk at
-    ``disk_z`` (m; mid-span by default); the supports are the caller's."""
+    ``disk_z`` (m; mid-span by default); the supports are the caller's. ``modal_damping``
+    damps the stiff shaft's bending modes (hundreds of kHz), which a loop with a sampled
+    controller's delay would otherwise find undamped."""
+    damping = f"modal_damping = {modal_damping}\n" if modal_damping else ""
     return f"""
 [rotor]
 name = "{name}"
-[materials.rigid]
+{damping}[materials.rigid]
 E = {E_RIGID}
 rho = {RHO}
 nu = 0.3

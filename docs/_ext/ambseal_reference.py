@@ -481,9 +481,10 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                                       "gap or backup clearance, else 5 µm)"),
     "Design.one_speed": ("", "H∞ and μ designed at the operating speed alone (default "
                              "false: on a rig with a speed range, a design that loses the "
-                             "rotor at another judged speed is designed again from "
-                             "standstill up, the first that holds every judged condition "
-                             "kept)"),
+                             "rotor at another judged speed is designed again with the "
+                             "spin speed uncertain over the judged speeds, else at each "
+                             "stability speed from standstill up, the first that holds "
+                             "every judged condition kept)"),
     "Design.tracked": ("", "``ambseal run`` adds the controller scheduled on the tracked "
                            "seal k (LMI synthesis: minutes)"),
     "UnbalanceSpec.grade_mm_s": ("mm/s", "ISO 21940-11 balance grade G"),

@@ -253,9 +253,10 @@ def _lost_over_speed(cfg: RigConfig, designs: list[Designed]) -> list[str]:
     unstable at another speed of the machine's range, standstill to the top speed: where
     the gyroscopics move the modes out of what one frozen design holds — also where the
     design over the speed range then found another design speed whose loop holds
-    (``design_speed_hz``): that design is stable, but may stand in a poor zone at the
-    speeds it was not designed at, and the LPV is the controller made for the range. For
-    them the main
+    (``design_speed_hz``), or the design with the speed uncertain over the range
+    (``speed_range_hz``): that design is stable, but one fixed controller spans the whole
+    range and may stand in a poorer zone than the LPV, the controller scheduled on it,
+    which the run then offers beside it. For them the main
     job adds the speed-scheduled LPV controller (:func:`ambseal.design.lpv_design.
     design_lpv`, thesis P3 §4) over standstill to the top speed, on the same design model
     (``[design] model_states``) — a rig with a speed range only."""
@@ -265,7 +266,8 @@ def _lost_over_speed(cfg: RigConfig, designs: list[Designed]) -> list[str]:
     out = []
     for d in designs:
         fo = d.result.full_order
-        moved = getattr(d.result, "design_speed_hz", None) is not None
+        moved = (getattr(d.result, "design_speed_hz", None) is not None
+                 or getattr(d.result, "speed_range_hz", None) is not None)
         if d.method in method_names(synthesised=True) and fo and (moved or (
                 not fo["stable"] and abs(fo["speed_hz"] - f0) > 1e-9 * max(f0, 1.0))):
             out.append(d.method)

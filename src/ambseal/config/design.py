@@ -70,8 +70,11 @@ and bounded (the bounds beside each key in the code, with their reasons).
 ``[design] one_speed`` (bool, default false)
     H∞ and μ designed at ``[operating] speed_rpm`` only. By default, on a rig with a speed
     range, a design whose full-order loop loses the rotor at another judged speed is
-    designed again at each stability speed from standstill up, and the first that holds
-    every judged condition is kept (:func:`ambseal.design.recipes.design`).
+    designed again with the spin speed a real LFT parameter, uncertain from the lowest to
+    the highest judged speed (:mod:`ambseal.design.speed_lft`), and kept where it holds
+    every judged condition; else it is designed again at each stability speed from
+    standstill up, and the first that holds every judged condition is kept
+    (:func:`ambseal.design.recipes.design`).
 ``[design] tracked`` (bool, default false)
     ``ambseal run`` adds the ``tracked`` controller: scheduled on the first
     seal's k as tracked on line (:mod:`ambseal.design.seal_schedule`), judged at the

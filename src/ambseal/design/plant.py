@@ -49,6 +49,7 @@ import control
 import numpy as np
 
 from ambseal.design.modal_bands import LIGHT_DAMPING, with_modal_frequencies
+from ambseal.design.speed_lft import with_speed
 from ambseal.design.weights import diagonal_weight
 from ambseal.errors import ConfigError, ModelError
 from ambseal.lti import picklable
@@ -344,6 +345,7 @@ def generalized_plant(
     gain_weight: Any = None,
     damping_margins: tuple = (),
     modal_bands: tuple = (),
+    speed_range_hz: tuple | None = None,
 ) -> GeneralizedPlant:
     """Build the generalised plant of P5 Figs. 8–9 from a rig or a plant.
 
@@ -401,6 +403,12 @@ def generalized_plant(
         Modes whose damped frequency is uncertain over the band it sweeps with speed
         (:func:`ambseal.design.modal_bands.with_modal_frequencies`): each a real scalar
         block after those of ``uncertainty``.
+    speed_range_hz : (float, float), optional
+        The spin speed uncertain over this range (Hz): a real parameter
+        (:data:`ambseal.design.speed_lft.SPEED`, rad/s) repeated as often as the
+        gyroscopic term's rank (:func:`ambseal.design.speed_lft.with_speed`), its block
+        after those of ``uncertainty``. From a rig only; the design model is the one at the
+        rig's ``[operating] speed_rpm``, and its centre that of the range.
 
     Returns
     -------
@@ -428,9 +436,18 @@ def generalized_plant(
             raise ConfigError(f"generalized_plant: {nm}={v!r} must be finite and > 0")
     full, cur, fcols = _source_plant(source, reduced, pressure_bar, states, force_positions,
                                      force_disturbance is not None)
+    uncertainty = dict(uncertainty or {})
+    if speed_range_hz is not None:
+        if isinstance(source, Plant) or not reduced:
+            raise ConfigError("generalized_plant: speed_range_hz needs a rig and its reduced "
+                              "design model")
+        full, ranges = with_speed(
+            full, source, range_hz=speed_range_hz, states=states,
+            pressure_bar=(source.operating.pressure_bar if pressure_bar is None
+                          else pressure_bar), force_positions=tuple(force_positions))
+        uncertainty.update(ranges)
     if damping_margins:
         full = less_damped(full, damping_margins)
-    uncertainty = dict(uncertainty or {})
     if modal_bands:
         full, ranges = with_modal_frequencies(full, modal_bands)
         uncertainty.update(ranges)

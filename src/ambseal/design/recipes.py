@@ -152,6 +152,11 @@ class DesignResult:
         The speed (Hz) an H∞ or μ design over the speed range was designed at, where the
         design at ``[operating] speed_rpm`` lost the rotor at another judged speed
         (:func:`design`); None for a design at the operating speed.
+    speed_range_hz : (float, float) or None
+        The speed range (Hz) over which an H∞ or μ design took the spin speed as an
+        uncertain parameter of its LFT (:mod:`ambseal.design.speed_lft`), where the design
+        at ``[operating] speed_rpm`` alone lost the rotor at another judged speed; None
+        otherwise.
     stopping : dict or None
         Why the synthesis stopped: μ, the rule that ended each phase, its iterations and
         the D search's γ evaluations (:attr:`ambseal.robust.dk.MusynResult.stopping`);
@@ -187,6 +192,7 @@ class DesignResult:
     stopping: dict | None = None
     scheduled: Any = field(default=None, repr=False)
     design_speed_hz: float | None = None
+    speed_range_hz: tuple | None = None
 
     @property
     def controller(self):
@@ -207,7 +213,9 @@ class DesignResult:
                 "kept_unstable": self.kept_unstable, "delay": self.delay,
                 "steps": list(self.steps),
                 "notes": list(self.notes), "verdict": self.verdict,
-                "stopping": self.stopping}
+                "stopping": self.stopping,
+                "speed_range_hz": None if self.speed_range_hz is None
+                else list(self.speed_range_hz)}
 
     def to_dict(self) -> dict:
         """Summary plus the controller matrices (lists) and the D–K history."""
@@ -398,18 +406,19 @@ def design(
     steps: list[str] = []
     t0 = time.perf_counter()
 
-    def synthesise(c, into: list, m: str = method):
+    def synthesise(c, into: list, m: str = method, speed=None, n_speed=None):
         return _synthesise_enlarging(
-            c, m, p, w if m == method else sp.weights[m], unc, sp, states,
+            c, m, p, w if m == method else sp.weights[m], unc, sp,
+            states if n_speed is None else n_speed,
             None if omega is None else np.asarray(omega, float), reduce_to,
             max_iter or sp.max_iter, sp.dk_order if dk_order is None else dk_order, dl,
-            enlarge, into, progress)
+            enlarge if speed is None else 0, into, progress, speed)
 
     r, check, n = synthesise(cfg, steps)
-    moved = None
+    moved = over = None
     if not cfg.design.one_speed:
-        (r, check, n), moved = _over_speed(cfg, method, sp, (r, check, n), synthesise, steps,
-                                           progress)
+        (r, check, n), moved, over = _over_speed(cfg, method, sp, (r, check, n), synthesise,
+                                                 steps, progress)
     if not check["stable"] and not allow_unstable:
         raise SynthesisError(_unstable_message(method, check, n, steps, _top_mode_hz(cfg, p, n),
                                                _lost_by(cfg, r.K, check, p),
@@ -422,17 +431,18 @@ def design(
         design_states=n, full_order=check, kept_unstable=not check["stable"],
         delay=dl.to_dict(), steps=tuple(steps), notes=tuple(sp.notes),
         verdict=_verdict(method, r, check), omega=r.omega, stopping=r.stopping,
-        design_speed_hz=moved)
+        design_speed_hz=moved, speed_range_hz=over)
 
 
 def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max_iter,
-                          dk_order, dl, enlarge, steps, progress):
+                          dk_order, dl, enlarge, steps, progress, speed=None):
     """:func:`_synthesise` on the specification's design model, corrected (at most
     ``enlarge`` times) while the full-order loop is unstable: enlarged (unless ``states``
     fixes it) to keep a mode the model left out, or, where the model keeps the mode,
     given a damping margin on it (:func:`margin_for`); if no margin holds it, the last
     design without margins is returned. Each correction is appended to ``steps`` and
-    reported to ``progress``. Returns (synthesis, full-order check, design states)."""
+    reported to ``progress``. With ``speed`` (Hz) the spin speed is uncertain over that
+    range (:func:`_synthesise`). Returns (synthesis, full-order check, design states)."""
     n = int(states or sp.model_states)
     # held where it is judged and wherever the machine runs, standstill to the top speed
     conditions = [(q, f) for q in sp.pressures_bar
@@ -444,7 +454,8 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
     for attempt in range(enlarge + 1):
         r = _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl,
                         tuple(margins.items()),
-                        progress and (lambda line: progress(f"{method}: {line}")), tuple(bands))
+                        progress and (lambda line: progress(f"{method}: {line}")), tuple(bands),
+                        speed)
         # a design that can still be corrected is checked until it loses a mode
         check = full_order_check(cfg, r.K, conditions, first_loss=attempt < enlarge)
         if not margins:
@@ -506,22 +517,48 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
 
 def _over_speed(cfg, method: str, sp, first, synthesise, steps: list, progress):
     """The design over the speed range: where ``first`` (synthesis, full-order check,
-    states), designed at the operating speed, loses the rotor at another judged speed, the
-    design at another of the specification's stability speeds; the first whose full-order
-    loop holds at every judged condition is kept and ``steps`` names its speed, else
-    ``first``. Returns (the design, its speed in Hz or None for ``first``). H∞ tries each stability speed in turn from standstill up (the gyroscopic
-    moments change the plant monotonically with speed, so the loss moves with the design
-    speed); μ, whose D–K steps cost a hundred H∞ designs, is designed once more, at the
-    speed that search finds for H∞ (``synthesise(cfg, steps, "hinf")``), where there is
-    one. Measured on the seeded gyroscopic family (benchmarks/README.md, bench_family.py):
-    a design at the top speed leans on the gyroscopic stiffening of the conical mode and
-    loses it at standstill, one at standstill can lose the nutation or a bending mode at
-    the top speed, and one between may hold both. ``[design] one_speed`` turns it off."""
+    states), designed at the operating speed, loses the rotor at another judged speed,
+
+    1. the design with the spin speed a real parameter of the LFT, uncertain from the
+       lowest to the highest judged speed (:mod:`ambseal.design.speed_lft`; H∞ at the
+       speed channel's constant scalings, μ by its D–K with the speed's block), on
+       ``first``'s design model: kept where its full-order loop holds every judged
+       condition. μ, whose D–K steps cost a hundred H∞ designs, is tried only where the
+       H∞ design with the speed channel holds;
+    2. else the design at another of the specification's stability speeds: the first
+       whose full-order loop holds at every judged condition. H∞ tries each in turn from
+       standstill up (the gyroscopic moments change the plant monotonically with speed,
+       so the loss moves with the design speed); μ is designed once more, at the speed
+       that search finds for H∞ (``synthesise(cfg, steps, "hinf")``), where there is one;
+    3. else ``first``.
+
+    Returns (the design, the speed in Hz it was designed at for 2, the speed range in Hz
+    for 1; None where not). Measured
+    on the seeded gyroscopic family (benchmarks/README.md, bench_family.py): a design at
+    the top speed leans on the gyroscopic stiffening of the conical mode and loses it at
+    standstill, one at standstill can lose the nutation or a bending mode at the top
+    speed; the design with the speed uncertain holds both on rotors whose gyroscopic
+    coupling a fixed controller can span (tests/data/gyro_wheel_rig.toml, Ip/It 0.54:
+    H∞ γ 2.1, μ 0.79), where the frozen search can only find a speed in between.
+    ``[design] one_speed`` turns it off."""
     r, check, n = first
     f0 = cfg.operating.speed_rpm / 60.0
     if check["stable"] or cfg.operating.speed_range_hz is None \
             or abs(check["speed_hz"] - f0) <= 1e-9 * max(f0, 1.0):
-        return first, None
+        return first, None, None
+    judged = sorted({*sp.speeds_hz, *sp.stability_speeds_hz})
+    rng = (judged[0], judged[-1])
+    lost = (f"the design at the operating speed ({f0:g} Hz) lost the rotor at "
+            f"{check['speed_hz']:g} Hz (mode at {check['mode_hz']:.4g} Hz, ζ = "
+            f"{check['damping']:.3g})")
+    held = _held_over_speed(cfg, method, rng, n, synthesise)
+    if held is not None:
+        steps.append(f"{method}: designed with the spin speed uncertain over {rng[0]:g}–"
+                     f"{rng[1]:g} Hz (a real LFT parameter), which holds every judged "
+                     f"condition; {lost}")
+        if progress:
+            progress(steps[-1])
+        return held, None, rng
     speeds = [f for f in sorted(set(sp.stability_speeds_hz))
               if abs(f - f0) > 1e-9 * max(f0, 1.0)]
     if method != "hinf":
@@ -529,16 +566,28 @@ def _over_speed(cfg, method: str, sp, first, synthesise, steps: list, progress):
         speeds = [] if found is None else [found[0]]
     found = _first_held(cfg, speeds, lambda c: synthesise(c, []))
     if found is None:
-        return first, None
+        return first, None, None
     f, out = found
     steps.append(f"{method}: designed at {f:g} Hz, the first stability speed from standstill "
                  f"whose {'H∞ ' if method != 'hinf' else ''}design holds every judged "
-                 f"condition; the design at the operating speed ({f0:g} Hz) lost the rotor "
-                 f"at {check['speed_hz']:g} Hz (mode at {check['mode_hz']:.4g} Hz, ζ = "
-                 f"{check['damping']:.3g})")
+                 f"condition; {lost}")
     if progress:
         progress(steps[-1])
-    return out, f
+    return out, f, None
+
+
+def _held_over_speed(cfg, method: str, rng, n: int, synthesise):
+    """``synthesise``'s design with the speed uncertain over ``rng`` (Hz) on the n-state
+    design model, where its full-order loop holds every judged condition (μ: where H∞'s
+    does first), else None."""
+    for m in ("hinf",) if method == "hinf" else ("hinf", method):
+        try:
+            out = synthesise(cfg, [], m, speed=rng, n_speed=n)
+        except (SynthesisError, ModelError):
+            return None
+        if not out[1]["stable"]:
+            return None
+    return out
 
 
 def _first_held(cfg, speeds, synthesise):
@@ -603,11 +652,18 @@ class _Synthesis:
 
 
 def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order, dl,
-                margins=(), progress=None, bands=()):
+                margins=(), progress=None, bands=(), speed=None):
     """One synthesis on an n-state design model (with ``margins``, see
     :func:`ambseal.design.plant.less_damped`; μ with ``bands`` of uncertain mode frequency,
-    :func:`ambseal.design.modal_bands.with_modal_frequencies`), reduced, as a physical
-    controller; ``progress(line)`` gets μ's iterations."""
+    :func:`ambseal.design.modal_bands.with_modal_frequencies`; with ``speed``, a range in
+    Hz, the spin speed uncertain over it, :func:`ambseal.design.speed_lft.with_speed`),
+    reduced, as a physical controller; ``progress(line)`` gets μ's iterations.
+
+    H∞ over a speed range is the K-step of D–K at constant scalings
+    (:func:`~ambseal.robust.dk.musyn` with ``order=0``, one iteration): the H∞ synthesis on
+    ``D P D⁻¹`` with the constant D of the smallest γ_opt, whose γ < 1 would certify every
+    plant of the range by the small-gain theorem (Zhou, Doyle & Glover, *Robust and
+    Optimal Control*, 1996, §11.3: scaled H∞); a controller of the nominal H∞'s order."""
 
     robust = method in method_names(robust=True)  # against the uncertain parameters
     Wf = w.Wf()
@@ -617,9 +673,18 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
                            force_disturbance=Wf, force_positions=fpos, d_e=w.d_e, d_u=w.d_u,
                            actuator_delay=dl.system,
                            gain_weight=w.Wk(), damping_margins=margins,
-                           modal_bands=bands if robust else ())
+                           modal_bands=bands if robust else (), speed_range_hz=speed)
     mu_omega = None
-    if not robust:  # nominal H∞
+    if not robust and speed is not None:  # H∞ at the constant scalings of the speed channel
+        r = musyn(gp.P, gp.blocks, gp.nmeas, gp.ncon, design_omega(*sp.synthesis_band_hz),
+                  order=0, max_iter=1)
+        K_P, gamma, mu, hist = r.K, float(r.gamma), None, ()
+        stopping = {"hinf": {"rule": "the constant scalings of the speed channel of the "
+                                     "smallest γ_opt (D–K's start), then γ_opt bisected to "
+                                     "rtol=1e-06 and the controller built at backoff·γ_opt",
+                             "speed_range_hz": list(speed)}}
+        P_red, blocks = gp.P_nominal, None
+    elif not robust:  # nominal H∞
         r = hinfsyn(gp.P_nominal, gp.nmeas, gp.ncon)
         K_P, gamma, mu, hist = r.K, float(r.gamma), None, ()
         stopping = {"hinf": {"iterations": r.iterations,

@@ -351,16 +351,39 @@ def build_plant(
 _PLANTS = ArrayMemo(keep=4, keep_bytes=64 * 2**20)
 
 
+def reduction_size(cfg: RigConfig, states: int | None = None,
+                   cutoff_hz: float | None = None) -> dict:
+    """The modal reduction's size as :func:`build_plant` takes it.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig (its ``[reduction]``).
+    states : int, optional
+        States to keep.
+    cutoff_hz : float, optional
+        Keep every mode below this frequency (Hz) instead.
+
+    Returns
+    -------
+    dict
+        ``{"states": ..., "cutoff_hz": ...}``, keyword arguments of
+        :func:`ambseal.model.reduction.modal_reduction`: those given, else
+        ``[reduction]``'s, else 8 states (the rigid-body modes, thesis P3 §2.2).
+    """
+    if states is None and cutoff_hz is None:
+        states, cutoff_hz = cfg.reduction.states, cfg.reduction.cutoff_hz
+        if states is None and cutoff_hz is None:
+            states = 8
+    return {"states": states, "cutoff_hz": cutoff_hz}
+
+
 def _build_plant(cfg, reduced, pressure_bar, speed_rpm, force_positions, states, cutoff_hz):
     sys = build_system(cfg, pressure_bar=pressure_bar, speed_rpm=speed_rpm,
                        force_positions=force_positions)
     plant = mechanical_plant(sys)
     if reduced:
-        if states is None and cutoff_hz is None:
-            states, cutoff_hz = cfg.reduction.states, cfg.reduction.cutoff_hz
-            if states is None and cutoff_hz is None:
-                states = 8
-        plant = modal_reduction(plant, states=states, cutoff_hz=cutoff_hz).plant
+        plant = modal_reduction(plant, **reduction_size(cfg, states, cutoff_hz)).plant
     n_cur = 2 * len(cfg.amb)
     if cfg.actuator.eddy_time_constant > 0 and n_cur:
         plant = plant.series_actuator(*eddy_lag_matrices(cfg.actuator.eddy_time_constant),

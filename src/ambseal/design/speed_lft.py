@@ -1,0 +1,116 @@
+"""The spin speed Ω as a real parameter of the design model's LFT.
+
+A rotor's plant changes with its spin speed through the gyroscopic term Ω·G (and through
+seal coefficients tabulated against the synchronous frequency). On the design model — the
+modal reduction at the design speed, thesis P1 §III.4–6 — the change is
+
+    A(Ω) = A(Ω₀) + (Ω − Ω₀)·A₁,    A₁ = T_L [[0, 0], [0, −M⁻¹G]] T_R
+
+(thesis P3 Eqs. 4–10: the LPV model of :func:`ambseal.design.lpv_plant.lpv_plant`, in the
+same basis). Written as an LFT channel of rank r = rank A₁ (A₁ = B_Ω C_Ω by its singular
+value decomposition), Ω is one real parameter repeated r times, like a seal's k (thesis P1
+Eqs. 46–52). With Ω uncertain over standstill to the top speed, a μ design whose bound is
+below 1 holds every plant of the speed range; an H∞ design on the same generalised plant,
+at constant D scalings of the speed channel, does where its γ is below 1, by the
+small-gain theorem (the D-scaled upper
+bound of μ: Packard & Doyle, "The complex structured singular value", Automatica 29(1),
+1993).
+
+Frequency-tabulated seal coefficients change along the speed range too; they enter by the
+secant of A(Ω) over the range, which equals A₁ where A is affine in Ω (no tabulated seal).
+Every design is judged on the full-order plant at each judged speed all the same
+(:func:`ambseal.design.recipes.full_order_check`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ambseal.errors import ModelError
+from ambseal.model import (
+    Parameter, Plant, build_system, mechanical_plant, modal_reduction, reduction_size,
+)
+
+__all__ = ["SPEED", "with_speed"]
+
+_TWO_PI = 2.0 * np.pi
+
+#: The LFT parameter's name (rad/s).
+SPEED = "rotor.speed"
+
+#: Singular values of A₁ below this fraction of the largest are left out of the channel:
+#: they change A by less than 1e-4 of what the gyroscopic term changes over the range
+#: (the projected term of the design models measured falls by four decades after its
+#: conical and bending pairs), and each kept one is a repeat of the real block.
+RANK_TOL = 1e-4
+
+
+def with_speed(plant: Plant, cfg, *, range_hz: tuple[float, float],
+               states: int | None, pressure_bar: float,
+               force_positions: tuple[float, ...] = ()) -> tuple[Plant, dict]:
+    """The design model with the spin speed as a real LFT parameter.
+
+    Parameters
+    ----------
+    plant : ambseal.model.lft.Plant
+        The design model: :func:`ambseal.model.rig.build_plant` of ``cfg`` reduced to
+        ``states`` at ``pressure_bar`` with ``force_positions``, at the rig's
+        ``[operating] speed_rpm`` (the design speed).
+    cfg : RigConfig
+        The rig at the design speed.
+    range_hz : (float, float)
+        The speed range the design holds (Hz), low < high.
+    states : int or None
+        Mechanical states of the design model (None: the rig's default,
+        :func:`ambseal.model.rig.reduction_size`).
+    pressure_bar : float
+        Its pressure drop (bar).
+    force_positions : tuple of float
+        Its force inputs' positions (m).
+
+    Returns
+    -------
+    plant : Plant
+        The same A, B, C, D and a parameter :data:`SPEED` (rad/s, nominal the design
+        speed) repeated as often as A₁ has singular values above :data:`RANK_TOL`.
+    ranges : dict
+        ``{SPEED: (2π·low, 2π·high)}`` for :func:`ambseal.design.plant.generalized_plant`.
+
+    Raises
+    ------
+    ModelError
+        A range that is not increasing or below zero; a design model that is not the
+        rig's modal reduction (a plant built otherwise).
+    """
+    lo, hi = (float(x) for x in range_hz)
+    if not (0.0 <= lo < hi and np.isfinite(hi)):
+        raise ModelError(f"with_speed: speed range {lo}–{hi} Hz, expected 0 ≤ low < high")
+    fpos = tuple(force_positions)
+    # the design model's own reduction (build_plant's arguments), for its basis T_L, T_R
+    red = modal_reduction(mechanical_plant(build_system(
+        cfg, pressure_bar=pressure_bar, force_positions=fpos)), **reduction_size(cfg, states))
+    nr = red.plant.A.shape[0]
+    if not np.allclose(red.plant.A, plant.A[:nr, :nr], rtol=0.0,
+                       atol=1e-9 * np.abs(plant.A).max()):
+        raise ModelError("with_speed: the design model is not the rig's modal reduction at "
+                         f"{cfg.operating.speed_rpm:g} rpm and {pressure_bar:g} bar")
+
+    def full_a(f_hz: float) -> np.ndarray:
+        return build_system(cfg, pressure_bar=pressure_bar, speed_rpm=60.0 * f_hz,
+                            force_positions=fpos).state_matrices()[0]
+
+    # the secant over the range: A₁ itself where A is affine in Ω; the actuator's states,
+    # after the mechanical ones, do not change with Ω
+    A1 = np.zeros_like(plant.A)
+    A1[:nr, :nr] = red.T_L @ ((full_a(hi) - full_a(lo)) / (_TWO_PI * (hi - lo))) @ red.T_R
+    U, s, Vt = np.linalg.svd(A1)
+    r = int(np.sum(s > RANK_TOL * s[0])) if s.size and s[0] > 0 else 0
+    if r == 0:
+        return plant, {}
+    root = np.sqrt(s[:r])
+    params = dict(plant.parameters)
+    params[SPEED] = Parameter(SPEED, cfg.speed, "rad/s", B=U[:, :r] * root,
+                              C=root[:, None] * Vt[:r], D=np.zeros((r, plant.B.shape[1])))
+    return replace(plant, parameters=params), {SPEED: (_TWO_PI * lo, _TWO_PI * hi)}

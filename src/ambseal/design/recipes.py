@@ -551,13 +551,16 @@ def _over_speed(cfg, method: str, sp, first, synthesise, steps: list, progress):
     lost = (f"the design at the operating speed ({f0:g} Hz) lost the rotor at "
             f"{check['speed_hz']:g} Hz (mode at {check['mode_hz']:.4g} Hz, ζ = "
             f"{check['damping']:.3g})")
-    held = _held_over_speed(cfg, method, rng, n, synthesise)
-    if held is not None:
-        steps.append(f"{method}: designed with the spin speed uncertain over {rng[0]:g}–"
-                     f"{rng[1]:g} Hz (a real LFT parameter), which holds every judged "
-                     f"condition; {lost}")
+
+    def step(line: str) -> None:
+        steps.append(f"{method}: designed {line} holds every judged condition; {lost}")
         if progress:
             progress(steps[-1])
+
+    held = _held_over_speed(cfg, method, rng, n, synthesise)
+    if held is not None:
+        step(f"with the spin speed uncertain over {rng[0]:g}–{rng[1]:g} Hz (a real LFT "
+             "parameter), which")
         return held, None, rng
     speeds = [f for f in sorted(set(sp.stability_speeds_hz))
               if abs(f - f0) > 1e-9 * max(f0, 1.0)]
@@ -568,11 +571,8 @@ def _over_speed(cfg, method: str, sp, first, synthesise, steps: list, progress):
     if found is None:
         return first, None, None
     f, out = found
-    steps.append(f"{method}: designed at {f:g} Hz, the first stability speed from standstill "
-                 f"whose {'H∞ ' if method != 'hinf' else ''}design holds every judged "
-                 f"condition; {lost}")
-    if progress:
-        progress(steps[-1])
+    step(f"at {f:g} Hz, the first stability speed from standstill whose "
+         f"{'H∞ ' if method != 'hinf' else ''}design")
     return out, f, None
 
 

@@ -54,8 +54,8 @@ def expander_run(tmp_path_factory):
     "flywheel", pytest.param("expander_generator", marks=pytest.mark.slow)])
 def gyroscopic_run(request, tmp_path_factory):
     """``(rig path, exit code, metrics, out folder)`` of each gyroscopic example's run."""
-    rig = EXAMPLES / f"{request.param}.toml"
-    return rig, *request.getfixturevalue(f"{rig.stem.split('_')[0]}_run")
+    fixture = {"flywheel": "flywheel_run", "expander_generator": "expander_run"}
+    return EXAMPLES / f"{request.param}.toml", *request.getfixturevalue(fixture[request.param])
 
 
 def _frf(A, B, C, D, z: np.ndarray) -> np.ndarray:

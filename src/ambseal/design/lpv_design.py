@@ -34,6 +34,18 @@ bandwidth it leaves the rigid-body loop alone, but it rolls the controller off a
 bending modes left out of the design model: with a static W_u, σ̄(S_o) on the full-order
 plant peaked at 4.4–6.7 there (spill-over). The turboexpander's numbers with and
 without the rule: benchmarks/README.md ("Where the design defaults come from").
+
+Poles the target can run: the synthesis bounds the controller's poles by the target's
+Nyquist frequency π·``sample_rate_hz`` (``pole_bound`` of :func:`lpvsyn`). A pole above it
+has no counterpart in the sampled controller (its dynamics alias), and the H∞ central
+controller has such poles far outside the design band (the flywheel's at 10 kHz: a pair
+at 51 MHz, others at 20 and 44 kHz, against a design model whose fastest pole is 8.3 kHz).
+They are removed with their static gain kept where the reduced table holds every frozen
+loop within 1 % of the synthesised H∞ norms (on the examples' LPVs no norm rose by more
+than 3e-4; benchmarks/README.md); else the controller stays as synthesised and
+:attr:`LpvDesign.pole_bound` says why. The discretisation then removes or keeps the poles
+between half of Nyquist and Nyquist as for every design
+(:mod:`ambseal.robust.digital`).
 """
 
 from __future__ import annotations
@@ -150,6 +162,11 @@ class LpvDesign(ScheduledController):
         ``"frozen"`` (the best frozen-point design, better at every frozen speed).
     frozen_best_gamma : float
         That frozen-point design's worst γ on the check grid (NaN if not compared).
+    pole_bound : dict or None
+        The controller's poles against the target's Nyquist frequency
+        (:attr:`ambseal.robust.lpv.LpvSynResult.pole_bound` in Hz): ``bound_hz``,
+        ``above_hz`` (the poles above it as synthesised), ``reduced`` (removed, the
+        reduced loop certified at ``gamma``) and ``note`` (why they were kept).
     """
 
     parameter: ClassVar[str] = SPEED
@@ -172,6 +189,7 @@ class LpvDesign(ScheduledController):
     delay: Any = None
     kind: str = "lpv"
     frozen_best_gamma: float = float("nan")
+    pole_bound: dict | None = None
 
     @property
     def order(self) -> int:
@@ -244,23 +262,36 @@ class LpvDesign(ScheduledController):
                 "delay": None if self.delay is None else self.delay.to_dict(),
                 "kind": self.kind, "frozen_best_gamma": json_float(self.frozen_best_gamma),
                 "sdp_status": self.sdp_status, "sdp_shortfall": self.sdp_shortfall,
-                "verdict": self.verdict}
+                "pole_bound": self.pole_bound, "verdict": self.verdict}
 
     @property
     def verdict(self) -> str:
         """One plain line: the LMI bound over the scheduled range (and, where an SDP it
         rests on ended short of optimal, that it is a certified bound, not the optimum,
-        of a controller that depends on the machine's rounding), the frozen loops, and the
-        full-order stability."""
+        of a controller that depends on the machine's rounding), the frozen loops (of the
+        controller with its poles above the Nyquist frequency removed, where they were),
+        and the full-order stability."""
         lo, hi = float(self.speeds_hz.min()), float(self.speeds_hz.max())
         short = self.sdp_shortfall
         # no ";" inside: the run's verdict takes the bound as the line's first clause
         # short: the report's section on the syntheses says what it means
         note = f" — NOT SOLVED TO OPTIMALITY: {short}" if short else ""
+        pb = self.pole_bound or {}
+        removed = (f" with its {len(pb['above_hz'])} poles above the Nyquist frequency "
+                   f"({pb['bound_hz']:.4g} Hz) removed" if pb.get("reduced") else "")
         return (f"LPV γ = {bound_text(self.gamma)} over {lo:g}–{hi:g} Hz ({self.lyapunov} "
-                f"Lyapunov function{note}), frozen loops γ ≤ "
+                f"Lyapunov function{note}), frozen loops{removed} γ ≤ "
                 f"{float(np.max(self.check_gamma)):.3g}"
                 f"; {_stability_over_speed(self.full_order)}")
+
+
+def _pole_bound_hz(rec: dict | None) -> dict | None:
+    """:attr:`ambseal.robust.lpv.LpvSynResult.pole_bound` with its frequencies in Hz."""
+    if rec is None:
+        return None
+    return {"bound_hz": rec["bound_rad_s"] / _TWO_PI,
+            "above_hz": [w / _TWO_PI for w in rec["above_rad_s"]],
+            "reduced": rec["reduced"], "note": rec["note"]}
 
 
 def _stability_over_speed(check: dict | None) -> str:
@@ -485,6 +516,9 @@ def design_lpv(cfg, *, speeds_hz=None, n_grid: int | None = None,
     fg = np.full(grid.size, np.nan)
     if frozen_gamma:
         fg = np.array([hinfsyn(p, nmeas, ncon).gamma for p in P])
+    # the target cannot run a pole above its Nyquist frequency: the sampled controller
+    # aliases it (module docstring, "Poles the target can run")
+    lpvsyn_kw.setdefault("pole_bound", np.pi * cfg.controller.sample_rate_hz)
     r = lpvsyn(P, L.speeds_rad_s, nmeas, ncon, dA=dA, lyapunov=lyapunov, rate_bound=nu,
                **lpvsyn_kw)
     d = LpvDesign(K=r.K, gamma=r.gamma, gamma_design=r.gamma_design, frozen_gamma=fg,
@@ -492,7 +526,8 @@ def design_lpv(cfg, *, speeds_hz=None, n_grid: int | None = None,
                   check_speeds_hz=r.check_grid / _TWO_PI, lyapunov=lyapunov,
                   rate_bound_hz_per_s=None if nu is None else float(rate_bound_hz_per_s),
                   weights=w, reports=r.reports, synthesis_s=r.time_s, plant=L,
-                  delay=dl, kind=r.kind, frozen_best_gamma=r.frozen_best_gamma)
+                  delay=dl, kind=r.kind, frozen_best_gamma=r.frozen_best_gamma,
+                  pole_bound=_pole_bound_hz(r.pole_bound))
     check = check_full_order(cfg, sp, d.controller_at, "lpv", allow_unstable)
     return replace(d, full_order=check, elapsed_s=time.perf_counter() - t0)
 

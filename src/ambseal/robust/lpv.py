@@ -78,6 +78,7 @@ from ambseal.robust._lpv_lmi import (
 )
 from ambseal.robust._lpv_frozen import frozen_reference, quadratic_gamma
 from ambseal.robust._lpv_reconstruct import interp_A, reconstruct_table
+from ambseal.robust.digital import residualize, split_fast
 from ambseal.robust.hinf import hinfnorm
 from ambseal.robust.stability import is_stable
 from ambseal.threads import with_numerics_threads
@@ -225,6 +226,13 @@ class LpvSynResult:
         The trace term's share of the γ stage's cost at its last solve, relative to γ
         (1 % or less unless the SDP could not be solved with a smaller weight): how much
         of ``gamma`` may be the price of bounded R and S rather than of the plant.
+    pole_bound : dict or None
+        With ``pole_bound`` given (:func:`lpvsyn`): ``bound_rad_s``, ``above_rad_s`` (the
+        moduli of the poles above it, of the table's middle entry as synthesised),
+        ``check_gamma`` (the reduced table's frozen H∞ norms, ``None`` where not
+        computed), ``reduced`` (whether :attr:`K` is the reduced controller, those poles
+        removed) and ``note`` (why not, in words; ``""`` where reduced or no pole was
+        above the bound). ``None`` without a bound.
 
     Notes
     -----
@@ -250,6 +258,7 @@ class LpvSynResult:
     kind: str = "lpv"
     penalty_share: float = 0.0
     lyapunov_r: Any = "constant"
+    pole_bound: dict | None = None
 
     def __iter__(self):
         """``K, CL, gamma, info = lpvsyn(...)``: the scheduled controller, θ ↦ the frozen
@@ -287,6 +296,7 @@ class LpvSynResult:
                 "frozen_best_gamma": json_float(self.frozen_best_gamma),
                 "frozen_best_theta": json_float(self.frozen_best_theta),
                 "penalty_share": self.penalty_share, "sdp_status": self.sdp_status,
+                "pole_bound": self.pole_bound,
                 "reports": [r.to_dict() for r in self.reports], "time_s": self.time_s}
 
 
@@ -298,7 +308,7 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
            check_density: int = 5, solver_options: dict | None = None,
            margin: float = 1e-6, scaling: str = "auto", penalty: float = 1e-4,
            coupling_ratio: float = 1.1, centre: bool = False,
-           frozen_check: bool = True) -> LpvSynResult:
+           frozen_check: bool = True, pole_bound: float | None = None) -> LpvSynResult:
     """Gridded H∞ LPV controller (Apkarian & Adams 1998; Wu et al. 1996).
 
     Stages, the first two SDPs solved by CVXOPT and required to end ``optimal``:
@@ -380,6 +390,20 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
         a bound under any trajectory of θ) is not above the scheduled one's, the design is
         delivered instead (``kind = "frozen"``). Costs one H∞ synthesis per grid point and
         one norm per grid point and check-grid value (``benchmarks/README.md``).
+    pole_bound : float, optional
+        The largest controller pole modulus the target can run (rad/s; the design layer
+        gives the Nyquist frequency π·f_s). The controller's poles above it are removed by
+        singular perturbation (their static gain kept; Skogestad & Postlethwaite Eq.
+        11.26) in one state basis over the table (the slow/fast split of its middle
+        entry, so that the reduced entries still interpolate), and the reduced table is
+        checked as the synthesised one is: every frozen loop on the table and at its
+        midpoints stable, and the H∞ norm of each on the table within ``BOUND_RISE``
+        (1 %) of the synthesised controller's. Where it passes the reduced controller is
+        delivered, else the synthesised one, with the reason
+        (:attr:`LpvSynResult.pole_bound`); ``gamma`` remains the synthesised controller's
+        LMI bound. Chilali & Gahinet's (1996) pole region would put a disk |λ| ≤ bound on
+        the closed loop in the SDP, with the controller's variables in it: N² more
+        unknowns at every grid point of an SDP that is already the synthesis's cost.
 
     Returns
     -------
@@ -399,7 +423,8 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
         a rate bound with both constant (or none with a parameter-dependent S or R),
         ``nmeas``, ``ncon`` or ``check_density`` not a whole number ≥ 1, ``margin`` not a
         finite number > 0, ``backoff`` not a finite number ≥ 1, ``coupling_ratio`` not a
-        number > 1 or ``penalty`` not a number ≥ 0.
+        number > 1, ``penalty`` not a number ≥ 0 or ``pole_bound`` not a finite number
+        > 0.
     SynthesisError
         Infeasible LMIs, a solver status other than ``optimal``, or a reconstructed frozen
         closed loop that is unstable.
@@ -421,6 +446,12 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
     if unknown:
         raise ModelError(f"lpvsyn: solver_options {unknown} unknown; expected some of "
                              f"{', '.join(SOLVER_KEYS)} (CVXOPT's options)")
+    if pole_bound is not None and not (
+            isinstance(pole_bound, (int, float, np.integer, np.floating))
+            and not isinstance(pole_bound, bool) and np.isfinite(pole_bound)
+            and pole_bound > 0):
+        raise ModelError(f"lpvsyn: pole_bound={pole_bound!r}; expected a finite number > 0 "
+                         "(rad/s)")
     if scaling not in ("auto", "riccati", "diagonal"):
         raise ModelError(f"lpvsyn: scaling={scaling!r}; expected 'auto', 'riccati' or "
                              "'diagonal'")
@@ -454,6 +485,8 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
                 raise first from None
     if frozen_check:
         r = _against_frozen(r, data, solver_options, margin)
+    if pole_bound is not None:
+        r = _within_bound(r, data, float(pole_bound))
     return replace(r, time_s=time.perf_counter() - t_start)
 
 
@@ -467,6 +500,58 @@ def _short(reports) -> bool:
     ``optimal``: a solution where CVXOPT stopped follows the machine's rounding, an optimum
     does not, so between two solves an optimal one is kept before a lower γ."""
     return any(v != "optimal" for v in sdp_status(reports).values())
+
+
+#: How much a frozen loop's H∞ norm may rise, at any table entry, when the controller's
+#: poles above ``pole_bound`` are removed (:func:`_within_bound`). Measured on the
+#: examples' LPVs (the flywheel at 10, 20 and 40 kHz, the turboexpander, the
+#: expander-generator): no rise above 3e-4 at any entry (benchmarks/README.md).
+BOUND_RISE = 1e-2
+
+
+def _within_bound(r: LpvSynResult, data, bound: float) -> LpvSynResult:
+    """``r`` with its controller's poles above ``bound`` (rad/s) removed where the reduced
+    table keeps every frozen loop (``pole_bound`` of :func:`lpvsyn`), its record in
+    :attr:`LpvSynResult.pole_bound` either way."""
+    plants, grid, As, dAs, B, C, D, nw, nz, nmeas, ncon = data
+    K = r.K
+    V, k, fast = split_fast(K.AK[K.theta.size // 2], bound / (2 * np.pi))
+    record = {"bound_rad_s": bound, "above_rad_s": sorted(float(abs(p)) for p in fast),
+              "check_gamma": None, "reduced": False, "note": ""}
+
+    def kept(note: str) -> LpvSynResult:
+        return replace(r, pole_bound={**record, "note": note})
+
+    if not any(np.abs(np.linalg.eigvals(A)).max(initial=0.0) > bound for A in K.AK):
+        return kept("")
+    if K.takes_rate:
+        return kept("the controller takes θ̇ (a parameter-dependent R), which the "
+                    "reduction does not carry")
+    if not fast.size:
+        return kept("the table's middle entry has no pole above the bound to split off")
+    if not k:
+        return kept("every pole of the controller is above the bound")
+    A22 = [np.linalg.solve(V, A @ V)[k:, k:] for A in K.AK]
+    if not all(is_stable(np.linalg.eigvals(X)) for X in A22):
+        return kept("the part above the bound is unstable at a table entry")
+    table = [residualize((K.AK[j], K.BK[j], K.CK[j], K.DK[j]), V, k)
+             for j in range(K.theta.size)]
+    if any(np.abs(np.linalg.eigvals(t[0])).max(initial=0.0) > bound for t in table):
+        return kept("the reduced controller still has a pole above the bound (the split "
+                    "of the middle entry does not hold over the table)")
+    Kr = LpvController(K.theta, *(np.array([t[i] for t in table]) for i in range(4)),
+                       K.input_names, K.output_names)
+    try:
+        check_g = _check_table(Kr, interp_A(As, dAs, grid), B, C, D, nmeas, ncon)
+    except SynthesisError:
+        return kept("the reduced controller loses a frozen loop on the table")
+    record["check_gamma"] = [json_float(g) for g in check_g]
+    rise = float(np.max(check_g / r.check_gamma)) - 1.0
+    if rise > BOUND_RISE:
+        return kept(f"removing them raises a frozen loop's H∞ norm by {100 * rise:.3g} % "
+                    f"(more than {100 * BOUND_RISE:g} %)")
+    return replace(r, K=Kr, check_gamma=check_g, closed_loop=replace(r.closed_loop, K=Kr),
+                   pole_bound={**record, "reduced": True})
 
 
 #: Relative margin by which the best frozen-point design must beat the scheduled

@@ -7,8 +7,9 @@ import control as ct
 import numpy as np
 import pytest
 
-from ambseal.analysis.amplifier import (capacity_block, capacity_words, force_demand,
-                                        notched_currents)
+from ambseal.analysis.amplifier import (SWITCH_ON_FRACTION, capacity_block, capacity_words,
+                                        force_demand, notched_currents, switch_on_hz,
+                                        used_by_speed)
 from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
 from ambseal.analysis.unbalance import forward_forces, unbalance_force
 from ambseal.design.specs import design_spec
@@ -190,6 +191,50 @@ def test_a_notch_that_holds_leaves_the_amplifier_what_it_leaves(testrig_cfg, jud
     assert capacity_words(block).startswith(
         "holding the unbalance (its unbalance force rejection on, switched on by the run: "
         "the controller alone saturates the amplifier) it uses")
+
+
+def test_the_fraction_used_speed_by_speed_is_the_closed_form_of_the_limits(testrig_cfg,
+                                                                          judged):
+    """Reference: the closed forms, as above, speed by speed: the coil current
+    |H_a(jΩ)|·i over the rig's 6 A current limit and over its bias's linear range, the
+    larger at each speed and over the axes; two conditions on speeds that partly coincide
+    give the larger at each speed. Its largest value is the block's."""
+    _, _, _, curves = judged
+    speeds, current, names = curves["unbalance_current"]
+    wn, zeta = testrig_cfg.actuator.natural_frequency, testrig_cfg.actuator.damping_ratio
+    sw = 2j * math.pi * speeds
+    coil = np.abs(wn ** 2 / (sw ** 2 + 2 * zeta * wn * sw + wn ** 2))[:, None] * current
+    i0 = np.array([next(a.bias_current for a in testrig_cfg.amb
+                        if n.startswith(f"i_{a.name}_")) for n in names])
+    expected = np.maximum(coil / 6.0, coil / i0).max(axis=1)
+    f, used = used_by_speed(testrig_cfg, [("0 bar", speeds, current, names, None)])
+    np.testing.assert_array_equal(f, np.sort(speeds))
+    np.testing.assert_allclose(used, expected[np.argsort(speeds)], rtol=1e-12)
+    half = [("a", speeds, current, names, None), ("b", speeds[::2], 2 * current[::2], names, None)]
+    f2, used2 = used_by_speed(testrig_cfg, half)
+    np.testing.assert_allclose(used2[::2], 2 * expected[::2], rtol=1e-12)
+    np.testing.assert_allclose(used2[1::2], expected[1::2], rtol=1e-12)
+    block = capacity_block(testrig_cfg, [("0 bar", speeds, current, names, None)])
+    assert used.max() == pytest.approx(max(block["current_used"], block["bias_used"]),
+                                       rel=1e-12)
+
+
+def test_the_notch_switches_on_below_the_continuous_speeds_only_through_a_saturation():
+    """switch_on_hz: a controller alone that saturates its amplifier at a critical below
+    the continuous speeds (1.34× at 106 Hz, as the supercritical example) gets its notch on
+    from the highest speed below the critical where it uses at most half of it; one that
+    saturates only within the continuous speeds, or nowhere, at the minimum continuous
+    speed; one that is never that quiet below the critical, from the lowest turning
+    speed."""
+    f = np.linspace(0.0, 180.0, 181)
+    critical = 0.06 + 1.28 / (1.0 + ((f - 106.0) / 2.0) ** 2)  # a resonance peaking at 1.34
+    on = switch_on_hz(f, critical, 120.0)
+    assert critical[f == on][0] <= SWITCH_ON_FRACTION < critical[f == on + 1][0]
+    assert 100.0 < on < 106.0
+    assert switch_on_hz(f, np.where(f > 130.0, 1.2, 0.3), 120.0) == 120.0
+    assert switch_on_hz(f, np.full(f.size, 0.9), 120.0) == 120.0
+    loud = np.where(f > 0, 0.8 + 0.6 * (f > 90.0), 0.0)
+    assert switch_on_hz(f, loud, 120.0) == 1.0
 
 
 def test_impulse_voltage_is_the_coil_driven_through_the_amplifier(testrig_cfg, judged):

@@ -53,7 +53,12 @@ from ambseal.model import (AXES, actuator_matrices, amb_factors, amplifier_needs
                            axis_label, coil_inductance, limits_used, transient_needs)
 
 __all__ = ["unbalance_currents", "notched_currents", "impulse_coil_currents", "force_demand",
-           "capacity_block", "capacity_words", "saturates"]
+           "capacity_block", "capacity_words", "saturates", "used_by_speed", "switch_on_hz",
+           "SWITCH_ON_FRACTION"]
+
+#: The largest fraction of its amplifier the controller alone may use where an unbalance
+#: force rejection switches on below the continuous speeds (:func:`switch_on_hz`).
+SWITCH_ON_FRACTION = 0.5
 
 #: Why a sizing has no supply voltage (``supply_voltage_note``, :func:`capacity_block`).
 NO_COIL = ("the rig file gives neither the coil's inductance nor its geometry (turns, "
@@ -114,6 +119,83 @@ def notched_currents(entries, on_hz: float, left_a: float):
         i_ref = np.array(i_ref, float)
         i_ref[np.asarray(speed_hz, float) >= on_hz] = float(left_a)
         yield label, speed_hz, i_ref, names, static
+
+
+def used_by_speed(cfg, entries) -> tuple[np.ndarray, np.ndarray]:
+    """The largest fraction of an amplifier limit the controller uses to hold the unbalance
+    at each judged speed, over every condition, AMB axis and limit (:func:`capacity_block`'s
+    fractions, speed by speed).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig: its ``[[amb]]`` limits (each with its ``bias_current``) and
+        ``[actuator]``.
+    entries : iterable of (str, ndarray, ndarray, sequence of str, dict or None)
+        As :func:`capacity_block`'s.
+
+    Returns
+    -------
+    speeds_hz : ndarray, shape (F,)
+        Every speed of the entries (Hz), increasing.
+    used : ndarray, shape (F,)
+        The largest fraction at each (1 is a limit).
+    """
+    by_axis = {f"i_{amb.name}_{ax}": amb for amb in cfg.amb for ax in AXES}
+    act = actuator_matrices(cfg.actuator)
+    most: dict[float, float] = {}
+    for _, speed_hz, i_ref, names, static in entries:
+        f = np.asarray(speed_hz, float)
+        gain = np.abs(freqresp_at(act, 2j * np.pi * f)[:, 0, 0])
+        for a, name in enumerate(names):
+            amb = by_axis[name]
+            need = amplifier_needs(amb, 2 * np.pi * f, gain * np.asarray(i_ref)[:, a],
+                                   static_a=(static or {}).get(name, 0.0))
+            use = np.max([v for v in limits_used(amb, need).values() if v is not None],
+                         axis=0)
+            for fk, uk in zip(f.tolist(), use.tolist()):
+                most[fk] = max(most.get(fk, 0.0), uk)
+    speeds = np.array(sorted(most))
+    return speeds, np.array([most[s] for s in speeds.tolist()])
+
+
+def switch_on_hz(speeds_hz, used, continuous_hz: float) -> float:
+    """The speed an unbalance force rejection switches on at: the minimum continuous speed,
+    or below it where the controller alone saturates the amplifier on the way there.
+
+    A rotor that runs up through a critical speed below its continuous speeds may need
+    more current than its amplifier has to hold the unbalance there, whatever its
+    controller: at the critical the bearings must balance the mode's share of the
+    unbalance force (the supercritical example needs 1.34× the bias current's linear range
+    at its 106 Hz bending critical under each of its three controllers). With the notch on
+    the bearings let the rotor turn about its axis of inertia instead (Herzog et al.,
+    IEEE TCST 4(5), 1996); whether that orbit fits the clearances and the notched loops
+    hold is judged as at every other speed. The notch then switches on at the highest
+    judged speed below the first saturated one where the controller alone uses at most
+    :data:`SWITCH_ON_FRACTION` of its amplifier: a run-up that passes the switch-on speed
+    faster than the notch settles (2/ε, ≈ 6 revolutions) leaves it the other half for
+    the transient. Where no judged speed below it is that quiet, the lowest turning one.
+
+    Parameters
+    ----------
+    speeds_hz, used : array_like, shape (F,)
+        :func:`used_by_speed` of the controller alone.
+    continuous_hz : float
+        The minimum continuous speed (Hz, > 0), where the notch is on otherwise.
+
+    Returns
+    -------
+    float
+        The switch-on speed (Hz), at most ``continuous_hz``.
+    """
+    f, u = np.asarray(speeds_hz, float), np.asarray(used, float)
+    turning = f > 0
+    saturated = f[turning & (u > 1)]
+    if not saturated.size or saturated.min() >= continuous_hz:
+        return float(continuous_hz)
+    first = float(saturated.min())
+    quiet = f[turning & (f < first) & (u <= SWITCH_ON_FRACTION)]
+    return float(quiet.max()) if quiet.size else float(f[turning].min())
 
 
 def impulse_coil_currents(act, impulse) -> tuple[np.ndarray, np.ndarray | None]:

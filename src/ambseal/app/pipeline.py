@@ -45,8 +45,10 @@ from ambseal.analysis import (
     speed_scheduled,
     stability_case,
     stability_points,
+    switch_on_hz,
     synthesis_failure,
     unstable_open_loop_poles,
+    used_by_speed,
     verdict_line,
 )
 from ambseal.app.commands import (
@@ -602,13 +604,15 @@ def _why_not_notched(n: _Notch) -> str:
             f"{CLEARANCE_WORDS.get(name, name)} ({clearance_um:.3g} µm)")
 
 
-def _notches(st: _RunState, methods=None) -> dict[str, _Notch]:
+def _notches(st: _RunState, methods=None, starts=None) -> dict[str, _Notch]:
     """Each controller's unbalance force rejection
     (:func:`~ambseal.design.synchronous_rejection.design_rejection` on the design rig) but
     those that cannot run on the target or are scheduled on another parameter, judged at
     every condition the run judges its controller at, in full and over the speed range,
     and shown against the controller alone on the judged rig: method → :class:`_Notch`.
-    ``methods`` limits it to those controllers (all if None)."""
+    ``methods`` limits it to those controllers (all if None); ``starts`` gives, by method,
+    the speed (Hz) its notch switches on at (:func:`~ambseal.analysis.amplifier.
+    switch_on_hz`; the minimum continuous speed where not given)."""
     st.stages.begin("rejection", "unbalance force rejection")
     r = st.cfg.design.rejection
     kw = {k: v for k, v in (("rate_fraction", r.rate_fraction), ("points", r.points))
@@ -621,7 +625,9 @@ def _notches(st: _RunState, methods=None) -> dict[str, _Notch]:
         if g is None or getattr(g, "parameter", SPEED) != SPEED \
                 or (methods is not None and d.method not in methods):
             continue
-        rej = design_rejection(st.design_cfg, d.controller, g, **kw)
+        on = (starts or {}).get(d.method)
+        rej = design_rejection(st.design_cfg, d.controller, g, **kw, **(
+            {} if on is None else {"speeds_hz": (on, st.cfg.operating.continuous_hz[1])}))
         rows = rejection_stability(st.judge_cfg, rej, [j.point for j in st.jobs
                                                        if j.name == d.method] + speeds)
         lost = [x["condition"] for x in rows
@@ -702,8 +708,14 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
     currents = {d.method: list(_unbalance_currents(d.method, st.jobs, st.judged))
                 for d in st.designs}
     automatic: set[str] = set()
+    lo = cfg.operating.continuous_hz[0]
+    # on below the continuous speeds where the controller alone saturates the amplifier on
+    # the way up to them (switch_on_hz: through a critical speed)
+    starts = {m: switch_on_hz(*used_by_speed(cfg, entries), lo)
+              for m, entries in currents.items() if lo > 0 and cfg.amb
+              and all(a.bias_current is not None for a in cfg.amb)}
     if cfg.design.rejection.enabled:
-        notches = _notches(st)
+        notches = _notches(st, starts=starts)
     else:
         # the amplifier's limit is part of the design: a controller whose loops hold but
         # which alone cannot hold the unbalance (a fraction above 1 in the unbalance
@@ -714,10 +726,12 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
         turns = max((cfg.operating.speed_rpm / 60.0, *(cfg.operating.speed_range_hz or ()))) > 0
         automatic = {m for m, entries in currents.items() if turns
                      and m not in st.failed and saturates(capacity_block(cfg, entries))}
-        notches = _notches(st, automatic) if automatic else {}
+        notches = _notches(st, automatic, starts) if automatic else {}
         for m in sorted(automatic):
+            below = (f" from {starts[m]:.4g} Hz, below the minimum continuous speed"
+                     if starts.get(m, lo) < lo else "")
             st.say(f"{m}: the amplifier cannot hold the unbalance with the controller alone; "
-                   "its unbalance force rejection is switched on")
+                   f"its unbalance force rejection is switched on{below}")
     alone = {}
     for m, n in notches.items():  # a notch that holds runs with its controller
         if n.holds:

@@ -21,7 +21,9 @@ Rules, each a parameter:
   judgement checks every condition);
 - on from the lowest of them: below the minimum continuous speed the rotor passes its
   critical speeds on the feedback alone, and at standstill a notch at 0 Hz would take the
-  controller's static stiffness;
+  controller's static stiffness — unless the run passes a lower start (``speeds_hz``):
+  where the controller alone saturates the amplifier through a critical below the
+  continuous speeds (:func:`ambseal.analysis.amplifier.switch_on_hz`);
 - ε = :data:`RATE_FRACTION` × Ω: a narrow notch, its poles ε/2 from the imaginary axis,
   settling (time constant 2/ε) in 1/(π·0.05) ≈ 6 revolutions at every speed — slow
   against the rotation it tracks, as the first-order placement needs.

@@ -277,11 +277,11 @@ class LpvDesign(ScheduledController):
         # short: the report's section on the syntheses says what it means
         note = f" — NOT SOLVED TO OPTIMALITY: {short}" if short else ""
         pb = self.pole_bound or {}
-        removed = (f" with its {len(pb['above_hz'])} poles above the Nyquist frequency "
-                   f"({pb['bound_hz']:.4g} Hz) removed" if pb.get("reduced") else "")
+        removed = (f" (its {len(pb['above_hz'])} poles above the {pb['bound_hz']:.4g} Hz "
+                   "Nyquist frequency removed)" if pb.get("reduced") else "")
         return (f"LPV γ = {bound_text(self.gamma)} over {lo:g}–{hi:g} Hz ({self.lyapunov} "
-                f"Lyapunov function{note}), frozen loops{removed} γ ≤ "
-                f"{float(np.max(self.check_gamma)):.3g}"
+                f"Lyapunov function{note}), frozen loops γ ≤ "
+                f"{float(np.max(self.check_gamma)):.3g}{removed}"
                 f"; {_stability_over_speed(self.full_order)}")
 
 

@@ -26,20 +26,6 @@ def file_at(f, hz: float) -> list[np.ndarray]:
     return mats
 
 
-def sampled_loop(cfg, f, hz: float) -> control.StateSpace:
-    """An exported controller file at ``hz`` (:func:`file_at`), its delay after it, closed
-    on the rig's full-order plant at that speed sampled by python-control with a
-    zero-order hold: the loop as it runs on the target (python-control's poles of it are
-    the reference; its frequency response of a delayed discrete loop is not, tests/README)."""
-    Ts, d = float(f["Ts"]), int(f["delay_samples"])
-    K = control.ss(*file_at(f, hz), Ts) * control.tf([1], [1] + [0] * d, Ts)
-    plant = build_plant(cfg, speed_rpm=60.0 * hz)
-    cur = plant.current_inputs()
-    G = control.sample_system(control.ss(plant.A, plant.B[:, cur], plant.C, plant.D[:, cur]),
-                              Ts, "zoh")
-    return control.feedback(G, K)
-
-
 def rejection_held_by_python_control(rig: Path, metrics: dict, out: Path) -> None:
     """The exported unbalance force rejection checked as tests/test_examples.py's
     ``_held_by_python_control`` checks the controllers: each delivered controller's file

@@ -28,7 +28,8 @@ from ambseal.config import method_label
 from ambseal.design import machine
 
 __all__ = ["FailedController", "loop_failure", "saturation_failure", "synthesis_failure",
-           "also_failed", "rig_clearances_um", "worst_orbit_um", "clearance_exceeded",
+           "also_failed", "rig_clearances_um", "worst_orbit_um", "notched_orbit_um",
+           "clearance_exceeded",
            "clearance_failure", "CLEARANCE_WORDS"]
 
 #: How a sentence names each clearance of :func:`rig_clearances_um`.
@@ -250,6 +251,34 @@ def worst_orbit_um(cases) -> float | None:
                                        (c.get("discrete") or {}).get("unbalance_peak_um"))
             if v is not None]
     return max(vals) if vals else None
+
+
+def notched_orbit_um(curves, on_hz: float, with_um: float) -> float:
+    """The worst unbalance orbit of a controller delivered with its unbalance force
+    rejection: the controller alone below the speed its notch switches on at, the notch's
+    orbit from there up. The same controller's orbit alone over every speed
+    (:func:`worst_orbit_um`) is not what runs where the notch is on: through a critical
+    speed the notch lets the rotor turn about its inertia axis, with a larger orbit.
+
+    Parameters
+    ----------
+    curves : iterable of (ndarray, ndarray)
+        The controller alone, each judged loop that holds (continuous and as it runs): its
+        unbalance response's speeds (Hz, shape (S,)) and worst orbit (µm, shape (S,)).
+    on_hz : float
+        The speed (Hz) the notch is on from.
+    with_um : float
+        The largest orbit (µm) with the notch on, over the speeds it is on at
+        (:func:`ambseal.analysis.rejection.rejection_effect`'s ``orbit_um["with"]``).
+
+    Returns
+    -------
+    float
+        The orbit (µm, zero-to-peak).
+    """
+    below = [float(np.max(np.asarray(r, float)[np.asarray(s, float) < on_hz]))
+             for s, r in curves if np.any(np.asarray(s, float) < on_hz)]
+    return max([float(with_um), *below])
 
 
 def clearance_exceeded(orbit_um: float | None,

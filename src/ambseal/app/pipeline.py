@@ -33,6 +33,7 @@ from ambseal.analysis import (
     judge_spinup,
     loop_failure,
     notched_currents,
+    notched_orbit_um,
     operating_points,
     rejection_effect,
     rig_clearances_um,
@@ -548,6 +549,16 @@ def _unbalance_currents(method: str, jobs, judged):
             yield (case.label, *c["unbalance_current"], _static(c))
 
 
+def _unbalance_orbits(method: str, jobs, judged):
+    """The unbalance orbits of ``method``'s judged loops that hold, continuous and as it
+    runs: ``(speeds Hz, worst orbit µm)`` each, as :func:`~ambseal.analysis.delivery.
+    worst_orbit_um` counts them."""
+    for job, (_, curves) in zip(jobs, judged):
+        for c in (curves, curves.get("discrete") or {}):  # (a lost loop has none)
+            if job.name == method and "unbalance" in c:
+                yield c["unbalance"]
+
+
 def _impulses(method: str, jobs, judged):
     """The current-impulse responses of ``method``'s stable judged loops, as it runs
     where it runs sampled: ``(condition, speed Hz, response, static currents by axis or
@@ -676,6 +687,9 @@ def _rejections(st: _RunState, summaries: dict, notches: dict[str, _Notch]) -> d
         elif delivered:  # on the facility at the top speed (the most synchronous current), then
             # beside the controller's files: its notch as a file and as C
             lo, top = float(rej.speeds_hz[0]), float(rej.speeds_hz[-1])
+            # what runs: the controller alone below its notch, the notch from there up
+            summaries[m]["rejection"]["orbit_delivered_um"] = notched_orbit_um(
+                _unbalance_orbits(m, st.jobs, st.judged), lo, orbit)
             runout = None if r.runout_um is None else 1e-6 * r.runout_um
             fac = facility_rejection(st.judge_cfg, g, rej, top, runout_m=runout)
             # and a speed step to the top from 10 % below it (within the range)

@@ -91,7 +91,11 @@ class Verdict:
         Largest σ̄(S_o) peak over those loops where stable (-).
     orbit_um, impulse_peak_um, impulse_settling_s : float or None
         Worst unbalance orbit (µm), impulse peak (µm) and 2 % settling time (s; None where
-        a judged response did not settle: ``impulse_settling_note`` says why).
+        a judged response did not settle: ``impulse_settling_note`` says why). The orbit
+        is the one that runs: with an unbalance force rejection delivered, the controller
+        alone below the speed its notch is on from and the notch's orbit from there up (the
+        rejection block's ``orbit_delivered_um``, :func:`ambseal.analysis.delivery.
+        notched_orbit_um`).
     clearances_um : dict
         Clearances the orbit is set against, e.g. ``{"air gap": 500.0}`` (µm).
     target_difference : float or None
@@ -112,6 +116,9 @@ class Verdict:
         without per-axis peaks.
     worst_axis_peak : float or None
         That peak (-), which :attr:`zone_axis` is graded from.
+    notch_on_hz : float or None
+        The speed (Hz) the delivered unbalance force rejection is on from, where the orbit
+        counts it; None without one.
     synthesis_shortfall : str
         Where the design's synthesis stopped short of its optimum (an LPV design whose SDP
         ended "feasible" at CVXOPT's iteration cap or stalled: the design summary's
@@ -165,6 +172,7 @@ class Verdict:
     impulse_settling_note: str | None = None
     worst_axis_peak: float | None = None
     synthesis_shortfall: str = ""
+    notch_on_hz: float | None = None
 
     def critical_text(self) -> str:
         """The critical speeds in words, ``""`` without any: ``"a critical speed (1×
@@ -231,11 +239,14 @@ class Verdict:
         return text
 
     def orbit_text(self) -> str:
-        """``"3.1 µm (0.6 % of the air gap)"``."""
+        """``"3.1 µm (0.6 % of the air gap)"``, and ``"; its notch on from 102 Hz"`` in the
+        brackets where the orbit counts a delivered unbalance force rejection."""
         if self.orbit_um is None:
             return "—"
-        rel = "; ".join(f"{100 * self.orbit_um / c:.2g} % of the {n}"
-                        for n, c in self.clearances_um.items() if c)
+        rel = "; ".join([f"{100 * self.orbit_um / c:.2g} % of the {n}"
+                         for n, c in self.clearances_um.items() if c]
+                        + ([] if self.notch_on_hz is None
+                           else [f"its notch on from {sig(self.notch_on_hz)} Hz"]))
         return f"{sig(self.orbit_um)} µm" + (f" ({rel})" if rel else "")
 
     def amplifier_text(self) -> str:
@@ -406,13 +417,15 @@ def _verdict(name: str, cs: list, by_speed: bool, sc: list,
                  if c.get("stable") and c.get("impulse_settling_note")]
     note = None if not unsettled else unsettled[0][1] + (
         f" (at {unsettled[0][0]})" if len(cs) > 1 else "")
+    # with a delivered notch the orbit that runs is the notch's where it is on
+    notched = (design.get("rejection") or {}).get("orbit_delivered_um")
     return Verdict(
         controller=name, conditions=tuple(label),
         stable_at=tuple(lb for lb, c in zip(label, cs) if c.get("stable")),
         unstable_at=tuple(lb for lb, c in zip(label, cs) if not c.get("stable")),
         zone_axis=worst_zone(axis_zones),
         zone_sigma=worst_zone([c.get("iso_zone") for c in [*cs, *loops[len(ok):]]] + lost),
-        sigma_peak=peak("sensitivity_peak", loops), orbit_um=worst_orbit_um(cs),
+        sigma_peak=peak("sensitivity_peak", loops), orbit_um=worst_orbit_um(cs) if notched is None else notched,
         impulse_peak_um=peak("impulse_peak_um"),
         impulse_settling_s=None if unsettled else peak("impulse_settling_s"),
         impulse_settling_note=note,
@@ -427,7 +440,8 @@ def _verdict(name: str, cs: list, by_speed: bool, sc: list,
         range_hz=tuple(sorted({float(c["speed_hz"]) for c in sc
                                if c.get("speed_hz") is not None})),
         criticals=_criticals(cs), speed_graded=any(c.get("iso_zone") for c in sc),
-        synthesis_shortfall=design.get("sdp_shortfall") or "")
+        synthesis_shortfall=design.get("sdp_shortfall") or "",
+        notch_on_hz=None if notched is None else design["rejection"]["on_from_hz"])
 
 
 def _criticals(cs: list) -> tuple:

@@ -111,13 +111,20 @@ def overhung():
     return cfg, design(cfg, "pid").controller
 
 
-def test_running_plant_is_python_controls_plant_built_at_each_speed(overhung):
+@pytest.mark.parametrize("rig, speeds", [
+    ("overhung_compressor", (40.0, 180.0, 305.0)),  # gyroscopic, constant seal
+    ("turboexpander", (35.0, 130.0, 265.0)),  # seals tabulated over frequency, between rows
+])
+def test_running_plant_is_python_controls_plant_built_at_each_speed(rig, speeds):
     """The open loop at the running speed equals the frequency response of the full-order
     plant :func:`build_plant` makes at that speed (python-control's state space, solved
-    densely at jΩ): current inputs and forces at the bearings, to 1e-7."""
-    cfg, _ = overhung
+    densely at jΩ; its seal tables taken at Ω/2π): current inputs and forces at the
+    bearings, to 1e-7 — on a gyroscopic machine and on one whose seal coefficients follow
+    the whirl frequency, where the per-speed seals are what differs."""
+    cfg = load_rig(f"examples/{rig}.toml")
+    assert (rig == "turboexpander") == any(sl.frequency_dependent for sl in cfg.seal)
     zs = tuple(a.position for a in cfg.amb)
-    speeds = np.array([40.0, 180.0, 305.0])
+    speeds = np.array(speeds)
     rp = running_plant(cfg, speeds, zs)
     for k, f in enumerate(speeds):
         P = build_plant(cfg, speed_rpm=60.0 * f, force_positions=zs).to_statespace()

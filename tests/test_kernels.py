@@ -24,13 +24,16 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
-from tests.kernel_compare import delivered, differences
+from tests.exported_files import file_at
+from tests.kernel_compare import RTOL, delivered, differences, words
 
 ROOT = Path(__file__).resolve().parents[1]
 BLAS_VARS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS",
@@ -126,6 +129,61 @@ def test_blower_delivers_the_same_answer_under_two_kernel_sets(tmp_path, request
         pytest.fail("the blower's μ design, what the test exercises, was not delivered")
     diff = differences(*metrics)
     assert not diff, f"{pair[0]} against {pair[1]}:\n" + "\n".join(diff)
+
+
+def _both(pair, argv: list[str], tmp_path: Path, timeout: float) -> None:
+    """``ambseal argv…`` in two processes at once, one per kernel set of ``pair``, each
+    writing to ``tmp_path/<kernels>``; a run that does not exit 0 fails the test."""
+    procs = [(c, subprocess.Popen([sys.executable, "-c", _MAIN, "-q", *argv, "--out",
+                                   str(tmp_path / c)], env=_env(c), cwd=tmp_path,
+                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True))
+             for c in pair]
+    try:
+        for c, proc in procs:
+            _, stderr = proc.communicate(timeout=timeout)
+            if proc.returncode != 0:
+                pytest.fail(f"{c}: exit {proc.returncode}\n{stderr[-3000:]}")
+    finally:
+        for _, proc in procs:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
+
+
+def test_the_flywheels_lpv_at_10_khz_is_the_same_under_two_kernel_sets(tmp_path):
+    """The LPV on speed of the example flywheel on a 10 kHz target (a copy with its rate
+    changed), designed under two kernel sets: the same discretisation and words, γ within
+    its 2 %, and the same controller as it runs — the exported discrete tables' frequency
+    responses within 2 % of their largest gain at every table speed. Before R and S were
+    centred at the backed-off γ, the SkylakeX kernels gave another controller, which no
+    discretisation could run at 10 kHz (``design`` exited 2)."""
+    pair = _kernel_pair()
+    if pair is None:
+        pytest.skip("no two OpenBLAS kernel sets on this processor (neither AVX2 nor AVX-512)")
+    arch = [_architecture(c) for c in pair]
+    if [[c.lower()] for c in pair] != [[a.lower() for a in x] for x in arch]:
+        pytest.skip(f"OPENBLAS_CORETYPE does not select the kernels here: {pair} gave {arch}")
+    text, n = re.subn(r"(?m)^sample_rate_hz\s*=.*$", "sample_rate_hz = 10000.0",
+                      (ROOT / "examples" / "flywheel.toml").read_text(encoding="utf-8"))
+    assert n == 1
+    rig = tmp_path / "flywheel_10k.toml"
+    rig.write_text(text, encoding="utf-8")
+    _both(pair, ["design", str(rig), "--method", "lpv"], tmp_path, 600)
+    s = [json.loads((tmp_path / c / "design_lpv.json").read_text()) for c in pair]
+    assert s[0]["gamma"] == pytest.approx(s[1]["gamma"], rel=RTOL["gamma"])
+    assert words(s[0]["verdict"]) == words(s[1]["verdict"])
+    f = [np.load(tmp_path / c / "controller_lpv.npz", allow_pickle=False) for c in pair]
+    assert str(f[0]["method"]) == str(f[1]["method"])
+    Ts = float(f[0]["Ts"])
+    z = np.exp(1j * np.pi * np.logspace(-4, 0, 400)[:-1])
+    for w in f[0]["grid"]:
+        K = []
+        for g in f:
+            A, B, C, D = file_at(g, w / (2 * np.pi))
+            K.append(np.stack([C @ np.linalg.solve(zk * np.eye(A.shape[0]) - A, B) + D
+                               for zk in z]))
+        gap = np.abs(K[0] - K[1]).max() / np.abs(K[1]).max()
+        assert gap < RTOL["gamma"], (w / (2 * np.pi), gap, Ts)
 
 
 def _metrics(mu=0.60, zone="A", peak=2.5, verdict="robust performance met: μ = 0.600 ≤ 1"):

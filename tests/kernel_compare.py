@@ -44,10 +44,11 @@ EXACT = {"iso_zone", "controller", "label"}
 #: Zone tables compared value by value, exactly.
 EXACT_TABLES = {"iso_zone_per_axis"}
 #: Sentences compared word for word, numbers masked.
-WORDS = {"verdict", "steps", "notes"}
-#: Subtrees that hold a design's path or its inputs, not what it delivers.
+WORDS = {"verdict", "steps", "notes", "sdp_shortfall"}
+#: Subtrees that hold a design's path or its inputs, not what it delivers (an LPV's
+#: ``sdp_status`` is where each SDP stopped, which its ``sdp_shortfall`` puts in words).
 SKIP = {"design_spec", "weights", "discretisation", "reduction", "stopping", "history",
-        "full_order", "delay", "uncertainty", "sizing", "worst"}
+        "full_order", "delay", "uncertainty", "sizing", "worst", "sdp_status"}
 
 _NUMBER = re.compile(r"[-+−]?(?:\d+(?:[.,]\d+)*)(?:[eE][-+]?\d+)?")
 

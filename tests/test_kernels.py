@@ -222,3 +222,14 @@ def test_comparison_holds_words_and_zones_exactly_and_numbers_to_their_tolerance
     failed["failed"] = {"mu": {"reason": "μ: not delivered — unstable at 0 bar"}}
     assert delivered(failed) == ["pid"]
     assert differences(base, failed)[0] == "delivered: ['mu', 'pid'] against ['pid']"
+    lpv = _metrics()
+    lpv["controllers"]["lpv"] = {"gamma": 2.0, "verdict": "LPV γ = 2",
+                                 "sdp_status": {"gamma": "optimal", "centre": "feasible"},
+                                 "sdp_shortfall": ""}
+    other = _metrics()
+    other["controllers"]["lpv"] = {**lpv["controllers"]["lpv"],
+                                   "sdp_status": {"gamma": "optimal", "centre": "optimal"}}
+    assert differences(lpv, other) == []  # where each SDP stopped: the path
+    other["controllers"]["lpv"]["sdp_shortfall"] = "the γ stage's SDP ended “feasible”"
+    d = differences(lpv, other)
+    assert len(d) == 1 and d[0].startswith("/controllers/lpv/sdp_shortfall: words differ")

@@ -63,7 +63,8 @@ def test_every_step_settles_within_20_ms(runs):
 def test_lpv_faster_than_140_hz_controller_away_from_140_hz(runs):
     """P3 §4, Fig. 11: away from the 140 Hz design speed of the LTI controller (below
     80 Hz and above 200 Hz) the LPV controller settles every disturbance faster, force and
-    output steps alike, and its force-step peak is lower at every speed."""
+    output steps alike. (P3 claims the settling and a less oscillatory response, not a lower
+    peak: above 140 Hz the two force-step peaks are within 4 % of each other.)"""
     _, _, _, sims, _ = runs
     for kind in ("force", "output"):
         pairs = list(zip(_steps(sims["lpv"], kind), _steps(sims["hinf140"], kind)))
@@ -71,8 +72,6 @@ def test_lpv_faster_than_140_hz_controller_away_from_140_hz(runs):
         assert len(away) >= 4
         assert all(a.settling_ms < b.settling_ms for a, b in away), \
             [(a.speed_hz, a.settling_ms, b.settling_ms) for a, b in away]
-    assert all(a.peak_um < b.peak_um for a, b in zip(_steps(sims["lpv"], "force"),
-                                                      _steps(sims["hinf140"], "force")))
 
 
 def test_force_window_final_value_is_its_own(runs):

@@ -325,8 +325,10 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
        ``optimal`` (``penalty_share`` says where it ended).
     2. ``"centre"`` (only with ``centre=True``): stage 1 with α = 1, then at
        γ_d = backoff·γ minimise tr R + mean_k tr S(θ_k) with α = ``coupling_ratio``
-       (lowered towards 1 if infeasible). Gives the least conservative γ, but with a
-       dynamic W_u this second SDP can end short of optimal (then refused).
+       (lowered towards 1 if infeasible). Gives the least conservative γ. This second
+       SDP often ends short of its tolerances, stalled or at CVXOPT's cap, on a point where
+       its LMIs hold: that point certifies γ_d all the same and is kept
+       (:func:`sdp_shortfall` does not count it); ``design_lpv`` centres by default.
     3. ``"reconstruct"``: the controller on the 5× denser table, in closed form
        (central solutions of the reconstruction LMIs, ``robust/_lpv_reconstruct.py``).
 

@@ -522,8 +522,9 @@ def design_lpv(cfg, *, speeds_hz=None, n_grid: int | None = None,
     # R and S centred at the backed-off γ (lpvsyn's stage 2): the γ stage alone leaves the
     # controller where CVXOPT stopped near the LMIs' boundary, which the BLAS kernels'
     # rounding moves (the flywheel's LPV at 10 kHz: other poles, and a sampled loop no
-    # discretisation held, under other kernels); centred, the controllers of three kernel
-    # sets agree to 0.1 % (benchmarks/README.md), at about 1.7× the synthesis time
+    # discretisation held, under other kernels); centred, those of two kernel sets and two
+    # Pythons agree to 0.5 % of their gain (benchmarks/README.md), at 1.6–2.4× the
+    # synthesis time
     lpvsyn_kw.setdefault("centre", True)
     r = lpvsyn(P, L.speeds_rad_s, nmeas, ncon, dA=dA, lyapunov=lyapunov, rate_bound=nu,
                **lpvsyn_kw)

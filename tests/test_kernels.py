@@ -154,9 +154,9 @@ def test_the_flywheels_lpv_at_10_khz_is_the_same_under_two_kernel_sets(tmp_path)
     """The LPV on speed of the example flywheel on a 10 kHz target (a copy with its rate
     changed), designed under two kernel sets: the same discretisation and words, γ within
     its 2 %, and the same controller as it runs — the exported discrete tables' frequency
-    responses within 2 % of their largest gain at every table speed. Before R and S were
-    centred at the backed-off γ, the SkylakeX kernels gave another controller, which no
-    discretisation could run at 10 kHz (``design`` exited 2)."""
+    responses within 2 % of their largest gain at every table speed. Uncentred (R and S of
+    lpvsyn's γ stage alone) the SkylakeX kernels give another controller, which no
+    discretisation runs at 10 kHz (``design`` exits 2)."""
     pair = _kernel_pair()
     if pair is None:
         pytest.skip("no two OpenBLAS kernel sets on this processor (neither AVX2 nor AVX-512)")

@@ -1,14 +1,13 @@
 """The LPV on speed runs on its target: the example flywheel (``examples/flywheel.toml``,
 Ip/It 1.18, 0–60 000 rpm) on a 10 kHz target, one sample of delay. Synthesised, its H∞ LPV
-controller has poles above the 5 kHz Nyquist frequency, where the sampled controller has no
-counterpart (their number and place follow the machine's rounding: a pair at 51 MHz under
-one kernel set, 0.8 MHz under another); they are removed in the synthesis (``pole_bound``
-of :func:`ambseal.robust.lpv.lpvsyn`), and R and S are centred at the backed-off γ so that
-the controller does not follow that rounding. Without the centring, other kernels gave
-another controller whose sampled loop no discretisation held. The reference is
-python-control: the poles of the exported continuous table, and the exported discrete
-table closed on the full-order plant sampled by python-control with a zero-order hold,
-the delay after the controller, at every judged speed and between them."""
+controller has poles above the 5 kHz Nyquist frequency (up to a pair near 0.8 MHz), where
+the sampled controller has no counterpart; they are removed in the synthesis
+(``pole_bound`` of :func:`ambseal.robust.lpv.lpvsyn`), and R and S are centred at the
+backed-off γ so that the controller does not follow the machine's rounding: uncentred,
+SkylakeX kernels give another controller, whose sampled loop no discretisation holds. The
+reference is python-control: the poles of the exported continuous table, and the exported
+discrete table closed on the full-order plant sampled by python-control with a zero-order
+hold, the delay after the controller, at every judged speed and between them."""
 
 from __future__ import annotations
 

@@ -65,8 +65,8 @@ def test_the_verdict_gives_the_orbit_that_runs_with_the_notch(supercritical_run)
     """The verdict table's worst unbalance orbit is the delivered configuration's: through
     the critical the notch lets the rotor turn about its inertia axis, a larger orbit than
     the controller alone keeps (here every controller alone stays below its notched orbit
-    at every speed, so the notched one is the worst). It gave the controller alone's
-    (56, 40 and 79 µm against 331 µm)."""
+    at every speed, so the notched one is the worst: 331 µm against the controllers'
+    56, 40 and 79 µm alone)."""
     _, metrics, out = supercritical_run
     cfg = load_rig(RIG)
     html = (out / "report.html").read_text(encoding="utf-8")

@@ -276,9 +276,8 @@ def notched_orbit_um(curves, on_hz: float, with_um: float) -> float:
     float
         The orbit (µm, zero-to-peak).
     """
-    below = [float(np.max(np.asarray(r, float)[np.asarray(s, float) < on_hz]))
-             for s, r in curves if np.any(np.asarray(s, float) < on_hz)]
-    return max([float(with_um), *below])
+    below = [np.asarray(r, float)[np.asarray(s, float) < on_hz] for s, r in curves]
+    return max([float(with_um), *(float(b.max()) for b in below if b.size)])
 
 
 def clearance_exceeded(orbit_um: float | None,

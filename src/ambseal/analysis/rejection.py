@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from ambseal.analysis.synchronous import Unbalance, synchronous_response
+from ambseal.analysis.synchronous import Unbalance, synchronous_evaluator
 from ambseal.config import TruthSection
 from ambseal.errors import ModelError
 from ambseal.identify import at_speed, prepare_facility
@@ -149,10 +149,14 @@ def rejection_effect(cfg, digital, rejection, settings, *, pressure_bar=None) ->
     p = rejection.pressure_bar if pressure_bar is None else float(pressure_bar)
     pairs = (("without", digital), ("with", rejection.digital))
 
+    # each controller's loop assembled once, for the grid and the peaks' searches
+    loops = {key: synchronous_evaluator(cfg, K, cases, sensors, pressure_bar=p)
+             for key, K in pairs}
+
     def at(f: np.ndarray) -> dict:
         res = {}
-        for key, K in pairs:
-            r = synchronous_response(cfg, K, f, cases, sensors, pressure_bar=p)
+        for key, _ in pairs:
+            r = loops[key](f)
             res[key] = (r.current_a.max(axis=(0, 2)), r.force_n.max(axis=(0, 2)),
                         1e6 * r.amplitude_m.max(axis=(0, 2)))
         return res
@@ -161,9 +165,8 @@ def rejection_effect(cfg, digital, rejection, settings, *, pressure_bar=None) ->
     # the orbit's peaks between the grid's speeds: with the notch on through a critical
     # speed the rotor's resonance is as sharp as its own damping, far narrower than the grid
     # (the supercritical example's: 213 µm on the grid, 331 µm at its peak)
-    extra = sorted({f for key, K in pairs for f in _peaks(
-        lambda f, K=K: 1e6 * float(synchronous_response(
-            cfg, K, np.array([f]), cases, sensors, pressure_bar=p).amplitude_m.max()),
+    extra = sorted({f for key, _ in pairs for f in _peaks(
+        lambda f, key=key: 1e6 * float(loops[key]([f]).amplitude_m.max()),
         speeds, grid[key][2])} - set(speeds.tolist()))
     if extra:
         more = at(np.array(extra))

@@ -50,7 +50,8 @@ from ambseal.model import (
     seal_values,
 )
 
-__all__ = ["Unbalance", "SynchronousResponse", "synchronous_response", "orbit_semi_major",
+__all__ = ["Unbalance", "SynchronousResponse", "synchronous_response",
+           "synchronous_evaluator", "orbit_semi_major",
            "RunningPlant", "running_plant", "hold_fundamental", "amb_dynamic_stiffness"]
 
 
@@ -203,7 +204,8 @@ def amb_dynamic_stiffness(cfg, controller, speeds_hz, *, pressure_bar: float | N
 def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
                          pressure_bar: float | None = None,
                          angles_deg=None) -> SynchronousResponse:
-    """The loop's response to rotating unbalances over speed (module docstring).
+    """The loop's response to rotating unbalances over speed (module docstring):
+    :func:`synchronous_evaluator` of the same arguments at ``speeds_hz``.
 
     Parameters
     ----------
@@ -235,7 +237,34 @@ def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
         singular dynamic stiffness (a
         loop with an undamped mode exactly at a speed).
     """
-    speeds = np.atleast_1d(np.asarray(speeds_hz, dtype=float))
+    return synchronous_evaluator(cfg, controller, cases, positions_m,
+                                 pressure_bar=pressure_bar, angles_deg=angles_deg)(speeds_hz)
+
+
+def synchronous_evaluator(cfg, controller, cases, positions_m, *,
+                          pressure_bar: float | None = None, angles_deg=None):
+    """:func:`synchronous_response` with the rotor, its bearings and its seals assembled
+    once, for any speeds: a search that asks for one speed at a time (a peak, its
+    half-power points) then costs a solve per speed, not an FE assembly.
+
+    Parameters
+    ----------
+    cfg, controller, cases, positions_m, pressure_bar, angles_deg
+        As :func:`synchronous_response`.
+
+    Returns
+    -------
+    callable
+        ``evaluate(speeds_hz) → SynchronousResponse``, ``speeds_hz`` array_like of shape
+        (n_s,) in Hz, ≥ 0; the same numbers as :func:`synchronous_response` at those
+        speeds.
+
+    Raises
+    ------
+    ModelError
+        As :func:`synchronous_response`: probe angles that do not match the positions here,
+        a controller not wired to the rig or a singular dynamic stiffness when evaluated.
+    """
     zs = np.atleast_1d(np.asarray(positions_m, dtype=float))
     where = tuple(sorted({*(u.position for c in cases for u in c), *map(float, zs)}))
     act = (actuator_matrices(cfg.actuator), eddy_lag_matrices(cfg.actuator.eddy_time_constant))
@@ -259,14 +288,49 @@ def synchronous_response(cfg, controller, speeds_hz, cases, positions_m, *,
     n_cur = len(base.output_names)
     closed = controller is not None and n_cur > 0
     if closed:
-        Krs = _controller_at(controller, base.output_names, base.input_names[:n_cur],
-                             2 * math.pi * speeds, seal_values(cfg.seal, p))
         Bi = base.B[:, :n_cur]
         ki = np.linalg.norm(Bi, axis=0)  # each column is Ki along the axis at its node
         ks = np.array([_ks(cfg, name) for name in base.input_names[:n_cur]])
-        current = np.empty((len(cases), speeds.size, n_cur))
+    return _Evaluator(controller, base, stiffness, act, seal_values(cfg.seal, p), F1, zs,
+                      rows_x, rows_y, angles, directional,
+                      (Bi, ki, ks) if closed else None)
+
+
+@dataclass(frozen=True)
+class _Evaluator:
+    """:func:`synchronous_evaluator`'s callable: what it assembled once, and the response
+    at any speeds."""
+    controller: object
+    base: object  # the rotor, AMBs and springs (``_running_system``)
+    stiffness: object  # f_hz ↦ its dynamic stiffness with the seals
+    act: tuple  # the amplifier's and the eddy-current lag's matrices
+    seals: object  # the seals' values the controller is scheduled on
+    F1: np.ndarray  # the cases' forces per unit Ω², (n_dof, n_c)
+    zs: np.ndarray
+    rows_x: list
+    rows_y: list
+    angles: list
+    directional: list
+    coils: tuple | None  # (B_i, Ki, Ks) of the current inputs; None: no loop closed
+
+    def __call__(self, speeds_hz) -> SynchronousResponse:
+        return _evaluate(self, np.atleast_1d(np.asarray(speeds_hz, dtype=float)))
+
+
+def _evaluate(e: _Evaluator, speeds: np.ndarray) -> SynchronousResponse:
+    """``e``'s response at ``speeds`` (Hz): a solve of the dynamic stiffness per speed."""
+    base, F1, zs, rows_x, rows_y = e.base, e.F1, e.zs, e.rows_x, e.rows_y
+    cases = F1.shape[1]
+    closed = e.coils is not None
+    if closed:
+        Bi, ki, ks = e.coils
+        n_cur = Bi.shape[1]
+        Krs = _controller_at(e.controller, base.output_names, base.input_names[:n_cur],
+                             2 * math.pi * speeds, e.seals)
+        current = np.empty((cases, speeds.size, n_cur))
         force = np.empty_like(current)
-    amp = np.empty((len(cases), speeds.size, zs.size))
+    amp = np.empty((cases, speeds.size, zs.size))
+    act, angles, directional, stiffness = e.act, e.angles, e.directional, e.stiffness
     for k, f in enumerate(speeds):
         omega = 2 * math.pi * f
         Z = stiffness(f)

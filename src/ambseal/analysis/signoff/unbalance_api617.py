@@ -91,7 +91,9 @@ from ambseal.analysis.signoff.level1 import (
     without_seals,
 )
 from ambseal.analysis.statics import support_forces
-from ambseal.analysis.synchronous import Unbalance, orbit_semi_major, synchronous_response
+from ambseal.analysis.synchronous import (
+    Unbalance, orbit_semi_major, synchronous_evaluator, synchronous_response,
+)
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
 from ambseal.model import (
@@ -754,10 +756,13 @@ def api617_unbalance(cfg, controller=None, *, name: str = "none",
     for c, (f_mode, rule, unb) in enumerate(cases):
         pr = amp[c, :, :len(probes)]
 
-        def at(s, p, c=c):  # this case's probe p at one speed
-            r = synchronous_response(cfg, controller, [s], [cases[c][2]], [probes[p]],
-                                     angles_deg=[angles[p]])
-            return 2e6 * float(r.amplitude_m[0, 0, 0])
+        built: dict = {}  # per probe, the loop assembled once for the searches
+
+        def at(s, p, unb=unb, built=built):  # this case's probe p at one speed
+            if p not in built:
+                built[p] = synchronous_evaluator(cfg, controller, [unb], [probes[p]],
+                                                 angles_deg=[angles[p]])
+            return 2e6 * float(built[p]([s]).amplitude_m[0, 0, 0])
 
         crit = _criticals(speed, pr, probes, f_min, f_max, at, floor)
         a1 = float(pr[a1_speeds].max())

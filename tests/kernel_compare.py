@@ -71,12 +71,14 @@ def _rel(a: float, b: float) -> float:
     return 0.0 if scale == 0 else abs(a - b) / scale
 
 
-def _number(path: str, key: str, a: Any, b: Any, out: list) -> None:
+def _number(path: str, key: str, a: Any, b: Any, out: list, seen: dict | None) -> None:
     if a is None or b is None:
         if (a is None) != (b is None):
             out.append(f"{path}: {a!r} against {b!r}")
         return
     d = _rel(float(a), float(b))
+    if seen is not None:
+        seen[key] = max(seen.get(key, 0.0), d)
     if d > RTOL[key]:
         out.append(f"{path}: {a:.6g} against {b:.6g} ({100 * d:.2f} % > "
                    f"{100 * RTOL[key]:g} %)")
@@ -89,7 +91,7 @@ def _sentences(path: str, a: Any, b: Any, out: list) -> None:
         out.append(f"{path}: words differ:\n    {la!r}\n    {lb!r}")
 
 
-def _walk(path: str, a: Any, b: Any, out: list) -> None:
+def _walk(path: str, a: Any, b: Any, out: list, seen: dict | None = None) -> None:
     if isinstance(a, dict) and isinstance(b, dict):
         for key in sorted(set(a) | set(b)):
             p = f"{path}/{key}"
@@ -100,30 +102,30 @@ def _walk(path: str, a: Any, b: Any, out: list) -> None:
                 continue
             x, y = a[key], b[key]
             if key in RTOL and not isinstance(x, (dict, list)):
-                _number(p, key, x, y, out)
+                _number(p, key, x, y, out, seen)
             elif key in PER_AXIS:
                 if set(x or {}) != set(y or {}):
                     out.append(f"{p}: axes {sorted(x or {})} against {sorted(y or {})}")
                 else:
                     for axis in sorted(x or {}):
-                        _number(f"{p}/{axis}", PER_AXIS[key], x[axis], y[axis], out)
+                        _number(f"{p}/{axis}", PER_AXIS[key], x[axis], y[axis], out, seen)
             elif key in EXACT or key in EXACT_TABLES:
                 if x != y:
                     out.append(f"{p}: {x!r} against {y!r}")
             elif key in WORDS:
                 _sentences(p, x, y, out)
             else:
-                _walk(p, x, y, out)
+                _walk(p, x, y, out, seen)
     elif isinstance(a, list) and isinstance(b, list):
         if len(a) != len(b):
             if any(isinstance(v, dict) for v in a + b):
                 out.append(f"{path}: {len(a)} entries against {len(b)}")
             return
         for i, (x, y) in enumerate(zip(a, b)):
-            _walk(f"{path}[{i}]", x, y, out)
+            _walk(f"{path}[{i}]", x, y, out, seen)
 
 
-def differences(a: dict, b: dict) -> list[str]:
+def differences(a: dict, b: dict, seen: dict | None = None) -> list[str]:
     """What differs between two runs' metrics.json beyond the stated tolerances, one line
     each (empty: the same delivered answer).
 
@@ -131,6 +133,9 @@ def differences(a: dict, b: dict) -> list[str]:
     ----------
     a, b : dict
         The two runs' ``metrics.json``, loaded.
+    seen : dict, optional
+        Filled with the largest relative difference found under each key of
+        :data:`RTOL` (benchmarks/bench_tolerances.py's table), within tolerance or not.
 
     Returns
     -------
@@ -146,7 +151,7 @@ def differences(a: dict, b: dict) -> list[str]:
         for m in sorted(set(fa) & set(fb)):
             _sentences(f"/{key}/{m}", _reason(fa[m]), _reason(fb[m]), out)
     for key in ("controllers", "cases", "stability"):
-        _walk(f"/{key}", a.get(key), b.get(key), out)
+        _walk(f"/{key}", a.get(key), b.get(key), out, seen)
     return out
 
 

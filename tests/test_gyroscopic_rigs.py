@@ -26,6 +26,9 @@ from ambseal.model import build_plant
 
 from .exported_files import file_at, rejection_held_by_python_control
 
+# the flywheel's run (≈ 100 s) is a module fixture: its tests share one worker
+pytestmark = pytest.mark.xdist_group("flywheel_run")
+
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 RIG = EXAMPLES / "flywheel.toml"
 

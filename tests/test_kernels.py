@@ -15,8 +15,9 @@ tolerances is rounding carried into a design's path. The whole run is used, not
 ``ambseal design --method mu`` alone: the μ design is ~85 % of the run's ~78 s of CPU
 (65 s of it), so a cheaper command saves little, and the zones and verdicts a user reads
 come from the judgement that follows it. Cost: two runs of ~78 s of CPU each, at once on
-two cores (~86 s wall on an idle 2-core machine), about 80 s more per Python in CI.
-Skipped where the processor offers no two kernel sets or ``OPENBLAS_CORETYPE`` does not
+two cores (~86 s wall on an idle 2-core machine, 150 s beside the rest of the suite):
+while D–G–K follows rounding the blower's comparison is an expected failure, so it runs
+with ``-m slow``, not in every run of the suite. Skipped where the processor offers no two kernel sets or ``OPENBLAS_CORETYPE`` does not
 select them (another BLAS).
 """
 
@@ -110,6 +111,7 @@ def _both(pair, argv: list[str], tmp_path: Path, timeout: float) -> None:
                 proc.wait()
 
 
+@pytest.mark.slow
 def test_blower_delivers_the_same_answer_under_two_kernel_sets(tmp_path, request):
     """Expected to fail on the comparison (``KNOWN``), strictly where that was measured:
     with Haswell against SkylakeX kernels it must fail until D–G–K ends where rounding

@@ -17,6 +17,9 @@ pytest.importorskip("control")
 from ambseal.config import load_rig  # noqa: E402
 from ambseal.errors import ModelError  # noqa: E402
 
+# the spin-ups are a module fixture: its tests share one worker
+pytestmark = pytest.mark.xdist_group("spinup_runs")
+
 TURBO = Path(__file__).resolve().parents[2] / "examples" / "turboexpander.toml"
 
 

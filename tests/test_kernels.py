@@ -17,8 +17,8 @@ tolerances is rounding carried into a design's path. The whole run is used, not
 come from the judgement that follows it. Cost: two runs of ~78 s of CPU each, at once on
 two cores (~86 s wall on an idle 2-core machine, 150 s beside the rest of the suite):
 while D–G–K follows rounding the blower's comparison is an expected failure, so it runs
-with ``-m slow``, not in every run of the suite. Skipped where the processor offers no two kernel sets or ``OPENBLAS_CORETYPE`` does not
-select them (another BLAS).
+with ``-m slow``, not in every run of the suite. Skipped where the processor offers no
+two kernel sets or ``OPENBLAS_CORETYPE`` does not select them (another BLAS).
 """
 
 from __future__ import annotations

@@ -146,7 +146,7 @@ def table(rows: list[dict]) -> str:
 def _args(argv=None) -> argparse.Namespace:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--side", action="append", required=True,
-                    help="REV[@CORETYPE]; the first is the reference (at least two)")
+                    help="REV[@CORETYPE[:THREADS]]; the first is the reference (at least two)")
     ap.add_argument("--rigs", nargs="*", default=None,
                     help="example rig names (default: every examples/*.toml)")
     ap.add_argument("--workers", type=int, default=1)
@@ -192,15 +192,18 @@ def main(argv=None) -> int:
         compared = []
         for row in rows:
             print(json.dumps(row), flush=True)
+        # only what this call ran or resumed: a run that wrote nothing leaves an earlier
+        # run's metrics.json in a kept folder
+        fresh = {(r["rig"], r["side"]) for r in rows if "delivered" in r or r.get("resumed")}
         for name in names:
             runs = {c["side"]: Path(c["out"]) / "metrics.json" for c in cases
-                    if Path(c["rig"]).stem == name}
+                    if Path(c["rig"]).stem == name and (name, c["side"]) in fresh}
             ref = sides[0][0]
-            if not runs[ref].is_file():
+            if ref not in runs:
                 continue
             a = json.loads(runs[ref].read_text())
             for side, *_ in sides[1:]:
-                if runs[side].is_file():
+                if side in runs:
                     row = compare(name, ref, side, a, json.loads(runs[side].read_text()))
                     compared.append(row)
                     print(json.dumps(row), flush=True)

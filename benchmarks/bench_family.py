@@ -51,18 +51,16 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import resource
 import subprocess
 import sys
 import tempfile
-import time
 import tomllib
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_suite import child_env, log, machine_reference  # noqa: E402
+from bench_suite import child_env, log, machine_reference, timed_child  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 #: ISO 14839-3 zone B's upper limit of the sensitivity function's peak (Annex A, 12 dB)
@@ -222,22 +220,16 @@ def run_rig(case: dict, timeout: float) -> dict:
                "sys.exit(main(sys.argv[1:]))", "run", str(rig), "--no-identify",
                "--out", str(Path(tmp) / "run")]
         ref0 = machine_reference()
-        before = resource.getrusage(resource.RUSAGE_CHILDREN)
-        t0 = time.perf_counter()
         try:
-            proc = subprocess.run(cmd, cwd=tmp, env=child_env(), stdout=subprocess.DEVNULL,
-                                  stderr=subprocess.PIPE, text=True, timeout=timeout)
+            wall, code, tail, cpu = timed_child(cmd, Path(tmp), child_env(), timeout)
         except subprocess.TimeoutExpired:
             return {**row, "timed_out": True, "timeout_s": timeout}
-        after = resource.getrusage(resource.RUSAGE_CHILDREN)
-        cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
         ref = (ref0 + machine_reference()) / 2
         metrics = Path(tmp) / "run" / "metrics.json"
         m = json.loads(metrics.read_text()) if metrics.is_file() else None
-        row.update(returncode=proc.returncode, wall_s=time.perf_counter() - t0, cpu_s=cpu,
-                   cpu_per_reference=cpu / ref)
+        row.update(returncode=code, wall_s=wall, cpu_s=cpu, cpu_per_reference=cpu / ref)
         if m is None:
-            row["error"] = (proc.stderr.strip().splitlines() or ["no output"])[-1]
+            row["error"] = (tail.splitlines() or ["no output"])[-1]
         else:
             row["delivered"] = delivered(m)
             row["failed"] = {k: v["reason"] for k, v in m["failed"].items()}

@@ -100,15 +100,15 @@ def child_env(default: bool = False) -> dict[str, str]:
     return env
 
 
-def timed_child(cmd: list[str], cwd: Path, env: dict[str, str] | None = None
-                ) -> tuple[float, int, str, float]:
+def timed_child(cmd: list[str], cwd: Path, env: dict[str, str] | None = None,
+                timeout: float | None = None) -> tuple[float, int, str, float]:
     """Wall time (s), return code, the last lines of output and the CPU time (s, user +
-    system) of a child process."""
+    system) of a child process; ``subprocess.TimeoutExpired`` after ``timeout`` s."""
     log("$ " + shlex.join(cmd))
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     proc = subprocess.run(cmd, cwd=cwd, env=env or child_env(), stdout=subprocess.PIPE,
-                          stderr=subprocess.STDOUT, text=True)
+                          stderr=subprocess.STDOUT, text=True, timeout=timeout)
     elapsed = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)

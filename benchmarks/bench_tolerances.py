@@ -27,17 +27,15 @@ from __future__ import annotations
 
 import argparse
 import json
-import resource
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 sys.path.insert(0, str(ROOT))
-from bench_suite import child_env, log, machine_reference  # noqa: E402
+from bench_suite import child_env, log, machine_reference, timed_child  # noqa: E402
 
 from tests.kernel_compare import RTOL, delivered, differences  # noqa: E402
 
@@ -93,23 +91,17 @@ def run_side(case: dict, timeout: float) -> dict:
            "--out", str(out)]
     row = {"case": "run", "rig": Path(case["rig"]).stem, "side": case["side"]}
     ref0 = machine_reference()
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
     try:
-        proc = subprocess.run(cmd, cwd=out.parent, env=env, stdout=subprocess.DEVNULL,
-                              stderr=subprocess.PIPE, text=True, timeout=timeout)
+        wall, code, tail, cpu = timed_child(cmd, out.parent, env, timeout)
     except subprocess.TimeoutExpired:
         return {**row, "timed_out": True, "timeout_s": timeout}
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     ref = (ref0 + machine_reference()) / 2
-    row.update(returncode=proc.returncode, wall_s=time.perf_counter() - t0, cpu_s=cpu,
-               cpu_per_reference=cpu / ref)
+    row.update(returncode=code, wall_s=wall, cpu_s=cpu, cpu_per_reference=cpu / ref)
     metrics = out / "metrics.json"
     if metrics.is_file():
         row["delivered"] = delivered(json.loads(metrics.read_text()))
     else:
-        row["error"] = (proc.stderr.strip().splitlines() or ["no output"])[-1]
+        row["error"] = (tail.splitlines() or ["no output"])[-1]
     return row
 
 

@@ -46,3 +46,37 @@ def test_a_family_rig_runs_end_to_end_with_a_method_delivered(seed):
     row = bf.run_rig({"text": text, "draw": draw}, timeout=1800.0)
     assert row.get("returncode") in (0, 1), row.get("error")
     assert any(row["delivered"].values()), row["failed"]
+
+
+@pytest.mark.slow
+def test_a_disc_like_rotor_switches_its_notch_on_where_it_needs_it(tmp_path):
+    """Seed 2 (Ip/It 1.09, 191–574 Hz at 40 kHz): its LPV alone needs 1.14× the bias
+    current's linear range at the top speed, so the run switches its unbalance force
+    rejection on. On from the minimum continuous speed the notch leaves the rotor on the
+    bearings' negative stiffness near the conical critical where (Ip − It)·Ω² equals the
+    tilting stiffness they take away (163 Hz for the rigid rotor), and loses the loop at
+    191 Hz; the run then switches it on where the controller alone last uses at most half
+    of its amplifier below its saturation, and delivers the LPV with its notch from
+    there."""
+    import json
+    import subprocess
+
+    bf = _bench_family()
+    text, _ = bf.family_rig(2)
+    rig = tmp_path / "rig.toml"
+    rig.write_text(text, encoding="utf-8")
+    cmd = [sys.executable, "-c", "import sys; from ambseal.cli import main; "
+           "sys.exit(main(sys.argv[1:]))", "run", str(rig), "--no-identify",
+           "--out", str(tmp_path / "run")]
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=1800,
+                          env=bf.child_env())
+    assert done.returncode in (0, 1), done.stderr[-2000:]
+    m = json.loads((tmp_path / "run" / "metrics.json").read_text())
+    assert bf.delivered(m)["lpv"], m["failed"].get("lpv")
+    lo, top = parse_rig(tomllib.loads(text)).operating.speed_range_hz
+    rej = m["controllers"]["lpv"]["rejection"]
+    assert rej["stable"] and rej["beyond"] is None
+    assert lo < rej["on_from_hz"] < top
+    assert rej["first_start"]["on_from_hz"] == pytest.approx(lo)
+    assert rej["first_start"]["why"].startswith("loses the loop at")
+    assert m["controllers"]["lpv"]["capacity"]["rejection_automatic"]

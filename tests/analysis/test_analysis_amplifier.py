@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from ambseal.analysis.amplifier import (SWITCH_ON_FRACTION, capacity_block, capacity_words,
-                                        force_demand, notched_currents, switch_on_hz,
+                                        force_demand, later_switch_on_hz, notched_currents,
+                                        switch_on_hz,
                                         used_by_speed)
 from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
 from ambseal.analysis.unbalance import forward_forces, unbalance_force
@@ -235,6 +236,22 @@ def test_the_notch_switches_on_below_the_continuous_speeds_only_through_a_satura
     assert switch_on_hz(f, np.full(f.size, 0.9), 120.0) == 120.0
     loud = np.where(f > 0, 0.8 + 0.6 * (f > 90.0), 0.0)
     assert switch_on_hz(f, loud, 120.0) == 1.0
+
+
+def test_a_notch_that_cannot_run_from_its_start_switches_on_where_it_is_needed():
+    """later_switch_on_hz: the synchronous current of a rigid support grows as Ω² (the
+    unbalance force m·e·Ω²), u = 1.14·(f/574)² as the generated rotor whose notch lost its
+    loop at the bottom of its 191–574 Hz range: on again from the highest speed where
+    u ≤ ½, 574·√(0.5/1.14) = 380.1 Hz, below the first saturated one, 574/√1.14 = 537.6 Hz;
+    none where no speed above the first start is that quiet, or where the controller
+    alone saturates nowhere above it."""
+    f = np.arange(0.0, 575.0)
+    u = 1.14 * (f / 574.0) ** 2
+    assert later_switch_on_hz(f, u, 191.0) == 380.0
+    assert u[f == 380.0][0] <= SWITCH_ON_FRACTION < u[f == 381.0][0]
+    assert later_switch_on_hz(f, u, 400.0) is None
+    assert later_switch_on_hz(f, 0.9 * u / u.max(), 191.0) is None
+    assert later_switch_on_hz(f, u, 0.0) == switch_on_hz(f, u, 600.0) == 380.0
 
 
 def test_impulse_voltage_is_the_coil_driven_through_the_amplifier(testrig_cfg, judged):

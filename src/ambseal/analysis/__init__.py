@@ -87,6 +87,7 @@ _FROM = {
     "capacity_block": "amplifier", "capacity_words": "amplifier", "force_demand": "amplifier",
     "saturates": "amplifier", "unbalance_currents": "amplifier", "notched_currents": "amplifier",
     "used_by_speed": "amplifier", "switch_on_hz": "amplifier",
+    "later_switch_on_hz": "amplifier",
     "rejection_effect": "rejection", "rejection_stability": "rejection",
     "facility_rejection": "rejection", "FacilityRejection": "rejection",
     "facility_speed_step": "rejection", "SpeedStep": "rejection",

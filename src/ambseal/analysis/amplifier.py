@@ -54,7 +54,7 @@ from ambseal.model import (AXES, actuator_matrices, amb_factors, amplifier_needs
 
 __all__ = ["unbalance_currents", "notched_currents", "impulse_coil_currents", "force_demand",
            "capacity_block", "capacity_words", "saturates", "used_by_speed", "switch_on_hz",
-           "SWITCH_ON_FRACTION"]
+           "later_switch_on_hz", "SWITCH_ON_FRACTION"]
 
 #: The largest fraction of its amplifier the controller alone may use where an unbalance
 #: force rejection switches on below the continuous speeds (:func:`switch_on_hz`).
@@ -189,13 +189,58 @@ def switch_on_hz(speeds_hz, used, continuous_hz: float) -> float:
         The switch-on speed (Hz), at most ``continuous_hz``.
     """
     f, u = np.asarray(speeds_hz, float), np.asarray(used, float)
-    turning = f > 0
-    saturated = f[turning & (u > 1)]
-    if not saturated.size or saturated.min() >= continuous_hz:
+    first, quiet = _before_saturation(f, u, 0.0)
+    if first is None or first >= continuous_hz:
         return float(continuous_hz)
+    return quiet if quiet is not None else float(f[f > 0].min())
+
+
+def later_switch_on_hz(speeds_hz, used, on_hz: float) -> float | None:
+    """A later speed for an unbalance force rejection to switch on at, where on from
+    ``on_hz`` it loses a loop or whirls the rotor beyond a clearance: the highest judged
+    speed above ``on_hz`` and below the first one above it where the controller alone
+    saturates the amplifier, at which the controller alone uses at most
+    :data:`SWITCH_ON_FRACTION` of it (the rule of :func:`switch_on_hz`).
+
+    Below it the controller alone holds the unbalance, and the notch is spared the speeds
+    where it cannot run. A notch makes the bearings transparent at the rotational
+    frequency, so there a rigid rotor turns on the AMBs' negative stiffness alone: its
+    tilt φ = θ_ζ + jθ_η obeys It φ̈ − j Ip Ω φ̇ − κ φ = 0 (κ = Σ k_s,b (z_b − z_g)² > 0),
+    and a synchronous whirl φ = e^{jΩt} solves it where (Ip − It) Ω² = κ. A disc-like
+    rotor (Ip > It) meets that critical at a finite speed, and a notch on from the
+    bottom of its range can meet it too (family seed 2 of ``benchmarks/bench_family.py``:
+    Ip/It 1.09, κ/(Ip − It) at 163 Hz for the rigid rotor: its notch on from 191 Hz lost
+    the loop at 191 Hz).
+
+    Parameters
+    ----------
+    speeds_hz, used : array_like, shape (F,)
+        :func:`used_by_speed` of the controller alone.
+    on_hz : float
+        The speed (Hz) the notch was on from.
+
+    Returns
+    -------
+    float or None
+        The later switch-on speed (Hz), or None where the controller alone saturates
+        nowhere above ``on_hz`` (no notch is needed there) or uses more than
+        :data:`SWITCH_ON_FRACTION` at every speed between.
+    """
+    return _before_saturation(np.asarray(speeds_hz, float), np.asarray(used, float),
+                              float(on_hz))[1]
+
+
+def _before_saturation(f: np.ndarray, u: np.ndarray, above: float):
+    """``(first, quiet)``: the lowest speed above ``above`` (Hz) where ``u > 1``, and the
+    highest speed between the two where ``u ≤`` :data:`SWITCH_ON_FRACTION`; None for
+    either where there is none."""
+    turning = f > above
+    saturated = f[turning & (u > 1)]
+    if not saturated.size:
+        return None, None
     first = float(saturated.min())
     quiet = f[turning & (f < first) & (u <= SWITCH_ON_FRACTION)]
-    return float(quiet.max()) if quiet.size else float(f[turning].min())
+    return first, float(quiet.max()) if quiet.size else None
 
 
 def impulse_coil_currents(act, impulse) -> tuple[np.ndarray, np.ndarray | None]:

@@ -31,6 +31,7 @@ from ambseal.analysis import (
     judge_jobs,
     judge_settings,
     judge_spinup,
+    later_switch_on_hz,
     loop_failure,
     notched_currents,
     notched_orbit_um,
@@ -582,18 +583,38 @@ class _Notch:
     every condition judged where it is on (:func:`~ambseal.analysis.rejection.
     rejection_stability`), the conditions where one is lost, its effect over the speed
     range (:func:`~ambseal.analysis.rejection.rejection_effect`) and the clearance its
-    orbit exceeds (``(name, µm)``, or None)."""
+    orbit exceeds (``(name, µm)``, or None); ``first``, the notch from the earlier start
+    that did not hold, where this one switches on later (:func:`_notches`)."""
 
     rejection: object
     rows: list
     lost: list
     effect: dict
     beyond: tuple | None
+    first: "_Notch | None" = None
 
     @property
     def holds(self) -> bool:
         """Every loop with the notch holds and its orbit fits the rig's clearances."""
         return not self.lost and self.beyond is None
+
+    @property
+    def on_hz(self) -> float:
+        """The speed (Hz) the notch is on from."""
+        return self.rejection.controller.notch.on_rad_s / (2 * np.pi)
+
+    def later_words(self) -> str:
+        """Where the notch is on from a later start (else ""): from where, and why not
+        from the first start."""
+        if self.first is None:
+            return ""
+        return (f" from {self.on_hz:.4g} Hz (the controller alone holds the unbalance "
+                f"below it): on from {self.first.on_hz:.4g} Hz it "
+                f"{_why_not_notched(self.first).removeprefix(NOTCH_HEAD)}")
+
+
+#: How :func:`_why_not_notched` begins.
+NOTCH_HEAD = "its unbalance force rejection, switched on by the run, "
 
 
 def _why_not_notched(n: _Notch) -> str:
@@ -602,20 +623,19 @@ def _why_not_notched(n: _Notch) -> str:
     where it holds, that the amplifier saturates with it on as well (below the speed it
     is on from, as through a critical speed under the speed range, or in the impulse
     response, neither of which a notch at the rotational frequency reaches)."""
-    head = "its unbalance force rejection, switched on by the run, "
+    head = NOTCH_HEAD
     if n.lost:
         return head + f"loses the loop at {', '.join(n.lost)}"
     if n.beyond is None:
-        on_hz = n.rejection.controller.notch.on_rad_s / (2 * np.pi)
         return (head + "holds, but the amplifier saturates with it on as well: below "
-                f"{on_hz:.4g} Hz, where it is off, or in the impulse response")
+                f"{n.on_hz:.4g} Hz, where it is off, or in the impulse response")
     name, clearance_um = n.beyond
     orbit = float(np.max(n.effect["orbit_um"]["with"]))
     return (head + f"whirls the rotor about its axis of inertia by {orbit:.3g} µm, beyond "
             f"{CLEARANCE_WORDS.get(name, name)} ({clearance_um:.3g} µm)")
 
 
-def _notches(st: _RunState, methods=None, starts=None) -> dict[str, _Notch]:
+def _notches(st: _RunState, methods=None, starts=None, used=None) -> dict[str, _Notch]:
     """Each controller's unbalance force rejection
     (:func:`~ambseal.design.synchronous_rejection.design_rejection` on the design rig) but
     those that cannot run on the target or are scheduled on another parameter, judged at
@@ -623,7 +643,11 @@ def _notches(st: _RunState, methods=None, starts=None) -> dict[str, _Notch]:
     and shown against the controller alone on the judged rig: method → :class:`_Notch`.
     ``methods`` limits it to those controllers (all if None); ``starts`` gives, by method,
     the speed (Hz) its notch switches on at (:func:`~ambseal.analysis.amplifier.
-    switch_on_hz`; the minimum continuous speed where not given)."""
+    switch_on_hz`; the minimum continuous speed where not given). ``used`` gives, by
+    method, the controller alone's :func:`~ambseal.analysis.amplifier.used_by_speed`: a
+    notch that does not hold from its start is designed again from the later speed
+    :func:`~ambseal.analysis.amplifier.later_switch_on_hz` finds, and kept where it holds
+    from there (``_Notch.first`` then says why the first did not)."""
     st.stages.begin("rejection", "unbalance force rejection")
     r = st.cfg.design.rejection
     kw = {k: v for k, v in (("rate_fraction", r.rate_fraction), ("points", r.points))
@@ -636,16 +660,24 @@ def _notches(st: _RunState, methods=None, starts=None) -> dict[str, _Notch]:
         if g is None or getattr(g, "parameter", SPEED) != SPEED \
                 or (methods is not None and d.method not in methods):
             continue
-        on = (starts or {}).get(d.method)
-        rej = design_rejection(st.design_cfg, d.controller, g, **kw, **(
-            {} if on is None else {"speeds_hz": (on, st.cfg.operating.continuous_hz[1])}))
-        rows = rejection_stability(st.judge_cfg, rej, [j.point for j in st.jobs
-                                                       if j.name == d.method] + speeds)
-        lost = [x["condition"] for x in rows
-                if not x["stable"] or x["stable_as_runs"] is False]
-        effect = rejection_effect(st.judge_cfg, g, rej, st.settings)
-        beyond = clearance_exceeded(float(np.max(effect["orbit_um"]["with"])), clearances)
-        out[d.method] = _Notch(rej, rows, lost, effect, beyond)
+        def notch(on):
+            rej = design_rejection(st.design_cfg, d.controller, g, **kw, **(
+                {} if on is None else {"speeds_hz": (on, st.cfg.operating.continuous_hz[1])}))
+            rows = rejection_stability(st.judge_cfg, rej, [j.point for j in st.jobs
+                                                           if j.name == d.method] + speeds)
+            lost = [x["condition"] for x in rows
+                    if not x["stable"] or x["stable_as_runs"] is False]
+            effect = rejection_effect(st.judge_cfg, g, rej, st.settings)
+            beyond = clearance_exceeded(float(np.max(effect["orbit_um"]["with"])), clearances)
+            return _Notch(rej, rows, lost, effect, beyond)
+
+        n = notch((starts or {}).get(d.method))
+        if not n.holds and d.method in (used or {}):
+            later = later_switch_on_hz(*used[d.method], n.on_hz)
+            if later is not None:
+                again = notch(later)
+                n = replace(again, first=n) if again.holds else n
+        out[d.method] = n
         st.stages.step()
     return out
 
@@ -676,7 +708,10 @@ def _rejections(st: _RunState, summaries: dict, notches: dict[str, _Notch]) -> d
                                           / np.maximum(e["current_a"]["without"], 1e-300))),
             "beyond": None if beyond is None else {"clearance": beyond[0],
                                                    "clearance_um": beyond[1],
-                                                   "orbit_um": orbit}}
+                                                   "orbit_um": orbit},
+            "first_start": None if n.first is None else {
+                "on_from_hz": n.first.on_hz,
+                "why": _why_not_notched(n.first).removeprefix(NOTCH_HEAD)}}
         delivered = summaries[m].get("discretisation") is not None
         if lost:  # said, not delivered
             st.say(f"{m}: its unbalance force rejection loses the loop at {', '.join(lost)}")
@@ -725,11 +760,14 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
     lo = cfg.operating.continuous_hz[0]
     # on below the continuous speeds where the controller alone saturates the amplifier on
     # the way up to them (switch_on_hz: through a critical speed)
-    starts = {m: switch_on_hz(*used_by_speed(cfg, entries), lo)
-              for m, entries in currents.items() if lo > 0 and cfg.amb
-              and all(a.bias_current is not None for a in cfg.amb)}
+    used = {m: used_by_speed(cfg, entries) for m, entries in currents.items()
+            if lo > 0 and cfg.amb and all(a.bias_current is not None for a in cfg.amb)}
+    starts = {m: switch_on_hz(*u, lo) for m, u in used.items()}
     if cfg.design.rejection.enabled:
-        notches = _notches(st, starts=starts)
+        notches = _notches(st, starts=starts, used=used)
+        for m, n in notches.items():
+            if n.first is not None:
+                st.say(f"{m}: its unbalance force rejection is on{n.later_words()}")
     else:
         # the amplifier's limit is part of the design: a controller whose loops hold but
         # which alone cannot hold the unbalance (a fraction above 1 in the unbalance
@@ -740,10 +778,12 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
         turns = max((cfg.operating.speed_rpm / 60.0, *(cfg.operating.speed_range_hz or ()))) > 0
         automatic = {m for m, entries in currents.items() if turns
                      and m not in st.failed and saturates(capacity_block(cfg, entries))}
-        notches = _notches(st, automatic, starts) if automatic else {}
+        notches = _notches(st, automatic, starts, used) if automatic else {}
         for m in sorted(automatic):
             below = (f" from {starts[m]:.4g} Hz, below the minimum continuous speed"
                      if starts.get(m, lo) < lo else "")
+            if m in notches and notches[m].first is not None:
+                below = notches[m].later_words()
             st.say(f"{m}: the amplifier cannot hold the unbalance with the controller alone; "
                    f"its unbalance force rejection is switched on{below}")
     alone = {}

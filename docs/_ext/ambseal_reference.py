@@ -731,7 +731,10 @@ def _sections() -> list[Section]:
         Section("[design.mu]", d.MuSpec, "Every key of ``[design.hinf]``, and:"),
         Section("[design.rejection]", d.RejectionSpec, "The unbalance force rejection "
                 "(Herzog et al., IEEE TCST 1996): a generalised notch filter in each "
-                "controller's input, on from the minimum continuous speed."),
+                "controller's input, on from the minimum continuous speed (lower where the "
+                "controller alone saturates its amplifier through a critical on the way "
+                "there; later where a notch from there does not hold, see the run's "
+                "``rejection`` block in :doc:`/getting-started`)."),
         Section("{ zeta, eta }", r.AxisPair, "A value per actuator axis (``ki``, ``ks``); "
                 "with the geometry one axis may be left out."),
         Section("{ at_zero, per_bar }", r.Affine, "A coefficient affine in the pressure "

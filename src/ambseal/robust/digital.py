@@ -12,15 +12,17 @@ Systems*, 3rd ed., ch. 6):
    of the slow poles. The rise of γ (H∞) or μ that this costs is reported by the
    caller's ``rise``;
    a fast pole that is unstable is refused. A fast pole that is
-   stable and whose damped frequency |Im p|/2π lies below the same fraction of Nyquist
-   aliases nothing under a hold equivalent (``z = e^{pT}`` inside the unit disc at an
-   angle below π/2; a real pole, or a pair damped at ζ near 1, :func:`hold_keeps`), so
-   when every fast pole does, the hold equivalents are also tried on the controller as
-   designed (candidates ``zoh+fast``, ``foh+fast``; an H∞ controller with real poles at
-   5.9 and 7.9 kHz keeps them: its discrete σ̄(S_o) peaks are then those of the
-   continuous loop to 0.1–3 % instead of up to 145 %; an LPV table's 6.3–6.6 kHz pairs,
-   ζ ≥ 0.998, cost +7.5 % at its 190 Hz σ̄(S_o) peak when residualised, −0.3 % when kept
-   under the triangle hold; benchmarks/README.md).
+   stable and whose damped frequency |Im p|/2π lies below Nyquist aliases nothing under a
+   hold equivalent (``z = e^{pT}`` inside the unit disc at an angle below π, which maps
+   back to p alone; a real pole, a pair damped near ζ = 1, or a lightly damped pair
+   between half of Nyquist and Nyquist, :func:`hold_keeps`), so when every fast pole
+   does, the hold equivalents are also tried on the controller as designed (candidates
+   ``zoh+fast``, ``foh+fast``; an H∞ controller with real poles at 5.9 and 7.9 kHz keeps
+   them: its discrete σ̄(S_o) peaks are then those of the continuous loop to 0.1–3 %
+   instead of up to 145 %; an LPV table's 6.3–6.6 kHz pairs, ζ ≥ 0.998, cost +7.5 % at
+   its 190 Hz σ̄(S_o) peak when residualised, −0.3 % when kept under the triangle hold;
+   a generated flywheel's LPV at 20 kHz with a pair at 5.1 kHz, ζ = 0.006, runs only with
+   the pair kept; benchmarks/README.md).
 2. **Candidates.** Tustin, Tustin pre-warped at the frequency that matters (the
    least-damped pole of the continuous loop on the full-order plant: where the loop is
    closest to instability, the controller's phase must be right), the zero-order-hold
@@ -318,13 +320,15 @@ def hold_keeps(fast: np.ndarray, fs: float) -> bool:
     Returns
     -------
     bool
-        True when there is one at least and each is stable with |Im p| below
-        ``FAST_FRACTION`` of Nyquist ``fs/2``: ``z = e^{pT}`` inside the unit disc at an
-        angle below ``FAST_FRACTION·π``, aliasing no other frequency.
+        True when there is one at least and each is stable with |Im p| below Nyquist
+        ``fs/2`` (2π·fs/2 rad/s): ``z = e^{pT}`` inside the unit disc at an angle below π,
+        aliasing no other frequency (the map from p to z is one to one in that strip).
+        Whether the held controller then runs the loop as designed is for the choice
+        (step 3) to judge.
     """
     fast = np.asarray(fast, complex)
     return bool(fast.size and is_stable(fast)
-                and np.all(np.abs(fast.imag) < 2 * np.pi * FAST_FRACTION * fs / 2))
+                and np.all(np.abs(fast.imag) < 2 * np.pi * fs / 2))
 
 
 def residualize(mats: Matrices, V: np.ndarray, k: int) -> Matrices:

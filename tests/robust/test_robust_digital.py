@@ -212,42 +212,62 @@ def _lead_with_fast_pair(theta):
         [wf**2], [1, 2 * 0.998 * wf, wf**2])
 
 
+#: The toy plant of the tests below: G(s) = k_i/(m s² − k_s), m 10 kg, k_s 1 MN/m,
+#: k_i 200 N/A (A → m).
+_MASS_PLANT = ct.ss(ct.tf([200.0], [10.0, 0.0, -1e6]))
+
+
+def _scheduled(tf_at):
+    """A ScheduledController on a seal's k (θ from 0 to 1) whose controller at θ is the
+    SISO transfer function ``tf_at(θ)`` (y → i)."""
+    from ambseal.machine.controller import ScheduledController
+
+    class Toy(ScheduledController):
+        parameter, schedule = "seal.k", (0.0, 1.0)
+
+        def matrices_at(self, th):
+            return _mats(ct.ss(tf_at(th)))
+
+        def at(self, th, name="K"):
+            return ct.ss(*self.matrices_at(th), inputs=["y"], outputs=["i"], name=name)
+
+    return Toy()
+
+
+def _s_peaks(K, Kd_delayed, fs):
+    """``(continuous, sampled)`` |S| peaks of ``_MASS_PLANT`` closed by the transfer
+    function ``K``: the continuous loop in closed form, G(jω) = k_i/(−mω² − k_s) with K(jω)
+    of its polynomials and the exact hold + computation delay e^{−jω·1.5T} (Franklin,
+    Powell & Workman §5.3.1); the sampled one python-control's, the plant ZOH-sampled and
+    closed by the discrete controller with its delay ``Kd_delayed``; up to Nyquist."""
+    T = 1.0 / fs
+    w = 2 * np.pi * np.logspace(1, np.log10(0.999 * fs / 2), 4000)
+    num, den = K.num[0][0], K.den[0][0]
+    L = (200.0 / (-10.0 * w**2 - 1e6) * np.polyval(num, 1j * w) / np.polyval(den, 1j * w)
+         * np.exp(-1.5j * w * T))
+    Ld = ct.frequency_response(ct.sample_system(_MASS_PLANT, T, "zoh") * Kd_delayed,
+                               w).complex
+    return np.max(np.abs(1 / (1 + L))), np.max(np.abs(1 / (1 + np.ravel(Ld))))
+
+
 def test_scheduled_table_keeps_well_damped_fast_poles_and_matches_the_continuous_loop():
-    """Reference: the continuous loop in closed form, G(jω) = k_i/(−mω² − k_s) (m 10 kg,
-    k_s 1 MN/m, k_i 200 N/A) with K(jω) of the polynomials and the exact hold +
-    computation delay e^{−jω·1.5T} (Franklin, Powell & Workman §5.3.1), against
+    """Reference: the continuous loop in closed form (:func:`_s_peaks`) against
     python-control's ZOH-sampled plant with the table's delayed discrete controller: the
     |S| peaks agree within 0.5 % at θ = 0.25 and 0.8 (between entries). The 6.5 kHz pair
     (above half of Nyquist, ζ = 0.998: z = e^{pT} at an angle of 0.26 rad, no alias) is
     kept under a hold equivalent; residualised, the peak was 55 % off. A 3 kHz pair at
     ζ = 0.1 (angle 1.9 rad, below π) may be kept too; a 6 kHz one (its damped frequency
     above the 5 kHz Nyquist frequency, an alias) or an unstable pole is not."""
-    from ambseal.machine.controller import ScheduledController
     from ambseal.robust.digital import hold_keeps
     from ambseal.machine.scheduled_digital import scheduled_digital
 
-    class Lead(ScheduledController):
-        parameter, schedule = "seal.k", (0.0, 1.0)
-
-        def matrices_at(self, th):
-            return _mats(ct.ss(_lead_with_fast_pair(th)))
-
-        def at(self, th, name="K"):
-            return ct.ss(*self.matrices_at(th), inputs=["y"], outputs=["i"], name=name)
-
-    fs, T = 1e4, 1e-4
-    G = ct.ss(ct.tf([200.0], [10.0, 0.0, -1e6]))
-    sd = scheduled_digital(Lead(), [0.0, 0.5, 1.0], fs, [(0.0, _mats(G)), (0.25, _mats(G))],
-                           delay_samples=1, name="K_lead")
+    fs, G = 1e4, _mats(_MASS_PLANT)
+    sd = scheduled_digital(_scheduled(_lead_with_fast_pair), [0.0, 0.5, 1.0], fs,
+                           [(0.0, G), (0.25, G)], delay_samples=1, name="K_lead")
     assert sd.choice.endswith("+fast") and sd.removed_poles_hz == ()
-    w = 2 * np.pi * np.logspace(1, np.log10(0.999 * fs / 2), 4000)
-    Gd = ct.sample_system(G, T, "zoh")
     for th in (0.25, 0.8):
-        num, den = _lead_with_fast_pair(th).num[0][0], _lead_with_fast_pair(th).den[0][0]
-        L = (200.0 / (-10.0 * w**2 - 1e6) * np.polyval(num, 1j * w) / np.polyval(den, 1j * w)
-             * np.exp(-1.5j * w * T))
-        Ld = ct.frequency_response(Gd * sd.statespace_at(th, delayed=True), w).complex
-        peak, peak_d = np.max(np.abs(1 / (1 + L))), np.max(np.abs(1 / (1 + np.ravel(Ld))))
+        peak, peak_d = _s_peaks(_lead_with_fast_pair(th), sd.statespace_at(th, delayed=True),
+                                fs)
         assert abs(peak_d / peak - 1) < 0.005, (th, peak, peak_d)
     pair = lambda f, z: 2 * np.pi * f * np.array([-z + 1j * np.sqrt(1 - z * z),
                                                   -z - 1j * np.sqrt(1 - z * z)])
@@ -260,27 +280,20 @@ def test_a_lightly_damped_pair_between_half_nyquist_and_nyquist_is_kept():
     """A controller with a resonant pair at 3.2 kHz, ζ = 0.05, on a 10 kHz target: above
     half of Nyquist, but its damped frequency below Nyquist, so z = e^{pT} (at an angle of
     2.0 rad) aliases nothing and the hold equivalents may keep it. Reference: the
-    continuous loop in closed form (the test above's plant and hold + computation delay
-    e^{−jω·1.5T}) against python-control's ZOH-sampled plant with the delayed discrete
-    controller: the |S| peaks agree within 0.5 %; residualised, the best candidate was
-    1.9 % off."""
+    continuous loop in closed form (:func:`_s_peaks`) against python-control's sampled
+    loop with the delayed discrete controller: the |S| peaks agree within 0.5 %;
+    residualised, the best candidate was 1.9 % off."""
     from ambseal.robust.digital import digital_controller
 
-    fs, T, wf = 1e4, 1e-4, 2 * np.pi * 3200.0
+    fs, wf = 1e4, 2 * np.pi * 3200.0
     K = ct.tf([1.5e-3 * 7500.0, 7500.0], [1 / (2 * np.pi * 2000), 1]) * ct.tf(
         [1, 2 * 0.5 * wf, wf**2], [1, 2 * 0.05 * wf, wf**2])
     Kss = ct.ss(*_mats(ct.ss(K)), inputs=["y"], outputs=["i"], name="K_pair")
-    G = ct.ss(ct.tf([200.0], [10.0, 0.0, -1e6]))
-    dc = digital_controller(Kss, fs, [_mats(G)], delay_samples=1, rise=lambda Kr: None)
+    dc = digital_controller(Kss, fs, [_mats(_MASS_PLANT)], delay_samples=1,
+                            rise=lambda Kr: None)
     assert dc.choice.endswith("+fast") and dc.removed_poles_hz == ()
-    w = 2 * np.pi * np.logspace(1, np.log10(0.999 * fs / 2), 4000)
-    num, den = K.num[0][0], K.den[0][0]
-    L = (200.0 / (-10.0 * w**2 - 1e6) * np.polyval(num, 1j * w) / np.polyval(den, 1j * w)
-         * np.exp(-1.5j * w * T))
     Kd = dc.discrete
-    Kdel = ct.ss(*with_delay((Kd.A, Kd.B, Kd.C, Kd.D), 1), T)
-    Ld = ct.frequency_response(ct.sample_system(G, T, "zoh") * Kdel, w).complex
-    peak, peak_d = np.max(np.abs(1 / (1 + L))), np.max(np.abs(1 / (1 + np.ravel(Ld))))
+    peak, peak_d = _s_peaks(K, ct.ss(*with_delay((Kd.A, Kd.B, Kd.C, Kd.D), 1), 1 / fs), fs)
     assert abs(peak_d / peak - 1) < 0.005, (peak, peak_d)
 
 
@@ -288,11 +301,10 @@ def test_scheduled_table_keeps_a_fast_pair_that_slows_below_half_nyquist_at_an_e
     """A table whose well-damped pair lies above half of Nyquist at its middle entry and
     below it at the low end (2.35 → 3.15 kHz, ζ = 0.998, at 10 kHz): the entries without a
     fast pole alias nothing, so the hold equivalents may keep the pair, as where every
-    entry has it. Reference: the continuous loop in closed form, as in the test above,
+    entry has it. Reference: the continuous loop in closed form (:func:`_s_peaks`)
     against python-control's sampled loop with the table's delayed discrete controller:
     the |S| peaks agree within 0.5 % at θ = 0.3 and 0.8 (between entries); the candidates
     that residualise the pair were 18–52 % off."""
-    from ambseal.machine.controller import ScheduledController
     from ambseal.machine.scheduled_digital import scheduled_digital
 
     def lead(th):
@@ -300,31 +312,15 @@ def test_scheduled_table_keeps_a_fast_pair_that_slows_below_half_nyquist_at_an_e
         return ct.tf([1.5e-3 * kp, kp], [1 / (2 * np.pi * 2000), 1]) * ct.tf(
             [wf**2], [1, 2 * 0.998 * wf, wf**2])
 
-    class Lead(ScheduledController):
-        parameter, schedule = "seal.k", (0.0, 1.0)
-
-        def matrices_at(self, th):
-            return _mats(ct.ss(lead(th)))
-
-        def at(self, th, name="K"):
-            return ct.ss(*self.matrices_at(th), inputs=["y"], outputs=["i"], name=name)
-
-    fs, T = 1e4, 1e-4
+    fs, G = 1e4, _mats(_MASS_PLANT)
     assert np.abs(ct.poles(lead(0.0))).max() < 2 * np.pi * fs / 4 < np.abs(
         ct.poles(lead(0.5))).max()
-    G = ct.ss(ct.tf([200.0], [10.0, 0.0, -1e6]))
-    sd = scheduled_digital(Lead(), np.linspace(0.0, 1.0, 9), fs,
-                           [(th, _mats(G)) for th in (0.0, 0.3, 0.8)], delay_samples=1,
+    sd = scheduled_digital(_scheduled(lead), np.linspace(0.0, 1.0, 9), fs,
+                           [(th, G) for th in (0.0, 0.3, 0.8)], delay_samples=1,
                            name="K_lead")
     assert sd.choice.endswith("+fast") and sd.removed_poles_hz == ()
-    w = 2 * np.pi * np.logspace(1, np.log10(0.999 * fs / 2), 4000)
-    Gd = ct.sample_system(G, T, "zoh")
     for th in (0.3, 0.8):
-        num, den = lead(th).num[0][0], lead(th).den[0][0]
-        L = (200.0 / (-10.0 * w**2 - 1e6) * np.polyval(num, 1j * w) / np.polyval(den, 1j * w)
-             * np.exp(-1.5j * w * T))
-        Ld = ct.frequency_response(Gd * sd.statespace_at(th, delayed=True), w).complex
-        peak, peak_d = np.max(np.abs(1 / (1 + L))), np.max(np.abs(1 / (1 + np.ravel(Ld))))
+        peak, peak_d = _s_peaks(lead(th), sd.statespace_at(th, delayed=True), fs)
         assert abs(peak_d / peak - 1) < 0.005, (th, peak, peak_d)
 
 

@@ -13,6 +13,9 @@ Synthesis (each returns the controller, the closed loop, the bound and a result 
 * :func:`lpvsyn` — gridded H∞ LPV synthesis by LMIs (CVXOPT, structured); the status each
   of its SDP stages ended on, :func:`sdp_status`, and any short of optimal in words,
   :func:`sdp_shortfall`;
+* :func:`performance_level` — the largest level of the performance weights at which a
+  scaled-H∞ bound certifies the uncertainty (a wide interval of a real parameter), and
+  :func:`scaled_performance` the plant at that level;
 * :func:`reduce_controller`, :func:`balred_controller` — order reduction with its cost.
 
 Analysis: :func:`mussv` — μ upper and lower bounds for mixed real/complex block structures.
@@ -57,6 +60,8 @@ _FROM = {
     "discrete_controller": "digital_loop", "DiscreteController": "digital_loop",
     "design_omega": "dk", "fit_magnitude": "dk", "musyn": "dk", "MusynResult": "dk",
     "hinfnorm": "hinf", "hinfsyn": "hinf", "lft_lower": "hinf", "HinfResult": "hinf",
+    "performance_level": "level", "scaled_performance": "level", "LevelResult": "level",
+    "LEVEL_FLOOR": "level", "LEVEL_RTOL": "level",
     "lpvsyn": "lpv", "LpvController": "lpv", "LpvSynResult": "lpv", "sdp_status": "lpv",
     "sdp_shortfall": "lpv", "mussv": "mu",
     "MuResult": "mu", "balred_controller": "order", "reduce_controller": "order",

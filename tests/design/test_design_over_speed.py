@@ -66,13 +66,11 @@ def _rigid_rig(tmp_path, disk_ip: float = 0.4) -> Path:
 BETWEEN_HZ = (0.0, 25.0, 60.0, 110.0, 170.0, 230.0, 290.0, 350.0, 400.0)
 
 
-@pytest.mark.parametrize("method", ["hinf", "mu"])
-def test_a_rigid_gyroscopic_rotor_is_held_from_standstill_to_the_top_speed(tmp_path, method):
-    """Reference: python-control's poles of the sampled, delayed loop on the full-order
-    plant. Designed at the top speed alone (``[design] one_speed``) the loop is unstable
-    at standstill; the design with the speed uncertain over 0–400 Hz holds at every speed
-    of :data:`BETWEEN_HZ`, and its steps say how it was designed."""
-    rig = _rigid_rig(tmp_path)
+def _held_where_one_speed_is_not(rig: Path, method: str):
+    """The rule's design of ``rig`` by ``method``, after checking (python-control's poles
+    of the sampled, delayed loop on the full-order plant) that the design at the top speed
+    alone (``[design] one_speed``) loses the rotor at standstill and that the rule's
+    holds it at every speed of :data:`BETWEEN_HZ`, designed over 0–400 Hz."""
     one = load_rig(rig, ("design.one_speed=true",))
     frozen = design(one, method, allow_unstable=True)
     assert not _held_as_it_runs(one, frozen.K, [0.0])[0]
@@ -80,6 +78,15 @@ def test_a_rigid_gyroscopic_rotor_is_held_from_standstill_to_the_top_speed(tmp_p
     held = design(cfg, method)
     assert all(_held_as_it_runs(cfg, held.K, BETWEEN_HZ))
     assert held.design_speed_hz is None and held.speed_range_hz == (0.0, 400.0)
+    return held
+
+
+@pytest.mark.parametrize("method", ["hinf", "mu"])
+def test_a_rigid_gyroscopic_rotor_is_held_from_standstill_to_the_top_speed(tmp_path, method):
+    """Designed at the top speed alone the loop is unstable at standstill; the design with
+    the speed uncertain over 0–400 Hz holds at every speed of :data:`BETWEEN_HZ`
+    (:func:`_held_where_one_speed_is_not`), and its steps say how it was designed."""
+    held = _held_where_one_speed_is_not(_rigid_rig(tmp_path), method)
     assert held.steps[-1].startswith(f"{method}: designed with the spin speed uncertain "
                                      "over 0–400 Hz (a real LFT parameter)")
     assert "rotor.speed" in held.uncertainty
@@ -108,22 +115,15 @@ def test_a_disc_like_rigid_rotor_is_held_at_the_performance_level_the_speed_rang
         tmp_path, method):
     """A disc-like rigid rotor (Ip/It 1.2) over 0–400 Hz: at the weights as given the H∞
     with the speed uncertain is not certified (scaled γ 2.5, measured) and loses the rotor
-    at standstill, as the one-speed design does. Reference: python-control's poles of the
-    sampled, delayed loop on the full-order plant; the design at the largest performance
+    at standstill, as the one-speed design does. The design at the largest performance
     level that certifies the speed range holds the rotor at every speed of
-    :data:`BETWEEN_HZ`, and its step names the level."""
+    :data:`BETWEEN_HZ` (:func:`_held_where_one_speed_is_not`), and its step names the
+    level."""
     _, it, ip = inertia(20.0, 0.622, 0.2)
     assert ip / it == pytest.approx(1.2, abs=0.01)
-    rig = _rigid_rig(tmp_path, 0.622)
-    one = load_rig(rig, ("design.one_speed=true",))
-    frozen = design(one, method, allow_unstable=True)
-    assert not _held_as_it_runs(one, frozen.K, [0.0])[0]
-    cfg = load_rig(rig)
-    held = design(cfg, method)
-    assert all(_held_as_it_runs(cfg, held.K, BETWEEN_HZ))
+    held = _held_where_one_speed_is_not(_rigid_rig(tmp_path, 0.622), method)
     level = held.stopping["performance_level"]
     assert LEVEL_FLOOR < level["level"] < 1
     if method == "hinf":
         assert held.gamma < 1
     assert f"at {100 * level['level']:.2g} % of the performance weights" in held.steps[-1]
-    assert held.speed_range_hz == (0.0, 400.0)

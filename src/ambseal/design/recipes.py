@@ -715,7 +715,9 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
                      order=0, max_iter=1)
 
     P, tried, found = gp.P, (), None
-    if speed is not None and level == "auto":
+    if speed is None:
+        level = None
+    elif level == "auto":
         # asked for where the weights as given were not certified (or gave no design)
         found = performance_level(gp.P, gp.blocks, gp.nmeas, gp.ncon, scaled_hinf,
                                   refused=1.0)
@@ -725,9 +727,7 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
                 f"certifies the speed range {speed[0]:g}–{speed[1]:g} Hz at constant "
                 f"scalings (γ {found.tried[-1][1]:.3g} there)")
         level, tried = found.level, found.tried
-    if speed is None or level is None:
-        level = None
-    elif robust or found is None:
+    if level is not None and (robust or found is None):
         P = scaled_performance(gp.P, gp.blocks, gp.nmeas, gp.ncon, level)
     if not robust and speed is not None:
         if found is not None:  # designed at the level with the same u and y

@@ -70,7 +70,7 @@ class LevelResult:
     tried: tuple
 
 
-def _channels(P, blocks, nmeas: int, ncon: int) -> tuple[int, int]:
+def _channels(blocks) -> tuple[int, int]:
     """(w_Δ inputs, z_Δ outputs) of ``blocks`` less its last (performance) block."""
     if len(blocks) < 2:
         raise ConfigError("performance_level: blocks has no uncertainty block before the "
@@ -108,7 +108,7 @@ def scaled_performance(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int
     """
     if not 0 < level <= 1:
         raise ConfigError(f"scaled_performance: level={level!r}, expected 0 < level ≤ 1")
-    _, nzd = _channels(P, blocks, nmeas, ncon)
+    _, nzd = _channels(blocks)
     C, D = np.array(P.C, float), np.array(P.D, float)
     nz = C.shape[0] - nmeas
     C[nzd:nz] *= level
@@ -170,7 +170,7 @@ def performance_level(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int,
     if refused is not None and not floor < refused <= 1:
         raise ConfigError(f"performance_level: refused={refused!r}, expected a level in "
                           f"({floor:g}, 1]")
-    nwd, _ = _channels(P, blocks, nmeas, ncon)
+    nwd, _ = _channels(blocks)
     tried = []
 
     def at(a):

@@ -173,10 +173,12 @@ class DesignCache:
             return real_digital(cfg, method, controller, result, points, cache)
 
         def design(cfg, method="mu", **kw):
-            # the main job passes the rig's own specification, a progress callback and
+            # the main job passes the rig's own specification, a progress callback,
             # allow_unstable=True (the judgement decides; the cached designs are stable, so
-            # it changes nothing), `ambseal design` the operating pressure (None: the rig's)
-            plain = set(kw) <= {"spec", "progress", "allow_unstable", "pressure_bar"} \
+            # it changes nothing) and the trials its designs share (the same designs),
+            # `ambseal design` the operating pressure (None: the rig's)
+            plain = set(kw) <= {"spec", "progress", "allow_unstable", "pressure_bar",
+                                "trials"} \
                 and kw.get("pressure_bar") is None
             if rig == "testrig" and plain and _same(cfg, got["testrig_cfg"]):
                 self.hits.append(f"design:{method}")

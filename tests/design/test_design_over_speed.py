@@ -127,3 +127,32 @@ def test_a_disc_like_rigid_rotor_is_held_at_the_performance_level_the_speed_rang
     if method == "hinf":
         assert held.gamma < 1
     assert f"at {100 * level['level']:.2g} % of the performance weights" in held.steps[-1]
+
+
+def test_mu_takes_the_speed_range_hinf_designs_that_hinf_tried_before(tmp_path, monkeypatch):
+    """One run's designs share their trials over the speed range: μ tries H∞ with the speed
+    uncertain before its own, and H∞'s design has made that one. Given H∞'s trials, μ's
+    design makes no H∞ synthesis of its own; without them it makes it again
+    (``_synthesise_enlarging`` counted), and the two μ controllers are the same matrices:
+    reusing a trial changes nothing but the work."""
+    import ambseal.design.recipes as recipes
+
+    cfg = load_rig(_rigid_rig(tmp_path))
+    sp, trials = design_spec(cfg), {}
+    design(cfg, "hinf", spec=sp, trials=trials)
+    made, real = [], recipes._synthesise_enlarging
+
+    def counted(c, method, *args):
+        made.append(method)
+        return real(c, method, *args)
+
+    monkeypatch.setattr(recipes, "_synthesise_enlarging", counted)
+    shared = design(cfg, "mu", spec=sp, trials=trials)
+    assert "hinf" not in made and "mu" in made
+    assert shared.speed_range_hz == (0.0, 400.0)
+    made.clear()
+    alone = design(cfg, "mu", spec=sp)
+    assert "hinf" in made
+    for a, b in zip((shared.K.A, shared.K.B, shared.K.C, shared.K.D),
+                    (alone.K.A, alone.K.B, alone.K.C, alone.K.D)):
+        np.testing.assert_array_equal(a, b)

@@ -208,10 +208,14 @@ def _controllers(cfg: RigConfig, spec, say, failed: dict,
         say(f"{m} designed", 1)
         return [d]
 
+    # the H∞ designs over the speed range that H∞'s design tries, μ's tries again
+    trials: dict = {}
+
     def robust(m: str) -> list[Designed]:
         say(f"designing {m}", 0)
         return guarded(m, lambda: Designed(design(cfg, m, spec=spec, allow_unstable=True,
-                                             progress=lambda msg: say(msg, 0))))
+                                             progress=lambda msg: say(msg, 0),
+                                             trials=trials)))
 
     if speed_scheduled(cfg):
         out = [Designed(design(cfg, "pid"))]

@@ -49,6 +49,8 @@ unstable (unless ``allow_unstable``).
 
 from __future__ import annotations
 
+import copy
+import json
 import time
 from dataclasses import dataclass, field
 from functools import partial
@@ -322,6 +324,7 @@ def design(
     spec: Any = None,
     progress: Any = None,
     enlarge: int = 2,
+    trials: dict | None = None,
 ) -> DesignResult:
     """Design a controller for a rig (thesis P5 §4).
 
@@ -366,6 +369,13 @@ def design(
         Automatic design steps when the full-order loop is unstable: the design model
         enlarged to keep a mode it left out, or a damping margin on a lightly damped mode
         it keeps (:func:`margin_for`, :func:`ambseal.design.plant.less_damped`).
+    trials : dict, optional
+        Shared by the designs of one rig and specification (the main job's): the H∞
+        designs tried over the speed range (with the speed uncertain, or at another
+        stability speed) are kept in it by their inputs, and the next design that tries
+        the same one takes it from there instead of designing it again — μ tries H∞'s,
+        which H∞'s own design has just made. The same result either way; None: nothing
+        kept.
 
     Returns
     -------
@@ -411,12 +421,15 @@ def design(
     t0 = time.perf_counter()
 
     def synthesise(c, into: list, m: str = method, speed=None, n_speed=None, level=None):
-        return _synthesise_enlarging(
-            c, m, p, w if m == method else sp.weights[m], unc, sp,
-            states if n_speed is None else n_speed,
-            None if omega is None else np.asarray(omega, float), reduce_to,
-            max_iter or sp.max_iter, sp.dk_order if dk_order is None else dk_order, dl,
-            enlarge if speed is None else 0, into, progress, speed, level)
+        args = (c, m, p, w if m == method else sp.weights[m], unc, sp,
+                states if n_speed is None else n_speed,
+                None if omega is None else np.asarray(omega, float), reduce_to,
+                max_iter or sp.max_iter, sp.dk_order if dk_order is None else dk_order, dl,
+                enlarge if speed is None else 0)
+        if trials is None or m != "hinf" or (speed is None and c is cfg):  # not a trial
+            return _synthesise_enlarging(*args, into, progress, speed, level)
+        return _tried(trials, args + (speed, level),
+                      lambda: _synthesise_enlarging(*args, into, progress, speed, level))
 
     r, check, n = synthesise(cfg, steps)
     moved = over = None
@@ -436,6 +449,29 @@ def design(
         delay=dl.to_dict(), steps=tuple(steps), notes=tuple(sp.notes),
         verdict=_verdict(method, r, check), omega=r.omega, stopping=r.stopping,
         design_speed_hz=moved, speed_range_hz=over)
+
+
+def _tried(trials: dict, inputs: tuple, make):
+    """``make()``'s result (or the SynthesisError or ModelError it raised) kept in
+    ``trials`` under its synthesis ``inputs``, taken from there when they were tried
+    before. The key spells the inputs out — the rig as its JSON, the weights and
+    uncertainty as their dicts, the frequency grid as its values; the specification by
+    identity (one per run), and with it the design delay, which the rig's rate and the
+    specification's band fix."""
+    cfg, m, p, w, unc, sp, n, om, reduce_to, max_iter, dk_order, _, *rest = inputs
+    key = (cfg.model_dump_json(), m, p, json.dumps(w.to_dict(), sort_keys=True, default=str),
+           json.dumps(unc, sort_keys=True, default=str), id(sp), n,
+           None if om is None else tuple(np.asarray(om, float).tolist()),
+           reduce_to, max_iter, dk_order, repr(rest))
+    if key not in trials:
+        try:
+            trials[key] = make()
+        except (SynthesisError, ModelError) as exc:
+            trials[key] = exc
+    got = trials[key]
+    if isinstance(got, Exception):
+        raise got
+    return copy.deepcopy(got)  # the next design may amend its check; this one's stays
 
 
 def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max_iter,

@@ -89,7 +89,8 @@ KNOWN = ("D–G–K follows rounding: its first step's SLSQP refinement of the s
          "another minimiser under each kernel set (peak 1.0045402 against 1.0045363), the "
          "K-step near γ_opt turns that into μ 0.7439 against 0.7447, and six steps later the "
          "blower's delivered μ is 0.587 against 0.621, its σ̄(S_o) peaks 7–12 % and its "
-         "currents 9–11 % apart")
+         "currents 9–11 % apart. No K-step reaches γ ≤ 1, the only norm that certifies its "
+         "level, so a step can jump back (0.582 → 0.665) and each path jumps elsewhere")
 
 
 def _both(pair, argv: list[str], tmp_path: Path, timeout: float) -> None:

@@ -134,6 +134,22 @@ def test_a_target_complex_dk_meets_skips_the_dgk_steps(complex_dk):
     assert "D-G-K" in {h["step"] for h in stepped.history} and stepped.mu < dk.mu
 
 
+def test_dgk_steps_end_at_the_first_that_meets_the_target():
+    """``target`` also ends the D–G–K phase: at the first step whose μ (re-checked) is at
+    or below it, whatever ``max_iter`` and ``patience`` allow, the rule saying so.
+    Reference: the same design without a target, whose steps go on past that μ (on
+    :func:`gain_plant`, complex D–K 1.72, D–G–K 1.653, 1.549, 1.547, 1.544)."""
+    P, w = gain_plant(), np.logspace(-2, 3, 6)
+    free = musyn_dgk(P, BLOCKS, 1, 1, w, max_iter=4, search=0)
+    steps = [h["mu"] for h in free.history if h["step"] == "D-G-K"]
+    complex_mu = min(h["mu"] for h in free.history if h["step"] == "D-K")
+    assert len(steps) > 1 and steps[0] < complex_mu
+    met = musyn_dgk(P, BLOCKS, 1, 1, w, max_iter=4, search=0, target=steps[0] * (1 + 1e-9))
+    assert [h["mu"] for h in met.history if h["step"] == "D-G-K"] == [steps[0]]
+    assert met.stopping["dgk"]["iterations"] == 1 and "target" in met.stopping["dgk"]["rule"]
+    assert met.mu == pytest.approx(steps[0], rel=1e-9) and met.mu > free.mu
+
+
 def test_design_mu_iteration_key_defaults_to_dgk():
     """[design.mu] iteration: "dgk" by default (the rig's real seal parameters), "dk" by
     --set; anything else refused naming the key."""
@@ -287,8 +303,8 @@ def test_musyn_dgk_defaults_reach_the_published_mixed_mu_spring_mass_result():
     1×1, complex 1×1 and 2×2 blocks) on python-control's F_l over 701 points log-spaced in
     10⁻³…10⁵ rad/s, and the worst-case performance by brute force over the uncertainty
     (k1 at 21 values of its range, the delay block on its unit circle), which the μ bound
-    must cover. Measured: complex D–K 1.082, D–G–K 0.941 (AB13MD agrees to 1e-4), worst
-    case 0.941 — the example's worst-case gain of its mixed-μ controller is 0.88 (MATLAB's
+    must cover. Measured: complex D–K 1.082, D–G–K 0.945 (AB13MD agrees to 1e-5), worst
+    case 0.945 — the example's worst-case gain of its mixed-μ controller is 0.88 (MATLAB's
     wcgain), not reached."""
     from slycot import ab13md
 

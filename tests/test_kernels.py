@@ -12,13 +12,11 @@ tolerance (μ and γ 2 %, σ̄(S_o) peaks 5 %, orbits and currents 5 %).
 
 The reference is the run itself under the other kernels: any difference beyond the
 tolerances is rounding carried into a design's path. The whole run is used, not
-``ambseal design --method mu`` alone: the μ design is ~85 % of the run's ~78 s of CPU
-(65 s of it), so a cheaper command saves little, and the zones and verdicts a user reads
-come from the judgement that follows it. Cost: two runs of ~78 s of CPU each, at once on
-two cores (~86 s wall on an idle 2-core machine, 150 s beside the rest of the suite):
-while D–G–K follows rounding the blower's comparison is an expected failure, so it runs
-with ``-m slow``, not in every run of the suite. Skipped where the processor offers no
-two kernel sets or ``OPENBLAS_CORETYPE`` does not select them (another BLAS).
+``ambseal design --method mu`` alone: the μ design is most of the run's CPU, so a cheaper
+command saves little, and the zones and verdicts a user reads come from the judgement
+that follows it. Cost: two runs of ~70 s of CPU each, at once on two cores. Skipped where
+the processor offers no two kernel sets or ``OPENBLAS_CORETYPE`` does not select them
+(another BLAS).
 """
 
 from __future__ import annotations
@@ -84,15 +82,6 @@ def _architecture(coretype: str) -> list[str]:
     return json.loads(out.stdout) if out.returncode == 0 else []
 
 
-#: Why the comparison fails today, measured with Haswell against SkylakeX kernels
-KNOWN = ("D–G–K follows rounding: its first step's SLSQP refinement of the scalings ends at "
-         "another minimiser under each kernel set (peak 1.0045402 against 1.0045363), the "
-         "K-step near γ_opt turns that into μ 0.7439 against 0.7447, and six steps later the "
-         "blower's delivered μ is 0.587 against 0.621, its σ̄(S_o) peaks 7–12 % and its "
-         "currents 9–11 % apart. No K-step reaches γ ≤ 1, the only norm that certifies its "
-         "level, so a step can jump back (0.582 → 0.665) and each path jumps elsewhere")
-
-
 def _both(pair, argv: list[str], tmp_path: Path, timeout: float) -> None:
     """``ambseal argv…`` in two processes at once, one per kernel set of ``pair``, each
     writing to ``tmp_path/<kernels>``; a run that does not exit 0 fails the test."""
@@ -112,22 +101,18 @@ def _both(pair, argv: list[str], tmp_path: Path, timeout: float) -> None:
                 proc.wait()
 
 
-@pytest.mark.slow
-def test_blower_delivers_the_same_answer_under_two_kernel_sets(tmp_path, request):
-    """Expected to fail on the comparison (``KNOWN``), strictly where that was measured:
-    with Haswell against SkylakeX kernels it must fail until D–G–K ends where rounding
-    cannot move it, and then the marker comes off. With another pair (Sandybridge against
-    Haswell, not measured) the comparison may hold and the test passes; a run that
-    crashes fails everywhere."""
+def test_blower_delivers_the_same_answer_under_two_kernel_sets(tmp_path):
+    """The blower's μ is designed by D–G–K (complex D–K's μ is above 1 there): its steps
+    went on past μ = 1, each following the rounding of the one before, to μ 0.587 under
+    Haswell kernels and 0.621 under SkylakeX, their σ̄(S_o) peaks 7–12 % apart and zone A
+    against B. D–G–K now ends at the first step that meets the target, built further from
+    γ_opt (:data:`ambseal.robust.dgk.DGK_BACKOFF`), where the two agree to 0.5 %."""
     pair = _kernel_pair()
     if pair is None:
         pytest.skip("no two OpenBLAS kernel sets on this processor (neither AVX2 nor AVX-512)")
-    request.node.add_marker(pytest.mark.xfail(strict=pair == ("Haswell", "SkylakeX"),
-                                              raises=AssertionError, reason=KNOWN))
     arch = [_architecture(c) for c in pair]
     if [[c.lower()] for c in pair] != [[a.lower() for a in x] for x in arch]:
         pytest.skip(f"OPENBLAS_CORETYPE does not select the kernels here: {pair} gave {arch}")
-    # a run that does not exit 0 is not the comparison: a failure even while it is known
     _both(pair, ["run", str(ROOT / "examples" / "blower.toml"), "--no-identify"], tmp_path,
           1200)
     metrics = [json.loads((tmp_path / c / "metrics.json").read_text()) for c in pair]

@@ -521,7 +521,8 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
     "MethodSpec.w1_corner_hz": ("Hz", "W_1: corner frequency"),
     "MethodSpec.orbit_um": ("µm", "unbalance-orbit demand (0: off)"),
     "MethodSpec.wf_rolloff_hz": ("Hz", "roll-off of the unbalance-force weight W_f"),
-    "MuSpec.max_iter": ("", "D–K iterations at most"),
+    "MuSpec.max_iter": ("", "a cap on each D–K phase's iterations (none: its stall rule "
+                            "ends it)"),
     "MuSpec.dk_order": ("", "order of the fitted D scales"),
     "MuSpec.iteration": ("", "``dgk``: D–G–K, real parameters kept real (Young 1996); "
                              "``dk``: complex D–K as the thesis"),

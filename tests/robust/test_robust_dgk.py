@@ -150,6 +150,34 @@ def test_dgk_steps_end_at_the_first_that_meets_the_target():
     assert met.mu == pytest.approx(steps[0], rel=1e-9) and met.mu > free.mu
 
 
+def test_dgk_steps_end_by_the_stall_rule_not_a_count(monkeypatch):
+    """Without ``max_iter`` the D–G–K phase ends by its stall rule alone, however many
+    steps each gain more than ``rtol``: an iteration cap would stop where the path happens
+    to be. Fault injection: the re-checked μ of the first 11 steps falls by 3 % a step
+    (more than rtol = 1 %) from 1.5, below complex D–K's 1.72, then stays; the phase
+    ends ``patience`` steps later, at the 13th step, the rule naming patience, the best
+    iterate (the 11th) kept."""
+    import ambseal.robust.dgk as dgk
+
+    P, w, real_check, seen = gain_plant(), np.logspace(-2, 3, 6), dgk._check, []
+
+    def check(P_, K, *args):
+        pk = real_check(P_, K, *args)
+        if len(seen) >= 13:  # the result's own re-check: as it is
+            return pk
+        seen.append(K)
+        return replace(pk, peak=1.5 * 0.97 ** min(len(seen) - 1, 10))
+
+    monkeypatch.setattr(dgk, "_check", check)
+    r = musyn_dgk(P, BLOCKS, 1, 1, w, search=0)
+    steps = [h for h in r.history if h["step"] == "D-G-K"]
+    assert len(steps) == 13 and r.stopping["dgk"]["iterations"] == 13
+    assert r.stopping["dgk"]["rule"].startswith("patience=2")
+    assert r.best_iteration == steps[10]["iteration"]
+    capped = musyn_dgk(P, BLOCKS, 1, 1, w, search=0, max_iter=4)
+    assert capped.stopping["dgk"] == {"iterations": 4, "rule": "max_iter=4"}
+
+
 def test_design_mu_iteration_key_defaults_to_dgk():
     """[design.mu] iteration: "dgk" by default (the rig's real seal parameters), "dk" by
     --set; anything else refused naming the key."""
@@ -161,6 +189,18 @@ def test_design_mu_iteration_key_defaults_to_dgk():
     assert sp.mu_iteration == "dk" and 'iteration = "dk"' in sp.to_toml()
     with pytest.raises(ConfigError, match="design.mu.iteration"):
         load_rig(None, ["design.mu.iteration=complex"])
+
+
+def test_design_mu_has_no_iteration_cap_unless_the_rig_sets_one():
+    """[design.mu] max_iter: none by default (each D–K phase ends by its stall rule, the
+    specification's TOML says so), a cap where the rig or --set gives one."""
+    from ambseal.config import load_rig
+    from ambseal.design.specs import design_spec
+
+    sp = design_spec(load_rig())
+    assert sp.max_iter is None and "max_iter =" not in sp.to_toml()
+    sp = design_spec(load_rig(None, ["design.mu.max_iter=3"]))
+    assert sp.max_iter == 3 and "max_iter = 3" in sp.to_toml()
 
 
 @pytest.mark.slow

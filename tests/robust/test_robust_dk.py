@@ -148,6 +148,31 @@ def test_one_iteration_returns_hinfsyn_and_says_why_it_stopped():
     assert r.stopping["search"]["granted"] == 0 and r.stopping["search"]["evaluations"] == 0
 
 
+def test_dk_iterations_end_by_the_stall_rule_not_a_count(monkeypatch):
+    """Without ``max_iter`` the D–K iterations end by their stall rule alone, however many
+    of them gain more than ``rtol``. Fault injection: the μ curve of the first 11
+    iterations is scaled to fall by 3 % an iteration (more than rtol = 1 %), then to
+    stay; the iterations end ``patience`` = 2 later, at the 13th, the rule naming
+    patience and the best iterate (the 11th) kept."""
+    import ambseal.robust.dk as dk
+
+    real_mu_step, seen = dk._mu_step, []
+
+    def mu_step(cl, *args):
+        mu_c, curve = real_mu_step(cl, *args)
+        seen.append(cl)
+        return mu_c, curve * (0.97 ** min(len(seen) - 1, 10) / np.max(curve))
+
+    monkeypatch.setattr(dk, "_mu_step", mu_step)
+    r = musyn(rp_plant(), [(1, 1), (1, 1)], 1, 1, search=0)
+    assert len(r.history) == 13 and r.stopping["dk"]["iterations"] == 13
+    assert r.stopping["dk"]["rule"].startswith("patience=2")
+    assert r.best_iteration == 10
+    seen.clear()
+    capped = musyn(rp_plant(), [(1, 1), (1, 1)], 1, 1, search=0, max_iter=3)
+    assert capped.stopping["dk"] == {"iterations": 3, "rule": "max_iter=3"}
+
+
 def test_musyn_gives_the_same_mu_and_controller_in_any_units():
     """Reference: μ(D M D⁻¹) = μ(M) for a constant D commuting with Δ (Packard & Doyle
     1993), so a change of units of the uncertainty channels (w_Δ × a, z_Δ ÷ a) must leave

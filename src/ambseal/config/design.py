@@ -55,7 +55,8 @@ and bounded (the bounds beside each key in the code, with their reasons).
     ``A`` (W_p, P5 Eq. 7), ``wu_gain``, ``wu_corner_hz``, ``wu_hf_gain`` (W_u, constant or
     high-pass), ``w1_gain``, ``w1_corner_hz`` (W_1), ``orbit_um`` (the unbalance-orbit demand
     in µm; 0 switches it off) and ``wf_rolloff_hz`` (the roll-off of its force weight W_f);
-    ``[design.mu]`` also ``max_iter`` and ``dk_order`` (D–K iterations, D-scale fit order)
+    ``[design.mu]`` also ``max_iter`` (a cap on the D–K iterations; none by default: they
+    end by their stall rule) and ``dk_order`` (D-scale fit order)
     and ``iteration``: ``"dgk"`` (default: D–G–K, the real parameters kept real in the
     synthesis, Young 1996) or ``"dk"`` (complex D–K, every block treated as complex).
 ``[design.rejection]``

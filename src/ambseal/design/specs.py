@@ -264,7 +264,11 @@ class DesignSpec:
         ``{parameter: fraction or (low, high)}`` (read-only).
     weights : Mapping
         ``{"hinf" | "mu" | "lpv": Weights}`` (read-only).
-    max_iter, dk_order : int
+    max_iter : int or None
+        ``[design.mu] max_iter``, a cap on each D–K / D–G–K phase's iterations; None (the
+        default): each phase ends by its stall rule or the target μ of 1
+        (:func:`~ambseal.robust.dgk.musyn_dgk`).
+    dk_order : int
     mu_iteration : {"dgk", "dk"}
         μ synthesis: D–G–K (real parameters kept real, Young 1996; its steps taken only
         where complex D–K leaves μ above 1) or complex D–K.
@@ -301,7 +305,7 @@ class DesignSpec:
     impulse_s: float
     uncertainty: Mapping
     weights: Mapping = field(repr=False)
-    max_iter: int = 6
+    max_iter: int | None = None
     dk_order: int = 2
     mu_iteration: str = "dgk"
     unbalance_plant: str = "running"
@@ -371,7 +375,9 @@ class DesignSpec:
         for method, w in self.weights.items():
             out += ["", f"[design.{method}]"] + _weight_lines(method, w, src)
             if method == "mu":
-                out += [f"max_iter = {self.max_iter}", f"dk_order = {self.dk_order}",
+                out += ([f"max_iter = {self.max_iter}"] if self.max_iter is not None
+                        else ["# max_iter: none, each D–K phase ends by its stall rule"])
+                out += [f"dk_order = {self.dk_order}",
                         f"iteration = {toml_string(self.mu_iteration)}"]
         return "\n".join(out) + "\n"
 
@@ -639,7 +645,7 @@ def design_spec(cfg, pressure_bar: float | None = None) -> DesignSpec:
         # read-only: one specification is shared by every stage of a run
         uncertainty=MappingProxyType(_uncertainty(cfg, d, rules, notes, p)),
         weights=MappingProxyType(weights),
-        max_iter=mu.max_iter or 6, dk_order=mu.dk_order if mu.dk_order is not None else 2,
+        max_iter=mu.max_iter, dk_order=mu.dk_order if mu.dk_order is not None else 2,
         mu_iteration=mu.iteration or "dgk",
         unbalance_plant=d.unbalance.plant or "running",
         sources=MappingProxyType(rules), notes=tuple(notes))

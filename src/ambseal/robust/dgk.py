@@ -48,6 +48,7 @@ to 0.910 (0.920 → 0.911 after reduction) for about 6 s more CPU (benchmarks/RE
 
 from __future__ import annotations
 
+import itertools
 import time
 from dataclasses import replace
 from typing import Any, Sequence
@@ -196,7 +197,7 @@ def _k_step(Ps, nmeas, ncon, level):
 
 @with_numerics_threads
 def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None, *,
-              order: int | str = "auto", max_iter: int = 8, rtol: float = 1e-2,
+              order: int | str = "auto", max_iter: int | None = None, rtol: float = 1e-2,
               patience: int = 2, backoff: float = 1.01, fit_tol: float = 0.05,
               search: int | str = "auto", search_backoff: float = 1.001,
               target: float | None = None, progress: Any = False) -> MusynResult:
@@ -227,8 +228,12 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
     order : int or "auto"
         D-scale fit order (0–4) of the D–K phase, as in :func:`~ambseal.robust.dk.musyn`;
         the D–G–K phase selects its orders automatically.
-    max_iter : int
-        Maximum number of iterations of each phase.
+    max_iter : int, optional
+        A cap on the number of iterations of each phase, for a caller who wants one. None
+        (default): each phase ends by its stall rule (``rtol``, ``patience``), or the
+        target; the stall rule always ends it, μ being bounded below (the published
+        spring–mass case, no target: D–G–K's ninth step, μ 0.945, the same controller as
+        at a cap of 8).
     rtol : float
         Relative improvement of peak μ below which an iteration counts as no progress.
     patience : int
@@ -244,7 +249,7 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
         A μ level the design asks for (1: robust performance): when complex D–K's μ is at
         or below it, its result is returned without D–G–K steps, which would only lower a
         bound already met; otherwise the D–G–K phase ends at the first step whose μ is at
-        or below it. None: D–G–K until its stall rule or ``max_iter``. The steps after
+        or below it. None: D–G–K until its stall rule. The steps after
         the target is met follow the machine's rounding: no K-step of the D–G-scaled plant
         reaches the norm 1 that certifies its level (the fitted ĝ puts the norm's floor
         within 0.1 % of 1), each lands where its H∞ synthesis near γ_opt and its scalings'
@@ -297,7 +302,7 @@ def musyn_dgk(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=N
     best = (dk.mu, dk.best_iteration, dk.K, dk.gamma, np.asarray(dk.mu_curve), dk.scalings)
     K, stall, rule = dk.K, 0, f"max_iter={max_iter}"
     first = len(history)
-    for it in range(first, first + max_iter):
+    for it in (itertools.count(first) if max_iter is None else range(first, first + max_iter)):
         mu_s = mussv(lft_lower(P, K, nmeas, ncon), sblocks, w, lower=False, peak=False)
         beta = float(np.max(mu_s.upper))
         if console is not None:

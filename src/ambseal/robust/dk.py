@@ -12,10 +12,11 @@ where each D-step's pointwise-optimal D of the current K is not the best D for t
 K-step. The μ reported is the upper bound of the kept controller re-checked between the grid
 points around its peaks (:func:`~ambseal.robust.mu.mu_peak`), and the result names that grid.
 
-Every stop is decided by counts and tolerances (iterations, ``patience``, γ evaluations,
-the search's work in γ evaluations × states³), never by a clock: the same problem gives the
-same controller on every machine, quiet or loaded; ``MusynResult.stopping`` says which rule
-ended each phase.
+Every stop is decided by tolerances and counts, never by a clock: the iterations end by
+their stall rule (``rtol``, ``patience``; an iteration cap only where the caller sets
+``max_iter``), the search by its γ evaluations and its work in γ evaluations × states³. The
+same problem gives the same controller on every machine, quiet or loaded;
+``MusynResult.stopping`` says which rule ended each phase.
 
 Simplifications (documented limits): real blocks are treated as complex and repeated scalars
 as independent scalars in the D-step (so D is diagonal, one scalar per channel group); the
@@ -24,6 +25,7 @@ reported μ is computed with the structure as given (mixed, repeated), which is 
 
 from __future__ import annotations
 
+import itertools
 import time
 from dataclasses import dataclass, field, replace
 from typing import Any, Sequence
@@ -353,9 +355,12 @@ class MusynResult:
 
 # --------------------------------------------------------------------------- D–K
 def _check_counts(**values) -> None:
-    """The stopping rules' counts and tolerances: ``max_iter`` and ``patience`` whole numbers
-    ≥ 1, ``rtol`` ≥ 0, ``backoff`` ≥ 1 and ``fit_tol`` > 0, all finite (ConfigError)."""
+    """The stopping rules' counts and tolerances: ``max_iter`` (or None) and ``patience``
+    whole numbers ≥ 1, ``rtol`` ≥ 0, ``backoff`` ≥ 1 and ``fit_tol`` > 0, all finite
+    (ConfigError)."""
     for name, x in values.items():
+        if name == "max_iter" and x is None:
+            continue
         if name in ("max_iter", "patience"):
             ok = isinstance(x, (int, np.integer)) and not isinstance(x, bool) and x >= 1
             want = "a whole number ≥ 1"
@@ -397,7 +402,7 @@ class _Lines:
 
 @with_numerics_threads
 def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None, *,
-          order: int | str = "auto", max_iter: int = 8, rtol: float = 1e-2,
+          order: int | str = "auto", max_iter: int | None = None, rtol: float = 1e-2,
           patience: int = 2, backoff: float = 1.01, fit_tol: float = 0.05,
           search: int | str = "auto", search_backoff: float = 1.001,
           progress: Any = False) -> MusynResult:
@@ -446,8 +451,11 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
         order whose fit, weighted by ``(μ(ω)/max μ)⁴``, is within ``fit_tol``
         (:func:`fit_dscale`; MATLAB ``musyn`` also chooses its fit orders by the fit's
         error).
-    max_iter : int
-        Maximum number of D–K iterations (the first is plain H∞).
+    max_iter : int, optional
+        A cap on the number of D–K iterations (the first is plain H∞), for a caller who
+        wants one. None (default): the iterations end by the stall rule (``rtol``,
+        ``patience``) alone, which always ends them: μ is bounded below, and each
+        ``patience`` iterations must lower the best μ by the factor ``1 − rtol``.
     rtol : float
         Relative improvement of peak μ below which an iteration counts as no progress.
     patience : int
@@ -527,7 +535,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     stall, rule = 0, f"max_iter={max_iter}"
     last = None  # the previous complexified μ, for a D-step redone with static fits
     near = None  # the last K-step's γ_opt
-    for it in range(max_iter):
+    for it in (itertools.count() if max_iter is None else range(max_iter)):
         Ps = _scaled_plant(P, cblocks, fits, nmeas, ncon) if fits else P
         try:
             # the last K-step's γ_opt starts the search: a D-step moves it by a few %

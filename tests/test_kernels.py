@@ -204,3 +204,46 @@ def test_comparison_holds_words_and_zones_exactly_and_numbers_to_their_tolerance
     other["controllers"]["lpv"]["sdp_shortfall"] = "the γ stage's SDP ended “feasible”"
     d = differences(lpv, other)
     assert len(d) == 1 and d[0].startswith("/controllers/lpv/sdp_shortfall: words differ")
+
+
+def _kernels_selectable():
+    """The kernel pair of :func:`_kernel_pair` where ``OPENBLAS_CORETYPE`` selects it, else
+    the test is skipped saying why."""
+    pair = _kernel_pair()
+    if pair is None:
+        pytest.skip("no two OpenBLAS kernel sets on this processor (neither AVX2 nor AVX-512)")
+    arch = [_architecture(c) for c in pair]
+    if [[c.lower()] for c in pair] != [[a.lower() for a in x] for x in arch]:
+        pytest.skip(f"OPENBLAS_CORETYPE does not select the kernels here: {pair} gave {arch}")
+    return pair
+
+
+def test_the_overhung_bands_channels_are_the_same_under_two_kernel_sets(tmp_path):
+    """The overhung compressor's band channels (every ΔA = B_θ C_θ of the frequencies μ
+    takes as uncertain, :func:`ambseal.design.modal_bands.with_modal_frequencies`, on its
+    36-state design model) computed under two kernel sets agree to 1e-9 of their largest
+    entry. With LAPACK's eigenvector phase, nine of its fourteen (433, 647, 885 Hz and six
+    above) differed between Haswell and SkylakeX kernels: a circular whirl's two
+    transverse components tie, and the kernels picked which one was made real."""
+    pair = _kernels_selectable()
+    script = tmp_path / "channels.py"
+    script.write_text(
+        "import sys, numpy as np\n"
+        "from ambseal.config import load_rig\n"
+        "from ambseal.design.modal_bands import mode_bands, with_modal_frequencies\n"
+        "from ambseal.design.plant import build_plant\n"
+        "cfg = load_rig(sys.argv[1])\n"
+        "bands = mode_bands(cfg, [0.0, 150.0, 305.0], design_speed_hz=300.0, states=36)\n"
+        "p = with_modal_frequencies(build_plant(cfg, states=36), bands)[0]\n"
+        "np.save(sys.argv[2], np.array([q.B @ q.C for k, q in p.parameters.items()\n"
+        "                               if k.endswith('omega_sq')]), allow_pickle=False)\n",
+        encoding="utf-8")
+    rig = ROOT / "examples" / "overhung_compressor.toml"
+    for c in pair:
+        subprocess.run([sys.executable, str(script), str(rig), str(tmp_path / f"{c}.npy")],
+                       env=_env(c), cwd=tmp_path, check=True, timeout=300)
+    a, b = (np.load(tmp_path / f"{c}.npy", allow_pickle=False) for c in pair)
+    assert a.shape == b.shape and a.shape[0] >= 4
+    for x, y in zip(a, b):
+        assert np.allclose(x, y, rtol=0, atol=1e-9 * np.abs(x).max())
+

@@ -175,3 +175,40 @@ def test_two_bands_of_one_frequency_are_two_modes():
                                              "mode_200Hz_2.omega_sq": w2 ** 2}).A)
     up = np.sort(lam.imag[lam.imag > 0])
     assert up[:2] == pytest.approx([w1, w2], rel=1e-6)
+
+
+def test_a_bands_channel_does_not_turn_with_the_eigenvectors_phase(monkeypatch):
+    """A complex eigenvector is known up to a phase, which LAPACK fixes by making its
+    largest component real; a circular whirl's two transverse components tie, and rounding
+    (the BLAS kernels) picks one. The band's LFT channel ΔA = B_θ C_θ must be the same
+    whichever phases ``eig`` returns. Reference: the channel on the same plant with
+    ``eig``'s eigenvectors turned by seeded random phases, on a general plant and on a
+    circular whirl (a gyroscopic disc on isotropic supports)."""
+    plant = _mixed_oscillators([(100.0, 0.01), (400.0, 0.005)])
+    # a circular whirl: a rigid disc on isotropic supports, gyroscopic (states x, y, ẋ, ẏ;
+    # |x| = |y| and |ẋ| = |ẏ| in each whirl's eigenvector)
+    k, c, g = (2 * np.pi * 400.0) ** 2, 2 * 0.005 * 2 * np.pi * 400.0, 300.0
+    A = np.block([[np.zeros((2, 2)), np.eye(2)],
+                  [-k * np.eye(2), -c * np.eye(2) - g * np.array([[0.0, 1.0], [-1.0, 0.0]])]])
+    circ = Plant(A, np.vstack([np.zeros((2, 2)), np.eye(2)]), np.eye(2, 4), np.zeros((2, 2)),
+                 ("i_A_x", "i_A_y"), ("y_A_x", "y_A_y"), ("x", "y", "vx", "vy"))
+    real_eig, rng = np.linalg.eig, np.random.default_rng(7)
+
+    def channel(p, band):
+        q = with_modal_frequencies(p, [band])[0].parameters[band.name]
+        return q.B @ q.C
+
+    forward = np.max(np.linalg.eigvals(A).imag) / (2 * np.pi)  # the forward whirl, Hz
+    for p, band in ((plant, ModeBand(400.0, 380.0, 410.0)),
+                    (circ, ModeBand(forward, forward - 20.0, forward + 10.0))):
+        ref = channel(p, band)
+
+        def turned(A):
+            lam, V = real_eig(A)
+            return lam, V * np.exp(1j * rng.uniform(-np.pi, np.pi, V.shape[1]))
+
+        monkeypatch.setattr(np.linalg, "eig", turned)
+        for _ in range(4):
+            assert np.allclose(channel(p, band), ref, rtol=0, atol=1e-9 * np.abs(ref).max())
+        monkeypatch.setattr(np.linalg, "eig", real_eig)
+

@@ -20,7 +20,9 @@ mode's frequency is one of the uncertain parameters, over the band it sweeps:
   into [[σ, ω_d], [−θ/ω_d, σ]], whose eigenvalues are σ ± j√θ exactly, and leaves every
   other eigenvalue where it was (it acts inside the mode's invariant subspace): θ is the
   mode's squared damped frequency, entering A affinely as the LFT of thesis P1 Eqs. 46–52
-  asks. The real parameter is one scalar block (Young's D–G–K keeps it real).
+  asks. The real parameter is one scalar block (Young's D–G–K keeps it real). v is known
+  only up to a phase, and the channel turns with it: the phase is fixed by a rule
+  (:func:`_fixed_phase`), not by the BLAS kernels' rounding.
 
 This is the modal-parameter uncertainty of flexible-structure robust control (natural
 frequencies as real parametric uncertainty in μ-synthesis; e.g. Balas & Doyle,
@@ -182,6 +184,31 @@ def bands_near(bands, f_hz: float) -> list[ModeBand]:
     return [b for b in bands if b.lo_hz / BAND_MATCH <= f_hz]
 
 
+#: Eigenvector components within this relative distance of the largest magnitude tie
+#: (:func:`_fixed_phase`): the two transverse directions of a circular whirl are equal in
+#: magnitude up to rounding.
+PHASE_TIE_RTOL = 1e-6
+
+
+def _fixed_phase(V):
+    """The eigenvectors ``V`` (columns), each turned by a phase so that its first component
+    within :data:`PHASE_TIE_RTOL` of its largest magnitude is real and positive.
+
+    A complex eigenvector is unique only up to such a phase, and LAPACK makes its largest
+    component real: on a rotor whose two transverse axes are alike, a circular whirl has
+    two largest components equal but for rounding, and which one LAPACK takes follows the
+    machine's BLAS kernels. The rank-one channel of :func:`with_modal_frequencies` (the
+    mode's real and imaginary parts) turns with that phase: under Haswell and SkylakeX
+    kernels nine of the overhung compressor example's fourteen bands had other channels,
+    so its μ designs under the two began from different uncertainty sets
+    (benchmarks/README.md, "A circular whirl's uncertain frequency").
+    """
+    mag = np.abs(V)
+    first = np.argmax(mag >= (1.0 - PHASE_TIE_RTOL) * mag.max(axis=0), axis=0)
+    pivot = V[first, np.arange(V.shape[1])]
+    return V * (np.abs(pivot) / np.where(pivot == 0, 1.0, pivot))
+
+
 def with_modal_frequencies(plant: Plant, bands) -> tuple[Plant, dict]:
     """The plant with each band's mode frequency as an LFT parameter (module docstring).
 
@@ -211,6 +238,7 @@ def with_modal_frequencies(plant: Plant, bands) -> tuple[Plant, dict]:
 
     A = np.asarray(plant.A, float)
     lam, V = np.linalg.eig(A)
+    V = _fixed_phase(V)
     W = np.linalg.inv(V)
     # a mode a damping margin (ambseal.design.plant.less_damped) took below zero damping is
     # still the band's mode: with it left out, a design given both remedies for one mode

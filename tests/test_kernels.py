@@ -82,6 +82,18 @@ def _architecture(coretype: str) -> list[str]:
     return json.loads(out.stdout) if out.returncode == 0 else []
 
 
+def _kernels_selectable():
+    """The kernel pair of :func:`_kernel_pair` where ``OPENBLAS_CORETYPE`` selects it, else
+    the test is skipped saying why."""
+    pair = _kernel_pair()
+    if pair is None:
+        pytest.skip("no two OpenBLAS kernel sets on this processor (neither AVX2 nor AVX-512)")
+    arch = [_architecture(c) for c in pair]
+    if [[c.lower()] for c in pair] != [[a.lower() for a in x] for x in arch]:
+        pytest.skip(f"OPENBLAS_CORETYPE does not select the kernels here: {pair} gave {arch}")
+    return pair
+
+
 def _both(pair, argv: list[str], tmp_path: Path, timeout: float) -> None:
     """``ambseal argv…`` in two processes at once, one per kernel set of ``pair``, each
     writing to ``tmp_path/<kernels>``; a run that does not exit 0 fails the test."""
@@ -107,12 +119,7 @@ def test_blower_delivers_the_same_answer_under_two_kernel_sets(tmp_path):
     Haswell kernels and 0.621 under SkylakeX, their σ̄(S_o) peaks 7–12 % apart and zone A
     against B. D–G–K now ends at the first step that meets the target, built further from
     γ_opt (:data:`ambseal.robust.dgk.DGK_BACKOFF`), where the two agree to 0.5 %."""
-    pair = _kernel_pair()
-    if pair is None:
-        pytest.skip("no two OpenBLAS kernel sets on this processor (neither AVX2 nor AVX-512)")
-    arch = [_architecture(c) for c in pair]
-    if [[c.lower()] for c in pair] != [[a.lower() for a in x] for x in arch]:
-        pytest.skip(f"OPENBLAS_CORETYPE does not select the kernels here: {pair} gave {arch}")
+    pair = _kernels_selectable()
     _both(pair, ["run", str(ROOT / "examples" / "blower.toml"), "--no-identify"], tmp_path,
           1200)
     metrics = [json.loads((tmp_path / c / "metrics.json").read_text()) for c in pair]
@@ -129,12 +136,7 @@ def test_the_flywheels_lpv_at_10_khz_is_the_same_under_two_kernel_sets(tmp_path)
     responses within 2 % of their largest gain at every table speed. Uncentred (R and S of
     lpvsyn's γ stage alone) the SkylakeX kernels give another controller, which no
     discretisation runs at 10 kHz (``design`` exits 2)."""
-    pair = _kernel_pair()
-    if pair is None:
-        pytest.skip("no two OpenBLAS kernel sets on this processor (neither AVX2 nor AVX-512)")
-    arch = [_architecture(c) for c in pair]
-    if [[c.lower()] for c in pair] != [[a.lower() for a in x] for x in arch]:
-        pytest.skip(f"OPENBLAS_CORETYPE does not select the kernels here: {pair} gave {arch}")
+    pair = _kernels_selectable()
     text, n = re.subn(r"(?m)^sample_rate_hz\s*=.*$", "sample_rate_hz = 10000.0",
                       (ROOT / "examples" / "flywheel.toml").read_text(encoding="utf-8"))
     assert n == 1
@@ -206,25 +208,14 @@ def test_comparison_holds_words_and_zones_exactly_and_numbers_to_their_tolerance
     assert len(d) == 1 and d[0].startswith("/controllers/lpv/sdp_shortfall: words differ")
 
 
-def _kernels_selectable():
-    """The kernel pair of :func:`_kernel_pair` where ``OPENBLAS_CORETYPE`` selects it, else
-    the test is skipped saying why."""
-    pair = _kernel_pair()
-    if pair is None:
-        pytest.skip("no two OpenBLAS kernel sets on this processor (neither AVX2 nor AVX-512)")
-    arch = [_architecture(c) for c in pair]
-    if [[c.lower()] for c in pair] != [[a.lower() for a in x] for x in arch]:
-        pytest.skip(f"OPENBLAS_CORETYPE does not select the kernels here: {pair} gave {arch}")
-    return pair
-
-
 def test_the_overhung_bands_channels_are_the_same_under_two_kernel_sets(tmp_path):
     """The overhung compressor's band channels (every ΔA = B_θ C_θ of the frequencies μ
     takes as uncertain, :func:`ambseal.design.modal_bands.with_modal_frequencies`, on its
     36-state design model) computed under two kernel sets agree to 1e-9 of their largest
-    entry. With LAPACK's eigenvector phase, nine of its fourteen (433, 647, 885 Hz and six
-    above) differed between Haswell and SkylakeX kernels: a circular whirl's two
-    transverse components tie, and the kernels picked which one was made real."""
+    entry. With LAPACK's eigenvector phase they differed between Haswell and SkylakeX
+    kernels (nine of the fourteen of the run's design model: 433, 647, 885 Hz and six
+    above): a circular whirl's two transverse components tie, and the kernels picked which
+    one was made real."""
     pair = _kernels_selectable()
     script = tmp_path / "channels.py"
     script.write_text(
@@ -246,4 +237,3 @@ def test_the_overhung_bands_channels_are_the_same_under_two_kernel_sets(tmp_path
     assert a.shape == b.shape and a.shape[0] >= 4
     for x, y in zip(a, b):
         assert np.allclose(x, y, rtol=0, atol=1e-9 * np.abs(x).max())
-

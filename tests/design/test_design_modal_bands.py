@@ -198,17 +198,15 @@ def test_a_bands_channel_does_not_turn_with_the_eigenvectors_phase(monkeypatch):
         q = with_modal_frequencies(p, [band])[0].parameters[band.name]
         return q.B @ q.C
 
+    def turned(A):
+        lam, V = real_eig(A)
+        return lam, V * np.exp(1j * rng.uniform(-np.pi, np.pi, V.shape[1]))
+
     forward = np.max(np.linalg.eigvals(A).imag) / (2 * np.pi)  # the forward whirl, Hz
     for p, band in ((plant, ModeBand(400.0, 380.0, 410.0)),
                     (circ, ModeBand(forward, forward - 20.0, forward + 10.0))):
         ref = channel(p, band)
-
-        def turned(A):
-            lam, V = real_eig(A)
-            return lam, V * np.exp(1j * rng.uniform(-np.pi, np.pi, V.shape[1]))
-
         monkeypatch.setattr(np.linalg, "eig", turned)
         for _ in range(4):
             assert np.allclose(channel(p, band), ref, rtol=0, atol=1e-9 * np.abs(ref).max())
         monkeypatch.setattr(np.linalg, "eig", real_eig)
-

@@ -205,8 +205,8 @@ def _fixed_phase(V):
     """
     mag = np.abs(V)
     first = np.argmax(mag >= (1.0 - PHASE_TIE_RTOL) * mag.max(axis=0), axis=0)
-    pivot = V[first, np.arange(V.shape[1])]
-    return V * (np.abs(pivot) / np.where(pivot == 0, 1.0, pivot))
+    pivot = V[first, np.arange(V.shape[1])]  # a largest component: never zero
+    return V * (np.abs(pivot) / pivot)
 
 
 def with_modal_frequencies(plant: Plant, bands) -> tuple[Plant, dict]:

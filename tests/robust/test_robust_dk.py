@@ -8,7 +8,10 @@ import control as ct
 
 from ambseal.robust._dscale import (
     SEARCH_EVALS_PER_PARAMETER,
+    SEARCH_STALL_EVALS_PER_PARAMETER,
+    SEARCH_STALL_RTOL,
     SEARCH_WORK,
+    _search_dscales,
     _search_evals,
     _tf_to_theta,
 )
@@ -195,16 +198,16 @@ def test_musyn_gives_the_same_mu_and_controller_in_any_units():
 
 def test_start_search_work_rule_is_a_count():
     """Reference: the rule itself (``START_WORK`` in γ evaluations × states³). Two scales
-    on the largest plant within the limit get ``START_EVALS_PER_SCALE`` evaluations each,
-    one state more gets none (the RMS balance alone), as does ``search=0``; an explicit
-    search count caps the start's too."""
+    on the largest plant whose estimate (``START_EVALS_PER_SCALE`` evaluations each) is
+    within the limit get the start with no cap, one state more gets none (the RMS balance
+    alone), as does ``search=0``; an explicit search count caps the start's."""
     from ambseal.robust._dscale import START_EVALS_PER_SCALE, START_WORK, _start_evals
 
     cb = [(1, 1), (1, 1), (2, 2)]
     full = 2 * START_EVALS_PER_SCALE
     edge = int((START_WORK / full) ** (1 / 3))
     assert full * edge ** 3 <= START_WORK < full * (edge + 1) ** 3
-    assert _start_evals("auto", cb, edge) == full
+    assert _start_evals("auto", cb, edge) is None  # no cap: it ends where it converged
     assert _start_evals("auto", cb, edge + 1) == 0
     assert _start_evals(0, cb, 4) == 0 and _start_evals(7, cb, 4) == 7
 
@@ -219,12 +222,47 @@ def test_search_work_rule_is_a_count():
     full = SEARCH_EVALS_PER_PARAMETER * n
     edge = int((SEARCH_WORK / full) ** (1 / 3))
     assert full * edge ** 3 <= SEARCH_WORK < full * (edge + 1) ** 3
-    assert _search_evals("auto", fits, edge)[0] == full
+    assert _search_evals("auto", fits, edge) == (None, "auto: 3 parameters, no cap")
     granted, rule = _search_evals("auto", fits, edge + 1)
     assert granted == 0 and "not started" in rule
     assert _search_evals(7, fits, edge + 1) == (7, "search=7")
     assert _search_evals(0, fits, edge) == (0, "search=0")
     assert _search_evals("auto", [], edge)[0] == 0
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")  # the simplex keeps expanding
+def test_the_d_search_ends_by_its_stall_rule_not_a_count(monkeypatch):
+    """Reference: the stall rule in closed form. Fault injection: every γ evaluation
+    returns ``1 + 0.5·exp(−k/400)`` at its k-th call, wherever the simplex is, so the
+    best γ keeps falling and Nelder–Mead never converges. With no cap the search must
+    end at the first k where the best γ fell by less than ``SEARCH_STALL_RTOL`` over the
+    last ``SEARCH_STALL_EVALS_PER_PARAMETER`` evaluations per parameter (1 896 here, for
+    three parameters), not at a count of evaluations (before: 50 per parameter, 150); a
+    caller's cap still ends it at its count."""
+    import ambseal.robust._dscale as ds
+
+    calls = [0]
+
+    def gamma_opt(Ps, nmeas, ncon, rtol, near):
+        calls[0] += 1
+        return 1 + 0.5 * np.exp(-calls[0] / 400)
+
+    monkeypatch.setattr(ds, "hinf_gamma_opt", gamma_opt)
+    monkeypatch.setattr(ds, "_scaled_plant", lambda *args: None)
+    monkeypatch.setattr(ds, "_realize", lambda *args: None)
+    fits = [ct.tf([1.0, 2.0], [1.0, 3.0])]  # three parameters
+    window = SEARCH_STALL_EVALS_PER_PARAMETER * 3
+    k = np.arange(window + 1, 100_000)
+    g = 1 + 0.5 * np.exp(-k / 400)
+    stop = int(k[np.argmax(g >= (1 + 0.5 * np.exp(-(k - window) / 400))
+                           * (1 - SEARCH_STALL_RTOL))])
+    assert stop > 10 * SEARCH_EVALS_PER_PARAMETER * 3
+    _, gamma, n, rule = _search_dscales(None, [(1, 1), (2, 2)], fits, 1, 1)
+    assert n == stop and rule.startswith("stalled")
+    assert gamma == pytest.approx(1 + 0.5 * np.exp(-stop / 400), rel=1e-12)
+    calls[0] = 0
+    assert _search_dscales(None, [(1, 1), (2, 2)], fits, 1, 1, evals=150)[2:] == \
+        (150, "the cap of 150 evaluations reached")
 
 
 def test_dscale_parameters_round_trip():

@@ -197,9 +197,10 @@ def _balance_channels(P, cblocks, nmeas, ncon, w, evals=0):
        block j's z_Δ rows of P(jω) into the non-Δ inputs ``[w, u]`` and ``c_j`` the same of
        its w_Δ columns seen at the non-Δ outputs ``[z, y]`` (a block with no such path
        keeps 1): channels in other units (z_Δ·a, w_Δ/a) scale r_j by a and c_j by 1/a.
-    2. From there, at most ``evals`` γ evaluations of Nelder–Mead over log b for the
-       smallest γ_opt of ``P_b`` (the best constant D of the H∞ problem; 0: none):
-       translation in log b, the change of units, leaves the search unchanged.
+    2. From there, Nelder–Mead over log b for the smallest γ_opt of ``P_b`` (the best
+       constant D of the H∞ problem), until its simplex has converged (1 % in log b) or,
+       where ``evals`` is a number, at most that many γ evaluations (0: none): translation
+       in log b, the change of units, leaves the search unchanged.
     """
     nzd = sum(c for _, c in cblocks[:-1])
     nwd = sum(r for r, _ in cblocks[:-1])
@@ -242,14 +243,17 @@ def _balance_channels(P, cblocks, nmeas, ncon, w, evals=0):
         near[0] = g if near[0] is None else min(near[0], g)
         return g
 
-    if evals > x.size + 1:
-
+    if evals is None or evals > x.size + 1:
         # first simplex: each log b moved by 1 (a factor e): the RMS balance is a start,
-        # not the optimum, which lies a decade or two away on plants with integrators
+        # not the optimum, which lies a decade or two away on plants with integrators.
+        # It ends where the simplex has converged (1 % in log b, 1e-4 in γ), or at a
+        # caller's count
         g0 = gamma(x)
-        res = minimize(gamma, x, method="Nelder-Mead",
-                       options={"maxfev": int(evals) - 1, "xatol": 1e-2, "fatol": 1e-4,
-                                "initial_simplex": np.vstack([x, x + np.eye(x.size)])})
+        options = {"xatol": 1e-2, "fatol": 1e-4,
+                   "initial_simplex": np.vstack([x, x + np.eye(x.size)])}
+        if evals is not None:
+            options["maxfev"] = int(evals) - 1
+        res = minimize(gamma, x, method="Nelder-Mead", options=options)
         if np.isfinite(res.fun) and res.fun < g0:
             x = np.asarray(res.x, float)
     return scaled(x), [float(np.exp(v)) for v in x], count[0]
@@ -281,11 +285,21 @@ def _tf_to_theta(tf):
     return np.array(th), order
 
 
-#: D search: Nelder–Mead evaluations per parameter of the fitted D scales. On Skogestad &
-#: Postlethwaite's distillation problem (18 parameters, D–K started from the balanced
-#: channels; ``musyn(search=N)``) 450 γ evaluations reached μ 1.002, 700 0.986, 900 0.970
-#: and 1200 0.962, below the published optimum 0.9737: 50 per parameter is within 1 %.
+#: D search's work estimate, in Nelder–Mead evaluations per parameter of the fitted D
+#: scales, by which ``search="auto"`` decides whether to start it (``SEARCH_WORK``). On
+#: Skogestad & Postlethwaite's distillation problem (18 parameters, D–K started from the
+#: balanced channels; ``musyn(search=N)``) 450 γ evaluations reached μ 1.002, 700 0.986,
+#: 900 0.970 and 1200 0.962, below the published optimum 0.9737.
 SEARCH_EVALS_PER_PARAMETER = 50
+#: D search's stall rule: it ends when its best γ_opt fell by less than
+#: ``SEARCH_STALL_RTOL`` over the last ``SEARCH_STALL_EVALS_PER_PARAMETER`` evaluations per
+#: parameter — D–K's own rule (``rtol`` within ``patience`` steps) with a simplex's
+#: evaluations as the steps. Measured on the best γ of three published problems searched
+#: without a cap (benchmarks/README.md, "The D search ends by its stall rule"): 0.1 % over
+#: 10 per parameter ends the distillation column's search near 1 450 evaluations at γ
+#: 0.960, 0.2 % above where 5 000 evaluations reach (0.958).
+SEARCH_STALL_RTOL = 1e-3
+SEARCH_STALL_EVALS_PER_PARAMETER = 30
 #: D search: the first simplex moves each parameter (a logarithm) by this much, a factor e,
 #: as the best-constant-D start moves its log D (:func:`_balance_channels`): a D–K stall
 #: leaves the best D's sections a fair way from the fitted ones, and a small simplex spends
@@ -293,30 +307,38 @@ SEARCH_EVALS_PER_PARAMETER = 50
 #: from a first simplex of 0.3 reached μ 0.985, of 0.6 0.986, of 0.8 … 1.2 0.979 … 0.962,
 #: of 1.5 0.999 and of 2 0.984.
 SEARCH_SIMPLEX_STEP = 1.0
-#: The work ``search="auto"`` may spend, counted in γ evaluations × n³, n the states of the
-#: scaled plant: a γ evaluation (Riccati equations and Hamiltonian eigenvalues of the scaled
-#: plant) costs ∝ n³. A count, not a clock, so the same problem gets the same search on
-#: every machine, quiet or loaded. The distillation column's full search is 900 × 22³ ≈
-#: 9.6·10⁶; on a 92-state scaled plant (10 parameters) it would be
-#: 500 × 92³ ≈ 3.9·10⁸, at a K-step of 0.4 s minutes for a μ 0.1 % lower
-#: (benchmarks/README.md, bench_dk): the limit lies between.
+#: The work ``search="auto"`` may expect to spend, counted in γ evaluations × n³, n the
+#: states of the scaled plant: a γ evaluation (Riccati equations and Hamiltonian
+#: eigenvalues of the scaled plant) costs ∝ n³. The search starts when its estimate,
+#: ``SEARCH_EVALS_PER_PARAMETER`` evaluations per parameter, is within it: a decision by
+#: the problem's size, not a clock, so the same problem gets the same search on every
+#: machine, quiet or loaded. The distillation column's estimate is 900 × 22³ ≈ 9.6·10⁶;
+#: on a 92-state scaled plant (10 parameters) it would be 500 × 92³ ≈ 3.9·10⁸, at a
+#: K-step of 0.4 s minutes for a μ 0.1 % lower (benchmarks/README.md, bench_dk): the
+#: limit lies between.
 SEARCH_WORK = 1e8
 
 
-def _search_dscales(P, cblocks, fits, nmeas, ncon, evals, restarts=2):
-    """Direct search (Nelder–Mead, at most ``evals`` γ evaluations) over the section
-    parameters of the fitted D scales for the smallest γ_opt of ``D P D⁻¹`` (γ to
-    ``SEARCH_GAMMA_RTOL``).
+class _Stalled(Exception):
+    """Raised inside a Nelder–Mead objective to end the search by its stall rule."""
+
+
+def _search_dscales(P, cblocks, fits, nmeas, ncon, evals=None):
+    """Direct search (Nelder–Mead) over the section parameters of the fitted D scales for
+    the smallest γ_opt of ``D P D⁻¹`` (γ to ``SEARCH_GAMMA_RTOL``).
 
     D–K stalls above the μ-optimum because each D-step fits the pointwise-optimal D of the
     *current* K; this searches the same rational D's for the best K-step directly. Every
     parameter vector is a stable, minimum-phase D (:func:`_logmag`), and γ_opt of the scaled
-    problem bounds μ of its optimal controller at every frequency. When Nelder–Mead
-    converges before the evaluations run out it restarts from its best point with a fresh
-    simplex (at most ``restarts`` times): a converged simplex in a dozen dimensions has
-    often collapsed onto a subspace (Lagarias et al. 1998; the restart is the classical
-    remedy, Kelley 1999). Returns ``(fits, γ_opt, evaluations, rule)``, with ``fits`` None
-    when no better D was found and ``rule`` the one that ended the search.
+    problem bounds μ of its optimal controller at every frequency. The search ends by its
+    stall rule (``SEARCH_STALL_RTOL`` over ``SEARCH_STALL_EVALS_PER_PARAMETER`` evaluations
+    per parameter), or when a restart lowers γ by less than 1e-4: when Nelder–Mead
+    converges it restarts from its best point with a fresh simplex, since a converged
+    simplex in a dozen dimensions has often collapsed onto a subspace (Lagarias et al.
+    1998; the restart is the classical remedy, Kelley 1999). Both rules end it: γ_opt is
+    bounded below. ``evals``: None (no cap), or at most that many γ evaluations, a
+    caller's cap. Returns ``(fits, γ_opt, evaluations, rule)``, with ``fits`` None when no
+    better D was found and ``rule`` the one that ended the search.
     """
     parts = [_tf_to_theta(f) for f in fits]
     cuts = np.cumsum([0] + [th.size for th, _ in parts])
@@ -325,6 +347,8 @@ def _search_dscales(P, cblocks, fits, nmeas, ncon, evals, restarts=2):
         return [(x[a:b], od) for (_, od), a, b in zip(parts, cuts[:-1], cuts[1:])]
 
     best = {"x": None, "g": np.inf, "n": 0}
+    trail = []  # the best γ after each evaluation, for the stall rule
+    window = SEARCH_STALL_EVALS_PER_PARAMETER * int(cuts[-1])
 
     def gamma(x):
         best["n"] += 1
@@ -332,27 +356,36 @@ def _search_dscales(P, cblocks, fits, nmeas, ncon, evals, restarts=2):
             Ps = _scaled_plant(P, cblocks, [_realize(*t) for t in sections(x)], nmeas, ncon)
             g = hinf_gamma_opt(Ps, nmeas, ncon, rtol=SEARCH_GAMMA_RTOL, near=near[0])
         except (SynthesisError, ModelError, ValueError, np.linalg.LinAlgError):
-            return np.inf
-        near[0] = g if near[0] is None else min(near[0], g)
+            g = np.inf
+        else:
+            near[0] = g if near[0] is None else min(near[0], g)
         if g < best["g"]:
             best.update(x=np.array(x, float), g=g)
+        trail.append(best["g"])
+        if len(trail) > window and not trail[-1] < trail[-1 - window] * (1 - SEARCH_STALL_RTOL):
+            raise _Stalled
         return g
 
     x0 = np.concatenate([th for th, _ in parts])
     near = [None]
     g0 = gamma(x0)
     x = x0
-    rule = f"{int(restarts)} restarts done"
-    for _ in range(int(restarts) + 1):
-        left = int(evals) - best["n"]
-        if left <= x.size + 1:
-            rule = "evaluations spent"
-            break
-        simplex = np.vstack([x, x + SEARCH_SIMPLEX_STEP * np.eye(x.size)])
+    while True:
+        options = {"adaptive": True, "xatol": 1e-3, "fatol": 1e-5,
+                   "initial_simplex": np.vstack([x, x + SEARCH_SIMPLEX_STEP * np.eye(x.size)])}
+        if evals is not None:
+            left = int(evals) - best["n"]
+            if left <= x.size + 1:
+                rule = f"the cap of {int(evals)} evaluations reached"
+                break
+            options["maxfev"] = left
         g_start = best["g"]
-        minimize(gamma, x, method="Nelder-Mead",
-                 options={"maxfev": left, "adaptive": True, "xatol": 1e-3,
-                          "fatol": 1e-5, "initial_simplex": simplex})
+        try:
+            minimize(gamma, x, method="Nelder-Mead", options=options)
+        except _Stalled:
+            rule = (f"stalled: the best γ fell by less than {SEARCH_STALL_RTOL:g} over the "
+                    f"last {window} evaluations")
+            break
         if not best["g"] < g_start * (1 - 1e-4):
             rule = "converged: a restart lowered γ by less than 1e-4"
             break
@@ -363,9 +396,10 @@ def _search_dscales(P, cblocks, fits, nmeas, ncon, evals, restarts=2):
         best["n"], rule
 
 
-def _search_evals(search, fits, n_states: int) -> tuple[int, str]:
-    """γ evaluations granted to the D search (0: no search) on a scaled plant of
-    ``n_states`` states, and the rule that granted them; see :func:`musyn`."""
+def _search_evals(search, fits, n_states: int) -> tuple[int | None, str]:
+    """The γ evaluations granted to the D search on a scaled plant of ``n_states``
+    states — 0: no search, None: no cap, it ends by its own rules — and the rule that
+    granted them; see :func:`musyn`."""
     if not fits:
         return 0, "no D scales fitted"
     if search == 0:
@@ -373,33 +407,37 @@ def _search_evals(search, fits, n_states: int) -> tuple[int, str]:
     n = sum(_tf_to_theta(f)[0].size for f in fits)
     if search != "auto":
         return int(search), f"search={int(search)}"
-    full = SEARCH_EVALS_PER_PARAMETER * n
-    work = full * float(n_states) ** 3
+    estimate = SEARCH_EVALS_PER_PARAMETER * n
+    work = estimate * float(n_states) ** 3
     if work <= SEARCH_WORK:
-        return full, f"auto: {SEARCH_EVALS_PER_PARAMETER} per parameter of {n}"
-    return 0, (f"auto: not started, {full} evaluations on a {n_states}-state plant exceed "
-               f"the work limit ({work:.2g} > {SEARCH_WORK:.0e} evaluations × states³)")
+        return None, f"auto: {n} parameters, no cap"
+    return 0, (f"auto: not started, an estimated {estimate} evaluations on a {n_states}-state "
+               f"plant exceed the work limit ({work:.2g} > {SEARCH_WORK:.0e} evaluations × "
+               f"states³)")
 
 
-#: The best-constant-D start: Nelder–Mead evaluations per scale (a search in one to a few
-#: dimensions from the RMS balance, converged to 1 % in log D within about 20).
+#: The best-constant-D start's work estimate, in Nelder–Mead evaluations per scale (a
+#: search in one to a few dimensions from the RMS balance, converged to 1 % in log D
+#: within about 20), by which ``search="auto"`` decides whether to start it.
 START_EVALS_PER_SCALE = 20
-#: The work the best-constant-D start may spend (γ evaluations × n³). It pays where the
-#: RMS balance is far off, on small plants with near-integrating weights (Skogestad &
-#: Postlethwaite's column: D–K ends at μ 1.11 from the RMS balance, 0.98 from the best
-#: constant D); on the back-to-back compressor's 94-state plant its 80 evaluations took
-#: 9.4 s for a first synthesis at μ 0.4850 instead of 0.4872 and the same delivered design.
+#: The work the best-constant-D start may expect to spend (γ evaluations × n³). It pays
+#: where the RMS balance is far off, on small plants with near-integrating weights
+#: (Skogestad & Postlethwaite's column: D–K ends at μ 1.11 from the RMS balance, 0.98
+#: from the best constant D); on the back-to-back compressor's 94-state plant its 80
+#: evaluations took 9.4 s for a first synthesis at μ 0.4850 instead of 0.4872 and the same
+#: delivered design.
 START_WORK = 1e7
 
 
-def _start_evals(search, cblocks, n_states: int) -> int:
-    """γ evaluations granted to :func:`_balance_channels`' search for the best constant D
-    (0: none): ``START_EVALS_PER_SCALE`` per scale when ``search`` is not 0 and their
-    work, evaluations × ``n_states``³, is within ``START_WORK``."""
-    evals = START_EVALS_PER_SCALE * (len(cblocks) - 1)
-    if search == 0 or evals * float(n_states) ** 3 > START_WORK:
+def _start_evals(search, cblocks, n_states: int) -> int | None:
+    """γ evaluations granted to :func:`_balance_channels`' search for the best constant D:
+    0 (none) when ``search`` is 0 or its estimate (``START_EVALS_PER_SCALE`` per scale) ×
+    ``n_states``³ exceeds ``START_WORK``; else None with ``"auto"`` (no cap: it ends where
+    its simplex has converged), and a number ``search`` caps it."""
+    estimate = START_EVALS_PER_SCALE * (len(cblocks) - 1)
+    if search == 0 or estimate * float(n_states) ** 3 > START_WORK:
         return 0
-    return evals if search == "auto" else min(evals, int(search))
+    return None if search == "auto" else int(search)
 
 
 def _search_step(P, blocks, cblocks, nmeas, ncon, w, best, evals, backoff, history,

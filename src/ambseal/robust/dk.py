@@ -416,8 +416,9 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     w_Δ × 1e5, z_Δ ÷ 1e5: μ 1.34 instead of 0.98). D–K starts instead from the constant
     D of :func:`~ambseal.robust._dscale._balance_channels` — an RMS balance of each
     block's rows and columns, then Nelder–Mead for the D of the smallest γ_opt
-    (``START_EVALS_PER_SCALE`` γ evaluations per scale when their work is within
-    ``START_WORK``; none with ``search=0``) — the same plant in any units of the
+    (started when its estimated work, ``START_EVALS_PER_SCALE`` γ evaluations per scale,
+    is within ``START_WORK``, and ended where its simplex has converged; none with
+    ``search=0``) — the same plant in any units of the
     channels, so μ and the controller are too (to rounding; tests: 12 decades).
 
     The steps, after Balas et al. (1993) and MATLAB's ``musyn`` (D-K Iteration Process,
@@ -466,16 +467,18 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     fit_tol : float
         Relative magnitude tolerance of the automatic D-scale fit order.
     search : int or "auto"
-        The D search after the iterations: at most this many γ evaluations (0: none).
-        ``"auto"`` (default): 50 per parameter of the fitted scales when their work, γ
-        evaluations × n³ with n the states of the scaled plant, is within ``SEARCH_WORK``
-        (10⁸), else none: a γ evaluation costs ∝ n³, so this bounds the search's cost by
-        a count that is the same on every machine. Its controller (at
-        ``search_backoff``) is kept when its μ is lower, recorded in ``history`` with
-        ``step = "D search"``. On Skogestad & Postlethwaite's distillation problem
-        (§8.12.4) D–K stalls at μ 1.09 and the search comes within 1 % of the published
-        μ-optimal 0.974 (benchmarks/bench_dk.py); on plants of 80 states or more it is not
-        started.
+        The D search after the iterations. ``"auto"`` (default): started when its
+        estimated work, ``SEARCH_EVALS_PER_PARAMETER`` (50) γ evaluations per parameter of
+        the fitted scales × n³ with n the states of the scaled plant, is within
+        ``SEARCH_WORK`` (10⁸), a decision by the problem's size that is the same on every
+        machine; it then ends by its stall rule (the best γ_opt must fall by 0.1 % within
+        30 evaluations per parameter) or when a restart of its simplex gains less than
+        0.01 %. A number caps it (and the best-constant-D start) at that many γ
+        evaluations; 0: none. Its controller (at ``search_backoff``) is kept when its μ is
+        lower, recorded in ``history`` with ``step = "D search"``. On Skogestad &
+        Postlethwaite's distillation problem (§8.12.4) D–K stalls at μ 1.10 and the search
+        ends below the published μ-optimal 0.974 (benchmarks/bench_dk.py); on plants of
+        80 states or more it is not started.
     search_backoff : float
         The controller of the D found by the search is built at ``search_backoff·γ_opt``:
         the search minimised γ_opt, and a controller ``backoff`` (1 %) above it gives back
@@ -581,10 +584,12 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     n_scaled = _scaled_plant(P, cblocks, best[4], nmeas, ncon).nstates if best[4] else 0
     evals, granted = _search_evals(search, best[4], n_scaled)
     stopping = {"start": {"scales": bal, "evaluations": n_start,
-                          "rule": f"RMS balance, then {start} γ evaluations granted"},
+                          "rule": {None: "RMS balance, then the best constant D",
+                                   0: "RMS balance"}.get(
+                              start, f"RMS balance, then at most {start} γ evaluations")},
                 "dk": {"iterations": len(history), "rule": rule},
                 "search": {"granted": evals, "evaluations": 0, "rule": granted}}
-    if evals:
+    if evals != 0:
         found, done = _search_step(P, blocks, cblocks, nmeas, ncon, w, best, evals,
                                    search_backoff, history, console)
         stopping["search"].update(done, rule=f"{granted}; {done['rule']}")

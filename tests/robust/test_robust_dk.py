@@ -236,7 +236,7 @@ def test_the_d_search_ends_by_its_stall_rule_not_a_count(monkeypatch):
     returns ``1 + 0.5·exp(−k/400)`` at its k-th call, wherever the simplex is, so the
     best γ keeps falling and Nelder–Mead never converges. With no cap the search must
     end at the first k where the best γ fell by less than ``SEARCH_STALL_RTOL`` over the
-    last ``SEARCH_STALL_EVALS_PER_PARAMETER`` evaluations per parameter (1 896 here, for
+    last ``SEARCH_STALL_EVALS_PER_PARAMETER`` evaluations per parameter (1 934 here, for
     three parameters), not at a count of evaluations (before: 50 per parameter, 150); a
     caller's cap still ends it at its count."""
     import ambseal.robust._dscale as ds

@@ -295,9 +295,11 @@ SEARCH_EVALS_PER_PARAMETER = 50
 #: ``SEARCH_STALL_RTOL`` over the last ``SEARCH_STALL_EVALS_PER_PARAMETER`` evaluations per
 #: parameter — D–K's own rule (``rtol`` within ``patience`` steps) with a simplex's
 #: evaluations as the steps. Measured on the best γ of three published problems searched
-#: without a cap (benchmarks/README.md, "The D search ends by its stall rule"): 0.1 % over
-#: 10 per parameter ends the distillation column's search near 1 450 evaluations at γ
-#: 0.960, 0.2 % above where 5 000 evaluations reach (0.958).
+#: to 5 000 evaluations (benchmarks/README.md, "The D search ends by its stall rule"): the
+#: aircraft's first simplex descent runs about 15 per parameter without a gain, so a window
+#: of 10 or 20 ends it there (γ 0.981, against 0.9754 at 5 000); 0.1 % over 30 ends it at
+#: 0.9756, and the distillation column's search near 2 000 evaluations at γ 0.9587, 0.06 %
+#: above where 5 000 reach.
 SEARCH_STALL_RTOL = 1e-3
 SEARCH_STALL_EVALS_PER_PARAMETER = 30
 #: D search: the first simplex moves each parameter (a logarithm) by this much, a factor e,

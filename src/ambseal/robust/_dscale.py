@@ -198,9 +198,11 @@ def _balance_channels(P, cblocks, nmeas, ncon, w, evals=0):
        its w_Δ columns seen at the non-Δ outputs ``[z, y]`` (a block with no such path
        keeps 1): channels in other units (z_Δ·a, w_Δ/a) scale r_j by a and c_j by 1/a.
     2. From there, Nelder–Mead over log b for the smallest γ_opt of ``P_b`` (the best
-       constant D of the H∞ problem), until its simplex has converged (1 % in log b) or,
-       where ``evals`` is a number, at most that many γ evaluations (0: none): translation
-       in log b, the change of units, leaves the search unchanged.
+       constant D of the H∞ problem), until its simplex has converged (1 % in log b) or
+       reaches SciPy's own bound of 200 evaluations per scale (its default for
+       Nelder–Mead; on the flywheel example's 8 scales one start ended at 1 520 of 1 600)
+       or, where ``evals`` is a number, at most that many γ evaluations (0: none):
+       translation in log b, the change of units, leaves the search unchanged.
     """
     nzd = sum(c for _, c in cblocks[:-1])
     nwd = sum(r for r, _ in cblocks[:-1])
@@ -246,8 +248,8 @@ def _balance_channels(P, cblocks, nmeas, ncon, w, evals=0):
     if evals is None or evals > x.size + 1:
         # first simplex: each log b moved by 1 (a factor e): the RMS balance is a start,
         # not the optimum, which lies a decade or two away on plants with integrators.
-        # It ends where the simplex has converged (1 % in log b, 1e-4 in γ), or at a
-        # caller's count
+        # It ends where the simplex has converged (1 % in log b, 1e-4 in γ), at SciPy's
+        # default bound of 200 evaluations per scale, or at a caller's count
         g0 = gamma(x)
         options = {"xatol": 1e-2, "fatol": 1e-4,
                    "initial_simplex": np.vstack([x, x + np.eye(x.size)])}
@@ -338,8 +340,10 @@ def _search_dscales(P, cblocks, fits, nmeas, ncon, evals=None):
     converges it restarts from its best point with a fresh simplex, since a converged
     simplex in a dozen dimensions has often collapsed onto a subspace (Lagarias et al.
     1998; the restart is the classical remedy, Kelley 1999). Both rules end it: γ_opt is
-    bounded below. ``evals``: None (no cap), or at most that many γ evaluations, a
-    caller's cap. Returns ``(fits, γ_opt, evaluations, rule)``, with ``fits`` None when no
+    bounded below. A Nelder–Mead run that reaches SciPy's own bound (its default of 200
+    evaluations per parameter) is restarted like a converged one, so that bound ends no
+    search. ``evals``: None (no cap), or at most that many γ evaluations, a caller's
+    cap. Returns ``(fits, γ_opt, evaluations, rule)``, with ``fits`` None when no
     better D was found and ``rule`` the one that ended the search.
     """
     parts = [_tf_to_theta(f) for f in fits]
@@ -434,8 +438,9 @@ START_WORK = 1e7
 def _start_evals(search, cblocks, n_states: int) -> int | None:
     """γ evaluations granted to :func:`_balance_channels`' search for the best constant D:
     0 (none) when ``search`` is 0 or its estimate (``START_EVALS_PER_SCALE`` per scale) ×
-    ``n_states``³ exceeds ``START_WORK``; else None with ``"auto"`` (no cap: it ends where
-    its simplex has converged), and a number ``search`` caps it."""
+    ``n_states``³ exceeds ``START_WORK``; else None with ``"auto"`` (no cap of ours: it
+    ends where its simplex has converged, or at SciPy's default bound of 200 evaluations
+    per scale), and a number ``search`` caps it."""
     estimate = START_EVALS_PER_SCALE * (len(cblocks) - 1)
     if search == 0 or estimate * float(n_states) ** 3 > START_WORK:
         return 0

@@ -212,6 +212,41 @@ def test_start_search_work_rule_is_a_count():
     assert _start_evals(0, cb, 4) == 0 and _start_evals(7, cb, 4) == 7
 
 
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")  # the simplex grows without bound
+def test_the_start_ends_by_its_stall_rule_not_scipys_count(monkeypatch):
+    """Reference: the stall rule in closed form. Fault injection: every γ evaluation of
+    the best-constant-D start returns ``1 + 0.5·exp(−k/400)`` at its k-th call, wherever
+    the simplex is, so its best γ keeps falling and Nelder–Mead never converges. With no
+    cap the start must end at the first k where the best γ fell by less than
+    ``SEARCH_STALL_RTOL`` over the last ``SEARCH_STALL_EVALS_PER_PARAMETER`` evaluations
+    per scale (1 460 for one scale), not at SciPy's default bound of 200 evaluations per
+    scale; a caller's cap still ends it at its count, and a plant with no uncertainty
+    channel has no start to search."""
+    import ambseal.robust._dscale as ds
+
+    calls = [0]
+
+    def gamma_opt(Ps, nmeas, ncon, rtol, near):
+        calls[0] += 1
+        return 1 + 0.5 * np.exp(-calls[0] / 400)
+
+    monkeypatch.setattr(ds, "hinf_gamma_opt", gamma_opt)
+    P, cb, w = rp_plant(), [(1, 1), (1, 1)], np.logspace(-2, 2, 9)
+    window = SEARCH_STALL_EVALS_PER_PARAMETER
+    k = np.arange(window + 1, 100_000)
+    g = 1 + 0.5 * np.exp(-k / 400)
+    stop = int(k[np.argmax(g >= (1 + 0.5 * np.exp(-(k - window) / 400))
+                           * (1 - SEARCH_STALL_RTOL))])
+    assert stop == 1460
+    _, _, n, rule = ds._balance_channels(P, cb, 1, 1, w, None)
+    assert n == stop and "stalled" in rule
+    calls[0] = 0
+    _, _, n, rule = ds._balance_channels(P, cb, 1, 1, w, 50)
+    assert n == 50 and "at most 50" in rule
+    # no uncertainty block besides the performance block: nothing to search
+    assert ds._balance_channels(P, [(2, 2)], 1, 1, w, None)[1:] == ([], 0, "RMS balance")
+
+
 def test_search_work_rule_is_a_count():
     """Reference: the rule itself (``SEARCH_WORK`` in γ evaluations × states³). A plant
     whose full search (``SEARCH_EVALS_PER_PARAMETER`` per parameter) fits in the work limit gets it, one

@@ -185,8 +185,8 @@ def _scaled_plant(P, cblocks, fits, nmeas, ncon):
 
 
 def _balance_channels(P, cblocks, nmeas, ncon, w, evals=0):
-    """The uncertainty channels of ``P`` in balanced units: ``(P_b, b, evaluations)`` with
-    ``P_b = diag(b, I) · P · diag(b⁻¹, I)``, one constant ``b_j > 0`` per block of the
+    """The uncertainty channels of ``P`` in balanced units: ``(P_b, b, evaluations, rule)``
+    with ``P_b = diag(b, I) · P · diag(b⁻¹, I)``, one constant ``b_j > 0`` per block of the
     complexified structure but the last (performance) block.
 
     μ is unchanged by such a D (Packard & Doyle 1993: μ(DMD⁻¹) = μ(M) for D commuting
@@ -199,10 +199,10 @@ def _balance_channels(P, cblocks, nmeas, ncon, w, evals=0):
        keeps 1): channels in other units (z_Δ·a, w_Δ/a) scale r_j by a and c_j by 1/a.
     2. From there, Nelder–Mead over log b for the smallest γ_opt of ``P_b`` (the best
        constant D of the H∞ problem), until its simplex has converged (1 % in log b) or
-       reaches SciPy's own bound of 200 evaluations per scale (its default for
-       Nelder–Mead; on the flywheel example's 8 scales one start ended at 1 520 of 1 600)
-       or, where ``evals`` is a number, at most that many γ evaluations (0: none):
-       translation in log b, the change of units, leaves the search unchanged.
+       by the D search's stall rule (:class:`_StallWatch`: the best γ fell by less than
+       0.1 % over the last 30 evaluations per scale) or, where ``evals`` is a number, at
+       most that many γ evaluations (0: none): translation in log b, the change of
+       units, leaves the search unchanged. ``rule`` names what ended it.
     """
     nzd = sum(c for _, c in cblocks[:-1])
     nwd = sum(r for r, _ in cblocks[:-1])
@@ -234,6 +234,8 @@ def _balance_channels(P, cblocks, nmeas, ncon, w, evals=0):
 
     x = np.array(logb, float)
     near, count = [None], [0]
+    watch = _StallWatch(x.size)
+    rule = "RMS balance"
 
     def gamma(y):
         count[0] += 1
@@ -241,24 +243,33 @@ def _balance_channels(P, cblocks, nmeas, ncon, w, evals=0):
             g = hinf_gamma_opt(scaled(y), nmeas, ncon, rtol=SEARCH_GAMMA_RTOL,
                                near=near[0])
         except (SynthesisError, ModelError, ValueError, np.linalg.LinAlgError):
-            return np.inf
-        near[0] = g if near[0] is None else min(near[0], g)
+            g = np.inf
+        else:
+            near[0] = g if near[0] is None else min(near[0], g)
+        watch.record(y, g)
         return g
 
-    if evals is None or evals > x.size + 1:
+    if x.size and (evals is None or evals > x.size + 1):
         # first simplex: each log b moved by 1 (a factor e): the RMS balance is a start,
         # not the optimum, which lies a decade or two away on plants with integrators.
-        # It ends where the simplex has converged (1 % in log b, 1e-4 in γ), at SciPy's
-        # default bound of 200 evaluations per scale, or at a caller's count
+        # It ends where the simplex has converged (1 % in log b, 1e-4 in γ), by the
+        # stall rule, or at a caller's count; SciPy's default bound (200 evaluations per
+        # scale) does not end it
         g0 = gamma(x)
-        options = {"xatol": 1e-2, "fatol": 1e-4,
+        options = {"xatol": 1e-2, "fatol": 1e-4, "maxfev": np.inf, "maxiter": np.inf,
                    "initial_simplex": np.vstack([x, x + np.eye(x.size)])}
         if evals is not None:
             options["maxfev"] = int(evals) - 1
-        res = minimize(gamma, x, method="Nelder-Mead", options=options)
-        if np.isfinite(res.fun) and res.fun < g0:
-            x = np.asarray(res.x, float)
-    return scaled(x), [float(np.exp(v)) for v in x], count[0]
+        try:
+            minimize(gamma, x, method="Nelder-Mead", options=options)
+            rule = ("RMS balance, then the best constant D: its simplex converged"
+                    if evals is None else
+                    f"RMS balance, then the best constant D in at most {evals} γ evaluations")
+        except _Stalled:
+            rule = f"RMS balance, then the best constant D: {watch.rule()}"
+        if watch.best_g < g0:
+            x = watch.best_x
+    return scaled(x), [float(np.exp(v)) for v in x], count[0], rule
 
 
 def _unbalanced_fit(fit, b):
@@ -327,6 +338,32 @@ class _Stalled(Exception):
     """Raised inside a Nelder–Mead objective to end the search by its stall rule."""
 
 
+class _StallWatch:
+    """The best γ after each evaluation of a search over ``n_parameters`` parameters, and
+    its stall rule: :meth:`record` raises :class:`_Stalled` once the best γ fell by less
+    than ``SEARCH_STALL_RTOL`` over the last ``SEARCH_STALL_EVALS_PER_PARAMETER``
+    evaluations per parameter. The rule ends every search: γ is bounded below (by 0), so
+    the best γ can fall by that fraction only finitely often, and an infinite γ (no
+    controller) never counts as a fall."""
+
+    def __init__(self, n_parameters: int):
+        self.window = SEARCH_STALL_EVALS_PER_PARAMETER * int(n_parameters)
+        self.trail: list[float] = []
+        self.best_x, self.best_g = None, np.inf
+
+    def record(self, x, g: float) -> None:
+        if g < self.best_g:
+            self.best_x, self.best_g = np.array(x, float), float(g)
+        self.trail.append(self.best_g)
+        t = self.trail
+        if len(t) > self.window and not t[-1] < t[-1 - self.window] * (1 - SEARCH_STALL_RTOL):
+            raise _Stalled
+
+    def rule(self) -> str:
+        return (f"stalled: the best γ fell by less than {SEARCH_STALL_RTOL:g} over the last "
+                f"{self.window} evaluations")
+
+
 def _search_dscales(P, cblocks, fits, nmeas, ncon, evals=None):
     """Direct search (Nelder–Mead) over the section parameters of the fitted D scales for
     the smallest γ_opt of ``D P D⁻¹`` (γ to ``SEARCH_GAMMA_RTOL``).
@@ -352,12 +389,9 @@ def _search_dscales(P, cblocks, fits, nmeas, ncon, evals=None):
     def sections(x):
         return [(x[a:b], od) for (_, od), a, b in zip(parts, cuts[:-1], cuts[1:])]
 
-    best = {"x": None, "g": np.inf, "n": 0}
-    trail = []  # the best γ after each evaluation, for the stall rule
-    window = SEARCH_STALL_EVALS_PER_PARAMETER * int(cuts[-1])
+    watch = _StallWatch(cuts[-1])
 
     def gamma(x):
-        best["n"] += 1
         try:
             Ps = _scaled_plant(P, cblocks, [_realize(*t) for t in sections(x)], nmeas, ncon)
             g = hinf_gamma_opt(Ps, nmeas, ncon, rtol=SEARCH_GAMMA_RTOL, near=near[0])
@@ -365,11 +399,7 @@ def _search_dscales(P, cblocks, fits, nmeas, ncon, evals=None):
             g = np.inf
         else:
             near[0] = g if near[0] is None else min(near[0], g)
-        if g < best["g"]:
-            best.update(x=np.array(x, float), g=g)
-        trail.append(best["g"])
-        if len(trail) > window and not trail[-1] < trail[-1 - window] * (1 - SEARCH_STALL_RTOL):
-            raise _Stalled
+        watch.record(x, g)
         return g
 
     x0 = np.concatenate([th for th, _ in parts])
@@ -380,26 +410,26 @@ def _search_dscales(P, cblocks, fits, nmeas, ncon, evals=None):
         options = {"adaptive": True, "xatol": 1e-3, "fatol": 1e-5,
                    "initial_simplex": np.vstack([x, x + SEARCH_SIMPLEX_STEP * np.eye(x.size)])}
         if evals is not None:
-            left = int(evals) - best["n"]
+            left = int(evals) - len(watch.trail)
             if left <= x.size + 1:
                 rule = f"the cap of {int(evals)} evaluations reached"
                 break
             options["maxfev"] = left
-        g_start = best["g"]
+        g_start = watch.best_g
         try:
             minimize(gamma, x, method="Nelder-Mead", options=options)
         except _Stalled:
-            rule = (f"stalled: the best γ fell by less than {SEARCH_STALL_RTOL:g} over the "
-                    f"last {window} evaluations")
+            rule = watch.rule()
             break
-        if not best["g"] < g_start * (1 - 1e-4):
+        if not watch.best_g < g_start * (1 - 1e-4):
             rule = "converged: a restart lowered γ by less than 1e-4"
             break
-        x = best["x"]
-    if not best["g"] < g0:
-        return None, g0, best["n"], rule
-    return [ct.tf(*_theta_to_tf(*t)) for t in sections(best["x"])], float(best["g"]), \
-        best["n"], rule
+        x = watch.best_x
+    n = len(watch.trail)
+    if not watch.best_g < g0:
+        return None, g0, n, rule
+    return [ct.tf(*_theta_to_tf(*t)) for t in sections(watch.best_x)], float(watch.best_g), \
+        n, rule
 
 
 def _search_evals(search, fits, n_states: int) -> tuple[int | None, str]:
@@ -438,9 +468,9 @@ START_WORK = 1e7
 def _start_evals(search, cblocks, n_states: int) -> int | None:
     """γ evaluations granted to :func:`_balance_channels`' search for the best constant D:
     0 (none) when ``search`` is 0 or its estimate (``START_EVALS_PER_SCALE`` per scale) ×
-    ``n_states``³ exceeds ``START_WORK``; else None with ``"auto"`` (no cap of ours: it
-    ends where its simplex has converged, or at SciPy's default bound of 200 evaluations
-    per scale), and a number ``search`` caps it."""
+    ``n_states``³ exceeds ``START_WORK``; else None with ``"auto"`` (no cap: it ends
+    where its simplex has converged or by its stall rule), and a number ``search`` caps
+    it."""
     estimate = START_EVALS_PER_SCALE * (len(cblocks) - 1)
     if search == 0 or estimate * float(n_states) ** 3 > START_WORK:
         return 0

@@ -417,8 +417,8 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     D of :func:`~ambseal.robust._dscale._balance_channels` — an RMS balance of each
     block's rows and columns, then Nelder–Mead for the D of the smallest γ_opt
     (started when its estimated work, ``START_EVALS_PER_SCALE`` γ evaluations per scale,
-    is within ``START_WORK``, and ended where its simplex has converged; none with
-    ``search=0``) — the same plant in any units of the
+    is within ``START_WORK``, and ended where its simplex has converged or by the D
+    search's stall rule; none with ``search=0``) — the same plant in any units of the
     channels, so μ and the controller are too (to rounding; tests: 12 decades).
 
     The steps, after Balas et al. (1993) and MATLAB's ``musyn`` (D-K Iteration Process,
@@ -529,7 +529,8 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     cblocks = _complexify(blks)
     console = progress_printer(progress)
     start = _start_evals(search, cblocks, P.nstates)
-    P_user, (P, bal, n_start) = P, _balance_channels(P, cblocks, nmeas, ncon, w, start)
+    P_user, (P, bal, n_start, start_rule) = P, _balance_channels(P, cblocks, nmeas, ncon,
+                                                                  w, start)
     if unchecked:
         check_plant(P, nmeas, ncon)
 
@@ -583,10 +584,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     finalists = [_finalist(best)]
     n_scaled = _scaled_plant(P, cblocks, best[4], nmeas, ncon).nstates if best[4] else 0
     evals, granted = _search_evals(search, best[4], n_scaled)
-    stopping = {"start": {"scales": bal, "evaluations": n_start,
-                          "rule": {None: "RMS balance, then the best constant D",
-                                   0: "RMS balance"}.get(
-                              start, f"RMS balance, then at most {start} γ evaluations")},
+    stopping = {"start": {"scales": bal, "evaluations": n_start, "rule": start_rule},
                 "dk": {"iterations": len(history), "rule": rule},
                 "search": {"granted": evals, "evaluations": 0, "rule": granted}}
     if evals != 0:

@@ -476,7 +476,7 @@ def test_a_zone_on_its_limit_names_both_sides_in_the_verdict():
 
 def test_an_lpv_design_whose_sdp_stopped_at_its_cap_is_marked_where_it_is_delivered():
     """Reference: CVXOPT's iteration count and cap (``maxiters`` 8 on a toy whose γ SDP
-    converges in 11; tests/robust/test_robust_lpv.py). The LPV design built from that
+    converges in 10; tests/robust/test_robust_lpv.py). The LPV design built from that
     synthesis names the stage that stopped short of optimal in its summary (``sdp_status``,
     ``sdp_shortfall``) and in its bound's words; the run's verdict on it, its design-bound
     cell and the report's section on the syntheses say NOT SOLVED TO OPTIMALITY. The same
@@ -521,4 +521,4 @@ def test_an_lpv_design_whose_sdp_stopped_at_its_cap_is_marked_where_it_is_delive
     d, summary, v, text = delivered(None)
     assert summary["sdp_status"] == {"gamma": "optimal"} and summary["sdp_shortfall"] == ""
     assert "OPTIMALITY" not in d.verdict + v.words() + text
-    assert "γ stage optimal after 11 of at most 100 interior-point iterations" in text
+    assert "γ stage optimal after 10 of at most 100 interior-point iterations" in text

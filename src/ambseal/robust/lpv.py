@@ -363,8 +363,10 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
         The controller table (and check grid) has ``check_density·(n_p − 1) + 1`` values.
     solver_options : dict, optional
         CVXOPT's ``abstol``, ``reltol``, ``feastol``, ``maxiters``, ``refinement``
-        (e.g. ``{"maxiters": 200}``); defaults: CVXOPT's own (gaps 1e-7 absolute, 1e-6
-        relative, feasibility 1e-7).
+        (e.g. ``{"maxiters": 200}``), each replacing its default
+        (:data:`ambseal.robust._lpv_lmi.DEFAULT_TOL`: gaps 1e-7 absolute and 1e-4
+        relative, residuals 1e-5, two refinement steps, where every SDP stage of the
+        examples' LPV designs ends "optimal"; CVXOPT's own cap of 100 iterations).
     margin : float
         Strictness margin of the LMIs (scaled units).
     scaling : {"auto", "riccati", "diagonal"}

@@ -233,12 +233,11 @@ def _balance_channels(P, cblocks, nmeas, ncon, w, evals=0):
                      name=P.name)
 
     x = np.array(logb, float)
-    near, count = [None], [0]
+    near = [None]
     watch = _StallWatch(x.size)
     rule = "RMS balance"
 
     def gamma(y):
-        count[0] += 1
         try:
             g = hinf_gamma_opt(scaled(y), nmeas, ncon, rtol=SEARCH_GAMMA_RTOL,
                                near=near[0])
@@ -269,7 +268,7 @@ def _balance_channels(P, cblocks, nmeas, ncon, w, evals=0):
             rule = f"RMS balance, then the best constant D: {watch.rule()}"
         if watch.best_g < g0:
             x = watch.best_x
-    return scaled(x), [float(np.exp(v)) for v in x], count[0], rule
+    return scaled(x), [float(np.exp(v)) for v in x], len(watch.trail), rule
 
 
 def _unbalanced_fit(fit, b):

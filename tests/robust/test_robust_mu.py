@@ -345,6 +345,32 @@ def test_mu_peak_finds_a_resonance_between_grid_points():
         assert p.peak == pytest.approx(float(np.max(np.abs(G(1j * p.omega)))), rel=1e-6)
 
 
+def test_mu_peak_finds_every_resonance_of_a_seeded_family():
+    """Reference: closed form, as above, on 60 lightly damped modes (ζ 2.5e-4 … 0.05, ω_n
+    drawn log-uniform over 0.2–5 rad/s, seed 0) against the same 20-point grid: every
+    refined peak within 1 % of 1/(2ζ√(1 − ζ²)). The points of a round lie on a lattice of
+    the grid's spacing; a new point repeating the best one made the bracket drop the side
+    the peak was on, a rule on two rounds' rise stopped where the best point lay closer to a
+    sharp peak than the round's points, and a cap of 6 rounds stopped short of ``xtol``:
+    together 17 of these 60 more than 1 % low, one at 6 % of its peak. A caller's
+    ``rounds`` still caps the search at that many rounds of ``points`` each."""
+    from ambseal.robust.mu import mu_peak
+
+    w = np.logspace(-1, 1, 20)
+    rng = np.random.default_rng(0)
+    worst = 1.0
+    for zeta in (2.5e-4, 2.5e-3, 0.05):
+        for wn in np.exp(rng.uniform(np.log(0.2), np.log(5.0), 20)):
+            G = ct.ss(ct.tf([wn**2], [1.0, 2 * zeta * wn, wn**2]))
+            exact = 1 / (2 * zeta * np.sqrt(1 - zeta**2))
+            p = mu_peak(G, [(1, 1)], w)
+            assert p.peak <= exact * (1 + 1e-6)  # each value is |G(jω)| at some ω
+            worst = min(worst, p.peak / exact)
+    assert worst > 0.99
+    capped = mu_peak(G, [(1, 1)], w, rounds=2, candidates=1)
+    assert capped.evaluated == 2 * 4
+
+
 def _two_lightly_damped_modes():
     """Two modes (3 and 7 rad/s, ζ = 0.005) seen through two real scalar parameters."""
     rng = np.random.default_rng(3)

@@ -304,7 +304,7 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
     peak : bool
         With a system ``M`` on more than one frequency: also refine the upper bound's peak
         between the grid points (:func:`mu_peak` with its defaults: brackets narrowed to
-        1e-4 in ln ω or until the peak rises by less than 1e-4 relative in two rounds),
+        1e-4 in ln ω or to a top flat within 1e-4 relative),
         in ``MuResult.peak`` and :attr:`MuResult.peak_upper`; ``upper`` stays on ``omega``.
         A grid of 100 points misses a sharp real-μ peak at a lightly damped mode by several
         per cent. False: the grid alone (callers that refine the peaks they keep, such as
@@ -516,7 +516,8 @@ class MuPeak:
 
 
 def mu_peak(M, blocks, omega, upper=None, *, candidates: int = 2, band: float = PEAK_BAND,
-            points: int = 4, rounds: int = 6, xtol: float = 1e-4, ftol: float = 1e-4,
+            points: int = 4, rounds: int | None = None, xtol: float = 1e-4,
+            ftol: float = 1e-4,
             resolve: int = 2, tol: float = 1e-3) -> MuPeak:
     """Peak of the μ upper bound of a system over frequency, refined around the grid's peaks.
 
@@ -529,11 +530,16 @@ def mu_peak(M, blocks, omega, upper=None, *, candidates: int = 2, band: float = 
     and the bracket shrinks
     to the best point's neighbours — a grid search that contracts by about
     ``2/(points + 1)`` per round, the derivative-free interval reduction of Kiefer's
-    Fibonacci/golden-section search (Kiefer 1953), batched. It stops after ``rounds``
-    rounds, when every bracket is narrower than ``xtol`` in ln ω, or when two rounds in a
-    row raised the largest value by less than ``ftol`` (relative): the best point then
-    sits on a flat top (one such round alone is no proof: its points may all lie farther
-    from a sharp peak than the best point). The ``resolve`` best points found are solved
+    Fibonacci/golden-section search (Kiefer 1953), batched; a new point that repeats one
+    the bracket has is left out. A bracket is done when it is narrower than ``xtol`` in
+    ln ω, or when its best point's two neighbours are both within ``ftol`` (relative) of
+    it: a flat top, on which the peak lies between them. The search ends when every
+    bracket is done, which the geometric contraction makes sure of: from two grid spacings
+    of a 10-points-per-decade grid (0.46 in ln ω) to ``xtol`` in 10 rounds. ``rounds`` is a
+    caller's cap, none by default. (A rule on the rise of the largest value over two rounds
+    stopped on sharp resonances where the best point lay closer to the peak than the
+    round's points: on a seeded family of lightly damped modes it left 1 in 5 peaks more
+    than 1 % low, one at 6 % of its value.) The ``resolve`` best points found are solved
     again to ``tol·1e-3``, as :func:`mussv` does with a grid's largest bounds, and added to
     the grid. The value returned is the largest upper bound on that grid: each is a
     certificate at its own frequency (:func:`mussv`), so the result is an honest lower
@@ -556,13 +562,13 @@ def mu_peak(M, blocks, omega, upper=None, *, candidates: int = 2, band: float = 
         Only local maxima at least ``band`` times the grid's largest value are refined.
     points : int
         New frequencies per bracket and round.
-    rounds : int
-        Largest number of rounds.
+    rounds : int, optional
+        A cap on the rounds; None (default): the rules above alone end them.
     xtol : float
         Bracket width (in ln ω) below which a bracket is not refined further.
     ftol : float
-        Relative rise of the largest value in two rounds in a row below which the rounds
-        stop.
+        Relative difference of the best point's neighbours from it below which a bracket is
+        a flat top, not refined further.
     tol : float
         Tolerance of the bound's solver (:func:`mussv`): the grid's and the added points'
         (``tol/10`` while searching).
@@ -608,15 +614,21 @@ def mu_peak(M, blocks, omega, upper=None, *, candidates: int = 2, band: float = 
         lo, hi = max(i - 1, 0), min(i + 1, w.size - 1)
         brackets.append((lw[lo:hi + 1].copy(), u[lo:hi + 1].copy()))
     new_w, new_u = [], []
-    top, flat = grid_peak, 0
-    for _ in range(int(rounds)):
+    done = 0
+    while rounds is None or done < int(rounds):
+        done += 1
         todo = []
         for k, (x, y) in enumerate(brackets):
             j = int(np.argmax(y))
-            a, b = x[max(j - 1, 0)], x[min(j + 1, x.size - 1)]
-            if b - a <= xtol:
+            lo, hi = max(j - 1, 0), min(j + 1, x.size - 1)
+            if x[hi] - x[lo] <= xtol or min(y[lo], y[hi]) >= (1.0 - ftol) * y[j]:
                 continue
-            todo.extend((k, v) for v in np.linspace(a, b, int(points) + 2)[1:-1])
+            # the points lie on a lattice of the grid's spacing, so a new one can repeat an
+            # old one; a repeated best point would be its own neighbour, and the bracket
+            # would lose the side the peak is on
+            width = x[hi] - x[lo]
+            todo.extend((k, v) for v in np.linspace(x[lo], x[hi], int(points) + 2)[1:-1]
+                        if np.min(np.abs(x - v)) > 1e-9 * width)
         if not todo:
             break
         xs = np.array([v for _, v in todo])
@@ -630,12 +642,6 @@ def mu_peak(M, blocks, omega, upper=None, *, candidates: int = 2, band: float = 
             brackets[k] = (np.insert(x, pos, v), np.insert(y, pos, val))
         new_w.extend(np.exp(xs))
         new_u.extend(vals)
-        # a first round's rise within tol of the grid's peak is not taken for one: its bounds
-        # (to tol/10) may exceed the grid's (to tol·1e-3) on a flat top
-        rise, top = float(np.max(vals)) / top - 1.0, max(top, float(np.max(vals)))
-        flat = flat + 1 if rise < ftol + (tol if len(new_w) == len(vals) else 0.0) else 0
-        if flat >= 2:
-            break
     new_w, new_u = np.asarray(new_w, float), np.asarray(new_u, float)
     evaluated = int(new_w.size)
     # the rounds solved each bound to tol/10, enough to locate the peak; the best few are

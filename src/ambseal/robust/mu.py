@@ -261,7 +261,7 @@ PEAK_BAND = 0.95
 
 
 @with_numerics_threads
-def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
+def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int | None = None,
           lower_iter: int = 20, gmax: float = 1e3, seed: int = 0,
           lower: bool = True, peak_tol: float | None = None, peak: bool = True) -> MuResult:
     """Upper and lower bounds of the structured singular value μ_Δ(M).
@@ -284,8 +284,11 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
         (measured on a 108-state loop, 500 frequencies: peak within 3e-10 of a
         ``tol = 1e-6`` solve; refining only the largest, one at a time, had left it 2.6e-4
         above).
-    max_iter : int
-        Outer iterations of the upper-bound solver.
+    max_iter : int, optional
+        A cap on the upper-bound solver's levels (outer iterations) per matrix. None (the
+        default): each matrix's solve ends at its own criterion, the gap within ``tol``,
+        its interior lost to rounding, or a stall (its bound fell by less than ``tol`` over
+        100 levels; ``_mu_upper.STALL_LEVELS``).
     lower_iter : int
         Power iterations per start for the lower bound.
     gmax : float
@@ -319,9 +322,9 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
     Raises
     ------
     ModelError
-        Malformed blocks, ``tol`` outside (0, 1), ``max_iter`` or ``lower_iter`` not a whole
-        number ≥ 1, dimensions that do not match ``M``, missing ``omega``, non-finite
-        entries.
+        Malformed blocks, ``tol`` outside (0, 1), ``max_iter`` (when given) or
+        ``lower_iter`` not a whole number ≥ 1, dimensions that do not match ``M``, missing
+        ``omega``, non-finite entries.
 
     Notes
     -----
@@ -340,7 +343,8 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int = 200,
     blks = parse_blocks(blocks)
     if not (isinstance(tol, (int, float)) and 0.0 < tol < 1.0):
         raise ModelError(f"mussv: tol={tol!r}, expected a relative tolerance in (0, 1)")
-    for name, v in (("max_iter", max_iter), ("lower_iter", lower_iter)):
+    counts = (("max_iter", max_iter),) * (max_iter is not None) + (("lower_iter", lower_iter),)
+    for name, v in counts:
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
             raise ModelError(f"mussv: {name}={v!r}, expected a whole number ≥ 1")
     w = None

@@ -36,6 +36,7 @@ from scipy.optimize import least_squares
 
 from ambseal.errors import IdentificationError
 from ambseal.identify.fitting.budget import ErrorBudget, propagate
+from ambseal.identify.fitting.converged import least_squares_converged
 from ambseal.identify.fitting.residuals import MISMATCH, ResidualTests, residual_tests
 from ambseal.identify.fitting.sandwich import _covariance, _long_run_covariance, _score_test, _t_quantile  # noqa: F401
 from ambseal.identify.fitting.sensor_lag import TAU_S, lag_test_dict, with_sensor_lag
@@ -311,7 +312,7 @@ def fit_parameters(
     initial: dict[str, float] | None = None,
     bounds: dict[str, tuple[float, float]] | None = None,
     current_weight: float = 0.0,
-    max_nfev: int = 200,
+    max_nfev: int | None = None,
     window: tuple[int, int | None] = (0, None),
     fixed: dict[str, tuple[float, str]] | None = None,
     fixed_correlation: tuple[tuple[str, ...], np.ndarray] | None = None,
@@ -334,8 +335,10 @@ def fit_parameters(
         stiffness), [0, 0.05] s for τ_e, unbounded otherwise.
     current_weight : float
         Weight of the coil-current residuals relative to the displacements (0: off).
-    max_nfev : int
-        Budget of model evaluations; exhausting it flags the result as not converged.
+    max_nfev : int, optional
+        A cap on model evaluations; exhausting it flags the result as not converged. None
+        (the default): the fit ends at its tolerances
+        (:func:`ambseal.identify.fitting.converged.least_squares_converged`), never at a count.
     window : (start, stop)
         Samples of each record in the cost (e.g. one frequency of a stepped sine); the
         simulation always starts at rest at sample 0.
@@ -452,7 +455,7 @@ def _stopped(sol, names, est, lo, hi) -> tuple[bool, str]:
     return bool(sol.status > 0), str(sol.message)
 
 
-def _solve(residuals, x0, r0, bounds, max_nfev: int):
+def _solve(residuals, x0, r0, bounds, max_nfev: int | None):
     """``scipy.optimize.least_squares`` (trf) from ``x0``, whose residuals ``r0`` are known:
     its first evaluation, at the start, takes them instead of simulating again."""
     first = {x0.tobytes(): r0}
@@ -463,8 +466,10 @@ def _solve(residuals, x0, r0, bounds, max_nfev: int):
 
     # scipy's default tolerances: 1e-10 took 35 % more evaluations, moved estimates < 1e-3 SE
     try:
-        return least_squares(cost, x0, bounds=bounds, method="trf", x_scale=1.0,
-                             max_nfev=max_nfev, xtol=1e-8, ftol=1e-8, gtol=1e-8)
+        opts = dict(bounds=bounds, method="trf", x_scale=1.0, xtol=1e-8, ftol=1e-8,
+                    gtol=1e-8)
+        return (least_squares_converged(cost, x0, **opts) if max_nfev is None
+                else least_squares(cost, x0, max_nfev=max_nfev, **opts))
     except ValueError as exc:  # residuals so large that their differences overflow
         raise IdentificationError(
             f"fit: the residuals' Jacobian is not finite ({exc}): the records' closed-loop "

@@ -74,6 +74,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ambseal.errors import IdentificationError
+from ambseal.identify.fitting.converged import least_squares_converged
 from ambseal.identify.fitting.coprime import (
     CoprimeFactors,
     _as_2d,
@@ -378,7 +379,7 @@ def identify_youla(
     theta0: Sequence[float] | None = None,
     scales: Mapping[str, float] | None = None,
     bounds: tuple[float, float] = (-np.inf, np.inf),
-    max_nfev: int = 200,
+    max_nfev: int | None = None,
 ) -> YoulaResult:
     """Identify normalised parameter changes θ from a closed-loop record (P1 §II, Eqs. 13–15).
 
@@ -409,8 +410,9 @@ def identify_youla(
         SI size of θ = 1 per parameter; |nominal| by default.
     bounds : (float, float)
         Bounds on every normalised θ.
-    max_nfev : int
-        Function evaluations allowed.
+    max_nfev : int, optional
+        A cap on function evaluations. None (the default): the fit ends at its tolerances
+        (:func:`ambseal.identify.fitting.converged.least_squares_converged`), never at a count.
 
     Returns
     -------
@@ -466,8 +468,10 @@ def identify_youla(
         return np.clip(np.nan_to_num(r, nan=1e10, posinf=1e10, neginf=-1e10), -1e10, 1e10)
 
     try:
-        sol = least_squares(residuals, x0, bounds=bounds, x_scale=1.0, method="trf",
-                            max_nfev=max_nfev, xtol=1e-12, ftol=1e-12, gtol=1e-12)
+        opts = dict(bounds=bounds, x_scale=1.0, method="trf", xtol=1e-12, ftol=1e-12,
+                    gtol=1e-12)
+        sol = (least_squares_converged(residuals, x0, **opts) if max_nfev is None
+               else least_squares(residuals, x0, max_nfev=max_nfev, **opts))
     except (ValueError, np.linalg.LinAlgError) as exc:
         raise IdentificationError(f"identify_youla: least squares failed ({exc})") from None
     theta = sol.x

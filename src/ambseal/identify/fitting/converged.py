@@ -1,0 +1,63 @@
+"""Nonlinear least squares ended by its own tolerances, never by a count of evaluations.
+
+``scipy.optimize.least_squares`` stops at the first of its tolerances (``ftol``, ``xtol``,
+``gtol``: statuses 2, 3, 1, or 4 for two at once) or when ``max_nfev`` evaluations are
+spent (status 0; by default ``100·n`` for ``trf``). A fit ended by the count depends on
+the count, and on every rounding that moves the path by an evaluation.
+:func:`least_squares_converged` continues such a fit from where the count stopped it, a
+round of SciPy's default count at a time, until a tolerance ends it, or until a whole
+round lowers the cost by less than ``ftol`` of it: SciPy's ``ftol`` test, which it applies
+to one step, applied to the round. The fit has then stalled, and more rounds would not
+move it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import OptimizeResult, least_squares
+
+__all__ = ["least_squares_converged"]
+
+#: SciPy's default ``ftol`` of ``least_squares``, the round test's when none is given.
+DEFAULT_FTOL = 1e-8
+
+
+def least_squares_converged(fun, x0, **kwargs) -> OptimizeResult:
+    """``scipy.optimize.least_squares(fun, x0, **kwargs)`` run until one of its tolerances,
+    or the round's stall test, ends it (module docstring).
+
+    Parameters
+    ----------
+    fun, x0, **kwargs
+        As for ``scipy.optimize.least_squares``. ``max_nfev`` is refused, because this
+        function exists to remove a count.
+
+    Returns
+    -------
+    scipy.optimize.OptimizeResult
+        The last round's result. Its ``nfev`` and ``njev`` are summed over every round, and
+        ``rounds`` is their number. ``status`` is the tolerance that ended it (1–4). A fit
+        ended by the round's stall test has ``status`` 2 (``ftol``) and a ``message`` that
+        says so.
+
+    Raises
+    ------
+    TypeError
+        ``max_nfev`` given.
+    """
+    if "max_nfev" in kwargs:
+        raise TypeError("least_squares_converged: max_nfev is not taken (it runs to tolerance)")
+    ftol = kwargs.get("ftol") or DEFAULT_FTOL
+    res = least_squares(fun, x0, **kwargs)
+    nfev, njev, rounds = res.nfev, res.njev or 0, 1
+    while res.status == 0:
+        nxt = least_squares(fun, res.x, **kwargs)
+        nfev, njev, rounds = nfev + nxt.nfev, njev + (nxt.njev or 0), rounds + 1
+        # trf takes only steps that lower the cost, so a round from res.x never raises it
+        fell, res = res.cost - nxt.cost, nxt
+        if res.status == 0 and fell <= ftol * max(res.cost, np.finfo(float).tiny):
+            res.status = 2
+            res.message = (f"stalled: a round of {nxt.nfev} evaluations lowered the cost "
+                           f"by less than ftol = {ftol:g} of it")
+    res.nfev, res.njev, res.rounds = nfev, njev, rounds
+    return res

@@ -277,8 +277,8 @@ def test_the_largest_bound_is_refined_however_many_matrices_tie_at_it():
     """Reference: the rank-one closed form, μ(a bᴴ) = Σ|a_i||b_i| for complex scalar blocks
     (Packard & Doyle 1993, §9.3). 100 matrices U a bᴴ Uᴴ, U diagonal and unitary, have the
     same μ and the same solver path: every bound ties at the peak, so the peak's refinement
-    must reach each of them, however many, before the largest bound is a refined one. Cut
-    at 64 matrices it reported an unrefined bound 4.8e-5 above μ."""
+    must reach each of them, however many, before the largest bound is a refined one. A
+    refinement cut at 64 matrices reports an unrefined bound, 4.8e-5 above μ."""
     rng = np.random.default_rng(3)
     a, b = crandn(rng, 4), crandn(rng, 4)
     u = np.exp(1j * rng.uniform(0.0, 2 * np.pi, (100, 4)))
@@ -291,7 +291,7 @@ def test_a_centring_that_stalls_ends_by_its_stall_rule(monkeypatch):
     """The upper bound's method of centres ends each matrix at its own criterion: the gap
     within tol, a lost interior or, when its bound no longer falls, the stall rule
     (STALL_LEVELS levels without a fall of tol). Newton steps that never centre and never
-    move leave only the stall rule to end the solve; before, 200 levels (a count) did."""
+    move leave only the stall rule to end the solve, not a count of levels."""
     import ambseal.robust._mu_upper as mu_upper
 
     calls = []

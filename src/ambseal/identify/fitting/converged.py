@@ -1,7 +1,7 @@
 """Nonlinear least squares ended by its own tolerances, never by a count of evaluations.
 
-``scipy.optimize.least_squares`` stops at the first of its tolerances (``ftol``, ``xtol``,
-``gtol``: statuses 2, 3, 1, or 4 for two at once) or when ``max_nfev`` evaluations are
+``scipy.optimize.least_squares`` stops at the first of its tolerances (status 1 ``gtol``,
+2 ``ftol``, 3 ``xtol``, 4 ``ftol`` and ``xtol`` at once) or when ``max_nfev`` evaluations are
 spent (status 0; by default ``100·n`` for ``trf``). A fit ended by the count depends on
 the count, and on every rounding that moves the path by an evaluation.
 :func:`least_squares_converged` continues such a fit from where the count stopped it, a

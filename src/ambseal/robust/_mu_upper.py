@@ -269,11 +269,9 @@ def _pd_all(*stacks):
 #: Levels of the method of centres over which a matrix's best λ must fall by ``tol`` of
 #: itself, or its solve has stalled and ends (:func:`_centres_chunk`). A centred solve
 #: shrinks the gap by θ = 1/4 a level, so it meets a tolerance of 1e-9 within 15 levels;
-#: one that centres slowly can go longer between falls and still converge. Measured on
-#: ``bench_dk``'s aircraft, distillation and mixed spring–mass cases (7 554 solves, all
-#: ended by their gap): at most 35 levels without a fall of ``tol``. At 30 the rule cut
-#: solves of the spring–mass D–G–K short, and its μ ended at 1.079 instead of 0.937; at 60
-#: and at 1 000 none was cut. 100 leaves three times the longest measured.
+#: one that centres slowly goes longer between falls and still converges. 100 is about
+#: three times the longest such run on published μ-synthesis problems (benchmarks/README.md,
+#: "μ's upper bound ends by its own rules"), where a rule at 30 cut converging solves short.
 STALL_LEVELS = 100
 
 _CHUNK_ELEMS = 2_000_000  # complex entries of the (F, p, N, N) derivative stack per chunk

@@ -186,7 +186,7 @@ def test_the_count_never_decides_the_estimates(rig, prbs_fit, monkeypatch):
     """SciPy's count cut to 3 evaluations a round: the fit, continued round by round to its
     tolerances, ends converged at the estimates of the uncut fit (within 1e-3 of a standard
     error), not stopped by the count and flagged not converged."""
-    import ambseal.identify.fitting.converged as converged
+    import ambseal.lti.least_squares as converged
     from scipy.optimize import least_squares
 
     rec, _ = prbs_fit

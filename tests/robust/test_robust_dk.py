@@ -67,6 +67,47 @@ def test_fit_dscale_selects_the_lowest_sufficient_order():
     assert np.all(np.real(fit.poles()) < 0) and np.all(np.real(fit.zeros()) < 0)
 
 
+def test_a_d_scale_fit_ends_at_its_bounded_minimum_not_at_a_count(monkeypatch):
+    """Reference: SciPy's L-BFGS-B, an independent solver run to 1e-14, on the same
+    weighted, bounded least squares from the same start. A D scale whose lightly damped
+    pairs (ζ down to 0.003) lie outside the fit's bounds (ζ ≥ 0.05), weighted unevenly:
+    trust-region steps crawl along the bounds, and 150 evaluations end 38 % above the
+    minimum. The fit, continued until a tolerance or its stall test ends it, reaches the
+    minimum's cost within 0.1 %."""
+    import ambseal.robust.dk as dk
+    from scipy.optimize import minimize
+
+    rng = np.random.default_rng(0)
+    w = np.logspace(-1, 4, 200)
+    s = 1j * w
+    num, den = np.ones_like(s), np.ones_like(s)
+    for _ in range(2):
+        wn, zeta = 10 ** rng.uniform(0, 3), 10 ** rng.uniform(-2.5, -0.5)
+        num *= s**2 + 2 * zeta * wn * s * rng.uniform(0.2, 5) + wn**2
+        den *= s**2 + 2 * zeta * wn * s + wn**2
+    mag, wgt = np.abs(num / den), rng.uniform(0, 1, w.size) ** 4
+    fits = []
+
+    def recorded(fun, x0, **kw):
+        res = fit(fun, x0, **kw)
+        fits.append((fun, x0, kw["bounds"], res))
+        return res
+
+    fit = dk.least_squares_converged
+    monkeypatch.setattr(dk, "least_squares_converged", recorded)
+    dk._fit_weighted(w, np.log(mag), 4, wgt, [(np.log(w).mean(), 1.0)])
+    (fun, x0, (lb, ub), res), = fits
+    assert res.status > 0
+
+    def cost(x):
+        return 0.5 * float(np.sum(fun(x) ** 2))
+
+    ref = minimize(cost, x0, method="L-BFGS-B", bounds=list(zip(lb, ub)),
+                   options={"maxiter": 100_000, "maxfun": 1_000_000, "ftol": 1e-14,
+                            "gtol": 1e-12})
+    assert res.cost <= ref.fun * (1 + 1e-3)
+
+
 def _mu_ab13md(cl, omega, sizes=(1, 1), pad_cols=0):
     """Peak over ``omega`` of slycot AB13MD's μ upper bound for square complex blocks of
     ``sizes`` (two 1×1 by default), on python-control's frequency response of ``cl``;

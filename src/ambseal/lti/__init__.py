@@ -22,6 +22,8 @@ The lowest numerical layer (it imports only :mod:`ambseal.errors`); each idea on
 * :func:`interp_table` — the one rule for tables against a parameter;
 * :func:`lowest_eigenpairs` — the eigenvalues of smallest |λ| of a large state matrix with
   right and left eigenvectors (shift-invert Arnoldi; a modal reduction's input);
+* :func:`least_squares_converged` — SciPy's nonlinear least squares ended by its own
+  tolerances or a stated stall test, never by a count of evaluations;
 * :func:`picklable` — ``control.StateSpace`` through :mod:`pickle` (Dask workers);
 * what every layer shares beneath them: :func:`ss_matrices`, :func:`as_omega`,
   :func:`labels`, :func:`shared_ss`, :func:`select_inputs` (checked matrices, grids, signal
@@ -58,7 +60,7 @@ _FROM = {
     "lowest_eigenpairs": "lowest", "ArrayMemo": "memo", "as_omega": "matrices",
     "freeze": "memo", "labels": "matrices", "select_inputs": "matrices",
     "shared_ss": "matrices", "ss_matrices": "matrices", "picklable": "pickling",
-    "interp_table": "tables",
+    "interp_table": "tables", "least_squares_converged": "least_squares",
 }
 
 __all__ = sorted(_FROM)

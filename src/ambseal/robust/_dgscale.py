@@ -44,11 +44,13 @@ from dataclasses import dataclass
 
 import control as ct
 import numpy as np
-from scipy.optimize import least_squares, minimize
+from scipy.optimize import minimize
 
 from ambseal.lti.freqresp import freqresp
+from ambseal.lti import least_squares_converged
 from ambseal.robust._dscale import (
-    _d_logmag_jac, _d_sections, _d_theta, _diag_sys, _ss, _tf_to_theta, _theta_to_tf,
+    FIT_STALL_RTOL, _d_logmag_jac, _d_sections, _d_theta, _diag_sys, _ss, _tf_to_theta,
+    _theta_to_tf,
 )
 from ambseal.robust.hinf import hinfnorm, lft_lower
 
@@ -126,9 +128,13 @@ def fit_allpass_pair(w, g, wgt, tol):
             for c1, c2 in ((cen[0::2], cen[1::2]), (cen[1::2], cen[0::2])):
                 x0 = np.r_[[v for v in c1[:k1]], [v for c in c1[k1:] for v in (c, np.log(0.3))],
                            [v for v in c2[:k1]], [v for c in c2[k1:] for v in (c, np.log(0.3))]]
-                res = least_squares(resid, np.clip(x0, lb + 1e-3, ub - 1e-3), jac=jac,
-                                    bounds=(lb, ub), max_nfev=100)
-                err = float(np.max(np.abs(resid(res.x)) * sq / wgt.max()))
+                def largest(x):
+                    return float(np.max(np.abs(resid(x)) * sq / wgt.max()))
+
+                res = least_squares_converged(resid, np.clip(x0, lb + 1e-3, ub - 1e-3),
+                                              jac=jac, bounds=(lb, ub), stall=largest,
+                                              stall_rtol=FIT_STALL_RTOL)
+                err = largest(res.x)
                 if err < best[3]:
                     best = (res.x, k1, k2, err)
         if best[3] <= 2 * np.arctan(tol):

@@ -38,6 +38,16 @@ from ambseal.robust.mu import mussv
 #: more time (Brent's method converges superlinearly: one or two more margins per γ).
 SEARCH_GAMMA_RTOL = 1e-8
 
+#: Stall test of the D scales' weighted least-squares fits (:func:`ambseal.robust.dk.
+#: fit_dscale`, :func:`ambseal.robust._dgscale.fit_allpass_pair`), which run until SciPy's
+#: tolerances end them (:func:`ambseal.lti.least_squares.least_squares_converged`) or a
+#: round of SciPy's default count (100 evaluations per parameter) lowers the fit's largest
+#: weighted error by less than this fraction of it. The largest error is what the order
+#: choice reads, and it prefers a higher order only for a 10 % lower error: a round that
+#: moves it by a tenth of that step cannot change the choice by itself. Where a tolerance
+#: ends the fit within its first round the test is never reached.
+FIT_STALL_RTOL = 0.01
+
 
 def _logmag(theta, w, order):
     """log|W(jω)| for W = k Π(num sections)/Π(den sections), all roots in the LHP."""

@@ -33,10 +33,11 @@ from typing import Any, Sequence
 import control as ct
 import numpy as np
 from rich.console import Console
-from scipy.optimize import least_squares
 
 from ambseal.errors import ConfigError, ModelError, SynthesisError
+from ambseal.lti import least_squares_converged
 from ambseal.robust._dscale import (
+    FIT_STALL_RTOL,
     _balance_channels,
     _complexify,
     _d_theta,
@@ -111,10 +112,10 @@ def fit_magnitude(omega, mag, order: int):
                 th += [cs[n2 + i] if n2 + i < cs.size else cs[-1]]
         th = np.array(th)
         th[0] = np.mean(y - _logmag(th, w, order))
-        res = least_squares(lambda t: _logmag(t, w, order) - y, th, method="trf",
-                            bounds=(np.r_[-60.0, np.full(th.size - 1, lw.min() - 12)],
-                                    np.r_[60.0, np.full(th.size - 1, 2 * lw.max() + 12)]),
-                            max_nfev=400)
+        res = least_squares_converged(
+            lambda t: _logmag(t, w, order) - y, th, method="trf",
+            bounds=(np.r_[-60.0, np.full(th.size - 1, lw.min() - 12)],
+                    np.r_[60.0, np.full(th.size - 1, 2 * lw.max() + 12)]))
         if best is None or res.cost < best.cost:
             best = res
     num, den = _theta_to_tf(best.x, order)
@@ -147,10 +148,13 @@ def _fit_weighted(w, y, order, wgt, starts):
             np.array([60.0] + [b[1] for b in sec] * 2)
         x = np.clip(np.array(x), lb + 1e-6, ub - 1e-6)
         x[0] = np.average(y - _logmag(theta(x), w, order), weights=wgt)
-        res = least_squares(lambda t: sq * (_logmag(theta(t), w, order) - y), x,
-                            method="trf", bounds=(lb, ub), max_nfev=150)
-        th = theta(res.x)
-        err = float(np.max(np.abs(_logmag(th, w, order) - y) * wgt / wgt.max()))
+        def largest(t):
+            return float(np.max(np.abs(_logmag(theta(t), w, order) - y) * wgt / wgt.max()))
+
+        res = least_squares_converged(lambda t: sq * (_logmag(theta(t), w, order) - y), x,
+                                      method="trf", bounds=(lb, ub), stall=largest,
+                                      stall_rtol=FIT_STALL_RTOL)
+        th, err = theta(res.x), largest(res.x)
         if err < best_err:
             best, best_err = th, err
     return best, best_err

@@ -36,12 +36,11 @@ from scipy.optimize import least_squares
 
 from ambseal.errors import IdentificationError
 from ambseal.identify.fitting.budget import ErrorBudget, propagate
-from ambseal.identify.fitting.converged import least_squares_converged
 from ambseal.identify.fitting.residuals import MISMATCH, ResidualTests, residual_tests
 from ambseal.identify.fitting.sandwich import _covariance, _long_run_covariance, _score_test, _t_quantile  # noqa: F401
 from ambseal.identify.fitting.sensor_lag import TAU_S, lag_test_dict, with_sensor_lag
 from ambseal.identify.fitting.stats import jacobian_correlation
-from ambseal.lti import series_inputs, simulate_lti, zoh
+from ambseal.lti import least_squares_converged, series_inputs, simulate_lti, zoh
 from ambseal.model import Plant, eddy_lag_matrices
 from ambseal.robust import DiscreteController, closed_loop_matrices
 from ambseal.threads import with_numerics_threads
@@ -338,7 +337,7 @@ def fit_parameters(
     max_nfev : int, optional
         A cap on model evaluations; exhausting it flags the result as not converged. None
         (the default): the fit ends at its tolerances
-        (:func:`ambseal.identify.fitting.converged.least_squares_converged`), never at a count.
+        (:func:`ambseal.lti.least_squares.least_squares_converged`), never at a count.
     window : (start, stop)
         Samples of each record in the cost (e.g. one frequency of a stepped sine); the
         simulation always starts at rest at sample 0.

@@ -74,7 +74,6 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ambseal.errors import IdentificationError
-from ambseal.identify.fitting.converged import least_squares_converged
 from ambseal.identify.fitting.coprime import (
     CoprimeFactors,
     _as_2d,
@@ -84,7 +83,7 @@ from ambseal.identify.fitting.coprime import (
     observer_gains,
     youla_factorisation,
 )
-from ambseal.lti import simulate_lti, zoh
+from ambseal.lti import least_squares_converged, simulate_lti, zoh
 from ambseal.model import Plant
 
 __all__ = [
@@ -412,7 +411,7 @@ def identify_youla(
         Bounds on every normalised θ.
     max_nfev : int, optional
         A cap on function evaluations. None (the default): the fit ends at its tolerances
-        (:func:`ambseal.identify.fitting.converged.least_squares_converged`), never at a count.
+        (:func:`ambseal.lti.least_squares.least_squares_converged`), never at a count.
 
     Returns
     -------

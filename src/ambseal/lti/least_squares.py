@@ -9,6 +9,10 @@ round of SciPy's default count at a time, until a tolerance ends it, or until a 
 round lowers the cost by less than ``ftol`` of it: SciPy's ``ftol`` test, which it applies
 to one step, applied to the round. The fit has then stalled, and more rounds would not
 move it.
+
+A caller that reads another number of the fit than its cost (a D-scale fit's order is
+chosen by its largest weighted error, not by the sum of squares) gives that number as
+``stall``: the round's test is then applied to it, with its own relative tolerance.
 """
 
 from __future__ import annotations
@@ -22,13 +26,25 @@ __all__ = ["least_squares_converged"]
 DEFAULT_FTOL = 1e-8
 
 
-def least_squares_converged(fun, x0, **kwargs) -> OptimizeResult:
+def least_squares_converged(fun, x0, *, stall=None, stall_rtol: float | None = None,
+                            **kwargs) -> OptimizeResult:
     """``scipy.optimize.least_squares(fun, x0, **kwargs)`` run until one of its tolerances,
     or the round's stall test, ends it (module docstring).
 
     Parameters
     ----------
-    fun, x0, **kwargs
+    fun : callable
+        ``fun(x) -> ndarray``, the residuals, as for ``scipy.optimize.least_squares``.
+    x0 : array_like, shape (n,)
+        The start.
+    stall : callable, optional
+        ``stall(x) -> float``, the non-negative number of the fit the caller reads; a round
+        that lowers it by less than ``stall_rtol`` of it (or raises it) ends the fit. The
+        cost by default.
+    stall_rtol : float, optional
+        The round test's relative tolerance; ``ftol`` (SciPy's default 1e-8 when none is
+        given) by default.
+    **kwargs
         As for ``scipy.optimize.least_squares``. ``max_nfev`` is refused, because this
         function exists to remove a count.
 
@@ -47,17 +63,24 @@ def least_squares_converged(fun, x0, **kwargs) -> OptimizeResult:
     """
     if "max_nfev" in kwargs:
         raise TypeError("least_squares_converged: max_nfev is not taken (it runs to tolerance)")
-    ftol = kwargs.get("ftol") or DEFAULT_FTOL
+    rtol = stall_rtol if stall_rtol is not None else (kwargs.get("ftol") or DEFAULT_FTOL)
+    what = "the cost" if stall is None else "the stall measure"
+
+    def measure(r):
+        return r.cost if stall is None else float(stall(r.x))
+
     res = least_squares(fun, x0, **kwargs)
     nfev, njev, rounds = res.nfev, res.njev or 0, 1
     while res.status == 0:
-        nxt = least_squares(fun, res.x, **kwargs)
-        nfev, njev, rounds = nfev + nxt.nfev, njev + (nxt.njev or 0), rounds + 1
-        # trf takes only steps that lower the cost, so a round from res.x never raises it
-        fell, res = res.cost - nxt.cost, nxt
-        if res.status == 0 and fell <= ftol * max(res.cost, np.finfo(float).tiny):
+        before = measure(res)
+        # trf takes only steps that lower the cost, so a round from res.x never raises it;
+        # a stall measure other than the cost may rise, which ends the fit too
+        res = least_squares(fun, res.x, **kwargs)
+        nfev, njev, rounds = nfev + res.nfev, njev + (res.njev or 0), rounds + 1
+        after = measure(res)
+        if res.status == 0 and before - after <= rtol * max(after, np.finfo(float).tiny):
             res.status = 2
-            res.message = (f"stalled: a round of {nxt.nfev} evaluations lowered the cost "
-                           f"by less than ftol = {ftol:g} of it")
+            res.message = (f"stalled: a round of {res.nfev} evaluations lowered {what} "
+                           f"by less than {rtol:g} of it")
     res.nfev, res.njev, res.rounds = nfev, njev, rounds
     return res

@@ -1,5 +1,5 @@
 """A fit ends at its own tolerances, never at a count of evaluations
-(:mod:`ambseal.identify.fitting.converged`)."""
+(:mod:`ambseal.lti.least_squares`)."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from scipy.optimize import least_squares
 
-import ambseal.identify.fitting.converged as converged
-from ambseal.identify.fitting.converged import least_squares_converged
+import ambseal.lti.least_squares as converged
+from ambseal.lti.least_squares import least_squares_converged
 
 
 def rosenbrock(x):
@@ -43,6 +43,21 @@ def test_a_round_that_does_not_lower_the_cost_ends_the_fit(monkeypatch):
     res = least_squares_converged(lambda x: np.array([1.0, 1.0 + 0.0 * x[0]]), [0.5],
                                   gtol=None, xtol=None)
     assert res.status == 2 and res.rounds == 2 and "stalled" in res.message
+
+
+def test_a_round_that_does_not_lower_the_callers_measure_ends_the_fit(monkeypatch):
+    """The caller's stall measure, not the cost, is tested: Rosenbrock's cost falls in every
+    round cut at 4 evaluations, but a measure that stays at 1 ends the fit after one
+    continued round; one that keeps falling lets it reach the minimum (1, 1)."""
+    cut_rounds(monkeypatch, 4)
+    res = least_squares_converged(rosenbrock, [-1.2, 1.0], stall=lambda x: 1.0,
+                                  stall_rtol=0.01)
+    assert res.status == 2 and res.rounds == 2 and "stall measure" in res.message
+    assert np.max(np.abs(res.x - 1.0)) > 1e-3
+    res = least_squares_converged(rosenbrock, [-1.2, 1.0],
+                                  stall=lambda x: float(np.sum(rosenbrock(x) ** 2)),
+                                  stall_rtol=0.01)
+    np.testing.assert_allclose(res.x, [1.0, 1.0], atol=1e-6)
 
 
 def test_a_count_is_refused():

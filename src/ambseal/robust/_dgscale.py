@@ -31,7 +31,7 @@ worse. So, in turn:
   uncontrollable copies in the K-step's plant and controller.
 
 On the spring–mass case the fits then certify the current controller within 0.3 % at every
-step (σ̄(S) 1.000–1.003), and D–G–K reaches μ 0.94 (complex D–K: 1.08).
+step (σ̄(S) 1.000–1.003), and D–G–K reaches μ 0.95 (complex D–K: 1.08).
 
 References: Young, "Controller design for mixed uncertainties using a D-G-K iteration"
 (1996); Kraft, "A software package for sequential quadratic programming" (1988, SLSQP);
@@ -481,8 +481,12 @@ def scaled_plant_dg(P, sblocks, fits, beta, nmeas, ncon):
 # --------------------------------------------------------------------------- refinement
 #: refinement grid: points per interval of μ's grid, and decades added at both ends
 _DENSE, _WIDEN = 3, 0.5
-#: SLSQP iterations per refinement; cutting planes (H∞ peaks added to the grid)
-_MAX_ITER, _MAX_CUTS = 100, 3
+#: cutting planes (H∞ peaks added to the grid) per refinement
+_MAX_CUTS = 3
+#: SLSQP's ``ftol`` of each refinement; also its rounds' stall test (:func:`_minimax`)
+_SLSQP_FTOL = 1e-6
+#: SLSQP's status where its iteration count (SciPy's default, 100) stopped it
+_SLSQP_COUNT = 9
 #: a peak between grid points this far above the grid's peak is added to the grid
 _CUT_RTOL = 1e-2
 #: scalings whose level stays this far above 1 are refined once more at the largest orders
@@ -497,8 +501,8 @@ def _dense_grid(w):
 
 
 def _minimax(sc: DGScalings, x0, M, w):
-    """x minimising max_ω σ̄(S) on ``w`` from x0 (SLSQP on the epigraph); never worse
-    than x0."""
+    """x minimising max_ω σ̄(S) on ``w`` from x0 (SLSQP on the epigraph, ended by its
+    ``ftol`` or a round's stall, never by its count); never worse than x0."""
     s0 = sc.sigma(x0, M, w)
     p = x0.size
 
@@ -509,11 +513,20 @@ def _minimax(sc: DGScalings, x0, M, w):
         _, G = sc.sigma(z[:-1], M, w, grad=True)
         return np.hstack([-G, np.ones((w.size, 1))])
 
-    res = minimize(lambda z: z[-1], np.r_[x0, s0.max()],
-                   jac=lambda z: np.r_[np.zeros(p), 1.0], method="SLSQP",
-                   bounds=list(zip(np.r_[sc.lb, 0.0], np.r_[sc.ub, np.inf])),
-                   constraints=[{"type": "ineq", "fun": cons, "jac": cons_jac}],
-                   options={"maxiter": _MAX_ITER, "ftol": 1e-6})
+    def solve(z0):
+        return minimize(lambda z: z[-1], z0, jac=lambda z: np.r_[np.zeros(p), 1.0],
+                        method="SLSQP", bounds=list(zip(np.r_[sc.lb, 0.0], np.r_[sc.ub, np.inf])),
+                        constraints=[{"type": "ineq", "fun": cons, "jac": cons_jac}],
+                        options={"ftol": _SLSQP_FTOL})
+
+    res = solve(np.r_[x0, s0.max()])
+    # where SciPy's count stopped SLSQP, it goes on from there until its ftol ends it or a
+    # whole round lowers the level by less than ftol: a stall, not a count
+    while res.status == _SLSQP_COUNT:
+        level = res.fun
+        res = solve(res.x)
+        if res.status == _SLSQP_COUNT and level - res.fun <= _SLSQP_FTOL:
+            break
     x = np.clip(res.x[:-1], sc.lb, sc.ub)
     return x if np.all(np.isfinite(x)) and sc.sigma(x, M, w).max() < s0.max() else x0
 

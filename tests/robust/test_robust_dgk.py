@@ -310,6 +310,52 @@ def test_the_refinement_ends_by_slsqps_tolerance_not_its_count(monkeypatch):
     assert level <= whole * (1 + 1e-3)
 
 
+@pytest.mark.parametrize("points", [27, 35])
+def test_the_cutting_planes_end_when_the_bound_is_tight_or_stalls_not_after_a_count(
+        monkeypatch, points):
+    """On μ's grids of 27 and 35 points the spring–mass loop of an H∞ controller puts the
+    scaled loop's H∞ peaks between the points, and the refinement adds cutting planes
+    (under one BLAS thread and two, 4–11 H∞ norms). Each pass (the fitted orders, then
+    the largest) ends at the first cut where the H∞ level is within ``_CUT_RTOL`` of the
+    grid's peak or where ``_CUT_PATIENCE`` cuts in a row have not lowered the pass's
+    best level by ``_CUT_RTOL``, and the refinement delivers the lowest level it
+    evaluated. Three cuts a pass, keeping each pass's last, broke both: on 27 points
+    under two threads it delivered 1.18 where a cut had reached 1.12, under one 3.25
+    where one had reached 1.18."""
+    from ambseal.robust import dgk
+    from ambseal.robust.hinf import hinfsyn
+
+    P = spring_mass_plant()
+    K = hinfsyn(ct.ss(P.A, P.B[:, 2:], P.C[2:], P.D[2:, 2:]), 1, 1).K
+    w = np.logspace(-2, 3, points)
+    mu_s = mussv(freqresp(lft_lower(P, K, 1, 1), w), SM_BLOCKS)
+    cuts, minimax, hinfnorm = [], dg._minimax, dg.hinfnorm
+
+    def seen_minimax(sc, x0, M, wd):
+        x = minimax(sc, x0, M, wd)
+        cuts.append([id(sc), float(sc.sigma(x, M, wd).max())])
+        return x
+
+    def seen_hinfnorm(*args, **kw):
+        level, w_peak = hinfnorm(*args, **kw)
+        cuts[-1].append(float(level))
+        return level, w_peak
+
+    monkeypatch.setattr(dg, "_minimax", seen_minimax)
+    monkeypatch.setattr(dg, "hinfnorm", seen_hinfnorm)
+    level = dgk._dg_step_scalings(P, K, 1, 1, mu_s, SM_REAL, float(mu_s.upper.max()), w,
+                                  0.05)[2]
+    assert len(cuts) >= 4  # three cuts or more: where a count of three ended the pass
+    assert level == min(c[2] for c in cuts)
+    for sc in dict.fromkeys(c[0] for c in cuts):
+        best, misses, ended = np.inf, 0, []
+        for _, peak, lv in (c for c in cuts if c[0] == sc):
+            misses = 0 if lv < best * (1 - dg._CUT_RTOL) else misses + 1
+            best = min(best, lv)
+            ended.append(lv <= peak * (1 + dg._CUT_RTOL) or misses >= dg._CUT_PATIENCE)
+        assert ended[-1] and not any(ended[:-1]), ended
+
+
 def test_relaxed_pointwise_scalings_keep_their_level_and_vary_less():
     """Reference: the μ upper bound of mussv (its own generalised eigenvalue solver) at the
     pointwise scalings of a spring–mass loop equals the level _levels computes from those

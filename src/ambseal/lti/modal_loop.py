@@ -80,6 +80,13 @@ _EPS = float(np.finfo(float).eps)
 #: on three plants of 540, 840 and 1 888 states. At 0.5 the 540-state plant's loops,
 #: strong parts of 190–290, took the structured path at 2–3 times the dense cost.
 _MAX_STRONG_FRACTION = 0.25
+#: The fixed-point iterations of the strong and weak poles (:meth:`_StrongPart.refine`,
+#: :func:`_weak_poles`) contract by about the weak modes' relative shift (at most
+#: ``WEAK``), so each settles to its rounding-level tolerance in a few steps (measured:
+#: within three on each of the 18 loops of tests/lti/test_modal_loop.py, strong part and
+#: weak modes alike). One that has not settled after this many circles at rounding
+#: level: the loop's poles then come from the dense eigenvalues (``None``). A choice
+#: between two paths that both meet the tolerance, not an answer cut short.
 _MAX_ITER = 30
 #: The split of the last loops (:class:`_Solved`, no n × n array: 0.6 MB at 1 888
 #: states): a loop's poles and its time response share one, also when the design's check

@@ -25,8 +25,9 @@ worse. So, in turn:
 * the fits (uniform weights) are refined to minimise ``max_ω σ̄(S)`` directly
   (:func:`refine_scalings`: SLSQP on the epigraph with analytic gradients, on a grid three
   times denser than μ's and half a decade wider; the H∞ norm of the scaled closed loop,
-  AB13DD, adds the frequency of any peak between grid points, a cutting plane), once more
-  at the largest orders if that leaves σ̄(S) above 1;
+  AB13DD, adds the frequency of any peak between grid points, a cutting plane, until the
+  bound is tight or the cuts stall), once more at the largest orders if that leaves σ̄(S)
+  above 1;
 * the scaled plant realises each all-pass pair once (:func:`scaled_plant_dg`): no
   uncontrollable copies in the K-step's plant and controller.
 
@@ -481,13 +482,15 @@ def scaled_plant_dg(P, sblocks, fits, beta, nmeas, ncon):
 # --------------------------------------------------------------------------- refinement
 #: refinement grid: points per interval of μ's grid, and decades added at both ends
 _DENSE, _WIDEN = 3, 0.5
-#: cutting planes (H∞ peaks added to the grid) per refinement
-_MAX_CUTS = 3
+#: cutting planes (H∞ peaks added to the grid) that in a row do not lower the best level
+#: by ``_CUT_RTOL`` end a refinement: a stall, as D–G–K's steps end by their patience
+_CUT_PATIENCE = 2
 #: SLSQP's ``ftol`` of each refinement; also its rounds' stall test (:func:`_minimax`)
 _SLSQP_FTOL = 1e-6
 #: SLSQP's status where its iteration count (SciPy's default, 100) stopped it
 _SLSQP_COUNT = 9
-#: a peak between grid points this far above the grid's peak is added to the grid
+#: a peak between grid points this far above the grid's peak is added to the grid; also
+#: the gain in the level that counts for the cuts' patience
 _CUT_RTOL = 1e-2
 #: scalings whose level stays this far above 1 are refined once more at the largest orders
 _RETRY = 1e-2
@@ -533,7 +536,9 @@ def _minimax(sc: DGScalings, x0, M, w):
 
 def refine_scalings(sc: DGScalings, P, K, sblocks, nmeas, ncon, w):
     """The scalings' parameters that minimise ``max_ω σ̄(S)`` of the current controller
-    (module docstring), and that peak.
+    (module docstring), and that peak: the lowest H∞ level of the cutting planes' scalings
+    (Kelley 1960), each pass ended where the level is within ``_CUT_RTOL`` of the grid's
+    peak or ``_CUT_PATIENCE`` cuts in a row have not lowered the pass's best by it.
 
     Parameters
     ----------
@@ -560,21 +565,34 @@ def refine_scalings(sc: DGScalings, P, K, sblocks, nmeas, ncon, w):
     M = freqresp(cl, wd)
     best = None
     while sc is not None:
-        x = sc.x0
-        for _ in range(_MAX_CUTS + 1):
+        x, here, misses = sc.x0, None, 0
+        # Kelley's cutting planes: each H∞ peak between the grid's points joins the grid,
+        # until the level is within _CUT_RTOL of the grid's peak (the bound is tight) or
+        # _CUT_PATIENCE cuts in a row lower the best level by less than _CUT_RTOL; the
+        # best of the cuts' scalings is kept (a cut can raise the level)
+        while True:
             x = _minimax(sc, x, M, wd)
             peak = float(sc.sigma(x, M, wd).max())
             fits = sc.fits(x)
             level, w_peak = hinfnorm(lft_lower(scaled_plant_dg(P, sblocks, fits, sc.beta,
                                                               nmeas, ncon), K, nmeas, ncon),
                                      rtol=1e-6)
-            if not (np.isfinite(level) and level > peak * (1 + _CUT_RTOL) and w_peak > 0):
+            if here is None or level < here[2] * (1 - _CUT_RTOL):
+                misses = 0
+            else:
+                misses += 1
+            if here is None or level < here[2]:
+                here = (x, fits, float(level))
+            tight = not (np.isfinite(level) and level > peak * (1 + _CUT_RTOL) and w_peak > 0)
+            if not tight:  # the peak joins the grid, also for the pass at the largest orders
+                wn = w_peak * np.array([0.98, 1.0, 1.02])
+                wd = np.r_[wd, wn]
+                M = np.concatenate([M, freqresp(cl, wn)])
+            if tight or misses >= _CUT_PATIENCE:
                 break
-            wn = w_peak * np.array([0.98, 1.0, 1.02])
-            wd = np.r_[wd, wn]
-            M = np.concatenate([M, freqresp(cl, wn)])
+        x, fits, level = here
         if best is None or level < best[1]:
-            best = (fits, float(level))
+            best = (fits, level)
         # the fitted orders could not reach the pointwise level: once more at the largest
         sc = sc.enlarged(x) if level > 1 + _RETRY else None
     return best

@@ -47,8 +47,8 @@ import control as ct
 import numpy as np
 from scipy.optimize import minimize
 
-from ambseal.lti.freqresp import freqresp
 from ambseal.lti import least_squares_converged
+from ambseal.lti.freqresp import freqresp
 from ambseal.robust._dscale import (
     FIT_STALL_RTOL, _d_logmag_jac, _d_sections, _d_theta, _diag_sys, _ss, _tf_to_theta,
     _theta_to_tf,

@@ -625,12 +625,12 @@ def mu_peak(M, blocks, omega, upper=None, *, candidates: int = 2, band: float = 
         for k, (x, y) in enumerate(brackets):
             j = int(np.argmax(y))
             lo, hi = max(j - 1, 0), min(j + 1, x.size - 1)
-            if x[hi] - x[lo] <= xtol or min(y[lo], y[hi]) >= (1.0 - ftol) * y[j]:
+            width = x[hi] - x[lo]
+            if width <= xtol or min(y[lo], y[hi]) >= (1.0 - ftol) * y[j]:
                 continue
             # the points lie on a lattice of the grid's spacing, so a new one can repeat an
             # old one; a repeated best point would be its own neighbour, and the bracket
             # would lose the side the peak is on
-            width = x[hi] - x[lo]
             todo.extend((k, v) for v in np.linspace(x[lo], x[hi], int(points) + 2)[1:-1]
                         if np.min(np.abs(x - v)) > 1e-9 * width)
         if not todo:

@@ -192,6 +192,39 @@ def test_one_iteration_returns_hinfsyn_and_says_why_it_stopped():
     assert r.stopping["search"]["granted"] == 0 and r.stopping["search"]["evaluations"] == 0
 
 
+def test_scaled_hinf_is_musyns_first_k_step_without_its_mu_analysis(monkeypatch):
+    """Reference: H∞ at constant scalings is musyn's start and first K-step
+    (``order=0, max_iter=1``): the same controller and γ, and that γ is
+    ‖D F_l(P, K) D⁻¹‖_∞ with D the start's scale (python-control's ``linfnorm`` on the
+    unscaled plant's closed loop, in the start's units). It computes no μ: the analysis
+    of the closed loop, which the scaled-H∞ designs over a speed range discarded, was
+    most of their time."""
+    import ambseal.robust.dk as dk
+    from ambseal.robust.dk import scaled_hinfsyn
+
+    P = rp_plant()
+    ref = musyn(P, [(1, 1), (1, 1)], 1, 1, order=0, max_iter=1)
+
+    def no_mu(*args, **kw):
+        raise AssertionError("scaled_hinfsyn ran a μ analysis")
+
+    monkeypatch.setattr(dk, "mussv", no_mu)
+    monkeypatch.setattr(dk, "mu_peak", no_mu)
+    r = scaled_hinfsyn(P, [(1, 1), (1, 1)], 1, 1)
+    assert r.stopping["start"] == ref.stopping["start"]
+    assert r.gamma == pytest.approx(ref.gamma, rel=1e-12)
+    w = np.logspace(-3, 3, 7)
+    np.testing.assert_allclose(r.K(1j * w), ref.K(1j * w), rtol=1e-10)
+    (b,) = r.stopping["start"]["scales"]
+    gamma, _ = ct.linfnorm(in_units(P, 1 / b).lft(r.K, 1, 1))
+    assert r.gamma == pytest.approx(gamma, rel=1e-4)
+    assert r.gamma_opt <= r.gamma
+    with pytest.raises(ValueError, match="backoff"):
+        scaled_hinfsyn(P, [(1, 1), (1, 1)], 1, 1, backoff=0.5)
+    with pytest.raises(ValueError, match="performance"):
+        scaled_hinfsyn(P, [(1, 1), (1, 0)], 1, 1)
+
+
 def test_dk_iterations_end_by_the_stall_rule_not_a_count(monkeypatch):
     """Without ``max_iter`` the D–K iterations end by their stall rule alone, however many
     of them gain more than ``rtol``. Fault injection: the μ curve of the first 11

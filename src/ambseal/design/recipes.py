@@ -86,6 +86,7 @@ from ambseal.robust import (
     musyn_dgk,
     performance_level,
     reduce_controller,
+    scaled_hinfsyn,
     scaled_performance,
     unstable_poles,
 )
@@ -730,7 +731,7 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
     ``progress(line)`` gets μ's iterations.
 
     H∞ over a speed range is the K-step of D–K at constant scalings
-    (:func:`~ambseal.robust.dk.musyn` with ``order=0``, one iteration): the H∞ synthesis on
+    (:func:`~ambseal.robust.dk.scaled_hinfsyn`): the H∞ synthesis on
     ``D P D⁻¹`` with the constant D of the smallest γ_opt, whose γ < 1 would certify every
     plant of the range by the small-gain theorem (Zhou, Doyle & Glover, *Robust and
     Optimal Control*, 1996, §11.3: scaled H∞); a controller of the nominal H∞'s order."""
@@ -747,8 +748,8 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
     mu_omega = None
 
     def scaled_hinf(P):  # H∞ at the constant scalings of the speed channel
-        return musyn(P, gp.blocks, gp.nmeas, gp.ncon, design_omega(*sp.synthesis_band_hz),
-                     order=0, max_iter=1)
+        return scaled_hinfsyn(P, gp.blocks, gp.nmeas, gp.ncon,
+                              design_omega(*sp.synthesis_band_hz))
 
     P, tried, found = gp.P, (), None
     if speed is None:

@@ -59,6 +59,7 @@ _FROM = {
     "PEAK_TOLERANCE": "digital", "closed_loop_matrices": "digital_loop",
     "discrete_controller": "digital_loop", "DiscreteController": "digital_loop",
     "design_omega": "dk", "fit_magnitude": "dk", "musyn": "dk", "MusynResult": "dk",
+    "scaled_hinfsyn": "dk", "ScaledHinfResult": "dk",
     "hinfnorm": "hinf", "hinfsyn": "hinf", "lft_lower": "hinf", "HinfResult": "hinf",
     "performance_level": "level", "scaled_performance": "level", "LevelResult": "level",
     "LEVEL_FLOOR": "level", "LEVEL_RTOL": "level",

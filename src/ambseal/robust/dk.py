@@ -54,7 +54,7 @@ from ambseal.robust.mu import check_blocks, mu_peak, mussv, upper_near_peak
 from ambseal.threads import with_numerics_threads
 
 __all__ = ["MusynResult", "musyn", "fit_magnitude", "fit_dscale", "default_omega",
-           "design_omega"]
+           "design_omega", "ScaledHinfResult", "scaled_hinfsyn"]
 
 
 # --------------------------------------------------------------------------- D fitting
@@ -516,27 +516,13 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     Methods for Optimization (1999) §8.1 (restarts).
     """
     t0 = time.process_time()
-    try:
-        check_plant(P, nmeas, ncon)
-        unchecked = False
-    except SynthesisError:  # its rank tests depend on the Δ channels' units: judged balanced
-        unchecked = True
-    blks = check_blocks(P, blocks, nmeas, ncon)
-    if blks[-1].kind != "full":
-        raise ModelError("musyn: the last block must be the full complex performance block")
     _check_settings(order, search, search_backoff)
     _check_counts(max_iter=max_iter, patience=patience, rtol=rtol, backoff=backoff,
                   fit_tol=fit_tol)
-    w = default_omega(P) if omega is None else np.asarray(omega, float)
-    if w.ndim != 1 or w.size < 2 or np.any(w <= 0) or not np.all(np.isfinite(w)):
-        raise ConfigError("musyn: omega must be a 1-D grid of positive rad/s values")
-    cblocks = _complexify(blks)
+    P_user, w = P, _grid(P, omega, "musyn")
+    P, cblocks, (bal, n_start, start_rule) = _balanced_start(P, blocks, nmeas, ncon, w,
+                                                             search, "musyn")
     console = progress_printer(progress)
-    start = _start_evals(search, cblocks, P.nstates)
-    P_user, (P, bal, n_start, start_rule) = P, _balance_channels(P, cblocks, nmeas, ncon,
-                                                                  w, start)
-    if unchecked:
-        check_plant(P, nmeas, ncon)
 
     history, best = [], None
     fits: list = []
@@ -602,6 +588,113 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     # returned in the user's units
     r = _result(P, blocks, nmeas, ncon, w, finalists, history, t0, stopping=stopping)
     return replace(r, closed_loop=lft_lower(P_user, r.K, nmeas, ncon))
+
+
+def _grid(P, omega, who: str) -> np.ndarray:
+    """The frequency grid (rad/s): ``omega`` checked, or :func:`default_omega`."""
+    w = default_omega(P) if omega is None else np.asarray(omega, float)
+    if w.ndim != 1 or w.size < 2 or np.any(w <= 0) or not np.all(np.isfinite(w)):
+        raise ConfigError(f"{who}: omega must be a 1-D grid of positive rad/s values")
+    return w
+
+
+def _balanced_start(P, blocks, nmeas, ncon, w, search, who: str):
+    """D–K's start: ``(P_b, cblocks, (scales, evaluations, rule))``, the plant with its
+    uncertainty channels at the constant D of :func:`_balance_channels` and the
+    complexified structure; the plant's assumptions checked on ``P_b`` where, on ``P``,
+    they fail only in the Δ channels' units (ModelError, SynthesisError)."""
+    try:
+        check_plant(P, nmeas, ncon)
+        unchecked = False
+    except SynthesisError:  # its rank tests depend on the Δ channels' units: judged balanced
+        unchecked = True
+    blks = check_blocks(P, blocks, nmeas, ncon)
+    if blks[-1].kind != "full":
+        raise ModelError(f"{who}: the last block must be the full complex performance block")
+    cblocks = _complexify(blks)
+    start = _start_evals(search, cblocks, P.nstates)
+    P, *rest = _balance_channels(P, cblocks, nmeas, ncon, w, start)
+    if unchecked:
+        check_plant(P, nmeas, ncon)
+    return P, cblocks, tuple(rest)
+
+
+@dataclass(frozen=True)
+class ScaledHinfResult:
+    """Result of :func:`scaled_hinfsyn`.
+
+    Attributes
+    ----------
+    K : control.StateSpace
+        Controller ``u = K y`` (the same ``u`` and ``y`` as ``P``'s).
+    gamma : float
+        ``‖D F_l(P, K) D⁻¹‖_∞`` at the constant scalings D: below 1, it certifies every
+        Δ of the structure with σ̄(Δ) ≤ 1 by the small-gain theorem.
+    gamma_opt : float
+        γ_opt of the scaled plant.
+    stopping : dict
+        ``start`` ``{"scales", "evaluations", "rule"}`` (as :class:`MusynResult`'s).
+    elapsed_s : float
+        CPU time (s, this process): a measurement.
+    """
+
+    K: Any
+    gamma: float
+    gamma_opt: float
+    stopping: dict = field(default_factory=dict)
+    elapsed_s: float = float("nan")
+
+
+@with_numerics_threads
+def scaled_hinfsyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
+                   *, backoff: float = 1.01, search: int | str = "auto") -> ScaledHinfResult:
+    """H∞ synthesis at the constant scalings of the smallest γ_opt: :func:`musyn`'s start
+    and first K-step, without its μ analysis (Zhou, Doyle & Glover, *Robust and Optimal
+    Control*, 1996, §11.3: scaled H∞).
+
+    The same controller and γ as ``musyn(P, blocks, nmeas, ncon, omega, order=0,
+    max_iter=1, backoff=backoff, search=search)``, whose μ of the closed loop (the D–G
+    upper bound over ``omega`` and its re-check around the peaks) a caller that wants the
+    certificate of γ alone does not need.
+
+    Parameters
+    ----------
+    P : control.StateSpace
+        Generalised plant, inputs ``[w_Δ, w, u]``, outputs ``[z_Δ, z, y]``.
+    blocks : sequence of (int, int)
+        The structure (:func:`musyn`'s); the last block is the performance block.
+    nmeas, ncon : int
+        Number of measurements and control inputs.
+    omega : array_like, optional
+        Frequency grid in rad/s of the channels' RMS balance (default:
+        :func:`default_omega`).
+    backoff : float
+        The controller is built at ``backoff·γ_opt`` (:func:`~ambseal.robust.hinf.hinfsyn`).
+    search : int or "auto"
+        The search for the constant D (:func:`musyn`'s ``search``, which also caps it).
+
+    Returns
+    -------
+    ScaledHinfResult
+
+    Raises
+    ------
+    ModelError, ConfigError
+        Blocks that do not match P's exogenous channels, a bad grid or setting.
+    SynthesisError
+        No controller for the scaled plant (plant assumptions violated).
+    """
+    t0 = time.process_time()
+    _check_settings(0, search, 1.0)
+    _check_counts(backoff=backoff)
+    w = _grid(P, omega, "scaled_hinfsyn")
+    Pb, _, (bal, n_start, start_rule) = _balanced_start(P, blocks, nmeas, ncon, w, search,
+                                                        "scaled_hinfsyn")
+    hr = hinfsyn(Pb, nmeas, ncon, backoff=backoff)
+    return ScaledHinfResult(
+        K=hr.K, gamma=float(hr.gamma), gamma_opt=float(hr.gamma_opt),
+        stopping={"start": {"scales": bal, "evaluations": n_start, "rule": start_rule}},
+        elapsed_s=time.process_time() - t0)
 
 
 def _check_settings(order, search, search_backoff) -> None:

@@ -141,7 +141,7 @@ def performance_level(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int,
         Measurements and controls.
     synthesise : callable
         ``synthesise(P_alpha)`` → a result with ``gamma``, a constant-scaled H∞ bound
-        (:func:`ambseal.robust.dk.musyn` with ``order=0``, say), for ``P`` with its
+        (:func:`ambseal.robust.dk.scaled_hinfsyn`, say), for ``P`` with its
         uncertainty inputs scaled by 1/α; the bound at level α is α·``gamma``.
     refused : float, optional
         A level in (``floor``, 1] the caller already found not certified (bound ≥ 1

@@ -127,19 +127,6 @@ def _theta_to_tf(theta, order):
     return k * polys[0], polys[1]
 
 
-def _complexify(blks):
-    """Diagonal-D structure: repeated scalars → independent complex scalars."""
-    out, groups = [], []
-    for j, b in enumerate(blks):
-        if b.kind == "full":
-            out.append((b.r, b.c))
-            groups.append(j)
-        else:
-            out.extend([(1, 1)] * b.r)
-            groups.extend([j] * b.r)
-    return out
-
-
 def _ss(tf):
     s = ct.ss(tf)
     return np.asarray(s.A, float), np.asarray(s.B, float), np.asarray(s.C, float), np.asarray(s.D, float)

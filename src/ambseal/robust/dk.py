@@ -39,7 +39,6 @@ from ambseal.lti import least_squares_converged
 from ambseal.robust._dscale import (
     FIT_STALL_RTOL,
     _balance_channels,
-    _complexify,
     _d_theta,
     _logmag,
     _scaled_plant,
@@ -50,7 +49,7 @@ from ambseal.robust._dscale import (
     _unbalanced_fit,
 )
 from ambseal.robust.hinf import check_plant, hinfsyn, lft_lower
-from ambseal.robust.mu import check_blocks, mu_peak, mussv, upper_near_peak
+from ambseal.robust.mu import _complexify, check_blocks, mu_peak, upper_on_grid
 from ambseal.threads import with_numerics_threads
 
 __all__ = ["MusynResult", "musyn", "fit_magnitude", "fit_dscale", "default_omega",
@@ -555,7 +554,7 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
                               "static scalings taken")
         near = hr.gamma_opt
         cl = lft_lower(P, hr.K, nmeas, ncon)
-        mu_c, curve = _mu_step(cl, blocks, cblocks, w)
+        mu_c, curve = _mu_step(cl, blocks, w)
         peak = float(np.max(curve))
         history.append({"iteration": it, "gamma": hr.gamma, "mu": peak, "order": hr.order})
         if console is not None:
@@ -708,15 +707,11 @@ def _check_settings(order, search, search_backoff) -> None:
         raise ConfigError(f"search_backoff={search_backoff!r}: expected a number ≥ 1")
 
 
-def _mu_step(cl, blocks, cblocks, w):
+def _mu_step(cl, blocks, w):
     """The μ-step on the closed loop ``cl``: the complexified structure's bound (whose
-    scalings the D-step fits) and the upper bound of the structure as given on ``w``, the
-    mixed one solved where it can reach its peak
-    (:func:`~ambseal.robust.mu.upper_near_peak`)."""
-    mu_c = mussv(cl, cblocks, w, lower=False, peak=False)
-    if cblocks == [tuple(b) for b in blocks]:
-        return mu_c, np.asarray(mu_c.upper, float)
-    return mu_c, upper_near_peak(cl, blocks, w, mu_c.upper)
+    scalings the D-step fits) and the upper bound of the structure as given on ``w``
+    (:func:`~ambseal.robust.mu.upper_on_grid`)."""
+    return upper_on_grid(cl, blocks, w)
 
 
 def _d_step(w, mu_c, order, fit_tol) -> list:

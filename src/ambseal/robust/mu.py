@@ -46,8 +46,8 @@ from ambseal.robust._mu_lower import lower_bound as _lower_bound
 from ambseal.robust._mu_upper import upper_bound as _upper_bound
 from ambseal.threads import with_numerics_threads
 
-__all__ = ["MuResult", "MuPeak", "mussv", "mu_peak", "upper_near_peak", "parse_blocks",
-           "check_blocks", "PEAK_BAND"]
+__all__ = ["MuResult", "MuPeak", "mussv", "mu_peak", "upper_near_peak", "upper_on_grid",
+           "parse_blocks", "check_blocks", "PEAK_BAND"]
 
 
 # --------------------------------------------------------------------------- blocks
@@ -412,6 +412,53 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int | None = No
               and np.all(w > 0) else None))
 
 
+def _complexify(blks):
+    """Diagonal-D structure: repeated scalars → independent complex scalars."""
+    out = []
+    for b in blks:
+        out.extend([(b.r, b.c)] if b.kind == "full" else [(1, 1)] * b.r)
+    return out
+
+
+def upper_on_grid(M, blocks, omega, *, tol: float = 1e-3):
+    """The μ upper bound of a system on a frequency grid, a mixed structure solved only
+    where it can reach its peak (D–K's μ-step, Balas et al. 1993).
+
+    The structure with every repeated or real scalar made an independent complex scalar
+    (diagonal D, the bound whose scalings D–K fits) is solved on the whole grid; where
+    ``blocks`` is not that structure, its bound is :func:`upper_near_peak`'s with that
+    bound as the cover: the whole grid's peak, at a fraction of the cost of a mixed bound
+    at every frequency.
+
+    Parameters
+    ----------
+    M : control.StateSpace
+        Continuous-time system, ``Σ c`` outputs × ``Σ r`` inputs of ``blocks``.
+    blocks : sequence of (int, int)
+        MATLAB ``mussv`` block structure.
+    omega : array_like, shape (F,)
+        Increasing frequencies (rad/s).
+    tol : float
+        :func:`mussv`'s tolerance.
+
+    Returns
+    -------
+    (MuResult, ndarray of shape (F,))
+        :func:`mussv`'s result for the complexified structure (without the lower bound)
+        and the upper bound of ``blocks`` on the grid.
+
+    Raises
+    ------
+    ModelError
+        As :func:`mussv`.
+    """
+    cblocks = _complexify(parse_blocks(blocks))
+    mu_c = mussv(M, cblocks, omega, tol=tol, lower=False, peak=False)
+    if cblocks == [tuple(b) for b in blocks]:
+        return mu_c, np.asarray(mu_c.upper, float)
+    return mu_c, upper_near_peak(M, blocks, omega, mu_c.upper, tol=tol)
+
+
 def upper_near_peak(M, blocks, omega, cover, *, tol: float = 1e-3, chunk: int = 8
                     ) -> np.ndarray:
     """The μ upper bound of a system on a frequency grid where it can reach
@@ -424,11 +471,13 @@ def upper_near_peak(M, blocks, omega, cover, *, tol: float = 1e-3, chunk: int = 
     bound found: the frequencies left cannot hold the peak or a local maximum
     :func:`mu_peak` refines. On a grid solved cold (at most twice the continuation stride,
     e.g. the 60 points of a design grid) the chunks are solved without :func:`mussv`'s peak
-    refinement, then the bounds within ``2·tol`` of the largest again in one call that
-    refines them as a whole-grid call would: the peak is the whole grid's to about 1e-8,
-    each other bound to the solver's tolerance (the method of centres runs a stack
-    together, so a subset's bounds differ from the whole grid's by up to about 1e-4
-    relative). On a longer grid every point is solved in one call.
+    refinement, then the bounds within ``2·tol`` of the largest again in a call that
+    refines them as a whole-grid call would, until the largest bound is a refined one (a
+    bound solved to ``tol`` alone can lie 0.3 % above its optimum, above the refined
+    peak: the blower's reduced loop read 0.7309 against 0.7293): the peak is the whole
+    grid's to about 1e-6, each other bound to the solver's tolerance (the method of
+    centres runs a stack together, so a subset's bounds differ from the whole grid's by up
+    to about 1e-4 relative). On a longer grid every point is solved in one call.
 
     Parameters
     ----------
@@ -472,10 +521,17 @@ def upper_near_peak(M, blocks, omega, cover, *, tol: float = 1e-3, chunk: int = 
                          peak_tol=tol).upper
         solved[idx] = True
         best = max(best, float(out[idx].max()))
-    # the refinement of a whole-grid call: the bounds within 2·tol (on μ²) of the largest
-    top = np.flatnonzero(solved & (out ** 2 >= (1.0 - 2.0 * tol) * best ** 2))
-    out[top] = mussv(M, blocks, w[top], tol=tol, lower=False, peak=False).upper
-    return out
+    # the refinement of a whole-grid call: the bounds within 2·tol (on μ²) of the largest,
+    # until the largest is a refined one (an unrefined bound can lie above the optimum by
+    # several times tol, and above the refined peak)
+    refined = np.zeros(w.size, bool)
+    while True:
+        best = float(out[solved].max())
+        top = np.flatnonzero(solved & ~refined & (out ** 2 >= (1.0 - 2.0 * tol) * best ** 2))
+        if not top.size:
+            return out
+        out[top] = mussv(M, blocks, w[top], tol=tol, lower=False, peak=False).upper
+        refined[top] = True
 
 
 # --------------------------------------------------------------------------- peak

@@ -20,7 +20,7 @@ from slycot import ab09md
 from ambseal.errors import ConfigError, ModelError
 from ambseal.lti import ss_matrices
 from ambseal.robust.hinf import hinfnorm, lft_lower
-from ambseal.robust.mu import mussv
+from ambseal.robust.mu import upper_on_grid
 
 __all__ = ["ReductionResult", "balred_controller", "reduce_controller"]
 
@@ -94,7 +94,8 @@ class ReductionResult:
         ‖F_l(P, K)‖_∞ with the full and the reduced controller (``inf`` if the reduced loop
         is unstable).
     mu_full, mu : float or None
-        Peak μ upper bounds on ``omega`` when ``blocks`` were given.
+        Peak μ upper bounds on ``omega`` when ``blocks`` were given
+        (:func:`~ambseal.robust.mu.upper_on_grid`).
     hsv : ndarray
         Hankel singular values of the controller's stable part.
     """
@@ -166,11 +167,12 @@ def reduce_controller(P, K, order: int, nmeas: int, ncon: int, *,
     g_red, _ = hinfnorm(lft_lower(P, Kr, nmeas, ncon))
     mu_red = None
     if blocks is not None:
+        # the peak on the grid: a mixed structure solved only where it can reach it
         if mu_full is None:
-            mu_full = float(np.max(mussv(lft_lower(P, K, nmeas, ncon), blocks, omega,
-                                         peak=False).upper))
-        mu_red = (float(np.max(mussv(lft_lower(P, Kr, nmeas, ncon), blocks, omega,
-                                           peak=False).upper))
+            mu_full = float(np.max(upper_on_grid(lft_lower(P, K, nmeas, ncon), blocks,
+                                                 omega)[1]))
+        mu_red = (float(np.max(upper_on_grid(lft_lower(P, Kr, nmeas, ncon), blocks,
+                                             omega)[1]))
                   if np.isfinite(g_red) else float("inf"))
     return ReductionResult(K=Kr, order_full=int(K.nstates), order=int(Kr.nstates),
                            gamma_full=float(g_full), gamma=float(g_red), mu_full=mu_full,

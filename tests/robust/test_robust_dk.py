@@ -226,6 +226,9 @@ def test_scaled_hinf_is_musyns_first_k_step_without_its_mu_analysis(monkeypatch)
         scaled_hinfsyn(P, [(1, 1), (1, 1)], 1, 1, backoff=0.5)
     with pytest.raises(ValueError, match="performance"):
         scaled_hinfsyn(P, [(1, 1), (1, 0)], 1, 1)
+    for syn in (scaled_hinfsyn, musyn):  # the plant is checked before its default grid
+        with pytest.raises(ValueError, match="StateSpace"):
+            syn(ct.tf([1.0], [1.0, 1.0]), [(1, 1), (1, 1)], 1, 1)
 
 
 def test_dk_iterations_end_by_the_stall_rule_not_a_count(monkeypatch):

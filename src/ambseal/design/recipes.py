@@ -732,9 +732,10 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
 
     H∞ over a speed range is the K-step of D–K at constant scalings
     (:func:`~ambseal.robust.dk.scaled_hinfsyn`): the H∞ synthesis on
-    ``D P D⁻¹`` with the constant D of the smallest γ_opt, whose γ < 1 would certify every
-    plant of the range by the small-gain theorem (Zhou, Doyle & Glover, *Robust and
-    Optimal Control*, 1996, §11.3: scaled H∞); a controller of the nominal H∞'s order."""
+    ``D P D⁻¹`` with D–K's starting constant D (the smallest γ_opt where its search runs),
+    whose γ < 1 would certify every plant of the range by the small-gain theorem (Zhou,
+    Doyle & Glover, *Robust and Optimal Control*, 1996, §11.3: scaled H∞); a controller of
+    the nominal H∞'s order."""
 
     robust = method in method_names(robust=True)  # against the uncertain parameters
     Wf = w.Wf()

@@ -515,13 +515,14 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     Methods for Optimization (1999) §8.1 (restarts).
     """
     t0 = time.process_time()
+    cblocks, unchecked = _structure(P, blocks, nmeas, ncon, "musyn")
     _check_settings(order, search, search_backoff)
     _check_counts(max_iter=max_iter, patience=patience, rtol=rtol, backoff=backoff,
                   fit_tol=fit_tol)
     P_user, w = P, _grid(P, omega, "musyn")
-    P, cblocks, (bal, n_start, start_rule) = _balanced_start(P, blocks, nmeas, ncon, w,
-                                                             search, "musyn")
     console = progress_printer(progress)
+    P, (bal, n_start, start_rule) = _balanced_start(P, cblocks, unchecked, nmeas, ncon, w,
+                                                    search)
 
     history, best = [], None
     fits: list = []
@@ -597,11 +598,10 @@ def _grid(P, omega, who: str) -> np.ndarray:
     return w
 
 
-def _balanced_start(P, blocks, nmeas, ncon, w, search, who: str):
-    """D–K's start: ``(P_b, cblocks, (scales, evaluations, rule))``, the plant with its
-    uncertainty channels at the constant D of :func:`_balance_channels` and the
-    complexified structure; the plant's assumptions checked on ``P_b`` where, on ``P``,
-    they fail only in the Δ channels' units (ModelError, SynthesisError)."""
+def _structure(P, blocks, nmeas, ncon, who: str):
+    """The plant and its blocks checked (ModelError; SynthesisError): ``(cblocks,
+    unchecked)``, the complexified structure and whether the plant's assumptions are left
+    to check on the balanced plant (they fail only in the Δ channels' units)."""
     try:
         check_plant(P, nmeas, ncon)
         unchecked = False
@@ -610,12 +610,18 @@ def _balanced_start(P, blocks, nmeas, ncon, w, search, who: str):
     blks = check_blocks(P, blocks, nmeas, ncon)
     if blks[-1].kind != "full":
         raise ModelError(f"{who}: the last block must be the full complex performance block")
-    cblocks = _complexify(blks)
+    return _complexify(blks), unchecked
+
+
+def _balanced_start(P, cblocks, unchecked, nmeas, ncon, w, search):
+    """D–K's start: ``(P_b, (scales, evaluations, rule))``, the plant with its uncertainty
+    channels at the constant D of :func:`_balance_channels`, and its assumptions checked
+    there where :func:`_structure` left them (SynthesisError)."""
     start = _start_evals(search, cblocks, P.nstates)
     P, *rest = _balance_channels(P, cblocks, nmeas, ncon, w, start)
     if unchecked:
         check_plant(P, nmeas, ncon)
-    return P, cblocks, tuple(rest)
+    return P, tuple(rest)
 
 
 @dataclass(frozen=True)
@@ -647,8 +653,9 @@ class ScaledHinfResult:
 @with_numerics_threads
 def scaled_hinfsyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
                    *, backoff: float = 1.01, search: int | str = "auto") -> ScaledHinfResult:
-    """H∞ synthesis at the constant scalings of the smallest γ_opt: :func:`musyn`'s start
-    and first K-step, without its μ analysis (Zhou, Doyle & Glover, *Robust and Optimal
+    """H∞ synthesis at D–K's starting constant scalings (the RMS balance of the uncertainty
+    channels, then the smallest γ_opt where ``search`` allows): :func:`musyn`'s start and
+    first K-step, without its μ analysis (Zhou, Doyle & Glover, *Robust and Optimal
     Control*, 1996, §11.3: scaled H∞).
 
     The same controller and γ as ``musyn(P, blocks, nmeas, ncon, omega, order=0,
@@ -684,11 +691,12 @@ def scaled_hinfsyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, om
         No controller for the scaled plant (plant assumptions violated).
     """
     t0 = time.process_time()
+    cblocks, unchecked = _structure(P, blocks, nmeas, ncon, "scaled_hinfsyn")
     _check_settings(0, search, 1.0)
     _check_counts(backoff=backoff)
     w = _grid(P, omega, "scaled_hinfsyn")
-    Pb, _, (bal, n_start, start_rule) = _balanced_start(P, blocks, nmeas, ncon, w, search,
-                                                        "scaled_hinfsyn")
+    Pb, (bal, n_start, start_rule) = _balanced_start(P, cblocks, unchecked, nmeas, ncon, w,
+                                                     search)
     hr = hinfsyn(Pb, nmeas, ncon, backoff=backoff)
     return ScaledHinfResult(
         K=hr.K, gamma=float(hr.gamma), gamma_opt=float(hr.gamma_opt),

@@ -29,8 +29,9 @@ Lower bound
     complex structures) from several starts — the right singular vector of M, the worst
     direction of the D–G certificate, seeded random vectors and, for real blocks, the
     complex iteration's phases projected on the real axis — then a refinement of the best
-    candidates (gradient projection on max |λ| s.t. λ real, ``robust/_mu_lower.py``). The
-    bound is 1/σ̄(Δ) for a structured Δ that makes I − MΔ singular (returned as ``delta``).
+    candidates (gradient projection on max |λ| s.t. λ real, ``robust/_mu_lower.py``), each
+    stage ended by its own stall rule, not a count. The bound is 1/σ̄(Δ) for a structured Δ
+    that makes I − MΔ singular (returned as ``delta``).
 """
 
 from __future__ import annotations
@@ -262,7 +263,7 @@ PEAK_BAND = 0.95
 
 @with_numerics_threads
 def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int | None = None,
-          lower_iter: int = 20, gmax: float = 1e3, seed: int = 0,
+          lower_iter: int | None = None, gmax: float = 1e3, seed: int = 0,
           lower: bool = True, peak_tol: float | None = None, peak: bool = True) -> MuResult:
     """Upper and lower bounds of the structured singular value μ_Δ(M).
 
@@ -289,8 +290,13 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int | None = No
         default): each matrix's solve ends at its own criterion, the gap within ``tol``,
         its interior lost to rounding, or a stall (its bound fell by less than ``tol`` over
         100 levels; ``_mu_upper.STALL_LEVELS``).
-    lower_iter : int
-        Power iterations per start for the lower bound.
+    lower_iter : int, optional
+        A cap on the lower bound's power iterations per start. None (the default): each
+        start's iteration ends at its first checkpoint (every 10 steps) that raises its
+        best candidate by no more than 1e-4 of it, and the refinement of a candidate after
+        eight steps in a row that raise it by no more than 1e-4 of its bound at the last
+        rise (``_mu_lower.POWER_RTOL``, ``REFINE_RTOL``, ``PATIENCE``). The bound is a
+        certificate either way.
     gmax : float
         Bound on ‖G‖ relative to the normalised problem (real blocks only).
     seed : int
@@ -322,8 +328,8 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int | None = No
     Raises
     ------
     ModelError
-        Malformed blocks, ``tol`` outside (0, 1), ``max_iter`` (when given) or
-        ``lower_iter`` not a whole number ≥ 1, dimensions that do not match ``M``, missing
+        Malformed blocks, ``tol`` outside (0, 1), ``max_iter`` or ``lower_iter`` (when
+        given) not a whole number ≥ 1, dimensions that do not match ``M``, missing
         ``omega``, non-finite entries.
 
     Notes
@@ -343,8 +349,8 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int | None = No
     blks = parse_blocks(blocks)
     if not (isinstance(tol, (int, float)) and 0.0 < tol < 1.0):
         raise ModelError(f"mussv: tol={tol!r}, expected a relative tolerance in (0, 1)")
-    counts = (("max_iter", max_iter),) * (max_iter is not None) + (("lower_iter", lower_iter),)
-    for name, v in counts:
+    counts = (("max_iter", max_iter), ("lower_iter", lower_iter))
+    for name, v in ((k, v) for k, v in counts if v is not None):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
             raise ModelError(f"mussv: {name}={v!r}, expected a whole number ≥ 1")
     w = None

@@ -69,7 +69,8 @@ def design_rise(result, K_reduced, omega=None, nyquist_hz: float | None = None
                        rise_to_nyquist=g1 / g0 - 1.0)
     else:
         out["mu_full"] = float(result.mu)
-        out["mu"] = float(np.max(gp.mu(K_reduced, omega, peak=False).upper))
+        # the upper bound alone: the lower bound and its worst-case Δ are not read here
+        out["mu"] = float(np.max(gp.mu(K_reduced, omega, peak=False, lower=False).upper))
         out["rise"] = out["mu"] / out["mu_full"] - 1.0
     return out
 

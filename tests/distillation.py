@@ -5,14 +5,15 @@ import control
 import numpy as np
 
 
-def distillation_rp_plant(pole: float | None = None, wp_low: float = 1e-5):
+def distillation_rp_plant(pole: float | None = None, wp_low: float = 1e-5, gains=None):
     """G = 1/(75s+1)·[87.8 −86.4; 108.2 −109.6], W_I = (s+0.2)/(0.5s+1)·I,
     W_P = 0.5(10s+1)/(10s+1e-5)·I; inputs [w_Δ, w, u], outputs [z_Δ, z, v]; blocks
     [(1, 1), (1, 1), (2, 2)]. With ``pole`` (rad/s) the column's time constant is 1/pole
     instead of 75 s, in a realisation whose B and C do not depend on it
     (G = (g0/75)/(s + pole)): the frozen plants of an LPV family. ``wp_low`` is the
-    constant of W_P's denominator (1e-5: a near-integrator)."""
-    g0 = np.array([[87.8, -86.4], [108.2, -109.6]])
+    constant of W_P's denominator (1e-5: a near-integrator); ``gains`` the 2 × 2 steady-state
+    gains instead of Table 8.1's."""
+    g0 = np.array([[87.8, -86.4], [108.2, -109.6]] if gains is None else gains, float)
     if pole is None:
         G = control.ss(control.tf([[[g0[i, j]] for j in range(2)] for i in range(2)],
                                   [[[75.0, 1.0]] * 2] * 2), inputs=["up0", "up1"],

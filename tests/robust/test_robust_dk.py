@@ -340,7 +340,7 @@ def test_the_start_keeps_one_scale_for_mirror_image_channels(monkeypatch):
     P = distillation_rp_plant(gains=[[87.8, -86.4], [-86.4, 87.8]])
     cb, w = [(1, 1), (1, 1), (2, 2)], np.logspace(-3, 3, 60)
     Pb, scales, n, rule = ds._balance_channels(P, cb, 2, 2, w, None)
-    assert scales[0] == scales[1] and "over 1 parameters" in rule
+    assert scales[0] == scales[1] and "over 1 parameter:" in rule
     monkeypatch.setattr(ds, "MIRROR_RTOL", -1.0)  # a scale per channel
     Pu, free, n_free, rule_free = ds._balance_channels(P, cb, 2, 2, w, None)
     assert free[0] != pytest.approx(free[1], rel=1e-3) and "parameters" not in rule_free

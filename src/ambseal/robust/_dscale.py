@@ -275,8 +275,8 @@ def _balance_channels(P, cblocks, nmeas, ncon, w, evals=0):
         except _Stalled:
             rule = f"RMS balance, then the best constant D: {watch.rule()}"
         if y0.size < x.size:
-            rule += (f" (over {y0.size} parameters: the scales of channels with equal RMS "
-                     f"norms kept equal)")
+            rule += (f" (over {y0.size} parameter{'s' * (y0.size > 1)}: the scales of "
+                     f"channels with equal RMS norms kept equal)")
         if watch.best_g < g0:
             x = watch.best_x[tie]
     return scaled(x), [float(np.exp(v)) for v in x], len(watch.trail), rule

@@ -258,12 +258,14 @@ def test_rank_one_mixed_closed_form(kinds):
 
 
 @pytest.mark.parametrize("kinds", ["rrc", "rrrc"])
-def test_the_lower_bound_ends_where_its_iterations_stall_not_after_a_count(kinds):
+def test_the_lower_bound_ends_where_its_iterations_stall_not_after_a_count(kinds, monkeypatch):
     """Reference: the rank-one closed form (Young 1994, as above), on 100 seeded matrices
     per structure. Power iterations that end at their stall, not after 20 steps, and a
     refinement that ends at its own stall, not after 25, bring every certified lower
-    bound within 0.5 % of μ (20 steps and 25 left one at 4 % below it on each structure).
-    ``lower_iter`` stays a caller's cap."""
+    bound within 1 % of μ (measured: within 0.41 %; 20 steps and 25 left one at 4 % below
+    it on each structure). ``lower_iter`` stays a caller's cap on the power iterations:
+    one step per start where the stall rule takes more."""
+    import ambseal.robust._mu_lower as ml
     from ambseal.errors import ModelError
 
     rng = np.random.default_rng(sum(map(ord, kinds)) + 1000)
@@ -274,9 +276,20 @@ def test_the_lower_bound_ends_where_its_iterations_stall_not_after_a_count(kinds
     exact = np.array([_rank_one_mu(a[k] * np.conj(b[k]), real) for k in range(100)])
     res = mussv(M, blocks)
     assert np.all(res.lower <= exact * (1 + 1e-9))
-    assert np.all(res.lower >= 0.995 * exact), np.min(res.lower / exact)
+    assert np.all(res.lower >= 0.99 * exact), np.min(res.lower / exact)
+    steps = [0]
+    step = ml._PowerIteration.step
+
+    def counted(self, *args):
+        steps[0] += 1
+        return step(self, *args)
+
+    monkeypatch.setattr(ml._PowerIteration, "step", counted)
     capped = mussv(M[:3], blocks, lower_iter=1)
     assert np.all(capped.lower <= exact[:3] * (1 + 1e-9))
+    n_capped, steps[0] = steps[0], 0
+    mussv(M[:3], blocks)
+    assert n_capped <= 2 < steps[0]  # a step in each of the two groups of starts
     with pytest.raises(ModelError, match="lower_iter"):
         mussv(M[:3], blocks, lower_iter=0)
 

@@ -293,10 +293,11 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int | None = No
     lower_iter : int, optional
         A cap on the lower bound's power iterations per start. None (the default): each
         start's iteration ends at its first checkpoint (every 10 steps) that raises its
-        best candidate by no more than 1e-4 of it, and the refinement of a candidate after
-        eight steps in a row that raise it by no more than 1e-4 of its bound at the last
-        rise (``_mu_lower.POWER_RTOL``, ``REFINE_RTOL``, ``PATIENCE``). The bound is a
-        certificate either way.
+        best candidate by no more than 1e-3 of it, and the refinement of a candidate after
+        eight steps in a row that raise it by no more than 1e-3 of its bound at the last
+        rise, a candidate not yet on the real axis having at least 25 steps to reach it
+        (``_mu_lower.POWER_RTOL``, ``REFINE_RTOL``, ``PATIENCE``, ``REACH_STEPS``); the
+        cap does not bound the refinement. The bound is a certificate either way.
     gmax : float
         Bound on ‖G‖ relative to the normalised problem (real blocks only).
     seed : int

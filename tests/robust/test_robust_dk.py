@@ -343,13 +343,16 @@ def test_the_start_keeps_one_scale_for_mirror_image_channels(monkeypatch):
     assert scales[0] == scales[1] and "over 1 parameter:" in rule
     monkeypatch.setattr(ds, "MIRROR_RTOL", -1.0)  # a scale per channel
     Pu, free, n_free, rule_free = ds._balance_channels(P, cb, 2, 2, w, None)
-    assert free[0] != pytest.approx(free[1], rel=1e-3) and "parameters" not in rule_free
+    assert free[0] != pytest.approx(free[1], rel=1e-3) and "kept equal" not in rule_free
     assert n < n_free
     assert hinf_gamma_opt(Pb, 2, 2, rtol=1e-8) <= hinf_gamma_opt(Pu, 2, 2, rtol=1e-8)
-    # the column as published has no mirror-image channels: a scale each
+    # no mirror images: the column as published, and gains whose channels have equal row
+    # and column norms (100) but other entries
     monkeypatch.undo()
-    assert "parameters" not in ds._balance_channels(distillation_rp_plant(), cb, 2, 2, w,
-                                                    None)[3]
+    for gains in (None, [[100.0, 60.0], [0.0, 80.0]]):
+        _, sc, _, rule = ds._balance_channels(distillation_rp_plant(gains=gains), cb, 2, 2,
+                                              w, None)
+        assert "kept equal" not in rule and sc[0] != pytest.approx(sc[1], rel=1e-6)
 
 
 def test_search_work_rule_is_a_count():

@@ -224,7 +224,7 @@ def _balance_channels(P, cblocks, nmeas, ncon, w, evals=0):
         rj, cj = rms(H[:, zo:zo + c, nwd:]), rms(H[:, nzd:, wo:wo + r])
         ok = rj > 0 and cj > 0 and np.isfinite(cj / rj)
         logb.append(0.5 * np.log(cj / rj) if ok else 0.0)
-        norms.append((rj, cj) if ok else None)
+        norms.append(_signature(H, zo, wo, r, c, nzd, nwd) if ok else None)
         zs.append(slice(zo, zo + c))
         ws.append(slice(wo, wo + r))
         zo, wo = zo + c, wo + r
@@ -276,27 +276,43 @@ def _balance_channels(P, cblocks, nmeas, ncon, w, evals=0):
             rule = f"RMS balance, then the best constant D: {watch.rule()}"
         if y0.size < x.size:
             rule += (f" (over {y0.size} parameter{'s' * (y0.size > 1)}: the scales of "
-                     f"channels with equal RMS norms kept equal)")
+                     f"mirror-image channels kept equal)")
         if watch.best_g < g0:
             x = watch.best_x[tie]
     return scaled(x), [float(np.exp(v)) for v in x], len(watch.trail), rule
 
 
-#: Two uncertainty channels whose RMS norms (:func:`_balance_channels`, step 1) agree to
-#: this share, rows and columns alike, are taken for mirror images (a plant that their
-#: exchange leaves as it is) and keep one scale in the search for the best constant D.
+#: Two uncertainty channels of one shape whose signatures (:func:`_signature`) agree to
+#: this share of their largest entry are taken for mirror images (a plant that their
+#: exchange, with the other channels', leaves as it is) and keep one scale in the search
+#: for the best constant D.
 MIRROR_RTOL = 1e-6
+
+
+def _signature(H, zo, wo, r, c, nzd, nwd):
+    """A channel's signature, the same for mirror images: its shape, and the RMS over the
+    grid of each entry of its rows of ``H`` (F, outputs, inputs) into the non-Δ inputs and
+    of its columns seen at the non-Δ outputs, each set sorted (an exchange of channels
+    permutes them)."""
+    def entries(block):
+        return np.sort(np.sqrt(np.mean(np.abs(block) ** 2, axis=0)).ravel())
+
+    return (r, c), np.concatenate([entries(H[:, zo:zo + c, nwd:]),
+                                   entries(H[:, nzd:, wo:wo + r])])
 
 
 def _mirror_groups(norms) -> np.ndarray:
     """The search parameter of each scale (ints, first appearance order): scales whose
-    channels' RMS norms ``(r_j, c_j)`` both agree to :data:`MIRROR_RTOL` share one (a
-    channel without norms, None, keeps its own)."""
+    channels' signatures (:func:`_signature`) have the same shape and entries within
+    :data:`MIRROR_RTOL` of their largest share one (a channel without norms, None, keeps
+    its own). Equal row and column norms alone do not make mirror images: with
+    G = [[100, 60], [0, 80]] under input uncertainty both channels have them, but the
+    entries of their columns (100 and 0, 60 and 80) tell them apart."""
     out, reps = [], []
     for nj in norms:
         k = next((i for i, rep in enumerate(reps) if nj is not None and rep is not None
-                  and all(abs(a - b) <= MIRROR_RTOL * max(abs(a), abs(b))
-                          for a, b in zip(nj, rep))), None)
+                  and nj[0] == rep[0] and np.max(np.abs(nj[1] - rep[1]), initial=0.0)
+                  <= MIRROR_RTOL * np.max(np.abs(rep[1]), initial=0.0)), None)
         if k is None:
             k = len(reps)
             reps.append(nj)

@@ -184,28 +184,46 @@ def bands_near(bands, f_hz: float) -> list[ModeBand]:
     return [b for b in bands if b.lo_hz / BAND_MATCH <= f_hz]
 
 
-#: Eigenvector components within this relative distance of the largest magnitude tie
-#: (:func:`_fixed_phase`): the two transverse directions of a circular whirl are equal in
-#: magnitude up to rounding.
+#: Components of a mode's output shape within this relative distance of the largest
+#: magnitude tie (:func:`_fixed_phase`): the two transverse directions of a circular whirl
+#: are equal in magnitude up to rounding.
 PHASE_TIE_RTOL = 1e-6
 
+#: A mode whose output shape ``C v`` is below this share of ``‖C‖·max|v|`` is one the
+#: outputs do not see; its phase is fixed on its state coordinates instead.
+UNSEEN_RTOL = 1e-9
 
-def _fixed_phase(V):
-    """The eigenvectors ``V`` (columns), each turned by a phase so that its first component
-    within :data:`PHASE_TIE_RTOL` of its largest magnitude is real and positive.
 
-    A complex eigenvector is unique only up to such a phase, and LAPACK makes its largest
-    component real: on a rotor whose two transverse axes are alike, a circular whirl has
-    two largest components equal but for rounding, and which one LAPACK takes follows the
-    machine's BLAS kernels. The rank-one channel of :func:`with_modal_frequencies` (the
-    mode's real and imaginary parts) turns with that phase: under Haswell and SkylakeX
-    kernels nine of the overhung compressor example's fourteen bands had other channels,
-    so its μ designs under the two began from different uncertainty sets
-    (benchmarks/README.md, "A circular whirl's uncertain frequency").
+def _fixed_phase(V, C):
+    """The eigenvectors ``V`` (columns) of a plant with output matrix ``C``, each turned by
+    a phase so that its output shape ``C v`` has its first component within
+    :data:`PHASE_TIE_RTOL` of its largest magnitude real and positive.
+
+    A complex eigenvector is unique only up to such a phase, and the rank-one channel of
+    :func:`with_modal_frequencies` (the mode's real and imaginary parts) turns with it.
+    LAPACK makes the largest state component real: on a rotor whose two transverse axes
+    are alike, a circular whirl has two largest components equal but for rounding, and
+    which one LAPACK takes follows the machine's BLAS kernels. A rule on the state
+    components still follows them, since the design model's state coordinates do: its
+    modal reduction is built from the full model's eigenvectors, whose phases turn each
+    mode's pair of real coordinates. Under Haswell and SkylakeX kernels three of the
+    overhung compressor example's four bands had other channels, so its μ designs under
+    the two began from different uncertainty sets and ended at μ 1.018 and 0.826. The
+    output shape does not depend on the state coordinates (``C T⁻¹ · T v``); the outputs
+    (sensors) come in the rig's channel order, which breaks a circular whirl's tie
+    (benchmarks/README.md, "A circular whirl's uncertain frequency" and "The design model's
+    coordinates").
     """
-    mag = np.abs(V)
-    first = np.argmax(mag >= (1.0 - PHASE_TIE_RTOL) * mag.max(axis=0), axis=0)
-    pivot = V[first, np.arange(V.shape[1])]  # a largest component: never zero
+    def first_largest(Y):
+        mag = np.abs(Y)
+        first = np.argmax(mag >= (1.0 - PHASE_TIE_RTOL) * mag.max(axis=0), axis=0)
+        return Y[first, np.arange(Y.shape[1])]
+
+    C = np.asarray(C)
+    shown = first_largest(C @ V)
+    scale = UNSEEN_RTOL * np.linalg.norm(C, 2)
+    # a mode the outputs do not see: its largest state component, as LAPACK's rule
+    pivot = np.where(np.abs(shown) > scale * np.abs(V).max(axis=0), shown, first_largest(V))
     return V * (np.abs(pivot) / pivot)
 
 
@@ -238,7 +256,7 @@ def with_modal_frequencies(plant: Plant, bands) -> tuple[Plant, dict]:
 
     A = np.asarray(plant.A, float)
     lam, V = np.linalg.eig(A)
-    V = _fixed_phase(V)
+    V = _fixed_phase(V, plant.C)
     W = np.linalg.inv(V)
     # a mode a damping margin (ambseal.design.plant.less_damped) took below zero damping is
     # still the band's mode: with it left out, a design given both remedies for one mode

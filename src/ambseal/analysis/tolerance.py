@@ -13,9 +13,11 @@ side of a limit a number lies on — the words must be the same on every machine
   boundary (:func:`side_of`), and the words name both sides. Each number states its
   tolerance beside the rule it is graded by (ISO 14839-3's zones:
   :data:`ambseal.analysis.iso.ZONE_RTOL`; API 617's separation margins:
-  :data:`SEPARATION_RTOL`): the accuracy to which the number is computed, which exceeds
-  the spread of one loop's number between machines. A value on the boundary on one
-  machine is then on it or on the side it leans to on another, never on the far side.
+  :data:`SEPARATION_RTOL`; a design's μ against 1:
+  :data:`ambseal.design.recipes.MU_BOUNDARY_RTOL`): the accuracy to which the number is
+  computed, which exceeds the spread of one loop's number between machines. A value on
+  the boundary on one machine is then on it or on the side it leans to on another, never
+  on the far side.
 """
 
 from __future__ import annotations

@@ -165,8 +165,8 @@ def test_a_mu_within_its_tolerance_of_1_is_on_the_boundary_in_words():
     """A delivered μ moves with the machine's rounding (D–G–K's path) by less than its
     stated tolerance of 2 %, so a μ within 2 % of 1 reads the same on either side of 1:
     "on its boundary", naming both; beyond it "met" or "NOT met". Reference: μ = 0.999
-    and 1.001 (the flywheel example's design read 0.99995 against 1.00014 on two kernel
-    sets), the words compared with the numbers masked as the kernel test masks them."""
+    and 1.001 (the flywheel example's design read 1.000139 against 0.990 on two kernel
+    sets), the words compared with their numbers masked."""
     import re
 
     from ambseal.design.recipes import _Synthesis, _verdict

@@ -184,9 +184,10 @@ def bands_near(bands, f_hz: float) -> list[ModeBand]:
     return [b for b in bands if b.lo_hz / BAND_MATCH <= f_hz]
 
 
-#: Components of a mode's output shape within this relative distance of the largest
-#: magnitude tie (:func:`_fixed_phase`): the two transverse directions of a circular whirl
-#: are equal in magnitude up to rounding.
+#: Components of a mode's output shape (or, for a mode the outputs do not see, of its
+#: eigenvector) within this relative distance of the largest magnitude tie
+#: (:func:`_fixed_phase`): the two transverse directions of a circular whirl are equal in
+#: magnitude up to rounding.
 PHASE_TIE_RTOL = 1e-6
 
 #: A mode whose output shape ``C v`` is below this share of ``‖C‖·max|v|`` is one the

@@ -108,8 +108,9 @@ class Verdict:
         or as it runs, is unstable (``"0 bar, 0 Hz"``).
     design_bound : str or None
         The design's own bound: ``"H∞ γ = <γ> on the nominal design model"`` or
-        ``"robust performance met: μ = <μ> ≤ 1 on the design model"`` (its summary's
-        verdict, up to the full-order check); None for the PID.
+        ``"robust performance met: μ = <μ> ≤ 1 on the design model"``, or ``"… on its
+        boundary: …"`` within 2 % of 1 (its summary's verdict, up to the full-order
+        check); None for the PID.
     worst_axis : str or None
         The axis and condition of the largest per-axis sensitivity peak over those loops,
         e.g. ``"A ζ at 4.08 bar"`` or ``"B η at 40 bar, 500 Hz, as it runs"``; None

@@ -167,7 +167,8 @@ def test_a_mu_within_its_tolerance_of_1_is_on_the_boundary_in_words():
     1 reads the same on either side of 1:
     "on its boundary", naming both; beyond it "met" or "NOT met". Reference: μ = 0.999
     and 1.001 (the flywheel example's design read 1.000139 against 0.990 on two kernel
-    sets), the words compared with their numbers masked."""
+    sets), the words compared with their numbers masked; 0.98 and 1.02, the band's edges,
+    are in it."""
     import re
 
     from ambseal.design.recipes import _Synthesis, _verdict
@@ -182,6 +183,9 @@ def test_a_mu_within_its_tolerance_of_1_is_on_the_boundary_in_words():
     assert below.startswith("robust performance on its boundary: μ = 0.999, within 2 % of 1 "
                             "on the design model, met or missed")
     assert "316.7 Hz" in below and below.endswith("stable at every judged condition")
+    # the band's edges are in it (|0.98 − 1| is 0.020000000000000018 in binary)
+    for edge in (0.98, 1.02):
+        assert words(edge).startswith(f"robust performance on its boundary: μ = {edge:g},")
     assert words(0.979).startswith("robust performance met: μ = 0.979 ≤ 1")
     assert words(1.021).startswith("robust performance NOT met: μ = 1.021 > 1")
 

@@ -174,8 +174,8 @@ def test_dgk_steps_end_by_the_stall_rule_not_a_count(monkeypatch):
     assert len(steps) == 13 and r.stopping["dgk"]["iterations"] == 13
     assert r.stopping["dgk"]["rule"].startswith("patience=2")
     assert r.best_iteration == steps[10]["iteration"]
-    capped = musyn_dgk(P, BLOCKS, 1, 1, w, search=0, max_iter=4)
-    assert capped.stopping["dgk"] == {"iterations": 4, "rule": "max_iter=4"}
+    capped = musyn_dgk(P, BLOCKS, 1, 1, w, search=0, max_iter=1)
+    assert capped.stopping["dgk"] == {"iterations": 1, "rule": "max_iter=1"}
 
 
 def test_design_mu_iteration_key_defaults_to_dgk():
@@ -314,7 +314,8 @@ def test_the_refinement_ends_by_slsqps_tolerance_not_its_count(monkeypatch):
 def test_the_cutting_planes_end_when_the_bound_is_tight_or_stalls_not_after_a_count(
         monkeypatch, points):
     """On μ's grids of 27 and 35 points the spring–mass loop of an H∞ controller puts the
-    scaled loop's H∞ peaks between the points, and the refinement adds cutting planes
+    scaled loop's H∞ peaks between the points, and the refinement of the fits (uniform
+    weights, as a D–G step refines them) adds cutting planes
     (under one BLAS thread and two, 4–11 H∞ norms). Each pass (the fitted orders, then
     the largest) ends at the first cut where the H∞ level is within ``_CUT_RTOL`` of the
     grid's peak or where ``_CUT_PATIENCE`` cuts in a row have not lowered the pass's
@@ -341,10 +342,16 @@ def test_the_cutting_planes_end_when_the_bound_is_tight_or_stalls_not_after_a_co
         cuts[-1].append(float(level))
         return level, w_peak
 
+    beta = float(mu_s.upper.max())
+    M = freqresp(lft_lower(P, K, 1, 1), w)
+    ds, gs = dg.relax_pointwise(M, mu_s.blocks, SM_REAL, np.asarray(mu_s.Dl),
+                                np.asarray(mu_s.G), mu_s.upper, beta, w)
+    x, k1, k2, _ = dg.fit_allpass_pair(w, gs[:, 0], np.ones_like(w), 0.05)
+    sc = dg.DGScalings(mu_s.blocks, SM_REAL, [dgk.fit_dscale(w, ds[:, j], tol=0.05)[0]
+                                              for j in range(2)], {0: (x, k1, k2)}, beta, w)
     monkeypatch.setattr(dg, "_minimax", seen_minimax)
     monkeypatch.setattr(dg, "hinfnorm", seen_hinfnorm)
-    level = dgk._dg_step_scalings(P, K, 1, 1, mu_s, SM_REAL, float(mu_s.upper.max()), w,
-                                  0.05)[2]
+    level = dg.refine_scalings(sc, P, K, mu_s.blocks, 1, 1, w)[1]
     assert len(cuts) >= 4  # three cuts or more: where a count of three ended the pass
     assert level == min(c[2] for c in cuts)
     for sc in dict.fromkeys(c[0] for c in cuts):
@@ -447,6 +454,9 @@ def test_dgk_keeps_the_iterate_of_the_lowest_rechecked_mu(monkeypatch):
     import ambseal.robust.dgk as dgk
 
     P, w, max_iter = gain_plant(), np.logspace(-2, 3, 6), 4
+    free = musyn_dgk(P, BLOCKS, 1, 1, w, max_iter=max_iter, search=0)
+    grid = [h["mu_grid"] for h in free.history if h["step"] == "D-G-K"]
+    low = int(np.argmin(grid))
     made, real_check, real_k_step = [], dgk._check, dgk._k_step
 
     def k_step(*args):
@@ -456,7 +466,7 @@ def test_dgk_keeps_the_iterate_of_the_lowest_rechecked_mu(monkeypatch):
 
     def check(P_, K, *args):
         pk = real_check(P_, K, *args)
-        if len(made) == max_iter and K is made[-1]:
+        if len(made) == low + 1 and K is made[-1]:
             return replace(pk, peak=2 * pk.peak)
         return pk
 
@@ -464,11 +474,48 @@ def test_dgk_keeps_the_iterate_of_the_lowest_rechecked_mu(monkeypatch):
     monkeypatch.setattr(dgk, "_check", check)
     r = musyn_dgk(P, BLOCKS, 1, 1, w, max_iter=max_iter, search=0)
     steps = [h for h in r.history if h["step"] == "D-G-K"]
-    assert len(steps) == max_iter and all(h["mu"] >= h["mu_grid"] * (1 - 1e-9)
-                                          for h in steps[:-1])
-    assert steps[-1]["mu_grid"] == min(h["mu_grid"] for h in steps)
-    assert steps[-1]["mu"] > 1.9 * steps[-1]["mu_grid"]
-    kept = min(steps[:-1], key=lambda h: h["mu"])
+    assert len(steps) > 1 and [h["mu_grid"] for h in steps] == grid[:len(steps)]
+    assert steps[low]["mu"] > 1.9 * steps[low]["mu_grid"]
+    others = [h for i, h in enumerate(steps) if i != low]
+    assert all(h["mu"] >= h["mu_grid"] * (1 - 1e-9) for h in others)
+    kept = min(others, key=lambda h: h["mu"])
     assert r.best_iteration == kept["iteration"] and r.K is made[steps.index(kept)]
     true = float(np.max(mussv(P.lft(r.K, nu=1, ny=1), BLOCKS, np.logspace(-2, 3, 2000)).upper))
     assert r.mu == kept["mu"] and r.mu == pytest.approx(true, rel=1e-3)
+
+
+@pytest.mark.slow
+def test_a_dgk_steps_scalings_do_not_follow_the_rounding_of_its_loop():
+    """The first D–G–K step of the overhung compressor example's μ design
+    (tests/data/overhung_dgk_step.npz: its generalised plant, D–K's controller and the
+    mixed bound's pointwise scalings at β = 1.16), solved as it is and with the plant's A
+    perturbed by 1e-13 of each entry (seeded): about what two BLAS kernel sets change.
+    The scalings' responses agree to 1e-3 of their largest (measured: 3e-5), and the
+    scaled loop's H∞ level to 1e-4 (its norm is computed to 1e-6). Reference: the minimax
+    of the peak from the first fits (SLSQP), which this step ran before: its scalings
+    ended 194 % apart, at levels 1.0149 and 1.0083 (its iterates part threefold per step;
+    benchmarks/README.md)."""
+    import ambseal.robust.dgk as dgk
+    from pathlib import Path
+    from types import SimpleNamespace
+
+    d = np.load(Path(__file__).resolve().parents[1] / "data" / "overhung_dgk_step.npz",
+                allow_pickle=False)
+    mu_s = SimpleNamespace(Dl=d["Dl"], G=d["G"], upper=d["upper"],
+                           blocks=tuple(tuple(int(v) for v in b) for b in d["blocks"]))
+    K = ct.ss(d["KA"], d["KB"], d["KC"], d["KD"])
+    w = d["w"]
+
+    def step(eps):
+        rng = np.random.default_rng(0)
+        A = d["PA"] * (1 + eps * rng.standard_normal(d["PA"].shape))
+        fits, _, level = dgk._dg_step_scalings(
+            ct.ss(A, d["PB"], d["PC"], d["PD"]), K, int(d["nmeas"]), int(d["ncon"]), mu_s,
+            [bool(r) for r in d["real"]], float(d["beta"]), w, float(d["fit_tol"]))
+        resp = np.concatenate([np.ravel(np.asarray(f(1j * w))) for fit in fits
+                               for f in fit[:3] if f is not None])
+        return level, resp
+
+    (l0, r0), (l1, r1) = step(0.0), step(1e-13)
+    assert np.max(np.abs(r0 - r1)) <= 1e-3 * np.max(np.abs(r0))
+    assert l1 == pytest.approx(l0, rel=1e-4)

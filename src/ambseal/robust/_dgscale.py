@@ -22,9 +22,14 @@ worse. So, in turn:
 * :func:`relax_pointwise` moves each frequency's scalings towards those interpolated from
   the frequencies near the peak, as far as the level allows (the scalings that certify a
   level form a convex set);
-* the fits (uniform weights) are refined to minimise ``max_ω σ̄(S)`` directly
-  (:func:`refine_scalings`: SLSQP on the epigraph with analytic gradients, on a grid three
-  times denser than μ's and half a decade wider; the H∞ norm of the scaled closed loop,
+* the fits are weighted again, round by round, towards the frequencies where the last
+  round's scalings certify least (:func:`ambseal.robust.dgk._dg_step_scalings`), and the
+  best round is kept where its peak of σ̄(S) is within 1 % of 1: least squares, which the
+  machine's rounding moves by about its own size;
+* else the first round's fits (uniform weights) are refined to minimise ``max_ω σ̄(S)``
+  directly (:func:`refine_scalings`: SLSQP on the epigraph with analytic gradients, whose
+  end point follows the rounding; on a grid three times denser than μ's and half a
+  decade wider; the H∞ norm of the scaled closed loop,
   AB13DD, adds the frequency of any peak between grid points, a cutting plane, until the
   bound is tight or the cuts stall), once more at the largest orders if that leaves σ̄(S)
   above 1;

@@ -22,9 +22,11 @@ neighbouring frequencies), fits ``d_i(s)`` stable minimum-phase with ``|d_i| ≈
 difference ψ fits ``2·arctan ĝ_i(ω)`` (:func:`fit_g`): then ``|f|² + |h|² = 1`` and
 ``h/f = −j tan(ψ/2)`` hold exactly, i.e. ``f = (1 + ĝ²)^-½`` and ``h = −jĝ f`` for the
 fitted ĝ — Young's stable fit of jG in a form whose scaled problem is a valid D–G
-certificate whatever the fit error. The fitted parameters are then refined so that the
-current controller's scaled closed loop peaks as low as they allow (MATLAB's "DG Fit"; the
-private module ``_dgscale`` says why and how). The K-step is H∞ synthesis on
+certificate whatever the fit error. The fits are weighted again, round by round, towards
+the frequencies where the current controller's scaled closed loop peaks (MATLAB's "DG
+Fit"), and refined by a minimax of that peak only where they stay above it by more than
+1 % (``_dg_step_scalings``; the private module ``_dgscale`` says why). The K-step is
+H∞ synthesis on
 
     P_s = diag(D(s)/β̄, I) · P · diag(F(s) D(s)⁻¹, I) + [[H(s), 0], [0, 0]],
 

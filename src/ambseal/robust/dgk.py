@@ -163,9 +163,10 @@ FIT_REWEIGHT_POWER = 4
 #: grid's peak of σ̄(S) by less than this share of the best; the best round is kept.
 FIT_REWEIGHT_RTOL = 1e-3
 FIT_REWEIGHT_PATIENCE = 2
-#: Reweighted fits whose grid peak of σ̄(S) is within this share of 1 certify the current
-#: controller (μ ≤ β within it) and are kept; others are refined by the minimax of the
-#: peak (:func:`~ambseal.robust._dgscale.refine_scalings`) from the first round's fits.
+#: Reweighted fits whose peak of σ̄(S) on μ's grid is within this share of 1 are kept
+#: (between the grid's points the scaled loop can peak higher: the K-step reads its H∞
+#: norm); others are refined by the minimax of the peak
+#: (:func:`~ambseal.robust._dgscale.refine_scalings`) from the first round's fits.
 FIT_REWEIGHT_LEVEL = 1e-2
 
 

@@ -990,12 +990,10 @@ def _pid_verdict(d: Mapping) -> str:
 
 #: A design's μ within this share of 1 lies on the robust-performance boundary, and its
 #: verdict names both sides: the tolerance stated for a delivered μ (benchmarks/README.md,
-#: "bench_tolerances.py"), above what the machine's rounding moved it by (D–G–K's
-#: minimax refinement of its scalings: 0.8225 against 0.8269 on the overhung compressor
-#: example under two BLAS kernel sets, "The design model's coordinates"; it is now kept
-#: for the steps whose reweighted fits do not certify). Within it, "met" and
-#: "NOT met" would follow the machine the design ran on. A design whose D–G–K path parts
-#: further (the flywheel example's μ, 0.985 against 1.033) is beyond this rule.
+#: "bench_tolerances.py"), above what the machine's rounding moves a D–G–K design by where
+#: its scalings are refined by the minimax (benchmarks/README.md, "D–G–K's refinement
+#: amplifies rounding"). Within it, "met" and "NOT met" would follow the machine the
+#: design ran on; a design whose D–G–K path parts further is beyond this rule.
 MU_BOUNDARY_RTOL = 0.02
 
 

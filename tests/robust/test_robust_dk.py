@@ -11,9 +11,13 @@ from ambseal.robust._dscale import (
     SEARCH_STALL_EVALS_PER_PARAMETER,
     SEARCH_STALL_RTOL,
     SEARCH_WORK,
+    _d_logmag_jac,
+    _d_theta,
+    _logmag_jac,
     _search_dscales,
     _search_evals,
     _tf_to_theta,
+    _theta_to_tf,
 )
 from ambseal.robust.dk import fit_dscale, fit_magnitude, musyn
 from ambseal.robust.hinf import hinfsyn, lft_lower
@@ -49,6 +53,23 @@ def test_fit_magnitude_recovers_minimum_phase_scale():
     assert float(np.real(c(1j))) == pytest.approx(3.0)
     with pytest.raises(ValueError, match="0–4"):
         fit_magnitude(w, mag, 5)
+
+
+@pytest.mark.parametrize("order", [1, 2, 3, 4])
+def test_the_d_scale_fits_jacobians_are_the_derivatives_of_their_magnitudes(order):
+    """References: |D(jω)| of the section parameters' transfer function evaluated by
+    python-control, and central differences (step 1e-6) of it for both parametrisations the
+    fits use (θ, and x with log 2ζ in place of log 2ζω_n)."""
+    rng = np.random.default_rng(order)
+    w = np.logspace(0, 4, 40)
+    x = rng.uniform(0.0, 8.0, 1 + 2 * order)  # section frequencies within the grid's
+    for par, jac in ((lambda v: v, _logmag_jac), (lambda v: _d_theta(v, order), _d_logmag_jac)):
+        val, J = jac(x, w, order)
+        num, den = _theta_to_tf(par(x), order)
+        np.testing.assert_allclose(val, np.log(np.abs(ct.tf(num, den)(1j * w))), atol=1e-10)
+        fd = np.column_stack([(jac(x + e, w, order)[0] - jac(x - e, w, order)[0]) / 2e-6
+                              for e in 1e-6 * np.eye(x.size)])
+        np.testing.assert_allclose(J, fd, atol=1e-6)
 
 
 def test_fit_dscale_selects_the_lowest_sufficient_order():

@@ -86,9 +86,9 @@ def _d_theta(x, order):
     return th
 
 
-def _d_logmag_jac(x, w, order):
-    """log|d(jω)| and its gradient in x (:func:`_d_theta`), shapes (F,) and (F, 1 + 2·order)."""
-    th = _d_theta(x, order)
+def _logmag_jac(theta, w, order):
+    """:func:`_logmag` and its gradient in θ, shapes (F,) and (F, 1 + 2·order)."""
+    th = np.asarray(theta, float)
     sec, first = _d_sections(order)
     half = sec.size // 2, first.size // 2
     w2 = w ** 2
@@ -107,6 +107,13 @@ def _d_logmag_jac(x, w, order):
         a2 = np.exp(2 * th[i])
         val += sign * 0.5 * np.log(w2 + a2)
         J[:, i] = sign * a2 / (w2 + a2)
+    return val, J
+
+
+def _d_logmag_jac(x, w, order):
+    """log|d(jω)| and its gradient in x (:func:`_d_theta`), shapes (F,) and (F, 1 + 2·order)."""
+    val, J = _logmag_jac(_d_theta(x, order), w, order)
+    sec, _ = _d_sections(order)
     J[:, sec] += 0.5 * J[:, sec + 1]  # chain rule of θ[i + 1] = x[i + 1] + x[i]/2
     return val, J
 

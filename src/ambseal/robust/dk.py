@@ -39,8 +39,10 @@ from ambseal.lti import least_squares_converged
 from ambseal.robust._dscale import (
     FIT_STALL_RTOL,
     _balance_channels,
+    _d_logmag_jac,
     _d_theta,
     _logmag,
+    _logmag_jac,
     _scaled_plant,
     _search_evals,
     _search_step,
@@ -113,6 +115,7 @@ def fit_magnitude(omega, mag, order: int):
         th[0] = np.mean(y - _logmag(th, w, order))
         res = least_squares_converged(
             lambda t: _logmag(t, w, order) - y, th, method="trf",
+            jac=lambda t: _logmag_jac(t, w, order)[1],
             bounds=(np.r_[-60.0, np.full(th.size - 1, lw.min() - 12)],
                     np.r_[60.0, np.full(th.size - 1, 2 * lw.max() + 12)]))
         if best is None or res.cost < best.cost:
@@ -151,6 +154,7 @@ def _fit_weighted(w, y, order, wgt, starts):
             return float(np.max(np.abs(_logmag(theta(t), w, order) - y) * wgt / wgt.max()))
 
         res = least_squares_converged(lambda t: sq * (_logmag(theta(t), w, order) - y), x,
+                                      jac=lambda t: sq[:, None] * _d_logmag_jac(t, w, order)[1],
                                       method="trf", bounds=(lb, ub), stall=largest,
                                       stall_rtol=FIT_STALL_RTOL)
         th, err = theta(res.x), largest(res.x)

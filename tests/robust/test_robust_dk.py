@@ -62,7 +62,7 @@ def test_the_d_scale_fits_jacobians_are_the_derivatives_of_their_magnitudes(orde
     fits use (θ, and x with log 2ζ in place of log 2ζω_n)."""
     rng = np.random.default_rng(order)
     w = np.logspace(0, 4, 40)
-    x = rng.uniform(0.0, 8.0, 1 + 2 * order)  # section frequencies within the grid's
+    x = rng.uniform(0.0, 8.0, 1 + 2 * order)  # log frequencies within the grid's range
     for par, jac in ((lambda v: v, _logmag_jac), (lambda v: _d_theta(v, order), _d_logmag_jac)):
         val, J = jac(x, w, order)
         num, den = _theta_to_tf(par(x), order)

@@ -111,29 +111,69 @@ def overhung():
     return cfg, design(cfg, "pid").controller
 
 
-@pytest.mark.parametrize("rig, speeds", [
-    ("overhung_compressor", (40.0, 180.0, 305.0)),  # gyroscopic, constant seal
-    ("turboexpander", (35.0, 130.0, 265.0)),  # seals tabulated over frequency, between rows
+@pytest.mark.parametrize("rig, speeds, pressure", [
+    ("overhung_compressor", (40.0, 180.0, 305.0), 1.0),  # gyroscopic, constant seal
+    ("overhung_compressor", (40.0, 180.0, 305.0), 2.0),  # its seal at twice the pressure
+    ("turboexpander", (35.0, 130.0, 265.0), 1.0),  # seals tabulated over frequency
+    ("b2b_compressor", (20.0, 115.0, 185.0), 0.0),  # two seals, at no pressure drop
 ])
-def test_running_plant_is_python_controls_plant_built_at_each_speed(rig, speeds):
+def test_running_plant_is_python_controls_plant_built_at_each_speed(rig, speeds, pressure):
     """The open loop at the running speed equals the frequency response of the full-order
-    plant :func:`build_plant` makes at that speed (python-control's state space, solved
-    densely at jΩ; its seal tables taken at Ω/2π): current inputs and forces at the
-    bearings, to 1e-7 — on a gyroscopic machine and on one whose seal coefficients follow
-    the whirl frequency, where the per-speed seals are what differs."""
+    plant :func:`build_plant` makes at that speed and pressure drop (python-control's state
+    space, solved densely at jΩ; its seal tables taken at Ω/2π): current inputs and forces
+    at the bearings, to 1e-7 — on a gyroscopic machine, on one whose seal coefficients
+    follow the whirl frequency, where the per-speed seals are what differs, and at pressure
+    drops other than the operating one (reached from it through the seals' DOFs)."""
     cfg = load_rig(f"examples/{rig}.toml")
     assert (rig == "turboexpander") == any(sl.frequency_dependent for sl in cfg.seal)
     zs = tuple(a.position for a in cfg.amb)
     speeds = np.array(speeds)
-    rp = running_plant(cfg, speeds, zs)
+    p = pressure * cfg.operating.pressure_bar
+    rp = running_plant(cfg, speeds, zs, pressure_bar=p)
     for k, f in enumerate(speeds):
-        P = build_plant(cfg, speed_rpm=60.0 * f, force_positions=zs).to_statespace()
+        P = build_plant(cfg, speed_rpm=60.0 * f, force_positions=zs,
+                        pressure_bar=p).to_statespace()
         H = _at(P, 2j * math.pi * f)
         nu = rp.Gu.shape[2]
         assert P.output_labels == list(rp.outputs)
         scale = np.abs(H).max()
         np.testing.assert_allclose(rp.Gu[k], H[:, :nu], atol=1e-7 * scale)
         np.testing.assert_allclose(rp.Gf[k], H[:, nu:], atol=1e-7 * scale)
+
+
+def test_running_plant_solves_each_speed_once_for_every_pressure_drop(monkeypatch):
+    """Each speed's n-DOF dynamic stiffness is solved once for all pressure drops: the
+    judged conditions at three pressures share one initial sweep. Where the Woodbury
+    identity's small system is too ill-conditioned (forced here with a limit of 0), the
+    speed is solved densely at its pressure drop, to the same numbers (1e-9)."""
+    from ambseal.analysis import synchronous as syn
+    from ambseal.lti import ArrayMemo
+
+    cfg = load_rig("examples/b2b_compressor.toml")
+    zs = tuple(a.position for a in cfg.amb)
+    p0 = cfg.operating.pressure_bar
+    formed = []
+    real = syn._running_system
+
+    def counted(cfg, where, p):
+        base, stiffness = real(cfg, where, p)
+        return base, lambda f: formed.append(f) or stiffness(f)
+
+    monkeypatch.setattr(syn, "_running_system", counted)
+    monkeypatch.setattr(syn, "_RUNNING", ArrayMemo(keep=8))
+    monkeypatch.setattr(syn, "_REFERENCE", ArrayMemo(keep=4), raising=False)
+    speeds = np.array([20.0, 115.0, 185.0])
+    shared = [running_plant(cfg, speeds, zs, pressure_bar=p) for p in (0.0, p0, 2 * p0)]
+    assert sorted(formed) == speeds.tolist()
+    monkeypatch.setattr(syn, "_RUNNING", ArrayMemo(keep=8))
+    monkeypatch.setattr(syn, "_WOODBURY_COND", 0.0)
+    dense = running_plant(cfg, speeds, zs, pressure_bar=2 * p0)
+    assert sorted(formed) == sorted(2 * speeds.tolist())
+    scale = np.abs(dense.Gf).max()
+    np.testing.assert_allclose(shared[2].Gf, dense.Gf, rtol=0, atol=1e-9 * scale)
+    np.testing.assert_allclose(shared[2].Gu, dense.Gu, rtol=0,
+                               atol=1e-9 * np.abs(dense.Gu).max())
+    assert not np.allclose(shared[2].Gf, shared[0].Gf, rtol=1e-3, atol=0)  # seals matter
 
 
 def test_judged_orbit_is_the_loop_closed_on_the_plant_at_that_speed(overhung):

@@ -464,6 +464,17 @@ def running_plant(cfg, speeds_hz, force_positions, *, pressure_bar: float | None
         Kept for the last few rigs, pressures and grids (the controllers judged at one
         condition close the same open loop).
 
+    Notes
+    -----
+    The seals act on their nodes' x and y alone, so the dynamic stiffness at a pressure
+    drop p is the one at the rig's operating pressure drop plus a change of rank two per
+    seal: each speed is solved densely once, at the operating pressure drop, and every
+    other pressure drop follows by the Sherman–Morrison–Woodbury identity (Golub & Van
+    Loan, *Matrix Computations*, 4th ed., §2.1.4) on the seals' DOFs. Where that small
+    system's condition number exceeds 1/√ε (6.7e7; the seals then move a mode near the
+    speed by more than rounding lets the identity cancel), the speed is solved densely at
+    p instead.
+
     Raises
     ------
     ModelError
@@ -475,34 +486,115 @@ def running_plant(cfg, speeds_hz, force_positions, *, pressure_bar: float | None
     p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
     rig = hashlib.sha256(cfg.model_dump_json().encode()).digest()
     key = hashlib.sha256(rig + speeds.tobytes()).digest()
-    return _RUNNING.get_digested(key, (p, where), lambda: _running_plant(cfg, speeds, where, p))
+    return _RUNNING.get_digested(key, (p, where),
+                                 lambda: _running_plant(cfg, rig, speeds, where, p))
 
 
 #: The open loops at the running speed of the last conditions: each judged condition's
 #: controllers (continuous and as they run) close the same one.
 _RUNNING = ArrayMemo(keep=8, keep_bytes=16 * 2**20)
 
+#: The largest condition number of the Woodbury identity's small system (I + ΔZ W) taken:
+#: 1/√ε of double precision, so that at least half the digits survive its cancellation;
+#: beyond it the speed is solved densely.
+_WOODBURY_COND = 1.0 / math.sqrt(np.finfo(float).eps)
 
-def _running_plant(cfg, speeds: np.ndarray, where: tuple, p: float) -> RunningPlant:
-    base, stiffness = _running_system(cfg, where, p)
-    n_cur = len(base.output_names)
-    if n_cur == 0:
-        raise ModelError("the running plant needs AMBs: the rig has none")
-    act = (actuator_matrices(cfg.actuator), eddy_lag_matrices(cfg.actuator.eddy_time_constant))
-    Bi, Bf = base.B[:, :n_cur], base.B[:, n_cur:]
-    Gu = np.empty((speeds.size, n_cur, n_cur), complex)
-    Gf = np.empty((speeds.size, n_cur, Bf.shape[1]), complex)
-    for k, f in enumerate(speeds):
-        h_amp, h_eddy = (_siso_at(m, 2j * math.pi * f) for m in act)
+
+class _AtReference:
+    """Each speed's dense solve at the rig's operating pressure drop, for one rig and set
+    of force positions, kept speed by speed for every pressure drop (:func:`running_plant`'s
+    notes): per speed ``(Cq X, Cq X_s, E X, E X_s)`` with ``X`` the solve of the inputs'
+    columns, ``X_s`` of the seals' DOFs and ``E`` those DOFs' rows; None where the dynamic
+    stiffness there is singular."""
+
+    def __init__(self, cfg, mesh):
+        self.p = cfg.operating.pressure_bar
+        nodes = sorted({mesh.node_at(sl.position) for sl in cfg.seal})
+        self.dofs = [4 * i + ax for i in nodes for ax in (0, 1)]
+        self.rows: dict[float, tuple | None] = {}
+
+    def solve(self, system: "_Running", speeds) -> None:
+        """Solve the speeds not kept yet with ``system`` (at the operating pressure drop)."""
+        E = np.zeros((system.base.n_dof, len(self.dofs)))
+        E[self.dofs, range(len(self.dofs))] = 1.0
+        for f in speeds:
+            try:
+                X = system.solve(f, E)
+            except np.linalg.LinAlgError:
+                self.rows[f] = None
+                continue
+            m = X.shape[1] - E.shape[1]
+            CX, EX = system.base.Cq @ X, X[self.dofs]
+            self.rows[f] = (CX[:, :m], CX[:, m:], EX[:, :m], EX[:, m:])
+
+
+class _Running:
+    """The open loop's dynamic stiffness at one pressure drop and its input columns."""
+
+    def __init__(self, cfg, where: tuple, p: float):
+        self.base, self.stiffness = _running_system(cfg, where, p)
+        self.n_cur = len(self.base.output_names)
+        if self.n_cur == 0:
+            raise ModelError("the running plant needs AMBs: the rig has none")
+        self.act = (actuator_matrices(cfg.actuator),
+                    eddy_lag_matrices(cfg.actuator.eddy_time_constant))
+
+    def solve(self, f: float, extra: np.ndarray | None = None) -> np.ndarray:
+        """``Z(f)⁻¹ [B_i H_a(jΩ) H_e(jΩ), B_f, extra]`` (raises LinAlgError if singular)."""
+        base, n_cur = self.base, self.n_cur
+        h_amp, h_eddy = (_siso_at(m, 2j * math.pi * f) for m in self.act)
+        cols = [base.B[:, :n_cur] * (h_amp * h_eddy), base.B[:, n_cur:]]
+        return np.linalg.solve(self.stiffness(f), np.hstack(cols + ([] if extra is None
+                                                                    else [extra])))
+
+
+def _seal_change(cfg, mesh, dofs: list, p: float, p_ref: float, f: float) -> np.ndarray:
+    """The seals' dynamic stiffness at ``p`` less that at ``p_ref`` (bar), whirl at ``f``
+    (Hz), on ``dofs`` (their nodes' x and y): ``ΔK − Ω²ΔM + jΩΔC``."""
+    omega = 2 * math.pi * f
+    D = np.zeros((len(dofs), len(dofs)), complex)
+    for sl in cfg.seal:
+        at = dofs.index(4 * mesh.node_at(sl.position))
+        K1, C1, M1 = SealElement.from_config(sl, mesh, p, f).matrices()
+        K0, C0, M0 = SealElement.from_config(sl, mesh, p_ref, f).matrices()
+        D[at:at + 2, at:at + 2] += (K1 - K0) - omega ** 2 * (M1 - M0) + 1j * omega * (C1 - C0)
+    return D
+
+
+#: Each rig's and force positions' solves at its operating pressure drop, speed by speed
+_REFERENCE = ArrayMemo(keep=4)
+
+
+def _running_plant(cfg, rig: bytes, speeds: np.ndarray, where: tuple, p: float
+                   ) -> RunningPlant:
+    system = _Running(cfg, where, p)
+    base = system.base
+    ref = _REFERENCE.get_digested(rig, where, lambda: _AtReference(cfg, base.mesh))
+    todo = sorted({float(f) for f in speeds} - ref.rows.keys())
+    if todo:
+        ref.solve(system if p == ref.p else _Running(cfg, where, ref.p), todo)
+    rows = []
+    for f in speeds:
+        kept = ref.rows[float(f)]
+        if kept is not None and (p == ref.p or not ref.dofs):
+            rows.append(kept[0])
+            continue
+        if kept is not None:
+            A, Bs, Wr, W = kept
+            D = _seal_change(cfg, base.mesh, ref.dofs, p, ref.p, f)
+            cap = np.eye(len(ref.dofs)) + D @ W
+            if np.linalg.cond(cap) <= _WOODBURY_COND:
+                rows.append(A - Bs @ np.linalg.solve(cap, D @ Wr))
+                continue
         try:
-            X = np.linalg.solve(stiffness(f), np.hstack([Bi * (h_amp * h_eddy), Bf]))
+            rows.append(base.Cq @ system.solve(f))
         except np.linalg.LinAlgError:
             raise ModelError(f"running plant: the dynamic stiffness is singular at {f:g} Hz "
                              "(an undamped mode at that speed)") from None
-        Y = base.Cq @ X
-        Gu[k], Gf[k] = Y[:, :n_cur], Y[:, n_cur:]
-    return RunningPlant(speeds, Gu, Gf, tuple(base.input_names[:n_cur]),
-                        tuple(base.output_names), tuple(base.input_names[n_cur:]))
+    n_cur, names = system.n_cur, base.input_names
+    Y = np.array(rows).reshape((speeds.size, n_cur, -1))
+    return RunningPlant(speeds, Y[:, :, :n_cur], Y[:, :, n_cur:], tuple(names[:n_cur]),
+                        tuple(base.output_names), tuple(names[n_cur:]))
 
 
 def _ks(cfg, input_name: str) -> float:

@@ -464,6 +464,12 @@ def running_plant(cfg, speeds_hz, force_positions, *, pressure_bar: float | None
         Kept for the last few rigs, pressures and grids (the controllers judged at one
         condition close the same open loop).
 
+    Raises
+    ------
+    ModelError
+        A singular dynamic stiffness (an undamped open-loop mode exactly at a speed), or a
+        rig without AMBs.
+
     Notes
     -----
     The seals act on their nodes' x and y alone, so the dynamic stiffness at a pressure
@@ -474,12 +480,6 @@ def running_plant(cfg, speeds_hz, force_positions, *, pressure_bar: float | None
     system's condition number exceeds 1/√ε (6.7e7; the seals then move a mode near the
     speed by more than rounding lets the identity cancel), the speed is solved densely at
     p instead.
-
-    Raises
-    ------
-    ModelError
-        A singular dynamic stiffness (an undamped open-loop mode exactly at a speed), or a
-        rig without AMBs.
     """
     speeds = np.array(np.atleast_1d(np.asarray(speeds_hz, dtype=float)))
     where = tuple(float(z) for z in force_positions)

@@ -39,7 +39,8 @@ same rows either way, since each row comes from its own child. One JSON line per
 stdout: the draw, the exit status, CPU in machine references and per method
 ``delivered`` — in ``metrics.json``'s controllers, neither failed nor unable to run on
 the target, and ISO 14839-3 zone A or B on every axis (σ̄(S_o) peak per axis below 4, as
-it runs: the discrete loop's) at every judged condition. The last line sums the family:
+it runs: the discrete loop's) at every judged condition, and ``why_not`` each other
+method is (:func:`why_not`). The last line sums the family:
 per method the fraction delivered, the rigs where no method is, and the CPU.
 
 Run from the repository root: ``PYTHONPATH=src python benchmarks/bench_family.py
@@ -198,15 +199,30 @@ def example_rigs() -> list[tuple[str, dict]]:
 def delivered(metrics: dict) -> dict[str, bool]:
     """Per method: delivered as it runs, standstill to the top speed, zone A or B on
     every axis (module docstring)."""
-    out = {}
+    return {m: why is None for m, why in why_not(metrics).items()}
+
+
+def why_not(metrics: dict) -> dict[str, str | None]:
+    """Per method: None where it is delivered (:func:`delivered`), else why not — not
+    designed, its failure's or its target's reason, or the worst axis's σ̄(S_o) peak as it
+    runs at zone C or D, with its condition."""
+    out: dict[str, str | None] = {}
     for m in METHODS:
-        if m not in metrics["controllers"] or m in metrics["failed"] \
-                or m in metrics["cannot_run"]:
-            out[m] = False
-            continue
-        peaks = [v for c in metrics["cases"] if c["controller"] == m
-                 for v in (c.get("discrete") or c)["sensitivity_peak_per_axis"].values()]
-        out[m] = bool(peaks) and max(peaks) < ZONE_B_LIMIT
+        if m not in metrics["controllers"]:
+            out[m] = "not designed"
+        elif m in metrics["failed"]:
+            out[m] = f"failed: {metrics['failed'][m]['reason']}"
+        elif m in metrics["cannot_run"]:
+            out[m] = f"cannot run: {metrics['cannot_run'][m]}"
+        else:
+            peaks = [(v, axis, c["speed_hz"], c["pressure_bar"])
+                     for c in metrics["cases"] if c["controller"] == m
+                     for axis, v in (c.get("discrete") or c)["sensitivity_peak_per_axis"]
+                     .items()]
+            worst = max(peaks, default=None)
+            out[m] = ("no judged case" if worst is None else None if worst[0] < ZONE_B_LIMIT
+                      else f"zone C/D: σ̄(S_o) {worst[0]:.3g} on {worst[1]} at "
+                           f"{worst[2]:g} Hz, {worst[3]:g} bar")
     return out
 
 
@@ -232,6 +248,7 @@ def run_rig(case: dict, timeout: float) -> dict:
             row["error"] = (tail.splitlines() or ["no output"])[-1]
         else:
             row["delivered"] = delivered(m)
+            row["why_not"] = {k: v for k, v in why_not(m).items() if v is not None}
             row["failed"] = {k: v["reason"] for k, v in m["failed"].items()}
             row["cannot_run"] = m["cannot_run"]
     return row

@@ -80,3 +80,31 @@ def test_a_disc_like_rotor_switches_its_notch_on_where_it_needs_it(tmp_path):
     assert rej["first_start"]["on_from_hz"] == pytest.approx(lo)
     assert rej["first_start"]["why"].startswith("loses the loop at")
     assert m["controllers"]["lpv"]["capacity"]["rejection_automatic"]
+
+
+def test_every_method_not_delivered_says_why():
+    """:func:`bench_family.why_not` on a run's metrics: a method not designed, one failed,
+    one its target cannot run, one whose worst axis as it runs is at zone C (σ̄(S_o) 4 or
+    more: ISO 14839-3's B/C limit), each with its reason, and one delivered (None)."""
+    bf = _bench_family()
+
+    def case(method, speed, peaks):
+        return {"controller": method, "speed_hz": speed, "pressure_bar": 0.0,
+                "sensitivity_peak_per_axis": {"A_zeta": 1.0, "A_eta": 1.0},
+                "discrete": {"sensitivity_peak_per_axis": peaks}}
+
+    metrics = {"controllers": {"pid": {}, "hinf": {}, "mu": {}, "lpv": {}},
+               "failed": {"hinf": {"reason": "unstable at 0 Hz"}},
+               "cannot_run": {"mu": "highest controller pole 7.9e+06 Hz"},
+               "cases": [case("pid", 0.0, {"A_zeta": 2.5, "A_eta": 2.5}),
+                         case("pid", 300.0, {"A_zeta": 2.5, "A_eta": 4.2}),
+                         case("lpv", 300.0, {"A_zeta": 3.9, "A_eta": 2.0})]}
+    metrics["controllers"].pop("lpv")
+    why = bf.why_not(metrics)
+    assert why == {"pid": "zone C/D: σ̄(S_o) 4.2 on A_eta at 300 Hz, 0 bar",
+                   "hinf": "failed: unstable at 0 Hz",
+                   "mu": "cannot run: highest controller pole 7.9e+06 Hz",
+                   "lpv": "not designed"}
+    metrics["controllers"]["lpv"] = {}
+    assert bf.why_not(metrics)["lpv"] is None
+    assert bf.delivered(metrics) == {"pid": False, "hinf": False, "mu": False, "lpv": True}

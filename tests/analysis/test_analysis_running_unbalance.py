@@ -145,7 +145,8 @@ def test_running_plant_solves_each_speed_once_for_every_pressure_drop(monkeypatc
     """Each speed's n-DOF dynamic stiffness is solved once for all pressure drops: the
     judged conditions at three pressures share one initial sweep. Where the Woodbury
     identity's small system is too ill-conditioned (forced here with a limit of 0), the
-    speed is solved densely at its pressure drop, to the same numbers (1e-9)."""
+    speed is solved densely at its pressure drop, to the same numbers (1e-9). No speed
+    gives empty arrays of the loop's shape."""
     from ambseal.analysis import synchronous as syn
     from ambseal.lti import ArrayMemo
 
@@ -174,6 +175,8 @@ def test_running_plant_solves_each_speed_once_for_every_pressure_drop(monkeypatc
     np.testing.assert_allclose(shared[2].Gu, dense.Gu, rtol=0,
                                atol=1e-9 * np.abs(dense.Gu).max())
     assert not np.allclose(shared[2].Gf, shared[0].Gf, rtol=1e-3, atol=0)  # seals matter
+    none = running_plant(cfg, [], zs, pressure_bar=0.0)  # a refinement with no speed left
+    assert none.Gu.shape == (0, 4, 4) and none.Gf.shape == (0, 4, 4)
 
 
 def test_judged_orbit_is_the_loop_closed_on_the_plant_at_that_speed(overhung):

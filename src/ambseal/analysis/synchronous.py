@@ -507,9 +507,11 @@ class _AtReference:
     columns, ``X_s`` of the seals' DOFs and ``E`` those DOFs' rows; None where the dynamic
     stiffness there is singular."""
 
-    def __init__(self, cfg, mesh):
-        self.p = cfg.operating.pressure_bar
-        nodes = sorted({mesh.node_at(sl.position) for sl in cfg.seal})
+    def __init__(self, cfg, system: "_Running"):
+        base = system.base
+        self.p, self.mesh, self.n_cur = system.p, base.mesh, system.n_cur
+        self.names = (tuple(base.input_names), tuple(base.output_names))
+        nodes = sorted({base.mesh.node_at(sl.position) for sl in cfg.seal})
         self.dofs = [4 * i + ax for i in nodes for ax in (0, 1)]
         self.rows: dict[float, tuple | None] = {}
 
@@ -532,6 +534,7 @@ class _Running:
     """The open loop's dynamic stiffness at one pressure drop and its input columns."""
 
     def __init__(self, cfg, where: tuple, p: float):
+        self.p = p
         self.base, self.stiffness = _running_system(cfg, where, p)
         self.n_cur = len(self.base.output_names)
         if self.n_cur == 0:
@@ -567,12 +570,19 @@ _REFERENCE = ArrayMemo(keep=4)
 
 def _running_plant(cfg, rig: bytes, speeds: np.ndarray, where: tuple, p: float
                    ) -> RunningPlant:
-    system = _Running(cfg, where, p)
-    base = system.base
-    ref = _REFERENCE.get_digested(rig, where, lambda: _AtReference(cfg, base.mesh))
+    made: dict[float, _Running] = {}
+
+    def at(q: float) -> _Running:
+        """The system at pressure drop ``q``, built where a speed needs a dense solve."""
+        if q not in made:
+            made[q] = _Running(cfg, where, q)
+        return made[q]
+
+    ref = _REFERENCE.get_digested(
+        rig, where, lambda: _AtReference(cfg, at(cfg.operating.pressure_bar)))
     todo = sorted({float(f) for f in speeds} - ref.rows.keys())
     if todo:
-        ref.solve(system if p == ref.p else _Running(cfg, where, ref.p), todo)
+        ref.solve(at(ref.p), todo)
     rows = []
     for f in speeds:
         kept = ref.rows[float(f)]
@@ -581,20 +591,20 @@ def _running_plant(cfg, rig: bytes, speeds: np.ndarray, where: tuple, p: float
             continue
         if kept is not None:
             A, Bs, Wr, W = kept
-            D = _seal_change(cfg, base.mesh, ref.dofs, p, ref.p, f)
+            D = _seal_change(cfg, ref.mesh, ref.dofs, p, ref.p, f)
             cap = np.eye(len(ref.dofs)) + D @ W
             if np.linalg.cond(cap) <= _WOODBURY_COND:
                 rows.append(A - Bs @ np.linalg.solve(cap, D @ Wr))
                 continue
         try:
-            rows.append(base.Cq @ system.solve(f))
+            rows.append(at(p).base.Cq @ at(p).solve(f))
         except np.linalg.LinAlgError:
             raise ModelError(f"running plant: the dynamic stiffness is singular at {f:g} Hz "
                              "(an undamped mode at that speed)") from None
-    n_cur, names = system.n_cur, base.input_names
-    Y = np.array(rows).reshape((speeds.size, n_cur, -1))
-    return RunningPlant(speeds, Y[:, :, :n_cur], Y[:, :, n_cur:], tuple(names[:n_cur]),
-                        tuple(base.output_names), tuple(names[n_cur:]))
+    (inputs, outputs), n_cur = ref.names, ref.n_cur
+    Y = np.array(rows, dtype=complex).reshape((speeds.size, len(outputs), len(inputs)))
+    return RunningPlant(speeds, Y[:, :, :n_cur], Y[:, :, n_cur:], inputs[:n_cur], outputs,
+                        inputs[n_cur:])
 
 
 def _ks(cfg, input_name: str) -> float:

@@ -146,6 +146,28 @@ def test_a_rotor_plants_inputs_share_one_eigendecomposition(monkeypatch):
     assert calls == [n]
 
 
+
+def test_one_or_two_points_of_a_large_model_are_solved_densely(monkeypatch):
+    """From ``STRUCTURED_STATES`` states one or two points are the probes every fast form
+    is checked against: answered by dense solves alone, with no eigendecomposition or
+    Hessenberg reduction of the model, and as the solves refined in extended precision
+    (to 1e-12 of the peak)."""
+    import scipy.linalg
+
+    A, B, C, D, wn = _lightly_damped(n=fr.STRUCTURED_STATES, seed=7)
+    calls = []
+    for name in ("eig", "hessenberg"):
+        real = getattr(scipy.linalg, name)
+        monkeypatch.setattr(scipy.linalg, name, lambda *a, real=real, name=name, **k: (
+            calls.append(name), real(*a, **k))[1])
+    monkeypatch.setattr(fr, "_USE_SLYCOT", False)
+    w = np.sort(wn[:2])
+    for H, s in ((fr.freqresp((A, B, C, D), w), 1j * w),
+                 (fr.freqresp_at((A, B, C, D), 1j * w[:1] + 3.0), 1j * w[:1] + 3.0)):
+        R = _refined(A, B, C, D, s)
+        assert np.max(np.abs(H - R)) <= 1e-12 * np.max(np.abs(R))
+    assert calls == []
+
 def _refined(A, B, C, D, s):
     """Reference: dense solves refined to extended precision (residuals in long double,
     four steps of iterative refinement)."""

@@ -113,3 +113,27 @@ def test_rejection_is_off_below_the_speed_range_and_needs_a_turning_rotor(
     assert rejection.controller.at(2 * math.pi * lo).nstates == turbo_frozen.K.nstates + 8
     with pytest.raises(ConfigError, match="speed_range_hz"):
         design_rejection(testrig_cfg, testrig_designs["hinf"].K)
+
+
+def test_a_second_table_on_the_same_speeds_builds_no_plant(turbo_cfg, turbo_frozen,
+                                                           turbo_hinf_digital, monkeypatch):
+    """The plant at a table's speed does not depend on the controller: a second table at
+    the same speeds and pressure drop (another run's controller, another rate) builds and
+    evaluates no plant, and its gains are those of a table made from fresh plants, to the
+    bit."""
+    import ambseal.design.synchronous_rejection as sr
+
+    design_rejection(turbo_cfg, turbo_frozen.K, turbo_hinf_digital, rate_fraction=0.01)
+    built, real = [], sr.build_plant
+    monkeypatch.setattr(sr, "build_plant", lambda *a, **k: built.append(k) or real(*a, **k))
+    again = design_rejection(turbo_cfg, turbo_frozen.K, turbo_hinf_digital,
+                             rate_fraction=0.02)
+    assert built == []
+    monkeypatch.setattr(sr, "_PLANT_AT", sr.ArrayMemo(keep=256))
+    fresh = design_rejection(turbo_cfg, turbo_frozen.K, turbo_hinf_digital,
+                             rate_fraction=0.02)
+    assert len(built) == sr.GRID_POINTS
+    for a, b in ((again.controller.notch, fresh.controller.notch),
+                 (again.digital.notch, fresh.digital.notch)):
+        assert np.array_equal(a.gain_re, b.gain_re) and np.array_equal(a.gain_im, b.gain_im)
+        assert a.gain_re.shape[0] == sr.GRID_POINTS

@@ -168,6 +168,37 @@ def test_one_or_two_points_of_a_large_model_are_solved_densely(monkeypatch):
         assert np.max(np.abs(H - R)) <= 1e-12 * np.max(np.abs(R))
     assert calls == []
 
+
+def test_a_large_models_cond_v_is_the_2_norm_one_without_an_svd(monkeypatch):
+    """From ``STRUCTURED_STATES`` states cond V, which decides whether the modal form is
+    tried, is the 2-norm condition number from two largest singular values by Lanczos
+    (V and V⁻¹ through its LU): no SVD of V, and the SVD's value to 1e-5 (a well
+    conditioned V, and the ill conditioned eigenvectors of the thesis rig's unbalanced
+    FE plant at two speeds, block diagonal).
+    A singular V has cond V = inf."""
+    import scipy.linalg
+    from ambseal.config import load_rig
+    from ambseal.model.rig import build_plant
+
+    A1, _, C1, _, _ = _lightly_damped(n=fr.STRUCTURED_STATES, seed=11)
+    P0, P1 = (build_plant(load_rig(), speed_rpm=r) for r in (0.0, 6000.0))
+    calls = []
+    real_cond = np.linalg.cond
+    monkeypatch.setattr(np.linalg, "cond", lambda *a, **k: (calls.append(1),
+                                                             real_cond(*a, **k))[1])
+    fe = scipy.linalg.block_diag(P0.A, P1.A), scipy.linalg.block_diag(P0.C, P1.C)
+    for A, C in ((A1, C1), fe):
+        assert A.shape[0] >= fr.STRUCTURED_STATES
+        lam, cond, lu, Cm, sc = fr._eig_form(A, C, 1e8, False)
+        assert calls == []
+        exact = real_cond(scipy.linalg.eig(A)[1])
+        assert cond == pytest.approx(exact, rel=1e-5)
+    V = np.eye(fr.STRUCTURED_STATES, dtype=complex)
+    V[:, 1] = V[:, 0]
+    with pytest.warns(scipy.linalg.LinAlgWarning):  # an exactly zero pivot
+        lu = scipy.linalg.lu_factor(V, check_finite=False)
+    assert fr._cond_2(V, lu) == np.inf
+
 def _refined(A, B, C, D, s):
     """Reference: dense solves refined to extended precision (residuals in long double,
     four steps of iterative refinement)."""

@@ -199,6 +199,25 @@ def test_a_large_models_cond_v_is_the_2_norm_one_without_an_svd(monkeypatch):
         lu = scipy.linalg.lu_factor(V, check_finite=False)
     assert fr._cond_2(V, lu) == np.inf
 
+
+def test_large_decompositions_are_kept_to_the_byte_budget(monkeypatch):
+    """Large models' decompositions are kept while they fit in the memo's byte budget, not
+    only its count: eight 500-state systems' (4 MB each, 32 MB in all against 128 MB) are
+    all kept, and asked again none is decomposed again."""
+    import scipy.linalg
+
+    monkeypatch.setattr(fr, "_EIG", fr.ArrayMemo(keep=6, min_states=fr._EIG_STATES,
+                                                 keep_bytes=128 * 2**20))
+    systems = [_lightly_damped(n=fr.STRUCTURED_STATES, seed=20 + k)[:3] for k in range(8)]
+    for A, B, C in systems:
+        fr._modal_form(A, B, C, 1e8)
+    calls, real = [], scipy.linalg.eig
+    monkeypatch.setattr(scipy.linalg, "eig", lambda *a, **k: (calls.append(1),
+                                                               real(*a, **k))[1])
+    for A, B, C in systems:
+        fr._modal_form(A, B, C, 1e8)
+    assert calls == []
+
 def _refined(A, B, C, D, s):
     """Reference: dense solves refined to extended precision (residuals in long double,
     four steps of iterative refinement)."""

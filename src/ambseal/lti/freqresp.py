@@ -804,14 +804,15 @@ def _cond_2(V: np.ndarray, lu) -> float:
     """cond₂ V = σ_max(V) σ_max(V⁻¹), each largest singular value by ARPACK's implicitly
     restarted Lanczos iteration on ``XᴴX`` (SciPy's ``svds``, to :data:`_COND_RTOL`, from a
     seeded start), ``V⁻¹`` applied through the LU of V: O(n²) a step instead of the SVD's
-    O(n³) (840 states: 0.1–0.18 s against 0.31 s, the same seven digits). ``inf`` where the
-    LU is singular; the SVD where ARPACK does not converge."""
+    O(n³) (an FE plant's V: 0.08–0.09 s against 0.31 s at 840 states, 0.04 s against
+    0.06 s at 500; the same seven digits).
+    ``inf`` where the LU is singular; the SVD where ARPACK does not converge."""
     if not np.all(np.diagonal(lu[0])):
         return np.inf
     n, dtype = V.shape[0], np.result_type(V.dtype, np.complex64)
     start = np.random.default_rng(0).standard_normal(n).astype(dtype)
     ops = (LinearOperator((n, n), dtype=dtype, matvec=lambda x: V @ x,
-                          rmatvec=lambda x: V.conj().T @ x),
+                          rmatvec=lambda x: (x.conj() @ V).conj()),  # Vᴴx, V not copied
            LinearOperator((n, n), dtype=dtype,
                           matvec=lambda x: scipy.linalg.lu_solve(lu, x, check_finite=False),
                           rmatvec=lambda x: scipy.linalg.lu_solve(lu, x, trans=2,

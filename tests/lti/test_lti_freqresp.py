@@ -146,7 +146,6 @@ def test_a_rotor_plants_inputs_share_one_eigendecomposition(monkeypatch):
     assert calls == [n]
 
 
-
 def test_one_or_two_points_of_a_large_model_are_solved_densely(monkeypatch):
     """From ``STRUCTURED_STATES`` states one or two points are the probes every fast form
     is checked against: answered by dense solves alone, with no eigendecomposition or
@@ -217,6 +216,7 @@ def test_large_decompositions_are_kept_to_the_byte_budget(monkeypatch):
     for A, B, C in systems:
         fr._modal_form(A, B, C, 1e8)
     assert calls == []
+
 
 def _refined(A, B, C, D, s):
     """Reference: dense solves refined to extended precision (residuals in long double,

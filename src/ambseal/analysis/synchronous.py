@@ -484,7 +484,7 @@ def running_plant(cfg, speeds_hz, force_positions, *, pressure_bar: float | None
     speeds = np.array(np.atleast_1d(np.asarray(speeds_hz, dtype=float)))
     where = tuple(float(z) for z in force_positions)
     p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
-    rig = hashlib.sha256(cfg.model_dump_json().encode()).digest()
+    rig = cfg.digest()
     key = hashlib.sha256(rig + speeds.tobytes()).digest()
     return _RUNNING.get_digested(key, (p, where),
                                  lambda: _running_plant(cfg, rig, speeds, where, p))

@@ -110,6 +110,7 @@ Tables and keys (see ``examples/testrig.toml`` for a complete, commented file):
 
 from __future__ import annotations
 
+import hashlib
 import math
 from pathlib import Path
 from typing import Annotated, Literal
@@ -1000,6 +1001,13 @@ class RigConfig(_Strict):
     def speed(self) -> float:
         """Rotational speed Ω (rad/s)."""
         return self.operating.speed_rpm * 2.0 * math.pi / 60.0
+
+    def digest(self) -> bytes:
+        """SHA-256 of the validated rig's JSON form (32 bytes): the key under which what
+        the rig alone determines (its plants, their responses, its scheduled designs) is
+        kept; two rigs that validate to the same values share it, whatever their files'
+        layout."""
+        return hashlib.sha256(self.model_dump_json().encode()).digest()
 
     def backup_clearance(self, amb: Amb) -> float | None:
         """The radial clearance (m) of the backup bearing beside an AMB: on a rig with

@@ -292,7 +292,7 @@ def _key(cfg, args) -> str:
     """Cache key: the rig, the arguments, the package version and
     :data:`SYNTHESIS_VERSION`."""
 
-    h = hashlib.sha256(cfg.model_dump_json().encode())
+    h = hashlib.sha256(cfg.digest())
     h.update(f"ambseal {__version__} synthesis {SYNTHESIS_VERSION}".encode())
     h.update(repr(args).encode())
     return h.hexdigest()[:20]

@@ -31,7 +31,6 @@ Rules, each a parameter:
 
 from __future__ import annotations
 
-import hashlib
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -139,10 +138,9 @@ def design_rejection(cfg, controller, digital=None, *, pressure_bar: float | Non
     lag = loop_delay(fs, nd).system
     gains: dict = {"c": [], "d": []}
     names: dict = {}
-    rig = hashlib.sha256(cfg.model_dump_json().encode()).digest()
+    rig, sampled = cfg.digest(), digital is not None
     for f in grid:
         w = 2 * math.pi * float(f)
-        sampled = digital is not None
         outputs, inputs, Hc, Hd = _PLANT_AT.get_digested(
             rig, (p, float(f), fs, nd, sampled),
             lambda: _plant_at(cfg, p, float(f), lag, fs if sampled else None))

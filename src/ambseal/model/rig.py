@@ -15,7 +15,6 @@ The state is x = [q; q̇]; A = [[0, I], [−M⁻¹K, −M⁻¹(C + ΩG)]].
 
 from __future__ import annotations
 
-import hashlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -335,7 +334,7 @@ def build_plant(
     speed_rpm = cfg.operating.speed_rpm if speed_rpm is None else float(speed_rpm)
     force_positions = tuple(float(z) for z in force_positions)
     # the rig by the digest of its validated form, the arguments as the memo's extra key
-    rig = hashlib.sha256(cfg.model_dump_json().encode()).digest()
+    rig = cfg.digest()
     return _PLANTS.get_digested(
         rig, (reduced, pressure_bar, speed_rpm, force_positions, states, cutoff_hz),
         lambda: _build_plant(cfg, reduced, pressure_bar, speed_rpm, force_positions, states,

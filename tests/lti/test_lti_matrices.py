@@ -106,8 +106,8 @@ def test_memo_keeps_more_than_its_count_within_its_byte_budget():
     """A sweep of 5 inputs repeated (a Level I sweep per controller): with ``keep=2`` alone
     every lookup of the second pass computes again (least recently used goes first); with
     a byte budget for 5 results, none does; a budget for 3 keeps the count's 2 at least
-    and no more than 3. An object's ``nbytes`` is its size; one without is never kept
-    beyond the count."""
+    and no more than 3. An object's ``nbytes`` is its size, numbers, names and None beside
+    arrays are counted too; an object without a size is never kept beyond the count."""
     from ambseal.lti.memo import ArrayMemo
 
     inputs = [np.full((64, 64), float(k)) for k in range(5)]  # 32 kB each
@@ -130,8 +130,10 @@ def test_memo_keeps_more_than_its_count_within_its_byte_budget():
     class Sized:  # a result that states its size (a plant), and one that does not
         nbytes = inputs[0].nbytes
 
-    for value, kept in ((Sized(), 5), (object(), 2)):
-        memo = ArrayMemo(keep=2, keep_bytes=5 * inputs[0].nbytes)
+    # arrays with a condition number, signal names and no sampled response beside them
+    mixed = (inputs[0], 1.5, 2 + 1j, ["x1", "y1"], None)
+    for value, kept in ((Sized(), 5), (mixed, 5), (object(), 2)):
+        memo = ArrayMemo(keep=2, keep_bytes=5 * (inputs[0].nbytes + 64))
         for A in inputs:
             memo.get((A,), None, lambda: value)
         assert len(memo._kept) == kept

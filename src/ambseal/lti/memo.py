@@ -96,11 +96,19 @@ def array_digest(arrays: tuple) -> bytes:
 
 
 def _nbytes(value) -> float:
-    """The bytes of a result's arrays: an array's or an object's ``nbytes``, or the sum over
-    a tuple or list of them; infinite for anything else (its size unknown, it never
-    exceeds ``keep``)."""
+    """The bytes of a result's arrays: an array's or an object's ``nbytes``, a Python
+    number's 8 (16 complex), a string's UTF-8 length, None's 0, or the sum over a tuple or
+    list of them; infinite for anything else (its size unknown, it never exceeds
+    ``keep``): a condition number or a list of signal names beside the arrays must not
+    make the whole result unbounded."""
     if isinstance(value, (tuple, list)):
         return float(sum(_nbytes(v) for v in value))
+    if value is None:
+        return 0.0
+    if isinstance(value, str):
+        return float(len(value.encode()))
+    if isinstance(value, (bool, int, float, complex)):
+        return 16.0 if isinstance(value, complex) else 8.0
     size = getattr(value, "nbytes", None)
     return float(size) if isinstance(size, (int, np.integer)) else math.inf
 
@@ -123,8 +131,8 @@ class ArrayMemo:
         Inputs whose first array has fewer rows are computed every time, not kept.
     keep_bytes : int
         More than ``keep`` results are kept while the arrays of all of them (a result that
-        is an array, has ``nbytes``, or is a tuple or list of such; any other counts as
-        unbounded) hold at most this many bytes: a sweep over more inputs than ``keep``,
+        is an array, has ``nbytes``, is a number, a string or None, or is a tuple or
+        list of such; any other counts as unbounded) hold at most this many bytes: a sweep over more inputs than ``keep``,
         repeated for each controller, finds its results on a small model, where on a
         large one the ``keep`` bound holds.
     """

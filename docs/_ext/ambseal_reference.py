@@ -474,8 +474,10 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                                   "on speed over ``speed_range_hz``, judged and shown"),
     "RejectionSpec.rate_fraction": ("", "ε/Ω of the notch (default 0.05: it settles in "
                                         "≈ 6 revolutions)"),
-    "RejectionSpec.points": ("", "speeds of its gain table over the speed range (default "
-                                 "16)"),
+    "RejectionSpec.points": ("", "that many evenly spaced speeds of its gain table over "
+                                 "the speed range (default: speeds found by bisection "
+                                 "until the interpolated gain holds the notch's poles "
+                                 "within 25 % of their placement)"),
     "RejectionSpec.runout_um": ("µm", "the synchronous sensor runout of its check on the "
                                       "virtual facility (default 1 % of the smallest air "
                                       "gap or backup clearance, else 5 µm)"),

@@ -65,7 +65,9 @@ and bounded (the bounds beside each key in the code, with their reasons).
     the rotational frequency, scheduled on speed over ``[operating] speed_range_hz`` and on
     from its minimum, judged at every condition with it and shown against the controller
     alone; ``rate_fraction`` (ε/Ω, default 0.05: the notch settles in ≈ 6 revolutions),
-    ``points`` (speeds of its gain table, default 16) and ``runout_um`` (the synchronous
+    ``points`` (that many evenly spaced speeds of its gain table; default: speeds found
+    by bisection until the interpolated gain holds the notch's poles within 25 % of their
+    placement) and ``runout_um`` (the synchronous
     sensor runout of its check on the virtual facility, µm; default 1 % of the smallest
     air gap or backup clearance, else 5 µm).
 ``[design] one_speed`` (bool, default false)

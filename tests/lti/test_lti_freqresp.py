@@ -168,6 +168,34 @@ def test_one_or_two_points_of_a_large_model_are_solved_densely(monkeypatch):
     assert calls == []
 
 
+def test_one_or_two_points_of_a_large_sampled_plant_are_solved_densely(monkeypatch):
+    """From ``STRUCTURED_STATES`` states the sampled plant's response at one or two
+    frequencies, which are their own probes, comes from dense solves of the plant sampled
+    by python-control's zero-order hold (``control.c2d``), to 1e-9 of the peak, with no
+    eigendecomposition of the plant: at one table speed of the unbalance rejection an
+    ``expm`` costs less than a modal form and its certification. With its inputs in
+    groups (control inputs and forces) the answer is the same."""
+    import scipy.linalg
+
+    A, B, C, D, wn = _lightly_damped(n=fr.STRUCTURED_STATES, seed=5)
+    dt = 1e-4
+    Pd = control.c2d(control.ss(A, B, C, D), dt, "zoh")
+    calls = []
+    real = scipy.linalg.eig
+    monkeypatch.setattr(scipy.linalg, "eig", lambda *a, **k: (calls.append(1),
+                                                               real(*a, **k))[1])
+    w = np.sort(wn[:2])
+    z = np.exp(1j * w * dt)
+    R = np.array([Pd.C @ np.linalg.solve(zk * np.eye(A.shape[0]) - Pd.A, Pd.B) + Pd.D
+                  for zk in z])
+    for H in (fr.sampled_response_at((A, B, C, D), dt, w),
+              fr.sampled_response_at((A, B, C, D), dt, w, groups=([0, 1], [2, 3]))):
+        assert np.max(np.abs(H - R)) <= 1e-9 * np.max(np.abs(R))
+    one = fr.sampled_response_at((A, B, C, D), dt, w[:1])
+    assert np.max(np.abs(one[0] - R[0])) <= 1e-9 * np.max(np.abs(R[0]))
+    assert calls == []
+
+
 def test_a_large_models_cond_v_is_the_2_norm_one_without_an_svd(monkeypatch):
     """From ``STRUCTURED_STATES`` states cond V, which decides whether the modal form is
     tried, is the 2-norm condition number from two largest singular values by Lanczos

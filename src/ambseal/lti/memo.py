@@ -132,9 +132,9 @@ class ArrayMemo:
     keep_bytes : int
         More than ``keep`` results are kept while the arrays of all of them (a result that
         is an array, has ``nbytes``, is a number, a string or None, or is a tuple or
-        list of such; any other counts as unbounded) hold at most this many bytes: a sweep over more inputs than ``keep``,
-        repeated for each controller, finds its results on a small model, where on a
-        large one the ``keep`` bound holds.
+        list of such; any other counts as unbounded) hold at most this many bytes: a
+        sweep over more inputs than ``keep``, repeated for each controller, finds its
+        results on a small model, where on a large one the ``keep`` bound holds.
     """
 
     def __init__(self, keep: int = 8, min_states: int = 64, keep_bytes: int = 0):

@@ -62,11 +62,21 @@ CONTROLLER_STATES = 40
 _STAGE = re.compile(r"ambseal: ([a-z-]+): done in ([0-9.]+) s \(([0-9.]+) s CPU\)")
 
 
+def _meshes(text: str) -> list[str]:
+    """``--mesh``: the meshes to run, in order; ``both`` is ``own,finer``."""
+    names = ["own", "finer"] if text == "both" else text.split(",")
+    if any(n not in ("own", "finer") for n in names):
+        raise argparse.ArgumentTypeError(f"expected own, finer, both, or a comma list of "
+                                         f"own and finer; got {text!r}")
+    return names
+
+
 def _args(argv=None) -> argparse.Namespace:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--rig", action="append", default=None,
                     help="a rig file (repeatable); default every examples/*.toml")
-    ap.add_argument("--mesh", default="own,finer", help="own, finer or both")
+    ap.add_argument("--mesh", type=_meshes, default="own,finer",
+                    help="own, finer, both, or a comma list of own and finer")
     ap.add_argument("--factor", type=float, default=1.3,
                     help="the finer mesh's elements per section, × this, rounded up")
     ap.add_argument("--timeout", type=float, default=1800.0, help="seconds per run")
@@ -167,7 +177,7 @@ def main(argv=None) -> int:
     rigs = [Path(r) for r in args.rig] if args.rig else sorted((ROOT / "examples").glob(
         "*.toml"))
     for rig in rigs:
-        for mesh in args.mesh.split(","):
+        for mesh in args.mesh:
             print(json.dumps(run_one(rig, mesh, args.factor, args.timeout)), flush=True)
     return 0
 

@@ -797,9 +797,6 @@ def _eig_form(A, C, max_cond, balance):
         gecon, = scipy.linalg.get_lapack_funcs(("gecon",), (lu[0],))
         rcond, info = gecon(lu[0], norm, norm="1")
         cond = 1.0 / rcond if info == 0 and rcond > 0 else np.inf
-    # a numpy scalar: :class:`ArrayMemo` counts its bytes, a Python float's as unbounded
-    # (then only ``keep`` decompositions are kept, not what 128 MB holds)
-    cond = np.float64(cond)
     if not np.isfinite(cond) or cond > max_cond:
         return lam, cond, None, None, sc
     return lam, cond, lu, Cm, sc

@@ -3,21 +3,13 @@ and a mesh it does not know is refused, not run as the rig's own mesh under its 
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-from pathlib import Path
-
 import pytest
 
-BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
+from .benchmark_module import bench_module
 
 
 def _bench_rigs():
-    sys.path.insert(0, str(BENCH))  # its sibling bench_suite
-    spec = importlib.util.spec_from_file_location("bench_rigs", BENCH / "bench_rigs.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return bench_module("bench_rigs")
 
 
 @pytest.mark.parametrize("given, meshes", [(None, ["own", "finer"]),

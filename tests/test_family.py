@@ -8,25 +8,19 @@ delivered as it runs from standstill to the top speed, zone A or B on every axis
 
 from __future__ import annotations
 
-import importlib.util
 import sys
 import tomllib
-from pathlib import Path
 
 import pytest
 
 from ambseal.config import parse_rig
 from ambseal.model.modes import free_bending_hz
 
-BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
+from .benchmark_module import bench_module
 
 
 def _bench_family():
-    sys.path.insert(0, str(BENCH))  # its sibling bench_suite
-    spec = importlib.util.spec_from_file_location("bench_family", BENCH / "bench_family.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return bench_module("bench_family")
 
 
 @pytest.mark.slow

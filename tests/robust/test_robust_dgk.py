@@ -423,8 +423,8 @@ def test_musyn_dgk_defaults_reach_the_published_mixed_mu_spring_mass_result():
     1×1, complex 1×1 and 2×2 blocks) on python-control's F_l over 701 points log-spaced in
     10⁻³…10⁵ rad/s, and the worst-case performance by brute force over the uncertainty
     (k1 at 21 values of its range, the delay block on its unit circle), which the μ bound
-    must cover. Measured: complex D–K 1.082, D–G–K 0.945 (AB13MD agrees to 1e-5), worst
-    case 0.945 — the example's worst-case gain of its mixed-μ controller is 0.88 (MATLAB's
+    must cover. Measured: complex D–K 1.082, D–G–K 0.925 (AB13MD agrees to 1e-5), worst
+    case 0.925 — the example's worst-case gain of its mixed-μ controller is 0.88 (MATLAB's
     wcgain), not reached."""
     from slycot import ab13md
 

@@ -162,14 +162,20 @@ def test_the_failures_name_the_mode_by_its_kind_and_a_remedy_that_holds(flywheel
     near 2.2 kHz to the target's lag at every speed, H∞ and μ designed at the top speed
     lose a rigid conical mode at standstill: their
     lines say so (the kind from the mode's shape, tests/analysis/test_mode_naming.py), and
-    the remedy they name — the LPV on speed — is delivered and holds (above)."""
+    the remedy they name — the LPV on speed — is delivered and holds (above). μ's design
+    takes no band step: the bands of the bending modes (1.7–2.9 kHz) it lost beside the
+    conical mode leave the conical loss as it was (measured: the D–G–K design with those
+    bands lost it all the same, at 75 Hz, ζ = −0.92, after 255 s of CPU)."""
     code, metrics, _ = flywheel_run
     assert code == 1  # H∞ and μ not delivered
+    assert not any("made uncertain over the band" in s
+                   for s in metrics["controllers"]["mu"]["steps"])
     failed = metrics["failed"]
     assert re.search(r"0 bar \(mode at 22\d\d Hz, ζ = −[\d.]+, bending, (forward|backward) "
                      r"whirl\)", failed["pid"]["reason"]), failed["pid"]["reason"]
     for m in ("hinf", "mu"):
-        assert re.search(r"0 bar, 0 Hz \(mode at [\d.]+ Hz, ζ = −[\d.]+, rigid conical\)",
+        # the least stable condition, alone or the first of several
+        assert re.search(r"0 bar, 0 Hz(: | \()mode at [\d.]+ Hz, ζ = −[\d.]+, rigid conical\)",
                          failed[m]["reason"]), failed[m]["reason"]
         assert "the LPV on speed holds the rotor over the speed range" in failed[m]["reason"]
     assert "lpv" not in failed

@@ -480,8 +480,15 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
     """:func:`_synthesise` on the specification's design model, corrected (at most
     ``enlarge`` times) while the full-order loop is unstable: enlarged (unless ``states``
     fixes it) to keep a mode the model left out, or, where the model keeps the mode,
-    given a damping margin on it (:func:`margin_for`); if no margin holds it, the last
-    design without margins is returned. Each correction is appended to ``steps`` and
+    given a damping margin on it (:func:`margin_for`), or, for μ and a mode lost away from
+    the design speed, its frequency (and those of the sweeping modes below it) made
+    uncertain over the band it sweeps (:mod:`ambseal.design.modal_bands`); if no margin
+    holds it, the last design without margins is returned. A least stable loss that none
+    of these reaches — a mode below every band with ζ ≤ −``LIGHT_DAMPING``, the conical
+    mode at standstill of a design that leaned on the gyroscopic stiffening — ends the
+    corrections (measured on the example flywheel: the bands of the bending modes lost
+    beside it cost a D–G–K design of 255 s that lost it all the same, at 75 Hz, ζ = −0.92;
+    :func:`_over_speed` is what can hold it). Each correction is appended to ``steps`` and
     reported to ``progress``. With ``speed`` (Hz) the spin speed is uncertain over that
     range, the performance weights at ``level`` (:func:`_synthesise`). Returns (synthesis,
     full-order check, design states)."""
@@ -511,9 +518,14 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
             # every mode lost away from the design speed, not only the least stable one:
             # one design step for all the bands they call for
             swept = _swept(cfg, conditions, n, f0, swept)
-            away = {c["mode_hz"] for c in check["unstable"] if abs(c["speed_hz"] - f0) > 1e-9}
-            new = sorted({b for f in away for b in bands_near(swept[1], f)} - set(bands),
-                         key=lambda b: b.f_hz)
+            if -check["damping"] < LIGHT_DAMPING or bands_near(swept[1], check["mode_hz"]):
+                away = {c["mode_hz"] for c in check["unstable"]
+                        if abs(c["speed_hz"] - f0) > 1e-9}
+                new = sorted({b for f in away for b in bands_near(swept[1], f)} - set(bands),
+                             key=lambda b: b.f_hz)
+            # else the least stable loss lies below every band and far from stable: bands
+            # of the modes above it leave its cause as it was, and no margin holds it
+            # (below), so the corrections end (docstring)
         if n_new > n:
             steps.append(f"{method}: full-order loop unstable at {check['mode_hz']:.4g} Hz "
                          f"(ζ = {check['damping']:.3g}, {check['pressure_bar']:g} bar); design "

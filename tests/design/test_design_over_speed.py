@@ -66,27 +66,52 @@ def _rigid_rig(tmp_path, disk_ip: float = 0.4) -> Path:
 BETWEEN_HZ = (0.0, 25.0, 60.0, 110.0, 170.0, 230.0, 290.0, 350.0, 400.0)
 
 
-def _held_where_one_speed_is_not(rig: Path, method: str):
-    """The rule's design of ``rig`` by ``method``, after checking (python-control's poles
-    of the sampled, delayed loop on the full-order plant) that the design at the top speed
-    alone (``[design] one_speed``) loses the rotor at standstill and that the rule's
-    holds it at every speed of :data:`BETWEEN_HZ`, designed over 0–400 Hz."""
+def _held_where_one_speed_is_not(rig: Path, method: str, held=None):
+    """The rule's design of ``rig`` by ``method`` (``held`` where it is made already),
+    after checking (python-control's poles of the sampled, delayed loop on the full-order
+    plant) that the design at the top speed alone (``[design] one_speed``) loses the rotor
+    at standstill and that the rule's holds it at every speed of :data:`BETWEEN_HZ`,
+    designed over 0–400 Hz."""
     one = load_rig(rig, ("design.one_speed=true",))
     frozen = design(one, method, allow_unstable=True)
     assert not _held_as_it_runs(one, frozen.K, [0.0])[0]
     cfg = load_rig(rig)
-    held = design(cfg, method)
+    held = design(cfg, method) if held is None else held
     assert all(_held_as_it_runs(cfg, held.K, BETWEEN_HZ))
     assert held.design_speed_hz is None and held.speed_range_hz == (0.0, 400.0)
     return held
 
 
+@pytest.fixture(scope="module")
+def rigid_mu(tmp_path_factory):
+    """``(rig path, the rule's μ design of the rigid rotor, the methods it synthesised)``:
+    designed alone, no trials shared (about a minute of CPU, which two tests share)."""
+    import ambseal.design.recipes as recipes
+
+    rig = _rigid_rig(tmp_path_factory.mktemp("rigid"))
+    made, real = [], recipes._synthesise_enlarging
+
+    def counted(c, method, *args):
+        made.append(method)
+        return real(c, method, *args)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(recipes, "_synthesise_enlarging", counted)
+        held = design(load_rig(rig), "mu")
+    return rig, held, made
+
+
+@pytest.mark.xdist_group("rigid_mu")
 @pytest.mark.parametrize("method", ["hinf", "mu"])
-def test_a_rigid_gyroscopic_rotor_is_held_from_standstill_to_the_top_speed(tmp_path, method):
+def test_a_rigid_gyroscopic_rotor_is_held_from_standstill_to_the_top_speed(
+        tmp_path, method, request):
     """Designed at the top speed alone the loop is unstable at standstill; the design with
     the speed uncertain over 0–400 Hz holds at every speed of :data:`BETWEEN_HZ`
     (:func:`_held_where_one_speed_is_not`), and its steps say how it was designed."""
-    held = _held_where_one_speed_is_not(_rigid_rig(tmp_path), method)
+    rig, held = _rigid_rig(tmp_path), None
+    if method == "mu":
+        rig, held, _ = request.getfixturevalue("rigid_mu")
+    held = _held_where_one_speed_is_not(rig, method, held)
     assert held.steps[-1].startswith(f"{method}: designed with the spin speed uncertain "
                                      "over 0–400 Hz (a real LFT parameter)")
     assert "rotor.speed" in held.uncertainty
@@ -141,15 +166,17 @@ def test_a_disc_like_rigid_rotor_is_held_at_the_performance_level_the_speed_rang
     assert f"at {100 * level['level']:.2g} % of the performance weights" in held.steps[-1]
 
 
-def test_mu_takes_the_speed_range_hinf_designs_that_hinf_tried_before(tmp_path, monkeypatch):
+@pytest.mark.xdist_group("rigid_mu")
+def test_mu_takes_the_speed_range_hinf_designs_that_hinf_tried_before(rigid_mu, monkeypatch):
     """One run's designs share their trials over the speed range: μ tries H∞ with the speed
     uncertain before its own, and H∞'s design has made that one. Given H∞'s trials, μ's
-    design makes no H∞ synthesis of its own; without them it makes it again
+    design makes no H∞ synthesis of its own; without them (``rigid_mu``) it makes it again
     (``_synthesise_enlarging`` counted), and the two μ controllers are the same matrices:
     reusing a trial changes nothing but the work."""
     import ambseal.design.recipes as recipes
 
-    cfg = load_rig(_rigid_rig(tmp_path))
+    rig, alone, made_alone = rigid_mu
+    cfg = load_rig(rig)
     sp, trials = design_spec(cfg), {}
     design(cfg, "hinf", spec=sp, trials=trials)
     made, real = [], recipes._synthesise_enlarging
@@ -162,9 +189,7 @@ def test_mu_takes_the_speed_range_hinf_designs_that_hinf_tried_before(tmp_path, 
     shared = design(cfg, "mu", spec=sp, trials=trials)
     assert "hinf" not in made and "mu" in made
     assert shared.speed_range_hz == (0.0, 400.0)
-    made.clear()
-    alone = design(cfg, "mu", spec=sp)
-    assert "hinf" in made
+    assert "hinf" in made_alone
     for a, b in zip((shared.K.A, shared.K.B, shared.K.C, shared.K.D),
                     (alone.K.A, alone.K.B, alone.K.C, alone.K.D)):
         np.testing.assert_array_equal(a, b)

@@ -26,8 +26,8 @@ from ambseal.model import build_plant
 
 from .exported_files import file_at, rejection_held_by_python_control
 
-# the flywheel's run (≈ 7 min of CPU, most of it the μ it does not deliver) is a module
-# fixture: its tests share one worker
+# the flywheel's run (≈ 1 min of CPU, most of it the LPV) is a module fixture: its tests
+# share one worker
 pytestmark = pytest.mark.xdist_group("flywheel_run")
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

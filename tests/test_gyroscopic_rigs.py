@@ -174,7 +174,7 @@ def test_the_failures_name_the_mode_by_its_kind_and_a_remedy_that_holds(flywheel
     assert re.search(r"0 bar \(mode at 22\d\d Hz, ζ = −[\d.]+, bending, (forward|backward) "
                      r"whirl\)", failed["pid"]["reason"]), failed["pid"]["reason"]
     for m in ("hinf", "mu"):
-        # the least stable condition, alone or the first of several
+        # the least stable condition, named alone or after the list of several
         assert re.search(r"0 bar, 0 Hz(: | \()mode at [\d.]+ Hz, ζ = −[\d.]+, rigid conical\)",
                          failed[m]["reason"]), failed[m]["reason"]
         assert "the LPV on speed holds the rotor over the speed range" in failed[m]["reason"]

@@ -486,9 +486,9 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
     holds it, the last design without margins is returned. A least stable loss that none
     of these reaches — a mode below every band with ζ ≤ −``LIGHT_DAMPING``, the conical
     mode at standstill of a design that leaned on the gyroscopic stiffening — ends the
-    corrections (measured on the example flywheel: the bands of the bending modes lost
-    beside it cost a D–G–K design of 255 s that lost it all the same, at 75 Hz, ζ = −0.92;
-    :func:`_over_speed` is what can hold it). Each correction is appended to ``steps`` and
+    corrections: the bands of the modes above it leave its cause as it was (the example
+    flywheel, benchmarks/README.md, "μ's corrections end at a loss no mode band reaches"),
+    and :func:`_over_speed` is what can hold it. Each correction is appended to ``steps`` and
     reported to ``progress``. With ``speed`` (Hz) the spin speed is uncertain over that
     range, the performance weights at ``level`` (:func:`_synthesise`). Returns (synthesis,
     full-order check, design states)."""

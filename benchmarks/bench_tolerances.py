@@ -3,7 +3,8 @@ machines, against the tolerance stated for each number.
 
 Each *side* is a git revision of this repository, an OpenBLAS kernel set and a BLAS
 thread count (``REV@CORETYPE:THREADS``; ``REV`` alone keeps this environment's kernels
-and one thread, ``REV@:2`` its kernels and two threads). For each side the revision is
+and one thread, ``REV@:2`` its kernels and two threads: ambseal's thread policy,
+``AMBSEAL_BLAS_THREADS``, and the BLAS variables). For each side the revision is
 exported (``git archive``) to a temporary folder, and ``ambseal run RIG --no-identify``
 runs on every example rig with that tree's ``src`` first on PYTHONPATH, in a child
 process. The first side is the reference; every other side's ``metrics.json``
@@ -83,7 +84,10 @@ def run_side(case: dict, timeout: float) -> dict:
     env["PYTHONPATH"] = str(Path(case["tree"]) / "src")
     if case["coretype"]:
         env["OPENBLAS_CORETYPE"] = case["coretype"]
-    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    # the policy's variable too: without it ambseal's numerics run on one BLAS thread
+    # whatever the BLAS variables say (ambseal.threads), and the sides would not differ
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS",
+                "AMBSEAL_BLAS_THREADS"):
         env[var] = str(case["threads"])
     out = Path(case["out"])
     cmd = [sys.executable, "-c", "import sys; from ambseal.cli import main; "

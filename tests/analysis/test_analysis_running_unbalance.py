@@ -20,6 +20,7 @@ import control
 import numpy as np
 import pytest
 from scipy.optimize import minimize_scalar
+from scipy.signal import find_peaks
 
 from ambseal.analysis.judge import OperatingPoint, judge, judge_settings
 from ambseal.analysis.synchronous import Unbalance, running_plant, synchronous_response
@@ -324,6 +325,36 @@ def test_critical_speeds_are_the_api_617_separation_check(f_range, zeta, where):
     assert c["af"] == pytest.approx(af, rel=2 * zeta)
     assert c["margin_pct"] == pytest.approx(margin, rel=1e-3, abs=1e-9)
     assert c["required_pct"] == pytest.approx(need, rel=0.01)
+
+
+def test_one_resonance_is_one_critical_speed_however_its_top_is_rounded():
+    """Reference: two single-degree-of-freedom resonances 1/|1 − r² + 2jζr|, ζ 0.05 (AF =
+    1/(2ζ) = 10 to the order ζ), as the worst orbit over two planes sees them (their
+    larger): at 100 and 100.3 Hz, the second 1e-4 lower, the response has two maxima
+    0.3 Hz apart on one flat top and never falls to half power between them — one
+    resonance, one critical speed at the higher maximum (API 684's half-power band holds
+    both). At 100 and 130 Hz the response falls below half power between them: two."""
+    from ambseal.analysis.judge import critical_speeds
+    from ambseal.analysis.unbalance import UnbalanceResponse
+
+    f = np.linspace(40.0, 160.0, 24001)
+
+    def sdof(fn, scale=1.0):
+        r = f / fn
+        return scale * 1e-5 / np.abs(1 - r**2 + 2j * 0.05 * r)
+
+    def criticals(amp):
+        unb = UnbalanceResponse(2 * np.pi * f, np.ones_like(f), amp, 0.0, 0.0, 1.0, 1.0)
+        return critical_speeds(unb, 90.0, 140.0)
+
+    twin = np.maximum(sdof(100.0), sdof(100.3, 1 - 1e-4))
+    assert len(find_peaks(twin)[0]) == 2  # the rounding this guards against
+    (c,) = criticals(twin)
+    assert c["speed_hz"] == pytest.approx(100.0 * math.sqrt(1 - 2 * 0.05**2), abs=0.01)
+    assert c["af"] == pytest.approx(10.0, rel=0.1)
+    pair = criticals(np.maximum(sdof(100.0), sdof(130.0)))
+    assert [round(c["speed_hz"]) for c in pair] == [100, 130]
+    assert all(c["af"] == pytest.approx(10.0, rel=0.1) for c in pair)
 
 
 def test_a_separation_margin_on_its_requirement_is_named_on_the_boundary():

@@ -82,7 +82,7 @@ __all__ = ["JudgeSettings", "OperatingPoint", "LoopJudgement", "JudgedCase", "Ju
            "operating_points", "speed_scheduled",
            "judge_settings", "unstable_open_loop_poles", "condition_values", "frozen_at",
            "frozen_discrete", "judge_jobs", "points_for", "sensitivity_grades",
-           "critical_speeds", "unbalance_speeds_hz"]
+           "critical_speeds", "resonance_tops", "unbalance_speeds_hz"]
 
 #: Where a loop's static response is taken (rad/s): far below any AMB loop's dynamics (the
 #: plant there equals its static response to ~1e-8), and not zero, where an integrating
@@ -605,6 +605,7 @@ def critical_speeds(unb: UnbalanceResponse, f_min: float, f_max: float) -> list[
     sweep ends before the orbit falls to half power on one side, the other side's
     half-width is taken for both; a peak that falls to half power on neither side within
     the sweep is no resonance — a ripple of a broad response — and is left out); its
+    one resonance is one critical speed (:func:`resonance_tops`); its
     separation margin from the continuous range [f_min, f_max] is
     ``100 (f_min − N)/f_min`` below it and ``100 (N − f_max)/f_max`` above it, and API 617
     (8th ed., §2.6.2.10) requires ``min(16, 17(1 − 1/(AF − 1.5)))`` % below and
@@ -626,7 +627,7 @@ def critical_speeds(unb: UnbalanceResponse, f_min: float, f_max: float) -> list[
     """
     f, a = unb.speed_hz, unb.response_m
     out = []
-    for i in find_peaks(a)[0]:
+    for i in resonance_tops(a):
         af, n1, n2 = amplification_factor(f, a, int(i))
         n = float(f[i])
         if np.isnan(af):  # one side (or none) within the sweep
@@ -643,6 +644,44 @@ def critical_speeds(unb: UnbalanceResponse, f_min: float, f_max: float) -> list[
             out.append({"speed_hz": n, "af": json_float(af), "margin_pct": margin,
                         "required_pct": need})
     return out
+
+
+def resonance_tops(amp) -> np.ndarray:
+    """The local maxima of a response over speed that each top a resonance of their own.
+
+    A local maximum from which a higher one (or an equal one at a lower speed) is reached
+    without the response falling to half power, ``amp[i]/√2``, lies on that one's flank or
+    flat top: the same resonance, whose half-power band (API 684 §2.8) holds both, and it
+    is left out: else a flat top on which rounding leaves a second maximum beside the
+    first is one critical speed or two as the BLAS's kernels and threads round
+    (benchmarks/README.md). The sign-off's criticals ask for the same half-power dip, on
+    both sides, as a prominence (:mod:`ambseal.analysis.signoff.unbalance_api617`).
+
+    Parameters
+    ----------
+    amp : array_like, shape (n,)
+        The response at ascending speeds.
+
+    Returns
+    -------
+    ndarray of int
+        The kept maxima's indices, ascending.
+    """
+    a = np.asarray(amp, float)
+    idx = find_peaks(a)[0]
+    keep = []
+    for i in idx:
+        half = a[i] / math.sqrt(2.0)
+        top = True
+        for j in idx:
+            if a[j] > a[i] or (a[j] == a[i] and j < i):
+                lo, hi = sorted((int(i), int(j)))
+                if a[lo:hi + 1].min() > half:  # no half-power dip between them
+                    top = False
+                    break
+        if top:
+            keep.append(int(i))
+    return np.asarray(keep, dtype=int)
 
 
 def _within(unb: UnbalanceResponse, keep: np.ndarray) -> UnbalanceResponse:

@@ -604,9 +604,10 @@ def critical_speeds(unb: UnbalanceResponse, f_min: float, f_max: float) -> list[
     crossing) with a half-power amplification factor AF ≥ 2.5 (API 684 §2.8; where the
     sweep ends before the orbit falls to half power on one side, the other side's
     half-width is taken for both; a peak that falls to half power on neither side within
-    the sweep is no resonance — a ripple of a broad response — and is left out); its
-    one resonance is one critical speed (:func:`resonance_tops`); its
-    separation margin from the continuous range [f_min, f_max] is
+    the sweep is no resonance — a ripple of a broad response — and is left out; maxima
+    with no half-power dip between them are one resonance, one critical speed,
+    :func:`resonance_tops`); its separation margin from the continuous range
+    [f_min, f_max] is
     ``100 (f_min − N)/f_min`` below it and ``100 (N − f_max)/f_max`` above it, and API 617
     (8th ed., §2.6.2.10) requires ``min(16, 17(1 − 1/(AF − 1.5)))`` % below and
     ``min(26, 10 + 17(1 − 1/(AF − 1.5)))`` % above

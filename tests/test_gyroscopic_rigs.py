@@ -165,11 +165,20 @@ def test_the_failures_name_the_mode_by_its_kind_and_a_remedy_that_holds(flywheel
     the remedy they name — the LPV on speed — is delivered and holds (above). μ's design
     takes no band step: the bands of the bending modes (1.7–2.9 kHz) it lost beside the
     conical mode leave the conical loss as it was (measured: the D–G–K design with those
-    bands lost it all the same, at 75 Hz, ζ = −0.92, after 255 s of CPU)."""
+    bands lost it all the same, at 75 Hz, ζ = −0.92, after 255 s of CPU). Their last step
+    says what the design over the speed range tried and where each try lost the rotor,
+    the design at standstill among them (on a design model of whole whirl pairs: the
+    operating speed's count splits a repeated pair there)."""
     code, metrics, _ = flywheel_run
     assert code == 1  # H∞ and μ not delivered
     assert not any("made uncertain over the band" in s
                    for s in metrics["controllers"]["mu"]["steps"])
+    for m, kind in (("hinf", ""), ("mu", "H∞ ")):
+        last = metrics["controllers"][m]["steps"][-1]
+        assert last.startswith(f"{m}: no design over the speed range held every judged "
+                               "condition, so the design at the operating speed stays"), last
+        assert f"tried: {kind}with the spin speed uncertain over 0–1000 Hz" in last, last
+        assert re.search(rf"; {kind}designed at 0 Hz: lost at [\d.]+ Hz \(mode at", last), last
     failed = metrics["failed"]
     assert re.search(r"0 bar \(mode at 22\d\d Hz, ζ = −[\d.]+, bending, (forward|backward) "
                      r"whirl\)", failed["pid"]["reason"]), failed["pid"]["reason"]

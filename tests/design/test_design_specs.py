@@ -12,8 +12,9 @@ import numpy as np
 import pytest
 
 from ambseal.config import dump_rig, load_rig, parse_rig
-from ambseal.design.specs import design_spec, round_125
-from ambseal.errors import ConfigError
+from ambseal.design.specs import design_spec, design_states_at, round_125
+from ambseal.errors import ConfigError, ModelError
+from ambseal.model import build_plant, build_system, modal_reduction
 
 SRC = Path(__file__).resolve().parents[2] / "src" / "ambseal"
 
@@ -75,6 +76,34 @@ def test_design_model_keeps_the_modes_the_actuator_reaches(specs):
     assert specs["testrig"].model_states == 12
     assert specs["beam"].model_states == 12
     assert F1 < specs["beam"].model_cutoff_hz < F2
+
+
+def test_a_design_at_standstill_keeps_whole_whirl_pairs():
+    """The example flywheel's derived design model keeps every mode below 5 kHz: 18
+    states at its operating speed, 1000 Hz, where the gyroscopic moments split each whirl
+    pair. At standstill its ζ and η modes are repeated pairs, 18 states fall between two of
+    them and no modal reduction keeps that count; the rule applied at standstill
+    (:func:`design_states_at`) keeps whole pairs. Reference: the supported rotor's
+    eigenvalues below the cut-off, counted by a dense eig of its first-order form
+    [[0, I], [−M⁻¹K, −M⁻¹(C + ΩG)]] at each speed."""
+    cfg = load_rig(Path(__file__).resolve().parents[2] / "examples" / "flywheel.toml")
+    sp = design_spec(cfg)
+    assert sp.model_cutoff_hz == pytest.approx(5000.0) and sp.model_states == 18
+    for f in (0.0, 250.0, 1000.0):
+        at = cfg.model_copy(update={"operating": cfg.operating.model_copy(
+            update={"speed_rpm": 60.0 * f})})
+        rotor = build_system(at)
+        assert rotor.speed == pytest.approx(2 * np.pi * f)
+        Mi, n = np.linalg.inv(rotor.M), rotor.M.shape[0]
+        A = np.block([[np.zeros((n, n)), np.eye(n)],
+                      [-Mi @ rotor.K, -Mi @ (rotor.C + 2 * np.pi * f * rotor.G)]])
+        lam_hz = np.abs(np.linalg.eigvals(A)) / (2 * np.pi)
+        expected = int(np.sum(lam_hz < sp.model_cutoff_hz))
+        assert design_states_at(cfg, sp, f) == expected
+        modal_reduction(build_plant(at), states=expected)
+    with pytest.raises(ModelError, match="splits modes of equal"):
+        modal_reduction(build_plant(cfg, speed_rpm=0.0), states=sp.model_states)
+    assert design_states_at(cfg, sp, 0.0) == 20
 
 
 def test_bands_grids_and_unbalance(specs):

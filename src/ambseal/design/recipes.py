@@ -51,6 +51,7 @@ from __future__ import annotations
 
 import copy
 import json
+import re
 import time
 from dataclasses import dataclass, field
 from functools import partial
@@ -68,7 +69,7 @@ from ambseal.design.plant import (
     generalized_plant,
     less_damped,
 )
-from ambseal.design.specs import design_spec
+from ambseal.design.specs import design_spec, design_states_at
 from ambseal.design.weights import Weights
 from ambseal.errors import ConfigError, ModelError, SynthesisError
 from ambseal.lti import lft_lower
@@ -421,16 +422,18 @@ def design(
     steps: list[str] = []
     t0 = time.perf_counter()
 
-    def synthesise(c, into: list, m: str = method, speed=None, n_speed=None, level=None):
+    def synthesise(c, into: list, m: str = method, speed=None, n_speed=None, level=None,
+                   n_start=None):
         args = (c, m, p, w if m == method else sp.weights[m], unc, sp,
                 states if n_speed is None else n_speed,
                 None if omega is None else np.asarray(omega, float), reduce_to,
                 max_iter or sp.max_iter, sp.dk_order if dk_order is None else dk_order, dl,
                 enlarge if speed is None else 0)
         if trials is None or m != "hinf" or (speed is None and c is cfg):  # not a trial
-            return _synthesise_enlarging(*args, into, progress, speed, level)
-        return _tried(trials, args + (speed, level),
-                      lambda: _synthesise_enlarging(*args, into, progress, speed, level))
+            return _synthesise_enlarging(*args, into, progress, speed, level, n_start)
+        return _tried(trials, args + (speed, level, n_start),
+                      lambda: _synthesise_enlarging(*args, into, progress, speed, level,
+                                                    n_start))
 
     r, check, n = synthesise(cfg, steps)
     moved = over = None
@@ -476,7 +479,8 @@ def _tried(trials: dict, inputs: tuple, make):
 
 
 def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max_iter,
-                          dk_order, dl, enlarge, steps, progress, speed=None, level=None):
+                          dk_order, dl, enlarge, steps, progress, speed=None, level=None,
+                          n_start=None):
     """:func:`_synthesise` on the specification's design model, corrected (at most
     ``enlarge`` times) while the full-order loop is unstable: enlarged (unless ``states``
     fixes it) to keep a mode the model left out, or, where the model keeps the mode,
@@ -490,9 +494,10 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
     flywheel, benchmarks/README.md, "μ's corrections end at a loss no mode band reaches"),
     and :func:`_over_speed` is what can hold it. Each correction is appended to ``steps`` and
     reported to ``progress``. With ``speed`` (Hz) the spin speed is uncertain over that
-    range, the performance weights at ``level`` (:func:`_synthesise`). Returns (synthesis,
-    full-order check, design states)."""
-    n = int(states or sp.model_states)
+    range, the performance weights at ``level`` (:func:`_synthesise`). ``n_start``: the
+    design model's states to start from where ``states`` does not fix them (default the
+    specification's). Returns (synthesis, full-order check, design states)."""
+    n = int(states or n_start or sp.model_states)
     # held where it is judged and wherever the machine runs, standstill to the top speed
     conditions = [(q, f) for q in sp.pressures_bar
                   for f in sorted({*sp.speeds_hz, *sp.stability_speeds_hz})]
@@ -584,7 +589,8 @@ def _over_speed(cfg, method: str, sp, first, synthesise, steps: list, progress):
        standstill up (the gyroscopic moments change the plant monotonically with speed,
        so the loss moves with the design speed); μ is designed once more, at the speed
        that search finds for H∞ (``synthesise(cfg, steps, "hinf")``), where there is one;
-    3. else ``first``.
+    3. else ``first``, with a step that names what was tried and how each lost the
+       rotor (or why there was no design), so the user sees the range was tried.
 
     Returns (the design, the speed in Hz it was designed at for 2, the speed range in Hz
     for 1; None where not). Measured
@@ -611,7 +617,8 @@ def _over_speed(cfg, method: str, sp, first, synthesise, steps: list, progress):
         if progress:
             progress(steps[-1])
 
-    held = _held_over_speed(cfg, method, rng, n, synthesise)
+    tried: list[str] = []
+    held = _held_over_speed(cfg, method, rng, n, synthesise, tried)
     if held is not None:
         step(f"with the spin speed uncertain over {rng[0]:g}–{rng[1]:g} Hz (a real LFT "
              f"parameter){_level_words(held[0].level)}, which")
@@ -619,10 +626,16 @@ def _over_speed(cfg, method: str, sp, first, synthesise, steps: list, progress):
     speeds = [f for f in sorted(set(sp.stability_speeds_hz))
               if abs(f - f0) > 1e-9 * max(f0, 1.0)]
     if method != "hinf":
-        found = _first_held(cfg, speeds, lambda c: synthesise(c, [], "hinf"))
+        found = _first_held(cfg, speeds, lambda c, n_f: synthesise(c, [], "hinf", n_start=n_f),
+                            sp, tried, "H∞ ")
         speeds = [] if found is None else [found[0]]
-    found = _first_held(cfg, speeds, lambda c: synthesise(c, []))
+    found = _first_held(cfg, speeds, lambda c, n_f: synthesise(c, [], n_start=n_f), sp, tried)
     if found is None:
+        steps.append(f"{method}: no design over the speed range held every judged "
+                     f"condition, so the design at the operating speed stays; {lost}; "
+                     f"tried: {'; '.join(tried)}")
+        if progress:
+            progress(steps[-1])
         return first, None, None
     f, out = found
     step(f"at {f:g} Hz, the first stability speed from standstill whose "
@@ -630,9 +643,10 @@ def _over_speed(cfg, method: str, sp, first, synthesise, steps: list, progress):
     return out, f, None
 
 
-def _held_over_speed(cfg, method: str, rng, n: int, synthesise):
+def _held_over_speed(cfg, method: str, rng, n: int, synthesise, tried: list):
     """``synthesise``'s design with the speed uncertain over ``rng`` (Hz) on the n-state
-    design model, where its full-order loop holds every judged condition, else None.
+    design model, where its full-order loop holds every judged condition, else None; each
+    design that did not hold is appended to ``tried`` in words (:func:`_tried_words`).
 
     H∞ is designed first at the performance weights as given; where its loop does not
     hold, at the largest performance level whose constant-scaled γ certifies the speed
@@ -642,37 +656,63 @@ def _held_over_speed(cfg, method: str, rng, n: int, synthesise):
     the rotor is held at zone A at every speed. μ is designed where H∞'s loop holds, at
     H∞'s level."""
     held = None
+    head = f"with the spin speed uncertain over {rng[0]:g}–{rng[1]:g} Hz"
     for level in (None, "auto"):
+        what = head + (" at the weights as given" if level is None else
+                       " at the largest performance level that certifies it")
         try:
             out = synthesise(cfg, [], "hinf", speed=rng, n_speed=n, level=level)
-        except (SynthesisError, ModelError):
+        except (SynthesisError, ModelError) as e:
+            tried.append(_tried_words(f"H∞ {what}" if method != "hinf" else what, error=e))
             continue
         if out[1]["stable"]:
             held = out
             break
+        tried.append(_tried_words(f"H∞ {what}" if method != "hinf" else what, out[1]))
         if out[0].gamma < 1:  # certified at the weights as given: relaxing them adds nothing
             break
     if held is None or method == "hinf":
         return held
+    what = head + _level_words(held[0].level)
     try:
         out = synthesise(cfg, [], method, speed=rng, n_speed=n, level=held[0].level)
-    except (SynthesisError, ModelError):
+    except (SynthesisError, ModelError) as e:
+        tried.append(_tried_words(what, error=e))
         return None
-    return out if out[1]["stable"] else None
+    if out[1]["stable"]:
+        return out
+    tried.append(_tried_words(what, out[1]))
+    return None
 
 
-def _first_held(cfg, speeds, synthesise):
-    """``(f, synthesise(rig at f Hz))`` for the first speed in ``speeds`` whose design's
-    full-order loop holds at every judged condition, or None."""
+def _tried_words(what: str, check: Mapping | None = None, error: Exception | None = None
+                 ) -> str:
+    """A design over the speed range that did not hold, in words: ``what`` it was, then
+    where its full-order ``check`` lost the rotor, or the ``error`` that left no design."""
+    if error is not None:
+        return f"{what}: no design ({re.sub(r'^(hinf|mu): ', '', str(error)).rstrip('.')})"
+    return (f"{what}: lost at {check['speed_hz']:g} Hz (mode at {check['mode_hz']:.4g} Hz, "
+            f"ζ = {check['damping']:.3g})")
+
+
+def _first_held(cfg, speeds, synthesise, sp, tried: list, kind: str = ""):
+    """``(f, synthesise(rig at f Hz, design states))`` for the first speed in ``speeds``
+    whose design's full-order loop holds at every judged condition, or None; each design
+    before it is appended to ``tried`` in words (``kind``: the method's name where it is not
+    the one designed). The design model at f starts from ``sp``'s rule applied at f
+    (:func:`~ambseal.design.specs.design_states_at`): the operating speed's count can split
+    a whirl pair that the gyroscopic moments no longer separate."""
     for f in speeds:
         at = cfg.model_copy(update={"operating": cfg.operating.model_copy(
             update={"speed_rpm": 60.0 * f})})
         try:
-            out = synthesise(at)
-        except (SynthesisError, ModelError):  # no design at that speed: the next one
+            out = synthesise(at, design_states_at(cfg, sp, f))
+        except (SynthesisError, ModelError) as e:  # no design at that speed: the next one
+            tried.append(_tried_words(f"{kind}designed at {f:g} Hz", error=e))
             continue
         if out[1]["stable"]:
             return f, out
+        tried.append(_tried_words(f"{kind}designed at {f:g} Hz", out[1]))
     return None
 
 

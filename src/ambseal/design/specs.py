@@ -107,8 +107,8 @@ from ambseal.model import (
     poles_near_zero,
 )
 
-__all__ = ["Machine", "DesignSpec", "air_gaps", "machine", "design_spec", "round_125",
-           "judged_conditions"]
+__all__ = ["Machine", "DesignSpec", "air_gaps", "design_spec", "design_states_at", "machine",
+           "round_125", "judged_conditions"]
 
 RIGID_STATES = 8  # 2 translations and 2 tilts of a rigid rotor, 2 states each
 #: ω_B·T_i of the H∞ and μ performance weights (module docstring, "H∞ and μ weights")
@@ -452,10 +452,34 @@ def _design_model(cfg, d, mach: Machine, rules: dict) -> tuple[int, float, float
         cut = min(3 * mach.actuator_hz, mach.sample_rate_hz / 4)
         rules["model_states"] = (f"every mode below min(3 f_a, f_s/4) = {cut:.4g} Hz, "
                                  f"at least the {RIGID_STATES} rigid-body states")
+    n, lam = _below(sys, cut)
+    return n, cut, float(lam[min(n, lam.size) - 1])
+
+
+def _below(sys, cut: float) -> tuple[int, np.ndarray]:
+    """The design model's states under the cut-off rule — every mode of ``sys`` below
+    ``cut`` Hz, at least :data:`RIGID_STATES` — and the frequencies (Hz) it looked at."""
     lam = np.abs(poles_near_zero(sys, count=RIGID_STATES,
                                  radius_rad_s=2 * math.pi * cut).poles) / (2 * math.pi)
-    n = max(RIGID_STATES, int(np.sum(lam < cut)))
-    return n, cut, float(lam[min(n, lam.size) - 1])
+    return max(RIGID_STATES, int(np.sum(lam < cut))), lam
+
+
+def design_states_at(cfg, spec: "DesignSpec", speed_hz: float) -> int:
+    """The design model's states for a design at ``speed_hz`` (Hz): ``spec``'s rule
+    applied to the rig's model at that speed — every mode below ``spec.model_cutoff_hz``,
+    at least :data:`RIGID_STATES` — or ``spec.model_states`` where the user set that
+    count (``[design] model_states``).
+
+    The count ``spec`` holds was taken at the operating speed, where the gyroscopic
+    moments split each whirl pair; at standstill an axisymmetric rotor's ζ and η modes
+    are a repeated pair, and that count can fall between them, which no modal reduction
+    can keep (:func:`ambseal.model.modal_reduction`). The same cut-off at the design
+    speed counts whole pairs."""
+    if spec.sources.get("model_states") == "set":
+        return int(spec.model_states)
+    at = cfg.model_copy(update={"operating": cfg.operating.model_copy(
+        update={"speed_rpm": 60.0 * float(speed_hz)})})
+    return _below(build_system(at), spec.model_cutoff_hz)[0]
 
 
 def _bands(d, mach: Machine, top_mode_hz: float, rules: dict):

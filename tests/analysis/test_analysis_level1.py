@@ -202,6 +202,14 @@ def test_q0_with_a_pd_acting_amb_is_the_closed_form_of_its_equivalent_support():
     assert r.Q_0 == pytest.approx(c * math.sqrt(k / m), rel=0.02)
     assert r.converged and r.frequency_hz[0] == pytest.approx(
         math.sqrt(k / m) / (2 * math.pi), rel=0.03)
+    # Q_0 is refined on the loop's eigenvalues alone: the poles of the modes as run
+    from ambseal.analysis.campbell import modes_as_run, poles_as_run
+
+    for ctrl in (digital, None):
+        at = {"speed_hz": 50.0, "max_hz": 2.0e4}
+        modes = modes_as_run(cfg, ctrl, **at)
+        assert modes.poles.size >= 2
+        np.testing.assert_allclose(poles_as_run(cfg, ctrl, **at), modes.poles, rtol=1e-9)
 
 
 def test_csr_boundary_is_linear_between_its_points_and_flat_beyond():

@@ -92,6 +92,7 @@ _FROM = {
     "facility_rejection": "rejection", "FacilityRejection": "rejection",
     "facility_speed_step": "rejection", "SpeedStep": "rejection",
     "closed_loop_modes": "campbell", "log_decrement": "campbell", "modes_as_run": "campbell",
+    "poles_as_run": "campbell",
     "open_loop_modes": "campbell", "Campbell": "campbell", "ClosedLoopModes": "campbell",
     "OVERDAMPED_ZETA": "campbell", "AF_CRITICAL": "campbell", "dask_available": "cases",
     "probe_scheduler": "cases",

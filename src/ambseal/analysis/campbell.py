@@ -47,7 +47,7 @@ from ambseal.robust import decay_rate, is_stable, unstable_poles
 __all__ = ["AF_CRITICAL", "API684_LOG_DEC", "OVERDAMPED_ZETA", "ClosedLoopModes", "Crossing",
            "Campbell", "log_decrement", "amplification_factor", "resonant",
            "lowest_log_decrement", "whirl_of",
-           "closed_loop_state_matrix", "closed_loop_modes", "modes_as_run",
+           "closed_loop_state_matrix", "closed_loop_modes", "modes_as_run", "poles_as_run",
            "modes_of_state_matrix", "modes_of_sampled_loop", "track_modes", "open_loop_modes",
            "campbell"]
 
@@ -343,11 +343,61 @@ def modes_as_run(cfg, controller=None, *, speed_hz: float, max_hz: float,
         A controller that is not a digital one as it runs.
     """
     p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
-    plant = build_plant(cfg, speed_rpm=60.0 * speed_hz, pressure_bar=p)
+    A, dt = _matrix_as_run(cfg, controller, speed_hz, p)
     mesh = build_mesh(cfg)
+    if dt is None:
+        return modes_of_state_matrix(A, mesh, speed_hz=speed_hz, pressure_bar=p,
+                                     max_hz=max_hz)
+    return modes_of_sampled_loop(A, dt, mesh, speed_hz=speed_hz, pressure_bar=p,
+                                 max_hz=max_hz)
+
+
+def poles_as_run(cfg, controller=None, *, speed_hz: float, max_hz: float,
+                 pressure_bar: float | None = None) -> np.ndarray:
+    """The poles of :func:`modes_as_run`'s modes from the loop's eigenvalues alone: no
+    eigenvectors, so no shapes or whirl, at about a third of the cost of a dense
+    eigendecomposition with vectors. For callers that follow a pole, such as a root
+    search on it (API 617 Level I's Q_0, :mod:`ambseal.analysis.signoff.level1`).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig, its plant built at ``speed_hz`` and ``pressure_bar``.
+    controller : DigitalController or ScheduledDigital, optional
+        As it runs (:func:`ambseal.machine.controller_as_runs`); None: the rig alone.
+    speed_hz, max_hz : float
+        Spin speed and highest damped frequency kept (Hz; below Nyquist for a sampled
+        loop).
+    pressure_bar : float, optional
+        The seals' pressure drop; default ``[operating] pressure_bar``.
+
+    Returns
+    -------
+    ndarray of complex, shape (k,)
+        :func:`modes_as_run`'s ``poles`` (rad/s): Im λ > 0 up to ``max_hz``, rigid-body
+        modes left out, ascending in frequency.
+
+    Raises
+    ------
+    ConfigError
+        A controller that is not a digital one as it runs.
+    """
+    p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
+    A, dt = _matrix_as_run(cfg, controller, speed_hz, p)
+    lam = sla.eigvals(A)
+    if dt is not None:
+        lam = np.log(lam[np.abs(lam) > 1e-12].astype(complex)) / dt
+    lam = lam[_kept(lam, float(np.abs(lam).max(initial=0.0)), max_hz)]
+    return lam
+
+
+def _matrix_as_run(cfg, controller, speed_hz: float, p: float):
+    """``(A, dt)``: the state matrix of the loop as it runs (:func:`modes_as_run`) — the
+    sampled loop with ``dt`` its sample time (s), or the rig's own plant with ``dt`` None
+    (no controller, or no AMB)."""
+    plant = build_plant(cfg, speed_rpm=60.0 * speed_hz, pressure_bar=p)
     if controller is None or not cfg.amb:
-        return modes_of_state_matrix(np.asarray(plant.A), mesh, speed_hz=speed_hz,
-                                     pressure_bar=p, max_hz=max_hz)
+        return np.asarray(plant.A), None
     # python-control: loaded when a controller is closed, not for the open loop's modes
     from ambseal.machine import controller_as_runs, sampled_loop_matrix
 
@@ -355,9 +405,7 @@ def modes_as_run(cfg, controller=None, *, speed_hz: float, max_hz: float,
                             ).to_statespace()
     Kd = controller_as_runs(controller, 2 * math.pi * speed_hz, seal_values(cfg.seal, p))
     # the matrix alone: its eigenvectors give the modes and its eigenvalues the verdict
-    A = sampled_loop_matrix(G, Kd)
-    return modes_of_sampled_loop(A, float(Kd.dt), mesh, speed_hz=speed_hz, pressure_bar=p,
-                                 max_hz=max_hz)
+    return sampled_loop_matrix(G, Kd), float(Kd.dt)
 
 
 def modes_of_state_matrix(A: np.ndarray, mesh, *, speed_hz: float, pressure_bar: float,
@@ -484,10 +532,7 @@ def _modes_of_pairs(lam, Q, mesh, *, speed_hz, pressure_bar, max_hz, verdict,
     (n_dof × len(lam)) of their eigenvectors; ``verdict`` decides stability, ``w_max`` is
     the scale of :func:`~ambseal.model.modes.classify_poles`."""
 
-    rigid, _ = classify_poles(lam, w_max, where="closed-loop modes")
-    keep = np.flatnonzero((lam.imag >= RIGID_BODY_RAD_S) & ~rigid
-                          & (lam.imag <= 2 * np.pi * max_hz))
-    keep = keep[np.argsort(lam.imag[keep])]
+    keep = _kept(lam, w_max, max_hz)
     n = mesh.n_dof
     shapes = _circular_pairs(lam[keep], np.stack([Q[0:n:4, keep], Q[1:n:4, keep]],
                                                  axis=-1).transpose(1, 0, 2))
@@ -502,6 +547,17 @@ def _modes_of_pairs(lam, Q, mesh, *, speed_hz, pressure_bar, max_hz, verdict,
         kappa=np.array([k for _, k in whirls]), shapes=shapes, node_z_m=np.asarray(mesh.z),
         max_real_pole=decay_rate(verdict), stable=is_stable(verdict),
         unstable=unstable_poles(verdict))
+
+
+def _kept(lam: np.ndarray, w_max: float, max_hz: float) -> np.ndarray:
+    """Indices of the oscillating modes of ``lam`` (rad/s) that :class:`ClosedLoopModes`
+    keeps: Im λ from :data:`RIGID_BODY_RAD_S` to 2π·``max_hz``, no rigid-body mode
+    (:func:`~ambseal.model.modes.classify_poles` at the scale ``w_max``), ascending in
+    frequency."""
+    rigid, _ = classify_poles(lam, w_max, where="closed-loop modes")
+    keep = np.flatnonzero((lam.imag >= RIGID_BODY_RAD_S) & ~rigid
+                          & (lam.imag <= 2 * np.pi * max_hz))
+    return keep[np.argsort(lam.imag[keep])]
 
 
 #: Eigenvalues closer than this (relative) are one repeated eigenvalue: an isotropic

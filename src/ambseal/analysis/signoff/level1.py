@@ -63,7 +63,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from ambseal.analysis.campbell import modes_as_run, resonant, track_modes
+from ambseal.analysis.campbell import modes_as_run, poles_as_run, resonant, track_modes
 from ambseal.config import MAX_SUPPORT_STIFFNESS, Spring
 from ambseal.errors import ConfigError
 from ambseal.lti import json_float
@@ -413,6 +413,12 @@ def level1_screening(cfg, controller=None, *, name: str = "none", points: int = 
             progress(f"{name}: Q = {Q:.4g} N/m, {state}")
         return m
 
+    def poles(Q: float):  # the refinement follows one pole: no mode shapes needed
+        if progress:
+            progress(f"{name}: Q = {Q:.4g} N/m, refining Q_0")
+        return poles_as_run(_with_cross_coupling(cfg, where, Q), controller,
+                            speed_hz=speed_hz, max_hz=max_hz, pressure_bar=0.0)
+
     # Q_A is a point of the grid: 0, Q_A/2·k, … (points − 1 intervals to q_max_factor·Q_A)
     grid = np.linspace(0.0, q_max_factor * Q_A, int(points))
     iA = int(np.argmin(np.abs(grid - Q_A)))
@@ -437,7 +443,7 @@ def level1_screening(cfg, controller=None, *, name: str = "none", points: int = 
         Q_0, converged = 0.0, True
     else:
         Q_0, converged = _zero(grid, lost, pts[lost - 1].poles[idx[lost - 1, j]],
-                               pts[lost].poles[idx[lost, j]], modes, Q_A)
+                               pts[lost].poles[idx[lost, j]], poles, Q_A)
     ratio = math.inf if Q_0 is None else Q_0 / Q_A
     f_rigid = _rigid_critical_hz(cfg)
     csr = speed_hz / f_rigid
@@ -472,11 +478,12 @@ def level1_screening(cfg, controller=None, *, name: str = "none", points: int = 
                   apart_hz=apart)
 
 
-def _zero(grid, i: int, lam0: complex, lam1: complex, modes, Q_A: float
+def _zero(grid, i: int, lam0: complex, lam1: complex, poles, Q_A: float
           ) -> tuple[float, bool]:
     """Q_0 in ``[grid[i-1], grid[i]]``, where the screened mode's pole (``lam0`` there,
     ``lam1`` here) crosses the imaginary axis: Brent's method on Re λ(Q), λ(Q) the pole
-    of the loop nearest to the straight line between them, to :data:`Q0_XTOL`·Q_A."""
+    of the loop (``poles(Q)``, :func:`~ambseal.analysis.campbell.poles_as_run`) nearest to
+    the straight line between them, to :data:`Q0_XTOL`·Q_A."""
     a, b = float(grid[i - 1]), float(grid[i])
 
     def re(Q: float) -> float:
@@ -486,7 +493,7 @@ def _zero(grid, i: int, lam0: complex, lam1: complex, modes, Q_A: float
             return float(lam1.real)
         t = (Q - a) / (b - a)
         guess = (1 - t) * lam0 + t * lam1
-        p = modes(Q).poles
+        p = poles(Q)
         return float(p[np.argmin(np.abs(p - guess))].real) if p.size else math.nan
 
     try:

@@ -438,8 +438,8 @@ def design(
     r, check, n = synthesise(cfg, steps)
     moved = over = None
     if not cfg.design.one_speed:
-        (r, check, n), moved, over = _over_speed(cfg, method, sp, (r, check, n), synthesise,
-                                                 steps, progress)
+        (r, check, n), moved, over = _over_speed(cfg, method, p, sp, (r, check, n),
+                                                 synthesise, steps, progress)
     if not check["stable"] and not allow_unstable:
         raise SynthesisError(_unstable_message(method, check, n, steps, _top_mode_hz(cfg, p, n),
                                                _lost_by(cfg, r.K, check, p),
@@ -574,9 +574,13 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
     return r, check, n
 
 
-def _over_speed(cfg, method: str, sp, first, synthesise, steps: list, progress):
+def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
+                progress):
     """The design over the speed range: where ``first`` (synthesis, full-order check,
-    states), designed at the operating speed, loses the rotor at another judged speed,
+    states), designed at the operating speed and pressure ``p`` (bar), loses the rotor at
+    another judged speed, and the speed is what loses it (:func:`_lost_by`: at ``p`` that
+    speed's loop is lost too; where only another pressure loses it, the design speed's
+    loop at that pressure is lost as well, and no design speed holds it),
 
     1. the design with the spin speed a real parameter of the LFT, uncertain from the
        lowest to the highest judged speed (:mod:`ambseal.design.speed_lft`; H∞ at the
@@ -604,7 +608,8 @@ def _over_speed(cfg, method: str, sp, first, synthesise, steps: list, progress):
     r, check, n = first
     f0 = cfg.operating.speed_rpm / 60.0
     if check["stable"] or cfg.operating.speed_range_hz is None \
-            or abs(check["speed_hz"] - f0) <= 1e-9 * max(f0, 1.0):
+            or abs(check["speed_hz"] - f0) <= 1e-9 * max(f0, 1.0) \
+            or not _lost_by(cfg, r.K, check, p)[1]:
         return first, None, None
     judged = sorted({*sp.speeds_hz, *sp.stability_speeds_hz})
     rng = (judged[0], judged[-1])

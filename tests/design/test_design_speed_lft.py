@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import tomllib
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -65,3 +66,46 @@ def test_a_plant_built_otherwise_is_refused():
     with pytest.raises(ModelError, match="expected 0 ≤ low < high"):
         with_speed(build_plant(cfg, reduced=True, states=8), cfg, range_hz=(400.0, 0.0),
                    states=8, pressure_bar=0.0)
+
+
+def test_the_speed_range_model_keeps_each_whirl_pair_whole():
+    """Reference: dense eigenvalues and eigenvectors of the example flywheel's state matrix
+    (140 states) at standstill and at its 1 000 Hz design speed. There the 18 states below
+    its 5 kHz cut-off end with a mode at 4.75 kHz whose orbit at the sensors whirls
+    opposite to the next mode's, at 5.11 kHz, above the cut-off; at standstill the two are
+    one repeated pair (equal |λ| to 1e-9) and no other mode lies between them. So 18 states
+    keep one branch of a whirl pair, and the count of whole pairs is two states fewer;
+    a count that splits nothing (16, or 20 with both branches) is kept."""
+    import scipy.linalg as sla
+
+    from ambseal.config import load_rig
+    from ambseal.design.speed_lft import whole_pair_states
+    from ambseal.model import build_system
+
+    cfg = load_rig(Path(__file__).resolve().parents[2] / "examples" / "flywheel.toml")
+    f0, cut = cfg.operating.speed_rpm / 60.0, 5000.0
+
+    def eig(f):
+        s = build_system(cfg, speed_rpm=60.0 * f)
+        lam, X = sla.eig(s.state_matrices()[0])
+        order = np.argsort(np.abs(lam))
+        return lam[order], s.Cq @ X[:s.n_dof, order]
+
+    lam, Y = eig(f0)
+    hz = np.abs(lam) / (2 * np.pi)
+    assert f0 == 1000.0 and np.sum(hz < cut) == 18
+    kept, left = 17, 18  # the 18th state's mode, the first above the cut-off
+    assert 4700 < hz[kept] < cut < hz[left] < 5200
+
+    def whirl(k):  # the sign of the orbit's turning at the sensors, for Im λ > 0
+        y = Y[:, k] if lam[k].imag > 0 else np.conj(Y[:, k])
+        return np.sign(np.sum(np.imag(np.conj(y[0::2]) * y[1::2])))
+
+    assert whirl(kept) == -whirl(left) != 0
+    lam0, _ = eig(0.0)
+    hz0 = np.abs(lam0) / (2 * np.pi)
+    inside = hz0[(hz0 > hz[kept]) & (hz0 < hz[left])]
+    assert inside.size == 4 and np.ptp(inside) < 1e-9 * inside[0]
+    assert whole_pair_states(cfg, 18, pressure_bar=0.0) == 16
+    assert whole_pair_states(cfg, 16, pressure_bar=0.0) == 16
+    assert whole_pair_states(cfg, 20, pressure_bar=0.0) == 20

@@ -70,6 +70,7 @@ from ambseal.design.plant import (
     less_damped,
 )
 from ambseal.design.specs import design_spec, design_states_at
+from ambseal.design.speed_lft import whole_pair_states
 from ambseal.design.weights import Weights
 from ambseal.errors import ConfigError, ModelError, SynthesisError
 from ambseal.lti import lft_lower
@@ -439,7 +440,8 @@ def design(
     moved = over = None
     if not cfg.design.one_speed:
         (r, check, n), moved, over = _over_speed(cfg, method, p, sp, (r, check, n),
-                                                 synthesise, steps, progress)
+                                                 synthesise, steps, progress,
+                                                 fixed=states is not None)
     if not check["stable"] and not allow_unstable:
         raise SynthesisError(_unstable_message(method, check, n, steps, _top_mode_hz(cfg, p, n),
                                                _lost_by(cfg, r.K, check, p),
@@ -575,7 +577,7 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
 
 
 def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
-                progress):
+                progress, fixed: bool = False):
     """The design over the speed range: where ``first`` (synthesis, full-order check,
     states), designed at the operating speed and pressure ``p`` (bar), loses the rotor at
     another judged speed, and the speed is what loses it (:func:`_lost_by`: at ``p`` that
@@ -587,7 +589,13 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
        speed channel's constant scalings, μ by its D–K with the speed's block), on
        ``first``'s design model: kept where its full-order loop holds every judged
        condition. μ, whose D–K steps cost a hundred H∞ designs, is tried only where the
-       H∞ design with the speed channel holds;
+       H∞ design with the speed channel holds. Where none holds and the design model
+       keeps one whirl of a pair and not its twin, the same is tried on the model of
+       whole pairs (:func:`~ambseal.design.speed_lft.whole_pair_states`), unless the user
+       fixed its states (``fixed``, or ``[design] model_states``): measured, family seeds
+       7 and 13 hold only on whole pairs, the expander-generator example's μ only on the
+       split model (benchmarks/README.md, "Whole whirl pairs in the speed-range design
+       model");
     2. else the design at another of the specification's stability speeds: the first
        whose full-order loop holds at every judged condition. H∞ tries each in turn from
        standstill up (the gyroscopic moments change the plant monotonically with speed,
@@ -623,10 +631,15 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
             progress(steps[-1])
 
     tried: list[str] = []
-    held = _held_over_speed(cfg, method, rng, n, synthesise, tried)
+    held, model = _held_over_speed(cfg, method, rng, n, synthesise, tried), ""
+    if held is None and not (fixed or sp.sources.get("model_states") == "set"):
+        n_whole = whole_pair_states(cfg, n, pressure_bar=p)
+        if n_whole != n:
+            model = f" on {n_whole} states (the {n} of the operating speed split a whirl pair)"
+            held = _held_over_speed(cfg, method, rng, n_whole, synthesise, tried, model)
     if held is not None:
         step(f"with the spin speed uncertain over {rng[0]:g}–{rng[1]:g} Hz (a real LFT "
-             f"parameter){_level_words(held[0].level)}, which")
+             f"parameter){model}{_level_words(held[0].level)}, which")
         return held, None, rng
     speeds = [f for f in sorted(set(sp.stability_speeds_hz))
               if abs(f - f0) > 1e-9 * max(f0, 1.0)]
@@ -648,7 +661,8 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
     return out, f, None
 
 
-def _held_over_speed(cfg, method: str, rng, n: int, synthesise, tried: list):
+def _held_over_speed(cfg, method: str, rng, n: int, synthesise, tried: list,
+                     model: str = ""):
     """``synthesise``'s design with the speed uncertain over ``rng`` (Hz) on the n-state
     design model, where its full-order loop holds every judged condition, else None; each
     design that did not hold is appended to ``tried`` in words (:func:`_tried_words`).
@@ -659,9 +673,9 @@ def _held_over_speed(cfg, method: str, rng, n: int, synthesise, tried: list):
     Ip/It 1.2 over 0–400 Hz (tests/design/test_design_over_speed.py), the weights as given
     ask for a γ of 2.5 and the loop is lost at standstill; at 8.7 % of them γ is 0.99 and
     the rotor is held at zone A at every speed. μ is designed where H∞'s loop holds, at
-    H∞'s level."""
+    H∞'s level. ``model`` says in words where n is not the operating speed's count."""
     held = None
-    head = f"with the spin speed uncertain over {rng[0]:g}–{rng[1]:g} Hz"
+    head = f"with the spin speed uncertain over {rng[0]:g}–{rng[1]:g} Hz{model}"
     for level in (None, "auto"):
         what = head + (" at the weights as given" if level is None else
                        " at the largest performance level that certifies it")

@@ -27,13 +27,17 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
+from scipy.optimize import linear_sum_assignment
 
+from ambseal.design.modal_bands import TRACK_POINTS
+from ambseal.design.specs import RIGID_STATES
 from ambseal.errors import ModelError
 from ambseal.model import (
-    Parameter, Plant, build_system, mechanical_plant, modal_reduction, reduction_size,
+    Parameter, Plant, build_system, mechanical_plant, modal_reduction, poles_near_zero,
+    reduction_size,
 )
 
-__all__ = ["SPEED", "with_speed"]
+__all__ = ["SPEED", "whole_pair_states", "with_speed"]
 
 _TWO_PI = 2.0 * np.pi
 
@@ -45,6 +49,99 @@ SPEED = "rotor.speed"
 #: (the projected term of the design models measured falls by four decades after its
 #: conical and bending pairs), and each kept one is a repeat of the real block.
 RANK_TOL = 1e-4
+
+
+#: Eigenvalues at standstill this close (relative to |λ|) are one whirl pair: an
+#: axisymmetric rotor's ζ and η modes repeat, up to the eigensolver's rounding.
+PAIR_RTOL = 1e-6
+
+#: A pole of the next tracked speed is the same mode's only where it moved by less than
+#: this share of |λ| in one step (1/30 of the range), or by less than :data:`GYRO_RATIO`
+#: times the step in Ω; a pole farther off has entered the tracked disk from outside it
+#: and starts a mode of its own.
+STEP_RTOL = 0.25
+
+#: The most a whirl frequency moves per unit of spin speed: a thin disc's Ip/It is 2
+#: (the perpendicular-axis theorem), and its forward conical whirl tends to Ip/It·Ω.
+GYRO_RATIO = 2.0
+
+
+def whole_pair_states(cfg, states: int, *, pressure_bar: float) -> int:
+    """The largest count of the design model's states, at most ``states``, that keeps each
+    whirl pair whole over the speed range.
+
+    A rotor's ζ and η modes at standstill are one pair of equal |λ|; the gyroscopic
+    moments split it with speed, the forward whirl up and the backward whirl down. The
+    design model at the design speed keeps the lowest ``states`` by |λ| there, and a
+    cut-off between the two branches keeps the backward one and drops its forward twin.
+    With the speed an LFT parameter (:func:`with_speed`), A₁ then moves a branch whose twin
+    is missing: its singular values no longer come in equal pairs, the speed channel's
+    scalings cannot be tied pairwise, and the model cannot represent the pair's split.
+    Measured (benchmarks/README.md, "Whole whirl pairs in the speed-range design model"):
+    two rigs of the generated family hold over the speed range only on whole pairs; the
+    expander-generator example's μ holds only on its split model, so whole pairs are the
+    second try (:func:`ambseal.design.recipes.design`).
+
+    The rule: the rig's eigenvalues are followed from standstill to the design speed
+    (``cfg``'s ``[operating] speed_rpm``) on
+    :data:`~ambseal.design.modal_bands.TRACK_POINTS` speeds, each matched to its nearest
+    at the next speed (a move beyond :data:`STEP_RTOL` of |λ| and :data:`GYRO_RATIO` times
+    the step in Ω starts a mode of its own); the eigenvalues of equal |λ| at standstill
+    (:data:`PAIR_RTOL`) are a group. The count kept is the largest k ≤
+    ``states`` whose k lowest eigenvalues at the design speed hold every group they touch
+    whole and do not end inside a tie of |λ|; ``states`` where none of at least
+    :data:`~ambseal.design.specs.RIGID_STATES` does, and on a rig whose supports make
+    no pair repeat at standstill (each group one eigenvalue).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig at the design speed.
+    states : int
+        The design model's mechanical states at the design speed (its cut-off's count).
+    pressure_bar : float
+        The seals' pressure drop (bar) the design model is built at.
+
+    Returns
+    -------
+    int
+        The count, ``RIGID_STATES ≤ k ≤ states`` or ``states``.
+
+    Raises
+    ------
+    ModelError
+        A rig whose eigenvalues cannot be found (its mass matrix not positive definite).
+    """
+    f0 = cfg.operating.speed_rpm / 60.0
+    if f0 <= 0 or states <= RIGID_STATES:
+        return int(states)
+    count = 2 * int(states) + RIGID_STATES  # a partner leaving the kept set is followed out
+    step = _TWO_PI * f0 / (TRACK_POINTS - 1)
+
+    def lowest(f_hz: float) -> np.ndarray:
+        return poles_near_zero(build_system(cfg, pressure_bar=pressure_bar,
+                                            speed_rpm=60.0 * f_hz), count=count).poles[:count]
+
+    lam = lowest(0.0)
+    mag = np.abs(lam)
+    label = np.cumsum(np.r_[0, np.diff(mag) > PAIR_RTOL * mag[1:]])
+    size = dict(zip(*np.unique(label, return_counts=True)))
+    for f in np.linspace(0.0, f0, TRACK_POINTS)[1:]:
+        nxt = lowest(f)
+        rows, cols = linear_sum_assignment(np.abs(lam[:, None] - nxt[None, :]))
+        moved = np.abs(lam[rows] - nxt[cols]) <= np.maximum(
+            STEP_RTOL * np.abs(nxt[cols]), GYRO_RATIO * step)
+        new = np.arange(len(size), len(size) + nxt.size)
+        new[cols[moved]] = label[rows[moved]]
+        size.update((int(x), 1) for x in new if x >= len(size))
+        lam, label = nxt, new
+    mag = np.abs(lam)  # sorted by |λ| (poles_near_zero)
+    for k in range(min(int(states), lam.size - 1), RIGID_STATES - 1, -1):
+        kept, n_kept = np.unique(label[:k], return_counts=True)
+        whole = all(size[int(x)] == c for x, c in zip(kept, n_kept))
+        if whole and mag[k] - mag[k - 1] > PAIR_RTOL * mag[k]:
+            return k
+    return int(states)
 
 
 def with_speed(plant: Plant, cfg, *, range_hz: tuple[float, float],

@@ -125,16 +125,17 @@ def whole_pair_states(cfg, states: int, *, pressure_bar: float) -> int:
     lam = lowest(0.0)
     mag = np.abs(lam)
     label = np.cumsum(np.r_[0, np.diff(mag) > PAIR_RTOL * mag[1:]])
-    size = dict(zip(*np.unique(label, return_counts=True)))
+    size = dict(zip(*np.unique(label, return_counts=True)))  # group → its eigenvalues
+    fresh = int(label[-1]) + 1  # the next unused label
     for f in np.linspace(0.0, f0, TRACK_POINTS)[1:]:
         nxt = lowest(f)
         rows, cols = linear_sum_assignment(np.abs(lam[:, None] - nxt[None, :]))
         moved = np.abs(lam[rows] - nxt[cols]) <= np.maximum(
             STEP_RTOL * np.abs(nxt[cols]), GYRO_RATIO * step)
-        new = np.arange(len(size), len(size) + nxt.size)
+        new = np.arange(fresh, fresh + nxt.size)  # a mode of its own unless matched
         new[cols[moved]] = label[rows[moved]]
-        size.update((int(x), 1) for x in new if x >= len(size))
-        lam, label = nxt, new
+        size.update((int(x), 1) for x in new if x >= fresh)
+        lam, label, fresh = nxt, new, fresh + nxt.size
     mag = np.abs(lam)  # sorted by |λ| (poles_near_zero)
     for k in range(min(int(states), lam.size - 1), RIGID_STATES - 1, -1):
         kept, n_kept = np.unique(label[:k], return_counts=True)

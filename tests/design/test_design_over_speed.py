@@ -218,8 +218,8 @@ def test_a_rotor_whose_operating_count_splits_a_whirl_pair_is_held_on_whole_pair
     """A rig of the family (``bench_family.family_rig(7)``: Ip/It 0.89, 10 kHz, vertical,
     collocated) whose design model at the top speed (every mode below 2.5 kHz: 18
     states) keeps a flexible pair's backward whirl and not its forward one. Designed with
-    the speed uncertain on those 18 states, no level of the weights certifies the range
-    and the rotor is lost; on the 16 states of whole pairs
+    the speed uncertain on those 18 states, at the weights as given or at a level of them,
+    the rotor is lost; on the 16 states of whole pairs
     (:func:`ambseal.design.speed_lft.whole_pair_states`) the design holds, where the one
     designed at the top speed alone loses the rotor at standstill. Reference:
     python-control's poles of the loop on the full-order plant at every stability speed,

@@ -110,16 +110,22 @@ def _ap_bounds(w, k1, k2):
     return lb, ub
 
 
-def fit_allpass_pair(w, g, wgt, tol):
+def fit_allpass_pair(w, g, wgt, tol, start=None):
     """The all-pass pair whose phase difference fits ψ = 2·arctan ĝ (weighted nonlinear
     least squares, several starts; :func:`ambseal.robust.dgk.fit_g`). Returns
     ``(x, k1, k2, error)``, ``x = [x1, x2]`` of :func:`_ap_phase` (``None`` when no pair
-    beats ψ ≡ 0), error the weighted largest |ψ error| in rad."""
+    beats ψ ≡ 0), error the weighted largest |ψ error| in rad.
+
+    ``start``, an earlier ``(x, k1, k2)`` of the same ĝ under other weights (the D–G
+    step's reweighting rounds, :func:`ambseal.robust.dgk._dg_step_scalings`): one fit at
+    its order from it, in place of the orders and starts; the continuation of that fit
+    as its weights move."""
     psi = 2 * np.arctan(g)
     lw = np.log(w)
     sq = np.sqrt(wgt)
     best = (None, 0, 0, float(np.max(np.abs(psi) * wgt / wgt.max())))
-    for k1, k2 in _AP_ORDERS:
+    orders = _AP_ORDERS if start is None else ((start[1], start[2]),)
+    for k1, k2 in orders:
         n = k1 + 2 * k2
         lb, ub = _ap_bounds(w, k1, k2)
 
@@ -129,23 +135,30 @@ def fit_allpass_pair(w, g, wgt, tol):
         def jac(x):
             return sq[:, None] * np.hstack([-_ap_jac(x[:n], w, k1, k2), _ap_jac(x[n:], w, k1, k2)])
 
-        for shift in (0.0, 0.7, -0.7):
-            cen = np.linspace(lw.min(), lw.max(), 2 * (k1 + k2) + 2)[1:-1] + shift
-            for c1, c2 in ((cen[0::2], cen[1::2]), (cen[1::2], cen[0::2])):
-                x0 = np.r_[[v for v in c1[:k1]], [v for c in c1[k1:] for v in (c, np.log(0.3))],
-                           [v for v in c2[:k1]], [v for c in c2[k1:] for v in (c, np.log(0.3))]]
-                def largest(x):
-                    return float(np.max(np.abs(resid(x)) * sq / wgt.max()))
+        def largest(x):
+            return float(np.max(np.abs(resid(x)) * sq / wgt.max()))
 
-                res = least_squares_converged(resid, np.clip(x0, lb + 1e-3, ub - 1e-3),
-                                              jac=jac, bounds=(lb, ub), stall=largest,
-                                              stall_rtol=FIT_STALL_RTOL)
-                err = largest(res.x)
-                if err < best[3]:
-                    best = (res.x, k1, k2, err)
+        for x0 in (_ap_starts(lw, k1, k2) if start is None else (start[0],)):
+            res = least_squares_converged(resid, np.clip(x0, lb + 1e-3, ub - 1e-3), jac=jac,
+                                          bounds=(lb, ub), stall=largest,
+                                          stall_rtol=FIT_STALL_RTOL)
+            err = largest(res.x)
+            if err < best[3]:
+                best = (res.x, k1, k2, err)
         if best[3] <= 2 * np.arctan(tol):
             break
     return best
+
+
+def _ap_starts(lw, k1, k2):
+    """The multistart of :func:`fit_allpass_pair` at one order: the sections' corners
+    spread evenly over the grid (log ω ``lw``), shifted by ±0.7 and alternated between
+    the pair's two functions."""
+    for shift in (0.0, 0.7, -0.7):
+        cen = np.linspace(lw.min(), lw.max(), 2 * (k1 + k2) + 2)[1:-1] + shift
+        for c1, c2 in ((cen[0::2], cen[1::2]), (cen[1::2], cen[0::2])):
+            yield np.r_[[v for v in c1[:k1]], [v for c in c1[k1:] for v in (c, np.log(0.3))],
+                        [v for v in c2[:k1]], [v for c in c2[k1:] for v in (c, np.log(0.3))]]
 
 
 # --------------------------------------------------------------------------- D sections

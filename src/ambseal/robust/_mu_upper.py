@@ -210,6 +210,17 @@ class _Problem:
         self.BGrf = self.BGr.reshape(self.pG, ri.size ** 2)
         # blocks for the barrier −Σ log det D_k (full blocks: scalar multiples of I)
         self.offs = np.asarray(S.offs, np.int64)
+        # the coordinates' map to the scaling entries (D's, then G's), sparse by rows: the
+        # Newton steps' Hessian of −log det(t D − A) is formed from it (_mu_newton._lmi_term)
+        T = np.zeros((p, S.TD.shape[1] + S.TG.shape[1]), complex)
+        T[:self.pD, :S.TD.shape[1]] = S.TD
+        T[self.pD:, S.TD.shape[1]:] = S.TG
+        rows, cols = np.nonzero(T)
+        self.tp = np.searchsorted(rows, np.arange(p + 1)).astype(np.int64)
+        self.tu, self.tv = cols.astype(np.int64), np.ascontiguousarray(T[rows, cols])
+        self.ekind = np.r_[np.zeros(S.aD.size, np.int64), np.ones(S.aG.size, np.int64)]
+        self.ea = np.r_[S.aD, S.aG].astype(np.int64)
+        self.eb = np.r_[S.bD, S.bG].astype(np.int64)
         self.full = np.array([b.kind == "full" for b in blks], np.bool_)
 
     def affine(self, idx):
@@ -302,6 +313,7 @@ def _centres_chunk(P, z, t, tol, max_iter, idx, theta=0.25, n_newton=5, dec_tol=
     F, N = z.shape[0], P.S.N
     idx = np.asarray(idx)
     A0all, Vall = P.affine(idx)
+    Mall = np.ascontiguousarray(P.M[idx], complex)
     z, t = z.copy(), t.copy()
     best_lam = _gevp(*P._mats(z, A0all, Vall))
     best_z = z.copy()
@@ -332,7 +344,8 @@ def _centres_chunk(P, z, t, tol, max_iter, idx, theta=0.25, n_newton=5, dec_tol=
         # damped Newton steps towards the centre (compiled, one matrix at a time; in place)
         centred, lost = newton_steps(L1, D, Gr if pG else np.zeros((Fa, 0, 0), complex), za,
                                      Lder, P.U, P.BD, P.BGr, P.offs, P.full, float(gmax), pD,
-                                     n_newton, dec_tol)
+                                     n_newton, dec_tol, Mall[active], ta, P.tp, P.tu, P.tv,
+                                     P.ekind, P.ea, P.eb)
         lam_a = _gevp(D, ta[:, None, None] * D - L1)
         better = lam_a < best_lam[active]
         best_lam[active[better]] = lam_a[better]

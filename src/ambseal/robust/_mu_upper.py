@@ -341,7 +341,7 @@ def _centres_chunk(P, z, t, tol, max_iter, idx, theta=0.25, n_newton=5, dec_tol=
             Fa = active.size
             if Fa == 0:
                 break
-        # damped Newton steps towards the centre (compiled, one matrix at a time; in place)
+        # damped Newton steps towards the centre (in place; see newton_steps)
         centred, lost = newton_steps(L1, D, Gr if pG else np.zeros((Fa, 0, 0), complex), za,
                                      Lder, P.U, P.BD, P.BGr, P.offs, P.full, float(gmax), pD,
                                      n_newton, dec_tol, Mall[active], ta, P.tp, P.tu, P.tv,

@@ -93,6 +93,7 @@ def test_drop_coasting_down(tmp_path, capsys):
 EXAMPLES = sorted(Path(__file__).resolve().parents[1].glob("examples/*.toml"))
 
 
+@pytest.mark.heavy
 @pytest.mark.parametrize("rig", EXAMPLES, ids=lambda p: p.stem)
 def test_every_example_rig_lands_on_its_own_touchdown_bearings(rig, tmp_path, capsys):
     """Each example carries two touchdown bearings and drops onto them at its operating
@@ -191,6 +192,7 @@ def test_an_unbalanced_drop_starts_from_its_levitated_orbit_or_at_rest(tmp_path,
     assert docs["rest"]["controller_runs"] is None
 
 
+@pytest.mark.heavy
 def test_the_events_from_the_command_line(tmp_path, capsys):
     """``--event one-axis`` loses the most loaded axis by default (a vertical one; here
     both AMBs alike, the first), lands its end, the other AMB taking up more of the
@@ -283,6 +285,7 @@ def test_the_seals_drop_with_the_rotor_at_their_pressure(tmp_path, capsys):
     assert "--pressure-bar: expected a value >= 0.0, got -1.0" in capsys.readouterr().err
 
 
+@pytest.mark.heavy
 def test_a_seal_surge_lands_a_rotor_its_loop_held(tmp_path, capsys):
     """``--event overload --surge-bar P``: the seal's pressure drop steps from the
     operating 0 bar to 3000 bar at the event, its cross-coupled stiffness (2e3 N/m per
@@ -342,6 +345,7 @@ def test_the_thrust_drives_the_rotor_onto_its_axial_stop(tmp_path, capsys):
     assert code == 2 and "--axial-thrust-n" in err and "Traceback" not in err
 
 
+@pytest.mark.heavy
 def test_monte_carlo_drops_of_an_event(tmp_path, capsys):
     """``--runs`` with ``--event overload``: every run is the overload beyond the AMBs'
     capacity from the reference PID's orbit (both ends land in each, whatever its

@@ -496,6 +496,7 @@ def test_fuzz_ranges(tmp_path_factory, data):
     _range_case(tmp_path_factory, data)
 
 
+@pytest.mark.heavy
 @fuzz(40)
 @given(data=st.data())
 def test_fuzz_physics_changes_show(tmp_path_factory, data):
@@ -509,6 +510,7 @@ _TWINS = tomllib.loads(dump(DROP_RIG).replace('name = "TB"', 'name = "TA"'))
 _SHORT = ["--duration-s", "0.005"]
 
 
+@pytest.mark.heavy
 @fuzz(8)
 @given(doc=_drop_rigs(), args=_drop_args())
 @example(doc=_TWINS, args=["--runs", "1", "--workers", "1", *_SHORT])

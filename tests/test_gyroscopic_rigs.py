@@ -28,7 +28,7 @@ from .exported_files import file_at, rejection_held_by_python_control
 
 # the flywheel's run (≈ 1 min of CPU, most of it the LPV) is a module fixture: its tests
 # share one worker
-pytestmark = pytest.mark.xdist_group("flywheel_run")
+pytestmark = [pytest.mark.xdist_group("flywheel_run"), pytest.mark.heavy]
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 RIG = EXAMPLES / "flywheel.toml"

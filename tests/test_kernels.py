@@ -113,6 +113,7 @@ def _both(pair, argv: list[str], tmp_path: Path, timeout: float) -> None:
                 proc.wait()
 
 
+@pytest.mark.heavy
 def test_blower_delivers_the_same_answer_under_two_kernel_sets(tmp_path):
     """The blower's μ is designed by D–G–K (complex D–K's μ is above 1 there): its steps
     went on past μ = 1, each following the rounding of the one before, to μ 0.587 under
@@ -129,6 +130,7 @@ def test_blower_delivers_the_same_answer_under_two_kernel_sets(tmp_path):
     assert not diff, f"{pair[0]} against {pair[1]}:\n" + "\n".join(diff)
 
 
+@pytest.mark.heavy
 def test_the_flywheels_lpv_at_10_khz_is_the_same_under_two_kernel_sets(tmp_path):
     """The LPV on speed of the example flywheel on a 10 kHz target (a copy with its rate
     changed), designed under two kernel sets: every SDP stage ended "optimal", the same
@@ -216,6 +218,7 @@ def test_comparison_holds_words_and_zones_exactly_and_numbers_to_their_tolerance
     assert len(d) == 1 and d[0].startswith("/controllers/lpv/sdp_shortfall: words differ")
 
 
+@pytest.mark.heavy
 def test_the_overhung_bands_channels_are_the_same_under_two_kernel_sets(tmp_path):
     """The overhung compressor's band channels (every ΔA = B_θ C_θ of the frequencies μ
     takes as uncertain, :func:`ambseal.design.modal_bands.with_modal_frequencies`, on its

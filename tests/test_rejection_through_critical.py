@@ -31,7 +31,7 @@ from ambseal.report.verdict import verdicts
 from .exported_files import rejection_held_by_python_control
 
 # the supercritical rotor's run is a module fixture: its tests share one worker
-pytestmark = pytest.mark.xdist_group("supercritical_run")
+pytestmark = [pytest.mark.xdist_group("supercritical_run"), pytest.mark.heavy]
 
 RIG = Path(__file__).resolve().parents[1] / "examples" / "supercritical_rotor.toml"
 

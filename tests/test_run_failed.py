@@ -135,6 +135,7 @@ def test_a_failure_found_later_adds_its_conditions():
     assert also_failed(None, more) is more
 
 
+@pytest.mark.heavy
 def test_run_with_a_failing_controller_writes_the_report_and_exits_1(tmp_path, capsys):
     """The embedded rig with the seal's cross-coupling per bar tripled: H∞, designed on the
     nominal plant, loses the loop at 0 and 4.08 bar (a plant three times as far from its
@@ -242,6 +243,7 @@ def test_run_on_a_stronger_seal_reports_every_controller(example, tmp_path, caps
             assert f"ambseal: {m['failed'][name]['reason']}" in err
 
 
+@pytest.mark.heavy
 def test_a_controller_whose_amplifier_saturates_is_not_delivered(tmp_path, capsys, request,
                                                                  design_cache_for):
     """The embedded rig with a 1 V supply and 10 mH coils (R = 0): holding the judged

@@ -117,6 +117,7 @@ print(json.dumps({"mu": r.mu, "gamma": r.gamma, "re": h.real.tolist(), "im": h.i
 """
 
 
+@pytest.mark.heavy
 def test_synthesis_is_the_same_whatever_the_threads_and_load():
     """μ-synthesis with its D search in three child processes — one BLAS thread set by
     the environment, four set by it, and none set with a CPU hog running beside it: μ and γ

@@ -18,7 +18,7 @@ from ambseal.config import load_rig  # noqa: E402
 from ambseal.errors import ModelError  # noqa: E402
 
 # the spin-ups are a module fixture: its tests share one worker
-pytestmark = pytest.mark.xdist_group("spinup_runs")
+pytestmark = [pytest.mark.xdist_group("spinup_runs"), pytest.mark.heavy]
 
 TURBO = Path(__file__).resolve().parents[2] / "examples" / "turboexpander.toml"
 

@@ -58,6 +58,7 @@ def test_an_unstable_scheduled_loop_is_refused_with_its_mode(turbo_cfg, turbo_fr
     assert np.isfinite(kept["mode_hz"]) and isinstance(flipped, control.StateSpace)
 
 
+@pytest.mark.heavy
 def test_the_lpv_on_speed_holds_the_blower_from_standstill_to_its_top_speed():
     """Reference: python-control's feedback poles of the full-order plant at every judged
     pressure and stability speed of ``examples/blower.toml`` (0–600 Hz, where the

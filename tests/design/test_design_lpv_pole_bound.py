@@ -44,6 +44,7 @@ def flywheel_at_10_khz(tmp_path_factory):
     return rig, out
 
 
+@pytest.mark.heavy
 def test_the_lpv_has_no_pole_above_nyquist_and_runs_at_every_speed(flywheel_at_10_khz):
     rig, out = flywheel_at_10_khz
     cfg = load_rig(rig)

@@ -120,6 +120,7 @@ def rigid_mu(tmp_path_factory):
     return rig, held, made
 
 
+@pytest.mark.heavy
 @pytest.mark.xdist_group("rigid_mu")
 @pytest.mark.parametrize("method", ["hinf", "mu"])
 def test_a_rigid_gyroscopic_rotor_is_held_from_standstill_to_the_top_speed(
@@ -136,6 +137,7 @@ def test_a_rigid_gyroscopic_rotor_is_held_from_standstill_to_the_top_speed(
     assert "rotor.speed" in held.uncertainty
 
 
+@pytest.mark.heavy
 def test_hinf_designed_over_the_speed_range_holds_from_standstill_to_the_top_speed():
     """Reference: python-control's poles of the sampled, delayed loop on the full-order
     plant at every stability speed (standstill to the top speed). The one-speed design
@@ -154,6 +156,7 @@ def test_hinf_designed_over_the_speed_range_holds_from_standstill_to_the_top_spe
     assert "hinf: designed with the spin speed uncertain over 0–" in held.steps[-1]
 
 
+@pytest.mark.heavy
 @pytest.mark.parametrize("method", ["hinf", "mu"])
 def test_a_disc_like_rigid_rotor_is_held_at_the_performance_level_the_speed_range_leaves(
         tmp_path, method, monkeypatch):
@@ -185,6 +188,7 @@ def test_a_disc_like_rigid_rotor_is_held_at_the_performance_level_the_speed_rang
     assert f"at {100 * level['level']:.2g} % of the performance weights" in held.steps[-1]
 
 
+@pytest.mark.heavy
 @pytest.mark.xdist_group("rigid_mu")
 def test_mu_takes_the_speed_range_hinf_designs_that_hinf_tried_before(rigid_mu, monkeypatch):
     """One run's designs share their trials over the speed range: μ tries H∞ with the speed
@@ -214,6 +218,7 @@ def test_mu_takes_the_speed_range_hinf_designs_that_hinf_tried_before(rigid_mu, 
         np.testing.assert_array_equal(a, b)
 
 
+@pytest.mark.heavy
 def test_a_rotor_whose_operating_count_splits_a_whirl_pair_is_held_on_whole_pairs():
     """A rig of the family (``bench_family.family_rig(7)``: Ip/It 0.89, 10 kHz, vertical,
     collocated) whose design model at the top speed (every mode below 2.5 kHz: 18

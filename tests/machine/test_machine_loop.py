@@ -73,6 +73,7 @@ def _numbers(d, path=""):
     return {path: d}
 
 
+@pytest.mark.heavy
 def test_the_judged_case_equals_the_one_from_dense_solves(testrig_cfg, testrig_designs,
                                                           testrig_digital, monkeypatch):
     """Reference: the same judgement with every plant response taken by dense LU solves of

@@ -12,6 +12,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -58,6 +59,7 @@ print(json.dumps({
 """
 
 
+@pytest.mark.heavy
 def test_the_core_runs_on_skogestads_column_with_no_rotor_in_sight():
     """References: python-control's hinfsyn on the same plant (γ_opt to 1e-4), SLICOT
     AB13MD at every frequency (μ upper bound to 1e-3), the frozen H∞ optima as lower

@@ -85,6 +85,7 @@ def complex_dk():
     return at
 
 
+@pytest.mark.heavy
 def test_dgk_result_holds_by_a_parameter_sweep(complex_dk):
     """D–G–K steps are taken on a real ±90 % gain uncertainty, and the kept controller is
     never worse than complex D–K's (with or without D–K's D search). Reference for the μ
@@ -120,6 +121,7 @@ def test_dgk_result_holds_by_a_parameter_sweep(complex_dk):
         assert np.max(perf) <= r.mu * (1 + 1e-6)
 
 
+@pytest.mark.heavy
 def test_a_target_complex_dk_meets_skips_the_dgk_steps(complex_dk):
     """``target``: complex D–K's result as it is (its controller and μ, no D–G–K step, the
     rule saying why) when its μ is at or below the target; D–G–K steps when above."""
@@ -150,6 +152,7 @@ def test_dgk_steps_end_at_the_first_that_meets_the_target():
     assert met.mu == pytest.approx(steps[0], rel=1e-9) and met.mu > free.mu
 
 
+@pytest.mark.heavy
 def test_dgk_steps_end_by_the_stall_rule_not_a_count(monkeypatch):
     """Without ``max_iter`` the D–G–K phase ends by its stall rule alone, however many
     steps each gain more than ``rtol``: an iteration cap would stop where the path happens
@@ -310,6 +313,7 @@ def test_the_refinement_ends_by_slsqps_tolerance_not_its_count(monkeypatch):
     assert level <= whole * (1 + 1e-3)
 
 
+@pytest.mark.heavy
 def test_the_cutting_planes_end_when_the_bound_is_tight_or_stalls_not_after_a_count(
         monkeypatch):
     """On μ's grids of 27 and 35 points the spring–mass loop of an H∞ controller puts the

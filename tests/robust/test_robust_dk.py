@@ -252,6 +252,7 @@ def test_scaled_hinf_is_musyns_first_k_step_without_its_mu_analysis(monkeypatch)
             syn(ct.tf([1.0], [1.0, 1.0]), [(1, 1), (1, 1)], 1, 1)
 
 
+@pytest.mark.heavy
 def test_dk_iterations_end_by_the_stall_rule_not_a_count(monkeypatch):
     """Without ``max_iter`` the D–K iterations end by their stall rule alone, however many
     of them gain more than ``rtol``. Fault injection: the μ curve of the first 11
@@ -277,6 +278,7 @@ def test_dk_iterations_end_by_the_stall_rule_not_a_count(monkeypatch):
     assert capped.stopping["dk"] == {"iterations": 3, "rule": "max_iter=3"}
 
 
+@pytest.mark.heavy
 def test_musyn_gives_the_same_mu_and_controller_in_any_units():
     """Reference: μ(D M D⁻¹) = μ(M) for a constant D commuting with Δ (Packard & Doyle
     1993), so a change of units of the uncertainty channels (w_Δ × a, z_Δ ÷ a) must leave
@@ -492,6 +494,7 @@ def test_dk_with_d_search_reaches_the_published_optimum_within_two_percent():
     assert np.max(mu.lower) >= 0.99 * np.max(mu.upper)
 
 
+@pytest.mark.heavy
 def test_musyn_defaults_come_within_one_percent_of_the_published_optimum():
     """Reference: Skogestad & Postlethwaite (2005) §8.12.4 — their D–K reaches μ 1.0189 after
     three iterations (Table 8.2 script, MATLAB μ toolbox) and their μ-optimal controller

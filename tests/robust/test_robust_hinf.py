@@ -349,6 +349,7 @@ def test_stabilisability_test_does_not_depend_on_the_state_scaling():
     assert r.gamma_opt == pytest.approx(ref.gamma_opt, rel=1e-5)
 
 
+@pytest.mark.heavy
 @pytest.mark.parametrize("dual", [False, True], ids=["stabilisable", "detectable"])
 def test_a_weakly_reached_unstable_mode_beside_a_fast_one_is_synthesised(dual):
     """Reference: python-control's ``hinfsyn`` (SLICOT SB10AD without a PBH pre-check),

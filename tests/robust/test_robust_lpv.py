@@ -519,6 +519,7 @@ def wu1996_rotation():
                                coupling_ratio=1.01, **kw)}
 
 
+@pytest.mark.heavy
 def test_wu1996_full_rotation_against_lpvtools_published_gamma(wu1996_rotation):
     """Reference: LPVTools' published normlpv = 0.9250 (LMI γ at 1.02 × its minimum, with
     the coupling [X I; I Y] ⪰ 0). With the same back-off and a coupling ratio of 1.01 (the

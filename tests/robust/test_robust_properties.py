@@ -269,6 +269,7 @@ def test_tolerances_and_counts_out_of_range_are_refused(tol, count):
     _refused(lambda: hinfnorm("G"))
 
 
+@pytest.mark.heavy
 @SETTINGS
 @given(st.integers(0, 2**31 - 1), st.lists(st.integers(-6, 6), min_size=4, max_size=4),
        st.sampled_from([((1, 1),) * 4, ((-1, 0), (1, 1), (1, 1), (1, 1)),

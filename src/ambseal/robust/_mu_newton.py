@@ -214,15 +214,18 @@ def _lmi_term(Yinv, M, t, tp, tu, tv, ekind, ea, eb, g, H):
     for u in range(r):
         for a in range(2):
             tr[u] += s[u, a] * W[ky[u, a], kx[u, a], eb[u], ea[u]]
+    # tr(Y⁻¹Λ_u Y⁻¹Λ_v) = tr(Y⁻¹Λ_v Y⁻¹Λ_u) (the trace is cyclic): Hel is symmetric, each
+    # pair is formed once
     Hel = np.empty((r, r), np.complex128)
     for u in range(r):
-        for v in range(r):
+        for v in range(u, r):
             acc = 0.0j
             for a in range(2):
                 for b in range(2):
                     acc += (s[u, a] * s[v, b] * W[ky[u, a], kx[v, b], eb[u], ea[v]]
                             * W[ky[v, b], kx[u, a], eb[v], ea[u]])
             Hel[u, v] = acc
+            Hel[v, u] = acc
     TH = np.zeros((p, r), np.complex128)  # T Hel
     for i in range(p):
         gi = 0.0j
@@ -233,12 +236,14 @@ def _lmi_term(Yinv, M, t, tp, tu, tv, ekind, ea, eb, g, H):
             for v in range(r):
                 TH[i, v] += c * Hel[u, v]
         g[i] -= gi.real
-    for i in range(p):
-        for j in range(p):
+    for i in range(p):  # T Hel Tᵀ is symmetric as Hel is
+        for j in range(i, p):
             acc = 0.0j
             for k in range(tp[j], tp[j + 1]):
                 acc += TH[i, tu[k]] * tv[k]
             H[i, j] += acc.real
+            if j != i:
+                H[j, i] += acc.real
 
 
 @cached_njit()

@@ -12,7 +12,7 @@ ROOT = Path(__file__).resolve().parents[1]
 def _rig(tmp_path, controller_lines: str) -> Path:
     """The embedded rig with its ``[controller]`` table replaced."""
     text = (ROOT / "examples" / "testrig.toml").read_text()
-    text = re.sub(r"\[controller\.pid\]", controller_lines + "\n\n[controller.pid]", text, 1)
+    text = re.sub(r"\[controller\.pid\]", controller_lines + "\n\n[controller.pid]", text, count=1)
     path = tmp_path / "rig.toml"
     path.write_text(text)
     return path

@@ -19,6 +19,7 @@ import pytest
 
 from ambseal.config import load_rig, parse_rig
 from ambseal.design import design, design_spec
+from ambseal.errors import SynthesisError
 from ambseal.model import build_plant
 from ambseal.robust import LEVEL_FLOOR
 
@@ -154,6 +155,31 @@ def test_hinf_designed_over_the_speed_range_holds_from_standstill_to_the_top_spe
     assert all(_held_as_it_runs(cfg, held.K, speeds))
     assert frozen.design_speed_hz is None and held.design_speed_hz is None
     assert "hinf: designed with the spin speed uncertain over 0–" in held.steps[-1]
+
+
+def test_a_design_refused_over_the_speed_range_checks_what_lost_it_once(tmp_path, monkeypatch):
+    """Where no design over the speed range holds, the design at the top speed is refused,
+    and the refusal says the speed lost the rotor (at standstill, the conical mode, which
+    the gyroscopic moments move). Whether the speed or the pressure lost it costs two
+    full-order checks; they are made once, by the rule that decides whether to design over
+    the speed range, and its answer is what the refusal says. Every design over the speed
+    range is stubbed to hold nothing: only the top speed's H∞ is synthesised."""
+    import ambseal.design.recipes as recipes
+
+    monkeypatch.setattr(recipes, "_held_over_speed", lambda *a, **k: None)
+    monkeypatch.setattr(recipes, "_first_held", lambda *a, **k: None)
+    asked, real = [], recipes._lost_by
+
+    def counted(*args):
+        asked.append(args[-1])
+        return real(*args)
+
+    monkeypatch.setattr(recipes, "_lost_by", counted)
+    with pytest.raises(SynthesisError) as refused:
+        design(load_rig(_rigid_rig(tmp_path)), "hinf")
+    assert len(asked) == 1
+    message = str(refused.value)
+    assert "0 bar, 0 Hz" in message and "the gyroscopic moments move it" in message, message
 
 
 @pytest.mark.heavy

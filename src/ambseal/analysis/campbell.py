@@ -387,8 +387,7 @@ def poles_as_run(cfg, controller=None, *, speed_hz: float, max_hz: float,
     lam = sla.eigvals(A)
     if dt is not None:
         lam = np.log(lam[np.abs(lam) > 1e-12].astype(complex)) / dt
-    lam = lam[_kept(lam, float(np.abs(lam).max(initial=0.0)), max_hz)]
-    return lam
+    return lam[_kept(lam, float(np.abs(lam).max(initial=0.0)), max_hz)]
 
 
 def _matrix_as_run(cfg, controller, speed_hz: float, p: float):

@@ -437,14 +437,14 @@ def design(
                                                     n_start))
 
     r, check, n = synthesise(cfg, steps)
-    moved = over = None
+    moved = over = lost = None
     if not cfg.design.one_speed:
-        (r, check, n), moved, over = _over_speed(cfg, method, p, sp, (r, check, n),
-                                                 synthesise, steps, progress,
-                                                 fixed=states is not None)
+        (r, check, n), moved, over, lost = _over_speed(cfg, method, p, sp, (r, check, n),
+                                                       synthesise, steps, progress,
+                                                       fixed=states is not None)
     if not check["stable"] and not allow_unstable:
         raise SynthesisError(_unstable_message(method, check, n, steps, _top_mode_hz(cfg, p, n),
-                                               _lost_by(cfg, r.K, check, p),
+                                               lost or _lost_by(cfg, r.K, check, p),
                                                _outside(cfg, r.gp.parameters, check, p)))
     return DesignResult(
         method, r.K, p, gamma=r.gamma, mu=r.mu, order=int(r.K.nstates),
@@ -605,7 +605,8 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
        rotor (or why there was no design), so the user sees the range was tried.
 
     Returns (the design, the speed in Hz it was designed at for 2, the speed range in Hz
-    for 1; None where not). Measured
+    for 1; None where not; and, where ``first`` is returned after :func:`_lost_by` was
+    asked of it, that answer, else None: a refusal's message reuses it). Measured
     on the seeded gyroscopic family (benchmarks/README.md, bench_family.py): a design at
     the top speed leans on the gyroscopic stiffening of the conical mode and loses it at
     standstill, one at standstill can lose the nutation or a bending mode at the top
@@ -616,9 +617,11 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
     r, check, n = first
     f0 = cfg.operating.speed_rpm / 60.0
     if check["stable"] or cfg.operating.speed_range_hz is None \
-            or abs(check["speed_hz"] - f0) <= 1e-9 * max(f0, 1.0) \
-            or not _lost_by(cfg, r.K, check, p)[1]:
-        return first, None, None
+            or abs(check["speed_hz"] - f0) <= 1e-9 * max(f0, 1.0):
+        return first, None, None, None
+    lost_by = _lost_by(cfg, r.K, check, p)
+    if not lost_by[1]:
+        return first, None, None, lost_by
     judged = sorted({*sp.speeds_hz, *sp.stability_speeds_hz})
     rng = (judged[0], judged[-1])
     lost = (f"the design at the operating speed ({f0:g} Hz) lost the rotor at "
@@ -640,7 +643,7 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
     if held is not None:
         step(f"with the spin speed uncertain over {rng[0]:g}–{rng[1]:g} Hz (a real LFT "
              f"parameter){model}{_level_words(held[0].level)}, which")
-        return held, None, rng
+        return held, None, rng, None
     speeds = [f for f in sorted(set(sp.stability_speeds_hz))
               if abs(f - f0) > 1e-9 * max(f0, 1.0)]
     if method != "hinf":
@@ -654,11 +657,11 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
                      f"tried: {'; '.join(tried)}")
         if progress:
             progress(steps[-1])
-        return first, None, None
+        return first, None, None, lost_by
     f, out = found
     step(f"at {f:g} Hz, the first stability speed from standstill whose "
          f"{'H∞ ' if method != 'hinf' else ''}design")
-    return out, f, None
+    return out, f, None, None
 
 
 def _held_over_speed(cfg, method: str, rng, n: int, synthesise, tried: list,

@@ -775,3 +775,68 @@ def test_a_solve_that_stopped_short_is_not_kept_before_an_optimal_one(monkeypatc
     np.testing.assert_array_equal(r.K.at(2.0).A, first.K.at(2.0).A)
     used = [x for x in r.reports if x.stage == "gamma" and x.used]
     assert len(used) == 1 and used[0].status == "optimal"
+
+
+
+def test_a_centring_that_cannot_change_the_delivered_controller_is_not_run(monkeypatch):
+    """Reference: lpvsyn's rule between its two scalings, stated in its docstring — the
+    diagonal scaling tried where the Riccati solve kept is held up by the trace term or
+    stopped short, an optimal solve kept before a lower γ, the diagonal scaling alone
+    where the Riccati one fails. Fault injection: each scaling's synthesis replaced by
+    one whose outcome the test sets, the Riccati one's kept solve waiting on its
+    rebalanced scaling's centring (γ 1.0 or 0.9, each held up by the trace term). The
+    centring is run (the Riccati result asked for) only where its outcome can change
+    what is delivered; the delivered result is the rule's in every case."""
+    import types
+
+    import ambseal.robust.lpv as lpv_mod
+    from ambseal.robust._lpv_lmi import SolverReport
+
+    def result(gamma, status="optimal"):
+        return types.SimpleNamespace(gamma=gamma, penalty_share=0.5, reports=(
+            SolverReport("gamma", status, 20, 0.1), SolverReport("centre", status, 20, 0.1)))
+
+    class Riccati:
+        open, certainly_short_or_held, gammas = True, True, (1.0, 0.9)
+
+        def __init__(self, kept):
+            self.kept, self.asked = kept, 0
+
+        def result(self):
+            self.asked += 1
+            if isinstance(self.kept, Exception):
+                raise self.kept
+            return self.kept
+
+    def delivered(kept, diagonal, **state):
+        riccati = Riccati(kept)
+        for k, v in state.items():
+            setattr(riccati, k, v)
+        monkeypatch.setattr(lpv_mod._Scaling, "solve", lambda *a, **k: riccati)
+
+        def synthesise(data, scaling, **settings):
+            assert scaling == "diagonal"
+            if isinstance(diagonal, Exception):
+                raise diagonal
+            return diagonal
+
+        monkeypatch.setattr(lpv_mod, "_synthesise", synthesise)
+        try:
+            return lpv_mod._either_scaling(None, {}), riccati.asked
+        except SynthesisError as exc:
+            return exc, riccati.asked
+
+    rebalanced, low, between = result(0.9), result(0.8), result(0.95)
+    assert delivered(rebalanced, low) == (low, 0)  # below both: the centring not run
+    assert delivered(rebalanced, between) == (rebalanced, 1)
+    assert delivered(result(1.0), between) == (between, 1)  # the centring failed
+    short = result(0.8, "feasible")
+    assert delivered(rebalanced, short) == (rebalanced, 1)  # optimal before lower γ
+    assert delivered(result(0.9, "feasible"), short) == (short, 1)
+    failed = SynthesisError("reconstruction")
+    assert delivered(failed, between) == (between, 1)  # the diagonal scaling alone
+    assert delivered(failed, SynthesisError("diagonal")) == (failed, 1)
+    # the kept solve may be neither held up nor short: the diagonal one waits on it
+    r, asked = delivered(result(0.9), low, certainly_short_or_held=False)
+    assert (r, asked) == (low, 1)
+    assert delivered(rebalanced, low, open=False) == (low, 1)

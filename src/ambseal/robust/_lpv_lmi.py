@@ -28,6 +28,7 @@ from ambseal.errors import SynthesisError
 from ambseal.robust import _lmi_sdp as _sdp
 
 __all__ = ["LmiInfeasible", "SolverReport", "Scaled", "scale_grid", "lmi_blocks", "solve_lmis",
+           "GammaStage", "gamma_stage",
            "basis", "basis_at", "is_constant", "rebalanced", "BASES", "sdp_status",
            "sdp_shortfall"]
 
@@ -386,9 +387,64 @@ def _affine_in_p(As: np.ndarray, ps: np.ndarray, rtol: float = 1e-9) -> bool:
 
 
 def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
-               backoff: float, margin: float, penalty: float, coupling_ratio: float,
-               centre: bool, solver_options: dict, lyapunov_r="constant"):
-    """The SDP stages of :func:`ambseal.robust.lpv.lpvsyn` on the scaled grid.
+               centre: bool, **kw):
+    """The SDP stages of :func:`ambseal.robust.lpv.lpvsyn` on the scaled grid: the γ
+    stage (:func:`gamma_stage`, whose parameters ``kw`` are) and, with ``centre``, its
+    centring.
+
+    Returns
+    -------
+    gamma, gamma_design, R, S, reports, penalty_share
+        As :class:`GammaStage`, R and S the centred ones with ``centre``, the centring's
+        report appended.
+
+    Raises
+    ------
+    SynthesisError
+        As :func:`gamma_stage` and :attr:`GammaStage.centre`.
+    """
+    st = gamma_stage(sc, blocks, grid, lyapunov, nu_s, centre=centre, **kw)
+    R, S, more = st.centre() if centre else (st.R, st.S, [])
+    return st.gamma, st.gamma_d, R, S, st.reports + more, st.share
+
+
+@dataclass(frozen=True)
+class GammaStage:
+    """Stage 1 of :func:`solve_lmis` (minimise γ), and its centring to be run.
+
+    Attributes
+    ----------
+    gamma : float
+        Optimal γ.
+    gamma_d : float
+        ``backoff·γ``.
+    R, S : list of ndarray, shape (N, N)
+        The γ stage's coefficients of R(θ) and S(θ).
+    reports : list of SolverReport
+        Every γ solve, those the result was not built from ``used=False``.
+    share : float
+        The trace term's share of the cost at its last solve (relative to γ).
+    centre : callable or None
+        ``centre() -> (R, S, reports)``: stage 2, R and S centred at γ_d with
+        S R ⪰ α² I, and its report; raises :class:`~ambseal.errors.SynthesisError` where
+        it is infeasible at every α it tries or its solve fails. Run only where its
+        outcome is needed (:func:`ambseal.robust.lpv.lpvsyn`). None for a γ stage
+        solved without a centring to follow.
+    """
+
+    gamma: float
+    gamma_d: float
+    R: list
+    S: list
+    reports: list
+    share: float
+    centre: Any
+
+
+def gamma_stage(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
+                backoff: float, margin: float, penalty: float, coupling_ratio: float,
+                centre: bool, solver_options: dict, lyapunov_r="constant") -> GammaStage:
+    """Stage 1 of :func:`solve_lmis`: γ minimised with the trace term's continuation.
 
     Parameters
     ----------
@@ -403,27 +459,21 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
     nu_s : float
         Rate bound in scaled units (dp/dt'), 0 without one.
     backoff, margin, penalty, coupling_ratio, centre
-        As in :func:`ambseal.robust.lpv.lpvsyn`.
+        As in :func:`ambseal.robust.lpv.lpvsyn`: with ``centre`` the γ stage's coupling
+        LMI is [[R, I], [I, S]] ⪰ 0 and ``coupling_ratio`` the α of its centring
+        (:attr:`GammaStage.centre`), without it α is the γ stage's.
     solver_options : dict
         CVXOPT options, complete (:data:`DEFAULT_TOL` and the user's).
 
     Returns
     -------
-    gamma : float
-        Optimal γ of stage 1.
-    gamma_design : float
-        ``backoff·γ``.
-    R, S : list of ndarray, shape (N, N)
-        Coefficients R_j, S_i of R(θ) = Σ g_j(θ) R_j and S(θ) = Σ f_i(θ) S_i.
-    reports : list of SolverReport
-        Every solve, those the result was not built from ``used=False``.
-    penalty_share : float
-        The trace term's share of stage 1's cost at its last solve (relative to γ).
+    GammaStage
+        R_j, S_i the coefficients of R(θ) = Σ g_j(θ) R_j and S(θ) = Σ f_i(θ) S_i.
 
     Raises
     ------
     SynthesisError
-        Infeasible LMIs or a solver status other than ``optimal``.
+        Infeasible LMIs or a solver status other than ``optimal`` or ``feasible``.
     """
 
     B1, B2, C1, C2, D11, D12, D21 = blocks
@@ -531,22 +581,27 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
                   for k, r in enumerate(reports)]
     gamma = float(sol.gamma)
     gamma_d = backoff * gamma
-    if centre:
+
+    def centring():
         # stage 2: centre R, S at the backed-off γ with S R ⪰ α² I
-        alpha, last = float(coupling_ratio), None
+        alpha, last, more = float(coupling_ratio), None, []
         for _ in range(4):
             lmis, tr = build(gamma_d, alpha)
             try:
-                sol = _solve_sdp(lmis, N, n_vars, None, tr, solver_options, "centre",
-                                 reports)
+                centred = _solve_sdp(lmis, N, n_vars, None, tr, solver_options, "centre",
+                                     more)
                 break
             except SynthesisError as exc:
                 last = exc
                 alpha = 1.0 + 0.5 * (alpha - 1.0)
         else:
             raise last
+        X = [_sym(X) for X in centred.X]
+        return X[:nbR], X[nbR:], more
+
     X = [_sym(X) for X in sol.X]
-    return gamma, gamma_d, X[:nbR], X[nbR:], reports, share
+    return GammaStage(gamma, gamma_d, X[:nbR], X[nbR:], reports, share,
+                      centring if centre else None)
 
 
 def _reconstruction_loss(R, S, at) -> float:

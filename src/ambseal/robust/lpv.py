@@ -70,6 +70,7 @@ from ambseal.robust._lpv_lmi import (
     SolverReport,
     is_constant,
     lmi_blocks,
+    gamma_stage,
     rebalanced,
     scale_grid,
     sdp_shortfall,
@@ -466,32 +467,53 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
                     check_density=check_density, solver_options=solver_options,
                     margin=margin, penalty=penalty, coupling_ratio=coupling_ratio,
                     centre=centre)
-    if scaling != "auto":
-        r = _synthesise(data, scaling, **settings)
-    else:
-        try:
-            r = _synthesise(data, "riccati", **settings)
-            # γ held up by the trace term, or an SDP that stopped short of optimal: try the
-            # other scaling, and keep an optimal solve before a lower γ
-            if r.penalty_share > PENALTY_SHARE or not _optimal(r):
-                try:
-                    alt = _synthesise(data, "diagonal", **settings)
-                    if (not _optimal(alt), alt.gamma) < (not _optimal(r), r.gamma):
-                        r = alt
-                except SynthesisError:
-                    pass
-        except SynthesisError as first:
-            try:  # a plant the balancing does not suit: the diagonal scaling alone
-                r = _synthesise(data, "diagonal", **settings)
-            except LmiInfeasible as proof:  # a certificate holds in every state basis
-                raise proof from None
-            except SynthesisError:
-                raise first from None
+    r = (_synthesise(data, scaling, **settings) if scaling != "auto"
+         else _either_scaling(data, settings))
     if frozen_check:
         r = _against_frozen(r, data, solver_options, margin)
     if pole_bound is not None:
         r = _within_bound(r, data, float(pole_bound))
     return replace(r, time_s=time.perf_counter() - t_start)
+
+
+def _either_scaling(data, settings: dict) -> LpvSynResult:
+    """``scaling="auto"`` of :func:`lpvsyn`: the Riccati scaling's synthesis, and the
+    diagonal scaling's where the Riccati one fails, its γ is held up by the trace term or
+    an SDP stopped short of optimal; of the two, an optimal solve is kept before a lower
+    γ. Where the diagonal scaling is tried whichever Riccati solve is kept, and its
+    optimal γ is below every one's, it is delivered without the Riccati rebalanced
+    scaling's centring (:class:`_Scaling`), whose outcome cannot change it."""
+    diagonal: dict = {}
+
+    def diagonal_result():  # tried once, its result or its error kept
+        if not diagonal:
+            try:
+                diagonal["r"] = _synthesise(data, "diagonal", **settings)
+            except SynthesisError as exc:
+                diagonal["error"] = exc
+        return diagonal.get("r")
+
+    try:
+        riccati = _Scaling.solve(data, "riccati", **settings)
+        if riccati.open and riccati.certainly_short_or_held:
+            alt = diagonal_result()
+            if alt is not None and _optimal(alt) and all(alt.gamma < g
+                                                         for g in riccati.gammas):
+                return alt
+        r = riccati.result()
+        if r.penalty_share > PENALTY_SHARE or not _optimal(r):
+            alt = diagonal_result()
+            if alt is not None and (not _optimal(alt), alt.gamma) < (not _optimal(r),
+                                                                      r.gamma):
+                r = alt
+        return r
+    except SynthesisError as first:  # a plant the balancing does not suit
+        alt = diagonal_result()
+        if alt is not None:
+            return alt
+        if isinstance(diagonal["error"], LmiInfeasible):  # it holds in every state basis
+            raise diagonal["error"] from None
+        raise first from None
 
 
 def _optimal(r: LpvSynResult) -> bool:
@@ -590,56 +612,136 @@ def _against_frozen(r: LpvSynResult, data, solver_options, margin) -> LpvSynResu
                    closed_loop=CL, kind="frozen")
 
 
-def _synthesise(data, scaling: str, *, lyapunov, lyapunov_r, rate_bound, backoff,
-                check_density, solver_options, margin, penalty, coupling_ratio,
-                centre) -> LpvSynResult:
+def _synthesise(data, scaling: str, **settings) -> LpvSynResult:
     """Stages 1–3 of :func:`lpvsyn` with one state scaling; SynthesisError as there."""
-    plants, grid, As, dAs, B, C, D, nw, nz, nmeas, ncon = data
-    sc = scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling)
-    nu_s = 0.0 if rate_bound is None else float(rate_bound) / sc.w0 * sc.dp_dtheta  # dp/dt'
-    lmi_kw = dict(backoff=backoff, margin=margin, penalty=penalty,
-                  coupling_ratio=coupling_ratio, centre=centre,
-                  solver_options=solver_options, lyapunov_r=lyapunov_r)
-    blocks = lmi_blocks(sc, nw, nz, ncon, nmeas)
-    gamma, gamma_d, R, S, reports, share = solve_lmis(sc, blocks, grid, lyapunov, nu_s,
-                                                      **lmi_kw)
-    if share > PENALTY_SHARE:  # γ held up by the trace term: R and S of one size, again
-        sc2 = rebalanced(sc, R, S, grid, lyapunov, lyapunov_r)
-        blocks2 = lmi_blocks(sc2, nw, nz, ncon, nmeas)
-        try:
-            again = solve_lmis(sc2, blocks2, grid, lyapunov, nu_s, **lmi_kw)
-        except SynthesisError:
-            again = None
-        if again is not None and (_short(again[4]), again[0]) < (_short(reports), gamma):
-            sc, blocks = sc2, blocks2
-            gamma, gamma_d, R, S, more, share = again
-            reports = [replace(r, used=False) for r in reports] + more
+    return _Scaling.solve(data, scaling, **settings).result()
 
-    # controller table on the check grid
-    dens = max(int(check_density), 1)
-    table = np.concatenate([np.linspace(grid[j], grid[j + 1], dens + 1)[:-1]
-                            for j in range(grid.size - 1)] + [grid[-1:]])
-    A_of = interp_A(As, dAs, grid)
-    AK, AK_rate, BK, CK, DK, rep = reconstruct_table(sc, blocks, table, A_of, R, S, lyapunov,
-                                                     nu_s, gamma_d * 1.02, margin,
-                                                     lyapunov_r)
-    reports.append(rep)
-    in_names = tuple(list(getattr(plants[0], "output_labels", []))[nz:]) or \
-        tuple(f"y{i}" for i in range(nmeas))
-    out_names = tuple(list(getattr(plants[0], "input_labels", []))[nw:]) or \
-        tuple(f"u{i}" for i in range(ncon))
-    K = LpvController(table, AK, BK, CK, DK, in_names, out_names,
-                      None if is_constant(lyapunov_r) else AK_rate)
-    check_g = _check_table(K, A_of, B, C, D, nmeas, ncon)
-    names = (list(getattr(plants[0], "input_labels", []))[:nw],
-             list(getattr(plants[0], "output_labels", []))[:nz])
-    CL = FrozenClosedLoop(grid, As, dAs, B, C, D, K, nmeas, ncon, *map(tuple, names))
-    return LpvSynResult(K=K, gamma=gamma, gamma_design=gamma_d, lyapunov=lyapunov,
-                        lyapunov_r=lyapunov_r,
-                        rate_bound=None if rate_bound is None else float(rate_bound),
-                        grid=grid, check_grid=table, check_gamma=check_g,
-                        check_stable=True, reports=tuple(reports), closed_loop=CL,
-                        scaling=scaling, penalty_share=share)
+
+@dataclass
+class _Scaling:
+    """One state scaling's synthesis (:func:`_synthesise`) with the rebalanced scaling's
+    centring not yet run.
+
+    Stage 1 and its centring in the scaling, then, where the trace term held γ up
+    (``penalty_share`` above :data:`PENALTY_SHARE`), stage 1 again in the rebalanced
+    scaling (:func:`~ambseal.robust._lpv_lmi.rebalanced`, from the centred R and S). The
+    rebalanced solve is kept where (stopped short, γ) is lower than the first's, which
+    for its centring's status needs that centring: where it cannot be lower even with
+    an optimal centring, the centring is never run (:attr:`open` false), and
+    :func:`lpvsyn` runs it only where its outcome can change what is delivered. Which
+    solves are run does not change the result: each is one deterministic solve, the
+    same whenever it runs.
+    """
+
+    data: tuple
+    settings: dict
+    sc: Any
+    blocks: tuple
+    nu_s: float
+    first: tuple  # (γ, γ_d, R, S, reports, share), centred
+    rebalanced: tuple | None  # (Scaled, blocks, GammaStage) or None
+
+    @classmethod
+    def solve(cls, data, scaling: str, *, lyapunov, lyapunov_r, rate_bound, backoff,
+              check_density, solver_options, margin, penalty, coupling_ratio,
+              centre) -> "_Scaling":
+        plants, grid, As, dAs, B, C, D, nw, nz, nmeas, ncon = data
+        settings = dict(lyapunov=lyapunov, lyapunov_r=lyapunov_r, rate_bound=rate_bound,
+                        check_density=check_density, margin=margin)
+        sc = scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling)
+        nu_s = 0.0 if rate_bound is None else float(rate_bound) / sc.w0 * sc.dp_dtheta
+        lmi_kw = dict(backoff=backoff, margin=margin, penalty=penalty,
+                      coupling_ratio=coupling_ratio, centre=centre,
+                      solver_options=solver_options, lyapunov_r=lyapunov_r)
+        blocks = lmi_blocks(sc, nw, nz, ncon, nmeas)
+        first = solve_lmis(sc, blocks, grid, lyapunov, nu_s, **lmi_kw)
+        again = None
+        if first[5] > PENALTY_SHARE:  # γ held up by the trace term: R and S of one size
+            sc2 = rebalanced(sc, first[2], first[3], grid, lyapunov, lyapunov_r)
+            blocks2 = lmi_blocks(sc2, nw, nz, ncon, nmeas)
+            try:
+                again = (sc2, blocks2, gamma_stage(sc2, blocks2, grid, lyapunov, nu_s,
+                                                   **lmi_kw))
+            except SynthesisError:
+                again = None
+        return cls(data, {**settings, "scaling": scaling}, sc, blocks, nu_s, first, again)
+
+    def _may_win(self) -> bool:
+        """Whether the rebalanced solve is kept with an optimal centring (else it is not
+        kept whatever its centring)."""
+        st = self.rebalanced[2]
+        return (_short(st.reports), st.gamma) < (_short(self.first[4]), self.first[0])
+
+    @property
+    def open(self) -> bool:
+        """Which solve is kept waits on the rebalanced scaling's centring."""
+        return (self.rebalanced is not None and self.rebalanced[2].centre is not None
+                and self._may_win())
+
+    @property
+    def gammas(self) -> tuple[float, ...]:
+        """The γ of each solve that may be kept."""
+        return (self.first[0],) + ((self.rebalanced[2].gamma,) if self.open else ())
+
+    @property
+    def certainly_short_or_held(self) -> bool:
+        """Whether whichever solve is kept has γ held up by the trace term or stopped
+        short of optimal (:func:`lpvsyn` then tries the diagonal scaling)."""
+        kept = [self.first[5] > PENALTY_SHARE or _short(self.first[4])]
+        if self.open:
+            st = self.rebalanced[2]
+            kept.append(st.share > PENALTY_SHARE or _short(st.reports))
+        return all(kept)
+
+    def result(self) -> LpvSynResult:
+        """The kept solve's controller table, checked (runs the rebalanced scaling's
+        centring where it is needed)."""
+        sc, blocks = self.sc, self.blocks
+        gamma, gamma_d, R, S, reports, share = self.first
+        if self.rebalanced is not None and (self.rebalanced[2].centre is None
+                                            or self._may_win()):
+            sc2, blocks2, st = self.rebalanced
+            try:
+                R2, S2, more = st.centre() if st.centre is not None else (st.R, st.S, [])
+            except SynthesisError:
+                R2 = None
+            if R2 is not None and (_short(st.reports + more), st.gamma) < (_short(reports),
+                                                                            gamma):
+                sc, blocks = sc2, blocks2
+                gamma, gamma_d, R, S, share = st.gamma, st.gamma_d, R2, S2, st.share
+                reports = [replace(r, used=False) for r in reports] + st.reports + more
+        return self._table(sc, blocks, gamma, gamma_d, R, S, list(reports), share)
+
+    def _table(self, sc, blocks, gamma, gamma_d, R, S, reports, share) -> LpvSynResult:
+        plants, grid, As, dAs, B, C, D, nw, nz, nmeas, ncon = self.data
+        st = self.settings
+        lyapunov, lyapunov_r, rate_bound = st["lyapunov"], st["lyapunov_r"], st["rate_bound"]
+        check_density, scaling, margin = st["check_density"], st["scaling"], st["margin"]
+        # controller table on the check grid
+        dens = max(int(check_density), 1)
+        table = np.concatenate([np.linspace(grid[j], grid[j + 1], dens + 1)[:-1]
+                                for j in range(grid.size - 1)] + [grid[-1:]])
+        A_of = interp_A(As, dAs, grid)
+        AK, AK_rate, BK, CK, DK, rep = reconstruct_table(sc, blocks, table, A_of, R, S,
+                                                         lyapunov, self.nu_s,
+                                                         gamma_d * 1.02, margin, lyapunov_r)
+        reports.append(rep)
+        in_names = tuple(list(getattr(plants[0], "output_labels", []))[nz:]) or \
+            tuple(f"y{i}" for i in range(nmeas))
+        out_names = tuple(list(getattr(plants[0], "input_labels", []))[nw:]) or \
+            tuple(f"u{i}" for i in range(ncon))
+        K = LpvController(table, AK, BK, CK, DK, in_names, out_names,
+                          None if is_constant(lyapunov_r) else AK_rate)
+        check_g = _check_table(K, A_of, B, C, D, nmeas, ncon)
+        names = (list(getattr(plants[0], "input_labels", []))[:nw],
+                 list(getattr(plants[0], "output_labels", []))[:nz])
+        CL = FrozenClosedLoop(grid, As, dAs, B, C, D, K, nmeas, ncon, *map(tuple, names))
+        return LpvSynResult(K=K, gamma=gamma, gamma_design=gamma_d, lyapunov=lyapunov,
+                            lyapunov_r=lyapunov_r,
+                            rate_bound=None if rate_bound is None else float(rate_bound),
+                            grid=grid, check_grid=table, check_gamma=check_g,
+                            check_stable=True, reports=tuple(reports), closed_loop=CL,
+                            scaling=scaling, penalty_share=share)
 
 
 def _basis_name(kind) -> str:

@@ -380,7 +380,11 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
         term (``penalty_share`` above its bound) and the diagonal one reaches a lower γ;
         the result says which (``scaling``). When both fail, the error is
         the diagonal scaling's if it is the solver's certificate that the LMIs are
-        infeasible (true in any state basis), else the Riccati scaling's.
+        infeasible (true in any state basis), else the Riccati scaling's. A centring
+        SDP whose outcome cannot change the result is not solved (where the diagonal
+        scaling ends optimal below every γ the Riccati one may keep, the Riccati
+        rebalanced scaling's centring): the controller is the same, and ``reports``
+        lists the solves that ran.
     penalty : float
         Starting weight of the trace term in stage 1 (scaled units; ≥ 0).
     coupling_ratio : float

@@ -53,7 +53,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field, replace
-from typing import Any, Sequence
+from typing import Any, NamedTuple, Sequence
 
 import control
 import control as ct
@@ -621,6 +621,26 @@ def _synthesise(data, scaling: str, **settings) -> LpvSynResult:
     return _Scaling.solve(data, scaling, **settings).result()
 
 
+class _Solved(NamedTuple):
+    """One scaling's SDP stages as :func:`~ambseal.robust._lpv_lmi.solve_lmis` returns
+    them (R and S centred where a centring was asked for)."""
+
+    gamma: float
+    gamma_d: float
+    R: list
+    S: list
+    reports: list
+    share: float
+
+
+class _Rebalanced(NamedTuple):
+    """The rebalanced scaling and its stage 1 (its centring not yet run)."""
+
+    sc: Any
+    blocks: tuple
+    stage: Any  # GammaStage
+
+
 @dataclass
 class _Scaling:
     """One state scaling's synthesis (:func:`_synthesise`) with the rebalanced scaling's
@@ -642,8 +662,8 @@ class _Scaling:
     sc: Any
     blocks: tuple
     nu_s: float
-    first: tuple  # (γ, γ_d, R, S, reports, share), centred
-    rebalanced: tuple | None  # (Scaled, blocks, GammaStage) or None
+    first: _Solved
+    rebalanced: _Rebalanced | None
 
     @classmethod
     def solve(cls, data, scaling: str, *, lyapunov, lyapunov_r, rate_bound, backoff,
@@ -658,14 +678,14 @@ class _Scaling:
                       coupling_ratio=coupling_ratio, centre=centre,
                       solver_options=solver_options, lyapunov_r=lyapunov_r)
         blocks = lmi_blocks(sc, nw, nz, ncon, nmeas)
-        first = solve_lmis(sc, blocks, grid, lyapunov, nu_s, **lmi_kw)
+        first = _Solved(*solve_lmis(sc, blocks, grid, lyapunov, nu_s, **lmi_kw))
         again = None
-        if first[5] > PENALTY_SHARE:  # γ held up by the trace term: R and S of one size
-            sc2 = rebalanced(sc, first[2], first[3], grid, lyapunov, lyapunov_r)
+        if first.share > PENALTY_SHARE:  # γ held up by the trace term: R and S of one size
+            sc2 = rebalanced(sc, first.R, first.S, grid, lyapunov, lyapunov_r)
             blocks2 = lmi_blocks(sc2, nw, nz, ncon, nmeas)
             try:
-                again = (sc2, blocks2, gamma_stage(sc2, blocks2, grid, lyapunov, nu_s,
-                                                   **lmi_kw))
+                again = _Rebalanced(sc2, blocks2, gamma_stage(sc2, blocks2, grid, lyapunov,
+                                                              nu_s, **lmi_kw))
             except SynthesisError:
                 again = None
         return cls(data, {**settings, "scaling": scaling}, sc, blocks, nu_s, first, again)
@@ -673,27 +693,27 @@ class _Scaling:
     def _may_win(self) -> bool:
         """Whether the rebalanced solve is kept with an optimal centring (else it is not
         kept whatever its centring)."""
-        st = self.rebalanced[2]
-        return (_short(st.reports), st.gamma) < (_short(self.first[4]), self.first[0])
+        st = self.rebalanced.stage
+        return (_short(st.reports), st.gamma) < (_short(self.first.reports), self.first.gamma)
 
     @property
     def open(self) -> bool:
         """Which solve is kept waits on the rebalanced scaling's centring."""
-        return (self.rebalanced is not None and self.rebalanced[2].centre is not None
+        return (self.rebalanced is not None and self.rebalanced.stage.centre is not None
                 and self._may_win())
 
     @property
     def gammas(self) -> tuple[float, ...]:
         """The γ of each solve that may be kept."""
-        return (self.first[0],) + ((self.rebalanced[2].gamma,) if self.open else ())
+        return (self.first.gamma,) + ((self.rebalanced.stage.gamma,) if self.open else ())
 
     @property
     def certainly_short_or_held(self) -> bool:
         """Whether whichever solve is kept has γ held up by the trace term or stopped
         short of optimal (:func:`lpvsyn` then tries the diagonal scaling)."""
-        kept = [self.first[5] > PENALTY_SHARE or _short(self.first[4])]
+        kept = [self.first.share > PENALTY_SHARE or _short(self.first.reports)]
         if self.open:
-            st = self.rebalanced[2]
+            st = self.rebalanced.stage
             kept.append(st.share > PENALTY_SHARE or _short(st.reports))
         return all(kept)
 
@@ -702,7 +722,7 @@ class _Scaling:
         centring where it is needed)."""
         sc, blocks = self.sc, self.blocks
         gamma, gamma_d, R, S, reports, share = self.first
-        if self.rebalanced is not None and (self.rebalanced[2].centre is None
+        if self.rebalanced is not None and (self.rebalanced.stage.centre is None
                                             or self._may_win()):
             sc2, blocks2, st = self.rebalanced
             try:

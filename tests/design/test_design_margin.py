@@ -13,7 +13,8 @@ import pytest
 
 from ambseal.config import load_rig
 from ambseal.design.plant import less_damped
-from ambseal.design.recipes import MARGIN_ZETA, design, margin_for
+from ambseal.design import design_spec
+from ambseal.design.recipes import MARGIN_ZETA, _margin_reaches, design, margin_for
 from ambseal.errors import ModelError
 from ambseal.model import build_plant
 from ambseal.model.lft import Plant
@@ -116,3 +117,29 @@ def test_the_supercritical_rotors_hinf_holds_with_the_margin_and_not_without():
     assert r.full_order["stable"]
     assert any("damping there lowered" in s for s in r.steps), r.steps
     assert _held_sampled(cfg, r.K, [0.0, 38.0, 76.0, 114.0, 150.0]) < 1.0
+
+
+def _light_hz(A) -> list[float]:
+    """Damped frequencies (Hz) of the lightly damped modes (0 < ζ < 0.2) of a state matrix."""
+    lam = np.linalg.eigvals(np.asarray(A, float))
+    zeta = -lam.real / np.abs(lam)
+    return sorted(float(x.imag / (2 * np.pi)) for x, z in zip(lam, zeta)
+                  if x.imag > 0 and 0 < z < 0.2)
+
+
+def test_a_margin_is_asked_of_the_design_model_not_of_the_modes_it_leaves_out():
+    """The recipe gives a lost mode a margin only where the margin lowers a mode of the
+    design model the synthesis takes: the supercritical rotor's 24-state model keeps its
+    modes up to 1.2 kHz, its full-order plant has more above. A margin at a full-order
+    mode above the model's band reaches nothing the synthesis sees (the next design would
+    be the last one again), one at the model's highest mode does; the full-order plant
+    would have answered yes to both."""
+    cfg = load_rig(SUPERCRITICAL)
+    sp = design_spec(cfg)
+    p, n = cfg.operating.pressure_bar, sp.model_states
+    kept = _light_hz(build_plant(cfg, reduced=True, pressure_bar=p, states=n).A)
+    full = build_plant(cfg, pressure_bar=p)
+    above = next(f for f in _light_hz(full.A) if f > 1.2 * kept[-1])
+    assert not _margin_reaches(cfg, p, n, above, 0.01)
+    assert _margin_reaches(cfg, p, n, kept[-1], 0.01)
+    assert less_damped(full, [(above, 0.01)]) is not full

@@ -554,8 +554,7 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
             # a lightly damped mode the model keeps, barely damped by the design: a margin
             # on it (a rigid-body mode the loop no longer holds is no such mode)
             f, dz = margin_for(check, margins)
-            model = build_plant(cfg, pressure_bar=p, states=n)
-            if -check["damping"] >= LIGHT_DAMPING or less_damped(model, [(f, dz)]) is model:
+            if -check["damping"] >= LIGHT_DAMPING or not _margin_reaches(cfg, p, n, f, dz):
                 break
             margins[f] = dz
             steps.append(f"{method}: full-order loop unstable at {check['mode_hz']:.4g} Hz "
@@ -942,6 +941,17 @@ def _top_mode_hz(cfg, p: float, n: int) -> float:
 
     lam = np.abs(poles_near_zero(build_system(cfg, pressure_bar=p), count=n).poles)
     return float(lam[min(n, lam.size) - 1] / (2 * np.pi))
+
+
+def _margin_reaches(cfg, p: float, n: int, f_hz: float, dz: float) -> bool:
+    """Whether a damping margin ``(f_hz, dz)`` lowers a lightly damped mode of the n-state
+    design model at pressure ``p`` (bar): the plant the synthesis takes the margin on
+    (:func:`~ambseal.design.plant.generalized_plant`'s reduced model,
+    :func:`~ambseal.design.plant.less_damped`), not the full-order one, whose modes above
+    the design model's would answer yes for a margin that leaves the next design as it
+    was."""
+    model = build_plant(cfg, reduced=True, pressure_bar=p, states=n)
+    return less_damped(model, [(f_hz, dz)]) is not model
 
 
 def _states_to_keep(cfg, p: float, mode_hz: float) -> int:

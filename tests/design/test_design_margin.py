@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from ambseal.config import load_rig
-from ambseal.design.plant import less_damped
 from ambseal.design import design_spec
+from ambseal.design.plant import less_damped
 from ambseal.design.recipes import MARGIN_ZETA, _margin_reaches, design, margin_for
 from ambseal.errors import ModelError
 from ambseal.model import build_plant
@@ -132,8 +132,8 @@ def test_a_margin_is_asked_of_the_design_model_not_of_the_modes_it_leaves_out():
     design model the synthesis takes: the supercritical rotor's 24-state model keeps its
     modes up to 1.2 kHz, its full-order plant has more above. A margin at a full-order
     mode above the model's band reaches nothing the synthesis sees (the next design would
-    be the last one again), one at the model's highest mode does; the full-order plant
-    would have answered yes to both."""
+    be the last one again), one at the model's highest mode does; the full-order plant,
+    which has the first mode, would answer yes to it."""
     cfg = load_rig(SUPERCRITICAL)
     sp = design_spec(cfg)
     p, n = cfg.operating.pressure_bar, sp.model_states

@@ -403,9 +403,8 @@ def solve_lmis(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
     SynthesisError
         As :func:`gamma_stage` and :attr:`GammaStage.centre`.
     """
-    st = gamma_stage(sc, blocks, grid, lyapunov, nu_s, centre=centre, **kw)
-    R, S, more = st.centre() if centre else (st.R, st.S, [])
-    return st.gamma, st.gamma_d, R, S, st.reports + more, st.share
+    st = gamma_stage(sc, blocks, grid, lyapunov, nu_s, centre=centre, **kw).centred()
+    return st.gamma, st.gamma_d, st.R, st.S, st.reports, st.share
 
 
 @dataclass(frozen=True)
@@ -439,6 +438,15 @@ class GammaStage:
     reports: list
     share: float
     centre: Any
+
+    def centred(self) -> "GammaStage":
+        """This stage with its centring run: R and S the centred ones, the centring's
+        reports appended, no centring left; itself where it has none. Raises
+        :class:`~ambseal.errors.SynthesisError` as :attr:`centre`."""
+        if self.centre is None:
+            return self
+        R, S, more = self.centre()
+        return replace(self, R=R, S=S, reports=self.reports + more, centre=None)
 
 
 def gamma_stage(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,

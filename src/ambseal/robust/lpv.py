@@ -65,6 +65,7 @@ from ambseal.robust._lpv_lmi import (
     BASES,
     DEFAULT_TOL,
     PENALTY_SHARE,
+    GammaStage,
     LmiInfeasible,
     SOLVER_KEYS,
     SolverReport,
@@ -75,7 +76,6 @@ from ambseal.robust._lpv_lmi import (
     scale_grid,
     sdp_shortfall,
     sdp_status,
-    solve_lmis,
 )
 from ambseal.robust._lpv_frozen import frozen_reference, quadratic_gamma
 from ambseal.robust._lpv_reconstruct import interp_A, reconstruct_table
@@ -621,24 +621,12 @@ def _synthesise(data, scaling: str, **settings) -> LpvSynResult:
     return _Scaling.solve(data, scaling, **settings).result()
 
 
-class _Solved(NamedTuple):
-    """One scaling's SDP stages as :func:`~ambseal.robust._lpv_lmi.solve_lmis` returns
-    them (R and S centred where a centring was asked for)."""
-
-    gamma: float
-    gamma_d: float
-    R: list
-    S: list
-    reports: list
-    share: float
-
-
 class _Rebalanced(NamedTuple):
     """The rebalanced scaling and its stage 1 (its centring not yet run)."""
 
     sc: Any
     blocks: tuple
-    stage: Any  # GammaStage
+    stage: GammaStage
 
 
 @dataclass
@@ -662,7 +650,7 @@ class _Scaling:
     sc: Any
     blocks: tuple
     nu_s: float
-    first: _Solved
+    first: GammaStage  # centred where a centring was asked for
     rebalanced: _Rebalanced | None
 
     @classmethod
@@ -678,7 +666,7 @@ class _Scaling:
                       coupling_ratio=coupling_ratio, centre=centre,
                       solver_options=solver_options, lyapunov_r=lyapunov_r)
         blocks = lmi_blocks(sc, nw, nz, ncon, nmeas)
-        first = _Solved(*solve_lmis(sc, blocks, grid, lyapunov, nu_s, **lmi_kw))
+        first = gamma_stage(sc, blocks, grid, lyapunov, nu_s, **lmi_kw).centred()
         again = None
         if first.share > PENALTY_SHARE:  # γ held up by the trace term: R and S of one size
             sc2 = rebalanced(sc, first.R, first.S, grid, lyapunov, lyapunov_r)
@@ -720,21 +708,21 @@ class _Scaling:
     def result(self) -> LpvSynResult:
         """The kept solve's controller table, checked (runs the rebalanced scaling's
         centring where it is needed)."""
-        sc, blocks = self.sc, self.blocks
-        gamma, gamma_d, R, S, reports, share = self.first
+        sc, blocks, kept = self.sc, self.blocks, self.first
+        reports = kept.reports
         if self.rebalanced is not None and (self.rebalanced.stage.centre is None
                                             or self._may_win()):
             sc2, blocks2, st = self.rebalanced
             try:
-                R2, S2, more = st.centre() if st.centre is not None else (st.R, st.S, [])
+                st = st.centred()
             except SynthesisError:
-                R2 = None
-            if R2 is not None and (_short(st.reports + more), st.gamma) < (_short(reports),
-                                                                            gamma):
-                sc, blocks = sc2, blocks2
-                gamma, gamma_d, R, S, share = st.gamma, st.gamma_d, R2, S2, st.share
-                reports = [replace(r, used=False) for r in reports] + st.reports + more
-        return self._table(sc, blocks, gamma, gamma_d, R, S, list(reports), share)
+                st = None
+            if st is not None and (_short(st.reports), st.gamma) < (_short(reports),
+                                                                    kept.gamma):
+                sc, blocks, kept = sc2, blocks2, st
+                reports = [replace(r, used=False) for r in reports] + st.reports
+        return self._table(sc, blocks, kept.gamma, kept.gamma_d, kept.R, kept.S,
+                           list(reports), kept.share)
 
     def _table(self, sc, blocks, gamma, gamma_d, R, S, reports, share) -> LpvSynResult:
         plants, grid, As, dAs, B, C, D, nw, nz, nmeas, ncon = self.data

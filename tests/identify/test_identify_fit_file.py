@@ -75,10 +75,10 @@ def _call(args: list[str]) -> tuple[int, str]:
     return code, err.getvalue()
 
 
-def test_the_fit_read_as_written():
+def test_the_fit_read_as_written(tmp_path):
     """Reference: the fit's own intervals — the undamaged fit gives its two model
     parameters' ci95 (τ_e, whose interval failed, left out), unchanged."""
-    path = Path(tempfile.mkdtemp()) / "fit.json"
+    path = tmp_path / "fit.json"
     path.write_text(json.dumps(FIT))
     assert uncertainty_from_fit(path) == {"seal.k": (1.9e6, 2.5e6), "A.Ki_zeta": (98.8, 103.2)}
 
@@ -142,13 +142,15 @@ def test_a_damaged_fit_is_refused_naming_the_file_or_read_as_it_holds(doc):
     duplicated): the reader refuses it with a DataError naming the file, or returns, for
     each parameter but τ_e, exactly the fit's finite [low, high] with low < high — never
     another exception."""
-    path = Path(tempfile.mkdtemp()) / "fit.json"
-    path.write_text(json.dumps(doc))  # NaN and Infinity as Python's json writes them
-    try:
-        got = uncertainty_from_fit(path)
-    except DataError as exc:
-        assert str(exc).startswith(f"{path}: "), exc
-        return
+    # a folder per example, removed with it: hypothesis runs hundreds
+    with tempfile.TemporaryDirectory(prefix="ambseal-test-") as folder:
+        path = Path(folder) / "fit.json"
+        path.write_text(json.dumps(doc))  # NaN and Infinity as Python's json writes them
+        try:
+            got = uncertainty_from_fit(path)
+        except DataError as exc:
+            assert str(exc).startswith(f"{path}: "), exc
+            return
     params = doc["parameters"]
     assert list(got) == [n for n in params if n != "tau_e"]
     for n, (lo, hi) in got.items():

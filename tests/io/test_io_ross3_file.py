@@ -240,24 +240,27 @@ def test_the_ross3_reader_refuses_or_accounts_for_every_element(data):
     from ambseal.io.ross import _check_file, from_ross
     from ambseal.io.ross_file import read_ross3_file
 
-    src = Path(tempfile.mkdtemp()) / "damaged.json"
-    src.write_text(json.dumps(data))
-    try:
-        rotor = read_ross3_file(src, _check_file(src))
-        imp = from_ross(rotor, where=str(src))
-    except ConfigError as exc:
-        assert str(src) in str(exc) or "damaged" in str(exc), exc
-        return
-    elements = [k for k, v in data.items() if k != "parameters" and isinstance(v, dict)]
-    kinds = [k.split("_")[0] for k in elements]
-    rig = imp.rig
-    masses = kinds.count("PointMass")  # a disk on the shaft, or a housing's mass
-    assert len(rig.shaft) == kinds.count("ShaftElement")
-    assert kinds.count("DiskElement") <= len(rig.disk) <= kinds.count("DiskElement") + masses
-    supports = sum(k == "BearingElement" or k.endswith("Seal") for k in kinds)
-    assert len(rig.spring) + len(rig.seal) + len(rig.amb) == supports
-    assert len(elements) == (kinds.count("ShaftElement") + kinds.count("DiskElement")
-                             + masses + supports)
+    # a folder per example, removed with it: hypothesis runs hundreds
+    with tempfile.TemporaryDirectory(prefix="ambseal-test-") as folder:
+        src = Path(folder) / "damaged.json"
+        src.write_text(json.dumps(data))
+        try:
+            rotor = read_ross3_file(src, _check_file(src))
+            imp = from_ross(rotor, where=str(src))
+        except ConfigError as exc:
+            assert str(src) in str(exc) or "damaged" in str(exc), exc
+            return
+        elements = [k for k, v in data.items() if k != "parameters" and isinstance(v, dict)]
+        kinds = [k.split("_")[0] for k in elements]
+        rig = imp.rig
+        masses = kinds.count("PointMass")  # a disk on the shaft, or a housing's mass
+        assert len(rig.shaft) == kinds.count("ShaftElement")
+        disks = kinds.count("DiskElement")
+        assert disks <= len(rig.disk) <= disks + masses
+        supports = sum(k == "BearingElement" or k.endswith("Seal") for k in kinds)
+        assert len(rig.spring) + len(rig.seal) + len(rig.amb) == supports
+        assert len(elements) == (kinds.count("ShaftElement") + kinds.count("DiskElement")
+                                 + masses + supports)
 
 
 #: Level I's references (``make.py``): the test's stage giving ROSS's Q_A, and where Q

@@ -91,9 +91,10 @@ Example
 >>> t = np.arange(100) / 1000.0
 >>> z = np.zeros((100, 1))
 >>> m = Measurement(t, z, z, z, z, ("A_zeta",), {"rig": "demo"})
->>> p = pathlib.Path(tempfile.mkdtemp()) / "run.csv"
->>> _ = save_measurement(m, p)
->>> load_measurement(p, axes=("A_zeta",)).metadata["sample_rate_hz"]
+>>> with tempfile.TemporaryDirectory() as folder:
+...     p = pathlib.Path(folder) / "run.csv"
+...     _ = save_measurement(m, p)
+...     load_measurement(p, axes=("A_zeta",)).metadata["sample_rate_hz"]
 1000.0
 """
 

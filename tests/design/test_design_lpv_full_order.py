@@ -64,15 +64,19 @@ def test_the_lpv_on_speed_holds_the_blower_from_standstill_to_its_top_speed():
     pressure and stability speed of ``examples/blower.toml`` (0–600 Hz, where the
     gyroscopic moments split the first bending mode at ~930 Hz): the LPV controller
     scheduled on speed over standstill to 600 Hz holds the rotor at every condition — as
-    the main job delivers it where a frozen design loses it."""
+    the main job delivers it where a frozen design loses it. ``design_lpv``'s defaults are
+    that job's schedule (:func:`~ambseal.design.lpv_design.lpv_schedule`), not the
+    rig's ``speed_range_hz`` of 100–600 Hz on the rigid-body modes alone."""
     from ambseal.config import load_rig
     from ambseal.design.lpv_design import design_lpv
 
     cfg = load_rig(Path(__file__).resolve().parents[2] / "examples" / "blower.toml")
     sp = design_spec(cfg)
     conds = [(p, f) for p in sp.pressures_bar for f in sp.stability_speeds_hz]
-    lpv = design_lpv(cfg, speeds_hz=(0.0, 600.0), states=sp.model_states,
-                     allow_unstable=True, spec=sp)
+    lpv = design_lpv(cfg, allow_unstable=True, spec=sp)
+    assert (lpv.speeds_hz[0], lpv.speeds_hz[-1]) == (0.0, 600.0)
+    mechanical = [n for n in lpv.plant.state_names if not n.startswith("act_")]
+    assert len(mechanical) == sp.model_states == 24  # the actuators' states besides
     assert lpv.full_order["stable"]
     assert all(_max_real_pole(cfg, lpv.controller_at(f), p, f) < 0 for p, f in conds)
 

@@ -415,7 +415,7 @@ def _delay(cfg, spec: DesignSpec):
 
 def design_lpv(cfg, *, speeds_hz=None, n_grid: int | None = None,
                rate_bound_hz_per_s: float | None = None, lyapunov: str | None = None,
-               weights: Weights | None = None, states: int = 8,
+               weights: Weights | None = None, states: int | None = None,
                frozen_gamma: bool = True, allow_unstable: bool = False,
                spec: DesignSpec | None = None, **lpvsyn_kw) -> LpvDesign:
     """Speed-scheduled H∞ LPV controller for a rig (thesis P3 §4).
@@ -424,9 +424,11 @@ def design_lpv(cfg, *, speeds_hz=None, n_grid: int | None = None,
     ----------
     cfg : ambseal.config.RigConfig
         The rig (the turboexpander: ``examples/turboexpander.toml``).
-    speeds_hz : (float, float)
-        Operating speed range (Hz), P3 §4: 20–300 Hz. (Not yet a config key; a future
-        ``[operating] speed_range_hz`` would feed it.)
+    speeds_hz : (float, float), optional
+        Speed range (Hz) to schedule on. Default: :func:`lpv_schedule`'s, the one
+        ``ambseal run`` and ``ambseal design --method lpv`` use (``[operating]
+        speed_range_hz`` on a rig whose seals follow the speed, as the turboexpander's
+        20–300 Hz of P3 §4; else standstill to the top speed).
     n_grid : int, optional
         Design grid points, equally spaced over the range (≥ 2). Default: with a constant
         Lyapunov function the vertex grid (:func:`ambseal.design.lpv_plant.vertex_grid_hz`:
@@ -448,9 +450,10 @@ def design_lpv(cfg, *, speeds_hz=None, n_grid: int | None = None,
     weights : Weights, optional
         The rig's ``[design.lpv]`` weights completed by the specification's rules if
         omitted (module docstring).
-    states : int
+    states : int, optional
         Mechanical states of the design model (8: rigid body; 12 adds the first bending
-        pair).
+        pair). Default: :func:`lpv_schedule`'s (:data:`LPV_SEAL_STATES` where the seals
+        follow the speed, else the specification's ``model_states``).
     frozen_gamma : bool
         Also compute the frozen-point H∞ γ at each grid speed (a lower bound of the LPV γ).
     allow_unstable : bool
@@ -468,6 +471,9 @@ def design_lpv(cfg, *, speeds_hz=None, n_grid: int | None = None,
 
     Raises
     ------
+    ConfigError
+        Neither range nor states given and the rig runs at standstill
+        (:func:`lpv_schedule`).
     SynthesisError
         From :func:`lpvsyn`: one grid point, a rate bound with a constant Lyapunov
         function, infeasible LMIs, an inaccurate solver status, an unstable frozen loop;
@@ -485,11 +491,10 @@ def design_lpv(cfg, *, speeds_hz=None, n_grid: int | None = None,
     t0 = time.perf_counter()
     sp = spec or design_spec(cfg)
     w = weights or sp.weights["lpv"]
-    if speeds_hz is None:
-        if cfg.operating.speed_range_hz is None:
-            raise ConfigError("design_lpv: no speed range to schedule on: set [operating] "
-                              "speed_range_hz or pass speeds_hz")
-        speeds_hz = cfg.operating.speed_range_hz
+    if speeds_hz is None or states is None:  # the run's rule, not one of its own
+        rule_speeds, rule_states, _ = lpv_schedule(cfg, sp)
+        speeds_hz = rule_speeds if speeds_hz is None else speeds_hz
+        states = rule_states if states is None else states
     lo, hi = (float(x) for x in speeds_hz)
     if lyapunov is None:
         lyapunov = "constant" if rate_bound_hz_per_s is None else "affine"

@@ -514,3 +514,7 @@ def test_a_notch_that_holds_but_leaves_the_amplifier_saturated_says_so():
         "response")
     lost = _Notch(n.rejection, [], ["0 bar, 191 Hz"], {}, None)
     assert _why_not_notched(lost).endswith("loses the loop at 0 bar, 191 Hz")
+    # conditions hold commas themselves: two are told apart by "; "
+    two = _Notch(n.rejection, [], ["0 bar, 305.185 Hz", "0 bar, 295.987 Hz"], {}, None)
+    assert _why_not_notched(two).endswith(
+        "loses the loop at 0 bar, 305.185 Hz; 0 bar, 295.987 Hz")

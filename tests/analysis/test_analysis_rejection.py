@@ -95,3 +95,25 @@ def test_facility_speed_step_keeps_the_synchronous_current_out(turbo_cfg, turbo_
         assert np.all(q["with"][after] < 1e-2 * q["without"][after])
     const = facility_rejection(turbo_cfg, turbo_hinf_digital, rejection, 300.0)
     assert step.current_a["without"][-1] == pytest.approx(const.before_a, rel=1e-2)
+
+
+def _row(label, p, f, stable, as_runs):
+    return {"condition": label, "pressure_bar": p, "speed_hz": f, "stable": stable,
+            "stable_as_runs": as_runs}
+
+
+#: The rows of a rig judged at one speed (305.185 Hz): its judged point labelled by
+#: pressure alone, its stability speeds by pressure and speed
+LOST_ROWS = [_row("0 bar", 0.0, 305.185, False, False),
+             _row("0 bar, 98.66 Hz", 0.0, 98.66, True, True),
+             _row("0 bar, 295.987 Hz", 0.0, 295.987, True, False),
+             _row("2 bar, 120 Hz", 2.0, 120.0, True, None),
+             _row("0 bar, 295.987 Hz", 0.0, 295.987, False, None)]
+
+
+def test_a_lost_condition_is_named_by_its_pressure_and_speed_whatever_its_label():
+    """The lost ones of those rows, joined, had read "0 bar, 0 bar, 295.987 Hz": each is
+    named by its own pressure and speed, once, in the rows' order."""
+    from ambseal.analysis.rejection import lost_conditions
+
+    assert lost_conditions(LOST_ROWS) == ["0 bar, 305.185 Hz", "0 bar, 295.987 Hz"]

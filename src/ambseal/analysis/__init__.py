@@ -89,6 +89,7 @@ _FROM = {
     "used_by_speed": "amplifier", "switch_on_hz": "amplifier",
     "later_switch_on_hz": "amplifier",
     "rejection_effect": "rejection", "rejection_stability": "rejection",
+    "lost_conditions": "rejection",
     "facility_rejection": "rejection", "FacilityRejection": "rejection",
     "facility_speed_step": "rejection", "SpeedStep": "rejection",
     "closed_loop_modes": "campbell", "log_decrement": "campbell", "modes_as_run": "campbell",

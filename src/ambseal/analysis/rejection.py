@@ -47,9 +47,9 @@ from ambseal.machine import controller_as_runs, judged_loop
 from ambseal.model import build_plant
 from ambseal.robust import DiscreteController, loop_delay
 
-__all__ = ["rejection_stability", "rejection_effect", "facility_rejection",
-           "FacilityRejection", "facility_speed_step", "SpeedStep", "EFFECT_SPEEDS",
-           "RUNOUT_FRACTION", "RUNOUT_M"]
+__all__ = ["rejection_stability", "lost_conditions", "rejection_effect",
+           "facility_rejection", "FacilityRejection", "facility_speed_step", "SpeedStep",
+           "EFFECT_SPEEDS", "RUNOUT_FRACTION", "RUNOUT_M"]
 
 #: Speeds of the synchronous response over the speed range.
 EFFECT_SPEEDS = 61
@@ -106,6 +106,32 @@ def rejection_stability(cfg, rejection, points) -> list[dict]:
             row.update(stable_as_runs=bool(runs.stable),
                        max_abs_pole_z=float(np.abs(runs.poles).max()))
         out.append(row)
+    return out
+
+
+def lost_conditions(rows) -> list[str]:
+    """The conditions of :func:`rejection_stability`'s ``rows`` where a loop with the notch
+    is lost (continuous, or as it runs), each named by its pressure drop and speed —
+    ``"0 bar, 295.987 Hz"`` — whatever the label its point came with: the judged points
+    of a rig at one speed leave the speed out of their labels (``"0 bar"``), and beside
+    the stability speeds' such a list would not say which speed was lost. In the rows'
+    order, each once. Join them with ``"; "``: a condition holds a comma itself.
+
+    Parameters
+    ----------
+    rows : list of dict
+        :func:`rejection_stability`'s rows.
+
+    Returns
+    -------
+    list of str
+    """
+    out = []
+    for r in rows:
+        if not r["stable"] or r["stable_as_runs"] is False:
+            words = f"{r['pressure_bar']:g} bar, {r['speed_hz']:g} Hz"
+            if words not in out:
+                out.append(words)
     return out
 
 

@@ -33,6 +33,7 @@ from ambseal.analysis import (
     judge_spinup,
     later_switch_on_hz,
     loop_failure,
+    lost_conditions,
     notched_currents,
     notched_orbit_um,
     operating_points,
@@ -629,7 +630,7 @@ def _why_not_notched(n: _Notch) -> str:
     response, neither of which a notch at the rotational frequency reaches)."""
     head = NOTCH_HEAD
     if n.lost:
-        return head + f"loses the loop at {', '.join(n.lost)}"
+        return head + f"loses the loop at {'; '.join(n.lost)}"
     if n.beyond is None:
         return (head + "holds, but the amplifier saturates with it on as well: below "
                 f"{n.on_hz:.4g} Hz, where it is off, or in the impulse response")
@@ -669,8 +670,7 @@ def _notches(st: _RunState, methods=None, starts=None, used=None) -> dict[str, _
                 {} if on is None else {"speeds_hz": (on, st.cfg.operating.continuous_hz[1])}))
             rows = rejection_stability(st.judge_cfg, rej, [j.point for j in st.jobs
                                                            if j.name == d.method] + speeds)
-            lost = [x["condition"] for x in rows
-                    if not x["stable"] or x["stable_as_runs"] is False]
+            lost = lost_conditions(rows)
             effect = rejection_effect(st.judge_cfg, g, rej, st.settings)
             beyond = clearance_exceeded(float(np.max(effect["orbit_um"]["with"])), clearances)
             return _Notch(rej, rows, lost, effect, beyond)
@@ -718,7 +718,7 @@ def _rejections(st: _RunState, summaries: dict, notches: dict[str, _Notch]) -> d
                 "why": _why_not_notched(n.first).removeprefix(NOTCH_HEAD)}}
         delivered = summaries[m].get("discretisation") is not None
         if lost:  # said, not delivered
-            st.say(f"{m}: its unbalance force rejection loses the loop at {', '.join(lost)}")
+            st.say(f"{m}: its unbalance force rejection loses the loop at {'; '.join(lost)}")
         elif beyond is not None:
             st.say(f"{m}: with its unbalance force rejection the orbit, {orbit:.3g} µm, "
                    f"exceeds {CLEARANCE_WORDS.get(beyond[0], beyond[0])} ({beyond[1]:.3g} µm):"

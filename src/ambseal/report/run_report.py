@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ambseal import __version__
-from ambseal.analysis import force_demand, worst_zone
+from ambseal.analysis import force_demand, lost_conditions, worst_zone
 from ambseal.config import method_label
 from ambseal.identify import MIN_FIT_PCT, fit_reliability, interval_check, true_line
 from ambseal.lti.freqresp import freqresp
@@ -780,9 +780,8 @@ def _rejection_section(metrics: dict) -> list[dict]:
     def held(r: dict) -> str:
         if r["stable"]:
             return f"yes, at {len(r['conditions'])} conditions"
-        lost = [c["condition"] for c in r["conditions"]
-                if not c["stable"] or c["stable_as_runs"] is False]
-        return "<b>no</b>: loses the loop at " + html.escape(", ".join(lost))
+        return "<b>no</b>: loses the loop at " + html.escape(
+            "; ".join(lost_conditions(r["conditions"])))
 
     body = "".join(
         f"<tr><td>{html.escape(method_label(m))}</td><td>{sig(r['on_from_hz'])} Hz</td>"

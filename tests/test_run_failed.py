@@ -99,6 +99,27 @@ def test_a_loop_lost_only_to_the_delays_pade_approximation_says_so():
     assert "fails — the full-order loop is unstable at 0 bar (mode at 1323 Hz" in g.reason
 
 
+
+def test_a_point_judged_at_one_speed_is_named_with_its_speed_beside_the_speed_range():
+    """A rig judged in full at one speed (305.185 Hz) labels that point by its pressure
+    alone; where the run also judges the speed range, its failure had read "unstable at
+    0 bar (…); … unstable at 0 bar, 0 Hz", not saying at which speed the first was lost.
+    With ``speed_in_labels`` the line names it "0 bar, 305.185 Hz", a label that already
+    has its speed stays as it is, and the failure's conditions keep the cases' labels."""
+    w = 2 * math.pi * 557.0
+    bad = {"poles": np.array([0.7 + 1j * w, 0.7 - 1j * w])}
+    judged = StabilityCase("hinf", "0 bar", 0.0, 305.185, False, 0.7, None)
+    ranged = StabilityCase("hinf", "0 bar, 98.66 Hz", 0.0, 98.66, False, 0.7, None)
+    f = loop_failure("hinf", [(judged, bad), (ranged, bad)], designed=True,
+                     speed_in_labels=True)
+    assert f.reason.startswith("H∞: not delivered — the full-order loop is unstable at "
+                               "0 bar, 305.185 Hz (mode at 557 Hz")
+    assert "and 0 bar, 98.66 Hz (mode at 557 Hz" in f.reason
+    assert f.conditions == ["0 bar", "0 bar, 98.66 Hz"]
+    alone = loop_failure("hinf", [(judged, bad)], designed=True)
+    assert alone.reason.startswith("H∞: not delivered — the full-order loop is unstable at "
+                                   "0 bar (mode")
+
 def test_many_unstable_conditions_are_listed_with_the_least_stable_mode():
     """Beyond four unstable conditions the line lists them and names the mode of the one
     with the rightmost pole (σ = 2 of 0.1–2 here: a 50 Hz pair, ζ = −2/|λ|, closed form)."""

@@ -116,7 +116,7 @@ def _listed(found: list[tuple], kind=None) -> str:
 
 def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
                  kept: bool = False, derived: bool = False,
-                 kind_of=None) -> FailedController | None:
+                 kind_of=None, speed_in_labels: bool = False) -> FailedController | None:
     """The failure of one controller from its judged cases, or None when every judged
     loop (continuous and, where judged, discrete) is stable.
 
@@ -142,6 +142,12 @@ def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
         ``kind_of(case, pole) → str or None``: the kind of the mode of ``pole`` (rad/s) at
         that case's condition (:func:`ambseal.analysis.mode_naming.failing_mode_kind`),
         asked only for the modes the line names.
+    speed_in_labels : bool
+        In the line, name each condition whose label leaves its speed out by pressure drop
+        and speed (``"0 bar, 305.185 Hz"``, as the stability speeds are named): a rig
+        judged in full at one speed labels those points by pressure alone, and where the
+        run judges other speeds as well, "unstable at 0 bar" would not say at which. The
+        failure's ``conditions`` keep the cases' labels.
 
     Returns
     -------
@@ -151,20 +157,22 @@ def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
     cont, pade_only, disc_parts, where = [], [], [], []
     for case, curves in judged:
         label = case.label or f"{case.pressure_bar:g} bar"
+        said = (f"{case.pressure_bar:g} bar, {case.speed_hz:g} Hz"
+                if speed_in_labels and not label.endswith(" Hz") else label)
         if not case.stable:
             z = _least_stable(curves.get('poles', ()))
             # the delay's Padé approximation can lose a mode the loop as it runs keeps:
             # still a failure (a margin of nothing), said as what it is
             held = case.discrete is not None and case.discrete.stable
             (pade_only if held else cont).append(
-                (label, _mode_text(z), case.max_real_pole, case, z))
+                (said, _mode_text(z), case.max_real_pole, case, z))
             where.append(label)
             continue
         disc = case.discrete
         if disc is not None and not disc.stable:
             z = _least_stable((curves.get("discrete") or {}).get("poles", ()),
                               1.0 / disc.sample_rate_hz)
-            disc_parts.append((label, f"{_mode_text(z)}, max |z| = {disc.max_abs_pole_z:.5f}",
+            disc_parts.append((said, f"{_mode_text(z)}, max |z| = {disc.max_abs_pole_z:.5f}",
                                disc.max_abs_pole_z, case, z))
             where.append(label)
     parts = ([f"the full-order loop is unstable at {_listed(cont, kind_of)}"] if cont else []

@@ -507,11 +507,14 @@ def _judge_stage(st: _RunState) -> None:
     remedies`), the remedied design replacing it."""
     st.stages.begin("judge")
     st.jobs, st.judged = _judge_designs(st, st.designs, st.digitals)
+    # where the speed range is judged as well, a failure names the speed of every condition
+    with_speed = bool(stability_points(st.spec.pressures_bar, st.spec.stability_speeds_hz,
+                                       st.points))
     for d in st.designs:
         f = loop_failure(d.method, _judged_of(d.method, st.jobs, st.judged),
                          designed=d.method != "pid", kept=st.allow_unstable,
                          derived=st.cfg.controller.pid is None,
-                         kind_of=kind_of(st.cfg, d.controller))
+                         kind_of=kind_of(st.cfg, d.controller), speed_in_labels=with_speed)
         if f is not None:
             st.failed[d.method] = f
     if speed_scheduled(st.cfg):

@@ -122,6 +122,12 @@ def test_verdict_holds_only_where_the_machine_runs_up_too():
     # lost at its judged condition too: "none" of those, and the speed range still counted
     lost = verdicts([dict(case, stable=False)], None, st)[0]
     assert lost.stable_range == "none; unstable at 2 of 3 speed-range conditions"
+    # its judged condition named with its speed beside the speed range's (at 140 Hz here):
+    # "unstable at 2.04 bar; 2.04 bar, 0 Hz" would not say where the first was lost
+    at_speed = verdicts([dict(case, stable=False, speed_hz=140.0)], None, st)[0]
+    assert at_speed.unstable_at == ("2.04 bar, 140 Hz",)
+    assert at_speed.words().startswith("Not acceptable: the loop is unstable at 2.04 bar, "
+                                       "140 Hz; 2.04 bar, 0 Hz; 2.04 bar, 50 Hz (where")
     # lost at its judged condition only: not "none" alone, the range that holds named
     held = verdicts([dict(case, stable=False)], None, st[2:])[0]
     assert held.stable_range == ("none; stable at the 1 speed-range condition "

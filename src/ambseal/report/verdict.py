@@ -80,7 +80,9 @@ class Verdict:
     ----------
     controller : str
     conditions, stable_at, unstable_at : tuple of str
-        Judged conditions (``"2.04 bar"`` or ``"140 Hz"``), those with a stable loop, the rest.
+        Judged conditions (``"2.04 bar"`` or ``"140 Hz"``), those with a stable loop, the
+        rest (named with their speed, ``"0 bar, 1000 Hz"``, where the speed range was
+        judged too and the judged conditions share one speed: beside ``speed_unstable``).
     zone_axis, zone_sigma : str or None
         Worst per-axis ISO 14839-3 zone (unstable → D), and the zone of σ̄(S_o), over
         every graded loop: the judged conditions, continuous and as it runs, and the
@@ -423,7 +425,9 @@ def _verdict(name: str, cs: list, by_speed: bool, sc: list,
     return Verdict(
         controller=name, conditions=tuple(label),
         stable_at=tuple(lb for lb, c in zip(label, cs) if c.get("stable")),
-        unstable_at=tuple(lb for lb, c in zip(label, cs) if not c.get("stable")),
+        # beside the speed range's conditions a judged one is named with its speed too
+        unstable_at=tuple(lb if by_speed or not sc else f"{lb}, {c['speed_hz']:g} Hz"
+                          for lb, c in zip(label, cs) if not c.get("stable")),
         zone_axis=worst_zone(axis_zones),
         zone_sigma=worst_zone([c.get("iso_zone") for c in [*cs, *loops[len(ok):]]] + lost),
         sigma_peak=peak("sensitivity_peak", loops),

@@ -144,9 +144,9 @@ def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
         asked only for the modes the line names.
     speed_in_labels : bool
         In the line, name each condition whose label leaves its speed out by pressure drop
-        and speed (``"0 bar, 305.185 Hz"``, as the stability speeds are named): a rig
+        and speed (``"<p> bar, <f> Hz"``, as the stability speeds are named): a rig
         judged in full at one speed labels those points by pressure alone, and where the
-        run judges other speeds as well, "unstable at 0 bar" would not say at which. The
+        run judges other speeds as well, "unstable at <p> bar" would not say at which. The
         failure's ``conditions`` keep the cases' labels.
 
     Returns

@@ -112,8 +112,8 @@ def rejection_stability(cfg, rejection, points) -> list[dict]:
 def lost_conditions(rows) -> list[str]:
     """The conditions of :func:`rejection_stability`'s ``rows`` where a loop with the notch
     is lost (continuous, or as it runs), each named by its pressure drop and speed —
-    ``"0 bar, 295.987 Hz"`` — whatever the label its point came with: the judged points
-    of a rig at one speed leave the speed out of their labels (``"0 bar"``), and beside
+    ``"<p> bar, <f> Hz"`` — whatever the label its point came with: the judged points
+    of a rig at one speed leave the speed out of their labels (``"<p> bar"``), and beside
     the stability speeds' such a list would not say which speed was lost. In the rows'
     order, each once. Join them with ``"; "``: a condition holds a comma itself.
 

@@ -427,8 +427,8 @@ def design_lpv(cfg, *, speeds_hz=None, n_grid: int | None = None,
     speeds_hz : (float, float), optional
         Speed range (Hz) to schedule on. Default: :func:`lpv_schedule`'s, the one
         ``ambseal run`` and ``ambseal design --method lpv`` use (``[operating]
-        speed_range_hz`` on a rig whose seals follow the speed, as the turboexpander's
-        20–300 Hz of P3 §4; else standstill to the top speed).
+        speed_range_hz`` on a rig whose seals follow the speed, as in P3 §4; else
+        standstill to the top speed).
     n_grid : int, optional
         Design grid points, equally spaced over the range (≥ 2). Default: with a constant
         Lyapunov function the vertex grid (:func:`ambseal.design.lpv_plant.vertex_grid_hz`:

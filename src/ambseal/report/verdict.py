@@ -80,9 +80,10 @@ class Verdict:
     ----------
     controller : str
     conditions, stable_at, unstable_at : tuple of str
-        Judged conditions (``"2.04 bar"`` or ``"140 Hz"``), those with a stable loop, the
-        rest (named with their speed, ``"0 bar, 1000 Hz"``, where the speed range was
-        judged too and the judged conditions share one speed: beside ``speed_unstable``).
+        Judged conditions (``"<p> bar"``, or ``"<f> Hz"`` where they differ in speed),
+        those with a stable loop, the rest (named ``"<p> bar, <f> Hz"`` where the speed
+        range was judged too and the judged conditions share one speed: beside
+        ``speed_unstable``).
     zone_axis, zone_sigma : str or None
         Worst per-axis ISO 14839-3 zone (unstable → D), and the zone of σ̄(S_o), over
         every graded loop: the judged conditions, continuous and as it runs, and the

@@ -86,3 +86,55 @@ def test_a_remedy_at_zero_pressure_keeps_the_seal_uncertainty_it_was_given(monke
     assert len(given) == 2 and "zero width" not in f.reason
     assert given[0]["seal.k"] == pytest.approx((0.0, 2 * 1.1e6 * 2.04), rel=1e-12)
     assert f.reason.count("the design failed: stop here") == 2
+
+
+def test_a_remedy_beside_the_speed_range_names_each_condition_by_its_speed(monkeypatch):
+    """A rig judged at its operating point (labelled by its pressure drop alone, "0 bar",
+    at the operating speed) and over the speed range ("0 bar, 0 Hz", …): a remedy whose
+    design still loses the loop at the operating point and at standstill says so as
+    "0 bar, <f0> Hz; 0 bar, 0 Hz", not "0 bar, 0 bar, 0 Hz", and its first attempt is
+    named by the pressure it is designed at (0 bar), not by standstill, the speed of the
+    worst condition, at which it is not designed. Without the speed range the words are
+    the cases' labels."""
+    import ambseal.app.remedies as rem
+
+    cfg = load_rig()
+    spec = design_spec(cfg)
+    f0 = cfg.operating.speed_rpm / 60.0
+    at_point = StabilityCase("hinf", "0 bar", 0.0, f0, False, 1.0)
+    standstill = StabilityCase("hinf", "0 bar, 0 Hz", 0.0, 0.0, False, 2.0)
+    held = StabilityCase("hinf", "0 bar, 100 Hz", 0.0, 100.0, True, -5.0)
+    cases = [at_point, standstill, held]
+
+    class Result:
+        method = "hinf"
+
+        def summary(self):
+            return {"pressure_bar": 0.0}
+
+    designed_at = []
+
+    def fake_design(cfg_, method, *, pressure_bar, **kw):
+        designed_at.append(pressure_bar)
+        return Result()
+
+    monkeypatch.setattr(rem, "design", fake_design)
+    monkeypatch.setattr(rem, "digitals_for", lambda c, ds, pts: ({"hinf": object()}, {}))
+
+    def judge(designs, digitals):
+        return [None] * len(cases), [(c, {}) for c in cases]
+
+    failure = FailedController("H∞: not delivered — ...", True, True,
+                               ["0 bar", "0 bar, 0 Hz"])
+    words = {}
+    for with_speed in (True, False):
+        _, f = remedy("hinf", failure, cases, cfg, spec, [], judge, lambda line: None,
+                      speed_in_labels=with_speed)
+        words[with_speed] = f.reason.split(". Tried: ")[1]
+    assert designed_at == [0.0] * 4
+    assert words[True].startswith(
+        f"designed at 0 bar (still unstable at 0 bar, {f0:g} Hz; 0 bar, 0 Hz); designed "
+        f"there with ω_B × {rem.OMEGA_B_FACTOR:g} (")
+    assert words[True].count(f"(still unstable at 0 bar, {f0:g} Hz; 0 bar, 0 Hz)") == 2
+    assert words[False].startswith("designed at 0 bar (still unstable at 0 bar; 0 bar, "
+                                   "0 Hz)")

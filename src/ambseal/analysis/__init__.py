@@ -9,7 +9,8 @@ sampled with its delay) on the full-order plant:
   job's cases (:func:`judge_jobs`, :func:`points_for`, :func:`frozen_at`,
   :func:`speed_scheduled`, :func:`judge_spinup`, :func:`unstable_open_loop_poles`) and its
   verdict on a controller that failed (:class:`FailedController`,
-  :func:`synthesis_failure`, :func:`loop_failure`, :func:`also_failed`; an unbalance orbit
+  :func:`synthesis_failure`, :func:`loop_failure`, :func:`also_failed`, its conditions
+  named by :func:`case_label`; an unbalance orbit
   beyond the rig's clearances, :func:`clearance_failure` on :func:`rig_clearances_um`;
   the failing mode named by its kind, :func:`failing_mode_kind`, :func:`mode_kind` on
   :func:`support_span_m`);
@@ -98,7 +99,7 @@ _FROM = {
     "OVERDAMPED_ZETA": "campbell", "AF_CRITICAL": "campbell", "dask_available": "cases",
     "probe_scheduler": "cases",
     "run_cases": "cases", "CaseError": "cases", "also_failed": "delivery",
-    "loop_failure": "delivery", "saturation_failure": "delivery",
+    "case_label": "delivery", "loop_failure": "delivery", "saturation_failure": "delivery",
     "synthesis_failure": "delivery", "rig_clearances_um": "delivery",
     "worst_orbit_um": "delivery", "notched_orbit_um": "delivery",
     "clearance_exceeded": "delivery",

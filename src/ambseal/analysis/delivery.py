@@ -27,7 +27,7 @@ from ambseal.analysis.amplifier import capacity_words, saturates
 from ambseal.config import method_label
 from ambseal.design import machine
 
-__all__ = ["FailedController", "loop_failure", "saturation_failure", "synthesis_failure",
+__all__ = ["FailedController", "case_label", "loop_failure", "saturation_failure", "synthesis_failure",
            "also_failed", "rig_clearances_um", "worst_orbit_um", "notched_orbit_um",
            "clearance_exceeded",
            "clearance_failure", "CLEARANCE_WORDS"]
@@ -114,6 +114,29 @@ def _listed(found: list[tuple], kind=None) -> str:
             f"(the least stable {worst[0]}: {mode(worst)})")
 
 
+def case_label(case, with_speed: bool = False) -> str:
+    """A judged case's condition in words: its label (its pressure drop where it has
+    none), or with ``with_speed`` its pressure drop and speed (``"<p> bar, <f> Hz"``, as
+    the stability speeds are labelled) where the label leaves the speed out.
+
+    Parameters
+    ----------
+    case : JudgedCase or StabilityCase
+        ``label``, ``pressure_bar`` and ``speed_hz``.
+    with_speed : bool
+        Name the speed too: where a run judges other speeds besides a point labelled by
+        its pressure alone, "<p> bar" would not say at which speed.
+
+    Returns
+    -------
+    str
+    """
+    label = case.label or f"{case.pressure_bar:g} bar"
+    if with_speed and not label.endswith(" Hz"):
+        return f"{case.pressure_bar:g} bar, {case.speed_hz:g} Hz"
+    return label
+
+
 def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
                  kept: bool = False, derived: bool = False,
                  kind_of=None, speed_in_labels: bool = False) -> FailedController | None:
@@ -156,9 +179,8 @@ def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
 
     cont, pade_only, disc_parts, where = [], [], [], []
     for case, curves in judged:
-        label = case.label or f"{case.pressure_bar:g} bar"
-        said = (f"{case.pressure_bar:g} bar, {case.speed_hz:g} Hz"
-                if speed_in_labels and not label.endswith(" Hz") else label)
+        label = case_label(case)
+        said = case_label(case, speed_in_labels)
         if not case.stable:
             z = _least_stable(curves.get('poles', ()))
             # the delay's Padé approximation can lose a mode the loop as it runs keeps:

@@ -524,7 +524,8 @@ def _judge_stage(st: _RunState) -> None:
         fixed, st.failed[m] = remedy(
             m, st.failed[m], [c for c, _ in _judged_of(m, st.jobs, st.judged)],
             st.design_cfg, st.spec, st.points,
-            lambda ds, digs: _judge_designs(st, ds, digs, 0), lambda s: st.say(s, 0))
+            lambda ds, digs: _judge_designs(st, ds, digs, 0), lambda s: st.say(s, 0),
+            speed_in_labels=with_speed)
         if fixed is not None:  # the remedied design replaces the failed one
             del st.failed[m]
             st.designs = [fixed.design if d.method == m else d for d in st.designs]

@@ -25,7 +25,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
-from ambseal.analysis import FailedController, JudgedCase, loop_failure
+from ambseal.analysis import FailedController, JudgedCase, case_label, loop_failure
 from ambseal.app.commands import Designed, digitals_for
 from ambseal.config import method_label, method_names
 from ambseal.design import design, uncertainty_at
@@ -86,8 +86,8 @@ def worst_case(cases: list[JudgedCase]) -> JudgedCase:
 
 
 def remedy(method: str, failure: FailedController, cases: list[JudgedCase], design_cfg, spec,
-           points, judge: Callable, say: Callable[[str], None]
-           ) -> tuple[Remedied | None, FailedController]:
+           points, judge: Callable, say: Callable[[str], None], *,
+           speed_in_labels: bool = False) -> tuple[Remedied | None, FailedController]:
     """Try the remedies of the module docstring for one failed design.
 
     Parameters
@@ -108,6 +108,10 @@ def remedy(method: str, failure: FailedController, cases: list[JudgedCase], desi
         (:func:`ambseal.analysis.judge.judge_jobs` and the cases' curves).
     say : callable
         Progress lines.
+    speed_in_labels : bool
+        The run judges the speed range besides points labelled by their pressure drop
+        alone: the words name each condition by pressure drop and speed
+        (:func:`~ambseal.analysis.delivery.case_label`).
 
     Returns
     -------
@@ -115,11 +119,19 @@ def remedy(method: str, failure: FailedController, cases: list[JudgedCase], desi
         The first design that holds and the original failure, or None and the failure with
         the remedies tried added to its reason.
     """
+    def named(conditions, judged_cases) -> str:
+        # each condition as the line names it; "; " since one named with its speed holds
+        # a comma itself
+        by_label = {case_label(c): case_label(c, speed_in_labels) for c in judged_cases}
+        return "; ".join(by_label.get(c, c) for c in conditions)
+
     worst = worst_case(cases)
     p = float(worst.pressure_bar)
     base = spec.weights[method]
     wider = replace(base, omega_b=base.omega_b * OMEGA_B_FACTOR)
-    attempts = [(f"designed at {worst.label or f'{p:g} bar'}", base),
+    # named by the pressure it is designed at: the worst condition's speed, where its
+    # label holds one, is not where it is designed
+    attempts = [(f"designed at {p:g} bar", base),
                 (f"designed there with ω_B × {OMEGA_B_FACTOR:g} ({wider.omega_b:.3g} rad/s)",
                  wider)]
     tried = []
@@ -139,7 +151,7 @@ def remedy(method: str, failure: FailedController, cases: list[JudgedCase], desi
             continue
         d = Designed(res, {**res.summary(), "remedy": (
             f"{label}: the design at the operating point lost the loop at "
-            f"{', '.join(failure.conditions)}")})
+            f"{named(failure.conditions, cases)}")})
         digitals, cannot = digitals_for(design_cfg, [d], points)
         if method not in digitals:
             tried.append(f"{label} (cannot run on the target: {cannot.get(method, '')})")
@@ -149,7 +161,8 @@ def remedy(method: str, failure: FailedController, cases: list[JudgedCase], desi
         if again is None:
             say(f"{method}: {label} holds at every judged condition")
             return Remedied(d, digitals[method], jobs, judged), failure
-        tried.append(f"{label} (still unstable at {', '.join(again.conditions)})")
+        tried.append(f"{label} (still unstable at "
+                     f"{named(again.conditions, [c for c, _ in judged])})")
     why = "; ".join(tried)
     return None, replace(failure, reason=f"{failure.reason}. Tried: {why}"
                          + ("" if method in method_names(robust=True) else

@@ -230,6 +230,7 @@ def test_a_critical_seen_at_two_probes_and_two_placements_is_counted_once():
     assert critical_speeds_hz([]) == []
 
 
+@pytest.mark.xdist_group("terminal_run")  # the session's run, made once on that worker
 def test_signoff_into_a_runs_folder_is_refused(terminal_run, tmp_path, capsys):
     """`ambseal run R --out D` then `ambseal signoff R --out D` replaced the run's
     level1.png and api617_unbalance.png by the sign-off's while metrics.json and

@@ -138,3 +138,10 @@ def test_a_remedy_beside_the_speed_range_names_each_condition_by_its_speed(monke
     assert words[True].count(f"(still unstable at 0 bar, {f0:g} Hz; 0 bar, 0 Hz)") == 2
     assert words[False].startswith("designed at 0 bar (still unstable at 0 bar; 0 bar, "
                                    "0 Hz)")
+    # a remedy that holds says where the first design lost the loop, named the same way
+    fixed, _ = remedy("hinf", failure, cases, cfg, spec, [],
+                      lambda ds, digs: ([None], [(held, {})]), lambda line: None,
+                      speed_in_labels=True)
+    assert fixed.design.summary["remedy"] == (
+        f"designed at 0 bar: the design at the operating point lost the loop at 0 bar, "
+        f"{f0:g} Hz; 0 bar, 0 Hz")

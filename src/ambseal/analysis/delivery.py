@@ -27,8 +27,8 @@ from ambseal.analysis.amplifier import capacity_words, saturates
 from ambseal.config import method_label
 from ambseal.design import machine
 
-__all__ = ["FailedController", "case_label", "loop_failure", "saturation_failure", "synthesis_failure",
-           "also_failed", "rig_clearances_um", "worst_orbit_um", "notched_orbit_um",
+__all__ = ["FailedController", "case_label", "loop_failure", "saturation_failure",
+           "synthesis_failure", "also_failed", "rig_clearances_um", "worst_orbit_um", "notched_orbit_um",
            "clearance_exceeded",
            "clearance_failure", "CLEARANCE_WORDS"]
 

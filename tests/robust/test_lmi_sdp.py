@@ -143,6 +143,44 @@ def test_schur_complement_is_its_definition(monkeypatch, rows):
     H = sdp._schur(lmis, lay)
     np.testing.assert_allclose(H, ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max())
     assert H.flags.f_contiguous
+    # on the matrices a pairing leaves invariant, x = E x̃: Eᵀ H E, whatever the LMIs
+    red = sdp._Reduced(lay, 3, sdp.StatePairing(np.array([0, 2]), np.array([1, 3]),
+                                                np.array([1.0, -1.0])))
+    E = np.stack([red.expand(e) for e in np.eye(red.size)], axis=1)
+    Hr = sdp._schur(lmis, lay, red)
+    np.testing.assert_allclose(Hr, E.T @ ref @ E, rtol=1e-12,
+                               atol=1e-12 * np.abs(ref).max())
+    assert Hr.flags.f_contiguous and Hr.shape == (1 + 3 * 4,) * 2  # (n/2)² per matrix
+
+
+def test_an_invariant_sdp_is_solved_on_its_invariant_matrices():
+    """Reference: the same SDP on all symmetric matrices. LMIs and cost invariant under
+    X ↦ TᵀXT for the pairing's T (orthogonal, T² = −I; A commuting with T): a Lyapunov
+    inequality, γI ⪰ X and Y ⪰ 2X, minimising γ + tr X + tr Y. The invariant unknowns,
+    (n/2)² per matrix against n(n+1)/2, give the same optimum, and every matrix of them
+    is invariant."""
+    rng = np.random.default_rng(0)
+    n = 8
+    pairing = sdp.StatePairing(np.arange(0, n, 2), np.arange(1, n, 2),
+                               np.array([1.0, -1.0, 1.0, -1.0]))
+    T = pairing.matrix(n)
+    np.testing.assert_array_equal(T.T @ T, np.eye(n))
+    np.testing.assert_array_equal(T @ T, -np.eye(n))
+    M = rng.standard_normal((n, n)) - 3 * np.eye(n)
+    A = 0.5 * (M + T.T @ M @ T)  # commutes with T
+    eye = np.eye(n)
+    lmis = [sdp.Lmi(-eye, None, (sdp.LmiTerm(0, eye, -A.T),)),
+            sdp.Lmi(np.zeros((n, n)), eye, (sdp.LmiTerm(0, eye, -0.5 * eye),)),
+            sdp.Lmi(np.zeros((n, n)), None, (sdp.LmiTerm(1, eye, 0.5 * eye),
+                                             sdp.LmiTerm(0, eye, -eye)))]
+    opts = {"abstol": 1e-9, "reltol": 1e-9, "feastol": 1e-9, "refinement": 2}
+    whole = sdp.solve_lmis(lmis, n, 2, 1.0, [1.0, 1.0], opts)
+    inv = sdp.solve_lmis(lmis, n, 2, 1.0, [1.0, 1.0], opts, pairing)
+    assert whole.status == inv.status == "optimal"
+    assert inv.gamma == pytest.approx(whole.gamma, rel=1e-9)
+    for Xw, Xi in zip(whole.X, inv.X):
+        np.testing.assert_allclose(Xi, Xw, rtol=1e-6, atol=1e-8 * np.abs(Xw).max())
+        np.testing.assert_allclose(T.T @ Xi @ T, Xi, rtol=0, atol=1e-12 * np.abs(Xi).max())
 
 
 def test_infeasible_lmis_are_reported():

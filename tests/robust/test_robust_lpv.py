@@ -670,10 +670,10 @@ def test_a_centring_sdp_ends_at_its_tolerance_and_a_short_one_is_named(monkeypat
     assert r.gamma_design == pytest.approx(1.05 * r.gamma, rel=1e-12)
     real_solve = sdp.solve_lmis
 
-    def centre_capped(lmis, n, n_vars, cost_gamma, cost_trace, options):
+    def centre_capped(lmis, n, n_vars, cost_gamma, cost_trace, options, pairing=None):
         if cost_gamma is None:  # the centring SDP: γ_d fixed
             options = {**options, "maxiters": 8}
-        return real_solve(lmis, n, n_vars, cost_gamma, cost_trace, options)
+        return real_solve(lmis, n, n_vars, cost_gamma, cost_trace, options, pairing)
 
     monkeypatch.setattr(sdp, "solve_lmis", centre_capped)
     capped = lpvsyn(plants, grid, 2, 2, frozen_check=False, centre=True, scaling="riccati")
@@ -712,8 +712,8 @@ def test_a_solve_that_stalls_short_of_its_tolerance_is_solved_again(monkeypatch)
     assert loose["feastol"] > first["feastol"] and third["refinement"] > first["refinement"]
 
     def stalls_under(stalling):
-        def solve(lmis, n, n_vars, cost_gamma, cost_trace, options):
-            sol = real_solve(lmis, n, n_vars, cost_gamma, cost_trace, options)
+        def solve(lmis, n, n_vars, cost_gamma, cost_trace, options, pairing=None):
+            sol = real_solve(lmis, n, n_vars, cost_gamma, cost_trace, options, pairing)
             seen.append(options)
             if sol.status == "optimal" and any(options == o for o in stalling):
                 return dataclasses.replace(sol, status="feasible")
@@ -840,3 +840,68 @@ def test_a_centring_that_cannot_change_the_delivered_controller_is_not_run(monke
     r, asked = delivered(result(0.9), low, certainly_short_or_held=False)
     assert (r, asked) == (low, 1)
     assert delivered(rebalanced, low, open=False) == (low, 1)
+
+
+def _two_axis_plants(speeds, k_eta: float = 1.0):
+    """A point mass on an unstable magnetic bearing in ζ and η (negative stiffness 1 in
+    ζ, ``k_eta`` in η) with a gyroscopic coupling Ω between its two velocities: inputs
+    a force disturbance and a sensor noise per axis, then the forces; outputs the
+    positions, the forces weighted by 0.1, then the measured positions. With ``k_eta``
+    1 a 90° turn maps it onto itself at every Ω."""
+    import control
+
+    names_in = ["d_zeta", "d_eta", "n_zeta", "n_eta", "u_zeta", "u_eta"]
+    names_out = ["zp_zeta", "zp_eta", "zu_zeta", "zu_eta", "y_zeta", "y_eta"]
+    Z, I2 = np.zeros((2, 2)), np.eye(2)
+    B = np.block([[Z, Z, Z], [I2, Z, I2]])
+    C = np.block([[I2, Z], [Z, Z], [I2, Z]])
+    D = np.block([[Z, Z, Z], [Z, Z, 0.1 * I2], [Z, 0.1 * I2, Z]])
+    out = []
+    for w in speeds:
+        A = np.block([[Z, I2], [np.diag([1.0, k_eta]), np.array([[0.0, -w], [w, 0.0]])]])
+        out.append(control.ss(A, B, C, D, inputs=names_in, outputs=names_out))
+    return out
+
+
+def test_an_isotropic_plant_is_synthesised_on_the_invariant_matrices(monkeypatch):
+    """Reference: the same synthesis on all symmetric R and S. On a plant that a 90°
+    turn maps onto itself (:func:`_two_axis_plants`), given that turn of its signals
+    (``axis_rotation`` of the design layer), the SDPs are solved on the matrices it
+    leaves invariant — the states' pairing is found in the scaled coordinates — with the
+    same γ to the SDPs' tolerance; with the η stiffness 10 % off, no pairing is found
+    and the whole problem is solved."""
+    import ambseal.robust._lpv_lmi as lmi_mod
+    from ambseal.design.lpv_design import axis_rotation
+
+    pairings, real = [], lmi_mod._sdp.solve_lmis
+
+    def recorded(*args, **kw):
+        pairings.append(args[6] if len(args) > 6 else kw.get("pairing"))
+        return real(*args, **kw)
+
+    monkeypatch.setattr(lmi_mod._sdp, "solve_lmis", recorded)
+    speeds = [0.0, 2.0]
+    P = _two_axis_plants(speeds)
+    rot = axis_rotation(P[0])
+    assert rot is not None
+    whole = lpvsyn(P, speeds, 2, 2, scaling="riccati", centre=True, frozen_check=False)
+    assert pairings and all(p is None for p in pairings)
+    pairings.clear()
+    inv = lpvsyn(P, speeds, 2, 2, scaling="riccati", centre=True, frozen_check=False,
+                 rotation=rot)
+    assert pairings and all(p is not None for p in pairings)
+    assert inv.gamma == pytest.approx(whole.gamma, rel=1e-3) and inv.check_stable
+    pairings.clear()
+    off = lpvsyn(_two_axis_plants(speeds, 1.1), speeds, 2, 2, scaling="riccati",
+                 centre=True, frozen_check=False,
+                 rotation=axis_rotation(_two_axis_plants(speeds, 1.1)[0]))
+    assert pairings and all(p is None for p in pairings) and off.check_stable
+    with pytest.raises(ModelError, match="rotation"):
+        lpvsyn(P, speeds, 2, 2, rotation=(np.eye(6), 2 * np.eye(6)))
+    # a signal with no ζ/η partner: no turn of the signals is given
+    import control
+
+    lone = control.ss(P[0].A, P[0].B, P[0].C, P[0].D,
+                      inputs=["d_zeta", "d_eta", "n_zeta", "n_eta", "u_zeta", "F0_x"],
+                      outputs=list(P[0].output_labels))
+    assert axis_rotation(lone) is None

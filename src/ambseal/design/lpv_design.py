@@ -68,7 +68,7 @@ from ambseal.machine import SPEED, ScheduledController
 from ambseal.robust import (design_delay, design_omega, hinfsyn, lpvsyn, musyn, sdp_shortfall,
                             sdp_status)
 
-__all__ = ["LpvDesign", "FrozenDesign", "design_lpv", "design_frozen",
+__all__ = ["LpvDesign", "FrozenDesign", "axis_rotation", "design_lpv", "design_frozen",
            "lpv_generalized_plants", "check_full_order", "lpv_schedule"]
 
 #: Mechanical states of the design model of an LPV controller on a rig whose seals follow
@@ -413,6 +413,38 @@ def _delay(cfg, spec: DesignSpec):
                         spec.synthesis_band_hz[1], max_order=1)
 
 
+def axis_rotation(P) -> tuple[np.ndarray, np.ndarray] | None:
+    """The 90° turn of a generalised plant's signals: each pair ``<name>_zeta``,
+    ``<name>_eta`` of its inputs and of its outputs taken to (−η, ζ), the rotation about
+    the spin axis that carries the ζ axis onto the η axis.
+
+    Parameters
+    ----------
+    P : control.StateSpace
+        Named inputs and outputs.
+
+    Returns
+    -------
+    (T_u, T_y) or None
+        Orthogonal maps of the inputs and of the outputs (``lpvsyn``'s ``rotation``);
+        None where a signal has no ζ/η partner. Whether the plant is invariant under
+        them is the synthesis's to check.
+    """
+    out = []
+    for names in (list(P.input_labels), list(P.output_labels)):
+        at = {n: k for k, n in enumerate(names)}
+        T = np.zeros((len(names), len(names)))
+        for k, n in enumerate(names):
+            base = n[:-5] if n.endswith("_zeta") else n[:-4] if n.endswith("_eta") else None
+            j = None if base is None else at.get(base + ("_eta" if n.endswith("_zeta")
+                                                          else "_zeta"))
+            if j is None:
+                return None
+            T[j, k] = 1.0 if n.endswith("_zeta") else -1.0  # ζ → η, η → −ζ
+        out.append(T)
+    return out[0], out[1]
+
+
 def design_lpv(cfg, *, speeds_hz=None, n_grid: int | None = None,
                rate_bound_hz_per_s: float | None = None, lyapunov: str | None = None,
                weights: Weights | None = None, states: int | None = None,
@@ -464,6 +496,9 @@ def design_lpv(cfg, *, speeds_hz=None, n_grid: int | None = None,
         by :func:`~ambseal.design.specs.design_spec` when omitted.
     **lpvsyn_kw
         Passed to :func:`ambseal.robust.lpv.lpvsyn` (``backoff``, ``solver_options``, …).
+        ``rotation`` defaults to the 90° turn of the plant's ζ and η signals
+        (:func:`axis_rotation`): on a rotor the same in both, R and S are sought among the
+        matrices that turn leaves invariant, half the unknowns.
 
     Returns
     -------
@@ -531,6 +566,9 @@ def design_lpv(cfg, *, speeds_hz=None, n_grid: int | None = None,
     # Pythons agree to 0.5 % of their gain (benchmarks/README.md), at 1.6–2.4× the
     # synthesis time
     lpvsyn_kw.setdefault("centre", True)
+    # a rotor the same in ζ and η: the SDPs on the matrices a 90° turn leaves invariant,
+    # half the unknowns (lpvsyn's `rotation`), where the plant keeps that symmetry
+    lpvsyn_kw.setdefault("rotation", axis_rotation(P[0]))
     r = lpvsyn(P, L.speeds_rad_s, nmeas, ncon, dA=dA, lyapunov=lyapunov, rate_bound=nu,
                **lpvsyn_kw)
     d = LpvDesign(K=r.K, gamma=r.gamma, gamma_design=r.gamma_design, frozen_gamma=fg,

@@ -25,6 +25,17 @@ method (its documented interface for a user KKT solver and a matrix-free G, "Exp
 structure", Andersen, Dahl & Vandenberghe); :func:`solve_lmis` supplies G and the KKT
 solver.
 
+Where the problem is invariant under an orthogonal map T of the states with T² = −I that
+pairs them with a sign (T e_i = s e_j, T e_j = −s e_i: a quarter turn of a plant
+symmetric under rotation, in coordinates that keep it orthogonal), its feasible set and
+cost are invariant under X ↦ Tᵀ X T, and so is its optimum where that is unique;
+:func:`solve_lmis` given the pairing (:class:`StatePairing`) solves it on the invariant
+matrices — per two pairs k ≠ l the block [[a, b], [−σb, σa]] (σ = s_k s_l), per pair
+a·I: (n/2)² unknowns instead of n(n+1)/2, each two entries of vech(X) (the map E). The
+Schur complement is then Eᵀ H E, formed from H's rows with their columns reduced by E,
+and its Cholesky factorisation is an eighth of the work. Every point of the subspace is
+one of the whole problem: what it certifies holds.
+
 Storage follows CVXOPT: the 's' part of a vector is each d × d matrix in column-major
 order, of which only the lower triangle is read (the upper triangle is written
 symmetrically here). The unknowns are x = [γ, vech(X_0), vech(X_1), …] with vech the
@@ -41,7 +52,7 @@ import numpy as np
 import scipy.linalg as sla
 from cvxopt import solvers
 
-__all__ = ["LmiTerm", "Lmi", "SdpSolution", "solve_lmis"]
+__all__ = ["LmiTerm", "Lmi", "SdpSolution", "StatePairing", "solve_lmis"]
 
 
 @dataclass(frozen=True)
@@ -87,6 +98,77 @@ class SdpSolution:
     status: str
     iterations: int
     max_iterations: int = CVXOPT_MAXITERS
+
+
+@dataclass(frozen=True)
+class StatePairing:
+    """The states' pairing by an orthogonal symmetry T of the problem, T² = −I:
+    T e_i = s e_j and T e_j = −s e_i for each (i, j, s) of ``(first, second, sign)``
+    (arrays of n/2 ints, ints, ±1.0), every state in one pair."""
+
+    first: np.ndarray
+    second: np.ndarray
+    sign: np.ndarray
+
+    def matrix(self, n: int) -> np.ndarray:
+        """T (n × n)."""
+        T = np.zeros((n, n))
+        T[self.second, self.first] = self.sign
+        T[self.first, self.second] = -self.sign
+        return T
+
+
+class _Reduced:
+    """x = E x̃ on the matrices invariant under a pairing (module docstring): for each
+    unknown of x̃, its one or two entries of x (``rows``, the second ``-1`` where there is
+    none) and their coefficients (``vals``)."""
+
+    def __init__(self, lay: "_Layout", n_vars: int, pairing: StatePairing):
+        n = lay.n
+        pos = np.full((n, n), -1, int)
+        pos[lay.I, lay.J] = np.arange(lay.m)
+        pos[lay.J, lay.I] = np.arange(lay.m)
+        i, j, sg = (np.asarray(pairing.first, int), np.asarray(pairing.second, int),
+                    np.asarray(pairing.sign, float))
+        one = [(pos[i[k], i[k]], pos[j[k], j[k]], 1.0, 1.0) for k in range(i.size)]
+        for k in range(i.size):
+            for m in range(k + 1, i.size):
+                sigma = sg[k] * sg[m]
+                p, q = i[m], j[m]
+                one.append((pos[i[k], p], pos[j[k], q], 1.0, sigma))  # a
+                one.append((pos[i[k], q], pos[j[k], p], 1.0, -sigma))  # b
+        per = np.array(one)
+        r1, r2 = per[:, 0].astype(int), per[:, 1].astype(int)
+        v1, v2 = per[:, 2], per[:, 3]
+        rows1, rows2, vals1, vals2 = ([0], [-1], [1.0], [0.0]) if lay.with_gamma else \
+            ([], [], [], [])
+        for v in range(n_vars):
+            rows1 += list(lay.off[v] + r1)
+            rows2 += list(lay.off[v] + r2)
+            vals1 += list(v1)
+            vals2 += list(v2)
+        self.rows1, self.rows2 = np.array(rows1, int), np.array(rows2, int)
+        self.vals1, self.vals2 = np.array(vals1), np.array(vals2)
+        self.two = self.rows2 >= 0
+        self.size, self.full = self.rows1.size, lay.size
+        # one variable's unknowns in its own vech (every variable alike), and where each
+        # variable's unknowns start in x̃
+        self.local = (r1, v1, r2, v2)
+        self.per = r1.size
+        self.start = [int(lay.with_gamma) + v * r1.size for v in range(n_vars)]
+
+    def expand(self, xr: np.ndarray) -> np.ndarray:
+        """E x̃."""
+        x = np.zeros(self.full)
+        x[self.rows1] += self.vals1 * xr
+        x[self.rows2[self.two]] += self.vals2[self.two] * xr[self.two]
+        return x
+
+    def restrict(self, g: np.ndarray) -> np.ndarray:
+        """Eᵀ g."""
+        out = self.vals1 * g[self.rows1]
+        out[self.two] += self.vals2[self.two] * g[self.rows2[self.two]]
+        return out
 
 
 class _Layout:
@@ -184,7 +266,7 @@ def _scaled(lmi: Lmi, rti: np.ndarray) -> Lmi:
 _SCHUR_ROWS = 64
 
 
-def _schur(scaled, lay: _Layout) -> np.ndarray:
+def _schur(scaled, lay: _Layout, red: "_Reduced | None" = None) -> np.ndarray:
     """H = Σ_j 𝒜_jᵀ (Z_j ⊗ Z_j) 𝒜_j in the vech coordinates (module docstring), from the
     scaled LMIs (:func:`_scaled`, Z = I); Fortran-ordered, as LAPACK factorises it.
 
@@ -198,9 +280,12 @@ def _schur(scaled, lay: _Layout) -> np.ndarray:
     columns J_p of the R_k, summed over every LMI and pair of terms of the block. The
     rows are formed :data:`_SCHUR_ROWS` at a time: the n⁴ array of every row at once is
     written and read back from memory, which costs more than the products.
+
+    With ``red``, Eᵀ H E on the invariant unknowns (module docstring): each block's rows
+    with their columns reduced by E as they are formed, then its rows.
     """
-    H = np.zeros((lay.size, lay.size), order="F")
     m, n = lay.m, lay.n
+    H = np.zeros((lay.size, lay.size) if red is None else (red.size, red.size), order="F")
     factors: dict = {}
     for lmi in scaled:
         for a, ta in enumerate(lmi.terms):
@@ -217,12 +302,17 @@ def _schur(scaled, lay: _Layout) -> np.ndarray:
             H[0, 0] += float(np.sum(lmi.gamma * lmi.gamma))
             col = np.zeros(lay.size)
             _lin_adjoint(Lmi(lmi.const, None, lmi.terms), lay, lmi.gamma, col)
+            if red is not None:
+                col = red.restrict(col)
             H[0, :] += col
             H[1:, 0] += col[1:]
     for (v, w), (Ls, Rs) in factors.items():
         rows = np.stack(Ls)[:, lay.I, :].transpose(1, 2, 0)  # (m, n, K): L_k[I_p, :]
         cols = np.stack(Rs)[:, :, lay.J].transpose(2, 0, 1)  # (m, K, n): R_k[:, J_p]
         ov, ow = lay.off[v], lay.off[w]
+        if red is not None:  # the block's rows with their columns reduced by E, then its rows
+            r1, v1, r2, v2 = red.local
+            out = np.empty((m, red.per))
         for p0 in range(0, m, _SCHUR_ROWS):
             p1 = min(p0 + _SCHUR_ROWS, m)
             M = np.matmul(rows[p0:p1], cols[p0:p1]).reshape(p1 - p0, n * n)
@@ -230,14 +320,24 @@ def _schur(scaled, lay: _Layout) -> np.ndarray:
             blk *= lay.off_q
             blk += np.take(M, lay.at_ij, axis=1)
             blk *= lay.w[p0:p1, None]
+            if red is not None:
+                out[p0:p1] = np.take(blk, r1, axis=1) * v1 + np.take(blk, r2, axis=1) * v2
+                continue
             H[ov + p0:ov + p1, ow:ow + m] += blk
             if v != w:
                 H[ow:ow + m, ov + p0:ov + p1] += blk.T
+        if red is not None:
+            blk = v1[:, None] * np.take(out, r1, axis=0) + v2[:, None] * np.take(out, r2,
+                                                                                 axis=0)
+            sv, sw = red.start[v], red.start[w]
+            H[sv:sv + red.per, sw:sw + red.per] += blk
+            if v != w:
+                H[sw:sw + red.per, sv:sv + red.per] += blk.T
     return H
 
 
 def solve_lmis(lmis, n: int, n_vars: int, cost_gamma: float | None, cost_trace,
-               options: dict) -> SdpSolution:
+               options: dict, pairing: StatePairing | None = None) -> SdpSolution:
     """Minimise ``cost_gamma·γ + Σ_v cost_trace[v]·tr X_v`` subject to the LMIs ``s_j ⪰ 0``.
 
     Parameters
@@ -252,6 +352,9 @@ def solve_lmis(lmis, n: int, n_vars: int, cost_gamma: float | None, cost_trace,
     options : dict
         CVXOPT solver options (``abstol``, ``reltol``, ``feastol``, ``maxiters``,
         ``refinement``).
+    pairing : StatePairing, optional
+        A symmetry of the LMIs and the cost (module docstring): every X_v is sought among
+        the matrices it leaves invariant. None: among all symmetric ones.
 
     Returns
     -------
@@ -271,17 +374,22 @@ def solve_lmis(lmis, n: int, n_vars: int, cost_gamma: float | None, cost_trace,
     for v, ct in enumerate(cost_trace):
         c[lay.off[v]:lay.off[v] + lay.m] = ct * (lay.I == lay.J)
     h = np.concatenate([lmi.const.ravel(order="F") for lmi in lmis])
+    red = None if pairing is None else _Reduced(lay, n_vars, pairing)
+    expand = (lambda x: x) if red is None else red.expand
+    restrict = (lambda g: g) if red is None else red.restrict
+    c = restrict(c)
 
     def G(u, v, alpha=1.0, beta=0.0, trans="N"):
         un, vn = np.asarray(u)[:, 0], np.asarray(v)[:, 0]
         if trans == "N":  # G x = −(γ Γ + Σ terms): s = h − G x
-            gx = np.concatenate([-_lin(lmi, lay, un).ravel(order="F") for lmi in lmis])
+            x = expand(un)
+            gx = np.concatenate([-_lin(lmi, lay, x).ravel(order="F") for lmi in lmis])
         else:
             gx = np.zeros(lay.size)
             for j, lmi in enumerate(lmis):
                 _lin_adjoint(lmi, lay, _sym_from_lower(un[offs[j]:offs[j + 1]], lmi.size),
                              gx)
-            gx = -gx
+            gx = -restrict(gx)
         vn *= beta
         vn += alpha * gx
 
@@ -290,7 +398,8 @@ def solve_lmis(lmis, n: int, n_vars: int, cost_gamma: float | None, cost_trace,
         scaled = [_scaled(lmi, r) for lmi, r in zip(lmis, rtis)]
         try:
             # H is ours and Fortran-ordered: factorised where it lies, not copied
-            cf = sla.cho_factor(_schur(scaled, lay), check_finite=False, overwrite_a=True)
+            cf = sla.cho_factor(_schur(scaled, lay, red), check_finite=False,
+                                overwrite_a=True)
         except (np.linalg.LinAlgError, ValueError) as exc:
             raise ArithmeticError(str(exc)) from exc
 
@@ -301,8 +410,10 @@ def solve_lmis(lmis, n: int, n_vars: int, cost_gamma: float | None, cost_trace,
             g = np.zeros(lay.size)
             for lmi, B in zip(scaled, Bz):
                 _lin_adjoint(lmi, lay, B, g)
-            ux = sla.cho_solve(cf, xn - g, check_finite=False)  # H ux = bx + Gᵀ(WᵀW)⁻¹bz
+            # H ux = bx + Gᵀ(WᵀW)⁻¹bz
+            ux = sla.cho_solve(cf, xn - restrict(g), check_finite=False)
             xn[:] = ux
+            ux = expand(ux)
             for j, (lmi, B) in enumerate(zip(scaled, Bz)):  # W uz = W⁻ᵀ(G ux − bz)
                 zn[offs[j]:offs[j + 1]] = (-_lin(lmi, lay, ux) - B).ravel(order="F")
         return f
@@ -312,7 +423,8 @@ def solve_lmis(lmis, n: int, n_vars: int, cost_gamma: float | None, cost_trace,
     res = solvers.conelp(cvxopt.matrix(c), G, cvxopt.matrix(h), dims,
                          kktsolver=kktsolver, options=opts)
     status = {"primal infeasible": "infeasible"}.get(res["status"], res["status"])
-    x = np.asarray(res["x"])[:, 0] if res["x"] is not None else np.full(lay.size, np.nan)
+    x = expand(np.asarray(res["x"])[:, 0]) if res["x"] is not None else \
+        np.full(lay.size, np.nan)
     if status == "unknown" and holds(lmis, lay, x):
         status = "feasible"
     X = [lay.unpack(x, v) for v in range(n_vars)]

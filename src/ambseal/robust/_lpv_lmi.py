@@ -30,7 +30,7 @@ from ambseal.robust import _lmi_sdp as _sdp
 __all__ = ["LmiInfeasible", "SolverReport", "Scaled", "scale_grid", "lmi_blocks", "solve_lmis",
            "GammaStage", "gamma_stage",
            "basis", "basis_at", "is_constant", "rebalanced", "BASES", "sdp_status",
-           "sdp_shortfall"]
+           "sdp_shortfall", "state_pairing", "PAIRING_RTOL"]
 
 BASES = {"constant": 1, "affine": 2, "quadratic": 3}
 #: The largest share of stage 1's cost the trace term may take before its weight is
@@ -255,10 +255,62 @@ class Scaled:
     p_of: Any  # θ (its own unit) → p ∈ [−1, 1]
     dp_dtheta: float
     sigma: np.ndarray  # balanced Riccati values (1 for diagonal scaling)
+    #: the inputs' and outputs' maps (T_u, T_y) of a rotation symmetry, in these
+    #: coordinates, and the states' pairing that goes with them here (:func:`state_pairing`)
+    rotation: Any = None
+    pairing: Any = None
 
     def to_scaled_A(self, A: np.ndarray) -> np.ndarray:
         """A frozen physical A(θ) in the scaled coordinates of the LMIs."""
         return np.linalg.solve(self.T, A @ self.T) / self.w0
+
+
+#: A rotation's pairing of the scaled states is used where it commutes with every grid
+#: plant (A, its slope, B, C, D) to this fraction of each matrix's norm: the SDPs' own
+#: relative gap (:data:`DEFAULT_TOL`), below which the invariant optimum cannot be told
+#: from the whole problem's. Measured on rotation-symmetric plants: 2e-7 to 2e-5,
+#: the LQG balancing's Riccati solutions' rounding (benchmarks/README.md, "The LPV's
+#: LMIs keep a rotation symmetry").
+PAIRING_RTOL = 1e-4
+
+
+def state_pairing(sc: "Scaled") -> "_sdp.StatePairing | None":
+    """The states' pairing of a rotation symmetry in ``sc``'s coordinates, or None.
+
+    In LQG-balanced coordinates (:func:`_riccati_balance`) an orthogonal symmetry T
+    commutes with Σ, so where the balanced values come in equal pairs, in order, it maps
+    each pair's two states onto each other with a sign (the 2 × 2 orthogonal blocks with
+    T² = −I are ±[[0, −1], [1, 0]] in any basis of the pair). The signs are read from B's
+    rows (T B = B T_u); the pairing is kept where it commutes with the whole grid to
+    :data:`PAIRING_RTOL` (module _lmi_sdp: the SDPs are then solved on the invariant R
+    and S), else None: no rotation given, an odd order, a plant not symmetric, the
+    diagonal scaling's coordinates.
+    """
+    if sc.rotation is None:
+        return None
+    Tu, Ty = sc.rotation
+    n = sc.A.shape[1]
+    if n % 2 or n == 0:
+        return None
+    first, second = np.arange(0, n, 2), np.arange(1, n, 2)
+    BT = sc.B @ Tu
+    # (T B)_j = s B_i and (T B)_i = −s B_j for the pair (i, j)
+    fit = [np.linalg.norm(sc.B[first] - BT[second], axis=1)
+           + np.linalg.norm(sc.B[second] + BT[first], axis=1),
+           np.linalg.norm(sc.B[first] + BT[second], axis=1)
+           + np.linalg.norm(sc.B[second] - BT[first], axis=1)]
+    sign = np.where(fit[0] <= fit[1], 1.0, -1.0)
+    pair = _sdp.StatePairing(first, second, sign)
+    T = pair.matrix(n)
+
+    def off(a, b) -> bool:
+        return bool(np.linalg.norm(a - b) > PAIRING_RTOL * max(np.linalg.norm(a),
+                                                               np.linalg.norm(b)))
+
+    if any(off(T @ A, A @ T) for A in (*sc.A, *sc.dA)) or off(T @ sc.B, BT) \
+            or off(sc.C @ T, Ty @ sc.C) or off(sc.D @ Tu, Ty @ sc.D):
+        return None
+    return pair
 
 
 def _riccati_balance(A, B1, B2, C1, C2, D12, D21) -> tuple[np.ndarray, np.ndarray]:
@@ -287,7 +339,8 @@ def _riccati_balance(A, B1, B2, C1, C2, D12, D21) -> tuple[np.ndarray, np.ndarra
     return T, sig
 
 
-def scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling: str = "riccati") -> Scaled:
+def scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling: str = "riccati",
+               rotation=None) -> Scaled:
     """State, time and signal scaling for the whole grid (norm-preserving for w → z).
 
     1. one diagonal state scaling balancing the envelope of |A(θ_k)| against B and C;
@@ -297,6 +350,10 @@ def scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling: str = "ricc
        reported as NaN, when the centre plant has no stabilising Riccati solution — then
        the LMIs are infeasible anyway and the solver says so);
     4. controls and measurements to unit-norm columns/rows of [B2; D12] and [C2, D21].
+
+    ``rotation``: (T_u, T_y), orthogonal maps of the inputs and outputs under which the
+    plant is invariant with some map of its states (a quarter turn), or None; the
+    states' pairing it implies in the scaled coordinates is looked for (:func:`state_pairing`).
     """
     n = As.shape[1]
     env = np.max(np.abs(As), axis=0)
@@ -344,8 +401,14 @@ def scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling: str = "ricc
     half = 0.5 * (grid[-1] - grid[0])
     mid = 0.5 * (grid[-1] + grid[0])
     dAs_s = np.einsum("ij,kjl,lm->kim", Tinv, dAs, T) / w0 * half  # per unit p
-    return Scaled(As_s, dAs_s, Bs, Cs, Ds, T, su, sy, w0,
-                   lambda th: (np.asarray(th, float) - mid) / half, 1.0 / half, sig)
+    rot = None
+    if rotation is not None:  # in the scaled signals: u_s = u/su, y_s = sy·y
+        fu, fy = np.concatenate([np.ones(nw), su]), np.concatenate([np.ones(nz), sy])
+        rot = ((1.0 / fu)[:, None] * np.asarray(rotation[0], float) * fu[None, :],
+               fy[:, None] * np.asarray(rotation[1], float) / fy[None, :])
+    sc = Scaled(As_s, dAs_s, Bs, Cs, Ds, T, su, sy, w0,
+                lambda th: (np.asarray(th, float) - mid) / half, 1.0 / half, sig, rot)
+    return replace(sc, pairing=state_pairing(sc))
 
 
 def rebalanced(sc: Scaled, R: list, S: list, grid: np.ndarray, lyapunov,
@@ -365,9 +428,10 @@ def rebalanced(sc: Scaled, R: list, S: list, grid: np.ndarray, lyapunov,
     r, s = diag_mean(R, lyapunov_r), diag_mean(S, lyapunov)
     d = (np.maximum(r, 1e-300) / np.maximum(s, 1e-300)) ** 0.25
     d = d / np.exp(np.mean(np.log(d)))  # the overall size is the time scale's business
-    return replace(sc, A=sc.A * d[None, None, :] / d[None, :, None],
-                   dA=sc.dA * d[None, None, :] / d[None, :, None], B=sc.B / d[:, None],
-                   C=sc.C * d[None, :], T=sc.T * d[None, :])
+    out = replace(sc, A=sc.A * d[None, None, :] / d[None, :, None],
+                  dA=sc.dA * d[None, None, :] / d[None, :, None], B=sc.B / d[:, None],
+                  C=sc.C * d[None, :], T=sc.T * d[None, :])
+    return replace(out, pairing=state_pairing(out))
 
 
 def lmi_blocks(sc: Scaled, nw, nz, ncon, nmeas):
@@ -556,7 +620,8 @@ def gamma_stage(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
     reports = []
     n_vars = nbR + nbS
     lmis, tr = build(None, float(coupling_ratio) if not centre else 1.0)
-    sol = _solve_sdp(lmis, N, n_vars, 1.0, penalty * tr, solver_options, "gamma", reports)
+    sol = _solve_sdp(lmis, N, n_vars, 1.0, penalty * tr, solver_options, "gamma", reports,
+                     sc.pairing)
     kept = len(reports) - 1  # the γ solve the controller is built from
     # The trace term keeps R and S bounded, but where they must grow large it also buys a
     # smaller trace with a larger γ: while its share of the cost exceeds PENALTY_SHARE the
@@ -577,7 +642,7 @@ def gamma_stage(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
         lower_weight = weight * 0.5 * PENALTY_SHARE / share  # aim inside the bound
         try:
             lower = _solve_sdp(lmis, N, n_vars, 1.0, lower_weight * tr, solver_options,
-                               "gamma", reports)
+                               "gamma", reports, sc.pairing)
         except SynthesisError:
             break
         if lower.status != "optimal" or not float(lower.gamma) < float(sol.gamma) or \
@@ -597,7 +662,7 @@ def gamma_stage(sc: Scaled, blocks, grid: np.ndarray, lyapunov, nu_s: float, *,
             lmis, tr = build(gamma_d, alpha)
             try:
                 centred = _solve_sdp(lmis, N, n_vars, None, tr, solver_options, "centre",
-                                     more)
+                                     more, sc.pairing)
                 break
             except SynthesisError as exc:
                 last = exc
@@ -626,14 +691,16 @@ def _reconstruction_loss(R, S, at) -> float:
     return worst
 
 
-def _solve_sdp(lmis, N, n_vars, cost_gamma, cost_trace, options, stage, reports):
-    """One SDP stage by :func:`ambseal.robust._lmi_sdp.solve_lmis`; its report appended.
+def _solve_sdp(lmis, N, n_vars, cost_gamma, cost_trace, options, stage, reports,
+               pairing=None):
+    """One SDP stage by :func:`ambseal.robust._lmi_sdp.solve_lmis` (on the matrices the
+    states' ``pairing`` leaves invariant, where given); its report appended.
     Where it stops short of its tolerance, it is solved again under each option set of
     :data:`STALL_RETRIES` that does not tighten ``feastol``, and the first that ends
     ``optimal`` is kept."""
     t0 = time.perf_counter()
     try:
-        sol = _sdp.solve_lmis(lmis, N, n_vars, cost_gamma, cost_trace, options)
+        sol = _sdp.solve_lmis(lmis, N, n_vars, cost_gamma, cost_trace, options, pairing)
     except (ArithmeticError, ValueError) as exc:  # CVXOPT: a singular scaling or KKT system
         raise SynthesisError(
             f"lpvsyn ({stage}): CVXOPT stopped on a singular system ({exc!r}): the LMIs are "
@@ -643,7 +710,7 @@ def _solve_sdp(lmis, N, n_vars, cost_gamma, cost_trace, options, stage, reports)
         if retry == options or retry["feastol"] < options.get("feastol", 0.0):
             continue
         try:
-            again = _sdp.solve_lmis(lmis, N, n_vars, cost_gamma, cost_trace, retry)
+            again = _sdp.solve_lmis(lmis, N, n_vars, cost_gamma, cost_trace, retry, pairing)
         except (ArithmeticError, ValueError):
             continue
         if again.status == "optimal":

@@ -309,7 +309,8 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
            check_density: int = 5, solver_options: dict | None = None,
            margin: float = 1e-6, scaling: str = "auto", penalty: float = 1e-4,
            coupling_ratio: float = 1.1, centre: bool = False,
-           frozen_check: bool = True, pole_bound: float | None = None) -> LpvSynResult:
+           frozen_check: bool = True, pole_bound: float | None = None,
+           rotation=None) -> LpvSynResult:
     """Gridded H∞ LPV controller (Apkarian & Adams 1998; Wu et al. 1996).
 
     Stages, the first two SDPs solved by CVXOPT and required to end ``optimal``:
@@ -413,6 +414,16 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
         LMI bound. Chilali & Gahinet's (1996) pole region would put a disk |λ| ≤ bound on
         the closed loop in the SDP, with the controller's variables in it: N² more
         unknowns at every grid point of an SDP that is already the synthesis's cost.
+    rotation : (ndarray, ndarray), optional
+        ``(T_u, T_y)``: orthogonal maps of the plants' inputs ``[w, u]`` and outputs
+        ``[z, y]`` under which every plant of the grid is invariant with some map of its
+        states — a plant symmetric under rotation, turned a quarter turn (each pair of
+        signals (a, b) to (−b, a)). Then the SDPs' feasible set and cost are invariant,
+        and where the states' pairing it implies holds in the scaled coordinates
+        (:func:`ambseal.robust._lpv_lmi.state_pairing`) R and S are sought among the
+        invariant matrices: half the unknowns, the same optimum within the SDPs'
+        tolerances (``benchmarks/README.md``, "The LPV's LMIs keep a rotation
+        symmetry"). None: R and S among all symmetric matrices.
 
     Returns
     -------
@@ -433,7 +444,8 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
         ``nmeas``, ``ncon`` or ``check_density`` not a whole number ≥ 1, ``margin`` not a
         finite number > 0, ``backoff`` not a finite number ≥ 1, ``coupling_ratio`` not a
         number > 1, ``penalty`` not a number ≥ 0 or ``pole_bound`` not a finite number
-        > 0.
+        > 0, or a ``rotation`` whose maps are not orthogonal matrices of the plants'
+        input and output counts.
     SynthesisError
         Infeasible LMIs, a solver status other than ``optimal``, or a reconstructed frozen
         closed loop that is unstable.
@@ -464,13 +476,21 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
     if scaling not in ("auto", "riccati", "diagonal"):
         raise ModelError(f"lpvsyn: scaling={scaling!r}; expected 'auto', 'riccati' or "
                              "'diagonal'")
+    if rotation is not None:
+        rotation = tuple(np.asarray(T, float) for T in rotation)
+        sizes = (B.shape[1], C.shape[0])
+        if len(rotation) != 2 or any(
+                T.shape != (k, k) or not np.allclose(T.T @ T, np.eye(k), atol=1e-12)
+                for T, k in zip(rotation, sizes)):
+            raise ModelError(f"lpvsyn: rotation, expected orthogonal maps of the {sizes[0]} "
+                             f"inputs and the {sizes[1]} outputs")
     solver_options = {**DEFAULT_TOL, **(solver_options or {})}
     data = (plants, grid, As, dAs, B, C, D, nw, nz, nmeas, ncon)
     settings = dict(lyapunov=lyapunov, lyapunov_r=lyapunov_r, rate_bound=rate_bound,
                     backoff=backoff,
                     check_density=check_density, solver_options=solver_options,
                     margin=margin, penalty=penalty, coupling_ratio=coupling_ratio,
-                    centre=centre)
+                    centre=centre, rotation=rotation)
     r = (_synthesise(data, scaling, **settings) if scaling != "auto"
          else _either_scaling(data, settings))
     if frozen_check:
@@ -656,11 +676,11 @@ class _Scaling:
     @classmethod
     def solve(cls, data, scaling: str, *, lyapunov, lyapunov_r, rate_bound, backoff,
               check_density, solver_options, margin, penalty, coupling_ratio,
-              centre) -> "_Scaling":
+              centre, rotation=None) -> "_Scaling":
         plants, grid, As, dAs, B, C, D, nw, nz, nmeas, ncon = data
         settings = dict(lyapunov=lyapunov, lyapunov_r=lyapunov_r, rate_bound=rate_bound,
                         check_density=check_density, margin=margin)
-        sc = scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling)
+        sc = scale_grid(As, dAs, B, C, D, grid, nw, nz, ncon, nmeas, scaling, rotation)
         nu_s = 0.0 if rate_bound is None else float(rate_bound) / sc.w0 * sc.dp_dtheta
         lmi_kw = dict(backoff=backoff, margin=margin, penalty=penalty,
                       coupling_ratio=coupling_ratio, centre=centre,

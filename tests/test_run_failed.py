@@ -99,7 +99,6 @@ def test_a_loop_lost_only_to_the_delays_pade_approximation_says_so():
     assert "fails — the full-order loop is unstable at 0 bar (mode at 1323 Hz" in g.reason
 
 
-
 def test_a_point_judged_at_one_speed_is_named_with_its_speed_beside_the_speed_range():
     """A rig judged in full at one speed (305.185 Hz) labels that point by its pressure
     alone; where the run also judges the speed range, its failure had read "unstable at
@@ -119,6 +118,7 @@ def test_a_point_judged_at_one_speed_is_named_with_its_speed_beside_the_speed_ra
     alone = loop_failure("hinf", [(judged, bad)], designed=True)
     assert alone.reason.startswith("H∞: not delivered — the full-order loop is unstable at "
                                    "0 bar (mode")
+
 
 def test_many_unstable_conditions_are_listed_with_the_least_stable_mode():
     """Beyond four unstable conditions the line lists them and names the mode of the one

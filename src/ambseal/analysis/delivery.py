@@ -28,9 +28,8 @@ from ambseal.config import method_label
 from ambseal.design import machine
 
 __all__ = ["FailedController", "case_label", "loop_failure", "saturation_failure",
-           "synthesis_failure", "also_failed", "rig_clearances_um", "worst_orbit_um", "notched_orbit_um",
-           "clearance_exceeded",
-           "clearance_failure", "CLEARANCE_WORDS"]
+           "synthesis_failure", "also_failed", "rig_clearances_um", "worst_orbit_um",
+           "notched_orbit_um", "clearance_exceeded", "clearance_failure", "CLEARANCE_WORDS"]
 
 #: How a sentence names each clearance of :func:`rig_clearances_um`.
 CLEARANCE_WORDS = {"air gap": "the air gap", "backup bearing": "the backup bearing's clearance"}

@@ -7,9 +7,10 @@ The classes: controller files (channels not the rig's, a continuous controller m
 discrete, a device instead of a file, a rig that does not exist); options and values
 (a negative tolerance, too many workers, an unknown parameter, a ``--set`` value with a
 newline); input sizes (2 000 disks, a mesh split past the element bound, a FIFO or a
-device as an input file); a Dask scheduler that accepts and never answers; a library
-planted where ``import-ross`` runs; a read-only installation (numba without a cache).
-The reference is the CLI's promise (ambseal.cli): one line on stderr and status 2.
+device as an input file); a library planted where ``import-ross`` runs; a read-only
+installation (numba without a cache). The reference is the CLI's promise (ambseal.cli):
+one line on stderr and status 2. (A Dask scheduler that accepts and never answers is
+tests/analysis/test_analysis_sweep.py's, at a deadline of 1 s instead of the probe's 10.)
 """
 
 from __future__ import annotations
@@ -35,9 +36,9 @@ from .conftest import ROOT
 from .test_cli_export import CHANNELS, _small_digital
 from .toml_text import dump
 
-#: The longest one case may take (s) before it counts as a hang: the slowest waits for the
-#: scheduler probe's 10 s or imports ROSS (10–20 s on 2 idle cores); ten times that, so a
-#: loaded machine (two CPU hogs beside the suite) never breaks it.
+#: The longest one case may take (s) before it counts as a hang: the slowest imports ROSS
+#: (10–20 s on 2 idle cores); ten times that, so a loaded machine (two CPU hogs beside the
+#: suite) never breaks it.
 DEADLINE_S = 300
 RIG = str(default_rig_path())
 BASE = tomllib.loads((ROOT / "examples" / "testrig.toml").read_text())
@@ -196,15 +197,6 @@ def test_refused_in_one_line(tmp_path, make, words):
     proc = _ambseal(tmp_path, make(tmp_path))
     _refused(proc, *words)
     assert not (tmp_path / "o").exists() and not (tmp_path / "c").exists()
-
-
-def test_a_silent_scheduler_is_refused_before_any_work(tmp_path, silent_peer):
-    """``sweep --scheduler`` at a peer that accepts and never answers: one line naming the
-    address after the probe's deadline, not a hang."""
-    pytest.importorskip("distributed")
-    proc = _ambseal(tmp_path, ["sweep", RIG, "--pressure-bar", "1", "--scheduler",
-                               silent_peer, "--out", tmp_path / "o"])
-    _refused(proc, silent_peer, "no answer")
 
 
 def test_a_read_only_installation_runs(tmp_path):

@@ -311,6 +311,34 @@ def terminal_run(tmp_path_factory, request, design_cache_for):
     return out, json.loads((out / "metrics.json").read_text()), screen
 
 
+@pytest.fixture(scope="session")
+def flywheel_10k_lpv(tmp_path_factory):
+    """``(rig, {kernels: out folder})``: ``ambseal design --method lpv`` on the example
+    flywheel with its sample rate set to 10 kHz (a copy; the example stays as it is), in
+    two processes at once under the two BLAS kernel sets of :mod:`tests.kernel_runs`
+    where ``OPENBLAS_CORETYPE`` selects them, else once in this process (key
+    ``"native"``). Its readers (the LPV's pole bound, and its sameness under two kernel
+    sets) carry the group ``flywheel_10k_lpv``: the design is made once."""
+    import re
+
+    from ambseal.cli import main
+    from tests.kernel_runs import run_both, selectable_pair
+
+    tmp = tmp_path_factory.mktemp("flywheel10k")
+    text, n = re.subn(r"(?m)^sample_rate_hz\s*=.*$", "sample_rate_hz = 10000.0",
+                      (ROOT / "examples" / "flywheel.toml").read_text(encoding="utf-8"))
+    assert n == 1
+    rig = tmp / "flywheel_10k.toml"
+    rig.write_text(text, encoding="utf-8")
+    argv = ["design", str(rig), "--method", "lpv"]
+    pair, _ = selectable_pair()
+    if pair is None:
+        assert main(["--quiet", *argv, "--out", str(tmp / "native")]) == 0
+        return rig, {"native": tmp / "native"}
+    run_both(pair, argv, tmp, 600)
+    return rig, {c: tmp / c for c in pair}
+
+
 @pytest.fixture
 def silent_peer():
     """The address of a TCP socket on this machine that accepts connections and never

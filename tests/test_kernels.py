@@ -22,8 +22,6 @@ the processor offers no two kernel sets or ``OPENBLAS_CORETYPE`` does not select
 from __future__ import annotations
 
 import json
-import os
-import re
 import subprocess
 import sys
 from pathlib import Path
@@ -34,83 +32,9 @@ import pytest
 from tests.exported_files import file_at
 from tests.kernel_compare import RTOL, delivered, differences, words
 
+from tests.kernel_runs import kernel_env, kernels_selectable, run_both
+
 ROOT = Path(__file__).resolve().parents[1]
-BLAS_VARS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS",
-             "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS",
-             "OPENBLAS_CORETYPE", "OPENBLAS_VERBOSE", "AMBSEAL_BLAS_THREADS")
-_MAIN = "import sys; from ambseal.cli import main; sys.exit(main())"
-_ARCH = ("import json, numpy, scipy.linalg, threadpoolctl; print(json.dumps(sorted("
-         "{i.get('architecture') or '' for i in threadpoolctl.threadpool_info() "
-         "if i.get('internal_api') == 'openblas'})))")
-
-
-def _env(coretype: str) -> dict:
-    """This environment without BLAS variables, then one kernel set and one thread."""
-    env = {k: v for k, v in os.environ.items() if k not in BLAS_VARS}
-    env.update(OPENBLAS_CORETYPE=coretype, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
-               MPLBACKEND="Agg")
-    env["PYTHONPATH"] = os.pathsep.join([str(ROOT / "src"), env.get("PYTHONPATH", "")])
-    return env
-
-
-def _cpu_flags() -> set[str]:
-    try:
-        text = Path("/proc/cpuinfo").read_text()
-    except OSError:
-        return set()
-    for line in text.splitlines():
-        if line.startswith("flags"):
-            return set(line.split(":", 1)[1].split())
-    return set()
-
-
-def _kernel_pair() -> tuple[str, str] | None:
-    """Two OpenBLAS kernel sets this processor runs: the AVX-512 one against AVX2's where
-    it has AVX-512, else AVX2's against AVX's; None where it has neither."""
-    flags = _cpu_flags()
-    if "avx512f" in flags:
-        return "Haswell", "SkylakeX"
-    if "avx2" in flags:
-        return "Sandybridge", "Haswell"
-    return None
-
-
-def _architecture(coretype: str) -> list[str]:
-    """The kernel sets NumPy's and SciPy's OpenBLAS report under ``coretype``."""
-    out = subprocess.run([sys.executable, "-c", _ARCH], env=_env(coretype), cwd=ROOT,
-                         capture_output=True, text=True, timeout=120)
-    return json.loads(out.stdout) if out.returncode == 0 else []
-
-
-def _kernels_selectable():
-    """The kernel pair of :func:`_kernel_pair` where ``OPENBLAS_CORETYPE`` selects it, else
-    the test is skipped saying why."""
-    pair = _kernel_pair()
-    if pair is None:
-        pytest.skip("no two OpenBLAS kernel sets on this processor (neither AVX2 nor AVX-512)")
-    arch = [_architecture(c) for c in pair]
-    if [[c.lower()] for c in pair] != [[a.lower() for a in x] for x in arch]:
-        pytest.skip(f"OPENBLAS_CORETYPE does not select the kernels here: {pair} gave {arch}")
-    return pair
-
-
-def _both(pair, argv: list[str], tmp_path: Path, timeout: float) -> None:
-    """``ambseal argv…`` in two processes at once, one per kernel set of ``pair``, each
-    writing to ``tmp_path/<kernels>``; a run that does not exit 0 fails the test."""
-    procs = [(c, subprocess.Popen([sys.executable, "-c", _MAIN, "-q", *argv, "--out",
-                                   str(tmp_path / c)], env=_env(c), cwd=tmp_path,
-                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True))
-             for c in pair]
-    try:
-        for c, proc in procs:
-            _, stderr = proc.communicate(timeout=timeout)
-            if proc.returncode != 0:
-                pytest.fail(f"{c}: exit {proc.returncode}\n{stderr[-3000:]}")
-    finally:
-        for _, proc in procs:
-            if proc.poll() is None:
-                proc.kill()
-                proc.wait()
 
 
 @pytest.mark.heavy
@@ -120,8 +44,8 @@ def test_blower_delivers_the_same_answer_under_two_kernel_sets(tmp_path):
     Haswell kernels and 0.621 under SkylakeX, their σ̄(S_o) peaks 7–12 % apart and zone A
     against B. D–G–K now ends at the first step that meets the target, built further from
     γ_opt (:data:`ambseal.robust.dgk.DGK_BACKOFF`), where the two agree to 0.5 %."""
-    pair = _kernels_selectable()
-    _both(pair, ["run", str(ROOT / "examples" / "blower.toml"), "--no-identify"], tmp_path,
+    pair = kernels_selectable()
+    run_both(pair, ["run", str(ROOT / "examples" / "blower.toml"), "--no-identify"], tmp_path,
           1200)
     metrics = [json.loads((tmp_path / c / "metrics.json").read_text()) for c in pair]
     if "mu" not in delivered(metrics[0]):
@@ -131,7 +55,8 @@ def test_blower_delivers_the_same_answer_under_two_kernel_sets(tmp_path):
 
 
 @pytest.mark.heavy
-def test_the_flywheels_lpv_at_10_khz_is_the_same_under_two_kernel_sets(tmp_path):
+@pytest.mark.xdist_group("flywheel_10k_lpv")  # the session's design, made once
+def test_the_flywheels_lpv_at_10_khz_is_the_same_under_two_kernel_sets(flywheel_10k_lpv):
     """The LPV on speed of the example flywheel on a 10 kHz target (a copy with its rate
     changed), designed under two kernel sets: every SDP stage ended "optimal", the same
     discretisation and words, γ within its 2 %, and the same controller as it runs — the
@@ -144,19 +69,16 @@ def test_the_flywheels_lpv_at_10_khz_is_the_same_under_two_kernel_sets(tmp_path)
     the cap under SkylakeX, and the two controllers were 60 % apart; with a further solve
     at residuals of 1e-4 only, under NumPy 2.5 another centring stayed stalled under both
     (``STALL_RETRIES``), and its R and S set the rebalanced scaling: 2.7 % apart."""
-    pair = _kernels_selectable()
-    text, n = re.subn(r"(?m)^sample_rate_hz\s*=.*$", "sample_rate_hz = 10000.0",
-                      (ROOT / "examples" / "flywheel.toml").read_text(encoding="utf-8"))
-    assert n == 1
-    rig = tmp_path / "flywheel_10k.toml"
-    rig.write_text(text, encoding="utf-8")
-    _both(pair, ["design", str(rig), "--method", "lpv"], tmp_path, 600)
-    s = [json.loads((tmp_path / c / "design_lpv.json").read_text()) for c in pair]
+    _, outs = flywheel_10k_lpv
+    if set(outs) == {"native"}:
+        kernels_selectable()  # skipped, saying why
+    pair = tuple(outs)
+    s = [json.loads((outs[c] / "design_lpv.json").read_text()) for c in pair]
     for c, d in zip(pair, s):  # each SDP ended at its own tolerance, not CVXOPT's cap
         assert set(d["sdp_status"].values()) == {"optimal"}, (c, d["sdp_status"])
     assert s[0]["gamma"] == pytest.approx(s[1]["gamma"], rel=RTOL["gamma"])
     assert words(s[0]["verdict"]) == words(s[1]["verdict"])
-    f = [np.load(tmp_path / c / "controller_lpv.npz", allow_pickle=False) for c in pair]
+    f = [np.load(outs[c] / "controller_lpv.npz", allow_pickle=False) for c in pair]
     assert str(f[0]["method"]) == str(f[1]["method"])
     z = np.exp(1j * np.pi * np.logspace(-4, 0, 400)[:-1])
     for w in f[0]["grid"]:
@@ -227,7 +149,7 @@ def test_the_overhung_bands_channels_are_the_same_under_two_kernel_sets(tmp_path
     kernels (nine of the fourteen of the run's design model: 433, 647, 885 Hz and six
     above): a circular whirl's two transverse components tie, and the kernels picked which
     one was made real."""
-    pair = _kernels_selectable()
+    pair = kernels_selectable()
     script = tmp_path / "channels.py"
     script.write_text(
         "import sys, numpy as np\n"
@@ -243,7 +165,7 @@ def test_the_overhung_bands_channels_are_the_same_under_two_kernel_sets(tmp_path
     rig = ROOT / "examples" / "overhung_compressor.toml"
     for c in pair:
         subprocess.run([sys.executable, str(script), str(rig), str(tmp_path / f"{c}.npy")],
-                       env=_env(c), cwd=tmp_path, check=True, timeout=300)
+                       env=kernel_env(c), cwd=tmp_path, check=True, timeout=300)
     a, b = (np.load(tmp_path / f"{c}.npy", allow_pickle=False) for c in pair)
     assert a.shape == b.shape and a.shape[0] >= 4
     for x, y in zip(a, b):

@@ -60,8 +60,8 @@ def test_grouped_tests_run_on_one_worker(tmp_path):
 
 
 #: Session fixtures whose readers share one worker, by the group they carry: made once
-#: per worker that asks, each a whole `ambseal run` of tens of seconds.
-GROUPED_FIXTURES = {"terminal_run": "terminal_run"}
+#: per worker that asks, each a whole `ambseal run` or design of tens of seconds.
+GROUPED_FIXTURES = {"terminal_run": "terminal_run", "flywheel_10k_lpv": "flywheel_10k_lpv"}
 
 
 def _groups(decorators) -> set[str]:

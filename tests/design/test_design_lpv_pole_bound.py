@@ -12,41 +12,24 @@ hold, the delay after the controller, at every judged speed and between them."""
 from __future__ import annotations
 
 import json
-import re
-from pathlib import Path
 
 import control
 import numpy as np
 import pytest
 
-from ambseal.cli import main
 from ambseal.config import load_rig
 from ambseal.model import build_plant
 
 from ..exported_files import file_at
 
-EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "flywheel.toml"
 RATE_HZ = 10_000.0
 
 
-@pytest.fixture(scope="module")
-def flywheel_at_10_khz(tmp_path_factory):
-    """``(rig, out folder)`` of ``ambseal design --method lpv`` on the example flywheel with
-    its sample rate set to 10 kHz (a copy; the example stays as it is)."""
-    tmp = tmp_path_factory.mktemp("flywheel10k")
-    text, n = re.subn(r"(?m)^sample_rate_hz\s*=.*$", f"sample_rate_hz = {RATE_HZ}",
-                      EXAMPLE.read_text(encoding="utf-8"))
-    assert n == 1
-    rig = tmp / "flywheel_10k.toml"
-    rig.write_text(text, encoding="utf-8")
-    out = tmp / "out"
-    assert main(["--quiet", "design", str(rig), "--method", "lpv", "--out", str(out)]) == 0
-    return rig, out
-
-
 @pytest.mark.heavy
-def test_the_lpv_has_no_pole_above_nyquist_and_runs_at_every_speed(flywheel_at_10_khz):
-    rig, out = flywheel_at_10_khz
+@pytest.mark.xdist_group("flywheel_10k_lpv")  # the session's design, made once
+def test_the_lpv_has_no_pole_above_nyquist_and_runs_at_every_speed(flywheel_10k_lpv):
+    rig, outs = flywheel_10k_lpv
+    out = next(iter(outs.values()))
     cfg = load_rig(rig)
     f = np.load(out / "controller_lpv.npz", allow_pickle=False)
     for A in f["A_c"]:

@@ -11,7 +11,8 @@ Cases (one JSON line each on stdout; progress and the children's output go to st
     elements (e.g. ``--rig examples/b2b_compressor.toml``). Goal 60 s (CPU too).
 ``pytest``
     The test suite, ``python -m pytest -q -p no:cacheprovider [ARGS]`` from the
-    repository root (``--pytest-args`` replaces the default of the whole suite). Goal 300 s.
+    repository root (``--pytest-args`` replaces the default run: the suite without the
+    tests marked ``slow`` or ``heavy``). Goal 300 s.
 
 Each is a child process (wall time, interpreter start and imports included) with one BLAS
 thread (``OPENBLAS_NUM_THREADS`` = ``OMP_NUM_THREADS`` = ``MKL_NUM_THREADS`` = 1) and
@@ -71,7 +72,7 @@ def _args(argv: list[str] | None = None) -> argparse.Namespace:
     ap.add_argument("--cold", action="store_true",
                     help="the main job with an empty numba cache (first run after install)")
     ap.add_argument("--pytest-args", default=None,
-                    help="arguments for pytest instead of the whole suite, e.g. "
+                    help="arguments for pytest instead of the default run, e.g. "
                          "'tests/model/test_model_fe.py'")
     return ap.parse_args(argv)
 
@@ -184,7 +185,7 @@ def case_pytest(pytest_args: str | None) -> dict:
     cmd = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *args]
     elapsed, rc, tail, cpu = timed_child(cmd, ROOT)
     summary = tail.splitlines()[-1] if tail else ""
-    return record("pytest", elapsed, rc, cpu, args=args or "whole suite", summary=summary)
+    return record("pytest", elapsed, rc, cpu, args=args or "default run", summary=summary)
 
 
 def record(case: str, elapsed: float, rc: int, cpu: float, **extra) -> dict:

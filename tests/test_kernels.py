@@ -31,7 +31,6 @@ import pytest
 
 from tests.exported_files import file_at
 from tests.kernel_compare import RTOL, delivered, differences, words
-
 from tests.kernel_runs import kernel_env, kernels_selectable, run_both
 
 ROOT = Path(__file__).resolve().parents[1]

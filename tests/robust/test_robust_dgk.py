@@ -500,7 +500,9 @@ def test_a_dgk_steps_scalings_do_not_follow_the_rounding_of_its_loop():
     (tests/data/overhung_dgk_step.npz: its generalised plant, D–K's controller and the
     mixed bound's pointwise scalings at β = 1.16), solved as it is and with the plant's A
     perturbed by 1e-13 of each entry (seeded): about what two BLAS kernel sets change.
-    The scalings' responses agree to 1e-3 of their largest (measured: 3e-5), and the
+    The scalings' responses agree to 1e-3 of their largest (measured: 4.7e-4, 3e-5
+    before the D fits were continued; 2.0 with them continued through two equal
+    all-pass corners, which the rounding parted or not), and the
     scaled loop's H∞ level to 1e-4 (its norm is computed to 1e-6). Reference: the minimax
     of the peak from the first fits (SLSQP), which this step ran before: its scalings
     ended 194 % apart, at levels 1.0149 and 1.0083 (its iterates part threefold per step;
@@ -566,3 +568,70 @@ def test_a_reweighted_round_continues_each_all_pass_fit_from_the_last_round(monk
     monkeypatch.setattr(dgk, "fit_allpass_pair", lambda *a, start=None: fit_pair(*a))
     every = dgk._dg_step_scalings(P, K, 1, 1, mu_s, real, beta, w, 0.05)[2]
     assert level == pytest.approx(every, rel=0.02)
+
+
+def test_a_reweighted_round_continues_each_d_fit_from_the_last_round(monkeypatch):
+    """The D–G step's reweighting rounds fit each channel's D scale once, from the last
+    round's fit at its order; the multistart over orders and starts (up to 16 fits) runs
+    in the first round only. Reference: the same step with the multistart in every round,
+    on :func:`gain_plant`'s loop of an H∞ controller (30 points): the continued fits
+    certify the controller at a level (the H∞ norm of the scaled loop) within μ's 2 %
+    tolerance of it (benchmarks/README.md, "D–G–K's D fits continued")."""
+    import ambseal.robust.dk as dk
+    from ambseal.robust import dgk
+    from ambseal.robust.hinf import hinfsyn
+    from ambseal.robust.mu import check_blocks
+
+    P = gain_plant()
+    K = hinfsyn(ct.ss(P.A, P.B[:, 1:], P.C[1:], P.D[1:, 1:]), 1, 1).K
+    w = np.logspace(-2, 3, 30)
+    sblocks, real = dgk._split(check_blocks(P, BLOCKS, 1, 1))
+    mu_s = mussv(freqresp(lft_lower(P, K, 1, 1), w), sblocks)
+    beta = float(mu_s.upper.max())
+    calls, fit_d, solve = [], dk._fit_dscale, dk.least_squares_converged
+
+    def counted(*args, **kw):
+        calls[-1][1] += 1
+        return solve(*args, **kw)
+
+    def fit(*args, start=None, **kw):
+        calls.append([start, 0])
+        out = fit_d(*args, start=start, **kw)
+        calls[-1].append(out[3])
+        return out
+
+    monkeypatch.setattr(dk, "least_squares_converged", counted)
+    monkeypatch.setattr(dgk, "_fit_dscale", fit)
+    level = dgk._dg_step_scalings(P, K, 1, 1, mu_s, real, beta, w, 0.05)[2]
+    channels = len(real) - 1
+    first, later = calls[:channels], calls[channels:]
+    assert later and all(s is None for s, _, _ in first)
+    assert sum(n for _, n, _ in first) >= 4, first
+    for k, (start, n, (x, order)) in enumerate(later):
+        last = calls[k][2]
+        assert start is last and order == last[1]
+        assert n == (1 if order else 0)
+    monkeypatch.setattr(dgk, "_fit_dscale", lambda *a, start=None, **kw: fit_d(*a, **kw))
+    every = dgk._dg_step_scalings(P, K, 1, 1, mu_s, real, beta, w, 0.05)[2]
+    assert level == pytest.approx(every, rel=0.02)
+
+
+def test_equal_sections_are_spread_before_a_continued_fit():
+    """Two interchangeable sections of one function within SECTION_TIE in every coordinate
+    (a point of symmetry of the fit, which rounding alone would decide to leave or not)
+    get corners SECTION_TIE apart about their mean, the first below; sections that differ,
+    and other functions' sections, are left as they are."""
+    from ambseal.robust._dscale import SECTION_TIE, untied
+
+    x = np.array([4.8076, 4.8081, 7.6, -1.9, 7.6 + 1e-4, -1.9, 3.0, 3.0])
+    groups = [[[0], [1]], [[2, 3], [4, 5]], [[6]], [[7]]]
+    y = untied(x, groups)
+    assert y[0] == pytest.approx(4.80785 - SECTION_TIE / 2, abs=1e-12)
+    assert y[1] == pytest.approx(4.80785 + SECTION_TIE / 2, abs=1e-12)
+    assert y[2] == pytest.approx(7.60005 - SECTION_TIE / 2, abs=1e-12)
+    assert y[4] == pytest.approx(7.60005 + SECTION_TIE / 2, abs=1e-12)
+    assert y[3] == y[5] == -1.9 and np.array_equal(y[6:], x[6:])
+    far = x.copy()
+    far[1] = far[0] + 2 * SECTION_TIE
+    far[3] = -1.8
+    assert np.array_equal(untied(far, groups)[:6], far[:6])

@@ -56,7 +56,7 @@ from ambseal.lti import least_squares_converged
 from ambseal.lti.freqresp import freqresp
 from ambseal.robust._dscale import (
     FIT_STALL_RTOL, _d_logmag_jac, _d_sections, _d_theta, _diag_sys, _ss, _tf_to_theta,
-    _theta_to_tf,
+    _theta_to_tf, untied,
 )
 from ambseal.robust.hinf import hinfnorm, lft_lower
 
@@ -138,7 +138,7 @@ def fit_allpass_pair(w, g, wgt, tol, start=None):
         def largest(x):
             return float(np.max(np.abs(resid(x)) * sq / wgt.max()))
 
-        for x0 in (_ap_starts(lw, k1, k2) if start is None else (start[0],)):
+        for x0 in (_ap_starts(lw, k1, k2) if start is None else (untied(start[0], _ap_sections(k1, k2)),)):
             res = least_squares_converged(resid, np.clip(x0, lb + 1e-3, ub - 1e-3), jac=jac,
                                           bounds=(lb, ub), stall=largest,
                                           stall_rtol=FIT_STALL_RTOL)
@@ -148,6 +148,14 @@ def fit_allpass_pair(w, g, wgt, tol, start=None):
         if best[3] <= 2 * np.arctan(tol):
             break
     return best
+
+
+def _ap_sections(k1, k2):
+    """The interchangeable sections of a pair's two all-pass functions (:func:`untied`):
+    per function its first-order corners, and its second-order sections (corner, damping)."""
+    n = k1 + 2 * k2
+    return [[[h + i] for i in range(k1)] for h in (0, n)] + \
+        [[[h + k1 + 2 * i, h + k1 + 2 * i + 1] for i in range(k2)] for h in (0, n)]
 
 
 def _ap_starts(lw, k1, k2):

@@ -49,6 +49,34 @@ SEARCH_GAMMA_RTOL = 1e-8
 FIT_STALL_RTOL = 0.01
 
 
+#: Log-frequency spacing (0.1 %) at which two interchangeable sections of one fitted
+#: function count as equal: :func:`untied` spreads them to it.
+SECTION_TIE = 1e-3
+
+
+def untied(x, groups):
+    """The fit's coordinates x with its equal sections spread apart: ``groups`` lists, per
+    rational function, its interchangeable sections as index lists into x (the corner's
+    log-frequency first); two sections of a group within :data:`SECTION_TIE` in every
+    coordinate get corners :data:`SECTION_TIE` apart about their mean, the first below.
+
+    Equal sections are a point of symmetry of a fit (swapping them changes nothing), where
+    its gradient cannot part them: a fit continued from there (D–G–K's reweighting rounds,
+    :func:`ambseal.robust.dgk._dg_step_scalings`) leaves it, or not, by the machine's
+    rounding, and then ends in another basin (measured on the overhung compressor
+    example's first D–G–K step: two equal all-pass corners, scalings 2.0 apart under a
+    1e-13 perturbation; benchmarks/README.md, "D–G–K's D fits continued"). Spread, the
+    fit leaves it the same way on every machine."""
+    x = np.array(x, float)
+    for group in groups:
+        for i, a in enumerate(group):
+            for b in group[i + 1:]:
+                if np.all(np.abs(x[a] - x[b]) < SECTION_TIE):
+                    mid = 0.5 * (x[a[0]] + x[b[0]])
+                    x[a[0]], x[b[0]] = mid - 0.5 * SECTION_TIE, mid + 0.5 * SECTION_TIE
+    return x
+
+
 def _logmag(theta, w, order):
     """log|W(jω)| for W = k Π(num sections)/Π(den sections), all roots in the LHP."""
     lk, rest = theta[0], theta[1:]

@@ -71,6 +71,7 @@ from ambseal.robust._dgscale import (
 from ambseal.robust.dk import (
     MusynResult,
     _check,
+    _fit_dscale,
     default_omega,
     fit_dscale,
     musyn,
@@ -175,8 +176,9 @@ def _dg_step_scalings(P, K, nmeas, ncon, mu_s, real, beta, w, fit_tol):
     bound of ``F_l(P, K)`` on the scalar structure at level ``beta``) relaxed
     (:func:`~ambseal.robust._dgscale.relax_pointwise`); per scalar/full block (all but the
     last) ``d`` fitted to their D (:func:`fit_dscale`) and, for real scalars, the all-pass
-    pair fitted to their ĝ (as :func:`fit_g` in the first round; in each later round
-    continued from the last round's pair), the fits weighted again round by round
+    pair fitted to their ĝ (as :func:`fit_g`), both in the first round; in each later
+    round each fit continued from the last round's at its order, the fits weighted again
+    round by round
     towards the frequencies where the scaled closed loop of ``K`` peaks
     (:data:`FIT_REWEIGHT_POWER`) until the grid's peak stalls (:data:`FIT_REWEIGHT_RTOL`,
     :data:`FIT_REWEIGHT_PATIENCE`). Where the best round's peak is within
@@ -196,15 +198,18 @@ def _dg_step_scalings(P, K, nmeas, ncon, mu_s, real, beta, w, fit_tol):
     M = freqresp(lft_lower(P, K, nmeas, ncon), w)
     ds, gs = relax_pointwise(M, mu_s.blocks, real, np.asarray(mu_s.Dl), np.asarray(mu_s.G),
                              mu_s.upper, beta, w)
-    wgt, rounds, stall, g_fits = np.ones_like(w), [], 0, {}
+    wgt, rounds, stall, g_fits, d_at = np.ones_like(w), [], 0, {}, {}
     while stall < FIT_REWEIGHT_PATIENCE:
-        # a reweighted round is the last one's problem with its weights moved: its
-        # all-pass pairs continue from the last round's, the multistart over orders and
-        # starts runs once, at uniform weights (it was most of a D–G–K step's time;
-        # benchmarks/README.md, "D–G–K's all-pass fits continued")
+        # a reweighted round is the last one's problem with its weights moved: its D fits
+        # and all-pass pairs continue from the last round's, the multistart over orders
+        # and starts runs once, at uniform weights (it was most of a D–G–K step's time;
+        # benchmarks/README.md, "D–G–K's all-pass fits continued", "D–G–K's D fits
+        # continued")
         d_fits, g_last, g_fits, jg_err = [], g_fits, {}, 0.0
+        d_last, d_at = d_at, {}
         for j, is_real in enumerate(real[:-1]):
-            d_fits.append(fit_dscale(w, ds[:, j], wgt, tol=fit_tol)[0])
+            fit, *_, d_at[j] = _fit_dscale(w, ds[:, j], wgt, tol=fit_tol, start=d_last.get(j))
+            d_fits.append(fit)
             if is_real:
                 x, k1, k2, e = fit_allpass_pair(w, gs[:, j], wgt, fit_tol,
                                                 start=g_last.get(j))

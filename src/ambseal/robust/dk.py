@@ -40,6 +40,7 @@ from ambseal.robust._dscale import (
     FIT_STALL_RTOL,
     _balance_channels,
     _d_logmag_jac,
+    _d_sections,
     _d_theta,
     _logmag,
     _logmag_jac,
@@ -49,6 +50,7 @@ from ambseal.robust._dscale import (
     _start_evals,
     _theta_to_tf,
     _unbalanced_fit,
+    untied,
 )
 from ambseal.robust.hinf import check_plant, hinfsyn, lft_lower
 from ambseal.robust.mu import _complexify, check_blocks, mu_peak, upper_on_grid
@@ -127,40 +129,60 @@ def fit_magnitude(omega, mag, order: int):
 def _fit_weighted(w, y, order, wgt, starts):
     """Weighted log-magnitude least squares of one order from several starts; pole and zero
     frequencies kept within a decade of the grid, second-order sections' damping ζ within
-    0.05 … 2. Returns (theta, weighted max |error|)."""
+    0.05 … 2. ``starts``: ``(centre, spread)`` of the roots' log-frequencies, or an
+    earlier fit's x (:func:`_fit_from`). Returns (x, weighted max |error|) of the best;
+    θ of :func:`_logmag` is ``_d_theta(x, order)``."""
+    lw = np.log(w)
+    n2, n1 = divmod(order, 2)
+    best, best_err = None, np.inf
+    for start in starts:
+        if isinstance(start, np.ndarray):
+            x = start
+        else:
+            cen0, spread = start
+            cen = np.linspace(lw.min(), lw.max(), 2 * (n2 + n1) + 2)[1:-1]
+            cen = cen0 + spread * (cen - lw.mean())
+            zc, pc = cen[0::2], cen[1::2]
+            x = [0.0]
+            for cs in (zc, pc):
+                x += [v for i in range(n2) for v in (2 * cs[i], np.log(1.4))]
+                x += [cs[n2 + i] if n2 + i < cs.size else cs[-1] for i in range(n1)]
+            x = np.array(x)
+        x, err = _fit_from(w, y, order, wgt, x, fresh=not isinstance(start, np.ndarray))
+        if err < best_err:
+            best, best_err = x, err
+    return best, best_err
+
+
+def _fit_from(w, y, order, wgt, x, fresh: bool = True):
+    """One bounded fit of :func:`_fit_weighted` from x (per second-order section log ω_n²,
+    log 2ζ; per first-order one log a; x[0] the gain), clipped into the bounds; ``fresh``:
+    x[0] set to the weighted mean offset first (a start from the grid, not an earlier
+    fit). Returns (x, weighted max |error|)."""
     lw = np.log(w)
     n2, n1 = divmod(order, 2)
     lo_b, hi_b = lw.min() - np.log(10.0), lw.max() + np.log(10.0)
     sq = np.sqrt(wgt)
-    # x: per second-order section (log ωn², log 2ζ); θ of _logmag: (log ωn², log 2ζωn)
-    def theta(x):
-        return _d_theta(x, order)
 
-    best, best_err = None, np.inf
-    for cen0, spread in starts:
-        cen = np.linspace(lw.min(), lw.max(), 2 * (n2 + n1) + 2)[1:-1]
-        cen = cen0 + spread * (cen - lw.mean())
-        zc, pc = cen[0::2], cen[1::2]
-        x = [0.0]
-        for cs in (zc, pc):
-            x += [v for i in range(n2) for v in (2 * cs[i], np.log(1.4))]
-            x += [cs[n2 + i] if n2 + i < cs.size else cs[-1] for i in range(n1)]
-        sec = [(2 * lo_b, 2 * hi_b), (np.log(0.1), np.log(4.0))] * n2 + [(lo_b, hi_b)] * n1
-        lb, ub = np.array([-60.0] + [b[0] for b in sec] * 2), \
-            np.array([60.0] + [b[1] for b in sec] * 2)
-        x = np.clip(np.array(x), lb + 1e-6, ub - 1e-6)
+    def theta(t):
+        # x: per second-order section (log ωn², log 2ζ); θ of _logmag: (log ωn², log 2ζωn)
+        return _d_theta(t, order)
+
+    sec = [(2 * lo_b, 2 * hi_b), (np.log(0.1), np.log(4.0))] * n2 + [(lo_b, hi_b)] * n1
+    lb, ub = np.array([-60.0] + [b[0] for b in sec] * 2), \
+        np.array([60.0] + [b[1] for b in sec] * 2)
+    x = np.clip(np.array(x, float), lb + 1e-6, ub - 1e-6)
+    if fresh:
         x[0] = np.average(y - _logmag(theta(x), w, order), weights=wgt)
-        def largest(t):
-            return float(np.max(np.abs(_logmag(theta(t), w, order) - y) * wgt / wgt.max()))
 
-        res = least_squares_converged(lambda t: sq * (_logmag(theta(t), w, order) - y), x,
-                                      jac=lambda t: sq[:, None] * _d_logmag_jac(t, w, order)[1],
-                                      method="trf", bounds=(lb, ub), stall=largest,
-                                      stall_rtol=FIT_STALL_RTOL)
-        th, err = theta(res.x), largest(res.x)
-        if err < best_err:
-            best, best_err = th, err
-    return best, best_err
+    def largest(t):
+        return float(np.max(np.abs(_logmag(theta(t), w, order) - y) * wgt / wgt.max()))
+
+    res = least_squares_converged(lambda t: sq * (_logmag(theta(t), w, order) - y), x,
+                                  jac=lambda t: sq[:, None] * _d_logmag_jac(t, w, order)[1],
+                                  method="trf", bounds=(lb, ub), stall=largest,
+                                  stall_rtol=FIT_STALL_RTOL)
+    return res.x, largest(res.x)
 
 
 def fit_dscale(omega, mag, weight=None, *, max_order: int = 4, tol: float = 0.05):
@@ -196,6 +218,16 @@ def fit_dscale(omega, mag, weight=None, *, max_order: int = 4, tol: float = 0.05
     ConfigError
         Non-positive or non-finite data, or ``max_order`` outside 0–4.
     """
+    return _fit_dscale(omega, mag, weight, max_order=max_order, tol=tol)[:3]
+
+
+def _fit_dscale(omega, mag, weight=None, *, max_order: int = 4, tol: float = 0.05,
+                start=None):
+    """:func:`fit_dscale`, returning ``(fit, order, error, (x, order))``: x the fit's
+    coordinates (:func:`_fit_from`). ``start``, such a ``(x, order)`` of an earlier fit of
+    the same D under other weights (D–G–K's reweighting rounds,
+    :func:`ambseal.robust.dgk._dg_step_scalings`): one fit at its order from it, in place
+    of the orders and starts — the continuation of that fit as its weights move."""
     w, d = np.asarray(omega, float), np.asarray(mag, float)
     if not (isinstance(max_order, (int, np.integer)) and 0 <= max_order <= 4):
         raise ConfigError(f"max_order={max_order!r}: the D-scale fit order must be 0–4")
@@ -206,23 +238,28 @@ def fit_dscale(omega, mag, weight=None, *, max_order: int = 4, tol: float = 0.05
     y = np.log(np.clip(d, 1e-8, 1e8))
     lw = np.log(w)
     best = None
-    for order in range(max_order + 1):
+    orders = range(max_order + 1) if start is None else (start[1],)
+    for order in orders:
         if order == 0:
-            th = np.array([np.average(y, weights=wgt)])
-            err = float(np.max(np.abs(th[0] - y) * wgt / wgt.max()))
+            x = np.array([np.average(y, weights=wgt)])
+            err = float(np.max(np.abs(x[0] - y) * wgt / wgt.max()))
         else:
-            starts = [(lw.mean(), 1.0), (lw.mean(), 0.5), (lw.mean() - 1.5, 1.0),
-                      (lw.mean() + 1.5, 1.0)]
-            th, err = _fit_weighted(w, y, order, wgt, starts)
+            sec, _ = _d_sections(order)
+            n2 = order // 2
+            starts = ([(lw.mean(), 1.0), (lw.mean(), 0.5), (lw.mean() - 1.5, 1.0),
+                       (lw.mean() + 1.5, 1.0)] if start is None else
+                      [untied(start[0], [[[i, i + 1] for i in half]
+                                         for half in (sec[:n2], sec[n2:])])])
+            x, err = _fit_weighted(w, y, order, wgt, starts)
         if best is None or err < best[2] * 0.9:
-            best = (th, order, err)
+            best = (x, order, err)
         if err <= np.log1p(tol):
             break
-    th, order, err = best
+    x, order, err = best
     if order == 0:
-        return ct.tf([float(np.exp(th[0]))], [1.0]), 0, err
-    num, den = _theta_to_tf(th, order)
-    return ct.tf(num, den), order, err
+        return ct.tf([float(np.exp(x[0]))], [1.0]), 0, err, (x, 0)
+    num, den = _theta_to_tf(_d_theta(x, order), order)
+    return ct.tf(num, den), order, err, (x, order)
 
 
 def default_omega(P, n: int = 120) -> np.ndarray:

@@ -26,12 +26,22 @@ from __future__ import annotations
 
 import contextlib
 import json
+import os
 import socket
 import sys
 import threading
 from pathlib import Path
 
-import pytest
+# One BLAS thread per test process, as CI runs the suite (.ci/run) and the README's run
+# times are measured: set here, before the workers pytest-xdist starts load numpy, so that
+# they inherit it. Otherwise each worker starts OpenBLAS with a thread per core, and the
+# README's `pytest -n auto` took 15.7 min of wall time (30 min of CPU) on 2 cores instead
+# of 4.3, and a sweep case run in a Dask worker thread rounded one number 1 ulp apart from
+# the serial run (OpenBLAS started with two threads, then held to one by the thread policy).
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import pytest  # noqa: E402  (after the thread variables)
 
 ROOT = Path(__file__).resolve().parents[1]
 TURBO = ROOT / "examples" / "turboexpander.toml"

@@ -138,7 +138,9 @@ def fit_allpass_pair(w, g, wgt, tol, start=None):
         def largest(x):
             return float(np.max(np.abs(resid(x)) * sq / wgt.max()))
 
-        for x0 in (_ap_starts(lw, k1, k2) if start is None else (untied(start[0], _ap_sections(k1, k2)),)):
+        starts = (_ap_starts(lw, k1, k2) if start is None
+                  else (untied(start[0], _ap_sections(k1, k2)),))
+        for x0 in starts:
             res = least_squares_converged(resid, np.clip(x0, lb + 1e-3, ub - 1e-3), jac=jac,
                                           bounds=(lb, ub), stall=largest,
                                           stall_rtol=FIT_STALL_RTOL)

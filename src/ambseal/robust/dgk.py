@@ -178,8 +178,7 @@ def _dg_step_scalings(P, K, nmeas, ncon, mu_s, real, beta, w, fit_tol):
     last) ``d`` fitted to their D (:func:`fit_dscale`) and, for real scalars, the all-pass
     pair fitted to their ĝ (as :func:`fit_g`), both in the first round; in each later
     round each fit continued from the last round's at its order, the fits weighted again
-    round by round
-    towards the frequencies where the scaled closed loop of ``K`` peaks
+    round by round towards the frequencies where the scaled closed loop of ``K`` peaks
     (:data:`FIT_REWEIGHT_POWER`) until the grid's peak stalls (:data:`FIT_REWEIGHT_RTOL`,
     :data:`FIT_REWEIGHT_PATIENCE`). Where the best round's peak is within
     :data:`FIT_REWEIGHT_LEVEL` of 1 its fits are kept; else the first round's (uniform

@@ -12,7 +12,7 @@ from ambseal.errors import ConfigError
 from ambseal.lti.freqresp import freqresp
 from ambseal.robust import _dgscale as dg
 from ambseal.robust.dgk import fit_g, musyn_dgk
-from ambseal.robust.dk import musyn
+from ambseal.robust.dk import fit_dscale, musyn
 from ambseal.robust.hinf import lft_lower
 from ambseal.robust.mu import mussv
 
@@ -353,7 +353,7 @@ def test_the_cutting_planes_end_when_the_bound_is_tight_or_stalls_not_after_a_co
         ds, gs = dg.relax_pointwise(M, mu_s.blocks, SM_REAL, np.asarray(mu_s.Dl),
                                     np.asarray(mu_s.G), mu_s.upper, beta, w)
         x, k1, k2, _ = dg.fit_allpass_pair(w, gs[:, 0], np.ones_like(w), 0.05)
-        sc = dg.DGScalings(mu_s.blocks, SM_REAL, [dgk.fit_dscale(w, ds[:, j], tol=0.05)[0]
+        sc = dg.DGScalings(mu_s.blocks, SM_REAL, [fit_dscale(w, ds[:, j], tol=0.05)[0]
                                                   for j in range(2)], {0: (x, k1, k2)},
                            beta, w)
         monkeypatch.setattr(dg, "_minimax", seen_minimax)

@@ -73,7 +73,6 @@ from ambseal.robust.dk import (
     _check,
     _fit_dscale,
     default_omega,
-    fit_dscale,
     musyn,
     progress_printer,
 )
@@ -172,17 +171,17 @@ FIT_REWEIGHT_LEVEL = 1e-2
 
 
 def _dg_step_scalings(P, K, nmeas, ncon, mu_s, real, beta, w, fit_tol):
-    """The D–G step's rational scalings: the pointwise scalings of ``mu_s`` (the mixed
-    bound of ``F_l(P, K)`` on the scalar structure at level ``beta``) relaxed
+    """The D–G step's rational scalings: the pointwise scalings of ``mu_s`` (the mixed bound
+    of ``F_l(P, K)`` on the scalar structure at level ``beta``) relaxed
     (:func:`~ambseal.robust._dgscale.relax_pointwise`); per scalar/full block (all but the
-    last) ``d`` fitted to their D (:func:`fit_dscale`) and, for real scalars, the all-pass
-    pair fitted to their ĝ (as :func:`fit_g`), both in the first round; in each later
-    round each fit continued from the last round's at its order, the fits weighted again
-    round by round towards the frequencies where the scaled closed loop of ``K`` peaks
-    (:data:`FIT_REWEIGHT_POWER`) until the grid's peak stalls (:data:`FIT_REWEIGHT_RTOL`,
-    :data:`FIT_REWEIGHT_PATIENCE`). Where the best round's peak is within
-    :data:`FIT_REWEIGHT_LEVEL` of 1 its fits are kept; else the first round's (uniform
-    weights) are refined against the scaled closed loop of ``K``
+    last) ``d`` fitted to their D (:func:`~ambseal.robust.dk.fit_dscale`) and, for real
+    scalars, the all-pass pair fitted to their ĝ (as :func:`fit_g`), both in the first
+    round; in each later round each fit continued from the last round's at its order, the
+    fits weighted again round by round towards the frequencies where the scaled closed loop
+    of ``K`` peaks (:data:`FIT_REWEIGHT_POWER`) until the grid's peak stalls
+    (:data:`FIT_REWEIGHT_RTOL`, :data:`FIT_REWEIGHT_PATIENCE`). Where the best round's peak
+    is within :data:`FIT_REWEIGHT_LEVEL` of 1 its fits are kept; else the first round's
+    (uniform weights) are refined against the scaled closed loop of ``K``
     (:func:`~ambseal.robust._dgscale.refine_scalings`). Returns the ``(d, f, h)`` per block
     (f, h None without a G scaling), the largest ψ error (rad) of the fit to the relaxed ĝ
     and the H∞ norm of the scaled closed loop of ``K``.

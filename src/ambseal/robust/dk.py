@@ -136,7 +136,8 @@ def _fit_weighted(w, y, order, wgt, starts):
     n2, n1 = divmod(order, 2)
     best, best_err = None, np.inf
     for start in starts:
-        if isinstance(start, np.ndarray):
+        fresh = not isinstance(start, np.ndarray)
+        if not fresh:
             x = start
         else:
             cen0, spread = start
@@ -148,7 +149,7 @@ def _fit_weighted(w, y, order, wgt, starts):
                 x += [v for i in range(n2) for v in (2 * cs[i], np.log(1.4))]
                 x += [cs[n2 + i] if n2 + i < cs.size else cs[-1] for i in range(n1)]
             x = np.array(x)
-        x, err = _fit_from(w, y, order, wgt, x, fresh=not isinstance(start, np.ndarray))
+        x, err = _fit_from(w, y, order, wgt, x, fresh=fresh)
         if err < best_err:
             best, best_err = x, err
     return best, best_err
@@ -243,14 +244,15 @@ def _fit_dscale(omega, mag, weight=None, *, max_order: int = 4, tol: float = 0.0
         if order == 0:
             x = np.array([np.average(y, weights=wgt)])
             err = float(np.max(np.abs(x[0] - y) * wgt / wgt.max()))
-        else:
+        elif start is None:
+            x, err = _fit_weighted(w, y, order, wgt, [
+                (lw.mean(), 1.0), (lw.mean(), 0.5), (lw.mean() - 1.5, 1.0),
+                (lw.mean() + 1.5, 1.0)])
+        else:  # the numerator's and the denominator's sections, each interchangeable
             sec, _ = _d_sections(order)
-            n2 = order // 2
-            starts = ([(lw.mean(), 1.0), (lw.mean(), 0.5), (lw.mean() - 1.5, 1.0),
-                       (lw.mean() + 1.5, 1.0)] if start is None else
-                      [untied(start[0], [[[i, i + 1] for i in half]
-                                         for half in (sec[:n2], sec[n2:])])])
-            x, err = _fit_weighted(w, y, order, wgt, starts)
+            num, den = np.split(sec, 2)
+            x, err = _fit_weighted(w, y, order, wgt, [untied(
+                start[0], [[[i, i + 1] for i in half] for half in (num, den)])])
         if best is None or err < best[2] * 0.9:
             best = (x, order, err)
         if err <= np.log1p(tol):

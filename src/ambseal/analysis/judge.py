@@ -52,6 +52,7 @@ from ambseal.analysis.loops import (
     compliance_from,
     loop_responses_from,
     resolved_grid,
+    resolved_peaks,
     response_points,
     sigma_max,
 )
@@ -722,12 +723,17 @@ def _controller_at_speed(G, K, schedule, delay):
 
 
 def _sensitivity_grid(loop, freq_hz) -> np.ndarray:
-    """The judged loop's grid (rad/s): ``freq_hz``'s log grid, up to Nyquist for a
-    discrete loop, refined around its lightly damped poles."""
+    """The judged loop's grid (rad/s): :func:`_log_grid` refined around its lightly damped
+    poles."""
+    # a 0.5 %-damped bending mode must not slip through
+    return resolved_grid(_log_grid(loop, freq_hz), loop.s_poles)
+
+
+def _log_grid(loop, freq_hz) -> np.ndarray:
+    """``freq_hz``'s log grid (rad/s), up to Nyquist for a discrete loop."""
     dt = loop.dt
     f_hi = 0.999 * 0.5 / dt if dt else freq_hz[1]  # discrete: up to Nyquist
-    w = 2 * np.pi * np.logspace(math.log10(freq_hz[0]), math.log10(f_hi), freq_hz[2])
-    return resolved_grid(w, loop.s_poles)  # a 0.5 %-damped bending mode must not slip through
+    return 2 * np.pi * np.logspace(math.log10(freq_hz[0]), math.log10(f_hi), freq_hz[2])
 
 
 def _grades(resp, ny_names, stable: bool) -> tuple[dict, np.ndarray]:
@@ -766,10 +772,22 @@ def sensitivity_grades(judged: JudgedLoop, controller, cur, freq_hz) -> dict:
     """
     loop = judged.loop
     G = _signals(judged.source, cur)
-    w = _sensitivity_grid(loop, freq_hz)
-    pts, _ = response_points(w, loop.dt)
-    Gw = judged.plant_response(w)[:, :, list(cur)]
-    Kw = freqresp_at(wired(G, controller), pts)
+    base = _log_grid(loop, freq_hz)
+    # the controller (a few states, kept by no memo) once on every frequency either pass
+    # may ask for: each pass's frequencies are a subset of the resolved grid
+    grid = resolved_grid(base, loop.s_poles)
+    Kgrid = freqresp_at(wired(G, controller), response_points(grid, loop.dt)[0])
+
+    def responses(w):
+        return judged.plant_response(w)[:, :, list(cur)], Kgrid[np.searchsorted(grid, w)]
+
+    def gains(Gw, Kw):
+        So = loop_responses_from(Gw, Kw, np.zeros(len(Gw)), G.output_labels,
+                                 G.input_labels).So
+        return np.column_stack([sigma_max(So), np.abs(np.diagonal(So, axis1=1, axis2=2))])
+
+    # only the peaks are graded: the resolved grid where they can lie
+    w, (Gw, Kw) = resolved_peaks(base, loop.s_poles, responses, gains)
     resp = loop_responses_from(Gw, Kw, w, G.output_labels, G.input_labels)
     return _grades(resp, G.output_labels, loop.stable)[0]
 

@@ -254,7 +254,8 @@ def resolved_grid(omega: Any, poles: np.ndarray, *, zeta_max: float = 0.2,
 
     Adds, around each pole with damping ratio ζ < ``zeta_max`` and damped frequency ω_d
     inside the grid's range, ``points`` frequencies over ω_d (1 ± ``width``·ζ) — the
-    half-power band is ω_d (1 ± ζ), so a peak is caught within ~0.1 % of its height — and
+    half-power band is ω_d (1 ± ζ), so a single resonance's peak is caught within 0.5 % of
+    its height (at most 0.1ζ·ω_d from a frequency: 1/√(1 + 0.01)) — and
     returns the sorted union with ``omega`` (rad/s). A 0.5 % damped bending mode is
     otherwise easily stepped over by a log grid.
     """

@@ -778,16 +778,15 @@ def sensitivity_grades(judged: JudgedLoop, controller, cur, freq_hz) -> dict:
     grid = resolved_grid(base, loop.s_poles)
     Kgrid = freqresp_at(wired(G, controller), response_points(grid, loop.dt)[0])
 
-    def responses(w):
-        return judged.plant_response(w)[:, :, list(cur)], Kgrid[np.searchsorted(grid, w)]
+    def responses(w):  # w too, so that a non-finite response names its frequency
+        return judged.plant_response(w)[:, :, list(cur)], Kgrid[np.searchsorted(grid, w)], w
 
-    def gains(Gw, Kw):
-        So = loop_responses_from(Gw, Kw, np.zeros(len(Gw)), G.output_labels,
-                                 G.input_labels).So
+    def gains(Gw, Kw, w):
+        So = loop_responses_from(Gw, Kw, w, G.output_labels, G.input_labels).So
         return np.column_stack([sigma_max(So), np.abs(np.diagonal(So, axis1=1, axis2=2))])
 
     # only the peaks are graded: the resolved grid where they can lie
-    w, (Gw, Kw) = resolved_peaks(base, loop.s_poles, responses, gains)
+    w, (Gw, Kw, _) = resolved_peaks(base, loop.s_poles, responses, gains)
     resp = loop_responses_from(Gw, Kw, w, G.output_labels, G.input_labels)
     return _grades(resp, G.output_labels, loop.stable)[0]
 

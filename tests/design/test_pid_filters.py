@@ -249,3 +249,30 @@ def test_a_lead_above_nyquist_is_left_out_and_named():
     assert f"above the Nyquist frequency {FS / 2:.4g} Hz" in text
     poles = _as_it_runs(G, fd.filters)
     assert np.abs(poles).max() < 1 and _zeta(poles).min() >= FLOOR
+
+
+@pytest.mark.heavy
+def test_the_derived_pid_chosen_below_the_sample_rate_is_the_full_orders(monkeypatch):
+    """The derived PID's corner and flexible-mode filters are chosen on each condition's
+    plant reduced to its modes below the sample rate (``CHOICE_MODES_PER_FS``). On a
+    generated compressor that needs a filter (``benchmarks/bench_compressors.py`` seed 10,
+    20 kHz, 428-state plant), the choice on every mode of the plant, its reference, gives
+    the same corner and the same filters, their parameters within 1e-5."""
+    import ambseal.design.pid as pid
+
+    from ..benchmark_module import bench_module
+
+    text, _ = bench_module("bench_compressors").compressor_rig(10)
+    cfg = parse_rig(tomllib.loads(text))
+    monkeypatch.setattr(pid, "_DERIVED", {})
+    below = pid.pid_from_rig(cfg)
+    monkeypatch.setattr(pid, "_DERIVED", {})
+    monkeypatch.setattr(pid, "CHOICE_MODES_PER_FS", 1e6)  # every mode of the FE model
+    every = pid.pid_from_rig(cfg)
+    assert below["filters"], below["rule"]
+    assert below["corner_hz"] == every["corner_hz"]
+    assert [f["kind"] for f in below["filters"]] == [f["kind"] for f in every["filters"]]
+    for a, b in zip(below["filters"], every["filters"]):
+        for key, v in a.items():
+            if isinstance(v, float):
+                assert v == pytest.approx(b[key], rel=1e-5), key

@@ -387,8 +387,8 @@ def test_run_not_on_a_terminal_logs_one_line_per_stage(turbo_run):
     stages = [re.match(r"ambseal: ([a-z-]+): done in ([0-9.]+) s \(([0-9.]+) s CPU\), "
                        r"elapsed ([0-9.]+) s$", ln) for ln in lines]
     assert all(stages), lines
-    assert [m.group(1) for m in stages] == ["model", "design", "judge", "speed-range", "spin-up",
-                                           "report"]
+    assert [m.group(1) for m in stages] == ["specification", "model", "design", "judge",
+                                           "speed-range", "spin-up", "report"]
     elapsed = [float(m.group(4)) for m in stages]
     assert elapsed == sorted(elapsed)
     walls = [float(m.group(2)) for m in stages]

@@ -9,6 +9,7 @@ a temporary name and a rename.
 from __future__ import annotations
 
 import sys
+import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -349,13 +350,16 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         raise ConfigError(f"{rig_path}: amb: the main job needs at least one [[amb]]")
     # the truth file is refused before any work
     truth_cfg = load_truth(truth) if identification and truth is not None else None
+    # the specification is the run's first stage, timed as the others are: its derived
+    # defaults (the reference PID's corner and filters among them) judge loops too
+    begun = ("specification", time.perf_counter(), time.process_time())
     spec = design_spec(cfg)
     points = operating_points(spec)
     final = Path(out_dir)
     # one run = one folder: written into a staging folder that replaces out_dir at the end
     with RunFolder(final, force) as out, \
-            StageProgress(_stage_totals(cfg, points),
-                          display=progress and sys.stderr.isatty()) as stages:
+            StageProgress(_stage_totals(cfg, points), display=progress and sys.stderr.isatty(),
+                          begun=begun) as stages:
         (out / "controllers").mkdir()
         check_reference_rate(cfg, rig_path)  # before any stage, as validate refuses it
         st = _RunState(cfg, spec, points, judge_settings(spec, cfg), out, stages, allow_unstable,

@@ -34,9 +34,14 @@ class StageProgress:
         then pulses until the stage ends).
     display : bool
         Show rich's live display on stderr (only sensible on a terminal).
+    begun : (str, float, float), optional
+        A stage begun before this object was made: its name and its start by
+        ``time.perf_counter()`` and ``time.process_time()``. The first :meth:`begin` ends
+        it, and logs it, as it ends any stage, and the elapsed time counts from its start.
     """
 
-    def __init__(self, totals: Mapping[str, int | None], *, display: bool = False):
+    def __init__(self, totals: Mapping[str, int | None], *, display: bool = False,
+                 begun: tuple[str, float, float] | None = None):
         self._totals = dict(totals)
         self._display = display
         self._progress = None
@@ -45,6 +50,9 @@ class StageProgress:
         self._steps = 0
         self._t0 = self._t_stage = time.perf_counter()
         self._cpu_stage = time.process_time()
+        if begun is not None:
+            self._name, self._t_stage, self._cpu_stage = begun
+            self._t0 = self._t_stage
 
     def __enter__(self) -> "StageProgress":
         if self._display:

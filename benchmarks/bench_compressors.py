@@ -49,8 +49,6 @@ Run from the repository root: ``PYTHONPATH=src python benchmarks/bench_compresso
 
 from __future__ import annotations
 
-import argparse
-import json
 import math
 import sys
 import tomllib
@@ -59,8 +57,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_family import run_rig, summary  # noqa: E402
-from bench_suite import log  # noqa: E402
+from bench_family import family_parser, run_family  # noqa: E402
 
 STEEL = {"E": 2.11e11, "rho": 7810.0, "nu": 0.3}
 GRAVITY = 9.81
@@ -225,39 +222,10 @@ def compressor_rig(seed: int) -> tuple[str, dict]:
                   "bending_per_top": f / (p["top_rpm"] / 60)}
 
 
-def _args(argv=None) -> argparse.Namespace:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--seeds", default="0:12", help="a:b, the seeds a … b−1 (default 0:12)")
-    ap.add_argument("--workers", type=int, default=1, help="local Dask workers (1: serial)")
-    ap.add_argument("--scheduler", default=None, help="a running Dask scheduler's address")
-    ap.add_argument("--timeout", type=float, default=3600.0, help="seconds per rig")
-    ap.add_argument("--write-only", default=None, metavar="DIR",
-                    help="write the rig files to DIR and run nothing")
-    return ap.parse_args(argv)
-
-
 def main(argv=None) -> int:
-    from ambseal.analysis.cases import run_cases
-
-    args = _args(argv)
+    args = family_parser(__doc__, "0:12").parse_args(argv)
     a, b = (int(x) for x in args.seeds.split(":"))
-    rigs = [compressor_rig(s) for s in range(a, b)]
-    if args.write_only:
-        out = Path(args.write_only)
-        out.mkdir(parents=True, exist_ok=True)
-        for text, draw in rigs:
-            (out / f"compressor_{draw['seed']}.toml").write_text(text, encoding="utf-8")
-            print(json.dumps(draw), flush=True)
-        return 0
-    cases = [{"text": t, "draw": d} for t, d in rigs]
-    log(f"{len(cases)} rigs")
-    rows = run_cases(run_rig, cases, shared={"timeout": args.timeout}, workers=args.workers,
-                     scheduler=args.scheduler, progress=False,
-                     on_done=lambda i, r: print(json.dumps(r), flush=True))
-    rows = [r if isinstance(r, dict) else {"seed": cases[i]["draw"]["seed"], "error": r.error}
-            for i, r in enumerate(rows)]
-    print(json.dumps(summary(rows)), flush=True)
-    return 0
+    return run_family([compressor_rig(s) for s in range(a, b)], args, "compressor")
 
 
 if __name__ == "__main__":

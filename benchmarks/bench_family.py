@@ -268,30 +268,41 @@ def summary(rows: list[dict]) -> dict:
                                              default=None)}}
 
 
-def _args(argv=None) -> argparse.Namespace:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--seeds", default="0:24", help="a:b, the seeds a … b−1 (default 0:24)")
-    ap.add_argument("--no-examples", action="store_true",
-                    help="leave out the example flywheel at 10, 20 and 40 kHz")
+def family_parser(doc: str, seeds: str) -> argparse.ArgumentParser:
+    """The options of a family's benchmark: ``--seeds`` (default ``seeds``), ``--workers``,
+    ``--scheduler``, ``--timeout`` and ``--write-only``; described by ``doc``'s first
+    paragraph."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    ap.add_argument("--seeds", default=seeds, help=f"a:b, the seeds a … b−1 (default {seeds})")
     ap.add_argument("--workers", type=int, default=1, help="local Dask workers (1: serial)")
     ap.add_argument("--scheduler", default=None, help="a running Dask scheduler's address")
     ap.add_argument("--timeout", type=float, default=3600.0, help="seconds per rig")
     ap.add_argument("--write-only", default=None, metavar="DIR",
                     help="write the rig files to DIR and run nothing")
-    return ap.parse_args(argv)
+    return ap
 
 
 def main(argv=None) -> int:
-    from ambseal.analysis.cases import run_cases
-
-    args = _args(argv)
+    ap = family_parser(__doc__, "0:24")
+    ap.add_argument("--no-examples", action="store_true",
+                    help="leave out the example flywheel at 10, 20 and 40 kHz")
+    args = ap.parse_args(argv)
     a, b = (int(x) for x in args.seeds.split(":"))
     rigs = [family_rig(s) for s in range(a, b)] + ([] if args.no_examples else example_rigs())
+    return run_family(rigs, args, "family")
+
+
+def run_family(rigs: list[tuple[str, dict]], args: argparse.Namespace, name: str) -> int:
+    """Each rig (its file's text and its draw) written as ``DIR/<name>_<seed>.toml`` with
+    ``--write-only DIR``, else run (:func:`run_rig`: serially, or on a Dask cluster) with a
+    JSON line per rig and the family's :func:`summary` last."""
+    from ambseal.analysis.cases import run_cases
+
     if args.write_only:
         out = Path(args.write_only)
         out.mkdir(parents=True, exist_ok=True)
         for text, draw in rigs:
-            (out / f"family_{draw['seed']}.toml").write_text(text, encoding="utf-8")
+            (out / f"{name}_{draw['seed']}.toml").write_text(text, encoding="utf-8")
             print(json.dumps(draw), flush=True)
         return 0
     cases = [{"text": t, "draw": d} for t, d in rigs]

@@ -46,11 +46,12 @@ ZONE_LIMITS: tuple[float, float, float] = (3.0, 4.0, 5.0)
 #: Zone letters from best to worst.
 ZONES: tuple[str, str, str, str] = ("A", "B", "C", "D")
 #: Relative band around each limit of :data:`ZONE_LIMITS` within which a sensitivity peak
-#: is graded on the boundary (:func:`graded_zone`). The judged peaks are maxima on grids
-#: that resolve a resonance's peak to ~0.1 % of its height
-#: (:func:`ambseal.analysis.loops.resolved_grid`): a peak within 0.1 % of a limit is not
-#: known to lie on either side of it. One loop's peaks differ between machines far less
-#: (benchmarks/README.md, "What rounding may not decide").
+#: is graded on the boundary (:func:`graded_zone`): what rounding may not decide. One
+#: loop's peaks differ between machines and BLAS kernels far less than this
+#: (benchmarks/README.md, "What rounding may not decide"). The grid's own resolution is
+#: another matter: :func:`ambseal.analysis.loops.resolved_grid` finds a single
+#: resonance's peak to 0.5 % of its height, always from below and the same on every
+#: machine, so it lowers a grade's number without making it depend on the machine.
 ZONE_RTOL = 1e-3
 #: Every grade from best to worst: the zones and the boundaries between them.
 ZONE_SCALE: tuple[str, ...] = ("A", "A/B", "B", "B/C", "C", "C/D", "D")

@@ -133,7 +133,7 @@ def _rig_text(p: dict, d_body: float) -> str:
                       0.09 * ip_imp))
     out += [f'[[disk]]\nname = "{n}"\nposition = {z!r}\nmass = {mm!r}\nIp = {a!r}\n'
             f'Id = {b!r}\n' for n, z, mm, a, b in disks]
-    mass = p["mass_kg"] = _mass(p, d_body, lay, disks)
+    mass = p["mass_kg"] = _mass(diam, lay, disks)
     i0, s0 = p["bias_a"], p["air_gap_m"]
     ki = p["load_factor"] * mass * GRAVITY / 2 / i0
     ks = ki * i0 / s0
@@ -173,9 +173,9 @@ def _rig_text(p: dict, d_body: float) -> str:
     return "\n".join(out)
 
 
-def _mass(p: dict, d_body: float, lay: dict, disks) -> float:
-    """The rotor's mass (kg): the shaft's sections and the disks."""
-    diam = [0.68 * d_body, 0.85 * d_body, d_body, 0.85 * d_body, 0.68 * d_body]
+def _mass(diam, lay: dict, disks) -> float:
+    """The rotor's mass (kg): the shaft's sections (outside diameters ``diam``) and the
+    disks."""
     shaft = sum(STEEL["rho"] * math.pi / 4 * d ** 2 * s for s, d in zip(lay["sections"], diam))
     return float(shaft + sum(d[2] for d in disks))
 

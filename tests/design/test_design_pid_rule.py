@@ -118,3 +118,13 @@ def test_a_controller_that_cannot_run_is_stated_and_the_others_go_on(rigs):
     assert cannot["old_pid"].startswith("old_pid cannot run on the target")
     assert "sample_rate_hz = 10000 Hz (delay 1 samples)" in cannot["old_pid"]
     assert said == [cannot["old_pid"]]
+
+
+def test_the_rule_says_which_plants_its_damping_ratios_are_of(rigs):
+    """The blower's derived PID takes filters for its bending modes, chosen on each judged
+    condition's plant reduced to its modes below the sample rate (20 kHz): the damping
+    ratios its rule states are of those plants, not of the full-order loop the run judges,
+    and the rule says so where it states them."""
+    rule = rigs["blower"][3]["rule"]
+    assert "structural damping as it runs on the modes below f_s, else the best" in rule
+    assert "; flexible modes as it runs on the modes below f_s = 20000 Hz: 1600 Hz mode" in rule

@@ -314,6 +314,7 @@ def pid_from_rig(cfg) -> dict:
     frac, kept = _corner_for_target(cfg, kp, ti, td)
     eps = float(1 / (2 * np.pi * frac * fs * td))
     lost = np.degrees((cfg.controller.delay_samples + 0.5) * w_n / fs)
+    below = "f_s" if CHOICE_MODES_PER_FS == 1 else f"{CHOICE_MODES_PER_FS:g} f_s"
     out = {"kp": float(kp), "ti": ti, "td": td, "eps": eps, "corner_hz": frac * fs,
            "rule": f"k_eq = {K_EQ_PER_KS:g} Ks, ζ = {PID_ZETA:g} on the rigid-body modes "
                    f"({w_n / (2 * np.pi):.3g} Hz), Ti = {TI_PER_OMEGA_N:g}/"
@@ -323,8 +324,9 @@ def pid_from_rig(cfg) -> dict:
                    f"filter at f_s/{1 / frac:.3g} = {frac * fs:.4g} Hz (ε = {eps:.2g}; the "
                    f"first of f_s/"
                    f"{', f_s/'.join(f'{1 / c:.3g}' for c in PID_CORNERS_PER_FS)} that "
-                   f"keeps {KEEP_OF_STRUCTURAL:g} of the structural damping as it runs, "
-                   f"else the best); sampling and delay cost {lost:.1f}° at ω_n"}
+                   f"keeps {KEEP_OF_STRUCTURAL:g} of the structural damping as it runs on "
+                   f"the modes below {below}, else the best); sampling and delay cost "
+                   f"{lost:.1f}° at ω_n"}
     if slow:
         with contextlib.suppress(ConfigError):  # a note only: no lever arm, no note
             full = 2 * np.pi * top_hz * gyroscopic_cancellation(cfg)
@@ -334,7 +336,11 @@ def pid_from_rig(cfg) -> dict:
     fd = None if kept else _filters_for_target(cfg, kp, ti, td, eps, w_n / (2 * np.pi))
     out["filters"] = [dict(f) for f in fd.filters] if fd else []
     if fd and fd.modes:
-        out["rule"] += "; flexible modes as it runs: " + "; ".join(m.text() for m in fd.modes)
+        # the damping ratios are those of the plants the choice is made on, not the run's
+        # full-order judgement of the PID: the rule says so
+        out["rule"] += (f"; flexible modes as it runs on the modes below {below} = "
+                        f"{CHOICE_MODES_PER_FS * fs:.5g} Hz: "
+                        + "; ".join(m.text() for m in fd.modes))
         if not fd.kept:
             out["rule"] += (f" — as it runs the PID leaves a flexible mode below "
                             f"{KEEP_OF_STRUCTURAL:g} of the structural damping (least ζ "

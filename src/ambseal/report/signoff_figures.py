@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import html
 import os
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -98,16 +99,20 @@ def api617_unbalance_figure(path: str | os.PathLike, results, *,
         The PNG written.
     """
     n = len(results)
-    fig = Figure(figsize=(8, 2.6 + 2.2 * n))
+    # the legend beside the panels: a case's placement (where, how far apart, how heavy)
+    # is read whole, so it is wrapped, never cut, and kept off the curves
+    fig = Figure(figsize=(12, 2.6 + 2.2 * n))
     axes = np.atleast_1d(fig.subplots(n, 1, squeeze=False)[:, 0])
     for ax, r in zip(axes, results):
+        marked = []
         for i, c in enumerate(r.cases):
             ax.semilogy(c.speed_hz * 60.0, c.probe_um.max(axis=1), lw=1.2,
-                        label=f"case {i + 1}: {c.placement}"[:70])
-            for k in c.criticals:
-                ax.plot(k.speed_hz * 60.0, k.amplitude_um, "kv", ms=5)
-                ax.annotate(f"AF {k.af:.3g}", (k.speed_hz * 60.0, k.amplitude_um),
-                            textcoords="offset points", xytext=(4, 4), fontsize=7)
+                        label=textwrap.fill(f"case {i + 1}: {c.placement}", LEGEND_WRAP,
+                                            subsequent_indent="  "))
+            marked += [(float(k.speed_hz) * 60.0, float(k.amplitude_um), float(k.af))
+                       for k in c.criticals]
+        _mark_criticals(ax, marked, max((float(np.max(c.speed_hz)) for c in r.cases),
+                                        default=0.0) * 60.0)
         ax.axhline(r.vibration_limit_um, color="r", ls="--", lw=1.0,
                    label=f"A_vl = {r.vibration_limit_um:.3g} µm p-p")
         ax.axvspan(60.0 * r.min_hz, 60.0 * r.max_hz, color="0.85", alpha=0.6,
@@ -117,10 +122,36 @@ def api617_unbalance_figure(path: str | os.PathLike, results, *,
         ax.set_title(f"{r.controller}: {'passed' if r.passed else 'NOT passed'}",
                      fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7, loc="lower right")
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0),
+                  borderaxespad=0.0)
     axes[-1].set_xlabel("speed (rpm)")
     fig.suptitle(title, fontsize=10)
     return save_figure(fig, path, tight=True)
+
+
+#: Characters per line of the unbalance figure's legend entries
+LEGEND_WRAP = 48
+#: Criticals each within this fraction of the speed axis of the next are one group, whose
+#: AFs share one label (in the order of their speeds) above its highest marker: labels of
+#: criticals that close would be drawn over each other
+AF_CROWD = 0.08
+
+
+def _mark_criticals(ax, marked, top_rpm: float) -> None:
+    """Each critical ``(speed rpm, amplitude µm, AF)`` of a panel as a marker, and the AFs
+    of each group (:data:`AF_CROWD`) as one label; consecutive groups' labels alternate
+    between two heights."""
+    groups: list[list] = []
+    for k in sorted(marked):
+        ax.plot(k[0], k[1], "kv", ms=5)
+        if groups and k[0] - groups[-1][-1][0] < AF_CROWD * top_rpm:
+            groups[-1].append(k)
+        else:
+            groups.append([k])
+    for i, g in enumerate(groups):
+        rpm, amp, _ = max(g, key=lambda k: k[1])
+        ax.annotate("AF " + ", ".join(f"{k[2]:.3g}" for k in g), (rpm, amp),
+                    textcoords="offset points", xytext=(4, 4 + 9 * (i % 2)), fontsize=7)
 
 
 def ucs_map_figure(path: str | os.PathLike, ucs, *, speeds_hz=None,

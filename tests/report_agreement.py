@@ -156,6 +156,12 @@ def check_report_agrees(out: Path) -> None:
                 zones = [z for c in at for b in (c, c.get("discrete") or {})
                          for z in (b.get("iso_zone_per_axis") or {}).values()]
                 want = ("stable" + (f", zone {worst(zones)}" if zones else "")) if ok else None
+                # σ̄(S_o) over all axes, graded here from its peaks, where worse than any axis
+                peaks = [b["sensitivity_peak"] for c in at for b in (c, c.get("discrete") or {})
+                         if b.get("sensitivity_peak") is not None]
+                mimo = worst([zone_of(x) for x in peaks])
+                if ok and zones and worst([mimo, worst(zones)]) != worst(zones):
+                    want += f"; σ̄(S_o) zone {mimo} ({max(peaks):.3g})"
                 assert (cell == want if ok else cell.startswith("unstable") if at
                         else cell == "—"), (row[0], f, cell)
 

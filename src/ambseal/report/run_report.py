@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ambseal import __version__
-from ambseal.analysis import force_demand, lost_conditions, worst_zone
+from ambseal.analysis import ZONE_SCALE, force_demand, lost_conditions, worst_zone
 from ambseal.config import method_label
 from ambseal.identify import MIN_FIT_PCT, fit_reliability, interval_check, true_line
 from ambseal.lti.freqresp import freqresp
@@ -560,6 +560,14 @@ def _speed_range_section(metrics: dict) -> list[dict]:
                      for z in (b.get("iso_zone_per_axis") or {}).values()]
             zone = worst_zone(zones)
             ok = "stable" + (f", zone {zone}" if zone else "")
+            # σ̄(S_o) over all axes, where its zone is worse than every axis's: the verdict
+            # counts it, so the table says where
+            loops = [b for c in at for b in (c, c.get("discrete") or {})]
+            mimo = worst_zone([b.get("iso_zone") for b in loops])
+            if zone and mimo and ZONE_SCALE.index(mimo) > ZONE_SCALE.index(zone):
+                top = max(b["sensitivity_peak"] for b in loops
+                          if b.get("sensitivity_peak") is not None)
+                ok += f"; σ̄(S_o) zone {mimo} ({sig(top)})"
             cells.append('<td>—</td>' if not at else f'<td>{ok}</td>' if not bad else
                          '<td class="unstable">unstable at '
                          + html.escape(", ".join(f"{q:g}" for q in bad)) + " bar</td>")
@@ -569,8 +577,9 @@ def _speed_range_section(metrics: dict) -> list[dict]:
              f"{''.join(rows)}</table></div>")
     text = ("Every controller closed on the full-order plant at each judged pressure and "
             "each speed from standstill to the top speed that is not a judged condition, "
-            "continuous with the target's delay and as it runs (sampled): its stability and "
-            "the worst ISO 14839-3 zone of any axis there (the verdict counts it).")
+            "continuous with the target's delay and as it runs (sampled): its stability, "
+            "the worst ISO 14839-3 zone of any axis there and, where σ̄(S_o) over all axes "
+            "is in a worse zone, that zone and its largest peak (the verdict counts both).")
     return [{"title": "From standstill to the top speed", "text": text, "html": table}]
 
 

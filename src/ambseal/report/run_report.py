@@ -510,9 +510,10 @@ def _styles(curves: list) -> tuple[dict, dict]:
 
 
 def _discrete_section(metrics: dict) -> list[dict]:
-    """One line per case: the controller as it runs on the target beside the continuous
-    design (the ``discrete`` blocks of ``metrics.json``)."""
-    lines = []
+    """A row per judged case: the controller as it runs on the target beside the continuous
+    design (the ``discrete`` blocks of ``metrics.json``), in a table, and the explanations
+    of the differences above the tolerance before it."""
+    rows = []
     for c in metrics["cases"]:
         d = c.get("discrete")
         if d is None:
@@ -524,19 +525,28 @@ def _discrete_section(metrics: dict) -> list[dict]:
         how = (f"{disc['method']} at {d['sample_rate_hz']:g} Hz, {disc['delay_samples']} "
                "sample(s) delay" if {"method", "delay_samples"} <= disc.keys()
                else f"at {d['sample_rate_hz']:g} Hz")
-        lines.append(
-            f"{c['controller']} at {c['pressure_bar']:g} bar, {c['speed_hz']:g} Hz: "
-            f"{'stable' if d['stable'] else 'UNSTABLE'} (max |z| {d['max_abs_pole_z']:.5f}), "
-            f"σ̄(S_o) {peak(d['sensitivity_peak'])} against {peak(c['sensitivity_peak'])} "
-            f"continuous, zone {d['iso_zone']}; {how}")
-    if not lines:
+        cells = (c["controller"], f"{c['pressure_bar']:g} bar, {c['speed_hz']:g} Hz",
+                 "stable" if d["stable"] else "UNSTABLE", f"{d['max_abs_pole_z']:.5f}",
+                 peak(d["sensitivity_peak"]), peak(c["sensitivity_peak"]),
+                 str(d["iso_zone"]), how)
+        rows.append(("<tr>" if d["stable"] else '<tr class="unstable">')
+                    + "".join(f'<td class="text">{html.escape(x)}</td>' if i in (0, 1, 7)
+                              else f"<td>{html.escape(x)}</td>" for i, x in enumerate(cells))
+                    + "</tr>")
+    if not rows:
         return []
     why = [f"{m}: {d['peak_difference']['explanation']}" for m, c in metrics["controllers"].items()
            for d in [c.get("discretisation") or {}]
            if (d.get("peak_difference") or {}).get("explanation")]
-    head = ". ".join(why) + ". " if why else ""
-    return [{"title": "On the target (discrete judgement)",
-             "text": head + "; ".join(lines) + "."}]
+    text = (". ".join(why) + ". " if why else "") + (
+        "Each judged condition with the controller as it runs: the plant sampled by the "
+        "hold, the discrete controller and its computation delay, beside the continuous "
+        "loop with the target's delay.")
+    head = "".join(f"<th>{h}</th>" for h in (
+        "Controller", "Condition", "As it runs", "max |z|", "σ̄(S_o) peak as it runs",
+        "σ̄(S_o) peak continuous", "ISO 14839-3 zone as it runs", "Discretisation"))
+    table = (f'<div class="scroll"><table><tr>{head}</tr>{"".join(rows)}</table></div>')
+    return [{"title": "On the target (discrete judgement)", "text": text, "html": table}]
 
 
 def _speed_range_section(metrics: dict) -> list[dict]:

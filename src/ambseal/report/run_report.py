@@ -574,9 +574,10 @@ def _speed_range_section(metrics: dict) -> list[dict]:
             # counts it, so the table says where
             loops = [b for c in at for b in (c, c.get("discrete") or {})]
             mimo = worst_zone([b.get("iso_zone") for b in loops])
-            if zone and mimo and ZONE_SCALE.index(mimo) > ZONE_SCALE.index(zone):
-                top = max(b["sensitivity_peak"] for b in loops
-                          if b.get("sensitivity_peak") is not None)
+            top = max((b["sensitivity_peak"] for b in loops
+                       if b.get("sensitivity_peak") is not None), default=None)
+            if zone and mimo and top is not None \
+                    and ZONE_SCALE.index(mimo) > ZONE_SCALE.index(zone):
                 ok += f"; σ̄(S_o) zone {mimo} ({sig(top)})"
             cells.append('<td>—</td>' if not at else f'<td>{ok}</td>' if not bad else
                          '<td class="unstable">unstable at '

@@ -82,7 +82,8 @@ def api617_unbalance_figure(path: str | os.PathLike, results, *,
                      title: str = "API 617 unbalance response") -> Path:
     """The probes' peak-to-peak response against speed: one panel per controller, one
     line per unbalance case (the largest probe), with A_vl, the minimum and maximum
-    continuous and the trip speed, and each critical marked with its AF.
+    continuous and the trip speed, and each critical marked with its AF (criticals close
+    together share one label, :data:`AF_CROWD`); the legend beside each panel.
 
     Parameters
     ----------

@@ -126,12 +126,12 @@ def test_the_whirl_waterfall_puts_backward_whirl_below_zero():
 def test_the_api617_unbalance_figure_keeps_every_placement_and_af_readable(tmp_path,
                                                                            monkeypatch):
     """API 617's unbalance figure as a person reads it, measured on the drawn figure: each
-    case's legend entry is its whole placement (wrapped, not cut), the legend lies beside
-    the panel, not over its curves, and no two AF labels overlap where criticals crowd
-    (four within 1 400 rpm of a 14 000 rpm axis, as a generated compressor's H∞ gave)."""
+    case's legend entry is its whole placement (wrapped, not cut) with the AF and speed of
+    each of its criticals (four within 1 600 rpm of each other, as a generated compressor's
+    H∞ gave: labels on the curves would overlap); no text is drawn over the curves; each
+    legend lies beside its panel, inside the figure, over no panel and no other legend,
+    also where a panel has eight cases."""
     from types import SimpleNamespace as NS
-
-    from matplotlib.text import Annotation
 
     from ambseal.report import signoff_figures
 
@@ -142,24 +142,34 @@ def test_the_api617_unbalance_figure_keeps_every_placement_and_af_readable(tmp_p
     f = np.linspace(1.0, 230.0, 400)
     placements = ["second mode, at the journals 0.241 m and 1.44 m, 180° apart, W = 557.1 kg "
                   "(every journal)", "20 antinode(s): 0.1 m at 0° (W = 60.28 kg, outboard of "
-                  "the support)"]
-    criticals = [NS(speed_hz=s / 60.0, amplitude_um=a, af=af) for s, a, af in
-                 [(7000.0, 3.6, 0.87), (7100.0, 2.7, 0.913), (8300.0, 5.3, 1.14),
-                  (8400.0, 5.6, 1.1)]]
-    cases = [NS(speed_hz=f, probe_um=np.column_stack([k * f / 40, k * f / 50]),
-                placement=p, criticals=criticals if k == 1 else [])
-             for k, p in zip((1, 2), placements)]
-    result = NS(cases=cases, vibration_limit_um=25.4, min_hz=110.0, max_hz=175.0,
-                trip_hz=183.0, controller="hinf", passed=True)
-    _ok(signoff_figures.api617_unbalance_figure(tmp_path / "u.png", [result, result]))
+                  "the support)"] * 4
+    crowd = [(7000.0, 3.6, 0.87), (7100.0, 2.7, 0.913), (8300.0, 5.3, 1.14),
+             (8600.0, 5.6, 1.1)]
+    cases = [NS(speed_hz=f, probe_um=np.column_stack([k * f / 40, k * f / 50]), placement=p,
+                criticals=[NS(speed_hz=s / 60.0, amplitude_um=a, af=af) for s, a, af in
+                           (crowd if k == 1 else [])])
+             for k, p in enumerate(placements, start=1)]
+
+    def result(n):
+        return NS(cases=cases[:n], vibration_limit_um=25.4, min_hz=110.0, max_hz=175.0,
+                  trip_hz=183.0, controller="hinf", passed=True)
+
+    _ok(signoff_figures.api617_unbalance_figure(tmp_path / "u.png",
+                                                [result(2), result(8), result(2)]))
     fig = drawn[0]
     renderer = fig.canvas.get_renderer()
-    for ax in fig.axes:
-        legend = ax.get_legend()
-        texts = [t.get_text() for t in legend.get_texts()]
-        for i, p in enumerate(placements):
-            assert " ".join(texts[i].split()) == f"case {i + 1}: {p}"
-        assert not legend.get_window_extent(renderer).overlaps(ax.get_window_extent(renderer))
-        boxes = [t.get_window_extent(renderer) for t in ax.texts if isinstance(t, Annotation)]
-        assert [t.get_text() for t in ax.texts] == ["AF 0.87, 0.913", "AF 1.14, 1.1"]
-        assert not any(a.overlaps(b) for i, a in enumerate(boxes) for b in boxes[i + 1:])
+    plots = [ax for ax in fig.axes if ax.axison]
+    legends = [ax.get_legend() for ax in fig.axes if not ax.axison]
+    assert len(plots) == len(legends) == 3
+    boxes = [lg.get_window_extent(renderer) for lg in legends]
+    inside = fig.bbox
+    for lg, box in zip(legends, boxes):
+        texts = [" ".join(t.get_text().split()) for t in lg.get_texts()]
+        assert texts[0] == (f"case 1: {placements[0]}; AF 0.87 at 7000 rpm, 0.913 at 7100 "
+                            "rpm, 1.14 at 8300 rpm, 1.1 at 8600 rpm")
+        assert texts[1] == f"case 2: {placements[1]}"
+        assert inside.x0 <= box.x0 and box.x1 <= inside.x1
+        assert inside.y0 <= box.y0 and box.y1 <= inside.y1
+        assert not any(box.overlaps(ax.get_window_extent(renderer)) for ax in plots)
+    assert not any(a.overlaps(b) for i, a in enumerate(boxes) for b in boxes[i + 1:])
+    assert not any(ax.texts for ax in plots)

@@ -82,8 +82,10 @@ def api617_unbalance_figure(path: str | os.PathLike, results, *,
                      title: str = "API 617 unbalance response") -> Path:
     """The probes' peak-to-peak response against speed: one panel per controller, one
     line per unbalance case (the largest probe), with A_vl, the minimum and maximum
-    continuous and the trip speed, and each critical marked with its AF (criticals close
-    together share one label, :data:`AF_CROWD`); the legend beside each panel.
+    continuous and the trip speed, and each critical marked in its case's colour. Beside
+    each panel its legend: every case's placement whole, wrapped, with the AF and speed of
+    each of its criticals (labels on the curves would lie over each other where criticals
+    crowd); each panel as tall as its legend needs.
 
     Parameters
     ----------
@@ -99,21 +101,22 @@ def api617_unbalance_figure(path: str | os.PathLike, results, *,
     Path
         The PNG written.
     """
-    n = len(results)
-    # the legend beside the panels: a case's placement (where, how far apart, how heavy)
-    # is read whole, so it is wrapped, never cut, and kept off the curves
-    fig = Figure(figsize=(12, 2.6 + 2.2 * n))
-    axes = np.atleast_1d(fig.subplots(n, 1, squeeze=False)[:, 0])
-    for ax, r in zip(axes, results):
-        marked = []
-        for i, c in enumerate(r.cases):
-            ax.semilogy(c.speed_hz * 60.0, c.probe_um.max(axis=1), lw=1.2,
-                        label=textwrap.fill(f"case {i + 1}: {c.placement}", LEGEND_WRAP,
-                                            subsequent_indent="  "))
-            marked += [(float(k.speed_hz) * 60.0, float(k.amplitude_um), float(k.af))
-                       for k in c.criticals]
-        _mark_criticals(ax, marked, max((float(np.max(c.speed_hz)) for c in r.cases),
-                                        default=0.0) * 60.0)
+    labels = [[_case_label(i, c) for i, c in enumerate(r.cases)] for r in results]
+    # a legend of 7-point text: 8.5 pt a line, 3.5 pt between entries, 8 pt of border;
+    # its entries are the cases and A_vl, the speed range and the trip speed (one line
+    # each); each row also holds the panel's title and tick labels (0.6 in)
+    heights = [max(2.2, (8.5 * (sum(t.count("\n") + 1 for t in ls) + 3)
+                         + 3.5 * (len(ls) + 3) + 8.0) / 72.0 + 0.6) for ls in labels]
+    fig = Figure(figsize=(13, 1.0 + sum(heights)))
+    grid = fig.add_gridspec(len(results), 2, width_ratios=(3.0, 1.25), height_ratios=heights)
+    axes = [fig.add_subplot(grid[k, 0]) for k in range(len(results))]
+    for k, (ax, r, ls) in enumerate(zip(axes, results, labels)):
+        for c, label in zip(r.cases, ls):
+            line, = ax.semilogy(c.speed_hz * 60.0, c.probe_um.max(axis=1), lw=1.2,
+                                label=label)
+            for cr in c.criticals:
+                ax.plot(cr.speed_hz * 60.0, cr.amplitude_um, "v", color=line.get_color(),
+                        mec="k", mew=0.6, ms=6)
         ax.axhline(r.vibration_limit_um, color="r", ls="--", lw=1.0,
                    label=f"A_vl = {r.vibration_limit_um:.3g} µm p-p")
         ax.axvspan(60.0 * r.min_hz, 60.0 * r.max_hz, color="0.85", alpha=0.6,
@@ -123,36 +126,27 @@ def api617_unbalance_figure(path: str | os.PathLike, results, *,
         ax.set_title(f"{r.controller}: {'passed' if r.passed else 'NOT passed'}",
                      fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0),
-                  borderaxespad=0.0)
+        side = fig.add_subplot(grid[k, 1])
+        side.axis("off")
+        side.legend(*ax.get_legend_handles_labels(), fontsize=7, loc="upper left",
+                    borderaxespad=0.0)
     axes[-1].set_xlabel("speed (rpm)")
     fig.suptitle(title, fontsize=10)
     return save_figure(fig, path, tight=True)
 
 
 #: Characters per line of the unbalance figure's legend entries
-LEGEND_WRAP = 48
-#: Criticals each within this fraction of the speed axis of the next are one group, whose
-#: AFs share one label (in the order of their speeds) above its highest marker: labels of
-#: criticals that close would be drawn over each other
-AF_CROWD = 0.08
+LEGEND_WRAP = 56
 
 
-def _mark_criticals(ax, marked, top_rpm: float) -> None:
-    """Each critical ``(speed rpm, amplitude µm, AF)`` of a panel as a marker, and the AFs
-    of each group (:data:`AF_CROWD`) as one label; consecutive groups' labels alternate
-    between two heights."""
-    groups: list[list] = []
-    for k in sorted(marked):
-        ax.plot(k[0], k[1], "kv", ms=5)
-        if groups and k[0] - groups[-1][-1][0] < AF_CROWD * top_rpm:
-            groups[-1].append(k)
-        else:
-            groups.append([k])
-    for i, g in enumerate(groups):
-        rpm, amp, _ = max(g, key=lambda k: k[1])
-        ax.annotate("AF " + ", ".join(f"{k[2]:.3g}" for k in g), (rpm, amp),
-                    textcoords="offset points", xytext=(4, 4 + 9 * (i % 2)), fontsize=7)
+def _case_label(i: int, case) -> str:
+    """A case's legend entry: its number and placement, then each critical's AF and speed
+    (rpm), wrapped at :data:`LEGEND_WRAP` characters."""
+    text = f"case {i + 1}: {case.placement}"
+    if len(case.criticals):
+        text += "; AF " + ", ".join(f"{k.af:.3g} at {60.0 * k.speed_hz:.0f} rpm"
+                                    for k in case.criticals)
+    return textwrap.fill(text, LEGEND_WRAP, subsequent_indent="  ")
 
 
 def ucs_map_figure(path: str | os.PathLike, ucs, *, speeds_hz=None,

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ambseal import __version__
-from ambseal.analysis import ZONE_SCALE, force_demand, lost_conditions, worst_zone
+from ambseal.analysis import force_demand, lost_conditions, worst_zone
 from ambseal.config import method_label
 from ambseal.identify import MIN_FIT_PCT, fit_reliability, interval_check, true_line
 from ambseal.lti.freqresp import freqresp
@@ -576,8 +576,7 @@ def _speed_range_section(metrics: dict) -> list[dict]:
             mimo = worst_zone([b.get("iso_zone") for b in loops])
             top = max((b["sensitivity_peak"] for b in loops
                        if b.get("sensitivity_peak") is not None), default=None)
-            if zone and mimo and top is not None \
-                    and ZONE_SCALE.index(mimo) > ZONE_SCALE.index(zone):
+            if zone and mimo and top is not None and worst_zone([zone, mimo]) != zone:
                 ok += f"; σ̄(S_o) zone {mimo} ({sig(top)})"
             cells.append('<td>—</td>' if not at else f'<td>{ok}</td>' if not bad else
                          '<td class="unstable">unstable at '

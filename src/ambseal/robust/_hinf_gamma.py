@@ -16,7 +16,24 @@ from slycot import _wrapper
 
 from ambseal.errors import SynthesisError
 
-__all__ = ["backoff_ladder", "game_riccati", "gamma_search", "sb10ad", "search_gamma"]
+__all__ = ["backoff_ladder", "game_hamiltonian", "game_riccati", "gamma_search",
+           "hamiltonian_level", "sb10ad", "search_gamma"]
+
+
+def game_hamiltonian(A, B, C1, D1, nw: int, g: float):
+    """The Hamiltonian of :func:`game_riccati`'s equation at γ = g, ``(2n, 2n)``; None where
+    ``R = D1ᵀD1 − diag(γ²I_nw, 0)`` is singular or the matrix is not finite."""
+    n = A.shape[0]
+    R = D1.T @ D1
+    R[np.arange(nw), np.arange(nw)] -= g * g
+    try:
+        S = np.linalg.solve(R, np.hstack([D1.T @ C1, B.T]))
+    except np.linalg.LinAlgError:
+        return None
+    RiDC, RiBt = S[:, :n], S[:, n:]
+    Ah = A - B @ RiDC
+    H = np.block([[Ah, -B @ RiBt], [C1.T @ (D1 @ RiDC - C1), -Ah.T]])
+    return H if np.all(np.isfinite(H)) else None
 
 
 def game_riccati(A, B, C1, D1, nw: int, g: float):
@@ -29,16 +46,8 @@ def game_riccati(A, B, C1, D1, nw: int, g: float):
     n = A.shape[0]
     if n == 0:
         return np.zeros((0, 0))
-    R = D1.T @ D1
-    R[np.arange(nw), np.arange(nw)] -= g * g
-    try:
-        S = np.linalg.solve(R, np.hstack([D1.T @ C1, B.T]))
-    except np.linalg.LinAlgError:
-        return None
-    RiDC, RiBt = S[:, :n], S[:, n:]
-    Ah = A - B @ RiDC
-    H = np.block([[Ah, -B @ RiBt], [C1.T @ (D1 @ RiDC - C1), -Ah.T]])
-    if not np.all(np.isfinite(H)):
+    H = game_hamiltonian(A, B, C1, D1, nw, g)
+    if H is None:
         return None
     _, sdim, wr, wi, Z, _, info = dgees(lambda x, y: x < 0.0, H, sort_t=1)
     if info or sdim != n:  # (info = n+1, n+2: eigenvalues on the imaginary axis to rounding)
@@ -54,6 +63,89 @@ def game_riccati(A, B, C1, D1, nw: int, g: float):
     if np.min(np.linalg.eigvalsh(X)) < -1e-9 * max(1.0, float(np.max(np.abs(X)))):
         return None
     return X
+
+
+#: Relative real part (of the largest |λ|) below which :func:`hamiltonian_level` reads a
+#: Hamiltonian eigenvalue as on the imaginary axis. Looser than :func:`game_riccati`'s
+#: 1e-12: near the level sought two imaginary eigenvalues nearly coincide, and a double
+#: eigenvalue is computed to about √ε (Bruinsma & Steinbuch 1990 §4). An eigenvalue near
+#: the imaginary axis read as on it costs one more evaluation, and what the level says is
+#: checked by the Riccati margin anyway.
+IMAGINARY_RTOL = 1e-8
+
+
+def hamiltonian_level(A, B, C1, D1, nw: int, rtol: float):
+    """The level γ_h at which :func:`game_riccati`'s Hamiltonian acquires imaginary-axis
+    eigenvalues as γ falls: below it the stabilising X∞ does not exist, so γ_opt ≥ γ_h.
+
+    The Hamiltonian has an eigenvalue jω exactly where the Popov function
+    ``G(jω)ᴴG(jω) − diag(γ²I_nw, 0)`` (``G = C1 (sI − A)⁻¹ B + D1``, inputs ``[w, u]``) is
+    singular, that is where γ is a singular value of ``Π⊥ G_w(jω)``, the w columns seen
+    past the range of the u columns (a Schur complement of the Popov function; Zhou, Doyle
+    & Glover 1996 §13.2 for the Hamiltonian, §17.3 for the projection). So γ_h is the
+    L∞ norm of that projected function, found as Bruinsma & Steinbuch (1990, Syst. Control
+    Lett. 14, 287–293) find an H∞ norm: from a lower bound (the largest σ̄ at ω = 0 and
+    at A's damped natural frequencies), the Hamiltonian at the bound × (1 + rtol/4)
+    either has no imaginary eigenvalue — the bound is within that of γ_h — or its
+    imaginary eigenvalues bracket the frequencies where the norm lies higher, and the
+    largest σ̄ at their midpoints is the next bound. It ends there, or where a bound no
+    longer rises by rtol/4 (rounding).
+
+    Parameters
+    ----------
+    A, B, C1, D1 : numpy.ndarray
+        The equation's system, as :func:`game_riccati` (``nw`` first columns of B and D1:
+        the exogenous inputs).
+    nw : int
+    rtol : float
+        Relative tolerance of the level.
+
+    Returns
+    -------
+    float or None
+        The largest lower bound found (γ_h to ``rtol``); None where it is not determined:
+        no states, no exogenous input, a singular frequency response or u columns that
+        lose rank on the imaginary axis, or a Hamiltonian not formed.
+    """
+    n = A.shape[0]
+    if n == 0 or nw == 0 or not np.all(np.isfinite(A)):
+        return None
+    eye = np.eye(n)
+
+    def level(w: float) -> float:
+        try:
+            G = C1 @ np.linalg.solve(1j * w * eye - A, B) + D1
+        except np.linalg.LinAlgError:
+            return np.nan
+        Gw, Gu = G[:, :nw], G[:, nw:]
+        if Gu.shape[1]:
+            Q, R = np.linalg.qr(Gu)
+            d = np.abs(np.diag(R))
+            if not d.min() > 1e-12 * max(float(d.max()), np.finfo(float).tiny):
+                return np.nan
+            Gw = Gw - Q @ (Q.conj().T @ Gw)
+        return float(np.linalg.svd(Gw, compute_uv=False)[0])
+
+    lam = np.linalg.eigvals(A)
+    start = [level(w) for w in [0.0, *np.abs(lam.imag[lam.imag > 0])]]
+    if np.any(np.isnan(start)):
+        return None
+    lb = max(start)
+    while True:
+        H = game_hamiltonian(A, B, C1, D1, nw, lb * (1.0 + 0.25 * rtol))
+        if H is None:
+            return None
+        ev = np.linalg.eigvals(H)
+        on_jw = np.abs(ev.real) <= IMAGINARY_RTOL * max(1.0, float(np.max(np.abs(ev))))
+        w = np.sort(np.abs(ev.imag[on_jw]))
+        if not w.size:
+            return lb
+        up = [level(x) for x in [*w, *(0.5 * (w[1:] + w[:-1]))]]
+        if np.any(np.isnan(up)):
+            return None
+        if not max(up) > lb * (1.0 + 0.25 * rtol):
+            return lb
+        lb = max(up)
 
 
 def search_gamma(margin, lo: float, rtol: float, seen: dict | None = None, *,

@@ -43,6 +43,7 @@ from ambseal.lti import lft_lower, lft_lower_matrices, ss_matrices
 from ambseal.robust._hinf_gamma import backoff_ladder as _backoff_ladder
 from ambseal.robust._hinf_gamma import game_riccati as _game_riccati
 from ambseal.robust._hinf_gamma import gamma_search as _gamma_search
+from ambseal.robust._hinf_gamma import hamiltonian_level as _hamiltonian_level
 from ambseal.robust._hinf_gamma import sb10ad as _sb10ad
 from ambseal.robust._hinf_gamma import search_gamma as _search_gamma
 from ambseal.robust._hinf_small import small_margin
@@ -603,8 +604,7 @@ def hinf_gamma_opt(P, nmeas: int, ncon: int, *, rtol: float = 1e-6,
     sb = _Sb10(P, nmeas, ncon)
     if near is None:
         return float(sb.gamma_opt(rtol)[0])
-    return float(_search_gamma(sb.riccati_margin, sb.parrott_bound, rtol, start=near,
-                               factor=NEAR_FACTOR)[0])
+    return float(sb.search(rtol, start=near, factor=NEAR_FACTOR)[0])
 
 
 @dataclass(frozen=True)
@@ -643,6 +643,8 @@ class _Sb10:
         self._margins: dict = {}
         #: the game Riccati equation (X∞ or Y∞) :meth:`riccati_margin` solves first
         self._fails_first = "X"
+        #: :meth:`hamiltonian_levels` per tolerance
+        self._levels: dict = {}
 
     def sb10ad(self, g: float, job: int, gtol: float = 1e-6):
         """SLICOT SB10AD on the scaled plant at γ = g (job 4: test and controller at g; job
@@ -733,6 +735,44 @@ class _Sb10:
         b = np.linalg.svd(D11 @ V, compute_uv=False)[0] if V.size else 0.0
         return float(max(a, b))
 
+    def search(self, rtol: float, seen: dict | None = None, *, start: float | None = None,
+               factor: float = 4.0) -> tuple[float, float, int]:
+        """γ_opt to ``rtol``, ``(hi, lo, tests)`` as :func:`_search_gamma`: where the γ at
+        which a game Hamiltonian meets the imaginary axis (:meth:`hamiltonian_levels`)
+        decides γ_opt — the margin (:meth:`riccati_margin`) admits that level × (1 +
+        rtol/2) — that γ and the level × (1 − rtol/4), below which no controller exists
+        (Glover & Doyle 1988, Thm 3.1: X∞ and Y∞ need Hamiltonians without imaginary
+        eigenvalues); else :func:`_search_gamma` on the margin from the Parrott bound (a
+        ladder from ``start`` by ``factor``, ``seen`` the margins known).
+
+        Where the level decides, the margin jumps from below 0 to +1 there, and Brent's
+        method bisected some 25 margins to a tolerance of 1e-8 — to where rounding in the
+        Schur form of a Hamiltonian with two nearly equal eigenvalues on the imaginary axis
+        stopped reading them as such, 1e-8 to 2e-7 below the level on a 122-state plant's
+        D search, and not monotonically, so each bracket's bisection ended elsewhere in
+        that band (benchmarks/README.md, "γ_opt where a Hamiltonian meets the imaginary
+        axis"). The level is a singular value at one frequency, which rounding moves by
+        about ε."""
+        level = self.hamiltonian_levels(rtol)
+        if level is not None and level > self.parrott_bound * (1.0 + 1e-9):
+            hi = level * (1.0 + 0.5 * rtol)
+            if self.riccati_margin(hi) < 0:
+                return hi, level * (1.0 - 0.25 * rtol), 1
+        return _search_gamma(self.riccati_margin, self.parrott_bound, rtol, seen,
+                             start=start, factor=factor)
+
+    def hamiltonian_levels(self, rtol: float) -> float | None:
+        """The larger of the levels at which the X∞ and the Y∞ game Hamiltonians of the
+        scaled plant meet the imaginary axis as γ falls (:func:`_hamiltonian_level`, to
+        ``rtol``): a lower bound of γ_opt. None where either is not determined."""
+        if rtol not in self._levels:
+            nz, nw, A, B, C, D = self.nz, self.nw, self.A, self.B, self.C, self.D
+            x = _hamiltonian_level(A, B, C[:nz], D[:nz], nw, rtol)
+            y = None if x is None else _hamiltonian_level(A.T, C.T, B[:, :nw].T,
+                                                          D[:, :nw].T, nz, rtol)
+            self._levels[rtol] = None if y is None else max(x, y)
+        return self._levels[rtol]
+
     def riccati_margin(self, g: float) -> float:
         """The γ test of Glover & Doyle (1988), Thm 3.1, on the scaled plant, as a number:
         ``ρ(X∞Y∞)/γ² − 1`` (< 0: γ admissible) when the stabilising X∞ ⪰ 0 and Y∞ ⪰ 0 of the
@@ -819,8 +859,7 @@ class _Sb10:
         g0 = max(1.5 * lo0, 1.0)
         if near is not None and self.A.shape[0] > _SMALL_STATES:
             sb0 = None
-            hi, lo, tests = _search_gamma(self.riccati_margin, lo0, rtol, start=near,
-                                          factor=NEAR_FACTOR)
+            hi, lo, tests = self.search(rtol, start=near, factor=NEAR_FACTOR)
         else:
             ric0, tests, sb0 = self._small_margin(g0), 1, None  # (g0 > the Parrott bound)
             if np.isnan(ric0):
@@ -834,7 +873,7 @@ class _Sb10:
                     if self._keeps_gamma(g0):
                         return self._ladder_job1(lo0, g0, sb0, rtol, tests)
                     sb0 = 1.0
-            hi, lo, more = _search_gamma(self.riccati_margin, lo0, rtol, {g0: ric0})
+            hi, lo, more = self.search(rtol, {g0: ric0})
             tests += more
         if lo > lo0 * (1.0 + 1e-9) and self.riccati_margin(lo) >= 1.0:
             # the margin refused lo for want of a stabilising X∞ ⪰ 0 or Y∞ ⪰ 0 — which a

@@ -750,9 +750,9 @@ class _Sb10:
         Schur form of a Hamiltonian with two nearly equal eigenvalues on the imaginary axis
         stopped reading them as such, 1e-8 to 2e-7 below the level on a 122-state plant's
         D search, and not monotonically, so each bracket's bisection ended elsewhere in
-        that band (benchmarks/README.md, "γ_opt where a Hamiltonian meets the imaginary
-        axis"). The level is a singular value at one frequency, which rounding moves by
-        about ε."""
+        that band (benchmarks/README.md, "γ_opt where a Hamiltonian meets the
+        imaginary axis"). The level is a singular value at one frequency, which rounding
+        moves by about ε."""
         level = self.hamiltonian_levels(rtol)
         if level is not None and level > self.parrott_bound * (1.0 + 1e-9):
             hi = level * (1.0 + 0.5 * rtol)

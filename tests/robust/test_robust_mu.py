@@ -562,3 +562,49 @@ def test_the_newton_hessian_of_the_lmi_term_is_the_dense_trace_form(blocks):
     _lmi_term(Li, np.ascontiguousarray(M[0]), t, P.tp, P.tu, P.tv, P.ekind, P.ea, P.eb, g, H)
     np.testing.assert_allclose(g, g_ref, rtol=0, atol=1e-11 * np.abs(g_ref).max())
     np.testing.assert_allclose(H, H_ref, rtol=0, atol=1e-11 * np.abs(H_ref).max())
+
+
+@pytest.mark.parametrize("blocks", [[(-10, 0), (2, 2), (4, 4), (2, 0), (1, 1)],
+                                    [(-1, 0), (-1, 0), (2, 2), (1, 1), (1, 1)],
+                                    [(-3, 0), (3, 0), (1, 1), (2, 3)]])
+def test_the_newton_derivatives_of_the_whole_barrier_are_the_dense_trace_form(blocks):
+    """Reference: the method of centres' barrier −log det(t D − A) − log det D
+    − log det(gmax I − G) − log det(gmax I + G) (G on the real blocks' rows; D block
+    diagonal, its full blocks d·I) differentiated from the dense derivative matrices of the
+    problem's affine form (numpy): g_i = −Σ tr(Y⁻¹Y_i), H_ij = Σ Re tr(Y⁻¹Y_i Y⁻¹Y_j).
+    The compiled derivatives (``_mu_newton._derivs``: the LMI's rank-two form, the D and G
+    blocks' Hessians from the entries of Y⁻¹) must give both to rounding, with a repeated
+    real block of 10 (p = 206), a repeated complex block of 3 and real scalars."""
+    from ambseal.robust._mu_newton import _derivs
+    from ambseal.robust._mu_upper import _Problem, structure
+    from ambseal.robust.mu import parse_blocks
+
+    rng = np.random.default_rng(12)
+    blks = parse_blocks(blocks)
+    S = structure(blks)
+    N, gmax, t = S.N, 10.0, 2.5
+    M = crandn(rng, 1, N, N) / N
+    P = _Problem(M, blks, S, gmax)
+    A0, V = P.affine(np.arange(1))
+    z = 0.01 * rng.standard_normal((1, P.p))
+    D, A = P._mats(z, A0, V)
+    ri = S.realidx
+    Gr = np.ascontiguousarray(P.G(z)[0][np.ix_(ri, ri)])
+    Lder = t * P.U - V[0]
+    terms = [(t * D[0] - A[0], Lder), (D[0], P.U)]
+    if P.pG:
+        dG = np.concatenate([np.zeros((P.pD, ri.size, ri.size)), P.BGr])
+        eye = np.eye(ri.size)
+        terms += [(gmax * eye - Gr, -dG), (gmax * eye + Gr, dG)]
+    g_ref, H_ref = np.zeros(P.p), np.zeros((P.p, P.p))
+    for Y, dY in terms:
+        R = np.einsum("ab,ibc->iac", np.linalg.inv(Y), dY)
+        g_ref -= np.real(np.einsum("iaa->i", R))
+        H_ref += np.real(np.einsum("iab,jba->ij", R, R))
+    g, H, inside = _derivs(np.ascontiguousarray(t * D[0] - A[0]), np.ascontiguousarray(D[0]),
+                           Gr if P.pG else np.zeros((0, 0), complex),
+                           np.ascontiguousarray(M[0]), t, P.tp, P.tu, P.tv, P.ekind, P.ea,
+                           P.eb, P.BD, P.BGr, P.offs, P.full, gmax, P.pD)
+    assert inside
+    np.testing.assert_allclose(g, g_ref, rtol=0, atol=1e-11 * np.abs(g_ref).max())
+    np.testing.assert_allclose(H, H_ref, rtol=0, atol=1e-11 * np.abs(H_ref).max())

@@ -604,7 +604,7 @@ def test_the_newton_derivatives_of_the_whole_barrier_are_the_dense_trace_form(bl
     g, H, inside = _derivs(np.ascontiguousarray(t * D[0] - A[0]), np.ascontiguousarray(D[0]),
                            Gr if P.pG else np.zeros((0, 0), complex),
                            np.ascontiguousarray(M[0]), t, P.tp, P.tu, P.tv, P.ekind, P.ea,
-                           P.eb, P.BD, P.BGr, P.offs, P.full, gmax, P.pD)
+                           P.eb, P.loc_a, P.loc_b, P.BD, P.BGr, P.offs, P.full, gmax, P.pD)
     assert inside
     np.testing.assert_allclose(g, g_ref, rtol=0, atol=1e-11 * np.abs(g_ref).max())
     np.testing.assert_allclose(H, H_ref, rtol=0, atol=1e-11 * np.abs(H_ref).max())

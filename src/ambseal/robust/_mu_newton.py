@@ -271,11 +271,11 @@ def _lmi_term(Yinv, M, t, tp, tu, tv, ekind, ea, eb, g, H):
 
 
 @cached_njit()
-def _derivs(L1, D, Gr, M, t, tp, tu, tv, ekind, ea, eb, BD, BGr, offs, full, gmax, pD):
+def _derivs(L1, D, Gr, M, t, tp, tu, tv, ekind, ea, eb, loc_a, loc_b, BD, BGr, offs, full,
+            gmax, pD):
     """Gradient (p,) and Hessian (p, p) of the barrier at one matrix's current point, and
     whether the point is inside the barrier's domain (every matrix positive definite)."""
     p = tp.size - 1
-    r = ekind.size
     g = np.zeros(p)
     H = np.zeros((p, p))
     o = offs[0]  # = 0, typed int64 (a literal 0 would compile _entry_term twice)
@@ -296,27 +296,9 @@ def _derivs(L1, D, Gr, M, t, tp, tu, tv, ekind, ea, eb, BD, BGr, offs, full, gma
         else:
             Yinv, ok = _inv(np.ascontiguousarray(D[o0:o1, o0:o1]))
             inside = inside and ok
-            la = np.full(r, -1, np.int64)
-            lb = np.full(r, -1, np.int64)
-            for u in range(r):
-                if ekind[u] == 0 and o0 <= ea[u] < o1:
-                    la[u], lb[u] = ea[u] - o0, eb[u] - o0
-            _entry_term(Yinv, la, lb, tp, tu, tv, o, pD, 1.0, g, H)
+            _entry_term(Yinv, loc_a[k], loc_b[k], tp, tu, tv, o, pD, 1.0, g, H)
     if BGr.shape[0]:  # gmax I ∓ G: derivatives ∓B_i, on the real blocks' rows
-        loc = np.full(M.shape[0], -1, np.int64)
-        for u in range(r):
-            if ekind[u] == 1:
-                loc[ea[u]] = 0
-        nr = 0
-        for a in range(loc.size):  # the real rows in order: G's local coordinates
-            if loc[a] == 0:
-                loc[a] = nr
-                nr += 1
-        la = np.full(r, -1, np.int64)
-        lb = np.full(r, -1, np.int64)
-        for u in range(r):
-            if ekind[u] == 1:
-                la[u], lb[u] = loc[ea[u]], loc[eb[u]]
+        la, lb = loc_a[offs.size - 1], loc_b[offs.size - 1]
         Yinv, ok = _inv(_shift(Gr, -1.0, gmax))
         inside = inside and ok
         _entry_term(Yinv, la, lb, tp, tu, tv, pD, p, -1.0, g, H)
@@ -359,7 +341,7 @@ def _feasible(L1, D, Gr, gmax):
 
 
 def newton_steps(L1, D, Gr, za, Lder, U, BD, BGr, offs, full, gmax, pD, n_newton, dec_tol,
-                 M, t, tp, tu, tv, ekind, ea, eb):
+                 M, t, tp, tu, tv, ekind, ea, eb, loc_a, loc_b):
     """Up to ``n_newton`` damped Newton steps on every matrix of the stack; in place.
 
     The barrier's derivatives and the damped steps are compiled (one matrix at a time); the
@@ -382,6 +364,8 @@ def newton_steps(L1, D, Gr, za, Lder, U, BD, BGr, offs, full, gmax, pD, n_newton
     tp, tu, tv : the sparse map from coordinates to scaling entries, row i of T at
         ``tu[tp[i]:tp[i+1]]`` with values ``tv[…]`` (complex)
     ekind, ea, eb : (r,) int, each scaling entry's kind (0: D, 1: G) and position (a, b)
+    loc_a, loc_b : (nblocks + 1, r) int, each entry's position inside D's block k (row k)
+        and inside gmax I ∓ G on the real rows (the last row); -1 outside
 
     Returns
     -------
@@ -396,8 +380,8 @@ def newton_steps(L1, D, Gr, za, Lder, U, BD, BGr, offs, full, gmax, pD, n_newton
     centred = np.zeros(F, np.bool_)
     lost = np.zeros(F, np.bool_)
     for _k in range(n_newton):
-        g, H, inside = _stack_derivs(L1, D, Gr, M, t, tp, tu, tv, ekind, ea, eb, BD, BGr,
-                                     offs, full, gmax, pD, lost)
+        g, H, inside = _stack_derivs(L1, D, Gr, M, t, tp, tu, tv, ekind, ea, eb, loc_a,
+                                     loc_b, BD, BGr, offs, full, gmax, pD, lost)
         lost |= ~inside
         dz, dec = np.zeros((F, p)), np.zeros(F)
         ok = np.flatnonzero(~lost)
@@ -411,8 +395,8 @@ def newton_steps(L1, D, Gr, za, Lder, U, BD, BGr, offs, full, gmax, pD, n_newton
 
 
 @cached_njit()
-def _stack_derivs(L1, D, Gr, M, t, tp, tu, tv, ekind, ea, eb, BD, BGr, offs, full, gmax, pD,
-                  skip):
+def _stack_derivs(L1, D, Gr, M, t, tp, tu, tv, ekind, ea, eb, loc_a, loc_b, BD, BGr, offs,
+                  full, gmax, pD, skip):
     """:func:`_derivs` of every matrix not in ``skip``: g (F, p), H (F, p, p), inside (F,)."""
     F, p = L1.shape[0], tp.size - 1
     g = np.zeros((F, p))
@@ -422,7 +406,7 @@ def _stack_derivs(L1, D, Gr, M, t, tp, tu, tv, ekind, ea, eb, BD, BGr, offs, ful
         if skip[f]:
             continue
         gf, Hf, inside[f] = _derivs(L1[f], D[f], Gr[f], M[f], t[f], tp, tu, tv, ekind, ea,
-                                    eb, BD, BGr, offs, full, gmax, pD)
+                                    eb, loc_a, loc_b, BD, BGr, offs, full, gmax, pD)
         for i in range(p):  # (loops: a slice assignment costs seconds to compile)
             g[f, i] = gf[i]
             for j in range(p):

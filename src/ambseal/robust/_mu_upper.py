@@ -222,6 +222,15 @@ class _Problem:
         self.ea = np.r_[S.aD, S.aG].astype(np.int64)
         self.eb = np.r_[S.bD, S.bG].astype(np.int64)
         self.full = np.array([b.kind == "full" for b in blks], np.bool_)
+        # each entry's position inside the barrier matrix it lies in (-1: another one): row
+        # k for D's block k, the last row for gmax I ∓ G on the real rows (_mu_newton._derivs)
+        r, nb = self.ea.size, len(blks)
+        self.loc_a = np.full((nb + 1, r), -1, np.int64)
+        self.loc_b = np.full((nb + 1, r), -1, np.int64)
+        for k, (o0, o1) in enumerate(zip(self.offs[:-1], self.offs[1:])):
+            inb = (self.ekind == 0) & (self.ea >= o0) & (self.ea < o1)
+            self.loc_a[k, inb], self.loc_b[k, inb] = self.ea[inb] - o0, self.eb[inb] - o0
+        self.loc_a[nb, S.aD.size:], self.loc_b[nb, S.aD.size:] = S.aGl, S.bGl
 
     def affine(self, idx):
         """A_0 (F, N, N) and V (F, p, N, N) for the matrices M[idx]."""
@@ -345,7 +354,7 @@ def _centres_chunk(P, z, t, tol, max_iter, idx, theta=0.25, n_newton=5, dec_tol=
         centred, lost = newton_steps(L1, D, Gr if pG else np.zeros((Fa, 0, 0), complex), za,
                                      Lder, P.U, P.BD, P.BGr, P.offs, P.full, float(gmax), pD,
                                      n_newton, dec_tol, Mall[active], ta, P.tp, P.tu, P.tv,
-                                     P.ekind, P.ea, P.eb)
+                                     P.ekind, P.ea, P.eb, P.loc_a, P.loc_b)
         lam_a = _gevp(D, ta[:, None, None] * D - L1)
         better = lam_a < best_lam[active]
         best_lam[active[better]] = lam_a[better]

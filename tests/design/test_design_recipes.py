@@ -13,6 +13,7 @@ the log grid but 5.8 at 556.8 Hz, 4.08 bar).
 """
 
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -21,7 +22,14 @@ from ambseal.analysis.loops import compliance, loop_responses
 from ambseal.machine.loop import closed_loop
 from ambseal.analysis.unbalance import unbalance_from_compliance
 from ambseal.design.plant import UncertainParameter
-from ambseal.design.recipes import _outside, _unstable_message, design
+from ambseal.design import recipes
+from ambseal.design.recipes import (
+    MU_BOUNDARY_RTOL,
+    ORDER_RISE,
+    _outside,
+    _unstable_message,
+    design,
+)
 from ambseal.design.weights import Weights
 from ambseal.config import load_rig
 
@@ -32,11 +40,6 @@ OMEGA = 2 * np.pi * np.logspace(-1, np.log10(3000.0), 800)
 ISO_ZONE_A_LIMIT = 3.0
 #: Thesis demand on the worst-case G2.5 unbalance orbit up to 200 Hz (P5 §4.4.1): 8 µm.
 ORBIT_DEMAND_UM = 8.0
-#: Regression pin, not a published value: order reduction of the μ controller (46 → 28
-#: states) raised the peak μ by 2.1 % (1.116 → 1.139) when this pin was set;
-#: P5 §4.3 reduces its controllers without quoting the cost. 5 % flags a change.
-MU_REDUCTION_COST_PIN = 0.05
-
 
 @pytest.fixture(scope="module")
 def cfg(testrig_cfg):
@@ -104,14 +107,49 @@ def test_hinf_gamma_is_the_verified_closed_loop_norm(designs):
     assert r.K.ninputs == r.K.noutputs == 4 and r.order == r.K.nstates
 
 
-def test_mu_reduction_cost_regression_pin(designs):
-    """Regression pin MU_REDUCTION_COST_PIN (module constant, own measurement): the reduced μ
-    controller's peak μ is within 5 % of the full-order one, and reduction did reduce."""
+def test_mu_reduction_reduces_within_the_order_band(designs):
+    """The test rig's μ controller is reduced (46 states at full order when this was
+    written) and its peak μ stays within ``ORDER_RISE`` of the full-order one: the
+    automatic order stopped inside its band, not at the full order."""
     mu = designs["mu"]
     red = mu.reduction
     assert red is not None and red["order"] < red["order_full"] == mu.order_full
     assert mu.order == mu.K.nstates == red["order"]
-    assert red["mu"] <= (1 + MU_REDUCTION_COST_PIN) * red["mu_full"]
+    assert red["mu"] <= (1 + ORDER_RISE) * red["mu_full"]
+
+
+def _order_choice(monkeypatch, mu_full: float, rises: dict) -> float:
+    """μ delivered by :func:`_reduce_best` from a 70-state D–G–K controller of peak μ
+    ``mu_full``, whose balanced truncation to order n raises μ by ``rises[n]``: the
+    reductions scripted, the rule the design's."""
+    from ambseal.robust.order import ReductionResult
+
+    def reduce(P, K, order, nmeas, ncon, *, blocks=None, omega=None, full=None):
+        return ReductionResult(K=order, order_full=70, order=order, gamma_full=1.0,
+                               gamma=1.0, mu_full=full[1], mu=full[1] * (1 + rises[order]))
+
+    monkeypatch.setattr(recipes, "reduce_controller", reduce)
+    cand = {"step": "D-G-K", "K": SimpleNamespace(nstates=70), "mu": mu_full, "gamma": 1.0}
+    _, red, _, mu = recipes._reduce_best(None, [cand], 48, True,
+                                         SimpleNamespace(nmeas=4, ncon=4), [(1, 1)], None)
+    assert red["order"] < 70
+    return mu
+
+
+def test_orders_on_either_side_of_the_bands_edge_deliver_mu_within_its_tolerance(
+        monkeypatch):
+    """The overhung compressor's μ design on two revisions whose arithmetic differed only
+    in rounding (benchmarks/README.md, "μ's Newton steps"): full-order μ 0.7598 against
+    0.7530 (0.9 %), and the truncation to 52 states raising it by 8.9 % on one side and by
+    just over 10 % on the other, where 56 states cost 1.7 % and 1.5 %. With the band at
+    10 % the delivered μ were 0.827 and 0.766, 7.4 % apart; a band of half μ's stated
+    tolerance (``MU_BOUNDARY_RTOL``) keeps the two within that tolerance."""
+    one = _order_choice(monkeypatch, 0.7598, {48: 0.25, 52: 0.089, 56: 0.017, 60: 0.008,
+                                              64: 0.004})
+    other = _order_choice(monkeypatch, 0.7530, {48: 0.24, 52: 0.101, 56: 0.015, 60: 0.006,
+                                                64: 0.002})
+    assert abs(one / other - 1) <= MU_BOUNDARY_RTOL, (one, other)
+    assert ORDER_RISE <= MU_BOUNDARY_RTOL / 2
 
 
 def test_mu_delivers_the_candidate_with_lower_mu_after_reduction(designs):

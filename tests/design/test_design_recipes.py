@@ -41,6 +41,7 @@ ISO_ZONE_A_LIMIT = 3.0
 #: Thesis demand on the worst-case G2.5 unbalance orbit up to 200 Hz (P5 §4.4.1): 8 µm.
 ORBIT_DEMAND_UM = 8.0
 
+
 @pytest.fixture(scope="module")
 def cfg(testrig_cfg):
     return testrig_cfg

@@ -119,15 +119,26 @@ def test_mu_reduction_reduces_within_the_order_band(designs):
     assert red["mu"] <= (1 + ORDER_RISE) * red["mu_full"]
 
 
-def _order_choice(monkeypatch, mu_full: float, rises: dict) -> float:
+def _order_choice(monkeypatch, mu_full: float, rises: dict, asked: dict | None = None
+                  ) -> float:
     """μ delivered by :func:`_reduce_best` from a 70-state D–G–K controller of peak μ
     ``mu_full``, whose balanced truncation to order n raises μ by ``rises[n]``: the
-    reductions scripted, the rule the design's."""
+    reductions scripted, the rule the design's. Where the scan asks whether an order's μ
+    is above a level and it is, the answer is a lower bound 0.1 % below the peak, as
+    :func:`~ambseal.robust.mu.lower_on_grid` gives one; each level asked is recorded in
+    ``asked`` (order → level or None)."""
     from ambseal.robust.order import ReductionResult
 
-    def reduce(P, K, order, nmeas, ncon, *, blocks=None, omega=None, full=None):
+    def reduce(P, K, order, nmeas, ncon, *, blocks=None, omega=None, full=None,
+               mu_above=None):
+        mu = full[1] * (1 + rises[order])
+        low = 0.999 * mu
+        if asked is not None:
+            asked[order] = mu_above
+        lower = mu_above is not None and low > mu_above
         return ReductionResult(K=order, order_full=70, order=order, gamma_full=1.0,
-                               gamma=1.0, mu_full=full[1], mu=full[1] * (1 + rises[order]))
+                               gamma=1.0, mu_full=full[1], mu=low if lower else mu,
+                               mu_is_lower=lower)
 
     monkeypatch.setattr(recipes, "reduce_controller", reduce)
     cand = {"step": "D-G-K", "K": SimpleNamespace(nstates=70), "mu": mu_full, "gamma": 1.0}
@@ -135,6 +146,21 @@ def _order_choice(monkeypatch, mu_full: float, rises: dict) -> float:
                                          SimpleNamespace(nmeas=4, ncon=4), [(1, 1)], None)
     assert red["order"] < 70
     return mu
+
+
+def test_the_order_scan_asks_each_order_below_the_full_one_only_whether_it_is_above_its_band(
+        monkeypatch):
+    """An order the scan steps past matters only as "above the band": each truncation below
+    the full order is asked whether its μ exceeds (1 + ``ORDER_RISE``)·μ of the full-order
+    controller, which a certified lower bound can answer without the upper bound. An
+    order whose lower bound sits above the band is stepped past, and the order delivered,
+    and its μ, are the peak's — the same as a scan that computed every upper bound."""
+    asked: dict = {}
+    rises = {48: 0.25, 52: 0.089, 56: 0.017, 60: 0.008, 64: 0.004}
+    mu = _order_choice(monkeypatch, 0.7530, rises, asked)
+    assert asked == {n: pytest.approx((1 + ORDER_RISE) * 0.7530, rel=1e-15)
+                     for n in (48, 52, 56, 60)}
+    assert mu == pytest.approx(0.7530 * (1 + rises[60]), rel=1e-15)
 
 
 def test_orders_on_either_side_of_the_bands_edge_deliver_mu_within_its_tolerance(

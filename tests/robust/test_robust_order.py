@@ -137,3 +137,47 @@ def test_reduce_controller_solves_a_mixed_structure_only_where_it_reaches_its_pe
     assert res.mu_full == pytest.approx(ref[0], rel=1e-6)
     assert res.mu == pytest.approx(ref[1], rel=1e-6)
     assert 0 < sum(solved) < 2 * 0.6 * w.size
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_a_reduced_loop_known_above_a_level_is_not_solved_for_its_upper_bound(
+        seed, monkeypatch):
+    """Reference: mussv's upper bound of the structure as given on the whole grid, for the
+    plant and reduced controller of the test above. Asked only whether the reduced loop's
+    μ exceeds a level below its peak, ``reduce_controller`` answers from a certified lower
+    bound: ``mu_is_lower``, ``mu`` above the level and at most the whole grid's upper
+    bound, and the mixed structure solved at no frequency. Asked about a level above the
+    peak it reports the peak as without the level."""
+    import ambseal.robust.mu as mu
+    import ambseal.robust.order as order
+
+    rng = np.random.default_rng(seed)
+    n = 12
+    A = rng.normal(size=(n, n))
+    A -= (np.abs(np.linalg.eigvals(A)).max() + 0.3) * np.eye(n)
+    P = ct.ss(A, rng.normal(size=(n, 6)), rng.normal(size=(6, n)),
+              0.2 * rng.normal(size=(6, 6)))
+    P.D[5, 5] = 0.0
+    Ak = rng.normal(size=(6, 6))
+    Ak -= (np.abs(np.linalg.eigvals(Ak)).max() + 0.5) * np.eye(6)
+    K = ct.ss(Ak, rng.normal(size=(6, 1)), 0.02 * rng.normal(size=(1, 6)), 0.0)
+    w = np.logspace(-1, 2, 60)
+    blocks = [(-1, 0), (-1, 0), (-1, 0), (2, 2)]
+    peak = float(np.max(mussv(P.lft(balred_controller(K, 3)[0], 1, 1), blocks, w,
+                              lower=False, peak=False).upper))
+    solved, real = [], mu.mussv
+
+    def counted(M, b, om=None, **kw):
+        if list(map(tuple, b)) == blocks:
+            solved.append(np.size(om))
+        return real(M, b, om, **kw)
+
+    monkeypatch.setattr(mu, "mussv", counted)
+    below = reduce_controller(P, K, 3, 1, 1, blocks=blocks, omega=w, full=(None, 1.0),
+                              mu_above=0.9 * peak)
+    assert below.mu_is_lower and 0.9 * peak < below.mu <= peak * (1 + 1e-9)
+    assert not solved
+    above = reduce_controller(P, K, 3, 1, 1, blocks=blocks, omega=w, full=(None, 1.0),
+                              mu_above=1.1 * peak)
+    assert not above.mu_is_lower and above.mu == pytest.approx(peak, rel=1e-6)
+    assert solved

@@ -924,11 +924,16 @@ def _reduce_best(P, cands, order: int, auto: bool, gp, blocks, omega):
         # a candidate's μ is the peak on this loop, structure and grid (musyn's, musyn_dgk's)
         n, full = order, (None, c["mu"] if blocks is not None else None)
         while True:
+            # an order the scan would step past only needs to be known above the band: a
+            # certified lower bound of its μ there ends it without the upper bound
+            above = (1.0 + ORDER_RISE) * full[1] if (
+                auto and full[1] is not None and n < c["K"].nstates) else None
             rr = reduce_controller(P, c["K"], min(n, int(c["K"].nstates)), gp.nmeas, gp.ncon,
-                                   blocks=blocks, omega=omega, full=full)
+                                   blocks=blocks, omega=omega, full=full, mu_above=above)
             full = (rr.gamma_full, rr.mu_full)
             rise = rr.mu / rr.mu_full - 1 if rr.mu is not None else rr.gamma_rise
-            if (np.isfinite(rr.gamma) and rise <= ORDER_RISE) or not auto \
+            if (np.isfinite(rr.gamma) and rise <= ORDER_RISE and not rr.mu_is_lower) \
+                    or not auto \
                     or n >= c["K"].nstates:
                 break
             n += gp.ncon

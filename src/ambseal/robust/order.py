@@ -20,7 +20,7 @@ from slycot import ab09md
 from ambseal.errors import ConfigError, ModelError
 from ambseal.lti import ss_matrices
 from ambseal.robust.hinf import hinfnorm, lft_lower
-from ambseal.robust.mu import upper_on_grid
+from ambseal.robust.mu import lower_on_grid, upper_on_grid
 
 __all__ = ["ReductionResult", "balred_controller", "reduce_controller"]
 
@@ -95,9 +95,13 @@ class ReductionResult:
         is unstable).
     mu_full, mu : float or None
         Peak μ upper bounds on ``omega`` when ``blocks`` were given
-        (:func:`~ambseal.robust.mu.upper_on_grid`).
+        (:func:`~ambseal.robust.mu.upper_on_grid`), or ``mu`` a certified lower bound
+        (``mu_is_lower``).
     hsv : ndarray
         Hankel singular values of the controller's stable part.
+    mu_is_lower : bool
+        ``mu`` is a certified lower bound above the ``mu_above`` :func:`reduce_controller`
+        was given, not the peak: the reduced loop's μ is known to exceed that level.
     """
 
     K: Any
@@ -108,6 +112,7 @@ class ReductionResult:
     mu_full: float | None = None
     mu: float | None = None
     hsv: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    mu_is_lower: bool = False
 
     @property
     def gamma_rise(self) -> float:
@@ -124,8 +129,8 @@ class ReductionResult:
 
 def reduce_controller(P, K, order: int, nmeas: int, ncon: int, *,
                       blocks: Sequence[Sequence[int]] | None = None, omega=None,
-                      alpha: float | None = None, full: tuple | None = None
-                      ) -> ReductionResult:
+                      alpha: float | None = None, full: tuple | None = None,
+                      mu_above: float | None = None) -> ReductionResult:
     """Reduce K and report what it costs in closed-loop γ (and peak μ).
 
     Parameters
@@ -148,6 +153,12 @@ def reduce_controller(P, K, order: int, nmeas: int, ncon: int, *,
         γ and peak μ of the full-order loop when already known (a search over orders
         reduces the same controller several times; a μ design knows its μ on the same
         grid); each one omitted or None is computed.
+    mu_above : float, optional
+        For a search over orders that asks only whether the reduced loop's μ exceeds this
+        level: where a certified lower bound on the grid already does
+        (:func:`~ambseal.robust.mu.lower_on_grid`), ``mu`` is that lower bound
+        (``mu_is_lower``) and the upper bound, which can only be larger, is not computed.
+        None: the upper bound.
 
     Returns
     -------
@@ -165,15 +176,20 @@ def reduce_controller(P, K, order: int, nmeas: int, ncon: int, *,
     if g_full is None:
         g_full = hinfnorm(lft_lower(P, K, nmeas, ncon))[0]
     g_red, _ = hinfnorm(lft_lower(P, Kr, nmeas, ncon))
-    mu_red = None
+    mu_red, mu_is_lower = None, False
     if blocks is not None:
         # the peak on the grid: a mixed structure solved only where it can reach it
         if mu_full is None:
             mu_full = float(np.max(upper_on_grid(lft_lower(P, K, nmeas, ncon), blocks,
                                                  omega)[1]))
-        mu_red = (float(np.max(upper_on_grid(lft_lower(P, Kr, nmeas, ncon), blocks,
-                                             omega)[1]))
-                  if np.isfinite(g_red) else float("inf"))
+        mu_red = float("inf")
+        if np.isfinite(g_red):
+            loop = lft_lower(P, Kr, nmeas, ncon)
+            if mu_above is not None:
+                low = float(np.max(lower_on_grid(loop, blocks, omega)))
+                mu_is_lower = low > mu_above
+            mu_red = low if mu_is_lower else float(np.max(upper_on_grid(loop, blocks,
+                                                                        omega)[1]))
     return ReductionResult(K=Kr, order_full=int(K.nstates), order=int(Kr.nstates),
                            gamma_full=float(g_full), gamma=float(g_red), mu_full=mu_full,
-                           mu=mu_red, hsv=hsv)
+                           mu=mu_red, hsv=hsv, mu_is_lower=mu_is_lower)

@@ -95,6 +95,41 @@ def test_reduction_that_destabilises_reports_infinite_gamma():
     assert np.isinf(res.gamma) and np.isfinite(res.gamma_full)
 
 
+def _mixed_problem(seed: int):
+    """A stable 12-state plant with three real scalars and a complex 2 × 2 block (five
+    exogenous channels, one measurement, one control), a stable 6-state controller, a
+    60-point grid and the structure: ``(P, K, omega, blocks)``."""
+    rng = np.random.default_rng(seed)
+    n = 12
+    A = rng.normal(size=(n, n))
+    A -= (np.abs(np.linalg.eigvals(A)).max() + 0.3) * np.eye(n)
+    P = ct.ss(A, rng.normal(size=(n, 6)), rng.normal(size=(6, n)),
+              0.2 * rng.normal(size=(6, 6)))
+    P.D[5, 5] = 0.0
+    Ak = rng.normal(size=(6, 6))
+    Ak -= (np.abs(np.linalg.eigvals(Ak)).max() + 0.5) * np.eye(6)
+    K = ct.ss(Ak, rng.normal(size=(6, 1)), 0.02 * rng.normal(size=(1, 6)), 0.0)
+    return P, K, np.logspace(-1, 2, 60), [(-1, 0), (-1, 0), (-1, 0), (2, 2)]
+
+
+def _count_mixed_solves(monkeypatch, blocks) -> list:
+    """Every call of mussv on the structure ``blocks`` from here on, as the number of
+    frequencies it solved (the list returned fills as they happen)."""
+    import ambseal.robust.mu as mu
+    import ambseal.robust.order as order
+
+    solved, real = [], mu.mussv
+
+    def counted(M, b, om=None, **kw):
+        if list(map(tuple, b)) == blocks:
+            solved.append(np.size(om))
+        return real(M, b, om, **kw)
+
+    monkeypatch.setattr(mu, "mussv", counted)
+    monkeypatch.setattr(order, "mussv", counted, raising=False)  # if imported by name
+    return solved
+
+
 @pytest.mark.parametrize("seed", [3, 4])
 def test_reduce_controller_solves_a_mixed_structure_only_where_it_reaches_its_peak(
         seed, monkeypatch):
@@ -106,32 +141,10 @@ def test_reduce_controller_solves_a_mixed_structure_only_where_it_reaches_its_pe
     60 % of the frequencies (the complexified bound covers the rest, as in D–K's
     μ-step). Solving it at every frequency was most of the expander-generator's order
     search."""
-    import ambseal.robust.mu as mu
-    import ambseal.robust.order as order
-
-    rng = np.random.default_rng(seed)
-    n = 12
-    A = rng.normal(size=(n, n))
-    A -= (np.abs(np.linalg.eigvals(A)).max() + 0.3) * np.eye(n)
-    P = ct.ss(A, rng.normal(size=(n, 6)), rng.normal(size=(6, n)),
-              0.2 * rng.normal(size=(6, 6)))
-    P.D[5, 5] = 0.0
-    Ak = rng.normal(size=(6, 6))
-    Ak -= (np.abs(np.linalg.eigvals(Ak)).max() + 0.5) * np.eye(6)
-    K = ct.ss(Ak, rng.normal(size=(6, 1)), 0.02 * rng.normal(size=(1, 6)), 0.0)
-    w = np.logspace(-1, 2, 60)
-    blocks = [(-1, 0), (-1, 0), (-1, 0), (2, 2)]
+    P, K, w, blocks = _mixed_problem(seed)
     ref = [float(np.max(mussv(P.lft(k, 1, 1), blocks, w, lower=False, peak=False).upper))
            for k in (K, balred_controller(K, 3)[0])]
-    solved, real = [], mu.mussv
-
-    def counted(M, b, om=None, **kw):
-        if list(map(tuple, b)) == blocks:
-            solved.append(np.size(om))
-        return real(M, b, om, **kw)
-
-    monkeypatch.setattr(mu, "mussv", counted)
-    monkeypatch.setattr(order, "mussv", counted, raising=False)  # if imported by name
+    solved = _count_mixed_solves(monkeypatch, blocks)
     res = reduce_controller(P, K, 3, 1, 1, blocks=blocks, omega=w)
     assert np.isfinite(res.gamma)
     assert res.mu_full == pytest.approx(ref[0], rel=1e-6)
@@ -148,31 +161,10 @@ def test_a_reduced_loop_known_above_a_level_is_not_solved_for_its_upper_bound(
     bound: ``mu_is_lower``, ``mu`` above the level and at most the whole grid's upper
     bound, and the mixed structure solved at no frequency. Asked about a level above the
     peak it reports the peak as without the level."""
-    import ambseal.robust.mu as mu
-    import ambseal.robust.order as order
-
-    rng = np.random.default_rng(seed)
-    n = 12
-    A = rng.normal(size=(n, n))
-    A -= (np.abs(np.linalg.eigvals(A)).max() + 0.3) * np.eye(n)
-    P = ct.ss(A, rng.normal(size=(n, 6)), rng.normal(size=(6, n)),
-              0.2 * rng.normal(size=(6, 6)))
-    P.D[5, 5] = 0.0
-    Ak = rng.normal(size=(6, 6))
-    Ak -= (np.abs(np.linalg.eigvals(Ak)).max() + 0.5) * np.eye(6)
-    K = ct.ss(Ak, rng.normal(size=(6, 1)), 0.02 * rng.normal(size=(1, 6)), 0.0)
-    w = np.logspace(-1, 2, 60)
-    blocks = [(-1, 0), (-1, 0), (-1, 0), (2, 2)]
+    P, K, w, blocks = _mixed_problem(seed)
     peak = float(np.max(mussv(P.lft(balred_controller(K, 3)[0], 1, 1), blocks, w,
                               lower=False, peak=False).upper))
-    solved, real = [], mu.mussv
-
-    def counted(M, b, om=None, **kw):
-        if list(map(tuple, b)) == blocks:
-            solved.append(np.size(om))
-        return real(M, b, om, **kw)
-
-    monkeypatch.setattr(mu, "mussv", counted)
+    solved = _count_mixed_solves(monkeypatch, blocks)
     below = reduce_controller(P, K, 3, 1, 1, blocks=blocks, omega=w, full=(None, 1.0),
                               mu_above=0.9 * peak)
     assert below.mu_is_lower and 0.9 * peak < below.mu <= peak * (1 + 1e-9)

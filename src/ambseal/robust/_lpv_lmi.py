@@ -68,20 +68,24 @@ DEFAULT_TOL = {"abstol": 1e-7, "reltol": 1e-4, "feastol": 1e-5, "refinement": 2}
 #: within a few percent of ``feastol`` and then stall, where each BLAS kernel set's
 #: rounding falls either side:
 #:
-#: - a third refinement step of each KKT solve, at the same tolerances: on the flywheel
-#:   example at 10 kHz under NumPy 2.5 a centring solve ran 48 iterations under Haswell
-#:   kernels and to the cap under SkylakeX, and ends "optimal" in 32 under both with it;
-#:   there residuals of 1e-4 gave a certificate of infeasibility that the tighter solves
-#:   do not find (spurious, so not taken from a further solve);
-#: - residuals of 1e-4: a centring solve that the third step left stalled (71–100
-#:   iterations) ends "optimal" in 22 under both, its trace within 1e-5 of the stalled
-#:   point's; another at 10 kHz under NumPy 2.4 ended "optimal" at 22 iterations under
-#:   Haswell (dual residual just within 1e-5) and at the cap under SkylakeX, and ends
-#:   "optimal" under both at this tolerance.
+#: - residuals of 1e-4 with a third refinement step of each KKT solve: a centring solve
+#:   that stalled at 1e-5 (71–100 iterations) ends "optimal" in 22 under both kernel
+#:   sets, its trace within 1e-5 of the stalled point's; another at 10 kHz under NumPy 2.4
+#:   ended "optimal" at 22 iterations under Haswell (dual residual just within 1e-5) and
+#:   at the cap under SkylakeX, and ends "optimal" under both at this tolerance;
+#: - a third refinement step at the same tolerances, where the looser solve stopped short
+#:   too or gave a certificate of infeasibility (which can be spurious, so is not taken
+#:   from a further solve): on the flywheel example at 10 kHz under NumPy 2.5 a centring
+#:   solve ran 48 iterations under Haswell kernels and to the cap under SkylakeX, ends
+#:   "optimal" in 32 under both with it, and got such a certificate at 1e-4.
 #:
+#: In that order because the looser solve ends "optimal" more often and sooner: on the
+#: gyroscopic family's LPVs (benchmarks/README.md, "The LPV's stalled solves: the looser
+#: one first") the third step alone ended 2 of 15 stalled solves "optimal" and ran 13 to
+#: a stall or to CVXOPT's cap (539 iterations), the looser solve after it 6 of 13.
 #: A kept solve's LMIs are met to its ``feastol`` of the data's norm, and the frozen loops
 #: are checked after the synthesis as always.
-STALL_RETRIES = ({"refinement": 3}, {"refinement": 3, "feastol": 1e-4})
+STALL_RETRIES = ({"refinement": 3, "feastol": 1e-4}, {"refinement": 3})
 SOLVER_KEYS = ("abstol", "reltol", "feastol", "maxiters", "refinement")
 
 

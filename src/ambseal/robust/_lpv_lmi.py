@@ -79,10 +79,11 @@ DEFAULT_TOL = {"abstol": 1e-7, "reltol": 1e-4, "feastol": 1e-5, "refinement": 2}
 #:   solve ran 48 iterations under Haswell kernels and to the cap under SkylakeX, ends
 #:   "optimal" in 32 under both with it, and got such a certificate at 1e-4.
 #:
-#: In that order because the looser solve ends "optimal" more often and sooner: on the
-#: gyroscopic family's LPVs (benchmarks/README.md, "The LPV's stalled solves: the looser
-#: one first") the third step alone ended 2 of 15 stalled solves "optimal" and ran 13 to
-#: a stall or to CVXOPT's cap (539 iterations), the looser solve after it 6 of 13.
+#: In that order because the looser solve ends "optimal" more often and sooner: on 39
+#: measured LPV syntheses (benchmarks/README.md, "The LPV's stalled solves: the looser
+#: one first") the third step alone ended 4 of 39 stalled solves "optimal" and ran 35 to
+#: a stall or to CVXOPT's cap (1 657 iterations), the looser solve after it 20 of those
+#: 35, in 21–35 iterations.
 #: A kept solve's LMIs are met to its ``feastol`` of the data's norm, and the frozen loops
 #: are checked after the synthesis as always.
 STALL_RETRIES = ({"refinement": 3, "feastol": 1e-4}, {"refinement": 3})

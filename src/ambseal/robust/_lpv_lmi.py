@@ -83,7 +83,7 @@ DEFAULT_TOL = {"abstol": 1e-7, "reltol": 1e-4, "feastol": 1e-5, "refinement": 2}
 #: measured LPV syntheses (benchmarks/README.md, "The LPV's stalled solves: the looser
 #: one first") the third step alone ended 4 of 39 stalled solves "optimal" and ran 35 to
 #: a stall or to CVXOPT's cap (1 657 iterations), the looser solve after it 20 of those
-#: 35, in 21–35 iterations.
+#: 35, in 20–35 iterations.
 #: A kept solve's LMIs are met to its ``feastol`` of the data's norm, and the frozen loops
 #: are checked after the synthesis as always.
 STALL_RETRIES = ({"refinement": 3, "feastol": 1e-4}, {"refinement": 3})

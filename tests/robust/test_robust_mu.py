@@ -651,3 +651,8 @@ def test_lower_on_grid_lies_below_the_upper_bound_and_near_its_peak():
     assert low.max() == pytest.approx(up.max(), rel=1e-2)
     with pytest.raises(ModelError, match="lower_on_grid"):
         lower_on_grid(M, blocks[1:], w)
+    # refused as mussv refuses them: a sampled system, a grid that is not one
+    with pytest.raises(ModelError, match="lower_on_grid: only continuous-time"):
+        lower_on_grid(ct.ss(M.A, M.B, M.C, M.D, 1e-4), blocks, w)
+    with pytest.raises(ModelError, match="lower_on_grid: omega must be"):
+        lower_on_grid(M, blocks, [np.nan])

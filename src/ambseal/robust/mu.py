@@ -354,36 +354,8 @@ def mussv(M, blocks, omega=None, *, tol: float = 1e-3, max_iter: int | None = No
     for name, v in ((k, v) for k, v in counts if v is not None):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
             raise ModelError(f"mussv: {name}={v!r}, expected a whole number ≥ 1")
-    w = None
-    if hasattr(M, "A") and hasattr(M, "B"):
-        if omega is None:
-            raise ModelError("mussv: a state-space M needs a frequency grid omega (rad/s)")
-        if getattr(M, "dt", 0) not in (0, None):
-            raise ModelError("mussv: only continuous-time systems (dt = 0) are supported")
-        try:
-            w = np.atleast_1d(np.asarray(omega, float))
-        except (TypeError, ValueError):
-            w = np.zeros((0,))
-        if w.ndim != 1 or w.size == 0 or not np.all(np.isfinite(w)):
-            raise ModelError("mussv: omega must be a non-empty 1-D array of finite rad/s values")
-        Marr = freqresp(M, w)
-    else:
-        try:
-            Marr = np.asarray(M, complex)
-        except (TypeError, ValueError) as exc:
-            raise ModelError(f"mussv: M must be a complex matrix or stack of them ({exc})"
-                             ) from None
-        if omega is not None:
-            raise ModelError("mussv: omega is only used with a state-space M")
-    if Marr.ndim < 2:
-        raise ModelError(f"mussv: M must be (..., n, m), got shape {Marr.shape}")
+    Marr, w = _checked_response(M, blks, blocks, omega, "mussv")
     n, m = _dims(blks)
-    if Marr.shape[-2:] != (n, m):
-        raise ModelError(
-            f"mussv: blocks {list(blocks)} need M of shape (..., {n}, {m}) "
-            f"(Σc = {n} rows, Σr = {m} columns), got {Marr.shape[-2:]}")
-    if not np.all(np.isfinite(Marr)):
-        raise ModelError("mussv: M has non-finite entries")
     stack = Marr.shape[:-2]
     Mf = Marr.reshape((-1, n, m))
     F = Mf.shape[0]
@@ -425,6 +397,45 @@ def _complexify(blks):
     for b in blks:
         out.extend([(b.r, b.c)] if b.kind == "full" else [(1, 1)] * b.r)
     return out
+
+
+def _checked_response(M, blks, blocks, omega, who: str):
+    """``(M(jω) as (..., n, m), ω or None)``: a continuous state-space ``M`` evaluated on
+    ``omega``, or a complex matrix (stack) as given; ModelError, naming ``who``, for a
+    missing, misplaced or malformed grid, a discrete-time system, a shape that does not
+    match ``blocks`` (``blks`` parsed) or non-finite entries."""
+    w = None
+    if hasattr(M, "A") and hasattr(M, "B"):
+        if omega is None:
+            raise ModelError(f"{who}: a state-space M needs a frequency grid omega (rad/s)")
+        if getattr(M, "dt", 0) not in (0, None):
+            raise ModelError(f"{who}: only continuous-time systems (dt = 0) are supported")
+        try:
+            w = np.atleast_1d(np.asarray(omega, float))
+        except (TypeError, ValueError):
+            w = np.zeros((0,))
+        if w.ndim != 1 or w.size == 0 or not np.all(np.isfinite(w)):
+            raise ModelError(f"{who}: omega must be a non-empty 1-D array of finite rad/s "
+                             "values")
+        Marr = freqresp(M, w)
+    else:
+        try:
+            Marr = np.asarray(M, complex)
+        except (TypeError, ValueError) as exc:
+            raise ModelError(f"{who}: M must be a complex matrix or stack of them ({exc})"
+                             ) from None
+        if omega is not None:
+            raise ModelError(f"{who}: omega is only used with a state-space M")
+    if Marr.ndim < 2:
+        raise ModelError(f"{who}: M must be (..., n, m), got shape {Marr.shape}")
+    n, m = _dims(blks)
+    if Marr.shape[-2:] != (n, m):
+        raise ModelError(
+            f"{who}: blocks {list(blocks)} need M of shape (..., {n}, {m}) "
+            f"(Σc = {n} rows, Σr = {m} columns), got {Marr.shape[-2:]}")
+    if not np.all(np.isfinite(Marr)):
+        raise ModelError(f"{who}: M has non-finite entries")
+    return Marr, w
 
 
 def upper_on_grid(M, blocks, omega, *, tol: float = 1e-3):
@@ -577,14 +588,13 @@ def lower_on_grid(M, blocks, omega, *, seed: int = 0) -> np.ndarray:
     Raises
     ------
     ModelError
-        ``M``'s channels do not match ``blocks``, or a non-finite response.
+        As :func:`mussv` for a state-space ``M``: a missing or malformed grid, a
+        discrete-time ``M``, channels that do not match ``blocks``, a non-finite response.
     """
     blks = parse_blocks(blocks)
-    Mf = freqresp(M, np.atleast_1d(np.asarray(omega, float)))
-    n, m = _dims(blks)
-    if Mf.shape[-2:] != (n, m) or not np.all(np.isfinite(Mf)):
-        raise ModelError(f"lower_on_grid: blocks {list(blocks)} need a finite response of "
-                         f"shape (F, {n}, {m}), got {Mf.shape}")
+    if omega is None:  # a matrix stack is mussv's to bound; here a grid is the point
+        raise ModelError("lower_on_grid: expected a state-space M and its grid omega (rad/s)")
+    Mf, _ = _checked_response(M, blks, blocks, omega, "lower_on_grid")
     lower, _ = _lower_bound(Mf, blks, None, np.random.default_rng(seed))
     return lower
 

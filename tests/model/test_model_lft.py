@@ -163,3 +163,58 @@ def test_reduction_keeps_a_defective_mode_by_its_invariant_subspace():
         want = C @ S[:, :4] @ np.linalg.solve(s * np.eye(4) - J[:4, :4], Si[:4] @ B)
         got = red.plant.C @ np.linalg.solve(s * np.eye(4) - red.plant.A, red.plant.B)
         np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-9 * np.abs(want).max())
+
+
+def test_reduction_keeps_a_complex_pair_whose_imaginary_part_is_tiny():
+    """Reference: the closed form of a plant S J S⁻¹ whose slowest pair 200 ± 0.006j 1/s
+    (a whirl split by weak gyroscopic coupling) has an imaginary part below 1e-9 of its
+    spectrum (a stiff mode at −1e7 1/s): kept as the pair it is, in real modal
+    coordinates (the block [[σ, ω], [−ω, σ]] of P1 Eq. 32), with the kept blocks'
+    transfer exactly (1e-9). Taken for two real eigenvalues, the pair gave one real line
+    twice and the reduction fell back to the Schur form."""
+    from ambseal.model.lft import Plant
+
+    rng = np.random.default_rng(7)
+    J = np.zeros((5, 5))
+    J[:2, :2] = [[200.0, 0.006], [-0.006, 200.0]]
+    J[2:, 2:] = np.diag([-900.0, -4e5, -1e7])
+    S = np.eye(5) + 0.3 * rng.standard_normal((5, 5))
+    Si = np.linalg.inv(S)
+    B, C = rng.standard_normal((5, 2)), rng.standard_normal((2, 5))
+    plant = Plant(A=S @ J @ Si, B=B, C=C, D=np.zeros((2, 2)), input_names=("u0", "u1"),
+                  output_names=("y0", "y1"), state_names=tuple(f"x{i}" for i in range(5)))
+    red = modal_reduction(plant, states=2)
+    assert red.plant.state_names == ("mode0_re", "mode0_im")
+    # to the rounding of a spectrum of 1e7 1/s
+    np.testing.assert_allclose(red.plant.A, [[200.0, 0.006], [-0.006, 200.0]], atol=1e-6)
+    for s in (0.0, 1j, 3.0 + 2j, 300j):
+        want = C @ S[:, :2] @ np.linalg.solve(s * np.eye(2) - J[:2, :2], Si[:2] @ B)
+        got = red.plant.C @ np.linalg.solve(s * np.eye(2) - red.plant.A, red.plant.B)
+        np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-9 * np.abs(want).max())
+
+
+def test_a_symmetric_rotor_at_standstill_reduces_to_a_symmetric_model():
+    """Reference: the rotor's symmetry about its axis. The example flywheel at standstill
+    has its cylindrical and conical modes twice over (ζ and η; the eigensolver gives the
+    conical twins as a conjugate pair 264.44 ± 5e-9j 1/s). Its 12-state design model is
+    in real modal coordinates and keeps the symmetry in its responses, G_ζζ = G_ηη and
+    G_ζη = −G_ηζ at both bearings, to 1e-9 (the Schur form it fell back to kept them to
+    3e-5, with entries of 1e8 in its A)."""
+    from pathlib import Path
+
+    cfg = load_rig(Path(__file__).resolve().parents[2] / "examples" / "flywheel.toml")
+    red = modal_reduction(mechanical_plant(build_system(cfg, pressure_bar=0.0,
+                                                        speed_rpm=0.0)), states=12)
+    p = red.plant
+    assert not any(n.startswith("schur") for n in p.state_names)
+    w = 2 * np.pi * np.logspace(0, 4, 40)
+    H = np.array([p.C @ np.linalg.solve(1j * x * np.eye(12) - p.A, p.B) for x in w])
+    i, o = list(p.input_names), list(p.output_names)
+    for b in ("A", "B"):
+        zz = H[:, o.index(f"y_{b}_zeta"), i.index(f"i_{b}_zeta")]
+        ee = H[:, o.index(f"y_{b}_eta"), i.index(f"i_{b}_eta")]
+        ze = H[:, o.index(f"y_{b}_zeta"), i.index(f"i_{b}_eta")]
+        ez = H[:, o.index(f"y_{b}_eta"), i.index(f"i_{b}_zeta")]
+        scale = np.abs(zz).max()
+        assert np.abs(zz - ee).max() <= 1e-9 * scale
+        assert np.abs(ze + ez).max() <= 1e-9 * scale

@@ -14,9 +14,10 @@ so that T_L T_R = I. Both are built here directly:
 so A = T_L A_f T_R is block diagonal with the real 2×2 blocks [[σ, ω], [−ω, σ]] of P1
 Eq. 32 and has exactly the kept eigenvalues; B = T_L B_f, C = C_f T_R (Eqs. 43–45).
 
-Where the kept eigenvectors cannot be paired (Wᵀ T_R singular to working precision: a
-defective or nearly defective eigenvalue, whose eigenvectors are not a basis of its
-invariant subspace) the same invariant subspace is taken from the ordered real Schur form
+A complex pair is told by its conjugate twin, however small its imaginary part. Where the
+kept eigenvectors cannot be paired (Wᵀ T_R singular to working precision, or a pair's
+Re v and Im v nearly one line: a defective or nearly defective eigenvalue, whose
+eigenvectors are not a basis of its invariant subspace) the same invariant subspace is taken from the ordered real Schur form
 A_f = Q T Qᵀ, the kept eigenvalues first (Golub & Van Loan, Matrix Computations, 4th ed.,
 §7.6.2 and §7.6.3): T_R = Q₁ and T_L = Q₁ᵀ − Y Q₂ᵀ with T₁₁ Y − Y T₂₂ = −T₁₂, the spectral
 projector's block diagonalisation. T_L T_R = I again and A = T₁₁ (quasi-triangular, the
@@ -55,6 +56,36 @@ class ModalReduction:
     T_L: np.ndarray
     T_R: np.ndarray
     poles: np.ndarray
+
+
+#: A complex pair's real basis (Re v, Im v) conditioned beyond this is nearly one line: a
+#: nearly defective eigenvalue (a Jordan block's twins, split by rounding), whose
+#: eigenvectors are no basis of its invariant subspace; the Schur form is taken. A whirl
+#: of a rotor symmetric about its axis is circular (Re v ⊥ Im v, of equal lengths: 1),
+#: and the ζ and η twins that rounding gives as a conjugate pair are a few units
+#: (benchmarks/README.md, "A complex pair told by its twin"). The number is the same for
+#: every phase of v (a phase turns (Re v, Im v) by an orthogonal 2 × 2 matrix); the limit
+#: is the square root of the whole basis's (1e12).
+PAIR_COND = 1e6
+
+
+def _has_conjugate(lam: np.ndarray, j: int) -> bool:
+    """Whether ``lam[j]``, not real, has its conjugate among the other ``lam``: a complex
+    pair, however small its imaginary part against the spectrum's size.
+
+    A real matrix's eigensolvers (LAPACK's real QR algorithm, ARPACK's real Arnoldi) give
+    a complex pair as exact conjugates and a real eigenvalue with no imaginary part, so a
+    pair is told by its twin, not by a tolerance. Taken for two real eigenvalues, a pair
+    gives its one real line twice, no basis of its plane (Wᵀ T_R singular), and the
+    reduction fell back to the Schur form, whose design model keeps a symmetric rotor's
+    ζ/η symmetry less well (benchmarks/README.md, "A complex pair told by its twin": the
+    flywheel example's whirls meshed 1.3× finer, and its twins at standstill)."""
+    lj = lam[j]
+    if lj.imag == 0:
+        return False
+    d = np.abs(lam - np.conj(lj))
+    d[j] = np.inf
+    return bool(d.min() <= 1e-12 * abs(lj))
 
 
 def _real_phase(v: np.ndarray) -> np.ndarray:
@@ -114,15 +145,16 @@ def modal_reduction(
             )
     kept = lam[:n_keep]
     tol = 1e-9 * scale
-    cols_r, cols_l, names = [], [], []
+    cols_r, cols_l, names, flat = [], [], [], 1.0
     for j, lj in enumerate(kept):
-        if abs(lj.imag) <= tol:
+        if abs(lj.imag) <= tol and not _has_conjugate(kept, j):
             cols_r.append(_real_phase(V[:, j]))
             cols_l.append(_real_phase(W[:, j]))
             names.append(f"mode{len(names)}")
         elif lj.imag > 0:
             v = V[:, j] / np.linalg.norm(V[:, j])
             w = W[:, j] / np.linalg.norm(W[:, j])
+            flat = max(flat, np.linalg.cond(np.column_stack([v.real, v.imag])))
             cols_r += [v.real, v.imag]
             cols_l += [w.real, w.imag]
             names += [f"mode{len(names)}_re", f"mode{len(names)}_im"]
@@ -133,7 +165,8 @@ def modal_reduction(
     T_R = np.column_stack(cols_r)
     Wr = np.column_stack(cols_l)
     P = Wr.T @ T_R
-    if np.linalg.cond(P) > 1e12:  # no eigenvector basis: the invariant subspace itself
+    if np.linalg.cond(P) > 1e12 or flat > PAIR_COND:
+        # no eigenvector basis: the invariant subspace itself
         T_L, T_R = _schur_subspace(np.asarray(plant.A, float), n_keep)
         names = [f"schur{k}" for k in range(n_keep)]
     else:

@@ -198,8 +198,8 @@ def test_a_symmetric_rotor_at_standstill_reduces_to_a_symmetric_model():
     has its cylindrical and conical modes twice over (ζ and η; the eigensolver gives the
     conical twins as a conjugate pair 264.44 ± 5e-9j 1/s). Its 12-state design model is
     in real modal coordinates and keeps the symmetry in its responses, G_ζζ = G_ηη and
-    G_ζη = −G_ηζ at both bearings, to 1e-9 (the Schur form it fell back to kept them to
-    3e-5, with entries of 1e8 in its A)."""
+    G_ζη = −G_ηζ at both bearings, to 1e-9 (1e-11 measured; the Schur form it fell back
+    to kept them to 9e-6, with entries of 1.3e8 in its A)."""
     from pathlib import Path
 
     cfg = load_rig(Path(__file__).resolve().parents[2] / "examples" / "flywheel.toml")

@@ -17,11 +17,12 @@ Eq. 32 and has exactly the kept eigenvalues; B = T_L B_f, C = C_f T_R (Eqs. 43�
 A complex pair is told by its conjugate twin, however small its imaginary part. Where the
 kept eigenvectors cannot be paired (Wᵀ T_R singular to working precision, or a pair's
 Re v and Im v nearly one line: a defective or nearly defective eigenvalue, whose
-eigenvectors are not a basis of its invariant subspace) the same invariant subspace is taken from the ordered real Schur form
-A_f = Q T Qᵀ, the kept eigenvalues first (Golub & Van Loan, Matrix Computations, 4th ed.,
-§7.6.2 and §7.6.3): T_R = Q₁ and T_L = Q₁ᵀ − Y Q₂ᵀ with T₁₁ Y − Y T₂₂ = −T₁₂, the spectral
-projector's block diagonalisation. T_L T_R = I again and A = T₁₁ (quasi-triangular, the
-kept eigenvalues on its diagonal blocks); the states are named ``schur<k>``.
+eigenvectors are not a basis of its invariant subspace) the same invariant subspace is
+taken from the ordered real Schur form A_f = Q T Qᵀ, the kept eigenvalues first (Golub &
+Van Loan, Matrix Computations, 4th ed., §7.6.2 and §7.6.3): T_R = Q₁ and T_L = Q₁ᵀ − Y Q₂ᵀ
+with T₁₁ Y − Y T₂₂ = −T₁₂, the spectral projector's block diagonalisation. T_L T_R = I
+again and A = T₁₁ (quasi-triangular, the kept eigenvalues on its diagonal blocks); the
+states are named ``schur<k>``.
 """
 
 from __future__ import annotations

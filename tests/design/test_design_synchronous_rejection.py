@@ -140,6 +140,31 @@ def test_a_second_table_on_the_same_speeds_builds_no_plant(turbo_cfg, turbo_froz
         assert a.gain_re.shape[0] == again.speeds_hz.size
 
 
+def test_tables_that_start_at_other_speeds_share_the_plants_above(turbo_cfg, turbo_frozen,
+                                                                 turbo_hinf_digital,
+                                                                 monkeypatch):
+    """Each controller's table starts at its own switch-on speed (the amplifier's, below
+    the continuous range); above its start it splits at the dyadic speeds of the range's
+    top, so a second table from a start 1.3 % higher samples the plant at its start alone
+    and takes every other speed from the first table. Reference: the bisection's rule by
+    hand — each speed of a table other than its ends is the dyadic speed f_top·k/2^j of the
+    coarsest level between its neighbours at the time of the split, which the speeds of
+    the first table above the second's start already are."""
+    import ambseal.design.synchronous_rejection as sr
+
+    lo, hi = turbo_cfg.operating.continuous_hz
+    first = design_rejection(turbo_cfg, turbo_frozen.K, turbo_hinf_digital,
+                             speeds_hz=(0.8 * lo, hi))
+    built, real = [], sr.build_plant
+    monkeypatch.setattr(sr, "build_plant", lambda *a, **k: built.append(k) or real(*a, **k))
+    second = design_rejection(turbo_cfg, turbo_frozen.K, turbo_hinf_digital,
+                              speeds_hz=(0.81 * lo, hi))
+    assert [k["speed_rpm"] / 60.0 for k in built] == [pytest.approx(0.81 * lo)]
+    assert set(second.speeds_hz[1:].tolist()) <= set(first.speeds_hz.tolist())
+    for f in first.speeds_hz[1:-1]:
+        assert any(abs(f / hi * 2**j - round(f / hi * 2**j)) < 1e-9 for j in range(30))
+
+
 def test_the_table_interpolates_the_gain_between_its_speeds(turbo_cfg, turbo_frozen,
                                                             turbo_hinf_digital, rejection):
     """Midway between every two neighbouring speeds of the table (speeds it never

@@ -18,17 +18,22 @@ Rules, each a parameter:
   speed), else the operating speed alone. The table is interpolated linearly between its
   speeds, and the first-order poles stay in the left half-plane while the interpolated
   gain's phase error stays below 90° (the judgement checks every condition). Its speeds
-  are found by bisection: from the range's ends, an interval's midpoint is evaluated and
-  kept, and both halves are bisected again while, at the midpoint, the interpolated gain
+  are found by bisection: from the range's ends, an interval is split at a speed that is
+  evaluated and kept, and both parts are split again while, there, the interpolated gain
   T̃ misses the evaluated T by ‖(T̃ − T) T⁻¹‖₂ > :data:`INTERP_RTOL`, in the continuous
-  or in the sampled loop. The notch's first-order poles are placed by the eigenvalues of
-  T̃ T⁻¹ = I + E, which lie within ‖E‖ of 1: at 0.25 each pole keeps at least 75 % of its
-  distance ε/2 from the axis, and the notch settles in at most 4/3 of its designed time.
-  An interval no wider than that distance (in Hz: ``rate_fraction``/2 of its lower end)
-  is not halved: the notch does not resolve the gain finer than its own bandwidth. Where
+  or in the sampled loop. The split is the dyadic speed f_top·k/2^j of the coarsest
+  level inside the interval (f_top the range's top; the midpoint where both ends are
+  such speeds): each controller's table starts at its own switch-on speed, and splits
+  that do not depend on that start let the tables of one rig share their speeds and so
+  their plants (an ``expm`` each, 0.3 s at 840 states). The notch's first-order poles
+  are placed by the eigenvalues of T̃ T⁻¹ = I + E, which lie within ‖E‖ of 1: at 0.25
+  each pole keeps at least 75 % of its distance ε/2 from the axis, and the notch settles
+  in at most 4/3 of its designed time. An interval no wider than that distance (in Hz:
+  ``rate_fraction``/2 of its lower end) is not split: the notch does not resolve the gain
+  finer than its own bandwidth. Where
   ``[design.rejection] points`` is given, that many evenly spaced speeds instead (16
   evenly spaced speeds on the turboexpander example put ‖E‖ at 0.31 between two of them;
-  the bisection 15 speeds, 0.06 at most on 257 of them);
+  the bisection 15 speeds, 0.07 at most on 257 of them);
 - on from the lowest of them: below the minimum continuous speed the rotor passes its
   critical speeds on the feedback alone, and at standstill a notch at 0 Hz would take the
   controller's static stiffness — unless the run passes a lower start (``speeds_hz``):
@@ -190,19 +195,37 @@ def design_rejection(cfg, controller, digital=None, *, pressure_bar: float | Non
 
 def _bisected(lo: float, hi: float, gains_at, rate_fraction: float) -> dict:
     """The table's gains by speed (Hz) over ``lo``–``hi``, its speeds found by bisection
-    (module docstring): ``gains_at(f)`` gives each loop's T at f."""
+    on the dyadic speeds of ``hi`` (:func:`dyadic_split`, module docstring):
+    ``gains_at(f)`` gives each loop's T at f."""
     table = {lo: gains_at(lo), hi: gains_at(hi)}
     todo = [(lo, hi)]
     while todo:
         a, b = todo.pop()
         if b - a <= 0.5 * rate_fraction * a:  # within the notch's bandwidth
             continue
-        m = 0.5 * (a + b)
+        m = dyadic_split(a, b, hi)
         table[m] = gains_at(m)
-        if max(np.linalg.norm(np.linalg.solve(T.T, (0.5 * (table[a][k] + table[b][k]) - T).T),
-                              2) > INTERP_RTOL for k, T in table[m].items()):
+        t = (m - a) / (b - a)
+        if max(np.linalg.norm(np.linalg.solve(
+                T.T, ((1 - t) * table[a][k] + t * table[b][k] - T).T), 2) > INTERP_RTOL
+               for k, T in table[m].items()):
             todo += [(a, m), (m, b)]
     return table
+
+
+def dyadic_split(a: float, b: float, top: float) -> float:
+    """The speed ``top·k/2^j`` of the smallest ``j`` strictly between ``a`` and ``b``
+    (0 ≤ a < b ≤ top): unique (of two neighbours at level j one is at level j − 1), the
+    midpoint where ``a`` and ``b`` are dyadic speeds of ``top`` themselves. Tables with the
+    same top speed split every interval they share at the same speed, whatever speed each
+    starts from, so their plants are shared (:data:`_PLANT_AT`)."""
+    j = 0
+    while True:
+        k = math.floor(math.ldexp(a / top, j)) + 1
+        m = math.ldexp(top * k, -j)
+        if a < m < b:
+            return m
+        j += 1
 
 
 #: The plant's responses at the last tables' speeds, by rig and speed: every controller's

@@ -144,12 +144,10 @@ def test_tables_that_start_at_other_speeds_share_the_plants_above(turbo_cfg, tur
                                                                  turbo_hinf_digital,
                                                                  monkeypatch):
     """Each controller's table starts at its own switch-on speed (the amplifier's, below
-    the continuous range); above its start it splits at the dyadic speeds of the range's
-    top, so a second table from a start 1.3 % higher samples the plant at its start alone
-    and takes every other speed from the first table. Reference: the bisection's rule by
-    hand — each speed of a table other than its ends is the dyadic speed f_top·k/2^j of the
-    coarsest level between its neighbours at the time of the split, which the speeds of
-    the first table above the second's start already are."""
+    the continuous range) and splits at the dyadic speeds f_top·k/2^j of the range's top,
+    so a second table from a start 1.25 % higher samples the plant at its start alone and
+    takes every other speed, and its plant, from the first table. Reference: the rule
+    itself — every inner speed of the first table is such a speed."""
     import ambseal.design.synchronous_rejection as sr
 
     lo, hi = turbo_cfg.operating.continuous_hz

@@ -30,10 +30,10 @@ Rules, each a parameter:
   each pole keeps at least 75 % of its distance ε/2 from the axis, and the notch settles
   in at most 4/3 of its designed time. An interval no wider than that distance (in Hz:
   ``rate_fraction``/2 of its lower end) is not split: the notch does not resolve the gain
-  finer than its own bandwidth. Where
-  ``[design.rejection] points`` is given, that many evenly spaced speeds instead (16
-  evenly spaced speeds on the turboexpander example put ‖E‖ at 0.31 between two of them;
-  the bisection 15 speeds, 0.07 at most on 257 of them);
+  finer than its own bandwidth. Where ``[design.rejection] points`` is given, that many
+  evenly spaced speeds instead (16 evenly spaced speeds on the turboexpander example put
+  ‖E‖ at 0.31 between two of them; the bisection 15 speeds, 0.07 at most on 257 of
+  them);
 - on from the lowest of them: below the minimum continuous speed the rotor passes its
   critical speeds on the feedback alone, and at standstill a notch at 0 Hz would take the
   controller's static stiffness — unless the run passes a lower start (``speeds_hz``):

@@ -163,6 +163,28 @@ def test_tables_that_start_at_other_speeds_share_the_plants_above(turbo_cfg, tur
         assert any(abs(f / hi * 2**j - round(f / hi * 2**j)) < 1e-9 for j in range(30))
 
 
+def test_a_split_is_the_coarsest_dyadic_speed_inside_also_from_a_dyadic_end():
+    """:func:`dyadic_split` against the rule by enumeration: of the speeds
+    ``ldexp(top·k, −j)`` (k = 1 … 2^j − 1, the tables' own rounding of top·k/2^j) strictly
+    inside (a, b), the one of the smallest j — one speed there, never two. Seeded tops,
+    and intervals whose lower end is itself such a speed, as an earlier split made it:
+    there ``a/top`` can round below k/2^j (about 4 % of these draws), which must not make
+    the lower end its own split, nor loop on it."""
+    from ambseal.design.synchronous_rejection import dyadic_split
+
+    rng = np.random.default_rng(7)
+    for _ in range(500):
+        top = float(rng.uniform(50.0, 2000.0))
+        j0 = int(rng.integers(1, 8))
+        a = math.ldexp(top * int(rng.integers(1, 2**j0)), -j0)
+        b = a + float(rng.uniform(0.02, 1.0)) * (top - a)
+        inside, j = [], 0
+        while not inside:
+            inside = [s for s in (math.ldexp(top * k, -j) for k in range(1, 2**j)) if a < s < b]
+            j += 1
+        assert len(inside) == 1 and dyadic_split(a, b, top) == inside[0]
+
+
 def test_the_table_interpolates_the_gain_between_its_speeds(turbo_cfg, turbo_frozen,
                                                             turbo_hinf_digital, rejection):
     """Midway between every two neighbouring speeds of the table (speeds it never

@@ -220,10 +220,12 @@ def dyadic_split(a: float, b: float, top: float) -> float:
     same top speed split every interval they share at the same speed, whatever speed each
     starts from, so their plants are shared (:data:`_PLANT_AT`)."""
     j = 0
-    while True:
+    while True:  # ends: at the level whose step is below b − a, the next speed is inside
         k = math.floor(math.ldexp(a / top, j)) + 1
         m = math.ldexp(top * k, -j)
-        if a < m < b:
+        if m <= a:  # a is that level's speed, and a/top was rounded below it
+            m = math.ldexp(top * (k + 1), -j)
+        if m < b:
             return m
         j += 1
 

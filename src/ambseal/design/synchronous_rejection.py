@@ -22,8 +22,8 @@ Rules, each a parameter:
   evaluated and kept, and both parts are split again while, there, the interpolated gain
   T̃ misses the evaluated T by ‖(T̃ − T) T⁻¹‖₂ > :data:`INTERP_RTOL`, in the continuous
   or in the sampled loop. The split is the dyadic speed f_top·k/2^j of the coarsest
-  level inside the interval (f_top the range's top; the midpoint where both ends are
-  such speeds): each controller's table starts at its own switch-on speed, and splits
+  level inside the interval (f_top the range's top; the midpoint where its ends are
+  neighbouring such speeds): each controller's table starts at its own switch-on speed, and splits
   that do not depend on that start let the tables of one rig share their speeds and so
   their plants (an ``expm`` each, 0.3 s at 840 states). The notch's first-order poles
   are placed by the eigenvalues of T̃ T⁻¹ = I + E, which lie within ‖E‖ of 1: at 0.25
@@ -216,7 +216,7 @@ def _bisected(lo: float, hi: float, gains_at, rate_fraction: float) -> dict:
 def dyadic_split(a: float, b: float, top: float) -> float:
     """The speed ``top·k/2^j`` of the smallest ``j`` strictly between ``a`` and ``b``
     (0 ≤ a < b ≤ top): unique (of two neighbours at level j one is at level j − 1), the
-    midpoint where ``a`` and ``b`` are dyadic speeds of ``top`` themselves. Tables with the
+    midpoint where ``a`` and ``b`` are neighbouring dyadic speeds of ``top``. Tables with the
     same top speed split every interval they share at the same speed, whatever speed each
     starts from, so their plants are shared (:data:`_PLANT_AT`)."""
     j = 0

@@ -28,7 +28,9 @@ discretises a family of controllers (a scheduled one): :func:`check_rate`,
 :func:`split_fast`, :func:`hold_keeps`, :func:`residualize`, :func:`discretize_as`,
 :func:`with_delay`, :func:`prewarp_frequency_hz`, :func:`sampled_plants`,
 :func:`choose_method`, :func:`chosen_error`, :func:`peak_difference` and their constants;
-:func:`closed_loop_matrices` — the sampled loop as it runs.
+:func:`closed_loop_matrices` — the sampled loop as it runs. A synthesis on the sampled,
+delayed plant itself: :func:`w_plane_plant`, the plant's w-plane image, whose controller's
+Tustin transform is the discrete design.
 
 The one stability rule: :func:`is_stable`, :func:`unstable_poles`, :func:`decay_rate`.
 
@@ -68,6 +70,7 @@ _FROM = {
     "MuResult": "mu", "balred_controller": "order", "reduce_controller": "order",
     "ReductionResult": "order", "decay_rate": "stability", "is_stable": "stability",
     "unstable_poles": "stability", "MAX_DELAY_SAMPLES": "timing", "check_timing": "timing",
+    "w_plane_plant": "w_plane",
 }
 
 __all__ = sorted(_FROM)

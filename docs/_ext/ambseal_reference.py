@@ -487,6 +487,11 @@ KEY_DOCS: dict[str, tuple[str, str]] = {
                              "spin speed uncertain over the judged speeds, else at each "
                              "stability speed from standstill up, the first that holds "
                              "every judged condition kept)"),
+    "Design.synthesis_plant": ("", "``continuous`` (default): H∞ and μ synthesised on the "
+                                   "design model with the delay as a Padé lag, then "
+                                   "discretised; ``sampled``: on the design model sampled "
+                                   "with its delay, in the w-plane, the discrete controller "
+                                   "its Tustin transform"),
     "Design.tracked": ("", "``ambseal run`` adds the controller scheduled on the tracked "
                            "seal k (LMI synthesis: minutes)"),
     "UnbalanceSpec.grade_mm_s": ("mm/s", "ISO 21940-11 balance grade G"),

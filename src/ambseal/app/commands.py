@@ -150,8 +150,11 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
         cache = {} if cache is None else cache
         rise = ((lambda Kr: design_rise(result, Kr, getattr(result, "omega", None), fs / 2))
                 if method in method_names(synthesised=True) else None)
+        # a design on the sampled plant: its Tustin transform is the discrete design
+        w_plane = getattr(result, "synthesis_plant", "continuous") == "sampled"
         try:  # before the plants
-            check_rate(controller, fs, delay, removable=rise is not None)
+            if not w_plane:
+                check_rate(controller, fs, delay, removable=rise is not None)
         except ConfigError as exc:
             if method != "pid" or written_pid(cfg):
                 raise
@@ -164,7 +167,7 @@ def digital_for(cfg, method: str, controller, result, points, cache: dict | None
                                              delay_samples=delay)
         try:
             return digital_controller(controller, fs, cache["plants"],
-                                      delay_samples=delay, rise=rise)
+                                      delay_samples=delay, rise=rise, w_plane=w_plane)
         except SynthesisError as exc:
             if method != "pid" or written_pid(cfg):
                 raise

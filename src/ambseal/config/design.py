@@ -78,6 +78,16 @@ and bounded (the bounds beside each key in the code, with their reasons).
     every judged condition; else it is designed again at each stability speed from
     standstill up, and the first that holds every judged condition is kept
     (:func:`ambseal.design.recipes.design`).
+``[design] synthesis_plant`` (``"continuous"``, the default, or ``"sampled"``)
+    The plant H∞ and μ are synthesised on. ``"continuous"``: the design model with the
+    target's hold and computation delay as a Padé lag, the controller then discretised
+    (:mod:`ambseal.robust.digital`). ``"sampled"``: the design model sampled by ZOH at
+    ``[controller] sample_rate_hz`` with ``delay_samples`` of delay, synthesised in the
+    w-plane (:mod:`ambseal.robust.w_plane`); the discrete controller is the Tustin
+    transform of the one designed, exactly, and the design's own checks close it with the
+    sampled full-order plant. For a low rate, where the loop as it runs parts from the
+    continuous one the design foresaw. Judged as every design: continuous (its w-plane
+    form with the Padé lag) and as it runs.
 ``[design] tracked`` (bool, default false)
     ``ambseal run`` adds the ``tracked`` controller: scheduled on the first
     seal's k as tracked on line (:mod:`ambseal.design.seal_schedule`), judged at the
@@ -263,6 +273,7 @@ class Design(_Strict):
     lpv: MethodSpec = MethodSpec()
     rejection: RejectionSpec = RejectionSpec()
     one_speed: bool = False
+    synthesis_plant: Literal["continuous", "sampled"] = "continuous"
     tracked: bool = False
 
     @model_validator(mode="after")

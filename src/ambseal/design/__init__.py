@@ -11,7 +11,8 @@
   :func:`controller_from_metadata` for the one a record names; :class:`ScheduledPid` where
   its cross gains are scheduled on speed), nominal H∞ and robust μ;
   :func:`full_order_check` — a design closed with the full-order plant, and
-  :func:`full_order_words` — its result in a verdict's words;
+  :func:`full_order_words` — its result in a verdict's words; :func:`on_sampled_plant` —
+  whether H∞ and μ are synthesised on the sampled plant (``[design] synthesis_plant``);
   :func:`design_rise` — what the removal of fast poles costs a design;
 * :class:`Design` — what every design result offers (:class:`DesignResult` and the
   scheduled designs below alike);
@@ -42,6 +43,7 @@ from ambseal.design.recipes import (
     design,
     full_order_check,
     full_order_words,
+    on_sampled_plant,
 )
 from ambseal.design.result import Design
 from ambseal.design.seal_schedule import design_seal_scheduled
@@ -61,6 +63,7 @@ __all__ = ["RIGID_STATES", "Design", "DesignResult", "DesignSpec", "Machine", "W
            "controller_from_metadata", "default_weights", "design", "design_frozen",
            "design_lpv", "lpv_schedule", "design_rise", "design_seal_scheduled", "design_spec",
            "full_order_check", "full_order_words", "generalized_plant", "machine",
+           "on_sampled_plant",
            "uncertainty_at",
            "physical_controller", "pid_controller", "pid_description", "reference_pid",
            "vertex_grid_hz", "SynchronousRejection", "design_rejection"]

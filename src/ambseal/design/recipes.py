@@ -53,7 +53,7 @@ import copy
 import json
 import re
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import partial
 from typing import Any, Mapping
 
@@ -82,6 +82,7 @@ from ambseal.robust import (
     LEVEL_RTOL,
     design_delay,
     design_omega,
+    discretize_as,
     hinfsyn,
     loop_delay,
     musyn,
@@ -91,6 +92,8 @@ from ambseal.robust import (
     scaled_hinfsyn,
     scaled_performance,
     unstable_poles,
+    w_plane_plant,
+    with_delay,
 )
 from ambseal.threads import with_numerics_threads
 
@@ -163,7 +166,9 @@ class DesignResult:
         its judgement can mark the design failed); not the user's flag.
     delay : dict or None
         The controller's hold + computation delay the design model carries
-        (:meth:`ambseal.robust.delay.DesignDelay.to_dict`); None for the PID.
+        (:meth:`ambseal.robust.delay.DesignDelay.to_dict`; on the sampled plant, exact:
+        ``delay_s`` ≈ (delay_samples + ½)/rate and ``sampled``, the rate and the delay in
+        samples); None for the PID.
     steps : tuple of str
         The automatic design-loop steps taken (model enlargements, damping margins).
     omega : ndarray or None
@@ -180,6 +185,11 @@ class DesignResult:
         uncertain parameter of its LFT (:mod:`ambseal.design.speed_lft`), where the design
         at ``[operating] speed_rpm`` alone lost the rotor at another judged speed; None
         otherwise.
+    synthesis_plant : {"continuous", "sampled"}
+        The plant H∞ or μ was synthesised on (``[design] synthesis_plant``): ``"sampled"``,
+        the sampled, delayed design model in the w-plane (:mod:`ambseal.robust.w_plane`),
+        ``K`` the w-plane controller whose Tustin transform is the discrete design;
+        ``"continuous"`` for every other design.
     stopping : dict or None
         Why the synthesis stopped: μ, the rule that ended each phase, its iterations and
         the D search's γ evaluations (:attr:`ambseal.robust.dk.MusynResult.stopping`);
@@ -216,6 +226,7 @@ class DesignResult:
     scheduled: Any = field(default=None, repr=False)
     design_speed_hz: float | None = None
     speed_range_hz: tuple | None = None
+    synthesis_plant: str = "continuous"
 
     @property
     def controller(self):
@@ -238,7 +249,7 @@ class DesignResult:
                 "notes": list(self.notes), "verdict": self.verdict,
                 "stopping": self.stopping,
                 "speed_range_hz": None if self.speed_range_hz is None
-                else list(self.speed_range_hz)}
+                else list(self.speed_range_hz), "synthesis_plant": self.synthesis_plant}
 
     def to_dict(self) -> dict:
         """Summary plus the controller matrices (lists) and the D–K history."""
@@ -266,10 +277,14 @@ def _pid(cfg, p):
                         notes=notes, scheduled=sched, verdict=_pid_verdict(d))
 
 
-def full_order_check(cfg, K, conditions, *, first_loss: bool = False) -> dict:
+def full_order_check(cfg, K, conditions, *, first_loss: bool = False,
+                     sampled: bool = False) -> dict:
     """Close a physical controller with the full-order plant at each condition, as the
     main job judges it (:func:`ambseal.machine.loop.judged_loop`: the target's hold and
-    computation delay as :func:`ambseal.robust.delay.loop_delay`'s lag).
+    computation delay as :func:`ambseal.robust.delay.loop_delay`'s lag), or, with
+    ``sampled``, as it runs: its Tustin transform with the computation delay on the plant
+    sampled at ``[controller] sample_rate_hz`` (a design on the sampled plant,
+    :mod:`ambseal.robust.w_plane`, whose discrete controller that transform is).
 
     Parameters
     ----------
@@ -285,6 +300,8 @@ def full_order_check(cfg, K, conditions, *, first_loss: bool = False) -> dict:
         checked: for a design about to be corrected, whose lost modes matter and not
         every condition's verdict. The gyroscopic moments move a frozen design's modes
         the more the farther the speed, so the farthest speed loses the modes first.
+    sampled : bool
+        Judge the loop as it runs (above); its poles z are taken to s by λ = ln z / T.
 
     Returns
     -------
@@ -298,7 +315,13 @@ def full_order_check(cfg, K, conditions, *, first_loss: bool = False) -> dict:
         number of conditions checked (fewer than given only with ``first_loss``).
     """
 
-    L = loop_delay(cfg.controller.sample_rate_hz, cfg.controller.delay_samples).system
+    fs, nd = cfg.controller.sample_rate_hz, cfg.controller.delay_samples
+    L = loop_delay(fs, nd).system
+    if sampled:
+        mats = with_delay(discretize_as(tuple(np.asarray(getattr(K, x), float)
+                                              for x in "ABCD"), 1.0 / fs, "tustin"), nd)
+        K = control.ss(*mats, 1.0 / fs, inputs=list(K.input_labels),
+                       outputs=list(K.output_labels), name=K.name)
     conditions = list(conditions)
     if first_loss:
         f0 = cfg.operating.speed_rpm / 60.0
@@ -311,6 +334,8 @@ def full_order_check(cfg, K, conditions, *, first_loss: bool = False) -> dict:
         plant = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * f)
         judged = judged_loop(plant.to_statespace(), K, plant.current_inputs(), delay=L)
         lam = judged.loop.poles
+        if sampled:  # the delay's poles at z = 0 have no s image (infinitely fast)
+            lam = np.log(lam[np.abs(lam) > 0].astype(complex)) * fs
         lost += [{"mode_hz": float(x.imag / (2 * np.pi)), "speed_hz": float(f),
                   "pressure_bar": float(p)} for x in unstable_poles(lam) if x.imag >= 0]
         z = lam[int(np.argmax(lam.real))]
@@ -322,6 +347,26 @@ def full_order_check(cfg, K, conditions, *, first_loss: bool = False) -> dict:
             "max_real_pole": float(z.real), "mode_hz": float(abs(z.imag) / (2 * np.pi)),
             "damping": float(-z.real / max(abs(z), 1e-300)), "unstable": lost,
             "checked": checked}
+
+
+def on_sampled_plant(cfg) -> bool:
+    """Whether the rig's H∞ and μ are synthesised on the sampled, delayed plant.
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig; ``[design] synthesis_plant`` decides.
+
+    Returns
+    -------
+    bool
+        True for ``"sampled"``: the design model sampled with its delay, in the w-plane
+        (:mod:`ambseal.robust.w_plane`); the full-order checks then close the loop as it
+        runs (:func:`full_order_check`), and the discrete controller is the Tustin
+        transform of the one designed (:func:`ambseal.robust.digital.digital_controller`
+        with ``w_plane``).
+    """
+    return cfg.design.synthesis_plant == "sampled"
 
 
 @with_numerics_threads
@@ -466,9 +511,14 @@ def design(
         uncertainty={q.name: (q.low, q.high) for q in r.gp.parameters},
         elapsed_s=time.perf_counter() - t0, reduction=r.reduction, plant=r.gp,
         design_states=n, full_order=check, kept_unstable=not check["stable"],
-        delay=dl.to_dict(), steps=tuple(steps), notes=tuple(sp.notes),
+        delay=({"delay_s": (cfg.controller.delay_samples + 0.5) / cfg.controller.sample_rate_hz,
+                "sampled": {"sample_rate_hz": cfg.controller.sample_rate_hz,
+                            "delay_samples": cfg.controller.delay_samples}}
+               if on_sampled_plant(cfg) else dl.to_dict()),
+        steps=tuple(steps), notes=tuple(sp.notes),
         verdict=_verdict(method, r, check), omega=r.omega, stopping=r.stopping,
-        design_speed_hz=moved, speed_range_hz=over)
+        design_speed_hz=moved, speed_range_hz=over,
+        synthesis_plant="sampled" if on_sampled_plant(cfg) else "continuous")
 
 
 def _tried(trials: dict, inputs: tuple, make):
@@ -527,7 +577,8 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
                         progress and (lambda line: progress(f"{method}: {line}")), tuple(bands),
                         speed, level)
         # a design that can still be corrected is checked until it loses a mode
-        check = full_order_check(cfg, r.K, conditions, first_loss=attempt < enlarge)
+        check = full_order_check(cfg, r.K, conditions, first_loss=attempt < enlarge,
+                                 sampled=on_sampled_plant(cfg))
         if not margins:
             plain = (r, check, n)
         if check["stable"] or attempt == enlarge:
@@ -585,7 +636,7 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
         r, check, n = plain
     if check["checked"] < len(conditions):
         # the design delivered, or refused, is judged at every condition
-        check = full_order_check(cfg, r.K, conditions)
+        check = full_order_check(cfg, r.K, conditions, sampled=on_sampled_plant(cfg))
     return r, check, n
 
 
@@ -827,12 +878,17 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
     robust = method in method_names(robust=True)  # against the uncertain parameters
     Wf = w.Wf()
     fpos = tuple(w.force_positions_m or sp.force_positions_m) if Wf is not None else ()
+    sampled = on_sampled_plant(cfg)
     gp = generalized_plant(cfg, w.Wp(), w.Wu(), uncertainty=unc if robust else None,
                            pressure_bar=p, states=n, input_disturbance=w.W1(),
                            force_disturbance=Wf, force_positions=fpos, d_e=w.d_e, d_u=w.d_u,
-                           actuator_delay=dl.system,
+                           actuator_delay=None if sampled else dl.system,
                            gain_weight=w.Wk(), damping_margins=margins,
                            modal_bands=bands if robust else (), speed_range_hz=speed)
+    if sampled:  # the plant as the discrete controller sees it, in the w-plane
+        fs, nd = cfg.controller.sample_rate_hz, cfg.controller.delay_samples
+        gp = replace(gp, P=w_plane_plant(gp.P, gp.ncon, fs, nd),
+                     P_nominal=w_plane_plant(gp.P_nominal, gp.ncon, fs, nd))
     mu_omega = None
 
     def scaled_hinf(P):  # H∞ at the constant scalings of the speed channel
@@ -890,7 +946,8 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
     order_full = int(K_P.nstates)
     if reduce_to == "auto":
         reduce_to = sp.order_max or (gp.design_plant.A.shape[0] + gp.ncon * (
-            gp.Wp.nstates + gp.Wu.nstates + dl.system.nstates))
+            gp.Wp.nstates + gp.Wu.nstates
+            + (cfg.controller.delay_samples if sampled else dl.system.nstates)))
         auto = not sp.order_max
     else:
         auto = False
@@ -990,7 +1047,7 @@ def _lost_by(cfg, K, check, p: float) -> tuple[bool, bool, float]:
     other_f = abs(check["speed_hz"] - f0) > 1e-9
     if not (other_p and other_f):
         return other_p, other_f, f0
-    lost = [not full_order_check(cfg, K, [c])["stable"]
+    lost = [not full_order_check(cfg, K, [c], sampled=on_sampled_plant(cfg))["stable"]
             for c in ((check["pressure_bar"], f0), (p, check["speed_hz"]))]
     return lost[0] or not lost[1], lost[1], f0
 

@@ -698,7 +698,8 @@ def _none_holds(cands: list, cont_stable: list, fs: float, delay: int, name: str
 
 def digital_controller(K, sample_rate_hz: float, plants, *,
                        delay_samples: int = 1, rise: Callable | None = None,
-                       methods: Sequence[str] = DISCRETISATIONS) -> DigitalController:
+                       methods: Sequence[str] = DISCRETISATIONS,
+                       w_plane: bool = False) -> DigitalController:
     """Choose the discrete controller that runs on the target (module docstring).
 
     Parameters
@@ -718,6 +719,12 @@ def digital_controller(K, sample_rate_hz: float, plants, *,
         are not removed and a rate below twice the highest is refused.
     methods : sequence of str
         Candidates, a subset of :data:`DISCRETISATIONS`.
+    w_plane : bool
+        ``K`` was designed on the sampled plant in the w-plane
+        (:func:`~ambseal.robust.w_plane.w_plane_plant`): its Tustin transform without
+        prewarp is the discrete design itself, the only candidate, nothing removed
+        (``rise`` and ``methods`` ignored); its poles, however fast, map inside the unit
+        circle, so the rate check does not apply.
 
     Returns
     -------
@@ -733,7 +740,11 @@ def digital_controller(K, sample_rate_hz: float, plants, *,
         An unstable fast pole, or no candidate keeps the sampled loop stable where the
         continuous loop is: the reason names the rate and the controller's poles.
     """
-    check_rate(K, sample_rate_hz, delay_samples, removable=rise is not None)
+    if w_plane:
+        check_timing(sample_rate_hz, delay_samples)
+        rise, methods = None, ("tustin",)
+    else:
+        check_rate(K, sample_rate_hz, delay_samples, removable=rise is not None)
     if not isinstance(plants, SampledPlants) and len(plants) == 0:
         raise ModelError("digital_controller: plants is empty; expected the full-order plant "
                          "at one condition at least, (A, B, C, D) each")
@@ -745,7 +756,7 @@ def digital_controller(K, sample_rate_hz: float, plants, *,
     if abs(sp.fs - fs) > 1e-9 * fs:
         raise ConfigError(f"digital_controller: plants sampled at {sp.fs} Hz, not {fs} Hz")
     n = len(sp.ideal)
-    f_pw = prewarp_frequency_hz(sp.ideal, mats, fs, lag=sp.lag)
+    f_pw = None if w_plane else prewarp_frequency_hz(sp.ideal, mats, fs, lag=sp.lag)
     keep = hold_keeps(fast, fs)
     tried = list(methods) + ([f"{m}{KEPT}" for m in HOLDS if m in methods] if keep else [])
 

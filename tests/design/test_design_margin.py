@@ -14,8 +14,9 @@ import pytest
 from ambseal.config import load_rig
 from ambseal.design import design_spec
 from ambseal.design.plant import less_damped
-from ambseal.design.recipes import MARGIN_ZETA, _margin_reaches, design, margin_for
-from ambseal.errors import ModelError
+from ambseal.design.recipes import (MARGIN_ZETA, _margin_reaches, design, full_order_check,
+                                    margin_for)
+from ambseal.errors import ConfigError, ModelError
 from ambseal.model import build_plant
 from ambseal.model.lft import Plant
 
@@ -143,3 +144,32 @@ def test_a_margin_is_asked_of_the_design_model_not_of_the_modes_it_leaves_out():
     assert not _margin_reaches(cfg, p, n, above, 0.01)
     assert _margin_reaches(cfg, p, n, kept[-1], 0.01)
     assert less_damped(full, [(above, 0.01)]) is not full
+
+
+def test_a_design_on_the_sampled_plant_is_checked_as_it_runs():
+    """``[design] synthesis_plant = "sampled"``: the design's full-order check closes the
+    Tustin transform of the w-plane controller, one sample late, with the ZOH-sampled
+    full-order plant. At each judged condition its least stable pole, taken back to z,
+    is python-control's: the same loop built by ``sample_system`` and ``feedback``."""
+    cfg = load_rig(SUPERCRITICAL, ("design.synthesis_plant=sampled", "design.one_speed=true"))
+    r = design(cfg, "hinf", enlarge=0, allow_unstable=True)
+    assert r.synthesis_plant == "sampled" and r.summary()["synthesis_plant"] == "sampled"
+    assert r.delay["sampled"] == {"sample_rate_hz": 10000.0, "delay_samples": 1}
+    T = 1.0 / cfg.controller.sample_rate_hz
+    Kd = control.sample_system(control.ss(r.K.A, r.K.B, r.K.C, r.K.D), T, method="tustin")
+    n = Kd.noutputs
+    late = control.ss(np.zeros((n, n)), np.eye(n), np.eye(n), np.zeros((n, n)), T)  # z⁻¹
+    sp = design_spec(cfg)
+    for p, f in [(p, f) for p in sp.pressures_bar for f in sp.speeds_hz]:
+        ours = full_order_check(cfg, r.K, [(p, f)], sampled=True)
+        pl = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * f)
+        G = pl.select_inputs([pl.input_names[j] for j in pl.current_inputs()])
+        Gd = control.sample_system(control.ss(G.A, G.B, G.C, G.D), T, method="zoh")
+        z = np.abs(control.feedback(Gd, late * Kd).poles()).max()
+        assert ours["stable"] == (z < 1.0)
+        assert np.exp(ours["max_real_pole"] * T) == pytest.approx(z, rel=1e-6)
+
+
+def test_an_unknown_synthesis_plant_is_refused_by_its_key():
+    with pytest.raises(ConfigError, match="synthesis_plant"):
+        load_rig(SUPERCRITICAL, ("design.synthesis_plant=discrete",))

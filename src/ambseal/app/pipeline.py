@@ -72,7 +72,7 @@ from ambseal.app.metrics import (
     RunMetrics,
     Signoff,
 )
-from ambseal.app.remedies import remedy
+from ambseal.app.remedies import on_the_sampled_plant, remedy
 from ambseal.app.tracked import tracked_designs, tracked_ramp
 from ambseal.config import (
     RigConfig,
@@ -90,6 +90,7 @@ from ambseal.design import (
     design_rejection,
     design_spec,
     lpv_schedule,
+    on_sampled_plant,
 )
 from ambseal.errors import ConfigError, ModelError, SynthesisError
 from ambseal.export import export_notch, write_notch_c
@@ -369,6 +370,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         _judge_stage(st)
         stability = _speed_range(st.designs, st.digitals, spec, points, st.design_cfg,
                                  st.judge_cfg, stages, st.failed, allow_unstable)
+        stability = _sampled_remedies(st, stability)
         _note_speed_lpv(st)
         metrics = _deliver_and_report(st, model, stability, rig_path, truth, command)
     exit_status = EXIT_FAILED if any(f.designed and not (allow_unstable and f.judged)
@@ -538,6 +540,56 @@ def _judge_stage(st: _RunState) -> None:
             new = iter(zip(fixed.jobs, fixed.judged))
             st.jobs, st.judged = map(list, zip(*[next(new) if j.name == m else (j, r)
                                                  for j, r in zip(st.jobs, st.judged)]))
+
+
+def _sampled_remedies(st: _RunState, stability: list) -> list:
+    """Each H∞ or μ design whose loop is lost only as it runs (its continuous loop with
+    the delay stable at every judged condition and stability speed), or that cannot run on
+    the target, designed again on the sampled plant
+    (:func:`ambseal.app.remedies.on_the_sampled_plant`): where that design holds, it
+    replaces the first, its cases theirs; else the failure says what was tried. Returns
+    the stability cases."""
+    if speed_scheduled(st.cfg) or on_sampled_plant(st.design_cfg):
+        return stability
+    spoints = stability_points(st.spec.pressures_bar, st.spec.stability_speeds_hz, st.points)
+
+    def speed_range(ds, digs) -> list:
+        if not spoints:
+            return []
+        jobs = judge_jobs(ds, digs, spoints, st.design_cfg)
+        return _by_condition(stability_case, jobs, {"cfg": st.judge_cfg, "settings":
+                                                    judge_settings(st.spec, st.judge_cfg)},
+                             lambda i, r: None)
+
+    for m in [d.method for d in st.designs if d.method in method_names(synthesised=True)]:
+        if m in st.cannot_run:
+            why = "the design on the continuous plant cannot run on the target"
+        elif m in st.failed and st.failed[m].designed and st.failed[m].judged and all(
+                c.stable for c in [c for c, _ in _judged_of(m, st.jobs, st.judged)]
+                + [c for c in stability if c.controller == m]):
+            why = "the design on the continuous plant lost the loop as it runs"
+        else:
+            continue
+        fixed, cases, tried = on_the_sampled_plant(
+            m, why, st.design_cfg, st.spec, st.points,
+            lambda ds, digs: _judge_designs(st, ds, digs, 0), speed_range,
+            lambda line: st.say(line, 0))
+        if fixed is None:
+            if m in st.failed:
+                st.failed[m] = replace(st.failed[m], reason=f"{st.failed[m].reason}. "
+                                                            f"Tried: {tried}")
+            else:
+                st.cannot_run[m] = f"{st.cannot_run[m]}. Tried: {tried}"
+            continue
+        st.failed.pop(m, None)
+        st.cannot_run.pop(m, None)
+        st.designs = [fixed.design if d.method == m else d for d in st.designs]
+        st.digitals[m] = fixed.digital
+        new = iter(zip(fixed.jobs, fixed.judged))
+        st.jobs, st.judged = map(list, zip(*[next(new) if j.name == m else (j, r)
+                                             for j, r in zip(st.jobs, st.judged)]))
+        stability = [c for c in stability if c.controller != m] + cases
+    return stability
 
 
 def _note_speed_lpv(st: _RunState) -> None:

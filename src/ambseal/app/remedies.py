@@ -14,7 +14,17 @@ this order, and judges each attempt at every condition like the first design:
    trades performance for robustness).
 
 The first attempt that holds at every judged condition replaces the design, its summary
-saying so (``remedy``). When none holds, the failure line lists what was tried; the μ
+saying so (``remedy``).
+
+**A loop lost only as it runs** — the continuous loop with the delay holds at every
+judged condition and stability speed, but the discrete controller's sampled loop does
+not, or no discretisation runs it at all — is a gap between the loop designed and the
+loop that runs, which neither remedy above closes: the design is made again on the
+sampled, delayed plant in the w-plane (:func:`on_the_sampled_plant`, ``[design]
+synthesis_plant = "sampled"``), whose discrete controller is its Tustin transform
+exactly, and replaces the first where it holds at every judged condition and stability
+speed, continuous and as it runs. Measured on the gyroscopic family at 10 kHz
+(benchmarks/README.md, "H∞ and μ designed against the sampled plant"). When none holds, the failure line lists what was tried; the μ
 controller, robust to the specification's uncertainty (thesis P5 §4), is the run's robust
 one. A speed-scheduled rig's designs (frozen at a speed, or scheduled on it) get no
 remedy here: their schedule is the remedy.
@@ -31,7 +41,7 @@ from ambseal.config import method_label, method_names
 from ambseal.design import design, uncertainty_at
 from ambseal.errors import ConfigError, SynthesisError
 
-__all__ = ["Remedied", "remedy", "worst_case"]
+__all__ = ["Remedied", "on_the_sampled_plant", "remedy", "worst_case"]
 
 #: Factor on the performance weight's bandwidth ω_B in the second attempt.
 OMEGA_B_FACTOR = 0.5
@@ -168,3 +178,51 @@ def remedy(method: str, failure: FailedController, cases: list[JudgedCase], desi
                          + ("" if method in method_names(robust=True) else
                             f"; {' and '.join(map(method_label, method_names(robust=True)))} "
                             "is the robust controller"))
+
+
+def on_the_sampled_plant(method: str, why: str, design_cfg, spec, points, judge: Callable,
+                         stability: Callable, say: Callable[[str], None]
+                         ) -> tuple[Remedied | None, list, str]:
+    """``method`` designed again on the sampled plant (module docstring), for a design whose
+    loop is lost only as it runs.
+
+    Parameters
+    ----------
+    method : {"hinf", "mu"}
+    why : str
+        Why the first design is redesigned (its summary's ``remedy`` says so).
+    design_cfg, spec, points, judge, say
+        As for :func:`remedy`.
+    stability : callable
+        ``stability(designs, digitals) -> [(case, curves)]``: the run's stability cases at
+        the speed range's conditions not judged in full (:func:`ambseal.analysis.
+        stability_case`); empty where there are none.
+
+    Returns
+    -------
+    (Remedied or None, list, str)
+        The new design where it holds at every judged condition and stability speed, and
+        its stability cases; else None, [] and what was tried, for the failure's line.
+    """
+    cfg = design_cfg.model_copy(update={"design": design_cfg.design.model_copy(
+        update={"synthesis_plant": "sampled"})})
+    label = "designed on the sampled plant (w-plane, its Tustin transform the discrete design)"
+    say(f"{method}: {why}: {label}")
+    try:
+        res = design(cfg, method, spec=spec, allow_unstable=True)
+    except (SynthesisError, ConfigError) as exc:
+        return None, [], f"{label}: the design failed: {exc}"
+    d = Designed(res, {**res.summary(), "remedy": f"{label}: {why}"})
+    digitals, cannot = digitals_for(cfg, [d], points)
+    if method not in digitals:
+        return None, [], f"{label}: cannot run on the target: {cannot.get(method, '')}"
+    jobs, judged = judge([d], digitals)
+    cases = stability([d], digitals)
+    lost = [f for f in (loop_failure(method, judged, designed=True),
+                        loop_failure(method, cases, designed=True) if cases else None)
+            if f is not None]
+    if not lost:
+        say(f"{method}: {label} holds at every judged condition")
+        return Remedied(d, digitals[method], jobs, judged), [c for c, _ in cases], ""
+    where = "; ".join(c for f in lost for c in f.conditions)
+    return None, [], f"{label}: still unstable at {where}"

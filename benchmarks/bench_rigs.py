@@ -16,7 +16,8 @@ model's, from ``metrics.json``), ``returncode``, ``cpu_s`` (the child's user + s
 CPU, interpreter start and imports included) and ``cpu_per_reference`` against the goal
 ``goal_references`` (113: 60 s at the developers' machine reference of 0.53 s) with
 ``meets_goal``; per stage of the run
-(``model``, ``design``, ``judge``, ``speed-range``, ``spin-up``, ``report``, the sign-off
+(``model``, ``design``, ``judge``, ``speed-range``, ``sampled-redesign`` where a design is
+lost only as it runs, ``spin-up``, ``report``, the sign-off
 where the run has one) its CPU time (s, the stage line's own process CPU) and references
 (``stages``); the design time of each method (``design_s``, its ``elapsed_s``); and the
 limit each stage's cost is held to — the judged conditions (judged cases and speed-range

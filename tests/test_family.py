@@ -23,6 +23,24 @@ def _bench_family():
     return bench_module("bench_family")
 
 
+def _run(bf, seed: int, tmp_path):
+    """Seed ``seed``'s rig text and the metrics of its ``ambseal run --no-identify`` in a
+    child process, as the benchmark runs it."""
+    import json
+    import subprocess
+
+    text, _ = bf.family_rig(seed)
+    rig = tmp_path / "rig.toml"
+    rig.write_text(text, encoding="utf-8")
+    cmd = [sys.executable, "-c", "import sys; from ambseal.cli import main; "
+           "sys.exit(main(sys.argv[1:]))", "run", str(rig), "--no-identify",
+           "--out", str(tmp_path / "run")]
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=1800,
+                          env=bf.child_env())
+    assert done.returncode in (0, 1), done.stderr[-2000:]
+    return text, json.loads((tmp_path / "run" / "metrics.json").read_text())
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_a_family_rig_runs_end_to_end_with_a_method_delivered(seed):
@@ -52,20 +70,8 @@ def test_a_disc_like_rotor_switches_its_notch_on_where_it_needs_it(tmp_path):
     191 Hz; the run then switches it on where the controller alone last uses at most half
     of its amplifier below its saturation, and delivers the LPV with its notch from
     there."""
-    import json
-    import subprocess
-
     bf = _bench_family()
-    text, _ = bf.family_rig(2)
-    rig = tmp_path / "rig.toml"
-    rig.write_text(text, encoding="utf-8")
-    cmd = [sys.executable, "-c", "import sys; from ambseal.cli import main; "
-           "sys.exit(main(sys.argv[1:]))", "run", str(rig), "--no-identify",
-           "--out", str(tmp_path / "run")]
-    done = subprocess.run(cmd, capture_output=True, text=True, timeout=1800,
-                          env=bf.child_env())
-    assert done.returncode in (0, 1), done.stderr[-2000:]
-    m = json.loads((tmp_path / "run" / "metrics.json").read_text())
+    text, m = _run(bf, 2, tmp_path)
     assert bf.delivered(m)["lpv"], m["failed"].get("lpv")
     lo, top = parse_rig(tomllib.loads(text)).operating.speed_range_hz
     rej = m["controllers"]["lpv"]["rejection"]
@@ -83,25 +89,13 @@ def test_a_design_lost_only_as_it_runs_is_designed_on_the_sampled_plant(tmp_path
     before the sampled design). The run designs it again on the sampled plant and delivers
     it; its exported discrete controller, with its delay, closed by python-control with the
     ZOH-sampled full-order plant at standstill and at the top speed, is stable there."""
-    import json
-    import subprocess
-
     import control as ct
     import numpy as np
 
     from ambseal.model import build_plant
 
     bf = _bench_family()
-    text, _ = bf.family_rig(17)
-    rig = tmp_path / "rig.toml"
-    rig.write_text(text, encoding="utf-8")
-    cmd = [sys.executable, "-c", "import sys; from ambseal.cli import main; "
-           "sys.exit(main(sys.argv[1:]))", "run", str(rig), "--no-identify",
-           "--out", str(tmp_path / "run")]
-    done = subprocess.run(cmd, capture_output=True, text=True, timeout=1800,
-                          env=bf.child_env())
-    assert done.returncode in (0, 1), done.stderr[-2000:]
-    m = json.loads((tmp_path / "run" / "metrics.json").read_text())
+    text, m = _run(bf, 17, tmp_path)
     h = m["controllers"]["hinf"]
     assert h["synthesis_plant"] == "sampled" and "sampled plant" in h["remedy"]
     assert h["discretisation"]["method"] == "tustin"

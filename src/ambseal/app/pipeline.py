@@ -561,6 +561,7 @@ def _sampled_remedies(st: _RunState, stability: list) -> list:
                                                     judge_settings(st.spec, st.judge_cfg)},
                              lambda i, r: None)
 
+    begun = False
     for m in [d.method for d in st.designs if d.method in method_names(synthesised=True)]:
         if m in st.cannot_run:
             why = "the design on the continuous plant cannot run on the target"
@@ -570,6 +571,9 @@ def _sampled_remedies(st: _RunState, stability: list) -> list:
             why = "the design on the continuous plant lost the loop as it runs"
         else:
             continue
+        if not begun:  # timed apart: a w-plane μ can take minutes
+            st.stages.begin("sampled-redesign", "H∞ and μ lost only as they run")
+            begun = True
         fixed, cases, tried = on_the_sampled_plant(
             m, why, st.design_cfg, st.spec, st.points,
             lambda ds, digs: _judge_designs(st, ds, digs, 0), speed_range,

@@ -224,5 +224,5 @@ def on_the_sampled_plant(method: str, why: str, design_cfg, spec, points, judge:
     if not lost:
         say(f"{method}: {label} holds at every judged condition")
         return Remedied(d, digitals[method], jobs, judged), [c for c, _ in cases], ""
-    where = "; ".join(c for f in lost for c in f.conditions)
-    return None, [], f"{label}: still unstable at {where}"
+    # each failure's own words (which loop, where, the least stable mode), not its head
+    return None, [], f"{label}: " + "; ".join(f.reason.split(" — ", 1)[-1] for f in lost)

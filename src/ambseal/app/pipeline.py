@@ -157,15 +157,12 @@ def _speed_range(designs, digitals, spec, points, design_cfg, judge_cfg, stages,
     (:mod:`ambseal.analysis.speed_range`); a loop unstable there fails its controller, its
     line naming those conditions after any found before (``failed`` is updated). Returns
     the stability cases."""
-    spoints = stability_points(spec.pressures_bar, spec.stability_speeds_hz, points)
-    if not spoints:
+    if not stability_points(spec.pressures_bar, spec.stability_speeds_hz, points):
         return []
     stages.begin("speed-range", f"stability from standstill to "
                  f"{max(spec.stability_speeds_hz):g} Hz")
-    jobs = judge_jobs(designs, digitals, spoints, design_cfg)
-    done = _by_condition(stability_case, jobs, {"cfg": judge_cfg,
-                                                "settings": judge_settings(spec, judge_cfg)},
-                         lambda i, r: stages.step(f"{jobs[i].name} at {jobs[i].point.label}"))
+    jobs, done = _stability_cases(designs, digitals, spec, points, design_cfg, judge_cfg,
+                                  lambda job: stages.step(f"{job.name} at {job.point.label}"))
     for d in designs:
         f = loop_failure(d.method, _judged_of(d.method, jobs, done),
                          designed=d.method != "pid", kept=allow_unstable,
@@ -174,6 +171,20 @@ def _speed_range(designs, digitals, spec, points, design_cfg, judge_cfg, stages,
         if f is not None:
             failed[d.method] = also_failed(failed.get(d.method), f)
     return [case for case, _ in done]
+
+
+def _stability_cases(designs, digitals, spec, points, design_cfg, judge_cfg, on_done
+                     ) -> tuple[list, list]:
+    """Every design closed at each judged pressure and stability speed not judged in full:
+    ``(jobs, [(case, curves)])``, ``on_done(job)`` after each (none where there are no
+    such conditions)."""
+    spoints = stability_points(spec.pressures_bar, spec.stability_speeds_hz, points)
+    if not spoints:
+        return [], []
+    jobs = judge_jobs(designs, digitals, spoints, design_cfg)
+    return jobs, _by_condition(stability_case, jobs,
+                               {"cfg": judge_cfg, "settings": judge_settings(spec, judge_cfg)},
+                               lambda i, r: on_done(jobs[i]))
 
 
 def default_truth_path() -> Path:
@@ -551,15 +562,9 @@ def _sampled_remedies(st: _RunState, stability: list) -> list:
     the stability cases."""
     if speed_scheduled(st.cfg) or on_sampled_plant(st.design_cfg):
         return stability
-    spoints = stability_points(st.spec.pressures_bar, st.spec.stability_speeds_hz, st.points)
-
     def speed_range(ds, digs) -> list:
-        if not spoints:
-            return []
-        jobs = judge_jobs(ds, digs, spoints, st.design_cfg)
-        return _by_condition(stability_case, jobs, {"cfg": st.judge_cfg, "settings":
-                                                    judge_settings(st.spec, st.judge_cfg)},
-                             lambda i, r: None)
+        return _stability_cases(ds, digs, st.spec, st.points, st.design_cfg, st.judge_cfg,
+                                lambda job: None)[1]
 
     begun = False
     for m in [d.method for d in st.designs if d.method in method_names(synthesised=True)]:

@@ -14,7 +14,10 @@ this order, and judges each attempt at every condition like the first design:
    trades performance for robustness).
 
 The first attempt that holds at every judged condition replaces the design, its summary
-saying so (``remedy``).
+saying so (``remedy``). When none holds, the failure line lists what was tried; the μ
+controller, robust to the specification's uncertainty (thesis P5 §4), is the run's robust
+one. A speed-scheduled rig's designs (frozen at a speed, or scheduled on it) get no
+remedy here: their schedule is the remedy.
 
 **A loop lost only as it runs** — the continuous loop with the delay holds at every
 judged condition and stability speed, but the discrete controller's sampled loop does
@@ -23,11 +26,8 @@ loop that runs, which neither remedy above closes: the design is made again on t
 sampled, delayed plant in the w-plane (:func:`on_the_sampled_plant`, ``[design]
 synthesis_plant = "sampled"``), whose discrete controller is its Tustin transform
 exactly, and replaces the first where it holds at every judged condition and stability
-speed, continuous and as it runs. Measured on the gyroscopic family at 10 kHz
-(benchmarks/README.md, "H∞ and μ designed against the sampled plant"). When none holds, the failure line lists what was tried; the μ
-controller, robust to the specification's uncertainty (thesis P5 §4), is the run's robust
-one. A speed-scheduled rig's designs (frozen at a speed, or scheduled on it) get no
-remedy here: their schedule is the remedy.
+speed, continuous and as it runs (benchmarks/README.md, "The sampled design as the run's
+remedy for a loop lost only as it runs").
 """
 
 from __future__ import annotations

@@ -12,12 +12,12 @@ in w,
 
 the inverse of the Tustin transform without prewarp (``scipy.signal.cont2discrete``'s
 ``"bilinear"``; the w transformation of Ogata, *Discrete-Time Control Systems*, 2nd ed.,
-1995, ch. 4). The map takes the unit
-circle onto the imaginary axis and the unit disc onto the left half-plane, so a system's
-H∞ norm and its stability are the same in z and in w: an H∞ or μ controller designed on
-the w-plane plant, transformed by Tustin without prewarp, is a discrete controller whose
-sampled, delayed loop has the same closed-loop norm and is stable where the w-plane loop
-is — no Padé lag of the delay, and no gap between the loop designed and the loop that runs.
+1995, ch. 4). The map takes the unit circle onto the imaginary axis and the unit disc
+onto the left half-plane, so a system's H∞ norm and its stability are the same in z and
+in w: an H∞ or μ controller designed on the w-plane plant, transformed by Tustin without
+prewarp, is a discrete controller whose sampled, delayed loop has the same closed-loop
+norm and is stable where the w-plane loop is — no Padé lag of the delay, and no gap
+between the loop designed and the loop that runs.
 
 Nothing here knows the machine: :func:`w_plane_plant` takes any generalised plant whose
 last ``ncon`` inputs are the commands.
@@ -30,6 +30,7 @@ import numpy as np
 
 from ambseal.errors import ConfigError, SynthesisError
 from ambseal.lti import zoh
+from ambseal.robust.digital import with_delay
 from ambseal.robust.timing import check_timing
 
 __all__ = ["w_plane_plant"]
@@ -81,24 +82,17 @@ def w_plane_plant(P, ncon: int, sample_rate_hz: float, delay_samples: int):
         raise ConfigError(f"w_plane_plant: ncon={ncon!r}, expected 1 to {m} (the inputs)")
     T = 1.0 / float(sample_rate_hz)
     Ad, Bd = zoh(A, B, T, keep=False)
-    nw, nd = m - ncon, int(delay_samples)
-    if nd:
-        # u[k] reaches the plant nd samples later: a shift register of nd·ncon states
-        # after the plant's, the oldest command last; its feedthrough moves to that state
-        n, k = Ad.shape[0], nd * ncon
-        Aa = np.zeros((n + k, n + k))
-        Aa[:n, :n] = Ad
-        Aa[:n, n + k - ncon:] = Bd[:, nw:]
-        for j in range(1, nd):
-            Aa[n + j * ncon:n + (j + 1) * ncon, n + (j - 1) * ncon:n + j * ncon] = np.eye(ncon)
-        Ba = np.zeros((n + k, m))
-        Ba[:n, :nw] = Bd[:, :nw]
-        Ba[n:n + ncon, nw:] = np.eye(ncon)
-        Ca = np.hstack([C, np.zeros((C.shape[0], k))])
-        Ca[:, n + k - ncon:] = D[:, nw:]
-        Da = D.copy()
-        Da[:, nw:] = 0.0
-        Ad, Bd, C, D = Aa, Ba, Ca, Da
+    # u[k] reaches the plant delay_samples later: the target's own delay block
+    # (:func:`~ambseal.robust.digital.with_delay` of a unit gain) in front of the commands
+    nw = m - ncon
+    Al, Bl, Cl, Dl = with_delay((np.zeros((0, 0)), np.zeros((0, ncon)), np.zeros((ncon, 0)),
+                                 np.eye(ncon)), int(delay_samples))
+    Bw_, Bu = Bd[:, :nw], Bd[:, nw:]
+    Dw_, Du = D[:, :nw], D[:, nw:]
+    k = Al.shape[0]
+    Ad = np.block([[Ad, Bu @ Cl], [np.zeros((k, Ad.shape[0])), Al]])
+    Bd = np.block([[Bw_, Bu @ Dl], [np.zeros((k, nw)), Bl]])
+    C, D = np.hstack([C, Du @ Cl]), np.hstack([Dw_, Du @ Dl])
     I = np.eye(Ad.shape[0])
     lu = Ad + I
     sv = np.linalg.svd(lu, compute_uv=False)

@@ -787,7 +787,9 @@ def test_a_centring_that_cannot_change_the_delivered_controller_is_not_run(monke
     one whose outcome the test sets, the Riccati one's kept solve waiting on its
     rebalanced scaling's centring (γ 1.0 or 0.9, each held up by the trace term). The
     centring is run (the Riccati result asked for) only where its outcome can change
-    what is delivered; the delivered result is the rule's in every case."""
+    what is delivered, and the diagonal scaling's centring and table (its result asked
+    for) only where one of its γ stages is below an optimal Riccati result's γ; the
+    delivered result is the rule's in every case."""
     import types
 
     import ambseal.robust.lpv as lpv_mod
@@ -797,11 +799,12 @@ def test_a_centring_that_cannot_change_the_delivered_controller_is_not_run(monke
         return types.SimpleNamespace(gamma=gamma, penalty_share=0.5, reports=(
             SolverReport("gamma", status, 20, 0.1), SolverReport("centre", status, 20, 0.1)))
 
-    class Riccati:
+    class Scaling:
         open, certainly_short_or_held, gammas = True, True, (1.0, 0.9)
 
-        def __init__(self, kept):
+        def __init__(self, kept, reachable=None):
             self.kept, self.asked = kept, 0
+            self.reachable_gammas = reachable or (getattr(kept, "gamma", 0.0),)
 
         def result(self):
             self.asked += 1
@@ -809,23 +812,27 @@ def test_a_centring_that_cannot_change_the_delivered_controller_is_not_run(monke
                 raise self.kept
             return self.kept
 
-    def delivered(kept, diagonal, **state):
-        riccati = Riccati(kept)
+    def delivered(kept, diagonal, reachable=None, asked_diagonal=False, **state):
+        riccati = Scaling(kept)
         for k, v in state.items():
             setattr(riccati, k, v)
-        monkeypatch.setattr(lpv_mod._Scaling, "solve", lambda *a, **k: riccati)
+        diag = None if isinstance(diagonal, Exception) else Scaling(diagonal, reachable)
 
-        def synthesise(data, scaling, **settings):
-            assert scaling == "diagonal"
-            if isinstance(diagonal, Exception):
+        def solve(data, scaling, **settings):
+            if scaling == "riccati":
+                return riccati
+            if diag is None:
                 raise diagonal
-            return diagonal
+            return diag
 
-        monkeypatch.setattr(lpv_mod, "_synthesise", synthesise)
+        monkeypatch.setattr(lpv_mod._Scaling, "solve", solve)
         try:
-            return lpv_mod._either_scaling(None, {}), riccati.asked
+            out = lpv_mod._either_scaling(None, {}), riccati.asked
         except SynthesisError as exc:
-            return exc, riccati.asked
+            out = exc, riccati.asked
+        if asked_diagonal:
+            return out, diag.asked
+        return out
 
     rebalanced, low, between = result(0.9), result(0.8), result(0.95)
     assert delivered(rebalanced, low) == (low, 0)  # below both: the centring not run
@@ -841,6 +848,16 @@ def test_a_centring_that_cannot_change_the_delivered_controller_is_not_run(monke
     r, asked = delivered(result(0.9), low, certainly_short_or_held=False)
     assert (r, asked) == (low, 1)
     assert delivered(rebalanced, low, open=False) == (low, 1)
+    # no γ stage of the diagonal scaling below the optimal Riccati result's: its centring
+    # and table are not made, and the Riccati result is delivered
+    assert delivered(rebalanced, between, asked_diagonal=True) == ((rebalanced, 1), 0)
+    kept = dict(certainly_short_or_held=False, asked_diagonal=True)
+    assert delivered(rebalanced, between, (0.95, 0.92), **kept) == ((rebalanced, 1), 0)
+    # one below it: made, and kept only where it ends below it too
+    assert delivered(rebalanced, between, (0.95, 0.85), **kept) == ((rebalanced, 1), 1)
+    assert delivered(rebalanced, low, (0.95, 0.8), **kept) == ((low, 1), 1)
+    # a Riccati result short of optimal: the diagonal one is made whatever its γ
+    assert delivered(short, between, (0.95,), **kept) == ((between, 1), 1)
 
 
 def _two_axis_plants(speeds, k_eta: float = 1.0):

@@ -384,8 +384,9 @@ def lpvsyn(plants: Sequence[Any], theta, nmeas: int, ncon: int, *,
         infeasible (true in any state basis), else the Riccati scaling's. A centring
         SDP whose outcome cannot change the result is not solved (where the diagonal
         scaling ends optimal below every γ the Riccati one may keep, the Riccati
-        rebalanced scaling's centring): the controller is the same, and ``reports``
-        lists the solves that ran.
+        rebalanced scaling's centring; where no γ stage of the diagonal scaling is below
+        an optimal Riccati result's γ, the diagonal scaling's centring and table): the
+        controller is the same, and ``reports`` lists the solves that ran.
     penalty : float
         Starting weight of the trace term in stage 1 (scaled units; ≥ 0).
     coupling_ratio : float
@@ -506,27 +507,39 @@ def _either_scaling(data, settings: dict) -> LpvSynResult:
     an SDP stopped short of optimal; of the two, an optimal solve is kept before a lower
     γ. Where the diagonal scaling is tried whichever Riccati solve is kept, and its
     optimal γ is below every one's, it is delivered without the Riccati rebalanced
-    scaling's centring (:class:`_Scaling`), whose outcome cannot change it."""
+    scaling's centring (:class:`_Scaling`), whose outcome cannot change it. Likewise the
+    diagonal scaling's centrings and controller table are made only where one of its γ
+    stages lies below the γ it would have to beat: its result's γ is one of them."""
     diagonal: dict = {}
 
-    def diagonal_result():  # tried once, its result or its error kept
-        if not diagonal:
+    def diagonal_result(below: float | None = None):
+        """The diagonal scaling's result, each part made once; None where it fails, or
+        where none of its γ stages is below ``below``."""
+        if "solve" not in diagonal:
             try:
-                diagonal["r"] = _synthesise(data, "diagonal", **settings)
+                diagonal["solve"] = _Scaling.solve(data, "diagonal", **settings)
             except SynthesisError as exc:
-                diagonal["error"] = exc
-        return diagonal.get("r")
+                diagonal["solve"], diagonal["error"] = None, exc
+        sc = diagonal["solve"]
+        if sc is None or (below is not None and min(sc.reachable_gammas) >= below):
+            return None
+        if "r" not in diagonal:
+            try:
+                diagonal["r"] = sc.result()
+            except SynthesisError as exc:
+                diagonal["r"], diagonal["error"] = None, exc
+        return diagonal["r"]
 
     try:
         riccati = _Scaling.solve(data, "riccati", **settings)
         if riccati.open and riccati.certainly_short_or_held:
-            alt = diagonal_result()
+            alt = diagonal_result(below=min(riccati.gammas))
             if alt is not None and _optimal(alt) and all(alt.gamma < g
                                                          for g in riccati.gammas):
                 return alt
         r = riccati.result()
         if r.penalty_share > PENALTY_SHARE or not _optimal(r):
-            alt = diagonal_result()
+            alt = diagonal_result(below=r.gamma if _optimal(r) else None)
             if alt is not None and (not _optimal(alt), alt.gamma) < (not _optimal(r),
                                                                       r.gamma):
                 r = alt
@@ -714,6 +727,13 @@ class _Scaling:
     def gammas(self) -> tuple[float, ...]:
         """The γ of each solve that may be kept."""
         return (self.first.gamma,) + ((self.rebalanced.stage.gamma,) if self.open else ())
+
+    @property
+    def reachable_gammas(self) -> tuple[float, ...]:
+        """The γ of each solve :meth:`result` may keep, whatever its centrings end on:
+        its result's γ is one of them."""
+        return (self.first.gamma,) + ((self.rebalanced.stage.gamma,)
+                                      if self.rebalanced is not None else ())
 
     @property
     def certainly_short_or_held(self) -> bool:

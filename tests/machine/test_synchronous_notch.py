@@ -56,9 +56,15 @@ def test_notched_controller_is_k_after_the_notch_loop(dt):
     K (I + N)⁻¹ — at speeds away from Ω equal to ours; at Ω itself zero (the notch's poles
     are the controller's zeros); below the speed it is on from, K itself."""
     n = _notch(dt)
-    K = ct.rss(4, P, P, dt=dt or None, strictly_proper=False)
-    K = ct.ss(K.A, K.B, K.C, K.D, dt or 0, inputs=list(NAMES),
-              outputs=[f"i_{k}" for k in range(P)], name="K")
+    # a controller drawn from a seeded generator (python-control's rss draws from NumPy's
+    # global state, which the tests run before it set): poles from 20 to 2 000 rad/s,
+    # mapped by exp(sT) when discrete, away from the points it is evaluated at
+    rng = np.random.default_rng(11)
+    V = rng.normal(size=(4, 4))
+    s = -np.array([20.0, 150.0, 600.0, 2000.0])
+    A = V @ np.diag(np.exp(s * dt) if dt else s) @ np.linalg.inv(V)
+    K = ct.ss(A, rng.normal(size=(4, P)), rng.normal(size=(P, 4)), rng.normal(size=(P, P)),
+              dt or 0, inputs=list(NAMES), outputs=[f"i_{k}" for k in range(P)], name="K")
     w = 250.0
     ours = n.around(K, w)
     An, Bn, Cn = n.matrices_at(w)

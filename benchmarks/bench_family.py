@@ -39,7 +39,9 @@ same rows either way, since each row comes from its own child. One JSON line per
 stdout: the draw, the exit status, CPU in machine references and per method
 ``delivered`` — in ``metrics.json``'s controllers, neither failed nor unable to run on
 the target, and ISO 14839-3 zone A or B on every axis (σ̄(S_o) peak per axis below 4, as
-it runs: the discrete loop's) at every judged condition, and ``why_not`` each other
+it runs: the discrete loop's) at every judged condition and every speed of the range from
+standstill to the top speed that the run closes the loop at (``metrics.json``'s
+``stability``), and ``why_not`` each other
 method is (:func:`why_not`). The last line sums the family:
 per method the fraction delivered, the rigs where no method is, and the CPU.
 
@@ -216,7 +218,8 @@ def why_not(metrics: dict) -> dict[str, str | None]:
             out[m] = f"cannot run: {metrics['cannot_run'][m]}"
         else:
             peaks = [(v, axis, c["speed_hz"], c["pressure_bar"])
-                     for c in metrics["cases"] if c["controller"] == m
+                     for c in metrics["cases"] + metrics.get("stability", [])
+                     if c["controller"] == m
                      for axis, v in (c.get("discrete") or c)["sensitivity_peak_per_axis"]
                      .items()]
             worst = max(peaks, default=None)

@@ -119,7 +119,8 @@ def test_a_design_lost_only_as_it_runs_is_designed_on_the_sampled_plant(tmp_path
 def test_every_method_not_delivered_says_why():
     """:func:`bench_family.why_not` on a run's metrics: a method not designed, one failed,
     one its target cannot run, one whose worst axis as it runs is at zone C (σ̄(S_o) 4 or
-    more: ISO 14839-3's B/C limit), each with its reason, and one delivered (None)."""
+    more: ISO 14839-3's B/C limit) at a speed of the range between the judged ones, each
+    with its reason, and one delivered (None)."""
     bf = _bench_family()
 
     def case(method, speed, peaks):
@@ -131,11 +132,13 @@ def test_every_method_not_delivered_says_why():
                "failed": {"hinf": {"reason": "unstable at 0 Hz"}},
                "cannot_run": {"mu": "highest controller pole 7.9e+06 Hz"},
                "cases": [case("pid", 0.0, {"A_zeta": 2.5, "A_eta": 2.5}),
-                         case("pid", 300.0, {"A_zeta": 2.5, "A_eta": 4.2}),
-                         case("lpv", 300.0, {"A_zeta": 3.9, "A_eta": 2.0})]}
+                         case("pid", 300.0, {"A_zeta": 2.5, "A_eta": 2.5}),
+                         case("lpv", 300.0, {"A_zeta": 3.9, "A_eta": 2.0})],
+               "stability": [case("pid", 150.0, {"A_zeta": 2.5, "A_eta": 4.2}),
+                             case("lpv", 150.0, {"A_zeta": 3.9, "A_eta": 2.0})]}
     metrics["controllers"].pop("lpv")
     why = bf.why_not(metrics)
-    assert why == {"pid": "zone C/D: σ̄(S_o) 4.2 on A_eta at 300 Hz, 0 bar",
+    assert why == {"pid": "zone C/D: σ̄(S_o) 4.2 on A_eta at 150 Hz, 0 bar",
                    "hinf": "failed: unstable at 0 Hz",
                    "mu": "cannot run: highest controller pole 7.9e+06 Hz",
                    "lpv": "not designed"}

@@ -168,9 +168,13 @@ def stability_case(case: JudgeJob, cfg, settings: JudgeSettings | None = None
     def grades(j, K) -> dict:
         return {} if settings is None else sensitivity_grades(j, K, cur, settings.freq_hz)
 
-    curves: dict = {"poles": loop.poles}
+    curves: dict = {"poles": loop.s_poles}
     disc = None
-    if case.discrete is not None:
+    if case.discrete is case.controller:  # judged as it runs alone (judge_jobs): once
+        disc = SampledStability(bool(loop.stable), float(loop.max_abs_pole), 1.0 / loop.dt,
+                                **grades(judged, case.discrete))
+        curves["discrete"] = {"poles": loop.poles}
+    elif case.discrete is not None:
         djudged = judged_loop(P, case.discrete, cur)
         dloop = djudged.loop
         disc = SampledStability(bool(dloop.stable), float(dloop.max_abs_pole), 1.0 / dloop.dt,

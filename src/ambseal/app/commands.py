@@ -127,6 +127,12 @@ class Designed:
         """The controller that runs (:attr:`ambseal.design.Design.controller`)."""
         return self.result.controller
 
+    @property
+    def synthesis_plant(self) -> str:
+        """``"sampled"`` for an H∞ or μ synthesised on the sampled plant (``[design]
+        synthesis_plant``, :mod:`ambseal.robust.w_plane`), else ``"continuous"``."""
+        return getattr(self.result, "synthesis_plant", "continuous")
+
 
 def digital_for(cfg, method: str, controller, result, points, cache: dict | None = None
                 ) -> object:

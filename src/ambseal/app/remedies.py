@@ -26,8 +26,9 @@ loop that runs, which neither remedy above closes: the design is made again on t
 sampled, delayed plant in the w-plane (:func:`on_the_sampled_plant`, ``[design]
 synthesis_plant = "sampled"``), whose discrete controller is its Tustin transform
 exactly, and replaces the first where it holds at every judged condition and stability
-speed, continuous and as it runs (benchmarks/README.md, "The sampled design as the run's
-remedy for a loop lost only as it runs").
+speed as it runs, the only loop it has (:func:`ambseal.analysis.judge.judge_jobs`;
+benchmarks/README.md, "The sampled design as the run's remedy for a loop lost only as it
+runs" and "A design on the sampled plant judged as it runs").
 """
 
 from __future__ import annotations

@@ -86,8 +86,8 @@ and bounded (the bounds beside each key in the code, with their reasons).
     w-plane (:mod:`ambseal.robust.w_plane`); the discrete controller is the Tustin
     transform of the one designed, exactly, and the design's own checks close it with the
     sampled full-order plant. For a low rate, where the loop as it runs parts from the
-    continuous one the design foresaw. Judged as every design: continuous (its w-plane
-    form with the Padé lag) and as it runs.
+    continuous one the design foresaw. Judged as it runs alone: its w-plane form closed in
+    continuous time is no loop that runs (:func:`ambseal.analysis.judge.judge_jobs`).
 ``[design] tracked`` (bool, default false)
     ``ambseal run`` adds the ``tracked`` controller: scheduled on the first
     seal's k as tracked on line (:mod:`ambseal.design.seal_schedule`), judged at the

@@ -544,7 +544,9 @@ def judge(cfg, controller, name: str, point: OperatingPoint,
         return judged
 
     body, curves = _judge_loop(judged_loop(P, controller, cur, delay=dl.system), cur, force,
-                               controller, s, impulse, static, running(schedule))
+                               controller, s, impulse, static,
+                               running(schedule_discrete if discrete is controller
+                                       else schedule))
     disc = None
     if discrete is controller:  # judged as it runs alone (:func:`judge_jobs`): once
         disc, curves["discrete"] = body, dict(curves)  # its poles z, as a discrete block's

@@ -65,7 +65,7 @@ SETTLE_TIME_CONSTANTS = 7.0
 MAX_PHASE_S = 5.0
 
 
-def rejection_stability(cfg, rejection, points) -> list[dict]:
+def rejection_stability(cfg, rejection, points, *, as_runs_only: bool = False) -> list[dict]:
     """The loops of a controller with its notch at the judged conditions (module
     docstring).
 
@@ -78,6 +78,10 @@ def rejection_stability(cfg, rejection, points) -> list[dict]:
         ``digital`` is judged as it runs where given.
     points : iterable of OperatingPoint
         The judged conditions.
+    as_runs_only : bool
+        The controller was designed on the sampled plant (:func:`ambseal.analysis.judge.
+        judge_jobs`): with a ``digital``, its loop as it runs is its only one, and
+        ``stable`` and ``max_real_pole`` are that loop's too (ln max|z| / T).
 
     Returns
     -------
@@ -96,13 +100,15 @@ def rejection_stability(cfg, rejection, points) -> list[dict]:
             continue
         plant = build_plant(cfg, pressure_bar=pt.pressure_bar, speed_rpm=pt.speed_rpm)
         P, cur = plant.to_statespace(), plant.current_inputs()
-        cont = judged_loop(P, rejection.controller.at(w), cur, delay=lag).loop
+        runs = None if rejection.digital is None else judged_loop(
+            P, rejection.digital.statespace_at(w, delayed=True), cur).loop
+        cont = runs if as_runs_only and runs is not None else judged_loop(
+            P, rejection.controller.at(w), cur, delay=lag).loop
         row = {"condition": pt.label, "speed_hz": pt.speed_rpm / 60.0,
                "pressure_bar": float(pt.pressure_bar), "stable": bool(cont.stable),
                "max_real_pole": float(cont.max_real_pole), "stable_as_runs": None,
                "max_abs_pole_z": None}
-        if rejection.digital is not None:
-            runs = judged_loop(P, rejection.digital.statespace_at(w, delayed=True), cur).loop
+        if runs is not None:
             row.update(stable_as_runs=bool(runs.stable),
                        max_abs_pole_z=float(np.abs(runs.poles).max()))
         out.append(row)

@@ -169,10 +169,10 @@ def stability_case(case: JudgeJob, cfg, settings: JudgeSettings | None = None
         return {} if settings is None else sensitivity_grades(j, K, cur, settings.freq_hz)
 
     curves: dict = {"poles": loop.s_poles}
-    disc = None
+    disc, graded = None, grades(judged, case.controller)
     if case.discrete is case.controller:  # judged as it runs alone (judge_jobs): once
         disc = SampledStability(bool(loop.stable), float(loop.max_abs_pole), 1.0 / loop.dt,
-                                **grades(judged, case.discrete))
+                                **graded)
         curves["discrete"] = {"poles": loop.poles}
     elif case.discrete is not None:
         djudged = judged_loop(P, case.discrete, cur)
@@ -182,5 +182,4 @@ def stability_case(case: JudgeJob, cfg, settings: JudgeSettings | None = None
         curves["discrete"] = {"poles": dloop.poles}
     return StabilityCase(case.name, point.label, float(point.pressure_bar),
                          float(point.speed_rpm) / 60.0, bool(loop.stable),
-                         json_float(loop.max_real_pole), disc,
-                         **grades(judged, case.controller)), curves
+                         json_float(loop.max_real_pole), disc, **graded), curves

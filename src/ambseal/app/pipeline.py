@@ -738,7 +738,8 @@ def _notches(st: _RunState, methods=None, starts=None, used=None) -> dict[str, _
             rej = design_rejection(st.design_cfg, d.controller, g, **kw, **(
                 {} if on is None else {"speeds_hz": (on, st.cfg.operating.continuous_hz[1])}))
             rows = rejection_stability(st.judge_cfg, rej, [j.point for j in st.jobs
-                                                           if j.name == d.method] + speeds)
+                                                           if j.name == d.method] + speeds,
+                                       as_runs_only=d.synthesis_plant == "sampled")
             lost = lost_conditions(rows)
             effect = rejection_effect(st.judge_cfg, g, rej, st.settings)
             beyond = clearance_exceeded(float(np.max(effect["orbit_um"]["with"])), clearances)

@@ -99,6 +99,25 @@ def test_a_loop_lost_only_to_the_delays_pade_approximation_says_so():
     assert "fails — the full-order loop is unstable at 0 bar (mode at 1323 Hz" in g.reason
 
 
+def test_a_loop_judged_as_it_runs_alone_is_said_lost_as_it_runs():
+    """A design on the sampled plant is judged as it runs alone (its case's loop and its
+    discrete block the same sampled loop): its loss is said as the loop as it runs, with
+    its largest |z| and the mode ln z / T gives (900 Hz, growing at 0.2 1/s)."""
+    dt = 1e-4
+    z = np.exp(np.array([0.2 + 2j * math.pi * 900, 0.2 - 2j * math.pi * 900, -1.0]) * dt)
+    runs = SampledStability(False, float(abs(z[0])), 1 / dt)
+    case = _case(0.0, False, "0 bar", max_real_pole=0.2, discrete=runs)
+    curves = {"poles": np.log(z) / dt, "discrete": {"poles": z}}
+    f = loop_failure("mu", [(case, curves)], designed=True, as_runs_only=True)
+    assert f.reason.startswith("μ: not delivered — as it runs on the target (sampled, "
+                               "delayed) the loop is unstable at 0 bar (mode at 900 Hz")
+    assert f"max |z| = {abs(z[0]):.5f}" in f.reason and "full-order" not in f.reason
+    assert f.conditions == ["0 bar"]
+    # the same case of a design on the continuous plant: its continuous loop is lost
+    assert loop_failure("mu", [(case, curves)], designed=True).reason.startswith(
+        "μ: not delivered — the full-order loop is unstable at 0 bar (mode at 900 Hz")
+
+
 def test_a_point_judged_at_one_speed_is_named_with_its_speed_beside_the_speed_range():
     """A rig judged in full at one speed (305.185 Hz) labels that point by its pressure
     alone; where the run also judges the speed range, its failure had read "unstable at

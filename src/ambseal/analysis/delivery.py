@@ -138,7 +138,8 @@ def case_label(case, with_speed: bool = False) -> str:
 
 def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
                  kept: bool = False, derived: bool = False,
-                 kind_of=None, speed_in_labels: bool = False) -> FailedController | None:
+                 kind_of=None, speed_in_labels: bool = False,
+                 as_runs_only: bool = False) -> FailedController | None:
     """The failure of one controller from its judged cases, or None when every judged
     loop (continuous and, where judged, discrete) is stable.
 
@@ -170,6 +171,10 @@ def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
         judged in full at one speed labels those points by pressure alone, and where the
         run judges other speeds as well, "unstable at <p> bar" would not say at which. The
         failure's ``conditions`` keep the cases' labels.
+    as_runs_only : bool
+        The controller is judged as it runs alone (a design on the sampled plant,
+        :func:`ambseal.analysis.judge.judge_jobs`): a case's loop is then the one as it
+        runs, and its loss is said so, with its largest ``|z|``.
 
     Returns
     -------
@@ -180,7 +185,7 @@ def loop_failure(method: str, judged: list[tuple[dict, dict]], designed: bool,
     for case, curves in judged:
         label = case_label(case)
         said = case_label(case, speed_in_labels)
-        if not case.stable:
+        if not case.stable and not (as_runs_only and case.discrete is not None):
             z = _least_stable(curves.get('poles', ()))
             # the delay's Padé approximation can lose a mode the loop as it runs keeps:
             # still a failure (a margin of nothing), said as what it is

@@ -167,7 +167,8 @@ def _speed_range(designs, digitals, spec, points, design_cfg, judge_cfg, stages,
         f = loop_failure(d.method, _judged_of(d.method, jobs, done),
                          designed=d.method != "pid", kept=allow_unstable,
                          derived=design_cfg.controller.pid is None,
-                         kind_of=kind_of(judge_cfg, d.controller))
+                         kind_of=kind_of(judge_cfg, d.controller),
+                         as_runs_only=d.synthesis_plant == "sampled")
         if f is not None:
             failed[d.method] = also_failed(failed.get(d.method), f)
     return [case for case, _ in done]
@@ -531,7 +532,8 @@ def _judge_stage(st: _RunState) -> None:
         f = loop_failure(d.method, _judged_of(d.method, st.jobs, st.judged),
                          designed=d.method != "pid", kept=st.allow_unstable,
                          derived=st.cfg.controller.pid is None,
-                         kind_of=kind_of(st.cfg, d.controller), speed_in_labels=with_speed)
+                         kind_of=kind_of(st.cfg, d.controller), speed_in_labels=with_speed,
+                         as_runs_only=d.synthesis_plant == "sampled")
         if f is not None:
             st.failed[d.method] = f
     if speed_scheduled(st.cfg):

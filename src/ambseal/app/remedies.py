@@ -168,7 +168,8 @@ def remedy(method: str, failure: FailedController, cases: list[JudgedCase], desi
             tried.append(f"{label} (cannot run on the target: {cannot.get(method, '')})")
             continue
         jobs, judged = judge([d], digitals)
-        again = loop_failure(method, judged, designed=True)
+        again = loop_failure(method, judged, designed=True,
+                             as_runs_only=d.synthesis_plant == "sampled")
         if again is None:
             say(f"{method}: {label} holds at every judged condition")
             return Remedied(d, digitals[method], jobs, judged), failure
@@ -219,8 +220,9 @@ def on_the_sampled_plant(method: str, why: str, design_cfg, spec, points, judge:
         return None, [], f"{label}: cannot run on the target: {cannot.get(method, '')}"
     jobs, judged = judge([d], digitals)
     cases = stability([d], digitals)
-    lost = [f for f in (loop_failure(method, judged, designed=True),
-                        loop_failure(method, cases, designed=True) if cases else None)
+    lost = [f for f in (loop_failure(method, judged, designed=True, as_runs_only=True),
+                        loop_failure(method, cases, designed=True, as_runs_only=True)
+                        if cases else None)
             if f is not None]
     if not lost:
         say(f"{method}: {label} holds at every judged condition")

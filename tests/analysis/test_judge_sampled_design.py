@@ -12,15 +12,26 @@ import control
 import numpy as np
 import pytest
 
+from ambseal.analysis.campbell import closed_loop_modes
 from ambseal.analysis.judge import judge_case, judge_jobs, judge_settings, operating_points
 from ambseal.analysis.speed_range import stability_case, stability_points
+from ambseal.analysis.sweep import refine_boundary, sweep
 from ambseal.app.commands import Designed, digital_for
+from ambseal.app.controllers import controller_for
 from ambseal.config import load_rig
 from ambseal.design import design_spec
 from ambseal.design.recipes import design
+from ambseal.errors import DataError, SynthesisError
+from ambseal.export import export_controller, load_controller
 from ambseal.model import build_plant
 
 SUPERCRITICAL = Path(__file__).resolve().parents[2] / "examples" / "supercritical_rotor.toml"
+
+
+#: A speed (Hz) between the crossings of the w-plane controller closed in continuous time
+#: (unstable below 133.8 Hz) and of the loop as it runs (below 130.8 Hz): the two part
+#: there, the loop as it runs holding.
+_PARTED_HZ = 132.0
 
 
 @pytest.fixture(scope="module")
@@ -35,6 +46,11 @@ def sampled_hinf():
 def _z_of_python_control(cfg, K, p_bar, speed_hz) -> float:
     """Largest |z| of the loop as it runs, built by python-control: the Tustin transform
     of ``K`` ``delay_samples`` late on the ZOH-sampled plant."""
+    return float(np.abs(_poles_of_python_control(cfg, K, p_bar, speed_hz)).max())
+
+
+def _poles_of_python_control(cfg, K, p_bar, speed_hz) -> np.ndarray:
+    """The poles z of :func:`_z_of_python_control`'s loop."""
     T = 1.0 / cfg.controller.sample_rate_hz
     Kd = control.sample_system(control.ss(K.A, K.B, K.C, K.D), T, method="tustin")
     n = Kd.noutputs
@@ -44,7 +60,7 @@ def _z_of_python_control(cfg, K, p_bar, speed_hz) -> float:
     pl = build_plant(cfg, pressure_bar=p_bar, speed_rpm=60.0 * speed_hz)
     G = pl.select_inputs([pl.input_names[j] for j in pl.current_inputs()])
     Gd = control.sample_system(control.ss(G.A, G.B, G.C, G.D), T, method="zoh")
-    return float(np.abs(control.feedback(Gd, Kd).poles()).max())
+    return control.feedback(Gd, Kd).poles()
 
 
 def test_a_sampled_design_is_judged_on_its_loop_as_it_runs(sampled_hinf):
@@ -123,3 +139,95 @@ def test_a_sampled_designs_notch_is_judged_as_it_runs(sampled_hinf):
     cont = rejection_stability(cfg, rej, points)
     assert [np.exp(r["max_real_pole"] * T) for r in cont] != pytest.approx(
         [r["max_abs_pole_z"] for r in cont], rel=1e-6)
+
+
+@pytest.mark.parametrize("suffix", [".json", ".npz", ".mat"])
+def test_a_sampled_designs_file_says_so_and_its_modes_are_as_it_runs(sampled_hinf, tmp_path,
+                                                                     suffix):
+    """A controller file of a design on the sampled plant records it, and ``modes``,
+    ``campbell`` and ``sweep --controller FILE`` close it as it runs: its modes are the
+    python-control loop's poles ln z / T, not the w-plane controller's in continuous
+    time."""
+    cfg, d, spec, points, digital = sampled_hinf
+    path = export_controller(digital, tmp_path / f"controller_hinf{suffix}")
+    assert load_controller(path).synthesis_plant == "sampled"
+    K = controller_for(cfg, str(path))
+    assert K.as_runs_only
+    T = 1.0 / cfg.controller.sample_rate_hz
+    p = cfg.operating.pressure_bar
+    z = _poles_of_python_control(cfg, d.controller, p, _PARTED_HZ)
+    assert np.abs(z).max() < 1.0  # the loop as it runs holds there
+    ref = np.log(z[np.abs(z) > 1e-12].astype(complex)) / T
+    m = closed_loop_modes(cfg, K, speed_hz=_PARTED_HZ, pressure_bar=p)
+    assert m.poles.size and m.stable
+    # its w-plane form closed in continuous time, what these commands closed before, does not
+    assert not closed_loop_modes(cfg, d.controller, speed_hz=_PARTED_HZ, pressure_bar=p).stable
+    assert np.abs(m.poles.imag).max() < np.pi / T  # below Nyquist: no aliased mode listed
+    for lam in m.poles:
+        assert np.abs(ref - lam).min() == pytest.approx(0.0, abs=1e-6 * abs(lam))
+
+
+def test_a_file_without_synthesis_plant_is_a_continuous_design(sampled_hinf, tmp_path):
+    """A file written before the key existed holds a continuous design; a value other than
+    the two known ones is refused, naming the file and the key."""
+    import json
+
+    cfg, d, spec, points, digital = sampled_hinf
+    path = export_controller(digital, tmp_path / "controller_hinf.json")
+    doc = json.loads(path.read_text())
+    doc.pop("synthesis_plant")
+    path.write_text(json.dumps(doc))
+    assert load_controller(path).synthesis_plant == "continuous"
+    assert not controller_for(cfg, str(path)).dt  # its continuous design
+    doc["synthesis_plant"] = "analog"
+    path.write_text(json.dumps(doc))
+    with pytest.raises(DataError, match=r"controller_hinf\.json: synthesis_plant = 'analog'"):
+        load_controller(path)
+
+
+def test_a_sweep_judges_a_sampled_design_as_it_runs_alone(sampled_hinf):
+    """Every column of a sweep row, and the stability boundary's bisection, is the loop as
+    it runs (python-control's max |z|), for a design that exists only as it runs."""
+    cfg, d, spec, points, digital = sampled_hinf
+    T = 1.0 / cfg.controller.sample_rate_hz
+    p = cfg.operating.pressure_bar
+    rows = sweep(cfg, {"hinf": digital}, [p], [0.0, _PARTED_HZ],
+                 settings=judge_settings(spec, cfg), digitals={"hinf": digital})
+    for r in rows:
+        z = _z_of_python_control(cfg, d.controller, r["pressure_bar"], r["speed_hz"])
+        assert r["stable"] == (z < 1.0) == r["stable_as_runs"]
+        assert np.exp(r["max_real_pole"] * T) == pytest.approx(z, rel=1e-6)
+        assert r["sensitivity_peak"] == r["sensitivity_peak_as_runs"]
+    assert [r["stable"] for r in rows] == [False, True]
+    # a bracket bisected on the loop as it runs, which holds at every pressure there (the
+    # rig has no seal): the boundary goes to the bracket's unstable end
+    edge = refine_boundary(cfg, {"hinf": digital}, [
+        {"controller": "hinf", "speed_hz": _PARTED_HZ, "last_stable_bar": 0.0,
+         "first_unstable_bar": 40.0, "boundary_pressure_bar": 40.0}], tol_bar=1.0)[0]
+    assert edge["boundary_pressure_bar"] > 39.0
+
+
+def test_a_sampled_design_is_never_refused_for_parting_from_its_w_plane_form(sampled_hinf):
+    """At 475 Hz, far above the range, the w-plane controller closed in continuous time
+    without the delay holds and the loop as it runs does not (python-control's max |z|
+    above 1): a design on the continuous plant would be refused there ("cannot run"),
+    but the sampled loop is the one this design foresaw, so its discrete controller — its
+    Tustin transform, exactly — is returned for the judgement to find the loss."""
+    from ambseal.robust import digital_controller
+
+    cfg, d, spec, points, _ = sampled_hinf
+    fs, delay = cfg.controller.sample_rate_hz, cfg.controller.delay_samples
+    p = cfg.operating.pressure_bar
+    assert _z_of_python_control(cfg, d.controller, p, 475.0) > 1.0
+    pl = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * 475.0)
+    G = pl.select_inputs([pl.input_names[j] for j in pl.current_inputs()])
+    plants = [tuple(np.asarray(X, float) for X in (G.A, G.B, G.C, G.D))]
+    assert control.feedback(control.ss(*plants[0]), d.controller).poles().real.max() < 0
+    dc = digital_controller(d.controller, fs, plants, delay_samples=delay, w_plane=True)
+    assert dc.method == "tustin" and dc.as_runs_only
+    ref = control.sample_system(control.ss(d.controller.A, d.controller.B, d.controller.C,
+                                           d.controller.D), 1.0 / fs, method="tustin")
+    assert np.allclose(dc.discrete.A, ref.A) and np.allclose(dc.discrete.D, ref.D)
+    with pytest.raises(SynthesisError, match="cannot run|stable"):
+        digital_controller(d.controller, fs, plants, delay_samples=delay,
+                           methods=("tustin",))

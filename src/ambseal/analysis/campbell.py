@@ -47,7 +47,8 @@ from ambseal.robust import decay_rate, is_stable, unstable_poles
 __all__ = ["AF_CRITICAL", "API684_LOG_DEC", "OVERDAMPED_ZETA", "ClosedLoopModes", "Crossing",
            "Campbell", "log_decrement", "amplification_factor", "resonant",
            "lowest_log_decrement", "whirl_of",
-           "closed_loop_state_matrix", "closed_loop_modes", "modes_as_run", "poles_as_run",
+           "closed_loop_state_matrix", "state_matrix_as_run", "closed_loop_modes", "modes_as_run",
+           "poles_as_run",
            "modes_of_state_matrix", "modes_of_sampled_loop", "track_modes", "open_loop_modes",
            "campbell"]
 
@@ -283,8 +284,12 @@ def closed_loop_modes(cfg, controller=None, *, speed_hz: float = 0.0,
     ----------
     cfg : RigConfig
         The rig, at full order.
-    controller : control.StateSpace or ScheduledController, optional
-        Displacement (m) → current (A), ``i = −K y``; omitted: the open-loop rig.
+    controller : StateSpace, ScheduledController or DigitalController, optional
+        Displacement (m) → current (A), ``i = −K y``; omitted: the open-loop rig. A
+        digital controller designed on the sampled plant, which has no continuous form
+        that runs (:attr:`~ambseal.robust.DigitalController.as_runs_only`), is closed as
+        it runs (:func:`modes_as_run`, ``delay`` ignored), its modes kept below the
+        Nyquist frequency.
     speed_hz : float
         Spin speed (Hz).
     pressure_bar : float, optional
@@ -308,6 +313,9 @@ def closed_loop_modes(cfg, controller=None, *, speed_hz: float = 0.0,
 
     p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
     f_max = bending_limit_hz(cfg) if max_hz is None else float(max_hz)
+    if getattr(controller, "as_runs_only", False):  # a sampled loop aliases above Nyquist
+        return modes_as_run(cfg, controller, speed_hz=speed_hz, pressure_bar=p,
+                            max_hz=min(f_max, 0.5 * controller.sample_rate_hz))
     # the loop the run judges, its delay included: the modes' log decrements are those of
     # the loop that runs, not of a better-damped one without the target's lag
     A, mesh = closed_loop_state_matrix(cfg, controller, speed_hz=speed_hz, pressure_bar=p,
@@ -343,7 +351,7 @@ def modes_as_run(cfg, controller=None, *, speed_hz: float, max_hz: float,
         A controller that is not a digital one as it runs.
     """
     p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
-    A, dt = _matrix_as_run(cfg, controller, speed_hz, p)
+    A, dt = state_matrix_as_run(cfg, controller, speed_hz=speed_hz, pressure_bar=p)
     mesh = build_mesh(cfg)
     if dt is None:
         return modes_of_state_matrix(A, mesh, speed_hz=speed_hz, pressure_bar=p,
@@ -383,17 +391,34 @@ def poles_as_run(cfg, controller=None, *, speed_hz: float, max_hz: float,
         A controller that is not a digital one as it runs.
     """
     p = cfg.operating.pressure_bar if pressure_bar is None else float(pressure_bar)
-    A, dt = _matrix_as_run(cfg, controller, speed_hz, p)
+    A, dt = state_matrix_as_run(cfg, controller, speed_hz=speed_hz, pressure_bar=p)
     lam = sla.eigvals(A)
     if dt is not None:
         lam = np.log(lam[np.abs(lam) > 1e-12].astype(complex)) / dt
     return lam[_kept(lam, float(np.abs(lam).max(initial=0.0)), max_hz)]
 
 
-def _matrix_as_run(cfg, controller, speed_hz: float, p: float):
-    """``(A, dt)``: the state matrix of the loop as it runs (:func:`modes_as_run`) — the
-    sampled loop with ``dt`` its sample time (s), or the rig's own plant with ``dt`` None
-    (no controller, or no AMB)."""
+def state_matrix_as_run(cfg, controller=None, *, speed_hz: float, pressure_bar: float):
+    """The state matrix of the loop as it runs (:func:`modes_as_run`).
+
+    Parameters
+    ----------
+    cfg : RigConfig
+        The rig, its plant built at ``speed_hz`` and ``pressure_bar``.
+    controller : DigitalController or ScheduledDigital, optional
+        As it runs (:func:`ambseal.machine.controller_as_runs`); None: the rig alone.
+    speed_hz, pressure_bar : float
+        Spin speed (Hz) and the seals' pressure drop (bar).
+
+    Returns
+    -------
+    A : ndarray, shape (n, n)
+        The sampled loop's state matrix (the full-order plant sampled by a zero-order
+        hold, the discrete controller and its computation delay), or the rig's own plant's.
+    dt : float or None
+        The sample time (s); None for the rig's own plant (no controller, or no AMB).
+    """
+    p = float(pressure_bar)
     plant = build_plant(cfg, speed_rpm=60.0 * speed_hz, pressure_bar=p)
     if controller is None or not cfg.amb:
         return np.asarray(plant.A), None
@@ -743,7 +768,9 @@ def campbell(cfg, controller=None, speeds_hz=None, *, pressure_bar: float | None
     Parameters
     ----------
     cfg : RigConfig
-    controller : control.StateSpace or ScheduledController, optional
+    controller : StateSpace, ScheduledController or DigitalController, optional
+        As in :func:`closed_loop_modes`: one designed on the sampled plant is closed as
+        it runs.
     speeds_hz : array_like, optional
         Speeds (Hz); default 31 points from 0 to 1.2× the upper end of ``[operating]
         speed_range_hz``, else of the operating speed, else of the first free–free bending

@@ -20,6 +20,10 @@ A controller that runs on a target (a controller file of ``ambseal design``: its
 controller with its computation delay on the plant sampled at its rate, as ``ambseal run``
 judges it: the row's ``*_as_runs`` columns (``stable_as_runs``, ``max_abs_pole_z``,
 ``sensitivity_peak_as_runs``, ``iso_zone_as_runs`` and per axis, ``unbalance_peak_um_as_runs``).
+A controller that exists only as it runs (an H∞ or μ designed on the sampled plant,
+:attr:`~ambseal.robust.DigitalController.as_runs_only`: its continuous form is the w-plane
+controller, no loop that runs) is judged as it runs alone: every column, and the stability
+boundary's bisection, is its loop as it runs (``max_real_pole`` is ln max|z| / T).
 """
 
 from __future__ import annotations
@@ -30,7 +34,8 @@ import math
 import control
 import numpy as np
 
-from ambseal.analysis.campbell import closed_loop_state_matrix, lowest_log_decrement
+from ambseal.analysis.campbell import (closed_loop_state_matrix, lowest_log_decrement,
+                                       state_matrix_as_run)
 from ambseal.analysis.cases import CaseError, run_cases
 from ambseal.analysis.judge import (JudgeSettings, OperatingPoint, frozen_at, frozen_discrete,
                                    judge)
@@ -111,7 +116,9 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
         taken in the plant's channel order; or ``{name: ScheduledController}`` (a controller
         file's table, :class:`~ambseal.machine.ScheduledDigital`), frozen at the case's
         speed or at the nominal rig's seal coefficient at the case's pressure
-        (:func:`ambseal.analysis.judge.frozen_at`, as ``run`` judges it).
+        (:func:`ambseal.analysis.judge.frozen_at`, as ``run`` judges it); or ``{name:
+        DigitalController}`` that exists only as it runs, judged as it runs alone
+        (module docstring).
     max_hz : float
         Highest frequency (Hz) of the modes the lowest log decrement is taken over.
     settings : JudgeSettings
@@ -139,7 +146,9 @@ def sweep_case(case: dict, rig: dict, controllers: dict, max_hz: float,
     g = (digitals or {}).get(case["controller"])
     on_speed = getattr(g, "parameter", None) == SPEED  # the running unbalance at each speed
     res, curves = judge(cfg, K, case["controller"], point, settings, impulse=False,
-                        discrete=frozen_discrete(g, point, nominal),
+                        # one that exists only as it runs: its loop judged once, as it runs
+                        discrete=K if _as_runs_only(entry) else frozen_discrete(g, point,
+                                                                                 nominal),
                         schedule=entry if on_speed else None,
                         schedule_discrete=g if on_speed else None)
     dec, dec_hz = lowest_log_decrement(curves["poles"], max_hz)
@@ -172,15 +181,24 @@ def _shared(cfg, controllers: dict) -> dict:
     signal names, so that the case wires it to the plant by name (a scheduled table is
     plain already)."""
     return {"rig": cfg.model_dump(exclude_none=True),
-            "controllers": {n: K if isinstance(K, ScheduledController) else
+            "controllers": {n: K if isinstance(K, ScheduledController) or _as_runs_only(K) else
                             (*(np.asarray(M, float) for M in (K.A, K.B, K.C, K.D)),
                              list(K.input_labels), list(K.output_labels))
                             for n, K in controllers.items()}}
 
 
+def _as_runs_only(K) -> bool:
+    """Whether ``K`` exists only as it runs (a design on the sampled plant,
+    :attr:`~ambseal.robust.DigitalController.as_runs_only`)."""
+    return bool(getattr(K, "as_runs_only", False))
+
+
 def _controller(entry, point: OperatingPoint, nominal):
     """A case's controller at ``point`` as a StateSpace: ``(A, B, C, D[, inputs,
-    outputs])``, or a scheduled one frozen there on the ``nominal`` rig."""
+    outputs])``, a scheduled one frozen there on the ``nominal`` rig, or one that exists
+    only as it runs, its delayed discrete controller."""
+    if _as_runs_only(entry):
+        return frozen_discrete(entry, point, nominal)
     if isinstance(entry, ScheduledController):
         return frozen_at(entry, point, nominal)
     mats, names = entry[:4], entry[4:]
@@ -217,8 +235,9 @@ def sweep(cfg, controllers: dict, pressures_bar, speeds_hz, params: dict | None 
     ----------
     cfg : RigConfig
     controllers : dict
-        ``{name: control.StateSpace}`` (fixed controllers) or ``{name:
-        ScheduledController}`` (frozen at each case as :func:`sweep_case` says).
+        ``{name: control.StateSpace}`` (fixed controllers), ``{name:
+        ScheduledController}`` (frozen at each case as :func:`sweep_case` says), or ``{name:
+        DigitalController}`` for one that exists only as it runs (module docstring).
     pressures_bar, speeds_hz : array_like
     params : dict, optional
         ``{name: values}`` of rig parameters (:func:`ambseal.config.rig_with_values` names).
@@ -315,10 +334,17 @@ def boundary_case(case: dict, rig: dict, controllers: dict, tol_bar: float) -> f
         mid = 0.5 * (lo + hi)
         if not lo < mid < hi:  # the bracket is two adjacent floats: no narrower one exists
             break
-        K = _controller(entry, OperatingPoint(mid, 60.0 * case["speed_hz"], ""), nominal)
-        A, _ = closed_loop_state_matrix(cfg, K, speed_hz=case["speed_hz"], pressure_bar=mid,
-                                        delay=True)  # the loop judge() judges
-        lo, hi = (mid, hi) if is_stable(np.linalg.eigvals(A)) else (lo, mid)
+        if _as_runs_only(entry):  # its loop as it runs: stable inside the unit circle
+            A, _ = state_matrix_as_run(cfg, entry, speed_hz=case["speed_hz"],
+                                       pressure_bar=mid)
+            stable = bool(np.abs(np.linalg.eigvals(A)).max(initial=0.0) < 1.0)
+        else:
+            K = _controller(entry, OperatingPoint(mid, 60.0 * case["speed_hz"], ""), nominal)
+            A, _ = closed_loop_state_matrix(cfg, K,
+                                            speed_hz=case["speed_hz"], pressure_bar=mid,
+                                            delay=True)  # the loop judge() judges
+            stable = is_stable(np.linalg.eigvals(A))
+        lo, hi = (mid, hi) if stable else (lo, mid)
     return 0.5 * (lo + hi)
 
 

@@ -5,9 +5,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ambseal.analysis import operating_points
+from ambseal.app.commands import digital_for
 from ambseal.config import method_names
-from ambseal.design import design
-from ambseal.errors import ConfigError
+from ambseal.design import design, design_spec
+from ambseal.errors import ConfigError, SynthesisError
 from ambseal.export import load_controller
 from ambseal.model import channel_names
 from ambseal.robust import DigitalController
@@ -20,19 +22,35 @@ def controller_for(cfg, spec: str | None, pressure_bar: float | None = None):
     :func:`ambseal.design.recipes.design` at ``pressure_bar``), or a controller file of
     ``ambseal design`` (.json, .npz, .mat) — its kind checked and wired to the rig's
     channels by signal name (:func:`~ambseal.export.controller_files.load_controller`);
-    ``None`` or ``"none"`` for the open loop."""
+    ``None`` or ``"none"`` for the open loop.
+
+    A digital controller's continuous design is returned, the loop the commands close in
+    continuous time; but an H∞ or μ designed on the sampled plant (``[design]
+    synthesis_plant = "sampled"``, or a file that records it) exists only as it runs: its
+    :class:`~ambseal.robust.DigitalController` is returned (discretised here for a method
+    the rig designs, as ``ambseal design`` does), for the commands to close as it runs
+    (:attr:`~ambseal.robust.DigitalController.as_runs_only`). Such a design that cannot run
+    on the target keeps its w-plane form, the only loop there is."""
     if spec is None or spec == "none":
         return None
 
     if spec in method_names(fixed=True):
-        return design(cfg, spec, pressure_bar=pressure_bar).K
+        res = design(cfg, spec, pressure_bar=pressure_bar)
+        if getattr(res, "synthesis_plant", "continuous") != "sampled":
+            return res.K
+        try:
+            return digital_for(cfg, spec, res.K, res, operating_points(design_spec(cfg)))
+        except SynthesisError:
+            return res.K
     if Path(spec).suffix.lower() not in (".json", ".npz", ".mat"):
         raise ConfigError(f"--controller: expected {', '.join(method_names(fixed=True))}, "
                           f"none or a controller file "
                           f"(.json, .npz, .mat), got {spec!r}")
 
-    K = load_controller(spec, channel_names(cfg))  # a judged digital one: its continuous design
-    return K.continuous if isinstance(K, DigitalController) else K
+    K = load_controller(spec, channel_names(cfg))
+    if isinstance(K, DigitalController) and not K.as_runs_only:
+        return K.continuous  # a judged digital one: its continuous design
+    return K
 
 
 def runs_as(cfg, spec: str | None):

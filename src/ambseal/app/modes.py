@@ -81,6 +81,8 @@ def modes_command(args: argparse.Namespace) -> int:
             from ambseal.app.controllers import controller_for
 
             K = controller_for(cfg, args.controller, p)
+            if getattr(K, "as_runs_only", False):  # closed as it runs: aliased above Nyquist
+                f_max = min(f_max, 0.5 * K.sample_rate_hz)
         # --n-modes: the N-th frequency comes from another eigen-solve than the modes listed,
         # so it may lie a rounding below theirs (the solvers agree to 1e-8, model.modes.modes)
         keep_hz = f_max * (1 + 1e-8) if args.n_modes and args.max_hz is None else f_max

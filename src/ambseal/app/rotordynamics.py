@@ -378,6 +378,8 @@ def _drop(args: argparse.Namespace) -> int:
     dm = drop_model(cfg, args.modes_hz)
     controller = controller_for(cfg, args.controller) if args.controller else None
     digital = runs_as(cfg, args.controller) if args.controller else None
+    if digital is None and getattr(controller, "as_runs_only", False):
+        digital = controller
     if digital is not None:  # a digital controller's file: as it runs on the target
         d = discrete_as_runs(cfg, digital, 2 * math.pi * rpm / 60.0,
                              cfg.operating.pressure_bar)

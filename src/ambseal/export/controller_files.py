@@ -10,7 +10,11 @@ Every file holds the same document (:func:`controller_document`):
   ``delay_samples`` (the computation delay it was judged with), ``method`` and
   ``prewarp_hz`` (``NaN`` unless Tustin was pre-warped), ``removed_poles_hz``;
 * ``A_c … D_c`` — the continuous design, ``A_r … D_r`` the continuous controller that was
-  discretised (fast poles removed);
+  discretised (fast poles removed); ``synthesis_plant`` (a fixed controller's) —
+  ``"continuous"``, or ``"sampled"`` for an H∞ or μ designed in the w-plane, whose
+  ``A_c … D_c`` is the w-plane controller, no loop that runs: ambseal closes such a
+  controller as it runs only (:attr:`~ambseal.robust.DigitalController.as_runs_only`); a
+  file without it is read as ``"continuous"``;
 * ``discretisation_json`` — the choice (candidates, their ``|z|``, the rise of γ/μ) and
   ``judged_json`` — the judged discrete margins per condition, as JSON text;
 * ``loop_holds`` (``"yes"``, ``"no"``, ``"not judged"``), ``allow_unstable`` (``"yes"`` or
@@ -201,7 +205,7 @@ def controller_document(ctrl, judged=None, verdict: dict | None = None) -> dict:
         return doc
     d = ctrl.discrete
     doc.update(kind="fixed", name=str(ctrl.continuous.name), inputs=ctrl.inputs,
-               outputs=ctrl.outputs)
+               outputs=ctrl.outputs, synthesis_plant=ctrl.synthesis_plant)
     for suf, sys in (("_c", ctrl.continuous), ("_r", ctrl.reduced)):
         doc.update({f"{k}{suf}": np.asarray(getattr(sys, k), float) for k in "ABCD"})
     doc.update({k: np.asarray(getattr(d, k), float) for k in "ABCD"})
@@ -552,8 +556,14 @@ def _load(path: Path, channels):
     def ss(suf, nm):
         return control.ss(*(arr[k + suf] for k in "ABCD"), inputs=ins, outputs=outs, name=nm)
 
+    # files written before it was recorded held continuous designs only
+    plant = _name(doc.get("synthesis_plant", "continuous"), "synthesis_plant", path)
+    if plant not in ("continuous", "sampled") or (plant == "sampled" and method != "tustin"):
+        raise DataError(f"{path}: synthesis_plant = {plant[:60]!r} with method {method!r}: "
+                        "expected 'continuous', or 'sampled' (a w-plane design, discretised "
+                        "by 'tustin')")
     desc = {"type": "state_space", "name": name, "discretisation": method}
     disc = DiscreteController(*(arr[k] for k in "ABCD"), 1.0 / fs, description=desc)
     return DigitalController(ss("_c", name), ss("_r", f"{name}_r"), disc, method, pw, fs,
                              delay, removed, meta.get("reduction"), cands,
-                             str(meta.get("choice", "")))
+                             str(meta.get("choice", "")), synthesis_plant=plant)

@@ -129,6 +129,11 @@ class DigitalController:
         ``None`` and ``not_checked`` says why (:func:`choose_method`).
     choice : str
         The candidate kept (``method``, or ``method + KEPT`` when the fast poles were kept).
+    synthesis_plant : {"continuous", "sampled"}
+        The plant ``continuous`` was designed on: ``"sampled"`` for a controller designed
+        in the w-plane (:func:`~ambseal.robust.w_plane.w_plane_plant`), whose discrete form
+        is its Tustin transform and whose ``continuous`` form is no loop that runs
+        (:attr:`as_runs_only`).
     """
 
     continuous: Any = field(repr=False)
@@ -142,6 +147,15 @@ class DigitalController:
     reduction: dict | None = None
     candidates: tuple = ()
     choice: str = ""
+    synthesis_plant: str = "continuous"
+
+    @property
+    def as_runs_only(self) -> bool:
+        """True for a controller designed on the sampled plant: it exists only as it runs.
+        Its ``continuous`` form is the w-plane controller, which closed with the continuous
+        plant parts from the loop that runs towards Nyquist (the bilinear map warps
+        frequency, w = (2/T)·tan(ωT/2)), so every loop of it is closed as it runs."""
+        return self.synthesis_plant == "sampled"
 
     @property
     def Ts(self) -> float:
@@ -173,6 +187,7 @@ class DigitalController:
                 "prewarp_hz": self.prewarp_hz,
                 "sample_rate_hz": self.sample_rate_hz, "Ts": self.Ts,
                 "delay_samples": self.delay_samples,
+                "synthesis_plant": self.synthesis_plant,
                 "fast_fraction_of_nyquist": FAST_FRACTION,
                 "removed_poles_hz": [float(f) for f in self.removed_poles_hz],
                 "order": int(self.discrete.A.shape[0]),
@@ -590,7 +605,7 @@ def sampled_plants(plants: Sequence[Matrices], fs: float, n_grid: int = 400, *,
 
 
 def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int, methods,
-                  f_pw: float | None, name: str):
+                  f_pw: float | None, name: str, foreseen: bool = True):
     """Step 3 of the module docstring: the candidates closed with each sampled plant.
 
     Parameters
@@ -610,6 +625,12 @@ def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int,
         Prewarp frequency (Hz) of ``"tustin_prewarp"``; ``None`` skips that candidate.
     name : str
         The controller's name in the error message.
+    foreseen : bool
+        Whether the continuous loop is the one the design foresaw, so that the sampled
+        loop must be stable wherever it is (the default). False for a controller designed
+        on the sampled plant (in the w-plane), whose foreseen loop is the sampled one
+        itself: nothing is asked of it here, and where its loop as it runs is unstable
+        the judgement says so.
 
     Returns
     -------
@@ -647,7 +668,7 @@ def choose_method(sp: SampledPlants, cont: list, discrete: Callable, delay: int,
     # where both are stable
     ideal_stable = [is_stable(feedback_poles(G, Kc, dt=0.0)) for G, Kc in zip(sp.ideal, cont)]
     delayed_stable = [is_stable(sp.delayed_poles(j, Kc)) for j, Kc in enumerate(cont)]
-    cont_stable = [a or b for a, b in zip(ideal_stable, delayed_stable)]
+    cont_stable = [foreseen and (a or b) for a, b in zip(ideal_stable, delayed_stable)]
     judged = [j for j in range(len(cont)) if ideal_stable[j] and delayed_stable[j]]
     peak_c = {j: _so_peak(sp.continuous_response[j], freqresp_at(cont[j], 1j * w))
               for j in judged}
@@ -724,7 +745,9 @@ def digital_controller(K, sample_rate_hz: float, plants, *,
         (:func:`~ambseal.robust.w_plane.w_plane_plant`): its Tustin transform without
         prewarp is the discrete design itself, the only candidate, nothing removed
         (``rise`` and ``methods`` ignored); its poles, however fast, map inside the unit
-        circle, so the rate check does not apply.
+        circle, so the rate check does not apply; and its sampled loop is the loop it
+        foresaw, so none is refused for parting from ``K`` closed in continuous time
+        (:func:`choose_method`'s ``foreseen``): where it is unstable the judgement says so.
 
     Returns
     -------
@@ -765,7 +788,7 @@ def digital_controller(K, sample_rate_hz: float, plants, *,
         return [discretize_as(mats if m.endswith(KEPT) else reduced, T, base, f_pw)] * n
 
     m, Kds, cands = choose_method(sp, [mats] * n, discrete, int(delay_samples), tried, f_pw,
-                                  str(K.name))
+                                  str(K.name), foreseen=not w_plane)
     choice = m
     if m.endswith(KEPT):  # the controller as designed: nothing removed
         m, Kr, fast, red = m.removesuffix(KEPT), K, np.zeros(0), None
@@ -775,4 +798,5 @@ def digital_controller(K, sample_rate_hz: float, plants, *,
         method=m, prewarp_hz=f_pw if m == "tustin_prewarp" else None, sample_rate_hz=fs,
         delay_samples=int(delay_samples),
         removed_poles_hz=tuple(sorted(float(abs(p)) / (2 * np.pi) for p in fast)),
-        reduction=red, candidates=cands, choice=choice)
+        reduction=red, candidates=cands, choice=choice,
+        synthesis_plant="sampled" if w_plane else "continuous")

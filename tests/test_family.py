@@ -102,6 +102,7 @@ def test_a_design_lost_only_as_it_runs_is_designed_on_the_sampled_plant(tmp_path
     assert bf.delivered(m)["hinf"], bf.why_not(m)["hinf"]
     z = np.load(tmp_path / "run" / "controllers" / "controller_hinf.npz", allow_pickle=False)
     T, nd = float(z["Ts"]), int(z["delay_samples"])
+    assert str(z["synthesis_plant"]) == "sampled"  # what other commands close as it runs
     Kd = ct.ss(z["A"], z["B"], z["C"], z["D"], T)
     delay = ct.ss(np.zeros((4, 4)), np.eye(4), np.eye(4), np.zeros((4, 4)), T)  # z⁻¹
     assert nd == 1

@@ -231,3 +231,24 @@ def test_a_sampled_design_is_never_refused_for_parting_from_its_w_plane_form(sam
     with pytest.raises(SynthesisError, match="cannot run|stable"):
         digital_controller(d.controller, fs, plants, delay_samples=delay,
                            methods=("tustin",))
+
+
+def test_a_sampled_designs_failing_mode_is_named_on_its_loop_as_it_runs(sampled_hinf):
+    """The mode a lost loop's line names is the one of the loop as it runs nearest the
+    failing pole (python-control's ln z / T), its kind that mode's shape's."""
+    from ambseal.analysis.campbell import modes_as_run
+    from ambseal.analysis.mode_naming import failing_mode_kind, mode_kind, support_span_m
+
+    cfg, d, spec, points, digital = sampled_hinf
+    T = 1.0 / cfg.controller.sample_rate_hz
+    p = cfg.operating.pressure_bar
+    z = _poles_of_python_control(cfg, d.controller, p, 0.0)
+    lost = np.log(complex(z[np.argmax(np.abs(z))])) / T
+    assert lost.real > 0 and lost.imag != 0  # an oscillating mode lost at standstill
+    kind = failing_mode_kind(cfg, digital, pressure_bar=p, speed_hz=0.0, pole=lost)
+    m = modes_as_run(cfg, digital, speed_hz=0.0, pressure_bar=p,
+                     max_hz=1.5 * abs(lost.imag) / (2 * np.pi) + 10.0)
+    k = int(np.argmin(np.abs(m.poles - complex(lost.real, abs(lost.imag)))))
+    assert m.poles[k] == pytest.approx(complex(lost.real, abs(lost.imag)), rel=1e-6)
+    assert kind == mode_kind(m.shapes[k], m.node_z_m, support_span_m(cfg), m.whirl[k], 0.0)
+    assert kind is not None

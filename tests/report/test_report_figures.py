@@ -173,3 +173,28 @@ def test_the_api617_unbalance_figure_keeps_every_placement_and_af_readable(tmp_p
         assert not any(box.overlaps(ax.get_window_extent(renderer)) for ax in plots)
     assert not any(a.overlaps(b) for i, a in enumerate(boxes) for b in boxes[i + 1:])
     assert not any(ax.texts for ax in plots)
+
+
+def test_a_discrete_controllers_gains_are_taken_on_the_unit_circle(tmp_path, monkeypatch):
+    """Reference: python-control's frequency response of a discrete controller, K(e^{jωT}),
+    below the Nyquist frequency only (a design on the sampled plant has no continuous
+    form to plot at s = jω); a continuous one beside it at s = jω, up to 2 kHz."""
+    import control
+
+    from ambseal.report import run_report
+
+    got = {}
+    monkeypatch.setattr(run_report, "controller_gains_figure",
+                        lambda path, rows, names, styles: got.update(rows=rows) or path)
+    T = 1.0 / 3000.0  # Nyquist at 1.5 kHz, inside the figure's 2 kHz
+    Kc = control.ss([[-800.0, 0.0], [0.0, -1200.0]], np.eye(2), [[2e4, 3e3], [1e3, 1.5e4]],
+                    np.diag([40.0, 30.0]), inputs=["y_A_zeta", "y_A_eta"],
+                    outputs=["i_A_zeta", "i_A_eta"])
+    Kd = control.sample_system(Kc, T, method="tustin")
+    run_report.gains_figure(tmp_path, [("pid", Kc), ("hinf", Kd)])
+    (_, fc, Gc), (_, fd, Gd) = got["rows"]
+    assert fc[-1] == pytest.approx(2000.0) and fd.max() < 1500.0 < fd.max() * 1.05
+    ref_c = control.frequency_response(Kc, 2 * np.pi * fc)
+    ref_d = control.frequency_response(Kd, 2 * np.pi * fd)
+    assert np.allclose(np.moveaxis(Gc, 0, -1), ref_c.complex, rtol=1e-9)
+    assert np.allclose(np.moveaxis(Gd, 0, -1), ref_d.complex, rtol=1e-9)

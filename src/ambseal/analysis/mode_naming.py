@@ -125,8 +125,9 @@ def failing_mode_kind(cfg, controller, *, pressure_bar: float, speed_hz: float,
     ----------
     cfg : RigConfig
         The rig.
-    controller : control.StateSpace or ScheduledController
-        The controller (``i = −K y``); a scheduled one frozen at the speed.
+    controller : control.StateSpace, ScheduledController or DigitalController
+        The controller (``i = −K y``); a scheduled one frozen at the speed; a digital one
+        designed on the sampled plant closed as it runs (:func:`closed_loop_modes`).
     pressure_bar, speed_hz : float
         The condition.
     pole : complex

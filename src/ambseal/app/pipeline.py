@@ -133,6 +133,15 @@ class RunResult:
     exit_status: int = 0
 
 
+def _closed_as(d, digitals: dict):
+    """The controller design ``d``'s loops are closed with: for a design on the sampled
+    plant its digital controller, which exists only as it runs
+    (:attr:`~ambseal.robust.DigitalController.as_runs_only`), else (or where it cannot
+    run) the design's own."""
+    return (digitals[d.method] if d.synthesis_plant == "sampled" and d.method in digitals
+            else d.controller)
+
+
 def kind_of(cfg, controller):
     """``kind_of`` of :func:`~ambseal.analysis.loop_failure` for one controller on the rig:
     the failing mode's kind (:func:`~ambseal.analysis.failing_mode_kind`) at the case's
@@ -167,7 +176,7 @@ def _speed_range(designs, digitals, spec, points, design_cfg, judge_cfg, stages,
         f = loop_failure(d.method, _judged_of(d.method, jobs, done),
                          designed=d.method != "pid", kept=allow_unstable,
                          derived=design_cfg.controller.pid is None,
-                         kind_of=kind_of(judge_cfg, d.controller),
+                         kind_of=kind_of(judge_cfg, _closed_as(d, digitals)),
                          as_runs_only=d.synthesis_plant == "sampled")
         if f is not None:
             failed[d.method] = also_failed(failed.get(d.method), f)
@@ -532,7 +541,8 @@ def _judge_stage(st: _RunState) -> None:
         f = loop_failure(d.method, _judged_of(d.method, st.jobs, st.judged),
                          designed=d.method != "pid", kept=st.allow_unstable,
                          derived=st.cfg.controller.pid is None,
-                         kind_of=kind_of(st.cfg, d.controller), speed_in_labels=with_speed,
+                         kind_of=kind_of(st.cfg, _closed_as(d, st.digitals)),
+                         speed_in_labels=with_speed,
                          as_runs_only=d.synthesis_plant == "sampled")
         if f is not None:
             st.failed[d.method] = f
@@ -936,8 +946,11 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
         ramp=ramp, signoff=signoff).to_dict()
     stages.begin("report")
     write_json(out / "metrics.json", metrics)
-    figs.append(gains_figure(out, [(d.method, frozen_at(d.controller, cfg.operating,
-                                                        st.design_cfg)) for d in st.designs]))
+    # a design on the sampled plant as it runs: its w-plane form's gains are warped
+    figs.append(gains_figure(out, [(d.method, K.statespace() if K is not d.controller
+                                    else frozen_at(K, cfg.operating, st.design_cfg))
+                                   for d in st.designs
+                                   for K in [_closed_as(d, st.digitals)]]))
     figs += capacity_figure(out, cfg, currents)
     figs += rejection_figure(out, rejections)
     sections.append(statics_section(rotor_at_rest(cfg).to_dict()))

@@ -19,6 +19,7 @@ from ambseal import __version__
 from ambseal.analysis import force_demand, lost_conditions, worst_zone
 from ambseal.config import method_label
 from ambseal.identify import MIN_FIT_PCT, fit_reliability, interval_check, true_line
+from ambseal.lti import freqresp_at
 from ambseal.lti.freqresp import freqresp
 from ambseal.model import amb_factors, force_capacity, load_capacity
 from ambseal.report import figures
@@ -118,7 +119,10 @@ def gains_figure(out: Path, controllers: list[tuple[str, object]]) -> tuple[str,
     out : Path
         Folder of the figure (``controller_gains.png``).
     controllers : list of (str, control.StateSpace)
-        Method and physical controller (``i = −K y``), one input per measurement.
+        Method and physical controller (``i = −K y``), one input per measurement: a
+        continuous one at s = jω, a discrete one (``dt`` > 0, e.g. a design on the
+        sampled plant, which has no continuous form) at z = e^{jωT}, below the Nyquist
+        frequency.
 
     Returns
     -------
@@ -126,8 +130,14 @@ def gains_figure(out: Path, controllers: list[tuple[str, object]]) -> tuple[str,
         The caption and the PNG written.
     """
 
+    def gains(K):
+        if not K.dt:
+            return f, freqresp(K, 2 * np.pi * f)
+        fd = f[f < 0.5 / K.dt]  # aliased above
+        return fd, freqresp_at(K, np.exp(2j * np.pi * fd * K.dt))
+
     f = np.logspace(0, math.log10(2000.0), 300)
-    rows = [(m, f, freqresp(K, 2 * np.pi * f)) for m, K in controllers]
+    rows = [(m, *gains(K)) for m, K in controllers]
     names = [axis_label(n.removeprefix("y_")) for n in controllers[0][1].input_labels]
     colours = controller_colours([m for m, _ in controllers])
     return ("Direct and cross gains of the controllers (P5 Fig. 10)",

@@ -6,6 +6,7 @@ with the delay's Padé lag."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import control
@@ -170,8 +171,6 @@ def test_a_sampled_designs_file_says_so_and_its_modes_are_as_it_runs(sampled_hin
 def test_a_file_without_synthesis_plant_is_a_continuous_design(sampled_hinf, tmp_path):
     """A file written before the key existed holds a continuous design; a value other than
     the two known ones is refused, naming the file and the key."""
-    import json
-
     cfg, d, spec, points, digital = sampled_hinf
     path = export_controller(digital, tmp_path / "controller_hinf.json")
     doc = json.loads(path.read_text())
@@ -252,3 +251,39 @@ def test_a_sampled_designs_failing_mode_is_named_on_its_loop_as_it_runs(sampled_
     assert m.poles[k] == pytest.approx(complex(lost.real, abs(lost.imag)), rel=1e-6)
     assert kind == mode_kind(m.shapes[k], m.node_z_m, support_span_m(cfg), m.whirl[k], 0.0)
     assert kind is not None
+
+
+def test_the_cli_closes_a_method_designed_on_the_sampled_plant_as_it_runs(tmp_path, capsys):
+    """``ambseal modes RIG --controller hinf`` on a rig whose ``[design]`` designs on the
+    sampled plant designs, discretises and closes the loop as it runs: every mode it lists
+    is a pole ln z / T of python-control's sampled loop of the same design (its Tustin
+    transform, one sample late, on the ZOH-sampled plant), not one of its w-plane form
+    closed in continuous time."""
+    from ambseal.cli import main
+
+    rig = tmp_path / "sampled.toml"
+    rig.write_text(SUPERCRITICAL.read_text()
+                   + '\n[design]\nsynthesis_plant = "sampled"\none_speed = true\n')
+    cfg = load_rig(rig)
+    K = design(cfg, "hinf").K  # the design the command makes
+    p = cfg.operating.pressure_bar
+    T = 1.0 / cfg.controller.sample_rate_hz
+    z = _poles_of_python_control(cfg, K, p, _PARTED_HZ)
+    assert np.abs(z).max() < 1.0
+    cont = closed_loop_modes(cfg, K, speed_hz=_PARTED_HZ, pressure_bar=p).poles
+    ref = np.log(z[np.abs(z) > 1e-12].astype(complex)) / T
+    ref = ref[ref.imag > 0]
+    assert main(["modes", str(rig), "--controller", "hinf", "--speed-rpm",
+                 f"{60.0 * _PARTED_HZ:g}", "--max-hz", "2000", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["unstable_poles"] == []
+    listed = [(f, zeta) for f, zeta in zip(out["natural_frequencies_hz"],
+                                           out["damping_ratios"])]
+    assert len(listed) > 20
+    for f, zeta in listed:
+        k = int(np.argmin(np.abs(ref.imag / (2 * np.pi) - f)))
+        assert ref[k].imag / (2 * np.pi) == pytest.approx(f, rel=1e-6)
+        assert -ref[k].real / abs(ref[k]) == pytest.approx(zeta, rel=1e-5, abs=1e-8)
+    apart = [min(abs(cont - ref[int(np.argmin(np.abs(ref.imag / (2 * np.pi) - f)))]))
+             / (2 * np.pi * f) for f, _ in listed]
+    assert max(apart) > 1e-2  # what the commands closed before lists other modes

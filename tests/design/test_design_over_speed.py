@@ -163,11 +163,13 @@ def test_a_design_refused_over_the_speed_range_checks_what_lost_it_once(tmp_path
     the gyroscopic moments move). Whether the speed or the pressure lost it costs two
     full-order checks; they are made once, by the rule that decides whether to design over
     the speed range, and its answer is what the refusal says. Every design over the speed
-    range is stubbed to hold nothing: only the top speed's H∞ is synthesised."""
+    range (its schedule on speed too) is stubbed to hold nothing: only the top speed's H∞
+    is synthesised."""
     import ambseal.design.recipes as recipes
 
     monkeypatch.setattr(recipes, "_held_over_speed", lambda *a, **k: None)
     monkeypatch.setattr(recipes, "_first_held", lambda *a, **k: None)
+    monkeypatch.setattr(recipes, "_scheduled_over_speed", lambda *a, **k: None)
     asked, real = [], recipes._lost_by
 
     def counted(*args):

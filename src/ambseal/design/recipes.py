@@ -71,11 +71,12 @@ from ambseal.design.plant import (
 )
 from ambseal.design.specs import design_spec, design_states_at
 from ambseal.design.speed_lft import whole_pair_states
+from ambseal.design.speed_schedule import schedule_hinf
 from ambseal.design.weights import Weights
 from ambseal.errors import ConfigError, ModelError, SynthesisError
 from ambseal.lti import lft_lower
 from ambseal.lti.freqresp import freqresp
-from ambseal.machine import judged_loop
+from ambseal.machine import frozen, judged_loop
 from ambseal.model import build_plant, build_system, channel_names, poles_near_zero
 from ambseal.robust import (
     LEVEL_FLOOR,
@@ -290,8 +291,10 @@ def full_order_check(cfg, K, conditions, *, first_loss: bool = False,
     ----------
     cfg : RigConfig
         The rig; its full-order plant is built at each condition.
-    K : control.StateSpace
-        Displacements (m) → current references (A), negative feedback ``i = −K y``.
+    K : control.StateSpace or ScheduledController
+        Displacements (m) → current references (A), negative feedback ``i = −K y``; a
+        controller scheduled on speed is frozen at each condition's speed
+        (:func:`ambseal.machine.frozen`).
     conditions : iterable of (pressure_bar, speed_hz)
         The judged conditions: pressure drop (bar) and speed (Hz).
     first_loss : bool
@@ -332,7 +335,8 @@ def full_order_check(cfg, K, conditions, *, first_loss: bool = False,
             break
         checked += 1
         plant = build_plant(cfg, pressure_bar=p, speed_rpm=60.0 * f)
-        judged = judged_loop(plant.to_statespace(), K, plant.current_inputs(), delay=L)
+        judged = judged_loop(plant.to_statespace(), frozen(K, 2 * np.pi * f),
+                             plant.current_inputs(), delay=L)
         lam = judged.loop.poles
         if sampled:  # the delay's poles at z = 0 have no s image (infinitely fast)
             lam = np.log(lam[np.abs(lam) > 0].astype(complex)) * fs
@@ -498,9 +502,12 @@ def design(
     r, check, n = synthesise(cfg, steps)
     moved = over = lost = None
     if not cfg.design.one_speed:
+        scheduled = (None if method != "hinf" or on_sampled_plant(cfg) else
+                     partial(_scheduled_over_speed, cfg, p, w, sp, dl))
         (r, check, n), moved, over, lost = _over_speed(cfg, method, p, sp, (r, check, n),
                                                        synthesise, steps, progress,
-                                                       fixed=states is not None)
+                                                       fixed=states is not None,
+                                                       schedule=scheduled)
     if not check["stable"] and not allow_unstable:
         raise SynthesisError(_unstable_message(method, check, n, steps, _top_mode_hz(cfg, p, n),
                                                lost or _lost_by(cfg, r.K, check, p),
@@ -518,7 +525,8 @@ def design(
         steps=tuple(steps), notes=tuple(sp.notes),
         verdict=_verdict(method, r, check), omega=r.omega, stopping=r.stopping,
         design_speed_hz=moved, speed_range_hz=over,
-        synthesis_plant="sampled" if on_sampled_plant(cfg) else "continuous")
+        synthesis_plant="sampled" if on_sampled_plant(cfg) else "continuous",
+        scheduled=r.scheduled)
 
 
 def _tried(trials: dict, inputs: tuple, make):
@@ -641,7 +649,7 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
 
 
 def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
-                progress, fixed: bool = False):
+                progress, fixed: bool = False, schedule=None):
     """The design over the speed range: where ``first`` (synthesis, full-order check,
     states), designed at the operating speed and pressure ``p`` (bar), loses the rotor at
     another judged speed, and the speed is what loses it (:func:`_lost_by`: at ``p`` that
@@ -665,7 +673,14 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
        standstill up (the gyroscopic moments change the plant monotonically with speed,
        so the loss moves with the design speed); μ is designed once more, at the speed
        that search finds for H∞ (``synthesise(cfg, steps, "hinf")``), where there is one;
-    3. else ``first``, with a step that names what was tried and how each lost the
+    3. else, given ``schedule`` (H∞ on the continuous plant), H∞ scheduled on the spin
+       speed (:mod:`ambseal.design.speed_schedule`; ``schedule(range_hz, states,
+       tried)``, :func:`_scheduled_over_speed`), kept where its full-order loop holds every
+       judged condition: the gyroscopic moments are known where the controller runs,
+       and a fixed controller over the range is the simpler one to run, so it is tried
+       first. Measured on the gyroscopic family (benchmarks/README.md, "H∞ scheduled on
+       the spin speed"): the schedule holds 26 of 27 rigs, the fixed designs 9;
+    4. else ``first``, with a step that names what was tried and how each lost the
        rotor (or why there was no design), so the user sees the range was tried.
 
     Returns (the design, the speed in Hz it was designed at for 2, the speed range in Hz
@@ -715,6 +730,14 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
                             sp, tried, "H∞ ")
         speeds = [] if found is None else [found[0]]
     found = _first_held(cfg, speeds, lambda c, n_f: synthesise(c, [], n_start=n_f), sp, tried)
+    if found is None and schedule is not None:
+        held = schedule(rng, n, tried)
+        if held is not None:
+            step(f"as a controller scheduled on the spin speed over {rng[0]:g}–{rng[1]:g} Hz "
+                 f"(the central H∞ controllers, at γ {held[0].gamma:.3g}, of the plants frozen at its "
+                 f"{held[0].scheduled.table_theta.size} judged speeds, interpolated "
+                 "linearly), which")
+            return held, None, rng, None
     if found is None:
         steps.append(f"{method}: no design over the speed range held every judged "
                      f"condition, so the design at the operating speed stays; {lost}; "
@@ -726,6 +749,35 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
     step(f"at {f:g} Hz, the first stability speed from standstill whose "
          f"{'H∞ ' if method != 'hinf' else ''}design")
     return out, f, None, None
+
+
+def _scheduled_over_speed(cfg, p: float, w, sp, dl, rng, n: int, tried: list):
+    """H∞ scheduled on the spin speed over ``rng`` (Hz) on the n-state design model at
+    ``p`` bar (:func:`~ambseal.design.speed_schedule.schedule_hinf`, its table at the
+    judged speeds), as ``(synthesis, full-order check, n)`` where its full-order loop
+    holds every judged condition, else None with the loss (or why there is no design)
+    appended to ``tried``."""
+    speeds = sorted({*sp.speeds_hz, *sp.stability_speeds_hz})
+    try:
+        gp = _generalised(cfg, "hinf", p, w, {}, n, sp, dl, speed=rng)
+        sched = schedule_hinf(gp, speeds)
+    except (SynthesisError, ModelError) as exc:
+        tried.append(_tried_words("scheduled on the spin speed", error=exc))
+        return None
+    check = full_order_check(cfg, sched, [(q, f) for q in sp.pressures_bar for f in speeds])
+    if not check["stable"]:
+        tried.append(_tried_words("scheduled on the spin speed", check))
+        return None
+    f0 = cfg.operating.speed_rpm / 60.0
+    r = _Synthesis(sched.at(2 * np.pi * f0), sched.gamma, None, (), sched.order, None, gp,
+                   stopping={"hinf": {
+                       "rule": "the central H∞ controller of the plant frozen at each judged "
+                               f"speed, at γ = {sched.backoff:g} × the largest "
+                               "γ_opt (each γ_opt bisected to rtol=1e-06)",
+                       "table_speeds_hz": [float(f) for f in speeds],
+                       "gamma_opt": [float(g) for g in sched.gamma_opt]}},
+                   scheduled=sched)
+    return r, check, n
 
 
 def _held_over_speed(cfg, method: str, rng, n: int, synthesise, tried: list,
@@ -847,6 +899,7 @@ class _Synthesis:
     stopping: dict | None = None
     bands: tuple = ()
     level: float | None = None
+    scheduled: Any = None
 
 
 def _level_words(level: float | None) -> str:
@@ -876,19 +929,8 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
     the nominal H∞'s order."""
 
     robust = method in method_names(robust=True)  # against the uncertain parameters
-    Wf = w.Wf()
-    fpos = tuple(w.force_positions_m or sp.force_positions_m) if Wf is not None else ()
     sampled = on_sampled_plant(cfg)
-    gp = generalized_plant(cfg, w.Wp(), w.Wu(), uncertainty=unc if robust else None,
-                           pressure_bar=p, states=n, input_disturbance=w.W1(),
-                           force_disturbance=Wf, force_positions=fpos, d_e=w.d_e, d_u=w.d_u,
-                           actuator_delay=None if sampled else dl.system,
-                           gain_weight=w.Wk(), damping_margins=margins,
-                           modal_bands=bands if robust else (), speed_range_hz=speed)
-    if sampled:  # the plant as the discrete controller sees it, in the w-plane
-        fs, nd = cfg.controller.sample_rate_hz, cfg.controller.delay_samples
-        gp = replace(gp, P=w_plane_plant(gp.P, gp.ncon, fs, nd),
-                     P_nominal=w_plane_plant(gp.P_nominal, gp.ncon, fs, nd))
+    gp = _generalised(cfg, method, p, w, unc, n, sp, dl, margins, bands, speed)
     mu_omega = None
 
     def scaled_hinf(P):  # H∞ at the constant scalings of the speed channel
@@ -963,6 +1005,28 @@ def _synthesise(cfg, method, p, w, unc, n, om, sp, reduce_to, max_iter, dk_order
     return _Synthesis(K, gamma, mu, tuple(hist), order_full, red, gp, K_P, mu_omega,
                       om if robust else None, stopping, tuple(bands) if robust else (),
                       level)
+
+
+def _generalised(cfg, method, p, w, unc, n, sp, dl, margins=(), bands=(), speed=None):
+    """The generalised plant of one synthesis (:func:`_synthesise`'s arguments): the
+    recipe's weights on the n-state design model at ``p`` bar, μ's uncertainty, the spin
+    speed uncertain over ``speed`` (Hz) where given, and on a sampled rig the w-plane
+    image of the sampled plant."""
+    robust = method in method_names(robust=True)
+    Wf = w.Wf()
+    fpos = tuple(w.force_positions_m or sp.force_positions_m) if Wf is not None else ()
+    sampled = on_sampled_plant(cfg)
+    gp = generalized_plant(cfg, w.Wp(), w.Wu(), uncertainty=unc if robust else None,
+                           pressure_bar=p, states=n, input_disturbance=w.W1(),
+                           force_disturbance=Wf, force_positions=fpos, d_e=w.d_e, d_u=w.d_u,
+                           actuator_delay=None if sampled else dl.system,
+                           gain_weight=w.Wk(), damping_margins=margins,
+                           modal_bands=bands if robust else (), speed_range_hz=speed)
+    if sampled:  # the plant as the discrete controller sees it, in the w-plane
+        fs, nd = cfg.controller.sample_rate_hz, cfg.controller.delay_samples
+        gp = replace(gp, P=w_plane_plant(gp.P, gp.ncon, fs, nd),
+                     P_nominal=w_plane_plant(gp.P_nominal, gp.ncon, fs, nd))
+    return gp
 
 
 def _reduce_best(P, cands, order: int, auto: bool, gp, blocks, omega):

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import control
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
@@ -37,7 +38,7 @@ from ambseal.model import (
     reduction_size,
 )
 
-__all__ = ["SPEED", "whole_pair_states", "with_speed"]
+__all__ = ["SPEED", "at_speed", "whole_pair_states", "with_speed"]
 
 _TWO_PI = 2.0 * np.pi
 
@@ -212,3 +213,44 @@ def with_speed(plant: Plant, cfg, *, range_hz: tuple[float, float],
     params[SPEED] = Parameter(SPEED, cfg.speed, "rad/s", B=U[:, :r] * root,
                               C=root[:, None] * Vt[:r], D=np.zeros((r, plant.B.shape[1])))
     return replace(plant, parameters=params), {SPEED: (_TWO_PI * lo, _TWO_PI * hi)}
+
+
+def at_speed(gp, speed_rad_s: float):
+    """The generalised plant frozen at a spin speed: its speed channel closed,
+    ``F_u(P, δ·I_r)`` with δ the speed's normalised value (thesis P1 Eqs. 46–52).
+
+    Parameters
+    ----------
+    gp : GeneralizedPlant
+        A generalised plant whose first LFT parameter is :data:`SPEED`
+        (:func:`ambseal.design.plant.generalized_plant` with ``speed_range_hz``).
+    speed_rad_s : float
+        Ω (rad/s), within the parameter's range.
+
+    Returns
+    -------
+    control.StateSpace
+        ``gp.P`` without the speed's r channels: the same states (one state basis at
+        every speed) and the other channels' names.
+
+    Raises
+    ------
+    ModelError
+        No speed parameter first, or Ω outside its range.
+    """
+    if not gp.parameters or gp.parameters[0].name != SPEED:
+        raise ModelError(f"at_speed: the generalised plant's first LFT parameter is not "
+                         f"{SPEED!r}")
+    q = gp.parameters[0]
+    delta = q.delta(float(speed_rad_s))
+    if not -1.0 - 1e-9 <= delta <= 1.0 + 1e-9:
+        raise ModelError(f"at_speed: {speed_rad_s:g} rad/s lies outside the speed range "
+                         f"{q.low:g}–{q.high:g} rad/s")
+    P, r = gp.P, q.repeats
+    A, B, C, D = (np.asarray(M, float) for M in (P.A, P.B, P.C, P.D))
+    # w_Δ = δ z_Δ: solved for the loop through D_ΔΔ
+    M = delta * np.linalg.inv(np.eye(r) - delta * D[:r, :r])
+    return control.ss(A + B[:, :r] @ M @ C[:r], B[:, r:] + B[:, :r] @ M @ D[:r, r:],
+                      C[r:] + D[r:, :r] @ M @ C[:r], D[r:, r:] + D[r:, :r] @ M @ D[:r, r:],
+                      inputs=list(P.input_labels)[r:], outputs=list(P.output_labels)[r:],
+                      states=list(P.state_labels), name=P.name)

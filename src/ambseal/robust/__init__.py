@@ -13,6 +13,8 @@ Synthesis (each returns the controller, the closed loop, the bound and a result 
 * :func:`lpvsyn` — gridded H∞ LPV synthesis by LMIs (CVXOPT, structured); the status each
   of its SDP stages ended on, :func:`sdp_status`, and any short of optimal in words,
   :func:`sdp_shortfall`;
+* :func:`hinf_scheduled` — central H∞ controllers of a table of frozen plants at one γ,
+  in their common state basis, as a controller scheduled on the table's parameter;
 * :func:`performance_level` — the largest level of the performance weights at which a
   scaled-H∞ bound certifies the uncertainty (a wide interval of a real parameter), and
   :func:`scaled_performance` the plant at that level;
@@ -70,7 +72,8 @@ _FROM = {
     "MuResult": "mu", "balred_controller": "order", "reduce_controller": "order",
     "ReductionResult": "order", "decay_rate": "stability", "is_stable": "stability",
     "unstable_poles": "stability", "MAX_DELAY_SAMPLES": "timing", "check_timing": "timing",
-    "w_plane_plant": "w_plane",
+    "w_plane_plant": "w_plane", "hinf_scheduled": "scheduled_hinf",
+    "ScheduledHinfResult": "scheduled_hinf",
 }
 
 __all__ = sorted(_FROM)

@@ -632,7 +632,7 @@ class _Sb10:
         A0, B0, C0, D0 = (np.asarray(M, float) for M in (P.A, P.B, P.C, P.D))
         self.P0, self.nmeas, self.ncon = (A0, B0, C0, D0), nmeas, ncon
         self.nw, self.nz = B0.shape[1] - ncon, C0.shape[0] - nmeas
-        A, B, C, D, _, self.su, self.sy = _scale(A0, B0, C0, D0, self.nw, self.nz)
+        A, B, C, D, self.t, self.su, self.sy = _scale(A0, B0, C0, D0, self.nw, self.nz)
         self.A, self.B, self.C, self.D = (np.ascontiguousarray(M) for M in (A, B, C, D))
         #: smallest γ not refused by SB10AD's lower-bound check so far (:meth:`sb10ad`)
         self._bound_above = np.inf

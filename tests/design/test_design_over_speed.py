@@ -269,3 +269,66 @@ def test_a_rotor_whose_operating_count_splits_a_whirl_pair_is_held_on_whole_pair
     assert held.speed_range_hz is not None and held.speed_range_hz[0] == 0.0
     assert "on 16 states (the 18 of the operating speed split a whirl pair)" in held.steps[-1]
     assert all(_held_with_delay(cfg, held.K, design_spec(cfg).stability_speeds_hz))
+
+
+def test_hinf_scheduled_on_speed_holds_a_rigid_rotor_no_fixed_design_holds(tmp_path,
+                                                                        monkeypatch):
+    """The disc-like rigid rotor (Ip/It 1.2) with every fixed design over the speed range
+    stubbed to hold nothing: the rule ends with H∞ scheduled on the spin speed, whose
+    controller frozen at each speed of :data:`BETWEEN_HZ` — at table entries and between
+    them — holds the loop as it runs (python-control's poles of the sampled, delayed
+    loop on the full-order plant), where the design at the top speed alone loses the rotor
+    at standstill."""
+    import ambseal.design.recipes as recipes
+    from ambseal.design.speed_schedule import SpeedScheduledHinf
+
+    monkeypatch.setattr(recipes, "_held_over_speed", lambda *a, **k: None)
+    monkeypatch.setattr(recipes, "_first_held", lambda *a, **k: None)
+    rig = _rigid_rig(tmp_path, 0.622)
+    one = load_rig(rig, ("design.one_speed=true",))
+    assert not _held_as_it_runs(one, design(one, "hinf", allow_unstable=True).K, [0.0])[0]
+    held = design(load_rig(rig), "hinf")
+    K = held.controller
+    assert isinstance(K, SpeedScheduledHinf) and held.speed_range_hz == (0.0, 400.0)
+    table = set(np.round(K.speeds_hz, 6))
+    assert table == set(np.round(design_spec(load_rig(rig)).stability_speeds_hz, 6)) | {400.0}
+    assert any(f not in table for f in BETWEEN_HZ)
+    cfg = load_rig(rig)
+    assert all(_held_as_it_runs(cfg, K.at(2 * np.pi * f), [f])[0] for f in BETWEEN_HZ)
+    assert held.steps[-1].startswith("hinf: designed as a controller scheduled on the spin "
+                                     "speed over 0–400 Hz")
+    assert held.verdict.startswith(f"H∞ γ = {K.gamma:.3g} on the design model frozen at each "
+                                   f"of its {len(table)} table speeds")
+    # its frozen controller at the operating speed is the delivered K
+    np.testing.assert_array_equal(held.K.A, K.at(2 * np.pi * 400.0).A)
+
+
+def test_ambseal_design_exports_the_hinf_scheduled_on_speed(tmp_path, monkeypatch, capsys):
+    """``ambseal design --method hinf`` of a rig whose H∞ is scheduled on speed exports the
+    schedule, not its frozen controller at the operating speed: the file's discrete table
+    at standstill is python-control's transform of the design frozen there by the method
+    chosen (no pole removed on this rig), in frequency response."""
+    import json
+
+    import ambseal.design.recipes as recipes
+    from ambseal.cli import main
+    from ambseal.export import load_controller
+
+    monkeypatch.setattr(recipes, "_held_over_speed", lambda *a, **k: None)
+    monkeypatch.setattr(recipes, "_first_held", lambda *a, **k: None)
+    rig = _rigid_rig(tmp_path, 0.622)
+    assert main(["design", str(rig), "--method", "hinf", "--out", str(tmp_path / "d")]) == 0
+    out = json.loads(capsys.readouterr().out)
+    method = out["discretisation"]["method"]
+    assert out["loop"]["loop_holds"] and not out["discretisation"]["removed_poles_hz"]
+    K = design(load_rig(rig), "hinf").controller
+    T = 1.0 / load_rig(rig).controller.sample_rate_hz
+    table = load_controller(tmp_path / "d" / "controller_hinf.npz")
+    assert hasattr(table, "statespace_at")
+    ref = control.sample_system(K.at(0.0), T, method=method)
+    got = table.statespace_at(0.0)
+    z = np.exp(1j * 2 * np.pi * np.logspace(0, np.log10(0.45 / T), 40) * T)
+    np.testing.assert_allclose(got(z), ref(z), rtol=1e-7, atol=1e-7 * np.abs(ref(z)).max())
+    # and not the controller at the operating speed (400 Hz)
+    top = control.sample_system(K.at(2 * np.pi * 400.0), T, method=method)
+    assert np.abs(top(z) - ref(z)).max() > 1e-3 * np.abs(ref(z)).max()

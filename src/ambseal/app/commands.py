@@ -540,11 +540,11 @@ def design_files(rig: str | Path, method: str, out_dir: str | Path, *,
         res = design(cfg, method, pressure_bar=pressure_bar, allow_unstable=allow_unstable,
                      spec=spec if pressure_bar is None else design_spec(cfg, pressure_bar),
                      progress=logging.getLogger("ambseal").info)  # -q silences it
-        K, summary = res.K, res.to_dict()
+        K, summary = res.controller, res.to_dict()  # scheduled on speed where it is
 
     points = operating_points(spec)
     digital = digital_for(cfg, method, K, res, points)
-    if summary.get("full_order") is None and not isinstance(K, ScheduledController):
+    if summary.get("full_order") is None:
         # the reference PID is given, not designed: judged here before it is handed over,
         # and its verdict says so as a design's does
         check = full_order_check(cfg, K, [(q.pressure_bar, q.speed_rpm / 60.0) for q in points])

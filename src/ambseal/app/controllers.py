@@ -24,7 +24,9 @@ def controller_for(cfg, spec: str | None, pressure_bar: float | None = None):
     channels by signal name (:func:`~ambseal.export.controller_files.load_controller`);
     ``None`` or ``"none"`` for the open loop.
 
-    A digital controller's continuous design is returned, the loop the commands close in
+    A design scheduled on speed (a PID's cross gains, an H∞ scheduled over the speed
+    range) is returned scheduled, for the commands to freeze at each speed. A digital
+    controller's continuous design is returned, the loop the commands close in
     continuous time; but an H∞ or μ designed on the sampled plant (``[design]
     synthesis_plant = "sampled"``, or a file that records it) exists only as it runs: its
     :class:`~ambseal.robust.DigitalController` is returned (discretised here for a method
@@ -37,7 +39,7 @@ def controller_for(cfg, spec: str | None, pressure_bar: float | None = None):
     if spec in method_names(fixed=True):
         res = design(cfg, spec, pressure_bar=pressure_bar)
         if getattr(res, "synthesis_plant", "continuous") != "sampled":
-            return res.K
+            return res.controller  # scheduled on speed where the design is
         try:
             return digital_for(cfg, spec, res.K, res, operating_points(design_spec(cfg)))
         except SynthesisError:

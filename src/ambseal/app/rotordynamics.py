@@ -67,6 +67,7 @@ from ambseal.errors import ConfigError
 from ambseal.export import load_controller
 from ambseal.files import OwnedFolder, atomic_write, write_json, write_text
 from ambseal.io import import_ross_file
+from ambseal.machine import frozen
 from ambseal.model import channel_names, inclination
 from ambseal.report import (
     api617_unbalance_figure,
@@ -377,6 +378,7 @@ def _drop(args: argparse.Namespace) -> int:
                           "or give one value")
     dm = drop_model(cfg, args.modes_hz)
     controller = controller_for(cfg, args.controller) if args.controller else None
+    controller = frozen(controller, 2 * math.pi * rpm / 60.0)  # scheduled: where it drops
     digital = runs_as(cfg, args.controller) if args.controller else None
     if digital is None and getattr(controller, "as_runs_only", False):
         digital = controller

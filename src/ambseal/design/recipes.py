@@ -1218,6 +1218,10 @@ def _verdict(method, r: _Synthesis, check) -> str:
     stab = full_order_words(check)
     relaxed = _level_words(r.level)
     if method == "hinf":
+        if r.scheduled is not None:
+            return (f"H∞ γ = {r.gamma:.3g} on the design model frozen at each of its "
+                    f"{r.scheduled.table_theta.size} table speeds, scheduled on speed (no "
+                    f"bound between them); {stab}")
         if relaxed:
             return (f"H∞ γ = {r.gamma:.3g} on the design model with the spin speed uncertain"
                     f"{relaxed}; {stab}")

@@ -122,6 +122,25 @@ def test_bands_grids_and_unbalance(specs):
     assert specs["turbo"].unbalance_range_hz == (20.0, 300.0)
 
 
+def test_an_hinf_orbit_demand_set_alone_gets_the_derived_roll_off(specs):
+    """H∞ has no orbit demand by default, but its W_f roll-off is derived as μ's: a user
+    who sets only ``design.hinf.orbit_um`` gets H∞ with a force channel rolled off at
+    260 Hz on the test rig (1.3 × its 200 Hz unbalance band), rather than a refusal for
+    the roll-off nobody derived."""
+    tr = specs["testrig"]
+    assert tr.weights["hinf"].orbit_um is None and tr.weights["hinf"].Wf() is None
+    assert tr.weights["hinf"].wf_rolloff_hz == tr.weights["mu"].wf_rolloff_hz == \
+        pytest.approx(260.0)
+    w = design_spec(load_rig(None, ["design.hinf.orbit_um=10"])).weights["hinf"]
+    assert w.orbit_um == 10.0
+    # W_p W_f / D_e = |F_u(Ω)| |B_4| / orbit (ISO 21940-11 law, F_u = m G Ω²/Ω_max), the
+    # 4th-order Butterworth B_4 at 1/√2 at its corner, 260 Hz
+    wr = 2 * math.pi * 260.0
+    force = w.unbalance_mass_kg * w.unbalance_grade_mm_s * 1e-3 * wr**2 / w.max_speed_rad_s
+    got = abs(complex((w.Wp() * w.Wf())(1j * wr))) / w.d_e
+    assert got == pytest.approx(force / math.sqrt(2) / 10e-6, rel=1e-6)
+
+
 def test_unbalance_law_speed_and_place(specs, testrig_cfg):
     """ISO 21940-11 law by default, with Ω_max the test rig's "G2.5 norm at 500 Hz" (P5
     §4.4.1, set in its file), the turboexpander's top of [operating] speed_range_hz (300 Hz),

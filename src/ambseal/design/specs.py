@@ -48,7 +48,10 @@ the value the thesis used on its test facility, P5, where it names one):
   benchmarks/README.md, "Where the design defaults come from"). The orbit demand 0.5 D_e (test rig
   10 µm: the demand adds its force channel to the design, the thesis's 8 µm is met with
   margin, 4.6 µm); W_f rolls off at 1.3× the top of the unbalance band, at most f_b/2
-  (test rig: 1.3 × 200 Hz = 260 Hz, below 557/2 Hz). The other weights are the method's
+  (test rig: 1.3 × 200 Hz = 260 Hz, below 557/2 Hz). H∞ has no orbit demand unless
+  ``[design.hinf] orbit_um`` is set, or it is scheduled on the spin speed
+  (:func:`ambseal.design.recipes.design`, which then demands μ's), and the same W_f roll-off
+  for it. The other weights are the method's
   tuning on the scaled plant (:func:`ambseal.design.weights.default_weights`).
 * **LPV weights** (P3 Eq. 11, §3.3): the same D_e and D_u; W_u a high-pass whose
   low-frequency gain is D_u/(2.5 D_e Kp (1 + 1/ε)) (μ's form, above, before W_K made μ's
@@ -589,13 +592,17 @@ def _weights(d, method: str, mach: Machine, d_e: float, d_u: float, band_hi: flo
         w = replace(w, omega_b=OMEGA_B_TIMES_TI / pid["ti"])
         rules[f"{method}.omega_b_rad_s"] = (f"{OMEGA_B_TIMES_TI:g}/T_i of the reference PID "
                                             "(integral time the PID's, P5 §4.3)")
-    if method == "mu" and d_e is not None:
+    if method in ("hinf", "mu") and d_e is not None:
+        # H∞'s too, though its orbit demand is off by default: a user who sets
+        # design.hinf.orbit_um, and H∞ scheduled on speed (which turns it on), need W_f
         roll = 1.3 * unb_range[1]
         if mach.first_bending_hz is not None:
             roll = min(roll, mach.first_bending_hz / 2)
-        w = replace(w, orbit_um=ORBIT_PER_DE * d_e * 1e6, wf_rolloff_hz=roll)
+        w = replace(w, wf_rolloff_hz=roll)
+        rules[f"{method}.wf_rolloff_hz"] = "1.3× the top of the unbalance band, at most f_b/2"
+    if method == "mu" and d_e is not None:
+        w = replace(w, orbit_um=ORBIT_PER_DE * d_e * 1e6)
         rules["mu.orbit_um"] = f"{ORBIT_PER_DE:g} D_e"
-        rules["mu.wf_rolloff_hz"] = "1.3× the top of the unbalance band, at most f_b/2"
         w = replace(w, gain_factor=GAIN_FACTOR, gain_band_hz=tuple(b * unb_range[1] for b in
                     GAIN_BAND), pid_reference=tuple(pid[k] for k in ("kp", "ti", "td", "eps")))
         rules["mu.gain_factor"] = f"{GAIN_FACTOR:g} (P5 Fig. 10: within 2× the PID's)"

@@ -80,14 +80,34 @@ def test_the_lpv_runs_from_standstill_to_the_top_speed(gyroscopic_run):
     design model, its W_u corner below where that delay lags 45°, and its discrete table
     denser than standstill and top speed, no discretisation at 20 kHz held the flywheel."""
     rig, code, metrics, out = gyroscopic_run
-    assert "lpv" in metrics["controllers"], metrics["failed"]
-    assert "lpv" not in metrics["failed"] and "lpv" not in metrics["cannot_run"]
+    _runs_from_standstill_to_the_top_speed(rig, metrics, out, "lpv")
+
+
+def test_the_flywheel_hinf_scheduled_on_speed_runs_from_standstill_to_the_top_speed(
+        flywheel_run):
+    """H∞, which no fixed design holds over the flywheel's speed range, is delivered
+    scheduled on the spin speed with an unbalance-orbit demand, and its exported table
+    passes the LPV's checks above (python-control's sampled loop at 17 speeds, the
+    sensitivity by dense solves, the orbit inside the backup clearance). Designed on S_o
+    and K S_o alone, its central controllers cancelled the nutation instead of damping it:
+    the loop held, but whirled the rotor by 2.2 mm through it at the trip speed."""
+    _runs_from_standstill_to_the_top_speed(RIG, flywheel_run[1], flywheel_run[2], "hinf")
+    assert "unbalance-orbit demand" in flywheel_run[1]["controllers"]["hinf"]["steps"][-1]
+
+
+def _runs_from_standstill_to_the_top_speed(rig: Path, metrics: dict, out: Path, method: str):
+    """The run's ``method`` controller, scheduled on speed and delivered, holds the rig as
+    exported from standstill to the top speed (the checks of
+    :func:`test_the_lpv_runs_from_standstill_to_the_top_speed`)."""
+    assert method in metrics["controllers"], metrics["failed"]
+    assert method not in metrics["failed"] and method not in metrics["cannot_run"]
     cfg = load_rig(rig)
     top_hz = max(cfg.operating.speed_rpm / 60.0, cfg.operating.speed_range_hz[1])
-    f = np.load(out / "controllers" / "controller_lpv.npz", allow_pickle=False)
+    f = np.load(out / "controllers" / f"controller_{method}.npz", allow_pickle=False)
     Ts, d = float(f["Ts"]), int(f["delay_samples"])
     assert (Ts, d) == (1 / cfg.controller.sample_rate_hz, cfg.controller.delay_samples)
-    rows = [r for r in [*metrics["cases"], *metrics["stability"]] if r["controller"] == "lpv"]
+    rows = [r for r in [*metrics["cases"], *metrics["stability"]]
+            if r["controller"] == method]
     judged = sorted({r["speed_hz"] for r in rows})
     assert judged[0] == 0.0 and judged[-1] == pytest.approx(top_hz)
     # its files say where it was judged: the design speed and the speed range
@@ -116,7 +136,7 @@ def test_the_lpv_runs_from_standstill_to_the_top_speed(gyroscopic_run):
         np.testing.assert_allclose(per_axis, ours, rtol=0.05)
         assert set(row["discrete"]["iso_zone_per_axis"].values()) <= {"A", "A/B", "B"}, row
     backup_um = min(map(cfg.backup_clearance, cfg.amb)) * 1e6
-    for r in (r for r in metrics["cases"] if r["controller"] == "lpv"):
+    for r in (r for r in metrics["cases"] if r["controller"] == method):
         assert r["discrete"]["unbalance_peak_um"] < backup_um, r["discrete"]
 
 
@@ -169,10 +189,9 @@ def test_the_failures_name_the_mode_by_its_kind_and_a_remedy_that_holds(flywheel
     tried and where each try lost the rotor, the design at standstill among them (on a
     design model of whole whirl pairs: the operating speed's count splits a repeated pair
     there). H∞, which no fixed design holds over the range either, ends scheduled on the
-    spin speed, stable at every judged condition, and is refused for what the judge
-    measures instead: its unbalance orbit beyond the backup bearing's clearance."""
+    spin speed and is delivered (above)."""
     code, metrics, _ = flywheel_run
-    assert code == 1  # H∞ and μ not delivered
+    assert code == 1  # μ not delivered
     assert not any("made uncertain over the band" in s
                    for s in metrics["controllers"]["mu"]["steps"])
     last = metrics["controllers"]["mu"]["steps"][-1]
@@ -183,11 +202,8 @@ def test_the_failures_name_the_mode_by_its_kind_and_a_remedy_that_holds(flywheel
     last = metrics["controllers"]["hinf"]["steps"][-1]
     assert last.startswith("hinf: designed as a controller scheduled on the spin speed "
                            "over 0–1000 Hz"), last
-    assert all(c["stable"] for c in metrics["cases"] + metrics["stability"]
-               if c["controller"] == "hinf")
     failed = metrics["failed"]
-    assert re.search(r"worst unbalance orbit, [\d.e+]+ µm, exceeds the backup bearing's "
-                     r"clearance \(250 µm\)", failed["hinf"]["reason"]), failed["hinf"]
+    assert "hinf" not in failed
     # the judged point named with its speed, beside the speed range's conditions
     assert re.search(r"unstable at 0 bar, 1000 Hz \(mode at 22\d\d Hz, ζ = −[\d.]+, bending, "
                      r"(forward|backward) whirl\)", failed["pid"]["reason"]), \

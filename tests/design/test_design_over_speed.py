@@ -275,10 +275,12 @@ def test_hinf_scheduled_on_speed_holds_a_rigid_rotor_no_fixed_design_holds(tmp_p
                                                                         monkeypatch):
     """The disc-like rigid rotor (Ip/It 1.2) with every fixed design over the speed range
     stubbed to hold nothing: the rule ends with H∞ scheduled on the spin speed, whose
-    controller frozen at each speed of :data:`BETWEEN_HZ` — at table entries and between
-    them — holds the loop as it runs (python-control's poles of the sampled, delayed
-    loop on the full-order plant), where the design at the top speed alone loses the rotor
-    at standstill."""
+    controller frozen at each speed of :data:`BETWEEN_HZ` and half way between the judged
+    speeds — at table entries and between them — holds the loop as it runs
+    (python-control's poles of the sampled, delayed loop on the full-order plant), where
+    the design at the top speed alone loses the rotor at standstill. The judged speeds'
+    controllers interpolated alone lose it at 250 Hz: the rule made that speed an entry.
+    Its nutation is damped (ζ > 0.1), not cancelled."""
     import ambseal.design.recipes as recipes
     from ambseal.design.speed_schedule import SpeedScheduledHinf
 
@@ -291,16 +293,57 @@ def test_hinf_scheduled_on_speed_holds_a_rigid_rotor_no_fixed_design_holds(tmp_p
     K = held.controller
     assert isinstance(K, SpeedScheduledHinf) and held.speed_range_hz == (0.0, 400.0)
     table = set(np.round(K.speeds_hz, 6))
-    assert table == set(np.round(design_spec(load_rig(rig)).stability_speeds_hz, 6)) | {400.0}
+    judged = sorted(set(np.round(design_spec(load_rig(rig)).stability_speeds_hz, 6)) | {400.0})
+    added = table - set(judged)
+    assert added == set(held.stopping["hinf"]["added_speeds_hz"])
     assert any(f not in table for f in BETWEEN_HZ)
     cfg = load_rig(rig)
-    assert all(_held_as_it_runs(cfg, K.at(2 * np.pi * f), [f])[0] for f in BETWEEN_HZ)
+    # between the entries and half way between the judged speeds: the linear
+    # interpolation of the judged speeds' controllers alone loses the loop at 250 Hz,
+    # which became an entry
+    halves = [(a + b) / 2 for a, b in zip(judged[:-1], judged[1:])]
+    assert all(_held_as_it_runs(cfg, K.at(2 * np.pi * f), [f])[0]
+               for f in sorted({*BETWEEN_HZ, *halves}))
     assert held.steps[-1].startswith("hinf: designed as a controller scheduled on the spin "
-                                     "speed over 0–400 Hz")
+                                     "speed over 0–400 Hz (the central H∞ controllers with an "
+                                     "unbalance-orbit demand of 10 µm")
+    assert (f"{len(judged)} judged speeds and {len(added)} between them where the "
+            "interpolated loop was lost" in held.steps[-1]) == bool(added)
+    # the nutation (forward, near Ω Ip/It) damped where it runs, not cancelled
+    assert min(_nutation_damping(cfg, K, f) for f in (350.0, 400.0)) > 0.1
     assert held.verdict.startswith(f"H∞ γ = {K.gamma:.3g} on the design model frozen at each "
                                    f"of its {len(table)} table speeds")
     # its frozen controller at the operating speed is the delivered K
     np.testing.assert_array_equal(held.K.A, K.at(2 * np.pi * 400.0).A)
+
+
+def _nutation_damping(cfg, K, speed_hz: float) -> float:
+    """python-control: the least damping ratio of the continuous full-order loop's poles
+    between 0.5 and 3× the spin speed, where the rigid disc's nutation lies (Ω Ip/It)."""
+    pl = build_plant(cfg, speed_rpm=60.0 * speed_hz)
+    cur = pl.current_inputs()
+    Kf = K.at(2 * np.pi * speed_hz)
+    p = control.feedback(control.ss(pl.A, pl.B[:, cur], pl.C, pl.D[:, cur]),
+                         control.ss(Kf.A, Kf.B, Kf.C, Kf.D)).poles()
+    w = 2 * np.pi * speed_hz
+    p = p[(np.abs(p) > 0.5 * w) & (np.abs(p) < 3 * w)]
+    return float(np.min(-p.real / np.abs(p)))
+
+
+def test_hinf_scheduled_on_speed_without_the_orbit_demand_cancels_the_nutation(tmp_path,
+                                                                               monkeypatch):
+    """With ``design.hinf.orbit_um = 0`` (the demand switched off) the schedule is designed
+    as set, on S_o and K S_o alone: its central controllers cancel the nutation rather
+    than damp it (ζ below 0.01 at the top speed, python-control's loop poles), which is
+    why the rule gives the schedule μ's orbit demand."""
+    import ambseal.design.recipes as recipes
+
+    monkeypatch.setattr(recipes, "_held_over_speed", lambda *a, **k: None)
+    monkeypatch.setattr(recipes, "_first_held", lambda *a, **k: None)
+    cfg = load_rig(_rigid_rig(tmp_path, 0.622), ("design.hinf.orbit_um=0",))
+    held = design(cfg, "hinf")
+    assert "orbit demand" not in held.steps[-1]
+    assert _nutation_damping(cfg, held.controller, 400.0) < 0.01
 
 
 def test_ambseal_design_exports_the_hinf_scheduled_on_speed(tmp_path, monkeypatch, capsys):

@@ -69,14 +69,14 @@ from ambseal.design.plant import (
     generalized_plant,
     less_damped,
 )
-from ambseal.design.specs import design_spec, design_states_at
+from ambseal.design.specs import ORBIT_PER_DE, design_spec, design_states_at
 from ambseal.design.speed_lft import whole_pair_states
 from ambseal.design.speed_schedule import schedule_hinf
 from ambseal.design.weights import Weights
 from ambseal.errors import ConfigError, ModelError, SynthesisError
 from ambseal.lti import lft_lower
 from ambseal.lti.freqresp import freqresp
-from ambseal.machine import frozen, judged_loop
+from ambseal.machine import frozen, judged_loop, table_grid
 from ambseal.model import build_plant, build_system, channel_names, poles_near_zero
 from ambseal.robust import (
     LEVEL_FLOOR,
@@ -503,7 +503,8 @@ def design(
     moved = over = lost = None
     if not cfg.design.one_speed:
         scheduled = (None if method != "hinf" or on_sampled_plant(cfg) else
-                     partial(_scheduled_over_speed, cfg, p, w, sp, dl))
+                     partial(_scheduled_over_speed, cfg, p,
+                             w if weights is not None else _with_orbit_demand(w, sp), sp, dl))
         (r, check, n), moved, over, lost = _over_speed(cfg, method, p, sp, (r, check, n),
                                                        synthesise, steps, progress,
                                                        fixed=states is not None,
@@ -675,10 +676,11 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
        that search finds for H∞ (``synthesise(cfg, steps, "hinf")``), where there is one;
     3. else, given ``schedule`` (H∞ on the continuous plant), H∞ scheduled on the spin
        speed (:mod:`ambseal.design.speed_schedule`; ``schedule(range_hz, states,
-       tried)``, :func:`_scheduled_over_speed`), kept where its full-order loop holds every
-       judged condition: the gyroscopic moments are known where the controller runs,
-       and a fixed controller over the range is the simpler one to run, so it is tried
-       first. Measured on the gyroscopic family (benchmarks/README.md, "H∞ scheduled on
+       tried)``, :func:`_scheduled_over_speed`; with μ's orbit demand,
+       :func:`_with_orbit_demand`), kept where its full-order loop holds every judged
+       condition and between its entries: the gyroscopic moments are known where the
+       controller runs, and a fixed controller over the range is the simpler one to run,
+       so it is tried first. Measured on the gyroscopic family (benchmarks/README.md, "H∞ scheduled on
        the spin speed"): with it the run delivers H∞ on 18 of 27 rigs, 9 without;
     4. else ``first``, with a step that names what was tried and how each lost the
        rotor (or why there was no design), so the user sees the range was tried.
@@ -733,10 +735,15 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
     if found is None and schedule is not None:
         held = schedule(rng, n, tried)
         if held is not None:
+            orbit = held[0].stopping["hinf"].get("orbit_um")
+            demand = "" if orbit is None else f" with an unbalance-orbit demand of {orbit:.3g} µm"
+            added = len(held[0].stopping["hinf"]["added_speeds_hz"])
+            table = (f"its {held[0].scheduled.table_theta.size} judged speeds" if not added
+                     else f"its {held[0].scheduled.table_theta.size - added} judged speeds "
+                          f"and {added} between them where the interpolated loop was lost")
             step(f"as a controller scheduled on the spin speed over {rng[0]:g}–{rng[1]:g} Hz "
-                 f"(the central H∞ controllers, at γ {held[0].gamma:.3g}, of the plants "
-                 f"frozen at its {held[0].scheduled.table_theta.size} judged speeds, "
-                 "interpolated linearly), which")
+                 f"(the central H∞ controllers{demand}, at γ {held[0].gamma:.3g}, of the "
+                 f"plants frozen at {table}, interpolated linearly), which")
             return held, None, rng, None
     if found is None:
         steps.append(f"{method}: no design over the speed range held every judged "
@@ -751,33 +758,100 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
     return out, f, None, None
 
 
+def _with_orbit_demand(w: Weights, sp) -> Weights:
+    """H∞'s weights ``w`` with μ's unbalance-orbit demand (ORBIT_PER_DE·D_e and its force
+    channel W_f, :mod:`ambseal.design.specs`) where the user left ``[design.hinf]
+    orbit_um`` unset (0 switches it off): the weights of H∞ scheduled on the spin speed.
+    Weighted on S_o and K S_o alone, the central controllers cancel the forward nutation,
+    which follows the speed: measured on the flywheel example, the schedule held every
+    judged speed with that mode at ζ 0.0008 just above the synchronous line and an orbit
+    of 2.2 mm through it at the trip speed; with the force channel, 36 µm at zone A
+    (benchmarks/README.md, "H∞ scheduled on the spin speed")."""
+    if sp.sources.get("hinf.orbit_um") == "set" or w.wf_rolloff_hz is None or w.d_e is None:
+        return w
+    return replace(w, orbit_um=ORBIT_PER_DE * w.d_e * 1e6)
+
+
 def _scheduled_over_speed(cfg, p: float, w, sp, dl, rng, n: int, tried: list):
     """H∞ scheduled on the spin speed over ``rng`` (Hz) on the n-state design model at
-    ``p`` bar (:func:`~ambseal.design.speed_schedule.schedule_hinf`, its table at the
-    judged speeds), as ``(synthesis, full-order check, n)`` where its full-order loop
-    holds every judged condition, else None with the loss (or why there is no design)
-    appended to ``tried``."""
+    ``p`` bar (:func:`~ambseal.design.speed_schedule.schedule_hinf`), as ``(synthesis,
+    full-order check, n)`` where its full-order loop holds every judged condition and,
+    at each judged pressure, every speed between table entries the target's table will
+    run (:func:`_between_entries_hz`), else None with the loss (or why there is no design)
+    appended to ``tried``.
+
+    The table starts at the judged speeds. A speed between entries whose loop is lost
+    becomes an entry (its plant's central controller, every entry again at the common
+    γ), until every speed between entries holds: the stopping rule. A loss at an entry,
+    or between entries closer than :data:`MIN_TABLE_STEP` of the range, ends it with no
+    design. Measured on the flywheel example: its six judged speeds held, but the
+    interpolated controller half way from standstill to the first judged speed lost the
+    slow precession (|z| 1.0002 as exported)."""
     speeds = sorted({*sp.speeds_hz, *sp.stability_speeds_hz})
+    judged = list(speeds)
     try:
         gp = _generalised(cfg, "hinf", p, w, {}, n, sp, dl, speed=rng)
-        sched = schedule_hinf(gp, speeds)
     except (SynthesisError, ModelError) as exc:
         tried.append(_tried_words("scheduled on the spin speed", error=exc))
         return None
-    check = full_order_check(cfg, sched, [(q, f) for q in sp.pressures_bar for f in speeds])
-    if not check["stable"]:
-        tried.append(_tried_words("scheduled on the spin speed", check))
-        return None
+    while True:
+        try:
+            sched = schedule_hinf(gp, speeds)
+        except (SynthesisError, ModelError) as exc:
+            tried.append(_tried_words("scheduled on the spin speed", error=exc))
+            return None
+        between = _between_entries_hz(speeds)
+        check = full_order_check(cfg, sched, [(q, f) for q in sp.pressures_bar
+                                               for f in sorted({*speeds, *between})])
+        if check["stable"]:
+            break
+        lost = sorted({u["speed_hz"] for u in check["unstable"]})
+        step = MIN_TABLE_STEP * (speeds[-1] - speeds[0])
+        if any(f in speeds or min(abs(f - e) for e in speeds) < step for f in lost):
+            tried.append(_tried_words("scheduled on the spin speed", check))
+            return None
+        speeds = sorted({*speeds, *lost})
     f0 = cfg.operating.speed_rpm / 60.0
+    added = [f for f in speeds if f not in judged]
     r = _Synthesis(sched.at(2 * np.pi * f0), sched.gamma, None, (), sched.order, None, gp,
                    stopping={"hinf": {
-                       "rule": "the central H∞ controller of the plant frozen at each judged "
+                       "rule": "the central H∞ controller of the plant frozen at each table "
                                f"speed, at γ = {sched.backoff:g} × the largest "
-                               "γ_opt (each γ_opt bisected to rtol=1e-06)",
+                               "γ_opt (each γ_opt bisected to rtol=1e-06); a speed between "
+                               "entries whose loop was lost made an entry, until every one "
+                               "held",
                        "table_speeds_hz": [float(f) for f in speeds],
+                       "added_speeds_hz": [float(f) for f in added],
+                       "orbit_um": w.orbit_um,
                        "gamma_opt": [float(g) for g in sched.gamma_opt]}},
                    scheduled=sched)
     return r, check, n
+
+
+#: The closest two entries of H∞'s table on speed may come, as a fraction of its range
+#: (:func:`_scheduled_over_speed`): finer than that, a loss between them is the design's,
+#: not the interpolation's.
+MIN_TABLE_STEP = 1.0 / 64.0
+
+
+def _between_entries_hz(speeds_hz) -> list[float]:
+    """The speeds between the entries of a table on speed at which its loop is judged: the
+    entries the target's discrete table adds (:func:`ambseal.machine.table_grid`) and the
+    midpoints of the discrete table's intervals, none of them an entry.
+
+    Parameters
+    ----------
+    speeds_hz : sequence of float
+        The table's speeds (Hz), increasing, at least two.
+
+    Returns
+    -------
+    list of float
+        Increasing speeds (Hz), strictly between the first and the last entry.
+    """
+    grid = table_grid(np.asarray(speeds_hz, float))
+    mids = (grid[:-1] + grid[1:]) / 2
+    return sorted({float(f) for f in (*grid, *mids)} - {float(f) for f in speeds_hz})
 
 
 def _held_over_speed(cfg, method: str, rng, n: int, synthesise, tried: list,

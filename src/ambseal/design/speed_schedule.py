@@ -17,13 +17,18 @@ controller runs — an AMB controller reads the speed — so the H∞ design is 
   plant frozen at each (:func:`ambseal.design.speed_lft.at_speed`), its central H∞
   controller at one γ (:func:`ambseal.robust.scheduled_hinf.hinf_scheduled`), so every
   judged loop runs a table entry exactly;
-- between entries the controller is interpolated linearly, as the LPV's is; the loop
-  there is judged as it runs (the digital table's checks between entries,
-  :func:`ambseal.app.commands.digital_for`).
+- between entries the controller is interpolated linearly, as the LPV's is; the design
+  rule (:func:`ambseal.design.recipes.design`) checks the full-order loop at every entry
+  the target's discrete table adds and half way along its intervals, and makes a speed
+  whose loop is lost there an entry of its own; the run judges it between entries as it
+  runs too (:func:`ambseal.app.commands.digital_for`);
+- the weights are the H∞ recipe's with μ's unbalance-orbit demand (its force channel):
+  on S_o and K S_o alone the central controllers cancel the nutation, which follows the
+  speed, rather than damp it.
 
 Unlike the LPV (P3), no LMI certifies the loop between the table's speeds or while the
 speed changes: the design is kept only where the full-order loop holds at every judged
-condition, and judged between entries as it runs.
+condition and at those speeds between entries.
 """
 
 from __future__ import annotations

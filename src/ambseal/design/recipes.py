@@ -681,7 +681,7 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
        condition and between its entries: the gyroscopic moments are known where the
        controller runs, and a fixed controller over the range is the simpler one to run,
        so it is tried first. Measured on the gyroscopic family (benchmarks/README.md, "H∞
-       scheduled on the spin speed"): with it the run delivers H∞ on 18 of 27 rigs, 9
+       scheduled on the spin speed"): with it the run delivers H∞ on 22 of 27 rigs, 9
        without;
     4. else ``first``, with a step that names what was tried and how each lost the
        rotor (or why there was no design), so the user sees the range was tried.

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ambseal.analysis import (
+    ZONE_SCALE,
     FailedController,
     JudgeSettings,
     OperatingPoint,
@@ -72,7 +73,12 @@ from ambseal.app.metrics import (
     RunMetrics,
     Signoff,
 )
-from ambseal.app.remedies import on_the_sampled_plant, remedy
+from ambseal.app.remedies import (
+    on_the_sampled_plant,
+    remedy,
+    scheduled_on_speed,
+    worst_zone_as_runs,
+)
 from ambseal.app.tracked import tracked_designs, tracked_ramp
 from ambseal.config import (
     RigConfig,
@@ -392,6 +398,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
         stability = _speed_range(st.designs, st.digitals, spec, points, st.design_cfg,
                                  st.judge_cfg, stages, st.failed, allow_unstable)
         stability = _sampled_remedies(st, stability)
+        stability = _scheduled_remedies(st, stability)
         _note_speed_lpv(st)
         metrics = _deliver_and_report(st, model, stability, rig_path, truth, command)
     exit_status = EXIT_FAILED if any(f.designed and not (allow_unstable and f.judged)
@@ -604,13 +611,53 @@ def _sampled_remedies(st: _RunState, stability: list) -> list:
             continue
         st.failed.pop(m, None)
         st.cannot_run.pop(m, None)
-        st.designs = [fixed.design if d.method == m else d for d in st.designs]
-        st.digitals[m] = fixed.digital
-        new = iter(zip(fixed.jobs, fixed.judged))
-        st.jobs, st.judged = map(list, zip(*[next(new) if j.name == m else (j, r)
-                                             for j, r in zip(st.jobs, st.judged)]))
-        stability = [c for c in stability if c.controller != m] + cases
+        stability = _replaced(st, fixed, stability, cases)
     return stability
+
+
+def _scheduled_remedies(st: _RunState, stability: list) -> list:
+    """An H∞ over the speed range (on the continuous plant, or its redesign on the sampled
+    plant, :func:`_sampled_remedies`) whose loops all hold but whose worst ISO 14839-3
+    grade as it runs is beyond zone B, designed again scheduled on the spin speed
+    (:func:`ambseal.app.remedies.scheduled_on_speed`): where that design holds at a
+    better grade, it replaces the first, its cases theirs; else the first stays and its
+    notes say what was tried. Returns the stability cases."""
+    cfg = st.design_cfg
+    if speed_scheduled(st.cfg) or on_sampled_plant(cfg) or cfg.design.one_speed \
+            or cfg.operating.speed_range_hz is None:
+        return stability
+    for d in [d for d in st.designs if d.method == "hinf"]:
+        m = d.method
+        if m in st.failed or m in st.cannot_run or d.result.scheduled is not None:
+            continue
+        zone = worst_zone_as_runs([c for c, _ in _judged_of(m, st.jobs, st.judged)]
+                                  + [c for c in stability if c.controller == m])
+        if zone is None or ZONE_SCALE.index(zone) <= ZONE_SCALE.index("B"):
+            continue
+        st.stages.begin("scheduled-redesign", "H∞ beyond zone B over the speed range")
+        fixed, cases, tried = scheduled_on_speed(
+            m, zone, cfg, st.spec, st.points, lambda ds, digs: _judge_designs(st, ds, digs, 0),
+            lambda ds, digs: _stability_cases(ds, digs, st.spec, st.points, cfg,
+                                              st.judge_cfg, lambda job: None)[1],
+            lambda line: st.say(line, 0))
+        if fixed is None:
+            d.summary["notes"] = [*d.summary.get("notes", []), f"Tried: {tried}"]
+            continue
+        stability = _replaced(st, fixed, stability, cases)
+    return stability
+
+
+def _replaced(st: _RunState, fixed, stability: list, cases: list) -> list:
+    """A remedied design (:class:`ambseal.app.remedies.Remedied`) in place of its method's
+    first: its design, digital controller and judged cases in ``st``; returns the
+    stability cases with ``cases`` in place of the first's."""
+    m = fixed.design.method
+    st.designs = [fixed.design if d.method == m else d for d in st.designs]
+    st.digitals[m] = fixed.digital
+    new = iter(zip(fixed.jobs, fixed.judged))
+    st.jobs, st.judged = map(list, zip(*[next(new) if j.name == m else (j, r)
+                                         for j, r in zip(st.jobs, st.judged)]))
+    return [c for c in stability if c.controller != m] + cases
 
 
 def _note_speed_lpv(st: _RunState) -> None:

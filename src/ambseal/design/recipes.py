@@ -391,6 +391,7 @@ def design(
     progress: Any = None,
     enlarge: int = 2,
     trials: dict | None = None,
+    scheduled_on_speed: bool = False,
 ) -> DesignResult:
     """Design a controller for a rig (thesis P5 §4).
 
@@ -442,6 +443,12 @@ def design(
         the same one takes it from there instead of designing it again — μ tries H∞'s,
         which H∞'s own design has just made. The same result either way; None: nothing
         kept.
+    scheduled_on_speed : bool
+        H∞ only: designed scheduled on the spin speed over the judged speeds
+        (:func:`_scheduled_over_speed`) without trying a fixed design over the speed range
+        first — the run's remedy where a fixed design holds the loop but not its ISO
+        14839-3 zone as it runs (:mod:`ambseal.app.remedies`). Needs ``[operating]
+        speed_range_hz`` and the continuous synthesis plant.
 
     Returns
     -------
@@ -451,7 +458,8 @@ def design(
     ------
     ConfigError
         Unknown method, bad weights or uncertainty ranges, ``reduce_to`` not an int,
-        ``"pid"`` on a rig without ``[controller.pid]``.
+        ``"pid"`` on a rig without ``[controller.pid]``, ``scheduled_on_speed`` for another
+        method than H∞, on a rig without a speed range or on the sampled synthesis plant.
     SynthesisError
         If synthesis fails, the reduced controller no longer stabilises the design loop, or
         the full-order loop is unstable at a judged condition (naming the mode, its
@@ -469,6 +477,10 @@ def design(
         raise ConfigError(f"design: method={method!r}, expected one of "
                           f"{method_names(fixed=True)}")
     p = float(cfg.operating.pressure_bar if pressure_bar is None else pressure_bar)
+    if scheduled_on_speed and (method != "hinf" or cfg.operating.speed_range_hz is None
+                               or on_sampled_plant(cfg)):
+        raise ConfigError("design: scheduled_on_speed is for H∞ on the continuous synthesis "
+                          "plant of a rig with [operating] speed_range_hz")
     if method == "pid":
         return _pid(cfg, p)
     if isinstance(reduce_to, str) and reduce_to != "auto":
@@ -501,14 +513,15 @@ def design(
 
     r, check, n = synthesise(cfg, steps)
     moved = over = lost = None
-    if not cfg.design.one_speed:
+    if not cfg.design.one_speed or scheduled_on_speed:
         scheduled = (None if method != "hinf" or on_sampled_plant(cfg) else
                      partial(_scheduled_over_speed, cfg, p,
                              w if weights is not None else _with_orbit_demand(w, sp), sp, dl))
         (r, check, n), moved, over, lost = _over_speed(cfg, method, p, sp, (r, check, n),
                                                        synthesise, steps, progress,
                                                        fixed=states is not None,
-                                                       schedule=scheduled)
+                                                       schedule=scheduled,
+                                                       schedule_only=scheduled_on_speed)
     if not check["stable"] and not allow_unstable:
         raise SynthesisError(_unstable_message(method, check, n, steps, _top_mode_hz(cfg, p, n),
                                                lost or _lost_by(cfg, r.K, check, p),
@@ -650,7 +663,7 @@ def _synthesise_enlarging(cfg, method, p, w, unc, sp, states, om, reduce_to, max
 
 
 def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
-                progress, fixed: bool = False, schedule=None):
+                progress, fixed: bool = False, schedule=None, schedule_only: bool = False):
     """The design over the speed range: where ``first`` (synthesis, full-order check,
     states), designed at the operating speed and pressure ``p`` (bar), loses the rotor at
     another judged speed, and the speed is what loses it (:func:`_lost_by`: at ``p`` that
@@ -695,17 +708,29 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
     speed; the design with the speed uncertain holds both on rotors whose gyroscopic
     coupling a fixed controller can span (tests/data/gyro_wheel_rig.toml, Ip/It 0.54:
     H∞ γ 2.1, μ 0.79), where the frozen search can only find a speed in between.
-    ``[design] one_speed`` turns it off."""
+    ``[design] one_speed`` turns it off. ``schedule_only`` goes to 3 directly, whatever
+    ``first`` held, and raises :class:`SynthesisError` where the schedule holds nothing."""
     r, check, n = first
     f0 = cfg.operating.speed_rpm / 60.0
+    judged = sorted({*sp.speeds_hz, *sp.stability_speeds_hz})
+    rng = (judged[0], judged[-1])
+    if schedule_only:
+        tried: list[str] = []
+        held = schedule(rng, n, tried)
+        if held is None:
+            raise SynthesisError(f"{method}: not scheduled on the spin speed: "
+                                 + "; ".join(tried))
+        steps.append(f"{method}: designed {_schedule_words(held[0], rng)} holds every "
+                     "judged condition (asked for without a fixed design over the range)")
+        if progress:
+            progress(steps[-1])
+        return held, None, rng, None
     if check["stable"] or cfg.operating.speed_range_hz is None \
             or abs(check["speed_hz"] - f0) <= 1e-9 * max(f0, 1.0):
         return first, None, None, None
     lost_by = _lost_by(cfg, r.K, check, p)
     if not lost_by[1]:
         return first, None, None, lost_by
-    judged = sorted({*sp.speeds_hz, *sp.stability_speeds_hz})
-    rng = (judged[0], judged[-1])
     lost = (f"the design at the operating speed ({f0:g} Hz) lost the rotor at "
             f"{check['speed_hz']:g} Hz (mode at {check['mode_hz']:.4g} Hz, ζ = "
             f"{check['damping']:.3g})")
@@ -736,15 +761,7 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
     if found is None and schedule is not None:
         held = schedule(rng, n, tried)
         if held is not None:
-            orbit = held[0].stopping["hinf"].get("orbit_um")
-            demand = "" if orbit is None else f" with an unbalance-orbit demand of {orbit:.3g} µm"
-            added = len(held[0].stopping["hinf"]["added_speeds_hz"])
-            table = (f"its {held[0].scheduled.table_theta.size} judged speeds" if not added
-                     else f"its {held[0].scheduled.table_theta.size - added} judged speeds "
-                          f"and {added} between them where the interpolated loop was lost")
-            step(f"as a controller scheduled on the spin speed over {rng[0]:g}–{rng[1]:g} Hz "
-                 f"(the central H∞ controllers{demand}, at γ {held[0].gamma:.3g}, of the "
-                 f"plants frozen at {table}, interpolated linearly), which")
+            step(f"{_schedule_words(held[0], rng)}, which")
             return held, None, rng, None
     if found is None:
         steps.append(f"{method}: no design over the speed range held every judged "
@@ -757,6 +774,19 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
     step(f"at {f:g} Hz, the first stability speed from standstill whose "
          f"{'H∞ ' if method != 'hinf' else ''}design")
     return out, f, None, None
+
+
+def _schedule_words(r: _Synthesis, rng) -> str:
+    """H∞ scheduled on the spin speed over ``rng`` (Hz), in the words of a design step."""
+    orbit = r.stopping["hinf"].get("orbit_um")
+    demand = "" if orbit is None else f" with an unbalance-orbit demand of {orbit:.3g} µm"
+    added = len(r.stopping["hinf"]["added_speeds_hz"])
+    table = (f"its {r.scheduled.table_theta.size} judged speeds" if not added
+             else f"its {r.scheduled.table_theta.size - added} judged speeds and {added} "
+                  "between them where the interpolated loop was lost")
+    return (f"as a controller scheduled on the spin speed over {rng[0]:g}–{rng[1]:g} Hz "
+            f"(the central H∞ controllers{demand}, at γ {r.gamma:.3g}, of the plants frozen "
+            f"at {table}, interpolated linearly)")
 
 
 def _with_orbit_demand(w: Weights, sp) -> Weights:

@@ -6,7 +6,7 @@ import pytest
 from ambseal.analysis.delivery import FailedController
 from ambseal.analysis.judge import JudgeJob, operating_points
 from ambseal.analysis.speed_range import SampledStability, StabilityCase
-from ambseal.app.remedies import Remedied, remedy, worst_case
+from ambseal.app.remedies import Remedied, remedy, worst_case, worst_zone_as_runs
 from ambseal.config import load_rig
 from ambseal.design.specs import design_spec
 
@@ -26,6 +26,24 @@ def test_worst_case_is_the_least_stable_failing_condition():
     assert worst_case([ok, za, zb]) is zb
     with pytest.raises(ValueError):
         worst_case([ok])
+
+
+def test_the_zone_as_it_runs_is_the_worst_axis_of_the_loop_that_runs():
+    """ISO 14839-3 grades each control axis: a loop whose σ̄(S_o) over all axes is 5.8
+    (coupled axes, family seed 17's sampled-plant H∞) but 2.1 on its worst axis is zone
+    A; the sampled loop, where judged, is the one graded, not the continuous one."""
+    def run(peak, axes):
+        return SampledStability(True, 0.99, 1e4, peak, dict.fromkeys(axes, 2.1),
+                                "D" if peak >= 5 else "A", axes)
+    coupled = run(5.8, {"A_zeta": "A", "B_eta": "A"})
+    assert worst_zone_as_runs([_case(0.0, True, -1.0, coupled)]) == "A"
+    lost = StabilityCase("hinf", "", 0.0, 0.0, True, -1.0, run(4.2, {"A_zeta": "A",
+                                                                      "B_eta": "C"}),
+                         2.1, None, "A", {"A_zeta": "A", "B_eta": "A"})
+    assert worst_zone_as_runs([_case(0.0, True, -1.0, coupled), lost]) == "C"
+    # without per-axis grades, the grade of the whole loop
+    assert worst_zone_as_runs([_case(0.0, True, -1.0, run(5.8, {}))]) == "D"
+    assert worst_zone_as_runs([]) is None
 
 
 def test_a_design_that_holds_after_the_first_remedy_replaces_the_failed_one():

@@ -377,33 +377,16 @@ def test_ambseal_design_exports_the_hinf_scheduled_on_speed(tmp_path, monkeypatc
     assert np.abs(top(z) - ref(z)).max() > 1e-3 * np.abs(ref(z)).max()
 
 
-@pytest.mark.heavy
-def test_a_fixed_hinf_beyond_zone_b_as_it_runs_is_scheduled_on_speed(tmp_path):
-    """The rigid rotor of Ip/It 0.79 sampled at 10 kHz: H∞ with the spin speed uncertain
-    holds its loops from standstill to 400 Hz at a few percent of the performance weights,
-    but reaches ISO 14839-3 zone D as it runs. ``ambseal run`` designs it again scheduled
-    on the spin speed, which replaces it: the exported table holds the full-order plant
-    sampled by python-control from standstill to the top speed at zone B or better
-    (:func:`tests.exported_files.runs_from_standstill_to_the_top_speed`). The direct route
-    is H∞'s alone."""
-    import json
-
-    from ambseal.cli import main
+def test_only_hinf_on_the_continuous_plant_of_a_speed_range_is_asked_for_scheduled(tmp_path):
+    """The direct route to the schedule (the run's remedy for a fixed H∞ beyond zone B as
+    it runs, tests/test_rejection_through_critical.py) is H∞'s alone, on a rig with a
+    speed range and the continuous synthesis plant."""
     from ambseal.errors import ConfigError
 
-    from ..exported_files import runs_from_standstill_to_the_top_speed
-
-    rig = _rigid_rig(tmp_path, 0.4)
-    rig.write_text(rig.read_text().replace("sample_rate_hz = 20000.0",
-                                           "sample_rate_hz = 10000.0"))
-    out = tmp_path / "out"
-    main(["--quiet", "run", str(rig), "--no-identify", "--out", str(out)])
-    metrics = json.loads((out / "metrics.json").read_text())
-    h = metrics["controllers"]["hinf"]
-    assert h["remedy"] == ("designed scheduled on the spin speed: the fixed design over the "
-                           "speed range reaches ISO 14839-3 zone D as it runs")
-    assert h["steps"][-1].endswith("holds every judged condition (asked for without a fixed "
-                                   "design over the range)")
-    runs_from_standstill_to_the_top_speed(rig, metrics, out, "hinf")
+    cfg = load_rig(_rigid_rig(tmp_path, 0.4))
     with pytest.raises(ConfigError, match="scheduled_on_speed"):
-        design(load_rig(rig), "mu", scheduled_on_speed=True)
+        design(cfg, "mu", scheduled_on_speed=True)
+    sampled = cfg.model_copy(update={"design": cfg.design.model_copy(
+        update={"synthesis_plant": "sampled"})})
+    with pytest.raises(ConfigError, match="scheduled_on_speed"):
+        design(sampled, "hinf", scheduled_on_speed=True)

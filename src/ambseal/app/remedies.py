@@ -241,8 +241,14 @@ def on_the_sampled_plant(method: str, why: str, design_cfg, spec, points, judge:
 
 
 def worst_zone_as_runs(cases) -> str | None:
-    """The worst ISO 14839-3 grade of judged cases, each as it runs where it was judged so
-    (its ``discrete`` loop), else as judged in continuous time.
+    """The worst ISO 14839-3 grade on any axis of judged cases, each as it runs where it
+    was judged so (its ``discrete`` loop), else as judged in continuous time.
+
+    ISO 14839-3:2006 grades the sensitivity function of each control axis
+    (:mod:`ambseal.analysis.iso`), as the run's delivery does; the thesis's σ̄(S_o) over
+    all axes together (P5 §4.1 item 4), stricter where the axes couple, stands in only for
+    a case judged without per-axis grades. On family seed 17 the design on the sampled
+    plant is zone A on every axis while σ̄(S_o) is 5.8: a redesign is not called for.
 
     Parameters
     ----------
@@ -255,7 +261,9 @@ def worst_zone_as_runs(cases) -> str | None:
     str or None
         A name of :data:`ambseal.analysis.ZONE_SCALE`; None where no case has a grade.
     """
-    return worst_zone((c.discrete if c.discrete is not None else c).iso_zone for c in cases)
+    loops = [c.discrete if c.discrete is not None else c for c in cases]
+    return worst_zone(z for c in loops
+                      for z in ((c.iso_zone_per_axis or {}).values() or [c.iso_zone]))
 
 
 def scheduled_on_speed(method: str, zone: str, design_cfg, spec, points, judge: Callable,

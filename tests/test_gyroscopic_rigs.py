@@ -58,7 +58,7 @@ def gyroscopic_run(request, tmp_path_factory):
     return EXAMPLES / f"{request.param}.toml", *request.getfixturevalue(fixture[request.param])
 
 
-def test_the_lpvruns_from_standstill_to_the_top_speed(gyroscopic_run):
+def test_the_lpv_runs_from_standstill_to_the_top_speed(gyroscopic_run):
     """The LPV on speed is delivered and, as exported (discrete table at the rig's sample
     rate, one sample of delay), holds the full-order plant sampled by python-control
     (zero-order hold) at 17 speeds from standstill to the top speed, on and between its
@@ -72,7 +72,7 @@ def test_the_lpvruns_from_standstill_to_the_top_speed(gyroscopic_run):
     runs_from_standstill_to_the_top_speed(rig, metrics, out, "lpv")
 
 
-def test_the_flywheel_hinf_scheduled_on_speedruns_from_standstill_to_the_top_speed(
+def test_the_flywheel_hinf_scheduled_on_speed_runs_from_standstill_to_the_top_speed(
         flywheel_run):
     """H∞, which no fixed design holds over the flywheel's speed range, is delivered
     scheduled on the spin speed with an unbalance-orbit demand, and its exported table

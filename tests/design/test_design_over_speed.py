@@ -317,6 +317,38 @@ def test_hinf_scheduled_on_speed_holds_a_rigid_rotor_no_fixed_design_holds(tmp_p
     np.testing.assert_array_equal(held.K.A, K.at(2 * np.pi * 400.0).A)
 
 
+def test_mu_scheduled_on_speed_is_the_k_step_on_each_frozen_plant(tmp_path):
+    """μ asked for scheduled on the spin speed on the disc-like rigid rotor (Ip/It 1.2, no
+    seal: the spin speed is its only uncertainty, so the frozen structure is the
+    performance block alone and each entry's μ is the H∞ norm of its frozen loop). Each
+    entry's reported μ is that norm by slycot AB13DD (python-control ``norm``), the
+    design's μ the largest; the controller frozen at each speed of :data:`BETWEEN_HZ`
+    and half way between the table's speeds holds the loop as it runs (python-control's
+    poles of the sampled, delayed loop on the full-order plant)."""
+    from ambseal.design.speed_lft import at_speed
+
+    cfg = load_rig(_rigid_rig(tmp_path, 0.622))
+    held = design(cfg, "mu", scheduled_on_speed=True)
+    K, stop = held.controller, held.stopping["mu"]
+    assert held.speed_range_hz == (0.0, 400.0) and stop["d_scales"] == 0
+    assert len(held.plant.blocks) == 2  # the speed's, then the performance block
+    for th, mu in zip(K.table_theta, stop["mu_by_speed"]):
+        Kf = control.ss(*K.K.matrices(float(th)))
+        norm = control.norm(at_speed(held.plant, th).lft(Kf, 4, 4), p="inf")
+        assert norm * (1 - 1e-2) <= mu <= norm * (1 + 1e-3), (th, mu, norm)
+    assert held.mu == max(stop["mu_by_speed"]) < 1
+    speeds = list(K.speeds_hz)
+    halves = [(a + b) / 2 for a, b in zip(speeds[:-1], speeds[1:])]
+    assert all(_held_as_it_runs(cfg, K.at(2 * np.pi * f), [f])[0]
+               for f in sorted({*BETWEEN_HZ, *halves}))
+    assert held.steps[-1].startswith("mu: designed as a controller scheduled on the spin "
+                                     "speed over 0–400 Hz (the central H∞ controllers of μ's "
+                                     "weights with an unbalance-orbit demand of")
+    assert held.verdict.startswith(f"robust performance met: μ = {held.mu:.3g} ≤ 1 on the "
+                                   f"design model frozen at each of its {len(speeds)} table "
+                                   "speeds, scheduled on speed")
+
+
 def _nutation_damping(cfg, K, speed_hz: float) -> float:
     """python-control: the least damping ratio of the continuous full-order loop's poles
     between 0.5 and 3× the spin speed, where the rigid disc's nutation lies (Ω Ip/It)."""
@@ -377,15 +409,15 @@ def test_ambseal_design_exports_the_hinf_scheduled_on_speed(tmp_path, monkeypatc
     assert np.abs(top(z) - ref(z)).max() > 1e-3 * np.abs(ref(z)).max()
 
 
-def test_only_hinf_on_the_continuous_plant_of_a_speed_range_is_asked_for_scheduled(tmp_path):
+def test_only_hinf_and_mu_on_the_continuous_plant_are_asked_for_scheduled(tmp_path):
     """The direct route to the schedule (the run's remedy for a fixed H∞ beyond zone B as
-    it runs, tests/test_rejection_through_critical.py) is H∞'s alone, on a rig with a
-    speed range and the continuous synthesis plant."""
+    it runs, tests/test_rejection_through_critical.py) is for the synthesised methods on
+    a rig with a speed range and the continuous synthesis plant."""
     from ambseal.errors import ConfigError
 
     cfg = load_rig(_rigid_rig(tmp_path, 0.4))
     with pytest.raises(ConfigError, match="scheduled_on_speed"):
-        design(cfg, "mu", scheduled_on_speed=True)
+        design(cfg, "pid", scheduled_on_speed=True)
     sampled = cfg.model_copy(update={"design": cfg.design.model_copy(
         update={"synthesis_plant": "sampled"})})
     with pytest.raises(ConfigError, match="scheduled_on_speed"):

@@ -111,3 +111,37 @@ def test_the_speed_range_model_keeps_each_whirl_pair_whole():
     assert whole_pair_states(cfg, 18, pressure_bar=0.0) == 16
     assert whole_pair_states(cfg, 16, pressure_bar=0.0) == 16
     assert whole_pair_states(cfg, 20, pressure_bar=0.0) == 20
+
+
+def test_the_speed_is_frozen_wherever_its_channels_lie():
+    """:func:`at_speed` on a plant whose spin speed is its second LFT parameter (μ's plant:
+    a seal coefficient first). Reference: the upper LFT ``P_oo + P_os δ (I − δ P_ss)⁻¹ P_so``
+    of the plant's own frequency response (python-control, dense), at δ the speed's
+    normalised value; the other parameter's channels stay, with their names."""
+    from types import SimpleNamespace
+
+    import control
+
+    from ambseal.design.plant import UncertainParameter
+    from ambseal.design.speed_lft import at_speed
+
+    rng = np.random.default_rng(3)
+    n, seal, spin, rest = 6, 2, 3, 2
+    A = rng.standard_normal((n, n)) - 4 * n * np.eye(n)
+    m = seal + spin + rest
+    P = control.ss(A, rng.standard_normal((n, m)), rng.standard_normal((m, n)),
+                   0.3 * rng.standard_normal((m, m)),
+                   inputs=[f"w{i}" for i in range(m)], outputs=[f"z{i}" for i in range(m)])
+    params = [UncertainParameter("seal.k", 1.0, 0.5, 1.5, seal),
+              UncertainParameter(SPEED, 100.0, 0.0, 400.0, spin)]
+    frozen = at_speed(SimpleNamespace(P=P, parameters=params), 300.0)
+    d = params[1].delta(300.0)
+    s_, o_ = np.arange(seal, seal + spin), np.r_[np.arange(seal), np.arange(seal + spin, m)]
+    assert frozen.input_labels == [f"w{i}" for i in o_]
+    for s in (0.5j, 3.0 + 40j, 700j):
+        G = P(s)
+        ref = G[np.ix_(o_, o_)] + G[np.ix_(o_, s_)] @ (
+            d * np.linalg.solve(np.eye(spin) - d * G[np.ix_(s_, s_)], G[np.ix_(s_, o_)]))
+        np.testing.assert_allclose(frozen(s), ref, rtol=1e-9, atol=1e-12)
+    with pytest.raises(ModelError, match="outside the speed range"):
+        at_speed(SimpleNamespace(P=P, parameters=params), 500.0)

@@ -19,7 +19,13 @@ from ambseal.robust._dscale import (
     _tf_to_theta,
     _theta_to_tf,
 )
-from ambseal.robust.dk import fit_dscale, fit_magnitude, musyn
+from ambseal.robust.dk import (
+    dscaled_plant,
+    fit_dscale,
+    fit_magnitude,
+    musyn,
+    result_scalings,
+)
 from ambseal.robust.hinf import hinfsyn, lft_lower
 from ambseal.robust.mu import mussv
 
@@ -142,7 +148,13 @@ def _mu_ab13md(cl, omega, sizes=(1, 1), pad_cols=0):
     return max(ab13md(np.asfortranarray(Hk), nb, np.full(nb.size, 2))[0] for Hk in H)
 
 
-def test_dk_improves_on_hinf_and_records_history():
+@pytest.fixture(scope="module")
+def rp_musyn():
+    """D–K on :func:`rp_plant` (second-order fits, three iterations), shared."""
+    return musyn(rp_plant(), [(1, 1), (1, 1)], 1, 1, order=2, max_iter=3)
+
+
+def test_dk_improves_on_hinf_and_records_history(rp_musyn):
     """Reference: μ ≤ σ̄ with D = I (Packard & Doyle 1993), so D–K can only improve on the H∞
     γ of the unscaled problem; for this two-block problem μ = inf_D σ̄(DMD⁻¹) and D–K from
     γ ≈ 1.17 gets below 0.85 of it. The reported μ's (final and first iteration) are checked
@@ -151,7 +163,7 @@ def test_dk_improves_on_hinf_and_records_history():
     P = rp_plant()
     blocks = [(1, 1), (1, 1)]
     h = hinfsyn(P, 1, 1)
-    r = musyn(P, blocks, 1, 1, order=2, max_iter=3)
+    r = rp_musyn
     h0 = hinfsyn(in_units(P, 1 / r.stopping["start"]["scales"][0]), 1, 1)
     assert r.mu <= h.gamma * (1 + 1e-3)
     assert r.mu < 0.85 * h.gamma
@@ -211,6 +223,29 @@ def test_one_iteration_returns_hinfsyn_and_says_why_it_stopped():
     assert 0 < r.stopping["start"]["evaluations"] <= 20
     assert r.stopping["dk"] == {"iterations": 1, "rule": "max_iter=1"}
     assert r.stopping["search"]["granted"] == 0 and r.stopping["search"]["evaluations"] == 0
+
+
+def test_the_d_scaled_plant_is_the_plant_of_the_kept_controllers_k_step(rp_musyn):
+    """:func:`dscaled_plant` with a result's D scales (:func:`result_scalings`) is the
+    plant its controller's K-step was made on, in the user's units. With one iteration
+    (no fit yet) that is the start's constant D: the same frequency response as
+    ``in_units`` gives. After fitted scales, the kept controller's closed loop on it has
+    the H∞ norm D–K reports (slycot AB13DD through python-control's ``norm``)."""
+    from dataclasses import replace
+
+    P = rp_plant()
+    blocks = [(1, 1), (1, 1)]
+    r = rp_musyn
+    (b,) = r.stopping["start"]["scales"]
+    first = replace(r, scalings=())  # kept at the first iteration: the start's D
+    S, ref = dscaled_plant(P, blocks, result_scalings(first), 1, 1), in_units(P, 1 / b)
+    for s in 1j * np.logspace(-3, 2, 7):
+        np.testing.assert_allclose(S(s), ref(s), rtol=1e-10, atol=1e-12)
+    assert r.scalings and r.best_iteration > 0
+    cl = dscaled_plant(P, blocks, result_scalings(r), 1, 1).lft(r.K, 1, 1)
+    assert ct.norm(cl, p="inf") == pytest.approx(r.gamma, rel=1e-3)
+    with pytest.raises(ValueError, match="D scales"):
+        dscaled_plant(P, blocks, (), 1, 1)
 
 
 def test_scaled_hinf_is_musyns_first_k_step_without_its_mu_analysis(monkeypatch):

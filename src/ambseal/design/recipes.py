@@ -70,8 +70,8 @@ from ambseal.design.plant import (
     less_damped,
 )
 from ambseal.design.specs import ORBIT_PER_DE, design_spec, design_states_at
-from ambseal.design.speed_lft import whole_pair_states
-from ambseal.design.speed_schedule import schedule_hinf
+from ambseal.design.speed_lft import at_speed, whole_pair_states
+from ambseal.design.speed_schedule import frozen_structure, mu_by_speed, schedule_hinf
 from ambseal.design.weights import Weights
 from ambseal.errors import ConfigError, ModelError, SynthesisError
 from ambseal.lti import lft_lower
@@ -90,6 +90,7 @@ from ambseal.robust import (
     musyn_dgk,
     performance_level,
     reduce_controller,
+    result_scalings,
     scaled_hinfsyn,
     scaled_performance,
     unstable_poles,
@@ -444,10 +445,10 @@ def design(
         which H∞'s own design has just made. The same result either way; None: nothing
         kept.
     scheduled_on_speed : bool
-        H∞ only: designed scheduled on the spin speed over the judged speeds
+        H∞ or μ: designed scheduled on the spin speed over the judged speeds
         (:func:`_scheduled_over_speed`) without trying a fixed design over the speed range
-        first — the run's remedy where a fixed design holds the loop but not its ISO
-        14839-3 zone as it runs (:mod:`ambseal.app.remedies`). Needs ``[operating]
+        first — the run's remedy where a fixed H∞ holds the loop but not its ISO 14839-3
+        zone as it runs (:mod:`ambseal.app.remedies`). Needs ``[operating]
         speed_range_hz`` and the continuous synthesis plant.
 
     Returns
@@ -458,8 +459,8 @@ def design(
     ------
     ConfigError
         Unknown method, bad weights or uncertainty ranges, ``reduce_to`` not an int,
-        ``"pid"`` on a rig without ``[controller.pid]``, ``scheduled_on_speed`` for another
-        method than H∞, on a rig without a speed range or on the sampled synthesis plant.
+        ``"pid"`` on a rig without ``[controller.pid]``, ``scheduled_on_speed`` for the
+        PID, on a rig without a speed range or on the sampled synthesis plant.
     SynthesisError
         If synthesis fails, the reduced controller no longer stabilises the design loop, or
         the full-order loop is unstable at a judged condition (naming the mode, its
@@ -477,10 +478,10 @@ def design(
         raise ConfigError(f"design: method={method!r}, expected one of "
                           f"{method_names(fixed=True)}")
     p = float(cfg.operating.pressure_bar if pressure_bar is None else pressure_bar)
-    if scheduled_on_speed and (method != "hinf" or cfg.operating.speed_range_hz is None
+    if scheduled_on_speed and (method == "pid" or cfg.operating.speed_range_hz is None
                                or on_sampled_plant(cfg)):
-        raise ConfigError("design: scheduled_on_speed is for H∞ on the continuous synthesis "
-                          "plant of a rig with [operating] speed_range_hz")
+        raise ConfigError("design: scheduled_on_speed is for H∞ and μ on the continuous "
+                          "synthesis plant of a rig with [operating] speed_range_hz")
     if method == "pid":
         return _pid(cfg, p)
     if isinstance(reduce_to, str) and reduce_to != "auto":
@@ -514,9 +515,10 @@ def design(
     r, check, n = synthesise(cfg, steps)
     moved = over = lost = None
     if not cfg.design.one_speed or scheduled_on_speed:
-        scheduled = (None if method != "hinf" or on_sampled_plant(cfg) else
-                     partial(_scheduled_over_speed, cfg, p,
-                             w if weights is not None else _with_orbit_demand(w, sp), sp, dl))
+        scheduled = (None if method == "pid" or on_sampled_plant(cfg) else
+                     partial(_scheduled_over_speed, cfg, method, p,
+                             w if weights is not None or method != "hinf"
+                             else _with_orbit_demand(w, sp), unc, sp, dl))
         (r, check, n), moved, over, lost = _over_speed(cfg, method, p, sp, (r, check, n),
                                                        synthesise, steps, progress,
                                                        fixed=states is not None,
@@ -687,9 +689,9 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
        standstill up (the gyroscopic moments change the plant monotonically with speed,
        so the loss moves with the design speed); μ is designed once more, at the speed
        that search finds for H∞ (``synthesise(cfg, steps, "hinf")``), where there is one;
-    3. else, given ``schedule`` (H∞ on the continuous plant), H∞ scheduled on the spin
-       speed (:mod:`ambseal.design.speed_schedule`; ``schedule(range_hz, states,
-       tried)``, :func:`_scheduled_over_speed`; with μ's orbit demand,
+    3. else, given ``schedule`` (H∞ or μ on the continuous plant), the method scheduled
+       on the spin speed (:mod:`ambseal.design.speed_schedule`; ``schedule(range_hz,
+       states, tried)``, :func:`_scheduled_over_speed`; H∞ with μ's orbit demand,
        :func:`_with_orbit_demand`), kept where its full-order loop holds every judged
        condition and between its entries: the gyroscopic moments are known where the
        controller runs, and a fixed controller over the range is the simpler one to run,
@@ -777,10 +779,16 @@ def _over_speed(cfg, method: str, p: float, sp, first, synthesise, steps: list,
 
 
 def _schedule_words(r: _Synthesis, rng) -> str:
-    """H∞ scheduled on the spin speed over ``rng`` (Hz), in the words of a design step."""
-    orbit = r.stopping["hinf"].get("orbit_um")
+    """H∞ or μ scheduled on the spin speed over ``rng`` (Hz), in the words of a design
+    step."""
+    (method, stop), = r.stopping.items()
+    orbit = stop.get("orbit_um")
     demand = "" if orbit is None else f" with an unbalance-orbit demand of {orbit:.3g} µm"
-    added = len(r.stopping["hinf"]["added_speeds_hz"])
+    if method != "hinf":
+        demand = (f" of μ's weights{demand}"
+                  + (f", at the D scales of its D–K at {rng[1]:g} Hz" if stop["d_scales"]
+                     else "") + f", μ {r.mu:.3g} at the worst entry")
+    added = len(stop["added_speeds_hz"])
     table = (f"its {r.scheduled.table_theta.size} judged speeds" if not added
              else f"its {r.scheduled.table_theta.size - added} judged speeds and {added} "
                   "between them where the interpolated loop was lost")
@@ -803,8 +811,9 @@ def _with_orbit_demand(w: Weights, sp) -> Weights:
     return replace(w, orbit_um=ORBIT_PER_DE * w.d_e * 1e6)
 
 
-def _scheduled_over_speed(cfg, p: float, w, sp, dl, rng, n: int, tried: list):
-    """H∞ scheduled on the spin speed over ``rng`` (Hz) on the n-state design model at
+def _scheduled_over_speed(cfg, method: str, p: float, w, unc, sp, dl, rng, n: int,
+                          tried: list):
+    """H∞ or μ scheduled on the spin speed over ``rng`` (Hz) on the n-state design model at
     ``p`` bar (:func:`~ambseal.design.speed_schedule.schedule_hinf`), as ``(synthesis,
     full-order check, n)`` where its full-order loop holds every judged condition and,
     at each judged pressure, every speed between table entries the target's table will
@@ -817,19 +826,38 @@ def _scheduled_over_speed(cfg, p: float, w, sp, dl, rng, n: int, tried: list):
     or between entries closer than :data:`MIN_TABLE_STEP` of the range, ends it with no
     design. Measured on the flywheel example: its six judged speeds held, but the
     interpolated controller half way from standstill to the first judged speed lost the
-    slow precession (|z| 1.0002 as exported)."""
+    slow precession (|z| 1.0002 as exported).
+
+    μ's table is the K-step of D–K on the frozen plants with one set of D scales: those of
+    μ's D–K (:func:`~ambseal.robust.musyn`) on the plant frozen at the top judged speed,
+    where the gyroscopic moments and the seal's speed-dependent forces are largest; its
+    uncertain parameters stay uncertain at every speed, and its μ is the largest of the
+    entries' peaks (:func:`~ambseal.design.speed_schedule.mu_by_speed`). On a rig whose
+    only uncertainty is the speed, the frozen structure is the performance block alone and
+    the table is H∞'s with μ's weights. Measured on family seed 9 (no seal): every fixed
+    μ lost the rotor at standstill; the schedule holds every judged speed at μ ≤ 0.96."""
+    what = "scheduled on the spin speed"
     speeds = sorted({*sp.speeds_hz, *sp.stability_speeds_hz})
     judged = list(speeds)
+    robust = method in method_names(robust=True)
     try:
-        gp = _generalised(cfg, "hinf", p, w, {}, n, sp, dl, speed=rng)
+        gp = _generalised(cfg, method, p, w, unc, n, sp, dl, speed=rng)
+        om = design_omega(*sp.synthesis_band_hz)
+        scalings = None
+        if robust and len(frozen_structure(gp)) > 1:
+            top = musyn(at_speed(gp, 2 * np.pi * speeds[-1]), frozen_structure(gp),
+                        gp.nmeas, gp.ncon, om, order=sp.dk_order, max_iter=sp.max_iter)
+            scalings = result_scalings(top)
+        elif robust:
+            scalings = ()
     except (SynthesisError, ModelError) as exc:
-        tried.append(_tried_words("scheduled on the spin speed", error=exc))
+        tried.append(_tried_words(what, error=exc))
         return None
     while True:
         try:
-            sched = schedule_hinf(gp, speeds)
+            sched = schedule_hinf(gp, speeds, scalings, name=f"K_{method}")
         except (SynthesisError, ModelError) as exc:
-            tried.append(_tried_words("scheduled on the spin speed", error=exc))
+            tried.append(_tried_words(what, error=exc))
             return None
         between = _between_entries_hz(speeds)
         check = full_order_check(cfg, sched, [(q, f) for q in sp.pressures_bar
@@ -839,22 +867,29 @@ def _scheduled_over_speed(cfg, p: float, w, sp, dl, rng, n: int, tried: list):
         lost = sorted({u["speed_hz"] for u in check["unstable"]})
         step = MIN_TABLE_STEP * (speeds[-1] - speeds[0])
         if any(f in speeds or min(abs(f - e) for e in speeds) < step for f in lost):
-            tried.append(_tried_words("scheduled on the spin speed", check))
+            tried.append(_tried_words(what, check))
             return None
         speeds = sorted({*speeds, *lost})
     f0 = cfg.operating.speed_rpm / 60.0
     added = [f for f in speeds if f not in judged]
-    r = _Synthesis(sched.at(2 * np.pi * f0), sched.gamma, None, (), sched.order, None, gp,
-                   stopping={"hinf": {
-                       "rule": "the central H∞ controller of the plant frozen at each table "
-                               f"speed, at γ = {sched.backoff:g} × the largest "
-                               "γ_opt (each γ_opt bisected to rtol=1e-06); a speed between "
-                               "entries whose loop was lost made an entry, until every one "
-                               "held",
+    peaks = mu_by_speed(gp, sched, om) if robust else None
+    mu = None if peaks is None else max(pk.peak for pk in peaks)
+    rule = ("the central H∞ controller of the plant frozen at each table speed"
+            + (", its uncertainty channels at the D scales of μ's D–K at the top speed"
+               if scalings else "")
+            + f", at γ = {sched.backoff:g} × the largest γ_opt (each γ_opt bisected to "
+              "rtol=1e-06); a speed between entries whose loop was lost made an entry, "
+              "until every one held")
+    r = _Synthesis(sched.at(2 * np.pi * f0), sched.gamma, mu, (), sched.order, None, gp,
+                   stopping={method: {
+                       "rule": rule,
                        "table_speeds_hz": [float(f) for f in speeds],
                        "added_speeds_hz": [float(f) for f in added],
                        "orbit_um": w.orbit_um,
-                       "gamma_opt": [float(g) for g in sched.gamma_opt]}},
+                       "gamma_opt": [float(g) for g in sched.gamma_opt],
+                       **({} if peaks is None else {
+                           "mu_by_speed": [float(pk.peak) for pk in peaks],
+                           "d_scales": len(scalings)})}},
                    scheduled=sched)
     return r, check, n
 
@@ -1334,6 +1369,9 @@ def _verdict(method, r: _Synthesis, check) -> str:
     # what the design model was robust to beyond [[design.uncertainty]]: the mode bands
     swept = (f", with the modes at {', '.join(b.text() for b in r.bands)} uncertain in "
              "frequency over the speed range" if r.bands else "") + relaxed
+    if r.scheduled is not None:  # the worst entry's μ
+        swept += (f" frozen at each of its {r.scheduled.table_theta.size} table speeds, "
+                  "scheduled on speed (no bound between them)")
     # the band's edges as written: |0.98 − 1| is 0.020000000000000018 in binary
     if r.mu is not None and 1 - MU_BOUNDARY_RTOL <= r.mu <= 1 + MU_BOUNDARY_RTOL:
         return (f"robust performance on its boundary: μ = {bound_text(r.mu)}, within "
@@ -1342,7 +1380,7 @@ def _verdict(method, r: _Synthesis, check) -> str:
     if r.mu is not None and r.mu <= 1:
         return (f"robust performance met: μ = {bound_text(r.mu)} ≤ 1 on the design model"
                 f"{swept}; {stab}")
-    by = _dominant_weight(r)
+    by = "" if r.scheduled is not None else _dominant_weight(r)
     return (f"robust performance NOT met: μ = {bound_text(r.mu)} > 1: missed by "
             f"{100 * (r.mu - 1):.2g} %{by}{swept}; {stab}")
 

@@ -222,8 +222,9 @@ def at_speed(gp, speed_rad_s: float):
     Parameters
     ----------
     gp : GeneralizedPlant
-        A generalised plant whose first LFT parameter is :data:`SPEED`
-        (:func:`ambseal.design.plant.generalized_plant` with ``speed_range_hz``).
+        A generalised plant with the :data:`SPEED` LFT parameter
+        (:func:`ambseal.design.plant.generalized_plant` with ``speed_range_hz``); its
+        other parameters (μ's uncertain ones) stay channels of the frozen plant.
     speed_rad_s : float
         Ω (rad/s), within the parameter's range.
 
@@ -231,26 +232,35 @@ def at_speed(gp, speed_rad_s: float):
     -------
     control.StateSpace
         ``gp.P`` without the speed's r channels: the same states (one state basis at
-        every speed) and the other channels' names.
+        every speed) and the other channels' names, in their order.
 
     Raises
     ------
     ModelError
-        No speed parameter first, or Ω outside its range.
+        No speed parameter, or Ω outside its range.
     """
-    if not gp.parameters or gp.parameters[0].name != SPEED:
-        raise ModelError(f"at_speed: the generalised plant's first LFT parameter is not "
-                         f"{SPEED!r}")
-    q = gp.parameters[0]
+    names = [q.name for q in gp.parameters]
+    if SPEED not in names:
+        raise ModelError(f"at_speed: the generalised plant has no {SPEED!r} LFT parameter "
+                         f"({names})")
+    k = names.index(SPEED)
+    q = gp.parameters[k]
     delta = q.delta(float(speed_rad_s))
     if not -1.0 - 1e-9 <= delta <= 1.0 + 1e-9:
         raise ModelError(f"at_speed: {speed_rad_s:g} rad/s lies outside the speed range "
                          f"{q.low:g}–{q.high:g} rad/s")
-    P, r = gp.P, q.repeats
+    P = gp.P
+    first = sum(p.repeats for p in gp.parameters[:k])
+    sp = np.arange(first, first + q.repeats)  # the speed's channels, in and out alike
+    o_in = np.setdiff1d(np.arange(P.ninputs), sp)
+    o_out = np.setdiff1d(np.arange(P.noutputs), sp)
     A, B, C, D = (np.asarray(M, float) for M in (P.A, P.B, P.C, P.D))
     # w_Δ = δ z_Δ: solved for the loop through D_ΔΔ
-    M = delta * np.linalg.inv(np.eye(r) - delta * D[:r, :r])
-    return control.ss(A + B[:, :r] @ M @ C[:r], B[:, r:] + B[:, :r] @ M @ D[:r, r:],
-                      C[r:] + D[r:, :r] @ M @ C[:r], D[r:, r:] + D[r:, :r] @ M @ D[:r, r:],
-                      inputs=list(P.input_labels)[r:], outputs=list(P.output_labels)[r:],
+    M = delta * np.linalg.inv(np.eye(q.repeats) - delta * D[np.ix_(sp, sp)])
+    Bs, Cs = B[:, sp], C[sp]
+    return control.ss(A + Bs @ M @ Cs, B[:, o_in] + Bs @ M @ D[np.ix_(sp, o_in)],
+                      C[o_out] + D[np.ix_(o_out, sp)] @ M @ Cs,
+                      D[np.ix_(o_out, o_in)] + D[np.ix_(o_out, sp)] @ M @ D[np.ix_(sp, o_in)],
+                      inputs=[str(n) for n in np.asarray(P.input_labels)[o_in]],
+                      outputs=[str(n) for n in np.asarray(P.output_labels)[o_out]],
                       states=list(P.state_labels), name=P.name)

@@ -1,4 +1,4 @@
-"""H∞ scheduled on the spin speed: the design for a gyroscopic rotor that no fixed H∞
+"""H∞ and μ scheduled on the spin speed: the design for a gyroscopic rotor that no fixed
 controller holds from standstill to the top speed.
 
 A fixed H∞ controller designed at the top speed leans on the gyroscopic stiffening of the
@@ -26,6 +26,11 @@ controller runs — an AMB controller reads the speed — so the H∞ design is 
   on S_o and K S_o alone the central controllers cancel the nutation, which follows the
   speed, rather than damp it.
 
+μ is scheduled the same way (``scalings``): the K-step of D–K (Zhou, Doyle & Glover 1996
+§11.3) on the frozen plants with one set of D scales, so the entries keep one state basis;
+the uncertain parameters other than the speed stay channels of the frozen plants, and
+each entry's μ is the peak of its frozen loop's upper bound (:func:`mu_by_speed`).
+
 Unlike the LPV (P3), no LMI certifies the loop between the table's speeds or while the
 speed changes: the design is kept only where the full-order loop holds at every judged
 condition and at those speeds between entries.
@@ -36,6 +41,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
+import control
 import numpy as np
 
 from ambseal.design.plant import physical_controller, physical_matrices
@@ -43,9 +49,9 @@ from ambseal.design.speed_lft import SPEED as SPEED_PARAMETER
 from ambseal.design.speed_lft import at_speed
 from ambseal.errors import ModelError
 from ambseal.machine import SPEED, ScheduledController
-from ambseal.robust import hinf_scheduled
+from ambseal.robust import dscaled_plant, hinf_scheduled, lft_lower, mu_peak
 
-__all__ = ["SpeedScheduledHinf", "schedule_hinf"]
+__all__ = ["SpeedScheduledHinf", "frozen_structure", "mu_by_speed", "schedule_hinf"]
 
 _TWO_PI = 2.0 * np.pi
 
@@ -111,16 +117,25 @@ class SpeedScheduledHinf(ScheduledController):
         return physical_matrices(self.K.matrices(float(speed_rad_s)), self.d_e, self.d_u)
 
 
-def schedule_hinf(gp, speeds_hz) -> SpeedScheduledHinf:
-    """The H∞ controller scheduled on speed over a table of speeds (module docstring).
+def schedule_hinf(gp, speeds_hz, scalings=None, name: str = "K_hinf") -> SpeedScheduledHinf:
+    """The H∞ controller scheduled on speed over a table of speeds (module docstring); with
+    ``scalings``, μ's: each frozen plant's uncertainty channels D-scaled (the K-step of
+    D–K on the frozen plants with one set of D scales, :func:`frozen_structure`).
 
     Parameters
     ----------
     gp : GeneralizedPlant
-        The H∞ recipe's generalised plant with the spin speed as its only LFT parameter
-        (:func:`ambseal.design.plant.generalized_plant` with ``speed_range_hz``).
+        The recipe's generalised plant with the spin speed as an LFT parameter
+        (:func:`ambseal.design.plant.generalized_plant` with ``speed_range_hz``); any
+        other parameters (μ's uncertain ones) stay as channels of the frozen plants.
     speeds_hz : sequence of float
         The table's speeds (Hz), within the parameter's range; sorted and made unique.
+    scalings : sequence, optional
+        One D scale per uncertainty block of the frozen plants
+        (:func:`ambseal.robust.dscaled_plant`); None: the plants as they are, which needs
+        the spin speed as the only parameter.
+    name : str
+        The controller's name.
 
     Returns
     -------
@@ -129,17 +144,54 @@ def schedule_hinf(gp, speeds_hz) -> SpeedScheduledHinf:
     Raises
     ------
     ModelError
-        A plant whose LFT parameters are not the spin speed alone, or a speed outside its
-        range.
+        A plant without the spin speed as an LFT parameter, other parameters without
+        ``scalings``, or a speed outside its range.
     SynthesisError
         A frozen plant without an H∞ controller at the table's γ.
     """
     names = [q.name for q in gp.parameters]
-    if names != [SPEED_PARAMETER]:
+    if SPEED_PARAMETER not in names or (scalings is None and len(names) > 1):
         raise ModelError(f"schedule_hinf: the generalised plant's LFT parameters are {names}, "
-                         f"expected the spin speed alone ({SPEED_PARAMETER!r})")
+                         f"expected the spin speed ({SPEED_PARAMETER!r}), and alone "
+                         "without D scales")
     speeds = np.unique(np.asarray(speeds_hz, float))
     plants = [at_speed(gp, _TWO_PI * f) for f in speeds]
+    if scalings is not None:
+        plants = [dscaled_plant(P, frozen_structure(gp), scalings, gp.nmeas, gp.ncon)
+                  for P in plants]
     r = hinf_scheduled(plants, _TWO_PI * speeds, gp.nmeas, gp.ncon)
     return SpeedScheduledHinf(K=r.K, d_e=gp.d_e, d_u=gp.d_u, channels=tuple(gp.channels),
-                              gamma=r.gamma, gamma_opt=r.gamma_opt, backoff=r.backoff)
+                              gamma=r.gamma, gamma_opt=r.gamma_opt, backoff=r.backoff,
+                              name=name)
+
+
+def frozen_structure(gp) -> tuple:
+    """The block structure of ``gp`` frozen at a speed (:func:`~ambseal.design.speed_lft.
+    at_speed`): its blocks without the spin speed's (one block per LFT parameter, in
+    their order, then the performance block)."""
+    k = [q.name for q in gp.parameters].index(SPEED_PARAMETER)
+    return tuple(b for i, b in enumerate(gp.blocks) if i != k)
+
+
+def mu_by_speed(gp, sched: SpeedScheduledHinf, omega) -> list:
+    """The μ upper bound's peak (:func:`ambseal.robust.mu_peak`) of each table entry's
+    loop: ``F_l(P(Ω_i), K(Ω_i))`` with the structure of the frozen plant, the uncertain
+    parameters and the performance block (robust performance at that speed, thesis P5
+    §4.4).
+
+    Parameters
+    ----------
+    gp : GeneralizedPlant
+        The generalised plant ``sched`` was designed on.
+    sched : SpeedScheduledHinf
+    omega : array_like
+        Frequency grid (rad/s) the peaks are searched from.
+
+    Returns
+    -------
+    list of MuPeak
+        One per table speed, in the table's order.
+    """
+    return [mu_peak(lft_lower(at_speed(gp, th), control.ss(*sched.K.matrices(float(th))),
+                              gp.nmeas, gp.ncon), frozen_structure(gp), omega)
+            for th in sched.table_theta]

@@ -57,7 +57,8 @@ from ambseal.robust.mu import _complexify, check_blocks, mu_peak, upper_on_grid
 from ambseal.threads import with_numerics_threads
 
 __all__ = ["MusynResult", "musyn", "fit_magnitude", "fit_dscale", "default_omega",
-           "design_omega", "ScaledHinfResult", "scaled_hinfsyn"]
+           "design_omega", "ScaledHinfResult", "scaled_hinfsyn", "dscaled_plant",
+           "result_scalings"]
 
 
 # --------------------------------------------------------------------------- D fitting
@@ -631,6 +632,50 @@ def musyn(P, blocks: Sequence[Sequence[int]], nmeas: int, ncon: int, omega=None,
     # returned in the user's units
     r = _result(P, blocks, nmeas, ncon, w, finalists, history, t0, stopping=stopping)
     return replace(r, closed_loop=lft_lower(P_user, r.K, nmeas, ncon))
+
+
+def result_scalings(r: MusynResult) -> tuple:
+    """The D scales a :func:`musyn` result's controller was designed with, in its plant's
+    units: its fitted ``scalings``, or where the best iteration was the first (no fit
+    yet), the constant D of the uncertainty channels D–K started from
+    (``stopping["start"]["scales"]``)."""
+    if r.scalings:
+        return tuple(r.scalings)
+    return tuple(ct.tf([float(b)], [1.0]) for b in r.stopping["start"]["scales"])
+
+
+def dscaled_plant(P, blocks: Sequence[Sequence[int]], scalings, nmeas: int, ncon: int):
+    """``diag(D, I) · P · diag(D⁻¹, I)``: a generalised plant with its uncertainty channels
+    scaled by D–K's D scales (the K-step's plant, Zhou, Doyle & Glover 1996 §11.3).
+
+    Parameters
+    ----------
+    P : control.StateSpace
+        Generalised plant, inputs ``[w_Δ, w_p, u]``, outputs ``[z_Δ, z_p, y]``.
+    blocks : sequence of (int, int)
+        Its structure (MATLAB ``mussv`` notation), the last block the performance block.
+    scalings : sequence
+        One D scale per block of the complexified structure but the last
+        (:func:`result_scalings` of a :func:`musyn` result on a plant of the same
+        structure): a ``control.TransferFunction``, stable and minimum phase.
+    nmeas, ncon : int
+        Measurements and controls.
+
+    Returns
+    -------
+    control.StateSpace
+        The scaled plant, ``P``'s channels and names; the D scales' states after ``P``'s.
+
+    Raises
+    ------
+    ModelError
+        Blocks that do not match ``P``, or not one scale per uncertainty block.
+    """
+    cblocks, _ = _structure(P, blocks, nmeas, ncon, "dscaled_plant")
+    if len(scalings) != len(cblocks) - 1:
+        raise ModelError(f"dscaled_plant: {len(scalings)} D scales for "
+                         f"{len(cblocks) - 1} uncertainty blocks")
+    return _scaled_plant(P, cblocks, list(scalings), nmeas, ncon)
 
 
 def _grid(P, omega, who: str) -> np.ndarray:

@@ -117,6 +117,31 @@ def test_a_design_lost_only_as_it_runs_is_designed_on_the_sampled_plant(tmp_path
         assert np.abs(loop.poles()).max() < 1.0
 
 
+@pytest.mark.heavy
+def test_a_rig_no_fixed_mu_holds_gets_mu_and_hinf_scheduled_on_speed(tmp_path):
+    """Seed 9 (Ip/It 1.43, 0–363 Hz at 10 kHz, no seal): every fixed μ over the speed range
+    loses the rigid conical mode at standstill, and the fixed H∞ holds its loops but
+    reaches ISO 14839-3 zone D on an axis as it runs. The run delivers μ scheduled on the
+    spin speed (μ below 1 at every entry) and H∞ scheduled as its remedy; each exported
+    table, closed by python-control with the ZOH-sampled full-order plant at 17 speeds
+    and the judged ones, holds the rotor at zone B or better on every axis
+    (:func:`tests.exported_files.runs_from_standstill_to_the_top_speed`)."""
+    from .exported_files import runs_from_standstill_to_the_top_speed
+
+    bf = _bench_family()
+    text, m = _run(bf, 9, tmp_path)
+    rig = tmp_path / "rig.toml"
+    mu = m["controllers"]["mu"]
+    assert mu["steps"][-1].startswith("mu: designed as a controller scheduled on the spin "
+                                      "speed"), mu["steps"][-1]
+    assert mu["mu"] < 1 and "scheduled on speed" in mu["verdict"]
+    assert m["controllers"]["hinf"]["remedy"].startswith("designed scheduled on the spin "
+                                                         "speed")
+    assert bf.delivered(m)["mu"] and bf.delivered(m)["hinf"], bf.why_not(m)
+    for method in ("mu", "hinf"):
+        runs_from_standstill_to_the_top_speed(rig, m, tmp_path / "run", method)
+
+
 def test_every_method_not_delivered_says_why():
     """:func:`bench_family.why_not` on a run's metrics: a method not designed, one failed,
     one its target cannot run, one whose worst axis as it runs is at zone C (σ̄(S_o) 4 or

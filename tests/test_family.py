@@ -117,7 +117,7 @@ def test_a_design_lost_only_as_it_runs_is_designed_on_the_sampled_plant(tmp_path
         assert np.abs(loop.poles()).max() < 1.0
 
 
-@pytest.mark.heavy
+@pytest.mark.slow
 def test_a_rig_no_fixed_mu_holds_gets_mu_and_hinf_scheduled_on_speed(tmp_path):
     """Seed 9 (Ip/It 1.43, 0–363 Hz at 10 kHz, no seal): every fixed μ over the speed range
     loses the rigid conical mode at standstill, and the fixed H∞ holds its loops but

@@ -142,6 +142,24 @@ def test_a_rig_no_fixed_mu_holds_gets_mu_and_hinf_scheduled_on_speed(tmp_path):
         runs_from_standstill_to_the_top_speed(rig, m, tmp_path / "run", method)
 
 
+@pytest.mark.slow
+def test_a_fixed_mu_beyond_zone_b_as_it_runs_is_scheduled_on_speed(tmp_path):
+    """Seed 10 (Ip/It 1.23, 0–360 Hz): a fixed μ over the speed range holds every loop but
+    reaches σ̄(S_o) 5.8 on an axis at standstill (ISO 14839-3 zone D). The run designs μ
+    again scheduled on the spin speed, which replaces it (its ``remedy`` says so) and is
+    delivered; python-control holds the exported table at 17 speeds at zone B or better
+    on every axis (:func:`tests.exported_files.runs_from_standstill_to_the_top_speed`)."""
+    from .exported_files import runs_from_standstill_to_the_top_speed
+
+    bf = _bench_family()
+    _, m = _run(bf, 10, tmp_path)
+    mu = m["controllers"]["mu"]
+    assert mu["remedy"].startswith("designed scheduled on the spin speed: the fixed design "
+                                   "over the speed range reaches ISO 14839-3 zone")
+    assert mu["mu"] < 1 and bf.delivered(m)["mu"], bf.why_not(m)["mu"]
+    runs_from_standstill_to_the_top_speed(tmp_path / "rig.toml", m, tmp_path / "run", "mu")
+
+
 def test_every_method_not_delivered_says_why():
     """:func:`bench_family.why_not` on a run's metrics: a method not designed, one failed,
     one its target cannot run, one whose worst axis as it runs is at zone C (σ̄(S_o) 4 or

@@ -86,6 +86,7 @@ from ambseal.config import (
     default_rig_path,
     load_rig,
     load_truth,
+    method_label,
     method_names,
 )
 from ambseal.design import (
@@ -616,9 +617,9 @@ def _sampled_remedies(st: _RunState, stability: list) -> list:
 
 
 def _scheduled_remedies(st: _RunState, stability: list) -> list:
-    """An H∞ over the speed range (on the continuous plant, or its redesign on the sampled
-    plant, :func:`_sampled_remedies`) whose loops all hold but whose worst ISO 14839-3
-    grade as it runs is beyond zone B, designed again scheduled on the spin speed
+    """An H∞ or μ over the speed range (on the continuous plant, or its redesign on the
+    sampled plant, :func:`_sampled_remedies`) whose loops all hold but whose worst ISO
+    14839-3 grade as it runs is beyond zone B, designed again scheduled on the spin speed
     (:func:`ambseal.app.remedies.scheduled_on_speed`): where that design holds at a
     better grade, it replaces the first, its cases theirs; else the first stays and its
     notes say what was tried. Returns the stability cases."""
@@ -626,7 +627,7 @@ def _scheduled_remedies(st: _RunState, stability: list) -> list:
     if speed_scheduled(st.cfg) or on_sampled_plant(cfg) or cfg.design.one_speed \
             or cfg.operating.speed_range_hz is None:
         return stability
-    for d in [d for d in st.designs if d.method == "hinf"]:
+    for d in [d for d in st.designs if d.method in ("hinf", "mu")]:
         m = d.method
         if m in st.failed or m in st.cannot_run or d.result.scheduled is not None:
             continue
@@ -634,7 +635,8 @@ def _scheduled_remedies(st: _RunState, stability: list) -> list:
                                   + [c for c in stability if c.controller == m])
         if zone is None or ZONE_SCALE.index(zone) <= ZONE_SCALE.index("B"):
             continue
-        st.stages.begin("scheduled-redesign", "H∞ beyond zone B over the speed range")
+        st.stages.begin("scheduled-redesign",
+                        f"{method_label(m)} beyond zone B over the speed range")
         fixed, cases, tried = scheduled_on_speed(
             m, zone, cfg, st.spec, st.points, lambda ds, digs: _judge_designs(st, ds, digs, 0),
             lambda ds, digs: _stability_cases(ds, digs, st.spec, st.points, cfg,

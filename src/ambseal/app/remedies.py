@@ -30,9 +30,10 @@ speed as it runs, the only loop it has (:func:`ambseal.analysis.judge.judge_jobs
 benchmarks/README.md, "The sampled design as the run's remedy for a loop lost only as it
 runs" and "A design on the sampled plant judged as it runs").
 
-**An H∞ over the speed range that holds the loop beyond ISO 14839-3 zone B** — a fixed
-design whose loops all hold from standstill to the top speed, but whose σ̄(S_o) as it
-runs reaches zone C or D somewhere — is designed again scheduled on the spin speed
+**An H∞ or μ over the speed range that holds the loop beyond ISO 14839-3 zone B** — a
+fixed design whose loops all hold from standstill to the top speed, but whose σ̄(S_o) on
+an axis as it runs reaches zone C or D somewhere — is designed again scheduled on the
+spin speed
 (:func:`scheduled_on_speed`, :func:`ambseal.design.recipes.design` with
 ``scheduled_on_speed``): each table entry is the central controller of the plant at its
 own speed, not one controller stretched over the range. It replaces the first where it
@@ -269,12 +270,12 @@ def worst_zone_as_runs(cases) -> str | None:
 def scheduled_on_speed(method: str, zone: str, design_cfg, spec, points, judge: Callable,
                        stability: Callable, say: Callable[[str], None]
                        ) -> tuple[Remedied | None, list, str]:
-    """``method`` (H∞) designed again scheduled on the spin speed (module docstring), for a
-    fixed design over the speed range whose loops hold at worst grade ``zone``.
+    """``method`` (H∞ or μ) designed again scheduled on the spin speed (module docstring),
+    for a fixed design over the speed range whose loops hold at worst grade ``zone``.
 
     Parameters
     ----------
-    method : {"hinf"}
+    method : {"hinf", "mu"}
     zone : str
         The first design's worst grade as it runs (:func:`worst_zone_as_runs`), beyond B.
     design_cfg, spec, points, judge, stability, say

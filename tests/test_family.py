@@ -144,7 +144,7 @@ def test_a_rig_no_fixed_mu_holds_gets_mu_and_hinf_scheduled_on_speed(tmp_path):
 
 @pytest.mark.slow
 def test_a_fixed_mu_beyond_zone_b_as_it_runs_is_scheduled_on_speed(tmp_path):
-    """Seed 10 (Ip/It 1.23, 0–360 Hz): a fixed μ over the speed range holds every loop but
+    """Seed 10 (Ip/It 1.18, 0–360 Hz): a fixed μ over the speed range holds every loop but
     reaches σ̄(S_o) 5.8 on an axis at standstill (ISO 14839-3 zone D). The run designs μ
     again scheduled on the spin speed, which replaces it (its ``remedy`` says so) and is
     delivered; python-control holds the exported table at 17 speeds at zone B or better

@@ -447,8 +447,8 @@ def design(
     scheduled_on_speed : bool
         H∞ or μ: designed scheduled on the spin speed over the judged speeds
         (:func:`_scheduled_over_speed`) without trying a fixed design over the speed range
-        first — the run's remedy where a fixed H∞ holds the loop but not its ISO 14839-3
-        zone as it runs (:mod:`ambseal.app.remedies`). Needs ``[operating]
+        first — the run's remedy where a fixed design holds the loop but not its ISO
+        14839-3 zone as it runs (:mod:`ambseal.app.remedies`). Needs ``[operating]
         speed_range_hz`` and the continuous synthesis plant.
 
     Returns

@@ -638,7 +638,19 @@ def result_scalings(r: MusynResult) -> tuple:
     """The D scales a :func:`musyn` result's controller was designed with, in its plant's
     units: its fitted ``scalings``, or where the best iteration was the first (no fit
     yet), the constant D of the uncertainty channels D–K started from
-    (``stopping["start"]["scales"]``)."""
+    (``stopping["start"]["scales"]``).
+
+    Parameters
+    ----------
+    r : MusynResult
+        A :func:`musyn` result.
+
+    Returns
+    -------
+    tuple of control.TransferFunction
+        One D scale per uncertainty block of the complexified structure
+        (:func:`dscaled_plant`'s ``scalings``).
+    """
     if r.scalings:
         return tuple(r.scalings)
     return tuple(ct.tf([float(b)], [1.0]) for b in r.stopping["start"]["scales"])

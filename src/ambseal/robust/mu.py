@@ -694,6 +694,8 @@ def mu_peak(M, blocks, omega, upper=None, *, candidates: int = 2, band: float = 
     ftol : float
         Relative difference of the best point's neighbours from it below which a bracket is
         a flat top, not refined further.
+    resolve : int
+        The best points found that are solved again to ``tol·1e-3`` and added to the grid.
     tol : float
         Tolerance of the bound's solver (:func:`mussv`): the grid's and the added points'
         (``tol/10`` while searching).

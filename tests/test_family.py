@@ -129,7 +129,7 @@ def test_a_rig_no_fixed_mu_holds_gets_mu_and_hinf_scheduled_on_speed(tmp_path):
     from .exported_files import runs_from_standstill_to_the_top_speed
 
     bf = _bench_family()
-    text, m = _run(bf, 9, tmp_path)
+    _, m = _run(bf, 9, tmp_path)
     rig = tmp_path / "rig.toml"
     mu = m["controllers"]["mu"]
     assert mu["steps"][-1].startswith("mu: designed as a controller scheduled on the spin "

@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 import control as ct
 
-from ambseal.design.weights import (check_weight, control_weight, diagonal_weight,
-                                     performance_weight, wp_gain)
+from ambseal.design.weights import (PEAK_DAMPING, Weights, check_weight, control_weight,
+                                     diagonal_weight, peak_weight, performance_weight,
+                                     wp_gain)
 
 
 def test_wp_low_high_and_bandwidth_values():
@@ -37,6 +38,28 @@ def test_wu_high_pass_gains():
     assert abs(W(0)) == pytest.approx(0.2)
     assert abs(W(1e12j)) == pytest.approx(4.0, rel=1e-6)
     assert abs(control_weight(0.3)(1j)) == pytest.approx(0.3)
+
+
+def test_the_synchronous_peak_is_h_at_its_frequency_and_one_away_from_it():
+    """W_Ω = (s² + 2hζΩ₀s + Ω₀²)/(s² + 2ζΩ₀s + Ω₀²): the closed form
+    |W_Ω(jω)| = √((Ω₀² − ω²)² + (2hζΩ₀ω)²) / √((Ω₀² − ω²)² + (2ζΩ₀ω)²), h at Ω₀, 1 at DC
+    and at high frequency; on W_u it multiplies the control weight."""
+    f0, h, z = 250.0, 6.0, PEAK_DAMPING
+    W = peak_weight(f0, h)
+    w0, w = 2 * np.pi * f0, 2 * np.pi * np.array([0.0, 25.0, 225.0, 250.0, 275.0, 2500.0])
+    closed = np.hypot(w0**2 - w**2, 2 * h * z * w0 * w) / np.hypot(w0**2 - w**2, 2 * z * w0 * w)
+    got = np.abs([complex(W(1j * x)) for x in w])
+    assert np.allclose(got, closed, rtol=1e-12)
+    assert got[3] == pytest.approx(h, rel=1e-12) and got[0] == pytest.approx(1.0)
+    assert 1 < got[-1] < 1.03 and 1 < got[1] < 1.03
+    assert np.all(np.real(W.poles()) < 0) and np.all(np.real(W.zeros()) < 0)
+    base = Weights(wu_gain=0.2, wu_corner_hz=100.0, wu_hf_gain=2.0)
+    peaked = Weights(wu_gain=0.2, wu_corner_hz=100.0, wu_hf_gain=2.0, wu_peak_hz=f0,
+                     wu_peak_gain=h)
+    s0 = 2j * np.pi * f0
+    assert complex(peaked.Wu()(s0)) == pytest.approx(h * complex(base.Wu()(s0)), rel=1e-12)
+    with pytest.raises(ValueError, match="gain"):
+        peak_weight(f0, 0.5)
 
 
 def test_improper_weight_raises_naming_it():

@@ -16,6 +16,19 @@
 
   low-frequency gain ``k``, high-frequency gain ``k ω_p/ω_z``. It must be biproper so that
   ``D12`` of the generalised plant has full column rank.
+* Synchronous peak on the control weight (:func:`peak_weight`), where the amplifier cannot
+  hold the unbalance at a speed Ω₀: a biproper second-order band weight, 1 away from Ω₀
+  and ``h`` at it, multiplies W_u, so that the design bounds ``|K S_o(jΩ₀)|`` h times
+  tighter there, and with it the synchronous current ``K S_o G_f F_u`` (Schweitzer &
+  Maslen, *Magnetic Bearings*, 2009, ch. 15)::
+
+      W_Ω(s) = (s² + 2 h ζ Ω₀ s + Ω₀²) / (s² + 2 ζ Ω₀ s + Ω₀²)
+
+  On W_1 instead (the unbalance as a current F_u/Ki entering at a bearing) the same peak
+  also weights the compliance ``S_o G`` at Ω₀, which no controller changes on a
+  supercritical rotor (it is the mass line): on the rigid gyroscopic rotor of
+  tests/design/test_design_amplifier_weight.py γ rose 14-fold and ``|T_i(jΩ₀)|`` grew,
+  where on W_u a peak of 8 cut ``|K S_o(jΩ₀)|`` 6.5-fold at γ 0.73 against 0.65.
 
 All frequencies in rad/s unless the name says ``_hz``.
 
@@ -41,7 +54,13 @@ from ambseal.robust import is_stable
 GAIN_SENSITIVITY = 3.0
 
 __all__ = ["Weights", "default_weights", "performance_weight", "control_weight",
-           "check_weight", "diagonal_weight", "wp_gain"]
+           "peak_weight", "check_weight", "diagonal_weight", "wp_gain"]
+
+#: Damping ζ of :func:`peak_weight`'s poles: the weight stays above about h/√2 within ±ζ of
+#: Ω₀ (for h ≫ 1), so ±10 % covers the judged speeds next to the worst one (the top
+#: continuous speed and a trip speed 5 % above it) and leaves the loop's gain free an
+#: octave away, where the rigid-body crossover and the bending modes need it.
+PEAK_DAMPING = 0.1
 
 
 def performance_weight(M: float, omega_b: float, A: float = 1e-3):
@@ -132,6 +151,44 @@ def control_weight(gain: float, *, corner_hz: float | None = None,
     wz = 2 * np.pi * corner_hz
     wp = wz * hf_gain / gain
     return control.tf([gain / wz, gain], [1.0 / wp, 1.0])
+
+
+def peak_weight(peak_hz: float, gain: float, damping: float = PEAK_DAMPING):
+    """The synchronous peak ``W_Ω`` on the control weight (module docstring).
+
+    Parameters
+    ----------
+    peak_hz : float
+        Ω₀/2π (Hz), > 0: where the amplifier needs its current back.
+    gain : float
+        The height h = ``|W_Ω(jΩ₀)|`` (-), ≥ 1; 1 is no peak.
+    damping : float
+        ζ of the poles (-), > 0 (:data:`PEAK_DAMPING`).
+
+    Returns
+    -------
+    control.TransferFunction
+        SISO, second order, stable and minimum phase, biproper: 1 at DC and at high
+        frequency.
+
+    Raises
+    ------
+    ConfigError
+        A non-positive or non-finite frequency or damping, or a height below 1.
+
+    Examples
+    --------
+    >>> W = peak_weight(100.0, 4.0)
+    >>> round(float(abs(W(2j * np.pi * 100.0))), 6), round(float(abs(W(0))), 6)
+    (4.0, 1.0)
+    """
+    for name, v in (("peak_hz", peak_hz), ("damping", damping)):
+        if not (np.isfinite(v) and v > 0):
+            raise ConfigError(f"peak_weight: {name}={v!r} must be finite and > 0")
+    if not (np.isfinite(gain) and gain >= 1):
+        raise ConfigError(f"peak_weight: gain={gain!r} must be finite and >= 1")
+    w0 = 2 * np.pi * peak_hz
+    return control.tf([1.0, 2 * gain * damping * w0, w0**2], [1.0, 2 * damping * w0, w0**2])
 
 
 def check_weight(W, name: str, *, biproper: bool = False):
@@ -233,6 +290,10 @@ class Weights:
     wu_corner_hz, wu_hf_gain : float or None
         Optional high-pass W_u (:func:`control_weight`): corner (Hz) and high-frequency
         gain (-).
+    wu_peak_hz, wu_peak_gain : float or None
+        Optional synchronous peak on W_u (:func:`peak_weight`): where (Hz) and its height
+        (-); ``ambseal run`` sets them where a design's unbalance current exceeds the
+        amplifier (:func:`ambseal.app.remedies.within_the_amplifier`).
     w1_gain : float
         High-frequency gain of the input-disturbance weight W_1 (-).
     w1_corner_hz : float or None
@@ -277,6 +338,8 @@ class Weights:
     wu_gain: float = 0.3
     wu_corner_hz: float | None = None
     wu_hf_gain: float | None = None
+    wu_peak_hz: float | None = None
+    wu_peak_gain: float | None = None
     w1_gain: float = 1.0
     w1_corner_hz: float | None = None
     orbit_um: float | None = None
@@ -297,8 +360,12 @@ class Weights:
         return performance_weight(self.M, self.omega_b, self.A)
 
     def Wu(self):
-        """W_u as a ``control.TransferFunction`` (:func:`control_weight`)."""
-        return control_weight(self.wu_gain, corner_hz=self.wu_corner_hz, hf_gain=self.wu_hf_gain)
+        """W_u as a ``control.TransferFunction`` (:func:`control_weight`), times the
+        synchronous peak :func:`peak_weight` where ``wu_peak_hz`` is given."""
+        W = control_weight(self.wu_gain, corner_hz=self.wu_corner_hz, hf_gain=self.wu_hf_gain)
+        if self.wu_peak_hz is None:
+            return W
+        return W * peak_weight(self.wu_peak_hz, self.wu_peak_gain or 1.0)
 
     def Wk(self):
         """W_K on the current, the gain demand, or None without ``gain_factor``.

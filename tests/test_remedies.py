@@ -163,3 +163,78 @@ def test_a_remedy_beside_the_speed_range_names_each_condition_by_its_speed(monke
     assert fixed.design.summary["remedy"] == (
         f"designed at 0 bar: the design at the operating point lost the loop at 0 bar, "
         f"{f0:g} Hz; 0 bar, 0 Hz")
+
+
+def test_a_design_beyond_its_amplifier_is_designed_again_with_its_limit_in_w_u(monkeypatch):
+    """A design whose loops hold but that needs 1.2× its amplifier at 400 Hz is designed
+    again with W_u peaked there (by the route it took: scheduled on the spin speed), the
+    peak raised by the fraction used over 0.8 and at least fourfold: 4, then 4 × 4 after
+    a redesign that needs 1.1×; the one within its amplifier replaces it. A design that
+    needs 4× starts at 4/0.8 = 5. A redesign that lowers the current by less than
+    5 % ends the attempts; one beyond zone B (the first at A), or whose orbit exceeds a
+    clearance, is refused."""
+    import numpy as np
+
+    import ambseal.app.remedies as rem
+    from ambseal.app.commands import Designed
+    cfg = load_rig()
+    spec = design_spec(cfg)
+
+    class Result:
+        method = "hinf"
+        synthesis_plant = "continuous"
+        scheduled = object()
+
+        def summary(self):
+            return {}
+
+    asked = []
+
+    def fake_design(cfg_, method, *, spec=None, scheduled_on_speed=False, **kw):
+        w = spec.weights[method]
+        asked.append((w.wu_peak_hz, w.wu_peak_gain, w.wu_gain, scheduled_on_speed, kw))
+        return Result()
+
+    monkeypatch.setattr(rem, "design", fake_design)
+    monkeypatch.setattr(rem, "digitals_for", lambda c, ds, pts: ({"hinf": object()}, {}))
+
+    def graded(zone):
+        run = SampledStability(True, 0.5, 1e4, 2.0, {"A_zeta": 2.0}, zone, {"A_zeta": zone})
+        return lambda ds, digs: ([None], [(_case(0.0, True, -5.0, run), {})])
+
+    def fractions(*values):
+        it = iter(values)
+        return lambda jobs, judged: (np.array([400.0]), np.array([next(it)]))
+
+    used = (np.array([300.0, 400.0, 420.0]), np.array([0.5, 1.2, 1.1]))
+    first, lines = Designed(Result()), []
+    fixed, cases, tried = rem.within_the_amplifier(
+        first, used, "A", cfg, spec, [], graded("A"), lambda ds, digs: [],
+        fractions(1.1, 0.7), lambda judged: None, lines.append)
+    assert isinstance(fixed, Remedied) and cases == [] and tried == ""
+    # the specification's weights with the peak (the recipe adds what it adds to its own)
+    gain = spec.weights["hinf"].wu_gain
+    assert asked == [(400.0, pytest.approx(4.0), gain, True, {}),
+                     (400.0, pytest.approx(16.0), gain, True, {})]
+    assert fixed.design.summary["remedy"].endswith(
+        "it needs 1.2× its amplifier to hold the unbalance at 400 Hz")
+    assert "within its amplifier (0.7× at most), zone A" in lines[-1]
+    asked.clear()
+    fixed, _, tried = rem.within_the_amplifier(
+        first, (used[0], used[1] * 4 / 1.2), "A", cfg, spec, [], graded("A"),
+        lambda ds, digs: [], fractions(3.9), lambda judged: None, lines.append)
+    assert fixed is None and tried.endswith("3.9× its amplifier (no lower)")
+    assert [a[1] for a in asked] == [pytest.approx(5.0)]
+    fixed, _, tried = rem.within_the_amplifier(
+        first, used, "A", cfg, spec, [], graded("C"), lambda ds, digs: [],
+        fractions(0.5), lambda judged: None, lines.append)
+    assert fixed is None and tried.endswith("zone C as it runs")
+    # less current where the bearings carried the unbalance is a larger orbit
+    fixed, _, tried = rem.within_the_amplifier(
+        first, used, "A", cfg, spec, [], graded("A"), lambda ds, digs: [],
+        fractions(0.5), lambda judged: ("backup bearing", 250.0), lines.append)
+    assert fixed is None and tried.endswith(
+        "its unbalance orbit exceeds the backup bearing's clearance (250 µm)")
+    with pytest.raises(ValueError):
+        rem.within_the_amplifier(first, (np.array([1.0]), np.array([0.9])), "A", cfg, spec,
+                                 [], None, None, None, None, None)

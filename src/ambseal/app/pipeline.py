@@ -55,6 +55,7 @@ from ambseal.analysis import (
     unstable_open_loop_poles,
     used_by_speed,
     verdict_line,
+    worst_orbit_um,
 )
 from ambseal.app.commands import (
     Designed,
@@ -77,6 +78,7 @@ from ambseal.app.remedies import (
     on_the_sampled_plant,
     remedy,
     scheduled_on_speed,
+    within_the_amplifier,
     worst_zone_as_runs,
 )
 from ambseal.app.tracked import tracked_designs, tracked_ramp
@@ -400,6 +402,7 @@ def run(rig: str | Path | None = None, out_dir: str | Path = "ambseal-out",
                                  st.judge_cfg, stages, st.failed, allow_unstable)
         stability = _sampled_remedies(st, stability)
         stability = _scheduled_remedies(st, stability)
+        stability = _amplifier_remedies(st, stability)
         _note_speed_lpv(st)
         metrics = _deliver_and_report(st, model, stability, rig_path, truth, command)
     exit_status = EXIT_FAILED if any(f.designed and not (allow_unstable and f.judged)
@@ -637,15 +640,72 @@ def _scheduled_remedies(st: _RunState, stability: list) -> list:
             continue
         st.stages.begin("scheduled-redesign",
                         f"{method_label(m)} beyond zone B over the speed range")
-        fixed, cases, tried = scheduled_on_speed(
-            m, zone, cfg, st.spec, st.points, lambda ds, digs: _judge_designs(st, ds, digs, 0),
-            lambda ds, digs: _stability_cases(ds, digs, st.spec, st.points, cfg,
-                                              st.judge_cfg, lambda job: None)[1],
-            lambda line: st.say(line, 0))
-        if fixed is None:
-            d.summary["notes"] = [*d.summary.get("notes", []), f"Tried: {tried}"]
+        got = scheduled_on_speed(m, zone, cfg, st.spec, st.points, *_judging(st),
+                                 lambda line: st.say(line, 0))
+        stability = _kept(st, d, got, stability)
+    return stability
+
+
+def _judging(st: _RunState) -> tuple:
+    """How a redesign is judged, as the run judged the first: its judged conditions and
+    its stability speeds (``judge`` and ``stability`` of :mod:`ambseal.app.remedies`)."""
+    return (lambda ds, digs: _judge_designs(st, ds, digs, 0),
+            lambda ds, digs: _stability_cases(ds, digs, st.spec, st.points, st.design_cfg,
+                                              st.judge_cfg, lambda job: None)[1])
+
+
+def _kept(st: _RunState, first, got: tuple, stability: list) -> list:
+    """A remedy's ``(Remedied or None, stability cases, what was tried)``: the redesign in
+    place of ``first`` (:func:`_replaced`), or ``first`` kept with what was tried in its
+    notes. Returns the stability cases."""
+    fixed, cases, tried = got
+    if fixed is None:
+        first.summary["notes"] = [*first.summary.get("notes", []), f"Tried: {tried}"]
+        return stability
+    return _replaced(st, fixed, stability, cases)
+
+
+def _amplifier_remedies(st: _RunState, stability: list) -> list:
+    """An H∞ or μ whose loops all hold but whose unbalance current exceeds its amplifier
+    at a continuous speed or above (:func:`~ambseal.analysis.amplifier.used_by_speed`
+    above 1), on a rig whose own ``[design.rejection]`` is off, designed again
+    with the amplifier's limit in its control weight
+    (:func:`ambseal.app.remedies.within_the_amplifier`): where the current then fits and
+    the loops hold, it replaces the first, its cases theirs; else the first stays and its
+    notes say what was tried. Returns the stability cases."""
+    cfg = st.design_cfg
+    # with the rig's own unbalance force rejection on, the notch holds the unbalance where
+    # it is on and the amplifier is judged with it (ambseal.analysis.amplifier)
+    if speed_scheduled(st.cfg) or not cfg.amb or cfg.design.rejection.enabled \
+            or any(a.bias_current is None for a in cfg.amb):
+        return stability
+    lo = cfg.operating.continuous_hz[0]
+    clearances = rig_clearances_um(st.judge_cfg)
+    def amplifier(method, jobs, judged):
+        # from the minimum continuous speed up: below it (through a critical speed) the
+        # bearings must balance the mode's share of the unbalance whatever the controller,
+        # and the run's notch switches on there (switch_on_hz)
+        speeds, used = used_by_speed(st.judge_cfg, _unbalance_currents(method, jobs, judged))
+        return speeds[speeds >= lo], used[speeds >= lo]
+
+    for d in [d for d in st.designs if d.method in ("hinf", "mu")]:
+        m = d.method
+        if m in st.failed or m in st.cannot_run:
             continue
-        stability = _replaced(st, fixed, stability, cases)
+        used = amplifier(m, st.jobs, st.judged)
+        if not used[1].size or not np.max(used[1]) > 1:
+            continue
+        zone = worst_zone_as_runs([c for c, _ in _judged_of(m, st.jobs, st.judged)]
+                                  + [c for c in stability if c.controller == m])
+        st.stages.begin("amplifier-redesign",
+                        f"{method_label(m)} beyond its amplifier holding the unbalance")
+        got = within_the_amplifier(
+            d, used, zone, cfg, st.spec, st.points, *_judging(st),
+            lambda jobs, judged, m=m: amplifier(m, jobs, judged),
+            lambda judged: clearance_exceeded(
+                worst_orbit_um([c.to_dict() for c, _ in judged]), clearances),
+            lambda line: st.say(line, 0))
+        stability = _kept(st, d, got, stability)
     return stability
 
 

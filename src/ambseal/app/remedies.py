@@ -40,6 +40,33 @@ own speed, not one controller stretched over the range. It replaces the first wh
 holds every judged condition and stability speed at a better worst zone. Measured on the
 gyroscopic family (benchmarks/README.md, "The schedule as the remedy for a zone beyond
 B"): seed 9's fixed H∞ reached σ̄(S_o) 8.22 at standstill, its schedule 2.56 (zone A).
+
+**An H∞ or μ whose loops hold but that needs more current than the amplifier has to hold
+the unbalance** — at a judged speed from the minimum continuous one up (below it, through a
+critical speed, the run's notch switches on instead: :func:`ambseal.analysis.amplifier.
+switch_on_hz`) its synchronous current reference uses more than
+the bias current's linear range, the current limit or the supply
+(:func:`ambseal.analysis.amplifier.used_by_speed`) — is designed again with the
+amplifier's limit in its control weight (:func:`within_the_amplifier`): W_u gets a
+synchronous peak (:func:`ambseal.design.weights.peak_weight`) at the speed where the
+current is largest, h times the weight there, so the synthesis itself bounds
+``|K S_o|`` at that frequency; the synchronous current is ``K S_o G_f F_u``. Each
+redesign multiplies the height by the fraction its design before used over
+:data:`AMPLIFIER_TARGET`, and at least by :data:`AMPLIFIER_STEP` (a peak below the
+bound the rest of the loop sets moves little: on the rigid gyroscopic rotor of
+tests/test_amplifier_remedy.py μ's synchronous current at the trip speed fell 3 % with
+a peak of 2, 26 % with 8 and 55 % with 32, H∞'s 23 % with 4), until the
+current fits (the redesign replaces the first where its loops all hold within ISO
+14839-3 zone B, or no worse than the first's, and its unbalance orbit within the rig's
+clearances), or a step lowers it by less than
+1 − :data:`AMPLIFIER_STALL`: then the first design stays, and the run's unbalance force
+rejection (Herzog et al., IEEE TCST 4(5), 1996) is what is left. The current cannot
+always be bought: where the rotor's synchronous compliance is large (a disc whose
+I_p is near I_t resists a conical whirl at Ω with (I_p − I_t)Ω² only), the loop's gain
+at Ω stays high whatever the weight, T_i ≈ 1 and the bearings carry the unbalance; less
+current there is a larger orbit (the flywheel example's rig without its notch: μ needs
+1.21× the bias range at the trip speed with and without the peak, and H∞'s peak that
+fits its amplifier lets the orbit reach 765 µm against a 250 µm backup clearance).
 """
 
 from __future__ import annotations
@@ -47,7 +74,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
+import numpy as np
+
 from ambseal.analysis import (
+    CLEARANCE_WORDS,
     ZONE_SCALE,
     FailedController,
     JudgedCase,
@@ -61,10 +91,23 @@ from ambseal.design import design, uncertainty_at
 from ambseal.errors import ConfigError, SynthesisError
 
 __all__ = ["Remedied", "on_the_sampled_plant", "remedy", "scheduled_on_speed",
-           "worst_case", "worst_zone_as_runs"]
+           "within_the_amplifier", "worst_case", "worst_zone_as_runs", "AMPLIFIER_TARGET",
+           "AMPLIFIER_STALL", "AMPLIFIER_STEP"]
 
 #: Factor on the performance weight's bandwidth ω_B in the second attempt.
 OMEGA_B_FACTOR = 0.5
+
+#: The fraction of its amplifier a redesign within it aims at: the judged speeds are a
+#: grid, and the current between two of them and the held value's harmonics take a share.
+AMPLIFIER_TARGET = 0.8
+
+#: A redesign within the amplifier that leaves more than this fraction of the current of
+#: the one before has stalled: a higher peak no longer buys current (the loop needs its
+#: gain at that frequency).
+AMPLIFIER_STALL = 0.95
+
+#: The least factor by which each redesign within the amplifier raises its peak.
+AMPLIFIER_STEP = 4.0
 
 
 @dataclass(frozen=True)
@@ -328,3 +371,91 @@ def _redesigned(method: str, label: str, why: str, cfg, points, judge: Callable,
                         if cases else None)
             if f is not None]
     return (d, digitals[method], jobs, judged, cases, lost), ""
+
+
+def within_the_amplifier(first, used: tuple, zone: str | None, design_cfg, spec, points,
+                         judge: Callable, stability: Callable, amplifier: Callable,
+                         beyond: Callable, say: Callable[[str], None]
+                         ) -> tuple[Remedied | None, list, str]:
+    """An H∞ or μ designed again with the amplifier's limit in its control weight (module
+    docstring), for a design whose loops hold but whose unbalance current exceeds its
+    amplifier.
+
+    Parameters
+    ----------
+    first : Designed
+        The design (its weights, its synthesis plant, whether scheduled on the spin speed;
+        a redesign takes the same route).
+    used : (ndarray, ndarray)
+        Its judged speeds (Hz) and the largest fraction of an amplifier limit it uses at
+        each (:func:`ambseal.analysis.amplifier.used_by_speed`), above 1 somewhere.
+    design_cfg, spec, points, judge, stability, say
+        As for :func:`on_the_sampled_plant`.
+    amplifier : callable
+        ``amplifier(jobs, judged) -> (speeds_hz, used)``: the same for a redesign's judged
+        cases.
+    beyond : callable
+        ``beyond(judged) -> (name, µm) or None``: the clearance a redesign's worst
+        unbalance orbit exceeds (:func:`ambseal.analysis.delivery.clearance_exceeded`):
+        less current at Ω is a larger orbit where the bearings carried the unbalance.
+
+    Returns
+    -------
+    (Remedied or None, list, str)
+        The redesign whose current fits, whose orbit fits the clearances and whose loops
+        hold at every judged condition and stability speed within zone B (or no worse
+        than ``first``), and its stability cases; else None, [] and what was tried, for
+        the design's notes.
+
+    Raises
+    ------
+    ValueError
+        ``used`` nowhere above 1.
+    """
+    method, res = first.method, first.result
+    speeds, fraction = (np.asarray(x, float) for x in used)
+    if not np.max(fraction) > 1:
+        raise ValueError("within_the_amplifier: the design fits its amplifier")
+    peak_hz = float(speeds[np.argmax(fraction)])
+    cfg = design_cfg.model_copy(update={"design": design_cfg.design.model_copy(
+        update={"synthesis_plant": res.synthesis_plant})})
+    # a redesign may trade grade for current down to zone B, never below the first's
+    allowed = max(ZONE_SCALE.index("B"), ZONE_SCALE.index(zone) if zone else 0)
+    base = spec.weights[method]
+    height, ratio, tried = 1.0, float(np.max(fraction)), []
+    why = (f"it needs {ratio:.3g}× its amplifier to hold the unbalance at {peak_hz:.4g} Hz")
+    while True:
+        height *= max(ratio / AMPLIFIER_TARGET, AMPLIFIER_STEP)
+        # the specification's weights with the peak: the recipe then adds what it adds to
+        # its own (H∞'s orbit demand where it is scheduled on the spin speed)
+        peaked = replace(spec, weights={**spec.weights, method: replace(
+            base, wu_peak_hz=peak_hz, wu_peak_gain=height)})
+        label = f"designed with W_u × {height:.3g} at {peak_hz:.4g} Hz"
+        got, words = _redesigned(
+            method, label, why, cfg, points, judge, stability, say,
+            lambda peaked=peaked: design(cfg, method, spec=peaked,
+                                         scheduled_on_speed=res.scheduled is not None),
+            as_runs_only=res.synthesis_plant == "sampled")
+        if got is None:
+            return None, [], "; ".join([*tried, words])
+        d, digital, jobs, judged, cases, lost = got
+        if lost:
+            return None, [], "; ".join([*tried, f"{label}: " + "; ".join(
+                f.reason.split(" — ", 1)[-1] for f in lost)])
+        grade = worst_zone_as_runs([c for c, _ in judged] + [c for c, _ in cases])
+        if grade is not None and ZONE_SCALE.index(grade) > allowed:
+            return None, [], "; ".join([*tried, f"{label}: zone {grade} as it runs"])
+        over = beyond(judged)
+        if over is not None:
+            return None, [], "; ".join([*tried, f"{label}: its unbalance orbit exceeds "
+                                        f"{CLEARANCE_WORDS.get(over[0], over[0])} "
+                                        f"({over[1]:.3g} µm)"])
+        again = float(np.max(amplifier(jobs, judged)[1], initial=0.0))
+        if again <= 1:
+            say(f"{method}: {label} holds at every judged condition within its amplifier "
+                f"({again:.3g}× at most), zone {grade} as it runs")
+            return Remedied(d, digital, jobs, judged), [c for c, _ in cases], ""
+        tried.append(f"{label}: {again:.3g}× its amplifier")
+        if again > AMPLIFIER_STALL * ratio:
+            return None, [], "; ".join(tried) + " (no lower)"
+        ratio = again

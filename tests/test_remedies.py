@@ -171,8 +171,9 @@ def test_a_design_beyond_its_amplifier_is_designed_again_with_its_limit_in_w_u(m
     peak raised by the fraction used over 0.8 and at least fourfold: 4, then 4 × 4 after
     a redesign that needs 1.1×; the one within its amplifier replaces it. A design that
     needs 4× starts at 4/0.8 = 5. A redesign that lowers the current by less than
-    5 % ends the attempts; one beyond zone B (the first at A), or whose orbit exceeds a
-    clearance, is refused."""
+    5 % ends the attempts; one beyond zone B (the first at A), or that fails what else
+    the run delivers on (an orbit beyond a clearance), is refused. A first design that
+    came by a remedy keeps that remedy's words ahead of this one's."""
     import numpy as np
 
     import ambseal.app.remedies as rem
@@ -210,7 +211,7 @@ def test_a_design_beyond_its_amplifier_is_designed_again_with_its_limit_in_w_u(m
     first, lines = Designed(Result()), []
     fixed, cases, tried = rem.within_the_amplifier(
         first, used, "A", cfg, spec, [], graded("A"), lambda ds, digs: [],
-        fractions(1.1, 0.7), lambda judged: None, lines.append)
+        fractions(1.1, 0.7), lambda jobs, judged: None, lines.append)
     assert isinstance(fixed, Remedied) and cases == [] and tried == ""
     # the specification's weights with the peak (the recipe adds what it adds to its own)
     gain = spec.weights["hinf"].wu_gain
@@ -219,22 +220,29 @@ def test_a_design_beyond_its_amplifier_is_designed_again_with_its_limit_in_w_u(m
     assert fixed.design.summary["remedy"].endswith(
         "it needs 1.2× its amplifier to hold the unbalance at 400 Hz")
     assert "within its amplifier (0.7× at most), zone A" in lines[-1]
+    # a first design that came by a remedy keeps its story
+    came = Designed(Result(), {"remedy": "designed on the sampled plant: lost as it runs"})
+    fixed, _, _ = rem.within_the_amplifier(
+        came, used, "A", cfg, spec, [], graded("A"), lambda ds, digs: [], fractions(0.7),
+        lambda jobs, judged: None, lines.append)
+    assert fixed.design.summary["remedy"].startswith(
+        "designed on the sampled plant: lost as it runs; then designed with W_u × 4 at 400 Hz")
     asked.clear()
     fixed, _, tried = rem.within_the_amplifier(
         first, (used[0], used[1] * 4 / 1.2), "A", cfg, spec, [], graded("A"),
-        lambda ds, digs: [], fractions(3.9), lambda judged: None, lines.append)
+        lambda ds, digs: [], fractions(3.9), lambda jobs, judged: None, lines.append)
     assert fixed is None and tried.endswith("3.9× its amplifier (no lower)")
     assert [a[1] for a in asked] == [pytest.approx(5.0)]
     fixed, _, tried = rem.within_the_amplifier(
         first, used, "A", cfg, spec, [], graded("C"), lambda ds, digs: [],
-        fractions(0.5), lambda judged: None, lines.append)
+        fractions(0.5), lambda jobs, judged: None, lines.append)
     assert fixed is None and tried.endswith("zone C as it runs")
     # less current where the bearings carried the unbalance is a larger orbit
     fixed, _, tried = rem.within_the_amplifier(
         first, used, "A", cfg, spec, [], graded("A"), lambda ds, digs: [],
-        fractions(0.5), lambda judged: ("backup bearing", 250.0), lines.append)
-    assert fixed is None and tried.endswith(
-        "its unbalance orbit exceeds the backup bearing's clearance (250 µm)")
+        fractions(0.5), lambda jobs, judged: "its orbit exceeds the air gap", lines.append)
+    assert fixed is None
+    assert tried == "designed with W_u × 4 at 400 Hz: its orbit exceeds the air gap"
     with pytest.raises(ValueError):
         rem.within_the_amplifier(first, (np.array([1.0]), np.array([0.9])), "A", cfg, spec,
                                  [], None, None, None, None, None)

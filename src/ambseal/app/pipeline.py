@@ -23,6 +23,7 @@ from ambseal.analysis import (
     also_failed,
     CLEARANCE_WORDS,
     capacity_block,
+    capacity_words,
     clearance_exceeded,
     clearance_failure,
     facility_rejection,
@@ -440,6 +441,8 @@ class _RunState:
     digitals: dict = field(default_factory=dict)
     #: method → why it has no digital controller
     cannot_run: dict[str, str] = field(default_factory=dict)
+    #: method → what its redesigns within the amplifier tried, where none was kept
+    amplifier_tried: dict[str, str] = field(default_factory=dict)
     ident: Identified | None = None
     #: the judged cases: one job per design and condition, and its (case, curves)
     jobs: list[dict] = field(default_factory=list)
@@ -688,6 +691,17 @@ def _amplifier_remedies(st: _RunState, stability: list) -> list:
         speeds, used = used_by_speed(st.judge_cfg, _unbalance_currents(method, jobs, judged))
         return speeds[speeds >= lo], used[speeds >= lo]
 
+    def fails(method, jobs, judged) -> str | None:
+        # less current at Ω is a larger orbit where the bearings carried the unbalance; and
+        # a softer loop may need more of its amplifier in the current impulse
+        over = clearance_exceeded(worst_orbit_um([c.to_dict() for c, _ in judged]),
+                                  clearances)
+        if over is not None:
+            return (f"its unbalance orbit exceeds {CLEARANCE_WORDS.get(over[0], over[0])} "
+                    f"({over[1]:.3g} µm)")
+        block = capacity_block(st.judge_cfg, [], _impulses(method, jobs, judged))
+        return capacity_words(block) if saturates(block) else None
+
     for d in [d for d in st.designs if d.method in ("hinf", "mu")]:
         m = d.method
         if m in st.failed or m in st.cannot_run:
@@ -702,9 +716,10 @@ def _amplifier_remedies(st: _RunState, stability: list) -> list:
         got = within_the_amplifier(
             d, used, zone, cfg, st.spec, st.points, *_judging(st),
             lambda jobs, judged, m=m: amplifier(m, jobs, judged),
-            lambda judged: clearance_exceeded(
-                worst_orbit_um([c.to_dict() for c, _ in judged]), clearances),
+            lambda jobs, judged, m=m: fails(m, jobs, judged),
             lambda line: st.say(line, 0))
+        if got[0] is None:
+            st.amplifier_tried[m] = got[2]
         stability = _kept(st, d, got, stability)
     return stability
 
@@ -998,6 +1013,9 @@ def _deliver_and_report(st: _RunState, model: _Model, stability: list, rig_path:
     for m, block in capacity.items():  # an amplifier that saturates fails its controller
         f = saturation_failure(m, block, designed=m != "pid", kept=st.allow_unstable,
                                derived=cfg.controller.pid is None)
+        if f is not None and m in st.amplifier_tried:
+            f = replace(f, reason=f"{f.reason}; designed again with the amplifier's limit in "
+                                  f"its control weight: {st.amplifier_tried[m]}")
         if f is not None and m in automatic and m in notches:
             f = replace(f, reason=f"{f.reason}; {_why_not_notched(notches[m])}")
         if f is not None:

@@ -57,8 +57,8 @@ bound the rest of the loop sets moves little: on the rigid gyroscopic rotor of
 tests/test_amplifier_remedy.py μ's synchronous current at the trip speed fell 3 % with
 a peak of 2, 26 % with 8 and 55 % with 32, H∞'s 23 % with 4), until the
 current fits (the redesign replaces the first where its loops all hold within ISO
-14839-3 zone B, or no worse than the first's, and its unbalance orbit within the rig's
-clearances), or a step lowers it by less than
+14839-3 zone B, or no worse than the first's, its unbalance orbit within the rig's
+clearances and its current impulse within the amplifier), or a step lowers it by less than
 1 − :data:`AMPLIFIER_STALL`: then the first design stays, and the run's unbalance force
 rejection (Herzog et al., IEEE TCST 4(5), 1996) is what is left. The current cannot
 always be bought: where the rotor's synchronous compliance is large (a disc whose
@@ -77,7 +77,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ambseal.analysis import (
-    CLEARANCE_WORDS,
     ZONE_SCALE,
     FailedController,
     JudgedCase,
@@ -395,16 +394,17 @@ def within_the_amplifier(first, used: tuple, zone: str | None, design_cfg, spec,
         ``amplifier(jobs, judged) -> (speeds_hz, used)``: the same for a redesign's judged
         cases.
     beyond : callable
-        ``beyond(judged) -> (name, µm) or None``: the clearance a redesign's worst
-        unbalance orbit exceeds (:func:`ambseal.analysis.delivery.clearance_exceeded`):
-        less current at Ω is a larger orbit where the bearings carried the unbalance.
+        ``beyond(jobs, judged) -> str or None``: what else of the delivery a redesign's
+        judged cases fail, in words (the run's: an unbalance orbit beyond a clearance,
+        :func:`ambseal.analysis.delivery.clearance_exceeded`, where less current at Ω is
+        a larger orbit; an amplifier the current impulse saturates).
 
     Returns
     -------
     (Remedied or None, list, str)
-        The redesign whose current fits, whose orbit fits the clearances and whose loops
-        hold at every judged condition and stability speed within zone B (or no worse
-        than ``first``), and its stability cases; else None, [] and what was tried, for
+        The redesign whose current fits, that fails nothing ``beyond`` names and whose
+        loops hold at every judged condition and stability speed within zone B (or no
+        worse than ``first``), and its stability cases; else None, [] and what was tried, for
         the design's notes.
 
     Raises
@@ -445,15 +445,15 @@ def within_the_amplifier(first, used: tuple, zone: str | None, design_cfg, spec,
         grade = worst_zone_as_runs([c for c, _ in judged] + [c for c, _ in cases])
         if grade is not None and ZONE_SCALE.index(grade) > allowed:
             return None, [], "; ".join([*tried, f"{label}: zone {grade} as it runs"])
-        over = beyond(judged)
-        if over is not None:
-            return None, [], "; ".join([*tried, f"{label}: its unbalance orbit exceeds "
-                                        f"{CLEARANCE_WORDS.get(over[0], over[0])} "
-                                        f"({over[1]:.3g} µm)"])
+        other = beyond(jobs, judged)
+        if other is not None:
+            return None, [], "; ".join([*tried, f"{label}: {other}"])
         again = float(np.max(amplifier(jobs, judged)[1], initial=0.0))
         if again <= 1:
             say(f"{method}: {label} holds at every judged condition within its amplifier "
                 f"({again:.3g}× at most), zone {grade} as it runs")
+            if first.summary.get("remedy"):  # the way the first came, then this
+                d.summary["remedy"] = f"{first.summary['remedy']}; then {d.summary['remedy']}"
             return Remedied(d, digital, jobs, judged), [c for c, _ in cases], ""
         tried.append(f"{label}: {again:.3g}× its amplifier")
         if again > AMPLIFIER_STALL * ratio:

@@ -1,5 +1,5 @@
 """The amplifier's limit inside the design, end to end: a rigid gyroscopic rotor (Ip/It
-0.79, 133–400 Hz, tests/design/test_design_over_speed.py) whose bearings have a bias
+0.79, 133–400 Hz, :func:`tests.rigid_rotor.rigid_amb_rig`) whose bearings have a bias
 current of 0.9 A, so that H∞ and μ as first designed need 1.29× and 1.23× the bias
 current's linear range to hold the G2.5 unbalance at the trip speed (419 Hz) — and μ's
 notch, switched on by the run, loses the loop. ``ambseal run`` designs each again with a
@@ -18,9 +18,9 @@ from ambseal.app.pipeline import run
 from ambseal.config import load_rig
 from ambseal.model import build_plant
 
-from .design.test_design_over_speed import _rigid_rig
 from .exported_files import file_at
 from .freq_at import at
+from .rigid_rotor import inertia, rigid_amb_rig
 
 pytestmark = pytest.mark.heavy
 
@@ -31,9 +31,7 @@ BIAS_A = 0.9
 @pytest.fixture(scope="module")
 def low_bias_run(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("amplifier")
-    rig = tmp / "low_bias.toml"
-    rig.write_text(_rigid_rig(tmp).read_text().replace("bias_current = 2.5",
-                                                       f"bias_current = {BIAS_A}"))
+    rig = rigid_amb_rig(tmp, bias_a=BIAS_A)
     out = tmp / "out"
     run(rig, out, identification=False, progress=False)
     return rig, json.loads((out / "metrics.json").read_text()), out
@@ -63,9 +61,7 @@ def _coil_current_a(rig, out, method: str, hz: float) -> float:
     for k in range(len(frc) // 2):
         T[2 * k, k], T[2 * k + 1, k] = 1.0, -1j
     i_ref = np.linalg.norm(Kz @ np.linalg.solve(np.eye(len(Gz)) + Gz @ Kz, Gfz @ T), axis=1)
-    # the rig's solid shaft and its disk
-    mass = sum(cfg.materials[s.material].rho * np.pi / 4 * s.outer_diameter ** 2 * s.length
-               for s in cfg.shaft) + sum(k.mass for k in cfg.disk)
+    mass = inertia(cfg.disk[0].mass, cfg.disk[0].Ip, cfg.disk[0].Id)[0]  # by hand
     omega, top = 2 * np.pi * hz, 2 * np.pi * cfg.operating.speed_range_hz[1]
     force = mass * 2.5e-3 * omega ** 2 / top
     loop = 1 / abs(1 + 1j * hz / cfg.actuator.cutoff_hz)

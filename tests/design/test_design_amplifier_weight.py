@@ -14,7 +14,7 @@ from ambseal.config import load_rig
 from ambseal.design import design
 from ambseal.model import build_plant
 
-from .test_design_over_speed import _rigid_rig
+from ..rigid_rotor import rigid_amb_rig
 
 
 def _ks(cfg, K, f_hz: float) -> float:
@@ -34,7 +34,7 @@ def test_a_peak_on_w_u_at_the_top_speed_lowers_the_synchronous_gain_there(tmp_pa
     at 400 Hz, σ̄(K S_o) there falls by at least h/2 (the synthesis's own bound moves by
     h; the rest of the loop takes a share of it), and an octave below, where the rigid
     modes need the gain, it falls by less than a third as much."""
-    cfg = load_rig(_rigid_rig(tmp_path), ("design.one_speed=true",))
+    cfg = load_rig(rigid_amb_rig(tmp_path), ("design.one_speed=true",))
     first = design(cfg, "hinf", allow_unstable=True)
     peaked = design(cfg, "hinf", allow_unstable=True, weights=replace(
         first.weights, wu_peak_hz=400.0, wu_peak_gain=height))

@@ -24,7 +24,7 @@ from ambseal.model import build_plant
 from ambseal.robust import LEVEL_FLOOR
 
 from ..benchmark_module import bench_module
-from ..rigid_rotor import L, inertia, rotor_text
+from ..rigid_rotor import L, inertia, rigid_amb_rig, rotor_text
 
 FAMILY_RIG = Path(__file__).resolve().parents[1] / "data" / "gyro_wheel_rig.toml"
 
@@ -63,24 +63,6 @@ def _held_with_delay(cfg, K, speeds_hz) -> list[bool]:
     return out
 
 
-def _rigid_rig(tmp_path, disk_ip: float = 0.4) -> Path:
-    """A rigid rotor (shaft 1e4 times stiffer than steel) with a disk of polar inertia
-    ``disk_ip`` (0.4 kg·m²: Ip/It 0.79 about the centre of mass), on two AMBs, run
-    133–400 Hz, sampled at 20 kHz with one sample of delay."""
-    text = rotor_text("rigid gyroscopic rotor", 20.0, disk_ip, 0.2, 4, modal_damping=0.01)
-    for name, z in (("A", 0.05), ("B", L - 0.05)):
-        text += (f'[[amb]]\nname = "{name}"\nposition = {z}\nsensor_position = {z}\n'
-                 "ki = 200.0\nks = 1.0e6\nbias_current = 2.5\ncurrent_limit = 5.0\n"
-                 "air_gap = 5.0e-4\n")
-    text += ('[actuator]\nmodel = "first_order"\ncutoff_hz = 2000.0\n'
-             "[controller]\nsample_rate_hz = 20000.0\ndelay_samples = 1\n"
-             "[operating]\nspeed_rpm = 24000.0\npressure_bar = 0.0\n"
-             "speed_range_hz = [133.3, 400.0]\n")
-    path = tmp_path / "rigid_rotor.toml"
-    path.write_text(text)
-    return path
-
-
 #: Speeds between and beside the judged ones (Hz): the design over the range holds the
 #: plant at every speed of it, not only at the speeds it was checked at.
 BETWEEN_HZ = (0.0, 25.0, 60.0, 110.0, 170.0, 230.0, 290.0, 350.0, 400.0)
@@ -108,7 +90,7 @@ def rigid_mu(tmp_path_factory):
     designed alone, no trials shared (about a minute of CPU, which two tests share)."""
     import ambseal.design.recipes as recipes
 
-    rig = _rigid_rig(tmp_path_factory.mktemp("rigid"))
+    rig = rigid_amb_rig(tmp_path_factory.mktemp("rigid"))
     made, real = [], recipes._synthesise_enlarging
 
     def counted(c, method, *args):
@@ -129,7 +111,7 @@ def test_a_rigid_gyroscopic_rotor_is_held_from_standstill_to_the_top_speed(
     """Designed at the top speed alone the loop is unstable at standstill; the design with
     the speed uncertain over 0–400 Hz holds at every speed of :data:`BETWEEN_HZ`
     (:func:`_held_where_one_speed_is_not`), and its steps say how it was designed."""
-    rig, held = _rigid_rig(tmp_path), None
+    rig, held = rigid_amb_rig(tmp_path), None
     if method == "mu":
         rig, held, _ = request.getfixturevalue("rigid_mu")
     held = _held_where_one_speed_is_not(rig, method, held)
@@ -178,7 +160,7 @@ def test_a_design_refused_over_the_speed_range_checks_what_lost_it_once(tmp_path
 
     monkeypatch.setattr(recipes, "_lost_by", counted)
     with pytest.raises(SynthesisError) as refused:
-        design(load_rig(_rigid_rig(tmp_path)), "hinf")
+        design(load_rig(rigid_amb_rig(tmp_path)), "hinf")
     assert len(asked) == 1
     message = str(refused.value)
     assert "0 bar, 0 Hz" in message and "the gyroscopic moments move it" in message, message
@@ -207,7 +189,7 @@ def test_a_disc_like_rigid_rotor_is_held_at_the_performance_level_the_speed_rang
     monkeypatch.setattr(dk, "mussv", counted, raising=False)
     _, it, ip = inertia(20.0, 0.622, 0.2)
     assert ip / it == pytest.approx(1.2, abs=0.01)
-    held = _held_where_one_speed_is_not(_rigid_rig(tmp_path, 0.622), method)
+    held = _held_where_one_speed_is_not(rigid_amb_rig(tmp_path, 0.622), method)
     assert (len(analyses) == 0) == (method == "hinf")
     level = held.stopping["performance_level"]
     assert LEVEL_FLOOR < level["level"] < 1
@@ -286,7 +268,7 @@ def test_hinf_scheduled_on_speed_holds_a_rigid_rotor_no_fixed_design_holds(tmp_p
 
     monkeypatch.setattr(recipes, "_held_over_speed", lambda *a, **k: None)
     monkeypatch.setattr(recipes, "_first_held", lambda *a, **k: None)
-    rig = _rigid_rig(tmp_path, 0.622)
+    rig = rigid_amb_rig(tmp_path, 0.622)
     one = load_rig(rig, ("design.one_speed=true",))
     assert not _held_as_it_runs(one, design(one, "hinf", allow_unstable=True).K, [0.0])[0]
     held = design(load_rig(rig), "hinf")
@@ -327,7 +309,7 @@ def test_mu_scheduled_on_speed_is_the_k_step_on_each_frozen_plant(tmp_path):
     poles of the sampled, delayed loop on the full-order plant)."""
     from ambseal.design.speed_lft import at_speed
 
-    cfg = load_rig(_rigid_rig(tmp_path, 0.622))
+    cfg = load_rig(rigid_amb_rig(tmp_path, 0.622))
     held = design(cfg, "mu", scheduled_on_speed=True)
     K, stop = held.controller, held.stopping["mu"]
     assert held.speed_range_hz == (0.0, 400.0) and stop["d_scales"] == 0
@@ -372,7 +354,7 @@ def test_hinf_scheduled_on_speed_without_the_orbit_demand_cancels_the_nutation(t
 
     monkeypatch.setattr(recipes, "_held_over_speed", lambda *a, **k: None)
     monkeypatch.setattr(recipes, "_first_held", lambda *a, **k: None)
-    cfg = load_rig(_rigid_rig(tmp_path, 0.622), ("design.hinf.orbit_um=0",))
+    cfg = load_rig(rigid_amb_rig(tmp_path, 0.622), ("design.hinf.orbit_um=0",))
     held = design(cfg, "hinf")
     assert "orbit demand" not in held.steps[-1]
     assert _nutation_damping(cfg, held.controller, 400.0) < 0.01
@@ -391,7 +373,7 @@ def test_ambseal_design_exports_the_hinf_scheduled_on_speed(tmp_path, monkeypatc
 
     monkeypatch.setattr(recipes, "_held_over_speed", lambda *a, **k: None)
     monkeypatch.setattr(recipes, "_first_held", lambda *a, **k: None)
-    rig = _rigid_rig(tmp_path, 0.622)
+    rig = rigid_amb_rig(tmp_path, 0.622)
     assert main(["design", str(rig), "--method", "hinf", "--out", str(tmp_path / "d")]) == 0
     out = json.loads(capsys.readouterr().out)
     method = out["discretisation"]["method"]
@@ -415,7 +397,7 @@ def test_only_hinf_and_mu_on_the_continuous_plant_are_asked_for_scheduled(tmp_pa
     a rig with a speed range and the continuous synthesis plant."""
     from ambseal.errors import ConfigError
 
-    cfg = load_rig(_rigid_rig(tmp_path, 0.4))
+    cfg = load_rig(rigid_amb_rig(tmp_path, 0.4))
     with pytest.raises(ConfigError, match="scheduled_on_speed"):
         design(cfg, "pid", scheduled_on_speed=True)
     sampled = cfg.model_copy(update={"design": cfg.design.model_copy(

@@ -55,7 +55,8 @@ redesign multiplies the height by the fraction its design before used over
 :data:`AMPLIFIER_TARGET`, and at least by :data:`AMPLIFIER_STEP` (a peak below the
 bound the rest of the loop sets moves little: on the rigid gyroscopic rotor of
 tests/test_amplifier_remedy.py μ's synchronous current at the trip speed fell 3 % with
-a peak of 2, 26 % with 8 and 55 % with 32, H∞'s 23 % with 4), until the
+a peak of 2, 26 % with 8 and 55 % with 32, H∞'s 23 % with 4; benchmarks/README.md, "The
+amplifier's limit inside the design"), until the
 current fits (the redesign replaces the first where its loops all hold within ISO
 14839-3 zone B, or no worse than the first's, its unbalance orbit within the rig's
 clearances and its current impulse within the amplifier), or a step lowers it by less than

@@ -26,9 +26,9 @@
 
   On W_1 instead (the unbalance as a current F_u/Ki entering at a bearing) the same peak
   also weights the compliance ``S_o G`` at Ω₀, which no controller changes on a
-  supercritical rotor (it is the mass line): on the rigid gyroscopic rotor of
-  tests/design/test_design_amplifier_weight.py γ rose 14-fold and ``|T_i(jΩ₀)|`` grew,
-  where on W_u a peak of 8 cut ``|K S_o(jΩ₀)|`` 6.5-fold at γ 0.73 against 0.65.
+  supercritical rotor (it is the mass line): on a rigid gyroscopic rotor γ rose 14-fold
+  and ``|T_i(jΩ₀)|`` grew, where on W_u a peak of 8 cut ``|K S_o(jΩ₀)|`` 6.5-fold at γ
+  0.73 against 0.65 (benchmarks/README.md, "The amplifier's limit inside the design").
 
 All frequencies in rad/s unless the name says ``_hz``.
 

@@ -24,7 +24,7 @@ from ambseal.model import build_plant
 from ambseal.robust import LEVEL_FLOOR
 
 from ..benchmark_module import bench_module
-from ..rigid_rotor import L, inertia, rigid_amb_rig, rotor_text
+from ..rigid_rotor import inertia, rigid_amb_rig
 
 FAMILY_RIG = Path(__file__).resolve().parents[1] / "data" / "gyro_wheel_rig.toml"
 

@@ -22,7 +22,8 @@ from .exported_files import file_at
 from .freq_at import at
 from .rigid_rotor import inertia, rigid_amb_rig
 
-pytestmark = pytest.mark.heavy
+# both methods read one run, made once on one worker (pyproject.toml: --dist loadgroup)
+pytestmark = [pytest.mark.heavy, pytest.mark.xdist_group("low_bias_run")]
 
 #: The bias current (A) that the first designs' unbalance current exceeds.
 BIAS_A = 0.9

@@ -158,7 +158,8 @@ def test_the_failures_name_the_mode_by_its_kind_and_a_remedy_that_holds(flywheel
     # the amplifier's limit was put inside the design first: near the trip speed the
     # disc's conical whirl meets (Ip − It)Ω² only, and no peak on W_u buys the current
     assert re.search(r"designed again with the amplifier's limit in its control weight: "
-                     r"designed with W_u × 4 at 1047 Hz: 1\.\d+× its amplifier \(no lower\)",
+                     r"designed with W_u × 4 at 1047 Hz by complex D–K: 1\.\d+× its amplifier "
+                     r"\(no lower\)",
                      failed["mu"]["reason"]), failed["mu"]["reason"]
     assert "lpv" not in failed
 

@@ -189,15 +189,20 @@ def test_a_design_beyond_its_amplifier_is_designed_again_with_its_limit_in_w_u(m
         def summary(self):
             return {}
 
-    asked = []
+    class MuResult(Result):
+        method = "mu"
+
+    asked, iterations = [], []
 
     def fake_design(cfg_, method, *, spec=None, scheduled_on_speed=False, **kw):
         w = spec.weights[method]
         asked.append((w.wu_peak_hz, w.wu_peak_gain, w.wu_gain, scheduled_on_speed, kw))
-        return Result()
+        iterations.append((method, spec.mu_iteration))
+        return Result() if method == "hinf" else MuResult()
 
     monkeypatch.setattr(rem, "design", fake_design)
-    monkeypatch.setattr(rem, "digitals_for", lambda c, ds, pts: ({"hinf": object()}, {}))
+    monkeypatch.setattr(rem, "digitals_for",
+                        lambda c, ds, pts: ({ds[0].method: object()}, {}))
 
     def graded(zone):
         run = SampledStability(True, 0.5, 1e4, 2.0, {"A_zeta": 2.0}, zone, {"A_zeta": zone})
@@ -243,6 +248,16 @@ def test_a_design_beyond_its_amplifier_is_designed_again_with_its_limit_in_w_u(m
         fractions(0.5), lambda jobs, judged: "its orbit exceeds the air gap", lines.append)
     assert fixed is None
     assert tried == "designed with W_u × 4 at 400 Hz: its orbit exceeds the air gap"
+    # H∞ by its own iteration; μ by complex D–K, whose μ under the peak's demand beyond
+    # the specification is not lifted into D–G–K's steps
+    assert set(iterations) == {("hinf", spec.mu_iteration)} and spec.mu_iteration == "dgk"
+    iterations.clear()
+    fixed, _, _ = rem.within_the_amplifier(
+        Designed(MuResult()), used, "A", cfg, spec, [], graded("A"), lambda ds, digs: [],
+        fractions(0.7), lambda jobs, judged: None, lines.append)
+    assert isinstance(fixed, Remedied) and iterations == [("mu", "dk")]
+    assert fixed.design.summary["remedy"].startswith(
+        "designed with W_u × 4 at 400 Hz by complex D–K: it needs 1.2×")
     with pytest.raises(ValueError):
         rem.within_the_amplifier(first, (np.array([1.0]), np.array([0.9])), "A", cfg, spec,
                                  [], None, None, None, None, None)

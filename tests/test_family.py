@@ -82,7 +82,11 @@ def test_a_disc_like_rotor_switches_its_notch_on_where_it_needs_it(tmp_path):
     assert m["controllers"]["lpv"]["capacity"]["rejection_automatic"]
 
 
-@pytest.mark.heavy
+# a whole family rig's run, six minutes on one CI core: behind `slow` with the other family
+# runs, so that CI keeps within its 30 minutes; the default run checks the remedy's wiring
+# (tests/test_remedies.py) and a design on the sampled plant closed as it runs
+# (tests/analysis/test_judge_sampled_design.py, tests/design/test_design_margin.py)
+@pytest.mark.slow
 def test_a_design_lost_only_as_it_runs_is_designed_on_the_sampled_plant(tmp_path):
     """Seed 17 (10 kHz, one sample of delay): H∞ designed on the continuous plant holds its
     continuous loop everywhere but loses a 1.3 kHz bending mode as it runs (not delivered

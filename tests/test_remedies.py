@@ -261,3 +261,61 @@ def test_a_design_beyond_its_amplifier_is_designed_again_with_its_limit_in_w_u(m
     with pytest.raises(ValueError):
         rem.within_the_amplifier(first, (np.array([1.0]), np.array([0.9])), "A", cfg, spec,
                                  [], None, None, None, None, None)
+
+
+def test_a_design_lost_only_as_it_runs_is_designed_again_on_the_sampled_plant(monkeypatch):
+    """The redesign is made on the sampled plant (``[design] synthesis_plant =
+    "sampled"``, the rest of the rig as it was) with its unstable loops kept for the
+    judgement, and judged as it runs alone: a loop lost there fails it though its
+    continuous loop holds, in that loop's own words; where every loop as it runs holds it
+    replaces the first, its remedy naming why."""
+    import ambseal.app.remedies as rem
+    from ambseal.app.commands import Designed
+
+    cfg = load_rig()
+    spec = design_spec(cfg)
+
+    class Result:
+        method = "hinf"
+        synthesis_plant = "sampled"
+
+        def summary(self):
+            return {}
+
+    asked = []
+
+    def fake_design(cfg_, method, *, spec=None, **kw):
+        asked.append((cfg_.design.synthesis_plant, cfg_.model_copy(update={
+            "design": cfg.design}) == cfg, spec, kw))
+        return Result()
+
+    monkeypatch.setattr(rem, "design", fake_design)
+    monkeypatch.setattr(rem, "digitals_for",
+                        lambda c, ds, pts: ({ds[0].method: object()}, {}))
+    lost = SampledStability(False, 1.02, 1e4)
+    held = SampledStability(True, 0.98, 1e4)
+
+    def judge(discrete, continuous=True):  # the loop as it runs, as given
+        return lambda ds, digs: ([None], [(_case(0.0, continuous, -5.0 if continuous else 1.0,
+                                                 discrete, "0 bar"), {})])
+
+    fixed, cases, words = rem.on_the_sampled_plant(
+        "hinf", "lost as it runs", cfg, spec, [], judge(lost), lambda ds, digs: [],
+        lambda line: None)
+    assert fixed is None and cases == []
+    assert words.startswith("designed on the sampled plant (w-plane, its Tustin transform "
+                            "the discrete design): ") and "0 bar" in words
+    assert asked == [("sampled", True, spec, {"allow_unstable": True})]
+    fixed, cases, words = rem.on_the_sampled_plant(
+        "hinf", "lost as it runs", cfg, spec, [], judge(held), lambda ds, digs: [],
+        lambda line: None)
+    assert isinstance(fixed, Remedied) and words == ""
+    assert isinstance(fixed.design, Designed)
+    assert fixed.design.summary["remedy"] == (
+        "designed on the sampled plant (w-plane, its Tustin transform the discrete "
+        "design): lost as it runs")
+    # its w-plane form closed in continuous time is not a loop that runs
+    fixed, _, words = rem.on_the_sampled_plant(
+        "hinf", "lost as it runs", cfg, spec, [], judge(held, continuous=False),
+        lambda ds, digs: [], lambda line: None)
+    assert isinstance(fixed, Remedied) and words == ""

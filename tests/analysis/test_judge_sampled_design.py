@@ -158,14 +158,17 @@ def test_a_sampled_designs_file_says_so_and_its_modes_are_as_it_runs(sampled_hin
     p = cfg.operating.pressure_bar
     z = _poles_of_python_control(cfg, d.controller, p, _PARTED_HZ)
     assert np.abs(z).max() < 1.0  # the loop as it runs holds there
-    ref = np.log(z[np.abs(z) > 1e-12].astype(complex)) / T
     m = closed_loop_modes(cfg, K, speed_hz=_PARTED_HZ, pressure_bar=p)
     assert m.poles.size and m.stable
     # its w-plane form closed in continuous time, what these commands closed before, does not
     assert not closed_loop_modes(cfg, d.controller, speed_hz=_PARTED_HZ, pressure_bar=p).stable
     assert np.abs(m.poles.imag).max() < np.pi / T  # below Nyquist: no aliased mode listed
+    # compared where both were computed, in z: a cluster of poles near z = 1 (here two
+    # about 40 rad/s, 0.4 rad/s apart) is accurate to about √ε there, not to ε|λ| in
+    # λ = ln z / T, and python-control's z moves by 5e-9 between BLAS kernel sets
+    z_ref = z[np.abs(z) > 1e-12]
     for lam in m.poles:
-        assert np.abs(ref - lam).min() == pytest.approx(0.0, abs=1e-6 * abs(lam))
+        assert np.abs(z_ref - np.exp(lam * T)).min() == pytest.approx(0.0, abs=1e-7)
 
 
 def test_a_file_without_synthesis_plant_is_a_continuous_design(sampled_hinf, tmp_path):

@@ -26,7 +26,7 @@ worse. So, in turn:
   round's scalings certify least (:func:`ambseal.robust.dgk._dg_step_scalings`), and the
   best round is kept where its peak of σ̄(S) is within 1 % of 1: least squares, which the
   machine's rounding moves by about its own size;
-* else the first round's fits (uniform weights) are refined to minimise ``max_ω σ̄(S)``
+* else the best round's fits are refined to minimise ``max_ω σ̄(S)``
   directly (:func:`refine_scalings`: SLSQP on the epigraph with analytic gradients, whose
   end point follows the rounding; on a grid three times denser than μ's and half a
   decade wider; the H∞ norm of the scaled closed loop,

@@ -228,11 +228,11 @@ def _dg_step_scalings(P, K, nmeas, ncon, mu_s, real, beta, w, fit_tol):
         level, _ = hinfnorm(lft_lower(scaled_plant_dg(P, mu_s.blocks, fits, beta, nmeas,
                                                       ncon), K, nmeas, ncon), rtol=1e-6)
         return fits, jg_err, float(level)
-    # the minimax starts from the best round, nearest its end: from the first round's
-    # (uniform weights, a level 1.78 on the overhung compressor's second step) it ended
-    # at 1.047 under SkylakeX kernels and 1.273 under Haswell, from the best round at
-    # 1.043 and 1.009, both of whose K-steps meet μ ≤ 1 (benchmarks/README.md, "The
-    # minimax from the best reweighted round")
+    # the minimax starts from the best round, the nearest to its end: from the first
+    # round's fits (uniform weights) the overhung compressor's second D–G–K step ended at
+    # 1.047 under SkylakeX kernels and 1.273 under Haswell, μ met on one only; from the
+    # best round at 1.043 and 1.009, μ met on both (benchmarks/README.md, "The minimax
+    # from the best reweighted round")
     fits, level = refine_scalings(sc, P, K, mu_s.blocks, nmeas, ncon, w)
     return fits, jg_err, level
 

@@ -46,6 +46,7 @@ import pytest  # noqa: E402  (after the thread variables)
 ROOT = Path(__file__).resolve().parents[1]
 TURBO = ROOT / "examples" / "turboexpander.toml"
 
+
 def pytest_collection_modifyitems(config, items):
     """Under pytest-xdist, the tests marked ``heavy`` first. ``--dist loadgroup`` hands
     out the groups largest first, then the single tests in collection order, so a test

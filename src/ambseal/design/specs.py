@@ -48,11 +48,11 @@ the value the thesis used on its test facility, P5, where it names one):
   benchmarks/README.md, "Where the design defaults come from"). The orbit demand 0.5 D_e (test rig
   10 µm: the demand adds its force channel to the design, the thesis's 8 µm is met with
   margin, 4.6 µm); W_f rolls off at 1.3× the top of the unbalance band, at most f_b/2
-  (test rig: 1.3 × 200 Hz = 260 Hz, below 557/2 Hz). H∞ has no orbit demand unless
-  ``[design.hinf] orbit_um`` is set, or it is scheduled on the spin speed
-  (:func:`ambseal.design.recipes.design`, which then demands μ's), and the same W_f roll-off
-  for it. The other weights are the method's
-  tuning on the scaled plant (:func:`ambseal.design.weights.default_weights`).
+  (both from the rig and its model). The other weights are the method's
+  tuning on the scaled plant (:func:`ambseal.design.weights.default_weights`). H∞ has no
+  orbit demand unless ``[design.hinf] orbit_um`` is set, or it is scheduled on the spin
+  speed (:func:`ambseal.design.recipes.design`, which then demands μ's); its W_f roll-off
+  follows the same rule.
 * **LPV weights** (P3 Eq. 11, §3.3): the same D_e and D_u; W_u a high-pass whose
   low-frequency gain is D_u/(2.5 D_e Kp (1 + 1/ε)) (μ's form, above, before W_K made μ's
   3×: the LPV designs have no W_K) and which rises tenfold above its corner

@@ -146,14 +146,15 @@ def test_a_rotor_plants_inputs_share_one_eigendecomposition(monkeypatch):
     assert calls == [n]
 
 
-def test_one_or_two_points_of_a_large_model_are_solved_densely(monkeypatch):
-    """From ``STRUCTURED_STATES`` states one or two points are the probes every fast form
-    is checked against: answered by dense solves alone, with no eigendecomposition or
-    Hessenberg reduction of the model, and as the solves refined in extended precision
-    (to 1e-12 of the peak)."""
+@pytest.mark.parametrize("n", [40, fr.STRUCTURED_STATES])
+def test_one_or_two_points_are_solved_densely(monkeypatch, n):
+    """One or two points are the probes every fast form is checked against: answered by
+    dense solves alone, with no eigendecomposition or Hessenberg reduction of the model,
+    and as the solves refined in extended precision (to 1e-12 of the peak). A small model
+    too: a scheduled controller is a new model at every speed it is evaluated at."""
     import scipy.linalg
 
-    A, B, C, D, wn = _lightly_damped(n=fr.STRUCTURED_STATES, seed=7)
+    A, B, C, D, wn = _lightly_damped(n=n, seed=7)
     calls = []
     for name in ("eig", "hessenberg"):
         real = getattr(scipy.linalg, name)
@@ -168,16 +169,17 @@ def test_one_or_two_points_of_a_large_model_are_solved_densely(monkeypatch):
     assert calls == []
 
 
-def test_one_or_two_points_of_a_large_sampled_plant_are_solved_densely(monkeypatch):
-    """From ``STRUCTURED_STATES`` states the sampled plant's response at one or two
-    frequencies, which are their own probes, comes from dense solves of the plant sampled
-    by python-control's zero-order hold (``control.c2d``), to 1e-9 of the peak, with no
-    eigendecomposition of the plant: at one table speed of the unbalance rejection an
-    ``expm`` costs less than a modal form and its certification. With its inputs in
-    groups (control inputs and forces) the answer is the same."""
+@pytest.mark.parametrize("n", [40, fr.STRUCTURED_STATES])
+def test_one_or_two_points_of_a_sampled_plant_are_solved_densely(monkeypatch, n):
+    """The sampled plant's response at one or two frequencies, which are their own probes,
+    comes from dense solves of the plant sampled by python-control's zero-order hold
+    (``control.c2d``), to 1e-9 of the peak, with no eigendecomposition of the plant: at
+    one table speed of the unbalance rejection an ``expm`` costs less than a modal form
+    and its certification, on a small plant as on a large one. With its inputs in groups
+    (control inputs and forces) the answer is the same."""
     import scipy.linalg
 
-    A, B, C, D, wn = _lightly_damped(n=fr.STRUCTURED_STATES, seed=5)
+    A, B, C, D, wn = _lightly_damped(n=n, seed=5)
     dt = 1e-4
     Pd = control.c2d(control.ss(A, B, C, D), dt, "zoh")
     calls = []

@@ -128,9 +128,9 @@ def freqresp(
         ``"auto"`` uses the modal form when it is well conditioned and agrees with the
         Hessenberg form at three probe frequencies; where they disagree, the one that agrees
         with dense solves at the probes, or dense solves everywhere if neither does; else the
-        Hessenberg form. From ``STRUCTURED_STATES`` states, one or two frequencies are
-        their own probes and are solved densely. ``"modal"`` forces the modal form (raises if
-        ``A`` is numerically defective), ``"hessenberg"`` forces the Hessenberg form.
+        Hessenberg form. One or two frequencies are their own probes and are solved
+        densely. ``"modal"`` forces the modal form (raises if ``A`` is numerically
+        defective), ``"hessenberg"`` forces the Hessenberg form.
     max_cond : float
         Largest accepted condition number of the eigenvector matrix ``V`` (the 2-norm one;
         above 1 000 states LAPACK's estimate of the 1-norm one, which costs no SVD).
@@ -221,12 +221,12 @@ def sampled_response_at(sys: Any, dt: float, omega: Any, *, groups: Any = None,
     ``G_d(z) = C V diag(φ(λ)/(z − e^{λ dt})) V⁻¹ B + D`` (Franklin, Powell & Workman,
     *Digital Control of Dynamic Systems*, 3rd ed., §6.3): the modal form of the continuous
     plant (kept for its other responses) serves the sampled one too, with no
-    eigendecomposition of ``A_d``. From ``STRUCTURED_STATES`` states that form is
-    :func:`sampled_modal_form`'s, certified on the continuous plant (no ``expm``), but at
-    one or two frequencies, which are their own probes: there the dense solves of
-    ``(zI − A_d) X = B_d`` are the answer (one ``expm``, 0.3 s at 840 states, against an
-    eigendecomposition and its certification, 0.6–0.8 s). Else, or
-    where that is not certified, the form — the balanced one first above
+    eigendecomposition of ``A_d``. At one or two frequencies, which are their own probes,
+    the dense solves of ``(zI − A_d) X = B_d`` are the answer (one ``expm``, 0.3 s at 840
+    states, against an eigendecomposition and its certification, 0.6–0.8 s). Elsewhere,
+    from ``STRUCTURED_STATES`` states, that form is :func:`sampled_modal_form`'s,
+    certified on the continuous plant (no ``expm``). Else, or where that is not
+    certified, the form — the balanced one first above
     ``_SVD_COND_STATES`` states, as :func:`freqresp` — is taken where it is within ``rtol``
     of dense solves of ``(zI − A_d) X = B_d`` at three probe frequencies; else
     :func:`freqresp_at` of ``(A_d, B_d, C, D)``.
@@ -269,10 +269,10 @@ def sampled_response_at(sys: Any, dt: float, omega: Any, *, groups: Any = None,
     if sorted(j for g in groups for j in g) != list(range(B.shape[1])):
         raise ModelError(f"sampled_response_at: groups {groups} are not a partition of the "
                          f"{B.shape[1]} inputs")
-    if A.shape[0] >= STRUCTURED_STATES and w.size < 3:
+    if w.size < 3:
         # one or two points are their own probes (as in freqresp_at): dense solves of the
-        # plant sampled by one expm, the reference a sampled form is certified against
-        # below STRUCTURED_STATES, cost less than the eigendecomposition of the form
+        # plant sampled by one expm, the reference every sampled form is certified
+        # against, cost less than the eigendecomposition of the form
         Ad, Bd = zoh(A, B, dt)
         return _probe_response(Ad, Bd, C, D, z)
     if len(groups) > 1:
@@ -382,10 +382,12 @@ def _response(A, B, C, D, s, method, max_cond, rtol) -> np.ndarray:
         return np.broadcast_to(D.astype(complex), (s.size, *D.shape)).copy()
     if method == "hessenberg":
         return _hessenberg_response(A, B, C, D, s)
-    if method == "auto" and s.size < 3 and n >= STRUCTURED_STATES:
+    if method == "auto" and s.size < 3:
         # one or two points are their own probes (:func:`_probes`): the dense solves every
         # fast form is checked against there are the answer, without the eigendecomposition
-        # of a large model for a point (0.4–1 s at 840 states against 0.03 s a point)
+        # of the model for a point (0.4–1 s at 840 states against 0.03 s a point), nor the
+        # Hessenberg form each check takes (a controller scheduled on a parameter is a
+        # new model at each of the ~200 values it is evaluated at, kept by no memo)
         return _probe_response(A, B, C, D, s)
     if method == "auto" and n > _SVD_COND_STATES:
         H = _balanced_modal_checked(A, B, C, D, s, max_cond, rtol)  # large: balanced first

@@ -483,10 +483,8 @@ def _probes(s: np.ndarray) -> np.ndarray:
     one between. On the imaginary axis (``jω``) or the unit circle (``e^{jωT}``) the one
     between is at the geometric mean of the ends' frequencies, on the grid or not, so that
     grids with the same ends (one plant's responses on grids refined around different
-    loops' poles) share their probes (:data:`_PROBED`); elsewhere the middle point."""
-    ends = s[np.unique([0, s.size - 1])]
-    if s.size < 3:
-        return ends
+    loops' poles) share their probes (:data:`_PROBED`); elsewhere the middle point. At
+    least three points: one or two are their own probes and are solved as such."""
     a, b = s[0], s[-1]
     with np.errstate(all="ignore"):
         if np.all(s.real == 0) and a.imag > 0 and b.imag > 0:

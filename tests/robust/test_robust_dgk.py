@@ -317,7 +317,6 @@ def test_the_refinement_ends_by_slsqps_tolerance_or_a_rounds_stall_not_its_count
     assert abs(level - whole) <= dg._ROUND_RTOL * whole
 
 
-@pytest.mark.heavy
 def _refinement_start(points, tol=0.05):
     """The spring–mass loop of an H∞ controller on μ's grid of ``points`` and the D–G
     step's fits at uniform weights to ``tol``, where the refinement starts: (P, K, w,
@@ -338,6 +337,7 @@ def _refinement_start(points, tol=0.05):
     return P, K, w, mu_s, sc
 
 
+@pytest.mark.heavy
 def test_the_pass_at_the_largest_orders_is_kept_only_where_it_gains(monkeypatch):
     """The refinement's pass at the largest orders (run where the fitted orders leave the
     level above 1 + ``_RETRY``) is delivered only where it lowers the first pass's level
@@ -367,6 +367,7 @@ def test_the_pass_at_the_largest_orders_is_kept_only_where_it_gains(monkeypatch)
         assert states == (passes[-1] if second else passes[0]), (states, passes)
 
 
+@pytest.mark.heavy
 def test_the_cutting_planes_end_when_the_bound_is_tight_or_stalls_not_after_a_count(
         monkeypatch):
     """On μ's grids of 27 and 35 points the spring–mass loop of an H∞ controller puts the
@@ -378,9 +379,9 @@ def test_the_cutting_planes_end_when_the_bound_is_tight_or_stalls_not_after_a_co
     within ``_CUT_RTOL`` of the grid's peak or where ``_CUT_PATIENCE`` cuts in a row have
     not lowered the pass's best level by ``_CUT_RTOL``, and the refinement delivers the
     first pass's best level, or the second's where it is lower beyond the norm's accuracy.
-    Three cuts a pass, keeping each pass's last, broke both: on 27 points under two threads it
-    delivered 1.18 where a cut had reached 1.12, under one 3.25 where one had reached
-    1.18."""
+    Three cuts a pass, keeping each pass's last, broke both: on 27 points under two
+    threads it delivered 1.18 where a cut had reached 1.12, under one 3.25 where one had
+    reached 1.18."""
     minimax, hinfnorm, counts = dg._minimax, dg.hinfnorm, []
     for points in (27, 35):
         P, K, w, mu_s, sc = _refinement_start(points)
